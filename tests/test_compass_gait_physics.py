@@ -6,13 +6,13 @@ from scipy.integrate import solve_ivp
 
 from walkerlab.codegen.symbolic import derive
 from walkerlab.models.hybrid.printed_equations import (
-    compass_gait_structure,
     energies,
     flow,
     impact,
     make_compass_gait,
     swing_foot_height,
 )
+from walkerlab.walker.description import compass_gait_structure
 
 P = (5.0, 10.0, 1.0, 0.5, 9.81)  # m, M_H, L, a, g (Table 1)
 PHI = 0.0174

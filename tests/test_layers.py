@@ -13,7 +13,8 @@ also those inside functions), never by running it: dependencies point down.
 - the middle floor: ``analysis/`` never imports ``studies/``, ``bench/``, ``export/`` or
   ``comparison/``;
   ``models/``, ``integrate/``, ``codegen/`` and ``walker/`` never import ``analysis/``;
-  ``config/`` never imports ``io/`` (a scene opens no artifact);
+  ``config/`` never imports ``io/`` (a scene opens no artifact); ``models/contact/`` never
+  imports ``models/hybrid/`` (the contact view is generated from the description alone);
 - no name private to a module (``_name``) is imported by another package, and no private
   module is imported from outside its package;
 - no import circle among walkerlab's modules (imports inside functions count: a circle
@@ -170,6 +171,9 @@ MIDDLE_FLOOR_RULES = [
                      "walkerlab.comparison")),
     (("models", "integrate", "codegen", "walker"), ("walkerlab.analysis",)),
     (("config",), ("walkerlab.io",)),
+    # the contact view is generated from the description alone: the facts both views read
+    # (joints, the ground's landings, the torque laws) lie below both
+    (("models/contact",), ("walkerlab.models.hybrid",)),
 ]
 
 
@@ -182,6 +186,9 @@ def test_the_middle_floor_rules_catch_a_violation(tmp_path):
     bad = tmp_path / "x.py"
     bad.write_text("def f():\n    from walkerlab.studies.mfpt import run\n")
     assert _floor_violations([bad], MIDDLE_FLOOR_RULES[0][1])
+    up = tmp_path / "y.py"  # a module of the contact view reaching the rigid one
+    up.write_text("def f():\n    from walkerlab.models.hybrid.actuators import joint_links\n")
+    assert _floor_violations([up], dict(MIDDLE_FLOOR_RULES)[("models/contact",)])
 
 
 def test_the_middle_floor_points_down():

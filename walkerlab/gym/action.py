@@ -129,9 +129,7 @@ def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 
     st = data.structure
-    if st.foot == "flat":
-        raise ValueError("walkerlab.gym: flat feet are not carried yet (each stance-foot mode "
-                         "has its own mass matrix); use point or arc feet")
+    st.kind.require("walk", "gym", "walkerlab.gym")  # flat feet, a wheel: the table's
     if st.bodies and all(b.massless for b in st.bodies):
         raise ValueError("walkerlab.gym: the legs are massless (Kuo's simplest walker): a "
                          "joint torque has no inertia to act on; give the legs mass")

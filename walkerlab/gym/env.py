@@ -93,7 +93,7 @@ def _check_rigid_ground(scene) -> None:
     footholds of several heights or slopes, per-step random ground) is refused in one line
     (``walkerlab simulate`` walks them step by step; the contact view has the ground as
     geometry)."""
-    from walkerlab.models.hybrid.ground import foothold_steps
+    from walkerlab.models.ground import foothold_steps
 
     t = scene.terrain
     if t is None:
@@ -204,8 +204,8 @@ class WalkerEnv(gym.Env):
                              f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
         self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
         sc = self.rigid.scene
-        if sc.walker.model == "rimless_wheel":
-            raise ValueError("walkerlab.gym: the rimless wheel has no joint to drive")
+        data = walker_data(sc.walker, sc.slope.phi_rad)
+        data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
         if view == "rigid":
             _check_rigid_ground(sc)
         self.scene, self.view = sc, view
@@ -219,7 +219,6 @@ class WalkerEnv(gym.Env):
         self.start_noise = float(start_noise)
         self.terrain_roughness_m = float(terrain_roughness_m)
         model = self.rigid.model
-        data = walker_data(sc.walker, sc.slope.phi_rad)
         self.joints = action_joints(sc)
         self.gait = _gait(self.rigid)
         self.sim = RigidView(model, self.rigid.solver, data, self.joints,

@@ -17,7 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TorqueLaws", "phase_reference", "push_off_impulse", "saturate"]
+from walkerlab.walker.joints import joint_angles, joint_columns, joint_links, link_angles
+
+__all__ = ["JointMap", "TorqueLaws", "phase_reference", "push_off_impulse", "saturate",
+           "shared_phase_table"]
 
 
 def phase_reference(table):
@@ -54,6 +57,41 @@ def phase_reference(table):
         return slope[k] * ((r > s[0]) & (r < s[-1]))
 
     return lin, dlin
+
+
+def shared_phase_table(torques):
+    """The references ``[(h_i, dh_i)]`` of laws that all track cubic phase tables on the
+    same abscissa, from ONE vector-valued spline (the same not-a-knot
+    :class:`scipy.interpolate.CubicSpline` per column as
+    :func:`phase_reference`, held at its end values outside,
+    complex-step aware), evaluated once per phase value; None when the laws differ."""
+    tabs = [t.law.reference for t in torques]
+    if (not tabs or any(r is None or r.interpolation != "cubic" or len(r.phase_rad) < 3
+                        or r.phase_rad != tabs[0].phase_rad for r in tabs)):
+        return None
+    from scipy.interpolate import CubicSpline
+
+    s = np.asarray(tabs[0].phase_rad, float)
+    cs = CubicSpline(s, np.array([r.values_rad for r in tabs], float).T, bc_type="not-a-knot",
+                     extrapolate=False)
+    d1, d2 = cs.derivative(), cs.derivative(2)
+    memo: dict = {}
+
+    def at(u):  # (h (k,), dh (k,)) at the phase u
+        key = (bool(np.iscomplexobj(u)), complex(u))  # a real call never reads a complex
+        if key not in memo:
+            memo.clear()
+            r = min(max(float(np.real(u)), s[0]), s[-1])
+            inside = float(s[0] < np.real(u) < s[-1])
+            h, dh = cs(r), d1(r) * inside
+            if np.iscomplexobj(u):
+                h = h + 1j * np.imag(u) * dh
+                dh = dh + 1j * np.imag(u) * d2(r) * inside
+            memo[key] = (h, dh)
+        return memo[key]
+
+    return [((lambda u, i=i: at(u)[0][i]), (lambda u, i=i: at(u)[1][i]))
+            for i in range(len(tabs))]
 
 
 def _table_coefficients(table) -> tuple[np.ndarray, np.ndarray]:
@@ -170,3 +208,50 @@ def push_off_impulse(push_off, hip_speed):
     p = push_off.impulse_n_s + push_off.speed_gain_n_s2_per_m * (
         push_off.reference_speed_m_per_s - hip_speed)
     return np.where(np.real(p) > 0.0, p, 0.0 * p)
+
+
+class JointMap:
+    """The joint torques of a walker whose every coordinate is a link's absolute angle (a
+    free-jointed biped), in the rigid view's role order: each joint's links
+    (:func:`walkerlab.walker.joints.joint_links`), its column of ``B``
+    (:func:`walkerlab.walker.joints.joint_columns`) and the laws (one spline for laws
+    sharing a phase table, :func:`shared_phase_table`) - what both views evaluate.
+
+    Parameters
+    ----------
+    spec : walkerlab.config.actuation.Actuation
+    leg_angles : callable
+        The walker's generated ``leg_angles`` (``x (2n,) -> {<link>_angle, <link>_rate}``).
+    n : int
+        Number of generalised coordinates (role order).
+
+    Raises
+    ------
+    ValueError
+        A joint the walker does not have (naming the joints it has) or a torque per foot
+        mass (one line, naming the field).
+    """
+
+    def __init__(self, spec, leg_angles, n: int):
+        for i, t in enumerate(spec.torques):
+            if t.scaled_by != "none":
+                raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
+                                 "walkers whose legs are massless")
+        self.spec = spec
+        self._angles = lambda x: link_angles(leg_angles(x))
+        z = np.zeros(n)
+        names = self._angles(np.concatenate([z, z]))
+        self.links = [joint_links(names, t.joint, f"walker.actuation.torques.{i}.joint")
+                      for i, t in enumerate(spec.torques)]
+        #: (n, k) each joint's generalised-force column
+        self.B = joint_columns(self._angles, n, self.links)
+        self.laws = TorqueLaws(spec.torques)
+        shared = shared_phase_table(spec.torques)
+        if shared is not None:  # one spline for every law's reference: 2 calls, not 2k
+            self.laws.refs = shared
+
+    def joint_angles(self, x):
+        """``(deltas, ddeltas, s, ds)`` at the role state ``x`` (2n,): each joint's angle
+        [rad] and rate [rad/s], the phase variable (the virtual stance leg's angle) [rad] and
+        its rate [rad/s] (:func:`walkerlab.walker.joints.joint_angles`)."""
+        return joint_angles(self._angles(x), self.links, "stance")

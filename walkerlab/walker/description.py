@@ -295,6 +295,12 @@ def _spring_roles(between, stance_leg: str) -> tuple[tuple[str, str], float]:
     return (b, a), -1.0
 
 
+def compass_gait_structure() -> Structure:
+    """The compass gait (paper A.1-A.3) as a generic biped structure: a hip point mass and one
+    point mass per leg (:class:`Structure`)."""
+    return Structure("absolute", (BodySpec("mass", "point_mass"),))
+
+
 def _spoked_data(w, slope_rad: float) -> WalkerData:
     """Structure and parameters (:data:`SPOKED_PARAMS`) of a ``model: rimless_wheel``
     section: a point-mass hub unless ``hub_inertia_kg_m2`` is given."""

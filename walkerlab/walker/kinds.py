@@ -175,7 +175,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                            "toe contacts; --format mjcf carries flat feet"),
         ("ankle_push_off", "osim"): ("the OpenSim export has no flat feet; --format mjcf "
                                      "carries them"),
-        ("walk", "gym"): f"not carried yet ({_FLAT_MODES}); use point or arc feet",
+        ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
                                  "point and arc feet (a flat foot's modes have no per-step "
                                  "landing yet)"),
@@ -198,7 +198,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                             "(one rigid body) is exported as mjcf or urdf"),
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as mjcf or urdf"),
-        ("walk", "gym"): _NO_JOINT,
+        ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
         **{(f, "mjcf"): ("a spoked wheel's MJCF carries the slope's plane only; "

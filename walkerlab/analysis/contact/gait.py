@@ -790,15 +790,25 @@ def scuff_cause(walker) -> str:
     -------
     str
     """
-    st = walker.data.structure
-    if st.knee and not st.free_knees:
-        if walker.knee_stop is not None and not walker.knee_stop.latch:
-            return ("(the stance knee is not latched: it flexes under the load and the hip "
-                    "sinks; contact.knee_stop.latch: true holds it as the rigid model's "
-                    "knee lock does)")
-        return ""
-    if st.knee or st.foot == "flat" or st.spokes:
-        return ""
+    return _SCUFF_CAUSES.get(walker.data.structure.kind.name, _no_cause)(walker)
+
+
+def _no_cause(walker) -> str:
+    """Flat feet, free knees, a wheel: nothing general to name."""
+    return ""
+
+
+def _unlatched_knee(walker) -> str:
+    """A kneed walker's scuff: its stance knee not latched."""
+    if walker.knee_stop is not None and not walker.knee_stop.latch:
+        return ("(the stance knee is not latched: it flexes under the load and the hip "
+                "sinks; contact.knee_stop.latch: true holds it as the rigid model's "
+                "knee lock does)")
+    return ""
+
+
+def _straight_leg_scuff(walker) -> str:
+    """Straight legs: the swing foot below the ground line near mid-stance."""
     straight = "a straight leg's swing foot passes below the ground line near mid-stance"
     if getattr(walker, "ground_line", None) is not None:  # a profile: continuous only
         return (f"({straight}; a profile is continuous ground, where straight legs scuff: "
@@ -806,6 +816,11 @@ def scuff_cause(walker) -> str:
     if walker.continuous:
         return f"({straight}; terrain.lanes: checkerboard gives it a gap there)"
     return f"({straight})"
+
+
+#: kind name -> the likely cause of its swing foot's scuffs (:func:`scuff_cause`; a kind
+#: not listed has none to name)
+_SCUFF_CAUSES = {"straight_legs": _straight_leg_scuff, "locking_knees": _unlatched_knee}
 
 
 def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,

@@ -118,6 +118,10 @@ FELL_ADVICE = ("the contact gait, if there is one, is far from the rigid gait th
 #: a step of the map that fell
 FELL = f"step map: the walker fell (hip below L/2): {FELL_ADVICE}"
 
+#: the kinds whose swing leg is flexed at mid-stance (knees): a continuous ground is kept
+#: for them (module docstring), the straight-legged kinds' lanes follow the footfalls
+_FLEXED_SWING = frozenset({"locking_knees", "free_joints"})
+
 #: the step map's default integrator (LSODA with the analytic Jacobian)
 DEFAULT_SOLVER = Solver("LSODA", 1e-11, 1e-13)
 
@@ -195,7 +199,7 @@ class StepMap:
         self.spacing = float(patch_spacing)
         # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
         # a kneed swing leg is flexed there, so its continuous ground is kept
-        keep_ground = walker.continuous and walker.structure.knee
+        keep_ground = walker.continuous and walker.structure.kind.name in _FLEXED_SWING
         # each patch centred on its foot's footprint (a flat foot's lies ahead of its heel)
         o2 = footprint_offsets(walker.data)[1]
         #: height [m] of the swing lane's patch above the stance patch (stairs, footholds)

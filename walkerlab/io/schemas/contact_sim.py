@@ -305,9 +305,8 @@ def _write_work(f, run: ContactSimRun) -> None:
                        "dissipation and the energy their springs hold",
             "knee_stop": "work of the knee stops (a kneed walker): their dissipation and "
                          "the energy their springs hold"}
-    if run.walker.structure.free_knees:  # a five-link biped: every joint torque's work
-        what.update(hip_torque_positive="positive work of the joint torques (hips and knees)",
-                    hip_torque_negative="negative work of the joint torques (hips and knees)")
+    # the actuators' own words (a five-link biped's hip-torque terms carry every joint's)
+    what.update(run.walker.actuators.work_labels)
     # the samples' times as the ledger's own coordinate (without it the dimension was a
     # bare scale of zeros)
     coordinate(f.require_group("ledger"), "time", np.asarray(run.result.t, float), "s",

@@ -216,6 +216,8 @@ class ContactActuators(PushOffPulse, ContactRows):
         leg{i}_shank_angle`` in place of ``leg{i}_angle``).
     pulse_s : float
         Push-off pulse duration [s] (0: an impulse).
+    kind : walkerlab.walker.kinds.Kind
+        The walker's kind (its refusals: :data:`walkerlab.walker.kinds.CAPABILITIES`).
     torso : bool
         The walker has a torso bisecting the legs (its angle the mean of the legs', of the
         thighs' on knees: the rigid view's).
@@ -232,8 +234,12 @@ class ContactActuators(PushOffPulse, ContactRows):
     #: near mid-stance is not one; the contact gait analysis' ``min_step_m`` default).
     min_step_m = 0.05
 
-    def __init__(self, spec, coordinates, pulse_s: float, torso: bool = False):
-        from walkerlab.models.hybrid.actuators import joint_links
+    #: the ledger's words for this walker's work terms where they differ from the generic
+    #: ones (:mod:`walkerlab.io.schemas.contact_sim`): none
+    work_labels: dict = {}
+
+    def __init__(self, spec, coordinates, pulse_s: float, kind, torso: bool = False):
+        from walkerlab.walker.joints import joint_links
 
         names = tuple(coordinates)
         #: a kneed walker: the hip torque acts on the thighs (module docstring)
@@ -246,8 +252,8 @@ class ContactActuators(PushOffPulse, ContactRows):
                              "free-jointed biped has its own)")
         flat = "leg1_foot_angle" in names
         ankle = getattr(spec, "ankle_push_off", None)
-        if ankle is not None and not flat:
-            raise ValueError("walker.actuation.ankle_push_off: flat feet only")
+        if ankle is not None:  # the table's: a flat foot's ankle only
+            kind.require("ankle_push_off", "contact", "walker.actuation.ankle_push_off")
         for i, t in enumerate(spec.torques):
             if t.scaled_by != "none":
                 raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "

@@ -9,7 +9,8 @@ position), so a floating state with leg ``stance`` in stance is a rigid state in
 (:data:`walkerlab.walker.description.FREE_KNEE_ROLES` + ``torso``): ``stance_shank`` is
 ``leg{stance}_shank_angle``, ``swing_thigh`` the other leg's thigh, ``torso`` the torso's
 angle, and so on.  The torques are those of the rigid view's
-:class:`~walkerlab.models.hybrid.free_joint_actuators.FiveLinkActuators` at that role state:
+:class:`~walkerlab.models.actuation.JointMap` at that role state (the joints, ``B`` and
+laws the rigid view's actuators evaluate):
 
 - each joint's angle ``delta = q[second] - q[first]`` and its rate
   (:data:`walkerlab.config.actuation.FIVE_LINK_JOINTS`; ``stance_hip`` = stance thigh minus
@@ -41,6 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.models.actuation import JointMap
 from walkerlab.models.contact.actuation import WORK_NAMES, ContactRows, PushOffPulse
 
 __all__ = ["JointTorqueActuators"]
@@ -67,8 +69,8 @@ class JointTorqueActuators(PushOffPulse, ContactRows):
     Raises
     ------
     ValueError
-        A joint the walker lacks (one line, naming the field; the rigid view's
-        :func:`~walkerlab.models.hybrid.free_joint_actuators.five_link_actuators`).
+        A joint the walker lacks or a torque per foot mass (one line, naming the field;
+        :class:`walkerlab.models.actuation.JointMap`, as in the rigid view).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (as
@@ -83,13 +85,18 @@ class JointTorqueActuators(PushOffPulse, ContactRows):
     #: The work integrals a run carries (:data:`~walkerlab.models.contact.actuation.WORK_NAMES`:
     #: the hip-torque names carry every joint torque's work).
     work_names = WORK_NAMES
+    #: ... named for what they are in the ledger (:mod:`walkerlab.io.schemas.contact_sim`)
+    work_labels = {"hip_torque_positive": "positive work of the joint torques (hips and knees)",
+                   "hip_torque_negative": "negative work of the joint torques (hips and knees)"}
 
     def __init__(self, data, spec, coordinates, pulse_s: float = 0.0):
-        from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
+        from walkerlab.codegen.cache import functions
 
         self.spec = spec
         roles = tuple(data.structure.roles)
-        self.rigid = five_link_actuators(data, spec, roles, push_off=True)
+        #: the joints, their ``B`` and laws in the rigid view's role order (what the rigid
+        #: view's actuators evaluate, :class:`walkerlab.models.actuation.JointMap`)
+        self.joints = JointMap(spec, functions(data)["leg_angles"], len(roles))
         names = tuple(coordinates)
         self.nq = len(names)
         self.pulse_s = float(pulse_s)
@@ -104,6 +111,11 @@ class JointTorqueActuators(PushOffPulse, ContactRows):
                 else names.index(f"{leg[r.split('_')[0]]}_{r.split('_')[1]}_angle")
                 for r in roles]))
 
+    @property
+    def rigid(self) -> JointMap:
+        """:attr:`joints` (the name its users know: the rigid view's joint torques)."""
+        return self.joints
+
     def role_state(self, x, stance: int) -> np.ndarray:
         """The rigid view's role state (2 n,) [rad, rad/s] of the floating state ``x``
         (2 nq,) with leg ``stance`` (0: leg1, 1: leg2) in stance."""
@@ -114,14 +126,14 @@ class JointTorqueActuators(PushOffPulse, ContactRows):
         """Each actuator's torque (k,) [N m] (``walker.actuation.torques`` order); ``t_step``
         the time since the step's heel strike [s]."""
         xr = self.role_state(np.asarray(x, float), stance)
-        return self.rigid.laws.each(*self.rigid.joint_angles(xr), t_step)
+        return self.joints.laws.each(*self.joints.joint_angles(xr), t_step)
 
     def hip_torque(self, x, stance: int, t_step: float = 0.0) -> tuple[np.ndarray, float]:
         """Generalised force of the joint torques (nq,) [N, N m] and their power [W] (the
         name is :class:`ContactActuators`'; here every joint: hips and knees)."""
         x = np.asarray(x, float)
         tau = self.torques(x, stance, t_step)
-        Qr = self.rigid.B @ tau
+        Qr = self.joints.B @ tau
         Q = np.zeros(self.nq)
         Q[self.index[stance]] = Qr
         i = self.index[stance]

@@ -50,6 +50,7 @@ import numpy as np
 from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainSettings
 
 from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
+from .parts import contact_part
 
 __all__ = ["FOOT_NAMES", "FOOT_RATE_ATOL_FACTOR", "ContactWalker", "STATE_OF_COORDINATE",
            "checkerboard_lanes", "compass_gait_data", "flat_foot_numbers", "footprint_offsets",
@@ -103,15 +104,10 @@ def flat_foot_numbers(data) -> list[dict]:
     -------
     list of dict
         Two dicts (leg1, leg2) with float values ``heel`` [m], ``toe`` [m], ``r`` [rad]; an
-        empty list unless ``data.structure.foot == "flat"``.
+        empty list unless the walker's kind is flat feet (its contact part's
+        :meth:`~walkerlab.models.contact.parts.ContactPart.flat_feet`).
     """
-    st = data.structure
-    if st.foot != "flat":
-        return []
-    P = dict(zip(st.param_names, data.params))
-    tags = ("sw_", "st_") if st.asymmetric else ("", "")
-    return [{"heel": P[f"heel_{t}m"], "toe": P[f"toe_{t}m"], "r": P[f"r_{t}ankle"]}
-            for t in tags]
+    return contact_part(data.structure).flat_feet(data)
 
 
 def footprint_offsets(data) -> tuple[float, float]:
@@ -143,8 +139,7 @@ def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
     """:class:`~walkerlab.walker.description.WalkerData` of the paper's compass gait (Table 1):
     leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
-    from walkerlab.models.hybrid.printed_equations import compass_gait_structure
-    from walkerlab.walker.description import WalkerData
+    from walkerlab.walker.description import WalkerData, compass_gait_structure
 
     st = compass_gait_structure()
     vals = {"g": g, "L": L, "gamma": phi, "M_hip": MH, "m_mass": m, "d_mass": L - a}
@@ -385,7 +380,8 @@ class ContactWalker:
         """``compass_gait_contact`` for two straight point-footed legs alike with their
         bodies on the axis and nothing else (the paper's family), else ``biped_contact``."""
         st = self.structure
-        extra = (st.knee or st.torso or st.springs or st.asymmetric or st.foot != "point"
+        extra = (not contact_part(st).plain or st.torso or st.springs or st.asymmetric
+                 or st.foot != "point"
                  or any(b.off_axis for b in st.bodies))
         return "biped_contact" if extra else "compass_gait_contact"
 
@@ -607,29 +603,8 @@ class ContactWalker:
         ndarray, shape (2 nq - 4,)
             The pinned state z (:meth:`pinned_state`), [rad] and [rad/s].
         """
-        from walkerlab.walker.layout import floating_links_from_rigid
-
-        x = np.asarray(x_ideal, float)
-        st = self.structure
-        if st.spokes:  # spoke 0 is the stance spoke: [wheel angle, its rate (stance scale)]
-            return np.array([x[0], x[1] * rate_scale[1]])
-        if st.coordinates == "absolute" or st.knee:
-            values = self.rigid_layout().named(x)  # the rigid state, by name
-            if st.foot == "flat":
-                # the feet's absolute angles: the swing foot at its spring's rest, turning
-                # with its leg (massless in the rigid view); the stance foot's sole at stance
-                # + ankle (the rigid view's ankle angle and rate)
-                r1 = flat_foot_numbers(self.data)[0]["r"]
-                values["swing_foot_angle"] = values["swing_angle"] + r1
-                values["swing_foot_rate"] = values["swing_rate"]
-                values["stance_foot_angle"] = (values["stance_angle"]
-                                               + values["stance_ankle_angle"])
-                values["stance_foot_rate"] = values["stance_rate"] + values["stance_ankle_rate"]
-        else:
-            from walkerlab.codegen.cache import functions
-
-            values = functions(self.data)["leg_angles"](x)
-        return floating_links_from_rigid(values, self.layout(), rate_scale)
+        return contact_part(self.structure).link_state(self, np.asarray(x_ideal, float),
+                                                       rate_scale)
 
     # ------------------------------------------------------------------ post-processing
     def _rows(self, X) -> np.ndarray:
@@ -678,7 +653,7 @@ class ContactWalker:
         or (2, 2) for one: the foot point, an arc's lowest point, a flat foot's heel."""
         X = self._rows(X)
         pts = self.kernels.points(X.T, self.walker_params)
-        key = {"arc": "contact", "flat": "heel"}.get(self.structure.foot, "foot")
+        key = contact_part(self.structure).foot_point(self.structure)
         out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
                         for leg in FOOT_NAMES], axis=1)
         return out if len(out) > 1 else out[0]
@@ -740,7 +715,7 @@ class ContactWalker:
             ``{"leg1": {...}, "leg2": {...}}``, arrays (n,) as :meth:`contact_quantities`.
         """
         cq = self.contact_quantities(X)
-        if self._contacts == FOOT_NAMES or self.structure.spokes:  # a wheel: per spoke
+        if self._contacts == FOOT_NAMES or contact_part(self.structure).per_point_feet:
             return cq
         out = {}
         for leg in FOOT_NAMES:

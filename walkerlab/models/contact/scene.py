@@ -25,7 +25,8 @@ from walkerlab.config import (
 from .actuation import ContactActuators
 from .joint_torques import JointTorqueActuators
 from .laws import ContactParamsSI, KneeStopSI
-from .model import ContactWalker, flat_foot_numbers
+from .model import ContactWalker
+from .parts import contact_part
 from .rigid_limit import contact_si
 from .terrain import check_ground
 
@@ -56,28 +57,7 @@ def ideal_step_length(walker: ContactWalker, x_ideal, along_slope: bool = False)
     spaced by it.  ``along_slope``: the chord's component along the slope instead (stairs
     and footholds, where the feet at heel strike stand a riser apart: the footholds'
     spacing)."""
-    if walker.structure.spokes:  # a wheel: the chord between neighbouring spoke tips
-        p = dict(zip(walker.structure.param_names, walker.walker_params))
-        return float(2.0 * p["L"] * np.sin(p["alpha"]))
-    z = walker.link_state_from_ideal(x_ideal)
-    x = walker.pinned_to_full(z, np.zeros(2))
-    feet = walker.foot_positions(x)
-    chord = float(np.hypot(*(feet[1] - feet[0])))
-    if along_slope:
-        chord = abs(float((feet[1] - feet[0]) @ walker.tangent))
-    if walker.structure.foot == "flat":
-        pts = walker.points(x)
-        f1 = flat_foot_numbers(walker.data)[0]
-        ankle = np.asarray(pts["leg1_ankle"], float).ravel()
-        h = min(max(float(ankle @ walker.normal), 0.0), f1["toe"])
-        s_toe = float(ankle @ walker.tangent) + np.sqrt(f1["toe"] ** 2 - h ** 2)
-        heel2 = float(np.asarray(pts["leg2_heel"], float).ravel() @ walker.tangent)
-        return heel2 - (s_toe - f1["heel"] - f1["toe"])
-    if walker.structure.foot != "arc":
-        return chord
-    R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
-    m = walker.nq - 2  # link angles: leg1's, then leg2's; the foot is on each leg's last link
-    return chord + R * (z[m - 1] - z[m // 2 - 1])
+    return contact_part(walker.structure).step_length(walker, x_ideal, along_slope)
 
 
 @dataclass(frozen=True)
@@ -187,7 +167,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         (``contact_sim.start: periodic_gait``, ``periodic_gait: true`` or ``periodic``) of a
         walker whose step map it does not carry (a rimless wheel) (one line).
     """
-    from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
+    from walkerlab.codegen.floating import check_masses
     from walkerlab.walker.description import walker_data
 
     if scene.contact is None:
@@ -211,36 +191,12 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    if data.structure.foot == "flat" and contact.flat_foot() is None:
-        raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
-    if data.structure.spokes:
-        _check_wheel(scene, data, checked)
+    why = contact_part(data.structure).check(scene, data, checked)
+    if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
+        raise ContactSceneError(f"scene '{scene.name}': {why}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators)
-
-
-def _check_wheel(scene: Scene, data, cs: ContactSimSettings) -> None:
-    """A spoked wheel's contact scene: a regularising hub inertia for a point-mass hub
-    (:data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`), continuous ground (its
-    spokes are not a pair of legs with a lane each) and no contact periodic gait (the step
-    map's mid-stance section is a biped's); one-line refusals."""
-    from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
-
-    if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
-            and scene.contact.hub_inertia_kg_m2 is None:
-        raise ContactSceneError(f"scene '{scene.name}': {HUB_INERTIA_MESSAGE}")
-    terrain = scene.terrain or TerrainSettings()
-    if terrain.lanes != "continuous":
-        raise ContactSceneError(f"scene '{scene.name}': terrain.lanes: {terrain.lanes}: a "
-                                "rimless wheel's contact model runs on continuous ground "
-                                "(its spokes have no lanes of their own)")
-    if cs.start == "periodic_gait" or cs.periodic_gait:
-        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start / periodic_gait: "
-                                "the contact periodic gait (also --periodic) is found on a "
-                                "biped's mid-stance step map, which a rimless wheel has not: "
-                                "start from the rigid gait (start: ideal, periodic_gait: "
-                                "false)")
 
 
 def _actuators(scene: Scene, data, cs: ContactSimSettings
@@ -252,7 +208,7 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
-    five_link = st.free_knees
+    part = contact_part(st)
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
@@ -261,12 +217,8 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
                                 "powered walker's contact run starts from the rigid gait "
                                 "(start: ideal) or its own periodic gait (periodic_gait)")
     if cs.start == "periodic_gait" or cs.periodic_gait:
-        if five_link:
-            raise ContactSceneError(f"scene '{scene.name}': contact_sim.start / "
-                                    "periodic_gait: the contact periodic gait's step map "
-                                    "carries straight legs' hip torques and push-off, not "
-                                    "joint torques at the knees: start from the rigid gait "
-                                    "(start: ideal, periodic_gait: false)")
+        if part.periodic_actuators is not None:
+            raise ContactSceneError(f"scene '{scene.name}': {part.periodic_actuators}")
         tr = [t.law.time_reference for t in getattr(spec, "torques", None) or ()]
         if any(r is not None for r in tr):
             raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
@@ -278,11 +230,8 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
                                     "push-off on at heel off: start from the rigid gait "
                                     "(start: ideal, periodic_gait: false)")
     pulse = scene.contact.push_off_pulse_s()
-    try:
-        if five_link:  # joint torques at the hips and knees (the rigid view's laws)
-            return JointTorqueActuators(data, spec, coordinate_names(st), pulse)
-        return ContactActuators(spec, coordinate_names(st), pulse,
-                                torso=bool(st.torso) and not st.hinged_torso)
+    try:  # the kind's actuators (a five-link biped's: the rigid view's joint torques)
+        return part.actuators(data, spec, coordinate_names(st), pulse)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
 

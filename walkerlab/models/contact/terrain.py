@@ -22,7 +22,7 @@ normal (:attr:`walkerlab.models.contact.model.ContactWalker.heights1`), so
 The scene's ground (``terrain.kind``, :func:`terrain_ground`) enters the same way: on the
 paper's checkerboard lanes (``lanes: checkerboard``) stairs and footholds are patches at the
 rigid gait's footholds, footfall ``k`` at the height of its tread, ``-k`` times the landing
-drop per step (:func:`walkerlab.models.hybrid.ground.landing_drop`; the heights the rigid
+drop per step (:func:`walkerlab.models.ground.landing_drop`; the heights the rigid
 model's heel strikes meet); on continuous ground (``lanes: continuous``) the stairs are a
 polyline of level treads and vertical risers (:func:`stairs_line`) that both feet meet
 everywhere, so a toe swinging into a riser is caught by it
@@ -36,7 +36,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.models.hybrid.ground import landing_drop
+from walkerlab.models.ground import landing_drop
 
 __all__ = ["check_ground", "footfall_lanes", "profile_line", "slope_heights", "stairs_line",
            "step_heights", "terrain_ground"]

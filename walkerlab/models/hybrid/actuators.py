@@ -46,52 +46,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.config.actuation import JOINTS
 from walkerlab.models.actuation import TorqueLaws
 from walkerlab.models.hybrid.push_off import PushOffTransition
 from walkerlab.numerics import complex_step_jacobian
+from walkerlab.walker.joints import (  # noqa: F401 (joint_links: importable from here)
+    joint_angles,
+    joint_columns,
+    joint_links,
+    link_angles,
+)
 
 __all__ = ["Actuators", "joint_links", "link_angles", "torque_chain_jacobian"]
-
-
-def link_angles(la: dict) -> dict:
-    """The absolute angle and rate of every link, ``{link: (angle [rad], rate [rad/s])}``,
-    from a walker's generated ``leg_angles`` output ``la`` (keys ``<link>_angle``,
-    ``<link>_rate``): ``stance``, ``swing`` (straight legs; on a kneed walker the virtual legs
-    hip to foot where generated), ``stance_thigh``, ``stance_shank``, ``swing_thigh``,
-    ``swing_shank`` (kneed), ``torso``; on flat feet (whose output gives the ankles'
-    angles, the sole's from the leg's perpendicular) ``stance_foot`` / ``swing_foot`` = leg +
-    ankle.  Complex-safe (sums of the generated outputs)."""
-    out = {k[:-6]: (v, la[f"{k[:-6]}_rate"]) for k, v in la.items()
-           if k.endswith("_angle") and f"{k[:-6]}_rate" in la}
-    for leg in ("stance", "swing"):
-        ankle = out.pop(f"{leg}_ankle", None)
-        if ankle is not None:
-            out[f"{leg}_foot"] = (out[leg][0] + ankle[0], out[leg][1] + ankle[1])
-    return out
-
-
-def joint_links(links, joint: str, where: str = "joint") -> tuple[str, str]:
-    """``(first, second)``: the links (keys of :func:`link_angles`) a joint joins
-    (:data:`walkerlab.config.actuation.JOINTS`; a leg's link at the hip is its thigh on a
-    kneed walker).
-
-    Raises
-    ------
-    ValueError
-        The walker has no such joint: one line naming ``where`` and the joints it has.
-    """
-    links = set(links)
-    thigh = "_thigh" if "stance_thigh" in links else ""
-
-    def resolve(name):
-        a, b = JOINTS[name]
-        return tuple(f"{r[:-4]}{thigh}" if r.endswith("_leg") else r for r in (a, b))
-    have = [j for j in JOINTS if set(resolve(j)) <= links]
-    if joint not in have:
-        raise ValueError(f"{where}: {joint} is not a joint of this walker (its joints: "
-                         f"{', '.join(have)})")
-    return resolve(joint)
 
 
 @dataclass
@@ -149,16 +114,8 @@ class Actuators:
         names = self.link_angles(np.concatenate([z, z]))
         self.links = [joint_links(names, t.joint, f"walker.actuation.torques.{i}.joint")
                       for i, t in enumerate(self.spec.torques)]
-        ang = [self.link_angles(np.concatenate([z, e])) for e in eye]
-        self.B = np.array([[float(np.real(a[b][1] - a[f][1])) for (f, b) in self.links]
-                           for a in ang]).reshape(self.n, len(self.links))
-        q1 = np.linspace(0.1, 0.3, self.n)  # affine link angles: the same rows elsewhere
-        ang1 = [self.link_angles(np.concatenate([q1, e])) for e in eye]
-        B1 = np.array([[float(np.real(a[b][1] - a[f][1])) for (f, b) in self.links]
-                       for a in ang1]).reshape(self.n, len(self.links))
-        if not np.array_equal(B1, self.B):
-            raise ValueError("walker.actuation.torques: a joint's angle is not affine in the "
-                             "coordinates (B(q) would vary)")
+        self.B = joint_columns(self.link_angles, self.n, self.links)
+        q1 = np.linspace(0.1, 0.3, self.n)  # a second configuration (link_rows' point)
         #: every actuator at the one hip between the legs (the straight-legged walkers'
         #: actuation: B tau = ddelta_dq sum(tau), as before)
         self.hip_only = all(t.joint == "hip" for t in self.spec.torques) and not (
@@ -253,9 +210,7 @@ class Actuators:
         walker's stance thigh's, a five-link biped's virtual stance leg's) [rad] and its
         rate [rad/s]."""
         d = self.link_angles(x)
-        s = d["stance"] if "stance" in d else d[self.legs[1]]
-        return ([d[b][0] - d[a][0] for a, b in self.links],
-                [d[b][1] - d[a][1] for a, b in self.links], s[0], s[1])
+        return joint_angles(d, self.links, "stance" if "stance" in d else self.legs[1])
 
     def torques(self, t, x) -> np.ndarray:
         """Torque of each actuator (k,) [N m; N m/kg when ``scaled_by: foot_mass``] at the

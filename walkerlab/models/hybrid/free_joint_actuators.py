@@ -23,8 +23,7 @@ Jacobian is taken by the complex step as on the straight-legged walkers.
 
 from __future__ import annotations
 
-import numpy as np
-
+from walkerlab.models.actuation import shared_phase_table as _shared_phase_table
 from walkerlab.models.hybrid.actuators import Actuators
 
 __all__ = ["FiveLinkActuators", "five_link_actuators"]
@@ -32,41 +31,6 @@ __all__ = ["FiveLinkActuators", "five_link_actuators"]
 
 #: a free-jointed walker's actuators are the generic ones (the name kept for its users)
 FiveLinkActuators = Actuators
-
-
-def _shared_phase_table(torques):
-    """The references ``[(h_i, dh_i)]`` of laws that all track cubic phase tables on the
-    same abscissa, from ONE vector-valued spline (the same not-a-knot
-    :class:`scipy.interpolate.CubicSpline` per column as
-    :func:`walkerlab.models.actuation.phase_reference`, held at its end values outside,
-    complex-step aware), evaluated once per phase value; None when the laws differ."""
-    tabs = [t.law.reference for t in torques]
-    if (not tabs or any(r is None or r.interpolation != "cubic" or len(r.phase_rad) < 3
-                        or r.phase_rad != tabs[0].phase_rad for r in tabs)):
-        return None
-    from scipy.interpolate import CubicSpline
-
-    s = np.asarray(tabs[0].phase_rad, float)
-    cs = CubicSpline(s, np.array([r.values_rad for r in tabs], float).T, bc_type="not-a-knot",
-                     extrapolate=False)
-    d1, d2 = cs.derivative(), cs.derivative(2)
-    memo: dict = {}
-
-    def at(u):  # (h (k,), dh (k,)) at the phase u
-        key = (bool(np.iscomplexobj(u)), complex(u))  # a real call never reads a complex
-        if key not in memo:
-            memo.clear()
-            r = min(max(float(np.real(u)), s[0]), s[-1])
-            inside = float(s[0] < np.real(u) < s[-1])
-            h, dh = cs(r), d1(r) * inside
-            if np.iscomplexobj(u):
-                h = h + 1j * np.imag(u) * dh
-                dh = dh + 1j * np.imag(u) * d2(r) * inside
-            memo[key] = (h, dh)
-        return memo[key]
-
-    return [((lambda u, i=i: at(u)[0][i]), (lambda u, i=i: at(u)[1][i]))
-            for i in range(len(tabs))]
 
 
 def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkActuators:

@@ -41,6 +41,7 @@ import numpy as np
 
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import complex_step_jacobian
+from walkerlab.walker.description import compass_gait_structure  # noqa: F401
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 
@@ -180,14 +181,6 @@ def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
 
 
 # --------------------------------------------------------------------------- builder
-def compass_gait_structure():
-    """The compass gait (paper A.1-A.3) as a generic biped structure: a hip point mass and one
-    point mass per leg (:class:`~walkerlab.walker.description.Structure`)."""
-    from walkerlab.walker.description import BodySpec, Structure
-
-    return Structure("absolute", (BodySpec("mass", "point_mass"),))
-
-
 def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
           slope_rad):
     from walkerlab.config import CompassGaitParams

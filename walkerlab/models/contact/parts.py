@@ -1,0 +1,226 @@
+"""The compliant-contact view's part of each walker kind (:mod:`walkerlab.walker.kinds`):
+what the contact model does differently for straight legs, locking knees, flat feet, free
+joints and a rolling polygon, reached by the kind's name (:func:`contact_part`), never by
+the description's switches.
+
+A part holds the handful of entries the contact layer needs: the flat feet's numbers, the
+state the contact run starts from (the rigid gait's link angles), the step length its
+patches are spaced by, the scene's kind-level checks, the actuators and the reference point
+of a foot.  Structural details that are not the kind (point or arc feet, the coordinate
+scheme) stay read where they change a formula.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["PARTS", "ContactPart", "contact_part"]
+
+
+class ContactPart:
+    """Straight legs on point or arc feet (the compass gait family); the other kinds'
+    parts override what differs.
+
+    Attributes
+    ----------
+    plain : bool
+        The walker may carry the paper's model name ``compass_gait_contact`` when nothing
+        else sets it apart (:attr:`walkerlab.models.contact.model.ContactWalker.model_name`).
+    per_point_feet : bool
+        Each contact point is a foot of its own in the gait's foot quantities (a wheel's
+        spokes), not combined per leg.
+    """
+
+    plain = True
+    per_point_feet = False
+
+    def flat_feet(self, data) -> list[dict]:
+        """Each leg's flat foot numbers ``{"heel", "toe", "r"}`` (:func:`walkerlab.models.
+        contact.model.flat_foot_numbers`): none here."""
+        return []
+
+    def foot_point(self, structure) -> str:
+        """The name (``leg{i}_<name>`` among the generated points) of a foot's reference
+        contact point: the foot point, an arc's lowest point."""
+        return "contact" if structure.foot == "arc" else "foot"
+
+    def rigid_values(self, walker, x) -> dict:
+        """The rigid state ``x`` (role order) by link name (absolute coordinates: the rigid
+        layout's names; otherwise through the generated leg angles)."""
+        if walker.structure.coordinates == "absolute":
+            return walker.rigid_layout().named(x)
+        from walkerlab.codegen.cache import functions
+
+        return functions(walker.data)["leg_angles"](x)
+
+    def link_state(self, walker, x, rate_scale) -> np.ndarray:
+        """:meth:`walkerlab.models.contact.model.ContactWalker.link_state_from_ideal`."""
+        from walkerlab.walker.layout import floating_links_from_rigid
+
+        return floating_links_from_rigid(self.rigid_values(walker, x), walker.layout(),
+                                         rate_scale)
+
+    def step_length(self, walker, x_ideal, along_slope: bool) -> float:
+        """:func:`walkerlab.models.contact.scene.ideal_step_length`: the foot-to-foot chord
+        at heel strike, plus an arc foot's roll over the step."""
+        z, chord = self._chord(walker, x_ideal, along_slope)[:2]
+        if walker.structure.foot != "arc":
+            return chord
+        R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
+        m = walker.nq - 2  # link angles: leg1's, then leg2's; the foot on each leg's last link
+        return chord + R * (z[m - 1] - z[m // 2 - 1])
+
+    @staticmethod
+    def _chord(walker, x_ideal, along_slope: bool):
+        """``(z, chord, x)``: the pinned start, the distance between the feet's reference
+        points (along the slope: its component there) and the full state."""
+        z = walker.link_state_from_ideal(x_ideal)
+        x = walker.pinned_to_full(z, np.zeros(2))
+        feet = walker.foot_positions(x)
+        chord = float(np.hypot(*(feet[1] - feet[0])))
+        if along_slope:
+            chord = abs(float((feet[1] - feet[0]) @ walker.tangent))
+        return z, chord, x
+
+    def check(self, scene, data, cs) -> str | None:
+        """The kind's refusal of the contact scene (one line without the scene's name), or
+        None."""
+        return None
+
+    def actuators(self, data, spec, coordinates, pulse_s: float):
+        """The contact view's actuators: joint torques at the links' joints, a push-off
+        pulse, an ankle push-off (:class:`walkerlab.models.contact.actuation.
+        ContactActuators`)."""
+        from .actuation import ContactActuators
+
+        st = data.structure
+        return ContactActuators(spec, coordinates, pulse_s, st.kind,
+                                torso=bool(st.torso) and not st.hinged_torso)
+
+    #: why the contact periodic gait refuses this kind's actuators (None: it carries them)
+    periodic_actuators: str | None = None
+
+
+class KneedPart(ContactPart):
+    """Locking knees: the rigid state by name whatever the coordinates."""
+
+    plain = False
+
+    def rigid_values(self, walker, x) -> dict:
+        return walker.rigid_layout().named(x)
+
+
+class FlatFeetPart(ContactPart):
+    """Flat feet on ankle springs: heel and toe contacts, the feet's absolute angles."""
+
+    plain = False
+
+    def flat_feet(self, data) -> list[dict]:
+        st = data.structure
+        P = dict(zip(st.param_names, data.params))
+        tags = ("sw_", "st_") if st.asymmetric else ("", "")
+        return [{"heel": P[f"heel_{t}m"], "toe": P[f"toe_{t}m"], "r": P[f"r_{t}ankle"]}
+                for t in tags]
+
+    def foot_point(self, structure) -> str:
+        return "heel"
+
+    def rigid_values(self, walker, x) -> dict:
+        values = super().rigid_values(walker, x)
+        if walker.structure.coordinates == "absolute":
+            # the feet's absolute angles: the swing foot at its spring's rest, turning with
+            # its leg (massless in the rigid view); the stance foot's sole at stance + ankle
+            # (the rigid view's ankle angle and rate)
+            r1 = self.flat_feet(walker.data)[0]["r"]
+            values["swing_foot_angle"] = values["swing_angle"] + r1
+            values["swing_foot_rate"] = values["swing_rate"]
+            values["stance_foot_angle"] = (values["stance_angle"]
+                                           + values["stance_ankle_angle"])
+            values["stance_foot_rate"] = values["stance_rate"] + values["stance_ankle_rate"]
+        return values
+
+    def step_length(self, walker, x_ideal, along_slope: bool) -> float:
+        """From the trailing foot's heel touchdown point to the new stance heel (module
+        docstring of :func:`walkerlab.models.contact.scene.ideal_step_length`)."""
+        x = self._chord(walker, x_ideal, along_slope)[2]
+        pts = walker.points(x)
+        f1 = self.flat_feet(walker.data)[0]
+        ankle = np.asarray(pts["leg1_ankle"], float).ravel()
+        h = min(max(float(ankle @ walker.normal), 0.0), f1["toe"])
+        s_toe = float(ankle @ walker.tangent) + np.sqrt(f1["toe"] ** 2 - h ** 2)
+        heel2 = float(np.asarray(pts["leg2_heel"], float).ravel() @ walker.tangent)
+        return heel2 - (s_toe - f1["heel"] - f1["toe"])
+
+    def check(self, scene, data, cs) -> str | None:
+        from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE
+
+        return FLAT_FOOT_MESSAGE if scene.contact.flat_foot() is None else None
+
+
+class FreeJointsPart(KneedPart):
+    """Free hips and knees (the five-link biped): its joint torques are the rigid view's."""
+
+    periodic_actuators = ("contact_sim.start / periodic_gait: the contact periodic gait's "
+                          "step map carries straight legs' hip torques and push-off, not "
+                          "joint torques at the knees: start from the rigid gait (start: "
+                          "ideal, periodic_gait: false)")
+
+    def actuators(self, data, spec, coordinates, pulse_s: float):
+        """Joint torques at the hips and knees (the rigid view's laws,
+        :class:`walkerlab.models.contact.joint_torques.JointTorqueActuators`)."""
+        from .joint_torques import JointTorqueActuators
+
+        return JointTorqueActuators(data, spec, coordinates, pulse_s)
+
+
+class RollingPolygonPart(ContactPart):
+    """A rimless (spoked) wheel: one rigid body on its spokes' tips."""
+
+    per_point_feet = True
+
+    def link_state(self, walker, x, rate_scale) -> np.ndarray:
+        # spoke 0 is the stance spoke: [wheel angle, its rate (stance scale)]
+        return np.array([x[0], x[1] * rate_scale[1]])
+
+    def step_length(self, walker, x_ideal, along_slope: bool) -> float:
+        """The chord between neighbouring spoke tips."""
+        p = dict(zip(walker.structure.param_names, walker.walker_params))
+        return float(2.0 * p["L"] * np.sin(p["alpha"]))
+
+    def check(self, scene, data, cs) -> str | None:
+        """A regularising hub inertia for a point-mass hub
+        (:data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`), continuous ground (its
+        spokes are not a pair of legs with a lane each) and no contact periodic gait (the
+        step map's mid-stance section is a biped's)."""
+        from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
+        from walkerlab.config import TerrainSettings
+
+        if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
+                and scene.contact.hub_inertia_kg_m2 is None:
+            return HUB_INERTIA_MESSAGE
+        terrain = scene.terrain or TerrainSettings()
+        if terrain.lanes != "continuous":
+            return (f"terrain.lanes: {terrain.lanes}: a rimless wheel's contact model runs "
+                    "on continuous ground (its spokes have no lanes of their own)")
+        if cs.start == "periodic_gait" or cs.periodic_gait:
+            return ("contact_sim.start / periodic_gait: the contact periodic gait (also "
+                    "--periodic) is found on a biped's mid-stance step map, which a rimless "
+                    "wheel has not: start from the rigid gait (start: ideal, periodic_gait: "
+                    "false)")
+        return None
+
+
+#: kind name -> the contact view's part
+PARTS: dict[str, ContactPart] = {
+    "straight_legs": ContactPart(),
+    "locking_knees": KneedPart(),
+    "flat_feet": FlatFeetPart(),
+    "free_joints": FreeJointsPart(),
+    "rolling_polygon": RollingPolygonPart(),
+}
+
+
+def contact_part(structure) -> ContactPart:
+    """The contact view's part of ``structure``'s kind (:attr:`walkerlab.walker.description.
+    Structure.kind`)."""
+    return PARTS[structure.kind.name]
