@@ -35,6 +35,7 @@ extensions = [
     "sphinx_gallery.gen_gallery",
     "scene_schema",
     "artifact_reference",
+    "capability_table",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}

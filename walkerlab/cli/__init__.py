@@ -9,6 +9,7 @@ module                    what
 ``commands_output``       plot, report, animate, export, bench
 ``commands_families``     sweep, bifurcation, continuation
 ``commands_robustness``   basin, mfpt, robustness, stability-map
+``commands_reference``    capabilities (the walker kinds' capability table)
 ``options``               the shared arguments, loading the scene, the status line
 ``errors``                the exit policy (:func:`walkerlab.cli.errors.guard`)
 ``process``               process settings (OpenBLAS threads, numba cache) and --version
@@ -31,6 +32,7 @@ import typer
 from walkerlab.cli import (
     commands_families,
     commands_output,
+    commands_reference,
     commands_robustness,
     commands_runs,
 )
@@ -74,7 +76,7 @@ COMMANDS = (
     ("mfpt", commands_robustness.mfpt), ("robustness", commands_robustness.robustness),
     ("stability-map", commands_robustness.stability_map),
     ("animate", commands_output.animate), ("export", commands_output.export),
-    ("bench", commands_output.bench),
+    ("bench", commands_output.bench), ("capabilities", commands_reference.capabilities),
 )
 for _name, _command in COMMANDS:
     app.command(_name)(_command)

@@ -92,7 +92,8 @@ class Kind:
 
     def cell(self, feature: str, view: str) -> str | None:
         """None when the kind supports ``feature`` in ``view``, else the one-line reason
-        (:data:`CAPABILITIES`).
+        (:data:`CAPABILITIES`; a view that refuses the walker itself, ``walk``, refuses
+        each of its features for that reason).
 
         Raises
         ------
@@ -103,6 +104,8 @@ class Kind:
             raise KeyError(f"{feature!r} in {view!r}: features are {', '.join(FEATURES)}; "
                            f"views {', '.join(VIEWS)}")
         row = CAPABILITIES[self.name]
+        if feature != "walk" and ("walk", view) in row:  # a view without the walker: none
+            return row[("walk", view)]                    # of its features either
         return row.get((feature, view), row.get((feature, "*")))
 
     def supports(self, feature: str, view: str) -> bool:
@@ -146,8 +149,31 @@ KINDS = {k.name: k for k in (
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
              "feet have none")
+_NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
+                  "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-_FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
+_ONE_LANDING = ("footholds of different heights differ from step to step: not one landing "
+                "for every step (the rigid model walks them, one walker per step)")
+_GYM_GROUND = ("the rigid view steps one walker on a ground whose every step is alike "
+               "(slope, stairs, footholds of one height); use view='contact'")
+_OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
+                 "half-spaces, not a polyline; --format mjcf writes it as a height field)")
+_ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
+                  "the footholds' heights), not continuous profile")
+_OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
+                    "scene without it")
+_PHASED_PUSH_OFF = "the phased transcription (knees or flat feet) has no push-off yet"
+_FIVE_LINK_JOINTS = ("stance_hip, swing_hip, stance_knee and swing_knee need a five-link "
+                     "biped (free knees, a torso)")
+#: what the views of every legged kind refuse: grounds whose steps differ outside the rigid
+#: view, a profile in the Adams dataset, the OpenSim model and the gym
+_GROUNDS = {
+    **{("footholds", v): _ONE_LANDING for v in ("contact", "mjcf", "adams", "osim")},
+    ("footholds", "gym"): _GYM_GROUND,
+    ("profile", "gym"): _GYM_GROUND,
+    ("profile", "adams"): _ADAMS_PROFILE,
+    ("profile", "osim"): _OSIM_PROFILE,
+}
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -156,40 +182,43 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     "straight_legs": {
         ("knee_torque", "*"): _NO_KNEE,
         ("ankle_torque", "*"): _NO_ANKLE,
-        ("ankle_push_off", "*"): _NO_ANKLE,
-        ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
-                              "not a height profile; --format mjcf carries it as a height "
-                              "field"),
+        ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
+        ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+        ("torso_torque", "adams"): _FIVE_LINK_JOINTS,
+        **_GROUNDS,
     },
     "locking_knees": {
         ("ankle_torque", "*"): _NO_ANKLE,
-        ("ankle_push_off", "*"): _NO_ANKLE,
-        ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
-                              "not a height profile; --format mjcf carries it as a height "
-                              "field"),
+        ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
+        ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+        ("knee_torque", "adams"): _FIVE_LINK_JOINTS,
+        ("torso_torque", "adams"): _FIVE_LINK_JOINTS,
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        **_GROUNDS,
     },
     "flat_feet": {
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "
                                "(walker.leg.knee)"),
-        ("walk", "osim"): ("the OpenSim export has no foot bodies, ankle springs or heel and "
-                           "toe contacts; --format mjcf carries flat feet"),
-        ("ankle_push_off", "osim"): ("the OpenSim export has no flat feet; --format mjcf "
-                                     "carries them"),
-        ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
-        ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
-                                 "point and arc feet (a flat foot's modes have no per-step "
-                                 "landing yet)"),
+        ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
+                           "springs or heel and toe contacts); --format mjcf carries them"),
+        ("walk", "gym"): ("flat feet are not carried yet (each stance-foot mode has its own "
+                          "mass matrix); use point or arc feet"),
+        ("stairs", "*"): ("flat feet on stairs or footholds are not supported yet (their "
+                          "heel strike is a guard per foot mode)"),
+        ("footholds", "*"): ("footholds of several heights or slopes: not built for this "
+                             "walker (flat feet or actuators)"),
+        ("profile", "adams"): _ADAMS_PROFILE,
+        ("profile", "gym"): _GYM_GROUND,
     },
     "free_joints": {
         ("ankle_torque", "*"): _NO_ANKLE,
-        ("ankle_push_off", "*"): _NO_ANKLE,
+        ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
-        ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
-                                 "passive walkers; a five-link biped walks by its torques"),
-        ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
-                              "not a height profile; --format mjcf carries it as a height "
-                              "field"),
+        ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+        **_GROUNDS,
+        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
+                              "walkers only") for v in ("rigid", "contact")},
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
@@ -199,6 +228,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as mjcf or urdf"),
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
+        ("footholds", "contact"): _ONE_LANDING,
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
         **{(f, "mjcf"): ("a spoked wheel's MJCF carries the slope's plane only; "

@@ -1,0 +1,280 @@
+"""The capability table (:data:`walkerlab.walker.kinds.CAPABILITIES`) tells the truth.
+
+For each walker kind, its shipped scene, and each cell of the table (a feature in a view),
+the cell is tried in the view, cheaply (nothing long is solved):
+
+- ``rigid``: the rigid walker with the feature (``walkerlab.api.walker.Walker``, its model
+  built);
+- ``contact``: the compliant-contact set-up (:func:`walkerlab.models.contact.scene.
+  contact_setup`, no run);
+- ``mjcf`` / ``adams`` / ``osim``: the export written into a temporary runs folder (its
+  keyframe's rigid gait searched as ``walkerlab export`` does; no gait is the walker's
+  dynamics, not a refusal);
+- ``gym``: the Gymnasium environment built (:class:`walkerlab.gym.env.WalkerEnv`);
+- ``optimize``: ``walkerlab optimize`` up to IPOPT (CasADi's ``Opti.solve`` replaced by an
+  exit: every refusal and the transcription's set-up passed).
+
+A supported cell must be accepted; a refused cell refused with the table's reason in its
+one line (whatever the field named first).  The quick suite tries the cells that take
+under a second (the rigid and contact set-ups, the refusals that come before any gait
+search); ``pytest -m slow`` tries every cell.  This replaces issue 48's probing script
+(issue 48's ``scripts/capability_table.py``).
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: kind -> its shipped scene
+SCENES = {
+    "straight_legs": "configs/paper_rods.yaml",
+    "locking_knees": "configs/kneed.yaml",
+    "flat_feet": "configs/flat_feet.yaml",
+    "free_joints": "configs/rabbit.yaml",
+    "rolling_polygon": "configs/rimless_wheel.yaml",
+}
+
+#: a small PD law [N m/rad, N m s/rad] about the joint's zero angle
+SMALL_PD = {"stiffness_n_m_per_rad": 0.1, "damping_n_m_s_per_rad": 0.01}
+
+#: feature -> the joint its torque acts at (a five-link biped's hips: torso to thigh)
+JOINT = {"hip_torque": "hip", "knee_torque": "swing_knee", "ankle_torque": "stance_ankle",
+         "torso_torque": "stance_hip"}
+FIVE_LINK_JOINT = {"hip_torque": "swing_hip"}
+
+#: an upper body held on the legs' bisector (configs/torso_bhm.yaml): the torso torque's
+#: other link on a walker shipped without one
+TORSO = {"coupling": "bisecting_hip",
+         "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 5.0,
+                     "from_hip_m": 0.2}]}
+
+#: the non-slope grounds (configs/stairs.yaml, footholds.yaml, profile.yaml)
+TERRAIN = {
+    "stairs": {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.41, "direction": "down",
+               "lanes": "continuous"},
+    "footholds": {"kind": "footholds", "foothold_heights_m": [-0.005, 0.005],
+                  "periodic": True, "lanes": "checkerboard", "patch_width_m": 0.3},
+    "profile": {"kind": "profile", "lanes": "continuous",
+                "profile_m": [[-1.0, 0.05], [0.0, 0.0], [1.0, -0.05], [2.0, -0.1],
+                              [3.0, -0.15], [4.0, -0.2]]},
+}
+
+#: an optimize section a kind's optimisation needs (a five-link biped's least effort needs
+#: a target: configs/rabbit_optimal.yaml's 0.5 m in 0.7 s)
+OPTIMIZE = {"free_joints": {"target_step_length_m": 0.5, "target_step_period_s": 0.7}}
+
+
+def scene_for(kind: str, feature: str, view: str) -> dict:
+    """The kind's shipped scene with the feature (a mapping)."""
+    with open(ROOT / SCENES[kind]) as fh:
+        d = yaml.safe_load(fh)
+    d["name"] = f"{kind}-{feature}-{view}"
+    w = d["walker"]
+    shipped = copy.deepcopy(w.get("actuation")) or {}
+    if feature in JOINT:
+        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind == "free_joints"
+                 else JOINT[feature])
+        if feature == "torso_torque" and "torso" not in w and "leg" in w:
+            w["torso"] = copy.deepcopy(TORSO)
+        torques = [t for t in shipped.get("torques", []) if t["joint"] != joint]
+        shipped["torques"] = [*torques, {"joint": joint, "law": dict(SMALL_PD)}]
+        w["actuation"] = shipped
+    elif feature == "push_off":
+        w["actuation"] = {**shipped, "push_off": {"impulse_n_s": 0.05}}
+    elif feature == "ankle_push_off":
+        w["actuation"] = {**shipped, "ankle_push_off": {"constant_n_m": 1.0}}
+    elif feature in TERRAIN:
+        terrain = copy.deepcopy(TERRAIN[feature])
+        if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
+            terrain.pop("lanes")
+            terrain.update(lanes="checkerboard", patch_width_m=d["terrain"]["patch_width_m"])
+        d["terrain"] = terrain
+        if feature == "stairs":
+            d["slope"] = {"angle_rad": 0.0}
+    if view == "optimize" and kind in OPTIMIZE:
+        d.setdefault("optimize", dict(OPTIMIZE[kind]))
+    elif view == "optimize" and feature == "stairs":  # level treads: a step from targets
+        d["optimize"] = {"target_step_length_m": 0.41, "target_step_period_s": 0.75}
+    return d
+
+
+# ---------------------------------------------------------------------------- the probes
+
+class Reached(Exception):
+    """The optimisation reached IPOPT: its set-up was accepted."""
+
+
+def _rigid(d, tmp):
+    from walkerlab.api.walker import Walker
+
+    assert Walker.from_scene(d).model is not None  # built (its refusals said)
+
+
+def _contact(d, tmp):
+    from walkerlab.config import scene_from_dict
+    from walkerlab.models.contact.scene import contact_setup
+
+    _rigid(d, tmp)  # contact-sim starts from the rigid gait (fixedpoint.h5): its walker
+    contact_setup(scene_from_dict(d))
+
+
+def _export(fmt):
+    def probe(d, tmp):
+        from walkerlab.config import scene_from_dict
+        from walkerlab.stages import export
+
+        export.run(scene_from_dict(d), tmp, fmt)
+    return probe
+
+
+def _gym(d, tmp):
+    from walkerlab.gym.env import WalkerEnv
+
+    WalkerEnv(d).close()
+
+
+def _optimize(d, tmp, monkeypatch):
+    import casadi
+
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import pipeline
+
+    def solve(self, *a, **k):
+        raise Reached
+
+    monkeypatch.setattr(casadi.Opti, "solve", solve)
+    try:
+        pipeline.run("optimize", scene_from_dict(d), tmp, False)
+    except Reached:
+        pass
+
+
+PROBES = {"rigid": _rigid, "contact": _contact, "mjcf": _export("mjcf"),
+          "adams": _export("adm"), "osim": _export("osim"), "gym": _gym,
+          "optimize": _optimize}
+
+#: a message that says the walker has no gait (its dynamics, not a refusal of the cell)
+NO_GAIT = ("no rigid gait", "no period-1 gait found", "FixedPointNotFound", "GaitNotFound",
+           "no fixed point", "did not converge")
+
+
+def outcome(kind: str, feature: str, view: str, tmp: Path, monkeypatch) -> tuple[str, str]:
+    """``("accepted" | "refused", one line)`` of the cell tried in its view."""
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound
+    from walkerlab.stages.common import StageError
+
+    try:
+        from walkerlab.analysis.gait.search import GaitNotFound
+    except ImportError:  # pragma: no cover - where the search names it otherwise
+        GaitNotFound = FixedPointNotFound
+    d = scene_for(kind, feature, view)
+    probe = PROBES[view]
+    try:
+        if view == "optimize":
+            probe(d, tmp, monkeypatch)
+        else:
+            probe(d, tmp)
+    except (FixedPointNotFound, GaitNotFound) as exc:
+        return "accepted", f"no gait: {type(exc).__name__}"
+    except (ValueError, StageError) as exc:
+        line = " ".join(str(exc).split())
+        if any(s in line for s in NO_GAIT):
+            return "accepted", f"no gait: {line}"
+        return "refused", line
+    return "accepted", ""
+
+
+def cells():
+    for kind in KINDS:
+        for feature in FEATURES:
+            for view in VIEWS:
+                yield kind, feature, view
+
+
+def absent_part(kind: str, feature: str) -> tuple[str, ...]:
+    """The one lines in which the scene's own checks refuse a part the walker does not have,
+    before its kind is asked (each says what the table's reason says): a joint the walker
+    lacks (:func:`walkerlab.models.hybrid.actuators.joint_links` names the joints it has)
+    and ``walker.actuation`` on a walker model without actuators (the scene's schema)."""
+    out = []
+    if feature in JOINT:
+        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind == "free_joints"
+                 else JOINT[feature])
+        out += [f"{joint} is not a joint of this walker (its joints: ",
+                f"{joint} is not a joint of the "]  # an export's joints (the walker's)
+    if kind == "rolling_polygon" and feature in (*JOINT, "push_off", "ankle_push_off"):
+        out.append("walker.actuation: unknown field")
+    return tuple(out)
+
+
+def _check(kind, feature, view, tmp_path, monkeypatch):
+    why = KINDS[kind].cell(feature, view)
+    status, line = outcome(kind, feature, view, tmp_path, monkeypatch)
+    if why is None:
+        assert status == "accepted", f"the table says supported; the view refuses: {line}"
+    else:
+        if status == "accepted" and line.startswith("no gait"):
+            pytest.skip(f"no gait before the view's check ({line[:80]})")
+        assert status == "refused", f"the table refuses ({why}); the view accepts {line}"
+        said = (why, *absent_part(kind, feature))
+        assert any(s in line for s in said), \
+            f"the table's reason {why!r} is not in the refusal {line!r}"
+
+
+#: the cells the quick suite tries (each under ~1 s: set-ups and the refusals that come
+#: before any gait search)
+QUICK = [c for c in cells() if c[2] in ("rigid", "contact")]
+
+
+@pytest.mark.parametrize("kind,feature,view", QUICK)
+def test_the_table_tells_the_truth(kind, feature, view, tmp_path, monkeypatch):
+    _check(kind, feature, view, tmp_path, monkeypatch)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind,feature,view", [c for c in cells() if c not in QUICK])
+def test_the_table_tells_the_truth_in_every_view(kind, feature, view, tmp_path,
+                                                 monkeypatch):
+    _check(kind, feature, view, tmp_path, monkeypatch)
+
+
+def test_every_kind_has_a_row_and_a_scene():
+    assert set(CAPABILITIES) == set(KINDS) == set(SCENES)
+    for row in CAPABILITIES.values():
+        for feature, view in row:
+            assert feature in FEATURES and (view == "*" or view in VIEWS)
+
+
+def test_the_command_and_the_docs_show_the_table():
+    """``walkerlab capabilities`` (text and --json) and the docs' page are the table."""
+    import importlib.util
+    import json
+
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.walker.kinds import table_rows
+
+    r = CliRunner().invoke(app, ["capabilities", "--json"])
+    assert r.exit_code == 0 and json.loads(r.output) == table_rows()
+    r = CliRunner().invoke(app, ["capabilities"])
+    assert r.exit_code == 0
+    for kind in KINDS.values():
+        assert f"{kind.name}: {kind.title}" in r.output
+        for row in CAPABILITIES[kind.name].values():
+            assert row in r.output
+    spec = importlib.util.spec_from_file_location(
+        "capability_table", ROOT / "docs" / "_ext" / "capability_table.py")
+    ext = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ext)
+    page = ext.rst()
+    assert all(kind.name in page for kind in KINDS.values())
+    assert "capability-table" in (ROOT / "docs" / "reference" / "capabilities.rst").read_text()

@@ -1,0 +1,27 @@
+"""Commands that print what walkerlab can do, without building a model."""
+
+from __future__ import annotations
+
+import typer
+
+from walkerlab.cli.errors import guard
+
+
+@guard
+def capabilities(as_json: bool = typer.Option(False, "--json", help="print every cell as "
+                                              "JSON: kind, feature, view, supported, "
+                                              "reason")) -> None:
+    """The capability table: for each walker kind (straight legs, locking knees, flat
+    feet, free joints, rolling polygon), which features (actuators, grounds) each view
+    (rigid, contact, exports, gym, optimize) supports, and the one-line reason of each
+    refusal (walkerlab.walker.kinds.CAPABILITIES; no model is built)."""
+    if as_json:
+        import json
+
+        from walkerlab.walker.kinds import table_rows
+
+        typer.echo(json.dumps(table_rows(), indent=1, ensure_ascii=False))
+        return
+    from walkerlab.walker.capability_tables import text
+
+    typer.echo(text(), nl=False)

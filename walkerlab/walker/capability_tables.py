@@ -1,0 +1,91 @@
+"""The capability table (:data:`walkerlab.walker.kinds.CAPABILITIES`) laid out for reading:
+one grid per walker kind, a row per feature and a column per view, each cell ``✓`` or a
+numbered refusal whose one-line reason is listed under the grid.  ``walkerlab
+capabilities`` prints it as text, the documentation's capability page shows it (the
+``capability-table`` directive, ``docs/_ext/capability_table.py``) and
+``walkerlab capabilities --json`` prints :func:`walkerlab.walker.kinds.table_rows`.
+Nothing here builds a model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS, Kind
+
+__all__ = ["SUPPORTED", "KindGrid", "grids", "kind_grid", "markdown", "text"]
+
+#: the mark of a supported cell
+SUPPORTED = "✓"
+
+
+@dataclass(frozen=True)
+class KindGrid:
+    """One kind's cells: ``rows[i][j]`` is feature ``i`` in view ``j`` (:data:`SUPPORTED`
+    or ``"✗ n"``, ``n`` the 1-based index into ``reasons``)."""
+
+    kind: Kind
+    features: tuple[str, ...]
+    views: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    reasons: tuple[str, ...]
+
+
+def kind_grid(kind: Kind) -> KindGrid:
+    """The grid of one kind, its reasons numbered in the order they first appear (row by
+    row), each listed once."""
+    reasons: list[str] = []
+    rows = []
+    for feature in FEATURES:
+        row = []
+        for view in VIEWS:
+            why = kind.cell(feature, view)
+            if why is None:
+                row.append(SUPPORTED)
+                continue
+            if why not in reasons:
+                reasons.append(why)
+            row.append(f"✗ {reasons.index(why) + 1}")
+        rows.append(tuple(row))
+    return KindGrid(kind, tuple(FEATURES), tuple(VIEWS), tuple(rows), tuple(reasons))
+
+
+def grids() -> list[KindGrid]:
+    """Every kind's grid, in :data:`walkerlab.walker.kinds.KINDS`' order."""
+    return [kind_grid(k) for k in KINDS.values()]
+
+
+def _legend() -> list[str]:
+    return ["views: " + "; ".join(f"{v}: {what}" for v, what in VIEWS.items()),
+            "features: " + "; ".join(f"{f}: {what}" for f, what in FEATURES.items())]
+
+
+def text() -> str:
+    """The table as plain text (``walkerlab capabilities``): per kind its title, the grid
+    (columns padded) and its numbered reasons; the views and features explained first."""
+    out = ["walker kind x feature x view: ✓ supported, ✗ n refused (reason n below the "
+           "kind's grid)", *_legend(), ""]
+    for g in grids():
+        head = ("feature", *g.views)
+        rows = [(f, *r) for f, r in zip(g.features, g.rows)]
+        width = [max(len(r[i]) for r in (head, *rows)) for i in range(len(head))]
+        out.append(f"{g.kind.name}: {g.kind.title} ({g.kind.reference})")
+        for r in (head, *rows):
+            out.append("  " + "  ".join(c.ljust(w) for c, w in zip(r, width)).rstrip())
+        out += [f"  {i}. {why}" for i, why in enumerate(g.reasons, 1)]
+        out.append("")
+    return "\n".join(out).rstrip() + "\n"
+
+
+def markdown() -> str:
+    """The table as Markdown: per kind a heading, the grid and its numbered reasons."""
+    out = []
+    for g in grids():
+        out += [f"### {g.kind.name}: {g.kind.title}", "", f"{g.kind.reference}.", "",
+                "| feature | " + " | ".join(g.views) + " |",
+                "|---|" + "---|" * len(g.views)]
+        out += [f"| {f} | " + " | ".join(r) + " |" for f, r in zip(g.features, g.rows)]
+        out.append("")
+        out += [f"{i}. {why}" for i, why in enumerate(g.reasons, 1)]
+        out.append("")
+    return "\n".join(out).rstrip() + "\n"
