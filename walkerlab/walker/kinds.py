@@ -148,6 +148,10 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
              "feet have none")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
 _FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
+_PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
+                    "its heel strike is the plain impact (the rigid kneed model's push-off "
+                    "runs in fixedpoint and simulate, not here); optimise the hip torque "
+                    "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -164,6 +168,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     "locking_knees": {
         ("ankle_torque", "*"): _NO_ANKLE,
         ("ankle_push_off", "*"): _NO_ANKLE,
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
                               "not a height profile; --format mjcf carries it as a height "
                               "field"),
@@ -176,6 +181,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("ankle_push_off", "osim"): ("the OpenSim export has no flat feet; --format mjcf "
                                      "carries them"),
         ("walk", "gym"): f"not carried yet ({_FLAT_MODES}); use point or arc feet",
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
+                                         "(the rigid flat feet take an ankle push-off or "
+                                         "hip torques, not together)"),
         ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
                                  "point and arc feet (a flat foot's modes have no per-step "
                                  "landing yet)"),
