@@ -94,7 +94,11 @@ class PhaseReplayData:
 
 @dataclass
 class OptimizeData:
-    """The contents of ``optimize.h5`` (units in the module docstring)."""
+    """The contents of ``optimize.h5`` (units in the module docstring): the one record of
+    an optimised gait, as the driver returns it (:func:`walkerlab.optimal.driver.
+    optimize_scene`; its ``phase_replays`` the replays themselves until
+    :func:`optimize_record` makes them :class:`PhaseReplayData`) and as :func:`load`
+    reads it."""
 
     time: np.ndarray
     states: dict
@@ -145,17 +149,15 @@ def phase_replay_records(replays: dict) -> dict:
             for name, r in replays.items()}
 
 
-def optimize_record(optimum, energy_unit: str = "J") -> OptimizeData:
-    """``optimize.h5``'s record of an optimised gait (the driver's
-    :class:`walkerlab.optimal.driver.Optimum`: an object with :class:`OptimizeData`'s
-    fields, its ``phase_replays`` the replays themselves), the energies in
-    ``energy_unit`` (the scene's)."""
-    from dataclasses import fields
+def optimize_record(optimum: OptimizeData, energy_unit: str = "J") -> OptimizeData:
+    """``optimize.h5``'s record of an optimised gait: the driver's
+    (:func:`walkerlab.optimal.driver.optimize_scene`, whose ``phase_replays`` are the
+    replays themselves) with their records (:func:`phase_replay_records`) and the energies
+    in ``energy_unit`` (the scene's)."""
+    from dataclasses import replace
 
-    kw = {f.name: getattr(optimum, f.name) for f in fields(OptimizeData)
-          if f.name != "energy_unit"}
-    kw["phase_replays"] = phase_replay_records(kw["phase_replays"])
-    return OptimizeData(**kw, energy_unit=energy_unit)
+    return replace(optimum, phase_replays=phase_replay_records(optimum.phase_replays),
+                   energy_unit=energy_unit)
 
 
 def _write_phase(f, law: str, r: PhaseReplayData) -> None:

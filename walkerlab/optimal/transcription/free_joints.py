@@ -155,7 +155,7 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     Parameters
     ----------
     data : WalkerData
-        ``structure.free_knees`` set (with or without a torso).
+        Of the kind ``free_joints`` (with or without a torso).
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         ``intervals``, ``max_torque_n_m`` and the targets (its push-off fields must be off).
     fns : dict, optional
