@@ -1,7 +1,7 @@
 """The MFPT Monte Carlo walks on three integrators, in one process, interleaved: CPU per heel
 strike of walkerlab's compiled walk (:mod:`walkerlab.integrate.rows_dop853` through
 :func:`walkerlab.studies.mfpt.run_walks`), of CyRK's compiled DOP853 driven from a numba
-loop, and of the minimal numba loop (:mod:`walkerlab.bench.minimal_collocation`).
+loop, and of the minimal numba loop (:mod:`walkerlab.bench.monte_carlo_yardstick`).
 
     python scripts/bench_mc_cyrk.py [--scene configs/paper.yaml] [--walks 500] [--steps 100]
                                     [--sigma 0.002] [--repeats 5] [--out FILE.json]
@@ -163,7 +163,7 @@ def measure(scene_path: str, walks: int = 500, steps: int = 100, sigma: float = 
     minimal loop (medians and each repeat's), and the walks that differ from it."""
     sys.path.insert(0, str(ROOT))
     spec = importlib.util.spec_from_file_location(
-        "minimal_collocation", ROOT / "walkerlab" / "bench" / "minimal_collocation.py")
+        "monte_carlo_yardstick", ROOT / "walkerlab" / "bench" / "monte_carlo_yardstick.py")
     mc = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mc)
     from walkerlab.analysis.gait.scene import solve_scene

@@ -1,8 +1,9 @@
 """The structure of ``walkerlab optimize`` (read from the source, never run): one driver
-(:mod:`walkerlab.optimal.driver`) whose optimum is numbers (:class:`~walkerlab.optimal.
-driver.Optimum`), the stage building ``optimize.h5``'s records from it
-(:func:`walkerlab.io.schemas.optimize.optimize_record`), and one step of straight legs
-collocated as a sequence of one phase by the multi-phase transcription."""
+(:mod:`walkerlab.optimal.driver`) returning the one record type of an optimum
+(:class:`~walkerlab.io.schemas.optimize.OptimizeData`), the stage completing its records
+(:func:`walkerlab.io.schemas.optimize.optimize_record`), the transcription reached through
+the walker's kind, and one step of straight legs collocated as a sequence of one phase by
+the multi-phase transcription."""
 
 from __future__ import annotations
 
@@ -14,8 +15,8 @@ import numpy as np
 
 PKG = Path(__file__).resolve().parents[1] / "walkerlab"
 
-#: the names of optimize.h5's records
-RECORDS = {"OptimizeData", "PhaseReplayData", "optimize_record", "phase_replay_records"}
+#: what builds or writes optimize.h5's records (the stage's, never optimal/'s)
+RECORDS = {"PhaseReplayData", "optimize_record", "phase_replay_records", "write"}
 
 
 def _imported_names(path: Path) -> set:
@@ -27,8 +28,9 @@ def _imported_names(path: Path) -> set:
 
 
 def test_optimal_builds_no_artifact_records_the_stage_does():
-    """No module of ``walkerlab/optimal/`` imports a record of ``optimize.h5``; the stage
-    builds them (``optimize_record``); one driver module, no ``drivers/`` package."""
+    """No module of ``walkerlab/optimal/`` imports what builds or writes ``optimize.h5``'s
+    records; the stage does (``optimize_record``); one driver module, no ``drivers/``
+    package."""
     mods = sorted((PKG / "optimal").rglob("*.py"))
     assert len(mods) > 10
     bad = {str(p.relative_to(PKG)): sorted(n & RECORDS) for p in mods
@@ -40,27 +42,89 @@ def test_optimal_builds_no_artifact_records_the_stage_does():
     assert not (PKG / "optimal" / "records.py").exists()
 
 
-def test_an_optimum_becomes_the_artifacts_record_field_for_field():
-    """Every field of ``OptimizeData`` but the energy's unit (the scene's, given by the
-    stage) is a field of the driver's ``Optimum``; the phase replays become
-    ``PhaseReplayData``."""
+def test_one_record_type_per_optimum():
+    """The driver returns ``OptimizeData`` itself (no record type of its own repeating
+    its fields: no dataclass in the driver but its kinds' parts); the stage's
+    ``optimize_record`` turns the replays into ``PhaseReplayData`` and sets the scene's
+    energy unit, field for field otherwise."""
     from types import SimpleNamespace
 
     from walkerlab.io.schemas.optimize import OptimizeData, PhaseReplayData, optimize_record
-    from walkerlab.optimal.driver import Optimum
+    from walkerlab.optimal import driver
 
-    want = {f.name for f in fields(OptimizeData)} - {"energy_unit"}
-    assert want <= {f.name for f in fields(Optimum)}
+    tree = ast.parse((PKG / "optimal" / "driver.py").read_text())
+    classes = {n.name for n in tree.body if isinstance(n, ast.ClassDef)}
+    assert classes == {"Collocation"}, classes
+    assert driver.optimize_scene.__annotations__["return"] in ("OptimizeData", OptimizeData)
     replay = SimpleNamespace(collocated_start_error=1e-5, start_shift=2e-5,
                              return_error=3e-12, step_period_s=0.7, torque_error=0.02,
                              multipliers=np.array([0.4 + 0j]), closed=True, x0=np.zeros(2))
-    o = Optimum(np.zeros(3), {"a": np.zeros(3)}, np.zeros(3), 0.7, 0.5, 0.0, 1.0, 1e-9,
-                np.zeros(2, complex), True, "Solve_Succeeded", 5, 0.1, {"a": "rad"},
-                phase_replays={"feedback": replay})
+    o = OptimizeData(np.zeros(3), {"a": np.zeros(3)}, np.zeros(3), 0.7, 0.5, 0.0, 1.0, 1e-9,
+                     np.zeros(2, complex), True, "Solve_Succeeded", 5, 0.1, {"a": "rad"},
+                     phase_replays={"feedback": replay})
     d = optimize_record(o, "kJ")
     assert isinstance(d, OptimizeData) and d.energy_unit == "kJ"
     assert isinstance(d.phase_replays["feedback"], PhaseReplayData)
     assert d.phase_replays["feedback"].return_error == 3e-12 and d.step_period_s == 0.7
+    same = {f.name for f in fields(OptimizeData)} - {"energy_unit", "phase_replays"}
+    assert all(getattr(d, k) is getattr(o, k) for k in same)
+
+
+def _switch_reads(tree) -> list:
+    """The lines of ``tree`` that read a switch of the walker's description choosing its
+    kind (``.free_knees``, ``.spokes``, ``.lock``, ``structure.knee``, ``foot.kind``, a
+    comparison with ``"flat"`` or ``"rimless_wheel"``) or ``getattr(..., "actuation")``."""
+    out = []
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Attribute) and (
+                n.attr in ("free_knees", "spokes", "lock")
+                or (n.attr == "knee" and getattr(n.value, "attr", getattr(n.value, "id", ""))
+                    in ("structure", "st"))
+                or (n.attr == "kind" and getattr(n.value, "attr", "") == "foot")):
+            out.append(n.lineno)
+        elif isinstance(n, ast.Compare) and any(
+                isinstance(c, ast.Constant) and c.value in ("flat", "rimless_wheel")
+                for c in [n.left, *n.comparators]):
+            out.append(n.lineno)
+        elif (isinstance(n, ast.Call) and getattr(n.func, "id", "") == "getattr"
+              and len(n.args) > 1 and getattr(n.args[1], "value", None) == "actuation"):
+            out.append(n.lineno)
+    return out
+
+
+def test_the_transcription_is_reached_through_the_walker_kind():
+    """The driver has one part per walker kind it takes (:data:`walkerlab.optimal.driver.
+    PARTS`, by the kind's name); no module of ``walkerlab/optimal/`` reads a switch of the
+    description to choose its code (nor ``getattr`` for the walker's actuation); the
+    spoked wheel is refused from the capability table."""
+    from walkerlab.optimal.driver import PARTS
+    from walkerlab.walker.kinds import KINDS
+
+    assert set(PARTS) == set(KINDS) - {"rolling_polygon"}
+    assert not KINDS["rolling_polygon"].supports("walk", "optimize")
+    mods = sorted((PKG / "optimal").rglob("*.py")) + [PKG / "stages" / "optimize.py"]
+    bad = {str(p.relative_to(PKG)): got for p in mods
+           if (got := _switch_reads(ast.parse(p.read_text())))}
+    assert not bad, bad
+    probe = 'if st.foot == "flat" or s.free_knees: pass\na = getattr(w, "actuation", None)'
+    assert sorted(_switch_reads(ast.parse(probe))) == [1, 1, 2]  # the reader sees them
+
+
+def test_a_spoked_wheel_is_refused_from_the_table():
+    """``walkerlab optimize`` on a rimless wheel: the capability table's one line, naming
+    the walker, before any stage runs."""
+    import pytest
+
+    from walkerlab.config import load_scene
+    from walkerlab.optimal.driver import check_scene, needs_gait
+    from walkerlab.stages.common import with_defaults
+    from walkerlab.walker.kinds import KindRefused
+
+    scene = with_defaults(load_scene(PKG.parent / "configs" / "rimless_wheel.yaml"),
+                          "optimize", "optimize")
+    assert not needs_gait(scene)  # refused at once: no fixed point first
+    with pytest.raises(KindRefused, match=r"^walker: a spoked wheel is one rigid body"):
+        check_scene(scene)
 
 
 def _calls(path: Path, name: str) -> set:

@@ -30,9 +30,9 @@ WALKER_COUNT = re.compile(r"^(nq|NQ|n_coordinates|n_states)$")
 #: (path relative to walkerlab/, source of the subscript): why it is not a state
 ALLOWED = {("config/errors.py", "x[:1]"): "the first character of an exponent string",
            # the benchmark's plain-numba baseline is a hand-written compass gait, a model of
-           # its own that shares nothing with the library (walkerlab.bench.minimal_collocation)
+           # its own that shares nothing with the library (walkerlab.bench.monte_carlo_yardstick)
            **{(f"bench/{f}.py", f"x[{i}]"): "the baseline's own compass state"
-              for f in ("minimal_collocation", "minimal_casadi") for i in range(4)}}
+              for f in ("monte_carlo_yardstick", "minimal_casadi") for i in range(4)}}
 
 
 def _int_literal(e) -> bool:

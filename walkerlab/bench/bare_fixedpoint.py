@@ -5,7 +5,7 @@ this file as a whole process beside any code tree).
     python walkerlab/bench/bare_fixedpoint.py
 
 Model: the compass-gait walker of the paper's Table 1 (Goswami, Thuilot & Espiau 1996, INRIA
-RR-2996; the same equations as :mod:`walkerlab.bench.minimal_collocation`): legs of 1 m, 5 kg at
+RR-2996; the same equations as :mod:`walkerlab.bench.monte_carlo_yardstick`): legs of 1 m, 5 kg at
 0.5 m from the foot, hip 10 kg, g = 9.81 m/s^2, slope 0.0174 rad.  State ``[theta1, theta2,
 dtheta1, dtheta2]`` (swing leg first, absolute angles from the vertical) just after heel strike.
 One step is ``scipy.integrate.solve_ivp`` (DOP853, rtol = atol = 1e-12, the scene's solver) to
@@ -32,7 +32,7 @@ GUESS = np.array([-0.2022, 0.1674, -0.60, -0.84])  # the paper's Eq. (11)
 def flow(t, y):
     """dy/dt (4,) [rad/s, rad/s, rad/s^2, rad/s^2] of the pinned compass gait at the state
     ``y`` (4,) [rad, rad, rad/s, rad/s] (Lagrange; Goswami, Thuilot & Espiau 1996, the
-    equations of :func:`walkerlab.bench.minimal_collocation.flow`); ``t`` [s] unused."""
+    equations of :func:`walkerlab.bench.monte_carlo_yardstick.flow`); ``t`` [s] unused."""
     mu = M * A + (M + MH) * L
     s, c = math.sin(y[0] - y[1]), math.cos(y[0] - y[1])
     d11, d12, d22 = M * B * B, -M * L * B * c, M * A * A + (M + MH) * L * L

@@ -29,7 +29,7 @@ measurement            what is timed                                            
                        in process, :func:`walkerlab.studies.mfpt.run_walks`) against
                        the minimal numba loop over the same compass-gait flow at the
                        same accuracy and on the same slopes
-                       (:mod:`walkerlab.bench.minimal_collocation`), interleaved; also
+                       (:mod:`walkerlab.bench.monte_carlo_yardstick`), interleaved; also
                        the median, min and max over the repeats of the two timed back
                        to back (``montecarlo_pair_ratio_*``)
 ``mesh``               wall time of the mesh MFPT at ``sigma_mesh`` (2 workers,         15 s
@@ -75,7 +75,7 @@ import importlib.util, json, sys, time
 import numpy as np
 scene_path, sd, W, S, reps, base_file = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), \
     int(sys.argv[4]), int(sys.argv[5]), sys.argv[6]
-spec = importlib.util.spec_from_file_location("minimal_collocation", base_file)
+spec = importlib.util.spec_from_file_location("monte_carlo_yardstick", base_file)
 mc = importlib.util.module_from_spec(spec); spec.loader.exec_module(mc)
 from walkerlab.analysis.gait.scene import solve_scene
 from walkerlab.analysis.robustness.mfpt import draw_slopes
@@ -310,7 +310,7 @@ def run_main_job(scene: str = "configs/paper.yaml", code: Path | None = None,
             for r in range(max(1, repeats // 3)):
                 for k in (list(trees) if r % 2 == 0 else list(trees)[::-1]):
                     mc[k].append(child(trees[k], MC_CHILD, scene, sigma_mc, walks, steps,
-                                       max(3, repeats), HERE.with_name("minimal_collocation.py")))
+                                       max(3, repeats), HERE.with_name("monte_carlo_yardstick.py")))
         for r in range(mesh_repeats):
             for k in (list(trees) if r % 2 == 0 else list(trees)[::-1]):
                 if "mesh" in cfg["parts"]:

@@ -5,7 +5,7 @@ walkerlab import, so a benchmark can run this file as a process beside any code 
 Walker (configs/compass_optimal.yaml: the paper's Table 1 walker on a 0.0525 rad slope):
 two legs of length ``L`` [m], each a point mass ``m`` [kg] at ``a`` [m] from its foot, hip
 mass ``M_H`` [kg], gravity ``g`` [m/s^2] (Goswami, Thuilot & Espiau 1996, INRIA RR-2996;
-the derivation as in :mod:`walkerlab.bench.minimal_collocation`).  State
+the derivation as in :mod:`walkerlab.bench.monte_carlo_yardstick`).  State
 ``[theta1, theta2, dtheta1, dtheta2]`` [rad, rad/s], swing leg first, absolute angles from
 the vertical (walkerlab's ``swing_angle, stance_angle, swing_rate, stance_rate``); the hip
 torque ``u`` [N m] acts ``+u`` on the swing leg and ``-u`` on the stance leg.

@@ -37,7 +37,7 @@ be depends on the gait: too short and a step takes a second call, too long and t
 side in one process (``scripts/bench_mc_cyrk.py``: the same slopes, start, step cap and
 accuracy; the same walks and falls), CyRK with the span tuned to the paper walker's step
 was no faster than this module and at the Monte Carlo's allowance over the minimal numba
-loop (:mod:`walkerlab.bench.minimal_collocation`), and several times slower with a span that
+loop (:mod:`walkerlab.bench.monte_carlo_yardstick`), and several times slower with a span that
 does not suit the step; a span rule for every walker and every phase of this module's
 rows (several guards, the kneed and flat-foot phases) would have to be found first.  So
 this loop stays.  It is also what every stored Monte Carlo result was computed with

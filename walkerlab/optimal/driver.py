@@ -2,103 +2,45 @@
 from the scene - its walker, slope, push-off and ``optimize`` section - starts it from the
 scene's gait (or from the targets, or another optimisation), replays the optimum on the
 rigid model (its Floquet multipliers from the replay), in the contact model and as a
-phase-variable law, and returns it as an :class:`Optimum` (numbers; the stage writes the
-artifact's records: :func:`walkerlab.io.schemas.optimize.optimize_record`).
+phase-variable law, and returns it as ``optimize.h5``'s record
+(:class:`walkerlab.io.schemas.optimize.OptimizeData`, the one record type of an optimum;
+the stage fills in the scene's energy unit and the replays' records:
+:func:`walkerlab.io.schemas.optimize.optimize_record`).
 
-The transcription follows the walker's step (Hermite-Simpson collocation, CasADi + IPOPT):
+The transcription follows the walker's kind (:class:`walkerlab.walker.kinds.Kind`), reached
+through the kind's part (:data:`PARTS`: a :class:`Collocation` holding the kind's
+transcription, guess and replays; Hermite-Simpson collocation, CasADi + IPOPT); a kind the
+collocation does not take, and a feature the kind lacks here, are refused from the
+capability table (:func:`check_kind`):
 
-- straight legs (point or arc feet, a torso, massless legs with a hip mass): one step,
-  one phase, the heel strike's reset (push-off included) the periodic boundary condition
-  (:mod:`walkerlab.optimal.transcription.step`);
-- knees or flat feet: the step as the walker's sequence of phases, each with its guard and
-  reset from the generated model (:mod:`walkerlab.optimal.transcription.mode_sequence`);
-- legs that differ: a stride, the step sequence of the walker and its mirror
-  (:mod:`walkerlab.optimal.transcription.stride`, on the same multi-phase transcription);
-- free knees (a five-link biped): one phase with its four joint torques, from the targets
-  (Kelly 2017's set-up; :mod:`walkerlab.optimal.transcription.free_joints`), closed by
-  shooting and replayed as virtual constraints.
+- ``straight_legs`` (point or arc feet, a torso, massless legs with a hip mass): one
+  step, one phase, the heel strike's reset (push-off included) the periodic boundary
+  condition (:mod:`walkerlab.optimal.transcription.step`); legs that differ: a stride, the
+  step sequence of the walker and its mirror (:mod:`walkerlab.optimal.transcription.
+  stride`, on the multi-phase transcription);
+- ``locking_knees``, ``flat_feet``: the step as the walker's sequence of phases, each with
+  its guard and reset from the generated model
+  (:mod:`walkerlab.optimal.transcription.mode_sequence`);
+- ``free_joints`` (a five-link biped): one phase with its four joint torques, from the
+  targets (Kelly 2017's set-up; :mod:`walkerlab.optimal.transcription.free_joints`),
+  closed by shooting and replayed as virtual constraints;
+- ``rolling_polygon``: refused (a spoked wheel has no joint to drive).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
-__all__ = ["Optimum", "check_clearance", "check_targets", "collocation_spec", "five_link",
-           "needs_gait", "no_gait_of_its_own", "not_a_gait_outcome", "optimize_scene",
-           "replay_multipliers",
-           "starting_phases", "starting_stride", "history_and_energies", "stick_figures"]
+from walkerlab.io.schemas.optimize import OptimizeData
 
-
-@dataclass
-class Optimum:
-    """An optimised gait and its replays, in numbers (the fields of
-    :class:`walkerlab.io.schemas.optimize.OptimizeData`, whose record the stage builds from
-    it: :func:`walkerlab.io.schemas.optimize.optimize_record`).
-
-    Attributes
-    ----------
-    time : ndarray (m,)
-        Collocation times since the heel strike [s].
-    states : dict of str -> ndarray (m,)
-        The states by the rigid walker's names [rad, rad/s].
-    torque : ndarray (m,) or (m, k)
-        The optimised torque(s) [N m; N m/kg on massless legs].
-    step_period_s, step_length_m, push_off_n_s, objective : float
-        A stride's: its mean step's period and length.
-    replay_error : float
-        The rigid replay's return error [rad, rad/s].
-    multipliers : ndarray (2n,) complex
-        The replay map's Floquet multipliers (NaN: none).
-    gait : bool
-        IPOPT converged and the replay closed within ``optimize.replay_tolerance``.
-    status : str
-    iterations : int
-    wall_time_s : float
-    state_units : dict
-    energy : dict
-        ``kinetic``, ``potential`` at the points [J] (each step's from its own walker).
-    phase_replays : dict of str -> walkerlab.optimal.replay.phase.PhaseReplay
-        The phase-variable replays (empty: none; ``phase_replay_outcome`` says why).
-    The other fields: as :class:`~walkerlab.io.schemas.optimize.OptimizeData`.
-    """
-
-    time: np.ndarray
-    states: dict
-    torque: np.ndarray
-    step_period_s: float
-    step_length_m: float
-    push_off_n_s: float
-    objective: float
-    replay_error: float
-    multipliers: np.ndarray
-    gait: bool
-    status: str
-    iterations: int
-    wall_time_s: float
-    state_units: dict
-    objective_name: str = "effort"
-    objective_unit: str = "N^2 m^2 s"
-    terms: dict = field(default_factory=dict)
-    contact_step_period_s: float = float("nan")
-    contact_outcome: str = ""
-    torque_unit: str = "N m"
-    torque_names: tuple = ("hip",)
-    start_shift: float = float("nan")
-    replay_step_period_s: float = float("nan")
-    collocated_start_error: float = float("nan")
-    cpu_time_s: float = float("nan")
-    ipopt_history: dict = field(default_factory=dict)
-    energy: dict = field(default_factory=dict)
-    phase_names: tuple = ()
-    phase_start: np.ndarray | None = None
-    phase_duration_s: np.ndarray | None = None
-    build_time_s: float = float("nan")
-    phase_replays: dict = field(default_factory=dict)
-    steps: int = 1
-    phase_replay_outcome: str = ""
-    violations: str = ""
+__all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
+           "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
+           "not_a_gait_outcome", "optimize_scene", "replay_multipliers", "starting_phases",
+           "starting_stride", "history_and_energies", "stick_figures"]
 
 
 # -- the scene's set-up ------------------------------------------------------------------
@@ -110,7 +52,7 @@ def collocation_spec(scene):
     from walkerlab.optimal.transcription.step import CollocationSpec
 
     o = scene.optimize
-    act = getattr(scene.walker, "actuation", None)
+    act = scene.walker.actuation
     push = float(act.push_off.impulse_n_s) if act is not None and act.push_off else 0.0
     return CollocationSpec(intervals=o.intervals, push_off_n_s=push,
                            push_off_free=o.push_off == "free",
@@ -129,18 +71,48 @@ def collocation_spec(scene):
                            touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
 
 
+def _structure(scene):
+    """The walker structure of ``scene`` (:class:`walkerlab.walker.description.Structure`;
+    its kind: ``.kind``)."""
+    from walkerlab.walker.description import walker_data
+
+    return walker_data(scene.walker, scene.slope.phi_rad).structure
+
+
+def _part(structure) -> Collocation:
+    """The collocation's part for the walker kind of ``structure`` (:data:`PARTS`).
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+        A kind the collocation does not take (the capability table's line, ``walker: ...``).
+    """
+    structure.kind.require("walk", "optimize", "walker")
+    return PARTS[structure.kind.name]
+
+
 def needs_gait(scene) -> bool:
     """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
-    walker but a five-link biped (``walker.leg.knee.lock: free``), whose guess is built from
-    the targets, and a walker with no gait of its own (:func:`no_gait_of_its_own`), whose
-    step is built from them too (:func:`walkerlab.optimal.guess.target_step`)."""
-    return not five_link(scene) and not no_gait_of_its_own(scene)
+    walker kind but one whose guess is built from the targets (a five-link biped:
+    :attr:`Collocation.from_targets`) and a walker with no gait of its own
+    (:func:`no_gait_of_its_own`), whose step is built from them too
+    (:func:`walkerlab.optimal.guess.target_step`).  A kind the collocation does not take
+    needs none (the stage refuses it at once)."""
+    part = PARTS.get(_structure(scene).kind.name)
+    return part is not None and not part.from_targets and not no_gait_of_its_own(scene)
 
 
-def five_link(scene) -> bool:
-    """Whether the scene's walker is a five-link biped (``walker.leg.knee.lock: free``)."""
-    knee = getattr(getattr(scene.walker, "leg", None), "knee", None)
-    return getattr(knee, "lock", None) == "free"
+def guess_from_targets(scene) -> bool:
+    """Whether the scene's walker kind starts its optimisation from the targets alone, with
+    no upstream gait, and needs them (:func:`check_targets`): a five-link biped
+    (:attr:`Collocation.from_targets`).
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+        A kind the collocation does not take (one line).
+    """
+    return _part(_structure(scene)).from_targets
 
 
 def no_gait_of_its_own(scene) -> bool:
@@ -152,7 +124,7 @@ def no_gait_of_its_own(scene) -> bool:
     the hip torque powering it: Srinivasan & Ruina 2006, Kelly 2017's OptimTraj) starts
     from the targets."""
     o = getattr(scene, "optimize", None)
-    return (getattr(scene.walker, "actuation", None) is None and scene.slope.phi_rad <= 0.0
+    return (scene.walker.actuation is None and scene.slope.phi_rad <= 0.0
             and (o is None or o.initial_guess is None))
 
 
@@ -179,9 +151,10 @@ def check_targets(o) -> None:
 # -- the one entry point -----------------------------------------------------------------
 
 def optimize_scene(scene, x_gait: np.ndarray | None = None,
-                   period_s: float | None = None) -> Optimum:
-    """Optimise the scene's gait (the ``optimize`` section): a step, a step of phases, a
-    stride of two steps (legs that differ) or a five-link biped's step (module docstring).
+                   period_s: float | None = None) -> OptimizeData:
+    """Optimise the scene's gait (the ``optimize`` section) by its walker kind's part
+    (:data:`PARTS`): a step, a step of phases, a stride of two steps (legs that differ) or
+    a five-link biped's step (module docstring).
 
     Parameters
     ----------
@@ -197,46 +170,73 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
 
     Returns
     -------
-    Optimum
+    walkerlab.io.schemas.optimize.OptimizeData
+        The optimum and its replays (``phase_replays``: the replays themselves,
+        :class:`walkerlab.optimal.replay.phase.PhaseReplay`; the stage's
+        :func:`walkerlab.io.schemas.optimize.optimize_record` makes them records and sets
+        the scene's energy unit).
 
     Raises
     ------
     ValueError
-        A walker the transcription does not handle, the starting gait does not make a step,
-        the initial guess's artifact is unusable, no gait and a walker the targets' guess
-        does not build (legs with knees, flat feet, legs that differ), a five-link biped
-        without a target or with a push-off (one line).
+        A walker kind or feature the collocation does not take (the capability table's
+        line: :func:`check_kind`), the starting gait does not make a step, the initial
+        guess's artifact is unusable, no gait and a walker the targets' guess does not
+        build (legs with knees, flat feet, legs that differ), a five-link biped without a
+        target (one line).
     """
     try:
         import casadi  # noqa: F401 - the collocation's modelling layer and IPOPT
     except ImportError:
         raise ValueError("optimize needs CasADi: pip install -e '.[optimize]'") from None
-    if five_link(scene):
-        return _five_link(scene)
     from walkerlab.walker.description import walker_data
 
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    spec = collocation_spec(scene)
-    check_clearance(scene, data)
-    if x_gait is None and (data.mirror is not None or data.structure.knee
-                           or data.structure.foot == "flat"):
+    part = _part(data.structure)
+    check_scene(scene, data)
+    if x_gait is None and not part.from_targets and (data.mirror is not None
+                                                     or not part.target_step):
         raise ValueError("optimize: the walker has no gait of its own to start from (passive "
                          "on level ground), and a step from the targets is built for "
                          "straight legs with point feet only; give optimize.initial_guess "
                          "(another optimize.h5) or a downhill slope")
-    if data.mirror is not None:  # legs that differ: a stride of two different steps
-        return _stride(scene, data, spec, x_gait, period_s)
-    if data.structure.knee or data.structure.foot == "flat":  # a step of phases
-        return _phased(scene, data, spec, x_gait, period_s)
-    return _step(scene, data, spec, x_gait, period_s)
+    return part.optimize(scene, data, x_gait, period_s)
 
 
-def check_clearance(scene, data=None) -> None:
-    """Refuse, before any stage runs, what the collocation cannot do: a clearance that
-    cannot hold (``optimize.min_clearance_m > 0`` for straight legs of one length and foot:
-    :func:`_feet_level_when_legs_cross`) and a push-off on a kneed walker (the phased
-    transcription has none: :data:`walkerlab.optimal.transcription.mode_sequence.
-    PHASED_PUSH_OFF`).
+def check_kind(scene, kind) -> None:
+    """Refuse what the walker's kind does not have in the collocation, from the capability
+    table (:data:`walkerlab.walker.kinds.CAPABILITIES`, view ``optimize``): the walker
+    itself (a spoked wheel), a push-off (fixed, ``walker.actuation.push_off``, or
+    ``optimize.push_off: free``), an ankle push-off.
+
+    Parameters
+    ----------
+    scene : Scene
+        With ``optimize``.
+    kind : walkerlab.walker.kinds.Kind
+        Its walker's.
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+        ``walker: ...``, ``optimize.push_off: ...`` or ``walker.actuation.ankle_push_off:
+        ...`` (one line).
+    """
+    kind.require("walk", "optimize", "walker")
+    act = scene.walker.actuation
+    if scene.optimize.push_off == "free" or (act is not None and act.push_off
+                                             and act.push_off.impulse_n_s):
+        kind.require("push_off", "optimize", "optimize.push_off")
+    if act is not None and act.ankle_push_off is not None:
+        kind.require("ankle_push_off", "optimize", "walker.actuation.ankle_push_off")
+
+
+def check_scene(scene, data=None) -> None:
+    """Refuse, before any stage runs, what the collocation cannot do: what the walker's
+    kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
+    flat-footed or five-link walker) and a clearance that cannot hold
+    (``optimize.min_clearance_m > 0`` for straight legs of one length and foot:
+    :func:`_feet_level_when_legs_cross`).
 
     Parameters
     ----------
@@ -247,22 +247,17 @@ def check_clearance(scene, data=None) -> None:
     Raises
     ------
     ValueError
-        ``optimize.min_clearance_m: ...`` or ``optimize.push_off: ...`` with the reason and
-        what to give instead (one line).
+        ``walker: ...``, ``optimize.push_off: ...``, ``optimize.min_clearance_m: ...``
+        with the reason and what to give instead (one line).
     """
     o = getattr(scene, "optimize", None)
-    if o is None or five_link(scene):
+    if o is None:
         return
     if data is None:
         from walkerlab.walker.description import walker_data
 
         data = walker_data(scene.walker, scene.slope.phi_rad)
-    act = getattr(scene.walker, "actuation", None)
-    if data.structure.knee and (o.push_off == "free" or (
-            act is not None and act.push_off and act.push_off.impulse_n_s)):
-        from walkerlab.optimal.transcription.mode_sequence import PHASED_PUSH_OFF
-
-        raise ValueError(PHASED_PUSH_OFF)
+    check_kind(scene, data.structure.kind)
     if (o.min_clearance_m or 0.0) > 0.0 and _feet_level_when_legs_cross(scene, data):
         raise ValueError(
             "optimize.min_clearance_m: straight legs cannot clear the ground mid-swing: the "
@@ -272,15 +267,15 @@ def check_clearance(scene, data=None) -> None:
 
 
 def _feet_level_when_legs_cross(scene, data) -> bool:
-    """Whether the swing foot is level with the stance foot when the legs cross: straight
-    legs (no knee, not flat feet) of one length and foot.  With the legs at angles
-    ``theta`` (stance) and ``phi`` (swing) from the slope's normal, the swing foot's
-    clearance is ``l (cos theta - cos phi)`` (point feet; arc feet alike, the arcs' centres
-    at the same distance), zero when ``phi = theta``: the swing leg passes the stance leg
-    mid-step, so no clearance > 0 holds over the swing - the straight-legged models ignore
-    that scuffing (McGeer 1990, Int. J. Robotics Research 9(2):62-82; Garcia et al. 1998,
-    J. Biomech. Eng. 120:281-288)."""
-    if data.structure.knee or data.structure.foot == "flat":
+    """Whether the swing foot is level with the stance foot when the legs cross: a kind
+    whose legs are straight (:attr:`Collocation.legs_cross_level`), of one length and
+    foot.  With the legs at angles ``theta`` (stance) and ``phi`` (swing) from the slope's
+    normal, the swing foot's clearance is ``l (cos theta - cos phi)`` (point feet; arc
+    feet alike, the arcs' centres at the same distance), zero when ``phi = theta``: the
+    swing leg passes the stance leg mid-step, so no clearance > 0 holds over the swing -
+    the straight-legged models ignore that scuffing (McGeer 1990, Int. J. Robotics
+    Research 9(2):62-82; Garcia et al. 1998, J. Biomech. Eng. 120:281-288)."""
+    if not _part(data.structure).legs_cross_level:
         return False
     w = scene.walker.model_dump()
     legs = [leg for leg in [w.get("leg")] + list(w.get("legs") or []) if leg]
@@ -342,8 +337,9 @@ def _phase_replays(scene, data, res, tau) -> tuple[dict, str]:
 def history_and_energies(scene, walker, res) -> dict:
     """IPOPT's iteration history and the walker's kinetic and potential energy at the
     collocation points (``res``: a collocation result with ``x`` (2N + 1, 2n) in the
-    walker's state order and ``history``), as :class:`Optimum` keywords (J); with the
-    constraint groups IPOPT left violated (``res.violations``, when it did not converge)."""
+    walker's state order and ``history``), as
+    :class:`~walkerlab.io.schemas.optimize.OptimizeData` keywords (J); with the constraint
+    groups IPOPT left violated (``res.violations``, when it did not converge)."""
     ke, pe = walker.energies(np.asarray(res.x, float).T)
     return {"ipopt_history": dict(res.history),
             "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)},
@@ -405,7 +401,14 @@ def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
 
 # -- one step of straight legs -----------------------------------------------------------
 
-def _step(scene, data, spec, x_gait, period_s) -> Optimum:
+def _straight_legs(scene, data, x_gait, period_s) -> OptimizeData:
+    """Straight legs: one step (:func:`_step`), or a stride of two steps when the legs
+    differ (:func:`_stride`)."""
+    spec = collocation_spec(scene)
+    return (_step if data.mirror is None else _stride)(scene, data, spec, x_gait, period_s)
+
+
+def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     """One step of straight legs (point or arc feet, a torso, massless legs with a hip
     mass): :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`."""
     from walkerlab.models.registry import build_walker
@@ -429,14 +432,14 @@ def _step(scene, data, spec, x_gait, period_s) -> Optimum:
         scene, res, err, lambda: contact_replay(scene, res))
     phases, phase_note = _phase_replays(scene, data, res, torque_of_time(res))
     states, units = _states(walker, res)
-    return Optimum(res.t, states, res.u, res.step_period_s, res.step_length_m,
-                   res.push_off_n_s, res.objective, err, mu, gait, res.status,
-                   res.iterations, res.wall_time_s, units, objective_name=o.objective,
-                   objective_unit=_unit(o, data), terms=res.terms,
-                   contact_step_period_s=contact_period, contact_outcome=contact_outcome,
-                   torque_unit="N m/kg" if _massless(data) else "N m",
-                   phase_replays=phases, phase_replay_outcome=phase_note,
-                   **history_and_energies(scene, walker, res))
+    return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m,
+                        res.push_off_n_s, res.objective, err, mu, gait, res.status,
+                        res.iterations, res.wall_time_s, units, objective_name=o.objective,
+                        objective_unit=_unit(o, data), terms=res.terms,
+                        contact_step_period_s=contact_period, contact_outcome=contact_outcome,
+                        torque_unit="N m/kg" if _massless(data) else "N m",
+                        phase_replays=phases, phase_replay_outcome=phase_note,
+                        **history_and_energies(scene, walker, res))
 
 
 # -- a step of phases (knees, flat feet) -------------------------------------------------
@@ -481,18 +484,20 @@ def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
     return (*optimized_guess(got, [n for n, _g, _d in order], intervals), order)
 
 
-def _phased(scene, data, spec, x_gait, period_s) -> Optimum:
+def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> OptimizeData:
     """One step of a kneed or flat-footed walker phase by phase
     (:func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`), replayed on
     the rigid model and in the contact model (2 strides; the hip torque acts between a
-    kneed walker's thighs, between a flat-footed walker's legs)."""
+    kneed walker's thighs, between a flat-footed walker's legs).  ``resolve_gait``: the
+    scene's gait has a double-support phase the collocation's walker has not (flat feet),
+    so the start is that walker's own gait, solved here (``x_gait``, ``period_s``
+    unused)."""
     import time
 
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.replay.contact import contact_replay_phased
     from walkerlab.optimal.transcription.mode_sequence import (
-        PHASED_PUSH_OFF,
         collocate_phases,
         phase_torque_of_time,
         replay_phases,
@@ -500,16 +505,9 @@ def _phased(scene, data, spec, x_gait, period_s) -> Optimum:
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
     o = scene.optimize
-    act = getattr(scene.walker, "actuation", None)
-    if act is not None and getattr(act, "ankle_push_off", None) is not None:
-        raise ValueError("walker.actuation.ankle_push_off: the phased transcription has a hip "
-                         "torque only (the rigid flat feet take an ankle push-off or hip "
-                         "torques, not together)")
-    if data.structure.knee and (spec.push_off_free or spec.push_off_n_s):
-        # before the guess: the passive guess of a pushed walker may not make a step
-        raise ValueError(PHASED_PUSH_OFF)
+    spec = collocation_spec(scene)  # its push-off refused before (check_kind)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
-    if data.structure.foot == "flat":  # fixedpoint's gait has its double support
+    if resolve_gait:  # fixedpoint's gait has its double support
         g = solve_scene(scene, False, walker=walker)[1].gait.result
         x_gait, period_s = g.x, float(g.period_s)
     guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
@@ -524,15 +522,16 @@ def _phased(scene, data, spec, x_gait, period_s) -> Optimum:
         scene, res, err, lambda: contact_replay_phased(scene, res, strides=2))
     phases, phase_note = _phase_replays(scene, data, res, phase_torque_of_time(res))
     states, units = _states(walker, res)
-    return Optimum(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
-                   res.objective, err, mu, gait, res.status, res.iterations,
-                   res.wall_time_s, units, objective_name=o.objective,
-                   objective_unit=_unit(o), terms=res.terms,
-                   contact_step_period_s=contact_period, contact_outcome=contact_outcome,
-                   cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
-                   phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
-                   build_time_s=build + res.build_time_s, phase_replays=phases,
-                   phase_replay_outcome=phase_note, **history_and_energies(scene, walker, res))
+    return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
+                        res.objective, err, mu, gait, res.status, res.iterations,
+                        res.wall_time_s, units, objective_name=o.objective,
+                        objective_unit=_unit(o), terms=res.terms,
+                        contact_step_period_s=contact_period, contact_outcome=contact_outcome,
+                        cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
+                        phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
+                        build_time_s=build + res.build_time_s, phase_replays=phases,
+                        phase_replay_outcome=phase_note,
+                        **history_and_energies(scene, walker, res))
 
 
 # -- a stride of two steps (legs that differ) --------------------------------------------
@@ -591,7 +590,7 @@ def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
                         intervals), None
 
 
-def _stride(scene, data, spec, x_gait, period_s) -> Optimum:
+def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
     """One stride of a walker whose legs differ (the step sequence of the walker and its
     mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
@@ -626,17 +625,17 @@ def _stride(scene, data, spec, x_gait, period_s) -> Optimum:
     record["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
                         for kind in record["energy"]}
     states, units = _states(walker, res)
-    return Optimum(res.t, states, res.u, res.step_period_s / 2, float(np.mean(lengths)),
-                   res.push_off_n_s, res.objective, err, mu, gait, res.status,
-                   res.iterations, res.wall_time_s, units, objective_name=o.objective,
-                   objective_unit=_unit(o), terms=res.terms,
-                   contact_step_period_s=contact_period, contact_outcome=contact_outcome,
-                   cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
-                   phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
-                   build_time_s=build + res.build_time_s, steps=2,
-                   phase_replay_outcome="not replayed: a stride of legs that differ is "
-                   "replayed as a function of time only" if o.phase_replay else "",
-                   **record)
+    return OptimizeData(res.t, states, res.u, res.step_period_s / 2, float(np.mean(lengths)),
+                        res.push_off_n_s, res.objective, err, mu, gait, res.status,
+                        res.iterations, res.wall_time_s, units, objective_name=o.objective,
+                        objective_unit=_unit(o), terms=res.terms,
+                        contact_step_period_s=contact_period, contact_outcome=contact_outcome,
+                        cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
+                        phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
+                        build_time_s=build + res.build_time_s, steps=2,
+                        phase_replay_outcome="not replayed: a stride of legs that differ is "
+                        "replayed as a function of time only" if o.phase_replay else "",
+                        **record)
 
 
 def _guide(walker, data, spec):
@@ -657,7 +656,7 @@ def _guide(walker, data, spec):
 CONTACT_STRIDES = 2
 
 
-def _five_link(scene) -> Optimum:
+def _five_link(scene, data, x_gait=None, period_s=None) -> OptimizeData:
     """Optimise, close and replay one step of the scene's five-link walker: collocated
     (:mod:`walkerlab.optimal.transcription.free_joints`, its four joint torques), closed by
     shooting under its own torques (:mod:`walkerlab.optimal.replay.shooting`), replayed on
@@ -670,8 +669,8 @@ def _five_link(scene) -> Optimum:
     Raises
     ------
     ValueError
-        No target (:func:`check_targets`), a push-off asked for, a walker the five-link
-        generator does not handle (one line).
+        No target (:func:`check_targets`), a walker the five-link generator does not
+        handle (one line).
     """
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.replay.shooting import close_step
@@ -684,14 +683,9 @@ def _five_link(scene) -> Optimum:
         replay_five_link,
     )
     from walkerlab.optimal.transcription.step import CollocationSpec
-    from walkerlab.walker.description import walker_data
 
     o = scene.optimize
     check_targets(o)
-    if o.push_off == "free":
-        raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
-                         "knees are driven)")
-    data = walker_data(scene.walker, scene.slope.phi_rad)
     fns = five_link_functions(data.structure)
     spec = CollocationSpec(intervals=o.intervals, max_torque_n_m=o.max_torque_n_m,
                            target_speed_m_per_s=o.target_speed_m_per_s,
@@ -709,7 +703,7 @@ def _five_link(scene) -> Optimum:
                            "not replayed: not a gait (the shooting did not close the step)")
     phases, contact = _five_link_replays(scene, data, res, why)
     states, units = _states(rigid, res)
-    return Optimum(
+    return OptimizeData(
         res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0, res.objective, err,
         closed.multipliers, gait, res.status, res.iterations, res.wall_time_s, units,
         torque_names=JOINTS, start_shift=closed.shift, replay_step_period_s=closed.period_s,
@@ -764,3 +758,44 @@ def stick_figures(scene, d, frames: int = 8) -> list:
         top = next(v for key, v in pts.items() if key.startswith("torso_"))
         out.append(np.array([pts[n] if n != "torso_top" else top for n in STICK]))
     return out
+
+
+# -- the collocation's part per walker kind ----------------------------------------------
+
+@dataclass(frozen=True)
+class Collocation:
+    """How ``walkerlab optimize`` finds and replays the optimal gait of one walker kind
+    (:class:`walkerlab.walker.kinds.Kind`): its transcription, starting guess and replay
+    laws, reached through :data:`PARTS` by the kind's name.
+
+    Attributes
+    ----------
+    optimize : callable
+        ``(scene, data, x_gait, period_s) -> OptimizeData``: set up, started, solved and
+        replayed (``data``: the scene's :class:`~walkerlab.walker.description.WalkerData`;
+        ``x_gait`` (2n,), ``period_s`` [s]: the scene's gait, or None).
+    from_targets : bool
+        The guess is built from the targets alone, which are required
+        (:func:`check_targets`), with no upstream gait (Kelly 2017's set-up).
+    target_step : bool
+        A walker of the kind with no gait of its own starts from a step built from the
+        targets (:func:`walkerlab.optimal.guess.target_step`).
+    legs_cross_level : bool
+        The legs are straight: the swing foot is level with the stance foot when the legs
+        of one length cross (:func:`_feet_level_when_legs_cross`).
+    """
+
+    optimize: Callable[..., OptimizeData]
+    from_targets: bool = False
+    target_step: bool = False
+    legs_cross_level: bool = False
+
+
+#: the collocation's part for each walker kind it takes, by :attr:`Kind.name` (the spoked
+#: wheel has none: refused from the capability table, :func:`_part`)
+PARTS = {
+    "straight_legs": Collocation(_straight_legs, target_step=True, legs_cross_level=True),
+    "locking_knees": Collocation(_phased),
+    "flat_feet": Collocation(partial(_phased, resolve_gait=True)),
+    "free_joints": Collocation(_five_link, from_targets=True),
+}

@@ -39,14 +39,15 @@ def check(scene: Scene, **options) -> None:
     walkerlab.extras.MissingExtra
         CasADi is not installed (one line naming the ``optimize`` extra).
     ValueError
-        A swing-foot clearance that cannot hold (``optimize.min_clearance_m > 0`` on
-        straight legs: :func:`walkerlab.optimal.driver.check_clearance`; one line).
+        A walker kind or feature the collocation does not take (the capability table's
+        line), a swing-foot clearance that cannot hold (``optimize.min_clearance_m > 0`` on
+        straight legs: :func:`walkerlab.optimal.driver.check_scene`; one line).
     """
     from walkerlab.extras import require
-    from walkerlab.optimal.driver import check_clearance
+    from walkerlab.optimal.driver import check_scene
 
     require("casadi", "optimize", "walkerlab optimize")
-    check_clearance(scene)
+    check_scene(scene)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
@@ -59,13 +60,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         chained to its origin for the debug trace); a five-link biped without a target
         in its ``optimize`` section, or without the section (its step is built from the
         targets).  A missing ``optimize`` section of another walker runs with its
-        defaults (said in one note), a missing ``fixedpoint`` section with its.
+        defaults (said in one note), a missing ``fixedpoint`` section with its.  A walker
+        kind the collocation does not take (the capability table's line).
     """
-    from walkerlab.optimal.driver import check_targets, five_link, no_gait_of_its_own
+    from walkerlab.optimal.driver import check_targets, guess_from_targets, no_gait_of_its_own
 
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
-    if five_link(scene):  # a five-link biped: its guess is built from the targets
+    try:
+        from_targets = guess_from_targets(scene)
+    except ValueError as exc:  # a kind the collocation does not take
+        raise StageError(str(exc)) from exc
+    if from_targets:  # a five-link biped: its guess is built from the targets
         try:
             check_targets(scene.optimize)  # at once, before the collocation is built
         except ValueError as exc:

@@ -162,7 +162,6 @@ _ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: check
                   "the footholds' heights), not continuous profile")
 _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
                     "scene without it")
-_PHASED_PUSH_OFF = "the phased transcription (knees or flat feet) has no push-off yet"
 _FIVE_LINK_JOINTS = ("stance_hip, swing_hip, stance_knee and swing_knee need a five-link "
                      "biped (free knees, a torso)")
 #: what the views of every legged kind refuse: grounds whose steps differ outside the rigid
@@ -174,6 +173,11 @@ _GROUNDS = {
     ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,
 }
+_FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
+_PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
+                    "its heel strike is the plain impact (the rigid kneed model's push-off "
+                    "runs in fixedpoint and simulate, not here); optimise the hip torque "
+                    "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -201,14 +205,17 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                "(walker.leg.knee)"),
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
-        ("walk", "gym"): ("flat feet are not carried yet (each stance-foot mode has its own "
-                          "mass matrix); use point or arc feet"),
+        ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         ("stairs", "*"): ("flat feet on stairs or footholds are not supported yet (their "
                           "heel strike is a guard per foot mode)"),
         ("footholds", "*"): ("footholds of several heights or slopes: not built for this "
                              "walker (flat feet or actuators)"),
         ("profile", "adams"): _ADAMS_PROFILE,
         ("profile", "gym"): _GYM_GROUND,
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
+                                         "(the rigid flat feet take an ankle push-off or "
+                                         "hip torques, not together)"),
     },
     "free_joints": {
         ("ankle_torque", "*"): _NO_ANKLE,

@@ -94,7 +94,40 @@ class PhaseReplayData:
 
 @dataclass
 class OptimizeData:
-    """The contents of ``optimize.h5`` (units in the module docstring)."""
+    """The contents of ``optimize.h5`` (units in the module docstring): the one record of
+    an optimised gait, as the driver returns it (:func:`walkerlab.optimal.driver.
+    optimize_scene`; its ``phase_replays`` the replays themselves until
+    :func:`optimize_record` makes them :class:`PhaseReplayData`) and as :func:`load`
+    reads it.
+
+    Attributes
+    ----------
+    time : ndarray (m,)
+        Collocation times since the heel strike [s].
+    states : dict of str -> ndarray (m,)
+        The states by the rigid walker's names [rad, rad/s].
+    torque : ndarray (m,) or (m, k)
+        The optimised torque(s) [N m; N m/kg on massless legs].
+    step_period_s, step_length_m, push_off_n_s, objective : float
+        A stride's: its mean step's period and length.
+    replay_error : float
+        The rigid replay's return error [rad, rad/s].
+    multipliers : ndarray (2n,) complex
+        The replay map's Floquet multipliers (NaN: none).
+    gait : bool
+        IPOPT converged and the replay closed within ``optimize.replay_tolerance``.
+    status, iterations, wall_time_s, cpu_time_s, build_time_s
+        IPOPT's status and iterations, the solve's wall and CPU time and the programme's
+        build time [s].
+    state_units : dict
+    energy : dict
+        ``kinetic``, ``potential`` at the points [``energy_unit``] (each step's from its
+        own walker).
+    phase_replays : dict
+        Law name -> :class:`PhaseReplayData` (the driver's: the replays themselves; empty:
+        none, ``phase_replay_outcome`` says why).
+    The other fields: the module docstring's datasets and attributes.
+    """
 
     time: np.ndarray
     states: dict
@@ -145,17 +178,15 @@ def phase_replay_records(replays: dict) -> dict:
             for name, r in replays.items()}
 
 
-def optimize_record(optimum, energy_unit: str = "J") -> OptimizeData:
-    """``optimize.h5``'s record of an optimised gait (the driver's
-    :class:`walkerlab.optimal.driver.Optimum`: an object with :class:`OptimizeData`'s
-    fields, its ``phase_replays`` the replays themselves), the energies in
-    ``energy_unit`` (the scene's)."""
-    from dataclasses import fields
+def optimize_record(optimum: OptimizeData, energy_unit: str = "J") -> OptimizeData:
+    """``optimize.h5``'s record of an optimised gait: the driver's
+    (:func:`walkerlab.optimal.driver.optimize_scene`, whose ``phase_replays`` are the
+    replays themselves) with their records (:func:`phase_replay_records`) and the energies
+    in ``energy_unit`` (the scene's)."""
+    from dataclasses import replace
 
-    kw = {f.name: getattr(optimum, f.name) for f in fields(OptimizeData)
-          if f.name != "energy_unit"}
-    kw["phase_replays"] = phase_replay_records(kw["phase_replays"])
-    return OptimizeData(**kw, energy_unit=energy_unit)
+    return replace(optimum, phase_replays=phase_replay_records(optimum.phase_replays),
+                   energy_unit=energy_unit)
 
 
 def _write_phase(f, law: str, r: PhaseReplayData) -> None:

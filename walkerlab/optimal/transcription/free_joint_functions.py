@@ -96,7 +96,8 @@ def five_link_functions(structure) -> dict:
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
-        ``free_knees`` set (the five-link generator's walkers).
+        Of the kind ``free_joints`` (:attr:`~walkerlab.walker.description.Structure.kind`:
+        the five-link generator's walkers).
 
     Returns
     -------
@@ -112,7 +113,7 @@ def five_link_functions(structure) -> dict:
     from walkerlab.codegen.cache import cache_key
     from walkerlab.codegen.casadi_functions import cached_functions
 
-    if not (structure.free_knees and structure.hinged_torso):
+    if structure.kind.name != "free_joints" or not structure.hinged_torso:
         raise ValueError("optimize: the five-link collocation drives the hips between a hinged "
                          "torso and the thighs and the free knees (walker.torso.coupling: "
                          "hinged, walker.leg.knee.lock: free)")

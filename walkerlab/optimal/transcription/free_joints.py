@@ -155,7 +155,7 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     Parameters
     ----------
     data : WalkerData
-        ``structure.free_knees`` set (with or without a torso).
+        Of the kind ``free_joints`` (with or without a torso).
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         ``intervals``, ``max_torque_n_m`` and the targets (its push-off fields must be off).
     fns : dict, optional
@@ -169,7 +169,7 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     Raises
     ------
     ValueError
-        A push-off asked for (one line).
+        A push-off asked for (the capability table's line: ``optimize.push_off: ...``).
     """
     from dataclasses import replace
 
@@ -178,9 +178,8 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     from walkerlab.optimal.transcription.free_joint_functions import five_link_functions
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
 
-    if spec.push_off_free or spec.push_off_n_s:
-        raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
-                         "knees are driven)")
+    if spec.push_off_free or spec.push_off_n_s:  # the capability table's line
+        data.structure.kind.require("push_off", "optimize", "optimize.push_off")
     fns = fns or five_link_functions(data.structure)
     K = 2 * int(spec.intervals) + 1
     p = ca.DM(np.asarray(data.params, float))

@@ -24,6 +24,7 @@ from walkerlab.optimal.transcription.ipopt import (
     largest_violations,
     solve,
 )
+from walkerlab.walker.kinds import KINDS
 
 __all__ = ["PhasedResult", "collocate_phases", "collocate_step", "optimized_guess",
            "phase_torque_of_time", "phased_guess", "replay_phases", "step_phase"]
@@ -279,12 +280,9 @@ def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
     return work
 
 
-#: why a walker with phases is not optimised with a push-off (one line)
-PHASED_PUSH_OFF = (
-    "optimize.push_off: the phased transcription (knees or flat feet) has no push-off yet: "
-    "its heel strike is the plain impact (the rigid kneed model's push-off runs in "
-    "fixedpoint and simulate, not here); optimise the hip torque alone (no "
-    "walker.actuation.push_off, optimize.push_off: fixed)")
+#: why a walker with phases is not optimised with a push-off (one line: the capability
+#: table's, :data:`walkerlab.walker.kinds.CAPABILITIES`)
+PHASED_PUSH_OFF = "optimize.push_off: " + KINDS["locking_knees"].cell("push_off", "optimize")
 
 
 def _pushes(spec) -> bool:

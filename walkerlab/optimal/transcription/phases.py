@@ -177,11 +177,12 @@ def mode_functions(data, walker, order=None) -> dict:
     import casadi as ca
 
     st = data.structure
-    if st.torso or st.free_knees or st.foot == "arc" or any(b.massless for b in st.bodies):
+    modes = _MODES.get(st.kind.name)
+    if modes is None or st.torso or st.foot == "arc" or any(b.massless for b in st.bodies):
         raise ValueError("optimize: the phased transcription takes massive legs with point "
                          "or flat feet and no torso today")
     order = order if order is not None else phase_order(walker)
-    kind = _FlatModes(data) if st.foot == "flat" else _KneedModes(data)
+    kind = modes(data)
     n = kind.n
     x, u, P = ca.SX.sym("x", 2 * n), ca.SX.sym("u"), ca.SX.sym("P")
     phases = []
@@ -276,9 +277,10 @@ class _Modes:
 
 
 class _KneedModes(_Modes):
-    """A kneed walker (or straight legs): ``unlocked_swing`` / ``early_swing`` /
-    ``late_swing`` on the free flow, ``locked_swing`` on the locked one; ``knee_strike``
-    (the plastic knee strike), ``midstance`` (no jump), ``heel_strike``."""
+    """A kneed walker (or straight legs: :class:`_StraightModes`): ``unlocked_swing`` /
+    ``early_swing`` / ``late_swing`` on the free flow, ``locked_swing`` on the locked one;
+    ``knee_strike`` (the plastic knee strike), ``midstance`` (no jump), ``heel_strike``
+    (the plain impact: the rigid kneed model's push-off is not transcribed)."""
 
     def __init__(self, data):
         from walkerlab.codegen import symbolic
@@ -318,19 +320,6 @@ class _KneedModes(_Modes):
     def clearance(self, name, x):
         return self.cas([self.eq.guards["swing_clearance"]], x)
 
-    def push_off(self, gname, x, P, k):
-        """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step
-        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`)."""
-        import casadi as ca
-
-        from walkerlab.optimal.transcription.step import _reset_extended
-
-        if gname != "heel_strike" or self.data.structure.knee:
-            return None
-        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
-                                       self.data.total_mass_kg)
-        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
-
     def grf(self, name, x, f):
         return self.resultant(self.eq.points, x, f)
 
@@ -339,6 +328,24 @@ class _KneedModes(_Modes):
 
         foot = self.cas(self.eq.points["swing_foot"], x)
         return ca.sqrt(foot[0] ** 2 + foot[1] ** 2)
+
+
+class _StraightModes(_KneedModes):
+    """Straight legs (``early_swing``, ``late_swing``): the kneed walker's free flow and
+    guards, and a heel strike that may follow a push-off."""
+
+    def push_off(self, gname, x, P, k):
+        """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`)."""
+        import casadi as ca
+
+        from walkerlab.optimal.transcription.step import _reset_extended
+
+        if gname != "heel_strike":
+            return None
+        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
+                                       self.data.total_mass_kg)
+        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
 
 
 class _FlatModes(_Modes):
@@ -425,3 +432,10 @@ class _Impact:
     B: object
     relabel_q: object
     relabel_rate: object
+
+
+#: the phases' symbolic pieces of each walker kind the phased transcription takes, by
+#: :attr:`walkerlab.walker.kinds.Kind.name` (a five-link biped has its own transcription,
+#: :mod:`walkerlab.optimal.transcription.free_joints`; a spoked wheel none)
+_MODES = {"straight_legs": _StraightModes, "locking_knees": _KneedModes,
+          "flat_feet": _FlatModes}

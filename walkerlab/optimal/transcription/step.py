@@ -53,9 +53,9 @@ import numpy as np
 
 from walkerlab.codegen.casadi_functions import casadi_function
 
-__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "check_objective",
-           "ipopt_options", "number", "positive_power", "replay", "step_functions",
-           "target_constraints", "torque_of_time"]
+__all__ = ["OBJECTIVES", "ONE_STEP_KINDS", "CollocationResult", "CollocationSpec",
+           "check_objective", "ipopt_options", "number", "positive_power", "replay",
+           "step_functions", "target_constraints", "torque_of_time"]
 
 
 @dataclass(frozen=True)
@@ -124,6 +124,11 @@ class CollocationSpec:
     touchdown_rate_rad_per_s: float = 0.05
     warm_start: bool = False
 
+
+#: the walker kinds (:attr:`walkerlab.walker.kinds.Kind.name`) one step of one phase
+#: transcribes: straight legs (a kneed or flat-footed step is a sequence of phases,
+#: :mod:`walkerlab.optimal.transcription.phases`)
+ONE_STEP_KINDS = ("straight_legs",)
 
 #: Objectives of one step, with their units (``u`` per foot mass on massless legs).
 OBJECTIVES = {"effort": "N^2 m^2 s", "push_off_work": "J", "cost_of_transport": "-",
@@ -206,7 +211,7 @@ def step_functions(data, eq):
     st = data.structure
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
-    if st.knee or st.foot == "flat":
+    if st.kind.name not in ONE_STEP_KINDS:
         raise ValueError("optimize: knees and flat feet take a step of phases "
                          "(walkerlab.optimal.transcription.phases.mode_functions)")
     if any(massless) and not limit:
