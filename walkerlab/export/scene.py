@@ -46,9 +46,9 @@ from walkerlab.export.parts import EXPORT_PARTS
 from walkerlab.models.contact.laws import ContactParamsSI
 from walkerlab.walker.kinds import Kind
 
-__all__ = ["EXPORT_STEPS", "SCENE_FEET", "WHEEL_FORMATS", "WheelKeyframe", "arc_roll_m",
-           "FORMAT_VIEWS", "check_exportable", "check_wheel_exportable", "flat_feet", "joint_state",
-           "mjcf_scene", "mujoco_contact", "wheel_keyframe", "wheel_keyframe_json"]
+__all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "WHEEL_FORMATS", "WheelKeyframe",
+           "arc_roll_m", "check_exportable", "check_wheel_exportable", "flat_feet",
+           "joint_state", "mjcf_scene", "mujoco_contact", "wheel_keyframe", "wheel_keyframe_json"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -262,25 +262,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
             lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
         lanes = feet_part.footprints(lanes, data)
     latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
-    notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
-             f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
-             "origin.",) + notes
-    if latch:
-        notes += (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
-                  f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
-                  f"{knee.latch_height:.4g} m above the ground and its knee within "
-                  f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
-                  "(data.eq_active), MuJoCo has no contact-switched lock.",)
-    actuation = scene.walker.actuation
-    if actuation is not None:
-        notes += (part.mjcf_actuators,)
-    if actuation is not None and actuation.ankle_push_off:
-        notes += ("Ankle push-off (walker.actuation.ankle_push_off): motors "
-                  "leg<i>_ankle_motor on the ankle hinges; a stepping loop latches the "
-                  "stance foot's heel off (its heel geom leg<i>_foot out of contact while its "
-                  "toe leg<i>_toe touches) and sets the stance ankle's motor to -stiffness "
-                  "(a - rest_angle_rad) - constant_n_m until the next heel strike "
-                  "(walkerlab.export.mujoco_walk), the contact model's AnklePushOff.",)
+    notes = _walker_notes(scene, part, ideal, latch, knee, notes)
     notes += feet_part.notes
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     if treads is not None:
@@ -300,9 +282,34 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                           "(a riser below or above the last).",)
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
-                     dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
+                     dt, solref, solimp, mu, latch, notes + terrain_notes, scene.walker.actuation,
                      dt, ahead,  # the push-off over one timestep: the rigid model's impulse
                      feet, lane_heights, treads, profile)
+
+
+def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) -> tuple:
+    """The MJCF's comments on its keyframe, knee latch and actuators (``part``: the kind's
+    :class:`walkerlab.export.parts.ExportPart`), then ``contact_notes``."""
+    notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
+             f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
+             "origin.",) + contact_notes
+    if latch:
+        notes += (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
+                  f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
+                  f"{knee.latch_height:.4g} m above the ground and its knee within "
+                  f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
+                  "(data.eq_active), MuJoCo has no contact-switched lock.",)
+    actuation = scene.walker.actuation
+    if actuation is not None:
+        notes += (part.mjcf_actuators,)
+    if actuation is not None and actuation.ankle_push_off:
+        notes += ("Ankle push-off (walker.actuation.ankle_push_off): motors "
+                  "leg<i>_ankle_motor on the ankle hinges; a stepping loop latches the "
+                  "stance foot's heel off (its heel geom leg<i>_foot out of contact while its "
+                  "toe leg<i>_toe touches) and sets the stance ankle's motor to -stiffness "
+                  "(a - rest_angle_rad) - constant_n_m until the next heel strike "
+                  "(walkerlab.export.mujoco_walk), the contact model's AnklePushOff.",)
+    return notes
 
 
 def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
