@@ -1,11 +1,11 @@
 """MJCF motors' control ranges from the laws' saturations
 (:func:`walkerlab.export.mjcf_scene.motor_limits`): a motor's control is the sum of its
-joint's present role's laws, each clipped at its ``max_torque_n_m``."""
+joint's present role's laws, each clipped at its ``max_torque_n_m``.  They take the typed
+``walker.actuation`` (:class:`walkerlab.config.actuation.Actuation`)."""
 
 from __future__ import annotations
 
-import json
-
+from walkerlab.config.actuation import Actuation
 from walkerlab.export.mjcf_scene import motor_limits
 from walkerlab.export.multibody import motors
 
@@ -15,7 +15,7 @@ def _act(*torques, push_off=None):
                        else {"joint": j, "law": {}} for j, m in torques]}
     if push_off is not None:
         out["push_off"] = push_off
-    return json.dumps(out)
+    return Actuation.model_validate(out)
 
 
 def test_hip_motor_range_is_the_sum_of_its_laws_limits():
@@ -26,7 +26,7 @@ def test_hip_motor_range_is_the_sum_of_its_laws_limits():
     assert [m[0] for m in motors(act)] == ["hip"]
     assert motor_limits(act) == {"hip": 42.5}
     assert motor_limits(_act(("hip", 12.5), ("hip", None))) == {}
-    assert motor_limits(json.dumps({"push_off": {"impulse_n_s": 3.0}})) == {}
+    assert motor_limits(Actuation.model_validate({"push_off": {"impulse_n_s": 3.0}})) == {}
     assert motor_limits(None) == {}
 
 

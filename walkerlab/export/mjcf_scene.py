@@ -11,10 +11,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
+    from walkerlab.config.actuation import Actuation
     from walkerlab.walker.multibody import Multibody
 
 __all__ = ["LANE_BITS", "MJCF_DEFAULT_TIMESTEP_S", "MJCF_MIN_INERTIA_KG_M2",
-           "MJCF_MIN_LENGTH_M", "MJCF_MIN_MASS_KG", "MjcfScene", "motor_limits",
+           "MJCF_MIN_LENGTH_M", "MJCF_MIN_MASS_KG", "MjcfScene", "actuation_dict", "actuation_text",
+           "motor_limits",
            "point_foot_radius"]
 
 #: Floor of a MuJoCo principal inertia [kg m^2] (MuJoCo's mjMINVAL is 1e-15).
@@ -65,10 +67,11 @@ class MjcfScene:
         Sliding friction coefficient [-].
     latch : (float, float) or None
         Knee latch (release height above the ground [m], capture flexion [rad]); None without.
-    actuation_json : str or None
-        The scene's ``walker.actuation`` as JSON (a powered walker): the hip-torque laws a
-        stepping loop evaluates into the ``hip`` motor and the push-off it applies at each
-        heel strike (:mod:`walkerlab.export.mujoco_walk`); None for a passive walker.
+    actuation : Actuation or None
+        The scene's ``walker.actuation`` (a powered walker): the hip-torque laws a stepping
+        loop evaluates into the ``hip`` motor and the push-off it applies at each heel
+        strike (:mod:`walkerlab.export.mujoco_walk`; the file carries it as
+        :func:`actuation_text`); None for a passive walker.
     push_off_duration_s : float
         The push-off pulse's duration [s]: one timestep (the rigid model's impulse as MuJoCo
         applies it; :func:`walkerlab.export.scene.mjcf_scene`).
@@ -106,7 +109,7 @@ class MjcfScene:
     friction: float
     latch: tuple | None = None
     notes: tuple = ()
-    actuation_json: str | None = None
+    actuation: Actuation | None = None
     push_off_duration_s: float = 0.005
     patch_ahead_m: float = 0.0
     flat_feet: tuple | None = None
@@ -132,7 +135,22 @@ def point_foot_radius(mb: Multibody) -> float:
     return mb.leg_length_m / 1000
 
 
-def motor_limits(actuation_json: str | None) -> dict[str, float]:
+def actuation_text(act: Actuation) -> str:
+    """The scene's ``walker.actuation`` as the exported files carry it (one line of JSON,
+    fields left unset omitted): the MJCF's custom text ``walkerlab_actuation``, the OpenSim
+    model's comment, the URDF keyframe sidecar's ``actuation``; what a stepping loop reads
+    back (:mod:`walkerlab.export.mujoco_walk`, :mod:`walkerlab.export.opensim_walk`)."""
+    import json
+
+    return json.dumps(actuation_dict(act))
+
+
+def actuation_dict(act: Actuation) -> dict:
+    """:func:`actuation_text`'s fields as a dict (JSON types)."""
+    return act.model_dump(mode="json", exclude_none=True)
+
+
+def motor_limits(act: Actuation | None) -> dict[str, float]:
     """The control limits [N m] of a powered export's motors (``ctrlrange``, by motor name
     as :func:`walkerlab.export.multibody.motors` names them) from the laws' saturations:
     a motor's control is the sum of the laws of its joint's present role, each clipped at
@@ -142,8 +160,8 @@ def motor_limits(actuation_json: str | None) -> dict[str, float]:
 
     Parameters
     ----------
-    actuation_json : str or None
-        The scene's ``walker.actuation`` as JSON (:attr:`MjcfScene.actuation_json`).
+    act : Actuation or None
+        The scene's ``walker.actuation`` (:attr:`MjcfScene.actuation`).
 
     Returns
     -------
@@ -152,13 +170,11 @@ def motor_limits(actuation_json: str | None) -> dict[str, float]:
         (``stance_hip`` / ``swing_hip``), ``leg<i>_knee_motor`` (``stance_knee`` /
         ``swing_knee``).
     """
-    import json
-
-    if actuation_json is None:
+    if act is None:
         return {}
     roles: dict[str, list] = {}
-    for t in json.loads(actuation_json).get("torques", []):
-        roles.setdefault(t["joint"], []).append(t.get("max_torque_n_m"))
+    for t in act.torques:
+        roles.setdefault(t.joint, []).append(t.max_torque_n_m)
 
     def total(joint):
         lims = roles.get(joint)

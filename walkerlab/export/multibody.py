@@ -99,12 +99,16 @@ from walkerlab.export.mjcf_scene import (
     MJCF_MIN_INERTIA_KG_M2,
     MJCF_MIN_MASS_KG,
     MjcfScene,
+    actuation_dict,
+    actuation_text,
     motor_limits,
     point_foot_radius,
 )
+from walkerlab.export.parts import export_part
 from walkerlab.export.text import arc_feet, comment, header, num, nums
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
+    from walkerlab.config.actuation import Actuation
     from walkerlab.walker.multibody import Link, Multibody
 
 __all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION", "comments_in_scene_units",
@@ -122,7 +126,7 @@ AXIS = "0 -1 0"
 
 
 def urdf_text(mb: Multibody, name: str, version: str = "",
-              actuation_json: str | None = None) -> str:
+              actuation: Actuation | None = None) -> str:
     """The walker as a URDF robot (ROS URDF XML specification, http://wiki.ros.org/urdf/XML).
 
     Parameters
@@ -133,8 +137,8 @@ def urdf_text(mb: Multibody, name: str, version: str = "",
         Robot name (the scene's name).
     version : str
         walkerlab version, for the header comment.
-    actuation_json : str, optional
-        The scene's ``walker.actuation`` as JSON: its motors (:func:`motors`) are stated in
+    actuation : Actuation, optional
+        The scene's ``walker.actuation``: its motors (:func:`motors`) are stated in
         comments (URDF has no element for them).
 
     Returns
@@ -145,7 +149,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "",
     """
     width = mb.leg_length_m / 50  # visual thickness of the links
     out = ['<?xml version="1.0"?>', *header(mb, name, "URDF", version),
-           *(comment(_motor_note(*m)) for m in motors(actuation_json)),
+           *(comment(_motor_note(*m)) for m in motors(actuation)),
            f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
            '  <link name="hip_slider"/>']
     for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
@@ -186,7 +190,7 @@ def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) ->
 
 
 def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
-    knee = ln.joint.endswith("_knee") and mb.knee_stop  # free knees: no stop
+    knee = ln.joint.endswith("_knee") and export_part(mb).knee_stops  # free knees: no stop
     jtype = "revolute" if knee else "continuous"
     reach = -ln.length_m if ln.up else ln.length_m  # the visual runs up the torso
     out = [f'  <joint name="{ln.joint}" type="{jtype}">', f'    <parent link="{ln.parent}"/>',
@@ -314,15 +318,15 @@ def _joint_springs(mb: Multibody) -> dict:
 HIP_ACTUATION_TENDON = "hip_actuation"
 
 
-def motors(actuation_json: str | None) -> list[tuple[str, str, str]]:
+def motors(act: Actuation | None) -> list[tuple[str, str, str]]:
     """The motors of a powered export (module docstring): ``(name, kind, target)`` with
     ``kind`` ``"tendon"`` or ``"joint"``; none without actuation or torques.  A five-link
     biped's joints (``stance_hip``, ``swing_knee``, ...) become the physical joints' motors of
     both legs (the roles swap at each heel strike); an ankle push-off the motors
     ``leg<i>_ankle_motor`` on the ankle hinges (flat feet)."""
-    if actuation_json is None:
+    if act is None:
         return []
-    joints = {t["joint"] for t in json.loads(actuation_json).get("torques", [])}
+    joints = {t.joint for t in act.torques}
     out = []
     if "hip" in joints or not joints:  # (a push-off alone: the hip motor, at 0)
         out.append(("hip", "tendon", HIP_ACTUATION_TENDON))
@@ -331,7 +335,7 @@ def motors(actuation_json: str | None) -> list[tuple[str, str, str]]:
             out += [(f"{leg}_{kind}_motor", "tendon" if kind == "hip" else "joint",
                      f"{leg}_hip_torso" if kind == "hip" else f"{leg}_knee")
                     for leg in ("leg1", "leg2")]
-    if "ankle_push_off" in json.loads(actuation_json):  # flat feet: the stance ankle's
+    if act.ankle_push_off is not None:  # flat feet: the stance ankle's
         out += [(f"{leg}_ankle_motor", "joint", f"{leg}_ankle") for leg in ("leg1", "leg2")]
     return out
 
@@ -424,10 +428,10 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
         children.setdefault(ln.parent, []).append(ln)
     for ln in children["hip"]:
         out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
-    motor_list = motors(extra.actuation_json if extra is not None else None)
+    motor_list = motors(extra.actuation if extra is not None else None)
     out += ["    </body>", "  </worldbody>", *_tendons(mb, motor_list)]
     if motor_list:  # the laws live in the custom text, a stepping loop sets the controls
-        lim = motor_limits(extra.actuation_json)  # the saturations: MuJoCo clamps ctrl
+        lim = motor_limits(extra.actuation)  # the saturations: MuJoCo clamps ctrl
         rng = {n: f' ctrllimited="true" ctrlrange="{nums(-u, u)}"' for n, u in lim.items()}
         out += ["  <actuator>", *(f'    <motor name="{name}" {kind}="{target}" gear="1"'
                                   f'{rng.get(name, "")}/>'
@@ -443,7 +447,8 @@ def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
     lo = MJCF_MIN_INERTIA_KG_M2
     width = mb.leg_length_m / 50
     inertia = max(ln.inertia_kg_m2, lo)
-    rng = f' range="{nums(-math.pi, 0)}"' if ln.joint.endswith("_knee") and mb.knee_stop else ""
+    stop = ln.joint.endswith("_knee") and export_part(mb).knee_stops
+    rng = f' range="{nums(-math.pi, 0)}"' if stop else ""
     if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
         sp = joint_springs[ln.joint]
         rng += (f' stiffness="{num(sp.stiffness_n_m_per_rad)}" '
@@ -527,13 +532,13 @@ def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     if extra is not None:  # what a stepping loop needs (walkerlab.export.mujoco_walk)
         arc = mb.foot_radius_m if arc_feet(mb) else 0.0
         custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
-        if extra.latch is not None and mb.knee:
+        if extra.latch is not None:
             custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
-        if extra.actuation_json is not None:
+        if extra.actuation is not None:
             custom["push_off_duration_s"] = extra.push_off_duration_s
         texts = ([f'    <text name="walkerlab_actuation" '
-                  f'data={quoteattr(extra.actuation_json)}/>']
-                 if extra.actuation_json is not None else [])
+                  f'data={quoteattr(actuation_text(extra.actuation))}/>']
+                 if extra.actuation is not None else [])
         out += ["  <custom>", *(f'    <numeric name="{k}" data="{num(v)}"/>'
                                 for k, v in custom.items()), *texts, "  </custom>"]
     return out + ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>"]
@@ -548,16 +553,9 @@ def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
            "leg2 in stance, its foot at the origin on the ground line",
            "joints": joints, "units": units, "qpos": list(extra.qpos),
            "qvel": list(extra.qvel)}
-    if extra.actuation_json is not None:  # a powered walker: its actuators, as the scene
-        out["actuation"] = json.loads(extra.actuation_json)
-        out["actuation_note"] = (
-            "joint torques on a five-link biped: stance_hip / swing_hip act +tau on the "
-            "stance / swing leg's hip joint and -tau on torso_hip, stance_knee / swing_knee "
-            "+tau on that leg's knee; leg2 stands at the keyframe, the roles swap at each "
-            "heel strike; the phase variable is the angle of the line from the hip to the "
-            "stance foot from the downward vertical" if not mb.knee_stop else
-            "hip torques act +tau on the swing leg's hip joint and -tau on the stance leg's; "
-            "the push-off is an impulse along the trailing leg at its foot at each heel strike")
+    if extra.actuation is not None:  # a powered walker: its actuators, as the scene
+        out["actuation"] = actuation_dict(extra.actuation)
+        out["actuation_note"] = export_part(mb).sidecar_actuators
     return json.dumps(out, indent=1) + "\n"
 
 

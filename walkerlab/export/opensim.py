@@ -67,6 +67,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -74,9 +75,14 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
-from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.export.mjcf_scene import actuation_text, point_foot_radius
+from walkerlab.export.parts import export_part
 from walkerlab.export.text import comment, num, nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
+from walkerlab.walker.kinds import KINDS
+
+if TYPE_CHECKING:
+    from walkerlab.config.actuation import Actuation
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
            "knee_stop_expression", "osim_gait", "osim_text", "patch_radius",
@@ -113,8 +119,8 @@ class OsimGait:
         ``walker.actuation.push_off`` (:class:`walkerlab.config.actuation.PushOff`).
     push_off_duration_s : float
         The push-off pulse's duration [s] (the scene's ``contact.push_off_duration_s``).
-    actuation_json : str or None
-        The scene's ``walker.actuation`` as JSON.
+    actuation : Actuation or None
+        The scene's ``walker.actuation``.
     lane_heights : tuple of (tuple of float, tuple of float) or None
         Stairs and footholds: each patch's height along the slope normal [m] (its tread's,
         as :class:`walkerlab.export.mjcf_scene.MjcfScene` has them); None: on the slope line.
@@ -131,7 +137,7 @@ class OsimGait:
     knee: KneeStopSI
     push_off: object = None
     push_off_duration_s: float = 0.005
-    actuation_json: str | None = None
+    actuation: Actuation | None = None
     lane_heights: tuple | None = None
 
     @property
@@ -146,19 +152,17 @@ def check_osim_exportable(scene: Scene, mb) -> None:
     Raises
     ------
     ValueError
-        One line naming the field: flat feet (``walker.leg.foot.kind``: no foot bodies in
-        this export), an ankle push-off (``walker.actuation.ankle_push_off``), a torque law
-        per foot mass or on a joint the model lacks (``walker.actuation.torques.<i>``).
+        One line naming the field, as the capability table has it
+        (:meth:`walkerlab.walker.kinds.Kind.require`): flat feet (``walker.leg.foot.kind``:
+        no foot bodies in this export), an ankle push-off
+        (``walker.actuation.ankle_push_off``); a torque law per foot mass or on a joint the
+        model lacks (``walker.actuation.torques.<i>``).
     """
-    foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
-    if getattr(foot, "kind", None) == "flat":
-        raise ValueError("walker.leg.foot.kind: flat feet are not in the OpenSim export (no "
-                         "foot bodies, ankle springs or heel and toe contacts); --format mjcf "
-                         "carries them")
-    act = getattr(scene.walker, "actuation", None)
+    kind = KINDS[mb.kind]
+    kind.require("walk", "osim", "walker.leg.foot.kind")
+    act = scene.walker.actuation
     if act is not None and act.ankle_push_off is not None:
-        raise ValueError("walker.actuation.ankle_push_off: not in the OpenSim export (the "
-                         "model would walk passively); export the scene without it")
+        kind.require("ankle_push_off", "osim", "walker.actuation.ankle_push_off")
     coords = [ln.joint for ln in mb.links]
     for i, t in enumerate(getattr(act, "torques", None) or []):
         field = f"walker.actuation.torques.{i}"
@@ -329,11 +333,11 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:
         ell = 0.5 * (ells[0] + ells[1])
-    act = getattr(scene.walker, "actuation", None)
+    act = scene.walker.actuation
     return OsimGait(ms.qpos, ms.qvel, float(ideal.period_s), float(ell), ms.lanes,
                     terrain.patch_width_m, ms.ground_offset_m, c, knee,
                     None if act is None else act.push_off,
-                    settings.push_off_pulse_s(), ms.actuation_json, ms.lane_heights)
+                    settings.push_off_pulse_s(), ms.actuation, ms.lane_heights)
 
 
 # ----------------------------------------------------------------------------- the XML
@@ -403,17 +407,14 @@ def _couplers(mb) -> list[str]:
     return out + ["\t\t\t</objects>", "\t\t</ConstraintSet>"]
 
 
-def _torque_joints(actuation_json: str | None, mb) -> list[str]:
+def _torque_joints(act: Actuation | None, mb) -> list[str]:
     """Coordinates that get a ``CoordinateActuator``: every coordinate a torque law's joint
     moves in either stance (:func:`walkerlab.export.joint_torques.torque_generalized_forces`)."""
-    import json
-
-    if actuation_json is None:
+    if act is None:
         return []
-    laws = json.loads(actuation_json).get("torques", [])
     coords = [ln.joint for ln in mb.links]
-    used = {c for t in laws for st in (0, 1)
-            for c in torque_generalized_forces(t["joint"], st, coords)}
+    used = {c for t in act.torques for st in (0, 1)
+            for c in torque_generalized_forces(t.joint, st, coords)}
     return [c for c in coords if c in used]
 
 
@@ -483,7 +484,7 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
             f"switches the trailing leg's on for T = {gait.push_off_duration_s:g} s from each "
             "heel strike (P / F for a law whose impulse P depends on the hip's speed; the rigid "
             "model pushes off immediately before heel strike)."))
-    motors = _torque_joints(gait.actuation_json, mb)
+    motors = _torque_joints(gait.actuation, mb)
     if motors:
         out.append(comment(
             "Joint torques (walker.actuation.torques, walkerlab_actuation below): "
@@ -493,9 +494,9 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
             "those links' absolute angles (leg<i>_hip and torso_hip are absolute, leg<i>_knee "
             "is shank - thigh); a stepping loop (walkerlab.export.opensim_walk) sets them from "
             "the laws between windows, the roles swapping at each heel strike."))
-    if gait.actuation_json is not None:
-        out.append(comment(f"walkerlab_actuation: {gait.actuation_json}"))
-    if mb.knee and mb.knee_stop:
+    if gait.actuation is not None:
+        out.append(comment(f"walkerlab_actuation: {actuation_text(gait.actuation)}"))
+    if export_part(mb).knee_stops:
         out.append(comment(
             "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
             f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "
@@ -592,7 +593,7 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
                 *_frame(f"{second}_spring_{j2}", f"/bodyset/{second}",
                         orientation=(0.0, 0.0, -sp.rest_angle_rad)),
                 "\t\t\t\t\t</frames>", "\t\t\t\t</BushingForce>"]
-    if mb.knee and mb.knee_stop:
+    if export_part(mb).knee_stops:
         for ln in mb.links:
             if ln.joint.endswith("_knee"):
                 out += _expression_force(f"{ln.joint}_stop", ln.joint,

@@ -42,11 +42,13 @@ from walkerlab.export.mjcf_scene import (
     MjcfScene,
     point_foot_radius,
 )
+from walkerlab.export.parts import EXPORT_PARTS
 from walkerlab.models.contact.laws import ContactParamsSI
+from walkerlab.walker.kinds import Kind
 
-__all__ = ["EXPORT_STEPS", "WHEEL_FORMATS", "WheelKeyframe", "actuation_json", "arc_roll_m",
-           "check_exportable", "check_wheel_exportable", "flat_feet", "joint_state",
-           "mjcf_scene", "mujoco_contact", "wheel_keyframe", "wheel_keyframe_json"]
+__all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "WHEEL_FORMATS", "WheelKeyframe",
+           "arc_roll_m", "check_exportable", "check_wheel_exportable", "flat_feet",
+           "joint_state", "mjcf_scene", "mujoco_contact", "wheel_keyframe", "wheel_keyframe_json"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -56,11 +58,14 @@ EXPORT_STEPS = 40
 WHEEL_FORMATS = ("urdf", "mjcf")
 
 
-def check_exportable(scene: Scene, fmt: str | None = None, walker_only: bool = False) -> None:
+def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
+                     walker_only: bool = False) -> None:
     """Refuse walkers whose numbers MuJoCo cannot represent.
 
-    ``fmt`` (``"mjcf"``, ``"urdf"``; None: any) and ``walker_only`` (no gait, contact or
-    terrain) are the export's: flat feet are written to an MJCF with its scene only.
+    ``kind`` is the walker's (:attr:`walkerlab.walker.description.Structure.kind`); ``fmt``
+    (``"mjcf"``, ``"urdf"``; None: any) and ``walker_only`` (no gait, contact or terrain)
+    are the export's: flat feet are written to an MJCF with its scene only
+    (:meth:`_LinkFeet.check_format`).
 
     Raises
     ------
@@ -73,11 +78,8 @@ def check_exportable(scene: Scene, fmt: str | None = None, walker_only: bool = F
         ankle push-off (flat feet) is exported: motors ``leg<i>_ankle_motor`` that
         :mod:`walkerlab.export.mujoco_walk` drives.
     """
-    foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
-    if getattr(foot, "kind", None) == "flat" and (fmt != "mjcf" or walker_only):
-        raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF with the "
-                         "scene only (a URDF would hold point feet: no foot link, ankle "
-                         "spring or heel and toe contacts; --walker-only has no foot mass)")
+    SCENE_FEET[kind.name].check_format(fmt, walker_only)
+
     def walk(obj, path):
         if isinstance(obj, dict):
             for k, v in obj.items():
@@ -198,17 +200,6 @@ def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[f
     return ahead, (f"Terrain: {line} (walkerlab.export.scene.arc_roll_m).",)
 
 
-def actuation_json(scene: Scene) -> str | None:
-    """The scene's ``walker.actuation`` as JSON (None for a passive walker): what the
-    exported files carry for a stepping loop (MJCF custom text, URDF keyframe sidecar)."""
-    act = getattr(scene.walker, "actuation", None)
-    if act is None:
-        return None
-    import json
-
-    return json.dumps(act.model_dump(mode="json", exclude_none=True))
-
-
 def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
 
@@ -242,16 +233,11 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
-    flat = data.structure.foot == "flat"
+    feet_part, part = SCENE_FEET[mb.kind], EXPORT_PARTS[mb.kind]
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
-                           flat_foot=settings.flat_foot() if flat else None)
+                           flat_foot=feet_part.foot_mass(settings))
     ideal = ideal_gait(scene) if ideal is None else ideal
-    if flat:
-        qpos, qvel, feet = _flat_keyframe(scene, mb, data, walker, ideal.x)
-    else:
-        z = walker.link_state_from_ideal(ideal.x)
-        qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
-        feet = None
+    qpos, qvel, feet = feet_part.keyframe(scene, mb, data, walker, ideal.x)
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
     lanes = lane_heights = treads = profile = None
     if terrain.kind == "profile":
@@ -274,56 +260,10 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
             lanes = (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
         else:
             lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
-        if flat:  # a flat foot's patch centred on its sole, not on its heel's touchdown
-            from walkerlab.models.contact.model import footprint_offsets
-
-            lanes = tuple(tuple(s + off for s in lane)
-                          for lane, off in zip(lanes, footprint_offsets(data)))
-    latch = (knee.latch_height, knee.latch_capture) if mb.knee and mb.knee_stop else None
-    notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
-             f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
-             "origin.",) + notes
-    if latch:
-        notes += (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
-                  f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
-                  f"{knee.latch_height:.4g} m above the ground and its knee within "
-                  f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
-                  "(data.eq_active), MuJoCo has no contact-switched lock.",)
-    actuation = actuation_json(scene)
-    if actuation is not None and data.structure.free_knees:
-        notes += ("Actuators (walker.actuation, in the custom text walkerlab_actuation): "
-                  "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip and "
-                  "leg<i>_knee_motor on the knees, for a controller of one's own; "
-                  "walkerlab's stepping loop applies each law's torque in its joint's present "
-                  "role (stance_hip, swing_knee, ...: leg2 stands at the keyframe, the roles "
-                  "swap at each heel strike) as generalised forces (qfrc_applied), the phase "
-                  "variable the virtual stance leg's angle (hip to stance foot) "
-                  "(walkerlab.export.mujoco_walk).",)
-    elif actuation is not None:
-        notes += ("Actuators (walker.actuation, in the custom text walkerlab_actuation): one "
-                  "motor 'hip' on the tendon leg1_hip - leg2_hip, for a controller of one's "
-                  "own; walkerlab's stepping loop applies the swing leg's hip torque as "
-                  "generalised forces (qfrc_applied: +tau on the swing leg, -tau on the "
-                  "stance leg) and the push-off as a force along the trailing leg at its foot for "
-                  "push_off_duration_s from each heel strike (walkerlab.export.mujoco_walk): "
-                  "one MuJoCo timestep, the rigid model's impulse as MuJoCo can apply it (the "
-                  "contact model's contact.push_off_duration_s pulse agrees with it only to "
-                  "first order in its length: -2.1 % step period with 5 ms).",)
-    if actuation is not None and getattr(scene.walker.actuation, "ankle_push_off", None):
-        notes += ("Ankle push-off (walker.actuation.ankle_push_off): motors "
-                  "leg<i>_ankle_motor on the ankle hinges; a stepping loop latches the "
-                  "stance foot's heel off (its heel geom leg<i>_foot out of contact while its "
-                  "toe leg<i>_toe touches) and sets the stance ankle's motor to -stiffness "
-                  "(a - rest_angle_rad) - constant_n_m until the next heel strike "
-                  "(walkerlab.export.mujoco_walk), the contact model's AnklePushOff.",)
-    if flat:
-        notes += ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
-                  "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
-                  "the contact model's regularising foot mass and inertia at the ankle "
-                  "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
-                  "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
-                  "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
-                  "gait's double support as it begins).",)
+        lanes = feet_part.footprints(lanes, data)
+    latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
+    notes = _walker_notes(scene, part, ideal, latch, knee, notes)
+    notes += feet_part.notes
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     if treads is not None:
         lanes = None  # continuous stairs: the treads are the ground
@@ -342,9 +282,34 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                           "(a riser below or above the last).",)
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
-                     dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
+                     dt, solref, solimp, mu, latch, notes + terrain_notes, scene.walker.actuation,
                      dt, ahead,  # the push-off over one timestep: the rigid model's impulse
                      feet, lane_heights, treads, profile)
+
+
+def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) -> tuple:
+    """The MJCF's comments on its keyframe, knee latch and actuators (``part``: the kind's
+    :class:`walkerlab.export.parts.ExportPart`), then ``contact_notes``."""
+    notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
+             f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
+             "origin.",) + contact_notes
+    if latch:
+        notes += (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
+                  f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
+                  f"{knee.latch_height:.4g} m above the ground and its knee within "
+                  f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
+                  "(data.eq_active), MuJoCo has no contact-switched lock.",)
+    actuation = scene.walker.actuation
+    if actuation is not None:
+        notes += (part.mjcf_actuators,)
+    if actuation is not None and actuation.ankle_push_off:
+        notes += ("Ankle push-off (walker.actuation.ankle_push_off): motors "
+                  "leg<i>_ankle_motor on the ankle hinges; a stepping loop latches the "
+                  "stance foot's heel off (its heel geom leg<i>_foot out of contact while its "
+                  "toe leg<i>_toe touches) and sets the stance ankle's motor to -stiffness "
+                  "(a - rest_angle_rad) - constant_n_m until the next heel strike "
+                  "(walkerlab.export.mujoco_walk), the contact model's AnklePushOff.",)
+    return notes
 
 
 def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
@@ -420,25 +385,96 @@ def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
     return np.array(qpos, float), np.array(qvel, float), feet
 
 
+class _LinkFeet:
+    """The MJCF scene's feet on a tree of leg links whose legs end in point or arc feet
+    (no foot bodies): the keyframe of the links' joints, patches centred on the footfalls."""
+
+    notes: tuple = ()
+
+    def check_format(self, fmt: str | None, walker_only: bool) -> None:
+        """Every format carries these feet."""
+
+    def foot_mass(self, settings: ContactSettings):
+        """The contact walker's regularising foot mass and inertia: none."""
+        return None
+
+    def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
+        """``qpos``, ``qvel`` (:func:`joint_state`) and no foot bodies."""
+        z = walker.link_state_from_ideal(x_ideal)
+        qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
+        return qpos, qvel, None
+
+    def footprints(self, lanes: tuple, data) -> tuple:
+        """The checkerboard's patch centres: the footfalls."""
+        return lanes
+
+
+class _FlatFeet(_LinkFeet):
+    """The MJCF scene's flat feet: foot bodies on ankle hinges with the contact model's
+    regularising mass (:func:`flat_feet`), the rigid heel strike's double support as the
+    keyframe (:func:`_flat_keyframe`), patches centred on the soles."""
+
+    notes = ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
+             "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
+             "the contact model's regularising foot mass and inertia at the ankle "
+             "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+             "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
+             "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
+             "gait's double support as it begins).",)
+
+    def check_format(self, fmt: str | None, walker_only: bool) -> None:
+        """Flat feet go to an MJCF with its scene only (one line naming the field)."""
+        if fmt != "mjcf" or walker_only:
+            raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF with the "
+                             "scene only (a URDF would hold point feet: no foot link, ankle "
+                             "spring or heel and toe contacts; --walker-only has no foot "
+                             "mass)")
+
+    def foot_mass(self, settings: ContactSettings):
+        """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2``."""
+        return settings.flat_foot()
+
+    def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
+        """:func:`_flat_keyframe`."""
+        return _flat_keyframe(scene, mb, data, walker, x_ideal)
+
+    def footprints(self, lanes: tuple, data) -> tuple:
+        """A flat foot's patch centred on its sole, not on its heel's touchdown."""
+        from walkerlab.models.contact.model import footprint_offsets
+
+        return tuple(tuple(s + off for s in lane)
+                     for lane, off in zip(lanes, footprint_offsets(data)))
+
+
+#: kind name -> the MJCF scene's feet of that kind (a spoked wheel's keyframe is
+#: :func:`wheel_keyframe`'s; its entry only passes :func:`check_exportable`)
+SCENE_FEET = {"straight_legs": _LinkFeet(), "locking_knees": _LinkFeet(),
+              "flat_feet": _FlatFeet(), "free_joints": _LinkFeet(),
+              "rolling_polygon": _LinkFeet()}
+
+
 # ---------------------------------------------------------------------------- a spoked wheel
-def check_wheel_exportable(scene: Scene, fmt: str, walker_only: bool = False) -> None:
-    """Refuse what a spoked wheel's export (:data:`WHEEL_FORMATS`) cannot write.
+#: The capability table's view (:data:`walkerlab.walker.kinds.VIEWS`) of each export format
+#: (a URDF is the MJCF's walker without its scene).
+FORMAT_VIEWS = {"urdf": "mjcf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
+
+
+def check_wheel_exportable(scene: Scene, kind: Kind, fmt: str,
+                           walker_only: bool = False) -> None:
+    """Refuse what a spoked wheel's export (:data:`WHEEL_FORMATS`) cannot write, as the
+    capability table has it (:meth:`walkerlab.walker.kinds.Kind.require`).
 
     Raises
     ------
-    ValueError
+    walkerlab.walker.kinds.KindRefused
         One line naming the field: ``walker.model`` for a format other than
         :data:`WHEEL_FORMATS` (the Adams and OpenSim writers build leg links);
         ``terrain.kind`` for a ground other than the slope unless ``walker_only`` (the
         wheel's MJCF has one plane).
     """
-    if fmt not in WHEEL_FORMATS:
-        raise ValueError(f"walker.model: {scene.walker.model}: the {fmt} export writes a tree "
-                         "of leg links; a spoked wheel (one rigid body on its spokes) is "
-                         f"exported as {' or '.join(WHEEL_FORMATS)}")
+    kind.require("walk", FORMAT_VIEWS[fmt], f"walker.model: {scene.walker.model}")
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
-        raise ValueError(f"terrain.kind: {scene.terrain.kind}: a spoked wheel's MJCF carries "
-                         "the slope's plane only; --walker-only writes the wheel alone")
+        kind.require(scene.terrain.kind, "mjcf", f"terrain.kind: {scene.terrain.kind}")
 
 
 @dataclass(frozen=True)

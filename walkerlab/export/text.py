@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from walkerlab.export.parts import export_part
+
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.walker.multibody import Multibody
 
@@ -26,9 +28,10 @@ def header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
     """The comments that open an exported file (format ``fmt``): the walker's name and
     walkerlab's version, the axes and joints, gravity and the slope, the leg and its feet,
     each spring and coupling."""
+    knees = any(ln.joint.endswith("_knee") for ln in mb.links)
     knee = ("; leg<i>_knee = shank - thigh angle, limit [-pi, 0], 0 = straight-leg stop"
-            if mb.knee and mb.knee_stop else "; leg<i>_knee = shank - thigh angle, free (no "
-            "stop)" if mb.knee else "")
+            if export_part(mb).knee_stops else "; leg<i>_knee = shank - thigh angle, free (no "
+            "stop)" if knees else "")
     if any(ln.name == "torso" for ln in mb.links) and not mb.couplings:
         knee += ("; torso_hip = the torso's absolute angle from the upward vertical, positive "
                  "leaning back (a free hinge)")

@@ -35,7 +35,6 @@ from walkerlab.export.multibody import (
 )
 from walkerlab.export.opensim import OSIM_FILE, check_osim_exportable, osim_gait, osim_text
 from walkerlab.export.scene import (
-    actuation_json,
     check_exportable,
     check_wheel_exportable,
     mjcf_scene,
@@ -105,7 +104,7 @@ def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -
         raise ValueError("--walker-only: the OpenSim export carries the gait, ground and "
                          "contact (its default state is the rigid gait); drop --walker-only")
     check_osim_exportable(scene, mb)  # before the gait search
-    check_exportable(scene, "osim")
+    check_exportable(scene, data.structure.kind, "osim")
     gait = _gait(scene, runs_root, lambda ideal: osim_gait(scene, mb, data, ideal))
     text = osim_text(mb, gait, name, walkerlab.__version__)
     path = export_path(scene, runs_root, "osim", claim=True)
@@ -128,13 +127,15 @@ def _gait(scene: Scene, runs_root, build):
 
 
 def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
-    """A spoked wheel (one rigid body on its spokes, no tree of leg links) by its own
-    writers (:func:`walkerlab.export.multibody.wheel_urdf_text`, ``wheel_mjcf_text``): the
-    rigid gait as the MJCF's ``gait`` keyframe (the URDF's sidecar), the scene's static
-    friction coefficient on the spoke tips; other formats and grounds refused in one line
+    """The rolling polygon kind's writer: a spoked wheel (one rigid body on its spokes, no
+    tree of leg links) by its own writers (:func:`walkerlab.export.multibody.wheel_urdf_text`,
+    ``wheel_mjcf_text``): the rigid gait as the MJCF's ``gait`` keyframe (the URDF's
+    sidecar), the scene's static friction coefficient on the spoke tips; other formats and
+    grounds refused in one line as the capability table has it
     (:func:`walkerlab.export.scene.check_wheel_exportable`)."""
-    check_wheel_exportable(scene, fmt, walker_only)
-    check_exportable(scene, fmt, walker_only)
+    kind = data.structure.kind
+    check_wheel_exportable(scene, kind, fmt, walker_only)
+    check_exportable(scene, kind, fmt, walker_only)
     hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
     key = None if walker_only else _gait(scene, runs_root,
                                          lambda ideal: wheel_keyframe(scene, data, ideal))
@@ -189,7 +190,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         the export (``walker.urdf`` and ``walker.gait.json``, ``walker.adm`` and
         ``walker.acf``) are all written or all left as they were (one line).
     """
-    path = export_path(scene, runs_root, fmt)  # check the format before building anything
+    export_path(scene, runs_root, fmt)  # check the format before building anything
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
         if fmt not in ("mjcf", "osim", "adm"):
             raise ValueError(f"terrain.kind: {scene.terrain.kind}: the {fmt} export carries a "
@@ -201,17 +202,22 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         check_ground(scene.terrain)  # a profile: one line
     data = walker_data(scene.walker, scene.slope.phi_rad)
     name = scene.name or "walker"
-    if data.structure.spokes:  # one rigid body on its spokes: no tree of leg links
-        return _run_wheel(scene, runs_root, data, name, fmt, walker_only)
+    return _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+
+
+def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
+    """The writer of the kinds whose walker is a tree of leg links
+    (:func:`walkerlab.walker.multibody.multibody`): the URDF and MJCF here, the Adams
+    dataset (:func:`_run_adams`) and the OpenSim model (:func:`_run_osim`)."""
     mb = multibody(data)
     if fmt == "adm":
         return _run_adams(scene, runs_root, mb, data, name)
     if fmt == "osim":
         return _run_osim(scene, runs_root, mb, data, name, walker_only)
-    check_exportable(scene, fmt, walker_only)
+    check_exportable(scene, data.structure.kind, fmt, walker_only)
     extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":
-        text = urdf_text(mb, name, walkerlab.__version__, actuation_json(scene))
+        text = urdf_text(mb, name, walkerlab.__version__, scene.walker.actuation)
     else:
         text = mjcf_text(mb, name, walkerlab.__version__, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
@@ -221,3 +227,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                       keyframe_json(mb, extra)))
     runpaths.atomic_texts(files)  # the walker and its keyframe: both or neither
     return path
+
+
+#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> the export's writer of that kind
+_WRITERS = {"straight_legs": _run_links, "locking_knees": _run_links, "flat_feet": _run_links,
+            "free_joints": _run_links, "rolling_polygon": _run_wheel}

@@ -231,9 +231,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off")},
         ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
-                            "(one rigid body) is exported as mjcf or urdf"),
+                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
-                           "(one rigid body) is exported as mjcf or urdf"),
+                           "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
         ("footholds", "contact"): _ONE_LANDING,
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "

@@ -171,6 +171,9 @@ class Multibody:
     knee_stop : bool
         The knees have the straight-leg stop (``shank - thigh <= 0``, a joint limit); False
         for free knees (``knee.lock: free``, the five-link biped: no stop in any view).
+    kind : str
+        The walker's structural kind (:attr:`walkerlab.walker.description.Structure.kind`'s
+        name): the key of the exports' tables of parts.
     """
 
     hip_mass_kg: float
@@ -184,6 +187,7 @@ class Multibody:
     springs: tuple[Spring, ...] = ()
     couplings: tuple[Coupling, ...] = ()
     knee_stop: bool = True
+    kind: str = "straight_legs"
 
 
 def _combine(name: str, parts: list[tuple[float, float, float, str, float]]
@@ -287,4 +291,5 @@ def multibody(data: WalkerData) -> Multibody:
                                   ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
                                   p["c_knee"]))
     return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
-                     data.slope_rad, tuple(springs), couplings, not s.free_knees)
+                     data.slope_rad, tuple(springs), couplings, not s.free_knees,
+                     s.kind.name)

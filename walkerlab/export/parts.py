@@ -1,0 +1,80 @@
+"""The export's part of each walker kind: what the writers (URDF, MJCF, Adams, OpenSim) do
+differently for a kind, reached through the kind's name (:mod:`walkerlab.walker.kinds`).
+
+The writers never ask the description's switches (flat feet, free knees, spokes) which code
+runs: they look the walker's kind up in :data:`EXPORT_PARTS` (the Adams dataset's foot
+statements in :data:`walkerlab.export.adams_feet.ADAMS_FEET`, the MJCF scene's feet in
+:data:`walkerlab.export.scene.SCENE_FEET`, the export stage's writer per kind in
+``walkerlab.stages.export``).  Whether a kind is exported in a format at all is the
+capability table's (:meth:`walkerlab.walker.kinds.Kind.require`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["EXPORT_PARTS", "ExportPart", "export_part"]
+
+_HIP_SIDECAR = ("hip torques act +tau on the swing leg's hip joint and -tau on the stance "
+                "leg's; the push-off is an impulse along the trailing leg at its foot at each "
+                "heel strike")
+_HIP_MJCF = ("Actuators (walker.actuation, in the custom text walkerlab_actuation): one "
+             "motor 'hip' on the tendon leg1_hip - leg2_hip, for a controller of one's "
+             "own; walkerlab's stepping loop applies the swing leg's hip torque as "
+             "generalised forces (qfrc_applied: +tau on the swing leg, -tau on the "
+             "stance leg) and the push-off as a force along the trailing leg at its foot for "
+             "push_off_duration_s from each heel strike (walkerlab.export.mujoco_walk): "
+             "one MuJoCo timestep, the rigid model's impulse as MuJoCo can apply it (the "
+             "contact model's contact.push_off_duration_s pulse agrees with it only to "
+             "first order in its length: -2.1 % step period with 5 ms).")
+
+
+@dataclass(frozen=True)
+class ExportPart:
+    """What the exports write differently for one walker kind.
+
+    Attributes
+    ----------
+    knee_stops : bool
+        The knees have the straight-leg stop and its latch (McGeer 1990's locking knees):
+        a joint limit, the contact model's IMPACT stop, a latch a stepping loop switches.
+    mjcf_actuators : str
+        The MJCF's note on the actuators of a powered walker.
+    sidecar_actuators : str
+        The URDF keyframe sidecar's ``actuation_note``.
+    """
+
+    knee_stops: bool = False
+    mjcf_actuators: str = _HIP_MJCF
+    sidecar_actuators: str = _HIP_SIDECAR
+
+
+#: kind name -> its export part (:data:`walkerlab.walker.kinds.KINDS`)
+EXPORT_PARTS = {
+    "straight_legs": ExportPart(),
+    "locking_knees": ExportPart(knee_stops=True),
+    "flat_feet": ExportPart(),
+    "free_joints": ExportPart(
+        mjcf_actuators=(
+            "Actuators (walker.actuation, in the custom text walkerlab_actuation): "
+            "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip and "
+            "leg<i>_knee_motor on the knees, for a controller of one's own; "
+            "walkerlab's stepping loop applies each law's torque in its joint's present "
+            "role (stance_hip, swing_knee, ...: leg2 stands at the keyframe, the roles "
+            "swap at each heel strike) as generalised forces (qfrc_applied), the phase "
+            "variable the virtual stance leg's angle (hip to stance foot) "
+            "(walkerlab.export.mujoco_walk)."),
+        sidecar_actuators=(
+            "joint torques on a five-link biped: stance_hip / swing_hip act +tau on the "
+            "stance / swing leg's hip joint and -tau on torso_hip, stance_knee / swing_knee "
+            "+tau on that leg's knee; leg2 stands at the keyframe, the roles swap at each "
+            "heel strike; the phase variable is the angle of the line from the hip to the "
+            "stance foot from the downward vertical")),
+    "rolling_polygon": ExportPart(),
+}
+
+
+def export_part(mb) -> ExportPart:
+    """The export part of a multibody walker's kind (``mb.kind``,
+    :class:`walkerlab.walker.multibody.Multibody`)."""
+    return EXPORT_PARTS[mb.kind]
