@@ -148,6 +148,8 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
              "feet have none")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
 _FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
+_FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported yet (their "
+                 "heel strike is a guard per foot mode)")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -179,6 +181,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
                                  "point and arc feet (a flat foot's modes have no per-step "
                                  "landing yet)"),
+        ("stairs", "rigid"): _FLAT_LANDING,
+        ("profile", "rigid"): _FLAT_LANDING,
     },
     "free_joints": {
         ("ankle_torque", "*"): _NO_ANKLE,
