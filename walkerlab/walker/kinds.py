@@ -189,8 +189,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("ankle_push_off", "*"): _NO_ANKLE,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
-        ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
-                                 "passive walkers; a five-link biped walks by its torques"),
         ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
                               "not a height profile; --format mjcf carries it as a height "
                               "field"),
