@@ -27,8 +27,9 @@ def build_walker(scene) -> HybridWalker:
 
     ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
     (``ideal.variant``); ``model: biped`` is any walker described as data, derived
-    symbolically (variant ``derived`` only); ``model: rimless_wheel`` is a spoked wheel
-    (:mod:`walkerlab.models.hybrid.rolling_polygon`, variant ``derived`` only).
+    symbolically (variant ``derived`` only), as is ``model: rimless_wheel``: each reached
+    through its kind (:data:`walkerlab.models.hybrid.rigid.BUILDERS`; a spoked wheel is the
+    rolling polygon, :mod:`walkerlab.models.hybrid.rolling_polygon`).
 
     A ``walker.actuation`` section adds its actuators (:func:`walkerlab.models.hybrid.
     actuated.actuate`).
@@ -131,9 +132,8 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
     if getattr(scene.walker, "actuation", None) is not None:
         raise ValueError("walker.actuation: footholds of several heights or slopes are built "
                          "for passive walkers only")
-    if walker.actuators is not None or walker.step_entry is not None:
-        raise ValueError("terrain.kind: footholds of several heights or slopes: not built "
-                         "for this walker (flat feet or actuators)")
+    walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
+        "footholds", "rigid", "terrain.kind")
 
     def at(g: float) -> HybridWalker:
         if g == scene.slope.phi_rad:
@@ -156,20 +156,12 @@ def _passive(scene) -> HybridWalker:
             w.leg_length_m, w.leg_mass_kg, w.hip_mass_kg, w.gravity_m_per_s2,
             w.leg_mass_from_foot_m, scene.slope.phi_rad, scene.ideal.variant,
         )
-    if w.model == "biped":
-        from walkerlab.models.hybrid.rigid import make_rigid_walker
-        from walkerlab.walker.description import walker_data
+    # any other walker is described as data: its kind builds it
+    # (walkerlab.models.hybrid.rigid.BUILDERS; a rimless wheel: the rolling polygon)
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.walker.description import walker_data
 
-        if scene.ideal.variant != "derived":
-            raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
-                             "model: compass_gait (the paper's printed equations)")
-        return make_rigid_walker(walker_data(w, scene.slope.phi_rad), "biped", "derived")
-    if w.model == "rimless_wheel":
-        from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
-        from walkerlab.walker.description import walker_data
-
-        if scene.ideal.variant != "derived":
-            raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
-                             "model: compass_gait (the paper's printed equations)")
-        return make_spoked_walker(walker_data(w, scene.slope.phi_rad))
-    raise ValueError(f"walker.model: no rigid model for {w.model!r}")
+    if scene.ideal.variant != "derived":
+        raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
+                         "model: compass_gait (the paper's printed equations)")
+    return make_rigid_walker(walker_data(w, scene.slope.phi_rad), w.model, "derived")

@@ -178,6 +178,8 @@ _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-o
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
                     "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
+_FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported yet (their "
+                 "heel strike is a guard per foot mode)")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -206,10 +208,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
-        ("stairs", "*"): ("flat feet on stairs or footholds are not supported yet (their "
-                          "heel strike is a guard per foot mode)"),
-        ("footholds", "*"): ("footholds of several heights or slopes: not built for this "
-                             "walker (flat feet or actuators)"),
+        ("stairs", "*"): _FLAT_LANDING,
+        ("profile", "rigid"): _FLAT_LANDING,
+        ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
+                             "arc feet (a flat foot's modes have no per-step landing yet)"),
         ("profile", "adams"): _ADAMS_PROFILE,
         ("profile", "gym"): _GYM_GROUND,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
@@ -224,8 +226,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                    "has no push-off"),
         ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
         **_GROUNDS,
-        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact")},
+        **{("footholds", v): ("a five-link biped walks by its joint torques, and footholds of "
+                              "several heights or slopes are built for passive walkers only")
+           for v in ("rigid", "contact")},
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",

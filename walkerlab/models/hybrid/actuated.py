@@ -8,7 +8,9 @@ the generated link angles; the push-off of Kuo (2002) in its transition.  Free k
 five-link biped) add one spline for laws sharing a table
 (:mod:`walkerlab.models.hybrid.free_joint_actuators`); flat feet run their stance-foot modes'
 own mass matrices (:mod:`walkerlab.models.hybrid.mode_torques`) or an ankle push-off
-(:mod:`walkerlab.models.hybrid.ankle_push_off`).  Those modules import the shared
+(:mod:`walkerlab.models.hybrid.ankle_push_off`).  Each kind's way is its part, reached
+through the walker's kind (``_PARTS``); what a kind cannot carry is refused by its row of
+:data:`walkerlab.walker.kinds.CAPABILITIES`.  Those modules import the shared
 actuators from :mod:`walkerlab.models.hybrid.actuators`, never this one.
 """
 
@@ -28,11 +30,9 @@ __all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
 def _structure_check(data, spec) -> bool:
     """Refuse what is physically impossible (one line); True for massless legs.  A joint
     the walker does not have is refused by :func:`walkerlab.models.hybrid.actuators.
-    joint_links` (naming the joints it has)."""
+    joint_links` (naming the joints it has), an ankle push-off by the kind
+    (:meth:`_Joints.actuate`)."""
     st = data.structure
-    if spec.ankle_push_off is not None:
-        raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
-                         "flat); point feet take push_off, the impulse along the leg")
     massless = [b.massless for b in st.bodies]
     # Kuo's limit: massless legs on a point hip mass.  Legs with some massless bodies, or
     # massless legs under a torso (which the legs' angles move): the force in the massless
@@ -85,13 +85,14 @@ def spring_equivalent(data, spec):
     r) - D ddelta`` with ``K = sum K_i > 0``, ``r = (sum K_i r_i + sum c_i) / K``, ``D = sum
     D_i`` (or ``K = 0`` and no constant torque: a damper), on the pair (swing, stance) of
     :data:`walkerlab.walker.description.SPRING_LINKS` (its ``delta`` is stance - swing: rest
-    angle ``-r``).  Its flows are then the generated, compiled ones; None otherwise."""
+    angle ``-r``).  Its flows are then the generated, compiled ones; None otherwise (and for
+    a kind whose part has no such spring, ``hip_spring``: knees, free joints, flat feet)."""
     from walkerlab.walker.description import WalkerData
 
     st = data.structure
     laws = [t for t in spec.torques]
-    if not laws or st.knee or st.knee_spring or st.torso or any(b.massless for b in st.bodies) \
-            or any(
+    if not laws or not _PARTS[st.kind.name].hip_spring or st.knee_spring or st.torso \
+            or any(b.massless for b in st.bodies) or any(
             t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
             or t.law.reference is not None or t.law.time_reference is not None for t in laws):
         return None
@@ -121,10 +122,8 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     if limit or acts.rows is not None:  # the force in the massless limit's rows: Python
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
-    if guards is None and data.structure.free_knees:
-        from walkerlab.models.hybrid.rigid_free_joints import guard_outputs
-
-        guards = guard_outputs(phase, data)
+    if guards is None:  # a passive flow run in Python: the guards' outputs from the kind
+        guards = _PARTS[data.structure.kind.name].guard_outputs(phase, data)
     if guards is None:
         return None
     links = acts.links  # each actuator's (first, second) link: keys of ``leg_angles``
@@ -161,26 +160,13 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         link that carries no mass, a torque scaling that does not fit the legs, a push-off
         on massless arc-footed legs (one line).
     """
-    from walkerlab.codegen.cache import functions
+    return _PARTS[data.structure.kind.name].actuate(walker, data, spec)
 
-    if data.structure.foot == "flat":
-        from walkerlab.models.hybrid.ankle_push_off import actuate_flat
 
-        return actuate_flat(walker, data, spec)
-    limit = False
-    if data.structure.free_knees:  # every joint free: hips and knees (five-link bipeds)
-        from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
-
-        acts = five_link_actuators(data, spec, walker.roles, push_off=True)
-    else:
-        limit = _structure_check(data, spec)
-        acts = Actuators(spec, functions(data), len(walker.roles), limit,
-                         float(walker.total_mass_kg),
-                         some_massless=any(b.massless for b in data.structure.bodies))
-        if data.structure.knee:  # heel strike with the swing knee locked (the last phase's)
-            acts.hold_lock(walker.phases[-1].constraint)
-        if spec.push_off is not None and acts.rows is not None:
-            _massive_impact_check(acts)
+def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
+    """:func:`actuate` for a kind whose actuators are :class:`Actuators` on its joints
+    (``part``: the kind's :class:`_Joints`)."""
+    acts, limit = part.actuators(walker, data, spec)
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 
@@ -211,8 +197,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         return J
 
     phases = []
-    sprung = (spring_equivalent(data, spec) if has_torque and not limit
-              and not data.structure.free_knees else None)
+    sprung = spring_equivalent(data, spec) if has_torque and not limit else None
     if sprung is not None:  # the torques as a generated (compiled) hip spring-damper
         from walkerlab.models.hybrid.rigid import make_rigid_walker
 
@@ -241,3 +226,107 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
                    variational=base_jac if sprung is not None else jac_of(base_jac),
                    mirror=mirror, actuators=acts)
 
+
+class _Joints:
+    """How :func:`actuate` drives straight legs (the parts of the other kinds derive from
+    it): the generic :class:`Actuators` at the joints, hip laws linear in the hip angle
+    as a generated hip spring-damper (:func:`spring_equivalent`)."""
+
+    #: hip laws may become a generated spring (:func:`spring_equivalent`)
+    hip_spring = True
+
+    def actuate(self, walker: HybridWalker, data, spec) -> HybridWalker:
+        """The actuated walker (an ankle push-off refused by the kind's table)."""
+        if spec.ankle_push_off is not None:
+            data.structure.kind.require("ankle_push_off", "rigid",
+                                        "walker.actuation.ankle_push_off")
+        return _actuate_joints(self, walker, data, spec)
+
+    def actuators(self, walker: HybridWalker, data, spec):
+        """``(acts, limit)``: the actuators and whether the legs are massless (Kuo's
+        limit, :func:`_structure_check`)."""
+        from walkerlab.codegen.cache import functions
+
+        limit = _structure_check(data, spec)
+        acts = Actuators(spec, functions(data), len(walker.roles), limit,
+                         float(walker.total_mass_kg),
+                         some_massless=any(b.massless for b in data.structure.bodies))
+        self.hold(acts, walker)
+        if spec.push_off is not None and acts.rows is not None:
+            _massive_impact_check(acts)
+        return acts, limit
+
+    def hold(self, acts, walker: HybridWalker) -> None:
+        """The constraint the heel strike holds (none for straight legs)."""
+
+    def guard_outputs(self, phase: Phase, data):
+        """The compiled outputs of a phase's guards when the passive phase has no compiled
+        flow (none here: every legged phase has one)."""
+        return None
+
+
+class _LockingKnees(_Joints):
+    """Knees that lock: the heel strike takes place with the swing knee locked (the last
+    phase's constraint); no hip spring (the generated spring acts on straight legs)."""
+
+    hip_spring = False
+
+    def hold(self, acts, walker: HybridWalker) -> None:
+        """The locked knee of the last phase (``locked_swing``)."""
+        acts.hold_lock(walker.phases[-1].constraint)
+
+
+class _FreeJoints(_Joints):
+    """Every joint free (five-link bipeds): hips and knees driven, one spline for laws that
+    share a table (:func:`walkerlab.models.hybrid.free_joint_actuators.
+    five_link_actuators`); the passive flow is not compiled, the driven one takes its
+    guards' outputs from :func:`walkerlab.models.hybrid.rigid_free_joints.guard_outputs`."""
+
+    hip_spring = False
+
+    def actuators(self, walker: HybridWalker, data, spec):
+        """``(acts, False)``: the free-jointed walker's actuators (its legs carry mass)."""
+        from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
+
+        return five_link_actuators(data, spec, walker.roles, push_off=True), False
+
+    def guard_outputs(self, phase: Phase, data):
+        """Each guard of ``phase`` as a generated output and offset."""
+        from walkerlab.models.hybrid.rigid_free_joints import guard_outputs
+
+        return guard_outputs(phase, data)
+
+
+class _FlatFeet:
+    """Flat feet: their stance-foot modes' own mass matrices or an ankle push-off
+    (:func:`walkerlab.models.hybrid.ankle_push_off.actuate_flat`)."""
+
+    hip_spring = False
+
+    def actuate(self, walker: HybridWalker, data, spec) -> HybridWalker:
+        """The actuated flat-footed walker."""
+        from walkerlab.models.hybrid.ankle_push_off import actuate_flat
+
+        return actuate_flat(walker, data, spec)
+
+
+class _RollingPolygon:
+    """A spoked wheel: one rigid body, no joint - every actuator refused by the table."""
+
+    hip_spring = False
+
+    def actuate(self, walker: HybridWalker, data, spec) -> HybridWalker:
+        """Refuse the first actuator ``spec`` asks for (one line, naming its field)."""
+        kind = data.structure.kind
+        for i, t in enumerate(spec.torques):
+            kind.require(f"{t.joint}_torque", "rigid", f"walker.actuation.torques.{i}.joint")
+        for name in ("push_off", "ankle_push_off"):
+            if getattr(spec, name) is not None:
+                kind.require(name, "rigid", f"walker.actuation.{name}")
+        return walker
+
+
+#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> how :func:`actuate` drives it
+_PARTS = {"straight_legs": _Joints(), "locking_knees": _LockingKnees(),
+          "free_joints": _FreeJoints(), "flat_feet": _FlatFeet(),
+          "rolling_polygon": _RollingPolygon()}

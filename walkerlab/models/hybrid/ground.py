@@ -3,9 +3,9 @@ above) the stance foot's level (stairs, footholds).
 
 The generated model of every point- or arc-footed biped has the swing foot's clearance above
 the slope line through the stance foot (``guard_swing_clearance``: its lowest point's
-distance along the slope's normal, :mod:`walkerlab.codegen.symbolic`; a free-jointed biped's
-heel-strike guard is that clearance itself).  A landing ``drop_m`` [m] below that line (a
-stair ``riser_m`` down; negative: up) is the same guard plus a constant,
+distance along the slope's normal, :mod:`walkerlab.codegen.symbolic`; the free-jointed
+biped's and the spoked wheel's generated models have it too).  A landing ``drop_m`` [m]
+below that line (a stair ``riser_m`` down; negative: up) is the same guard plus a constant,
 
     ``heel_strike = swing_clearance + drop_m cos(gamma)``  (zero crossing downward),
 
@@ -60,10 +60,10 @@ def check_periodic_ground(terrain, study: str) -> None:
                          "with terrain.kind: slope has the ramp's periodic gait)")
 
 
-def _clearance_names(f: dict) -> str:
-    if "guard_swing_clearance" in f:
-        return "swing_clearance"
-    return "heel_strike"  # a free-jointed biped: its heel strike is the clearance itself
+#: the generated guard a landing shifts by a constant: the swing foot's clearance above the
+#: slope line, which every kind that lands on stairs in the rigid view has (a kind without
+#: it is refused by its cell of :data:`walkerlab.walker.kinds.CAPABILITIES`)
+CLEARANCE = "swing_clearance"
 
 
 def _at(clearance, offset, t, x):
@@ -148,8 +148,9 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     Raises
     ------
     ValueError
-        A walker with flat feet (a heel-strike guard per foot mode) or printed equations
-        replacing the generated ones: one line.
+        A kind that does not land on stairs in the rigid view (flat feet: a heel-strike
+        guard per foot mode; :meth:`walkerlab.walker.kinds.Kind.require`) or printed
+        equations replacing the generated ones: one line.
     """
     if drop_m == 0.0:
         return walker
@@ -173,11 +174,9 @@ def with_clearance_guard(walker: HybridWalker, data) -> HybridWalker:
 
 def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     """:func:`on_landing`'s walker for any ``drop_m`` (0 included)."""
-    if data.structure.foot == "flat":
-        raise ValueError("terrain.kind: flat feet on stairs or footholds are not supported yet "
-                         "(their heel strike is a guard per foot mode)")
+    data.structure.kind.require("stairs", "rigid", "terrain.kind")
     f = functions(data)
-    name = _clearance_names(f)
+    name = CLEARANCE
     clear, grad = f[f"guard_{name}"], f[f"grad_{name}"]
     offset = float(drop_m) * math.cos(float(data.slope_rad))
     phases = []

@@ -57,6 +57,39 @@ __all__ = ["StanceReaction", "TransitionImpulses"]
 _FOOT_OF_ROLE = {"swing": "leg1", "stance": "leg2"}
 
 
+@dataclass(frozen=True)
+class _Part:
+    """What :class:`StanceReaction` needs of a walker's kind.
+
+    Attributes
+    ----------
+    hub : bool
+        All the mass is at the hip (a spoked wheel's hub): the force from the hip's
+        acceleration, whatever the bodies (a legged walker: only when its legs are
+        massless).
+    trailing_point : str
+        The rigid model's point that is the old stance foot after the transition (a
+        biped's new swing foot, a wheel's spoke behind).
+    refusal : str or None
+        Why the kind is not checked here (one line), or None.
+    """
+
+    hub: bool = False
+    trailing_point: str = "swing_foot"
+    refusal: str | None = None
+
+
+#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> its part of the stance reaction
+_PARTS = {
+    "straight_legs": _Part(),
+    "locking_knees": _Part(),
+    "free_joints": _Part(),
+    "flat_feet": _Part(refusal="flat feet: the rigid model's own guards check the heel's "
+                               "and toe's normal forces"),
+    "rolling_polygon": _Part(hub=True, trailing_point="trailing_foot"),
+}
+
+
 class _View:
     """The generated floating module's kernels (:mod:`walkerlab.codegen.floating`: ``dyn``,
     ``feet``, ``feet_jac``) run as the plain Python they are generated from
@@ -157,15 +190,15 @@ class StanceReaction:
 
     def __init__(self, walker, data):
         st = data.structure
-        if st.foot == "flat":
-            raise ValueError("flat feet: the rigid model's own guards check the heel's and "
-                             "toe's normal forces")
+        self.part = _PARTS[st.kind.name]
+        if self.part.refusal is not None:
+            raise ValueError(self.part.refusal)
         self.walker = walker
         phi = float(walker.slope_rad)
         self.normal = np.array([np.sin(phi), np.cos(phi)])
         self.tangent = np.array([np.cos(phi), -np.sin(phi)])
         self.view = None
-        if st.spokes or any(b.massless for b in st.bodies):  # a wheel: its mass at the hub
+        if self.part.hub or any(b.massless for b in st.bodies):  # all the mass at the hub
             if not st.hip_mass or any(not b.massless for b in (*st.bodies, *st.torso)):
                 floating_plain(st)  # raises: a massless body beside massive ones
             # massless legs, all the mass at the hip (module docstring)
@@ -288,8 +321,7 @@ class StanceReaction:
                                         - self._point_velocity("hip", x_minus))
             e = self._point("hip", x_minus[:w.n_coordinates])  # from the trailing foot
             # the old stance foot: a biped's new swing foot, a wheel's spoke behind
-            trail = self._point_velocity("trailing_foot" if "trailing_foot" in w.points(
-                x_plus) else "swing_foot", x_plus)
+            trail = self._point_velocity(self.part.trailing_point, x_plus)
             push = self._push_off(x_minus, e)
             return TransitionImpulses(total - push, push, trail, self.normal.copy())
         q0, v0 = self.floating_state(x_minus)

@@ -15,7 +15,10 @@ Phases of a step (point feet, straight legs):
   stance leg, or the hip reaches the slope.
 
 Flat feet on ankle springs have their own phase graph
-(:mod:`walkerlab.models.hybrid.rigid_foot_modes`).
+(:mod:`walkerlab.models.hybrid.rigid_foot_modes`), free joints theirs
+(:mod:`walkerlab.models.hybrid.rigid_free_joints`), a rimless wheel its one phase
+(:mod:`walkerlab.models.hybrid.rolling_polygon`): :func:`make_rigid_walker` reaches each
+through the walker's kind (:data:`BUILDERS`).
 
 Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
 
@@ -36,7 +39,8 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
 
 from __future__ import annotations
 
-from dataclasses import replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -56,14 +60,15 @@ def _below(clearance, depth, t, x):
     return clearance(t, x) + depth
 
 
-def _kneed_phases(data: WalkerData, f: dict, flow, var, compiled, heel: Guard,
+def _kneed_phases(data: WalkerData, f: dict, flow, flow_jacobian, var, compiled, heel: Guard,
                   falls_back: Guard, fall: Guard) -> tuple[Phase, Phase]:
     """The two phases of a kneed walker for :func:`make_rigid_walker`: ``unlocked_swing``
     (the free knee, ended by the knee strike, its reset leading to the next phase, or by a
     swing foot scuffing more than :data:`SCUFF_DEPTH` times the leg length below the ground)
     and ``locked_swing`` (the locked knee, ended by the heel strike), each also by a fall;
     ``f`` are the generated functions, ``flow`` the unlocked flow, ``var`` its variational
-    right-hand side and ``compiled(name, *guards)`` the compiled flow (or None)."""
+    right-hand side and ``compiled(name, *guards)`` the compiled flow (or None);
+    ``flow_jacobian`` is unused (the printed equations' replacements are straight-legged)."""
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
     return (
         Phase("unlocked_swing", flow, (
@@ -93,12 +98,13 @@ def _lock_gradient(grad, x):
     return np.asarray(grad(x))[:x.size // 2]
 
 
-def _straight_leg_phases(f: dict, flow, flow_jacobian, var, compiled, heel: Guard,
-                         falls_back: Guard, fall: Guard) -> tuple[Phase, Phase]:
+def _straight_leg_phases(data: WalkerData, f: dict, flow, flow_jacobian, var, compiled,
+                         heel: Guard, falls_back: Guard, fall: Guard) -> tuple[Phase, Phase]:
     """The two phases of a straight-leg walker for :func:`make_rigid_walker`:
     ``early_swing`` until mid-stance (the swing foot passing the stance foot) and
     ``late_swing`` until the heel strike or the swing leg falling back, each also ended by a
-    fall; ``f`` are the generated functions, ``flow``/``flow_jacobian`` the flow and its
+    fall; ``data`` the walker's description (unused: as :func:`_kneed_phases`), ``f`` the
+    generated functions, ``flow``/``flow_jacobian`` the flow and its
     Jacobian (``flow_jacobian`` None: the generated one), ``var`` the variational
     right-hand side and ``compiled(name, *guards)`` the compiled flow (or None)."""
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
@@ -119,13 +125,17 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     """A hybrid walker from generated code; ``flow``/``reset`` may override the generated ones
     (the paper's printed Appendix A variants).
 
+    The walker's kind (:attr:`walkerlab.walker.description.Structure.kind`) picks its
+    builder in :data:`BUILDERS`.
+
     Parameters
     ----------
     data : WalkerData
     name, variant : str
         Stored in artifacts.
     flow, flow_jacobian, reset, reset_jacobian : callable, optional
-        Replacements for the generated functions (same signatures).
+        Replacements for the generated functions (same signatures): straight legs and
+        locking knees only.
     double_support : bool
         Flat feet: the double support after heel strike
         (:func:`walkerlab.models.hybrid.rigid_foot_modes.make_flat_walker`); False: the trailing
@@ -134,13 +144,50 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     Returns
     -------
     HybridWalker
-    """
-    if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
-        return make_flat_walker(data, name, variant, double_support=double_support)
-    if data.structure.free_knees:  # every joint free (five-link bipeds): one flow
-        from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
 
-        return make_five_link_walker(data, name, variant)
+    Raises
+    ------
+    ValueError
+        Replacements for a kind whose equations have none (one line).
+    """
+    printed = {"flow": flow, "flow_jacobian": flow_jacobian, "reset": reset,
+               "reset_jacobian": reset_jacobian}
+    return BUILDERS[data.structure.kind.name](data, name, variant, printed, double_support)
+
+
+@dataclass(frozen=True)
+class _Legs:
+    """What the legged kinds built on one generated flow differ in: ``phases`` (the phases
+    of a step, :func:`_straight_leg_phases` or :func:`_kneed_phases`) and
+    ``angles_are_coordinates(structure)`` (the state's coordinates are the legs' absolute
+    angles, so the walker needs no ``leg_angles`` map)."""
+
+    phases: Callable
+    angles_are_coordinates: Callable
+
+
+def _absolute_legs_only(structure) -> bool:
+    """Straight legs: absolute coordinates and no upper body."""
+    return structure.coordinates == "absolute" and not structure.torso
+
+
+def _never(structure) -> bool:
+    """A knee's shank angle is a coordinate of its own: the map is always needed."""
+    return False
+
+
+#: the legged kinds' parts (:func:`_make_legged`)
+_LEGS = {"straight_legs": _Legs(_straight_leg_phases, _absolute_legs_only),
+         "locking_knees": _Legs(_kneed_phases, _never)}
+
+
+def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
+                 double_support: bool) -> HybridWalker:
+    """Straight legs or locking knees (:data:`_LEGS`): one generated flow, its phases, the
+    heel-strike reset (``printed``: the printed equations' replacements)."""
+    legs = _LEGS[data.structure.kind.name]
+    flow, flow_jacobian = printed["flow"], printed["flow_jacobian"]
+    reset, reset_jacobian = printed["reset"], printed["reset_jacobian"]
     f = functions(data)
     # the compiled flow is the generated one: none when the flow is replaced
     generated_flow = flow is None and flow_jacobian is None
@@ -156,16 +203,12 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
     heel = Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike", f["grad_heel_strike"])
     falls_back = Guard("swing_leg_falls_back", ahead, -1, "fall", dahead)
-    phases = (_kneed_phases(data, f, flow, var, compiled, heel, falls_back, fall)
-              if data.structure.knee else
-              _straight_leg_phases(f, flow, flow_jacobian, var, compiled, heel, falls_back,
-                                   fall))
+    phases = legs.phases(data, f, flow, flow_jacobian, var, compiled, heel, falls_back, fall)
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
               "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
               **dict(zip(structure.param_names, data.params))}
-    coords = (None if structure.coordinates == "absolute" and not structure.knee
-              and not structure.torso else f["leg_angles"])
+    coords = None if legs.angles_are_coordinates(structure) else f["leg_angles"]
     mirror = data.mirror
     if mirror is not None:  # legs that differ: the next step's walker (leg2 swinging)
         mirror = make_rigid_walker(replace(mirror, mirror_params=None), name, variant)
@@ -179,3 +222,50 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
         heel_strike_guard=f["guard_heel_strike"], leg_angles=coords, mirror=mirror,
         matrices=f["matrices"],
     )
+
+
+def _only_generated(data: WalkerData, printed: dict) -> None:
+    """Refuse the printed equations' replacements for a kind that has none (one line)."""
+    given = [k for k, v in printed.items() if v is not None]
+    if given:
+        raise ValueError(f"{', '.join(given)}: printed equations replace a straight-legged "
+                         f"walker's only, not the {data.structure.kind.title}")
+
+
+def _make_flat(data: WalkerData, name: str, variant: str, printed: dict,
+               double_support: bool) -> HybridWalker:
+    """Flat feet: the stance foot's modes, a phase graph of their own
+    (:func:`walkerlab.models.hybrid.rigid_foot_modes.make_flat_walker`)."""
+    _only_generated(data, printed)
+    return make_flat_walker(data, name, variant, double_support=double_support)
+
+
+def _make_free(data: WalkerData, name: str, variant: str, printed: dict,
+               double_support: bool) -> HybridWalker:
+    """Every joint free (five-link bipeds): one flow
+    (:func:`walkerlab.models.hybrid.rigid_free_joints.make_five_link_walker`)."""
+    from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
+
+    _only_generated(data, printed)
+    return make_five_link_walker(data, name, variant)
+
+
+def _make_polygon(data: WalkerData, name: str, variant: str, printed: dict,
+                  double_support: bool) -> HybridWalker:
+    """A rimless (spoked) wheel rolling on its spokes
+    (:func:`walkerlab.models.hybrid.rolling_polygon.make_spoked_walker`)."""
+    from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
+
+    _only_generated(data, printed)
+    return make_spoked_walker(data, name, variant)
+
+
+#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> its builder ``(data, name, variant,
+#: printed, double_support) -> HybridWalker``
+BUILDERS: dict[str, Callable] = {
+    "straight_legs": _make_legged,
+    "locking_knees": _make_legged,
+    "flat_feet": _make_flat,
+    "free_joints": _make_free,
+    "rolling_polygon": _make_polygon,
+}

@@ -58,7 +58,7 @@ def make_five_link_walker(data: WalkerData, name: str = "biped",
     Parameters
     ----------
     data : WalkerData
-        ``data.structure.free_knees`` set.
+        Of the ``free_joints`` kind (:attr:`walkerlab.walker.description.Structure.kind`).
     name, variant : str
         Stored in artifacts.
 

@@ -31,8 +31,9 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
     Parameters
     ----------
     data : WalkerData
-        With ``data.structure.spokes`` (:func:`walkerlab.walker.description.walker_data` of
-        a ``model: rimless_wheel`` section).
+        Of the ``rolling_polygon`` kind (:func:`walkerlab.walker.description.walker_data`
+        of a ``model: rimless_wheel`` section), reached through it
+        (:data:`walkerlab.models.hybrid.rigid.BUILDERS`).
     name, variant : str
         Stored in artifacts.
 
