@@ -115,14 +115,27 @@ class Reached(Exception):
 def _rigid(d, tmp):
     from walkerlab.api.walker import Walker
 
-    assert Walker.from_scene(d).model is not None  # built (its refusals said)
+    w = Walker.from_scene(d)
+    assert w.model is not None  # built (its refusals said)
+    if (d.get("terrain") or {}).get("kind") == "profile":
+        # a profile is walked step by step, each step's walker landing on its segment
+        # (analysis.gait.profile_walk): the landing of the first one
+        from walkerlab.models.hybrid.ground import on_landing
+        from walkerlab.walker.description import walker_data
+
+        sc = w.scene
+        on_landing(w.model, walker_data(sc.walker, sc.slope.phi_rad), 0.001)
 
 
 def _contact(d, tmp):
     from walkerlab.config import scene_from_dict
     from walkerlab.models.contact.scene import contact_setup
 
-    _rigid(d, tmp)  # contact-sim starts from the rigid gait (fixedpoint.h5): its walker
+    from walkerlab.api.walker import Walker
+
+    # contact-sim starts from the rigid gait (fixedpoint.h5; on a profile the slope's): its
+    # walker
+    assert Walker.from_scene(d).model is not None
     contact_setup(scene_from_dict(d))
 
 

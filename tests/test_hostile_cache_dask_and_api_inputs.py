@@ -175,7 +175,7 @@ def _kernel_run(env):
 
 @pytest.mark.parametrize("damage", ["garbage", "empty", "fifo"])
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
-def test_m1_damaged_numba_cache_files_are_rebuilt(tmp_path, damage):
+def test_damaged_numba_cache_files_are_rebuilt(tmp_path, damage):
     cache = tmp_path / "cache"
     env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
@@ -205,7 +205,7 @@ def _package_pycache() -> set[Path]:
 
 @pytest.mark.slow  # each case compiles the kernels into a fresh cache (~10 s CPU)
 @pytest.mark.parametrize("how", ["group_writable", "symlink", "not_creatable", "read_only"])
-def test_m2_unusable_numba_cache_never_writes_into_the_package(tmp_path, how):
+def test_unusable_numba_cache_never_writes_into_the_package(tmp_path, how):
     if how == "read_only" and os.geteuid() == 0:
         pytest.skip("root writes into read-only folders (not_creatable covers the fallback)")
     cache, tmp = tmp_path / "cache", tmp_path / "tmp"
@@ -250,7 +250,7 @@ def test_m2_unusable_numba_cache_never_writes_into_the_package(tmp_path, how):
 
 
 # ----------------------------------------------------------------------------- API (Medium)
-def test_m5_api_runs_dir_empty_is_refused_not_the_current_folder(tmp_path, monkeypatch):
+def test_api_runs_dir_empty_is_refused_not_the_current_folder(tmp_path, monkeypatch):
     import walkerlab.api as wl
     from walkerlab.safefs import RunPathError
 
@@ -264,7 +264,7 @@ def test_m5_api_runs_dir_empty_is_refused_not_the_current_folder(tmp_path, monke
     assert list(tmp_path.iterdir()) == []  # before: ./paper/fixedpoint.h5
 
 
-def test_m5_api_sweep_values_must_be_a_sequence(tmp_path):
+def test_api_sweep_values_must_be_a_sequence(tmp_path):
     import walkerlab.api as wl
     from walkerlab.studies.params import SweepError
 
@@ -275,7 +275,7 @@ def test_m5_api_sweep_values_must_be_a_sequence(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_m5_api_load_scene_name_is_validated():
+def test_api_load_scene_name_is_validated():
     import walkerlab.api as wl
     from walkerlab.config import SceneError
 
@@ -285,7 +285,7 @@ def test_m5_api_load_scene_name_is_validated():
     assert wl.load_scene(PAPER, name="steep_1").name == "steep_1"
 
 
-def test_m5_a_5000_digit_integer_is_one_line_naming_the_field():
+def test_a_5000_digit_integer_is_one_line_naming_the_field():
     import yaml
 
     import walkerlab.api as wl
@@ -302,7 +302,7 @@ def test_m5_a_5000_digit_integer_is_one_line_naming_the_field():
 
 # ----------------------------------------------------------------------------- guess (Medium)
 @pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
-def test_m6_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
+def test_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
     import yaml
 
     d = yaml.safe_load(PAPER.read_text())
@@ -318,7 +318,7 @@ def test_m6_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
     assert "62.6 rad/s" in lines[0]  # 20 sqrt(9.81 / 1.0)
 
 
-def test_m6_every_shipped_initial_guess_is_within_the_walking_bound():
+def test_every_shipped_initial_guess_is_within_the_walking_bound():
     from walkerlab.analysis.gait.scene import initial_guess
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
@@ -425,7 +425,7 @@ def _digests(folder: Path) -> dict[str, str]:
 
 
 @pytest.mark.slow
-def test_m4_figures_and_report_key_on_the_content_they_draw(tmp_path):
+def test_figures_and_report_key_on_the_content_they_draw(tmp_path):
     scene, env = _rigid_scene(tmp_path), _env(tmp_path)
     runs = tmp_path / "runs"
     folder, figs = runs / "rigid", runs / "rigid" / "report" / "figures"
@@ -474,7 +474,7 @@ def _first_float_dataset(path: Path) -> str:
 
 
 @pytest.mark.slow
-def test_m4_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
+def test_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
     import yaml
 
     env, runs = _env(tmp_path), tmp_path / "runs"

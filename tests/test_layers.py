@@ -472,3 +472,48 @@ def test_no_module_is_named_after_a_walker_family():
              if any(w in part for part in p.relative_to(pkg).with_suffix("").parts
                     for w in FAMILY_WORDS)]
     assert not named, named
+
+
+def _kind_switch_reads(tree: ast.Module) -> list[int]:
+    """Lines of ``tree`` that read a switch of the walker description that chooses its kind
+    (:func:`walkerlab.walker.kinds.kind_of`): ``.free_knees``, ``.spokes``, ``knee.lock``,
+    ``structure.knee`` / ``st.knee``, ``foot.kind``, a comparison with ``"flat"`` or
+    ``"rimless_wheel"``."""
+    out = []
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Attribute) and (
+                n.attr in ("free_knees", "spokes")
+                or (n.attr == "lock" and getattr(n.value, "attr", "") == "knee")
+                or (n.attr == "knee" and getattr(n.value, "attr", getattr(n.value, "id", ""))
+                    in ("structure", "st"))
+                or (n.attr == "kind" and getattr(n.value, "attr", "") == "foot")):
+            out.append(n.lineno)
+        elif isinstance(n, ast.Compare) and any(
+                isinstance(c, ast.Constant) and c.value in ("flat", "rimless_wheel")
+                for c in [n.left, *n.comparators]):
+            out.append(n.lineno)
+    return out
+
+
+#: modules outside walker/, codegen/ and config/ that may still read a kind switch (at most
+#: three): the wheel's spoke count in its exported parameters (a number, not a branch), and a
+#: check of the generated contact source whose text keys the compiled-module cache
+KIND_SWITCH_READERS = {"export/multibody.py", "models/contact/generated.py"}
+
+
+def test_the_walker_kind_is_chosen_once_and_the_layers_consult_it():
+    """A walker's structural kind is chosen in ``walker/`` (from the description, which
+    ``config/`` and ``codegen/`` also read); every other layer reaches its code for a kind
+    through the kind (its table of parts) and reads its refusals from the capability table,
+    never by testing the description's switches (at most three modules excepted)."""
+    assert len(KIND_SWITCH_READERS) <= 3
+    found = {}
+    for p in sorted(PKG.rglob("*.py")):
+        rel = p.relative_to(PKG)
+        if rel.parts[0] in ("walker", "codegen", "config"):
+            continue
+        if lines := _kind_switch_reads(_tree(p)):
+            found[rel.as_posix()] = lines
+    assert set(found) <= KIND_SWITCH_READERS, found
+    probe = 'if st.foot == "flat" or s.free_knees or leg.knee.lock: pass\nn = w.spokes'
+    assert sorted(_kind_switch_reads(ast.parse(probe))) == [1, 1, 1, 2]  # the reader sees

@@ -40,7 +40,7 @@ DEFAULT_TORQUE_FRACTION = 0.1
 def action_joints(scene) -> list[str]:
     """The joints the action drives: those of ``walker.actuation.torques`` (each once, in
     order), else ``["hip"]``."""
-    act = getattr(scene.walker, "actuation", None)
+    act = scene.walker.actuation
     joints: list[str] = []
     for t in (act.torques if act is not None else ()):
         if t.joint not in joints:
@@ -81,7 +81,7 @@ def action_limits(scene, joints: list[str], total_mass_kg: float, gravity: float
                              f"or {k} (one per joint: {', '.join(joints)}) [N m]")
         return arr
     default = DEFAULT_TORQUE_FRACTION * total_mass_kg * gravity * leg_length_m
-    act = getattr(scene.walker, "actuation", None)
+    act = scene.walker.actuation
     out = np.full(k, default)
     for i, j in enumerate(joints):
         caps = [t.max_torque_n_m for t in (act.torques if act is not None else ())

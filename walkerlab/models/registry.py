@@ -41,7 +41,7 @@ def build_walker(scene) -> HybridWalker:
         or actuators the walker cannot carry (one line).
     """
     walker = _on_ground(scene, _passive(scene))
-    act = getattr(scene.walker, "actuation", None)
+    act = scene.walker.actuation
     if act is None:
         return walker
     from walkerlab.models.hybrid.actuated import actuate
@@ -129,7 +129,7 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
     if walker.variant != "derived":
         raise ValueError("terrain.kind: footholds need ideal.variant: derived (the printed "
                          "Appendix A equations know only the slope)")
-    if getattr(scene.walker, "actuation", None) is not None:
+    if scene.walker.actuation is not None:
         raise ValueError("walker.actuation: footholds of several heights or slopes are built "
                          "for passive walkers only")
     walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(

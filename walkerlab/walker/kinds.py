@@ -226,9 +226,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                    "has no push-off"),
         ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
         **_GROUNDS,
-        **{("footholds", v): ("a five-link biped walks by its joint torques, and footholds of "
-                              "several heights or slopes are built for passive walkers only")
-           for v in ("rigid", "contact")},
+        # the shipped five-link biped walks by its joint torques (a passive one would build)
+        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
+                              "walkers only") for v in ("rigid", "contact")},
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",

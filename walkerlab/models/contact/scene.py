@@ -202,7 +202,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
 def _actuators(scene: Scene, data, cs: ContactSimSettings
                ) -> ContactActuators | JointTorqueActuators | None:
     """The scene's actuators in the contact view, or None; one-line refusals."""
-    spec = getattr(scene.walker, "actuation", None)
+    spec = scene.walker.actuation
     if spec is None:
         return None
     from walkerlab.codegen.floating import coordinate_names
