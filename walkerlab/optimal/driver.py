@@ -40,17 +40,9 @@ from functools import partial
 import numpy as np
 
 from walkerlab.io.schemas.optimize import OptimizeData
+from walkerlab.optimal import outcome as reported
 from walkerlab.optimal.free_joints import optimize_five_link, stick_figures
-from walkerlab.optimal.outcome import (
-    hip_phase_replays_of,
-    history_and_energies,
-    massless_legs,
-    named_states,
-    not_a_gait_outcome,
-    optimum_outcome,
-    replay_multipliers,
-    unit_of_objective,
-)
+from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
 
 __all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
            "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
@@ -328,16 +320,16 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data))
     err, replayed = replay(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
-    gait, contact_period, contact_outcome = optimum_outcome(
+    gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay(scene, res))
-    phases, phase_note = hip_phase_replays_of(scene, data, res, torque_of_time(res))
-    states, units = named_states(walker, res)
+    phases, phase_note = reported.hip_phase_replays_of(scene, data, res, torque_of_time(res))
+    states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m,
                         res.push_off_n_s, res.objective, err, mu, gait, res.status,
                         res.iterations, res.wall_time_s, units, objective_name=o.objective,
-                        objective_unit=unit_of_objective(o, data), terms=res.terms,
+                        objective_unit=reported.unit_of_objective(o, data), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
-                        torque_unit="N m/kg" if massless_legs(data) else "N m",
+                        torque_unit="N m/kg" if reported.massless_legs(data) else "N m",
                         phase_replays=phases, phase_replay_outcome=phase_note,
                         **history_and_energies(scene, walker, res))
 
@@ -418,14 +410,14 @@ def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> Optimi
                            guess_u)
     err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
-    gait, contact_period, contact_outcome = optimum_outcome(
+    gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_phased(scene, res, strides=2))
-    phases, phase_note = hip_phase_replays_of(scene, data, res, phase_torque_of_time(res))
-    states, units = named_states(walker, res)
+    phases, phase_note = reported.hip_phase_replays_of(scene, data, res, phase_torque_of_time(res))
+    states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
                         res.objective, err, mu, gait, res.status, res.iterations,
                         res.wall_time_s, units, objective_name=o.objective,
-                        objective_unit=unit_of_objective(o), terms=res.terms,
+                        objective_unit=reported.unit_of_objective(o), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
@@ -515,7 +507,7 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
                            guess_u)
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
-    gait, contact_period, contact_outcome = optimum_outcome(
+    gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2))
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
@@ -524,11 +516,11 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
              for k, w in enumerate((walker, walker.mirror))]
     record["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
                         for kind in record["energy"]}
-    states, units = named_states(walker, res)
+    states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s / 2, float(np.mean(lengths)),
                         res.push_off_n_s, res.objective, err, mu, gait, res.status,
                         res.iterations, res.wall_time_s, units, objective_name=o.objective,
-                        objective_unit=unit_of_objective(o), terms=res.terms,
+                        objective_unit=reported.unit_of_objective(o), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
