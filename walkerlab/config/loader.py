@@ -128,37 +128,16 @@ def parse_yaml(text: str):
     return yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene YAML file.
-
-    Parameters
-    ----------
-    path : str or Path
-        YAML scene file; one not found in the working folder may name a shipped scene
-        (``"paper"``, ``"kneed"``, ``"configs/rabbit.yaml"``: :func:`shipped_scene_path`).
-
-    Returns
-    -------
-    Scene
-        Validated, frozen scene; ``name`` defaults to the file stem.
+def _read_scene_text(path: Path) -> str:
+    """The scene file's text (at most :data:`MAX_SCENE_BYTES`, UTF-8).
 
     Raises
     ------
     SceneError
-        File missing, malformed YAML, or a field that fails validation (one line, naming
-        the file and the field).
+        Not a regular file, not UTF-8 text, or unreadable (one line naming the file).
     """
     from walkerlab.safefs import NotARegularFile, read_regular
 
-    path = Path(path)
-    if not path.exists() and (shipped := shipped_scene_path(path)) is not None:
-        path = shipped
-    if path.is_dir():
-        raise SceneError(f"{path}: is a directory, not a scene file")
-    if not path.is_file():
-        if path.exists():  # a device, FIFO or socket (/dev/zero)
-            raise SceneError(f"{path}: not a regular file; give a YAML scene file")
-        raise SceneError(f"{path}: scene file not found")
     try:
         text = read_regular(path, MAX_SCENE_BYTES, "scene file").decode("utf-8")
     except NotARegularFile as exc:
@@ -168,6 +147,18 @@ def load_scene(path: str | Path) -> Scene:
                          f"0x{exc.object[exc.start]:02x})") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from None
+    return text
+
+
+def _parse_scene_yaml(text: str, path: Path):
+    """The scene file's YAML ``text`` parsed (:func:`parse_yaml`).
+
+    Raises
+    ------
+    SceneError
+        An unreadable number, nesting too deep, a control character, a duplicate key or
+        malformed YAML (one line naming the file and the line).
+    """
     try:
         data = parse_yaml(text)
     except ValueError as exc:  # int(...) of a 5000-digit number
@@ -189,6 +180,40 @@ def load_scene(path: str | Path) -> Scene:
         if str(problem).startswith(("duplicate key", "nesting deeper")):
             raise SceneError(f"{path}:{where} {problem}") from None
         raise SceneError(f"{path}:{where} malformed YAML ({problem})") from None
+    return data
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene YAML file.
+
+    Parameters
+    ----------
+    path : str or Path
+        YAML scene file; one not found in the working folder may name a shipped scene
+        (``"paper"``, ``"kneed"``, ``"configs/rabbit.yaml"``: :func:`shipped_scene_path`).
+
+    Returns
+    -------
+    Scene
+        Validated, frozen scene; ``name`` defaults to the file stem.
+
+    Raises
+    ------
+    SceneError
+        File missing, malformed YAML, or a field that fails validation (one line, naming
+        the file and the field).
+    """
+    path = Path(path)
+    if not path.exists() and (shipped := shipped_scene_path(path)) is not None:
+        path = shipped
+    if path.is_dir():
+        raise SceneError(f"{path}: is a directory, not a scene file")
+    if not path.is_file():
+        if path.exists():  # a device, FIFO or socket (/dev/zero)
+            raise SceneError(f"{path}: not a regular file; give a YAML scene file")
+        raise SceneError(f"{path}: scene file not found")
+    text = _read_scene_text(path)
+    data = _parse_scene_yaml(text, path)
     if not isinstance(data, dict):
         raise SceneError(f"{path}: a scene must be a YAML mapping")
     if data.get("name") is None:

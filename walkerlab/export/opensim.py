@@ -75,9 +75,22 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
-from walkerlab.export.mjcf_scene import actuation_text, point_foot_radius
+from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.export.opensim_xml import (
+    body_set,
+    contact_forces,
+    contact_geometry_set,
+    couplers,
+    header_comments,
+    joint_set,
+    knee_stop_forces,
+    motor_forces,
+    push_off_forces,
+    spring_forces,
+    torque_joints,
+)
 from walkerlab.export.parts import export_part
-from walkerlab.export.text import comment, num, nums
+from walkerlab.export.text import nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 from walkerlab.walker.kinds import KINDS
 
@@ -340,84 +353,6 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
                     settings.push_off_pulse_s(), ms.actuation, ms.lane_heights)
 
 
-# ----------------------------------------------------------------------------- the XML
-
-
-def _frame(name: str, parent: str, translation=(0.0, 0.0, 0.0), orientation=(0.0, 0.0, 0.0),
-           ind: str = "\t\t\t\t\t\t") -> list[str]:
-    return [f"{ind}<PhysicalOffsetFrame name={quoteattr(name)}>",
-            f"{ind}\t<socket_parent>{parent}</socket_parent>",
-            f"{ind}\t<translation>{nums(*translation)}</translation>",
-            f"{ind}\t<orientation>{nums(*orientation)}</orientation>",
-            f"{ind}</PhysicalOffsetFrame>"]
-
-
-def _coordinate(name: str, value: float, speed: float, ind: str = "\t\t\t\t\t\t") -> list[str]:
-    return [f"{ind}<Coordinate name={quoteattr(name)}>",
-            f"{ind}\t<default_value>{num(value)}</default_value>",
-            f"{ind}\t<default_speed_value>{num(speed)}</default_speed_value>",
-            f"{ind}\t<range>-1e6 1e6</range>",
-            f"{ind}\t<clamped>false</clamped>",
-            f"{ind}</Coordinate>"]
-
-
-def _body(name: str, mass: float, com=(0.0, 0.0), inertia: float = 0.0) -> list[str]:
-    i = "\t\t\t\t"
-    return [f"{i}<Body name={quoteattr(name)}>", f"{i}\t<mass>{num(mass)}</mass>",
-            f"{i}\t<mass_center>{nums(com[0], com[1], 0.0)}</mass_center>",
-            f"{i}\t<inertia>{nums(inertia, inertia, inertia, 0.0, 0.0, 0.0)}</inertia>",
-            f"{i}</Body>"]
-
-
-def _expression_force(name: str, coord: str, expression: str, applies: bool = True
-                      ) -> list[str]:
-    i = "\t\t\t\t"
-    return [f"{i}<ExpressionBasedCoordinateForce name={quoteattr(name)}>",
-            f"{i}\t<appliesForce>{str(applies).lower()}</appliesForce>",
-            f"{i}\t<coordinate>{coord}</coordinate>",
-            f"{i}\t<expression>{expression}</expression>",
-            f"{i}</ExpressionBasedCoordinateForce>"]
-
-
-def _couplers(mb) -> list[str]:
-    """A ``ConstraintSet`` of one ``CoordinateCouplerConstraint`` per coupling of ``mb`` (the
-    bisecting hip: ``torso_hip = 0.5 leg1_hip + 0.5 leg2_hip``, the links' absolute angles):
-    a first-order ``MultivariatePolynomialFunction`` of the independent coordinates, whose
-    coefficients OpenSim orders as the constant, then the last coordinate's, ..., the first's."""
-    if not mb.couplings:
-        return []
-    i = "\t\t\t\t"
-    out = ['\t\t<ConstraintSet name="constraintset">', "\t\t\t<objects>"]
-    for cp in mb.couplings:
-        coefs = [0.0, *(c for _, c in reversed(cp.terms))]
-        out += [f"{i}<CoordinateCouplerConstraint name={quoteattr(cp.name)}>",
-                f"{i}\t<isEnforced>true</isEnforced>",
-                f"{i}\t<coupled_coordinates_function>",
-                f"{i}\t\t<MultivariatePolynomialFunction>",
-                f"{i}\t\t\t<coefficients>{nums(*coefs)}</coefficients>",
-                f"{i}\t\t\t<dimension>{len(cp.terms)}</dimension>",
-                f"{i}\t\t\t<order>1</order>",
-                f"{i}\t\t</MultivariatePolynomialFunction>",
-                f"{i}\t</coupled_coordinates_function>",
-                f"{i}\t<independent_coordinate_names>{' '.join(j for j, _ in cp.terms)}"
-                "</independent_coordinate_names>",
-                f"{i}\t<dependent_coordinate_name>{cp.joint}</dependent_coordinate_name>",
-                f"{i}\t<scale_factor>1</scale_factor>",
-                f"{i}</CoordinateCouplerConstraint>"]
-    return out + ["\t\t\t</objects>", "\t\t</ConstraintSet>"]
-
-
-def _torque_joints(act: Actuation | None, mb) -> list[str]:
-    """Coordinates that get a ``CoordinateActuator``: every coordinate a torque law's joint
-    moves in either stance (:func:`walkerlab.export.joint_torques.torque_generalized_forces`)."""
-    if act is None:
-        return []
-    coords = [ln.joint for ln in mb.links]
-    used = {c for t in act.torques for st in (0, 1)
-            for c in torque_generalized_forces(t.joint, st, coords)}
-    return [c for c in coords if c in used]
-
-
 def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     """The OpenSim model's XML (module docstring for its content).
 
@@ -450,204 +385,28 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     stiff, diss, vt, contact_note = hunt_crossley(gait.contact, weight, r_eff)
     joints = ["hip_x", "hip_y", *(ln.joint for ln in mb.links)]
     q0, v0 = dict(zip(joints, gait.qpos)), dict(zip(joints, gait.qvel))
-    link_of = {ln.name: ln for ln in mb.links}
+    knee_stops = export_part(mb).knee_stops
+    motors = torque_joints(gait.actuation, mb)
 
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
-           comment(f"walker {name!s} exported by walkerlab {version} (OpenSim model)."),
-           comment("Planar walker in the x-y plane: x downhill (horizontal), y up; joints about "
-                   "z (positive angle = foot ahead). Coordinates: hip_x, hip_y (the hip's "
-                   "position [m]); leg<i>_hip = absolute link angle from the vertical [rad]; "
-                   "leg<i>_knee = shank - thigh [rad], 0 = straight."),
-           comment(f"Gravity g = {num(g)} m/s^2 along -y. Ground: slope {num(phi)} rad, "
-                   f"falling towards +x. Total mass {num(total)} kg."),
-           comment(f"Default state: the rigid gait's fixed point just after heel strike (leg2 "
-                   f"in stance, its foot's contact point at the origin): step period "
-                   f"{gait.period_s:.8g} s, step length {gait.step_length_m:.8g} m, speed "
-                   f"{gait.speed_m_per_s:.8g} m/s along the slope."),
-           comment(contact_note)]
-    if rg is not None:
-        out.append(comment(
-            f"Terrain: checkerboard lanes (each leg touches only its own); a patch of width "
-            f"{num(gait.patch_width_m)} m is a sphere of radius {rg:.6g} m whose top touches "
-            f"the slope line at the footfall (it falls {r_foot:.4g} m below the line at the "
-            "patch's edge: walkerlab.export.opensim.patch_radius)"
-            + ("" if gait.lane_heights is None else
-               "; stairs or footholds: each patch's top at its tread's height, the radius "
-               "small enough that the tread behind falls clear of the swing foot's path "
-               "(walkerlab.export.opensim.terrain_patch_radius)") + "."))
-    if gait.push_off is not None:
-        out.append(comment(
-            "Push-off (walker.actuation.push_off, walkerlab_actuation below): PrescribedForce "
-            "leg<i>_push_off, F = impulse_n_s / T along the leg from foot to hip at its foot, "
-            "applies no force by default; a stepping loop (walkerlab.export.opensim_walk) "
-            f"switches the trailing leg's on for T = {gait.push_off_duration_s:g} s from each "
-            "heel strike (P / F for a law whose impulse P depends on the hip's speed; the rigid "
-            "model pushes off immediately before heel strike)."))
-    motors = _torque_joints(gait.actuation, mb)
-    if motors:
-        out.append(comment(
-            "Joint torques (walker.actuation.torques, walkerlab_actuation below): "
-            f"CoordinateActuators {', '.join(m + '_motor' for m in motors)} (optimal force "
-            "1 N m: the control is the generalised force); a torque tau at a joint of angle "
-            "angle(second link) - angle(first link) is +tau and -tau on the coordinates of "
-            "those links' absolute angles (leg<i>_hip and torso_hip are absolute, leg<i>_knee "
-            "is shank - thigh); a stepping loop (walkerlab.export.opensim_walk) sets them from "
-            "the laws between windows, the roles swapping at each heel strike."))
-    if gait.actuation is not None:
-        out.append(comment(f"walkerlab_actuation: {actuation_text(gait.actuation)}"))
-    if export_part(mb).knee_stops:
-        out.append(comment(
-            "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
-            f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "
-            f"{gait.knee.cmax:.6g} N m s/rad, dmax = {gait.knee.dmax:.4g} rad; pushing only); "
-            "knee latch leg<i>_knee_latch (the same law acting in flexion) applies no force by "
-            "default: "
-            f"a stepping loop switches it on while the leg's foot is less than "
-            f"{gait.knee.latch_height:.4g} m above the ground and its knee within "
-            f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk)."))
-    out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>",
-            '\t\t<BodySet name="bodyset">', "\t\t\t<objects>"]
-    out += _body("hip", mb.hip_mass_kg)
-    for ln in mb.links:
-        along = -ln.com_m  # com_m is along the link's downward axis (-y)
-        out += _body(ln.name, ln.mass_kg, (ln.com_off_axis_m, along), ln.inertia_kg_m2)
-    out += ["\t\t\t</objects>", "\t\t</BodySet>", '\t\t<JointSet name="jointset">',
-            "\t\t\t<objects>", '\t\t\t\t<CustomJoint name="base">',
-            "\t\t\t\t\t<socket_parent_frame>/ground</socket_parent_frame>",
-            "\t\t\t\t\t<socket_child_frame>/bodyset/hip</socket_child_frame>",
-            "\t\t\t\t\t<coordinates>",
-            *_coordinate("hip_x", q0["hip_x"], v0["hip_x"]),
-            *_coordinate("hip_y", q0["hip_y"], v0["hip_y"]),
-            "\t\t\t\t\t</coordinates>", "\t\t\t\t\t<SpatialTransform>"]
-    for axis_name, axis, coord in (("rotation1", "1 0 0", None), ("rotation2", "0 1 0", None),
-                                   ("rotation3", "0 0 1", None),
-                                   ("translation1", "1 0 0", "hip_x"),
-                                   ("translation2", "0 1 0", "hip_y"),
-                                   ("translation3", "0 0 1", None)):
-        fn = ('<LinearFunction name="function"><coefficients>1 0</coefficients>'
-              "</LinearFunction>" if coord else
-              '<Constant name="function"><value>0</value></Constant>')
-        out += [f'\t\t\t\t\t\t<TransformAxis name="{axis_name}">',
-                f"\t\t\t\t\t\t\t<coordinates>{coord or ''}</coordinates>",
-                f"\t\t\t\t\t\t\t<axis>{axis}</axis>", f"\t\t\t\t\t\t\t{fn}",
-                "\t\t\t\t\t\t</TransformAxis>"]
-    out += ["\t\t\t\t\t</SpatialTransform>", "\t\t\t\t</CustomJoint>"]
-    for ln in mb.links:
-        parent = "hip" if ln.parent == "hip" else ln.parent
-        out += [f"\t\t\t\t<PinJoint name={quoteattr(ln.joint)}>",
-                f"\t\t\t\t\t<socket_parent_frame>{parent}_at_{ln.joint}</socket_parent_frame>",
-                f"\t\t\t\t\t<socket_child_frame>{ln.name}_at_{ln.joint}</socket_child_frame>",
-                "\t\t\t\t\t<coordinates>", *_coordinate(ln.joint, q0[ln.joint], v0[ln.joint]),
-                "\t\t\t\t\t</coordinates>", "\t\t\t\t\t<frames>",
-                *_frame(f"{parent}_at_{ln.joint}", f"/bodyset/{parent}",
-                        (0.0, -ln.joint_from_parent_m, 0.0)),
-                *_frame(f"{ln.name}_at_{ln.joint}", f"/bodyset/{ln.name}"),
-                "\t\t\t\t\t</frames>", "\t\t\t\t</PinJoint>"]
-    out += ["\t\t\t</objects>", "\t\t</JointSet>", *_couplers(mb),
-            '\t\t<ForceSet name="forceset">',
-            "\t\t\t<objects>"]
+           *header_comments(mb, gait, name, version, total, contact_note, rg, r_foot, motors,
+                            knee_stops)]
+    out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
+    out += body_set(mb)
+    out += joint_set(mb, q0, v0)
+    out += couplers(mb)
     feet = [ln for ln in mb.links if ln.foot_m is not None]
-    for i, ln in enumerate(feet):
-        leg = ln.name.split("_")[0]
-        grounds = ["ground"] if rg is None else [
-            f"{leg}_patch{j}" for j in range(len(gait.lanes[i]))]
-        out += [f"\t\t\t\t<HuntCrossleyForce name=\"{leg}_contact\">",
-                '\t\t\t\t\t<HuntCrossleyForce::ContactParametersSet name="contact_parameters">',
-                "\t\t\t\t\t\t<objects>", "\t\t\t\t\t\t\t<HuntCrossleyForce::ContactParameters>",
-                f"\t\t\t\t\t\t\t\t<geometry>{leg}_foot {' '.join(grounds)}</geometry>",
-                f"\t\t\t\t\t\t\t\t<stiffness>{num(stiff)}</stiffness>",
-                f"\t\t\t\t\t\t\t\t<dissipation>{num(diss)}</dissipation>",
-                f"\t\t\t\t\t\t\t\t<static_friction>{num(gait.contact.mu_s)}</static_friction>",
-                f"\t\t\t\t\t\t\t\t<dynamic_friction>{num(gait.contact.mu_d)}"
-                "</dynamic_friction>",
-                "\t\t\t\t\t\t\t\t<viscous_friction>0</viscous_friction>",
-                "\t\t\t\t\t\t\t</HuntCrossleyForce::ContactParameters>",
-                "\t\t\t\t\t\t</objects>", "\t\t\t\t\t</HuntCrossleyForce::ContactParametersSet>",
-                f"\t\t\t\t\t<transition_velocity>{num(vt)}</transition_velocity>",
-                "\t\t\t\t</HuntCrossleyForce>"]
-    for sp in mb.springs:
-        if len(sp.terms) == 1:  # a knee spring: the knee coordinate itself
-            out += [f"\t\t\t\t<SpringGeneralizedForce name={quoteattr(sp.name)}>",
-                    f"\t\t\t\t\t<coordinate>{sp.terms[0][0]}</coordinate>",
-                    f"\t\t\t\t\t<stiffness>{num(sp.stiffness_n_m_per_rad)}</stiffness>",
-                    f"\t\t\t\t\t<rest_length>{num(sp.rest_angle_rad)}</rest_length>",
-                    f"\t\t\t\t\t<viscosity>{num(sp.damping_n_m_s_per_rad)}</viscosity>",
-                    "\t\t\t\t</SpringGeneralizedForce>"]
-            continue
-        first, second = sp.between  # delta = angle(second) - angle(first), about z
-        j1, j2 = link_of[first].joint, link_of[second].joint
-        # the rest angle: the second link's frame turned by +rest, so delta - rest is the
-        # bushing's rotation of frame2 relative to frame1
-        out += [f"\t\t\t\t<BushingForce name={quoteattr(sp.name)}>",
-                f"\t\t\t\t\t<socket_frame1>{first}_spring_{j1}</socket_frame1>",
-                f"\t\t\t\t\t<socket_frame2>{second}_spring_{j2}</socket_frame2>",
-                f"\t\t\t\t\t<rotational_stiffness>{nums(0, 0, sp.stiffness_n_m_per_rad)}"
-                "</rotational_stiffness>",
-                "\t\t\t\t\t<translational_stiffness>0 0 0</translational_stiffness>",
-                f"\t\t\t\t\t<rotational_damping>{nums(0, 0, sp.damping_n_m_s_per_rad)}"
-                "</rotational_damping>",
-                "\t\t\t\t\t<translational_damping>0 0 0</translational_damping>",
-                "\t\t\t\t\t<frames>",
-                *_frame(f"{first}_spring_{j1}", f"/bodyset/{first}"),
-                *_frame(f"{second}_spring_{j2}", f"/bodyset/{second}",
-                        orientation=(0.0, 0.0, -sp.rest_angle_rad)),
-                "\t\t\t\t\t</frames>", "\t\t\t\t</BushingForce>"]
-    if export_part(mb).knee_stops:
-        for ln in mb.links:
-            if ln.joint.endswith("_knee"):
-                out += _expression_force(f"{ln.joint}_stop", ln.joint,
-                                         knee_stop_expression(gait.knee, "stop"))
-                out += _expression_force(f"{ln.joint}_latch", ln.joint,
-                                         knee_stop_expression(gait.knee, "latch"),
-                                         applies=False)
-    for j in motors:
-        out += [f"\t\t\t\t<CoordinateActuator name=\"{j}_motor\">",
-                f"\t\t\t\t\t<coordinate>{j}</coordinate>",
-                "\t\t\t\t\t<optimal_force>1</optimal_force>", "\t\t\t\t</CoordinateActuator>"]
+    out += ['\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
+    out += contact_forces(feet, gait, rg, stiff, diss, vt)
+    out += spring_forces(mb)
+    if knee_stops:
+        out += knee_stop_forces(mb, knee_stop_expression(gait.knee, "stop"),
+                                knee_stop_expression(gait.knee, "latch"))
+    out += motor_forces(motors)
     if gait.push_off is not None:
-        force = gait.push_off.impulse_n_s / gait.push_off_duration_s
-        for ln in feet:
-            leg = ln.name.split("_")[0]
-            out += [f"\t\t\t\t<PrescribedForce name=\"{leg}_push_off\">",
-                    "\t\t\t\t\t<appliesForce>false</appliesForce>",
-                    f"\t\t\t\t\t<socket_frame>/bodyset/{ln.name}</socket_frame>",
-                    "\t\t\t\t\t<pointIsGlobal>false</pointIsGlobal>",
-                    "\t\t\t\t\t<forceIsGlobal>false</forceIsGlobal>",
-                    '\t\t\t\t\t<FunctionSet name="forceFunctions"><objects>'
-                    '<Constant><value>0</value></Constant>'
-                    f'<Constant><value>{num(force)}</value></Constant>'
-                    '<Constant><value>0</value></Constant></objects></FunctionSet>',
-                    '\t\t\t\t\t<FunctionSet name="pointFunctions"><objects>'
-                    '<Constant><value>0</value></Constant>'
-                    f'<Constant><value>{num(-ln.foot_m)}</value></Constant>'
-                    '<Constant><value>0</value></Constant></objects></FunctionSet>',
-                    "\t\t\t\t</PrescribedForce>"]
-    out += ["\t\t\t</objects>", "\t\t</ForceSet>",
-            '\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
-    for ln in feet:
-        leg = ln.name.split("_")[0]
-        out += [f"\t\t\t\t<ContactSphere name=\"{leg}_foot\">",
-                f"\t\t\t\t\t<socket_frame>/bodyset/{ln.name}</socket_frame>",
-                f"\t\t\t\t\t<location>{nums(0.0, -ln.foot_m, 0.0)}</location>",
-                f"\t\t\t\t\t<radius>{num(r_foot)}</radius>", "\t\t\t\t</ContactSphere>"]
-    if rg is None:  # OpenSim's half-space fills local x > 0: turned so its normal is n_hat
-        p = -offset * n_hat
-        out += ['\t\t\t\t<ContactHalfSpace name="ground">',
-                "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
-                f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
-                f"\t\t\t\t\t<orientation>{nums(0.0, 0.0, -math.pi / 2 - phi)}</orientation>",
-                "\t\t\t\t</ContactHalfSpace>"]
-    else:
-        for i, ln in enumerate(feet):
-            leg = ln.name.split("_")[0]
-            for j, s in enumerate(gait.lanes[i]):
-                h = 0.0 if gait.lane_heights is None else gait.lane_heights[i][j]
-                p = s * t_hat + (h - offset - rg) * n_hat
-                out += [f"\t\t\t\t<ContactSphere name=\"{leg}_patch{j}\">",
-                        "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
-                        f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
-                        f"\t\t\t\t\t<radius>{num(rg)}</radius>", "\t\t\t\t</ContactSphere>"]
-    out += ["\t\t\t</objects>", "\t\t</ContactGeometrySet>", "\t</Model>",
-            "</OpenSimDocument>", ""]
+        out += push_off_forces(feet, gait.push_off.impulse_n_s / gait.push_off_duration_s)
+    out += ["\t\t\t</objects>", "\t\t</ForceSet>"]
+    out += contact_geometry_set(feet, gait, r_foot, rg, offset, phi, t_hat, n_hat)
+    out += ["\t</Model>", "</OpenSimDocument>", ""]
     return "\n".join(out)

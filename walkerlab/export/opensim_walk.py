@@ -235,16 +235,8 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
 
     Parameters
     ----------
-    path : path
-        An OpenSim export (:mod:`walkerlab.export.opensim`).
-    duration_s : float
-        Simulated time [s].
-    window_s : float
-        Length of a window between the stepping rules [s].
-    min_air_s : float
-        Shortest time off the ground before a contact counts as a heel strike [s].
-    accuracy : float
-        The integrator's accuracy (OpenSim's default integrator, Runge-Kutta-Merson).
+    path, duration_s, window_s, min_air_s, accuracy
+        As :func:`walk`.
 
     Returns
     -------

@@ -23,8 +23,12 @@ capability table (:func:`check_kind`):
   (:mod:`walkerlab.optimal.transcription.mode_sequence`);
 - ``free_joints`` (a five-link biped): one phase with its four joint torques, from the
   targets (Kelly 2017's set-up; :mod:`walkerlab.optimal.transcription.free_joints`),
-  closed by shooting and replayed as virtual constraints;
+  closed by shooting and replayed as virtual constraints (:mod:`walkerlab.optimal.
+  free_joints`);
 - ``rolling_polygon``: refused (a spoked wheel has no joint to drive).
+
+What every set-up reports of its optimum (outcome, units, replays' multipliers) is
+:mod:`walkerlab.optimal.outcome`'s.
 """
 
 from __future__ import annotations
@@ -36,6 +40,9 @@ from functools import partial
 import numpy as np
 
 from walkerlab.io.schemas.optimize import OptimizeData
+from walkerlab.optimal import outcome as reported
+from walkerlab.optimal.free_joints import optimize_five_link, stick_figures
+from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
 
 __all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
            "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
@@ -200,6 +207,8 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
                          "on level ground), and a step from the targets is built for "
                          "straight legs with point feet only; give optimize.initial_guess "
                          "(another optimize.h5) or a downhill slope")
+    if part.from_targets:
+        check_targets(scene.optimize)
     return part.optimize(scene, data, x_gait, period_s)
 
 
@@ -282,123 +291,6 @@ def _feet_level_when_legs_cross(scene, data) -> bool:
     return len({(repr(leg.get("length_m")), repr(leg.get("foot"))) for leg in legs}) <= 1
 
 
-# -- what every set-up shares ------------------------------------------------------------
-
-def _outcome(scene, res, err: float, contact) -> tuple[bool, float, str]:
-    """``(gait, contact step period [s], contact outcome)``: a gait when IPOPT converged
-    and the replay closed within ``optimize.replay_tolerance``; the contact model replays
-    a gait only (``contact()``: its ``(period, outcome)``)."""
-    gait = bool(err <= scene.optimize.replay_tolerance and res.status == "Solve_Succeeded")
-    if not gait:
-        return gait, float("nan"), not_a_gait_outcome(err, res.status)
-    return (gait, *contact())
-
-
-def _unit(o, data=None) -> str:
-    """The objective's unit (a weighted sum's: ``-``; the torque per foot mass on massless
-    legs: N m/kg in place of N m)."""
-    from walkerlab.optimal.transcription.step import OBJECTIVES
-
-    unit = OBJECTIVES.get(o.objective, "-")
-    if data is not None and _massless(data):
-        unit = {"N^2 m^2 s": "N^2 m^2 s / kg^2", "N m": "N m/kg"}.get(unit, unit)
-    return unit
-
-
-def _massless(data) -> bool:
-    """The legs are massless (the torque is per foot mass)."""
-    return bool(data.structure.bodies) and all(b.massless for b in data.structure.bodies)
-
-
-def _states(walker, res) -> tuple[dict, dict]:
-    """The collocated states by the walker's names, and their units."""
-    names = list(walker.state_names())
-    return ({n: res.x[:, k] for k, n in enumerate(names)},
-            dict(zip(names, walker.state_units())))
-
-
-def _phase_replays(scene, data, res, tau) -> tuple[dict, str]:
-    """The hip torque's phase-variable replays of the optimised step ``res`` (``tau``: its
-    torque of the time since the heel strike;
-    :func:`walkerlab.optimal.replay.hip_phase.hip_phase_replays`, the scene's solver), and
-    why there are none (``({}, "")`` unless ``optimize.phase_replay`` is on: off by default
-    here)."""
-    from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.replay.hip_phase import hip_phase_replays
-
-    if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
-        return {}, ""
-    try:
-        return hip_phase_replays(data, res, tau, Solver.from_settings(scene.solver)), ""
-    except ValueError as exc:
-        return {}, f"not replayed: {exc}"
-
-
-def history_and_energies(scene, walker, res) -> dict:
-    """IPOPT's iteration history and the walker's kinetic and potential energy at the
-    collocation points (``res``: a collocation result with ``x`` (2N + 1, 2n) in the
-    walker's state order and ``history``), as
-    :class:`~walkerlab.io.schemas.optimize.OptimizeData` keywords (J); with the constraint
-    groups IPOPT left violated (``res.violations``, when it did not converge)."""
-    ke, pe = walker.energies(np.asarray(res.x, float).T)
-    return {"ipopt_history": dict(res.history),
-            "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)},
-            "violations": str(getattr(res, "violations", ""))}
-
-
-def not_a_gait_outcome(err: float, status: str) -> str:
-    """The contact replay's outcome of an optimum that is not a gait (it is not replayed:
-    a step that does not close on the rigid model says nothing of the contact one).
-
-    Parameters
-    ----------
-    err : float
-        The rigid replay's return error [rad, rad/s] (inf or NaN: the replay failed).
-    status : str
-        IPOPT's status.
-    """
-    if not np.isfinite(err):
-        return "not replayed: the rigid replay failed"
-    if status != "Solve_Succeeded":
-        return f"not replayed: not a gait (IPOPT: {status})"
-    return (f"not replayed: not a gait (the rigid replay returns {err:.2g} away, more than "
-            "optimize.replay_tolerance)")
-
-
-def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
-    """The replay map's Floquet multipliers at the start (variational equations +
-    saltation through every phase, or both steps of a stride).
-
-    Parameters
-    ----------
-    replayed : HybridWalker
-        The rigid walker under the optimised torques.
-    res : CollocationResult or PhasedResult
-        The optimum (its start ``res.x[0]``, shape (n,), and ``step_period_s`` [s]).
-    scene : Scene
-        Its ``solver`` integrates the map.
-    err : float
-        The replay's return error (NaN: the replay failed).
-
-    Returns
-    -------
-    ndarray, shape (n,), complex
-        The multipliers, NaN when the replay or the map failed (a report, not a gate).
-    """
-    from walkerlab.analysis.gait.poincare import poincare_map
-    from walkerlab.integrate.solver import Solver
-
-    mu = np.full(res.x.shape[1], np.nan, complex)
-    if not np.isfinite(err):
-        return mu
-    try:
-        DP = poincare_map(replayed, res.x[0], Solver.from_settings(scene.solver),
-                          max_step_time=3.0 * res.step_period_s, jacobian=True)[2]
-        return np.linalg.eigvals(DP).astype(complex)
-    except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
-        return mu
-
-
 # -- one step of straight legs -----------------------------------------------------------
 
 def _straight_legs(scene, data, x_gait, period_s) -> OptimizeData:
@@ -428,16 +320,16 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data))
     err, replayed = replay(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
-    gait, contact_period, contact_outcome = _outcome(
+    gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay(scene, res))
-    phases, phase_note = _phase_replays(scene, data, res, torque_of_time(res))
-    states, units = _states(walker, res)
+    phases, phase_note = reported.hip_phase_replays_of(scene, data, res, torque_of_time(res))
+    states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m,
                         res.push_off_n_s, res.objective, err, mu, gait, res.status,
                         res.iterations, res.wall_time_s, units, objective_name=o.objective,
-                        objective_unit=_unit(o, data), terms=res.terms,
+                        objective_unit=reported.unit_of_objective(o, data), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
-                        torque_unit="N m/kg" if _massless(data) else "N m",
+                        torque_unit="N m/kg" if reported.massless_legs(data) else "N m",
                         phase_replays=phases, phase_replay_outcome=phase_note,
                         **history_and_energies(scene, walker, res))
 
@@ -518,14 +410,14 @@ def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> Optimi
                            guess_u)
     err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
-    gait, contact_period, contact_outcome = _outcome(
+    gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_phased(scene, res, strides=2))
-    phases, phase_note = _phase_replays(scene, data, res, phase_torque_of_time(res))
-    states, units = _states(walker, res)
+    phases, phase_note = reported.hip_phase_replays_of(scene, data, res, phase_torque_of_time(res))
+    states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
                         res.objective, err, mu, gait, res.status, res.iterations,
                         res.wall_time_s, units, objective_name=o.objective,
-                        objective_unit=_unit(o), terms=res.terms,
+                        objective_unit=reported.unit_of_objective(o), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
@@ -615,7 +507,7 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
                            guess_u)
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
-    gait, contact_period, contact_outcome = _outcome(
+    gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2))
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
@@ -624,11 +516,11 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
              for k, w in enumerate((walker, walker.mirror))]
     record["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
                         for kind in record["energy"]}
-    states, units = _states(walker, res)
+    states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s / 2, float(np.mean(lengths)),
                         res.push_off_n_s, res.objective, err, mu, gait, res.status,
                         res.iterations, res.wall_time_s, units, objective_name=o.objective,
-                        objective_unit=_unit(o), terms=res.terms,
+                        objective_unit=reported.unit_of_objective(o), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
@@ -648,116 +540,6 @@ def _guide(walker, data, spec):
     from walkerlab.models.hybrid.actuated import actuate
 
     return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=spec.push_off_n_s)))
-
-
-# -- a five-link biped (free knees) ------------------------------------------------------
-
-#: strides of the five-link contact replay (2 steps each; the first from the rigid state)
-CONTACT_STRIDES = 2
-
-
-def _five_link(scene, data, x_gait=None, period_s=None) -> OptimizeData:
-    """Optimise, close and replay one step of the scene's five-link walker: collocated
-    (:mod:`walkerlab.optimal.transcription.free_joints`, its four joint torques), closed by
-    shooting under its own torques (:mod:`walkerlab.optimal.replay.shooting`), replayed on
-    the rigid model's generated code, and with the torques as a function of the phase
-    variable (feed-forward + PD, and the feed-forward alone:
-    :mod:`walkerlab.optimal.replay.virtual_constraints`) on the rigid model and - the PD
-    law - in the contact model (~35 rigid step maps and 2 contact strides).  Needs no
-    upstream gait: the guess is built from the targets (Kelly 2017's set-up).
-
-    Raises
-    ------
-    ValueError
-        No target (:func:`check_targets`), a walker the five-link generator does not
-        handle (one line).
-    """
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.shooting import close_step
-    from walkerlab.optimal.transcription.free_joint_functions import (
-        JOINTS,
-        five_link_functions,
-    )
-    from walkerlab.optimal.transcription.free_joints import (
-        collocate_five_link,
-        replay_five_link,
-    )
-    from walkerlab.optimal.transcription.step import CollocationSpec
-
-    o = scene.optimize
-    check_targets(o)
-    fns = five_link_functions(data.structure)
-    spec = CollocationSpec(intervals=o.intervals, max_torque_n_m=o.max_torque_n_m,
-                           target_speed_m_per_s=o.target_speed_m_per_s,
-                           target_step_length_m=o.target_step_length_m,
-                           target_step_period_s=o.target_step_period_s)
-    res = collocate_five_link(data, spec, fns)
-    closed = close_step(fns, data.params, res.t, res.x, res.u)
-    err = float("inf")
-    if closed.converged:
-        err = replay_five_link(data, res, closed.x0)[0]
-    rigid = make_rigid_walker(data, "biped", "derived")
-    gait = bool(res.status == "Solve_Succeeded" and closed.converged
-                and err <= o.replay_tolerance)
-    why = "" if gait else (not_a_gait_outcome(err, res.status) if closed.converged else
-                           "not replayed: not a gait (the shooting did not close the step)")
-    phases, contact = _five_link_replays(scene, data, res, why)
-    states, units = _states(rigid, res)
-    return OptimizeData(
-        res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0, res.objective, err,
-        closed.multipliers, gait, res.status, res.iterations, res.wall_time_s, units,
-        torque_names=JOINTS, start_shift=closed.shift, replay_step_period_s=closed.period_s,
-        collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s,
-        contact_step_period_s=contact[0], contact_outcome=contact[1], phase_replays=phases,
-        **history_and_energies(scene, rigid, res))
-
-
-def _five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple]:
-    """The phase-variable replays
-    (:func:`walkerlab.optimal.replay.virtual_constraints.phase_replays`) and the contact
-    model's ``(step period [s], outcome)`` under the feed-forward + PD law from its closed
-    start; an optimum that is not a gait is not replayed there (``not_gait``: why, the
-    contact outcome)."""
-    from walkerlab.optimal.replay.contact import contact_replay_five_link
-    from walkerlab.optimal.replay.virtual_constraints import phase_replays
-
-    if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
-        return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "
-                    "replay runs the feed-forward + PD law)")
-    try:
-        replays, laws = phase_replays(data, res.t, res.x, res.u)
-    except ValueError as exc:  # the phase variable is not monotonic: no such replay
-        return {}, (float("nan"), f"not replayed: {exc}")
-    if not_gait:
-        return replays, (float("nan"), not_gait)
-    fb = replays["feedback"]
-    if not fb.closed:
-        return replays, (float("nan"), "not replayed: the feed-forward + PD law did not "
-                         "close on the rigid model")
-    contact = contact_replay_five_link(scene, laws["feedback"], fb.x0, fb.step_period_s,
-                                       strides=CONTACT_STRIDES)
-    return replays, contact
-
-
-#: the stick figure's polyline through the walker's named points
-STICK = ("stance_foot", "stance_knee", "hip", "torso_top", "hip", "swing_knee", "swing_foot")
-
-
-def stick_figures(scene, d, frames: int = 8) -> list:
-    """The five-link walker of ``scene`` at ``frames`` instants of the stored step ``d``
-    (a loaded ``optimize.h5``): polylines (7, 2) [m] through :data:`STICK` (the torso's
-    top: its centre of mass, the generated ``torso_*`` point)."""
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.walker.description import walker_data
-
-    w = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad), "biped", "derived")
-    names = w.state_names()
-    out = []
-    for k in np.linspace(0, len(d.time) - 1, frames).round().astype(int):
-        pts = w.points(np.array([d.states[n][k] for n in names]))
-        top = next(v for key, v in pts.items() if key.startswith("torso_"))
-        out.append(np.array([pts[n] if n != "torso_top" else top for n in STICK]))
-    return out
 
 
 # -- the collocation's part per walker kind ----------------------------------------------
@@ -797,5 +579,5 @@ PARTS = {
     "straight_legs": Collocation(_straight_legs, target_step=True, legs_cross_level=True),
     "locking_knees": Collocation(_phased),
     "flat_feet": Collocation(partial(_phased, resolve_gait=True)),
-    "free_joints": Collocation(_five_link, from_targets=True),
+    "free_joints": Collocation(optimize_five_link, from_targets=True),
 }

@@ -13,6 +13,10 @@ Touchdown and lift-off are the zero crossings of the penetration, located on the
 Hermite interpolant of the samples and their rates; a heel strike is a touchdown of the
 non-stance foot at least ``min_step_m`` downhill of the stance foot's touchdown point, other
 touchdowns of that foot are scuffs, of the stance foot bounces.
+
+The run's outcome and verdict are :mod:`walkerlab.analysis.contact.verdict`'s, the
+footfalls against a checkerboard :mod:`walkerlab.analysis.contact.terrain_fit`'s (both
+importable from here).
 """
 
 from __future__ import annotations
@@ -21,67 +25,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.analysis.contact.terrain_fit import PatchFit, patch_fit
+from walkerlab.analysis.contact.verdict import (
+    CONTACT_OUTCOMES,
+    Outcome,
+    classify,
+    classify_complete,
+    scuff_cause,
+    step_trend,
+    walk_verdict,
+)
 from walkerlab.integrate.contact import hermite_root
-from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
 
 __all__ = ["CONTACT_OUTCOMES", "FOOT_MODES", "ContactResult", "FootTrace", "Outcome",
            "PatchFit", "StepSummary", "classify", "classify_complete", "foot_modes",
-           "gait_events", "heel_strike_count", "patch_fit", "phase_slip", "step_trend",
-           "walk_verdict"]
-
-#: Outcome kinds of a contact run: the shared run ends (:mod:`walkerlab.integrate.ends`)
-#: that the contact model can produce.
-CONTACT_OUTCOMES = tuple(k for k in RUN_END_NAMES)
-
-
-@dataclass
-class Outcome:
-    """How a contact run ended (``kind``: one of :data:`CONTACT_OUTCOMES`).
-
-    Attributes
-    ----------
-    kind : str
-    time_s : float
-        Event time [s] (trip, fall, airborne: the event; scuff, slip: start of the offending
-        step; solver failure / time limit: last sample); NaN when the run walked to its end.
-    foot : str
-        The foot of a trip, scuff or slip ("" otherwise).
-    patch_edge_m : float
-        Along-slope position [m] of the patch side hit (trip), else NaN.
-    hip_height_m : float
-        Hip height above the ground line at ``time_s`` (or at the end) [m].
-    message : str
-        One line for people.
-    after : str
-        A run that made the heel strikes asked for and then met another end (``trip``,
-        ``fall``, ``airborne``, ``solver_failure``, ``time_limit``): that end's kind ("" when
-        none followed).  ``kind`` stays the strides cap's (the run made its promise); the
-        message names what followed, and :func:`walk_verdict` does not call it a walk.
-    after_time_s : float
-        Time [s] of that end (NaN when none).
-    after_message : str
-        What followed, in a few words (e.g. "fell into a gap (...) at t = 9.445 s").
-    """
-
-    kind: str
-    time_s: float = float("nan")
-    foot: str = ""
-    patch_edge_m: float = float("nan")
-    hip_height_m: float = float("nan")
-    message: str = ""
-    after: str = ""
-    after_time_s: float = float("nan")
-    after_message: str = ""
-
-    @property
-    def ok(self) -> bool:
-        """The walker walked: made its heel strikes or reached its end time."""
-        return self.kind in ("heel_strike", "t_final")
-
-    @property
-    def walked(self) -> bool:
-        """A run that counts as a walk (exit code 0): :data:`CONTACT_WALKED`."""
-        return self.kind in CONTACT_WALKED
+           "gait_events", "heel_strike_count", "patch_fit", "phase_slip", "scuff_cause",
+           "step_trend", "walk_verdict"]
 
 
 @dataclass
@@ -407,6 +366,83 @@ def heel_strike_count(walker, t, X, min_step_m: float = 0.05,
     return len(_heel_strikes(t, feet, min_step_m, initial_stance)[0])
 
 
+def _double_support(t, feet, names) -> list:
+    """Double-support intervals ``[(start, end, (foot, foot))]`` [s]: the overlaps of the
+    feet's contact intervals (event times); a wheel: any two of its spokes, each overlap
+    with the pair of spokes in contact."""
+    iv = {f: _intervals(feet[f].touchdown_times, feet[f].liftoff_times, float(t[-1]))
+          for f in names}
+    return [(max(a1, a2), min(b1, b2), (f1, f2)) for j, f1 in enumerate(names)
+            for f2 in names[j + 1:] for a1, b1 in iv[f1] for a2, b2 in iv[f2]
+            if min(b1, b2) > max(a1, a2)]
+
+
+def _held_phases(t, phases, dt_sample):
+    """The stance phases from the first sample one sample interval after each touchdown:
+    the heel-strike collision (a fraction of a millisecond) falls between the samples, and
+    a sample that happens to land in it would alias its sliding (0.6 m/s against ~0.01 m/s
+    of creep) into the slip path (its loss is the heel strike's); None as ``phases``."""
+    held = None if phases is None else [
+        (a if a <= t[0] else float(t[min(np.searchsorted(t, a + dt_sample), t.size - 1)]),
+         b) for a, b in phases]
+    return held if held is None else [(a, b) for a, b in held if b > a]
+
+
+def _step_summary(t, feet, points, names, starts, loaded, ds, j, ta, leg, bounces, scuffs,
+                  rolling, leg_of, dt_sample) -> StepSummary:
+    """Step ``j`` of :func:`gait_events`: from ``ta`` [s] (``starts[j]``) with ``leg`` in
+    stance to the next heel strike, its slip, slip path, friction work, double-support
+    creep (over ``ds``, :func:`_double_support`) and peak penetration."""
+    tb = starts[j + 1] if j + 1 < len(starts) else np.nan
+    tb_or_end = tb if np.isfinite(tb) else t[-1]
+    # stance phases of this leg that begin between its heel strike and the other foot's
+    # (its touchdowns after that are the swing foot's scuffs, not stance)
+    t_other = starts[j + 1] if j + 1 < len(starts) else np.inf
+    t_next = starts[j + 2] if j + 2 < len(starts) else np.inf
+    ft = feet[leg]
+    td = ft.touchdown_times
+    if j == 0 and (not td.size or td[0] > t[0]) and loaded[leg][0]:
+        td = np.concatenate([[t[0]], td])
+    slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_other,
+                      ft.slip_velocity if rolling else None)
+    phases = stance_phases(td, ft.liftoff_times, ta, t_other)
+    held = _held_phases(t, phases, dt_sample)
+    path = phase_integral(t, np.abs(ft.slip_velocity), held)
+    mine = [p for name, p in points.items()
+            if name == leg or (name not in feet and leg_of is not None
+                               and leg_of(name) == leg)]
+    friction = -sum(phase_integral(t, p.friction_force * p.slip_velocity, held)
+                    for p in mine) if phases else np.nan
+    lo_mine = ft.liftoff_times[(ft.liftoff_times > ta) & (ft.liftoff_times < t_next)]
+    sel = (t >= ta) & (t <= tb_or_end)
+    creep = 0.0
+    for a, b, pair in ds:
+        a, b = max(a, ta), min(b, tb_or_end)
+        if b > a:
+            creep += sum(abs(float(np.interp(b, t, feet[f].s) - np.interp(a, t, feet[f].s)))
+                         for f in pair)
+    peak = max(float(np.max(feet[f].penetration[sel] * feet[f].on_ground[sel]))
+               for f in names) if sel.any() else np.nan
+    return StepSummary(j, leg, float(ta), float(tb), float(tb - ta),
+                       float(1e3 * slip), float(1e3 * creep), int(bounces),
+                       int(scuffs), max(peak, 0.0),
+                       float(lo_mine[-1]) if lo_mine.size else np.nan,
+                       stance_slip_path_mm=float(1e3 * path) if phases else np.nan,
+                       friction_work_j=float(friction) if phases else np.nan)
+
+
+def _annotate_foot_modes(t, points, steps) -> None:
+    """Flat feet: set each step's ``foot_modes`` from the contact table (modes shorter than
+    two sample intervals left out, repeats merged)."""
+    dt = 2.0 * float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    for st in steps:
+        tb = st.t_end if np.isfinite(st.t_end) else float(t[-1])
+        segs = [(m, a) for m, a, b in foot_modes(t, points, st.stance_leg, st.t_start, tb)
+                if b - a >= dt]
+        merged = [s_ for k, s_ in enumerate(segs) if k == 0 or s_[0] != segs[k - 1][0]]
+        st.foot_modes = " > ".join(f"{m} ({a:.4f} s)" for m, a in merged)
+
+
 def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "leg2") -> dict:
     """Foot traces, heel strikes and step summaries of a contact run's samples.
 
@@ -441,72 +477,17 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     starts = [t[0]] + hs_t
     legs = [initial_stance] + hs_leg
     loaded = {f: (feet[f].penetration > 0) & feet[f].on_ground for f in names}
-    # double-support intervals: overlaps of the feet's contact intervals (event times)
-    iv = {f: _intervals(feet[f].touchdown_times, feet[f].liftoff_times, float(t[-1]))
-          for f in names}
-    # (a wheel: any two of its spokes, each overlap with the pair of spokes in contact)
-    ds = [(max(a1, a2), min(b1, b2), (f1, f2)) for j, f1 in enumerate(names)
-          for f2 in names[j + 1:] for a1, b1 in iv[f1] for a2, b2 in iv[f2]
-          if min(b1, b2) > max(a1, a2)]
+    ds = _double_support(t, feet, names)
     points = feet if tuple(walker.contact_names()) == tuple(feet) else \
         _foot_traces(walker, t, X, points=True)
     leg_of = getattr(walker, "contact_leg", None)
     dt_sample = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-    steps = []
-    for j, (ta, leg) in enumerate(zip(starts, legs)):
-        tb = starts[j + 1] if j + 1 < len(starts) else np.nan
-        tb_or_end = tb if np.isfinite(tb) else t[-1]
-        # stance phases of this leg that begin between its heel strike and the other foot's
-        # (its touchdowns after that are the swing foot's scuffs, not stance)
-        t_other = starts[j + 1] if j + 1 < len(starts) else np.inf
-        t_next = starts[j + 2] if j + 2 < len(starts) else np.inf
-        ft = feet[leg]
-        td = ft.touchdown_times
-        if j == 0 and (not td.size or td[0] > t[0]) and loaded[leg][0]:
-            td = np.concatenate([[t[0]], td])
-        slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_other,
-                          ft.slip_velocity if rolling else None)
-        phases = stance_phases(td, ft.liftoff_times, ta, t_other)
-        # the slip path and friction work of the stance, from the first sample one sample
-        # interval after each touchdown: the heel-strike collision (a fraction of a
-        # millisecond) falls between the samples, and a sample that happens to land in it
-        # would alias its sliding (0.6 m/s against ~0.01 m/s of creep) into the sum (its
-        # loss is the heel strike's)
-        held = None if phases is None else [
-            (a if a <= t[0] else float(t[min(np.searchsorted(t, a + dt_sample), t.size - 1)]),
-             b) for a, b in phases]
-        held = held if held is None else [(a, b) for a, b in held if b > a]
-        path = phase_integral(t, np.abs(ft.slip_velocity), held)
-        mine = [p for name, p in points.items()
-                if name == leg or (name not in feet and leg_of is not None
-                                   and leg_of(name) == leg)]
-        friction = -sum(phase_integral(t, p.friction_force * p.slip_velocity, held)
-                        for p in mine) if phases else np.nan
-        lo_mine = ft.liftoff_times[(ft.liftoff_times > ta) & (ft.liftoff_times < t_next)]
-        sel = (t >= ta) & (t <= tb_or_end)
-        creep = 0.0
-        for a, b, pair in ds:
-            a, b = max(a, ta), min(b, tb_or_end)
-            if b > a:
-                creep += sum(abs(float(np.interp(b, t, feet[f].s) - np.interp(a, t, feet[f].s)))
-                             for f in pair)
-        peak = max(float(np.max(feet[f].penetration[sel] * feet[f].on_ground[sel]))
-                   for f in names) if sel.any() else np.nan
-        steps.append(StepSummary(j, leg, float(ta), float(tb), float(tb - ta),
-                                 float(1e3 * slip), float(1e3 * creep), int(bounces[j]),
-                                 int(scuffs[j]), max(peak, 0.0),
-                                 float(lo_mine[-1]) if lo_mine.size else np.nan,
-                                 stance_slip_path_mm=float(1e3 * path) if phases else np.nan,
-                                 friction_work_j=float(friction) if phases else np.nan))
+    steps = [_step_summary(t, feet, points, names, starts, loaded, ds, j, ta, leg,
+                           int(bounces[j]), int(scuffs[j]), rolling, leg_of, dt_sample)
+             for j, (ta, leg) in enumerate(zip(starts, legs))]
     if all(f"{st.stance_leg}_heel" in points and f"{st.stance_leg}_toe" in points
            for st in steps):  # flat feet: each step's mode sequence from the contact table
-        dt = 2.0 * float(np.median(np.diff(t))) if t.size > 1 else 0.0
-        for st in steps:
-            tb = st.t_end if np.isfinite(st.t_end) else float(t[-1])
-            segs = [(m, a) for m, a, b in foot_modes(t, points, st.stance_leg, st.t_start, tb)
-                    if b - a >= dt]
-            merged = [s_ for k, s_ in enumerate(segs) if k == 0 or s_[0] != segs[k - 1][0]]
-            st.foot_modes = " > ".join(f"{m} ({a:.4f} s)" for m, a in merged)
+        _annotate_foot_modes(t, points, steps)
     return {"feet": feet, "hs_t": np.array(hs_t), "hs_leg": hs_leg, "steps": steps,
             "points": points}
 
@@ -550,330 +531,3 @@ def foot_modes(t, points: dict, leg: str, t0: float = -np.inf,
         else:
             out.append((m, float(ts[k]), float(ts[k])))
     return out
-
-
-# ---------------------------------------------------------------------------- terrain fit
-#: a footfall this far (as a fraction of the smaller margin of :class:`PatchFit`) from its
-#: patch's centre has used up most of the room the checkerboard gives it
-PATCH_MARGIN_USED = 0.5
-
-
-@dataclass
-class PatchFit:
-    """Where a contact run's footfalls landed on the checkerboard laid out for its gait.
-
-    Footfall ``k`` of the gait has a patch centred at ``s = k l`` in its leg's lane
-    (:func:`walkerlab.models.contact.model.checkerboard_lanes`, ``l`` the patch spacing,
-    the rigid gait's step); a patch is ``2 h`` wide.  A footfall lands on ground while it is
-    within ``h`` of its patch's centre; at mid-stance the swing foot passes the stance foot
-    (a straight leg's swing foot dips below the ground line there) over the gap of its own
-    lane, which reaches ``l - h`` either side of the stance footfall's patch centre.  The
-    footfalls of a contact gait whose steps differ from the spacing drift through both.
-
-    Attributes
-    ----------
-    spacing_m : float
-        Patch spacing ``l`` [m] (footfall to footfall).
-    half_width_m : float
-        ``h`` [m] (``terrain.patch_width_m / 2``).
-    offsets_m : ndarray (k,)
-        Each heel strike's footfall minus its patch's centre [m] (negative: short of it).
-    steps_m : ndarray (k,)
-        Each step's length, footfall to footfall [m] (the first from the initial stance
-        foot).
-    """
-
-    spacing_m: float
-    half_width_m: float
-    offsets_m: np.ndarray
-    steps_m: np.ndarray
-
-    @property
-    def margin_m(self) -> float:
-        """The smaller room [m] a footfall has: ``h`` (on its patch) or ``l - h`` (the swing
-        foot over its lane's gap beside it)."""
-        return min(self.half_width_m, self.spacing_m - self.half_width_m)
-
-    @property
-    def drift_m_per_step(self) -> float:
-        """Least-squares slope of the footfalls' offsets over the heel strikes [m/step]
-        (NaN with fewer than two)."""
-        k = self.offsets_m.size
-        return float(np.polyfit(np.arange(k), self.offsets_m, 1)[0]) if k >= 2 else np.nan
-
-    def note(self) -> str:
-        """Why the checkerboard does not suit the gait, when the last footfall used more
-        than :data:`PATCH_MARGIN_USED` of :attr:`margin_m` ("" otherwise): its offset, the
-        drift per step, the contact steps against the spacing, both margins, and the
-        patch width that balances them."""
-        if self.offsets_m.size < 2 or not np.isfinite(self.margin_m) or self.margin_m <= 0:
-            return ""
-        last = float(self.offsets_m[-1])
-        if abs(last) < PATCH_MARGIN_USED * self.margin_m:
-            return ""
-        sp, h = self.spacing_m, self.half_width_m
-        mean = float(np.mean(self.steps_m))
-        return (f"the patches ({2 * h:.3g} m wide at {sp:.4g} m spacing, the rigid gait's "
-                f"step) do not suit this gait's step: its contact steps average {mean:.4g} m, "
-                f"its footfalls drifted {1e3 * self.drift_m_per_step:+.3g} mm a step and "
-                f"heel strike {self.offsets_m.size} landed {last:+.3f} m from its patch's "
-                f"centre, where a footfall has ±{h:.3g} m on its patch and the swing foot "
-                f"±{sp - h:.3g} m over its lane's gap at mid-stance (terrain.patch_width_m "
-                f"near {sp:.3g} m balances the two; contact_sim.start: periodic_gait lays the "
-                "patches at the contact gait's own footfalls)")
-
-
-def patch_fit(walker, t, feet: dict, hs_t, hs_leg, initial_stance: str = "leg2"
-              ) -> PatchFit | None:
-    """The footfalls of a contact run against its checkerboard (:class:`PatchFit`); None on
-    continuous ground or without heel strikes.
-
-    Parameters
-    ----------
-    walker : ContactWalker
-        Its lanes (``walker.lane(leg)``, patch centres [m]) and ``patch_half_width`` [m].
-    t : ndarray (n,)
-        Sample times [s].
-    feet : dict[str, FootTrace]
-        Per leg (:func:`gait_events`' ``feet``).
-    hs_t, hs_leg : sequence
-        Heel-strike times [s] and legs.
-    initial_stance : str
-        The leg in stance at ``t[0]`` (its foot is footfall 0).
-    """
-    if getattr(walker, "continuous", True) or not len(hs_t):
-        return None
-    s_prev = float(feet[initial_stance].s[0])
-    off, steps = [], []
-    for th, leg in zip(hs_t, hs_leg):
-        s = float(np.interp(th, t, feet[leg].s))
-        lane = np.asarray(walker.lane(leg), float)
-        if not lane.size:
-            return None
-        off.append(s - float(lane[np.argmin(np.abs(lane - s))]))
-        steps.append(s - s_prev)
-        s_prev = s
-    c1, c2 = np.asarray(walker.lane("leg1"), float), np.asarray(walker.lane("leg2"), float)
-    spacing = float(abs(c1[0] - c2[0])) if c1.size and c2.size else np.nan
-    return PatchFit(spacing, float(walker.patch_half_width), np.array(off), np.array(steps))
-
-
-# ---------------------------------------------------------------------------- verdict
-#: ends after the strides asked for that are the walker's own (not the solver's or the
-#: wall clock's): a run that meets one does not walk
-WALKER_ENDS = ("trip", "fall", "airborne")
-#: a contact run's steps have settled when the last change of a leg's step period (against
-#: that leg's previous step: an asymmetric gait alternates) is below this fraction of it ...
-STEADY_PERIOD_CHANGE = 0.005
-#: ... or smaller than this fraction of the changes before it (they die out)
-SETTLING_RATIO = 0.5
-
-
-def step_trend(periods) -> str:
-    """"" when a contact run's step periods [s] settle, else what they do.
-
-    A leg's step is compared with that leg's previous one (``T_k - T_{k-2}``: a period-2
-    gait's steps alternate).  The steps have not settled when the last three such changes
-    share a sign, the last exceeds :data:`STEADY_PERIOD_CHANGE` of the period and is at
-    least :data:`SETTLING_RATIO` of the first of them (no decay towards a gait).
-
-    Parameters
-    ----------
-    periods : array_like (k,)
-        Step periods [s] (NaN: a step the run did not finish, left out).
-
-    Returns
-    -------
-    str
-        e.g. "its steps shorten monotonically (0.583 → 0.509 s)"; "" with fewer than five
-        finished steps.
-    """
-    T = np.asarray(periods, float)
-    T = T[np.isfinite(T)]
-    if T.size < 5:
-        return ""
-    d = T[2:] - T[:-2]
-    last3 = d[-3:]
-    if not (np.all(last3 > 0) or np.all(last3 < 0)):
-        return ""
-    if abs(last3[-1]) <= STEADY_PERIOD_CHANGE * T[-1] \
-            or abs(last3[-1]) < SETTLING_RATIO * abs(last3[0]):
-        return ""
-    way = "shorten" if last3[-1] < 0 else "lengthen"
-    mono = np.all(np.diff(T) < 0) if way == "shorten" else np.all(np.diff(T) > 0)
-    return (f"its steps {way}{' monotonically' if mono else ''} ({T[0]:.3f} → {T[-1]:.3f} s"
-            f", the last by {100 * abs(last3[-1]) / T[-1]:.2g} % against the same leg's "
-            "step before): no steady gait")
-
-
-def walk_verdict(outcome: Outcome, steps) -> tuple[bool, str]:
-    """Whether a contact run walks, one verdict from its steps: it made its heel strikes
-    (:attr:`Outcome.walked`), no trip, fall or flight (:data:`WALKER_ENDS`) ended it after
-    them (:attr:`Outcome.after`; a solver failure or the wall-time limit there is named in
-    the message only), and its step periods settle (:func:`step_trend`).
-
-    Returns
-    -------
-    walks : bool
-    why : str
-        "" when it walks, else the reason (one phrase).
-    """
-    if not outcome.walked:
-        return False, outcome.message
-    why = []
-    if outcome.after in WALKER_ENDS:  # a solver's failure or the wall time is no fall
-        what = outcome.after_message or (f"a {outcome.after.replace('_', ' ')} ended it at "
-                                         f"t = {outcome.after_time_s:.4g} s")
-        why.append(f"it made the heel strikes asked for, then {what}")
-    trend = step_trend([st.period for st in steps])
-    if trend:
-        why.append(trend)
-    return (not why), "; ".join(why)
-
-
-# ---------------------------------------------------------------------------- outcome
-def classify_complete(steps, slip_limit_mm: float | None, hip_height_m: float,
-                      end: str = "t_final") -> Outcome:
-    """Outcome of a run that reached its end (``end``: ``t_final`` or ``heel_strike``):
-    ``no_heel_strike`` if it made no step, ``slip`` if a stance phase slid farther than
-    ``slip_limit_mm`` [mm], ``scuff`` if the swing foot touched down before its heel strike,
-    else ``end``."""
-    if len(steps) <= 1:
-        return Outcome("no_heel_strike", hip_height_m=hip_height_m,
-                       message="no heel strike: the walker reached the end of the run "
-                       "without taking a step")
-    if slip_limit_mm is not None:
-        for st in steps:
-            if np.isfinite(st.stance_slip_mm) and abs(st.stance_slip_mm) > slip_limit_mm:
-                return Outcome("slip", st.t_start, st.stance_leg, np.nan, hip_height_m,
-                               f"slip: {st.stance_leg} slid {st.stance_slip_mm:.3g} mm in the "
-                               f"stance phase from t = {st.t_start:.4g} s (limit "
-                               f"{slip_limit_mm:g} mm)")
-    for st in steps:
-        if st.scuff_count:
-            return Outcome("scuff", st.t_start, _other(steps, st.stance_leg), np.nan,
-                           hip_height_m, f"scuff: the swing foot touched ground "
-                           f"{st.scuff_count} time(s) before its heel strike in step "
-                           f"{st.index}")
-    return Outcome(end, hip_height_m=hip_height_m,
-                   message=f"walked: {len(steps) - 1} heel strikes"
-                   + (" (the number asked for)" if end == "heel_strike" else
-                      " by the end time"))
-
-
-def _other(steps, leg: str) -> str:
-    """The other foot than ``leg`` among the steps' stance legs ("" if unknown)."""
-    return next((s.stance_leg for s in steps if s.stance_leg != leg), "")
-
-
-def scuff_cause(walker) -> str:
-    """The likely cause of swing-foot scuffs before a fall, for the walker and its ground,
-    and what helps (a parenthesis; ``""``: none to name).
-
-    - a kneed walker whose stance knee is not latched
-      (``contact.knee_stop.latch: false``): the stance knee flexes under load, the hip
-      sinks and the swing foot meets the ground; the latch holds it as the rigid model's
-      knee lock does;
-    - straight legs: the swing foot passes below the ground line near mid-stance (the
-      rigid model ignores that scuffing); on continuous slope or stairs the checkerboard
-      (``terrain.lanes: checkerboard``) gives it a gap there; a profile is continuous
-      ground only (the checkerboard is refused there): knees clear it;
-    - a latched kneed walker, flat feet, free knees: nothing general to name.
-
-    Parameters
-    ----------
-    walker : walkerlab.models.contact.model.ContactWalker
-        The run's walker (its ``data.structure``, ``knee_stop``, ``continuous`` and
-        ``ground_line``).
-
-    Returns
-    -------
-    str
-    """
-    return _SCUFF_CAUSES.get(walker.data.structure.kind.name, _no_cause)(walker)
-
-
-def _no_cause(walker) -> str:
-    """Flat feet, free knees, a wheel: nothing general to name."""
-    return ""
-
-
-def _unlatched_knee(walker) -> str:
-    """A kneed walker's scuff: its stance knee not latched."""
-    if walker.knee_stop is not None and not walker.knee_stop.latch:
-        return ("(the stance knee is not latched: it flexes under the load and the hip "
-                "sinks; contact.knee_stop.latch: true holds it as the rigid model's "
-                "knee lock does)")
-    return ""
-
-
-def _straight_leg_scuff(walker) -> str:
-    """Straight legs: the swing foot below the ground line near mid-stance."""
-    straight = "a straight leg's swing foot passes below the ground line near mid-stance"
-    if getattr(walker, "ground_line", None) is not None:  # a profile: continuous only
-        return (f"({straight}; a profile is continuous ground, where straight legs scuff: "
-                "a walker with knees clears it)")
-    if walker.continuous:
-        return f"({straight}; terrain.lanes: checkerboard gives it a gap there)"
-    return f"({straight})"
-
-
-#: kind name -> the likely cause of its swing foot's scuffs (:func:`scuff_cause`; a kind
-#: not listed has none to name)
-_SCUFF_CAUSES = {"straight_legs": _straight_leg_scuff, "locking_knees": _unlatched_knee}
-
-
-def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,
-             message: str, limits, slip_limit_mm: float | None,
-             wall_time_limit_s: float | None, scuff_why: str = "") -> Outcome:
-    """The typed outcome of a contact run from how its integration stopped.
-
-    Parameters
-    ----------
-    termination : str
-        :attr:`walkerlab.integrate.contact.ContactIntegration.termination`.
-    event : tuple or None
-        Its ``event``.
-    t : ndarray (n,)
-        Sample times [s].
-    hip_height_m : float
-        Hip height at the last sample [m].
-    steps : list[StepSummary]
-    message : str
-        The solver's message.
-    limits : ContactLimits
-    slip_limit_mm, wall_time_limit_s : float or None
-    scuff_why : str
-        The likely cause of swing-foot scuffs before a fall, and what helps
-        (:func:`scuff_cause` of the run's walker; ``""``: none named).
-    """
-    n_hs = max(len(steps) - 1, 0)
-    te = float(t[-1])
-    if termination == "trip":
-        _, _, te, foot, edge = event
-        return Outcome("trip", te, foot, edge, hip_height_m,
-                       f"trip: {foot} hit the side of the patch edge at s = {edge:.4f} m at "
-                       f"t = {te:.4g} s after {n_hs} heel strikes")
-    if termination == "fall":
-        scuffs = sum(st.scuff_count for st in steps)
-        why = ""
-        if scuffs:  # the run's own table counts them: name the likely cause
-            why = (f"; the swing foot scuffed the ground {scuffs} time(s) before"
-                   + (f" {scuff_why}" if scuff_why else ""))
-        return Outcome("fall", te, "", np.nan, hip_height_m,
-                       f"fall: hip {hip_height_m:.3f} m above ground "
-                       f"(< {limits.fall_hip_height_m:g} m) at t = {te:.4g} s after {n_hs} "
-                       f"heel strikes{why}")
-    if termination == "airborne":
-        return Outcome("airborne", te, "", np.nan, hip_height_m,
-                       f"airborne: the hip rose {hip_height_m:.3g} m above the ground "
-                       f"(> {limits.airborne_hip_height_m:g} m) at t = {te:.4g} s after "
-                       f"{n_hs} heel strikes: the walker flew off the ground")
-    if termination == "solver_failure":
-        return Outcome("solver_failure", te, "", np.nan, hip_height_m,
-                       f"solver failure at t = {te:.4g} s: {message}")
-    if termination == "time_limit":
-        return Outcome("time_limit", te, "", np.nan, hip_height_m,
-                       f"time limit: {wall_time_limit_s:g} s of wall time used by t = "
-                       f"{te:.4g} s ({n_hs} heel strikes)")
-    return classify_complete(steps, slip_limit_mm, hip_height_m, end=termination)

@@ -140,19 +140,48 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
             < max_heel_strikes - 1):  # short of the strides asked for (2 N heel strikes)
         run = _go_on(walker, run, t_more, solver, limits, stop)
     if stop is not None and (run.event is not None or run.termination in _EVENTLESS_ENDS):
-        # the strides asked for (2 N heel strikes; the cap stops at the one after) were made
-        # before the event, the solver's failure or the wall-time limit: the run made its
-        # promise, its end comes after it
-        def made(t, X):
-            return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
-                >= max_heel_strikes - 1
-        before = run
-        run = _made_before_event(run, made) if run.event is not None \
-            else _made_before_end(run, made)
-        if run is not before:  # the end that followed the strides asked for, kept to name
-            after = (before.termination, float(before.event[2]) if before.event is not None
-                     else float(before.t[-1]), before.message)
+        run, after = _strides_then_end(walker, run, min_step_m, initial_stance,
+                                       max_heel_strikes)
     ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
+    out = _run_outcome(walker, run, ev, after, limits, slip_limit_mm, initial_stance)
+    return _contact_result(walker, run, ev, out, solver.method)
+
+
+def _contact_result(walker, run, ev, out, method: str) -> ContactResult:
+    """The :class:`ContactResult` of the integration ``run``, its gait events ``ev``
+    (:func:`gait_events`) and outcome ``out``."""
+    return ContactResult(t=run.t, x=run.X, state_names=tuple(walker.state_names()),
+                         feet=ev["feet"], heel_strike_times=ev["hs_t"],
+                         heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
+                         termination=run.termination, message=run.message, nfev=run.nfev,
+                         njev=run.njev, wall_time_s=run.wall_time_s, method=method,
+                         pin_end_time=run.pin_end_time, outcome=out, points=ev["points"],
+                         work=run.work)
+
+
+def _strides_then_end(walker, run, min_step_m, initial_stance, max_heel_strikes):
+    """``(run, after)``: a run that made the strides asked for (2 N heel strikes; the cap
+    stops at the one after) before its event, solver failure or wall-time limit made its
+    promise, its end comes after it: the run cut at them, and the end that followed
+    (``(termination, time [s], message)``, kept to name; ``(run, None)`` when none did)."""
+    def made(t, X):
+        return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
+            >= max_heel_strikes - 1
+    before = run
+    run = _made_before_event(run, made) if run.event is not None \
+        else _made_before_end(run, made)
+    after = None
+    if run is not before:  # the end that followed the strides asked for, kept to name
+        after = (before.termination, float(before.event[2]) if before.event is not None
+                 else float(before.t[-1]), before.message)
+    return run, after
+
+
+def _run_outcome(walker, run, ev, after, limits, slip_limit_mm, initial_stance):
+    """The run's typed outcome (:func:`walkerlab.analysis.contact.verdict.classify`) from
+    its termination and steps ``ev`` (:func:`gait_events`), with the end that followed the
+    strides asked for (``after``) and, when the footfalls left the patches, the
+    checkerboard's note (:meth:`walkerlab.analysis.contact.terrain_fit.PatchFit.note`)."""
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
                    slip_limit_mm, limits.wall_time_limit_s, scuff_cause(walker))
@@ -163,13 +192,7 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         note = fit.note() if fit is not None else ""
         if note:
             out = replace(out, message=f"{out.message}; {note}")
-    return ContactResult(t=run.t, x=run.X, state_names=tuple(walker.state_names()),
-                         feet=ev["feet"], heel_strike_times=ev["hs_t"],
-                         heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
-                         termination=run.termination, message=run.message, nfev=run.nfev,
-                         njev=run.njev, wall_time_s=run.wall_time_s, method=solver.method,
-                         pin_end_time=run.pin_end_time, outcome=out, points=ev["points"],
-                         work=run.work)
+    return out
 
 
 #: the ends without an event that a run met after its strides asked for still ends by the cap
