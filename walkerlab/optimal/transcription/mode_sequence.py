@@ -24,6 +24,7 @@ from walkerlab.optimal.transcription.ipopt import (
     largest_violations,
     solve,
 )
+from walkerlab.optimal.transcription.phase_nlp import _chain_phases, _objective, _pushes
 from walkerlab.walker.kinds import KINDS
 
 __all__ = ["PhasedResult", "collocate_phases", "collocate_step", "optimized_guess",
@@ -207,87 +208,9 @@ def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
     return t, cumulative_trapezoid(rho, t, initial=0.0)
 
 
-def _simpson(T, tau, values):
-    """Simpson's rule on the 2N + 1 points ``T tau`` of one phase (``values`` (1, 2N + 1),
-    ``tau`` (2N + 1,) from 0 to 1, mid-points halfway)."""
-    import casadi as ca
-
-    K = values.shape[1]
-    w = np.zeros(K)
-    for i in range(0, K - 1, 2):
-        dt = tau[i + 2] - tau[i]
-        w[i] += dt / 6
-        w[i + 1] += 4 * dt / 6
-        w[i + 2] += dt / 6
-    return T * ca.sum2(ca.DM(w).T * values)
-
-
-def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
-    """One phase's defects (on the mesh ``T tau``), its guard at the end (transversal) and
-    inside (its sign), its unilateral contacts and the path constraints."""
-    import casadi as ca
-
-    K = X.shape[1]
-    several = U.shape[0] > 1  # several torques (k, K): a column a point
-
-    def at(k):
-        return U[:, k] if several else U[k]
-    f = [mp.flow(X[:, k], at(k)) for k in range(K)]
-    for i in range(0, K - 1, 2):
-        m, j = i + 1, i + 2
-        h = T * (tau[j] - tau[i])
-        opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
-        opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
-    d = mp.direction
-    opti.subject_to(mp.guard(X[:, -1], at(-1)) == 0)
-    opti.subject_to(d * mp.guard_rate(X[:, -1], at(-1)) >= spec.touchdown_rate_rad_per_s)
-    for k in range(1, K - 1) if mp.inside else ():  # the event has not happened inside
-        opti.subject_to(d * mp.guard(X[:, k], at(k)) <= 0)
-    if mp.keep is not None:  # unilateral contacts push
-        for k in range(K):
-            opti.subject_to(mp.keep(X[:, k], at(k)) >= 0)
-    if spec.min_clearance_m is not None:
-        for k in range(1 if first else 0, K - 1 if last else K):
-            opti.subject_to(mp.clearance(X[:, k]) >= spec.min_clearance_m)
-    if spec.hip_angle_range_rad is not None:
-        lo, hi = spec.hip_angle_range_rad
-        for k in range(K):
-            opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
-    if spec.max_torque_n_m is not None:
-        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    if spec.friction_coefficient is not None:  # the stance foot's resultant in its cone
-        mu = spec.friction_coefficient
-        for k in range(K):
-            F = mp.grf(X[:, k], at(k))
-            opti.subject_to(F[0] >= 0)
-            opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
-    return _simpson(T, tau, ca.sum1(U ** 2) if several else U ** 2)
-
-
-def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
-    """The hip's positive work over the step [J]: Simpson's rule per phase on
-    ``max(p, 0)`` at the points (``p = u d(hip angle)/dt``), exactly by slack variables
-    when ``slack`` (:func:`walkerlab.optimal.transcription.step.positive_power`), else evaluated
-    (for the record)."""
-    import casadi as ca
-
-    from walkerlab.optimal.transcription.step import positive_power
-
-    work = 0
-    for X, U, T, tau in zip(Xs, Us, Ts, taus):
-        p = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(X.shape[1])])
-        work = work + _simpson(T, tau, positive_power(opti, p) if slack else ca.fmax(p, 0))
-    return work
-
-
 #: why a walker with phases is not optimised with a push-off (one line: the capability
 #: table's, :data:`walkerlab.walker.kinds.CAPABILITIES`)
 PHASED_PUSH_OFF = "optimize.push_off: " + KINDS["locking_knees"].cell("push_off", "optimize")
-
-
-def _pushes(spec) -> bool:
-    """The spec has a push-off (fixed and positive, or free)."""
-    return bool(spec.push_off_free or spec.push_off_n_s)
 
 
 def _check(spec, phases) -> None:
@@ -341,7 +264,7 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     """
     import casadi as ca
 
-    from walkerlab.optimal.transcription.step import ipopt_options, peak_torque
+    from walkerlab.optimal.transcription.step import ipopt_options
 
     phases = fns["phases"]
     _check(spec, phases)
@@ -349,7 +272,7 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
         raise ValueError("optimize: the starting step's phases "
                          f"{[g[0] for g in guess]} are not the walker's")
     t_build = time.perf_counter()
-    n2, P = 2 * fns["n"], len(phases)
+    n2 = 2 * fns["n"]
     opti = ca.Opti()
     Xs = [opti.variable(n2, g[1].size) for g in guess]
     nu = int(fns.get("torques", 1))  # torques at every point (a five-link biped: 4)
@@ -361,42 +284,10 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
         opti.subject_to(opti.bounded(0.0, push, spec.push_off_max_n_s))
         opti.set_initial(push, spec.push_off_n_s)
     taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
-    for p, mp in enumerate(phases):  # a step starts at 0 and after each heel strike
-        starts = p == 0 or phases[p - 1].guard_name == "heel_strike"
-        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], starts,
-                                 p == P - 1 or mp.guard_name == "heel_strike", fns)
-        nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
-        if _pushes(spec) and mp.guard_name == "heel_strike":  # push-off + heel strike
-            x_plus, w = mp.push_off(Xs[p][:, -1], push)
-            opti.subject_to(nxt == x_plus)
-            po_work, strikes = po_work + w, strikes + 1
-        else:
-            opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
-        Tg = float(guess[p][1][-1])
-        opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
-        opti.set_initial(Ts[p], Tg)
-        opti.set_initial(Xs[p], guess[p][2].T)
-        size = guess[p][1].size
-        opti.set_initial(Us[p], np.zeros((nu, size)) if guess_u is None
-                         else np.asarray(guess_u[p], float).reshape(size, nu).T)
-    period = sum(Ts[1:], Ts[0])
-    distance = _targets(opti, spec, fns, Xs, period)
-    U = ca.horzcat(*Us)
-    asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
-    terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
-    if "power" in fns:  # the hip torque's power: the cost of transport
-        work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
-        if _pushes(spec):  # the push-offs' work is positive work too
-            work = work + po_work
-        terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"]
-                                             * distance)
-    if _pushes(spec):
-        terms["push_off_work"] = po_work
-    obj = sum(w * terms[k] for k, w in asked.items())
-    if spec.objective == "effort" and spec.push_off_free:  # as one step's, at each strike
-        obj = obj + strikes * spec.push_off_weight * push ** 2
-    if spec.objective == "cost_of_transport":
-        obj = obj + spec.cost_of_transport_effort_weight * effort
+    effort, po_work, strikes = _chain_phases(opti, fns, spec, guess, guess_u, (Xs, Us, Ts),
+                                             taus, push, (effort, po_work, strikes))
+    obj, terms = _objective(opti, spec, fns, (Xs, Us, Ts), taus, (effort, po_work, strikes),
+                            push)
     opti.minimize(obj)
     if "constrain" in fns:  # a walker's own constraints on the whole sequence
         fns["constrain"](opti, Xs, Us, Ts)
@@ -406,25 +297,6 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build,
                   push if _pushes(spec) else 0.0)
-
-
-def _targets(opti, spec, fns, Xs, period):
-    """Every heel strike with the swing foot ahead and the gait targets on the step (a
-    stride: its mean step's period and length); returns the distance walked [m] (a
-    stride's: its steps' sum)."""
-    from walkerlab.optimal.transcription.step import target_constraints
-
-    phases, P = fns["phases"], len(fns["phases"])
-    strikes = [p for p, mp in enumerate(phases[:-1]) if mp.guard_name == "heel_strike"]
-    for p in [*strikes, P - 1]:  # every heel strike with the swing foot ahead
-        opti.subject_to(fns["ahead"](Xs[p][:, -1]) >= 1e-3)
-    if strikes:  # a stride of steps: its mean step's period and length
-        steps = [phases[p].step(Xs[p][:, -1]) for p in [*strikes, P - 1]]
-        target_constraints(opti, spec, period / len(steps), sum(steps) / len(steps))
-        return sum(steps)
-    length = phases[-1].step(Xs[-1][:, -1])
-    target_constraints(opti, spec, period, length)
-    return length
 
 
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> PhasedResult:
