@@ -372,8 +372,6 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
     ValueError
         An unknown objective (one line).
     """
-    from scipy.optimize import minimize
-
     from walkerlab.studies.continuation import scene_value
 
     if objective not in MEASURES:
@@ -387,42 +385,59 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
                    bounds=(lo, hi))
     sign = -1.0 if maximize else 1.0
     history: list = []
+    box = (p0, lo, hi, sign)
     if objective in SMOOTH:
-        def fun(p):
-            p = np.clip(p, lo, hi)  # the optimiser's rounding never leaves the bounds
-            v, g = measure_gradient(gaits, p, objective)
-            history.append((np.array(p, float), v))
-            return sign * v, sign * g
-
-        res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
-                       options={"maxiter": max_evaluations, "ftol": 1e-12})
-        res.x = np.clip(res.x, lo, hi)
-        value, grad = measure_gradient(gaits, res.x, objective)
+        res, value, grad = _gradient_search(
+            gaits, lambda g, p: measure_gradient(g, p, objective), box, 1e-12,
+            max_evaluations, history)
     elif objective in DIFFERENCED + SPECTRAL:
         slope = multiplier_gradient if objective in SPECTRAL else \
             (lambda g, p: g.differenced(p, objective))
-
-        def fun(p):
-            p = np.clip(p, lo, hi)
-            v, g = slope(gaits, p)
-            history.append((np.array(p, float), v))
-            return sign * v, sign * g
-
-        res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
-                       options={"maxiter": max_evaluations, "ftol": 1e-10})
-        res.x = np.clip(res.x, lo, hi)
-        value, grad = slope(gaits, res.x)
+        res, value, grad = _gradient_search(gaits, slope, box, 1e-10, max_evaluations,
+                                            history)
     else:
-        def fun(p):
-            p = np.clip(p, lo, hi)
-            v = gaits.value(p, objective)
-            history.append((np.array(p, float), v))
-            return sign * v
-
-        res = minimize(fun, p0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
-                       options={"maxfev": max_evaluations, "xatol": 1e-6, "fatol": 1e-9})
-        res.x = np.clip(res.x, lo, hi)
-        value, grad = gaits.value(res.x, objective), np.full(len(fields), np.nan)
+        res, value, grad = _simplex_search(gaits, objective, box, max_evaluations, history)
     return DesignResult(fields, np.asarray(res.x, float), objective, float(value),
                         np.asarray(grad, float), bool(res.success), str(res.message),
                         gaits.count, history, MEASURES[objective])
+
+
+def _gradient_search(gaits, slope, box, ftol: float, max_evaluations: int, history: list):
+    """SLSQP (Kraft 1988) on ``sign * value`` with its gradient ``slope(gaits, p) -> (value,
+    gradient)`` inside the bounds; ``box`` is ``(p0, lo, hi, sign)``.  Every evaluation is
+    appended to ``history``; returns ``(res, value, gradient)`` at the clipped optimum."""
+    from scipy.optimize import minimize
+
+    p0, lo, hi, sign = box
+
+    def fun(p):
+        p = np.clip(p, lo, hi)  # the optimiser's rounding never leaves the bounds
+        v, g = slope(gaits, p)
+        history.append((np.array(p, float), v))
+        return sign * v, sign * g
+
+    res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
+                   options={"maxiter": max_evaluations, "ftol": ftol})
+    res.x = np.clip(res.x, lo, hi)
+    value, grad = slope(gaits, res.x)
+    return res, value, grad
+
+
+def _simplex_search(gaits, objective: str, box, max_evaluations: int, history: list):
+    """Nelder-Mead (Nelder & Mead 1965) on ``sign * value`` of a measure with no gradient,
+    inside the bounds; ``box`` is ``(p0, lo, hi, sign)``.  Every evaluation is appended to
+    ``history``; returns ``(res, value, NaN gradient)`` at the clipped optimum."""
+    from scipy.optimize import minimize
+
+    p0, lo, hi, sign = box
+
+    def fun(p):
+        p = np.clip(p, lo, hi)
+        v = gaits.value(p, objective)
+        history.append((np.array(p, float), v))
+        return sign * v
+
+    res = minimize(fun, p0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
+                   options={"maxfev": max_evaluations, "xatol": 1e-6, "fatol": 1e-9})
+    res.x = np.clip(res.x, lo, hi)
+    return res, gaits.value(res.x, objective), np.full(len(p0), np.nan)

@@ -331,8 +331,6 @@ def replay_law(walker, solver, t, x, tau, close: bool = True, tol: float = 1e-10
         ``return_error`` inf, NaN multipliers when a step does not end in a heel strike
         (or crosses other phases).
     """
-    from scipy.optimize import root
-
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.numerics import fd_jacobian
 
@@ -354,8 +352,26 @@ def replay_law(walker, solver, t, x, tau, close: bool = True, tol: float = 1e-10
         return PhaseReplay(float("inf"), x_col, 0.0, float("inf"), float("nan"),
                            np.full(x_col.size, np.nan + 0j), float("nan"), False)
     e_col = float(np.max(np.abs(p_col - x_col)))
+    x0, seg = _closed_start(step, x_col, J, close and e_col > tol)
+    err = float(np.max(np.abs(seg.x_next - x0)))
+    closed = bool(close and err <= tol)
+    if x0 is not x_col:
+        J = fd_jacobian(lambda z: step(z).x_next, x0, 1e-6, central=False, f0=seg.x_next)
+    return PhaseReplay(e_col, np.asarray(x0, float), float(np.max(np.abs(x0 - x_col))), err,
+                       float(seg.t_end), sort_multipliers(np.linalg.eigvals(J)),
+                       torque_error(walker, seg, t, tau), closed)
+
+
+def _closed_start(step, x_col, J, close: bool):
+    """The start of the replayed step and its step: the fixed point of the step map from the
+    collocated start ``x_col`` by MINPACK's hybrj (``scipy.optimize.root``, Jacobian ``J``
+    of the map minus the identity) when ``close``, else (or where the root finder's iterate
+    falls or does not step) ``x_col``.  ``step(z)`` is one step from ``z``; returns ``(x0,
+    seg)``."""
+    from scipy.optimize import root
+
     x0 = x_col
-    if close and e_col > tol:
+    if close:
         eye = np.eye(x_col.size)
         try:
             sol = root(lambda z: step(z).x_next - z, x_col, jac=lambda z: J - eye,
@@ -368,13 +384,7 @@ def replay_law(walker, solver, t, x, tau, close: bool = True, tol: float = 1e-10
     except ValueError:  # the root finder's last iterate does not step: the collocated start
         x0 = x_col
         seg = step(x0)
-    err = float(np.max(np.abs(seg.x_next - x0)))
-    closed = bool(close and err <= tol)
-    if x0 is not x_col:
-        J = fd_jacobian(lambda z: step(z).x_next, x0, 1e-6, central=False, f0=seg.x_next)
-    return PhaseReplay(e_col, np.asarray(x0, float), float(np.max(np.abs(x0 - x_col))), err,
-                       float(seg.t_end), sort_multipliers(np.linalg.eigvals(J)),
-                       torque_error(walker, seg, t, tau), closed)
+    return x0, seg
 
 
 def torque_error(walker, seg, t, tau) -> float:
