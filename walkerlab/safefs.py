@@ -226,69 +226,91 @@ def atomic_replace_all(items, *, mode: int = 0o644, suffix: str = ".tmp") -> lis
         A temporary file cannot be filled or a file cannot be replaced: every file is left
         as it was, no temporary file or backup is left behind.
     """
-    import tempfile
-
     paths = [Path(p) for p, _ in items]
     temps: list[str] = []
     backups: list[tuple[Path, str | None]] = []  # (file, hard link to its old content)
     done: list[int] = []
     try:
         for path, (_, fill) in zip(paths, items):
-            if path.is_dir():  # refused before anything is written
-                raise IsADirectoryError(21, "a folder stands in the file's place", str(path))
-            remove_stale_temps(path.parent, path.name, (suffix, ".bak"))
-            fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=suffix,
-                                       dir=path.parent)
-            temps.append(tmp)
-            try:
-                fill(fd, tmp)
-            except BaseException:
-                try:
-                    os.close(fd)
-                except OSError:
-                    pass
-                raise
-            os.chmod(tmp, mode)
+            _fill_temp(path, fill, mode, suffix, temps)
         raise_if_interrupted()  # a result computed across an interrupt is not kept
         for path in paths:
-            old = None
-            if os.path.lexists(path):
-                _, old = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=".bak",
-                                          dir=path.parent)
-                os.unlink(old)
-                try:
-                    os.link(path, old, follow_symlinks=False)
-                except OSError as exc:  # a file system without hard links: a copy
-                    if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV,
-                                         errno.EMLINK):
-                        raise
-                    import shutil
-
-                    shutil.copy2(path, old)
-            backups.append((path, old))
+            backups.append((path, _backup(path)))
         for i, (path, tmp) in enumerate(zip(paths, temps)):
             os.replace(tmp, path)
             done.append(i)
     except BaseException:
-        for i in reversed(done):  # put back what was replaced
-            path, old = backups[i]
-            try:
-                if old is None:
-                    path.unlink(missing_ok=True)
-                else:
-                    os.replace(old, path)
-            except OSError:
-                pass
-        for tmp in temps:
-            Path(tmp).unlink(missing_ok=True)
-        for _, old in backups:
-            if old is not None:
-                Path(old).unlink(missing_ok=True)
+        _put_back(done, backups, temps)
         raise
     for _, old in backups:
         if old is not None:
             Path(old).unlink(missing_ok=True)
     return paths
+
+
+def _fill_temp(path: Path, fill, mode: int, suffix: str, temps: list) -> None:
+    """Fill a new temporary file beside ``path`` by ``fill(fd, name)`` with ``mode`` (its
+    name appended to ``temps`` first, so a failure's clean-up removes it); a folder in
+    ``path``'s place is refused before anything is written (:func:`atomic_replace_all`)."""
+    import tempfile
+
+    if path.is_dir():  # refused before anything is written
+        raise IsADirectoryError(21, "a folder stands in the file's place", str(path))
+    remove_stale_temps(path.parent, path.name, (suffix, ".bak"))
+    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=suffix,
+                               dir=path.parent)
+    temps.append(tmp)
+    try:
+        fill(fd, tmp)
+    except BaseException:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+        raise
+    os.chmod(tmp, mode)
+
+
+def _backup(path: Path) -> str | None:
+    """A hard link (where the file system has none: a copy) to ``path``'s old content
+    beside it, or None when there is no file (:func:`atomic_replace_all`)."""
+    import tempfile
+
+    old = None
+    if os.path.lexists(path):
+        _, old = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=".bak",
+                                  dir=path.parent)
+        os.unlink(old)
+        try:
+            os.link(path, old, follow_symlinks=False)
+        except OSError as exc:  # a file system without hard links: a copy
+            if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV,
+                                 errno.EMLINK):
+                raise
+            import shutil
+
+            shutil.copy2(path, old)
+    return old
+
+
+def _put_back(done: list, backups: list, temps: list) -> None:
+    """Undo a failed :func:`atomic_replace_all`: the replaced files (indices ``done``) from
+    their ``backups`` (a file that was not there removed), then every temporary file and
+    backup removed."""
+    for i in reversed(done):  # put back what was replaced
+        path, old = backups[i]
+        try:
+            if old is None:
+                path.unlink(missing_ok=True)
+            else:
+                os.replace(old, path)
+        except OSError:
+            pass
+    for tmp in temps:
+        Path(tmp).unlink(missing_ok=True)
+    for _, old in backups:
+        if old is not None:
+            Path(old).unlink(missing_ok=True)
 
 
 def process_alive(pid: int) -> bool:

@@ -38,6 +38,7 @@ imports numba), so numba never writes into the installed package.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 import sys
@@ -241,70 +242,81 @@ def _discard(path: str) -> None:
         pass
 
 
-def _patch_numba_caching(caching) -> None:
-    """Make numba's cache reads bounded, non-blocking and tolerant of damage (a miss), and
-    its writes leave no temporary file when interrupted."""
-    import contextlib
+def _load_index(self):
+    """``IndexDataCacheFile._load_index``, bounded and non-blocking (a regular file of at
+    most :data:`MAX_CACHE_FILE_BYTES`); a damaged index is discarded (a miss)."""
     import io
     import pickle
-    import uuid
 
     from walkerlab.safefs import NotARegularFile, read_regular
 
+    try:
+        raw = read_regular(self._index_path, MAX_CACHE_FILE_BYTES, "numba cache index",
+                           follow_links=False)
+    except FileNotFoundError:
+        return {}
+    except (OSError, NotARegularFile):  # FIFO, device, folder, huge, unreadable
+        _discard(self._index_path)
+        return {}
+    try:
+        f = io.BytesIO(raw)
+        version = pickle.load(f)
+        if version != self._version:
+            return {}
+        stamp, overloads = pickle.loads(f.read())
+        if not isinstance(overloads, dict):
+            raise TypeError("index is not a dict")
+    except Exception:  # noqa: BLE001 - garbage, empty, truncated: rebuilt
+        _discard(self._index_path)
+        return {}
+    return overloads if stamp == self._source_stamp else {}
+
+
+def _load_data(self, name):
+    """``IndexDataCacheFile._load_data``, bounded; a damaged entry is discarded and read as
+    an OSError (numba recompiles)."""
+    import pickle
+
+    from walkerlab.safefs import read_regular
+
+    path = self._data_path(name)
+    try:
+        raw = read_regular(path, MAX_CACHE_FILE_BYTES, "numba cache data",
+                           follow_links=False)
+        return pickle.loads(raw)
+    except FileNotFoundError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged entry is a miss (recompiled)
+        _discard(path)
+        raise OSError(f"{path}: damaged numba cache file") from exc
+
+
+@contextlib.contextmanager
+def _open_for_write(self, filepath):
+    """``IndexDataCacheFile._open_for_write``: numba's own, but an interrupt (SIGTERM of a
+    side process, Ctrl-C) removes the temporary file too: nothing half-written stays in
+    the cache."""
+    import uuid
+
+    tmp = f"{filepath}.tmp.{uuid.uuid4().hex[:16]}"
+    try:
+        with open(tmp, "wb") as f:
+            yield f
+        os.replace(tmp, filepath)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def _patch_numba_caching(caching) -> None:
+    """Make numba's cache reads bounded, non-blocking and tolerant of damage (a miss), and
+    its writes leave no temporary file when interrupted."""
     cls = caching.IndexDataCacheFile
     if getattr(cls, "_walkerlab_guarded", False):
         return
-
-    def _load_index(self):
-        try:
-            raw = read_regular(self._index_path, MAX_CACHE_FILE_BYTES, "numba cache index",
-                               follow_links=False)
-        except FileNotFoundError:
-            return {}
-        except (OSError, NotARegularFile):  # FIFO, device, folder, huge, unreadable
-            _discard(self._index_path)
-            return {}
-        try:
-            f = io.BytesIO(raw)
-            version = pickle.load(f)
-            if version != self._version:
-                return {}
-            stamp, overloads = pickle.loads(f.read())
-            if not isinstance(overloads, dict):
-                raise TypeError("index is not a dict")
-        except Exception:  # noqa: BLE001 - garbage, empty, truncated: rebuilt
-            _discard(self._index_path)
-            return {}
-        return overloads if stamp == self._source_stamp else {}
-
-    def _load_data(self, name):
-        path = self._data_path(name)
-        try:
-            raw = read_regular(path, MAX_CACHE_FILE_BYTES, "numba cache data",
-                               follow_links=False)
-            return pickle.loads(raw)
-        except FileNotFoundError:
-            raise
-        except Exception as exc:  # noqa: BLE001 - a damaged entry is a miss (recompiled)
-            _discard(path)
-            raise OSError(f"{path}: damaged numba cache file") from exc
-
-    @contextlib.contextmanager
-    def _open_for_write(self, filepath):
-        # numba's own, but an interrupt (SIGTERM of a side process, Ctrl-C) removes the
-        # temporary file too: nothing half-written stays in the cache
-        tmp = f"{filepath}.tmp.{uuid.uuid4().hex[:16]}"
-        try:
-            with open(tmp, "wb") as f:
-                yield f
-            os.replace(tmp, filepath)
-        except BaseException:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-            raise
-
     cls._load_index = _load_index
     cls._load_data = _load_data
     cls._open_for_write = _open_for_write
