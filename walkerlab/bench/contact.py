@@ -269,23 +269,34 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     target, scan = {}, {}
     for method in methods:
         scan[method], best = _scan(case, method, target_error_rad, repeats)
-        target[method] = {"reached": best is not None}
-        if best is not None:
-            target[method].update(
-                rtols=[r["rtol"] for r in best], atol_over_rtol=0.1,
-                max_angle_error_rad=[r["error"] for r in best],
-                wall_time_s=[r["wall_time_s"] for r in best], nfev=[r["nfev"] for r in best],
-                median_wall_time_s=float(np.median([r["wall_time_s"] for r in best])),
-                worst_error_rad=float(max(r["error"] for r in best)))
-    ref = case.ref
+        target[method] = _target_entry(best)
     return {"scene": scene.name, "n_strides": n_strides, "t_final_s": t_final,
-            "reference": {"method": reference_method, "rtol": reference_rtol,
-                          "wall_time_s": ref.wall_time_s, "nfev": ref.nfev,
-                          "heel_strikes": len(ref.heel_strike_times),
-                          "termination": ref.termination,
-                          "end_time_s": float(ref.t[-1]) if len(ref.t) else 0.0,
-                          "complete": case.complete(ref), "message": ref.message},
+            "reference": _reference_entry(case, reference_method, reference_rtol),
             "rhs_cost": rhs_cost(walker, x0), "target": target, "scan": scan}
+
+
+def _target_entry(best: list[dict] | None) -> dict:
+    """A method's entry of :func:`run_scene_benchmark`'s ``target``: whether a band reached
+    the target and, if so, its tolerances, errors, wall times [s] and their median."""
+    entry = {"reached": best is not None}
+    if best is not None:
+        entry.update(
+            rtols=[r["rtol"] for r in best], atol_over_rtol=0.1,
+            max_angle_error_rad=[r["error"] for r in best],
+            wall_time_s=[r["wall_time_s"] for r in best], nfev=[r["nfev"] for r in best],
+            median_wall_time_s=float(np.median([r["wall_time_s"] for r in best])),
+            worst_error_rad=float(max(r["error"] for r in best)))
+    return entry
+
+
+def _reference_entry(case: _Case, method: str, rtol: float) -> dict:
+    """:func:`run_scene_benchmark`'s ``reference``: the reference run's integrator, tolerance,
+    wall time [s], evaluations and how it ended."""
+    ref = case.ref
+    return {"method": method, "rtol": rtol, "wall_time_s": ref.wall_time_s, "nfev": ref.nfev,
+            "heel_strikes": len(ref.heel_strike_times), "termination": ref.termination,
+            "end_time_s": float(ref.t[-1]) if len(ref.t) else 0.0,
+            "complete": case.complete(ref), "message": ref.message}
 
 
 def _scan(case: _Case, method: str, target_error_rad: float, repeats: int

@@ -225,54 +225,13 @@ def optimize(scene: Path | None = SceneArg,
         _optimize_design(scene, design, objective, maximize, runs_dir, force)
         return
 
-    from walkerlab.report.figures_section import cot_terms_text, not_a_gait_reason
-    from walkerlab.units import for_scene
+    from walkerlab.report.figures_section import not_a_gait_reason
 
     sc = load(scene)
     out = pipeline.run("optimize", sc, runs_dir, force)
     d = out.summary.get("data")
     if d is not None:
-        u = for_scene(sc)  # the scene's units (a nondimensional scene: l, sqrt(l/g), ...)
-        t = u.time
-        mu = max(abs(d.multipliers)) if len(d.multipliers) else float("nan")
-        cpu = "" if d.cpu_time_s != d.cpu_time_s else f", CPU {d.cpu_time_s:.2f} s"
-        typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s"
-                   f"{cpu})")
-        peak = ", ".join(f"{n} {v:.4g}" for n, v in zip(
-            d.torque_names, abs(d.torque.reshape(len(d.time), -1)).max(axis=0)))
-        typer.echo(f"  step period {d.step_period_s:.6g} {t}, step length "
-                   f"{d.step_length_m:.5g} {u.length}, speed "
-                   f"{d.step_length_m / d.step_period_s:.5g} {u.speed}, push-off "
-                   f"{d.push_off_n_s:.5g} {u('N s')}, peak |torque| [{u(d.torque_unit)}]: "
-                   f"{peak}")
-        if d.start_shift == d.start_shift:  # closed by shooting (a five-link biped)
-            typer.echo(f"  open loop from the collocated start: return error "
-                       f"{d.collocated_start_error:.2g}; closed by shooting under the same "
-                       f"torques: start moved {d.start_shift:.2g}, step period "
-                       f"{d.replay_step_period_s:.9g} {t}")
-        typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {u(d.objective_unit)}"
-                   + cot_terms_text(d, u) + f"; replay return error {d.replay_error:.2g}; "
-                   f"max |Floquet multiplier| {mu:.4g}")
-        if d.phase_replay_outcome:  # asked for, and refused (a non-monotonic phase variable)
-            typer.echo(f"  phase-variable replay: {d.phase_replay_outcome}")
-        for law, r in d.phase_replays.items():  # the phase-variable laws (when asked for)
-            typer.echo(f"  phase-variable {law} law: from the collocated start "
-                       f"{r.collocated_start_error:.2g}; "
-                       + (f"closed (start moved {r.start_shift:.2g}): return error "
-                          f"{r.return_error:.2g}, step period {r.step_period_s:.9g} {t}, "
-                          if r.closed else "not closed, ")
-                       + f"max |multiplier| {max(abs(r.multipliers)):.4g}, torque within "
-                       f"{r.torque_error:.2g} {u('N m')} of the optimal")
-        if d.contact_step_period_s == d.contact_step_period_s:  # not NaN: replayed
-            typer.echo(f"  contact model driven by the optimised torque: step period "
-                       f"{d.contact_step_period_s:.5g} {t} "
-                       f"({100 * (d.contact_step_period_s / d.step_period_s - 1):+.2f} %)"
-                       + ("" if d.contact_outcome == "heel_strike" else
-                          f"; the run ended short of its strides: {d.contact_outcome}"))
-        else:
-            typer.echo(f"  contact model: {d.contact_outcome}")
-        typer.echo("  a gait (the replay closes)" if d.gait else
-                   f"  NOT a gait: {not_a_gait_reason(d)}")
+        _echo_optimum(sc, d)
     typer.echo(status(out))
     from walkerlab.stages.optimize import draw
 
@@ -284,6 +243,56 @@ def optimize(scene: Path | None = SceneArg,
         if not d.gait:
             fail(RuntimeError(f"--require-gait: the optimum is NOT a gait: "
                               f"{not_a_gait_reason(d)}"))
+
+
+def _echo_optimum(sc, d) -> None:
+    """Print the optimum ``d`` (an ``OptimizeData``) of ``walkerlab optimize`` in the scene's
+    units: IPOPT's status, the step, the objective, the replays (rigid, phase-variable laws,
+    contact model) and whether it is a gait."""
+    from walkerlab.report.figures_section import cot_terms_text, not_a_gait_reason
+    from walkerlab.units import for_scene
+
+    u = for_scene(sc)  # the scene's units (a nondimensional scene: l, sqrt(l/g), ...)
+    t = u.time
+    mu = max(abs(d.multipliers)) if len(d.multipliers) else float("nan")
+    cpu = "" if d.cpu_time_s != d.cpu_time_s else f", CPU {d.cpu_time_s:.2f} s"
+    typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s"
+               f"{cpu})")
+    peak = ", ".join(f"{n} {v:.4g}" for n, v in zip(
+        d.torque_names, abs(d.torque.reshape(len(d.time), -1)).max(axis=0)))
+    typer.echo(f"  step period {d.step_period_s:.6g} {t}, step length "
+               f"{d.step_length_m:.5g} {u.length}, speed "
+               f"{d.step_length_m / d.step_period_s:.5g} {u.speed}, push-off "
+               f"{d.push_off_n_s:.5g} {u('N s')}, peak |torque| [{u(d.torque_unit)}]: "
+               f"{peak}")
+    if d.start_shift == d.start_shift:  # closed by shooting (a five-link biped)
+        typer.echo(f"  open loop from the collocated start: return error "
+                   f"{d.collocated_start_error:.2g}; closed by shooting under the same "
+                   f"torques: start moved {d.start_shift:.2g}, step period "
+                   f"{d.replay_step_period_s:.9g} {t}")
+    typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {u(d.objective_unit)}"
+               + cot_terms_text(d, u) + f"; replay return error {d.replay_error:.2g}; "
+               f"max |Floquet multiplier| {mu:.4g}")
+    if d.phase_replay_outcome:  # asked for, and refused (a non-monotonic phase variable)
+        typer.echo(f"  phase-variable replay: {d.phase_replay_outcome}")
+    for law, r in d.phase_replays.items():  # the phase-variable laws (when asked for)
+        typer.echo(f"  phase-variable {law} law: from the collocated start "
+                   f"{r.collocated_start_error:.2g}; "
+                   + (f"closed (start moved {r.start_shift:.2g}): return error "
+                      f"{r.return_error:.2g}, step period {r.step_period_s:.9g} {t}, "
+                      if r.closed else "not closed, ")
+                   + f"max |multiplier| {max(abs(r.multipliers)):.4g}, torque within "
+                   f"{r.torque_error:.2g} {u('N m')} of the optimal")
+    if d.contact_step_period_s == d.contact_step_period_s:  # not NaN: replayed
+        typer.echo(f"  contact model driven by the optimised torque: step period "
+                   f"{d.contact_step_period_s:.5g} {t} "
+                   f"({100 * (d.contact_step_period_s / d.step_period_s - 1):+.2f} %)"
+                   + ("" if d.contact_outcome == "heel_strike" else
+                      f"; the run ended short of its strides: {d.contact_outcome}"))
+    else:
+        typer.echo(f"  contact model: {d.contact_outcome}")
+    typer.echo("  a gait (the replay closes)" if d.gait else
+               f"  NOT a gait: {not_a_gait_reason(d)}")
 
 
 def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> None:

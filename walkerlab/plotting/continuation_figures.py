@@ -77,6 +77,61 @@ def _label_offset(ax, x: float, y: float, i: int) -> tuple[tuple[float, float], 
     return ((7 if right else -7, d if up else -d), "bottom" if up else "top",
             "left" if right else "right")
 
+def _draw_branches(ax1, ax2, data, seen: set) -> str:
+    """Each branch of ``data`` (a ContinuationData) in its period's colour, solid where
+    stable and dashed where not: the state at every heel strike of the orbit on ``ax1``,
+    the largest |Floquet multiplier| on ``ax2``; legend labels once (``seen``).  Returns the
+    state axis' label ("" without branches)."""
+    ylabel = ""
+    for b in data.branches:
+        k, p = b["period"], np.asarray(b["param"], float)
+        ys, ylabel = _y(data, b.get("orbit", b["states"]))
+        ys = ys.reshape(p.size, -1)
+        mmax = np.max(np.abs(b["multipliers"]), axis=1)
+        c = PERIOD_COLORS.get(k, "tab:gray")
+        for pp, yy, mm, st in stability_pieces(p, ys, mmax):
+            key = f"period {k}, {'stable' if st else 'unstable'}"
+            lab = None if key in seen else key
+            seen.add(key)
+            ls = "-" if st else "--"
+            if pp.size == 1:
+                ax1.plot(pp, yy[:, 0], "o", color=c, mfc=c if st else "w", label=lab)
+                ax2.plot(pp, mm, "o", color=c, mfc=c if st else "w")
+            else:  # every heel strike of the period-k orbit: k curves
+                for h in range(yy.shape[1]):
+                    ax1.plot(pp, yy[:, h], ls, color=c, lw=1.4,
+                             label=lab if h == 0 else None, zorder=3)
+                ax2.plot(pp, mm, ls, color=c, lw=1.2, zorder=3)
+    return ylabel
+
+
+def _draw_special_points(ax1, ax2, data, seen: set) -> None:
+    """The special points of ``data`` (folds, period doublings, Neimark-Sacker points,
+    branch ends) marked on ``ax1`` and labelled inside the axes (:func:`_label_offset`),
+    a dotted line each on ``ax2``; legend labels once (``seen``)."""
+    sp = data.special
+    labels = []
+    for i, kind in enumerate(sp.get("kind", [])):
+        mk, col, short = MARKERS.get(str(kind), ("*", "k", str(kind)))
+        y, _ = _y(data, {n: np.atleast_1d(v)[i:i + 1] for n, v in sp["states"].items()})
+        pv = float(sp["param"][i])
+        lab = {"fold": "fold (multiplier +1)", "period_doubling": "period doubling (-1)",
+               "neimark_sacker": "Neimark-Sacker (|complex pair| 1)",
+               "branch_end": "branch end"}.get(str(kind), str(kind))
+        ax1.plot([pv], y, mk, color=col, ms=7, mfc="none", mew=1.6, zorder=5,
+                 label=None if lab in seen else lab)
+        seen.add(lab)
+        if np.isfinite(y[0]):
+            labels.append((f"{short}{int(sp['period'][i])} {pv:.5g}", pv, y[0], col))
+        ax2.axvline(pv, color=col, lw=0.5, ls=":")
+    for i, (text, pv, y0, col) in enumerate(labels):  # after the limits are known
+        off, va, ha = _label_offset(ax1, pv, y0, i)
+        ax1.annotate(text, (pv, y0), textcoords="offset points", xytext=off, fontsize=7,
+                     color=col, va=va, ha=ha, zorder=6, annotation_clip=True,
+                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                           "alpha": 0.85},
+                     arrowprops={"arrowstyle": "-", "color": col, "lw": 0.5})
+
 
 def continuation_figure(data, title: str = "", brute: dict | None = None):
     """Continuation diagram.
@@ -105,50 +160,10 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
         m = np.isfinite(yy)
         ax1.plot(ss[m], yy[m], ".", ms=2.0, color="0.35", zorder=1,
                  label="steady state, simulated (bifurcation)")
-    seen = set()
-    for b in data.branches:
-        k, p = b["period"], np.asarray(b["param"], float)
-        ys, ylabel = _y(data, b.get("orbit", b["states"]))
-        ys = ys.reshape(p.size, -1)
-        y = ys[:, 0]
-        mmax = np.max(np.abs(b["multipliers"]), axis=1)
-        c = PERIOD_COLORS.get(k, "tab:gray")
-        for pp, yy, mm, st in stability_pieces(p, ys, mmax):
-            key = f"period {k}, {'stable' if st else 'unstable'}"
-            lab = None if key in seen else key
-            seen.add(key)
-            ls = "-" if st else "--"
-            if pp.size == 1:
-                ax1.plot(pp, yy[:, 0], "o", color=c, mfc=c if st else "w", label=lab)
-                ax2.plot(pp, mm, "o", color=c, mfc=c if st else "w")
-            else:  # every heel strike of the period-k orbit: k curves
-                for h in range(yy.shape[1]):
-                    ax1.plot(pp, yy[:, h], ls, color=c, lw=1.4,
-                             label=lab if h == 0 else None, zorder=3)
-                ax2.plot(pp, mm, ls, color=c, lw=1.2, zorder=3)
-    sp = data.special
+    seen: set = set()
+    ylabel = _draw_branches(ax1, ax2, data, seen)
     ax1.margins(x=0.04, y=0.15)
-    labels = []
-    for i, kind in enumerate(sp.get("kind", [])):
-        mk, col, short = MARKERS.get(str(kind), ("*", "k", str(kind)))
-        y, _ = _y(data, {n: np.atleast_1d(v)[i:i + 1] for n, v in sp["states"].items()})
-        pv = float(sp["param"][i])
-        lab = {"fold": "fold (multiplier +1)", "period_doubling": "period doubling (-1)",
-               "neimark_sacker": "Neimark-Sacker (|complex pair| 1)",
-               "branch_end": "branch end"}.get(str(kind), str(kind))
-        ax1.plot([pv], y, mk, color=col, ms=7, mfc="none", mew=1.6, zorder=5,
-                 label=None if lab in seen else lab)
-        seen.add(lab)
-        if np.isfinite(y[0]):
-            labels.append((f"{short}{int(sp['period'][i])} {pv:.5g}", pv, y[0], col))
-        ax2.axvline(pv, color=col, lw=0.5, ls=":")
-    for i, (text, pv, y0, col) in enumerate(labels):  # after the limits are known
-        off, va, ha = _label_offset(ax1, pv, y0, i)
-        ax1.annotate(text, (pv, y0), textcoords="offset points", xytext=off, fontsize=7,
-                     color=col, va=va, ha=ha, zorder=6, annotation_clip=True,
-                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
-                           "alpha": 0.85},
-                     arrowprops={"arrowstyle": "-", "color": col, "lw": 0.5})
+    _draw_special_points(ax1, ax2, data, seen)
     ax1.axvline(data.start, color="0.5", lw=0.6, ls="-.", label="start (the scene's gait)")
     ax1.set_ylabel(ylabel if data.branches else "")
     ax2.axhline(1.0, color="0.5", lw=0.8)
