@@ -49,6 +49,64 @@ def clearance_text(lowest: float, u: Units) -> str:
     return (f"the swing foot dips up to {v} {unit} below the slope inside the steps "
             "(penetration): foot scuffing, which the rigid model ignores")
 
+def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
+    """The fixed point's verdicts (gait found, stable, ground reaction) appended to
+    ``bullets`` and its numbers (state, step period, largest multiplier) with the published
+    fixed point's to ``rows`` (:func:`summary_section`)."""
+    bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
+                   f"{num(fp.residual, 2)}), step period "
+                   f"{num(fp.step_period_s)} {u.time}.")
+    bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
+                   f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
+    g = getattr(fp, "ground_contact", None)
+    if g is not None:  # a gait that needs the ground to pull is no gait on real ground
+        bullets.append("- **Ground reaction**: " + ground_contact_text(g, u).split(
+            ": ", 1)[1] + ".")
+    eq = dict(zip(*published_fixed_point(pub)))
+    for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
+        # as many digits as the published value has, so the two can be compared digit by digit
+        dig = max(4, sig_digits(printed(eq[n]))) if n in eq else 4
+        rows.append([f"fixed point {n}", un, num(v, dig),
+                     printed(eq[n]) if n in eq else "—"])
+    rows.append(["step period", u.time, num(fp.step_period_s), "—"])
+    rows.append(["max abs(multiplier)", "-", num(fp.max_abs_multiplier()), "—"])
+
+
+def _contact_verdict(c) -> str:
+    """The contact walker's verdict (:func:`summary_section`): whether it walks, from the
+    steps stored with the run (an older artifact: its outcome), and its own periodic gait."""
+    from walkerlab.integrate.ends import CONTACT_WALKED
+
+    walks = c.walks if c.walks is not None else c.outcome in CONTACT_WALKED
+    extra = ""
+    if c.periodic is not None and c.periodic.found:
+        extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
+                                                  else "unstable"))
+    elif c.periodic is not None:
+        extra = f"; its own periodic gait was not found ({c.periodic.outcome})"
+    why = f": {c.walks_reason}" if not walks and c.walks_reason else ""
+    return (f"- **Contact walker walks**: {'yes' if walks else 'no'} "
+            f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}"
+            f"{why}){extra}.")
+
+
+def _gait_rows(ideal: dict, pub, u) -> list:
+    """The rigid gait's cycle time, speed, mean energy and step length beside the
+    published values (Table 3 of ``pub`` where it has one; :func:`summary_section`)."""
+    rows = []
+    t3 = getattr(pub, "TABLE3", {})
+    for key in ("t_cycle_s", "v_com_m_per_s"):
+        name, _sym, unit = TABLE3_ROWS[key]
+        rows.append([name, u(unit), num(ideal[key]),
+                     printed(t3[key][0]) if key in t3 else "—"])
+    if "E_avg_J" in t3:
+        rows.append(["average mechanical energy, PE from the stance foot", u.energy,
+                     num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
+    step_pub = getattr(pub, "STEP_LENGTH_M", None)
+    rows.append(["step length", u.length, num(ideal["step_length_m"]),
+                 printed(step_pub) if step_pub is not None else "—"])
+    return rows
+
 
 def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     """Short verdicts and headline numbers, with the published values where they exist."""
@@ -60,23 +118,7 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     pub_name = f"published ({pub.SHORT})" if pub is not None else None
     fp = arts.get("fixedpoint")
     if fp is not None:
-        bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
-                       f"{num(fp.residual, 2)}), step period "
-                       f"{num(fp.step_period_s)} {u.time}.")
-        bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
-                       f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
-        g = getattr(fp, "ground_contact", None)
-        if g is not None:  # a gait that needs the ground to pull is no gait on real ground
-            bullets.append("- **Ground reaction**: " + ground_contact_text(g, u).split(
-                ": ", 1)[1] + ".")
-        eq = dict(zip(*published_fixed_point(pub)))
-        for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
-            # as many digits as the published value has, so the two can be compared digit by digit
-            dig = max(4, sig_digits(printed(eq[n]))) if n in eq else 4
-            rows.append([f"fixed point {n}", un, num(v, dig),
-                         printed(eq[n]) if n in eq else "—"])
-        rows.append(["step period", u.time, num(fp.step_period_s), "—"])
-        rows.append(["max abs(multiplier)", "-", num(fp.max_abs_multiplier()), "—"])
+        _fixedpoint_summary(fp, pub, u, bullets, rows)
     elif "fixedpoint" not in arts and scene.fixedpoint is not None:
         bullets.append("- **Gait found**: no fixed point artifact.")
     sim = arts.get("simulate")
@@ -93,34 +135,11 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                          num(u.small_scale * clear, 3), "—"])
     c = arts.get("contact-sim")
     if c is not None:
-        from walkerlab.integrate.ends import CONTACT_WALKED
-
-        # one verdict, from the steps (stored with the run); an older artifact: its outcome
-        walks = c.walks if c.walks is not None else c.outcome in CONTACT_WALKED
-        extra = ""
-        if c.periodic is not None and c.periodic.found:
-            extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
-                                                      else "unstable"))
-        elif c.periodic is not None:
-            extra = f"; its own periodic gait was not found ({c.periodic.outcome})"
-        why = f": {c.walks_reason}" if not walks and c.walks_reason else ""
-        bullets.append(f"- **Contact walker walks**: {'yes' if walks else 'no'} "
-                       f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}"
-                       f"{why}){extra}.")
+        bullets.append(_contact_verdict(c))
     cols = inputs.gait_columns
     ideal = cols.get("ours, ideal")
     if ideal:
-        t3 = getattr(pub, "TABLE3", {})
-        for key in ("t_cycle_s", "v_com_m_per_s"):
-            name, _sym, unit = TABLE3_ROWS[key]
-            rows.append([name, u(unit), num(ideal[key]),
-                         printed(t3[key][0]) if key in t3 else "—"])
-        if "E_avg_J" in t3:
-            rows.append(["average mechanical energy, PE from the stance foot", u.energy,
-                         num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
-        step_pub = getattr(pub, "STEP_LENGTH_M", None)
-        rows.append(["step length", u.length, num(ideal["step_length_m"]),
-                     printed(step_pub) if step_pub is not None else "—"])
+        rows += _gait_rows(ideal, pub, u)
     out += bullets
     if rows:
         header = ["quantity", "unit", "ours"]

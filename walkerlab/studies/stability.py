@@ -271,15 +271,8 @@ def stability_map_run(scene, spec: MapSpec, workers: int = 2,
                       progress: Callable[[int, int], None] | None = None):
     """:func:`gait_map` with a progress bar, packed for the stability-map artifact.
 
-    Parameters
-    ----------
-    scene : walkerlab.config.Scene
-        Base scene (needs ``contact`` and ``fixedpoint``).
-    spec : MapSpec
-    workers : int
-        Worker processes (1 = in this process).
-    progress : callable, optional
-        ``progress(rows_done, rows_total)``, beside the terminal's progress bar.
+    The parameters are :func:`gait_map`'s (``progress`` is called beside the terminal's
+    progress bar).
 
     Returns
     -------

@@ -192,6 +192,14 @@ def _measures(walker, x, solver) -> dict[str, float]:
             "speed": g["speed"], "cost_of_transport": g["cost_of_transport"]}
 
 
+def _gait_at(gaits: _Gaits, p):
+    """``(p, walker, x*, DP)`` at the design ``p`` (k,): its walker, its gait's fixed point
+    (2n,) and the Poincaré map's variational Jacobian there (2n, 2n), as float arrays."""
+    p = np.asarray(p, float)
+    w, fp = gaits.gait(p)
+    return p, w, np.asarray(fp.x, float), np.asarray(fp.jacobian_variational, float)
+
+
 def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
                      h_p: float = 1e-6) -> tuple[float, np.ndarray]:
     """The measure ``name`` of the gait at ``p`` and its gradient (k,) through the fixed
@@ -202,12 +210,8 @@ def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
     walkerlab.analysis.gait.poincare.FixedPointNotFound
         No gait at ``p`` near the last one.
     """
-
-    p = np.asarray(p, float)
-    w, fp = gaits.gait(p)
-    x = np.asarray(fp.x, float)
+    p, w, x, J = _gait_at(gaits, p)
     value = _measures(w, x, gaits.solver)[name]
-    J = np.asarray(fp.jacobian_variational, float)
     n2 = x.size
     dm_dx = np.array([(_measures(w, x + h_x * e, gaits.solver)[name]
                        - _measures(w, x - h_x * e, gaits.solver)[name]) / (2 * h_x)
@@ -270,10 +274,7 @@ def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.nd
 
     from walkerlab.analysis.gait.poincare import poincare_map
 
-    p = np.asarray(p, float)
-    w, fp = gaits.gait(p)
-    x = np.asarray(fp.x, float)
-    J = np.asarray(fp.jacobian_variational, float)
+    p, w, x, J = _gait_at(gaits, p)
     ev, W, V = eig(J, left=True, right=True)
     i = int(np.argmax(np.abs(ev)))
     lam, v, wl = ev[i], V[:, i], W[:, i]

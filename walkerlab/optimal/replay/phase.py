@@ -199,13 +199,9 @@ def law_of_rows(rows, u, stiffness, damping, t=None,
         At each collocation point (m,): each actuator's joint angle [rad] and rate [rad/s]
         (sequences, length k), the phase variable [rad] and its rate [rad/s] (the
         actuators' ``joint_angles``).
-    u : ndarray (m, k)
-        Collocated torques [N m].
-    stiffness, damping : sequence of float (k,)
-        PD gains [N m/rad], [N m s/rad] (zeros: the feed-forward alone).
-    t : ndarray (m,), optional
-        Collocation times [s] (the feed-forward: the control at ``T(s)``; without: a
-        spline of ``u`` over ``s``).
+    u, stiffness, damping, t
+        As :func:`walkerlab.optimal.replay.virtual_constraints.phase_law`'s: the collocated
+        torques (m, k) [N m], the PD gains (k,) and the collocation times (m,) [s].
     where : str
         The stretch of the step, for the error ("the optimised step", a phase).
 

@@ -200,13 +200,8 @@ def torques_of_time(t: np.ndarray, u: np.ndarray):
     [N m]: in each Hermite-Simpson interval the quadratic through its three points (the
     transcription's own control); before ``t_0`` held, after ``t_2N`` the last quadratic
     extrapolated (a replayed step may end slightly later than the collocated one).
-
-    Parameters
-    ----------
-    t : ndarray (2N + 1,)
-        Collocation times [s].
-    u : ndarray (2N + 1, k)
-        Torques there [N m].
+    ``t`` (2N + 1,) [s] and ``u`` (2N + 1, k) [N m] are the collocation times and the
+    torques there (as :func:`walkerlab.optimal.replay.phase.control_of_time`'s).
     """
     t, u = np.asarray(t, float), np.asarray(u, float).reshape(len(t), -1)
     nint = (len(t) - 1) // 2
