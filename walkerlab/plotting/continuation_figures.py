@@ -77,6 +77,16 @@ def _label_offset(ax, x: float, y: float, i: int) -> tuple[tuple[float, float], 
     return ((7 if right else -7, d if up else -d), "bottom" if up else "top",
             "left" if right else "right")
 
+def _finished(fig, ax, title: str):
+    """``fig`` with ``ax``'s legend outside the axes on the right, ``title`` (if any) and a
+    tight layout."""
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
 def _draw_branches(ax1, ax2, data, seen: set) -> str:
     """Each branch of ``data`` (a ContinuationData) in its period's colour, solid where
     stable and dashed where not: the state at every heel strike of the orbit on ``ax1``,
@@ -172,11 +182,7 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
         ax2.set_yscale("log")
     ax2.set_ylabel("max |Floquet multiplier| [-]")
     ax2.set_xlabel(f"{data.path}{unit}")
-    ax1.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
-    if title:
-        ax1.set_title(title, fontsize=10)
-    fig.tight_layout()
-    return fig
+    return _finished(fig, ax1, title)
 
 
 def two_parameter_figure(data, title: str = ""):
@@ -197,11 +203,7 @@ def two_parameter_figure(data, title: str = ""):
         u2 = "" if c0["unit2"] in ("-", "") else f" [{c0['unit2']}]"
         ax.set_xlabel(f"{c0['path2']}{u2}")
     ax.set_ylabel(f"{data.path}{unit}")
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
-    if title:
-        ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    return fig
+    return _finished(fig, ax, title)
 
 
 def cost_of_transport_figure(data, title: str = ""):
