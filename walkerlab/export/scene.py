@@ -53,7 +53,7 @@ __all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "WHEEL_FORMATS", "Wheel
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
 #: The formats whose writers take a walker that is one rigid body on its spokes (a
-#: spoked wheel: :func:`walkerlab.export.multibody.wheel_urdf_text`, ``wheel_mjcf_text``);
+#: spoked wheel: :func:`walkerlab.export.spoked.wheel_urdf_text`, ``wheel_mjcf_text``);
 #: the Adams and OpenSim writers build a tree of leg links.
 WHEEL_FORMATS = ("urdf", "mjcf")
 
