@@ -137,7 +137,7 @@ import math
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import LENGTH_UNITS, ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.adams_actuation import (
     ACT_BLOCK,
     ACT_VARIABLES,
@@ -155,6 +155,7 @@ from walkerlab.export.adams_actuation import (
     hip_torque_ids,
     table_terms,
 )
+from walkerlab.export.adams_contact import contact_mm, contact_statements
 from walkerlab.export.adams_feet import (
     ANKLE_JOINT,
     ANKLE_SPRING,
@@ -226,39 +227,6 @@ def check_adams_exportable(mb) -> None:
                 abs(sum(c for _j, c in cp.terms) - 1.0) > 1e-12:
             raise ValueError(f"walker.torso: the coupling {cp.name} is not a weighted mean of "
                              "the hip joints, which a COUPLER of the hip revolutes cannot hold")
-
-
-def contact_mm(settings: ContactSettings) -> dict[str, float]:
-    """The scene's contact law in the file's mm-kg-s units.
-
-    A number the scene writes in mm-kg-s (``stiffness_family: paper``) is written as is;
-    otherwise the SI value of :func:`walkerlab.models.contact.rigid_limit.contact_si` is
-    converted (``k_mm = k_SI / 1000^e``, damping / 1000, lengths and speeds * 1000).
-
-    Returns
-    -------
-    dict
-        ``STIFFNESS`` [N/mm^e], ``EXPONENT``, ``DAMPING`` [N s/mm], ``DMAX`` [mm],
-        ``MU_STATIC``, ``MU_DYNAMIC``, ``STICTION_TRANSITION_VELOCITY``,
-        ``FRICTION_TRANSITION_VELOCITY`` [mm/s].
-    """
-    from walkerlab.models.contact.rigid_limit import contact_si
-
-    c, _ = contact_si(settings)
-    si = {"stiffness": c.k / MM ** c.e, "max_damping": c.cmax / MM,
-          "penetration_at_max_damping": c.dmax * MM, "stiction_velocity": c.v_s * MM,
-          "friction_velocity": c.v_d * MM}
-    out = {}
-    for q, v in si.items():
-        val, unit, _field = settings.written(q)
-        if settings.stiffness_family == "paper" and LENGTH_UNITS[unit] == 1e-3:
-            v = float(val)
-        out[q] = v
-    return {"STIFFNESS": out["stiffness"], "EXPONENT": float(c.e),
-            "DAMPING": out["max_damping"], "DMAX": out["penetration_at_max_damping"],
-            "MU_STATIC": float(c.mu_s), "MU_DYNAMIC": float(c.mu_d),
-            "STICTION_TRANSITION_VELOCITY": out["stiction_velocity"],
-            "FRICTION_TRANSITION_VELOCITY": out["friction_velocity"]}
 
 
 def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
@@ -442,23 +410,6 @@ def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
     return out
 
 
-def _contacts(mb, ids: dict, lanes: bool, n_patches: tuple, law: dict) -> list[str]:
-    """One CONTACT per foot sphere and patch of its lane (:func:`contact_pairs`)."""
-    out = ["!", "! ---- contact: IMPACT normal force + Coulomb friction, mm-kg-s ----"]
-    for cid, _leg, _role, m, g in contact_pairs(mb, ids, lanes, n_patches):
-        out += _stmt(f"CONTACT/{cid}, IGEOM={m}, JGEOM={g}",
-                     f"IMPACT, STIFFNESS={_f(law['STIFFNESS'])}, "
-                     f"EXPONENT={_f(law['EXPONENT'])}",
-                     f"DAMPING={_f(law['DAMPING'])}, DMAX={_f(law['DMAX'])}",
-                     f"COULOMB_FRICTION=ON, MU_STATIC={_f(law['MU_STATIC'])}, "
-                     f"MU_DYNAMIC={_f(law['MU_DYNAMIC'])}",
-                     "STICTION_TRANSITION_VELOCITY="
-                     f"{_f(law['STICTION_TRANSITION_VELOCITY'])}",
-                     "FRICTION_TRANSITION_VELOCITY="
-                     f"{_f(law['FRICTION_TRANSITION_VELOCITY'])}")
-    return out
-
-
 def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None) -> list[str]:
     """Hip springs (SPRINGDAMPER), knee stops (SFORCE with IMPACT) and flat feet's ankle
     springs (SPRINGDAMPER between the foot and its leg: ``feet`` of
@@ -591,7 +542,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     out += _joints(mb, start, ids)
     out += _forces(mb, scene, ids, feet)
     n = tuple(len(lane) for lane in start.lanes) if lanes else (1,)
-    out += _contacts(mb, ids, lanes, n, law)
+    out += contact_statements(mb, ids, lanes, n, law)
     out += actuation_statements(mb, scene, ids, n, lanes)
     out += _requests(mb, ids, feet)
     return "\n".join([*out, "END", ""])
