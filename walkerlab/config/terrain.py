@@ -11,21 +11,15 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import (
-    BaseModel,
-    BeforeValidator,
-    ConfigDict,
-    Field,
-    model_serializer,
-    model_validator,
-)
+from pydantic import BaseModel, BeforeValidator, Field, model_serializer, model_validator
 
 from walkerlab.config.base import _list_to_tuple
 
 __all__ = ["GROUND_KINDS", "LANE_KINDS", "PerStepTerrain", "TerrainSettings", "check_profile"]
 
-# Numbers are strict and finite, unknown keys rejected (as the contact sections').
-_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+# Numbers are strict and finite, unknown keys rejected (as the contact sections'; a pydantic
+# ``ConfigDict`` is this dict).
+_STRICT = {"extra": "forbid", "strict": True, "allow_inf_nan": False}
 
 
 def _points_to_tuples(v):

@@ -177,6 +177,7 @@ from walkerlab.export.adams_statements import (
     _rot,
     _stmt,
     marker_id,
+    part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.parts import export_part
@@ -236,9 +237,9 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
 
     Parameters
     ----------
-    scene : Scene
-    mb : Multibody
-    data : WalkerData
+    scene, mb, data
+        The scene, its walker as a :class:`~walkerlab.walker.multibody.Multibody` and its
+        ``WalkerData``.
     ideal : gait, optional
         The rigid gait (as :func:`walkerlab.export.scene.mjcf_scene` takes it); default:
         searched.
@@ -312,11 +313,7 @@ def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = N
         vcm = vjoint + w * np.array((-r[1], r[0]))
         inertia = ln.inertia_kg_m2 * MM * MM  # about z (planar) and x; none along the axis
         out += [f"! {ln.name}: {ln.mass_kg:g} kg, joint {ln.joint}"]
-        out += _stmt(f"PART/{p}, MASS={_f(ln.mass_kg)}, CM={marker_id(p, 'cm')}",
-                     f"IP={_fs(inertia, 0.0, inertia)}",
-                     f"QG={_fs(joint[0] * MM, joint[1] * MM, 0.0)}",
-                     f"REULER={_deg(psi)}, 0.0D, 0.0D", f"VX={_f(vcm[0] * MM)}",
-                     f"VY={_f(vcm[1] * MM)}", f"WZ={_f(w)}")
+        out += part_statement(p, ln.mass_kg, inertia, joint, 0.0, psi, vcm, w)
         out += _stmt(f"MARKER/{marker_id(p, 'cm')}, PART={p}",
                      f"QP={_fs(com[0] * MM, com[1] * MM, 0.0)}")
         out.append(f"MARKER/{marker_id(p, 'joint')}, PART={p}, QP=0.0, 0.0, 0.0")

@@ -113,13 +113,9 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
 
     Parameters
     ----------
-    data : WalkerData
-        From :func:`walkerlab.walker.description.walker_data` (``structure.spokes`` > 0).
-    name, version : str
-        Model name, walkerlab version (header comment).
-    hub_inertia_kg_m2 : float, optional
-        A point-mass hub's inertia [kg m^2] (``contact.hub_inertia_kg_m2``; default
-        :data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
+    data, name, version, hub_inertia_kg_m2
+        The wheel, model name, walkerlab version and hub inertia, as for
+        :func:`wheel_urdf_text`.
     qpos, qvel : sequence of 3 floats, optional
         A keyframe ``gait`` [m, m, rad] and [m/s, m/s, rad/s] (the floating view's state
         ``[hip_x, hip_y, wheel_angle]`` and its rates: MuJoCo's z is walkerlab's y).
