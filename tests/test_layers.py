@@ -498,7 +498,7 @@ def _kind_switch_reads(tree: ast.Module) -> list[int]:
 #: modules outside walker/, codegen/ and config/ that may still read a kind switch (at most
 #: three): the wheel's spoke count in its exported parameters (a number, not a branch), and a
 #: check of the generated contact source whose text keys the compiled-module cache
-KIND_SWITCH_READERS = {"export/multibody.py", "models/contact/generated.py"}
+KIND_SWITCH_READERS = {"export/spoked.py", "models/contact/generated.py"}
 
 
 def test_the_walker_kind_is_chosen_once_and_the_layers_consult_it():

@@ -58,31 +58,55 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     if hip is not None and n_cyc >= 1:
         i0, i1 = bounds[0], bounds[2 * n_cyc]
         out["v_com_m_per_s"] = float((hip[0, i1] - hip[0, i0]) / (tr.time[i1] - tr.time[i0]))
-        feet = [tr.points.get(f"{leg}_foot") for leg in tr.legs]
-        # flat feet: heel to heel, from where the stance heel landed (the step's first
-        # sample) to where the swing heel lands (the stance foot is heeled off by then and
-        # its "foot" point, the ankle, is not on the ground)
-        heels = [tr.points.get(f"{leg}_heel") for leg in tr.legs]
-        flat = all(h is not None for h in heels)
-        if all(f is not None for f in feet):
-            lengths, left_step = [], []
-            for k in range(1, int(done.sum()) + 1):
-                i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
-                st = int(stance[k - 1])
-                d = (heels[1 - st][:, i] - heels[st][:, bounds[k - 1]] if flat
-                     else feet[0][:, i] - feet[1][:, i])
-                lengths.append(np.hypot(*d))
-                left_step.append(stance[k - 1] != li)
-            out["step_length_m"] = float(np.mean(lengths)) if lengths else np.nan
-            lengths, left_step = np.array(lengths), np.array(left_step, dtype=bool)
-            # per leg (legs that differ take steps of two lengths): the step its swing ends
-            for side, m in (("left", left_step), ("right", ~left_step)):
-                out[f"step_length_{side}_m"] = (float(np.mean(lengths[m])) if m.any()
-                                                else np.nan)
+        out.update(_step_lengths(tr, bounds, stance, done, li))
     else:
         out["v_com_m_per_s"] = np.nan
     out.setdefault("step_length_m", np.nan)
-    iE = bounds[min(n_energy_steps, periods.size)]
+    out.update(_energies(tr, bounds[min(n_energy_steps, periods.size)], mass_kg, g))
+    return out
+
+
+def table3(trajectories: dict[str, NamedTrajectory], mass_kg: float,
+           g: float) -> dict[str, dict[str, float]]:
+    """Table 3 columns of loaded trajectories ``{label: NamedTrajectory}`` (total mass
+    ``mass_kg`` [kg], gravity ``g`` [m/s^2])."""
+    return {label: gait_metrics(tr, mass_kg=mass_kg, g=g) for label, tr in trajectories.items()}
+
+
+def _step_lengths(tr: NamedTrajectory, bounds, stance, done, li: int) -> dict[str, float]:
+    """:func:`gait_metrics`' step lengths over the complete steps (``done``; steps between
+    ``bounds``, stance legs ``stance``, ``li`` the left leg): ``step_length_m`` and per leg
+    ``step_length_left_m``, ``step_length_right_m``; none without both feet's points."""
+    out = {}
+    feet = [tr.points.get(f"{leg}_foot") for leg in tr.legs]
+    # flat feet: heel to heel, from where the stance heel landed (the step's first
+    # sample) to where the swing heel lands (the stance foot is heeled off by then and
+    # its "foot" point, the ankle, is not on the ground)
+    heels = [tr.points.get(f"{leg}_heel") for leg in tr.legs]
+    flat = all(h is not None for h in heels)
+    if all(f is not None for f in feet):
+        lengths, left_step = [], []
+        for k in range(1, int(done.sum()) + 1):
+            i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
+            st = int(stance[k - 1])
+            d = (heels[1 - st][:, i] - heels[st][:, bounds[k - 1]] if flat
+                 else feet[0][:, i] - feet[1][:, i])
+            lengths.append(np.hypot(*d))
+            left_step.append(stance[k - 1] != li)
+        out["step_length_m"] = float(np.mean(lengths)) if lengths else np.nan
+        lengths, left_step = np.array(lengths), np.array(left_step, dtype=bool)
+        # per leg (legs that differ take steps of two lengths): the step its swing ends
+        for side, m in (("left", left_step), ("right", ~left_step)):
+            out[f"step_length_{side}_m"] = (float(np.mean(lengths[m])) if m.any()
+                                            else np.nan)
+    return out
+
+
+def _energies(tr: NamedTrajectory, iE: int, mass_kg: float | None, g: float
+              ) -> dict[str, float]:
+    """:func:`gait_metrics`' time-averaged energies up to sample ``iE``: ``E_avg_J`` and,
+    with ``mass_kg``, ``E_avg_stance_frame_J``."""
+    out = {}
     sl = slice(0, max(iE, 2))
     tt = tr.time[sl]
     out["E_avg_J"] = float(np.trapezoid(tr.total[sl], tt) / (tt[-1] - tt[0]))
@@ -96,10 +120,3 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
         e_st = tr.total[sl] - mass_kg * g * y_st
         out["E_avg_stance_frame_J"] = float(np.trapezoid(e_st, tt) / (tt[-1] - tt[0]))
     return out
-
-
-def table3(trajectories: dict[str, NamedTrajectory], mass_kg: float,
-           g: float) -> dict[str, dict[str, float]]:
-    """Table 3 columns of loaded trajectories ``{label: NamedTrajectory}`` (total mass
-    ``mass_kg`` [kg], gravity ``g`` [m/s^2])."""
-    return {label: gait_metrics(tr, mass_kg=mass_kg, g=g) for label, tr in trajectories.items()}

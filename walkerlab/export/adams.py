@@ -137,7 +137,7 @@ import math
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import LENGTH_UNITS, ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.adams_actuation import (
     ACT_BLOCK,
     ACT_VARIABLES,
@@ -155,6 +155,7 @@ from walkerlab.export.adams_actuation import (
     hip_torque_ids,
     table_terms,
 )
+from walkerlab.export.adams_contact import contact_mm, contact_statements
 from walkerlab.export.adams_feet import (
     ANKLE_JOINT,
     ANKLE_SPRING,
@@ -176,6 +177,7 @@ from walkerlab.export.adams_statements import (
     _rot,
     _stmt,
     marker_id,
+    part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.parts import export_part
@@ -228,39 +230,6 @@ def check_adams_exportable(mb) -> None:
                              "the hip joints, which a COUPLER of the hip revolutes cannot hold")
 
 
-def contact_mm(settings: ContactSettings) -> dict[str, float]:
-    """The scene's contact law in the file's mm-kg-s units.
-
-    A number the scene writes in mm-kg-s (``stiffness_family: paper``) is written as is;
-    otherwise the SI value of :func:`walkerlab.models.contact.rigid_limit.contact_si` is
-    converted (``k_mm = k_SI / 1000^e``, damping / 1000, lengths and speeds * 1000).
-
-    Returns
-    -------
-    dict
-        ``STIFFNESS`` [N/mm^e], ``EXPONENT``, ``DAMPING`` [N s/mm], ``DMAX`` [mm],
-        ``MU_STATIC``, ``MU_DYNAMIC``, ``STICTION_TRANSITION_VELOCITY``,
-        ``FRICTION_TRANSITION_VELOCITY`` [mm/s].
-    """
-    from walkerlab.models.contact.rigid_limit import contact_si
-
-    c, _ = contact_si(settings)
-    si = {"stiffness": c.k / MM ** c.e, "max_damping": c.cmax / MM,
-          "penetration_at_max_damping": c.dmax * MM, "stiction_velocity": c.v_s * MM,
-          "friction_velocity": c.v_d * MM}
-    out = {}
-    for q, v in si.items():
-        val, unit, _field = settings.written(q)
-        if settings.stiffness_family == "paper" and LENGTH_UNITS[unit] == 1e-3:
-            v = float(val)
-        out[q] = v
-    return {"STIFFNESS": out["stiffness"], "EXPONENT": float(c.e),
-            "DAMPING": out["max_damping"], "DMAX": out["penetration_at_max_damping"],
-            "MU_STATIC": float(c.mu_s), "MU_DYNAMIC": float(c.mu_d),
-            "STICTION_TRANSITION_VELOCITY": out["stiction_velocity"],
-            "FRICTION_TRANSITION_VELOCITY": out["friction_velocity"]}
-
-
 def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
     """The rigid gait's post-impact state (leg2 in stance, its foot at the origin), its rates
     times ``contact_sim.initial_rate_scale`` (the paper's Table 2 adjustment), and the
@@ -268,9 +237,9 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
 
     Parameters
     ----------
-    scene : Scene
-    mb : Multibody
-    data : WalkerData
+    scene, mb, data
+        The scene, its walker as a :class:`~walkerlab.walker.multibody.Multibody` and its
+        ``WalkerData``.
     ideal : gait, optional
         The rigid gait (as :func:`walkerlab.export.scene.mjcf_scene` takes it); default:
         searched.
@@ -344,11 +313,7 @@ def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = N
         vcm = vjoint + w * np.array((-r[1], r[0]))
         inertia = ln.inertia_kg_m2 * MM * MM  # about z (planar) and x; none along the axis
         out += [f"! {ln.name}: {ln.mass_kg:g} kg, joint {ln.joint}"]
-        out += _stmt(f"PART/{p}, MASS={_f(ln.mass_kg)}, CM={marker_id(p, 'cm')}",
-                     f"IP={_fs(inertia, 0.0, inertia)}",
-                     f"QG={_fs(joint[0] * MM, joint[1] * MM, 0.0)}",
-                     f"REULER={_deg(psi)}, 0.0D, 0.0D", f"VX={_f(vcm[0] * MM)}",
-                     f"VY={_f(vcm[1] * MM)}", f"WZ={_f(w)}")
+        out += part_statement(p, ln.mass_kg, inertia, joint, 0.0, psi, vcm, w)
         out += _stmt(f"MARKER/{marker_id(p, 'cm')}, PART={p}",
                      f"QP={_fs(com[0] * MM, com[1] * MM, 0.0)}")
         out.append(f"MARKER/{marker_id(p, 'joint')}, PART={p}, QP=0.0, 0.0, 0.0")
@@ -439,23 +404,6 @@ def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
             out += _stmt(f"GRAPHICS/{gid}, BOX, CORNER={gid}",
                          f"X={_f(length * MM)}, Y={_f(depth * MM)}, Z={_f(zw * MM)}")
             gid += 1
-    return out
-
-
-def _contacts(mb, ids: dict, lanes: bool, n_patches: tuple, law: dict) -> list[str]:
-    """One CONTACT per foot sphere and patch of its lane (:func:`contact_pairs`)."""
-    out = ["!", "! ---- contact: IMPACT normal force + Coulomb friction, mm-kg-s ----"]
-    for cid, _leg, _role, m, g in contact_pairs(mb, ids, lanes, n_patches):
-        out += _stmt(f"CONTACT/{cid}, IGEOM={m}, JGEOM={g}",
-                     f"IMPACT, STIFFNESS={_f(law['STIFFNESS'])}, "
-                     f"EXPONENT={_f(law['EXPONENT'])}",
-                     f"DAMPING={_f(law['DAMPING'])}, DMAX={_f(law['DMAX'])}",
-                     f"COULOMB_FRICTION=ON, MU_STATIC={_f(law['MU_STATIC'])}, "
-                     f"MU_DYNAMIC={_f(law['MU_DYNAMIC'])}",
-                     "STICTION_TRANSITION_VELOCITY="
-                     f"{_f(law['STICTION_TRANSITION_VELOCITY'])}",
-                     "FRICTION_TRANSITION_VELOCITY="
-                     f"{_f(law['FRICTION_TRANSITION_VELOCITY'])}")
     return out
 
 
@@ -591,7 +539,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     out += _joints(mb, start, ids)
     out += _forces(mb, scene, ids, feet)
     n = tuple(len(lane) for lane in start.lanes) if lanes else (1,)
-    out += _contacts(mb, ids, lanes, n, law)
+    out += contact_statements(mb, ids, lanes, n, law)
     out += actuation_statements(mb, scene, ids, n, lanes)
     out += _requests(mb, ids, feet)
     return "\n".join([*out, "END", ""])

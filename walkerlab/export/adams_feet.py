@@ -15,13 +15,13 @@ from walkerlab.export.adams_statements import (
     MM,
     AdamsStart,
     _chain_sum,
-    _deg,
     _f,
     _fs,
     _rot,
     _stmt,
     _var,
     marker_id,
+    part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
 
@@ -254,11 +254,7 @@ def _flat_foot_parts(mb, start: AdamsStart, ids: dict, lanes: bool, frames: dict
         p = ids[f"{leg}_foot"]
         zl = LANE_Z[leg] * mb.leg_length_m * MM if lanes else 0.0
         out += [f"! {leg}_foot: {mass:g} kg at the ankle, heel {heel:g} m, toe {toe:g} m"]
-        out += _stmt(f"PART/{p}, MASS={_f(mass)}, CM={marker_id(p, 'cm')}",
-                     f"IP={_fs(inertia * MM * MM, 0.0, inertia * MM * MM)}",
-                     f"QG={_fs(pos[0] * MM, pos[1] * MM, zl)}",
-                     f"REULER={_deg(psi + a)}, 0.0D, 0.0D", f"VX={_f(vel[0] * MM)}",
-                     f"VY={_f(vel[1] * MM)}", f"WZ={_f(w + da)}")
+        out += part_statement(p, mass, inertia * MM * MM, pos, zl, psi + a, vel, w + da)
         out += [f"MARKER/{marker_id(p, 'cm')}, PART={p}, QP=0.0, 0.0, 0.0",
                 f"MARKER/{marker_id(p, 'joint')}, PART={p}, QP=0.0, 0.0, 0.0"]
         d = 2 * _foot_sphere_m(mb) * MM

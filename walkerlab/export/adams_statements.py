@@ -7,7 +7,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["LANE_Z", "LINE_WIDTH", "MARKER_OFFSET", "MM", "AdamsStart", "marker_id"]
+__all__ = ["LANE_Z", "LINE_WIDTH", "MARKER_OFFSET", "MM", "AdamsStart", "marker_id",
+           "part_statement"]
 
 #: Millimetres per metre (the file's length unit).
 MM = 1000.0
@@ -118,3 +119,14 @@ def _chain_sum(first: int, out_id: int, terms: list[str]) -> list[str]:
         acc, vid = target, vid + 1
     return lines
 
+
+def part_statement(p: int, mass: float, inertia: float, pos, z: float, psi: float, vel,
+                   w: float) -> list[str]:
+    """The ``PART`` statement of part ``p``: mass [kg], inertia [kg mm^2] about z and x (none
+    along the link's axis), its frame at ``pos`` [m] (x, y) and ``z`` [mm], turned by ``psi``
+    [rad], moving at ``vel`` [m/s] and ``w`` [rad/s] (markers ``cm`` and ``joint``)."""
+    return _stmt(f"PART/{p}, MASS={_f(mass)}, CM={marker_id(p, 'cm')}",
+                 f"IP={_fs(inertia, 0.0, inertia)}",
+                 f"QG={_fs(pos[0] * MM, pos[1] * MM, z)}",
+                 f"REULER={_deg(psi)}, 0.0D, 0.0D", f"VX={_f(vel[0] * MM)}",
+                 f"VY={_f(vel[1] * MM)}", f"WZ={_f(w)}")

@@ -105,7 +105,8 @@ from walkerlab.export.mjcf_scene import (
     point_foot_radius,
 )
 from walkerlab.export.parts import export_part
-from walkerlab.export.text import arc_feet, comment, header, num, nums
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_mjcf_text, wheel_urdf_text
+from walkerlab.export.text import AXIS, arc_feet, comment, header, num, nums
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.config.actuation import Actuation
@@ -121,8 +122,6 @@ FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
 SIDECAR = "walker.gait.json"
 #: ``solimp`` of a coupling's equality: the largest impedance MuJoCo accepts (mjMAXIMP).
 COUPLING_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
-#: Joint-axis of every hinge: world -y, so that a positive angle moves the foot ahead.
-AXIS = "0 -1 0"
 
 
 def urdf_text(mb: Multibody, name: str, version: str = "",
@@ -379,12 +378,9 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
 
     Parameters
     ----------
-    mb : Multibody
-        From :func:`walkerlab.walker.multibody.multibody`.
-    name : str
-        Model name (the scene's name).
-    version : str
-        walkerlab version, for the header comment.
+    mb, name, version
+        The walker, model name (the scene's name) and walkerlab version, as for
+        :func:`urdf_text`.
     extra : MjcfScene, optional
         The gait keyframe, terrain, contact setting and knee latch of the scene; without it
         a plane through the feet and MuJoCo's default contact.
@@ -569,157 +565,3 @@ def comments_in_scene_units(text: str, units) -> str:
     unit = re.compile(r"(?:(?<=\d )|(?<=\[))(m/s\^2|kg m\^2|kg|m|s)(?=[\];.,) ])")
     return "\n".join(unit.sub(lambda m: units(m.group(1)), ln)
                      if ln.lstrip().startswith("<!--") else ln for ln in text.split("\n"))
-
-
-# ---------------------------------------------------------------------------- the rimless wheel
-#: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
-#: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
-WHEEL_TIP_FRACTION = 1e-3
-
-
-def _wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
-    """A spoked wheel's numbers by name (:data:`walkerlab.walker.description.SPOKED_PARAMS`)
-    with its hub inertia [kg m^2]: the walker's, else ``hub_inertia_kg_m2`` (the contact
-    view's regularisation), else :data:`MJCF_MIN_INERTIA_KG_M2`."""
-    p = dict(zip(data.structure.param_names, data.params))
-    if p["I_hub"] <= 0.0:
-        p["I_hub"] = hub_inertia_kg_m2 if hub_inertia_kg_m2 is not None else MJCF_MIN_INERTIA_KG_M2
-    p["n"] = data.structure.spokes
-    p["r"] = WHEEL_TIP_FRACTION * p["L"]
-    return p
-
-
-def _spoke_tip(p: dict, k: int, to: float) -> tuple[float, float]:
-    """(x, z) [m] in the hub's frame of the point at ``to`` [m] along spoke ``k`` (wheel
-    angle 0: spoke 0 hangs straight down; spoke k at ``2 pi k / n`` ahead of it)."""
-    psi = 2.0 * math.pi * k / p["n"]
-    return to * math.sin(psi), -to * math.cos(psi)
-
-
-def _wheel_header(name: str, fmt: str, version: str, p: dict, slope: float) -> list[str]:
-    return [comment(f"rimless wheel {name!s} exported by walkerlab {version} ({fmt})."),
-            comment("Planar wheel in the x-z plane: x downhill (horizontal), z up; joints "
-                    "hip_x, hip_z (the hub's position) and wheel (spoke 0's angle from the "
-                    "downward vertical, axis -y: positive = its tip ahead of the hub)."),
-            comment(f"{p['n']} massless spokes of length {num(p['L'])} m, 2 pi / {p['n']} "
-                    f"apart, on a hub of mass {num(p['M_hub'])} kg and inertia "
-                    f"{num(p['I_hub'])} kg m^2; a sphere of radius {num(p['r'])} m at each "
-                    f"spoke's tip (its lowest point at the spoke length); gravity "
-                    f"{num(p['g'])} m/s^2; the ground falls towards +x at {num(slope)} rad "
-                    "(McGeer 1990; Coleman, Chatterjee & Ruina 1997).")]
-
-
-def wheel_urdf_text(data, name: str, version: str = "",
-                    hub_inertia_kg_m2: float | None = None) -> str:
-    """A rimless wheel (``model: rimless_wheel``) as URDF: a massless carriage on two
-    prismatic joints (``hip_x``, ``hip_z``), the hub on a continuous joint ``wheel`` (axis
-    -y), each spoke a capsule-like cylinder (visual) and a sphere at its tip (collision).
-
-    Parameters
-    ----------
-    data : WalkerData
-        From :func:`walkerlab.walker.description.walker_data` (``structure.spokes`` > 0).
-    name, version : str
-        Model name, walkerlab version (header comment).
-    hub_inertia_kg_m2 : float, optional
-        A point-mass hub's inertia [kg m^2] (``contact.hub_inertia_kg_m2``; default
-        :data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
-
-    Returns
-    -------
-    str
-        URDF XML (ROS URDF XML specification).
-    """
-    p = _wheel_numbers(data, hub_inertia_kg_m2)
-    L, r = p["L"], p["r"]
-    out = ['<?xml version="1.0"?>', *_wheel_header(name, "URDF", version, p, data.slope_rad),
-           f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
-           '  <link name="carriage_x"/>', '  <link name="carriage"/>',
-           '  <joint name="hip_x" type="prismatic"><parent link="world"/>'
-           '<child link="carriage_x"/><axis xyz="1 0 0"/>'
-           '<limit lower="-1000" upper="1000" effort="0" velocity="1000"/></joint>',
-           '  <joint name="hip_z" type="prismatic"><parent link="carriage_x"/>'
-           '<child link="carriage"/><axis xyz="0 0 1"/>'
-           '<limit lower="-1000" upper="1000" effort="0" velocity="1000"/></joint>',
-           '  <link name="hub">',
-           f'    <inertial><origin xyz="0 0 0"/><mass value="{num(p["M_hub"])}"/>'
-           f'<inertia ixx="{num(p["I_hub"])}" ixy="0" ixz="0" iyy="{num(p["I_hub"])}" iyz="0" '
-           f'izz="{num(p["I_hub"])}"/></inertial>']
-    for k in range(p["n"]):
-        mx, mz = _spoke_tip(p, k, (L - r) / 2)
-        tx, tz = _spoke_tip(p, k, L - r)
-        pitch = -2.0 * math.pi * k / p["n"]  # the cylinder's z axis turned onto the spoke
-        out += [f'    <visual name="spoke{k}"><origin xyz="{nums(mx, 0, mz)}" '
-                f'rpy="0 {num(pitch)} 0"/><geometry><cylinder radius="{num(L / 100)}" '
-                f'length="{num(L - r)}"/></geometry></visual>',
-                f'    <collision name="spoke{k}_tip"><origin xyz="{nums(tx, 0, tz)}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
-    out += ["  </link>", '  <joint name="wheel" type="continuous"><parent link="carriage"/>'
-            '<child link="hub"/><axis xyz="0 -1 0"/></joint>', "</robot>", ""]
-    return "\n".join(out)
-
-
-def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float | None = None,
-                    qpos=None, qvel=None, timestep_s: float = 1e-4,
-                    solref=(0.002, 1.0), friction: float = 1.0) -> str:
-    """A rimless wheel (``model: rimless_wheel``) as a MuJoCo model (MJCF): the ground plane
-    tilted by the slope, the hub body on slide joints ``hip_x``, ``hip_z`` and a hinge
-    ``wheel`` (axis -y), each spoke a capsule (no contact) and a sphere ``spoke<k>_tip`` at
-    its tip (the only geoms that touch the ground).
-
-    Parameters
-    ----------
-    data : WalkerData
-        From :func:`walkerlab.walker.description.walker_data` (``structure.spokes`` > 0).
-    name, version : str
-        Model name, walkerlab version (header comment).
-    hub_inertia_kg_m2 : float, optional
-        A point-mass hub's inertia [kg m^2] (``contact.hub_inertia_kg_m2``; default
-        :data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
-    qpos, qvel : sequence of 3 floats, optional
-        A keyframe ``gait`` [m, m, rad] and [m/s, m/s, rad/s] (the floating view's state
-        ``[hip_x, hip_y, wheel_angle]`` and its rates: MuJoCo's z is walkerlab's y).
-    timestep_s : float
-        Integration step [s].
-    solref : (float, float)
-        MuJoCo's contact time constant [s] and damping ratio [-] (critically damped: the
-        plastic impact of the rigid view).
-    friction : float
-        Sliding friction coefficient [-].
-
-    Returns
-    -------
-    str
-        MJCF XML (MuJoCo XML Reference).
-    """
-    p = _wheel_numbers(data, hub_inertia_kg_m2)
-    L, r, phi = p["L"], p["r"], data.slope_rad
-    out = [*_wheel_header(name, "MJCF", version, p, phi), f"<mujoco model={quoteattr(name)}>",
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-           f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(timestep_s)}" '
-           'integrator="implicitfast"/>',
-           f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-           f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
-           '</default>',
-           "  <worldbody>",
-           f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
-           'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
-           '    <body name="hub" pos="0 0 0">',
-           '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
-           '      <joint name="hip_z" type="slide" axis="0 0 1"/>',
-           f'      <joint name="wheel" type="hinge" axis="{AXIS}"/>',
-           f'      <inertial pos="0 0 0" mass="{num(p["M_hub"])}" '
-           f'diaginertia="{nums(p["I_hub"], p["I_hub"], p["I_hub"])}"/>',
-           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>']
-    for k in range(p["n"]):
-        tx, tz = _spoke_tip(p, k, L - r)
-        out += [f'      <geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
-                f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
-                f'      <geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
-                f'pos="{nums(tx, 0, tz)}" contype="1" conaffinity="1"/>']
-    out += ["    </body>", "  </worldbody>"]
-    if qpos is not None:
-        qv = (0.0, 0.0, 0.0) if qvel is None else qvel
-        out += ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
-                "  </keyframe>"]
-    return "\n".join(out + ["</mujoco>", ""])

@@ -53,7 +53,7 @@ __all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "WHEEL_FORMATS", "Wheel
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
 #: The formats whose writers take a walker that is one rigid body on its spokes (a
-#: spoked wheel: :func:`walkerlab.export.multibody.wheel_urdf_text`, ``wheel_mjcf_text``);
+#: spoked wheel: :func:`walkerlab.export.spoked.wheel_urdf_text`, ``wheel_mjcf_text``);
 #: the Adams and OpenSim writers build a tree of leg links.
 WHEEL_FORMATS = ("urdf", "mjcf")
 
@@ -228,7 +228,6 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
-    from walkerlab.models.contact.scene import ideal_step_length
 
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain or TerrainSettings()
@@ -248,31 +247,48 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     elif not terrain.is_slope:
         lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
     if terrain.lanes == "checkerboard":
-        # the keyframe's feet are one step apart: leg2's step, the last of the gait's map
-        # (stairs, footholds: the footholds' spacing, along the slope)
-        ell2 = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
-        ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
-        # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
-        # (exact for point feet), else footfalls drift off the patches stride by stride
-        k = np.arange(EXPORT_STEPS // 2 + 1)
-        if len(ells) == 2:
-            ell1 = ell2 + (ells[0] - ells[1])
-            lanes = (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
-        else:
-            lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
-        lanes = feet_part.footprints(lanes, data)
+        lanes = feet_part.footprints(_checkerboard(walker, ideal, terrain), data)
     latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
     notes = _walker_notes(scene, part, ideal, latch, knee, notes)
     notes += feet_part.notes
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
+    if treads is not None or profile is not None:
+        lanes = None  # continuous stairs (the treads) or a profile (a height field) is the ground
+    terrain_notes += _ground_notes(terrain, treads, profile, lane_heights)
+    return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
+                     0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
+                     dt, solref, solimp, mu, latch, notes + terrain_notes, scene.walker.actuation,
+                     dt, ahead,  # the push-off over one timestep: the rigid model's impulse
+                     feet, lane_heights, treads, profile)
+
+
+def _checkerboard(walker, ideal, terrain: TerrainSettings) -> tuple:
+    """The checkerboard's footfalls ``(leg1's, leg2's)`` along the ground [m], before the
+    feet's :meth:`footprints`: the keyframe's feet are one step apart, leg2's step (the last
+    of the gait's map; stairs, footholds: the footholds' spacing, along the slope)."""
+    from walkerlab.models.contact.scene import ideal_step_length
+
+    ell2 = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
+    ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
+    # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
+    # (exact for point feet), else footfalls drift off the patches stride by stride
+    k = np.arange(EXPORT_STEPS // 2 + 1)
+    if len(ells) == 2:
+        ell1 = ell2 + (ells[0] - ells[1])
+        return (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
+    return (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
+
+
+def _ground_notes(terrain: TerrainSettings, treads, profile, lane_heights) -> tuple:
+    """The MJCF's comments on a ground that is not the plain slope (stairs, a profile,
+    footholds)."""
+    terrain_notes = ()
     if treads is not None:
-        lanes = None  # continuous stairs: the treads are the ground
         terrain_notes += (f"Stairs (terrain: riser {terrain.riser_m:g} m "
                           f"{terrain.direction or 'down'}, tread {terrain.tread_m:g} m): a box "
                           "per tread (geoms tread<i>), its top the tread, its faces the "
                           "risers.",)
     elif profile is not None:
-        lanes = None
         terrain_notes += ("Profile (terrain.kind: profile, lanes: continuous): a height field "
                           "hfield 'profile' sampled every 5 mm from its polyline, the first "
                           "stance foot on its first point (both feet touch it).",)
@@ -280,11 +296,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         terrain_notes += ("Footholds (terrain.kind: " + terrain.kind + "): the checkerboard "
                           "patches at the rigid gait's footholds, each at its tread's height "
                           "(a riser below or above the last).",)
-    return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
-                     0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
-                     dt, solref, solimp, mu, latch, notes + terrain_notes, scene.walker.actuation,
-                     dt, ahead,  # the push-off over one timestep: the rigid model's impulse
-                     feet, lane_heights, treads, profile)
+    return terrain_notes
 
 
 def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) -> tuple:

@@ -11,7 +11,10 @@ from walkerlab.export.parts import export_part
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["arc_feet", "comment", "header", "num", "nums"]
+__all__ = ["AXIS", "arc_feet", "comment", "header", "num", "nums"]
+
+#: Joint-axis of every hinge: world -y, so that a positive angle moves the foot ahead.
+AXIS = "0 -1 0"
 
 
 def num(x: float) -> str:

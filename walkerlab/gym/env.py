@@ -115,6 +115,33 @@ class InvalidAction(ValueError, gym.error.InvalidAction):
     (a ``ValueError`` and gymnasium's ``InvalidAction``)."""
 
 
+def _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
+                     terrain_roughness_m) -> None:
+    """Refuse :class:`WalkerEnv`'s arguments out of their ranges (one line naming the
+    argument)."""
+    if view not in ("rigid", "contact"):
+        raise ValueError(f"view={view!r}: give 'rigid' or 'contact'")
+    if not (isinstance(control_period_s, (int, float)) and not isinstance(
+            control_period_s, bool) and 0 < control_period_s <= 1.0
+            and math.isfinite(control_period_s)):
+        raise ValueError(f"control_period_s={control_period_s!r}: give a positive number "
+                         "of seconds, at most 1")
+    if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, int) \
+            or max_episode_steps < 1:
+        raise ValueError(f"max_episode_steps={max_episode_steps!r}: give a whole number "
+                         ">= 1")
+    if render_mode not in (None, "rgb_array"):
+        raise ValueError(f"render_mode={render_mode!r}: give None or 'rgb_array'")
+    for name, v in (("start_noise", start_noise),
+                    ("terrain_roughness_m", terrain_roughness_m)):
+        if not (isinstance(v, (int, float)) and not isinstance(v, bool)
+                and math.isfinite(v) and v >= 0):
+            raise ValueError(f"{name}={v!r}: give a number >= 0")
+    if start_noise > MAX_START_NOISE:
+        raise ValueError(f"start_noise={start_noise!r}: give a relative noise in [0, "
+                         f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
+
+
 class WalkerEnv(gym.Env):
     """A walkerlab scene's walker as a Gymnasium environment (module docstring: spaces,
     reward, episode, info).
@@ -181,27 +208,8 @@ class WalkerEnv(gym.Env):
         from .action import action_joints, action_limits, action_torques
         from .rigid_view import RigidView
 
-        if view not in ("rigid", "contact"):
-            raise ValueError(f"view={view!r}: give 'rigid' or 'contact'")
-        if not (isinstance(control_period_s, (int, float)) and not isinstance(
-                control_period_s, bool) and 0 < control_period_s <= 1.0
-                and math.isfinite(control_period_s)):
-            raise ValueError(f"control_period_s={control_period_s!r}: give a positive number "
-                             "of seconds, at most 1")
-        if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, int) \
-                or max_episode_steps < 1:
-            raise ValueError(f"max_episode_steps={max_episode_steps!r}: give a whole number "
-                             ">= 1")
-        if render_mode not in (None, "rgb_array"):
-            raise ValueError(f"render_mode={render_mode!r}: give None or 'rgb_array'")
-        for name, v in (("start_noise", start_noise),
-                        ("terrain_roughness_m", terrain_roughness_m)):
-            if not (isinstance(v, (int, float)) and not isinstance(v, bool)
-                    and math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name}={v!r}: give a number >= 0")
-        if start_noise > MAX_START_NOISE:
-            raise ValueError(f"start_noise={start_noise!r}: give a relative noise in [0, "
-                             f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
+        _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
+                         terrain_roughness_m)
         self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)

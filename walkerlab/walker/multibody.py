@@ -230,13 +230,28 @@ def multibody(data: WalkerData) -> Multibody:
     """
     s = data.structure
     check_floating_view(s)
-    if s.spokes:  # one rigid body, no links: walkerlab.export.multibody's wheel branch
+    if s.spokes:  # one rigid body, no links: walkerlab.export.spoked
         raise ValueError("walker.model: rimless_wheel is one rigid body, not a tree of leg "
-                         "links: its URDF/MJCF come from walkerlab.export.multibody's "
+                         "links: its URDF/MJCF come from walkerlab.export.spoked's "
                          "wheel_urdf_text / wheel_mjcf_text")
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
     lt, R = p["L_thigh"] if s.knee else 0.0, p["R_foot"] if s.foot == "arc" else 0.0
+    links = _leg_links(s, p, L, lt, R)
+    couplings = ()
+    if s.torso:
+        torso, couplings = _torso(s, p, L)
+        links.append(torso)
+    springs = _springs(s, p)
+    return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
+                     data.slope_rad, tuple(springs), couplings, not s.free_knees,
+                     s.kind.name)
+
+
+def _leg_links(s, p: dict, L: float, lt: float, R: float) -> list[Link]:
+    """Both legs' links (``leg<i>`` or ``leg<i>_thigh``, ``leg<i>_shank``) from the bodies
+    of structure ``s`` and the named parameters ``p``: the first step's numbers (with legs
+    that differ leg1's are the swing role's)."""
     segments = ("thigh", "shank") if s.knee else ("leg",)
     # the first step's numbers: with legs that differ leg1's are the swing role's (``sw``)
     tags = ("sw_", "st_") if s.asymmetric else ("", "")
@@ -264,18 +279,28 @@ def multibody(data: WalkerData) -> Multibody:
             else:
                 links.append(Link(name, "hip", f"{leg}_hip", 0.0, L, m, c, inertia,
                                   foot_from_hip, ce))
-    couplings = ()
-    if s.torso:  # bodies d up the torso's axis: -d along the link's downward axis
-        parts = [(p[f"m_torso_{b.name}"], -p[f"d_torso_{b.name}"],
-                  p.get(f"I_torso_{b.name}", 0.0), b.name, p.get(f"e_torso_{b.name}", 0.0))
-                 for b in s.torso]
-        m, c, inertia, ce = _combine("torso", parts)
-        height = max(max(-x[1] for x in parts), L / 10)
-        links.append(Link("torso", "hip", "torso_hip", 0.0, height, m, c, inertia, None, ce,
-                          up=True))
-        if not s.hinged_torso:  # a hinged torso (five-link biped): a free joint of its own
-            couplings = (Coupling("bisecting_hip", "torso_hip",
-                                  tuple((f"{leg}_hip", 0.5) for leg in LEGS)),)
+    return links
+
+
+def _torso(s, p: dict, L: float) -> tuple[Link, tuple[Coupling, ...]]:
+    """The torso's link and its coupling: the bisecting hip mechanism, none for a hinged
+    torso (the five-link biped: a free joint of its own)."""
+    # bodies d up the torso's axis: -d along the link's downward axis
+    parts = [(p[f"m_torso_{b.name}"], -p[f"d_torso_{b.name}"],
+              p.get(f"I_torso_{b.name}", 0.0), b.name, p.get(f"e_torso_{b.name}", 0.0))
+             for b in s.torso]
+    m, c, inertia, ce = _combine("torso", parts)
+    height = max(max(-x[1] for x in parts), L / 10)
+    link = Link("torso", "hip", "torso_hip", 0.0, height, m, c, inertia, None, ce, up=True)
+    if s.hinged_torso:
+        return link, ()
+    return link, (Coupling("bisecting_hip", "torso_hip",
+                           tuple((f"{leg}_hip", 0.5) for leg in LEGS)),)
+
+
+def _springs(s, p: dict) -> list[Spring]:
+    """The torsional springs between links at the hip (``s.springs``; one with no stiffness
+    and no damping is left out) and on each knee (``s.knee_spring``)."""
     joint = {"swing": "leg1_hip", "stance": "leg2_hip", "torso": "torso_hip"}
     link_of = {"swing": "leg1", "stance": "leg2", "torso": "torso"}
     springs = []
@@ -290,6 +315,4 @@ def multibody(data: WalkerData) -> Multibody:
             springs.append(Spring(f"{leg}_knee_spring", (f"{leg}_thigh", f"{leg}_shank"),
                                   ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
                                   p["c_knee"]))
-    return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
-                     data.slope_rad, tuple(springs), couplings, not s.free_knees,
-                     s.kind.name)
+    return springs
