@@ -27,7 +27,8 @@ from walkerlab import usercache
 
 ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
-                    "walker/description.py", "codegen/cache.py")
+                    "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
+                    "codegen/equations.py")
 _memo: dict[str, dict] = {}
 
 
@@ -53,8 +54,16 @@ def _generator_hash() -> str:
 
 @cache
 def _flat_generator_hash() -> str:
-    """sha256 of the flat-foot generator's source (once per process)."""
-    return hashlib.sha256((Path(__file__).parent / "foot_modes.py").read_bytes()).hexdigest()
+    """sha256 of the flat-foot generator's sources (once per process)."""
+    return _source_hash("foot_modes.py", "double_support.py", "push_off.py")
+
+
+def _source_hash(*names: str) -> str:
+    """sha256 of the sources ``names`` of this package, in order."""
+    h = hashlib.sha256()
+    for name in names:
+        h.update((Path(__file__).parent / name).read_bytes())
+    return h.hexdigest()
 
 
 @cache

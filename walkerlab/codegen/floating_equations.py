@@ -243,13 +243,6 @@ def _symbols(structure: Structure) -> _Symbols:
                     P["L_thigh"] if knee else 0, P["R_foot"] if arc else 0, tags, hip_links)
 
 
-def _e(psi):
-    """The unit vector ``(sin psi, -cos psi)`` along a link at angle ``psi``."""
-    import sympy as sp
-
-    return sp.Matrix([sp.sin(psi), -sp.cos(psi)])
-
-
 def _legs(s: _Symbols) -> tuple[list, list, dict]:
     """The legs' bodies ``(mass, {angle: length}, inertia, link angle or None)`` (the hip's
     point mass first), their contact points ``(position, Jacobian)`` and named points.
@@ -260,13 +253,14 @@ def _legs(s: _Symbols) -> tuple[list, list, dict]:
     without a trigonometric simplifier."""
     import sympy as sp
 
+    from walkerlab.codegen.link_sums import e
+
     structure, q, P, tags = s.structure, s.q, s.P, s.tags
     L, gamma, lt, R, knee = P["L"], P["gamma"], s.lt, s.R, s.knee
     n_vec = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
     t_vec = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
     nq = len(q)
     hip = sp.Matrix([q[0], q[1]])
-    e = _e
     bodies = []
     feet, points = [], {"hip": hip}
     if structure.hip_mass:
@@ -327,8 +321,9 @@ def _torso(s: _Symbols, bodies: list, points: dict):
     ``torso_angle``; a point ``d`` up its axis is at ``hip - d e(t)``."""
     import sympy as sp
 
+    from walkerlab.codegen.link_sums import e
+
     structure, q, P, hip_links = s.structure, s.q, s.P, s.hip_links
-    e = _e
     hip = points["hip"]
     psi_t = (hip_links[0] + hip_links[1]) / 2 if structure.torso else None
     if structure.hinged_torso:

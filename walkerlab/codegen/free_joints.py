@@ -41,7 +41,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from walkerlab.codegen.symbolic import Equations, dot_terms, position_of, velocity_terms
+from walkerlab.codegen.link_sums import dot_terms, position_of, velocity_terms
+from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
 
 __all__ = ["derive_five_link", "generate_five_link"]
