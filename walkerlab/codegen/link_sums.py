@@ -47,3 +47,17 @@ def add_length(lin: dict, psi, length) -> dict:
     out = dict(lin)
     out[psi] = out.get(psi, 0) + length
     return out
+
+
+def add_mass_terms(M, Mi, B, mass, lin: dict, foot_lin: dict, qs, n: int) -> None:
+    """Add, in place, a point mass ``mass`` at the leg-vector sum ``lin`` to the mass matrix
+    ``M`` (``sum m e'(a) . e'(b)`` of its velocity) and to the impact matrices ``Mi`` (its
+    velocity with the point at ``foot_lin`` at rest, the new stance foot) and ``B`` (the
+    momentum of the pre-impact velocity on those directions), all (n, n) in ``qs``."""
+    rel = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in {**lin, **foot_lin}}
+    dl, dn = velocity_terms(lin, qs), velocity_terms(rel, qs)
+    for i in range(n):
+        for j in range(n):
+            M[i, j] += mass * dot_terms(dl[i], dl[j])
+            Mi[i, j] += mass * dot_terms(dn[i], dn[j])
+            B[i, j] += mass * dot_terms(dn[i], dl[j])

@@ -49,7 +49,11 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.link_sums import add_length, dot_terms, position_of, velocity_terms
+from walkerlab.codegen.link_sums import (
+    add_length,
+    add_mass_terms,
+    position_of,
+)
 from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: coordinate of ``q`` eliminated on the heel-strike surface (the rest parametrise the section)
@@ -306,16 +310,8 @@ def _inertia(s: _Symbols, geo: _Geometry, bodies: list):
             Bm += mass * Jn.T * J
         else:
             # d(position)/d(psi_k) = sum over the angles a of lin[a] da/dpsi_k e'(a)
-            # (a = psi_k for a body on a leg's axis)
-            foot_lin = geo.foot_lin
-            new = {k: lin.get(k, 0) - foot_lin.get(k, 0)
-                   for k in {**lin, **foot_lin}}  # swing foot at rest
-            dl, dn = velocity_terms(lin, psv), velocity_terms(new, psv)
-            for i in range(n):
-                for j in range(n):
-                    Mp[i, j] += mass * dot_terms(dl[i], dl[j])
-                    Mi[i, j] += mass * dot_terms(dn[i], dn[j])
-                    Bm[i, j] += mass * dot_terms(dn[i], dl[j])
+            # (a = psi_k for a body on a leg's axis); Mi, Bm with the swing foot at rest
+            add_mass_terms(Mp, Mi, Bm, mass, lin, geo.foot_lin, psv, n)
         Mp += inertia * a.T * a
         Mi += inertia * a.T * a
         Bm += inertia * a.T * a
