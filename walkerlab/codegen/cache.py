@@ -9,11 +9,12 @@ without a private folder the code stays in memory.
 
 Key: sha256 of the walker :class:`~walkerlab.walker.description.Structure` (no numbers: a
 sweep over masses shares one file) and of the generator's own source files (``symbolic.py``,
-``source.py``, ``walker/description.py``, ``cache.py``) and the sympy version, so editing the
-generator regenerates.  Files are written atomically (temporary name, then ``os.replace``;
-a failed write - disk full, read-only - leaves nothing behind); each starts with a sha256 of
-its body: a truncated or damaged file is regenerated, as is one that fails to compile.  (The
-header detects damage, not tampering: trust comes from the file's owner and mode.)
+``source.py``, ``walker/description.py``, ``cache.py``, ``link_sums.py``, ``equations.py``)
+and the sympy version, so editing the generator regenerates.  Files are written atomically
+(temporary name, then ``os.replace``; a failed write - disk full, read-only - leaves nothing
+behind); each starts with a sha256 of its body: a truncated or damaged file is regenerated,
+as is one that fails to compile.  (The header detects damage, not tampering: trust comes
+from the file's owner and mode.)
 """
 
 from __future__ import annotations
@@ -27,7 +28,8 @@ from walkerlab import usercache
 
 ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
-                    "walker/description.py", "codegen/cache.py")
+                    "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
+                    "codegen/equations.py")
 _memo: dict[str, dict] = {}
 
 
@@ -53,8 +55,16 @@ def _generator_hash() -> str:
 
 @cache
 def _flat_generator_hash() -> str:
-    """sha256 of the flat-foot generator's source (once per process)."""
-    return hashlib.sha256((Path(__file__).parent / "foot_modes.py").read_bytes()).hexdigest()
+    """sha256 of the flat-foot generator's sources (once per process)."""
+    return _source_hash("foot_modes.py", "double_support.py", "push_off.py")
+
+
+def _source_hash(*names: str) -> str:
+    """sha256 of the sources ``names`` of this package, in order."""
+    h = hashlib.sha256()
+    for name in names:
+        h.update((Path(__file__).parent / name).read_bytes())
+    return h.hexdigest()
 
 
 @cache
@@ -72,8 +82,9 @@ def _five_link_generator_hash() -> str:
 
 def cache_key(structure) -> str:
     """Cache key (hex, 24 characters) of a structure for the current generator (a
-    flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes`, a free-kneed one's
-    :mod:`walkerlab.codegen.free_joints`, a spoked wheel's
+    flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes` (with
+    :mod:`~walkerlab.codegen.double_support` and :mod:`~walkerlab.codegen.push_off`), a
+    free-kneed one's :mod:`walkerlab.codegen.free_joints`, a spoked wheel's
     :mod:`walkerlab.codegen.rolling_polygon`, which no other structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())

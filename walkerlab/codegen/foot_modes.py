@@ -37,7 +37,8 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
   trailing foot is released (massless, it snaps to its rest angle) unless the double
   support keeps its toe down (below).
 
-Double support (after heel strike, roles swapped; :func:`_double_support`): the leading foot
+Double support (after heel strike, roles swapped;
+:func:`walkerlab.codegen.double_support.derive_double_support`): the leading foot
 on its heel (or flat), the trailing foot on its toe, pinned (no slip); its ankle angle ``b``
 follows from the toe on the slope, the flow is Lagrange's equations on ``(q, b)`` with the
 toe's constraint and its force as multipliers (a numeric KKT solve in the generated code);
@@ -59,6 +60,13 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen import source as codegen
+from walkerlab.codegen.double_support import (
+    DOUBLE_SUPPORT_LEADS,
+    derive_double_support,
+    double_support_lines,
+)
+from walkerlab.codegen.link_sums import add_length, dot_terms, position_of, velocity_terms
+from walkerlab.codegen.push_off import push_off_systems
 from walkerlab.codegen.source import (
     IND,
     PRINTER,
@@ -68,7 +76,6 @@ from walkerlab.codegen.source import (
     reset_lines,
     start_module,
 )
-from walkerlab.codegen.symbolic import dot_terms, position_of, velocity_terms
 from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: Index of the stance ankle's angle in ``q``.
@@ -134,15 +141,68 @@ class FlatEquations:
     double_support: dict | None = None
 
 
-def _add(lin: dict, angle, length) -> dict:
-    out = dict(lin)
-    out[angle] = out.get(angle, 0) + length
-    return out
+@dataclass(frozen=True)
+class _Walker:
+    """The symbols and numbers every section of :func:`derive_flat` reads: ``q``, ``dq``,
+    ``qdd``, the parameters (``P`` by name) and the bodies of a pinned ankle
+    (:meth:`bodies_from`)."""
+
+    structure: Structure
+    q: tuple
+    dq: tuple
+    qdd: tuple
+    par: tuple
+    P: dict
+
+    def fp(self, kind: str, role: str):
+        """A foot's number (per role when the legs differ)."""
+        t = f"{ROLE_TAG[role]}_" if self.structure.asymmetric else ""
+        return self.P[{"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle",
+                       "r": f"r_{t}ankle", "c": f"c_{t}ankle"}[kind]]
+
+    def bp(self, kind: str, name: str, role: str):
+        """A leg body's number (per role when the legs differ)."""
+        return self.P[f"{kind}_{ROLE_TAG[role]}_{name}" if self.structure.asymmetric
+                      else f"{kind}_{name}"]
+
+    def bodies_from(self, ankle_lin: dict, pinned: str = "stance"):
+        """(mass, lin, inertia, link angle, name) of every body, the hip's lin and the
+        other leg's ankle's lin, for the ``pinned`` leg's ankle at ``ankle_lin``; names
+        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike)."""
+        structure, P, bp = self.structure, self.P, self.bp
+        ps_sw, ps_st, _a = self.q
+        L, half = P["L"], sp.pi / 2
+        other = {"stance": "swing", "swing": "stance"}[pinned]
+        leg_psi = {"stance": ps_st, "swing": ps_sw}
+        hip = add_length(ankle_lin, leg_psi[pinned], -L)
+        out = []
+        if structure.hip_mass:
+            out.append((P["M_hip"], hip, 0, leg_psi[pinned], "hip"))
+        for b in structure.bodies:
+            for role in (pinned, other):
+                psi = leg_psi[role]
+                lin = add_length(hip, psi, bp("d", b.name, role))
+                if b.off_axis:
+                    lin = add_length(lin, psi + half, bp("e", b.name, role))
+                inertia = bp("I", b.name, role) if b.kind == "rod" else 0
+                out.append((bp("m", b.name, role), lin, inertia, psi, f"{role}_{b.name}"))
+        psi_t = (ps_sw + ps_st) / 2
+        for b in structure.torso:
+            lin = add_length(hip, psi_t, -P[f"d_torso_{b.name}"])
+            if b.off_axis:
+                lin = add_length(lin, psi_t + half, P[f"e_torso_{b.name}"])
+            inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
+            out.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t, f"torso_{b.name}"))
+        return out, hip, add_length(hip, leg_psi[other], L)
 
 
 @cache
 def derive_flat(structure: Structure) -> FlatEquations:
-    """Derive the modes, resets, guards, ground reactions and points of a flat-footed biped.
+    """Derive the modes, resets, guards, ground reactions and points of a flat-footed biped:
+    the pinned modes (:func:`_pinned_modes`), foot flat and the resets
+    (:func:`_locked_and_resets`), the push-off systems
+    (:func:`walkerlab.codegen.push_off.push_off_systems`) and the
+    double support (:func:`walkerlab.codegen.double_support.derive_double_support`).
 
     Returns
     -------
@@ -163,113 +223,81 @@ def derive_flat(structure: Structure) -> FlatEquations:
     qdd = sp.symbols("ddq_swing ddq_stance ddq_stance_ankle", real=True)
     par = sp.symbols(structure.param_names, real=True)
     P = dict(zip(structure.param_names, par))
-    g, L, gamma = P["g"], P["L"], P["gamma"]
+    w = _Walker(structure, q, dq, qdd, par, P)
+    gamma = P["gamma"]
     ps_sw, ps_st, a = q
-    b_new = sp.Symbol("b_new_ankle", real=True)  # the swing ankle, once it is the stance one
-
-    def fp(kind, role):  # a foot's number (per role when the legs differ)
-        t = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
-        return P[{"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle",
-                  "r": f"r_{t}ankle", "c": f"c_{t}ankle"}[kind]]
-
-    def bp(kind, name, role):
-        return P[f"{kind}_{ROLE_TAG[role]}_{name}" if structure.asymmetric else f"{kind}_{name}"]
-
+    fp = w.fp
     hs, ts = fp("heel", "stance"), fp("toe", "stance")
-    hw, tw, rw = fp("heel", "swing"), fp("toe", "swing"), fp("r", "swing")
-    k_a, r_a, c_a = fp("k", "stance"), fp("r", "stance"), fp("c", "stance")
+    rw = fp("r", "swing")
     half = sp.pi / 2
     normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
     tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])  # along the slope, downhill
     theta_f = ps_st + a
-    swap = {"stance": "swing", "swing": "stance"}
     # positions = sum of {angle: length} e(angle) + a constant offset (e(angle + pi/2) is
     # the unit vector at ``angle`` from the x axis)
     anchors = {"heel": ({theta_f + half: hs}, sp.zeros(2, 1)),
                "toe": ({theta_f + half: -ts}, (hs + ts) * tangent)}
+    flows, kin, ground, guards, lead_force, trailing_ankle = _pinned_modes(
+        w, anchors, normal)
+    guards["swing_foot_ahead"] = ps_sw - ps_st
+    guards["foot_angle"] = ps_st + a + gamma
+    Jl = sp.Matrix([[0, 1, 1]])
+    resets, post_q, post = _locked_and_resets(w, anchors, flows, Jl)
+    push_off = push_off_systems(q, anchors, w.bodies_from, kin, flows, resets, post_q, post)
+    leg_angles = {"swing_angle": ps_sw, "stance_angle": ps_st, "stance_ankle_angle": a,
+                  "swing_ankle_angle": rw + 0 * ps_sw,
+                  "swing_rate": dq[0], "stance_rate": dq[1], "stance_ankle_rate": dq[2],
+                  "swing_ankle_rate": 0 * dq[0]}
+    double = derive_double_support(q, dq, qdd, flows, trailing_ankle, lead_force["heel"],
+                                   (fp("toe", "swing"), fp("k", "swing"), fp("r", "swing"),
+                                    fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl)
+    return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
+                         guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles,
+                         push_off=push_off, double_support=double)
 
-    def bodies_from(ankle_lin: dict, pinned: str = "stance"):
-        """(mass, lin, inertia, link angle, name) of every body, the hip's lin and the
-        other leg's ankle's lin, for the ``pinned`` leg's ankle at ``ankle_lin``; names
-        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike)."""
-        other = swap[pinned]
-        leg_psi = {"stance": ps_st, "swing": ps_sw}
-        hip = _add(ankle_lin, leg_psi[pinned], -L)
-        out = []
-        if structure.hip_mass:
-            out.append((P["M_hip"], hip, 0, leg_psi[pinned], "hip"))
-        for b in structure.bodies:
-            for role in (pinned, other):
-                psi = leg_psi[role]
-                lin = _add(hip, psi, bp("d", b.name, role))
-                if b.off_axis:
-                    lin = _add(lin, psi + half, bp("e", b.name, role))
-                inertia = bp("I", b.name, role) if b.kind == "rod" else 0
-                out.append((bp("m", b.name, role), lin, inertia, psi, f"{role}_{b.name}"))
-        psi_t = (ps_sw + ps_st) / 2
-        for b in structure.torso:
-            lin = _add(hip, psi_t, -P[f"d_torso_{b.name}"])
-            if b.off_axis:
-                lin = _add(lin, psi_t + half, P[f"e_torso_{b.name}"])
-            inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
-            out.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t, f"torso_{b.name}"))
-        return out, hip, _add(hip, leg_psi[other], L)
 
-    qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(qdd)
+def _pinned_modes(w: _Walker, anchors: dict, normal):
+    """Per pinned point (``heel``, ``toe``): the flow ``heel_contact`` / ``heel_off``
+    (:func:`_pinned_dynamics`), the kinematics (points, energies), the ground reaction
+    (Newton's total and, heel pinned, the toe's share from the moment balance about the
+    heel: module docstring) and the guards on the swing heel's and the hip's heights.
+
+    Returns
+    -------
+    flows, kinematics, ground, guards : dict
+    lead_force : dict
+        Per pin, Newton's total force and moment ``(F, mom)``.
+    trailing_ankle : Matrix (2, 1)
+        The swing ankle's position, heel pinned.
+    """
+    q, fp = w.q, w.fp
+    ps_sw, ps_st, a = q
+    half = sp.pi / 2
+    hs, ts = fp("heel", "stance"), fp("toe", "stance")
+    hw, tw, rw = fp("heel", "swing"), fp("toe", "swing"), fp("r", "swing")
+    theta_f = ps_st + a
+    dqv = sp.Matrix(w.dq)
     link_angle = {"swing": ps_sw, "stance": ps_st, "torso": (ps_sw + ps_st) / 2}
     flows, kin, ground, guards = {}, {}, {}, {}
     lead_force = {}
     for pin, (ankle_lin, off) in anchors.items():
-        bodies, hip, sw_ankle = bodies_from(ankle_lin)
+        bodies, hip, sw_ankle = w.bodies_from(ankle_lin)
         if pin == "heel":
             trailing_ankle = position_of(sw_ankle)
 
         def at(lin, _off=off):
             return position_of(lin) + _off
-        M = sp.zeros(3, 3)
-        V = k_a * (a - r_a) ** 2 / 2
-        F = sp.zeros(2, 1)
-        mom = sp.Integer(0)
-        for mass, lin, inertia, psi, _name in bodies:
-            d = velocity_terms(lin, q)
-            w = sp.Matrix([[sp.diff(psi, s) for s in q]])
-            for i in range(3):
-                for j in range(3):
-                    M[i, j] += mass * dot_terms(d[i], d[j])
-            M += inertia * w.T * w
-            pos = at(lin)
-            V += mass * g * pos[1]
-            vel = pos.jacobian(qv) * dqv
-            acc = vel.jacobian(qv) * dqv + vel.jacobian(dqv) * ddv
-            f = mass * (acc + sp.Matrix([0, g]))
-            F += f
-            mom += pos[0] * f[1] - pos[1] * f[0] + inertia * (w * ddv)[0]
-        for i, (first, second) in enumerate(structure.springs):  # springs between links
-            delta = link_angle[second] - link_angle[first]
-            V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
-        M = M.applyfunc(sp.factor_terms)
-        G = sp.Matrix([sp.diff(V, s) for s in q])
-        C = sp.zeros(3, 3)
-        for i in range(3):
-            for j in range(3):
-                C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(M[i, j], q[k]) + sp.diff(M[i, k], q[j])
-                                                   - sp.diff(M[j, k], q[i])) * dq[k]
-                              for k in range(3))
-        C[ANKLE, ANKLE] += c_a  # the ankle damper: torque -c da/dt on the ankle coordinate
-        for i, (first, second) in enumerate(structure.springs):
-            delta = link_angle[second] - link_angle[first]
-            Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
-            C += P[f"c_s{i}"] * Jd.T * Jd
+        M, C, G, V, F, mom = _pinned_dynamics(w, bodies, at, link_angle)
         mode = "heel_contact" if pin == "heel" else "heel_off"
-        flows[mode] = _System(q, dq, M=M, C=C, G=G)
+        flows[mode] = _System(q, w.dq, M=M, C=C, G=G)
         N = (F.T * normal)[0]
         lead_force[pin] = (F, mom)
         # moment balance about the pinned heel: the toe's normal force (see module docstring)
         ground[pin] = [N, mom / (hs + ts)] if pin == "heel" else [N]
-        heel_sw = at(_add(sw_ankle, ps_sw + rw + half, -hw))
-        toe_sw = at(_add(sw_ankle, ps_sw + rw + half, tw))
-        points = {"stance_heel": at(_add(ankle_lin, theta_f + half, -hs)),
-                  "stance_toe": at(_add(ankle_lin, theta_f + half, ts)),
+        heel_sw = at(add_length(sw_ankle, ps_sw + rw + half, -hw))
+        toe_sw = at(add_length(sw_ankle, ps_sw + rw + half, tw))
+        points = {"stance_heel": at(add_length(ankle_lin, theta_f + half, -hs)),
+                  "stance_toe": at(add_length(ankle_lin, theta_f + half, ts)),
                   "stance_ankle": at(ankle_lin), "hip": at(hip),
                   "swing_ankle": at(sw_ankle), "swing_heel": heel_sw, "swing_toe": toe_sw}
         # the contract's names: the stance foot is the stance leg's end, the swing foot the
@@ -283,10 +311,71 @@ def derive_flat(structure: Structure) -> FlatEquations:
         kin[pin] = {"points": points, "kinetic": T, "potential": V}
         guards[f"swing_heel_height_{pin}"] = (heel_sw.T * normal)[0]
         guards[f"hip_height_{pin}"] = (at(hip).T * normal)[0]
-    guards["swing_foot_ahead"] = ps_sw - ps_st
-    guards["foot_angle"] = ps_st + a + gamma
-    # foot flat: the heel-contact flow with the foot's angle locked
-    Jl = sp.Matrix([[0, 1, 1]])
+    return flows, kin, ground, guards, lead_force, trailing_ankle
+
+
+def _pinned_dynamics(w: _Walker, bodies: list, at, link_angle: dict):
+    """Lagrange's equations of one pinned mode: ``M``, ``C`` (Christoffel form plus the
+    ankle's and the springs' dampers), ``G`` and the potential ``V`` (gravity, the ankle
+    spring, the springs between links), and Newton's total force ``F`` and moment ``mom``
+    about the origin of the bodies (positions ``at(lin)``)."""
+    q, dq, P, structure = w.q, w.dq, w.P, w.structure
+    _ps_sw, _ps_st, a = q
+    g = P["g"]
+    k_a, r_a, c_a = w.fp("k", "stance"), w.fp("r", "stance"), w.fp("c", "stance")
+    qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(w.qdd)
+    M = sp.zeros(3, 3)
+    V = k_a * (a - r_a) ** 2 / 2
+    F = sp.zeros(2, 1)
+    mom = sp.Integer(0)
+    for mass, lin, inertia, psi, _name in bodies:
+        d = velocity_terms(lin, q)
+        wr = sp.Matrix([[sp.diff(psi, s) for s in q]])
+        for i in range(3):
+            for j in range(3):
+                M[i, j] += mass * dot_terms(d[i], d[j])
+        M += inertia * wr.T * wr
+        pos = at(lin)
+        V += mass * g * pos[1]
+        vel = pos.jacobian(qv) * dqv
+        acc = vel.jacobian(qv) * dqv + vel.jacobian(dqv) * ddv
+        f = mass * (acc + sp.Matrix([0, g]))
+        F += f
+        mom += pos[0] * f[1] - pos[1] * f[0] + inertia * (wr * ddv)[0]
+    for i, (first, second) in enumerate(structure.springs):  # springs between links
+        delta = link_angle[second] - link_angle[first]
+        V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
+    M = M.applyfunc(sp.factor_terms)
+    G = sp.Matrix([sp.diff(V, s) for s in q])
+    C = sp.zeros(3, 3)
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(M[i, j], q[k]) + sp.diff(M[i, k], q[j])
+                                               - sp.diff(M[j, k], q[i])) * dq[k]
+                          for k in range(3))
+    C[ANKLE, ANKLE] += c_a  # the ankle damper: torque -c da/dt on the ankle coordinate
+    for i, (first, second) in enumerate(structure.springs):
+        delta = link_angle[second] - link_angle[first]
+        Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
+        C += P[f"c_s{i}"] * Jd.T * Jd
+    return M, C, G, V, F, mom
+
+
+def _locked_and_resets(w: _Walker, anchors: dict, flows: dict, Jl):
+    """Add the ``foot_flat`` flow (the heel-contact flow with the foot's angle locked,
+    ``Jl = d phi / dq``) to ``flows``; return the resets (``foot_slap``, ``heel_strike_heel``,
+    ``heel_strike_toe``), the post-impact coordinates and the post-impact bodies by name.
+
+    Heel strike: post-impact coordinates ``(swing, stance, b)`` with the swing heel pinned
+    and the swing foot at angle ``swing + b`` (``b`` its rest angle at impact), in the
+    pre-impact labelling; then the roles swap (new swing = old stance, new stance = old
+    swing)."""
+    q, dq = w.q, w.dq
+    ps_sw, ps_st, _a = q
+    half = sp.pi / 2
+    hw, rw = w.fp("heel", "swing"), w.fp("r", "swing")
+    b_new = sp.Symbol("b_new_ankle", real=True)  # the swing ankle, once it is the stance one
+    qv = sp.Matrix(q)
     S = sp.Matrix([[1, 0], [0, 1], [0, -1]])
     hc = flows["heel_contact"]
     flows["foot_flat"] = _System(q, dq, M=(S.T * hc.M).col_join(Jl),
@@ -295,16 +384,13 @@ def derive_flat(structure: Structure) -> FlatEquations:
     resets = {"foot_slap": _System(q, dq, Mi=(S.T * hc.M).col_join(Jl),
                                    B=(S.T * hc.M).col_join(sp.zeros(1, 3)),
                                    relabel_q=qv, relabel_rate=sp.eye(3))}
-    # heel strike: post-impact coordinates (swing, stance, b) with the swing heel pinned and
-    # the swing foot at angle swing + b (b = its rest angle at impact), in the pre-impact
-    # labelling; then the roles swap (new swing = old stance, new stance = old swing)
     post_q = (ps_sw, ps_st, b_new)
-    post_bodies, _h, _a = bodies_from({ps_sw + b_new + half: hw}, "swing")
+    post_bodies, _h, _a = w.bodies_from({ps_sw + b_new + half: hw}, "swing")
     post = {b[4]: b for b in post_bodies}
     relabel_q = sp.Matrix([ps_st, ps_sw, rw])
     relabel_rate = sp.Matrix([[0, 1, 0], [1, 0, 0], [0, 0, 1]])
     for pin, (ankle_lin, _off) in anchors.items():
-        pre_bodies, _h, _a = bodies_from(ankle_lin)
+        pre_bodies, _h, _a = w.bodies_from(ankle_lin)
         Mi, Bm = sp.zeros(3, 3), sp.zeros(3, 3)
         for mass, lin, inertia, psi, name in pre_bodies:
             pmass, plin, pinertia, ppsi, _n = post[name]
@@ -320,206 +406,10 @@ def derive_flat(structure: Structure) -> FlatEquations:
         Mi, Bm = (X.subs(b_new, rw).applyfunc(sp.factor_terms) for X in (Mi, Bm))
         resets[f"heel_strike_{pin}"] = _System(q, dq, Mi=Mi, B=Bm, relabel_q=relabel_q,
                                                relabel_rate=relabel_rate)
-    push_off = _push_off_systems(q, anchors, bodies_from, kin, flows, resets, post_q, post)
-    leg_angles = {"swing_angle": ps_sw, "stance_angle": ps_st, "stance_ankle_angle": a,
-                  "swing_ankle_angle": rw + 0 * ps_sw,
-                  "swing_rate": dq[0], "stance_rate": dq[1], "stance_ankle_rate": dq[2],
-                  "swing_ankle_rate": 0 * dq[0]}
-    double = _double_support(q, dq, qdd, flows, trailing_ankle, lead_force["heel"],
-                             (fp("toe", "swing"), fp("k", "swing"), fp("r", "swing"),
-                              fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl)
-    return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
-                         guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles,
-                         push_off=push_off, double_support=double)
-
-
-def _translation_rows(lin: dict, qs) -> sp.Matrix:
-    """``d position / d q`` (len(qs), 2) of a ``{angle: length}`` leg-vector sum, row ``i``
-    the position's rate for ``dq = e_i`` (``e'(a) = (cos a, sin a)``)."""
-    rows = [[sum((c * sp.cos(a) for a, c in t), sp.Integer(0)),
-             sum((c * sp.sin(a) for a, c in t), sp.Integer(0))]
-            for t in velocity_terms(lin, qs)]
-    return sp.Matrix(rows)
-
-
-def _push_off_systems(q, anchors, bodies_from, kin, flows, resets, post_q, post) -> dict:
-    """The extended impact system of each pinned point (``heel``, ``toe``): the push-off at
-    the stance toe and the heel strike after it.
-
-    Extended coordinates ``qe = (q, x_f, y_f)``: the walker translated by ``(x_f, y_f)``
-    with its pinned point.  Per pin: ``De`` (5, 5), the Hessian of the kinetic energy in
-    ``dqe`` (``[M, Mt; Mt^T, m I]``, ``Mt = sum m dr/dq``; singular along the massless
-    foot's turn about the ankle, which the push-off holds); ``Jt`` (2, 5), the stance toe's
-    Jacobian; ``Jh`` (2, 3), the hip's (its speed for a push-off law); ``Mi`` (3, 3) and
-    ``Be`` (3, 5), the heel strike's ``Mi dq+ = Be dqe-`` (momenta of the pre-impact
-    velocities, the trailing foot free and moving, projected on the post-impact coordinates
-    with the swing heel pinned: ``Be = [B | sum J+^T m]``, ``B`` the passive heel strike's,
-    so ``Be [dq; 0] = B dq`` to round-off); ``push`` (2,) the vector toe -> hip;
-    ``relabel_q`` (3,) and ``relabel_rate`` (3, 3) the role swap."""
-    qv = sp.Matrix(q)
-    out = {}
-    mode = {"heel": "heel_contact", "toe": "heel_off"}
-    for pin, (ankle_lin, _off) in anchors.items():
-        pre_bodies, _h, _a = bodies_from(ankle_lin)
-        Mt, trans, mass = sp.zeros(3, 2), sp.zeros(3, 2), sp.Integer(0)
-        for m_, lin, _i, _psi, name in pre_bodies:
-            mass += m_
-            Mt += m_ * _translation_rows(lin, q)
-            trans += m_ * _translation_rows(post[name][1], post_q)
-        hs = resets[f"heel_strike_{pin}"]
-        b_new = post_q[2]
-        trans = trans.subs(b_new, hs.relabel_q[2]).applyfunc(sp.factor_terms)
-        De = flows[mode[pin]].M.row_join(Mt).col_join(Mt.T.row_join(mass * sp.eye(2)))
-        pts = kin[pin]["points"]
-        toe = pts["stance_toe"]
-        out[pin] = {"De": De, "Jt": toe.jacobian(qv).row_join(sp.eye(2)),
-                    "Jh": pts["hip"].jacobian(qv), "Mi": hs.Mi, "Be": hs.B.row_join(trans),
-                    "push": pts["hip"] - toe, "relabel_q": hs.relabel_q,
-                    "relabel_rate": hs.relabel_rate}
-    return out
+    return resets, post_q, post
 
 
 
-#: The leading foot's modes in double support (the trailing foot on its toe): on its heel
-#: (turning about it) or flat (its angle locked).
-DOUBLE_SUPPORT_LEADS = ("heel_contact", "foot_flat")
-
-
-def _double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma, normal,
-                    tangent, Jl) -> dict:
-    """Double support after heel strike (roles already swapped): the leading (stance) foot
-    on its heel at ``O`` (heel contact) or flat (foot flat), the trailing (swing) foot on its
-    toe at a point ``P`` of the slope.  The trailing foot's ankle angle ``b`` (its sole at
-    ``swing + b``) is no state: with the toe on the slope, ``sin(swing + b + gamma) = -h/t``
-    (``h`` the trailing ankle's height above the slope, ``t`` the toe length), the branch
-    with the heel up; its rate from the toe's zero normal velocity.  The flow: Lagrange's
-    equations on ``Q = (swing, stance, stance_ankle, b)`` (the foot massless: ``b``'s row
-    holds the spring ``k (b - r)`` and damper ``c db`` against the toe's force), the toe
-    pinned, ``[M, -J^T; J, 0] [Qdd; lam] = [-C dQ - G; -dJ dQ]`` (``J = dT/dQ`` (2 x 4) of
-    the toe ``T``; foot flat adds ``phi = 0``'s row ``[0, 1, 1, 0]``), ``lam`` the ground's
-    force on the toe (world axes) [N].  Entry (the plastic impact that pins the toe, Newton's
-    restitution 0): in ``q`` the toe's pin is one row ``g = u^T dA/dq`` (``A`` the trailing
-    ankle, ``u`` the unit vector from toe to ankle: a massless foot takes no impulsive
-    moment, so the toe's impulse ``Lam u`` passes through the ankle) and
-    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``."""
-    b, db = sp.symbols("b_trail db_trail", real=True)
-    t_len, k_b, r_b, c_b = trailing
-    sw = q[0]
-    h = (ankle.T * normal)[0]
-    theta = sw + b
-    toe = ankle + t_len * sp.Matrix([sp.cos(theta), sp.sin(theta)])
-    Q, dQ = (*q, b), (*dq, db)
-    Qv, dQv = sp.Matrix(Q), sp.Matrix(dQ)
-    J = toe.jacobian(Qv)
-    dJ = (J * dQv).jacobian(Qv) * dQv
-    hc = flows["heel_contact"]
-    M4 = sp.zeros(4, 4)
-    M4[:3, :3] = hc.M
-    rhs = sp.zeros(4, 1)
-    rhs[:3, 0] = -hc.C * sp.Matrix(dq) - hc.G
-    rhs[3, 0] = -c_b * db - k_b * (b - r_b)
-    b_of = sp.asin(-h / t_len) - gamma - sw
-    hdot = (sp.Matrix([h]).jacobian(sp.Matrix(q)) * sp.Matrix(dq))[0]
-    db_of = -hdot / (t_len * sp.cos(theta + gamma)) - dq[0]
-    dA = ankle.jacobian(sp.Matrix(q))
-    u = -sp.Matrix([sp.cos(theta), sp.sin(theta)])  # toe -> ankle
-    g_row = u.T * dA
-    F, mom = lead_force
-    out = {"b": b, "db": db, "b_of": b_of, "db_of": db_of, "u": u, "toe": toe,
-           "trailing_spring": k_b * (b - r_b) ** 2 / 2, "foot_angle": theta + gamma}
-    for lead in DOUBLE_SUPPORT_LEADS:
-        rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
-        gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
-        m = rows.rows
-        K = sp.zeros(4 + m, 4 + m)
-        K[:4, :4] = M4
-        K[:4, 4:] = -rows.T
-        K[4:, :4] = rows
-        imp_rows = g_row if lead == "heel_contact" else g_row.col_join(Jl)
-        mi = imp_rows.rows
-        Ki = sp.zeros(3 + mi, 3 + mi)
-        Ki[:3, :3] = hc.M
-        Ki[:3, 3:] = -imp_rows.T
-        Ki[3:, :3] = imp_rows
-        out[lead] = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
-                     "Ki_rhs": (hc.M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
-    # the leading foot's ground force: Newton's total (feet massless) less the toe's; in
-    # foot flat its toe's share from the moment balance about its heel, less the trailing
-    # toe's moment (the lock's multiplier is that moment: its toe force times the sole)
-    lam = sp.Matrix(sp.symbols("lam_x lam_y", real=True))
-    out["lead_normal"] = ((F - lam).T * normal)[0]
-    out["trail_normal"] = (lam.T * normal)[0]
-    out["trail_tangential"] = (lam.T * tangent)[0]
-    out["lam"] = lam
-    out["sole"] = sole
-    return out
-
-
-def _double_support_lines(eq: FlatEquations, lead: str) -> list[str]:
-    """Source of ``_double_support_<lead>(x, gen=None) -> (xdot (6,), forces (4,))``
-    (forces: the trailing toe's normal and tangential force, the leading foot's normal force
-    and its toe's share [N]; ``gen`` (3,) [N m], if given, a generalised force in ``q``'s
-    rows added to the right-hand side: joint torques' ``B tau``, the closed chain's
-    ``[M -J^T; J 0] [Qdd; lam] = [-C dQ - G + (B tau, 0); -dJ dQ]``),
-    ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's impulse [N s])
-    and, once, ``double_support_trailing(x) -> (b, db)``."""
-    ds = eq.double_support
-    sysd = ds[lead]
-    n = len(eq.q)
-    head = [codegen.unpack(eq)]
-    lines, red = cse_lines([ds["b_of"]], PRINTER)
-    head += lines + [f"{IND}{ds['b']} = {PRINTER.doprint(red[0])}"]
-    lines, red = cse_lines([ds["db_of"]], PRINTER)
-    head += lines + [f"{IND}{ds['db']} = {PRINTER.doprint(red[0])}"]
-    K, rhs = sysd["K"], sysd["rhs"]
-    m = K.rows
-    lines, red = cse_lines(list(K) + list(rhs), PRINTER)
-    body = list(head) + lines
-    body.append(f"{IND}_K = np.array(({', '.join(PRINTER.doprint(e) for e in red[:m * m])},),"
-                f" dtype=float).reshape({m}, {m})")
-    body.append(f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[m * m:])},),"
-                " dtype=float)")
-    body.append(f"{IND}if gen is not None:  # joint torques' generalised force in q's rows")
-    body.append(f"{IND}    _b[:{n}] += gen")
-    body.append(f"{IND}_s = np.linalg.solve(_K, _b).tolist()")
-    body += [f"{IND}{s} = _s[{i}]" for i, s in enumerate(eq.qdd)]
-    body += [f"{IND}{ds['lam'][0]}, {ds['lam'][1]} = _s[4], _s[5]"]
-    toe_share = (f"_s[6] / ({PRINTER.doprint(ds['sole'])})" if lead == "foot_flat" else "0.0")
-    lines, red = cse_lines([ds["trail_normal"], ds["trail_tangential"], ds["lead_normal"]],
-                           PRINTER)
-    body += lines
-    rates = ", ".join(str(s) for s in eq.dq)
-    accs = ", ".join(str(s) for s in eq.qdd)
-    body.append(f"{IND}return (np.array(({rates}, {accs})), "
-                f"({', '.join(PRINTER.doprint(e) for e in red)}, {toe_share}))")
-    out = [f"    def _double_support_{lead}(x, gen=None):", *body,
-           f"    def flow_double_support_{lead}(t, x, gen=None):",
-           f"{IND}return _double_support_{lead}(x, gen)[0]",
-           f"    def double_support_{lead}_forces(t, x, gen=None):",
-           f"{IND}return _double_support_{lead}(x, gen)[1]"]
-    Ki, kr = sysd["Ki"], sysd["Ki_rhs"]
-    mi = Ki.rows
-    lines, red = cse_lines(list(Ki) + list(kr) + list(ds["u"]), PRINTER)
-    nk = mi * mi + mi
-    u = [PRINTER.doprint(e) for e in red[nk:]]
-    names = ", ".join(str(s) for s in eq.q)
-    out += [f"    def double_support_{lead}_entry(x):", *head, *lines,
-            f"{IND}_K = np.array(({', '.join(PRINTER.doprint(e) for e in red[:mi * mi])},),"
-            f" dtype=float).reshape({mi}, {mi})",
-            f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[mi * mi:nk])},),"
-            " dtype=float)",
-            f"{IND}_s = np.linalg.solve(_K, _b)",
-            f"{IND}_u = ({u[0]}, {u[1]})",
-            f"{IND}_L = float(_s[{n}])",
-            f"{IND}_n = (_u[0] * sin(gamma) + _u[1] * cos(gamma)) * _L",
-            f"{IND}_t = (_u[0] * cos(gamma) - _u[1] * sin(gamma)) * _L",
-            f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
-    if lead == DOUBLE_SUPPORT_LEADS[0]:
-        lines, red = cse_lines([ds["trailing_spring"], ds["foot_angle"]], PRINTER)
-        out += ["    def double_support_trailing(x):", *head, *lines,
-                f"{IND}return {ds['b']}, {ds['db']}, {PRINTER.doprint(red[0])}, "
-                f"{PRINTER.doprint(red[1])}"]
-    return out
 
 
 def _scalar_fn(name: str, eq: FlatEquations, exprs: list, with_acc: bool) -> list[str]:
@@ -572,7 +462,7 @@ def generate_flat(structure: Structure, key: str) -> str:
     for pin, exprs in eq.ground.items():
         fast += _scalar_fn(f"ground_{pin}", eq, exprs, True)
     for lead in DOUBLE_SUPPORT_LEADS:
-        fast += _double_support_lines(eq, lead)
+        fast += double_support_lines(eq, lead)
     rest = "r_st_ankle" if structure.asymmetric else "r_ankle"
     section = [
         "    def section(x):",

@@ -41,7 +41,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from walkerlab.codegen.symbolic import Equations, dot_terms, position_of, velocity_terms
+from walkerlab.codegen.link_sums import add_mass_terms, position_of
+from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
 
 __all__ = ["derive_five_link", "generate_five_link"]
@@ -108,14 +109,8 @@ def _matrices(q, bodies: list, foot_lin: dict, g):
     M, Mi, B = sp.zeros(n, n), sp.zeros(n, n), sp.zeros(n, n)
     V = sp.Integer(0)
     for mass, lin, inertia, a in bodies:
-        rel = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in {**lin, **foot_lin}}
-        dl, dn = velocity_terms(lin, q), velocity_terms(rel, q)
         w = sp.Matrix([[sp.diff(a, k) for k in q]])
-        for i in range(n):
-            for j in range(n):
-                M[i, j] += mass * dot_terms(dl[i], dl[j])
-                Mi[i, j] += mass * dot_terms(dn[i], dn[j])
-                B[i, j] += mass * dot_terms(dn[i], dl[j])
+        add_mass_terms(M, Mi, B, mass, lin, foot_lin, q, n)
         M += inertia * w.T * w
         Mi += inertia * w.T * w
         B += inertia * w.T * w

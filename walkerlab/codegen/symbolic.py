@@ -48,80 +48,16 @@ from functools import cache
 
 import sympy as sp
 
+from walkerlab.codegen.equations import Equations
+from walkerlab.codegen.link_sums import (
+    add_length,
+    add_mass_terms,
+    position_of,
+)
 from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: coordinate of ``q`` eliminated on the heel-strike surface (the rest parametrise the section)
 SECTION_DROP = {"absolute": 0, "slope_relative": 1}
-
-
-@dataclass(frozen=True)
-class Equations:
-    """Symbolic results of :func:`derive` (all sympy; ``n = len(q)``).
-
-    Attributes
-    ----------
-    q, dq : tuple of Symbol, shape (n,)
-    params : tuple of Symbol
-        In ``structure.param_names`` order.
-    M, C : Matrix (n, n); G : Matrix (n, 1)
-        Flow ``M qdd + C dq + G = 0`` (after the massless limit, if any).
-    Mi, B : Matrix (n, n)
-        Impact ``Mi dq+ = B dq-`` in the pre-impact labelling.
-    relabel_q : Matrix (n, 1)
-        Coordinates after the role swap, as functions of the pre-impact ``q``.
-    relabel_rate : Matrix (n, n)
-        ``dq_new = relabel_rate @ dq+``.
-    kinetic, potential : Expr
-        Energies [J] (massless bodies carry none); potential from the stance foot's height.
-    guards : dict[str, Expr]
-        ``heel_strike``, ``swing_foot_ahead``, ``hip_height``.
-    points : dict[str, Matrix (2, 1)]
-        Named points relative to the stance foot (world axes, x downhill, y up).
-    leg_angles : dict[str, Expr]
-        ``stance`` and ``swing`` absolute leg angles from the vertical.
-    section_drop : int
-        Index in ``q`` solved from the heel-strike guard; ``drop_solution`` is its expression.
-    De, E : Matrix
-        Extended impact matrices (coordinates ``[q, x_f, y_f]``, paper Eq. 6-7, A.7-A.24):
-        the stance foot free, ``E`` the swing foot's material contact point's Jacobian
-        (every foot kind: the push-off's transition reads them).
-    section_tied : dict[int, int]
-        State indices equal to another one on the section (kneed: the swing shank angle and
-        rate equal the thigh's just after heel strike).
-    locked : tuple (M, C, G) or None
-        Flow with the swing knee locked, as the square system described above.
-    knee_impact : tuple (Mk, Bk) or None
-        Plastic knee strike ``Mk dq+ = Bk dq-``.
-    """
-
-    q: tuple
-    dq: tuple
-    params: tuple
-    M: sp.Matrix
-    C: sp.Matrix
-    G: sp.Matrix
-    Mi: sp.Matrix
-    B: sp.Matrix
-    relabel_q: sp.Matrix
-    relabel_rate: sp.Matrix
-    kinetic: sp.Expr
-    potential: sp.Expr
-    guards: dict
-    points: dict
-    leg_angles: dict
-    section_drop: int
-    drop_solution: sp.Expr
-    De: sp.Matrix
-    E: sp.Matrix
-    limit: bool
-    section_tied: dict | None = None
-    locked: tuple | None = None
-    knee_impact: tuple | None = None
-
-
-def _e(psi):
-    """Unit vector from the hip towards the foot of a leg at angle ``psi`` from the vertical."""
-    return sp.Matrix([sp.sin(psi), -sp.cos(psi)])
 
 
 def _leg_angles(structure: Structure, q, gamma):
@@ -131,33 +67,6 @@ def _leg_angles(structure: Structure, q, gamma):
         return stance, swing
     theta, phi = q  # Garcia et al. (1998): theta from the slope normal, phi between the legs
     return theta - gamma, theta - phi - gamma
-
-
-def position_of(lin: dict) -> sp.Matrix:
-    """Position ``sum(length * e(angle))`` of a ``{angle: length}`` leg-vector sum."""
-    out = sp.zeros(2, 1)
-    for psi, length in lin.items():
-        out += length * _e(psi)
-    return out
-
-
-def velocity_terms(lin: dict, psv) -> list[list[tuple]]:
-    """For each ``psi_k``: the ``(angle, coefficient)`` terms of ``d position / d psi_k =
-    sum coefficient * e'(angle)`` of a ``{angle: length}`` leg-vector sum."""
-    out = []
-    for s in psv:
-        terms = []
-        for a, length in lin.items():
-            da = sp.diff(a, s)
-            if length != 0 and da != 0:
-                terms.append((a, length * da))
-        out.append(terms)
-    return out
-
-
-def dot_terms(u: list, v: list):
-    """``(sum cu e'(a)) . (sum cv e'(b)) = sum cu cv cos(a - b)``."""
-    return sum((cu * cv * sp.cos(a - b) for a, cu in u for b, cv in v), sp.Integer(0))
 
 
 def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
@@ -250,13 +159,6 @@ class _Dynamics:
     knee_impact: tuple | None
 
 
-def _add(lin: dict, psi, length) -> dict:
-    """Copy of the leg-vector sum ``lin`` with ``length`` more along the angle ``psi``."""
-    out = dict(lin)
-    out[psi] = out.get(psi, 0) + length
-    return out
-
-
 def _symbols(structure: Structure) -> _Symbols:
     """Check the structure is one this derivation handles and set up its symbols: the scene's
     coordinates, rates and parameters, the absolute leg angles they give, and the absolute link
@@ -311,8 +213,9 @@ def _geometry(s: _Symbols) -> _Geometry:
     def at(lin):
         return position_of(lin) + offset
 
-    knee_lin = _add(hip_lin, s.ps_sw, s.lt) if s.knee else hip_lin
-    foot_lin = _add(knee_lin, s.ps_shank, L - s.lt - R)  # point foot, or the swing arc's centre
+    knee_lin = add_length(hip_lin, s.ps_sw, s.lt) if s.knee else hip_lin
+    # point foot, or the swing arc's centre
+    foot_lin = add_length(knee_lin, s.ps_shank, L - s.lt - R)
     centre_sw = None
     if s.arc:
         centre_sw = at(foot_lin)
@@ -323,7 +226,7 @@ def _geometry(s: _Symbols) -> _Geometry:
     points = {"stance_foot": sp.zeros(2, 1), "hip": at(hip_lin), "swing_foot": swing_foot}
     if s.knee:
         points["swing_knee"] = at(knee_lin)
-        points["stance_knee"] = at(_add(hip_lin, ps_st, s.lt))
+        points["stance_knee"] = at(add_length(hip_lin, ps_st, s.lt))
     if s.arc:
         points["stance_contact"] = offset - R * s.normal
         points["stance_foot_centre"] = offset
@@ -354,22 +257,22 @@ def _bodies(s: _Symbols, geo: _Geometry) -> tuple[list, dict]:
             inertia = bp("I", b.name, role) if b.kind == "rod" else 0
             d = bp("d", b.name, role)
             if role == "stance":
-                lin, psi = _add(hip_lin, s.ps_st, d), s.ps_st
+                lin, psi = add_length(hip_lin, s.ps_st, d), s.ps_st
             elif b.link == "shank":
-                lin, psi = _add(geo.knee_lin, s.ps_shank, d - s.lt), s.ps_shank
+                lin, psi = add_length(geo.knee_lin, s.ps_shank, d - s.lt), s.ps_shank
             else:
-                lin, psi = _add(hip_lin, s.ps_sw, d), s.ps_sw
+                lin, psi = add_length(hip_lin, s.ps_sw, d), s.ps_sw
             if b.off_axis:  # ahead of the link's axis: e(psi + pi/2) = (cos psi, sin psi)
-                lin = _add(lin, psi + sp.pi / 2, bp("e", b.name, role))
+                lin = add_length(lin, psi + sp.pi / 2, bp("e", b.name, role))
             if f"{role}_{b.name}" in points:
                 raise ValueError(f"walker.leg.bodies: body name {b.name!r} is reserved")
             points[f"{role}_{b.name}"] = geo.at(lin)
             bodies.append((mass, lin, inertia, psi))
     psi_t = s.psi_t
     for b in structure.torso:
-        lin = _add(hip_lin, psi_t, -P[f"d_torso_{b.name}"])
+        lin = add_length(hip_lin, psi_t, -P[f"d_torso_{b.name}"])
         if b.off_axis:
-            lin = _add(lin, psi_t + sp.pi / 2, P[f"e_torso_{b.name}"])
+            lin = add_length(lin, psi_t + sp.pi / 2, P[f"e_torso_{b.name}"])
         points[f"torso_{b.name}"] = geo.at(lin)
         inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
         bodies.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t))
@@ -407,16 +310,8 @@ def _inertia(s: _Symbols, geo: _Geometry, bodies: list):
             Bm += mass * Jn.T * J
         else:
             # d(position)/d(psi_k) = sum over the angles a of lin[a] da/dpsi_k e'(a)
-            # (a = psi_k for a body on a leg's axis)
-            foot_lin = geo.foot_lin
-            new = {k: lin.get(k, 0) - foot_lin.get(k, 0)
-                   for k in {**lin, **foot_lin}}  # swing foot at rest
-            dl, dn = velocity_terms(lin, psv), velocity_terms(new, psv)
-            for i in range(n):
-                for j in range(n):
-                    Mp[i, j] += mass * dot_terms(dl[i], dl[j])
-                    Mi[i, j] += mass * dot_terms(dn[i], dn[j])
-                    Bm[i, j] += mass * dot_terms(dn[i], dl[j])
+            # (a = psi_k for a body on a leg's axis); Mi, Bm with the swing foot at rest
+            add_mass_terms(Mp, Mi, Bm, mass, lin, geo.foot_lin, psv, n)
         Mp += inertia * a.T * a
         Mi += inertia * a.T * a
         Bm += inertia * a.T * a

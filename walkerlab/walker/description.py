@@ -348,14 +348,6 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     bodies = [BodySpec(b.name, b.kind, b.mass_kg == 0.0, b.link,
                        any(v[1] != 0.0 for v in (v1[i], v2[i])))
               for i, b in enumerate(leg.bodies)]
-
-    def leg_block(swing_vals, stance_vals) -> list[float]:
-        out = []
-        for i, b in enumerate(bodies):
-            for vals, off in ((swing_vals[i], stance_vals[i]) if asym else (swing_vals[i],)):
-                out += vals + ([off] if b.off_axis else [])
-        return out
-
     tail = []
     if leg.knee is not None:
         tail.append(leg.knee.thigh_length_m)
@@ -366,28 +358,9 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     f2 = _flat_foot_values(leg2.foot) if flat else []
     asym = asym or f1 != f2
     n_foot_tail = len(tail)  # the flat foot's numbers (per role) go here, before the torso's
-    torso = []
-    if walker_cfg.torso is not None:
-        for b in walker_cfg.torso.bodies:
-            rigid = b.kind == "rigid_body"
-            off = b.com_off_axis_m if rigid else b.off_axis_m
-            torso.append(BodySpec(b.name, b.kind, False, "torso", off != 0.0))
-            tail += [b.mass_kg, b.com_from_hip_m if rigid else b.from_hip_m]
-            tail += [off] if off != 0.0 else []
-            tail += [b.inertia_about_com_kg_m2] if rigid else []
-    # springs: the role pairs of both steps (leg1 swinging, then leg2), each with its numbers
-    pairs, steps = [], ([], [])
-    for spr in walker_cfg.springs:
-        (pa, sa), (pb, sb) = (_spring_roles(spr.between, st) for st in ("leg2", "leg1"))
-        k, r, c = spr.stiffness_n_m_per_rad, spr.rest_angle_rad, spr.damping_n_m_s_per_rad
-        if pa == pb:  # leg to leg: the same pair in both steps, the rest angle's sign flips
-            pairs.append(pa)
-            steps[0].append([k, sa * r, c])
-            steps[1].append([k, sb * r, c])
-        else:  # torso to one leg: that leg's role changes, one entry per role
-            pairs += [pa, pb]
-            steps[0].extend([[k, sa * r, c], [0.0, 0.0, 0.0]])
-            steps[1].extend([[0.0, 0.0, 0.0], [k, sb * r, c]])
+    torso, torso_tail = _torso_section(walker_cfg.torso)
+    tail += torso_tail
+    pairs, steps = _spring_steps(walker_cfg.springs)
     hip = walker_cfg.hip_mass_kg > 0
     head = [walker_cfg.gravity_m_per_s2, leg.length_m, slope_rad]
     if hip:
@@ -400,20 +373,71 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
                           hinged_torso=(walker_cfg.torso is not None
                                         and walker_cfg.torso.coupling == "hinged"))
 
-    def params(swing_vals, stance_vals, springs) -> tuple[float, ...]:
-        feet = ((f1, f2) if swing_vals is v1 else (f2, f1)) if asym else (f1,)
-        vals = (head + leg_block(swing_vals, stance_vals) + tail[:n_foot_tail]
-                + [x for f in feet for x in f] + tail[n_foot_tail:])
-        for k in springs:
-            vals += k
-        if knee_spring is not None:
-            vals += [knee_spring.stiffness_n_m_per_rad, knee_spring.rest_angle_rad,
-                     knee_spring.damping_n_m_s_per_rad]
-        return tuple(float(v) for v in vals)
+    def params(swing_vals, stance_vals, feet, springs) -> tuple[float, ...]:
+        return _param_vector(head, _leg_block(bodies, asym, swing_vals, stance_vals),
+                             tail, n_foot_tail, feet if asym else feet[:1], springs,
+                             knee_spring)
 
-    p1 = params(v1, v2, steps[0])
-    p2 = params(v2, v1, steps[1])
+    p1 = params(v1, v2, (f1, f2), steps[0])
+    p2 = params(v2, v1, (f2, f1), steps[1])
     total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
              + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ())))
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
                       slope_rad, extra, None if p2 == p1 else p2)
+
+
+def _leg_block(bodies, asym: bool, swing_vals, stance_vals) -> list[float]:
+    """The legs' numbers of one step: per body, its numbers (the swing role's then, with
+    legs that differ, the stance role's), each followed by its off-axis distance if any."""
+    out = []
+    for i, b in enumerate(bodies):
+        for vals, off in ((swing_vals[i], stance_vals[i]) if asym else (swing_vals[i],)):
+            out += vals + ([off] if b.off_axis else [])
+    return out
+
+
+def _torso_section(torso_cfg) -> tuple[list, list]:
+    """The torso's bodies (:class:`BodySpec`, link ``torso``) and their numbers (mass, distance
+    from the hip, off-axis distance if any, a rigid body's inertia about its centre)."""
+    torso, tail = [], []
+    if torso_cfg is not None:
+        for b in torso_cfg.bodies:
+            rigid = b.kind == "rigid_body"
+            off = b.com_off_axis_m if rigid else b.off_axis_m
+            torso.append(BodySpec(b.name, b.kind, False, "torso", off != 0.0))
+            tail += [b.mass_kg, b.com_from_hip_m if rigid else b.from_hip_m]
+            tail += [off] if off != 0.0 else []
+            tail += [b.inertia_about_com_kg_m2] if rigid else []
+    return torso, tail
+
+
+def _spring_steps(springs) -> tuple[list, tuple[list, list]]:
+    """The springs' role pairs of both steps (leg1 swinging, then leg2) and, per step, each
+    pair's numbers ``[k, r, c]``."""
+    pairs, steps = [], ([], [])
+    for spr in springs:
+        (pa, sa), (pb, sb) = (_spring_roles(spr.between, st) for st in ("leg2", "leg1"))
+        k, r, c = spr.stiffness_n_m_per_rad, spr.rest_angle_rad, spr.damping_n_m_s_per_rad
+        if pa == pb:  # leg to leg: the same pair in both steps, the rest angle's sign flips
+            pairs.append(pa)
+            steps[0].append([k, sa * r, c])
+            steps[1].append([k, sb * r, c])
+        else:  # torso to one leg: that leg's role changes, one entry per role
+            pairs += [pa, pb]
+            steps[0].extend([[k, sa * r, c], [0.0, 0.0, 0.0]])
+            steps[1].extend([[0.0, 0.0, 0.0], [k, sb * r, c]])
+    return pairs, steps
+
+
+def _param_vector(head, block, tail, n_foot_tail: int, feet, springs,
+                  knee_spring) -> tuple[float, ...]:
+    """One step's parameter vector: ``head``, the legs' ``block``, the knee's and arc's
+    numbers, the flat feet's (per role), the torso's, the springs', the knee spring's."""
+    vals = (head + block + tail[:n_foot_tail] + [x for f in feet for x in f]
+            + tail[n_foot_tail:])
+    for k in springs:
+        vals += k
+    if knee_spring is not None:
+        vals += [knee_spring.stiffness_n_m_per_rad, knee_spring.rest_angle_rad,
+                 knee_spring.damping_n_m_s_per_rad]
+    return tuple(float(v) for v in vals)
