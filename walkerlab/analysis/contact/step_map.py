@@ -77,12 +77,8 @@ import numpy as np
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.contact import ContactLimits, run_powered
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
-from walkerlab.integrate.contact_powered import (
-    powered_to_section,
-    pulse_lead,
-    pulse_lead_s,
-    push_off,
-)
+from walkerlab.integrate.contact_powered import pulse_lead, pulse_lead_s
+from walkerlab.integrate.contact_powered_step import powered_to_section, push_off
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
@@ -400,9 +396,9 @@ class StepMap:
         swap.  Push-off alone: the passive flow (compiled, :meth:`_grid_crossing`) to the
         pulse's start (``pulse_s`` before the predicted touchdown of the swing foot on its
         patch ahead; the touchdown itself for an impulse), the pulse on the powered contact
-        integrator (:func:`walkerlab.integrate.contact_powered.push_off`), the passive flow
+        integrator (:func:`walkerlab.integrate.contact_powered_step.push_off`), the passive flow
         to mid-stance; with hip torques the whole step on the powered contact integrator
-        (:func:`walkerlab.integrate.contact_powered.powered_to_section`)."""
+        (:func:`walkerlab.integrate.contact_powered_step.powered_to_section`)."""
         acts = self.walker.actuators
         if not acts.laws:
             return self._push_off_section(x0, stance_to_come, ist, isw, hth)
