@@ -59,10 +59,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
     n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     acts = walker.actuators
 
-    def cross(t, y):
-        return section(y[:n])
-
-    cross.terminal, cross.direction = True, 1.0
+    cross = _section_event(section, n)
     y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
     lead = (_pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
             else None)
@@ -96,6 +93,16 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
             return end
         t, y = got
     return t, y[:n], RunEnd.NO_HEEL_STRIKE
+
+
+def _section_event(section, n: int):
+    """Event: ``section`` of the walker's state (the first ``n`` entries) crosses 0 upwards
+    (terminal)."""
+    def cross(t, y):
+        return section(y[:n])
+
+    cross.terminal, cross.direction = True, 1.0
+    return cross
 
 
 def _pulse_segment(run, y, t, tp, trailing, force, events):
