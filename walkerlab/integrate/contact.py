@@ -95,10 +95,9 @@ class ContactIntegration:
 
     Attributes
     ----------
-    t : ndarray (n,)
-        Sample times [s] (the last one is the event time if an event ended the run).
-    X : ndarray (n, N)
-        States, columns named by ``walker.state_names()``.
+    t, X : ndarray (n,), ndarray (n, N)
+        Sample times [s] (the last one the event time if an event ended the run) and the
+        states there, columns named by ``walker.state_names()``.
     termination : str
         ``t_final``, ``heel_strike`` (the ``stop`` predicate held: strides cap), ``fall``,
         ``trip``, ``airborne``, ``solver_failure`` or ``time_limit``

@@ -79,12 +79,13 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     step_period_s : float
         The rigid step period [s] (sets the run's length).
     strides : int
-        As :func:`contact_replay`.
+        Strides to run (2 steps each).
 
     Returns
     -------
     (step_period_s, outcome) : (float, str)
-        As :func:`contact_replay` (``outcome`` one line).
+        The mean period [s] of the run's steps after the first touchdown and how the run
+        ended, or why there is no replay (one line), as :func:`contact_replay`.
     """
     from walkerlab.config import SolverSettings
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS
