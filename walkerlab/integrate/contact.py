@@ -95,10 +95,9 @@ class ContactIntegration:
 
     Attributes
     ----------
-    t : ndarray (n,)
-        Sample times [s] (the last one is the event time if an event ended the run).
-    X : ndarray (n, N)
-        States, columns named by ``walker.state_names()``.
+    t, X : ndarray (n,), ndarray (n, N)
+        Sample times [s] (the last one the event time if an event ended the run) and the
+        states there, columns named by ``walker.state_names()``.
     termination : str
         ``t_final``, ``heel_strike`` (the ``stop`` predicate held: strides cap), ``fall``,
         ``trip``, ``airborne``, ``solver_failure`` or ``time_limit``
@@ -277,32 +276,22 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
     Returns (t, X, nfev, njev, termination, message, event, work), ``work`` None for a
     passive run (:class:`ContactIntegration`)."""
     if hook is not None:
-        hook.start(x0, t0)
-    be = _Backend(walker, solver, limits.use_jacobian, deadline) if hook is None else None
+        return _run_hooked(hook, x0, t0, t1, limits, stop)
+    be = _Backend(walker, solver, limits.use_jacobian, deadline)
     rate = limits.sample_rate_hz
     ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
     ta, xa = t0, x0
     term, msg, event = RunEnd.T_FINAL, "Integration successful.", None
     n_checked = 1
     # the energy guard (walkerlab.models.contact.energy): no sample above the start's energy + bound
-    if hook is None:  # (a powered walker gains energy: no guard)
-        e_start = float(total_energy(walker, x0)[0])
-        e_bound = energy_rise_bound(walker, x0, solver.rtol)
+    # (a powered walker gains energy: no guard)
+    e_start = float(total_energy(walker, x0)[0])
+    e_bound = energy_rise_bound(walker, x0, solver.rtol)
     guarded = False  # the energy guard ended the run (no event state to interpolate)
     # numbalsoda: the first chunk is short, later ones sized to CHUNK_WALL_S
-    span = (min(limits.chunk_s, 20.0 / rate) if be is not None and be.sized_by_wall
-            else limits.chunk_s)
+    span = min(limits.chunk_s, 20.0 / rate) if be.sized_by_wall else limits.chunk_s
     while ta < t1 - 1e-12:
         tb = min(ta + span, t1)
-        if hook is not None:  # the powered walker's chunk: segments between its events
-            step = hook.advance(tb, t1)
-            if step == "end":
-                break
-            ta = hook.t
-            if step == "strike" and stop is not None and stop(*hook.samples()):
-                hook.stopped()
-                break
-            continue
         tg = sample_grid(ta, tb, rate)
         w0 = time.perf_counter()
         be.calls[0] = 0
@@ -323,14 +312,8 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
         ts.append(tn)
         Xs.append(Xn)
         t_all, X_all = np.concatenate(ts), np.vstack(Xs)
-        # events among the trustworthy samples and the first one past them (a trip's first
-        # sample on the patch already carries the spring's energy)
-        n_ok = len(t_all) if bad is None else n_prev + bad + 1
-        event = first_event(walker, t_all[:n_ok], X_all[:n_ok], limits, k0=n_checked)
+        event = _chunk_event(walker, t_all, X_all, limits, n_checked, n_prev, bad)
         n_checked = len(t_all)
-        if event is not None and bad is not None and event[1] >= n_prev + bad \
-                and event[0] != "trip":
-            event = None  # a fall or flight seen only on a blown-up sample is not one
         if event is None and bad is not None:  # blown-up samples are not data
             ts[-1], Xs[-1] = tn[:bad], Xn[:bad]
             event, term, msg = _energy_guard_end(walker, ta, xa, tn, Xn, bad, n_prev, e_bound,
@@ -352,12 +335,42 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
             term, msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
             break
         ta, xa = t_all[-1], X_all[-1]
-    if hook is not None:
-        return hook.finish()
     t_all, X_all = np.concatenate(ts), np.vstack(Xs)
     if event is not None and not guarded:  # cut at the event and append the event state
         t_all, X_all, msg = _cut_at_event(walker, t_all, X_all, event, term)
     return t_all, X_all, nfev, njev, term, msg, event, None
+
+
+def _chunk_event(walker, t_all, X_all, limits, n_checked: int, n_prev: int, bad):
+    """The first event (:func:`first_event`, from sample ``n_checked`` on) of a passive run's
+    samples so far, ``n_prev`` of them before this chunk, ``bad`` the chunk's first sample
+    over the energy guard (None: none): looked for among the trustworthy samples and the
+    first one past them (a trip's first sample on the patch already carries the spring's
+    energy); a fall or flight seen only on a blown-up sample is not one (None)."""
+    n_ok = len(t_all) if bad is None else n_prev + bad + 1
+    event = first_event(walker, t_all[:n_ok], X_all[:n_ok], limits, k0=n_checked)
+    if event is not None and bad is not None and event[1] >= n_prev + bad \
+            and event[0] != "trip":
+        event = None  # a fall or flight seen only on a blown-up sample is not one
+    return event
+
+
+def _run_hooked(hook, x0, t0, t1, limits, stop):
+    """:func:`_run_free`'s loop for a powered walker: ``hook`` integrates each chunk (segments
+    between its events), ``stop`` asked after each of its heel strikes; returns
+    ``hook.finish()``."""
+    hook.start(x0, t0)
+    ta, span = t0, limits.chunk_s
+    while ta < t1 - 1e-12:
+        tb = min(ta + span, t1)
+        step = hook.advance(tb, t1)
+        if step == "end":
+            break
+        ta = hook.t
+        if step == "strike" and stop is not None and stop(*hook.samples()):
+            hook.stopped()
+            break
+    return hook.finish()
 
 
 def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: float,

@@ -102,79 +102,100 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
         (``"scene"``) and of the best start (``"best"``), so that neither is run again.
     """
     from walkerlab import progress
-    from walkerlab.analysis.contact.sim import simulate_from
 
     cs = setup.sim
-    n_strides = cs.n_strides
     budget = getattr(cs, "adjust_cpu_budget_s", None) if cpu_budget_s is None else cpu_budget_s
     scene_scale = np.asarray(cs.initial_rate_scale, float)
     lo, hi, n = grid
     most = 1 + n * n + NELDER_MEAD_RUNS
-    cpu0 = time.process_time()
-    count = {"n": 0}
-    best = {"J": np.inf, "scale": scene_scale, "run": None}
-    runs = {}
-    errors = []  # (scale, exception) of trial runs that ended in an error
-
-    def J(s, bar):
-        spent = time.process_time() - cpu0
-        if count["n"] and budget is not None and spent > budget:
-            raise _BudgetSpent
-        count["n"] += 1
-        s = np.clip(np.asarray(s, float), 0.2, 5.0)
-        try:
-            run = simulate_from(setup, x_fp, period, rate_scale=tuple(s))
-        except (ValueError, RuntimeError, ArithmeticError) as exc:
-            if "scene" not in runs:  # the scene's own start: as without --adjust
-                raise
-            # an off-nominal start the integrator could not finish (e.g. scipy's event
-            # location on a powered run): a start that does not walk, worse than any fall
-            errors.append((s, exc))
-            v = 2.0 + 2 * n_strides
-            bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: run failed")
-            return v
-        walker, res, _, l_star = run
-        v = start_mismatch(walker, res, period, l_star, n_strides)
-        if "scene" not in runs:
-            runs["scene"] = run
-        if v < best["J"]:
-            best.update(J=v, scale=s, run=run)
-        spent = time.process_time() - cpu0
-        bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: J {v:.3g}; best "
-                   f"{best['J']:.3g}; CPU {spent:.0f} s"
-                   + (f" of {budget:.0f} s" if budget is not None else ""))
-        return v
-
+    trials = _Trials(setup, x_fp, period, budget, scene_scale)
+    best = trials.best
     gave_up = note = ""
     x0 = scene_scale
     with progress.task("adjust: contact runs (the scene's start, a grid, then Nelder-Mead; "
                        "at most)", most) as bar:
         try:
-            scene_J = J(scene_scale, bar)
-            x0 = np.asarray(brute(lambda s: J(s, bar), ((lo, hi), (lo, hi)), Ns=n,
+            scene_J = trials(scene_scale, bar)
+            x0 = np.asarray(brute(lambda s: trials(s, bar), ((lo, hi), (lo, hi)), Ns=n,
                                   finish=None), float)
             if best["J"] >= 1.0:  # no start walked all its heel strikes: J is a step function
-                note = (f"no start walked all {2 * n_strides} heel strikes "
+                note = (f"no start walked all {2 * cs.n_strides} heel strikes "
                         f"(best J {best['J']:.3g}); the Nelder-Mead refinement was skipped")
             else:
-                minimize(lambda s: J(s, bar), x0, method="Nelder-Mead",
+                minimize(lambda s: trials(s, bar), x0, method="Nelder-Mead",
                          options={"xatol": 1e-3, "fatol": 1e-8, "maxfev": NELDER_MEAD_RUNS})
         except _BudgetSpent:
-            gave_up = (f"the search gave up after {time.process_time() - cpu0:.3g} s of CPU "
-                       f"time (contact_sim.adjust_cpu_budget_s: {budget:g} s, checked between "
-                       f"runs) and {count['n']} of at most {most} contact runs; kept the best "
-                       "start found so far")
-    if errors:
-        (s0, e0) = errors[0]
-        first = str(e0).splitlines()[0] if str(e0) else type(e0).__name__
-        note = "; ".join(filter(None, [note, (
-            f"{len(errors)} trial run(s) ended in an error and count as failed starts "
-            f"(the first at rate scale {s0[0]:.3g}, {s0[1]:.3g}: {first})")]))
+            gave_up = (f"the search gave up after {time.process_time() - trials.cpu0:.3g} s "
+                       f"of CPU time (contact_sim.adjust_cpu_budget_s: {budget:g} s, checked "
+                       f"between runs) and {trials.count} of at most {most} contact runs; "
+                       "kept the best start found so far")
+    note = _errors_note(note, trials.errors)
     return {"scale": np.asarray(best["scale"], float), "objective": float(best["J"]),
-            "scene_objective": float(scene_J), "evaluations": count["n"],
-            "grid_best": np.asarray(x0, float), "cpu_s": float(time.process_time() - cpu0),
+            "scene_objective": float(scene_J), "evaluations": trials.count,
+            "grid_best": np.asarray(x0, float),
+            "cpu_s": float(time.process_time() - trials.cpu0),
             "gave_up": gave_up, "note": note,
-            "runs": {"scene": runs.get("scene"), "best": best["run"]}}
+            "runs": {"scene": trials.runs.get("scene"), "best": best["run"]}}
+
+
+class _Trials:
+    """The search's objective over rate scales (:func:`adjust_rates`): each call one contact
+    run from the ideal fixed point, its ``J`` (:func:`start_mismatch`); keeps the count of
+    runs, the best start, the scene's own run (the first) and the trial runs that ended in
+    an error (``ValueError``/``RuntimeError``/``ArithmeticError``: a failed start, ``J = 2 +
+    2 n_strides``); raises :class:`_BudgetSpent` before a run past the CPU budget [s]."""
+
+    def __init__(self, setup, x_fp, period, budget, scene_scale):
+        self.setup, self.x_fp, self.period, self.budget = setup, x_fp, period, budget
+        self.n_strides = setup.sim.n_strides
+        self.cpu0 = time.process_time()
+        self.count = 0
+        self.best = {"J": np.inf, "scale": scene_scale, "run": None}
+        self.runs = {}
+        self.errors = []  # (scale, exception) of trial runs that ended in an error
+
+    def __call__(self, s, bar):
+        from walkerlab.analysis.contact.sim import simulate_from
+
+        best, runs, budget = self.best, self.runs, self.budget
+        spent = time.process_time() - self.cpu0
+        if self.count and budget is not None and spent > budget:
+            raise _BudgetSpent
+        self.count += 1
+        s = np.clip(np.asarray(s, float), 0.2, 5.0)
+        try:
+            run = simulate_from(self.setup, self.x_fp, self.period, rate_scale=tuple(s))
+        except (ValueError, RuntimeError, ArithmeticError) as exc:
+            if "scene" not in runs:  # the scene's own start: as without --adjust
+                raise
+            # an off-nominal start the integrator could not finish (e.g. scipy's event
+            # location on a powered run): a start that does not walk, worse than any fall
+            self.errors.append((s, exc))
+            v = 2.0 + 2 * self.n_strides
+            bar.update(self.count, info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: run failed")
+            return v
+        walker, res, _, l_star = run
+        v = start_mismatch(walker, res, self.period, l_star, self.n_strides)
+        if "scene" not in runs:
+            runs["scene"] = run
+        if v < best["J"]:
+            best.update(J=v, scale=s, run=run)
+        spent = time.process_time() - self.cpu0
+        bar.update(self.count, info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: J {v:.3g}; best "
+                   f"{best['J']:.3g}; CPU {spent:.0f} s"
+                   + (f" of {budget:.0f} s" if budget is not None else ""))
+        return v
+
+
+def _errors_note(note: str, errors) -> str:
+    """``note`` with one line on the trial runs that ended in an error (none: unchanged)."""
+    if not errors:
+        return note
+    (s0, e0) = errors[0]
+    first = str(e0).splitlines()[0] if str(e0) else type(e0).__name__
+    return "; ".join(filter(None, [note, (
+        f"{len(errors)} trial run(s) ended in an error and count as failed starts "
+        f"(the first at rate scale {s0[0]:.3g}, {s0[1]:.3g}: {first})")]))
 
 
 #: run ends of a contact walker that walked cleanly; then those that walked with a defect

@@ -268,26 +268,42 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     """
     wall = time.perf_counter()
     deadline = None if time_limit_s is None else wall + time_limit_s
+    solver, jacobian_solver, coarse_solver = _map_solvers(walker, solver, jacobian_solver,
+                                                          coarse_solver)
+    P, PC, coarse = _step_maps(walker, patch_spacing, solver, coarse_solver, deadline)
+    z, hist = _warm_up_guess(walker, P, PC, guess, rate_scale, warmup_steps)
+    sol, root_nfev = _solve_fixed_point(P, PC, coarse, z, solver.method, fd_step, xtol,
+                                        coarse_xtol, residual_tol)
+    return _periodic_gait_result(
+        walker, P, PC, coarse, sol, root_nfev, hist, solver=solver,
+        coarse_solver=coarse_solver, jacobian_solver=jacobian_solver,
+        patch_spacing=patch_spacing, deadline=deadline, fd_step=fd_step, check_fd=check_fd,
+        residual_tol=residual_tol, wall=wall)
+
+
+def _map_solvers(walker: ContactWalker, solver, jacobian_solver, coarse_solver):
+    """The map's solvers (:func:`find_contact_periodic_gait`): a walker with hip torques has
+    the whole map in Python, so the defaults become the looser :data:`POWERED_MAP_SOLVER`
+    and :data:`POWERED_COARSE_SOLVER`; a solver given stays."""
     acts = getattr(walker, "actuators", None)
     if acts is not None and acts.laws:  # hip torques: the whole map in Python, looser
         solver = POWERED_MAP_SOLVER if solver is MAP_SOLVER else solver
         jacobian_solver = POWERED_MAP_SOLVER if jacobian_solver is MAP_SOLVER else jacobian_solver
         coarse_solver = (POWERED_COARSE_SOLVER if coarse_solver is COARSE_SOLVER
                          else coarse_solver)
+    return solver, jacobian_solver, coarse_solver
+
+
+def _step_maps(walker: ContactWalker, patch_spacing, solver, coarse_solver, deadline):
+    """The step map on ``solver`` and the cheap one on ``coarse_solver`` (the same method) when
+    its ``rtol`` is looser (else the map itself): ``(P, PC, coarse)``."""
     method = solver.method
     P = StepMap(walker, patch_spacing, solver, deadline=deadline)
     coarse = coarse_solver is not None and coarse_solver.rtol > solver.rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, dataclasses.replace(coarse_solver, method=method),
                  deadline=deadline) if coarse else P
-    z, hist = _warm_up_guess(walker, P, PC, guess, rate_scale, warmup_steps)
-    sol, root_nfev = _solve_fixed_point(P, PC, coarse, z, method, fd_step, xtol, coarse_xtol,
-                                        residual_tol)
-    return _periodic_gait_result(
-        walker, P, PC, coarse, sol, root_nfev, hist, solver=solver,
-        coarse_solver=coarse_solver, jacobian_solver=jacobian_solver,
-        patch_spacing=patch_spacing, deadline=deadline, fd_step=fd_step, check_fd=check_fd,
-        residual_tol=residual_tol, wall=wall)
+    return P, PC, coarse
 
 
 def _warm_up_guess(walker: ContactWalker, P: StepMap, PC: StepMap, guess, rate_scale,

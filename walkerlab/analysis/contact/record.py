@@ -151,17 +151,7 @@ def contact_walk(setup: ContactSetup, x_ideal: np.ndarray, period: float,
         tried = adj.pop("runs", None) or {}  # not made again
         scale = adj["scale"]
     if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
-        from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
-        from walkerlab.analysis.contact.step_map import PeriodicGaitError
-
-        try:
-            walker, res, x0, step_length, gait = simulate_from_periodic_gait(
-                setup, x_ideal, solver=solver)
-        except PeriodicGaitError as exc:
-            raise PeriodicGaitError(exc.kind, f"scene '{setup.name}': contact_sim.start: "
-                                    "periodic_gait: "
-                                    f"the contact walker's periodic gait was not found ({exc})"
-                                    ) from None
+        walker, res, x0, step_length, gait = _periodic_start(setup, x_ideal, solver)
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
     else:
         run = tried.get("best") or contact_run.simulate_from(
@@ -176,6 +166,23 @@ def contact_walk(setup: ContactSetup, x_ideal: np.ndarray, period: float,
                 run, scale = plain, None
         walker, res, x0, step_length = run
     return walker, res, x0, step_length, scale, gait, adj
+
+
+def _periodic_start(setup: ContactSetup, x_ideal, solver):
+    """:func:`contact_walk` from the contact model's own periodic gait
+    (``contact_sim.start: periodic_gait``): ``(walker, result, x0, step_length, gait)`` of
+    :func:`~walkerlab.analysis.contact.periodic.simulate_from_periodic_gait`; its
+    ``PeriodicGaitError`` again with the scene and the field named."""
+    from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+    try:
+        return simulate_from_periodic_gait(setup, x_ideal, solver=solver)
+    except PeriodicGaitError as exc:
+        raise PeriodicGaitError(exc.kind, f"scene '{setup.name}': contact_sim.start: "
+                                "periodic_gait: "
+                                f"the contact walker's periodic gait was not found ({exc})"
+                                ) from None
 
 
 def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: bool = False):

@@ -77,26 +77,20 @@ import numpy as np
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.contact import ContactLimits, run_powered
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
-from walkerlab.integrate.contact_powered import (
-    powered_to_section,
-    pulse_lead,
-    pulse_lead_s,
-    push_off,
-)
+from walkerlab.integrate.contact_powered import pulse_lead, pulse_lead_s
+from walkerlab.integrate.contact_powered_step import powered_to_section, push_off
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
 
+from .section import SCALES, SECTION_NAMES, SECTION_UNITS, section_coordinates
+
 brentq = import_on_fresh_stack("scipy.optimize").brentq  # see walkerlab.freshstack
 
 __all__ = ["SCALES", "SECTION_NAMES", "SECTION_UNITS", "PeriodicGaitError", "StepMap",
            "section_coordinates", "section_guess_from_ideal"]
-
-SECTION_NAMES = ("theta_stance", "dtheta_swing", "dtheta_stance", "delta_stance",
-                 "v_t_stance", "ddelta_stance")
-SECTION_UNITS = ("rad", "rad/s", "rad/s", "m", "m/s", "m/s")
 
 
 class PeriodicGaitError(RuntimeError):
@@ -400,9 +394,9 @@ class StepMap:
         swap.  Push-off alone: the passive flow (compiled, :meth:`_grid_crossing`) to the
         pulse's start (``pulse_s`` before the predicted touchdown of the swing foot on its
         patch ahead; the touchdown itself for an impulse), the pulse on the powered contact
-        integrator (:func:`walkerlab.integrate.contact_powered.push_off`), the passive flow
+        integrator (:func:`walkerlab.integrate.contact_powered_step.push_off`), the passive flow
         to mid-stance; with hip torques the whole step on the powered contact integrator
-        (:func:`walkerlab.integrate.contact_powered.powered_to_section`)."""
+        (:func:`walkerlab.integrate.contact_powered_step.powered_to_section`)."""
         acts = self.walker.actuators
         if not acts.laws:
             return self._push_off_section(x0, stance_to_come, ist, isw, hth)
@@ -509,46 +503,6 @@ class StepMap:
             if sel.any():
                 margin = min(margin, float(np.min(hw - np.abs(q["s"][sel] - c))))
         return margin
-
-
-#: coordinate scales (SI) of the straight-legged section (:data:`SECTION_NAMES`) used for
-#: the root finder, the residual and the FD steps; the penetration scale is replaced by the
-#: walker's static penetration at run time (:func:`section_coordinates` for any walker).
-SCALES = np.array([1.0, 1.0, 1.0, 6e-5, 1e-3, 1e-3])
-
-
-def _role_name(state: str, role: str) -> str:
-    """``theta1_thigh`` -> ``theta_<role>_thigh``, ``dtheta2`` -> ``dtheta_<role>``."""
-    head, _, tail = state.partition("_")
-    return head.rstrip("12") + f"_{role}" + (f"_{tail}" if tail else "")
-
-
-def section_coordinates(walker: ContactWalker) -> tuple[tuple, tuple, np.ndarray]:
-    """Names, units and scales of the mid-stance section coordinates of ``walker``.
-
-    All states minus the section constraint (the swing leg's proximal link aligned with the
-    stance leg's) minus the along-slope translation, the hip position replaced by the stance
-    foot's contact: the stance leg's link angles, the swing leg's other link angles, the
-    swing leg's link rates, the stance leg's link rates, then ``delta_stance`` [m],
-    ``v_t_stance`` [m/s], ``ddelta_stance`` [m/s].  Straight legs: :data:`SECTION_NAMES`
-    (6); kneed legs: 10.
-
-    Returns
-    -------
-    names : tuple of str
-    units : tuple of str
-    scale : ndarray (n,)
-        1 rad, 1 rad/s, the static penetration, 1 mm/s, 1 mm/s (:data:`SCALES`).
-    """
-    st, sw = walker.leg_angle_states("leg2"), walker.leg_angle_states("leg1")
-    angles = [_role_name(a, "stance") for a in st] + [_role_name(a, "swing") for a in sw[1:]]
-    rates = ([_role_name("d" + a, "swing") for a in sw]
-             + [_role_name("d" + a, "stance") for a in st])
-    names = tuple(angles + rates) + SECTION_NAMES[-3:]
-    units = ("rad",) * len(angles) + ("rad/s",) * len(rates) + SECTION_UNITS[-3:]
-    scale = np.array([1.0] * (len(angles) + len(rates))
-                     + [walker.static_penetration(), 1e-3, 1e-3])
-    return names, units, scale
 
 
 def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:

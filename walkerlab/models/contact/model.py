@@ -14,7 +14,7 @@ State names
 ``x = [q, dq]``.  The floating coordinates are named by
 :func:`walkerlab.codegen.floating.coordinate_names` (``hip_x``, ``hip_y``, ``leg1_angle``, ...);
 the contact model keeps its established state vocabulary, mapped one to one
-(:data:`STATE_OF_COORDINATE`):
+(:data:`~walkerlab.models.contact.states.STATE_OF_COORDINATE`):
 
 ============================  ===========================  ==========================
 coordinate                    state                        rate state
@@ -42,21 +42,22 @@ of the walkers before flat feet, unchanged), ``leg1_heel``, ``leg1_toe``, ``leg2
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainSettings
 
+from .lanes import checkerboard_lanes, flat_foot_numbers, footprint_offsets
 from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
 from .parts import contact_part
+from .readouts import ContactReadouts
+from .states import FOOT_NAMES, STATE_OF_COORDINATE, state_name
 
 __all__ = ["FOOT_NAMES", "FOOT_RATE_ATOL_FACTOR", "ContactWalker", "STATE_OF_COORDINATE",
            "checkerboard_lanes", "compass_gait_data", "flat_foot_numbers", "footprint_offsets",
            "state_name"]
 
-FOOT_NAMES = ("leg1", "leg2")
 #: A flat foot's rotation rate is integrated to this many times the run's ``atol`` [-]
 #: (:meth:`ContactWalker.atol_scale`).  The regularising foot inertia (0.1 kg, 5e-4 kg m^2)
 #: makes that rate a fast variable on the contact's slow manifold (eigenvalue ~ -7e5 1/s in
@@ -66,74 +67,6 @@ FOOT_NAMES = ("leg1", "leg2")
 #: (4 us steps at mid-stance, 13x the RHS calls at rtol 1e-9) and ends farther from the
 #: reference (configs/flat_feet.yaml, 5 strides: 1.8e-6 -> 2.3e-7 rad at rtol 1e-9).
 FOOT_RATE_ATOL_FACTOR = 100.0
-
-
-def state_name(coordinate: str, rate: bool = False) -> str:
-    """State name of a floating coordinate (module docstring's table)."""
-    if coordinate in ("hip_x", "hip_y"):
-        return ("v" if rate else "") + coordinate
-    if coordinate == "torso_angle":  # a hinged torso (five-link biped)
-        return ("d" if rate else "") + "theta_torso"
-    if coordinate == "wheel_angle":  # a spoked wheel: spoke 0's angle
-        return ("d" if rate else "") + "theta_wheel"
-    leg, rest = coordinate.split("_", 1)
-    i = leg[-1]
-    link = rest[:-len("_angle")]
-    base = f"theta{i}" + ("" if link == "" else f"_{link}")
-    return ("d" if rate else "") + base
-
-
-#: Floating coordinate name -> state name (angle), e.g. ``leg1_angle -> theta1``.
-STATE_OF_COORDINATE = {c: state_name(c) for c in
-                       ("hip_x", "hip_y", "leg1_angle", "leg2_angle", "leg1_thigh_angle",
-                        "leg1_shank_angle", "leg2_thigh_angle", "leg2_shank_angle",
-                        "leg1_foot_angle", "leg2_foot_angle", "torso_angle", "wheel_angle")}
-
-
-def flat_foot_numbers(data) -> list[dict]:
-    """Per leg (leg1, leg2) a flat foot's numbers ``heel``, ``toe`` [m], ``r`` [rad] from the
-    parameter vector (leg1 the swing role's when the legs differ); [] for other feet.
-
-    Parameters
-    ----------
-    data : WalkerData
-        The walker; read are ``data.structure`` and ``data.params`` (shape
-        ``(len(structure.param_names),)``, named by ``structure.param_names``).
-
-    Returns
-    -------
-    list of dict
-        Two dicts (leg1, leg2) with float values ``heel`` [m], ``toe`` [m], ``r`` [rad]; an
-        empty list unless the walker's kind is flat feet (its contact part's
-        :meth:`~walkerlab.models.contact.parts.ContactPart.flat_feet`).
-    """
-    return contact_part(data.structure).flat_feet(data)
-
-
-def footprint_offsets(data) -> tuple[float, float]:
-    """Along-slope offset [m] of each leg's footprint centre from its reference point (the
-    point the ideal footfalls are measured to): 0 for point and arc feet, ``(heel + toe) /
-    2`` for a flat foot (reference = its heel's touchdown point; the foot lies flat from
-    there to ``heel + toe`` downhill)."""
-    f = flat_foot_numbers(data)
-    return tuple(0.5 * (n["heel"] + n["toe"]) for n in f) if f else (0.0, 0.0)
-
-
-def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """Patch centres [m] (along-slope s) of each leg's lane.
-
-    leg2 (first stance leg): s = 0, 2l, 4l, ...; leg1: s = l, 3l, ...; ``n_steps + 2`` footfalls
-    in total so a run of ``n_steps`` steps never runs out of ground.
-
-    Returns
-    -------
-    (c1, c2) : tuple of ndarray
-        Centres of leg1's and leg2's patches [m].
-    """
-    k = n_steps // 2 + 2
-    c2 = 2.0 * step_length * np.arange(k)
-    c1 = step_length * (1.0 + 2.0 * np.arange(k))
-    return c1, c2
 
 
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
@@ -148,7 +81,7 @@ def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
 
 
 @dataclass(frozen=True, eq=False)
-class ContactWalker:
+class ContactWalker(ContactReadouts):
     """A walker, slope, SI contact parameters and terrain.
 
     Attributes
@@ -495,10 +428,8 @@ class ContactWalker:
 
         Parameters
         ----------
-        t : float
-            Time [s] (ignored).
-        x : array_like, shape (2 nq,)
-            State in :meth:`state_names` order, units :meth:`state_units`.
+        t, x
+            As :meth:`rhs` (``t`` ignored; ``x`` of shape (2 nq,)).
 
         Returns
         -------
@@ -605,170 +536,6 @@ class ContactWalker:
         """
         return contact_part(self.structure).link_state(self, np.asarray(x_ideal, float),
                                                        rate_scale)
-
-    # ------------------------------------------------------------------ post-processing
-    def _rows(self, X) -> np.ndarray:
-        return np.ascontiguousarray(np.atleast_2d(X), dtype=float)
-
-    def contact_names(self) -> tuple[str, ...]:
-        """Names of the contact points, in the order of the generated kernels (module
-        docstring): ``leg1``, ``leg2``; flat feet ``leg1_heel``, ``leg1_toe``, ..."""
-        return self._contacts
-
-    def contact_leg(self, name: str) -> str:
-        """The leg (``leg1``/``leg2``) of contact point ``name``."""
-        return FOOT_NAMES[self._point_legs[self._contacts.index(name)]]
-
-    def lane(self, name: str) -> np.ndarray:
-        """Patch centres [m] of the lane of contact point (or leg) ``name``: ``lane1`` or
-        ``lane2``, shape (number of patches,).
-
-        Raises
-        ------
-        ValueError
-            ``name`` is neither a leg nor one of :meth:`contact_names`.
-        """
-        leg = name if name in FOOT_NAMES else self.contact_leg(name)
-        return self.lane1 if leg == "leg1" else self.lane2
-
-    def lane_heights(self, name: str) -> np.ndarray:
-        """Heights [m] (along the slope's outward normal) of the patches of the lane of
-        contact point (or leg) ``name``, one per :meth:`lane` centre (zeros: the flat
-        checkerboard)."""
-        leg = self.contact_leg(name) if name in self._contacts else name
-        return self._kernel_lane1[self.lane1.size:2 * self.lane1.size] if leg == "leg1" \
-            else self._kernel_lane2[self.lane2.size:2 * self.lane2.size]
-
-    def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
-        """Reference contact point of leg ``i`` (0/1) (its only point; a flat foot's heel)
-        and the velocity of the material point there: (px, py, vx, vy) [m, m/s]."""
-        n, nf = self.nq, len(self._contacts)
-        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
-        self.kernels.feet(np.asarray(x, float), self.walker_params, P, V, J)
-        i = self._point_legs.index(i)
-        return float(P[i, 0]), float(P[i, 1]), float(V[i, 0]), float(V[i, 1])
-
-    def foot_positions(self, X) -> np.ndarray:
-        """Reference contact point of each leg (n, 2, 2) [m] (leg, xy) for states X (n, 2 nq),
-        or (2, 2) for one: the foot point, an arc's lowest point, a flat foot's heel."""
-        X = self._rows(X)
-        pts = self.kernels.points(X.T, self.walker_params)
-        key = contact_part(self.structure).foot_point(self.structure)
-        out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
-                        for leg in FOOT_NAMES], axis=1)
-        return out if len(out) > 1 else out[0]
-
-    def points(self, X) -> dict:
-        """Named points (2, n) [m]: hip, each body (``leg1_<body>``), feet, knees."""
-        return self.kernels.points(self._rows(X).T, self.walker_params)
-
-    def hip_height(self, X) -> np.ndarray:
-        """Hip height above the ground line, hip . n [m], for X (n, 2 nq) -> (n,) (numpy: a
-        dot product is not worth a compiled kernel per walker structure, compiled anew in
-        a fresh user cache; the same operations as that kernel had)."""
-        X = self._rows(X)
-        phi = float(self.contact_params[self.kernels.I_PHI])
-        return X[:, 0] * math.sin(phi) + X[:, 1] * math.cos(phi)
-
-    def fall_margin(self, x, threshold: float) -> float:
-        """The one fall test: hip height of state ``x`` minus ``threshold`` [m]
-        (negative = fallen).  Used as the fall event of every integration.
-
-        Parameters
-        ----------
-        x : array_like, shape (2 nq,)
-            State (:meth:`state_names`).
-        threshold : float
-            Hip height [m] below which the walker has fallen.
-        """
-        return float(self.hip_height(x)[0]) - threshold
-
-    def contact_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
-        """Per-contact-point quantities for states X (n, 2 nq) (the contact table).
-
-        Returns
-        -------
-        dict
-            Keyed by :meth:`contact_names` (``{"leg1": {...}, "leg2": {...}}`` for point
-            and arc feet), each with arrays (n,): ``penetration`` [m] (signed; negative =
-            height above ground), ``penetration_rate`` [m/s], ``slip_velocity`` [m/s]
-            (down-slope, of the material point), ``s`` [m] along-slope position,
-            ``normal_force`` [N], ``friction_force`` [N] (along t), ``power`` [W] (F . v),
-            ``on_ground`` (1.0 where the point's lane has ground).
-        """
-        tab = self.kernels.contact_table(self._rows(X), *self._args())
-        names = ("penetration", "penetration_rate", "slip_velocity", "s", "normal_force",
-                 "friction_force", "power", "on_ground")
-        return {foot: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
-                for i, foot in enumerate(self._contacts)}
-
-    def foot_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
-        """Per-leg contact quantities (``leg1``, ``leg2``) for states X (n, 2 nq) [m, rad, m/s,
-        rad/s] (or one state (2 nq,)): the
-        contact table itself for one point per leg; a flat foot's points combined: forces
-        and power summed, the deepest point's penetration, its rate, slip velocity, ``s``
-        and ``on_ground`` (the point that touches down first and lifts off last).
-
-        Returns
-        -------
-        dict
-            ``{"leg1": {...}, "leg2": {...}}``, arrays (n,) as :meth:`contact_quantities`.
-        """
-        cq = self.contact_quantities(X)
-        if self._contacts == FOOT_NAMES or contact_part(self.structure).per_point_feet:
-            return cq
-        out = {}
-        for leg in FOOT_NAMES:
-            pts = [cq[c] for c in self._contacts if self.contact_leg(c) == leg]
-            pen = np.stack([q["penetration"] for q in pts])
-            # the deepest point on ground (a point over a gap does not count)
-            on = np.stack([q["on_ground"] for q in pts]) > 0.5
-            deep = np.argmax(np.where(on, pen, pen - 1e3), axis=0)
-            d = {k: np.take_along_axis(np.stack([q[k] for q in pts]), deep[None], 0)[0]
-                 for k in pts[0]}
-            for k in ("normal_force", "friction_force", "power"):
-                d[k] = np.sum([q[k] for q in pts], axis=0)
-            out[leg] = d
-        return out
-
-    def knee_stop_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
-        """Per-knee stop quantities for states X (n, 2 nq); empty for straight legs.
-
-        Returns
-        -------
-        dict
-            ``{"leg1": {...}, "leg2": {...}}`` each with arrays (n,): ``extension`` [rad]
-            (shank - thigh angle, > 0 hyperextended), ``extension_rate`` [rad/s],
-            ``torque`` [N m] (> 0: pushes the knee straight from hyperextension; < 0: the
-            latch holds a loaded leg's knee against flexion), ``power`` [W] (of the stop on
-            the walker).  Empty for straight legs and free knees (no stop).
-        """
-        if not self.kernels.KNEE:  # straight legs, free knees (no stop)
-            return {}
-        tab = self.kernels.knee_table(self._rows(X), *self._args())
-        names = ("extension", "extension_rate", "torque", "power")
-        return {leg: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
-                for i, leg in enumerate(FOOT_NAMES)}
-
-    def energies(self, X) -> dict[str, np.ndarray]:
-        """Kinetic, potential (relative to y = 0) and total energy [J] for X (n, 2 nq).
-
-        ``T = 1/2 dq^T M(q) dq`` and ``V = g sum(m_i y_i)`` of the generated mechanics
-        (:mod:`walkerlab.codegen.floating`), the contact and knee-stop springs' energy not
-        included.
-
-        Parameters
-        ----------
-        X : array_like, shape (n, 2 nq) or (2 nq,)
-            States (:meth:`state_names`).
-
-        Returns
-        -------
-        dict[str, ndarray]
-            ``kinetic``, ``potential``, ``total``, each of shape (n,) [J].
-        """
-        T, V = self.kernels.energies(self._rows(X).T, self.walker_params)
-        return {"kinetic": T, "potential": V, "total": T + V}
 
     # ------------------------------------------------------------------ compiled integrators
     def pack(self) -> np.ndarray:

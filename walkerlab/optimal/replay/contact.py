@@ -47,14 +47,11 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
               for b in leg.get("bodies", [])]
     if bodies and all(b.get("mass_kg", 1.0) == 0.0 for b in bodies):
         return float("nan"), "not replayed: massless legs (the contact view needs masses)"
-    act = {"torques": [{"joint": "hip", "law": {}}]}
-    if res.push_off_n_s > 0.0:
-        act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
-    setup, why = _powered_setup(scene, act, {"n_strides": strides, "sample_rate_hz": 500})
+    setup, why = _powered_setup(scene, _hip_actuation(res),
+                                {"n_strides": strides, "sample_rate_hz": 500})
     if setup is None:
         return float("nan"), why
-    tau = torque_of_time(res)
-    setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
+    setup.actuators.laws = _law_of_time(torque_of_time(res))
     solver = scene.contact_solver or SolverSettings.for_contact(method="LSODA", rtol=1e-6,
                                                                 atol=1e-8)
     return _run(setup, res.x[0], res.step_period_s, strides, solver)
@@ -86,11 +83,9 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
 
     Returns
     -------
-    step_period_s : float
-        Mean period of the run's steps after the first touchdown [s] (NaN if it made
-        fewer than two).
-    outcome : str
-        How the run ended, or why there is no replay (one line).
+    (step_period_s, outcome) : (float, str)
+        The mean period [s] of the run's steps after the first touchdown and how the run
+        ended, or why there is no replay (one line), as :func:`contact_replay`.
     """
     from walkerlab.config import SolverSettings
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS
@@ -127,17 +122,14 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
         The optimised scene.
     res : walkerlab.optimal.transcription.mode_sequence.PhasedResult
     strides : int
-        Strides to run (2 steps each).
+        As :func:`contact_replay`.
 
     Returns
     -------
-    step_period_s : float
-        Mean period of the run's steps after the first touchdown [s] (NaN if it made
-        fewer than two).
-    outcome : str
-        How the run ended, or why there is no replay (a scene without the contact
-        section's flat-foot regularisation, a walker the contact view carries no hip torque
-        on; one line).
+    (step_period_s, outcome) : (float, str)
+        As :func:`contact_replay`; no replay also for a scene without the contact
+        section's flat-foot regularisation or a walker the contact view carries no hip
+        torque on (one line).
     """
     from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
 
@@ -148,8 +140,7 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
                                  "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S})
     if setup is None:
         return float("nan"), why
-    tau = phase_torque_of_time(res)
-    setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
+    setup.actuators.laws = _law_of_time(phase_torque_of_time(res))
     return _run(setup, res.x[0], res.step_period_s, strides)
 
 
@@ -170,29 +161,23 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     res : walkerlab.optimal.transcription.mode_sequence.PhasedResult
         The optimised stride (its ``step_period_s`` the stride's).
     strides : int
-        Strides to run (2 steps each).
+        As :func:`contact_replay`.
 
     Returns
     -------
-    step_period_s : float
-        Mean period of the run's steps after the first touchdown [s] (NaN if it made
-        fewer than two).
-    outcome : str
-        How the run ended, or why there is no replay (one line).
+    (step_period_s, outcome) : (float, str)
+        As :func:`contact_replay` (``outcome`` one line).
     """
     from walkerlab.config import SolverSettings
     from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
     from walkerlab.optimal.transcription.stride import step_of
 
-    act = {"torques": [{"joint": "hip", "law": {}}]}
-    if res.push_off_n_s > 0.0:  # before each touchdown, as in the rigid model
-        act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
-    setup, why = _powered_setup(scene, act, {"n_strides": strides, "sample_rate_hz": 500})
+    setup, why = _powered_setup(scene, _hip_actuation(res),
+                                {"n_strides": strides, "sample_rate_hz": 500})
     if setup is None:
         return float("nan"), why
     acts = setup.actuators
-    laws = [(lambda tau: lambda delta, ddelta, s, ds, t: np.array([tau(float(t))]))(
-        phase_torque_of_time(step_of(res, k))) for k in (0, 1)]
+    laws = [_law_of_time(phase_torque_of_time(step_of(res, k))) for k in (0, 1)]
     own = acts.hip_torque
 
     def hip_torque(x, stance: int, t_step: float = 0.0):  # stance 1: leg2, leg A's step
@@ -203,6 +188,21 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     # replay is kept as it was): the outcome of a failure says so
     solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
     return _run(setup, res.x[0], res.step_period_s / 2, strides, solver, fixed=True)
+
+
+def _hip_actuation(res) -> dict:
+    """The actuation section of a replay of ``res``: a hip torque (its law set after) and the
+    optimum's push-off impulse before each touchdown (as in the rigid model) if it has one."""
+    act = {"torques": [{"joint": "hip", "law": {}}]}
+    if res.push_off_n_s > 0.0:
+        act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
+    return act
+
+
+def _law_of_time(tau):
+    """A hip torque law ``(delta, ddelta, s, ds, t) -> [tau(t)]`` [N m] of the time ``t`` [s]
+    since the step's touchdown alone."""
+    return lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
 
 
 def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = False):

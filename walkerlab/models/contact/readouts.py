@@ -1,0 +1,183 @@
+"""What a contact run's states show: the contact table per point and per leg, the knee
+stops, points, energies and the fall test of a
+:class:`~walkerlab.models.contact.model.ContactWalker` (the mix-in :class:`ContactReadouts`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .parts import contact_part
+from .states import FOOT_NAMES
+
+__all__ = ["ContactReadouts"]
+
+
+class ContactReadouts:
+    """Post-processing of a :class:`~walkerlab.models.contact.model.ContactWalker`'s states
+    (a mix-in: it reads the walker's compiled ``kernels``, ``walker_params``, its contact
+    points ``_contacts`` and ``_point_legs``, and ``nq``)."""
+
+    def _rows(self, X) -> np.ndarray:
+        return np.ascontiguousarray(np.atleast_2d(X), dtype=float)
+
+    def contact_names(self) -> tuple[str, ...]:
+        """Names of the contact points, in the order of the generated kernels (module
+        docstring): ``leg1``, ``leg2``; flat feet ``leg1_heel``, ``leg1_toe``, ..."""
+        return self._contacts
+
+    def contact_leg(self, name: str) -> str:
+        """The leg (``leg1``/``leg2``) of contact point ``name``."""
+        return FOOT_NAMES[self._point_legs[self._contacts.index(name)]]
+
+    def lane(self, name: str) -> np.ndarray:
+        """Patch centres [m] of the lane of contact point (or leg) ``name``: ``lane1`` or
+        ``lane2``, shape (number of patches,).
+
+        Raises
+        ------
+        ValueError
+            ``name`` is neither a leg nor one of :meth:`contact_names`.
+        """
+        leg = name if name in FOOT_NAMES else self.contact_leg(name)
+        return self.lane1 if leg == "leg1" else self.lane2
+
+    def lane_heights(self, name: str) -> np.ndarray:
+        """Heights [m] (along the slope's outward normal) of the patches of the lane of
+        contact point (or leg) ``name``, one per :meth:`lane` centre (zeros: the flat
+        checkerboard)."""
+        leg = self.contact_leg(name) if name in self._contacts else name
+        return self._kernel_lane1[self.lane1.size:2 * self.lane1.size] if leg == "leg1" \
+            else self._kernel_lane2[self.lane2.size:2 * self.lane2.size]
+
+    def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
+        """Reference contact point of leg ``i`` (0/1) (its only point; a flat foot's heel)
+        and the velocity of the material point there: (px, py, vx, vy) [m, m/s]."""
+        n, nf = self.nq, len(self._contacts)
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
+        self.kernels.feet(np.asarray(x, float), self.walker_params, P, V, J)
+        i = self._point_legs.index(i)
+        return float(P[i, 0]), float(P[i, 1]), float(V[i, 0]), float(V[i, 1])
+
+    def foot_positions(self, X) -> np.ndarray:
+        """Reference contact point of each leg (n, 2, 2) [m] (leg, xy) for states X (n, 2 nq),
+        or (2, 2) for one: the foot point, an arc's lowest point, a flat foot's heel."""
+        X = self._rows(X)
+        pts = self.kernels.points(X.T, self.walker_params)
+        key = contact_part(self.structure).foot_point(self.structure)
+        out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
+                        for leg in FOOT_NAMES], axis=1)
+        return out if len(out) > 1 else out[0]
+
+    def points(self, X) -> dict:
+        """Named points (2, n) [m]: hip, each body (``leg1_<body>``), feet, knees."""
+        return self.kernels.points(self._rows(X).T, self.walker_params)
+
+    def hip_height(self, X) -> np.ndarray:
+        """Hip height above the ground line, hip . n [m], for X (n, 2 nq) -> (n,) (numpy: a
+        dot product is not worth a compiled kernel per walker structure, compiled anew in
+        a fresh user cache; the same operations as that kernel had)."""
+        X = self._rows(X)
+        phi = float(self.contact_params[self.kernels.I_PHI])
+        return X[:, 0] * math.sin(phi) + X[:, 1] * math.cos(phi)
+
+    def fall_margin(self, x, threshold: float) -> float:
+        """The one fall test: hip height of state ``x`` minus ``threshold`` [m]
+        (negative = fallen).  Used as the fall event of every integration.
+
+        Parameters
+        ----------
+        x : array_like, shape (2 nq,)
+            State (:meth:`state_names`).
+        threshold : float
+            Hip height [m] below which the walker has fallen.
+        """
+        return float(self.hip_height(x)[0]) - threshold
+
+    def contact_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
+        """Per-contact-point quantities for states X (n, 2 nq) (the contact table).
+
+        Returns
+        -------
+        dict
+            Keyed by :meth:`contact_names` (``{"leg1": {...}, "leg2": {...}}`` for point
+            and arc feet), each with arrays (n,): ``penetration`` [m] (signed; negative =
+            height above ground), ``penetration_rate`` [m/s], ``slip_velocity`` [m/s]
+            (down-slope, of the material point), ``s`` [m] along-slope position,
+            ``normal_force`` [N], ``friction_force`` [N] (along t), ``power`` [W] (F . v),
+            ``on_ground`` (1.0 where the point's lane has ground).
+        """
+        tab = self.kernels.contact_table(self._rows(X), *self._args())
+        names = ("penetration", "penetration_rate", "slip_velocity", "s", "normal_force",
+                 "friction_force", "power", "on_ground")
+        return {foot: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
+                for i, foot in enumerate(self._contacts)}
+
+    def foot_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
+        """Per-leg contact quantities (``leg1``, ``leg2``) for states X (n, 2 nq) [m, rad, m/s,
+        rad/s] (or one state (2 nq,)): the
+        contact table itself for one point per leg; a flat foot's points combined: forces
+        and power summed, the deepest point's penetration, its rate, slip velocity, ``s``
+        and ``on_ground`` (the point that touches down first and lifts off last).
+
+        Returns
+        -------
+        dict
+            ``{"leg1": {...}, "leg2": {...}}``, arrays (n,) as :meth:`contact_quantities`.
+        """
+        cq = self.contact_quantities(X)
+        if self._contacts == FOOT_NAMES or contact_part(self.structure).per_point_feet:
+            return cq
+        out = {}
+        for leg in FOOT_NAMES:
+            pts = [cq[c] for c in self._contacts if self.contact_leg(c) == leg]
+            pen = np.stack([q["penetration"] for q in pts])
+            # the deepest point on ground (a point over a gap does not count)
+            on = np.stack([q["on_ground"] for q in pts]) > 0.5
+            deep = np.argmax(np.where(on, pen, pen - 1e3), axis=0)
+            d = {k: np.take_along_axis(np.stack([q[k] for q in pts]), deep[None], 0)[0]
+                 for k in pts[0]}
+            for k in ("normal_force", "friction_force", "power"):
+                d[k] = np.sum([q[k] for q in pts], axis=0)
+            out[leg] = d
+        return out
+
+    def knee_stop_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
+        """Per-knee stop quantities for states X (n, 2 nq); empty for straight legs.
+
+        Returns
+        -------
+        dict
+            ``{"leg1": {...}, "leg2": {...}}`` each with arrays (n,): ``extension`` [rad]
+            (shank - thigh angle, > 0 hyperextended), ``extension_rate`` [rad/s],
+            ``torque`` [N m] (> 0: pushes the knee straight from hyperextension; < 0: the
+            latch holds a loaded leg's knee against flexion), ``power`` [W] (of the stop on
+            the walker).  Empty for straight legs and free knees (no stop).
+        """
+        if not self.kernels.KNEE:  # straight legs, free knees (no stop)
+            return {}
+        tab = self.kernels.knee_table(self._rows(X), *self._args())
+        names = ("extension", "extension_rate", "torque", "power")
+        return {leg: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
+                for i, leg in enumerate(FOOT_NAMES)}
+
+    def energies(self, X) -> dict[str, np.ndarray]:
+        """Kinetic, potential (relative to y = 0) and total energy [J] for X (n, 2 nq).
+
+        ``T = 1/2 dq^T M(q) dq`` and ``V = g sum(m_i y_i)`` of the generated mechanics
+        (:mod:`walkerlab.codegen.floating`), the contact and knee-stop springs' energy not
+        included.
+
+        Parameters
+        ----------
+        X : array_like, shape (n, 2 nq) or (2 nq,)
+            States (:meth:`state_names`).
+
+        Returns
+        -------
+        dict[str, ndarray]
+            ``kinetic``, ``potential``, ``total``, each of shape (n,) [J].
+        """
+        T, V = self.kernels.energies(self._rows(X).T, self.walker_params)
+        return {"kinetic": T, "potential": V, "total": T + V}
