@@ -43,7 +43,9 @@ def pytest_collection_modifyitems(config, items):
     """Each test file runs on one pytest-xdist worker (``--dist loadgroup``, pyproject): a
     file's module-scoped fixtures (fixed points, compiled models) are computed once, not once
     per worker, and the two workers do not compile the same model side by side.  Tests with
-    an ``xdist_group`` mark of their own keep it (the group then spans files)."""
+    an ``xdist_group`` mark of their own keep it (the group then spans files).  The long
+    runs (``slow``) are spread over both workers one by one: each is long beside its file's
+    fixtures."""
     for item in items:
-        if not any(item.iter_markers("xdist_group")):
+        if not any(item.iter_markers("xdist_group")) and not any(item.iter_markers("slow")):
             item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))

@@ -24,8 +24,10 @@ search); ``pytest -m slow`` tries every cell.  This replaces issue 48's probing 
 from __future__ import annotations
 
 import copy
+import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -128,10 +130,9 @@ def _rigid(d, tmp):
 
 
 def _contact(d, tmp):
+    from walkerlab.api.walker import Walker
     from walkerlab.config import scene_from_dict
     from walkerlab.models.contact.scene import contact_setup
-
-    from walkerlab.api.walker import Walker
 
     # contact-sim starts from the rigid gait (fixedpoint.h5; on a profile the slope's): its
     # walker
@@ -176,7 +177,7 @@ PROBES = {"rigid": _rigid, "contact": _contact, "mjcf": _export("mjcf"),
 
 #: a message that says the walker has no gait (its dynamics, not a refusal of the cell)
 NO_GAIT = ("no rigid gait", "no period-1 gait found", "FixedPointNotFound", "GaitNotFound",
-           "no fixed point", "did not converge")
+           "no fixed point", "did not converge", "has no gait of its own to start from")
 
 
 def outcome(kind: str, feature: str, view: str, tmp: Path, monkeypatch) -> tuple[str, str]:
@@ -191,10 +192,16 @@ def outcome(kind: str, feature: str, view: str, tmp: Path, monkeypatch) -> tuple
     d = scene_for(kind, feature, view)
     probe = PROBES[view]
     try:
-        if view == "optimize":
-            probe(d, tmp, monkeypatch)
-        else:
-            probe(d, tmp)
+        with warnings.catch_warnings():
+            # a gait search on an odd walker (a knee torque's law on RABBIT's gait) warns on
+            # its way to no gait (a zero denominator, a complex step cast); the cell is about
+            # what the view accepts, not that search's numerics
+            warnings.simplefilter("ignore", RuntimeWarning)
+            warnings.simplefilter("ignore", np.exceptions.ComplexWarning)
+            if view == "optimize":
+                probe(d, tmp, monkeypatch)
+            else:
+                probe(d, tmp)
     except (FixedPointNotFound, GaitNotFound) as exc:
         return "accepted", f"no gait: {type(exc).__name__}"
     except (ValueError, StageError) as exc:
@@ -228,6 +235,15 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
     return tuple(out)
 
 
+def _reasons_on_the_way(kind: str, feature: str, view: str) -> tuple[str, ...]:
+    """The table's reasons a probe of ``(feature, view)`` may meet first: the feature's in
+    every view (each probe builds the rigid walker and lays the scene's ground) and the
+    walker's own in ``view``."""
+    k = KINDS[kind]
+    out = [k.cell(feature, v) for v in VIEWS] + [k.cell("walk", view)]
+    return tuple(r for r in out if r)
+
+
 def _check(kind, feature, view, tmp_path, monkeypatch):
     why = KINDS[kind].cell(feature, view)
     status, line = outcome(kind, feature, view, tmp_path, monkeypatch)
@@ -237,9 +253,12 @@ def _check(kind, feature, view, tmp_path, monkeypatch):
         if status == "accepted" and line.startswith("no gait"):
             pytest.skip(f"no gait before the view's check ({line[:80]})")
         assert status == "refused", f"the table refuses ({why}); the view accepts {line}"
-        said = (why, *absent_part(kind, feature))
+        # every view's probe passes through others first (the rigid gait, the scene's
+        # ground): the refusal may be the table's for this feature in another view, or for
+        # the walker itself in this one - still one of the table's reasons
+        said = (why, *absent_part(kind, feature), *_reasons_on_the_way(kind, feature, view))
         assert any(s in line for s in said), \
-            f"the table's reason {why!r} is not in the refusal {line!r}"
+            f"none of the table's reasons {said!r} is in the refusal {line!r}"
 
 
 #: the cells the quick suite tries (each under ~1 s: set-ups and the refusals that come

@@ -216,7 +216,7 @@ def check_kind(scene, kind) -> None:
     """Refuse what the walker's kind does not have in the collocation, from the capability
     table (:data:`walkerlab.walker.kinds.CAPABILITIES`, view ``optimize``): the walker
     itself (a spoked wheel), a push-off (fixed, ``walker.actuation.push_off``, or
-    ``optimize.push_off: free``), an ankle push-off.
+    ``optimize.push_off: free``), an ankle push-off, an ankle torque.
 
     Parameters
     ----------
@@ -238,6 +238,9 @@ def check_kind(scene, kind) -> None:
         kind.require("push_off", "optimize", "optimize.push_off")
     if act is not None and act.ankle_push_off is not None:
         kind.require("ankle_push_off", "optimize", "walker.actuation.ankle_push_off")
+    for i, t in enumerate(act.torques if act is not None else ()):
+        if t.joint.endswith("_ankle"):  # a step from targets builds no rigid walker to ask
+            kind.require("ankle_torque", "optimize", f"walker.actuation.torques.{i}.joint")
 
 
 def check_scene(scene, data=None) -> None:

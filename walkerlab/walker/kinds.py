@@ -212,6 +212,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("profile", "rigid"): _FLAT_LANDING,
         ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
                              "arc feet (a flat foot's modes have no per-step landing yet)"),
+        # the exports refuse any walker's footholds that differ before its feet
+        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
         ("profile", "adams"): _ADAMS_PROFILE,
         ("profile", "gym"): _GYM_GROUND,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,

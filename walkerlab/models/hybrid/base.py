@@ -67,6 +67,31 @@ class OffSection(RuntimeError):
     as a fall is."""
 
 
+class SectionInverse:
+    """A walker's ``from_section`` whose domain errors are :class:`OffSection`: the generated
+    inverse solves the guard for an angle (``acos``, ``sqrt``), and section coordinates no
+    state on the surface has raise ``ValueError("math domain error")`` there - for a root
+    finder that is a point off the surface, as an unreachable landing is.
+
+    Parameters
+    ----------
+    inverse : callable ``z -> x``
+        The generated inverse of ``section``.
+    """
+
+    def __init__(self, inverse: Callable[[np.ndarray], np.ndarray]):
+        self.inverse = inverse
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        try:
+            return self.inverse(z)
+        except ValueError as exc:
+            if "math domain error" not in str(exc):
+                raise
+            raise OffSection(f"no state on the heel-strike surface at section coordinates "
+                             f"{np.asarray(z).tolist()} ({exc})") from None
+
+
 def role_to_leg(stance_leg: str) -> dict[str, str]:
     """``{"stance": stance_leg, "swing": other leg}``.
 
@@ -250,6 +275,11 @@ class HybridWalker:
     step_entry: Callable[[np.ndarray], tuple] | None = None
     cycle: tuple | None = None
     ground_steps: int | None = None
+
+    def __post_init__(self):
+        # the inverse of the section raises OffSection off the surface (SectionInverse)
+        if not isinstance(self.from_section, SectionInverse):
+            object.__setattr__(self, "from_section", SectionInverse(self.from_section))
 
     def for_step(self, k: int) -> HybridWalker:
         """The walker of step ``k`` (0-based from the map's start, ``legs[1]`` in stance
