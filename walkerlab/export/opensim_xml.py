@@ -274,8 +274,8 @@ def spring_forces(mb) -> list[str]:
 
 def knee_stop_forces(mb, stop: str, latch: str) -> list[str]:
     """Each knee's stop (expression ``stop``) and latch (``latch``, applying no force by
-    default) as ``ExpressionBasedCoordinateForce`` (:func:`walkerlab.export.opensim.
-    knee_stop_expression`)."""
+    default) as ``ExpressionBasedCoordinateForce``
+    (:func:`walkerlab.export.opensim.knee_stop_expression`)."""
     out = []
     for ln in mb.links:
         if ln.joint.endswith("_knee"):

@@ -221,6 +221,6 @@ PARTS: dict[str, ContactPart] = {
 
 
 def contact_part(structure) -> ContactPart:
-    """The contact view's part of ``structure``'s kind (:attr:`walkerlab.walker.description.
-    Structure.kind`)."""
+    """The contact view's part of ``structure``'s kind
+    (:attr:`walkerlab.walker.description.Structure.kind`)."""
     return PARTS[structure.kind.name]
