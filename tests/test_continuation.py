@@ -20,6 +20,7 @@ import pytest
 from scipy.optimize import brentq, root
 from typer.testing import CliRunner
 
+from tests.cli_run import run_cli as _cli
 from walkerlab.analysis.continuation.branch import SPECIAL_KINDS
 from walkerlab.analysis.gait.poincare import poincare_map
 from walkerlab.cli import app
@@ -188,9 +189,7 @@ def test_paper_rods_bifurcation_chain_keeps_the_stable_long_gait():
 def test_artifact_round_trip_and_cli(tmp_path):
     """The CLI writes continuation_<field>.h5 (kinds as strings, the parameter in its unit,
     the branch period) and its figure; the loader reads back the located points."""
-    from typer.testing import CliRunner
 
-    from walkerlab.cli import app
     from walkerlab.io.schemas.continuation import load_continuation
 
     r = CliRunner().invoke(app, ["continuation", str(ROOT / "configs" / "paper_rods.yaml"),
@@ -272,9 +271,7 @@ def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
     ``initial_guess`` naming a continuation artifact and a parameter value starts the root
     finder on that branch: it converges to the continuation's own fixed point there."""
     import yaml
-    from typer.testing import CliRunner
 
-    from walkerlab.cli import app
 
     d = yaml.safe_load((ROOT / "configs" / "kneed.yaml").read_text())
     d["slope"]["angle_rad"], d["walker"]["hip_mass_kg"] = 0.12, 1.0
@@ -391,9 +388,6 @@ def test_a_homotopy_from_a_scene_with_the_same_numbers_says_so_without_an_empty_
 
 
 # -------------------- --param of a continuation, a fall named once, a two-parameter artifact
-def _cli(*args, env=None):
-    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 def _one_line(*args) -> str:

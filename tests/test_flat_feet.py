@@ -10,10 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from typer.testing import CliRunner
 
+from tests.cli_run import run_cli as _cli
 from walkerlab.analysis.gait.poincare import find_fixed_point
-from walkerlab.cli import app
 from walkerlab.codegen.cache import functions
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
@@ -506,9 +505,6 @@ def test_the_guards_the_walker_calls_have_the_right_sign_along_a_step(walker, st
 
 
 # -------------------- flat-foot edges
-def _cli(*args, env=None):
-    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 FLAT = yaml.safe_load((ROOT / "configs" / "flat_feet.yaml").read_text())

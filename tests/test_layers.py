@@ -490,7 +490,9 @@ def _kind_switch_reads(tree: ast.Module) -> list[int]:
             out.append(n.lineno)
         elif isinstance(n, ast.Compare) and any(
                 isinstance(c, ast.Constant) and c.value in ("flat", "rimless_wheel")
-                for c in [n.left, *n.comparators]):
+                for side in [n.left, *n.comparators]
+                for c in (side.elts if isinstance(side, (ast.Tuple, ast.List, ast.Set))
+                          else [side])):
             out.append(n.lineno)
     return out
 
@@ -515,5 +517,6 @@ def test_the_walker_kind_is_chosen_once_and_the_layers_consult_it():
         if lines := _kind_switch_reads(_tree(p)):
             found[rel.as_posix()] = lines
     assert set(found) <= KIND_SWITCH_READERS, found
-    probe = 'if st.foot == "flat" or s.free_knees or leg.knee.lock: pass\nn = w.spokes'
-    assert sorted(_kind_switch_reads(ast.parse(probe))) == [1, 1, 1, 2]  # the reader sees
+    probe = ('if st.foot == "flat" or s.free_knees or leg.knee.lock: pass\nn = w.spokes\n'
+             'r = f in ("arc", "flat")')
+    assert sorted(_kind_switch_reads(ast.parse(probe))) == [1, 1, 1, 2, 3]  # the reader sees

@@ -9,6 +9,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from tests.cli_run import IDEAL
+from tests.cli_run import run_cli as _cli
 from walkerlab.analysis.robustness import mfpt as M
 from walkerlab.cli import app
 from walkerlab.config import load_scene
@@ -364,9 +366,7 @@ def test_the_mfpt_lines_give_the_standard_error_and_the_falls_and_no_mesh_nan(tm
                                                                              monkeypatch):
     """Issue 56 item 16: the terminal printed "MFPT Monte Carlo 1234, mesh nan steps" for a
     Monte-Carlo-only study, without the standard error or the number of walks that fell."""
-    from typer.testing import CliRunner
 
-    from walkerlab.cli import app
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
     from walkerlab.stages import common, pipeline
     from walkerlab.studies.mfpt import mfpt_summary
@@ -411,16 +411,6 @@ def test_mfpt_says_it_does_not_use_the_scenes_per_step_slope_spread(tmp_path, mo
 
 
 # -------------------- an unconverged mesh
-PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
-
-
-IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
-                                                  "simulate")}
-
-
-def _cli(*args, env=None):
-    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 def _scene(tmp_path: Path, name: str = "paper", **sections) -> Path:

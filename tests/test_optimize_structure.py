@@ -72,19 +72,13 @@ def test_one_record_type_per_optimum():
 
 def _switch_reads(tree) -> list:
     """The lines of ``tree`` that read a switch of the walker's description choosing its
-    kind (``.free_knees``, ``.spokes``, ``.lock``, ``structure.knee``, ``foot.kind``, a
-    comparison with ``"flat"`` or ``"rimless_wheel"``) or ``getattr(..., "actuation")``."""
-    out = []
+    kind (:func:`tests.test_layers._kind_switch_reads`; here ``knee.lock`` or any ``.lock``
+    too) or ``getattr(..., "actuation")``."""
+    from tests.test_layers import _kind_switch_reads
+
+    out = _kind_switch_reads(tree)
     for n in ast.walk(tree):
-        if isinstance(n, ast.Attribute) and (
-                n.attr in ("free_knees", "spokes", "lock")
-                or (n.attr == "knee" and getattr(n.value, "attr", getattr(n.value, "id", ""))
-                    in ("structure", "st"))
-                or (n.attr == "kind" and getattr(n.value, "attr", "") == "foot")):
-            out.append(n.lineno)
-        elif isinstance(n, ast.Compare) and any(
-                isinstance(c, ast.Constant) and c.value in ("flat", "rimless_wheel")
-                for c in [n.left, *n.comparators]):
+        if isinstance(n, ast.Attribute) and n.attr == "lock" and n.lineno not in out:
             out.append(n.lineno)
         elif (isinstance(n, ast.Call) and getattr(n.func, "id", "") == "getattr"
               and len(n.args) > 1 and getattr(n.args[1], "value", None) == "actuation"):

@@ -24,6 +24,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from tests.cli_run import IDEAL
+from tests.cli_run import run_cli as _cli
 from walkerlab.cli import app
 from walkerlab.cli.errors import one_line as _one_line
 from walkerlab.config import scene_from_dict
@@ -33,15 +35,7 @@ from walkerlab.io.runpaths import RunPathError, artifact_lock
 from walkerlab.stages import common
 
 ROOT = Path(__file__).resolve().parents[1]
-PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
-IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
-                                                  "simulate")}
 ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
-
-
-def _cli(*args, env=None):
-    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 def _fake_compute(value: float):

@@ -8,9 +8,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import yaml
-from typer.testing import CliRunner
 
-from walkerlab.cli import app
+from tests.cli_run import IDEAL
+from tests.cli_run import run_cli as _cli
 from walkerlab.comparison.report_numbers import report_numbers
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.io.schemas.compare import load_compare
@@ -105,16 +105,6 @@ def test_a_spring_written_as_an_actuator_law_is_named_as_motor_work():
 
 
 # -------------------- the gait simulate starts from; a damper is not drift
-PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
-
-
-IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
-                                                  "simulate")}
-
-
-def _cli(*args, env=None):
-    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 # ------------------------------------------------------------------ 10: the gait simulate uses

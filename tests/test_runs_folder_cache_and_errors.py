@@ -25,6 +25,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from tests.cli_run import IDEAL, PAPER
+from tests.cli_run import run_cli as _cli
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.io import freshness
@@ -38,9 +40,6 @@ from walkerlab.studies.outcomes import empty_row
 from walkerlab.studies.params import SweepError, parse_param
 
 ROOT = Path(__file__).resolve().parents[1]
-PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
-IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
-                                                  "simulate")}
 
 
 def _with(base: dict, path: str, value) -> dict:
@@ -57,11 +56,6 @@ def _write(path: Path, data: dict) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(yaml.safe_dump(data))
     return path
-
-
-def _cli(*args, env=None):
-    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 # ------------------------------------------------------------------ D1, D2: names and paths

@@ -36,6 +36,7 @@ from walkerlab.analysis.contact.verdict import (
     walk_verdict,
 )
 from walkerlab.integrate.contact import hermite_root
+from walkerlab.models.contact.parts import contact_part
 
 __all__ = ["CONTACT_OUTCOMES", "FOOT_MODES", "ContactResult", "FootTrace", "Outcome",
            "PatchFit", "StepSummary", "classify", "classify_complete", "foot_modes",
@@ -472,7 +473,8 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     initial_stance = _first_stance(feet, initial_stance)
     # an arc's contact point moves as it rolls, a flat foot's loaded point changes from heel
     # to toe: their slip is the integral of the material point's tangential velocity
-    rolling = getattr(getattr(walker, "structure", None), "foot", "point") in ("arc", "flat")
+    st = getattr(walker, "structure", None)
+    rolling = st is not None and contact_part(st).foot_rolls(st)
     names = list(feet)
     starts = [t[0]] + hs_t
     legs = [initial_stance] + hs_leg

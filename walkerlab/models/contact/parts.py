@@ -44,6 +44,11 @@ class ContactPart:
         contact point: the foot point, an arc's lowest point."""
         return "contact" if structure.foot == "arc" else "foot"
 
+    def foot_rolls(self, structure) -> bool:
+        """Whether the foot's loaded contact point moves along it during stance (an arc rolls;
+        a point does not): its slip is then the material point's tangential velocity."""
+        return structure.foot == "arc"
+
     def rigid_values(self, walker, x) -> dict:
         """The rigid state ``x`` (role order) by link name (absolute coordinates: the rigid
         layout's names; otherwise through the generated leg angles)."""
@@ -124,6 +129,9 @@ class FlatFeetPart(ContactPart):
 
     def foot_point(self, structure) -> str:
         return "heel"
+
+    def foot_rolls(self, structure) -> bool:
+        return True  # the loaded point goes from heel to toe
 
     def rigid_values(self, walker, x) -> dict:
         values = super().rigid_values(walker, x)
