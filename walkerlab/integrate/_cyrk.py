@@ -25,7 +25,7 @@ import ctypes
 
 import numpy as np
 
-__all__ = ["CYRK_METHODS", "solve_chunk"]
+__all__ = ["CYRK_METHODS", "DenseInterval", "solve_chunk"]
 
 #: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (RHS calls
 #: of ``walkerlab bench contact``): CyRK's LSODA needs ~1.3x the RHS calls of numbalsoda's, its
@@ -34,7 +34,8 @@ __all__ = ["CYRK_METHODS", "solve_chunk"]
 #: ~ -1e5 1/s).
 CYRK_METHODS = {"cyrk_bdf": "BDF"}
 
-_FPTR: dict = {}  # generated kernels module name -> cfunc address
+_FPTR: dict = {}
+FIRST = [0.0]  # generated kernels module name -> cfunc address
 
 
 def address(kernels, ready=None) -> int:
@@ -50,36 +51,41 @@ def address(kernels, ready=None) -> int:
 
 def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
                 rtol: float, atol, max_step: float = np.inf, max_num_steps: int = 0, *,
-                kernels=None, ready=None):
+                kernels=None, ready=None, dense: bool = False):
     """Integrate from ``x0`` at ``t_eval[0]`` over the sample times ``t_eval`` (n,) [s].
 
     Parameters
     ----------
     method : str
         A key of :data:`CYRK_METHODS`.
-    x0 : ndarray (2 nq,)
+    x0 : ndarray (N,)
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :meth:`walkerlab.models.contact.model.ContactWalker.pack`.
+        From :meth:`walkerlab.models.contact.model.ContactWalker.pack` (or a powered
+        walker's :meth:`walkerlab.models.contact.powered_data.PoweredData.data`).
     rtol : float
-    atol : float or ndarray (2 nq,)
+    atol : float or ndarray (N,)
         [m, rad, m/s, rad/s].
     max_step : float
         Largest step [s] (inf: none).
-    kernels : module
-        The walker's generated kernels (``ContactWalker.kernels``).
     max_num_steps : int
         Most solver steps in this call (0: CyRK's default); past it the call stops
         unsuccessfully at the last sample reached (how a caller bounds the wall time of a
         compiled chunk, which checks no clock).
+    kernels : module
+        The walker's generated kernels (``ContactWalker.kernels``), or a stand-in with
+        ``__name__`` and ``build_cyrk()``.
     ready : walkerlab.codegen.pending.CompiledElsewhere, optional
         The caller's hand-off when a side process compiles the right-hand side
         (``ContactWalker.rhs_ready``).
+    dense : bool
+        Keep CyRK's dense output: a fifth value, the :class:`DenseInterval` over the
+        samples reached (the caller frees it).
 
     Returns
     -------
-    X : ndarray (m, 2 nq)
+    X : ndarray (m, N)
         States at ``t_eval[:m]`` (``m = n`` on success; fewer when the solver stopped early).
     ok : bool
         CyRK reported success.
@@ -101,11 +107,13 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     # (one call per chunk; avoids compiling that njit wrapper in every process)
     ptr = ns.c_numba_cysolve_ivp(
         fptr, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
-        0, 0, data.ctypes.data, data.size * 8, int(max_num_steps), 2000, False,
+        0, 0, data.ctypes.data, data.size * 8, int(max_num_steps), 2000, bool(dense),
         te.ctypes.data, te.size, None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data,
-        at.size, hmax, 0.0, True)
+        at.size, hmax, float(FIRST[0]), True)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK
-        return np.empty((0, u0.size)), False, 0, "CyRK returned no result"
+        out = np.empty((0, u0.size)), False, 0, "CyRK returned no result"
+        return (*out, None) if dense else out
+    kept = False
     try:
         ok = bool(ns.c_get_success(ptr))
         n = int(ns.c_get_size(ptr))
@@ -117,6 +125,33 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
         buf = ctypes.create_string_buffer(256)
         ns.c_get_msg_buf(ptr, ctypes.addressof(buf), 256)
         msg = buf.value.decode(errors="replace")
+        if dense:
+            kept = True
+            return X, ok, nfev, msg, DenseInterval(ptr, u0.size)
     finally:
-        ns.c_free(ptr)
+        if not kept:
+            ns.c_free(ptr)
     return X, ok, nfev, msg
+
+
+class DenseInterval:
+    """CyRK's dense output of one integration (:func:`solve_chunk` with ``dense``): call it
+    at a time [s] inside the integrated span for the state (N,); :meth:`free` releases
+    CyRK's solution."""
+
+    def __init__(self, ptr, n: int):
+        self.ptr, self.n = ptr, n
+
+    def __call__(self, t: float) -> np.ndarray:
+        from CyRK.nb import numba_solver as ns
+
+        y = np.empty(self.n)
+        ns.c_call(self.ptr, float(t), y.ctypes.data)
+        return y
+
+    def free(self) -> None:
+        from CyRK.nb import numba_solver as ns
+
+        if self.ptr:
+            ns.c_free(self.ptr)
+            self.ptr = None

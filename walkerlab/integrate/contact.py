@@ -362,7 +362,7 @@ def _run_hooked(hook, x0, t0, t1, limits, stop):
     hook.start(x0, t0)
     ta, span = t0, limits.chunk_s
     while ta < t1 - 1e-12:
-        tb = min(ta + span, t1)
+        tb = min(hook.segment_end(ta, span), t1)
         step = hook.advance(tb, t1)
         if step == "end":
             break

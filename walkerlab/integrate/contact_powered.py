@@ -46,19 +46,23 @@ with ``E`` the walker's kinetic + gravitational energy (the contact springs' ene
 the contact term).  Samples are on the run's grid (``sample_rate_hz`` from ``t0``); trips and
 flights are found on them as in the passive run (:func:`walkerlab.integrate.contact.first_event`).
 
-Methods: a :func:`~scipy.integrate.solve_ivp` method of the settings (``LSODA``, ``Radau``,
-``BDF``, ...); ``numbalsoda`` and ``odeint`` have no event location and run as ``LSODA``
-here.  With ``cyrk_bdf`` a walker whose actuation the compiled kernel carries (point or arc
-feet, straight legs, plain hip laws: :func:`walkerlab.integrate.contact_powered_chunks.
-chunk_rhs`) runs between its events in compiled chunks on the run's samples, as the passive
-run does; the sample interval where an event's function changes sign is handed to the
-``LSODA`` segments here, which locate the event and apply its transition (the push-off pulse
-runs there too); other walkers run as ``LSODA``.  The analytic Jacobian of the passive
-walker is passed to ``solve_ivp`` (the actuation's derivatives left out: Newton directions
-only).
+Methods: with ``cyrk_bdf`` (:data:`walkerlab.integrate._cyrk.CYRK_METHODS`) the run is
+compiled segments (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`): the
+walker's actuators are data of its compiled right-hand side
+(:mod:`walkerlab.models.contact.powered_source`: torque laws with their phase and time
+tables, the pulse, the ankle push-off, the stance leg and the step's start), the events are
+found on each segment's samples and located on CyRK's dense output, and after a heel strike
+the run goes on from a sample :data:`RESUME_BACK_S` before it with the strike in its data;
+no Python runs inside a step.  A replay whose laws are Python callables, and the
+:func:`~scipy.integrate.solve_ivp` methods (``LSODA``, ``Radau``, ``BDF``, ...), run
+``solve_ivp`` segments with the same events (``numbalsoda`` and ``odeint`` have no event
+location and run as ``LSODA`` here); the analytic Jacobian of the passive walker is passed
+to ``solve_ivp`` (the actuation's derivatives left out: Newton directions only).
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 
@@ -77,9 +81,17 @@ IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
 #: force jump the solver cannot step over, e.g. a foot entering a patch from its side).
 STALL_CALLS = 20_000
 
-#: Most CyRK steps in one compiled chunk of a powered run (as the passive loop's
-#: ``CYRK_STEPS_PER_CALL``): past it the chunk goes on in ``solve_ivp``.
-CHUNK_STEPS = 100_000
+#: A compiled segment ends this many times the last step's duration after the step began
+#: (:meth:`ActuationHook.segment_end`).
+STEP_MARGIN = 1.1
+#: ... and at least this long [s].
+MIN_SEGMENT_S = 0.05
+#: A compiled run goes on after a heel strike from a sample this long [s] before it, the
+#: strike in its data (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`):
+#: CyRK's BDF started cold at a touchdown takes ~1.6x the evaluations of one that meets
+#: it warm (the paper walker, 0.65 s after a touchdown: 4188 against 2554 from 50 ms
+#: before).
+RESUME_BACK_S = 0.05
 
 
 class _Deadline(Exception):
@@ -131,6 +143,26 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
                      events=events, dense_output=False, **kw)
 
 
+def compiled_segments(walker, solver, grid):
+    """The compiled segments of a powered run
+    (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`), or None when the run
+    is on ``solve_ivp``: ``solver.method`` not a compiled one
+    (:data:`walkerlab.integrate._cyrk.CYRK_METHODS`) or torque laws that are not data (a
+    replay's Python callables: :func:`walkerlab.models.contact.powered_data.powered_data`)."""
+    from walkerlab.models.contact.powered_data import powered_data
+
+    from ._cyrk import CYRK_METHODS
+
+    if solver.method not in CYRK_METHODS:
+        return None
+    data = powered_data(walker)
+    if data is None:
+        return None
+    from .compiled_segments import CompiledSegments
+
+    return CompiledSegments(walker, data, solver, powered_atol(walker, solver.atol), grid)
+
+
 def powered_atol(walker, atol: float):
     """The absolute tolerance of a powered run's state and work integrals: the scalar
     ``atol``, or, for hip torques on flat feet, ``atol`` times the walker's per-state
@@ -164,6 +196,12 @@ def _touchdown_event(walker, stance_of):
             return 1.0
         return -float(sw[0])
 
+    def values(X):  # the same on states X (m, 2 nq)
+        sw, st = _leg_rows(walker, X, stance_of())
+        away = (sw[:, 7] < 0.5) | (sw[:, 3] - st[:, 3] < acts.min_step_m)
+        return np.where(away, 1.0, -sw[:, 0])
+
+    touch.values = values
     touch.terminal = True
     touch.direction = -1
     return touch
@@ -185,9 +223,31 @@ def _pulse_event(walker, stance_of, lead_s: float):
             return 1.0
         return -float(pulse_lead(sw[0], sw[1], lead_s))
 
+    def values(X):  # the same on states X (m, 2 nq)
+        sw, st = _leg_rows(walker, X, stance_of())
+        away = (sw[:, 7] < 0.5) | (sw[:, 3] - st[:, 3] < acts.min_step_m)
+        return np.where(away, 1.0, -pulse_lead(sw[:, 0], sw[:, 1], lead_s))
+
+    pulse.values = values
     pulse.terminal = True
     pulse.direction = -1
     return pulse
+
+
+def _leg_rows(walker, X, stance: int):
+    """The swing and stance legs' contact-table rows (m, 8) on states ``X`` (m, 2 nq): each
+    leg's deepest point on ground (its only point for point feet), as
+    :meth:`~walkerlab.models.contact.actuation.ContactRows.leg_contacts` picks it."""
+    tab = walker.kernels.contact_table(np.ascontiguousarray(X, float), *walker._args())
+    names = walker.contact_names()
+    out = []
+    for leg in ("leg1", "leg2"):
+        idx = [k for k, c in enumerate(names) if walker.contact_leg(c) == leg]
+        rows = tab[:, idx]  # (m, points, 8)
+        pick = np.argmax(np.where(rows[:, :, 7] > 0.5, rows[:, :, 0], rows[:, :, 0] - 1e3),
+                         axis=1)
+        out.append(rows[np.arange(len(X)), pick])
+    return out[1 - stance], out[stance]
 
 
 def pulse_lead(penetration, rate, pulse_s: float):
@@ -222,6 +282,12 @@ def _heel_off_event(walker, stance_of):
             return 1.0
         return float(tab[heel[stance], 0])
 
+    def values(X):  # the same on states X (m, 2 nq)
+        stance = stance_of()
+        tab = walker.kernels.contact_table(np.ascontiguousarray(X, float), *walker._args())
+        return np.where(tab[:, toe[stance], 0] <= 0.0, 1.0, tab[:, heel[stance], 0])
+
+    heel_off.values = values
     heel_off.terminal = True
     heel_off.direction = -1
     return heel_off
@@ -233,6 +299,7 @@ def _fall_event(walker, limits):
     def fall(t, y):
         return walker.fall_margin(y[:n], limits.fall_hip_height_m)
 
+    fall.values = lambda X: walker.hip_height(X) - limits.fall_hip_height_m
     fall.terminal = True
     fall.direction = -1
     return fall
@@ -291,6 +358,11 @@ class ActuationHook:
         self.deadline, self.grid = deadline, grid
         self.stance = 1  # leg2 carries the first stance (the contact model's convention)
         self.t_origin = float(grid[0])  # when the present step began [s]
+        self.step_s = None  # the last step's duration [s] (none before the first strike)
+        # a compiled run's next segment from before the last heel strike: (t, y, stance,
+        # step start, ankle on) before it (None: from the present state)
+        self.resume, self.segment = None, None
+        self.segments = None  # compiled segments, set by start() where they apply
         self.touch = _touchdown_event(walker, lambda: self.stance)
         self.fall = _fall_event(walker, limits)
         self.heel_off = (None if walker.actuators.ankle is None  # flat feet only
@@ -300,10 +372,35 @@ class ActuationHook:
         self.term, self.msg, self.event = RunEnd.T_FINAL, "Integration successful.", None
 
     def _run(self, y, t, tb, push, events):
-        """One segment; returns the solution, or None when the run ends here."""
+        """One segment (compiled where :attr:`segments` is set, else on ``solve_ivp``);
+        returns the solution, or None when the run ends here."""
+        from .compiled_segments import Stalled
+
         try:
-            sol = _segment(self.walker, y, t, tb, self.grid, self.stance, push, self.solver,
-                           self.limits, self.deadline, events, self.t_origin, self.ankle_on)
+            if self.segments is not None:
+                if time.perf_counter() > self.deadline:
+                    raise _Deadline
+                if self.resume is not None and push is None:  # from before the strike
+                    tr, yr, stance, origin, ankle = self.resume
+                    sol = self.segments.run(yr, tr, tb, events, stance, origin, None, ankle,
+                                            switch_s=t)
+                else:
+                    sol = self.segments.run(y, t, tb, events, self.stance, self.t_origin,
+                                            push, self.ankle_on)
+                self.resume = None
+                self.segment = (t, y, sol)
+            else:
+                sol = _segment(self.walker, y, t, tb, self.grid, self.stance, push,
+                               self.solver, self.limits, self.deadline, events,
+                               self.t_origin, self.ankle_on)
+        except Stalled as stall:
+            from .contact_events import trip_or_failure
+
+            t_s, y_s, why = stall.args
+            self.term, self.msg, self.event = trip_or_failure(
+                self.walker, t_s, np.asarray(y_s)[:2 * self.walker.nq],
+                f"the compiled solver stopped at t = {t_s:.6g} s ({why})", -1, 0.01)
+            return None
         except _Deadline:
             self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             return None
@@ -368,55 +465,7 @@ class ActuationHook:
         self.lead = (_pulse_event(self.walker, lambda: self.stance, acts.pulse_s)
                      if self.pulsed else None)
         self.pushed = False
-        # the compiled chunks between events (contact_powered_chunks), where they apply
-        from .contact_powered_chunks import chunk_rhs
-
-        self.fast = chunk_rhs(self.walker, self.solver.method)
-
-    def _compiled(self, tb: float):
-        """A compiled chunk from the present state to ``tb`` [s] on the run's samples
-        (:mod:`walkerlab.integrate.contact_powered_chunks`): ``"go"`` when it reached ``tb``
-        with no event on its samples, ``"end"`` at the deadline, else the time [s] of the
-        sample closing the first sample interval where an event's function changes sign
-        (or where the compiled solver stopped), the present state moved to the interval's
-        start: ``solve_ivp`` takes it from there."""
-        import time
-
-        from . import _cyrk
-
-        walker, acts, n = self.walker, self.walker.actuators, 2 * self.walker.nq
-        t, grid = self.t, self.grid
-        tg = np.concatenate([[t], grid[(grid > t + 1e-12) & (grid < tb - 1e-12)], [tb]])
-        s = self.solver
-        X, ok, nf, _m = _cyrk.solve_chunk(
-            s.method, self.y, tg, self.fast.data(self.stance), s.rtol,
-            powered_atol(walker, s.atol), s.max_step_s or np.inf, CHUNK_STEPS,
-            kernels=self.fast.kernels)
-        self.nfev += nf
-        if len(X) < 2:
-            return tb
-        # per point: penetration, its rate, slip, s, Fn, Ff, power, on_ground
-        rows = walker.kernels.contact_table(np.ascontiguousarray(X[:, :n]), *walker._args())
-        sw, st = rows[:, acts.push_row(walker, 1 - self.stance)], \
-            rows[:, acts.push_row(walker, self.stance)]
-        ahead = (sw[:, 7] >= 0.5) & (sw[:, 3] - st[:, 3] >= acts.min_step_m)
-        gs = [walker.hip_height(X[:, :n]) - self.limits.fall_hip_height_m,
-              np.where(ahead, -sw[:, 0], 1.0)]
-        if self.pulsed and not self.pushed:
-            gs.append(np.where(ahead, -pulse_lead(sw[:, 0], sw[:, 1], acts.pulse_s), 1.0))
-        hit = np.zeros(len(X) - 1, bool)
-        for g in gs:  # solve_ivp's rule for direction -1: g >= 0, then g <= 0
-            hit |= (g[:-1] >= 0.0) & (g[1:] <= 0.0)
-        k = int(np.argmax(hit)) + 1 if hit.any() else len(X)
-        self.ts.append(tg[1:k])
-        self.Ys.append(X[1:k])
-        self.t, self.y = float(tg[k - 1]), X[k - 1].copy()
-        if k == len(X) == len(tg) and ok:
-            return "go"
-        if time.perf_counter() > self.deadline:
-            self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
-            return "end"
-        return float(tg[k]) if k < len(tg) else tb
+        self.segments = compiled_segments(self.walker, self.solver, self.grid)
 
     def advance(self, tb: float, t1: float) -> str:
         """Integrate from the present ``(self.t, self.y)`` to ``tb`` [s] or the next discrete
@@ -427,12 +476,6 @@ class ActuationHook:
         predicate) or ``"go"``."""
         acts = self.walker.actuators
         n = 2 * self.walker.nq
-        if self.fast is not None and acts.laws is self.fast.source:  # compiled up to
-            # the sample interval of the next event
-            got = self._compiled(tb)
-            if isinstance(got, str):
-                return got
-            tb = got
         t, y = self.t, self.y
         watch = acts.ankle is not None and not self.ankle_on
         arm = self.pulsed and not self.pushed
@@ -485,9 +528,12 @@ class ActuationHook:
         self._keep(sol, t)
         self.t, self.y = t, y
         trailing = self.stance
+        before = (trailing, self.t_origin, self.ankle_on)
         self._strike(t)
         P = acts.impulse(y[:n]) if not self.pushed else 0.0
         self.pushed = False
+        if self.segments is not None and not P > 0.0:  # the next segment: from before it
+            self.resume = (*self._back(t), *before)
         if P > 0.0 and acts.pulse_s == 0.0:
             y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
             y[n + 2] += w
@@ -534,7 +580,27 @@ class ActuationHook:
     def _strike(self, t):
         """Heel strike at ``t`` [s]: the roles swap, the step's clock and ankle reset."""
         self.stance = 1 - self.stance
+        self.step_s = t - self.t_origin
         self.t_origin, self.ankle_on = t, False
+
+    def _back(self, te: float):
+        """``(t, y)``: the last sample of the present compiled segment (or its start) at
+        least :data:`RESUME_BACK_S` before the heel strike at ``te`` [s]."""
+        t0, y0, sol = self.segment
+        ok = np.flatnonzero(np.asarray(sol.t) <= te - RESUME_BACK_S)
+        if not ok.size:
+            return t0, np.asarray(y0, float).copy()
+        return float(sol.t[ok[-1]]), sol.y[:, ok[-1]].copy()
+
+    def segment_end(self, ta: float, span: float) -> float:
+        """Where the loop's next chunk from ``ta`` [s] ends: ``ta + span`` on ``solve_ivp``;
+        on compiled segments, which integrate to their end before their events are looked
+        for, :data:`STEP_MARGIN` times the last step's duration after the present step's
+        start (the integration past the touchdown is thrown away), at least
+        :data:`MIN_SEGMENT_S` ahead."""
+        if self.segments is None or self.step_s is None:
+            return ta + span
+        return max(self.t_origin + STEP_MARGIN * self.step_s, ta + MIN_SEGMENT_S)
 
     def _keep_last(self, t, y):
         if t > self.ts[-1][-1] + 1e-12 if len(self.ts[-1]) else True:

@@ -84,6 +84,10 @@ from walkerlab.walker.description import Structure
 
 __all__ = ["ASSEMBLY", "NPC", "contact_module", "contact_source", "rhs_source"]
 
+#: The files whose text the generated module's source is made of (its cache key).
+_SOURCES = (Path(__file__), Path(__file__).with_name("powered_source.py"),
+            Path(__file__).parents[2] / "codegen" / "torque_law.py")
+
 #: Number of contact parameters (see the table above).
 NPC = 18
 
@@ -562,7 +566,7 @@ def build_lsoda(sig):
 '''
 
 
-def rhs_source(eq) -> str:
+def rhs_source(eq, forced: bool = False) -> str:
     """Straight-line numba source of ``rhs(x, PC, p, c1, c2)`` for the floating equations
     ``eq`` (:class:`walkerlab.codegen.floating.FloatingEquations`): the feet's contact points
     and material velocities, the contact forces and knee-stop torques from the laws, then
@@ -574,6 +578,12 @@ def rhs_source(eq) -> str:
     The generated ``rhs`` takes the state ``x`` of shape (2 nq,) [m, rad, m/s, rad/s], the
     contact parameters ``PC`` (SI), the walker's parameters ``p`` (SI) and the kernel lanes
     ``c1``, ``c2`` [m], and returns dx/dt of shape (2 nq,).
+
+    ``forced``: the source of ``rhs_q(x, PC, p, c1, c2, Qx, pw)`` instead, the same
+    arithmetic with the generalised force ``Qx`` (nq,) [N, N m] added to ``Q - h`` before the
+    solve (an actuated walker's forces, :mod:`walkerlab.models.contact.powered_source`), and
+    ``pw`` (2,) filled with the contact forces' power ``sum F . v`` over the contact points
+    (their material velocities) and the knee stops' power ``-T d(ext)/dt`` [W].
     """
     import sympy as sp
     from sympy.printing.pycode import PythonCodePrinter
@@ -581,7 +591,9 @@ def rhs_source(eq) -> str:
     pr = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
     nq = len(eq.q)
     dqv = sp.Matrix(eq.dq)
-    lines = ["@njit(cache=True, error_model='numpy')", "def rhs(x, PC, p, c1, c2):",
+    head = ("def rhs_q(x, PC, p, c1, c2, Qx, pw):" if forced
+            else "def rhs(x, PC, p, c1, c2):")
+    lines = ["@njit(cache=True, error_model='numpy')", head,
              '    """dx/dt (NX,) of the free-floating walker (generated straight-line code)."""',
              f"    {', '.join(str(s) for s in eq.params)}, = p"]
     lines += [f"    {s} = x[{i}]" for i, s in enumerate(eq.q)]
@@ -594,8 +606,11 @@ def rhs_source(eq) -> str:
     repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
     lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
     Fs = sp.symbols(" ".join(f"_Fx{i} _Fy{i}" for i in range(len(eq.feet))), real=True)
+    power = []  # forced: each point's F . v
     for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
         args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
+        power.append(f"{Fs[2 * i]} * ({pr.doprint(red[4 * i + 2])}) + "
+                     f"{Fs[2 * i + 1]} * ({pr.doprint(red[4 * i + 3])})")
         lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})",
                   # (Fn, Ff) in the world, along the ground's normal (the slope's: _sp, _cp)
                   f"    {Fs[2 * i]} = _r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]",
@@ -614,6 +629,7 @@ def rhs_source(eq) -> str:
                          f"{eq.dq[sh]} - {eq.dq[t]}, PC, {dl})")
             Q[t] += T
             Q[sh] -= T
+            power.append(f"-{T} * ({eq.dq[sh]} - {eq.dq[t]})")
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}
     mexprs = [eq.M[i, j] for i in range(nq) for j in range(i + 1) if (i, j) in nz]
     repl, red = sp.cse(mexprs + list(Q), symbols=sp.numbered_symbols("_m"), order="none")
@@ -624,7 +640,11 @@ def rhs_source(eq) -> str:
             if (i, j) in nz:
                 lines.append(f"    _M{i}_{j} = {pr.doprint(next(it))}")
     for i in range(nq):
-        lines.append(f"    _Q{i} = {pr.doprint(next(it))}")
+        lines.append(f"    _Q{i} = {pr.doprint(next(it))}" + (f" + Qx[{i}]" if forced else ""))
+    if forced:
+        nf = len(eq.feet)
+        lines.append(f"    pw[0] = {' + '.join(power[:nf])}")
+        lines.append(f"    pw[1] = {' + '.join(power[nf:]) or '0.0'}")
     # unrolled Cholesky M = L L^T with structural zeros (and fill-in) tracked
     Lnz = set()
     for j in range(nq):
@@ -662,6 +682,8 @@ def contact_source(structure: Structure, key: str) -> str:
     """
     from walkerlab.codegen import floating
 
+    from .powered_source import powered_source
+
     eq = floating.derive_floating(structure)
     if structure.knee and len(eq.feet) != 2:
         raise ValueError("a kneed walker's contact model needs one contact point per leg")
@@ -669,7 +691,8 @@ def contact_source(structure: Structure, key: str) -> str:
     legs = tuple(eq.point_legs)
     return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(eq.knees)}\n"
             f"NF = {len(eq.feet)}\nPOINT_LEG = {legs!r}\nPIN = {legs.index(1)}\n"
-            f"CONTACTS = {tuple(eq.contacts)!r}\n" + ASSEMBLY + "\n\n" + rhs_source(eq))
+            f"CONTACTS = {tuple(eq.contacts)!r}\n" + ASSEMBLY + "\n\n" + rhs_source(eq)
+            + "\n\n" + rhs_source(eq, forced=True) + "\n\n" + powered_source())
 
 
 def contact_module(structure: Structure):
@@ -686,7 +709,7 @@ def contact_module(structure: Structure):
     floating.check_masses(structure)
     return floating.load_generated(structure, "contact",
                                    lambda key: contact_source(structure, key),
-                                   sources=(Path(__file__),))
+                                   sources=_SOURCES)
 
 
 def contact_module_state(structure: Structure) -> tuple[str, bool | None]:
@@ -697,4 +720,4 @@ def contact_module_state(structure: Structure) -> tuple[str, bool | None]:
     folder), without generating or importing it."""
     from walkerlab.codegen import floating
 
-    return floating.generated_state(structure, "contact", sources=(Path(__file__),))
+    return floating.generated_state(structure, "contact", sources=_SOURCES)

@@ -1,0 +1,152 @@
+"""Compiled segments of a powered contact run: CyRK's BDF on the walker's compiled powered
+right-hand side (:mod:`walkerlab.models.contact.powered_source`), with event location.
+
+A segment integrates from ``(t0, y0)`` to ``t1`` on the run's sample grid in one compiled
+call (no Python inside it); the run's event functions (:mod:`walkerlab.integrate.
+contact_powered`: the swing foot's touchdown, the push-off pulse's start, a flat foot's heel
+lift-off, a fall) are evaluated on its samples at once, vectorised over the contact table.
+In the first sample interval where one of them changes sign in its direction (the rule of
+:func:`scipy.integrate.solve_ivp`: ``g >= 0`` then ``g <= 0`` for direction -1) the interval
+is integrated again with CyRK's dense output, and the event is located on that interpolant by
+:func:`scipy.optimize.brentq` (``xtol`` 1e-13 s); the state there is the interpolant's.  The
+answer has :func:`~scipy.integrate.solve_ivp`'s shape (``t``, ``y``, ``t_events``,
+``y_events``, ``status``, ``nfev``), so the event loop is the same for either integrator.
+
+Python runs per segment and per event (a handful per step), never per integrator step.
+"""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+
+from . import _cyrk
+
+__all__ = ["CompiledSegments", "LOCATE_XTOL_S"]
+
+#: Event location's tolerance on the time [s] (scipy's ``solve_ivp`` locates to 4 eps).
+LOCATE_XTOL_S = 1e-13
+#: Most CyRK steps of one segment; past them the segment stops (a stall: the caller's).
+SEGMENT_STEPS = 100_000
+
+_ADDRESS: dict = {}  # generated kernels module name -> powered cfunc address
+
+
+class Stalled(Exception):
+    """The compiled solver stopped inside a segment (``args``: the time [s] and state it
+    reached, CyRK's message)."""
+
+
+class CompiledSegments:
+    """Segments of a powered contact walker's run on its compiled right-hand side.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators``.
+    data : walkerlab.models.contact.powered_data.PoweredData
+    solver : Solver
+        ``method`` a key of :data:`walkerlab.integrate._cyrk.CYRK_METHODS`, tolerances.
+    atol : float or ndarray
+        Absolute tolerance of the state and the work integrals.
+    grid : ndarray
+        The run's sample times [s].
+    """
+
+    def __init__(self, walker, data, solver, atol, grid):
+        self.walker, self.pdata, self.solver, self.atol, self.grid = (walker, data, solver,
+                                                                     atol, grid)
+        name = walker.kernels.__name__
+        if name not in _ADDRESS:
+            _ADDRESS[name] = walker.kernels.build_cyrk_powered()
+        # a kernels stand-in for _cyrk.solve_chunk: the powered cfunc
+        self.kernels = types.SimpleNamespace(__name__=f"{name}_powered",
+                                             build_cyrk=lambda: _ADDRESS[name])
+
+    def run(self, y0, t0: float, t1: float, events, stance: int, t_origin: float,
+            push=None, ankle: bool = False, switch_s: float = np.inf):
+        """Integrate from ``y0`` (2 nq + works,) at ``t0`` to ``t1`` [s] or the first of
+        ``events`` (each with ``values(X) -> (m,)`` on states ``X`` (m, 2 nq), direction
+        -1).  Returns a namespace like :func:`scipy.integrate.solve_ivp`'s: ``t`` (k,) the
+        samples after ``t0`` up to the event or ``t1``, ``y`` (N, k), ``t_events`` and
+        ``y_events`` (one list entry per event, at most one located), ``status`` (0 the
+        end, 1 an event), ``nfev``, ``njev`` (0).
+
+        ``switch_s`` [s]: a heel strike located before, inside ``(t0, t1)``: the other leg
+        in stance from then (the data's switch); the answer starts after it (its samples
+        and events after ``switch_s`` only).  A run resumed this way from a sample some
+        way before the heel strike meets the collision with the solver's order and step
+        built up, instead of starting it cold at the touchdown.
+
+        Raises
+        ------
+        Stalled
+            The compiled solver stopped before ``t1`` (its step limit or a failure).
+        """
+        s, grid = self.solver, self.grid
+        d = self.pdata.data(stance, t_origin, push, ankle, switch_s)
+        tg = np.concatenate([[t0], grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)], [t1]])
+        X, ok, nfev, msg, dense = _cyrk.solve_chunk(
+            s.method, y0, tg, d, s.rtol, self.atol, s.max_step_s or np.inf, SEGMENT_STEPS,
+            kernels=self.kernels, dense=True)
+        try:
+            out = self._answer(X, ok, nfev, msg, dense, tg, events, len(y0), switch_s)
+        finally:
+            if dense is not None:
+                dense.free()
+        if np.isfinite(switch_s):  # the samples after the heel strike only
+            keep = out.t > switch_s + 1e-12
+            out.t, out.y = out.t[keep], out.y[:, keep]
+        return out
+
+    def _answer(self, X, ok, nfev, msg, dense, tg, events, ny, switch_s):
+        """:meth:`run`'s answer from the segment's samples ``X`` at ``tg`` and its dense
+        output: cut at the first event located on it."""
+        n = 2 * self.walker.nq
+        out = types.SimpleNamespace(t_events=[np.empty(0) for _ in events],
+                                    y_events=[np.empty((0, ny)) for _ in events],
+                                    nfev=nfev, njev=0, status=0, message=msg)
+        m = len(X)
+        G = np.column_stack([ev.values(X[:, :n]) for ev in events]) if events and m \
+            else np.empty((m, 0))
+        hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
+        if len(hit):
+            hit[0] &= G[0] > 0.0  # an event at the start was the last segment's
+        if len(hit) and np.isfinite(switch_s):  # before the switch: the last step's
+            hit &= (tg[:m - 1] >= switch_s - 1e-12)[:, None]
+        rows = np.flatnonzero(hit.any(axis=1))
+        if rows.size:
+            k = int(rows[0])
+            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(hit[k]),
+                                n)
+            out.t, out.y = tg[1:k + 1], X[1:k + 1].T
+            out.t_events[j], out.y_events[j] = np.array([te]), ye[None]
+            out.status = 1
+            return out
+        if not ok or m < len(tg):
+            k = max(m - 1, 0)
+            raise Stalled(float(tg[k]), X[k].copy() if m else np.full(ny, np.nan), msg)
+        out.t, out.y = tg[1:], X[1:].T
+        return out
+
+
+def _locate(dense, x0, ta: float, tb: float, events, which, n: int):
+    """The first root in ``[ta, tb]`` [s] of the events ``which`` (changing sign on the
+    samples at ``ta`` and ``tb``) on the dense output: ``(event index, time, state)``; an
+    event that changes sign on the samples but not on the interpolant is located at ``tb``
+    (the interpolant agrees with the samples to the solver's tolerance)."""
+    from scipy.optimize import brentq
+
+    best = None
+    for j in which:
+        ev = events[j]
+
+        def g(t, ev=ev):
+            return float(ev.values(dense(t)[None, :n])[0])
+
+        ga, gb = float(ev.values(x0[None, :n])[0]), g(tb)
+        te = tb if not (ga > 0.0 and gb < 0.0) else brentq(g, ta, tb, xtol=LOCATE_XTOL_S)
+        if best is None or te < best[1]:
+            best = (int(j), te)
+    return best[0], best[1], dense(best[1])

@@ -1,0 +1,113 @@
+"""The data vector of a powered contact walker's compiled right-hand side: its actuators as
+numbers (:mod:`walkerlab.models.contact.powered_source`, the block's layout).
+
+One :class:`PoweredData` per run: what does not change (the passive data, each stance's
+joint columns, the laws, the ankle and the ledger's map) is packed once; :meth:`PoweredData.
+data` fills in the run's discrete state (stance leg, the time the step began, a push-off
+pulse, the ankle push-off) between events.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .powered_source import A_HEAD, W_INDEX
+
+__all__ = ["PoweredData", "powered_data"]
+
+
+def _laws(acts):
+    """The walker's joint-torque laws as a law block (:meth:`TorqueLaws.packed`), or None
+    when they are not data (a replay's Python callables, a torque function set on the
+    instance)."""
+    if "hip_torque" in vars(acts):  # a per-stance law swapped in by a replay
+        return None
+    laws = acts.joints.laws if hasattr(acts, "joints") else acts.laws
+    if not laws:
+        return np.array([3.0, 0.0, 0.0])
+    packed = getattr(laws, "packed", None)
+    return None if packed is None else np.asarray(packed(), float)
+
+
+class PoweredData:
+    """The compiled right-hand side's data of one powered contact walker.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators`` (:class:`~walkerlab.models.contact.actuation.ContactActuators` or
+        :class:`~walkerlab.models.contact.joint_torques.JointTorqueActuators`).
+    laws : ndarray
+        The law block (:func:`powered_data` reads it from the actuators).
+    """
+
+    def __init__(self, walker, laws: np.ndarray):
+        acts = walker.actuators
+        self.walker, self.laws = walker, laws
+        n = walker.nq
+        names = tuple(walker.contact_names())
+        self.base = walker.pack()[:-1]
+        k = int(laws[1])
+        free = hasattr(acts, "joints")  # a free-jointed biped: role-ordered joint columns
+        self.B, self.phase = [], []
+        for stance in (0, 1):
+            if free:
+                B = np.zeros((n, k))
+                B[acts.index[stance]] = acts.joints.B
+                self.phase.append((1.0, float(names.index(f"leg{stance + 1}"))))
+            else:
+                B = np.asarray(acts.B[stance], float).reshape(n, k) if k else np.zeros((n, 0))
+                self.phase.append((0.0, float(acts.leg[stance])))
+            self.B.append(B.ravel())
+        self.push_rows = (acts.push_row(walker, 0), acts.push_row(walker, 1))
+        foot = getattr(acts, "foot", None)
+        head = np.zeros(A_HEAD)
+        head[1], head[2] = n, k
+        head[7:9] = acts.hip
+        ankle = getattr(acts, "ankle", None)
+        if ankle is not None:
+            head[12:15] = (ankle.stiffness_n_m_per_rad, ankle.rest_angle_rad, ankle.constant_n_m)
+        if foot is not None:  # flat feet: the dampers' term, the pulse's ankle hold
+            p = dict(zip(walker.data.structure.param_names, walker.data.params))
+            head[18] = float(p.get("c_ankle", 0.0))
+            head[19] = sum(float(p[f"c_s{i}"]) for i in range(len(walker.data.structure.springs)))
+            head[20:26] = (*foot, *acts.ankle_leg, *acts.leg)
+            head[26] = 1.0
+        self.foot = foot
+        works = [W_INDEX[w] for w in acts.work_names]
+        head[27] = len(works)
+        self.head = np.concatenate([head, works])
+        self.ny = 2 * n + len(works)
+
+    def data(self, stance: int, t_origin: float, push: tuple[int, float] | None = None,
+             ankle: bool = False, switch_s: float = np.inf) -> np.ndarray:
+        """The data vector with leg ``stance`` in stance (0: leg1, 1: leg2), the step begun
+        at ``t_origin`` [s], a push-off pulse ``(trailing leg, force [N])`` on (None: off),
+        the ankle push-off on or off, and a heel strike at ``switch_s`` [s] (the other leg
+        in stance from then, inf: none); shape (len,), float64, the call counter 0."""
+        acts = self.walker.actuators
+        h = self.head.copy()
+        h[3:5] = self.phase[0]
+        h[31] = self.phase[1][1]
+        h[5], h[6] = -1.0, 0.0
+        h[28:31] = (stance, switch_s, t_origin)
+        if push is not None:
+            trailing = int(push[0])
+            h[5], h[6] = self.push_rows[trailing], float(push[1])
+            if self.foot is not None:
+                h[15:18] = (1.0, self.foot[trailing], acts.ankle_leg[trailing])
+        if ankle:
+            h[9:12] = (1.0, self.foot[0], acts.ankle_leg[0])
+            h[32:34] = (self.foot[1], acts.ankle_leg[1])
+        block = np.concatenate([h, self.B[0], self.B[1], self.laws])
+        block[0] = block.size
+        scratch = np.zeros(self.walker.nq + 8)  # the compiled call's force and powers
+        return np.concatenate([self.base, block, scratch, [0.0]]).astype(np.float64)
+
+
+def powered_data(walker) -> PoweredData | None:
+    """The compiled data of ``walker``'s actuators (:class:`PoweredData`), or None when its
+    torque laws are not data (a replay's Python callables: the run stays on
+    :func:`scipy.integrate.solve_ivp`)."""
+    laws = _laws(walker.actuators)
+    return None if laws is None else PoweredData(walker, laws)
