@@ -16,7 +16,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_serializer, model_validator
 
-from walkerlab.config.base import Strict
+from walkerlab.config.base import Strict, drop_unset
 
 #: a reference table's angle [rad]: within two turns of zero (a joint or stance-leg angle
 #: beyond that is no posture, and an unbounded one overflows the spline)
@@ -53,12 +53,7 @@ class _JointTable(Strict):
 
     @model_serializer(mode="wrap")
     def _as_given(self, handler):
-        out = handler(self)
-        if isinstance(out, dict):
-            for k in ("hip_angle_rad", "angle_rad"):
-                if k in out and out[k] is None:
-                    out.pop(k)
-        return out
+        return drop_unset(handler(self), ("hip_angle_rad", "angle_rad"))
 
 
 class PushOff(Strict):
