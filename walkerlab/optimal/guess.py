@@ -154,7 +154,7 @@ def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
     Raises
     ------
     ValueError
-        The step does not end in a heel strike (one line).
+        As :func:`starting_segment` (no heel strike; one line).
     """
     x0 = np.asarray(x0, float)
     seg = starting_segment(walker, x0, period_s, solver)

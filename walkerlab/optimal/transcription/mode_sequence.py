@@ -107,7 +107,8 @@ def phased_guess(walker, x0, period_s: float, solver, intervals: int):
     Raises
     ------
     ValueError
-        The step does not end in a heel strike (one line).
+        As :func:`walkerlab.optimal.guess.starting_segment`: the step does not end in a heel
+        strike (one line).
     """
     from walkerlab.optimal.guess import starting_segment
 
