@@ -34,6 +34,17 @@ _TOKEN = re.compile(r"(?<![\w/^])(" + "|".join(
     + r")(?![\w/^²])")
 
 
+def _dimension(what: str, si: str) -> property:
+    """The read-only property of :class:`Units` that labels ``what`` (a dimension whose SI
+    unit is ``si``): ``units(si)``, its docstring naming both systems' labels."""
+    def label(self) -> str:
+        return self(si)
+
+    label.__doc__ = (f"Label of {what}: ``{si}`` in SI, ``{NONDIMENSIONAL_LABELS[si]}`` "
+                     "nondimensional.")
+    return property(label)
+
+
 @dataclass(frozen=True)
 class Units:
     """Unit labels of one unit system (``"SI"`` or ``"nondimensional"``)."""
@@ -53,15 +64,11 @@ class Units:
         return _TOKEN.sub(lambda m: NONDIMENSIONAL_LABELS[m.group(1)], si)
 
     # the dimensions the report and the figures name most often
-    @property
-    def time(self) -> str:
-        """Label of a time: ``s`` in SI, ``√(l/g)`` nondimensional."""
-        return self("s")
-
-    @property
-    def length(self) -> str:
-        """Label of a length: ``m`` in SI, ``l`` nondimensional."""
-        return self("m")
+    time = _dimension("a time", "s")
+    length = _dimension("a length", "m")
+    speed = _dimension("a speed", "m/s")
+    rate = _dimension("an angular rate", "rad/s")
+    energy = _dimension("an energy", "J")
 
     @property
     def small_length(self) -> str:
@@ -73,21 +80,6 @@ class Units:
     def small_scale(self) -> float:
         """Factor from the scene's length unit to :attr:`small_length` (1e3 in SI)."""
         return 1.0 if self.nondimensional else 1e3
-
-    @property
-    def speed(self) -> str:
-        """Label of a speed: ``m/s`` in SI, ``√(g l)`` nondimensional."""
-        return self("m/s")
-
-    @property
-    def rate(self) -> str:
-        """Label of an angular rate: ``rad/s`` in SI, ``rad/√(l/g)`` nondimensional."""
-        return self("rad/s")
-
-    @property
-    def energy(self) -> str:
-        """Label of an energy: ``J`` in SI, ``M g l`` nondimensional."""
-        return self("J")
 
     def sentence(self) -> str:
         """One line saying what the numbers are measured in."""

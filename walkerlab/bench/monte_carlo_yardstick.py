@@ -141,16 +141,23 @@ def _locate(F, y_old, h, gamma, which, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _stage(y, h, K, s, p, out):  # pragma: no cover - compiled
+    """Stage ``s`` of the step: its state ``out = y + h sum_j A[s, j] K[j]`` (j < s), its
+    slope into ``K[s]``."""
+    for k in range(y.size):
+        acc = 0.0
+        for j in range(s):
+            acc += A[s, j] * K[j, k]
+        out[k] = y[k] + h * acc
+    flow(out, p, K[s])
+
+
+@njit(cache=True)
 def _dense_coeffs(y, ynew, h, K, F, ev, p):  # pragma: no cover - compiled
     """The 3 extra stages and the interpolant's coefficients ``F`` of the step."""
     n = y.size
     for s in range(NS + 1, 16):
-        for k in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += A[s, j] * K[j, k]
-            ev[k] = y[k] + h * acc
-        flow(ev, p, K[s])
+        _stage(y, h, K, s, p, ev)
     for k in range(n):
         dy = ynew[k] - y[k]
         F[0, k] = dy
@@ -181,12 +188,7 @@ def step(x0, gamma, p, rtol, atol, max_time, out):  # pragma: no cover - compile
         while True:
             K[0] = f
             for s in range(1, NS):
-                for k in range(n):
-                    acc = 0.0
-                    for j in range(s):
-                        acc += A[s, j] * K[j, k]
-                    ynew[k] = y[k] + h * acc
-                flow(ynew, p, K[s])
+                _stage(y, h, K, s, p, ynew)
             for k in range(n):
                 acc = 0.0
                 for j in range(NS):

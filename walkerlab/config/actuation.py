@@ -12,23 +12,29 @@ constraints: PD tracking of a reference of a monotonic phase variable).
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_serializer, model_validator
 
-from walkerlab.config.base import Strict
+from walkerlab.config.base import Strict, drop_unset
 
 #: a reference table's angle [rad]: within two turns of zero (a joint or stance-leg angle
 #: beyond that is no posture, and an unbounded one overflows the spline)
 TableAngle = Annotated[float, Field(ge=-6.3, le=6.3)]
 #: a time table's time since heel strike [s]: a step, not an era
 TableTime = Annotated[float, Field(ge=0, le=1e3)]
+#: how a reference table is read between its points
+Interpolation = Annotated[Literal["linear", "cubic"],
+                          Field(description="piecewise-linear or not-a-knot cubic spline")]
 
 
 class _JointTable(Strict):
     """A reference table's values: ``hip_angle_rad`` (the straight-legged walkers' hip) or
     ``angle_rad`` (any joint's angle, e.g. a five-link biped's knee); the one not given is
     left out of the dump (a table as before serialises as before)."""
+
+    #: the field that holds the table's abscissa
+    _ABSCISSA: ClassVar[str] = "phase_rad"
 
     hip_angle_rad: list[TableAngle] | None = Field(
         None, min_length=2, max_length=200, description="reference hip angle (swing minus "
@@ -42,7 +48,11 @@ class _JointTable(Strict):
         """The reference values [rad] (whichever of the two fields is given)."""
         return self.hip_angle_rad if self.hip_angle_rad is not None else self.angle_rad
 
-    def _one_of(self, abscissa: list[float], name: str) -> None:
+    @model_validator(mode="after")
+    def _table(self) -> _JointTable:
+        # one of the value fields, as long as the abscissa (``phase_rad``: the table's
+        # abscissa, whichever field holds it), which increases
+        name, abscissa = self._ABSCISSA, self.phase_rad
         if (self.hip_angle_rad is None) == (self.angle_rad is None):
             raise ValueError("give hip_angle_rad or angle_rad (one of them)")
         if len(abscissa) != len(self.values_rad):
@@ -50,15 +60,11 @@ class _JointTable(Strict):
             raise ValueError(f"{name} and {field} need the same length")
         if any(b <= a for a, b in zip(abscissa, abscissa[1:])):
             raise ValueError(f"{name} must increase")
+        return self
 
     @model_serializer(mode="wrap")
     def _as_given(self, handler):
-        out = handler(self)
-        if isinstance(out, dict):
-            for k in ("hip_angle_rad", "angle_rad"):
-                if k in out and out[k] is None:
-                    out.pop(k)
-        return out
+        return drop_unset(handler(self), ("hip_angle_rad", "angle_rad"))
 
 
 class PushOff(Strict):
@@ -85,13 +91,7 @@ class PhaseReference(_JointTable):
 
     phase_rad: list[TableAngle] = Field(min_length=2, max_length=200, description="stance-leg "
                                    "angles of the table, increasing [rad]")
-    interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
-                                                      "or not-a-knot cubic spline")
-
-    @model_validator(mode="after")
-    def _table(self) -> PhaseReference:
-        self._one_of(self.phase_rad, "phase_rad")
-        return self
+    interpolation: Interpolation = "cubic"
 
 
 class TimeReference(_JointTable):
@@ -102,12 +102,12 @@ class TimeReference(_JointTable):
 
     time_s: list[TableTime] = Field(min_length=2, max_length=200, description="times since the "
                                 "step's heel strike, increasing [s]")
-    interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
-                                                      "or not-a-knot cubic spline")
+    interpolation: Interpolation = "cubic"
+
+    _ABSCISSA: ClassVar[str] = "time_s"
 
     @model_validator(mode="after")
-    def _table(self) -> TimeReference:
-        self._one_of(self.time_s, "time_s")
+    def _from_heel_strike(self) -> TimeReference:
         if self.time_s[0] < 0:
             raise ValueError("time_s starts at the step's heel strike: no negative times")
         return self

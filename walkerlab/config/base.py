@@ -23,3 +23,30 @@ def _list_to_tuple(v):
 
 # A fixed-length tuple given as a YAML list (strict mode alone would want a Python tuple).
 AsTuple = BeforeValidator(_list_to_tuple)
+
+
+def drop_unset(d, keys):
+    """A section's serialised form without the optional fields it leaves unset.
+
+    A scene that leaves a field added later unset serialises as before the field existed
+    (the same scene JSON and content hashes): each of ``keys`` whose value is None is
+    dropped (a missing key is left alone).  The one rule every section's wrap serialiser
+    applies.
+
+    Parameters
+    ----------
+    d : dict or object
+        What the section's pydantic handler returned (a dict is changed in place).
+    keys : iterable of str
+        The optional fields.
+
+    Returns
+    -------
+    dict or object
+        ``d`` (not a dict: unchanged).
+    """
+    if isinstance(d, dict):
+        for k in keys:
+            if d.get(k, 0) is None:
+                d.pop(k)
+    return d

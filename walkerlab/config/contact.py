@@ -26,7 +26,7 @@ from pydantic import (
     model_validator,
 )
 
-from walkerlab.config.base import _list_to_tuple
+from walkerlab.config.base import _list_to_tuple, drop_unset
 from walkerlab.config.terrain import (
     GROUND_KINDS,
     LANE_KINDS,
@@ -312,18 +312,11 @@ class ContactSettings(BaseModel):
     @model_serializer(mode="wrap")
     def _written_names_only(self, handler):
         # the name not used of each pair is not part of the scene (nor of its content hash)
-        d = handler(self)
-        if isinstance(d, dict):
-            for names in CONTACT_QUANTITIES.values():
-                for name, _unit in names.values():
-                    if d.get(name, 0) is None:
-                        d.pop(name)
-            # a scene without flat feet serialises as before (same content hashes)
-            for k in ("flat_foot_mass_kg", "flat_foot_inertia_kg_m2", "push_off_duration_s",
-                      "hub_inertia_kg_m2"):
-                if d.get(k, 0) is None:
-                    d.pop(k)
-        return d
+        # and a scene without flat feet serialises as before (same content hashes)
+        return drop_unset(handler(self), [
+            *(name for names in CONTACT_QUANTITIES.values() for name, _unit in names.values()),
+            "flat_foot_mass_kg", "flat_foot_inertia_kg_m2", "push_off_duration_s",
+            "hub_inertia_kg_m2"])
 
     def written(self, quantity: str) -> tuple[float, str, str]:
         """A dimensional quantity as the scene writes it.

@@ -30,7 +30,7 @@ from pydantic import (
     model_validator,
 )
 
-from walkerlab.config.base import Strict
+from walkerlab.config.base import Strict, drop_unset
 from walkerlab.config.contact import (
     ContactSettings,
     ContactSimSettings,
@@ -136,10 +136,7 @@ class Scene(Strict):
     @model_serializer(mode="wrap")
     def _drop_unused_optimize(self, handler):
         # a scene without an optimize section serialises as before (same scene JSON)
-        d = handler(self)
-        if isinstance(d, dict) and d.get("optimize", 0) is None:
-            d.pop("optimize")
-        return d
+        return drop_unset(handler(self), ("optimize",))
 
     @model_validator(mode="after")
     def _units_consistent(self) -> Scene:

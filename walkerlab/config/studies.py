@@ -21,7 +21,7 @@ from pydantic import (
     model_validator,
 )
 
-from walkerlab.config.base import AsTuple, Strict
+from walkerlab.config.base import AsTuple, Strict, drop_unset
 from walkerlab.config.limits import (
     MAX_BASIN_CELLS_PER_AXIS,
     MAX_SIMULATE_STRIDES,
@@ -191,10 +191,7 @@ class SimulateSettings(Strict):
     @model_serializer(mode="wrap")
     def _drop_unset(self, handler):
         # a scene without a terrain seed serialises as before (same content hashes)
-        d = handler(self)
-        if isinstance(d, dict) and d.get("terrain_seed", 0) is None:
-            d.pop("terrain_seed")
-        return d
+        return drop_unset(handler(self), ("terrain_seed",))
 
 
 class WorkPrecisionSettings(Strict):
@@ -320,10 +317,7 @@ class MfptSettings(Strict):
     @model_serializer(mode="wrap")
     def _drop_unset(self, handler):
         # a study of per-step slopes serialises as before (same content hashes)
-        d = handler(self)
-        if isinstance(d, dict) and d.get("sigma_m", 0) is None:
-            d.pop("sigma_m")
-        return d
+        return drop_unset(handler(self), ("sigma_m",))
 
     @model_validator(mode="after")
     def _heights_by_montecarlo(self) -> MfptSettings:

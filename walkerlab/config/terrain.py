@@ -13,7 +13,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, Field, model_serializer, model_validator
 
-from walkerlab.config.base import _list_to_tuple
+from walkerlab.config.base import _list_to_tuple, drop_unset
 
 __all__ = ["GROUND_KINDS", "LANE_KINDS", "PerStepTerrain", "TerrainSettings", "check_profile"]
 
@@ -55,12 +55,7 @@ class PerStepTerrain(BaseModel):
     @model_serializer(mode="wrap")
     def _drop_unset(self, handler):
         # a scene without per-step heights serialises as before (same content hashes)
-        d = handler(self)
-        if isinstance(d, dict):
-            for k in ("height_distribution", "height_sd_m"):
-                if d.get(k, 0) is None:
-                    d.pop(k)
-        return d
+        return drop_unset(handler(self), ("height_distribution", "height_sd_m"))
 
     @property
     def heights(self) -> tuple[str, float]:
@@ -220,14 +215,11 @@ class TerrainSettings(BaseModel):
     def _drop_unset(self, handler):
         # a scene of today's ground serialises as before (same content hashes): no unset
         # field, the lanes written as ``kind``
-        d = handler(self)
+        d = drop_unset(handler(self), (
+            "per_step", "riser_m", "tread_m", "direction", "first_foothold_m",
+            "foothold_heights_m", "foothold_slopes_rad", "periodic", "profile_m", "profile_csv"))
         if not isinstance(d, dict):
             return d
-        for k in ("per_step", "riser_m", "tread_m", "direction", "first_foothold_m",
-                  "foothold_heights_m", "foothold_slopes_rad", "periodic", "profile_m",
-                  "profile_csv"):
-            if d.get(k, 0) is None:
-                d.pop(k)
         if d.get("kind") == "slope":
             d["kind"] = d.pop("lanes")
             d = {"kind": d.pop("kind"), **d}

@@ -14,7 +14,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Discriminator, Field, Tag, field_validator, model_serializer, model_validator
 
 from walkerlab.config.actuation import Actuation
-from walkerlab.config.base import Strict
+from walkerlab.config.base import Strict, drop_unset
 
 
 class _Actuated(Strict):
@@ -26,10 +26,7 @@ class _Actuated(Strict):
 
     @model_serializer(mode="wrap")
     def _passive_as_before(self, handler):
-        out = handler(self)
-        if isinstance(out, dict) and out.get("actuation", 0) is None:
-            out.pop("actuation")
-        return out
+        return drop_unset(handler(self), ("actuation",))
 
 
 class CompassGaitParams(_Actuated):

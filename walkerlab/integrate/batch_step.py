@@ -70,6 +70,28 @@ class BatchStep:
     step_time_s: np.ndarray
 
 
+def step_rows(X, gamma, slope_rad: float) -> tuple[np.ndarray, np.ndarray]:
+    """A step map's input as rows: the states ``X`` (2n,) or (N, 2n) as (N, 2n) and each
+    row's slope (N,) [rad] from ``gamma`` (an array, a float, or None: ``slope_rad``)."""
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    return X, np.broadcast_to(slope_rad if gamma is None else np.asarray(gamma, dtype=float),
+                              (X.shape[0],)).copy()
+
+
+def walker_on_slope(step_map, gamma: float):
+    """The walker of a step map (its ``walker``, ``walker_at``, ``slope_rad`` and a dict
+    ``_walkers``) on the slope ``gamma`` [rad]: its own walker on its slope, else one built
+    by ``walker_at(gamma)`` and kept (at most 4096 slopes; then the cache starts again)."""
+    if gamma == step_map.slope_rad:
+        return step_map.walker
+    w = step_map._walkers.get(gamma)
+    if w is None:
+        if len(step_map._walkers) > 4096:
+            step_map._walkers.clear()
+        w = step_map._walkers[gamma] = step_map.walker_at(gamma)
+    return w
+
+
 class BatchStepMap:
     """The step map ``x_{k+1} = P(x_k; gamma_k)`` of a rigid walker, for many rows at once.
 
@@ -277,14 +299,9 @@ class BatchStepMap:
         return self._gtab
 
     def _walker(self, gamma: float):
-        if not self._resets_depend_on_slope or gamma == self.slope_rad:
+        if not self._resets_depend_on_slope:
             return self.walker
-        w = self._walkers.get(gamma)
-        if w is None:
-            if len(self._walkers) > 4096:
-                self._walkers.clear()
-            w = self._walkers[gamma] = self.walker_at(gamma)
-        return w
+        return walker_on_slope(self, gamma)
 
     def data(self, gamma: np.ndarray) -> np.ndarray:
         """Data vectors (N, c) of the compiled functions, one per slope [rad]."""
@@ -330,10 +347,8 @@ class BatchStepMap:
         -------
         BatchStep
         """
-        X = np.atleast_2d(np.asarray(X, dtype=float))
+        X, gamma = step_rows(X, gamma, self.slope_rad)
         N, m = X.shape
-        gamma = np.broadcast_to(self.slope_rad if gamma is None else
-                                np.asarray(gamma, dtype=float), (N,)).copy()
         D = self.data(gamma)
         nc = D.shape[1]
         self._hoff = None

@@ -28,7 +28,15 @@ import dataclasses
 
 import numpy as np
 
-from walkerlab.integrate.batch_step import FALL, HEEL_STRIKE, SOLVER_FAILURE, TIMEOUT, BatchStep
+from walkerlab.integrate.batch_step import (
+    FALL,
+    HEEL_STRIKE,
+    SOLVER_FAILURE,
+    TIMEOUT,
+    BatchStep,
+    step_rows,
+    walker_on_slope,
+)
 
 
 def needs_python_path(walker) -> bool:
@@ -105,28 +113,15 @@ class PythonStepMap:
         self.solver = Solver("DOP853", rtol, atol, None, "auto")
         self._walkers: dict[float, object] = {}
 
-    def _walker(self, gamma: float):
-        if gamma == self.slope_rad:
-            return self.walker
-        w = self._walkers.get(gamma)
-        if w is None:
-            if len(self._walkers) > 4096:
-                self._walkers.clear()
-            w = self._walkers[gamma] = self.walker_at(gamma)
-        return w
-
     def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None,
              drop_m: np.ndarray | float | None = None) -> BatchStep:
         """One step of every row (as :meth:`BatchStepMap.step`).
 
         Parameters
         ----------
-        X : ndarray, shape (N, 2n)
-            Role-ordered states just after a heel strike.
-        gamma : ndarray (N,) or float, optional
-            Slope of this step [rad] per row; default the walker's.
-        drop_m : ndarray (N,) or float, optional
-            The ground at the footfall this far [m] below the slope line (negative: up).
+        X, gamma, drop_m
+            As :meth:`BatchStepMap.step`'s: the role-ordered states (N, 2n) just after a heel
+            strike, each row's slope [rad] (default the walker's) and step-down [m].
 
         Returns
         -------
@@ -134,16 +129,14 @@ class PythonStepMap:
         """
         from walkerlab.integrate.rigid import integrate_step
 
-        X = np.atleast_2d(np.asarray(X, dtype=float))
+        X, gamma = step_rows(X, gamma, self.slope_rad)
         N, m = X.shape
-        gamma = np.broadcast_to(self.slope_rad if gamma is None else
-                                np.asarray(gamma, dtype=float), (N,))
         drop = np.broadcast_to(0.0 if drop_m is None else np.asarray(drop_m, dtype=float),
                                (N,))
         out = BatchStep(np.full(N, TIMEOUT, np.int8), np.full((N, m), np.nan),
                         np.full((N, m), np.nan), np.full(N, np.nan))
         for i in range(N):
-            w = self._walker(float(gamma[i]))
+            w = walker_on_slope(self, float(gamma[i]))
             if drop[i] != 0:
                 w = _lowered(w, float(drop[i]))
             seg = integrate_step(w, X[i], self.solver, max_step_time=self.max_step_time_s)

@@ -102,17 +102,24 @@ def _dense_at(F, y_old, x, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
+def _stage(fs, t, h, y, K, d, s, out):  # pragma: no cover - compiled
+    """Stage ``s`` of the step (the flow ``fs``): its state ``out = y + h sum_j A[s, j]
+    K[j]`` (j < s), its slope into ``K[s]``."""
+    for k in range(y.size):
+        acc = 0.0
+        for j in range(s):
+            acc += A[s, j] * K[j, k]
+        out[k] = y[k] + h * acc
+    fs(K[s].ctypes, t + C[s] * h, out.ctypes, d.ctypes)
+
+
+@njit(cache=True, error_model="numpy")
 def _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compiled
     """The 3 extra stages (flow ``fs``) and the interpolant's coefficients ``F`` (7, m)
     of the step."""
     m = y.size
     for s in range(NS + 1, 16):
-        for k in range(m):
-            acc = 0.0
-            for j in range(s):
-                acc += A[s, j] * K[j, k]
-            tmp[k] = y[k] + h * acc
-        fs(K[s].ctypes, t + C[s] * h, tmp.ctypes, d.ctypes)
+        _stage(fs, t, h, y, K, d, s, tmp)
     for k in range(m):
         dy = ynew[k] - y[k]
         F[0, k] = dy
@@ -181,12 +188,7 @@ def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - comp
     ``K[NS]``; returns the error norm."""
     m = y.size
     for s in range(1, NS):
-        for k in range(m):
-            acc = 0.0
-            for j in range(s):
-                acc += A[s, j] * K[j, k]
-            ynew[k] = y[k] + h * acc
-        fs(K[s].ctypes, t + C[s] * h, ynew.ctypes, d.ctypes)
+        _stage(fs, t, h, y, K, d, s, ynew)
     for k in range(m):
         acc = 0.0
         for j in range(NS):

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["has_target", "read_guess", "simulated_step", "starting_step", "target_numbers",
-           "target_step"]
+__all__ = ["has_target", "read_guess", "simulated_step", "starting_segment", "starting_step",
+           "target_numbers", "target_step"]
 
 #: the swing leg's forward swing over the straight-line guess, as a share of the step's
 #: half-angle (a bump ``b sin(pi s)``: the swing foot clears level ground mid-step)
@@ -118,6 +118,29 @@ def _states_from_legs(walker, stance, swing, dstance, dswing) -> np.ndarray:
 
 
 
+def starting_segment(walker, x0, period_s: float, solver):
+    """The one step of ``walker`` from the post-impact state ``x0`` (2n,) that a starting
+    guess samples (at most 3 ``period_s`` [s] long).
+
+    Returns
+    -------
+    walkerlab.integrate.rigid.Segment
+
+    Raises
+    ------
+    ValueError
+        The step does not end in a heel strike (one line).
+    """
+    from walkerlab.integrate.rigid import simulate_steps
+
+    seg = simulate_steps(walker, np.asarray(x0, float), 1, solver,
+                         max_step_time=3.0 * period_s).segments[0]
+    if seg.termination != "heel_strike":
+        raise ValueError("optimize: the starting gait does not make a step "
+                         f"({seg.termination})")
+    return seg
+
+
 def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
     """One step of ``walker`` from the post-impact state ``x0`` (2n,) sampled at
     ``samples`` times from its dense output.
@@ -131,15 +154,10 @@ def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
     Raises
     ------
     ValueError
-        The step does not end in a heel strike (one line).
+        As :func:`starting_segment` (no heel strike; one line).
     """
-    from walkerlab.integrate.rigid import simulate_steps
-
     x0 = np.asarray(x0, float)
-    seg = simulate_steps(walker, x0, 1, solver, max_step_time=3.0 * period_s).segments[0]
-    if seg.termination != "heel_strike":
-        raise ValueError("optimize: the starting gait does not make a step "
-                         f"({seg.termination})")
+    seg = starting_segment(walker, x0, period_s, solver)
     t = np.linspace(seg.t_start, seg.t_end, samples)
     x = np.empty((t.size, x0.size))
     for k, (_ph, sol, (a, b)) in enumerate(seg.pieces):  # each phase's dense output

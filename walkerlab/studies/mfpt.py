@@ -75,13 +75,25 @@ def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
 
 
 @dataclass(frozen=True)
-class WalkTask:
-    """Monte Carlo walks ``walks`` at one sigma (picklable).
+class StepMapTask:
+    """A chunk of work on a scene's batched step map, sent to a worker process
+    (picklable): the worker rebuilds the map from ``base`` once (:func:`step_map_for`).
 
     Attributes
     ----------
     base : dict
         What :func:`step_map_for` rebuilds the batched step map from.
+    """
+
+    base: dict
+
+
+@dataclass(frozen=True)
+class WalkTask(StepMapTask):
+    """Monte Carlo walks ``walks`` at one sigma (a :class:`StepMapTask`).
+
+    Attributes
+    ----------
     x0 : tuple of float, length 2n
         The gait's post-impact state (``state_names()``, [rad, rad/s]).
     sd : float
@@ -96,7 +108,6 @@ class WalkTask:
         Per-step landing heights' distribution and standard deviation [m]; None: none.
     """
 
-    base: dict
     x0: tuple
     sd: float
     walks: tuple
@@ -108,13 +119,11 @@ class WalkTask:
 
 
 @dataclass(frozen=True)
-class ImageTask:
-    """Step-map images of ``X`` on slopes ``gamma`` (picklable).
+class ImageTask(StepMapTask):
+    """Step-map images of ``X`` on slopes ``gamma`` (a :class:`StepMapTask`).
 
     Attributes
     ----------
-    base : dict
-        What :func:`step_map_for` rebuilds the batched step map from.
     X : ndarray, shape (k, 2n)
         Post-impact states [rad, rad/s].
     gamma : ndarray, shape (k,)
@@ -123,7 +132,6 @@ class ImageTask:
         Row of the chunk's first state in the whole list.
     """
 
-    base: dict
     X: np.ndarray
     gamma: np.ndarray
     start: int

@@ -173,6 +173,12 @@ _GROUNDS = {
     ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,
 }
+#: what the kinds without ankles (point or arc feet) refuse of the ankle's features
+_NO_ANKLES = {
+    ("ankle_torque", "*"): _NO_ANKLE,
+    ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
+    ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+}
 _FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
@@ -187,16 +193,12 @@ _FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported 
 CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     "straight_legs": {
         ("knee_torque", "*"): _NO_KNEE,
-        ("ankle_torque", "*"): _NO_ANKLE,
-        ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
-        ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+        **_NO_ANKLES,
         ("torso_torque", "adams"): _FIVE_LINK_JOINTS,
         **_GROUNDS,
     },
     "locking_knees": {
-        ("ankle_torque", "*"): _NO_ANKLE,
-        ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
-        ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+        **_NO_ANKLES,
         ("knee_torque", "adams"): _FIVE_LINK_JOINTS,
         ("torso_torque", "adams"): _FIVE_LINK_JOINTS,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
@@ -222,11 +224,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                          "hip torques, not together)"),
     },
     "free_joints": {
-        ("ankle_torque", "*"): _NO_ANKLE,
-        ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
+        **_NO_ANKLES,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
-        ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
         **_GROUNDS,
         # the shipped five-link biped walks by its joint torques (a passive one would build)
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "

@@ -243,27 +243,19 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     Parameters
     ----------
     scene : Scene
-    x_ideal : ndarray (2n,)
-        Ideal fixed point (role order of the rigid walker, leg2 = stance) [rad, rad/s].
-    n_steps : int
-        Steps the run may take (sets how many patches are laid out).
-    step_length_m : float, optional
-        Patch spacing [m] instead of the ideal step length (a run started on the contact
-        model's own periodic gait lays its patches at that gait's footfalls).
+    x_ideal, n_steps, step_length_m
+        As :meth:`ContactSetup.build`'s: the ideal fixed point (2n,) [rad, rad/s], the
+        steps the run may take, the patch spacing [m] instead of the ideal step length.
 
     Returns
     -------
     walker : ContactWalker
     step_length : float
-        Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
+        As :meth:`ContactSetup.build`'s (the ideal step length [m]).
 
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, actuators with a pinned or non-ideal start (or a time law
-        with the contact periodic gait), a joint the walker does not have, a walker with a
-        massless body, flat feet without
-        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
-        that is not a point (one line).
+        As :func:`contact_setup` (a scene the contact model does not take; one line).
     """
     return contact_setup(scene).build(x_ideal, n_steps, step_length_m)

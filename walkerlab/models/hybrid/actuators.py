@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws
-from walkerlab.models.hybrid.push_off import PushOffTransition
+from walkerlab.models.hybrid.push_off import PushOffTransition, leg_rate_jacobian
 from walkerlab.numerics import complex_step_jacobian
 from walkerlab.walker.joints import (  # noqa: F401 (joint_links: importable from here)
     joint_angles,
@@ -69,11 +69,9 @@ class Actuators:
     fns : dict
         The generated model's functions (``matrices``, ``impact_matrices``, ``points``,
         ``leg_angles``, ``reset``, ``energies``).
-    n : int
-        Number of generalised coordinates.
-    limit : bool
-        The legs are massless (the walker's equations are the limit ``m_foot -> 0``).
-    hip_mass_kg : float
+    n, limit, hip_mass_kg
+        As :class:`~walkerlab.models.hybrid.push_off.PushOffTransition`'s: the number of
+        generalised coordinates, whether the legs are massless, the hip's mass [kg].
     torque_jacobian : callable or None
         ``(t, x) -> (k, 2n)``: the torques' derivative by the state when it is known in
         closed form (a torque of time alone: zeros), set after construction; the flow's
@@ -97,17 +95,9 @@ class Actuators:
     some_massless: bool = False
 
     def __post_init__(self):
-        eye = np.eye(self.n)
-        la = self.fns["leg_angles"]
         z = np.zeros(self.n)
-        # d(delta)/dq and the absolute leg angles' Jacobian A = d(psi_sw, psi_st)/dq, exact:
-        # the generated leg angles' rates are linear in dq
-        rows = [la(np.concatenate([z, eye[k]])) for k in range(self.n)]
-        # the hip joins the thighs: a kneed walker's legs name them
-        self.legs = ("swing_thigh", "stance_thigh") if "swing_thigh_rate" in rows[0] \
-            else ("swing", "stance")
-        self.A = np.array([[float(r[f"{self.legs[0]}_rate"]) for r in rows],
-                           [float(r[f"{self.legs[1]}_rate"]) for r in rows]])
+        # d(delta)/dq from the absolute leg angles' Jacobian A = d(psi_sw, psi_st)/dq
+        self.legs, self.A = leg_rate_jacobian(self.fns["leg_angles"], self.n)
         self.ddelta_dq = self.A[0] - self.A[1]
         self.laws = TorqueLaws(self.spec.torques)
         # each actuator's (first, second) link and its row of B^T = d(delta)/dq (exact)

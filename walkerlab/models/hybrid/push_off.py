@@ -41,7 +41,8 @@ import numpy as np
 from walkerlab.models.actuation import push_off_impulse
 from walkerlab.numerics import complex_step_jacobian
 
-__all__ = ["FlatPushOff", "PushOffTransition", "Transitions", "push_off_flat"]
+__all__ = ["FlatPushOff", "PushOffTransition", "Transitions", "leg_rate_jacobian",
+           "push_off_flat"]
 
 
 class Transitions:
@@ -74,6 +75,32 @@ class Transitions:
         return self.transition(x)["x_plus"]
 
 
+def leg_rate_jacobian(leg_angles, n: int) -> tuple[tuple[str, str], np.ndarray]:
+    """The legs the hip joins and their absolute angles' Jacobian ``A = d(psi_sw,
+    psi_st)/dq``, exact: the generated leg angles' rates are linear in ``dq``, so ``A``'s
+    columns are the rates at unit ``dq`` (and ``q = 0``).
+
+    Parameters
+    ----------
+    leg_angles : callable
+        The generated model's ``leg_angles(x)`` (2n,) -> dict of angles and rates.
+    n : int
+        Number of generalised coordinates.
+
+    Returns
+    -------
+    legs : (str, str)
+        ``("swing", "stance")``, or a kneed walker's ``("swing_thigh", "stance_thigh")``.
+    A : ndarray (2, n)
+        [-] (angle per generalised coordinate, every one an angle).
+    """
+    eye, z = np.eye(n), np.zeros(n)
+    rows = [leg_angles(np.concatenate([z, eye[k]])) for k in range(n)]
+    legs = ("swing_thigh", "stance_thigh") if "swing_thigh_rate" in rows[0] \
+        else ("swing", "stance")
+    return legs, np.array([[float(r[f"{legs[0]}_rate"]) for r in rows],
+                           [float(r[f"{legs[1]}_rate"]) for r in rows]])
+
 @dataclass
 class PushOffTransition(Transitions):
     """Push-off and heel strike of a point- or arc-footed walker (module docstring).
@@ -99,14 +126,8 @@ class PushOffTransition(Transitions):
     hip_mass_kg: float
 
     def __post_init__(self):
-        eye, z = np.eye(self.n), np.zeros(self.n)
-        # the absolute leg angles' Jacobian A = d(psi_sw, psi_st)/dq, exact: the generated
-        # leg angles' rates are linear in dq; the role swap's rate map R = A^-1 S A
-        rows = [self.fns["leg_angles"](np.concatenate([z, eye[k]])) for k in range(self.n)]
-        legs = ("swing_thigh", "stance_thigh") if "swing_thigh_rate" in rows[0] \
-            else ("swing", "stance")
-        A = np.array([[float(r[f"{legs[0]}_rate"]) for r in rows],
-                      [float(r[f"{legs[1]}_rate"]) for r in rows]])
+        # the role swap's rate map R = A^-1 S A (A: the absolute leg angles' Jacobian)
+        _legs, A = leg_rate_jacobian(self.fns["leg_angles"], self.n)
         swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
         self.R = np.linalg.pinv(A) @ swap @ A
         self.lock = None  # the gradient (n,) of a constraint held through the transition

@@ -107,14 +107,13 @@ def phased_guess(walker, x0, period_s: float, solver, intervals: int):
     Raises
     ------
     ValueError
-        The step does not end in a heel strike (one line).
+        As :func:`walkerlab.optimal.guess.starting_segment`: the step does not end in a heel
+        strike (one line).
     """
-    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.optimal.guess import starting_segment
 
     x0 = np.asarray(x0, float)
-    seg = simulate_steps(walker, x0, 1, solver, max_step_time=3.0 * period_s).segments[0]
-    if seg.termination != "heel_strike":
-        raise ValueError(f"optimize: the starting gait does not make a step ({seg.termination})")
+    seg = starting_segment(walker, x0, period_s, solver)
     dens = [mesh_density(ph, sol, a, b, x0.size) for ph, sol, (a, b) in seg.pieces]
     total = sum(c[-1] for _t, c in dens)
     out = []
