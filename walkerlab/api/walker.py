@@ -420,9 +420,10 @@ class Walker:
         stairs and footholds through the walker's heel-strike guard, a height profile
         segment by segment, a rough ground drawn from ``terrain_seed``; each step bounded
         to :attr:`walk_step_time` of simulated time.  From the stage's start (the gait of
-        :meth:`fixed_point`, or ``simulate.initial_state``) with the scene's strides and
-        rate, the heel strikes, step table and samples' states are those of
-        ``walkerlab simulate``, bit for bit.
+        :meth:`fixed_point`, or ``simulate.initial_state``) with the scene's strides, the
+        heel strikes, the step table and the energy ledger are those of
+        ``walkerlab simulate``, bit for bit (the samples are the same walk, taken on each
+        step's own time grid).
 
         Parameters
         ----------
