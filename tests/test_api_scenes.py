@@ -192,6 +192,58 @@ def test_a_ground_the_walk_cannot_read_is_refused_in_the_command_s_line(tmp_path
     assert code != 0 and err == f"error: {msg}"
 
 
+def _scene_file(tmp_path: Path, name: str, **changes) -> Path:
+    """configs/paper.yaml's rigid walker with ``changes`` (section -> fields) written to
+    ``tmp_path / name.yaml``."""
+    scene = {k: dict(v) for k, v in PAPER.items() if k in ("walker", "slope", "solver",
+                                                            "fixedpoint", "simulate",
+                                                            "terrain")}
+    for section, fields in changes.items():
+        scene[section].update(fields)
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    return path
+
+
+def test_a_rough_ground_drawn_from_the_scene_s_seed_is_the_command_s(tmp_path):
+    # simulate.terrain_seed: the per-step slopes of terrain.per_step drawn from it; the
+    # API walked the mean slope (every period 0.70360 s)
+    f = _scene_file(tmp_path, "rough", terrain={"per_step": {"slope_sd_rad": 0.002}},
+                    simulate={"terrain_seed": 7, "strides": 3})
+    code, err, _ = run_cli("-q", "simulate", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    w = wl.Walker.from_scene(f)
+    art = load_simulate(stage_artifact(w.scene, tmp_path / "runs", "simulate"))
+    walk = w.simulate(w.fixed_point().x, 3)
+    assert np.array_equal(walk.steps["period"], art.steps["period"])
+    assert np.ptp(walk.steps["period"]) > 0.01  # 0.676 to 0.716 s on this ground
+    other = w.simulate(w.fixed_point().x, 3, terrain_seed=8)  # another ground
+    assert not np.array_equal(other.steps["period"], walk.steps["period"])
+
+
+def test_a_gait_carried_from_fixedpoint_from_is_the_command_s(tmp_path):
+    # no initial guess: the start is the paper walker's gait carried by homotopy to a
+    # heavier hip, as `walkerlab fixedpoint` starts it
+    f = _scene_file(tmp_path, "heavier", walker={"hip_mass_kg": 12.0},
+                    fixedpoint={"from": str(CONFIGS / "paper.yaml")})
+    scene = yaml.safe_load(f.read_text())
+    scene["fixedpoint"].pop("initial_guess")
+    f.write_text(yaml.safe_dump(scene))
+    code, err, _ = run_cli("-q", "fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    w = wl.Walker.from_scene(f)
+    art = load_fixedpoint(stage_artifact(w.scene, tmp_path / "runs", "fixedpoint"))
+    assert any("by homotopy" in n for n in art.gait_notes)
+    gait = w.fixed_point()
+    assert np.array_equal(gait.x, art.x) and gait.step_period == art.step_period_s
+    scene["fixedpoint"]["from"] = str(tmp_path / "missing.yaml")
+    f.write_text(yaml.safe_dump(scene))
+    with pytest.raises(SceneError, match="^fixedpoint.from: .*missing.yaml") as exc:
+        wl.Walker.from_scene(f).fixed_point()
+    code, err, _ = run_cli("-q", "fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code != 0 and err == f"error: {exc.value}"
+
+
 def test_a_terrain_seed_without_a_per_step_ground_is_refused_in_one_line():
     w = wl.Walker.from_scene(CONFIGS / "paper.yaml")
     with pytest.raises(SceneError, match=r"^simulate: terrain_seed=3: the scene has no "
