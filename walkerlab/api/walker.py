@@ -20,6 +20,15 @@ Each object builds its model and integrator once, from the scene (:attr:`Walker.
 :attr:`Walker.solver`; :attr:`ContactWalker.setup`, :attr:`ContactWalker.solver`); every
 method uses them, and :meth:`Walker.with_changes` makes a new walker.
 
+The walker is the scene's: its ground (a slope, per-step slopes, stairs, footholds of one
+or several heights, a height profile, a rough ground drawn from ``simulate.terrain_seed``),
+its actuation and its gait search's start (``fixedpoint.initial_guess``, or a known gait
+carried here from ``fixedpoint.from``) are those of the commands, through the same library
+functions, so every number equals ``walkerlab fixedpoint``/``simulate``/``contact-sim``'s
+for the same scene (``tests/test_api_scenes.py`` walks every shipped scene both ways).  A
+scene feature a view cannot carry is refused in one line naming the key, as by the command
+(a profile walked by an actuated walker: ``terrain.kind: profile: ...``).
+
 States are role-ordered arrays of :meth:`Walker.state_names` (angles [rad], rates [rad/s];
 in a ``units: nondimensional`` scene every quantity is in the walker's own units, time in
 √(l/g)).  Nothing here knows how many states a walker has.
@@ -63,8 +72,9 @@ class Walker:
     Parameters
     ----------
     scene : walkerlab.config.Scene
-        A validated scene (its ``walker``, ``slope``, ``ideal``, ``solver`` and
-        ``fixedpoint`` sections are used).
+        A validated scene (its ``walker``, ``slope``, ``ideal``, ``terrain``, ``solver``,
+        ``fixedpoint`` and ``simulate`` sections are used, as the ``fixedpoint`` and
+        ``simulate`` stages use them).
     step_time_limit_s : float
         CPU time each walking step of :meth:`step`, :meth:`jacobian`, :meth:`floquet` and
         :meth:`simulate` may take [s] (this thread's CPU time, so a busy machine does not
@@ -80,12 +90,20 @@ class Walker:
     solver : walkerlab.integrate.solver.Solver
         The integrator of the scene's ``solver`` section.
     max_step_time : float
-        Longest simulated time of one step [s] (``fixedpoint.max_step_time_s``).
+        Longest simulated time of one step of the map [s] (``fixedpoint.max_step_time_s``).
+    walk_step_time : float
+        Longest simulated time of one step of :meth:`simulate` [s]
+        (``simulate.max_step_time_s``, as the ``simulate`` stage; a scene without a
+        ``simulate`` section: :attr:`max_step_time`).
 
     Raises
     ------
     walkerlab.config.SceneError
         ``step_time_limit_s`` not a positive number.
+    ValueError
+        A walker or ground the rigid model does not carry (one line naming the key, as
+        :func:`walkerlab.models.registry.build_walker`: footholds of several heights for
+        an actuated walker, printed equations on stairs, ...).
     """
 
     def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
@@ -98,6 +116,8 @@ class Walker:
         self.solver = Solver.from_settings(scene.solver)
         fp = scene.fixedpoint
         self.max_step_time = 5.0 if fp is None else fp.max_step_time_s
+        sim = scene.simulate
+        self.walk_step_time = self.max_step_time if sim is None else sim.max_step_time_s
 
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
@@ -290,8 +310,11 @@ class Walker:
     def fixed_point(self) -> Gait:
         """The period-1 gait the ``fixedpoint`` stage finds, bit for bit (the same search:
         :func:`walkerlab.analysis.gait.scene.solve_scene`, on this walker's own model
-        :attr:`model` and integrator :attr:`solver`: nothing is rebuilt from the scene),
-        without writing anything.
+        :attr:`model` and integrator :attr:`solver`: nothing is rebuilt from the scene; with
+        the stage's check of each gait's ground contact, which the choice among several
+        gaits prefers, and the stage's start: ``fixedpoint.initial_guess``, or the gait of
+        the scene ``fixedpoint.from`` names carried here by homotopy,
+        :func:`walkerlab.studies.continuation.homotopy_start`), without writing anything.
 
         Returns
         -------
@@ -304,15 +327,19 @@ class Walker:
         ------
         walkerlab.analysis.gait.search.GaitNotFound
             No gait (one line: what was tried, what to try next).
+        walkerlab.config.SceneError
+            ``fixedpoint.from`` names a scene that does not load (one line).
         ValueError
-            A malformed initial guess or gait choice (one line naming the field).
+            A malformed initial guess or gait choice, or a ``fixedpoint.from`` gait that
+            does not reach this walker (one line naming the field).
         """
         import numpy as np
 
         from walkerlab.analysis.gait.energy import gait_ledger
         from walkerlab.analysis.gait.scene import solve_scene
 
-        _, search = solve_scene(self.scene, walker=self.model, solver=self.solver)
+        _, search = solve_scene(self.scene, guess=self._known_start(), walker=self.model,
+                                solver=self.solver, ground=True)
         chosen = search.gaits[search.selected]
         r = chosen.result
         m, ledger = gait_ledger(self.model, r.x, self.model.steps_per_map, self.solver,
@@ -322,6 +349,22 @@ class Walker:
                     np.asarray(r.multipliers_variational),
                     np.asarray(r.jacobian_variational), float(r.residual), chosen.label,
                     m["step_length"], m["speed"], m["cost_of_transport"], ledger)
+
+    def _known_start(self):
+        """The start of the gait search carried from ``fixedpoint.from`` (as the
+        ``fixedpoint`` stage: :func:`walkerlab.studies.continuation.known_scene`,
+        :func:`~walkerlab.studies.continuation.homotopy_start`), None without one."""
+        fp = self.scene.fixedpoint
+        if fp is None or fp.from_ is None:
+            return None
+        from walkerlab.config import SceneError
+        from walkerlab.studies.continuation import homotopy_start, known_scene
+
+        try:
+            src = known_scene(self.scene)
+        except SceneError as exc:
+            raise SceneError(f"fixedpoint.from: {exc}") from None
+        return homotopy_start(self.scene, src)[0]
 
     def find_gait_for(self, vary: str, **target: float) -> tuple[Walker, Gait]:
         """The walker whose period-1 gait meets a target, one field freed (Kuo's
@@ -369,8 +412,18 @@ class Walker:
                 float(v) for n, v in zip(found.state_names(), res.x)})
         return found, found.fixed_point()
 
-    def simulate(self, x0, strides: int, sample_rate_hz: float = 500.0) -> Walk:
-        """Walk ``strides`` strides (2 * strides heel strikes) from ``x0``.
+    def simulate(self, x0, strides: int, sample_rate_hz: float = 500.0, *,
+                 terrain_seed: int | None = None) -> Walk:
+        """Walk ``strides`` strides (2 * strides heel strikes) from ``x0`` on the scene's
+        ground, as the ``simulate`` stage walks it
+        (:func:`walkerlab.analysis.gait.rigid_run.walk_scene`): a slope, per-step slopes,
+        stairs and footholds through the walker's heel-strike guard, a height profile
+        segment by segment, a rough ground drawn from ``terrain_seed``; each step bounded
+        to :attr:`walk_step_time` of simulated time.  From the stage's start (the gait of
+        :meth:`fixed_point`, or ``simulate.initial_state``) with the scene's strides, the
+        heel strikes, the step table and the energy ledger are those of
+        ``walkerlab simulate``, bit for bit (the samples are the same walk, taken on each
+        step's own time grid).
 
         Parameters
         ----------
@@ -383,6 +436,12 @@ class Walker:
             Samples per second of the returned arrays [Hz] (as ``simulate.sample_rate_hz``);
             the walk holds at most :data:`~walkerlab.config.MAX_SIMULATE_SAMPLES` samples,
             as the ``simulate`` stage.
+        terrain_seed : int, optional
+            Walk the per-step ground of ``terrain.per_step`` drawn from this seed (as
+            ``walkerlab simulate --terrain-seed``;
+            :func:`walkerlab.analysis.gait.rigid_run.rough_ground_steps`: the walk ends
+            after its ``2 * strides`` steps); default the scene's
+            ``simulate.terrain_seed`` (none: the scene's own ground).
 
         Returns
         -------
@@ -394,7 +453,11 @@ class Walker:
         walkerlab.config.SceneError
             ``strides`` not a whole number in range (``1.5``, ``True``, ``"2"``, ``10**9``),
             ``sample_rate_hz`` not a positive number, more samples than the cap (said before
-            any is taken), or ``x0`` no state of the walker (one line each).
+            any is taken), ``x0`` no state of the walker, a ``terrain_seed`` out of range
+            or without ``terrain.per_step``, or a ground the walk does not read (a profile
+            only in ``terrain.profile_csv``, a profile walked by an actuated walker or
+            printed equations: ``terrain.kind: profile: ...``) (one line each, naming the
+            key).
         walkerlab.analysis.gait.poincare.StepFailed
             A step used up ``step_time_limit_s`` of CPU time (a fall is recorded in
             ``termination``, not raised).
@@ -403,14 +466,28 @@ class Walker:
 
         from walkerlab.analysis.gait.energy import trajectory_ledger
         from walkerlab.analysis.gait.metrics import step_table
+        from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene
         from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
-        from walkerlab.integrate.rigid import simulate_steps
+        from walkerlab.config.options import with_terrain_seed
 
         strides, rate = simulate_options(strides, sample_rate_hz)
         x0 = self.check_state(x0, "x0")
-        with self._bounded():
-            traj = simulate_steps(self.model, x0, 2 * strides, self.solver,
-                                  max_step_time=self.max_step_time)
+        try:
+            scene = with_terrain_seed(self.scene, terrain_seed)
+        except SceneError as exc:
+            raise SceneError(f"simulate: terrain_seed={short(terrain_seed)}: "
+                             f"{str(exc).split(': ', 1)[-1]}") from None
+        walker = self.model
+        try:
+            if scene.simulate is not None and scene.simulate.terrain_seed is not None:
+                walker = rough_ground_walker(scene, 2 * strides)
+            with self._bounded():
+                traj = walk_scene(scene, walker, x0, 2 * strides, self.solver,
+                                  self.walk_step_time)
+        except SceneError:
+            raise
+        except ValueError as exc:  # a ground this walk does not read (one line, its key)
+            raise SceneError(str(exc)) from None
         counts = [max(2, int(np.ceil((seg.t_end - seg.t_start) * rate)) + 1)
                   for seg in traj.segments]
         if sum(counts) > MAX_SIMULATE_SAMPLES:

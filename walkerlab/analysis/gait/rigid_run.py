@@ -51,11 +51,8 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
         (:func:`walkerlab.analysis.gait.metrics.sample_trajectory`).
     """
     sim = scene.simulate
-    if scene.terrain is not None and scene.terrain.kind == "profile":
-        traj = profile_walk(scene, x0, 2 * sim.strides)
-    else:
-        traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
-                              max_step_time=sim.max_step_time_s)
+    traj = walk_scene(scene, walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
+                      sim.max_step_time_s)
     samples = sample_trajectory(traj, sim.sample_rate_hz)
     steps = step_table(traj)
     ok = steps["termination"] == "heel_strike"
@@ -74,6 +71,46 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
     if ends is not None and traj.termination == "heel_strike" and ends < 2 * sim.strides:
         summary["ground_steps"] = int(ends)  # a finite ground ended the walk
     return RigidRun(traj, samples, steps, summary)
+
+
+def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solver,
+               max_step_time: float):
+    """``n_steps`` steps of the scene's rigid walker from ``x0`` on the scene's ground: the
+    walk of the ``simulate`` stage and of :meth:`walkerlab.api.walker.Walker.simulate`.
+
+    ``walker`` carries the ground of a slope, per-step slopes, stairs and footholds (its
+    heel-strike guard: :func:`walkerlab.models.registry.build_walker`, or a drawn rough
+    ground, :func:`rough_ground_walker`) and is walked by
+    :func:`walkerlab.integrate.rigid.simulate_steps`; a height profile
+    (``terrain.kind: profile``) is walked segment by segment (:func:`profile_walk`), whose
+    walkers are built per segment from the scene.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    walker : walkerlab.models.hybrid.HybridWalker
+        The scene's rigid walker.
+    x0 : ndarray (2n,)
+        State just after heel strike [rad, rad/s].
+    n_steps : int
+    solver : walkerlab.integrate.solver.Solver
+        The scene's integrator (``solver`` section).
+    max_step_time : float
+        Longest simulated time of one step [s].
+
+    Returns
+    -------
+    walkerlab.integrate.rigid.HybridTrajectory
+
+    Raises
+    ------
+    ValueError
+        A profile the rigid walk does not read (:func:`profile_walk`; one line naming the
+        field).
+    """
+    if scene.terrain is not None and scene.terrain.kind == "profile":
+        return profile_walk(scene, x0, n_steps, solver, max_step_time)
+    return simulate_steps(walker, x0, n_steps, solver, max_step_time=max_step_time)
 
 
 def simulate_run(scene: Scene, fixed_point=None):
@@ -164,9 +201,11 @@ def rough_ground_walker(scene, n_steps: int):
     return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps))
 
 
-def profile_walk(scene, x0: np.ndarray, n_steps: int):
+def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = None,
+                 max_step_time: float | None = None):
     """``n_steps`` steps of the scene's rigid walker on its height profile from ``x0``
-    (:func:`walkerlab.analysis.gait.profile_walk.simulate_on_profile`).
+    (:func:`walkerlab.analysis.gait.profile_walk.simulate_on_profile`), with ``solver``
+    (default the scene's) and ``max_step_time`` [s] (default ``simulate.max_step_time_s``).
 
     Raises
     ------
@@ -181,6 +220,8 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int):
         raise ValueError("terrain.kind: profile: walked by the passive walker of the "
                          "generated model only (no walker.actuation, ideal.variant: derived)")
     at, data_at = passive_walker_at(scene)
+    solver = Solver.from_settings(scene.solver) if solver is None else solver
+    if max_step_time is None:
+        max_step_time = scene.simulate.max_step_time_s
     return simulate_on_profile(at, data_at, profile_points(scene.terrain), x0, n_steps,
-                               Solver.from_settings(scene.solver),
-                               max_step_time=scene.simulate.max_step_time_s)
+                               solver, max_step_time=max_step_time)
