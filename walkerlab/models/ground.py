@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.walker.kinds import SEVERAL_FOOTHOLDS
+
 __all__ = ["Ground", "foothold_steps", "landing_drop", "scene_ground", "stair_treads"]
 
 
@@ -36,7 +38,8 @@ def landing_drop(terrain) -> float:
     ValueError
         A ground whose steps differ (footholds of several heights or of their own slopes:
         :func:`foothold_steps` and :func:`walkerlab.models.hybrid.ground.on_footholds`
-        walk them): one line.
+        walk them in the rigid model): one line naming the field and what to do
+        (:data:`walkerlab.walker.kinds.SEVERAL_FOOTHOLDS`, the capability table's reason).
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
@@ -45,14 +48,10 @@ def landing_drop(terrain) -> float:
     if terrain.kind == "footholds":
         h = set(terrain.foothold_heights_m or (0.0,))
         if terrain.foothold_slopes_rad is not None:
-            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes "
-                             "differ from step to step: not one landing for every step (the "
-                             "rigid model walks them, one walker per step)")
+            raise ValueError(f"terrain.foothold_slopes_rad: {SEVERAL_FOOTHOLDS}")
         if len(h) == 1:
             return -float(h.pop())
-        raise ValueError("terrain.foothold_heights_m: footholds of different heights "
-                         "differ from step to step: not one landing for every step (the "
-                         "rigid model walks them, one walker per step)")
+        raise ValueError(f"terrain.foothold_heights_m: {SEVERAL_FOOTHOLDS}")
     # a profile: walked step by step (walkerlab.analysis.gait.profile_walk); its periodic
     # gait, the start of the walk, is the scene's slope's
     return 0.0

@@ -123,9 +123,9 @@ def check_ground(terrain) -> float:
     Raises
     ------
     ValueError
-        One line naming the field: a profile on checkerboard lanes or from a CSV,
-        footholds of several heights or of their own slopes, footholds on continuous ground
-        (no ground between the footholds).
+        One line naming the field and what to do: a profile on checkerboard lanes or from
+        a CSV, footholds of several heights or of their own slopes (the rigid model walks
+        them), footholds on continuous ground (no ground between the footholds).
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
