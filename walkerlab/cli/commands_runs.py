@@ -68,7 +68,10 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                                             "that make the contact walker match the ideal gait"),
                 periodic: bool = typer.Option(False, "--periodic", help="also find the contact "
                                               "walker's own periodic gait and its Floquet "
-                                              "multipliers (about 10 s)")
+                                              "multipliers (about 10 s)"),
+                strides: int | None = typer.Option(
+                    None, "--strides", help="strides to simulate (1 stride = 2 steps) "
+                    "(default: contact_sim.n_strides of the scene)")
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
     from walkerlab.io.schemas.contact_sim import load_contact_sim
@@ -76,7 +79,7 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     from walkerlab.stages import pipeline
 
     out = pipeline.run("contact-sim", load(scene), runs_dir, force, adjust=adjust,
-                       periodic=periodic)
+                       periodic=periodic, strides=strides)
     typer.echo(contact_text(load_contact_sim(out.path)))
     typer.echo(status(out))
     if out.failure:

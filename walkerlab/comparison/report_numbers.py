@@ -2,7 +2,8 @@
 
 The report (:mod:`walkerlab.report`) only writes text; what it states beyond the stored
 datasets is computed here, once, before it is written: Table 3's columns of the rigid and
-contact runs, the rigid run's energy drift within a phase and swing-foot clearance, the step
+contact runs, the rigid run's energy drift within a phase and swing-foot clearance above
+the scene's ground, the step
 length the published fixed point implies, the phase-aligned error of the comparison, the
 contact walker's mean stance-foot creep, and the basin's area in the basin map's slice.
 """
@@ -23,7 +24,9 @@ def report_numbers(scene, arts: dict) -> dict:
         With ``simulate`` loaded: ``gait_columns`` (Table 3 columns by label,
         :func:`walkerlab.comparison.tables.table3`), ``energy_drift`` ([J] and relative,
         :func:`walkerlab.analysis.gait.checks.energy_drift_in_swing`), ``swing_clearance``
-        (lowest swing-foot height above the slope [m]) and, where the scene's published
+        (lowest swing-foot height above the scene's ground [m],
+        :func:`walkerlab.analysis.gait.checks.run_ground`) and ``clearance_ground`` (that
+        ground's name) and, where the scene's published
         module prints Eq. (11) and Table 3, ``published_step_length_m``
         (:func:`published_step_length`); with ``compare``: ``phase_error``
         (:func:`phase_aligned_angle_error`); with ``contact-sim``: ``mean_stance_slip_mm``
@@ -40,11 +43,17 @@ def report_numbers(scene, arts: dict) -> dict:
     out: dict = {}
     sim, contact = arts.get("simulate"), arts.get("contact-sim")
     if sim is not None:
-        from walkerlab.analysis.gait.checks import energy_drift_in_swing, swing_foot_clearance
+        from walkerlab.analysis.gait.checks import (
+            energy_drift_in_swing,
+            run_ground,
+            swing_foot_clearance,
+        )
         from walkerlab.comparison.tables import table3
 
         out["energy_drift"] = energy_drift_in_swing(sim.samples)
-        out["swing_clearance"] = swing_foot_clearance(sim.samples, scene.slope.phi_rad)
+        ground = run_ground(scene, sim.samples)
+        out["swing_clearance"] = swing_foot_clearance(sim.samples, ground)
+        out["clearance_ground"] = ground.name
         trajs = {"ours, ideal": sim.samples} | (
             {"ours, contact": contact.samples} if contact is not None else {})
         out["gait_columns"] = table3(trajs, sim.total_mass_kg, sim.gravity_m_per_s2)

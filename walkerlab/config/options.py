@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from walkerlab.config.contact import TerrainSettings
+from walkerlab.config.contact import ContactSimSettings, TerrainSettings
 from walkerlab.config.loader import validate_option
 from walkerlab.config.schema import (
     BasinSettings,
@@ -175,6 +175,25 @@ def with_strides(scene: Scene, strides: int | None) -> Scene:
             raise SceneError(f"--strides {strides}: {err.errors()[0]['msg'].lower()} "
                              "(simulate.strides)") from None
     return scene.model_copy(update={"simulate": sim})
+
+
+def with_contact_strides(scene: Scene, strides: int | None) -> Scene:
+    """The scene with ``contact_sim.n_strides`` set to ``strides`` (``contact-sim
+    --strides``, as :func:`with_strides` for the rigid run; the section is created with its
+    defaults when absent; None keeps the scene, bit for bit).
+
+    Raises
+    ------
+    SceneError
+        ``strides`` out of bounds: ``--strides 0: input should be ...
+        (contact_sim.n_strides)``.
+    """
+    if strides is None:
+        return scene
+    n = validate_option(ContactSimSettings, "n_strides", strides, "--strides",
+                        "contact_sim.n_strides")
+    cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"n_strides": n})
+    return scene.model_copy(update={"contact_sim": cs})
 
 
 def map_not_applicable(scene: Scene, kind: str) -> str:

@@ -91,8 +91,8 @@ def _gait(walker):
 def _check_rigid_ground(scene) -> None:
     """The rigid view steps one hybrid walker: a ground whose steps differ (a profile,
     footholds of several heights or slopes, per-step random ground) is refused in one line
-    (``walkerlab simulate`` walks them step by step; the contact view has the ground as
-    geometry)."""
+    (``walkerlab simulate`` walks them step by step; the contact view has a profile as
+    geometry, and refuses footholds that differ, so their line names no other view)."""
     from walkerlab.models.ground import foothold_steps
 
     t = scene.terrain
@@ -103,7 +103,12 @@ def _check_rigid_ground(scene) -> None:
     elif getattr(t, "per_step", None) is not None:
         what = "terrain.per_step"
     elif t.kind == "footholds" and foothold_steps(t, scene.slope.phi_rad) is not None:
-        what = "terrain.foothold_heights_m"
+        from walkerlab.walker.kinds import GYM_FOOTHOLDS
+
+        # neither view takes them (the contact view lays patches for one height)
+        key = "foothold_slopes_rad" if t.foothold_slopes_rad is not None else \
+            "foothold_heights_m"
+        raise ValueError(f"walkerlab.gym: terrain.{key}: {GYM_FOOTHOLDS}")
     else:
         return
     raise ValueError(f"walkerlab.gym: {what}: the rigid view steps one walker on a ground "

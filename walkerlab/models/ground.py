@@ -7,11 +7,23 @@ A stair ``riser_m`` down is a landing ``riser_m`` below the stance foot's level 
 it); footholds of one height ``h`` a landing at ``-h``; footholds of several heights or of
 their own slopes are one landing per step (:func:`foothold_steps`); the slope and a height
 profile (walked step by step from the slope's gait) land on the slope's line.
+
+The ground's shape in the rigid run's world frame (x forward, y up, the first stance foot
+where the run puts it) is :class:`Ground` (:func:`scene_ground`): straight pieces, each with
+the line it lies on, from which the swing foot's clearance is measured
+(:meth:`Ground.clearance`) by the fixed point's stair check and the report alike.
 """
 
 from __future__ import annotations
 
-__all__ = ["foothold_steps", "landing_drop"]
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.walker.kinds import SEVERAL_FOOTHOLDS
+
+__all__ = ["Ground", "foothold_steps", "landing_drop", "scene_ground", "stair_treads"]
 
 
 def landing_drop(terrain) -> float:
@@ -26,7 +38,8 @@ def landing_drop(terrain) -> float:
     ValueError
         A ground whose steps differ (footholds of several heights or of their own slopes:
         :func:`foothold_steps` and :func:`walkerlab.models.hybrid.ground.on_footholds`
-        walk them): one line.
+        walk them in the rigid model): one line naming the field and what to do
+        (:data:`walkerlab.walker.kinds.SEVERAL_FOOTHOLDS`, the capability table's reason).
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
@@ -35,14 +48,10 @@ def landing_drop(terrain) -> float:
     if terrain.kind == "footholds":
         h = set(terrain.foothold_heights_m or (0.0,))
         if terrain.foothold_slopes_rad is not None:
-            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes "
-                             "differ from step to step: not one landing for every step (the "
-                             "rigid model walks them, one walker per step)")
+            raise ValueError(f"terrain.foothold_slopes_rad: {SEVERAL_FOOTHOLDS}")
         if len(h) == 1:
             return -float(h.pop())
-        raise ValueError("terrain.foothold_heights_m: footholds of different heights "
-                         "differ from step to step: not one landing for every step (the "
-                         "rigid model walks them, one walker per step)")
+        raise ValueError(f"terrain.foothold_heights_m: {SEVERAL_FOOTHOLDS}")
     # a profile: walked step by step (walkerlab.analysis.gait.profile_walk); its periodic
     # gait, the start of the walk, is the scene's slope's
     return 0.0
@@ -68,3 +77,143 @@ def foothold_steps(terrain, slope_rad: float) -> tuple[tuple[float, float], ...]
     n = len(h) if h else len(g)
     return tuple((-float(h[k]) if h else 0.0, float(g[k]) if g else float(slope_rad))
                  for k in range(n))
+
+
+def stair_treads(terrain, first_x_m: float, n_treads: int, behind: int = 3
+                 ) -> list[tuple[float, float, float]]:
+    """``[(x_start, x_end, height), ...]`` [m] of stairs' level treads in the world frame,
+    ``tread_m`` deep, each ``riser_m`` below (``direction: down``) or above (``up``) the
+    last; tread 0 at height 0 holds the first stance foot at ``x = first_x_m``,
+    ``first_foothold_m`` from its back end (default mid-tread).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings
+        ``kind: stairs``.
+    first_x_m : float
+        The first stance foot's x [m].
+    n_treads : int
+        Treads ahead of tread 0 (the last one runs on for 100 treads' depth).
+    behind : int
+        Treads behind tread 0 (the first one runs back for 100 treads' depth).
+    """
+    D = float(terrain.tread_m)
+    dh = -landing_drop(terrain)  # each tread's height above the last [m]
+    u0 = D / 2 if terrain.first_foothold_m is None else float(terrain.first_foothold_m)
+    x0 = float(first_x_m) - u0
+    out = []
+    for k in range(-int(behind), int(n_treads) + 1):
+        a, b = x0 + k * D, x0 + (k + 1) * D
+        if k == -int(behind):
+            a -= 100.0 * D
+        if k == int(n_treads):
+            b += 100.0 * D
+        out.append((a, b, k * dh))
+    return out
+
+
+@dataclass(frozen=True)
+class Ground:
+    """A ground of straight pieces in the world frame (x forward, y up) [m]: piece ``i``
+    holds ``start[i] <= x < start[i + 1]`` (the first runs back, the last on, without end)
+    and lies on the line through ``anchor[i]`` at slope ``slope[i]`` [rad] (downhill
+    positive, as the scene's slope).
+
+    Attributes
+    ----------
+    start : ndarray (m,)
+        x where each piece begins [m], increasing (``start[0]`` is not read).
+    anchor : ndarray (m, 2)
+        A point of each piece's line [m].
+    slope : ndarray (m,)
+        Each piece's slope [rad].
+    name : str
+        What the ground is, for a sentence: ``slope``, ``treads``, ``footholds``,
+        ``profile``, ``ground``.
+    """
+
+    start: np.ndarray
+    anchor: np.ndarray
+    slope: np.ndarray
+    name: str = "ground"
+
+    def piece(self, x) -> np.ndarray:
+        """Index of the piece under each ``x`` [m] (ndarray of int, the shape of ``x``)."""
+        i = np.searchsorted(self.start, np.asarray(x, float), side="right") - 1
+        return np.clip(i, 0, self.start.size - 1)
+
+    def clearance(self, x, y) -> np.ndarray:
+        """Height [m] of the points ``(x, y)`` [m] above the piece under them, along that
+        piece's normal: ``(y - y_i) cos(g_i) + (x - x_i) sin(g_i)`` for the piece's anchor
+        ``(x_i, y_i)`` and slope ``g_i``; negative below the ground (shape of ``x``)."""
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        i = self.piece(x)
+        g, a = self.slope[i], self.anchor[i]
+        return (y - a[..., 1]) * np.cos(g) + (x - a[..., 0]) * np.sin(g)
+
+
+def _pieces(rows, name: str) -> Ground:
+    """:class:`Ground` of ``[(x_start, anchor_x, anchor_y, slope), ...]``."""
+    r = np.asarray(rows, float).reshape(-1, 4)
+    return Ground(r[:, 0].copy(), r[:, 1:3].copy(), r[:, 3].copy(), name)
+
+
+def scene_ground(terrain, slope_rad: float, footfalls=None, step_slopes=None) -> Ground:
+    """The ground of a scene in the rigid run's world frame (the first stance foot at
+    ``footfalls[1]``, the world origin without ``footfalls``).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings or None
+    slope_rad : float
+        The scene's slope [rad].
+    footfalls : ndarray (k, 2), optional
+        Where the feet stood [m], in walking order: the first swing foot's start, each
+        step's stance foot, the last step's landing (the contact points,
+        :func:`walkerlab.analysis.gait.checks.footfalls`).  Needed for footholds and a
+        drawn per-step ground (their pieces are where the feet stood).
+    step_slopes : sequence of float, optional
+        Each step's ground slope [rad] on footholds or a drawn per-step ground, step ``k``
+        with ``footfalls[k + 1]`` in stance (the list repeats; default the scene's slope).
+
+    Returns
+    -------
+    Ground
+        ``slope`` (and no terrain): the scene's line through the origin.  ``stairs``: the
+        treads (:func:`stair_treads`, level, tread 0 at the first stance foot).
+        ``profile``: the profile's segments (its own world coordinates, as the rigid walk's,
+        :mod:`walkerlab.analysis.gait.profile_walk`), the first and last running on.
+        ``footholds`` (or ``step_slopes`` given): one piece per footfall, through it at its
+        step's slope, from half-way to the footfall behind to half-way to the one ahead.
+
+    Raises
+    ------
+    ValueError
+        Footholds without ``footfalls``; a profile given only as ``profile_csv`` (one line).
+    """
+    kind = "slope" if terrain is None else terrain.kind
+    if kind == "footholds" or step_slopes is not None:
+        if footfalls is None or len(footfalls) < 2:
+            raise ValueError("terrain.kind: footholds: the ground is where the feet stood "
+                             "(footfalls of a run)")
+        f = np.asarray(footfalls, float)
+        g = list(step_slopes) if step_slopes else [float(slope_rad)]
+        gk = [g[max(k - 1, 0) % len(g)] for k in range(len(f))]  # footfall k: step k - 1's
+        edges = np.maximum.accumulate(np.concatenate([[-np.inf], (f[1:, 0] + f[:-1, 0]) / 2]))
+        return _pieces([(edges[k], f[k, 0], f[k, 1], gk[k]) for k in range(len(f))],
+                       "footholds" if kind == "footholds" else "ground")
+    if kind == "stairs":
+        x0, y0 = (0.0, 0.0) if footfalls is None else np.asarray(footfalls, float)[1]
+        n = 2 if footfalls is None else len(footfalls)
+        return _pieces([(a, a, y0 + h, 0.0) for a, _b, h in stair_treads(terrain, x0, n)],
+                       "treads")
+    if kind == "profile":
+        if terrain.profile_m is None:
+            raise ValueError("terrain.profile_csv: the rigid walk reads inline profiles "
+                             "(terrain.profile_m) only so far")
+        P = np.asarray(terrain.profile_m, float)
+        rows = [(P[j, 0] if j else -np.inf, P[j, 0], P[j, 1],
+                 -math.atan((P[j + 1, 1] - P[j, 1]) / (P[j + 1, 0] - P[j, 0])))
+                for j in range(len(P) - 1)]
+        return _pieces(rows, "profile")
+    return _pieces([(-np.inf, 0.0, 0.0, float(slope_rad))], "slope")

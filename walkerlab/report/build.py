@@ -45,7 +45,11 @@ class ReportInputs:
         Largest energy change within a phase of the rigid run [J] and relative [-]
         (:func:`walkerlab.analysis.gait.checks.energy_drift_in_swing`).
     swing_clearance : float
-        Lowest swing-foot height above the slope [m] (NaN: none).
+        Lowest swing-foot height above the scene's ground [m] (NaN: none;
+        :func:`walkerlab.analysis.gait.checks.swing_foot_clearance`).
+    clearance_ground : str
+        What that ground is (:attr:`walkerlab.models.ground.Ground.name`: ``slope``,
+        ``treads``, ``footholds``, ``profile``, ``ground``).
     basin_area : BasinArea or None
         The basin's area in the basin map's slice
         (:func:`walkerlab.analysis.robustness.basin_area.basin_area`; None: no basin).
@@ -70,6 +74,7 @@ class ReportInputs:
     gait_columns: dict = field(default_factory=dict)
     energy_drift: tuple = (float("nan"), float("nan"))
     swing_clearance: float = float("nan")
+    clearance_ground: str = "slope"
     basin_area: object = None
     published_step_length_m: float = float("nan")
     phase_error: tuple | None = None

@@ -39,14 +39,15 @@ def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
 
 
 # --------------------------------------------------------------------------- summary
-def clearance_text(lowest: float, u: Units) -> str:
-    """The swing foot's lowest height above the slope (scene length unit) in words:
-    clearance when positive, penetration depth below the slope (foot scuffing) when
-    negative; ``u``: the scene's units (shown in mm in SI)."""
+def clearance_text(lowest: float, u: Units, ground: str = "slope") -> str:
+    """The swing foot's lowest height above the ground (scene length unit) in words:
+    clearance when positive, penetration depth below the ground (foot scuffing) when
+    negative; ``u``: the scene's units (shown in mm in SI); ``ground``: what the ground is
+    (:attr:`walkerlab.models.ground.Ground.name`: ``slope``, ``treads``, ...)."""
     v, unit = num(abs(lowest) * u.small_scale, 3), u.small_length
     if lowest > 0:
-        return f"lowest {v} {unit} above the slope inside the steps: no scuffing"
-    return (f"the swing foot dips up to {v} {unit} below the slope inside the steps "
+        return f"lowest {v} {unit} above the {ground} inside the steps: no scuffing"
+    return (f"the swing foot dips up to {v} {unit} below the {ground} inside the steps "
             "(penetration): foot scuffing, which the rigid model ignores")
 
 def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
@@ -130,7 +131,8 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
         rows += energy_rows
         clear = inputs.swing_clearance
         if np.isfinite(clear):
-            bullets.append("- **Swing-foot clearance**: " + clearance_text(clear, u) + ".")
+            bullets.append("- **Swing-foot clearance**: "
+                           + clearance_text(clear, u, inputs.clearance_ground) + ".")
             rows.append(["lowest swing-foot clearance (negative: penetration)", u.small_length,
                          num(u.small_scale * clear, 3), "—"])
     c = arts.get("contact-sim")

@@ -17,7 +17,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from walkerlab.analysis.contact.record import contact_sim_run
-from walkerlab.config import Scene
+from walkerlab.config import Scene, SceneError
+from walkerlab.config.options import with_contact_strides
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
@@ -107,11 +108,28 @@ def _rhs_beside(setup: ContactSetup, rhs_ready: CompiledElsewhere | None):
     side.close(cancel=not fut.done())
 
 
+def check(scene: Scene, strides: int | None = None, **_options) -> None:
+    """Refuse a bad ``--strides`` before anything runs (:func:`walkerlab.stages.pipeline.run`).
+
+    Raises
+    ------
+    StageError
+        ``strides`` out of bounds (one line naming ``contact_sim.n_strides``).
+    """
+    try:
+        with_contact_strides(scene, strides)
+    except SceneError as exc:
+        raise StageError(str(exc)) from None
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         adjust: bool = False, periodic: bool = False,
-        rhs_ready: CompiledElsewhere | None = None) -> StageOutcome:
+        rhs_ready: CompiledElsewhere | None = None, strides: int | None = None
+        ) -> StageOutcome:
     """Simulate the contact walker (optionally after ``--adjust``) from ``fixedpoint.h5``
     (which must exist: :mod:`walkerlab.stages.pipeline` runs it first) and write the artifact.
+    ``strides`` (``--strides``): ``contact_sim.n_strides`` for this run (the artifact's
+    inputs, so a run of another number of strides is not reused for it).
     ``rhs_ready``: the caller's side process compiling the compiled right-hand side
     (:func:`rhs_beside`; ``walkerlab report``), else this run starts its own when cold.
 
@@ -123,9 +141,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         The scene has no ``contact`` section, its walker cannot stand on contacts, or its
         periodic gait (``periodic``) is one the contact view does not find
         (:func:`walkerlab.models.contact.scene.contact_setup`; one line).
+    StageError
+        ``strides`` out of bounds (one line naming ``contact_sim.n_strides``).
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
+    try:
+        scene = with_contact_strides(scene, strides)
+    except SceneError as exc:
+        raise StageError(str(exc)) from None
     setup = contact_setup(scene, periodic)  # the scene read once: all the run needs, typed
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)

@@ -21,6 +21,31 @@ from walkerlab.execution.side import SideWorker
 from walkerlab.stages.pipeline import report_plan, stage_module
 
 
+def _named(stage: str, run, *args, **kwargs):
+    """``run(*args, **kwargs)`` (a stage of the report), a refusal said with the stage's
+    name: ``report stopped at contact-sim: <the stage's one line>``.
+
+    Raises
+    ------
+    StageError
+        The stage refused (a :class:`StageError`, an unreadable artifact, a one-line
+        ``ValueError`` such as :class:`walkerlab.models.contact.scene.ContactSceneError`);
+        a scene error (:class:`walkerlab.config.SceneError`, possibly several lines) and
+        anything else pass unchanged.
+    """
+    from walkerlab.config import SceneError
+    from walkerlab.io.artifacts import ArtifactError
+    from walkerlab.stages.common import StageError
+
+    try:
+        return run(*args, **kwargs)
+    except SceneError:
+        raise
+    except (StageError, ArtifactError, ValueError) as exc:
+        msg = " ".join(str(exc).split()) or type(exc).__name__
+        raise StageError(f"report stopped at {stage}: {msg}") from None
+
+
 def _study(scene: Scene, runs_root, force: bool):
     """The work-precision stage in a thread of the report, overlapping the untimed stages
     (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
@@ -97,7 +122,8 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     try:
         warm, module = _warm_up(scene, runs_root, force, plan, side) or (None, None)
         if "fixedpoint" in plan:
-            add(stage_module("fixedpoint").run(scene, runs_root, force, compare_variants=True))
+            add(_named("fixedpoint", stage_module("fixedpoint").run, scene, runs_root, force,
+                       compare_variants=True))
         if study is not None:
             study.start()
         if study is not None and study.needs("contact"):
@@ -112,9 +138,9 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
                 if module is None:  # (else the walk waits for its right-hand side)
                     side.wait(warm)  # compiled there (or failed: compiled here), never twice
             if name in plan:
-                add(stage_module(name).run(scene, runs_root, force,
-                                           **({"rhs_ready": module} if module is not None
-                                              and name == "contact-sim" else {})))
+                add(_named(name, stage_module(name).run, scene, runs_root, force,
+                           **({"rhs_ready": module} if module is not None
+                              and name == "contact-sim" else {})))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
             # shared only with a side process already up (matplotlib loaded): one started
             # for the figures alone costs about what it saves
@@ -128,13 +154,13 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     side.close()
     if study is not None:
         study.release()
-        add(study.join())
+        add(_named("workprecision", study.join))
         drawn.append(draw_if_changed(scene, runs_root, force, "workprecision"))
     # after the study: the basin's worker processes and the attribution's timed cases would
     # share the timed cases' cores
     for name in ("basin", "robustness", "attribution", "optimize"):
         if name in plan:
-            add(stage_module(name).run(scene, runs_root, force))
+            add(_named(name, stage_module(name).run, scene, runs_root, force))
     if "optimize" in plan:
         stage_module("optimize").draw(scene, runs_root)
     return done, drawn

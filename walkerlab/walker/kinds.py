@@ -152,10 +152,19 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
 _NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
                   "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-_ONE_LANDING = ("footholds of different heights differ from step to step: not one landing "
-                "for every step (the rigid model walks them, one walker per step)")
+#: why a view other than the rigid one refuses footholds that differ from step to step
+#: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
+SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model only "
+                     "(walkerlab fixedpoint, simulate): give footholds of one height for "
+                     "this view")
+_ONE_LANDING = SEVERAL_FOOTHOLDS
 _GYM_GROUND = ("the rigid view steps one walker on a ground whose every step is alike "
                "(slope, stairs, footholds of one height); use view='contact'")
+#: why neither gym view takes footholds that differ from step to step (the contact view
+#: lays its patches for one height, :data:`SEVERAL_FOOTHOLDS`)
+GYM_FOOTHOLDS = ("the gym's views step one walker on a ground whose every step is alike "
+                 "(slope, stairs, footholds of one height); footholds that differ from step "
+                 "to step run in walkerlab fixedpoint and simulate only")
 _OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                  "half-spaces, not a polyline; --format mjcf writes it as a height field)")
 _ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
@@ -168,7 +177,7 @@ _FIVE_LINK_JOINTS = ("stance_hip, swing_hip, stance_knee and swing_knee need a f
 #: view, a profile in the Adams dataset, the OpenSim model and the gym
 _GROUNDS = {
     **{("footholds", v): _ONE_LANDING for v in ("contact", "mjcf", "adams", "osim")},
-    ("footholds", "gym"): _GYM_GROUND,
+    ("footholds", "gym"): GYM_FOOTHOLDS,
     ("profile", "gym"): _GYM_GROUND,
     ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,

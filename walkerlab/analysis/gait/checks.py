@@ -1,5 +1,5 @@
 """Checks of a rigid run's trajectory the report states: energy drift between impacts, the
-swing foot's clearance above the slope, and whether the gait's ground contact is unilateral
+swing foot's clearance above the scene's ground, and whether the gait's ground contact is unilateral
 (the ground pushes the stance foot, never pulls it)."""
 
 from __future__ import annotations
@@ -24,14 +24,56 @@ def energy_drift_in_swing(tr: NamedTrajectory) -> tuple[float, float]:
     return drift, drift / float(np.max(np.abs(tot)))
 
 
-def swing_foot_clearance(tr: NamedTrajectory, slope_rad: float, margin: float = 0.1) -> float:
-    """Lowest height [m] of the swing foot above the slope inside the steps of ``tr``.
+def _foot(tr: NamedTrajectory, leg: str):
+    """The ``<leg>_contact`` point (round feet) or else ``<leg>_foot`` (2, k); None."""
+    return tr.points.get(f"{leg}_contact", tr.points.get(f"{leg}_foot"))
 
-    Heights are normal to the slope through the first stance foot; the first and last
-    ``margin`` of each step (lift-off, heel strike, where the height is ~0) are left out.
-    A negative value means the foot passes through the ground (scuffing, which the rigid
-    model ignores).  Round feet use the ``<leg>_contact`` point when the walker has one.
+
+def footfalls(tr: NamedTrajectory) -> np.ndarray | None:
+    """Where the feet of a two-legged run stood (k, 2) [m], in walking order: the first
+    swing foot at the start, each step's stance foot, the last step's swing foot at its end
+    (the ``<leg>_contact`` point when the walker has one); None for another walker."""
+    if len(tr.legs) != 2:
+        return None
+    out = []
+    for j, k in enumerate(np.unique(tr.step_index)):
+        i = np.flatnonzero(tr.step_index == k)
+        stance = int(tr.stance_leg[i[0]])
+        feet = _foot(tr, tr.legs[stance]), _foot(tr, tr.legs[1 - stance])
+        if feet[0] is None or feet[1] is None:
+            return None
+        if j == 0:
+            out.append(feet[1][:, i[0]])
+        out.append(feet[0][:, i[0]])
+        last = feet[1][:, i[-1]]
+    return np.asarray([*out, last], float) if out else None
+
+
+def swing_foot_clearance(tr: NamedTrajectory, ground, margin: float = 0.1) -> float:
+    """Lowest height [m] of the swing foot above the ground inside the steps of ``tr``.
+
+    Heights are along the normal of the ground's piece under the foot
+    (:meth:`walkerlab.models.ground.Ground.clearance`, the quantity the fixed point's stair
+    check measures, :func:`walkerlab.analysis.gait.treads.tread_landing`); the first and
+    last ``margin`` of each step (lift-off, heel strike, where the height is ~0) are left
+    out.  A negative value means the foot passes through the ground (scuffing, which the
+    rigid model ignores).  Round feet use the ``<leg>_contact`` point when the walker has
+    one.
+
+    Parameters
+    ----------
+    tr : NamedTrajectory
+        A rigid run, points in its world frame.
+    ground : walkerlab.models.ground.Ground or float
+        The scene's ground (:func:`run_ground`), or a slope [rad]: the line through the
+        first stance foot (the world origin).
+    margin : float
+        Fraction of each step left out at either end [-].
     """
+    if not hasattr(ground, "clearance"):
+        from walkerlab.models.ground import scene_ground
+
+        ground = scene_ground(None, float(ground))
     lowest = np.inf
     for k in np.unique(tr.step_index):
         m = tr.step_index == k
@@ -40,13 +82,41 @@ def swing_foot_clearance(tr: NamedTrajectory, slope_rad: float, margin: float = 
         swing = tr.legs[1 - int(tr.stance_leg[m][0])] if len(tr.legs) == 2 else None
         if swing is None or not inner.any():
             continue
-        foot = tr.points.get(f"{swing}_contact", tr.points.get(f"{swing}_foot"))
+        foot = _foot(tr, swing)
         if foot is None:
             continue
         xy = foot[:, m][:, inner]
-        h = xy[1] * np.cos(slope_rad) + xy[0] * np.sin(slope_rad)
-        lowest = min(lowest, float(np.min(h)))
+        lowest = min(lowest, float(np.min(ground.clearance(xy[0], xy[1]))))
     return lowest
+
+
+def run_ground(scene, tr: NamedTrajectory):
+    """The scene's ground under a rigid run ``tr`` of it
+    (:func:`walkerlab.models.ground.scene_ground`): footholds (and a drawn per-step ground,
+    ``simulate.terrain_seed``) where the run's feet stood (:func:`footfalls`).
+
+    Raises
+    ------
+    ValueError
+        Footholds under a run without two legs' feet (one line).
+    """
+    from walkerlab.models.ground import foothold_steps, scene_ground
+
+    terrain, phi = scene.terrain, float(scene.slope.phi_rad)
+    sim = scene.simulate
+    slopes = None
+    if terrain is not None and terrain.kind == "footholds":
+        steps = foothold_steps(terrain, phi)
+        slopes = [g for _d, g in steps] if steps is not None else [phi]
+    elif sim is not None and sim.terrain_seed is not None and terrain is not None \
+            and terrain.per_step is not None:
+        from walkerlab.analysis.gait.rigid_run import rough_ground_steps
+
+        n = int(np.unique(tr.step_index).size)
+        slopes = [g for _d, g in rough_ground_steps(scene, n)]
+    if slopes is None and (terrain is None or terrain.kind == "slope"):
+        return scene_ground(None, phi)
+    return scene_ground(terrain, phi, footfalls(tr), slopes)
 
 
 # ---------------------------------------------------------------------------- ground contact

@@ -9,8 +9,10 @@ strike) and tread depth ``D``, the foot's place on the tread, ``u`` from the tre
 misses its tread when ``u_k`` leaves ``[0, D]`` (``u_k > D``: beyond the nosing, on the next
 tread; ``u_k < 0``: the foot would have met the stance tread first).
 
-Clearances (the step from the fixed point, the stance foot at ``u_0``; heights relative to
-the stance tread): over the tread behind (the swing foot's start), over the stance tread
+Clearances (the step from the fixed point, the stance foot at ``u_0``; heights above the
+tread under the foot, :meth:`walkerlab.models.ground.Ground.clearance` of the scene's ground,
+as the report's :func:`walkerlab.analysis.gait.checks.swing_foot_clearance`): over the tread
+behind (the swing foot's start), over the stance tread
 (the mid-stance foot-through the ideal model ignores, as on a slope) and at the riser edge
 ahead (the foot passing above the nosing going down, above the next tread going up); a
 negative riser clearance is a scuff against the riser, which the rigid model reports and
@@ -25,6 +27,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from walkerlab.integrate.rigid import integrate_step
+from walkerlab.models.ground import scene_ground
 
 __all__ = ["TreadLanding", "steps_until_miss", "tread_landing"]
 
@@ -120,19 +123,21 @@ def tread_landing(walker, x, terrain, solver) -> TreadLanding:
                          "heel strike")
     a = float(walker.points(seg.x_end)["swing_foot"][0])
     drift = a - D
-    behind, ahead = (-H, H) if up else (H, -H)
+    ahead = H if up else -H
+    ground = scene_ground(terrain, 0.0)  # the stance foot at the origin, on tread 0
     back, mid = np.inf, np.inf
     cross = []
     for _phase, sol, (ta, tb) in seg.pieces:
         t = np.linspace(ta, tb, _SAMPLES)
         p = np.asarray(walker.points(sol(t))["swing_foot"])
-        xf, yf = p[0], p[1]
+        xf = p[0]
+        c = ground.clearance(xf, p[1])  # the report's quantity (checks.swing_foot_clearance)
         over_back = xf < -u0
         over_stance = (xf >= -u0) & (xf <= D - u0)
         if over_back.any():
-            back = min(back, float(np.min(yf[over_back] - behind)))
+            back = min(back, float(np.min(c[over_back])))
         if over_stance.any():
-            mid = min(mid, float(np.min(yf[over_stance])))
+            mid = min(mid, float(np.min(c[over_stance])))
         s = xf - (D - u0)
         k = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0))
         if k.size and not cross:

@@ -257,15 +257,19 @@ class ContactWalker(ContactReadouts):
         Raises
         ------
         ValueError
-            From the copy's ``__post_init__``: ``heights1``/``heights2`` are set and no longer
-            have one value per patch of the new lanes; a ground the contact model does not
-            build (:func:`walkerlab.models.contact.terrain.terrain_ground`, one line).
+            A ground the contact model does not build
+            (:func:`walkerlab.models.contact.terrain.terrain_ground`, one line naming the
+            scene key).  A walker already on a terrain is laid out afresh (its patch heights
+            and polyline are replaced, never carried to lanes they do not fit).
         """
         c1, c2 = checkerboard_lanes(step_length, n_steps)
         o1, o2 = footprint_offsets(self.data)
+        # the ground laid afresh: a previous terrain's patch heights or polyline go with it
+        # (heights of other lanes would not fit these)
         walker = dataclasses.replace(self, lane1=c1 + o1, lane2=c2 + o2,
                                      patch_half_width=0.5 * terrain.patch_width_m,
-                                     continuous=terrain.lanes == "continuous")
+                                     continuous=terrain.lanes == "continuous",
+                                     heights1=None, heights2=None, ground_line=None)
         if terrain.is_slope:
             return walker
         from .terrain import terrain_ground

@@ -36,7 +36,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.models.ground import landing_drop
+from walkerlab.models.ground import landing_drop, stair_treads
 
 __all__ = ["check_ground", "footfall_lanes", "profile_line", "slope_heights", "stairs_line",
            "step_heights", "terrain_ground"]
@@ -94,9 +94,9 @@ def footfall_lanes(walker, heights_m: np.ndarray):
 
 
 def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np.ndarray:
-    """Vertices (m, 2) [m] of stairs as a polyline in the world frame: level treads
-    ``tread_m`` deep, each ``riser_m`` below (``direction: down``) or above (``up``) the last,
-    joined by vertical risers; tread 0 at height 0 holds the first stance foot at
+    """Vertices (m, 2) [m] of stairs as a polyline in the world frame: the level treads of
+    :func:`walkerlab.models.ground.stair_treads` (the rigid view's, the same ground) joined
+    by vertical risers; tread 0 at height 0 holds the first stance foot at
     ``x = first_x_m``, ``first_foothold_m`` from its back end (default mid-tread).
 
     Parameters
@@ -110,18 +110,9 @@ def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np
     behind : int
         Treads behind tread 0 (the first one runs back for 100 treads' depth).
     """
-    D = float(terrain.tread_m)
-    dh = -landing_drop(terrain)  # each tread's height above the last [m]
-    u0 = D / 2 if terrain.first_foothold_m is None else float(terrain.first_foothold_m)
-    x0 = float(first_x_m) - u0
     pts = []
-    for k in range(-int(behind), int(n_treads) + 1):
-        a, b = x0 + k * D, x0 + (k + 1) * D
-        if k == -int(behind):
-            a -= 100.0 * D
-        if k == int(n_treads):
-            b += 100.0 * D
-        pts += [(a, k * dh), (b, k * dh)]
+    for a, b, h in stair_treads(terrain, first_x_m, n_treads, behind):
+        pts += [(a, h), (b, h)]
     return np.asarray(pts, dtype=float)
 
 
@@ -132,9 +123,9 @@ def check_ground(terrain) -> float:
     Raises
     ------
     ValueError
-        One line naming the field: a profile on checkerboard lanes or from a CSV,
-        footholds of several heights or of their own slopes, footholds on continuous ground
-        (no ground between the footholds).
+        One line naming the field and what to do: a profile on checkerboard lanes or from
+        a CSV, footholds of several heights or of their own slopes (the rigid model walks
+        them), footholds on continuous ground (no ground between the footholds).
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
