@@ -31,6 +31,9 @@ benchmark      what is timed                                                    
                whole process, cold (fresh runs folder and code cache) and warm  Kuo <= 5 s,
                (``--force``), wall and CPU, medians of 3                        five-link
                (:mod:`walkerlab.bench.optimize`; ``scripts/bench_optimize.py``) <= 60 s
+``powered``    a powered contact run (hip law, push-off, RABBIT's phase law) on <= 1.5x
+               its compiled run against the passive run of the same walker,     passive
+               CPU, medians (:mod:`walkerlab.bench.powered_contact`)
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -49,7 +52,8 @@ import numpy as np
 from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
 
-BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job", "optimize")
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job", "optimize",
+              "powered")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -148,6 +152,11 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
 
             lines += optimize_lines(res["result"])
             continue
+        if name == "powered":
+            from walkerlab.bench.powered_contact import lines as powered_lines
+
+            lines += powered_lines(res["result"])
+            continue
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines
 
@@ -165,6 +174,10 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.optimize import bench_optimize
 
         return bench_optimize()
+    if name == "powered":
+        from walkerlab.bench.powered_contact import bench_powered_contact
+
+        return bench_powered_contact()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
             "basin": B.bench_basin,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

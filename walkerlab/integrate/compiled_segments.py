@@ -134,8 +134,9 @@ class CompiledSegments:
 def _locate(dense, x0, ta: float, tb: float, events, which, n: int):
     """The first root in ``[ta, tb]`` [s] of the events ``which`` (changing sign on the
     samples at ``ta`` and ``tb``) on the dense output: ``(event index, time, state)``; an
-    event that changes sign on the samples but not on the interpolant is located at ``tb``
-    (the interpolant agrees with the samples to the solver's tolerance)."""
+    event that changes sign on the samples but not on the interpolant is located at the
+    interval's end where the interpolant is past it (the interpolant agrees with the samples
+    to the solver's tolerance)."""
     from scipy.optimize import brentq
 
     best = None
@@ -145,8 +146,13 @@ def _locate(dense, x0, ta: float, tb: float, events, which, n: int):
         def g(t, ev=ev):
             return float(ev.values(dense(t)[None, :n])[0])
 
-        ga, gb = float(ev.values(x0[None, :n])[0]), g(tb)
-        te = tb if not (ga > 0.0 and gb < 0.0) else brentq(g, ta, tb, xtol=LOCATE_XTOL_S)
+        ga, gb = g(ta), g(tb)  # on the interpolant (the samples agree to its tolerance)
+        if ga <= 0.0:
+            te = ta
+        elif gb >= 0.0:
+            te = tb
+        else:
+            te = brentq(g, ta, tb, xtol=LOCATE_XTOL_S)
         if best is None or te < best[1]:
             best = (int(j), te)
     return best[0], best[1], dense(best[1])

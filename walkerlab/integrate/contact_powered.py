@@ -404,6 +404,11 @@ class ActuationHook:
         except _Deadline:
             self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             return None
+        except ValueError as err:  # solve_ivp's event bracketing (a force jump between
+            # its function's evaluations): the run ends, the reason said
+            self.term = RunEnd.SOLVER_FAILURE
+            self.msg = f"solve_ivp could not locate an event at t = {t:.6g} s ({err})"
+            return None
         except _Stall as stall:
             from .contact_events import trip_or_failure
 
