@@ -16,9 +16,8 @@ is the object for loops and notebooks, as MuJoCo's ``MjModel``/``MjData`` or Pin
     walk = cw.simulate(strides=2)       # the very numbers of `walkerlab contact-sim`
     walk.step_periods, walk.normal_force["leg2"], cw.periodic_gait().multipliers
 
-Each object builds its model and integrator once, from the scene (:attr:`Walker.model`,
-:attr:`Walker.solver`; :attr:`ContactWalker.setup`, :attr:`ContactWalker.solver`); every
-method uses them, and :meth:`Walker.with_changes` makes a new walker.
+Each object builds its model and integrator once, from the scene; :meth:`Walker.
+with_changes` makes a new walker.
 
 The walker is the scene's: its ground (a slope, per-step slopes, stairs, footholds of one
 or several heights, a height profile, a rough ground drawn from ``simulate.terrain_seed``),
@@ -539,15 +538,9 @@ class ContactWalker:
     ----------
     scene : walkerlab.config.Scene
     setup : walkerlab.models.contact.scene.ContactSetup
-        The scene read once for the contact model (law in SI, walker data, actuators, run
-        options ``contact_sim``, solver settings).
     model : walkerlab.models.contact.model.ContactWalker
-        The floating walker with compliant feet (state names, points, energies), on no
-        terrain.
     solver : walkerlab.integrate.solver.Solver
-        The integrator of the scene's ``contact_solver`` section (default cyrk_bdf).
     rigid : Walker
-        The rigid view (its gait starts the runs).
 
     Raises
     ------

@@ -99,16 +99,7 @@ def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np
     by vertical risers; tread 0 at height 0 holds the first stance foot at
     ``x = first_x_m``, ``first_foothold_m`` from its back end (default mid-tread).
 
-    Parameters
-    ----------
-    terrain : walkerlab.config.TerrainSettings
-        ``kind: stairs``.
-    first_x_m : float
-        The first stance foot's x [m].
-    n_treads : int
-        Treads ahead of tread 0 (the last one runs on for 100 treads' depth).
-    behind : int
-        Treads behind tread 0 (the first one runs back for 100 treads' depth).
+    The parameters are :func:`~walkerlab.models.ground.stair_treads`'.
     """
     pts = []
     for a, b, h in stair_treads(terrain, first_x_m, n_treads, behind):
