@@ -5,20 +5,20 @@ terrain) advanced one control period at a time.
 The walker, its terrain's patches and its start are those of ``walkerlab contact-sim``
 (:func:`walkerlab.analysis.contact.sim.scene_start`: the stance foot at its static
 penetration, the rigid gait's rates times ``contact_sim.initial_rate_scale``), the patches
-laid out for the episode's longest walk.  Each control period runs ``solve_ivp`` (LSODA
-unless ``contact_solver.method`` is one of its methods, with the scene's tolerances and the
-model's analytic Jacobian) with two terminal events: the swing foot's touchdown on ground at
-least ``min_step_m`` ahead of the stance foot (the heel strike: the stance leg switches
-there, as in :mod:`walkerlab.integrate.contact_powered`) and the hip's fall below
-``contact_sim.fall_hip_height_m`` (the contact model's fall test,
-:meth:`~walkerlab.models.contact.model.ContactWalker.fall_margin`).
-
-The scene's own actuation acts as in the contact view's powered run
-(:func:`walkerlab.models.contact.actuation.powered_rhs`: its torque laws); its push-off is
-applied as an impulse at the touchdown (the pulse's limit ``T -> 0``,
-:func:`walkerlab.integrate.contact_powered.impulse_jump`).  The action's torques act ``+tau``
-on the second link of their joint and ``-tau`` on the first, on the floating coordinates
-(absolute link angles, the same convention as the rigid view's).
+laid out for the episode's longest walk.  Each control period is the contact view's one
+powered run (:class:`walkerlab.integrate.contact_powered.ActuationHook`, advanced to the
+period's end: :meth:`~walkerlab.integrate.contact_powered.ActuationHook.run_until`) on its
+compiled segments (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`, CyRK's
+BDF at the scene's ``contact_solver`` tolerances, whatever its method): the action's
+torques are a generalised force held in the compiled right-hand side's data, beside the
+scene's own actuation (its torque laws, its push-off pulse, a flat foot's ankle push-off),
+exactly as ``walkerlab contact-sim`` runs them.  Its events are that run's: the swing foot's
+touchdown on ground at least ``min_step_m`` ahead of the stance foot (the heel strike: the
+stance leg switches there) and the hip's fall below ``contact_sim.fall_hip_height_m``.  The
+action's torques act ``+tau`` on the second link of their joint and ``-tau`` on the first,
+on the floating coordinates (absolute link angles, the same convention as the rigid
+view's); their positive and negative work, the scene's torques' and the push-off's are the
+run's work integrals.
 
 Seeded terrain: with ``terrain_roughness_m > 0`` each patch is raised or lowered by a height
 drawn uniformly from ``[-r, r]`` by the episode's terrain seed (rough ground as geometry,
@@ -29,15 +29,15 @@ as many as the walk nears their end (memory and each contact evaluation's patch 
 proportional to the walk so far, not to ``max_episode_steps``); a patch's height depends on
 the seed and its place only, so the ground a walker meets does not depend on when it was laid.
 
-A third terminal event ends the episode as ``launch``: the hip more than
-:data:`LAUNCH_HIP_FACTOR` leg lengths above the ground line (plus the highest ground laid out).
-No walker with a foot on the ground gets there; a foot that meets a raised patch's side below
-its top does (the contact law measures the penetration below the patch's top, so the foot is
-pushed out at once as from that depth: the walker is thrown into the air).
+The fall event also ends the episode as ``launch``: the hip more than
+:data:`LAUNCH_HIP_FACTOR` leg lengths above the ground line (plus the highest ground laid
+out).  No walker with a foot on the ground gets there; a foot that meets a raised patch's
+side below its top does (the contact law measures the penetration below the patch's top, so
+the foot is pushed out at once as from that depth: the walker is thrown into the air).
 
-A control period whose heel-strike event cannot be located (``solve_ivp``'s root bracketing
-fails: the swing foot's touchdown test jumps where a foot meets a patch's side below its top)
-ends the episode as ``solver_failure``, with the solver's message in :attr:`ContactView.failure`.
+A control period whose compiled solver stops (a force jump it cannot step over, where a foot
+meets a patch's side below its top) ends the episode as ``solver_failure`` (or ``trip``,
+when the foot is found at a patch's side), with the reason in :attr:`ContactView.failure`.
 """
 
 from __future__ import annotations
@@ -45,8 +45,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-
-from walkerlab.models.contact.actuation import ContactRows
 
 __all__ = ["CONTACT_LEDGER_TERMS", "ContactView"]
 
@@ -61,8 +59,12 @@ MIN_STEP_M = 0.05
 LAUNCH_HIP_FACTOR = 1.5
 #: steps the patches are laid out for at a time (the layout doubles as the walk nears its end)
 LAYOUT_STEPS = 32
-_IVP_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
+#: the run's works [J] that make each ledger term (the terms' names: the ledger's)
+_LEDGER = {"action_work_positive": ("action_positive",),
+           "action_work_negative": ("action_negative",),
+           "scene_torque_work": ("hip_torque_positive", "hip_torque_negative",
+                                 "ankle_torque_positive", "ankle_torque_negative"),
+           "push_off_work": ("push_off",)}
 
 
 def _link_coordinate(link: str, leg: dict, names: tuple) -> int:
@@ -101,11 +103,7 @@ class ContactView:
         with no floating coordinate (a torso that bisects the legs), one line.
     """
 
-    def __init__(self, setup, links, x_gait, n_steps: int):
-        acts = setup.actuators
-        if acts is not None and getattr(acts, "ankle", None) is not None:
-            raise ValueError("walkerlab.gym: the contact view does not carry the scene's "
-                             "ankle push-off yet; use view='rigid'")
+    def __init__(self, setup, links, x_gait, n_steps: int, horizon_s: float = 60.0):
         self._setup, self._x_gait = setup, np.asarray(x_gait, float)
         self._first_layout = max(1, min(int(n_steps), LAYOUT_STEPS))
         self._roughness, self._seed = 0.0, 0
@@ -118,12 +116,11 @@ class ContactView:
             self.index.append([(_link_coordinate(a, leg, names),
                                 _link_coordinate(b, leg, names)) for a, b in links])
         s = setup.solver
-        self.method = s.method if s.method in _IVP_METHODS else "LSODA"
-        self.rtol, self.atol = s.rtol, s.atol
-        self.rows = acts if acts is not None else ContactRows()
-        self.acts = acts
+        #: the run's integrator: the compiled one at the scene's tolerances
+        self.solver = s.model_copy(update={"method": "cyrk_bdf"})
+        self.grid = np.arange(0.0, float(horizon_s), 1.0 / self.limits.sample_rate_hz)
         self.state_names = list(self.walker.state_names())
-
+        self.hook = None
     def _lay_out(self, n_steps: int):
         """Patches for ``n_steps`` steps (:func:`walkerlab.analysis.contact.sim.scene_start`),
         the episode's roughness on them; returns the scene's start, limits, step length."""
@@ -170,14 +167,48 @@ class ContactView:
     def reset(self, x0: np.ndarray | None = None) -> None:
         """Start at the contact state ``x0`` (N,) (default: the scene's start), leg2 in
         stance, at t = 0."""
-        self.t = 0.0
-        self.t_step = 0.0
-        self.stance = 1
-        self.x = np.array(self.x_start if x0 is None else x0, dtype=float)
         self.ended = ""
         self.failure = ""
         self.ledger = dict.fromkeys(CONTACT_LEDGER_TERMS, 0.0)
         self.steps = 0
+        self._start(np.array(self.x_start if x0 is None else x0, dtype=float), 0.0)
+
+    def _start(self, x, t: float, keep=None) -> None:
+        """The run's hook on the present walker from ``(t, x)``; ``keep``: the stance leg,
+        step start, ankle push-off and work integrals carried over (a new layout)."""
+        from walkerlab.integrate.contact_powered import ActuationHook
+
+        w = self.walker
+        if w.actuators is None:  # the action alone: actuators with no law of the scene's
+            w = dataclasses.replace(w, actuators=self._setup.held_actuators())
+        self.hook = ActuationHook(w, self.solver, self.limits, np.inf, self.grid,
+                                  held_force=True, launch_height_m=self._launch_height)
+        self.hook.start(x, t)
+        if keep is not None:
+            h = self.hook
+            h.stance, h.t_origin, h.ankle_on, h.step_s = keep[:4]
+            h.y[2 * self.nq:] = keep[4]
+        self._works = list(self.hook.work_names)
+
+    @property
+    def x(self) -> np.ndarray:
+        """The walker's state (N,)."""
+        return self.hook.y[:2 * self.nq].copy()
+
+    @property
+    def t(self) -> float:
+        """The time [s]."""
+        return float(self.hook.t)
+
+    @property
+    def t_step(self) -> float:
+        """When the present step began (the last heel strike, or 0) [s]."""
+        return float(self.hook.t_origin)
+
+    @property
+    def stance(self) -> int:
+        """The stance leg (0: leg1, 1: leg2)."""
+        return int(self.hook.stance)
 
     def hip_x(self) -> float:
         """World position of the hip along x (horizontal, downhill) [m]."""
@@ -188,67 +219,16 @@ class ContactView:
         return {k: np.asarray(v, float)[:, 0] for k, v in self.walker.points(self.x).items()}
 
     # ------------------------------------------------------------------ stepping
-    def _action_force(self, u):
-        Q = np.zeros(self.nq)
-        for tau, (a, b) in zip(u, self.index[self.stance]):
-            Q[b] += tau
-            Q[a] -= tau
-        return Q
-
-    def _rhs(self, u):
-        w, n, acts = self.walker, self.nq, self.acts
-        Q = self._action_force(u)
-        act_on = bool(np.any(Q))
-        stance, t_step = self.stance, self.t_step
-
-        def f(t, x):
-            if acts is None:
-                dx = np.array(w.rhs(t, x), float)
-            else:
-                from walkerlab.models.contact.actuation import powered_rhs
-
-                dx = powered_rhs(w, x, stance, None, t - t_step)[0]
-            if act_on:
-                dx[n:] += np.linalg.solve(w.mass_matrix(x), Q)
-            return dx
-        return f, Q
-
-    def _events(self):
-        w, rows, stance, n = self.walker, self.rows, self.stance, 2 * self.nq
-
-        def touch(t, y):
-            r = rows.leg_contacts(w, y[:n])
-            sw, st = r[1 - stance], r[stance]
-            if sw[7] < 0.5 or sw[3] - st[3] < MIN_STEP_M:
-                return 1.0
-            return -float(sw[0])
-        touch.terminal, touch.direction = True, -1
-
-        def fall(t, y):
-            return w.fall_margin(y[:n], self.limits.fall_hip_height_m)
-        fall.terminal, fall.direction = True, -1
-
-        def launch(t, y):
-            return self._launch_height - float(w.hip_height(y[:n])[0])
-        launch.terminal, launch.direction = True, -1
-        return [touch, fall, launch]
-
-    def _work(self, sol, ta, tb, Q) -> None:
-        acts = self.acts
-        if tb <= ta:
-            return
-        ts = 0.5 * (tb - ta) * _GL_X + 0.5 * (ta + tb)
-        X = np.atleast_2d(sol(ts))
-        h, n = 0.5 * (tb - ta), self.nq
-        for j, tj in enumerate(ts):
-            xj = X[:, j]
-            if np.any(Q):
-                p = float(Q @ xj[n:])
-                key = "action_work_positive" if p > 0 else "action_work_negative"
-                self.ledger[key] += h * _GL_W[j] * p
-            if acts is not None and acts.spec.torques:
-                p_sc = acts.hip_torque(xj, self.stance, tj - self.t_step)[1]
-                self.ledger["scene_torque_work"] += h * _GL_W[j] * p_sc
+    def _held(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """The action's generalised force (nq,) with leg1, then leg2 in stance."""
+        out = []
+        for stance in (0, 1):
+            Q = np.zeros(self.nq)
+            for tau, (a, b) in zip(u, self.index[stance]):
+                Q[b] += tau
+                Q[a] -= tau
+            out.append(Q)
+        return tuple(out)
 
     def advance(self, u: np.ndarray, t_end: float) -> list[float]:
         """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
@@ -257,54 +237,38 @@ class ContactView:
         -------
         list of float
             The heel-strike (touchdown) times inside the period [s]; :attr:`ended` is set
-            when the episode ended inside it (``fall``, ``launch``, ``solver_failure``).
+            when the episode ended inside it (``fall``, ``launch``, ``trip``,
+            ``solver_failure``).
         """
-        from scipy.integrate import solve_ivp
+        from walkerlab.integrate.ends import RunEnd
 
-        strikes: list[float] = []
-        while self.t < t_end and not self.ended:
-            f, Q = self._rhs(u)
-            jac = self.walker.jac if self.method in ("Radau", "BDF", "LSODA") else None
-            kw = {"jac": jac} if jac is not None else {}
-            try:
-                sol = solve_ivp(f, (self.t, t_end), self.x, method=self.method,
-                                rtol=self.rtol, atol=self.atol, events=self._events(),
-                                dense_output=True, **kw)
-            except ValueError as err:  # an event's root not bracketed (module docstring)
-                self.ended, self.failure = "solver_failure", str(err)
-                break
-            if sol.status == -1 or not np.all(np.isfinite(sol.y[:, -1])):
-                self.ended, self.failure = "solver_failure", str(sol.message)
-                break
-            fired = [(te[0], i) for i, te in enumerate(sol.t_events) if len(te)]
-            if fired:
-                te, i = min(fired)
-                self._work(sol.sol, self.t, te, Q)
-                self.t, self.x = float(te), np.array(sol.y_events[i][0], float)
-                if i > 0:
-                    self.ended = "fall" if i == 1 else "launch"
-                    break
-                self._touchdown()
-                strikes.append(self.t)
-                continue
-            self._work(sol.sol, self.t, float(sol.t[-1]), Q)
-            self.t, self.x = float(sol.t[-1]), np.array(sol.y[:, -1], float)
+        h, n = self.hook, 2 * self.nq
+        h.segments.pdata.held = self._held(np.asarray(u, float))
+        before = h.y[n:].copy()
+        strikes = h.run_until(t_end)
+        gained = h.y[n:] - before
+        for term, names in _LEDGER.items():
+            self.ledger[term] += float(sum(gained[self._works.index(k)] for k in names
+                                           if k in self._works))
+        self.steps += len(strikes)
+        if h.t < t_end - 1e-12 or h.term is not RunEnd.T_FINAL:
+            self._ended(h)
+        h.forget()
+        if not self.ended and self.steps + 4 >= self._laid:  # lay out more patches
+            keep = (h.stance, h.t_origin, h.ankle_on, h.step_s, h.y[n:].copy())
+            x, t = self.x, self.t
+            self._lay_out(2 * self._laid)
+            self._start(x, t, keep)
         return strikes
 
-    def _touchdown(self) -> None:
-        """Heel strike: the scene's push-off impulse at the trailing foot, then the stance
-        leg switches to the leg that touched down."""
-        acts = self.acts
-        trailing = self.stance
-        if acts is not None and getattr(acts.spec, "push_off", None) is not None:
-            from walkerlab.integrate.contact_powered import impulse_jump
+    def _ended(self, h) -> None:
+        """The episode's end from the run's (a fall event above the ground: ``launch``)."""
+        from walkerlab.integrate.ends import RunEnd
 
-            P = acts.impulse(self.x)
-            if P > 0:
-                self.x, work = impulse_jump(self.walker, self.x, trailing, P)
-                self.ledger["push_off_work"] += work
-        self.stance = 1 - trailing
-        self.t_step = self.t
-        self.steps += 1
-        if self.steps + 4 >= self._laid:  # the walk nears the patches' end: lay out more
-            self._lay_out(2 * self._laid)
+        if h.term is RunEnd.FALL:
+            high = float(self.walker.hip_height(self.x)[0]) > 0.5 * self._launch_height
+            self.ended = "launch" if high else "fall"
+        elif h.term is RunEnd.TRIP:
+            self.ended, self.failure = "trip", str(h.msg)
+        else:
+            self.ended, self.failure = "solver_failure", str(h.msg)

@@ -38,7 +38,8 @@ Terminated on a fall (a fall guard of the rigid model; in the contact view the h
 ``contact_sim.fall_hip_height_m``), a stall (no heel strike within
 ``fixedpoint.max_step_time_s``), a launch (contact view: the hip thrown above
 :data:`walkerlab.gym.contact_view.LAUNCH_HIP_FACTOR` leg lengths, a foot having met a raised
-patch's side) or a solver failure; truncated after ``max_episode_steps`` control periods.
+patch's side), a trip (contact view: a foot found at a patch's side where the solver stopped)
+or a solver failure; truncated after ``max_episode_steps`` control periods.
 ``step`` and ``render`` before the first ``reset`` raise gymnasium's ``ResetNeeded`` (as
 ``gym.make``'s order enforcing does); an action that is not ``k`` finite real numbers of shape
 ``(k,)`` (None, NaN, inf, complex, another shape) raises :class:`InvalidAction` (a
@@ -47,8 +48,9 @@ patch's side) or a solver failure; truncated after ``max_episode_steps`` control
 ``info``: ``time_s``, ``heel_strike`` (bool), ``heel_strike_time_s`` (the exact event time
 of the last heel strike inside the control period, else None), ``heel_strike_times_s`` (all
 of them), ``steps`` (heel strikes so far), ``stance_leg``, ``hip_x_m``, ``termination``
-(``""``, ``fall``, ``stall``, ``launch``, ``solver_failure``), ``solver_message`` (the
-solver's words on a ``solver_failure`` in the contact view, else ``""``), ``terrain_seed`` and
+(``""``, ``fall``, ``stall``, ``launch``, ``trip``, ``solver_failure``),
+``solver_message`` (the solver's words on a ``trip`` or ``solver_failure`` in the contact
+view, else ``""``), ``terrain_seed`` and
 the energy ledger's
 terms so far [J] (``ledger_<term>``: :data:`walkerlab.gym.rigid_view.LEDGER_TERMS`).
 ``reset(seed=...)`` draws the terrain seed and the start's noise from the seed: the same

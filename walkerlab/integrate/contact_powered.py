@@ -143,32 +143,35 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
                      events=events, dense_output=False, **kw)
 
 
-def compiled_segments(walker, solver, grid):
+def compiled_segments(walker, solver, grid, held_force: bool = False):
     """The compiled segments of a powered run
     (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`), or None when the run
     is on ``solve_ivp``: ``solver.method`` not a compiled one
     (:data:`walkerlab.integrate._cyrk.CYRK_METHODS`) or torque laws that are not data (a
-    replay's Python callables: :func:`walkerlab.models.contact.powered_data.powered_data`)."""
+    replay's Python callables: :func:`walkerlab.models.contact.powered_data.powered_data`);
+    ``held_force``: the run carries a force held from outside (a Gymnasium action)."""
     from walkerlab.models.contact.powered_data import powered_data
 
     from ._cyrk import CYRK_METHODS
 
     if solver.method not in CYRK_METHODS:
         return None
-    data = powered_data(walker)
+    data = powered_data(walker, held_force)
     if data is None:
         return None
     from .compiled_segments import CompiledSegments
 
-    return CompiledSegments(walker, data, solver, powered_atol(walker, solver.atol), grid)
+    return CompiledSegments(walker, data, solver,
+                            powered_atol(walker, solver.atol, len(data.work_names)), grid)
 
 
-def powered_atol(walker, atol: float):
+def powered_atol(walker, atol: float, n_works: int | None = None):
     """The absolute tolerance of a powered run's state and work integrals: the scalar
     ``atol``, or, for hip torques on flat feet, ``atol`` times the walker's per-state
     :meth:`~walkerlab.models.contact.model.ContactWalker.atol_scale` (a flat foot's rotation
     rates looser, as in a passive run: :func:`walkerlab.integrate.contact.run_atol`) and
-    ``atol`` on each work integral, shape (2 nq + len(work_names),).  An ankle push-off run
+    ``atol`` on each work integral, shape (2 nq + n_works,) (``n_works`` default
+    ``len(work_names)``).  An ankle push-off run
     keeps the scalar (configs/flat_feet_push_off.yaml's numbers were measured with it).
 
     Held to the angles' atol, LSODA chatters in foot flat on the regularising foot inertia's
@@ -179,8 +182,8 @@ def powered_atol(walker, atol: float):
         return atol
     from .contact_events import run_atol
 
-    return np.concatenate([run_atol(walker, atol, "LSODA"),
-                           np.full(len(acts.work_names), float(atol))])
+    nw = len(acts.work_names) if n_works is None else n_works
+    return np.concatenate([run_atol(walker, atol, "LSODA"), np.full(nw, float(atol))])
 
 
 def _touchdown_event(walker, stance_of):
@@ -293,13 +296,18 @@ def _heel_off_event(walker, stance_of):
     return heel_off
 
 
-def _fall_event(walker, limits):
+def _fall_event(walker, limits, launch_height_m: float | None = None):
+    """Event: the hip falls below ``limits.fall_hip_height_m`` (or, with
+    ``launch_height_m``, rises above it: a walker thrown off a patch's side)."""
     n = 2 * walker.nq
+    top = np.inf if launch_height_m is None else float(launch_height_m)
 
     def fall(t, y):
-        return walker.fall_margin(y[:n], limits.fall_hip_height_m)
+        h = float(walker.hip_height(y[:n])[0])
+        return min(h - limits.fall_hip_height_m, top - h)
 
-    fall.values = lambda X: walker.hip_height(X) - limits.fall_hip_height_m
+    fall.values = lambda X: np.minimum(walker.hip_height(X) - limits.fall_hip_height_m,
+                                       top - walker.hip_height(X))
     fall.terminal = True
     fall.direction = -1
     return fall
@@ -353,8 +361,10 @@ class ActuationHook:
         The run's sample times [s].
     """
 
-    def __init__(self, walker, solver, limits, deadline, grid):
+    def __init__(self, walker, solver, limits, deadline, grid, held_force: bool = False,
+                 launch_height_m: float | None = None):
         self.walker, self.solver, self.limits = walker, solver, limits
+        self.held_force = held_force
         self.deadline, self.grid = deadline, grid
         self.stance = 1  # leg2 carries the first stance (the contact model's convention)
         self.t_origin = float(grid[0])  # when the present step began [s]
@@ -364,7 +374,7 @@ class ActuationHook:
         self.resume, self.segment = None, None
         self.segments = None  # compiled segments, set by start() where they apply
         self.touch = _touchdown_event(walker, lambda: self.stance)
-        self.fall = _fall_event(walker, limits)
+        self.fall = _fall_event(walker, limits, launch_height_m)
         self.heel_off = (None if walker.actuators.ankle is None  # flat feet only
                          else _heel_off_event(walker, lambda: self.stance))
         self.ankle_on = False  # the ankle push-off (flat feet), off until the heel lifts
@@ -461,7 +471,11 @@ class ActuationHook:
     def start(self, x0, t):
         """Start a run at ``(t, x0)`` (leg2 in stance, the work integrals 0)."""
         acts = self.walker.actuators
-        nw = len(acts.work_names)
+        self.segments = compiled_segments(self.walker, self.solver, self.grid,
+                                          self.held_force)
+        self.work_names = (tuple(acts.work_names) if self.segments is None
+                           else self.segments.pdata.work_names)
+        nw = len(self.work_names)
         self.t, self.y = float(t), np.concatenate([np.asarray(x0, float), np.zeros(nw)])
         self.ts, self.Ys = [np.array([self.t])], [self.y[None]]
         # the pulse ends at the predicted touchdown (module docstring); ``pushed``: this
@@ -470,7 +484,23 @@ class ActuationHook:
         self.lead = (_pulse_event(self.walker, lambda: self.stance, acts.pulse_s)
                      if self.pulsed else None)
         self.pushed = False
-        self.segments = compiled_segments(self.walker, self.solver, self.grid)
+
+    def run_until(self, t_end: float) -> list[float]:
+        """Advance to ``t_end`` [s] or the run's end (:attr:`term`); returns the heel-strike
+        times inside [s] (a Gymnasium control period: the environment's one run)."""
+        strikes = []
+        while self.t < t_end - 1e-12:
+            step = self.advance(min(self.segment_end(self.t, self.limits.chunk_s), t_end),
+                                t_end)
+            if step == "end":
+                break
+            if step == "strike":
+                strikes.append(self.t_origin)
+        return strikes
+
+    def forget(self) -> None:
+        """Drop the samples kept so far but the present state (a long episode's memory)."""
+        self.ts, self.Ys = [np.array([self.t])], [self.y[None]]
 
     def advance(self, tb: float, t1: float) -> str:
         """Integrate from the present ``(self.t, self.y)`` to ``tb`` [s] or the next discrete

@@ -39,9 +39,13 @@ class PoweredData:
         :class:`~walkerlab.models.contact.joint_torques.JointTorqueActuators`).
     laws : ndarray
         The law block (:func:`powered_data` reads it from the actuators).
+    held_force : bool
+        The run carries a generalised force held from outside (:attr:`held`, per stance
+        leg; a Gymnasium action's torques) and its positive and negative work integrals
+        after the walker's ``work_names``.
     """
 
-    def __init__(self, walker, laws: np.ndarray):
+    def __init__(self, walker, laws: np.ndarray, held_force: bool = False):
         acts = walker.actuators
         self.walker, self.laws = walker, laws
         n = walker.nq
@@ -74,7 +78,12 @@ class PoweredData:
             head[20:26] = (*foot, *acts.ankle_leg, *acts.leg)
             head[26] = 1.0
         self.foot = foot
-        works = [W_INDEX[w] for w in acts.work_names]
+        self.work_names = tuple(acts.work_names) + (
+            ("action_positive", "action_negative") if held_force else ())
+        works = [W_INDEX[w] for w in self.work_names]
+        head[34] = 1.0 if held_force else 0.0
+        #: the held generalised force (nq,) [N, N m] with leg1, leg2 in stance
+        self.held = (np.zeros(n), np.zeros(n))
         head[27] = len(works)
         self.head = np.concatenate([head, works])
         self.ny = 2 * n + len(works)
@@ -99,15 +108,15 @@ class PoweredData:
         if ankle:
             h[9:12] = (1.0, self.foot[0], acts.ankle_leg[0])
             h[32:34] = (self.foot[1], acts.ankle_leg[1])
-        block = np.concatenate([h, self.B[0], self.B[1], self.laws])
+        block = np.concatenate([h, self.B[0], self.B[1], *self.held, self.laws])
         block[0] = block.size
-        scratch = np.zeros(self.walker.nq + 8)  # the compiled call's force and powers
+        scratch = np.zeros(self.walker.nq + 10)  # the compiled call's force and powers
         return np.concatenate([self.base, block, scratch, [0.0]]).astype(np.float64)
 
 
-def powered_data(walker) -> PoweredData | None:
-    """The compiled data of ``walker``'s actuators (:class:`PoweredData`), or None when its
-    torque laws are not data (a replay's Python callables: the run stays on
-    :func:`scipy.integrate.solve_ivp`)."""
+def powered_data(walker, held_force: bool = False) -> PoweredData | None:
+    """The compiled data of ``walker``'s actuators (:class:`PoweredData`; ``held_force`` as
+    there), or None when its torque laws are not data (a replay's Python callables: the run
+    stays on :func:`scipy.integrate.solve_ivp`)."""
     laws = _laws(walker.actuators)
-    return None if laws is None else PoweredData(walker, laws)
+    return None if laws is None else PoweredData(walker, laws, held_force)

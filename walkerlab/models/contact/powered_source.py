@@ -24,8 +24,11 @@ reference arithmetic; a test holds the two equal on every kind of walker):
 - the push-off pulse: a force ``F e`` at the trailing foot's push point along the line to
   the hip, ``Q += J^T F e`` (on a flat foot with the ankle torque ``lam`` that holds the
   ankle: ``a M^-1 (J^T F e + a lam) = 0``);
-- the ledger's powers: ``W = [tau+, tau-, ankle+, ankle-, push, damper, contact, knee]``,
-  of which the block's work map picks the walker's ``work_names`` in order.
+- a generalised force held from outside (a Gymnasium action's torques, per stance leg),
+  power ``E . dq``;
+- the ledger's powers: ``W = [tau+, tau-, ankle+, ankle-, push, damper, contact, knee,
+  action+, action-]``, of which the block's work map picks the run's work integrals in
+  order.
 
 The actuation block ``A`` (after the passive data ``[n1, n2, PC, p, c1, c2]``; then the call
 counter):
@@ -54,11 +57,13 @@ counter):
                begun then, the ankle push-off off (a heel strike located in advance, so the
                solver meets it warm: :mod:`walkerlab.integrate.compiled_segments`)
 ``A[30]``      the time [s] the present step began (before the switch)
-then           ``B`` with leg1 in stance, then with leg2 (nq * k each, row-major), then the
-               law block (its ``b[2]``, the time the step began, written by each call)
+``A[34]``      a held generalised force is on (0/1)
+then           ``B`` with leg1 in stance, then with leg2 (nq * k each, row-major), the held
+               force ``E`` with leg1 in stance, then with leg2 (nq each), then the law block
+               (its ``b[2]``, the time the step began, written by each call)
 =============  =============================================================================
 
-After the block, ``nq + 8`` numbers of scratch (the force and the powers of one call: the
+After the block, ``nq + 10`` numbers of scratch (the force and the powers of one call: the
 right-hand side allocates nothing), then the call counter.
 """
 
@@ -67,16 +72,16 @@ from __future__ import annotations
 __all__ = ["A_HEAD", "W_INDEX", "powered_source"]
 
 #: Fixed fields of the actuation block before the work map (module docstring).
-A_HEAD = 34
+A_HEAD = 36
 #: Index in the powers ``W`` of each work integral's name.
 W_INDEX = {"hip_torque_positive": 0, "hip_torque_negative": 1, "ankle_torque_positive": 2,
            "ankle_torque_negative": 3, "push_off": 4, "damper": 5, "contact": 6,
-           "knee_stop": 7}
+           "knee_stop": 7, "action_positive": 8, "action_negative": 9}
 
 _SOURCE = '''
 # ---------------------------------------------------------------- powered walker
 # (walkerlab.models.contact.powered_source: walker-independent; the actuation as data)
-A_HEAD = 34
+A_HEAD = 36
 
 
 @njit(cache=True, error_model='numpy')
@@ -146,7 +151,8 @@ def actuate(t, x, A, p, Q, W):
     if switched:  # the heel strike at A[29]: the other leg in stance
         st = 1 - st
     bo = A_HEAD + int(A[27]) + st * n * k
-    law = A[A_HEAD + int(A[27]) + 2 * n * k:]
+    eo = A_HEAD + int(A[27]) + 2 * n * k + st * n
+    law = A[A_HEAD + int(A[27]) + 2 * n * (k + 1):]
     law[2] = A[29] if switched else A[30]
     if k > 0:
         s, ds = _phase(x, A, p, st)
@@ -176,6 +182,13 @@ def actuate(t, x, A, p, Q, W):
         W[3] = pa if pa < 0.0 else 0.0
     if A[5] >= 0.0:
         _pulse(x, A, p, Q, W)
+    if A[34] > 0.5:  # the held force
+        pe = 0.0
+        for i in range(n):
+            Q[i] += A[eo + i]
+            pe += A[eo + i] * x[n + i]
+        W[8] = pe if pe > 0.0 else 0.0
+        W[9] = pe if pe < 0.0 else 0.0
     if A[26] > 0.5:  # the dampers' power
         r1 = x[n + int(A[20])] - x[n + int(A[22])]
         r2 = x[n + int(A[21])] - x[n + int(A[23])]
@@ -188,7 +201,7 @@ _PACKED = '''
 @njit(cache=True, error_model='numpy')
 def powered_packed(t, y, d, dy):
     """dy/dt of a powered walker's state and work integrals from the data vector ``d``
-    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 8), calls]``); counts the call in
+    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 10), calls]``); counts the call in
     ``d[-1]``."""
     a1 = D_P + NP
     a2 = a1 + int(d[D_N1])
@@ -196,12 +209,12 @@ def powered_packed(t, y, d, dy):
     la = int(d[a3])
     A = d[a3:a3 + la]
     p = d[D_P:a1]
-    # scratch in the data vector (no allocation per call): Q (NQ), the powers W (8)
+    # scratch in the data vector (no allocation per call): Q (NQ), the powers W (10)
     Q = d[a3 + la:a3 + la + NQ]
-    W = d[a3 + la + NQ:a3 + la + NQ + 8]
+    W = d[a3 + la + NQ:a3 + la + NQ + 10]
     for i in range(NQ):
         Q[i] = 0.0
-    for i in range(8):
+    for i in range(10):
         W[i] = 0.0
     actuate(t, y, A, p, Q, W)
     r = rhs_q(y, d[D_PC:D_P], p, d[a1:a2], d[a2:a3], Q, W[6:8])
@@ -217,7 +230,7 @@ def powered_packed(t, y, d, dy):
 def powered_size(d):
     """Length of a powered data vector (``d`` may be a raw pointer in a cfunc)."""
     a3 = D_P + NP + int(d[D_N1]) + int(d[D_N2])
-    return a3 + int(d[a3]) + NQ + 8 + 1
+    return a3 + int(d[a3]) + NQ + 10 + 1
 
 
 @njit(cache=True)

@@ -117,6 +117,22 @@ class ContactSetup:
                              flat_foot=self.law.flat_foot(), actuators=self.actuators,
                              rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2)
 
+    def held_actuators(self):
+        """Actuators with no law of the scene's (an empty actuation): what a run that holds a
+        force from outside (a Gymnasium action) carries on a passive walker; the kind's own
+        class (:func:`walkerlab.models.contact.parts.contact_part`).
+
+        Returns
+        -------
+        ContactActuators or JointTorqueActuators
+        """
+        from walkerlab.codegen.floating import coordinate_names
+        from walkerlab.config.actuation import Actuation
+
+        st = self.walker.structure
+        empty = Actuation.model_construct(torques=[], push_off=None, ankle_push_off=None)
+        return contact_part(st).actuators(self.walker, empty, coordinate_names(st), 0.0)
+
     def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
         """ContactWalker of the setup with checkerboard patches from the ideal step length.
 
