@@ -73,3 +73,25 @@ def test_the_compiled_powered_rhs_equals_the_reference_formulas(case):
         after = np.empty(data.ny)
         walker.kernels.powered_packed(0.25, y, data.data(stance, 0.2), after)
         np.testing.assert_array_equal(sw, after)
+
+
+def test_an_optimised_torque_of_time_is_the_same_function_as_data():
+    """A replay's hip torque (Hermite-Simpson's quadratics through each interval's three
+    nodes, held outside the step) as the compiled run's law block (kind
+    TIME_FEEDFORWARD) gives the torque of the Lagrange form it was made from, inside the
+    step and held outside it, to 1e-12 N m."""
+    from types import SimpleNamespace
+
+    from walkerlab.codegen.torque_law import law_torque
+    from walkerlab.models.actuation import TorqueOfTime
+    from walkerlab.optimal.transcription.step import torque_of_time
+
+    rng = np.random.default_rng(7)
+    t = np.linspace(0.0, 0.62, 21)
+    u = rng.normal(0.0, 2.0, t.size)
+    tau = torque_of_time(SimpleNamespace(t=t, u=u))
+    law = TorqueOfTime(tau, [(t, u)])
+    block = law.packed()
+    for s in np.concatenate([rng.uniform(0.0, 0.62, 40), [-0.1, 0.0, 0.31, 0.62, 0.9]]):
+        got = law_torque(block, 0, 0.3, -1.0, 0.1, 0.5, s + block[2])[0]
+        assert abs(got - tau(s)) < 1e-12, s

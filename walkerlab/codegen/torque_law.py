@@ -33,6 +33,10 @@ h(s)) - D (ddelta - h'(s) ds)``, every spline extrapolated with its end interval
 ``U``'s coefficients per interval (``U`` the feed-forward of time; a quadratic padded with
 ``c0 = 0``).
 
+Kind 5, a *feed-forward of time* (an optimised step's torque replayed from each heel strike,
+:class:`walkerlab.models.actuation.TorqueOfTime`): ``tau = U(t - t_step)``, its table as a
+kind-1 table's (held at its end values outside its knots), the gains not read.
+
 Kind 4, a *piecewise* phase-variable law (one kind-3 law per phase of a step, the one in
 force chosen by ``s``: :class:`walkerlab.optimal.replay.hip_phase.PiecewisePhaseLaw`): the
 header's ``knots`` field holds the count of pieces ``P``; the table holds ``sign`` (the
@@ -54,7 +58,7 @@ FIELDS = ("kind", "constant_n_m", "stiffness_n_m_per_rad", "damping_n_m_s_per_ra
           "rest_angle_rad", "limit_n_m", "knots", "table_offset")
 HEAD = len(FIELDS)
 #: Law kinds.
-PLAIN, PHASE, TIME, FEEDFORWARD, PIECEWISE = 0, 1, 2, 3, 4
+PLAIN, PHASE, TIME, FEEDFORWARD, PIECEWISE, TIME_FEEDFORWARD = 0, 1, 2, 3, 4, 5
 
 
 def pack_laws(laws) -> np.ndarray:
@@ -65,11 +69,12 @@ def pack_laws(laws) -> np.ndarray:
     laws : sequence of tuple
         Per actuator ``(kind, constant, stiffness, damping, rest, limit, knots, coefs[,
         tail])``: ``kind`` one of :data:`PLAIN`, :data:`PHASE`, :data:`TIME`,
-        :data:`FEEDFORWARD`, :data:`PIECEWISE`; ``limit`` [N m] or None; ``knots`` (n,)
-        increasing and ``coefs`` (4, n - 1) (PPoly order, highest degree first), both None
-        for a plain law; ``tail`` (1-D) appended after the table (a :data:`FEEDFORWARD`
-        law's ``T`` and ``U``, module docstring).  A :data:`PIECEWISE` law gives its piece
-        count as ``knots`` (an int), ``coefs`` None and its whole table as ``tail``.
+        :data:`FEEDFORWARD`, :data:`PIECEWISE`, :data:`TIME_FEEDFORWARD`; ``limit`` [N m]
+        or None; ``knots`` (n,) increasing and ``coefs`` (4, n - 1) (PPoly order, highest
+        degree first), both None for a plain law; ``tail`` (1-D) appended after the table
+        (a :data:`FEEDFORWARD` law's ``T`` and ``U``, module docstring).  A
+        :data:`PIECEWISE` law gives its piece count as ``knots`` (an int), ``coefs`` None
+        and its whole table as ``tail``.
 
     Returns
     -------
@@ -168,6 +173,9 @@ def law_torque(b, i, delta, ddelta, s, ds, t):
     elif kind == TIME:
         r, r1, _r2 = table_value(b, int(b[h + 7]), int(b[h + 6]), t - b[2])
         err, derr = delta - r, ddelta - r1
+    elif kind == TIME_FEEDFORWARD:  # U(t) of the time since the step began, held outside
+        c0 = table_value(b, int(b[h + 7]), int(b[h + 6]), t - b[2])[0]
+        err, derr = 0.0, 0.0
     elif kind == FEEDFORWARD:  # U(T(s)) and the reference h(s), extrapolated
         c0, err, derr, g_s, g_ds = feedforward_terms(b, int(b[h + 7]), int(b[h + 6]), delta,
                                                      ddelta, s, ds, K, D)
@@ -196,7 +204,7 @@ def kernel_source() -> list[str]:
     import inspect
 
     out = [f"HEAD, PLAIN, PHASE, TIME, FEEDFORWARD, PIECEWISE = {HEAD}, {PLAIN}, {PHASE}, "
-           f"{TIME}, {FEEDFORWARD}, {PIECEWISE}", ""]
+           f"{TIME}, {FEEDFORWARD}, {PIECEWISE}", f"TIME_FEEDFORWARD = {TIME_FEEDFORWARD}", ""]
     for fn in (table_value, interval, cubic_at, feedforward_terms, law_torque):
         src = inspect.getsource(fn).splitlines()
         body = [ln for ln in src if ln.strip()]

@@ -19,8 +19,8 @@ import numpy as np
 
 from walkerlab.walker.joints import joint_angles, joint_columns, joint_links, link_angles
 
-__all__ = ["JointMap", "TorqueLaws", "phase_reference", "push_off_impulse", "saturate",
-           "shared_phase_table"]
+__all__ = ["JointMap", "TorqueLaws", "TorqueOfTime", "phase_reference", "push_off_impulse",
+           "saturate", "shared_phase_table"]
 
 
 def phase_reference(table):
@@ -194,6 +194,59 @@ class TorqueLaws:
                 - law.damping_n_m_s_per_rad * derr
             out.append(saturate(tau, act.max_torque_n_m))
         return np.array(out)
+
+
+class TorqueOfTime:
+    """One hip torque of the time since the step's heel strike alone: an optimised step's
+    torque replayed (Hermite-Simpson collocation's control, a quadratic on each interval
+    through its three nodes, held at its end values outside the step), as data of the
+    compiled contact run (:meth:`packed`, the law kind
+    :data:`walkerlab.codegen.torque_law.TIME_FEEDFORWARD`) and as a Python law (``tau``,
+    the callable it was made from, for the ``solve_ivp`` runs).
+
+    Parameters
+    ----------
+    tau : callable
+        ``tau(t) -> float`` [N m] of the time since the heel strike [s].
+    pieces : sequence of (ndarray, ndarray) or None
+        Each phase's collocation nodes ``t`` (2 m + 1,) [s] (since the heel strike,
+        increasing, phase after phase) and controls ``u`` (2 m + 1,) [N m]; None: ``tau``
+        alone (no law block: :meth:`packed` answers None).
+    """
+
+    def __init__(self, tau, pieces):
+        self.tau = tau
+        self.knots = self.coefs = None
+        if pieces is None:
+            return
+        knots, coefs = [], []
+        for t, u in pieces:
+            t, u = np.asarray(t, float), np.asarray(u, float)
+            for i in range(0, len(t) - 2, 2):
+                x = t[i:i + 3] - t[i]
+                a2, a1, a0 = np.polyfit(x, u[i:i + 3], 2)  # through the three nodes
+                knots.append(t[i])
+                coefs.append((0.0, a2, a1, a0))
+        knots.append(float(np.asarray(pieces[-1][0], float)[-1]))
+        self.knots, self.coefs = np.array(knots), np.array(coefs).T
+
+    def __bool__(self) -> bool:
+        return True
+
+    def __call__(self, delta, ddelta, s, ds, t=0.0) -> np.ndarray:
+        """The torque (1,) [N m] at the time ``t`` [s] since the heel strike (the other
+        arguments, a torque law's, are not read)."""
+        return np.array([self.tau(float(t))])
+
+    def packed(self) -> np.ndarray | None:
+        """The law block (:func:`walkerlab.codegen.torque_law.pack_laws`) of this torque
+        (None without its pieces)."""
+        from walkerlab.codegen.torque_law import TIME_FEEDFORWARD, pack_laws
+
+        if self.knots is None:
+            return None
+        return pack_laws([(TIME_FEEDFORWARD, 0.0, 0.0, 0.0, 0.0, None, self.knots,
+                           self.coefs)])
 
 
 def push_off_impulse(push_off, hip_speed):

@@ -26,7 +26,8 @@ def _laws(acts):
     if not laws:
         return np.array([3.0, 0.0, 0.0])
     packed = getattr(laws, "packed", None)
-    return None if packed is None else np.asarray(packed(), float)
+    block = None if packed is None else packed()
+    return None if block is None else np.asarray(block, float)
 
 
 class PoweredData:

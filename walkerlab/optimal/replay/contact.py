@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.models.actuation import TorqueOfTime
+
 __all__ = ["REPLAY_WALL_TIME_LIMIT_S", "contact_replay", "contact_replay_five_link",
            "contact_replay_phased", "contact_replay_stride", "replay_failure"]
 
@@ -24,8 +26,8 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     Parameters
     ----------
     scene : Scene
-        The optimised scene (its ``contact``, ``terrain``, ``contact_solver``: LSODA at
-        rtol 1e-6, atol 1e-8 if none).
+        The optimised scene (its ``contact``, ``terrain``, ``contact_solver``: the contact
+        default (the compiled run) at rtol 1e-6, atol 1e-8 if none).
     res : walkerlab.optimal.transcription.step.CollocationResult
     strides : int
         Strides to run (2 steps each).
@@ -51,9 +53,8 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
                                 {"n_strides": strides, "sample_rate_hz": 500})
     if setup is None:
         return float("nan"), why
-    setup.actuators.laws = _law_of_time(torque_of_time(res))
-    solver = scene.contact_solver or SolverSettings.for_contact(method="LSODA", rtol=1e-6,
-                                                                atol=1e-8)
+    setup.actuators.laws = TorqueOfTime(torque_of_time(res), _nodes(res))
+    solver = scene.contact_solver or SolverSettings.for_contact(rtol=1e-6, atol=1e-8)
     return _run(setup, res.x[0], res.step_period_s, strides, solver)
 
 
@@ -67,7 +68,8 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     variable as the rigid one, :class:`walkerlab.models.contact.joint_torques.
     JointTorqueActuators`); the scene's ``contact`` law (the paper's default one if none),
     its terrain (continuous level ground if none: the optimised swing foot clears it) and
-    ``contact_solver`` (LSODA at rtol 1e-8, atol 1e-10 if none).
+    ``contact_solver`` (the contact default, the compiled run, at rtol 1e-8, atol 1e-10 if
+    none).
 
     Parameters
     ----------
@@ -95,8 +97,7 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     if setup is None:
         return float("nan"), why
     setup.actuators.rigid.laws = law
-    solver = scene.contact_solver or SolverSettings.for_contact(method="LSODA", rtol=1e-8,
-                                                                 atol=1e-10)
+    solver = scene.contact_solver or SolverSettings.for_contact(rtol=1e-8, atol=1e-10)
     return _run(setup, x0, step_period_s, strides, solver)
 
 
@@ -112,8 +113,8 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     ``res.x[0]``; the scene's ``contact`` law (a kneed walker needs its ``knee_stop.latch``
     to hold the stance knee as the rigid model's lock does; flat feet their regularising
     ``flat_foot_mass_kg`` and ``flat_foot_inertia_kg_m2``), ``terrain`` and
-    ``contact_solver`` (the contact default if none; a powered run takes it as LSODA, with a
-    flat foot's rotation rates at 100 times its atol:
+    ``contact_solver`` (the contact default, the compiled run, if none; a flat foot's
+    rotation rates at 100 times its atol:
     :func:`walkerlab.integrate.contact_powered.powered_atol`).
 
     Parameters
@@ -140,7 +141,8 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
                                  "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S})
     if setup is None:
         return float("nan"), why
-    setup.actuators.laws = _law_of_time(phase_torque_of_time(res))
+    setup.actuators.laws = TorqueOfTime(phase_torque_of_time(res),
+                                        _phases(res) if _nodes(res) else None)
     return _run(setup, res.x[0], res.step_period_s, strides)
 
 
@@ -197,6 +199,21 @@ def _hip_actuation(res) -> dict:
     if res.push_off_n_s > 0.0:
         act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
     return act
+
+
+def _nodes(res) -> list | None:
+    """The collocation nodes [s] and controls [N m] of a result (one phase), or None when it
+    carries none (its torque then stays a Python law)."""
+    t, u = getattr(res, "t", None), getattr(res, "u", None)
+    return None if t is None or u is None else [(t, u)]
+
+
+def _phases(res) -> list:
+    """Each phase's collocation nodes (times since the heel strike [s]) and controls [N m]
+    of a phased result (:func:`walkerlab.optimal.transcription.mode_sequence.
+    phase_torque_of_time`'s pieces)."""
+    bounds = list(res.phase_start) + [res.t.size]
+    return [(res.t[a:b], res.u[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
 def _law_of_time(tau):
