@@ -23,7 +23,7 @@ import numpy as np
 
 from . import _cyrk
 
-__all__ = ["CompiledSegments", "LOCATE_XTOL_S"]
+__all__ = ["CompiledSegments", "LOCATE_XTOL_S", "Stalled", "contact_tables"]
 
 #: Event location's tolerance on the time [s] (scipy's ``solve_ivp`` locates to 4 eps).
 LOCATE_XTOL_S = 1e-13
@@ -31,6 +31,12 @@ LOCATE_XTOL_S = 1e-13
 SEGMENT_STEPS = 100_000
 
 _ADDRESS: dict = {}  # generated kernels module name -> powered cfunc address
+
+
+def contact_tables(walker, X) -> np.ndarray:
+    """The contact table (m, points, 8) of states ``X`` (m, 2 nq) (the generated
+    ``contact_table``), computed once for every event of a segment's samples."""
+    return walker.kernels.contact_table(np.ascontiguousarray(X, float), *walker._args())
 
 
 class Stalled(Exception):
@@ -85,22 +91,24 @@ class CompiledSegments:
             The compiled solver stopped before ``t1`` (its step limit or a failure).
         """
         s, grid = self.solver, self.grid
-        d = self.pdata.data(stance, t_origin, push, ankle, switch_s)
+        d = self.pdata.data(stance, t_origin, push, ankle, switch_s, ghost=True)
         tg = np.concatenate([[t0], grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)], [t1]])
         X, ok, nfev, msg, dense = _cyrk.solve_chunk(
             s.method, y0, tg, d, s.rtol, self.atol, s.max_step_s or np.inf, SEGMENT_STEPS,
             kernels=self.kernels, dense=True)
+        self._extra = []
         try:
-            out = self._answer(X, ok, nfev, msg, dense, tg, events, len(y0), switch_s)
+            out = self._answer(X, ok, nfev, msg, dense, tg, events, len(y0), switch_s, d)
         finally:
-            if dense is not None:
-                dense.free()
+            for interp in [dense, *self._extra]:
+                if interp is not None:
+                    interp.free()
         if np.isfinite(switch_s):  # the samples after the heel strike only
             keep = out.t > switch_s + 1e-12
             out.t, out.y = out.t[keep], out.y[:, keep]
         return out
 
-    def _answer(self, X, ok, nfev, msg, dense, tg, events, ny, switch_s):
+    def _answer(self, X, ok, nfev, msg, dense, tg, events, ny, switch_s, d):
         """:meth:`run`'s answer from the segment's samples ``X`` at ``tg`` and its dense
         output: cut at the first event located on it."""
         n = 2 * self.walker.nq
@@ -108,8 +116,11 @@ class CompiledSegments:
                                     y_events=[np.empty((0, ny)) for _ in events],
                                     nfev=nfev, njev=0, status=0, message=msg)
         m = len(X)
-        G = np.column_stack([ev.values(X[:, :n]) for ev in events]) if events and m \
-            else np.empty((m, 0))
+        if events and m:
+            tab = contact_tables(self.walker, X[:, :n])  # once for every event
+            G = np.column_stack([ev.values(X[:, :n], tab) for ev in events])
+        else:
+            G = np.empty((m, 0))
         hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
         if len(hit):
             hit[0] &= G[0] > 0.0  # an event at the start was the last segment's
@@ -118,6 +129,14 @@ class CompiledSegments:
         rows = np.flatnonzero(hit.any(axis=1))
         if rows.size:
             k = int(rows[0])
+            if not ok:  # a stopped run's dense output is not the solution's: the interval
+                # integrated again from its first sample
+                _, ok_k, nf_k, _, dense = _cyrk.solve_chunk(
+                    self.solver.method, X[k], tg[k:k + 2], d, self.solver.rtol, self.atol,
+                    self.solver.max_step_s or np.inf, SEGMENT_STEPS, kernels=self.kernels,
+                    dense=True)
+                out.nfev += nf_k
+                self._extra.append(dense)
             j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(hit[k]),
                                 n)
             out.t, out.y = tg[1:k + 1], X[1:k + 1].T

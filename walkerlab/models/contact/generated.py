@@ -579,11 +579,18 @@ def rhs_source(eq, forced: bool = False) -> str:
     contact parameters ``PC`` (SI), the walker's parameters ``p`` (SI) and the kernel lanes
     ``c1``, ``c2`` [m], and returns dx/dt of shape (2 nq,).
 
-    ``forced``: the source of ``rhs_q(x, PC, p, c1, c2, Qx, pw)`` instead, the same
-    arithmetic with the generalised force ``Qx`` (nq,) [N, N m] added to ``Q - h`` before the
-    solve (an actuated walker's forces, :mod:`walkerlab.models.contact.powered_source`), and
-    ``pw`` (2,) filled with the contact forces' power ``sum F . v`` over the contact points
-    (their material velocities) and the knee stops' power ``-T d(ext)/dt`` [W].
+    ``forced``: the source of ``rhs_q(x, PC, p, c1, c2, S, out)`` instead (dx/dt written
+    into ``out``, the first 2 nq entries; ``S`` the scratch of
+    :mod:`walkerlab.models.contact.powered_source`), the same arithmetic with the
+    generalised force ``S[:nq]`` [N, N m] added to ``Q - h`` before the solve (an actuated
+    walker's forces), and ``S[nq + 6]``, ``S[nq + 7]`` filled with the contact forces' power
+    ``sum F . v`` over the contact points (their material velocities) and the knee stops'
+    power ``-T d(ext)/dt`` [W]; ``S[nq + 10:nq + 12]`` = ``G``:
+    the contact points of leg ``G[0]`` (0: leg1, 1: leg2; -1: none) at least ``G[1]`` [m]
+    ahead (along the ground) of every point of the other leg carry no contact force (a
+    *ghost* swing foot: up to its touchdown ahead the run is the same, and a compiled run
+    locates that touchdown without integrating the collision it starts,
+    :mod:`walkerlab.integrate.compiled_segments`).
     """
     import sympy as sp
     from sympy.printing.pycode import PythonCodePrinter
@@ -591,7 +598,7 @@ def rhs_source(eq, forced: bool = False) -> str:
     pr = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
     nq = len(eq.q)
     dqv = sp.Matrix(eq.dq)
-    head = ("def rhs_q(x, PC, p, c1, c2, Qx, pw):" if forced
+    head = ("def rhs_q(x, PC, p, c1, c2, S, out):" if forced
             else "def rhs(x, PC, p, c1, c2):")
     lines = ["@njit(cache=True, error_model='numpy')", head,
              '    """dx/dt (NX,) of the free-floating walker (generated straight-line code)."""',
@@ -611,10 +618,18 @@ def rhs_source(eq, forced: bool = False) -> str:
         args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
         power.append(f"{Fs[2 * i]} * ({pr.doprint(red[4 * i + 2])}) + "
                      f"{Fs[2 * i + 1]} * ({pr.doprint(red[4 * i + 3])})")
-        lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})",
-                  # (Fn, Ff) in the world, along the ground's normal (the slope's: _sp, _cp)
-                  f"    {Fs[2 * i]} = _r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]",
-                  f"    {Fs[2 * i + 1]} = _r{i}[4] * _r{i}[11] - _r{i}[5] * _r{i}[10]"]
+        lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
+    for i, leg in enumerate(eq.point_legs):
+        # (Fn, Ff) in the world, along the ground's normal (the slope's: _sp, _cp)
+        fx = f"_r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]"
+        fy = f"_r{i}[4] * _r{i}[11] - _r{i}[5] * _r{i}[10]"
+        if forced:  # a ghost point: of leg G[0], ahead of the other leg's points by G[1]
+            others = ", ".join(f"_r{j}[3]" for j, lg in enumerate(eq.point_legs) if lg != leg)
+            front = f"max({others}, -1e300)" if others.count(",") else f"{others}"
+            lines.append(f"    _ghost{i} = S[NQ + 10] == {float(leg)} and "
+                         f"_r{i}[3] - {front} >= S[NQ + 11]")
+            fx, fy = f"0.0 if _ghost{i} else {fx}", f"0.0 if _ghost{i} else {fy}"
+        lines += [f"    {Fs[2 * i]} = {fx}", f"    {Fs[2 * i + 1]} = {fy}"]
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
         Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])
@@ -640,11 +655,11 @@ def rhs_source(eq, forced: bool = False) -> str:
             if (i, j) in nz:
                 lines.append(f"    _M{i}_{j} = {pr.doprint(next(it))}")
     for i in range(nq):
-        lines.append(f"    _Q{i} = {pr.doprint(next(it))}" + (f" + Qx[{i}]" if forced else ""))
+        lines.append(f"    _Q{i} = {pr.doprint(next(it))}" + (f" + S[{i}]" if forced else ""))
     if forced:
         nf = len(eq.feet)
-        lines.append(f"    pw[0] = {' + '.join(power[:nf])}")
-        lines.append(f"    pw[1] = {' + '.join(power[nf:]) or '0.0'}")
+        lines.append(f"    S[NQ + 6] = {' + '.join(power[:nf])}")
+        lines.append(f"    S[NQ + 7] = {' + '.join(power[nf:]) or '0.0'}")
     # unrolled Cholesky M = L L^T with structural zeros (and fill-in) tracked
     Lnz = set()
     for j in range(nq):
@@ -665,7 +680,10 @@ def rhs_source(eq, forced: bool = False) -> str:
         terms = [f" - _L{k}_{i} * _a{k}" for k in range(i + 1, nq) if (k, i) in Lnz]
         lines.append(f"    _a{i} = (_y{i}{''.join(terms)}) * _d{i}")
     outs = [str(s) for s in eq.dq] + [f"_a{i}" for i in range(nq)]
-    lines.append(f"    return np.array(({', '.join(outs)},))")
+    if forced:  # into the caller's array (no allocation per call)
+        lines += [f"    out[{i}] = {o}" for i, o in enumerate(outs)]
+    else:
+        lines.append(f"    return np.array(({', '.join(outs)},))")
     return "\n".join(lines) + "\n"
 
 

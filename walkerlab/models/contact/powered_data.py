@@ -90,17 +90,22 @@ class PoweredData:
         self.ny = 2 * n + len(works)
 
     def data(self, stance: int, t_origin: float, push: tuple[int, float] | None = None,
-             ankle: bool = False, switch_s: float = np.inf) -> np.ndarray:
+             ankle: bool = False, switch_s: float = np.inf, ghost: bool = False
+             ) -> np.ndarray:
         """The data vector with leg ``stance`` in stance (0: leg1, 1: leg2), the step begun
         at ``t_origin`` [s], a push-off pulse ``(trailing leg, force [N])`` on (None: off),
         the ankle push-off on or off, and a heel strike at ``switch_s`` [s] (the other leg
-        in stance from then, inf: none); shape (len,), float64, the call counter 0."""
+        in stance from then, inf: none); ``ghost``: the swing foot carries no contact
+        force once it is ``min_step_m`` ahead of the stance foot (the swing leg's after the
+        switch, or with none pending: :mod:`walkerlab.models.contact.powered_source`);
+        shape (len,), float64, the call counter 0."""
         acts = self.walker.actuators
         h = self.head.copy()
         h[3:5] = self.phase[0]
         h[31] = self.phase[1][1]
         h[5], h[6] = -1.0, 0.0
         h[28:31] = (stance, switch_s, t_origin)
+        h[35] = float(acts.min_step_m) if ghost else -1.0
         if push is not None:
             trailing = int(push[0])
             h[5], h[6] = self.push_rows[trailing], float(push[1])
@@ -111,7 +116,7 @@ class PoweredData:
             h[32:34] = (self.foot[1], acts.ankle_leg[1])
         block = np.concatenate([h, self.B[0], self.B[1], *self.held, self.laws])
         block[0] = block.size
-        scratch = np.zeros(self.walker.nq + 10)  # the compiled call's force and powers
+        scratch = np.zeros(self.walker.nq + 12)  # the compiled call's force and powers
         return np.concatenate([self.base, block, scratch, [0.0]]).astype(np.float64)
 
 

@@ -58,13 +58,16 @@ counter):
                solver meets it warm: :mod:`walkerlab.integrate.compiled_segments`)
 ``A[30]``      the time [s] the present step began (before the switch)
 ``A[34]``      a held generalised force is on (0/1)
+``A[35]``      the ghost swing foot: its points at least ``A[35]`` [m] ahead of the stance
+               foot's carry no contact force (< 0: none; :func:`rhs_q`'s ``G``), the swing
+               leg's once the heel strike in the data has passed, or with none pending
 then           ``B`` with leg1 in stance, then with leg2 (nq * k each, row-major), the held
                force ``E`` with leg1 in stance, then with leg2 (nq each), then the law block
                (its ``b[2]``, the time the step began, written by each call)
 =============  =============================================================================
 
-After the block, ``nq + 10`` numbers of scratch (the force and the powers of one call: the
-right-hand side allocates nothing), then the call counter.
+After the block, ``nq + 12`` numbers of scratch (the force, the powers and the ghost
+swing foot of one call: the right-hand side allocates nothing), then the call counter.
 """
 
 from __future__ import annotations
@@ -104,8 +107,8 @@ def _phase(x, A, p, st):
 
 
 @njit(cache=True, error_model='numpy')
-def _pulse(x, A, p, Q, W):
-    """The push-off pulse's force into ``Q`` and its power into ``W[4]``."""
+def _pulse(x, A, p, S):
+    """The push-off pulse's force into ``S[:NQ]`` and its power into ``S[NQ + 4]``."""
     n = NQ
     P = np.empty((NF, 2))
     V = np.empty((NF, 2))
@@ -136,14 +139,15 @@ def _pulse(x, A, p, Q, W):
             Qp[i] += lam * a[i]
         pp += lam * (x[n + int(A[16])] - x[n + int(A[17])])
     for i in range(n):
-        Q[i] += Qp[i]
-    W[4] = pp
+        S[i] += Qp[i]
+    S[NQ + 4] = pp
 
 
 @njit(cache=True, error_model='numpy')
-def actuate(t, x, A, p, Q, W):
-    """The actuators' generalised force into ``Q`` (NQ,) and the powers ``W[:6]`` at the
-    time ``t`` [s] and state ``x`` from the actuation block ``A`` (module docstring)."""
+def actuate(t, x, A, p, S):
+    """The actuators' generalised force into ``S[:NQ]`` and the powers ``W`` into
+    ``S[NQ:NQ + 10]`` at the time ``t`` [s] and state ``x`` from the actuation block ``A``
+    (module docstring)."""
     n = NQ
     k = int(A[2])
     st = int(A[28])
@@ -165,35 +169,43 @@ def actuate(t, x, A, p, Q, W):
                 if b != 0.0:
                     d += b * x[i]
                     dd += b * x[n + i]
-            tau = law_torque(law, j, d, dd, s, ds, t)[0]
+            h = 3 + HEAD * j
+            if law[h] == PLAIN:  # a spring-damper (the law kernel's formula, inline)
+                tau = law[h + 1] - law[h + 2] * (d - law[h + 4]) - law[h + 3] * dd
+                if tau > law[h + 5]:
+                    tau = law[h + 5]
+                elif tau < -law[h + 5]:
+                    tau = -law[h + 5]
+            else:
+                tau = law_torque(law, j, d, dd, s, ds, t)[0]
             for i in range(n):
-                Q[i] += A[bo + i * k + j] * tau
+                S[i] += A[bo + i * k + j] * tau
             p_tau += tau * dd
-        W[0] = p_tau if p_tau > 0.0 else 0.0
-        W[1] = p_tau if p_tau < 0.0 else 0.0
+        S[NQ + 0] = p_tau if p_tau > 0.0 else 0.0
+        S[NQ + 1] = p_tau if p_tau < 0.0 else 0.0
     if A[9] > 0.5 and not switched:  # the ankle push-off
         f = int(A[10]) if st == 0 else int(A[32])
         lg = int(A[11]) if st == 0 else int(A[33])
         ta = -A[12] * (x[f] - x[lg] - A[13]) - A[14]
-        Q[f] += ta
-        Q[lg] -= ta
+        S[f] += ta
+        S[lg] -= ta
         pa = ta * (x[n + f] - x[n + lg])
-        W[2] = pa if pa > 0.0 else 0.0
-        W[3] = pa if pa < 0.0 else 0.0
+        S[NQ + 2] = pa if pa > 0.0 else 0.0
+        S[NQ + 3] = pa if pa < 0.0 else 0.0
     if A[5] >= 0.0:
-        _pulse(x, A, p, Q, W)
+        _pulse(x, A, p, S)
     if A[34] > 0.5:  # the held force
         pe = 0.0
         for i in range(n):
-            Q[i] += A[eo + i]
+            S[i] += A[eo + i]
             pe += A[eo + i] * x[n + i]
-        W[8] = pe if pe > 0.0 else 0.0
-        W[9] = pe if pe < 0.0 else 0.0
+        S[NQ + 8] = pe if pe > 0.0 else 0.0
+        S[NQ + 9] = pe if pe < 0.0 else 0.0
     if A[26] > 0.5:  # the dampers' power
         r1 = x[n + int(A[20])] - x[n + int(A[22])]
         r2 = x[n + int(A[21])] - x[n + int(A[23])]
         hp = x[n + int(A[25])] - x[n + int(A[24])]
-        W[5] = -A[18] * (r1 * r1 + r2 * r2) - A[19] * hp * hp
+        S[NQ + 5] = -A[18] * (r1 * r1 + r2 * r2) - A[19] * hp * hp
 '''
 
 _PACKED = '''
@@ -201,7 +213,7 @@ _PACKED = '''
 @njit(cache=True, error_model='numpy')
 def powered_packed(t, y, d, dy):
     """dy/dt of a powered walker's state and work integrals from the data vector ``d``
-    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 10), calls]``); counts the call in
+    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 12), calls]``); counts the call in
     ``d[-1]``."""
     a1 = D_P + NP
     a2 = a1 + int(d[D_N1])
@@ -209,20 +221,24 @@ def powered_packed(t, y, d, dy):
     la = int(d[a3])
     A = d[a3:a3 + la]
     p = d[D_P:a1]
-    # scratch in the data vector (no allocation per call): Q (NQ), the powers W (10)
-    Q = d[a3 + la:a3 + la + NQ]
-    W = d[a3 + la + NQ:a3 + la + NQ + 10]
-    for i in range(NQ):
-        Q[i] = 0.0
-    for i in range(10):
-        W[i] = 0.0
-    actuate(t, y, A, p, Q, W)
-    r = rhs_q(y, d[D_PC:D_P], p, d[a1:a2], d[a2:a3], Q, W[6:8])
-    for i in range(NX):
-        dy[i] = r[i]
+    # scratch in the data vector (no allocation per call): the force Q (NQ), the powers W
+    # (10), the ghost swing foot G (2)
+    S = d[a3 + la:a3 + la + NQ + 12]
+    for i in range(NQ + 10):
+        S[i] = 0.0
+    actuate(t, y, A, p, S)
+    # the ghost swing foot (A[35] >= 0: its ahead distance [m]): the swing leg's once the
+    # heel strike in the data (A[29]) has passed, or with none pending
+    st = int(A[28])
+    switched = t >= A[29]
+    if switched:
+        st = 1 - st
+    S[NQ + 10] = float(1 - st) if A[35] >= 0.0 and (switched or A[29] == np.inf) else -1.0
+    S[NQ + 11] = A[35]
+    rhs_q(y, d[D_PC:D_P], p, d[a1:a2], d[a2:a3], S, dy)
     m = int(A[27])
     for j in range(m):
-        dy[NX + j] = W[int(A[A_HEAD + j])]
+        dy[NX + j] = S[NQ + int(A[A_HEAD + j])]
     d[d.size - 1] += 1.0
 
 
@@ -230,7 +246,7 @@ def powered_packed(t, y, d, dy):
 def powered_size(d):
     """Length of a powered data vector (``d`` may be a raw pointer in a cfunc)."""
     a3 = D_P + NP + int(d[D_N1]) + int(d[D_N2])
-    return a3 + int(d[a3]) + NQ + 10 + 1
+    return a3 + int(d[a3]) + NQ + 12 + 1
 
 
 @njit(cache=True)
