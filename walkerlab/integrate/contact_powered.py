@@ -87,6 +87,8 @@ STALL_CALLS = 20_000
 STEP_MARGIN = 1.1
 #: ... and at least this long [s].
 MIN_SEGMENT_S = 0.05
+#: The segment after a push-off pulse that ended before its touchdown is this long [s].
+AFTER_PULSE_S = 0.005
 #: A compiled run goes on after a heel strike from a sample this long [s] before it, the
 #: strike in its data (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`):
 #: the segment that found the touchdown crossed it with a ghost swing foot (no collision
@@ -387,6 +389,7 @@ class ActuationHook:
         # a compiled run's next segment from before the last heel strike: (t, y, stance,
         # step start, ankle on) before it (None: from the present state)
         self.resume, self.segment = None, None
+        self.pulse_end = None  # when the last push-off pulse ended before its touchdown [s]
         self.segments = None  # compiled segments, set by start() where they apply
         self.touch = _touchdown_event(walker, lambda: self.stance)
         self.fall = _fall_event(walker, limits, launch_height_m)
@@ -559,6 +562,7 @@ class ActuationHook:
             t, y, touched = got
             self.t, self.y = t, y
             if not touched:  # the touchdown after the pulse: the next segments
+                self.pulse_end = t  # (it comes about now: a short segment first)
                 return "go"
             self._strike(t)  # the pulse straddles the touchdown: its rest after it
             if t < tp - 1e-12:
@@ -645,8 +649,14 @@ class ActuationHook:
         on compiled segments, which integrate to their end before their events are looked
         for, :data:`STEP_MARGIN` times the last step's duration after the present step's
         start (the integration past the touchdown is thrown away), at least
-        :data:`MIN_SEGMENT_S` ahead."""
-        if self.segments is None or self.step_s is None:
+        :data:`MIN_SEGMENT_S` ahead; right after a push-off pulse, which ends at the
+        predicted touchdown, :data:`AFTER_PULSE_S` ahead."""
+        if self.segments is None:
+            return ta + span
+        if self.pulse_end is not None and ta <= self.pulse_end + 1e-12:
+            # the pulse ended at the predicted touchdown: it comes within a few samples
+            return ta + AFTER_PULSE_S
+        if self.step_s is None:
             return ta + span
         return max(self.t_origin + STEP_MARGIN * self.step_s, ta + MIN_SEGMENT_S)
 
