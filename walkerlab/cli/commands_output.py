@@ -61,11 +61,15 @@ def export(scene: Path | None = SceneArg,
     """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
     walker.xml, walker.adm + walker.acf (Adams Solver) or walker.osim (OpenSim).  The URDF,
     MJCF and OpenSim model carry the rigid gait (found as `walkerlab fixedpoint` finds it) as
-    a keyframe (OpenSim: the default state)."""
+    a keyframe (OpenSim: the default state).  What the file leaves out is printed, one line
+    per item ("left out of walker.urdf: ..."), as the file's "Left out:" comments have it."""
     from walkerlab.stages import export as stage
 
     sc = load(scene)
-    typer.echo(f"wrote {stage.run(sc, runs_dir, fmt, walker_only=walker_only)}")
+    out = stage.write(sc, runs_dir, fmt, walker_only=walker_only)
+    typer.echo(f"wrote {out.path}")
+    for line in out.left_out:  # what the file leaves out: here too, not only in a comment
+        typer.echo(f"left out of {out.path.name}: {line}")
     if fmt == "adm":  # the dataset is not the scene's walker: say so here, not in a comment
         from walkerlab.export.adams import actuation_warning
 

@@ -180,6 +180,7 @@ from walkerlab.export.adams_statements import (
     part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.export.omitted import Omission, adams_comments
 from walkerlab.export.parts import export_part
 from walkerlab.units import for_scene
 
@@ -189,7 +190,7 @@ __all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ADAMS_FILES", "ANKLE_JOINT", "ANKLE_SF
            "ANKLE_SPRING", "ANKLE_TORQUE_SFORCE", "ANKLE_VARIABLES", "COUPLER_ID",
            "FOOT_FORCES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE", "LINE_WIDTH",
            "PIN_JOINT", "PUSH_FLOAT_MARKER", "PUSH_GFORCE", "PUSH_MIN_STEP_M", "AdamsStart",
-           "acf_text", "actuation_warning", "adams_start", "adm_text",
+           "acf_text", "actuation_warning", "adams_omissions", "adams_start", "adm_text",
            "check_adams_actuation", "check_adams_exportable", "contact_mm", "contact_pairs",
            "hip_torque_ids", "marker_id", "part_ids", "table_terms"]
 
@@ -213,6 +214,29 @@ def actuation_warning(scene: Scene) -> str:
     this is always "" (kept for the CLI's call).
     """
     return ""
+
+
+#: The knee latch's item of :func:`adams_omissions` (its comment stands by the knee stops).
+KNEE_LATCH = "the knee latch (contact.knee_stop.latch)"
+
+
+def adams_omissions(scene: Scene, mb) -> tuple[Omission, ...]:
+    """What :func:`adm_text` leaves out (:mod:`walkerlab.export.omitted`): the knee latch of
+    a kneed walker, and a contact start other than the rigid gait's
+    (``contact_sim.start``: the file starts from the rigid gait x ``initial_rate_scale``)."""
+    out = []
+    if scene.contact_sim is not None and scene.contact_sim.start != "ideal":
+        out.append(Omission(f"contact_sim.start = {scene.contact_sim.start}", "this file "
+                            "starts from the rigid gait x initial_rate_scale (the adjusted or "
+                            "periodic start is not written)"))
+    if export_part(mb).knee_stops:
+        from walkerlab.models.contact.rigid_limit import contact_si
+
+        _, ks = contact_si(scene.contact or ContactSettings())
+        out.append(Omission(KNEE_LATCH, f"the knee held straight while the foot is < "
+                            f"{ks.latch_height:.4g} m above ground needs a SENSOR or a user "
+                            "subroutine: not written"))
+    return tuple(out)
 
 
 def check_adams_exportable(mb) -> None:
@@ -440,9 +464,8 @@ def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None) -> list[str]
         from walkerlab.models.contact.rigid_limit import contact_si
 
         _, ks = contact_si(scene.contact or ContactSettings())
-        out += ["! knee stops: IMPACT on the hyperextension shank - thigh (> 0 past straight)",
-                f"! the latch (knee held straight while the foot is < {ks.latch_height:.4g} m",
-                "! above ground) needs a SENSOR or a user subroutine: not written"]
+        out += ["! knee stops: IMPACT on the hyperextension shank - thigh (> 0 past straight)"]
+        out += adams_comments(o for o in adams_omissions(scene, mb) if o.what == KNEE_LATCH)
         for leg in ("leg1", "leg2"):
             sh, th = ids[f"{leg}_shank"], ids[f"{leg}_thigh"]
             i_m, j_m = marker_id(sh, "joint"), marker_id(th, "knee")
@@ -527,10 +550,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     if for_scene(scene).nondimensional:
         out += ["! nondimensional scene (g = 1): its numbers are written as if in SI "
                 "(l = 1 m,", "! M = 1 kg, g = 1 m/s^2), then in mm-kg-s"]
-    if scene.contact_sim is not None and scene.contact_sim.start != "ideal":
-        out += [f"! contact_sim.start is {scene.contact_sim.start!r}: this file starts from "
-                "the rigid", "! gait x initial_rate_scale (the adjusted or periodic start "
-                "is not written)"]
+    out += adams_comments(o for o in adams_omissions(scene, mb) if o.what != KNEE_LATCH)
     if scene.walker.actuation is not None:
         out += ["! walker.actuation: its joint torques (SFORCE) and push-off (GFORCE",
                 "! pulses) are written below, after the contacts"]

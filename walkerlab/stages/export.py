@@ -11,6 +11,7 @@ leg links) is written by that module's wheel writers, as URDF or MJCF only.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import walkerlab
@@ -18,6 +19,7 @@ from walkerlab.config import Scene
 from walkerlab.export.adams import (
     ADAMS_FILES,
     acf_text,
+    adams_omissions,
     adams_start,
     adm_text,
     check_adams_actuation,
@@ -28,12 +30,20 @@ from walkerlab.export.multibody import (
     SIDECAR,
     comments_in_scene_units,
     keyframe_json,
+    mjcf_omissions,
     mjcf_text,
+    urdf_omissions,
     urdf_text,
     wheel_mjcf_text,
     wheel_urdf_text,
 )
-from walkerlab.export.opensim import OSIM_FILE, check_osim_exportable, osim_gait, osim_text
+from walkerlab.export.opensim import (
+    OSIM_FILE,
+    check_osim_exportable,
+    osim_gait,
+    osim_omissions,
+    osim_text,
+)
 from walkerlab.export.scene import (
     check_exportable,
     check_wheel_exportable,
@@ -41,6 +51,8 @@ from walkerlab.export.scene import (
     wheel_keyframe,
     wheel_keyframe_json,
 )
+from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS
+from walkerlab.export.text import comment
 from walkerlab.io import runpaths
 from walkerlab.units import for_scene
 from walkerlab.walker.description import walker_data
@@ -84,7 +96,7 @@ def stored_gait(scene: Scene, runs_root: Path | str):
     return fp if fp.variant == "derived" and not fp.error else None
 
 
-def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
+def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Exported:
     """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
     check_adams_exportable(mb)  # before the gait search
     check_adams_actuation(scene)
@@ -95,10 +107,10 @@ def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     runpaths.atomic_texts([  # both or neither
         (path, adm),
         (runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True), acf)])
-    return path
+    return Exported(path, tuple(o.line for o in adams_omissions(scene, mb)))
 
 
-def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -> Path:
+def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -> Exported:
     """``walker.osim``: the walker, its gait as the default state, its ground and contact."""
     if walker_only:
         raise ValueError("--walker-only: the OpenSim export carries the gait, ground and "
@@ -109,7 +121,7 @@ def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -
     text = osim_text(mb, gait, name, walkerlab.__version__)
     path = export_path(scene, runs_root, "osim", claim=True)
     runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
-    return path
+    return Exported(path, _xml_lines(osim_omissions(mb, gait), scene))
 
 
 def _gait(scene: Scene, runs_root, build):
@@ -126,7 +138,8 @@ def _gait(scene: Scene, runs_root, build):
                          f"{' '.join(str(exc).split())}") from None
 
 
-def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
+def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
+               ) -> Exported:
     """The rolling polygon kind's writer: a spoked wheel (one rigid body on its spokes, no
     tree of leg links) by its own writers (:func:`walkerlab.export.multibody.wheel_urdf_text`,
     ``wheel_mjcf_text``): the rigid gait as the MJCF's ``gait`` keyframe (the URDF's
@@ -153,7 +166,7 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
         files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                       wheel_keyframe_json(key)))
     runpaths.atomic_texts(files)  # the wheel and its keyframe: both or neither
-    return path
+    return Exported(path, _xml_lines(WHEEL_URDF_OMISSIONS if fmt == "urdf" else (), scene))
 
 
 def _gait_scene(scene: Scene, mb, data, runs_root):
@@ -162,12 +175,51 @@ def _gait_scene(scene: Scene, mb, data, runs_root):
     return _gait(scene, runs_root, lambda ideal: mjcf_scene(scene, mb, data, ideal))
 
 
+@dataclass(frozen=True)
+class Exported:
+    """An export's file and what it leaves out.
+
+    Attributes
+    ----------
+    path : Path
+        The written file (``walker.urdf``, ``walker.xml``, ``walker.adm``, ``walker.osim``).
+    left_out : tuple of str
+        One line per item the file leaves out (:mod:`walkerlab.export.omitted`): ``what:
+        why``, each the text of the file's comment after ``Left out:`` (an Adams comment's
+        lines joined), in the scene's units as the file has it; empty when the file carries
+        the whole scene.
+    """
+
+    path: Path
+    left_out: tuple[str, ...] = ()
+
+
+def _xml_lines(items, scene: Scene) -> tuple[str, ...]:
+    """The items' lines as an XML file's comments have them: ``--`` spaced
+    (:func:`walkerlab.export.text.comment`), units in the scene's system
+    (:func:`walkerlab.export.multibody.comments_in_scene_units`)."""
+    units = for_scene(scene)
+    out = []
+    for o in items:
+        text = comments_in_scene_units(comment(o.line), units)
+        out.append(text[len("<!-- "):-len(" -->")])
+    return tuple(out)
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         walker_only: bool = False) -> Path:
+    """:func:`write`'s file: the path alone (the callers that do not print what the file
+    leaves out)."""
+    return write(scene, runs_root, fmt, walker_only).path
+
+
+def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
+          walker_only: bool = False) -> Exported:
     """Write the scene's walker as ``fmt`` ("urdf", "mjcf", "adm": ``walker.adm`` and
     ``walker.acf``, returning the .adm's path, or "osim": ``walker.osim``,
     :mod:`walkerlab.export.opensim`) into
-    ``<runs_root>/<scene name>/`` and return the file's path.
+    ``<runs_root>/<scene name>/`` and return the file's path and what it leaves out
+    (:class:`Exported`).
 
     The URDF and MJCF carry the rigid gait (the MJCF's ``gait`` keyframe, terrain and
     contact; the URDF's keyframe sidecar): the gait of ``fixedpoint.h5`` when it is up to
@@ -205,7 +257,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     return _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
 
 
-def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
+def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
+               ) -> Exported:
     """The writer of the kinds whose walker is a tree of leg links
     (:func:`walkerlab.walker.multibody.multibody`): the URDF and MJCF here, the Adams
     dataset (:func:`_run_adams`) and the OpenSim model (:func:`_run_osim`)."""
@@ -218,15 +271,17 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, scene.walker.actuation)
+        left_out = urdf_omissions(mb, scene.walker.actuation)
     else:
         text = mjcf_text(mb, name, walkerlab.__version__, extra)
+        left_out = mjcf_omissions(mb, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
     files = [(path, comments_in_scene_units(text, for_scene(scene)))]
     if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
         files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                       keyframe_json(mb, extra)))
     runpaths.atomic_texts(files)  # the walker and its keyframe: both or neither
-    return path
+    return Exported(path, _xml_lines(left_out, scene))
 
 
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> the export's writer of that kind
