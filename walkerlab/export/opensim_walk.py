@@ -25,7 +25,9 @@ from it; OpenSim has no contact-switched force):
 
 - the **knee latch** of a kneed export (``leg<i>_knee_latch``, the knee stop mirrored) is on
   while the leg's foot is less than the release height above the slope line and its knee is
-  within the capture flexion of straight
+  within the capture flexion of straight, the foot's height its contact point's: the foot
+  sphere's centre less the file's offset (an arc foot's radius;
+  :func:`walkerlab.export.opensim_xml.latch_foot_offset`)
   (:func:`walkerlab.export.mujoco_walk.latch_rule`, the MJCF's rule);
 - the **push-off** of a powered export (``leg<i>_push_off``, the force ``F = P0 / T`` along
   the leg from foot to hip, ``P0`` the law's ``impulse_n_s``, ``T`` the scene's
@@ -90,6 +92,8 @@ def _header(text: str) -> dict:
     if m := re.search(r"less than (\S+) m above the ground and its knee within (\S+) rad",
                       text):
         out["latch"] = (float(m.group(1)), float(m.group(2)))
+    if m := re.search(r"slope line less (\S+) \S+ \(the sphere's radius", text):
+        out["latch_offset"] = float(m.group(1))
     if m := re.search(r"on for T = (\S+) s", text):
         out["pulse"] = float(m.group(1))
     if m := re.search(r"walkerlab_actuation: (\{.*\}) -->", text):
@@ -319,7 +323,9 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     while t < duration_s - 1e-12:
         changed = False
         if kneed:
-            want = {g: latch_rule(height(g, state), knee[g].getValue(state), *info["latch"])
+            off = info.get("latch_offset", 0.0)  # the contact point below the centre
+            want = {g: latch_rule(height(g, state) - off, knee[g].getValue(state),
+                                  *info["latch"])
                     for g in LEGS}  # both before either switch (a switch drops the stage)
             for g in LEGS:
                 if want[g] != latched[g]:
