@@ -53,6 +53,7 @@ CASES = {
     ("kneed", "urdf"): ["the ground (slope, terrain and contact law)",
                         "the knee latch (contact.knee_stop.latch)"],
     ("kneed", "mjcf"): ["the knee latch's switching"],
+    ("kneed", "adm"): [],
     ("kneed", "osim"): ["the knee latch's switching"],
     ("hip_spring", "urdf"): ["the ground (slope, terrain and contact law)",
                              "spring spring0"],

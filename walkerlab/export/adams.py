@@ -53,6 +53,10 @@ hip / knee joints                      JOINT/REVOLUTE I (child), J (parent)   -
 ``contact.friction_velocity_*``        CONTACT FRICTION_TRANSITION_VELOCITY   mm/s
 ``walker.springs`` (hip)               SPRINGDAMPER/ROTATIONAL KT, CT, ANGLE  N mm/rad, rad
 ``contact.knee_stop`` (kneed)          SFORCE/ROTATION FUNCTION=-IMPACT(..)   N mm, rad
+``contact.knee_stop.latch``            SFORCE/3, 4 ROTATION FUNCTION = the    N mm, rad, mm
+                                       STEP weights (VARIABLE/371-379: the
+                                       foot's contact height, the knee) x
+                                       IMPACT on the flexion
 ``walker.actuation.torques`` (hip)     SFORCE/10 ROTATION I leg1, J leg2,     N mm, rad
                                        FUNCTION = role sign x the laws' sum
                                        (VARIABLEs of AZ, WZ, MIN, MAX, IF)
@@ -128,6 +132,20 @@ its heel's normal force is 0 and its toe's positive (the contact view latches he
 ends the push-off at the touchdown; here it ends when the roles swap, a few ms later).  Not
 written (refused in one line): time references (the time since heel strike is a latched
 state), a pulse of length 0 (an impulse).
+
+Knee latch (``contact.knee_stop.latch``, :func:`_knee_latches`): the contact model's latch
+is a smooth weight of the present state, ``w = STEP(delta, -h, 0, 0, 1) STEP(ext, -a, 0,
+-a/2, 1)`` (``delta`` the foot contact point's penetration, ``h`` the release height, ``a``
+the capture flexion) times the stop's IMPACT law on the flexion, so it is written as that
+expression: an ``SFORCE`` per knee whose ``FUNCTION`` is the product of two ``STEP``s and
+``IMPACT`` (Adams Solver function reference: STEP, IMPACT), the contact height the foot
+sphere's centre along the slope normal (``DX``, ``DY``) less the arc's radius.  A ``SENSOR``
+(Adams Solver statement reference, adams_solver/state_sensor.html: an event when an
+expression reaches a value, whose actions change the output step or the integration step,
+halt, restart, return to the commands or store a value for ``SENVAL``) would make it a
+switched law with a memory, which the contact model's latch is not.  On stairs and
+footholds the latch is left out (the height of the patch under the foot is looked up by no
+statement): the file says so and ``walkerlab export`` prints it (:func:`adams_omissions`).
 """
 
 from __future__ import annotations
@@ -160,6 +178,7 @@ from walkerlab.export.adams_feet import (
     ANKLE_JOINT,
     ANKLE_SPRING,
     FOOT_FORCES,
+    _foot_sphere_m,
     adams_feet,
     contact_pairs,
     hip_link,
@@ -176,18 +195,21 @@ from walkerlab.export.adams_statements import (
     _fs,
     _rot,
     _stmt,
+    _var,
     marker_id,
     part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, adams_comments
+from walkerlab.export.opensim_xml import latch_foot_offset
 from walkerlab.export.parts import export_part
 from walkerlab.units import for_scene
 
 # the dataset's parts, contact and actuation live in sibling modules (statements, feet per
 # walker kind, actuation); their public names are this module's too
 __all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ADAMS_FILES", "ANKLE_JOINT", "ANKLE_SFORCE",
-           "ANKLE_SPRING", "ANKLE_TORQUE_SFORCE", "ANKLE_VARIABLES", "COUPLER_ID",
+           "ANKLE_SPRING", "ANKLE_TORQUE_SFORCE", "ANKLE_VARIABLES", "COUPLER_ID", "KNEE_LATCH",
+           "LATCH_SFORCE", "LATCH_VARIABLES",
            "FOOT_FORCES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE", "LINE_WIDTH",
            "PIN_JOINT", "PUSH_FLOAT_MARKER", "PUSH_GFORCE", "PUSH_MIN_STEP_M", "AdamsStart",
            "acf_text", "actuation_warning", "adams_omissions", "adams_start", "adm_text",
@@ -216,6 +238,13 @@ def actuation_warning(scene: Scene) -> str:
     return ""
 
 
+#: VARIABLE ids of the knee latch (:func:`_knee_latches`): the slope's sine and cosine, each
+#: leg's contact height [mm], the latch's engagement and its two factors (foot, knee).
+LATCH_VARIABLES = {"sin": 370, "cos": 375, "height_leg1": 371, "height_leg2": 372,
+                   "weight_leg1": 373, "weight_leg2": 374, "foot_leg1": 376,
+                   "foot_leg2": 377, "knee_leg1": 378, "knee_leg2": 379}
+#: SFORCE ids of the knee latches (the stops are SFORCE/1, 2).
+LATCH_SFORCE = {"leg1": 3, "leg2": 4}
 #: The knee latch's item of :func:`adams_omissions` (its comment stands by the knee stops).
 KNEE_LATCH = "the knee latch (contact.knee_stop.latch)"
 
@@ -233,9 +262,10 @@ def adams_omissions(scene: Scene, mb) -> tuple[Omission, ...]:
         from walkerlab.models.contact.rigid_limit import contact_si
 
         _, ks = contact_si(scene.contact or ContactSettings())
-        out.append(Omission(KNEE_LATCH, f"the knee held straight while the foot is < "
-                            f"{ks.latch_height:.4g} m above ground needs a SENSOR or a user "
-                            "subroutine: not written"))
+        if ks.latch and not _latch_written(scene, ks):
+            out.append(Omission(KNEE_LATCH, f"terrain.kind: {scene.terrain.kind}: the latch "
+                                "reads the foot's contact height, and the height of the patch "
+                                "under the foot (each tread's) is looked up by no statement"))
     return tuple(out)
 
 
@@ -472,6 +502,59 @@ def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None) -> list[str]
             out += _stmt(f"SFORCE/{1 if leg == 'leg1' else 2}, ROTATION, I={i_m}, J={j_m}",
                          f"FUNCTION=-IMPACT(-AZ({i_m},{j_m}),-WZ({i_m},{j_m},{j_m}),0.0,"
                          f"{_f(ks.k * MM)},{_f(ks.e)},{_f(ks.cmax * MM)},{_f(ks.dmax)})")
+        if _latch_written(scene, ks):
+            out += _knee_latches(mb, ids, ks)
+    return out
+
+
+def _latch_written(scene: Scene, ks) -> bool:
+    """The knee latch (``ks.latch``) is written: on the slope's ground (its foot height is
+    the contact point's above the slope line; on stairs and footholds the patch under the
+    foot has a height of its own, which no statement looks up)."""
+    terrain = scene.terrain or TerrainSettings()
+    return bool(ks.latch) and terrain.is_slope
+
+
+def _knee_latches(mb, ids: dict, ks) -> list[str]:
+    """The contact model's knee latch (:func:`walkerlab.models.contact.generated._knee`) as
+    statements: per leg the contact point's height above the ground [mm]
+    (:data:`LATCH_VARIABLES`: the foot sphere's centre above the slope line less
+    :func:`walkerlab.export.opensim_xml.latch_foot_offset`; the lower of a foot's spheres),
+    the engagement ``w = STEP(h, 0, 1, h_release, 0) STEP(ext, -capture, 0, -capture/2, 1)``
+    (the contact model's ``STEP(delta, -h_release, 0, 0, 1)`` in the height ``h = -delta``)
+    and an SFORCE (:data:`LATCH_SFORCE`) ``w IMPACT(ext, d ext/dt, 0, k, e, cmax, dmax)`` on
+    the knee's flexion: the stop's law mirrored, pushing the shank straight (Adams Solver
+    function reference: STEP, IMPACT = max(0, k (x1 - x)^e - STEP(x, x1 - d, cmax, x1, 0)
+    x') for x < x1, else 0; SFORCE/ROTATION: the torque on I about J's z)."""
+    V = LATCH_VARIABLES
+    arc = mb.foot == "arc" and mb.foot_radius_m > 0
+    lift = latch_foot_offset(_foot_sphere_m(mb), 0.0 if arc else point_foot_radius(mb)) * MM
+    h_rel, cap = ks.latch_height * MM, ks.latch_capture
+    out = ["! knee latch (contact.knee_stop.latch): the stop's IMPACT law on the flexion,",
+           f"! weighted by STEP(h, 0, 1, {_f(h_rel)}, 0) of the foot's contact height h [mm]",
+           f"! and STEP(knee, {_f(-cap)}, 0, {_f(-cap / 2)}, 1) of the knee angle [rad]: the "
+           "contact", "! model's latch (a smooth weight of the present state, no event)",
+           _var(V["sin"], _f(math.sin(mb.slope_rad))), _var(V["cos"], _f(math.cos(mb.slope_rad)))]
+    spheres: dict[str, list[int]] = {}
+    for leg, _role, marker in adams_feet(mb).geoms(mb, ids):
+        spheres.setdefault(leg, []).append(marker)
+    for leg in ("leg1", "leg2"):
+        heights = [f"VARVAL({V['sin']})*DX({m},101)+VARVAL({V['cos']})*DY({m},101)"
+                   + (f"-{_f(lift)}" if lift else "") for m in spheres[leg]]
+        h = heights[0] if len(heights) == 1 else f"MIN({heights[0]},{heights[1]})"
+        sh, th = ids[f"{leg}_shank"], ids[f"{leg}_thigh"]
+        i_m, j_m = marker_id(sh, "joint"), marker_id(th, "knee")
+        out += [_var(V[f"height_{leg}"], h),
+                _var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
+                     f"{_f(h_rel)},0.0)"),
+                _var(V[f"knee_{leg}"], f"STEP(AZ({i_m},{j_m}),{_f(-cap)},0.0,{_f(-cap / 2)},"
+                     "1.0)"),
+                _var(V[f"weight_{leg}"], f"VARVAL({V[f'foot_{leg}']})*"
+                     f"VARVAL({V[f'knee_{leg}']})"),
+                *_stmt(f"SFORCE/{LATCH_SFORCE[leg]}, ROTATION, I={i_m}, J={j_m}",
+                       f"FUNCTION=VARVAL({V[f'weight_{leg}']})*IMPACT(AZ({i_m},{j_m}),"
+                       f"WZ({i_m},{j_m},{j_m}),0.0,{_f(ks.k * MM)},{_f(ks.e)},"
+                       f"{_f(ks.cmax * MM)},{_f(ks.dmax)})")]
     return out
 
 
