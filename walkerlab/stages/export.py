@@ -7,11 +7,16 @@ MuJoCo reads MJCF), written from the scene's ``walker`` and ``slope`` sections o
 upstream artifact), atomically (temporary name, then rename).  Formats and conventions:
 :mod:`walkerlab.export.multibody`.  A spoked wheel (one rigid body on its spokes, no tree of
 leg links) is written by that module's wheel writers, as URDF or MJCF only.
+
+:func:`write` returns the file with what it leaves out (one line per item,
+:mod:`walkerlab.export.omitted`) and, asked (``walk=True``, ``walkerlab export --walk``), the
+file walked in its engine (:mod:`walkerlab.export.engine_walk`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import walkerlab
@@ -24,6 +29,13 @@ from walkerlab.export.adams import (
     adm_text,
     check_adams_actuation,
     check_adams_exportable,
+)
+from walkerlab.export.engine_walk import (
+    DEFAULT_STEPS,
+    ENGINES,
+    EngineWalk,
+    not_walked,
+    walk_export,
 )
 from walkerlab.export.multibody import (
     FORMATS,
@@ -117,11 +129,29 @@ def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -
                          "contact (its default state is the rigid gait); drop --walker-only")
     check_osim_exportable(scene, mb)  # before the gait search
     check_exportable(scene, data.structure.kind, "osim")
-    gait = _gait(scene, runs_root, lambda ideal: osim_gait(scene, mb, data, ideal))
+    ideal, gait = _gait(scene, runs_root, _with_ideal(
+        scene, lambda ideal: osim_gait(scene, mb, data, ideal)))
     text = osim_text(mb, gait, name, walkerlab.__version__)
     path = export_path(scene, runs_root, "osim", claim=True)
     runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
-    return Exported(path, _xml_lines(osim_omissions(mb, gait), scene))
+    return Exported(path, _xml_lines(osim_omissions(mb, gait), scene), _step_period(ideal))
+
+
+def _with_ideal(scene: Scene, build):
+    """``build`` that also returns the rigid gait it was given (searched when None, as the
+    writers search it)."""
+    def both(ideal):
+        from walkerlab.analysis.contact.periodic import ideal_gait
+
+        ideal = ideal_gait(scene) if ideal is None else ideal
+        return ideal, build(ideal)
+    return both
+
+
+def _step_period(ideal) -> float:
+    """The rigid gait's step period [s]: its period over its steps (legs that differ: a
+    stride of two)."""
+    return float(ideal.period_s) / max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
 
 
 def _gait(scene: Scene, runs_root, build):
@@ -166,13 +196,15 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
         files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                       wheel_keyframe_json(key)))
     runpaths.atomic_texts(files)  # the wheel and its keyframe: both or neither
-    return Exported(path, _xml_lines(WHEEL_URDF_OMISSIONS if fmt == "urdf" else (), scene))
+    return Exported(path, _xml_lines(WHEEL_URDF_OMISSIONS if fmt == "urdf" else (), scene),
+                    None if key is None else key.period_s)
 
 
 def _gait_scene(scene: Scene, mb, data, runs_root):
-    """The MJCF's gait keyframe, terrain and contact (the gait of an up-to-date
-    ``fixedpoint.h5``, else searched); no rigid gait: one line."""
-    return _gait(scene, runs_root, lambda ideal: mjcf_scene(scene, mb, data, ideal))
+    """The rigid gait and the MJCF's gait keyframe, terrain and contact (the gait of an
+    up-to-date ``fixedpoint.h5``, else searched); no rigid gait: one line."""
+    return _gait(scene, runs_root, _with_ideal(
+        scene, lambda ideal: mjcf_scene(scene, mb, data, ideal)))
 
 
 @dataclass(frozen=True)
@@ -188,10 +220,19 @@ class Exported:
         why``, each the text of the file's comment after ``Left out:`` (an Adams comment's
         lines joined), in the scene's units as the file has it; empty when the file carries
         the whole scene.
+    step_period_s : float or None
+        The rigid gait's step period the file starts from [s] (a stride's two steps: their
+        mean); None without a gait (``--walker-only``, an Adams dataset's start is not
+        checked here).
+    walk : EngineWalk or None
+        The file walked in its engine (``walk=True``,
+        :func:`walkerlab.export.engine_walk.walk_export`); None when not asked.
     """
 
     path: Path
     left_out: tuple[str, ...] = ()
+    step_period_s: float | None = None
+    walk: EngineWalk | None = None
 
 
 def _xml_lines(items, scene: Scene) -> tuple[str, ...]:
@@ -214,7 +255,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
 
 
 def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
-          walker_only: bool = False) -> Exported:
+          walker_only: bool = False, walk: bool = False,
+          walk_steps: int = DEFAULT_STEPS) -> Exported:
     """Write the scene's walker as ``fmt`` ("urdf", "mjcf", "adm": ``walker.adm`` and
     ``walker.acf``, returning the .adm's path, or "osim": ``walker.osim``,
     :mod:`walkerlab.export.opensim`) into
@@ -252,9 +294,31 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         from walkerlab.models.contact.terrain import check_ground
 
         check_ground(scene.terrain)  # a profile: one line
+    if walk and walker_only:
+        raise ValueError("--walk: the walker alone (--walker-only) has no gait to walk from; "
+                         "drop one of them")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     name = scene.name or "walker"
-    return _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+    out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+    if not walk:
+        return out
+    return replace(out, walk=_walk(out, fmt, data, walk_steps))
+
+
+def _walk(out: Exported, fmt: str, data, steps: int) -> EngineWalk:
+    """The written file walked in its engine (:func:`walkerlab.export.engine_walk.
+    walk_export`), or why not: the kind's own reason (a rimless wheel), no gait."""
+    reason = _NOT_WALKED.get(data.structure.kind.name)
+    if reason and fmt in ENGINES:
+        return not_walked(reason)
+    if out.step_period_s is None and fmt in ENGINES:
+        return not_walked("the file has no gait to start from")
+    return walk_export(out.path, fmt, out.step_period_s or math.nan, steps)
+
+
+#: kind name -> why its exports are not walked by the engines' stepping loops
+_NOT_WALKED = {"rolling_polygon": "the stepping loops count two legs' heel strikes; a rimless "
+               "wheel rolls on its spokes"}
 
 
 def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
@@ -268,7 +332,7 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     if fmt == "osim":
         return _run_osim(scene, runs_root, mb, data, name, walker_only)
     check_exportable(scene, data.structure.kind, fmt, walker_only)
-    extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
+    ideal, extra = (None, None) if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)
@@ -281,7 +345,8 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
         files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                       keyframe_json(mb, extra)))
     runpaths.atomic_texts(files)  # the walker and its keyframe: both or neither
-    return Exported(path, _xml_lines(left_out, scene))
+    return Exported(path, _xml_lines(left_out, scene),
+                    None if ideal is None else _step_period(ideal))
 
 
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> the export's writer of that kind
