@@ -19,7 +19,8 @@ from pathlib import Path
 
 __all__ = ["DEFAULT_STEPS", "DEFAULT_TOLERANCE", "EngineWalk", "not_walked", "walk_export"]
 
-#: Heel strikes a walk must reach (issue 25's MuJoCo check: >= 10 alternating strikes).
+#: Heel strikes a walk must reach (the MuJoCo check of every shipped scene: >= 10 alternating
+#: strikes).
 DEFAULT_STEPS = 10
 #: Relative step-period tolerance against the rigid gait (MuJoCo's contact is soft and
 #: linear: walkerlab's own contact model differs from the rigid one by 0.1-1 %).
