@@ -5,9 +5,9 @@ file's own start (the MJCF's ``gait`` keyframe, the OpenSim model's default stat
 gait just after heel strike) for ``steps`` rigid step periods and a third, its heel strikes'
 mean step period set against the rigid gait's.
 
-A format no engine here walks (a URDF has no ground, an Adams dataset needs Adams Solver), an
-engine that is not installed, and a walker the stepping loops do not drive (a rimless wheel's
-spokes are not legs whose heel strikes they count) give one line saying why, and no walk.
+A spoked wheel's MJCF rolls (:func:`walkerlab.export.mujoco_walk.roll`: its spoke strikes
+are its steps).  A format no engine here walks (a URDF has no ground, an Adams dataset needs
+Adams Solver) and an engine that is not installed give one line saying why, and no walk.
 """
 
 from __future__ import annotations
@@ -45,9 +45,10 @@ class EngineWalk:
     strikes : int
         Heel strikes seen.
     alternating : bool
-        Every strike by the other leg than the one before.
+        Every strike by the other leg than the one before (a wheel: by the next spoke).
     first_leg : str
-        The leg of the first strike (leg2 stands at the start: "leg1"; "" without strikes).
+        The leg of the first strike (leg2 stands at the start: "leg1"; a spoked wheel's
+        spoke 0 stands: "spoke1"; "" without strikes).
     fell : bool
         The hip fell below half its height (the loops' fall test).
     t_end_s : float
@@ -115,8 +116,8 @@ def not_walked(reason: str) -> EngineWalk:
 
 
 def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
-                steps: int = DEFAULT_STEPS, tolerance: float = DEFAULT_TOLERANCE
-                ) -> EngineWalk:
+                steps: int = DEFAULT_STEPS, tolerance: float = DEFAULT_TOLERANCE,
+                spokes: bool = False) -> EngineWalk:
     """Walk the exported file ``path`` (format ``fmt``) in its engine for ``steps + 1.3``
     rigid step periods (module docstring).
 
@@ -132,6 +133,9 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
         Heel strikes asked for.
     tolerance : float
         Relative step-period tolerance.
+    spokes : bool
+        A spoked wheel's MJCF: its spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`)
+        instead of two legs' heel strikes.
 
     Returns
     -------
@@ -145,7 +149,9 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
     if importlib.util.find_spec(module) is None:
         return not_walked(f"{engine} is not importable here (pip install -e '.[{extra}]')")
     duration = (steps + 1.3) * rigid_period_s
-    if fmt == "mjcf":
+    if fmt == "mjcf" and spokes:
+        from walkerlab.export.mujoco_walk import roll as walk
+    elif fmt == "mjcf":
         from walkerlab.export.mujoco_walk import walk
     else:
         from walkerlab.export.opensim_walk import walk

@@ -307,18 +307,15 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
 
 def _walk(out: Exported, fmt: str, data, steps: int) -> EngineWalk:
     """The written file walked in its engine (:func:`walkerlab.export.engine_walk.
-    walk_export`), or why not: the kind's own reason (a rimless wheel), no gait."""
-    reason = _NOT_WALKED.get(data.structure.kind.name)
-    if reason and fmt in ENGINES:
-        return not_walked(reason)
+    walk_export`; a spoked wheel rolls on its spokes), or why not."""
     if out.step_period_s is None and fmt in ENGINES:
         return not_walked("the file has no gait to start from")
-    return walk_export(out.path, fmt, out.step_period_s or math.nan, steps)
+    return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,
+                       spokes=data.structure.kind.name in _SPOKED)
 
 
-#: kind name -> why its exports are not walked by the engines' stepping loops
-_NOT_WALKED = {"rolling_polygon": "the stepping loops count two legs' heel strikes; a rimless "
-               "wheel rolls on its spokes"}
+#: kinds whose steps are spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`)
+_SPOKED = ("rolling_polygon",)
 
 
 def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
