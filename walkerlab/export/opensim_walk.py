@@ -91,14 +91,15 @@ def _header(text: str) -> dict:
     out: dict = {}
     if m := re.search(r"Ground: slope (\S+) rad", text):
         out["slope"] = float(m.group(1))
-    if m := re.search(r"less than (\S+) m above the ground and its knee within (\S+) rad",
+    # a unit after a number is the scene's (a nondimensional scene's "l", not "m")
+    if m := re.search(r"less than (\S+) \S+ above the ground and its knee within (\S+) rad",
                       text):
         out["latch"] = (float(m.group(1)), float(m.group(2)))
     if m := re.search(r"slope line less (\S+) \S+ \(the sphere's radius", text):
         out["latch_offset"] = float(m.group(1))
     if m := re.search(r"a patch of width (\S+) \S+ is a sphere", text):
         out["patch_width"] = float(m.group(1))
-    if m := re.search(r"on for T = (\S+) s", text):
+    if m := re.search(r"on for T = (\S+) \S+ from each", text):
         out["pulse"] = float(m.group(1))
     if m := re.search(r"walkerlab_actuation: (\{.*\}) -->", text):
         out["actuation"] = json.loads(m.group(1))
