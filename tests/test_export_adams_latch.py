@@ -122,14 +122,65 @@ def test_adams_knee_latch_equals_the_contact_models(foot):
     assert held and free
 
 
-def test_adams_knee_latch_left_out_on_footholds_in_one_line(tmp_path):
-    """On footholds (patches at tread heights) the latch is not written (its foot height
-    would be the slope line's, not the patch's under the foot): the file has no latch SFORCE
-    and one ``Left out:`` item naming terrain.kind; on the slope (kneed.yaml) no item."""
-    from walkerlab.export.adams import adams_omissions
+@pytest.mark.parametrize("foot", [{"kind": "point"}, {"kind": "arc", "radius_m": 0.05}])
+def test_adams_knee_latch_on_footholds_reads_the_tread_under_the_foot(foot):
+    """Footholds 5 mm below each other (the dataset's patches at tread heights): each knee's
+    stop + latch torque from the dataset equals the contact model's with the same patches
+    (the dataset's start: centres and tread heights) to 1e-9 relative, 1e-6 N mm, at the
+    start's state with the swing leg lifted and knees flexed, and with the walker moved k =
+    1, 2 steps down the footholds, its stance foot about 0.5 mm above leg2's k-th tread (10,
+    20 mm below the slope line: read against the slope line, the latch would take a foot
+    that is up as 9-19 mm in the ground); nothing left out."""
+    from walkerlab.export.adams import adams_omissions, adams_start
 
-    scene = _kneed({"kind": "point"}, kind="footholds", foothold_heights_m=[-0.005])
-    mb = multibody(walker_data(scene.walker, scene.slope.phi_rad))
-    (item,) = adams_omissions(scene, mb)
-    assert item.what.startswith("the knee latch") and "terrain.kind: footholds" in item.why
-    assert adams_omissions(_kneed({"kind": "point"}), mb) == ()
+    scene = _kneed(foot, kind="footholds", foothold_heights_m=[-0.005])
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    mb = multibody(data)
+    start = adams_start(scene, mb, data)
+    assert start.lane_heights is not None and adams_omissions(scene, mb) == ()
+    model = read_adm(adm_text(scene, mb, data, "k", "test", start))
+    sforces, variables = model.functions("SFORCE"), model.functions()
+    from walkerlab.config.contact import ContactSettings
+    from walkerlab.models.contact.model import ContactWalker
+    from walkerlab.models.contact.rigid_limit import contact_si
+
+    c, knee = contact_si(scene.contact or ContactSettings())
+    w = ContactWalker(contact=c, data=data, knee_stop=knee, lane1=np.array(start.lanes[0]),
+                      lane2=np.array(start.lanes[1]), heights1=np.array(start.lane_heights[0]),
+                      heights2=np.array(start.lane_heights[1]),
+                      patch_half_width=start.patch_width_m / 2, continuous=False)
+    phi = scene.slope.phi_rad
+    t_hat = np.array([math.cos(phi), -math.sin(phi)])
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    held = 0
+    for lift, flex, k in ((0.0, -0.004, 0), (0.3, -0.3, 0), (0.0, -0.004, 1),
+                          (0.1, -0.2, 2), (0.45, -0.003, 1)):
+        psi = dict(start.angles)
+        psi["leg1_thigh"] += lift
+        psi["leg1_shank"] += lift + flex
+        psi["leg2_shank"] += -0.004  # the stance knee flexed within the capture
+        hip = np.array(start.hip, float)
+        if k:
+            lane, hs = start.lanes[1], start.lane_heights[1]
+            hip = hip + (lane[k] - lane[0]) * t_hat + (hs[k] - hs[0] + 0.001) * n_hat
+        om = dict(start.rates)
+        st = AdamsState(mb, hip * MM, np.array(start.hip_velocity) * MM, psi, om, {})
+        ns = st.namespace(variables)
+        ns.update(STEP=_step, IMPACT=_impact, ABS=abs)
+        x = np.zeros(len(w.state_names()))
+        x[:6] = (*hip, psi["leg1_thigh"], psi["leg1_shank"], psi["leg2_thigh"],
+                 psi["leg2_shank"])
+        x[6:] = (*start.hip_velocity, om["leg1_thigh"], om["leg1_shank"], om["leg2_thigh"],
+                 om["leg2_shank"])
+        pen = w.foot_quantities(x[None])
+        for i, g in enumerate(("leg1", "leg2")):
+            ext = psi[f"{g}_shank"] - psi[f"{g}_thigh"]
+            rate = om[f"{g}_shank"] - om[f"{g}_thigh"]
+            delta = float(pen[g]["penetration"][0])
+            ref = -w.kernels._knee_torque(ext, rate, w.contact_params, delta) * MM
+            got = evaluate(sforces[i + 1], ns) + evaluate(sforces[LATCH_SFORCE[g]], ns)
+            assert got == pytest.approx(ref, rel=1e-9, abs=1e-6), (lift, k, g, delta)
+            if g == "leg2" and k:
+                assert -0.002 < delta < 0.0  # just above its tread (the knee flexed 4 mrad)
+                held += ref > 1e3
+    assert held

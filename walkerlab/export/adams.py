@@ -139,13 +139,13 @@ is a smooth weight of the present state, ``w = STEP(delta, -h, 0, 0, 1) STEP(ext
 the capture flexion) times the stop's IMPACT law on the flexion, so it is written as that
 expression: an ``SFORCE`` per knee whose ``FUNCTION`` is the product of two ``STEP``s and
 ``IMPACT`` (Adams Solver function reference: STEP, IMPACT), the contact height the foot
-sphere's centre along the slope normal (``DX``, ``DY``) less the arc's radius.  A ``SENSOR``
+sphere's centre along the slope normal (``DX``, ``DY``) less the arc's radius, on stairs and
+footholds less the tread of the patch under the foot (``IF`` of its distance along the slope
+from each patch's centre).  A ``SENSOR``
 (Adams Solver statement reference, adams_solver/state_sensor.html: an event when an
 expression reaches a value, whose actions change the output step or the integration step,
 halt, restart, return to the commands or store a value for ``SENVAL``) would make it a
-switched law with a memory, which the contact model's latch is not.  On stairs and
-footholds the latch is left out (the height of the patch under the foot is looked up by no
-statement): the file says so and ``walkerlab export`` prints it (:func:`adams_omissions`).
+switched law with a memory, which the contact model's latch is not.
 """
 
 from __future__ import annotations
@@ -190,6 +190,7 @@ from walkerlab.export.adams_statements import (
     LINE_WIDTH,
     MM,
     AdamsStart,
+    _chain_sum,
     _deg,
     _f,
     _fs,
@@ -208,8 +209,8 @@ from walkerlab.units import for_scene
 # the dataset's parts, contact and actuation live in sibling modules (statements, feet per
 # walker kind, actuation); their public names are this module's too
 __all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ADAMS_FILES", "ANKLE_JOINT", "ANKLE_SFORCE",
-           "ANKLE_SPRING", "ANKLE_TORQUE_SFORCE", "ANKLE_VARIABLES", "COUPLER_ID", "KNEE_LATCH",
-           "LATCH_SFORCE", "LATCH_VARIABLES",
+           "ANKLE_SPRING", "ANKLE_TORQUE_SFORCE", "ANKLE_VARIABLES", "COUPLER_ID",
+           "LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK",
            "FOOT_FORCES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE", "LINE_WIDTH",
            "PIN_JOINT", "PUSH_FLOAT_MARKER", "PUSH_GFORCE", "PUSH_MIN_STEP_M", "AdamsStart",
            "acf_text", "actuation_warning", "adams_omissions", "adams_start", "adm_text",
@@ -239,33 +240,29 @@ def actuation_warning(scene: Scene) -> str:
 
 
 #: VARIABLE ids of the knee latch (:func:`_knee_latches`): the slope's sine and cosine, each
-#: leg's contact height [mm], the latch's engagement and its two factors (foot, knee).
+#: leg's contact height [mm], the latch's engagement and its two factors (foot, knee); on
+#: stairs and footholds the height above the slope line, the position along it and the
+#: tread under the foot.
 LATCH_VARIABLES = {"sin": 370, "cos": 375, "height_leg1": 371, "height_leg2": 372,
                    "weight_leg1": 373, "weight_leg2": 374, "foot_leg1": 376,
-                   "foot_leg2": 377, "knee_leg1": 378, "knee_leg2": 379}
+                   "foot_leg2": 377, "knee_leg1": 378, "knee_leg2": 379, "line_leg1": 380,
+                   "line_leg2": 381, "along_leg1": 382, "along_leg2": 383,
+                   "tread_leg1": 384, "tread_leg2": 385, "above_leg1": 386,
+                   "above_leg2": 387, "below_top_leg1": 388, "below_top_leg2": 389}
+#: First VARIABLE id of each leg's patch terms (stairs, footholds: :func:`_tread_under`; two
+#: a patch, the partial sums from ``+ 1000``).
+TREAD_BLOCK = {"leg1": 20000, "leg2": 30000}
 #: SFORCE ids of the knee latches (the stops are SFORCE/1, 2).
 LATCH_SFORCE = {"leg1": 3, "leg2": 4}
-#: The knee latch's item of :func:`adams_omissions` (its comment stands by the knee stops).
-KNEE_LATCH = "the knee latch (contact.knee_stop.latch)"
-
-
 def adams_omissions(scene: Scene, mb) -> tuple[Omission, ...]:
-    """What :func:`adm_text` leaves out (:mod:`walkerlab.export.omitted`): the knee latch of
-    a kneed walker, and a contact start other than the rigid gait's
-    (``contact_sim.start``: the file starts from the rigid gait x ``initial_rate_scale``)."""
+    """What :func:`adm_text` leaves out (:mod:`walkerlab.export.omitted`): a contact start
+    other than the rigid gait's (``contact_sim.start``: the file starts from the rigid gait x
+    ``initial_rate_scale``)."""
     out = []
     if scene.contact_sim is not None and scene.contact_sim.start != "ideal":
         out.append(Omission(f"contact_sim.start = {scene.contact_sim.start}", "this file "
                             "starts from the rigid gait x initial_rate_scale (the adjusted or "
                             "periodic start is not written)"))
-    if export_part(mb).knee_stops:
-        from walkerlab.models.contact.rigid_limit import contact_si
-
-        _, ks = contact_si(scene.contact or ContactSettings())
-        if ks.latch and not _latch_written(scene, ks):
-            out.append(Omission(KNEE_LATCH, f"terrain.kind: {scene.terrain.kind}: the latch "
-                                "reads the foot's contact height, and the height of the patch "
-                                "under the foot (each tread's) is looked up by no statement"))
     return tuple(out)
 
 
@@ -461,7 +458,8 @@ def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
     return out
 
 
-def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None) -> list[str]:
+def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None,
+            start: AdamsStart | None = None) -> list[str]:
     """Hip springs (SPRINGDAMPER), knee stops (SFORCE with IMPACT) and flat feet's ankle
     springs (SPRINGDAMPER between the foot and its leg: ``feet`` of
     :func:`walkerlab.export.scene.flat_feet`)."""
@@ -495,27 +493,18 @@ def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None) -> list[str]
 
         _, ks = contact_si(scene.contact or ContactSettings())
         out += ["! knee stops: IMPACT on the hyperextension shank - thigh (> 0 past straight)"]
-        out += adams_comments(o for o in adams_omissions(scene, mb) if o.what == KNEE_LATCH)
         for leg in ("leg1", "leg2"):
             sh, th = ids[f"{leg}_shank"], ids[f"{leg}_thigh"]
             i_m, j_m = marker_id(sh, "joint"), marker_id(th, "knee")
             out += _stmt(f"SFORCE/{1 if leg == 'leg1' else 2}, ROTATION, I={i_m}, J={j_m}",
                          f"FUNCTION=-IMPACT(-AZ({i_m},{j_m}),-WZ({i_m},{j_m},{j_m}),0.0,"
                          f"{_f(ks.k * MM)},{_f(ks.e)},{_f(ks.cmax * MM)},{_f(ks.dmax)})")
-        if _latch_written(scene, ks):
-            out += _knee_latches(mb, ids, ks)
+        if ks.latch:
+            out += _knee_latches(mb, ids, ks, start)
     return out
 
 
-def _latch_written(scene: Scene, ks) -> bool:
-    """The knee latch (``ks.latch``) is written: on the slope's ground (its foot height is
-    the contact point's above the slope line; on stairs and footholds the patch under the
-    foot has a height of its own, which no statement looks up)."""
-    terrain = scene.terrain or TerrainSettings()
-    return bool(ks.latch) and terrain.is_slope
-
-
-def _knee_latches(mb, ids: dict, ks) -> list[str]:
+def _knee_latches(mb, ids: dict, ks, start: AdamsStart | None = None) -> list[str]:
     """The contact model's knee latch (:func:`walkerlab.models.contact.generated._knee`) as
     statements: per leg the contact point's height above the ground [mm]
     (:data:`LATCH_VARIABLES`: the foot sphere's centre above the slope line less
@@ -525,7 +514,9 @@ def _knee_latches(mb, ids: dict, ks) -> list[str]:
     and an SFORCE (:data:`LATCH_SFORCE`) ``w IMPACT(ext, d ext/dt, 0, k, e, cmax, dmax)`` on
     the knee's flexion: the stop's law mirrored, pushing the shank straight (Adams Solver
     function reference: STEP, IMPACT = max(0, k (x1 - x)^e - STEP(x, x1 - d, cmax, x1, 0)
-    x') for x < x1, else 0; SFORCE/ROTATION: the torque on I about J's z)."""
+    x') for x < x1, else 0; SFORCE/ROTATION: the torque on I about J's z).  On stairs and
+    footholds (``start.lane_heights``) the height is above the tread of the lane's patch
+    under the foot (:func:`_tread_under`), as the contact model reads it."""
     V = LATCH_VARIABLES
     arc = mb.foot == "arc" and mb.foot_radius_m > 0
     lift = latch_foot_offset(_foot_sphere_m(mb), 0.0 if arc else point_foot_radius(mb)) * MM
@@ -544,8 +535,12 @@ def _knee_latches(mb, ids: dict, ks) -> list[str]:
         h = heights[0] if len(heights) == 1 else f"MIN({heights[0]},{heights[1]})"
         sh, th = ids[f"{leg}_shank"], ids[f"{leg}_thigh"]
         i_m, j_m = marker_id(sh, "joint"), marker_id(th, "knee")
-        out += [_var(V[f"height_{leg}"], h),
-                _var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
+        treads = _tread_under(leg, spheres[leg][0], start, V[f"height_{leg}"])
+        if treads:  # the height above the slope line first, then above the tread
+            out += [_var(V[f"line_{leg}"], h), *treads]
+        else:
+            out.append(_var(V[f"height_{leg}"], h))
+        out += [_var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
                      f"{_f(h_rel)},0.0)"),
                 _var(V[f"knee_{leg}"], f"STEP(AZ({i_m},{j_m}),{_f(-cap)},0.0,{_f(-cap / 2)},"
                      "1.0)"),
@@ -555,6 +550,43 @@ def _knee_latches(mb, ids: dict, ks) -> list[str]:
                        f"FUNCTION=VARVAL({V[f'weight_{leg}']})*IMPACT(AZ({i_m},{j_m}),"
                        f"WZ({i_m},{j_m},{j_m}),0.0,{_f(ks.k * MM)},{_f(ks.e)},"
                        f"{_f(ks.cmax * MM)},{_f(ks.dmax)})")]
+    return out
+
+
+def _tread_under(leg: str, marker: int, start: AdamsStart | None, out_id: int) -> list[str]:
+    """VARIABLE ``out_id``: ``leg``'s contact height [mm] above the tread of its lane's patch
+    under ``marker`` (the foot sphere's centre: its position along the slope is the contact
+    point's) on stairs and footholds, from its height above the slope line (VARIABLE
+    ``LATCH_VARIABLES["line_<leg>"]``); the contact model's rule
+    (:func:`walkerlab.models.contact.generated._point`): a patch is under the point when its
+    centre lies within half the patch width along the slope, and a point above the lane's
+    highest tread reads its height above the slope line.  None ([]) without tread heights
+    (the slope's patches lie on its line)."""
+    if start is None or start.lane_heights is None or start.lanes is None:
+        return []
+    i = 0 if leg == "leg1" else 1
+    centres, heights = start.lanes[i], start.lane_heights[i]
+    V = LATCH_VARIABLES
+    line, along = V[f"line_{leg}"], V[f"along_{leg}"]
+    base, half = TREAD_BLOCK[leg], start.patch_width_m / 2 * MM
+    out = [_var(along, f"VARVAL({V['cos']})*DX({marker},101)-VARVAL({V['sin']})*"
+                       f"DY({marker},101)")]
+    terms = []
+    for j, (c, h) in enumerate(zip(centres, heights)):
+        if h == 0.0:
+            continue  # a tread on the slope line
+        d, t = base + 2 * j, base + 2 * j + 1
+        off = f"-{_f(c * MM)}" if c >= 0 else f"+{_f(-c * MM)}"
+        out += [_var(d, f"ABS(VARVAL({along}){off})"),
+                _var(t, f"{_f(h * MM)}*IF(VARVAL({d})-{_f(half)}:1,1,0)")]
+        terms.append(f"VARVAL({t})")
+    top = max([0.0, *heights]) * MM
+    tread = V[f"tread_{leg}"]
+    out += _chain_sum(base + 1000, tread, terms)
+    above, below = V[f"above_{leg}"], V[f"below_top_{leg}"]
+    out += [_var(above, f"VARVAL({line})-VARVAL({tread})"),
+            _var(below, f"VARVAL({line})-{_f(top)}"),
+            _var(out_id, f"IF(VARVAL({below}):VARVAL({above}),VARVAL({line}),VARVAL({line}))")]
     return out
 
 
@@ -633,14 +665,14 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     if for_scene(scene).nondimensional:
         out += ["! nondimensional scene (g = 1): its numbers are written as if in SI "
                 "(l = 1 m,", "! M = 1 kg, g = 1 m/s^2), then in mm-kg-s"]
-    out += adams_comments(o for o in adams_omissions(scene, mb) if o.what != KNEE_LATCH)
+    out += adams_comments(adams_omissions(scene, mb))
     if scene.walker.actuation is not None:
         out += ["! walker.actuation: its joint torques (SFORCE) and push-off (GFORCE",
                 "! pulses) are written below, after the contacts"]
     out += _ground(mb, start, lanes)
     out += _parts(mb, start, ids, lanes, feet)
     out += _joints(mb, start, ids)
-    out += _forces(mb, scene, ids, feet)
+    out += _forces(mb, scene, ids, feet, start if lanes else None)
     n = tuple(len(lane) for lane in start.lanes) if lanes else (1,)
     out += contact_statements(mb, ids, lanes, n, law)
     out += actuation_statements(mb, scene, ids, n, lanes)
