@@ -311,11 +311,13 @@ def _walk(out: Exported, fmt: str, data, steps: int) -> EngineWalk:
     if out.step_period_s is None and fmt in ENGINES:
         return not_walked("the file has no gait to start from")
     return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,
-                       spokes=data.structure.kind.name in _SPOKED)
+                       spokes=_ROLLS[data.structure.kind.name])
 
 
-#: kinds whose steps are spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`)
-_SPOKED = ("rolling_polygon",)
+#: kind name -> its steps are spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`), not
+#: two legs' heel strikes
+_ROLLS = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
+          "free_joints": False, "rolling_polygon": True}
 
 
 def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
