@@ -180,7 +180,7 @@ def test_motors_on_the_actuated_joints(exported):
         assert f'<motor name="{leg}_knee_motor" joint="{leg}_knee" gear="1" {lim}/>' in text
     assert " range=" not in text and "<equality>" not in text
     assert 'name="hip_actuation"' not in text
-    assert "Motor leg1_hip_motor" in Path(urdf).read_text()
+    assert "Left out: motor leg1_hip_motor: URDF has no actuator" in Path(urdf).read_text()
     assert 'type="revolute"' not in Path(urdf).read_text()  # free knees: continuous
     f, model = _mujoco(mjcf)
     data = mujoco.MjData(model)

@@ -38,17 +38,15 @@ def _scene(name):
 
 #: Shipped scenes the MJCF export refuses, and the field its one line names: massless legs
 #: have no multibody form (flat feet and their ankle push-off are exported:
-#: tests/test_export_flat_feet.py).  configs/rabbit.yaml (free knees, knee torques) is
-#: checked elsewhere.
+#: tests/test_export_flat_feet.py).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
            "simplest": "walker.leg.bodies"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
-#: tests/test_optimize_five_link.py); its walker is rabbit's (tests/test_export_five_link.py)
-#: kneed_optimal: kneed's walker (its MuJoCo walk needs kneed's knee latch: configs/kneed.yaml)
-#: rimless_wheel: no legs to alternate; its MJCF rolls from its keyframe in
-#: tests/test_rimless_wheel.py (test_rimless_wheel_export_stage_mjcf_rolls_in_mujoco)
-SHIPPED = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml")
-                 if p.stem not in ("rabbit", "rabbit_optimal", "kneed_optimal", "rimless_wheel"))
+#: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
+#: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.
+NO_GAIT = {"rabbit_optimal": "no rigid gait"}
+FIRST = {"rimless_wheel": "spoke1"}
+SHIPPED = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml"))
 #: Step-period tolerance against the rigid gait: 1 % (MuJoCo's contact is soft and linear,
 #: walkerlab's own contact model differs from the rigid one by 0.1-1 % on these walkers).
 #: powered_compass too: the export applies the push-off over one MuJoCo timestep (the rigid
@@ -66,34 +64,79 @@ PERIOD_RTOL: dict[str, float] = {"flat_feet": 0.025, "flat_feet_optimal": 0.025,
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
-    """Every shipped scene's MJCF walks >= 10 alternating heel strikes from its ``gait``
-    keyframe with plain stepping (the latch rule for the kneed walker, PoweredLoop for the
-    powered one), its mean step period within 1 % of the rigid gait's; or the export refuses
-    in one line naming the field, writing nothing.  Measured (11.3 rigid steps each; step
-    period against the rigid one): asymmetric_legs -0.05 %, compass_optimal +0.55 %,
-    goswami1996 +0.85 %, hip_spring -0.07 %, kneed -0.50 %, paper -0.05 %, paper_rods -0.04 %,
-    powered_compass +0.012 % (its push-off over one timestep: see
+    """Every shipped scene's MJCF, walked by the export's own check (``walkerlab export
+    --walk``: :func:`walkerlab.export.engine_walk.walk_export`, the latch rule for the kneed
+    walkers, PoweredLoop for the powered ones), makes >= 10 alternating heel strikes from
+    its ``gait`` keyframe, its mean step period within 1 % of the rigid gait's; or the
+    export refuses in one line naming the field (massless legs, no rigid gait), writing
+    nothing.  The rimless wheel rolls: 11 spoke strikes, -0.49 %.
+    Measured (11.3 rigid steps each; step period against the rigid one): asymmetric_legs
+    -0.05 %, compass_optimal +0.55 %, goswami1996 +0.85 %, hip_spring -0.07 %, kneed and
+    kneed_optimal -0.50 %, paper -0.05 %, paper_rods -0.04 %, powered_compass +0.012 % (its
+    push-off over one timestep: see
     test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens), round_feet +0.01 % (a
     cylinder foot: 7 strikes, legs out of turn after 4, steps 11 % short), torso_bhm -0.04 %,
-    stairs +0.04 % (patches at the footholds, each a riser lower), footholds +0.20 %.
-    About 5-12 s each under load."""
-    from walkerlab.analysis.contact.periodic import ideal_gait
-    from walkerlab.export.mujoco_walk import walk
-
+    stairs +0.04 % (patches at the footholds, each a riser lower), footholds +0.20 %, rabbit
+    (its gait searched by the export) within 1 %.  About 5-12 s each under load (rabbit
+    about a minute)."""
     scene = _scene(name)
-    if name in REFUSED:
+    if name in REFUSED or name in NO_GAIT:
         with pytest.raises(ValueError) as err:
-            export_stage.run(scene, tmp_path, "mjcf")
-        assert REFUSED[name] in str(err.value) and "\n" not in str(err.value)
+            export_stage.write(scene, tmp_path, "mjcf", walk=True)
+        assert {**REFUSED, **NO_GAIT}[name] in str(err.value) and "\n" not in str(err.value)
         assert not list(tmp_path.rglob("walker.*"))
         return
-    rigid = ideal_gait(scene)
-    step_s = rigid.period_s / max(1, len(rigid.step_lengths_m or ()))  # two steps: a stride
-    run = walk(export_stage.run(scene, tmp_path, "mjcf"), 11.3 * step_s)
-    assert not run.fell
-    assert len(run.times_s) >= 10 and run.alternating, run.legs
-    assert run.legs[0] == "leg1"  # leg2 stands at the keyframe
-    assert run.step_periods_s.mean() == pytest.approx(step_s, rel=PERIOD_RTOL.get(name, 0.01))
+    check = export_stage.write(scene, tmp_path, "mjcf", walk=True).walk
+    assert check.engine == "MuJoCo" and check.walked, check.line
+    assert not check.fell, check.line
+    assert check.strikes >= 10 and check.alternating, check.line
+    assert check.first_leg == FIRST.get(name, "leg1")  # leg2 stands at the keyframe
+    assert check.period_s == pytest.approx(check.rigid_period_s,
+                                           rel=PERIOD_RTOL.get(name, 0.01)), check.line
+
+
+def test_walk_check_reports_the_step_period_against_the_rigid_gait(tmp_path):
+    """``walkerlab export --walk`` on the paper's MJCF prints one line: 11 alternating heel
+    strikes, the mean step period against the rigid 0.703597 s within 1 % (measured
+    -0.05 %); the period is the strikes' own (independent of the check: MuJoCo run by
+    mujoco_walk.walk here); on the URDF and the Adams dataset one line why there is no walk;
+    on the OpenSim model, where OpenSim is not importable, one line saying so."""
+    import importlib.util
+
+    from tests.cli_run import run_cli
+    from walkerlab.export.mujoco_walk import walk
+
+    code, err, out = run_cli("export", ROOT / "configs" / "paper.yaml", "--format", "mjcf",
+                             "--runs-dir", tmp_path, "--walk")
+    assert code == 0, err
+    (line,) = [ln for ln in out.splitlines() if "walked in MuJoCo" in ln]
+    m = re.search(r"(\d+) heel strikes \(alternating\).*mean step period (\S+) s against "
+                  r"the rigid gait's (\S+) s \(([-+0-9.]+) %, within 1 %\)", line)
+    assert m, line
+    assert int(m.group(1)) >= 10
+    assert float(m.group(3)) == pytest.approx(0.703597, abs=1e-6)
+    run = walk(tmp_path / "paper" / "walker.xml", 11.3 * float(m.group(3)))
+    assert float(m.group(2)) == pytest.approx(run.step_periods_s.mean(), abs=1e-6)
+    for fmt, why in (("urdf", "a URDF has no ground"), ("adm", "Adams Solver"),
+                     ("osim", "OpenSim is not importable")):
+        if fmt == "osim" and importlib.util.find_spec("opensim") is not None:
+            continue
+        code, err, out = run_cli("export", ROOT / "configs" / "paper.yaml", "--format", fmt,
+                                 "--runs-dir", tmp_path, "--walk")
+        assert code == 0, err
+        (line,) = [ln for ln in out.splitlines() if "not walked" in ln]
+        assert why in line
+
+
+def test_walk_with_walker_only_is_refused_in_one_line(tmp_path):
+    """``--walk --walker-only``: the walker alone has no gait to walk from: one line,
+    nothing written."""
+    from tests.cli_run import run_cli
+
+    code, err, _ = run_cli("export", ROOT / "configs" / "paper.yaml", "--format", "mjcf",
+                           "--runs-dir", tmp_path, "--walk", "--walker-only")
+    assert code == 1 and "--walk" in err and "\n" not in err
+    assert not list(tmp_path.rglob("walker.*"))
 
 
 def test_powered_export_walks_in_mujoco_with_its_push_off(tmp_path):

@@ -57,15 +57,31 @@ def export(scene: Path | None = SceneArg,
            runs_dir: Path = RunsOpt,
            walker_only: bool = typer.Option(
                False, "--walker-only", help="urdf/mjcf: the walker alone, without the rigid "
-               "gait (no keyframe; the MJCF on a plane with MuJoCo's default contact)")) -> None:
+               "gait (no keyframe; the MJCF on a plane with MuJoCo's default contact)"),
+           walk: bool = typer.Option(
+               False, "--walk", help="walk the written file in its engine where it is "
+               "installed (MJCF: MuJoCo; OpenSim), 10 heel strikes from its gait, and print "
+               "its step period against the rigid gait's")) -> None:
     """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
     walker.xml, walker.adm + walker.acf (Adams Solver) or walker.osim (OpenSim).  The URDF,
     MJCF and OpenSim model carry the rigid gait (found as `walkerlab fixedpoint` finds it) as
-    a keyframe (OpenSim: the default state)."""
+    a keyframe (OpenSim: the default state).  What the file leaves out is printed, one line
+    per item ("left out of walker.urdf: ..."), as the file's "Left out:" comments have it.
+    --walk walks the MJCF in MuJoCo and the OpenSim model in OpenSim (where importable) for 10
+    heel strikes and prints the step period against the rigid gait's (exit code 0 either way;
+    a walk that falls or misses 1 % adds a warning on stderr)."""
     from walkerlab.stages import export as stage
 
     sc = load(scene)
-    typer.echo(f"wrote {stage.run(sc, runs_dir, fmt, walker_only=walker_only)}")
+    out = stage.write(sc, runs_dir, fmt, walker_only=walker_only, walk=walk)
+    typer.echo(f"wrote {out.path}")
+    for line in out.left_out:  # what the file leaves out: here too, not only in a comment
+        typer.echo(f"left out of {out.path.name}: {line}")
+    if out.walk is not None:
+        typer.echo(f"{out.path.name} {out.walk.line}")
+        if out.walk.walked and not out.walk.ok:
+            typer.echo(f"warning: {out.path.name} does not walk {out.walk.steps} steps "
+                       f"within {100 * out.walk.tolerance:g} % of the rigid gait", err=True)
     if fmt == "adm":  # the dataset is not the scene's walker: say so here, not in a comment
         from walkerlab.export.adams import actuation_warning
 

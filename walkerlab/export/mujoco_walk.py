@@ -40,7 +40,7 @@ import numpy as np
 
 from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
 
-__all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "walk"]
+__all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "roll", "walk"]
 
 LEGS = ("leg1", "leg2")
 
@@ -312,6 +312,66 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
                             powered.heel_strike(data, i)
                     last_contact[i] = data.time
         if data.qpos[hip] * n[0] + data.qpos[hip + 1] * n[2] < 0.5 * L:
+            fell = True
+            break
+    return MujocoWalk(np.array(times), legs, np.array(pos), fell, float(data.time))
+
+
+def roll(xml_path, t_final_s: float) -> MujocoWalk:
+    """Run a spoked wheel's MJCF (:func:`walkerlab.export.spoked.wheel_mjcf_text`, spoke tips
+    ``spoke<k>_tip``) at ``xml_path`` from its ``gait`` keyframe (spoke 0 in stance) for
+    ``t_final_s`` [s] and read its spoke strikes: a strike is the first contact of the next
+    spoke ahead (``spoke<k+1>_tip``), which then stands.
+
+    Returns
+    -------
+    MujocoWalk
+        ``legs`` the striking spokes' names (each the next: ``alternating`` holds while the
+        wheel rolls spoke by spoke), ``positions_m`` the striking tip along the slope,
+        ``fell``: the hub below half a spoke above the slope line.
+
+    Raises
+    ------
+    ValueError
+        The file has no ``gait`` keyframe.
+    walkerlab.extras.MissingExtra
+        MuJoCo is not installed (one line naming the ``engines`` extra).
+    """
+    from walkerlab.extras import require
+
+    mujoco = require("mujoco", "engines", "rolling an exported MJCF in MuJoCo")
+    model = mujoco.MjModel.from_xml_path(str(xml_path))
+    data = mujoco.MjData(model)
+    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "gait")
+    if key < 0:
+        raise ValueError(f"{xml_path}: no 'gait' keyframe")
+    mujoco.mj_resetDataKeyframe(model, data, key)
+    tips = {}
+    while (g := mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM,
+                                  f"spoke{len(tips)}_tip")) >= 0:
+        tips[g] = len(tips)
+    n = len(tips)
+    ground = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "ground")
+    q = model.geom_quat[ground] if ground >= 0 else (1.0, 0.0, 0.0, 0.0)
+    phi = 2.0 * math.atan2(float(q[2]), float(q[0]))  # the plane turned about y by phi
+    nrm = np.array([math.sin(phi), 0.0, math.cos(phi)])
+    tan = np.array([math.cos(phi), 0.0, -math.sin(phi)])
+    hub = int(model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")])
+    mujoco.mj_forward(model, data)
+    tip0 = next(g for g, k in tips.items() if k == 0)
+    L = float(np.linalg.norm(data.geom_xpos[tip0] - data.xpos[model.geom_bodyid[tip0]]))
+    stance, times, legs, pos, fell = 0, [], [], [], False
+    while data.time < t_final_s:
+        mujoco.mj_step(model, data)
+        touching = {tips[g] for c in data.contact[:data.ncon] for g in (c.geom1, c.geom2)
+                    if g in tips}
+        if (stance + 1) % n in touching:
+            stance = (stance + 1) % n
+            times.append(data.time)
+            legs.append(f"spoke{stance}")
+            g = next(g for g, k in tips.items() if k == stance)
+            pos.append(float(data.geom_xpos[g] @ tan))
+        if data.qpos[hub] * nrm[0] + data.qpos[hub + 1] * nrm[2] < 0.5 * L:
             fell = True
             break
     return MujocoWalk(np.array(times), legs, np.array(pos), fell, float(data.time))

@@ -104,6 +104,7 @@ from walkerlab.export.mjcf_scene import (
     motor_limits,
     point_foot_radius,
 )
+from walkerlab.export.omitted import URDF_GROUND, Omission, xml_comments
 from walkerlab.export.parts import export_part
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_mjcf_text, wheel_urdf_text
 from walkerlab.export.text import AXIS, arc_feet, comment, header, num, nums
@@ -112,9 +113,9 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.config.actuation import Actuation
     from walkerlab.walker.multibody import Link, Multibody
 
-__all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION", "comments_in_scene_units",
-           "keyframe_json", "mjcf_text", "motors", "urdf_text", "wheel_mjcf_text",
-           "wheel_urdf_text"]
+__all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION",
+           "comments_in_scene_units", "keyframe_json", "mjcf_omissions", "mjcf_text", "motors",
+           "urdf_omissions", "urdf_text", "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
 FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
@@ -148,7 +149,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "",
     """
     width = mb.leg_length_m / 50  # visual thickness of the links
     out = ['<?xml version="1.0"?>', *header(mb, name, "URDF", version),
-           *(comment(_motor_note(*m)) for m in motors(actuation)),
+           *xml_comments(urdf_omissions(mb, actuation)),
            f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
            '  <link name="hip_slider"/>']
     for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
@@ -168,16 +169,69 @@ def urdf_text(mb: Multibody, name: str, version: str = "",
     return "\n".join(out)
 
 
-def _motor_note(name: str, kind: str, target: str) -> str:
-    """A URDF comment's text for one motor of :func:`motors`."""
+def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
+                   ) -> tuple[Omission, ...]:
+    """What :func:`urdf_text` leaves out (:mod:`walkerlab.export.omitted`): the ground and
+    contact, each spring (URDF has no spring element), each coupling (``mimic`` follows one
+    joint only), the knee latch, each motor of :func:`motors` and the push-off (no actuator
+    or force element: the laws are in the keyframe sidecar)."""
+    out = [URDF_GROUND]
+    out += [Omission(f"spring {sp.name}", "URDF has no spring element (its law is in the "
+                     "header)") for sp in mb.springs]
+    out += [Omission(f"coupling {cp.name}", f"URDF's mimic follows one joint only, so a URDF "
+                     f"library sees a free {cp.joint} (the relation is in the header)")
+            for cp in mb.couplings]
+    if export_part(mb).knee_stops:
+        out.append(Omission("the knee latch (contact.knee_stop.latch)", "URDF has no "
+                            "contact-switched lock (the joint limit at 0 is the straight-leg "
+                            "stop)"))
+    out += [Omission(f"motor {name}", f"URDF has no actuator element for a torque u on "
+                     f"{_motor_target(kind, target)}; its law is the scene's walker.actuation "
+                     "(in the keyframe sidecar)") for name, kind, target in motors(actuation)]
+    if actuation is not None and actuation.push_off is not None:
+        out.append(Omission("the push-off (walker.actuation.push_off)", "URDF has no force "
+                            "element; its law is in the keyframe sidecar"))
+    return tuple(out)
+
+
+def _motor_target(kind: str, target: str) -> str:
+    """What a motor of :func:`motors` turns, in words."""
     if kind == "joint":
-        what = f"the joint {target} (+u extends the knee)"
-    elif target == HIP_ACTUATION_TENDON:
-        what = "leg1_hip - leg2_hip (+u on leg1_hip, -u on leg2_hip)"
-    else:
-        what = f"{target[:-len('_torso')]} - torso_hip (+u on the thigh's joint, -u on torso_hip)"
-    return (f"Motor {name}: a torque u on {what}; its law is the scene's walker.actuation "
-            "(in the keyframe sidecar)")
+        return f"the joint {target} (+u extends the knee)"
+    if target == HIP_ACTUATION_TENDON:
+        return "leg1_hip - leg2_hip (+u on leg1_hip, -u on leg2_hip)"
+    return f"{target[:-len('_torso')]} - torso_hip (+u on the thigh's joint, -u on torso_hip)"
+
+
+def mjcf_omissions(mb: Multibody, extra: MjcfScene | None = None) -> tuple[Omission, ...]:
+    """What :func:`mjcf_text` leaves to a stepping loop outside the file
+    (:mod:`walkerlab.export.omitted`; :mod:`walkerlab.export.mujoco_walk` is walkerlab's):
+    the knee latch's switching, the joint torque laws, the push-off and the ankle push-off's
+    heel-off latch.  The walker alone (no ``extra``) has no gait, latch or actuation."""
+    if extra is None:
+        return ()
+    out = []
+    knees = any(ln.joint.endswith("_knee") for ln in mb.links)
+    if knees and extra.latch is not None:
+        out.append(Omission("the knee latch's switching", "MuJoCo has no contact-switched "
+                            "lock: the equalities leg<i>_latch are switched by a stepping "
+                            "loop (walkerlab.export.mujoco_walk.latch_rule)"))
+    act = extra.actuation
+    if act is not None and act.torques:
+        out.append(Omission("the joint torque laws (walker.actuation.torques)", "MJCF has no "
+                            "state-dependent torque law: the laws are in the custom text "
+                            "walkerlab_actuation, applied by a stepping loop "
+                            "(walkerlab.export.mujoco_walk)"))
+    if act is not None and act.push_off is not None:
+        out.append(Omission("the push-off (walker.actuation.push_off)", "MJCF has no "
+                            "event-switched force: a stepping loop applies it from each heel "
+                            "strike (walkerlab.export.mujoco_walk)"))
+    if act is not None and act.ankle_push_off is not None:
+        out.append(Omission("the ankle push-off's heel-off latch "
+                            "(walker.actuation.ankle_push_off)", "MJCF has no contact-switched "
+                            "motor: a stepping loop sets the motors leg<i>_ankle_motor "
+                            "(walkerlab.export.mujoco_walk)"))
+    return tuple(out)
 
 
 def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:
@@ -399,6 +453,7 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     hip_mass = mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG
     out = [*header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
            *(comment(note) for note in (extra.notes if extra else ())),
+           *xml_comments(mjcf_omissions(mb, extra)),
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
     if extra is None:
         out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}"/>')

@@ -76,6 +76,7 @@ from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.export.omitted import Omission, xml_comments
 from walkerlab.export.opensim_xml import (
     body_set,
     contact_forces,
@@ -98,7 +99,7 @@ if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
-           "knee_stop_expression", "osim_gait", "osim_text", "patch_radius",
+           "knee_stop_expression", "osim_gait", "osim_omissions", "osim_text", "patch_radius",
            "terrain_patch_radius"]
 
 #: The export's file name in ``runs/<scene>/``.
@@ -353,6 +354,30 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
                     settings.push_off_pulse_s(), ms.actuation, ms.lane_heights)
 
 
+def osim_omissions(mb, gait: OsimGait) -> tuple[Omission, ...]:
+    """What :func:`osim_text` leaves to a stepping loop outside the file
+    (:mod:`walkerlab.export.omitted`; :mod:`walkerlab.export.opensim_walk` is walkerlab's):
+    the knee latch's switching, the joint torque laws and the push-off's switching (OpenSim
+    has no contact- or event-switched force)."""
+    out = []
+    if export_part(mb).knee_stops:
+        out.append(Omission("the knee latch's switching", "OpenSim has no contact-switched "
+                            "force: leg<i>_knee_latch applies no force by default, a stepping "
+                            "loop switches it (walkerlab.export.opensim_walk)"))
+    act = gait.actuation
+    if act is not None and act.torques:
+        out.append(Omission("the joint torque laws (walker.actuation.torques)", "OpenSim has "
+                            "no state-dependent torque law: the laws are in the comment "
+                            "walkerlab_actuation, a stepping loop sets the CoordinateActuators' "
+                            "controls (walkerlab.export.opensim_walk)"))
+    if gait.push_off is not None:
+        out.append(Omission("the push-off's switching (walker.actuation.push_off)", "OpenSim "
+                            "has no event-switched force: leg<i>_push_off applies no force by "
+                            "default, a stepping loop switches it from each heel strike "
+                            "(walkerlab.export.opensim_walk)"))
+    return tuple(out)
+
+
 def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     """The OpenSim model's XML (module docstring for its content).
 
@@ -391,7 +416,8 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
            *header_comments(mb, gait, name, version, total, contact_note, rg, r_foot, motors,
-                            knee_stops)]
+                            knee_stops),
+           *xml_comments(osim_omissions(mb, gait))]
     out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
     out += body_set(mb)
     out += joint_set(mb, q0, v0)

@@ -25,7 +25,11 @@ from it; OpenSim has no contact-switched force):
 
 - the **knee latch** of a kneed export (``leg<i>_knee_latch``, the knee stop mirrored) is on
   while the leg's foot is less than the release height above the slope line and its knee is
-  within the capture flexion of straight
+  within the capture flexion of straight, the foot's height its contact point's above the
+  ground as the contact model reads it (:func:`contact_height`: above the tread of the
+  lane's patch under it, or above the slope line; the contact point the sphere's centre
+  less the file's offset, an arc foot's radius,
+  :func:`walkerlab.export.opensim_xml.latch_foot_offset`)
   (:func:`walkerlab.export.mujoco_walk.latch_rule`, the MJCF's rule);
 - the **push-off** of a powered export (``leg<i>_push_off``, the force ``F = P0 / T`` along
   the leg from foot to hip, ``P0`` the law's ``impulse_n_s``, ``T`` the scene's
@@ -52,7 +56,7 @@ import numpy as np
 from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
 from walkerlab.export.mujoco_walk import MujocoWalk
 
-__all__ = ["OpensimWalk", "walk", "walk_here"]
+__all__ = ["OpensimWalk", "contact_height", "walk", "walk_here"]
 
 LEGS = ("leg1", "leg2")
 
@@ -87,14 +91,57 @@ def _header(text: str) -> dict:
     out: dict = {}
     if m := re.search(r"Ground: slope (\S+) rad", text):
         out["slope"] = float(m.group(1))
-    if m := re.search(r"less than (\S+) m above the ground and its knee within (\S+) rad",
+    # a unit after a number is the scene's (a nondimensional scene's "l", not "m")
+    if m := re.search(r"less than (\S+) \S+ above the ground and its knee within (\S+) rad",
                       text):
         out["latch"] = (float(m.group(1)), float(m.group(2)))
-    if m := re.search(r"on for T = (\S+) s", text):
+    if m := re.search(r"slope line less (\S+) \S+ \(the sphere's radius", text):
+        out["latch_offset"] = float(m.group(1))
+    if m := re.search(r"a patch of width (\S+) \S+ is a sphere", text):
+        out["patch_width"] = float(m.group(1))
+    if m := re.search(r"on for T = (\S+) \S+ from each", text):
         out["pulse"] = float(m.group(1))
     if m := re.search(r"walkerlab_actuation: (\{.*\}) -->", text):
         out["actuation"] = json.loads(m.group(1))
     return out
+
+
+def contact_height(centre, r_foot: float, offset: float, patches, half_width: float,
+                   t_hat, n_hat) -> float:
+    """The height [m] of a foot's contact point above the ground, as the contact model's knee
+    latch reads it (minus the penetration, :func:`walkerlab.models.contact.generated._point`):
+    the contact point's height above the top of the lane's patch whose centre lies within
+    ``half_width`` of it along the slope; above the slope line where no patch is under it or
+    where the point is above the lane's highest patch top (the contact model skips the
+    patches' lookup there: a foot above every patch touches none).  The contact point lies
+    ``offset`` below the foot sphere's centre (the file's latch offset,
+    :func:`walkerlab.export.opensim_xml.latch_foot_offset`: an arc's radius, a point foot's
+    0), a patch's tread ``r_foot - offset`` above its sphere's top (the ground's offset below
+    the treads).
+
+    Parameters
+    ----------
+    centre : array_like (2,)
+        The foot sphere's centre in the ground frame [m].
+    r_foot, offset : float
+        The sphere's radius and the latch offset [m].
+    patches : sequence of (float, float)
+        The lane's patches: each top's position along the slope and its height along the
+        slope normal [m] (the patch sphere's centre plus its radius); empty: no patches.
+    half_width : float
+        Half the patch width [m].
+    t_hat, n_hat : array_like (2,)
+        The slope's tangent (downhill) and normal (up).
+    """
+    c = np.asarray(centre, float)
+    h = float(c @ n_hat) - offset  # the contact point above the slope line
+    treads = [(s, top + r_foot - offset) for s, top in patches]
+    if h < max([0.0, *(t for _, t in treads)]):
+        along = float(c @ t_hat)
+        for s, tread in treads:
+            if abs(along - s) <= half_width:
+                return h - tread
+    return h
 
 
 class _Drive:
@@ -291,10 +338,19 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         p = bodies[g].findStationLocationInGround(s, foot_loc[g]).to_numpy()[:2]
         return float(p @ t_hat)
 
-    def height(g, s):  # the foot point's height above the slope line [m] (the ground lies
-        # one foot-sphere radius below it: 0 on the ground)
+    cg = model.getContactGeometrySet()
+    patches = {g: [] for g in LEGS}  # each lane's patch tops: (along, height) [m]
+    for g in LEGS:
+        while cg.contains(f"{g}_patch{len(patches[g])}"):
+            sph = osim.ContactSphere.safeDownCast(cg.get(f"{g}_patch{len(patches[g])}"))
+            loc = osim.Vec3(sph.get_location()).to_numpy()[:2]
+            patches[g].append((float(loc @ t_hat), float(loc @ n_hat) + sph.getRadius()))
+    half = info.get("patch_width", 0.0) / 2
+    off = info.get("latch_offset", 0.0)  # the contact point below the sphere's centre
+
+    def height(g, s):  # the foot's contact point above the ground under it [m]
         p = bodies[g].findStationLocationInGround(s, foot_loc[g]).to_numpy()[:2]
-        return float(p @ n_hat)
+        return contact_height(p, feet[g].getRadius(), off, patches[g], half, t_hat, n_hat)
 
     def loaded(g, s):
         v = contact[g].getRecordValues(s)

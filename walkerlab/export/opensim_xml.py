@@ -18,8 +18,8 @@ if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
 __all__ = ["body_set", "contact_forces", "contact_geometry_set", "couplers", "header_comments",
-           "joint_set", "knee_stop_forces", "motor_forces", "push_off_forces", "spring_forces",
-           "torque_joints"]
+           "joint_set", "knee_stop_forces", "latch_foot_offset", "motor_forces",
+           "push_off_forces", "spring_forces", "torque_joints"]
 
 
 
@@ -156,8 +156,24 @@ def header_comments(mb, gait, name: str, version: str, total: float, contact_not
             "default: "
             f"a stepping loop switches it on while the leg's foot is less than "
             f"{gait.knee.latch_height:.4g} m above the ground and its knee within "
-            f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk)."))
+            f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk). "
+            "The foot's height is its contact point's (the contact model's latch reads the "
+            "foot's penetration): the height of the sphere leg<i>_foot's centre above the "
+            f"slope line less {num(latch_foot_offset(r_foot, gait.ground_offset_m))} m (the "
+            "sphere's radius less the ground's offset below the slope line)."))
     return out
+
+
+def latch_foot_offset(r_foot: float, ground_offset_m: float) -> float:
+    """How far a foot sphere's centre stands above the ground when the sphere touches it
+    [m]: its radius ``r_foot`` less the ground's offset below the slope line
+    ``ground_offset_m`` (a point foot's sphere of radius ``L/1000`` on a ground lowered by
+    that radius: 0, its centre is the model's foot point; an arc foot's sphere of radius
+    ``R`` on the slope line: ``R``, its contact point is the lowest point).  The knee latch's
+    foot height is the centre's height above the slope line less this offset: the contact
+    point's, whose penetration the contact model's latch reads
+    (:func:`walkerlab.models.contact.generated._latch_weight`)."""
+    return float(r_foot) - float(ground_offset_m)
 
 
 def body_set(mb) -> list[str]:

@@ -12,9 +12,10 @@ import math
 from xml.sax.saxutils import quoteattr
 
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
 
-__all__ = ["WHEEL_TIP_FRACTION", "wheel_mjcf_text", "wheel_urdf_text"]
+__all__ = ["WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
@@ -53,6 +54,11 @@ def _wheel_header(name: str, fmt: str, version: str, p: dict, slope: float) -> l
                     "(McGeer 1990; Coleman, Chatterjee & Ruina 1997).")]
 
 
+#: What a spoked wheel's URDF leaves out (:mod:`walkerlab.export.omitted`): its ground and
+#: contact; its MJCF leaves out nothing.
+WHEEL_URDF_OMISSIONS = (URDF_GROUND,)
+
+
 def wheel_urdf_text(data, name: str, version: str = "",
                     hub_inertia_kg_m2: float | None = None) -> str:
     """A rimless wheel (``model: rimless_wheel``) as URDF: a massless carriage on two
@@ -77,7 +83,8 @@ def wheel_urdf_text(data, name: str, version: str = "",
     p = _wheel_numbers(data, hub_inertia_kg_m2)
     L, r = p["L"], p["r"]
     out = ['<?xml version="1.0"?>', *_wheel_header(name, "URDF", version, p, data.slope_rad),
-           f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
+           *xml_comments(WHEEL_URDF_OMISSIONS), f"<robot name={quoteattr(name)}>",
+           '  <link name="world"/>',
            '  <link name="carriage_x"/>', '  <link name="carriage"/>',
            '  <joint name="hip_x" type="prismatic"><parent link="world"/>'
            '<child link="carriage_x"/><axis xyz="1 0 0"/>'

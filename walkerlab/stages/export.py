@@ -7,10 +7,16 @@ MuJoCo reads MJCF), written from the scene's ``walker`` and ``slope`` sections o
 upstream artifact), atomically (temporary name, then rename).  Formats and conventions:
 :mod:`walkerlab.export.multibody`.  A spoked wheel (one rigid body on its spokes, no tree of
 leg links) is written by that module's wheel writers, as URDF or MJCF only.
+
+:func:`write` returns the file with what it leaves out (one line per item,
+:mod:`walkerlab.export.omitted`) and, asked (``walk=True``, ``walkerlab export --walk``), the
+file walked in its engine (:mod:`walkerlab.export.engine_walk`).
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import walkerlab
@@ -18,22 +24,38 @@ from walkerlab.config import Scene
 from walkerlab.export.adams import (
     ADAMS_FILES,
     acf_text,
+    adams_omissions,
     adams_start,
     adm_text,
     check_adams_actuation,
     check_adams_exportable,
+)
+from walkerlab.export.engine_walk import (
+    DEFAULT_STEPS,
+    ENGINES,
+    EngineWalk,
+    not_walked,
+    walk_export,
 )
 from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
     comments_in_scene_units,
     keyframe_json,
+    mjcf_omissions,
     mjcf_text,
+    urdf_omissions,
     urdf_text,
     wheel_mjcf_text,
     wheel_urdf_text,
 )
-from walkerlab.export.opensim import OSIM_FILE, check_osim_exportable, osim_gait, osim_text
+from walkerlab.export.opensim import (
+    OSIM_FILE,
+    check_osim_exportable,
+    osim_gait,
+    osim_omissions,
+    osim_text,
+)
 from walkerlab.export.scene import (
     check_exportable,
     check_wheel_exportable,
@@ -41,6 +63,8 @@ from walkerlab.export.scene import (
     wheel_keyframe,
     wheel_keyframe_json,
 )
+from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS
+from walkerlab.export.text import comment
 from walkerlab.io import runpaths
 from walkerlab.units import for_scene
 from walkerlab.walker.description import walker_data
@@ -84,7 +108,7 @@ def stored_gait(scene: Scene, runs_root: Path | str):
     return fp if fp.variant == "derived" and not fp.error else None
 
 
-def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
+def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Exported:
     """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
     check_adams_exportable(mb)  # before the gait search
     check_adams_actuation(scene)
@@ -95,21 +119,39 @@ def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     runpaths.atomic_texts([  # both or neither
         (path, adm),
         (runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True), acf)])
-    return path
+    return Exported(path, tuple(o.line for o in adams_omissions(scene, mb)))
 
 
-def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -> Path:
+def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -> Exported:
     """``walker.osim``: the walker, its gait as the default state, its ground and contact."""
     if walker_only:
         raise ValueError("--walker-only: the OpenSim export carries the gait, ground and "
                          "contact (its default state is the rigid gait); drop --walker-only")
     check_osim_exportable(scene, mb)  # before the gait search
     check_exportable(scene, data.structure.kind, "osim")
-    gait = _gait(scene, runs_root, lambda ideal: osim_gait(scene, mb, data, ideal))
+    ideal, gait = _gait(scene, runs_root, _with_ideal(
+        scene, lambda ideal: osim_gait(scene, mb, data, ideal)))
     text = osim_text(mb, gait, name, walkerlab.__version__)
     path = export_path(scene, runs_root, "osim", claim=True)
     runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
-    return path
+    return Exported(path, _xml_lines(osim_omissions(mb, gait), scene), _step_period(ideal))
+
+
+def _with_ideal(scene: Scene, build):
+    """``build`` that also returns the rigid gait it was given (searched when None, as the
+    writers search it)."""
+    def both(ideal):
+        from walkerlab.analysis.contact.periodic import ideal_gait
+
+        ideal = ideal_gait(scene) if ideal is None else ideal
+        return ideal, build(ideal)
+    return both
+
+
+def _step_period(ideal) -> float:
+    """The rigid gait's step period [s]: its period over its steps (legs that differ: a
+    stride of two)."""
+    return float(ideal.period_s) / max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
 
 
 def _gait(scene: Scene, runs_root, build):
@@ -126,7 +168,8 @@ def _gait(scene: Scene, runs_root, build):
                          f"{' '.join(str(exc).split())}") from None
 
 
-def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
+def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
+               ) -> Exported:
     """The rolling polygon kind's writer: a spoked wheel (one rigid body on its spokes, no
     tree of leg links) by its own writers (:func:`walkerlab.export.multibody.wheel_urdf_text`,
     ``wheel_mjcf_text``): the rigid gait as the MJCF's ``gait`` keyframe (the URDF's
@@ -153,21 +196,72 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
         files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                       wheel_keyframe_json(key)))
     runpaths.atomic_texts(files)  # the wheel and its keyframe: both or neither
-    return path
+    return Exported(path, _xml_lines(WHEEL_URDF_OMISSIONS if fmt == "urdf" else (), scene),
+                    None if key is None else key.period_s)
 
 
 def _gait_scene(scene: Scene, mb, data, runs_root):
-    """The MJCF's gait keyframe, terrain and contact (the gait of an up-to-date
-    ``fixedpoint.h5``, else searched); no rigid gait: one line."""
-    return _gait(scene, runs_root, lambda ideal: mjcf_scene(scene, mb, data, ideal))
+    """The rigid gait and the MJCF's gait keyframe, terrain and contact (the gait of an
+    up-to-date ``fixedpoint.h5``, else searched); no rigid gait: one line."""
+    return _gait(scene, runs_root, _with_ideal(
+        scene, lambda ideal: mjcf_scene(scene, mb, data, ideal)))
+
+
+@dataclass(frozen=True)
+class Exported:
+    """An export's file and what it leaves out.
+
+    Attributes
+    ----------
+    path : Path
+        The written file (``walker.urdf``, ``walker.xml``, ``walker.adm``, ``walker.osim``).
+    left_out : tuple of str
+        One line per item the file leaves out (:mod:`walkerlab.export.omitted`): ``what:
+        why``, each the text of the file's comment after ``Left out:`` (an Adams comment's
+        lines joined), in the scene's units as the file has it; empty when the file carries
+        the whole scene.
+    step_period_s : float or None
+        The rigid gait's step period the file starts from [s] (a stride's two steps: their
+        mean); None without a gait (``--walker-only``, an Adams dataset's start is not
+        checked here).
+    walk : EngineWalk or None
+        The file walked in its engine (``walk=True``,
+        :func:`walkerlab.export.engine_walk.walk_export`); None when not asked.
+    """
+
+    path: Path
+    left_out: tuple[str, ...] = ()
+    step_period_s: float | None = None
+    walk: EngineWalk | None = None
+
+
+def _xml_lines(items, scene: Scene) -> tuple[str, ...]:
+    """The items' lines as an XML file's comments have them: ``--`` spaced
+    (:func:`walkerlab.export.text.comment`), units in the scene's system
+    (:func:`walkerlab.export.multibody.comments_in_scene_units`)."""
+    units = for_scene(scene)
+    out = []
+    for o in items:
+        text = comments_in_scene_units(comment(o.line), units)
+        out.append(text[len("<!-- "):-len(" -->")])
+    return tuple(out)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         walker_only: bool = False) -> Path:
+    """:func:`write`'s file: the path alone (the callers that do not print what the file
+    leaves out)."""
+    return write(scene, runs_root, fmt, walker_only).path
+
+
+def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
+          walker_only: bool = False, walk: bool = False,
+          walk_steps: int = DEFAULT_STEPS) -> Exported:
     """Write the scene's walker as ``fmt`` ("urdf", "mjcf", "adm": ``walker.adm`` and
     ``walker.acf``, returning the .adm's path, or "osim": ``walker.osim``,
     :mod:`walkerlab.export.opensim`) into
-    ``<runs_root>/<scene name>/`` and return the file's path.
+    ``<runs_root>/<scene name>/`` and return the file's path and what it leaves out
+    (:class:`Exported`).
 
     The URDF and MJCF carry the rigid gait (the MJCF's ``gait`` keyframe, terrain and
     contact; the URDF's keyframe sidecar): the gait of ``fixedpoint.h5`` when it is up to
@@ -200,12 +294,34 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         from walkerlab.models.contact.terrain import check_ground
 
         check_ground(scene.terrain)  # a profile: one line
+    if walk and walker_only:
+        raise ValueError("--walk: the walker alone (--walker-only) has no gait to walk from; "
+                         "drop one of them")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     name = scene.name or "walker"
-    return _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+    out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+    if not walk:
+        return out
+    return replace(out, walk=_walk(out, fmt, data, walk_steps))
 
 
-def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
+def _walk(out: Exported, fmt: str, data, steps: int) -> EngineWalk:
+    """The written file walked in its engine (:func:`walkerlab.export.engine_walk.
+    walk_export`; a spoked wheel rolls on its spokes), or why not."""
+    if out.step_period_s is None and fmt in ENGINES:
+        return not_walked("the file has no gait to start from")
+    return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,
+                       spokes=_ROLLS[data.structure.kind.name])
+
+
+#: kind name -> its steps are spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`), not
+#: two legs' heel strikes
+_ROLLS = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
+          "free_joints": False, "rolling_polygon": True}
+
+
+def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
+               ) -> Exported:
     """The writer of the kinds whose walker is a tree of leg links
     (:func:`walkerlab.walker.multibody.multibody`): the URDF and MJCF here, the Adams
     dataset (:func:`_run_adams`) and the OpenSim model (:func:`_run_osim`)."""
@@ -215,18 +331,21 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     if fmt == "osim":
         return _run_osim(scene, runs_root, mb, data, name, walker_only)
     check_exportable(scene, data.structure.kind, fmt, walker_only)
-    extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
+    ideal, extra = (None, None) if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, scene.walker.actuation)
+        left_out = urdf_omissions(mb, scene.walker.actuation)
     else:
         text = mjcf_text(mb, name, walkerlab.__version__, extra)
+        left_out = mjcf_omissions(mb, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
     files = [(path, comments_in_scene_units(text, for_scene(scene)))]
     if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
         files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                       keyframe_json(mb, extra)))
     runpaths.atomic_texts(files)  # the walker and its keyframe: both or neither
-    return path
+    return Exported(path, _xml_lines(left_out, scene),
+                    None if ideal is None else _step_period(ideal))
 
 
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> the export's writer of that kind

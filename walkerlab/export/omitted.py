@@ -1,0 +1,84 @@
+"""What an exported file leaves out of the scene: one list per writer, written into the file
+as comments and printed by ``walkerlab export``, one line per item.
+
+Each writer (URDF and MJCF: :mod:`walkerlab.export.multibody`, a spoked wheel's:
+:mod:`walkerlab.export.spoked`; the Adams dataset: :mod:`walkerlab.export.adams`; the OpenSim
+model: :mod:`walkerlab.export.opensim`) builds a tuple of :class:`Omission` with its own
+function (``urdf_omissions``, ``mjcf_omissions``, ``adams_omissions``, ``osim_omissions``)
+and writes each item as one comment that starts with :data:`PREFIX` (the Adams dataset: a
+``!`` comment wrapped into its 80 columns, continued by ``!`` lines indented by
+:data:`ADAMS_CONTINUATION`); the export stage returns the same items and the command prints
+them.  An item is something of the scene the format has no element for (a spring in a URDF)
+or that needs a stepping loop outside the file (a contact-switched knee latch in MuJoCo and
+OpenSim); approximations of a law the file does carry (IMPACT as MuJoCo's linear contact or
+Hunt-Crossley's Hertz law) are stated in the file's notes, not here.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from dataclasses import dataclass
+
+__all__ = ["ADAMS_CONTINUATION", "PREFIX", "URDF_GROUND", "Omission", "adams_comments",
+           "lines", "xml_comments"]
+
+#: The text every omission comment starts with (after ``<!-- `` or ``! ``).
+PREFIX = "Left out: "
+#: The indent of an Adams omission comment's continuation lines (after ``!``).
+ADAMS_CONTINUATION = "   "
+
+
+@dataclass(frozen=True)
+class Omission:
+    """One thing of the scene an exported file does not carry.
+
+    Attributes
+    ----------
+    what : str
+        The scene's item (a field's name or the model's part: "spring hip_spring", "the
+        knee latch's switching").
+    why : str
+        Why the format does not carry it, and where it is instead (a comment, the keyframe
+        sidecar, a stepping loop).
+    """
+
+    what: str
+    why: str
+
+    @property
+    def line(self) -> str:
+        """The item as one line: ``what: why``."""
+        return f"{self.what}: {self.why}"
+
+
+#: A URDF's ground (it has no world): the first item of every URDF's list (a tree of links:
+#: :func:`walkerlab.export.multibody.urdf_omissions`; a spoked wheel).
+URDF_GROUND = Omission(
+    "the ground (slope, terrain and contact law)",
+    "URDF has no world or contact element; the slope is stated in the header, the rigid "
+    "gait in the keyframe sidecar (the MJCF export carries ground and contact)")
+
+
+def lines(items) -> tuple[str, ...]:
+    """Each item's :attr:`Omission.line`, prefixed by :data:`PREFIX` (the text of its
+    comment in the file)."""
+    return tuple(PREFIX + o.line for o in items)
+
+
+def xml_comments(items) -> list[str]:
+    """One XML comment per item (:func:`walkerlab.export.text.comment`)."""
+    from walkerlab.export.text import comment
+
+    return [comment(text) for text in lines(items)]
+
+
+def adams_comments(items, width: int = 80) -> list[str]:
+    """One ``!`` comment per item, wrapped into ``width`` columns: the first line ``! Left
+    out: ...``, the rest ``!`` + :data:`ADAMS_CONTINUATION` + the text (an item's words are
+    kept whole; a word longer than a line is not broken)."""
+    out = []
+    for text in lines(items):
+        out += textwrap.wrap(text, width=width, initial_indent="! ",
+                             subsequent_indent="!" + ADAMS_CONTINUATION,
+                             break_long_words=False, break_on_hyphens=False)
+    return out
