@@ -18,7 +18,7 @@ DOUBLE_SUPPORT_LEADS = ("heel_contact", "foot_flat")
 
 
 def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma, normal,
-                    tangent, Jl) -> dict:
+                    tangent, Jl, foot_inertia=0) -> dict:
     """Double support after heel strike (roles already swapped): the leading (stance) foot
     on its heel at ``O`` (heel contact) or flat (foot flat), the trailing (swing) foot on its
     toe at a point ``P`` of the slope.  The trailing foot's ankle angle ``b`` (its sole at
@@ -33,7 +33,16 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     restitution 0): in ``q`` the toe's pin is one row ``g = u^T dA/dq`` (``A`` the trailing
     ankle, ``u`` the unit vector from toe to ankle: a massless foot takes no impulsive
     moment, so the toe's impulse ``Lam u`` passes through the ankle) and
-    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``."""
+    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``.
+
+    Feet with mass (``foot_inertia`` ``I`` [kg m^2] about the ankle, the mass at the ankle
+    already a body of ``flows``, whose swing foot turns with its leg): the trailing sole
+    turns at ``d(swing + b)/dt``, so ``M`` gains ``I`` in the ``(swing, b)`` block beyond
+    the locked foot's ``I`` in ``(swing, swing)``; the entry is then the impact on ``Q``
+    with the toe pinned in both directions, ``[M4, -J^T (, -Jl4^T); J, 0 (; Jl4, 0)]
+    [dQ+; Lam] = [M4 (dq-, 0); 0 (; 0)]`` (the foot turning with its leg before it,
+    ``db- = 0``; ``Lam`` (2,) the toe's impulse in world axes [N s]), whose limit ``I -> 0``
+    is the massless entry above."""
     b, db = sp.symbols("b_trail db_trail", real=True)
     t_len, k_b, r_b, c_b = trailing
     sw = q[0]
@@ -47,6 +56,7 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     hc = flows["heel_contact"]
     M4 = sp.zeros(4, 4)
     M4[:3, :3] = hc.M
+    M4[0, 3] = M4[3, 0] = M4[3, 3] = foot_inertia
     rhs = sp.zeros(4, 1)
     rhs[:3, 0] = -hc.C * sp.Matrix(dq) - hc.G
     rhs[3, 0] = -c_b * db - k_b * (b - r_b)
@@ -75,6 +85,10 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
         Ki[3:, :3] = imp_rows
         out[lead] = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
                      "Ki_rhs": (hc.M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
+        if foot_inertia != 0:  # the toe pinned on Q (see above)
+            out[lead]["Ki"] = K
+            out[lead]["Ki_rhs"] = (M4 * sp.Matrix([*dq, 0])).col_join(sp.zeros(m, 1))
+            out[lead]["entry_on_Q"] = True
     # the leading foot's ground force: Newton's total (feet massless) less the toe's; in
     # foot flat its toe's share from the moment balance about its heel, less the trailing
     # toe's moment (the lock's multiplier is that moment: its toe force times the sole)
@@ -140,12 +154,17 @@ def double_support_lines(eq, lead: str) -> list[str]:
             f" dtype=float).reshape({mi}, {mi})",
             f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[mi * mi:nk])},),"
             " dtype=float)",
-            f"{IND}_s = np.linalg.solve(_K, _b)",
-            f"{IND}_u = ({u[0]}, {u[1]})",
-            f"{IND}_L = float(_s[{n}])",
-            f"{IND}_n = (_u[0] * sin(gamma) + _u[1] * cos(gamma)) * _L",
-            f"{IND}_t = (_u[0] * cos(gamma) - _u[1] * sin(gamma)) * _L",
-            f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
+            f"{IND}_s = np.linalg.solve(_K, _b)"]
+    if sysd.get("entry_on_Q"):  # feet with mass: the toe's impulse in world axes
+        out += [f"{IND}_lx, _ly = float(_s[{n + 1}]), float(_s[{n + 2}])",
+                f"{IND}_n = _lx * sin(gamma) + _ly * cos(gamma)",
+                f"{IND}_t = _lx * cos(gamma) - _ly * sin(gamma)"]
+    else:
+        out += [f"{IND}_u = ({u[0]}, {u[1]})",
+                f"{IND}_L = float(_s[{n}])",
+                f"{IND}_n = (_u[0] * sin(gamma) + _u[1] * cos(gamma)) * _L",
+                f"{IND}_t = (_u[0] * cos(gamma) - _u[1] * sin(gamma)) * _L"]
+    out += [f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
     if lead == DOUBLE_SUPPORT_LEADS[0]:
         lines, red = cse_lines([ds["trailing_spring"], ds["foot_angle"]], PRINTER)
         out += ["    def double_support_trailing(x):", *head, *lines,

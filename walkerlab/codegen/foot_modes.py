@@ -165,10 +165,15 @@ class _Walker:
         return self.P[f"{kind}_{ROLE_TAG[role]}_{name}" if self.structure.asymmetric
                       else f"{kind}_{name}"]
 
-    def bodies_from(self, ankle_lin: dict, pinned: str = "stance"):
+    def bodies_from(self, ankle_lin: dict, pinned: str = "stance", foot_angle=None):
         """(mass, lin, inertia, link angle, name) of every body, the hip's lin and the
         other leg's ankle's lin, for the ``pinned`` leg's ankle at ``ankle_lin``; names
-        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike)."""
+        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike).
+
+        Feet with mass (``structure.foot_mass``): each foot a body ``<role>_foot_body`` at
+        its ankle, mass ``m_foot``, inertia ``I_foot`` about it; the pinned leg's foot at
+        the sole angle ``foot_angle`` (default the stance sole's ``stance + a``), the other
+        leg's foot at its spring's rest angle from that leg (its angle no coordinate)."""
         structure, P, bp = self.structure, self.P, self.bp
         ps_sw, ps_st, _a = self.q
         L, half = P["L"], sp.pi / 2
@@ -193,7 +198,14 @@ class _Walker:
                 lin = add_length(lin, psi_t + half, P[f"e_torso_{b.name}"])
             inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
             out.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t, f"torso_{b.name}"))
-        return out, hip, add_length(hip, leg_psi[other], L)
+        other_ankle = add_length(hip, leg_psi[other], L)
+        if structure.foot_mass:
+            if foot_angle is None:
+                foot_angle = ps_st + _a
+            out.append((P["m_foot"], ankle_lin, P["I_foot"], foot_angle, f"{pinned}_foot_body"))
+            out.append((P["m_foot"], other_ankle, P["I_foot"],
+                        leg_psi[other] + self.fp("r", other), f"{other}_foot_body"))
+        return out, hip, other_ankle
 
 
 @cache
@@ -250,7 +262,8 @@ def derive_flat(structure: Structure) -> FlatEquations:
                   "swing_ankle_rate": 0 * dq[0]}
     double = derive_double_support(q, dq, qdd, flows, trailing_ankle, lead_force["heel"],
                                    (fp("toe", "swing"), fp("k", "swing"), fp("r", "swing"),
-                                    fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl)
+                                    fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl,
+                                   P["I_foot"] if structure.foot_mass else 0)
     return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
                          guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles,
                          push_off=push_off, double_support=double)
@@ -305,7 +318,7 @@ def _pinned_modes(w: _Walker, anchors: dict, normal):
         points["stance_foot"] = points["stance_ankle"]
         points["swing_foot"] = heel_sw
         for _m, lin, _i, _p, name in bodies:
-            if name != "hip":
+            if name != "hip" and not name.endswith("_foot_body"):  # feet: at the ankles
                 points[name] = at(lin)
         T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
         kin[pin] = {"points": points, "kinetic": T, "potential": V}
@@ -385,7 +398,7 @@ def _locked_and_resets(w: _Walker, anchors: dict, flows: dict, Jl):
                                    B=(S.T * hc.M).col_join(sp.zeros(1, 3)),
                                    relabel_q=qv, relabel_rate=sp.eye(3))}
     post_q = (ps_sw, ps_st, b_new)
-    post_bodies, _h, _a = w.bodies_from({ps_sw + b_new + half: hw}, "swing")
+    post_bodies, _h, _a = w.bodies_from({ps_sw + b_new + half: hw}, "swing", ps_sw + b_new)
     post = {b[4]: b for b in post_bodies}
     relabel_q = sp.Matrix([ps_st, ps_sw, rw])
     relabel_rate = sp.Matrix([[0, 1, 0], [1, 0, 0], [0, 0, 1]])
