@@ -207,6 +207,51 @@ def test_heel_strike_conserves_angular_momentum_about_the_striking_heel(tmp_path
     assert abs(h0 - h_pre) > 1e-4
 
 
+def _scene_with(tmp_path, edit):
+    d = yaml.safe_load(SCENE.read_text())
+    edit(d)
+    p = tmp_path / "edited.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return p
+
+
+@pytest.mark.parametrize("edit,key", [
+    (lambda d: d["contact"].update(flat_foot_mass_kg=0.1, flat_foot_inertia_kg_m2=5e-4),
+     "contact.flat_foot_mass_kg"),
+    (lambda d: d["walker"]["leg"]["foot"].pop("inertia_about_ankle_kg_m2"),
+     "inertia_about_ankle_kg_m2"),
+    (lambda d: d["walker"].update(legs=[d["walker"]["leg"], {
+        **d["walker"]["leg"], "foot": {**d["walker"]["leg"]["foot"], "mass_kg": 0.2}}])
+     or d["walker"].pop("leg"), "mass_kg"),
+])
+def test_a_second_or_half_given_foot_mass_is_refused_in_one_line(tmp_path, edit, key):
+    """The contact section's regularising foot beside the walker's own feet, a mass
+    without its inertia, legs whose feet differ in mass: one line naming the key."""
+    from tests.cli_run import run_cli
+
+    code, err, _out = run_cli("fixedpoint", _scene_with(tmp_path, edit), "--runs-dir",
+                              tmp_path)
+    assert code != 0 and key in err and "Traceback" not in err
+    assert len(err.splitlines()) == 1, err
+
+
+def test_massless_feet_keep_their_structure_key_and_parameters():
+    """A scene that leaves the foot's mass unset is the massless walker it was: the same
+    structure key (the generated code's cache key) and parameter vector as before the
+    fields existed (configs/flat_feet.yaml's artifacts stay bit-identical); with the mass,
+    the rigid view's parameters end the feet's block with ``m_foot``, ``I_foot`` and the
+    walker's mass counts both feet."""
+    old = load_scene(ROOT / "configs" / "flat_feet.yaml")
+    d = walker_data(old.walker, old.slope.angle_rad)
+    assert "foot_mass" not in d.structure.key() and "m_foot" not in d.structure.param_names
+    assert "mass_kg" not in old.model_dump()["walker"]["leg"]["foot"]
+    new = load_scene(SCENE)
+    e = walker_data(new.walker, new.slope.angle_rad)
+    assert e.structure.param_names == d.structure.param_names + ("m_foot", "I_foot")
+    assert e.params == d.params + (0.1, 5e-4)
+    assert e.total_mass_kg == pytest.approx(d.total_mass_kg + 0.2)
+
+
 @pytest.mark.slow
 def test_rigid_contact_and_mujoco_agree_within_one_percent_on_feet_with_mass(tmp_path):
     """configs/flat_feet_foot_mass.yaml (0.1 kg feet in every view): rigid step period
