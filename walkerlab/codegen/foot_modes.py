@@ -9,8 +9,12 @@ angle from the stance leg's perpendicular, positive toe up (the ankle spring's d
 plus its rest angle).  The sole angle from the horizontal is ``theta_f = stance + a``; on a
 slope ``gamma`` the foot lies flat when ``phi = stance + a + gamma = 0``.  Feet are massless
 (Wisse et al. 2006, "Ankle springs instead of arc-shaped feet for passive dynamic walkers",
-IEEE-RAS Humanoids); the ankle lies on the sole line, ``heel`` behind and ``toe`` ahead of it.
-The swing foot carries no load and sits at its spring's rest angle ``r_sw`` (no coordinate).
+IEEE-RAS Humanoids) or, with ``structure.foot_mass``, each a body of mass ``m_foot`` at its
+ankle and inertia ``I_foot`` about it; the ankle lies on the sole line, ``heel`` behind and
+``toe`` ahead of it.  The swing foot carries no load and sits at its spring's rest angle
+``r_sw`` (no coordinate; with mass it turns with its leg, the limit of its stiff, overdamped
+ankle: its spring-damper's time constant ``c / k`` is 25 ms on configs/flat_feet.yaml, its
+inertial torque ``I_foot`` times the leg's angular acceleration ~5e-3 N m).
 
 A *mode* is a pinned contact point plus locked coordinates; each is derived from the same
 bodies with Lagrange's equations ``M qdd + C dq + G = 0`` (``C`` in Christoffel form plus
@@ -33,8 +37,9 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
 - heel strike (the swing heel reaches the slope, in any stance mode): the post-impact
   velocities project the pre-impact momenta onto the coordinates with the swing heel pinned
   and the new stance ankle at the swing foot's rest angle, ``Mi dq+ = sum_i J_i+^T m_i v_i-``
-  (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms), then the leg roles swap; the
-  trailing foot is released (massless, it snaps to its rest angle) unless the double
+  (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms; feet with mass among the bodies,
+  the trailing sole's angular momentum projected on its leg's turn), then the leg roles
+  swap; the trailing foot is released (it snaps to its rest angle) unless the double
   support keeps its toe down (below).
 
 Double support (after heel strike, roles swapped;
@@ -46,7 +51,7 @@ the entry impact pins the toe (an impulse through the trailing ankle: the massle
 no impulsive moment), the second stage of the two-contact plastic impact.
 
 Ground reaction (for the heel-off and lift-off guards): the total force from Newton,
-``F = sum m_i (a_i - g)`` over the bodies (the feet are massless), normal part ``N = F . n``;
+``F = sum m_i (a_i - g)`` over the bodies (feet with mass among them), normal part ``N = F . n``;
 in foot flat the toe's share from the moment balance about the heel,
 ``N_toe (heel + toe) = sum (r_i x m_i (a_i - g)) + I_i alpha_i`` (friction along the slope
 has no moment about the heel), and the heel's ``N - N_toe``.

@@ -324,8 +324,10 @@ def double_support_phases(f: dict, c_trailing: float = 0.0,
     the contact forces of the guards carry it (a joint torque is internal: it moves the
     contact forces only through the accelerations and the constraint forces).
 
-    Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the massless
-    trailing foot then leaves the ground at its spring's rest angle, no impact) to
+    Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the trailing
+    foot then leaves the ground at its spring's rest angle, no impact; a foot with mass
+    loses its sole's turn relative to its leg with its spring's deflection, as its damper
+    dissipates them within ``c / k`` in the contact view) to
     ``heel_contact:early_swing`` / ``foot_flat:early_swing``; ``foot_slap`` to the flat
     lead (plastic, the toe kept pinned); falls: ``stance_foot_lifts`` (the leading foot's
     total normal force), ``stance_toe_lifts`` and ``stance_heel_lifts`` (foot flat),
