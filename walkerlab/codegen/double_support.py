@@ -67,8 +67,11 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     u = -sp.Matrix([sp.cos(theta), sp.sin(theta)])  # toe -> ankle
     g_row = u.T * dA
     F, mom = lead_force
+    held = k_b * (b - r_b) ** 2 / 2
+    if foot_inertia != 0:  # the sole's kinetic energy beyond turning with its leg (held in M)
+        held += foot_inertia * ((dq[0] + db) ** 2 - dq[0] ** 2) / 2
     out = {"b": b, "db": db, "b_of": b_of, "db_of": db_of, "u": u, "toe": toe,
-           "trailing_spring": k_b * (b - r_b) ** 2 / 2, "foot_angle": theta + gamma}
+           "trailing_spring": held, "foot_angle": theta + gamma}
     for lead in DOUBLE_SUPPORT_LEADS:
         rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
         gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
@@ -108,7 +111,10 @@ def double_support_lines(eq, lead: str) -> list[str]:
     rows added to the right-hand side: joint torques' ``B tau``, the closed chain's
     ``[M -J^T; J 0] [Qdd; lam] = [-C dQ - G + (B tau, 0); -dJ dQ]``),
     ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's impulse [N s])
-    and, once, ``double_support_trailing(x) -> (b, db)``."""
+    and, once, ``double_support_trailing(x) -> (b, db, held [J], sole angle from the slope
+    [rad])``, ``held`` the trailing ankle spring's energy plus, for feet with mass, the
+    trailing sole's kinetic energy beyond turning with its leg (``I ((dsw + db)^2 - dsw^2)
+    / 2``: the part the walker's ``energies`` leave out, lost with the spring's at toe off)."""
     ds = eq.double_support
     sysd = ds[lead]
     n = len(eq.q)

@@ -460,8 +460,9 @@ def generate_flat(structure: Structure, key: str) -> str:
     gen=None)`` (trailing toe normal and tangential, leading foot normal and its toe's share
     [N]; ``gen`` (3,) [N m] a generalised force in ``q``'s rows, joint torques' ``B tau``),
     ``double_support_<m>_entry(x) -> (x+, (Lam_n, Lam_t))`` [N s]; and
-    ``double_support_trailing(x) -> (b, db, spring energy [J], trailing sole angle from the
-    slope [rad])``;
+    ``double_support_trailing(x) -> (b, db, held energy [J], trailing sole angle from the
+    slope [rad])`` (held: the trailing spring's energy, with feet of mass plus the trailing
+    sole's kinetic energy beyond turning with its leg);
     ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)

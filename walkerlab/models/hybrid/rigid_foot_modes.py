@@ -307,7 +307,9 @@ def _flow_jacobian(flow, t, x):
 
 
 def _held(f: dict, c: float, x) -> tuple[float, float]:
-    """The trailing ankle's spring energy [J] and damper power [W] in double support."""
+    """The trailing ankle's spring energy [J] (with feet of mass plus its sole's kinetic
+    energy beyond turning with its leg, which the walker's ``energies`` leave out) and its
+    damper power [W] in double support."""
     _b, db, energy, _phi = f["double_support_trailing"](x)
     return float(energy), -c * float(db) ** 2
 
