@@ -250,7 +250,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         lanes = feet_part.footprints(_checkerboard(walker, ideal, terrain), data)
     latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
     notes = _walker_notes(scene, part, ideal, latch, knee, notes)
-    notes += feet_part.notes
+    notes += feet_part.notes_for(data)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     if treads is not None or profile is not None:
         lanes = None  # continuous stairs (the treads) or a profile (a height field) is the ground
@@ -406,6 +406,10 @@ class _LinkFeet:
 
     notes: tuple = ()
 
+    def notes_for(self, data) -> tuple:
+        """:attr:`notes` of the walker ``data``."""
+        return self.notes
+
     def check_format(self, fmt: str | None, walker_only: bool) -> None:
         """Every format carries these feet."""
 
@@ -436,6 +440,16 @@ class _FlatFeet(_LinkFeet):
              "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
              "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
              "gait's double support as it begins).",)
+
+    def notes_for(self, data) -> tuple:
+        """:attr:`notes`; feet with mass (``walker.leg.foot.mass_kg``): the walker's own."""
+        if not data.structure.foot_mass:
+            return self.notes
+        return (self.notes[0].replace(
+            "the contact model's regularising foot mass and inertia at the ankle "
+            "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+            "view's feet are massless)", "the walker's foot mass and inertia at the ankle "
+            "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)"),)
 
     def check_format(self, fmt: str | None, walker_only: bool) -> None:
         """Flat feet go to an MJCF with its scene only (one line naming the field)."""
