@@ -207,6 +207,26 @@ def test_heel_strike_conserves_angular_momentum_about_the_striking_heel(tmp_path
     assert abs(h0 - h_pre) > 1e-4
 
 
+def test_feet_of_vanishing_mass_give_the_massless_walker(tmp_path):
+    """The limit ``m_foot, I_foot -> 0`` (1e-7 kg, 1e-10 kg m^2) is the massless model: the
+    heel strike and the double support's toe-pinning entry (on ``(q, b)`` with mass, in
+    ``q`` through the ankle without) agree to 1e-5 rad/s and N s, and the gait's step
+    period is configs/flat_feet.yaml's 0.81016 s to 1e-5 s (0.8290 s with 0.1 kg feet)."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+
+    light = _undamped(tmp_path, mass_kg=1e-7, inertia_about_ankle_kg_m2=1e-10)
+    none = _undamped(tmp_path, mass_kg=None, inertia_about_ankle_kg_m2=None)
+    x_l, x_n = (f["reset_heel_strike_toe"](X_STRIKE) for f in (light, none))
+    np.testing.assert_allclose(x_l, x_n, atol=1e-5)
+    (e_l, i_l), (e_n, i_n) = (f["double_support_heel_contact_entry"](x_n)
+                              for f in (light, none))
+    np.testing.assert_allclose(e_l, e_n, atol=1e-5)
+    np.testing.assert_allclose(i_l, i_n, atol=1e-5)
+    scene = load_scene(_scene_with(tmp_path, lambda d: d["walker"]["leg"]["foot"].update(
+        mass_kg=1e-7, inertia_about_ankle_kg_m2=1e-10)))
+    assert float(ideal_gait(scene).period_s) == pytest.approx(0.8101592422, abs=1e-5)
+
+
 def test_energy_ledger_closes_with_the_feet_kinetic_energy(tmp_path):
     """walkerlab simulate's per-step ledger closes (dE equals the dampers' work less the
     impacts' losses to 1e-9 J) with feet of mass: the trailing sole's kinetic energy
