@@ -18,7 +18,7 @@ DOUBLE_SUPPORT_LEADS = ("heel_contact", "foot_flat")
 
 
 def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma, normal,
-                    tangent, Jl) -> dict:
+                    tangent, Jl, foot_inertia=0) -> dict:
     """Double support after heel strike (roles already swapped): the leading (stance) foot
     on its heel at ``O`` (heel contact) or flat (foot flat), the trailing (swing) foot on its
     toe at a point ``P`` of the slope.  The trailing foot's ankle angle ``b`` (its sole at
@@ -33,7 +33,16 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     restitution 0): in ``q`` the toe's pin is one row ``g = u^T dA/dq`` (``A`` the trailing
     ankle, ``u`` the unit vector from toe to ankle: a massless foot takes no impulsive
     moment, so the toe's impulse ``Lam u`` passes through the ankle) and
-    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``."""
+    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``.
+
+    Feet with mass (``foot_inertia`` ``I`` [kg m^2] about the ankle, the mass at the ankle
+    already a body of ``flows``, whose swing foot turns with its leg): the trailing sole
+    turns at ``d(swing + b)/dt``, so ``M`` gains ``I`` in the ``(swing, b)`` block beyond
+    the locked foot's ``I`` in ``(swing, swing)``; the entry is then the impact on ``Q``
+    with the toe pinned in both directions, ``[M4, -J^T (, -Jl4^T); J, 0 (; Jl4, 0)]
+    [dQ+; Lam] = [M4 (dq-, 0); 0 (; 0)]`` (the foot turning with its leg before it,
+    ``db- = 0``; ``Lam`` (2,) the toe's impulse in world axes [N s]), whose limit ``I -> 0``
+    is the massless entry above."""
     b, db = sp.symbols("b_trail db_trail", real=True)
     t_len, k_b, r_b, c_b = trailing
     sw = q[0]
@@ -47,6 +56,7 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     hc = flows["heel_contact"]
     M4 = sp.zeros(4, 4)
     M4[:3, :3] = hc.M
+    M4[0, 3] = M4[3, 0] = M4[3, 3] = foot_inertia
     rhs = sp.zeros(4, 1)
     rhs[:3, 0] = -hc.C * sp.Matrix(dq) - hc.G
     rhs[3, 0] = -c_b * db - k_b * (b - r_b)
@@ -57,8 +67,11 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     u = -sp.Matrix([sp.cos(theta), sp.sin(theta)])  # toe -> ankle
     g_row = u.T * dA
     F, mom = lead_force
+    held = k_b * (b - r_b) ** 2 / 2
+    if foot_inertia != 0:  # the sole's kinetic energy beyond turning with its leg (held in M)
+        held += foot_inertia * ((dq[0] + db) ** 2 - dq[0] ** 2) / 2
     out = {"b": b, "db": db, "b_of": b_of, "db_of": db_of, "u": u, "toe": toe,
-           "trailing_spring": k_b * (b - r_b) ** 2 / 2, "foot_angle": theta + gamma}
+           "trailing_spring": held, "foot_angle": theta + gamma}
     for lead in DOUBLE_SUPPORT_LEADS:
         rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
         gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
@@ -75,6 +88,10 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
         Ki[3:, :3] = imp_rows
         out[lead] = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
                      "Ki_rhs": (hc.M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
+        if foot_inertia != 0:  # the toe pinned on Q (see above)
+            out[lead]["Ki"] = K
+            out[lead]["Ki_rhs"] = (M4 * sp.Matrix([*dq, 0])).col_join(sp.zeros(m, 1))
+            out[lead]["entry_on_Q"] = True
     # the leading foot's ground force: Newton's total (feet massless) less the toe's; in
     # foot flat its toe's share from the moment balance about its heel, less the trailing
     # toe's moment (the lock's multiplier is that moment: its toe force times the sole)
@@ -94,7 +111,10 @@ def double_support_lines(eq, lead: str) -> list[str]:
     rows added to the right-hand side: joint torques' ``B tau``, the closed chain's
     ``[M -J^T; J 0] [Qdd; lam] = [-C dQ - G + (B tau, 0); -dJ dQ]``),
     ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's impulse [N s])
-    and, once, ``double_support_trailing(x) -> (b, db)``."""
+    and, once, ``double_support_trailing(x) -> (b, db, held [J], sole angle from the slope
+    [rad])``, ``held`` the trailing ankle spring's energy plus, for feet with mass, the
+    trailing sole's kinetic energy beyond turning with its leg (``I ((dsw + db)^2 - dsw^2)
+    / 2``: the part the walker's ``energies`` leave out, lost with the spring's at toe off)."""
     ds = eq.double_support
     sysd = ds[lead]
     n = len(eq.q)
@@ -140,12 +160,17 @@ def double_support_lines(eq, lead: str) -> list[str]:
             f" dtype=float).reshape({mi}, {mi})",
             f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[mi * mi:nk])},),"
             " dtype=float)",
-            f"{IND}_s = np.linalg.solve(_K, _b)",
-            f"{IND}_u = ({u[0]}, {u[1]})",
-            f"{IND}_L = float(_s[{n}])",
-            f"{IND}_n = (_u[0] * sin(gamma) + _u[1] * cos(gamma)) * _L",
-            f"{IND}_t = (_u[0] * cos(gamma) - _u[1] * sin(gamma)) * _L",
-            f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
+            f"{IND}_s = np.linalg.solve(_K, _b)"]
+    if sysd.get("entry_on_Q"):  # feet with mass: the toe's impulse in world axes
+        out += [f"{IND}_lx, _ly = float(_s[{n + 1}]), float(_s[{n + 2}])",
+                f"{IND}_n = _lx * sin(gamma) + _ly * cos(gamma)",
+                f"{IND}_t = _lx * cos(gamma) - _ly * sin(gamma)"]
+    else:
+        out += [f"{IND}_u = ({u[0]}, {u[1]})",
+                f"{IND}_L = float(_s[{n}])",
+                f"{IND}_n = (_u[0] * sin(gamma) + _u[1] * cos(gamma)) * _L",
+                f"{IND}_t = (_u[0] * cos(gamma) - _u[1] * sin(gamma)) * _L"]
+    out += [f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
     if lead == DOUBLE_SUPPORT_LEADS[0]:
         lines, red = cse_lines([ds["trailing_spring"], ds["foot_angle"]], PRINTER)
         out += ["    def double_support_trailing(x):", *head, *lines,

@@ -63,6 +63,11 @@ def floating_params(data: WalkerData, foot_mass_kg: float | None = None,
                     hub_inertia_kg_m2: float | None = None) -> np.ndarray:
     """The floating view's parameter vector (:func:`param_names` order) of ``data``.
 
+    ``foot_mass_kg`` [kg], ``foot_inertia_kg_m2`` [kg m^2]: a flat foot's regularising mass
+    and inertia about the ankle (``contact.flat_foot_mass_kg``, ``flat_foot_inertia_kg_m2``),
+    used only when the walker's feet are massless (``walker.leg.foot.mass_kg`` unset: feet
+    with mass carry their own ``m_foot``, ``I_foot`` in ``data.params``).
+
     ``hub_inertia_kg_m2`` [kg m^2]: a spoked wheel's regularising hub inertia
     (``contact.hub_inertia_kg_m2``), used only when the wheel's own ``I_hub`` is 0 (a
     point-mass hub, whose angle has no dynamics once no spoke is pinned); ignored otherwise.
@@ -81,7 +86,7 @@ def floating_params(data: WalkerData, foot_mass_kg: float | None = None,
                 raise ValueError(HUB_INERTIA_MESSAGE)
             p[i_hub] = float(hub_inertia_kg_m2)
         return np.asarray(p, dtype=float)
-    if data.structure.foot == "flat":
+    if data.structure.foot == "flat" and not data.structure.foot_mass:  # else the walker's
         if foot_mass_kg is None or foot_inertia_kg_m2 is None:
             raise ValueError(FLAT_FOOT_MESSAGE)
         p += [float(foot_mass_kg), float(foot_inertia_kg_m2)]

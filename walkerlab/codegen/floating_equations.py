@@ -87,8 +87,9 @@ def param_names(structure: Structure) -> tuple[str, ...]:
     """Names of the floating view's parameter vector: ``structure.param_names``, then for
     flat feet the contact model's regularising foot mass ``m_foot`` [kg] and inertia about
     the ankle ``I_foot`` [kg m^2] (:data:`FOOT_PARAMS`; the rigid view's foot is
-    massless)."""
-    extra = FOOT_PARAMS if structure.foot == "flat" else ()
+    massless) unless the walker's feet carry them (``structure.foot_mass``)."""
+    # feet with mass (walker.leg.foot.mass_kg) carry m_foot, I_foot in the walker's own vector
+    extra = FOOT_PARAMS if structure.foot == "flat" and not structure.foot_mass else ()
     return tuple(structure.param_names) + extra
 
 

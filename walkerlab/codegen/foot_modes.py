@@ -9,8 +9,12 @@ angle from the stance leg's perpendicular, positive toe up (the ankle spring's d
 plus its rest angle).  The sole angle from the horizontal is ``theta_f = stance + a``; on a
 slope ``gamma`` the foot lies flat when ``phi = stance + a + gamma = 0``.  Feet are massless
 (Wisse et al. 2006, "Ankle springs instead of arc-shaped feet for passive dynamic walkers",
-IEEE-RAS Humanoids); the ankle lies on the sole line, ``heel`` behind and ``toe`` ahead of it.
-The swing foot carries no load and sits at its spring's rest angle ``r_sw`` (no coordinate).
+IEEE-RAS Humanoids) or, with ``structure.foot_mass``, each a body of mass ``m_foot`` at its
+ankle and inertia ``I_foot`` about it; the ankle lies on the sole line, ``heel`` behind and
+``toe`` ahead of it.  The swing foot carries no load and sits at its spring's rest angle
+``r_sw`` (no coordinate; with mass it turns with its leg, the limit of its stiff, overdamped
+ankle: its spring-damper's time constant ``c / k`` is 25 ms on configs/flat_feet.yaml, its
+inertial torque ``I_foot`` times the leg's angular acceleration ~5e-3 N m).
 
 A *mode* is a pinned contact point plus locked coordinates; each is derived from the same
 bodies with Lagrange's equations ``M qdd + C dq + G = 0`` (``C`` in Christoffel form plus
@@ -33,8 +37,9 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
 - heel strike (the swing heel reaches the slope, in any stance mode): the post-impact
   velocities project the pre-impact momenta onto the coordinates with the swing heel pinned
   and the new stance ankle at the swing foot's rest angle, ``Mi dq+ = sum_i J_i+^T m_i v_i-``
-  (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms), then the leg roles swap; the
-  trailing foot is released (massless, it snaps to its rest angle) unless the double
+  (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms; feet with mass among the bodies,
+  the trailing sole's angular momentum projected on its leg's turn), then the leg roles
+  swap; the trailing foot is released (it snaps to its rest angle) unless the double
   support keeps its toe down (below).
 
 Double support (after heel strike, roles swapped;
@@ -46,7 +51,7 @@ the entry impact pins the toe (an impulse through the trailing ankle: the massle
 no impulsive moment), the second stage of the two-contact plastic impact.
 
 Ground reaction (for the heel-off and lift-off guards): the total force from Newton,
-``F = sum m_i (a_i - g)`` over the bodies (the feet are massless), normal part ``N = F . n``;
+``F = sum m_i (a_i - g)`` over the bodies (feet with mass among them), normal part ``N = F . n``;
 in foot flat the toe's share from the moment balance about the heel,
 ``N_toe (heel + toe) = sum (r_i x m_i (a_i - g)) + I_i alpha_i`` (friction along the slope
 has no moment about the heel), and the heel's ``N - N_toe``.
@@ -165,10 +170,15 @@ class _Walker:
         return self.P[f"{kind}_{ROLE_TAG[role]}_{name}" if self.structure.asymmetric
                       else f"{kind}_{name}"]
 
-    def bodies_from(self, ankle_lin: dict, pinned: str = "stance"):
+    def bodies_from(self, ankle_lin: dict, pinned: str = "stance", foot_angle=None):
         """(mass, lin, inertia, link angle, name) of every body, the hip's lin and the
         other leg's ankle's lin, for the ``pinned`` leg's ankle at ``ankle_lin``; names
-        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike)."""
+        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike).
+
+        Feet with mass (``structure.foot_mass``): each foot a body ``<role>_foot_body`` at
+        its ankle, mass ``m_foot``, inertia ``I_foot`` about it; the pinned leg's foot at
+        the sole angle ``foot_angle`` (default the stance sole's ``stance + a``), the other
+        leg's foot at its spring's rest angle from that leg (its angle no coordinate)."""
         structure, P, bp = self.structure, self.P, self.bp
         ps_sw, ps_st, _a = self.q
         L, half = P["L"], sp.pi / 2
@@ -193,7 +203,14 @@ class _Walker:
                 lin = add_length(lin, psi_t + half, P[f"e_torso_{b.name}"])
             inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
             out.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t, f"torso_{b.name}"))
-        return out, hip, add_length(hip, leg_psi[other], L)
+        other_ankle = add_length(hip, leg_psi[other], L)
+        if structure.foot_mass:
+            if foot_angle is None:
+                foot_angle = ps_st + _a
+            out.append((P["m_foot"], ankle_lin, P["I_foot"], foot_angle, f"{pinned}_foot_body"))
+            out.append((P["m_foot"], other_ankle, P["I_foot"],
+                        leg_psi[other] + self.fp("r", other), f"{other}_foot_body"))
+        return out, hip, other_ankle
 
 
 @cache
@@ -250,7 +267,8 @@ def derive_flat(structure: Structure) -> FlatEquations:
                   "swing_ankle_rate": 0 * dq[0]}
     double = derive_double_support(q, dq, qdd, flows, trailing_ankle, lead_force["heel"],
                                    (fp("toe", "swing"), fp("k", "swing"), fp("r", "swing"),
-                                    fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl)
+                                    fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl,
+                                   P["I_foot"] if structure.foot_mass else 0)
     return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
                          guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles,
                          push_off=push_off, double_support=double)
@@ -305,7 +323,7 @@ def _pinned_modes(w: _Walker, anchors: dict, normal):
         points["stance_foot"] = points["stance_ankle"]
         points["swing_foot"] = heel_sw
         for _m, lin, _i, _p, name in bodies:
-            if name != "hip":
+            if name != "hip" and not name.endswith("_foot_body"):  # feet: at the ankles
                 points[name] = at(lin)
         T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
         kin[pin] = {"points": points, "kinetic": T, "potential": V}
@@ -385,7 +403,7 @@ def _locked_and_resets(w: _Walker, anchors: dict, flows: dict, Jl):
                                    B=(S.T * hc.M).col_join(sp.zeros(1, 3)),
                                    relabel_q=qv, relabel_rate=sp.eye(3))}
     post_q = (ps_sw, ps_st, b_new)
-    post_bodies, _h, _a = w.bodies_from({ps_sw + b_new + half: hw}, "swing")
+    post_bodies, _h, _a = w.bodies_from({ps_sw + b_new + half: hw}, "swing", ps_sw + b_new)
     post = {b[4]: b for b in post_bodies}
     relabel_q = sp.Matrix([ps_st, ps_sw, rw])
     relabel_rate = sp.Matrix([[0, 1, 0], [1, 0, 0], [0, 0, 1]])
@@ -442,8 +460,9 @@ def generate_flat(structure: Structure, key: str) -> str:
     gen=None)`` (trailing toe normal and tangential, leading foot normal and its toe's share
     [N]; ``gen`` (3,) [N m] a generalised force in ``q``'s rows, joint torques' ``B tau``),
     ``double_support_<m>_entry(x) -> (x+, (Lam_n, Lam_t))`` [N s]; and
-    ``double_support_trailing(x) -> (b, db, spring energy [J], trailing sole angle from the
-    slope [rad])``;
+    ``double_support_trailing(x) -> (b, db, held energy [J], trailing sole angle from the
+    slope [rad])`` (held: the trailing spring's energy, with feet of mass plus the trailing
+    sole's kinetic energy beyond turning with its leg);
     ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)

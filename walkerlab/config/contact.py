@@ -256,10 +256,12 @@ class ContactSettings(BaseModel):
 
     flat_foot_mass_kg: float | None = Field(
         None, gt=0, le=100, description="Flat feet only: "
-        "each foot's mass [kg], at its ankle.  The walker description's flat foot is "
-        "massless (the rigid view); the floating contact model regularises it with this "
-        "small mass, a contact-model setting like the stiffness (with zero mass the foot's "
-        "angle would have no dynamics of its own).",
+        "each foot's mass [kg], at its ankle.  A massless flat foot in the walker "
+        "description (the rigid view's limit) is regularised in the floating contact model "
+        "(and the MJCF and Adams exports) with this small mass, a contact-model setting like "
+        "the stiffness (with zero mass the foot's angle would have no dynamics of its own); "
+        "its share shows as the views' difference.  Feet with mass in the description "
+        "(walker.leg.foot.mass_kg) are every view's: this is then refused.",
         json_schema_extra={"unit": "kg"})
     flat_foot_inertia_kg_m2: float | None = Field(
         None, gt=0, le=100, description="Flat feet only (SI): each foot's moment of inertia "

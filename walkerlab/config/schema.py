@@ -171,6 +171,21 @@ class Scene(Strict):
         return self
 
     @model_validator(mode="after")
+    def _one_foot_mass(self) -> Scene:
+        # feet with mass (walker.leg.foot.mass_kg) are the same feet in every view: the
+        # contact section's regularising foot mass would be a second, different foot
+        c = self.contact
+        foot = getattr(getattr(self.walker, "leg", None), "foot", None)
+        if foot is None and getattr(self.walker, "legs", None):
+            foot = self.walker.legs[0].foot
+        if (c is not None and getattr(foot, "kind", "") == "flat" and foot.mass() is not None
+                and (c.flat_foot_mass_kg is not None or c.flat_foot_inertia_kg_m2 is not None)):
+            raise ValueError("contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the "
+                             "walker's feet carry their own mass (walker.leg.foot.mass_kg, "
+                             "inertia_about_ankle_kg_m2), used by every view: remove these")
+        return self
+
+    @model_validator(mode="after")
     def _ground_fits_the_walker(self) -> Scene:
         t = self.terrain
         if t is None or t.kind != "stairs":

@@ -150,10 +150,15 @@ MIN_SOLE_FRACTION = 1e-3
 
 
 class FlatFoot(Strict):
-    """A massless flat foot on an ankle spring: a sole segment through the leg's end (the
-    ankle lies on the sole line, ankle height 0) from the heel, ``heel_m`` behind the ankle,
-    to the toe, ``toe_m`` ahead of it (Wisse et al. 2006).  A stance step rolls through heel
-    contact, foot flat and heel off (toe contact)."""
+    """A flat foot on an ankle spring: a sole segment through the leg's end (the ankle lies
+    on the sole line, ankle height 0) from the heel, ``heel_m`` behind the ankle, to the toe,
+    ``toe_m`` ahead of it (Wisse et al. 2006).  A stance step rolls through heel contact,
+    foot flat and heel off (toe contact).
+
+    Massless unless ``mass_kg`` and ``inertia_about_ankle_kg_m2`` are given: then every view
+    carries the same foot (its centre of mass at the ankle), the rigid view included, and the
+    contact model and the exports take these numbers instead of the contact section's
+    regularising ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``."""
 
     kind: Literal["flat"] = Field(description="foot shape")
     heel_m: float = Field(ge=0, le=10, description="heel behind the ankle along the sole [m] "
@@ -161,6 +166,32 @@ class FlatFoot(Strict):
     toe_m: float = Field(gt=0, le=10, description="toe ahead of the ankle along the sole [m] "
                          "(at least MIN_SOLE_FRACTION of the leg)")
     ankle: AnkleSpec = Field(description="the ankle joint's spring and damper")
+    mass_kg: float | None = Field(None, gt=0, le=100, description="the foot's mass [kg], its "
+                                  "centre of mass at the ankle (null: a massless foot; give "
+                                  "inertia_about_ankle_kg_m2 with it)",
+                                  json_schema_extra={"unit": "kg"})
+    inertia_about_ankle_kg_m2: float | None = Field(
+        None, gt=0, le=100, description="the foot's moment of inertia about its ankle "
+        "[kg m^2] (null: a massless foot; give mass_kg with it)",
+        json_schema_extra={"unit": "kg m^2"})
+
+    @model_validator(mode="after")
+    def _mass_and_inertia_together(self) -> FlatFoot:
+        if (self.mass_kg is None) != (self.inertia_about_ankle_kg_m2 is None):
+            raise ValueError("mass_kg and inertia_about_ankle_kg_m2: a flat foot's mass and "
+                             "its inertia about the ankle go together (give both or neither)")
+        return self
+
+    @model_serializer(mode="wrap")
+    def _massless_as_before(self, handler):
+        # a massless foot serialises as before the fields existed (same scene hashes)
+        return drop_unset(handler(self), ("mass_kg", "inertia_about_ankle_kg_m2"))
+
+    def mass(self) -> tuple[float, float] | None:
+        """``(mass_kg, inertia_about_ankle_kg_m2)`` or None for a massless foot."""
+        if self.mass_kg is None:
+            return None
+        return float(self.mass_kg), float(self.inertia_about_ankle_kg_m2)
 
 
 Foot = Annotated[PointFoot | ArcFoot | FlatFoot, Field(discriminator="kind")]
@@ -388,6 +419,9 @@ class BipedParams(_Actuated):
                 if va != vb:
                     raise ValueError(f"legs: both legs need the same {what} (masses, "
                                      "distances and inertias may differ)")
+            if a.foot.kind == "flat" and a.foot.mass() != b.foot.mass():
+                raise ValueError("legs: both flat feet need the same mass_kg and "
+                                 "inertia_about_ankle_kg_m2 (heel, toe and ankle may differ)")
             for x, y in zip(a.bodies, b.bodies):
                 if (x.mass_kg == 0) != (y.mass_kg == 0):
                     raise ValueError(f"legs: body {x.name!r} is massless on one leg only")

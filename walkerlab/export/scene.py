@@ -250,7 +250,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         lanes = feet_part.footprints(_checkerboard(walker, ideal, terrain), data)
     latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
     notes = _walker_notes(scene, part, ideal, latch, knee, notes)
-    notes += feet_part.notes
+    notes += feet_part.notes_for(data)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     if treads is not None or profile is not None:
         lanes = None  # continuous stairs (the treads) or a profile (a height field) is the ground
@@ -352,7 +352,9 @@ def flat_feet(scene: Scene, data) -> tuple:
     """Per leg (leg1, leg2: leg1 the swing role's numbers when the legs differ) ``(heel,
     toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot mass
     [kg], inertia about the ankle [kg m^2])`` of a flat-footed walker; mass and inertia the
-    contact model's (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``).
+    walker's (``walker.leg.foot.mass_kg``, ``inertia_about_ankle_kg_m2``) or, for massless
+    feet, the contact model's (``contact.flat_foot_mass_kg``,
+    ``contact.flat_foot_inertia_kg_m2``).
 
     Raises
     ------
@@ -360,13 +362,14 @@ def flat_feet(scene: Scene, data) -> tuple:
         The scene has no foot mass or inertia (one line naming the fields).
     """
     settings = scene.contact or ContactSettings()
-    mi = settings.flat_foot()
+    st = data.structure
+    P = dict(zip(st.param_names, data.params))
+    # the walker's own feet (walker.leg.foot.mass_kg) or the contact model's regularising ones
+    mi = (P["m_foot"], P["I_foot"]) if st.foot_mass else settings.flat_foot()
     if mi is None:
         raise ValueError("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: an "
                          "MJCF's flat feet need their mass and inertia (the rigid view's "
                          "feet are massless)")
-    st = data.structure
-    P = dict(zip(st.param_names, data.params))
     tags = ("sw_", "st_") if st.asymmetric else ("", "")
     return tuple((P[f"heel_{t}m"], P[f"toe_{t}m"], P[f"k_{t}ankle"], P[f"c_{t}ankle"],
                   P[f"r_{t}ankle"], *mi) for t in tags)
@@ -403,6 +406,10 @@ class _LinkFeet:
 
     notes: tuple = ()
 
+    def notes_for(self, data) -> tuple:
+        """:attr:`notes` of the walker ``data``."""
+        return self.notes
+
     def check_format(self, fmt: str | None, walker_only: bool) -> None:
         """Every format carries these feet."""
 
@@ -434,6 +441,16 @@ class _FlatFeet(_LinkFeet):
              "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
              "gait's double support as it begins).",)
 
+    def notes_for(self, data) -> tuple:
+        """:attr:`notes`; feet with mass (``walker.leg.foot.mass_kg``): the walker's own."""
+        if not data.structure.foot_mass:
+            return self.notes
+        return (self.notes[0].replace(
+            "the contact model's regularising foot mass and inertia at the ankle "
+            "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+            "view's feet are massless)", "the walker's foot mass and inertia at the ankle "
+            "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)"),)
+
     def check_format(self, fmt: str | None, walker_only: bool) -> None:
         """Flat feet go to an MJCF with its scene only (one line naming the field)."""
         if fmt != "mjcf" or walker_only:
@@ -443,7 +460,8 @@ class _FlatFeet(_LinkFeet):
                              "mass)")
 
     def foot_mass(self, settings: ContactSettings):
-        """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2``."""
+        """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2`` (the
+        contact walker uses them for massless feet only: feet with mass carry their own)."""
         return settings.flat_foot()
 
     def keyframe(self, scene: Scene, mb, data, walker, x_ideal):

@@ -105,6 +105,11 @@ class Structure:
         The torso (``torso`` bodies) is jointed at the hip with its own coordinate, role
         ``torso`` (its angle from the upward vertical, positive leaning back); needs
         ``free_knees``.
+    foot_mass : bool
+        Flat feet with mass (``walker.leg.foot.mass_kg``): each foot a body with mass
+        ``m_foot`` [kg] at its ankle and inertia ``I_foot`` [kg m^2] about it (the same on
+        both legs; after the flat feet's numbers in :attr:`param_names`); False: massless
+        feet (the limit ``m_foot -> 0``).
     spokes : int
         0, or the number of spokes of a spoked wheel (``model: rimless_wheel``): one rigid
         body, a hub with ``spokes`` massless spokes ``2 alpha = 2 pi / spokes`` apart,
@@ -126,6 +131,7 @@ class Structure:
     free_knees: bool = False
     hinged_torso: bool = False
     spokes: int = 0
+    foot_mass: bool = False
 
     @property
     def kind(self) -> Kind:
@@ -167,6 +173,8 @@ class Structure:
             for t in tags:
                 names += [f"heel_{t}m", f"toe_{t}m", f"k_{t}ankle", f"r_{t}ankle",
                           f"c_{t}ankle"]
+            if self.foot_mass:
+                names += ["m_foot", "I_foot"]
         for b in self.torso:
             names += [f"m_torso_{b.name}", f"d_torso_{b.name}"]
             if b.off_axis:
@@ -197,6 +205,8 @@ class Structure:
             d["free_knees"] = True
         if self.hinged_torso:
             d["hinged_torso"] = True
+        if self.foot_mass:
+            d["foot_mass"] = True
         if self.spokes:
             d = {"spokes": self.spokes}
         return json.dumps(d)
@@ -358,6 +368,7 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     f2 = _flat_foot_values(leg2.foot) if flat else []
     asym = asym or f1 != f2
     n_foot_tail = len(tail)  # the flat foot's numbers (per role) go here, before the torso's
+    foot_mass = leg1.foot.mass() if flat else None  # the same on both legs (config checks)
     torso, torso_tail = _torso_section(walker_cfg.torso)
     tail += torso_tail
     pairs, steps = _spring_steps(walker_cfg.springs)
@@ -371,17 +382,19 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
                           springs=tuple(pairs), knee_spring=knee_spring is not None,
                           free_knees=leg.knee is not None and leg.knee.lock == "free",
                           hinged_torso=(walker_cfg.torso is not None
-                                        and walker_cfg.torso.coupling == "hinged"))
+                                        and walker_cfg.torso.coupling == "hinged"),
+                          foot_mass=foot_mass is not None)
 
     def params(swing_vals, stance_vals, feet, springs) -> tuple[float, ...]:
         return _param_vector(head, _leg_block(bodies, asym, swing_vals, stance_vals),
                              tail, n_foot_tail, feet if asym else feet[:1], springs,
-                             knee_spring)
+                             knee_spring, foot_mass)
 
     p1 = params(v1, v2, (f1, f2), steps[0])
     p2 = params(v2, v1, (f2, f1), steps[1])
     total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
-             + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ())))
+             + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ()))
+             + (2 * foot_mass[0] if foot_mass is not None else 0.0))
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
                       slope_rad, extra, None if p2 == p1 else p2)
 
@@ -430,11 +443,12 @@ def _spring_steps(springs) -> tuple[list, tuple[list, list]]:
 
 
 def _param_vector(head, block, tail, n_foot_tail: int, feet, springs,
-                  knee_spring) -> tuple[float, ...]:
+                  knee_spring, foot_mass=None) -> tuple[float, ...]:
     """One step's parameter vector: ``head``, the legs' ``block``, the knee's and arc's
-    numbers, the flat feet's (per role), the torso's, the springs', the knee spring's."""
+    numbers, the flat feet's (per role) and their mass and inertia if any, the torso's, the
+    springs', the knee spring's."""
     vals = (head + block + tail[:n_foot_tail] + [x for f in feet for x in f]
-            + tail[n_foot_tail:])
+            + (list(foot_mass) if foot_mass is not None else []) + tail[n_foot_tail:])
     for k in springs:
         vals += k
     if knee_spring is not None:

@@ -15,8 +15,9 @@ walker's :class:`Kind`:
     Legs with knees that are free in early swing and lock at the knee strike (McGeer 1990,
     "Passive walking with knees"; Hsu Chen 2007): two phases, two resets.
 ``flat_feet``
-    Straight legs on massless flat feet on ankle springs, the stance foot going through heel
-    contact, foot flat and heel off (foot modes: a phase graph of its own).
+    Straight legs on flat feet (massless, or with mass at the ankle) on ankle springs, the
+    stance foot going through heel contact, foot flat and heel off (foot modes: a phase
+    graph of its own).
 ``free_joints``
     Every joint free - hips and knees, optionally a hinged torso: the five-link biped
     (Westervelt, Grizzle & Koditschek 2003, RABBIT), driven by joint torques.

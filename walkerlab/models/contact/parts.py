@@ -162,7 +162,8 @@ class FlatFeetPart(ContactPart):
     def check(self, scene, data, cs) -> str | None:
         from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE
 
-        return FLAT_FOOT_MESSAGE if scene.contact.flat_foot() is None else None
+        missing = scene.contact.flat_foot() is None and not data.structure.foot_mass
+        return FLAT_FOOT_MESSAGE if missing else None
 
 
 class FreeJointsPart(KneedPart):

@@ -307,7 +307,9 @@ def _flow_jacobian(flow, t, x):
 
 
 def _held(f: dict, c: float, x) -> tuple[float, float]:
-    """The trailing ankle's spring energy [J] and damper power [W] in double support."""
+    """The trailing ankle's spring energy [J] (with feet of mass plus its sole's kinetic
+    energy beyond turning with its leg, which the walker's ``energies`` leave out) and its
+    damper power [W] in double support."""
     _b, db, energy, _phi = f["double_support_trailing"](x)
     return float(energy), -c * float(db) ** 2
 
@@ -324,8 +326,10 @@ def double_support_phases(f: dict, c_trailing: float = 0.0,
     the contact forces of the guards carry it (a joint torque is internal: it moves the
     contact forces only through the accelerations and the constraint forces).
 
-    Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the massless
-    trailing foot then leaves the ground at its spring's rest angle, no impact) to
+    Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the trailing
+    foot then leaves the ground at its spring's rest angle, no impact; a foot with mass
+    loses its sole's turn relative to its leg with its spring's deflection, as its damper
+    dissipates them within ``c / k`` in the contact view) to
     ``heel_contact:early_swing`` / ``foot_flat:early_swing``; ``foot_slap`` to the flat
     lead (plastic, the toe kept pinned); falls: ``stance_foot_lifts`` (the leading foot's
     total normal force), ``stance_toe_lifts`` and ``stance_heel_lifts`` (foot flat),
