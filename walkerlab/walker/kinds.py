@@ -19,7 +19,10 @@ walker's :class:`Kind`:
     contact, foot flat and heel off (foot modes: a phase graph of its own).
 ``free_joints``
     Every joint free - hips and knees, optionally a hinged torso: the five-link biped
-    (Westervelt, Grizzle & Koditschek 2003, RABBIT), driven by joint torques.
+    (Westervelt, Grizzle & Koditschek 2003, RABBIT) - or a hinged torso on straight legs:
+    the three-link walker (Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau,
+    Choi & Morris 2007), driven by joint torques.  One flow per step, every coordinate a
+    link's absolute angle, one heel strike and the legs' role swap.
 ``rolling_polygon``
     A rimless (spoked) wheel: one rigid body rolling on its spokes (McGeer 1990; Coleman,
     Chatterjee & Ruina 1997).  It has no joint, so no actuator.
@@ -140,8 +143,10 @@ KINDS = {k.name: k for k in (
          "McGeer 1990 (passive walking with knees); Hsu Chen 2007"),
     Kind("flat_feet", "flat feet on ankle springs (foot modes)",
          "McGeer 1990; Collins, Wisse & Ruina 2001"),
-    Kind("free_joints", "free hips and knees, hinged torso (five-link biped)",
-         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)"),
+    Kind("free_joints", "free-jointed biped (a hinged torso on free hips, with free knees "
+         "or straight legs: five- and three-link)",
+         "Grizzle, Abba & Plestan 2001 (three-link); Westervelt, Grizzle & Koditschek 2003 "
+         "(RABBIT); Westervelt et al. 2007"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
          "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
 )}
@@ -273,7 +278,7 @@ def kind_of(structure) -> Kind:
     """
     if structure.spokes:
         return KINDS["rolling_polygon"]
-    if structure.free_knees:
+    if structure.free_knees or structure.hinged_torso:
         return KINDS["free_joints"]
     if structure.foot == "flat":
         return KINDS["flat_feet"]
