@@ -181,6 +181,16 @@ class FreeJointsPart(KneedPart):
         return JointTorqueActuators(data, spec, coordinates, pulse_s)
 
 
+class HingedTorsoPart(FreeJointsPart):
+    """A torso hinged on straight legs (the three-link walker): its hip torques are the rigid
+    view's joint torques."""
+
+    periodic_actuators = ("contact_sim.start / periodic_gait: the contact periodic gait's "
+                          "step map carries straight legs' hip torques between the legs and "
+                          "push-off, not joint torques between a torso and the legs: start "
+                          "from the rigid gait (start: ideal, periodic_gait: false)")
+
+
 class RollingPolygonPart(ContactPart):
     """A rimless (spoked) wheel: one rigid body on its spokes' tips."""
 
@@ -224,6 +234,7 @@ PARTS: dict[str, ContactPart] = {
     "locking_knees": KneedPart(),
     "flat_feet": FlatFeetPart(),
     "free_joints": FreeJointsPart(),
+    "hinged_torso": HingedTorsoPart(),
     "rolling_polygon": RollingPolygonPart(),
 }
 
