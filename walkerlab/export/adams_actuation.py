@@ -228,12 +228,17 @@ def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
         sh = {g: marker_id(ids[f"{g}_shank"], "joint") for g in ("leg1", "leg2")}
     to = marker_id(ids["torso"], "joint")
     sgn = f"VARVAL({V['sign']})"
-    out = ["! joint torques (walker.actuation.torques) [N mm] of a free-jointed biped: +tau",
-           "! on the second link of the joint (thigh or leg, shank), -tau on the first",
-           "! (torso, thigh); the joints follow the roles: stance_hip = stance thigh (or",
-           "! leg) - torso, swing_knee = swing shank - swing thigh, ... (the role sign picks",
-           "! the leg); the phase variable the angle of the line from the hip to the stance",
-           "! foot from the downward vertical, ATAN2(dx, -dy), and its rate"]
+    out = (["! joint torques (walker.actuation.torques) [N mm] of a five-link biped: +tau on",
+            "! the second link of the joint (thigh, shank), -tau on the first (torso,",
+            "! thigh); the joints follow the roles: stance_hip = stance thigh - torso,",
+            "! swing_knee = swing shank - swing thigh, ... (the role sign picks the leg);"]
+           if kneed else
+           ["! joint torques (walker.actuation.torques) [N mm] between a hinged torso and",
+            "! straight legs: +tau on the leg, -tau on the torso; the joints follow the",
+            "! roles: stance_hip = stance leg - torso, swing_hip = swing leg - torso (the",
+            "! role sign picks the leg);"]) + [
+           "! the phase variable the angle of the line from the hip to the stance foot",
+           "! from the downward vertical, ATAN2(dx, -dy), and its rate"]
     for g, (a, r) in (("leg1", (380, 382)), ("leg2", (381, 383))):
         f, h = feet[g], th[g]
         out += [_var(a, f"ATAN2(DX({f},{h}),-DY({f},{h}))"),
