@@ -62,7 +62,8 @@ def make_five_link_walker(data: WalkerData, name: str = "biped",
     Parameters
     ----------
     data : WalkerData
-        Of the ``free_joints`` kind (:attr:`walkerlab.walker.description.Structure.kind`).
+        Of a free-jointed kind, ``free_joints`` or ``hinged_torso``
+        (:attr:`walkerlab.walker.description.Structure.kind`).
     name, variant : str
         Stored in artifacts.
 
