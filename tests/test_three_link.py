@@ -72,6 +72,37 @@ def test_mass_matrix_bias_and_heel_strike_are_the_books(p, slope):
                                    ref.energy(x, p), rtol=TOL)
 
 
+@pytest.mark.parametrize("p, slope", [(BOOK, 0.0), (ODD, 0.04)])
+def test_arc_feet_roll_as_the_reference(p, slope):
+    """On arc feet (R = 0.3 m; McGeer 1990) the stance arc rolls and the heel strike is about
+    the swing arc's material contact point: the generated ``M``, ``h``, ``De`` and heel
+    strike equal the reference's (its hand-written Jacobians with the rolling offset, the
+    Coriolis and gravity terms by the complex step, exact to round-off) to 1e-12; with
+    R = 0 that reference is the closed forms'."""
+    R = 0.3
+    d = _scene(p, slope, actuation=False)
+    d["walker"]["leg"]["foot"] = {"kind": "arc", "radius_m": R}
+    data = walker_data(scene_from_dict(d).walker, slope)
+    assert data.structure.kind.name == "hinged_torso"
+    f = functions(data)
+    for x in _states(11):
+        q, dq = x[:3], x[3:]
+        M0, h0 = ref.rolling_dynamics(q, dq, p)
+        np.testing.assert_allclose(M0, ref.mass_matrix(q, p), rtol=0,
+                                   atol=TOL * np.abs(M0).max())
+        np.testing.assert_allclose(h0, ref.bias(q, dq, p), rtol=0,
+                                   atol=TOL * np.abs(h0).max())
+        M, C, G = f["matrices"](x)
+        Mr, hr = ref.rolling_dynamics(q, dq, p, slope, R)
+        np.testing.assert_allclose(M, Mr, rtol=0, atol=TOL * np.abs(Mr).max())
+        np.testing.assert_allclose(C @ dq + G, hr, rtol=0, atol=TOL * np.abs(hr).max())
+        De, _ = f["impact_matrices"](q)
+        Der = ref.extended_mass_matrix(q, p, slope, R)
+        np.testing.assert_allclose(De, Der, rtol=0, atol=TOL * np.abs(Der).max())
+        xr = ref.impact(x, p, slope, R)
+        np.testing.assert_allclose(f["reset"](x), xr, rtol=0, atol=TOL * np.abs(xr).max())
+
+
 def _law(scene: dict):
     """The reference's PD law from the scene's tables and gains (stance_hip, swing_hip)."""
     torques = {t["joint"]: t["law"] for t in scene["walker"]["actuation"]["torques"]}
@@ -233,11 +264,9 @@ def _refusal(change) -> str:
         {"kind": "point_mass", "name": "shank", "link": "shank", "mass_kg": 2.5,
          "from_hip_m": 0.75}]),
      "torso.coupling: 'hinged' needs straight legs or free knees"),
-    (lambda w: w["leg"].update(foot={"kind": "arc", "radius_m": 0.2}),
-     "a hinged torso on straight legs needs leg.foot.kind: point"),
     (lambda w: w["leg"].update(foot={"kind": "flat", "heel_m": 0.05, "toe_m": 0.1,
                                      "ankle": {"stiffness_n_m_per_rad": 10.0}}),
-     "a hinged torso on straight legs needs leg.foot.kind: point"),
+     "a hinged torso on straight legs needs leg.foot.kind: point or arc"),
     (lambda w: w.update(springs=[{"between": ["leg1", "leg2"],
                                   "stiffness_n_m_per_rad": 1.0}]),
      "needs no springs"),

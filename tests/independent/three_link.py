@@ -94,32 +94,71 @@ def acceleration(q, dq, u, p) -> np.ndarray:
     return np.linalg.solve(mass_matrix(q, p), B @ np.asarray(u, float) - bias(q, dq, p))
 
 
-def _jacobians(q, p) -> tuple[list, np.ndarray]:
-    """``[(mass, J (2, 5))]`` of the point masses in ``(q1, q2, q3, x_f, y_f)`` and the swing
-    foot's Jacobian ``E`` (2, 5)."""
+def _u(a):
+    """Unit vector of a leg at ``a`` from the downward vertical, and its derivative."""
+    return np.array([np.sin(a), -np.cos(a)]), np.array([np.cos(a), np.sin(a)])
+
+
+def _jacobians(q, p, gamma=0.0, R=0.0) -> tuple[list, np.ndarray]:
+    """``[(mass, J (2, 5), height)]`` of the point masses in ``(q1, q2, q3, x_f, y_f)`` and
+    the Jacobian ``E`` (2, 5) of the swing foot's material contact point.  Arc feet of
+    radius ``R`` (McGeer 1990; centre on the leg at ``r - R`` from the hip): the stance arc
+    rolls, its contact point ``-R (q1 + gamma)`` along the slope (tangent ``t = (cos gamma,
+    -sin gamma)``, normal ``n = (sin gamma, cos gamma)``) from the step's reference point,
+    its centre at ``R n`` above that; the swing arc's material contact point moves at its
+    centre's velocity plus ``R q2' t``.  Complex-safe (the complex step below)."""
     q1, q2, q3 = q
     r, m, d, MH, MT, lt = (p[k] for k in ("r", "m", "d", "MH", "MT", "l"))
-    c1, s1, c2, s2, c3, s3 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2), np.cos(q3), \
-        np.sin(q3)
-    hip = np.array([[-r * c1, 0, 0, 1, 0], [-r * s1, 0, 0, 0, 1]], float)
-    stance = np.array([[-(r - d) * c1, 0, 0, 1, 0], [-(r - d) * s1, 0, 0, 0, 1]], float)
-    swing = hip + np.array([[0, d * c2, 0, 0, 0], [0, d * s2, 0, 0, 0]])
-    torso = hip + np.array([[0, 0, -lt * c3, 0, 0], [0, 0, -lt * s3, 0, 0]])
-    E = hip + np.array([[0, r * c2, 0, 0, 0], [0, r * s2, 0, 0, 0]])
-    return [(MH, hip), (m, stance), (m, swing), (MT, torso)], E
+    t = np.array([np.cos(gamma), -np.sin(gamma)])
+    n = np.array([np.sin(gamma), np.cos(gamma)])
+    (u1, du1), (u2, du2), (u3, du3) = _u(q1), _u(q2), _u(q3)
+    base, dbase = -R * (q1 + gamma) * t + R * n, -R * t  # the stance arc's centre
+
+    def jac(d1=0.0, d2=0.0, d3=0.0):
+        return np.column_stack([d1 * np.ones(2) if np.isscalar(d1) else d1,
+                                d2 * np.ones(2) if np.isscalar(d2) else d2,
+                                d3 * np.ones(2) if np.isscalar(d3) else d3, np.eye(2)])
+    hip, dhip = base - (r - R) * u1, dbase - (r - R) * du1
+    bodies = [(MH, jac(dhip), hip[1]),
+              (m, jac(dbase - (r - R - d) * du1), (base - (r - R - d) * u1)[1]),
+              (m, jac(dhip, d * du2), (hip + d * u2)[1]),
+              (MT, jac(dhip, 0.0, -lt * du3), (hip - lt * u3)[1])]
+    E = jac(dhip, (r - R) * du2 + R * t)
+    return bodies, E
 
 
-def extended_mass_matrix(q, p) -> np.ndarray:
+def extended_mass_matrix(q, p, gamma=0.0, R=0.0) -> np.ndarray:
     """``De`` (5, 5) in ``(q, x_f, y_f)``."""
-    bodies, _ = _jacobians(q, p)
-    return sum(mass * J.T @ J for mass, J in bodies)
+    bodies, _ = _jacobians(q, p, gamma, R)
+    return sum(mass * J.T @ J for mass, J, _ in bodies)
 
 
-def impact(x, p) -> np.ndarray:
+def rolling_dynamics(q, dq, p, gamma=0.0, R=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(M, h)`` of any foot radius (arc feet; ``R = 0`` the point feet of the closed
+    forms): ``M`` the pinned block of :func:`extended_mass_matrix`, ``h = C q' + G`` with
+    ``h_i = sum_jk (dM_ij/dq_k - dM_jk/dq_i / 2) q'_j q'_k + dV/dq_i``, the derivatives by
+    the complex step (exact to round-off)."""
+    q = np.asarray(q, float)
+    dq = np.asarray(dq, float)
+    step = 1e-30
+
+    def M_of(z):
+        return extended_mass_matrix(z, p, gamma, R)[:3, :3]
+
+    def V_of(z):
+        return sum(mass * p["g"] * y for mass, _, y in _jacobians(z, p, gamma, R)[0])
+    dM = [np.imag(M_of(q + 1j * step * e)) / step for e in np.eye(3)]
+    G = np.array([np.imag(V_of(q + 1j * step * e)) / step for e in np.eye(3)])
+    h = np.array([sum((dM[k][i, j] - 0.5 * dM[i][j, k]) * dq[j] * dq[k]
+                      for j in range(3) for k in range(3)) for i in range(3)])
+    return np.real(M_of(q)), h + G
+
+
+def impact(x, p, gamma=0.0, R=0.0) -> np.ndarray:
     """The heel strike and relabelling: post-impact state (6,) of the pre-impact ``x``."""
     q, dq = np.asarray(x[:3], float), np.asarray(x[3:], float)
-    De = extended_mass_matrix(q, p)
-    _, E = _jacobians(q, p)
+    De = extended_mass_matrix(q, p, gamma, R)
+    _, E = _jacobians(q, p, gamma, R)
     A = np.block([[De, -E.T], [E, np.zeros((2, 2))]])
     rhs = np.concatenate([De @ np.concatenate([dq, [0.0, 0.0]]), [0.0, 0.0]])
     dqe = np.linalg.solve(A, rhs)[:3]

@@ -34,9 +34,11 @@ uses):
   (the torso keeps its angle);
 - guards: ``heel_strike`` = ``swing_clearance`` = the swing foot's height above the slope
   (straight legs: ``heel_strike = q_st + q_sw + 2 gamma``, the legs symmetric about the
-  slope's normal, as :mod:`walkerlab.codegen.symbolic`'s; their swing foot passes through the ground at mid-stance,
-  which the ideal model ignores), ``swing_foot_ahead`` = its distance ahead of the stance
-  foot along the slope, ``hip_height``;
+  slope's normal, as :mod:`walkerlab.codegen.symbolic`'s; their swing foot passes through
+  the ground at mid-stance, which the ideal model ignores), ``swing_foot_ahead`` = its
+  distance ahead of the stance foot along the slope, ``hip_height``;
+- arc feet (straight legs only): the stance arc rolls (:func:`_rolling`), the impact is
+  about the swing arc's material contact point;
 - Poincare section: the post-impact states, where the new swing foot (behind) is on the
   ground; the swing shank's angle is solved from that (``-acos(..) - gamma``; a straight
   swing leg's ``-q_st - 2 gamma``, the legs symmetric about the slope's normal);
@@ -74,7 +76,8 @@ def _check(structure: Structure) -> None:
     if not straight and (not structure.free_knees or not structure.knee):
         raise ValueError("walker.leg.knee.lock: the five-link generator needs free knees "
                          "(or straight legs under a hinged torso)")
-    if (structure.foot != "point" or structure.asymmetric or structure.springs
+    arc_ok = straight and structure.foot == "arc"
+    if ((structure.foot != "point" and not arc_ok) or structure.asymmetric or structure.springs
             or structure.knee_spring or any(b.off_axis or b.massless for b in structure.bodies)
             or any(b.off_axis for b in structure.torso)
             or (structure.torso and not structure.hinged_torso)):
@@ -147,6 +150,62 @@ def _extended(q, dq, bodies: list, foot):
     return sp.hessian(Te, dqe), (foot + sp.Matrix([xf, yf])).jacobian(qe)
 
 
+def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, tangent):
+    """Straight legs on arc feet (radius ``R``, centre on the leg's axis at ``L - R`` from
+    the hip; McGeer 1990): every position gains the stance arc's rolling offset ``-R (q_st +
+    gamma) t + R n`` (its contact point rolls along the slope from the step's reference
+    point), so ``M`` and the impact matrices come from plain Jacobians; the impact is about
+    the swing arc's material contact point, moving at ``v_centre + R w t`` (``w`` the swing
+    leg's rate), as :mod:`walkerlab.codegen.symbolic`'s arc feet.
+
+    Returns
+    -------
+    M, Mi, B : Matrix (n, n)
+    V : Expr
+    points : dict
+        The named points (``stance_foot`` the step's reference point, ``stance_contact``,
+        ``stance_foot_centre``, ``swing_contact``, ``swing_foot_centre``, ``swing_foot``
+        the next step's reference point).
+    De, E : Matrix
+        The extended impact (:func:`_extended`'s, with the offset and the arc's spin).
+    """
+    R, gamma, g = P["R_foot"], P["gamma"], P["g"]
+    st, ws = psi["stance"], psi["swing"]
+    offset = -R * (st + gamma) * tangent + R * normal
+    qv = sp.Matrix(q)
+    n = len(q)
+    spin = sp.Matrix([[sp.diff(ws, k) for k in q]])
+    centre = position_of(point_lin["swing_foot"]) + offset
+    Jf = centre.jacobian(qv) + R * tangent * spin  # the swing arc's material contact point
+    M, Mi, B = sp.zeros(n, n), sp.zeros(n, n), sp.zeros(n, n)
+    V = sp.Integer(0)
+    for mass, lin, inertia, a in bodies:
+        pos = position_of(lin) + offset
+        J = pos.jacobian(qv)
+        w = sp.Matrix([[sp.diff(a, k) for k in q]])
+        Jn = J - Jf
+        M += mass * J.T * J + inertia * w.T * w
+        Mi += mass * Jn.T * Jn + inertia * w.T * w
+        B += mass * Jn.T * J + inertia * w.T * w
+        V += mass * g * pos[1]
+    points = {k: position_of(v) + offset for k, v in point_lin.items()}
+    contact = centre - R * normal
+    points.update(stance_foot=sp.zeros(2, 1), stance_foot_centre=offset,
+                  stance_contact=offset - R * normal, swing_foot_centre=centre,
+                  swing_contact=contact, swing_foot=contact + R * (ws + gamma) * tangent)
+    xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
+    qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
+    Te = sp.Integer(0)
+    for mass, lin, inertia, a in bodies:
+        v = (position_of(lin) + offset + sp.Matrix([xf, yf])).jacobian(qe) * dqe
+        w = sp.Matrix([[sp.diff(a, k) for k in qe]])
+        Te += sp.Rational(1, 2) * (mass * (v.T * v)[0] + inertia * (w * dqe)[0] ** 2)
+    E = (centre + sp.Matrix([xf, yf])).jacobian(qe) \
+        + R * tangent * sp.Matrix([[sp.diff(ws, k) for k in qe]])
+    return ([X.applyfunc(sp.factor_terms) for X in (M, Mi, B)] + [V, points,
+            sp.hessian(Te, dqe), E])
+
+
 def derive_five_link(structure: Structure) -> Equations:
     """Flow, impact, guards, section, energies, points and leg angles of a free-jointed biped
     (see the module docstring).
@@ -182,12 +241,21 @@ def derive_five_link(structure: Structure) -> Equations:
         lin = {"stance_foot": {}, "stance_knee": {ss: -ls}, "hip": {ss: -ls, st: -lt}}
         lin["swing_knee"] = _plus(lin["hip"], wt, lt)
         lin["swing_foot"] = _plus(lin["swing_knee"], ws, ls)
-    else:  # straight legs under a hinged torso
+    else:  # straight legs under a hinged torso (arc feet: the hip at L - R from the centre)
         st, ws = psi["stance"], psi["swing"]
-        lin = {"stance_foot": {}, "hip": {st: -P["L"]}}
-        lin["swing_foot"] = _plus(lin["hip"], ws, P["L"])
+        reach = P["L"] - (P["R_foot"] if structure.foot == "arc" else 0)
+        lin = {"stance_foot": {}, "hip": {st: -reach}}
+        lin["swing_foot"] = _plus(lin["hip"], ws, reach)
     bodies, point_lin = _bodies(structure, P, psi, lin)
-    M, Mi, B, V = _matrices(q, bodies, lin["swing_foot"], g)
+    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
+    arc = structure.foot == "arc"
+    if arc:
+        M, Mi, B, V, points, De, E = _rolling(q, dq, bodies, point_lin, P, psi, normal,
+                                              tangent)
+    else:
+        M, Mi, B, V = _matrices(q, bodies, lin["swing_foot"], g)
+        points = {k: position_of(v) for k, v in point_lin.items()}
     n = len(q)
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
     C = sp.zeros(n, n)
@@ -197,16 +265,14 @@ def derive_five_link(structure: Structure) -> Equations:
                                                - sp.diff(M[j, k], q[i])) * dq[k]
                           for k in range(n))
     G = sp.Matrix([sp.diff(V, k) for k in q])
-    points = {k: position_of(v) for k, v in point_lin.items()}
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
-    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
     hip, foot = points["hip"], points["swing_foot"]
-    clearance = (foot.T * normal)[0]
+    clearance = ((points["swing_contact"] if arc else foot).T * normal)[0]
     # the heel strike: the swing foot reaching the slope (its height); straight legs, whose
     # swing foot passes through the ground at mid-stance (ignored, as the compass gait's,
     # Goswami et al. 1996), reach it when the legs are symmetric about the slope's normal
     strike = clearance if structure.knee else st + ws + 2 * gamma
-    guards = {"heel_strike": strike, "swing_foot_ahead": (foot.T * tangent)[0],
+    ahead = ((points["swing_contact"] - points["stance_contact"]) if arc else foot).T * tangent
+    guards = {"heel_strike": strike, "swing_foot_ahead": ahead[0],
               "hip_height": (hip.T * normal)[0], "swing_clearance": clearance}
     if structure.knee:
         relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])  # legs swap, the torso keeps its
@@ -221,7 +287,8 @@ def derive_five_link(structure: Structure) -> Equations:
     leg_angles = {"stance": sp.atan(-hip[0] / hip[1]),
                   "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
                   **{r: psi[r] for r in roles}}
-    De, E = _extended(q, dq, bodies, foot)
+    if not arc:
+        De, E = _extended(q, dq, bodies, foot)
     return Equations(
         q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_q.jacobian(qv),

@@ -429,7 +429,8 @@ class BipedParams(_Actuated):
                  else "torso.coupling: a hinged torso on straight legs")
         for what, bad in (("legs: both legs identical (give 'leg')", self.legs is not None
                            and pair[0] != pair[1]),
-                          ("leg.foot.kind: point", leg.foot.kind != "point"),
+                          (("leg.foot.kind: point" if free else "leg.foot.kind: point or arc"),
+                           leg.foot.kind not in (("point",) if free else ("point", "arc"))),
                           ("no leg.knee.spring", leg.knee is not None
                            and leg.knee.spring is not None),
                           ("no springs", bool(self.springs)),

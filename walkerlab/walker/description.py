@@ -235,11 +235,11 @@ def check_floating_view(structure: Structure) -> None:
         raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "
                          "floating view (contact model, export) with identical point-footed "
                          "legs and no springs only")
-    if structure.hinged_torso and (structure.foot != "point" or structure.asymmetric
-                                   or structure.springs):
+    if structure.hinged_torso and (structure.foot not in ("point", "arc")
+                                   or structure.asymmetric or structure.springs):
         raise ValueError("walker.torso.coupling: a hinged torso has a floating view (contact "
-                         "model, export) with identical point-footed legs and no springs "
-                         "only")
+                         "model, export) with identical point- or arc-footed legs and no "
+                         "springs only")
 
 
 def state_names(roles) -> list[str]:
