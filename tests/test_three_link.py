@@ -7,6 +7,7 @@ refusals of what it does not have."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -288,3 +289,64 @@ def test_optimize_refuses_it_with_the_tables_reason():
         kind.require("walk", "optimize", "walker")
     assert KINDS["hinged_torso"].cell("knee_torque", "mjcf") == \
         "the legs are straight: there is no knee"
+
+
+def test_the_adams_hip_torques_equal_walkerlab_laws():
+    """The Adams dataset of configs/threelink.yaml: SFORCE/11 and /12 on each leg's hip
+    against the torso (no knee SFORCE: straight legs), evaluated at 20 states, equal
+    walkerlab's laws in the role the contact forces give (stance_hip = stance leg - torso,
+    swing_hip = swing leg - torso), the phase variable the hip -> stance foot line's
+    ``atan2(dx, -dy)`` (the stance leg's angle)."""
+    from tests.test_export_adams_actuation import AdamsState, evaluate
+    from walkerlab.export.adams import (
+        ACT_VARIABLES,
+        JOINT_SFORCE,
+        LINE_WIDTH,
+        MM,
+        AdamsStart,
+        adm_text,
+        marker_id,
+        part_ids,
+    )
+    from walkerlab.export.adams_reader import AdmReadError, read_adm
+    from walkerlab.models.actuation import TorqueLaws
+    from walkerlab.walker.multibody import multibody
+
+    scene = load_scene(SCENE)
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    mb = multibody(data)
+    names = [ln.name for ln in mb.links]
+    assert names == ["leg1", "leg2", "torso"]
+    start = AdamsStart((0.1, 0.95), (0.7, 0.0), dict.fromkeys(names, 0.1),
+                       dict.fromkeys(names, 0.0), None, 0.1, 0.46, (1.0, 1.0))
+    adm = adm_text(scene, mb, data, "threelink", "test", start)
+    assert all(len(ln) <= LINE_WIDTH for ln in adm.splitlines())
+    model = read_adm(adm)
+    v = model.functions()
+    ids = part_ids(mb)
+    laws = TorqueLaws(scene.walker.actuation.torques)
+    rng = np.random.default_rng(9)
+    for n in range(20):
+        psi = {"leg1": rng.uniform(-0.35, 0.35), "leg2": rng.uniform(-0.35, 0.35),
+               "torso": rng.uniform(-0.3, 0.3)}
+        w = {k: rng.uniform(-3, 3) for k in psi}
+        stance = "leg1" if n % 2 else "leg2"
+        swing = "leg2" if stance == "leg1" else "leg1"
+        st = AdamsState(mb, (0.0, 950.0), (700.0, 10.0), psi, w,
+                        {1: 300.0} if stance == "leg1" else {2: 300.0})
+        ns = st.namespace(v)
+        assert ns["VARVAL"](ACT_VARIABLES["phase"]) == pytest.approx(psi[stance], abs=1e-12)
+        deltas = [psi[stance] - psi["torso"], psi[swing] - psi["torso"]]
+        rates = [w[stance] - w["torso"], w[swing] - w["torso"]]
+        taus = laws.each(deltas, rates, psi[stance], w[stance]) * MM
+        for (kind, g), sid in JOINT_SFORCE.items():
+            if kind == "knee":
+                with pytest.raises(AdmReadError):
+                    model.get("SFORCE", sid)
+                continue
+            sf = model.get("SFORCE", sid)
+            want = taus[0] if g == stance else taus[1]
+            got = evaluate(sf.args["FUNCTION"][0], ns)
+            assert math.isclose(got, want, rel_tol=1e-9, abs_tol=5e-3), (g, got, want)
+            assert sf.integer("I") == marker_id(ids[g], "joint")
+            assert sf.integer("J") == marker_id(ids["torso"], "joint")
