@@ -219,9 +219,9 @@ class Structure:
 
 def check_floating_view(structure: Structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
-    knees (the five-link biped) or a hinged torso on legs that differ, on feet other than
-    points, or with springs (what their rigid view, :mod:`walkerlab.codegen.free_joints`,
-    refuses too).
+    knees (the five-link biped) on legs that differ, on feet other than points, or with
+    springs, a hinged torso on straight legs that differ, on flat feet or with springs (what
+    their rigid view, :mod:`walkerlab.codegen.free_joints`, refuses too).
 
     A spoked wheel (``model: rimless_wheel``) has one: the hub's position and the wheel's
     angle with one contact point per spoke (:mod:`walkerlab.codegen.floating`).

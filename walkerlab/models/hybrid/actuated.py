@@ -278,10 +278,10 @@ class _LockingKnees(_Joints):
 
 class _FreeJoints(_Joints):
     """Every joint free (five-link bipeds; a torso hinged on straight legs): hips and knees
-    driven, one spline for laws that
-    share a table (:func:`walkerlab.models.hybrid.free_joint_actuators.
-    five_link_actuators`); the passive flow is not compiled, the driven one takes its
-    guards' outputs from :func:`walkerlab.models.hybrid.rigid_free_joints.guard_outputs`."""
+    driven, one spline for laws that share a table (:func:`walkerlab.models.hybrid.
+    free_joint_actuators.five_link_actuators`); the passive flow is not compiled, the driven
+    one takes its guards' outputs from :func:`walkerlab.models.hybrid.rigid_free_joints.
+    guard_outputs`."""
 
     hip_spring = False
 
