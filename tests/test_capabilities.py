@@ -41,6 +41,7 @@ SCENES = {
     "locking_knees": "configs/kneed.yaml",
     "flat_feet": "configs/flat_feet.yaml",
     "free_joints": "configs/rabbit.yaml",
+    "hinged_torso": "configs/threelink.yaml",
     "rolling_polygon": "configs/rimless_wheel.yaml",
 }
 
@@ -51,6 +52,8 @@ SMALL_PD = {"stiffness_n_m_per_rad": 0.1, "damping_n_m_s_per_rad": 0.01}
 JOINT = {"hip_torque": "hip", "knee_torque": "swing_knee", "ankle_torque": "stance_ankle",
          "torso_torque": "stance_hip"}
 FIVE_LINK_JOINT = {"hip_torque": "swing_hip"}
+#: the kinds whose hips join a hinged torso and the legs: their hip torque is FIVE_LINK_JOINT's
+TORSO_HIPS = ("free_joints", "hinged_torso")
 
 #: an upper body held on the legs' bisector (configs/torso_bhm.yaml): the torso torque's
 #: other link on a walker shipped without one
@@ -82,7 +85,7 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
     w = d["walker"]
     shipped = copy.deepcopy(w.get("actuation")) or {}
     if feature in JOINT:
-        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind == "free_joints"
+        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
                  else JOINT[feature])
         if feature == "torso_torque" and "torso" not in w and "leg" in w:
             w["torso"] = copy.deepcopy(TORSO)
@@ -226,7 +229,7 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
     and ``walker.actuation`` on a walker model without actuators (the scene's schema)."""
     out = []
     if feature in JOINT:
-        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind == "free_joints"
+        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
                  else JOINT[feature])
         out += [f"{joint} is not a joint of this walker (its joints: ",
                 f"{joint} is not a joint of the "]  # an export's joints (the walker's)

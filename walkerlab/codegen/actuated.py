@@ -242,7 +242,7 @@ def actuated_module(structure, joints):
     tag = hashlib.sha256(f"{joints!r}{_source_hash()}".encode()).hexdigest()[:12]
 
     def build() -> str:
-        if structure.free_knees:
+        if structure.kind.name in cache.FREE_JOINTED:
             from walkerlab.codegen.free_joints import derive_five_link
 
             eq = derive_five_link(structure)

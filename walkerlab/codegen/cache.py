@@ -80,17 +80,28 @@ def _five_link_generator_hash() -> str:
     return hashlib.sha256((Path(__file__).parent / "free_joints.py").read_bytes()).hexdigest()
 
 
+#: the walker kinds :mod:`walkerlab.codegen.free_joints` derives
+FREE_JOINTED = ("free_joints", "hinged_torso")
+
+
+def _free_jointed(structure) -> bool:
+    """Whether :mod:`walkerlab.codegen.free_joints` derives the walker (its kinds
+    ``free_joints``, free knees, and ``hinged_torso``, a hinged torso on straight legs)."""
+    return structure.kind.name in FREE_JOINTED
+
+
 def cache_key(structure) -> str:
     """Cache key (hex, 24 characters) of a structure for the current generator (a
     flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes` (with
     :mod:`~walkerlab.codegen.double_support` and :mod:`~walkerlab.codegen.push_off`), a
-    free-kneed one's :mod:`walkerlab.codegen.free_joints`, a spoked wheel's
+    free-jointed one's (free knees or a hinged torso) :mod:`walkerlab.codegen.free_joints`,
+    a spoked wheel's
     :mod:`walkerlab.codegen.rolling_polygon`, which no other structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())
     if structure.foot == "flat":
         h.update(_flat_generator_hash().encode())
-    if structure.free_knees:
+    if _free_jointed(structure):
         h.update(_five_link_generator_hash().encode())
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
@@ -155,7 +166,7 @@ def generated_module(structure) -> dict:
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)
-    if ns is None and structure.free_knees:
+    if ns is None and _free_jointed(structure):
         from walkerlab.codegen import free_joints as five_link
 
         body = five_link.generate_five_link(structure, key)

@@ -2,22 +2,28 @@
 on free (never locking) knees and, optionally, a torso hinged at the hip with its own
 coordinate - the five-link biped of Westervelt, Grizzle & Koditschek (2003), "Hybrid zero
 dynamics of planar biped walkers", IEEE TAC 48(1):42-56 (their RABBIT), and without the
-torso a four-link biped.
+torso a four-link biped - or two straight legs under a hinged torso: the three-link walker
+of Grizzle, Abba & Plestan (2001), "Asymptotically stable walking for biped robots:
+analysis via systems with impulse effects", IEEE TAC 46(1):51-64, and of Westervelt,
+Grizzle, Chevallereau, Choi & Morris (2007), *Feedback Control of Dynamic Bipedal Robot
+Locomotion*, CRC Press.
 
-Coordinates (:data:`walkerlab.walker.description.FREE_KNEE_ROLES`, then ``torso``): every
-link's absolute angle, the legs' from the downward vertical (positive when the link's lower
-end is ahead of its upper end, as the straight legs' angles, paper Eq. 1), the torso's from
-the upward vertical (positive leaning back, as the bisecting torso's).  All are
-counter-clockwise rotations, so a joint's relative angle is a difference of two
-coordinates.  With ``e(a) = (sin a, -cos a)`` (world axes: x downhill, y up) and the stance
-foot at the origin::
+Coordinates (:data:`walkerlab.walker.description.FREE_KNEE_ROLES`, then ``torso``; straight
+legs :data:`walkerlab.walker.description.HINGED_ROLES`): every link's absolute angle, the
+legs' from the downward vertical (positive when the link's lower end is ahead of its upper
+end, as the straight legs' angles, paper Eq. 1), the torso's from the upward vertical
+(positive leaning back, as the bisecting torso's).  All are counter-clockwise rotations, so
+a joint's relative angle is a difference of two coordinates.  With ``e(a) = (sin a, -cos
+a)`` (world axes: x downhill, y up) and the stance foot at the origin::
 
     stance knee = -l_s e(q_ss);  hip = stance knee - l_t e(q_st)
     swing knee  = hip + l_t e(q_wt);  swing foot = swing knee + l_s e(q_ws)
     torso point at d = hip - d e(q_t)
 
-(``l_t`` the thigh, ``l_s = L - l_t`` the shank).  Then, as in :mod:`walkerlab.codegen.
-symbolic` (whose helpers for sums of link vectors this module uses):
+(``l_t`` the thigh, ``l_s = L - l_t`` the shank); straight legs (``q = (q_st, q_sw,
+q_t)``): ``hip = -L e(q_st)``, ``swing foot = hip + L e(q_sw)``.  Then, as in
+:mod:`walkerlab.codegen.symbolic` (whose helpers for sums of link vectors this module
+uses):
 
 - flow: Lagrange's equations ``M qdd + C dq + G = 0``, ``C`` from Christoffel symbols;
 - heel strike: plastic impact of the swing foot, the old stance foot leaving the ground
@@ -26,11 +32,16 @@ symbolic` (whose helpers for sums of link vectors this module uses):
   impact as the extended-coordinate one, ``impact_matrices``: stance foot free at
   ``(x_f, y_f)``, ``De`` and the swing foot's Jacobian ``E``); then the legs' roles swap
   (the torso keeps its angle);
-- guards: ``heel_strike`` = ``swing_clearance`` = the swing foot's height above the slope,
-  ``swing_foot_ahead`` = its distance ahead of the stance foot along the slope,
-  ``hip_height``;
+- guards: ``heel_strike`` = ``swing_clearance`` = the swing foot's height above the slope
+  (straight legs: ``heel_strike = q_st + q_sw + 2 gamma``, the legs symmetric about the
+  slope's normal, as :mod:`walkerlab.codegen.symbolic`'s; their swing foot passes through
+  the ground at mid-stance, which the ideal model ignores), ``swing_foot_ahead`` = its
+  distance ahead of the stance foot along the slope, ``hip_height``;
+- arc feet (straight legs only): the stance arc rolls (:func:`_rolling`), the impact is
+  about the swing arc's material contact point;
 - Poincare section: the post-impact states, where the new swing foot (behind) is on the
-  ground; the swing shank's angle is solved from that (``-acos(..) - gamma``);
+  ground; the swing shank's angle is solved from that (``-acos(..) - gamma``; a straight
+  swing leg's ``-q_st - 2 gamma``, the legs symmetric about the slope's normal);
 - leg angles: every link's, and the virtual legs' (``stance``/``swing``: the angle of the line
   from the hip to the stance / swing foot, the straight legs' angles when the knees are
   straight; ``stance`` is the phase variable of the joint-torque laws; written with
@@ -49,6 +60,8 @@ __all__ = ["derive_five_link", "generate_five_link"]
 
 #: index of the swing shank's angle in ``q`` (solved from the heel-strike surface)
 SECTION_DROP = 3
+#: ... and of the straight swing leg's (:data:`walkerlab.walker.description.HINGED_ROLES`)
+STRAIGHT_SECTION_DROP = 1
 
 
 def _plus(lin: dict, psi, length) -> dict:
@@ -59,9 +72,12 @@ def _plus(lin: dict, psi, length) -> dict:
 
 
 def _check(structure: Structure) -> None:
-    if not structure.free_knees or not structure.knee:
-        raise ValueError("walker.leg.knee.lock: the five-link generator needs free knees")
-    if (structure.foot != "point" or structure.asymmetric or structure.springs
+    straight = structure.hinged_torso and not structure.knee
+    if not straight and (not structure.free_knees or not structure.knee):
+        raise ValueError("walker.leg.knee.lock: the five-link generator needs free knees "
+                         "(or straight legs under a hinged torso)")
+    arc_ok = straight and structure.foot == "arc"
+    if ((structure.foot != "point" and not arc_ok) or structure.asymmetric or structure.springs
             or structure.knee_spring or any(b.off_axis or b.massless for b in structure.bodies)
             or any(b.off_axis for b in structure.torso)
             or (structure.torso and not structure.hinged_torso)):
@@ -73,16 +89,19 @@ def _check(structure: Structure) -> None:
 def _bodies(structure: Structure, P: dict, psi: dict, lin: dict) -> tuple[list, dict]:
     """The bodies ``(mass, {angle: length}, inertia, link angle)`` and the named points'
     link-vector sums (see the module docstring for the chain)."""
-    lt, L = P["L_thigh"], P["L"]
+    lt, L = (P["L_thigh"] if structure.knee else 0), P["L"]
     points = dict(lin)
     bodies = []
     if structure.hip_mass:
-        bodies.append((P["M_hip"], lin["hip"], 0, psi["stance_thigh"]))
+        bodies.append((P["M_hip"], lin["hip"], 0, psi.get("stance_thigh", psi.get("stance"))))
     for b in structure.bodies:
         d = P[f"d_{b.name}"]
         inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
         for role in ("stance", "swing"):
-            if b.link == "thigh":
+            if b.link == "leg":  # a straight leg: d from the hip along it
+                a = psi[role]
+                where = _plus(lin["hip"], a, d)
+            elif b.link == "thigh":
                 a = psi[f"{role}_thigh"]
                 where = _plus(lin["hip"], a, d)
             elif role == "stance":  # d from the hip along the straightened leg
@@ -131,6 +150,62 @@ def _extended(q, dq, bodies: list, foot):
     return sp.hessian(Te, dqe), (foot + sp.Matrix([xf, yf])).jacobian(qe)
 
 
+def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, tangent):
+    """Straight legs on arc feet (radius ``R``, centre on the leg's axis at ``L - R`` from
+    the hip; McGeer 1990): every position gains the stance arc's rolling offset ``-R (q_st +
+    gamma) t + R n`` (its contact point rolls along the slope from the step's reference
+    point), so ``M`` and the impact matrices come from plain Jacobians; the impact is about
+    the swing arc's material contact point, moving at ``v_centre + R w t`` (``w`` the swing
+    leg's rate), as :mod:`walkerlab.codegen.symbolic`'s arc feet.
+
+    Returns
+    -------
+    M, Mi, B : Matrix (n, n)
+    V : Expr
+    points : dict
+        The named points (``stance_foot`` the step's reference point, ``stance_contact``,
+        ``stance_foot_centre``, ``swing_contact``, ``swing_foot_centre``, ``swing_foot``
+        the next step's reference point).
+    De, E : Matrix
+        The extended impact (:func:`_extended`'s, with the offset and the arc's spin).
+    """
+    R, gamma, g = P["R_foot"], P["gamma"], P["g"]
+    st, ws = psi["stance"], psi["swing"]
+    offset = -R * (st + gamma) * tangent + R * normal
+    qv = sp.Matrix(q)
+    n = len(q)
+    spin = sp.Matrix([[sp.diff(ws, k) for k in q]])
+    centre = position_of(point_lin["swing_foot"]) + offset
+    Jf = centre.jacobian(qv) + R * tangent * spin  # the swing arc's material contact point
+    M, Mi, B = sp.zeros(n, n), sp.zeros(n, n), sp.zeros(n, n)
+    V = sp.Integer(0)
+    for mass, lin, inertia, a in bodies:
+        pos = position_of(lin) + offset
+        J = pos.jacobian(qv)
+        w = sp.Matrix([[sp.diff(a, k) for k in q]])
+        Jn = J - Jf
+        M += mass * J.T * J + inertia * w.T * w
+        Mi += mass * Jn.T * Jn + inertia * w.T * w
+        B += mass * Jn.T * J + inertia * w.T * w
+        V += mass * g * pos[1]
+    points = {k: position_of(v) + offset for k, v in point_lin.items()}
+    contact = centre - R * normal
+    points.update(stance_foot=sp.zeros(2, 1), stance_foot_centre=offset,
+                  stance_contact=offset - R * normal, swing_foot_centre=centre,
+                  swing_contact=contact, swing_foot=contact + R * (ws + gamma) * tangent)
+    xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
+    qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
+    Te = sp.Integer(0)
+    for mass, lin, inertia, a in bodies:
+        v = (position_of(lin) + offset + sp.Matrix([xf, yf])).jacobian(qe) * dqe
+        w = sp.Matrix([[sp.diff(a, k) for k in qe]])
+        Te += sp.Rational(1, 2) * (mass * (v.T * v)[0] + inertia * (w * dqe)[0] ** 2)
+    E = (centre + sp.Matrix([xf, yf])).jacobian(qe) \
+        + R * tangent * sp.Matrix([[sp.diff(ws, k) for k in qe]])
+    return ([X.applyfunc(sp.factor_terms) for X in (M, Mi, B)] + [V, points,
+            sp.hessian(Te, dqe), E])
+
+
 def derive_five_link(structure: Structure) -> Equations:
     """Flow, impact, guards, section, energies, points and leg angles of a free-jointed biped
     (see the module docstring).
@@ -138,12 +213,13 @@ def derive_five_link(structure: Structure) -> Equations:
     Parameters
     ----------
     structure : Structure
-        With ``free_knees`` (and optionally ``hinged_torso``).
+        With ``free_knees`` (and optionally ``hinged_torso``), or straight legs with
+        ``hinged_torso``.
 
     Returns
     -------
     Equations
-        ``n = 4`` (no torso) or ``5``; no locked flow, no knee strike.
+        ``n = 4`` (no torso) or ``5``; straight legs ``3``; no locked flow, no knee strike.
 
     Raises
     ------
@@ -157,14 +233,29 @@ def derive_five_link(structure: Structure) -> Equations:
     par = sp.symbols(structure.param_names, real=True)
     P = dict(zip(structure.param_names, par))
     psi = dict(zip(roles, q))
-    g, gamma, lt = P["g"], P["gamma"], P["L_thigh"]
-    ls = P["L"] - lt
-    ss, st, wt, ws = (psi[r] for r in roles[:4])
-    lin = {"stance_foot": {}, "stance_knee": {ss: -ls}, "hip": {ss: -ls, st: -lt}}
-    lin["swing_knee"] = _plus(lin["hip"], wt, lt)
-    lin["swing_foot"] = _plus(lin["swing_knee"], ws, ls)
+    g, gamma = P["g"], P["gamma"]
+    if structure.knee:
+        lt = P["L_thigh"]
+        ls = P["L"] - lt
+        ss, st, wt, ws = (psi[r] for r in roles[:4])
+        lin = {"stance_foot": {}, "stance_knee": {ss: -ls}, "hip": {ss: -ls, st: -lt}}
+        lin["swing_knee"] = _plus(lin["hip"], wt, lt)
+        lin["swing_foot"] = _plus(lin["swing_knee"], ws, ls)
+    else:  # straight legs under a hinged torso (arc feet: the hip at L - R from the centre)
+        st, ws = psi["stance"], psi["swing"]
+        reach = P["L"] - (P["R_foot"] if structure.foot == "arc" else 0)
+        lin = {"stance_foot": {}, "hip": {st: -reach}}
+        lin["swing_foot"] = _plus(lin["hip"], ws, reach)
     bodies, point_lin = _bodies(structure, P, psi, lin)
-    M, Mi, B, V = _matrices(q, bodies, lin["swing_foot"], g)
+    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
+    arc = structure.foot == "arc"
+    if arc:
+        M, Mi, B, V, points, De, E = _rolling(q, dq, bodies, point_lin, P, psi, normal,
+                                              tangent)
+    else:
+        M, Mi, B, V = _matrices(q, bodies, lin["swing_foot"], g)
+        points = {k: position_of(v) for k, v in point_lin.items()}
     n = len(q)
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
     C = sp.zeros(n, n)
@@ -174,27 +265,36 @@ def derive_five_link(structure: Structure) -> Equations:
                                                - sp.diff(M[j, k], q[i])) * dq[k]
                           for k in range(n))
     G = sp.Matrix([sp.diff(V, k) for k in q])
-    points = {k: position_of(v) for k, v in point_lin.items()}
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
-    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
     hip, foot = points["hip"], points["swing_foot"]
-    clearance = (foot.T * normal)[0]
-    guards = {"heel_strike": clearance, "swing_foot_ahead": (foot.T * tangent)[0],
+    clearance = ((points["swing_contact"] if arc else foot).T * normal)[0]
+    # the heel strike: the swing foot reaching the slope (its height); straight legs, whose
+    # swing foot passes through the ground at mid-stance (ignored, as the compass gait's,
+    # Goswami et al. 1996), reach it when the legs are symmetric about the slope's normal
+    strike = clearance if structure.knee else st + ws + 2 * gamma
+    ahead = ((points["swing_contact"] - points["stance_contact"]) if arc else foot).T * tangent
+    guards = {"heel_strike": strike, "swing_foot_ahead": ahead[0],
               "hip_height": (hip.T * normal)[0], "swing_clearance": clearance}
-    relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])  # legs swap, the torso keeps its angle
-    reach = (ls * sp.cos(ss + gamma) + lt * sp.cos(st + gamma) - lt * sp.cos(wt + gamma)) / ls
+    if structure.knee:
+        relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])  # legs swap, the torso keeps its
+        reach = (ls * sp.cos(ss + gamma) + lt * sp.cos(st + gamma)  # angle
+                 - lt * sp.cos(wt + gamma)) / ls
+        drop, drop_solution = SECTION_DROP, -sp.acos(reach) - gamma
+    else:
+        relabel_q = sp.Matrix([ws, st, q[2]])  # the legs swap, the torso keeps its angle
+        drop, drop_solution = STRAIGHT_SECTION_DROP, -st - 2 * gamma
     # atan, not atan2: complex-safe (the complex-step Jacobians of torque laws that read the
     # phase variable), and exact while the hip is above both feet
     leg_angles = {"stance": sp.atan(-hip[0] / hip[1]),
                   "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
                   **{r: psi[r] for r in roles}}
-    De, E = _extended(q, dq, bodies, foot)
+    if not arc:
+        De, E = _extended(q, dq, bodies, foot)
     return Equations(
         q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_q.jacobian(qv),
         kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V, guards=guards,
-        points=points, leg_angles=leg_angles, section_drop=SECTION_DROP,
-        drop_solution=-sp.acos(reach) - gamma, De=De, E=E, limit=False, section_tied={})
+        points=points, leg_angles=leg_angles, section_drop=drop,
+        drop_solution=drop_solution, De=De, E=E, limit=False, section_tied={})
 
 
 def generate_five_link(structure: Structure, key: str) -> str:

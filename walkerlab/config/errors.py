@@ -158,10 +158,11 @@ WALKER_VOCABULARY = (
     "(with an optional spring-damper) or free knees (knee.lock: free), foot "
     "kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
     "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism, or "
-    "hinged at the hip with free knees (a five-link biped); actuation: torques at any joint "
-    "the walker has (hip, torso to leg, knees, flat feet's ankles) in the rigid model (the "
-    "contact model: hip torques on straight, point-footed legs and a five-link biped's "
-    "joints), a push-off impulse on point feet, an ankle push-off on flat feet), or "
+    "hinged at the hip, on free knees (a five-link biped) or straight point- or arc-footed "
+    "legs (a three-link walker); actuation: torques at any joint the walker has (hip, torso "
+    "to leg, knees, flat feet's ankles) in the rigid model (the contact model: hip torques on "
+    "straight, point-footed legs and a hinged torso's walker's joints), a push-off impulse on "
+    "point feet, an ankle push-off on flat feet), or "
     "rimless_wheel (spokes, spoke_length_m, mass_kg, optional hub_inertia_kg_m2)")
 
 

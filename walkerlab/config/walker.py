@@ -337,13 +337,16 @@ class TorsoSpec(Strict):
     The coupling is a holonomic linear constraint between link angles; the rigid model
     eliminates it (the torso adds bodies, not coordinates).  ``coupling: hinged``: a free
     revolute joint at the hip, the torso's angle its own coordinate (a five-link biped's
-    upper body, Westervelt et al. 2003)."""
+    upper body, Westervelt et al. 2003; on straight legs the three-link walker of Grizzle,
+    Abba & Plestan 2001, IEEE TAC 46(1), and of Westervelt et al. 2007, Feedback Control of
+    Dynamic Bipedal Robot Locomotion)."""
 
     coupling: Literal["bisecting_hip", "hinged"] = Field(
         "bisecting_hip", description="linear constraint between the torso's and the legs' "
         "angles: 'bisecting_hip' = torso angle (from the upward vertical, positive leaning "
         "back) equals the mean of the two leg angles; 'hinged': none, the torso is jointed "
-        "at the hip and has its own coordinate (held by hip torques; needs knee.lock: free)")
+        "at the hip and has its own coordinate (held by hip torques; on straight legs or free "
+        "knees, knee.lock: free)")
     bodies: list[TorsoBody] = Field(min_length=1, description="bodies on the upper body")
 
     @model_validator(mode="after")
@@ -444,26 +447,34 @@ class BipedParams(_Actuated):
         return self
 
     def _free_joints_check(self, pair) -> None:
-        """Free knees (``knee.lock: free``) and a hinged torso: the five-link biped's chain
-        of free joints, with what it supports today (one line otherwise)."""
+        """Free knees (``knee.lock: free``) and a hinged torso: a chain of free joints (the
+        five-link biped, or a hinged torso on straight legs: the three-link walker), with
+        what it supports today (one line otherwise)."""
         free = pair[0].knee is not None and pair[0].knee.lock == "free"
         hinged = self.torso is not None and self.torso.coupling == "hinged"
-        if hinged and not free:
-            raise ValueError("torso.coupling: 'hinged' needs free knees (leg.knee.lock: free;"
-                             " the five-link biped)")
-        if not free:
+        if hinged and pair[0].knee is not None and not free:
+            raise ValueError("torso.coupling: 'hinged' needs straight legs or free knees "
+                             "(leg.knee.lock: free); locking knees (lock: plastic) with a "
+                             "hinged torso are not available yet")
+        if not free and not hinged:
             return
         leg = pair[0]
+        field = ("leg.knee.lock: free knees" if free
+                 else "torso.coupling: a hinged torso on straight legs")
         for what, bad in (("legs: both legs identical (give 'leg')", self.legs is not None
                            and pair[0] != pair[1]),
-                          ("leg.foot.kind: point", leg.foot.kind != "point"),
-                          ("no leg.knee.spring", leg.knee.spring is not None),
+                          (("leg.foot.kind: point" if free else "leg.foot.kind: point or arc"),
+                           leg.foot.kind not in (("point",) if free else ("point", "arc"))),
+                          ("no leg.knee.spring", leg.knee is not None
+                           and leg.knee.spring is not None),
                           ("no springs", bool(self.springs)),
+                          ("massive leg bodies (mass_kg > 0)", any(
+                              b.mass_kg == 0 for b in leg.bodies)),
                           ("bodies on the leg axis (off_axis 0)", any(
                               (b.off_axis_m if b.kind == "point_mass" else b.com_off_axis_m)
                               != 0.0 for b in leg.bodies))):
             if bad:
-                raise ValueError(f"leg.knee.lock: free knees need {what} today")
+                raise ValueError(f"{field} need{'s' * (not free)} {what} today")
         if self.torso is not None and not hinged:
             raise ValueError("torso.coupling: free knees need a 'hinged' torso (the bisecting "
                              "hip mechanism is for locking knees)")

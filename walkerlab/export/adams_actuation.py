@@ -13,7 +13,7 @@ from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_feet import FOOT_FORCES, adams_feet, contact_pairs, hip_link, leg_end
 from walkerlab.export.adams_statements import MM, _chain_sum, _f, _plus, _var, marker_id
-from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.kinds import FREE_JOINT_TORQUES, KINDS
 
 __all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ANKLE_SFORCE", "ANKLE_TORQUE_SFORCE",
            "ANKLE_VARIABLES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE",
@@ -216,18 +216,27 @@ JOINT_SFORCE = {("hip", "leg1"): 11, ("hip", "leg2"): 12, ("knee", "leg1"): 13,
 
 
 def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
-    """A five-link biped's joint torques: the role joints' angles picked by the role sign,
-    the phase variable the virtual stance leg's angle, one SFORCE per physical joint."""
+    """A free-jointed biped's joint torques (a hinged torso on thighs and free knees, or on
+    straight legs): the role joints' angles picked by the role sign, the phase variable
+    the virtual stance leg's angle, one SFORCE per physical joint (the knees' only on
+    kneed legs)."""
     V = ACT_VARIABLES
-    th = {g: marker_id(ids[f"{g}_thigh"], "joint") for g in ("leg1", "leg2")}
-    kn = {g: marker_id(ids[f"{g}_thigh"], "knee") for g in ("leg1", "leg2")}
-    sh = {g: marker_id(ids[f"{g}_shank"], "joint") for g in ("leg1", "leg2")}
+    th = {g: marker_id(ids[hip_link(mb, g)], "joint") for g in ("leg1", "leg2")}
+    kneed = all(f"{g}_shank" in ids for g in ("leg1", "leg2"))
+    if kneed:
+        kn = {g: marker_id(ids[f"{g}_thigh"], "knee") for g in ("leg1", "leg2")}
+        sh = {g: marker_id(ids[f"{g}_shank"], "joint") for g in ("leg1", "leg2")}
     to = marker_id(ids["torso"], "joint")
     sgn = f"VARVAL({V['sign']})"
-    out = ["! joint torques (walker.actuation.torques) [N mm] of a five-link biped: +tau on",
-           "! the second link of the joint (thigh, shank), -tau on the first (torso,",
-           "! thigh); the joints follow the roles: stance_hip = stance thigh - torso,",
-           "! swing_knee = swing shank - swing thigh, ... (the role sign picks the leg);",
+    out = (["! joint torques (walker.actuation.torques) [N mm] of a five-link biped: +tau on",
+            "! the second link of the joint (thigh, shank), -tau on the first (torso,",
+            "! thigh); the joints follow the roles: stance_hip = stance thigh - torso,",
+            "! swing_knee = swing shank - swing thigh, ... (the role sign picks the leg);"]
+           if kneed else
+           ["! joint torques (walker.actuation.torques) [N mm] between a hinged torso and",
+            "! straight legs: +tau on the leg, -tau on the torso; the joints follow the",
+            "! roles: stance_hip = stance leg - torso, swing_hip = swing leg - torso (the",
+            "! role sign picks the leg);"]) + [
            "! the phase variable the angle of the line from the hip to the stance foot",
            "! from the downward vertical, ATAN2(dx, -dy), and its rate"]
     for g, (a, r) in (("leg1", (380, 382)), ("leg2", (381, 383))):
@@ -237,9 +246,11 @@ def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
                 _var(r, f"VARVAL({r + 4})/DM({f},{h})**2")]
     out += [_var(V["phase"], f"IF({sgn}:VARVAL(380),0,VARVAL(381))"),
             _var(V["dphase"], f"IF({sgn}:VARVAL(382),0,VARVAL(383))")]
-    angle = {"hip": lambda g: (f"AZ({th[g]},{to})", f"WZ({th[g]},{to},{to})"),
-             "knee": lambda g: (f"AZ({sh[g]},{kn[g]})", f"WZ({sh[g]},{kn[g]},{kn[g]})")}
-    for joint, (a, r) in ROLE_JOINT_VARIABLES.items():
+    angle = {"hip": lambda g: (f"AZ({th[g]},{to})", f"WZ({th[g]},{to},{to})")}
+    if kneed:
+        angle["knee"] = lambda g: (f"AZ({sh[g]},{kn[g]})", f"WZ({sh[g]},{kn[g]},{kn[g]})")
+    joints = {j: v for j, v in ROLE_JOINT_VARIABLES.items() if j.split("_")[1] in angle}
+    for joint, (a, r) in joints.items():
         role, kind = joint.split("_")
         first, second = ("leg1", "leg2") if role == "stance" else ("leg2", "leg1")
         (a1, r1), (a2, r2) = angle[kind](first), angle[kind](second)
@@ -247,10 +258,14 @@ def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
     for k, t in enumerate(act.torques):
         out += _law(k, t, *ROLE_JOINT_VARIABLES[t.joint])
     for joint, total in ROLE_TORQUE_SUM.items():
+        if joint not in joints:
+            continue
         taus = [f"VARVAL({hip_torque_ids(k)['tau']})" for k, t in enumerate(act.torques)
                 if t.joint == joint]
         out += _chain_sum(total - 100 + 10 * list(ROLE_TORQUE_SUM).index(joint), total, taus)
     for (kind, g), sid in JOINT_SFORCE.items():
+        if kind not in angle:
+            continue
         i_m, j_m = (th[g], to) if kind == "hip" else (sh[g], kn[g])
         st, sw = ROLE_TORQUE_SUM[f"stance_{kind}"], ROLE_TORQUE_SUM[f"swing_{kind}"]
         a, b = (st, sw) if g == "leg1" else (sw, st)  # sign < 0: leg1 stands
@@ -359,10 +374,12 @@ def actuation_statements(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: b
             out += _hip_torques(act, hips["leg1"], hips["leg2"], hip)
         out += _ankle_torques(mb, act, ids, hips, ankle, phase=not hip)
     elif any(t.joint != "hip" for t in act.torques):
-        if "torso" not in ids or "leg1_shank" not in ids or \
-                any(t.joint == "hip" for t in act.torques):
-            raise ValueError("walker.actuation.torques: stance_hip, swing_hip, stance_knee "
-                             "and swing_knee need a five-link biped (free knees, a torso)")
+        if "torso" not in ids or mb.kind not in ("free_joints", "hinged_torso"):
+            raise ValueError(f"walker.actuation.torques: {FREE_JOINT_TORQUES}")
+        if any(t.joint == "hip" for t in act.torques):
+            raise ValueError("walker.actuation.torques: the Adams dataset drives a hinged "
+                             "torso's walker at its joints (stance_hip, swing_hip, knees), "
+                             "not also between the legs (joint: hip)")
         out += _joint_torques(mb, act, ids, feet)
     elif act.torques:
         out += _hip_torques(act, hips["leg1"], hips["leg2"])

@@ -198,7 +198,8 @@ class FlatFeet(LegEndFeet):
 #: kind name -> the dataset's feet of that kind (the rolling polygon has no Adams dataset:
 #: :data:`walkerlab.walker.kinds.CAPABILITIES`)
 ADAMS_FEET = {"straight_legs": LegEndFeet(), "locking_knees": LegEndFeet(),
-              "flat_feet": FlatFeet(), "free_joints": LegEndFeet()}
+              "flat_feet": FlatFeet(), "free_joints": LegEndFeet(),
+              "hinged_torso": LegEndFeet()}
 
 
 def adams_feet(mb) -> LegEndFeet:

@@ -70,6 +70,20 @@ EXPORT_PARTS = {
             "+tau on that leg's knee; leg2 stands at the keyframe, the roles swap at each "
             "heel strike; the phase variable is the angle of the line from the hip to the "
             "stance foot from the downward vertical")),
+    "hinged_torso": ExportPart(
+        mjcf_actuators=(
+            "Actuators (walker.actuation, in the custom text walkerlab_actuation): "
+            "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip, for a "
+            "controller of one's own; walkerlab's stepping loop applies each law's torque "
+            "in its joint's present role (stance_hip, swing_hip: leg2 stands at the "
+            "keyframe, the roles swap at each heel strike) as generalised forces "
+            "(qfrc_applied), the phase variable the stance leg's angle "
+            "(walkerlab.export.mujoco_walk)."),
+        sidecar_actuators=(
+            "joint torques between a hinged torso and straight legs: stance_hip / swing_hip "
+            "act +tau on the stance / swing leg's hip joint and -tau on torso_hip; leg2 "
+            "stands at the keyframe, the roles swap at each heel strike; the phase variable "
+            "is the stance leg's angle from the downward vertical")),
     "rolling_polygon": ExportPart(),
 }
 

@@ -480,7 +480,7 @@ class _FlatFeet(_LinkFeet):
 #: :func:`wheel_keyframe`'s; its entry only passes :func:`check_exportable`)
 SCENE_FEET = {"straight_legs": _LinkFeet(), "locking_knees": _LinkFeet(),
               "flat_feet": _FlatFeet(), "free_joints": _LinkFeet(),
-              "rolling_polygon": _LinkFeet()}
+              "hinged_torso": _LinkFeet(), "rolling_polygon": _LinkFeet()}
 
 
 # ---------------------------------------------------------------------------- a spoked wheel

@@ -350,4 +350,5 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
 
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> the export's writer of that kind
 _WRITERS = {"straight_legs": _run_links, "locking_knees": _run_links, "flat_feet": _run_links,
-            "free_joints": _run_links, "rolling_polygon": _run_wheel}
+            "free_joints": _run_links, "hinged_torso": _run_links,
+            "rolling_polygon": _run_wheel}

@@ -24,6 +24,10 @@ KNEED_ROLES = ("swing_thigh", "swing_shank", "stance")
 #: Roles with free knees (``knee.lock: free``): every link's absolute angle, from the stance
 #: foot up the chain and down to the swing foot; a hinged torso's angle is appended.
 FREE_KNEE_ROLES = ("stance_shank", "stance_thigh", "swing_thigh", "swing_shank")
+#: Roles of straight legs under a hinged torso (the three-link walker; Grizzle, Abba &
+#: Plestan 2001): every link's absolute angle, stance leg, swing leg, torso (the chain's
+#: order, as :data:`FREE_KNEE_ROLES` then ``torso``).
+HINGED_ROLES = ("stance", "swing", "torso")
 #: Roles with flat feet: the absolute leg angles and the stance ankle's angle (the swing
 #: foot is massless and sits at its spring's rest angle: no coordinate).
 FLAT_ROLES = ("swing", "stance", "stance_ankle")
@@ -103,8 +107,9 @@ class Structure:
         :mod:`walkerlab.codegen.free_joints`.
     hinged_torso : bool
         The torso (``torso`` bodies) is jointed at the hip with its own coordinate, role
-        ``torso`` (its angle from the upward vertical, positive leaning back); needs
-        ``free_knees``.
+        ``torso`` (its angle from the upward vertical, positive leaning back), on free knees
+        or on straight legs (roles :data:`HINGED_ROLES`: the three-link walker); derived by
+        :mod:`walkerlab.codegen.free_joints`.
     foot_mass : bool
         Flat feet with mass (``walker.leg.foot.mass_kg``): each foot a body with mass
         ``m_foot`` [kg] at its ankle and inertia ``I_foot`` [kg m^2] about it (the same on
@@ -145,9 +150,19 @@ class Structure:
             return SPOKED_ROLES
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
+        if self.hinged_torso:
+            return HINGED_ROLES
         if self.foot == "flat":
             return FLAT_ROLES
         return KNEED_ROLES if self.knee else ROLES[self.coordinates]
+
+    @property
+    def swing_foot_clears(self) -> bool:
+        """Whether the swing foot can clear the ground through the step (a knee flexes it):
+        a free-jointed walker's early swing then ends in a fall if the foot scuffs; straight
+        legs pass their foot through the ground at mid-stance, which the ideal model
+        ignores (as the compass gait's, Goswami, Thuilot & Espiau 1996)."""
+        return self.knee
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -215,8 +230,8 @@ class Structure:
 def check_floating_view(structure: Structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
     knees (the five-link biped) on legs that differ, on feet other than points, or with
-    springs (what the rigid view of free knees, :mod:`walkerlab.codegen.free_joints`, refuses
-    too).
+    springs, a hinged torso on straight legs that differ, on flat feet or with springs (what
+    their rigid view, :mod:`walkerlab.codegen.free_joints`, refuses too).
 
     A spoked wheel (``model: rimless_wheel``) has one: the hub's position and the wheel's
     angle with one contact point per spoke (:mod:`walkerlab.codegen.floating`).
@@ -230,6 +245,11 @@ def check_floating_view(structure: Structure) -> None:
         raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "
                          "floating view (contact model, export) with identical point-footed "
                          "legs and no springs only")
+    if structure.hinged_torso and (structure.foot not in ("point", "arc")
+                                   or structure.asymmetric or structure.springs):
+        raise ValueError("walker.torso.coupling: a hinged torso has a floating view (contact "
+                         "model, export) with identical point- or arc-footed legs and no "
+                         "springs only")
 
 
 def state_names(roles) -> list[str]:

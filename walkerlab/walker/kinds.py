@@ -21,6 +21,13 @@ walker's :class:`Kind`:
 ``free_joints``
     Every joint free - hips and knees, optionally a hinged torso: the five-link biped
     (Westervelt, Grizzle & Koditschek 2003, RABBIT), driven by joint torques.
+``hinged_torso``
+    A torso hinged at the hip of two straight legs, every joint free: the three-link walker
+    (Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau, Choi & Morris 2007),
+    driven by torques between the torso and each leg.  Its model is derived as the
+    free-jointed biped's (one flow per step, every coordinate a link's absolute angle), its
+    step ends as the straight legs' (the swing foot passes through the ground at mid-stance,
+    ignored; the heel strike with the legs symmetric about the slope's normal).
 ``rolling_polygon``
     A rimless (spoked) wheel: one rigid body rolling on its spokes (McGeer 1990; Coleman,
     Chatterjee & Ruina 1997).  It has no joint, so no actuator.
@@ -143,6 +150,9 @@ KINDS = {k.name: k for k in (
          "McGeer 1990; Collins, Wisse & Ruina 2001"),
     Kind("free_joints", "free hips and knees, hinged torso (five-link biped)",
          "Westervelt, Grizzle & Koditschek 2003 (RABBIT)"),
+    Kind("hinged_torso", "a torso hinged on straight legs (three-link walker)",
+         "Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau, Choi & Morris "
+         "2007"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
          "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
 )}
@@ -172,8 +182,10 @@ _ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: check
                   "the footholds' heights), not continuous profile")
 _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
                     "scene without it")
-_FIVE_LINK_JOINTS = ("stance_hip, swing_hip, stance_knee and swing_knee need a five-link "
-                     "biped (free knees, a torso)")
+#: why the Adams dataset refuses joint torques other than the hip's on a walker that is not
+#: free-jointed (:mod:`walkerlab.export.adams_actuation` says it too)
+FREE_JOINT_TORQUES = ("stance_hip, swing_hip, stance_knee and swing_knee need a free-jointed "
+                      "biped (a hinged torso, on free knees or straight legs)")
 #: what the views of every legged kind refuse: grounds whose steps differ outside the rigid
 #: view, a profile in the Adams dataset, the OpenSim model and the gym
 _GROUNDS = {
@@ -204,13 +216,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     "straight_legs": {
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
-        ("torso_torque", "adams"): _FIVE_LINK_JOINTS,
+        ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         **_GROUNDS,
     },
     "locking_knees": {
         **_NO_ANKLES,
-        ("knee_torque", "adams"): _FIVE_LINK_JOINTS,
-        ("torso_torque", "adams"): _FIVE_LINK_JOINTS,
+        ("knee_torque", "adams"): FREE_JOINT_TORQUES,
+        ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         **_GROUNDS,
     },
@@ -239,6 +251,18 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                    "has no push-off"),
         **_GROUNDS,
         # the shipped five-link biped walks by its joint torques (a passive one would build)
+        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
+                              "walkers only") for v in ("rigid", "contact")},
+    },
+    "hinged_torso": {
+        ("knee_torque", "*"): _NO_KNEE,
+        **_NO_ANKLES,
+        ("walk", "optimize"): ("the free-jointed collocation drives a five-link biped's "
+                               "hips and knees; a torso hinged on straight legs is not "
+                               "transcribed yet (run it in fixedpoint, simulate, contact-sim, "
+                               "the exports and the gym)"),
+        **_GROUNDS,
+        # a walker held up by its joint torques (a passive one would build)
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
                               "walkers only") for v in ("rigid", "contact")},
     },
@@ -276,6 +300,8 @@ def kind_of(structure) -> Kind:
         return KINDS["rolling_polygon"]
     if structure.free_knees:
         return KINDS["free_joints"]
+    if structure.hinged_torso:
+        return KINDS["hinged_torso"]
     if structure.foot == "flat":
         return KINDS["flat_feet"]
     if structure.knee:

@@ -108,7 +108,7 @@ class JointTorqueActuators(PushOffPulse, ContactRows):
             leg = {"stance": f"leg{stance + 1}", "swing": f"leg{2 - stance}"}
             self.index.append(np.array([
                 names.index("torso_angle") if r == "torso"
-                else names.index(f"{leg[r.split('_')[0]]}_{r.split('_')[1]}_angle")
+                else names.index("_".join([leg[r.split("_")[0]], *r.split("_")[1:], "angle"]))
                 for r in roles]))
 
     @property

@@ -72,8 +72,12 @@ class ContactPart:
         if walker.structure.foot != "arc":
             return chord
         R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
-        m = walker.nq - 2  # link angles: leg1's, then leg2's; the foot on each leg's last link
-        return chord + R * (z[m - 1] - z[m // 2 - 1])
+        # link angles (the floating coordinates after the hip's): leg1's, then leg2's (then
+        # a hinged torso's); the foot on each leg's last link
+        links = walker.layout().coordinates[2:]
+        last = {leg: max(i for i, c in enumerate(links) if c.startswith(f"{leg}_"))
+                for leg in ("leg1", "leg2")}
+        return chord + R * (z[last["leg2"]] - z[last["leg1"]])
 
     @staticmethod
     def _chord(walker, x_ideal, along_slope: bool):
@@ -182,6 +186,16 @@ class FreeJointsPart(KneedPart):
         return JointTorqueActuators(data, spec, coordinates, pulse_s)
 
 
+class HingedTorsoPart(FreeJointsPart):
+    """A torso hinged on straight legs (the three-link walker): its hip torques are the rigid
+    view's joint torques."""
+
+    periodic_actuators = ("contact_sim.start / periodic_gait: the contact periodic gait's "
+                          "step map carries straight legs' hip torques between the legs and "
+                          "push-off, not joint torques between a torso and the legs: start "
+                          "from the rigid gait (start: ideal, periodic_gait: false)")
+
+
 class RollingPolygonPart(ContactPart):
     """A rimless (spoked) wheel: one rigid body on its spokes' tips."""
 
@@ -225,6 +239,7 @@ PARTS: dict[str, ContactPart] = {
     "locking_knees": KneedPart(),
     "flat_feet": FlatFeetPart(),
     "free_joints": FreeJointsPart(),
+    "hinged_torso": HingedTorsoPart(),
     "rolling_polygon": RollingPolygonPart(),
 }
 

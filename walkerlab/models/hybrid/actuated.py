@@ -277,10 +277,11 @@ class _LockingKnees(_Joints):
 
 
 class _FreeJoints(_Joints):
-    """Every joint free (five-link bipeds): hips and knees driven, one spline for laws that
-    share a table (:func:`walkerlab.models.hybrid.free_joint_actuators.
-    five_link_actuators`); the passive flow is not compiled, the driven one takes its
-    guards' outputs from :func:`walkerlab.models.hybrid.rigid_free_joints.guard_outputs`."""
+    """Every joint free (five-link bipeds; a torso hinged on straight legs): hips and knees
+    driven, one spline for laws that share a table (:func:`walkerlab.models.hybrid.
+    free_joint_actuators.five_link_actuators`); the passive flow is not compiled, the driven
+    one takes its guards' outputs from :func:`walkerlab.models.hybrid.rigid_free_joints.
+    guard_outputs`."""
 
     hip_spring = False
 
@@ -328,5 +329,5 @@ class _RollingPolygon:
 
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> how :func:`actuate` drives it
 _PARTS = {"straight_legs": _Joints(), "locking_knees": _LockingKnees(),
-          "free_joints": _FreeJoints(), "flat_feet": _FlatFeet(),
+          "free_joints": _FreeJoints(), "hinged_torso": _FreeJoints(), "flat_feet": _FlatFeet(),
           "rolling_polygon": _RollingPolygon()}

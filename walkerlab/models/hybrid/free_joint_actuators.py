@@ -39,7 +39,8 @@ def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkAc
     Parameters
     ----------
     data : walkerlab.walker.description.WalkerData
-        Of the ``free_joints`` kind (:attr:`walkerlab.walker.description.Structure.kind`).
+        Of a free-jointed kind, ``free_joints`` or ``hinged_torso``
+        (:attr:`walkerlab.walker.description.Structure.kind`).
     spec : walkerlab.config.actuation.Actuation
     roles : tuple of str
         The walker's roles.

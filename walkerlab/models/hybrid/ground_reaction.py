@@ -84,6 +84,7 @@ _PARTS = {
     "straight_legs": _Part(),
     "locking_knees": _Part(),
     "free_joints": _Part(),
+    "hinged_torso": _Part(),
     "flat_feet": _Part(refusal="flat feet: the rigid model's own guards check the heel's "
                                "and toe's normal forces"),
     "rolling_polygon": _Part(hub=True, trailing_point="trailing_foot"),

@@ -267,5 +267,6 @@ BUILDERS: dict[str, Callable] = {
     "locking_knees": _make_legged,
     "flat_feet": _make_flat,
     "free_joints": _make_free,
+    "hinged_torso": _make_free,
     "rolling_polygon": _make_polygon,
 }

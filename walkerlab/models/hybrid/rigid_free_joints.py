@@ -1,7 +1,8 @@
 """A :class:`~walkerlab.models.hybrid.base.HybridWalker` of a biped whose joints are all free
 (``knee.lock: free``; with a hinged torso the five-link biped of Westervelt, Grizzle &
-Koditschek 2003, IEEE TAC 48(1):42-56), from the code :mod:`walkerlab.codegen.free_joints`
-generates.
+Koditschek 2003, IEEE TAC 48(1):42-56; a hinged torso on straight legs, the three-link
+walker of Grizzle, Abba & Plestan 2001, IEEE TAC 46(1):51-64), from the code
+:mod:`walkerlab.codegen.free_joints` generates.
 
 One flow for the whole step (every link free, no knee lock), in two phases so that the
 heel strike is looked for only once the swing foot is ahead:
@@ -9,10 +10,13 @@ heel strike is looked for only once the swing foot is ahead:
 - ``early_swing`` until ``swing_foot_ahead`` (the swing foot's distance ahead of the
   stance foot along the slope) crosses zero upward; a fall if the swing foot goes more than
   ``SCUFF_DEPTH * L`` below the ground (``swing_foot_scuffs``: it starts on the ground, so a
-  foot driven into it fires at once) or the hip reaches the slope;
+  foot driven into it fires at once; not on straight legs, whose foot passes through the
+  ground at mid-stance, ignored as the compass gait's:
+  :attr:`~walkerlab.walker.description.Structure.swing_foot_clears`) or the hip reaches the
+  slope;
 - ``late_swing`` until ``heel_strike`` (the swing foot's height above the slope decreasing
-  through zero), or a fall: the swing foot falling back behind the stance foot, the hip
-  reaching the slope.
+  through zero; straight legs: the legs symmetric about the slope's normal), or a fall:
+  the swing foot falling back behind the stance foot, the hip reaching the slope.
 
 The heel strike is plastic, the old stance foot leaves the ground without impulse, the legs
 swap roles (:mod:`walkerlab.codegen.free_joints`).  The passive walker has no compiled flow
@@ -58,14 +62,16 @@ def make_five_link_walker(data: WalkerData, name: str = "biped",
     Parameters
     ----------
     data : WalkerData
-        Of the ``free_joints`` kind (:attr:`walkerlab.walker.description.Structure.kind`).
+        Of a free-jointed kind, ``free_joints`` or ``hinged_torso``
+        (:attr:`walkerlab.walker.description.Structure.kind`).
     name, variant : str
         Stored in artifacts.
 
     Returns
     -------
     HybridWalker
-        Roles ``stance_shank, stance_thigh, swing_thigh, swing_shank[, torso]``.
+        Roles ``stance_shank, stance_thigh, swing_thigh, swing_shank[, torso]``; straight
+        legs ``stance, swing, torso``.
     """
     f = functions(data)
     jac, var = f["flow_jacobian"], f.get("flow_variational")
@@ -75,7 +81,9 @@ def make_five_link_walker(data: WalkerData, name: str = "biped",
                                                 SCUFF_DEPTH * data.leg_length_m), -1, "fall",
                    f["grad_swing_clearance"])
     early = Phase("early_swing", f["flow"], (Guard("midstance", ahead, +1, "next_phase",
-                                                   dahead), scuffs, fall),
+                                                   dahead),
+                                             *((scuffs,) if data.structure.swing_foot_clears
+                                               else ()), fall),
                   jacobian=jac, variational=var)
     late = Phase("late_swing", f["flow"], (
         Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike",
