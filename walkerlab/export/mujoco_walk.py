@@ -352,8 +352,8 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
         tips[g] = len(tips)
     n = len(tips)
     ground = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "ground")
-    q = model.geom_quat[ground] if ground >= 0 else (1.0, 0.0, 0.0, 0.0)
-    phi = 2.0 * math.atan2(float(q[2]), float(q[0]))  # the plane turned about y by phi
+    qw, _, qy, _ = model.geom_quat[ground] if ground >= 0 else (1.0, 0.0, 0.0, 0.0)
+    phi = 2.0 * math.atan2(float(qy), float(qw))  # the plane turned about y by phi
     nrm = np.array([math.sin(phi), 0.0, math.cos(phi)])
     tan = np.array([math.cos(phi), 0.0, -math.sin(phi)])
     hub = int(model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")])
