@@ -302,10 +302,17 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     -------
     walker, x0, limits, step_length
         :class:`ContactWalker`, the initial state (N,), :class:`ContactLimits` from the
-        scene's ``contact_sim`` section, the ideal step length [m].
+        scene's ``contact_sim`` section, the ideal step length [m] (footholds of several
+        heights: the mean of the rigid gait's steps, whose footfalls the patches lie at,
+        :func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`).
     """
     cs = setup.sim
-    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m)
+    lengths = None
+    if step_length_m is None and setup.steps_differ:  # the rigid period-n gait's footfalls
+        from walkerlab.analysis.contact.footfalls import rigid_step_lengths
+
+        lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal)
+    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m, lengths)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
     x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
     limits = ContactLimits(
