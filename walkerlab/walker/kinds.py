@@ -162,9 +162,8 @@ _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
 FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (walkerlab "
-                   "fixedpoint, simulate; its per-step slope also turns gravity within the "
-                   "step): the contact model and the exports lay every patch parallel to the "
-                   "scene's slope; give foothold_heights_m alone for this view")
+                   "fixedpoint, simulate): the contact model and the exports lay every patch "
+                   "parallel to the scene's slope; give foothold_heights_m alone for this view")
 _GYM_GROUND = ("the rigid view steps one walker on a ground whose every step is alike "
                "(slope, stairs, footholds of one height); use view='contact'")
 #: why neither gym view takes footholds that differ from step to step (each view steps

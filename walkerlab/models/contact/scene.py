@@ -39,10 +39,9 @@ __all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal
 
 #: why the contact periodic gait refuses a ground whose steps differ
 SEVERAL_STEPS_PERIODIC = (
-    "contact_sim.start / periodic_gait: the contact periodic gait (also --periodic) is the "
-    "fixed point of one step's map on a ground whose every step is alike; footholds of "
-    "several heights (terrain.foothold_heights_m) have a gait of several steps: start from "
-    "the rigid gait (start: ideal, periodic_gait: false)")
+    "contact_sim.start / periodic_gait: the contact periodic gait is one step's map; footholds "
+    "of several heights have a gait of several steps: start from the rigid gait (start: "
+    "ideal, periodic_gait: false)")
 
 
 class ContactSceneError(ValueError):
