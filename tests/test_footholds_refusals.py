@@ -67,15 +67,32 @@ def test_report_runs_contact_sim_on_footholds_of_two_heights(tmp_path):
     assert not any(s in md for s in INTERNAL)
 
 
-def test_the_contact_periodic_gait_on_footholds_of_two_heights_is_one_line(tmp_path):
+def test_a_start_from_the_contact_periodic_gait_on_two_heights_is_one_line(tmp_path):
     from walkerlab.models.contact.scene import SEVERAL_STEPS_PERIODIC
 
-    for cs in ({"periodic_gait": True}, {"start": "periodic_gait"}):
-        rc, err, _ = run_cli("contact-sim", _scene_file(tmp_path, _with(contact_sim=cs)),
-                             "--runs-dir", tmp_path / "r")
-        assert rc == 1 and "\n" not in err
-        assert err == f"error: scene 'footholds2': {SEVERAL_STEPS_PERIODIC}"
-        assert "start: ideal, periodic_gait: false" in err  # what to do
+    rc, err, _ = run_cli("contact-sim", _scene_file(tmp_path, _with(contact_sim={
+        "start": "periodic_gait"})), "--runs-dir", tmp_path / "r")
+    assert rc == 1 and "\n" not in err
+    assert err == f"error: scene 'footholds2': {SEVERAL_STEPS_PERIODIC}"
+    assert "start: ideal, periodic_gait: false" in err  # what to do
+
+
+def test_the_contact_periodic_gait_asked_on_two_heights_is_recorded_as_not_found(tmp_path):
+    """configs/paper.yaml's contact_sim asks for the periodic gait too
+    (``periodic_gait: true``): the run walks, and the gait is stored as not found with the
+    reason (the one-step map), as a gait the search did not find is."""
+    import h5py
+
+    from walkerlab.models.contact.scene import SEVERAL_STEPS_PERIODIC
+
+    d = _with(contact_sim={"periodic_gait": True, "n_strides": 2})
+    rc, err, _ = run_cli("-q", "contact-sim", _scene_file(tmp_path, d), "--runs-dir",
+                         tmp_path / "r")
+    assert rc == 0, err
+    with h5py.File(tmp_path / "r" / "footholds2" / "contact_sim.h5") as f:
+        assert f["periodic_gait"].attrs["outcome"] == "several_steps"
+        assert f["periodic_gait"].attrs["message"] == SEVERAL_STEPS_PERIODIC
+        assert int(f["summary/heel_strikes"][()]) >= 4
 
 
 @pytest.mark.parametrize("fmt, view", [("osim", "osim"), ("adm", "adams")])

@@ -244,9 +244,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
-        # the shipped five-link biped walks by its joint torques (a passive one would build)
+        # the shipped five-link biped walks by its joint torques (a passive one would build);
+        # the MJCF's patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact")},
+                              "walkers only") for v in ("rigid", "contact", "mjcf")},
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
@@ -256,9 +257,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
+        # footholds have no ground between them; the wheel's contact model needs it
         ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
-                                   "ground (its spokes have no lanes of their own), and "
-                                   "footholds have no ground between them"),
+                                   "ground (its spokes have no lanes of their own)"),
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
         **{(f, "mjcf"): ("a spoked wheel's MJCF carries the slope's plane only; "

@@ -42,6 +42,8 @@ SEVERAL_STEPS_PERIODIC = (
     "contact_sim.start / periodic_gait: the contact periodic gait is one step's map; footholds "
     "of several heights have a gait of several steps: start from the rigid gait (start: "
     "ideal, periodic_gait: false)")
+#: the periodic gait's outcome on such a ground (``contact_sim.periodic_gait: true``)
+SEVERAL_STEPS_OUTCOME = "several_steps"
 
 
 class ContactSceneError(ValueError):
@@ -198,8 +200,10 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         that is not a point, a ground the contact model does not build (a height profile,
         footholds of their own slopes, footholds on continuous ground), or the periodic gait
         (``contact_sim.start: periodic_gait``, ``periodic_gait: true`` or ``periodic``) of a
-        walker or ground whose step map it does not carry (a rimless wheel, footholds of
-        several heights: :data:`SEVERAL_STEPS_PERIODIC`) (one line).
+        walker whose step map it does not carry (a rimless wheel), or a start from it
+        (``contact_sim.start: periodic_gait``) on footholds of several heights
+        (:data:`SEVERAL_STEPS_PERIODIC`; ``periodic_gait: true`` there records the gait as
+        not found, with that reason) (one line).
     """
     from walkerlab.codegen.floating import check_masses
     from walkerlab.walker.description import walker_data
@@ -228,8 +232,8 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     why = contact_part(data.structure).check(scene, data, checked)
     if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
         raise ContactSceneError(f"scene '{scene.name}': {why}")
-    if (checked.start == "periodic_gait" or checked.periodic_gait) \
-            and len(check_ground(scene.terrain)) > 1:
+    if cs.start == "periodic_gait" and len(check_ground(scene.terrain)) > 1:
+        # the run cannot start there (periodic_gait: true records the gait as not found)
         raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
