@@ -356,10 +356,37 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     # without an end time of its own, a run whose contact steps are slower than the rigid
     # ones goes on until its strides are made (or twice the rigid strides' time)
     t_more = 2.0 * t_final if cs.t_final_s is None else None
-    res = simulate_contact(walker, x0, t_final, sv, limits,
-                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None,
+    cap = 2 * n_strides + 1 if cs.stop_after_strides else None
+    res = simulate_contact(walker, x0, t_final, sv, limits, max_heel_strikes=cap,
                            t_more=t_more)
+    if setup.steps_differ:  # footholds of several heights: where the feet land
+        walker, res = _at_own_footfalls(setup, walker, res, lambda w: simulate_contact(
+            w, x0, t_final, sv, limits, max_heel_strikes=cap, t_more=t_more))
     return walker, res, x0, step_length
+
+
+def _at_own_footfalls(setup: ContactSetup, walker, res, run):
+    """``(walker, res)`` of a run on footholds of several heights that left the patches laid
+    at the rigid gait's footfalls (a trip, fall or scuff): run ``run(walker)`` again with
+    the patches moved to its own footfalls
+    (:func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes`), up to
+    :data:`~walkerlab.analysis.contact.footfalls.MAX_RELAYS` times while each walks further
+    (more heel strikes); the last that did is kept."""
+    from walkerlab.analysis.contact.footfalls import MAX_RELAYS, own_footfall_lanes
+    from walkerlab.models.contact.terrain import check_ground
+
+    period = len(check_ground(setup.terrain))
+    for _ in range(MAX_RELAYS):
+        if res.outcome.kind not in _OFF_THE_PATCHES:
+            break
+        moved = own_footfall_lanes(walker, res, period)
+        if moved is None:
+            break
+        again = run(moved)
+        if len(again.heel_strike_times) <= len(res.heel_strike_times):
+            break
+        walker, res = moved, again
+    return walker, res
 
 
 def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
