@@ -347,7 +347,9 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     -------
     walker, result, x0, step_length
         :class:`ContactWalker`, :class:`ContactResult`, the initial state (N,), the ideal
-        step length [m].
+        step length [m].  On footholds of several heights a run that left the patches at
+        the rigid footfalls (a trip, fall or scuff) is run again on patches at its own
+        footfalls (:func:`_at_own_footfalls`): the walker and result are the last run's.
     """
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
