@@ -347,9 +347,9 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     -------
     walker, result, x0, step_length
         :class:`ContactWalker`, :class:`ContactResult`, the initial state (N,), the ideal
-        step length [m].  On footholds of several heights a run that left the patches at
-        the rigid footfalls (a trip, fall or scuff) is run again on patches at its own
-        footfalls (:func:`_at_own_footfalls`): the walker and result are the last run's.
+        step length [m].  On footholds a run that left the patches at the rigid footfalls (a
+        trip, fall or scuff) is run again on patches at its own footfalls
+        (:func:`_at_own_footfalls`): the walker and result are the last run's.
     """
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
@@ -361,15 +361,15 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     cap = 2 * n_strides + 1 if cs.stop_after_strides else None
     res = simulate_contact(walker, x0, t_final, sv, limits, max_heel_strikes=cap,
                            t_more=t_more)
-    if setup.steps_differ:  # footholds of several heights: where the feet land
+    if setup.patches_follow_feet:  # footholds: where the feet land
         walker, res = _at_own_footfalls(setup, walker, res, lambda w: simulate_contact(
             w, x0, t_final, sv, limits, max_heel_strikes=cap, t_more=t_more))
     return walker, res, x0, step_length
 
 
 def _at_own_footfalls(setup: ContactSetup, walker, res, run):
-    """``(walker, res)`` of a run on footholds of several heights that left the patches laid
-    at the rigid gait's footfalls (a trip, fall or scuff): run ``run(walker)`` again with
+    """``(walker, res)`` of a run on footholds that left the patches laid at the rigid
+    gait's footfalls (a trip, fall or scuff): run ``run(walker)`` again with
     the patches moved to its own footfalls
     (:func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes`), up to
     :data:`~walkerlab.analysis.contact.footfalls.MAX_RELAYS` times while each walks further

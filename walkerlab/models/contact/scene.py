@@ -122,6 +122,15 @@ class ContactSetup:
         rigid gait's footfalls step by step (``step_lengths_m`` of :meth:`build`)."""
         return not self.terrain.is_slope and len(check_ground(self.terrain)) > 1
 
+    @property
+    def patches_follow_feet(self) -> bool:
+        """The ground is footholds on checkerboard lanes: each step's landing is where the
+        foot lands (``h_k`` below the stance foot's level, wherever that is), so a run whose
+        footfalls drift off the patches laid at the rigid gait's may lay them at its own
+        (:func:`walkerlab.analysis.contact.sim.simulate_from`); stairs' treads stay where
+        they are."""
+        return self.terrain.kind == "footholds" and self.terrain.lanes == "checkerboard"
+
     def model(self) -> ContactWalker:
         """The setup's contact walker on no terrain: its law, knee stop, flat feet,
         actuators, a wheel's regularising hub inertia (``contact.hub_inertia_kg_m2``) and
