@@ -73,8 +73,8 @@ def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
     return tuple(float(ideal_step_length(walker, sg.x_next, along_slope=True)) for sg in segs)
 
 
-#: relays of the patches at the contact walker's own footfalls a run on footholds of several
-#: heights may take (:func:`own_footfall_lanes`; each relay runs the walk again)
+#: relays of the patches at the contact walker's own footfalls a run on footholds may take
+#: (:func:`own_footfall_lanes`; each relay runs the walk again)
 MAX_RELAYS = 4
 
 
