@@ -228,7 +228,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
-    from walkerlab.models.contact.terrain import check_ground
+    from walkerlab.models.contact.terrain import ground_drops
 
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain or TerrainSettings()
@@ -247,7 +247,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin
     elif not terrain.is_slope:
         lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
-    if lane_heights is not None and len(check_ground(terrain)) > 1:
+    if lane_heights is not None and len(ground_drops(terrain)) > 1:
         # footholds of several heights: the rigid period-n gait's footfalls, step by step
         lanes, lane_heights = _footfalls_per_step(scene, walker, ideal.x, terrain)
         lanes = feet_part.footprints(lanes, data)
@@ -295,13 +295,13 @@ def _footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings
     above); leg2's lane holds footfalls 0, 2, ..., leg1's -1, 1, 3, ...."""
     from walkerlab.analysis.contact.footfalls import rigid_step_lengths
     from walkerlab.models.contact.terrain import (
-        check_ground,
         footfall_heights,
         footfall_positions,
+        ground_drops,
     )
 
     ells = rigid_step_lengths(scene, walker, x_ideal)
-    drops = check_ground(terrain)
+    drops = ground_drops(terrain)
     n = EXPORT_STEPS + 1  # footfalls 0 .. EXPORT_STEPS
     s = footfall_positions(ells, n)
     h = footfall_heights(drops, n, float(walker.phi))
@@ -378,7 +378,7 @@ def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
     """
     from walkerlab.models.contact.terrain import check_ground, stairs_line
 
-    drop = check_ground(terrain)[0] * math.cos(float(walker.phi))
+    drop = check_ground(terrain) * math.cos(float(walker.phi))
     if terrain.lanes == "checkerboard":
         k = np.arange(EXPORT_STEPS // 2 + 1)
         return (tuple(-(2 * k - 1) * drop), tuple(-(2 * k) * drop)), None

@@ -200,9 +200,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                              "slope's ground only (stairs, footholds and profiles are in the "
                              "MJCF, the OpenSim model and the Adams dataset); --walker-only "
                              "writes the walker alone")
-        from walkerlab.models.contact.terrain import check_ground
+        from walkerlab.models.contact.terrain import ground_drops
 
-        drops = check_ground(scene.terrain)  # a profile: one line
+        drops = ground_drops(scene.terrain)  # a profile: one line
     data = walker_data(scene.walker, scene.slope.phi_rad)
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope \
             and len(drops) > 1:  # footholds of several heights: the capability table's cell

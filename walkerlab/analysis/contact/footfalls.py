@@ -56,10 +56,10 @@ def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.contact.scene import ideal_step_length
-    from walkerlab.models.contact.terrain import check_ground
+    from walkerlab.models.contact.terrain import ground_drops
     from walkerlab.models.registry import build_walker
 
-    if scene.terrain is None or scene.terrain.is_slope or len(check_ground(scene.terrain)) < 2:
+    if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:
         return None
     rigid = build_walker(scene)
     m = len(rigid.cycle) if rigid.cycle is not None else 1

@@ -375,9 +375,9 @@ def _at_own_footfalls(setup: ContactSetup, walker, res, run):
     :data:`~walkerlab.analysis.contact.footfalls.MAX_RELAYS` times while each walks further
     (more heel strikes); the last that did is kept."""
     from walkerlab.analysis.contact.footfalls import MAX_RELAYS, own_footfall_lanes
-    from walkerlab.models.contact.terrain import check_ground
+    from walkerlab.models.contact.terrain import ground_drops
 
-    period = len(check_ground(setup.terrain))
+    period = len(ground_drops(setup.terrain))
     for _ in range(MAX_RELAYS):
         if res.outcome.kind not in _OFF_THE_PATCHES:
             break

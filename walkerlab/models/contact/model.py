@@ -276,10 +276,10 @@ class ContactWalker(ContactReadouts):
             already on a terrain is laid out afresh (its patch heights and polyline are
             replaced, never carried to lanes they do not fit).
         """
-        from .terrain import check_ground, footfall_positions
+        from .terrain import footfall_positions, ground_drops
 
         if step_lengths is None:
-            if not terrain.is_slope and len(check_ground(terrain)) > 1:
+            if not terrain.is_slope and len(ground_drops(terrain)) > 1:
                 raise ValueError("terrain.foothold_heights_m: footholds of several heights "
                                  "are laid at the rigid gait's footfalls, step by step "
                                  "(walkerlab contact-sim lays them; a fixed spacing misses "

@@ -28,7 +28,7 @@ from .laws import ContactParamsSI, KneeStopSI
 from .model import ContactWalker
 from .parts import contact_part
 from .rigid_limit import contact_si
-from .terrain import check_ground
+from .terrain import check_ground, ground_drops
 
 if TYPE_CHECKING:
     from walkerlab.codegen.pending import CompiledElsewhere
@@ -120,7 +120,7 @@ class ContactSetup:
     def steps_differ(self) -> bool:
         """The ground's steps differ (footholds of several heights): its patches lie at the
         rigid gait's footfalls step by step (``step_lengths_m`` of :meth:`build`)."""
-        return not self.terrain.is_slope and len(check_ground(self.terrain)) > 1
+        return not self.terrain.is_slope and len(ground_drops(self.terrain)) > 1
 
     @property
     def patches_follow_feet(self) -> bool:
@@ -241,7 +241,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     why = contact_part(data.structure).check(scene, data, checked)
     if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
         raise ContactSceneError(f"scene '{scene.name}': {why}")
-    if cs.start == "periodic_gait" and len(check_ground(scene.terrain)) > 1:
+    if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
         # the run cannot start there (periodic_gait: true records the gait as not found)
         raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run

@@ -44,7 +44,8 @@ import numpy as np
 from walkerlab.models.ground import landing_drops, stair_treads
 
 __all__ = ["check_ground", "footfall_heights", "footfall_lanes", "footfall_positions",
-           "profile_line", "slope_heights", "stairs_line", "step_heights", "terrain_ground"]
+           "ground_drops", "profile_line", "slope_heights", "stairs_line", "step_heights",
+           "terrain_ground"]
 
 
 def slope_heights(slopes_rad: np.ndarray, mean_rad: float, step_length_m: float
@@ -112,10 +113,10 @@ def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np
     return np.asarray(pts, dtype=float)
 
 
-def check_ground(terrain) -> tuple[float, ...]:
-    """The landing drop per step [m] of a ground the contact model builds, one per step of
-    the ground's period (``(0.0,)`` for the slope; footholds of several heights: one per
-    height, :func:`walkerlab.models.ground.landing_drops`).
+def check_ground(terrain) -> float:
+    """The landing drop per step [m] of a ground the contact model builds (0.0 for the
+    slope; :func:`walkerlab.models.ground.landing_drop`; footholds of several heights: their
+    mean, the drop per step on average; each step's is :func:`ground_drops`').
 
     Raises
     ------
@@ -123,6 +124,21 @@ def check_ground(terrain) -> tuple[float, ...]:
         One line naming the field and what to do: a profile on checkerboard lanes or from
         a CSV, footholds of their own slopes (the rigid model walks them), footholds on
         continuous ground (no ground between the footholds).
+    """
+    drops = ground_drops(terrain)
+    return drops[0] if len(drops) == 1 else float(np.mean(drops))
+
+
+def ground_drops(terrain) -> tuple[float, ...]:
+    """The landing drop [m] of each step of the ground's period, for a ground the contact
+    model builds: ``(0.0,)`` for the slope and a profile, ``(drop,)`` for stairs and
+    footholds of one height, one per height for footholds of several heights
+    (:func:`walkerlab.models.ground.landing_drops`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`check_ground` (one line).
     """
     if terrain is None or terrain.kind == "slope":
         return (0.0,)
@@ -208,11 +224,11 @@ def terrain_ground(walker, terrain, n_steps: int):
     ValueError
         A ground the contact model does not build (one line, naming the field): a profile
         on checkerboard lanes, footholds of their own slopes, footholds on continuous
-        ground (:func:`check_ground`).
+        ground (:func:`ground_drops`).
     """
     if terrain is None or terrain.kind == "slope":
         return walker
-    drops = check_ground(terrain)
+    drops = ground_drops(terrain)
     if terrain.lanes == "checkerboard":
         n = 2 * max(walker.lane1.size, walker.lane2.size)
         if len(drops) > 1:
