@@ -52,6 +52,7 @@ def test_the_contact_and_mjcf_cells_of_footholds_are_supported_adams_and_osim_re
     assert "contact-sim" in SEVERAL_FOOTHOLDS and "mjcf" in SEVERAL_FOOTHOLDS
 
 
+@pytest.mark.slow  # ~6 s: the whole report (figures)
 def test_report_runs_contact_sim_on_footholds_of_two_heights(tmp_path):
     """The refusal is gone: ``walkerlab report`` runs every stage, the contact walker makes
     its heel strikes (contact_sim.n_strides: 2 here, 4 heel strikes, to stay fast) and the
