@@ -1,8 +1,10 @@
-"""Footholds of several heights outside the rigid model (issue 58): the shipped
-``configs/footholds.yaml`` with ``configs/paper.yaml``'s contact sections is refused by the
-contact model in one line naming the scene key and what to do (no internal name such as
-``heights1``), ``walkerlab report`` names the stage that refused, and no view points the user
-to another view that refuses the same scene."""
+"""Footholds of several heights outside the rigid model (issue 58): the contact model and the
+MJCF export lay their patches at the rigid period-n gait's footfalls, so ``contact-sim`` and
+``report`` run them (before: one line, "footholds that differ from step to step run in the
+rigid model only"; before that an internal "heights1: ..." message); what still refuses them
+says so in one line naming the scene key (the contact periodic gait, a one-step map; the
+Adams dataset and the OpenSim model, by the capability table's cell; footholds of their own
+slopes), and no view points the user to another view that refuses the same scene."""
 
 from __future__ import annotations
 
@@ -11,42 +13,122 @@ import copy
 import numpy as np
 import pytest
 import yaml
-from cli_run import PAPER, ROOT, run_cli
+from cli_run import ROOT, run_cli
 
 from walkerlab.config import scene_from_dict
-from walkerlab.walker.kinds import GYM_FOOTHOLDS, SEVERAL_FOOTHOLDS
+from walkerlab.walker.kinds import (
+    FOOTHOLD_SLOPES,
+    GYM_FOOTHOLDS,
+    KINDS,
+    SEVERAL_FOOTHOLDS,
+)
 
-#: configs/footholds.yaml with configs/paper.yaml's contact sections (its lanes and
-#: patches too), the footholds at two heights
-FOOTHOLDS = yaml.safe_load((ROOT / "configs" / "footholds.yaml").read_text())
-SCENE = {**FOOTHOLDS, **{k: PAPER[k] for k in ("contact", "contact_sim", "contact_solver")},
-         "terrain": {**FOOTHOLDS["terrain"], "foothold_heights_m": [-0.005, -0.01],
-                     "lanes": "checkerboard", "patch_width_m": 0.10}}
+#: configs/footholds_two.yaml: the paper walker on footholds of two heights (stable rigid
+#: gait) with the paper's contact law and 0.3 m patches
+TWO = yaml.safe_load((ROOT / "configs" / "footholds_two.yaml").read_text())
 INTERNAL = ("heights1", "heights2", "lane1", "lane2", "shape (")
 
 
-def _scene_file(tmp_path):
-    p = tmp_path / "footholds2.yaml"
-    p.write_text(yaml.safe_dump(SCENE))
+def _scene_file(tmp_path, d=None, name="footholds2"):
+    p = tmp_path / f"{name}.yaml"
+    p.write_text(yaml.safe_dump(d or TWO))
     return p
 
 
-def test_contact_sim_on_footholds_of_two_heights_is_one_line_naming_the_key(tmp_path):
-    rc, err, _ = run_cli("contact-sim", _scene_file(tmp_path), "--runs-dir", tmp_path / "r")
-    assert rc == 1 and "\n" not in err
-    assert err == ("error: scene 'footholds2': terrain.foothold_heights_m: "
-                   + SEVERAL_FOOTHOLDS)
-    assert "give footholds of one height" in err  # what to do
-    assert not any(s in err for s in INTERNAL)
+def _with(**sections):
+    d = copy.deepcopy(TWO)
+    for k, v in sections.items():
+        d[k] = {**d[k], **v}
+    return d
 
 
-def test_report_names_the_stage_that_refused(tmp_path):
-    rc, err, out = run_cli("-q", "report", _scene_file(tmp_path), "--runs-dir", tmp_path / "r")
+def test_the_contact_and_mjcf_cells_of_footholds_are_supported_adams_and_osim_refuse():
+    for kind in ("straight_legs", "locking_knees"):
+        assert KINDS[kind].supports("footholds", "contact")
+        assert KINDS[kind].supports("footholds", "mjcf")
+        for view in ("adams", "osim"):
+            assert KINDS[kind].cell("footholds", view) == SEVERAL_FOOTHOLDS
+    # what the refusal tells the user to do names only views that take them
+    assert "contact-sim" in SEVERAL_FOOTHOLDS and "mjcf" in SEVERAL_FOOTHOLDS
+
+
+@pytest.mark.slow  # ~6 s: the whole report (figures)
+def test_report_runs_contact_sim_on_footholds_of_two_heights(tmp_path):
+    """The refusal is gone: ``walkerlab report`` runs every stage, the contact walker makes
+    its heel strikes (contact_sim.n_strides: 2 here, 4 heel strikes, to stay fast) and the
+    report has its contact sections."""
+    d = _with(contact_sim={"n_strides": 2})
+    rc, err, _ = run_cli("-q", "report", _scene_file(tmp_path, d), "--runs-dir",
+                         tmp_path / "r")
+    assert rc == 0, err
+    run = tmp_path / "r" / "footholds2"
+    assert (run / "contact_sim.h5").is_file()
+    md = (run / "report" / "report.md").read_text()
+    assert "Contact walker walks" in md and "Contact walker (MSC ADAMS-style model)" in md
+    assert not any(s in md for s in INTERNAL)
+
+
+def test_a_start_from_the_contact_periodic_gait_on_two_heights_is_one_line(tmp_path):
+    from walkerlab.models.contact.scene import SEVERAL_STEPS_PERIODIC
+
+    rc, err, _ = run_cli("contact-sim", _scene_file(tmp_path, _with(contact_sim={
+        "start": "periodic_gait"})), "--runs-dir", tmp_path / "r")
     assert rc == 1 and "\n" not in err
-    assert err.startswith("error: report stopped at contact-sim: scene 'footholds2': "
-                          "terrain.foothold_heights_m: ")
-    # the rigid stages before it ran: the rigid model walks these footholds
-    assert (tmp_path / "r" / "footholds2" / "simulate.h5").is_file()
+    assert err == f"error: scene 'footholds2': {SEVERAL_STEPS_PERIODIC}"
+    assert "start: ideal, periodic_gait: false" in err  # what to do
+
+
+def test_the_contact_periodic_gait_asked_on_two_heights_is_recorded_as_not_found(tmp_path):
+    """configs/paper.yaml's contact_sim asks for the periodic gait too
+    (``periodic_gait: true``): the run walks, and the gait is stored as not found with the
+    reason (the one-step map), as a gait the search did not find is."""
+    import h5py
+
+    from walkerlab.models.contact.scene import SEVERAL_STEPS_PERIODIC
+
+    d = _with(contact_sim={"periodic_gait": True, "n_strides": 2})
+    rc, err, _ = run_cli("-q", "contact-sim", _scene_file(tmp_path, d), "--runs-dir",
+                         tmp_path / "r")
+    assert rc == 0, err
+    with h5py.File(tmp_path / "r" / "footholds2" / "contact_sim.h5") as f:
+        assert f["periodic_gait"].attrs["outcome"] == "several_steps"
+        assert f["periodic_gait"].attrs["message"] == SEVERAL_STEPS_PERIODIC
+        assert int(f["summary/heel_strikes"][()]) >= 4
+
+
+@pytest.mark.parametrize("fmt, view", [("osim", "osim"), ("adm", "adams")])
+def test_the_adams_and_opensim_exports_refuse_two_heights_by_the_table(tmp_path, fmt, view):
+    rc, err, _ = run_cli("export", _scene_file(tmp_path), "--format", fmt, "--runs-dir",
+                         tmp_path / "r")
+    assert rc == 1 and "\n" not in err
+    assert err == ("error: terrain.foothold_heights_m: "
+                   + KINDS["straight_legs"].cell("footholds", view))
+
+
+def test_footholds_of_their_own_slopes_are_refused_by_the_contact_model_in_one_line():
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+
+    d = {**copy.deepcopy(TWO), "name": "footholds2"}
+    d["terrain"] = {**d["terrain"], "foothold_heights_m": None,
+                    "foothold_slopes_rad": [0.0174, 0.02]}
+    d["terrain"] = {k: v for k, v in d["terrain"].items() if v is not None}
+    with pytest.raises(ContactSceneError) as err:
+        contact_setup(scene_from_dict(d))
+    assert str(err.value) == ("scene 'footholds2': terrain.foothold_slopes_rad: "
+                              + FOOTHOLD_SLOPES)
+
+
+def test_a_contact_walker_laid_at_a_fixed_spacing_on_two_heights_is_refused_in_one_line():
+    """Footholds of several heights lie at the rigid gait's footfalls; a caller laying them
+    at one spacing gets one line naming the key, not the patches' internal arrays."""
+    from walkerlab.models.contact.scene import contact_setup
+
+    sc = scene_from_dict(TWO)
+    with pytest.raises(ValueError) as err:
+        contact_setup(sc).build(np.array([-0.249, 0.187, -0.552, -0.966]), 10)
+    assert str(err.value).startswith("terrain.foothold_heights_m: footholds of several "
+                                     "heights are laid at the rigid gait's footfalls")
+    assert not any(s in str(err.value) for s in INTERNAL)
 
 
 def test_a_contact_walker_laid_on_new_lanes_drops_the_old_patch_heights():
@@ -55,8 +137,8 @@ def test_a_contact_walker_laid_on_new_lanes_drops_the_old_patch_heights():
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.models.contact.scene import contact_setup
 
-    d = copy.deepcopy(SCENE)
-    d["terrain"]["foothold_heights_m"] = [-0.005]  # one height: the contact model's
+    d = copy.deepcopy(TWO)
+    d["terrain"]["foothold_heights_m"] = [-0.005]  # one height: one spacing
     sc = scene_from_dict(d)
     _, search = solve_scene(sc)
     walker, step = contact_setup(sc).build(search.result.x, 10)
@@ -72,6 +154,6 @@ def test_the_gym_names_no_view_that_refuses_the_same_footholds():
     from walkerlab.gym.env import _check_rigid_ground
 
     with pytest.raises(ValueError) as err:
-        _check_rigid_ground(scene_from_dict(SCENE))
+        _check_rigid_ground(scene_from_dict(TWO))
     assert str(err.value) == ("walkerlab.gym: terrain.foothold_heights_m: " + GYM_FOOTHOLDS)
     assert "view='contact'" not in str(err.value)

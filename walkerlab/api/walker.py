@@ -772,14 +772,12 @@ class ContactWalker:
             ``not_converged``, :func:`~walkerlab.analysis.contact.periodic.converged_gait`;
             one line), as the stage reports it.
         """
-        from walkerlab.analysis.contact.periodic import (
-            converged_gait,
-            find_contact_periodic_gait,
-        )
+        from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
+        from walkerlab.analysis.contact.sim import scene_start
 
         self._check_periodic()
         x = self.rigid_gait().x if x0 is None else self.rigid.check_state(x0, "x0")
-        walker, _ = self.setup.build(x, 2 * self.setup.sim.n_strides)
+        walker = scene_start(self.setup, x, self.setup.sim.n_strides)[0]  # the stage's ground
         return converged_gait(find_contact_periodic_gait(
             walker, x, time_limit_s=self.setup.sim.periodic_time_limit_s))
 

@@ -228,6 +228,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
+    from walkerlab.models.contact.terrain import ground_drops
 
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain or TerrainSettings()
@@ -246,7 +247,11 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin
     elif not terrain.is_slope:
         lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
-    if terrain.lanes == "checkerboard":
+    if lane_heights is not None and len(ground_drops(terrain)) > 1:
+        # footholds of several heights: the rigid period-n gait's footfalls, step by step
+        lanes, lane_heights = _footfalls_per_step(scene, walker, ideal.x, terrain)
+        lanes = feet_part.footprints(lanes, data)
+    elif terrain.lanes == "checkerboard":
         lanes = feet_part.footprints(_checkerboard(walker, ideal, terrain), data)
     latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
     notes = _walker_notes(scene, part, ideal, latch, knee, notes)
@@ -279,6 +284,34 @@ def _checkerboard(walker, ideal, terrain: TerrainSettings) -> tuple:
     return (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
 
 
+def _footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings
+                        ) -> tuple[tuple, tuple]:
+    """The checkerboard of footholds of several heights: ``(lanes, lane_heights)``, each
+    ``(leg1's, leg2's)`` [m], the patches at the rigid period-n gait's footfalls step by step
+    (:func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`) and their heights along
+    the slope normal (:func:`walkerlab.models.contact.terrain.footfall_heights`).  The
+    keyframe's stance foot (leg2) is footfall 0 at the origin, its trailing foot (leg1)
+    footfall -1, the last step of the rigid map (``l_{m-1}`` behind, ``d_{m-1} cos(phi)``
+    above); leg2's lane holds footfalls 0, 2, ..., leg1's -1, 1, 3, ...."""
+    from walkerlab.analysis.contact.footfalls import rigid_step_lengths
+    from walkerlab.models.contact.terrain import (
+        footfall_heights,
+        footfall_positions,
+        ground_drops,
+    )
+
+    ells = rigid_step_lengths(scene, walker, x_ideal)
+    drops = ground_drops(terrain)
+    n = EXPORT_STEPS + 1  # footfalls 0 .. EXPORT_STEPS
+    s = footfall_positions(ells, n)
+    h = footfall_heights(drops, n, float(walker.phi))
+    s_back = -ells[-1]
+    h_back = drops[(len(ells) - 1) % len(drops)] * math.cos(float(walker.phi))
+    lanes = (tuple(float(v) for v in (s_back, *s[1::2])), tuple(float(v) for v in s[0::2]))
+    heights = (tuple(float(v) for v in (h_back, *h[1::2])), tuple(float(v) for v in h[0::2]))
+    return lanes, heights
+
+
 def _ground_notes(terrain: TerrainSettings, treads, profile, lane_heights) -> tuple:
     """The MJCF's comments on a ground that is not the plain slope (stairs, a profile,
     footholds)."""
@@ -292,6 +325,12 @@ def _ground_notes(terrain: TerrainSettings, treads, profile, lane_heights) -> tu
         terrain_notes += ("Profile (terrain.kind: profile, lanes: continuous): a height field "
                           "hfield 'profile' sampled every 5 mm from its polyline, the first "
                           "stance foot on its first point (both feet touch it).",)
+    elif lane_heights is not None and terrain.kind == "footholds" \
+            and len(set(terrain.foothold_heights_m or (0.0,))) > 1:
+        terrain_notes += ("Footholds of several heights (terrain.foothold_heights_m, in "
+                          "turn): the checkerboard patches at the rigid period-n gait's "
+                          "footfalls step by step (walkerlab.analysis.contact.footfalls), "
+                          "each the step's height below the last along the vertical.",)
     elif lane_heights is not None:
         terrain_notes += ("Footholds (terrain.kind: " + terrain.kind + "): the checkerboard "
                           "patches at the rigid gait's footholds, each at its tread's height "

@@ -107,7 +107,8 @@ def _check_rigid_ground(scene) -> None:
     elif t.kind == "footholds" and foothold_steps(t, scene.slope.phi_rad) is not None:
         from walkerlab.walker.kinds import GYM_FOOTHOLDS
 
-        # neither view takes them (the contact view lays patches for one height)
+        # neither view takes them (the contact view lays its patches at one spacing as the
+        # walk goes; contact-sim lays them at the rigid period-n gait's footfalls)
         key = "foothold_slopes_rad" if t.foothold_slopes_rad is not None else \
             "foothold_heights_m"
         raise ValueError(f"walkerlab.gym: terrain.{key}: {GYM_FOOTHOLDS}")

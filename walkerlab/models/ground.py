@@ -21,9 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.walker.kinds import SEVERAL_FOOTHOLDS
+from walkerlab.walker.kinds import FOOTHOLD_SLOPES, SEVERAL_FOOTHOLDS
 
-__all__ = ["Ground", "foothold_steps", "landing_drop", "scene_ground", "stair_treads"]
+__all__ = ["Ground", "foothold_steps", "landing_drop", "landing_drops", "scene_ground",
+           "stair_treads"]
 
 
 def landing_drop(terrain) -> float:
@@ -48,13 +49,34 @@ def landing_drop(terrain) -> float:
     if terrain.kind == "footholds":
         h = set(terrain.foothold_heights_m or (0.0,))
         if terrain.foothold_slopes_rad is not None:
-            raise ValueError(f"terrain.foothold_slopes_rad: {SEVERAL_FOOTHOLDS}")
+            raise ValueError(f"terrain.foothold_slopes_rad: {FOOTHOLD_SLOPES}")
         if len(h) == 1:
             return -float(h.pop())
         raise ValueError(f"terrain.foothold_heights_m: {SEVERAL_FOOTHOLDS}")
     # a profile: walked step by step (walkerlab.analysis.gait.profile_walk); its periodic
     # gait, the start of the walk, is the scene's slope's
     return 0.0
+
+
+def landing_drops(terrain) -> tuple[float, ...]:
+    """Depth [m] of each step's landing below the stance foot's level, one per step of the
+    ground's period: ``(landing_drop(terrain),)`` for a ground whose every step is alike,
+    ``(-h_0, -h_1, ...)`` for footholds of several heights ``terrain.foothold_heights_m``
+    (the list repeats, step ``k`` landing ``-h_{k mod p}`` below the stance foot's level
+    along the vertical, as the rigid model's heel strike meets it,
+    :func:`walkerlab.models.hybrid.ground.on_footholds`).
+
+    Raises
+    ------
+    ValueError
+        Footholds of their own slopes (``terrain.foothold_slopes_rad``; one line naming
+        the field, :data:`walkerlab.walker.kinds.FOOTHOLD_SLOPES`).
+    """
+    if terrain is not None and terrain.kind == "footholds" \
+            and terrain.foothold_slopes_rad is None \
+            and len(set(terrain.foothold_heights_m or (0.0,))) > 1:
+        return tuple(-float(h) for h in terrain.foothold_heights_m)
+    return (landing_drop(terrain),)
 
 
 def foothold_steps(terrain, slope_rad: float) -> tuple[tuple[float, float], ...] | None:

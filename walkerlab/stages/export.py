@@ -57,6 +57,7 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.scene import (
+    FORMAT_VIEWS,
     check_exportable,
     check_wheel_exportable,
     mjcf_scene,
@@ -276,7 +277,9 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         Unknown format, a walker with a massless link (a multibody model needs positive
         masses), feet the formats cannot carry, a ground other than the slope (stairs ...)
         unless ``walker_only``, or no rigid gait to start from; a spoked wheel to a format
-        other than urdf or mjcf (naming walker.model); one line.
+        other than urdf or mjcf (naming walker.model); footholds of several heights where
+        the capability table refuses them (the Adams dataset, the OpenSim model: naming
+        terrain.foothold_heights_m); one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
     walkerlab.io.artifacts.ArtifactError
@@ -291,13 +294,17 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                              "slope's ground only (stairs, footholds and profiles are in the "
                              "MJCF, the OpenSim model and the Adams dataset); --walker-only "
                              "writes the walker alone")
-        from walkerlab.models.contact.terrain import check_ground
+        from walkerlab.models.contact.terrain import ground_drops
 
-        check_ground(scene.terrain)  # a profile: one line
+        drops = ground_drops(scene.terrain)  # a profile: one line
     if walk and walker_only:
         raise ValueError("--walk: the walker alone (--walker-only) has no gait to walk from; "
                          "drop one of them")
     data = walker_data(scene.walker, scene.slope.phi_rad)
+    if not walker_only and scene.terrain is not None and not scene.terrain.is_slope \
+            and len(drops) > 1:  # footholds of several heights: the capability table's cell
+        data.structure.kind.require("footholds", FORMAT_VIEWS[fmt],
+                                    "terrain.foothold_heights_m")
     name = scene.name or "walker"
     out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
     if not walk:

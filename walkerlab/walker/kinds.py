@@ -163,19 +163,25 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
 _NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
                   "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-#: why a view other than the rigid one refuses footholds that differ from step to step
+#: why the Adams and OpenSim views refuse footholds that differ from step to step
 #: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
-SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model only "
-                     "(walkerlab fixedpoint, simulate): give footholds of one height for "
-                     "this view")
+SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model, the "
+                     "contact model and the MJCF export (walkerlab fixedpoint, simulate, "
+                     "contact-sim, report, export --format mjcf): give footholds of one "
+                     "height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
+#: why every view but the rigid one refuses footholds of their own slopes
+#: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
+FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (walkerlab "
+                   "fixedpoint, simulate): the contact model and the exports lay every patch "
+                   "parallel to the scene's slope; give foothold_heights_m alone for this view")
 _GYM_GROUND = ("the rigid view steps one walker on a ground whose every step is alike "
                "(slope, stairs, footholds of one height); use view='contact'")
-#: why neither gym view takes footholds that differ from step to step (the contact view
-#: lays its patches for one height, :data:`SEVERAL_FOOTHOLDS`)
+#: why neither gym view takes footholds that differ from step to step (each view steps
+#: one walker on a ground whose every step is alike)
 GYM_FOOTHOLDS = ("the gym's views step one walker on a ground whose every step is alike "
                  "(slope, stairs, footholds of one height); footholds that differ from step "
-                 "to step run in walkerlab fixedpoint and simulate only")
+                 "to step run in walkerlab fixedpoint, simulate and contact-sim")
 _OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                  "half-spaces, not a polyline; --format mjcf writes it as a height field)")
 _ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
@@ -186,10 +192,11 @@ _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively);
 #: free-jointed (:mod:`walkerlab.export.adams_actuation` says it too)
 FREE_JOINT_TORQUES = ("stance_hip, swing_hip, stance_knee and swing_knee need a free-jointed "
                       "biped (a hinged torso, on free knees or straight legs)")
-#: what the views of every legged kind refuse: grounds whose steps differ outside the rigid
-#: view, a profile in the Adams dataset, the OpenSim model and the gym
+#: what the views of every legged kind refuse: grounds whose steps differ in the Adams
+#: dataset and the OpenSim model (the contact model and the MJCF lay their patches at the
+#: rigid period-n gait's footfalls), a profile there and in the gym
 _GROUNDS = {
-    **{("footholds", v): _ONE_LANDING for v in ("contact", "mjcf", "adams", "osim")},
+    **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
     ("footholds", "gym"): GYM_FOOTHOLDS,
     ("profile", "gym"): _GYM_GROUND,
     ("profile", "adams"): _ADAMS_PROFILE,
@@ -250,9 +257,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
-        # the shipped five-link biped walks by its joint torques (a passive one would build)
+        # the shipped five-link biped walks by its joint torques (a passive one would build);
+        # the MJCF's patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact")},
+                              "walkers only") for v in ("rigid", "contact", "mjcf")},
     },
     "hinged_torso": {
         ("knee_torque", "*"): _NO_KNEE,
@@ -262,9 +270,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                "transcribed yet (run it in fixedpoint, simulate, contact-sim, "
                                "the exports and the gym)"),
         **_GROUNDS,
-        # a walker held up by its joint torques (a passive one would build)
+        # a walker held up by its joint torques (a passive one would build); the MJCF's
+        # patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact")},
+                              "walkers only") for v in ("rigid", "contact", "mjcf")},
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
@@ -274,7 +283,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
-        ("footholds", "contact"): _ONE_LANDING,
+        # footholds have no ground between them; the wheel's contact model needs it
+        ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
+                                   "ground (its spokes have no lanes of their own)"),
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
         **{(f, "mjcf"): ("a spoked wheel's MJCF carries the slope's plane only; "

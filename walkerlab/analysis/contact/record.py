@@ -189,8 +189,9 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     """The ``contact-sim`` stage's run: the contact walker of a scene (its ``setup``,
     :func:`walkerlab.models.contact.scene.contact_setup`) started from the ideal fixed point
     ``fp`` (a loaded ``fixedpoint.h5``) as :func:`contact_walk` runs it; with ``periodic``
-    (or ``contact_sim.start: periodic_gait``) its periodic gait and Floquet multipliers; the
-    drop test and the headline numbers.
+    (or ``contact_sim.start: periodic_gait``) its periodic gait and Floquet multipliers (on
+    footholds of several heights not searched: recorded as not found, outcome
+    ``several_steps``, the one-step map's reason); the drop test and the headline numbers.
 
     Returns
     -------
@@ -208,7 +209,13 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     gait_error = None
     walker, res, x0, step_length, scale, gait, adj = contact_walk(
         setup, fp.x, fp.step_period_s, adjust)
-    if periodic and gait is None:
+    if periodic and gait is None and setup.steps_differ:
+        from walkerlab.analysis.contact.step_map import PeriodicGaitError
+        from walkerlab.models.contact.scene import SEVERAL_STEPS_OUTCOME, SEVERAL_STEPS_PERIODIC
+
+        # the step map is one step's; this ground's gait is of several (not searched)
+        gait_error = PeriodicGaitError(SEVERAL_STEPS_OUTCOME, SEVERAL_STEPS_PERIODIC)
+    elif periodic and gait is None:
         from walkerlab.analysis.contact.periodic import (
             converged_gait,
             find_contact_periodic_gait,

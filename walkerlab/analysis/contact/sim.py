@@ -302,10 +302,17 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     -------
     walker, x0, limits, step_length
         :class:`ContactWalker`, the initial state (N,), :class:`ContactLimits` from the
-        scene's ``contact_sim`` section, the ideal step length [m].
+        scene's ``contact_sim`` section, the ideal step length [m] (footholds of several
+        heights: the mean of the rigid gait's steps, whose footfalls the patches lie at,
+        :func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`).
     """
     cs = setup.sim
-    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m)
+    lengths = None
+    if step_length_m is None and setup.steps_differ:  # the rigid period-n gait's footfalls
+        from walkerlab.analysis.contact.footfalls import rigid_step_lengths
+
+        lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal)
+    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m, lengths)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
     x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
     limits = ContactLimits(
@@ -340,7 +347,9 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     -------
     walker, result, x0, step_length
         :class:`ContactWalker`, :class:`ContactResult`, the initial state (N,), the ideal
-        step length [m].
+        step length [m].  On footholds a run that left the patches at the rigid footfalls (a
+        trip, fall or scuff) is run again on patches at its own footfalls
+        (:func:`_at_own_footfalls`): the walker and result are the last run's.
     """
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
@@ -349,10 +358,37 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     # without an end time of its own, a run whose contact steps are slower than the rigid
     # ones goes on until its strides are made (or twice the rigid strides' time)
     t_more = 2.0 * t_final if cs.t_final_s is None else None
-    res = simulate_contact(walker, x0, t_final, sv, limits,
-                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None,
+    cap = 2 * n_strides + 1 if cs.stop_after_strides else None
+    res = simulate_contact(walker, x0, t_final, sv, limits, max_heel_strikes=cap,
                            t_more=t_more)
+    if setup.patches_follow_feet:  # footholds: where the feet land
+        walker, res = _at_own_footfalls(setup, walker, res, lambda w: simulate_contact(
+            w, x0, t_final, sv, limits, max_heel_strikes=cap, t_more=t_more))
     return walker, res, x0, step_length
+
+
+def _at_own_footfalls(setup: ContactSetup, walker, res, run):
+    """``(walker, res)`` of a run on footholds that left the patches laid at the rigid
+    gait's footfalls (a trip, fall or scuff): run ``run(walker)`` again with
+    the patches moved to its own footfalls
+    (:func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes`), up to
+    :data:`~walkerlab.analysis.contact.footfalls.MAX_RELAYS` times while each walks further
+    (more heel strikes); the last that did is kept."""
+    from walkerlab.analysis.contact.footfalls import MAX_RELAYS, own_footfall_lanes
+    from walkerlab.models.contact.terrain import ground_drops
+
+    period = len(ground_drops(setup.terrain))
+    for _ in range(MAX_RELAYS):
+        if res.outcome.kind not in _OFF_THE_PATCHES:
+            break
+        moved = own_footfall_lanes(walker, res, period)
+        if moved is None:
+            break
+        again = run(moved)
+        if len(again.heel_strike_times) <= len(res.heel_strike_times):
+            break
+        walker, res = moved, again
+    return walker, res
 
 
 def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:

@@ -96,7 +96,8 @@ __all__ = ["SCALES", "SECTION_NAMES", "SECTION_UNITS", "PeriodicGaitError", "Ste
 class PeriodicGaitError(RuntimeError):
     """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
     "time_limit", "solver_failure", "not_converged" (the search ended away from a fixed
-    point: :func:`walkerlab.analysis.contact.periodic.converged_gait`)."""
+    point: :func:`walkerlab.analysis.contact.periodic.converged_gait`), "several_steps" (a
+    ground whose steps differ: the one-step map does not apply, not searched)."""
 
     def __init__(self, kind: str, message: str):
         super().__init__(message)

@@ -241,12 +241,25 @@ class ContactWalker(ContactReadouts):
         return walker.on_terrain(terrain, step_length=step_length, n_steps=n_steps)
 
     def on_terrain(self, terrain: TerrainSettings, *, step_length: float,
-                   n_steps: int) -> ContactWalker:
+                   n_steps: int, step_lengths: tuple | None = None) -> ContactWalker:
         """The same walker and contact law on ``terrain``: checkerboard patches spaced by
-        ``step_length`` [m] for ``n_steps`` steps (each lane shifted by its leg's
-        :func:`footprint_offsets`), or continuous ground; stairs and footholds as the
-        patches' heights or a polyline ground (:func:`walkerlab.models.contact.terrain.
-        terrain_ground`).
+        ``step_length`` [m] (or by ``step_lengths`` in turn) for ``n_steps`` steps (each
+        lane shifted by its leg's :func:`footprint_offsets`), or continuous ground; stairs
+        and footholds as the patches' heights or a polyline ground
+        (:func:`walkerlab.models.contact.terrain.terrain_ground`).
+
+        Parameters
+        ----------
+        terrain : TerrainSettings
+        step_length : float
+            Patch spacing [m] (footfall to footfall along the slope).
+        n_steps : int
+            Steps the run may take.
+        step_lengths : tuple of float, optional
+            Each step's advance along the slope [m], in turn (a gait of several steps:
+            footholds of several heights, the rigid period-n gait's steps); replaces
+            ``step_length``; footfall ``k`` at
+            :func:`walkerlab.models.contact.terrain.footfall_positions`.
 
         Returns
         -------
@@ -259,10 +272,23 @@ class ContactWalker(ContactReadouts):
         ValueError
             A ground the contact model does not build
             (:func:`walkerlab.models.contact.terrain.terrain_ground`, one line naming the
-            scene key).  A walker already on a terrain is laid out afresh (its patch heights
-            and polyline are replaced, never carried to lanes they do not fit).
+            scene key); footholds of several heights without ``step_lengths``.  A walker
+            already on a terrain is laid out afresh (its patch heights and polyline are
+            replaced, never carried to lanes they do not fit).
         """
-        c1, c2 = checkerboard_lanes(step_length, n_steps)
+        from .terrain import footfall_positions, ground_drops
+
+        if step_lengths is None:
+            if not terrain.is_slope and len(ground_drops(terrain)) > 1:
+                raise ValueError("terrain.foothold_heights_m: footholds of several heights "
+                                 "are laid at the rigid gait's footfalls, step by step "
+                                 "(walkerlab contact-sim lays them; a fixed spacing misses "
+                                 "them)")
+            c1, c2 = checkerboard_lanes(step_length, n_steps)
+        else:
+            k = n_steps // 2 + 2
+            s = footfall_positions(step_lengths, 2 * k)
+            c1, c2 = s[1::2], s[0::2]
         o1, o2 = footprint_offsets(self.data)
         # the ground laid afresh: a previous terrain's patch heights or polyline go with it
         # (heights of other lanes would not fit these)

@@ -28,13 +28,22 @@ from .laws import ContactParamsSI, KneeStopSI
 from .model import ContactWalker
 from .parts import contact_part
 from .rigid_limit import contact_si
-from .terrain import check_ground
+from .terrain import check_ground, ground_drops
 
 if TYPE_CHECKING:
     from walkerlab.codegen.pending import CompiledElsewhere
     from walkerlab.walker.description import WalkerData
 
 __all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length"]
+
+
+#: why the contact periodic gait refuses a ground whose steps differ
+SEVERAL_STEPS_PERIODIC = (
+    "contact_sim.start / periodic_gait: the contact periodic gait is one step's map; footholds "
+    "of several heights have a gait of several steps: start from the rigid gait (start: "
+    "ideal, periodic_gait: false)")
+#: the periodic gait's outcome on such a ground (``contact_sim.periodic_gait: true``)
+SEVERAL_STEPS_OUTCOME = "several_steps"
 
 
 class ContactSceneError(ValueError):
@@ -90,6 +99,9 @@ class ContactSetup:
     rhs_ready : walkerlab.codegen.pending.CompiledElsewhere or None
         A side process compiling the walker's compiled right-hand side (the stage's hand-off:
         the walkers :meth:`build` makes carry it to the compiled backend); None: none.
+    scene : Scene or None
+        The scene read (its rigid walker lays footholds of several heights at the rigid
+        gait's footfalls: :mod:`walkerlab.analysis.contact.footfalls`); None: not kept.
     """
 
     name: str
@@ -102,6 +114,22 @@ class ContactSetup:
     solver: SolverSettings
     actuators: ContactActuators | JointTorqueActuators | None = None
     rhs_ready: CompiledElsewhere | None = None
+    scene: Scene | None = None
+
+    @property
+    def steps_differ(self) -> bool:
+        """The ground's steps differ (footholds of several heights): its patches lie at the
+        rigid gait's footfalls step by step (``step_lengths_m`` of :meth:`build`)."""
+        return not self.terrain.is_slope and len(ground_drops(self.terrain)) > 1
+
+    @property
+    def patches_follow_feet(self) -> bool:
+        """The ground is footholds on checkerboard lanes: each step's landing is where the
+        foot lands (``h_k`` below the stance foot's level, wherever that is), so a run whose
+        footfalls drift off the patches laid at the rigid gait's may lay them at its own
+        (:func:`walkerlab.analysis.contact.sim.simulate_from`); stairs' treads stay where
+        they are."""
+        return self.terrain.kind == "footholds" and self.terrain.lanes == "checkerboard"
 
     def model(self) -> ContactWalker:
         """The setup's contact walker on no terrain: its law, knee stop, flat feet,
@@ -133,7 +161,8 @@ class ContactSetup:
         empty = Actuation.model_construct(torques=[], push_off=None, ankle_push_off=None)
         return contact_part(st).actuators(self.walker, empty, coordinate_names(st), 0.0)
 
-    def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
+    def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None,
+              step_lengths_m: tuple | None = None):
         """ContactWalker of the setup with checkerboard patches from the ideal step length.
 
         Parameters
@@ -145,14 +174,29 @@ class ContactSetup:
         step_length_m : float, optional
             Patch spacing [m] instead of the ideal step length (a run started on the contact
             model's own periodic gait lays its patches at that gait's footfalls).
+        step_lengths_m : tuple of float, optional
+            Each step's advance along the slope [m] in turn, from the first step of
+            ``x_ideal`` on (footholds of several heights: the rigid period-n gait's steps,
+            :func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`); replaces the
+            spacing.
 
         Returns
         -------
         walker : ContactWalker
         step_length : float
-            Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
+            Ideal step length [m] (the patch spacing unless ``step_length_m`` is given; with
+            ``step_lengths_m`` their mean).
+
+        Raises
+        ------
+        ValueError
+            Footholds of several heights without ``step_lengths_m`` (one line).
         """
         probe = self.model()
+        if step_lengths_m is not None:
+            return (probe.on_terrain(self.terrain, step_length=float(np.mean(step_lengths_m)),
+                                     n_steps=n_steps + 4, step_lengths=tuple(step_lengths_m)),
+                    float(np.mean(step_lengths_m)))
         step_length = ideal_step_length(probe, x_ideal, along_slope=not self.terrain.is_slope)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4), step_length
@@ -179,9 +223,12 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, a pinned stance foot
         that is not a point, a ground the contact model does not build (a height profile,
-        footholds of several heights, footholds on continuous ground), or the periodic gait
+        footholds of their own slopes, footholds on continuous ground), or the periodic gait
         (``contact_sim.start: periodic_gait``, ``periodic_gait: true`` or ``periodic``) of a
-        walker whose step map it does not carry (a rimless wheel) (one line).
+        walker whose step map it does not carry (a rimless wheel), or a start from it
+        (``contact_sim.start: periodic_gait``) on footholds of several heights
+        (:data:`SEVERAL_STEPS_PERIODIC`; ``periodic_gait: true`` there records the gait as
+        not found, with that reason) (one line).
     """
     from walkerlab.codegen.floating import check_masses
     from walkerlab.walker.description import walker_data
@@ -210,9 +257,13 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     why = contact_part(data.structure).check(scene, data, checked)
     if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
         raise ContactSceneError(f"scene '{scene.name}': {why}")
+    if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
+        # the run cannot start there (periodic_gait: true records the gait as not found)
+        raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
-                        cs, scene.contact_solver or SolverSettings.for_contact(), actuators)
+                        cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
+                        scene=scene)
 
 
 def _actuators(scene: Scene, data, cs: ContactSimSettings

@@ -23,7 +23,12 @@ The scene's ground (``terrain.kind``, :func:`terrain_ground`) enters the same wa
 paper's checkerboard lanes (``lanes: checkerboard``) stairs and footholds are patches at the
 rigid gait's footholds, footfall ``k`` at the height of its tread, ``-k`` times the landing
 drop per step (:func:`walkerlab.models.ground.landing_drop`; the heights the rigid
-model's heel strikes meet); on continuous ground (``lanes: continuous``) the stairs are a
+model's heel strikes meet).  Footholds of several heights ``h_0, ..., h_{p-1}`` (the list
+repeats) are patches at the rigid period-``p`` gait's own footfalls, step by step
+(:func:`footfall_positions` of each step's advance along the slope, which the caller
+measures on the rigid gait: :mod:`walkerlab.analysis.contact.footfalls`), footfall ``k``
+at ``(h_0 + ... + h_{k-1}) cos(phi)`` along the slope's normal (:func:`footfall_heights`);
+on continuous ground (``lanes: continuous``) the stairs are a
 polyline of level treads and vertical risers (:func:`stairs_line`) that both feet meet
 everywhere, so a toe swinging into a riser is caught by it
 (:attr:`walkerlab.models.contact.model.ContactWalker.ground_line`).
@@ -36,10 +41,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.models.ground import landing_drop, stair_treads
+from walkerlab.models.ground import landing_drops, stair_treads
 
-__all__ = ["check_ground", "footfall_lanes", "profile_line", "slope_heights", "stairs_line",
-           "step_heights", "terrain_ground"]
+__all__ = ["check_ground", "footfall_heights", "footfall_lanes", "footfall_positions",
+           "ground_drops", "profile_line", "slope_heights", "stairs_line", "step_heights",
+           "terrain_ground"]
 
 
 def slope_heights(slopes_rad: np.ndarray, mean_rad: float, step_length_m: float
@@ -109,17 +115,33 @@ def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np
 
 def check_ground(terrain) -> float:
     """The landing drop per step [m] of a ground the contact model builds (0.0 for the
-    slope; :func:`landing_drop`).
+    slope; :func:`walkerlab.models.ground.landing_drop`; footholds of several heights: their
+    mean, the drop per step on average; each step's is :func:`ground_drops`').
 
     Raises
     ------
     ValueError
         One line naming the field and what to do: a profile on checkerboard lanes or from
-        a CSV, footholds of several heights or of their own slopes (the rigid model walks
-        them), footholds on continuous ground (no ground between the footholds).
+        a CSV, footholds of their own slopes (the rigid model walks them), footholds on
+        continuous ground (no ground between the footholds).
+    """
+    drops = ground_drops(terrain)
+    return drops[0] if len(drops) == 1 else float(np.mean(drops))
+
+
+def ground_drops(terrain) -> tuple[float, ...]:
+    """The landing drop [m] of each step of the ground's period, for a ground the contact
+    model builds: ``(0.0,)`` for the slope and a profile, ``(drop,)`` for stairs and
+    footholds of one height, one per height for footholds of several heights
+    (:func:`walkerlab.models.ground.landing_drops`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`check_ground` (one line).
     """
     if terrain is None or terrain.kind == "slope":
-        return 0.0
+        return (0.0,)
     if terrain.kind == "profile":
         if terrain.lanes != "continuous":
             raise ValueError("terrain.lanes: a profile is continuous ground for the contact "
@@ -128,12 +150,31 @@ def check_ground(terrain) -> float:
         if terrain.profile_m is None:
             raise ValueError("terrain.profile_csv: the contact model reads inline profiles "
                              "(terrain.profile_m) only so far, as the rigid walk does")
-        return 0.0
-    drop = landing_drop(terrain)
+        return (0.0,)
+    drops = landing_drops(terrain)
     if terrain.kind == "footholds" and terrain.lanes == "continuous":
         raise ValueError("terrain.lanes: continuous footholds have no ground between the "
                          "footholds: use lanes: checkerboard (patches at the footholds)")
-    return drop
+    return drops
+
+
+def footfall_positions(step_lengths_m, n_footfalls: int) -> np.ndarray:
+    """Along-slope positions [m] (n_footfalls,) of the footfalls of a gait whose steps
+    advance ``step_lengths_m`` (p,) in turn: footfall 0 at 0, footfall ``k`` at
+    ``l_0 + ... + l_{k-1}`` (``l_j = step_lengths_m[j mod p]``)."""
+    ell = np.asarray(step_lengths_m, float).ravel()
+    steps = ell[np.arange(max(int(n_footfalls) - 1, 0)) % ell.size]
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def footfall_heights(drops_m, n_footfalls: int, phi: float) -> np.ndarray:
+    """Heights [m] (n_footfalls,) along the slope's outward normal of the footfalls of a
+    ground whose steps land ``drops_m`` (p,) below the stance foot's level in turn (a drop
+    along the vertical, the rigid model's, :func:`walkerlab.models.ground.landing_drops`):
+    footfall 0 at 0, footfall ``k`` at ``-(d_0 + ... + d_{k-1}) cos(phi)``."""
+    d = np.asarray(drops_m, float).ravel()
+    steps = d[np.arange(max(int(n_footfalls) - 1, 0)) % d.size]
+    return -np.concatenate([[0.0], np.cumsum(steps)]) * math.cos(float(phi))
 
 
 def profile_line(terrain, first_x_m: float, first_y_m: float) -> np.ndarray:
@@ -173,22 +214,26 @@ def terrain_ground(walker, terrain, n_steps: int):
         ``kind: slope``: ``walker`` itself (bit for bit today's ground).  Stairs and
         footholds of one height on the checkerboard lanes: the patches at the footholds'
         heights (footfall ``k`` at ``-k drop cos(phi)`` along the slope's normal,
-        :func:`footfall_lanes`).  Stairs on continuous ground: the treads and risers as a
-        polyline (:func:`stairs_line`); a profile: its polyline (:func:`profile_line`).
+        :func:`footfall_lanes`); footholds of several heights: footfall ``k`` at
+        :func:`footfall_heights` (the lanes laid at the rigid gait's footfalls, step by
+        step).  Stairs on continuous ground: the treads and risers as a polyline
+        (:func:`stairs_line`); a profile: its polyline (:func:`profile_line`).
 
     Raises
     ------
     ValueError
-        A ground the contact model does not build (one line, naming the field): a profile,
-        footholds of several heights or slopes (:func:`landing_drop`'s refusals), footholds
-        on continuous ground (no ground between the footholds).
+        A ground the contact model does not build (one line, naming the field): a profile
+        on checkerboard lanes, footholds of their own slopes, footholds on continuous
+        ground (:func:`ground_drops`).
     """
     if terrain is None or terrain.kind == "slope":
         return walker
-    drop = check_ground(terrain)
+    drops = ground_drops(terrain)
     if terrain.lanes == "checkerboard":
         n = 2 * max(walker.lane1.size, walker.lane2.size)
-        heights = -np.arange(n) * drop * math.cos(float(walker.phi))
+        if len(drops) > 1:
+            return footfall_lanes(walker, footfall_heights(drops, n, float(walker.phi)))
+        heights = -np.arange(n) * drops[0] * math.cos(float(walker.phi))
         return footfall_lanes(walker, heights)
     first = float(walker.lane2[0]) if walker.lane2.size else 0.0
     if terrain.kind == "profile":  # the first footfall along the slope, in the world frame

@@ -1,0 +1,127 @@
+"""Where the rigid gait's feet land on a ground whose steps differ, for the contact view.
+
+On footholds of several heights (``terrain.foothold_heights_m``, the list repeating) the
+rigid gait is a fixed point of the map of ``p`` steps (:func:`walkerlab.models.hybrid.ground.
+on_footholds`), whose steps are of different lengths (the paper walker on
+``[-0.004, -0.006]``: 0.4449 and 0.4325 m).  The contact model's patches (and the MJCF's)
+lie at these footfalls, step by step: :func:`rigid_step_lengths` walks one period of the
+rigid gait from its fixed point and measures each step's advance along the slope with the
+contact view's own geometry (:func:`walkerlab.models.contact.scene.ideal_step_length`: the
+chord between the feet's reference points at heel strike along the slope, plus an arc
+foot's roll), so footfall ``k`` lies at ``l_0 + ... + l_{k-1}``
+(:func:`walkerlab.models.contact.terrain.footfall_positions`).
+
+The contact walker's steps differ from the rigid ones (the paper walker's are ~9 mm
+shorter), so its footfalls drift off these patches; footholds are where the feet land (each
+step's landing ``h_k`` below the stance foot's level), so a run that leaves them is run again
+on patches at its own footfalls (:func:`own_footfall_lanes`; the ``contact-sim`` run,
+:func:`walkerlab.analysis.contact.sim.simulate_from`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_step_lengths"]
+
+
+def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
+    """Each step's advance along the slope [m] of one period of the scene's rigid gait on a
+    ground whose steps differ, from its fixed point ``x_ideal``; None on a ground whose every
+    step is alike (the one spacing of :func:`walkerlab.models.contact.scene.
+    ideal_step_length`).
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        Its rigid walker (:func:`walkerlab.models.registry.build_walker`, the footholds'
+        cycle of per-step landings) and ``solver`` section.
+    walker : walkerlab.models.contact.model.ContactWalker
+        The contact walker whose geometry measures the steps (its reference points).
+    x_ideal : ndarray (2n,)
+        The rigid gait's fixed point (post-impact state before step 0 of the cycle, role
+        order) [rad, rad/s].
+
+    Returns
+    -------
+    tuple of float or None
+        ``(l_0, ..., l_{m-1})`` [m], ``m`` the steps of the rigid map (``p``, or ``2 p``
+        for legs that differ on an odd ``p``); step ``k`` lands on footfall ``k + 1``.
+
+    Raises
+    ------
+    ValueError
+        The rigid gait does not make its steps from ``x_ideal`` (a fall: one line).
+    """
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.contact.scene import ideal_step_length
+    from walkerlab.models.contact.terrain import ground_drops
+    from walkerlab.models.registry import build_walker
+
+    if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:
+        return None
+    rigid = build_walker(scene)
+    m = len(rigid.cycle) if rigid.cycle is not None else 1
+    traj = simulate_steps(rigid, np.asarray(x_ideal, float), m,
+                          Solver.from_settings(scene.solver))
+    segs = list(traj.segments)
+    if len(segs) < m or any(sg.x_next is None for sg in segs):
+        raise ValueError(f"scene '{scene.name}': fixedpoint: the rigid gait on "
+                         "terrain.foothold_heights_m does not make its steps from its fixed "
+                         "point (its footfalls lay the contact model's patches)")
+    return tuple(float(ideal_step_length(walker, sg.x_next, along_slope=True)) for sg in segs)
+
+
+#: relays of the patches at the contact walker's own footfalls a run on footholds may take
+#: (:func:`own_footfall_lanes`; each relay runs the walk again)
+MAX_RELAYS = 4
+
+
+def own_footfall_lanes(walker, result, period: int, initial_stance: str = "leg2"):
+    """``walker`` with its patches moved to the contact run's own footfalls, where its steps
+    drifted from the rigid gait's (footholds are where the feet land: each step's landing
+    ``h_k`` below the stance foot's level, wherever that is); None when the run has too few
+    alternating heel strikes to learn its steps from (fewer than ``period + 1``).
+
+    Footfall ``j`` (the initial stance foot ``j = 0``, heel strike ``j`` after) keeps its
+    patch's height and moves its centre to where the foot stood at that heel strike; the
+    footfalls after the last heel strike advance by the run's last step of the same step of
+    the cycle (step ``j`` of cycle step ``j mod period``), the contact gait's own.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        On checkerboard lanes (leg2's patches footfalls 0, 2, ..., leg1's 1, 3, ...).
+    result : walkerlab.analysis.contact.gait.ContactResult
+        A run of ``walker`` (its ``feet[leg].s``, heel-strike times and legs).
+    period : int
+        Steps of the ground's cycle (``len(terrain.foothold_heights_m)``).
+    initial_stance : str
+        The leg in stance at the run's start (footfall 0).
+
+    Returns
+    -------
+    ContactWalker or None
+    """
+    from dataclasses import replace
+
+    legs = [initial_stance, *result.heel_strike_legs]
+    if len(legs) < period + 2 or any(a == b for a, b in zip(legs, legs[1:])):
+        return None
+    t = np.asarray(result.t, float)
+    s = [float(result.feet[initial_stance].s[0])]
+    s += [float(np.interp(th, t, result.feet[leg].s))
+          for th, leg in zip(result.heel_strike_times, result.heel_strike_legs)]
+    steps = list(np.diff(s))  # step j - 1 lands footfall j
+    n = walker.lane1.size + walker.lane2.size
+    while len(s) < n:  # the next step as the last one of its cycle step
+        steps.append(steps[-period])
+        s.append(s[-1] + steps[-1])
+    s = np.asarray(s[:n])
+    # the legs alternate: footfall j is on the lane of legs[j % 2]
+    on = {legs[0]: s[0::2], legs[1]: s[1::2]}
+    lane1, lane2 = walker.lane1.copy(), walker.lane2.copy()
+    k1, k2 = min(lane1.size, on["leg1"].size), min(lane2.size, on["leg2"].size)
+    lane1[:k1], lane2[:k2] = on["leg1"][:k1], on["leg2"][:k2]
+    return replace(walker, lane1=lane1, lane2=lane2)
