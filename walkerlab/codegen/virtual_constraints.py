@@ -1,0 +1,179 @@
+"""The symbolic pieces of virtual constraints on a walker's generated model: the outputs'
+``h0(q)``, the phase variable ``theta(q)`` and their first and second derivatives, taken by
+sympy from the SAME derivation as the walker's flow (:func:`walkerlab.codegen.free_joints.
+derive_five_link` or :func:`walkerlab.codegen.symbolic.derive`: its ``leg_angles``, points
+and guards), so the decoupling matrix ``L_g L_f h = (dh/dq) M^-1 B`` and ``L_f^2 h`` of the
+computed-torque law (Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56, Eq. 38)
+are those of the flow the walker integrates.
+
+For ``h0`` (k outputs) and ``theta`` the module returns numpy functions of the state
+``x = (q, dq)`` (complex-safe: numpy's elementary functions), each evaluated at once:
+
+- ``h0``, ``Jh0 = dh0/dq`` (k, n), ``dd0 = sum_jl d2h0/dq_j dq_l dq_j dq_l`` (k,);
+- ``theta``, ``dtheta = dtheta/dq`` (n,), ``ddtheta = dq^T (d2theta/dq2) dq``;
+- the heel-strike guard (the swing foot's height above the ground), the swing foot's
+  distance ahead along the ground and the hip's horizontal position, of ``q``.
+"""
+
+from __future__ import annotations
+
+__all__ = ["OutputPieces", "derive_equations", "output_pieces", "resolve_link"]
+
+
+def derive_equations(structure):
+    """The walker's symbolic equations (:class:`walkerlab.codegen.symbolic.Equations`), as
+    its generated flow derives them (free joints: the five-link generator; else the
+    biped generator)."""
+    if structure.free_knees:
+        from walkerlab.codegen.free_joints import derive_five_link
+
+        return derive_five_link(structure)
+    from walkerlab.codegen import symbolic
+
+    return symbolic.derive(structure)
+
+
+def resolve_link(leg_angles: dict, link: str, where: str):
+    """The ``leg_angles`` expression of an output's ``link`` (:data:`walkerlab.config.
+    actuation.OUTPUT_LINKS`: ``stance_leg`` / ``swing_leg`` are the generated ``stance`` /
+    ``swing``).
+
+    Raises
+    ------
+    ValueError
+        The walker has no such link (one line naming ``where`` and the links it has).
+    """
+    key = {"stance_leg": "stance", "swing_leg": "swing"}.get(link, link)
+    if key not in leg_angles:
+        have = sorted({"stance": "stance_leg", "swing": "swing_leg"}.get(k, k)
+                      for k in leg_angles)
+        raise ValueError(f"{where}: {link} is not a link of this walker (its links: "
+                         f"{', '.join(have)})")
+    return leg_angles[key]
+
+
+def _joint_expr(leg_angles: dict, joint: str, where: str):
+    from walkerlab.walker.joints import joint_links
+
+    first, second = joint_links(leg_angles, joint, where)
+    return leg_angles[second] - leg_angles[first]
+
+
+class OutputPieces:
+    """Numpy functions of the outputs and the phase variable (module docstring).
+
+    Parameters
+    ----------
+    eq : walkerlab.codegen.symbolic.Equations
+    params : sequence of float
+        The walker's parameters (``structure.param_names`` order).
+    outputs : sequence of (kind, name)
+        ``("link", name)`` or ``("joint", name)``, each output's ``h0``.
+    phase : walkerlab.config.actuation.PhaseVariable
+    joints : sequence of str
+        The actuated joints (their columns of ``B``: :meth:`B`).
+    prefix : str
+        The scene key of the virtual constraints (for messages).
+
+    Raises
+    ------
+    ValueError
+        A link, joint or coordinate the walker does not have (one line naming the key).
+    """
+
+    def __init__(self, eq, params, outputs, phase, joints, prefix: str):
+        import sympy as sp
+
+        la = eq.leg_angles
+        q, dq = list(eq.q), list(eq.dq)
+        n = len(q)
+        h0 = []
+        for i, (kind, name) in enumerate(outputs):
+            where = f"{prefix}.outputs.{i}.{kind}"
+            h0.append(resolve_link(la, name, where) if kind == "link"
+                      else _joint_expr(la, name, where))
+        if phase.link is not None:
+            th = resolve_link(la, phase.link, f"{prefix}.phase.link")
+        elif phase.point is not None:
+            th = self._along(eq, eq.points["hip"])
+        else:
+            roles = [str(v)[2:] for v in q]
+            bad = [k for k in phase.coordinates if k not in roles]
+            if bad:
+                raise ValueError(f"{prefix}.phase.coordinates.{bad[0]}: not a coordinate of "
+                                 f"this walker (its coordinates: {', '.join(roles)})")
+            th = sum(c * q[roles.index(k)] for k, c in phase.coordinates.items())
+        self.joint_exprs = [_joint_expr(la, j, f"{prefix}.joints") for j in joints]
+        sub = dict(zip(eq.params, params))
+
+        def num(e):
+            return sp.sympify(e).subs(sub)
+        h0 = [num(e) for e in h0]
+        th = num(th)
+        J = [[sp.diff(e, v) for v in q] for e in h0]
+        dd = [sum(sp.diff(J[i][j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
+              for i in range(len(h0))]
+        gth = [sp.diff(th, v) for v in q]
+        ddth = sum(sp.diff(gth[j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
+        Bc = [[num(sp.diff(e, v)) for e in self.joint_exprs] for v in q]
+        foot = [num(eq.guards["heel_strike"]), num(eq.guards["swing_foot_ahead"]),
+                num(self._along(eq, eq.points["hip"]))]
+        args = [*q, *dq]
+        self.n, self.k = n, len(h0)
+        self._out = sp.lambdify(args, [h0, J, dd, th, gth, ddth], "numpy", cse=True)
+        self._foot = sp.lambdify(args, foot, "numpy", cse=True)
+        self._B = sp.lambdify(args, Bc, "numpy")
+        self.theta_expr = th
+
+    @staticmethod
+    def _along(eq, point):
+        """A point's coordinate along the ground (the slope's tangent), from the stance
+        foot [m]."""
+        import sympy as sp
+
+        gamma = [p for p in eq.params if str(p) == "gamma"]
+        g = gamma[0] if gamma else 0
+        return point[0] * sp.cos(g) - point[1] * sp.sin(g)
+
+    def __call__(self, x):
+        """``(h0 (k,), Jh0 (k, n), dd0 (k,), theta, dtheta (n,), ddtheta)`` at the state
+        ``x`` (2n,) (see the module docstring)."""
+        import numpy as np
+
+        h0, J, dd, th, gth, ddth = self._out(*x)
+        cplx = np.iscomplexobj(x)
+        dt = complex if cplx else float
+
+        def arr(v, shape):
+            return np.broadcast_to(np.asarray(v, dtype=dt), shape) if np.ndim(v) == 0 \
+                else np.asarray(v, dtype=dt)
+        J = np.array([[arr(v, ()) for v in row] for row in J], dtype=dt).reshape(
+            self.k, self.n)
+        gth = np.array([arr(v, ()) for v in gth], dtype=dt)
+        return (np.array(h0, dtype=dt), J, np.array(dd, dtype=dt), dt(th), gth, dt(ddth))
+
+    def foot(self, q):
+        """``(swing foot height, swing foot ahead, hip along the ground)`` [m] at the
+        configuration ``q`` (n,)."""
+        import numpy as np
+
+        return tuple(float(np.real(v)) for v in self._foot(*q, *np.zeros(self.n)))
+
+    def B(self):
+        """``B`` (n, k): each actuated joint's column ``d(delta)/dq`` (constant)."""
+        import numpy as np
+
+        return np.array(self._B(*np.zeros(2 * self.n)), dtype=float)
+
+
+def output_pieces(structure, params, outputs, phase, joints, prefix):
+    """:class:`OutputPieces` of ``structure``'s derivation (memoised per structure and
+    outputs: the derivation runs once per process)."""
+    key = (structure, tuple(params), tuple(outputs), phase.model_dump_json(), tuple(joints))
+    if key not in _MEMO:
+        _MEMO[key] = OutputPieces(derive_equations(structure), params, outputs, phase,
+                                  joints, prefix)
+    return _MEMO[key]
+
+
+_MEMO: dict = {}
