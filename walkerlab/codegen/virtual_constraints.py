@@ -120,7 +120,8 @@ class OutputPieces:
                 num(self._along(eq, eq.points["hip"]))]
         args = [*q, *dq]
         self.n, self.k = n, len(h0)
-        self._out = sp.lambdify(args, [h0, J, dd, th, gth, ddth], "numpy", cse=True)
+        flat = [*h0, *(e for row in J for e in row), *dd, th, *gth, ddth]
+        self._out = sp.lambdify(args, flat, "numpy", cse=True)
         self._foot = sp.lambdify(args, foot, "numpy", cse=True)
         self._B = sp.lambdify(args, Bc, "numpy")
         self.theta_expr = th
@@ -140,17 +141,11 @@ class OutputPieces:
         ``x`` (2n,) (see the module docstring)."""
         import numpy as np
 
-        h0, J, dd, th, gth, ddth = self._out(*x)
-        cplx = np.iscomplexobj(x)
-        dt = complex if cplx else float
-
-        def arr(v, shape):
-            return np.broadcast_to(np.asarray(v, dtype=dt), shape) if np.ndim(v) == 0 \
-                else np.asarray(v, dtype=dt)
-        J = np.array([[arr(v, ()) for v in row] for row in J], dtype=dt).reshape(
-            self.k, self.n)
-        gth = np.array([arr(v, ()) for v in gth], dtype=dt)
-        return (np.array(h0, dtype=dt), J, np.array(dd, dtype=dt), dt(th), gth, dt(ddth))
+        v = np.array(self._out(*x), dtype=complex if np.iscomplexobj(x) else float)
+        k, n = self.k, self.n
+        a = k + k * n
+        return (v[:k], v[k:a].reshape(k, n), v[a:a + k], v[a + k], v[a + k + 1:a + k + 1 + n],
+                v[-1])
 
     def foot(self, q):
         """``(swing foot height, swing foot ahead, hip along the ground)`` [m] at the

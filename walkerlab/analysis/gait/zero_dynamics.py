@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ZeroDynamics", "impact_multiplier", "zero_dynamics"]
+__all__ = ["ZeroDynamics", "compare_full_order", "impact_multiplier", "zero_dynamics"]
 
 #: Chebyshev points of the integrands along the step
 NODES = 64
@@ -74,6 +74,17 @@ class ZeroDynamics:
         energy unchanged, the quadrature's premise).
     timing_delta2_s, timing_total_s : float
         Wall time of ``delta^2`` alone and of everything here [s].
+    min_clearance_m : float
+        The swing foot's lowest height inside the step on the surface [m] (< 0: it strikes
+        the ground before ``theta-``, and the full-order gait is not the zero dynamics').
+    phase_unit : str
+        The phase variable's unit (rad, or m for the hip's position).
+    design : walkerlab.models.hybrid.virtual_constraints.Design
+    output_names, joints : tuple of str
+        The outputs and the actuated joints.
+    full_order : dict
+        The full-order fixed point's counterparts (:func:`compare_full_order`; empty until
+        then).
     """
 
     delta2: float
@@ -93,6 +104,12 @@ class ZeroDynamics:
     kinetic_invariance: float = 0.0
     timing_delta2_s: float = np.nan
     timing_total_s: float = np.nan
+    min_clearance_m: float = np.nan
+    phase_unit: str = "rad"
+    design: object = field(default=None, repr=False)
+    output_names: tuple = ()
+    joints: tuple = ()
+    full_order: dict = field(default_factory=dict)
 
     @property
     def stable(self) -> bool:
@@ -205,7 +222,7 @@ def zero_dynamics(ctrl) -> ZeroDynamics:
         us = []
         for q, qp, th in zip(qs, ts, theta):
             rate = sign * np.sqrt(2 * max(zeta_p - V(th), 0.0)) / abs(inertia(th))
-            y, dy, A, Lf2, *_ = ctrl.terms(np.concatenate([q, qp * rate]))
+            _y, _dy, A, Lf2, _mb = ctrl.terms(np.concatenate([q, qp * rate]))
             us.append(np.linalg.solve(np.real(A), -np.real(Lf2)))
         umax = float(np.max(np.abs(us)))
     return ZeroDynamics(
@@ -214,4 +231,45 @@ def zero_dynamics(ctrl) -> ZeroDynamics:
         phase_rate_minus=rate_m, phase_rate_plus=rate_p, step_period_s=period, x_plus=x_plus,
         max_torque_n_m=umax, saturates=bool(ctrl.limit is not None and umax > ctrl.limit),
         kinetic_invariance=float(np.max(np.abs(W)) / np.max(np.abs(I_))),
-        timing_delta2_s=t_delta, timing_total_s=time.perf_counter() - t0)
+        timing_delta2_s=t_delta, timing_total_s=time.perf_counter() - t0,
+        min_clearance_m=min(ctrl.pieces.foot(q)[0] for q in qs),
+        phase_unit="m" if ctrl.spec.phase.point is not None else "rad", design=d,
+        output_names=tuple(ctrl.output_names), joints=tuple(ctrl.joints))
+
+
+def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:
+    """The full-order fixed point's counterparts of the restricted map's numbers, stored in
+    ``zd.full_order`` and returned: ``phase_rate_minus``, ``phase_rate_plus`` (its phase
+    rates at the heel strike [rad/s or m/s]), ``step_period_s``, ``delta2_multiplier`` (the
+    variational Floquet multiplier nearest ``delta^2``), ``other_multiplier`` (the largest
+    |multiplier| of the others: the feedback's), ``output_plus``, ``output_rate_plus`` (max
+    |y|, |y'| just after the heel strike [rad, rad/s]).
+
+    Parameters
+    ----------
+    zd : ZeroDynamics
+    ctrl : walkerlab.models.hybrid.virtual_constraints.VirtualConstraintController
+    walker : HybridWalker
+    result : walkerlab.analysis.gait.poincare.FixedPointResult
+    solver : walkerlab.integrate.solver.Solver
+    """
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    n = ctrl.n
+    steps: list = []
+    poincare_map(walker, result.x, solver, steps=steps)
+    x_minus = np.asarray(steps[0].x_end, float)
+
+    def rate(x):
+        _h0, _J, _dd, _th, gth, _ = ctrl.pieces(np.asarray(x, float))
+        return float(gth @ np.asarray(x, float)[n:])
+    mult = np.asarray(result.multipliers_variational)
+    j = int(np.argmin(np.abs(mult - zd.delta2)))
+    others = np.delete(mult, j)
+    y, dy = ctrl.outputs(result.x)
+    zd.full_order = {
+        "phase_rate_minus": rate(x_minus), "phase_rate_plus": rate(result.x),
+        "step_period_s": float(result.period_s), "delta2_multiplier": complex(mult[j]),
+        "other_multiplier": float(np.max(np.abs(others))) if others.size else 0.0,
+        "output_plus": float(np.max(np.abs(y))), "output_rate_plus": float(np.max(np.abs(dy)))}
+    return zd.full_order

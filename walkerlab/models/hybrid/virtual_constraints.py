@@ -53,13 +53,16 @@ def bezier(c, s):
     Eq. 36; its derivatives by the difference of the coefficients).  Complex-safe."""
     c = np.asarray(c)
     M = c.shape[1] - 1
-
-    def basis(m, s):
-        return np.array([comb(m, j) * s ** j * (1 - s) ** (m - j) for j in range(m + 1)])
-    h = c @ basis(M, s)
     d1 = M * (c[:, 1:] - c[:, :-1])
     d2 = (M - 1) * (d1[:, 1:] - d1[:, :-1])
-    return h, d1 @ basis(M - 1, s), d2 @ basis(M - 2, s)
+    ps, qs = [1.0], [1.0]  # powers of s and 1 - s
+    for _ in range(M):
+        ps.append(ps[-1] * s)
+        qs.append(qs[-1] * (1 - s))
+
+    def basis(m):
+        return np.array([comb(m, j) * ps[j] * qs[m - j] for j in range(m + 1)])
+    return c @ basis(M), d1 @ basis(M - 1), d2 @ basis(M - 2)
 
 
 def default_joints(link_names) -> list[str]:
@@ -305,7 +308,7 @@ class VirtualConstraintController:
 
     # ------------------------------------------------------------------ feedback
     def terms(self, x):
-        """``(y, dy, LgLfh (k, k), Lf2h (k,), M, C, G)`` at the state ``x`` (2n,)
+        """``(y, dy, LgLfh (k, k), Lf2h (k,), M^-1 B (n, k))`` at the state ``x`` (2n,)
         (complex-safe)."""
         n = self.n
         d = self.design
@@ -319,10 +322,23 @@ class VirtualConstraintController:
         y = h0 - hd
         dy = J @ dq
         M, C, G = self.fns["matrices"](x)
-        MinvB = np.linalg.solve(M, self.B)
-        f0 = np.linalg.solve(M, -(C @ dq) - np.ravel(G))
+        sol = np.linalg.solve(M, np.column_stack([self.B, -(C @ dq) - np.ravel(G)]))
+        MinvB, f0 = sol[:, :-1], sol[:, -1]
         Lf2 = dd0 - hd2 * ds ** 2 - hd1 * ddth / dth + J @ f0
-        return y, dy, J @ MinvB, Lf2, M, C, G
+        return y, dy, J @ MinvB, Lf2, MinvB
+
+    def acceleration(self, x):
+        """``(u (k,), M^-1 B u (n,))``: the torques [N m] (saturated) and the acceleration
+        they add [rad/s^2] at the state ``x`` (2n,) (complex-safe)."""
+        y, dy, A, Lf2, MinvB = self.terms(x)
+        u = self._saturate(np.linalg.solve(A, -Lf2 - self.kp * y - self.kd * dy))
+        return u, MinvB @ u
+
+    def _saturate(self, u):
+        if self.limit is None:
+            return u
+        lim = self.limit
+        return np.where(np.real(u) > lim, lim, np.where(np.real(u) < -lim, -lim, u))
 
     def decoupling(self, x):
         """The decoupling matrix ``L_g L_f h = (dh/dq) M^-1 B`` (k, k) at ``x`` (2n,)."""
@@ -331,12 +347,7 @@ class VirtualConstraintController:
     def torques(self, x):
         """The actuators' torques ``u`` (k,) [N m] at the state ``x`` (2n,), saturated at
         ``max_torque_n_m`` (complex-safe: the saturation compares real parts)."""
-        y, dy, A, Lf2, *_ = self.terms(x)
-        u = np.linalg.solve(A, -Lf2 - self.kp * y - self.kd * dy)
-        if self.limit is not None:
-            lim = self.limit
-            u = np.where(np.real(u) > lim, lim, np.where(np.real(u) < -lim, -lim, u))
-        return u
+        return self.acceleration(x)[0]
 
     def outputs(self, x):
         """``(y, y')`` (k,) each [rad, rad/s] at the state ``x`` (2n,)."""
@@ -372,3 +383,10 @@ class VirtualConstraintActuators(Actuators):
     def torques(self, t, x) -> np.ndarray:
         """The computed torques (k,) [N m] at the state ``x`` (2n,)."""
         return self.controller.torques(x)
+
+    def added_acceleration(self, t, x, constraint=None, M=None):
+        """``M^-1 B u`` (n,) [rad/s^2] (:meth:`Actuators.added_acceleration`; the
+        controller's own ``M^-1 B``, no constraint: a free-jointed walker holds none)."""
+        if constraint is not None or M is not None:
+            return super().added_acceleration(t, x, constraint, M)
+        return self.controller.acceleration(x)[1]
