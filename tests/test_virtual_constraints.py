@@ -278,3 +278,26 @@ def test_torques_beside_virtual_constraints_refused():
     with pytest.raises(SceneError) as e:
         scene_from_dict(cfg)
     assert "torques" in str(e.value) and len(str(e.value).splitlines()) == 1
+
+
+def test_views_without_the_controller_refuse_it():
+    """The contact model, the exports, the gym and optimize do not carry the controller
+    yet: each refuses it in one line naming the field (the capability table's cell)."""
+    from walkerlab.export.scene import check_exportable
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+    from walkerlab.walker.kinds import KINDS, KindRefused
+
+    cfg = copy.deepcopy(SCENE)
+    cfg["contact"] = yaml.safe_load((ROOT / "configs" / "rabbit.yaml").read_text())["contact"]
+    scene = scene_from_dict(cfg)
+    with pytest.raises(ContactSceneError) as e:
+        contact_setup(scene)
+    assert "walker.actuation.virtual_constraints: " in one_line(e)
+    for fmt in ("mjcf", "adm", "osim"):
+        with pytest.raises(KindRefused) as e:
+            check_exportable(scene, KINDS["free_joints"], fmt)
+        assert one_line(e).startswith("walker.actuation.virtual_constraints: ")
+    for view in ("gym", "optimize"):
+        assert not KINDS["free_joints"].supports("virtual_constraints", view)
+    assert KINDS["free_joints"].supports("virtual_constraints", "rigid")
+    assert not KINDS["locking_knees"].supports("virtual_constraints", "rigid")

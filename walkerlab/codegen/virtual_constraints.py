@@ -11,8 +11,9 @@ For ``h0`` (k outputs) and ``theta`` the module returns numpy functions of the s
 
 - ``h0``, ``Jh0 = dh0/dq`` (k, n), ``dd0 = sum_jl d2h0/dq_j dq_l dq_j dq_l`` (k,);
 - ``theta``, ``dtheta = dtheta/dq`` (n,), ``ddtheta = dq^T (d2theta/dq2) dq``;
-- the heel-strike guard (the swing foot's height above the ground), the swing foot's
-  distance ahead along the ground and the hip's horizontal position, of ``q``.
+- the swing foot's height above the ground (the ``swing_clearance`` guard), whether it is
+  ahead of the stance foot (``swing_foot_ahead``) and the hip's horizontal position, of
+  ``q``.
 """
 
 from __future__ import annotations
@@ -116,7 +117,7 @@ class OutputPieces:
         gth = [sp.diff(th, v) for v in q]
         ddth = sum(sp.diff(gth[j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
         Bc = [[num(sp.diff(e, v)) for e in self.joint_exprs] for v in q]
-        foot = [num(eq.guards["heel_strike"]), num(eq.guards["swing_foot_ahead"]),
+        foot = [num(eq.guards["swing_clearance"]), num(eq.guards["swing_foot_ahead"]),
                 num(self._along(eq, eq.points["hip"]))]
         args = [*q, *dq]
         self.n, self.k = n, len(h0)
@@ -148,7 +149,8 @@ class OutputPieces:
                 v[-1])
 
     def foot(self, q):
-        """``(swing foot height, swing foot ahead, hip along the ground)`` [m] at the
+        """``(swing foot height [m], swing foot ahead (> 0: ahead of the stance foot; an
+        angle or a distance, as the walker's guard), hip along the ground [m])`` at the
         configuration ``q`` (n,)."""
         import numpy as np
 

@@ -174,6 +174,9 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         link that carries no mass, a torque scaling that does not fit the legs, a push-off
         on massless arc-footed legs (one line).
     """
+    if getattr(spec, "virtual_constraints", None) is not None:  # the kind's table
+        data.structure.kind.require("virtual_constraints", "rigid",
+                                    "walker.actuation.virtual_constraints")
     return _PARTS[data.structure.kind.name].actuate(walker, data, spec)
 
 

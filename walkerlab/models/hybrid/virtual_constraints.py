@@ -226,19 +226,17 @@ class VirtualConstraintController:
             def height(th, q0=a[0]):
                 return self.pieces.foot(self.configuration(np.append(cM, th), q0))[0]
             th = brentq(height, grid[i], grid[i + 1], xtol=1e-15, rtol=1e-15)
-            cands.append((th, self.configuration(np.append(cM, th), a[0])))
+            q = self.configuration(np.append(cM, th), a[0])
+            ahead = self.pieces.foot(q)[1]
+            if ahead > 1e-9:  # not where the feet pass each other
+                cands.append((ahead, th, q))
         if not cands:
             raise ValueError(f"{KEY}.outputs: at the last Bezier coefficients (c_M) the swing "
                              "foot reaches the ground ahead of the stance foot for no value "
                              "of the phase variable: no heel strike ends the step")
-        # the swing foot lands ahead: the configuration whose hip is highest
-        return max(cands, key=lambda c: self._hip_height(c[1]))
-
-    def _hip_height(self, q):
-        x = np.concatenate([q, np.zeros(self.n)])
-        pts = self.fns["points"](x)
-        hip = pts["hip"] if isinstance(pts, dict) else None
-        return float(np.real(hip[1])) if hip is not None else 0.0
+        # the swing foot lands ahead: the configuration where it is furthest ahead
+        _ahead, th, q = max(cands, key=lambda c: c[0])
+        return th, q
 
     def _design(self, given):
         """:class:`Design` of the scene's coefficients ``given`` (k, M + 1)."""
