@@ -301,3 +301,33 @@ def test_views_without_the_controller_refuse_it():
         assert not KINDS["free_joints"].supports("virtual_constraints", view)
     assert KINDS["free_joints"].supports("virtual_constraints", "rigid")
     assert not KINDS["locking_knees"].supports("virtual_constraints", "rigid")
+
+
+def test_sweep_and_continuation_name_a_bezier_coefficient():
+    """``...outputs.1.bezier_rad.5`` names one coefficient (its unit rad); a point sets it
+    alone; an index past the list or a field below a number is refused in one line."""
+    from walkerlab.studies.params import (
+        SweepError,
+        apply_point,
+        axis_unit,
+        check_axes,
+        parse_param,
+    )
+
+    scene = scene_from_dict(copy.deepcopy(SCENE))
+    path = "walker.actuation.virtual_constraints.outputs.1.bezier_rad.5"
+    axis = parse_param(f"{path}=0.40,0.44")
+    check_axes(scene, [axis])
+    assert axis_unit(scene, axis) == "rad"
+    sc = apply_point(scene.model_dump(mode="json"), [path], (0.44,))
+    got = sc.walker.actuation.virtual_constraints.outputs[1].bezier_rad
+    want = list(scene.walker.actuation.virtual_constraints.outputs[1].bezier_rad)
+    want[5] = 0.44
+    assert got == want
+    gain = parse_param("walker.actuation.virtual_constraints.feedback.kd_per_s=80,120")
+    check_axes(scene, [gain])
+    assert axis_unit(scene, gain) == "1/s"
+    for bad in (f"{path[:-1]}9=0.1", f"{path}.x=0.1"):
+        with pytest.raises(SweepError) as e:
+            check_axes(scene, [parse_param(bad)])
+        assert "\n" not in str(e.value)

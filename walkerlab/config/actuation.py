@@ -303,8 +303,10 @@ class OutputFeedback(Strict):
     et al. 2003, Sec. IV-B)."""
 
     kind: Literal["input_output_linearization"] = Field(description="the feedback law")
-    kp_per_s2: float = Field(gt=0, le=1e8, description="proportional gain [1/s^2]")
-    kd_per_s: float = Field(gt=0, le=1e5, description="derivative gain [1/s]")
+    kp_per_s2: float = Field(gt=0, le=1e8, description="proportional gain [1/s^2]",
+                             json_schema_extra={"unit": "1/s^2"})
+    kd_per_s: float = Field(gt=0, le=1e5, description="derivative gain [1/s]",
+                            json_schema_extra={"unit": "1/s"})
 
 
 class VirtualConstraints(Strict):

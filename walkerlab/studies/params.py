@@ -265,6 +265,7 @@ def _check_path(scene: Scene, axis: ParamAxis):
     keys = axis.path.split(".")
     obj: object = scene
     cls = type(scene)
+    info = None  # the last field's schema entry (a list of numbers: the list's)
     for i, k in enumerate(keys):
         here = ".".join(keys[:i + 1])
         if isinstance(obj, (list, tuple)):
