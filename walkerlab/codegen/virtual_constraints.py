@@ -18,7 +18,10 @@ For ``h0`` (k outputs) and ``theta`` the module returns numpy functions of the s
 
 from __future__ import annotations
 
-__all__ = ["OutputPieces", "derive_equations", "output_pieces", "resolve_link"]
+import hashlib
+
+__all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_pieces",
+           "resolve_link"]
 
 
 def derive_equations(structure):
@@ -60,89 +63,106 @@ def _joint_expr(leg_angles: dict, joint: str, where: str):
     return leg_angles[second] - leg_angles[first]
 
 
-class OutputPieces:
-    """Numpy functions of the outputs and the phase variable (module docstring).
-
-    Parameters
-    ----------
-    eq : walkerlab.codegen.symbolic.Equations
-    params : sequence of float
-        The walker's parameters (``structure.param_names`` order).
-    outputs : sequence of (kind, name)
-        ``("link", name)`` or ``("joint", name)``, each output's ``h0``.
-    phase : walkerlab.config.actuation.PhaseVariable
-    joints : sequence of str
-        The actuated joints (their columns of ``B``: :meth:`B`).
-    prefix : str
-        The scene key of the virtual constraints (for messages).
+def _expressions(eq, params, outputs, phase, joints, prefix: str):
+    """The flat lists of sympy expressions of the pieces (module docstring), the
+    parameters substituted: ``(out, foot, B)``.
 
     Raises
     ------
     ValueError
         A link, joint or coordinate the walker does not have (one line naming the key).
     """
+    import sympy as sp
 
-    def __init__(self, eq, params, outputs, phase, joints, prefix: str):
-        import sympy as sp
+    la = eq.leg_angles
+    q, dq = list(eq.q), list(eq.dq)
+    n = len(q)
+    h0 = []
+    for i, (kind, name) in enumerate(outputs):
+        where = f"{prefix}.outputs.{i}.{kind}"
+        h0.append(resolve_link(la, name, where) if kind == "link"
+                  else _joint_expr(la, name, where))
+    if phase.link is not None:
+        th = resolve_link(la, phase.link, f"{prefix}.phase.link")
+    elif phase.point is not None:
+        th = _along(eq, eq.points["hip"])
+    else:
+        roles = [str(v)[2:] for v in q]
+        bad = [k for k in phase.coordinates if k not in roles]
+        if bad:
+            raise ValueError(f"{prefix}.phase.coordinates.{bad[0]}: not a coordinate of "
+                             f"this walker (its coordinates: {', '.join(roles)})")
+        th = sum(c * q[roles.index(k)] for k, c in phase.coordinates.items())
+    joint_exprs = [_joint_expr(la, j, f"{prefix}.joints") for j in joints]
+    sub = dict(zip(eq.params, params))
 
-        la = eq.leg_angles
-        q, dq = list(eq.q), list(eq.dq)
-        n = len(q)
-        h0 = []
-        for i, (kind, name) in enumerate(outputs):
-            where = f"{prefix}.outputs.{i}.{kind}"
-            h0.append(resolve_link(la, name, where) if kind == "link"
-                      else _joint_expr(la, name, where))
-        if phase.link is not None:
-            th = resolve_link(la, phase.link, f"{prefix}.phase.link")
-        elif phase.point is not None:
-            th = self._along(eq, eq.points["hip"])
-        else:
-            roles = [str(v)[2:] for v in q]
-            bad = [k for k in phase.coordinates if k not in roles]
-            if bad:
-                raise ValueError(f"{prefix}.phase.coordinates.{bad[0]}: not a coordinate of "
-                                 f"this walker (its coordinates: {', '.join(roles)})")
-            th = sum(c * q[roles.index(k)] for k, c in phase.coordinates.items())
-        self.joint_exprs = [_joint_expr(la, j, f"{prefix}.joints") for j in joints]
-        sub = dict(zip(eq.params, params))
+    def num(e):
+        return sp.sympify(e).subs(sub)
+    h0 = [num(e) for e in h0]
+    th = num(th)
+    J = [[sp.diff(e, v) for v in q] for e in h0]
+    dd = [sum(sp.diff(J[i][j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
+          for i in range(len(h0))]
+    gth = [sp.diff(th, v) for v in q]
+    ddth = sum(sp.diff(gth[j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
+    B = [num(sp.diff(e, v)) for v in q for e in joint_exprs]
+    foot = [num(eq.guards["swing_clearance"]), num(eq.guards["swing_foot_ahead"]),
+            num(_along(eq, eq.points["hip"]))]
+    out = [*h0, *(e for row in J for e in row), *dd, th, *gth, ddth]
+    return out, foot, B
 
-        def num(e):
-            return sp.sympify(e).subs(sub)
-        h0 = [num(e) for e in h0]
-        th = num(th)
-        J = [[sp.diff(e, v) for v in q] for e in h0]
-        dd = [sum(sp.diff(J[i][j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
-              for i in range(len(h0))]
-        gth = [sp.diff(th, v) for v in q]
-        ddth = sum(sp.diff(gth[j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
-        Bc = [[num(sp.diff(e, v)) for e in self.joint_exprs] for v in q]
-        foot = [num(eq.guards["swing_clearance"]), num(eq.guards["swing_foot_ahead"]),
-                num(self._along(eq, eq.points["hip"]))]
-        args = [*q, *dq]
-        self.n, self.k = n, len(h0)
-        flat = [*h0, *(e for row in J for e in row), *dd, th, *gth, ddth]
-        self._out = sp.lambdify(args, flat, "numpy", cse=True)
-        self._foot = sp.lambdify(args, foot, "numpy", cse=True)
-        self._B = sp.lambdify(args, Bc, "numpy")
-        self.theta_expr = th
 
-    @staticmethod
-    def _along(eq, point):
-        """A point's coordinate along the ground (the slope's tangent), from the stance
-        foot [m]."""
-        import sympy as sp
+def _along(eq, point):
+    """A point's coordinate along the ground (the slope's tangent), from the stance foot
+    [m]."""
+    import sympy as sp
 
-        gamma = [p for p in eq.params if str(p) == "gamma"]
-        g = gamma[0] if gamma else 0
-        return point[0] * sp.cos(g) - point[1] * sp.sin(g)
+    gamma = [p for p in eq.params if str(p) == "gamma"]
+    g = gamma[0] if gamma else 0
+    return point[0] * sp.cos(g) - point[1] * sp.sin(g)
+
+
+def generate_pieces(eq, params, outputs, phase, joints, prefix: str, key: str) -> str:
+    """Source of the pieces' module: ``out(x)``, ``foot(x)``, ``B(x)`` (flat lists, numpy
+    code by :func:`sympy.lambdify`, common subexpressions eliminated) and ``K``, ``N``."""
+    import inspect
+
+    import sympy as sp
+
+    out, foot, B = _expressions(eq, params, outputs, phase, joints, prefix)
+    args = [*eq.q, *eq.dq]
+    text = [f"# walkerlab virtual-constraint pieces (walkerlab.codegen.virtual_constraints); "
+            f"key {key}",
+            "# Do not edit: regenerated when the walker, its outputs or the generator change.",
+            "import numpy", "from numpy import *  # noqa: F401,F403 (lambdify's names)", "",
+            f"K, N = {len(outputs)}, {len(eq.q)}", ""]
+    for name, exprs in (("out", out), ("foot", foot), ("B", B)):
+        fn = sp.lambdify(args, exprs, "numpy", cse=True)
+        src = inspect.getsource(fn).replace("def _lambdifygenerated(", f"def _{name}(", 1)
+        text += [src, "", f"def {name}(x):", f"    return _{name}(*x)", ""]
+    return "\n".join(text) + "\n"
+
+
+class OutputPieces:
+    """Numpy functions of the outputs and the phase variable (module docstring), from the
+    generated module (:func:`generate_pieces`, cached on disk as the walker's flow).
+
+    Parameters
+    ----------
+    module : module
+        The generated module.
+    """
+
+    def __init__(self, module):
+        self._mod = module
+        self.k, self.n = module.K, module.N
 
     def __call__(self, x):
         """``(h0 (k,), Jh0 (k, n), dd0 (k,), theta, dtheta (n,), ddtheta)`` at the state
         ``x`` (2n,) (see the module docstring)."""
         import numpy as np
 
-        v = np.array(self._out(*x), dtype=complex if np.iscomplexobj(x) else float)
+        v = np.array(self._mod.out(x), dtype=complex if np.iscomplexobj(x) else float)
         k, n = self.k, self.n
         a = k + k * n
         return (v[:k], v[k:a].reshape(k, n), v[a:a + k], v[a + k], v[a + k + 1:a + k + 1 + n],
@@ -154,23 +174,43 @@ class OutputPieces:
         configuration ``q`` (n,)."""
         import numpy as np
 
-        return tuple(float(np.real(v)) for v in self._foot(*q, *np.zeros(self.n)))
+        return tuple(float(np.real(v))
+                     for v in self._mod.foot(np.concatenate([q, np.zeros(self.n)])))
 
     def B(self):
         """``B`` (n, k): each actuated joint's column ``d(delta)/dq`` (constant)."""
         import numpy as np
 
-        return np.array(self._B(*np.zeros(2 * self.n)), dtype=float)
+        return np.array(self._mod.B(np.zeros(2 * self.n)), dtype=float).reshape(self.n, self.k)
+
+
+def _source_hash() -> str:
+    from pathlib import Path
+
+    return hashlib.sha256((Path(__file__).parent / "virtual_constraints.py").read_bytes()
+                          ).hexdigest()[:12]
 
 
 def output_pieces(structure, params, outputs, phase, joints, prefix):
-    """:class:`OutputPieces` of ``structure``'s derivation (memoised per structure and
-    outputs: the derivation runs once per process)."""
-    key = (structure, tuple(params), tuple(outputs), phase.model_dump_json(), tuple(joints))
-    if key not in _MEMO:
-        _MEMO[key] = OutputPieces(derive_equations(structure), params, outputs, phase,
-                                  joints, prefix)
-    return _MEMO[key]
+    """:class:`OutputPieces` of ``structure``'s derivation with ``params`` (its module
+    generated on a cache miss, file ``<key>_vc_<hash>.py``, the hash covering the
+    parameters, outputs, phase, joints and this generator's source).
 
+    Raises
+    ------
+    ValueError
+        A link, joint or coordinate the walker does not have (one line naming the key; on
+        a cache miss, from the derivation).
+    """
+    from walkerlab.codegen import cache
 
-_MEMO: dict = {}
+    key = cache.cache_key(structure)
+    what = repr((tuple(float(p) for p in params), tuple(outputs), phase.model_dump_json(),
+                 tuple(joints), _source_hash()))
+    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
+
+    def build() -> str:
+        return generate_pieces(derive_equations(structure), params, outputs, phase, joints,
+                               prefix, key)
+    return OutputPieces(cache.import_generated(f"{key}_vc_{tag}.py",
+                                               f"walkerlab_vc_{key}_{tag}", build))
