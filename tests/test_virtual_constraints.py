@@ -331,3 +331,27 @@ def test_sweep_and_continuation_name_a_bezier_coefficient():
         with pytest.raises(SweepError) as e:
             check_axes(scene, [parse_param(bad)])
         assert "\n" not in str(e.value)
+
+
+@pytest.mark.slow
+def test_fixedpoint_stores_and_prints_the_zero_dynamics(tmp_path):
+    """``walkerlab fixedpoint configs/rabbit_hzd.yaml``: fixedpoint.h5's zero_dynamics/ with
+    units, the restricted map beside the full-order fixed point (delta^2 a multiplier to
+    1e-6; the period and the phase rate at impact to 1e-8), printed side by side."""
+    from tests.cli_run import run_cli
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+
+    code, err, out = run_cli("fixedpoint", ROOT / "configs" / "rabbit_hzd.yaml",
+                             "--runs-dir", tmp_path)
+    assert code == 0, err
+    fp = load_fixedpoint(tmp_path / "rabbit_hzd" / "fixedpoint.h5")
+    z = fp.zero_dynamics
+    assert z["exists"] and z["stable"] and not z["saturates"]
+    fo = z["full_order"]
+    assert abs(fo["delta2_multiplier"] - z["delta2"]) < 1e-6
+    assert abs(fo["step_period_s"] - z["step_period_s"]) < 1e-8
+    assert abs(fo["phase_rate_minus"] - z["phase_rate_minus"]) < 1e-8
+    assert fo["other_multiplier"] < 1e-6
+    assert fo["output_plus"] < 1e-8 and fo["output_rate_plus"] < 1e-8
+    assert z["phase_unit"] == "rad" and z["timing_delta2_s"] > 0
+    assert "delta^2" in out and "full-order multiplier" in out and "existence" in out

@@ -172,8 +172,10 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     lines.append(f"  max difference {fp.max_difference:.2e}")
     mod = float(np.max(np.hypot(re, im)))
     verdict = "STABLE" if fp.stable else "UNSTABLE"
-    lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
-                 f"{zero_multipliers_text(re, im, fp.state_names, fp.scene_json)})")
+    why = (zero_multipliers_text(re, im, fp.state_names, fp.scene_json)
+           if fp.zero_dynamics is None else "the others are the output feedback's and the "
+           "heel-strike surface's, besides delta^2 of the zero dynamics")
+    lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; {why})")
     if fp.zero_dynamics is not None:
         lines += zero_dynamics_text(fp.zero_dynamics)
     if fp.ground_contact is not None:
