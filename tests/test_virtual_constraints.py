@@ -355,3 +355,30 @@ def test_fixedpoint_stores_and_prints_the_zero_dynamics(tmp_path):
     assert fo["output_plus"] < 1e-8 and fo["output_rate_plus"] < 1e-8
     assert z["phase_unit"] == "rad" and z["timing_delta2_s"] > 0
     assert "delta^2" in out and "full-order multiplier" in out and "existence" in out
+
+
+def test_compass_gait_under_one_virtual_constraint():
+    """The controller on another walker: straight legs with one hip actuator
+    (configs/paper_rods.yaml on its slope), the swing leg's absolute angle a cubic Bezier
+    polynomial of the stance leg's.  The restricted map's orbit (delta^2 = 0.8577, by
+    quadrature with gravity along the slope) is the full-order fixed point: P(x*) = x*,
+    the period to 1e-8, and delta^2 its variational Floquet multiplier to 1e-6."""
+    cfg = yaml.safe_load((ROOT / "configs" / "paper_rods.yaml").read_text())
+    cfg["walker"]["actuation"] = {"virtual_constraints": {
+        "phase": {"link": "stance_leg"},
+        "outputs": [{"link": "swing_leg", "bezier_rad": [-0.15, -0.15, 0.2, 0.15]}],
+        "feedback": {"kind": "input_output_linearization", "kp_per_s2": 2500,
+                     "kd_per_s": 100}}}
+    scene = scene_from_dict(cfg)
+    w = build_walker(scene)
+    ctrl = w.actuators.controller
+    assert ctrl.joints == ["hip"]
+    z = zero_dynamics(ctrl)
+    assert z.exists and z.stable and z.kinetic_invariance < 1e-12
+    x1, period, DP, _n = poincare_map(w, z.x_plus, Solver(method="LSODA", rtol=1e-11,
+                                                           atol=1e-11), jacobian=True)
+    np.testing.assert_allclose(x1, z.x_plus, rtol=0, atol=1e-8)
+    assert abs(period - z.step_period_s) < 1e-8
+    mult = np.linalg.eigvals(DP)
+    j = np.argmin(np.abs(mult - z.delta2))
+    assert abs(mult[j] - z.delta2) < 1e-6 and np.max(np.abs(np.delete(mult, j))) < 1e-6
