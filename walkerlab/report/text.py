@@ -231,6 +231,8 @@ def zero_dynamics_text(z: dict) -> list[str]:
                      f" rad, max |y'| {fo['output_rate_plus']:.1e} rad/s")
     lines.append(f"  invariance residuals: {z['invariance_residual_position']:.1e} rad, "
                  f"{z['invariance_residual_rate']:.1e} rad/{p}")
+    for name, c in zip(z.get("outputs", ()), z.get("bezier", ())):
+        lines.append(f"  {name:<18s} bezier_rad in force: [{', '.join(f'{v:.6g}' for v in c)}]")
     sat = "BINDS: the zero dynamics is not the closed loop's" if z["saturates"] else \
         "within the saturation"
     lines.append(f"  max |u| along the orbit {z['max_torque_n_m']:.4g} N m ({sat}); lowest "
