@@ -162,7 +162,11 @@ def test_decoupling_matrix_is_the_flows_torque_derivative(which, walker, hip_pha
     rng = np.random.default_rng(5)
     x0 = walker.actuators.controller.design.q_plus
     n = 5
-    B = acts.B  # joint_columns of the generated link angles (not the symbolic pieces)
+    from walkerlab.walker.joints import joint_columns
+
+    # B from the generated link angles' unit rates (not the controller's symbolic pieces)
+    B = joint_columns(acts.link_angles, n, acts.links)
+    np.testing.assert_array_equal(B, ctrl.B)
     for _ in range(3):
         x = np.concatenate([x0 + rng.normal(scale=0.05, size=n), rng.normal(size=n)])
         M = fns["matrices"](x)[0]
