@@ -386,3 +386,20 @@ def test_compass_gait_under_one_virtual_constraint():
     mult = np.linalg.eigvals(DP)
     j = np.argmin(np.abs(mult - z.delta2))
     assert abs(mult[j] - z.delta2) < 1e-6 and np.max(np.abs(np.delete(mult, j))) < 1e-6
+
+
+@pytest.mark.parametrize("name, words", [("round_feet", "needs point feet"),
+                                         ("kuo2002", "carry mass")])
+def test_walkers_the_quadrature_does_not_hold_for_refused(name, words):
+    """Arc feet roll (the stance foot is not a pin: sigma' != -b^T G) and massless legs
+    have no inertia to drive: one line naming the key."""
+    cfg = yaml.safe_load((ROOT / "configs" / f"{name}.yaml").read_text())
+    cfg["walker"]["actuation"] = {"virtual_constraints": {
+        "phase": {"link": "stance_leg"},
+        "outputs": [{"link": "swing_leg", "bezier_rad": [-0.15, -0.15, 0.2, 0.15]}],
+        "feedback": {"kind": "input_output_linearization", "kp_per_s2": 400,
+                     "kd_per_s": 40}}}
+    with pytest.raises(ValueError) as e:
+        build_walker(scene_from_dict(cfg))
+    msg = one_line(e)
+    assert msg.startswith("walker.actuation.virtual_constraints: ") and words in msg

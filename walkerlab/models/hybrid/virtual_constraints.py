@@ -132,6 +132,12 @@ class VirtualConstraintController:
         from walkerlab.walker.joints import link_angles
 
         self.spec, self.fns = spec, fns
+        if structure.foot != "point":
+            raise ValueError(f"{KEY}: needs point feet (the zero dynamics' quadrature pins the "
+                             f"stance foot; this walker's are {structure.foot})")
+        if any(b.massless for b in structure.bodies):
+            raise ValueError(f"{KEY}: needs legs whose bodies all carry mass (a massless "
+                             "link has no inertia for the computed torque to act on)")
         n = len(structure.roles)
         self.n = n
         names = link_angles(fns["leg_angles"](np.zeros(2 * n)))
