@@ -65,14 +65,15 @@ def bezier(c, s):
     return c @ basis(M), d1 @ basis(M - 1), d2 @ basis(M - 2)
 
 
-def default_joints(link_names) -> list[str]:
-    """The joints virtual constraints drive by default: with a torso, torso to each leg
-    (``stance_hip``, ``swing_hip``), else the hip between the legs; each knee on a walker
-    whose knees are free links."""
+def default_joints(link_names, hinged_torso: bool) -> list[str]:
+    """The joints virtual constraints drive by default: with a torso hinged at the hip (a
+    coordinate of its own), torso to each leg (``stance_hip``, ``swing_hip``), else the hip
+    between the legs (a bisecting torso follows the legs); each knee on a walker whose knees
+    are free links."""
     from walkerlab.walker.joints import joint_links
 
     names = set(link_names)
-    out = ["stance_hip", "swing_hip"] if "torso" in names else ["hip"]
+    out = ["stance_hip", "swing_hip"] if hinged_torso and "torso" in names else ["hip"]
     if "stance_shank" in names and "stance_thigh" in names:
         out += ["stance_knee", "swing_knee"]
     for j in out:
@@ -141,7 +142,8 @@ class VirtualConstraintController:
         n = len(structure.roles)
         self.n = n
         names = link_angles(fns["leg_angles"](np.zeros(2 * n)))
-        joints = list(spec.joints) if spec.joints is not None else default_joints(names)
+        joints = list(spec.joints) if spec.joints is not None else default_joints(
+            names, bool(structure.torso) and structure.hinged_torso)
         self.joints = joints
         outputs = [("link", o.link) if o.link is not None else ("joint", o.joint)
                    for o in spec.outputs]
@@ -301,8 +303,7 @@ class VirtualConstraintController:
         for si, q in zip(s, qs):
             A = self.decoupling(np.concatenate([q, np.zeros(self.n)]))
             sv = np.linalg.svd(A, compute_uv=False)
-            if not sv[-1] > sv[0] / MAX_CONDITION:
-                _u, _s, Vt = np.linalg.svd(A)
+            if not sv[-1] > sv[0] / MAX_CONDITION:  # the outputs in its left null space
                 w = np.abs(np.linalg.svd(A)[0][:, -1])
                 names = [self.output_names[i] for i in np.flatnonzero(w > 0.1 * w.max())]
                 raise ValueError(f"{KEY}.outputs: the decoupling matrix L_g L_f h is singular "
