@@ -34,6 +34,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.models.hybrid.virtual_constraints import annihilator, bezier
+
 __all__ = ["ZeroDynamics", "compare_full_order", "impact_multiplier", "zero_dynamics"]
 
 #: Chebyshev points of the integrands along the step
@@ -117,14 +119,6 @@ class ZeroDynamics:
         return bool(0.0 <= self.delta2 < 1.0)
 
 
-def annihilator(B) -> np.ndarray:
-    """``b`` (n,) with ``b^T B = 0`` (the direction no actuator drives), scaled so its
-    largest entry is +1."""
-    u, _s, _vt = np.linalg.svd(np.asarray(B, float))
-    b = u[:, -1]
-    return b / b[np.argmax(np.abs(b))]
-
-
 def impact_multiplier(ctrl, b=None) -> float:
     """``delta^2`` of ``ctrl`` (a :class:`walkerlab.models.hybrid.virtual_constraints.
     VirtualConstraintController`): the heel strike's ratio of ``sigma`` on the surface,
@@ -132,8 +126,6 @@ def impact_multiplier(ctrl, b=None) -> float:
     d = ctrl.design
     n = ctrl.n
     b = annihilator(ctrl.B) if b is None else b
-    from walkerlab.models.hybrid.virtual_constraints import bezier
-
     dth = d.theta_minus - d.theta_plus
     qd = ctrl.tangent(d.q_minus, bezier(d.alpha, 1.0)[1], dth)
     M_m = ctrl.fns["matrices"](np.concatenate([d.q_minus, qd]))[0]
@@ -157,8 +149,6 @@ def zero_dynamics(ctrl) -> ZeroDynamics:
     ZeroDynamics
     """
     from numpy.polynomial import Chebyshev
-
-    from walkerlab.models.hybrid.virtual_constraints import bezier
 
     t0 = time.perf_counter()
     b = annihilator(ctrl.B)

@@ -40,7 +40,7 @@ import numpy as np
 from walkerlab.models.hybrid.actuators import Actuators
 
 __all__ = ["Design", "VirtualConstraintActuators", "VirtualConstraintController",
-           "bezier", "default_joints"]
+           "annihilator", "bezier", "default_joints"]
 
 KEY = "walker.actuation.virtual_constraints"
 #: largest condition number of the decoupling matrix along the designed step
@@ -63,6 +63,15 @@ def bezier(c, s):
     def basis(m):
         return np.array([comb(m, j) * ps[j] * qs[m - j] for j in range(m + 1)])
     return c @ basis(M), d1 @ basis(M - 1), d2 @ basis(M - 2)
+
+
+def annihilator(B) -> np.ndarray:
+    """``b`` (n,) with ``b^T B = 0`` (the direction no actuator drives; for absolute link
+    angles the rotation of the whole walker about its stance foot), scaled so that its
+    largest entry is +1."""
+    u, _s, _vt = np.linalg.svd(np.asarray(B, float))
+    b = u[:, -1]
+    return b / b[np.argmax(np.abs(b))]
 
 
 def default_joints(link_names, hinged_torso: bool) -> list[str]:
@@ -133,9 +142,6 @@ class VirtualConstraintController:
         from walkerlab.walker.joints import link_angles
 
         self.spec, self.fns = spec, fns
-        if structure.foot != "point":
-            raise ValueError(f"{KEY}: needs point feet (the zero dynamics' quadrature pins the "
-                             f"stance foot; this walker's are {structure.foot})")
         if any(b.massless for b in structure.bodies):
             raise ValueError(f"{KEY}: needs legs whose bodies all carry mass (a massless "
                              "link has no inertia for the computed torque to act on)")
@@ -289,10 +295,12 @@ class VirtualConstraintController:
         return np.array(qs), np.array(ts)
 
     def _check_path(self):
-        """The phase advances with the hip and the decoupling matrix is regular along the
-        designed step (one line naming the key otherwise)."""
+        """The phase advances with the hip, the decoupling matrix is regular along the
+        designed step and the stance foot is a pin (the rotation ``b`` no actuator drives
+        leaves the kinetic energy unchanged: the zero dynamics' quadrature); one line naming
+        the key otherwise."""
         s = np.linspace(0.0, 1.0, 41)
-        qs, _ = self.path(s)
+        qs, tangents = self.path(s)
         hip = np.array([self.pieces.foot(q)[2] for q in qs])
         d = np.diff(hip)
         if not (np.all(d > 0) or np.all(d < 0)):
@@ -310,6 +318,18 @@ class VirtualConstraintController:
                                  f"at s = {si:.3f} (condition {sv[0] / max(sv[-1], 1e-300):.3g}):"
                                  f" the actuators ({', '.join(self.joints)}) cannot drive "
                                  f"the outputs {', '.join(names)} independently")
+        b = annihilator(self.B)
+        W, I_ = [], []
+        for q, qp in zip(qs, tangents):  # dT/db = q'^T (dM/db) q' / 2 = 0 on a pin
+            x = np.concatenate([q, qp]).astype(complex)
+            x[:self.n] += 1e-30j * b
+            M = self.fns["matrices"](x)[0]
+            W.append(qp @ (np.imag(M) / 1e-30) @ qp)
+            I_.append(b @ np.real(M) @ qp)
+        if np.max(np.abs(W)) > 1e-9 * np.max(np.abs(I_)):
+            raise ValueError(f"{KEY}: the stance foot is no pin (the kinetic energy changes "
+                             "under the rotation no actuator drives, as on rolling feet): the "
+                             "zero dynamics' quadrature needs point feet")
 
     # ------------------------------------------------------------------ feedback
     def terms(self, x):
