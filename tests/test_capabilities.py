@@ -96,6 +96,14 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         w["actuation"] = {**shipped, "push_off": {"impulse_n_s": 0.05}}
     elif feature == "ankle_push_off":
         w["actuation"] = {**shipped, "ankle_push_off": {"constant_n_m": 1.0}}
+    elif feature == "virtual_constraints":  # RABBIT's (configs/rabbit_hzd.yaml), or one
+        # output per hip on the others (the swing leg, the torso where there is one)
+        with open(ROOT / "configs" / "rabbit_hzd.yaml") as fh:
+            vc = yaml.safe_load(fh)["walker"]["actuation"]["virtual_constraints"]
+        if kind != "free_joints":
+            vc["outputs"] = [{"link": "swing_leg", "bezier_rad": [-0.2, -0.1, 0.0, 0.1, 0.2]}]
+            vc.pop("max_torque_n_m")
+        w["actuation"] = {"virtual_constraints": vc}
     elif feature in TERRAIN:
         terrain = copy.deepcopy(TERRAIN[feature])
         if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
@@ -233,7 +241,8 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
                  else JOINT[feature])
         out += [f"{joint} is not a joint of this walker (its joints: ",
                 f"{joint} is not a joint of the "]  # an export's joints (the walker's)
-    if kind == "rolling_polygon" and feature in (*JOINT, "push_off", "ankle_push_off"):
+    if kind == "rolling_polygon" and feature in (*JOINT, "push_off", "ankle_push_off",
+                                                 "virtual_constraints"):
         out.append("walker.actuation: unknown field")
     return tuple(out)
 

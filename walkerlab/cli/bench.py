@@ -34,6 +34,10 @@ benchmark      what is timed                                                    
 ``powered``    a powered contact run (hip law, push-off, RABBIT's phase law) on <= 1.5x
                its compiled run against the passive run of the same walker,     passive
                CPU, medians (:mod:`walkerlab.bench.powered_contact`)
+``hzd``        the restricted Poincare map's delta^2 of RABBIT under virtual    <= 10 ms
+               constraints (configs/rabbit_hzd.yaml), median; the whole zero
+               dynamics and one full-order step beside it
+               (:mod:`walkerlab.bench.hzd`; ``scripts/bench_hzd.py``)
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -53,7 +57,7 @@ from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
 
 BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job", "optimize",
-              "powered")
+              "powered", "hzd")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -157,6 +161,11 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
 
             lines += powered_lines(res["result"])
             continue
+        if name == "hzd":
+            from walkerlab.bench.hzd import lines as hzd_lines
+
+            lines += hzd_lines(res["result"])
+            continue
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines
 
@@ -178,6 +187,10 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.powered_contact import bench_powered_contact
 
         return bench_powered_contact()
+    if name == "hzd":
+        from walkerlab.bench.hzd import bench_hzd
+
+        return bench_hzd()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
             "basin": B.bench_basin,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

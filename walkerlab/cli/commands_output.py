@@ -91,8 +91,8 @@ def export(scene: Path | None = SceneArg,
 
 @guard
 def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
-                                     " | main-job | optimize | powered | all (all but basin, "
-                                     "main-job, optimize and powered)"),
+                                     " | main-job | optimize | powered | hzd | all (all but "
+                                     "basin, main-job, optimize, powered and hzd)"),
           scenes: list[Path] | None = typer.Argument(
               None, help="contact only: scene YAML files whose walkers are timed (5 contact "
               "strides at <= 1e-6 rad against a tight reference), e.g. configs/kneed.yaml "

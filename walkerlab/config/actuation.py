@@ -227,6 +227,129 @@ class AnklePushOff(Strict):
         return self
 
 
+#: A link an output or the phase variable reads (its absolute angle, walkerlab's
+#: convention: legs from the downward vertical, positive foot ahead; the torso from the
+#: upward vertical, positive leaning back).  ``stance_leg`` / ``swing_leg``: the leg, on a
+#: kneed walker the virtual leg (the line from the hip to the foot).
+OUTPUT_LINKS = ("stance_leg", "swing_leg", "stance_thigh", "stance_shank", "swing_thigh",
+                "swing_shank", "torso")
+LinkName = Literal["stance_leg", "swing_leg", "stance_thigh", "stance_shank", "swing_thigh",
+                   "swing_shank", "torso"]
+JointName = Literal["hip", "stance_hip", "swing_hip", "stance_knee", "swing_knee"]
+
+
+class PhaseVariable(Strict):
+    """The phase variable ``theta(q)`` of the virtual constraints, monotone over a step
+    (Westervelt, Grizzle & Koditschek 2003, Sec. IV-A): one of a link's absolute angle
+    (``link``; the stance leg's decreases through a step), the hip's horizontal position
+    (``point: hip``, [m], increasing), or a linear combination of the generalised coordinates
+    (``coordinates``: a coefficient per coordinate, by the walker's role names, e.g.
+    ``{stance_shank: 0.5, stance_thigh: 0.5}``).  The Bezier polynomials read ``s = (theta -
+    theta+) / (theta- - theta+)`` in [0, 1], ``theta+`` / ``theta-`` its values at the step's
+    start and end configurations (the outputs' first and last coefficients)."""
+
+    link: LinkName | None = Field(None, description="a link's absolute angle [rad]")
+    point: Literal["hip"] | None = Field(None, description="the hip's horizontal position "
+                                        "from the stance foot, along the ground [m]")
+    coordinates: dict[str, float] | None = Field(
+        None, min_length=1, max_length=8, description="coefficients of the generalised "
+        "coordinates (by role name) of a linear combination [rad per rad]")
+
+    @model_validator(mode="after")
+    def _one(self) -> PhaseVariable:
+        if sum(v is not None for v in (self.link, self.point, self.coordinates)) != 1:
+            raise ValueError("give one of link, point or coordinates")
+        if self.coordinates is not None and not any(self.coordinates.values()):
+            raise ValueError("coordinates: every coefficient is 0 (no phase variable)")
+        return self
+
+    @model_serializer(mode="wrap")
+    def _as_given(self, handler):
+        return drop_unset(handler(self), ("link", "point", "coordinates"))
+
+
+class BezierOutput(Strict):
+    """One controlled output ``y = h0(q) - hd(s)``: ``h0`` a link's absolute angle
+    (``link``) or a joint's relative angle (``joint``, :data:`JOINTS`: the second link's
+    angle minus the first's), ``hd(s) = sum_k c_k M!/(k!(M-k)!) s^k (1-s)^(M-k)`` the
+    Bezier polynomial of degree ``M`` of the coefficients ``bezier_rad = [c_0, ..., c_M]``
+    (Westervelt et al. 2003, Sec. V-B, Eq. 36)."""
+
+    link: LinkName | None = Field(None, description="a link's absolute angle")
+    joint: JointName | None = Field(None, description="a joint's angle (second link minus "
+                                    "first, walker.actuation's JOINTS)")
+    bezier_rad: list[TableAngle] = Field(min_length=4, max_length=21, description="Bezier "
+                                         "coefficients c_0..c_M (M >= 3) [rad]")
+
+    @model_validator(mode="after")
+    def _one(self) -> BezierOutput:
+        if (self.link is None) == (self.joint is None):
+            raise ValueError("give link or joint (one of them)")
+        return self
+
+    @property
+    def name(self) -> str:
+        """``link:<name>`` or ``joint:<name>`` (how messages name the output)."""
+        return f"link:{self.link}" if self.link is not None else f"joint:{self.joint}"
+
+    @model_serializer(mode="wrap")
+    def _as_given(self, handler):
+        return drop_unset(handler(self), ("link", "joint"))
+
+
+class OutputFeedback(Strict):
+    """Input-output linearisation of the outputs (computed torque): ``u = (L_g L_f h)^-1
+    (-L_f^2 h - kp y - kd y')``, so that ``y'' = -kp y - kd y'`` (Isidori 1995; Westervelt
+    et al. 2003, Sec. IV-B)."""
+
+    kind: Literal["input_output_linearization"] = Field(description="the feedback law")
+    kp_per_s2: float = Field(gt=0, le=1e8, description="proportional gain [1/s^2]",
+                             json_schema_extra={"unit": "1/s^2"})
+    kd_per_s: float = Field(gt=0, le=1e5, description="derivative gain [1/s]",
+                            json_schema_extra={"unit": "1/s"})
+
+
+class VirtualConstraints(Strict):
+    """Virtual constraints as the walker's feedback controller (hybrid zero dynamics:
+    Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56; Westervelt et al. 2007,
+    *Feedback Control of Dynamic Bipedal Robot Locomotion*, ch. 5-6): one output per
+    actuator, driven to zero by computed torque; ``invariant: true`` replaces ``c_0``, ``c_1``
+    of every output by the values that make the zero-dynamics surface invariant under the
+    heel strike (the given ones are placeholders; the computed ones are reported)."""
+
+    phase: PhaseVariable = Field(description="the phase variable theta(q)")
+    outputs: list[BezierOutput] = Field(min_length=1, max_length=8, description="the "
+                                        "controlled outputs (as many as actuators)")
+    feedback: OutputFeedback = Field(description="the output feedback")
+    invariant: bool = Field(True, description="set c_0, c_1 of every output from the impact "
+                            "map (the surface y = y' = 0 invariant under heel strike)")
+    joints: list[JointName] | None = Field(
+        None, min_length=1, max_length=8, description="the actuated joints (default: every "
+        "hip and knee of the walker: between a torso and each leg, or between the legs; "
+        "each knee)")
+    max_torque_n_m: float | None = Field(None, gt=0, le=1e6, description="saturation |u| <= "
+                                         "max at every actuator [N m] (null: none)")
+
+    @model_validator(mode="after")
+    def _outputs(self) -> VirtualConstraints:
+        n0 = len(self.outputs[0].bezier_rad)
+        for i, o in enumerate(self.outputs):
+            if len(o.bezier_rad) != n0:
+                raise ValueError(f"outputs.{i}.bezier_rad: {len(o.bezier_rad)} coefficients, "
+                                 f"outputs.0 has {n0}: every output needs the same degree")
+        names = [o.name for o in self.outputs]
+        for i, nm in enumerate(names):
+            if nm in names[:i]:
+                raise ValueError(f"outputs.{i}: {nm} is controlled twice")
+        if self.joints is not None and len(set(self.joints)) != len(self.joints):
+            raise ValueError("joints: a joint is listed twice")
+        return self
+
+    @model_serializer(mode="wrap")
+    def _as_given(self, handler):
+        return drop_unset(handler(self), ("joints", "max_torque_n_m"))
+
+
 class Actuation(Strict):
     """The walker's actuators (``walker.actuation``)."""
 
@@ -236,10 +359,26 @@ class Actuation(Strict):
         "off to heel strike")
     torques: list[JointTorque] = Field(default_factory=list, max_length=8,
                                        description="joint torque actuators")
+    virtual_constraints: VirtualConstraints | None = Field(
+        None, description="virtual constraints on Bezier outputs, enforced by output "
+        "feedback (hybrid zero dynamics)")
 
     @model_validator(mode="after")
     def _something(self) -> Actuation:
+        if self.virtual_constraints is not None:
+            for k in ("push_off", "ankle_push_off"):
+                if getattr(self, k) is not None:
+                    raise ValueError(f"{k}: the virtual constraints drive the walker alone "
+                                     "(their invariance is under the plain heel strike)")
+            if self.torques:
+                raise ValueError("torques: the virtual constraints drive every actuator: give "
+                                 "the joints in virtual_constraints.joints, not torques")
+            return self
         if self.push_off is None and not self.torques and self.ankle_push_off is None:
             raise ValueError("give push_off, torques or ankle_push_off (or leave actuation "
                              "out)")
         return self
+
+    @model_serializer(mode="wrap")
+    def _as_given(self, handler):
+        return drop_unset(handler(self), ("virtual_constraints",))

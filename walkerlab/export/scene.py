@@ -79,6 +79,10 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
         :mod:`walkerlab.export.mujoco_walk` drives.
     """
     SCENE_FEET[kind.name].check_format(fmt, walker_only)
+    act = scene.walker.actuation
+    if not walker_only and act is not None and act.virtual_constraints is not None:
+        kind.require("virtual_constraints", FORMAT_VIEWS.get(fmt or "mjcf", "mjcf"),
+                     "walker.actuation.virtual_constraints")
 
     def walk(obj, path):
         if isinstance(obj, dict):

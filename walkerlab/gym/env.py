@@ -222,6 +222,9 @@ class WalkerEnv(gym.Env):
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
+        if sc.walker.actuation is not None and sc.walker.actuation.virtual_constraints:
+            data.structure.kind.require("virtual_constraints", "gym",
+                                        "walker.actuation.virtual_constraints")
         if view == "rigid":
             _check_rigid_ground(sc)
         self.scene, self.view = sc, view

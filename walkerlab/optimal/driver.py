@@ -233,6 +233,8 @@ def check_kind(scene, kind) -> None:
     """
     kind.require("walk", "optimize", "walker")
     act = scene.walker.actuation
+    if act is not None and act.virtual_constraints is not None:
+        kind.require("virtual_constraints", "optimize", "walker.actuation.virtual_constraints")
     if scene.optimize.push_off == "free" or (act is not None and act.push_off
                                              and act.push_off.impulse_n_s):
         kind.require("push_off", "optimize", "optimize.push_off")

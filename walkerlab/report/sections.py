@@ -16,7 +16,11 @@ from types import ModuleType
 import numpy as np
 
 from walkerlab.report.markdown import num, printed, sig_digits, table
-from walkerlab.report.text import ground_contact_text, zero_multipliers_text
+from walkerlab.report.text import (
+    ground_contact_text,
+    zero_dynamics_text,
+    zero_multipliers_text,
+)
 from walkerlab.units import Units, for_scene
 
 #: Table 3 rows (keys of :func:`walkerlab.comparison.tables.gait_metrics`): name, symbol, unit
@@ -218,6 +222,9 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
             "", f"Max difference between the two: {num(fp.max_difference, 2)}. "
             f"Verdict: **{'stable' if fp.stable else 'unstable'}** "
             f"({zero_multipliers_text(re, im, fp.state_names, fp.scene_json)}).", ""]
+    if fp.zero_dynamics is not None:  # virtual constraints: the restricted map beside
+        out += ["### Hybrid zero dynamics", "", "```text",
+                *zero_dynamics_text(fp.zero_dynamics), "```", ""]
     return out
 
 

@@ -172,8 +172,12 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     lines.append(f"  max difference {fp.max_difference:.2e}")
     mod = float(np.max(np.hypot(re, im)))
     verdict = "STABLE" if fp.stable else "UNSTABLE"
-    lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
-                 f"{zero_multipliers_text(re, im, fp.state_names, fp.scene_json)})")
+    why = (zero_multipliers_text(re, im, fp.state_names, fp.scene_json)
+           if fp.zero_dynamics is None else "the others are the output feedback's and the "
+           "heel-strike surface's, besides delta^2 of the zero dynamics")
+    lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; {why})")
+    if fp.zero_dynamics is not None:
+        lines += zero_dynamics_text(fp.zero_dynamics)
     if fp.ground_contact is not None:
         lines.append(ground_contact_text(fp.ground_contact, u))
     if _terrain_kind(fp.scene_json) == "profile":
@@ -184,6 +188,58 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
         lines.append(footholds_text(fp.footholds))
     lines += gaits_text(fp)
     return "\n".join(lines)
+
+
+def zero_dynamics_text(z: dict) -> list[str]:
+    """Lines on the hybrid zero dynamics (``fixedpoint.h5``'s ``zero_dynamics/``), the
+    restricted Poincare map's numbers side by side with the full-order fixed point's."""
+    p, fo = z["phase_unit"], z.get("full_order", {})
+    E = "kg^2 m^4/s^2"
+
+    def vs(key, val, fmt, unit):
+        if key not in fo:
+            return f"{val:{fmt}} {unit}"
+        f = fo[key]
+        return (f"{val:{fmt}} {unit}   full order {f:{fmt}} {unit}   |diff| "
+                f"{abs(val - f):.1e}")
+    lines = ["zero dynamics (virtual constraints; restricted Poincare map rho(zeta) = "
+             "delta^2 zeta - V(theta-), zeta = sigma^2/2):"]
+    d2 = z["delta2"]
+    m = fo.get("delta2_multiplier")
+    lines.append(f"  delta^2          {d2:.10f}" + (
+        "" if m is None else f"   full-order multiplier {m.real:.10f}"
+        + (f"{m.imag:+.1e}j" if m.imag else "") + f"   |diff| {abs(d2 - m):.1e}"))
+    if "other_multiplier" in fo:
+        lines.append(f"  other full-order multipliers: |.| <= {fo['other_multiplier']:.2e} "
+                     "(the output feedback's)")
+    verdict = "exists" if z["exists"] else "DOES NOT EXIST"
+    lines.append(f"  V(theta-)        {z['v_minus']:.6g} {E}   V_max {z['v_max']:.6g} {E}")
+    lines.append(f"  existence        delta^2/(1-delta^2) V(theta-) + V_max = "
+                 f"{z['existence_margin']:.6g} {E}: the fixed point {verdict}"
+                 + (f", {'stable' if z['stable'] else 'UNSTABLE'} (delta^2 "
+                    f"{'<' if z['stable'] else '>='} 1)" if z["exists"] else ""))
+    lines.append(f"  zeta*            {z['zeta_star']:.10g} {E}")
+    lines.append(f"  theta+ / theta-  {z['theta_plus']:.10f} / {z['theta_minus']:.10f} {p}")
+    lines.append("  phase rate at impact " + vs("phase_rate_minus", z["phase_rate_minus"],
+                                                  ".10f", f"{p}/s"))
+    lines.append("  phase rate after     " + vs("phase_rate_plus", z["phase_rate_plus"],
+                                                  ".10f", f"{p}/s"))
+    lines.append("  step period (quadrature) " + vs("step_period_s", z["step_period_s"],
+                                                      ".10f", "s"))
+    if "output_plus" in fo:
+        lines.append(f"  outputs after heel strike (full order): max |y| {fo['output_plus']:.1e}"
+                     f" rad, max |y'| {fo['output_rate_plus']:.1e} rad/s")
+    lines.append(f"  invariance residuals: {z['invariance_residual_position']:.1e} rad, "
+                 f"{z['invariance_residual_rate']:.1e} rad/{p}")
+    for name, c in zip(z.get("outputs", ()), z.get("bezier", ())):
+        lines.append(f"  {name:<18s} bezier_rad in force: [{', '.join(f'{v:.6g}' for v in c)}]")
+    sat = "BINDS: the zero dynamics is not the closed loop's" if z["saturates"] else \
+        "within the saturation"
+    lines.append(f"  max |u| along the orbit {z['max_torque_n_m']:.4g} N m ({sat}); lowest "
+                 f"swing foot inside the step {z['min_clearance_m'] * 1e3:.4g} mm")
+    lines.append(f"  timing: delta^2 {z['timing_delta2_s'] * 1e3:.3g} ms, zero dynamics "
+                 f"{z['timing_total_s'] * 1e3:.3g} ms")
+    return lines
 
 
 def unstable_gait_line(fp: FixedPointArtifact) -> str:

@@ -144,7 +144,23 @@ def walker_columns(stage: str, scene) -> dict[str, tuple]:
         return dict(COLUMNS[stage])
     from walkerlab.models.registry import state_layout
 
-    return columns(stage, *state_layout(scene))
+    out = columns(stage, *state_layout(scene))
+    act = scene.walker.actuation if hasattr(scene.walker, "actuation") else None
+    if stage == "fixedpoint" and act is not None and act.virtual_constraints is not None:
+        out.update(ZERO_DYNAMICS_COLUMNS)  # a scene under virtual constraints: its HZD too
+    return out
+
+
+#: a sweep's fixedpoint columns of a scene under virtual constraints: its hybrid zero
+#: dynamics (:func:`walkerlab.analysis.gait.zero_dynamics.zero_dynamics`)
+ZERO_DYNAMICS_COLUMNS = {
+    "delta2": ("-", "restricted Poincare map's multiplier delta^2"),
+    "v_minus": ("kg^2 m^4/s^2", "V(theta-) of the zero dynamics"),
+    "v_max": ("kg^2 m^4/s^2", "largest V over the step"),
+    "existence_margin": ("kg^2 m^4/s^2", "delta^2/(1-delta^2) V(theta-) + V_max (< 0: the "
+                         "zero dynamics' fixed point exists)"),
+    "hzd_step_period_s": ("s", "step period of the zero dynamics' orbit (quadrature)"),
+}
 
 
 def empty_row(stage: str, index: int) -> dict:

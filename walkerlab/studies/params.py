@@ -2,7 +2,9 @@
 
 A parameter is a dotted path into the scene mapping (``slope.angle_deg``,
 ``contact.stiffness_n_per_mm_pow_e``, ``solver.rtol``; an item of a list by its ``name`` or index:
-``walker.leg.bodies.thigh_mass.mass_kg``, ``walker.leg.bodies.1.mass_kg``) and a list of
+``walker.leg.bodies.thigh_mass.mass_kg``, ``walker.leg.bodies.1.mass_kg``; one number of a
+list of numbers by its index: ``walker.actuation.virtual_constraints.outputs.1.bezier_rad.5``,
+a Bezier coefficient) and a list of
 values, given either as an inclusive range ``start:stop:step`` or as a comma list ``a,b,c``.
 A grid point is applied to the plain ``dict`` of the base scene and validated again through
 the same pydantic types (:func:`walkerlab.config.scene_from_dict`): a bad value is caught per
@@ -211,6 +213,10 @@ def _set_dotted(d: dict, path: str, value) -> None:
         elif not isinstance(nxt, (dict, list)):
             raise SceneError(f"{path}: '{k}' is not a section (it is {nxt!r})")
         node = nxt
+    if isinstance(node, list) and keys[-1].isdigit() and int(keys[-1]) < len(node) \
+            and not isinstance(node[int(keys[-1])], dict):  # one number of a list of them
+        node[int(keys[-1])] = value
+        return
     if isinstance(node, list):
         raise SceneError(f"{path}: '{keys[-1]}' is a list item, not a field: name the item's "
                          f"field ({path}.mass_kg, ...)")
@@ -259,10 +265,19 @@ def _check_path(scene: Scene, axis: ParamAxis):
     keys = axis.path.split(".")
     obj: object = scene
     cls = type(scene)
+    info = None  # the last field's schema entry (a list of numbers: the list's)
     for i, k in enumerate(keys):
         here = ".".join(keys[:i + 1])
         if isinstance(obj, (list, tuple)):
             items = [o.model_dump() if isinstance(o, BaseModel) else o for o in obj]
+            if k.isdigit() and not any(isinstance(o, dict) for o in items):  # a number
+                if i != len(keys) - 1:  # of a list of numbers (Bezier coefficients)
+                    raise SweepError(f"--param {axis.spec!r}: {here} is a value, not a "
+                                     f"section: it has no field {keys[i + 1]!r}")
+                if int(k) >= len(items):
+                    raise SweepError(f"--param {axis.spec!r}: {here}: index {k} is out of "
+                                     f"range (the list has {len(items)} values)")
+                return info
             try:
                 item = list_item(items, k, axis.path)
             except SceneError as exc:
@@ -326,7 +341,10 @@ def axis_unit(scene: Scene, axis: ParamAxis) -> str:
     info = _check_path(scene, axis)
     extra = getattr(info, "json_schema_extra", None)
     unit = extra.get("unit") if isinstance(extra, dict) else None
-    return unit or field_unit(axis.path) or "-"
+    path = axis.path
+    while path.rsplit(".", 1)[-1].isdigit():  # a number of a list field (bezier_rad.3)
+        path = path.rsplit(".", 1)[0]
+    return unit or field_unit(path) or "-"
 
 
 def check_axes(scene: Scene, axes: list[ParamAxis], values: bool = True) -> None:

@@ -114,7 +114,8 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     walker : HybridWalker
     result : FixedPointResult
     source : str
-        ``"neighbour"``, ``"scene"`` or ``"search"``.
+        ``"neighbour"``, ``"scene"``, ``"zero_dynamics"`` (virtual constraints: the
+        restricted map's fixed point) or ``"search"``.
 
     Raises
     ------
@@ -140,6 +141,11 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     if fp.initial_guess is not None:
         tries.append(("scene", initial_state(fp.initial_guess, walker.state_names()), None))
     else:
+        from walkerlab.analysis.gait.scene import hzd_start
+
+        x_hzd = hzd_start(walker)  # virtual constraints: the zero dynamics' orbit
+        if x_hzd is not None:
+            tries.append(("zero_dynamics", x_hzd, None))
         tries.append(("search", None, None))
     best, msg = math.inf, ""
     for source, g, J in tries:
@@ -213,6 +219,13 @@ def _fp_columns(walker, res) -> dict:
                 max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
                 map_evaluations=float(res.iterations),
                 variational_maps=float(res.variational_maps), nfev=float(res.nfev))
+    ctrl = getattr(getattr(walker, "actuators", None), "controller", None)
+    if ctrl is not None:  # virtual constraints: the restricted map beside the full one
+        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+
+        z = zero_dynamics(ctrl)
+        cols.update(delta2=z.delta2, v_minus=z.v_minus, v_max=z.v_max,
+                    existence_margin=z.existence_margin, hzd_step_period_s=z.step_period_s)
     return cols
 
 

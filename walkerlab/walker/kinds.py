@@ -70,6 +70,8 @@ FEATURES = {
     "torso_torque": "a torque law between torso and legs (walker.actuation.torques: torso)",
     "push_off": "a push-off impulse before heel strike (walker.actuation.push_off)",
     "ankle_push_off": "an ankle push-off of a flat foot (walker.actuation.ankle_push_off)",
+    "virtual_constraints": ("Bezier virtual constraints by output feedback "
+                            "(walker.actuation.virtual_constraints)"),
     "stairs": "stairs (terrain.kind: stairs)",
     "footholds": "footholds of several heights or slopes (terrain.kind: footholds)",
     "profile": "a height profile (terrain.kind: profile)",
@@ -192,6 +194,12 @@ _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively);
 #: free-jointed (:mod:`walkerlab.export.adams_actuation` says it too)
 FREE_JOINT_TORQUES = ("stance_hip, swing_hip, stance_knee and swing_knee need a free-jointed "
                       "biped (a hinged torso, on free knees or straight legs)")
+#: why a view other than the rigid model refuses virtual constraints (issue: the contact
+#: model, the exports, the gym and optimize are to carry them)
+_VC_RIGID = ("the virtual-constraint controller runs on the rigid model only so far "
+             "(walkerlab fixedpoint, simulate): leave it out of this view")
+_VC_VIEWS = {("virtual_constraints", v): _VC_RIGID
+             for v in ("contact", "mjcf", "adams", "osim", "gym", "optimize")}
 #: what the views of every legged kind refuse: grounds whose steps differ in the Adams
 #: dataset and the OpenSim model (the contact model and the MJCF lay their patches at the
 #: rigid period-n gait's footfalls), a profile there and in the gym
@@ -222,12 +230,16 @@ _FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported 
 CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     "straight_legs": {
         ("knee_torque", "*"): _NO_KNEE,
+        **_VC_VIEWS,
         **_NO_ANKLES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         **_GROUNDS,
     },
     "locking_knees": {
         **_NO_ANKLES,
+        ("virtual_constraints", "*"): ("a knee that locks changes the walker's degrees of "
+                                       "freedom within the step (its outputs would change "
+                                       "in number): give free knees (knee.lock: free)"),
         ("knee_torque", "adams"): FREE_JOINT_TORQUES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
@@ -236,6 +248,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     "flat_feet": {
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "
                                "(walker.leg.knee)"),
+        ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
+                                       "degrees of freedom within the step: give point "
+                                       "feet"),
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
@@ -254,6 +269,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     },
     "free_joints": {
         **_NO_ANKLES,
+        **_VC_VIEWS,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
@@ -264,6 +280,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     },
     "hinged_torso": {
         ("knee_torque", "*"): _NO_KNEE,
+        **_VC_VIEWS,
         **_NO_ANKLES,
         ("walk", "optimize"): ("the free-jointed collocation drives a five-link biped's "
                                "hips and knees; a torso hinged on straight legs is not "
@@ -277,7 +294,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
-                                         "torso_torque", "push_off", "ankle_push_off")},
+                                         "torso_torque", "push_off", "ankle_push_off",
+                                         "virtual_constraints")},
         ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
                             "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "

@@ -130,6 +130,8 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     walker = build_walker(scene) if walker is None else walker
     solver = Solver.from_settings(scene.solver) if solver is None else solver
     start = initial_guess(scene, walker) if guess is None else guess
+    if start is None:  # virtual constraints: the zero dynamics' periodic orbit, if any
+        start = hzd_start(walker)
     search = find_gaits(walker, solver, start,
                         policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
@@ -137,6 +139,25 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
                         ground_check=(lambda x: gait_ground_contact(scene, walker, x))
                         if ground else None)
     return walker, search
+
+
+def controller(walker):
+    """The walker's virtual-constraint controller
+    (:class:`walkerlab.models.hybrid.virtual_constraints.VirtualConstraintController`), or
+    None."""
+    return getattr(getattr(walker, "actuators", None), "controller", None)
+
+
+def hzd_start(walker):
+    """The post-impact state of the hybrid zero dynamics' periodic orbit (a walker under
+    virtual constraints whose restricted map has a fixed point), else None."""
+    ctrl = controller(walker)
+    if ctrl is None:
+        return None
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+
+    zd = zero_dynamics(ctrl)
+    return zd.x_plus.copy() if zd.exists else None
 
 
 def solve_variant(scene: Scene, variant: str, guess=None):
@@ -210,10 +231,17 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         from walkerlab.analysis.gait.treads import tread_landing
 
         treads = tread_landing(walker, main.x, scene.terrain, Solver.from_settings(scene.solver))
+    hzd = None
+    if controller(walker) is not None:  # virtual constraints: the restricted map too
+        from walkerlab.analysis.gait.zero_dynamics import compare_full_order, zero_dynamics
+
+        hzd = zero_dynamics(controller(walker))
+        compare_full_order(hzd, controller(walker), walker, main,
+                           Solver.from_settings(scene.solver))
     run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess, ground,
-                        treads)
+                        treads, hzd)
     summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results),
-               "ground_contact": ground, "footholds": treads}
+               "ground_contact": ground, "footholds": treads, "zero_dynamics": hzd}
     return run, summary
 
 

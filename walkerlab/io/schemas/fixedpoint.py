@@ -13,7 +13,11 @@ variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 evaluations, wall time [s]); ``ground_contact/`` (the selected gait: whether the ground only
 pushes, :data:`GROUND_FIELDS`); on stairs ``footholds/`` (attributes of
 :class:`walkerlab.analysis.gait.treads.TreadLanding`: step advance [m], tread drift per step
-[m], steps until a foot misses a tread, clearances [m]).
+[m], steps until a foot misses a tread, clearances [m]); under virtual constraints
+``zero_dynamics/`` (:data:`ZERO_DYNAMICS_FIELDS`: the restricted Poincare map's delta^2,
+V(theta-), V_max, zeta*, the existence margin, the phase rates at impact and the step
+period by quadrature, with units; ``virtual_constraints/``: the Bezier coefficients in
+force and the invariance residuals).
 """
 
 from __future__ import annotations
@@ -59,6 +63,80 @@ class FixedPointRun:
     other_guess: np.ndarray
     ground: object | None = None
     footholds: object | None = None
+    hzd: object | None = None
+
+
+#: ``zero_dynamics/`` datasets: attribute of :class:`walkerlab.analysis.gait.zero_dynamics.
+#: ZeroDynamics` -> (name, unit (``{p}``: the phase variable's), meaning)
+ZERO_DYNAMICS_FIELDS = {
+    "delta2": ("delta2", "-", "restricted Poincare map's multiplier delta^2 (the heel "
+               "strike's ratio of sigma^2 on the zero-dynamics surface)"),
+    "v_minus": ("v_minus", "kg^2 m^4/s^2", "V(theta-): zeta- = zeta+ - V(theta-), zeta = "
+                "sigma^2/2, sigma = b^T M dq (angular momentum about the stance foot)"),
+    "v_max": ("v_max", "kg^2 m^4/s^2", "largest V over the step"),
+    "zeta_star": ("zeta_star", "kg^2 m^4/s^2", "fixed point of rho(zeta) = delta^2 zeta - "
+                  "V(theta-) (pre-impact)"),
+    "existence_margin": ("existence_margin", "kg^2 m^4/s^2", "delta^2/(1-delta^2) V(theta-) "
+                         "+ V_max (< 0: the fixed point exists)"),
+    "theta_plus": ("theta_plus", "{p}", "phase variable at the step's start"),
+    "theta_minus": ("theta_minus", "{p}", "phase variable at the step's end"),
+    "phase_rate_minus": ("phase_rate_minus", "{p}/s", "phase rate just before heel strike "
+                         "at the fixed point"),
+    "phase_rate_plus": ("phase_rate_plus", "{p}/s", "phase rate just after heel strike"),
+    "step_period_s": ("step_period", "s", "step period by quadrature along the surface"),
+    "max_torque_n_m": ("max_torque", "N m", "largest |u| along the periodic orbit"),
+    "kinetic_invariance": ("kinetic_invariance", "-", "max |q'^T (dM/db) q'| / max |I| "
+                           "(0: the quadrature's premise holds)"),
+    "min_clearance_m": ("min_swing_clearance", "m", "lowest swing-foot height inside the "
+                        "step on the surface (< 0: the foot strikes before theta-)"),
+    "timing_delta2_s": ("timing/delta2", "s", "wall time of delta^2"),
+    "timing_total_s": ("timing/total", "s", "wall time of the zero dynamics"),
+}
+
+
+#: ``zero_dynamics/full_order/``: the full-order fixed point's counterparts
+#: (:func:`walkerlab.analysis.gait.zero_dynamics.compare_full_order`)
+FULL_ORDER_FIELDS = {
+    "phase_rate_minus": ("{p}/s", "full order: phase rate just before heel strike"),
+    "phase_rate_plus": ("{p}/s", "full order: phase rate just after heel strike"),
+    "step_period_s": ("s", "full order: step period"),
+    "delta2_multiplier": ("-", "full order: the Floquet multiplier nearest delta^2 "
+                          "(variational; real, imaginary part)"),
+    "other_multiplier": ("-", "full order: largest |multiplier| of the others (the "
+                         "feedback's)"),
+    "output_plus": ("rad", "full order: max |y| just after heel strike"),
+    "output_rate_plus": ("rad/s", "full order: max |y'| just after heel strike"),
+}
+
+
+def _write_hzd(g, z) -> None:
+    """``zero_dynamics/`` (the restricted map's numbers) and ``virtual_constraints/``
+    (the coefficients in force and the invariance residuals)."""
+    p = z.phase_unit
+    for attr, (name, unit, what) in ZERO_DYNAMICS_FIELDS.items():
+        put(g, name, float(getattr(z, attr)), unit.format(p=p), what)
+    g.attrs["exists"] = int(z.exists)
+    g.attrs["stable"] = int(z.stable)
+    g.attrs["saturates"] = int(z.saturates)
+    put(g, "x_plus", np.asarray(z.x_plus, float), "rad or rad/s", "post-impact state of the "
+        "zero dynamics' periodic orbit (state_names order)")
+    fo = getattr(z, "full_order", {}) or {}
+    for k, (unit, what) in FULL_ORDER_FIELDS.items():
+        if k in fo:
+            v = fo[k]
+            put(g, f"full_order/{k}", float(np.real(v)) if k != "delta2_multiplier"
+                else np.array([np.real(v), np.imag(v)]), unit.format(p=p), what)
+    d = z.design
+    vc = g.create_group("virtual_constraints")
+    vc.attrs["outputs"] = list(z.output_names)
+    vc.attrs["joints"] = list(z.joints)
+    put(vc, "bezier", np.asarray(d.alpha, float), "rad", "Bezier coefficients in force "
+        "(rows: outputs, columns c_0..c_M)")
+    put(vc, "bezier_given", np.asarray(d.given, float), "rad", "the scene's coefficients")
+    put(vc, "invariance_residual_position", d.residual_position, "rad",
+        "max |h0(q+) - c_0|")
+    put(vc, "invariance_residual_rate", d.residual_rate, "rad/" + p,
+        "max |y'+| / |theta'+| after the heel strike")
 
 
 def _write_result(g, walker, res, guess) -> None:
@@ -132,6 +210,8 @@ def write_fixedpoint(f, run: FixedPointRun) -> None:
             _write_ground(grp.create_group("ground_contact"), g.ground)
     if run.ground is not None:
         _write_ground(f.create_group("ground_contact"), run.ground)
+    if run.hzd is not None:  # virtual constraints only: other artifacts unchanged
+        _write_hzd(f.create_group("zero_dynamics"), run.hzd)
     if run.footholds is not None:  # stairs only: a slope's artifact is unchanged
         fh = f.create_group("footholds")
         for k, v in run.footholds.as_dict().items():
@@ -314,6 +394,30 @@ class FixedPointArtifact(GaitResult):
     scene_json: str = "{}"
     ground_contact: GroundContactRecord | None = None
     footholds: dict | None = None
+    zero_dynamics: dict | None = None
+
+
+def _zero_dynamics(f) -> dict | None:
+    """``zero_dynamics/`` by the fields of :data:`ZERO_DYNAMICS_FIELDS` (and ``exists``,
+    ``stable``, ``saturates``, ``unit``: the phase variable's), None without it."""
+    if "zero_dynamics" not in f:
+        return None
+    g = f["zero_dynamics"]
+    out = {a: float(g[name][()]) for a, (name, _u, _w) in ZERO_DYNAMICS_FIELDS.items()}
+    out.update({k: bool(g.attrs[k]) for k in ("exists", "stable", "saturates")})
+    out["phase_unit"] = str(g["theta_plus"].attrs["unit"])
+    out["invariance_residual_position"] = float(
+        g["virtual_constraints/invariance_residual_position"][()])
+    out["invariance_residual_rate"] = float(
+        g["virtual_constraints/invariance_residual_rate"][()])
+    out["full_order"] = {}
+    for k in FULL_ORDER_FIELDS:
+        if f"full_order/{k}" in g:
+            v = g[f"full_order/{k}"][()]
+            out["full_order"][k] = complex(v[0], v[1]) if np.ndim(v) else float(v)
+    out["bezier"] = g["virtual_constraints/bezier"][()]
+    out["outputs"] = [str(o) for o in g["virtual_constraints"].attrs["outputs"]]
+    return out
 
 
 def load_fixedpoint(path: Path) -> FixedPointArtifact:
@@ -340,4 +444,5 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
             variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
             if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
             footholds={k: (v.item() if hasattr(v, "item") else v)
-                       for k, v in f["footholds"].attrs.items()} if "footholds" in f else None)
+                       for k, v in f["footholds"].attrs.items()} if "footholds" in f else None,
+            zero_dynamics=_zero_dynamics(f))

@@ -275,6 +275,14 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
+    if getattr(spec, "virtual_constraints", None) is not None:
+        from walkerlab.walker.kinds import KindRefused
+
+        try:
+            st.kind.require("virtual_constraints", "contact",
+                            "walker.actuation.virtual_constraints")
+        except KindRefused as err:
+            raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     part = contact_part(st)
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "

@@ -27,6 +27,18 @@ from walkerlab.numerics import complex_step_jacobian
 __all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
 
 
+def _functions(data):
+    from walkerlab.codegen.cache import functions
+
+    return functions(data)
+
+
+def spec_of(acts):
+    """The actuation section ``acts`` drives (a virtual-constraint controller's: the scene's
+    ``walker.actuation``)."""
+    return getattr(acts, "vc_spec", acts.spec)
+
+
 def _structure_check(data, spec) -> bool:
     """Refuse what is physically impossible (one line); True for massless legs.  A joint
     the walker does not have is refused by :func:`walkerlab.models.hybrid.actuators.
@@ -121,6 +133,8 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     # a kneed walker's phases: the free flow and the knee-locked one (``flow_locked``)
     if limit or acts.rows is not None:  # the force in the massless limit's rows: Python
         return None
+    if getattr(spec_of(acts), "virtual_constraints", None) is not None:  # computed torque:
+        return None  # the Python flow (the controller's numpy terms)
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None:  # a passive flow run in Python: the guards' outputs from the kind
         guards = _PARTS[data.structure.kind.name].guard_outputs(phase, data)
@@ -160,15 +174,25 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         link that carries no mass, a torque scaling that does not fit the legs, a push-off
         on massless arc-footed legs (one line).
     """
+    if getattr(spec, "virtual_constraints", None) is not None:  # the kind's table
+        data.structure.kind.require("virtual_constraints", "rigid",
+                                    "walker.actuation.virtual_constraints")
     return _PARTS[data.structure.kind.name].actuate(walker, data, spec)
 
 
 def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
     """:func:`actuate` for a kind whose actuators are :class:`Actuators` on its joints
     (``part``: the kind's :class:`_Joints`)."""
-    acts, limit = part.actuators(walker, data, spec)
+    if getattr(spec, "virtual_constraints", None) is not None:  # computed torque (HZD)
+        from walkerlab.models.hybrid.virtual_constraints import VirtualConstraintActuators
+
+        acts, limit = VirtualConstraintActuators(
+            spec, _functions(data), len(walker.roles), float(walker.total_mass_kg),
+            data.structure, data.params), False
+    else:
+        acts, limit = part.actuators(walker, data, spec)
     base_jac = walker.variational
-    has_torque = bool(spec.torques)
+    has_torque = bool(spec.torques) or getattr(spec, "virtual_constraints", None) is not None
 
     def locked(constraint):  # the torque's acceleration, through a phase's lock if any
         if constraint is None:

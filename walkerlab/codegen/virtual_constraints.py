@@ -1,0 +1,216 @@
+"""The symbolic pieces of virtual constraints on a walker's generated model: the outputs'
+``h0(q)``, the phase variable ``theta(q)`` and their first and second derivatives, taken by
+sympy from the SAME derivation as the walker's flow (:func:`walkerlab.codegen.free_joints.
+derive_five_link` or :func:`walkerlab.codegen.symbolic.derive`: its ``leg_angles``, points
+and guards), so the decoupling matrix ``L_g L_f h = (dh/dq) M^-1 B`` and ``L_f^2 h`` of the
+computed-torque law (Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56, Eq. 38)
+are those of the flow the walker integrates.
+
+For ``h0`` (k outputs) and ``theta`` the module returns numpy functions of the state
+``x = (q, dq)`` (complex-safe: numpy's elementary functions), each evaluated at once:
+
+- ``h0``, ``Jh0 = dh0/dq`` (k, n), ``dd0 = sum_jl d2h0/dq_j dq_l dq_j dq_l`` (k,);
+- ``theta``, ``dtheta = dtheta/dq`` (n,), ``ddtheta = dq^T (d2theta/dq2) dq``;
+- the swing foot's height above the ground (the ``swing_clearance`` guard), whether it is
+  ahead of the stance foot (``swing_foot_ahead``) and the hip's horizontal position, of
+  ``q``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+__all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_pieces",
+           "resolve_link"]
+
+
+def derive_equations(structure):
+    """The walker's symbolic equations (:class:`walkerlab.codegen.symbolic.Equations`), as
+    its generated flow derives them (free joints: the five-link generator; else the
+    biped generator)."""
+    if structure.free_knees:
+        from walkerlab.codegen.free_joints import derive_five_link
+
+        return derive_five_link(structure)
+    from walkerlab.codegen import symbolic
+
+    return symbolic.derive(structure)
+
+
+def resolve_link(leg_angles: dict, link: str, where: str):
+    """The ``leg_angles`` expression of an output's ``link`` (:data:`walkerlab.config.
+    actuation.OUTPUT_LINKS`: ``stance_leg`` / ``swing_leg`` are the generated ``stance`` /
+    ``swing``).
+
+    Raises
+    ------
+    ValueError
+        The walker has no such link (one line naming ``where`` and the links it has).
+    """
+    key = {"stance_leg": "stance", "swing_leg": "swing"}.get(link, link)
+    if key not in leg_angles:
+        have = sorted({"stance": "stance_leg", "swing": "swing_leg"}.get(k, k)
+                      for k in leg_angles)
+        raise ValueError(f"{where}: {link} is not a link of this walker (its links: "
+                         f"{', '.join(have)})")
+    return leg_angles[key]
+
+
+def _joint_expr(leg_angles: dict, joint: str, where: str):
+    from walkerlab.walker.joints import joint_links
+
+    first, second = joint_links(leg_angles, joint, where)
+    return leg_angles[second] - leg_angles[first]
+
+
+def _expressions(eq, params, outputs, phase, joints, prefix: str):
+    """The flat lists of sympy expressions of the pieces (module docstring), the
+    parameters substituted: ``(out, foot, B)``.
+
+    Raises
+    ------
+    ValueError
+        A link, joint or coordinate the walker does not have (one line naming the key).
+    """
+    import sympy as sp
+
+    la = eq.leg_angles
+    q, dq = list(eq.q), list(eq.dq)
+    n = len(q)
+    h0 = []
+    for i, (kind, name) in enumerate(outputs):
+        where = f"{prefix}.outputs.{i}.{kind}"
+        h0.append(resolve_link(la, name, where) if kind == "link"
+                  else _joint_expr(la, name, where))
+    if phase.link is not None:
+        th = resolve_link(la, phase.link, f"{prefix}.phase.link")
+    elif phase.point is not None:
+        th = _along(eq, eq.points["hip"])
+    else:
+        roles = [str(v)[2:] for v in q]
+        bad = [k for k in phase.coordinates if k not in roles]
+        if bad:
+            raise ValueError(f"{prefix}.phase.coordinates.{bad[0]}: not a coordinate of "
+                             f"this walker (its coordinates: {', '.join(roles)})")
+        th = sum(c * q[roles.index(k)] for k, c in phase.coordinates.items())
+    joint_exprs = [_joint_expr(la, j, f"{prefix}.joints") for j in joints]
+    sub = dict(zip(eq.params, params))
+
+    def num(e):
+        return sp.sympify(e).subs(sub)
+    h0 = [num(e) for e in h0]
+    th = num(th)
+    J = [[sp.diff(e, v) for v in q] for e in h0]
+    dd = [sum(sp.diff(J[i][j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
+          for i in range(len(h0))]
+    gth = [sp.diff(th, v) for v in q]
+    ddth = sum(sp.diff(gth[j], q[m]) * dq[j] * dq[m] for j in range(n) for m in range(n))
+    B = [num(sp.diff(e, v)) for v in q for e in joint_exprs]
+    foot = [num(eq.guards["swing_clearance"]), num(eq.guards["swing_foot_ahead"]),
+            num(_along(eq, eq.points["hip"]))]
+    out = [*h0, *(e for row in J for e in row), *dd, th, *gth, ddth]
+    return out, foot, B
+
+
+def _along(eq, point):
+    """A point's coordinate along the ground (the slope's tangent), from the stance foot
+    [m]."""
+    import sympy as sp
+
+    gamma = [p for p in eq.params if str(p) == "gamma"]
+    g = gamma[0] if gamma else 0
+    return point[0] * sp.cos(g) - point[1] * sp.sin(g)
+
+
+def generate_pieces(eq, params, outputs, phase, joints, prefix: str, key: str) -> str:
+    """Source of the pieces' module: ``out(x)``, ``foot(x)``, ``B(x)`` (flat lists, numpy
+    code by :func:`sympy.lambdify`, common subexpressions eliminated) and ``K``, ``N``."""
+    import inspect
+
+    import sympy as sp
+
+    out, foot, B = _expressions(eq, params, outputs, phase, joints, prefix)
+    args = [*eq.q, *eq.dq]
+    text = [f"# walkerlab virtual-constraint pieces (walkerlab.codegen.virtual_constraints); "
+            f"key {key}",
+            "# Do not edit: regenerated when the walker, its outputs or the generator change.",
+            "import numpy", "from numpy import *  # noqa: F401,F403 (lambdify's names)", "",
+            f"K, N = {len(outputs)}, {len(eq.q)}", ""]
+    for name, exprs in (("out", out), ("foot", foot), ("B", B)):
+        fn = sp.lambdify(args, exprs, "numpy", cse=True)
+        src = inspect.getsource(fn).replace("def _lambdifygenerated(", f"def _{name}(", 1)
+        text += [src, "", f"def {name}(x):", f"    return _{name}(*x)", ""]
+    return "\n".join(text) + "\n"
+
+
+class OutputPieces:
+    """Numpy functions of the outputs and the phase variable (module docstring), from the
+    generated module (:func:`generate_pieces`, cached on disk as the walker's flow).
+
+    Parameters
+    ----------
+    module : module
+        The generated module.
+    """
+
+    def __init__(self, module):
+        self._mod = module
+        self.k, self.n = module.K, module.N
+
+    def __call__(self, x):
+        """``(h0 (k,), Jh0 (k, n), dd0 (k,), theta, dtheta (n,), ddtheta)`` at the state
+        ``x`` (2n,) (see the module docstring)."""
+        import numpy as np
+
+        v = np.array(self._mod.out(x), dtype=complex if np.iscomplexobj(x) else float)
+        k, n = self.k, self.n
+        a = k + k * n
+        return (v[:k], v[k:a].reshape(k, n), v[a:a + k], v[a + k], v[a + k + 1:a + k + 1 + n],
+                v[-1])
+
+    def foot(self, q):
+        """``(swing foot height [m], swing foot ahead (> 0: ahead of the stance foot; an
+        angle or a distance, as the walker's guard), hip along the ground [m])`` at the
+        configuration ``q`` (n,)."""
+        import numpy as np
+
+        return tuple(float(np.real(v))
+                     for v in self._mod.foot(np.concatenate([q, np.zeros(self.n)])))
+
+    def B(self):
+        """``B`` (n, k): each actuated joint's column ``d(delta)/dq`` (constant)."""
+        import numpy as np
+
+        return np.array(self._mod.B(np.zeros(2 * self.n)), dtype=float).reshape(self.n, self.k)
+
+
+def _source_hash() -> str:
+    from pathlib import Path
+
+    return hashlib.sha256((Path(__file__).parent / "virtual_constraints.py").read_bytes()
+                          ).hexdigest()[:12]
+
+
+def output_pieces(structure, params, outputs, phase, joints, prefix):
+    """:class:`OutputPieces` of ``structure``'s derivation with ``params`` (its module
+    generated on a cache miss, file ``<key>_vc_<hash>.py``, the hash covering the
+    parameters, outputs, phase, joints and this generator's source).
+
+    Raises
+    ------
+    ValueError
+        A link, joint or coordinate the walker does not have (one line naming the key; on
+        a cache miss, from the derivation).
+    """
+    from walkerlab.codegen import cache
+
+    key = cache.cache_key(structure)
+    what = repr((tuple(float(p) for p in params), tuple(outputs), phase.model_dump_json(),
+                 tuple(joints), _source_hash()))
+    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
+
+    def build() -> str:
+        return generate_pieces(derive_equations(structure), params, outputs, phase, joints,
+                               prefix, key)
+    return OutputPieces(cache.import_generated(f"{key}_vc_{tag}.py",
+                                               f"walkerlab_vc_{key}_{tag}", build))
