@@ -102,6 +102,8 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
             vc = yaml.safe_load(fh)["walker"]["actuation"]["virtual_constraints"]
         if kind != "free_joints":
             vc["outputs"] = [{"link": "swing_leg", "bezier_rad": [-0.2, -0.1, 0.0, 0.1, 0.2]}]
+            if kind == "hinged_torso":  # two hips: the swing leg and the torso
+                vc["outputs"].append({"link": "torso", "bezier_rad": [0.1] * 5})
             vc.pop("max_torque_n_m")
         w["actuation"] = {"virtual_constraints": vc}
     elif feature in TERRAIN:

@@ -26,9 +26,12 @@ __all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_pieces
 
 def derive_equations(structure):
     """The walker's symbolic equations (:class:`walkerlab.codegen.symbolic.Equations`), as
-    its generated flow derives them (free joints: the five-link generator; else the
-    biped generator)."""
-    if structure.free_knees:
+    its generated flow derives them (the free-jointed kinds, free knees or a hinged torso:
+    the free-joint generator, :data:`walkerlab.codegen.cache.FREE_JOINTED`; else the biped
+    generator)."""
+    from walkerlab.codegen import cache
+
+    if structure.kind.name in cache.FREE_JOINTED:
         from walkerlab.codegen.free_joints import derive_five_link
 
         return derive_five_link(structure)
