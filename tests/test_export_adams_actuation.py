@@ -6,7 +6,7 @@ evaluator of the functions the writer uses (``AZ``, ``WZ``, ``DX``, ``DY``, ``DM
 ``VY``, ``VM``, ``CONTACT``, ``VARVAL``, ``IF``, ``MIN``, ``MAX``) at sample states, against
 walkerlab's own laws at the same states (:class:`walkerlab.models.actuation.TorqueLaws`, the
 rigid and contact views' evaluation; the contact view's pulse criterion
-:func:`walkerlab.integrate.contact_powered.pulse_lead`).  Tolerances: the dataset writes
+:func:`walkerlab.integrate.powered_events.pulse_lead`).  Tolerances: the dataset writes
 every number as its shortest repr and the reference tables in truncated-power form (the same
 piecewise polynomial, summed in another order), so the torques agree to rounding: 1e-9
 relative to the largest torque term (2e6 N mm/rad x 1 rad).
@@ -39,7 +39,7 @@ from walkerlab.export.adams import (
     part_ids,
 )
 from walkerlab.export.adams_reader import read_adm
-from walkerlab.integrate.contact_powered import pulse_lead
+from walkerlab.integrate.powered_events import pulse_lead
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.multibody import multibody

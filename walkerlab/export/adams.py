@@ -125,7 +125,7 @@ hip -> stance foot line's ``ATAN2``), each saturated by ``MIN``/``MAX``.  The pu
 pulse ``P / T`` at the stance foot along the line to the hip, on while the swing foot is
 above ground, at least :data:`PUSH_MIN_STEP_M` ahead, and its penetration extrapolated ``T``
 ahead at its rate is positive (the contact view's start,
-:func:`walkerlab.integrate.contact_powered.pulse_lead`); it ends at the touchdown (the
+:func:`walkerlab.integrate.powered_events.pulse_lead`); it ends at the touchdown (the
 contact view runs a pulse that straddles the touchdown to its end); on flat feet it pushes at
 the toe and the touchdown is the heel's.  The ankle push-off acts on the stance ankle while
 its heel's normal force is 0 and its toe's positive (the contact view latches heel off and

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contact_powered import ActuationHook, _pulse_event, impulse_jump, pulse_lead_s
+from .contact_powered import ActuationHook, impulse_jump
 from .ends import RunEnd
+from .powered_events import pulse_event, pulse_lead_s
 
 __all__ = ["powered_to_section", "push_off"]
 
@@ -61,7 +62,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
 
     cross = _section_event(section, n)
     y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
-    lead = (_pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
+    lead = (pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
             else None)
     pushed = False  # the pulse of the heel strike to come has run (or is running)
     while t < t_max - 1e-12:

@@ -77,10 +77,10 @@ import numpy as np
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.contact import ContactLimits, run_powered
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
-from walkerlab.integrate.contact_powered import pulse_lead, pulse_lead_s
 from walkerlab.integrate.contact_powered_step import powered_to_section, push_off
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
+from walkerlab.integrate.powered_events import pulse_lead, pulse_lead_s
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
