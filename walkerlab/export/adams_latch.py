@@ -33,6 +33,8 @@ from walkerlab.export.adams_statements import (
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.opensim_xml import latch_foot_offset
 
+__all__ = ["LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK", "knee_latches"]
+
 #: VARIABLE ids of the knee latch (:func:`knee_latches`): the slope's sine and cosine, each
 #: leg's contact height [mm], the latch's engagement and its two factors (foot, knee); on
 #: stairs and footholds the height above the slope line, the position along it and the
@@ -62,7 +64,25 @@ def knee_latches(mb, ids: dict, ks, start: AdamsStart | None = None) -> list[str
     function reference: STEP, IMPACT = max(0, k (x1 - x)^e - STEP(x, x1 - d, cmax, x1, 0)
     x') for x < x1, else 0; SFORCE/ROTATION: the torque on I about J's z).  On stairs and
     footholds (``start.lane_heights``) the height is above the tread of the lane's patch
-    under the foot (:func:`_tread_under`), as the contact model reads it."""
+    under the foot (:func:`_tread_under`), as the contact model reads it.
+
+    Parameters
+    ----------
+    mb : walkerlab.walker.multibody.Multibody
+        The exported walker (kneed).
+    ids : dict
+        Part ids by link name (:func:`walkerlab.export.adams_feet.part_ids`).
+    ks : walkerlab.models.contact.laws.KneeStopSI
+        The knee stop with its latch (``latch_height`` [m], ``latch_capture`` [rad]).
+    start : AdamsStart, optional
+        The dataset's start; its ``lanes``, ``lane_heights`` and ``patch_width_m`` on
+        stairs and footholds.
+
+    Returns
+    -------
+    list of str
+        The dataset's lines (comments, VARIABLEs, SFORCEs).
+    """
     V = LATCH_VARIABLES
     arc = mb.foot == "arc" and mb.foot_radius_m > 0
     lift = latch_foot_offset(_foot_sphere_m(mb), 0.0 if arc else point_foot_radius(mb)) * MM

@@ -14,11 +14,26 @@ from walkerlab.export.text import nums
 if TYPE_CHECKING:
     from walkerlab.walker.multibody import Multibody
 
+__all__ = ["ground_geoms", "profile_asset"]
+
 
 def ground_geoms(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     """The ground's ``worldbody`` geoms: a plane (lowered by the ground offset with a scene),
     each lane's patches (boxes, footholds a riser lower or higher), stairs' tread boxes or a
-    profile's height field (its asset: :func:`profile_asset`)."""
+    profile's height field (its asset: :func:`profile_asset`).
+
+    Parameters
+    ----------
+    mb : walkerlab.walker.multibody.Multibody
+        The exported walker (its slope, leg length).
+    extra : MjcfScene or None
+        The scene's ground (None: the walker alone, on the slope plane).
+
+    Returns
+    -------
+    list of str
+        The ``geom`` lines, indented for ``worldbody``.
+    """
     phi = mb.slope_rad
     if extra is None:
         return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
