@@ -49,7 +49,7 @@ from walkerlab.api.checks import (
     short,
     simulate_options,
 )
-from walkerlab.api.walks import STEP_FIELDS, ContactWalk, Gait, Step, Walk
+from walkerlab.api.walks import STEP_FIELDS, ContactWalk, Gait, Step, Walk, sampled_walk
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
@@ -461,12 +461,8 @@ class Walker:
             A step used up ``step_time_limit_s`` of CPU time (a fall is recorded in
             ``termination``, not raised).
         """
-        import numpy as np
-
-        from walkerlab.analysis.gait.energy import trajectory_ledger
-        from walkerlab.analysis.gait.metrics import step_table
         from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene
-        from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
+        from walkerlab.config import SceneError
         from walkerlab.config.options import with_terrain_seed
 
         strides, rate = simulate_options(strides, sample_rate_hz)
@@ -487,23 +483,7 @@ class Walker:
             raise
         except ValueError as exc:  # a ground this walk does not read (one line, its key)
             raise SceneError(str(exc)) from None
-        counts = [max(2, int(np.ceil((seg.t_end - seg.t_start) * rate)) + 1)
-                  for seg in traj.segments]
-        if sum(counts) > MAX_SIMULATE_SAMPLES:
-            span = traj.segments[-1].t_end - traj.segments[0].t_start
-            raise SceneError(f"simulate: sample_rate_hz={rate:g} Hz over {span:.3g} s gives "
-                             f"{sum(counts):,} samples; at most {MAX_SIMULATE_SAMPLES:,} are "
-                             "kept (lower sample_rate_hz or strides)")
-        ts, xs, legs, events = [], [], [], []
-        for seg, n in zip(traj.segments, counts):
-            t = np.linspace(seg.t_start, seg.t_end, n)
-            ts.append(t)
-            xs.append(seg.sample(t).T)
-            legs.append(np.full(n, seg.stance_leg))
-            events += [(seg.index, seg.stance_leg, *entry) for entry in seg.phase_log]
-        hs = np.array([s.t_end for s in traj.segments if s.termination == "heel_strike"])
-        return Walk(np.concatenate(ts), np.concatenate(xs), np.concatenate(legs), hs, events,
-                    traj.termination, step_table(traj), trajectory_ledger(traj))
+        return sampled_walk(traj, rate)
 
     def __repr__(self) -> str:
         return (f"Walker({self.scene.name!r}, states={self.state_names()}, "

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
-__all__ = ["STEP_FIELDS", "ContactWalk", "Gait", "Step", "Walk"]
+__all__ = ["STEP_FIELDS", "ContactWalk", "Gait", "Step", "Walk", "sampled_walk"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,40 @@ class Walk:
         """Cost of transport of each step [-] (``ledger["cost_of_transport"]``)."""
         return self.ledger["cost_of_transport"]
 
+
+def sampled_walk(traj, rate: float) -> Walk:
+    """The :class:`Walk` of a rigid trajectory (:meth:`walkerlab.api.walker.Walker.simulate`):
+    each step sampled on its own time grid at ``rate`` [Hz] (at least its two ends), its heel
+    strikes, phases, step table and energy ledger.
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        More samples than :data:`~walkerlab.config.MAX_SIMULATE_SAMPLES` (one line).
+    """
+    import numpy as np
+
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.analysis.gait.metrics import step_table
+    from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
+
+    counts = [max(2, int(np.ceil((seg.t_end - seg.t_start) * rate)) + 1)
+              for seg in traj.segments]
+    if sum(counts) > MAX_SIMULATE_SAMPLES:
+        span = traj.segments[-1].t_end - traj.segments[0].t_start
+        raise SceneError(f"simulate: sample_rate_hz={rate:g} Hz over {span:.3g} s gives "
+                         f"{sum(counts):,} samples; at most {MAX_SIMULATE_SAMPLES:,} are "
+                         "kept (lower sample_rate_hz or strides)")
+    ts, xs, legs, events = [], [], [], []
+    for seg, n in zip(traj.segments, counts):
+        t = np.linspace(seg.t_start, seg.t_end, n)
+        ts.append(t)
+        xs.append(seg.sample(t).T)
+        legs.append(np.full(n, seg.stance_leg))
+        events += [(seg.index, seg.stance_leg, *entry) for entry in seg.phase_log]
+    hs = np.array([s.t_end for s in traj.segments if s.termination == "heel_strike"])
+    return Walk(np.concatenate(ts), np.concatenate(xs), np.concatenate(legs), hs, events,
+                traj.termination, step_table(traj), trajectory_ledger(traj))
 
 
 @dataclass(frozen=True)

@@ -246,6 +246,22 @@ def powered_loop(model) -> PoweredLoop:
     return PoweredLoop(model)
 
 
+def _at_gait_keyframe(xml_path, doing: str):
+    """``(mujoco, model, data)``: the MJCF at ``xml_path`` loaded and reset to its ``gait``
+    keyframe (:func:`walk` and :func:`roll`; their ``ValueError`` without one, their
+    ``MissingExtra`` without MuJoCo, ``doing`` naming the use in its line)."""
+    from walkerlab.extras import require
+
+    mujoco = require("mujoco", "engines", doing)
+    model = mujoco.MjModel.from_xml_path(str(xml_path))
+    data = mujoco.MjData(model)
+    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "gait")
+    if key < 0:
+        raise ValueError(f"{xml_path}: no 'gait' keyframe")
+    mujoco.mj_resetDataKeyframe(model, data, key)
+    return mujoco, model, data
+
+
 def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s].
 
@@ -260,15 +276,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     walkerlab.extras.MissingExtra
         MuJoCo is not installed (one line naming the ``engines`` extra).
     """
-    from walkerlab.extras import require
-
-    mujoco = require("mujoco", "engines", "walking an exported MJCF in MuJoCo")
-    model = mujoco.MjModel.from_xml_path(str(xml_path))
-    data = mujoco.MjData(model)
-    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "gait")
-    if key < 0:
-        raise ValueError(f"{xml_path}: no 'gait' keyframe")
-    mujoco.mj_resetDataKeyframe(model, data, key)
+    mujoco, model, data = _at_gait_keyframe(xml_path, "walking an exported MJCF in MuJoCo")
     phi = _numeric(model, "slope_rad", 0.0)
     off = _numeric(model, "foot_height_offset_m", 0.0)
     h_rel = _numeric(model, "latch_release_height_m")
@@ -337,15 +345,7 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
     walkerlab.extras.MissingExtra
         MuJoCo is not installed (one line naming the ``engines`` extra).
     """
-    from walkerlab.extras import require
-
-    mujoco = require("mujoco", "engines", "rolling an exported MJCF in MuJoCo")
-    model = mujoco.MjModel.from_xml_path(str(xml_path))
-    data = mujoco.MjData(model)
-    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "gait")
-    if key < 0:
-        raise ValueError(f"{xml_path}: no 'gait' keyframe")
-    mujoco.mj_resetDataKeyframe(model, data, key)
+    mujoco, model, data = _at_gait_keyframe(xml_path, "rolling an exported MJCF in MuJoCo")
     tips = {}
     while (g := mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM,
                                   f"spoke{len(tips)}_tip")) >= 0:

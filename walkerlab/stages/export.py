@@ -56,16 +56,14 @@ from walkerlab.export.opensim import (
     osim_omissions,
     osim_text,
 )
-from walkerlab.export.scene import (
-    FORMAT_VIEWS,
-    check_exportable,
+from walkerlab.export.scene import FORMAT_VIEWS, check_exportable, mjcf_scene
+from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS
+from walkerlab.export.text import comment
+from walkerlab.export.wheel_scene import (
     check_wheel_exportable,
-    mjcf_scene,
     wheel_keyframe,
     wheel_keyframe_json,
 )
-from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS
-from walkerlab.export.text import comment
 from walkerlab.io import runpaths
 from walkerlab.units import for_scene
 from walkerlab.walker.description import walker_data
@@ -176,7 +174,7 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     ``wheel_mjcf_text``): the rigid gait as the MJCF's ``gait`` keyframe (the URDF's
     sidecar), the scene's static friction coefficient on the spoke tips; other formats and
     grounds refused in one line as the capability table has it
-    (:func:`walkerlab.export.scene.check_wheel_exportable`)."""
+    (:func:`walkerlab.export.wheel_scene.check_wheel_exportable`)."""
     kind = data.structure.kind
     check_wheel_exportable(scene, kind, fmt, walker_only)
     check_exportable(scene, kind, fmt, walker_only)

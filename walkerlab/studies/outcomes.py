@@ -41,6 +41,13 @@ OUTCOMES = ("ok", "no_fixed_point", *RUN_END_OUTCOMES, "bounce", "max_steps",
 # column name -> (unit, description); all stored as float64 (NaN = not applicable).
 # Columns that depend on the walker's state (fixed point, initial state, multipliers) are
 # added by :func:`columns` from ``walker.state_names()``; these are the walker-free ones.
+# shared by the stages' tables: how a walk ended (simulate, contact-sim), the cost (all)
+_RUN_END = {
+    "t_end_s": ("s", "time at which the run ended"),
+    "fall_time_s": ("s", "time of the fall (NaN if none)"),
+}
+_NFEV = {"nfev": ("-", "right-hand-side evaluations")}
+
 _FP = {
     "step_period_s": ("s", "step period of the period-1 gait"),
     "residual": ("rad or rad/s", "max |P(x) - x| at the last iterate"),
@@ -49,27 +56,25 @@ _FP = {
     "map_evaluations": ("-", "Poincare-map calls of the root finder"),
     "variational_maps": ("-", "maps with the variational equations (Jacobians asked by the "
                          "root finder + the one for the multipliers)"),
-    "nfev": ("-", "right-hand-side evaluations"),
+    **_NFEV,
 }
 
 _SIM = {
     "steps_completed": ("-", "heel strikes before the run ended"),
-    "t_end_s": ("s", "time at which the run ended"),
-    "fall_time_s": ("s", "time of the fall (NaN if none)"),
+    **_RUN_END,
     "mean_step_period_s": ("s", "mean period of the completed steps"),
     "mean_step_length_m": ("m", "mean step length (foot to foot at heel strike)"),
     "mean_hip_speed_m_per_s": ("m/s", "mean step length / mean step period"),
     "interleg_angle_last_rad": ("rad", "inter-leg angle at the last heel strike"),
     "scuff_depth_m": ("m", "largest depth of the swing foot below the slope before heel "
                            "strike (the ideal model ignores it)"),
-    "nfev": ("-", "right-hand-side evaluations"),
+    **_NFEV,
 }
 
 _CONTACT = {
     "heel_strikes": ("-", "heel strikes detected"),
     "steps_expected": ("-", "2 * contact_sim.n_strides"),
-    "t_end_s": ("s", "time at which the run ended"),
-    "fall_time_s": ("s", "time of the fall (NaN if none)"),
+    **_RUN_END,
     "mean_step_period_s": ("s", "mean period of the complete steps"),
     "max_slip_mm": ("mm", "largest along-slope slide of a stance foot over a stance phase "
                     "(touchdown to lift-off; phases that do not end are left out)"),
@@ -82,7 +87,7 @@ _CONTACT = {
     "ideal_step_length_m": ("m", "step length of the ideal gait (checkerboard spacing)"),
     "ideal_step_period_s": ("s", "step period of the ideal gait"),
     "integration_wall_time_s": ("s", "wall time of the contact integration alone"),
-    "nfev": ("-", "right-hand-side evaluations"),
+    **_NFEV,
 }
 
 COLUMNS: dict[str, dict[str, tuple[str, str]]] = {

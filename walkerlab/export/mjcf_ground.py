@@ -1,0 +1,120 @@
+"""The MJCF ground of an exported scene (:mod:`walkerlab.export.multibody`): the slope plane,
+the lanes' patches, stairs' tread boxes, a profile's height field."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from walkerlab.export.mjcf_scene import LANE_BITS, MjcfScene
+from walkerlab.export.text import nums
+
+if TYPE_CHECKING:
+    from walkerlab.walker.multibody import Multibody
+
+__all__ = ["ground_geoms", "profile_asset"]
+
+
+def ground_geoms(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    """The ground's ``worldbody`` geoms: a plane (lowered by the ground offset with a scene),
+    each lane's patches (boxes, footholds a riser lower or higher), stairs' tread boxes or a
+    profile's height field (its asset: :func:`profile_asset`).
+
+    Parameters
+    ----------
+    mb : walkerlab.walker.multibody.Multibody
+        The exported walker (its slope, leg length).
+    extra : MjcfScene or None
+        The scene's ground (None: the walker alone, on the slope plane).
+
+    Returns
+    -------
+    list of str
+        The ``geom`` lines, indented for ``worldbody``.
+    """
+    phi = mb.slope_rad
+    if extra is None:
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
+                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
+    n = (math.sin(phi), math.cos(phi))  # slope normal in (x, z)
+    t = (math.cos(phi), -math.sin(phi))  # downhill along the slope
+    off = extra.ground_offset_m
+    if extra.treads is not None:  # stairs: a box per tread, its top the tread
+        return _tread_boxes(mb, extra)
+    if extra.profile is not None:  # a height profile: a height field (asset: profile_asset)
+        return _profile_geom(mb, extra)
+    if extra.lanes is None:
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}" '
+                f'pos="{nums(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
+                'rgba="0.8 0.8 0.8 1"/>']
+    half, depth = (extra.patch_width_m + extra.patch_ahead_m) / 2, extra.patch_width_m / 10
+    out = []
+    for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
+        heights = None if extra.lane_heights is None else extra.lane_heights[
+            0 if leg == "leg1" else 1]
+        for i, s in enumerate(centres):
+            s = s + extra.patch_ahead_m / 2  # from footfall - w/2 to footfall + w/2 + ahead
+            d = off + depth  # box centre below the surface
+            if heights is not None:  # a foothold a riser below (above) the last
+                d = d - heights[i]
+            size = nums(half, 0.04 * mb.leg_length_m, depth)
+            pos = nums(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
+            out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{size}" pos="{pos}"'
+                       f' euler="{nums(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
+                       ' rgba="0.8 0.8 0.8 1"/>')
+    return out
+
+
+def _profile_grid(mb: Multibody, extra: MjcfScene) -> tuple:
+    """The profile's height field: ``(x_lo, x_hi, z_lo, z_hi, heights)``, the polyline
+    (:attr:`MjcfScene.profile`, lowered by the ground offset) sampled every
+    :data:`PROFILE_DX_M` over the leg-length-padded span of its vertices; a flat profile
+    gets a 1 mm elevation range (MuJoCo needs one)."""
+    from walkerlab.export.mjcf_scene import PROFILE_DX_M
+
+    line = np.asarray(extra.profile, dtype=float)
+    pad = 2 * mb.leg_length_m
+    inner = line[1:-1] if len(line) > 3 else line
+    x_lo, x_hi = float(inner[0, 0]) - pad, float(inner[-1, 0]) + pad
+    n = int(math.ceil((x_hi - x_lo) / PROFILE_DX_M)) + 1
+    x = np.linspace(x_lo, x_hi, n)
+    z = np.interp(x, line[:, 0], line[:, 1]) - extra.ground_offset_m
+    z_lo, z_hi = float(z.min()), float(z.max())
+    if z_hi - z_lo < 1e-3:
+        z_hi = z_lo + 1e-3
+    return x_lo, x_hi, z_lo, z_hi, (z - z_lo) / (z_hi - z_lo)
+
+
+def profile_asset(mb: Multibody, extra: MjcfScene) -> list[str]:
+    """The ``hfield`` asset of a profile (two equal rows across the walker's plane)."""
+    x_lo, x_hi, z_lo, z_hi, e = _profile_grid(mb, extra)
+    elev = " ".join(f"{v:.6g}" for v in np.concatenate([e, e]))
+    size = nums((x_hi - x_lo) / 2, 0.2 * mb.leg_length_m, z_hi - z_lo, mb.leg_length_m)
+    return ["  <asset>", f'    <hfield name="profile" nrow="2" ncol="{e.size}" size="{size}" '
+            f'elevation="{elev}"/>', "  </asset>"]
+
+
+def _profile_geom(mb: Multibody, extra: MjcfScene) -> list[str]:
+    """The profile's height-field geom (both lanes' contact bits)."""
+    x_lo, x_hi, z_lo, _, _ = _profile_grid(mb, extra)
+    return [f'    <geom name="ground" type="hfield" hfield="profile" '
+            f'pos="{nums((x_lo + x_hi) / 2, 0, z_lo)}" contype="6" conaffinity="0" '
+            'rgba="0.8 0.8 0.8 1"/>']
+
+
+def _tread_boxes(mb: Multibody, extra: MjcfScene) -> list[str]:
+    """Continuous stairs: one box per tread (``extra.treads``), its top the tread at the
+    ground offset below it, reaching a leg length below the lowest tread (so each riser is
+    a box face a toe can hit), both lanes' contact bits."""
+    off = extra.ground_offset_m
+    floor = min(h for _, _, h in extra.treads) - off - mb.leg_length_m
+    out = []
+    for i, (a, b, h) in enumerate(extra.treads):
+        top = h - off
+        size = nums((b - a) / 2, 0.1 * mb.leg_length_m, (top - floor) / 2)
+        pos = nums((a + b) / 2, 0, (top + floor) / 2)
+        out.append(f'    <geom name="tread{i}" type="box" size="{size}" pos="{pos}" '
+                   'contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>')
+    return out
