@@ -46,6 +46,7 @@ noted (the machine may be shared: compare code trees side by side, in alternatin
 """
 from __future__ import annotations
 
+import importlib
 import json
 import tempfile
 import time
@@ -55,6 +56,10 @@ import numpy as np
 
 from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
+
+#: benchmark -> the module whose ``lines(result)`` prints it (the others: their JSON)
+_LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.optimize",
+          "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd"}
 
 BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job", "optimize",
               "powered", "hzd")
@@ -146,25 +151,8 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
         atomic_write(out / f"{name}.json", lambda fh, text=text: fh.write(text))
         if name == "contact" and scenes:
             lines += [B.scene_line(r) for r in res["result"]["scenes"]]
-        if name == "main-job":
-            from walkerlab.bench.main_job import lines as main_job_lines
-
-            lines += main_job_lines(res["result"])
-            continue
-        if name == "optimize":
-            from walkerlab.bench.optimize import lines as optimize_lines
-
-            lines += optimize_lines(res["result"])
-            continue
-        if name == "powered":
-            from walkerlab.bench.powered_contact import lines as powered_lines
-
-            lines += powered_lines(res["result"])
-            continue
-        if name == "hzd":
-            from walkerlab.bench.hzd import lines as hzd_lines
-
-            lines += hzd_lines(res["result"])
+        if name in _LINES:  # the benchmark's own printable lines
+            lines += importlib.import_module(_LINES[name]).lines(res["result"])
             continue
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines

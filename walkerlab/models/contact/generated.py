@@ -272,14 +272,17 @@ def _knee_torque(ext, rate, PC, delta):
 
 
 @njit(cache=True)
+def _buffers():
+    """The arrays :func:`_force` fills: M (NQ, NQ), the points' P, V (NF, 2), J (NF, 2, NQ),
+    their info (NF, 12) and the knees' (2, 5)."""
+    return (np.empty((NQ, NQ)), np.empty((NF, 2)), np.empty((NF, 2)), np.empty((NF, 2, NQ)),
+            np.zeros((NF, 12)), np.zeros((2, 5)))
+
+
+@njit(cache=True)
 def jac(x, PC, p, c1, c2):
     """Analytic d rhs / dx (NX, NX); patch membership locally constant."""
-    M = np.empty((NQ, NQ))
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, NQ))
-    info = np.zeros((NF, 12))
-    knees = np.zeros((2, 5))
+    M, P, V, J, info, knees = _buffers()
     Q = _force(x, PC, p, c1, c2, True, True, M, P, V, J, info, knees)
     L = _chol(M)
     a = _chol_solve(L, Q.reshape((NQ, 1)))[:, 0]
@@ -368,12 +371,7 @@ def rhs_pinned(z, PC, p, c1, c2, foot2):
     """Reduced dynamics with leg2's foot pinned: ``q = Phi(z)``, ``dq = Jp dz``,
     ``qdd = Jp zdd + gam``; ``Jp^T M Jp zdd = Jp^T (Q - h - M gam)`` (leg1 keeps its contact)."""
     x = pinned_to_full(z, p, foot2)
-    M = np.empty((NQ, NQ))
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, NQ))
-    info = np.zeros((NF, 12))
-    knees = np.zeros((2, 5))
+    M, P, V, J, info, knees = _buffers()
     Q = _force(x, PC, p, c1, c2, True, False, M, P, V, J, info, knees)
     dV = np.empty((NF, 2, NQ))
     dJtF = np.empty((NQ, NQ))
@@ -510,18 +508,7 @@ def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy,
         p_tau = tau * (x[n + sw] - x[n + st])
     p_po = 0.0
     if push_leg >= 0:
-        P = np.empty((NF, 2))
-        V = np.empty((NF, 2))
-        J = np.empty((NF, 2, n))
-        feet(x, p, P, V, J)
-        rr = np.empty(2)
-        rr[0] = x[hx] - P[push_leg, 0]
-        rr[1] = x[hy] - P[push_leg, 1]
-        e = rr / np.sqrt(np.dot(rr, rr))
-        F = force * e
-        Jt = np.ascontiguousarray(J[push_leg].T)
-        Qp = np.dot(Jt, F)
-        p_po = np.dot(F, V[push_leg].copy())
+        Qp, p_po = push_force(x, p, push_leg, force, hx, hy)
         Q = Q + Qp
     moved = False
     for i in range(n):
@@ -540,6 +527,23 @@ def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy,
     out[NX + 1] = 0.0 if 0.0 < p_tau else p_tau
     out[NX + 2] = p_po
     out[NX + 3] = p_contact
+
+
+@njit(cache=True, error_model='numpy')
+def push_force(x, p, push_leg, force, hx, hy):
+    """The generalised force (NQ,) of a force ``force`` [N] at contact point ``push_leg``
+    along the line from it to the hip (coordinates ``hx``, ``hy``), and its power [W]."""
+    P = np.empty((NF, 2))
+    V = np.empty((NF, 2))
+    J = np.empty((NF, 2, NQ))
+    feet(x, p, P, V, J)
+    rr = np.empty(2)
+    rr[0] = x[hx] - P[push_leg, 0]
+    rr[1] = x[hy] - P[push_leg, 1]
+    e = rr / np.sqrt(np.dot(rr, rr))
+    F = force * e
+    Jt = np.ascontiguousarray(J[push_leg].T)
+    return np.dot(Jt, F), np.dot(F, V[push_leg].copy())
 
 
 def build_cyrk():

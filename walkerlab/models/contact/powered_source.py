@@ -110,20 +110,7 @@ def _phase(x, A, p, st):
 def _pulse(x, A, p, S):
     """The push-off pulse's force into ``S[:NQ]`` and its power into ``S[NQ + 4]``."""
     n = NQ
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, n))
-    feet(x, p, P, V, J)
-    r = int(A[5])
-    ex = x[int(A[7])] - P[r, 0]
-    ey = x[int(A[8])] - P[r, 1]
-    nr = np.sqrt(ex * ex + ey * ey)
-    Fx = A[6] * ex / nr
-    Fy = A[6] * ey / nr
-    Qp = np.empty(n)
-    for i in range(n):
-        Qp[i] = J[r, 0, i] * Fx + J[r, 1, i] * Fy
-    pp = Fx * V[r, 0] + Fy * V[r, 1]
+    Qp, pp = push_force(x, p, int(A[5]), A[6], int(A[7]), int(A[8]))
     if A[15] > 0.5:  # a flat foot's ankle holds through the pulse
         a = np.zeros(n)
         a[int(A[16])] = 1.0
