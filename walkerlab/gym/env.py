@@ -90,33 +90,34 @@ def _gait(walker):
 
 
 
-def _check_rigid_ground(scene) -> None:
-    """The rigid view steps one hybrid walker: a ground whose steps differ (a profile,
-    footholds of several heights or slopes, per-step random ground) is refused in one line
-    (``walkerlab simulate`` walks them step by step; the contact view has a profile as
-    geometry, and refuses footholds that differ, so their line names no other view)."""
-    from walkerlab.models.ground import foothold_steps
+def _rigid_ground(scene):
+    """The rigid view's ground beyond its walker's own (:func:`walkerlab.integrate.rigid.
+    walker_of_step`: a slope, stairs, footholds of one or several heights or slopes, as
+    ``walkerlab simulate`` steps them): a height profile's steps
+    (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`), else None.
 
+    Raises
+    ------
+    ValueError
+        A per-step random ground (``terrain.per_step``), or a profile the rigid walk does
+        not read (one line).
+    """
     t = scene.terrain
     if t is None:
-        return
-    if t.kind == "profile":
-        what = "terrain.kind: profile"
-    elif getattr(t, "per_step", None) is not None:
-        what = "terrain.per_step"
-    elif t.kind == "footholds" and foothold_steps(t, scene.slope.phi_rad) is not None:
-        from walkerlab.walker.kinds import GYM_FOOTHOLDS
+        return None
+    if getattr(t, "per_step", None) is not None:
+        raise ValueError("walkerlab.gym: terrain.per_step: the rigid view walks the scene's "
+                         "own ground, not one drawn per step (walkerlab simulate "
+                         "--terrain-seed); use view='contact' with terrain_roughness_m")
+    if t.kind != "profile":
+        return None
+    from walkerlab.analysis.gait.rigid_run import profile_ground
 
-        # neither view takes them (the contact view lays its patches at one spacing as the
-        # walk goes; contact-sim lays them at the rigid period-n gait's footfalls)
-        key = "foothold_slopes_rad" if t.foothold_slopes_rad is not None else \
-            "foothold_heights_m"
-        raise ValueError(f"walkerlab.gym: terrain.{key}: {GYM_FOOTHOLDS}")
-    else:
-        return
-    raise ValueError(f"walkerlab.gym: {what}: the rigid view steps one walker on a ground "
-                     "whose every step is alike (slope, stairs, footholds of one height); "
-                     "use view='contact'")
+    try:
+        return profile_ground(scene)
+    except ValueError as exc:
+        raise ValueError(f"walkerlab.gym: {exc}") from None
+
 
 class InvalidAction(ValueError, gym.error.InvalidAction):
     """An action that is not the environment's ``k`` finite real torques of shape ``(k,)``
@@ -225,8 +226,7 @@ class WalkerEnv(gym.Env):
         if sc.walker.actuation is not None and sc.walker.actuation.virtual_constraints:
             data.structure.kind.require("virtual_constraints", "gym",
                                         "walker.actuation.virtual_constraints")
-        if view == "rigid":
-            _check_rigid_ground(sc)
+        ground = _rigid_ground(sc) if view == "rigid" else None
         self.scene, self.view = sc, view
         self.dt = float(control_period_s)
         self.max_episode_steps = max_episode_steps
@@ -241,7 +241,7 @@ class WalkerEnv(gym.Env):
         self.joints = action_joints(sc)
         self.gait = _gait(self.rigid)
         self.sim = RigidView(model, self.rigid.solver, data, self.joints,
-                             self.rigid.max_step_time)
+                             self.rigid.max_step_time, ground)
         if view == "contact":
             from walkerlab.models.contact.scene import contact_setup
 
