@@ -108,7 +108,7 @@ def _rigid_ground(scene):
     if getattr(t, "per_step", None) is not None:
         raise ValueError("walkerlab.gym: terrain.per_step: the rigid view walks the scene's "
                          "own ground, not one drawn per step (walkerlab simulate "
-                         "--terrain-seed); use view='contact' with terrain_roughness_m")
+                         "--terrain-seed draws it); leave terrain.per_step out")
     if t.kind != "profile":
         return None
     from walkerlab.analysis.gait.rigid_run import profile_ground

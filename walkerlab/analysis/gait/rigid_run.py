@@ -236,10 +236,10 @@ def profile_ground(scene):
     """
     from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points
     from walkerlab.models.registry import passive_walker_at
+    from walkerlab.walker.kinds import PROFILE_PASSIVE
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
-        raise ValueError("terrain.kind: profile: walked by the passive walker of the "
-                         "generated model only (no walker.actuation, ideal.variant: derived)")
+        raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
     P = profile_points(scene.terrain)
     at, data_at = passive_walker_at(scene)
     return ProfileGround(at, data_at, P)
