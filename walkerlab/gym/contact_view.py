@@ -20,6 +20,14 @@ on the floating coordinates (absolute link angles, the same convention as the ri
 view's); their positive and negative work, the scene's torques' and the push-off's are the
 run's work integrals.
 
+Footholds (``terrain.kind: footholds`` on checkerboard lanes): the patches are laid at the
+rigid gait's footfalls (of several heights: the period-n gait's, as ``contact-sim`` lays
+them, :func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`) and, once the episode
+has made a period of steps and one more, at its own footfalls as it goes (each heel strike:
+:func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes` of the heel strikes so far,
+the footfalls ahead advancing by the last step of their step of the cycle), as
+``contact-sim`` lays them again where its walker's footfalls drift off the rigid ones.
+
 Seeded terrain: with ``terrain_roughness_m > 0`` each patch is raised or lowered by a height
 drawn uniformly from ``[-r, r]`` by the episode's terrain seed (rough ground as geometry,
 :attr:`~walkerlab.models.contact.model.ContactWalker.heights1`), all but the starting stance

@@ -38,8 +38,18 @@ Terminated on a fall (a fall guard of the rigid model; in the contact view the h
 ``contact_sim.fall_hip_height_m``), a stall (no heel strike within
 ``fixedpoint.max_step_time_s``), a launch (contact view: the hip thrown above
 :data:`walkerlab.gym.contact_view.LAUNCH_HIP_FACTOR` leg lengths, a foot having met a raised
-patch's side), a trip (contact view: a foot found at a patch's side where the solver stopped)
-or a solver failure; truncated after ``max_episode_steps`` control periods.
+patch's side), a trip (contact view: a foot found at a patch's side where the solver stopped),
+the ground's end (rigid view: a finite foothold list walked, a landing past a profile's
+last point, as ``walkerlab simulate`` ends there) or a solver failure; truncated after
+``max_episode_steps`` control periods.
+
+Ground: the scene's, as the commands step it.  The rigid view steps each step's walker of
+a ground whose steps differ as ``walkerlab simulate`` does (footholds of several heights or
+slopes: :func:`walkerlab.integrate.rigid.walker_of_step`; a height profile: the walker
+landing on the segment under its foot, :class:`walkerlab.analysis.gait.profile_walk.
+ProfileGround`, a step landing off the segment it was walked on walked again from its
+start on the other with its periods' actions); the contact view lays the patches as
+``walkerlab contact-sim`` does (:mod:`walkerlab.gym.contact_view`).
 ``step`` and ``render`` before the first ``reset`` raise gymnasium's ``ResetNeeded`` (as
 ``gym.make``'s order enforcing does); an action that is not ``k`` finite real numbers of shape
 ``(k,)`` (None, NaN, inf, complex, another shape) raises :class:`InvalidAction` (a
@@ -48,7 +58,7 @@ or a solver failure; truncated after ``max_episode_steps`` control periods.
 ``info``: ``time_s``, ``heel_strike`` (bool), ``heel_strike_time_s`` (the exact event time
 of the last heel strike inside the control period, else None), ``heel_strike_times_s`` (all
 of them), ``steps`` (heel strikes so far), ``stance_leg``, ``hip_x_m``, ``termination``
-(``""``, ``fall``, ``stall``, ``launch``, ``trip``, ``solver_failure``),
+(``""``, ``fall``, ``stall``, ``launch``, ``trip``, ``ground_end``, ``solver_failure``),
 ``solver_message`` (the solver's words on a ``trip`` or ``solver_failure`` in the contact
 view, else ``""``), ``terrain_seed`` and
 the energy ledger's

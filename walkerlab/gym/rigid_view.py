@@ -11,6 +11,16 @@ end from the event's state.  So the heel strike's time is the event's own, locat
 integrator inside the period (not rounded to the control grid), and with a zero action the
 walk is the scene's own walk (the period boundaries only restart the integrator).
 
+The ground is stepped as ``walkerlab simulate`` steps it
+(:func:`walkerlab.analysis.gait.rigid_run.walk_scene`): each step's walker is
+:func:`walkerlab.integrate.rigid.walker_of_step`'s (footholds of several heights or slopes:
+the step's landing in the walker's cycle), or on a height profile the walker landing on the
+segment under the swing foot (:class:`walkerlab.analysis.gait.profile_walk.ProfileGround`);
+a heel strike off that segment walks the step again from its start on the segment the
+foot landed on, each of its control periods with the action it had (the step's start and
+periods are kept), so the landing is the one ``simulate`` finds.  A finite foothold list
+or a landing past the profile's end ends the episode (``ground_end``).
+
 The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
 ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
 
@@ -53,6 +63,9 @@ class RigidView:
         The action's joints (:func:`walkerlab.gym.action.action_joints`).
     max_step_time : float
         A step longer than this [s] ends the episode (the walker stalled).
+    ground : walkerlab.analysis.gait.profile_walk.ProfileGround, optional
+        A height profile's steps (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`);
+        None: the model's own ground (slope, stairs, footholds).
 
     Raises
     ------
@@ -170,7 +183,7 @@ class RigidView:
         list of float
             The heel-strike times inside the period [s] (the events' own times).
             :attr:`ended` is set when the episode ended inside it (``fall``, ``stall``,
-            ``solver_failure``).
+            ``ground_end``, ``solver_failure``).
         """
         self._period = (np.asarray(u, dtype=float), float(t_end))
         self._log.append(self._period)
