@@ -221,6 +221,21 @@ def test_the_rigid_view_walks_footholds_and_a_profile_as_simulate_does(name, per
         assert np.ptp(T) > 0.01  # [s]: 0.0189 measured
 
 
+def test_a_finite_foothold_list_ends_the_rigid_episode_where_simulate_ends():
+    """configs/footholds_two.yaml with ``periodic: false``: simulate walks the list's 2 steps
+    and stops; the episode ends there too, terminated as ``ground_end`` (not a fall)."""
+    import yaml
+
+    from walkerlab.gym.env import WalkerEnv
+
+    d = yaml.safe_load((ROOT / "configs" / "footholds_two.yaml").read_text())
+    d["terrain"]["periodic"] = False
+    env = WalkerEnv(d, max_episode_steps=400)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "ground_end" and strikes.size == info["steps"] == 2
+    np.testing.assert_allclose(np.diff(strikes, prepend=0.0), [0.6918, 0.7317], atol=1e-4)
+
+
 def test_the_rigid_view_refuses_a_ground_drawn_per_step_and_an_actuated_profile():
     """A per-step random ground is simulate's draw (--terrain-seed): the rigid view says so
     in one line; a profile with an actuated walker, as simulate, in one line."""
