@@ -168,15 +168,16 @@ _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
 #: why the Adams and OpenSim views refuse footholds that differ from step to step
 #: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
 SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model, the "
-                     "contact model and the MJCF export (walkerlab fixedpoint, simulate, "
-                     "contact-sim, report, export --format mjcf): give footholds of one "
-                     "height for this view")
+                     "contact model, the MJCF export and the Gymnasium environment "
+                     "(walkerlab fixedpoint, simulate, contact-sim, report, export --format "
+                     "mjcf, walkerlab.gym): give footholds of one height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
 FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (walkerlab "
-                   "fixedpoint, simulate): the contact model and the exports lay every patch "
-                   "parallel to the scene's slope; give foothold_heights_m alone for this view")
+                   "fixedpoint, simulate, the gym's rigid view): the contact model and the "
+                   "exports lay every patch parallel to the scene's slope; give "
+                   "foothold_heights_m alone for this view")
 #: why the rigid walk on a height profile (walkerlab simulate, the gym's rigid view) takes
 #: a passive walker only (:func:`walkerlab.analysis.gait.rigid_run.profile_ground` says it,
 #: after ``terrain.kind: profile: ``)
