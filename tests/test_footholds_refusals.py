@@ -18,7 +18,6 @@ from cli_run import ROOT, run_cli
 from walkerlab.config import scene_from_dict
 from walkerlab.walker.kinds import (
     FOOTHOLD_SLOPES,
-    GYM_FOOTHOLDS,
     KINDS,
     SEVERAL_FOOTHOLDS,
 )
@@ -150,10 +149,14 @@ def test_a_contact_walker_laid_on_new_lanes_drops_the_old_patch_heights():
     assert np.array_equal(again.heights1[:n], walker.heights1[:n])
 
 
-def test_the_gym_names_no_view_that_refuses_the_same_footholds():
-    from walkerlab.gym.env import _check_rigid_ground
+def test_the_gym_takes_the_same_footholds():
+    """The gym's views walk footholds of several heights (tests/test_gym.py: as simulate and
+    contact-sim do): the table's cell is supported and the rigid view's ground check passes
+    (before: one line, "the gym's views step one walker on a ground whose every step is
+    alike")."""
+    from walkerlab.gym.env import _rigid_ground
 
-    with pytest.raises(ValueError) as err:
-        _check_rigid_ground(scene_from_dict(TWO))
-    assert str(err.value) == ("walkerlab.gym: terrain.foothold_heights_m: " + GYM_FOOTHOLDS)
-    assert "view='contact'" not in str(err.value)
+    assert _rigid_ground(scene_from_dict(TWO)) is None  # the walker's own per-step cycle
+    for kind in ("straight_legs", "locking_knees"):
+        assert KINDS[kind].supports("footholds", "gym")
+        assert KINDS[kind].supports("profile", "gym")

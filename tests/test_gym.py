@@ -181,16 +181,95 @@ def test_the_contact_view_keeps_the_scenes_stairs():
         assert np.all(np.abs(d) <= 0.002) and np.any(d != 0)
 
 
-def test_the_rigid_view_refuses_a_ground_whose_steps_differ():
-    """A profile (or per-step ground): the rigid view steps one walker, so it says so in one
-    line (before: it walked the scene's slope under a profile); the contact view, which has
-    the profile as geometry, takes it."""
-    with pytest.raises(ValueError, match=r"^walkerlab\.gym: terrain\.kind: profile: .*"
-                       r"use view='contact'$"):
-        _env("profile")
-    env = _env("profile", view="contact", max_episode_steps=70)
+def _stage_heel_strikes(stage, name, tmp_path):
+    """The heel-strike times [s] of ``walkerlab simulate`` / ``contact-sim`` of a shipped
+    scene (its artifact: the step table's ends, the contact run's events)."""
+    import h5py
+
+    from walkerlab.config import load_scene
+    from walkerlab.stages import pipeline
+
+    path = pipeline.run(stage, load_scene(ROOT / "configs" / f"{name}.yaml"), tmp_path).path
+    with h5py.File(path, "r") as f:
+        if stage == "simulate":
+            ok = f["steps/termination"][:].astype(str) == "heel_strike"
+            return f["steps/t_end"][:][ok]
+        return f["events/heel_strike_times"][:]
+
+
+@pytest.mark.parametrize("name,periods,differ", [("footholds_two", 740, 0.0398),
+                                                 ("profile", 560, 0.0)])
+def test_the_rigid_view_walks_footholds_and_a_profile_as_simulate_does(name, periods,
+                                                                        differ, tmp_path):
+    """configs/footholds_two.yaml (two heights in turn: a period-2 gait, steps of 0.6918 and
+    0.7317 s) and configs/profile.yaml (an undulating ramp: step periods 0.530-0.558 s) in
+    the rigid view under a zero action: each of `walkerlab simulate`'s 10 heel strikes at
+    the same time to 1e-9 s (the same integrator; the gym restarts it at each control
+    period's bound, measured 1.8e-12 s); on the profile a step is walked again on the
+    segment its foot lands on (before: both scenes refused in one line)."""
+    ref = _stage_heel_strikes("simulate", name, tmp_path)
+    assert ref.size == 10
+    env = _env(name, max_episode_steps=periods)
     strikes, info = _zero_walk(env)
-    assert info["termination"] == "" and len(strikes) >= 1
+    assert info["termination"] == "" and strikes.size == ref.size, (strikes, info)
+    np.testing.assert_allclose(strikes, ref, rtol=0.0, atol=1e-9)
+    T = np.diff(strikes, prepend=0.0)
+    if differ:  # the period-2 gait: its two steps' periods in turn (the scene's comment)
+        np.testing.assert_allclose(T[0::2], 0.6918, atol=1e-4)
+        np.testing.assert_allclose(T[1::2], 0.7317, atol=1e-4)
+    else:  # the undulation moves the periods by up to 3.5 % (on the ramp alone: constant)
+        assert np.ptp(T) > 0.01  # [s]: 0.0189 measured
+
+
+def test_a_finite_foothold_list_ends_the_rigid_episode_where_simulate_ends():
+    """configs/footholds_two.yaml with ``periodic: false``: simulate walks the list's 2 steps
+    and stops; the episode ends there too, terminated as ``ground_end`` (not a fall)."""
+    import yaml
+
+    from walkerlab.gym.env import WalkerEnv
+
+    d = yaml.safe_load((ROOT / "configs" / "footholds_two.yaml").read_text())
+    d["terrain"]["periodic"] = False
+    env = WalkerEnv(d, max_episode_steps=400)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "ground_end" and strikes.size == info["steps"] == 2
+    np.testing.assert_allclose(np.diff(strikes, prepend=0.0), [0.6918, 0.7317], atol=1e-4)
+
+
+def test_the_rigid_view_refuses_a_ground_drawn_per_step_and_an_actuated_profile():
+    """A per-step random ground is simulate's draw (--terrain-seed): the rigid view says so
+    in one line; a profile with an actuated walker, as simulate, in one line."""
+    import yaml
+
+    from walkerlab.gym.env import WalkerEnv
+
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    d["terrain"] = {"kind": "slope", "per_step": {"slope_sd_rad": 0.001}}
+    with pytest.raises(ValueError, match=r"^walkerlab\.gym: terrain\.per_step: [^\n]*$"):
+        WalkerEnv(d)
+    d = yaml.safe_load((ROOT / "configs" / "profile.yaml").read_text())
+    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.05}}
+    with pytest.raises(ValueError, match=r"^walkerlab\.gym: terrain\.kind: profile: "
+                       r"walked by the passive walker"):
+        WalkerEnv(d)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,periods", [("footholds_two", 880), ("profile", 560)])
+def test_the_contact_view_walks_footholds_and_a_profile_as_contact_sim_does(name, periods,
+                                                                           tmp_path):
+    """configs/footholds_two.yaml (patches at the rigid period-2 gait's footfalls, then at
+    the walker's own: before, the episode tripped at a patch's side after 6 heel strikes)
+    and configs/profile.yaml (the profile as the contact model's polyline ground) in the
+    contact view under a zero action: every step period of `walkerlab contact-sim`'s heel
+    strikes (12 and 10) within 2 % (measured: 6e-5 s and 2.3e-4 s apart)."""
+    ref = _stage_heel_strikes("contact-sim", name, tmp_path)
+    assert ref.size >= 10
+    env = _env(name, view="contact", max_episode_steps=periods)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "" and strikes.size >= ref.size, (strikes, info)
+    got, want = np.diff(strikes[:ref.size], prepend=0.0), np.diff(ref, prepend=0.0)
+    np.testing.assert_allclose(got, want, rtol=0.02)
 
 
 def _one_line_error(exc_info, *words):

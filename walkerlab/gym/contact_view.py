@@ -20,6 +20,14 @@ on the floating coordinates (absolute link angles, the same convention as the ri
 view's); their positive and negative work, the scene's torques' and the push-off's are the
 run's work integrals.
 
+Footholds (``terrain.kind: footholds`` on checkerboard lanes): the patches are laid at the
+rigid gait's footfalls (of several heights: the period-n gait's, as ``contact-sim`` lays
+them, :func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`) and, once the episode
+has made a period of steps and one more, at its own footfalls as it goes (each heel strike:
+:func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes` of the heel strikes so far,
+the footfalls ahead advancing by the last step of their step of the cycle), as
+``contact-sim`` lays them again where its walker's footfalls drift off the rigid ones.
+
 Seeded terrain: with ``terrain_roughness_m > 0`` each patch is raised or lowered by a height
 drawn uniformly from ``[-r, r]`` by the episode's terrain seed (rough ground as geometry,
 :attr:`~walkerlab.models.contact.model.ContactWalker.heights1`), all but the starting stance
@@ -107,6 +115,7 @@ class ContactView:
         self._setup, self._x_gait = setup, np.asarray(x_gait, float)
         self._first_layout = max(1, min(int(n_steps), LAYOUT_STEPS))
         self._roughness, self._seed = 0.0, 0
+        self._track = None  # footholds: the episode's footfalls (:class:`_Footfalls`)
         self.x_start, self.limits, self.step_length = self._lay_out(self._first_layout)
         names = tuple(self.walker.coordinate_names())
         self.nq = len(names)
@@ -129,6 +138,23 @@ class ContactView:
         walker, x0, limits, step_length = scene_start(self._setup, self._x_gait,
                                                       n_steps // 2 + 1)
         self._laid = n_steps
+        self._at_rigid = walker  # the patches at the rigid gait's footfalls
+        self._use(self._own_footfalls(walker))
+        return x0, limits, step_length
+
+    def _own_footfalls(self, walker):
+        """Footholds: ``walker`` with its patches at the episode's own footfalls so far, as
+        ``contact-sim`` lays them (:func:`walkerlab.analysis.contact.footfalls.
+        own_footfall_lanes`; ``walker`` itself until enough heel strikes are known)."""
+        from walkerlab.analysis.contact.footfalls import own_footfall_lanes
+
+        if self._track is None:
+            return walker
+        moved = own_footfall_lanes(walker, self._track, self._track.period)
+        return walker if moved is None else moved
+
+    def _use(self, walker) -> None:
+        """Lay the episode's ground on ``walker``'s patches (its roughness added)."""
         self._lanes = (walker.lane1.copy(), walker.lane2.copy())
         # the scene's own patch heights (stairs, footholds; None on the slope): roughness adds
         self._heights = (walker.heights1, walker.heights2)
@@ -141,7 +167,6 @@ class ContactView:
             ground.append(float(np.max(w.ground_line[:, 0] * np.sin(w.phi)
                                        + w.ground_line[:, 1] * np.cos(w.phi))))
         self._launch_height = LAUNCH_HIP_FACTOR * float(w.L) + max(ground)
-        return x0, limits, step_length
 
     def _roughen(self) -> None:
         w, base, r = self._scene_walker, self._heights, self._roughness
@@ -162,6 +187,7 @@ class ContactView:
         ground as it is), the starting stance foot's patch (leg2's first) left as the scene
         has it; the patches laid out afresh for :data:`LAYOUT_STEPS` steps."""
         self._roughness, self._seed = float(roughness_m), int(seed)
+        self._track = None
         self._lay_out(self._first_layout)
 
     def reset(self, x0: np.ndarray | None = None) -> None:
@@ -171,7 +197,12 @@ class ContactView:
         self.failure = ""
         self.ledger = dict.fromkeys(CONTACT_LEDGER_TERMS, 0.0)
         self.steps = 0
+        if self._track is not None:  # the last episode's footfalls: the rigid gait's again
+            self._track = None
+            self._use(self._at_rigid)
         self._start(np.array(self.x_start if x0 is None else x0, dtype=float), 0.0)
+        if self._setup.patches_follow_feet:
+            self._track = _Footfalls(self._setup, self.walker, self.x)
 
     def _start(self, x, t: float, keep=None) -> None:
         """The run's hook on the present walker from ``(t, x)``; ``keep``: the stance leg,
@@ -253,11 +284,17 @@ class ContactView:
         self.steps += len(strikes)
         if h.t < t_end - 1e-12 or h.term is not RunEnd.T_FINAL:
             self._ended(h)
+        follow = bool(strikes) and self._track is not None and self._track.add(
+            self.walker, h, strikes)
         h.forget()
-        if not self.ended and self.steps + 4 >= self._laid:  # lay out more patches
+        more = self.steps + 4 >= self._laid
+        if not self.ended and (more or follow):  # lay out more patches, or move them
             keep = (h.stance, h.t_origin, h.ankle_on, h.step_s, h.y[n:].copy())
             x, t = self.x, self.t
-            self._lay_out(2 * self._laid)
+            if more:
+                self._lay_out(2 * self._laid)
+            else:
+                self._use(self._own_footfalls(self._at_rigid))
             self._start(x, t, keep)
         return strikes
 
@@ -272,3 +309,48 @@ class ContactView:
             self.ended, self.failure = "trip", str(h.msg)
         else:
             self.ended, self.failure = "solver_failure", str(h.msg)
+
+
+class _Footfalls:
+    """The episode's heel strikes on footholds and the feet's along-slope places at them
+    [s, m], read as :func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes` reads a
+    ``contact-sim`` run (its samples' ``t``, ``feet[leg].s``, heel-strike times and legs):
+    each place interpolated between the run's samples at the heel strike, as there."""
+
+    def __init__(self, setup, walker, x0: np.ndarray, t0: float = 0.0):
+        from walkerlab.models.contact.terrain import ground_drops
+
+        self.period = len(ground_drops(setup.terrain))
+        q = walker.foot_quantities(np.asarray(x0, float)[None])
+        self._t = [float(t0)]
+        self._s = {leg: [float(q[leg]["s"][0])] for leg in ("leg1", "leg2")}
+        self.heel_strike_times: list[float] = []
+        self.heel_strike_legs: list[str] = []
+
+    @property
+    def t(self) -> np.ndarray:
+        return np.asarray(self._t)
+
+    @property
+    def feet(self) -> dict:
+        return {leg: _Trace(np.asarray(s)) for leg, s in self._s.items()}
+
+    def add(self, walker, hook, strikes) -> bool:
+        """Record ``strikes`` [s] from the run's kept samples (``hook.ts``, ``hook.Ys``);
+        True when the patches are to follow the feet (enough heel strikes known)."""
+        T = np.concatenate(hook.ts)
+        q = walker.foot_quantities(np.vstack(hook.Ys)[:, :2 * walker.nq])
+        for th in strikes:
+            self._t.append(float(th))
+            for leg in self._s:
+                self._s[leg].append(float(np.interp(th, T, q[leg]["s"])))
+            # the legs alternate, leg2 in stance first
+            self.heel_strike_legs.append("leg1" if len(self.heel_strike_legs) % 2 == 0
+                                         else "leg2")
+            self.heel_strike_times.append(float(th))
+        return len(self.heel_strike_legs) >= self.period + 1
+
+
+@dataclasses.dataclass
+class _Trace:
+    s: np.ndarray

@@ -38,8 +38,18 @@ Terminated on a fall (a fall guard of the rigid model; in the contact view the h
 ``contact_sim.fall_hip_height_m``), a stall (no heel strike within
 ``fixedpoint.max_step_time_s``), a launch (contact view: the hip thrown above
 :data:`walkerlab.gym.contact_view.LAUNCH_HIP_FACTOR` leg lengths, a foot having met a raised
-patch's side), a trip (contact view: a foot found at a patch's side where the solver stopped)
-or a solver failure; truncated after ``max_episode_steps`` control periods.
+patch's side), a trip (contact view: a foot found at a patch's side where the solver stopped),
+the ground's end (rigid view: a finite foothold list walked, a landing past a profile's
+last point, as ``walkerlab simulate`` ends there) or a solver failure; truncated after
+``max_episode_steps`` control periods.
+
+Ground: the scene's, as the commands step it.  The rigid view steps each step's walker of
+a ground whose steps differ as ``walkerlab simulate`` does (footholds of several heights or
+slopes: :func:`walkerlab.integrate.rigid.walker_of_step`; a height profile: the walker
+landing on the segment under its foot, :class:`walkerlab.analysis.gait.profile_walk.
+ProfileGround`, a step landing off the segment it was walked on walked again from its
+start on the other with its periods' actions); the contact view lays the patches as
+``walkerlab contact-sim`` does (:mod:`walkerlab.gym.contact_view`).
 ``step`` and ``render`` before the first ``reset`` raise gymnasium's ``ResetNeeded`` (as
 ``gym.make``'s order enforcing does); an action that is not ``k`` finite real numbers of shape
 ``(k,)`` (None, NaN, inf, complex, another shape) raises :class:`InvalidAction` (a
@@ -48,7 +58,7 @@ or a solver failure; truncated after ``max_episode_steps`` control periods.
 ``info``: ``time_s``, ``heel_strike`` (bool), ``heel_strike_time_s`` (the exact event time
 of the last heel strike inside the control period, else None), ``heel_strike_times_s`` (all
 of them), ``steps`` (heel strikes so far), ``stance_leg``, ``hip_x_m``, ``termination``
-(``""``, ``fall``, ``stall``, ``launch``, ``trip``, ``solver_failure``),
+(``""``, ``fall``, ``stall``, ``launch``, ``trip``, ``ground_end``, ``solver_failure``),
 ``solver_message`` (the solver's words on a ``trip`` or ``solver_failure`` in the contact
 view, else ``""``), ``terrain_seed`` and
 the energy ledger's
@@ -90,33 +100,34 @@ def _gait(walker):
 
 
 
-def _check_rigid_ground(scene) -> None:
-    """The rigid view steps one hybrid walker: a ground whose steps differ (a profile,
-    footholds of several heights or slopes, per-step random ground) is refused in one line
-    (``walkerlab simulate`` walks them step by step; the contact view has a profile as
-    geometry, and refuses footholds that differ, so their line names no other view)."""
-    from walkerlab.models.ground import foothold_steps
+def _rigid_ground(scene):
+    """The rigid view's ground beyond its walker's own (:func:`walkerlab.integrate.rigid.
+    walker_of_step`: a slope, stairs, footholds of one or several heights or slopes, as
+    ``walkerlab simulate`` steps them): a height profile's steps
+    (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`), else None.
 
+    Raises
+    ------
+    ValueError
+        A per-step random ground (``terrain.per_step``), or a profile the rigid walk does
+        not read (one line).
+    """
     t = scene.terrain
     if t is None:
-        return
-    if t.kind == "profile":
-        what = "terrain.kind: profile"
-    elif getattr(t, "per_step", None) is not None:
-        what = "terrain.per_step"
-    elif t.kind == "footholds" and foothold_steps(t, scene.slope.phi_rad) is not None:
-        from walkerlab.walker.kinds import GYM_FOOTHOLDS
+        return None
+    if getattr(t, "per_step", None) is not None:
+        raise ValueError("walkerlab.gym: terrain.per_step: the rigid view walks the scene's "
+                         "own ground, not one drawn per step (walkerlab simulate "
+                         "--terrain-seed draws it); leave terrain.per_step out")
+    if t.kind != "profile":
+        return None
+    from walkerlab.analysis.gait.rigid_run import profile_ground
 
-        # neither view takes them (the contact view lays its patches at one spacing as the
-        # walk goes; contact-sim lays them at the rigid period-n gait's footfalls)
-        key = "foothold_slopes_rad" if t.foothold_slopes_rad is not None else \
-            "foothold_heights_m"
-        raise ValueError(f"walkerlab.gym: terrain.{key}: {GYM_FOOTHOLDS}")
-    else:
-        return
-    raise ValueError(f"walkerlab.gym: {what}: the rigid view steps one walker on a ground "
-                     "whose every step is alike (slope, stairs, footholds of one height); "
-                     "use view='contact'")
+    try:
+        return profile_ground(scene)
+    except ValueError as exc:
+        raise ValueError(f"walkerlab.gym: {exc}") from None
+
 
 class InvalidAction(ValueError, gym.error.InvalidAction):
     """An action that is not the environment's ``k`` finite real torques of shape ``(k,)``
@@ -225,8 +236,7 @@ class WalkerEnv(gym.Env):
         if sc.walker.actuation is not None and sc.walker.actuation.virtual_constraints:
             data.structure.kind.require("virtual_constraints", "gym",
                                         "walker.actuation.virtual_constraints")
-        if view == "rigid":
-            _check_rigid_ground(sc)
+        ground = _rigid_ground(sc) if view == "rigid" else None
         self.scene, self.view = sc, view
         self.dt = float(control_period_s)
         self.max_episode_steps = max_episode_steps
@@ -241,7 +251,7 @@ class WalkerEnv(gym.Env):
         self.joints = action_joints(sc)
         self.gait = _gait(self.rigid)
         self.sim = RigidView(model, self.rigid.solver, data, self.joints,
-                             self.rigid.max_step_time)
+                             self.rigid.max_step_time, ground)
         if view == "contact":
             from walkerlab.models.contact.scene import contact_setup
 

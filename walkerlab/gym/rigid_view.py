@@ -11,6 +11,16 @@ end from the event's state.  So the heel strike's time is the event's own, locat
 integrator inside the period (not rounded to the control grid), and with a zero action the
 walk is the scene's own walk (the period boundaries only restart the integrator).
 
+The ground is stepped as ``walkerlab simulate`` steps it
+(:func:`walkerlab.analysis.gait.rigid_run.walk_scene`): each step's walker is
+:func:`walkerlab.integrate.rigid.walker_of_step`'s (footholds of several heights or slopes:
+the step's landing in the walker's cycle), or on a height profile the walker landing on the
+segment under the swing foot (:class:`walkerlab.analysis.gait.profile_walk.ProfileGround`);
+a heel strike off that segment walks the step again from its start on the segment the
+foot landed on, each of its control periods with the action it had (the step's start and
+periods are kept), so the landing is the one ``simulate`` finds.  A finite foothold list
+or a landing past the profile's end ends the episode (``ground_end``).
+
 The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
 ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
 
@@ -25,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.integrate.rigid import MIN_STEP_TIME_S
+from walkerlab.integrate.rigid import MIN_STEP_TIME_S, walker_of_step
 from walkerlab.integrate.rigid_phase import integrate_phase
 
 from .action import action_torques
@@ -53,6 +63,9 @@ class RigidView:
         The action's joints (:func:`walkerlab.gym.action.action_joints`).
     max_step_time : float
         A step longer than this [s] ends the episode (the walker stalled).
+    ground : walkerlab.analysis.gait.profile_walk.ProfileGround, optional
+        A height profile's steps (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`);
+        None: the model's own ground (slope, stairs, footholds).
 
     Raises
     ------
@@ -60,17 +73,21 @@ class RigidView:
         A walker the action cannot drive (:func:`walkerlab.gym.action.action_torques`).
     """
 
-    def __init__(self, model, solver, data, joints, max_step_time: float):
+    def __init__(self, model, solver, data, joints, max_step_time: float, ground=None):
         self.model = model
+        self.ground = ground
         self.solver = solver
         backend = solver.resolved_backend()
         # the compiled flows carry the scene's laws only: the action needs the Python flow
         self.backend = "cyrk" if backend == "cyrk_compiled" else backend
         n = model.n_coordinates
         self.n = n
-        self.acts = {id(model): action_torques(data, n, joints)}
-        if model.mirror is not None:
-            self.acts[id(model.mirror)] = action_torques(data.mirror, n, joints)
+        # the action's actuators of each stance leg (legs that differ: the leg's own
+        # numbers, as its step's walker; a profile's walkers are all the first leg's)
+        own = action_torques(data, n, joints)
+        self.acts = {leg: own for leg in model.legs}
+        if model.mirror is not None and ground is None:
+            self.acts[model.legs[0]] = action_torques(data.mirror, n, joints)
         self.max_step_time = float(max_step_time)
         self.state_names = list(model.state_names())
 
@@ -80,15 +97,36 @@ class RigidView:
         self.t = 0.0
         self.t_step = 0.0
         self.leg = self.model.legs[-1]
-        self.walker = self.model.for_stance(self.leg)
         self.x = np.array(x0, dtype=float)
-        self.foot = np.zeros(2)
+        self.foot = np.zeros(2) if self.ground is None else self.ground.start.copy()
+        self.advance_x = 0.0  # the last step's advance along x [m] (a profile's segment)
         self.ended = ""
         self.ledger = dict.fromkeys(LEDGER_TERMS, 0.0)
         self.steps = 0
+        self._period = (np.zeros(0), 0.0)
         self._begin_step()
 
     def _begin_step(self) -> None:
+        """The step's walker (:func:`walkerlab.integrate.rigid.walker_of_step`, or on a
+        profile the walker landing on the segment it is first tried on), entered; the
+        step's start kept (a profile's step is walked again from it on another segment)."""
+        self._choose_walker()
+        self._start_step()
+
+    def _choose_walker(self) -> None:
+        if self.ground is None:
+            self.walker = walker_of_step(self.model, self.steps, self.leg)
+        else:
+            self.j = self.ground.first_segment(self.foot, self.advance_x)
+            self.tried: set = set()
+            self.walker = self.ground.walker(self.j, self.foot)
+
+    def _start_step(self) -> None:
+        self._step_start = (self.t, self.x.copy(), dict(self.ledger))
+        self._log = [self._period]  # the control periods of this step
+        self._enter()
+
+    def _enter(self) -> None:
         w = self.walker
         if w.actuators is not None:
             w.actuators.begin_step(self.t)
@@ -145,13 +183,44 @@ class RigidView:
         list of float
             The heel-strike times inside the period [s] (the events' own times).
             :attr:`ended` is set when the episode ended inside it (``fall``, ``stall``,
-            ``solver_failure``).
+            ``ground_end``, ``solver_failure``).
         """
+        self._period = (np.asarray(u, dtype=float), float(t_end))
+        self._log.append(self._period)
+        return self._run(u, t_end)
+
+    def _again(self, j: int) -> list[float]:
+        """Walk the present step again from its start on a profile's segment ``j`` (the
+        last heel strike landed off the segment it was walked on), its control periods'
+        actions as they were, up to the present period's start; returns the heel-strike
+        times met on the way [s]."""
+        period, log = self._period, self._log  # log[0]: the period the step began in
+        self.t, x, ledger = self._step_start
+        self.x, self.ledger = x.copy(), dict(ledger)
+        self.j, self.walker = j, self.ground.walker(j, self.foot)
+        self._log = [log[0]]
+        self._enter()
+        strikes: list[float] = []
+        if len(log) == 1:  # the step began in the present period: it goes on from there
+            return strikes
+        for i, (u, t_end) in enumerate(log[:-1]):
+            if self.ended:
+                break
+            if i == 0:  # from the step's start to the end of the period it began in
+                self._period = log[0]
+                strikes += self._run(u, t_end)
+            else:
+                strikes += self.advance(u, t_end)
+        self._period = period
+        self._log.append(period)
+        return strikes
+
+    def _run(self, u: np.ndarray, t_end: float) -> list[float]:
         strikes: list[float] = []
         n = self.n
         while self.t < t_end and not self.ended:
             w = self.walker
-            acts = self.acts[id(w)]
+            acts = self.acts[self.leg]
             acts.u = np.asarray(u, dtype=float)
             act_on = bool(np.any(acts.u))
             phase = w.phases[self.k]
@@ -189,8 +258,19 @@ class RigidView:
             elif self.t - self.t_step <= MIN_STEP_TIME_S:
                 self.ended = "stall"  # a heel strike at the step's start: no step
             else:
+                if self.ground is not None:  # a profile: the step's landing segment
+                    land = self.foot[0] + float(w.points(self.x)["swing_foot"][0])
+                    j2 = self.ground.retry(self.j, land, self.tried)
+                    if j2 is not None:
+                        strikes += self._again(j2)
+                        continue
+                    on = self.ground.goes_on(self.j, land)
                 self._heel_strike(guard)
                 strikes.append(self.t)
+                ends = self.model.ground_steps
+                if (self.ground is not None and not on) or (
+                        ends is not None and self.steps >= ends):
+                    self.ended = "ground_end"  # the walk left the ground's end
         return strikes
 
     def _heel_strike(self, guard) -> None:
@@ -207,13 +287,15 @@ class RigidView:
             push = float(tr["ke_push_off"] - tr["ke_minus"])
         else:
             x_plus = w.reset(x_minus)
-        self.foot = self.foot + np.asarray(w.points(x_minus)["swing_foot"], float)
+        step = np.asarray(w.points(x_minus)["swing_foot"], float)
+        self.foot = self.foot + step
+        self.advance_x = float(step[0])
         self.leg = [g for g in self.model.legs if g != self.leg][0]
-        self.walker = self.model.for_stance(self.leg)
         self.x = np.asarray(x_plus, float)
+        self.steps += 1
+        self._choose_walker()  # the next step's
         ke_plus = float(np.real(self.walker.energies(self.x)[0]))
         self.ledger["push_off_work"] += push
         self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
         self.t_step = self.t
-        self.steps += 1
-        self._begin_step()
+        self._start_step()

@@ -384,6 +384,16 @@ def other_leg(walker: HybridWalker, leg: str) -> str:
     return b if leg == a else a
 
 
+def walker_of_step(walker: HybridWalker, k: int, stance_leg: str) -> HybridWalker:
+    """The walker of step ``k`` (0 the first) with ``stance_leg`` in stance: on a ground that
+    differs from step to step, step ``k mod p`` of its :attr:`~HybridWalker.cycle`
+    (:func:`walkerlab.models.hybrid.ground.on_footholds`); else the stance leg's own
+    (:meth:`~HybridWalker.for_stance`: legs that differ)."""
+    if walker.cycle is not None:  # a ground that differs from step to step
+        return walker.cycle[k % len(walker.cycle)]
+    return walker.for_stance(stance_leg)  # legs that differ: each leg's own numbers
+
+
 def simulate_steps(walker: HybridWalker, x0: np.ndarray, n_steps: int, solver: Solver,
                    max_step_time: float = 5.0, first_stance_leg: str = "leg2") -> HybridTrajectory:
     """Simulate ``n_steps`` steps from ``x0``; stops early on fall or solver failure.
@@ -413,10 +423,7 @@ def simulate_steps(walker: HybridWalker, x0: np.ndarray, n_steps: int, solver: S
     for k in range(n_steps):
         if walker.ground_steps is not None and k >= walker.ground_steps:
             break  # a finite ground (a foothold list that does not repeat): it ends here
-        if walker.cycle is not None:  # a ground that differs from step to step
-            step_walker = walker.cycle[k % len(walker.cycle)]
-        else:
-            step_walker = walker.for_stance(leg)  # legs that differ: each leg's own numbers
+        step_walker = walker_of_step(walker, k, leg)
         seg = integrate_step(step_walker, x, solver, t0=t, max_step_time=max_step_time,
                              index=k, stance_leg=leg, stance_foot_world=foot.copy())
         segs.append(seg)

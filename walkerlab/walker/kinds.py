@@ -168,22 +168,21 @@ _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
 #: why the Adams and OpenSim views refuse footholds that differ from step to step
 #: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
 SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model, the "
-                     "contact model and the MJCF export (walkerlab fixedpoint, simulate, "
-                     "contact-sim, report, export --format mjcf): give footholds of one "
-                     "height for this view")
+                     "contact model, the MJCF export and the Gymnasium environment "
+                     "(walkerlab fixedpoint, simulate, contact-sim, report, export --format "
+                     "mjcf, walkerlab.gym): give footholds of one height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
 FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (walkerlab "
-                   "fixedpoint, simulate): the contact model and the exports lay every patch "
-                   "parallel to the scene's slope; give foothold_heights_m alone for this view")
-_GYM_GROUND = ("the rigid view steps one walker on a ground whose every step is alike "
-               "(slope, stairs, footholds of one height); use view='contact'")
-#: why neither gym view takes footholds that differ from step to step (each view steps
-#: one walker on a ground whose every step is alike)
-GYM_FOOTHOLDS = ("the gym's views step one walker on a ground whose every step is alike "
-                 "(slope, stairs, footholds of one height); footholds that differ from step "
-                 "to step run in walkerlab fixedpoint, simulate and contact-sim")
+                   "fixedpoint, simulate, the gym's rigid view): the contact model and the "
+                   "exports lay every patch parallel to the scene's slope; give "
+                   "foothold_heights_m alone for this view")
+#: why the rigid walk on a height profile (walkerlab simulate, the gym's rigid view) takes
+#: a passive walker only (:func:`walkerlab.analysis.gait.rigid_run.profile_ground` says it,
+#: after ``terrain.kind: profile: ``)
+PROFILE_PASSIVE = ("walked by the passive walker of the generated model only (no "
+                   "walker.actuation, ideal.variant: derived)")
 _OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                  "half-spaces, not a polyline; --format mjcf writes it as a height field)")
 _ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
@@ -201,12 +200,11 @@ _VC_RIGID = ("the virtual-constraint controller runs on the rigid model only so 
 _VC_VIEWS = {("virtual_constraints", v): _VC_RIGID
              for v in ("contact", "mjcf", "adams", "osim", "gym", "optimize")}
 #: what the views of every legged kind refuse: grounds whose steps differ in the Adams
-#: dataset and the OpenSim model (the contact model and the MJCF lay their patches at the
-#: rigid period-n gait's footfalls), a profile there and in the gym
+#: dataset and the OpenSim model (the contact model, the MJCF and the gym's contact view
+#: lay their patches at the rigid period-n gait's footfalls; the gym's rigid view steps
+#: them as simulate does), a profile there
 _GROUNDS = {
     **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
-    ("footholds", "gym"): GYM_FOOTHOLDS,
-    ("profile", "gym"): _GYM_GROUND,
     ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,
 }
@@ -261,7 +259,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         # the exports refuse any walker's footholds that differ before its feet
         **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
         ("profile", "adams"): _ADAMS_PROFILE,
-        ("profile", "gym"): _GYM_GROUND,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "
@@ -276,7 +273,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         # the shipped five-link biped walks by its joint torques (a passive one would build);
         # the MJCF's patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf")},
+                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
+        ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
         ("knee_torque", "*"): _NO_KNEE,
@@ -290,7 +288,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         # a walker held up by its joint torques (a passive one would build); the MJCF's
         # patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf")},
+                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
+        ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",

@@ -27,7 +27,7 @@ import numpy as np
 
 from walkerlab.integrate.rigid import HybridTrajectory, integrate_step, other_leg
 
-__all__ = ["profile_points", "simulate_on_profile"]
+__all__ = ["ProfileGround", "profile_points", "simulate_on_profile"]
 
 #: tries of one step's landing segment before the walk is ended as a solver failure
 _SEGMENT_TRIES = 8
@@ -59,6 +59,67 @@ def _line(P: np.ndarray, j: int) -> tuple[float, float]:
     return -math.atan(dydx), dydx
 
 
+class ProfileGround:
+    """The steps of a walk on the profile ``P`` (module docstring): each step's walker on
+    its landing segment and the choice of that segment, shared by
+    :func:`simulate_on_profile` and the Gymnasium environment's rigid view
+    (:mod:`walkerlab.gym.rigid_view`).
+
+    Parameters
+    ----------
+    walker_at : callable ``slope [rad] -> HybridWalker``
+        The scene's rigid walker on a slope (absolute coordinates).
+    data_at : callable ``slope [rad] -> WalkerData``
+    P : ndarray (k, 2)
+        Profile points [m], x increasing (:func:`profile_points`).
+    """
+
+    def __init__(self, walker_at, data_at, P: np.ndarray):
+        self.walker_at, self.data_at, self.P = walker_at, data_at, P
+        self._walkers: dict[tuple, object] = {}
+        #: the walker on the first segment's slope (the walk's legs, its trajectory's)
+        self.base = walker_at(_line(P, 0)[0])
+        #: the first stance foot's world place [m]
+        self.start = np.array([P[0, 0], P[0, 1]])
+
+    def walker(self, j: int, foot: np.ndarray):
+        """The walker of a step from the stance foot ``foot`` (2,) [m] landing on segment
+        ``j`` (:func:`walkerlab.models.hybrid.ground.on_landing`, built once per landing)."""
+        from walkerlab.models.hybrid.ground import on_landing
+
+        P = self.P
+        g, dydx = _line(P, j)
+        drop = float(foot[1] - (P[j, 1] + (foot[0] - P[j, 0]) * dydx))
+        key = (g, drop)
+        if key not in self._walkers:
+            self._walkers[key] = on_landing(self.walker_at(g), self.data_at(g), drop)
+        return self._walkers[key]
+
+    def first_segment(self, foot: np.ndarray, advance: float) -> int:
+        """The segment a step is first tried on: under the stance foot's x plus the last
+        step's advance ``advance`` [m] (0 before the first)."""
+        return _segment_of(self.P, foot[0] + advance)
+
+    def retry(self, j: int, land: float, tried: set) -> int | None:
+        """The segment to walk the step again on, after a heel strike at ``land`` [m]
+        (world x) on segment ``j``'s line; None to keep this landing (on the segment, or
+        no other segment takes it).  ``tried``: the step's segments so far (updated)."""
+        P = self.P
+        if P[j, 0] <= land <= P[j + 1, 0] or (j == 0 and land < P[0, 0]):
+            return None
+        tried.add(j)
+        j2 = _segment_of(P, land)
+        if j2 in tried or len(tried) >= _SEGMENT_TRIES:
+            return None  # beyond the profile's end, or no segment takes the landing
+        return j2
+
+    def goes_on(self, j: int, land: float) -> bool:
+        """Whether the walk goes on after a heel strike at ``land`` [m] on segment ``j``
+        (the landing on that segment and on the profile)."""
+        P = self.P
+        return bool(P[0, 0] <= land <= P[-1, 0] and P[j, 0] <= land <= P[j + 1, 0])
+
+
 def simulate_on_profile(walker_at, data_at, P: np.ndarray, x0: np.ndarray, n_steps: int,
                         solver, max_step_time: float = 5.0,
                         first_stance_leg: str = "leg2") -> HybridTrajectory:
@@ -86,44 +147,29 @@ def simulate_on_profile(walker_at, data_at, P: np.ndarray, x0: np.ndarray, n_ste
         Its segments carry each step's stance foot's world place (``stance_foot_world``
         [m], the first at ``(x_0, y_0)``).
     """
-    from walkerlab.models.hybrid.ground import on_landing
-
     t_wall = time.perf_counter()
-    walkers: dict[tuple, object] = {}
-
-    def on(j: int, foot: np.ndarray):
-        g, dydx = _line(P, j)
-        drop = float(foot[1] - (P[j, 1] + (foot[0] - P[j, 0]) * dydx))
-        key = (g, drop)
-        if key not in walkers:
-            walkers[key] = on_landing(walker_at(g), data_at(g), drop)
-        return walkers[key]
-
-    base = walker_at(_line(P, 0)[0])
+    ground = ProfileGround(walker_at, data_at, P)
+    base = ground.base
     segs = []
     x, t, leg = np.asarray(x0, float), 0.0, first_stance_leg
-    foot = np.array([P[0, 0], P[0, 1]])
+    foot = ground.start.copy()
     advance = 0.0
     for k in range(n_steps):
-        j = _segment_of(P, foot[0] + advance)
-        tried = set()
+        j = ground.first_segment(foot, advance)
+        tried: set = set()
         while True:
-            w = on(j, foot)
+            w = ground.walker(j, foot)
             seg = integrate_step(w, x, solver, t0=t, max_step_time=max_step_time, index=k,
                                  stance_leg=leg, stance_foot_world=foot.copy())
             if seg.termination != "heel_strike":
                 break
             land = foot[0] + float(w.points(seg.x_end)["swing_foot"][0])
-            if P[j, 0] <= land <= P[j + 1, 0] or (j == 0 and land < P[0, 0]):
+            j2 = ground.retry(j, land, tried)
+            if j2 is None:
                 break
-            tried.add(j)
-            j2 = _segment_of(P, land)
-            if j2 in tried or len(tried) >= _SEGMENT_TRIES:
-                break  # beyond the profile's end, or no segment takes the landing
             j = j2
         segs.append(seg)
-        if seg.termination != "heel_strike" or not P[0, 0] <= land <= P[-1, 0] or \
-                not P[j, 0] <= land <= P[j + 1, 0]:
+        if seg.termination != "heel_strike" or not ground.goes_on(j, land):
             break
         step = w.points(seg.x_end)["swing_foot"]
         advance = float(step[0])

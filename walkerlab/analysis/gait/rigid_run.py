@@ -213,15 +213,33 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = No
         A profile only in a CSV file, a walker with actuators or printed equations (one
         line).
     """
-    from walkerlab.analysis.gait.profile_walk import profile_points, simulate_on_profile
-    from walkerlab.models.registry import passive_walker_at
+    from walkerlab.analysis.gait.profile_walk import simulate_on_profile
 
-    if scene.walker.actuation is not None or scene.ideal.variant != "derived":
-        raise ValueError("terrain.kind: profile: walked by the passive walker of the "
-                         "generated model only (no walker.actuation, ideal.variant: derived)")
-    at, data_at = passive_walker_at(scene)
+    ground = profile_ground(scene)
     solver = Solver.from_settings(scene.solver) if solver is None else solver
     if max_step_time is None:
         max_step_time = scene.simulate.max_step_time_s
-    return simulate_on_profile(at, data_at, profile_points(scene.terrain), x0, n_steps,
+    return simulate_on_profile(ground.walker_at, ground.data_at, ground.P, x0, n_steps,
                                solver, max_step_time=max_step_time)
+
+
+def profile_ground(scene):
+    """The scene's height profile as the steps of a rigid walk
+    (:class:`walkerlab.analysis.gait.profile_walk.ProfileGround`: each step's walker on its
+    landing segment), for :func:`profile_walk` and the Gymnasium environment's rigid view.
+
+    Raises
+    ------
+    ValueError
+        A profile only in a CSV file, a walker with actuators or printed equations (one
+        line).
+    """
+    from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points
+    from walkerlab.models.registry import passive_walker_at
+    from walkerlab.walker.kinds import PROFILE_PASSIVE
+
+    if scene.walker.actuation is not None or scene.ideal.variant != "derived":
+        raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
+    P = profile_points(scene.terrain)
+    at, data_at = passive_walker_at(scene)
+    return ProfileGround(at, data_at, P)
