@@ -296,3 +296,27 @@ def test_fixedpoint_prints_and_stores_the_zero_dynamics(tmp_path):
     for word in ("delta^2", "full-order multiplier", "existence", "V(theta-)", "V_max",
                  "zeta*", "step period (quadrature)", "phase rate at impact"):
         assert word in out
+
+
+def test_energy_ledger_counts_the_controllers_work(walker, hzd, reference):
+    """The energy ledger of one step on the periodic orbit: the computed torques' work
+    (``q'^T B u`` integrated) closes the balance (relative 1e-9), and on the orbit it
+    equals the heel strike's loss (level ground: the energy returns to its start); the loss
+    is the hand-written impact map's (1e-9 relative)."""
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.integrate.rigid import simulate_steps
+
+    solver = Solver.from_settings(scene_from_dict(copy.deepcopy(SCENE)).solver)
+    traj = simulate_steps(walker, hzd.x_plus, 1, solver)
+    led = trajectory_ledger(traj)
+    ke = walker.energies(hzd.x_plus)[0]
+    assert abs(led["closure"][0]) < 1e-9 * ke
+    work = led["actuator_work_positive"][0] + led["actuator_work_negative"][0]
+    assert led["actuator_work_positive"][0] > 0
+    loss = led["heel_strike_loss"][0]
+    assert abs(work - loss) < 1e-7 * loss
+    x_minus = traj.segments[0].x_end
+    ke_ref = 0.5 * x_minus[3:] @ ref.mass_matrix(x_minus[:3], BOOK) @ x_minus[3:]
+    xp = ref.impact(x_minus, BOOK)
+    ke_ref_p = 0.5 * xp[3:] @ ref.mass_matrix(xp[:3], BOOK) @ xp[3:]
+    assert abs(loss - (ke_ref - ke_ref_p)) < 1e-9 * loss
