@@ -28,8 +28,8 @@ __all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_step_lengths"]
 def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
     """Each step's advance along the slope [m] of one period of the scene's rigid gait on a
     ground whose steps differ, from its fixed point ``x_ideal``; None on a ground whose every
-    step is alike (the one spacing of :func:`walkerlab.models.contact.scene.
-    ideal_step_length`).
+    step is alike (the one spacing of
+    :func:`walkerlab.models.contact.scene.ideal_step_length`).
 
     Parameters
     ----------

@@ -89,7 +89,9 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     scale = max(ke0, 1e-12)
     wpos = wneg = wdamp = internal = 0.0
     damped = _damped(walker)
-    torques = acts is not None and bool(acts.spec.torques) and not acts.limit
+    # joint torques that do work: the scene's laws, or a virtual-constraint controller's
+    torques = acts is not None and not acts.limit and (
+        bool(acts.spec.torques) or getattr(acts, "controller", None) is not None)
     prev_ke = None
     n2 = seg.x_start.size
     for _ph, sol, (ta, tb) in seg.pieces:

@@ -67,7 +67,7 @@ class ZeroDynamics:
     x_plus : ndarray (2n,)
         The fixed point's post-impact state on the surface [rad, rad/s].
     max_torque_n_m : float
-        Largest |u| of the feedforward torque along the periodic orbit [N m].
+        Largest ``|u|`` of the feedforward torque along the periodic orbit [N m].
     saturates : bool
         ``max_torque_n_m`` exceeds the controller's saturation (the computed torque is then
         not applied: the zero dynamics is not the closed loop's).
@@ -120,9 +120,9 @@ class ZeroDynamics:
 
 
 def impact_multiplier(ctrl, b=None) -> float:
-    """``delta^2`` of ``ctrl`` (a :class:`walkerlab.models.hybrid.virtual_constraints.
-    VirtualConstraintController`): the heel strike's ratio of ``sigma`` on the surface,
-    squared."""
+    """``delta^2`` of ``ctrl`` (a
+    :class:`walkerlab.models.hybrid.virtual_constraints.VirtualConstraintController`): the
+    heel strike's ratio of ``sigma`` on the surface, squared."""
     d = ctrl.design
     n = ctrl.n
     b = annihilator(ctrl.B) if b is None else b
@@ -232,8 +232,8 @@ def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:
     ``zd.full_order`` and returned: ``phase_rate_minus``, ``phase_rate_plus`` (its phase
     rates at the heel strike [rad/s or m/s]), ``step_period_s``, ``delta2_multiplier`` (the
     variational Floquet multiplier nearest ``delta^2``), ``other_multiplier`` (the largest
-    |multiplier| of the others: the feedback's), ``output_plus``, ``output_rate_plus`` (max
-    |y|, |y'| just after the heel strike [rad, rad/s]).
+    ``|multiplier|`` of the others: the feedback's), ``output_plus``, ``output_rate_plus``
+    (``max |y|``, ``max |y'|`` just after the heel strike [rad, rad/s]).
 
     Parameters
     ----------

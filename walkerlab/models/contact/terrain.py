@@ -161,7 +161,7 @@ def ground_drops(terrain) -> tuple[float, ...]:
 def footfall_positions(step_lengths_m, n_footfalls: int) -> np.ndarray:
     """Along-slope positions [m] (n_footfalls,) of the footfalls of a gait whose steps
     advance ``step_lengths_m`` (p,) in turn: footfall 0 at 0, footfall ``k`` at
-    ``l_0 + ... + l_{k-1}`` (``l_j = step_lengths_m[j mod p]``)."""
+    ``sum_{j<k} l_j`` (``l_j = step_lengths_m[j mod p]``)."""
     ell = np.asarray(step_lengths_m, float).ravel()
     steps = ell[np.arange(max(int(n_footfalls) - 1, 0)) % ell.size]
     return np.concatenate([[0.0], np.cumsum(steps)])
@@ -171,7 +171,7 @@ def footfall_heights(drops_m, n_footfalls: int, phi: float) -> np.ndarray:
     """Heights [m] (n_footfalls,) along the slope's outward normal of the footfalls of a
     ground whose steps land ``drops_m`` (p,) below the stance foot's level in turn (a drop
     along the vertical, the rigid model's, :func:`walkerlab.models.ground.landing_drops`):
-    footfall 0 at 0, footfall ``k`` at ``-(d_0 + ... + d_{k-1}) cos(phi)``."""
+    footfall 0 at 0, footfall ``k`` at ``-(sum_{j<k} d_j) cos(phi)``."""
     d = np.asarray(drops_m, float).ravel()
     steps = d[np.arange(max(int(n_footfalls) - 1, 0)) % d.size]
     return -np.concatenate([[0.0], np.cumsum(steps)]) * math.cos(float(phi))

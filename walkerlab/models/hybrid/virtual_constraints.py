@@ -409,6 +409,12 @@ class VirtualConstraintActuators(Actuators):
         """The computed torques (k,) [N m] at the state ``x`` (2n,)."""
         return self.controller.torques(x)
 
+    def power(self, t, x) -> float:
+        """Mechanical power of the computed torques [W]: ``q'^T B u`` (each joint's rate
+        times its torque; the energy ledger's actuator work)."""
+        x = np.asarray(x, float)
+        return float(np.real(x[self.n:] @ (self.B @ self.controller.torques(x))))
+
     def added_acceleration(self, t, x, constraint=None, M=None):
         """``M^-1 B u`` (n,) [rad/s^2] (:meth:`Actuators.added_acceleration`; the
         controller's own ``M^-1 B``, no constraint: a free-jointed walker holds none)."""

@@ -1,0 +1,322 @@
+"""The three-link walker under exactly invariant Bezier virtual constraints of degree 4
+(configs/threelink_hzd.yaml): the hybrid zero dynamics' restricted Poincare map against the
+full-order closed loop, impact invariance, and an independent reference.
+
+The reference shares no code with walkerlab's generator or controller: the book's closed
+forms of ``D, C, G, B`` and the heel strike written by hand in numpy
+(tests/independent/three_link.py; Grizzle, Abba & Plestan 2001; Westervelt et al. 2007), the
+Bezier polynomials by de Casteljau's algorithm, the invariant ``c_0, c_1`` from the hand
+impact map (Westervelt, Grizzle & Koditschek 2003, Theorem 3), ``delta^2``, ``V`` and the step
+period by scipy's adaptive quadrature (``quad``) of the zero dynamics, and the full-order
+closed loop under a computed torque written here, integrated by scipy's DOP853.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from tests.independent import three_link as ref
+from walkerlab.analysis.gait.poincare import poincare_map
+from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+from walkerlab.config import scene_from_dict
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.registry import build_walker
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = yaml.safe_load((ROOT / "configs" / "threelink_hzd.yaml").read_text())
+#: the book's numbers (configs/threelink.yaml, configs/threelink_hzd.yaml)
+BOOK = {"g": 9.8, "r": 1.0, "m": 5.0, "d": 0.5, "MH": 15.0, "MT": 10.0, "l": 0.5}
+VC = SCENE["walker"]["actuation"]["virtual_constraints"]
+#: the scene's coefficients (swing leg, torso), c_0, c_1 placeholders
+GIVEN = np.array([o["bezier_rad"] for o in VC["outputs"]], float)
+KP, KD = VC["feedback"]["kp_per_s2"], VC["feedback"]["kd_per_s"]
+#: b^T B = 0 for the reference's B (u1 on the stance leg, u2 on the swing leg, both -u on
+#: the torso): the rotation of the whole walker about its stance foot
+b = np.ones(3)
+
+
+@pytest.fixture(scope="module")
+def walker():
+    return build_walker(scene_from_dict(copy.deepcopy(SCENE)))
+
+
+@pytest.fixture(scope="module")
+def hzd(walker):
+    return zero_dynamics(walker.actuators.controller)
+
+
+def de_casteljau(c, s):
+    """Bezier polynomial of the coefficients ``c`` (M + 1,) at ``s``."""
+    p = list(c)
+    while len(p) > 1:
+        p = [(1 - s) * p[i] + s * p[i + 1] for i in range(len(p) - 1)]
+    return p[0]
+
+
+def bezier_derivatives(c, s):
+    """``(hd, hd', hd'')`` at ``s`` (de Casteljau of the differenced coefficients)."""
+    c = np.asarray(c, float)
+    M = len(c) - 1
+    d1 = M * np.diff(c)
+    d2 = (M - 1) * np.diff(d1)
+    return de_casteljau(c, s), de_casteljau(d1, s), de_casteljau(d2, s)
+
+
+class Reference:
+    """The zero dynamics of the scene's controller on the hand-written model: ``theta = q1``,
+    ``q2 = hd_1(s)``, ``q3 = hd_2(s)``, ``s = (q1 - theta+) / (theta- - theta+)``."""
+
+    def __init__(self, given=GIVEN, p=BOOK):
+        self.p = p
+        self.M = given.shape[1] - 1
+        # the heel strike (q1 + q2 = 0, swing foot ahead) at the swing leg's c_M
+        self.th_m = -given[0, -1]
+        q_m = np.array([self.th_m, given[0, -1], given[1, -1]])
+        self.q_m = q_m
+        self.th_p = q_m[1]  # after relabelling the stance leg is the former swing leg
+        self.dth = self.th_m - self.th_p
+        # the pre-impact velocity per unit phase rate on the surface (c_M, c_{M-1} given)
+        qd_m = np.array([1.0, *(self.M * (given[:, -1] - given[:, -2]) / self.dth)])
+        xp = ref.impact(np.concatenate([q_m, qd_m]), p)
+        alpha = given.copy()
+        alpha[:, 0] = xp[1:3]  # invariance: outputs zero and ...
+        alpha[:, 1] = alpha[:, 0] + self.dth / self.M * xp[4:6] / xp[3]  # ... rates zero
+        self.alpha, self.q_plus, self.x_plus_unit = alpha, xp[:3], xp
+        sig_m = b @ ref.mass_matrix(q_m, p) @ qd_m
+        sig_p = b @ ref.mass_matrix(xp[:3], p) @ xp[3:]
+        self.delta2 = (sig_p / sig_m) ** 2
+
+    def q_and_tangent(self, theta):
+        s = (theta - self.th_p) / self.dth
+        h = [bezier_derivatives(c, s) for c in self.alpha]
+        q = np.array([theta, h[0][0], h[1][0]])
+        qp = np.array([1.0, h[0][1] / self.dth, h[1][1] / self.dth])
+        return q, qp
+
+    def inertia(self, theta):
+        """``I(theta) = b^T D(q) dq/dtheta`` (sigma = I theta')."""
+        q, qp = self.q_and_tangent(theta)
+        return b @ ref.mass_matrix(q, self.p) @ qp
+
+    def V(self, theta):
+        """``V(theta) = int_{theta+}^{theta} I b^T G`` by adaptive quadrature."""
+        from scipy.integrate import quad
+
+        def f(t):
+            q, _ = self.q_and_tangent(t)
+            return self.inertia(t) * (b @ ref.gravity(q, self.p))
+        return quad(f, self.th_p, theta, epsabs=1e-12, epsrel=1e-11, limit=200)[0]
+
+    def orbit(self):
+        """``(zeta*, theta'- , theta'+, period [s], x+ (6,))`` of the restricted map's fixed
+        point ``rho(zeta) = delta^2 zeta - V(theta-)``."""
+        from scipy.integrate import quad
+
+        v_m = self.V(self.th_m)
+        zeta = -v_m / (1 - self.delta2)
+        zeta_p = self.delta2 * zeta
+        rate_m = -np.sqrt(2 * zeta) / abs(self.inertia(self.th_m))  # theta decreases
+        rate_p = -np.sqrt(2 * zeta_p) / abs(self.inertia(self.th_p))
+
+        def dt(t):  # d time / d theta, |I| / sigma
+            return abs(self.inertia(t)) / np.sqrt(2 * (zeta_p - self.V(t)))
+        period = quad(dt, self.th_m, self.th_p, epsabs=1e-12, epsrel=1e-11, limit=200)[0]
+        return zeta, rate_m, rate_p, period, np.concatenate(
+            [self.q_plus, self.x_plus_unit[3:] * rate_p / self.x_plus_unit[3]])
+
+    def computed_torque(self):
+        """The closed loop's law ``x -> u`` (2,): ``y = (q2, q3) - hd(s)``,
+        ``u = (J D^-1 B)^-1 (-J D^-1 (-h) + hd'' s'^2 - kp y - kd y')``."""
+        def law(x):
+            q, dq = x[:3], x[3:]
+            s = (q[0] - self.th_p) / self.dth
+            h = [bezier_derivatives(c, s) for c in self.alpha]
+            hd = np.array([h[0][0], h[1][0]])
+            hd1 = np.array([h[0][1], h[1][1]]) / self.dth
+            hd2 = np.array([h[0][2], h[1][2]]) / self.dth ** 2
+            J = np.array([[-hd1[0], 1.0, 0.0], [-hd1[1], 0.0, 1.0]])
+            y = q[1:] - hd
+            dy = J @ dq
+            D = ref.mass_matrix(q, self.p)
+            A = J @ np.linalg.solve(D, ref.B)
+            f0 = J @ np.linalg.solve(D, -ref.bias(q, dq, self.p)) - hd2 * dq[0] ** 2
+            return np.linalg.solve(A, -f0 - KP * y - KD * dy)
+        return law
+
+
+def step(x0, law, p=BOOK):
+    """One step of the hand-written closed loop (DOP853, rtol = atol = 1e-12): the flow
+    until the swing leg passes the stance leg (``q2 - q1`` rising through 0), then until the
+    heel strike (``q1 + q2`` falling through 0: the legs symmetric, the swing foot ahead;
+    two stages, since on this gait the legs pass each other at ``q1 + q2 < 0``), the heel
+    strike and relabelling (:func:`tests.independent.three_link.impact`).  Returns ``(x+,
+    duration [s])``."""
+    from scipy.integrate import solve_ivp
+
+    def f(t, x):
+        return np.concatenate([x[3:], ref.acceleration(x[:3], x[3:], law(x), p)])
+
+    def passing(t, x):
+        return x[1] - x[0]
+
+    def strike(t, x):
+        return x[0] + x[1]
+    t0, x = 0.0, np.asarray(x0, float)
+    for event, direction in ((passing, 1), (strike, -1)):
+        event.terminal, event.direction = True, direction
+        sol = solve_ivp(f, (t0, t0 + 5.0), x, method="DOP853", rtol=1e-12, atol=1e-12,
+                        events=event)
+        assert sol.t_events[0].size, f"no {event.__name__} event"
+        t0, x = float(sol.t_events[0][0]), sol.y_events[0][0]
+    return ref.impact(x, p), t0
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return Reference()
+
+
+def outputs_ref(walker, x, alpha, th_p, th_m):
+    """``(y, y')`` (2,) each from the generated link angles and de Casteljau's polynomials;
+    ``y'`` by the complex step along ``dq``."""
+    def y_of(z):
+        la = walker.leg_angles(z)
+        s = (la["stance_angle"] - th_p) / (th_m - th_p)
+        return np.array([la["swing_angle"] - de_casteljau(alpha[0], s),
+                         la["torso_angle"] - de_casteljau(alpha[1], s)])
+    x = np.asarray(x, float)
+    xc = x.astype(complex)
+    xc[:3] += 1e-30j * x[3:]
+    return np.real(y_of(x)), np.imag(y_of(xc)) / 1e-30
+
+
+def test_invariant_coefficients_put_the_heel_strike_on_the_surface(walker):
+    """invariant: true: a pre-impact state on the surface (y = y' = 0 at theta-, any phase
+    rate) is mapped by the walker's heel strike onto it: |y+|, |y'+| <= 1e-12; and the
+    coefficients in force are the hand impact map's (the reference's c_0, c_1) to 1e-12."""
+    ctrl = walker.actuators.controller
+    d = ctrl.design
+    alpha = d.alpha
+    dth = d.theta_minus - d.theta_plus
+    qd = np.array([1.0, *(4 * (alpha[:, -1] - alpha[:, -2]) / dth)])  # dq/dtheta at s = 1
+    for rate in (-0.5, -0.9661078796, -1.5):
+        x_minus = np.concatenate([d.q_minus, qd * rate])
+        y, dy = outputs_ref(walker, x_minus, alpha, d.theta_plus, d.theta_minus)
+        assert np.max(np.abs(y)) < 1e-13 and np.max(np.abs(dy)) < 1e-12
+        y, dy = outputs_ref(walker, walker.reset(x_minus), alpha, d.theta_plus, d.theta_minus)
+        assert np.max(np.abs(y)) < 1e-12 and np.max(np.abs(dy)) < 1e-12
+    assert d.residual_position < 1e-12 and d.residual_rate < 1e-12
+    r = Reference()
+    np.testing.assert_allclose(alpha, r.alpha, rtol=0, atol=1e-12)
+    assert abs(d.theta_minus - r.th_m) < 1e-12 and abs(d.theta_plus - r.th_p) < 1e-12
+    # the scene's c_1 are placeholders: not invariant by themselves
+    assert np.max(np.abs(GIVEN[:, 1] - alpha[:, 1])) > 0.01
+
+
+def test_restricted_map_fixed_point_is_the_full_order_one(walker, hzd):
+    """The zero dynamics' periodic orbit (by quadrature) is a fixed point of the full-order
+    Poincare map (the scene's LSODA, rtol 1e-11): P(x*) = x* to 1e-8, the step period and the
+    phase rate at impact to 1e-8; the existence condition holds."""
+    assert hzd.exists and hzd.stable and hzd.kinetic_invariance < 1e-12
+    assert hzd.delta2 / (1 - hzd.delta2) * hzd.v_minus + hzd.v_max < 0
+    steps = []
+    solver = Solver.from_settings(scene_from_dict(copy.deepcopy(SCENE)).solver)
+    x1, period, _n = poincare_map(walker, hzd.x_plus, solver, steps=steps)
+    np.testing.assert_allclose(x1, hzd.x_plus, rtol=0, atol=1e-8)
+    assert abs(period - hzd.step_period_s) < 1e-8
+    x_minus = steps[0].x_end
+    assert abs(walker.leg_angles(x_minus)["stance_rate"] - hzd.phase_rate_minus) < 1e-8
+    y, _dy = walker.actuators.controller.outputs(x_minus)
+    assert np.max(np.abs(y)) < 1e-8
+
+
+def test_delta2_is_a_full_order_floquet_multiplier(walker, hzd):
+    """The variational equations of the full-order closed loop at the fixed point: one
+    multiplier is delta^2 (to 1e-6), the others the output feedback's (kd = 100/s, both
+    poles at -50/s: ~exp(-50 T) T^2 over a 0.45 s step, far below 1e-6)."""
+    sol = Solver(method="LSODA", rtol=1e-10, atol=1e-10)
+    _x, _T, DP, _n = poincare_map(walker, hzd.x_plus, sol, jacobian=True)
+    mult = np.linalg.eigvals(DP)
+    j = np.argmin(np.abs(mult - hzd.delta2))
+    assert abs(mult[j] - hzd.delta2) < 1e-6
+    assert np.max(np.abs(np.delete(mult, j))) < 1e-6
+
+
+def test_zero_dynamics_match_an_independent_quadrature(hzd, reference):
+    """delta^2 from the hand-written model's impact map and mass matrix, V(theta-), the
+    fixed point zeta*, the phase rates at the heel strike and the step period by scipy's
+    adaptive quadrature: walkerlab's Chebyshev / Gauss-Legendre quadrature on the generated
+    model agrees (delta^2 to 1e-10, the rest to 1e-8 relative)."""
+    r = reference
+    assert abs(hzd.delta2 - r.delta2) < 1e-10
+    zeta, rate_m, rate_p, period, x_plus = r.orbit()
+    assert abs(hzd.v_minus - r.V(r.th_m)) < 1e-8 * abs(hzd.v_minus)
+    assert abs(hzd.zeta_star - zeta) < 1e-8 * zeta
+    assert abs(hzd.phase_rate_minus - rate_m) < 1e-8
+    assert abs(hzd.phase_rate_plus - rate_p) < 1e-8
+    assert abs(hzd.step_period_s - period) < 1e-8
+    np.testing.assert_allclose(hzd.x_plus, x_plus, rtol=0, atol=1e-8)
+
+
+def test_independent_closed_loop_walks_the_zero_dynamics_orbit(reference):
+    """The full-order closed loop written by hand (computed torque on the hand-written
+    ``D, C, G, B``, DOP853 rtol 1e-12) from the reference's orbit start returns to it after
+    one step (the restricted map's fixed point is the full-order one) with the
+    quadrature's step period, to 1e-8."""
+    r = reference
+    _zeta, rate_m, _rate_p, period, x_plus = r.orbit()
+    x1, T = step(x_plus, r.computed_torque())
+    np.testing.assert_allclose(x1, x_plus, rtol=0, atol=1e-8)
+    assert abs(T - period) < 1e-8
+
+
+@pytest.mark.slow
+def test_fixedpoint_prints_and_stores_the_zero_dynamics(tmp_path):
+    """``walkerlab fixedpoint configs/threelink_hzd.yaml``: fixedpoint.h5's zero_dynamics/
+    beside the full-order fixed point (delta^2 a multiplier to 1e-6, the period and the
+    phase rate at impact to 1e-8), printed side by side."""
+    from tests.cli_run import run_cli
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+
+    code, err, out = run_cli("fixedpoint", ROOT / "configs" / "threelink_hzd.yaml",
+                             "--runs-dir", tmp_path)
+    assert code == 0, err
+    z = load_fixedpoint(tmp_path / "threelink_hzd" / "fixedpoint.h5").zero_dynamics
+    assert z["exists"] and z["stable"] and not z["saturates"]
+    fo = z["full_order"]
+    assert abs(fo["delta2_multiplier"] - z["delta2"]) < 1e-6
+    assert abs(fo["step_period_s"] - z["step_period_s"]) < 1e-8
+    assert abs(fo["phase_rate_minus"] - z["phase_rate_minus"]) < 1e-8
+    assert fo["other_multiplier"] < 1e-6
+    for word in ("delta^2", "full-order multiplier", "existence", "V(theta-)", "V_max",
+                 "zeta*", "step period (quadrature)", "phase rate at impact"):
+        assert word in out
+
+
+def test_energy_ledger_counts_the_controllers_work(walker, hzd, reference):
+    """The energy ledger of one step on the periodic orbit: the computed torques' work
+    (``q'^T B u`` integrated) closes the balance (relative 1e-9), and on the orbit it
+    equals the heel strike's loss (level ground: the energy returns to its start); the loss
+    is the hand-written impact map's (1e-9 relative)."""
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.integrate.rigid import simulate_steps
+
+    solver = Solver.from_settings(scene_from_dict(copy.deepcopy(SCENE)).solver)
+    traj = simulate_steps(walker, hzd.x_plus, 1, solver)
+    led = trajectory_ledger(traj)
+    ke = walker.energies(hzd.x_plus)[0]
+    assert abs(led["closure"][0]) < 1e-9 * ke
+    work = led["actuator_work_positive"][0] + led["actuator_work_negative"][0]
+    assert led["actuator_work_positive"][0] > 0
+    loss = led["heel_strike_loss"][0]
+    assert abs(work - loss) < 1e-7 * loss
+    x_minus = traj.segments[0].x_end
+    ke_ref = 0.5 * x_minus[3:] @ ref.mass_matrix(x_minus[:3], BOOK) @ x_minus[3:]
+    xp = ref.impact(x_minus, BOOK)
+    ke_ref_p = 0.5 * xp[3:] @ ref.mass_matrix(xp[:3], BOOK) @ xp[3:]
+    assert abs(loss - (ke_ref - ke_ref_p)) < 1e-9 * loss
