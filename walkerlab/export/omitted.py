@@ -22,7 +22,8 @@ from dataclasses import dataclass
 __all__ = ["ADAMS_CONTINUATION", "PREFIX", "URDF_GROUND", "Omission", "adams_comments",
            "lines", "xml_comments"]
 
-#: The text every omission comment starts with (after ``<!-- `` or ``! ``).
+#: The text every omission comment starts with (after an XML comment's opening or an Adams
+#: comment's exclamation mark and a space).
 PREFIX = "Left out: "
 #: The indent of an Adams omission comment's continuation lines (after ``!``).
 ADAMS_CONTINUATION = "   "
