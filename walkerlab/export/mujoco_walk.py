@@ -31,7 +31,7 @@ ankle's motor gives ``-stiffness (a - rest_angle_rad) - constant_n_m`` on its an
 of contact :data:`HEEL_OFF_STEPS` MuJoCo steps running (the soft contact flickers).
 
 Virtual constraints (``walker.actuation.virtual_constraints``) are the rigid view's computed
-torque (:class:`walkerlab.models.hybrid.virtual_constraints.VirtualConstraintController`:
+torque (:class:`walkerlab.models.virtual_constraints.VirtualConstraintController`:
 ``u = (L_g L_f h)^-1 (-L_f^2 h - kp y - kd y')`` on the rigid model's ``M, C, G``;
 Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56) at MuJoCo's role state: each
 rigid role's absolute link angle and rate from the export's coordinates
@@ -126,7 +126,7 @@ class VirtualConstraintFeedback:
 
     Parameters
     ----------
-    controller : walkerlab.models.hybrid.virtual_constraints.VirtualConstraintController
+    controller : walkerlab.models.virtual_constraints.VirtualConstraintController
         The rigid view's controller of the scene's walker.
     roles : sequence of str
         The rigid model's coordinates by role (``structure.roles``: ``stance_thigh``,
@@ -160,14 +160,14 @@ def virtual_constraint_feedback(scene) -> VirtualConstraintFeedback | None:
     Raises
     ------
     ValueError
-        As :class:`walkerlab.models.hybrid.virtual_constraints.VirtualConstraintController`
+        As :class:`walkerlab.models.virtual_constraints.VirtualConstraintController`
         (one line naming the key).
     """
     act = scene.walker.actuation
     if act is None or act.virtual_constraints is None:
         return None
     from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.virtual_constraints import VirtualConstraintController
+    from walkerlab.models.virtual_constraints import VirtualConstraintController
     from walkerlab.walker.description import walker_data
 
     data = walker_data(scene.walker, scene.slope.phi_rad)

@@ -1,5 +1,5 @@
 """Virtual constraints as feedback in the compliant-contact view: the rigid view's
-computed torque (:class:`walkerlab.models.hybrid.virtual_constraints.
+computed torque (:class:`walkerlab.models.virtual_constraints.
 VirtualConstraintController`) evaluated at the contact walker's role state.
 
 The same controller, evaluated by the same code
@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.models.contact.joint_torques import JointTorqueActuators
-from walkerlab.models.hybrid.virtual_constraints import VirtualConstraintController
+from walkerlab.models.virtual_constraints import VirtualConstraintController
 
 __all__ = ["VirtualConstraintJointTorques", "VirtualConstraintLaw"]
 
