@@ -122,15 +122,18 @@ def speed_of(times, x):
 @pytest.fixture(scope="module")
 def rigid_gait(scene, tmp_path_factory):
     """The rigid closed loop's fixed point: ``(runs folder, step period [s], speed
-    [m/s])``."""
+    [m/s])``; the step length is the swing foot's lead at the designed heel strike (the
+    outputs' end configuration ``q-``)."""
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.models.registry import build_walker
     from walkerlab.stages import fixedpoint
 
     runs = tmp_path_factory.mktemp("runs")
     out = fixedpoint.run(scene, runs, compare_variants=False)
-    fp = load_fixedpoint(out.path)
-    period = float(fp.step_period_s)
-    return runs, period, float(np.mean(fp.step_lengths_m)) / period
+    period = float(load_fixedpoint(out.path).step_period_s)
+    ctrl = build_walker(scene).actuators.controller
+    step = float(ctrl.pieces.foot(ctrl.design.q_minus)[1])
+    return runs, period, step / period
 
 
 @pytest.mark.slow
@@ -144,6 +147,7 @@ def test_contact_model_walks_at_the_rigid_closed_loops_speed(scene, rigid_gait):
 
     runs, period, speed = rigid_gait
     assert period == pytest.approx(0.5591309, abs=1e-6)
+    assert speed == pytest.approx(0.704, abs=5e-4)
     out = contact_sim.run(scene, runs)
     assert out.failure is None or not out.failure
     with h5py.File(out.path) as f:
