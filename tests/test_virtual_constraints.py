@@ -284,7 +284,7 @@ def test_torques_beside_virtual_constraints_refused():
     assert "torques" in str(e.value) and len(str(e.value).splitlines()) == 1
 
 
-def test_views_without_the_controller_refuse_it():
+def test_views_without_the_controller_refuse_it(tmp_path):
     """The Adams and OpenSim exports, the gym and optimize do not carry the controller yet:
     each refuses it in one line naming the field (the capability table's cell); the contact
     model and the MJCF take it (tests/test_virtual_constraint_views.py walks them)."""
@@ -299,6 +299,11 @@ def test_views_without_the_controller_refuse_it():
         with pytest.raises(KindRefused) as e:
             check_exportable(scene, KINDS["free_joints"], fmt)
         assert one_line(e).startswith("walker.actuation.virtual_constraints: ")
+    from walkerlab.stages import export
+
+    with pytest.raises(KindRefused) as e:  # the Adams writer's own path asks the table too
+        export.run(scene, tmp_path, "adm")
+    assert one_line(e).startswith("walker.actuation.virtual_constraints: ")
     for view in ("gym", "optimize", "adams", "osim"):
         assert not KINDS["free_joints"].supports("virtual_constraints", view)
         assert not KINDS["hinged_torso"].supports("virtual_constraints", view)

@@ -111,6 +111,10 @@ def stored_gait(scene: Scene, runs_root: Path | str):
 
 def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Exported:
     """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
+    act = scene.walker.actuation
+    if act is not None and act.virtual_constraints is not None:  # the table's cell
+        data.structure.kind.require("virtual_constraints", "adams",
+                                    "walker.actuation.virtual_constraints")
     check_adams_exportable(mb)  # before the gait search
     check_adams_actuation(scene)
     start = adams_start(scene, mb, data, stored_gait(scene, runs_root))
