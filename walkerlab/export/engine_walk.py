@@ -117,7 +117,7 @@ def not_walked(reason: str) -> EngineWalk:
 
 def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
                 steps: int = DEFAULT_STEPS, tolerance: float = DEFAULT_TOLERANCE,
-                spokes: bool = False) -> EngineWalk:
+                spokes: bool = False, feedback=None) -> EngineWalk:
     """Walk the exported file ``path`` (format ``fmt``) in its engine for ``steps + 1.3``
     rigid step periods (module docstring).
 
@@ -136,6 +136,8 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
     spokes : bool
         A spoked wheel's MJCF: its spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`)
         instead of two legs' heel strikes.
+    feedback : walkerlab.export.mujoco_walk.VirtualConstraintFeedback, optional
+        The scene's virtual constraints (the MJCF's stepping loop evaluates them).
 
     Returns
     -------
@@ -155,7 +157,7 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
         from walkerlab.export.mujoco_walk import walk
     else:
         from walkerlab.export.opensim_walk import walk
-    run = walk(path, duration)
+    run = walk(path, duration) if feedback is None else walk(path, duration, feedback=feedback)
     periods = run.step_periods_s
     return EngineWalk(engine, strikes=len(run.times_s), alternating=run.alternating,
                       first_leg=run.legs[0] if run.legs else "", fell=bool(run.fell),

@@ -29,6 +29,15 @@ geom ``leg<i>_toe`` in contact) and off at the next heel strike; meanwhile the s
 ankle's motor gives ``-stiffness (a - rest_angle_rad) - constant_n_m`` on its angle ``a``
 (positive toe up), the swing ankle's 0; heel off is taken once the heel has been out
 of contact :data:`HEEL_OFF_STEPS` MuJoCo steps running (the soft contact flickers).
+
+Virtual constraints (``walker.actuation.virtual_constraints``) are the rigid view's computed
+torque (:class:`walkerlab.models.virtual_constraints.VirtualConstraintController`:
+``u = (L_g L_f h)^-1 (-L_f^2 h - kp y - kd y')`` on the rigid model's ``M, C, G``;
+Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56) at MuJoCo's role state: each
+rigid role's absolute link angle and rate from the export's coordinates
+(:func:`walkerlab.export.joint_torques.link_angle` in the present roles), the torques
+applied at their joints as the laws' (:class:`VirtualConstraintFeedback`, built from the
+scene: the file carries the controller's spec, not the walker's generated model).
 """
 
 from __future__ import annotations
@@ -40,7 +49,8 @@ import numpy as np
 
 from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
 
-__all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "roll", "walk"]
+__all__ = ["MujocoWalk", "PoweredLoop", "VirtualConstraintFeedback", "latch_rule",
+           "powered_loop", "roll", "virtual_constraint_feedback", "walk"]
 
 LEGS = ("leg1", "leg2")
 
@@ -110,6 +120,62 @@ def latch_rule(foot_height_m: float, knee_rad: float, release_height_m: float,
 HEEL_OFF_STEPS = 10
 
 
+class VirtualConstraintFeedback:
+    """The virtual constraints' computed torque on an export's coordinates (module
+    docstring).
+
+    Parameters
+    ----------
+    controller : walkerlab.models.virtual_constraints.VirtualConstraintController
+        The rigid view's controller of the scene's walker.
+    roles : sequence of str
+        The rigid model's coordinates by role (``structure.roles``: ``stance_thigh``,
+        ``torso``, ...), each a link's absolute angle.
+    """
+
+    def __init__(self, controller, roles):
+        self.controller = controller
+        self.roles = tuple(roles)
+        #: the actuated joints (``controller.joints`` order)
+        self.joints = tuple(controller.joints)
+
+    def role_state(self, q, v, stance: int) -> np.ndarray:
+        """The rigid role state (2 n,) [rad, rad/s] of the export's coordinates ``q``, ``v``
+        (name -> value) with leg ``stance`` (0: leg1) in stance."""
+        from walkerlab.export.joint_torques import link_angle
+
+        combos = [link_angle(r, stance, q.keys()) for r in self.roles]
+        return np.array([sum(k * q[c] for c, k in g.items()) for g in combos]
+                        + [sum(k * v[c] for c, k in g.items()) for g in combos])
+
+    def torques(self, q, v, stance: int) -> np.ndarray:
+        """The computed torques (k,) [N m] at the joints :attr:`joints`."""
+        return np.real(self.controller.torques(self.role_state(q, v, stance)))
+
+
+def virtual_constraint_feedback(scene) -> VirtualConstraintFeedback | None:
+    """:class:`VirtualConstraintFeedback` of ``scene``'s walker (None without
+    ``walker.actuation.virtual_constraints``).
+
+    Raises
+    ------
+    ValueError
+        As :class:`walkerlab.models.virtual_constraints.VirtualConstraintController`
+        (one line naming the key).
+    """
+    act = scene.walker.actuation
+    if act is None or act.virtual_constraints is None:
+        return None
+    from walkerlab.codegen.cache import functions
+    from walkerlab.models.virtual_constraints import VirtualConstraintController
+    from walkerlab.walker.description import walker_data
+
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    ctrl = VirtualConstraintController(act.virtual_constraints, functions(data),
+                                       data.structure, data.params)
+    return VirtualConstraintFeedback(ctrl, data.structure.roles)
+
+
 class PoweredLoop:
     """The controller of a powered export (module docstring).
 
@@ -117,9 +183,16 @@ class PoweredLoop:
     ----------
     model : mujoco.MjModel
         With the custom text ``walkerlab_actuation``.
+    feedback : VirtualConstraintFeedback, optional
+        The scene's virtual constraints (needed when the text carries them).
+
+    Raises
+    ------
+    ValueError
+        The text carries virtual constraints and no ``feedback`` is given.
     """
 
-    def __init__(self, model):
+    def __init__(self, model, feedback: VirtualConstraintFeedback | None = None):
         import json
 
         import mujoco
@@ -133,12 +206,19 @@ class PoweredLoop:
         self.spec = Actuation.model_validate(json.loads(
             bytes(model.text_data[adr:adr + size - 1]).decode()))
         self.laws = TorqueLaws(self.spec.torques)
+        if self.spec.virtual_constraints is not None and feedback is None:
+            raise ValueError("walkerlab_actuation: virtual constraints need the walker's "
+                             "rigid model: walk the MJCF with feedback= "
+                             "(virtual_constraint_feedback(scene); export --walk does)")
+        self.feedback = feedback if self.spec.virtual_constraints is not None else None
         self.pulse_s = _numeric(model, "push_off_duration_s", 0.005)
         hinges = [model.joint(i) for i in range(model.njnt)
                   if model.jnt_type[i] == mujoco.mjtJoint.mjJNT_HINGE]
         coords = [j.name for j in hinges]
-        self.gf = [[torque_generalized_forces(t.joint, st, coords) for t in self.spec.torques]
-                   for st in (0, 1)]  # per stance leg (0: leg1), per law
+        joints = ([t.joint for t in self.spec.torques] if self.feedback is None
+                  else self.feedback.joints)
+        self.gf = [[torque_generalized_forces(j, st, coords) for j in joints]
+                   for st in (0, 1)]  # per stance leg (0: leg1), per law (or joint)
         self.q_of = {j.name: int(j.qposadr[0]) for j in hinges}
         self.v_of = {j.name: int(j.dofadr[0]) for j in hinges}
         self.body = [int(model.body(g if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g)
@@ -191,7 +271,16 @@ class PoweredLoop:
         """Set the joint torques, the ankle motors and the push-off force for the coming
         step."""
         st, sw = self.stance, 1 - self.stance
-        if self.laws:
+        if self.feedback is not None:
+            q = {c: data.qpos[a] for c, a in self.q_of.items()}
+            v = {c: data.qvel[a] for c, a in self.v_of.items()}
+            out: dict[str, float] = {}
+            for g, tau in zip(self.gf[st], self.feedback.torques(q, v, st)):
+                for c, k in g.items():
+                    out[c] = out.get(c, 0.0) + k * float(tau)
+            for c, a in self.v_of.items():
+                data.qfrc_applied[a] = out.get(c, 0.0)
+        elif self.laws:
             q = {c: data.qpos[a] for c, a in self.q_of.items()}
             v = {c: data.qvel[a] for c, a in self.v_of.items()}
             out = law_generalized_forces(self.laws, self.gf[st], q, v, self.phase(data),
@@ -241,9 +330,9 @@ class PoweredLoop:
 LOOK_EVERY = 5
 
 
-def powered_loop(model) -> PoweredLoop:
+def powered_loop(model, feedback: VirtualConstraintFeedback | None = None) -> PoweredLoop:
     """The controller of a powered export (module docstring): :class:`PoweredLoop`."""
-    return PoweredLoop(model)
+    return PoweredLoop(model, feedback)
 
 
 def _at_gait_keyframe(xml_path, doing: str):
@@ -262,8 +351,11 @@ def _at_gait_keyframe(xml_path, doing: str):
     return mujoco, model, data
 
 
-def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
-    """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s].
+def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
+         feedback: VirtualConstraintFeedback | None = None) -> MujocoWalk:
+    """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s]
+    (``feedback``: the scene's virtual constraints, :func:`virtual_constraint_feedback`,
+    needed when the file carries them).
 
     Returns
     -------
@@ -292,7 +384,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     hip = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")]
     powered = None
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
-        powered = powered_loop(model)
+        powered = powered_loop(model, feedback)
         powered.bind(model, site)
     nstep = 1 if latched or powered else LOOK_EVERY
     mujoco.mj_forward(model, data)

@@ -109,6 +109,10 @@ def stored_gait(scene: Scene, runs_root: Path | str):
 
 def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Exported:
     """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
+    act = scene.walker.actuation
+    if act is not None and act.virtual_constraints is not None:  # the table's cell
+        data.structure.kind.require("virtual_constraints", "adams",
+                                    "walker.actuation.virtual_constraints")
     check_adams_exportable(mb)  # before the gait search
     check_adams_actuation(scene)
     start = adams_start(scene, mb, data, stored_gait(scene, runs_root))
@@ -307,16 +311,23 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
     if not walk:
         return out
-    return replace(out, walk=_walk(out, fmt, data, walk_steps))
+    return replace(out, walk=_walk(out, fmt, data, walk_steps, scene))
 
 
-def _walk(out: Exported, fmt: str, data, steps: int) -> EngineWalk:
+def _walk(out: Exported, fmt: str, data, steps: int, scene: Scene) -> EngineWalk:
     """The written file walked in its engine (:func:`walkerlab.export.engine_walk.
-    walk_export`; a spoked wheel rolls on its spokes), or why not."""
+    walk_export`; a spoked wheel rolls on its spokes; virtual constraints by their computed
+    torque, :func:`walkerlab.export.mujoco_walk.virtual_constraint_feedback`), or why
+    not."""
     if out.step_period_s is None and fmt in ENGINES:
         return not_walked("the file has no gait to start from")
+    feedback = None
+    if fmt == "mjcf":
+        from walkerlab.export.mujoco_walk import virtual_constraint_feedback
+
+        feedback = virtual_constraint_feedback(scene)
     return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,
-                       spokes=_ROLLS[data.structure.kind.name])
+                       spokes=_ROLLS[data.structure.kind.name], feedback=feedback)
 
 
 #: kind name -> its steps are spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`), not

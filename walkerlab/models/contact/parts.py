@@ -180,7 +180,13 @@ class FreeJointsPart(KneedPart):
 
     def actuators(self, data, spec, coordinates, pulse_s: float):
         """Joint torques at the hips and knees (the rigid view's laws,
-        :class:`walkerlab.models.contact.joint_torques.JointTorqueActuators`)."""
+        :class:`walkerlab.models.contact.joint_torques.JointTorqueActuators`; virtual
+        constraints: the rigid view's computed torque at the role state,
+        :class:`walkerlab.models.contact.virtual_constraints.VirtualConstraintJointTorques`)."""
+        if getattr(spec, "virtual_constraints", None) is not None:  # computed torque
+            from .virtual_constraints import VirtualConstraintJointTorques
+
+            return VirtualConstraintJointTorques(data, spec, coordinates, pulse_s)
         from .joint_torques import JointTorqueActuators
 
         return JointTorqueActuators(data, spec, coordinates, pulse_s)
