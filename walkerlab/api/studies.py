@@ -199,10 +199,8 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
         Standard deviations of the per-step slope [rad] (default ``mfpt.sigma_rad``).
     method : {"mesh", "montecarlo", "both"}, optional
         Default ``mfpt.method`` (both).
-    workers : int
-        Local worker processes (1: in this process).
-    runs_dir, force
-        As :func:`fixed_point`.
+    workers, runs_dir, force
+        As :func:`basin`.
 
     Returns
     -------

@@ -283,16 +283,8 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     Parameters
     ----------
     path, duration_s, window_s, min_air_s, accuracy
-        As :func:`walk`.
-
-    Returns
-    -------
-    OpensimWalk
-
-    Raises
-    ------
-    walkerlab.extras.MissingExtra
-        OpenSim is not installed (one line naming the ``osim`` extra).
+        As :func:`walk`, which also gives what it returns (:class:`OpensimWalk`) and raises
+        (:class:`walkerlab.extras.MissingExtra` without OpenSim).
     """
     from walkerlab.export.mujoco_walk import latch_rule
     from walkerlab.extras import require

@@ -64,17 +64,8 @@ def compile_rhs_kernels(setup: ContactSetup) -> bool:
     into numba's on-disk cache, without a run: no fixed point, none of the run's other
     kernels (``pinned_to_full``, the contact table).  A cold contact run
     (:func:`walkerlab.stages.contact_sim.run`) has this done in a side process while it
-    compiles those others itself; its walk then only loads it.
-
-    Returns
-    -------
-    bool
-        False when numba is not installed (nothing is compiled), else True.
-
-    Raises
-    ------
-    ValueError
-        Massless bodies (no contact model).
+    compiles those others itself; its walk then only loads it. Returns and raises as
+    :func:`compile_run_kernels` (its ``ValueError`` here only for massless bodies).
     """
     if importlib.util.find_spec("numba") is None:
         return False

@@ -128,11 +128,8 @@ def simulate_on_profile(walker_at, data_at, P: np.ndarray, x0: np.ndarray, n_ste
 
     Parameters
     ----------
-    walker_at : callable ``slope [rad] -> HybridWalker``
-        The scene's rigid walker on a slope (absolute coordinates).
-    data_at : callable ``slope [rad] -> WalkerData``
-    P : ndarray (k, 2)
-        Profile points [m], x increasing (:func:`profile_points`).
+    walker_at, data_at, P
+        As :class:`ProfileGround`.
     x0 : ndarray (2n,)
         State just after heel strike [rad, rad/s].
     n_steps : int
