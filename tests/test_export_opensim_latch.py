@@ -3,17 +3,18 @@
 A kneed walker with arc feet fell at 0.34-0.43 s in OpenSim: the stepping loop's latch read
 the height of the foot sphere's centre, an arc radius above the contact point, so the stance
 knee's latch (release height 2 mm) never held.  The file is checked by its numbers (no
-OpenSim needed), and, where OpenSim is installed, walked (a slow test): the foot height the file's latch uses (the sphere centre's height
-above the slope line, from the file's own coordinates, frames and sphere, less the file's
-offset) equals the contact point's height in walkerlab's contact model (minus its
-penetration, which its latch weight reads) on the same state, for point and arc feet.  The
-forward kinematics here are this test's own (the file's PinJoint frames and coordinates);
-flat feet are refused by the OpenSim export (the capability table), so only one sphere per
-foot occurs.
+OpenSim needed), and, where OpenSim is installed, walked (a slow test).  The numbers: the
+foot height the file's latch uses (the sphere centre's height above the slope line, from
+the file's own coordinates, frames and sphere, less the file's offset) equals the contact
+point's height in walkerlab's contact model (minus its penetration, which its latch weight
+reads) on the same state, for point and arc feet.  The forward kinematics here are this
+test's own (the file's PinJoint frames and coordinates); flat feet are refused by the
+OpenSim export (the capability table), so only one sphere per foot occurs.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import re
 from pathlib import Path
@@ -220,6 +221,8 @@ def _centre(f: dict, q: dict, leg: str) -> np.ndarray:
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(importlib.util.find_spec("opensim") is None,
+                    reason="opensim (the osim extra) not installed")
 def test_kneed_walker_with_arc_feet_walks_ten_steps_in_opensim(tmp_path):
     """The issue's walker (configs/kneed.yaml with 50 mm arc feet), exported and walked in
     OpenSim from its default state (the rigid gait's heel strike) for 11.5 rigid periods:
@@ -227,8 +230,7 @@ def test_kneed_walker_with_arc_feet_walks_ten_steps_in_opensim(tmp_path):
     the rigid gait's (measured: 0.5495 s against 0.54259 s, +1.3 %; the first two steps
     0.556 and 0.569 s while the compliant contact settles) and speed within 5 % (measured
     -2.8 %).  Before the latch read the contact point it fell at 0.34-0.43 s."""
-    pytest.importorskip("opensim")
-    from walkerlab.export.opensim_walk import walk
+    from walkerlab.export.opensim_walk import walk  # OpenSim in a child process
 
     text = _file(_kneed({"kind": "arc", "radius_m": 0.05}), tmp_path)
     path = next(Path(tmp_path).rglob("*.osim"))
