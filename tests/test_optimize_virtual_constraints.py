@@ -176,3 +176,58 @@ def test_written_scene_full_order_multipliers_contain_delta2(designed):
     assert abs(mu[j] - c.delta2) < 1e-6
     assert abs(mu[j]) <= 0.6 + 1e-6
     assert np.max(np.abs(np.delete(mu, j))) < 1e-6
+
+
+# -- the shipped RABBIT design (configs/rabbit_hzd_optimal.yaml; slow: ~2 min) -----------
+
+@pytest.fixture(scope="module")
+def rabbit_designed(tmp_path_factory):
+    from walkerlab.config import load_scene
+    from walkerlab.io.schemas.optimize import load
+    from walkerlab.stages import pipeline
+
+    runs = tmp_path_factory.mktemp("runs")
+    sc = load_scene(ROOT / "configs" / "rabbit_hzd_optimal.yaml")
+    out = pipeline.run("optimize", sc, runs, False)
+    return load(out.path), out.path.parent, runs
+
+
+@pytest.mark.slow
+def test_rabbit_controllers_at_two_speeds_are_stable(rabbit_designed):
+    """Two controllers, one per target speed, each with delta^2 <= 0.6 met, the written
+    scene's restricted map equal to the collocation's (1e-8) and its full-order closed
+    loop's multipliers containing delta^2 (1e-6), the rest the feedback's."""
+    d, folder, _runs = rabbit_designed
+    assert [c.target_speed_m_per_s for c in d.controllers] == [0.5, 0.8]
+    for c in d.controllers:
+        assert c.status == "Solve_Succeeded"
+        assert c.delta2 <= 0.6 + 1e-9
+        assert abs(c.delta2_restricted - c.delta2) < 1e-8
+        assert abs(c.delta2_multiplier - c.delta2_restricted) < 1e-6
+        others = np.delete(c.multipliers, int(np.argmin(np.abs(c.multipliers - c.delta2))))
+        assert np.max(np.abs(others)) < 1e-6
+        assert abs(c.step_length_m / c.step_period_s - c.target_speed_m_per_s) < 1e-9
+        assert (folder / c.scene_file).is_file()
+
+
+@pytest.mark.slow
+def test_rabbit_controller_walks_in_the_contact_model(rabbit_designed):
+    """The 0.5 m/s controller's written scene in ``walkerlab contact-sim`` (the computed
+    torque at the contact walker's role state, 11 strides): >= 20 heel strikes, the mean
+    speed of the last 10 steps within 3 % of the rigid closed loop's (measured -1.0 %: the
+    regularised friction lets the stance foot creep ~0.4 mm a step)."""
+    import h5py
+
+    from walkerlab.config import load_scene
+    from walkerlab.stages import pipeline
+
+    d, folder, runs = rabbit_designed
+    c = d.controllers[0]
+    out = pipeline.run("contact-sim", load_scene(folder / c.scene_file), runs, False)
+    with h5py.File(out.path, "r") as f:
+        t = f["events/heel_strike_times"][()]
+        dist = f["ledger/steps/distance"][()]
+    assert len(t) >= 20
+    speed = np.mean(dist[-10:]) / np.mean(np.diff(t)[-10:])
+    rigid = c.step_length_m / c.full_order_step_period_s
+    assert abs(speed / rigid - 1) < 0.03

@@ -23,7 +23,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 __all__ = ["ControllerDesign", "check_design", "controller_scene", "controller_scene_text",
-           "designs_controller", "optimize_virtual_constraints"]
+           "controller_step", "design_controllers", "designs_controller",
+           "optimize_virtual_constraints"]
 
 KEY = "walker.actuation.virtual_constraints"
 
@@ -164,9 +165,12 @@ def controller_scene_text(scene, c: ControllerDesign, name: str) -> str:
     return head + yaml.safe_dump(body, sort_keys=False, width=100)
 
 
-def _guess(walker, solver, points: int):
-    """One step of the scene's closed loop from its zero dynamics' fixed point, at
-    ``points`` uniform times: ``(t, x (points, 2n), u (points, k), alpha, zd)``.
+def controller_step(walker, solver, points: int):
+    """One step of the scene's closed loop (``walker``: its rigid walker with the
+    controller; ``solver``: a :class:`~walkerlab.integrate.solver.Solver`) from its zero
+    dynamics' fixed point, at ``points`` uniform times: ``(t [s], x (points, 2n), u
+    (points, k) [N m], alpha (k, M + 1) [rad], zd)`` (``zd``: :class:`~walkerlab.analysis.
+    gait.zero_dynamics.ZeroDynamics`), the design's start.
 
     Raises
     ------
@@ -273,7 +277,7 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
         spec = replace(spec, max_torque_n_m=vc.max_torque_n_m)
     walker = build_walker(scene)
     K = 2 * int(o.intervals) + 1
-    t, x, u, alpha, _zd = _guess(walker, Solver.from_settings(scene.solver), K)
+    t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
     t0 = time.perf_counter()
     fns = hzd_functions(data, vc)
     build = time.perf_counter() - t0
