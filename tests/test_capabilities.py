@@ -321,7 +321,7 @@ def test_the_command_and_the_docs_show_the_table():
     for kind in KINDS.values():
         assert f"{kind.name}: {kind.title}" in r.output
         for row in CAPABILITIES[kind.name].values():
-            assert row in r.output
+            assert row is None or row in r.output  # None: supported past a refused walk
     spec = importlib.util.spec_from_file_location(
         "capability_table", ROOT / "docs" / "_ext" / "capability_table.py")
     ext = importlib.util.module_from_spec(spec)
