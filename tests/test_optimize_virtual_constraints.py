@@ -80,6 +80,19 @@ def test_max_multiplier_without_design_refused():
     assert "optimize.max_multiplier" in one_line(e)
 
 
+@pytest.mark.parametrize("change, key", [
+    ({"target_speeds_m_per_s": [0.5, 0.8]}, "optimize.target_speeds_m_per_s"),
+    ({"objective": "peak_torque"}, "optimize.objective"),
+    ({"push_off": "free"}, "optimize.push_off"),
+])
+def test_design_options_it_does_not_take_refused(change, key):
+    """A speed list beside a single speed target, another objective, a push-off: one line
+    naming the key."""
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(_scene(THREELINK, {**DESIGN, **change}))
+    assert key in one_line(e)
+
+
 def test_design_on_a_walker_without_virtual_constraints_refused():
     from walkerlab.optimal.driver import check_scene
 
