@@ -59,6 +59,37 @@ def test_collocation_delta2_is_the_restricted_maps(cfg):
     assert np.max(np.abs(np.array(y))) < 1e-10
 
 
+@pytest.mark.parametrize("shift", [0.0, 0.03, -0.05])
+def test_collocation_delta2_matches_the_hand_written_three_link_model(shift):
+    """Against tests/independent/three_link.py (the book's closed forms of D and the heel
+    strike, numpy, no walkerlab code): delta^2 of the swing leg's c_M moved by ``shift``
+    [rad] (the heel strike at q1 = -c_M, q2 = c_M; q'- = (1, M (c_M - c_{M-1}) / (theta- -
+    theta+)), theta+ = c_M).  Round-off only: 1e-12."""
+    import casadi as ca
+
+    from tests.independent import three_link as ref
+    from walkerlab.optimal.transcription.virtual_constraints import hzd_functions
+    from walkerlab.walker.description import walker_data
+
+    sc = scene_from_dict(copy.deepcopy(THREELINK))
+    fns = hzd_functions(walker_data(sc.walker, sc.slope.phi_rad),
+                        sc.walker.actuation.virtual_constraints)
+    alpha = np.array([o["bezier_rad"] for o in
+                      THREELINK["walker"]["actuation"]["virtual_constraints"]["outputs"]])
+    alpha[0, -1] += shift
+    M = alpha.shape[1] - 1
+    p = {"g": 9.8, "r": 1.0, "m": 5.0, "d": 0.5, "MH": 15.0, "MT": 10.0, "l": 0.5}
+    q_m = np.array([-alpha[0, -1], alpha[0, -1], alpha[1, -1]])
+    dth = q_m[0] - q_m[1]
+    qd_m = np.array([1.0, *(M * (alpha[:, -1] - alpha[:, -2]) / dth)])
+    xp = ref.impact(np.concatenate([q_m, qd_m]), p)
+    b = np.ones(3)
+    want = ((b @ ref.mass_matrix(xp[:3], p) @ xp[3:])
+            / (b @ ref.mass_matrix(q_m, p) @ qd_m)) ** 2
+    got = float(fns.delta2(ca.DM(q_m), ca.DM(alpha)))
+    assert abs(got - want) < 1e-12
+
+
 def _scene(base, optimize, name="design"):
     cfg = copy.deepcopy(base)
     cfg["name"] = name
