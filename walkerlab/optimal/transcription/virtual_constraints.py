@@ -88,7 +88,6 @@ class HzdFunctions:
     clearance_guard : bool
         The heel-strike guard is the swing foot's height (kneed legs), so the swing foot is
         kept above the ground inside the step; straight legs pass through it mid-stance.
-    joints : list of str
     """
 
     n: int
@@ -102,7 +101,6 @@ class HzdFunctions:
     B: np.ndarray
     b: np.ndarray
     clearance_guard: bool
-    joints: list
 
     def outputs(self, x, alpha, th_p, th_m):
         """``(y, y')`` (k,) each at the state ``x`` (CasADi), the phase's ends ``th_p``,
@@ -143,7 +141,10 @@ def hzd_functions(data, vc, prefix: str = KEY) -> HzdFunctions:
     VirtualConstraints`: its outputs, phase and joints), from the derivation its generated
     flow and the controller's pieces come from
     (:func:`walkerlab.codegen.virtual_constraints.derive_equations`, :func:`~walkerlab.
-    codegen.virtual_constraints.output_expressions`).
+    codegen.virtual_constraints.output_expressions`); the CasADi functions cached on disk
+    as the generated flows (``<user cache>/models/<structure key>-hzd-<hash>.casadi``, the
+    hash covering the parameters, the outputs, phase and joints, this module's and the
+    printer's source and CasADi's version).
 
     Raises
     ------
@@ -151,12 +152,54 @@ def hzd_functions(data, vc, prefix: str = KEY) -> HzdFunctions:
         A link, joint or coordinate the walker does not have, outputs and actuators that
         differ in number (one line naming the key).
     """
+    import hashlib
+
+    from walkerlab.codegen.cache import cache_key
+    from walkerlab.codegen.casadi_functions import cached_functions
+    from walkerlab.models.virtual_constraints import annihilator
+
+    what = repr((tuple(float(v) for v in data.params), float(data.slope_rad),
+                 float(data.gravity_m_per_s2), tuple(o.name for o in vc.outputs),
+                 vc.phase.model_dump_json(), tuple(vc.joints or ()), _source_hash()))
+    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
+    fns = cached_functions(f"{cache_key(data.structure)}-hzd-{tag}",
+                           lambda: _build(data, vc, prefix))
+    n, k = (int(v) for v in np.asarray(fns["sizes"].call([])[0], float).ravel())
+    consts = np.asarray(fns["consts"].call([])[0], float).ravel()
+    B = consts[:n * k].reshape(n, k)
+    return HzdFunctions(n=n, k=k, flow=fns["flow"], chart=fns["chart"], reset=fns["reset"],
+                        matrix=fns["matrix"], feet=fns["feet"], grf=fns["grf"], B=B,
+                        b=annihilator(B), clearance_guard=bool(consts[-1]))
+
+
+def _source_hash() -> str:
+    """This module's, the output expressions' and the CasADi printer's source and CasADi's
+    version (the cached functions' dependence on code)."""
+    import hashlib
+    from pathlib import Path
+
+    import casadi as ca
+
+    from walkerlab.codegen import casadi_functions
+    from walkerlab.codegen import virtual_constraints as pieces
+
+    h = hashlib.sha256(Path(__file__).read_bytes())
+    for mod in (casadi_functions, pieces):
+        h.update(Path(mod.__file__).read_bytes())
+    h.update(ca.__version__.encode())
+    return h.hexdigest()[:12]
+
+
+def _build(data, vc, prefix: str) -> dict:
+    """The CasADi functions of :func:`hzd_functions` (sympy derivation, then CasADi), with
+    ``sizes`` (``n, k``) and ``consts`` (``vec(B)`` row-major, then 1 where the heel-strike
+    guard is the swing foot's height) as functions of no input."""
     import casadi as ca
     import sympy as sp
 
     from walkerlab.codegen.casadi_functions import casadi_matrix
     from walkerlab.codegen.virtual_constraints import derive_equations, output_expressions
-    from walkerlab.models.virtual_constraints import annihilator, default_joints
+    from walkerlab.models.virtual_constraints import default_joints
 
     st = data.structure
     eq = derive_equations(st)
@@ -219,9 +262,10 @@ def hzd_functions(data, vc, prefix: str = KEY) -> HzdFunctions:
                                                  ca.cos(gam) * Fw[0] - ca.sin(gam) * Fw[1])])
     clearance_guard = sp.simplify(sp.sympify(eq.guards["heel_strike"])
                                   - sp.sympify(eq.guards["swing_clearance"])) == 0
-    return HzdFunctions(n=n, k=k, flow=flow, chart=chart, reset=reset, matrix=matrix,
-                        feet=feet, grf=grf, B=B, b=annihilator(B),
-                        clearance_guard=bool(clearance_guard), joints=joints)
+    consts = ca.DM([*B.ravel(), 1.0 if clearance_guard else 0.0])
+    return {"flow": flow, "chart": chart, "reset": reset, "matrix": matrix, "feet": feet,
+            "grf": grf, "sizes": ca.Function("sizes", [], [ca.DM([n, k])]),
+            "consts": ca.Function("consts", [], [consts])}
 
 
 @dataclass
