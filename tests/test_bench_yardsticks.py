@@ -71,3 +71,20 @@ def test_minimal_casadi_script_finds_compass_optimal_gait():
     assert objective < 1e-12  # int u^2 dt [N^2 m^2 s]: zero torque
     assert abs(period - gait.step_period) < 1e-6
     np.testing.assert_allclose(start, gait.x, rtol=0, atol=1e-6)
+
+
+@pytest.mark.slow
+def test_minimal_casadi_hzd_script_finds_walkerlabs_design():
+    """The minimal CasADi script of the three-link design (the book's closed forms, no
+    walkerlab import) reaches walkerlab's optimum from the same start: the same objective,
+    delta^2 at its bound and period (both IPOPT at tol 1e-10 on the same formulation:
+    agreement to ~1e-8 relative; bound 1e-6), so the benchmark's times compare the same
+    work."""
+    from walkerlab.bench.hzd import bench_design
+
+    r = bench_design(repeats=1)
+    w, s = r["walkerlab"], r["script"]
+    assert w["status"] == s["status"] == "Solve_Succeeded"
+    assert abs(w["objective"] / s["objective"] - 1) < 1e-6
+    assert abs(w["period_s"] - s["period_s"]) < 1e-6
+    assert abs(w["delta2"] - 0.6) < 1e-8 and abs(s["delta2"] - 0.6) < 1e-8

@@ -285,9 +285,10 @@ def test_torques_beside_virtual_constraints_refused():
 
 
 def test_views_without_the_controller_refuse_it(tmp_path):
-    """The Adams and OpenSim exports, the gym and optimize do not carry the controller yet:
-    each refuses it in one line naming the field (the capability table's cell); the contact
-    model and the MJCF take it (tests/test_virtual_constraint_views.py walks them)."""
+    """The Adams and OpenSim exports and the gym do not carry the controller yet: each
+    refuses it in one line naming the field (the capability table's cell); the contact
+    model and the MJCF take it (tests/test_virtual_constraint_views.py walks them), and
+    optimize designs it (tests/test_optimize_virtual_constraints.py)."""
     from walkerlab.export.scene import check_exportable
     from walkerlab.models.contact.scene import contact_setup
     from walkerlab.walker.kinds import KINDS, KindRefused
@@ -304,11 +305,13 @@ def test_views_without_the_controller_refuse_it(tmp_path):
     with pytest.raises(KindRefused) as e:  # the Adams writer's own path asks the table too
         export.run(scene, tmp_path, "adm")
     assert one_line(e).startswith("walker.actuation.virtual_constraints: ")
-    for view in ("gym", "optimize", "adams", "osim"):
+    for view in ("gym", "adams", "osim"):
         assert not KINDS["free_joints"].supports("virtual_constraints", view)
         assert not KINDS["hinged_torso"].supports("virtual_constraints", view)
-    for view in ("rigid", "contact", "mjcf"):
+    for view in ("rigid", "contact", "mjcf", "optimize"):  # optimize: design by collocation
         assert KINDS["free_joints"].supports("virtual_constraints", view)
+    assert KINDS["hinged_torso"].supports("virtual_constraints", "optimize")
+    assert not KINDS["straight_legs"].supports("virtual_constraints", "optimize")
     assert not KINDS["locking_knees"].supports("virtual_constraints", "rigid")
 
 

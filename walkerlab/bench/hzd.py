@@ -4,6 +4,14 @@
 and, for scale, one full-order step map of the closed loop (Westervelt, Grizzle &
 Koditschek 2003, IEEE TAC 48(1):42-56, Sec. V).  Medians of ``repeats`` runs, wall time
 (:func:`time.perf_counter`).
+
+And the design of the three-link walker's virtual constraints (``optimize.design:
+virtual_constraints``, configs/threelink_hzd.yaml's controller as the start, 0.8 m/s,
+``delta^2 <= 0.6``, 20 intervals) against the minimal CasADi script of the same formulation
+(:mod:`walkerlab.bench.minimal_casadi_hzd`, run as a process from the same start): the
+programme's build plus IPOPT's solve on each side (target: walkerlab <= 2x the script), and
+the whole ``walkerlab optimize`` computation (the start, the build, the solve, the written
+controller's zero dynamics and full-order fixed point; not the artifact's writing).
 """
 
 from __future__ import annotations
@@ -13,15 +21,22 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["bench_hzd", "lines"]
+__all__ = ["bench_design", "bench_hzd", "lines"]
 
 #: the issue's target for delta^2 [s]
 TARGET_S = 0.010
+#: the issue's target for the design: walkerlab's time over the minimal script's
+TARGET_RATIO = 2.0
+#: the three-link design (tests/test_optimize_virtual_constraints.py's)
+DESIGN = {"design": "virtual_constraints", "max_multiplier": 0.6, "target_speed_m_per_s": 0.8,
+          "intervals": 20, "max_torque_n_m": 150.0, "friction_coefficient": 0.8}
 
 
-def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50) -> dict:
+def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
+              design: bool = True) -> dict:
     """Timings of the zero dynamics of ``scene_path`` (default: the shipped RABBIT under
-    virtual constraints).
+    virtual constraints) and, with ``design``, of the three-link design
+    (:func:`bench_design`, under ``design``).
 
     Returns
     -------
@@ -53,10 +68,104 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50) -> dict:
     t = time.perf_counter()
     poincare_map(walker, zd.x_plus, Solver.from_settings(scene.solver))
     step = time.perf_counter() - t
-    return {"scene": scene.name, "repeats": repeats, "delta2": d2,
-            "delta2_s": float(np.median(d2_times)), "delta2_min_s": float(np.min(d2_times)),
-            "zero_dynamics_s": float(np.median(zd_times)), "build_s": build,
-            "step_map_s": step, "target_s": TARGET_S, "step_period_s": zd.step_period_s}
+    out = {"scene": scene.name, "repeats": repeats, "delta2": d2,
+           "delta2_s": float(np.median(d2_times)), "delta2_min_s": float(np.min(d2_times)),
+           "zero_dynamics_s": float(np.median(zd_times)), "build_s": build,
+           "step_map_s": step, "target_s": TARGET_S, "step_period_s": zd.step_period_s}
+    if design:
+        out["design"] = bench_design()
+    return out
+
+
+def bench_design(repeats: int = 3) -> dict:
+    """Timings of the three-link walker's design (module docstring): medians of
+    ``repeats`` runs of walkerlab's collocation (:func:`walkerlab.optimal.transcription.
+    virtual_constraints.hzd_functions` and :func:`~walkerlab.optimal.transcription.
+    virtual_constraints.collocate_virtual_constraints`) and of the minimal script, from the
+    same start; one run of the whole stage.
+
+    Returns
+    -------
+    dict
+        ``walkerlab_s`` (the median of the runs after the first: each reads the CasADi
+        functions from the disk cache, as a new process does), ``walkerlab_cold_s`` (the
+        first: on an empty cache it derives them with sympy),
+        ``script_s`` (build + solve) [s], ``ratio``, ``target_ratio``,
+        ``stage_s`` [s], the two optima (``objective`` [N^2 m s], ``delta2``, ``period_s``),
+        IPOPT's status and iterations on each side.
+    """
+    import subprocess
+    import sys
+    import tempfile
+    import time
+
+    import yaml
+
+    from walkerlab.codegen.casadi_functions import clear_memo
+    from walkerlab.config import scene_from_dict
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.driver import collocation_spec, optimize_scene
+    from walkerlab.optimal.transcription.virtual_constraints import (
+        collocate_virtual_constraints,
+        hzd_functions,
+    )
+    from walkerlab.optimal.virtual_constraints import controller_step
+    from walkerlab.walker.description import walker_data
+
+    root = Path(__file__).resolve().parents[2]
+    cfg = yaml.safe_load((root / "configs" / "threelink_hzd.yaml").read_text())
+    cfg.update(name="threelink_design", optimize=dict(DESIGN))
+    scene = scene_from_dict(cfg)
+    vc = scene.walker.actuation.virtual_constraints
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    K = 2 * DESIGN["intervals"] + 1
+    t, x, u, alpha, _zd = controller_step(build_walker(scene), Solver.from_settings(
+        scene.solver), K)
+    spec = collocation_spec(scene)
+    ours, res = [], None
+    for _ in range(repeats):
+        clear_memo()  # each run reads its functions as a new process would (disk cache)
+        t0 = time.perf_counter()
+        fns = hzd_functions(data, vc)
+        res = collocate_virtual_constraints(
+            fns, spec, t, x, u, alpha, DESIGN["max_multiplier"],
+            (vc.feedback.kp_per_s2, vc.feedback.kd_per_s))
+        ours.append(time.perf_counter() - t0)
+    script = root / "walkerlab" / "bench" / "minimal_casadi_hzd.py"
+    theirs, words = [], []
+    with tempfile.TemporaryDirectory() as d:
+        npz = Path(d) / "start.npz"
+        np.savez(npz, t=t, x=x, u=u, alpha=alpha, N=DESIGN["intervals"],
+                 speed=DESIGN["target_speed_m_per_s"], max_multiplier=DESIGN["max_multiplier"],
+                 kp=vc.feedback.kp_per_s2, kd=vc.feedback.kd_per_s,
+                 u_max=DESIGN["max_torque_n_m"], mu=DESIGN["friction_coefficient"])
+        for _ in range(repeats):
+            run = subprocess.run([sys.executable, str(script), str(npz)], capture_output=True,
+                                 text=True, timeout=600, cwd="/")
+            if run.returncode != 0:
+                raise RuntimeError(f"bench hzd: the minimal script failed: {run.stderr[-500:]}")
+            words = run.stdout.split()
+            theirs.append(float(words[words.index("build_s") + 1])
+                          + float(words[words.index("solve_s") + 1]))
+    t0 = time.perf_counter()
+    optimize_scene(scene, None, None)  # the stage's computation (not its file writing)
+    stage = time.perf_counter() - t0
+
+    def word(key):
+        return float(words[words.index(key) + 1])
+    warm = ours[1:] or ours  # the first run may derive the model (sympy, an empty cache)
+    ratio = float(np.median(warm) / np.median(theirs))
+    return {"walkerlab_s": float(np.median(warm)), "walkerlab_cold_s": ours[0],
+            "script_s": float(np.median(theirs)),
+            "ratio": ratio, "target_ratio": TARGET_RATIO, "stage_s": stage,
+            "repeats": repeats, "walkerlab": {
+                "status": res.status, "iterations": res.iterations,
+                "objective": res.objective, "delta2": res.delta2,
+                "period_s": res.step_period_s},
+            "script": {"status": words[0], "iterations": int(word("iterations")),
+                       "objective": word("objective"), "delta2": word("delta2"),
+                       "period_s": word("period")}}
 
 
 def lines(res: dict) -> list[str]:
@@ -67,4 +176,23 @@ def lines(res: dict) -> list[str]:
             f"{1e3 * res['target_s']:.0f} ms: {ok})",
             f"hzd: zero dynamics (V, V_max, zeta*, period {res['step_period_s']:.10f} s) "
             f"{1e3 * res['zero_dynamics_s']:.1f} ms; controller build {res['build_s']:.2f} s; "
-            f"one full-order step map {res['step_map_s']:.3f} s"]
+            f"one full-order step map {res['step_map_s']:.3f} s"] + _design_lines(res)
+
+
+def _design_lines(res: dict) -> list[str]:
+    d = res.get("design")
+    if not d:
+        return []
+    ok = "met" if d["ratio"] <= d["target_ratio"] else "NOT MET"
+    w, s = d["walkerlab"], d["script"]
+    return [f"hzd: three-link design (0.8 m/s, delta^2 <= 0.6): walkerlab "
+            f"{d['walkerlab_s']:.2f} s, minimal CasADi script {d['script_s']:.2f} s (build + "
+            f"solve, medians of {d['repeats']}; walkerlab's after its first, from the disk "
+            f"cache): "
+            f"{d['ratio']:.2f}x (target <= "
+            f"{d['target_ratio']:.0f}x: {ok}); the first run (sympy on an empty cache) "
+            f"{d['walkerlab_cold_s']:.2f} s; the whole optimize computation {d['stage_s']:.1f} s",
+            f"hzd: optima: walkerlab {w['status']} in {w['iterations']} iterations, objective "
+            f"{w['objective']:.10g} N^2 m s, delta^2 {w['delta2']:.10g}, period "
+            f"{w['period_s']:.10g} s; script {s['status']} in {s['iterations']}, "
+            f"{s['objective']:.10g}, {s['delta2']:.10g}, {s['period_s']:.10g} s"]

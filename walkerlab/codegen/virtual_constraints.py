@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import hashlib
 
-__all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_pieces",
-           "resolve_link"]
+__all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_expressions",
+           "output_pieces", "resolve_link"]
 
 
 def derive_equations(structure):
@@ -66,20 +66,19 @@ def _joint_expr(leg_angles: dict, joint: str, where: str):
     return leg_angles[second] - leg_angles[first]
 
 
-def _expressions(eq, params, outputs, phase, joints, prefix: str):
-    """The flat lists of sympy expressions of the pieces (module docstring), the
-    parameters substituted: ``(out, foot, B)``.
+def output_expressions(eq, outputs, phase, joints, prefix: str):
+    """The outputs' ``h0`` (k sympy expressions), the phase variable ``theta`` and the
+    actuated joints' angles, of the walker's symbols (its parameters not substituted): the
+    one reading of a virtual-constraint spec on a derivation (the generated pieces and the
+    optimiser's CasADi functions, :mod:`walkerlab.optimal.transcription.virtual_constraints`).
 
     Raises
     ------
     ValueError
         A link, joint or coordinate the walker does not have (one line naming the key).
     """
-    import sympy as sp
-
     la = eq.leg_angles
-    q, dq = list(eq.q), list(eq.dq)
-    n = len(q)
+    q = list(eq.q)
     h0 = []
     for i, (kind, name) in enumerate(outputs):
         where = f"{prefix}.outputs.{i}.{kind}"
@@ -96,7 +95,23 @@ def _expressions(eq, params, outputs, phase, joints, prefix: str):
             raise ValueError(f"{prefix}.phase.coordinates.{bad[0]}: not a coordinate of "
                              f"this walker (its coordinates: {', '.join(roles)})")
         th = sum(c * q[roles.index(k)] for k, c in phase.coordinates.items())
-    joint_exprs = [_joint_expr(la, j, f"{prefix}.joints") for j in joints]
+    return h0, th, [_joint_expr(la, j, f"{prefix}.joints") for j in joints]
+
+
+def _expressions(eq, params, outputs, phase, joints, prefix: str):
+    """The flat lists of sympy expressions of the pieces (module docstring), the
+    parameters substituted: ``(out, foot, B)``.
+
+    Raises
+    ------
+    ValueError
+        A link, joint or coordinate the walker does not have (one line naming the key).
+    """
+    import sympy as sp
+
+    q, dq = list(eq.q), list(eq.dq)
+    n = len(q)
+    h0, th, joint_exprs = output_expressions(eq, outputs, phase, joints, prefix)
     sub = dict(zip(eq.params, params))
 
     def num(e):

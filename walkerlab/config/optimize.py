@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import ConfigDict, Field, model_validator
+from pydantic import ConfigDict, Field, model_serializer, model_validator
 
-from walkerlab.config.base import AsTuple, Strict
+from walkerlab.config.base import AsTuple, Strict, drop_unset
 
 __all__ = ["OptimizeGuess", "OptimizeSettings"]
 
@@ -96,6 +96,43 @@ class OptimizeSettings(Strict):
         "a five-link biped, off for the others (~20 step maps: on compiled flows for "
         "massive straight or kneed legs with point feet, ~10 ms each; massless legs and "
         "flat feet run the law in Python, ~2-3 s of CPU each)")
+    design: Literal["virtual_constraints"] | None = Field(
+        None, description="virtual_constraints: the walker's Bezier coefficients "
+        "(walker.actuation.virtual_constraints) are the decision variables, with the step "
+        "(FROST's formulation: the output dynamics at every point, impact invariance, "
+        "delta^2 <= max_multiplier); the optimum is a feedback controller, written as a "
+        "scene into the run folder (null: open-loop torques)")
+    max_multiplier: float | None = Field(
+        None, gt=0, lt=1, description="design: virtual_constraints: the restricted Poincare "
+        "map's multiplier delta^2 at most this (the closed loop's stability) [-]")
+    target_speeds_m_per_s: list[Annotated[float, Field(gt=0, le=20)]] | None = Field(
+        None, min_length=1, max_length=8, description="design: virtual_constraints: one "
+        "controller per speed (step length / step period) [m/s]")
+
+    @model_serializer(mode="wrap")
+    def _as_given(self, handler):
+        return drop_unset(handler(self), ("design", "max_multiplier",
+                                          "target_speeds_m_per_s"))
+
+    @model_validator(mode="after")
+    def _design(self) -> OptimizeSettings:
+        if self.design is None:
+            for k in ("max_multiplier", "target_speeds_m_per_s"):
+                if getattr(self, k) is not None:
+                    raise ValueError(f"optimize.{k}: give it with design: "
+                                     "virtual_constraints (and only then)")
+            return self
+        if self.target_speeds_m_per_s is not None and self.target_speed_m_per_s is not None:
+            raise ValueError("optimize.target_speeds_m_per_s: give it or target_speed_m_per_s,"
+                             " not both")
+        if self.objective != "effort":
+            raise ValueError(f"optimize.objective: design: virtual_constraints minimises the "
+                             f"effort per step length (int u^2 dt / step length), not "
+                             f"{self.objective}: leave objective out")
+        if self.push_off != "fixed" or self.initial_guess is not None:
+            raise ValueError("optimize.push_off / initial_guess: design: virtual_constraints "
+                             "starts from the scene's own controller and has no push-off")
+        return self
 
     @model_validator(mode="after")
     def _targets(self) -> OptimizeSettings:

@@ -43,6 +43,11 @@ from walkerlab.io.schemas.optimize import OptimizeData
 from walkerlab.optimal import outcome as reported
 from walkerlab.optimal.free_joints import optimize_five_link, stick_figures
 from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
+from walkerlab.optimal.virtual_constraints import (
+    check_design,
+    designs_controller,
+    optimize_virtual_constraints,
+)
 
 __all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
            "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
@@ -105,6 +110,8 @@ def needs_gait(scene) -> bool:
     (:func:`no_gait_of_its_own`), whose step is built from them too
     (:func:`walkerlab.optimal.guess.target_step`).  A kind the collocation does not take
     needs none (the stage refuses it at once)."""
+    if designs_controller(scene):  # starts from the scene's own controller
+        return False
     part = PARTS.get(_structure(scene).kind.name)
     return part is not None and not part.from_targets and not no_gait_of_its_own(scene)
 
@@ -199,6 +206,9 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
     from walkerlab.walker.description import walker_data
 
     data = walker_data(scene.walker, scene.slope.phi_rad)
+    if designs_controller(scene):  # virtual constraints: any kind the table lets through
+        check_scene(scene, data)
+        return optimize_virtual_constraints(scene, data, collocation_spec(scene))
     part = _part(data.structure)
     check_scene(scene, data)
     if x_gait is None and not part.from_targets and (data.mirror is not None
@@ -235,6 +245,10 @@ def check_kind(scene, kind) -> None:
     act = scene.walker.actuation
     if act is not None and act.virtual_constraints is not None:
         kind.require("virtual_constraints", "optimize", "walker.actuation.virtual_constraints")
+        raise ValueError("optimize.design: the walker is driven by its virtual constraints "
+                         "(walker.actuation.virtual_constraints): give design: "
+                         "virtual_constraints to optimise them (open-loop torques would "
+                         "replace the controller)")
     if scene.optimize.push_off == "free" or (act is not None and act.push_off
                                              and act.push_off.impulse_n_s):
         kind.require("push_off", "optimize", "optimize.push_off")
@@ -271,6 +285,9 @@ def check_scene(scene, data=None) -> None:
         from walkerlab.walker.description import walker_data
 
         data = walker_data(scene.walker, scene.slope.phi_rad)
+    if designs_controller(scene):
+        check_design(scene, data.structure.kind)
+        return
     check_kind(scene, data.structure.kind)
     if (o.min_clearance_m or 0.0) > 0.0 and _feet_level_when_legs_cross(scene, data):
         raise ValueError(

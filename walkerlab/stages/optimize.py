@@ -64,9 +64,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         kind the collocation does not take (the capability table's line).
     """
     from walkerlab.optimal.driver import check_targets, guess_from_targets, no_gait_of_its_own
+    from walkerlab.optimal.virtual_constraints import designs_controller
 
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
+    if designs_controller(scene):  # starts from the scene's own controller, no upstream
+        try:
+            check(scene)
+        except ValueError as exc:
+            raise StageError(str(exc)) from exc
+        out = _run_optimum(scene, runs_root, force, None, ())
+        write_controller_scenes(scene, out.path)
+        return out
     try:
         from_targets = guess_from_targets(scene)
     except ValueError as exc:  # a kind the collocation does not take
@@ -113,6 +122,29 @@ def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream) -> StageO
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, upstream, compute, force)
+
+
+def write_controller_scenes(scene: Scene, artifact: Path) -> list[Path]:
+    """Write the scene of every controller ``optimize.h5`` (``artifact``) holds beside it
+    (``controllers/<i>``' ``scene_file``: the scene with the optimised coefficients,
+    :func:`walkerlab.optimal.virtual_constraints.controller_scene_text`), each to a
+    temporary name and then renamed (a file either old or whole).  Returns the paths."""
+    import os
+
+    from walkerlab.optimal.virtual_constraints import controller_scene_text
+    from walkerlab.safefs import atomic_replace, refuse_link
+
+    paths = []
+    for c in schema.load(artifact).controllers:
+        path = refuse_link(Path(artifact).parent / c.scene_file)
+        text = controller_scene_text(scene, c, Path(c.scene_file).stem).encode()
+
+        def fill(fd, _tmp, text=text):
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(text)
+        atomic_replace(path, fill, mode=0o644, suffix=".yaml.tmp", name=path.stem)
+        paths.append(path)
+    return paths
 
 
 def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
@@ -180,7 +212,8 @@ def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True) -> list
 
     d = schema.load(stage_artifact(scene, runs_root, "optimize"))
     sticks = None
-    if d.torque_names != ("hip",):  # a five-link biped: its step as stop action
+    # a five-link biped's open-loop step: its stop action
+    if d.torque_names != ("hip",) and not d.controllers:
         from walkerlab.optimal.driver import stick_figures
 
         sticks = stick_figures(scene, d)

@@ -103,7 +103,9 @@ class Kind:
     def cell(self, feature: str, view: str) -> str | None:
         """None when the kind supports ``feature`` in ``view``, else the one-line reason
         (:data:`CAPABILITIES`; a view that refuses the walker itself, ``walk``, refuses
-        each of its features for that reason).
+        each of its features for that reason, but a feature whose cell is listed as None:
+        the view takes it by a set-up of its own, as ``optimize`` designs virtual
+        constraints on a walker whose open-loop torques it does not transcribe).
 
         Raises
         ------
@@ -114,8 +116,9 @@ class Kind:
             raise KeyError(f"{feature!r} in {view!r}: features are {', '.join(FEATURES)}; "
                            f"views {', '.join(VIEWS)}")
         row = CAPABILITIES[self.name]
-        if feature != "walk" and ("walk", view) in row:  # a view without the walker: none
-            return row[("walk", view)]                    # of its features either
+        if feature != "walk" and ("walk", view) in row and row.get((feature, view), "") \
+                is not None:  # a view without the walker: none of its features either,
+            return row[("walk", view)]  # but one listed as None (its own transcription)
         return row.get((feature, view), row.get((feature, "*")))
 
     def supports(self, feature: str, view: str) -> bool:
@@ -203,8 +206,6 @@ _VC_VIEWS = {
                                       "computed torque yet (export --format mjcf runs it)"),
     ("virtual_constraints", "gym"): ("the Gymnasium environment has no scene policy for "
                                      "virtual constraints yet (contact-sim runs them)"),
-    ("virtual_constraints", "optimize"): ("optimize does not take Bezier coefficients as "
-                                          "decision variables yet: leave them out"),
 }
 #: what the views of every legged kind refuse: grounds whose steps differ in the Adams
 #: dataset and the OpenSim model (the contact model, the MJCF and the gym's contact view
@@ -232,10 +233,14 @@ _FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
 #: part) or says what the view's model does not carry.
-CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
+CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "straight_legs": {
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
+        ("virtual_constraints", "optimize"): ("optimize.design: virtual_constraints is built "
+                                              "for a torso hinged on the legs (the three-link "
+                                              "walker, RABBIT): a walker of one actuator is not "
+                                              "transcribed yet; leave them out"),
         **_NO_ANKLES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         **_GROUNDS,
@@ -287,10 +292,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         **_NO_ANKLES,
-        ("walk", "optimize"): ("the free-jointed collocation drives a five-link biped's "
-                               "hips and knees; a torso hinged on straight legs is not "
-                               "transcribed yet (run it in fixedpoint, simulate, contact-sim, "
-                               "the exports and the gym)"),
+        ("walk", "optimize"): ("open-loop torques of a torso hinged on straight legs are "
+                               "not transcribed yet; its virtual constraints are "
+                               "(optimize.design: virtual_constraints)"),
+        ("virtual_constraints", "optimize"): None,  # optimize.design: virtual_constraints
         **_GROUNDS,
         # a walker held up by its joint torques (a passive one would build); the MJCF's
         # patches lie at the rigid gait's footfalls

@@ -52,6 +52,17 @@ points)::
                                   u*(t)| along it), ``multipliers/{real,imag}``; attribute
                                   ``closed``
 
+    controllers/<i>/...           (optimize.design: virtual_constraints) one designed
+                                  controller per target speed: ``bezier`` (rad, k x (M+1),
+                                  attribute output_names), delta2, delta2_restricted,
+                                  existence_margin, the collocated and the closed loop's
+                                  step periods, multipliers/{real,imag} (the full-order
+                                  fixed point's), ... (:data:`CONTROLLER_VALUES`);
+                                  attribute scene_file (the scene written beside it).
+                                  The top-level step is controller 0's; its
+                                  replay/max_state_error the full-order fixed point's
+                                  distance from the zero dynamics' orbit.
+
 attributes: ``gait`` (the replay closed), ``state_names``; ``steps`` (a stride of
 legs that differ: 2; absent for one step): ``time`` then covers the stride, its phases
 are the steps' (as many per step), ``step_period`` and ``step_length`` are the mean
@@ -70,9 +81,9 @@ import numpy as np
 
 STAGE = "optimize"
 
-__all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "PHASE_LAWS", "PhaseReplayData",
-           "STAGE", "load", "load_design", "optimize_record", "phase_replay_records", "write",
-           "write_design"]
+__all__ = ["CONTROLLER_VALUES", "ControllerData", "DESIGN_STAGE", "DesignData", "OptimizeData",
+           "PHASE_LAWS", "PhaseReplayData", "STAGE", "load", "load_design", "optimize_record",
+           "phase_replay_records", "write", "write_design"]
 
 #: the phase-variable replays an artifact may carry (optimize.phase_replay)
 PHASE_LAWS = ("feedback", "feedforward")
@@ -167,6 +178,64 @@ class OptimizeData:
     phase_replay_outcome: str = ""  # why there are no phase replays ("": there are, or off)
     # IPOPT did not converge: the constraint groups with the largest violation ("": none)
     violations: str = ""
+    # optimize.design: virtual_constraints: the designed controllers (ControllerData or the
+    # driver's walkerlab.optimal.virtual_constraints.ControllerDesign); empty: none
+    controllers: tuple = ()
+
+
+@dataclass
+class ControllerData:
+    """One designed controller (``controllers/<i>/``, ``optimize.design:
+    virtual_constraints``; units in the module docstring)."""
+
+    target_speed_m_per_s: float
+    bezier_rad: np.ndarray
+    output_names: tuple
+    step_period_s: float
+    step_length_m: float
+    objective: float
+    effort: float
+    delta2: float
+    delta2_restricted: float
+    existence_margin: float
+    restricted_step_period_s: float
+    full_order_step_period_s: float
+    orbit_shift: float
+    multipliers: np.ndarray
+    delta2_multiplier: complex
+    max_torque_n_m: float
+    max_output: float
+    max_output_rate: float
+    status: str
+    iterations: int
+    wall_time_s: float
+    build_time_s: float
+    scene_file: str
+
+
+#: controllers/<i>/ datasets: (field, unit, description)
+CONTROLLER_VALUES = (
+    ("target_speed_m_per_s", "m/s", "the target speed (NaN: none)"),
+    ("step_period_s", "s", "the collocated step's period"),
+    ("step_length_m", "m", "the collocated step's length"),
+    ("objective", "N^2 m s", "int |u|^2 dt / step length at the optimum"),
+    ("effort", "N^2 m^2 s", "int |u|^2 dt at the optimum"),
+    ("delta2", "-", "delta^2 at the optimum (the collocation's expression)"),
+    ("delta2_restricted", "-", "delta^2 of the written controller's restricted Poincare "
+     "map (walkerlab.analysis.gait.zero_dynamics)"),
+    ("existence_margin", "(kg m^2/s)^2", "delta^2/(1-delta^2) V(theta-) + V_max (< 0: the "
+     "zero dynamics' orbit exists; the phase variable's units)"),
+    ("restricted_step_period_s", "s", "the zero dynamics' step period by quadrature"),
+    ("full_order_step_period_s", "s", "the rigid closed loop's fixed point's period (NaN: "
+     "none)"),
+    ("orbit_shift", "-", "max |x* - x+|: the full-order fixed point from the zero dynamics' "
+     "post-impact state [rad, rad/s]"),
+    ("max_torque_n_m", "N m", "largest |u| of the collocated step"),
+    ("max_output", "rad", "max |y| over the collocation points"),
+    ("max_output_rate", "rad/s", "max |y'| over the collocation points"),
+    ("wall_time_s", "s", "IPOPT's wall time"),
+    ("build_time_s", "s", "the programme's build time"),
+)
 
 
 def phase_replay_records(replays: dict) -> dict:
@@ -288,7 +357,53 @@ def write(f, d: OptimizeData) -> None:
         f.attrs["phase_replay_outcome"] = d.phase_replay_outcome
     if d.violations:
         f.attrs["ipopt_violations"] = d.violations
+    for i, c in enumerate(d.controllers):
+        _write_controller(f, i, c)
     _write_history_and_energy(f, d)
+
+
+def _write_controller(f, i: int, c) -> None:
+    """``controllers/<i>/`` of one designed controller ``c`` (:class:`ControllerData`'s
+    attributes)."""
+    from walkerlab.io.artifacts import put
+
+    g = f"controllers/{i}"
+    put(f, f"{g}/bezier", np.asarray(c.bezier_rad, float), "rad", "the optimised Bezier "
+        "coefficients (one row per output, attribute output_names; c_0, c_1 recomputed by "
+        "invariant: true in the written scene)")
+    for key, unit, desc in CONTROLLER_VALUES:
+        put(f, f"{g}/{key}", float(getattr(c, key)), unit, desc)
+    mu = np.asarray(c.multipliers, complex)
+    put(f, f"{g}/multipliers/real", mu.real, "-", "the full-order fixed point's Floquet "
+        "multipliers (variational)")
+    put(f, f"{g}/multipliers/imag", mu.imag, "-", "the full-order fixed point's Floquet "
+        "multipliers (variational)")
+    near = complex(c.delta2_multiplier)
+    put(f, f"{g}/delta2_multiplier", np.array([near.real, near.imag]), "-", "the full-order "
+        "multiplier nearest delta^2 (real, imaginary)")
+    a = f[g].attrs
+    a["output_names"] = list(c.output_names)
+    a["ipopt_status"] = str(c.status)
+    a["ipopt_iterations"] = int(c.iterations)
+    a["scene_file"] = str(c.scene_file)
+
+
+def _load_controllers(f) -> tuple:
+    if "controllers" not in f:
+        return ()
+    out = []
+    for i in range(len(f["controllers"])):
+        g = f[f"controllers/{i}"]
+        vals = {key: float(g[key][()]) for key, _u, _d in CONTROLLER_VALUES}
+        near = g["delta2_multiplier"][()]
+        out.append(ControllerData(
+            bezier_rad=g["bezier"][()], output_names=tuple(str(s) for s in
+                                                           g.attrs["output_names"]),
+            multipliers=g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
+            delta2_multiplier=complex(near[0], near[1]), status=str(g.attrs["ipopt_status"]),
+            iterations=int(g.attrs["ipopt_iterations"]),
+            scene_file=str(g.attrs["scene_file"]), **vals))
+    return tuple(out)
 
 
 def _write_history_and_energy(f, d: OptimizeData) -> None:
@@ -351,7 +466,7 @@ def load(path: Path) -> OptimizeData:
             float(f.attrs.get("ipopt_build_time_s", float("nan"))),
             {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
             int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")),
-            str(f.attrs.get("ipopt_violations", "")))
+            str(f.attrs.get("ipopt_violations", "")), _load_controllers(f))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)

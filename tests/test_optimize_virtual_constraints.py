@@ -1,0 +1,277 @@
+"""Virtual constraints designed by ``walkerlab optimize`` (``optimize.design:
+virtual_constraints``; walkerlab.optimal.transcription.virtual_constraints): the collocation's
+``delta^2`` expression against the restricted Poincare map's (walkerlab.analysis.gait.
+zero_dynamics, numpy on the generated model: another code path), the stability bound met at
+the optimum, the written scene's full-order multipliers containing ``delta^2``, and the bad
+inputs refused in one line.
+
+The end-to-end design of the three-link walker (configs/threelink_hzd.yaml's controller as
+the start, 0.8 m/s, ``delta^2 <= 0.6``) takes ~10 s: marked slow.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from walkerlab.config import SceneError, scene_from_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+THREELINK = yaml.safe_load((ROOT / "configs" / "threelink_hzd.yaml").read_text())
+RABBIT = yaml.safe_load((ROOT / "configs" / "rabbit_hzd.yaml").read_text())
+#: the three-link design: 0.8 m/s, delta^2 <= 0.6 (the scene's own controller: 0.889)
+DESIGN = {"design": "virtual_constraints", "max_multiplier": 0.6, "target_speed_m_per_s": 0.8,
+          "intervals": 20, "max_torque_n_m": 150.0, "friction_coefficient": 0.8}
+
+
+def one_line(e) -> str:
+    text = str(e.value)
+    assert len(text.strip().splitlines()) == 1, text
+    return text
+
+
+@pytest.mark.parametrize("cfg", [THREELINK, RABBIT], ids=["threelink", "rabbit"])
+def test_collocation_delta2_is_the_restricted_maps(cfg):
+    """The CasADi ``delta^2(q-, alpha)`` (the symbolic derivation, CasADi's linear solve)
+    equals :func:`impact_multiplier` (numpy on the generated flow's matrices and reset) at
+    the scene's controller; round-off only (1e-12: both are a few 5x5 solves)."""
+    import casadi as ca
+
+    from walkerlab.analysis.gait.zero_dynamics import impact_multiplier
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.transcription.virtual_constraints import hzd_functions
+    from walkerlab.walker.description import walker_data
+
+    sc = scene_from_dict(copy.deepcopy(cfg))
+    ctrl = build_walker(sc).actuators.controller
+    fns = hzd_functions(walker_data(sc.walker, sc.slope.phi_rad),
+                        sc.walker.actuation.virtual_constraints)
+    d = ctrl.design
+    got = float(fns.delta2(ca.DM(d.q_minus), ca.DM(d.alpha)))
+    assert abs(got - impact_multiplier(ctrl)) < 1e-12
+    # and the outputs vanish on the controller's surface at its ends (y = 0 at q-)
+    y, _dy = fns.outputs(ca.DM(np.concatenate([d.q_minus, np.zeros(ctrl.n)])),
+                         ca.DM(d.alpha), d.theta_plus, d.theta_minus)
+    assert np.max(np.abs(np.array(y))) < 1e-10
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.03, -0.05])
+def test_collocation_delta2_matches_the_hand_written_three_link_model(shift):
+    """Against tests/independent/three_link.py (the book's closed forms of D and the heel
+    strike, numpy, no walkerlab code): delta^2 of the swing leg's c_M moved by ``shift``
+    [rad] (the heel strike at q1 = -c_M, q2 = c_M; q'- = (1, M (c_M - c_{M-1}) / (theta- -
+    theta+)), theta+ = c_M).  Round-off only: 1e-12."""
+    import casadi as ca
+
+    from tests.independent import three_link as ref
+    from walkerlab.optimal.transcription.virtual_constraints import hzd_functions
+    from walkerlab.walker.description import walker_data
+
+    sc = scene_from_dict(copy.deepcopy(THREELINK))
+    fns = hzd_functions(walker_data(sc.walker, sc.slope.phi_rad),
+                        sc.walker.actuation.virtual_constraints)
+    alpha = np.array([o["bezier_rad"] for o in
+                      THREELINK["walker"]["actuation"]["virtual_constraints"]["outputs"]])
+    alpha[0, -1] += shift
+    M = alpha.shape[1] - 1
+    p = {"g": 9.8, "r": 1.0, "m": 5.0, "d": 0.5, "MH": 15.0, "MT": 10.0, "l": 0.5}
+    q_m = np.array([-alpha[0, -1], alpha[0, -1], alpha[1, -1]])
+    dth = q_m[0] - q_m[1]
+    qd_m = np.array([1.0, *(M * (alpha[:, -1] - alpha[:, -2]) / dth)])
+    xp = ref.impact(np.concatenate([q_m, qd_m]), p)
+    b = np.ones(3)
+    want = ((b @ ref.mass_matrix(xp[:3], p) @ xp[3:])
+            / (b @ ref.mass_matrix(q_m, p) @ qd_m)) ** 2
+    got = float(fns.delta2(ca.DM(q_m), ca.DM(alpha)))
+    assert abs(got - want) < 1e-12
+
+
+def _scene(base, optimize, name="design"):
+    cfg = copy.deepcopy(base)
+    cfg["name"] = name
+    cfg["optimize"] = dict(optimize)
+    return cfg
+
+
+@pytest.mark.parametrize("value", [0.0, 1.0, 1.5])
+def test_max_multiplier_outside_the_unit_interval_refused(value):
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(_scene(THREELINK, {**DESIGN, "max_multiplier": value}))
+    assert "optimize.max_multiplier" in one_line(e)
+
+
+def test_max_multiplier_without_design_refused():
+    opt = {k: v for k, v in DESIGN.items() if k != "design"}
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(_scene(THREELINK, opt))
+    assert "optimize.max_multiplier" in one_line(e)
+
+
+@pytest.mark.parametrize("change, key", [
+    ({"target_speeds_m_per_s": [0.5, 0.8]}, "optimize.target_speeds_m_per_s"),
+    ({"objective": "peak_torque"}, "optimize.objective"),
+    ({"push_off": "free"}, "optimize.push_off"),
+])
+def test_design_options_it_does_not_take_refused(change, key):
+    """A speed list beside a single speed target, another objective, a push-off: one line
+    naming the key."""
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(_scene(THREELINK, {**DESIGN, **change}))
+    assert key in one_line(e)
+
+
+def test_design_on_a_walker_without_virtual_constraints_refused():
+    from walkerlab.optimal.driver import check_scene
+
+    cfg = yaml.safe_load((ROOT / "configs" / "threelink.yaml").read_text())
+    sc = scene_from_dict(_scene(cfg, DESIGN))
+    with pytest.raises(ValueError) as e:
+        check_scene(sc)
+    assert one_line(e).startswith("optimize.design")
+
+
+def test_virtual_constraints_without_design_refused():
+    """Open-loop torques would replace the controller: optimize asks for the design."""
+    from walkerlab.optimal.driver import check_scene
+
+    sc = scene_from_dict(_scene(RABBIT, {"target_speed_m_per_s": 0.6}))
+    with pytest.raises(ValueError) as e:
+        check_scene(sc)
+    assert one_line(e).startswith("optimize.design")
+
+
+def test_design_refused_where_the_table_refuses_it():
+    """Straight legs without a torso (one actuator): the capability table's line."""
+    from walkerlab.optimal.driver import check_scene
+    from walkerlab.walker.kinds import KINDS
+
+    cfg = yaml.safe_load((ROOT / "configs" / "powered_compass.yaml").read_text())
+    cfg["walker"]["actuation"] = {"virtual_constraints": {
+        "phase": {"link": "stance_leg"}, "outputs": [
+            {"link": "swing_leg", "bezier_rad": [-0.2, -0.1, 0.0, 0.1, 0.2]}],
+        "feedback": {"kind": "input_output_linearization", "kp_per_s2": 100, "kd_per_s": 20}}}
+    sc = scene_from_dict(_scene(cfg, DESIGN))
+    with pytest.raises(ValueError) as e:
+        check_scene(sc)
+    assert KINDS["straight_legs"].cell("virtual_constraints", "optimize") in one_line(e)
+
+
+# -- the three-link walker designed end to end (slow) ------------------------------------
+
+@pytest.fixture(scope="module")
+def designed(tmp_path_factory):
+    from walkerlab.io.schemas.optimize import load
+    from walkerlab.stages import pipeline
+
+    runs = tmp_path_factory.mktemp("runs")
+    sc = scene_from_dict(_scene(THREELINK, DESIGN, "threelink_design"))
+    out = pipeline.run("optimize", sc, runs, False)
+    return load(out.path), out.path.parent
+
+
+@pytest.mark.slow
+def test_design_meets_the_stability_bound_and_the_target(designed):
+    d, _folder = designed
+    c = d.controllers[0]
+    assert c.status == "Solve_Succeeded" and d.gait
+    assert c.delta2 <= 0.6 + 1e-9  # active: the scene's own controller has 0.889
+    assert abs(c.step_length_m / c.step_period_s - 0.8) < 1e-9
+    assert c.max_torque_n_m <= 150.0 + 1e-6
+
+
+@pytest.mark.slow
+def test_collocated_delta2_is_the_written_controllers_restricted_map(designed):
+    """The optimum's delta^2 (the collocation's expression at its q- of alpha) and the
+    restricted map of the written scene's controller (its own q- found from c_M, its c_0,
+    c_1 recomputed by invariant: true): 1e-8."""
+    d, folder = designed
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+    from walkerlab.config import load_scene
+    from walkerlab.models.registry import build_walker
+
+    c = d.controllers[0]
+    sc = load_scene(folder / c.scene_file)
+    zd = zero_dynamics(build_walker(sc).actuators.controller)
+    assert abs(zd.delta2 - c.delta2) < 1e-8
+    assert zd.exists
+    np.testing.assert_allclose(
+        [o.bezier_rad[2:] for o in sc.walker.actuation.virtual_constraints.outputs],
+        np.asarray(c.bezier_rad)[:, 2:], rtol=0, atol=1e-15)
+
+
+@pytest.mark.slow
+def test_written_scene_full_order_multipliers_contain_delta2(designed):
+    """``walkerlab fixedpoint``'s search on the written scene: one variational Floquet
+    multiplier is delta^2 (1e-6), <= 0.6; the others are the feedback's (kd = 100/s over
+    a 0.83 s step: exp(-50 T) ~ 1e-18, at the fixed point's tolerance)."""
+    d, folder = designed
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.config import load_scene
+
+    c = d.controllers[0]
+    sc = load_scene(folder / c.scene_file)
+    gait = solve_scene(sc, False)[1].gait.result
+    mu = np.asarray(gait.multipliers_variational)
+    j = int(np.argmin(np.abs(mu - c.delta2)))
+    assert abs(mu[j] - c.delta2) < 1e-6
+    assert abs(mu[j]) <= 0.6 + 1e-6
+    assert np.max(np.abs(np.delete(mu, j))) < 1e-6
+
+
+# -- the shipped RABBIT design (configs/rabbit_hzd_optimal.yaml; slow: ~2 min) -----------
+
+@pytest.fixture(scope="module")
+def rabbit_designed(tmp_path_factory):
+    from walkerlab.config import load_scene
+    from walkerlab.io.schemas.optimize import load
+    from walkerlab.stages import pipeline
+
+    runs = tmp_path_factory.mktemp("runs")
+    sc = load_scene(ROOT / "configs" / "rabbit_hzd_optimal.yaml")
+    out = pipeline.run("optimize", sc, runs, False)
+    return load(out.path), out.path.parent, runs
+
+
+@pytest.mark.slow
+def test_rabbit_controllers_at_two_speeds_are_stable(rabbit_designed):
+    """Two controllers, one per target speed, each with delta^2 <= 0.6 met, the written
+    scene's restricted map equal to the collocation's (1e-8) and its full-order closed
+    loop's multipliers containing delta^2 (1e-6), the rest the feedback's."""
+    d, folder, _runs = rabbit_designed
+    assert [c.target_speed_m_per_s for c in d.controllers] == [0.5, 0.8]
+    for c in d.controllers:
+        assert c.status == "Solve_Succeeded"
+        assert c.delta2 <= 0.6 + 1e-9
+        assert abs(c.delta2_restricted - c.delta2) < 1e-8
+        assert abs(c.delta2_multiplier - c.delta2_restricted) < 1e-6
+        others = np.delete(c.multipliers, int(np.argmin(np.abs(c.multipliers - c.delta2))))
+        assert np.max(np.abs(others)) < 1e-6
+        assert abs(c.step_length_m / c.step_period_s - c.target_speed_m_per_s) < 1e-9
+        assert (folder / c.scene_file).is_file()
+
+
+@pytest.mark.slow
+def test_rabbit_controller_walks_in_the_contact_model(rabbit_designed):
+    """The 0.5 m/s controller's written scene in ``walkerlab contact-sim`` (the computed
+    torque at the contact walker's role state, 11 strides): >= 20 heel strikes, the mean
+    speed of the last 10 steps within 3 % of the rigid closed loop's (measured -1.0 %: the
+    regularised friction lets the stance foot creep ~0.4 mm a step)."""
+    import h5py
+
+    from walkerlab.config import load_scene
+    from walkerlab.stages import pipeline
+
+    d, folder, runs = rabbit_designed
+    c = d.controllers[0]
+    out = pipeline.run("contact-sim", load_scene(folder / c.scene_file), runs, False)
+    with h5py.File(out.path, "r") as f:
+        t = f["events/heel_strike_times"][()]
+        dist = f["ledger/steps/distance"][()]
+    assert len(t) >= 20
+    speed = np.mean(dist[-10:]) / np.mean(np.diff(t)[-10:])
+    rigid = c.step_length_m / c.full_order_step_period_s
+    assert abs(speed / rigid - 1) < 0.03

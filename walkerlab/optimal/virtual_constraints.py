@@ -1,0 +1,344 @@
+"""Feedback controllers designed by optimisation (``optimize.design: virtual_constraints``):
+the walker's Bezier virtual constraints (``walker.actuation.virtual_constraints``: its
+outputs, phase variable, degree and gains) optimised with the step by collocation
+(:mod:`walkerlab.optimal.transcription.virtual_constraints`, FROST's formulation with
+``delta^2 <= optimize.max_multiplier``), one controller per target speed, each checked on
+the rigid closed loop it defines: its hybrid zero dynamics (the restricted Poincare map,
+:func:`walkerlab.analysis.gait.zero_dynamics.zero_dynamics`) and its full-order fixed point
+and Floquet multipliers, which contain ``delta^2`` (Westervelt, Grizzle & Koditschek 2003,
+IEEE TAC 48(1):42-56, Theorem 4).
+
+The start is the scene's own controller: one step of its closed loop from its zero
+dynamics' fixed point (its coefficients the guess's); each further speed starts from the
+previous optimum.  The optimum's coefficients are written as scenes
+(:func:`controller_scene_text`): the scene with its ``virtual_constraints`` replaced (its
+``optimize`` section dropped), which ``walkerlab fixedpoint``, ``simulate`` and
+``contact-sim`` run as they are.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+__all__ = ["ControllerDesign", "check_design", "controller_scene", "controller_scene_text",
+           "controller_step", "design_controllers", "designs_controller",
+           "optimize_virtual_constraints"]
+
+KEY = "walker.actuation.virtual_constraints"
+
+
+@dataclass
+class ControllerDesign:
+    """One optimised controller (``optimize.h5``'s ``controllers/<i>/``).
+
+    Attributes
+    ----------
+    target_speed_m_per_s : float
+        The speed asked for (NaN: none) [m/s].
+    bezier_rad : ndarray (k, M + 1)
+        The optimised coefficients (``c_0``, ``c_1`` the collocation's; the scene's
+        ``invariant: true`` recomputes them from the impact map) [rad].
+    output_names : tuple of str
+    step_period_s, step_length_m : float
+        The collocated step's.
+    objective, effort : float
+        ``int |u|^2 dt / step length`` [N^2 m s] and ``int |u|^2 dt`` [N^2 m^2 s].
+    delta2 : float
+        ``delta^2`` at the optimum (the collocation's CasADi expression) [-].
+    delta2_restricted : float
+        ``delta^2`` of the written controller's restricted map [-].
+    existence_margin : float
+        ``delta^2 / (1 - delta^2) V(theta-) + V_max`` (< 0: the orbit exists).
+    restricted_step_period_s : float
+        The zero dynamics' step period by quadrature [s].
+    full_order_step_period_s : float
+        The rigid closed loop's fixed point's period [s] (NaN: none found).
+    orbit_shift : float
+        ``max |x* - x+|``: the full-order fixed point's distance from the zero dynamics'
+        post-impact state [rad, rad/s] (inf: none found).
+    multipliers : ndarray complex
+        Its Floquet multipliers (variational).
+    delta2_multiplier : complex
+        The multiplier nearest ``delta^2``.
+    max_torque_n_m : float
+        Largest ``|u|`` of the collocated step [N m].
+    max_output, max_output_rate : float
+        ``max |y|``, ``max |y'|`` over the collocation points [rad, rad/s] (the
+        transcription's error off the first point).
+    status : str
+    iterations : int
+    wall_time_s, build_time_s : float
+    scene_file : str
+        The written scene's file name (in the run folder).
+    t, x, u : ndarray
+        The collocated step (times [s], states, torques [N m]).
+    """
+
+    target_speed_m_per_s: float
+    bezier_rad: np.ndarray
+    output_names: tuple
+    step_period_s: float
+    step_length_m: float
+    objective: float
+    effort: float
+    delta2: float
+    delta2_restricted: float
+    existence_margin: float
+    restricted_step_period_s: float
+    full_order_step_period_s: float
+    orbit_shift: float
+    multipliers: np.ndarray
+    delta2_multiplier: complex
+    max_torque_n_m: float
+    max_output: float
+    max_output_rate: float
+    status: str
+    iterations: int
+    wall_time_s: float
+    build_time_s: float
+    scene_file: str
+    t: np.ndarray = field(repr=False, default=None)
+    x: np.ndarray = field(repr=False, default=None)
+    u: np.ndarray = field(repr=False, default=None)
+    history: dict = field(repr=False, default_factory=dict)
+
+
+def designs_controller(scene) -> bool:
+    """Whether the scene's ``optimize`` section designs virtual constraints
+    (``design: virtual_constraints``)."""
+    o = getattr(scene, "optimize", None)
+    return o is not None and o.design == "virtual_constraints"
+
+
+def check_design(scene, kind) -> None:
+    """Refuse a design the walker cannot take (one line naming the key): no
+    ``walker.actuation.virtual_constraints`` to optimise, or a kind whose virtual
+    constraints the collocation does not take (the capability table's line).
+
+    Raises
+    ------
+    ValueError
+        As above.
+    """
+    act = scene.walker.actuation
+    if act is None or act.virtual_constraints is None:
+        raise ValueError("optimize.design: virtual_constraints optimises the walker's "
+                         "virtual constraints: give walker.actuation.virtual_constraints (its "
+                         "outputs, phase and degree; their coefficients are the start)")
+    kind.require("virtual_constraints", "optimize", KEY)
+
+
+def controller_scene(scene, bezier):
+    """``scene`` with its virtual constraints' coefficients ``bezier`` (k, M + 1) [rad]
+    and no ``optimize`` section."""
+    act = scene.walker.actuation
+    vc = act.virtual_constraints
+    outs = [o.model_copy(update={"bezier_rad": [float(c) for c in row]})
+            for o, row in zip(vc.outputs, np.asarray(bezier, float))]
+    vc = vc.model_copy(update={"outputs": outs})
+    walker = scene.walker.model_copy(update={"actuation": act.model_copy(
+        update={"virtual_constraints": vc})})
+    return scene.model_copy(update={"walker": walker, "optimize": None})
+
+
+def controller_scene_text(scene, c: ControllerDesign, name: str) -> str:
+    """The YAML text of the scene of controller ``c`` (:func:`controller_scene`), named
+    ``name``, with a header saying where it comes from."""
+    import yaml
+
+    body = controller_scene(scene, c.bezier_rad).model_dump(mode="json", exclude_none=True)
+    body["name"] = name
+    speed = c.step_length_m / c.step_period_s
+    body["source"] = (f"scene {scene.name}'s walker under virtual constraints optimised by "
+                      f"walkerlab optimize (design: virtual_constraints): delta^2 = "
+                      f"{c.delta2_restricted:.10g}, {speed:.6g} m/s")
+    head = (f"# Written by walkerlab optimize from scene '{scene.name}' (design: "
+            "virtual_constraints; do not edit: rewritten by the next run).\n"
+            + (f"# Its source: {scene.source}\n" if scene.source else "") +
+            f"# Collocated step: {c.step_length_m:.6g} m in {c.step_period_s:.6g} s "
+            f"({speed:.6g} m/s), int u^2 dt / length = {c.objective:.6g} N^2 m s, "
+            f"max |u| = {c.max_torque_n_m:.4g} N m.\n"
+            f"# Restricted Poincare map: delta^2 = {c.delta2_restricted:.10g}; full-order "
+            f"multiplier nearest it {abs(c.delta2_multiplier):.10g}.\n")
+    return head + yaml.safe_dump(body, sort_keys=False, width=100)
+
+
+def controller_step(walker, solver, points: int):
+    """One step of the scene's closed loop (``walker``: its rigid walker with the
+    controller; ``solver``: a :class:`~walkerlab.integrate.solver.Solver`) from its zero
+    dynamics' fixed point, at ``points`` uniform times: ``(t [s], x (points, 2n), u
+    (points, k) [N m], alpha (k, M + 1) [rad], zd)`` (``zd``: :class:`~walkerlab.analysis.
+    gait.zero_dynamics.ZeroDynamics`), the design's start.
+
+    Raises
+    ------
+    ValueError
+        The scene's controller has no periodic orbit or its step does not end in a heel
+        strike (one line naming the key).
+    """
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+    from walkerlab.integrate.rigid import integrate_step
+
+    ctrl = walker.actuators.controller
+    zd = zero_dynamics(ctrl)
+    if not zd.exists:
+        raise ValueError(f"{KEY}: the scene's controller, the design's start, has no gait of "
+                         f"its own to start from (no periodic orbit of its zero dynamics: "
+                         f"delta^2 = {zd.delta2:.4g}, existence margin "
+                         f"{zd.existence_margin:.4g}): give coefficients that walk")
+    seg = integrate_step(walker, zd.x_plus, solver, max_step_time=3 * zd.step_period_s)
+    if seg.termination != "heel_strike":
+        raise ValueError(f"{KEY}: the scene's controller does not step from its zero "
+                         f"dynamics' orbit ({seg.termination}): give coefficients that walk")
+    t = np.linspace(0.0, seg.t_end - seg.t_start, points)
+    x = seg.sample(seg.t_start + t).T
+    u = np.array([np.real(ctrl.torques(xi)) for xi in x])
+    return t, x, u, ctrl.design.alpha.copy(), zd
+
+
+def _evaluate(scene, res, target, name: str) -> ControllerDesign:
+    """The written controller of the optimum ``res`` on the rigid model: its restricted map
+    and its full-order fixed point (from the zero dynamics' orbit)."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    sc = controller_scene(scene, res.alpha)
+    walker = build_walker(sc)
+    ctrl = walker.actuators.controller
+    zd = zero_dynamics(ctrl)
+    period, mult, near = np.nan, np.full(2 * ctrl.n, np.nan + 0j), complex(np.nan)
+    shift = np.inf
+    if zd.exists:
+        try:
+            fp = solve_scene(sc, False, guess=zd.x_plus, walker=walker,
+                             solver=Solver.from_settings(sc.solver))[1].gait.result
+            period = float(fp.period_s)
+            mult = np.asarray(fp.multipliers_variational, complex)
+            near = complex(mult[int(np.argmin(np.abs(mult - zd.delta2)))])
+            shift = float(np.max(np.abs(np.asarray(fp.x, float) - zd.x_plus)))
+        except (ValueError, RuntimeError, ArithmeticError, AttributeError):
+            pass  # no fixed point: NaN (the design is reported, not a gait)
+    return ControllerDesign(
+        target_speed_m_per_s=float("nan") if target is None else float(target),
+        bezier_rad=res.alpha, output_names=tuple(ctrl.output_names),
+        step_period_s=res.step_period_s, step_length_m=res.step_length_m,
+        objective=res.objective, effort=res.effort, delta2=res.delta2,
+        delta2_restricted=zd.delta2, existence_margin=zd.existence_margin,
+        restricted_step_period_s=zd.step_period_s, full_order_step_period_s=period,
+        orbit_shift=shift,
+        multipliers=mult, delta2_multiplier=near,
+        max_torque_n_m=float(np.max(np.abs(res.u))), max_output=res.max_output,
+        max_output_rate=res.max_output_rate, status=res.status, iterations=res.iterations,
+        wall_time_s=res.wall_time_s, build_time_s=res.build_time_s, scene_file=name,
+        t=res.t, x=res.x, u=res.u, history=res.history)
+
+
+def design_controllers(scene, data, spec, print_level: int = 0) -> list[ControllerDesign]:
+    """Optimise one controller per target speed of ``scene`` (module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        With ``optimize.design: virtual_constraints`` and ``walker.actuation.
+        virtual_constraints``.
+    data : WalkerData
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
+        The ``optimize`` section's (:func:`walkerlab.optimal.driver.collocation_spec`; its
+        speed replaced by each of ``target_speeds_m_per_s``).
+    print_level : int
+        IPOPT's.
+
+    Returns
+    -------
+    list of ControllerDesign
+
+    Raises
+    ------
+    ValueError
+        The scene's controller does not walk (no start), a spec the walker does not have
+        (one line naming the key).
+    """
+    import time
+
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.transcription.virtual_constraints import (
+        collocate_virtual_constraints,
+        hzd_functions,
+    )
+
+    o = scene.optimize
+    vc = scene.walker.actuation.virtual_constraints
+    if spec.max_torque_n_m is None and vc.max_torque_n_m is not None:
+        spec = replace(spec, max_torque_n_m=vc.max_torque_n_m)
+    walker = build_walker(scene)
+    K = 2 * int(o.intervals) + 1
+    t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
+    t0 = time.perf_counter()
+    fns = hzd_functions(data, vc)
+    build = time.perf_counter() - t0
+    speeds = list(o.target_speeds_m_per_s or [o.target_speed_m_per_s])
+    out = []
+    for i, v in enumerate(speeds):
+        res = collocate_virtual_constraints(
+            fns, replace(spec, target_speed_m_per_s=v), t, x, u, alpha, o.max_multiplier,
+            (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level)
+        res.build_time_s += build
+        out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml"))
+        if res.status == "Solve_Succeeded":  # the next speed starts here
+            t, x, u, alpha = res.t, res.x, res.u, res.alpha
+    return out
+
+
+def optimize_virtual_constraints(scene, data, spec):
+    """``optimize.h5``'s record of the designed controllers
+    (:class:`walkerlab.io.schemas.optimize.OptimizeData`: the first controller's step as
+    its optimum, every controller in ``controllers``; a gait when IPOPT converged, the
+    restricted map's ``delta^2`` is the optimum's and the full-order fixed point exists).
+
+    Parameters
+    ----------
+    scene : Scene
+    data : WalkerData
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
+
+    Raises
+    ------
+    ValueError
+        As :func:`design_controllers`.
+    """
+    from walkerlab.io.schemas.optimize import OptimizeData
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal import outcome as reported
+
+    cs = design_controllers(scene, data, spec)
+    c = cs[0]
+    walker = build_walker(scene)
+    res = _AsResult(c)
+    states, units = reported.named_states(walker, res)
+    tol = scene.optimize.replay_tolerance
+    gait = bool(c.status == "Solve_Succeeded" and np.isfinite(c.full_order_step_period_s)
+                and abs(c.delta2_restricted - c.delta2) <= tol)
+    return OptimizeData(
+        c.t, states, c.u, c.step_period_s, c.step_length_m, 0.0, c.objective,
+        c.orbit_shift, c.multipliers, gait,
+        c.status, c.iterations, c.wall_time_s, units,
+        objective_name="effort_per_step_length", objective_unit="N^2 m s",
+        terms={"effort": c.effort}, torque_names=tuple(walker.actuators.controller.joints),
+        build_time_s=c.build_time_s, ipopt_history=c.history,
+        phase_replay_outcome="not replayed: the design is a feedback controller (its scene "
+        "runs in fixedpoint, simulate and contact-sim)",
+        contact_outcome="not replayed here: run contact-sim on the written scene",
+        controllers=tuple(cs))
+
+
+class _AsResult:
+    """The attributes :func:`walkerlab.optimal.outcome.named_states` reads of a
+    collocation's result (``x``)."""
+
+    def __init__(self, c: ControllerDesign):
+        self.x, self.t, self.u = c.x, c.t, c.u
