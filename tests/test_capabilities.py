@@ -329,3 +329,13 @@ def test_the_command_and_the_docs_show_the_table():
     page = ext.rst()
     assert all(kind.name in page for kind in KINDS.values())
     assert "capability-table" in (ROOT / "docs" / "reference" / "capabilities.rst").read_text()
+
+
+def test_every_per_kind_table_of_the_stages_and_integrators_names_every_kind():
+    """The part tables keyed by kind name name every kind (the three-link walker's
+    ``export --walk`` failed with KeyError 'hinged_torso' in the export stage's table)."""
+    from walkerlab.integrate.rigid import _SCIPY_RUNS_ACTUATED_COMPILED
+    from walkerlab.stages.export import _ROLLS
+
+    for table in (_ROLLS, _SCIPY_RUNS_ACTUATED_COMPILED):
+        assert set(table) == set(KINDS)

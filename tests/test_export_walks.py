@@ -40,9 +40,7 @@ def _scene(name):
 #: have no multibody form (flat feet and their ankle push-off are exported:
 #: tests/test_export_flat_feet.py).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies",
-           # virtual constraints run on the rigid model only so far
-           "rabbit_hzd": "virtual_constraints", "threelink_hzd": "virtual_constraints"}
+           "simplest": "walker.leg.bodies"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.

@@ -34,7 +34,8 @@ def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
     ----------
     link : str
         A link by role, as :data:`walkerlab.config.actuation.JOINTS` names them
-        (``stance_leg``, ``swing_thigh``, ``stance_shank``, ``torso``, ...).
+        (``stance_leg``, ``swing_thigh``, ``stance_shank``, ``torso``, ...), or a straight
+        leg's state role (``stance``, ``swing``: its leg).
     stance : {0, 1}
         The stance leg (0: ``leg1``).
     coordinates : collection of str
@@ -53,6 +54,7 @@ def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
     if link == "torso" and "torso_hip" in coordinates:
         return {"torso_hip": 1.0}
     role, _, part = link.partition("_")
+    part = part or "leg"  # a straight leg's role is its leg's angle (``stance``, ``swing``)
     leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"
     if role in ("stance", "swing") and part in ("leg", "thigh", "shank", "foot") \
             and f"{leg}_hip" in coordinates and (part != "foot" or f"{leg}_ankle" in coordinates):
