@@ -259,10 +259,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
-        ("stairs", "*"): _FLAT_LANDING,
+        # the rigid view lands its heel strike on stairs and footholds of several heights
+        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat)
+        **{("stairs", v): _FLAT_LANDING for v in ("contact", "mjcf", "adams", "optimize")},
         ("profile", "rigid"): _FLAT_LANDING,
-        ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
-                             "arc feet (a flat foot's modes have no per-step landing yet)"),
+        **{("footholds", v): ("footholds of several heights or slopes are built for point "
+                              "and arc feet (a flat foot's modes have no per-step landing "
+                              "yet)") for v in ("contact", "gym", "optimize")},
         # the exports refuse any walker's footholds that differ before its feet
         **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
         ("profile", "adams"): _ADAMS_PROFILE,

@@ -1,0 +1,117 @@
+"""Flat feet on stairs and footholds of several heights in the rigid view: the heel strike
+lands at the next step's height in every stance mode, and the double support keeps the
+trailing toe on the tread it stood on (configs/flat_feet_stairs.yaml,
+configs/flat_feet_footholds.yaml; walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat).
+
+The references are hand trigonometry of the walker's links (hip-to-ankle legs, the sole
+through the ankle, the swing sole at its rest angle to the leg's perpendicular), sharing no
+code with the generated kinematics.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.codegen.cache import functions
+from walkerlab.config import load_scene
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.hybrid.rigid_foot_modes import mode_of
+from walkerlab.models.registry import build_walker
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.kinds import KINDS
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the heel strike's event is located to the solver's tolerance (rtol 1e-12 on ~1 m): the
+#: landing height agrees to far below a micron
+LANDING_M = 1e-9
+
+
+def _unit(theta):
+    return np.array([math.cos(theta), math.sin(theta)])
+
+
+def _swing_heel_by_hand(x, pin: str, foot, gamma: float, length: float = 1.0):
+    """The swing heel [m] in the frame of the stance heel's touchdown point (x downhill
+    along the horizontal, y up), from the state ``x = (swing, stance, stance ankle, ...)``:
+    the stance foot pinned at its heel (heel contact, foot flat) or at its toe, ``heel +
+    toe`` down the slope from the touchdown point (heel off)."""
+    sw, st, a = x[:3]
+    sole = _unit(st + a)  # the stance sole, toe up for a positive angle
+    if pin == "heel":
+        ankle = foot.heel_m * sole
+    else:
+        ankle = (foot.heel_m + foot.toe_m) * np.array([math.cos(gamma), -math.sin(gamma)]) \
+            - foot.toe_m * sole
+    hip = ankle + length * np.array([-math.sin(st), math.cos(st)])
+    swing_ankle = hip + length * np.array([math.sin(sw), -math.cos(sw)])
+    return swing_ankle - foot.heel_m * _unit(sw + foot.ankle.rest_angle_rad)
+
+
+def _run(name: str, steps: int):
+    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+    walker = build_walker(scene)
+    x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
+    traj = simulate_steps(walker, x0, steps, Solver.from_settings(scene.solver))
+    assert len(traj.segments) == steps
+    assert all(sg.termination == "heel_strike" for sg in traj.segments)
+    return scene, walker, traj.segments
+
+
+def _landing_clearance(seg, foot, gamma):
+    """The swing heel's height at heel strike above the slope line through the stance
+    foot's touchdown point, along its normal [m] (hand geometry)."""
+    pin = "toe" if mode_of(seg.phase_log[-1][0]) == "heel_off" else "heel"
+    h = _swing_heel_by_hand(seg.x_end, pin, foot, gamma)
+    return h[1] * math.cos(gamma) + h[0] * math.sin(gamma), pin
+
+
+def test_flat_heel_strikes_the_next_tread_7p5mm_down_in_its_stance_mode():
+    scene, _walker, segs = _run("flat_feet_stairs", 2)
+    foot = scene.walker.leg.foot
+    for seg in segs:
+        clearance, pin = _landing_clearance(seg, foot, 0.0)
+        assert clearance == pytest.approx(-scene.terrain.riser_m, abs=LANDING_M)
+    # the gait's stance foot is on its toe when the heel strikes (the heel-off guard's pin)
+    assert pin == "toe"
+
+
+def test_flat_heel_strikes_each_foothold_at_its_own_height():
+    scene, _walker, segs = _run("flat_feet_footholds", 3)
+    foot, gamma = scene.walker.leg.foot, scene.slope.phi_rad
+    heights = scene.terrain.foothold_heights_m
+    for k, seg in enumerate(segs):
+        clearance, _pin = _landing_clearance(seg, foot, gamma)
+        # step k lands h_k below the stance foot's level along the vertical: h_k cos(gamma)
+        # along the slope's normal (h_k <= 0 is below)
+        assert clearance == pytest.approx(heights[k % 3] * math.cos(gamma), abs=LANDING_M)
+
+
+def test_double_support_keeps_the_trailing_toe_on_the_tread_above():
+    scene, walker, segs = _run("flat_feet_stairs", 1)
+    seg = segs[0]
+    assert seg.phase_log[0][0] == "double_support:heel_contact"
+    foot, riser = scene.walker.leg.foot, scene.terrain.riser_m
+    # the state just after heel strike with the trailing toe pinned (the step's first)
+    x = np.ravel(seg.pieces[0][1](seg.t_start))
+    f = functions(walker_data(scene.walker, scene.slope.phi_rad))
+    b = f["double_support_trailing"](x, riser)[0]
+    sw, st, a = x[:3]
+    ankle = foot.heel_m * _unit(st + a)  # the new stance heel at the origin
+    hip = ankle + np.array([-math.sin(st), math.cos(st)])
+    toe = hip + np.array([math.sin(sw), -math.cos(sw)]) + foot.toe_m * _unit(sw + b)
+    assert toe[1] == pytest.approx(riser, abs=1e-12)  # on the tread it stood on
+    # the same state's toe without the level would be on the lower tread: a test that can
+    # fail (the level moves the toe by the riser)
+    b0 = f["double_support_trailing"](x)[0]
+    toe0 = hip + np.array([math.sin(sw), -math.cos(sw)]) + foot.toe_m * _unit(sw + b0)
+    assert toe0[1] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_flat_feet_walk_stairs_and_footholds_in_the_rigid_view():
+    kind = KINDS["flat_feet"]
+    assert kind.supports("stairs", "rigid") and kind.supports("footholds", "rigid")
