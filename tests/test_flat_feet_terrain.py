@@ -115,3 +115,24 @@ def test_double_support_keeps_the_trailing_toe_on_the_tread_above():
 def test_flat_feet_walk_stairs_and_footholds_in_the_rigid_view():
     kind = KINDS["flat_feet"]
     assert kind.supports("stairs", "rigid") and kind.supports("footholds", "rigid")
+
+
+@pytest.mark.slow  # ~8 s: the rigid gait, then 10 heel strikes of the contact model
+def test_contact_walker_on_flat_feet_footholds_walks_five_strides_near_the_rigid_period(
+        tmp_path):
+    """configs/flat_feet_footholds.yaml in contact-sim: 0.6 m patches at the rigid period-3
+    gait's footfalls, each at its foothold's height.  The contact steps alternate about the
+    rigid ones (the rigid gait's multiplier -0.69, and the contact view's 0.1 kg feet:
+    configs/flat_feet.yaml), so the check is on the mean step: within 1.5 % of the rigid
+    gait's mean 0.8112 s (measured +0.67 %), over 10 heel strikes without a scuff."""
+    import h5py
+    from cli_run import run_cli
+
+    rc, err, _ = run_cli("-q", "contact-sim", ROOT / "configs" / "flat_feet_footholds.yaml",
+                         "--runs-dir", tmp_path)
+    assert rc == 0, err
+    with h5py.File(tmp_path / "flat_feet_footholds" / "contact_sim.h5", "r") as f:
+        t = f["events/heel_strike_times"][()]
+    assert t.size >= 10
+    rigid = (0.7975975921 + 0.8206136305 + 0.8154929357) / 3  # walkerlab fixedpoint
+    assert t[-1] / t.size == pytest.approx(rigid, rel=0.015)

@@ -226,8 +226,19 @@ _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-o
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
                     "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
-_FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported yet (their "
-                 "heel strike is a guard per foot mode)")
+_FLAT_LANDING = ("flat feet walk stairs and footholds in the rigid model only so far "
+                 "(walkerlab fixedpoint, simulate; footholds in contact-sim too): this view "
+                 "does not carry a flat foot's landing on them yet")
+#: why the rigid walk of a profile refuses flat feet
+_FLAT_PROFILE = ("a profile is walked step by step from the landing of point and arc feet "
+                 "(walkerlab.analysis.gait.profile_walk); a flat foot lands on a height per "
+                 "step only (stairs, footholds)")
+#: why the contact model refuses flat feet on stairs
+_FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after its first heel strike "
+                        "on stairs (configs/flat_feet_stairs.yaml: the level treads' gait is "
+                        "slow, 0.45 m/s, and the run starts with the trailing toe off the "
+                        "tread above, without the rigid gait's double support): walk it in "
+                        "the rigid model, or footholds on a slope in contact-sim")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -261,11 +272,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat)
-        **{("stairs", v): _FLAT_LANDING for v in ("contact", "mjcf", "adams", "optimize")},
-        ("profile", "rigid"): _FLAT_LANDING,
-        **{("footholds", v): ("footholds of several heights or slopes are built for point "
-                              "and arc feet (a flat foot's modes have no per-step landing "
-                              "yet)") for v in ("contact", "gym", "optimize")},
+        **{("stairs", v): _FLAT_LANDING for v in ("mjcf", "adams", "optimize")},
+        ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
+        ("profile", "rigid"): _FLAT_PROFILE,
+        ("footholds", "optimize"): _FLAT_LANDING,
         # the exports refuse any walker's footholds that differ before its feet
         **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
         ("profile", "adams"): _ADAMS_PROFILE,
