@@ -226,9 +226,10 @@ _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-o
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
                     "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
-_FLAT_LANDING = ("flat feet walk stairs and footholds in the rigid model only so far "
-                 "(walkerlab fixedpoint, simulate; footholds in contact-sim too): this view "
-                 "does not carry a flat foot's landing on them yet")
+_FLAT_LANDING = ("flat feet walk stairs and footholds in the rigid model, the MJCF export "
+                 "(walkerlab fixedpoint, simulate, export --format mjcf; footholds in "
+                 "contact-sim too): this view does not carry a flat foot's landing on them "
+                 "yet")
 #: why the rigid walk of a profile refuses flat feet
 _FLAT_PROFILE = ("a profile is walked step by step from the landing of point and arc feet "
                  "(walkerlab.analysis.gait.profile_walk); a flat foot lands on a height per "
@@ -272,12 +273,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat)
-        **{("stairs", v): _FLAT_LANDING for v in ("mjcf", "adams", "optimize")},
+        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize")},
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
         ("profile", "rigid"): _FLAT_PROFILE,
         ("footholds", "optimize"): _FLAT_LANDING,
-        # the exports refuse any walker's footholds that differ before its feet
-        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
+        # the exports refuse any walker's footholds that differ before its feet (the MJCF
+        # lays boxes at the rigid period-n gait's footfalls, flat feet's too)
+        **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
         ("profile", "adams"): _ADAMS_PROFILE,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
