@@ -235,11 +235,9 @@ _FLAT_PROFILE = ("a profile is walked step by step from the landing of point and
                  "(walkerlab.analysis.gait.profile_walk); a flat foot lands on a height per "
                  "step only (stairs, footholds)")
 #: why the contact model refuses flat feet on stairs
-_FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after its first heel strike "
-                        "on stairs (configs/flat_feet_stairs.yaml: the level treads' gait is "
-                        "slow, 0.45 m/s, and the run starts with the trailing toe off the "
-                        "tread above, without the rigid gait's double support): walk it in "
-                        "the rigid model, or footholds on a slope in contact-sim")
+_FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after one heel strike on stairs "
+                        "(it starts without the rigid gait's double support on the tread "
+                        "above); contact-sim walks flat feet on footholds")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
