@@ -177,3 +177,23 @@ def test_double_support_on_stairs_loses_energy_with_the_trailing_spring_counted(
         total.append(own[-1] + float(phase.held_energy(x)[0]))
     assert own[-1] - own[0] > 0.3  # the spring's release shows in the walker's energy
     assert np.all(np.diff(total) < 1e-9 * abs(total[0]))
+
+
+def test_an_actuated_flat_walker_keeps_its_landing_on_stairs():
+    """The actuators rebuild a flat-footed walker's modes (configs/flat_feet_push_off.yaml's
+    ankle push-off): on stairs each mode's heel-strike guard still lands a riser down."""
+    from walkerlab.config import scene_from_dict
+
+    d = load_scene(ROOT / "configs" / "flat_feet_push_off.yaml").model_dump(
+        mode="json", exclude_none=True)
+    level = build_walker(scene_from_dict(d))
+    d["terrain"] = {"kind": "stairs", "riser_m": 0.0075, "tread_m": 0.405}
+    stairs = build_walker(scene_from_dict(d))
+    assert stairs.actuators is not None and stairs.params["landing_drop_m"] == 0.0075
+    x = np.array([-0.2, 0.2, 0.0, -0.7, -0.7, -3.0])
+
+    def strikes(w):
+        return [g.function(0.0, x) for ph in w.phases for g in ph.guards
+                if g.name == "heel_strike"]
+    assert len(strikes(stairs)) == 3  # one per stance mode
+    assert np.allclose(np.subtract(strikes(stairs), strikes(level)), 0.0075, atol=1e-15)
