@@ -234,7 +234,7 @@ def check_kind(scene, kind) -> None:
     kind.require("walk", "optimize", "walker")
     ground = "slope" if scene.terrain is None else scene.terrain.kind
     if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
-        kind.require(ground, "optimize", "terrain.kind")
+        kind.require(ground, "optimize", f"terrain.kind: {ground}")
     act = scene.walker.actuation
     if act is not None and act.virtual_constraints is not None:
         kind.require("virtual_constraints", "optimize", "walker.actuation.virtual_constraints")

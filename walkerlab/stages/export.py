@@ -310,7 +310,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     if not walker_only and scene.terrain is not None \
             and scene.terrain.kind in ("stairs", "profile"):  # the kind's cell of that ground
         data.structure.kind.require(scene.terrain.kind, FORMAT_VIEWS.get(fmt, fmt),
-                                    "terrain.kind")
+                                    f"terrain.kind: {scene.terrain.kind}")
     name = scene.name or "walker"
     out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
     if not walk:

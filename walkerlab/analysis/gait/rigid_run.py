@@ -244,7 +244,7 @@ def profile_ground(scene):
         from walkerlab.walker.description import walker_data
 
         walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
-            "profile", "rigid", "terrain.kind")
+            "profile", "rigid", "terrain.kind: profile")
     P = profile_points(scene.terrain)
     at, data_at = passive_walker_at(scene)
     return ProfileGround(at, data_at, P)

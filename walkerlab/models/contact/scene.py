@@ -250,7 +250,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         from walkerlab.walker.kinds import KindRefused
 
         try:
-            data.structure.kind.require(ground, "contact", "terrain.kind")
+            data.structure.kind.require(ground, "contact", f"terrain.kind: {ground}")
         except KindRefused as err:
             raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     actuators = _actuators(scene, data, checked)
