@@ -139,11 +139,16 @@ def _rigid(d, tmp):
     assert w.model is not None  # built (its refusals said)
     if (d.get("terrain") or {}).get("kind") == "profile":
         # a profile is walked step by step, each step's walker landing on its segment
-        # (analysis.gait.profile_walk): the landing of the first one
+        # (analysis.gait.profile_walk): the ground as `walkerlab simulate` builds it for a
+        # passive walker (a driven one's is the gym's cell, PROFILE_PASSIVE), and the
+        # landing of the first step
+        from walkerlab.analysis.gait.rigid_run import profile_ground
         from walkerlab.models.hybrid.ground import on_landing
         from walkerlab.walker.description import walker_data
 
         sc = w.scene
+        if sc.walker.actuation is None:
+            profile_ground(sc)
         on_landing(w.model, walker_data(sc.walker, sc.slope.phi_rad), 0.001)
 
 

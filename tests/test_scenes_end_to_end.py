@@ -19,6 +19,7 @@ import yaml
 
 from walkerlab.config import load_scene
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.stages.pipeline import report_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "configs").glob("*.yaml"))
@@ -125,6 +126,7 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
         names = [str(n) for n in f["samples"].attrs["coordinates"]]
         tot, step = f["samples/energy/total"][()], f["samples/step_index"][()]
         phase = f["samples/phase"][()]
+        phases = [str(n) for n in f["samples"].attrs["phases"]]
         assert str(f.attrs["termination"]) == "heel_strike"
     # every coordinate of the walker appears by physical name (a kneed walker also names
     # the stance leg's locked thigh and shank), each angle with its rate
@@ -144,6 +146,12 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
                                    or act.virtual_constraints is not None)
     for k in np.unique(step) if not working else ():
         for ph in np.unique(phase[step == k]):
+            if phases[ph].startswith("double_support:"):
+                # a flat foot's trailing ankle spring, outside the walker's energy, pushes
+                # it off here (on stairs its release outweighs the dampers': +0.63 J):
+                # the walker's energy plus that spring's only falls, checked in
+                # tests/test_flat_feet_terrain.py
+                continue
             e = tot[(step == k) & (phase == ph)]
             if damped:
                 assert np.all(np.diff(e) < 1e-6 * np.max(np.abs(tot)))
@@ -155,7 +163,9 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
         md = (html.parent / "report.md").read_text()
         assert md.index("## Summary") < md.index("## Fixed point")
         assert "<details>" in md
-        has_contact = scene.contact is not None
+        # a contact section runs contact-sim where the walker's kind walks the ground in
+        # the contact view (flat feet on stairs: the section is the MJCF's)
+        has_contact = "contact-sim" in report_plan(scene)
         assert ("## Comparison ideal vs contact" in md) == has_contact
         assert ("work-precision" in md) is False  # reduced scenes have no work-precision section
         assert (("published (" in md) == (scene.published is not None))

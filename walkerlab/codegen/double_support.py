@@ -24,7 +24,9 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     toe at a point ``P`` of the slope.  The trailing foot's ankle angle ``b`` (its sole at
     ``swing + b``) is no state: with the toe on the slope, ``sin(swing + b + gamma) = -h/t``
     (``h`` the trailing ankle's height above the slope, ``t`` the toe length), the branch
-    with the heel up; its rate from the toe's zero normal velocity.  The flow: Lagrange's
+    with the heel up (a toe on a line ``level`` [m] above the leading heel's, the tread it
+    stood on when the heel struck a landing lower down: ``sin(swing + b + gamma) = (level -
+    h)/t``); its rate from the toe's zero normal velocity.  The flow: Lagrange's
     equations on ``Q = (swing, stance, stance_ankle, b)`` (the foot massless: ``b``'s row
     holds the spring ``k (b - r)`` and damper ``c db`` against the toe's force), the toe
     pinned, ``[M, -J^T; J, 0] [Qdd; lam] = [-C dQ - G; -dJ dQ]`` (``J = dT/dQ`` (2 x 4) of
@@ -61,6 +63,10 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     rhs[:3, 0] = -hc.C * sp.Matrix(dq) - hc.G
     rhs[3, 0] = -c_b * db - k_b * (b - r_b)
     b_of = sp.asin(-h / t_len) - gamma - sw
+    # the trailing toe on a line ``level`` [m] above the leading heel's (along the normal):
+    # the tread it stood on when the heel struck a lower landing (stairs, footholds)
+    level = sp.Symbol("level", real=True)
+    b_of_level = sp.asin((level - h) / t_len) - gamma - sw
     hdot = (sp.Matrix([h]).jacobian(sp.Matrix(q)) * sp.Matrix(dq))[0]
     db_of = -hdot / (t_len * sp.cos(theta + gamma)) - dq[0]
     dA = ankle.jacobian(sp.Matrix(q))
@@ -70,8 +76,8 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     held = k_b * (b - r_b) ** 2 / 2
     if foot_inertia != 0:  # the sole's kinetic energy beyond turning with its leg (held in M)
         held += foot_inertia * ((dq[0] + db) ** 2 - dq[0] ** 2) / 2
-    out = {"b": b, "db": db, "b_of": b_of, "db_of": db_of, "u": u, "toe": toe,
-           "trailing_spring": held, "foot_angle": theta + gamma}
+    out = {"b": b, "db": db, "b_of": b_of, "b_of_level": b_of_level, "db_of": db_of, "u": u,
+           "toe": toe, "trailing_spring": held, "foot_angle": theta + gamma}
     for lead in DOUBLE_SUPPORT_LEADS:
         rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
         gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
@@ -105,14 +111,17 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
 
 
 def double_support_lines(eq, lead: str) -> list[str]:
-    """Source of ``_double_support_<lead>(x, gen=None) -> (xdot (6,), forces (4,))``
+    """Source of ``_double_support_<lead>(x, gen=None, level=0.0) -> (xdot (6,), forces
+    (4,))``
     (forces: the trailing toe's normal and tangential force, the leading foot's normal force
     and its toe's share [N]; ``gen`` (3,) [N m], if given, a generalised force in ``q``'s
     rows added to the right-hand side: joint torques' ``B tau``, the closed chain's
     ``[M -J^T; J 0] [Qdd; lam] = [-C dQ - G + (B tau, 0); -dJ dQ]``),
-    ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's impulse [N s])
-    and, once, ``double_support_trailing(x) -> (b, db, held [J], sole angle from the slope
-    [rad])``, ``held`` the trailing ankle spring's energy plus, for feet with mass, the
+    ``double_support_<lead>_entry(x, level=0.0) -> (x+, (Lam_n, Lam_t))`` (the toe's
+    impulse [N s]) and, once, ``double_support_trailing(x, level=0.0) -> (b, db, held [J],
+    sole angle from the slope [rad])`` (``level`` [m]: the trailing toe's line above the
+    leading heel's, along the normal; 0, the same line, runs the lines without it),
+    ``held`` the trailing ankle spring's energy plus, for feet with mass, the
     trailing sole's kinetic energy beyond turning with its leg (``I ((dsw + db)^2 - dsw^2)
     / 2``: the part the walker's ``energies`` leave out, lost with the spring's at toe off)."""
     ds = eq.double_support
@@ -120,7 +129,9 @@ def double_support_lines(eq, lead: str) -> list[str]:
     n = len(eq.q)
     head = [unpack(eq)]
     lines, red = cse_lines([ds["b_of"]], PRINTER)
-    head += lines + [f"{IND}{ds['b']} = {PRINTER.doprint(red[0])}"]
+    head += lines + [f"{IND}{ds['b']} = {PRINTER.doprint(red[0])}",
+                     f"{IND}if level:  # the trailing toe on a tread above the leading heel's",
+                     f"{IND}    {ds['b']} = {PRINTER.doprint(ds['b_of_level'])}"]
     lines, red = cse_lines([ds["db_of"]], PRINTER)
     head += lines + [f"{IND}{ds['db']} = {PRINTER.doprint(red[0])}"]
     K, rhs = sysd["K"], sysd["rhs"]
@@ -144,18 +155,18 @@ def double_support_lines(eq, lead: str) -> list[str]:
     accs = ", ".join(str(s) for s in eq.qdd)
     body.append(f"{IND}return (np.array(({rates}, {accs})), "
                 f"({', '.join(PRINTER.doprint(e) for e in red)}, {toe_share}))")
-    out = [f"    def _double_support_{lead}(x, gen=None):", *body,
-           f"    def flow_double_support_{lead}(t, x, gen=None):",
-           f"{IND}return _double_support_{lead}(x, gen)[0]",
-           f"    def double_support_{lead}_forces(t, x, gen=None):",
-           f"{IND}return _double_support_{lead}(x, gen)[1]"]
+    out = [f"    def _double_support_{lead}(x, gen=None, level=0.0):", *body,
+           f"    def flow_double_support_{lead}(t, x, gen=None, level=0.0):",
+           f"{IND}return _double_support_{lead}(x, gen, level)[0]",
+           f"    def double_support_{lead}_forces(t, x, gen=None, level=0.0):",
+           f"{IND}return _double_support_{lead}(x, gen, level)[1]"]
     Ki, kr = sysd["Ki"], sysd["Ki_rhs"]
     mi = Ki.rows
     lines, red = cse_lines(list(Ki) + list(kr) + list(ds["u"]), PRINTER)
     nk = mi * mi + mi
     u = [PRINTER.doprint(e) for e in red[nk:]]
     names = ", ".join(str(s) for s in eq.q)
-    out += [f"    def double_support_{lead}_entry(x):", *head, *lines,
+    out += [f"    def double_support_{lead}_entry(x, level=0.0):", *head, *lines,
             f"{IND}_K = np.array(({', '.join(PRINTER.doprint(e) for e in red[:mi * mi])},),"
             f" dtype=float).reshape({mi}, {mi})",
             f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[mi * mi:nk])},),"
@@ -173,7 +184,7 @@ def double_support_lines(eq, lead: str) -> list[str]:
     out += [f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
     if lead == DOUBLE_SUPPORT_LEADS[0]:
         lines, red = cse_lines([ds["trailing_spring"], ds["foot_angle"]], PRINTER)
-        out += ["    def double_support_trailing(x):", *head, *lines,
+        out += ["    def double_support_trailing(x, level=0.0):", *head, *lines,
                 f"{IND}return {ds['b']}, {ds['db']}, {PRINTER.doprint(red[0])}, "
                 f"{PRINTER.doprint(red[1])}"]
     return out

@@ -456,13 +456,15 @@ def generate_flat(structure: Structure, key: str) -> str:
     ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
     ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
     per leading-foot mode ``m`` of the double support (``heel_contact``, ``foot_flat``):
-    ``flow_double_support_<m>(t, x, gen=None)``, ``double_support_<m>_forces(t, x,
-    gen=None)`` (trailing toe normal and tangential, leading foot normal and its toe's share
-    [N]; ``gen`` (3,) [N m] a generalised force in ``q``'s rows, joint torques' ``B tau``),
-    ``double_support_<m>_entry(x) -> (x+, (Lam_n, Lam_t))`` [N s]; and
-    ``double_support_trailing(x) -> (b, db, held energy [J], trailing sole angle from the
-    slope [rad])`` (held: the trailing spring's energy, with feet of mass plus the trailing
-    sole's kinetic energy beyond turning with its leg);
+    ``flow_double_support_<m>(t, x, gen=None, level=0.0)``, ``double_support_<m>_forces(t,
+    x, gen=None, level=0.0)`` (trailing toe normal and tangential, leading foot normal and
+    its toe's share [N]; ``gen`` (3,) [N m] a generalised force in ``q``'s rows, joint
+    torques' ``B tau``), ``double_support_<m>_entry(x, level=0.0) -> (x+, (Lam_n, Lam_t))``
+    [N s]; and ``double_support_trailing(x, level=0.0) -> (b, db, held energy [J], trailing
+    sole angle from the slope [rad])`` (``level`` [m]: the trailing toe's tread above the
+    leading heel's line, along the normal: stairs, footholds; held: the trailing spring's
+    energy, with feet of mass plus the trailing sole's kinetic energy beyond turning with
+    its leg);
     ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)

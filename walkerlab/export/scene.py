@@ -420,18 +420,24 @@ def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
     from the rigid fixed point ``x_ideal`` with the rest of its heel strike applied (the
     walker's :attr:`~walkerlab.models.hybrid.base.HybridWalker.step_entry`: the trailing
     toe kept on the ground in double support, its foot at the angle that puts the toe on
-    the slope) or, where the gait has none, the trailing foot at its rest angle."""
+    the slope, or on stairs and footholds on the tread it stood on: the landing of the step
+    before the keyframe, the last of the ground's period, above the new stance heel's line)
+    or, where the gait has none, the trailing foot at its rest angle."""
     from walkerlab.codegen.cache import functions
+    from walkerlab.models.ground import landing_drops
+    from walkerlab.models.hybrid.ground import on_landing
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     feet = flat_feet(scene, data)
-    rigid = make_rigid_walker(data)
+    drop = landing_drops(scene.terrain)[-1]  # the step that ended at the keyframe [m]
+    rigid = on_landing(make_rigid_walker(data), data, drop)
     x, phase = rigid.step_entry(np.asarray(x_ideal, float))
     X = walker.pinned_to_full(walker.link_state_from_ideal(x), np.zeros(2))
     q, v = walker.layout().coordinate_values(X)
     ankle1 = (feet[0][4], 0.0)
     if phase is not None:  # double support: the trailing (leg1) foot on its toe
-        b, db, _e, _phi = functions(data)["double_support_trailing"](x)
+        level = drop * float(np.cos(data.slope_rad))  # the trailing toe's tread
+        b, db, _e, _phi = functions(data)["double_support_trailing"](x, level)
         ankle1 = (b, db)
     qpos = [q["hip_x"], q["hip_y"], q["leg1_angle"], ankle1[0], q["leg2_angle"],
             q["leg2_foot_angle"] - q["leg2_angle"]]

@@ -238,10 +238,13 @@ def check_kind(scene, kind) -> None:
     Raises
     ------
     walkerlab.walker.kinds.KindRefused
-        ``walker: ...``, ``optimize.push_off: ...`` or ``walker.actuation.ankle_push_off:
-        ...`` (one line).
+        ``walker: ...``, ``terrain.kind: ...``, ``optimize.push_off: ...`` or
+        ``walker.actuation.ankle_push_off: ...`` (one line).
     """
     kind.require("walk", "optimize", "walker")
+    ground = "slope" if scene.terrain is None else scene.terrain.kind
+    if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
+        kind.require(ground, "optimize", f"terrain.kind: {ground}")
     act = scene.walker.actuation
     if act is not None and act.virtual_constraints is not None:
         kind.require("virtual_constraints", "optimize", "walker.actuation.virtual_constraints")

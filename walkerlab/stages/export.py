@@ -307,6 +307,10 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
             and len(drops) > 1:  # footholds of several heights: the capability table's cell
         data.structure.kind.require("footholds", FORMAT_VIEWS[fmt],
                                     "terrain.foothold_heights_m")
+    if not walker_only and scene.terrain is not None \
+            and scene.terrain.kind in ("stairs", "profile"):  # the kind's cell of that ground
+        data.structure.kind.require(scene.terrain.kind, FORMAT_VIEWS.get(fmt, fmt),
+                                    f"terrain.kind: {scene.terrain.kind}")
     name = scene.name or "walker"
     out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
     if not walk:

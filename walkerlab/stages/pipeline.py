@@ -85,6 +85,18 @@ def fresh_fixedpoint(scene: Scene, runs_root: Path | str = "runs") -> Path | Non
     return stage_module("fixedpoint").fresh_artifact(scene, runs_root)
 
 
+def _contact_walks_ground(scene: Scene) -> bool:
+    """Whether the walker's kind walks the scene's ground in the contact view (its cell of
+    :data:`walkerlab.walker.kinds.CAPABILITIES`; the slope always)."""
+    ground = "slope" if scene.terrain is None else scene.terrain.kind
+    if ground not in ("stairs", "footholds", "profile"):
+        return True
+    from walkerlab.walker.description import walker_data
+
+    kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+    return kind.supports(ground, "contact")
+
+
 def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order: each only when the scene has its
     sections (``fixedpoint`` also when ``simulate`` starts from the gait); the
@@ -98,6 +110,9 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
     # a contact section without a gait to start from (a five-link optimum's contact replay
     # reads it) runs no contact-sim
     contact = contact and (gait or "fixedpoint" not in needs("contact-sim", scene))
+    # nor one whose walker the contact view refuses on the scene's ground (flat feet on
+    # stairs: the section carries the MJCF's foot mass and contact law)
+    contact = contact and _contact_walks_ground(scene)
     plan = {"fixedpoint": gait, "simulate": sim, "contact-sim": contact,
             "compare": contact and sim, "workprecision": full and scene.workprecision is not None,
             "basin": scene.basin is not None and fp,

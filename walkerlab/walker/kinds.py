@@ -227,8 +227,18 @@ _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-o
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
                     "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
-_FLAT_LANDING = ("flat feet on stairs, footholds or a profile are not supported yet (their "
-                 "heel strike is a guard per foot mode)")
+_FLAT_LANDING = ("flat feet walk stairs and footholds in the rigid model, the MJCF export "
+                 "(walkerlab fixedpoint, simulate, export --format mjcf; footholds in "
+                 "contact-sim too): this view does not carry a flat foot's landing on them "
+                 "yet")
+#: why the rigid walk of a profile refuses flat feet
+_FLAT_PROFILE = ("a profile is walked step by step from the landing of point and arc feet "
+                 "(walkerlab.analysis.gait.profile_walk); a flat foot lands on a height per "
+                 "step only (stairs, footholds)")
+#: why the contact model refuses flat feet on stairs
+_FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after one heel strike on stairs "
+                        "(it starts without the rigid gait's double support on the tread "
+                        "above); contact-sim walks flat feet on footholds")
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -264,12 +274,15 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
-        ("stairs", "*"): _FLAT_LANDING,
-        ("profile", "rigid"): _FLAT_LANDING,
-        ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
-                             "arc feet (a flat foot's modes have no per-step landing yet)"),
-        # the exports refuse any walker's footholds that differ before its feet
-        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
+        # the rigid view lands its heel strike on stairs and footholds of several heights
+        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat)
+        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize")},
+        ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
+        ("profile", "rigid"): _FLAT_PROFILE,
+        ("footholds", "optimize"): _FLAT_LANDING,
+        # the exports refuse any walker's footholds that differ before its feet (the MJCF
+        # lays boxes at the rigid period-n gait's footfalls, flat feet's too)
+        **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
         ("profile", "adams"): _ADAMS_PROFILE,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "

@@ -240,6 +240,11 @@ def profile_ground(scene):
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
+    if scene.walker.model != "compass_gait":  # a described walker: its kind's cell
+        from walkerlab.walker.description import walker_data
+
+        walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
+            "profile", "rigid", "terrain.kind: profile")
     P = profile_points(scene.terrain)
     at, data_at = passive_walker_at(scene)
     return ProfileGround(at, data_at, P)

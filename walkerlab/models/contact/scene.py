@@ -245,6 +245,14 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     # checked as the run uses it: with its periodic gait when the caller asks for one
     checked = cs.model_copy(update={"periodic_gait": True}) if periodic else cs
     data = walker_data(scene.walker, scene.slope.phi_rad)
+    ground = "slope" if scene.terrain is None else scene.terrain.kind
+    if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
+        from walkerlab.walker.kinds import KindRefused
+
+        try:
+            data.structure.kind.require(ground, "contact", f"terrain.kind: {ground}")
+        except KindRefused as err:
+            raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     actuators = _actuators(scene, data, checked)
     if cs.pin_stance_until != "none" and data.structure.foot != "point":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "

@@ -127,7 +127,8 @@ def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
         torques = w.actuators
     elif off is not None:
         w = make_flat_walker(data, walker.name, walker.variant, off,
-                             double_support=walker.step_entry is not None)
+                             double_support=walker.step_entry is not None,
+                             landing_m=walker.params.get("landing_drop_m", 0.0))
     else:
         w = walker
     ankle = None if off is None else AnklePushOffActuator(

@@ -148,9 +148,9 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     Raises
     ------
     ValueError
-        A kind that does not land on stairs in the rigid view (flat feet: a heel-strike
-        guard per foot mode; :meth:`walkerlab.walker.kinds.Kind.require`) or printed
-        equations replacing the generated ones: one line.
+        A kind that does not land on stairs in the rigid view
+        (:meth:`walkerlab.walker.kinds.Kind.require`) or printed equations replacing the
+        generated ones: one line.
     """
     if drop_m == 0.0:
         return walker
@@ -173,8 +173,16 @@ def with_clearance_guard(walker: HybridWalker, data) -> HybridWalker:
 
 
 def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
-    """:func:`on_landing`'s walker for any ``drop_m`` (0 included)."""
+    """:func:`on_landing`'s walker for any ``drop_m`` (0 included): the kind's part of
+    :data:`LANDINGS`."""
     data.structure.kind.require("stairs", "rigid", "terrain.kind")
+    return LANDINGS[data.structure.kind.name](walker, data, drop_m)
+
+
+def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
+    """The landing of a kind whose heel strike is the generated swing clearance
+    (:data:`CLEARANCE`): that guard plus ``drop_m cos(gamma)``, the section of the
+    post-impact surface (:class:`_LandingSection`)."""
     f = functions(data)
     name = CLEARANCE
     clear, grad = f[f"guard_{name}"], f[f"grad_{name}"]
@@ -196,13 +204,28 @@ def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
                             constraint=ph.constraint))
     mirror = walker.mirror
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
-        mirror = _landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
+        mirror = _on_clearance(mirror, replace(data.mirror, mirror_params=None), drop_m)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
                    from_section=_LandingSection(walker, clear, grad, offset),
                    params={**walker.params, "landing_drop_m": float(drop_m)},
                    mirror=mirror)
 
+
+def _on_flat_feet(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
+    """Flat feet: every stance mode's heel-strike guard and the double support's trailing
+    toe (:func:`walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat`)."""
+    from walkerlab.models.hybrid.rigid_foot_modes import on_landing_flat
+
+    return on_landing_flat(walker, data, drop_m)
+
+
+#: kind name -> its landing part ``(walker, data, drop_m) -> HybridWalker``: the kinds whose
+#: rigid view lands on stairs and footholds (the rimless wheel's rolling polygon and the
+#: legged kinds with the generated swing clearance; flat feet, a guard per stance mode)
+LANDINGS = {"straight_legs": _on_clearance, "locking_knees": _on_clearance,
+            "free_joints": _on_clearance, "hinged_torso": _on_clearance,
+            "rolling_polygon": _on_clearance, "flat_feet": _on_flat_feet}
 
 
 def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalker:

@@ -108,7 +108,8 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
     w = make_flat_walker(replace(data, mirror_params=None), walker.name, walker.variant,
                          heel_off, flow_of=flow_of, force=acts.generalised_force,
                          step_clock=lambda: acts.t_origin,
-                         double_support=walker.step_entry is not None)
+                         double_support=walker.step_entry is not None,
+                         landing_m=walker.params.get("landing_drop_m", 0.0))
     mirror = walker.mirror
     if mirror is not None:  # legs that differ: the next step's walker, its own numbers
         mirror = actuate_flat_hips(mirror, data.mirror, spec)

@@ -105,7 +105,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
                      variant: str = "derived",
                      heel_off_data: WalkerData | None = None,
                      flow_of=None, double_support: bool = True,
-                     force=None, step_clock=None) -> HybridWalker:
+                     force=None, step_clock=None, landing_m: float = 0.0) -> HybridWalker:
     """A :class:`HybridWalker` for a flat-footed ``data`` (``structure.foot == "flat"``).
 
     ``flow_of(mode, flow, jacobian) -> (flow, jacobian)``, if given, replaces each mode's
@@ -120,6 +120,13 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     falls' contact forces, the step entry's check of the trailing toe's force, read at
     ``step_clock()`` [s], the time the present step began; default 0).
 
+    ``landing_m`` [m]: the heel strike lands that far below the slope line through the
+    stance foot, along the vertical (stairs down, footholds; negative: above): the guard
+    is the swing heel's height above that line plus ``landing_m cos(gamma)``, and the
+    double support keeps the trailing toe on its own tread, ``landing_m cos(gamma)`` above
+    the new stance heel's line (:func:`double_support_phases`).  0: the walker on its
+    slope, bit for bit.
+
     Returns
     -------
     HybridWalker
@@ -128,6 +135,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     """
     base = functions(data)
     off = base if heel_off_data is None else functions(heel_off_data)
+    level = float(landing_m) * float(np.cos(data.slope_rad)) if landing_m else 0.0
     pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
     def compiled(mode: str, part: str, guards: list[Guard]):
@@ -138,7 +146,8 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         if flow_of is not None:
             return None
         return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
-                            tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]), 0.0)
+                            tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]),
+                                   level if g.name == "heel_strike" else 0.0)
                                   for g in guards),
                             first_chunk_steps=FIRST_CHUNK_STEPS[f"{mode}:{part}"],
                             chunk_rtol=CHUNK_RTOL)
@@ -155,7 +164,8 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         late = part == "late_swing"
         guards = []
         if late:
-            guards.append(Guard("heel_strike", g[f"guard_swing_heel_height_{p}"], -1,
+            hs = g[f"guard_swing_heel_height_{p}"]
+            guards.append(Guard("heel_strike", partial(_above, hs, level) if level else hs, -1,
                                 "heel_strike", g[f"grad_swing_heel_height_{p}"],
                                 g[f"reset_heel_strike_{p}"],
                                 g[f"reset_heel_strike_{p}_jacobian"]))
@@ -194,17 +204,19 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     if double_support:
         trailing_c = dict(zip(data.structure.param_names, data.params)).get(
             "c_sw_ankle" if data.structure.asymmetric else "c_ankle", 0.0)
-        phases += double_support_phases(base, float(trailing_c), force)
-        entry = partial(_step_entry, base, force, step_clock)
+        phases += double_support_phases(base, float(trailing_c), force, level)
+        entry = partial(_step_entry, base, force, step_clock, level)
     f = base
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
               "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
               **dict(zip(structure.param_names, data.params))}
+    if landing_m:
+        params["landing_drop_m"] = float(landing_m)
     mirror = data.mirror
     if mirror is not None:  # legs that differ: the next step's walker (leg2 swinging)
         mirror = make_flat_walker(replace(mirror, mirror_params=None), name, variant,
-                                  double_support=double_support)
+                                  double_support=double_support, landing_m=landing_m)
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
         reset=f["reset_heel_strike_heel"], energies=f["energies"], points=f["points"],
@@ -212,9 +224,17 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
         variational=f["flow_heel_contact_jacobian"],
         reset_jacobian=f["reset_heel_strike_heel_jacobian"],
-        heel_strike_guard=f["guard_swing_heel_height_heel"], leg_angles=f["leg_angles"],
+        heel_strike_guard=(partial(_above, f["guard_swing_heel_height_heel"], level) if level
+                           else f["guard_swing_heel_height_heel"]),
+        leg_angles=f["leg_angles"],
         mirror=mirror, step_entry=entry,
     )
+
+
+def _above(height, level: float, t, x):
+    """``height(t, x) + level``: the swing heel's height above a landing ``level`` [m] below
+    the slope line through the stance foot (along its normal)."""
+    return height(t, x) + level
 
 
 #: The double support's phases: the leading (stance) foot's mode after ``double_support:``.
@@ -254,7 +274,7 @@ def _lead_heel(forces, t, x) -> float:
     return float(f[2] - f[3])
 
 
-def _step_entry(f: dict, force, step_clock, x):
+def _step_entry(f: dict, force, step_clock, level: float, x):
     """:attr:`HybridWalker.step_entry` of a flat-footed walker: the state after the
     single-contact heel-strike map (the trailing foot released); the trailing toe is kept on
     the ground when its foot is heel up and the impulse that pins it (the two-contact plastic
@@ -265,20 +285,23 @@ def _step_entry(f: dict, force, step_clock, x):
     push but the spring then lifts the toe at once, e.g. a foot plantarflexed by a push-off:
     a gait without double support keeps its numbers).  ``force(t, x) -> (3,)`` [N m] or
     None: joint torques' generalised force, in the toe's force after the impact, at the
-    step's start ``step_clock()`` [s] (None: 0)."""
+    step's start ``step_clock()`` [s] (None: 0).  ``level`` [m]: the trailing toe's
+    tread above the new stance heel's line (along the normal; 0 on the slope)."""
     if np.iscomplexobj(x):  # no complex step through the branch and the linear solve
         raise TypeError("the step entry takes real states")
     x = np.asarray(x, dtype=float)
     try:
-        phi_t = f["double_support_trailing"](x)[3]
+        phi_t = f["double_support_trailing"](x, level)[3]
     except ValueError:  # the trailing ankle higher than its toe is long: no toe contact
         return x, None
     if not phi_t < TRAILING_HEEL_UP_RAD:
         return x, None
-    x_plus, (impulse_n, _t) = f["double_support_heel_contact_entry"](x)
+    x_plus, (impulse_n, _t) = f["double_support_heel_contact_entry"](x, level)
     if impulse_n < 0.0:
         return x, None
     forces = f["double_support_heel_contact_forces"]
+    if level:
+        forces = partial(forces, level=level)
     if force is not None:
         forces = partial(_with_force, forces, force)
     t0 = 0.0 if step_clock is None else float(step_clock())
@@ -287,11 +310,11 @@ def _step_entry(f: dict, force, step_clock, x):
     return x_plus, DOUBLE_SUPPORT[0]
 
 
-def _foot_slap_in_double_support(f: dict, x):
+def _foot_slap_in_double_support(f: dict, level: float, x):
     """The leading foot's slap in double support: the single-support foot-slap map, then
     the impact that keeps the trailing toe pinned (the same composition as
     :func:`_step_entry`)."""
-    return f["double_support_foot_flat_entry"](f["reset_foot_slap"](x))[0]
+    return f["double_support_foot_flat_entry"](f["reset_foot_slap"](x), level)[0]
 
 
 def _jacobian(fun, x):
@@ -306,16 +329,16 @@ def _flow_jacobian(flow, t, x):
     return _jacobian(partial(flow, t), x)
 
 
-def _held(f: dict, c: float, x) -> tuple[float, float]:
+def _held(f: dict, c: float, level: float, x) -> tuple[float, float]:
     """The trailing ankle's spring energy [J] (with feet of mass plus its sole's kinetic
     energy beyond turning with its leg, which the walker's ``energies`` leave out) and its
     damper power [W] in double support."""
-    _b, db, energy, _phi = f["double_support_trailing"](x)
+    _b, db, energy, _phi = f["double_support_trailing"](x, level)
     return float(energy), -c * float(db) ** 2
 
 
 def double_support_phases(f: dict, c_trailing: float = 0.0,
-                          force=None) -> tuple[Phase, ...]:
+                          force=None, level: float = 0.0) -> tuple[Phase, ...]:
     """The double-support phases of a flat-footed walker's generated functions ``f``
     (:func:`walkerlab.codegen.foot_modes.generate_flat`): the trailing foot on its toe (a
     pin: no slip assumed; ``c_trailing`` its ankle damper [N m s/rad], for the phases'
@@ -325,6 +348,8 @@ def double_support_phases(f: dict, c_trailing: float = 0.0,
     right-hand side (``[M -J^T; J 0] [qdd; lam] = [-h + B tau; -dJ dq]``): the flows and
     the contact forces of the guards carry it (a joint torque is internal: it moves the
     contact forces only through the accelerations and the constraint forces).
+    ``level`` [m]: the trailing toe's tread above the leading heel's line, along the normal
+    (a landing lower down: stairs, footholds; 0 on the slope).
 
     Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the trailing
     foot then leaves the ground at its spring's rest angle, no impact; a foot with mass
@@ -335,14 +360,17 @@ def double_support_phases(f: dict, c_trailing: float = 0.0,
     total normal force), ``stance_toe_lifts`` and ``stance_heel_lifts`` (foot flat),
     ``trailing_toe_pulls`` (its force pulling as the flat lead begins, :data:`PULL_N`), ``fall``.
     """
-    held = partial(_held, f, c_trailing)
+    held = partial(_held, f, c_trailing, level)
     heel, flat = (f[f"double_support_{m}_forces"] for m in ("heel_contact", "foot_flat"))
     fl_heel, fl_flat = (f[f"flow_double_support_{m}"] for m in ("heel_contact", "foot_flat"))
+    if level:
+        heel, flat, fl_heel, fl_flat = (partial(fun, level=level)
+                                        for fun in (heel, flat, fl_heel, fl_flat))
     if force is not None:
         heel, flat, fl_heel, fl_flat = (partial(_with_force, fun, force)
                                         for fun in (heel, flat, fl_heel, fl_flat))
     hip = Guard("fall", f["guard_hip_height_heel"], -1, "fall", f["grad_hip_height_heel"])
-    slap = partial(_foot_slap_in_double_support, f)
+    slap = partial(_foot_slap_in_double_support, f, level)
     on_heel = Phase(DOUBLE_SUPPORT[0], fl_heel, (
         Guard("toe_off", partial(_force, heel, 0), -1, "next_phase",
               next_phase="heel_contact:early_swing"),
@@ -358,3 +386,17 @@ def double_support_phases(f: dict, c_trailing: float = 0.0,
         Guard("stance_heel_lifts", partial(_lead_heel, flat), -1, "fall", at_entry=True),
         hip), jacobian=partial(_flow_jacobian, fl_flat), held_energy=held)
     return on_heel, on_flat
+
+
+def on_landing_flat(walker: HybridWalker, data: WalkerData, drop_m: float) -> HybridWalker:
+    """The flat-footed ``walker`` (:func:`make_flat_walker` of ``data``) with its heel strike
+    at a landing ``drop_m`` [m] below the slope line through the stance foot (stairs down,
+    footholds; negative: above), the part of :func:`walkerlab.models.hybrid.ground.on_landing`
+    for flat feet: every mode's heel-strike guard (heel or toe pinned) shifted by ``drop_m
+    cos(gamma)`` and the double support's trailing toe on the tread above (``landing_m``).
+    The section is the walker's own (the post-impact state less the stance ankle, which
+    lands at its rest angle on any ground).  A walker of the same ``double_support`` and
+    ``mirror`` (legs that differ) as ``walker``; passive (actuators are added after)."""
+    w = make_flat_walker(data, walker.name, walker.variant,
+                         double_support=walker.step_entry is not None, landing_m=drop_m)
+    return w if walker.mirror is not None else replace(w, mirror=None)
