@@ -32,7 +32,13 @@ ALLOWED = {("config/errors.py", "x[:1]"): "the first character of an exponent st
            # the benchmark's plain-numba baseline is a hand-written compass gait, a model of
            # its own that shares nothing with the library (walkerlab.bench.monte_carlo_yardstick)
            **{(f"bench/{f}.py", f"x[{i}]"): "the baseline's own compass state"
-              for f in ("monte_carlo_yardstick", "minimal_casadi") for i in range(4)}}
+              for f in ("monte_carlo_yardstick", "minimal_casadi") for i in range(4)},
+           # the design benchmark's baseline: the book's three-link walker written by hand
+           # in CasADi, no walkerlab import (walkerlab.bench.minimal_casadi_hzd)
+           **{("bench/minimal_casadi_hzd.py", s): "the baseline's own three-link state"
+              for s in ("dq[0]", "dq[1]", "dq[2]", "q[0]", "q[1]", "q[2]", "x[0]", "x[1:3]",
+                        "x[1]", "x[2]", "x[3]", "x[3:]", "x[4:6]", "x[:3]", "xp[3:]",
+                        "xp[:3]")}}
 
 
 def _int_literal(e) -> bool:
