@@ -277,10 +277,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
-        # the shipped five-link biped walks by its joint torques (a passive one would build);
-        # the MJCF's patches lie at the rigid gait's footfalls
-        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
@@ -292,10 +288,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                "transcribed yet (run it in fixedpoint, simulate, contact-sim, "
                                "the exports and the gym)"),
         **_GROUNDS,
-        # a walker held up by its joint torques (a passive one would build); the MJCF's
-        # patches lie at the rigid gait's footfalls
-        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {

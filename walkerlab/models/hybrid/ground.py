@@ -205,7 +205,8 @@ def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
 
 
 
-def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalker:
+def on_footholds(walker_at, data_at, steps, periodic: bool = True,
+                 finish=None) -> HybridWalker:
     """The walker on footholds that differ from step to step: step ``k`` lands
     ``steps[k][0]`` [m] below the stance foot's level on ground of slope ``steps[k][1]``
     [rad] (its heel strike the generated clearance above that slope's line plus
@@ -224,6 +225,10 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalk
         ``(drop_m, slope_rad)`` per step (:func:`foothold_steps`).
     periodic : bool
         The list repeats (False: a walk ends after it).
+    finish : callable ``(HybridWalker, WalkerData) -> HybridWalker``, optional
+        Applied to each step's walker on its landing (the scene's actuators,
+        :func:`walkerlab.models.hybrid.actuated.actuate`: the torques act on every step's
+        walker, the heel strike's guard is its landing's).
 
     Returns
     -------
@@ -255,7 +260,8 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalk
         w, d = base[g], data[g]
         if legs_differ and k % 2 == 1:  # legs[0] in stance: the other leg's numbers
             w, d = w.mirror, replace(d.mirror, mirror_params=None)
-        cycle.append(on_landing(replace(w, mirror=None), d, drop))
+        step = on_landing(replace(w, mirror=None), d, drop)
+        cycle.append(step if finish is None else finish(step, d))
     last = cycle[-1]
     return replace(cycle[0], cycle=tuple(cycle), ground_steps=None if periodic else p,
                    mirror=cycle[1] if legs_differ else None,
