@@ -1,0 +1,60 @@
+"""Footholds of several heights for actuated walkers (issue 58): every step's walker of the
+footholds' cycle carries the scene's actuators (before: "footholds of several heights or
+slopes are built for passive walkers only" in every view of the torso walkers, and the rigid
+model refused a powered straight-legged walker despite its table cell)."""
+
+from __future__ import annotations
+
+import numpy as np
+import yaml
+from cli_run import ROOT
+
+from walkerlab.config import scene_from_dict
+from walkerlab.walker.kinds import KINDS, SEVERAL_FOOTHOLDS
+
+#: the two heights [m] of the landings above the stance foot's level (up, then down)
+HEIGHTS = (0.001, -0.001)
+
+
+def _powered_compass_on_footholds():
+    d = yaml.safe_load((ROOT / "configs" / "powered_compass.yaml").read_text())
+    d["name"] = "powered_footholds"
+    d["terrain"] = {"kind": "footholds", "foothold_heights_m": list(HEIGHTS),
+                    "lanes": "checkerboard", "patch_width_m": 0.3}
+    return scene_from_dict(d)
+
+
+def test_the_torso_walkers_take_footholds_where_the_ground_is_laid_at_their_footfalls():
+    for kind in ("hinged_torso", "free_joints"):
+        for view in ("rigid", "contact", "mjcf", "gym"):
+            assert KINDS[kind].supports("footholds", view), (kind, view)
+        for view in ("adams", "osim"):
+            assert KINDS[kind].cell("footholds", view) == SEVERAL_FOOTHOLDS
+
+
+def test_a_pushed_off_compass_walker_lands_each_step_at_its_footholds_height():
+    """The powered compass gait (push-off 3 N s on level ground, Kuo 2002) on footholds 1 mm
+    up and 1 mm down in turn: each step's walker has the push-off, and ten steps from the
+    level gait's start land at the heights in turn.  The reference is the geometry of two
+    straight legs of length L with point feet, the swing foot L (cos q_st - cos q_sw) above
+    the stance foot, not the generated guard; 1e-9 m is the event location's tolerance at
+    rtol 1e-12 (a passive walker on level ground, the push-off dropped, loses energy at
+    every heel strike and falls before ten steps)."""
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    scene = _powered_compass_on_footholds()
+    walker = build_walker(scene)
+    assert walker.cycle is not None and len(walker.cycle) == 2
+    assert all(w.actuators is not None for w in walker.cycle)
+    g = scene.fixedpoint.initial_guess
+    x0 = np.array([g.swing_angle_rad, g.stance_angle_rad, g.swing_rate_rad_per_s,
+                   g.stance_rate_rad_per_s])
+    traj = simulate_steps(walker, x0, 10, Solver.from_settings(scene.solver))
+    segs = list(traj.segments)
+    assert [s.termination for s in segs] == ["heel_strike"] * 10
+    L = scene.walker.leg_length_m
+    for k, s in enumerate(segs):
+        q_sw, q_st = s.x_end[0], s.x_end[1]
+        assert abs(L * (np.cos(q_st) - np.cos(q_sw)) - HEIGHTS[k % 2]) < 1e-9
