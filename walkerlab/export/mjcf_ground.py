@@ -14,7 +14,7 @@ from walkerlab.export.text import nums
 if TYPE_CHECKING:
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["ground_geoms", "profile_asset"]
+__all__ = ["ground_geoms", "profile_asset", "wheel_ground"]
 
 
 def ground_geoms(mb: Multibody, extra: MjcfScene | None) -> list[str]:
@@ -118,3 +118,50 @@ def _tread_boxes(mb: Multibody, extra: MjcfScene) -> list[str]:
         out.append(f'    <geom name="tread{i}" type="box" size="{size}" pos="{pos}" '
                    'contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>')
     return out
+
+
+def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60
+                 ) -> tuple[list[str], list[str]]:
+    """A spoked wheel's MJCF ground other than its slope plane, laid as its contact model
+    lays it (continuous ground, :func:`walkerlab.models.contact.terrain.terrain_ground`),
+    the stance spoke's tip at the origin as the ``gait`` keyframe stands it: stairs as one
+    box per tread (:func:`walkerlab.models.ground.stair_treads`, tread 0 holding the first
+    stance tip, its riser faces walls a tip can hit), a profile as a height field
+    (:func:`walkerlab.models.contact.terrain.profile_line`, its first point at the first
+    stance tip, sampled every :data:`walkerlab.export.mjcf_scene.PROFILE_DX_M`).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings
+        ``kind: stairs`` or ``profile`` (with ``profile_m``).
+    spoke_length_m : float
+        The wheel's spoke length [m] (the boxes reach a spoke below the lowest tread; the
+        height field runs on two spokes past the profile's vertices).
+    n_treads : int
+        Treads ahead of the first (the last runs on for 100 treads).
+
+    Returns
+    -------
+    asset, geoms : list of str
+        The ``asset`` lines (a profile's ``hfield``; none for stairs) and the ``worldbody``
+        geoms (contact bit 1, the spoke tips').
+    """
+    from types import SimpleNamespace
+
+    mb = SimpleNamespace(leg_length_m=float(spoke_length_m))
+    if terrain.kind == "stairs":
+        from walkerlab.models.ground import stair_treads
+
+        extra = SimpleNamespace(treads=stair_treads(terrain, 0.0, n_treads),
+                                ground_offset_m=0.0)
+        return [], [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
+                    for g in _tread_boxes(mb, extra)]
+    if terrain.kind == "profile":
+        from walkerlab.models.contact.terrain import profile_line
+
+        extra = SimpleNamespace(profile=profile_line(terrain, 0.0, 0.0), ground_offset_m=0.0)
+        geoms = [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
+                 for g in _profile_geom(mb, extra)]
+        return profile_asset(mb, extra), geoms
+    raise ValueError(f"terrain.kind: {terrain.kind}: a spoked wheel's MJCF lays stairs and "
+                     "profiles (its contact model's continuous ground)")

@@ -112,7 +112,7 @@ def wheel_urdf_text(data, name: str, version: str = "",
 
 def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float | None = None,
                     qpos=None, qvel=None, timestep_s: float = 1e-4,
-                    solref=(0.002, 1.0), friction: float = 1.0) -> str:
+                    solref=(0.002, 1.0), friction: float = 1.0, ground=None) -> str:
     """A rimless wheel (``model: rimless_wheel``) as a MuJoCo model (MJCF): the ground plane
     tilted by the slope, the hub body on slide joints ``hip_x``, ``hip_z`` and a hinge
     ``wheel`` (axis -y), each spoke a capsule (no contact) and a sphere ``spoke<k>_tip`` at
@@ -133,6 +133,9 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
         plastic impact of the rigid view).
     friction : float
         Sliding friction coefficient [-].
+    ground : (list of str, list of str), optional
+        The ground's ``asset`` lines and ``worldbody`` geoms in place of the slope's plane
+        (stairs, a profile: :func:`walkerlab.export.mjcf_ground.wheel_ground`).
 
     Returns
     -------
@@ -148,9 +151,11 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
            f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
            f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
            '</default>',
+           *(ground[0] if ground is not None else ()),
            "  <worldbody>",
-           f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
-           'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
+           *([f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
+              'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>'] if ground is None
+             else ground[1]),
            '    <body name="hub" pos="0 0 0">',
            '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
            '      <joint name="hip_z" type="slide" axis="0 0 1"/>',

@@ -37,6 +37,7 @@ from walkerlab.export.engine_walk import (
     not_walked,
     walk_export,
 )
+from walkerlab.export.mjcf_ground import wheel_ground
 from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
@@ -191,8 +192,10 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     elif key is None:
         text = wheel_mjcf_text(data, name, version, hub)
     else:
+        t = scene.terrain
+        ground = None if t is None or t.is_slope else wheel_ground(t, scene.walker.spoke_length_m)
         text = wheel_mjcf_text(data, name, version, hub, qpos=key.qpos, qvel=key.qvel,
-                               friction=key.friction)
+                               friction=key.friction, ground=ground)
     path = export_path(scene, runs_root, fmt, claim=True)
     files = [(path, comments_in_scene_units(text, for_scene(scene)))]
     if fmt == "urdf" and key is not None:  # URDF has no state: the keyframe beside it
