@@ -357,3 +357,46 @@ def test_the_adams_patches_stand_at_the_footholds_heights(name, tmp_path):
     if flat is not None:
         with pytest.raises(ValueError, match=r"^terrain\.lanes: continuous: the Adams"):
             export_stage.run(flat, tmp_path / "c", "adm")
+
+
+def test_the_adams_patches_of_two_foothold_heights_stand_at_each_footholds_height(tmp_path):
+    """Issue 58's "Adams: footholds of several heights" (before: refused by the table):
+    configs/footholds_two.yaml's boxes (the paper walker, landings 4 mm and 6 mm below the
+    stance foot in turn) read back with their top faces at the footholds' heights, footfall
+    k at ``-(h_0 + ... + h_{k-1}) cos(phi)`` along the slope normal from the scene's list
+    alone (leg2's lane: k = 0, 2, ...; leg1's: -1, 1, 3, ..., footfall -1 the last step's
+    height above footfall 0), the point foot's sphere radius below; along the slope the
+    footfalls alternate the rigid period-2 gait's two step lengths (0.4449 and 0.4325 m,
+    the file's comments; to 1e-9 m, the same step each other time)."""
+    from walkerlab.export.mjcf_scene import point_foot_radius
+
+    sc = load_scene(ROOT / "configs" / "footholds_two.yaml")
+    path = export_stage.run(sc, tmp_path, "adm")
+    model = read_adm(path.read_text())
+    mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
+    phi = sc.slope.phi_rad
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    t_hat = np.array([math.cos(phi), -math.sin(phi)])
+    h = sc.terrain.foothold_heights_m
+
+    def height(k):  # footfall k's height along the normal [m], footfall 0 at 0
+        if k < 0:
+            return -h[(k) % len(h)] * math.cos(phi)
+        return sum(h[j % len(h)] for j in range(k)) * math.cos(phi)
+
+    boxes = {g.integer("CORNER"): g for g in model.by_kind["GRAPHICS"].values()
+             if "BOX" in g.flags}
+    tops, starts = [], []
+    for mid, g in sorted(boxes.items()):
+        corner, _ = model.marker_pose(mid)  # [m]
+        tops.append(float(corner[:2] @ n_hat) + g.number("Y") / 1000.0)
+        starts.append(float(corner[:2] @ t_hat))
+    half = len(tops) // 2  # leg1's lane, then leg2's
+    ks = [*(2 * i - 1 for i in range(half)), *(2 * i for i in range(len(tops) - half))]
+    want = np.array([height(k) for k in ks]) - point_foot_radius(mb)
+    assert len(tops) >= 8 and np.allclose(tops, want, atol=1e-9)
+    s = np.array(starts)[np.argsort(ks)]  # in walking order: footfall -1, 0, 1, ...
+    steps = np.diff(s)
+    assert np.allclose(steps[2::2], steps[0], atol=1e-9)
+    assert np.allclose(steps[3::2], steps[1], atol=1e-9)
+    assert sorted(np.round(steps[:2], 4)) == [0.4325, 0.4449]

@@ -165,12 +165,14 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
 _NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
                   "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-#: why the Adams and OpenSim views refuse footholds that differ from step to step
-#: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
-SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model, the "
-                     "contact model, the MJCF export and the Gymnasium environment "
-                     "(walkerlab fixedpoint, simulate, contact-sim, report, export --format "
-                     "mjcf, walkerlab.gym): give footholds of one height for this view")
+#: why the OpenSim view refuses footholds that differ from step to step (its writer lays
+#: the patch spheres at each footfall's height, but no OpenSim walk has checked them:
+#: OpenSim was not installable where they were built) (:func:`walkerlab.models.ground.
+#: landing_drop` says it, after the field's name)
+SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid and contact "
+                     "models, the MJCF, the Adams dataset and the gym (walkerlab fixedpoint, "
+                     "simulate, contact-sim, report, export --format mjcf or adm, "
+                     "walkerlab.gym): give footholds of one height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
@@ -206,12 +208,12 @@ _VC_VIEWS = {
     ("virtual_constraints", "optimize"): ("optimize does not take Bezier coefficients as "
                                           "decision variables yet: leave them out"),
 }
-#: what the views of every legged kind refuse: grounds whose steps differ in the Adams
-#: dataset and the OpenSim model (the contact model, the MJCF and the gym's contact view
-#: lay their patches at the rigid period-n gait's footfalls; the gym's rigid view steps
-#: them as simulate does), a profile there
+#: what the views of every legged kind refuse: grounds whose steps differ in the OpenSim
+#: model (the contact model, the MJCF, the Adams dataset and the gym's contact view lay
+#: their patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
+#: simulate does), a profile in the Adams dataset and the OpenSim model
 _GROUNDS = {
-    **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
+    ("footholds", "osim"): _ONE_LANDING,
     ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,
 }
