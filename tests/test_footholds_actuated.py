@@ -57,3 +57,12 @@ def test_a_pushed_off_compass_walker_lands_each_step_at_its_footholds_height():
     for k, s in enumerate(segs):
         q_sw, q_st = s.x_end[0], s.x_end[1]
         assert abs(L * (np.cos(q_st) - np.cos(q_sw)) - HEIGHTS[k % 2]) < 1e-9
+
+
+def test_the_exports_walk_check_knows_every_kind():
+    """``export --walk`` picks heel strikes or spoke strikes by the walker's kind: every
+    kind has its entry (the three-link walker's was missing: a KeyError on its walk)."""
+    from walkerlab.stages.export import _ROLLS
+
+    assert set(_ROLLS) == set(KINDS)
+    assert [k for k, rolls in _ROLLS.items() if rolls] == ["rolling_polygon"]
