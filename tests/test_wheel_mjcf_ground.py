@@ -103,3 +103,26 @@ def test_the_wheel_rolls_its_profile_in_mujoco(tmp_path):
     assert check.walked and not check.fell, check.line
     assert check.strikes >= 10 and check.alternating, check.line
     assert check.period_s == pytest.approx(check.rigid_period_s, rel=0.01), check.line
+
+
+def test_the_wheels_post_impact_section_on_stairs_stands_the_spoke_behind_a_riser_up():
+    """The rigid wheel on stairs (a landing a riser below each step): just after a spoke
+    strike the old stance spoke stands on the tread behind, a riser up, so the stance
+    spoke's angle is ``alpha - asin(riser / (2 L sin alpha))`` (``alpha = pi / spokes``;
+    two spoke tips a chord apart).  Before, the section solved the clearance of the spoke
+    ahead and returned the mirror image, ``-0.3128`` rad, and ``fixedpoint`` found no gait;
+    the step from the section lands on the next tread (same angle, to the event's 1e-9)."""
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    scene = _wheel({"kind": "stairs", "riser_m": RISER, "tread_m": TREAD,
+                    "direction": "down", "lanes": "continuous"}, slope=0.0)
+    walker = build_walker(scene)
+    alpha, L = math.pi / scene.walker.spokes, scene.walker.spoke_length_m
+    want = alpha - math.asin(RISER / (2 * L * math.sin(alpha)))
+    x0 = walker.from_section(np.array([-1.0953]))
+    assert x0[0] == pytest.approx(want, abs=1e-12)
+    seg = simulate_steps(walker, x0, 1, Solver.from_settings(scene.solver)).segments[0]
+    assert seg.termination == "heel_strike"
+    assert seg.x_next[0] == pytest.approx(want, abs=1e-9)

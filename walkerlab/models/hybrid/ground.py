@@ -71,6 +71,37 @@ def _at(clearance, offset, t, x):
     return clearance(t, x) + offset
 
 
+def _flip(x, n):
+    """``x`` with its first ``n`` entries (the coordinates) negated."""
+    y = np.array(x, copy=True)
+    y[:n] = -y[:n]
+    return y
+
+
+class _Mirrored:
+    """``clearance`` or its ``gradient`` read at the mirror image of the state (the
+    coordinates negated): the clearance of the spoke behind the stance spoke of a spoked
+    wheel, whose generated ``swing_clearance`` is the next spoke's, ahead (the spokes are
+    ``2 alpha`` apart, so the spoke behind at ``theta`` stands as the spoke ahead at
+    ``-theta``)."""
+
+    def __init__(self, f, n: int, gradient: bool):
+        self.f, self.n, self.gradient = f, n, gradient
+
+    def __call__(self, *args):
+        *t, x = args
+        out = self.f(*t, _flip(x, self.n))
+        return _flip(np.asarray(out), self.n) if self.gradient else out
+
+
+#: kind name -> whether the post-impact section's clearance is the generated one read at
+#: the state's mirror image (:class:`_Mirrored`: a spoked wheel's old stance spoke is
+#: behind, its generated clearance the spoke's ahead); the legged kinds' swing foot is the
+#: old stance foot
+_SECTION_MIRRORED = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
+                     "free_joints": False, "hinged_torso": False, "rolling_polygon": True}
+
+
 class _LandingSection:
     """``from_section`` of the post-impact surface ``swing_clearance(x) = level`` (see the
     module docstring): the walker's own ``from_section`` (its slope's surface) as the start,
@@ -197,9 +228,13 @@ def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     mirror = walker.mirror
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
         mirror = _landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
+    s_clear, s_grad = clear, grad
+    if _SECTION_MIRRORED[data.structure.kind.name]:
+        n = walker.n_coordinates
+        s_clear, s_grad = _Mirrored(clear, n, False), _Mirrored(grad, n, True)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
-                   from_section=_LandingSection(walker, clear, grad, offset),
+                   from_section=_LandingSection(walker, s_clear, s_grad, offset),
                    params={**walker.params, "landing_drop_m": float(drop_m)},
                    mirror=mirror)
 
