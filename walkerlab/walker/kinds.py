@@ -187,8 +187,6 @@ PROFILE_PASSIVE = ("walked by the passive walker of the generated model only (no
                    "walker.actuation, ideal.variant: derived)")
 _OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                  "half-spaces, not a polyline; --format mjcf writes it as a height field)")
-_ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
-                  "the footholds' heights), not continuous profile")
 _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
                     "scene without it")
 #: why the Adams dataset refuses joint torques other than the hip's on a walker that is not
@@ -214,7 +212,6 @@ _VC_VIEWS = {
 #: simulate does), a profile in the Adams dataset and the OpenSim model
 _GROUNDS = {
     ("footholds", "osim"): _ONE_LANDING,
-    ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,
 }
 #: what the kinds without ankles (point or arc feet) refuse of the ankle's features
@@ -266,8 +263,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
                              "arc feet (a flat foot's modes have no per-step landing yet)"),
         # the exports refuse any walker's footholds that differ before its feet
-        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
-        ("profile", "adams"): _ADAMS_PROFILE,
+        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "osim")},
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "
