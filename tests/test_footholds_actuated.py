@@ -6,6 +6,7 @@ model refused a powered straight-legged walker despite its table cell)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import yaml
 from cli_run import ROOT
 
@@ -66,3 +67,40 @@ def test_the_exports_walk_check_knows_every_kind():
 
     assert set(_ROLLS) == set(KINDS)
     assert [k for k, rolls in _ROLLS.items() if rolls] == ["rolling_polygon"]
+
+
+@pytest.mark.slow  # ~25 s: simulate and 500 control periods of the rigid view
+def test_the_gyms_rigid_view_walks_the_three_link_footholds_as_simulate_does(tmp_path):
+    """configs/threelink_footholds.yaml (the three-link walker's PD law on footholds 1 mm
+    up and down in turn) in the gym's rigid view under a zero action (the scene's torques
+    act as in simulate): each of simulate's 10 heel strikes at the same time to 1e-7 s
+    (measured 1.7e-8 s: the gym restarts the integrator at each control period's bound,
+    where the PD law's torque is evaluated again), the two steps of the period-2 gait in
+    turn (0.45145 and 0.46370 s, the scene's comment)."""
+    from test_gym import _env, _stage_heel_strikes, _zero_walk
+
+    ref = _stage_heel_strikes("simulate", "threelink_footholds", tmp_path)
+    assert ref.size == 10
+    strikes, info = _zero_walk(_env("threelink_footholds", max_episode_steps=500))
+    assert info["termination"] == "" and strikes.size == ref.size, (strikes, info)
+    np.testing.assert_allclose(strikes, ref, rtol=0.0, atol=1e-7)
+    T = np.diff(strikes, prepend=0.0)
+    np.testing.assert_allclose(T[0::2], 0.45145, atol=1e-5)
+    np.testing.assert_allclose(T[1::2], 0.46370, atol=1e-5)
+
+
+@pytest.mark.slow  # ~40 s: the contact run
+def test_the_contact_model_walks_the_three_link_footholds_within_2_percent(tmp_path):
+    """Issue 58's "contact >= 10 heel strikes within 2 % of the rigid period-n gait" for an
+    actuated walker: configs/threelink_footholds.yaml's contact run (patches at the rigid
+    period-2 gait's footfalls) makes at least 10 alternating heel strikes, and each step of
+    the cycle (after the first two: the start's transient) is within 2 % of the rigid
+    step's 0.45145 and 0.46370 s (measured +0.40 % and +0.56 % on average)."""
+    from test_gym import _stage_heel_strikes
+
+    t = _stage_heel_strikes("contact-sim", "threelink_footholds", tmp_path)
+    assert t.size >= 10
+    T = np.diff(t)  # step k + 1 of the run: onto footfall k + 2 (cycle step (k + 1) mod 2)
+    rigid = np.array([0.45145, 0.46370])
+    k = np.arange(1, T.size + 1) % 2
+    assert np.all(np.abs(T[1:] / rigid[k[1:]] - 1.0) < 0.02), T
