@@ -52,12 +52,13 @@ def _ground_height(xml: str, x: float) -> float:
 
 def _xml(scene):
     from walkerlab.export.mjcf_ground import wheel_ground
-    from walkerlab.export.spoked import wheel_mjcf_text
+    from walkerlab.export.spoked import wheel_chord_m, wheel_mjcf_text
     from walkerlab.walker.description import walker_data
 
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    return wheel_mjcf_text(data, "w", hub_inertia_kg_m2=1e-3,
-                           ground=wheel_ground(scene.terrain, scene.walker.spoke_length_m))
+    ground = wheel_ground(scene.terrain, scene.walker.spoke_length_m,
+                          chord_m=wheel_chord_m(data), slope_rad=scene.slope.phi_rad)
+    return wheel_mjcf_text(data, "w", hub_inertia_kg_m2=1e-3, ground=ground)
 
 
 def test_the_wheels_mjcf_stairs_are_treads_a_riser_below_each_other():
@@ -81,12 +82,11 @@ def test_the_wheels_mjcf_profile_is_a_height_field_through_the_profiles_vertices
         assert _ground_height(xml, xi) == pytest.approx(yi, abs=1e-5)
 
 
-def test_a_wheel_on_stairs_or_a_profile_is_no_longer_refused_by_its_mjcf():
+def test_a_wheel_on_stairs_footholds_or_a_profile_is_no_longer_refused_by_its_mjcf():
     from walkerlab.walker.kinds import KINDS
 
     wheel = KINDS["rolling_polygon"]
-    assert wheel.supports("stairs", "mjcf") and wheel.supports("profile", "mjcf")
-    assert "no ground between them" in wheel.cell("footholds", "mjcf")
+    assert all(wheel.supports(f, "mjcf") for f in ("stairs", "footholds", "profile"))
 
 
 @pytest.mark.slow  # ~15 s: the rigid gait and 12 s of MuJoCo
@@ -126,3 +126,40 @@ def test_the_wheels_post_impact_section_on_stairs_stands_the_spoke_behind_a_rise
     seg = simulate_steps(walker, x0, 1, Solver.from_settings(scene.solver)).segments[0]
     assert seg.termination == "heel_strike"
     assert seg.x_next[0] == pytest.approx(want, abs=1e-9)
+
+
+def test_the_wheels_footholds_lie_a_chord_apart_at_their_heights_on_the_slope():
+    """The wheel on its 0.08 rad slope with footholds 1 cm above and below the stance
+    tip's level in turn: the rigid post-impact angle from the vertical after each landing
+    is ``alpha - asin(h cos(phi) / c) - phi`` (the spoke behind stands ``h cos(phi)`` along
+    the normal above the stance tip, a chord ``c = 2 L sin(alpha)`` away; to 1e-12 rad), and
+    the MJCF's patches are where the tips land: MuJoCo's ray cast finds each footfall's
+    patch top at the heights summed along the normal from the stance tip (1e-9 m)."""
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    h = (0.01, -0.01)
+    scene = _wheel({"kind": "footholds", "foothold_heights_m": list(h),
+                    "lanes": "checkerboard", "patch_width_m": 0.2})
+    phi, alpha, L = 0.08, math.pi / scene.walker.spokes, scene.walker.spoke_length_m
+    c = 2 * L * math.sin(alpha)
+
+    def after(k):  # the stance angle just after landing k (height h[k mod 2])
+        return alpha + math.asin(h[k % 2] * math.cos(phi) / c) - phi
+
+    walker = build_walker(scene)
+    x0 = walker.from_section(np.array([-1.09]))
+    assert x0[0] == pytest.approx(after(1), abs=1e-12)  # the map's section: step 1's
+    segs = simulate_steps(walker, x0, 4, Solver.from_settings(scene.solver)).segments
+    assert [s.termination for s in segs] == ["heel_strike"] * 4
+    for k, s in enumerate(segs):
+        assert s.x_next[0] == pytest.approx(after(k), abs=1e-9)
+    xml = _xml(scene)
+    t = np.array([math.cos(phi), -math.sin(phi)])
+    n = np.array([math.sin(phi), math.cos(phi)])
+    p = np.zeros(2)
+    for k in range(8):  # footfall k + 1 from footfall k: up h_k along n, the chord's rest along t
+        up = h[k % 2] * math.cos(phi)
+        p = p + math.sqrt(c * c - up * up) * t + up * n
+        assert _ground_height(xml, p[0]) == pytest.approx(p[1], abs=1e-9)

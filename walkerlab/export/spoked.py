@@ -15,7 +15,8 @@ from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
 
-__all__ = ["WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel_mjcf_text", "wheel_urdf_text"]
+__all__ = ["WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel_chord_m", "wheel_mjcf_text",
+           "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
@@ -32,6 +33,13 @@ def _wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
     p["n"] = data.structure.spokes
     p["r"] = WHEEL_TIP_FRACTION * p["L"]
     return p
+
+
+def wheel_chord_m(data) -> float:
+    """The distance [m] between two neighbouring spoke tips of a spoked wheel,
+    ``2 L sin(pi / spokes)`` (where its footfalls lie apart; McGeer 1990)."""
+    p = _wheel_numbers(data, None)
+    return 2.0 * p["L"] * math.sin(math.pi / p["n"])
 
 
 def _spoke_tip(p: dict, k: int, to: float) -> tuple[float, float]:

@@ -302,12 +302,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                    "ground (its spokes have no lanes of their own)"),
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
-        # its MJCF lays the ground as its contact model does: continuous (treads, a
-        # height field), and footholds have none between them
-        ("footholds", "mjcf"): ("a spoked wheel's MJCF lays its contact model's continuous "
-                                "ground (treads, a height field); footholds have no ground "
-                                "between them (rigid model only: walkerlab fixedpoint, "
-                                "simulate)"),
     },
 }
 

@@ -71,26 +71,28 @@ def _at(clearance, offset, t, x):
     return clearance(t, x) + offset
 
 
-def _flip(x, n):
-    """``x`` with its first ``n`` entries (the coordinates) negated."""
+def _flip(x, n, shift=0.0):
+    """``x`` with its first ``n`` entries (the coordinates) ``q`` mirrored to ``-q - shift``
+    (``shift = 0``: negated)."""
     y = np.array(x, copy=True)
-    y[:n] = -y[:n]
+    y[:n] = -y[:n] - shift
     return y
 
 
 class _Mirrored:
-    """``clearance`` or its ``gradient`` read at the mirror image of the state (the
-    coordinates negated): the clearance of the spoke behind the stance spoke of a spoked
-    wheel, whose generated ``swing_clearance`` is the next spoke's, ahead (the spokes are
-    ``2 alpha`` apart, so the spoke behind at ``theta`` stands as the spoke ahead at
-    ``-theta``)."""
+    """``clearance`` or its ``gradient`` read at the mirror image of the state about the
+    slope's normal: the clearance of the spoke behind the stance spoke of a spoked wheel,
+    whose generated ``swing_clearance`` is the next spoke's, ahead (the spokes are
+    ``2 alpha`` apart, so the spoke behind at ``theta`` from the slope's normal stands as
+    the spoke ahead at ``-theta``; its angle ``q`` from the vertical, ``theta = q + phi``,
+    mirrors to ``-q - 2 phi``)."""
 
-    def __init__(self, f, n: int, gradient: bool):
-        self.f, self.n, self.gradient = f, n, gradient
+    def __init__(self, f, n: int, gradient: bool, slope_rad: float):
+        self.f, self.n, self.gradient, self.shift = f, n, gradient, 2.0 * slope_rad
 
     def __call__(self, *args):
         *t, x = args
-        out = self.f(*t, _flip(x, self.n))
+        out = self.f(*t, _flip(x, self.n, self.shift))
         return _flip(np.asarray(out), self.n) if self.gradient else out
 
 
@@ -231,7 +233,8 @@ def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     s_clear, s_grad = clear, grad
     if _SECTION_MIRRORED[data.structure.kind.name]:
         n = walker.n_coordinates
-        s_clear, s_grad = _Mirrored(clear, n, False), _Mirrored(grad, n, True)
+        g = float(data.slope_rad)
+        s_clear, s_grad = _Mirrored(clear, n, False, g), _Mirrored(grad, n, True, g)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
                    from_section=_LandingSection(walker, s_clear, s_grad, offset),
