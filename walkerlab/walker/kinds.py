@@ -209,7 +209,7 @@ _VC_VIEWS = {
 #: what the views of every legged kind refuse: grounds whose steps differ in the OpenSim
 #: model (the contact model, the MJCF, the Adams dataset and the gym's contact view lay
 #: their patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
-#: simulate does), a profile in the Adams dataset and the OpenSim model
+#: simulate does), a profile in the OpenSim model
 _GROUNDS = {
     ("footholds", "osim"): _ONE_LANDING,
     ("profile", "osim"): _OSIM_PROFILE,
