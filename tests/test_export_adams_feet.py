@@ -329,9 +329,7 @@ def test_the_adams_patches_stand_at_the_footholds_heights(name, tmp_path):
     checkerboard's boxes of configs/stairs.yaml (1 cm risers) and configs/footholds.yaml
     (each footfall 5 mm lower) read back with their top faces at the footholds' heights,
     footfall k at -k drop cos(phi) along the slope normal (leg2's lane: k = 0, 2, ...;
-    leg1's: -1, 1, 3, ...), the point foot's sphere radius below; continuous stairs are
-    refused in one line."""
-    from walkerlab.api.scenes import with_changes
+    leg1's: -1, 1, 3, ...), the point foot's sphere radius below."""
     from walkerlab.export.mjcf_scene import point_foot_radius
 
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
@@ -353,7 +351,99 @@ def test_the_adams_patches_stand_at_the_footholds_heights(name, tmp_path):
     k2 = np.arange(len(tops) - half) * 2
     want = np.concatenate([-k1 * drop, -k2 * drop]) - point_foot_radius(mb)
     assert np.allclose(tops, want, atol=1e-9)
-    flat = with_changes(sc, {"terrain.lanes": "continuous"}) if name == "stairs" else None
-    if flat is not None:
-        with pytest.raises(ValueError, match=r"^terrain\.lanes: continuous: the Adams"):
-            export_stage.run(flat, tmp_path / "c", "adm")
+    # continuous stairs: tests/test_export_adams_feet.py::
+    # test_the_adams_ground_line_is_a_patch_per_segment_of_the_scenes_ground (issue 58)
+
+
+def test_the_adams_patches_of_two_foothold_heights_stand_at_each_footholds_height(tmp_path):
+    """Issue 58's "Adams: footholds of several heights" (before: refused by the table):
+    configs/footholds_two.yaml's boxes (the paper walker, landings 4 mm and 6 mm below the
+    stance foot in turn) read back with their top faces at the footholds' heights, footfall
+    k at ``-(h_0 + ... + h_{k-1}) cos(phi)`` along the slope normal from the scene's list
+    alone (leg2's lane: k = 0, 2, ...; leg1's: -1, 1, 3, ..., footfall -1 the last step's
+    height above footfall 0), the point foot's sphere radius below; along the slope the
+    footfalls alternate the rigid period-2 gait's two step lengths (0.4449 and 0.4325 m,
+    the file's comments; to 1e-9 m, the same step each other time)."""
+    from walkerlab.export.mjcf_scene import point_foot_radius
+
+    sc = load_scene(ROOT / "configs" / "footholds_two.yaml")
+    path = export_stage.run(sc, tmp_path, "adm")
+    model = read_adm(path.read_text())
+    mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
+    phi = sc.slope.phi_rad
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    t_hat = np.array([math.cos(phi), -math.sin(phi)])
+    h = sc.terrain.foothold_heights_m
+
+    def height(k):  # footfall k's height along the normal [m], footfall 0 at 0
+        if k < 0:
+            return -h[(k) % len(h)] * math.cos(phi)
+        return sum(h[j % len(h)] for j in range(k)) * math.cos(phi)
+
+    boxes = {g.integer("CORNER"): g for g in model.by_kind["GRAPHICS"].values()
+             if "BOX" in g.flags}
+    tops, starts = [], []
+    for mid, g in sorted(boxes.items()):
+        corner, _ = model.marker_pose(mid)  # [m]
+        tops.append(float(corner[:2] @ n_hat) + g.number("Y") / 1000.0)
+        starts.append(float(corner[:2] @ t_hat))
+    half = len(tops) // 2  # leg1's lane, then leg2's
+    ks = [*(2 * i - 1 for i in range(half)), *(2 * i for i in range(len(tops) - half))]
+    want = np.array([height(k) for k in ks]) - point_foot_radius(mb)
+    assert len(tops) >= 8 and np.allclose(tops, want, atol=1e-9)
+    s = np.array(starts)[np.argsort(ks)]  # in walking order: footfall -1, 0, 1, ...
+    steps = np.diff(s)
+    assert np.allclose(steps[2::2], steps[0], atol=1e-9)
+    assert np.allclose(steps[3::2], steps[1], atol=1e-9)
+    assert sorted(np.round(steps[:2], 4)) == [0.4325, 0.4449]
+
+
+def _box_top(model, mid, box):
+    """The two ends [m] (x, y) of a GRAPHICS BOX's top face (its CORNER marker's x axis
+    along the box, y across it: the face ``Y`` above the corner)."""
+    origin, rot = model.marker_pose(mid)
+    up = rot @ np.array([0.0, box.number("Y") / 1000.0, 0.0])
+    along = rot @ np.array([box.number("X") / 1000.0, 0.0, 0.0])
+    return (origin + up)[:2], (origin + up + along)[:2], rot[:2, 1]
+
+
+@pytest.mark.parametrize("name", ["profile", "stairs"])
+def test_the_adams_ground_line_is_a_patch_per_segment_of_the_scenes_ground(name, tmp_path):
+    """Issue 58's "Adams: ... profiles" (before: "the Adams dataset carries the ground as
+    patches ..., not continuous profile"): configs/profile.yaml (the kneed walker on its
+    ramp with a 1 mm undulation) and configs/stairs.yaml on continuous ground are written
+    as a box per segment of the ground's polyline, each box's top face, raised by the
+    point foot's sphere radius along its normal, running from one vertex of the scene's
+    ground to the next (the profile's own ``profile_m`` rows moved to leg2's foot at the
+    origin; the stairs' treads ``tread_m`` deep and ``riser_m`` apart, level, the first
+    stance foot mid-tread 0), to 1e-9 m; each foot has a CONTACT with every box."""
+    from walkerlab.api.scenes import with_changes
+    from walkerlab.export.mjcf_scene import point_foot_radius
+
+    sc = load_scene(ROOT / "configs" / f"{name}.yaml")
+    if name == "stairs":
+        sc = with_changes(sc, {"terrain.lanes": "continuous"})
+    model = read_adm(export_stage.run(sc, tmp_path, "adm").read_text())
+    r = point_foot_radius(multibody(walker_data(sc.walker, sc.slope.phi_rad)))
+    boxes = sorted((g.integer("CORNER"), g) for g in model.by_kind["GRAPHICS"].values()
+                   if "BOX" in g.flags)
+    ends = []
+    for mid, g in boxes:
+        a, b, nrm = _box_top(model, mid, g)
+        ends.append((a + r * nrm, b + r * nrm))
+    if name == "profile":
+        P = np.asarray(sc.terrain.profile_m, float)
+        want = P - P[0]
+        inner = ends[1:1 + len(want) - 1]  # the first and last boxes run on for 100 m
+        assert len(ends) == len(want) + 1
+        for (a, b), p, q in zip(inner, want[:-1], want[1:]):
+            assert np.allclose(a, p, atol=1e-9) and np.allclose(b, q, atol=1e-9)
+    else:
+        D, H = sc.terrain.tread_m, sc.terrain.riser_m
+        treads = [(a, b) for a, b in ends if abs(a[1] - b[1]) < 1e-12]  # level: treads
+        heights = sorted({round(-a[1] / H, 9) for a, _ in treads})
+        assert heights == list(range(-3, len(heights) - 3))  # tread k at -k riser
+        mid = [(a, b) for a, b in treads if abs(a[1]) < 1e-12][0]  # tread 0
+        assert np.allclose([mid[0][0], mid[1][0]], [-D / 2, D / 2], atol=1e-9)
+    contacts = [c for c in model.by_kind["CONTACT"].values()]
+    assert len(contacts) == 2 * len(boxes)

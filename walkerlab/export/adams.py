@@ -140,6 +140,7 @@ times the stop's IMPACT law, no SENSOR (:mod:`walkerlab.export.adams_latch`).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -281,14 +282,16 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
     ideal = ideal_gait(scene) if ideal is None else ideal
     extra = mjcf_scene(scene, mb, data, ideal)  # the same gait: one search, not two
     n = _strides(scene) + 2
-    if extra.lanes is None and (extra.treads is not None or extra.profile is not None):
-        raise ValueError(f"terrain.lanes: continuous: the Adams dataset carries the ground as "
-                         f"patches (lanes: checkerboard, at the footholds' heights), not "
-                         f"continuous {scene.terrain.kind}")
     lanes = None if extra.lanes is None else tuple(tuple(lane[:n]) for lane in extra.lanes)
     heights = (None if extra.lane_heights is None or lanes is None else
                tuple(tuple(float(h) for h in hs[:n]) for hs in extra.lane_heights))
-    return adams_feet(mb).start(scene, mb, data, ideal, extra, lanes, heights)
+    start = adams_feet(mb).start(scene, mb, data, ideal, extra, lanes, heights)
+    if extra.lanes is None and (extra.treads is not None or extra.profile is not None):
+        # continuous ground: its polyline, a patch per segment
+        line = (np.asarray(extra.profile, float) if extra.profile is not None else
+                np.asarray([(x, h) for a, b, h in extra.treads for x in (a, b)], float))
+        start = replace(start, ground_line=line)
+    return start
 
 
 def _strides(scene: Scene) -> int:
@@ -387,6 +390,41 @@ def _joints(mb, start: AdamsStart, ids: dict) -> list[str]:
     return out
 
 
+def _line_patches(line, r: float, L: float) -> list[str]:
+    """Continuous ground (a profile, continuous stairs) as the polyline ``line`` (m, 2) [m]
+    of patches: segment ``i`` a box whose top face lies on it, lowered by the foot
+    sphere's radius ``r`` [m] along its normal (as the checkerboard's patches), turned by
+    the segment's angle (``REULER``), ``L / 5`` wide across the plane; each foot touches
+    every segment (its CONTACTs)."""
+    out, gid = [], 1001
+    for i, (a, b) in enumerate(zip(line[:-1], line[1:])):
+        d = b - a
+        length = float(np.hypot(*d))
+        if length <= 0.0:
+            continue
+        g = math.atan2(float(d[1]), float(d[0]))  # the segment's angle (downhill: < 0)
+        depth = min(length, 1.0) / 10
+        nrm = (-math.sin(g), math.cos(g))  # its upward normal
+        corner = (a[0] - (r + depth) * nrm[0], a[1] - (r + depth) * nrm[1], -L / 10)
+        out.append(f"! segment {i} of the ground line from ({a[0]:.6g}, {a[1]:.6g}) m "
+                   f"to ({b[0]:.6g}, {b[1]:.6g}) m")
+        out += _stmt(f"MARKER/{gid}, PART=1", f"QP={_fs(*(x * MM for x in corner))}",
+                     f"REULER={_deg(g)}, 0.0D, 0.0D")
+        out += _stmt(f"GRAPHICS/{gid}, BOX, CORNER={gid}",
+                     f"X={_f(length * MM)}, Y={_f(depth * MM)}, Z={_f(L / 5 * MM)}")
+        gid += 1
+    return out
+
+
+def ground_patches(start: AdamsStart) -> int:
+    """The patches of the dataset's ground when it is a polyline (segments of positive
+    length of :attr:`AdamsStart.ground_line`); 1 (the slope's plane) otherwise."""
+    if start.ground_line is None:
+        return 1
+    d = np.diff(np.asarray(start.ground_line, float), axis=0)
+    return int(np.count_nonzero(np.hypot(d[:, 0], d[:, 1]) > 0.0))
+
+
 def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
     """PART/1 (ground), its markers, ACCGRAV and the checkerboard's patches (or one plane)."""
     arc = mb.foot == "arc" and mb.foot_radius_m > 0  # the sphere is the arc: no offset
@@ -403,6 +441,8 @@ def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
            f"{_f(LANE_Z['leg2'] * L * MM if lanes else 0.0)}",
            "MARKER/103, PART=1, QP=0.0, 0.0, 0.0",
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY={_f(-mb.gravity_m_per_s2 * MM)}, KGRAVITY=0.0"]
+    if start.ground_line is not None:  # continuous ground: a box per segment
+        return out + _line_patches(start.ground_line, r, L)
     t, n = (math.cos(phi), -math.sin(phi)), (math.sin(phi), math.cos(phi))
     w = start.patch_width_m
     depth = w / 10
@@ -558,7 +598,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     out += _parts(mb, start, ids, lanes, feet)
     out += _joints(mb, start, ids)
     out += _forces(mb, scene, ids, feet, start if lanes else None)
-    n = tuple(len(lane) for lane in start.lanes) if lanes else (1,)
+    n = tuple(len(lane) for lane in start.lanes) if lanes else (ground_patches(start),)
     out += contact_statements(mb, ids, lanes, n, law)
     out += actuation_statements(mb, scene, ids, n, lanes)
     out += _requests(mb, ids, feet)

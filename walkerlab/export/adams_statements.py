@@ -48,6 +48,11 @@ class AdamsStart:
     lane_heights : (tuple, tuple) or None
         Stairs and footholds: each patch's height along the slope normal [m] (its tread's,
         one per centre of ``lanes``); None: every patch on the slope line.
+    ground_line : ndarray (m, 2) or None
+        Continuous ground (``terrain.lanes: continuous``: a profile, continuous stairs):
+        the polyline's vertices [m] in the world frame (x downhill, y up, leg2's contact
+        point at the origin), each segment a patch both feet touch; None: ``lanes`` or
+        the slope's plane.
     """
 
     hip: tuple[float, float]
@@ -60,6 +65,7 @@ class AdamsStart:
     rate_scale: tuple[float, float]
     ankles: dict | None = None
     lane_heights: tuple | None = None
+    ground_line: object = None
 
 
 

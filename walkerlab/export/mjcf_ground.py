@@ -14,7 +14,7 @@ from walkerlab.export.text import nums
 if TYPE_CHECKING:
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["ground_geoms", "profile_asset"]
+__all__ = ["ground_geoms", "profile_asset", "wheel_ground"]
 
 
 def ground_geoms(mb: Multibody, extra: MjcfScene | None) -> list[str]:
@@ -117,4 +117,95 @@ def _tread_boxes(mb: Multibody, extra: MjcfScene) -> list[str]:
         pos = nums((a + b) / 2, 0, (top + floor) / 2)
         out.append(f'    <geom name="tread{i}" type="box" size="{size}" pos="{pos}" '
                    'contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>')
+    return out
+
+
+def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: float = 0.0,
+                 slope_rad: float = 0.0) -> tuple[list[str], list[str]]:
+    """A spoked wheel's MJCF ground other than its slope plane, laid as its contact model
+    lays it (continuous ground, :func:`walkerlab.models.contact.terrain.terrain_ground`),
+    the stance spoke's tip at the origin as the ``gait`` keyframe stands it: stairs as one
+    box per tread (:func:`walkerlab.models.ground.stair_treads`, tread 0 holding the first
+    stance tip, its riser faces walls a tip can hit), a profile as a height field
+    (:func:`walkerlab.models.contact.terrain.profile_line`, its first point at the first
+    stance tip, sampled every :data:`walkerlab.export.mjcf_scene.PROFILE_DX_M`).  Footholds
+    (of one height or several, :func:`walkerlab.models.ground.landing_drops`) are a patch
+    per footfall, ``patch_width_m`` long on the slope, where the rigid wheel's spoke tips
+    land: two tips are a chord ``c = 2 L sin(pi / spokes)`` apart, so footfall ``k + 1``
+    lies ``h_k cos(phi)`` along the slope's normal and ``sqrt(c^2 - (h_k cos phi)^2)``
+    along the slope from footfall ``k`` (the rigid heel strike's landing, step ``k``'s
+    height ``h_k`` above the stance tip's level).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings
+        ``kind: stairs`` or ``profile`` (with ``profile_m``).
+    spoke_length_m : float
+        The wheel's spoke length [m] (the boxes reach a spoke below the lowest tread; the
+        height field runs on two spokes past the profile's vertices).
+    n_treads : int
+        Treads (footholds: footfalls) ahead of the first (the last tread runs on for 100
+        treads).
+    chord_m : float
+        The distance [m] between two neighbouring spoke tips (footholds;
+        :func:`walkerlab.export.spoked.wheel_chord_m`).
+    slope_rad : float
+        The scene's slope [rad] (footholds lie on it).
+
+    Returns
+    -------
+    asset, geoms : list of str
+        The ``asset`` lines (a profile's ``hfield``; none for stairs) and the ``worldbody``
+        geoms (contact bit 1, the spoke tips').
+    """
+    from types import SimpleNamespace
+
+    mb = SimpleNamespace(leg_length_m=float(spoke_length_m))
+    if terrain.kind == "stairs":
+        from walkerlab.models.ground import stair_treads
+
+        extra = SimpleNamespace(treads=stair_treads(terrain, 0.0, n_treads),
+                                ground_offset_m=0.0)
+        return [], [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
+                    for g in _tread_boxes(mb, extra)]
+    if terrain.kind == "profile":
+        from walkerlab.models.contact.terrain import profile_line
+
+        extra = SimpleNamespace(profile=profile_line(terrain, 0.0, 0.0), ground_offset_m=0.0)
+        geoms = [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
+                 for g in _profile_geom(mb, extra)]
+        return profile_asset(mb, extra), geoms
+    if terrain.kind == "footholds" and chord_m > 0.0:
+        return [], _wheel_footholds(terrain, float(spoke_length_m), float(chord_m),
+                                    float(slope_rad), n_treads)
+    raise ValueError(f"terrain.kind: {terrain.kind}: a spoked wheel's MJCF lays stairs, "
+                     "footholds and profiles")
+
+
+def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int) -> list[str]:
+    """:func:`wheel_ground`'s footholds: a box per footfall, footfall -1 (behind the first
+    stance tip) to ``n`` (a finite list, ``periodic: false``: its own footfalls)."""
+    from walkerlab.models.ground import landing_drops
+
+    h = [-d for d in landing_drops(terrain)]  # each step's landing above the stance tip
+    t = np.array([math.cos(phi), -math.sin(phi)])
+    nrm = np.array([math.sin(phi), math.cos(phi)])
+    last = len(terrain.foothold_heights_m) if terrain.periodic is False else n
+
+    def step(k):  # footfall k -> k + 1 [m] in (x, z)
+        up = h[k % len(h)] * math.cos(phi)
+        return math.sqrt(c * c - up * up) * t + up * nrm
+
+    falls = {0: np.zeros(2), -1: -step(-1)}
+    for k in range(last):
+        falls[k + 1] = falls[k] + step(k)
+    w = float(terrain.patch_width_m)
+    depth = w / 10
+    out = []
+    for k in sorted(falls):
+        centre = falls[k] - depth * nrm
+        out.append(f'    <geom name="footfall{k}" type="box" '
+                   f'size="{nums(w / 2, 0.04 * L, depth)}" '
+                   f'pos="{nums(centre[0], 0, centre[1])}" euler="{nums(0, phi, 0)}" '
+                   'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>')
     return out

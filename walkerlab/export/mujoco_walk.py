@@ -428,7 +428,8 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
     MujocoWalk
         ``legs`` the striking spokes' names (each the next: ``alternating`` holds while the
         wheel rolls spoke by spoke), ``positions_m`` the striking tip along the slope,
-        ``fell``: the hub below half a spoke above the slope line.
+        ``fell``: the hub below half a spoke above its stance spoke's tip (along the
+        slope's normal; the tip stands on the ground, a tread or a profile too).
 
     Raises
     ------
@@ -463,7 +464,10 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
             legs.append(f"spoke{stance}")
             g = next(g for g, k in tips.items() if k == stance)
             pos.append(float(data.geom_xpos[g] @ tan))
-        if data.qpos[hub] * nrm[0] + data.qpos[hub + 1] * nrm[2] < 0.5 * L:
+        g = next(g for g, k in tips.items() if k == stance)
+        hub_x = np.array([data.qpos[hub], 0.0, data.qpos[hub + 1]])
+        if (hub_x - data.geom_xpos[g]) @ nrm < 0.5 * L:  # above its stance tip (stairs,
+            # a profile: the ground under the hub is the stance tip's)
             fell = True
             break
     return MujocoWalk(np.array(times), legs, np.array(pos), fell, float(data.time))

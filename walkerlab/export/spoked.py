@@ -15,7 +15,8 @@ from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
 
-__all__ = ["WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel_mjcf_text", "wheel_urdf_text"]
+__all__ = ["WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel_chord_m", "wheel_mjcf_text",
+           "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
@@ -32,6 +33,13 @@ def _wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
     p["n"] = data.structure.spokes
     p["r"] = WHEEL_TIP_FRACTION * p["L"]
     return p
+
+
+def wheel_chord_m(data) -> float:
+    """The distance [m] between two neighbouring spoke tips of a spoked wheel,
+    ``2 L sin(pi / spokes)`` (where its footfalls lie apart; McGeer 1990)."""
+    p = _wheel_numbers(data, None)
+    return 2.0 * p["L"] * math.sin(math.pi / p["n"])
 
 
 def _spoke_tip(p: dict, k: int, to: float) -> tuple[float, float]:
@@ -112,7 +120,7 @@ def wheel_urdf_text(data, name: str, version: str = "",
 
 def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float | None = None,
                     qpos=None, qvel=None, timestep_s: float = 1e-4,
-                    solref=(0.002, 1.0), friction: float = 1.0) -> str:
+                    solref=(0.002, 1.0), friction: float = 1.0, ground=None) -> str:
     """A rimless wheel (``model: rimless_wheel``) as a MuJoCo model (MJCF): the ground plane
     tilted by the slope, the hub body on slide joints ``hip_x``, ``hip_z`` and a hinge
     ``wheel`` (axis -y), each spoke a capsule (no contact) and a sphere ``spoke<k>_tip`` at
@@ -133,6 +141,9 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
         plastic impact of the rigid view).
     friction : float
         Sliding friction coefficient [-].
+    ground : (list of str, list of str), optional
+        The ground's ``asset`` lines and ``worldbody`` geoms in place of the slope's plane
+        (stairs, a profile: :func:`walkerlab.export.mjcf_ground.wheel_ground`).
 
     Returns
     -------
@@ -148,9 +159,11 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
            f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
            f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
            '</default>',
+           *(ground[0] if ground is not None else ()),
            "  <worldbody>",
-           f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
-           'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
+           *([f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
+              'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>'] if ground is None
+             else ground[1]),
            '    <body name="hub" pos="0 0 0">',
            '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
            '      <joint name="hip_z" type="slide" axis="0 0 1"/>',

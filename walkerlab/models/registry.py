@@ -40,9 +40,9 @@ def build_walker(scene) -> HybridWalker:
         The scene names a walker model or variant that has no rigid hybrid implementation,
         or actuators the walker cannot carry (one line).
     """
-    walker = _on_ground(scene, _passive(scene))
     act = scene.walker.actuation
-    if act is None:
+    walker = _on_ground(scene, _passive(scene))
+    if act is None or walker.cycle is not None:  # footholds: each step's walker actuated
         return walker
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.walker.description import walker_data
@@ -129,11 +129,18 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
     if walker.variant != "derived":
         raise ValueError("terrain.kind: footholds need ideal.variant: derived (the printed "
                          "Appendix A equations know only the slope)")
-    if scene.walker.actuation is not None:
-        raise ValueError("walker.actuation: footholds of several heights or slopes are built "
-                         "for passive walkers only")
     walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
         "footholds", "rigid", "terrain.kind")
+    finish = None
+    act = scene.walker.actuation
+    if act is not None:  # every step's walker carries the actuators
+        if scene.ideal.variant != "derived":
+            raise ValueError("walker.actuation: only with ideal.variant: derived (the "
+                             "printed Appendix A equations are passive)")
+        from walkerlab.models.hybrid.actuated import actuate
+
+        def finish(w, d):
+            return actuate(w, d, act)
 
     def at(g: float) -> HybridWalker:
         if g == scene.slope.phi_rad:
@@ -143,7 +150,8 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
 
     if periodic is None:
         periodic = scene.terrain.periodic is not False
-    return on_footholds(at, lambda g: walker_data(scene.walker, g), steps, periodic)
+    return on_footholds(at, lambda g: walker_data(scene.walker, g), steps, periodic,
+                        finish)
 
 
 def _passive(scene) -> HybridWalker:

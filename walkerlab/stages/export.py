@@ -37,6 +37,7 @@ from walkerlab.export.engine_walk import (
     not_walked,
     walk_export,
 )
+from walkerlab.export.mjcf_ground import wheel_ground
 from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
@@ -57,7 +58,7 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.scene import FORMAT_VIEWS, check_exportable, mjcf_scene
-from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS
+from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS, wheel_chord_m
 from walkerlab.export.text import comment
 from walkerlab.export.wheel_scene import (
     check_wheel_exportable,
@@ -176,23 +177,28 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     """The rolling polygon kind's writer: a spoked wheel (one rigid body on its spokes, no
     tree of leg links) by its own writers (:func:`walkerlab.export.multibody.wheel_urdf_text`,
     ``wheel_mjcf_text``): the rigid gait as the MJCF's ``gait`` keyframe (the URDF's
-    sidecar), the scene's static friction coefficient on the spoke tips; other formats and
-    grounds refused in one line as the capability table has it
+    sidecar), the scene's static friction coefficient on the spoke tips, a ground other
+    than the slope as :func:`walkerlab.export.mjcf_ground.wheel_ground` lays it; other
+    formats refused in one line as the capability table has it
     (:func:`walkerlab.export.wheel_scene.check_wheel_exportable`)."""
     kind = data.structure.kind
     check_wheel_exportable(scene, kind, fmt, walker_only)
     check_exportable(scene, kind, fmt, walker_only)
     hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
-    key = None if walker_only else _gait(scene, runs_root,
-                                         lambda ideal: wheel_keyframe(scene, data, ideal))
+    ideal, key = (None, None) if walker_only else _gait(scene, runs_root, _with_ideal(
+        scene, lambda ideal: wheel_keyframe(scene, data, ideal)))
     version = walkerlab.__version__
     if fmt == "urdf":
         text = wheel_urdf_text(data, name, version, hub)
     elif key is None:
         text = wheel_mjcf_text(data, name, version, hub)
     else:
+        t = scene.terrain
+        ground = None if t is None or t.is_slope else wheel_ground(
+            t, scene.walker.spoke_length_m, chord_m=wheel_chord_m(data),
+            slope_rad=scene.slope.phi_rad)
         text = wheel_mjcf_text(data, name, version, hub, qpos=key.qpos, qvel=key.qvel,
-                               friction=key.friction)
+                               friction=key.friction, ground=ground)
     path = export_path(scene, runs_root, fmt, claim=True)
     files = [(path, comments_in_scene_units(text, for_scene(scene)))]
     if fmt == "urdf" and key is not None:  # URDF has no state: the keyframe beside it
@@ -200,7 +206,7 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
                       wheel_keyframe_json(key)))
     runpaths.atomic_texts(files)  # the wheel and its keyframe: both or neither
     return Exported(path, _xml_lines(WHEEL_URDF_OMISSIONS if fmt == "urdf" else (), scene),
-                    None if key is None else key.period_s)
+                    None if key is None else _step_period(ideal))
 
 
 def _gait_scene(scene: Scene, mb, data, runs_root):

@@ -168,12 +168,14 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
 _NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
                   "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-#: why the Adams and OpenSim views refuse footholds that differ from step to step
-#: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
-SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model, the "
-                     "contact model, the MJCF export and the Gymnasium environment "
-                     "(walkerlab fixedpoint, simulate, contact-sim, report, export --format "
-                     "mjcf, walkerlab.gym): give footholds of one height for this view")
+#: why the OpenSim view refuses footholds that differ from step to step (its writer lays
+#: the patch spheres at each footfall's height, but no OpenSim walk has checked them:
+#: OpenSim was not installable where they were built) (:func:`walkerlab.models.ground.
+#: landing_drop` says it, after the field's name)
+SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid and contact "
+                     "models, the MJCF, the Adams dataset and the gym (walkerlab fixedpoint, "
+                     "simulate, contact-sim, report, export --format mjcf or adm, "
+                     "walkerlab.gym): give footholds of one height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
@@ -188,8 +190,6 @@ PROFILE_PASSIVE = ("walked by the passive walker of the generated model only (no
                    "walker.actuation, ideal.variant: derived)")
 _OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                  "half-spaces, not a polyline; --format mjcf writes it as a height field)")
-_ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
-                  "the footholds' heights), not continuous profile")
 _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
                     "scene without it")
 #: why the Adams dataset refuses joint torques other than the hip's on a walker that is not
@@ -207,13 +207,12 @@ _VC_VIEWS = {
     ("virtual_constraints", "gym"): ("the Gymnasium environment has no scene policy for "
                                      "virtual constraints yet (contact-sim runs them)"),
 }
-#: what the views of every legged kind refuse: grounds whose steps differ in the Adams
-#: dataset and the OpenSim model (the contact model, the MJCF and the gym's contact view
-#: lay their patches at the rigid period-n gait's footfalls; the gym's rigid view steps
-#: them as simulate does), a profile there
+#: what the views of every legged kind refuse: grounds whose steps differ in the OpenSim
+#: model (the contact model, the MJCF, the Adams dataset and the gym's contact view lay
+#: their patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
+#: simulate does), a profile in the OpenSim model
 _GROUNDS = {
-    **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
-    ("profile", "adams"): _ADAMS_PROFILE,
+    ("footholds", "osim"): _ONE_LANDING,
     ("profile", "osim"): _OSIM_PROFILE,
 }
 #: what the kinds without ankles (point or arc feet) refuse of the ankle's features
@@ -279,11 +278,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize")},
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
         ("profile", "rigid"): _FLAT_PROFILE,
-        ("footholds", "optimize"): _FLAT_LANDING,
-        # the exports refuse any walker's footholds that differ before its feet (the MJCF
-        # lays boxes at the rigid period-n gait's footfalls, flat feet's too)
-        **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
-        ("profile", "adams"): _ADAMS_PROFILE,
+        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize")},
+        ("footholds", "osim"): _ONE_LANDING,
+        ("profile", "adams"): _FLAT_PROFILE,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "
@@ -295,10 +292,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
-        # the shipped five-link biped walks by its joint torques (a passive one would build);
-        # the MJCF's patches lie at the rigid gait's footfalls
-        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
@@ -310,10 +303,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "(optimize.design: virtual_constraints)"),
         ("virtual_constraints", "optimize"): None,  # optimize.design: virtual_constraints
         **_GROUNDS,
-        # a walker held up by its joint torques (a passive one would build); the MJCF's
-        # patches lie at the rigid gait's footfalls
-        **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
@@ -330,9 +319,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                    "ground (its spokes have no lanes of their own)"),
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
-        **{(f, "mjcf"): ("a spoked wheel's MJCF carries the slope's plane only; "
-                         "--walker-only writes the wheel alone")
-           for f in ("stairs", "footholds", "profile")},
     },
 }
 

@@ -71,6 +71,39 @@ def _at(clearance, offset, t, x):
     return clearance(t, x) + offset
 
 
+def _flip(x, n, shift=0.0):
+    """``x`` with its first ``n`` entries (the coordinates) ``q`` mirrored to ``-q - shift``
+    (``shift = 0``: negated)."""
+    y = np.array(x, copy=True)
+    y[:n] = -y[:n] - shift
+    return y
+
+
+class _Mirrored:
+    """``clearance`` or its ``gradient`` read at the mirror image of the state about the
+    slope's normal: the clearance of the spoke behind the stance spoke of a spoked wheel,
+    whose generated ``swing_clearance`` is the next spoke's, ahead (the spokes are
+    ``2 alpha`` apart, so the spoke behind at ``theta`` from the slope's normal stands as
+    the spoke ahead at ``-theta``; its angle ``q`` from the vertical, ``theta = q + phi``,
+    mirrors to ``-q - 2 phi``)."""
+
+    def __init__(self, f, n: int, gradient: bool, slope_rad: float):
+        self.f, self.n, self.gradient, self.shift = f, n, gradient, 2.0 * slope_rad
+
+    def __call__(self, *args):
+        *t, x = args
+        out = self.f(*t, _flip(x, self.n, self.shift))
+        return _flip(np.asarray(out), self.n) if self.gradient else out
+
+
+#: kind name -> whether the post-impact section's clearance is the generated one read at
+#: the state's mirror image (:class:`_Mirrored`: a spoked wheel's old stance spoke is
+#: behind, its generated clearance the spoke's ahead); the legged kinds' swing foot is the
+#: old stance foot
+_SECTION_MIRRORED = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
+                     "free_joints": False, "hinged_torso": False, "rolling_polygon": True}
+
+
 class _LandingSection:
     """``from_section`` of the post-impact surface ``swing_clearance(x) = level`` (see the
     module docstring): the walker's own ``from_section`` (its slope's surface) as the start,
@@ -205,9 +238,14 @@ def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     mirror = walker.mirror
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
         mirror = _on_clearance(mirror, replace(data.mirror, mirror_params=None), drop_m)
+    s_clear, s_grad = clear, grad
+    if _SECTION_MIRRORED[data.structure.kind.name]:
+        n = walker.n_coordinates
+        g = float(data.slope_rad)
+        s_clear, s_grad = _Mirrored(clear, n, False, g), _Mirrored(grad, n, True, g)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
-                   from_section=_LandingSection(walker, clear, grad, offset),
+                   from_section=_LandingSection(walker, s_clear, s_grad, offset),
                    params={**walker.params, "landing_drop_m": float(drop_m)},
                    mirror=mirror)
 
@@ -228,7 +266,8 @@ LANDINGS = {"straight_legs": _on_clearance, "locking_knees": _on_clearance,
             "rolling_polygon": _on_clearance, "flat_feet": _on_flat_feet}
 
 
-def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalker:
+def on_footholds(walker_at, data_at, steps, periodic: bool = True,
+                 finish=None) -> HybridWalker:
     """The walker on footholds that differ from step to step: step ``k`` lands
     ``steps[k][0]`` [m] below the stance foot's level on ground of slope ``steps[k][1]``
     [rad] (its heel strike the generated clearance above that slope's line plus
@@ -247,6 +286,10 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalk
         ``(drop_m, slope_rad)`` per step (:func:`foothold_steps`).
     periodic : bool
         The list repeats (False: a walk ends after it).
+    finish : callable ``(HybridWalker, WalkerData) -> HybridWalker``, optional
+        Applied to each step's walker on its landing (the scene's actuators,
+        :func:`walkerlab.models.hybrid.actuated.actuate`: the torques act on every step's
+        walker, the heel strike's guard is its landing's).
 
     Returns
     -------
@@ -278,7 +321,8 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalk
         w, d = base[g], data[g]
         if legs_differ and k % 2 == 1:  # legs[0] in stance: the other leg's numbers
             w, d = w.mirror, replace(d.mirror, mirror_params=None)
-        cycle.append(on_landing(replace(w, mirror=None), d, drop))
+        step = on_landing(replace(w, mirror=None), d, drop)
+        cycle.append(step if finish is None else finish(step, d))
     last = cycle[-1]
     return replace(cycle[0], cycle=tuple(cycle), ground_steps=None if periodic else p,
                    mirror=cycle[1] if legs_differ else None,
