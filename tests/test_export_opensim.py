@@ -146,6 +146,66 @@ def test_osim_export_puts_the_patches_on_the_treads(name, radius, tmp_path):
     assert height["leg2_patch1"] == pytest.approx(-2 * drop, rel=1e-9)
 
 
+def _patch_tops(root, phi, foot=0.001):
+    """``{name: (centre (2,), radius, top (2,))}`` of the file's patch spheres [m]: the top
+    the foot's contact point meets (the ground lowered by the point foot's sphere ``foot``,
+    so one foot radius above the sphere's top, along the slope normal)."""
+    import numpy as np
+
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    out = {}
+    for g in root.iter("ContactSphere"):
+        if "patch" in g.get("name"):
+            c = np.array([float(x) for x in g.find("location").text.split()[:2]])
+            r = float(g.find("radius").text)
+            out[g.get("name")] = (c, r, c + (r + foot) * n_hat)
+    return out
+
+
+def test_osim_footholds_of_two_heights_lie_on_the_rigid_walks_ground(tmp_path):
+    """configs/footholds_two.yaml (4 and 6 mm in turn, a period-2 rigid gait): the patch
+    spheres' tops are the rigid walk's own footfalls (``walkerlab simulate``'s 10 heel
+    strikes, the hybrid model's heel-strike guard: no code shared with the export's layout)
+    to 1e-12 m, footfall k on leg1's lane for even k, leg2's for odd k (leg2 stands on the
+    origin in the default state); and over each patch's width the sphere's surface stays
+    between the ground model's foothold there (:func:`walkerlab.models.ground.scene_ground`
+    through the walk's footfalls) and one foot radius (1 mm) below it.  The file states the
+    rigid map's mean step, 0.7118 s and 0.4387 m (before: the two-step map's 1.4236 s as
+    the step period)."""
+    import re
+
+    import numpy as np
+
+    from walkerlab.analysis.gait.checks import footfalls, run_ground
+    from walkerlab.io.schemas.simulate import load_simulate
+    from walkerlab.stages import pipeline
+
+    sc = _scene("footholds_two")
+    text = export_stage.run(sc, tmp_path, "osim").read_text()
+    assert float(re.search(r"step period (\S+) s", text).group(1)) == pytest.approx(
+        (0.691846977 + 0.731733922) / 2, rel=1e-8)
+    pipeline.run("simulate", sc, tmp_path)
+    run = load_simulate(tmp_path / "footholds_two" / "simulate.h5").samples
+    feet = footfalls(run)  # the world frame: the first stance foot at feet[1]
+    assert len(feet) == 12
+    ground = run_ground(sc, run)
+    tops = _patch_tops(ET.fromstring(text.replace("::", "__")), sc.slope.phi_rad)
+    w, foot = sc.terrain.patch_width_m, 0.001
+    phi = sc.slope.phi_rad
+    t_hat, n_hat = np.array([math.cos(phi), -math.sin(phi)]), np.array([math.sin(phi),
+                                                                       math.cos(phi)])
+    for k, f in enumerate(feet):
+        c, r, top = tops[f"leg{1 + k % 2}_patch{k // 2}"]
+        np.testing.assert_allclose(top + feet[1], f, rtol=0, atol=1e-12)
+        u = np.linspace(-w / 2, w / 2, 41)[:, None]  # along the slope from the footfall
+        surface = c + feet[1] + np.sqrt(r ** 2 - u ** 2) * n_hat + u * t_hat + foot * n_hat
+        h = ground.clearance(surface[:, 0], surface[:, 1])
+        assert h.max() <= 1e-12 and h.min() >= -foot * (1 + 1e-3)
+    # the heights in turn: each footfall 4 or 6 mm (along the vertical) below the last
+    drops = feet[1:, 1] - feet[:-1, 1] + np.tan(sc.slope.phi_rad) * np.diff(feet[:, 0])
+    np.testing.assert_allclose(drops[1:], [-0.004, -0.006] * 5, atol=1e-9)
+
+
 def test_the_bisecting_torso_is_a_coordinate_coupler(tmp_path):
     """torso_bhm's bisecting hip mechanism: a CoordinateCouplerConstraint torso_hip =
     0.5 leg1_hip + 0.5 leg2_hip (before: refused), the default torso angle the legs' mean."""
@@ -229,6 +289,35 @@ def test_osim_export_walks_in_opensim(name, period_rtol, speed_rtol, tmp_path):
     assert not w.fell and w.alternating and len(w.times_s) >= 11
     assert w.step_periods_s[1:].mean() == pytest.approx(period, rel=period_rtol)
     assert w.speed_m_per_s() == pytest.approx(speed, rel=speed_rtol)
+
+
+@pytest.mark.slow
+def test_osim_walks_footholds_of_two_heights_in_the_rigid_period_2_gait(tmp_path):
+    """configs/footholds_two.yaml in OpenSim: >= 10 alternating heel strikes from the default
+    state, no fall; from the 3rd strike on, the steps onto each of the two footholds take
+    within 3 % of the rigid period-2 gait's step onto it (0.6918 and 0.7317 s; measured
+    0.6906 s, -0.2 %, and 0.7414 s, +1.3 %, 11 strikes), their mean within 1 %; the speed
+    within 5 % (-3.0 %: the compliant steps 0.43 m against 0.439 m).  About 40 s."""
+    pytest.importorskip("opensim")
+    import numpy as np
+
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.export.opensim_walk import walk
+
+    sc = _scene("footholds_two")
+    rigid = ideal_gait(sc)
+    steps = np.asarray(rigid.step_periods_s)
+    ell = np.mean(rigid.step_lengths_m)
+    w = walk(export_stage.run(sc, tmp_path, "osim"), 11.5 * steps.mean())
+    assert not w.fell and w.alternating and len(w.times_s) >= 11
+    # step_periods_s[k] is step k + 1 of the walk (the first strike ends step 0), the
+    # rigid map's step (k + 1) mod 2
+    periods = np.asarray(w.step_periods_s)[1:]
+    which = (np.arange(1, periods.size + 1) + 1) % 2
+    for j in (0, 1):
+        assert periods[which == j].mean() == pytest.approx(steps[j], rel=0.03)
+    assert periods.mean() == pytest.approx(steps.mean(), rel=0.01)
+    assert w.speed_m_per_s() == pytest.approx(ell / steps.mean(), rel=0.05)
 
 
 def test_an_opensim_walk_never_imports_opensim_beside_casadi(tmp_path, monkeypatch):

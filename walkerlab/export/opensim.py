@@ -34,9 +34,12 @@ Forces:
   the swing foot passes over the other lane's footfalls; OpenSim's Hunt-Crossley force takes
   spheres and half-spaces only).  On stairs and footholds (``terrain.lanes: checkerboard``)
   each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
-  is :func:`terrain_patch_radius`; continuous stairs are refused.  The scene's IMPACT law
-  ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated by :func:`hunt_crossley` (Hertz
-  ``d^1.5``, matched at the static penetration; stated in the file).
+  is :func:`terrain_patch_radius`; footholds of several heights in turn have their patches
+  at the rigid period-n gait's footfalls, step by step, each at its own foothold's height
+  (as the MJCF's, :func:`walkerlab.export.scene.mjcf_scene`); continuous stairs are
+  refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated
+  by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static penetration; stated in
+  the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
   and damping about z; the rest angle in the second frame's orientation).
@@ -118,9 +121,10 @@ class OsimGait:
         Default values and speeds of the coordinates (``hip_x``, ``hip_y``, then each link's
         joint as in :attr:`Multibody.links`) [m, rad; m/s, rad/s].
     period_s : float
-        The rigid gait's step period [s].
+        The rigid gait's step period [s] (a map of several steps, legs that differ or
+        footholds of several heights: their mean).
     step_length_m : float
-        The rigid gait's step length along the slope [m].
+        The rigid gait's step length along the slope [m] (their mean, as ``period_s``).
     lanes : tuple of (tuple of float, tuple of float) or None
         Footfall centres along the slope [m] of leg1's and leg2's lane; None: continuous.
     patch_width_m : float
@@ -347,8 +351,13 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:
         ell = 0.5 * (ells[0] + ells[1])
+    elif len(ells) > 2:  # footholds of three or more heights: a period-n gait
+        ell = sum(ells) / len(ells)
+    # the gait's map is of len(ells) steps (legs that differ, footholds of several heights):
+    # its mean step
+    period = float(ideal.period_s) / max(1, len(ells))
     act = scene.walker.actuation
-    return OsimGait(ms.qpos, ms.qvel, float(ideal.period_s), float(ell), ms.lanes,
+    return OsimGait(ms.qpos, ms.qvel, period, float(ell), ms.lanes,
                     terrain.patch_width_m, ms.ground_offset_m, c, knee,
                     None if act is None else act.push_off,
                     settings.push_off_pulse_s(), ms.actuation, ms.lane_heights)

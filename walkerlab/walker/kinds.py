@@ -165,12 +165,12 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
 _NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
                   "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-#: why the Adams and OpenSim views refuse footholds that differ from step to step
+#: why the Adams view refuses footholds that differ from step to step
 #: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
-SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid model, the "
-                     "contact model, the MJCF export and the Gymnasium environment "
-                     "(walkerlab fixedpoint, simulate, contact-sim, report, export --format "
-                     "mjcf, walkerlab.gym): give footholds of one height for this view")
+SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid and contact "
+                     "models, the MJCF and OpenSim exports and the gym (walkerlab "
+                     "fixedpoint, simulate, contact-sim, report, export --format mjcf or "
+                     "osim, walkerlab.gym): give footholds of one height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
@@ -207,11 +207,11 @@ _VC_VIEWS = {
                                           "decision variables yet: leave them out"),
 }
 #: what the views of every legged kind refuse: grounds whose steps differ in the Adams
-#: dataset and the OpenSim model (the contact model, the MJCF and the gym's contact view
-#: lay their patches at the rigid period-n gait's footfalls; the gym's rigid view steps
-#: them as simulate does), a profile there
+#: dataset (the contact model, the MJCF, the OpenSim model and the gym's contact view lay
+#: their patches at the rigid period-n gait's footfalls; the gym's rigid view steps them
+#: as simulate does), a profile there and in the OpenSim model
 _GROUNDS = {
-    **{("footholds", v): _ONE_LANDING for v in ("adams", "osim")},
+    ("footholds", "adams"): _ONE_LANDING,
     ("profile", "adams"): _ADAMS_PROFILE,
     ("profile", "osim"): _OSIM_PROFILE,
 }
@@ -280,7 +280,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         # the shipped five-link biped walks by its joint torques (a passive one would build);
         # the MJCF's patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
+                              "walkers only")
+           for v in ("rigid", "contact", "mjcf", "osim", "gym")},
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
@@ -295,7 +296,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         # a walker held up by its joint torques (a passive one would build); the MJCF's
         # patches lie at the rigid gait's footfalls
         **{("footholds", v): ("footholds of several heights or slopes are built for passive "
-                              "walkers only") for v in ("rigid", "contact", "mjcf", "gym")},
+                              "walkers only")
+           for v in ("rigid", "contact", "mjcf", "osim", "gym")},
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
