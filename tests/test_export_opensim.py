@@ -68,7 +68,8 @@ def test_osim_export_carries_the_walker_and_its_gait(paper_osim):
     assert sum(1 for _ in model.iter("PinJoint")) == 2
 
 
-@pytest.mark.parametrize("name, field", [("flat_feet", "walker.leg.foot.kind"),
+@pytest.mark.parametrize("name, field", [("flat_feet_push_off",
+                                          "walker.actuation.ankle_push_off"),
                                          ("stairs_continuous", "terrain.lanes: continuous"),
                                          ("simplest", "walker.leg.bodies")])
 def test_osim_export_refuses_in_one_line(name, field, tmp_path):
@@ -204,6 +205,91 @@ def test_osim_footholds_of_two_heights_lie_on_the_rigid_walks_ground(tmp_path):
     # the heights in turn: each footfall 4 or 6 mm (along the vertical) below the last
     drops = feet[1:, 1] - feet[:-1, 1] + np.tan(sc.slope.phi_rad) * np.diff(feet[:, 0])
     np.testing.assert_allclose(drops[1:], [-0.004, -0.006] * 5, atol=1e-9)
+
+
+def _flat_foot_points(root, leg):
+    """A flat-footed export's ankle, heel and toe of ``leg`` in the ground frame [m] at its
+    default state, by hand from the file's numbers (no OpenSim): the hip at (hip_x, hip_y),
+    the ankle ``foot_m`` down the leg at its angle psi (``(sin psi, -cos psi)``), the sole
+    along ``(cos(psi + a), sin(psi + a))`` for the ankle angle a."""
+    import numpy as np
+
+    q = {c.get("name"): float(c.find("default_value").text) for c in root.iter("Coordinate")}
+    frames = {f.get("name"): [float(x) for x in f.find("translation").text.split()]
+              for f in root.iter("PhysicalOffsetFrame")}
+    spheres = {g.get("name"): [float(x) for x in g.find("location").text.split()]
+               for g in root.iter("ContactSphere")}
+    psi, a = q[f"{leg}_hip"], q[f"{leg}_ankle"]
+    down = -frames[f"{leg}_at_{leg}_ankle"][1]
+    ankle = np.array([q["hip_x"], q["hip_y"]]) + down * np.array([math.sin(psi),
+                                                                   -math.cos(psi)])
+    sole = np.array([math.cos(psi + a), math.sin(psi + a)])
+    return ankle, ankle + spheres[f"{leg}_foot"][0] * sole, ankle + spheres[f"{leg}_toe"][0] \
+        * sole
+
+
+@pytest.mark.parametrize("name, foot_kg, foot_inertia", [
+    ("flat_feet", 0.1, 5e-4),             # contact.flat_foot_mass_kg: the MJCF's
+    ("flat_feet_foot_mass", 0.1, 5e-4)])  # walker.leg.foot.mass_kg: every view's
+def test_osim_flat_feet_carry_the_scenes_feet(name, foot_kg, foot_inertia, tmp_path):
+    """Flat feet in the OpenSim model (before: refused): a body leg<i>_sole per leg of the
+    scene's foot mass and inertia at the ankle (its origin, the leg's end at walkerlab's
+    multibody foot point), a PinJoint leg<i>_ankle, the scene's ankle spring as a
+    SpringGeneralizedForce, contact spheres at the heel and the toe (the scene's heel_m and
+    toe_m) on both legs' Hunt-Crossley forces; the model's mass the multibody's plus the
+    feet.  Its default state, by hand: leg2's heel at the origin, leg1's toe on the slope
+    line (the rigid gait's double support as it begins), leg2's toe and leg1's heel above
+    it."""
+    import numpy as np
+    import yaml
+
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    d = yaml.safe_load((ROOT / "configs" / f"{name}.yaml").read_text())
+    foot = d["walker"]["leg"]["foot"]
+    sc = _scene(name)
+    mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
+    root = ET.fromstring(export_stage.run(sc, tmp_path, "osim").read_text()
+                         .replace("::", "__"))
+    bodies = {b.get("name"): (float(b.find("mass").text),
+                              [float(x) for x in b.find("mass_center").text.split()],
+                              [float(x) for x in b.find("inertia").text.split()])
+              for b in root.iter("Body")}
+    links = sum(ln.mass_kg for ln in mb.links)
+    assert sum(m for m, _, _ in bodies.values()) == pytest.approx(
+        mb.hip_mass_kg + links + 2 * foot_kg, rel=1e-12)
+    for leg in ("leg1", "leg2"):
+        m, com, inertia = bodies[f"{leg}_sole"]
+        assert (m, com, inertia[2]) == (foot_kg, [0.0, 0.0, 0.0], foot_inertia)
+        link = next(ln for ln in mb.links if ln.name == leg)
+        frames = {f.get("name"): f for f in root.iter("PhysicalOffsetFrame")}
+        at = frames[f"{leg}_at_{leg}_ankle"]
+        assert at.find("socket_parent").text == f"/bodyset/{leg}"
+        assert [float(x) for x in at.find("translation").text.split()] == [
+            0.0, -link.foot_m, 0.0]
+        spring = next(f for f in root.iter("SpringGeneralizedForce")
+                      if f.find("coordinate").text == f"{leg}_ankle")
+        ankle = foot["ankle"]
+        assert [float(spring.find(k).text) for k in ("stiffness", "rest_length",
+                                                     "viscosity")] == [
+            ankle["stiffness_n_m_per_rad"], ankle["rest_angle_rad"],
+            ankle["damping_n_m_s_per_rad"]]
+        spheres = {g.get("name"): g for g in root.iter("ContactSphere")}
+        for sphere, x in ((f"{leg}_foot", -foot["heel_m"]), (f"{leg}_toe", foot["toe_m"])):
+            assert spheres[sphere].find("socket_frame").text == f"/bodyset/{leg}_sole"
+            assert [float(v) for v in spheres[sphere].find("location").text.split()] == [
+                x, 0.0, 0.0]
+    geometry = [p.find("geometry").text.split()[:2]
+                for p in root.iter("HuntCrossleyForce__ContactParameters")]
+    assert geometry == [["leg1_foot", "leg1_toe"], ["leg2_foot", "leg2_toe"]]
+    phi = sc.slope.phi_rad
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    _, heel2, toe2 = _flat_foot_points(root, "leg2")
+    _, heel1, toe1 = _flat_foot_points(root, "leg1")
+    np.testing.assert_allclose(heel2, [0.0, 0.0], atol=1e-12)
+    assert toe1 @ n_hat == pytest.approx(0.0, abs=1e-9)
+    assert toe2 @ n_hat > 0.01 and heel1 @ n_hat > 0.01
 
 
 def test_the_bisecting_torso_is_a_coordinate_coupler(tmp_path):

@@ -81,6 +81,7 @@ from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, xml_comments
 from walkerlab.export.opensim_xml import (
+    ankle_springs,
     body_set,
     contact_forces,
     contact_geometry_set,
@@ -102,8 +103,8 @@ if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
-           "knee_stop_expression", "osim_gait", "osim_omissions", "osim_text", "patch_radius",
-           "terrain_patch_radius"]
+           "knee_stop_expression", "osim_coordinates", "osim_gait", "osim_omissions",
+           "osim_text", "patch_radius", "terrain_patch_radius"]
 
 #: The export's file name in ``runs/<scene>/``.
 OSIM_FILE = "walker.osim"
@@ -142,6 +143,12 @@ class OsimGait:
     lane_heights : tuple of (tuple of float, tuple of float) or None
         Stairs and footholds: each patch's height along the slope normal [m] (its tread's,
         as :class:`walkerlab.export.mjcf_scene.MjcfScene` has them); None: on the slope line.
+    flat_feet : tuple or None
+        Flat feet, per leg (leg1, leg2) ``(heel [m], toe [m], ankle stiffness [N m/rad],
+        damping [N m s/rad], rest angle [rad], foot mass [kg], inertia about the ankle
+        [kg m^2])`` (:func:`walkerlab.export.scene.flat_feet`, the MJCF's); then ``qpos`` and
+        ``qvel`` hold the ankles after their legs (:func:`osim_coordinates`).  None: no
+        foot bodies.
     """
 
     qpos: tuple
@@ -157,6 +164,7 @@ class OsimGait:
     push_off_duration_s: float = 0.005
     actuation: Actuation | None = None
     lane_heights: tuple | None = None
+    flat_feet: tuple | None = None
 
     @property
     def speed_m_per_s(self) -> float:
@@ -171,17 +179,20 @@ def check_osim_exportable(scene: Scene, mb) -> None:
     ------
     ValueError
         One line naming the field, as the capability table has it
-        (:meth:`walkerlab.walker.kinds.Kind.require`): flat feet (``walker.leg.foot.kind``:
-        no foot bodies in this export), an ankle push-off
-        (``walker.actuation.ankle_push_off``); a torque law per foot mass or on a joint the
-        model lacks (``walker.actuation.torques.<i>``).
+        (:meth:`walkerlab.walker.kinds.Kind.require`): a walker the export does not write
+        (``walker.leg.foot.kind``, ``walker.model``), an ankle push-off
+        (``walker.actuation.ankle_push_off``), a push-off on flat feet
+        (``walker.actuation.push_off``); a torque law per foot mass or on a joint the model
+        lacks (``walker.actuation.torques.<i>``).
     """
     kind = KINDS[mb.kind]
     kind.require("walk", "osim", "walker.leg.foot.kind")
     act = scene.walker.actuation
     if act is not None and act.ankle_push_off is not None:
         kind.require("ankle_push_off", "osim", "walker.actuation.ankle_push_off")
-    coords = [ln.joint for ln in mb.links]
+    if act is not None and act.push_off is not None:
+        kind.require("push_off", "osim", "walker.actuation.push_off")
+    coords = osim_coordinates(mb)[2:]
     for i, t in enumerate(getattr(act, "torques", None) or []):
         field = f"walker.actuation.torques.{i}"
         if t.scaled_by != "none":
@@ -193,6 +204,20 @@ def check_osim_exportable(scene: Scene, mb) -> None:
         except ValueError:
             raise ValueError(f"{field}.joint: {t.joint} is not a joint of the OpenSim "
                              "export") from None
+
+
+def osim_coordinates(mb) -> list[str]:
+    """The OpenSim model's coordinates in its tree order (the order of :attr:`OsimGait.qpos`,
+    the MJCF keyframe's): ``hip_x``, ``hip_y``, each link's joint (:attr:`Multibody.links`)
+    and, on a kind whose legs end in foot bodies (:attr:`walkerlab.export.parts.ExportPart.
+    ankles`), each foot's ``leg<i>_ankle`` after its leg's joint."""
+    ankles = export_part(mb).ankles
+    out = ["hip_x", "hip_y"]
+    for ln in mb.links:
+        out.append(ln.joint)
+        if ankles and ln.foot_m is not None:
+            out.append(f"{ln.name.split('_')[0]}_ankle")
+    return out
 
 
 def hunt_crossley(c: ContactParamsSI, weight_n: float, radius_m: float
@@ -327,7 +352,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
         No rigid gait.
     """
     from walkerlab.analysis.contact.periodic import ideal_gait
-    from walkerlab.export.scene import mjcf_scene
+    from walkerlab.export.scene import SCENE_FEET, mjcf_scene
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.scene import ideal_step_length
@@ -346,7 +371,8 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
                          "half-spaces, not a tread's box); lanes: checkerboard puts the "
                          "patches on the treads")
     ms = mjcf_scene(scene, mb, data, ideal)
-    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
+    walker = ContactWalker(contact=c, data=data, knee_stop=knee,
+                           flat_foot=SCENE_FEET[mb.kind].foot_mass(settings))
     ell = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:
@@ -360,7 +386,8 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     return OsimGait(ms.qpos, ms.qvel, period, float(ell), ms.lanes,
                     terrain.patch_width_m, ms.ground_offset_m, c, knee,
                     None if act is None else act.push_off,
-                    settings.push_off_pulse_s(), ms.actuation, ms.lane_heights)
+                    settings.push_off_pulse_s(), ms.actuation, ms.lane_heights,
+                    ms.flat_feet)
 
 
 def osim_omissions(mb, gait: OsimGait) -> tuple[Omission, ...]:
@@ -412,15 +439,17 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     arc = mb.foot == "arc" and mb.foot_radius_m > 0
     r_foot = mb.foot_radius_m if arc else point_foot_radius(mb)
     offset = gait.ground_offset_m
-    total = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
+    total = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links) \
+        + sum(f[5] for f in gait.flat_feet or ())
     weight = total * g * math.cos(phi)
     rg = None if gait.lanes is None else terrain_patch_radius(gait, r_foot)
     r_eff = r_foot if rg is None else r_foot * rg / (r_foot + rg)
     stiff, diss, vt, contact_note = hunt_crossley(gait.contact, weight, r_eff)
-    joints = ["hip_x", "hip_y", *(ln.joint for ln in mb.links)]
+    joints = osim_coordinates(mb)
     q0, v0 = dict(zip(joints, gait.qpos)), dict(zip(joints, gait.qvel))
     knee_stops = export_part(mb).knee_stops
-    motors = torque_joints(gait.actuation, mb)
+    motors = torque_joints(gait.actuation, mb, joints[2:])
+    feet = [ln for ln in mb.links if ln.foot_m is not None]
 
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
@@ -428,13 +457,14 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
                             knee_stops),
            *xml_comments(osim_omissions(mb, gait))]
     out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
-    out += body_set(mb)
-    out += joint_set(mb, q0, v0)
+    out += body_set(mb, feet, gait.flat_feet)
+    out += joint_set(mb, q0, v0, feet if gait.flat_feet else ())
     out += couplers(mb)
-    feet = [ln for ln in mb.links if ln.foot_m is not None]
     out += ['\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
     out += contact_forces(feet, gait, rg, stiff, diss, vt)
     out += spring_forces(mb)
+    if gait.flat_feet:
+        out += ankle_springs(feet, gait.flat_feet)
     if knee_stops:
         out += knee_stop_forces(mb, knee_stop_expression(gait.knee, "stop"),
                                 knee_stop_expression(gait.knee, "latch"))

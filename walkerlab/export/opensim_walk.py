@@ -306,6 +306,9 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
             for g in LEGS}
     foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in LEGS}
+    for g in LEGS:  # a flat foot: the foot point is the ankle, its sole's frame origin
+        if model.getBodySet().contains(f"{g}_sole"):
+            bodies[g], foot_loc[g] = model.getBodySet().get(f"{g}_sole"), osim.Vec3(0, 0, 0)
     kneed = fs.contains("leg1_knee_latch")
     latch = {g: fs.get(f"{g}_knee_latch") for g in LEGS} if kneed else {}
     knee = {g: model.getCoordinateSet().get(f"{g}_knee") for g in LEGS} if kneed else {}

@@ -256,15 +256,19 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
         ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
                                        "degrees of freedom within the step: give point "
                                        "feet"),
-        ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
-                           "springs or heel and toe contacts); --format mjcf carries them"),
+        ("push_off", "osim"): ("the contact view holds a flat foot's ankle through the "
+                               "push-off pulse; the OpenSim stepping loop does not yet "
+                               "(--format mjcf, contact-sim)"),
+        ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
+                                     "ankle motors yet (--format mjcf, contact-sim)"),
+        ("profile", "osim"): _OSIM_PROFILE,
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         ("stairs", "*"): _FLAT_LANDING,
         ("profile", "rigid"): _FLAT_LANDING,
         ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
                              "arc feet (a flat foot's modes have no per-step landing yet)"),
         # the exports refuse any walker's footholds that differ before its feet
-        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams", "osim")},
+        **{("footholds", v): _ONE_LANDING for v in ("mjcf", "adams")},
         ("profile", "adams"): _ADAMS_PROFILE,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
