@@ -406,6 +406,37 @@ def test_osim_walks_footholds_of_two_heights_in_the_rigid_period_2_gait(tmp_path
     assert w.speed_m_per_s() == pytest.approx(ell / steps.mean(), rel=0.05)
 
 
+@pytest.mark.slow
+def test_osim_flat_feet_walk_in_opensim(tmp_path):
+    """configs/flat_feet.yaml in OpenSim (its 0.1 kg regularising feet, as the MJCF's): the
+    model has the multibody's mass plus the feet, and walks >= 6 alternating heel strikes
+    from the default state in double support without falling; its mean step period from
+    the 2nd strike on within 3 % of the rigid 0.8102 s (measured +1.1 %: 0.8225, 0.8135,
+    0.821 s; MuJoCo +1.94 %), the speed within 5 % (-0.5 %).  Slow: 10-20 min (the heel
+    and toe on stiff contact)."""
+    pytest.importorskip("opensim")
+    import re
+
+    from walkerlab.export.opensim_walk import walk
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    sc = _scene("flat_feet")
+    path = export_stage.run(sc, tmp_path, "osim")
+    text = path.read_text()
+    period = float(re.search(r"step period (\S+) s", text).group(1))
+    speed = float(re.search(r"speed (\S+) m/s along", text).group(1))
+    assert period == pytest.approx(0.8102, abs=1e-4)
+    mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
+    w = walk(path, 6.4 * period)
+    assert w.mass_kg == pytest.approx(
+        mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links) + 2 * 0.1, rel=1e-12)
+    assert not w.fell and w.alternating and len(w.times_s) >= 6
+    assert w.times_s[0] > 0.5 * period  # the trailing toe's contact at the start is no strike
+    assert w.step_periods_s[1:].mean() == pytest.approx(period, rel=0.03)
+    assert w.speed_m_per_s(skip=1) == pytest.approx(speed, rel=0.05)
+
+
 def test_an_opensim_walk_never_imports_opensim_beside_casadi(tmp_path, monkeypatch):
     """OpenSim's Moco links a CasADi of its own: with the ``optimize`` extra's CasADi
     loaded, ``import opensim`` fails ("libosimMoco.so: undefined symbol

@@ -16,7 +16,12 @@ Bodies and joints:
   mass, centre of mass ``(off-axis, -along, 0)`` and inertia about it (``Izz`` the planar
   moment; ``Ixx = Iyy = Izz`` only make the tensor valid, nothing turns about x or y);
 - ``PinJoint`` ``leg<i>_hip`` (coordinate = the absolute link angle, the base does not
-  rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``.
+  rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``;
+- flat feet: a ``Body`` ``leg<i>_sole`` per leg (the MJCF's foot mass and inertia at the
+  ankle, :func:`walkerlab.export.scene.flat_feet`) on a ``PinJoint`` ``leg<i>_ankle`` at
+  the leg's end (the angle from the leg's perpendicular, positive toe up), its ankle spring
+  a ``SpringGeneralizedForce``, contact spheres at its heel (``leg<i>_foot``) and toe
+  (``leg<i>_toe``).
   The coordinates' ``default_value`` and ``default_speed_value`` are the rigid gait's fixed
   point (:func:`walkerlab.export.scene.mjcf_scene`'s ``gait`` keyframe: just after heel
   strike, leg2 in stance, its foot's contact point at the origin): the model walks from its
@@ -320,8 +325,16 @@ def terrain_patch_radius(gait: OsimGait, foot_sphere_m: float) -> float:
     (``h`` the largest rise between consecutive footfalls, ``w`` the patch width, ``l`` the
     step length).  A sphere does not end at the patch's edge: on stairs.yaml, at the flat
     patches' radius (11.25 m), the tread behind reached into the swing foot's path, which
-    falls below the tread it left about half a step (0.22 of 0.41 m) from it."""
+    falls below the tread it left about half a step (0.22 of 0.41 m) from it.
+
+    Flat feet: no larger than the patch of the sole's length, ``patch_radius(heel + toe,
+    r)`` (the sole's ends one foot-sphere radius below the top, the foot flat on it to that):
+    at the 0.6 m patches' 45 m of configs/flat_feet.yaml the swing toe, which the rigid
+    model lets pass 2 mm below the slope line early in the swing, touched the trailing
+    patch's flank 0.1 m beyond its edge and the walker fell; at 2.81 m it walks."""
     rg = patch_radius(gait.patch_width_m, foot_sphere_m)
+    if gait.flat_feet:
+        rg = min(rg, patch_radius(max(f[0] + f[1] for f in gait.flat_feet), foot_sphere_m))
     if gait.lane_heights is None:
         return rg
     falls = sorted((s, h) for lane, hs in zip(gait.lanes, gait.lane_heights)

@@ -359,7 +359,9 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     manager.setIntegratorAccuracy(accuracy)
     state.setTime(0.0)
     model.realizeDynamics(state)
-    air = {g: (0.0 if loaded(g, state) else min_air_s) for g in LEGS}
+    # both feet start on the ground (the trailing one just left it, or stays on its toe in
+    # a flat foot's double support): a heel strike needs min_air_s off it first
+    air = {g: 0.0 for g in LEGS}
     on = {g: loaded(g, state) for g in LEGS}
     latched = {g: False for g in LEGS}
     stance = "leg2"  # the default state: leg2 in stance
