@@ -71,6 +71,7 @@ def test_osim_export_carries_the_walker_and_its_gait(paper_osim):
 @pytest.mark.parametrize("name, field", [("flat_feet_push_off",
                                           "walker.actuation.ankle_push_off"),
                                          ("stairs_continuous", "terrain.lanes: continuous"),
+                                         ("profile", "terrain.kind: profile"),
                                          ("simplest", "walker.leg.bodies")])
 def test_osim_export_refuses_in_one_line(name, field, tmp_path):
     """What the OpenSim export cannot express: one line naming the field, nothing written."""
@@ -292,36 +293,6 @@ def test_osim_flat_feet_carry_the_scenes_feet(name, foot_kg, foot_inertia, tmp_p
     assert toe2 @ n_hat > 0.01 and heel1 @ n_hat > 0.01
 
 
-def test_osim_profile_spheres_follow_the_polyline(tmp_path):
-    """configs/profile.yaml (a 1 mm undulation on a 0.05 rad ramp, turns up to 0.0102 rad
-    at its vertices): the ground is spheres ground<j> on both feet's contact forces
-    (before: refused); over the profile's 6 m the highest sphere surface at each x lies
-    between 5e-5 m below and 1e-6 m above the scene's polyline (read from the YAML, its first
-    vertex at the origin: the stance foot) lowered by the point foot's 1 mm sphere."""
-    import numpy as np
-    import yaml
-
-    sc = _scene("profile")
-    root = ET.fromstring(export_stage.run(sc, tmp_path, "osim").read_text()
-                         .replace("::", "__"))
-    spheres = [g for g in root.iter("ContactSphere") if g.get("name").startswith("ground")]
-    c = np.array([[float(v) for v in g.find("location").text.split()[:2]] for g in spheres])
-    (r,) = {float(g.find("radius").text) for g in spheres}
-    geometry = [p.find("geometry").text.split()
-                for p in root.iter("HuntCrossleyForce__ContactParameters")]
-    assert [g[0] for g in geometry] == ["leg1_foot", "leg2_foot"]
-    assert all(g[1:] == [f"ground{j}" for j in range(len(c))] for g in geometry)
-    d = yaml.safe_load((ROOT / "configs" / "profile.yaml").read_text())
-    line = np.asarray(d["terrain"]["profile_m"], float)
-    line -= line[0]
-    x = np.linspace(0.0, line[-1, 0], 24001)
-    dx = x[:, None] - c[None, :, 0]
-    top = np.where(np.abs(dx) < r, c[None, :, 1] + np.sqrt(np.clip(r * r - dx * dx, 0, None)),
-                   -np.inf).max(axis=1)
-    err = top - (np.interp(x, line[:, 0], line[:, 1]) - 0.001)
-    assert err.max() < 1e-6 and err.min() > -5e-5
-
-
 def test_the_bisecting_torso_is_a_coordinate_coupler(tmp_path):
     """torso_bhm's bisecting hip mechanism: a CoordinateCouplerConstraint torso_hip =
     0.5 leg1_hip + 0.5 leg2_hip (before: refused), the default torso angle the legs' mean."""
@@ -465,28 +436,6 @@ def test_osim_flat_feet_walk_in_opensim(tmp_path):
     assert w.times_s[0] > 0.5 * period  # the trailing toe's contact at the start is no strike
     assert w.step_periods_s[1:].mean() == pytest.approx(period, rel=0.03)
     assert w.speed_m_per_s(skip=1) == pytest.approx(speed, rel=0.05)
-
-
-@pytest.mark.slow
-def test_osim_walks_the_height_profile(tmp_path):
-    """configs/profile.yaml (the kneed walker on a 1 mm undulating ramp) in OpenSim on its
-    profile's spheres, the knee latch reading the foot's height above the sphere under it:
-    >= 10 alternating heel strikes without falling, the mean step period from the 2nd on
-    within 3 % of the rigid gait's on the ramp's slope, 0.54585 s (the rigid walk on the
-    profile steps 0.5456-0.5498 s), the speed within 5 %."""
-    pytest.importorskip("opensim")
-    import re
-
-    from walkerlab.export.opensim_walk import walk
-
-    path = export_stage.run(_scene("profile"), tmp_path, "osim")
-    text = path.read_text()
-    period = float(re.search(r"step period (\S+) s", text).group(1))
-    speed = float(re.search(r"speed (\S+) m/s along", text).group(1))
-    w = walk(path, 11.5 * period)
-    assert not w.fell and w.alternating and len(w.times_s) >= 11
-    assert w.step_periods_s[1:].mean() == pytest.approx(period, rel=0.03)
-    assert w.speed_m_per_s() == pytest.approx(speed, rel=0.05)
 
 
 def test_an_opensim_walk_never_imports_opensim_beside_casadi(tmp_path, monkeypatch):

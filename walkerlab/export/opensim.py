@@ -41,12 +41,10 @@ Forces:
   each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
   is :func:`terrain_patch_radius`; footholds of several heights in turn have their patches
   at the rigid period-n gait's footfalls, step by step, each at its own foothold's height
-  (as the MJCF's, :func:`walkerlab.export.scene.mjcf_scene`); a height profile is spheres
-  along its polyline whose surfaces stay within :data:`PROFILE_ERROR_M` of it
-  (:func:`profile_spheres`), touched by both feet; continuous stairs are refused (a
-  sphere has no riser's edge).  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax,
-  cmax) d'`` is translated by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the
-  static penetration; stated in the file).
+  (as the MJCF's, :func:`walkerlab.export.scene.mjcf_scene`); continuous stairs are
+  refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated
+  by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static penetration; stated in
+  the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
   and damping about z; the rest angle in the second frame's orientation).
@@ -111,7 +109,7 @@ if TYPE_CHECKING:
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
            "knee_stop_expression", "osim_coordinates", "osim_gait", "osim_omissions",
-           "osim_text", "patch_radius", "profile_spheres", "terrain_patch_radius"]
+           "osim_text", "patch_radius", "terrain_patch_radius"]
 
 #: The export's file name in ``runs/<scene>/``.
 OSIM_FILE = "walker.osim"
@@ -156,11 +154,6 @@ class OsimGait:
         [kg m^2])`` (:func:`walkerlab.export.scene.flat_feet`, the MJCF's); then ``qpos`` and
         ``qvel`` hold the ankles after their legs (:func:`osim_coordinates`).  None: no
         foot bodies.
-    profile : tuple of (float, float) or None
-        A height profile's polyline in the model's frame [m] (the MJCF's,
-        :func:`walkerlab.models.contact.terrain.profile_line`: its first vertex at the
-        stance foot's contact point, the first and last segments run on), laid as spheres
-        (:func:`profile_spheres`); None: no profile.
     """
 
     qpos: tuple
@@ -177,7 +170,6 @@ class OsimGait:
     actuation: Actuation | None = None
     lane_heights: tuple | None = None
     flat_feet: tuple | None = None
-    profile: tuple | None = None
 
     @property
     def speed_m_per_s(self) -> float:
@@ -352,64 +344,6 @@ def terrain_patch_radius(gait: OsimGait, foot_sphere_m: float) -> float:
     return min(rg, d ** 2 / (2 * (rise + 2 * foot_sphere_m)))
 
 
-#: Height error [m] a profile's spheres may make against its polyline (:func:`profile_spheres`)
-PROFILE_ERROR_M = 5e-5
-#: Longest spacing [m] of a profile's spheres along a segment
-PROFILE_SPACING_M = 0.1
-#: How far [m] the spheres run on along a profile's first and last segments
-PROFILE_RUN_ON_M = 1.0
-
-
-def profile_spheres(vertices, offset_m: float, error_m: float = PROFILE_ERROR_M
-                    ) -> tuple[float, list[tuple[float, float]]]:
-    """A height profile as OpenSim contact spheres: ``(radius [m], centres [(x, y), ...])``.
-
-    Each segment of the polyline holds spheres of one radius ``R`` whose surfaces touch its
-    line (lowered by ``offset_m``, the point foot's sphere) at points ``h`` apart.  Between
-    two points the surface dips ``h^2 / (8 R)`` below the line; at a convex vertex of
-    turn ``theta`` a sphere near it rises up to ``theta^2 R / 2`` above the next segment.
-    Both are kept within ``error_m``: ``R = 2 e / theta_max^2``, ``h = 4 e / theta_max``
-    (at most :data:`PROFILE_SPACING_M`; a straight profile: ``R = h^2 / (8 e)``).  The
-    first and last segments are laid :data:`PROFILE_RUN_ON_M` beyond the profile's ends.
-
-    Parameters
-    ----------
-    vertices : sequence of (float, float)
-        The polyline [m] (:attr:`OsimGait.profile`; its first and last points the run-ons').
-    offset_m : float
-        The ground's offset below the polyline [m].
-    error_m : float
-        The height error allowed [m].
-
-    Returns
-    -------
-    radius_m : float
-    centres : list of (float, float)
-    """
-    P = np.asarray(vertices, float)
-    d = np.diff(P, axis=0)
-    ang = np.arctan2(d[:, 1], d[:, 0])
-    turn = float(np.max(np.abs(np.diff(ang)))) if ang.size > 1 else 0.0
-    h = PROFILE_SPACING_M if turn == 0.0 else min(PROFILE_SPACING_M, 4 * error_m / turn)
-    R = 2 * error_m / turn ** 2 if turn > 0.0 and h < PROFILE_SPACING_M else \
-        h ** 2 / (8 * error_m)
-    # the run-ons (100 m) cut to PROFILE_RUN_ON_M
-    a = P[1] - PROFILE_RUN_ON_M * d[0] / np.hypot(*d[0])
-    b = P[-2] + PROFILE_RUN_ON_M * d[-1] / np.hypot(*d[-1])
-    Q = np.vstack([a, P[1:-1], b])
-    centres = []
-    for p, q in zip(Q[:-1], Q[1:]):
-        seg = q - p
-        length = float(np.hypot(*seg))
-        t = seg / length
-        n_up = np.array([-t[1], t[0]])  # the segment's normal, up (x runs ahead)
-        k = max(1, math.ceil(length / h))
-        for i in range(k):
-            c = p + (i + 0.5) * length / k * t - (offset_m + R) * n_up
-            centres.append((float(c[0]), float(c[1])))
-    return float(R), centres
-
-
 def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     """The rigid gait, ground and contact of ``scene`` for the OpenSim export.
 
@@ -440,7 +374,9 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
     ideal = ideal_gait(scene) if ideal is None else ideal
-    if not terrain.is_slope and terrain.kind != "profile" and terrain.lanes != "checkerboard":
+    if terrain.kind == "profile":  # the capability table's cell (every legged kind's)
+        KINDS[mb.kind].require("profile", "osim", "terrain.kind: profile")
+    if not terrain.is_slope and terrain.lanes != "checkerboard":
         raise ValueError(f"terrain.lanes: {terrain.lanes}: continuous {terrain.kind} are not "
                          "in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                          "half-spaces, not a tread's box); lanes: checkerboard puts the "
@@ -462,8 +398,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
                     terrain.patch_width_m, ms.ground_offset_m, c, knee,
                     None if act is None else act.push_off,
                     settings.push_off_pulse_s(), ms.actuation, ms.lane_heights,
-                    ms.flat_feet, None if ms.profile is None else tuple(
-                        (float(x), float(y)) for x, y in ms.profile))
+                    ms.flat_feet)
 
 
 def osim_omissions(mb, gait: OsimGait) -> tuple[Omission, ...]:
@@ -519,9 +454,7 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
         + sum(f[5] for f in gait.flat_feet or ())
     weight = total * g * math.cos(phi)
     rg = None if gait.lanes is None else terrain_patch_radius(gait, r_foot)
-    profile = None if gait.profile is None else profile_spheres(gait.profile, offset)
-    r_ground = rg if profile is None else profile[0]
-    r_eff = r_foot if r_ground is None else r_foot * r_ground / (r_foot + r_ground)
+    r_eff = r_foot if rg is None else r_foot * rg / (r_foot + rg)
     stiff, diss, vt, contact_note = hunt_crossley(gait.contact, weight, r_eff)
     joints = osim_coordinates(mb)
     q0, v0 = dict(zip(joints, gait.qpos)), dict(zip(joints, gait.qvel))
@@ -532,14 +465,14 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
            *header_comments(mb, gait, name, version, total, contact_note, rg, r_foot, motors,
-                            knee_stops, profile),
+                            knee_stops),
            *xml_comments(osim_omissions(mb, gait))]
     out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
     out += body_set(mb, feet, gait.flat_feet)
     out += joint_set(mb, q0, v0, feet if gait.flat_feet else ())
     out += couplers(mb)
     out += ['\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
-    out += contact_forces(feet, gait, rg, stiff, diss, vt, profile)
+    out += contact_forces(feet, gait, rg, stiff, diss, vt)
     out += spring_forces(mb)
     if gait.flat_feet:
         out += ankle_springs(feet, gait.flat_feet)
@@ -550,6 +483,6 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     if gait.push_off is not None:
         out += push_off_forces(feet, gait.push_off.impulse_n_s / gait.push_off_duration_s)
     out += ["\t\t\t</objects>", "\t\t</ForceSet>"]
-    out += contact_geometry_set(feet, gait, r_foot, rg, offset, phi, t_hat, n_hat, profile)
+    out += contact_geometry_set(feet, gait, r_foot, rg, offset, phi, t_hat, n_hat)
     out += ["\t</Model>", "</OpenSimDocument>", ""]
     return "\n".join(out)

@@ -27,8 +27,8 @@ from it; OpenSim has no contact-switched force):
   while the leg's foot is less than the release height above the slope line and its knee is
   within the capture flexion of straight, the foot's height its contact point's above the
   ground as the contact model reads it (:func:`contact_height`: above the tread of the
-  lane's patch under it, or of a height profile's sphere under it, or above the slope
-  line; the contact point the sphere's centre less the file's offset, an arc foot's radius,
+  lane's patch under it, or above the slope line; the contact point the sphere's centre
+  less the file's offset, an arc foot's radius,
   :func:`walkerlab.export.opensim_xml.latch_foot_offset`)
   (:func:`walkerlab.export.mujoco_walk.latch_rule`, the MJCF's rule);
 - the **push-off** of a powered export (``leg<i>_push_off``, the force ``F = P0 / T`` along
@@ -340,21 +340,12 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
             sph = osim.ContactSphere.safeDownCast(cg.get(f"{g}_patch{len(patches[g])}"))
             loc = osim.Vec3(sph.get_location()).to_numpy()[:2]
             patches[g].append((float(loc @ t_hat), float(loc @ n_hat) + sph.getRadius()))
-    half = {g: info.get("patch_width", 0.0) / 2 for g in LEGS}
-    profile = []  # a height profile's spheres (both feet's ground): their tops likewise
-    while cg.contains(f"ground{len(profile)}"):
-        sph = osim.ContactSphere.safeDownCast(cg.get(f"ground{len(profile)}"))
-        loc = osim.Vec3(sph.get_location()).to_numpy()[:2]
-        profile.append((float(loc @ t_hat), float(loc @ n_hat) + sph.getRadius()))
-    if len(profile) > 1:  # each sphere the ground within half the spacing of its top
-        half = {g: 0.5 * float(np.max(np.diff(sorted(s for s, _ in profile)))) for g in LEGS}
-        patches = {g: profile for g in LEGS}
+    half = info.get("patch_width", 0.0) / 2
     off = info.get("latch_offset", 0.0)  # the contact point below the sphere's centre
 
     def height(g, s):  # the foot's contact point above the ground under it [m]
         p = bodies[g].findStationLocationInGround(s, foot_loc[g]).to_numpy()[:2]
-        return contact_height(p, feet[g].getRadius(), off, patches[g], half[g], t_hat,
-                              n_hat)
+        return contact_height(p, feet[g].getRadius(), off, patches[g], half, t_hat, n_hat)
 
     def loaded(g, s):
         v = contact[g].getRecordValues(s)

@@ -103,7 +103,7 @@ def torque_joints(act: Actuation | None, mb, coords=None) -> list[str]:
 
 def header_comments(mb, gait, name: str, version: str, total: float, contact_note: str,
                     rg: float | None, r_foot: float, motors: list[str],
-                    knee_stops: bool, profile=None) -> list[str]:
+                    knee_stops: bool) -> list[str]:
     """The document's comments: the walker, its frame and gravity, the default state, the
     contact law (``contact_note``), and - when the scene has them - the terrain's patches
     (sphere radius ``rg`` [m], foot sphere ``r_foot`` [m]), the push-off, the joint torques'
@@ -134,16 +134,7 @@ def header_comments(mb, gait, name: str, version: str, total: float, contact_not
             + ("" if gait.lane_heights is None else
                "; stairs or footholds: each patch's top at its tread's height, the radius "
                "small enough that the tread behind falls clear of the swing foot's path "
-               "(walkerlab.export.opensim.terrain_patch_radius)")
-            + "."))
-    if profile is not None:
-        out.append(comment(
-            f"Terrain: a height profile (terrain.kind: profile) as {len(profile[1])} "
-            f"spheres ground<j> of radius {profile[0]:.6g} m whose surfaces touch its "
-            "polyline (lowered by the foot sphere's radius), both feet on them: within "
-            "5e-05 m of the line between spheres and at its convex vertices "
-            "(walkerlab.export.opensim.profile_spheres); its first vertex at the stance "
-            "foot's contact point."))
+               "(walkerlab.export.opensim.terrain_patch_radius)") + "."))
     if gait.flat_feet:
         (h1, t1, k1, c1, r1, m1, i1), (h2, t2, k2, c2, r2, m2, i2) = gait.flat_feet
         out.append(comment(
@@ -275,19 +266,15 @@ def joint_set(mb, q0: dict, v0: dict, ankles=()) -> list[str]:
 
 
 def contact_forces(feet, gait, rg: float | None, stiff: float, diss: float,
-                   vt: float, profile=None) -> list[str]:
+                   vt: float) -> list[str]:
     """A ``HuntCrossleyForce`` per foot between its sphere and the ground (or its lane's
     patches when ``rg`` is given), stiffness ``stiff``, dissipation ``diss``, transition
-    velocity ``vt`` [m/s] (:func:`walkerlab.export.opensim.hunt_crossley`); a height
-    profile's spheres ``ground<j>`` (``profile``: :func:`walkerlab.export.opensim.
-    profile_spheres`) for both feet."""
+    velocity ``vt`` [m/s] (:func:`walkerlab.export.opensim.hunt_crossley`)."""
     out = []
     for i, ln in enumerate(feet):
         leg = ln.name.split("_")[0]
         grounds = ["ground"] if rg is None else [
             f"{leg}_patch{j}" for j in range(len(gait.lanes[i]))]
-        if profile is not None:
-            grounds = [f"ground{j}" for j in range(len(profile[1]))]
         if gait.flat_feet:  # the heel (leg<i>_foot) and the toe
             grounds.insert(0, f"{leg}_toe")
         out += [f"\t\t\t\t<HuntCrossleyForce name=\"{leg}_contact\">",
@@ -405,13 +392,12 @@ def push_off_forces(feet, force: float) -> list[str]:
 
 
 def contact_geometry_set(feet, gait, r_foot: float, rg: float | None, offset: float,
-                         phi: float, t_hat, n_hat, profile=None) -> list[str]:
+                         phi: float, t_hat, n_hat) -> list[str]:
     """The ``ContactGeometrySet``: a sphere of radius ``r_foot`` [m] per foot (flat feet:
     ``leg<i>_foot`` at the heel and ``leg<i>_toe`` at the toe of the sole), and the
     ground: a half-space ``offset`` [m] below the slope line (slope ``phi`` [rad]), or each
     lane's patches as spheres of radius ``rg`` [m] (``t_hat``, ``n_hat``: the slope's
-    tangent, downhill, and normal, up); a height profile: its spheres ``ground<j>``
-    (``profile``: ``(radius, centres)``, :func:`walkerlab.export.opensim.profile_spheres`)."""
+    tangent, downhill, and normal, up)."""
     out = ['\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
     for i, ln in enumerate(feet):
         leg = ln.name.split("_")[0]
@@ -426,13 +412,7 @@ def contact_geometry_set(feet, gait, r_foot: float, rg: float | None, offset: fl
                     f"\t\t\t\t\t<location>{nums(x, y, 0.0)}</location>",
                     f"\t\t\t\t\t<radius>{num(r_foot)}</radius>",
                     "\t\t\t\t</ContactSphere>"]
-    if profile is not None:
-        for j, (x, y) in enumerate(profile[1]):
-            out += [f"\t\t\t\t<ContactSphere name=\"ground{j}\">",
-                    "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
-                    f"\t\t\t\t\t<location>{nums(x, y, 0.0)}</location>",
-                    f"\t\t\t\t\t<radius>{num(profile[0])}</radius>", "\t\t\t\t</ContactSphere>"]
-    elif rg is None:  # OpenSim's half-space fills local x > 0: turned so its normal is n_hat
+    if rg is None:  # OpenSim's half-space fills local x > 0: turned so its normal is n_hat
         p = -offset * n_hat
         out += ['\t\t\t\t<ContactHalfSpace name="ground">',
                 "\t\t\t\t\t<socket_frame>/ground</socket_frame>",

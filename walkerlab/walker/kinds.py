@@ -183,6 +183,10 @@ FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (w
 #: after ``terrain.kind: profile: ``)
 PROFILE_PASSIVE = ("walked by the passive walker of the generated model only (no "
                    "walker.actuation, ideal.variant: derived)")
+_OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
+                 "half-spaces, not a polyline: spheres that follow profile.yaml's to 0.05 "
+                 "mm take 524, one every 2 cm, and OpenSim then runs about 100 times "
+                 "slower; --format mjcf writes it as a height field)")
 _ADAMS_PROFILE = ("the Adams dataset carries the ground as patches (lanes: checkerboard, at "
                   "the footholds' heights), not continuous profile")
 _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
@@ -207,10 +211,11 @@ _VC_VIEWS = {
 #: what the views of every legged kind refuse: grounds whose steps differ in the Adams
 #: dataset (the contact model, the MJCF, the OpenSim model and the gym's contact view lay
 #: their patches at the rigid period-n gait's footfalls; the gym's rigid view steps them
-#: as simulate does), a profile there (the OpenSim model lays it as spheres)
+#: as simulate does), a profile there and in the OpenSim model
 _GROUNDS = {
     ("footholds", "adams"): _ONE_LANDING,
     ("profile", "adams"): _ADAMS_PROFILE,
+    ("profile", "osim"): _OSIM_PROFILE,
 }
 #: what the kinds without ankles (point or arc feet) refuse of the ankle's features
 _NO_ANKLES = {
@@ -258,6 +263,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                "(--format mjcf, contact-sim)"),
         ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
                                      "ankle motors yet (--format mjcf, contact-sim)"),
+        ("profile", "osim"): _OSIM_PROFILE,
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         ("stairs", "*"): _FLAT_LANDING,
         ("profile", "rigid"): _FLAT_LANDING,
