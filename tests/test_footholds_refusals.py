@@ -3,8 +3,9 @@ MJCF export lay their patches at the rigid period-n gait's footfalls, so ``conta
 ``report`` run them (before: one line, "footholds that differ from step to step run in the
 rigid model only"; before that an internal "heights1: ..." message); what still refuses them
 says so in one line naming the scene key (the contact periodic gait, a one-step map; the
-Adams dataset and the OpenSim model, by the capability table's cell; footholds of their own
-slopes), and no view points the user to another view that refuses the same scene."""
+Adams dataset, by the capability table's cell; footholds of their own slopes; the OpenSim
+model takes them since, tests/test_export_opensim.py), and no view points the user to
+another view that refuses the same scene."""
 
 from __future__ import annotations
 
@@ -41,14 +42,13 @@ def _with(**sections):
     return d
 
 
-def test_the_contact_mjcf_and_adams_cells_of_footholds_are_supported_osim_refuses():
+def test_every_view_of_point_and_arc_feet_takes_footholds_of_several_heights():
     for kind in ("straight_legs", "locking_knees"):
-        assert KINDS[kind].supports("footholds", "contact")
-        assert KINDS[kind].supports("footholds", "mjcf")
-        assert KINDS[kind].supports("footholds", "adams")  # issue 58: patches at each height
-        assert KINDS[kind].cell("footholds", "osim") == SEVERAL_FOOTHOLDS
-    # what the refusal tells the user to do names only views that take them
-    assert "contact-sim" in SEVERAL_FOOTHOLDS and "mjcf" in SEVERAL_FOOTHOLDS
+        for view in ("rigid", "contact", "mjcf", "osim", "adams", "gym"):
+            assert KINDS[kind].supports("footholds", view), view
+    # what a refusal tells the user to do names views that take them
+    assert "contact-sim" in SEVERAL_FOOTHOLDS and "MJCF" in SEVERAL_FOOTHOLDS
+    assert "OpenSim" in SEVERAL_FOOTHOLDS
 
 
 @pytest.mark.slow  # ~6 s: the whole report (figures)
@@ -95,13 +95,14 @@ def test_the_contact_periodic_gait_asked_on_two_heights_is_recorded_as_not_found
         assert int(f["summary/heel_strikes"][()]) >= 4
 
 
-@pytest.mark.parametrize("fmt, view", [("osim", "osim")])
-def test_the_opensim_export_refuses_two_heights_by_the_table(tmp_path, fmt, view):
+@pytest.mark.parametrize("fmt, name", [("osim", "walker.osim"), ("adm", "walker.adm")])
+def test_the_opensim_and_adams_exports_write_two_heights(tmp_path, fmt, name):
+    """Both exports lay a patch at each footfall's own height (their geometry:
+    tests/test_export_opensim.py, tests/test_export_adams_feet.py); before, both refused."""
     rc, err, _ = run_cli("export", _scene_file(tmp_path), "--format", fmt, "--runs-dir",
                          tmp_path / "r")
-    assert rc == 1 and "\n" not in err
-    assert err == ("error: terrain.foothold_heights_m: "
-                   + KINDS["straight_legs"].cell("footholds", view))
+    assert rc == 0, err
+    assert (tmp_path / "r" / "footholds2" / name).is_file()
 
 
 def test_footholds_of_their_own_slopes_are_refused_by_the_contact_model_in_one_line():

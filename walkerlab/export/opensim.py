@@ -16,7 +16,12 @@ Bodies and joints:
   mass, centre of mass ``(off-axis, -along, 0)`` and inertia about it (``Izz`` the planar
   moment; ``Ixx = Iyy = Izz`` only make the tensor valid, nothing turns about x or y);
 - ``PinJoint`` ``leg<i>_hip`` (coordinate = the absolute link angle, the base does not
-  rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``.
+  rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``;
+- flat feet: a ``Body`` ``leg<i>_sole`` per leg (the MJCF's foot mass and inertia at the
+  ankle, :func:`walkerlab.export.scene.flat_feet`) on a ``PinJoint`` ``leg<i>_ankle`` at
+  the leg's end (the angle from the leg's perpendicular, positive toe up), its ankle spring
+  a ``SpringGeneralizedForce``, contact spheres at its heel (``leg<i>_foot``) and toe
+  (``leg<i>_toe``).
   The coordinates' ``default_value`` and ``default_speed_value`` are the rigid gait's fixed
   point (:func:`walkerlab.export.scene.mjcf_scene`'s ``gait`` keyframe: just after heel
   strike, leg2 in stance, its foot's contact point at the origin): the model walks from its
@@ -34,9 +39,12 @@ Forces:
   the swing foot passes over the other lane's footfalls; OpenSim's Hunt-Crossley force takes
   spheres and half-spaces only).  On stairs and footholds (``terrain.lanes: checkerboard``)
   each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
-  is :func:`terrain_patch_radius`; continuous stairs are refused.  The scene's IMPACT law
-  ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated by :func:`hunt_crossley` (Hertz
-  ``d^1.5``, matched at the static penetration; stated in the file).
+  is :func:`terrain_patch_radius`; footholds of several heights in turn have their patches
+  at the rigid period-n gait's footfalls, step by step, each at its own foothold's height
+  (as the MJCF's, :func:`walkerlab.export.scene.mjcf_scene`); continuous stairs are
+  refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated
+  by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static penetration; stated in
+  the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
   and damping about z; the rest angle in the second frame's orientation).
@@ -78,6 +86,7 @@ from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, xml_comments
 from walkerlab.export.opensim_xml import (
+    ankle_springs,
     body_set,
     contact_forces,
     contact_geometry_set,
@@ -99,8 +108,8 @@ if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
-           "knee_stop_expression", "osim_gait", "osim_omissions", "osim_text", "patch_radius",
-           "terrain_patch_radius"]
+           "knee_stop_expression", "osim_coordinates", "osim_gait", "osim_omissions",
+           "osim_text", "patch_radius", "terrain_patch_radius"]
 
 #: The export's file name in ``runs/<scene>/``.
 OSIM_FILE = "walker.osim"
@@ -118,9 +127,10 @@ class OsimGait:
         Default values and speeds of the coordinates (``hip_x``, ``hip_y``, then each link's
         joint as in :attr:`Multibody.links`) [m, rad; m/s, rad/s].
     period_s : float
-        The rigid gait's step period [s].
+        The rigid gait's step period [s] (a map of several steps, legs that differ or
+        footholds of several heights: their mean).
     step_length_m : float
-        The rigid gait's step length along the slope [m].
+        The rigid gait's step length along the slope [m] (their mean, as ``period_s``).
     lanes : tuple of (tuple of float, tuple of float) or None
         Footfall centres along the slope [m] of leg1's and leg2's lane; None: continuous.
     patch_width_m : float
@@ -138,6 +148,12 @@ class OsimGait:
     lane_heights : tuple of (tuple of float, tuple of float) or None
         Stairs and footholds: each patch's height along the slope normal [m] (its tread's,
         as :class:`walkerlab.export.mjcf_scene.MjcfScene` has them); None: on the slope line.
+    flat_feet : tuple or None
+        Flat feet, per leg (leg1, leg2) ``(heel [m], toe [m], ankle stiffness [N m/rad],
+        damping [N m s/rad], rest angle [rad], foot mass [kg], inertia about the ankle
+        [kg m^2])`` (:func:`walkerlab.export.scene.flat_feet`, the MJCF's); then ``qpos`` and
+        ``qvel`` hold the ankles after their legs (:func:`osim_coordinates`).  None: no
+        foot bodies.
     """
 
     qpos: tuple
@@ -153,6 +169,7 @@ class OsimGait:
     push_off_duration_s: float = 0.005
     actuation: Actuation | None = None
     lane_heights: tuple | None = None
+    flat_feet: tuple | None = None
 
     @property
     def speed_m_per_s(self) -> float:
@@ -167,17 +184,20 @@ def check_osim_exportable(scene: Scene, mb) -> None:
     ------
     ValueError
         One line naming the field, as the capability table has it
-        (:meth:`walkerlab.walker.kinds.Kind.require`): flat feet (``walker.leg.foot.kind``:
-        no foot bodies in this export), an ankle push-off
-        (``walker.actuation.ankle_push_off``); a torque law per foot mass or on a joint the
-        model lacks (``walker.actuation.torques.<i>``).
+        (:meth:`walkerlab.walker.kinds.Kind.require`): a walker the export does not write
+        (``walker.leg.foot.kind``, ``walker.model``), an ankle push-off
+        (``walker.actuation.ankle_push_off``), a push-off on flat feet
+        (``walker.actuation.push_off``); a torque law per foot mass or on a joint the model
+        lacks (``walker.actuation.torques.<i>``).
     """
     kind = KINDS[mb.kind]
     kind.require("walk", "osim", "walker.leg.foot.kind")
     act = scene.walker.actuation
     if act is not None and act.ankle_push_off is not None:
         kind.require("ankle_push_off", "osim", "walker.actuation.ankle_push_off")
-    coords = [ln.joint for ln in mb.links]
+    if act is not None and act.push_off is not None:
+        kind.require("push_off", "osim", "walker.actuation.push_off")
+    coords = osim_coordinates(mb)[2:]
     for i, t in enumerate(getattr(act, "torques", None) or []):
         field = f"walker.actuation.torques.{i}"
         if t.scaled_by != "none":
@@ -189,6 +209,20 @@ def check_osim_exportable(scene: Scene, mb) -> None:
         except ValueError:
             raise ValueError(f"{field}.joint: {t.joint} is not a joint of the OpenSim "
                              "export") from None
+
+
+def osim_coordinates(mb) -> list[str]:
+    """The OpenSim model's coordinates in its tree order (the order of :attr:`OsimGait.qpos`,
+    the MJCF keyframe's): ``hip_x``, ``hip_y``, each link's joint (:attr:`Multibody.links`)
+    and, on a kind whose legs end in foot bodies (:attr:`walkerlab.export.parts.ExportPart.
+    ankles`), each foot's ``leg<i>_ankle`` after its leg's joint."""
+    ankles = export_part(mb).ankles
+    out = ["hip_x", "hip_y"]
+    for ln in mb.links:
+        out.append(ln.joint)
+        if ankles and ln.foot_m is not None:
+            out.append(f"{ln.name.split('_')[0]}_ankle")
+    return out
 
 
 def hunt_crossley(c: ContactParamsSI, weight_n: float, radius_m: float
@@ -291,8 +325,16 @@ def terrain_patch_radius(gait: OsimGait, foot_sphere_m: float) -> float:
     (``h`` the largest rise between consecutive footfalls, ``w`` the patch width, ``l`` the
     step length).  A sphere does not end at the patch's edge: on stairs.yaml, at the flat
     patches' radius (11.25 m), the tread behind reached into the swing foot's path, which
-    falls below the tread it left about half a step (0.22 of 0.41 m) from it."""
+    falls below the tread it left about half a step (0.22 of 0.41 m) from it.
+
+    Flat feet: no larger than the patch of the sole's length, ``patch_radius(heel + toe,
+    r)`` (the sole's ends one foot-sphere radius below the top, the foot flat on it to that):
+    at the 0.6 m patches' 45 m of configs/flat_feet.yaml the swing toe, which the rigid
+    model lets pass 2 mm below the slope line early in the swing, touched the trailing
+    patch's flank 0.1 m beyond its edge and the walker fell; at 2.81 m it walks."""
     rg = patch_radius(gait.patch_width_m, foot_sphere_m)
+    if gait.flat_feet:
+        rg = min(rg, patch_radius(max(f[0] + f[1] for f in gait.flat_feet), foot_sphere_m))
     if gait.lane_heights is None:
         return rg
     falls = sorted((s, h) for lane, hs in zip(gait.lanes, gait.lane_heights)
@@ -323,7 +365,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
         No rigid gait.
     """
     from walkerlab.analysis.contact.periodic import ideal_gait
-    from walkerlab.export.scene import mjcf_scene
+    from walkerlab.export.scene import SCENE_FEET, mjcf_scene
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.scene import ideal_step_length
@@ -332,26 +374,31 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
     ideal = ideal_gait(scene) if ideal is None else ideal
-    if terrain.kind == "profile":
-        raise ValueError("terrain.kind: profile: not in the OpenSim export (its Hunt-Crossley "
-                         "contact takes spheres and half-spaces, not a polyline; --format "
-                         "mjcf writes it as a height field)")
+    if terrain.kind == "profile":  # the capability table's cell (every legged kind's)
+        KINDS[mb.kind].require("profile", "osim", "terrain.kind: profile")
     if not terrain.is_slope and terrain.lanes != "checkerboard":
         raise ValueError(f"terrain.lanes: {terrain.lanes}: continuous {terrain.kind} are not "
                          "in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                          "half-spaces, not a tread's box); lanes: checkerboard puts the "
                          "patches on the treads")
     ms = mjcf_scene(scene, mb, data, ideal)
-    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
+    walker = ContactWalker(contact=c, data=data, knee_stop=knee,
+                           flat_foot=SCENE_FEET[mb.kind].foot_mass(settings))
     ell = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:
         ell = 0.5 * (ells[0] + ells[1])
+    elif len(ells) > 2:  # footholds of three or more heights: a period-n gait
+        ell = sum(ells) / len(ells)
+    # the gait's map is of len(ells) steps (legs that differ, footholds of several heights):
+    # its mean step
+    period = float(ideal.period_s) / max(1, len(ells))
     act = scene.walker.actuation
-    return OsimGait(ms.qpos, ms.qvel, float(ideal.period_s), float(ell), ms.lanes,
+    return OsimGait(ms.qpos, ms.qvel, period, float(ell), ms.lanes,
                     terrain.patch_width_m, ms.ground_offset_m, c, knee,
                     None if act is None else act.push_off,
-                    settings.push_off_pulse_s(), ms.actuation, ms.lane_heights)
+                    settings.push_off_pulse_s(), ms.actuation, ms.lane_heights,
+                    ms.flat_feet)
 
 
 def osim_omissions(mb, gait: OsimGait) -> tuple[Omission, ...]:
@@ -403,15 +450,17 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     arc = mb.foot == "arc" and mb.foot_radius_m > 0
     r_foot = mb.foot_radius_m if arc else point_foot_radius(mb)
     offset = gait.ground_offset_m
-    total = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
+    total = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links) \
+        + sum(f[5] for f in gait.flat_feet or ())
     weight = total * g * math.cos(phi)
     rg = None if gait.lanes is None else terrain_patch_radius(gait, r_foot)
     r_eff = r_foot if rg is None else r_foot * rg / (r_foot + rg)
     stiff, diss, vt, contact_note = hunt_crossley(gait.contact, weight, r_eff)
-    joints = ["hip_x", "hip_y", *(ln.joint for ln in mb.links)]
+    joints = osim_coordinates(mb)
     q0, v0 = dict(zip(joints, gait.qpos)), dict(zip(joints, gait.qvel))
     knee_stops = export_part(mb).knee_stops
-    motors = torque_joints(gait.actuation, mb)
+    motors = torque_joints(gait.actuation, mb, joints[2:])
+    feet = [ln for ln in mb.links if ln.foot_m is not None]
 
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
@@ -419,13 +468,14 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
                             knee_stops),
            *xml_comments(osim_omissions(mb, gait))]
     out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
-    out += body_set(mb)
-    out += joint_set(mb, q0, v0)
+    out += body_set(mb, feet, gait.flat_feet)
+    out += joint_set(mb, q0, v0, feet if gait.flat_feet else ())
     out += couplers(mb)
-    feet = [ln for ln in mb.links if ln.foot_m is not None]
     out += ['\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
     out += contact_forces(feet, gait, rg, stiff, diss, vt)
     out += spring_forces(mb)
+    if gait.flat_feet:
+        out += ankle_springs(feet, gait.flat_feet)
     if knee_stops:
         out += knee_stop_forces(mb, knee_stop_expression(gait.knee, "stop"),
                                 knee_stop_expression(gait.knee, "latch"))

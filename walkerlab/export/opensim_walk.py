@@ -306,6 +306,9 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
             for g in LEGS}
     foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in LEGS}
+    for g in LEGS:  # a flat foot: the foot point is the ankle, its sole's frame origin
+        if model.getBodySet().contains(f"{g}_sole"):
+            bodies[g], foot_loc[g] = model.getBodySet().get(f"{g}_sole"), osim.Vec3(0, 0, 0)
     kneed = fs.contains("leg1_knee_latch")
     latch = {g: fs.get(f"{g}_knee_latch") for g in LEGS} if kneed else {}
     knee = {g: model.getCoordinateSet().get(f"{g}_knee") for g in LEGS} if kneed else {}
@@ -356,7 +359,9 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     manager.setIntegratorAccuracy(accuracy)
     state.setTime(0.0)
     model.realizeDynamics(state)
-    air = {g: (0.0 if loaded(g, state) else min_air_s) for g in LEGS}
+    # both feet start on the ground (the trailing one just left it, or stays on its toe in
+    # a flat foot's double support): a heel strike needs min_air_s off it first
+    air = {g: 0.0 for g in LEGS}
     on = {g: loaded(g, state) for g in LEGS}
     latched = {g: False for g in LEGS}
     stance = "leg2"  # the default state: leg2 in stance

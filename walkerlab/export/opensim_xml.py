@@ -17,7 +17,8 @@ from walkerlab.export.text import comment, num, nums
 if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
-__all__ = ["body_set", "contact_forces", "contact_geometry_set", "couplers", "header_comments",
+__all__ = ["ankle_springs", "body_set", "contact_forces", "contact_geometry_set", "couplers",
+           "header_comments",
            "joint_set", "knee_stop_forces", "latch_foot_offset", "motor_forces",
            "push_off_forces", "spring_forces", "torque_joints"]
 
@@ -87,12 +88,14 @@ def couplers(mb) -> list[str]:
     return out + ["\t\t\t</objects>", "\t\t</ConstraintSet>"]
 
 
-def torque_joints(act: Actuation | None, mb) -> list[str]:
+def torque_joints(act: Actuation | None, mb, coords=None) -> list[str]:
     """Coordinates that get a ``CoordinateActuator``: every coordinate a torque law's joint
-    moves in either stance (:func:`walkerlab.export.joint_torques.torque_generalized_forces`)."""
+    moves in either stance (:func:`walkerlab.export.joint_torques.torque_generalized_forces`)
+    among ``coords`` (default the links' joints; flat feet: with the ankles,
+    :func:`walkerlab.export.opensim.osim_coordinates`)."""
     if act is None:
         return []
-    coords = [ln.joint for ln in mb.links]
+    coords = [ln.joint for ln in mb.links] if coords is None else list(coords)
     used = {c for t in act.torques for st in (0, 1)
             for c in torque_generalized_forces(t.joint, st, coords)}
     return [c for c in coords if c in used]
@@ -122,12 +125,30 @@ def header_comments(mb, gait, name: str, version: str, total: float, contact_not
         out.append(comment(
             f"Terrain: checkerboard lanes (each leg touches only its own); a patch of width "
             f"{num(gait.patch_width_m)} m is a sphere of radius {rg:.6g} m whose top touches "
-            f"the slope line at the footfall (it falls {r_foot:.4g} m below the line at the "
-            "patch's edge: walkerlab.export.opensim.patch_radius)"
+            f"the slope line at the footfall "
+            + (f"(it falls {r_foot:.4g} m below the line at the patch's edge: "
+               "walkerlab.export.opensim.patch_radius)" if not gait.flat_feet else
+               f"(flat feet: it falls {r_foot:.4g} m below the line at the heel and the toe "
+               "of a sole centred on it, no wider than the sole so that it falls clear of "
+               "the swing toe's path: walkerlab.export.opensim.terrain_patch_radius)")
             + ("" if gait.lane_heights is None else
                "; stairs or footholds: each patch's top at its tread's height, the radius "
                "small enough that the tread behind falls clear of the swing foot's path "
                "(walkerlab.export.opensim.terrain_patch_radius)") + "."))
+    if gait.flat_feet:
+        (h1, t1, k1, c1, r1, m1, i1), (h2, t2, k2, c2, r2, m2, i2) = gait.flat_feet
+        out.append(comment(
+            "Flat feet: bodies leg<i>_sole on PinJoints leg<i>_ankle at the legs' ends (the "
+            "angle from the leg's perpendicular, positive toe up), each of mass "
+            f"{num(m1)} and {num(m2)} kg at the ankle with inertia {num(i1)} and {num(i2)} "
+            "kg m^2 about it (walker.leg.foot.mass_kg, or the contact model's regularising "
+            "contact.flat_foot_mass_kg for massless feet: the MJCF's); the ankle springs "
+            "SpringGeneralizedForce leg<i>_ankle_spring (stiffness "
+            f"{num(k1)} and {num(k2)} N m/rad, rest {num(r1)} and {num(r2)} rad, damping "
+            f"{num(c1)} and {num(c2)} N m s/rad); contact spheres at the heel (leg<i>_foot, "
+            f"{num(h1)} and {num(h2)} m behind the ankle) and the toe (leg<i>_toe, "
+            f"{num(t1)} and {num(t2)} m ahead); the default state has the trailing foot on "
+            "its toe (the rigid gait's double support as it begins)."))
     if gait.push_off is not None:
         out.append(comment(
             "Push-off (walker.actuation.push_off, walkerlab_actuation below): PrescribedForce "
@@ -176,21 +197,28 @@ def latch_foot_offset(r_foot: float, ground_offset_m: float) -> float:
     return float(r_foot) - float(ground_offset_m)
 
 
-def body_set(mb) -> list[str]:
+def body_set(mb, feet=(), flat_feet=None) -> list[str]:
     """The ``BodySet``: the hip's point mass and each link (its centre of mass along its
-    downward axis, off-axis offset, inertia)."""
+    downward axis, off-axis offset, inertia); with ``flat_feet`` (:attr:`walkerlab.export.
+    opensim.OsimGait.flat_feet`) a body ``leg<i>_sole`` per foot link in ``feet``, its mass
+    at the ankle (its frame's origin) with its inertia about the ankle, as the MJCF's
+    foot bodies."""
     out = ['\t\t<BodySet name="bodyset">', "\t\t\t<objects>"]
     out += _body("hip", mb.hip_mass_kg)
     for ln in mb.links:
         along = -ln.com_m  # com_m is along the link's downward axis (-y)
         out += _body(ln.name, ln.mass_kg, (ln.com_off_axis_m, along), ln.inertia_kg_m2)
+    for ln, foot in zip(feet, flat_feet or ()):
+        out += _body(f"{ln.name.split('_')[0]}_sole", foot[5], (0.0, 0.0), foot[6])
     return out + ["\t\t\t</objects>", "\t\t</BodySet>"]
 
 
-def joint_set(mb, q0: dict, v0: dict) -> list[str]:
+def joint_set(mb, q0: dict, v0: dict, ankles=()) -> list[str]:
     """The ``JointSet``: the hip's planar ``CustomJoint`` to the ground (``hip_x``,
     ``hip_y``) and a ``PinJoint`` per link, each coordinate at its default value ``q0`` and
-    speed ``v0`` (by coordinate name)."""
+    speed ``v0`` (by coordinate name); a ``PinJoint`` ``leg<i>_ankle`` per foot link in
+    ``ankles`` (flat feet) from the link's foot point to its ``leg<i>_sole`` (the angle
+    from the leg's perpendicular, positive toe up; the sole along the body's x axis)."""
     out = ['\t\t<JointSet name="jointset">',
            "\t\t\t<objects>", '\t\t\t\t<CustomJoint name="base">',
            "\t\t\t\t\t<socket_parent_frame>/ground</socket_parent_frame>",
@@ -223,6 +251,17 @@ def joint_set(mb, q0: dict, v0: dict) -> list[str]:
                         (0.0, -ln.joint_from_parent_m, 0.0)),
                 *_frame(f"{ln.name}_at_{ln.joint}", f"/bodyset/{ln.name}"),
                 "\t\t\t\t\t</frames>", "\t\t\t\t</PinJoint>"]
+    for ln in ankles:
+        leg = ln.name.split("_")[0]
+        j = f"{leg}_ankle"
+        out += [f"\t\t\t\t<PinJoint name={quoteattr(j)}>",
+                f"\t\t\t\t\t<socket_parent_frame>{ln.name}_at_{j}</socket_parent_frame>",
+                f"\t\t\t\t\t<socket_child_frame>{leg}_sole_at_{j}</socket_child_frame>",
+                "\t\t\t\t\t<coordinates>", *_coordinate(j, q0[j], v0[j]),
+                "\t\t\t\t\t</coordinates>", "\t\t\t\t\t<frames>",
+                *_frame(f"{ln.name}_at_{j}", f"/bodyset/{ln.name}", (0.0, -ln.foot_m, 0.0)),
+                *_frame(f"{leg}_sole_at_{j}", f"/bodyset/{leg}_sole"),
+                "\t\t\t\t\t</frames>", "\t\t\t\t</PinJoint>"]
     return out + ["\t\t\t</objects>", "\t\t</JointSet>"]
 
 
@@ -236,6 +275,8 @@ def contact_forces(feet, gait, rg: float | None, stiff: float, diss: float,
         leg = ln.name.split("_")[0]
         grounds = ["ground"] if rg is None else [
             f"{leg}_patch{j}" for j in range(len(gait.lanes[i]))]
+        if gait.flat_feet:  # the heel (leg<i>_foot) and the toe
+            grounds.insert(0, f"{leg}_toe")
         out += [f"\t\t\t\t<HuntCrossleyForce name=\"{leg}_contact\">",
                 '\t\t\t\t\t<HuntCrossleyForce::ContactParametersSet name="contact_parameters">',
                 "\t\t\t\t\t\t<objects>", "\t\t\t\t\t\t\t<HuntCrossleyForce::ContactParameters>",
@@ -250,6 +291,23 @@ def contact_forces(feet, gait, rg: float | None, stiff: float, diss: float,
                 "\t\t\t\t\t\t</objects>", "\t\t\t\t\t</HuntCrossleyForce::ContactParametersSet>",
                 f"\t\t\t\t\t<transition_velocity>{num(vt)}</transition_velocity>",
                 "\t\t\t\t</HuntCrossleyForce>"]
+    return out
+
+
+def ankle_springs(feet, flat_feet) -> list[str]:
+    """A flat foot's ankle spring and damper (``walker.leg.foot.ankle``) per foot link in
+    ``feet``: a ``SpringGeneralizedForce`` ``leg<i>_ankle_spring`` on ``leg<i>_ankle``
+    (stiffness [N m/rad], rest angle [rad], viscosity = damping [N m s/rad]), the MJCF's
+    joint spring."""
+    out = []
+    for ln, (_heel, _toe, k, c, rest, _m, _i) in zip(feet, flat_feet):
+        leg = ln.name.split("_")[0]
+        out += [f"\t\t\t\t<SpringGeneralizedForce name=\"{leg}_ankle_spring\">",
+                f"\t\t\t\t\t<coordinate>{leg}_ankle</coordinate>",
+                f"\t\t\t\t\t<stiffness>{num(k)}</stiffness>",
+                f"\t\t\t\t\t<rest_length>{num(rest)}</rest_length>",
+                f"\t\t\t\t\t<viscosity>{num(c)}</viscosity>",
+                "\t\t\t\t</SpringGeneralizedForce>"]
     return out
 
 
@@ -335,17 +393,25 @@ def push_off_forces(feet, force: float) -> list[str]:
 
 def contact_geometry_set(feet, gait, r_foot: float, rg: float | None, offset: float,
                          phi: float, t_hat, n_hat) -> list[str]:
-    """The ``ContactGeometrySet``: a sphere of radius ``r_foot`` [m] per foot, and the
+    """The ``ContactGeometrySet``: a sphere of radius ``r_foot`` [m] per foot (flat feet:
+    ``leg<i>_foot`` at the heel and ``leg<i>_toe`` at the toe of the sole), and the
     ground: a half-space ``offset`` [m] below the slope line (slope ``phi`` [rad]), or each
     lane's patches as spheres of radius ``rg`` [m] (``t_hat``, ``n_hat``: the slope's
     tangent, downhill, and normal, up)."""
     out = ['\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
-    for ln in feet:
+    for i, ln in enumerate(feet):
         leg = ln.name.split("_")[0]
-        out += [f"\t\t\t\t<ContactSphere name=\"{leg}_foot\">",
-                f"\t\t\t\t\t<socket_frame>/bodyset/{ln.name}</socket_frame>",
-                f"\t\t\t\t\t<location>{nums(0.0, -ln.foot_m, 0.0)}</location>",
-                f"\t\t\t\t\t<radius>{num(r_foot)}</radius>", "\t\t\t\t</ContactSphere>"]
+        spheres = [(f"{leg}_foot", ln.name, (0.0, -ln.foot_m))]
+        if gait.flat_feet:  # heel and toe on the sole, the ankle at its frame's origin
+            heel, toe = gait.flat_feet[i][:2]
+            spheres = [(f"{leg}_foot", f"{leg}_sole", (-heel, 0.0)),
+                       (f"{leg}_toe", f"{leg}_sole", (toe, 0.0))]
+        for name, body, (x, y) in spheres:
+            out += [f"\t\t\t\t<ContactSphere name=\"{name}\">",
+                    f"\t\t\t\t\t<socket_frame>/bodyset/{body}</socket_frame>",
+                    f"\t\t\t\t\t<location>{nums(x, y, 0.0)}</location>",
+                    f"\t\t\t\t\t<radius>{num(r_foot)}</radius>",
+                    "\t\t\t\t</ContactSphere>"]
     if rg is None:  # OpenSim's half-space fills local x > 0: turned so its normal is n_hat
         p = -offset * n_hat
         out += ['\t\t\t\t<ContactHalfSpace name="ground">',

@@ -42,18 +42,22 @@ class ExportPart:
         The MJCF's note on the actuators of a powered walker.
     sidecar_actuators : str
         The URDF keyframe sidecar's ``actuation_note``.
+    ankles : bool
+        Each leg ends in a foot body on an ankle hinge (flat feet: the MJCF's and the
+        OpenSim model's ``leg<i>_ankle`` coordinates).
     """
 
     knee_stops: bool = False
     mjcf_actuators: str = _HIP_MJCF
     sidecar_actuators: str = _HIP_SIDECAR
+    ankles: bool = False
 
 
 #: kind name -> its export part (:data:`walkerlab.walker.kinds.KINDS`)
 EXPORT_PARTS = {
     "straight_legs": ExportPart(),
     "locking_knees": ExportPart(knee_stops=True),
-    "flat_feet": ExportPart(),
+    "flat_feet": ExportPart(ankles=True),
     "free_joints": ExportPart(
         mjcf_actuators=(
             "Actuators (walker.actuation, in the custom text walkerlab_actuation): "

@@ -498,10 +498,12 @@ class _FlatFeet(_LinkFeet):
             "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)"),)
 
     def check_format(self, fmt: str | None, walker_only: bool) -> None:
-        """Flat feet go to an MJCF with its scene only (one line naming the field)."""
-        if fmt != "mjcf" or walker_only:
-            raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF with the "
-                             "scene only (a URDF would hold point feet: no foot link, ankle "
+        """Flat feet go to an MJCF or an OpenSim model with its scene only (one line
+        naming the field)."""
+        if fmt not in ("mjcf", "osim") or walker_only:
+            raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF and "
+                             "OpenSim with the scene only (a URDF would hold point feet: "
+                             "no foot link, ankle "
                              "spring or heel and toe contacts; --walker-only has no foot "
                              "mass)")
 

@@ -168,14 +168,12 @@ _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); poin
 _NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
                   "impulse along the leg")
 _NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
-#: why the OpenSim view refuses footholds that differ from step to step (its writer lays
-#: the patch spheres at each footfall's height, but no OpenSim walk has checked them:
-#: OpenSim was not installable where they were built) (:func:`walkerlab.models.ground.
-#: landing_drop` says it, after the field's name)
+#: why a view refuses footholds that differ from step to step
+#: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
 SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid and contact "
-                     "models, the MJCF, the Adams dataset and the gym (walkerlab fixedpoint, "
-                     "simulate, contact-sim, report, export --format mjcf or adm, "
-                     "walkerlab.gym): give footholds of one height for this view")
+                     "models, the MJCF, OpenSim and Adams exports and the gym (walkerlab "
+                     "fixedpoint, simulate, contact-sim, report, export, walkerlab.gym): give "
+                     "footholds of one height for this view")
 _ONE_LANDING = SEVERAL_FOOTHOLDS
 #: why every view but the rigid one refuses footholds of their own slopes
 #: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
@@ -189,7 +187,9 @@ FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (w
 PROFILE_PASSIVE = ("walked by the passive walker of the generated model only (no "
                    "walker.actuation, ideal.variant: derived)")
 _OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
-                 "half-spaces, not a polyline; --format mjcf writes it as a height field)")
+                 "half-spaces, not a polyline: spheres that follow profile.yaml's to 0.05 "
+                 "mm take 524, one every 2 cm, and OpenSim then runs about 100 times "
+                 "slower; --format mjcf writes it as a height field)")
 _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
                     "scene without it")
 #: why the Adams dataset refuses joint torques other than the hip's on a walker that is not
@@ -207,12 +207,11 @@ _VC_VIEWS = {
     ("virtual_constraints", "gym"): ("the Gymnasium environment has no scene policy for "
                                      "virtual constraints yet (contact-sim runs them)"),
 }
-#: what the views of every legged kind refuse: grounds whose steps differ in the OpenSim
-#: model (the contact model, the MJCF, the Adams dataset and the gym's contact view lay
-#: their patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
-#: simulate does), a profile in the OpenSim model
+#: what the views of every legged kind refuse: a profile in the OpenSim model (the contact
+#: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
+#: patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
+#: simulate does)
 _GROUNDS = {
-    ("footholds", "osim"): _ONE_LANDING,
     ("profile", "osim"): _OSIM_PROFILE,
 }
 #: what the kinds without ankles (point or arc feet) refuse of the ankle's features
@@ -270,16 +269,19 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
                                        "degrees of freedom within the step: give point "
                                        "feet"),
-        ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
-                           "springs or heel and toe contacts); --format mjcf carries them"),
+        ("push_off", "osim"): ("the contact view holds a flat foot's ankle through the "
+                               "push-off pulse; the OpenSim stepping loop does not yet "
+                               "(--format mjcf, contact-sim)"),
+        ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
+                                     "ankle motors yet (--format mjcf, contact-sim)"),
+        ("profile", "osim"): _OSIM_PROFILE,
         ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat)
-        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize")},
+        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
         ("profile", "rigid"): _FLAT_PROFILE,
-        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize")},
-        ("footholds", "osim"): _ONE_LANDING,
+        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
         ("profile", "adams"): _FLAT_PROFILE,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
@@ -292,6 +294,12 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
+        # the OpenSim stepping loop drives joint torques (its walks: the powered compass,
+        # RABBIT's laws); a walker held up by them on footholds is walked in the rigid and
+        # contact models, the MJCF and the gym, and written to Adams
+        ("footholds", "osim"): ("footholds of several heights under joint torques run in the "
+                                "rigid and contact models, the MJCF, Adams and the gym; no "
+                                "OpenSim walk has checked them yet (export --format mjcf)"),
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
@@ -303,6 +311,12 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "(optimize.design: virtual_constraints)"),
         ("virtual_constraints", "optimize"): None,  # optimize.design: virtual_constraints
         **_GROUNDS,
+        # the OpenSim stepping loop drives joint torques (its walks: the powered compass,
+        # RABBIT's laws); a walker held up by them on footholds is walked in the rigid and
+        # contact models, the MJCF and the gym, and written to Adams
+        ("footholds", "osim"): ("footholds of several heights under joint torques run in the "
+                                "rigid and contact models, the MJCF, Adams and the gym; no "
+                                "OpenSim walk has checked them yet (export --format mjcf)"),
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
