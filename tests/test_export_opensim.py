@@ -399,13 +399,13 @@ def test_osim_export_walks_in_opensim(name, period_rtol, speed_rtol, tmp_path):
 
 
 @pytest.mark.slow
+@needs_opensim
 def test_osim_walks_footholds_of_two_heights_in_the_rigid_period_2_gait(tmp_path):
     """configs/footholds_two.yaml in OpenSim: >= 10 alternating heel strikes from the default
     state, no fall; from the 3rd strike on, the steps onto each of the two footholds take
     within 3 % of the rigid period-2 gait's step onto it (0.6918 and 0.7317 s; measured
     0.6906 s, -0.2 %, and 0.7414 s, +1.3 %, 11 strikes), their mean within 1 %; the speed
     within 5 % (-3.0 %: the compliant steps 0.43 m against 0.439 m).  About 40 s."""
-    pytest.importorskip("opensim")
     import numpy as np
 
     from walkerlab.analysis.contact.periodic import ideal_gait
@@ -428,6 +428,7 @@ def test_osim_walks_footholds_of_two_heights_in_the_rigid_period_2_gait(tmp_path
 
 
 @pytest.mark.slow
+@needs_opensim
 def test_osim_flat_feet_walk_in_opensim(tmp_path):
     """configs/flat_feet.yaml in OpenSim (its 0.1 kg regularising feet, as the MJCF's): the
     model has the multibody's mass plus the feet, and walks >= 6 alternating heel strikes
@@ -435,7 +436,6 @@ def test_osim_flat_feet_walk_in_opensim(tmp_path):
     the 2nd strike on within 3 % of the rigid 0.8102 s (measured +1.1 %: 0.8225, 0.8135,
     0.821 s; MuJoCo +1.94 %), the speed within 5 % (-0.5 %).  Slow: 10-20 min (the heel
     and toe on stiff contact)."""
-    pytest.importorskip("opensim")
     import re
 
     from walkerlab.export.opensim_walk import walk
