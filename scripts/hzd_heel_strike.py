@@ -5,7 +5,8 @@ Rigid (the scene's closed loop from its zero dynamics' fixed point, one step):
 
 - the heel strike's impulse ``Lambda`` on the new stance foot [N s] from the walker's
   generated extended impact (``De``, ``E``: ``De (q'e+ - q'e-) = E^T Lambda``, ``E q'e+ =
-  0``; Hurmuzlu & Marghitu 1994, Westervelt et al. 2007 Eq. 3.20), checked against an
+  0``; Y. Hurmuzlu & D. B. Marghitu 1994, Int. J. Robotics Research 13(1):82-92;
+  Westervelt et al. 2007, ch. 3), checked against an
   independent computation, the whole walker's linear momentum change ``m (v_com+ -
   v_com-)`` with ``q'+`` from the generated pinned impact (``Mi q'+ = B q'-``) and the
   centre of mass from the bodies' mass points; ``|Lambda_t / Lambda_n|`` against the
