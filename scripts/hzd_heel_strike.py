@@ -18,8 +18,8 @@ MuJoCo (``walkerlab export`` MJCF, the export's stepping loop with the scene's f
 optionally with the file's numbers replaced): per heel strike, the new stance foot's
 travel along the ground (the first 30 ms, then the rest of the step), the zero dynamics'
 momentum ``sigma = b^T M q'`` (the angular momentum about the stance foot) just before the
-strike, the rigid impact's ``sigma+`` of that state and MuJoCo's 3 ms after; the step period
-against the rigid one.
+strike, and 3 ms after it in MuJoCo and in the rigid closed loop from the rigid impact of the
+same pre-impact state; the step period against the rigid one.
 
 Usage: ``python scripts/hzd_heel_strike.py SCENE.yaml [OUTDIR] [--mujoco]
 [--sub REGEX::REPLACEMENT ...]`` (e.g. ``--sub 'friction="0.9 ::friction="2.0 '``).
@@ -123,6 +123,9 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
     import mujoco as mj
 
     from walkerlab.export import mujoco_walk as mw
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
     from walkerlab.models.virtual_constraints import annihilator
     from walkerlab.stages import export as export_stage
 
@@ -169,7 +172,7 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
                     if data.time - last[k] > 0.1:
                         strikes.append((data.time, k))
                         xr = np.real(ctrl.fns["reset"](before))
-                        pending = (data.time + 0.003, sigma(before), sigma(xr))
+                        pending = (data.time + 0.003, sigma(before), xr)
                         loop.heel_strike(data, k)
                     last[k] = data.time
     F = np.array(feet)
@@ -184,11 +187,18 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
         a = x[np.searchsorted(tt, t0 + 0.03)]
         slip.append((a - x[0], x[-1] - a))
     slip = 1e3 * np.array(slip[1:])
-    sm, sr, sa = (np.array(c) for c in zip(*rows[1:]))
+    walker, solver = build_walker(scene), Solver.from_settings(scene.solver)
+
+    def rigid_after(xr):  # the rigid closed loop 3 ms after its impact
+        seg = integrate_step(walker, xr, solver, max_step_time=0.003)
+        return sigma(seg.sample(np.array([seg.t_end])).T[-1])
+    sm = np.array([r[0] for r in rows[1:]])
+    sr = np.array([rigid_after(r[1]) for r in rows[1:]])
+    sa = np.array([r[2] for r in rows[1:]])
     print(f"  new stance foot's travel per step: {slip[:, 0].mean():.3f} mm in its first 30 ms, "
           f"{slip[:, 1].mean():.3f} mm after (mean of {len(slip)} steps)")
-    print(f"  sigma+ / sigma-: rigid impact {np.mean(sr / sm):.4f}, MuJoCo 3 ms after the "
-          f"strike {np.mean(sa / sm):.4f} (mean of {len(sm)} strikes)")
+    print(f"  sigma 3 ms after the strike / sigma before it: the rigid impact and closed loop "
+          f"{np.mean(sr / sm):.4f}, MuJoCo {np.mean(sa / sm):.4f} (mean of {len(sm)} strikes)")
 
 
 def main() -> None:
