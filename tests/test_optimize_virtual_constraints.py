@@ -275,3 +275,60 @@ def test_rabbit_controller_walks_in_the_contact_model(rabbit_designed):
     speed = np.mean(dist[-10:]) / np.mean(np.diff(t)[-10:])
     rigid = c.step_length_m / c.full_order_step_period_s
     assert abs(speed / rigid - 1) < 0.03
+
+
+@pytest.mark.slow
+def test_rabbit_controllers_heel_strike_impulse_inside_the_friction_cone(rabbit_designed):
+    """The rigid heel strike of each written controller (scripts/hzd_heel_strike.py): its
+    impulse on the new stance foot from the generated extended impact equals the momentum
+    balance (1e-9 N s), lies inside the design's friction cone (|Lambda_t / Lambda_n| <=
+    optimize.friction_coefficient 0.6; measured 0.278, 0.383: the cone the design puts on
+    the stance force holds the strike's impulse too, unconstrained) and the trailing foot
+    lifts off (measured 0.56, 0.51 m/s).  The stance force along the written controller's
+    step stays in the cone to the transcription's error (2e-3; measured 0.446, 0.6003)."""
+    import importlib.util
+
+    from walkerlab.config import load_scene
+
+    spec = importlib.util.spec_from_file_location("hzd_heel_strike",
+                                                  ROOT / "scripts" / "hzd_heel_strike.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    d, folder, _runs = rabbit_designed
+    for c in d.controllers:
+        r = mod.rigid(load_scene(folder / c.scene_file))
+        np.testing.assert_allclose(r["impulse_momentum"], r["impulse_world"], atol=1e-9)
+        assert r["impulse_n"] > 0
+        assert abs(r["impulse_t"] / r["impulse_n"]) <= 0.6
+        assert r["trailing_normal"] > 0
+        # the stance force's cone holds on the closed loop to the transcription's error
+        # (the collocation bounds it at its points; 0.6003 measured at the 0.8 m/s step's end)
+        assert np.max(r["stance_ratio"]) <= 0.6 + 2e-3
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("i", [0, pytest.param(1, marks=pytest.mark.xfail(
+    strict=True, reason="0.8 m/s: -3.6 % in MuJoCo, its soft heel strike keeps sigma 0.724 "
+    "against the rigid 0.777 (docs/user_guide/virtual_constraints.md); open"))])
+def test_rabbit_controller_walks_in_mujoco(rabbit_designed, i, tmp_path):
+    """Each written controller's MJCF export walks in MuJoCo under the export's stepping
+    loop with the scene's feedback: >= 20 heel strikes in 21.5 rigid periods, the speed
+    after the first strike within 3 % of the rigid closed loop's (measured -1.1 % at
+    0.5 m/s; -3.6 % at 0.8 m/s, an expected failure until the MJCF's heel strike is
+    stiffer)."""
+    pytest.importorskip("mujoco")
+    from walkerlab.config import load_scene
+    from walkerlab.export.mujoco_walk import virtual_constraint_feedback, walk
+    from walkerlab.stages import export as export_stage
+
+    d, folder, _runs = rabbit_designed
+    c = d.controllers[i]
+    sc = load_scene(folder / c.scene_file)
+    out = export_stage.write(sc, tmp_path, "mjcf")
+    run = walk(out.path, 21.5 * c.full_order_step_period_s,
+               feedback=virtual_constraint_feedback(sc))
+    assert not run.fell
+    assert len(run.times_s) >= 20
+    speed = (run.positions_m[-1] - run.positions_m[1]) / (run.times_s[-1] - run.times_s[1])
+    rigid = c.step_length_m / c.full_order_step_period_s
+    assert abs(speed / rigid - 1) < 0.03
