@@ -311,12 +311,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "(optimize.design: virtual_constraints)"),
         ("virtual_constraints", "optimize"): None,  # optimize.design: virtual_constraints
         **_GROUNDS,
-        # the OpenSim stepping loop drives joint torques (its walks: the powered compass,
-        # RABBIT's laws); a walker held up by them on footholds is walked in the rigid and
-        # contact models, the MJCF and the gym, and written to Adams
-        ("footholds", "osim"): ("footholds of several heights under joint torques run in the "
-                                "rigid and contact models, the MJCF, Adams and the gym; no "
-                                "OpenSim walk has checked them yet (export --format mjcf)"),
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
