@@ -214,8 +214,9 @@ def check_osim_exportable(scene: Scene, mb) -> None:
 def osim_coordinates(mb) -> list[str]:
     """The OpenSim model's coordinates in its tree order (the order of :attr:`OsimGait.qpos`,
     the MJCF keyframe's): ``hip_x``, ``hip_y``, each link's joint (:attr:`Multibody.links`)
-    and, on a kind whose legs end in foot bodies (:attr:`walkerlab.export.parts.ExportPart.
-    ankles`), each foot's ``leg<i>_ankle`` after its leg's joint."""
+    and, on a kind whose legs end in foot bodies
+    (:attr:`walkerlab.export.parts.ExportPart.ankles`), each foot's ``leg<i>_ankle`` after
+    its leg's joint."""
     ankles = export_part(mb).ankles
     out = ["hip_x", "hip_y"]
     for ln in mb.links:

@@ -199,8 +199,9 @@ def latch_foot_offset(r_foot: float, ground_offset_m: float) -> float:
 
 def body_set(mb, feet=(), flat_feet=None) -> list[str]:
     """The ``BodySet``: the hip's point mass and each link (its centre of mass along its
-    downward axis, off-axis offset, inertia); with ``flat_feet`` (:attr:`walkerlab.export.
-    opensim.OsimGait.flat_feet`) a body ``leg<i>_sole`` per foot link in ``feet``, its mass
+    downward axis, off-axis offset, inertia); with ``flat_feet``
+    (:attr:`walkerlab.export.opensim.OsimGait.flat_feet`) a body ``leg<i>_sole`` per foot
+    link in ``feet``, its mass
     at the ankle (its frame's origin) with its inertia about the ankle, as the MJCF's
     foot bodies."""
     out = ['\t\t<BodySet name="bodyset">', "\t\t\t<objects>"]

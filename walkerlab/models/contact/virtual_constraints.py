@@ -1,6 +1,7 @@
 """Virtual constraints as feedback in the compliant-contact view: the rigid view's
-computed torque (:class:`walkerlab.models.virtual_constraints.
-VirtualConstraintController`) evaluated at the contact walker's role state.
+computed torque
+(:class:`walkerlab.models.virtual_constraints.VirtualConstraintController`) evaluated at
+the contact walker's role state.
 
 The same controller, evaluated by the same code
 -----------------------------------------------
