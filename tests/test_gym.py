@@ -408,3 +408,87 @@ def test_rough_contact_ground_ends_episodes_cleanly_for_seeds_0_to_5():
         assert ends[seed] in ("", "launch", "trip", "solver_failure"), info
         assert (ends[seed] in ("trip", "solver_failure")) == bool(info["solver_message"])
     assert "" in ends.values(), ends
+
+
+def _policy_walk(env, periods, policy):
+    obs, info = env.reset()
+    strikes = []
+    for _ in range(periods):
+        obs, _r, term, trunc, info = env.step(policy(obs))
+        strikes += info["heel_strike_times_s"]
+        if term or trunc:
+            break
+    return np.array(strikes), info
+
+
+@pytest.mark.slow
+def test_the_scene_policy_walks_the_three_link_closed_loop_as_simulate_does(tmp_path):
+    """configs/threelink_hzd.yaml (Bezier virtual constraints on the three-link walker): the
+    environment steps the walker without its controller, and ``scene_policy()`` is the
+    controller, sampled at each control period's start and held (a zero-order hold).  Each
+    of `walkerlab simulate`'s 10 heel strikes' step periods (0.45054 s) is met within one
+    control period: the hold delays the computed torque by dt / 2 on average, a first-order
+    error in dt (measured: periods 2.3-3.1 ms short at dt = 10 ms, 0.27-0.37 ms at 1 ms);
+    so at a fifth of the period the error falls at least threefold (first order: fivefold).
+    ``policy="scene"`` adds the same held torque inside the environment: a zero action then
+    walks the policy's walk (to the float32 rounding of the policy's action)."""
+    from walkerlab.gym.env import WalkerEnv
+
+    ref = np.diff(_stage_heel_strikes("simulate", "threelink_hzd", tmp_path), prepend=0.0)
+    assert ref.size == 10
+    err = {}
+    for dt in (0.01, 0.002):
+        env = WalkerEnv(str(ROOT / "configs" / "threelink_hzd.yaml"), control_period_s=dt,
+                        max_episode_steps=int(round(4.6 / dt)))
+        assert env.joints == ["stance_hip", "swing_hip"]
+        strikes, info = _policy_walk(env, env.max_episode_steps, env.scene_policy())
+        assert info["termination"] == "" and strikes.size >= ref.size, (strikes, info)
+        d = np.diff(strikes, prepend=0.0)[:ref.size] - ref
+        assert np.max(np.abs(d)) < dt, (dt, d)
+        err[dt] = np.max(np.abs(d))
+        if dt == 0.01:
+            inside = WalkerEnv(str(ROOT / "configs" / "threelink_hzd.yaml"),
+                               control_period_s=dt, max_episode_steps=460, policy="scene")
+            same, _ = _policy_walk(inside, 460, lambda o: np.zeros(2))
+            np.testing.assert_allclose(same, strikes, rtol=0.0, atol=1e-6)
+            unforced, info = _policy_walk(env, 460, lambda o: np.zeros(2))
+            assert info["termination"] == "fall"  # the plant without its controller
+    assert err[0.002] < err[0.01] / 3, err
+
+
+def test_the_scene_policy_is_refused_in_one_line_where_the_scene_has_none():
+    from walkerlab.gym.env import WalkerEnv
+
+    env = _env("paper", max_episode_steps=5)
+    with pytest.raises(ValueError) as e:
+        env.scene_policy()
+    _one_line_error(e, "scene_policy", "walker.actuation.virtual_constraints")
+    with pytest.raises(ValueError) as e:
+        WalkerEnv(str(ROOT / "configs" / "paper.yaml"), policy="scene")
+    _one_line_error(e, "policy='scene'", "walker.actuation.virtual_constraints")
+    with pytest.raises(ValueError) as e:
+        WalkerEnv(str(ROOT / "configs" / "paper.yaml"), policy="pd")
+    _one_line_error(e, "policy='pd'")
+
+
+@pytest.mark.slow
+def test_rabbit_walks_twenty_contact_steps_under_its_scene_policy_near_the_rigid_speed():
+    """configs/rabbit_hzd.yaml in the contact view, its controller as the environment's
+    policy (``policy="scene"``: the computed torque at the contact walker's role state,
+    held over each 2 ms control period): at least 20 heel strikes, the mean speed from the
+    second heel strike on within 3 % of the rigid closed loop's (0.70445 m/s)."""
+    env = _env("rabbit_hzd", view="contact", control_period_s=0.002, policy="scene",
+               max_episode_steps=6500)
+    obs, info = env.reset()
+    strikes, x_at = [], []
+    for _ in range(env.max_episode_steps):
+        obs, _r, term, trunc, info = env.step(np.zeros(env.action_space.shape))
+        if info["heel_strike"]:
+            strikes.append(info["time_s"])
+            x_at.append(info["hip_x_m"])
+        if term or trunc or len(strikes) >= 22:
+            break
+    assert len(strikes) >= 21, (strikes, info)
+    rigid = env.gait.speed
+    speed = (x_at[-1] - x_at[1]) / (strikes[-1] - strikes[1])
+    assert abs(speed / rigid - 1.0) < 0.03, (speed, rigid)

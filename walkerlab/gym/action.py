@@ -13,7 +13,10 @@ Bounds
 ``|tau_k| <= max_torque_n_m`` of the scene's actuator at that joint, when it has one;
 otherwise :data:`DEFAULT_TORQUE_FRACTION` times ``M g l`` (total mass, gravity, leg length:
 the torque that holds the whole walker's weight at a leg's length, 196 N m for the paper's
-20 kg, 1 m walker), unless the environment is given its own bounds.
+20 kg, 1 m walker), unless the environment is given its own bounds.  A feedback controller
+(``walker.actuation.virtual_constraints``) bounds each joint at its ``max_torque_n_m``, or
+without one at ``M g l`` itself (its computed torque is the policy's action, and it exceeds
+a tenth of ``M g l``: configs/threelink_hzd.yaml's gait peaks at 53 N m, 0.15 ``M g l``).
 
 In the rigid view the torques act through the generic actuators of the hybrid model
 (:class:`walkerlab.models.hybrid.actuators.Actuators`, ``M^-1 B tau`` in the flow; in a phase
@@ -37,9 +40,12 @@ __all__ = ["DEFAULT_TORQUE_FRACTION", "ActionTorques", "action_joints", "action_
 DEFAULT_TORQUE_FRACTION = 0.1
 
 
-def action_joints(scene) -> list[str]:
-    """The joints the action drives: those of ``walker.actuation.torques`` (each once, in
-    order), else ``["hip"]``."""
+def action_joints(scene, controller=None) -> list[str]:
+    """The joints the action drives: a feedback controller's (``controller.joints``, of
+    ``walker.actuation.virtual_constraints``), else those of ``walker.actuation.torques``
+    (each once, in order), else ``["hip"]``."""
+    if controller is not None:
+        return list(controller.joints)
     act = scene.walker.actuation
     joints: list[str] = []
     for t in (act.torques if act is not None else ()):
@@ -82,6 +88,11 @@ def action_limits(scene, joints: list[str], total_mass_kg: float, gravity: float
         return arr
     default = DEFAULT_TORQUE_FRACTION * total_mass_kg * gravity * leg_length_m
     act = scene.walker.actuation
+    vc = act.virtual_constraints if act is not None else None
+    if vc is not None:  # a controller's joints: its own bound, else the weight's moment
+        cap = vc.max_torque_n_m
+        return np.full(k, float(cap) if cap is not None
+                       else total_mass_kg * gravity * leg_length_m)
     out = np.full(k, default)
     for i, j in enumerate(joints):
         caps = [t.max_torque_n_m for t in (act.torques if act is not None else ())

@@ -193,16 +193,15 @@ _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively);
 #: free-jointed (:mod:`walkerlab.export.adams_actuation` says it too)
 FREE_JOINT_TORQUES = ("stance_hip, swing_hip, stance_knee and swing_knee need a free-jointed "
                       "biped (a hinged torso, on free knees or straight legs)")
-#: why a view refuses virtual constraints (the rigid model, the contact model and the MJCF's
-#: stepping loop run the computed torque; the issue's remaining views are to carry them)
+#: why a view refuses virtual constraints (the rigid model, the contact model, the MJCF's
+#: stepping loop and the Gymnasium environment - the controller as its policy - run the
+#: computed torque; the issue's remaining views are to carry them)
 _VC_VIEWS = {
     ("virtual_constraints", "adams"): ("the Adams dataset carries torque laws of the joint "
                                        "angles and the phase, not a computed torque on the "
                                        "rigid model (run contact-sim or --format mjcf)"),
     ("virtual_constraints", "osim"): ("the OpenSim stepping loop does not evaluate the "
                                       "computed torque yet (export --format mjcf runs it)"),
-    ("virtual_constraints", "gym"): ("the Gymnasium environment has no scene policy for "
-                                     "virtual constraints yet (contact-sim runs them)"),
     ("virtual_constraints", "optimize"): ("optimize does not take Bezier coefficients as "
                                           "decision variables yet: leave them out"),
 }
