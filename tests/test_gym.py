@@ -492,3 +492,31 @@ def test_rabbit_walks_twenty_contact_steps_under_its_scene_policy_near_the_rigid
     rigid = env.gait.speed
     speed = (x_at[-1] - x_at[1]) / (strikes[-1] - strikes[1])
     assert abs(speed / rigid - 1.0) < 0.03, (speed, rigid)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,periods", [("flat_feet", 500), ("flat_feet_push_off", 900)])
+def test_flat_feet_walk_the_contact_view_as_contact_sim_does(name, periods, tmp_path):
+    """Flat feet on ankle springs (configs/flat_feet.yaml, passive on a slope;
+    configs/flat_feet_push_off.yaml, an ankle push-off on level ground) in the contact view
+    under a zero action: every step period of `walkerlab contact-sim`'s heel strikes (6 and
+    11) within 0.5 % (the environment's run is the compiled BDF with a held force, the
+    command's its own integrator at the same tolerances: measured 1.6e-3 s and 1.4e-4 s
+    apart at most, 0.2 % and 0.02 %)."""
+    ref = _stage_heel_strikes("contact-sim", name, tmp_path)
+    assert ref.size >= 6
+    env = _env(name, view="contact", max_episode_steps=periods)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "" and strikes.size >= ref.size, (strikes, info)
+    got, want = np.diff(strikes[:ref.size], prepend=0.0), np.diff(ref, prepend=0.0)
+    np.testing.assert_allclose(got, want, rtol=0.005)
+
+
+def test_flat_feet_are_refused_in_the_rigid_view_naming_the_contact_view():
+    """The rigid flat-foot model's stance-foot modes each have their own mass matrix (a held
+    torque is not carried there yet): one line naming the capability and view='contact'."""
+    from walkerlab.gym.env import WalkerEnv
+
+    with pytest.raises(ValueError) as e:
+        WalkerEnv(str(ROOT / "configs" / "flat_feet.yaml"))
+    _one_line_error(e, "walkerlab.gym", "mass matrix", "view='contact'")

@@ -118,7 +118,7 @@ class ActionTorques(Actuators):
         return self.u
 
 
-def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
+def action_torques(data, n: int, joints: list[str], view: str = "rigid") -> ActionTorques:
     """:class:`ActionTorques` at ``joints`` of the walker ``data``.
 
     Parameters
@@ -127,20 +127,25 @@ def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
     n : int
         Number of generalised coordinates of the rigid walker.
     joints : list of str
+    view : {"rigid", "contact"}
+        The view whose action they are: the rigid view's actuators act through the rigid
+        model's mass matrix (the capability table's ``walk`` x ``gym`` cell is asked); the
+        contact view takes their joints' links alone (:attr:`ActionTorques.links`).
 
     Raises
     ------
     ValueError
         A joint the walker does not have (naming those it has), or a walker whose legs are
         massless (a torque there has no inertia to act on: the limit of Kuo's simplest
-        walker) or flat-footed (its stance-foot modes have mass matrices of their own), one
-        line each.
+        walker) or, in the rigid view, flat-footed (its stance-foot modes have mass
+        matrices of their own), one line each.
     """
     from walkerlab.codegen.cache import functions
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 
     st = data.structure
-    st.kind.require("walk", "gym", "walkerlab.gym")  # flat feet, a wheel: the table's
+    if view == "rigid":  # flat feet, a wheel: the table's
+        st.kind.require("walk", "gym", "walkerlab.gym")
     if st.bodies and all(b.massless for b in st.bodies):
         raise ValueError("walkerlab.gym: the legs are massless (Kuo's simplest walker): a "
                          "joint torque has no inertia to act on; give the legs mass")

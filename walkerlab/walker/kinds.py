@@ -257,7 +257,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                        "feet"),
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
-        ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
+        # the contact view carries them (walkerlab.gym.env.CONTACT_VIEW_ONLY)
+        ("walk", "gym"): (f"the rigid view does not carry flat feet yet ({_FLAT_MODES}: a "
+                          "held torque accelerates each mode differently and moves the "
+                          "guards' ground forces); view='contact' runs them"),
         ("stairs", "*"): _FLAT_LANDING,
         ("profile", "rigid"): _FLAT_LANDING,
         ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
