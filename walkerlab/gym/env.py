@@ -94,13 +94,6 @@ MAX_START_NOISE = 1.0
 #: walking state (an observation past it is clipped to it)
 OBS_BOUND = 1e6
 
-#: the walker kinds (:data:`walkerlab.walker.kinds.KINDS`) whose contact view the
-#: environment carries while the capability table's ``walk`` x ``gym`` cell refuses the rigid
-#: view (that cell's reason names ``view='contact'``): flat feet, whose contact model runs
-#: the action as a held generalised force on the hip's links as for point feet, while the
-#: rigid model's stance-foot modes each have their own mass matrix
-CONTACT_VIEW_ONLY = ("flat_feet",)
-
 #: the fixed point of each scene, found once per process (key: the scene's JSON)
 _GAITS: dict[str, Any] = {}
 
@@ -262,9 +255,7 @@ class WalkerEnv(gym.Env):
         self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)
-        kind = data.structure.kind
-        if not (view == "contact" and kind.name in CONTACT_VIEW_ONLY):
-            kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
+        data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
         vc = sc.walker.actuation.virtual_constraints if sc.walker.actuation else None
         if vc is not None:
             data.structure.kind.require("virtual_constraints", "gym",
@@ -294,7 +285,7 @@ class WalkerEnv(gym.Env):
         self.joints = action_joints(sc, self.controller)
         if view == "rigid":
             self.sim = RigidView(model, plant.solver, data, self.joints,
-                                 plant.max_step_time, ground)
+                                 plant.max_step_time, ground, plant.scene.walker.actuation)
         self._contact_controller = None
         if view == "contact":
             import dataclasses
@@ -303,7 +294,7 @@ class WalkerEnv(gym.Env):
 
             from .contact_view import ContactView
 
-            links = action_torques(data, model.n_coordinates, self.joints, view).links
+            links = action_torques(data, model.n_coordinates, self.joints).links
             n_steps = int(math.ceil(max_episode_steps * self.dt / self.gait.step_period)) + 4
             setup = contact_setup(sc)
             if vc is not None:  # the controller at the contact walker's role state, held

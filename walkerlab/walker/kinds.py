@@ -220,7 +220,6 @@ _NO_ANKLES = {
     ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
     ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
 }
-_FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
@@ -257,10 +256,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
                                        "feet"),
         ("walk", "osim"): ("flat feet are not in the OpenSim export (no foot bodies, ankle "
                            "springs or heel and toe contacts); --format mjcf carries them"),
-        # the contact view carries them (walkerlab.gym.env.CONTACT_VIEW_ONLY)
-        ("walk", "gym"): (f"the rigid view does not carry flat feet yet ({_FLAT_MODES}: a "
-                          "held torque accelerates each mode differently and moves the "
-                          "guards' ground forces); view='contact' runs them"),
         ("stairs", "*"): _FLAT_LANDING,
         ("profile", "rigid"): _FLAT_LANDING,
         ("footholds", "*"): ("footholds of several heights or slopes are built for point and "
