@@ -44,7 +44,8 @@ def test_check_env_passes_for_a_passive_and_a_pushed_walker(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,view", [("rabbit", "rigid"), ("paper", "contact"),
-                                       ("powered_compass", "contact")])
+                                       ("powered_compass", "contact"), ("flat_feet", "rigid"),
+                                       ("flat_feet", "contact"), ("threelink_hzd", "rigid")])
 def test_check_env_passes_for_a_five_link_biped_and_the_contact_view(name, view):
     _check(name, view)
 
