@@ -44,7 +44,8 @@ def test_check_env_passes_for_a_passive_and_a_pushed_walker(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,view", [("rabbit", "rigid"), ("paper", "contact"),
-                                       ("powered_compass", "contact")])
+                                       ("powered_compass", "contact"), ("flat_feet", "rigid"),
+                                       ("flat_feet", "contact"), ("threelink_hzd", "rigid")])
 def test_check_env_passes_for_a_five_link_biped_and_the_contact_view(name, view):
     _check(name, view)
 
@@ -147,8 +148,7 @@ def test_reset_from_a_given_state_and_bad_inputs_say_one_line():
         with pytest.raises(ValueError, match=msg) as exc:
             WalkerEnv(scene, **kw)
         assert "\n" not in str(exc.value)
-    with pytest.raises(ValueError, match="flat feet") as exc:
-        WalkerEnv(str(ROOT / "configs" / "flat_feet.yaml"))
+    # flat feet walk both views now (test_flat_feet_walk_the_rigid_view_as_simulate_does)
     with pytest.raises(ValueError, match="rimless wheel"):
         WalkerEnv(str(ROOT / "configs" / "rimless_wheel.yaml"))
 
@@ -408,3 +408,152 @@ def test_rough_contact_ground_ends_episodes_cleanly_for_seeds_0_to_5():
         assert ends[seed] in ("", "launch", "trip", "solver_failure"), info
         assert (ends[seed] in ("trip", "solver_failure")) == bool(info["solver_message"])
     assert "" in ends.values(), ends
+
+
+def _policy_walk(env, periods, policy):
+    obs, info = env.reset()
+    strikes = []
+    for _ in range(periods):
+        obs, _r, term, trunc, info = env.step(policy(obs))
+        strikes += info["heel_strike_times_s"]
+        if term or trunc:
+            break
+    return np.array(strikes), info
+
+
+@pytest.mark.slow
+def test_the_scene_policy_walks_the_three_link_closed_loop_as_simulate_does(tmp_path):
+    """configs/threelink_hzd.yaml (Bezier virtual constraints on the three-link walker): the
+    environment steps the walker without its controller, and ``scene_policy()`` is the
+    controller, sampled at each control period's start and held (a zero-order hold).  Each
+    of `walkerlab simulate`'s 10 heel strikes' step periods (0.45054 s) is met within one
+    control period: the hold delays the computed torque by dt / 2 on average, a first-order
+    error in dt (measured: periods 2.3-3.1 ms short at dt = 10 ms, 0.27-0.37 ms at 1 ms);
+    so at a fifth of the period the error falls at least threefold (first order: fivefold).
+    ``policy="scene"`` adds the same held torque inside the environment: a zero action then
+    walks the policy's walk (to the float32 rounding of the policy's action)."""
+    from walkerlab.gym.env import WalkerEnv
+
+    ref = np.diff(_stage_heel_strikes("simulate", "threelink_hzd", tmp_path), prepend=0.0)
+    assert ref.size == 10
+    err = {}
+    for dt in (0.01, 0.002):
+        env = WalkerEnv(str(ROOT / "configs" / "threelink_hzd.yaml"), control_period_s=dt,
+                        max_episode_steps=int(round(4.6 / dt)))
+        assert env.joints == ["stance_hip", "swing_hip"]
+        strikes, info = _policy_walk(env, env.max_episode_steps, env.scene_policy())
+        assert info["termination"] == "" and strikes.size >= ref.size, (strikes, info)
+        d = np.diff(strikes, prepend=0.0)[:ref.size] - ref
+        assert np.max(np.abs(d)) < dt, (dt, d)
+        err[dt] = np.max(np.abs(d))
+        if dt == 0.01:
+            inside = WalkerEnv(str(ROOT / "configs" / "threelink_hzd.yaml"),
+                               control_period_s=dt, max_episode_steps=460, policy="scene")
+            same, _ = _policy_walk(inside, 460, lambda o: np.zeros(2))
+            np.testing.assert_allclose(same, strikes, rtol=0.0, atol=1e-6)
+            unforced, info = _policy_walk(env, 460, lambda o: np.zeros(2))
+            assert info["termination"] == "fall"  # the plant without its controller
+    assert err[0.002] < err[0.01] / 3, err
+
+
+def test_the_scene_policy_is_refused_in_one_line_where_the_scene_has_none():
+    from walkerlab.gym.env import WalkerEnv
+
+    env = _env("paper", max_episode_steps=5)
+    with pytest.raises(ValueError) as e:
+        env.scene_policy()
+    _one_line_error(e, "scene_policy", "walker.actuation.virtual_constraints")
+    with pytest.raises(ValueError) as e:
+        WalkerEnv(str(ROOT / "configs" / "paper.yaml"), policy="scene")
+    _one_line_error(e, "policy='scene'", "walker.actuation.virtual_constraints")
+    with pytest.raises(ValueError) as e:
+        WalkerEnv(str(ROOT / "configs" / "paper.yaml"), policy="pd")
+    _one_line_error(e, "policy='pd'")
+
+
+@pytest.mark.slow
+def test_rabbit_walks_twenty_contact_steps_under_its_scene_policy_near_the_rigid_speed():
+    """configs/rabbit_hzd.yaml in the contact view, its controller as the environment's
+    policy (``policy="scene"``: the computed torque at the contact walker's role state,
+    held over each 2 ms control period): at least 20 heel strikes, the mean speed from the
+    second heel strike on within 3 % of the rigid closed loop's (0.70445 m/s)."""
+    env = _env("rabbit_hzd", view="contact", control_period_s=0.002, policy="scene",
+               max_episode_steps=6500)
+    obs, info = env.reset()
+    strikes, x_at = [], []
+    for _ in range(env.max_episode_steps):
+        obs, _r, term, trunc, info = env.step(np.zeros(env.action_space.shape))
+        if info["heel_strike"]:
+            strikes.append(info["time_s"])
+            x_at.append(info["hip_x_m"])
+        if term or trunc or len(strikes) >= 22:
+            break
+    assert len(strikes) >= 21, (strikes, info)
+    rigid = env.gait.speed
+    speed = (x_at[-1] - x_at[1]) / (strikes[-1] - strikes[1])
+    assert abs(speed / rigid - 1.0) < 0.03, (speed, rigid)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,periods", [("flat_feet", 500), ("flat_feet_push_off", 900),
+                                          ("flat_feet_foot_mass", 1100)])
+def test_flat_feet_walk_the_contact_view_as_contact_sim_does(name, periods, tmp_path):
+    """Flat feet on ankle springs (configs/flat_feet.yaml, passive on a slope;
+    configs/flat_feet_push_off.yaml, an ankle push-off on level ground;
+    configs/flat_feet_foot_mass.yaml, 0.1 kg feet, started as contact-sim starts it on the
+    contact model's own periodic gait, ``contact_sim.start: periodic_gait``: a search of
+    ~40 s CPU, twice here) in the contact view under a zero action: every step period of
+    `walkerlab contact-sim`'s heel strikes (6, 11 and 11) within 0.5 % (the environment's
+    run is the compiled BDF with a held force, the command's its own integrator at the same
+    tolerances: measured 1.6e-3 s, 1.4e-4 s and 2.2e-4 s apart at most, 0.2 %, 0.02 % and
+    0.03 %; before the periodic start, the last scene's episode tripped at a patch's edge
+    after 6 heel strikes)."""
+    ref = _stage_heel_strikes("contact-sim", name, tmp_path)
+    assert ref.size >= 6
+    env = _env(name, view="contact", max_episode_steps=periods)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "" and strikes.size >= ref.size, (strikes, info)
+    got, want = np.diff(strikes[:ref.size], prepend=0.0), np.diff(ref, prepend=0.0)
+    np.testing.assert_allclose(got, want, rtol=0.005)
+
+
+@pytest.mark.parametrize("name,periods", [("flat_feet", 820), ("flat_feet_push_off", 780)])
+def test_flat_feet_walk_the_rigid_view_as_simulate_does(name, periods, tmp_path):
+    """Flat feet in the rigid view (the stance foot's heel, flat and toe modes, the double
+    support) under a zero action: `walkerlab simulate`'s 10 heel strikes at the same times
+    to 1e-9 s (the same integrator and phases; measured 1.5e-12 s).  A vanishing action
+    (1e-12 of the bound) walks through the action's twin walker (each mode's own mass
+    matrix, Python flows instead of the compiled ones): the first two heel strikes the
+    same to 1e-9 s (measured 2.5e-12 s), so the twin's modes, guards and resets are the
+    scene's (before: flat feet refused in the environment)."""
+    ref = _stage_heel_strikes("simulate", name, tmp_path)
+    assert ref.size == 10
+    env = _env(name, max_episode_steps=periods)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "" and strikes.size == ref.size, (strikes, info)
+    np.testing.assert_allclose(strikes, ref, rtol=0.0, atol=1e-9)
+    env.max_episode_steps = int(ref[1] / env.dt) + 2
+    tiny, info = _walk(env, env.max_episode_steps,
+                       action=lambda e: np.full(e.action_space.shape, 1e-12))[::2]
+    assert tiny.size == 2 and not info["termination"], (tiny, info)
+    np.testing.assert_allclose(tiny, ref[:2], rtol=0.0, atol=1e-9)
+
+
+def test_a_held_hip_torque_slows_the_flat_feet_step_alike_in_the_rigid_and_contact_views():
+    """configs/flat_feet.yaml with a held hip torque (0.02 of the bound: 0.39 N m): the
+    first step's period grows by the same amount in the rigid view (the twin's mode mass
+    matrices, M_mode^-1 B u) and in the contact view (the torque a generalised force on the
+    floating model's legs; no code shared with the rigid modes): measured +9.98 ms and
+    +9.86 ms (the zero-action periods differ by 4.5 ms, the foot's compliance); within 10 %."""
+    change = {}
+    for view in ("rigid", "contact"):
+        env = _env("flat_feet", view=view, max_episode_steps=120)
+        first = []
+        for a in (0.0, 0.02):
+            strikes, _, info = _walk(env, 120, action=lambda e, a=a: np.full(
+                e.action_space.shape, a))
+            assert strikes.size >= 1, info
+            first.append(strikes[0])
+        change[view] = first[1] - first[0]
+    assert change["rigid"] > 0.005, change
+    assert abs(change["contact"] / change["rigid"] - 1.0) < 0.1, change

@@ -285,10 +285,11 @@ def test_torques_beside_virtual_constraints_refused():
 
 
 def test_views_without_the_controller_refuse_it(tmp_path):
-    """The Adams and OpenSim exports and the gym do not carry the controller yet: each
+    """The Adams and OpenSim exports do not carry the controller yet: each
     refuses it in one line naming the field (the capability table's cell); the contact
     model and the MJCF take it (tests/test_virtual_constraint_views.py walks them), and
-    optimize designs it (tests/test_optimize_virtual_constraints.py)."""
+    optimize designs it (tests/test_optimize_virtual_constraints.py), the gym runs it as its
+    baseline policy (tests/test_gym.py)."""
     from walkerlab.export.scene import check_exportable
     from walkerlab.models.contact.scene import contact_setup
     from walkerlab.walker.kinds import KINDS, KindRefused
@@ -305,10 +306,11 @@ def test_views_without_the_controller_refuse_it(tmp_path):
     with pytest.raises(KindRefused) as e:  # the Adams writer's own path asks the table too
         export.run(scene, tmp_path, "adm")
     assert one_line(e).startswith("walker.actuation.virtual_constraints: ")
-    for view in ("gym", "adams", "osim"):
+    for view in ("adams", "osim"):
         assert not KINDS["free_joints"].supports("virtual_constraints", view)
         assert not KINDS["hinged_torso"].supports("virtual_constraints", view)
-    for view in ("rigid", "contact", "mjcf", "optimize"):  # optimize: design by collocation
+    # optimize: design by collocation; gym: the scene's controller as its baseline policy
+    for view in ("rigid", "contact", "mjcf", "optimize", "gym"):
         assert KINDS["free_joints"].supports("virtual_constraints", view)
     assert KINDS["hinged_torso"].supports("virtual_constraints", "optimize")
     assert not KINDS["straight_legs"].supports("virtual_constraints", "optimize")

@@ -13,7 +13,10 @@ Bounds
 ``|tau_k| <= max_torque_n_m`` of the scene's actuator at that joint, when it has one;
 otherwise :data:`DEFAULT_TORQUE_FRACTION` times ``M g l`` (total mass, gravity, leg length:
 the torque that holds the whole walker's weight at a leg's length, 196 N m for the paper's
-20 kg, 1 m walker), unless the environment is given its own bounds.
+20 kg, 1 m walker), unless the environment is given its own bounds.  A feedback controller
+(``walker.actuation.virtual_constraints``) bounds each joint at its ``max_torque_n_m``, or
+without one at ``M g l`` itself (its computed torque is the policy's action, and it exceeds
+a tenth of ``M g l``: configs/threelink_hzd.yaml's gait peaks at 53 N m, 0.15 ``M g l``).
 
 In the rigid view the torques act through the generic actuators of the hybrid model
 (:class:`walkerlab.models.hybrid.actuators.Actuators`, ``M^-1 B tau`` in the flow; in a phase
@@ -37,9 +40,12 @@ __all__ = ["DEFAULT_TORQUE_FRACTION", "ActionTorques", "action_joints", "action_
 DEFAULT_TORQUE_FRACTION = 0.1
 
 
-def action_joints(scene) -> list[str]:
-    """The joints the action drives: those of ``walker.actuation.torques`` (each once, in
-    order), else ``["hip"]``."""
+def action_joints(scene, controller=None) -> list[str]:
+    """The joints the action drives: a feedback controller's (``controller.joints``, of
+    ``walker.actuation.virtual_constraints``), else those of ``walker.actuation.torques``
+    (each once, in order), else ``["hip"]``."""
+    if controller is not None:
+        return list(controller.joints)
     act = scene.walker.actuation
     joints: list[str] = []
     for t in (act.torques if act is not None else ()):
@@ -82,6 +88,11 @@ def action_limits(scene, joints: list[str], total_mass_kg: float, gravity: float
         return arr
     default = DEFAULT_TORQUE_FRACTION * total_mass_kg * gravity * leg_length_m
     act = scene.walker.actuation
+    vc = act.virtual_constraints if act is not None else None
+    if vc is not None:  # a controller's joints: its own bound, else the weight's moment
+        cap = vc.max_torque_n_m
+        return np.full(k, float(cap) if cap is not None
+                       else total_mass_kg * gravity * leg_length_m)
     out = np.full(k, default)
     for i, j in enumerate(joints):
         caps = [t.max_torque_n_m for t in (act.torques if act is not None else ())
@@ -96,15 +107,66 @@ class ActionTorques(Actuators):
     """The generic joint actuators of a rigid walker whose torques are the action's
     (:attr:`u`, (k,) [N m], set before each control period) instead of laws: the flow gains
     :meth:`~walkerlab.models.hybrid.actuators.Actuators.added_acceleration` ``M^-1 B u``,
-    their power is :meth:`~walkerlab.models.hybrid.actuators.Actuators.power`."""
+    their power is :meth:`~walkerlab.models.hybrid.actuators.Actuators.power`.
+
+    ``first``: the spec's torques before this index are the scene's own laws, acting as
+    they are; the action's ``u`` drives the rest (0: the action alone)."""
+
+    first: int = 0
 
     def __post_init__(self):
         super().__post_init__()
-        self.u = np.zeros(len(self.spec.torques))
+        self.u = np.zeros(len(self.spec.torques) - self.first)
 
     def torques(self, t, x) -> np.ndarray:
-        """The action's torques (k,) [N m] (whatever the state)."""
-        return self.u
+        """The scene's laws' torques (the first :attr:`first`), then the action's (k,)
+        [N m] (whatever the state)."""
+        if not self.first:
+            return self.u
+        out = np.array(super().torques(t, x))
+        return np.concatenate([out[:self.first], out[self.first:] + self.u])
+
+
+def flat_action_walker(walker, data, joints: list[str], actuation):
+    """The flat-footed rigid walker of one step with the action's torques at ``joints``
+    acting in every stance-foot mode (:func:`walkerlab.models.hybrid.mode_torques.
+    actuate_flat_hips`: each mode's own mass matrix, the foot-flat lock, the guards' ground
+    forces and the double support carrying them), besides the scene's own torque laws and
+    ankle push-off (its heel-off numbers).  Its guards are the walker's, in the same order:
+    the heel strike's reset (a push-off impulse's) is read from the scene's walker
+    (:class:`walkerlab.gym.rigid_view.RigidView`).
+
+    Parameters
+    ----------
+    walker : walkerlab.models.hybrid.HybridWalker
+        The scene's walker of that step (its name, variant and double support kept).
+    data : walkerlab.walker.description.WalkerData
+        That step's walker data (without ``mirror_params``).
+    joints : list of str
+    actuation : walkerlab.config.actuation.Actuation or None
+        The scene's.
+
+    Returns
+    -------
+    (HybridWalker, ActionTorques)
+        The walker and its actuators (set :attr:`ActionTorques.u` before each period).
+    """
+    from dataclasses import replace
+
+    from walkerlab.codegen.cache import functions
+    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    from walkerlab.models.hybrid.ankle_push_off import heel_off_data
+    from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
+
+    own = list(actuation.torques) if actuation is not None else []
+    spec = Actuation(torques=own + [JointTorque(joint=j, law=TorqueLaw()) for j in joints])
+    off = (heel_off_data(data, actuation) if actuation is not None
+           and actuation.ankle_push_off is not None else None)
+    acts = ActionTorques(spec, functions(data), len(walker.roles), False,
+                         float(walker.total_mass_kg), torso_mean=bool(data.structure.torso),
+                         first=len(own))
+    twin = actuate_flat_hips(replace(walker, mirror=None), data, spec, off, actuators=acts)
+    return twin, acts
 
 
 def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
@@ -120,16 +182,17 @@ def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
     Raises
     ------
     ValueError
-        A joint the walker does not have (naming those it has), or a walker whose legs are
+        A joint the walker does not have (naming those it has), a walker whose legs are
         massless (a torque there has no inertia to act on: the limit of Kuo's simplest
-        walker) or flat-footed (its stance-foot modes have mass matrices of their own), one
-        line each.
+        walker) or one the capability table's ``walk`` x ``gym`` cell refuses (a rimless
+        wheel), one line each.  (Flat feet: these actuators' generic ``M^-1 B u`` is not
+        their modes'; the rigid view drives them through :func:`flat_action_walker`.)
     """
     from walkerlab.codegen.cache import functions
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 
     st = data.structure
-    st.kind.require("walk", "gym", "walkerlab.gym")  # flat feet, a wheel: the table's
+    st.kind.require("walk", "gym", "walkerlab.gym")  # a wheel: the table's
     if st.bodies and all(b.massless for b in st.bodies):
         raise ValueError("walkerlab.gym: the legs are massless (Kuo's simplest walker): a "
                          "joint torque has no inertia to act on; give the legs mass")

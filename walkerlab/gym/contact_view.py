@@ -4,8 +4,10 @@ terrain) advanced one control period at a time.
 
 The walker, its terrain's patches and its start are those of ``walkerlab contact-sim``
 (:func:`walkerlab.analysis.contact.sim.scene_start`: the stance foot at its static
-penetration, the rigid gait's rates times ``contact_sim.initial_rate_scale``), the patches
-laid out for the episode's longest walk.  Each control period is the contact view's one
+penetration, the rigid gait's rates times ``contact_sim.initial_rate_scale``; with
+``contact_sim.start: periodic_gait`` the contact model's own periodic gait at its mid-stance
+section, on patches spaced by its step length, found once per scene and process), the
+patches laid out for the episode's longest walk.  Each control period is the contact view's one
 powered run (:class:`walkerlab.integrate.contact_powered.ActuationHook`, advanced to the
 period's end: :meth:`~walkerlab.integrate.contact_powered.ActuationHook.run_until`) on its
 compiled segments (:class:`walkerlab.integrate.compiled_segments.CompiledSegments`, CyRK's
@@ -75,6 +77,35 @@ _LEDGER = {"action_work_positive": ("action_positive",),
            "push_off_work": ("push_off",)}
 
 
+#: the contact model's own periodic gait of each scene with ``contact_sim.start:
+#: periodic_gait``, found once per process (key: the scene's JSON)
+_PERIODIC: dict = {}
+
+
+def _periodic_gait(setup, probe, x_gait):
+    """The contact walker's own periodic gait (:func:`walkerlab.analysis.contact.periodic.
+    find_contact_periodic_gait` from the rigid gait ``x_gait``, within ``contact_sim.
+    periodic_time_limit_s``), as ``contact-sim`` starts from it
+    (:func:`walkerlab.analysis.contact.periodic.simulate_from_periodic_gait`): the run
+    starts at its mid-stance section, on patches spaced by its step length.
+
+    Raises
+    ------
+    walkerlab.analysis.contact.periodic.PeriodicGaitError
+        No periodic gait found (one line).
+    """
+    from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
+
+    key = setup.scene.model_dump_json() if setup.scene is not None else None
+    if key is None or key not in _PERIODIC:
+        gait = converged_gait(find_contact_periodic_gait(
+            probe, x_gait, time_limit_s=setup.sim.periodic_time_limit_s))
+        if key is None:
+            return gait
+        _PERIODIC[key] = gait
+    return _PERIODIC[key]
+
+
 def _link_coordinate(link: str, leg: dict, names: tuple) -> int:
     """Index of a rigid role link (``stance``, ``swing_thigh``, ``torso``, ...) among the
     floating coordinates ``names`` with ``leg`` = ``{"stance": legX, "swing": legY}``."""
@@ -137,6 +168,11 @@ class ContactView:
 
         walker, x0, limits, step_length = scene_start(self._setup, self._x_gait,
                                                       n_steps // 2 + 1)
+        if self._setup.sim.start == "periodic_gait":  # contact-sim's start: the contact
+            gait = _periodic_gait(self._setup, walker, self._x_gait)  # model's own gait,
+            walker, step_length = self._setup.build(  # its patches at the gait's steps
+                self._x_gait, 2 * (n_steps // 2 + 1), step_length_m=gait.step_length_m)
+            x0 = np.asarray(gait.full_state, float)
         self._laid = n_steps
         self._at_rigid = walker  # the patches at the rigid gait's footfalls
         self._use(self._own_footfalls(walker))

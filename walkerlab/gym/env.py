@@ -10,6 +10,12 @@ float32)``, the torque as a fraction of its bound ``tau = a * tau_max``
 gears), or with ``normalize_action=False`` ``Box(-tau_max, tau_max)`` in N m.  An all-zero
 action is the scene as written (passive, or its own torque laws and push-off).
 
+A scene whose actuation is a feedback controller (``walker.actuation.virtual_constraints``)
+is stepped without it: the action drives the controller's joints (bounded by its
+``max_torque_n_m``, else ``M g l``) and :meth:`WalkerEnv.scene_policy` is the controller as a
+policy (``obs -> action``, sampled at each control period's start and held);
+``policy="scene"`` adds that held torque to every action (a zero action: the closed loop).
+
 Observation: ``Box((2n + 3,), float64)`` (entries within +-:data:`OBS_BOUND`), by name
 :attr:`WalkerEnv.observation_names`:
 the walker's state (:attr:`WalkerEnv.state_names`: the rigid walker's role-ordered angles
@@ -129,6 +135,14 @@ def _rigid_ground(scene):
         raise ValueError(f"walkerlab.gym: {exc}") from None
 
 
+def _plant(scene):
+    """``scene`` without its feedback controller (``walker.actuation: None``): the walker
+    the environment steps when the controller is the policy (:meth:`WalkerEnv.
+    scene_policy`)."""
+    return scene.model_copy(update={"walker": scene.walker.model_copy(
+        update={"actuation": None})})
+
+
 class InvalidAction(ValueError, gym.error.InvalidAction):
     """An action that is not the environment's ``k`` finite real torques of shape ``(k,)``
     (a ``ValueError`` and gymnasium's ``InvalidAction``)."""
@@ -190,6 +204,10 @@ class WalkerEnv(gym.Env):
     normalize_action : bool
         Actions in [-1, 1] (fractions of :attr:`tau_max`; default) or in N m.
     render_mode : {None, "rgb_array"}
+    policy : {None, "scene"}
+        ``"scene"``: the scene's feedback controller (virtual constraints) acts with every
+        action, its torque sampled at the control period's start and held
+        (:meth:`scene_policy`); None: the action alone drives the controller's joints.
 
     Attributes
     ----------
@@ -207,8 +225,9 @@ class WalkerEnv(gym.Env):
     walkerlab.config.SceneError
         A scene that does not load or validate (one line).
     ValueError
-        A bad view, control period, episode length or bound, or a walker the action cannot
-        drive (flat feet, massless legs, a joint-less rimless wheel), one line each.
+        A bad view, control period, episode length, bound or policy (``"scene"`` without
+        virtual constraints), or a walker the action cannot drive (massless legs, a
+        joint-less rimless wheel), one line each.
     walkerlab.analysis.gait.search.GaitNotFound
         The scene has no gait to start from.
     """
@@ -220,7 +239,8 @@ class WalkerEnv(gym.Env):
                  forward_reward_weight: float = 1.0, healthy_reward: float = 1.0,
                  ctrl_cost_weight: float = 1e-3, work_cost_weight: float = 0.0,
                  reward_fn=None, start_noise: float = 0.0, terrain_roughness_m: float = 0.0,
-                 normalize_action: bool = True, render_mode: str | None = None):
+                 normalize_action: bool = True, render_mode: str | None = None,
+                 policy: str | None = None):
         from walkerlab.api.walker import Walker
         from walkerlab.walker.description import walker_data
 
@@ -229,13 +249,22 @@ class WalkerEnv(gym.Env):
 
         _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
                          terrain_roughness_m)
+        if policy not in (None, "scene"):
+            raise ValueError(f"policy={policy!r}: give None or 'scene' (the scene's feedback "
+                             "controller acting with the action)")
         self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
-        if sc.walker.actuation is not None and sc.walker.actuation.virtual_constraints:
+        vc = sc.walker.actuation.virtual_constraints if sc.walker.actuation else None
+        if vc is not None:
             data.structure.kind.require("virtual_constraints", "gym",
                                         "walker.actuation.virtual_constraints")
+        elif policy == "scene":
+            raise ValueError("policy='scene': the scene has no feedback controller "
+                             "(walker.actuation.virtual_constraints) to act as the policy; "
+                             "its torque laws act in the walker with policy=None")
+        self.policy = policy
         ground = _rigid_ground(sc) if view == "rigid" else None
         self.scene, self.view = sc, view
         self.dt = float(control_period_s)
@@ -247,19 +276,31 @@ class WalkerEnv(gym.Env):
         self.reward_fn = reward_fn
         self.start_noise = float(start_noise)
         self.terrain_roughness_m = float(terrain_roughness_m)
-        model = self.rigid.model
-        self.joints = action_joints(sc)
         self.gait = _gait(self.rigid)
-        self.sim = RigidView(model, self.rigid.solver, data, self.joints,
-                             self.rigid.max_step_time, ground)
+        #: the scene's feedback controller (virtual constraints; None: the scene has none):
+        #: out of the walker's flow, the policy (:meth:`scene_policy`)
+        self.controller = self.rigid.model.actuators.controller if vc is not None else None
+        plant = self.rigid if vc is None else Walker.from_scene(_plant(sc))
+        model = plant.model
+        self.joints = action_joints(sc, self.controller)
+        if view == "rigid":
+            self.sim = RigidView(model, plant.solver, data, self.joints,
+                                 plant.max_step_time, ground, plant.scene.walker.actuation)
+        self._contact_controller = None
         if view == "contact":
+            import dataclasses
+
             from walkerlab.models.contact.scene import contact_setup
 
             from .contact_view import ContactView
 
             links = action_torques(data, model.n_coordinates, self.joints).links
             n_steps = int(math.ceil(max_episode_steps * self.dt / self.gait.step_period)) + 4
-            self.sim = ContactView(contact_setup(sc), links, self.gait.x, n_steps)
+            setup = contact_setup(sc)
+            if vc is not None:  # the controller at the contact walker's role state, held
+                self._contact_controller = setup.actuators  # by the action (the plant's
+                setup = dataclasses.replace(setup, actuators=None)  # run stays compiled)
+            self.sim = ContactView(setup, links, self.gait.x, n_steps)
         p = model.params
         self.tau_max = action_limits(sc, self.joints, float(model.total_mass_kg),
                                      float(p["gravity_m_per_s2"]), float(p["leg_length_m"]),
@@ -280,6 +321,58 @@ class WalkerEnv(gym.Env):
         self.terrain_seed = 0
         self._elapsed = 0
         self._has_reset = False
+
+    # ------------------------------------------------------------------ scene policy
+    def _controller_torques(self, x, stance_is_leg1: bool) -> np.ndarray:
+        """The scene's feedback controller's torques (k,) [N m] at the view's state ``x``
+        (the rigid role state, or the contact view's floating state with leg1 in stance or
+        not), saturated at its ``max_torque_n_m``."""
+        x = np.asarray(x, dtype=float)
+        if self.view == "rigid":
+            return np.real(np.asarray(self.controller.torques(x), dtype=float))
+        return np.asarray(self._contact_controller.torques(x, 0 if stance_is_leg1 else 1),
+                          dtype=float)
+
+    def scene_policy(self):
+        """The scene's feedback controller as a policy: a callable ``observation ->
+        action``.
+
+        The controller is the computed torque of the scene's virtual constraints
+        (:class:`walkerlab.models.virtual_constraints.VirtualConstraintController`:
+        ``u = (L_g L_f h)^-1 (-L_f^2 h - kp y - kd y')``, Westervelt, Grizzle & Koditschek
+        2003, Sec. IV), at the observed state: the rigid view's role state, or the contact
+        view's floating state read at its stance leg (``stance_is_leg1``) as the rigid
+        walker's role state (:class:`walkerlab.models.contact.virtual_constraints.
+        VirtualConstraintJointTorques`).  The environment holds an action over its control
+        period, so the policy's torque is sampled at the period's start and held (a
+        zero-order hold); ``policy="scene"`` adds the same held torque to every action
+        inside the environment.
+
+        Returns
+        -------
+        callable
+            ``obs (2n + 3,) or (N + 3,) -> action (k,)`` float32, in the action space
+            (fractions of :attr:`tau_max`, or N m with ``normalize_action=False``), clipped
+            to its bounds.
+
+        Raises
+        ------
+        ValueError
+            The scene has no feedback controller (no ``walker.actuation.
+            virtual_constraints``), one line.
+        """
+        if self.controller is None:
+            raise ValueError("scene_policy: the scene has no feedback controller "
+                             "(walker.actuation.virtual_constraints); its torque laws act "
+                             "in the walker under any action")
+        m = len(self.state_names)
+
+        def policy(obs):
+            obs = np.asarray(obs, dtype=float)
+            u = np.clip(self._controller_torques(obs[:m], obs[m] > 0.5), -self.tau_max,
+                        self.tau_max)
+            return (u / self.tau_max if self.normalize_action else u).astype(np.float32)
+        return policy
 
     # ------------------------------------------------------------------ gymnasium API
     def _obs(self) -> np.ndarray:
@@ -395,8 +488,11 @@ class WalkerEnv(gym.Env):
         a = self._action(action)
         if self.normalize_action:
             a = a * self.tau_max
-        u = np.clip(a, -self.tau_max, self.tau_max)
         s = self.sim
+        if self.policy == "scene":  # the controller's torque at the period's start, held
+            leg1 = (s.leg == "leg1") if self.view == "rigid" else (s.stance == 0)
+            a = a + self._controller_torques(s.x, leg1)
+        u = np.clip(a, -self.tau_max, self.tau_max)
         x_before = s.hip_x()
         w_before = s.ledger["action_work_positive"]
         self._elapsed += 1

@@ -33,14 +33,24 @@ the heel strike's collision, <= 0).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from walkerlab.integrate.rigid import MIN_STEP_TIME_S, walker_of_step
 from walkerlab.integrate.rigid_phase import integrate_phase
 
-from .action import action_torques
+from .action import action_torques, flat_action_walker
 
-__all__ = ["LEDGER_TERMS", "RigidView"]
+__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
+
+#: the walker kinds (:data:`walkerlab.walker.kinds.KINDS`) whose phases each have a mass
+#: matrix of their own (a flat foot's stance modes: heel or toe pinned, the foot locked
+#: flat): the action acts through a twin of each step's walker, built by the kind's entry
+#: ``(walker, data, joints, actuation) -> (walker, ActionTorques)``, whose phases are the
+#: walker's with ``M_mode^-1 B u`` in each flow and in its guards' ground forces; the other
+#: kinds' flows gain the generic ``M^-1 B u``
+MODE_TWINS = {"flat_feet": flat_action_walker}
 
 #: the ledger's terms (:mod:`walkerlab.gym.rigid_view` docstring) [J]
 LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_work",
@@ -73,7 +83,8 @@ class RigidView:
         A walker the action cannot drive (:func:`walkerlab.gym.action.action_torques`).
     """
 
-    def __init__(self, model, solver, data, joints, max_step_time: float, ground=None):
+    def __init__(self, model, solver, data, joints, max_step_time: float, ground=None,
+                 actuation=None):
         self.model = model
         self.ground = ground
         self.solver = solver
@@ -90,6 +101,26 @@ class RigidView:
             self.acts[model.legs[0]] = action_torques(data.mirror, n, joints)
         self.max_step_time = float(max_step_time)
         self.state_names = list(model.state_names())
+        # a kind whose phases have their own mass matrices: each step's walker's twin with
+        # the action in its modes (MODE_TWINS), built on first use
+        self._twin_of = MODE_TWINS.get(data.structure.kind.name)
+        self._twins: dict = {}
+        self._data, self._joints, self._actuation = data, list(joints), actuation
+        if self._twin_of is not None:  # the first step's now (a bad walker says so here)
+            self._twins[id(model)] = self._twin_of(model, replace(data, mirror_params=None),
+                                                   self._joints, actuation)
+
+    def _twin(self, w):
+        """``(walker, actuators)``: the twin of the step's walker ``w`` with the action in
+        its modes (:data:`MODE_TWINS`), its actuators' clock at the step's start."""
+        key = id(w)
+        if key not in self._twins:
+            d = self._data if w is self.model else self._data.mirror
+            self._twins[key] = self._twin_of(w, replace(d, mirror_params=None),
+                                             self._joints, self._actuation)
+        tw, tacts = self._twins[key]
+        tacts.t_origin = self.t_step
+        return tw, tacts
 
     # ------------------------------------------------------------------ state
     def reset(self, x0: np.ndarray) -> None:
@@ -131,6 +162,10 @@ class RigidView:
         if w.actuators is not None:
             w.actuators.begin_step(self.t)
         self.k = 0
+        u = self._period[0]
+        if self._twin_of is not None and np.any(u):  # the trailing toe's force with the
+            w, acts = self._twin(w)                   # action's torque in it
+            acts.u = np.asarray(u, dtype=float)
         if w.step_entry is not None:
             x_new, name = w.step_entry(self.x)
             self.x = np.asarray(x_new, float)
@@ -231,7 +266,13 @@ class RigidView:
             if self.ended:
                 break
             t_stop = min(t_end, self.t_step + self.max_step_time)
-            rhs = self._flow(phase, acts, act_on)
+            if self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
+                tw, tacts = self._twin(w)
+                tacts.u = acts.u
+                phase = tw.phases[self.k]
+                rhs = phase.flow
+            else:
+                rhs = self._flow(phase, acts, act_on)
             jac = phase.jacobian if phase.jacobian is not None else w.variational
             run = integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n, self.solver,
                                   self.backend, rhs, jac, False)
@@ -244,7 +285,9 @@ class RigidView:
                 if self.t >= self.t_step + self.max_step_time:
                     self.ended = "stall"
                 continue
-            guard = phase.guards[run.event]
+            # the walker's own guard (a twin's are the same, in order; the heel strike's
+            # reset, a push-off's, is the scene walker's)
+            guard = w.phases[self.k].guards[run.event]
             if guard.outcome == "fall":
                 self.ended = "fall"
             elif guard.outcome == "next_phase":

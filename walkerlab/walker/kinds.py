@@ -196,16 +196,15 @@ _OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively);
 #: free-jointed (:mod:`walkerlab.export.adams_actuation` says it too)
 FREE_JOINT_TORQUES = ("stance_hip, swing_hip, stance_knee and swing_knee need a free-jointed "
                       "biped (a hinged torso, on free knees or straight legs)")
-#: why a view refuses virtual constraints (the rigid model, the contact model and the MJCF's
-#: stepping loop run the computed torque; the issue's remaining views are to carry them)
+#: why a view refuses virtual constraints (the rigid model, the contact model, the MJCF's
+#: stepping loop and the Gymnasium environment - the controller as its policy - run the
+#: computed torque; the issue's remaining views are to carry them)
 _VC_VIEWS = {
     ("virtual_constraints", "adams"): ("the Adams dataset carries torque laws of the joint "
                                        "angles and the phase, not a computed torque on the "
                                        "rigid model (run contact-sim or --format mjcf)"),
     ("virtual_constraints", "osim"): ("the OpenSim stepping loop does not evaluate the "
                                       "computed torque yet (export --format mjcf runs it)"),
-    ("virtual_constraints", "gym"): ("the Gymnasium environment has no scene policy for "
-                                     "virtual constraints yet (contact-sim runs them)"),
 }
 #: what the views of every legged kind refuse: a profile in the OpenSim model (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -220,7 +219,6 @@ _NO_ANKLES = {
     ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
     ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
 }
-_FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
@@ -275,14 +273,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
-        ("walk", "gym"): f"flat feet are not carried yet ({_FLAT_MODES}); use point or arc feet",
         # the rigid view lands its heel strike on stairs and footholds of several heights
-        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat)
-        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
+        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's views do
+        # not step flat feet on them yet
+        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize", "osim", "gym")},
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
-        ("profile", "rigid"): _FLAT_PROFILE,
-        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
-        ("profile", "adams"): _FLAT_PROFILE,
+        **{("profile", v): _FLAT_PROFILE for v in ("rigid", "adams", "gym")},
+        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim", "gym")},
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "

@@ -57,7 +57,8 @@ def mode_mass_matrix(kinetic, x) -> np.ndarray:
     return M
 
 
-def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> HybridWalker:
+def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None,
+                      actuators=None) -> HybridWalker:
     """The flat-footed walker with its joint torques (module docstring).
 
     The double support is kept when ``walker`` has it (its ``step_entry``; a walker made
@@ -66,6 +67,11 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
     ``heel_off``: the walker's data with the heel-off mode's ankle numbers of an ankle
     push-off acting as well (:func:`walkerlab.models.hybrid.ankle_push_off.heel_off_data`;
     then ``data`` is one step's, without ``mirror_params``), or None.
+
+    ``actuators``: the :class:`~walkerlab.models.hybrid.actuators.Actuators` of ``spec``
+    to act (a subclass whose torques are set from outside: the Gymnasium environment's
+    action, :class:`walkerlab.gym.action.ActionTorques`), or None: built from ``spec``.
+    Given, it acts on this step's walker only (``walker.mirror`` is dropped).
 
     Raises
     ------
@@ -83,8 +89,8 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
                              "walkers whose legs are massless (flat feet need massive legs)")
     f = functions(data)
     n = len(walker.roles)
-    acts = Actuators(spec, f, n, False, float(walker.total_mass_kg),
-                     torso_mean=bool(data.structure.torso))
+    acts = actuators if actuators is not None else Actuators(
+        spec, f, n, False, float(walker.total_mass_kg), torso_mean=bool(data.structure.torso))
 
     def flow_of(mode, flow, jac):
         kinetic = f[f"energies_{PIN[mode]}"]
@@ -110,7 +116,7 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
                          step_clock=lambda: acts.t_origin,
                          double_support=walker.step_entry is not None,
                          landing_m=walker.params.get("landing_drop_m", 0.0))
-    mirror = walker.mirror
+    mirror = walker.mirror if actuators is None else None
     if mirror is not None:  # legs that differ: the next step's walker, its own numbers
         mirror = actuate_flat_hips(mirror, data.mirror, spec)
     return replace(w, actuators=acts, mirror=mirror)
