@@ -11,7 +11,7 @@ import yaml
 from cli_run import ROOT
 
 from walkerlab.config import scene_from_dict
-from walkerlab.walker.kinds import KINDS, SEVERAL_FOOTHOLDS
+from walkerlab.walker.kinds import KINDS
 
 #: the two heights [m] of the landings above the stance foot's level (up, then down)
 HEIGHTS = (0.001, -0.001)
@@ -29,7 +29,11 @@ def test_the_torso_walkers_take_footholds_where_the_ground_is_laid_at_their_foot
     for kind in ("hinged_torso", "free_joints"):
         for view in ("rigid", "contact", "mjcf", "adams", "gym"):
             assert KINDS[kind].supports("footholds", view), (kind, view)
-        assert KINDS[kind].cell("footholds", "osim") == SEVERAL_FOOTHOLDS
+    # OpenSim walks the three-link walker on them (tests/test_export_opensim.py); the
+    # five-link biped's OpenSim walk on footholds is not checked yet
+    assert KINDS["hinged_torso"].supports("footholds", "osim")
+    assert "no OpenSim walk has checked them yet" in KINDS["free_joints"].cell("footholds",
+                                                                             "osim")
 
 
 def test_a_pushed_off_compass_walker_lands_each_step_at_its_footholds_height():
