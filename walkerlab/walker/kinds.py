@@ -274,12 +274,12 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
         # the rigid view lands its heel strike on stairs and footholds of several heights
-        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's views do
-        # not step flat feet on them yet
-        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize", "osim", "gym")},
+        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
+        # steps that walker (its contact view asks the contact cells)
+        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
         **{("profile", v): _FLAT_PROFILE for v in ("rigid", "adams", "gym")},
-        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim", "gym")},
+        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "
