@@ -129,9 +129,10 @@ class ActionTorques(Actuators):
 
 def flat_action_walker(walker, data, joints: list[str], actuation):
     """The flat-footed rigid walker of one step with the action's torques at ``joints``
-    acting in every stance-foot mode (:func:`walkerlab.models.hybrid.mode_torques.
-    actuate_flat_hips`: each mode's own mass matrix, the foot-flat lock, the guards' ground
-    forces and the double support carrying them), besides the scene's own torque laws and
+    acting in every stance-foot mode
+    (:func:`walkerlab.models.hybrid.mode_torques.actuate_flat_hips`: each mode's own mass
+    matrix, the foot-flat lock, the guards' ground forces and the double support carrying
+    them), besides the scene's own torque laws and
     ankle push-off (its heel-off numbers).  Its guards are the walker's, in the same order:
     the heel strike's reset (a push-off impulse's) is read from the scene's walker
     (:class:`walkerlab.gym.rigid_view.RigidView`).
