@@ -285,7 +285,8 @@ def test_optimize_refuses_it_with_the_tables_reason():
     from walkerlab.walker.kinds import KINDS, KindRefused
 
     kind = walker_data(load_scene(SCENE).walker, 0.0).structure.kind
-    with pytest.raises(KindRefused, match="^walker: open-loop torques of a torso hinged on straight legs are not transcribed"):
+    with pytest.raises(KindRefused, match="^walker: open-loop torques of a torso hinged on "
+                                          "straight legs are not transcribed"):
         kind.require("walk", "optimize", "walker")
     assert KINDS["hinged_torso"].cell("knee_torque", "mjcf") == \
         "the legs are straight: there is no knee"
