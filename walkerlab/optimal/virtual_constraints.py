@@ -22,6 +22,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from walkerlab.io.schemas.optimize import ControllerData
+
 __all__ = ["ControllerDesign", "check_design", "controller_scene", "controller_scene_text",
            "controller_step", "design_controllers", "designs_controller",
            "optimize_virtual_constraints"]
@@ -30,7 +32,7 @@ KEY = "walker.actuation.virtual_constraints"
 
 
 @dataclass
-class ControllerDesign:
+class ControllerDesign(ControllerData):
     """One optimised controller (``optimize.h5``'s ``controllers/<i>/``).
 
     Attributes
@@ -76,29 +78,6 @@ class ControllerDesign:
         The collocated step (times [s], states, torques [N m]).
     """
 
-    target_speed_m_per_s: float
-    bezier_rad: np.ndarray
-    output_names: tuple
-    step_period_s: float
-    step_length_m: float
-    objective: float
-    effort: float
-    delta2: float
-    delta2_restricted: float
-    existence_margin: float
-    restricted_step_period_s: float
-    full_order_step_period_s: float
-    orbit_shift: float
-    multipliers: np.ndarray
-    delta2_multiplier: complex
-    max_torque_n_m: float
-    max_output: float
-    max_output_rate: float
-    status: str
-    iterations: int
-    wall_time_s: float
-    build_time_s: float
-    scene_file: str
     t: np.ndarray = field(repr=False, default=None)
     x: np.ndarray = field(repr=False, default=None)
     u: np.ndarray = field(repr=False, default=None)
