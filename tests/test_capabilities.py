@@ -23,108 +23,23 @@ search); ``pytest -m slow`` tries every cell.  This replaces issue 48's probing 
 
 from __future__ import annotations
 
-import copy
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: kind -> its shipped scene
-SCENES = {
-    "straight_legs": "configs/paper_rods.yaml",
-    "locking_knees": "configs/kneed.yaml",
-    "flat_feet": "configs/flat_feet.yaml",
-    "free_joints": "configs/rabbit.yaml",
-    "hinged_torso": "configs/threelink.yaml",
-    "rolling_polygon": "configs/rimless_wheel.yaml",
-}
-
-#: a small PD law [N m/rad, N m s/rad] about the joint's zero angle
-SMALL_PD = {"stiffness_n_m_per_rad": 0.1, "damping_n_m_s_per_rad": 0.01}
-
-#: feature -> the joint its torque acts at (a five-link biped's hips: torso to thigh)
-JOINT = {"hip_torque": "hip", "knee_torque": "swing_knee", "ankle_torque": "stance_ankle",
-         "torso_torque": "stance_hip"}
-FIVE_LINK_JOINT = {"hip_torque": "swing_hip"}
-#: the kinds whose hips join a hinged torso and the legs: their hip torque is FIVE_LINK_JOINT's
-TORSO_HIPS = ("free_joints", "hinged_torso")
-
-#: an upper body held on the legs' bisector (configs/torso_bhm.yaml): the torso torque's
-#: other link on a walker shipped without one
-TORSO = {"coupling": "bisecting_hip",
-         "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 5.0,
-                     "from_hip_m": 0.2}]}
-
-#: the non-slope grounds (configs/stairs.yaml, footholds.yaml, profile.yaml)
-TERRAIN = {
-    "stairs": {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.41, "direction": "down",
-               "lanes": "continuous"},
-    "footholds": {"kind": "footholds", "foothold_heights_m": [-0.005, 0.005],
-                  "periodic": True, "lanes": "checkerboard", "patch_width_m": 0.3},
-    "profile": {"kind": "profile", "lanes": "continuous",
-                "profile_m": [[-1.0, 0.05], [0.0, 0.0], [1.0, -0.05], [2.0, -0.1],
-                              [3.0, -0.15], [4.0, -0.2]]},
-}
-
-#: an optimize section a kind's optimisation needs (a five-link biped's least effort needs
-#: a target: configs/rabbit_optimal.yaml's 0.5 m in 0.7 s)
-OPTIMIZE = {"free_joints": {"target_step_length_m": 0.5, "target_step_period_s": 0.7}}
-
-
-def scene_for(kind: str, feature: str, view: str) -> dict:
-    """The kind's shipped scene with the feature (a mapping)."""
-    with open(ROOT / SCENES[kind]) as fh:
-        d = yaml.safe_load(fh)
-    d["name"] = f"{kind}-{feature}-{view}"
-    w = d["walker"]
-    shipped = copy.deepcopy(w.get("actuation")) or {}
-    if feature in JOINT:
-        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
-                 else JOINT[feature])
-        if feature == "torso_torque" and "torso" not in w and "leg" in w:
-            w["torso"] = copy.deepcopy(TORSO)
-        torques = [t for t in shipped.get("torques", []) if t["joint"] != joint]
-        shipped["torques"] = [*torques, {"joint": joint, "law": dict(SMALL_PD)}]
-        w["actuation"] = shipped
-    elif feature == "push_off":
-        w["actuation"] = {**shipped, "push_off": {"impulse_n_s": 0.05}}
-    elif feature == "ankle_push_off":
-        w["actuation"] = {**shipped, "ankle_push_off": {"constant_n_m": 1.0}}
-    elif feature == "virtual_constraints":  # RABBIT's (configs/rabbit_hzd.yaml), or one
-        # output per hip on the others (the swing leg, the torso where there is one)
-        with open(ROOT / "configs" / "rabbit_hzd.yaml") as fh:
-            vc = yaml.safe_load(fh)["walker"]["actuation"]["virtual_constraints"]
-        if kind != "free_joints":
-            vc["outputs"] = [{"link": "swing_leg", "bezier_rad": [-0.2, -0.1, 0.0, 0.1, 0.2]}]
-            if kind == "hinged_torso":  # two hips: the swing leg and the torso
-                vc["outputs"].append({"link": "torso", "bezier_rad": [0.1] * 5})
-            vc.pop("max_torque_n_m")
-        w["actuation"] = {"virtual_constraints": vc}
-    elif feature in TERRAIN:
-        terrain = copy.deepcopy(TERRAIN[feature])
-        if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
-            terrain.pop("lanes")
-            terrain.update(lanes="checkerboard", patch_width_m=d["terrain"]["patch_width_m"])
-        d["terrain"] = terrain
-        if feature == "stairs":
-            d["slope"] = {"angle_rad": 0.0}
-    if view == "optimize" and feature == "virtual_constraints":  # designed by optimize
-        if kind == "hinged_torso":  # a controller that walks: its design's start
-            with open(ROOT / "configs" / "threelink_hzd.yaml") as fh:
-                w["actuation"] = yaml.safe_load(fh)["walker"]["actuation"]
-        d["optimize"] = {**OPTIMIZE.get(kind, {}), "design": "virtual_constraints"}
-    elif view == "optimize" and kind in OPTIMIZE:
-        d.setdefault("optimize", dict(OPTIMIZE[kind]))
-    elif view == "optimize" and feature == "stairs":  # level treads: a step from targets
-        d["optimize"] = {"target_step_length_m": 0.41, "target_step_period_s": 0.75}
-    return d
-
+from walkerlab.config.reference_cases import (  # noqa: E402 - the cases the table is tried on
+    FIVE_LINK_JOINT,
+    JOINT,
+    SCENES,
+    TORSO_HIPS,
+    scene_for,
+)
 
 # ---------------------------------------------------------------------------- the probes
 

@@ -11,6 +11,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from walkerlab.walker.capability_evidence import (
+    UNVERIFIED,
+    cell_evidence,
+    number,
+    unverified_reason,
+    verified,
+)
 from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS, Kind
 
 __all__ = ["SUPPORTED", "KindGrid", "grids", "kind_grid", "markdown", "text"]
@@ -21,8 +28,11 @@ SUPPORTED = "✓"
 
 @dataclass(frozen=True)
 class KindGrid:
-    """One kind's cells: ``rows[i][j]`` is feature ``i`` in view ``j`` (:data:`SUPPORTED`
-    or ``"✗ n"``, ``n`` the 1-based index into ``reasons``)."""
+    """One kind's cells: ``rows[i][j]`` is feature ``i`` in view ``j``: ``"✓ <number>"``
+    (supported and measured within its tolerance, the number measured:
+    :mod:`walkerlab.walker.capability_evidence`), ``"~ n"`` (the view runs it, but its
+    measurement is outside its tolerance or missing) or ``"✗ n"`` (refused), ``n`` the
+    1-based index into ``reasons``."""
 
     kind: Kind
     features: tuple[str, ...]
@@ -40,12 +50,15 @@ def kind_grid(kind: Kind) -> KindGrid:
         row = []
         for view in VIEWS:
             why = kind.cell(feature, view)
-            if why is None:
-                row.append(SUPPORTED)
+            mark = "✗"
+            if why is None and verified(kind.name, feature, view):
+                row.append(f"{SUPPORTED} {number(cell_evidence(kind.name, feature, view))}")
                 continue
+            if why is None:
+                why, mark = unverified_reason(kind.name, feature, view), UNVERIFIED
             if why not in reasons:
                 reasons.append(why)
-            row.append(f"✗ {reasons.index(why) + 1}")
+            row.append(f"{mark} {reasons.index(why) + 1}")
         rows.append(tuple(row))
     return KindGrid(kind, tuple(FEATURES), tuple(VIEWS), tuple(rows), tuple(reasons))
 
@@ -60,11 +73,19 @@ def _legend() -> list[str]:
             "features: " + "; ".join(f"{f}: {what}" for f, what in FEATURES.items())]
 
 
+def _tolerances() -> str:
+    from walkerlab.walker.capability_evidence import evidence
+
+    tol = evidence().get("tolerances", {})
+    return "tolerances: " + "; ".join(f"{v}: {t}" for v, t in tol.items()) if tol else ""
+
+
 def text() -> str:
     """The table as plain text (``walkerlab capabilities``): per kind its title, the grid
     (columns padded) and its numbered reasons; the views and features explained first."""
-    out = ["walker kind x feature x view: ✓ supported, ✗ n refused (reason n below the "
-           "kind's grid)", *_legend(), ""]
+    out = ["walker kind x feature x view: ✓ supported, with the agreement measured on its "
+           "reference case (within its view's tolerance); ~ n runs, not verified; ✗ n "
+           "refused (reason n below the kind's grid)", *_legend(), _tolerances(), ""]
     for g in grids():
         head = ("feature", *g.views)
         rows = [(f, *r) for f, r in zip(g.features, g.rows)]

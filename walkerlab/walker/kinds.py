@@ -355,13 +355,26 @@ def kind_of(structure) -> Kind:
 
 def table_rows() -> list[dict]:
     """The capability table, one row per kind × feature × view: ``{"kind", "feature",
-    "view", "supported", "reason"}`` (``reason`` "" when supported) - what ``walkerlab
-    capabilities --json`` prints."""
+    "view", "supported", "reason"}`` (``reason`` "" when supported), and for a supported
+    cell its evidence (:mod:`walkerlab.walker.capability_evidence`): ``verified`` (measured
+    within its tolerance), ``case`` (its reference case), ``quantity``, ``measured``,
+    ``tolerance``, ``unit``, ``detail`` and ``commit`` - what ``walkerlab capabilities
+    --json`` prints."""
+    from walkerlab.walker.capability_evidence import cell_evidence, verified
+
     rows = []
     for kind in KINDS.values():
         for feature in FEATURES:
             for view in VIEWS:
                 why = kind.cell(feature, view)
-                rows.append({"kind": kind.name, "feature": feature, "view": view,
-                             "supported": why is None, "reason": why or ""})
+                row = {"kind": kind.name, "feature": feature, "view": view,
+                       "supported": why is None, "reason": why or ""}
+                if why is None:
+                    e = cell_evidence(kind.name, feature, view) or {}
+                    row.update(verified=verified(kind.name, feature, view),
+                               case=e.get("case", ""), quantity=e.get("quantity", ""),
+                               measured=e.get("value"), tolerance=e.get("tolerance"),
+                               unit=e.get("unit", ""), detail=e.get("detail", ""),
+                               commit=e.get("commit", ""))
+                rows.append(row)
     return rows

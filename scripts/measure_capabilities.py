@@ -1,0 +1,97 @@
+"""Measure the capability table's supported cells on their reference cases and write the
+evidence beside the table (``walkerlab/walker/capability_evidence.json``):
+
+    python scripts/measure_capabilities.py                 # every supported cell
+    python scripts/measure_capabilities.py --view contact  # one view's cells (merged in)
+    python scripts/measure_capabilities.py --cell straight_legs/walk/mjcf --jobs 2
+
+Each cell runs in a process of its own (:func:`walkerlab.stages.capabilities.measure`, its
+artifacts in a temporary runs folder); the file is rewritten under a temporary name, then
+renamed, with each measured cell's commit (``git rev-parse --short HEAD``, ``+`` when the
+tree had changes).  The slow test ``tests/test_capability_evidence.py`` re-measures every
+cell against what this wrote.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _commit() -> str:
+    def git(*a):
+        return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True).stdout
+
+    head = git("rev-parse", "--short", "HEAD").strip()
+    dirty = bool(git("status", "--porcelain", "--untracked-files=no", "walkerlab").strip())
+    return head + ("+" if dirty else "")
+
+
+def _one(cell: str) -> dict:
+    from walkerlab.stages.capabilities import measure
+
+    kind, feature, view = cell.split("/")
+    with tempfile.TemporaryDirectory(prefix="walkerlab-cap-") as tmp:
+        t0 = time.process_time()
+        m = measure(kind, feature, view, tmp)
+        d = m.as_dict()
+    d["cpu_s"] = round(time.process_time() - t0, 2)
+    return d
+
+
+def main(argv=None) -> int:
+    from walkerlab.stages.capabilities import QUANTITIES
+    from walkerlab.walker.capability_evidence import EVIDENCE_FILE
+    from walkerlab.walker.kinds import table_rows
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--view", action="append", default=[])
+    ap.add_argument("--kind", action="append", default=[])
+    ap.add_argument("--cell", action="append", default=[], help="kind/feature/view")
+    ap.add_argument("--jobs", type=int, default=1)
+    a = ap.parse_args(argv)
+    cells = [f"{r['kind']}/{r['feature']}/{r['view']}" for r in table_rows()
+             if r["supported"] and (not a.view or r["view"] in a.view)
+             and (not a.kind or r["kind"] in a.kind)]
+    if a.cell:
+        cells = [c for c in cells if c in a.cell]
+    data = (json.loads(EVIDENCE_FILE.read_text()) if EVIDENCE_FILE.is_file()
+            else {"cells": {}})
+    data["tolerances"] = {v: f"{t:g} {u}" for v, (_, t, u) in QUANTITIES.items()}
+    commit = _commit()
+    done = 0
+    with ProcessPoolExecutor(a.jobs) as pool:
+        futs = {pool.submit(_one, c): c for c in cells}
+        for fut in as_completed(futs):
+            c = futs[fut]
+            try:
+                d = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a crashed worker: record it
+                d = {"value": None, "ok": False, "detail": f"crashed: {exc}"[:300],
+                     "case": "", "quantity": "", "tolerance": 0.0, "unit": ""}
+            d["commit"] = commit
+            for k in ("kind", "feature", "view"):
+                d.pop(k, None)
+            data["cells"][c] = d
+            done += 1
+            print(f"[{done}/{len(cells)}] {c}: {'ok' if d['ok'] else 'NOT'} "
+                  f"{d.get('value')} ({d.get('cpu_s', '?')} s) {d['detail'][:140]}",
+                  flush=True)
+            data["cells"] = dict(sorted(data["cells"].items()))
+            tmp = EVIDENCE_FILE.with_suffix(".json.tmp")
+            tmp.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n")
+            os.replace(tmp, EVIDENCE_FILE)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,213 @@
+"""The reference case of each cell of the capability table (:data:`walkerlab.walker.kinds.
+CAPABILITIES`): the kind's base walker - one shipped scene per kind - with that feature
+(a small torque law, a push-off, virtual constraints) and that ground (stairs, footholds,
+a profile), as a scene mapping.  The capability table's evidence
+(:mod:`walkerlab.walker.capability_evidence`) is measured on these cases
+(:mod:`walkerlab.stages.capabilities`), and the table's truth tests try them.
+
+Nothing here builds a model: it reads the shipped scenes (``configs/`` next to the package)
+and returns mappings that :func:`walkerlab.config.scene_from_dict` validates.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import yaml
+
+from walkerlab.config.loader import shipped_scene_path
+
+__all__ = ["JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "reference_scene",
+           "scene_for"]
+
+
+def _shipped(name: str) -> dict:
+    path = shipped_scene_path(name)
+    if path is None:  # pragma: no cover - a wheel install without configs/
+        raise FileNotFoundError(f"{name}: the shipped scenes (configs/) are not next to the "
+                                "package (install walkerlab from its repository)")
+    with open(path) as fh:
+        return yaml.safe_load(fh)
+
+
+#: kind -> its shipped scene
+SCENES = {
+    "straight_legs": "configs/paper_rods.yaml",
+    "locking_knees": "configs/kneed.yaml",
+    "flat_feet": "configs/flat_feet.yaml",
+    "free_joints": "configs/rabbit.yaml",
+    "hinged_torso": "configs/threelink.yaml",
+    "rolling_polygon": "configs/rimless_wheel.yaml",
+}
+
+#: a small PD law [N m/rad, N m s/rad] about the joint's zero angle
+SMALL_PD = {"stiffness_n_m_per_rad": 0.1, "damping_n_m_s_per_rad": 0.01}
+
+#: feature -> the joint its torque acts at (a five-link biped's hips: torso to thigh)
+JOINT = {"hip_torque": "hip", "knee_torque": "swing_knee", "ankle_torque": "stance_ankle",
+         "torso_torque": "stance_hip"}
+FIVE_LINK_JOINT = {"hip_torque": "swing_hip"}
+#: the kinds whose hips join a hinged torso and the legs: their hip torque is FIVE_LINK_JOINT's
+TORSO_HIPS = ("free_joints", "hinged_torso")
+
+#: an upper body held on the legs' bisector (configs/torso_bhm.yaml): the torso torque's
+#: other link on a walker shipped without one
+TORSO = {"coupling": "bisecting_hip",
+         "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 5.0,
+                     "from_hip_m": 0.2}]}
+
+#: the non-slope grounds (configs/stairs.yaml, footholds.yaml, profile.yaml)
+TERRAIN = {
+    "stairs": {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.41, "direction": "down",
+               "lanes": "continuous"},
+    "footholds": {"kind": "footholds", "foothold_heights_m": [-0.005, 0.005],
+                  "periodic": True, "lanes": "checkerboard", "patch_width_m": 0.3},
+    "profile": {"kind": "profile", "lanes": "continuous",
+                "profile_m": [[-1.0, 0.05], [0.0, 0.0], [1.0, -0.05], [2.0, -0.1],
+                              [3.0, -0.15], [4.0, -0.2]]},
+}
+
+#: an optimize section a kind's optimisation needs (a five-link biped's least effort needs
+#: a target: configs/rabbit_optimal.yaml's 0.5 m in 0.7 s)
+OPTIMIZE = {"free_joints": {"target_step_length_m": 0.5, "target_step_period_s": 0.7}}
+
+
+def scene_for(kind: str, feature: str, view: str) -> dict:
+    """The kind's base scene (:data:`SCENES`) with the feature, for the view (a mapping):
+    the case the table's truth tests try (accepted or refused), not necessarily one that
+    walks (:func:`reference_scene` prefers a shipped scene that does).
+
+    Parameters
+    ----------
+    kind, feature, view : str
+        Keys of :data:`walkerlab.walker.kinds.KINDS`, ``FEATURES`` and ``VIEWS``.
+
+    Returns
+    -------
+    dict
+        A scene mapping (``name``: ``<kind>-<feature>-<view>``).
+    """
+    d = _shipped(SCENES[kind])
+    d["name"] = f"{kind}-{feature}-{view}"
+    w = d["walker"]
+    shipped = copy.deepcopy(w.get("actuation")) or {}
+    if feature in JOINT:
+        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
+                 else JOINT[feature])
+        if feature == "torso_torque" and "torso" not in w and "leg" in w:
+            w["torso"] = copy.deepcopy(TORSO)
+        torques = [t for t in shipped.get("torques", []) if t["joint"] != joint]
+        shipped["torques"] = [*torques, {"joint": joint, "law": dict(SMALL_PD)}]
+        w["actuation"] = shipped
+    elif feature == "push_off":
+        w["actuation"] = {**shipped, "push_off": {"impulse_n_s": 0.05}}
+    elif feature == "ankle_push_off":
+        w["actuation"] = {**shipped, "ankle_push_off": {"constant_n_m": 1.0}}
+    elif feature == "virtual_constraints":  # RABBIT's (configs/rabbit_hzd.yaml), or one
+        # output per hip on the others (the swing leg, the torso where there is one)
+        vc = _shipped("rabbit_hzd")["walker"]["actuation"]["virtual_constraints"]
+        if kind != "free_joints":
+            vc["outputs"] = [{"link": "swing_leg", "bezier_rad": [-0.2, -0.1, 0.0, 0.1, 0.2]}]
+            if kind == "hinged_torso":  # two hips: the swing leg and the torso
+                vc["outputs"].append({"link": "torso", "bezier_rad": [0.1] * 5})
+            vc.pop("max_torque_n_m")
+        w["actuation"] = {"virtual_constraints": vc}
+    elif feature in TERRAIN:
+        terrain = copy.deepcopy(TERRAIN[feature])
+        if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
+            terrain.pop("lanes")
+            terrain.update(lanes="checkerboard", patch_width_m=d["terrain"]["patch_width_m"])
+        d["terrain"] = terrain
+        if feature == "stairs":
+            d["slope"] = {"angle_rad": 0.0}
+    if view == "optimize" and feature == "virtual_constraints":  # designed by optimize
+        if kind == "hinged_torso":  # a controller that walks: its design's start
+            w["actuation"] = _shipped("threelink_hzd")["walker"]["actuation"]
+        d["optimize"] = {**OPTIMIZE.get(kind, {}), "design": "virtual_constraints"}
+    elif view == "optimize" and kind in OPTIMIZE:
+        d.setdefault("optimize", dict(OPTIMIZE[kind]))
+    elif view == "optimize" and feature == "stairs":  # level treads: a step from targets
+        d["optimize"] = {"target_step_length_m": 0.41, "target_step_period_s": 0.75}
+    return d
+
+
+
+
+#: (kind, feature) -> the shipped scene that exercises the feature on a walker of that kind
+#: (its numbers are documented in the scene's comments): the reference case of the feature's
+#: cells in every view but ``optimize``
+SHIPPED = {
+    ("straight_legs", "walk"): "paper",
+    ("straight_legs", "push_off"): "powered_compass",
+    ("straight_legs", "stairs"): "stairs",
+    ("straight_legs", "footholds"): "footholds_two",
+    ("locking_knees", "walk"): "kneed",
+    ("locking_knees", "profile"): "profile",
+    ("flat_feet", "walk"): "flat_feet",
+    ("flat_feet", "ankle_push_off"): "flat_feet_push_off",
+    ("flat_feet", "stairs"): "flat_feet_stairs",
+    ("flat_feet", "footholds"): "flat_feet_footholds",
+    ("free_joints", "walk"): "rabbit",
+    ("free_joints", "virtual_constraints"): "rabbit_hzd",
+    ("free_joints", "footholds"): "rabbit_footholds",
+    ("hinged_torso", "walk"): "threelink",
+    ("hinged_torso", "virtual_constraints"): "threelink_hzd",
+    ("hinged_torso", "footholds"): "threelink_footholds",
+    ("rolling_polygon", "walk"): "rimless_wheel",
+}
+
+#: (kind, feature) -> the shipped scene with an optimize section: the reference case of the
+#: ``optimize`` cell
+SHIPPED_OPTIMIZE = {
+    ("straight_legs", "walk"): "compass_optimal",
+    ("locking_knees", "walk"): "kneed_optimal",
+    ("flat_feet", "walk"): "flat_feet_optimal",
+    ("free_joints", "walk"): "rabbit_optimal",
+}
+
+
+def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
+    """The reference case of a cell: a shipped scene that exercises the feature on the kind
+    (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`), else the kind's base walker with the
+    feature and the ground (:func:`scene_for`).
+
+    Returns
+    -------
+    case : str
+        ``configs/<name>.yaml`` or ``generated: <kind> base (configs/<base>.yaml) with
+        <feature>``.
+    scene : dict
+        The scene mapping.
+    """
+    table = SHIPPED_OPTIMIZE if view == "optimize" else SHIPPED
+    name = table.get((kind, feature))
+    if name is not None:
+        d = _shipped(name)
+        return f"configs/{name}.yaml", d
+    base = SCENES[kind].removeprefix("configs/")
+    d = scene_for(kind, feature, view)
+    if feature == "profile":  # the slope itself as a profile (x horizontal, y up [m]): its
+        # walk is the slope's walk, step for step
+        d["terrain"] = slope_profile(_shipped(base)["slope"])
+        return f"generated: configs/{base} on a profile equal to its slope", d
+    return f"generated: configs/{base} with {feature}", d
+
+
+def slope_profile(slope: dict, x_end_m: float = 40.0) -> dict:
+    """A ``terrain`` mapping: the scene's slope as a height profile, ``y = -x tan(phi)``
+    from x = -2 m to ``x_end_m`` (one point a metre).
+
+    Parameters
+    ----------
+    slope : dict
+        A scene's ``slope`` mapping (``angle_rad`` or ``angle_deg``).
+    x_end_m : float
+        The profile's last x [m].
+    """
+    import math
+
+    phi = (slope["angle_rad"] if slope.get("angle_rad") is not None
+           else math.radians(slope["angle_deg"]))
+    xs = [float(x) for x in range(-2, int(x_end_m) + 1)]
+    return {"kind": "profile", "lanes": "continuous",
+            "profile_m": [[x, -x * math.tan(phi)] for x in xs]}

@@ -1,0 +1,331 @@
+"""The capability table's evidence, measured: each supported cell (a kind's feature in a
+view, :data:`walkerlab.walker.kinds.CAPABILITIES`) run on its reference case
+(:func:`walkerlab.config.reference_cases.reference_scene`) and checked against a reference
+the cell does not compute itself.
+
+By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
+
+``rigid``
+    ``walkerlab simulate`` over 10 heel strikes from the gait of ``walkerlab fixedpoint``:
+    each step's period and length against the fixed point's (the Poincaré map's root,
+    found by a root finder, against an integration with event location; relative, 1e-6);
+    on a profile, where the gait changes from step to step, the footfalls against the
+    profile's height under them [m].
+``contact``
+    ``walkerlab contact-sim`` over at least 10 heel strikes against the rigid gait (mean
+    step period and speed, relative, 3 %), steady: the last steps' mean period within 3 %
+    of the first steps' (no monotone drift).
+``mjcf``, ``osim``
+    The exported file walked in its engine (MuJoCo, OpenSim) for 10 heel strikes from the
+    rigid gait: the mean step period against the rigid one (relative, 3 %).
+``adams``
+    No Adams Solver runs here: the dataset read back (:func:`walkerlab.export.adams_reader.
+    read_adm`): every part's mass against the walker description's (relative, 1e-9).
+``gym``
+    The environment's rigid view (a zero action; the scene's controller as the policy when
+    it has one) against ``walkerlab simulate``: heel-strike times over 10 heel strikes,
+    each step's period, relative (1e-6; a controller sampled once per control period: 3 %).
+``optimize``
+    ``walkerlab optimize``: its optimum replayed on the rigid model returns to its start
+    (max-norm return error, 1e-6).
+
+Runs every stage into a runs folder of its own (``runs_root``); nothing else is written.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import warnings
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.config import scene_from_dict
+from walkerlab.config.reference_cases import reference_scene
+
+__all__ = ["QUANTITIES", "Measurement", "measure"]
+
+#: view -> (quantity, tolerance, unit)
+QUANTITIES = {
+    "rigid": ("simulate's step periods and lengths over 10 heel strikes against the fixed "
+              "point's (a profile: footfall height against the profile)", 1e-6, "relative"),
+    "contact": ("contact-sim walks >= 10 heel strikes; over its last 4 steps, the mean step "
+                "period and speed against the rigid gait's, and the periods' spread "
+                "(steady: no drift)", 0.03, "relative"),
+    "mjcf": ("the MJCF walked in MuJoCo: mean step period over 10 heel strikes against the "
+             "rigid gait", 0.03, "relative"),
+    "osim": ("the OpenSim model walked by OpenSim: mean step period over 10 heel strikes "
+             "against the rigid gait", 0.03, "relative"),
+    "adams": ("the dataset read back: every part's mass against the walker description "
+              "(no Adams Solver here: the walk is not measured)", 1e-9, "relative"),
+    "gym": ("the rigid view under a zero action (or the scene's controller as its policy) "
+            "against walkerlab simulate: each of 10 step periods (relative; a controller "
+            "held per control period: 3 %)", 1e-6, "relative"),
+    "optimize": ("the optimum replayed on the rigid model: its return error (max norm)",
+                 1e-6, "state"),
+}
+#: the gym's tolerance when the scene's controller is the policy (its torque sampled once
+#: per control period and held: a zero-order hold of the continuous feedback)
+GYM_POLICY_TOLERANCE = 0.03
+#: heel strikes a walk must reach
+STRIKES = 10
+#: the steps of the contact walk held to the rigid gait: its last ones (an even number, a
+#: period-2 gait's two steps in turn), past the transient of its start from the rigid gait
+SETTLED = 4
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """One cell's measured agreement.
+
+    Attributes
+    ----------
+    kind, feature, view : str
+        The cell.
+    case : str
+        The reference case (``configs/<name>.yaml`` or ``generated: ...``).
+    quantity : str
+        What was measured against what.
+    value : float
+        The measured disagreement (signed where it has a sign: ``+0.012`` is 1.2 % long;
+        NaN when nothing could be measured).
+    tolerance : float
+        The tolerance the cell is held to (same unit as ``value``).
+    unit : str
+        "relative", "m" or "state".
+    ok : bool
+        ``|value| <= tolerance`` and the walk reached what it must.
+    detail : str
+        One line: what was seen (heel strikes, numbers) or why nothing was measured.
+    """
+
+    kind: str
+    feature: str
+    view: str
+    case: str
+    quantity: str
+    value: float
+    tolerance: float
+    unit: str
+    ok: bool
+    detail: str
+
+    def as_dict(self) -> dict:
+        """The measurement as a JSON-ready mapping (NaN as None)."""
+        d = asdict(self)
+        d["value"] = None if not math.isfinite(self.value) else float(self.value)
+        return d
+
+
+def _h5(path):
+    import h5py
+
+    return h5py.File(path, "r")
+
+
+def _cyclic_deviation(got: np.ndarray, ref: np.ndarray) -> float:
+    """Max relative deviation of ``got`` from the period-n ``ref`` repeated."""
+    rep = np.resize(ref, got.shape)
+    return float(np.max(np.abs(got / rep - 1.0)))
+
+
+def _strides_for(d: dict, view: str) -> None:
+    if view in ("rigid", "gym", "contact"):
+        sim = d.setdefault("simulate", {}) or {}
+        d["simulate"] = sim
+        sim["strides"] = max(int(sim.get("strides", 5)), 5)
+    if view == "contact":
+        d.setdefault("contact", {})
+        cs = d.get("contact_sim") or {}
+        cs["n_strides"] = max(int(cs.get("n_strides", 5)), 5)
+        cs.pop("t_final_s", None)
+        d["contact_sim"] = cs
+
+
+def _rigid(scene, d, runs: Path) -> tuple[float, str]:
+    from walkerlab.stages import pipeline
+
+    fp = pipeline.run("fixedpoint", scene, runs).path
+    sim = pipeline.run("simulate", scene, runs).path
+    with _h5(fp) as f, _h5(sim) as s:
+        term = s["steps/termination"][:].astype(str)
+        n = int(np.sum(term == "heel_strike"))
+        if n < STRIKES:
+            return math.nan, f"simulate reached {n} heel strikes of {STRIKES}"
+        ok = term == "heel_strike"
+        if (d.get("terrain") or {}).get("kind") == "profile":
+            return _profile_footfalls(s, d, ok)
+        lengths = s["steps/step_length"][:][ok]
+        if "steps" in f:  # a gait of n steps: each step's period and length in turn
+            dev_t = _cyclic_deviation(s["steps/period"][:][ok], f["steps/period"][:])
+            dev_l = _cyclic_deviation(lengths, f["steps/length"][:])
+        else:  # a symmetric period-1 gait: its step period; every step as long as the first
+            dev_t = _cyclic_deviation(s["steps/period"][:][ok],
+                                      np.array([f["step_period"][()]]))
+            dev_l = _cyclic_deviation(lengths, lengths[:1])
+    dev = max(dev_t, dev_l)
+    return dev, (f"{n} heel strikes; step periods {dev_t:.1e}, lengths {dev_l:.1e} from the "
+                 "fixed point's")
+
+
+def _profile_footfalls(s, d, ok) -> tuple[float, str]:
+    """The landing foot's height at each heel strike against the profile's under it."""
+    prof = np.asarray(d["terrain"]["profile_m"], float)
+    t_end = s["steps/t_end"][:][ok]
+    legs = s["steps/swing_leg"][:][ok].astype(str)
+    worst = 0.0
+    for t, leg in zip(t_end, legs):
+        g = f"samples/points/{leg}_foot"
+        ts, x, y = s[f"{g}/time"][:], s[f"{g}/x"][:], s[f"{g}/y"][:]
+        i = int(np.argmin(np.abs(ts - t)))
+        if abs(ts[i] - t) > 1e-9:
+            continue
+        worst = max(worst, abs(y[i] - np.interp(x[i], prof[:, 0], prof[:, 1])))
+    return worst, f"{len(t_end)} heel strikes; footfalls {worst:.1e} m from the profile"
+
+
+def _contact(scene, d, runs: Path) -> tuple[float, str]:
+    from walkerlab.stages import pipeline
+
+    cs = pipeline.run("contact-sim", scene, runs).path
+    cmp = pipeline.run("compare", scene, runs).path
+    with _h5(cs) as f, _h5(cmp) as c:
+        strikes = int(f["summary/heel_strikes"][()])
+        ti = float(c["metrics/ideal/t_cycle_s"][()]) / 2.0  # a stride: two steps
+        vi = float(c["metrics/ideal/v_com_m_per_s"][()])
+        h = np.asarray(f["events/heel_strike_times"][:], float)
+        t, x = f["samples/points/hip/time"][:], f["samples/points/hip/x"][:]
+    if strikes < STRIKES:
+        return math.nan, f"contact-sim walked {strikes} heel strikes of {STRIKES}"
+    # the settled walk: the last SETTLED steps (the first ones carry the start's transient)
+    w = h[-SETTLED - 1:]
+    last = np.diff(w)
+    dt = float(np.mean(last) / ti - 1.0)
+    dv = float((np.interp(w[-1], t, x) - np.interp(w[0], t, x)) / (w[-1] - w[0]) / vi - 1.0)
+    spread = float((last.max() - last.min()) / ti)
+    worst = max((dt, dv), key=abs)
+    if spread > abs(worst):
+        worst = spread
+    return worst, (f"{strikes} heel strikes; over the last {SETTLED} steps: period "
+                   f"{100 * dt:+.2f} %, speed {100 * dv:+.2f} %, spread of the periods "
+                   f"{100 * spread:.2f} % (steady within it)")
+
+
+def _engine(fmt):
+    def run(scene, d, runs: Path) -> tuple[float, str]:
+        from walkerlab.stages import export
+
+        ex = export.write(scene, runs, fmt, walk=True, walk_steps=STRIKES)
+        w = ex.walk
+        if w is None or not w.walked:
+            return math.nan, (w.line if w is not None else "not walked")
+        if w.fell or w.strikes < STRIKES or not w.alternating:
+            return math.nan, w.line
+        return w.relative, w.line
+    return run
+
+
+def _adams(scene, d, runs: Path) -> tuple[float, str]:
+    from walkerlab.export.adams_reader import read_adm
+    from walkerlab.stages import export
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    path = export.write(scene, runs, "adm").path
+    model = read_adm(Path(path).read_text())
+    mb = multibody(walker_data(scene.walker, scene.slope.phi_rad))
+    parts = [p for p in model.by_kind["PART"] if p != 1]
+    total = sum(model.part_mass(p) for p in parts)
+    want = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
+    dev = abs(total / want - 1.0)
+    return dev, f"{len(parts)} parts, {total:.6g} kg against {want:.6g} kg"
+
+
+def _gym(scene, d, runs: Path) -> tuple[float, str]:
+    from walkerlab.gym.env import WalkerEnv
+    from walkerlab.stages import pipeline
+
+    sim = pipeline.run("simulate", scene, runs).path
+    with _h5(sim) as s:
+        ok = s["steps/termination"][:].astype(str) == "heel_strike"
+        ref = s["steps/t_end"][:][ok][:STRIKES]
+        period = float(np.mean(s["steps/period"][:][ok]))
+    act = scene.walker.actuation if hasattr(scene.walker, "actuation") else None
+    policy = "scene" if getattr(act, "virtual_constraints", None) is not None else None
+    steps = int(math.ceil((ref[-1] + 2 * period) / 0.01)) + 10 if ref.size else 1000
+    env = WalkerEnv(d, max_episode_steps=steps, policy=policy)
+    try:
+        env.reset(seed=0)
+        strikes: list[float] = []
+        for _ in range(steps):
+            _, _, term, trunc, info = env.step(np.zeros(env.action_space.shape, np.float32))
+            strikes += info["heel_strike_times_s"]
+            if term or trunc or len(strikes) >= ref.size:
+                break
+    finally:
+        env.close()
+    got = np.asarray(strikes[:ref.size])
+    if ref.size < STRIKES or got.size < ref.size:
+        return math.nan, f"the gym walked {got.size} heel strikes, simulate {ref.size}"
+    gap = np.abs(np.diff(got, prepend=0.0) - np.diff(ref, prepend=0.0))
+    dev = float(np.max(gap) / period)
+    return dev, (f"{got.size} heel strikes; step periods {np.max(gap):.2g} s apart at most"
+                 + (" (the controller held per control period)" if policy else ""))
+
+
+def _optimize(scene, d, runs: Path) -> tuple[float, str]:
+    from walkerlab.stages import pipeline
+
+    path = pipeline.run("optimize", scene, runs).path
+    with _h5(path) as f:
+        if "replay/max_state_error" in f:
+            err = float(f["replay/max_state_error"][()])
+            return err, f"replay returns {err:.2g} from its start"
+        errs = [float(f[f"controllers/{c}/replay/max_state_error"][()])
+                for c in f.get("controllers", {}) if
+                f"controllers/{c}/replay/max_state_error" in f]
+        if errs:
+            return max(errs), f"{len(errs)} controllers, replays return {max(errs):.2g}"
+        status = {k: v for k, v in f.attrs.items() if "status" in k or "verdict" in k}
+    return math.nan, f"no replay error stored ({status})"
+
+
+_VIEWS = {"rigid": _rigid, "contact": _contact, "mjcf": _engine("mjcf"),
+          "osim": _engine("osim"), "adams": _adams, "gym": _gym, "optimize": _optimize}
+
+
+def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measurement:
+    """Measure one cell on its reference case.
+
+    Parameters
+    ----------
+    kind, feature, view : str
+        The cell (:data:`walkerlab.walker.kinds.KINDS`, ``FEATURES``, ``VIEWS``).
+    runs_root : path
+        A runs folder for the stages' artifacts (the case's scene name under it).
+
+    Returns
+    -------
+    Measurement
+        ``ok`` False with the reason in ``detail`` when the case does not run, falls or
+        misses its tolerance; a refusal or an error is reported there, not raised.
+    """
+    quantity, tol, unit = QUANTITIES[view]
+    case, d = reference_scene(kind, feature, view)
+    d = copy.deepcopy(d)
+    d["name"] = f"{kind}-{feature}-{view}"
+    _strides_for(d, view)
+    if view == "gym" and feature == "virtual_constraints":
+        tol = GYM_POLICY_TOLERANCE
+    try:
+        scene = scene_from_dict(d)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            value, detail = _VIEWS[view](scene, d, Path(runs_root))
+    except Exception as exc:  # noqa: BLE001 - a cell that fails is evidence, not a crash
+        value, detail = math.nan, f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
+    ok = math.isfinite(value) and abs(value) <= tol
+    return Measurement(kind, feature, view, case, quantity, float(value), tol, unit, ok,
+                       detail)
