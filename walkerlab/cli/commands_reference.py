@@ -10,11 +10,13 @@ from walkerlab.cli.errors import guard
 @guard
 def capabilities(as_json: bool = typer.Option(False, "--json", help="print every cell as "
                                               "JSON: kind, feature, view, supported, "
-                                              "reason")) -> None:
-    """The capability table: for each walker kind (straight legs, locking knees, flat
-    feet, free joints, rolling polygon), which features (actuators, grounds) each view
-    (rigid, contact, exports, gym, optimize) supports, and the one-line reason of each
-    refusal (walkerlab.walker.kinds.CAPABILITIES; no model is built)."""
+                                              "reason; a supported cell's evidence: "
+                                              "verified, case, quantity, measured, "
+                                              "tolerance, unit, detail, commit")) -> None:
+    """The capability table: for each walker kind, which features (actuators, grounds)
+    each view (rigid, contact, exports, gym, optimize) supports, each supported cell with
+    the agreement measured on its reference case (✓ -0.4 %; ~ n: runs, not verified), and
+    the one-line reason of each refusal (no model is built)."""
     if as_json:
         import json
 
