@@ -5,7 +5,7 @@ evidence beside the table (``walkerlab/walker/capability_evidence.json``):
     python scripts/measure_capabilities.py --view contact  # one view's cells (merged in)
     python scripts/measure_capabilities.py --cell straight_legs/walk/mjcf --jobs 2
 
-Each cell runs in a process of its own (:func:`walkerlab.stages.capabilities.measure`, its
+Each cell runs in a process of its own (:func:`walkerlab.api.capabilities.measure`, its
 artifacts in a temporary runs folder); the file is rewritten under a temporary name, then
 renamed, with each measured cell's commit (``git rev-parse --short HEAD``, ``+`` when the
 tree had changes).  The slow test ``tests/test_capability_evidence.py`` re-measures every
@@ -37,7 +37,7 @@ def _commit() -> str:
 
 
 def _one(cell: str) -> dict:
-    from walkerlab.stages.capabilities import measure
+    from walkerlab.api.capabilities import measure
 
     kind, feature, view = cell.split("/")
     with tempfile.TemporaryDirectory(prefix="walkerlab-cap-") as tmp:
@@ -49,7 +49,7 @@ def _one(cell: str) -> dict:
 
 
 def main(argv=None) -> int:
-    from walkerlab.stages.capabilities import QUANTITIES
+    from walkerlab.api.capabilities import QUANTITIES
     from walkerlab.walker.capability_evidence import EVIDENCE_FILE
     from walkerlab.walker.kinds import table_rows
 
@@ -58,15 +58,25 @@ def main(argv=None) -> int:
     ap.add_argument("--kind", action="append", default=[])
     ap.add_argument("--cell", action="append", default=[], help="kind/feature/view")
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--out", type=Path, default=None,
+                    help="write here instead of the package's evidence file (merge later "
+                         "with --merge)")
+    ap.add_argument("--merge", type=Path, action="append", default=[],
+                    help="merge the cells of these files into the evidence file and stop")
     a = ap.parse_args(argv)
+    out = a.out or EVIDENCE_FILE
     cells = [f"{r['kind']}/{r['feature']}/{r['view']}" for r in table_rows()
              if r["supported"] and (not a.view or r["view"] in a.view)
              and (not a.kind or r["kind"] in a.kind)]
     if a.cell:
         cells = [c for c in cells if c in a.cell]
-    data = (json.loads(EVIDENCE_FILE.read_text()) if EVIDENCE_FILE.is_file()
-            else {"cells": {}})
+    data = json.loads(out.read_text()) if out.is_file() else {"cells": {}}
     data["tolerances"] = {v: f"{t:g} {u}" for v, (_, t, u) in QUANTITIES.items()}
+    if a.merge:
+        for m in a.merge:
+            data["cells"].update(json.loads(m.read_text())["cells"])
+        _write(out, data)
+        return 0
     commit = _commit()
     done = 0
     with ProcessPoolExecutor(a.jobs) as pool:
@@ -86,11 +96,16 @@ def main(argv=None) -> int:
             print(f"[{done}/{len(cells)}] {c}: {'ok' if d['ok'] else 'NOT'} "
                   f"{d.get('value')} ({d.get('cpu_s', '?')} s) {d['detail'][:140]}",
                   flush=True)
-            data["cells"] = dict(sorted(data["cells"].items()))
-            tmp = EVIDENCE_FILE.with_suffix(".json.tmp")
-            tmp.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n")
-            os.replace(tmp, EVIDENCE_FILE)
+            _write(out, data)
     return 0
+
+
+def _write(path: Path, data: dict) -> None:
+    """``data`` to ``path``: cells sorted, a temporary name, then renamed."""
+    data["cells"] = dict(sorted(data["cells"].items()))
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n")
+    os.replace(tmp, path)
 
 
 if __name__ == "__main__":

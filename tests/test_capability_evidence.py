@@ -83,10 +83,10 @@ REPRODUCE = 0.1
 @pytest.mark.parametrize("kind,feature,view", SUPPORTED_CELLS)
 def test_each_cells_stored_measurement_is_what_the_code_gives(kind, feature, view,
                                                                 tmp_path):
-    """Re-measure the cell (:func:`walkerlab.stages.capabilities.measure`): a verified cell
+    """Re-measure the cell (:func:`walkerlab.api.capabilities.measure`): a verified cell
     must stay within its tolerance and near its stored number; an unverified one must not
     have become silently verified (update the evidence: scripts/measure_capabilities.py)."""
-    from walkerlab.stages.capabilities import measure
+    from walkerlab.api.capabilities import measure
 
     e = cell_evidence(kind, feature, view)
     if view == "osim" and not e["ok"] and "not importable" in e["detail"]:

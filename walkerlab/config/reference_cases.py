@@ -3,7 +3,7 @@ CAPABILITIES`): the kind's base walker - one shipped scene per kind - with that 
 (a small torque law, a push-off, virtual constraints) and that ground (stairs, footholds,
 a profile), as a scene mapping.  The capability table's evidence
 (:mod:`walkerlab.walker.capability_evidence`) is measured on these cases
-(:mod:`walkerlab.stages.capabilities`), and the table's truth tests try them.
+(:mod:`walkerlab.api.capabilities`), and the table's truth tests try them.
 
 Nothing here builds a model: it reads the shipped scenes (``configs/`` next to the package)
 and returns mappings that :func:`walkerlab.config.scene_from_dict` validates.

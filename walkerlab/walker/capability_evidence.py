@@ -3,7 +3,7 @@
 quantity checked against a reference the cell does not compute itself, the measured number,
 the tolerance, and the commit it was measured at (``capability_evidence.json`` next to this
 module, written by ``scripts/measure_capabilities.py`` through
-:func:`walkerlab.stages.capabilities.measure`).
+:func:`walkerlab.api.capabilities.measure`).
 
 A supported cell is *verified* (``✓`` with its number, e.g. ``✓ -0.4 %``) when its
 measurement is within its tolerance; otherwise the view still runs it, but the table marks it

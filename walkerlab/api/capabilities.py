@@ -120,9 +120,9 @@ class Measurement:
 
 
 def _h5(path):
-    import h5py
+    from walkerlab.io.artifacts import open_artifact
 
-    return h5py.File(path, "r")
+    return open_artifact(Path(path))
 
 
 def _cyclic_deviation(got: np.ndarray, ref: np.ndarray) -> float:
