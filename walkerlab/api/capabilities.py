@@ -336,7 +336,9 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
     quantity, tol, unit = QUANTITIES[view]
     case, d = reference_scene(kind, feature, view)
     d = copy.deepcopy(d)
-    d["name"] = f"{kind}-{feature}-{view}"
+    # one name for a feature's views: they share its rigid gait in one runs folder (its
+    # artifacts are reused where up to date, as the commands reuse them)
+    d["name"] = f"{kind}-{feature}" + ("-optimize" if view == "optimize" else "")
     _strides_for(d, view)
     if view == "gym" and feature == "virtual_constraints":
         tol = GYM_POLICY_TOLERANCE
