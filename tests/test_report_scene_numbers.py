@@ -147,3 +147,53 @@ def test_a_dampers_loss_is_named_and_the_balance_checked_with_it():
                                     "energy balance closure, largest per step (ledger)"]
     text, rows = energy_check(sim(0.0), (3.7e-9, 1e-11), Units())  # no damper: drift is the check
     assert text.startswith("energy drift between impacts 3.7e-09 J"), text
+
+
+# ------------------------------------------------ a minimal scene of one's own (issue 64, 3)
+#: a user's minimal contact scene: walker, slope, contact, terrain, contact_sim (no
+#: fixedpoint, no simulate); every stage runs on it standalone
+MINIMAL = {"walker": IDEAL["walker"], "slope": IDEAL["slope"],
+           "contact": yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())["contact"],
+           "terrain": {"kind": "checkerboard", "patch_width_m": 0.2},
+           "contact_sim": {"n_strides": 2}}
+
+
+def test_a_minimal_contact_scene_plans_the_gait_its_contact_run_starts_from():
+    plan = pipeline.report_plan(scene_from_dict(MINIMAL | {"name": "mini"}))
+    # before: [] (an empty report, exit 0); `walkerlab contact-sim` runs the same two
+    assert plan == ["fixedpoint", "contact-sim"]
+
+
+def test_a_scene_that_gives_the_report_nothing_is_refused_naming_the_sections(tmp_path):
+    scene = tmp_path / "bare.yaml"
+    scene.write_text(yaml.safe_dump({k: MINIMAL[k] for k in ("walker", "slope", "contact")}))
+    code, err, _ = _cli("report", scene, "--runs-dir", tmp_path / "runs")
+    assert code == 1 and len(err.splitlines()) == 1, err
+    assert all(f"'{s}'" in err for s in ("fixedpoint", "simulate", "contact_sim")), err
+    assert not (tmp_path / "runs" / "bare" / "report").exists()
+
+
+def test_a_contact_artifact_left_out_is_said_why_in_the_scenes_own_terms():
+    from walkerlab.stages.report_inputs import not_run
+
+    has_contact = scene_from_dict({k: MINIMAL[k] for k in ("walker", "slope", "contact")}
+                                  | {"name": "c", "simulate": IDEAL["simulate"]})
+    # before: "the scene has no 'contact' section" (it has one) and "the scene has needs both"
+    assert "no 'contact' section" not in not_run(has_contact, "contact-sim")
+    assert "'contact_sim'" in not_run(has_contact, "contact-sim")
+    assert not_run(scene_from_dict(IDEAL | {"name": "i"}), "compare") == "no 'contact' section"
+
+
+@pytest.mark.slow
+def test_the_report_of_a_minimal_contact_scene_shows_its_gait_and_contact_run(tmp_path):
+    scene = tmp_path / "mini.yaml"
+    scene.write_text(yaml.safe_dump(MINIMAL))
+    runs = tmp_path / "runs"
+    code, err, _ = _cli("contact-sim", scene, "--runs-dir", runs)  # the standalone run first
+    assert code == 0, err
+    code, err, _ = _cli("report", scene, "--runs-dir", runs)
+    assert code == 0, err
+    md = (runs / "mini" / "report" / "report.md").read_text()
+    summary = md.split("## Summary", 1)[1].split("\n## ", 1)[0]
+    assert "**Gait found**: yes" in summary and "**Contact walker walks**" in summary
+    assert "leaves out" not in err

@@ -14,20 +14,40 @@ from walkerlab.config import Scene
 from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
 from walkerlab.io.freshness import changed_fields, input_hash
 from walkerlab.io.runpaths import bifurcation_artifacts, stage_artifact
-from walkerlab.stages.pipeline import needs, stage_module
+from walkerlab.stages.pipeline import contact_walks_ground, needs, stage_module
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
                  "bifurcation", "basin", "robustness", "mfpt", "attribution", "optimize")
-#: why a report leaves out an artifact of a stage the scene does not run
-NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' section",
-           "contact-sim": "no 'contact' section",
-           "compare": "needs both a 'simulate' and a 'contact' section",
+#: why a report leaves out an artifact of a stage the scene does not run (the contact
+#: stages: :func:`not_run`)
+NOT_RUN = {"fixedpoint": "no 'fixedpoint' section (nor a 'simulate' or 'contact_sim' that "
+                         "starts from the gait)",
+           "simulate": "no 'simulate' section",
            "workprecision": "no 'workprecision' section",
            "basin": "no 'basin' section (or no 'fixedpoint')",
            "robustness": "no 'robustness' section (or no 'fixedpoint')",
            "mfpt": "no 'mfpt' section (or no 'fixedpoint')",
            "attribution": "no 'contact' or 'fixedpoint' section",
            "optimize": "no 'optimize' section (or no 'fixedpoint')"}
+
+
+def not_run(scene: Scene, stage: str) -> str:
+    """Why the report does not run ``stage`` for ``scene`` (completing "the scene has ...");
+    the contact stages by what the scene lacks, or the capability table's cell that
+    refuses its ground (:func:`walkerlab.stages.pipeline.report_plan`)."""
+    if stage == "compare" and scene.simulate is None:
+        return "no 'simulate' section (compare needs 'simulate' and 'contact-sim')"
+    if stage in ("contact-sim", "compare"):
+        if scene.contact is None:
+            return "no 'contact' section"
+        if not contact_walks_ground(scene):
+            ground = scene.terrain.kind if scene.terrain is not None else "slope"
+            return (f"a walker the contact view does not walk on {ground} "
+                    "(`walkerlab capabilities`)")
+        return "a 'contact' section but no 'contact_sim' or 'fixedpoint' section"
+    return NOT_RUN.get(stage, "no section for it")
+
+
 #: artifacts shown although this report did not compute them, when computed for the
 #: scene's current sections: (their stage, why one is left out)
 EARLIER = {"workprecision": "measured for other settings; `walkerlab report --full` "
@@ -66,7 +86,7 @@ def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
     kind = "bifurcation" if stage.startswith("bifurcation") else stage
     if kind not in EARLIER or (kind == "workprecision" and (scene.workprecision is None or full)
                                ) or (kind == "attribution" and (scene.contact is None or full)):
-        return f"an earlier standalone run: the scene has {NOT_RUN.get(stage, 'no section for it')}"
+        return f"an earlier standalone run: the scene has {not_run(scene, stage)}"
     if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
         return "changed after it was written: rerun 'walkerlab bifurcation'"
     return EARLIER[kind] if changed_fields(p, scene, stage_sections(kind, scene)) else ""
