@@ -22,7 +22,7 @@ A traceback shown to a user is a bug.  Every command runs inside
 :func:`walkerlab.cli.errors.guard`: one line ``error: ...`` on stderr and exit code 1 for
 bad input or a walker that falls (the stage's ``StageOutcome.failure``), ``interrupted`` and
 130 on Ctrl-C.  typer's own usage errors (unknown option, a value out of an option's range)
-keep typer's message and exit code 2.
+keep typer's message, as one line ``error: ...`` too, and exit code 2.
 """
 
 from __future__ import annotations
@@ -37,9 +37,10 @@ from walkerlab.cli import (
     commands_runs,
 )
 from walkerlab.cli.process import process_settings, single_threaded_blas, version_callback
-from walkerlab.cli.typer_flags import flags_take_no_value
+from walkerlab.cli.typer_flags import flags_take_no_value, usage_errors_in_one_spelling
 
 flags_take_no_value()
+usage_errors_in_one_spelling()
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: planar biped walkers, passive and powered, from fixed point to "
