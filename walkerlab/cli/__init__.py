@@ -54,8 +54,9 @@ def _main(version: bool = typer.Option(False, "--version", callback=version_call
                                        "and h5py versions and exit"),
           quiet: bool = typer.Option(False, "--quiet", "-q",
                                      help="no progress display and no notices on stderr "
-                                     "(errors are still shown); progress is also off when "
-                                     "stderr is not a terminal")) -> None:
+                                     "(errors are still shown); when stderr is not a "
+                                     "terminal, progress is a plain line per finished unit")
+          ) -> None:
     """walkerlab: planar biped walkers, passive and powered, from fixed point to report."""
     single_threaded_blas()
     process_settings()
