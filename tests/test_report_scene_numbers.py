@@ -197,3 +197,27 @@ def test_the_report_of_a_minimal_contact_scene_shows_its_gait_and_contact_run(tm
     summary = md.split("## Summary", 1)[1].split("\n## ", 1)[0]
     assert "**Gait found**: yes" in summary and "**Contact walker walks**" in summary
     assert "leaves out" not in err
+
+
+# ------------------------------------------- what the report leaves out, named in it (64, 10)
+def test_an_animation_not_drawn_from_the_current_run_is_left_out_and_named(tmp_path):
+    from walkerlab.io.runpaths import figures_dir
+    from walkerlab.stages.report_inputs import report_artifacts
+
+    scene = scene_from_dict(IDEAL | {"name": "anim"})
+    figs = figures_dir(scene, tmp_path)
+    figs.mkdir(parents=True)
+    (figs / "animation.gif").write_bytes(b"GIF89a")  # an earlier `walkerlab animate`'s
+    _paths, line = report_artifacts(scene, tmp_path, [])
+    assert "animation.gif (not drawn from this run folder's simulate.h5" in line
+
+
+def test_the_report_file_says_what_it_leaves_out(tmp_path):
+    from walkerlab.report.build import write_report
+
+    scene = scene_from_dict(IDEAL | {"name": "left"})
+    inputs = ReportInputs({}, left_out="report: leaves out mfpt.h5 (computed for other "
+                                       "settings: rerun `walkerlab mfpt`)", animation=False)
+    write_report(scene, inputs, tmp_path / "report", tmp_path / "figures")
+    md = (tmp_path / "report" / "report.md").read_text()
+    assert "*Leaves out mfpt.h5 (computed for other settings: rerun `walkerlab mfpt`).*" in md

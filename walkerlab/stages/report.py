@@ -24,7 +24,7 @@ from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.common import StageError
 from walkerlab.stages.pipeline import report_plan
 from walkerlab.stages.report_dag import run_report
-from walkerlab.stages.report_inputs import report_artifacts
+from walkerlab.stages.report_inputs import animation_current, report_artifacts
 
 
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
@@ -83,4 +83,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if left_out:
         echo(left_out)
     rep_dir, figs = report_dir(scene, runs_root, claim=True), figures_dir(scene, runs_root)
-    return write_report(scene, load_inputs(scene, paths, figs), rep_dir, figs, done)
+    inputs = load_inputs(scene, paths, figs)
+    inputs.animation = not animation_current(scene, runs_root)
+    inputs.left_out = left_out
+    return write_report(scene, inputs, rep_dir, figs, done)

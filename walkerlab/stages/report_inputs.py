@@ -12,8 +12,8 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
-from walkerlab.io.freshness import changed_fields, input_hash
-from walkerlab.io.runpaths import bifurcation_artifacts, stage_artifact
+from walkerlab.io.freshness import changed_fields, drawing_key, input_hash, stamp_matches
+from walkerlab.io.runpaths import bifurcation_artifacts, figures_dir, stage_artifact
 from walkerlab.stages.pipeline import contact_walks_ground, needs, stage_module
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
@@ -56,6 +56,28 @@ EARLIER = {"workprecision": "measured for other settings; `walkerlab report --fu
                           "it again",
            "bifurcation": "computed for another walker, slope or solver",
            "mfpt": "computed for other settings: rerun `walkerlab mfpt`"}
+
+
+#: the stamp beside ``animation.gif``: the drawing key of the artifacts it was drawn from
+#: (written by ``walkerlab animate``)
+ANIMATION_STAMP = ".drawn_from_animation"
+
+
+def animation_current(scene: Scene, runs_root) -> str:
+    """Why ``animation.gif`` must not be shown beside the run folder's current artifacts
+    ('' if it may): no stamp (drawn before stamps were written, or half written), or drawn
+    from other artifacts than the ``simulate.h5`` (and ``contact_sim.h5``) there now."""
+    stamp = figures_dir(scene, runs_root) / ANIMATION_STAMP
+    sim, contact = (stage_artifact(scene, runs_root, s) for s in ("simulate", "contact-sim"))
+    if not stamp.is_file() or not sim.is_file():
+        return "not drawn from this run folder's simulate.h5: rerun `walkerlab animate`"
+    keys = [drawing_key({"simulate": sim})]
+    if contact.is_file():
+        keys.append(drawing_key({"simulate": sim, "contact-sim": contact}))
+    if not any(stamp_matches(stamp, k) for k in keys):
+        return "drawn from an earlier simulate.h5 or contact_sim.h5: rerun `walkerlab animate`"
+    return ""
+
 
 
 def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] = ()) -> str:
@@ -111,4 +133,7 @@ def report_artifacts(scene: Scene, runs_root, done: list, full: bool = False
             left.append(f"{p.name} ({why})")
         else:
             paths[stage] = p
+    if (figures_dir(scene, runs_root) / "animation.gif").is_file() \
+            and (why := animation_current(scene, runs_root)):
+        left.append(f"animation.gif ({why})")
     return paths, ("report: leaves out " + "; ".join(left)) if left else ""
