@@ -310,3 +310,18 @@ def test_a_field_given_one_section_too_high_points_to_its_section():
     d = dict(SIMPLEST, angle_deg=2.0)
     lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
     assert lines == ["s.yaml: angle_deg: unknown field (did you mean slope.angle_deg?)"]
+
+
+def test_every_command_in_the_top_level_help_is_one_sentence_on_one_line():
+    """Issue 64 item 10: ``walkerlab --help`` cut the commands' help mid-sentence (each
+    docstring's hard line breaks kept)."""
+    from walkerlab.cli import COMMANDS
+
+    r = CliRunner().invoke(app, ["--help"], env={"COLUMNS": "80"}, terminal_width=80)
+    assert r.exit_code == 0
+    box = [ln for ln in r.stdout.split("Commands")[1].splitlines() if ln.startswith("│")]
+    names = [name for name, _ in COMMANDS]
+    assert len(box) == len(names)  # no continuation lines
+    for line, name in zip(box, names):
+        help_ = line.strip("│ ").removeprefix(name).strip()
+        assert help_.endswith(".") and help_.count(". ") == 0, line

@@ -80,5 +80,29 @@ COMMANDS = (
     ("animate", commands_output.animate), ("export", commands_output.export),
     ("bench", commands_output.bench), ("capabilities", commands_reference.capabilities),
 )
+#: each command's line in ``walkerlab --help``: one sentence that fits beside its name on
+#: an 80-column terminal (the command's own ``--help`` gives its whole docstring)
+SHORT_HELP = {
+    "fixedpoint": "Find the period-1 gait and its Floquet multipliers.",
+    "simulate": "Simulate the rigid walker for N strides.",
+    "contact-sim": "Simulate the compliant-contact walker on its terrain.",
+    "compare": "Compare the rigid and the contact trajectories.",
+    "workprecision": "Time every solver setting against its error.",
+    "plot": "Draw the figures from the scene's artifacts.",
+    "report": "Run what the scene needs and write the report.",
+    "sweep": "Run a stage over a grid of scene fields.",
+    "bifurcation": "Draw the bifurcation diagram over a scene field.",
+    "continuation": "Follow the gait over a field, naming its special points.",
+    "target": "Find the field value whose gait meets a target.",
+    "optimize": "Optimise a gait, or design fields, by collocation.",
+    "basin": "Map the basin of attraction of the gait.",
+    "mfpt": "Mean first-passage time on random per-step slopes.",
+    "robustness": "Gait sensitivity, step-down/up and MFPT at one sigma.",
+    "stability-map": "Map where the contact gait exists and is stable.",
+    "animate": "Animate the walker walking (GIF, and MP4 with ffmpeg).",
+    "export": "Export the walker (URDF, MJCF, Adams, OpenSim).",
+    "bench": "Benchmark wall time and right-hand-side evaluations.",
+    "capabilities": "Show what each walker kind supports in each view.",
+}
 for _name, _command in COMMANDS:
-    app.command(_name)(_command)
+    app.command(_name, short_help=SHORT_HELP[_name])(_command)
