@@ -221,3 +221,31 @@ def test_the_report_file_says_what_it_leaves_out(tmp_path):
     write_report(scene, inputs, tmp_path / "report", tmp_path / "figures")
     md = (tmp_path / "report" / "report.md").read_text()
     assert "*Leaves out mfpt.h5 (computed for other settings: rerun `walkerlab mfpt`).*" in md
+
+
+def test_a_published_value_far_from_ours_is_flagged_in_its_summary_row():
+    """Issue 64 item 10: "0.5278 vs published 0.0246 m/s" stood unflagged in the summary
+    (the explanation three sections later)."""
+    from walkerlab.published import paper
+    from walkerlab.report.sections import _gait_rows
+    from walkerlab.units import Units
+
+    ideal = {"t_cycle_s": 1.407, "v_com_m_per_s": 0.5278, "E_avg_stance_frame_J": 150.2,
+             "step_length_m": 0.3714}
+    rows = {r[0]: r[3] for r in _gait_rows(ideal, paper, Units())}
+    speed = rows["Average velocity of robot"]
+    assert speed.startswith("0.0246 ⚠ ours is 21.5× this")
+    assert rows["step length"].startswith("0.0342 ⚠ ours is 10.9× this")
+    assert rows["One cycle period"] == "1.39"  # 1.407 against 1.39: no flag
+
+
+def test_the_contact_outcome_is_one_sentence():
+    """Issue 64 item 10: "Outcome: t_final — walked: 10 heel strikes by the end time Walks
+    (the verdict from its steps): yes"."""
+    from walkerlab.report.contact_sections import _outcome_sentence
+
+    said = _outcome_sentence(("t_final", "walked: 10 heel strikes by the end time"), True, "")
+    assert said == ("Outcome: the run ended by **t_final** (walked: 10 heel strikes by the "
+                    "end time), and by the verdict from its steps the walker walks.")
+    assert _outcome_sentence(("fall", "fall"), False, "it fell in step 3").endswith(
+        "the walker **does not walk** (it fell in step 3).")

@@ -10,7 +10,6 @@ SceneError
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 from typing import Annotated, Any
 

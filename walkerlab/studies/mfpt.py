@@ -325,7 +325,6 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
         The walker cannot walk on per-step slopes; the contact model asked for the mesh,
         without patches or without a periodic gait (one line).
     """
-    import time
 
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
     from walkerlab.models.registry import build_walker
