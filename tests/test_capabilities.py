@@ -259,3 +259,37 @@ def test_every_per_kind_table_of_the_stages_and_integrators_names_every_kind():
 
     for table in (_ROLLS, _SCIPY_RUNS_ACTUATED_COMPILED):
         assert set(table) == set(KINDS)
+
+
+# ------------------------------------------- a refusal the table decides comes first (64, 6)
+class GaitSearched(Exception):
+    """A gait search started: the refusal came after costly work."""
+
+
+def _no_gait_search(*_a, **_k):
+    raise GaitSearched
+
+
+def test_contact_sim_refuses_flat_feet_on_stairs_before_any_gait_search(tmp_path,
+                                                                        monkeypatch):
+    """Issue 64 item 6: ``contact-sim configs/flat_feet_stairs.yaml`` refused after 21 s of
+    rigid gait search (the fixed point upstream) what the table knows from the scene."""
+    from walkerlab.config import load_scene
+    from walkerlab.stages import fixedpoint, pipeline
+
+    monkeypatch.setattr(fixedpoint, "run", _no_gait_search)
+    with pytest.raises(ValueError) as exc:
+        pipeline.run("contact-sim", load_scene(ROOT / "configs" / "flat_feet_stairs.yaml"),
+                     tmp_path)
+    assert KINDS["flat_feet"].cell("stairs", "contact") in str(exc.value)
+    assert "\n" not in str(exc.value)
+
+
+def test_the_gym_contact_view_refuses_its_ground_before_any_gait_search(monkeypatch):
+    pytest.importorskip("gymnasium")
+    from walkerlab.gym import env
+
+    monkeypatch.setattr(env, "_gait", _no_gait_search)
+    with pytest.raises(ValueError) as exc:
+        env.WalkerEnv(str(ROOT / "configs" / "flat_feet_stairs.yaml"), view="contact")
+    assert KINDS["flat_feet"].cell("stairs", "contact") in str(exc.value)

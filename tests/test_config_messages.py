@@ -135,6 +135,40 @@ def test_a_yaml_1_1_number_form_is_refused_naming_the_field(tmp_path, form, plai
     assert load_scene(p).walker.hip_mass_kg == 10  # a plain decimal is read
 
 
+@pytest.mark.parametrize("quoted", ['"10.0"', "'10'", '"1.0e+1"'])
+def test_a_quoted_number_is_told_to_lose_its_quotes_not_its_yaml_1_1_form(tmp_path, quoted):
+    """Issue 64 item 5: a quoted plain number (``hip_mass_kg: "10.0"``) was told it is "a
+    YAML 1.1 number form (hex, binary, octal, base 60, underscores)"."""
+    p = tmp_path / "q.yaml"
+    p.write_text("walker: {model: compass_gait, leg_length_m: 1, leg_mass_kg: 5, "
+                 f"hip_mass_kg: {quoted}, leg_mass_from_foot_m: 0.5}}\nslope: {{angle_deg: 1}}\n")
+    with pytest.raises(SceneError) as exc:
+        load_scene(p)
+    msg = str(exc.value)
+    assert "\n" not in msg and "walker.hip_mass_kg" in msg and "YAML 1.1" not in msg
+    assert msg.endswith("is written in quotes, which makes it text: write it without them")
+
+
+def test_a_usage_error_is_spelled_error_as_every_other_error():
+    """Issue 64 item 5: typer boxed a usage error under "Error" (click: ``Error: ...``)
+    where every walkerlab error is ``error: ...``."""
+    code, err, _ = _cli("fixedpoint", "--no-such-option")
+    assert code == 2
+    assert err.splitlines()[-1] == "error: No such option: --no-such-option"
+    assert "Error" not in err
+
+
+def test_a_vanishing_phase_scale_is_refused_naming_the_phase_not_the_outputs():
+    """Issue 64 item 5: ``phase.coordinates: {stance: 1e-300}`` was blamed on the outputs
+    ("the swing foot reaches the ground ... for no value of the phase variable")."""
+    three = yaml.safe_load((ROOT / "configs" / "threelink_hzd.yaml").read_text())
+    three["walker"]["actuation"]["virtual_constraints"]["phase"] = {
+        "coordinates": {"stance": 1e-300}}
+    (line,) = _errors(three)
+    assert "walker.actuation.virtual_constraints.phase: coordinates:" in line
+    assert "outputs" not in line and "1e-300" in line
+
+
 # --------------------------------------------------------------- 10: said once
 def test_messages_are_not_doubled():
     d = {"walker": {k: v for k, v in WALKER.items() if k != "leg_mass_from_foot_m"}
@@ -276,3 +310,18 @@ def test_a_field_given_one_section_too_high_points_to_its_section():
     d = dict(SIMPLEST, angle_deg=2.0)
     lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
     assert lines == ["s.yaml: angle_deg: unknown field (did you mean slope.angle_deg?)"]
+
+
+def test_every_command_in_the_top_level_help_is_one_sentence_on_one_line():
+    """Issue 64 item 10: ``walkerlab --help`` cut the commands' help mid-sentence (each
+    docstring's hard line breaks kept)."""
+    from walkerlab.cli import COMMANDS
+
+    r = CliRunner().invoke(app, ["--help"], env={"COLUMNS": "80"}, terminal_width=80)
+    assert r.exit_code == 0
+    box = [ln for ln in r.stdout.split("Commands")[1].splitlines() if ln.startswith("│")]
+    names = [name for name, _ in COMMANDS]
+    assert len(box) == len(names)  # no continuation lines
+    for line, name in zip(box, names):
+        help_ = line.strip("│ ").removeprefix(name).strip()
+        assert help_.endswith(".") and help_.count(". ") == 0, line

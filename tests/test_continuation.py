@@ -490,3 +490,33 @@ def test_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_pat
     assert orbit.ndim == 2 and orbit.shape[1] == 2  # two heel strikes a map at every point
     d = load_continuation(path)
     assert np.all(np.isfinite(d.branches[0]["param"]))
+
+
+def test_a_homotopy_turned_back_by_a_fold_says_how_far_it_got_not_only_where_it_ended(
+        monkeypatch):
+    """Issue 64 item 5: a branch turned back by a fold said "stopped at lambda = 0: fold at
+    lambda 0.2343" (where it ended after turning back, as if it had not started)."""
+    from types import SimpleNamespace
+
+    from walkerlab.studies import continuation as C
+
+    sc = load_scene(Path(__file__).resolve().parents[1] / "configs" / "paper.yaml")
+    pts = [SimpleNamespace(p=p) for p in (0.0, 0.1, 0.2, 0.2343, 0.2, 0.1, 0.0)]
+    fold = SimpleNamespace(kind="fold", p=0.2343, cause="")
+    res = SimpleNamespace(reached=False, fields={"slope.angle_rad": 1}, specials=[fold],
+                          x=np.zeros(4), branch=SimpleNamespace(points=pts))
+    monkeypatch.setattr(C, "homotopy_gait", lambda known, new: res)
+    with pytest.raises(ValueError) as exc:
+        C.homotopy_start(sc, sc)
+    msg = str(exc.value)
+    assert "stopped at lambda = 0" not in msg
+    assert "got as far as lambda = 0.2343, then turned back and ended at lambda = 0" in msg
+    assert msg.endswith("fold at lambda 0.2343)")
+
+
+def test_the_from_option_says_the_two_walkers_must_share_their_structure():
+    """Issue 64 item 5: ``--from`` refuses scenes whose body lists differ; its help did not
+    say so."""
+    code, _err, out = _cli("fixedpoint", "--help")
+    assert code == 0
+    assert "must have the same structure" in " ".join(out.replace("│", " ").split())

@@ -283,3 +283,54 @@ def test_special_point_labels_stay_inside_the_axes_clear_of_their_markers():
         assert box.x0 - 1 <= bb.x0 and bb.x1 <= box.x1 + 1, t.get_text()
         x, y = ax.transData.transform((float(t.xy[0]), float(t.xy[1])))
         assert not (bb.x0 - 4 <= x <= bb.x1 + 4 and bb.y0 - 4 <= y <= bb.y1 + 4), t.get_text()
+
+
+def test_fig9_titles_a_straight_legs_panel_by_the_legs_it_holds_not_leg():
+    """Issue 64 item 10: the paper walker's Fig. 9 panel was titled "leg"."""
+    from types import SimpleNamespace
+
+    t = np.linspace(0, 1, 20)
+    coords = {f"{leg}_{q}": np.sin(t + k) for k, leg in enumerate(("leg1", "leg2"))
+              for q in ("angle", "rate")}
+    tr = SimpleNamespace(legs=("leg1", "leg2"), coordinates=coords,
+                         phase_pairs=lambda: [("leg1_angle", "leg1_rate"),
+                                              ("leg2_angle", "leg2_rate")])
+    fig = F.fig9_limit_cycle({"ideal": tr})
+    (ax,) = fig.axes
+    assert ax.get_title() == "legs: leg1 and leg2"
+
+
+def test_the_optimize_figure_draws_every_controllers_outputs_against_the_phase(monkeypatch,
+                                                                              tmp_path):
+    """Issue 64 item 10: optimize.png of a design of two controllers had an empty panel,
+    drew controller 1 of 2 and no outputs against the phase (the Bezier polynomials)."""
+    from types import SimpleNamespace
+
+    from walkerlab.plotting import figures, optimize_figure
+
+    t = np.linspace(0.0, 0.4, 9)
+    ctrl = [SimpleNamespace(target_speed_m_per_s=v, output_names=("link:swing_leg",
+                                                                  "link:torso"),
+                            bezier_rad=np.array([[-0.2, -0.1, 0.0, 0.1, 0.2 + k],
+                                                 [0.1, 0.1, 0.1, 0.1, 0.1]]),
+                            step_period_s=0.45, step_length_m=0.3, max_torque_n_m=50.0,
+                            multipliers=np.array([0.5, 0.1]), status="Solve_Succeeded")
+            for k, v in enumerate((0.5, 0.8))]
+    d = SimpleNamespace(time=t, torque=np.zeros((9, 2)), torque_names=("u1", "u2"),
+                        torque_unit="N m", terms={}, objective_name="effort", objective=1.0,
+                        objective_unit="N^2 m^2 s", states={"torso": t}, state_units={
+                            "torso": "rad"}, step_length_m=0.3, step_period_s=0.45,
+                        replay_error=1e-6, energy={}, ipopt_history={
+                            "objective": np.ones(3), "primal_infeasibility": np.ones(3),
+                            "dual_infeasibility": np.ones(3)}, steps=1, phase_names=("s",),
+                        phase_start=(0,), gait=True, status="Solve_Succeeded", iterations=3,
+                        energy_unit="J", controllers=ctrl)
+    drawn = {}
+    monkeypatch.setattr(figures, "save", lambda fig, folder, name, svg: drawn.setdefault(
+        "fig", fig) and [])
+    optimize_figure.save_optimize_figure(d, "threelink_hzd", tmp_path)
+    shown = [a for a in drawn["fig"].axes if a.axison]
+    assert all(a.lines or a.texts for a in shown)  # no empty panel
+    (phase,) = [a for a in shown if "against the phase" in a.get_title()]
+    assert len([ln for ln in phase.lines if ln.get_linestyle() != "None"]) == 2 * 2
+    assert "all 2 controllers" in phase.get_title()

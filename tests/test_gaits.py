@@ -266,3 +266,18 @@ def test_list_items_by_name_or_index_in_paths():
                        "did you mean walker.leg.bodies.shank_mass.mass_kg")):
         with pytest.raises(SweepError, match=word):
             check_axes(scene, [parse_param(bad)])
+
+
+def test_a_walk_round_where_no_seed_lasts_its_steps_says_none_lasted(monkeypatch):
+    """Issue 64 item 5: "23 seeds walked 20 steps (0 root-finder starts)" meant that none
+    of the 23 lasted 20 steps."""
+    from walkerlab.analysis.gait import search
+    from walkerlab.analysis.gait.starts import WALK_STEPS
+
+    seeds = [(1.0, "seed", np.zeros(4))] * 23
+    monkeypatch.setattr(search, "screen_seeds", lambda *a: (seeds, 23, 0))
+    monkeypatch.setattr(search, "walked_start", lambda *a: None)  # every one falls
+    starts = search._RootStarts(None, None, {"max_step_time": 1.0})
+    monkeypatch.setattr(starts, "attempt", lambda *a, **k: None)
+    starts.from_seeds()
+    assert starts.tried[-1] == f"23 seeds set walking for {WALK_STEPS} steps (none lasted them)"

@@ -147,3 +147,105 @@ def test_a_dampers_loss_is_named_and_the_balance_checked_with_it():
                                     "energy balance closure, largest per step (ledger)"]
     text, rows = energy_check(sim(0.0), (3.7e-9, 1e-11), Units())  # no damper: drift is the check
     assert text.startswith("energy drift between impacts 3.7e-09 J"), text
+
+
+# ------------------------------------------------ a minimal scene of one's own (issue 64, 3)
+#: a user's minimal contact scene: walker, slope, contact, terrain, contact_sim (no
+#: fixedpoint, no simulate); every stage runs on it standalone
+MINIMAL = {"walker": IDEAL["walker"], "slope": IDEAL["slope"],
+           "contact": yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())["contact"],
+           "terrain": {"kind": "checkerboard", "patch_width_m": 0.2},
+           "contact_sim": {"n_strides": 2}}
+
+
+def test_a_minimal_contact_scene_plans_the_gait_its_contact_run_starts_from():
+    plan = pipeline.report_plan(scene_from_dict(MINIMAL | {"name": "mini"}))
+    # before: [] (an empty report, exit 0); `walkerlab contact-sim` runs the same two
+    assert plan == ["fixedpoint", "contact-sim"]
+
+
+def test_a_scene_that_gives_the_report_nothing_is_refused_naming_the_sections(tmp_path):
+    scene = tmp_path / "bare.yaml"
+    scene.write_text(yaml.safe_dump({k: MINIMAL[k] for k in ("walker", "slope", "contact")}))
+    code, err, _ = _cli("report", scene, "--runs-dir", tmp_path / "runs")
+    assert code == 1 and len(err.splitlines()) == 1, err
+    assert all(f"'{s}'" in err for s in ("fixedpoint", "simulate", "contact_sim")), err
+    assert not (tmp_path / "runs" / "bare" / "report").exists()
+
+
+def test_a_contact_artifact_left_out_is_said_why_in_the_scenes_own_terms():
+    from walkerlab.stages.report_inputs import not_run
+
+    has_contact = scene_from_dict({k: MINIMAL[k] for k in ("walker", "slope", "contact")}
+                                  | {"name": "c", "simulate": IDEAL["simulate"]})
+    # before: "the scene has no 'contact' section" (it has one) and "the scene has needs both"
+    assert "no 'contact' section" not in not_run(has_contact, "contact-sim")
+    assert "'contact_sim'" in not_run(has_contact, "contact-sim")
+    assert not_run(scene_from_dict(IDEAL | {"name": "i"}), "compare") == "no 'contact' section"
+
+
+@pytest.mark.slow
+def test_the_report_of_a_minimal_contact_scene_shows_its_gait_and_contact_run(tmp_path):
+    scene = tmp_path / "mini.yaml"
+    scene.write_text(yaml.safe_dump(MINIMAL))
+    runs = tmp_path / "runs"
+    code, err, _ = _cli("contact-sim", scene, "--runs-dir", runs)  # the standalone run first
+    assert code == 0, err
+    code, err, _ = _cli("report", scene, "--runs-dir", runs)
+    assert code == 0, err
+    md = (runs / "mini" / "report" / "report.md").read_text()
+    summary = md.split("## Summary", 1)[1].split("\n## ", 1)[0]
+    assert "**Gait found**: yes" in summary and "**Contact walker walks**" in summary
+    assert "leaves out" not in err
+
+
+# ------------------------------------------- what the report leaves out, named in it (64, 10)
+def test_an_animation_not_drawn_from_the_current_run_is_left_out_and_named(tmp_path):
+    from walkerlab.io.runpaths import figures_dir
+    from walkerlab.stages.report_inputs import report_artifacts
+
+    scene = scene_from_dict(IDEAL | {"name": "anim"})
+    figs = figures_dir(scene, tmp_path)
+    figs.mkdir(parents=True)
+    (figs / "animation.gif").write_bytes(b"GIF89a")  # an earlier `walkerlab animate`'s
+    _paths, line = report_artifacts(scene, tmp_path, [])
+    assert "animation.gif (not drawn from this run folder's simulate.h5" in line
+
+
+def test_the_report_file_says_what_it_leaves_out(tmp_path):
+    from walkerlab.report.build import write_report
+
+    scene = scene_from_dict(IDEAL | {"name": "left"})
+    inputs = ReportInputs({}, left_out="report: leaves out mfpt.h5 (computed for other "
+                                       "settings: rerun `walkerlab mfpt`)", animation=False)
+    write_report(scene, inputs, tmp_path / "report", tmp_path / "figures")
+    md = (tmp_path / "report" / "report.md").read_text()
+    assert "*Leaves out mfpt.h5 (computed for other settings: rerun `walkerlab mfpt`).*" in md
+
+
+def test_a_published_value_far_from_ours_is_flagged_in_its_summary_row():
+    """Issue 64 item 10: "0.5278 vs published 0.0246 m/s" stood unflagged in the summary
+    (the explanation three sections later)."""
+    from walkerlab.published import paper
+    from walkerlab.report.sections import _gait_rows
+    from walkerlab.units import Units
+
+    ideal = {"t_cycle_s": 1.407, "v_com_m_per_s": 0.5278, "E_avg_stance_frame_J": 150.2,
+             "step_length_m": 0.3714}
+    rows = {r[0]: r[3] for r in _gait_rows(ideal, paper, Units())}
+    speed = rows["Average velocity of robot"]
+    assert speed.startswith("0.0246 ⚠ ours is 21.5× this")
+    assert rows["step length"].startswith("0.0342 ⚠ ours is 10.9× this")
+    assert rows["One cycle period"] == "1.39"  # 1.407 against 1.39: no flag
+
+
+def test_the_contact_outcome_is_one_sentence():
+    """Issue 64 item 10: "Outcome: t_final — walked: 10 heel strikes by the end time Walks
+    (the verdict from its steps): yes"."""
+    from walkerlab.report.contact_sections import _outcome_sentence
+
+    said = _outcome_sentence(("t_final", "walked: 10 heel strikes by the end time"), True, "")
+    assert said == ("Outcome: the run ended by **t_final** (walked: 10 heel strikes by the "
+                    "end time), and by the verdict from its steps the walker walks.")
+    assert _outcome_sentence(("fall", "fall"), False, "it fell in step 3").endswith(
+        "the walker **does not walk** (it fell in step 3).")

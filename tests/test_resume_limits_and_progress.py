@@ -461,7 +461,7 @@ def test_progress_sink_follows_the_terminal_and_quiet():
             return False
 
     assert isinstance(progress.sink_for_terminal(False, Tty()), progress.RichSink)
-    assert isinstance(progress.sink_for_terminal(False, Pipe()), progress.QuietSink)
+    assert isinstance(progress.sink_for_terminal(False, Pipe()), progress.LineSink)
     quiet = progress.sink_for_terminal(True, Tty())
     assert isinstance(quiet, progress.QuietSink) and quiet.silent
 
@@ -472,10 +472,68 @@ def _run_cli(tmp_path, *args):
                           capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300)
 
 
-def test_progress_non_tty_sweep_prints_nothing_to_stderr(tmp_path, paper_scene):
+def test_progress_non_tty_sweep_prints_a_plain_line_per_point_and_nothing_under_quiet(
+        tmp_path, paper_scene):
+    """Issue 64 item 7: without a terminal (a pipe, nohup, CI) a long run printed nothing;
+    now a line per finished unit, no terminal codes; ``-q``: nothing."""
     r = _run_cli(tmp_path, "sweep", paper_scene, "--param", "slope.angle_deg=1,1.1",
                  "--workers", "1", "--runs-dir", "runs")
-    assert r.returncode == 0 and r.stderr == "", r.stderr  # no progress bar when piped
+    lines = r.stderr.strip().splitlines()  # a line per chunk of points finished
+    assert r.returncode == 0 and 1 <= len(lines) <= 2, r.stderr
+    assert all(ln.startswith("sweep fixedpoint (2 points): ") for ln in lines)
+    assert lines[-1].startswith("sweep fixedpoint (2 points): 2/2") and "\x1b" not in r.stderr
+    r = _run_cli(tmp_path, "-q", "sweep", paper_scene, "--param", "slope.angle_deg=1,1.1",
+                 "--workers", "1", "--runs-dir", "runs", "--name", "again")
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+def test_a_line_sink_prints_each_unit_of_a_short_task_and_tenths_of_a_long_one():
+    import io
+
+    out = io.StringIO()
+    with progress.use(progress.LineSink(out)):
+        with progress.task("mfpt: 3 sigma value(s)", 3) as t:
+            for sd in (0.001, 0.002, 0.003):
+                t.advance(info=f"sigma {sd:g} rad")
+        with progress.task("basin 100x100 cells", 10_000) as t:
+            for _ in range(10_000):
+                t.advance()
+        with progress.task("optimize: the contact replay"):
+            pass
+    lines = out.getvalue().splitlines()
+    assert [ln.rsplit(" (", 1)[0] for ln in lines[:3]] == [
+        f"mfpt: 3 sigma value(s): {k}/3 sigma 0.00{k} rad" for k in (1, 2, 3)]
+    assert len(lines) == 3 + 10  # ten tenths; the task of no count (a spinner): nothing
+    assert lines[12].startswith("basin 100x100 cells: 10000/10000")
+
+
+def test_the_mfpt_study_reports_each_sigma_it_finishes(monkeypatch):
+    from types import SimpleNamespace
+
+    from walkerlab.studies import mfpt as study
+
+    monkeypatch.setattr(study, "build_walker", lambda scene: SimpleNamespace(
+        state_names=lambda: ["a"]), raising=False)
+    monkeypatch.setattr("walkerlab.models.registry.build_walker",
+                        lambda scene: SimpleNamespace(state_names=lambda: ["a"]))
+    monkeypatch.setattr("walkerlab.integrate.python_step.needs_python_path", lambda w: False)
+    monkeypatch.setattr(study, "step_map_for", lambda *a, **k: None)
+
+    def one(scene, x_star, st, i, sd, vals, *rest):
+        vals["mfpt_steps_montecarlo"][i] = 100.0 * (i + 1)
+    monkeypatch.setattr(study, "_one_sigma", one)
+    st = SimpleNamespace(sigma_rad=[0.01, 0.02], method="montecarlo", model="rigid",
+                         seed=0, distribution="normal")
+    scene = SimpleNamespace(model_dump=lambda mode: {}, terrain=None)
+    got = []
+
+    class Rec(progress.QuietSink):
+        def update(self, key, completed, total, info):
+            got.append((completed, total, info))
+    with progress.use(Rec()):
+        study.mfpt_study(scene, np.zeros(2), st)
+    assert got == [(1, 2, "sigma 0.01 rad: Monte Carlo MFPT 100 steps"),
+                   (2, 2, "sigma 0.02 rad: Monte Carlo MFPT 200 steps")]
 
 
 @pytest.mark.parametrize("quiet", [True, False])
@@ -499,7 +557,9 @@ def test_progress_quiet_silences_notices(tmp_path, paper_scene, monkeypatch, qui
     if quiet:
         assert r.stderr == ""
     else:
-        assert len(r.stderr.strip().splitlines()) == 1 and "integrity" in r.stderr
+        notices = [ln for ln in r.stderr.strip().splitlines()
+                   if not ln.startswith("sweep ")]  # the progress lines: a pipe's log
+        assert len(notices) == 1 and "integrity" in notices[0]
 
 
 def test_progress_adjust_counts_contact_runs(monkeypatch):

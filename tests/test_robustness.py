@@ -122,3 +122,42 @@ def test_robustness_stage_round_trip_and_report_section(tmp_path):
         md = (runs / scene.name / "report" / "report.md").read_text()
         assert ("## Robustness" in md) == shown
         assert ("Jin et al." in md) == shown
+
+
+def test_a_reused_robustness_artifact_prints_its_numbers(tmp_path, monkeypatch):
+    """Issue 64 item 10: ``walkerlab robustness`` on an up-to-date artifact printed only
+    "reused", none of its numbers."""
+    from tests.cli_run import run_cli
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.schemas import robustness as schema
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageOutcome
+
+    sc = load_scene(Path(__file__).resolve().parents[1] / "configs" / "paper.yaml")
+    scalars = {k: 0.5 for k in schema.SCALARS} | {"mfpt_steps": 123.4, "sigma_rad": 0.01}
+    d = schema.RobustnessData(["slope"], {"slope": "rad"}, {"absolute": 0.6, "relative": 0.6},
+                              {"slope": 7.25}, {"slope": 7.3},
+                              {c: {"slope": 1.0} for c in schema.COORDINATES}, scalars)
+    path = write_artifact(tmp_path / "robustness.h5", "robustness", sc, "x",
+                          lambda f: schema.write(f, d), 1.0)
+    monkeypatch.setattr(pipeline, "run", lambda *a, **k: StageOutcome(
+        "robustness", path, True, 0.0))  # reused: no summary of the study
+    code, err, out = run_cli("robustness", "paper", "--runs-dir", tmp_path)
+    assert code == 0, err
+    assert "GSN slope: 7.25" in out and "MFPT 123.4" in out
+
+
+def test_stability_map_prints_the_path_of_the_figure_it_drew(tmp_path, monkeypatch):
+    """Issue 64 item 10: ``walkerlab stability-map`` did not say where its figure is."""
+    from tests.cli_run import run_cli
+    from walkerlab.stages import stability_map
+    from walkerlab.stages.common import StageOutcome
+
+    art = tmp_path / "paper" / "stability_map_friction.h5"
+    monkeypatch.setattr(stability_map, "run", lambda *a, **k: StageOutcome(
+        "stability-map", art, True, 0.0))
+    code, err, out = run_cli("stability-map", "paper", "--kind", "friction", "--runs-dir",
+                             tmp_path)
+    assert code == 0, err
+    assert f"figure: {tmp_path / 'paper' / 'report' / 'figures' / 'stability_map_friction.png'}" \
+        in out

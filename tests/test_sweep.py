@@ -352,3 +352,18 @@ def test_process_pool_matches_in_process_runner(scene, tmp_path):
                               name="pool", progress=False))
     for col in COLUMNS["fixedpoint"]:
         np.testing.assert_array_equal(a[col], b[col], err_msg=col)
+
+
+def test_a_sweeps_summary_names_its_failed_points_by_their_parameters():
+    """Issue 64 item 10: the summary counted failed points without naming them."""
+    from walkerlab.report.sweep_text import sweep_text
+
+    deg = np.array([1.0, 1.5, 2.0, 2.5])
+    data = {"attrs": {"sweep_stage": "fixedpoint", "scene_units": "SI"},
+            "axes": [("slope.angle_deg", deg)],
+            "points": {"outcome": np.array(["ok", "no_fixed_point", "ok", "no_fixed_point"]),
+                       "param/slope.angle_deg": deg,
+                       "step_period_s": np.array([0.7, np.nan, 0.72, np.nan]),
+                       "max_abs_multiplier": np.array([0.5, np.nan, 0.6, np.nan])}}
+    text = sweep_text(data)
+    assert "  no_fixed_point at slope.angle_deg = 1.500; slope.angle_deg = 2.500" in text

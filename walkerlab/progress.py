@@ -8,8 +8,10 @@ happens with those calls is decided by the installed *sink* (:func:`use`):
 - no sink (library use, tests): nothing is shown; notices go to stderr as one line;
 - the CLI installs :class:`RichSink` when stderr is a terminal and ``--quiet`` is not given
   (a ``rich.progress`` display on stderr: what is being done, count, elapsed time and an
-  estimate of what is left; a spinner with the elapsed time where no count is known), and
-  :class:`QuietSink` otherwise (``--quiet``: nothing; stderr not a terminal: notices only).
+  estimate of what is left; a spinner with the elapsed time where no count is known),
+  :class:`LineSink` when stderr is not a terminal (a pipe, ``nohup``, CI: one plain line per
+  finished unit of a task of few units - a sigma, a controller, a stage - and per tenth of a
+  longer one, and the notices), and ``QuietSink(silent=True)`` under ``--quiet`` (nothing).
 
 A sink is any object with the :class:`Sink` methods; a test can install a recorder.
 """
@@ -22,7 +24,7 @@ from contextlib import contextmanager
 from typing import Protocol
 
 __all__ = ["Sink", "Task", "task", "note", "use", "current", "install", "sink_for_terminal",
-           "QuietSink", "RichSink"]
+           "QuietSink", "RichSink", "LineSink"]
 
 
 class Sink(Protocol):
@@ -59,6 +61,56 @@ class QuietSink:
     def note(self, message):
         if not self.silent:
             print(message, file=sys.stderr, flush=True)
+
+
+class LineSink:
+    """Plain lines on ``stream`` (stderr) for a log without a terminal: a line per finished
+    unit (``<task>: <done>/<total> <info> (<elapsed m:ss>)``) of a task of at most
+    :attr:`EVERY_UNIT` units, else one per tenth of it (a task of no count, a spinner on a
+    terminal, prints nothing), and the notices as they come."""
+
+    #: tasks of at most this many units get a line per unit (sigmas, controllers, stages)
+    EVERY_UNIT = 50
+
+    def __init__(self, stream=None):
+        self._stream = stream
+        #: key -> (description, start [monotonic s], units shown, total)
+        self._tasks: dict[int, tuple[str, float, int, int | None]] = {}
+
+    def _print(self, line: str) -> None:
+        print(line, file=sys.stderr if self._stream is None else self._stream, flush=True)
+
+    @staticmethod
+    def _elapsed(t0: float) -> str:
+        import time
+
+        s = int(time.monotonic() - t0)
+        return f"{s // 60}:{s % 60:02d}"
+
+    def start(self, key, description, total, completed):
+        import time
+
+        self._tasks[key] = (description, time.monotonic(), int(completed), total)
+
+    def update(self, key, completed, total, info):
+        if key not in self._tasks:
+            return
+        description, t0, shown, _ = self._tasks[key]
+        if completed <= shown:
+            return
+        if total is not None and total > self.EVERY_UNIT and completed < total \
+                and completed * 10 // total == shown * 10 // total:
+            return  # a long task: a line per tenth
+        self._tasks[key] = (description, t0, completed, total)
+        done = f"{completed}/{total}" if total is not None else f"{completed}"
+        self._print(f"{description}: {done}" + (f" {info}" if info else "")
+                    + f" ({self._elapsed(t0)})")
+
+    def finish(self, key):
+        self._tasks.pop(key, None)  # a task of no count (a spinner) has no unit to report
+
+    def note(self, message):
+        self._print(message)
 
 
 class RichSink:
@@ -139,12 +191,12 @@ def install(sink: Sink) -> None:
 
 def sink_for_terminal(quiet: bool, stream=None) -> Sink:
     """The CLI's sink: nothing under ``--quiet``, rich progress when ``stream`` (stderr) is a
-    terminal, notices only otherwise."""
+    terminal, plain lines otherwise (:class:`LineSink`)."""
     stream = sys.stderr if stream is None else stream
     if quiet:
         return QuietSink(silent=True)
     isatty = getattr(stream, "isatty", None)
-    return RichSink() if isatty is not None and isatty() else QuietSink()
+    return RichSink() if isatty is not None and isatty() else LineSink()
 
 
 @contextmanager

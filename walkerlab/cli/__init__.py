@@ -22,7 +22,7 @@ A traceback shown to a user is a bug.  Every command runs inside
 :func:`walkerlab.cli.errors.guard`: one line ``error: ...`` on stderr and exit code 1 for
 bad input or a walker that falls (the stage's ``StageOutcome.failure``), ``interrupted`` and
 130 on Ctrl-C.  typer's own usage errors (unknown option, a value out of an option's range)
-keep typer's message and exit code 2.
+keep typer's message, as one line ``error: ...`` too, and exit code 2.
 """
 
 from __future__ import annotations
@@ -37,9 +37,10 @@ from walkerlab.cli import (
     commands_runs,
 )
 from walkerlab.cli.process import process_settings, single_threaded_blas, version_callback
-from walkerlab.cli.typer_flags import flags_take_no_value
+from walkerlab.cli.typer_flags import flags_take_no_value, usage_errors_in_one_spelling
 
 flags_take_no_value()
+usage_errors_in_one_spelling()
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: planar biped walkers, passive and powered, from fixed point to "
@@ -53,8 +54,9 @@ def _main(version: bool = typer.Option(False, "--version", callback=version_call
                                        "and h5py versions and exit"),
           quiet: bool = typer.Option(False, "--quiet", "-q",
                                      help="no progress display and no notices on stderr "
-                                     "(errors are still shown); progress is also off when "
-                                     "stderr is not a terminal")) -> None:
+                                     "(errors are still shown); when stderr is not a "
+                                     "terminal, progress is a plain line per finished unit")
+          ) -> None:
     """walkerlab: planar biped walkers, passive and powered, from fixed point to report."""
     single_threaded_blas()
     process_settings()
@@ -78,5 +80,29 @@ COMMANDS = (
     ("animate", commands_output.animate), ("export", commands_output.export),
     ("bench", commands_output.bench), ("capabilities", commands_reference.capabilities),
 )
+#: each command's line in ``walkerlab --help``: one sentence that fits beside its name on
+#: an 80-column terminal (the command's own ``--help`` gives its whole docstring)
+SHORT_HELP = {
+    "fixedpoint": "Find the period-1 gait and its Floquet multipliers.",
+    "simulate": "Simulate the rigid walker for N strides.",
+    "contact-sim": "Simulate the compliant-contact walker on its terrain.",
+    "compare": "Compare the rigid and the contact trajectories.",
+    "workprecision": "Time every solver setting against its error.",
+    "plot": "Draw the figures from the scene's artifacts.",
+    "report": "Run what the scene needs and write the report.",
+    "sweep": "Run a stage over a grid of scene fields.",
+    "bifurcation": "Draw the bifurcation diagram over a scene field.",
+    "continuation": "Follow the gait over a field, naming its special points.",
+    "target": "Find the field value whose gait meets a target.",
+    "optimize": "Optimise a gait, or design fields, by collocation.",
+    "basin": "Map the basin of attraction of the gait.",
+    "mfpt": "Mean first-passage time on random per-step slopes.",
+    "robustness": "Gait sensitivity, step-down/up and MFPT at one sigma.",
+    "stability-map": "Map where the contact gait exists and is stable.",
+    "animate": "Animate the walker walking (GIF, and MP4 with ffmpeg).",
+    "export": "Export the walker (URDF, MJCF, Adams, OpenSim).",
+    "bench": "Benchmark wall time and right-hand-side evaluations.",
+    "capabilities": "Show what each walker kind supports in each view.",
+}
 for _name, _command in COMMANDS:
-    app.command(_name)(_command)
+    app.command(_name, short_help=SHORT_HELP[_name])(_command)

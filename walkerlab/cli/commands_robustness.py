@@ -94,12 +94,14 @@ def robustness(scene: Path | None = SceneArg,
                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Gait sensitivity norms, largest step-down/up and MFPT at the scene's sigma
     (the scene's robustness section); writes robustness.h5."""
+    from walkerlab.io.schemas import robustness as schema
     from walkerlab.io.schemas.robustness import per_unit
     from walkerlab.stages import pipeline
 
     out = pipeline.run("robustness", load(scene), runs_dir, force, workers=workers,
                        scheduler=scheduler)
-    d = out.summary.get("data")
+    # computed now: the study's numbers; reused: the artifact's (the same numbers)
+    d = out.summary.get("data") or schema.load(out.path)
     if d is not None:
         for k in d.disturbances:
             typer.echo(f"GSN {k}: {d.gsn[k]:.4g} {per_unit(d.units[k])}")
@@ -140,3 +142,4 @@ def stability_map(scene: Path | None = SceneArg,
         typer.echo(f"{k}: " + (", ".join(f"{a}: {b:.3g}" if isinstance(b, float) else
                                          f"{a}: {b}" for a, b in s.items()) or "cached"))
         typer.echo(f"wrote {out.path}")
+        typer.echo(f"figure: {stage.figure_path(sc, runs_dir, out.path)}")

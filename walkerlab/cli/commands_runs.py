@@ -17,7 +17,10 @@ def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
                                                  "known: continue it along the straight line "
                                                  "between the two scenes' numeric fields to "
-                                                 "this walker (homotopy)"),
+                                                 "this walker (homotopy); the two walkers "
+                                                 "must have the same structure (the same "
+                                                 "legs and bodies, by name): only numbers "
+                                                 "may differ"),
                require_stable: bool = typer.Option(False, "--require-stable",
                                                    help="exit non-zero (one line) when the "
                                                    "gait found is unstable: no stable "

@@ -1,7 +1,10 @@
-"""A patch of typer's help: an on/off flag is listed without a value type.
+"""Patches of typer's help and usage errors.
 
 typer 0.29 with click 8.2+ shows ``<bool>`` beside ``--force`` and ``--help`` in ``--help``,
-as if they took a value; :func:`flags_take_no_value` makes them show none.
+as if they took a value; :func:`flags_take_no_value` makes them show none.  typer boxes a
+usage error under the title "Error" (click without rich prints ``Error: ...``) where every
+other walkerlab error is one line ``error: ...``; :func:`usage_errors_in_one_spelling` makes
+a usage error that line too.
 """
 
 from __future__ import annotations
@@ -21,3 +24,28 @@ def flags_take_no_value() -> None:
 
     display_type_rich._walkerlab = True
     TyperOption.display_type_rich = display_type_rich
+
+
+def usage_errors_in_one_spelling() -> None:
+    """A usage error (unknown option or command, a value out of range) is printed as the
+    usage, the help hint and one line ``error: <message>`` on stderr, the spelling of
+    every other walkerlab error (:mod:`walkerlab.cli.errors`); its exit code stays 2."""
+    import click
+    from typer import rich_utils
+
+    if getattr(rich_utils.rich_format_error, "_walkerlab", False):
+        return
+
+    def plain_error(exc: click.ClickException) -> None:
+        if exc.__class__.__name__ == "NoArgsIsHelpError":  # the help is shown instead
+            return
+        ctx = getattr(exc, "ctx", None)
+        if ctx is not None:
+            click.echo(ctx.get_usage(), err=True)
+            if ctx.command.get_help_option(ctx) is not None:
+                click.echo(f"Try '{ctx.command_path} {ctx.help_option_names[0]}' for help.",
+                           err=True)
+        click.echo(f"error: {exc.format_message()}", err=True)
+
+    plain_error._walkerlab = True
+    rich_utils.rich_format_error = plain_error

@@ -238,6 +238,12 @@ LinkName = Literal["stance_leg", "swing_leg", "stance_thigh", "stance_shank", "s
 JointName = Literal["hip", "stance_hip", "swing_hip", "stance_knee", "swing_knee"]
 
 
+#: the sizes the largest coefficient of ``phase.coordinates`` may have [rad per rad]: the
+#: phase is scale-free (the Bezier phase s divides by theta- - theta+), but the chart's
+#: Newton solve reads a phase gradient below ~1e-6 as singular
+PHASE_SCALE = (1e-6, 1e6)
+
+
 class PhaseVariable(Strict):
     """The phase variable ``theta(q)`` of the virtual constraints, monotone over a step
     (Westervelt, Grizzle & Koditschek 2003, Sec. IV-A): one of a link's absolute angle
@@ -261,6 +267,14 @@ class PhaseVariable(Strict):
             raise ValueError("give one of link, point or coordinates")
         if self.coordinates is not None and not any(self.coordinates.values()):
             raise ValueError("coordinates: every coefficient is 0 (no phase variable)")
+        if self.coordinates is not None and not (
+                PHASE_SCALE[0] <= max(abs(v) for v in self.coordinates.values())
+                <= PHASE_SCALE[1]):
+            big = max(self.coordinates.values(), key=abs)
+            raise ValueError(f"coordinates: the largest coefficient, {big:g}, is outside "
+                             f"[{PHASE_SCALE[0]:g}, {PHASE_SCALE[1]:g}] in size: a phase "
+                             "variable that scale cannot be told from a constant; give "
+                             "coefficients of order 1 (the Bezier phase s is scale-free)")
         return self
 
     @model_serializer(mode="wrap")

@@ -202,6 +202,14 @@ def _unit_hint(root: type[BaseModel], e: dict, parts: list) -> str:
         return f" ({v:g} m: a length in mm? {v:g} mm = {v / 1000:g} m)"
     return ""
 
+#: the number forms YAML 1.2 and YAML 1.1 read alike: decimal integers, decimal floats with a
+#: dot (``.inf``, ``.nan``); PyYAML (YAML 1.1) also reads hex (``0x10``), binary (``0b11``),
+#: leading-zero octal (``010`` = 8), digits with underscores (``1_0.0``) and base 60
+#: (``1:20`` = 80) as numbers
+PLAIN_NUMBER = re.compile(r"[-+]?(0|[1-9][0-9]*)(\.[0-9]*)?([eE][-+]?[0-9]+)?|"
+                           r"[-+]?\.[0-9]+([eE][-+]?[0-9]+)?|[-+]?\.(inf|Inf|INF)|\.(nan|NaN|NAN)")
+
+
 def _yaml11_number(text: str) -> str:
     """The plain decimal of a YAML-1.1-only number form (``0x10`` -> ``16``, ``1_0.0`` ->
     ``10.0``; :mod:`walkerlab.config.loader` keeps those as text), "" for other text."""
@@ -228,7 +236,12 @@ def _error_line(root: type[BaseModel], e: dict, suggest=None) -> str:
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
         msg += f" (got {_input_text(e['input'])})"
-        if isinstance(e["input"], str) and re.fullmatch(
+        if isinstance(e["input"], str) and PLAIN_NUMBER.fullmatch(e["input"]) \
+                and _yaml11_number(e["input"]):
+            # a number YAML reads as one unless quoted: it was written in quotes
+            msg += (f"; {e['input']} is written in quotes, which makes it text: write it "
+                    "without them")
+        elif isinstance(e["input"], str) and re.fullmatch(
                 r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+", e["input"].strip()):
             # YAML 1.1 (PyYAML) reads a float only with a dot and a signed exponent
             m, x = re.split("[eE]", e["input"].strip())

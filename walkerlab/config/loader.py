@@ -10,14 +10,13 @@ SceneError
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 from typing import Annotated, Any
 
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from walkerlab.config.errors import SceneError, format_error
+from walkerlab.config.errors import PLAIN_NUMBER, SceneError, format_error
 from walkerlab.config.limits import MAX_SCENE_BYTES, MAX_YAML_DEPTH, SMALL_SLOPE_DEG
 from walkerlab.config.schema import SCENE_NAME_RE, Scene
 
@@ -85,20 +84,12 @@ class _SceneLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
-#: the number forms YAML 1.2 and YAML 1.1 read alike: decimal integers, decimal floats with a
-#: dot (``.inf``, ``.nan``); PyYAML (YAML 1.1) also reads hex (``0x10``), binary (``0b11``),
-#: leading-zero octal (``010`` = 8), digits with underscores (``1_0.0``) and base 60
-#: (``1:20`` = 80) as numbers
-_PLAIN_NUMBER = re.compile(r"[-+]?(0|[1-9][0-9]*)(\.[0-9]*)?([eE][-+]?[0-9]+)?|"
-                           r"[-+]?\.[0-9]+([eE][-+]?[0-9]+)?|[-+]?\.(inf|Inf|INF)|\.(nan|NaN|NAN)")
-
-
 def _number_or_text(construct):
-    """A constructor that keeps a YAML-1.1-only number form (:data:`_PLAIN_NUMBER`) as the
+    """A constructor that keeps a YAML-1.1-only number form (:data:`PLAIN_NUMBER`) as the
     text it is, so the field that receives it refuses it (one line naming the field and
     the form, :func:`walkerlab.config.errors.format_error`)."""
     def build(loader, node):
-        if not _PLAIN_NUMBER.fullmatch(str(node.value)):
+        if not PLAIN_NUMBER.fullmatch(str(node.value)):
             return loader.construct_scalar(node)
         return construct(loader, node)
     return build
@@ -116,7 +107,7 @@ def _first_line(exc: BaseException) -> str:
 
 def parse_yaml(text: str):
     """Parse YAML text with :class:`_SceneLoader` (duplicate keys and deep nesting refused;
-    YAML-1.1-only number forms kept as text, :data:`_PLAIN_NUMBER`).
+    YAML-1.1-only number forms kept as text, :data:`PLAIN_NUMBER`).
 
     Raises
     ------

@@ -147,7 +147,8 @@ class FixedPointSettings(Strict):
         None, alias="from", description="a scene YAML whose gait is known: its gait is "
         "continued along the straight line between the two scenes' numeric walker and slope "
         "fields to this walker (homotopy), and used as the initial guess; relative to this "
-        "scene's folder")
+        "scene's folder.  The two walkers must have the same structure (the same legs and "
+        "bodies, by name, and the same fields): only numbers may differ")
     gait: Literal["stable", "long_period", "short_period", "nearest_guess"] = Field(
         "stable", description="which period-1 gait to use where two exist (Goswami et al. "
         "1996, Garcia et al. 1998: long- and short-period pair): 'stable' (the stable one; "

@@ -266,6 +266,11 @@ class WalkerEnv(gym.Env):
                              "its torque laws act in the walker with policy=None")
         self.policy = policy
         ground = _rigid_ground(sc) if view == "rigid" else None
+        if view == "contact":  # the contact view's refusals (the table's contact cells for
+            # the scene's features, its ground): from the scene alone, before the gait search
+            from walkerlab.models.contact.scene import contact_setup
+
+            setup = contact_setup(sc)
         self.scene, self.view = sc, view
         self.dt = float(control_period_s)
         self.max_episode_steps = max_episode_steps
@@ -290,13 +295,10 @@ class WalkerEnv(gym.Env):
         if view == "contact":
             import dataclasses
 
-            from walkerlab.models.contact.scene import contact_setup
-
             from .contact_view import ContactView
 
             links = action_torques(data, model.n_coordinates, self.joints).links
             n_steps = int(math.ceil(max_episode_steps * self.dt / self.gait.step_period)) + 4
-            setup = contact_setup(sc)
             if vc is not None:  # the controller at the contact walker's role state, held
                 self._contact_controller = setup.actuators  # by the action (the plant's
                 setup = dataclasses.replace(setup, actuators=None)  # run stays compiled)

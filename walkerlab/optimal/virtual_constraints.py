@@ -22,6 +22,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from walkerlab import progress
 from walkerlab.io.schemas.optimize import ControllerData
 
 __all__ = ["ControllerDesign", "check_design", "controller_scene", "controller_scene_text",
@@ -262,14 +263,16 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     build = time.perf_counter() - t0
     speeds = list(o.target_speeds_m_per_s or [o.target_speed_m_per_s])
     out = []
-    for i, v in enumerate(speeds):
-        res = collocate_virtual_constraints(
-            fns, replace(spec, target_speed_m_per_s=v), t, x, u, alpha, o.max_multiplier,
-            (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level)
-        res.build_time_s += build
-        out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml"))
-        if res.status == "Solve_Succeeded":  # the next speed starts here
-            t, x, u, alpha = res.t, res.x, res.u, res.alpha
+    with progress.task(f"optimize: {len(speeds)} controller(s)", len(speeds)) as bar:
+        for i, v in enumerate(speeds):
+            res = collocate_virtual_constraints(
+                fns, replace(spec, target_speed_m_per_s=v), t, x, u, alpha, o.max_multiplier,
+                (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level)
+            res.build_time_s += build
+            out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml"))
+            bar.advance(info=f"controller {i + 1} ({v:g} m/s): {res.status}")
+            if res.status == "Solve_Succeeded":  # the next speed starts here
+                t, x, u, alpha = res.t, res.x, res.u, res.alpha
     return out
 
 

@@ -194,6 +194,15 @@ def _phase_panels(tr: NamedTrajectory) -> dict[str, list[tuple[str, str, str]]]:
     return out
 
 
+def _panel_title(panel: str, members: list[tuple[str, str, str]]) -> str:
+    """A phase-plane panel's title: the link and whose it is (``"legs: leg1 and leg2"``,
+    ``"thighs: leg1 and leg2"``, ``"torso"``), not the bare part name ``"leg"``."""
+    owners = list(dict.fromkeys(o for o, _, _ in members))
+    if owners == [panel]:  # a link of its own (a torso)
+        return panel
+    return f"{panel}s: {' and '.join(owners)}" if len(owners) > 1 else f"{panel}: {owners[0]}"
+
+
 def fig9_limit_cycle(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS):
     """Fig. 9: limit cycles in the phase plane, rate [rad/s] vs angle [rad]: one panel per
     link (both legs drawn in it, colour per leg, line style per model)."""
@@ -213,7 +222,7 @@ def fig9_limit_cycle(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS)
                             label=f"{owner} - {label}")
         ax.set_xlabel(f"{panel} angle [rad]")
         ax.set_ylabel(f"{panel} rate [{units.rate}]")
-        ax.set_title(panel)
+        ax.set_title(_panel_title(panel, members))
         ax.grid(alpha=0.3)
         _legend(ax)
     fig.suptitle("Fig. 9 - limit cycles in the phase plane\n(both legs per panel: in a "

@@ -60,6 +60,12 @@ class ReportInputs:
         that step's number (None: no comparison).
     mean_stance_slip_mm : float
         Mean stance-foot slip per step of the contact run [mm] (NaN: none).
+    animation : bool
+        Whether ``animation.gif`` in the figures folder was drawn from the report's current
+        artifacts (shown only then).
+    left_out : str
+        The one line on the run folder's artifacts (and animation) the report leaves out,
+        and why ('' when none); written into the report under its summary.
     bifurcation_onsets : dict[str, (float, float)]
         Period-doubling onset and fall onset (NaN: none on the grid) in the grid's unit by
         bifurcation artifact key (:func:`walkerlab.studies.bifurcation.onset_value`,
@@ -80,6 +86,8 @@ class ReportInputs:
     phase_error: tuple | None = None
     mean_stance_slip_mm: float = float("nan")
     bifurcation_onsets: dict = field(default_factory=dict)
+    animation: bool = True
+    left_out: str = ""
 
 
 def _header(scene) -> list[str]:
@@ -129,6 +137,9 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md = _header(scene)
     arts = inputs.artifacts
     md += sections.summary_section(scene, inputs, pub)
+    if inputs.left_out:
+        said = inputs.left_out.removeprefix("report: ")
+        md += [f"*{text(said[:1].upper() + said[1:])}.*", ""]
     done = list(done)
     if done:
         md += details("What ran (stages, artifacts, compute time)",
@@ -149,13 +160,14 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md += study_sections.basin_section(arts)
     md += robustness_section(arts, inputs.basin_area)
     md += mfpt_section(arts)
-    md += figures_section(Path(figures_dir), str(rel), arts, units_for_scene(scene))
+    md += figures_section(Path(figures_dir), str(rel), arts, units_for_scene(scene),
+                          inputs.animation)
     md += ["## Scene", ""]
     md += details("Resolved scene (JSON)", "\n".join(
         ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),
          "```"]))
-    text = "\n".join(md)
-    atomic_text(report_dir / "report.md", text)
+    body = "\n".join(md)
+    atomic_text(report_dir / "report.md", body)
     html_path = report_dir / "report.html"
-    atomic_text(html_path, to_html(text, report_dir))
+    atomic_text(html_path, to_html(body, report_dir))
     return html_path

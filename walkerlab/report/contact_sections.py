@@ -43,6 +43,21 @@ def initial_states_section(scene, arts) -> list[str]:
         "(% column: change of magnitude relative to our ideal value.)", ""]
 
 
+
+def _outcome_sentence(outcome: tuple, walks: bool | None, reason: str) -> str:
+    """The contact run's outcome in one sentence: how it ended (``outcome``: the run end's
+    name and message) and whether the walker walks by the verdict from its steps
+    (``walks``; None: no verdict)."""
+    kind, message = outcome[0], outcome[1]
+    out = f"Outcome: the run ended by **{kind}**" + (
+        f" ({message})" if message and message != kind else "")
+    if walks is None:
+        return out + "."
+    return out + (", and by the verdict from its steps the walker walks." if walks else
+                  f", and by the verdict from its steps the walker **does not walk** "
+                  f"({reason}).")
+
+
 def contact_section(scene, arts) -> list[str]:
     """The contact walker's run: its summary, parameters, outcome, slips, periodic gait,
     drop test and stability maps (the initial states: :func:`initial_states_section`)."""
@@ -69,10 +84,7 @@ def contact_section(scene, arts) -> list[str]:
            "", "Contact parameters in SI (converted from the scene's unit system): "
            + ", ".join(f"{k} = {num(v)}" + (f" {u}" if u not in ("", "-") else "")
                        for k, (v, u) in cp.items()) + ".", "",
-           f"Outcome: **{outcome[0]}**" + (f" — {outcome[1]}" if outcome[1] and
-                                            outcome[1] != outcome[0] else "")
-           + ("" if c.walks is None else " Walks (the verdict from its steps): "
-              + ("yes." if c.walks else f"**no** — {c.walks_reason}.")), "",
+           _outcome_sentence(outcome, c.walks, c.walks_reason), "",
            "Per-step stance slip [mm] (touchdown to lift-off of the stance foot; nan: the "
            "phase had not ended when the run did): " + ", ".join(num(v, 3) for v in slips)
            + (("; creep of both feet during double support [mm]: "

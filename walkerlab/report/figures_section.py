@@ -233,14 +233,15 @@ def _drawn_from(stem: str, arts: dict) -> bool:
     return True
 
 
-def figures_section(fig_dir: Path, rel: str, arts: dict, units: Units = Units()
-                    ) -> list[str]:
+def figures_section(fig_dir: Path, rel: str, arts: dict, units: Units = Units(),
+                    animation: bool = True) -> list[str]:
     """Every figure that exists, with its raw data folded underneath where it is long
     (``arts``: the loaded artifacts by stage name; ``units``: the scene's), but the energy
-    ledger's (its own section, :func:`ledger_section`, beside the gait)."""
+    ledger's (its own section, :func:`ledger_section`, beside the gait); the animation only
+    when ``animation`` (drawn from the current artifacts)."""
     out = []
-    gif = fig_dir / "animation.gif"  # written by `walkerlab animate`, embedded when present
-    if gif.is_file():
+    gif = fig_dir / "animation.gif"  # written by `walkerlab animate`
+    if gif.is_file() and animation:
         cap = ("The walker walking (`walkerlab animate`; rigid model, and the contact model "
                "beside it where it was simulated).")
         out += [f"![{cap}]({rel}/{gif.name})", "", f"*{cap}*", ""]

@@ -103,14 +103,32 @@ def _gait_rows(ideal: dict, pub, u) -> list:
     for key in ("t_cycle_s", "v_com_m_per_s"):
         name, _sym, unit = TABLE3_ROWS[key]
         rows.append([name, u(unit), num(ideal[key]),
-                     printed(t3[key][0]) if key in t3 else "—"])
+                     _published(ideal[key], t3[key][0]) if key in t3 else "—"])
     if "E_avg_J" in t3:
+        ours = ideal.get("E_avg_stance_frame_J", np.nan)
         rows.append(["average mechanical energy, PE from the stance foot", u.energy,
-                     num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
+                     num(ours), _published(ours, t3["E_avg_J"][0])])
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
     rows.append(["step length", u.length, num(ideal["step_length_m"]),
-                 printed(step_pub) if step_pub is not None else "—"])
+                 _published(ideal["step_length_m"], step_pub) if step_pub is not None
+                 else "—"])
     return rows
+
+
+#: how far apart ours and a published value may be before the summary's row flags it: a
+#: factor (a value off by more than this is no rounding or modelling difference)
+FLAG_FACTOR = 2.0
+
+
+def _published(ours: float, value: float) -> str:
+    """The published value as printed, flagged in its row when ours is more than
+    :data:`FLAG_FACTOR` times it or less than its inverse (the gait section, three
+    sections below, explains the difference: :func:`gait_section`)."""
+    ratio = abs(ours / value) if value and np.isfinite(ours) else 1.0
+    if 1 / FLAG_FACTOR <= ratio <= FLAG_FACTOR:
+        return printed(value)
+    return (f"{printed(value)} ⚠ ours is {ratio:.3g}× this (explained under gait "
+            "characteristics, below)")
 
 
 def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:

@@ -58,4 +58,24 @@ def sweep_text(data: dict) -> str:
         rng = (f"{num(v.min())} .. {num(v.max())}" + (f" {u}" if u else "")
                if v.size else "no point walks")
         lines.append(f"  {c:<28s} {rng}")
+    lines += _failed_points(data, outcome)
     return "\n".join(lines)
+
+
+#: the most failed points a sweep's summary names one by one
+NAMED_FAILURES = 10
+
+
+def _failed_points(data: dict, outcome: np.ndarray) -> list[str]:
+    """One line per outcome other than ``ok`` naming its points by their parameter values
+    (``  no_fixed_point at slope.angle_deg = 1.2; 1.4``; the first :data:`NAMED_FAILURES`,
+    then how many more)."""
+    params = [(p, np.asarray(data["points"][f"param/{p}"])) for p, _ in data["axes"]]
+    out = []
+    for kind in dict.fromkeys(str(k) for k in outcome if k != "ok"):
+        idx = np.flatnonzero(outcome == kind)
+        named = "; ".join(", ".join(f"{p} = {num(v[i]) if v.dtype.kind in 'fi' else v[i]}"
+                                    for p, v in params) for i in idx[:NAMED_FAILURES])
+        more = f" (and {idx.size - NAMED_FAILURES} more)" if idx.size > NAMED_FAILURES else ""
+        out.append(f"  {kind} at {named}{more}")
+    return out

@@ -9,7 +9,9 @@ changed after it was written is left out, and a one-line note says why.
 The slope comes from the resolved scene stored in ``simulate.h5``.  GIF through matplotlib's
 Pillow writer (one shared palette, :func:`walkerlab.plotting.animation.gif_writer`); MP4
 through its ffmpeg writer only when ffmpeg is installed.  Both written atomically (temporary
-name in the same folder, then rename).
+name in the same folder, then rename), then a stamp of the artifacts they were drawn from
+(:data:`walkerlab.stages.report_inputs.ANIMATION_STAMP`): the report shows the animation
+only while they are the run folder's current ones.
 """
 
 from __future__ import annotations
@@ -19,12 +21,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from walkerlab.config import Scene, SlopeSettings, TerrainSettings
+from walkerlab.io import runpaths
+from walkerlab.io.freshness import drawing_key
 from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.terrain import load_terrain
 from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
-from walkerlab.stages.report_inputs import computed_for
+from walkerlab.stages.report_inputs import ANIMATION_STAMP, computed_for
 
 #: Frames per second, and the most frames one animation gets (a 5-stride compass gait,
 #: 7 s, is 141 frames at 20 fps; longer runs play faster).
@@ -73,6 +77,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames,
                               time_unit=sim.units.time, terrain=ground)
     out = AnimateOutcome(note="; ".join(notes))
+    stamp = folder / ANIMATION_STAMP
+    stamp.unlink(missing_ok=True)  # no stamp while the animation is half written
     try:
         out.paths.append(save_frames(frames, folder / "animation.gif", gif_writer(fps)))
         if writers.is_available("ffmpeg"):
@@ -82,4 +88,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
                                           "ffmpeg for the MP4)"])
     finally:
         plt.close(frames.fig)
+    drawn_from = {"simulate": stage_artifact(scene, runs_root, "simulate")}
+    if CONTACT_LABEL in trajs:
+        drawn_from["contact-sim"] = contact
+    runpaths.atomic_text(stamp, drawing_key(drawn_from))  # what the report checks it by
     return out
+

@@ -108,18 +108,26 @@ def _rhs_beside(setup: ContactSetup, rhs_ready: CompiledElsewhere | None):
     side.close(cancel=not fut.done())
 
 
-def check(scene: Scene, strides: int | None = None, **_options) -> None:
-    """Refuse a bad ``--strides`` before anything runs (:func:`walkerlab.stages.pipeline.run`).
+def check(scene: Scene, strides: int | None = None, periodic: bool = False,
+          **_options) -> None:
+    """Refuse, before anything runs (:func:`walkerlab.stages.pipeline.run`: before the gait
+    search upstream), a bad ``--strides`` and whatever the scene alone decides: the
+    capability table's contact cells for the walker's kind and the scene's features, its
+    ground and actuators (:func:`walkerlab.models.contact.scene.contact_setup`, as the run
+    reads the scene).
 
     Raises
     ------
     StageError
         ``strides`` out of bounds (one line naming ``contact_sim.n_strides``).
+    walkerlab.models.contact.scene.ContactSceneError
+        The contact view refuses the scene (one line).
     """
     try:
-        with_contact_strides(scene, strides)
+        scene = with_contact_strides(scene, strides)
     except SceneError as exc:
         raise StageError(str(exc)) from None
+    contact_setup(scene, periodic)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,

@@ -85,7 +85,7 @@ def fresh_fixedpoint(scene: Scene, runs_root: Path | str = "runs") -> Path | Non
     return stage_module("fixedpoint").fresh_artifact(scene, runs_root)
 
 
-def _contact_walks_ground(scene: Scene) -> bool:
+def contact_walks_ground(scene: Scene) -> bool:
     """Whether the walker's kind walks the scene's ground in the contact view (its cell of
     :data:`walkerlab.walker.kinds.CAPABILITIES`; the slope always)."""
     ground = "slope" if scene.terrain is None else scene.terrain.kind
@@ -99,20 +99,24 @@ def _contact_walks_ground(scene: Scene) -> bool:
 
 def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order: each only when the scene has its
-    sections (``fixedpoint`` also when ``simulate`` starts from the gait); the
+    sections (``fixedpoint``, with the section's defaults, also when ``simulate`` starts from
+    the gait or the scene asks for a contact run: ``contact`` and ``contact_sim``); the
     work-precision study (it times every solver setting: most of a cold report) and the
     Section-5 attribution (seven periodic-gait searches) only with ``full``."""
     sim, contact, fp = (getattr(scene, s) is not None for s in ("simulate", "contact",
                                                                 "fixedpoint"))
     # a simulation that starts from the gait runs (and shows) the fixed point it starts from,
-    # with the section's defaults when the scene has none
-    gait = fp or (sim and "fixedpoint" in needs("simulate", scene))
-    # a contact section without a gait to start from (a five-link optimum's contact replay
-    # reads it) runs no contact-sim
+    # with the section's defaults when the scene has none; so does a contact run the scene
+    # asks for (a 'contact_sim' section), as `walkerlab contact-sim` does
+    asked = contact and scene.contact_sim is not None and contact_walks_ground(scene)
+    gait = fp or (sim and "fixedpoint" in needs("simulate", scene)) or (
+        asked and "fixedpoint" in needs("contact-sim", scene))
+    # a contact section alone, without a gait to start from (a five-link optimum's contact
+    # replay reads it), runs no contact-sim
     contact = contact and (gait or "fixedpoint" not in needs("contact-sim", scene))
     # nor one whose walker the contact view refuses on the scene's ground (flat feet on
     # stairs: the section carries the MJCF's foot mass and contact law)
-    contact = contact and _contact_walks_ground(scene)
+    contact = contact and contact_walks_ground(scene)
     plan = {"fixedpoint": gait, "simulate": sim, "contact-sim": contact,
             "compare": contact and sim, "workprecision": full and scene.workprecision is not None,
             "basin": scene.basin is not None and fp,

@@ -21,9 +21,10 @@ from pathlib import Path
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir, report_dir
 from walkerlab.report.build import ReportInputs, write_report
+from walkerlab.stages.common import StageError
 from walkerlab.stages.pipeline import report_plan
 from walkerlab.stages.report_dag import run_report
-from walkerlab.stages.report_inputs import report_artifacts
+from walkerlab.stages.report_inputs import animation_current, report_artifacts
 
 
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
@@ -54,6 +55,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     from walkerlab import progress
 
     stages = report_plan(scene, full)
+    if not stages:
+        raise StageError(f"scene '{scene.name}' gives the report nothing to run: add a "
+                         "'fixedpoint', a 'simulate' or a 'contact_sim' section (with "
+                         "'contact')")
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
         done, drawn = run_report(scene, runs_root, force, full, lambda o: bar.advance(
@@ -78,4 +83,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if left_out:
         echo(left_out)
     rep_dir, figs = report_dir(scene, runs_root, claim=True), figures_dir(scene, runs_root)
-    return write_report(scene, load_inputs(scene, paths, figs), rep_dir, figs, done)
+    inputs = load_inputs(scene, paths, figs)
+    inputs.animation = not animation_current(scene, runs_root)
+    inputs.left_out = left_out
+    return write_report(scene, inputs, rep_dir, figs, done)

@@ -108,6 +108,11 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     from walkerlab.stages.plot import draw_ideal_ahead, draw_if_changed
 
     plan = report_plan(scene, full)
+    for name in plan:  # what the scene alone refuses (the capability table's cells, bad
+        # sections): said before any stage computes
+        mod = stage_module(name)
+        if hasattr(mod, "check"):
+            _named(name, mod.check, scene)
     done: list = []
 
     def add(o) -> None:

@@ -12,22 +12,42 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
-from walkerlab.io.freshness import changed_fields, input_hash
-from walkerlab.io.runpaths import bifurcation_artifacts, stage_artifact
-from walkerlab.stages.pipeline import needs, stage_module
+from walkerlab.io.freshness import changed_fields, drawing_key, input_hash, stamp_matches
+from walkerlab.io.runpaths import bifurcation_artifacts, figures_dir, stage_artifact
+from walkerlab.stages.pipeline import contact_walks_ground, needs, stage_module
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
                  "bifurcation", "basin", "robustness", "mfpt", "attribution", "optimize")
-#: why a report leaves out an artifact of a stage the scene does not run
-NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' section",
-           "contact-sim": "no 'contact' section",
-           "compare": "needs both a 'simulate' and a 'contact' section",
+#: why a report leaves out an artifact of a stage the scene does not run (the contact
+#: stages: :func:`not_run`)
+NOT_RUN = {"fixedpoint": "no 'fixedpoint' section (nor a 'simulate' or 'contact_sim' that "
+                         "starts from the gait)",
+           "simulate": "no 'simulate' section",
            "workprecision": "no 'workprecision' section",
            "basin": "no 'basin' section (or no 'fixedpoint')",
            "robustness": "no 'robustness' section (or no 'fixedpoint')",
            "mfpt": "no 'mfpt' section (or no 'fixedpoint')",
            "attribution": "no 'contact' or 'fixedpoint' section",
            "optimize": "no 'optimize' section (or no 'fixedpoint')"}
+
+
+def not_run(scene: Scene, stage: str) -> str:
+    """Why the report does not run ``stage`` for ``scene`` (completing "the scene has ...");
+    the contact stages by what the scene lacks, or the capability table's cell that
+    refuses its ground (:func:`walkerlab.stages.pipeline.report_plan`)."""
+    if stage == "compare" and scene.simulate is None:
+        return "no 'simulate' section (compare needs 'simulate' and 'contact-sim')"
+    if stage in ("contact-sim", "compare"):
+        if scene.contact is None:
+            return "no 'contact' section"
+        if not contact_walks_ground(scene):
+            ground = scene.terrain.kind if scene.terrain is not None else "slope"
+            return (f"a walker the contact view does not walk on {ground} "
+                    "(`walkerlab capabilities`)")
+        return "a 'contact' section but no 'contact_sim' or 'fixedpoint' section"
+    return NOT_RUN.get(stage, "no section for it")
+
+
 #: artifacts shown although this report did not compute them, when computed for the
 #: scene's current sections: (their stage, why one is left out)
 EARLIER = {"workprecision": "measured for other settings; `walkerlab report --full` "
@@ -36,6 +56,28 @@ EARLIER = {"workprecision": "measured for other settings; `walkerlab report --fu
                           "it again",
            "bifurcation": "computed for another walker, slope or solver",
            "mfpt": "computed for other settings: rerun `walkerlab mfpt`"}
+
+
+#: the stamp beside ``animation.gif``: the drawing key of the artifacts it was drawn from
+#: (written by ``walkerlab animate``)
+ANIMATION_STAMP = ".drawn_from_animation"
+
+
+def animation_current(scene: Scene, runs_root) -> str:
+    """Why ``animation.gif`` must not be shown beside the run folder's current artifacts
+    ('' if it may): no stamp (drawn before stamps were written, or half written), or drawn
+    from other artifacts than the ``simulate.h5`` (and ``contact_sim.h5``) there now."""
+    stamp = figures_dir(scene, runs_root) / ANIMATION_STAMP
+    sim, contact = (stage_artifact(scene, runs_root, s) for s in ("simulate", "contact-sim"))
+    if not stamp.is_file() or not sim.is_file():
+        return "not drawn from this run folder's simulate.h5: rerun `walkerlab animate`"
+    keys = [drawing_key({"simulate": sim})]
+    if contact.is_file():
+        keys.append(drawing_key({"simulate": sim, "contact-sim": contact}))
+    if not any(stamp_matches(stamp, k) for k in keys):
+        return "drawn from an earlier simulate.h5 or contact_sim.h5: rerun `walkerlab animate`"
+    return ""
+
 
 
 def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] = ()) -> str:
@@ -66,7 +108,7 @@ def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
     kind = "bifurcation" if stage.startswith("bifurcation") else stage
     if kind not in EARLIER or (kind == "workprecision" and (scene.workprecision is None or full)
                                ) or (kind == "attribution" and (scene.contact is None or full)):
-        return f"an earlier standalone run: the scene has {NOT_RUN.get(stage, 'no section for it')}"
+        return f"an earlier standalone run: the scene has {not_run(scene, stage)}"
     if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
         return "changed after it was written: rerun 'walkerlab bifurcation'"
     return EARLIER[kind] if changed_fields(p, scene, stage_sections(kind, scene)) else ""
@@ -91,4 +133,7 @@ def report_artifacts(scene: Scene, runs_root, done: list, full: bool = False
             left.append(f"{p.name} ({why})")
         else:
             paths[stage] = p
+    if (figures_dir(scene, runs_root) / "animation.gif").is_file() \
+            and (why := animation_current(scene, runs_root)):
+        left.append(f"animation.gif ({why})")
     return paths, ("report: leaves out " + "; ".join(left)) if left else ""

@@ -61,6 +61,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     return out
 
 
+def figure_path(scene: Scene, runs_root: Path | str, artifact: Path) -> Path:
+    """The PNG :func:`run` draws from the map ``artifact`` (``<artifact stem>.png`` in the
+    report's figures folder)."""
+    return figures_dir(scene, runs_root) / f"{Path(artifact).stem}.png"
+
+
 def draw(path: Path | str, out_dir: Path | str | None = None) -> list[Path]:
     """Figure of a stability-map artifact (``<stem>.png``, ``.svg``) in ``out_dir`` (default:
     the report's figures folder next to the artifact, ``report/figures/``)."""

@@ -242,7 +242,8 @@ def numeric_fields(a: dict, b: dict, prefix: str = "") -> dict:
         return out
     if isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
-            raise ValueError(f"{prefix[:-1]}: {len(a)} items vs {len(b)}")
+            raise ValueError(f"{prefix[:-1]}: {len(a)} items vs {len(b)} (a homotopy needs "
+                             "the same structure in both scenes: only numbers may differ)")
         for i, (x, y) in enumerate(zip(a, b)):
             key = x.get("name") if isinstance(x, dict) and x.get("name") else str(i)
             out.update(numeric_fields(x, y, f"{prefix}{key}."))
@@ -367,12 +368,16 @@ def homotopy_start(scene: Scene, known: Scene):
     except (ValueError, MapFailed) as exc:
         raise ValueError(f"fixedpoint.from {known.name}: {exc}") from None
     if not res.reached:
-        lam = res.branch.points[-1].p
+        # the furthest the branch got towards this walker (lambda = 1), and where it ended:
+        # past a fold it turns back, so its last point may be lambda = 0 again
+        far, last = max(p.p for p in res.branch.points), res.branch.points[-1].p
         why = "; ".join(f"{s.kind} at lambda {s.p:.4g}" + (f" ({s.cause})" if s.cause else "")
                         for s in res.specials) or "the branch left [0, 1]"
+        back = (f", then turned back and ended at lambda = {last:.4g}"
+                if abs(last - far) > 1e-12 else "")
         raise ValueError(f"fixedpoint.from {known.name}: the known gait does not reach this "
-                         f"walker along the straight line (stopped at lambda = {lam:.4g}: "
-                         f"{why})")
+                         f"walker along the straight line (lambda from 0 to 1; it got as "
+                         f"far as lambda = {far:.4g}{back}: {why})")
     on_way = ", ".join(f"{s.kind.replace('_', ' ')} at lambda {s.p:.4g}"
                        for s in res.specials) or "no special point"
     if not res.fields:  # nothing differs: the known gait is this walker's own

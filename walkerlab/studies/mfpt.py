@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab import progress as _progress
 from walkerlab.analysis.robustness import mfpt as M
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
@@ -324,7 +325,6 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
         The walker cannot walk on per-step slopes; the contact model asked for the mesh,
         without patches or without a periodic gait (one line).
     """
-    import time
 
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
     from walkerlab.models.registry import build_walker
@@ -339,6 +339,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
         return _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial)
     walker = build_walker(scene)
     contact = getattr(st, "model", "rigid") == "contact"
+    start = None
     if contact:
         start = _contact_start(scene, x_star, st)
     else:
@@ -352,34 +353,54 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     sig = np.asarray(st.sigma_rad, float)
     vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
     hist = []
-    for i, sd in enumerate(sig):
-        if contact:
-            from walkerlab.studies.contact_rough import contact_monte_carlo
-
-            t = time.perf_counter()
-            mc, _ = contact_monte_carlo(start, sd, st.walks, st.max_steps, seed, dist,
-                                        workers, scheduler, partial)
-        elif st.method in ("montecarlo", "both"):
-            t = time.perf_counter()
-            mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
-                             scheduler, partial)
-        if contact or st.method in ("montecarlo", "both"):
-            _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
-        if st.method in ("mesh", "both"):
-            t = time.perf_counter()
-            last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial)
-            vals["mfpt_steps_mesh"][i] = last.mfpt_steps
-            vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
-            vals["mesh_cells"][i] = last.cells
-            vals["mesh_change"][i] = last.change
-            vals["mesh_converged"][i] = float(last.converged)
-            vals["mesh_escaped"][i] = last.escaped
-            vals["mesh_wall_time_s"][i] = time.perf_counter() - t
-            hist += [{"sigma_rad": float(sd), "h": r.h, "cells": r.cells,
-                      "mfpt_steps": r.mfpt_steps,
-                      "change": r.change if math.isfinite(r.change) else math.nan}
-                     for r in all_meshes]
+    with _progress.task(f"mfpt: {sig.size} sigma value(s)", sig.size) as bar:
+        for i, sd in enumerate(sig):
+            _one_sigma(scene, x_star, st, i, sd, vals, hist, contact, start, seed, dist,
+                       workers, scheduler, partial)
+            bar.advance(info=_sigma_line(vals, i, sd, "rad"))
     return MfptData(sig, vals, st.method, walker.state_names(), hist)
+
+
+def _sigma_line(vals: dict, i: int, sd: float, unit: str) -> str:
+    """What a progress line says of sigma ``i`` once its study is done."""
+    mc, mesh = vals["mfpt_steps_montecarlo"][i], vals["mfpt_steps_mesh"][i]
+    said = [f"{name} MFPT {v:.4g} steps" for name, v in (("Monte Carlo", mc), ("mesh", mesh))
+            if np.isfinite(v)]
+    return f"sigma {sd:g} {unit}" + (f": {', '.join(said)}" if said else "")
+
+
+def _one_sigma(scene, x_star, st, i, sd, vals, hist, contact, start, seed, dist, workers,
+               scheduler, partial) -> None:
+    """The Monte Carlo walks and / or the mesh of :func:`mfpt_study` at sigma ``sd``
+    [rad] (row ``i`` of ``vals``; the mesh's refinements appended to ``hist``)."""
+    import time
+
+    if contact:
+        from walkerlab.studies.contact_rough import contact_monte_carlo
+
+        t = time.perf_counter()
+        mc, _ = contact_monte_carlo(start, sd, st.walks, st.max_steps, seed, dist,
+                                    workers, scheduler, partial)
+    elif st.method in ("montecarlo", "both"):
+        t = time.perf_counter()
+        mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
+                         scheduler, partial)
+    if contact or st.method in ("montecarlo", "both"):
+        _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
+    if st.method in ("mesh", "both"):
+        t = time.perf_counter()
+        last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial)
+        vals["mfpt_steps_mesh"][i] = last.mfpt_steps
+        vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
+        vals["mesh_cells"][i] = last.cells
+        vals["mesh_change"][i] = last.change
+        vals["mesh_converged"][i] = float(last.converged)
+        vals["mesh_escaped"][i] = last.escaped
+        vals["mesh_wall_time_s"][i] = time.perf_counter() - t
+        hist.extend({"sigma_rad": float(sd), "h": r.h, "cells": r.cells,
+                     "mfpt_steps": r.mfpt_steps,
+                     "change": r.change if math.isfinite(r.change) else math.nan}
+                    for r in all_meshes)
 
 
 def _record_monte_carlo(vals: dict, i: int, mc, wall_s: float) -> None:
@@ -405,11 +426,13 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
     slope_sd = float(per.slope_sd_rad) if per is not None else 0.0
     sig_m = np.asarray(st.sigma_m, float)
     vals = {k: np.full(sig_m.size, np.nan) for k in VARIABLES}
-    for i, sd_m in enumerate(sig_m):
-        t = time.perf_counter()
-        mc = monte_carlo(scene, x_star, slope_sd, st.walks, st.max_steps, seed, dist,
-                         workers, scheduler, partial, heights=(hdist, float(sd_m)))
-        _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
+    with _progress.task(f"mfpt: {sig_m.size} sigma value(s)", sig_m.size) as bar:
+        for i, sd_m in enumerate(sig_m):
+            t = time.perf_counter()
+            mc = monte_carlo(scene, x_star, slope_sd, st.walks, st.max_steps, seed, dist,
+                             workers, scheduler, partial, heights=(hdist, float(sd_m)))
+            _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
+            bar.advance(info=_sigma_line(vals, i, sd_m, "m"))
     return MfptData(np.full(sig_m.size, slope_sd), vals, st.method, walker.state_names(), [],
                     sigma_m=sig_m)
 

@@ -312,15 +312,16 @@ class _RootStarts:
             end = walked_start(walker, x, solver, max_step_time)
             if end is None:  # fell before WALK_STEPS steps: not near a stable gait
                 continue
-            n_started += 1
+            n_started += 1  # it lasted WALK_STEPS steps: a root-finder start from its end
             g = self.attempt(end, "walked seed")
             if g is not None:
                 self.found.append(g)
                 break
             if n_started == ROOT_STARTS:
                 break
-        self.tried.append(f"{n_walked} seeds walked {WALK_STEPS} steps "
-                          f"({n_started} root-finder starts)")
+        lasted = ("none lasted them" if not n_started else
+                  f"{n_started} lasted them, a root-finder start from each")
+        self.tried.append(f"{n_walked} seeds set walking for {WALK_STEPS} steps ({lasted})")
 
     def other_gait(self) -> None:
         """The other gait of the pair by deflation from starts near the first one, at the
