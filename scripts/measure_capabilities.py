@@ -42,6 +42,40 @@ ORDER = ("rigid", "gym", "contact", "mjcf", "adams", "osim", "optimize")
 NO_GAIT = ("no period-1 gait", "no rigid gait", "gave up after")
 
 
+#: wall seconds a cell may take (a walk that neither ends nor falls)
+CELL_LIMIT_S = 300
+
+
+class _Timeout(BaseException):  # past measure()'s own `except Exception`
+    pass
+
+
+def _timed(measure, kind, feature, view, tmp) -> dict:
+    """``measure(...)``'s mapping, or a failed cell after :data:`CELL_LIMIT_S` of CPU."""
+    import signal
+
+    from walkerlab.api.capabilities import QUANTITIES
+
+    def stop(*_):
+        raise _Timeout
+
+    old = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(CELL_LIMIT_S)
+    try:
+        return measure(kind, feature, view, tmp).as_dict()
+    except _Timeout:
+        from walkerlab.config.reference_cases import reference_scene
+
+        q, tol, unit = QUANTITIES[view]
+        case = reference_scene(kind, feature, view)[0]
+        return {"kind": kind, "feature": feature, "view": view, "case": case, "quantity": q,
+                "value": None, "tolerance": tol, "unit": unit, "ok": False,
+                "detail": f"not measured: the cell ran past {CELL_LIMIT_S} s"}
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
 def _group(cells: list[str]) -> list[dict]:
     """One feature's cells (``kind/feature/view``), in :data:`ORDER`, in one runs folder;
     when the rigid gait is not found, the views that start from it say so without
@@ -59,7 +93,7 @@ def _group(cells: list[str]) -> list[dict]:
 
                 d["quantity"], d["tolerance"], d["unit"] = QUANTITIES[view]
             else:
-                d = measure(kind, feature, view, tmp).as_dict()
+                d = _timed(measure, kind, feature, view, tmp)
             if view == "rigid" and not d["ok"] and any(s in d["detail"] for s in NO_GAIT):
                 no_gait = d
             d["cpu_s"] = round(time.process_time() - t0, 2)
