@@ -38,6 +38,7 @@ from walkerlab.export.engine_walk import (
     walk_export,
 )
 from walkerlab.export.mjcf_ground import wheel_ground
+from walkerlab.export.mjcf_scene import MjcfOptions
 from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
@@ -209,11 +210,12 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
                     None if key is None else _step_period(ideal))
 
 
-def _gait_scene(scene: Scene, mb, data, runs_root):
+def _gait_scene(scene: Scene, mb, data, runs_root, options=None):
     """The rigid gait and the MJCF's gait keyframe, terrain and contact (the gait of an
-    up-to-date ``fixedpoint.h5``, else searched); no rigid gait: one line."""
+    up-to-date ``fixedpoint.h5``, else searched; ``options``: the MJCF's
+    :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); no rigid gait: one line."""
     return _gait(scene, runs_root, _with_ideal(
-        scene, lambda ideal: mjcf_scene(scene, mb, data, ideal)))
+        scene, lambda ideal: mjcf_scene(scene, mb, data, ideal, options)))
 
 
 @dataclass(frozen=True)
@@ -265,7 +267,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
 
 def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
           walker_only: bool = False, walk: bool = False,
-          walk_steps: int = DEFAULT_STEPS) -> Exported:
+          walk_steps: int = DEFAULT_STEPS, mjcf: MjcfOptions | None = None) -> Exported:
     """Write the scene's walker as ``fmt`` ("urdf", "mjcf", "adm": ``walker.adm`` and
     ``walker.acf``, returning the .adm's path, or "osim": ``walker.osim``,
     :mod:`walkerlab.export.opensim`) into
@@ -278,6 +280,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     ``fixedpoint`` section or, without one, from its defaults (an automatic search).
     ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
     default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`).
+    ``mjcf``: the MJCF's contact time constant and timestep
+    (:class:`walkerlab.export.mjcf_scene.MjcfOptions`; default: the scene's contact law's).
 
     Raises
     ------
@@ -318,7 +322,15 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         data.structure.kind.require(scene.terrain.kind, FORMAT_VIEWS.get(fmt, fmt),
                                     f"terrain.kind: {scene.terrain.kind}")
     name = scene.name or "walker"
-    out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+    if mjcf is not None and mjcf != MjcfOptions():
+        if fmt != "mjcf" or data.structure.kind.name == "rolling_polygon":
+            raise ValueError("--mjcf-contact-time-constant-s, --mjcf-timestep-s: options of "
+                             "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
+                             "has its own contact")
+        out = _run_links(scene, runs_root, data, name, fmt, walker_only, mjcf)
+    else:
+        out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt,
+                                                 walker_only)
     if not walk:
         return out
     return replace(out, walk=_walk(out, fmt, data, walk_steps, scene))
@@ -346,8 +358,8 @@ _ROLLS = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
           "free_joints": False, "hinged_torso": False, "rolling_polygon": True}
 
 
-def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
-               ) -> Exported:
+def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool,
+               options=None) -> Exported:
     """The writer of the kinds whose walker is a tree of leg links
     (:func:`walkerlab.walker.multibody.multibody`): the URDF and MJCF here, the Adams
     dataset (:func:`_run_adams`) and the OpenSim model (:func:`_run_osim`)."""
@@ -357,7 +369,8 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     if fmt == "osim":
         return _run_osim(scene, runs_root, mb, data, name, walker_only)
     check_exportable(scene, data.structure.kind, fmt, walker_only)
-    ideal, extra = (None, None) if walker_only else _gait_scene(scene, mb, data, runs_root)
+    ideal, extra = (None, None) if walker_only else _gait_scene(scene, mb, data, runs_root,
+                                                                options)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)
