@@ -24,7 +24,7 @@ import numpy as np
 
 from walkerlab.io.schemas.optimize import ControllerData
 
-__all__ = ["CONTROLLER_CONTACT", "REPLAY_STRIDES", "ControllerDesign", "check_design",
+__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "REPLAY_STRIDES", "ControllerDesign", "check_design",
            "clearance_report", "contact_scene", "controller_scene", "controller_scene_text",
            "controller_step", "design_controllers", "designs_controller",
            "optimize_virtual_constraints", "replay_in_contact"]
@@ -77,6 +77,8 @@ class ControllerDesign(ControllerData):
         The written scene's file name (in the run folder).
     t, x, u : ndarray
         The collocated step (times [s], states, torques [N m]).
+    friction_ratio : float
+        The stance foot's largest ``|F_t / F_n|`` over the collocated step [-].
     min_clearance_m, mid_stance_window_m, mid_stance_low_m : float
         The swing foot's lowest height [m] outside the straight legs' mid-stance window,
         the window's half-width [m] (NaN: none) and the lowest height inside it [m].
@@ -107,6 +109,15 @@ class ControllerDesign(ControllerData):
 #: 0.908 to 1.10 s (+23 % against the rigid 0.898 s); at 10 and 100 mm/s they settle at
 #: +1.3 %.
 CONTROLLER_CONTACT = {"stiction_velocity_mm_per_s": 10.0, "friction_velocity_mm_per_s": 100.0}
+#: The fraction of the contact model's static friction coefficient that bounds a design's
+#: friction ratio |F_t / F_n| when the design has a friction cone
+#: (``optimize.friction_coefficient``: the smaller of the two).  Regularised friction lets
+#: the stance foot creep at a rate that grows with the ratio's share of the cone (the
+#: contact model's stiction ramp, MuJoCo's soft cone), a loss the zero dynamics' fixed
+#: point feels 1 / (1 - delta^2) times over: the three-link design at 0.6 m/s, delta^2 =
+#: 0.7 with mu = 0.6 pressed its foot to 0.46 (0.51 of mu_s = 0.9) before the heel strike
+#: and walked +8.4 % slow in MuJoCo; within 0.3 (a third) -1.06 % (contact model +1.21 %).
+CONTACT_CONE_FRACTION = 1.0 / 3.0
 #: Strides of a design's contact replay (12 heel strikes)
 REPLAY_STRIDES = 6
 
@@ -272,7 +283,11 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     data : WalkerData
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         The ``optimize`` section's (:func:`walkerlab.optimal.driver.collocation_spec`; its
-        speed replaced by each of ``target_speeds_m_per_s``).
+        speed replaced by each of ``target_speeds_m_per_s``; its friction coefficient, when
+        given, no more than :data:`CONTACT_CONE_FRACTION` of the contact model's static
+        one, :func:`contact_scene`; the swing foot's clearance outside the straight legs'
+        mid-stance window, :func:`walkerlab.optimal.transcription.virtual_constraints.
+        mid_stance_window`).
     print_level : int
         IPOPT's.
 
@@ -300,6 +315,9 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     vc = scene.walker.actuation.virtual_constraints
     if spec.max_torque_n_m is None and vc.max_torque_n_m is not None:
         spec = replace(spec, max_torque_n_m=vc.max_torque_n_m)
+    if spec.friction_coefficient is not None:  # inside the contact model's cone too
+        mu = CONTACT_CONE_FRACTION * float(contact_scene(scene).contact.mu_static)
+        spec = replace(spec, friction_coefficient=min(float(spec.friction_coefficient), mu))
     walker = build_walker(scene)
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
@@ -318,7 +336,8 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
             mid_stance_window_m=window)
         res.build_time_s += build
         out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml",
-                             clearance_report(fns, res.x, window)))
+                             {**clearance_report(fns, res.x, window),
+                              "friction_ratio": _friction_ratio(fns, res.x, res.u)}))
         if res.status == "Solve_Succeeded":  # the next speed starts here
             t, x, u, alpha = res.t, res.x, res.u, res.alpha
     return out
@@ -345,6 +364,12 @@ def clearance_report(fns, x, window_m: float | None) -> dict:
     return {"min_clearance_m": low(~inside),
             "mid_stance_window_m": float("nan") if window_m is None else float(window_m),
             "mid_stance_low_m": low(inside)}
+
+
+def _friction_ratio(fns, x, u) -> float:
+    """The largest ``|F_t / F_n|`` of the stance foot over the collocated step."""
+    f = np.array([np.asarray(fns.grf(xi, ui), float).ravel() for xi, ui in zip(x, u)])
+    return float(np.max(np.abs(f[:, 1]) / np.maximum(f[:, 0], 1e-12)))
 
 
 def replay_in_contact(scene, c: ControllerDesign) -> ControllerDesign:

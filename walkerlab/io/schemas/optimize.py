@@ -211,6 +211,7 @@ class ControllerData:
     wall_time_s: float
     build_time_s: float
     scene_file: str
+    friction_ratio: float = float("nan")
     min_clearance_m: float = float("nan")
     mid_stance_window_m: float = float("nan")
     mid_stance_low_m: float = float("nan")
@@ -242,6 +243,8 @@ CONTROLLER_VALUES = (
     ("max_output_rate", "rad/s", "max |y'| over the collocation points"),
     ("wall_time_s", "s", "IPOPT's wall time"),
     ("build_time_s", "s", "the programme's build time"),
+    ("friction_ratio", "-", "the stance foot's largest |F_t / F_n| over the collocated "
+     "step"),
     ("min_clearance_m", "m", "the swing foot's lowest height over the collocated step "
      "outside the straight legs' mid-stance window (every point: legs with knees)"),
     ("mid_stance_window_m", "m", "half-width of the straight legs' mid-stance pass exempted "
