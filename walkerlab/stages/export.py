@@ -333,7 +333,38 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                                                  walker_only)
     if not walk:
         return out
-    return replace(out, walk=_walk(out, fmt, data, walk_steps, scene))
+    walked = _walk(out, fmt, data, walk_steps, scene)
+    return replace(out, walk=replace(walked, contact_period_s=contact_period(scene,
+                                                                             runs_root)))
+
+
+#: The contact run's last steps whose mean period an engine's walk is set against
+CONTACT_STEPS = 4
+
+
+def contact_period(scene: Scene, runs_root) -> float:
+    """The contact model's mean step period [s] over the last :data:`CONTACT_STEPS` steps
+    of ``contact_sim.h5`` when it is up to date for ``scene`` (its sections and walkerlab's
+    code unchanged), else NaN (nothing is computed: run ``walkerlab contact-sim`` first)."""
+    import h5py
+    import numpy as np
+
+    from walkerlab.io.artifacts import code_hash, root_attrs, verified_hash
+    from walkerlab.io.freshness import changed_fields
+    from walkerlab.stages.contact_sim import SECTIONS
+
+    try:
+        path = runpaths.stage_artifact(scene, runs_root, "contact-sim")
+        if not path.is_file() or verified_hash(path) is None \
+                or changed_fields(path, scene, SECTIONS) \
+                or str(root_attrs(path, "code_hash").get("code_hash")) != code_hash():
+            return math.nan
+        with h5py.File(path, "r") as f:
+            T = np.asarray(f["steps/period"][()], float)
+    except (OSError, KeyError, ValueError, runpaths.RunPathError):
+        return math.nan
+    T = T[np.isfinite(T)]
+    return float(np.mean(T[-CONTACT_STEPS:])) if T.size >= CONTACT_STEPS else math.nan
 
 
 def _walk(out: Exported, fmt: str, data, steps: int, scene: Scene) -> EngineWalk:
