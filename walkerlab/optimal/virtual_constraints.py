@@ -24,8 +24,9 @@ import numpy as np
 
 from walkerlab.io.schemas.optimize import ControllerData
 
-__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "REPLAY_STRIDES", "ControllerDesign", "check_design",
-           "clearance_report", "contact_scene", "controller_scene", "controller_scene_text",
+__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "REPLAY_STRIDES", "ControllerDesign",
+           "check_design", "clearance_report", "contact_scene", "controller_scene",
+           "controller_scene_text",
            "controller_step", "design_controllers", "designs_controller",
            "optimize_virtual_constraints", "replay_in_contact"]
 

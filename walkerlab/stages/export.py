@@ -346,22 +346,21 @@ def contact_period(scene: Scene, runs_root) -> float:
     """The contact model's mean step period [s] over the last :data:`CONTACT_STEPS` steps
     of ``contact_sim.h5`` when it is up to date for ``scene`` (its sections and walkerlab's
     code unchanged), else NaN (nothing is computed: run ``walkerlab contact-sim`` first)."""
-    import h5py
     import numpy as np
 
-    from walkerlab.io.artifacts import code_hash, root_attrs, verified_hash
+    from walkerlab.io.artifacts import ArtifactError, code_hash, root_attrs, verified_hash
     from walkerlab.io.freshness import changed_fields
-    from walkerlab.stages.contact_sim import SECTIONS
+    from walkerlab.io.schemas.contact_sim import load_step_periods
+    from walkerlab.stages.pipeline import stage_module
 
     try:
         path = runpaths.stage_artifact(scene, runs_root, "contact-sim")
         if not path.is_file() or verified_hash(path) is None \
-                or changed_fields(path, scene, SECTIONS) \
+                or changed_fields(path, scene, stage_module("contact-sim").SECTIONS) \
                 or str(root_attrs(path, "code_hash").get("code_hash")) != code_hash():
             return math.nan
-        with h5py.File(path, "r") as f:
-            T = np.asarray(f["steps/period"][()], float)
-    except (OSError, KeyError, ValueError, runpaths.RunPathError):
+        T = load_step_periods(path)
+    except (ArtifactError, runpaths.RunPathError):
         return math.nan
     T = T[np.isfinite(T)]
     return float(np.mean(T[-CONTACT_STEPS:])) if T.size >= CONTACT_STEPS else math.nan
