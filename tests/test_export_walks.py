@@ -413,3 +413,45 @@ def test_no_rigid_gait_refused_in_one_line_and_walker_only_writes_the_walker(tmp
     assert r.exit_code == 0, r.output
     m = mujoco.MjModel.from_xml_path(str(tmp_path / "runs" / "level" / "walker.xml"))
     assert m.nkey == 1  # "standing" only
+
+
+def test_the_mjcf_contact_time_constant_and_timestep_are_export_options():
+    """By default the IMPACT law's linearised time constant is shrunk 4 times and the
+    timestep is a quarter of it (at most 1 ms); given, each is written as given; a time
+    constant below two timesteps (MuJoCo's floor) is refused in one line naming the flag."""
+    from walkerlab.config.contact import ContactSettings
+    from walkerlab.export.mjcf_scene import MJCF_CONTACT_SHRINK, MjcfOptions
+    from walkerlab.export.scene import mujoco_contact
+    from walkerlab.models.contact.rigid_limit import contact_si
+
+    c, _knee = contact_si(ContactSettings())
+    W, M = 9.81 * 10.0, 10.0
+    ds = (W / c.k) ** (1 / c.e)
+    kl = c.e * W / ds
+    s = min(ds / c.dmax, 1.0)
+    z = c.cmax * s * s * (3 - 2 * s) / (2 * np.sqrt(kl * M))
+    tau_lin = 1 / (z * np.sqrt(kl / M))
+    dt, (tau, zz), *_ = mujoco_contact(c, M, 9.81, 0.0)
+    assert tau == pytest.approx(tau_lin / MJCF_CONTACT_SHRINK, rel=1e-12)
+    assert dt == pytest.approx(min(tau / 4, 1e-3), rel=1e-12) and zz == pytest.approx(z)
+    dt, (tau, _z), *_ = mujoco_contact(c, M, 9.81, 0.0, MjcfOptions(0.004, 0.0005))
+    assert (tau, dt) == (0.004, 0.0005)
+    dt, (tau, _z), *_ = mujoco_contact(c, M, 9.81, 0.0, MjcfOptions(0.004))
+    assert dt == pytest.approx(0.001)
+    with pytest.raises(ValueError) as err:
+        mujoco_contact(c, M, 9.81, 0.0, MjcfOptions(0.001, 0.001))
+    assert "--mjcf-contact-time-constant-s" in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+def test_an_engine_walk_is_set_against_the_contact_model_too():
+    """The walk's line names the contact model's step period and the walk's difference
+    from it when there is one, and not otherwise."""
+    from walkerlab.export.engine_walk import EngineWalk
+
+    w = EngineWalk("MuJoCo", strikes=11, alternating=True, t_end_s=10.0, period_s=0.88,
+                   rigid_period_s=0.89)
+    assert "contact model" not in w.line
+    w = EngineWalk("MuJoCo", strikes=11, alternating=True, t_end_s=10.0, period_s=0.88,
+                   rigid_period_s=0.89, contact_period_s=0.9)
+    assert "the contact model's 0.9 s (-2.22 %)" in w.line
