@@ -290,8 +290,8 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
         speed replaced by each of ``target_speeds_m_per_s``; its friction coefficient, when
         given, no more than :data:`CONTACT_CONE_FRACTION` of the contact model's static
         one when the scene has no contact section, :func:`contact_scene`; the swing
-        foot's clearance outside the straight legs' mid-stance window, :func:`walkerlab.optimal.transcription.virtual_constraints.
-        mid_stance_window`).
+        foot's clearance outside the straight legs' mid-stance window,
+        :func:`walkerlab.optimal.transcription.virtual_constraints.mid_stance_window`).
     print_level : int
         IPOPT's.
 
