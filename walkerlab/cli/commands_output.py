@@ -61,7 +61,15 @@ def export(scene: Path | None = SceneArg,
            walk: bool = typer.Option(
                False, "--walk", help="walk the written file in its engine where it is "
                "installed (MJCF: MuJoCo; OpenSim), 10 heel strikes from its gait, and print "
-               "its step period against the rigid gait's")) -> None:
+               "its step period against the rigid gait's"),
+           mjcf_tau: float | None = typer.Option(
+               None, "--mjcf-contact-time-constant-s", min=1e-6, max=1.0,
+               help="mjcf: the contact's solref time constant [s] (default: the scene's "
+               "contact law linearised at the walker's weight, shrunk 4x)"),
+           mjcf_dt: float | None = typer.Option(
+               None, "--mjcf-timestep-s", min=1e-7, max=0.01,
+               help="mjcf: MuJoCo's timestep [s] (default: a quarter of the contact's time "
+               "constant, at most 1 ms)")) -> None:
     """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
     walker.xml, walker.adm + walker.acf (Adams Solver) or walker.osim (OpenSim).  The URDF,
     MJCF and OpenSim model carry the rigid gait (found as `walkerlab fixedpoint` finds it) as
@@ -70,10 +78,12 @@ def export(scene: Path | None = SceneArg,
     --walk walks the MJCF in MuJoCo and the OpenSim model in OpenSim (where importable) for 10
     heel strikes and prints the step period against the rigid gait's (exit code 0 either way;
     a walk that falls or misses 1 % adds a warning on stderr)."""
+    from walkerlab.export.mjcf_scene import MjcfOptions
     from walkerlab.stages import export as stage
 
     sc = load(scene)
-    out = stage.write(sc, runs_dir, fmt, walker_only=walker_only, walk=walk)
+    out = stage.write(sc, runs_dir, fmt, walker_only=walker_only, walk=walk,
+                      mjcf=MjcfOptions(mjcf_tau, mjcf_dt))
     typer.echo(f"wrote {out.path}")
     for line in out.left_out:  # what the file leaves out: here too, not only in a comment
         typer.echo(f"left out of {out.path.name}: {line}")

@@ -61,6 +61,10 @@ class EngineWalk:
         Heel strikes asked for.
     tolerance : float
         Relative step-period tolerance.
+    contact_period_s : float
+        The contact model's mean step period [s] over the last steps of the scene's
+        up-to-date ``contact_sim.h5`` (NaN: none), the other reference the walk is set
+        against.
     """
 
     engine: str
@@ -74,6 +78,7 @@ class EngineWalk:
     rigid_period_s: float = math.nan
     steps: int = DEFAULT_STEPS
     tolerance: float = DEFAULT_TOLERANCE
+    contact_period_s: float = math.nan
 
     @property
     def walked(self) -> bool:
@@ -105,9 +110,12 @@ class EngineWalk:
         if self.strikes < 2:
             return head + f"; the rigid gait steps every {self.rigid_period_s:.6g} s"
         verdict = "within" if abs(self.relative) <= self.tolerance else "outside"
+        contact = ("" if not math.isfinite(self.contact_period_s) else
+                   f"; the contact model's {self.contact_period_s:.6g} s "
+                   f"({100 * (self.period_s / self.contact_period_s - 1):+.2f} %)")
         return (f"{head}; mean step period {self.period_s:.6g} s against the rigid gait's "
                 f"{self.rigid_period_s:.6g} s ({100 * self.relative:+.2f} %, {verdict} "
-                f"{100 * self.tolerance:g} %)")
+                f"{100 * self.tolerance:g} %){contact}")
 
 
 def not_walked(reason: str) -> EngineWalk:

@@ -36,8 +36,10 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.mjcf_scene import (
+    MJCF_CONTACT_SHRINK,
     MJCF_MIN_LENGTH_M,
     MJCF_MIN_MASS_KG,
+    MjcfOptions,
     MjcfScene,
     point_foot_radius,
 )
@@ -102,6 +104,7 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
 
 
 def mujoco_contact(c: ContactParamsSI, mass_kg: float, g: float, phi: float,
+                   options: MjcfOptions | None = None,
                    ) -> tuple[float, tuple, tuple, float, tuple]:
     """MuJoCo contact parameters equivalent to the IMPACT law near the static penetration.
 
@@ -111,8 +114,12 @@ def mujoco_contact(c: ContactParamsSI, mass_kg: float, g: float, phi: float,
     ratio ``z = c_s / (2 sqrt(k_l M))``.  MuJoCo's reference acceleration
     ``-b v - k r`` with ``solref = (tau, z)`` has ``k = 1 / (tau z)^2``, ``b = 2 / tau``
     (per unit mass, impedance ~1 with ``solimp = (0.99, 0.99, ...)``), so ``tau = 1 / (z w)``
-    gives the same ``w`` and ``z`` (``z = 1`` if IMPACT has no damping there).  The timestep
-    is ``tau / 4`` (MuJoCo needs ``tau >= 2 dt``), at most 1 ms.
+    gives the same ``w`` and ``z`` (``z = 1`` if IMPACT has no damping there).  The
+    time constant written is that ``tau`` shrunk by :data:`~walkerlab.export.mjcf_scene.
+    MJCF_CONTACT_SHRINK` (a stiffer heel strike, nearer the rigid impact the gait is built
+    on: the linearised ``tau`` walked the shipped RABBIT controllers -3.6 % slow), and the
+    timestep ``tau / 4`` (MuJoCo needs ``tau >= 2 dt``), at most 1 ms; ``options``
+    (:class:`~walkerlab.export.mjcf_scene.MjcfOptions`) give either or both instead.
 
     Limits: MuJoCo's spring is linear in the penetration (IMPACT's ``d^e`` is exact only at
     ``d_s``: an impact penetrates less deeply and rebounds differently), the load on a foot
@@ -123,6 +130,11 @@ def mujoco_contact(c: ContactParamsSI, mass_kg: float, g: float, phi: float,
     Returns
     -------
     timestep_s, solref, solimp, friction, notes
+
+    Raises
+    ------
+    ValueError
+        A time constant below two timesteps (MuJoCo's floor; one line naming the option).
     """
     W = mass_kg * g * math.cos(phi)
     ds = (W / c.k) ** (1.0 / c.e)
@@ -131,14 +143,24 @@ def mujoco_contact(c: ContactParamsSI, mass_kg: float, g: float, phi: float,
     cs = c.cmax * s * s * (3 - 2 * s)
     w = math.sqrt(kl / mass_kg)
     z = cs / (2 * math.sqrt(kl * mass_kg)) if cs > 0 else 1.0
-    tau = 1.0 / (z * w)
-    dt = min(tau / 4, 1e-3)
+    tau_lin = 1.0 / (z * w)
+    opt = options or MjcfOptions()
+    tau = opt.contact_time_constant_s or tau_lin / MJCF_CONTACT_SHRINK
+    dt = opt.timestep_s or min(tau / 4, 1e-3)
+    if tau < 2 * dt:
+        raise ValueError(f"--mjcf-contact-time-constant-s: {tau:.4g} s is below two timesteps "
+                         f"({2 * dt:.4g} s), MuJoCo's floor: give a longer one or a shorter "
+                         "--mjcf-timestep-s")
+    how = (f"tau = {tau:.4g} s (given)" if opt.contact_time_constant_s else
+           f"tau = 1/(z w) / {MJCF_CONTACT_SHRINK:g} = {tau:.4g} s (the linearised "
+           f"{tau_lin:.4g} s shrunk: a stiffer heel strike)")
+    step = f"timestep {dt:.4g} s (given)" if opt.timestep_s else "timestep tau/4"
     notes = (f"Contact from the scene's IMPACT law (walkerlab.export.scene."
              f"mujoco_contact): k = {c.k:.6g} N/m^{c.e:g}, cmax = {c.cmax:.6g} N s/m, dmax = "
              f"{c.dmax:.6g} m linearised at the static penetration d_s = {ds:.4g} m of the "
              f"{mass_kg:.6g} kg walker on one foot: stiffness {kl:.4g} N/m, damping "
              f"{cs:.4g} N s/m, i.e. w = {w:.4g} rad/s, damping ratio z = {z:.4g}; MuJoCo "
-             f"solref = (tau, z) with tau = 1/(z w) = {tau:.4g} s, timestep tau/4. Limits: "
+             f"solref = (tau, z) with {how}, {step}. Limits: "
              "linear spring (exact only at d_s), one friction coefficient (mu_static), no "
              "stiction regularisation.",)
     return dt, (tau, z), (0.99, 0.99, 0.001, 0.5, 2.0), float(c.mu_s), notes
@@ -201,7 +223,8 @@ def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[f
     return ahead, (f"Terrain: {line} (walkerlab.export.scene.arc_roll_m).",)
 
 
-def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
+def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None = None
+               ) -> MjcfScene:
     """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
 
     Parameters
@@ -216,6 +239,8 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         [s] and, for legs that differ, ``step_lengths_m`` (a stored ``fixedpoint.h5`` gait,
         :class:`walkerlab.io.schemas.fixedpoint.GaitResult`); default: searched
         (:func:`walkerlab.analysis.contact.periodic.ideal_gait`).
+    options : MjcfOptions, optional
+        The contact's time constant and the timestep (:func:`mujoco_contact`).
 
     Returns
     -------
@@ -239,7 +264,8 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                            flat_foot=feet_part.foot_mass(settings))
     ideal = ideal_gait(scene) if ideal is None else ideal
     qpos, qvel, feet = feet_part.keyframe(scene, mb, data, walker, ideal.x)
-    dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
+    dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi,
+                                                   options)
     lanes = lane_heights = treads = profile = None
     if terrain.kind == "profile":
         from walkerlab.models.contact.terrain import check_ground, profile_line

@@ -25,9 +25,11 @@ import numpy as np
 from walkerlab import progress
 from walkerlab.io.schemas.optimize import ControllerData
 
-__all__ = ["ControllerDesign", "check_design", "controller_scene", "controller_scene_text",
+__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "REPLAY_STRIDES", "ControllerDesign",
+           "check_design", "clearance_report", "contact_scene", "controller_scene",
+           "controller_scene_text",
            "controller_step", "design_controllers", "designs_controller",
-           "optimize_virtual_constraints"]
+           "optimize_virtual_constraints", "replay_in_contact"]
 
 KEY = "walker.actuation.virtual_constraints"
 
@@ -77,12 +79,67 @@ class ControllerDesign(ControllerData):
         The written scene's file name (in the run folder).
     t, x, u : ndarray
         The collocated step (times [s], states, torques [N m]).
+    friction_ratio : float
+        The stance foot's largest ``|F_t / F_n|`` over the collocated step [-].
+    min_clearance_m, mid_stance_window_m, mid_stance_low_m : float
+        The swing foot's lowest height [m] outside the straight legs' mid-stance window,
+        the window's half-width [m] (NaN: none) and the lowest height inside it [m].
+    contact_step_period_s, contact_speed_m_per_s, contact_heel_strikes, contact_steady
+        The contact replay (:func:`walkerlab.optimal.replay.contact.
+        contact_replay_controller`): its settled step period [s] and speed [m/s], heel
+        strikes, 1 when it walks and settles (NaN: not replayed).
+    x_star : ndarray (2n,)
+        The rigid closed loop's fixed point (None: none found).
+    contact_outcome : str
+        The contact replay's one line.
     """
 
     t: np.ndarray = field(repr=False, default=None)
     x: np.ndarray = field(repr=False, default=None)
     u: np.ndarray = field(repr=False, default=None)
     history: dict = field(repr=False, default_factory=dict)
+    x_star: np.ndarray = field(repr=False, default=None)
+    contact_outcome: str = ""
+
+
+#: The contact law of a designed controller's scene whose design scene has none: the
+#: paper's (the contact defaults) with friction 10 times closer to Coulomb's, as the
+#: shipped powered scenes (configs/powered_compass.yaml, configs/rabbit_hzd.yaml).  At the
+#: defaults' 100 and 1000 mm/s the stance foot creeps (the three-link design at 0.6 m/s,
+#: delta^2 = 0.7: 1.4 mm and 0.42 J of friction work a step), a loss the zero dynamics'
+#: fixed point feels 1 / (1 - delta^2) times over: its contact steps lengthened from
+#: 0.908 to 1.10 s (+23 % against the rigid 0.898 s); at 10 and 100 mm/s they settle at
+#: +1.3 %.
+CONTROLLER_CONTACT = {"stiction_velocity_mm_per_s": 10.0, "friction_velocity_mm_per_s": 100.0}
+#: The fraction of the contact model's static friction coefficient that bounds a design's
+#: friction ratio |F_t / F_n| when the design has a friction cone
+#: (``optimize.friction_coefficient``: the smaller of the two) and its scene no contact law
+#: of its own (the written scene gets :data:`CONTROLLER_CONTACT`; a scene that names its
+#: law, as configs/rabbit_hzd_optimal.yaml, keeps its cone: its controllers walk within
+#: 1.3 % in MuJoCo at their 0.6).  Regularised friction lets
+#: the stance foot creep at a rate that grows with the ratio's share of the cone (the
+#: contact model's stiction ramp, MuJoCo's soft cone), a loss the zero dynamics' fixed
+#: point feels 1 / (1 - delta^2) times over: the three-link design at 0.6 m/s, delta^2 =
+#: 0.7 with mu = 0.6 pressed its foot to 0.46 (0.51 of mu_s = 0.9) before the heel strike
+#: and walked +8.4 % slow in MuJoCo; within 0.3 (a third) -1.06 % (contact model +1.21 %).
+CONTACT_CONE_FRACTION = 1.0 / 3.0
+#: Strides of a design's contact replay (12 heel strikes)
+REPLAY_STRIDES = 6
+
+
+def contact_scene(scene):
+    """``scene`` with what the contact model needs: its own ``contact`` and ``contact_sim``
+    sections, or (none) :data:`CONTROLLER_CONTACT` and the run's defaults; ``terrain`` and
+    ``contact_solver`` as they are (their defaults when absent: a checkerboard of the
+    footfalls, over whose gaps the straight swing foot passes at mid-stance)."""
+    from walkerlab.config.contact import ContactSettings, ContactSimSettings
+
+    update = {}
+    if scene.contact is None:
+        update["contact"] = ContactSettings.model_validate(CONTROLLER_CONTACT)
+    if scene.contact_sim is None:
+        update["contact_sim"] = ContactSimSettings()
+    return scene.model_copy(update=update) if update else scene
 
 
 def designs_controller(scene) -> bool:
@@ -111,8 +168,8 @@ def check_design(scene, kind) -> None:
 
 
 def controller_scene(scene, bezier):
-    """``scene`` with its virtual constraints' coefficients ``bezier`` (k, M + 1) [rad]
-    and no ``optimize`` section."""
+    """``scene`` with its virtual constraints' coefficients ``bezier`` (k, M + 1) [rad],
+    no ``optimize`` section and the sections ``contact-sim`` needs (:func:`contact_scene`)."""
     act = scene.walker.actuation
     vc = act.virtual_constraints
     outs = [o.model_copy(update={"bezier_rad": [float(c) for c in row]})
@@ -120,7 +177,7 @@ def controller_scene(scene, bezier):
     vc = vc.model_copy(update={"outputs": outs})
     walker = scene.walker.model_copy(update={"actuation": act.model_copy(
         update={"virtual_constraints": vc})})
-    return scene.model_copy(update={"walker": walker, "optimize": None})
+    return contact_scene(scene.model_copy(update={"walker": walker, "optimize": None}))
 
 
 def controller_scene_text(scene, c: ControllerDesign, name: str) -> str:
@@ -178,9 +235,10 @@ def controller_step(walker, solver, points: int):
     return t, x, u, ctrl.design.alpha.copy(), zd
 
 
-def _evaluate(scene, res, target, name: str) -> ControllerDesign:
+def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesign:
     """The written controller of the optimum ``res`` on the rigid model: its restricted map
-    and its full-order fixed point (from the zero dynamics' orbit)."""
+    and its full-order fixed point (from the zero dynamics' orbit); ``clearance``: the
+    swing foot's (:func:`clearance_report`)."""
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
     from walkerlab.integrate.solver import Solver
@@ -191,7 +249,7 @@ def _evaluate(scene, res, target, name: str) -> ControllerDesign:
     ctrl = walker.actuators.controller
     zd = zero_dynamics(ctrl)
     period, mult, near = np.nan, np.full(2 * ctrl.n, np.nan + 0j), complex(np.nan)
-    shift = np.inf
+    shift, x_star = np.inf, None
     if zd.exists:
         try:
             fp = solve_scene(sc, False, guess=zd.x_plus, walker=walker,
@@ -200,6 +258,7 @@ def _evaluate(scene, res, target, name: str) -> ControllerDesign:
             mult = np.asarray(fp.multipliers_variational, complex)
             near = complex(mult[int(np.argmin(np.abs(mult - zd.delta2)))])
             shift = float(np.max(np.abs(np.asarray(fp.x, float) - zd.x_plus)))
+            x_star = np.asarray(fp.x, float)
         except (ValueError, RuntimeError, ArithmeticError, AttributeError):
             pass  # no fixed point: NaN (the design is reported, not a gait)
     return ControllerDesign(
@@ -214,7 +273,8 @@ def _evaluate(scene, res, target, name: str) -> ControllerDesign:
         max_torque_n_m=float(np.max(np.abs(res.u))), max_output=res.max_output,
         max_output_rate=res.max_output_rate, status=res.status, iterations=res.iterations,
         wall_time_s=res.wall_time_s, build_time_s=res.build_time_s, scene_file=name,
-        t=res.t, x=res.x, u=res.u, history=res.history)
+        t=res.t, x=res.x, u=res.u, history=res.history, x_star=x_star,
+        **clearance)
 
 
 def design_controllers(scene, data, spec, print_level: int = 0) -> list[ControllerDesign]:
@@ -228,7 +288,11 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     data : WalkerData
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         The ``optimize`` section's (:func:`walkerlab.optimal.driver.collocation_spec`; its
-        speed replaced by each of ``target_speeds_m_per_s``).
+        speed replaced by each of ``target_speeds_m_per_s``; its friction coefficient, when
+        given, no more than :data:`CONTACT_CONE_FRACTION` of the contact model's static
+        one when the scene has no contact section, :func:`contact_scene`; the swing
+        foot's clearance outside the straight legs' mid-stance window,
+        :func:`walkerlab.optimal.transcription.virtual_constraints.mid_stance_window`).
     print_level : int
         IPOPT's.
 
@@ -249,12 +313,18 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     from walkerlab.optimal.transcription.virtual_constraints import (
         collocate_virtual_constraints,
         hzd_functions,
+        mid_stance_window,
     )
 
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
     if spec.max_torque_n_m is None and vc.max_torque_n_m is not None:
         spec = replace(spec, max_torque_n_m=vc.max_torque_n_m)
+    if spec.friction_coefficient is not None and scene.contact is None:
+        # the written scene's contact law is the design's (CONTROLLER_CONTACT): within a
+        # third of its cone too; a scene with its own law keeps its design's cone as given
+        mu = CONTACT_CONE_FRACTION * float(contact_scene(scene).contact.mu_static)
+        spec = replace(spec, friction_coefficient=min(float(spec.friction_coefficient), mu))
     walker = build_walker(scene)
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
@@ -262,18 +332,73 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     fns = hzd_functions(data, vc)
     build = time.perf_counter() - t0
     speeds = list(o.target_speeds_m_per_s or [o.target_speed_m_per_s])
+    window = None
+    if not fns.clearance_guard and spec.min_clearance_m is not None:
+        window = mid_stance_window(spec.min_clearance_m, _leg_length_m(scene))
     out = []
     with progress.task(f"optimize: {len(speeds)} controller(s)", len(speeds)) as bar:
         for i, v in enumerate(speeds):
             res = collocate_virtual_constraints(
                 fns, replace(spec, target_speed_m_per_s=v), t, x, u, alpha, o.max_multiplier,
-                (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level)
+                (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level,
+                mid_stance_window_m=window)
             res.build_time_s += build
-            out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml"))
+            out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml",
+                                 {**clearance_report(fns, res.x, window),
+                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)}))
             bar.advance(info=f"controller {i + 1} ({v:g} m/s): {res.status}")
             if res.status == "Solve_Succeeded":  # the next speed starts here
                 t, x, u, alpha = res.t, res.x, res.u, res.alpha
     return out
+
+
+def _leg_length_m(scene) -> float:
+    """The walker's longest leg [m] (hip to foot)."""
+    w = scene.walker.model_dump()
+    legs = [leg for leg in [w.get("leg")] + list(w.get("legs") or []) if leg]
+    return max(float(leg["length_m"]) for leg in legs)
+
+
+def clearance_report(fns, x, window_m: float | None) -> dict:
+    """The swing foot's lowest height [m] over the collocated states ``x`` (2N + 1, 2n)
+    inside the step (its ends on the ground excluded): outside the mid-stance window of
+    half-width ``window_m`` [m] and inside it (``window_m`` None: every point outside,
+    NaN inside), as :class:`ControllerDesign` keywords."""
+    feet = np.array([np.asarray(fns.feet(xi), float).ravel() for xi in np.asarray(x)[1:-1]])
+    height, ahead = feet[:, 3], feet[:, 2]
+    inside = np.abs(ahead) < window_m if window_m is not None else np.zeros(len(height), bool)
+
+    def low(mask):
+        return float(np.min(height[mask])) if np.any(mask) else float("nan")
+    return {"min_clearance_m": low(~inside),
+            "mid_stance_window_m": float("nan") if window_m is None else float(window_m),
+            "mid_stance_low_m": low(inside)}
+
+
+def _friction_ratio(fns, x, u) -> float:
+    """The largest ``|F_t / F_n|`` of the stance foot over the collocated step."""
+    f = np.array([np.asarray(fns.grf(xi, ui), float).ravel() for xi, ui in zip(x, u)])
+    return float(np.max(np.abs(f[:, 1]) / np.maximum(f[:, 0], 1e-12)))
+
+
+def replay_in_contact(scene, c: ControllerDesign) -> ControllerDesign:
+    """``c`` with its contact replay (:func:`walkerlab.optimal.replay.contact.
+    contact_replay_controller` of :func:`controller_scene`, :data:`REPLAY_STRIDES`
+    strides from the rigid fixed point); not replayed without one."""
+    from walkerlab.optimal.replay.contact import contact_replay_controller
+
+    if c.x_star is None or not np.isfinite(c.full_order_step_period_s):
+        return replace(c, contact_outcome="not replayed: the rigid closed loop has no "
+                       "fixed point")
+    r = contact_replay_controller(controller_scene(scene, c.bezier_rad), c.x_star,
+                                  c.full_order_step_period_s, c.step_length_m,
+                                  strides=REPLAY_STRIDES)
+    steady = float("nan") if r["outcome"].startswith("not replayed") else \
+        float(r["walks"] and not r["trend"])
+    return replace(c, contact_step_period_s=r["step_period_s"],
+                   contact_speed_m_per_s=r["speed_m_per_s"],
+                   contact_heel_strikes=float(r["heel_strikes"]), contact_steady=steady,
+                   contact_outcome=r["outcome"])
 
 
 def optimize_virtual_constraints(scene, data, spec):
@@ -297,7 +422,7 @@ def optimize_virtual_constraints(scene, data, spec):
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal import outcome as reported
 
-    cs = design_controllers(scene, data, spec)
+    cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec)]
     c = cs[0]
     walker = build_walker(scene)
     res = _AsResult(c)
@@ -314,7 +439,9 @@ def optimize_virtual_constraints(scene, data, spec):
         build_time_s=c.build_time_s, ipopt_history=c.history,
         phase_replay_outcome="not replayed: the design is a feedback controller (its scene "
         "runs in fixedpoint, simulate and contact-sim)",
-        contact_outcome="not replayed here: run contact-sim on the written scene",
+        contact_outcome="; ".join(f"controller {i + 1}: {d.contact_outcome}"
+                                  for i, d in enumerate(cs)) if len(cs) > 1
+        else c.contact_outcome,
         controllers=tuple(cs))
 
 

@@ -38,6 +38,7 @@ from walkerlab.export.engine_walk import (
     walk_export,
 )
 from walkerlab.export.mjcf_ground import wheel_ground
+from walkerlab.export.mjcf_scene import MjcfOptions
 from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
@@ -209,11 +210,12 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
                     None if key is None else _step_period(ideal))
 
 
-def _gait_scene(scene: Scene, mb, data, runs_root):
+def _gait_scene(scene: Scene, mb, data, runs_root, options=None):
     """The rigid gait and the MJCF's gait keyframe, terrain and contact (the gait of an
-    up-to-date ``fixedpoint.h5``, else searched); no rigid gait: one line."""
+    up-to-date ``fixedpoint.h5``, else searched; ``options``: the MJCF's
+    :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); no rigid gait: one line."""
     return _gait(scene, runs_root, _with_ideal(
-        scene, lambda ideal: mjcf_scene(scene, mb, data, ideal)))
+        scene, lambda ideal: mjcf_scene(scene, mb, data, ideal, options)))
 
 
 @dataclass(frozen=True)
@@ -265,7 +267,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
 
 def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
           walker_only: bool = False, walk: bool = False,
-          walk_steps: int = DEFAULT_STEPS) -> Exported:
+          walk_steps: int = DEFAULT_STEPS, mjcf: MjcfOptions | None = None) -> Exported:
     """Write the scene's walker as ``fmt`` ("urdf", "mjcf", "adm": ``walker.adm`` and
     ``walker.acf``, returning the .adm's path, or "osim": ``walker.osim``,
     :mod:`walkerlab.export.opensim`) into
@@ -278,6 +280,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     ``fixedpoint`` section or, without one, from its defaults (an automatic search).
     ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
     default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`).
+    ``mjcf``: the MJCF's contact time constant and timestep
+    (:class:`walkerlab.export.mjcf_scene.MjcfOptions`; default: the scene's contact law's).
 
     Raises
     ------
@@ -318,10 +322,48 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         data.structure.kind.require(scene.terrain.kind, FORMAT_VIEWS.get(fmt, fmt),
                                     f"terrain.kind: {scene.terrain.kind}")
     name = scene.name or "walker"
-    out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt, walker_only)
+    if mjcf is not None and mjcf != MjcfOptions():
+        if fmt != "mjcf" or data.structure.kind.name == "rolling_polygon":
+            raise ValueError("--mjcf-contact-time-constant-s, --mjcf-timestep-s: options of "
+                             "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
+                             "has its own contact")
+        out = _run_links(scene, runs_root, data, name, fmt, walker_only, mjcf)
+    else:
+        out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt,
+                                                 walker_only)
     if not walk:
         return out
-    return replace(out, walk=_walk(out, fmt, data, walk_steps, scene))
+    walked = _walk(out, fmt, data, walk_steps, scene)
+    return replace(out, walk=replace(walked, contact_period_s=contact_period(scene,
+                                                                             runs_root)))
+
+
+#: The contact run's last steps whose mean period an engine's walk is set against
+CONTACT_STEPS = 4
+
+
+def contact_period(scene: Scene, runs_root) -> float:
+    """The contact model's mean step period [s] over the last :data:`CONTACT_STEPS` steps
+    of ``contact_sim.h5`` when it is up to date for ``scene`` (its sections and walkerlab's
+    code unchanged), else NaN (nothing is computed: run ``walkerlab contact-sim`` first)."""
+    import numpy as np
+
+    from walkerlab.io.artifacts import ArtifactError, code_hash, root_attrs, verified_hash
+    from walkerlab.io.freshness import changed_fields
+    from walkerlab.io.schemas.contact_sim import load_step_periods
+    from walkerlab.stages.pipeline import stage_module
+
+    try:
+        path = runpaths.stage_artifact(scene, runs_root, "contact-sim")
+        if not path.is_file() or verified_hash(path) is None \
+                or changed_fields(path, scene, stage_module("contact-sim").SECTIONS) \
+                or str(root_attrs(path, "code_hash").get("code_hash")) != code_hash():
+            return math.nan
+        T = load_step_periods(path)
+    except (ArtifactError, runpaths.RunPathError):
+        return math.nan
+    T = T[np.isfinite(T)]
+    return float(np.mean(T[-CONTACT_STEPS:])) if T.size >= CONTACT_STEPS else math.nan
 
 
 def _walk(out: Exported, fmt: str, data, steps: int, scene: Scene) -> EngineWalk:
@@ -346,8 +388,8 @@ _ROLLS = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
           "free_joints": False, "hinged_torso": False, "rolling_polygon": True}
 
 
-def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
-               ) -> Exported:
+def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool,
+               options=None) -> Exported:
     """The writer of the kinds whose walker is a tree of leg links
     (:func:`walkerlab.walker.multibody.multibody`): the URDF and MJCF here, the Adams
     dataset (:func:`_run_adams`) and the OpenSim model (:func:`_run_osim`)."""
@@ -357,7 +399,8 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     if fmt == "osim":
         return _run_osim(scene, runs_root, mb, data, name, walker_only)
     check_exportable(scene, data.structure.kind, fmt, walker_only)
-    ideal, extra = (None, None) if walker_only else _gait_scene(scene, mb, data, runs_root)
+    ideal, extra = (None, None) if walker_only else _gait_scene(scene, mb, data, runs_root,
+                                                                options)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)

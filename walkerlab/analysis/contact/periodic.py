@@ -178,9 +178,18 @@ def ideal_gait(scene):
 
     fp = sc.fixedpoint or FixedPointSettings()  # every field optional: the defaults
     iw = build_walker(sc)
-    return find_gaits(iw, Solver.from_settings(sc.solver),
-                      None if fp.initial_guess is None
-                      else initial_state(fp.initial_guess, iw.state_names()),
+    guess = None if fp.initial_guess is None else initial_state(fp.initial_guess,
+                                                                iw.state_names())
+    ctrl = getattr(getattr(iw, "actuators", None), "controller", None) if guess is None \
+        else None
+    if ctrl is not None:  # virtual constraints: from their zero dynamics' orbit, as
+        # walkerlab fixedpoint starts (seeds off the constraint surface can leave the
+        # controller's domain: a math domain error in its flow)
+        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+
+        zd = zero_dynamics(ctrl)
+        guess = zd.x_plus if zd.exists else None
+    return find_gaits(iw, Solver.from_settings(sc.solver), guess,
                       policy=fp.gait, other_gait=False, xtol=fp.tolerance,
                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
 

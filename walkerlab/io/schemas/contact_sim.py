@@ -478,3 +478,17 @@ def run_end(path: Path) -> tuple[str, str]:
     with open_artifact(path, STAGE) as f:
         return (str(f.attrs.get("outcome", f.attrs["termination"])),
                 str(f.attrs.get("outcome_message", "")))
+
+
+def load_step_periods(path: Path) -> np.ndarray:
+    """The step periods [s] of ``contact_sim.h5`` at ``path`` (``steps/period``; NaN: a
+    step the run did not finish).
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        As :func:`walkerlab.io.artifacts.open_artifact` (one line).
+    """
+    with open_artifact(path, STAGE) as f:
+        return np.asarray(f["steps/period"][()], float) if "steps/period" in f else \
+            np.zeros(0)

@@ -211,6 +211,14 @@ class ControllerData:
     wall_time_s: float
     build_time_s: float
     scene_file: str
+    friction_ratio: float = float("nan")
+    min_clearance_m: float = float("nan")
+    mid_stance_window_m: float = float("nan")
+    mid_stance_low_m: float = float("nan")
+    contact_step_period_s: float = float("nan")
+    contact_speed_m_per_s: float = float("nan")
+    contact_heel_strikes: float = float("nan")
+    contact_steady: float = float("nan")
 
 
 #: controllers/<i>/ datasets: (field, unit, description)
@@ -235,6 +243,20 @@ CONTROLLER_VALUES = (
     ("max_output_rate", "rad/s", "max |y'| over the collocation points"),
     ("wall_time_s", "s", "IPOPT's wall time"),
     ("build_time_s", "s", "the programme's build time"),
+    ("friction_ratio", "-", "the stance foot's largest |F_t / F_n| over the collocated "
+     "step"),
+    ("min_clearance_m", "m", "the swing foot's lowest height over the collocated step "
+     "outside the straight legs' mid-stance window (every point: legs with knees)"),
+    ("mid_stance_window_m", "m", "half-width of the straight legs' mid-stance pass exempted "
+     "from optimize.min_clearance_m (the swing foot that near the stance foot; NaN: none)"),
+    ("mid_stance_low_m", "m", "the swing foot's lowest height inside that window (< 0: "
+     "below the ground line, as straight legs pass it; NaN: no window)"),
+    ("contact_step_period_s", "s", "the contact model's mean step period over the last "
+     "steps of its replay from the rigid fixed point (NaN: not replayed)"),
+    ("contact_speed_m_per_s", "m/s", "the contact model's speed over those steps"),
+    ("contact_heel_strikes", "-", "heel strikes of the contact replay"),
+    ("contact_steady", "-", "1: the contact replay walks and its steps settle; 0: it does "
+     "not (a fall, a trip or steps that drift); NaN: not replayed"),
 )
 
 
@@ -394,7 +416,8 @@ def _load_controllers(f) -> tuple:
     out = []
     for i in range(len(f["controllers"])):
         g = f[f"controllers/{i}"]
-        vals = {key: float(g[key][()]) for key, _u, _d in CONTROLLER_VALUES}
+        vals = {key: float(g[key][()]) for key, _u, _d in CONTROLLER_VALUES
+                if key in g}  # a file written before a field was added: its default
         near = g["delta2_multiplier"][()]
         out.append(ControllerData(
             bezier_rad=g["bezier"][()], output_names=tuple(str(s) for s in

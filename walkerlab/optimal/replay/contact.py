@@ -13,7 +13,8 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueOfTime
 
-__all__ = ["REPLAY_WALL_TIME_LIMIT_S", "contact_replay", "contact_replay_five_link",
+__all__ = ["REPLAY_WALL_TIME_LIMIT_S", "SETTLED_STEPS", "contact_replay",
+           "contact_replay_controller", "contact_replay_five_link",
            "contact_replay_phased", "contact_replay_stride", "replay_failure"]
 
 #: Wall-time limit [s] of a phased walker's contact replay (its powered run).
@@ -299,3 +300,78 @@ def replay_failure(exc: BaseException, solver=None, fixed: bool = False) -> str:
     return (f"not replayed: the contact model's solver{which} failed while locating a "
             f"contact event ({type(exc).__name__}: {what}); the rigid optimum and its "
             f"replays stand; {advice}")
+
+
+#: Steps at the end of a controller's contact replay whose mean period and speed are
+#: compared with the rigid gait's (the earlier ones: the start's transient)
+SETTLED_STEPS = 4
+
+
+def contact_replay_controller(scene, x_star, period_s: float, step_length_m: float,
+                              strides: int | None = None) -> dict:
+    """Run the contact model of a designed controller's scene (its walker under virtual
+    constraints, with its ``contact``, ``terrain``, ``contact_sim`` and ``contact_solver``)
+    from the rigid closed loop's fixed point and compare its steps with the rigid gait's.
+
+    Parameters
+    ----------
+    scene : Scene
+        The controller's scene with a ``contact`` section
+        (:func:`walkerlab.optimal.virtual_constraints.contact_scene`).
+    x_star : ndarray (2n,)
+        The rigid closed loop's fixed point (post-impact, ``state_names()`` order).
+    period_s, step_length_m : float
+        The rigid gait's step period [s] and length [m].
+    strides : int, optional
+        Strides to run (default the scene's ``contact_sim.n_strides``).
+
+    Returns
+    -------
+    dict
+        ``periods`` (ndarray, each step's [s]), ``step_period_s`` and ``speed_m_per_s``
+        (the mean over the last :data:`SETTLED_STEPS` steps: the period, the hip's
+        advance over their time), ``heel_strikes``, ``trend`` (""
+        when the steps settle, else :func:`walkerlab.analysis.contact.verdict.step_trend`'s
+        phrase), ``walks`` (bool) and ``outcome`` (one line: the run's end and the
+        comparison, or why there is no replay).
+    """
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.analysis.contact.verdict import step_trend, walk_verdict
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+    from walkerlab.safefs import raise_if_interrupted
+
+    nan = float("nan")
+    out = {"periods": np.zeros(0), "step_period_s": nan, "speed_m_per_s": nan,
+           "heel_strikes": 0, "trend": "", "walks": False}
+    try:
+        setup = contact_setup(scene)
+        walker, run, _, _ = simulate_from(setup, np.asarray(x_star, float), period_s,
+                                          strides=strides)
+    except (ContactSceneError, ValueError, ArithmeticError, RuntimeError) as exc:
+        raise_if_interrupted()
+        out["outcome"] = f"not replayed: {str(exc).strip().splitlines()[0]}"
+        return out
+    raise_if_interrupted()
+    T = np.array([s.period for s in run.steps], float)
+    T = T[np.isfinite(T)]
+    hs = np.asarray(run.heel_strike_times, float)
+    out["periods"], out["heel_strikes"] = T, int(hs.size)
+    walks, why = walk_verdict(run.outcome, run.steps)
+    out["trend"], out["walks"] = step_trend(T), bool(walks)
+    if T.size >= SETTLED_STEPS and hs.size > SETTLED_STEPS:
+        out["step_period_s"] = float(np.mean(T[-SETTLED_STEPS:]))
+        names = list(run.state_names)
+        hip = np.interp(hs[[-SETTLED_STEPS - 1, -1]], run.t, run.x[:, names.index("hip_x")])
+        cos = np.cos(float(scene.slope.phi_rad))  # along the slope
+        out["speed_m_per_s"] = float((hip[1] - hip[0]) / cos / (hs[-1] - hs[-SETTLED_STEPS - 1]))
+    v_rigid = step_length_m / period_s
+    dT = 100 * (out["step_period_s"] / period_s - 1)
+    dv = 100 * (out["speed_m_per_s"] / v_rigid - 1)
+    state = ("steady" if walks and not out["trend"] else
+             out["trend"] or why or "does not walk")
+    out["outcome"] = (f"the controller's scene from the rigid fixed point: "
+                      f"{run.outcome.kind}, {hs.size} heel strikes, step period "
+                      f"{out['step_period_s']:.6g} s ({dT:+.2f} % against the rigid "
+                      f"{period_s:.6g} s), speed {out['speed_m_per_s']:.6g} m/s ({dv:+.2f} % "
+                      f"against {v_rigid:.6g}) over the last {SETTLED_STEPS} steps; {state}")
+    return out

@@ -23,9 +23,15 @@ points of a separated Hermite-Simpson mesh on ``[0, T]`` (Kelly 2017, SIAM Revie
   relabelling), the step ending on the heel-strike guard with the swing foot ahead and
   moving down, the phase advancing at every point (``s' T >= 0.2``);
 - ``|u| <= max_torque_n_m``, the stance foot pushing (``F_n >= 0``) inside its friction
-  cone (``|F_t| <= mu F_n``), the swing foot's clearance at every interior point (a walker
-  whose heel-strike guard is the swing foot's height), the targets (speed, step length,
-  step period);
+  cone (``|F_t| <= mu F_n``), the swing foot's clearance ``>= min_clearance_m`` at every
+  interior point, the targets (speed, step length, step period).  Straight legs pass the
+  swing foot through the ground line where the legs cross at mid-stance (its height
+  ``l (cos theta - cos phi)`` is zero at ``phi = theta``; McGeer 1990, Int. J. Robotics
+  Research 9(2):62-82, ignores that scuffing), so their bound is lifted over the pass: the
+  points whose swing foot is within ``W = 2 sqrt(2 c l)`` of the stance foot along the
+  ground (``c`` the clearance, ``l`` the leg length: a straight leg lifts its foot by ``c``
+  only ``sqrt(2 c l)`` from the stance foot when the stance leg is upright), with the bound
+  relaxed continuously to the window's edge (:func:`clearance_bound`);
 - ``delta^2(q_2N, alpha) <= max_multiplier``: the restricted Poincare map's multiplier
   (:func:`walkerlab.analysis.gait.zero_dynamics.impact_multiplier`), an algebraic function
   of the pre-impact configuration and the coefficients through the impact map: ``q'- =
@@ -45,7 +51,8 @@ from math import comb
 
 import numpy as np
 
-__all__ = ["HzdDesign", "HzdFunctions", "collocate_virtual_constraints", "hzd_functions"]
+__all__ = ["MID_STANCE_DIP_M", "HzdDesign", "HzdFunctions", "clearance_bound",
+           "collocate_virtual_constraints", "hzd_functions", "mid_stance_window"]
 
 KEY = "walker.actuation.virtual_constraints"
 
@@ -58,6 +65,40 @@ def bezier_sx(alpha, s):
     d1 = [M * (alpha[:, j + 1] - alpha[:, j]) for j in range(M)]
     hd1 = sum(d1[j] * comb(M - 1, j) * s ** j * (1 - s) ** (M - 1 - j) for j in range(M))
     return hd, hd1
+
+
+def mid_stance_window(min_clearance_m: float, leg_length_m: float) -> float:
+    """The half-width ``W = 2 sqrt(2 c l)`` [m] of the straight legs' mid-stance pass that
+    the clearance bound ``c`` exempts (module docstring): the swing foot of a straight leg
+    of length ``l`` is ``l (cos theta - cos phi)`` above the ground, ``c`` only when it is
+    ``sqrt(2 c l)`` from an upright stance leg's foot; twice that leaves the stance leg a
+    range of angles at the window's edges (a window of ``sqrt(2 c l)`` would need the
+    stance leg upright at both)."""
+    return 2.0 * float(np.sqrt(2.0 * max(float(min_clearance_m), 0.0) * float(leg_length_m)))
+
+
+#: How far below the ground [m] a swing foot may pass at the middle of the mid-stance
+#: window (any real dip: the bound is lifted there, not traded)
+MID_STANCE_DIP_M = 1.0
+
+
+def clearance_bound(ahead, min_clearance_m: float, window_m: float):
+    """The swing foot's lowest height allowed [m] where it is ``ahead`` [m] of the stance
+    foot along the ground: ``c - B max(0, 1 - (d / W)^2)^2`` (``c`` outside the window
+    ``|d| >= W``, relaxed continuously (C1) to ``c - B`` at the stance foot,
+    ``B = c +`` :data:`MID_STANCE_DIP_M`).
+
+    Parameters
+    ----------
+    ahead : CasADi or float (m,)
+        The swing foot ahead of the stance foot [m].
+    min_clearance_m, window_m : float
+        ``c`` and ``W`` [m] (:func:`mid_stance_window`).
+    """
+    import casadi as ca
+
+    inside = ca.fmax(0.0, 1.0 - (ahead / window_m) ** 2) if window_m > 0 else 0.0 * ahead
+    return min_clearance_m - (min_clearance_m + MID_STANCE_DIP_M) * inside ** 2
 
 
 @dataclass
@@ -326,8 +367,8 @@ class HzdDesign:
 
 def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, guess_u,
                                   guess_alpha, max_multiplier: float | None,
-                                  gains: tuple[float, float], print_level: int = 0
-                                  ) -> HzdDesign:
+                                  gains: tuple[float, float], print_level: int = 0,
+                                  mid_stance_window_m: float | None = None) -> HzdDesign:
     """Optimise one step and its virtual constraints (module docstring).
 
     Parameters
@@ -349,6 +390,10 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
         controller's closed loop).
     print_level : int
         IPOPT's.
+    mid_stance_window_m : float, optional
+        Straight legs (the heel-strike guard is not the swing foot's height): the half-width
+        ``W`` [m] of the mid-stance pass exempted from ``spec.min_clearance_m``
+        (:func:`clearance_bound`; :func:`mid_stance_window`); None: no clearance bound.
 
     Returns
     -------
@@ -393,6 +438,10 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
     opti.subject_to(feet[2, -1] >= 1e-3)                         # the swing foot ahead
     if fns.clearance_guard:
         opti.subject_to(feet[3, 1:K - 1] >= (spec.min_clearance_m or 0.0))
+    elif spec.min_clearance_m is not None and mid_stance_window_m is not None:
+        # straight legs: the clearance outside the mid-stance pass (module docstring)
+        opti.subject_to(feet[3, 1:K - 1] >= clearance_bound(
+            feet[2, 1:K - 1], float(spec.min_clearance_m), float(mid_stance_window_m)))
     # the phase advances at every point: s' T >= 0.2 (s' = theta' / (theta- - theta+))
     qs = ca.MX.sym("q", 2 * n)
     rate = ca.Function("rate", [qs], [ca.mtimes(fns.chart(qs[:n])[1][-1, :], qs[n:])])
