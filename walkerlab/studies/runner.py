@@ -92,7 +92,8 @@ from walkerlab.studies.points import (
 )
 
 __all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
-           "sweep_executor", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
+           "sweep_executor", "sweep_input_hash", "pool_pays", "MAX_GRID_POINTS", "PIECE_POINTS",
+           "FLUSH_EVERY_S", "POOL_START_S"]
 
 MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
@@ -247,6 +248,11 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     for each piece as soon as it returns (:func:`walkerlab.execution.run_chains` of
     :func:`run_piece` on :func:`sweep_executor`).
 
+    With ``workers > 1``, no scheduler and ``pool`` None, the worker count follows the
+    work: the first piece runs in this process, and the rest go to a pool only when their
+    estimated time (the piece's median point) pays the pool's start-up
+    (:func:`pool_pays`); else they run here too.
+
     Parameters
     ----------
     chains : list of list of Task
@@ -257,8 +263,38 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     """
     if not any(chains):
         return
-    with sweep_executor(workers, scheduler, pool) as ex:
-        yield from run_chains(ex, run_piece, chains, guesses)
+    if scheduler is not None or pool is not None or workers <= 1:
+        with sweep_executor(workers, scheduler, pool) as ex:
+            yield from run_chains(ex, run_piece, chains, guesses)
+        return
+    # the first piece in this process, timed: a pool only when the rest pays its start-up
+    # (the rows are the same either way: every point is a function of itself alone)
+    carries = list(guesses) if guesses is not None else [None] * len(chains)
+    c0 = next(ci for ci, c in enumerate(chains) if c)
+    with sweep_executor(1, None, False) as ex:
+        for ci, k, rows, carry in run_chains(ex, run_piece, [chains[c0][:1]], [carries[c0]]):
+            yield c0, k, rows, carry
+    carries[c0] = carry
+    rest = [list(c) for c in chains]
+    rest[c0] = rest[c0][1:]
+    n_left = sum(len(t.points) for c in rest for t in c)
+    per_point = float(np.median([r["wall_time_s"] for r in rows]))
+    use_pool = pool_pays(n_left * per_point, workers)
+    with sweep_executor(workers, None, None if use_pool else False) as ex:
+        for ci, k, rows, carry in run_chains(ex, run_piece, rest, carries):
+            yield ci, k + (ci == c0), rows, carry
+
+
+#: the start-up of a local pool of sweep workers [s] (forkserver with the model libraries,
+#: each worker's first model build), as ``walkerlab bench sweep_workers`` measures it
+POOL_START_S = 0.5
+
+
+def pool_pays(work_s: float, workers: int) -> bool:
+    """Whether ``work_s`` [s] of points in this process take longer than on a pool of
+    ``workers`` processes after its start-up (:data:`POOL_START_S`): a pool only when
+    ``work_s (1 - 1 / workers) > POOL_START_S``."""
+    return workers > 1 and work_s * (1.0 - 1.0 / workers) > POOL_START_S
 
 
 def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,

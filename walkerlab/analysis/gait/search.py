@@ -7,7 +7,8 @@ the stable one).  They lie close together on the Poincaré section (they differ 
 swing leg's rate), so a root finder started between them lands on either.  This module
 
 1. starts the root finder from the scene's initial guess, if there is one;
-2. otherwise (or when that fails) makes *scale-free seeds* from the walker's own data - a
+2. otherwise (or when that fails, or under ``stable`` when the gaits it leads to are all
+   unstable) makes *scale-free seeds* from the walker's own data - a
    step angle ``alpha = c * gamma^(1/3)`` (the small-slope scaling of the step angle,
    Garcia et al. 1998), a stance-leg rate ``-k * alpha * sqrt(g / l)`` (their
    ``theta_dot ~ -theta``), a swing-leg rate ``r`` times the stance rate, knees straight -
@@ -185,7 +186,10 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         Unit of the step period in messages (``s``, or ``sqrt(l/g)`` for a nondimensional
         scene).
     seeds : bool
-        Try the scale-free seeds when the guess does not converge (always without a guess).
+        Try the scale-free seeds when the guess does not converge (always without a guess),
+        and under ``stable`` when every gait found from the guess (and its partner) is
+        unstable: a stable gait the guess does not lead to is looked for before an unstable
+        one is chosen.
     ground_check : callable, optional
         ``ground_check(x) -> GroundContact`` for a fixed point ``x`` (2n,): every gait found
         carries its verdict (:attr:`Gait.ground`), and :func:`select_gait` prefers gaits on
@@ -234,13 +238,22 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
     if not s.found:
         raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
                            s.best)
+    first = s.found[0]
+    if ground_check is not None and policy == "stable":
+        first.ground = ground_check(first.result.x)
     if other_gait or policy in ("long_period", "short_period") or (
-            policy == "stable" and not s.found[0].result.stable):
+            policy == "stable" and not (first.result.stable and first.on_real_ground)):
         s.other_gait()
+    if policy == "stable" and seeds and s.seeded is False \
+            and not any(g.result.stable for g in s.found):
+        # the guess and its partner are both unstable: the seeds may reach a stable gait
+        # (a gait found already is not taken twice: the seeds go on to a new one)
+        s.from_seeds()
     found = order_gaits(s.found)
     if ground_check is not None:
         for g in found:
-            g.ground = ground_check(g.result.x)
+            if g.ground is None:
+                g.ground = ground_check(g.result.x)
     search = GaitSearch(found, 0, policy, s.notes, s.tried)
     search.selected = select_gait(search, guess, time_unit)
     return search
@@ -270,6 +283,7 @@ class _RootStarts:
         self.notes: list[str] = []
         self.best = math.inf
         self.last_msg = ""
+        self.seeded = False  # the scale-free seeds were tried
 
     def attempt(self, x0, source: str, deflate=(), jacobian_guess=None) -> Gait | None:
         """The gait the root finder reaches from ``x0``, or None (no root, or a gait already
@@ -292,6 +306,8 @@ class _RootStarts:
         """Root from the best-ranked scale-free seeds; none converging, from where the seeds
         walk to in :data:`~walkerlab.analysis.gait.starts.WALK_STEPS` steps."""
         walker, solver, max_step_time = self.walker, self.solver, self.kw["max_step_time"]
+        self.seeded = True
+        n_before = len(self.found)
         n_started = 0
         ranked, n_seeds, n_off = screen_seeds(walker, solver, max_step_time)
         for _err, _desc, x in ranked[:ROOT_STARTS]:
@@ -304,7 +320,7 @@ class _RootStarts:
                           f"({n_seeds - len(ranked) - n_off} fell within the first step"
                           + (f", {n_off} could not reach the landing" if n_off else "")
                           + ")")
-        if self.found or not ranked:
+        if len(self.found) > n_before or not ranked:
             return
         n_walked = n_started = 0  # second round: from where the seeds walk to
         for _err, _desc, x in ranked:
