@@ -99,9 +99,10 @@ STRING_COLUMNS = {
     "outcome": "typed outcome (see walkerlab.studies.outcomes)",
     "message": "human-readable detail (exception text, solver message, guard name)",
     "fall_leg": "physical leg in stance when the walker fell ('' if none)",
-    "guess_source": "fixed-point guess used: 'neighbour' (continuation from the chunk's "
-                    "previous fixed points), 'scene' (its initial_guess), 'search' (found "
-                    "without a guess: walkerlab.analysis.gait.search), or ''",
+    "guess_source": "where the chosen gait's root finder started (as walkerlab fixedpoint "
+                    "searches, the point alone): 'scene' (its initial_guess), "
+                    "'zero_dynamics' (the restricted map's orbit), 'search' (scale-free "
+                    "seeds or deflation: walkerlab.analysis.gait.search), or ''",
 }
 
 STAGES = tuple(COLUMNS)
