@@ -285,15 +285,19 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
             yield ci, k + (ci == c0), rows, carry
 
 
-#: the start-up of a local pool of sweep workers [s] (forkserver with the model libraries,
-#: each worker's first model build), as ``walkerlab bench sweep_workers`` measures it
-POOL_START_S = 0.5
+#: the start-up of a local pool of sweep workers [s]: the forkserver with the model
+#: libraries, then each worker's first point, which loads its walker's model code (taken
+#: on the safe side of what ``walkerlab bench sweep-workers`` sees on a shared machine)
+POOL_START_S = 1.0
 
 
 def pool_pays(work_s: float, workers: int) -> bool:
     """Whether ``work_s`` [s] of points in this process take longer than on a pool of
-    ``workers`` processes after its start-up (:data:`POOL_START_S`): a pool only when
-    ``work_s (1 - 1 / workers) > POOL_START_S``."""
+    ``workers`` processes (at most the machine's CPUs) after its start-up
+    (:data:`POOL_START_S`): a pool only when ``work_s (1 - 1 / workers) > POOL_START_S``."""
+    import os
+
+    workers = min(workers, os.cpu_count() or 1)
     return workers > 1 and work_s * (1.0 - 1.0 / workers) > POOL_START_S
 
 
