@@ -1,18 +1,17 @@
 """Run a sweep: plan chunks, evaluate them locally or on Dask, append rows as they finish.
 
-Chunks are *runs along the first axis*: for every combination of the other axes the points
-of the first axis are evaluated in order by one worker, so each point can start its
-fixed-point search from its neighbours' fixed points (continuation: secant predictor and
-the previous Jacobian, :class:`walkerlab.studies.points.Continuation`).  When the base
-scene's own value of the first parameter lies inside the axis, a line is split there into
-an upward run and a downward run, both starting next to the scene's initial guess.
+Every point is a function of itself alone (:func:`walkerlab.studies.points.scene_gait`:
+the gait ``walkerlab fixedpoint`` finds and chooses for the point's scene; no neighbour's
+gait is carried along): a sweep's rows are the same, bit for bit, whatever the chunking,
+the worker count or the executor.  (A branch beyond the reach of the scene's guess and
+the seeds is followed by ``walkerlab continuation``.)
 
-Balance: all chains run at once (each has one piece in flight), so the workers stay busy
-while there are at least as many unfinished chains as workers; the sweep's wall time is
-then about ``max(total / workers, longest chain)``.  A run longer than ``total / workers``
-is therefore dealt out *interleaved* into ``k`` chains (points ``0, k, 2k, ...``,
-``1, k+1, ...``): each still starts next to the scene's guess and continues in steps of
-``k`` grid points, so no chain needs a guess far from the anchor.
+Chunks are *runs along the first axis* (for every combination of the other axes; split at
+the base scene's own value of the first parameter when it lies inside the axis), dealt
+out for balance: all chains run at once (each has one piece in flight), so the workers
+stay busy while there are at least as many unfinished chains as workers; a run longer
+than ``total / workers`` is dealt out *interleaved* into ``k`` chains (points ``0, k,
+2k, ...``, ``1, k+1, ...``).
 
 Executors
 ---------
@@ -20,16 +19,18 @@ The chains run on the one executor protocol of :mod:`walkerlab.execution`
 (:func:`sweep_executor`):
 
 - ``workers == 1`` and no scheduler: in this process (no start-up cost).
-- ``workers >= 2`` and no scheduler: a local process pool (forkserver processes on Linux,
-  with the model functions built once in the server).
+- ``workers >= 2`` and no scheduler: the first piece in this process, timed; the rest on a
+  local process pool (forkserver processes on Linux, with the model functions built once
+  in the server) only when their estimated time pays the pool's start-up
+  (:func:`pool_pays`), else here too.
 - ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
   the same :func:`run_piece` runs on its workers.
 
 Progress and robustness
 ----------------------------------
 - A chunk is cut into *pieces* of at most :data:`PIECE_POINTS` points; the next piece of a
-  chunk is submitted when the previous one returns, with its continuation state, so
-  continuation is unchanged while rows come back every few points (D12).  They are written
+  chunk is submitted when the previous one returns, so rows come back every few points
+  (D12).  They are written
   to the file after the first piece and then at least every :data:`FLUSH_EVERY_S` seconds
   (one HDF5 append of every column costs the main process CPU, taken from the workers
   on a 2-core machine), and on an interruption.
@@ -42,16 +43,10 @@ Progress and robustness
 
 Resume
 ---------------------------------
-A point's fixed point depends, to round-off (~1e-13, within the root finder's xtol), on the
-predictor it started from, i.e. on its chain.  Re-planning the chains from the points left
-(as before) restarted them from the scene's guess at a different point and changed the
-interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
-``guess_source``.  Now the plan made when the sweep starts is stored in the partial file with
-a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
-chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
-with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
-is hashed as written (:func:`walkerlab.io.sweep_resume.row_hashes`); a row or checkpoint that
-does not match on resume drops its chain's rows and the chain is computed again.
+The plan made when the sweep starts is stored in the partial file with a checkpoint per
+chain (points written); a resumed chain continues from its checkpoint.  Every row is hashed
+as written (:func:`walkerlab.io.sweep_resume.row_hashes`); a row or checkpoint that does not
+match on resume drops its chain's rows and the chain is computed again.
 """
 
 from __future__ import annotations

@@ -487,8 +487,8 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
               if walker.actuators is not None else "give fixedpoint.initial_guess (or start "
               "from a gait known nearby: walkerlab fixedpoint --from KNOWN_SCENE)")
     return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
-            "from a walker whose gait is known (walkerlab sweep SCENE --param "
-            f"FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or {nearer}"
+            "from a walker whose gait is known (walkerlab continuation SCENE --param "
+            f"FIELD=KNOWN:THIS, e.g. slope.angle_deg), or {nearer}"
             + f" [tried {' and '.join(tried)}{res}"
             + (f"; last: {last}]" if last else "]" if "standing" in why
                else "; last: every start fell]"))
