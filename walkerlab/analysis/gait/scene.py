@@ -251,14 +251,18 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
 
 def gait_ground_contact(scene: Scene, walker, x):
     """Whether the gait from ``x`` (the scene's walker's fixed point) needs only a ground that
-    pushes (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver).
+    pushes, and the friction it needs against the scene's ``mu``
+    (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver;
+    :func:`walkerlab.analysis.gait.friction.scene_friction`).
 
     Returns
     -------
     walkerlab.analysis.gait.checks.GroundContact
     """
     from walkerlab.analysis.gait.checks import ground_contact
+    from walkerlab.analysis.gait.friction import scene_friction
     from walkerlab.walker.description import walker_data
 
+    mu, mu_source = scene_friction(scene)
     return ground_contact(walker, walker_data(scene.walker, scene.slope.phi_rad), x,
-                          Solver.from_settings(scene.solver))
+                          Solver.from_settings(scene.solver), mu=mu, mu_source=mu_source)

@@ -111,6 +111,13 @@ class Gait:
         return getattr(self.ground, "ok", None) is not False
 
     @property
+    def inside_friction_cone(self) -> bool:
+        """False only when the ground check found that the gait needs more friction than
+        the ground's ``mu`` (:class:`walkerlab.analysis.gait.friction.FrictionVerdict`);
+        True when it holds or was not made."""
+        return getattr(getattr(self.ground, "friction", None), "inside", None) is not False
+
+    @property
     def max_multiplier(self) -> float:
         """Largest ``|Floquet multiplier|`` (variational) [-]."""
         return float(np.max(np.abs(self.result.multipliers_variational)))
@@ -242,7 +249,8 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
     if ground_check is not None and policy == "stable":
         first.ground = ground_check(first.result.x)
     if other_gait or policy in ("long_period", "short_period") or (
-            policy == "stable" and not (first.result.stable and first.on_real_ground)):
+            policy == "stable" and not (first.result.stable and first.on_real_ground
+                                        and first.inside_friction_cone)):
         s.other_gait()
     if policy == "stable" and seeds and s.seeded is False \
             and not any(g.result.stable for g in s.found):
@@ -385,7 +393,9 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
       one nearest it, max-norm over the state).
 
     Under ``stable`` the gaits that need the ground to pull (:attr:`Gait.on_real_ground`
-    False) are chosen only when no other gait was found, with a note.  Ties (equal
+    False) are chosen only when no other gait was found, with a note; so are, among the
+    rest, the gaits outside the ground's friction cone (:attr:`Gait.inside_friction_cone`
+    False).  Ties (equal
     multipliers or distances) go to the first gait in ``search.gaits`` (longest period
     first), so the choice depends only on the gaits found, not on the order they were
     found in.
@@ -427,6 +437,13 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
         pool = list(range(len(gaits)))
     if not real:
         search.notes.append("every gait found needs the ground to pull")
+    cone = [k for k in pool if gaits[k].inside_friction_cone]
+    if cone and len(cone) < len(pool):
+        search.notes.append(
+            "left out: the " + ", ".join(gaits[k].label.replace("_", "-") for k in pool
+                                          if k not in cone)
+            + " gait (needs more friction than the ground's mu: its feet would slip)")
+        pool = cone
     stable = [k for k in pool if gaits[k].result.stable]
     if stable:
         k = nearest(stable)
