@@ -99,6 +99,10 @@ def test_a_sweeps_rows_are_the_fixed_points_from_the_scenes_guess_bit_for_bit(sc
     assert list(rows["param/slope.angle_deg"]) == list(slopes)
     assert list(rows["outcome"]) == ["ok"] * 3
     assert list(rows["guess_source"]) == ["scene"] * 3
+    # every row carries its gait's ground verdict: Goswami's walker needs mu ~ 0.27 < 0.9
+    assert set(rows["inside_friction_cone"]) == {1.0} and set(rows["friction_coefficient"]) \
+        == {0.9} and np.all((0.2 < rows["max_friction_ratio"]) & (rows["max_friction_ratio"]
+                                                                   < 0.35))
     for k, v in enumerate(slopes):
         sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_deg"], (float(v),))
         w = build_walker(sc)

@@ -50,6 +50,15 @@ _NFEV = {"nfev": ("-", "right-hand-side evaluations")}
 
 _FP = {
     "step_period_s": ("s", "step period of the period-1 gait"),
+    "min_normal_force_n": ("N", "smallest normal force on the stance foot (< 0: the gait "
+                           "needs the ground to pull; NaN: not checked, e.g. flat feet)"),
+    "max_friction_ratio": ("-", "largest |tangential| / normal ground force at every foot "
+                           "on the ground (inf: a foot unloads while it carries a "
+                           "tangential force): the friction coefficient the gait needs"),
+    "friction_coefficient": ("-", "the ground's static friction coefficient (contact."
+                             "mu_static or its default)"),
+    "inside_friction_cone": ("-", "1 if max_friction_ratio <= friction_coefficient, 0 if "
+                             "not, NaN if not checked"),
     "residual": ("rad or rad/s", "max |P(x) - x| at the last iterate"),
     "max_abs_multiplier": ("-", "largest |Floquet multiplier|"),
     "stable": ("-", "1 if all |multipliers| < 1, else 0"),

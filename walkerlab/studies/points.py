@@ -285,6 +285,17 @@ def _fp_columns(walker, res) -> dict:
     return cols
 
 
+def _ground_columns(ground) -> dict:
+    """The chosen gait's ground verdict: the stance foot's smallest normal force and the
+    friction it needs against the ground's (NaN where not checked)."""
+    fr = getattr(ground, "friction", None)
+    inside = None if fr is None else fr.inside
+    return {"min_normal_force_n": float(getattr(ground, "min_normal_force_n", math.nan)),
+            "max_friction_ratio": math.nan if fr is None else float(fr.max_ratio),
+            "friction_coefficient": math.nan if fr is None else float(fr.mu),
+            "inside_friction_cone": math.nan if inside is None else float(inside)}
+
+
 # ----------------------------------------------------------------------------- stages
 def fixedpoint_point(scene: Scene, guess, options: dict):
     """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``): the gait
@@ -302,6 +313,7 @@ def fixedpoint_point(scene: Scene, guess, options: dict):
     walker, search, source = scene_gait(scene, options)
     res = search.result
     cols = _fp_columns(walker, res)
+    cols.update(_ground_columns(search.gait.ground))
     cols.update(outcome="ok", guess_source=source,
                 message="" if res.stable else "unstable period-1 gait (|multiplier| >= 1)")
     return cols, res
