@@ -179,9 +179,9 @@ def scene_gait(scene: Scene, options: dict | None = None):
     preferring gaits on a ground that only pushes and within its friction cone), without
     the finite-difference check of the multipliers, and with the other gait of the pair
     looked for only when the choice needs it (``fixedpoint.gait`` ``long_period`` or
-    ``short_period``; the first gait unstable under ``stable``, or off the ground's
-    verdict): the choice is the stage's unless both gaits of a pair are stable and on
-    real ground.  A function of the point alone: no neighbour's gait enters,
+    ``short_period``; the first gait unstable under ``stable``, or, with
+    ``fixedpoint.other_gait``, off the ground's verdict): the choice is the stage's unless
+    both gaits of a pair are stable, on real ground and inside the friction cone.  A function of the point alone: no neighbour's gait enters,
     so a sweep's rows do not depend on how its points are dealt out to workers.
 
     Returns
@@ -206,7 +206,9 @@ def scene_gait(scene: Scene, options: dict | None = None):
 
     opts = {**DEFAULT_OPTIONS, **(options or {})}
     try:
-        walker, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False)
+        fp = scene.fixedpoint
+        walker, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False,
+                                     partner_off_ground=fp is None or fp.other_gait)
     except GaitNotFound as exc:
         r = exc.residual
         raise PointOutcome("no_fixed_point", str(exc),

@@ -100,7 +100,8 @@ def with_variant(scene: Scene, variant: str) -> Scene:
 
 
 def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None,
-                ground: bool = False, other_gait: bool | None = None):
+                ground: bool = False, other_gait: bool | None = None,
+                partner_off_ground: bool = False):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
@@ -114,7 +115,9 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     (:func:`gait_ground_contact`; each :class:`~walkerlab.analysis.gait.search.Gait` carries
     its verdict and the selection prefers the gaits that need no pull).  ``other_gait``
     (default ``fixedpoint.other_gait``): look for the other gait of the pair even when the
-    choice does not need it (:func:`~walkerlab.analysis.gait.search.find_gaits`).
+    choice does not need it; ``partner_off_ground``: without it, still when the first gait
+    needs a pull or more friction than the ground has
+    (:func:`~walkerlab.analysis.gait.search.find_gaits`).
 
     Returns
     -------
@@ -141,7 +144,7 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
                         fd_check=fd_check,
                         ground_check=(lambda x: gait_ground_contact(scene, walker, x))
-                        if ground else None)
+                        if ground else None, partner_off_ground=partner_off_ground)
     return walker, search
 
 

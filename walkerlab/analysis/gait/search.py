@@ -170,7 +170,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
                policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
                fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
                time_unit: str = "s", seeds: bool = True,
-               ground_check=None) -> GaitSearch:
+               ground_check=None, partner_off_ground: bool = False) -> GaitSearch:
     """Find the walker's period-1 gait(s) and choose one.
 
     Parameters
@@ -200,7 +200,12 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     ground_check : callable, optional
         ``ground_check(x) -> GroundContact`` for a fixed point ``x`` (2n,): every gait found
         carries its verdict (:attr:`Gait.ground`), and :func:`select_gait` prefers gaits on
-        a ground that only pushes.
+        a ground that only pushes and inside its friction cone.
+    partner_off_ground : bool
+        Without ``other_gait``: look for the other gait when the first one, stable, needs
+        the ground to pull or more friction than it has (with ``ground_check``, under
+        ``stable``): the choice ``other_gait`` would make, at the cost of a second search
+        only where it can change (a sweep point).
 
     Returns
     -------
@@ -223,14 +228,16 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     try:
         with search_budget():  # every start, seed and root finder: one time budget
             return _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step,
-                               max_step_time, fd_check, time_unit, seeds, ground_check)
+                               max_step_time, fd_check, time_unit, seeds, ground_check,
+                               partner_off_ground)
     except (SearchGaveUp, FixedPointGaveUp) as exc:
         why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
         raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
 
 
 def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_step_time,
-                fd_check, time_unit, seeds, ground_check=None) -> GaitSearch:
+                fd_check, time_unit, seeds, ground_check=None,
+                partner_off_ground=False) -> GaitSearch:
     s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
                                      "max_step_time": max_step_time, "fd_check": fd_check})
     if guess is not None:
@@ -246,11 +253,13 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
         raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
                            s.best)
     first = s.found[0]
-    if ground_check is not None and policy == "stable":
+    off_ground = False  # the first gait needs a pull or more friction than the ground has
+    if partner_off_ground and not other_gait and ground_check is not None \
+            and policy == "stable":
         first.ground = ground_check(first.result.x)
+        off_ground = not (first.on_real_ground and first.inside_friction_cone)
     if other_gait or policy in ("long_period", "short_period") or (
-            policy == "stable" and not (first.result.stable and first.on_real_ground
-                                        and first.inside_friction_cone)):
+            policy == "stable" and (not first.result.stable or off_ground)):
         s.other_gait()
     if policy == "stable" and seeds and s.seeded is False \
             and not any(g.result.stable for g in s.found):
