@@ -63,8 +63,8 @@ from walkerlab.io.artifacts import atomic_write
 _LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.optimize",
           "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd"}
 
-BENCHMARKS = ("ideal", "fixedpoint", "sweep", "sweep-workers", "basin", "contact", "main-job", "optimize",
-              "powered", "hzd")
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "sweep-workers", "basin", "contact", "main-job",
+              "optimize", "powered", "hzd")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:

@@ -181,8 +181,9 @@ def scene_gait(scene: Scene, options: dict | None = None):
     looked for only when the choice needs it (``fixedpoint.gait`` ``long_period`` or
     ``short_period``; the first gait unstable under ``stable``, or, with
     ``fixedpoint.other_gait``, off the ground's verdict): the choice is the stage's unless
-    both gaits of a pair are stable, on real ground and inside the friction cone.  A function of the point alone: no neighbour's gait enters,
-    so a sweep's rows do not depend on how its points are dealt out to workers.
+    both gaits of a pair are stable, on real ground and inside the friction cone.  A
+    function of the point alone: no neighbour's gait enters, so a sweep's rows do not
+    depend on how its points are dealt out to workers.
 
     Returns
     -------

@@ -267,7 +267,7 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     carries = list(guesses) if guesses is not None else [None] * len(chains)
     c0 = next(ci for ci, c in enumerate(chains) if c)
     with sweep_executor(1, None, False) as ex:
-        for ci, k, rows, carry in run_chains(ex, run_piece, [chains[c0][:1]], [carries[c0]]):
+        for _ci, k, rows, carry in run_chains(ex, run_piece, [chains[c0][:1]], [carries[c0]]):
             yield c0, k, rows, carry
     carries[c0] = carry
     rest = [list(c) for c in chains]

@@ -215,7 +215,8 @@ def flat_foot_friction(walker, data, x, solver, mu: float, mu_source: str,
     Parameters
     ----------
     walker : HybridWalker
-        A flat-footed rigid walker (:func:`walkerlab.models.hybrid.rigid_foot_modes.make_flat_walker`).
+        A flat-footed rigid walker
+        (:func:`walkerlab.models.hybrid.rigid_foot_modes.make_flat_walker`).
     data : walkerlab.walker.description.WalkerData
     x : ndarray (2n,)
         Post-impact state (the fixed point) [rad, rad/s].

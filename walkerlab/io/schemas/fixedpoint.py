@@ -12,9 +12,10 @@ variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 ``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
 evaluations, wall time [s]); ``ground_contact/`` (the selected gait: whether the ground only
 pushes, :data:`GROUND_FIELDS`; ``ground_contact/friction/``: the friction it needs at
-every foot on the ground against the ground's ``mu``, :data:`FRICTION_FIELDS`); on stairs ``footholds/`` (attributes of
-:class:`walkerlab.analysis.gait.treads.TreadLanding`: step advance [m], tread drift per step
-[m], steps until a foot misses a tread, clearances [m]); under virtual constraints
+every foot on the ground against the ground's ``mu``, :data:`FRICTION_FIELDS`); on stairs
+``footholds/`` (attributes of :class:`walkerlab.analysis.gait.treads.TreadLanding`: step
+advance [m], tread drift per step [m], steps until a foot misses a tread, clearances [m]);
+under virtual constraints
 ``zero_dynamics/`` (:data:`ZERO_DYNAMICS_FIELDS`: the restricted Poincare map's delta^2,
 V(theta-), V_max, zeta*, the existence margin, the phase rates at impact and the step
 period by quadrature, with units; ``virtual_constraints/``: the Bezier coefficients in
