@@ -428,3 +428,25 @@ def test_a_hip_spring_sweep_is_one_stable_branch_on_any_worker_count(tmp_path):
     x = [one[state_column(n, u)][0] for n, u in zip(names, units)]
     assert np.array_equal(np.array(x), fp.x)
     assert one["step_period_s"][0] == fp.step_period_s
+
+
+@pytest.mark.slow  # a Dask cluster and 4 seeded points twice
+def test_a_hip_spring_sweep_on_dask_has_the_rows_of_one_worker(tmp_path, dask_cluster):
+    """Issue 64 on Dask (``--scheduler``): the rows of a cluster of two workers are those of
+    one local worker, bit for bit, and every point is the stable gait."""
+    import yaml
+
+    from walkerlab.config import load_scene
+
+    path = tmp_path / "hip_spring_push_off.yaml"
+    path.write_text(yaml.safe_dump(HIP_SPRING_PUSH_OFF))
+    sc = load_scene(path)
+    param = ["walker.actuation.torques.0.law.stiffness_n_m_per_rad=0:1.5:0.5"]
+    addr, _workers = dask_cluster
+    one = _rows(sweep_stage.run(sc, param, "fixedpoint", workers=1, runs_root=tmp_path,
+                                name="one", progress=False, figure=False))
+    dask = _rows(sweep_stage.run(sc, param, "fixedpoint", scheduler=addr, runs_root=tmp_path,
+                                 name="dask", progress=False, figure=False))
+    for col in [*COLUMNS["fixedpoint"], "outcome", "guess_source"]:
+        np.testing.assert_array_equal(one[col], dask[col], err_msg=col)
+    assert set(one["stable"]) == {1.0} and one["index"].size == 4
