@@ -121,7 +121,8 @@ def test_sweep_point_chooses_the_gait_as_the_stage_does():
     heavy-hip walker's stable long-period gait, not the unstable one its guess reaches."""
     base = scene_from_dict(HEAVY_HIP).model_dump(mode="json")
     row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {})
-    assert row["outcome"] == "ok" and row["guess_source"] == "scene"
+    # the stable gait is the partner of the one the guess reaches (deflation): "search"
+    assert row["outcome"] == "ok" and row["guess_source"] == "search"
     assert row["stable"] == 1.0 and 0.93 < row["step_period_s"] < 0.95
     row, _ = evaluate("fixedpoint", dict(base, fixedpoint={**base["fixedpoint"],
                                                           "gait": "nearest_guess"}),
@@ -190,6 +191,28 @@ def test_a_stable_gait_that_needs_the_ground_to_pull_is_not_chosen_over_one_on_r
     a, b = _fake_gait(0.7, [0.2, 0.0], 2.0, False, True), _fake_gait(0.7, [0.1, 0.0], 2.0,
                                                                          False, True)
     assert order_gaits([a, b])[0] is b and order_gaits([b, a])[0] is b
+
+
+def test_a_stable_gait_outside_the_friction_cone_is_not_chosen_over_one_inside():
+    """Two stable gaits on real ground, the stable long-period one needing mu 3.1 against
+    the ground's 0.9: fixedpoint.gait: stable takes the one inside the cone, with a note;
+    when every gait is outside it the choice is as before (the most stable)."""
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.gait.search import GaitSearch, order_gaits, select_gait
+
+    def with_mu(g, ratio):
+        g.ground = SimpleNamespace(ok=True, friction=SimpleNamespace(inside=ratio <= 0.9))
+        return g
+
+    found = order_gaits([with_mu(_fake_gait(0.9, [0.1, 0.2], 0.5, True, True), 3.1),
+                         with_mu(_fake_gait(0.5, [0.3, 0.4], 0.8, True, True), 0.2)])
+    search = GaitSearch(found, 0, "stable")
+    assert found[select_gait(search)].result.period_s == 0.5
+    assert any("long-period gait (needs more friction" in n for n in search.notes)
+    both_out = order_gaits([with_mu(_fake_gait(0.9, [0.1, 0.2], 0.5, True, True), 3.1),
+                            with_mu(_fake_gait(0.5, [0.3, 0.4], 0.8, True, True), 2.0)])
+    assert both_out[select_gait(GaitSearch(both_out, 0, "stable"))].result.period_s == 0.9
 
 
 def test_failed_search_says_what_was_tried_in_one_line():

@@ -175,3 +175,89 @@ def test_a_gait_that_needs_the_ground_to_pull_is_flagged(tmp_path):
     fp3 = load_fixedpoint(tmp_path / "r" / "t3" / "fixedpoint.h5")
     assert fp3.ground_contact.ok is True
     assert fp3.ground_contact.values["min_normal_force_n"] > 100.0  # 171.4 N
+
+
+@pytest.mark.parametrize("push_off, slope", [(3.0, 0.0), (0.0, 0.05)])
+def test_the_friction_ratio_is_newtons_from_the_com_trajectory(push_off, slope):
+    """The friction verdict's largest |F_t/F_n| at the stance foot against Newton's law on
+    the centre of mass, ``F = m_total (a_com + g)``, with ``a_com`` from second central
+    differences of the COM along the integrator's dense output over the step (the hip and
+    leg particles placed by the independent module's geometry): no code shared with the
+    floating view the verdict reads.  Both sample the step's ends, where the ratio is
+    largest here; the differences' error ~ h^2 |a''''| / 12 ~ 1e-9 N at h = 0.2 ms."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+
+    scene = scene_from_dict(_compass(push_off, slope))
+    if push_off == 0.0:  # the passive paper walker on its slope
+        scene = scene_from_dict({**_compass(0.0, slope), "walker": {
+            k: v for k, v in _compass(0.0, slope)["walker"].items() if k != "actuation"}})
+    w, search = solve_scene(scene, fd_check=False, ground=True)
+    fr = search.gait.ground.friction
+    assert fr.inside and fr.mu == 0.9 and fr.mu_source == "the contact model's default"
+    p = ref.PAPER
+    m, MH, L, a, b = p["m"], p["M_H"], p["L"], p["a"], p["L"] - p["a"]
+    seg = simulate_steps(w, search.result.x, 1, Solver.from_settings(scene.solver)).segments[0]
+    h = 2e-4
+    t = seg.t_start + h * np.arange(int((seg.t_end - seg.t_start) / h) + 1)  # uniform
+    X = seg.sample(t)
+    t1, t2 = X[0], X[1]
+    up = lambda th: np.array([-np.sin(th), np.cos(th)])  # noqa: E731
+    hip = L * up(t2)
+    com = (MH * hip + m * a * up(t2) + m * (hip - b * up(t1))) / (MH + 2 * m)
+    acc = (com[:, 2:] + com[:, :-2] - 2 * com[:, 1:-1]) / h ** 2
+    F = (MH + 2 * m) * (acc + np.array([[0.0], [G]]))
+    n, tan = np.array([np.sin(slope), np.cos(slope)]), np.array([np.cos(slope), -np.sin(slope)])
+    ratio = np.abs(tan @ F) / (n @ F)
+    # the differences (at t[1:-1]) miss the step's ends: the ratio's trend extrapolated to
+    # each end (linear, over at most 2h: error ~ r'' (2h)^2 / 2 < 1e-6 here)
+    tc = t[1:-1]
+    ends = [ratio[0] - (ratio[1] - ratio[0]) * (tc[0] - seg.t_start) / h,
+            ratio[-1] + (ratio[-1] - ratio[-2]) * (seg.t_end - tc[-1]) / h]
+    assert abs(max(ratio.max(), *ends) - fr.max_ratio) < 1e-5 * fr.max_ratio
+
+
+@pytest.mark.slow  # the flat-footed gait's search and its map: several seconds
+def test_a_flat_foots_friction_verdict_names_the_toe_that_would_slip():
+    """configs/flat_feet.yaml: in double support the trailing toe's normal force falls to 0
+    at toe off while it still pulls 26.6 N along the ground, so the gait needs an unbounded
+    friction coefficient and leaves the contact model's cone (mu 0.9) before toe off; the
+    stance foot alone needs about 0.25.  Newton's total force on the point masses, which the
+    verdict reads, gives the generated model's own normal forces (its guards'), from a
+    separate symbolic derivation, to the differences' O(h^2)."""
+    import math
+    from pathlib import Path
+
+    from walkerlab.analysis.gait.friction import _forces_of, _newton_force, _point_masses
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.config import load_scene
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml")
+    w, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False)
+    fr = search.gait.ground.friction
+    assert fr.inside is False and math.isinf(fr.max_ratio) and fr.foot == "trailing toe"
+    assert 20.0 < abs(fr.unloaded_tangential_n) < 35.0 and 0 < fr.exit_time_s < fr.time_s
+    assert 0.15 < fr.single_support_max_ratio < 0.9 and fr.mu == 0.9
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    masses, g = _point_masses(w, data), data.gravity_m_per_s2
+    weight = data.total_mass_kg * g
+    n = np.array([np.sin(scene.slope.phi_rad), np.cos(scene.slope.phi_rad)])
+    seg = simulate_steps(w, search.result.x, 1, Solver.from_settings(scene.solver)).segments[0]
+    checked = set()
+    for phase, sol, (ta, tb) in seg.pieces:
+        lifts = [gd for gd in phase.guards if gd.name == "stance_foot_lifts"]
+        if tb <= ta or not lifts:
+            continue
+        double = phase.name.startswith("double_support")
+        pin = "stance_toe" if phase.name.startswith("heel_off") else "stance_heel"
+        for t in np.linspace(ta, tb, 5)[1:-1]:
+            x = np.ravel(sol(t))[:6]
+            F = _newton_force(w, masses, pin, x, phase.flow(t, x), g)
+            total = float(F @ n) - (float(_forces_of(phase)(t, x)[0]) if double else 0.0)
+            # second differences at h = 1e-4: error ~ m h^2 w^4 |p| ~ 20 kg 1e-8 1e4 1 m/s^2
+            assert abs(total - lifts[0].function(t, x)) < 1e-5 * weight, (phase.name, t)
+        checked.add(phase.name.split(":")[0])
+    assert checked == {"double_support", "heel_contact", "heel_off"}

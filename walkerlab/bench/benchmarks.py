@@ -108,6 +108,32 @@ def bench_fixedpoint(runs: int = 5) -> dict:
         return {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
 
 
+def bench_sweep_workers(points=(8, 32), runs: int = 3) -> dict:
+    """``walkerlab sweep`` of the paper scene over the slope with 1 and with 2 workers,
+    whole process, for sweeps of ``points`` points (8 and 32: fixed-point points of a few ms,
+    where a pool's start-up would cost more than the points); the runs alternate 1 and 2
+    workers (a shared machine's load falls on both alike), medians of ``runs``.  Target: 2
+    workers never slower than 1 (the sweep runs a small job in its own process,
+    :func:`walkerlab.studies.runner.pool_pays`)."""
+    out: dict = {"target": "2 workers <= 1 worker (ratio <= 1)", "sweeps": []}
+    with tempfile.TemporaryDirectory() as d:
+        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True)
+        for n in points:
+            hi = 2.5 + 0.01 * (n - 1)
+            walls: dict[int, list[float]] = {1: [], 2: []}
+            for k in range(runs):
+                for w in (1, 2):
+                    cmd = _cli("sweep", "--param", f"slope.angle_deg=2.5:{hi:.2f}:0.01",
+                               "--workers", str(w), "--name", f"w{w}_{n}_{k}",
+                               "--runs-dir", d)
+                    walls[w].append(_time_process(cmd, 1)["wall_median_s"])
+            m1, m2 = float(np.median(walls[1])), float(np.median(walls[2]))
+            out["sweeps"].append({"points": n, "workers_1_wall_median_s": m1,
+                                  "workers_2_wall_median_s": m2, "ratio_2_to_1": m2 / m1,
+                                  "walls_s": {str(w): v for w, v in walls.items()}})
+    return out
+
+
 def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
     """``walkerlab basin --grid 200x200 --force`` on the paper scene, whole process.
 

@@ -14,6 +14,8 @@ benchmark      what is timed                                                    
 ``sweep``      fixed-point sweep over the slope (0.5-4.5 deg, 201 points), 2    >= 50 pt/s
                worker processes, pool start included (model code cache warm),
                to the finished artifact; the figure drawn after it timed apart
+``sweep-``     ``walkerlab sweep`` of the paper walker, 8 and 32 points, 1      2 workers
+``workers``    against 2 workers, whole process, alternating runs (medians)     <= 1
 ``basin``      ``walkerlab basin --grid 200x200 --force``, paper walker,        <= 120 s
                50 steps a cell at most, 2 workers, whole process
 ``contact``    the contact walker's work-precision benchmark
@@ -61,8 +63,8 @@ from walkerlab.io.artifacts import atomic_write
 _LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.optimize",
           "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd"}
 
-BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job", "optimize",
-              "powered", "hzd")
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "sweep-workers", "basin", "contact", "main-job",
+              "optimize", "powered", "hzd")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -180,5 +182,5 @@ def _run_one(name: str, scenes) -> dict:
 
         return bench_hzd()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
-            "basin": B.bench_basin,
+            "basin": B.bench_basin, "sweep-workers": B.bench_sweep_workers,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

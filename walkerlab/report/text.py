@@ -180,6 +180,8 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
         lines += zero_dynamics_text(fp.zero_dynamics)
     if fp.ground_contact is not None:
         lines.append(ground_contact_text(fp.ground_contact, u))
+        if fp.ground_contact.friction is not None:
+            lines.append(fp.ground_contact.friction.text())
     if _terrain_kind(fp.scene_json) == "profile":
         lines.append("ground: terrain.kind: profile: this is the gait of the scene's slope, "
                      "where the walk on the profile starts (walkerlab simulate walks the "
@@ -266,10 +268,14 @@ def _ground_word(g, u) -> str:
     """``, on real ground`` / ``, NEEDS THE GROUND TO PULL (min normal force -31.4 N)`` for
     a gait that carries its ground check, else ``""``."""
     gc = g.ground_contact
+    fr = getattr(gc, "friction", None)
+    slips = ("" if fr is None or fr.inside is not False else
+             f", OUTSIDE THE FRICTION CONE (needs {fr.needed()}, the ground's mu is "
+             f"{fr.mu:.3g})")
     if gc is None or gc.ok is None:
-        return ""
+        return slips
     if gc.ok:
-        return ", on real ground"
+        return ", on real ground" + slips
     n = gc.values.get("min_normal_force_n", 0.0)
     return (", NEEDS THE GROUND TO PULL" + (f" (stance normal force down to {n:.4g} {u('N')})"
                                               if n < 0 else " (a pulling impulse)"))

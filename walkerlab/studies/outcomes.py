@@ -50,6 +50,15 @@ _NFEV = {"nfev": ("-", "right-hand-side evaluations")}
 
 _FP = {
     "step_period_s": ("s", "step period of the period-1 gait"),
+    "min_normal_force_n": ("N", "smallest normal force on the stance foot (< 0: the gait "
+                           "needs the ground to pull; NaN: not checked, e.g. flat feet)"),
+    "max_friction_ratio": ("-", "largest |tangential| / normal ground force at every foot "
+                           "on the ground (inf: a foot unloads while it carries a "
+                           "tangential force): the friction coefficient the gait needs"),
+    "friction_coefficient": ("-", "the ground's static friction coefficient (contact."
+                             "mu_static or its default)"),
+    "inside_friction_cone": ("-", "1 if max_friction_ratio <= friction_coefficient, 0 if "
+                             "not, NaN if not checked"),
     "residual": ("rad or rad/s", "max |P(x) - x| at the last iterate"),
     "max_abs_multiplier": ("-", "largest |Floquet multiplier|"),
     "stable": ("-", "1 if all |multipliers| < 1, else 0"),
@@ -99,9 +108,10 @@ STRING_COLUMNS = {
     "outcome": "typed outcome (see walkerlab.studies.outcomes)",
     "message": "human-readable detail (exception text, solver message, guard name)",
     "fall_leg": "physical leg in stance when the walker fell ('' if none)",
-    "guess_source": "fixed-point guess used: 'neighbour' (continuation from the chunk's "
-                    "previous fixed points), 'scene' (its initial_guess), 'search' (found "
-                    "without a guess: walkerlab.analysis.gait.search), or ''",
+    "guess_source": "where the chosen gait's root finder started (as walkerlab fixedpoint "
+                    "searches, the point alone): 'scene' (its initial_guess), "
+                    "'zero_dynamics' (the restricted map's orbit), 'search' (scale-free "
+                    "seeds or deflation: walkerlab.analysis.gait.search), or ''",
 }
 
 STAGES = tuple(COLUMNS)

@@ -172,6 +172,65 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     raise PointOutcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
 
 
+def scene_gait(scene: Scene, options: dict | None = None):
+    """The scene's period-1 gait found and chosen exactly as ``walkerlab fixedpoint`` does
+    (:func:`walkerlab.analysis.gait.scene.solve_scene`: the scene's initial guess or the
+    zero dynamics' orbit, then the scale-free seeds; the choice by ``fixedpoint.gait``,
+    preferring gaits on a ground that only pushes and within its friction cone), without
+    the finite-difference check of the multipliers, and with the other gait of the pair
+    looked for only when the choice needs it (``fixedpoint.gait`` ``long_period`` or
+    ``short_period``; the first gait unstable under ``stable``, or, with
+    ``fixedpoint.other_gait``, off the ground's verdict): the choice is the stage's unless
+    both gaits of a pair are stable, on real ground and inside the friction cone.  A
+    function of the point alone: no neighbour's gait enters, so a sweep's rows do not
+    depend on how its points are dealt out to workers.
+
+    Returns
+    -------
+    walker : HybridWalker
+    search : walkerlab.analysis.gait.search.GaitSearch
+        The gaits found; ``search.result`` the chosen one's FixedPointResult.
+    source : str
+        ``"scene"`` (from the scene's initial guess), ``"zero_dynamics"`` (virtual
+        constraints: from the restricted map's orbit) or ``"search"`` (scale-free seeds, or
+        deflation near the first gait).
+
+    Raises
+    ------
+    PointOutcome
+        ``no_fixed_point`` (the search's one-line message and best residual; a degenerate
+        gait whose inter-leg angle is below ``options["min_interleg_angle_rad"]``) or
+        ``invalid_config`` (a malformed initial guess or gait choice).
+    """
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.analysis.gait.search import GaitNotFound
+
+    opts = {**DEFAULT_OPTIONS, **(options or {})}
+    try:
+        fp = scene.fixedpoint
+        walker, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False,
+                                     partner_off_ground=fp is None or fp.other_gait)
+    except GaitNotFound as exc:
+        r = exc.residual
+        raise PointOutcome("no_fixed_point", str(exc),
+                           residual=r if math.isfinite(r) else math.nan) from None
+    except ValueError as exc:
+        raise PointOutcome("invalid_config", str(exc)) from None
+    res = search.result
+    il = interleg_angle(walker, res.x)
+    if il < opts["min_interleg_angle_rad"]:
+        raise PointOutcome("no_fixed_point", f"degenerate fixed point (inter-leg angle "
+                           f"{il:.2e} rad < {opts['min_interleg_angle_rad']:g}): no step",
+                           residual=float(res.residual))
+    source = search.gait.source
+    if source == "initial_guess":
+        has_guess = scene.fixedpoint is not None and scene.fixedpoint.initial_guess is not None
+        source = "scene" if has_guess else "zero_dynamics"
+    else:
+        source = "search"
+    return walker, search, source
+
+
 def _searched_gait(walker, solver, fp, guess):
     """The scene's period-1 gait as the fixedpoint stage chooses it (``fixedpoint.gait``):
     from the scene's initial guess (no seeds when it fails: a sweep point stays cheap), or
@@ -229,9 +288,22 @@ def _fp_columns(walker, res) -> dict:
     return cols
 
 
+def _ground_columns(ground) -> dict:
+    """The chosen gait's ground verdict: the stance foot's smallest normal force and the
+    friction it needs against the ground's (NaN where not checked)."""
+    fr = getattr(ground, "friction", None)
+    inside = None if fr is None else fr.inside
+    return {"min_normal_force_n": float(getattr(ground, "min_normal_force_n", math.nan)),
+            "max_friction_ratio": math.nan if fr is None else float(fr.max_ratio),
+            "friction_coefficient": math.nan if fr is None else float(fr.mu),
+            "inside_friction_cone": math.nan if inside is None else float(inside)}
+
+
 # ----------------------------------------------------------------------------- stages
 def fixedpoint_point(scene: Scene, guess, options: dict):
-    """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``).
+    """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``): the gait
+    ``walkerlab fixedpoint`` finds and chooses for the point's scene (:func:`scene_gait`;
+    ``guess`` is not used: a point's row is a function of the point alone).
 
     Returns
     -------
@@ -239,10 +311,12 @@ def fixedpoint_point(scene: Scene, guess, options: dict):
         Columns of :data:`walkerlab.studies.outcomes.COLUMNS` ``["fixedpoint"]``, ``outcome``
         ``ok`` and ``guess_source``.
     fixed_point : FixedPointResult
-        For the next point of the chunk (continuation).
+        The chosen gait's.
     """
-    walker, res, source = ideal_fixed_point(scene, guess, options)
+    walker, search, source = scene_gait(scene, options)
+    res = search.result
     cols = _fp_columns(walker, res)
+    cols.update(_ground_columns(search.gait.ground))
     cols.update(outcome="ok", guess_source=source,
                 message="" if res.stable else "unstable period-1 gait (|multiplier| >= 1)")
     return cols, res
@@ -290,7 +364,8 @@ def simulate_point(scene: Scene, guess, options: dict):
     cols: dict = {}
     next_guess = None
     if sim.initial_state == "fixed_point":
-        walker, res, source = ideal_fixed_point(scene, guess, options)
+        walker, search, source = scene_gait(scene, options)
+        res = search.result
         x0, next_guess = res.x, res
         cols["guess_source"] = source
     else:
@@ -388,7 +463,8 @@ def contact_point(scene: Scene, guess, options: dict):
     from walkerlab.integrate.rigid import integrate_step
 
     opts = {**DEFAULT_OPTIONS, **options}
-    walker, fp, source = ideal_fixed_point(scene, guess, options)
+    walker, search, source = scene_gait(scene, options)
+    fp = search.result
     seg = integrate_step(walker, fp.x, _solver(scene),
                          max_step_time=(scene.fixedpoint
                                         or FixedPointSettings()).max_step_time_s)
@@ -445,10 +521,10 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
         All columns of the stage (NaN / ``""`` where not applicable; units as the columns'
         names say, :data:`walkerlab.studies.outcomes.COLUMNS`), ``index``, ``outcome``,
         ``message``, ``wall_time_s`` [s].
-    next_guess : Continuation or None
-        ``guess`` (a :class:`Continuation`) with this point's fixed point appended, for the
-        next point of the chunk (``None`` after a failure or without a fixed point: the
-        caller keeps the previous one, so a failed point never enters the extrapolation).
+    next_guess : None
+        Always None: no point's gait is carried to the next (``guess`` is not used either;
+        both stay in the signature of the chain protocol,
+        :func:`walkerlab.execution.run_chains`).
     """
     row = empty_row(stage, index)
     t0 = time.perf_counter()
@@ -462,12 +538,10 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
             warnings.simplefilter("always")
         try:
             scene = apply_point(base, list(paths), tuple(values), origin)
-            cont = guess if isinstance(guess, Continuation) else None
-            start = cont.aimed(values[0]) if cont is not None and cont.states else guess
-            cols, fp = POINT_FUNCTIONS[stage](scene, start, options)
+            # a point's row is a function of the point alone (no neighbour's gait): the rows
+            # do not depend on the chunking, the worker count or the executor
+            cols, _fp = POINT_FUNCTIONS[stage](scene, None, options)
             row.update(cols)
-            if fp is not None:
-                next_guess = (cont or Continuation()).then(values[0], fp)
         except SceneError as exc:
             row.update(outcome="invalid_config", message=str(exc))
         except PointOutcome as exc:

@@ -1,18 +1,17 @@
 """Run a sweep: plan chunks, evaluate them locally or on Dask, append rows as they finish.
 
-Chunks are *runs along the first axis*: for every combination of the other axes the points
-of the first axis are evaluated in order by one worker, so each point can start its
-fixed-point search from its neighbours' fixed points (continuation: secant predictor and
-the previous Jacobian, :class:`walkerlab.studies.points.Continuation`).  When the base
-scene's own value of the first parameter lies inside the axis, a line is split there into
-an upward run and a downward run, both starting next to the scene's initial guess.
+Every point is a function of itself alone (:func:`walkerlab.studies.points.scene_gait`:
+the gait ``walkerlab fixedpoint`` finds and chooses for the point's scene; no neighbour's
+gait is carried along): a sweep's rows are the same, bit for bit, whatever the chunking,
+the worker count or the executor.  (A branch beyond the reach of the scene's guess and
+the seeds is followed by ``walkerlab continuation``.)
 
-Balance: all chains run at once (each has one piece in flight), so the workers stay busy
-while there are at least as many unfinished chains as workers; the sweep's wall time is
-then about ``max(total / workers, longest chain)``.  A run longer than ``total / workers``
-is therefore dealt out *interleaved* into ``k`` chains (points ``0, k, 2k, ...``,
-``1, k+1, ...``): each still starts next to the scene's guess and continues in steps of
-``k`` grid points, so no chain needs a guess far from the anchor.
+Chunks are *runs along the first axis* (for every combination of the other axes; split at
+the base scene's own value of the first parameter when it lies inside the axis), dealt
+out for balance: all chains run at once (each has one piece in flight), so the workers
+stay busy while there are at least as many unfinished chains as workers; a run longer
+than ``total / workers`` is dealt out *interleaved* into ``k`` chains (points ``0, k,
+2k, ...``, ``1, k+1, ...``).
 
 Executors
 ---------
@@ -20,16 +19,18 @@ The chains run on the one executor protocol of :mod:`walkerlab.execution`
 (:func:`sweep_executor`):
 
 - ``workers == 1`` and no scheduler: in this process (no start-up cost).
-- ``workers >= 2`` and no scheduler: a local process pool (forkserver processes on Linux,
-  with the model functions built once in the server).
+- ``workers >= 2`` and no scheduler: the first piece in this process, timed; the rest on a
+  local process pool (forkserver processes on Linux, with the model functions built once
+  in the server) only when their estimated time pays the pool's start-up
+  (:func:`pool_pays`), else here too.
 - ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
   the same :func:`run_piece` runs on its workers.
 
 Progress and robustness
 ----------------------------------
 - A chunk is cut into *pieces* of at most :data:`PIECE_POINTS` points; the next piece of a
-  chunk is submitted when the previous one returns, with its continuation state, so
-  continuation is unchanged while rows come back every few points (D12).  They are written
+  chunk is submitted when the previous one returns, so rows come back every few points
+  (D12).  They are written
   to the file after the first piece and then at least every :data:`FLUSH_EVERY_S` seconds
   (one HDF5 append of every column costs the main process CPU, taken from the workers
   on a 2-core machine), and on an interruption.
@@ -42,16 +43,10 @@ Progress and robustness
 
 Resume
 ---------------------------------
-A point's fixed point depends, to round-off (~1e-13, within the root finder's xtol), on the
-predictor it started from, i.e. on its chain.  Re-planning the chains from the points left
-(as before) restarted them from the scene's guess at a different point and changed the
-interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
-``guess_source``.  Now the plan made when the sweep starts is stored in the partial file with
-a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
-chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
-with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
-is hashed as written (:func:`walkerlab.io.sweep_resume.row_hashes`); a row or checkpoint that
-does not match on resume drops its chain's rows and the chain is computed again.
+The plan made when the sweep starts is stored in the partial file with a checkpoint per
+chain (points written); a resumed chain continues from its checkpoint.  Every row is hashed
+as written (:func:`walkerlab.io.sweep_resume.row_hashes`); a row or checkpoint that does not
+match on resume drops its chain's rows and the chain is computed again.
 """
 
 from __future__ import annotations
@@ -92,7 +87,8 @@ from walkerlab.studies.points import (
 )
 
 __all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
-           "sweep_executor", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
+           "sweep_executor", "sweep_input_hash", "pool_pays", "MAX_GRID_POINTS", "PIECE_POINTS",
+           "FLUSH_EVERY_S", "POOL_START_S"]
 
 MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
@@ -247,6 +243,11 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     for each piece as soon as it returns (:func:`walkerlab.execution.run_chains` of
     :func:`run_piece` on :func:`sweep_executor`).
 
+    With ``workers > 1``, no scheduler and ``pool`` None, the worker count follows the
+    work: the first piece runs in this process, and the rest go to a pool only when their
+    estimated time (the piece's median point) pays the pool's start-up
+    (:func:`pool_pays`); else they run here too.
+
     Parameters
     ----------
     chains : list of list of Task
@@ -257,8 +258,42 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     """
     if not any(chains):
         return
-    with sweep_executor(workers, scheduler, pool) as ex:
-        yield from run_chains(ex, run_piece, chains, guesses)
+    if scheduler is not None or pool is not None or workers <= 1:
+        with sweep_executor(workers, scheduler, pool) as ex:
+            yield from run_chains(ex, run_piece, chains, guesses)
+        return
+    # the first piece in this process, timed: a pool only when the rest pays its start-up
+    # (the rows are the same either way: every point is a function of itself alone)
+    carries = list(guesses) if guesses is not None else [None] * len(chains)
+    c0 = next(ci for ci, c in enumerate(chains) if c)
+    with sweep_executor(1, None, False) as ex:
+        for _ci, k, rows, carry in run_chains(ex, run_piece, [chains[c0][:1]], [carries[c0]]):
+            yield c0, k, rows, carry
+    carries[c0] = carry
+    rest = [list(c) for c in chains]
+    rest[c0] = rest[c0][1:]
+    n_left = sum(len(t.points) for c in rest for t in c)
+    per_point = float(np.median([r["wall_time_s"] for r in rows]))
+    use_pool = pool_pays(n_left * per_point, workers)
+    with sweep_executor(workers, None, None if use_pool else False) as ex:
+        for ci, k, rows, carry in run_chains(ex, run_piece, rest, carries):
+            yield ci, k + (ci == c0), rows, carry
+
+
+#: the start-up of a local pool of sweep workers [s]: the forkserver with the model
+#: libraries, then each worker's first point, which loads its walker's model code (taken
+#: on the safe side of what ``walkerlab bench sweep-workers`` sees on a shared machine)
+POOL_START_S = 1.0
+
+
+def pool_pays(work_s: float, workers: int) -> bool:
+    """Whether ``work_s`` [s] of points in this process take longer than on a pool of
+    ``workers`` processes (at most the machine's CPUs) after its start-up
+    (:data:`POOL_START_S`): a pool only when ``work_s (1 - 1 / workers) > POOL_START_S``."""
+    import os
+
+    workers = min(workers, os.cpu_count() or 1)
+    return workers > 1 and work_s * (1.0 - 1.0 / workers) > POOL_START_S
 
 
 def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,

@@ -150,6 +150,10 @@ class GroundContact:
         Smallest normal velocity of the trailing foot just after a transition [m/s].
     not_checked : str
         Why the check could not be made ("" when it was): a walker without a floating view.
+    friction : walkerlab.analysis.gait.friction.FrictionVerdict or None
+        The friction the gait needs at every foot on the ground against the ground's
+        ``mu`` (None: no ``mu`` given); made for flat feet too, whose normal forces the
+        rigid model's own guards check.
     """
 
     min_normal_force_n: float = np.nan
@@ -159,6 +163,7 @@ class GroundContact:
     push_off_normal_impulse_n_s: float = np.nan
     trailing_foot_normal_velocity_m_per_s: float = np.nan
     not_checked: str = ""
+    friction: object | None = None
 
     @property
     def ok(self) -> bool | None:
@@ -171,8 +176,8 @@ class GroundContact:
                         self.trailing_foot_normal_velocity_m_per_s) >= 0)
 
 
-def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_PHASE
-                   ) -> GroundContact:
+def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_PHASE,
+                   mu: float | None = None, mu_source: str = "") -> GroundContact:
     """Check a rigid gait's ground contact over one Poincaré map from ``x`` (a step, or a
     stride for legs that differ): the stance foot's normal force at ``samples`` points of
     each continuous phase (its dense output), and the impulses of each transition
@@ -188,6 +193,10 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
     solver : Solver
     samples : int
         Samples per continuous phase.
+    mu : float, optional
+        The ground's friction coefficient [-] (``mu_source``: where it comes from): the
+        friction verdict (:attr:`GroundContact.friction`,
+        :mod:`walkerlab.analysis.gait.friction`) is made with it; None: not made.
 
     Returns
     -------
@@ -203,11 +212,17 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
         if walker.mirror is not None:
             reaction[id(walker.mirror)] = StanceReaction(walker.mirror, data.mirror)
     except ValueError as exc:
-        return GroundContact(not_checked=str(exc))
+        friction = None
+        if mu is not None and data.structure.kind.name == "flat_feet":
+            from walkerlab.analysis.gait.friction import flat_foot_friction
+
+            friction = flat_foot_friction(walker, data, x, solver, mu, mu_source, samples)
+        return GroundContact(not_checked=str(exc), friction=friction)
     traj = simulate_steps(walker, np.asarray(x, float), walker.steps_per_map, solver)
     n = np.asarray(x).size
     n_min, t_min, ratio = np.inf, np.nan, 0.0
     hs, po, vt = np.inf, np.inf, np.inf
+    forces = []  # (t, F_n, F_t) of the stance foot: the friction verdict's samples
     for seg in traj.segments:
         if seg.termination != "heel_strike":
             return GroundContact(not_checked=f"the map ends in {seg.termination}")
@@ -216,6 +231,7 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
             for t in np.linspace(ta, tb, samples):
                 xs = np.ravel(sol(t))[:n]
                 fn, ft = sr.normal_and_tangential(sr.force(t, xs, phase.flow))
+                forces.append((float(t), float(fn), float(ft)))
                 if fn < n_min:
                     n_min, t_min = fn, float(t)
                 if fn > 0:
@@ -223,4 +239,11 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
         imp = sr.transition(seg.x_end, seg.x_next)
         hs, po = min(hs, imp.heel_strike_normal), min(po, imp.push_off_normal)
         vt = min(vt, imp.trailing_foot_normal_velocity)
-    return GroundContact(float(n_min), t_min, float(ratio), float(hs), float(po), float(vt))
+    friction = None
+    if mu is not None:
+        from walkerlab.analysis.gait.friction import stance_friction
+
+        friction = stance_friction(forces, mu, mu_source,
+                                   float(data.total_mass_kg) * float(data.gravity_m_per_s2))
+    return GroundContact(float(n_min), t_min, float(ratio), float(hs), float(po), float(vt),
+                         friction=friction)

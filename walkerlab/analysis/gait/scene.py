@@ -100,7 +100,8 @@ def with_variant(scene: Scene, variant: str) -> Scene:
 
 
 def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None,
-                ground: bool = False):
+                ground: bool = False, other_gait: bool | None = None,
+                partner_off_ground: bool = False):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
@@ -112,7 +113,11 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     default: built here from the scene (:func:`build_walker`, ``Solver.from_settings``).
     ``ground``: check every gait found for a ground that only pushes
     (:func:`gait_ground_contact`; each :class:`~walkerlab.analysis.gait.search.Gait` carries
-    its verdict and the selection prefers the gaits that need no pull).
+    its verdict and the selection prefers the gaits that need no pull).  ``other_gait``
+    (default ``fixedpoint.other_gait``): look for the other gait of the pair even when the
+    choice does not need it; ``partner_off_ground``: without it, still when the first gait
+    needs a pull or more friction than the ground has
+    (:func:`~walkerlab.analysis.gait.search.find_gaits`).
 
     Returns
     -------
@@ -133,11 +138,13 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     if start is None:  # virtual constraints: the zero dynamics' periodic orbit, if any
         start = hzd_start(walker)
     search = find_gaits(walker, solver, start,
-                        policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
+                        policy=fp.gait,
+                        other_gait=fp.other_gait if other_gait is None else other_gait,
+                        xtol=fp.tolerance,
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
                         fd_check=fd_check,
                         ground_check=(lambda x: gait_ground_contact(scene, walker, x))
-                        if ground else None)
+                        if ground else None, partner_off_ground=partner_off_ground)
     return walker, search
 
 
@@ -247,14 +254,18 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
 
 def gait_ground_contact(scene: Scene, walker, x):
     """Whether the gait from ``x`` (the scene's walker's fixed point) needs only a ground that
-    pushes (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver).
+    pushes, and the friction it needs against the scene's ``mu``
+    (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver;
+    :func:`walkerlab.analysis.gait.friction.scene_friction`).
 
     Returns
     -------
     walkerlab.analysis.gait.checks.GroundContact
     """
     from walkerlab.analysis.gait.checks import ground_contact
+    from walkerlab.analysis.gait.friction import scene_friction
     from walkerlab.walker.description import walker_data
 
+    mu, mu_source = scene_friction(scene)
     return ground_contact(walker, walker_data(scene.walker, scene.slope.phi_rad), x,
-                          Solver.from_settings(scene.solver))
+                          Solver.from_settings(scene.solver), mu=mu, mu_source=mu_source)

@@ -7,7 +7,8 @@ the stable one).  They lie close together on the Poincaré section (they differ 
 swing leg's rate), so a root finder started between them lands on either.  This module
 
 1. starts the root finder from the scene's initial guess, if there is one;
-2. otherwise (or when that fails) makes *scale-free seeds* from the walker's own data - a
+2. otherwise (or when that fails, or under ``stable`` when the gaits it leads to are all
+   unstable) makes *scale-free seeds* from the walker's own data - a
    step angle ``alpha = c * gamma^(1/3)`` (the small-slope scaling of the step angle,
    Garcia et al. 1998), a stance-leg rate ``-k * alpha * sqrt(g / l)`` (their
    ``theta_dot ~ -theta``), a swing-leg rate ``r`` times the stance rate, knees straight -
@@ -110,6 +111,13 @@ class Gait:
         return getattr(self.ground, "ok", None) is not False
 
     @property
+    def inside_friction_cone(self) -> bool:
+        """False only when the ground check found that the gait needs more friction than
+        the ground's ``mu`` (:class:`walkerlab.analysis.gait.friction.FrictionVerdict`);
+        True when it holds or was not made."""
+        return getattr(getattr(self.ground, "friction", None), "inside", None) is not False
+
+    @property
     def max_multiplier(self) -> float:
         """Largest ``|Floquet multiplier|`` (variational) [-]."""
         return float(np.max(np.abs(self.result.multipliers_variational)))
@@ -162,7 +170,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
                policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
                fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
                time_unit: str = "s", seeds: bool = True,
-               ground_check=None) -> GaitSearch:
+               ground_check=None, partner_off_ground: bool = False) -> GaitSearch:
     """Find the walker's period-1 gait(s) and choose one.
 
     Parameters
@@ -185,11 +193,19 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         Unit of the step period in messages (``s``, or ``sqrt(l/g)`` for a nondimensional
         scene).
     seeds : bool
-        Try the scale-free seeds when the guess does not converge (always without a guess).
+        Try the scale-free seeds when the guess does not converge (always without a guess),
+        and under ``stable`` when every gait found from the guess (and its partner) is
+        unstable: a stable gait the guess does not lead to is looked for before an unstable
+        one is chosen.
     ground_check : callable, optional
         ``ground_check(x) -> GroundContact`` for a fixed point ``x`` (2n,): every gait found
         carries its verdict (:attr:`Gait.ground`), and :func:`select_gait` prefers gaits on
-        a ground that only pushes.
+        a ground that only pushes and inside its friction cone.
+    partner_off_ground : bool
+        Without ``other_gait``: look for the other gait when the first one, stable, needs
+        the ground to pull or more friction than it has (with ``ground_check``, under
+        ``stable``): the choice ``other_gait`` would make, at the cost of a second search
+        only where it can change (a sweep point).
 
     Returns
     -------
@@ -212,14 +228,16 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     try:
         with search_budget():  # every start, seed and root finder: one time budget
             return _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step,
-                               max_step_time, fd_check, time_unit, seeds, ground_check)
+                               max_step_time, fd_check, time_unit, seeds, ground_check,
+                               partner_off_ground)
     except (SearchGaveUp, FixedPointGaveUp) as exc:
         why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
         raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
 
 
 def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_step_time,
-                fd_check, time_unit, seeds, ground_check=None) -> GaitSearch:
+                fd_check, time_unit, seeds, ground_check=None,
+                partner_off_ground=False) -> GaitSearch:
     s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
                                      "max_step_time": max_step_time, "fd_check": fd_check})
     if guess is not None:
@@ -234,13 +252,25 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
     if not s.found:
         raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
                            s.best)
+    first = s.found[0]
+    off_ground = False  # the first gait needs a pull or more friction than the ground has
+    if partner_off_ground and not other_gait and ground_check is not None \
+            and policy == "stable":
+        first.ground = ground_check(first.result.x)
+        off_ground = not (first.on_real_ground and first.inside_friction_cone)
     if other_gait or policy in ("long_period", "short_period") or (
-            policy == "stable" and not s.found[0].result.stable):
+            policy == "stable" and (not first.result.stable or off_ground)):
         s.other_gait()
+    if policy == "stable" and seeds and s.seeded is False \
+            and not any(g.result.stable for g in s.found):
+        # the guess and its partner are both unstable: the seeds may reach a stable gait
+        # (a gait found already is not taken twice: the seeds go on to a new one)
+        s.from_seeds()
     found = order_gaits(s.found)
     if ground_check is not None:
         for g in found:
-            g.ground = ground_check(g.result.x)
+            if g.ground is None:
+                g.ground = ground_check(g.result.x)
     search = GaitSearch(found, 0, policy, s.notes, s.tried)
     search.selected = select_gait(search, guess, time_unit)
     return search
@@ -270,6 +300,7 @@ class _RootStarts:
         self.notes: list[str] = []
         self.best = math.inf
         self.last_msg = ""
+        self.seeded = False  # the scale-free seeds were tried
 
     def attempt(self, x0, source: str, deflate=(), jacobian_guess=None) -> Gait | None:
         """The gait the root finder reaches from ``x0``, or None (no root, or a gait already
@@ -292,6 +323,8 @@ class _RootStarts:
         """Root from the best-ranked scale-free seeds; none converging, from where the seeds
         walk to in :data:`~walkerlab.analysis.gait.starts.WALK_STEPS` steps."""
         walker, solver, max_step_time = self.walker, self.solver, self.kw["max_step_time"]
+        self.seeded = True
+        n_before = len(self.found)
         n_started = 0
         ranked, n_seeds, n_off = screen_seeds(walker, solver, max_step_time)
         for _err, _desc, x in ranked[:ROOT_STARTS]:
@@ -304,7 +337,7 @@ class _RootStarts:
                           f"({n_seeds - len(ranked) - n_off} fell within the first step"
                           + (f", {n_off} could not reach the landing" if n_off else "")
                           + ")")
-        if self.found or not ranked:
+        if len(self.found) > n_before or not ranked:
             return
         n_walked = n_started = 0  # second round: from where the seeds walk to
         for _err, _desc, x in ranked:
@@ -370,7 +403,9 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
       one nearest it, max-norm over the state).
 
     Under ``stable`` the gaits that need the ground to pull (:attr:`Gait.on_real_ground`
-    False) are chosen only when no other gait was found, with a note.  Ties (equal
+    False) are chosen only when no other gait was found, with a note; so are, among the
+    rest, the gaits outside the ground's friction cone (:attr:`Gait.inside_friction_cone`
+    False).  Ties (equal
     multipliers or distances) go to the first gait in ``search.gaits`` (longest period
     first), so the choice depends only on the gaits found, not on the order they were
     found in.
@@ -412,6 +447,13 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
         pool = list(range(len(gaits)))
     if not real:
         search.notes.append("every gait found needs the ground to pull")
+    cone = [k for k in pool if gaits[k].inside_friction_cone]
+    if cone and len(cone) < len(pool):
+        search.notes.append(
+            "left out: the " + ", ".join(gaits[k].label.replace("_", "-") for k in pool
+                                          if k not in cone)
+            + " gait (needs more friction than the ground's mu: its feet would slip)")
+        pool = cone
     stable = [k for k in pool if gaits[k].result.stable]
     if stable:
         k = nearest(stable)
@@ -472,8 +514,8 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
               if walker.actuators is not None else "give fixedpoint.initial_guess (or start "
               "from a gait known nearby: walkerlab fixedpoint --from KNOWN_SCENE)")
     return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
-            "from a walker whose gait is known (walkerlab sweep SCENE --param "
-            f"FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or {nearer}"
+            "from a walker whose gait is known (walkerlab continuation SCENE --param "
+            f"FIELD=KNOWN:THIS, e.g. slope.angle_deg), or {nearer}"
             + f" [tried {' and '.join(tried)}{res}"
             + (f"; last: {last}]" if last else "]" if "standing" in why
                else "; last: every start fell]"))

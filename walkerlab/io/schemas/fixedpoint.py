@@ -11,9 +11,11 @@ variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 ``floquet/{variational,finite_difference}/{real,imag,jacobian}``,
 ``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
 evaluations, wall time [s]); ``ground_contact/`` (the selected gait: whether the ground only
-pushes, :data:`GROUND_FIELDS`); on stairs ``footholds/`` (attributes of
-:class:`walkerlab.analysis.gait.treads.TreadLanding`: step advance [m], tread drift per step
-[m], steps until a foot misses a tread, clearances [m]); under virtual constraints
+pushes, :data:`GROUND_FIELDS`; ``ground_contact/friction/``: the friction it needs at
+every foot on the ground against the ground's ``mu``, :data:`FRICTION_FIELDS`); on stairs
+``footholds/`` (attributes of :class:`walkerlab.analysis.gait.treads.TreadLanding`: step
+advance [m], tread drift per step [m], steps until a foot misses a tread, clearances [m]);
+under virtual constraints
 ``zero_dynamics/`` (:data:`ZERO_DYNAMICS_FIELDS`: the restricted Poincare map's delta^2,
 V(theta-), V_max, zeta*, the existence margin, the phase rates at impact and the step
 period by quadrature, with units; ``virtual_constraints/``: the Bezier coefficients in
@@ -241,14 +243,46 @@ GROUND_FIELDS = {
 }
 
 
+#: ``ground_contact/friction/`` datasets: attribute of the verdict -> (name, unit, meaning)
+FRICTION_FIELDS = {
+    "max_ratio": ("max_ratio", "-", "largest |tangential| / normal force over every foot on "
+                  "the ground, single and double support (inf: a foot's normal force falls "
+                  "to 0 while it carries a tangential force): the friction coefficient the "
+                  "gait needs"),
+    "mu": ("friction_coefficient", "-", "the ground's static friction coefficient "
+           "(contact.mu_static, or its default)"),
+    "single_support_max_ratio": ("single_support_max_ratio", "-", "largest ratio at the "
+                                 "stance foot in single support"),
+    "double_support_max_ratio": ("double_support_max_ratio", "-", "largest ratio at either "
+                                 "foot in double support (NaN: none)"),
+    "time_s": ("max_ratio_time", "s", "when the largest ratio occurs, from the map's start"),
+    "exit_time_s": ("cone_exit_time", "s", "first time a foot's force leaves the friction "
+                    "cone (NaN: never)"),
+    "unloaded_tangential_n": ("unloaded_tangential_force", "N", "tangential force of a "
+                              "foot whose normal force falls to 0 (NaN: none)"),
+}
+
+
 def _write_ground(g, ground) -> None:
     """``ground_contact/``: the unilateral-contact check of the selected gait (attributes
-    ``ok`` 1/0/-1 for yes/no/not checked and ``not_checked``, why not)."""
+    ``ok`` 1/0/-1 for yes/no/not checked and ``not_checked``, why not) and, when made, its
+    friction verdict (``friction/``: attributes ``inside`` 1/0/-1, ``foot``, ``mu_source``,
+    ``not_checked``; datasets :data:`FRICTION_FIELDS`)."""
     ok = ground.ok
     g.attrs["ok"] = -1 if ok is None else int(ok)
     g.attrs["not_checked"] = ground.not_checked
     for attr, (name, unit, what) in GROUND_FIELDS.items():
         put(g, name, float(getattr(ground, attr)), unit, what)
+    fr = getattr(ground, "friction", None)
+    if fr is not None:  # new beside the datasets above (which stay as they were)
+        h = g.create_group("friction")
+        inside = fr.inside
+        h.attrs["inside"] = -1 if inside is None else int(inside)
+        h.attrs["foot"] = fr.foot
+        h.attrs["mu_source"] = fr.mu_source
+        h.attrs["not_checked"] = fr.not_checked
+        for attr, (name, unit, what) in FRICTION_FIELDS.items():
+            put(h, name, float(getattr(fr, attr)), unit, what)
 
 
 @dataclass
@@ -260,6 +294,7 @@ class GroundContactRecord:
     ok: bool | None
     not_checked: str
     values: dict
+    friction: object | None = None  # walkerlab.analysis.gait.friction.FrictionVerdict
 
 
 def _ground(f) -> GroundContactRecord | None:
@@ -267,9 +302,19 @@ def _ground(f) -> GroundContactRecord | None:
         return None
     g = f["ground_contact"]
     ok = int(g.attrs["ok"])
+    friction = None
+    if "friction" in g:  # artifacts written before the friction verdict have none
+        from walkerlab.analysis.gait.friction import FrictionVerdict
+
+        h = g["friction"]
+        friction = FrictionVerdict(
+            **{a: float(h[name][()]) for a, (name, _, _) in FRICTION_FIELDS.items()
+               if name in h},
+            foot=str(h.attrs["foot"]), mu_source=str(h.attrs["mu_source"]),
+            not_checked=str(h.attrs["not_checked"]))
     return GroundContactRecord(None if ok < 0 else bool(ok), str(g.attrs["not_checked"]),
                                {a: float(g[name][()]) for a, (name, _, _) in
-                                GROUND_FIELDS.items() if name in g})
+                                GROUND_FIELDS.items() if name in g}, friction)
 
 
 @dataclass
