@@ -349,6 +349,6 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
             value, detail = _VIEWS[view](scene, d, Path(runs_root))
     except Exception as exc:  # noqa: BLE001 - a cell that fails is evidence, not a crash
         value, detail = math.nan, f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
-    ok = math.isfinite(value) and abs(value) <= tol
+    ok = bool(math.isfinite(value) and abs(value) <= tol)
     return Measurement(kind, feature, view, case, quantity, float(value), tol, unit, ok,
                        detail)
