@@ -51,7 +51,8 @@ __all__ = ["QUANTITIES", "Measurement", "measure"]
 #: view -> (quantity, tolerance, unit)
 QUANTITIES = {
     "rigid": ("simulate's step periods and lengths over 10 heel strikes against the fixed "
-              "point's (a profile: footfall height against the profile)", 1e-6, "relative"),
+              "point's (a profile: footfall height against the profile), and the gait's "
+              "ground forces inside the friction cone", 1e-6, "relative"),
     "contact": ("contact-sim walks >= 10 heel strikes; over its last 4 steps (whole gait "
                 "periods), the mean step period and the hip's speed against simulate's same "
                 "steps on the same ground, and the spread of the step periods' deviations "
@@ -168,9 +169,28 @@ def _rigid(scene, d, runs: Path) -> tuple[float, str]:
             dev_t = _cyclic_deviation(s["steps/period"][:][ok],
                                       np.array([f["step_period"][()]]))
             dev_l = _cyclic_deviation(lengths, lengths[:1])
+        cone = _friction_verdict(f)
     dev = max(dev_t, dev_l)
-    return dev, (f"{n} heel strikes; step periods {dev_t:.1e}, lengths {dev_l:.1e} from the "
-                 "fixed point's")
+    detail = (f"{n} heel strikes; step periods {dev_t:.1e}, lengths {dev_l:.1e} from the "
+              "fixed point's")
+    if cone:  # the model's gait, but not one on real ground (the fixed point's verdict)
+        return math.nan, f"{detail}; but {cone}"
+    return dev, detail
+
+
+def _friction_verdict(f) -> str:
+    """Why the fixed point's gait leaves the friction cone ("" when it does not, or when
+    the artifact has no verdict): the foot, the ratio needed and the ground's mu."""
+    if "ground_contact/friction" not in f:
+        return ""
+    g = f["ground_contact/friction"]
+    if int(g.attrs.get("inside", 1)):
+        return ""
+    need = float(g["max_ratio"][()])
+    mu = float(g["friction_coefficient"][()])
+    need_s = "an unbounded ratio" if not math.isfinite(need) else f"mu >= {need:.3g}"
+    return (f"the gait leaves the friction cone: its {g.attrs.get('foot', 'foot')} needs "
+            f"{need_s} against the ground's mu {mu:g}")
 
 
 def _profile_footfalls(s, d, ok) -> tuple[float, str]:
