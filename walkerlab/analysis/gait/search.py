@@ -54,6 +54,7 @@ from walkerlab.analysis.gait.starts import (
     screen_seeds,
     walked_start,
 )
+from walkerlab.analysis.gait.zero_dynamics import no_orbit_reason
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 
@@ -230,6 +231,9 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
         else:
             s.notes.append(f"the initial guess did not converge ({_short(s.last_msg)})")
     if not s.found and (seeds or guess is None):
+        no_orbit = no_orbit_reason(walker)
+        if no_orbit:  # the seeds are a passive walker's: none can find what is not there
+            raise GaitNotFound(f"no period-1 gait found: {no_orbit}", math.nan)
         s.from_seeds()
     if not s.found:
         raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
