@@ -320,3 +320,97 @@ def test_energy_ledger_counts_the_controllers_work(walker, hzd, reference):
     xp = ref.impact(x_minus, BOOK)
     ke_ref_p = 0.5 * xp[3:] @ ref.mass_matrix(xp[:3], BOOK) @ xp[3:]
     assert abs(loss - (ke_ref - ke_ref_p)) < 1e-9 * loss
+
+
+# -- the gait search of a controller that does not walk ends, saying why ------------------
+
+def scene_with_c4(c4: float, **phase):
+    """configs/threelink_hzd.yaml with the swing leg's last Bezier coefficient ``c4`` [rad]
+    (and a ``phase`` given)."""
+    cfg = copy.deepcopy(SCENE)
+    vc = cfg["walker"]["actuation"]["virtual_constraints"]
+    vc["outputs"][0]["bezier_rad"][-1] = c4
+    if phase:
+        vc["phase"] = phase
+    return scene_from_dict(cfg)
+
+
+def test_a_hip_position_phase_puts_the_step_ends_within_half_a_turn():
+    """``phase: {point: hip}`` (the hip's position, m): the scan for the step's end drifted
+    the stance angle by whole turns (-8.9e5 rad, so c_0 = -8.9e5 rad and a zero-dynamics
+    start at -8.9e5 rad/s whose search ran for minutes).  The ends are the same
+    configurations as with the stance leg's angle (c_4 = 0.181051 rad puts the heel strike
+    at -+0.181051 rad, to the Newton solve's 1e-11), so c_0 is the swing leg's post-impact
+    angle, -0.181051 rad."""
+    d = build_walker(scene_with_c4(0.181051, point="hip")).actuators.controller.design
+    np.testing.assert_allclose(d.q_minus, [-0.181051, 0.181051, -0.106052], atol=1e-9)
+    np.testing.assert_allclose(d.q_plus, [0.181051, -0.181051, -0.106052], atol=1e-9)
+    assert abs(d.alpha[0, 0] + 0.181051) < 1e-9
+    assert abs(d.theta_minus - np.sin(0.181051)) < 1e-9  # the hip's x over the stance foot
+
+
+def test_a_controller_whose_zero_dynamics_has_no_orbit_is_refused_at_once():
+    """c_4 = 0.3 rad: delta^2 = 0.7297 but the existence margin is 249.5 > 0 (the step
+    stalls); with invariant outputs every gait lies on the zero dynamics' orbit, so the
+    search names it in one line and starts no root finder (it used to try the passive
+    seeds, one of whose maps ran 125 s)."""
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.analysis.gait.scene import solve_scene
+
+    started = []
+    real = gait_search.find_fixed_point
+
+    def counted(*a, **k):
+        started.append(1)
+        return real(*a, **k)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(gait_search, "find_fixed_point", counted)
+        mp.setattr(gait_search, "screen_seeds", lambda *a: pytest.fail("seeds tried"))
+        with pytest.raises(gait_search.GaitNotFound) as e:
+            solve_scene(scene_with_c4(0.3), False)
+    text = str(e.value)
+    assert len(text.splitlines()) == 1 and not started
+    assert "zero dynamics has no periodic orbit" in text and "existence margin 249.5" in text
+    assert "walker.actuation.virtual_constraints" in text and "spring" not in text
+
+
+#: a 3 m/s design of this walker (walkerlab optimize, design: virtual_constraints, target
+#: 3 m/s): its zero dynamics has an orbit (delta^2 0.834, step period 0.1846 s) but the
+#: straight swing foot dips 7 mm below the ground inside the step, so the full-order step
+#: from the orbit never meets the heel-strike guard from above
+FAST = [[-0.28052292849252825, -0.3669797008700445, -0.25993278216844284, 0.1402610936155856,
+         0.28052292849252836],
+        [-1.5066349070166543, -1.5527241395169769, -1.5470712696390043, -1.6145457647372112,
+         -1.5066349070166543]]
+
+
+def test_a_closed_loop_that_does_not_step_from_its_orbit_fails_at_its_first_map():
+    """The 3 m/s design (:data:`FAST`) is a gait search of one failed map: its phase leaves
+    the Bezier polynomials' range (s > 1.25, at t = 0.219 s against a 0.185 s orbit) and
+    the step ends as a fall there, instead of the controller extrapolating them to rates
+    of 1e11 rad/s while the integrator crawls (the search's whole budget, then the passive
+    seeds'); one line, naming the guard."""
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.analysis.gait.scene import solve_scene
+
+    cfg = copy.deepcopy(SCENE)
+    for o, row in zip(cfg["walker"]["actuation"]["virtual_constraints"]["outputs"], FAST):
+        o["bezier_rad"] = row
+    sc = scene_from_dict(cfg)
+    from walkerlab.analysis.gait import poincare as P
+
+    maps = []
+    real = P.poincare_map
+
+    def counted(*a, **k):
+        maps.append(1)
+        return real(*a, **k)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(P, "poincare_map", counted)
+        mp.setattr(gait_search, "screen_seeds", lambda *a: pytest.fail("seeds tried"))
+        with pytest.raises(gait_search.GaitNotFound) as e:
+            solve_scene(sc, False)
+    text = str(e.value)
+    assert len(text.splitlines()) == 1 and len(maps) == 1
+    assert "zero dynamics' orbit" in text and "phase_past_step_end" in text
+    assert "spring" not in text

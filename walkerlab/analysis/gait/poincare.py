@@ -11,6 +11,7 @@ multiplier is zero by construction because ``P`` lands on the guard surface.
 from __future__ import annotations
 
 import math
+import re
 import threading
 import time
 from collections.abc import Iterator
@@ -21,7 +22,7 @@ import numpy as np
 
 from walkerlab import numerics
 from walkerlab.analysis.gait.metrics import step_length
-from walkerlab.analysis.gait.zero_dynamics import no_orbit_reason
+from walkerlab.analysis.gait.zero_dynamics import gaits_on_zero_dynamics, no_orbit_reason
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
@@ -96,18 +97,26 @@ def search_budget(seconds: float | None = None) -> Iterator[None]:
 
 def slow_step_reason(walker: HybridWalker) -> str:
     """Why a step map of ``walker`` can crawl, said in the gait search's notices: its
-    virtual-constraint controller, its springs or dampers (``walker.actuation.torques``
-    with a stiffness or damping), or, for a walker with neither, its rates alone."""
+    virtual-constraint controller, its springs or dampers (``walker.springs`` and the knee's,
+    generated parameters ``k_s<i>``, ``c_s<i>``, ``k_knee``, ``c_knee``; torque laws of
+    ``walker.actuation.torques`` with a stiffness or damping), or, for a walker with
+    neither, its rates alone."""
     acts = getattr(walker, "actuators", None)
     if getattr(acts, "controller", None) is not None:
         return ("the virtual-constraint controller drives a start far from its designed "
                 "step to rates the integrator crawls through")
+    params = getattr(walker, "params", None) or {}
+    sprung = [k for k, v in params.items() if v and re.fullmatch(r"[kc]_(s\d+|knee)", k)]
     laws = [getattr(t, "law", None) for t in
             getattr(getattr(acts, "spec", None), "torques", None) or ()]
     if any(getattr(law, "stiffness_n_m_per_rad", 0.0) or getattr(law, "damping_n_m_s_per_rad",
                                                                  0.0) for law in laws):
-        return ("a very stiff or heavily damped spring (walker.actuation.torques) makes the "
-                "integrator crawl: soften it")
+        sprung.append("walker.actuation.torques")
+    if sprung:
+        where = ("walker.actuation.torques" if sprung == ["walker.actuation.torques"]
+                 else "walker.springs or the knee's")
+        return (f"a very stiff or heavily damped spring ({where}) makes the integrator "
+                "crawl: soften it")
     return "the step's rates grow so large that the integrator crawls"
 
 
@@ -254,7 +263,8 @@ def _step_map(walker, x, solver, max_step_time, jacobian, steps):
             steps.append(seg)
         nfev += seg.nfev
         if seg.termination != "heel_strike":
-            raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+            raise StepFailed(seg.termination, seg.t_end, seg.x_end,  # the guard, if one
+                             f"({seg.event})" if seg.event else seg.message)
         x, period = seg.x_next, seg.t_end
         if jacobian:
             DP = seg.monodromy @ DP
@@ -398,7 +408,9 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         The root finder did not converge, the map failed (fall) near the guess, or the
         budget was spent (the message says after how many maps and how long each took);
         at once, a walker under invariant virtual constraints whose zero dynamics has no
-        periodic orbit (:func:`~walkerlab.analysis.gait.zero_dynamics.no_orbit_reason`).
+        periodic orbit (:func:`~walkerlab.analysis.gait.zero_dynamics.no_orbit_reason`) or
+        whose closed loop does not step from the guess (its gaits are orbits of its zero
+        dynamics: :func:`~walkerlab.analysis.gait.zero_dynamics.gaits_on_zero_dynamics`).
     MultipliersDisagree
         With ``fd_check``: the variational and the central-difference multipliers disagree
         beyond :func:`multiplier_check_tolerance` (a wrong Jacobian: no verdict).
@@ -408,6 +420,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     no_orbit = no_orbit_reason(walker)  # invariant virtual constraints: none to find
     if no_orbit:
         raise FixedPointNotFound(no_orbit, math.nan)
+    on_orbit = gaits_on_zero_dynamics(walker)
     t0 = time.perf_counter()
     known = [walker.section(np.asarray(xk, float)) for xk in deflate]
     if known and jacobian_guess is not None:
@@ -416,6 +429,9 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     z0 = walker.section(np.asarray(guess, float))
     try:
         with search_budget(budget_s):
+            if on_orbit and F.fails_at(z0):  # its gait is an orbit of the zero dynamics:
+                raise FixedPointNotFound(  # a start that does not step is not near it
+                    f"the closed loop does not step from the start: {F.failure}", math.nan)
             if jacobian_guess is None:
                 sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
             else:
@@ -472,6 +488,7 @@ class _ReducedMap:
         self.known = known
         self.counter = {"nfev": 0, "calls": 0, "jacobians": 0}
         self.start: dict = {}  # the Jacobian start (z0 bytes -> section Jacobian)
+        self.failure = ""  # how the last failed map failed
         self._last: dict = {}  # the last iterate's residual (z bytes -> F(z))
         self._variational: dict = {}  # the last variational map asked as a Jacobian
 
@@ -485,8 +502,9 @@ class _ReducedMap:
         try:
             x = walker.from_section(z)
             xn, _, nf = poincare_map(walker, x, self.solver, self.max_step_time)
-        except (StepFailed, OffSection):
+        except (StepFailed, OffSection) as exc:
             r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
+            self.failure = str(exc)
         else:
             self.counter["nfev"] += nf
             r = walker.section(xn) - z
@@ -495,6 +513,13 @@ class _ReducedMap:
         self._last.clear()
         self._last[key] = r
         return r.copy()
+
+    def fails_at(self, z: np.ndarray) -> bool:
+        """Whether the map fails at ``z`` (:attr:`failure` says how; the residual is kept
+        for the root finder's first evaluation)."""
+        self.failure = ""
+        self.residual(z)
+        return bool(self.failure)
 
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         """``F_z`` (2n-1, 2n-1): the start at ``z0``, else from the variational equations."""

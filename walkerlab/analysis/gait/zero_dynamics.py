@@ -37,8 +37,8 @@ import numpy as np
 
 from walkerlab.models.hybrid.virtual_constraints import annihilator, bezier
 
-__all__ = ["ZeroDynamics", "compare_full_order", "impact_multiplier", "no_orbit_reason",
-           "zero_dynamics"]
+__all__ = ["ZeroDynamics", "compare_full_order", "gaits_on_zero_dynamics", "impact_multiplier",
+           "no_orbit_reason", "zero_dynamics"]
 
 #: Chebyshev points of the integrands along the step
 NODES = 64
@@ -268,6 +268,17 @@ def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:
     return zd.full_order
 
 
+def gaits_on_zero_dynamics(walker) -> bool:
+    """Whether ``walker`` (a :class:`~walkerlab.models.hybrid.base.HybridWalker`) is under
+    virtual constraints whose gaits are orbits of their hybrid zero dynamics: outputs made
+    invariant by the heel strike (``invariant: true``) and driven to zero by unsaturated
+    computed torque (no ``max_torque_n_m``; Westervelt, Grizzle & Koditschek 2003, IEEE
+    TAC 48(1):42-56, Sec. V, Theorems 3-4).  Its gait search then starts on that orbit
+    only (:func:`walkerlab.analysis.gait.search.find_gaits`)."""
+    ctrl = getattr(getattr(walker, "actuators", None), "controller", None)
+    return ctrl is not None and bool(ctrl.spec.invariant) and ctrl.limit is None
+
+
 def no_orbit_reason(walker) -> str:
     """Why a walker under invariant virtual constraints has no gait, or ``""``.
 
@@ -286,9 +297,9 @@ def no_orbit_reason(walker) -> str:
     controller (``max_torque_n_m``: the outputs may leave the surface) and non-invariant
     outputs.
     """
-    ctrl = getattr(getattr(walker, "actuators", None), "controller", None)
-    if ctrl is None or not ctrl.spec.invariant or ctrl.limit is not None:
+    if not gaits_on_zero_dynamics(walker):
         return ""
+    ctrl = walker.actuators.controller
     if ctrl in _NO_ORBIT:  # one controller, one answer: asked by every root-finder start
         return _NO_ORBIT[ctrl]
     _NO_ORBIT[ctrl] = _no_orbit(zero_dynamics(ctrl))
