@@ -414,3 +414,59 @@ def test_a_closed_loop_that_does_not_step_from_its_orbit_fails_at_its_first_map(
     assert len(text.splitlines()) == 1 and len(maps) == 1
     assert "zero dynamics' orbit" in text and "phase_past_step_end" in text
     assert "spring" not in text
+
+
+def _scene_file(tmp_path, name, change):
+    cfg = copy.deepcopy(SCENE)
+    change(cfg)
+    cfg["name"] = name
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(cfg, sort_keys=False))
+    return str(path)
+
+
+def _vc(cfg):
+    return cfg["walker"]["actuation"]["virtual_constraints"]
+
+
+#: the cases of a controller that does not walk (or a design that cannot be met) that used
+#: to run for 60 s to 10 min: (command, scene name, scene change, extra arguments)
+NO_WALK_CASES = {
+    "hip_phase": ("fixedpoint", lambda c: _vc(c).update(phase={"point": "hip"}), []),
+    "c4_0.3": ("fixedpoint", lambda c: _vc(c)["outputs"][0]["bezier_rad"].__setitem__(4, 0.3),
+               []),
+    "sweep_c4": ("sweep", lambda c: None, [
+        "--param", "walker.actuation.virtual_constraints.outputs.0.bezier_rad.4=0.2:0.3:0.05",
+        "--workers", "1"]),
+    "design_3_m_s": ("optimize", lambda c: c.update(optimize={
+        "design": "virtual_constraints", "target_speed_m_per_s": 3.0}), []),
+    "impossible_design": ("optimize", lambda c: c.update(optimize={
+        "design": "virtual_constraints", "max_multiplier": 0.01, "target_speed_m_per_s": 5.0,
+        "max_torque_n_m": 1.0, "friction_coefficient": 0.01}), []),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", list(NO_WALK_CASES))
+def test_a_controller_that_does_not_walk_ends_within_its_budget(case, tmp_path):
+    """Every gait search, sweep point and design of these cases ends within its budget
+    (60 s of CPU per search or designed controller) and a step: under 90 s of this
+    process's CPU time (the sweep on one worker, in this process), with at most one error
+    line and no traceback (they ran 60 s to 590 s, and the design at 3 m/s past 300 s)."""
+    import time
+
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    command, change, extra = NO_WALK_CASES[case]
+    scene = _scene_file(tmp_path, case.replace(".", "_"), change)
+    t0 = time.process_time()
+    r = CliRunner().invoke(app, ["-q", command, scene, "--runs-dir", str(tmp_path / "runs"),
+                                 *extra])
+    cpu = time.process_time() - t0
+    assert cpu < 90.0, (case, cpu)
+    assert "Traceback" not in r.output
+    errors = [ln for ln in r.output.splitlines() if ln.lower().startswith("error")]
+    assert len(errors) <= 1 and (r.exit_code == 0) == (not errors), r.output
+    assert "spring" not in r.output
