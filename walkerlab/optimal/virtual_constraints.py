@@ -171,7 +171,7 @@ def controller_scene_text(scene, c: ControllerData, name: str, failures: str = "
              + (f"# Closed loop of the coefficients below (rigid model, its fixed point): "
                 f"{c.full_order_step_length_m:.6g} m in {c.full_order_step_period_s:.6g} s "
                 f"({loop:.6g} m/s).\n" if np.isfinite(loop) else
-                f"# Closed loop of the coefficients below: no fixed point"
+                "# Closed loop of the coefficients below: no fixed point"
                 + (f" ({c.note})" if getattr(c, "note", "") else "") + ".\n")
              + ("# Bezier coefficients: IPOPT's last iterate's" if not np.isfinite(
                  c.delta2_restricted) else "# Bezier coefficients in force (c_0, c_1 the "
