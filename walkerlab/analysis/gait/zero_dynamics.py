@@ -287,15 +287,15 @@ def no_orbit_reason(walker) -> str:
     orbit of its hybrid zero dynamics (Westervelt, Grizzle & Koditschek 2003, IEEE TAC
     48(1):42-56, Sec. V, Theorems 3-4).  That orbit's pre-impact ``zeta* = -V(theta-) /
     (1 - delta^2)`` must carry the step over the top of the potential, ``delta^2 zeta* >
-    V_max`` (:func:`zero_dynamics`; for ``delta^2
-    < 1`` the existence margin ``delta^2 / (1 - delta^2) V(theta-) + V_max < 0``).  When
-    it cannot, the message (one clause naming the key) says so, and neither the root finder
+    V_max`` (:func:`zero_dynamics`; for ``delta^2 < 1`` the existence margin ``delta^2 /
+    (1 - delta^2) V(theta-) + V_max < 0``).  When it cannot, the message (one clause naming
+    the key) says so, and neither the root finder
     (``walkerlab.analysis.gait.poincare.find_fixed_point``) nor the scale-free seeds (a
     passive walker's) are started: they would spend the search's budget on starts the
     controller drives to huge rates.  ``walker``: a
-    :class:`~walkerlab.models.hybrid.base.HybridWalker`.  ``""`` for any other walker, a saturating
-    controller (``max_torque_n_m``: the outputs may leave the surface) and non-invariant
-    outputs.
+    :class:`~walkerlab.models.hybrid.base.HybridWalker`; ``""`` for any other walker, a
+    saturating controller (``max_torque_n_m``: the outputs may leave the surface) and
+    non-invariant outputs (:func:`gaits_on_zero_dynamics`).
     """
     if not gaits_on_zero_dynamics(walker):
         return ""
