@@ -226,6 +226,51 @@ def test_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
     assert len(notes) == 1 and "step map took" in notes[0], notes
 
 
+def test_a_step_map_under_way_is_stopped_at_the_search_budget(paper_walker, monkeypatch):
+    """One step map with no end (a controller or spring driving the rates to 1e9 rad/s, the
+    integrator crawling) used to run past the budget, which was looked at between maps
+    only: its integration now looks at the clock too (every 64 right-hand sides, as
+    ``solve_on`` wraps them) and the search ends inside the map, in one line saying where
+    the map was and why it crawls - for a walker with no spring, not a spring."""
+    from walkerlab import progress
+    from walkerlab.analysis.gait import poincare
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.integrate.time_limit import limited
+
+    monkeypatch.setattr(poincare, "ROOT_BUDGET_S", 0.3, raising=False)
+    notes = []
+    monkeypatch.setattr(progress, "note", notes.append)
+
+    def crawling_step(walker, x, *a, **k):  # the flow, wrapped as the integrator wraps it
+        rhs, y = limited(lambda t, y: y), np.full(np.size(x), 1e9)
+        while True:
+            rhs(0.25, y)
+    monkeypatch.setattr(poincare, "integrate_step", crawling_step)
+    with pytest.raises(poincare.FixedPointNotFound) as e:
+        find_fixed_point(paper_walker, np.array(paper.EQ11_STATE), Solver("DOP853", 1e-12,
+                                                                           1e-12))
+    text = str(e.value)
+    assert len(text.splitlines()) == 1 and "gave up after 1 step map" in text
+    assert "t = 0.25 s, rates 1e+09 rad/s" in text
+    assert "spring" not in text and "the step's rates grow" in text
+    assert not notes  # the line says it all: no notice beside it
+
+
+def test_the_slow_map_reason_names_what_the_walker_has():
+    """The notice of a slow map names the walker's spring (a torque law with a stiffness),
+    its virtual-constraint controller, or neither."""
+    from walkerlab.analysis.gait.poincare import slow_step_reason
+    from walkerlab.models.registry import build_walker
+
+    root = Path(__file__).resolve().parents[1] / "configs"
+    sprung = slow_step_reason(build_walker(load_scene(root / "hip_spring.yaml")))
+    hzd = slow_step_reason(build_walker(load_scene(root / "threelink_hzd.yaml")))
+    bare = slow_step_reason(build_walker(load_scene(root / "paper.yaml")))
+    assert "spring" in sprung and "walker.springs" in sprung
+    assert "virtual-constraint controller" in hzd and "spring" not in hzd
+    assert "spring" not in bare and "controller" not in bare
+
+
 def test_search_budgets_nest_and_end_with_their_search():
     """A fixed point inside a gait search keeps the search's earlier deadline and adds its
     maps to the search's count; after the search no map is bounded (per thread)."""

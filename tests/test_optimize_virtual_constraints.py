@@ -222,6 +222,72 @@ def test_written_scene_full_order_multipliers_contain_delta2(designed):
     assert np.max(np.abs(np.delete(mu, j))) < 1e-6
 
 
+@pytest.mark.slow
+def test_written_scene_holds_the_coefficients_in_force(designed):
+    """The written ``bezier_rad`` are the coefficients the checked controller runs (c_0,
+    c_1 the impact map's, not the collocation's, which missed them by its transcription
+    error, 2e-5 rad): rebuilt with ``invariant: true`` they come back bit for bit, and
+    with ``invariant: false`` (the file taken as written) the controller is the same: its
+    invariance residuals at round-off and the same zero-dynamics step period (1e-12 s;
+    the collocation's c_0, c_1 gave one 2.4e-6 s off)."""
+    d, folder = designed
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+    from walkerlab.config import load_scene
+    from walkerlab.models.registry import build_walker
+
+    c = d.controllers[0]
+    sc = load_scene(folder / c.scene_file)
+    written = np.array([o.bezier_rad for o in sc.walker.actuation.virtual_constraints.outputs])
+    ctrl = build_walker(sc).actuators.controller
+    assert np.array_equal(ctrl.design.alpha, written)
+    assert np.array_equal(np.asarray(c.bezier_rad), written)
+    cfg = yaml.safe_load((folder / c.scene_file).read_text())
+    cfg["walker"]["actuation"]["virtual_constraints"]["invariant"] = False
+    as_written = build_walker(scene_from_dict(cfg)).actuators.controller
+    assert as_written.design.residual_position < 1e-12
+    assert as_written.design.residual_rate < 1e-9
+    assert abs(zero_dynamics(as_written).step_period_s
+               - zero_dynamics(ctrl).step_period_s) < 1e-12
+
+
+@pytest.mark.slow
+def test_the_design_says_its_collocated_and_its_closed_loop_speed(designed):
+    """0.8 m/s is the collocated step's (its target, to IPOPT's tolerance); the closed loop
+    of the written coefficients walks within 1e-3 of it (the transcription's error), and
+    the header says both."""
+    d, folder = designed
+    c = d.controllers[0]
+    loop = c.full_order_step_length_m / c.full_order_step_period_s
+    assert abs(c.step_length_m / c.step_period_s - 0.8) < 1e-9
+    assert 0 < abs(loop - 0.8) < 1e-3
+    text = (folder / c.scene_file).read_text()
+    assert f"({loop:.6g} m/s)" in text and "(0.8 m/s)" in text
+
+
+@pytest.mark.slow
+def test_an_impossible_design_is_recorded_as_failed_not_blamed_on_the_scene(tmp_path):
+    """delta^2 <= 0.01 at 5 m/s with 1 N m and mu 0.01 cannot hold: IPOPT stops (here at a
+    5 s CPU budget: optimize.cpu_budget_s) and optimize.h5 records it; its last iterate's
+    coefficients make no controller, which is said as the design's failure (not as an
+    error naming the scene's outputs); the written scene's first line says it failed;
+    the reason names the optimize fields to relax."""
+    from walkerlab.io.schemas.optimize import load
+    from walkerlab.report.figures_section import not_a_gait_reason
+    from walkerlab.stages import pipeline
+
+    sc = scene_from_dict(_scene(THREELINK, {
+        "design": "virtual_constraints", "max_multiplier": 0.01, "target_speed_m_per_s": 5.0,
+        "max_torque_n_m": 1.0, "friction_coefficient": 0.01, "cpu_budget_s": 5.0}, "imp"))
+    out = pipeline.run("optimize", sc, tmp_path, False)
+    d = load(out.path)
+    c = d.controllers[0]
+    assert c.status != "Solve_Succeeded" and not d.gait
+    assert (out.path.parent / c.scene_file).read_text().startswith("# FAILED: IPOPT ")
+    why = not_a_gait_reason(d)
+    assert why.startswith("the design is ") and "optimize.max_multiplier" in why
+    assert "controller 1 (5 m/s): IPOPT" in why
+
+
 # -- the shipped RABBIT design (configs/rabbit_hzd_optimal.yaml; slow: ~2 min) -----------
 
 @pytest.fixture(scope="module")
@@ -441,3 +507,74 @@ def test_a_slow_three_link_design_walks_in_mujoco_within_3_percent(slow_designed
     assert T == pytest.approx(c.full_order_step_period_s, rel=0.03)
     speed = (run.positions_m[-1] - run.positions_m[1]) / (run.times_s[-1] - run.times_s[1])
     assert speed == pytest.approx(c.step_length_m / c.full_order_step_period_s, rel=0.03)
+
+
+# -- what a design writes into the run folder ---------------------------------------------
+
+def _controller(scene_file, status="Solve_Succeeded", length=0.5, loop_length=0.499992):
+    """A designed controller's record (the three-link scene's own coefficients)."""
+    from walkerlab.io.schemas.optimize import ControllerData
+
+    return ControllerData(
+        target_speed_m_per_s=0.5, bezier_rad=GIVEN_ALPHA, output_names=("swing_leg", "torso"),
+        step_period_s=1.0, step_length_m=length, objective=1.0, effort=1.0, delta2=0.6,
+        delta2_restricted=0.6, existence_margin=-1.0, restricted_step_period_s=1.0,
+        full_order_step_period_s=1.0, orbit_shift=0.0, multipliers=np.zeros(6, complex),
+        delta2_multiplier=0.6, max_torque_n_m=10.0, max_output=0.0, max_output_rate=0.0,
+        status=status, iterations=10, wall_time_s=1.0, build_time_s=1.0,
+        scene_file=scene_file, full_order_step_length_m=loop_length)
+
+
+GIVEN_ALPHA = np.array([o["bezier_rad"] for o in
+                        THREELINK["walker"]["actuation"]["virtual_constraints"]["outputs"]])
+
+
+def test_a_rerun_with_fewer_speeds_leaves_exactly_the_artifacts_controller_scenes(
+        tmp_path, monkeypatch):
+    """An earlier design's ``<scene>_controller_2.yaml`` is removed when ``optimize.h5``
+    holds one controller; another scene's and other files stay."""
+    from types import SimpleNamespace
+
+    from walkerlab.stages import optimize as stage
+
+    sc = scene_from_dict(_scene(THREELINK, DESIGN, "s"))
+    for name in ("s_controller_1.yaml", "s_controller_2.yaml", "t_controller_2.yaml",
+                 "s_controller_2.yaml.bak"):
+        (tmp_path / name).write_text("old\n")
+    art = tmp_path / "optimize.h5"
+    monkeypatch.setattr(stage.schema, "load", lambda p: SimpleNamespace(
+        controllers=(_controller("s_controller_1.yaml"),), violations=""))
+    stage.write_controller_scenes(sc, art)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "s_controller_1.yaml", "s_controller_2.yaml.bak", "t_controller_2.yaml"]
+    assert (tmp_path / "s_controller_1.yaml").read_text().startswith("# Written by")
+
+
+def test_the_written_scene_says_which_speed_is_the_collocations_and_which_it_walks():
+    """The 0.5 m/s of a design is the collocated step's (its target); the coefficients
+    written walk 0.499992 m/s on the rigid model: the header and the source say both."""
+    from walkerlab.optimal.virtual_constraints import controller_scene_text
+
+    sc = scene_from_dict(_scene(THREELINK, DESIGN, "s"))
+    text = controller_scene_text(sc, _controller("s_controller_1.yaml"), "s_controller_1")
+    head = [ln for ln in text.splitlines() if ln.startswith("#")]
+    assert any("Collocated step (the design's targets hold here)" in ln and "(0.5 m/s)" in ln
+               for ln in head)
+    assert any("Closed loop of the coefficients below" in ln and "(0.499992 m/s)" in ln
+               for ln in head)
+    body = yaml.safe_load(text)
+    assert "collocated 0.5 m/s, the closed loop walks 0.499992 m/s" in body["source"]
+    assert "FAILED" not in text
+
+
+def test_a_failed_designs_scene_says_it_failed_in_its_first_line():
+    from walkerlab.optimal.virtual_constraints import controller_scene_text
+
+    sc = scene_from_dict(_scene(THREELINK, DESIGN, "s"))
+    c = _controller("s_controller_1.yaml", status="Restoration_Failed", loop_length=np.nan)
+    text = controller_scene_text(sc, c, "s_controller_1", "controller 1 (0.5 m/s): IPOPT "
+                                 "Restoration_Failed, largest violations the friction cone 0.3")
+    first = text.splitlines()[0]
+    assert first.startswith("# FAILED: IPOPT Restoration_Failed, not a designed controller")
+    assert "the friction cone 0.3" in text.splitlines()[1]
+    assert yaml.safe_load(text)["source"].startswith("FAILED: IPOPT Restoration_Failed")

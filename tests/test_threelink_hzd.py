@@ -320,3 +320,153 @@ def test_energy_ledger_counts_the_controllers_work(walker, hzd, reference):
     xp = ref.impact(x_minus, BOOK)
     ke_ref_p = 0.5 * xp[3:] @ ref.mass_matrix(xp[:3], BOOK) @ xp[3:]
     assert abs(loss - (ke_ref - ke_ref_p)) < 1e-9 * loss
+
+
+# -- the gait search of a controller that does not walk ends, saying why ------------------
+
+def scene_with_c4(c4: float, **phase):
+    """configs/threelink_hzd.yaml with the swing leg's last Bezier coefficient ``c4`` [rad]
+    (and a ``phase`` given)."""
+    cfg = copy.deepcopy(SCENE)
+    vc = cfg["walker"]["actuation"]["virtual_constraints"]
+    vc["outputs"][0]["bezier_rad"][-1] = c4
+    if phase:
+        vc["phase"] = phase
+    return scene_from_dict(cfg)
+
+
+def test_a_hip_position_phase_puts_the_step_ends_within_half_a_turn():
+    """``phase: {point: hip}`` (the hip's position, m): the scan for the step's end drifted
+    the stance angle by whole turns (-8.9e5 rad, so c_0 = -8.9e5 rad and a zero-dynamics
+    start at -8.9e5 rad/s whose search ran for minutes).  The ends are the same
+    configurations as with the stance leg's angle (c_4 = 0.181051 rad puts the heel strike
+    at -+0.181051 rad, to the Newton solve's 1e-11), so c_0 is the swing leg's post-impact
+    angle, -0.181051 rad."""
+    d = build_walker(scene_with_c4(0.181051, point="hip")).actuators.controller.design
+    np.testing.assert_allclose(d.q_minus, [-0.181051, 0.181051, -0.106052], atol=1e-9)
+    np.testing.assert_allclose(d.q_plus, [0.181051, -0.181051, -0.106052], atol=1e-9)
+    assert abs(d.alpha[0, 0] + 0.181051) < 1e-9
+    assert abs(d.theta_minus - np.sin(0.181051)) < 1e-9  # the hip's x over the stance foot
+
+
+def test_a_controller_whose_zero_dynamics_has_no_orbit_is_refused_at_once():
+    """c_4 = 0.3 rad: delta^2 = 0.7297 but the existence margin is 249.5 > 0 (the step
+    stalls); with invariant outputs every gait lies on the zero dynamics' orbit, so the
+    search names it in one line and starts no root finder (it used to try the passive
+    seeds, one of whose maps ran 125 s)."""
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.analysis.gait.scene import solve_scene
+
+    started = []
+    real = gait_search.find_fixed_point
+
+    def counted(*a, **k):
+        started.append(1)
+        return real(*a, **k)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(gait_search, "find_fixed_point", counted)
+        mp.setattr(gait_search, "screen_seeds", lambda *a: pytest.fail("seeds tried"))
+        with pytest.raises(gait_search.GaitNotFound) as e:
+            solve_scene(scene_with_c4(0.3), False)
+    text = str(e.value)
+    assert len(text.splitlines()) == 1 and not started
+    assert "zero dynamics has no periodic orbit" in text and "existence margin 249.5" in text
+    assert "walker.actuation.virtual_constraints" in text and "spring" not in text
+
+
+#: a 3 m/s design of this walker (walkerlab optimize, design: virtual_constraints, target
+#: 3 m/s): its zero dynamics has an orbit (delta^2 0.834, step period 0.1846 s) but the
+#: straight swing foot dips 7 mm below the ground inside the step, so the full-order step
+#: from the orbit never meets the heel-strike guard from above
+FAST = [[-0.28052292849252825, -0.3669797008700445, -0.25993278216844284, 0.1402610936155856,
+         0.28052292849252836],
+        [-1.5066349070166543, -1.5527241395169769, -1.5470712696390043, -1.6145457647372112,
+         -1.5066349070166543]]
+
+
+def test_a_closed_loop_that_does_not_step_from_its_orbit_fails_at_its_first_map():
+    """The 3 m/s design (:data:`FAST`) is a gait search of one failed map: its phase leaves
+    the Bezier polynomials' range (s > 1.25, at t = 0.219 s against a 0.185 s orbit) and
+    the step ends as a fall there, instead of the controller extrapolating them to rates
+    of 1e11 rad/s while the integrator crawls (the search's whole budget, then the passive
+    seeds'); one line, naming the guard."""
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.analysis.gait.scene import solve_scene
+
+    cfg = copy.deepcopy(SCENE)
+    for o, row in zip(cfg["walker"]["actuation"]["virtual_constraints"]["outputs"], FAST):
+        o["bezier_rad"] = row
+    sc = scene_from_dict(cfg)
+    from walkerlab.analysis.gait import poincare as P
+
+    maps = []
+    real = P.poincare_map
+
+    def counted(*a, **k):
+        maps.append(1)
+        return real(*a, **k)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(P, "poincare_map", counted)
+        mp.setattr(gait_search, "screen_seeds", lambda *a: pytest.fail("seeds tried"))
+        with pytest.raises(gait_search.GaitNotFound) as e:
+            solve_scene(sc, False)
+    text = str(e.value)
+    assert len(text.splitlines()) == 1 and len(maps) == 1
+    assert "zero dynamics' orbit" in text and "phase_past_step_end" in text
+    assert "spring" not in text
+
+
+def _scene_file(tmp_path, name, change):
+    cfg = copy.deepcopy(SCENE)
+    change(cfg)
+    cfg["name"] = name
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(cfg, sort_keys=False))
+    return str(path)
+
+
+def _vc(cfg):
+    return cfg["walker"]["actuation"]["virtual_constraints"]
+
+
+#: the cases of a controller that does not walk (or a design that cannot be met) that used
+#: to run for 60 s to 10 min: (command, scene name, scene change, extra arguments)
+NO_WALK_CASES = {
+    "hip_phase": ("fixedpoint", lambda c: _vc(c).update(phase={"point": "hip"}), []),
+    "c4_0.3": ("fixedpoint", lambda c: _vc(c)["outputs"][0]["bezier_rad"].__setitem__(4, 0.3),
+               []),
+    "sweep_c4": ("sweep", lambda c: None, [
+        "--param", "walker.actuation.virtual_constraints.outputs.0.bezier_rad.4=0.2:0.3:0.05",
+        "--workers", "1"]),
+    "design_3_m_s": ("optimize", lambda c: c.update(optimize={
+        "design": "virtual_constraints", "target_speed_m_per_s": 3.0}), []),
+    "impossible_design": ("optimize", lambda c: c.update(optimize={
+        "design": "virtual_constraints", "max_multiplier": 0.01, "target_speed_m_per_s": 5.0,
+        "max_torque_n_m": 1.0, "friction_coefficient": 0.01}), []),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", list(NO_WALK_CASES))
+def test_a_controller_that_does_not_walk_ends_within_its_budget(case, tmp_path):
+    """Every gait search, sweep point and design of these cases ends within its budget
+    (60 s of CPU per search or designed controller) and a step: under 90 s of this
+    process's CPU time (the sweep on one worker, in this process), with at most one error
+    line and no traceback (they ran 60 s to 590 s, and the design at 3 m/s past 300 s)."""
+    import time
+
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    command, change, extra = NO_WALK_CASES[case]
+    scene = _scene_file(tmp_path, case.replace(".", "_"), change)
+    t0 = time.process_time()
+    r = CliRunner().invoke(app, ["-q", command, scene, "--runs-dir", str(tmp_path / "runs"),
+                                 *extra])
+    cpu = time.process_time() - t0
+    assert cpu < 90.0, (case, cpu)
+    assert "Traceback" not in r.output
+    errors = [ln for ln in r.output.splitlines() if ln.lower().startswith("error")]
+    assert len(errors) <= 1 and (r.exit_code == 0) == (not errors), r.output
+    assert "spring" not in r.output

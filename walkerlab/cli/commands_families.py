@@ -276,11 +276,16 @@ def _echo_optimum(sc, d) -> None:
     if d.phase_replay_outcome:  # asked for, and refused (a non-monotonic phase variable)
         typer.echo(f"  phase-variable replay: {d.phase_replay_outcome}")
     for i, c in enumerate(d.controllers):  # optimize.design: virtual_constraints
-        typer.echo(f"  controller {i + 1} ({c.scene_file}): {c.step_length_m:.5g} m in "
-                   f"{c.step_period_s:.6g} s, delta^2 {c.delta2:.10g} (its restricted map "
+        loop = c.full_order_step_length_m / c.full_order_step_period_s
+        typer.echo(f"  controller {i + 1} ({c.scene_file}): collocated {c.step_length_m:.5g} m"
+                   f" in {c.step_period_s:.6g} s ({c.step_length_m / c.step_period_s:.6g} m/s,"
+                   f" the targets'), delta^2 {c.delta2:.10g} (its restricted map "
                    f"{c.delta2_restricted:.10g}, the full-order multiplier "
-                   f"{abs(c.delta2_multiplier):.10g}), closed-loop step period "
-                   f"{c.full_order_step_period_s:.6g} s, IPOPT {c.status}")
+                   f"{abs(c.delta2_multiplier):.10g}), closed loop "
+                   + (f"{c.full_order_step_length_m:.6g} m in {c.full_order_step_period_s:.6g}"
+                      f" s ({loop:.6g} m/s)" if loop == loop else "without a fixed point")
+                   + f", IPOPT {c.status}"
+                   + ("" if c.status == "Solve_Succeeded" else ": NOT a designed controller"))
     for law, r in d.phase_replays.items():  # the phase-variable laws (when asked for)
         typer.echo(f"  phase-variable {law} law: from the collocated start "
                    f"{r.collocated_start_error:.2g}; "

@@ -108,16 +108,20 @@ class OptimizeSettings(Strict):
     target_speeds_m_per_s: list[Annotated[float, Field(gt=0, le=20)]] | None = Field(
         None, min_length=1, max_length=8, description="design: virtual_constraints: one "
         "controller per speed (step length / step period) [m/s]")
+    cpu_budget_s: float | None = Field(
+        None, gt=0, le=86400, description="design: virtual_constraints: the CPU time of "
+        "each controller [s]: IPOPT stops at it (status Maximum_CpuTime_Exceeded) and the "
+        "closed loop's gait search gets what IPOPT left, at least 10 s (default 60)")
 
     @model_serializer(mode="wrap")
     def _as_given(self, handler):
         return drop_unset(handler(self), ("design", "max_multiplier",
-                                          "target_speeds_m_per_s"))
+                                          "target_speeds_m_per_s", "cpu_budget_s"))
 
     @model_validator(mode="after")
     def _design(self) -> OptimizeSettings:
         if self.design is None:
-            for k in ("max_multiplier", "target_speeds_m_per_s"):
+            for k in ("max_multiplier", "target_speeds_m_per_s", "cpu_budget_s"):
                 if getattr(self, k) is not None:
                     raise ValueError(f"optimize.{k}: give it with design: "
                                      "virtual_constraints (and only then)")

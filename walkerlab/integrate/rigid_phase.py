@@ -179,7 +179,7 @@ def integrate_phase(phase: Phase, t0: float, x: np.ndarray, Phi: np.ndarray, t_s
     if backend == "cyrk_compiled" and phase.compiled is not None:
         from walkerlab.integrate._compiled import solve_phase
 
-        check_time_limit()  # no Python in the compiled flow: checked at each phase start
+        check_time_limit(t0, x)  # no Python in the compiled flow: checked at each phase start
 
         return PhaseRun(*solve_phase(phase.compiled, variational, t0, t_stop, y0,
                                      phase.guards, n, solver))

@@ -9,8 +9,12 @@ step (:func:`walkerlab.integrate.rigid.integrate_step` restarts the clock,
 right-hand-side evaluation of the ``scipy`` and ``cyrk`` backends (every 64th, and every
 phase start of the ``cyrk_compiled`` backend, whose flow calls no Python) checks this
 thread's CPU time, and past the limit raises :class:`IntegrationTimeLimit` out of the
-integration.  Outside such a block nothing is checked and nothing is wrapped (the
-integrations are the same, bit for bit).
+integration.  Inside :func:`integration_deadline` (a gait search's CPU-time budget,
+:func:`walkerlab.analysis.gait.poincare.search_budget`) the same checks raise
+:class:`IntegrationDeadline` once the thread's CPU clock passes an absolute deadline, so that
+one walking step cannot outlast the budget of the search it belongs to.  Outside such blocks
+nothing is checked and nothing is wrapped; inside them the right-hand side returns the same
+values (the integrations are the same, bit for bit).
 """
 
 from __future__ import annotations
@@ -21,8 +25,8 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["IntegrationTimeLimit", "check_time_limit", "integration_time_limit", "limited",
-           "start_step_clock"]
+__all__ = ["IntegrationDeadline", "IntegrationTimeLimit", "check_time_limit",
+           "integration_deadline", "integration_time_limit", "limited", "start_step_clock"]
 
 #: the clock: this thread's CPU time (a loaded machine does not trip the limit)
 _clock = time.thread_time
@@ -38,9 +42,20 @@ class IntegrationTimeLimit(RuntimeError):
         self.seconds = seconds
 
 
+class IntegrationDeadline(RuntimeError):
+    """The thread's CPU clock passed the deadline of :func:`integration_deadline` during a
+    walking step; ``t`` [s] and ``x`` (the state, [rad, rad/s]) are where the integration
+    was."""
+
+    def __init__(self, t: float, x):
+        super().__init__(f"the walking step passed its deadline at t = {t:.4g} s")
+        self.t, self.x = t, x
+
+
 class _Limit(threading.local):
-    deadline = math.inf
+    deadline = math.inf  # this step's (integration_time_limit)
     seconds = math.inf
+    hard = math.inf  # an absolute one on every step (integration_deadline)
 
 
 _LIMIT = _Limit()
@@ -65,22 +80,46 @@ def integration_time_limit(seconds: float) -> Iterator[None]:
         _LIMIT.deadline, _LIMIT.seconds = outer
 
 
+@contextmanager
+def integration_deadline(at: float) -> Iterator[None]:
+    """Stop every walking step integrated inside once this thread's CPU clock
+    (``time.thread_time``) passes ``at`` [s] (nested deadlines keep the earlier; ``inf``:
+    nothing checked).
+
+    Raises
+    ------
+    IntegrationDeadline
+        From the integration under way once the clock passes ``at``.
+    """
+    outer = _LIMIT.hard
+    _LIMIT.hard = min(outer, float(at))
+    try:
+        yield
+    finally:
+        _LIMIT.hard = outer
+
+
 def start_step_clock() -> None:
     """A walking step begins: inside a limit, its time counts from now (else nothing)."""
     if math.isfinite(_LIMIT.seconds):
         _LIMIT.deadline = _clock() + _LIMIT.seconds
 
 
-def check_time_limit() -> None:
-    """Raise :class:`IntegrationTimeLimit` when a limit is set and its time is used up."""
-    if _clock() > _LIMIT.deadline:
+def check_time_limit(t: float = math.nan, y=None) -> None:
+    """Raise :class:`IntegrationDeadline` past the deadline of :func:`integration_deadline`
+    (with the integration's time ``t`` [s] and state ``y``), :class:`IntegrationTimeLimit`
+    when a step's limit is set and its time is used up."""
+    now = _clock()
+    if now > _LIMIT.hard:
+        raise IntegrationDeadline(t, y)
+    if now > _LIMIT.deadline:
         raise IntegrationTimeLimit(_LIMIT.seconds)
 
 
 def limited(rhs):
     """``rhs`` itself outside a limit; inside one, ``rhs`` checking the clock every
     :data:`CHECK_EVERY` evaluations (same values returned)."""
-    if not math.isfinite(_LIMIT.deadline):
+    if not math.isfinite(min(_LIMIT.deadline, _LIMIT.hard)):
         return rhs
     check_time_limit()
     calls = [0]
@@ -88,6 +127,6 @@ def limited(rhs):
     def checked(t, y):
         calls[0] += 1
         if calls[0] % CHECK_EVERY == 0:
-            check_time_limit()
+            check_time_limit(t, y)
         return rhs(t, y)
     return checked

@@ -252,7 +252,10 @@ class VirtualConstraintController:
                              "of the phase variable: no heel strike ends the step")
         # the swing foot lands ahead: the configuration where it is furthest ahead
         _ahead, th, q = max(cands, key=lambda c: c[0])
-        return th, q
+        # every coordinate is an angle: the scan's Newton iterates can drift by whole turns
+        # where the phase is flat in a coordinate (a hip position near a leg's horizontal);
+        # the same configuration, its angles in (-pi, pi]
+        return th, np.where(np.abs(q) > np.pi, np.remainder(q + np.pi, 2 * np.pi) - np.pi, q)
 
     def _design(self, given):
         """:class:`Design` of the scene's coefficients ``given`` (k, M + 1)."""

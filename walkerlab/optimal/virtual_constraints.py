@@ -25,10 +25,10 @@ import numpy as np
 from walkerlab import progress
 from walkerlab.io.schemas.optimize import ControllerData
 
-__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "REPLAY_STRIDES", "ControllerDesign",
-           "check_design", "clearance_report", "contact_scene", "controller_scene",
-           "controller_scene_text",
-           "controller_step", "design_controllers", "designs_controller",
+__all__ = ["CHECK_MIN_S", "CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
+           "REPLAY_STRIDES", "ControllerDesign", "check_design", "clearance_report",
+           "contact_scene", "controller_scene", "controller_scene_text", "controller_step",
+           "design_controllers", "design_failures", "designs_controller",
            "optimize_virtual_constraints", "replay_in_contact"]
 
 KEY = "walker.actuation.virtual_constraints"
@@ -43,11 +43,17 @@ class ControllerDesign(ControllerData):
     target_speed_m_per_s : float
         The speed asked for (NaN: none) [m/s].
     bezier_rad : ndarray (k, M + 1)
-        The optimised coefficients (``c_0``, ``c_1`` the collocation's; the scene's
-        ``invariant: true`` recomputes them from the impact map) [rad].
+        The optimised coefficients in force [rad]: with ``invariant: true``, ``c_0``, ``c_1``
+        are the impact map's of the others (as the written scene recomputes them; the
+        collocation's own differ by its transcription error), so that the written scene
+        is the controller checked here; IPOPT's last iterate when they make no controller.
     output_names : tuple of str
     step_period_s, step_length_m : float
-        The collocated step's.
+        The collocated step's (the targets hold there: ``step_length_m / step_period_s`` is
+        the target speed).
+    full_order_step_length_m : float
+        The rigid closed loop's fixed point's step length [m] (NaN: none); with
+        ``full_order_step_period_s``, the speed the written controller walks.
     objective, effort : float
         ``int |u|^2 dt / step length`` [N^2 m s] and ``int |u|^2 dt`` [N^2 m^2 s].
     delta2 : float
@@ -92,6 +98,11 @@ class ControllerDesign(ControllerData):
         The rigid closed loop's fixed point (None: none found).
     contact_outcome : str
         The contact replay's one line.
+    violations : str
+        When IPOPT did not converge: the constraint groups it left violated.
+    note : str
+        Why the closed loop has no fixed point, or why the coefficients make no
+        controller (``""``: it has one).
     """
 
     t: np.ndarray = field(repr=False, default=None)
@@ -100,6 +111,7 @@ class ControllerDesign(ControllerData):
     history: dict = field(repr=False, default_factory=dict)
     x_star: np.ndarray = field(repr=False, default=None)
     contact_outcome: str = ""
+    violations: str = ""
 
 
 #: The contact law of a designed controller's scene whose design scene has none: the
@@ -180,25 +192,50 @@ def controller_scene(scene, bezier):
     return contact_scene(scene.model_copy(update={"walker": walker, "optimize": None}))
 
 
-def controller_scene_text(scene, c: ControllerDesign, name: str) -> str:
+def controller_scene_text(scene, c: ControllerData, name: str, failures: str = "") -> str:
     """The YAML text of the scene of controller ``c`` (:func:`controller_scene`), named
-    ``name``, with a header saying where it comes from."""
+    ``name``, with a header saying where it comes from: the collocated step (where the
+    design's targets hold) and the closed loop of the coefficients written (the rigid
+    model's fixed point), each with its speed; a design IPOPT did not converge on says so
+    in its first line and its ``source`` (``failures``: the design's failures,
+    :func:`design_failures`, said after it)."""
     import yaml
 
     body = controller_scene(scene, c.bezier_rad).model_dump(mode="json", exclude_none=True)
     body["name"] = name
     speed = c.step_length_m / c.step_period_s
-    body["source"] = (f"scene {scene.name}'s walker under virtual constraints optimised by "
+    loop = c.full_order_step_length_m / c.full_order_step_period_s
+    walks = (f"the closed loop walks {loop:.6g} m/s" if np.isfinite(loop)
+             else "the closed loop has no fixed point")
+    failed = (f"FAILED: IPOPT {c.status}, not a designed controller (its last iterate, "
+              "written to be inspected; it need not walk)") \
+        if c.status != "Solve_Succeeded" else ""
+    body["source"] = ((failed + "; " if failed else "")
+                      + f"scene {scene.name}'s walker under virtual constraints optimised by "
                       f"walkerlab optimize (design: virtual_constraints): delta^2 = "
-                      f"{c.delta2_restricted:.10g}, {speed:.6g} m/s")
-    head = (f"# Written by walkerlab optimize from scene '{scene.name}' (design: "
-            "virtual_constraints; do not edit: rewritten by the next run).\n"
-            + (f"# Its source: {scene.source}\n" if scene.source else "") +
-            f"# Collocated step: {c.step_length_m:.6g} m in {c.step_period_s:.6g} s "
-            f"({speed:.6g} m/s), int u^2 dt / length = {c.objective:.6g} N^2 m s, "
-            f"max |u| = {c.max_torque_n_m:.4g} N m.\n"
-            f"# Restricted Poincare map: delta^2 = {c.delta2_restricted:.10g}; full-order "
-            f"multiplier nearest it {abs(c.delta2_multiplier):.10g}.\n")
+                      f"{c.delta2_restricted:.10g}, collocated {speed:.6g} m/s, {walks}")
+    failures = getattr(c, "violations", "") or failures
+    head = ((f"# {failed}.\n" + (f"# The design's failures: {failures}.\n"
+                                  if failures else "")) if failed else "")
+    head += (f"# Written by walkerlab optimize from scene '{scene.name}' (design: "
+             "virtual_constraints; do not edit: rewritten by the next run).\n"
+             + (f"# Its source: {scene.source}\n" if scene.source else "")
+             + ("# Collocated step (IPOPT's last iterate: the targets need not hold): "
+                if failed else "# Collocated step (the design's targets hold here): ")
+             + f"{c.step_length_m:.6g} m "
+             f"in {c.step_period_s:.6g} s ({speed:.6g} m/s), int u^2 dt / length = "
+             f"{c.objective:.6g} N^2 m s, max |u| = {c.max_torque_n_m:.4g} N m.\n"
+             + (f"# Closed loop of the coefficients below (rigid model, its fixed point): "
+                f"{c.full_order_step_length_m:.6g} m in {c.full_order_step_period_s:.6g} s "
+                f"({loop:.6g} m/s).\n" if np.isfinite(loop) else
+                "# Closed loop of the coefficients below: no fixed point"
+                + (f" ({c.note})" if getattr(c, "note", "") else "") + ".\n")
+             + ("# Bezier coefficients: IPOPT's last iterate's" if not np.isfinite(
+                 c.delta2_restricted) else "# Bezier coefficients in force (c_0, c_1 the "
+                 "impact map's: invariant: true recomputes the same)")
+             + ".  Restricted Poincare map: delta^2 = "
+             f"{c.delta2_restricted:.10g}; full-order multiplier nearest it "
+             f"{abs(c.delta2_multiplier):.10g}.\n")
     return head + yaml.safe_dump(body, sort_keys=False, width=100)
 
 
@@ -235,46 +272,78 @@ def controller_step(walker, solver, points: int):
     return t, x, u, ctrl.design.alpha.copy(), zd
 
 
-def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesign:
-    """The written controller of the optimum ``res`` on the rigid model: its restricted map
-    and its full-order fixed point (from the zero dynamics' orbit); ``clearance``: the
-    swing foot's (:func:`clearance_report`)."""
+#: the CPU time of each designed controller when ``optimize.cpu_budget_s`` is not given [s]
+#: (IPOPT's ``max_cpu_time``: a bound, not a measure; configs/rabbit_hzd_optimal.yaml, whose
+#: 0.8 m/s controller takes 435 IPOPT iterations, gives its own)
+DESIGN_BUDGET_S = 60.0
+#: the least CPU time the closed loop's gait search of a controller gets, whatever IPOPT
+#: left of the budget [s]
+CHECK_MIN_S = 10.0
+
+
+def _evaluate(scene, res, target, name: str, clearance: dict,
+              budget_s: float = CHECK_MIN_S) -> ControllerDesign:
+    """The written controller of the optimum ``res`` on the rigid model: its coefficients
+    in force, its restricted map and its full-order fixed point (from the zero dynamics'
+    orbit; the gait search bounded to ``budget_s`` of CPU time [s]); ``clearance``: the
+    swing foot's (:func:`clearance_report`).  IPOPT's last
+    iterate whose coefficients make no controller (a failed design) is recorded as it is,
+    with the reason in ``note``."""
+    from walkerlab.analysis.gait.poincare import search_budget
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     sc = controller_scene(scene, res.alpha)
-    walker = build_walker(sc)
+    common = dict(
+        target_speed_m_per_s=float("nan") if target is None else float(target),
+        step_period_s=res.step_period_s, step_length_m=res.step_length_m,
+        objective=res.objective, effort=res.effort, delta2=res.delta2,
+        max_torque_n_m=float(np.max(np.abs(res.u))), max_output=res.max_output,
+        max_output_rate=res.max_output_rate, status=res.status, iterations=res.iterations,
+        wall_time_s=res.wall_time_s, build_time_s=res.build_time_s, scene_file=name,
+        t=res.t, x=res.x, u=res.u, history=res.history,
+        violations=getattr(res, "violations", ""), **clearance)
+    try:
+        walker = build_walker(sc)
+    except ValueError as exc:  # a failed design's last iterate: no controller to check
+        if res.status == "Solve_Succeeded":
+            raise
+        k = np.asarray(res.alpha).shape[0]
+        return ControllerDesign(
+            bezier_rad=np.asarray(res.alpha, float), output_names=tuple(
+                o.name for o in scene.walker.actuation.virtual_constraints.outputs),
+            delta2_restricted=np.nan, existence_margin=np.nan,
+            restricted_step_period_s=np.nan, full_order_step_period_s=np.nan,
+            orbit_shift=np.inf, multipliers=np.full(2 * (k + 1), np.nan + 0j),
+            delta2_multiplier=complex(np.nan), note=f"no controller: {exc}", **common)
     ctrl = walker.actuators.controller
     zd = zero_dynamics(ctrl)
-    period, mult, near = np.nan, np.full(2 * ctrl.n, np.nan + 0j), complex(np.nan)
-    shift, x_star = np.inf, None
+    period, length, mult = np.nan, np.nan, np.full(2 * ctrl.n, np.nan + 0j)
+    near, shift, note, x_star = complex(np.nan), np.inf, "", None
     if zd.exists:
         try:
-            fp = solve_scene(sc, False, guess=zd.x_plus, walker=walker,
-                             solver=Solver.from_settings(sc.solver))[1].gait.result
+            with search_budget(budget_s):
+                fp = solve_scene(sc, False, guess=zd.x_plus, walker=walker,
+                                 solver=Solver.from_settings(sc.solver))[1].gait.result
             period = float(fp.period_s)
+            length = float(fp.step_lengths_m[0]) if fp.step_lengths_m else np.nan
             mult = np.asarray(fp.multipliers_variational, complex)
             near = complex(mult[int(np.argmin(np.abs(mult - zd.delta2)))])
             shift = float(np.max(np.abs(np.asarray(fp.x, float) - zd.x_plus)))
             x_star = np.asarray(fp.x, float)
-        except (ValueError, RuntimeError, ArithmeticError, AttributeError):
-            pass  # no fixed point: NaN (the design is reported, not a gait)
+        except (ValueError, RuntimeError, ArithmeticError, AttributeError) as exc:
+            note = str(exc)  # no fixed point: NaN (the design is reported, not a gait)
+    else:
+        note = (f"its zero dynamics has no periodic orbit (delta^2 {zd.delta2:.4g}, existence"
+                f" margin {zd.existence_margin:.4g})")
     return ControllerDesign(
-        target_speed_m_per_s=float("nan") if target is None else float(target),
-        bezier_rad=res.alpha, output_names=tuple(ctrl.output_names),
-        step_period_s=res.step_period_s, step_length_m=res.step_length_m,
-        objective=res.objective, effort=res.effort, delta2=res.delta2,
+        bezier_rad=np.array(ctrl.design.alpha, float), output_names=tuple(ctrl.output_names),
         delta2_restricted=zd.delta2, existence_margin=zd.existence_margin,
         restricted_step_period_s=zd.step_period_s, full_order_step_period_s=period,
-        orbit_shift=shift,
-        multipliers=mult, delta2_multiplier=near,
-        max_torque_n_m=float(np.max(np.abs(res.u))), max_output=res.max_output,
-        max_output_rate=res.max_output_rate, status=res.status, iterations=res.iterations,
-        wall_time_s=res.wall_time_s, build_time_s=res.build_time_s, scene_file=name,
-        t=res.t, x=res.x, u=res.u, history=res.history, x_star=x_star,
-        **clearance)
+        full_order_step_length_m=length, orbit_shift=shift,
+        multipliers=mult, delta2_multiplier=near, note=note, x_star=x_star, **common)
 
 
 def design_controllers(scene, data, spec, print_level: int = 0) -> list[ControllerDesign]:
@@ -299,6 +368,9 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     Returns
     -------
     list of ControllerDesign
+        One per speed, converged or not (IPOPT's status; each controller's IPOPT solve
+        stops at ``optimize.cpu_budget_s``, default :data:`DESIGN_BUDGET_S`, of CPU time and
+        its closed loop's gait search gets what is left, at least :data:`CHECK_MIN_S`).
 
     Raises
     ------
@@ -335,17 +407,20 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     window = None
     if not fns.clearance_guard and spec.min_clearance_m is not None:
         window = mid_stance_window(spec.min_clearance_m, _leg_length_m(scene))
+    budget = float(o.cpu_budget_s or DESIGN_BUDGET_S)
     out = []
     with progress.task(f"optimize: {len(speeds)} controller(s)", len(speeds)) as bar:
         for i, v in enumerate(speeds):
             res = collocate_virtual_constraints(
                 fns, replace(spec, target_speed_m_per_s=v), t, x, u, alpha, o.max_multiplier,
                 (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level,
-                mid_stance_window_m=window)
+                mid_stance_window_m=window, cpu_budget_s=budget)
             res.build_time_s += build
+            left = max(budget - res.cpu_time_s, CHECK_MIN_S)  # the closed loop's search
             out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml",
                                  {**clearance_report(fns, res.x, window),
-                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)}))
+                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)},
+                                 left))
             bar.advance(info=f"controller {i + 1} ({v:g} m/s): {res.status}")
             if res.status == "Solve_Succeeded":  # the next speed starts here
                 t, x, u, alpha = res.t, res.x, res.u, res.alpha
@@ -442,7 +517,24 @@ def optimize_virtual_constraints(scene, data, spec):
         contact_outcome="; ".join(f"controller {i + 1}: {d.contact_outcome}"
                                   for i, d in enumerate(cs)) if len(cs) > 1
         else c.contact_outcome,
-        controllers=tuple(cs))
+        controllers=tuple(cs), violations=design_failures(cs))
+
+
+def design_failures(cs) -> str:
+    """What went wrong with the controllers ``cs`` that IPOPT did not converge on, one
+    clause (``""``: none): each one's IPOPT status, the constraint groups it left violated
+    and why its coefficients make no controller, if they do not."""
+    out = []
+    for i, c in enumerate(cs):
+        if c.status == "Solve_Succeeded":
+            continue
+        text = f"controller {i + 1} ({c.target_speed_m_per_s:g} m/s): IPOPT {c.status}"
+        if getattr(c, "violations", ""):
+            text += f", largest violations {c.violations}"
+        if getattr(c, "note", "").startswith("no controller"):
+            text += f" ({c.note})"
+        out.append(text)
+    return "; ".join(out)
 
 
 class _AsResult:

@@ -278,12 +278,29 @@ def cot_terms_text(d, units: Units = Units()) -> str:
             f"{units.time})")
 
 
+#: IPOPT's statuses that say the constraints cannot hold together
+INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed",
+              "Error_In_Step_Computation")
+
+
 def not_a_gait_reason(d) -> str:
     """Why an ``optimize.h5`` (``d``) is not called a gait, and what helps (one clause):
     IPOPT did not converge, or the replay does not return to its start within
     ``optimize.replay_tolerance`` - on an open-loop unstable gait (a multiplier outside the
     unit circle) the replay amplifies the collocation's own error, which more intervals
     shrink (Hermite-Simpson: O(h^4))."""
+    if getattr(d, "controllers", ()) and d.status != "Solve_Succeeded":  # a design
+        verdict = ("infeasible" if d.status in INFEASIBLE else "not converged")
+        return (f"the design is {verdict} ({d.violations or 'IPOPT ' + d.status}): relax "
+                "optimize.max_multiplier, the target speeds, max_torque_n_m or "
+                "friction_coefficient, or start from a controller that walks nearer them")
+    if getattr(d, "controllers", ()):  # a design that converged: its closed loop
+        c = d.controllers[0]
+        return ("controller 1's closed loop has no fixed point"
+                + (f" ({c.note})" if getattr(c, "note", "") else "")
+                if c.full_order_step_period_s != c.full_order_step_period_s else
+                f"controller 1's restricted map's delta^2 {c.delta2_restricted:.10g} is not "
+                f"the collocation's {c.delta2:.10g} within optimize.replay_tolerance")
     if d.status != "Solve_Succeeded":
         worst = getattr(d, "violations", "")
         return f"IPOPT did not converge ({d.status})" + (

@@ -146,6 +146,26 @@ def _stride_reason(scene_json) -> str:
     return f"the {' and the '.join(why)} differ" if why else "its steps differ"
 
 
+def _fd_error_text(scene_json: str) -> str:
+    """Which multipliers the verdict uses and why, with the central differences' own error
+    bound ``10 max(rtol, atol) / h`` (:func:`walkerlab.analysis.gait.poincare.
+    multiplier_check_tolerance`; a stiff closed loop, as a five-link walker's computed
+    torque, brings its finite-difference multipliers that close to the bound)."""
+    import json
+
+    try:
+        sc = json.loads(scene_json)
+        solver, fpset = sc.get("solver") or {}, sc.get("fixedpoint") or {}
+        err = 10.0 * max(float(solver["rtol"]), float(solver["atol"])) / float(
+            fpset.get("fd_step", 1e-7))
+        bound = f" = {err:.1g}"
+    except (ValueError, KeyError, TypeError):
+        bound = ""
+    return ("the verdict uses the variational multipliers, the map's Jacobian to the "
+            "integrator's tolerance; central differences err by up to 10 max(rtol, atol) / h"
+            f"{bound} and only check them")
+
+
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
@@ -169,13 +189,13 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
     lines.append(f"Floquet multipliers (finite diff.): "
                  f"{_fmt_mult(fp.multipliers_fd.real, fp.multipliers_fd.imag)}")
-    lines.append(f"  max difference {fp.max_difference:.2e}")
+    lines.append(f"  max difference {fp.max_difference:.2e} ({_fd_error_text(fp.scene_json)})")
     mod = float(np.max(np.hypot(re, im)))
     verdict = "STABLE" if fp.stable else "UNSTABLE"
     why = (zero_multipliers_text(re, im, fp.state_names, fp.scene_json)
            if fp.zero_dynamics is None else "the others are the output feedback's and the "
            "heel-strike surface's, besides delta^2 of the zero dynamics")
-    lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; {why})")
+    lines.append(f"verdict: {verdict} (largest variational |multiplier| = {mod:.6f}; {why})")
     if fp.zero_dynamics is not None:
         lines += zero_dynamics_text(fp.zero_dynamics)
     if fp.ground_contact is not None:

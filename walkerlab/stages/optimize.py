@@ -127,23 +127,35 @@ def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream) -> StageO
 def write_controller_scenes(scene: Scene, artifact: Path) -> list[Path]:
     """Write the scene of every controller ``optimize.h5`` (``artifact``) holds beside it
     (``controllers/<i>``' ``scene_file``: the scene with the optimised coefficients,
-    :func:`walkerlab.optimal.virtual_constraints.controller_scene_text`), each to a
-    temporary name and then renamed (a file either old or whole).  Returns the paths."""
+    :func:`walkerlab.optimal.virtual_constraints.controller_scene_text`; a controller IPOPT
+    did not converge on says so in its header), each to a temporary name and then renamed
+    (a file either old or whole), then remove the scene's other controller scenes there
+    (``<scene>_controller_<i>.yaml`` of an earlier design with more target speeds): the
+    run folder's controller scenes are exactly those of ``optimize.h5``.  Returns the
+    paths."""
     import os
+    import re
 
     from walkerlab.optimal.virtual_constraints import controller_scene_text
     from walkerlab.safefs import atomic_replace, refuse_link
 
+    folder = Path(artifact).parent
     paths = []
-    for c in schema.load(artifact).controllers:
-        path = refuse_link(Path(artifact).parent / c.scene_file)
-        text = controller_scene_text(scene, c, Path(c.scene_file).stem).encode()
+    d = schema.load(artifact)
+    for c in d.controllers:
+        path = refuse_link(folder / c.scene_file)
+        text = controller_scene_text(scene, c, Path(c.scene_file).stem, d.violations).encode()
 
         def fill(fd, _tmp, text=text):
             with os.fdopen(fd, "wb") as fh:
                 fh.write(text)
         atomic_replace(path, fill, mode=0o644, suffix=".yaml.tmp", name=path.stem)
         paths.append(path)
+    mine = re.compile(re.escape(scene.name) + r"_controller_\d+\.yaml")
+    keep = {p.name for p in paths}
+    for old in folder.iterdir():
+        if mine.fullmatch(old.name) and old.name not in keep and not old.is_dir():
+            old.unlink(missing_ok=True)  # one file, removed whole (unlink is atomic)
     return paths
 
 

@@ -11,6 +11,7 @@ multiplier is zero by construction because ``P`` lands on the guard surface.
 from __future__ import annotations
 
 import math
+import re
 import threading
 import time
 from collections.abc import Iterator
@@ -21,18 +22,21 @@ import numpy as np
 
 from walkerlab import numerics
 from walkerlab.analysis.gait.metrics import step_length
+from walkerlab.analysis.gait.zero_dynamics import gaits_on_zero_dynamics, no_orbit_reason
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
+from walkerlab.integrate.time_limit import IntegrationDeadline, integration_deadline
 from walkerlab.models.hybrid.base import HybridWalker, OffSection
 from walkerlab.numerics import sort_multipliers
 
 #: longest CPU time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
 #: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes
-#: need a small part of it; a spring or damper at its cap (1e6) makes the integrator crawl
-#: (stiff), and the search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it
-#: busy, silent, for many minutes before it says "no gait found"
+#: need a small part of it; a spring or damper at its cap (1e6), or a virtual-constraint
+#: controller started far from its designed step, makes the integrator crawl (stiff), and the
+#: search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it busy, silent, for
+#: many minutes before it says "no gait found"
 ROOT_BUDGET_S = 60.0
 #: the budget's clock: this thread's CPU time, so that a loaded machine (other processes on
 #: the same cores) does not make a search give up that would finish on a quiet one
@@ -65,14 +69,19 @@ _BUDGET = _Budget()
 
 class SearchGaveUp(Exception):
     """A search for a gait spent its CPU-time budget (:func:`search_budget`); raised
-    before a step map would start.  The message says after how many maps and how slow."""
+    before a step map would start, or from the step map under way (its integration checks
+    the clock).  The message says after how many maps, how slow, and why a map of this
+    walker can crawl (:func:`slow_step_reason`)."""
 
 
 @contextmanager
 def search_budget(seconds: float | None = None) -> Iterator[None]:
     """Bound every step map started inside to ``seconds`` of this thread's CPU time from now
     (default :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline): past it,
-    :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map.  A map
+    :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map, and stops
+    the map under way (:func:`walkerlab.integrate.time_limit.integration_deadline`: its
+    right-hand side looks at the clock every 64 evaluations; the compiled CyRK flow at each
+    phase's start), so that a search ends within its budget and a few evaluations.  A map
     slower than :data:`SLOW_MAP_S` is said once in a notice
     (:func:`walkerlab.progress.note`)."""
     outer = _BUDGET.deadline
@@ -86,27 +95,58 @@ def search_budget(seconds: float | None = None) -> Iterator[None]:
         _BUDGET.deadline = outer
 
 
-def _map_started() -> float:
+def slow_step_reason(walker: HybridWalker) -> str:
+    """Why a step map of ``walker`` can crawl, said in the gait search's notices: its
+    virtual-constraint controller, its springs or dampers (``walker.springs`` and the knee's,
+    generated parameters ``k_s<i>``, ``c_s<i>``, ``k_knee``, ``c_knee``; torque laws of
+    ``walker.actuation.torques`` with a stiffness or damping), or, for a walker with
+    neither, its rates alone."""
+    acts = getattr(walker, "actuators", None)
+    if getattr(acts, "controller", None) is not None:
+        return ("the virtual-constraint controller drives a start far from its designed "
+                "step to rates the integrator crawls through")
+    params = getattr(walker, "params", None) or {}
+    sprung = [k for k, v in params.items() if v and re.fullmatch(r"[kc]_(s\d+|knee)", k)]
+    laws = [getattr(t, "law", None) for t in
+            getattr(getattr(acts, "spec", None), "torques", None) or ()]
+    if any(getattr(law, "stiffness_n_m_per_rad", 0.0) or getattr(law, "damping_n_m_s_per_rad",
+                                                                 0.0) for law in laws):
+        sprung.append("walker.actuation.torques")
+    if sprung:
+        where = ("walker.actuation.torques" if sprung == ["walker.actuation.torques"]
+                 else "walker.springs or the knee's")
+        return (f"a very stiff or heavily damped spring ({where}) makes the integrator "
+                "crawl: soften it")
+    return "the step's rates grow so large that the integrator crawls"
+
+
+def _gave_up(walker: HybridWalker | None, where: str = "") -> SearchGaveUp:
+    """The :class:`SearchGaveUp` of a search whose budget is spent (``where``: how the map
+    under way was stopped, if one was)."""
+    where = where or f"the slowest map {_BUDGET.slowest:.1f} s"
+    return SearchGaveUp(
+        f"the search gave up after {_BUDGET.maps} step map(s), its "
+        f"{_BUDGET.deadline - _BUDGET.started:.0f} s CPU budget spent ({where}): "
+        f"{slow_step_reason(walker)}; start nearer the gait")
+
+
+def _map_started(walker: HybridWalker | None = None) -> float:
     t = _clock()
     if t > _BUDGET.deadline:
-        raise SearchGaveUp(
-            f"the search gave up after {_BUDGET.maps} step map(s) in "
-            f"{t - _BUDGET.started:.0f} s of CPU (its time budget; the slowest map took "
-            f"{_BUDGET.slowest:.1f} s - a very stiff or heavily damped spring makes the "
-            "integrator crawl: soften it, or start nearer the gait)")
+        raise _gave_up(walker)
     _BUDGET.maps += 1
     return t
 
 
-def _map_ended(t: float) -> None:
+def _map_ended(walker: HybridWalker, t: float) -> None:
     dt = _clock() - t
     if dt > SLOW_MAP_S and _BUDGET.slowest <= SLOW_MAP_S and math.isfinite(_BUDGET.deadline):
         from walkerlab import progress
 
-        progress.note(f"gait search: one step map took {dt:.0f} s (a very stiff or heavily "
-                      "damped spring makes every step slow); the search gives up once it "
-                      f"has spent {_BUDGET.deadline - _BUDGET.started:.0f} s of CPU time "
-                      "(checked between step maps: on a busy machine the wall time is longer)")
+        progress.note(f"gait search: one step map took {dt:.0f} s ({slow_step_reason(walker)});"
+                      f" the search gives up once it has spent "
+                      f"{_BUDGET.deadline - _BUDGET.started:.0f} s of CPU time (a step under "
+                      "way included: on a busy machine the wall time is longer)")
     _BUDGET.slowest = max(_BUDGET.slowest, dt)
 
 
@@ -190,13 +230,25 @@ def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
     StepFailed
         A step ended in a fall, a solver failure or ran past ``max_step_time``.
     SearchGaveUp
-        Inside a :func:`search_budget` whose time is spent (no map is started).
+        Inside a :func:`search_budget` whose time is spent: no map is started, and a map
+        under way is stopped (its integration checks the clock).
     """
-    t = _map_started()
-    try:
-        return _step_map(walker, x, solver, max_step_time, jacobian, steps)
-    finally:
-        _map_ended(t)
+    t = _map_started(walker)
+    try:  # a step under way is stopped at the budget's end too (nothing checked outside one)
+        with integration_deadline(_BUDGET.deadline):
+            out = _step_map(walker, x, solver, max_step_time, jacobian, steps)
+    except IntegrationDeadline as exc:
+        where = f"the last one stopped after {_clock() - t:.1f} s"
+        if exc.x is not None:
+            n = np.size(x) // 2
+            where += (f" at t = {exc.t:.3g} s, rates "
+                      f"{float(np.max(np.abs(np.asarray(exc.x)[n:2 * n]))):.2g} rad/s")
+        raise _gave_up(walker, where) from None
+    except BaseException:
+        _map_ended(walker, t)
+        raise
+    _map_ended(walker, t)
+    return out
 
 
 def _step_map(walker, x, solver, max_step_time, jacobian, steps):
@@ -211,7 +263,8 @@ def _step_map(walker, x, solver, max_step_time, jacobian, steps):
             steps.append(seg)
         nfev += seg.nfev
         if seg.termination != "heel_strike":
-            raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+            raise StepFailed(seg.termination, seg.t_end, seg.x_end,  # the guard, if one
+                             f"({seg.event})" if seg.event else seg.message)
         x, period = seg.x_next, seg.t_end
         if jacobian:
             DP = seg.monodromy @ DP
@@ -343,7 +396,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     budget_s : float, optional
         Longest CPU time of the search in this thread [s] (default :data:`ROOT_BUDGET_S`;
         an enclosing :func:`search_budget` keeps its earlier deadline), checked before each
-        step map: once spent, the search gives up and says why.
+        step map and inside it: once spent, the search gives up and says why.
 
     Returns
     -------
@@ -353,13 +406,21 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     ------
     FixedPointNotFound
         The root finder did not converge, the map failed (fall) near the guess, or the
-        budget was spent (the message says after how many maps and how long each took).
+        budget was spent (the message says after how many maps and how long each took);
+        at once, a walker under invariant virtual constraints whose zero dynamics has no
+        periodic orbit (:func:`~walkerlab.analysis.gait.zero_dynamics.no_orbit_reason`) or
+        whose closed loop does not step from the guess (its gaits are orbits of its zero
+        dynamics: :func:`~walkerlab.analysis.gait.zero_dynamics.gaits_on_zero_dynamics`).
     MultipliersDisagree
         With ``fd_check``: the variational and the central-difference multipliers disagree
         beyond :func:`multiplier_check_tolerance` (a wrong Jacobian: no verdict).
     """
     root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
 
+    no_orbit = no_orbit_reason(walker)  # invariant virtual constraints: none to find
+    if no_orbit:
+        raise FixedPointNotFound(no_orbit, math.nan)
+    on_orbit = gaits_on_zero_dynamics(walker)
     t0 = time.perf_counter()
     known = [walker.section(np.asarray(xk, float)) for xk in deflate]
     if known and jacobian_guess is not None:
@@ -368,6 +429,9 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     z0 = walker.section(np.asarray(guess, float))
     try:
         with search_budget(budget_s):
+            if on_orbit and F.fails_at(z0):  # its gait is an orbit of the zero dynamics:
+                raise FixedPointNotFound(  # a start that does not step is not near it
+                    f"the closed loop does not step from the start: {F.failure}", math.nan)
             if jacobian_guess is None:
                 sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
             else:
@@ -424,6 +488,7 @@ class _ReducedMap:
         self.known = known
         self.counter = {"nfev": 0, "calls": 0, "jacobians": 0}
         self.start: dict = {}  # the Jacobian start (z0 bytes -> section Jacobian)
+        self.failure = ""  # how the last failed map failed
         self._last: dict = {}  # the last iterate's residual (z bytes -> F(z))
         self._variational: dict = {}  # the last variational map asked as a Jacobian
 
@@ -437,8 +502,9 @@ class _ReducedMap:
         try:
             x = walker.from_section(z)
             xn, _, nf = poincare_map(walker, x, self.solver, self.max_step_time)
-        except (StepFailed, OffSection):
+        except (StepFailed, OffSection) as exc:
             r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
+            self.failure = str(exc)
         else:
             self.counter["nfev"] += nf
             r = walker.section(xn) - z
@@ -447,6 +513,13 @@ class _ReducedMap:
         self._last.clear()
         self._last[key] = r
         return r.copy()
+
+    def fails_at(self, z: np.ndarray) -> bool:
+        """Whether the map fails at ``z`` (:attr:`failure` says how; the residual is kept
+        for the root finder's first evaluation)."""
+        self.failure = ""
+        self.residual(z)
+        return bool(self.failure)
 
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         """``F_z`` (2n-1, 2n-1): the start at ``z0``, else from the variational equations."""

@@ -55,6 +55,7 @@ from walkerlab.analysis.gait.starts import (
     screen_seeds,
     walked_start,
 )
+from walkerlab.analysis.gait.zero_dynamics import gaits_on_zero_dynamics, no_orbit_reason
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 
@@ -248,7 +249,19 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
         else:
             s.notes.append(f"the initial guess did not converge ({_short(s.last_msg)})")
     if not s.found and (seeds or guess is None):
-        s.from_seeds()
+        no_orbit = no_orbit_reason(walker)
+        if no_orbit:  # the seeds are a passive walker's: none can find what is not there
+            raise GaitNotFound(f"no period-1 gait found: {no_orbit}", math.nan)
+        if gaits_on_zero_dynamics(walker):  # its gaits are the zero dynamics' orbit
+            s.from_orbit(guess)
+            if not s.found:
+                raise GaitNotFound(
+                    "no period-1 gait found: walker.actuation.virtual_constraints: no gait "
+                    "at its zero dynamics' orbit, where with invariant: true every gait lies"
+                    f" ({_short(s.last_msg)}); change the outputs' Bezier coefficients",
+                    s.best)
+        else:
+            s.from_seeds()
     if not s.found:
         raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
                            s.best)
@@ -318,6 +331,23 @@ class _RootStarts:
         if not _is_new(res, self.found):
             return None
         return Gait("period_1", res, source, np.asarray(x0, float))
+
+    def from_orbit(self, guess) -> None:
+        """Root from the zero dynamics' periodic orbit (a walker whose gaits lie on it:
+        :func:`~walkerlab.analysis.gait.zero_dynamics.gaits_on_zero_dynamics`), unless that
+        was the ``guess`` already tried."""
+        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+
+        zd = zero_dynamics(self.walker.actuators.controller)
+        if not zd.exists:  # an unstable orbit (delta^2 > 1): no start on it here
+            self.last_msg = self.last_msg or "no stable orbit of the zero dynamics to start on"
+            return
+        if guess is not None and np.array_equal(np.asarray(guess, float), zd.x_plus):
+            return
+        self.tried.append("the zero dynamics' orbit")
+        g = self.attempt(zd.x_plus, "zero_dynamics")
+        if g is not None:
+            self.found.append(g)
 
     def from_seeds(self) -> None:
         """Root from the best-ranked scale-free seeds; none converging, from where the seeds

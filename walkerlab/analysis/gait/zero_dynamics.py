@@ -30,16 +30,20 @@ points reach round-off) and a Gauss-Legendre rule for the period.
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from walkerlab.models.hybrid.virtual_constraints import annihilator, bezier
 
-__all__ = ["ZeroDynamics", "compare_full_order", "impact_multiplier", "zero_dynamics"]
+__all__ = ["ZeroDynamics", "compare_full_order", "gaits_on_zero_dynamics", "impact_multiplier",
+           "no_orbit_reason", "zero_dynamics"]
 
 #: Chebyshev points of the integrands along the step
 NODES = 64
+#: :func:`no_orbit_reason` of each controller (weakly held: gone with its walker)
+_NO_ORBIT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 @dataclass
@@ -243,12 +247,11 @@ def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:
     result : walkerlab.analysis.gait.poincare.FixedPointResult
     solver : walkerlab.integrate.solver.Solver
     """
-    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.integrate.rigid import integrate_step
 
-    n = ctrl.n
-    steps: list = []
-    poincare_map(walker, result.x, solver, steps=steps)
-    x_minus = np.asarray(steps[0].x_end, float)
+    n = ctrl.n  # the map's first step (walkerlab.analysis.gait.poincare.poincare_map's)
+    x_minus = np.asarray(integrate_step(walker.for_step(0), result.x, solver,
+                                        stance_leg=walker.legs[1]).x_end, float)
 
     def rate(x):
         _h0, _J, _dd, _th, gth, _ = ctrl.pieces(np.asarray(x, float))
@@ -263,3 +266,55 @@ def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:
         "other_multiplier": float(np.max(np.abs(others))) if others.size else 0.0,
         "output_plus": float(np.max(np.abs(y))), "output_rate_plus": float(np.max(np.abs(dy)))}
     return zd.full_order
+
+
+def gaits_on_zero_dynamics(walker) -> bool:
+    """Whether ``walker`` (a :class:`~walkerlab.models.hybrid.base.HybridWalker`) is under
+    virtual constraints whose gaits are orbits of their hybrid zero dynamics: outputs made
+    invariant by the heel strike (``invariant: true``) and driven to zero by unsaturated
+    computed torque (no ``max_torque_n_m``; Westervelt, Grizzle & Koditschek 2003, IEEE
+    TAC 48(1):42-56, Sec. V, Theorems 3-4).  Its gait search then starts on that orbit
+    only (:func:`walkerlab.analysis.gait.search.find_gaits`)."""
+    ctrl = getattr(getattr(walker, "actuators", None), "controller", None)
+    return ctrl is not None and bool(ctrl.spec.invariant) and ctrl.limit is None
+
+
+def no_orbit_reason(walker) -> str:
+    """Why a walker under invariant virtual constraints has no gait, or ``""``.
+
+    Under outputs made invariant by the heel strike (``invariant: true``) and driven to
+    zero by unsaturated computed torque, a period-1 gait of the closed loop is a periodic
+    orbit of its hybrid zero dynamics (Westervelt, Grizzle & Koditschek 2003, IEEE TAC
+    48(1):42-56, Sec. V, Theorems 3-4).  That orbit's pre-impact ``zeta* = -V(theta-) /
+    (1 - delta^2)`` must carry the step over the top of the potential, ``delta^2 zeta* >
+    V_max`` (:func:`zero_dynamics`; for ``delta^2 < 1`` the existence margin ``delta^2 /
+    (1 - delta^2) V(theta-) + V_max < 0``).  When it cannot, the message (one clause naming
+    the key) says so, and neither the root finder
+    (``walkerlab.analysis.gait.poincare.find_fixed_point``) nor the scale-free seeds (a
+    passive walker's) are started: they would spend the search's budget on starts the
+    controller drives to huge rates.  ``walker``: a
+    :class:`~walkerlab.models.hybrid.base.HybridWalker`; ``""`` for any other walker, a
+    saturating controller (``max_torque_n_m``: the outputs may leave the surface) and
+    non-invariant outputs (:func:`gaits_on_zero_dynamics`).
+    """
+    if not gaits_on_zero_dynamics(walker):
+        return ""
+    ctrl = walker.actuators.controller
+    if ctrl in _NO_ORBIT:  # one controller, one answer: asked by every root-finder start
+        return _NO_ORBIT[ctrl]
+    _NO_ORBIT[ctrl] = _no_orbit(zero_dynamics(ctrl))
+    return _NO_ORBIT[ctrl]
+
+
+def _no_orbit(zd: ZeroDynamics) -> str:
+    """:func:`no_orbit_reason` of the zero dynamics ``zd``."""
+    d2 = zd.delta2
+    if not np.isfinite(d2) or d2 == 1.0:
+        return ""
+    if d2 * (-zd.v_minus / (1.0 - d2)) > zd.v_max:  # an orbit (unstable when delta^2 > 1)
+        return ""
+    why = (f"existence margin {zd.existence_margin:.4g} > 0: the step stalls before its "
+           "heel strike" if d2 < 1 else f"V(theta-) {zd.v_minus:.4g}")
+    return ("walker.actuation.virtual_constraints: its zero dynamics has no periodic orbit "
+            f"(delta^2 {d2:.4g}, {why}), and with invariant: true every gait lies on it; "
+            "change the outputs' Bezier coefficients")

@@ -186,7 +186,8 @@ class OptimizeData:
 @dataclass
 class ControllerData:
     """One designed controller (``controllers/<i>/``, ``optimize.design:
-    virtual_constraints``; units in the module docstring)."""
+    virtual_constraints``; units in the module docstring; ``note``, attribute ``note``:
+    why its closed loop has no fixed point, or why its coefficients make no controller)."""
 
     target_speed_m_per_s: float
     bezier_rad: np.ndarray
@@ -219,6 +220,8 @@ class ControllerData:
     contact_speed_m_per_s: float = float("nan")
     contact_heel_strikes: float = float("nan")
     contact_steady: float = float("nan")
+    full_order_step_length_m: float = float("nan")
+    note: str = ""
 
 
 #: controllers/<i>/ datasets: (field, unit, description)
@@ -257,6 +260,9 @@ CONTROLLER_VALUES = (
     ("contact_heel_strikes", "-", "heel strikes of the contact replay"),
     ("contact_steady", "-", "1: the contact replay walks and its steps settle; 0: it does "
      "not (a fall, a trip or steps that drift); NaN: not replayed"),
+    ("full_order_step_length_m", "m", "the rigid closed loop's fixed point's step length "
+     "(NaN: none; with its period, the speed the controller walks, against the collocated "
+     "step's target)"),
 )
 
 
@@ -391,8 +397,8 @@ def _write_controller(f, i: int, c) -> None:
 
     g = f"controllers/{i}"
     put(f, f"{g}/bezier", np.asarray(c.bezier_rad, float), "rad", "the optimised Bezier "
-        "coefficients (one row per output, attribute output_names; c_0, c_1 recomputed by "
-        "invariant: true in the written scene)")
+        "coefficients in force (one row per output, attribute output_names; with "
+        "invariant: true c_0, c_1 are the impact map's, as the written scene's)")
     for key, unit, desc in CONTROLLER_VALUES:
         put(f, f"{g}/{key}", float(getattr(c, key)), unit, desc)
     mu = np.asarray(c.multipliers, complex)
@@ -408,6 +414,8 @@ def _write_controller(f, i: int, c) -> None:
     a["ipopt_status"] = str(c.status)
     a["ipopt_iterations"] = int(c.iterations)
     a["scene_file"] = str(c.scene_file)
+    if getattr(c, "note", ""):
+        a["note"] = str(c.note)
 
 
 def _load_controllers(f) -> tuple:
@@ -425,7 +433,8 @@ def _load_controllers(f) -> tuple:
             multipliers=g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
             delta2_multiplier=complex(near[0], near[1]), status=str(g.attrs["ipopt_status"]),
             iterations=int(g.attrs["ipopt_iterations"]),
-            scene_file=str(g.attrs["scene_file"]), **vals))
+            scene_file=str(g.attrs["scene_file"]), note=str(g.attrs.get("note", "")),
+            **vals))
     return tuple(out)
 
 

@@ -230,8 +230,10 @@ def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
         phases = [Phase(ph.name, ph.flow, ph.guards, jacobian=ph.jacobian,
                         variational=ph.variational, compiled=ph.compiled)
                   for ph in fast.phases]
+    # virtual constraints: a step ends as a fall once its phase leaves the polynomials'
+    extra = acts.phase_guards() if hasattr(acts, "phase_guards") else ()
     for ph in walker.phases if sprung is None else ():
-        phases.append(Phase(ph.name, flow_of(ph.flow, ph.constraint), ph.guards,
+        phases.append(Phase(ph.name, flow_of(ph.flow, ph.constraint), ph.guards + extra,
                             jacobian=jac_of(ph.jacobian or base_jac, ph.constraint),
                             variational=None if has_torque else ph.variational,
                             compiled=(_compiled_laws(ph, data, acts, limit) if has_torque

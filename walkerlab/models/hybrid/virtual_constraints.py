@@ -19,7 +19,11 @@ from walkerlab.models.virtual_constraints import (
     default_joints,
 )
 
-__all__ = ["MAX_CONDITION", "Design", "VirtualConstraintActuators",
+#: the normalised phase's range of a step (:meth:`VirtualConstraintActuators.phase_guards`):
+#: a quarter of a step beyond either end of the Bezier polynomials' [0, 1]
+S_MIN, S_MAX = -0.25, 1.25
+
+__all__ = ["MAX_CONDITION", "S_MAX", "S_MIN", "Design", "VirtualConstraintActuators",
            "VirtualConstraintController", "annihilator", "bezier", "default_joints"]
 
 
@@ -47,6 +51,25 @@ class VirtualConstraintActuators(Actuators):
         self.B = self.controller.B
         self.hip_only = False
         self.vc_spec = spec
+
+    def phase_guards(self) -> tuple:
+        """Fall guards (:class:`~walkerlab.models.hybrid.base.Guard`) on the normalised
+        phase ``s = (theta - theta+) / (theta- - theta+)`` (0 at the step's start, 1 at its
+        heel strike): a step whose phase leaves ``[S_MIN, S_MAX]`` without a heel strike has
+        run off the Bezier polynomials' interval (stalled and rolled back, or passed the
+        end with the swing foot off the ground), where the computed torque, extrapolating
+        them, drives the walker to rates the integrator crawls through; it ends there as a
+        fall instead (Westervelt et al. 2003 define the controller on one step's phase)."""
+        from walkerlab.models.hybrid.base import Guard
+
+        d = self.controller.design
+        th_p, dth = d.theta_plus, d.theta_minus - d.theta_plus
+        pieces = self.controller.pieces
+
+        def s(x):
+            return (pieces(x)[3] - th_p) / dth
+        return (Guard("phase_past_step_end", lambda t, x: s(x) - S_MAX, +1, "fall"),
+                Guard("phase_before_step_start", lambda t, x: S_MIN - s(x), +1, "fall"))
 
     def torques(self, t, x) -> np.ndarray:
         """The computed torques (k,) [N m] at the state ``x`` (2n,)."""

@@ -60,6 +60,19 @@ def solve(opti):
 #: the transcription's constraint groups, named by what their line of code constrains (the
 #: first key found in the line of ``opti.subject_to`` that set the constraint names it)
 CONSTRAINT_GROUPS = (
+    # the virtual constraints' design (walkerlab.optimal.transcription.virtual_constraints)
+    ("d2 <=", "delta^2 <= optimize.max_multiplier"),
+    ("mu * grf", "the friction cone (optimize.friction_coefficient)"),
+    ("grf[0, :] >= 0", "the stance foot's normal force >= 0"),
+    ("bounded(-lim", "the torque limit (optimize.max_torque_n_m)"),
+    ("Y[2 * k:", "the output dynamics y'' + kd y' + kp y = 0"),
+    ("Y[:2 * k, 0]", "the outputs on their surface after the heel strike"),
+    ("rates * T", "the phase variable advancing"),
+    ("fns.chart(Qm)", "the controller's end of step (h0 = c_M)"),
+    ("fns.feet(ca.vertcat(Qm", "the controller's end of step on the ground"),
+    ("feet[2, -1] >= 1e-3", "the swing foot ahead at heel strike"),
+    ("feet[0, -1] == 0", "the step ends on the heel-strike guard"),
+    ("feet[1, -1] <= 0", "the swing foot moving down at heel strike"),
     ("clearance", "the swing foot's clearance (optimize.min_clearance_m)"),
     ("guard_rate", "the touchdown rate (optimize.touchdown_rate_rad_per_s)"),
     ("guard(X[:, -1]", "the event (heel or knee strike) at the phase's end"),

@@ -341,6 +341,9 @@ class HzdDesign:
     iterations : int
     wall_time_s, cpu_time_s, build_time_s : float
     history : dict
+    violations : str
+        When IPOPT did not converge: the constraint groups it left violated at its last
+        iterate (:func:`walkerlab.optimal.transcription.ipopt.largest_violations`).
     """
 
     t: np.ndarray
@@ -363,12 +366,14 @@ class HzdDesign:
     cpu_time_s: float
     build_time_s: float = 0.0
     history: dict = field(default_factory=dict)
+    violations: str = ""
 
 
 def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, guess_u,
                                   guess_alpha, max_multiplier: float | None,
                                   gains: tuple[float, float], print_level: int = 0,
-                                  mid_stance_window_m: float | None = None) -> HzdDesign:
+                                  mid_stance_window_m: float | None = None,
+                                  cpu_budget_s: float | None = None) -> HzdDesign:
     """Optimise one step and its virtual constraints (module docstring).
 
     Parameters
@@ -394,6 +399,8 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
         Straight legs (the heel-strike guard is not the swing foot's height): the half-width
         ``W`` [m] of the mid-stance pass exempted from ``spec.min_clearance_m``
         (:func:`clearance_bound`; :func:`mid_stance_window`); None: no clearance bound.
+    cpu_budget_s : float, optional
+        IPOPT's ``max_cpu_time`` [s] (it then ends with ``Maximum_CpuTime_Exceeded``).
 
     Returns
     -------
@@ -401,7 +408,11 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
     """
     import casadi as ca
 
-    from walkerlab.optimal.transcription.ipopt import iteration_history, solve
+    from walkerlab.optimal.transcription.ipopt import (
+        iteration_history,
+        largest_violations,
+        solve,
+    )
 
     t_build = time.perf_counter()
     n, k = fns.n, fns.k
@@ -487,7 +498,8 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
     opti.set_initial(A, guess_alpha)
     opti.solver("ipopt", {"expand": True, "print_time": False},
                 {"print_level": print_level, "tol": 1e-10, "constr_viol_tol": 1e-11,
-                 "max_iter": 1000, "sb": "yes"})
+                 "max_iter": 1000, "sb": "yes",
+                 **({} if cpu_budget_s is None else {"max_cpu_time": float(cpu_budget_s)})})
     build = time.perf_counter() - t_build
     status, get, wall, cpu = solve(opti)
     Tv = float(get(T))
@@ -502,4 +514,5 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
         max_output=float(np.max(np.abs(Yv[:k]))),
         max_output_rate=float(np.max(np.abs(Yv[k:]))), status=status,
         iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall, cpu_time_s=cpu,
-        build_time_s=build, history=iteration_history(opti.stats()))
+        build_time_s=build, history=iteration_history(opti.stats()),
+        violations="" if status == "Solve_Succeeded" else largest_violations(opti))
