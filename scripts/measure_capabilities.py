@@ -160,8 +160,12 @@ def main(argv=None) -> int:
 
 
 def _write(path: Path, data: dict) -> None:
-    """``data`` to ``path``: cells sorted, a temporary name, then renamed."""
-    data["cells"] = dict(sorted(data["cells"].items()))
+    """``data`` to ``path``: the cells the table supports, sorted; a temporary name, then
+    renamed."""
+    from walkerlab.walker.kinds import table_rows
+
+    keep = {f"{r['kind']}/{r['feature']}/{r['view']}" for r in table_rows() if r["supported"]}
+    data["cells"] = {k: v for k, v in sorted(data["cells"].items()) if k in keep}
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n")
     os.replace(tmp, path)

@@ -96,3 +96,33 @@ def test_each_cells_stored_measurement_is_what_the_code_gives(kind, feature, vie
     if e["ok"]:
         assert math.isclose(m.value, e["value"], rel_tol=0.0,
                             abs_tol=REPRODUCE * e["tolerance"]), (m.value, e["value"])
+
+
+@pytest.mark.parametrize("terrain", [
+    {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.4, "direction": "down"},
+    {"kind": "stairs", "riser_m": 0.05, "tread_m": 0.4, "direction": "down"},
+    {"kind": "footholds", "foothold_heights_m": [-0.002, 0.002], "periodic": True}])
+def test_optimize_refuses_a_ground_it_does_not_transcribe_naming_terrain_kind(terrain,
+                                                                             tmp_path):
+    """Before: the paper walker's least-effort step on 1 cm and 5 cm risers was the level
+    ground's to every digit (the transcription and its replay ignored the ground), and
+    compass_optimal on +-2 mm footholds printed the slope's passive gait as a gait; the
+    table said ✓.  Now the cell is refused, in one line naming terrain.kind, before any
+    transcription."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.config.loader import shipped_scene_path
+
+    d = yaml.safe_load(shipped_scene_path("compass_optimal").read_text())
+    d["name"] = "ground"
+    d["terrain"] = terrain
+    if terrain["kind"] == "stairs":
+        d["slope"] = {"angle_rad": 0.0}
+    path = tmp_path / "ground.yaml"
+    path.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["optimize", str(path), "--runs-dir", str(tmp_path / "runs")])
+    assert r.exit_code == 1
+    assert f"terrain.kind: {terrain['kind']}" in r.output and "slope alone" in r.output
+    assert not (tmp_path / "runs" / "ground" / "optimize.h5").exists()

@@ -177,6 +177,9 @@ def check_design(scene, kind) -> None:
                          "virtual constraints: give walker.actuation.virtual_constraints (its "
                          "outputs, phase and degree; their coefficients are the start)")
     kind.require("virtual_constraints", "optimize", KEY)
+    ground = "slope" if scene.terrain is None else scene.terrain.kind
+    if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
+        kind.require(ground, "optimize", f"terrain.kind: {ground}")
 
 
 def controller_scene(scene, bezier):

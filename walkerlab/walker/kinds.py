@@ -236,6 +236,19 @@ _FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after one heel str
                         "(it starts without the rigid gait's double support on the tread "
                         "above); contact-sim walks flat feet on footholds")
 
+#: why ``optimize`` refuses a ground other than the slope: its transcription and its rigid
+#: replay are built on the slope alone (measured: the paper walker's least-effort step gave
+#: 154.924 N^2 m^2 s and a 37.85 N m hip torque on level ground, on 1 cm and on 5 cm risers
+#: alike; configs/compass_optimal.yaml on +-2 mm footholds and on a steep profile returned
+#: the slope's passive gait to every digit)
+_OPTIMIZE_GROUND = ("the collocation and its replay are built on the slope alone (the "
+                    "landing on stairs, footholds or a profile is not transcribed yet: on "
+                    "1 cm and 5 cm risers it gave the level ground's optimum to every digit); "
+                    "optimise on the slope (terrain.kind: slope) and walk the result on this "
+                    "ground with fixedpoint, simulate or contact-sim")
+_OPTIMIZE_GROUNDS = {(g, "optimize"): _OPTIMIZE_GROUND
+                     for g in ("stairs", "footholds", "profile")}
+
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
 #: part) or says what the view's model does not carry.
@@ -250,6 +263,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_NO_ANKLES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
     },
     "locking_knees": {
         **_NO_ANKLES,
@@ -260,6 +274,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
     },
     "flat_feet": {
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "
@@ -273,6 +288,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
+        ("profile", "optimize"): _OPTIMIZE_GROUND,
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
         # steps that walker (its contact view asks the contact cells)
@@ -291,6 +307,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
                                    "has no push-off"),
         **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
         # the OpenSim stepping loop drives joint torques (its walks: the powered compass,
         # RABBIT's laws); a walker held up by them on footholds is walked in the rigid and
         # contact models, the MJCF and the gym, and written to Adams
@@ -308,6 +325,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "(optimize.design: virtual_constraints)"),
         ("virtual_constraints", "optimize"): None,  # optimize.design: virtual_constraints
         **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
