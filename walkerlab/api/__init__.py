@@ -27,7 +27,7 @@ their runs) and :mod:`~walkerlab.api.targets` (:func:`target`: the field value w
 meets a target speed, step length or period, in memory as ``walkerlab target``); this
 module only gathers their public names.
 
-Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``test`` extra has them).
+Needs xarray and h5netcdf (main dependencies: ``pip install -e .`` installs them).
 Importing this module loads neither them nor the numeric stack: each function imports what
 it uses.
 
