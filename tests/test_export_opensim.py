@@ -465,7 +465,7 @@ def test_an_opensim_walk_never_imports_opensim_beside_casadi(tmp_path, monkeypat
     """OpenSim's Moco links a CasADi of its own: with the ``optimize`` extra's CasADi
     loaded, ``import opensim`` fails ("libosimMoco.so: undefined symbol
     _ZN6casadi2MX6binaryEx..."; the reverse order breaks ``import casadi``), and walkerlab
-    advised ``pip install 'walkerlab[osim]'``, which does not help.  Now the walk runs in a
+    advised ``pip install -e '.[osim]'``, which does not help.  Now the walk runs in a
     process of its own, which never imports CasADi.  A stand-in ``opensim`` fails as Moco
     does beside CasADi and says where it was imported otherwise: the walk reaches the
     child process (its error comes back in one line) and this process never imports it."""

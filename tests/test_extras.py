@@ -81,7 +81,7 @@ def test_require_names_the_extra_in_one_line(monkeypatch):
         require("casadi", "optimize", "walkerlab optimize")
     msg = str(exc.value)
     assert msg == ("walkerlab optimize needs casadi (not installed): "
-                   "pip install 'walkerlab[optimize]'")
+                   "pip install -e '.[optimize]'")
     assert isinstance(exc.value, ValueError) and isinstance(exc.value, ImportError)
     assert require("json", "optimize", "x") is sys.modules["json"]
 
@@ -95,7 +95,7 @@ def test_walkerlab_optimize_without_casadi_says_so_before_any_stage_runs(monkeyp
                                  "--runs-dir", str(tmp_path)])
     assert r.exit_code == 1
     assert r.stderr.strip() == ("error: walkerlab optimize needs casadi (not installed): "
-                                "pip install 'walkerlab[optimize]'")
+                                "pip install -e '.[optimize]'")
     assert not any(tmp_path.rglob("*.h5"))  # refused before the fixed point ran
 
 
@@ -104,7 +104,7 @@ def test_a_scheduler_without_dask_says_which_extra(monkeypatch):
 
     monkeypatch.setitem(sys.modules, "distributed", None)
     with pytest.raises(MissingExtra, match=r"^--scheduler needs distributed \(not "
-                       r"installed\): pip install 'walkerlab\[dask\]'$"):
+                       r"installed\): pip install -e '\.\[dask\]'$"):
         make_executor(2, "tcp://127.0.0.1:8786")
 
 
@@ -112,7 +112,7 @@ def test_walking_an_exported_mjcf_without_mujoco_says_which_extra(monkeypatch, t
     from walkerlab.export.mujoco_walk import walk
 
     monkeypatch.setitem(sys.modules, "mujoco", None)
-    with pytest.raises(MissingExtra, match=r"pip install 'walkerlab\[engines\]'$"):
+    with pytest.raises(MissingExtra, match=r"pip install -e '\.\[engines\]'$"):
         walk(tmp_path / "walker.xml", 1.0)
 
 
@@ -128,7 +128,7 @@ def test_the_python_api_without_its_datasets_says_which_extra(monkeypatch, tmp_p
     with h5py.File(path, "w") as f:
         f.attrs["stage"] = "fixedpoint"
     with pytest.raises(MissingExtra, match=r"^walkerlab's Python API needs h5netcdf \(not "
-                       r"installed\): pip install 'walkerlab\[api\]'$"):
+                       r"installed\): pip install -e '\.\[api\]'$"):
         load_dataset(path)
 
 
@@ -168,7 +168,7 @@ def test_the_banner_and_the_description_say_passive_and_powered():
 def test_an_installed_module_that_fails_to_import_is_not_sent_to_pip(tmp_path, monkeypatch):
     """A module that is installed but whose import fails on something else (OpenSim's
     Moco beside another CasADi: an undefined symbol; a missing system library) was told
-    ``pip install 'walkerlab[osim]'``, which installs nothing new.  Now the line names the
+    ``pip install -e '.[osim]'``, which installs nothing new.  Now the line names the
     failure and no extra."""
     (tmp_path / "broken_extra_module.py").write_text(
         "raise ImportError('libosimMoco.so: undefined symbol: _ZN6casadi', name='libosimMoco')\n")

@@ -57,7 +57,7 @@ def require(module: str, extra: str, what: str) -> ModuleType:
     Raises
     ------
     MissingExtra
-        ``"<what> needs <module> (not installed): pip install 'walkerlab[<extra>]'"``; a
+        ``"<what> needs <module> (not installed): pip install -e '.[<extra>]'"``; a
         module that is installed but fails to import names that failure and no extra
         (installing it again would not help: OpenSim's Moco beside another CasADi, a
         missing system library).
@@ -79,7 +79,7 @@ def require(module: str, extra: str, what: str) -> ModuleType:
 
 
 def _missing(module: str, extra: str, what: str) -> str:
-    return f"{what} needs {module} (not installed): pip install 'walkerlab[{extra}]'"
+    return f"{what} needs {module} (not installed): pip install -e '.[{extra}]'"
 
 
 def require_installed(module: str, extra: str, what: str) -> None:
@@ -90,7 +90,7 @@ def require_installed(module: str, extra: str, what: str) -> None:
     Raises
     ------
     MissingExtra
-        ``"<what> needs <module> (not installed): pip install 'walkerlab[<extra>]'"``.
+        ``"<what> needs <module> (not installed): pip install -e '.[<extra>]'"``.
     KeyError
         ``extra`` is not one of :data:`EXTRAS` (a programming error).
     """

@@ -46,5 +46,5 @@ def test_numbalsoda_missing_or_unsupported_is_one_clear_error(monkeypatch):
         simulate_contact(w, x0, 0.01,
                          SolverSettings.for_contact(method="numbalsoda", max_step_s=1e-3))
     monkeypatch.setattr(numbalsoda_backend, "lsoda", None)
-    with pytest.raises(ValueError, match=r"pip install 'walkerlab\[numbalsoda\]'"):
+    with pytest.raises(ValueError, match=r"pip install -e '\.\[numbalsoda\]'"):
         simulate_contact(w, x0, 0.01, SolverSettings.for_contact(method="numbalsoda"))

@@ -54,7 +54,7 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     walkerlab.safefs.RunPathError
         ``runs_dir`` empty (it would be the current folder) or not a path.
     ImportError
-        xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
+        xarray/h5netcdf missing (``pip install -e '.[api]'``).
     """
     from walkerlab.stages import pipeline
 
@@ -267,7 +267,7 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
     walkerlab.stages.common.StageError
         A walker the collocation does not handle, or no gait on the way (one line).
     ImportError
-        CasADi missing (``pip install 'walkerlab[optimize]'``), or as :func:`fixed_point`.
+        CasADi missing (``pip install -e '.[optimize]'``), or as :func:`fixed_point`.
     """
     from walkerlab.config import SceneError
     from walkerlab.optimal.design.search import MEASURES

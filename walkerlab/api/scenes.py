@@ -151,7 +151,7 @@ def read_dataset(path: Path) -> xarray.Dataset:
     Raises
     ------
     ImportError
-        xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
+        xarray/h5netcdf missing (``pip install -e '.[api]'``).
     """
     from walkerlab.io.datasets import load_dataset
 

@@ -46,7 +46,7 @@ class SolverSettings(BaseModel):
         "DOP853", description="solver: a scipy solve_ivp method (RK45, RK23, DOP853, Radau, "
         "BDF, LSODA); contact_solver: cyrk_bdf (CyRK's BDF from compiled code; the default), "
         "odeint (scipy.integrate.odeint), numbalsoda (LSODA from compiled code; optional "
-        "extra 'walkerlab[numbalsoda]') or a solve_ivp method")
+        "extra: pip install -e '.[numbalsoda]') or a solve_ivp method")
     rtol: float = Field(1e-10, gt=0, lt=1,
                         description="relative tolerance [-] (contact_solver: at least 1e-13, "
                         "as LSODA/odeint cannot meet a tighter one in double precision; "

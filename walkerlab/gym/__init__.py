@@ -1,7 +1,7 @@
 """A scene's walker as a Gymnasium environment: :class:`~walkerlab.gym.env.WalkerEnv`,
 registered as ``walkerlab/Walker-v0`` (keyword ``scene``) when this package is imported.
 
-Needs gymnasium (``pip install 'walkerlab[gym]'``); nothing else in walkerlab imports this
+Needs gymnasium (``pip install -e '.[gym]'``); nothing else in walkerlab imports this
 package, so the library runs without it.
 
 Example

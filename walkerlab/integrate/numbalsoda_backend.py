@@ -1,7 +1,7 @@
 """numbalsoda route for the contact walker: LSODA called from compiled code.
 
 Internal module, imported only when ``method="numbalsoda"`` is selected (numbalsoda is an
-optional extra: ``pip install 'walkerlab[numbalsoda]'``; building it from source needs a C++
+optional extra: ``pip install -e '.[numbalsoda]'``; building it from source needs a C++
 and a Fortran compiler and cmake).  The walker's generated right-hand side
 (:mod:`walkerlab.models.contact.generated`) is wrapped in a numba ``cfunc`` so that LSODA
 (numbalsoda's C++ port) integrates a whole chunk of samples without re-entering Python.
@@ -82,7 +82,7 @@ def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: floa
     """
     if lsoda is None:
         raise MissingNumbalsoda("contact_solver.method 'numbalsoda' needs the numbalsoda package: "
-                          "pip install 'walkerlab[numbalsoda]' (builds with cmake, g++, gfortran)")
+                          "pip install -e '.[numbalsoda]' (builds with cmake, g++, gfortran)")
     if kernels.__name__ not in _FPTR:
         _FPTR[kernels.__name__] = kernels.build_lsoda(lsoda_sig)
     n0 = data[-1]

@@ -27,7 +27,7 @@ Stage-specific views
   path (``slope.angle_deg``), when every grid point has its row; else on ``point``.
 
 Raises ``ArtifactError`` (missing or not an artifact) and ``ImportError`` with the install
-hint when xarray/h5netcdf are missing (``pip install 'walkerlab[api]'``).
+hint when xarray/h5netcdf are missing (``pip install -e '.[api]'``).
 """
 
 from __future__ import annotations
@@ -233,7 +233,7 @@ def load_dataset(path: str | Path):
     ArtifactError
         Missing file, not a walkerlab artifact, or groups whose dimensions disagree.
     ImportError
-        xarray or h5netcdf not installed (``pip install 'walkerlab[api]'``).
+        xarray or h5netcdf not installed (``pip install -e '.[api]'``).
     """
     path = Path(path)
     stage = _stage(path)
