@@ -180,3 +180,12 @@ def test_an_installed_module_that_fails_to_import_is_not_sent_to_pip(tmp_path, m
                    "but failed to import (libosimMoco.so: undefined symbol: _ZN6casadi); "
                    "repair that installation")
     assert "pip install" not in msg
+
+
+def test_install_hints_are_spelled_one_way():
+    """Before: ``pip install 'walkerlab[optimize]'`` here, ``pip install -e '.[engines]'``
+    there; now every hint in the package, the docs and the README is the latter."""
+    files = [*(ROOT / "walkerlab").rglob("*.py"), *(ROOT / "docs").rglob("*.md"),
+             *(ROOT / "docs").rglob("*.rst"), ROOT / "README.md"]
+    bad = [str(f) for f in files if "'walkerlab[" in f.read_text(errors="ignore")]
+    assert not bad, bad
