@@ -557,3 +557,21 @@ def test_a_held_hip_torque_slows_the_flat_feet_step_alike_in_the_rigid_and_conta
         change[view] = first[1] - first[0]
     assert change["rigid"] > 0.005, change
     assert abs(change["contact"] / change["rigid"] - 1.0) < 0.1, change
+
+
+def test_gym_make_max_episode_steps_governs_the_episode_not_the_envs_own_1000():
+    """Before: ``gym.make(..., max_episode_steps=2500)`` still truncated at 1000 control
+    periods (the env's own limit under the TimeLimit wrapper)."""
+    import gymnasium as gym
+
+    import walkerlab.gym  # noqa: F401 - registers the id
+
+    env = gym.make("walkerlab/Walker-v0", scene=str(ROOT / "configs" / "paper.yaml"),
+                   max_episode_steps=2500)
+    assert env.unwrapped.max_episode_steps is None and env.spec.max_episode_steps == 2500
+    env.reset(seed=0)
+    env.unwrapped._elapsed = 1000  # past the env's old limit, short of the wrapper's
+    _, _, term, trunc, _ = env.step(np.zeros(env.action_space.shape, np.float32))
+    assert not trunc or term
+    assert gym.make("walkerlab/Walker-v0", scene=str(ROOT / "configs" / "paper.yaml")
+                    ).spec.max_episode_steps == 1000

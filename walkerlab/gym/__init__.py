@@ -17,7 +17,7 @@ from walkerlab.extras import require
 
 gymnasium = require("gymnasium", "gym", "walkerlab.gym")
 
-from walkerlab.gym.env import InvalidAction, WalkerEnv  # noqa: E402
+from walkerlab.gym.env import DEFAULT_EPISODE_STEPS, InvalidAction, WalkerEnv  # noqa: E402
 
 __all__ = ["ENV_ID", "InvalidAction", "WalkerEnv"]
 
@@ -25,5 +25,5 @@ __all__ = ["ENV_ID", "InvalidAction", "WalkerEnv"]
 ENV_ID = "walkerlab/Walker-v0"
 
 if ENV_ID not in gymnasium.registry:
-    gymnasium.register(id=ENV_ID, entry_point="walkerlab.gym.env:WalkerEnv",
-                       max_episode_steps=None)
+    gymnasium.register(id=ENV_ID, entry_point="walkerlab.gym.env:registered_env",
+                       max_episode_steps=DEFAULT_EPISODE_STEPS)

@@ -159,8 +159,9 @@ def _check_arguments(view, control_period_s, max_episode_steps, render_mode, sta
             and math.isfinite(control_period_s)):
         raise ValueError(f"control_period_s={control_period_s!r}: give a positive number "
                          "of seconds, at most 1")
-    if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, int) \
-            or max_episode_steps < 1:
+    if max_episode_steps is not None and (
+            isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, int)
+            or max_episode_steps < 1):
         raise ValueError(f"max_episode_steps={max_episode_steps!r}: give a whole number "
                          ">= 1")
     if render_mode not in (None, "rgb_array"):
@@ -175,6 +176,19 @@ def _check_arguments(view, control_period_s, max_episode_steps, render_mode, sta
                          f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
 
 
+#: the episode's length in control periods when none is given (``WalkerEnv``'s default; the
+#: registered id's ``gym.make`` limit)
+DEFAULT_EPISODE_STEPS = 1000
+
+
+def registered_env(**kwargs) -> WalkerEnv:
+    """The entry point of ``gym.make("walkerlab/Walker-v0", ...)``: a :class:`WalkerEnv`
+    without a limit of its own, so that ``gym.make``'s ``max_episode_steps`` (its
+    ``TimeLimit`` wrapper; the id's default :data:`DEFAULT_EPISODE_STEPS`) governs the
+    episode's length (before: the env's own 1000 truncated ``max_episode_steps=2500``)."""
+    return WalkerEnv(**{"max_episode_steps": None, **kwargs})
+
+
 class WalkerEnv(gym.Env):
     """A walkerlab scene's walker as a Gymnasium environment (module docstring: spaces,
     reward, episode, info).
@@ -187,9 +201,10 @@ class WalkerEnv(gym.Env):
         The rigid hybrid model (default) or the compliant-contact model.
     control_period_s : float
         Time the action is held [s] (0.01: 100 Hz).
-    max_episode_steps : int
-        Control periods before truncation (through ``gym.make(..., max_episode_steps=N)``
-        the TimeLimit wrapper truncates at N).
+    max_episode_steps : int or None
+        Control periods before the env truncates (default 1000); None: no limit of its
+        own (``gym.make(..., max_episode_steps=N)`` builds it so: its TimeLimit wrapper
+        truncates at N, by default 1000).
     max_torque_n_m : float or sequence of float, optional
         The action's bounds [N m] (default: the actuators' ``max_torque_n_m``, else
         :data:`walkerlab.gym.action.DEFAULT_TORQUE_FRACTION` ``M g l``).
@@ -235,7 +250,7 @@ class WalkerEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
     def __init__(self, scene, view: str = "rigid", control_period_s: float = 0.01,
-                 max_episode_steps: int = 1000, max_torque_n_m=None,
+                 max_episode_steps: int | None = 1000, max_torque_n_m=None,
                  forward_reward_weight: float = 1.0, healthy_reward: float = 1.0,
                  ctrl_cost_weight: float = 1e-3, work_cost_weight: float = 0.0,
                  reward_fn=None, start_noise: float = 0.0, terrain_roughness_m: float = 0.0,
@@ -298,7 +313,8 @@ class WalkerEnv(gym.Env):
             from .contact_view import ContactView
 
             links = action_torques(data, model.n_coordinates, self.joints).links
-            n_steps = int(math.ceil(max_episode_steps * self.dt / self.gait.step_period)) + 4
+            n_steps = int(math.ceil((max_episode_steps or DEFAULT_EPISODE_STEPS) * self.dt
+                                    / self.gait.step_period)) + 4
             if vc is not None:  # the controller at the contact walker's role state, held
                 self._contact_controller = setup.actuators  # by the action (the plant's
                 setup = dataclasses.replace(setup, actuators=None)  # run stays compiled)
@@ -501,7 +517,8 @@ class WalkerEnv(gym.Env):
         strikes = s.advance(u, self._elapsed * self.dt)
         info = self._info(strikes)
         terminated = bool(s.ended)
-        truncated = (not terminated) and self._elapsed >= self.max_episode_steps
+        truncated = (not terminated and self.max_episode_steps is not None
+                     and self._elapsed >= self.max_episode_steps)
         if self.reward_fn is not None:
             reward = float(self.reward_fn(self, info))
         else:
