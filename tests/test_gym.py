@@ -575,3 +575,42 @@ def test_gym_make_max_episode_steps_governs_the_episode_not_the_envs_own_1000():
     assert not trunc or term
     assert gym.make("walkerlab/Walker-v0", scene=str(ROOT / "configs" / "paper.yaml")
                     ).spec.max_episode_steps == 1000
+
+
+def test_the_env_and_the_walker_pickle_and_a_subprocess_vector_env_steps():
+    """Before: ``WalkerEnv`` and ``wl.Walker`` did not pickle (a compiled flow), so
+    ``AsyncVectorEnv`` could not take them; now each pickles as what it was built from."""
+    import pickle
+
+    import gymnasium as gym
+
+    from walkerlab.api.walker import Walker
+    from walkerlab.gym.env import WalkerEnv
+
+    paper = str(ROOT / "configs" / "paper.yaml")
+    w = pickle.loads(pickle.dumps(Walker.from_scene(paper)))
+    assert w.state_names() == Walker.from_scene(paper).state_names()
+    env = pickle.loads(pickle.dumps(WalkerEnv(paper, max_episode_steps=7)))
+    assert env.max_episode_steps == 7
+    obs, _ = env.reset(seed=1)
+    ref, _ = WalkerEnv(paper).reset(seed=1)
+    np.testing.assert_array_equal(obs, ref)
+    vec = gym.vector.AsyncVectorEnv([lambda: WalkerEnv(paper)] * 2)
+    try:
+        obs, _ = vec.reset(seed=0)
+        obs, *_ = vec.step(np.zeros((2, *env.action_space.shape), np.float32))
+        assert obs.shape[0] == 2 and np.all(np.isfinite(obs))
+    finally:
+        vec.close()
+
+
+@pytest.mark.parametrize("view", ["rigid", "contact"])
+def test_a_reset_state_given_as_text_is_refused_in_one_line(view):
+    from walkerlab.config import SceneError
+
+    env = _env("paper", view=view, max_episode_steps=5)
+    x = [str(v) for v in env.reset(seed=0)[1].get("state", env.gait.x)] \
+        if view == "rigid" else [str(v) for v in env.sim.x_start]
+    with pytest.raises(SceneError) as e:
+        env.reset(options={"state": x})
+    _one_line_error(e, "options['state']", "not text")

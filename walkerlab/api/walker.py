@@ -105,6 +105,12 @@ class Walker:
         an actuated walker, printed equations on stairs, ...).
     """
 
+    def __reduce__(self):
+        """Pickled as its scene and step time limit (the model is built again: a compiled
+        flow does not pickle; a process pool or a vector env's subprocess gets the same
+        walker)."""
+        return (type(self), (self.scene, self.step_time_limit_s))
+
     def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
         from walkerlab.integrate.solver import Solver
         from walkerlab.models.registry import build_walker

@@ -181,6 +181,11 @@ def _check_arguments(view, control_period_s, max_episode_steps, render_mode, sta
 DEFAULT_EPISODE_STEPS = 1000
 
 
+def _rebuild_env(cls, kwargs):
+    """Unpickle a :class:`WalkerEnv`: built again from its arguments."""
+    return cls(**kwargs)
+
+
 def registered_env(**kwargs) -> WalkerEnv:
     """The entry point of ``gym.make("walkerlab/Walker-v0", ...)``: a :class:`WalkerEnv`
     without a limit of its own, so that ``gym.make``'s ``max_episode_steps`` (its
@@ -249,6 +254,11 @@ class WalkerEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
+    def __reduce__(self):
+        """Pickled as the arguments it was built from (a vector env's subprocess rebuilds
+        it; its episode state is not carried: reset it after unpickling)."""
+        return (_rebuild_env, (type(self), self._init_args))
+
     def __init__(self, scene, view: str = "rigid", control_period_s: float = 0.01,
                  max_episode_steps: int | None = 1000, max_torque_n_m=None,
                  forward_reward_weight: float = 1.0, healthy_reward: float = 1.0,
@@ -256,6 +266,8 @@ class WalkerEnv(gym.Env):
                  reward_fn=None, start_noise: float = 0.0, terrain_roughness_m: float = 0.0,
                  normalize_action: bool = True, render_mode: str | None = None,
                  policy: str | None = None):
+        #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
+        self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
         from walkerlab.api.walker import Walker
         from walkerlab.walker.description import walker_data
 
@@ -438,6 +450,12 @@ class WalkerEnv(gym.Env):
         if self.view == "contact":
             self.sim.set_terrain(self.terrain_roughness_m, self.terrain_seed)
         start = self.gait.x if self.view == "rigid" else self.sim.x_start
+        if state is not None and any(isinstance(v, str | bytes) for v in
+                                     np.ravel(np.asarray(state, dtype=object))):
+            from walkerlab.config import SceneError
+
+            raise SceneError(f"options['state']: give {len(self.state_names)} numbers "
+                             f"({', '.join(self.state_names)}), not text")
         try:
             x0 = np.array(start if state is None else state, float)
         except (TypeError, ValueError):  # not numbers: the checks below say so
