@@ -149,7 +149,8 @@ def test_samples_artifact_and_figures_name_the_torso(walker, fixed_point, scene,
 
     fig = F.fig9_limit_cycle({"ideal": back})
     # one panel per link: both legs share "leg", the torso has its own
-    assert [ax.get_title() for ax in fig.axes if ax.get_visible()] == ["leg", "torso"]
+    assert [ax.get_title() for ax in fig.axes if ax.get_visible()] == ["legs: leg1 and leg2",
+                                                                        "torso"]
     assert len(fig.axes[0].get_lines()) == 2 and len(fig.axes[1].get_lines()) == 1
     stick = F.stick_diagram(back, "torso test", slope_rad=scene.slope.phi_rad)
     assert len(stick.axes[0].lines) >= 3 * 14  # two legs and the torso per snapshot

@@ -303,4 +303,4 @@ def test_a_walk_round_where_no_seed_lasts_its_steps_says_none_lasted(monkeypatch
     starts = search._RootStarts(None, None, {"max_step_time": 1.0})
     monkeypatch.setattr(starts, "attempt", lambda *a, **k: None)
     starts.from_seeds()
-    assert starts.tried[-1] == f"23 seeds set walking for {WALK_STEPS} steps (none lasted them)"
+    assert starts.tried[-1] == f"23 seeds walked to last {WALK_STEPS} steps (none lasted them)"

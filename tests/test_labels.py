@@ -339,13 +339,13 @@ def test_fig9_one_panel_per_link_both_legs_no_empty_panels():
     fig = F.fig9_limit_cycle({"ideal": _walker_trajectory(knee=True)})
     axes = [ax for ax in fig.axes if ax.get_visible()]
     assert len(axes) == len(fig.axes) == 2
-    assert [ax.get_title() for ax in axes] == ["thigh", "shank"]
+    assert [ax.get_title() for ax in axes] == ["thighs: leg1 and leg2", "shanks: leg1 and leg2"]
     for ax in axes:
         assert sorted(ln.get_label().split(" - ")[0] for ln in ax.get_lines()) == \
             ["leg1", "leg2"]
     F.plt.close(fig)
     fig = F.fig9_limit_cycle({"ideal": _walker_trajectory()})
-    assert [ax.get_title() for ax in fig.axes] == ["leg"]
+    assert [ax.get_title() for ax in fig.axes] == ["legs: leg1 and leg2"]
     F.plt.close(fig)
 
 

@@ -64,11 +64,11 @@ def export(scene: Path | None = SceneArg,
                "its step period against the rigid gait's"),
            mjcf_tau: float | None = typer.Option(
                None, "--mjcf-contact-time-constant-s", min=1e-6, max=1.0,
-               help="mjcf: the contact's solref time constant [s] (default: the scene's "
+               help="mjcf: the contact's solref time constant in s (default: the scene's "
                "contact law linearised at the walker's weight, shrunk 4x)"),
            mjcf_dt: float | None = typer.Option(
                None, "--mjcf-timestep-s", min=1e-7, max=0.01,
-               help="mjcf: MuJoCo's timestep [s] (default: a quarter of the contact's time "
+               help="mjcf: MuJoCo's timestep in s (default: a quarter of the contact's time "
                "constant, at most 1 ms)")) -> None:
     """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
     walker.xml, walker.adm + walker.acf (Adams Solver) or walker.osim (OpenSim).  The URDF,

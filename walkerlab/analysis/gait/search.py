@@ -382,9 +382,8 @@ class _RootStarts:
                 break
             if n_started == ROOT_STARTS:
                 break
-        lasted = ("none lasted them" if not n_started else
-                  f"{n_started} lasted them, a root-finder start from each")
-        self.tried.append(f"{n_walked} seeds set walking for {WALK_STEPS} steps ({lasted})")
+        lasted = "none lasted them" if not n_started else f"{n_started} did: root-finder starts"
+        self.tried.append(f"{n_walked} seeds walked to last {WALK_STEPS} steps ({lasted})")
 
     def other_gait(self) -> None:
         """The other gait of the pair by deflation from starts near the first one, at the
