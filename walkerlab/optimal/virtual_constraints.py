@@ -424,7 +424,8 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
                                  {**clearance_report(fns, res.x, window),
                                   "friction_ratio": _friction_ratio(fns, res.x, res.u)},
                                  left))
-            bar.advance(info=f"controller {i + 1} ({v:g} m/s): {res.status}")
+            speed = "no target speed" if v is None else f"{v:g} m/s"
+            bar.advance(info=f"controller {i + 1} ({speed}): {res.status}")
             if res.status == "Solve_Succeeded":  # the next speed starts here
                 t, x, u, alpha = res.t, res.x, res.u, res.alpha
     return out
