@@ -1,7 +1,9 @@
-"""The reference case of each cell of the capability table (:data:`walkerlab.walker.kinds.
-CAPABILITIES`): the kind's base walker - one shipped scene per kind - with that feature
-(a small torque law, a push-off, virtual constraints) and that ground (stairs, footholds,
-a profile), as a scene mapping.  The capability table's evidence
+"""The reference case of each cell of the capability table, as a scene mapping.
+
+Each cell of :data:`walkerlab.walker.kinds.CAPABILITIES` has one: a shipped scene that
+exercises the feature on the kind, else the kind's base walker - one shipped scene per
+kind - with that feature (a small torque law, a push-off, virtual constraints) and that
+ground (stairs, footholds, a profile).  The capability table's evidence
 (:mod:`walkerlab.walker.capability_evidence`) is measured on these cases
 (:mod:`walkerlab.api.capabilities`), and the table's truth tests try them.
 
