@@ -189,3 +189,19 @@ def test_install_hints_are_spelled_one_way():
              *(ROOT / "docs").rglob("*.rst"), ROOT / "README.md"]
     bad = [str(f) for f in files if "'walkerlab[" in f.read_text(errors="ignore")]
     assert not bad, bad
+
+
+def test_the_package_imports_no_module_its_install_does_not_bring():
+    """A fresh ``pip install -e .`` has no ``click`` (typer 0.29 vendors its own): the
+    package importing it failed at ``walkerlab --help`` there, though a test environment
+    that has click (through another extra) passed."""
+    import ast
+
+    bad = []
+    for f in (ROOT / "walkerlab").rglob("*.py"):
+        for node in ast.walk(ast.parse(f.read_text())):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                     else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            if any(n.split(".")[0] == "click" for n in names):
+                bad.append(str(f.relative_to(ROOT)))
+    assert not bad, bad

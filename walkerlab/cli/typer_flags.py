@@ -30,22 +30,22 @@ def usage_errors_in_one_spelling() -> None:
     """A usage error (unknown option or command, a value out of range) is printed as the
     usage, the help hint and one line ``error: <message>`` on stderr, the spelling of
     every other walkerlab error (:mod:`walkerlab.cli.errors`); its exit code stays 2."""
-    import click
-    from typer import rich_utils
+    import typer  # typer 0.29 vendors click (typer._click): no `import click` here, which
+    from typer import rich_utils  # a fresh install does not have
 
     if getattr(rich_utils.rich_format_error, "_walkerlab", False):
         return
 
-    def plain_error(exc: click.ClickException) -> None:
+    def plain_error(exc) -> None:  # a (vendored) click.ClickException
         if exc.__class__.__name__ == "NoArgsIsHelpError":  # the help is shown instead
             return
         ctx = getattr(exc, "ctx", None)
         if ctx is not None:
-            click.echo(ctx.get_usage(), err=True)
+            typer.echo(ctx.get_usage(), err=True)
             if ctx.command.get_help_option(ctx) is not None:
-                click.echo(f"Try '{ctx.command_path} {ctx.help_option_names[0]}' for help.",
+                typer.echo(f"Try '{ctx.command_path} {ctx.help_option_names[0]}' for help.",
                            err=True)
-        click.echo(f"error: {exc.format_message()}", err=True)
+        typer.echo(f"error: {exc.format_message()}", err=True)
 
     plain_error._walkerlab = True
     rich_utils.rich_format_error = plain_error
