@@ -136,9 +136,19 @@ def no_gait_of_its_own(scene) -> bool:
     (the gait search says "a passive walker needs a downhill slope"); and no
     ``optimize.initial_guess`` names another start.  Its optimal gait (a free push-off or
     the hip torque powering it: Srinivasan & Ruina 2006, Kelly 2017's OptimTraj) starts
-    from the targets."""
+    from the targets.  On stairs or footholds the walker descends the mean landing depth a
+    step too (:func:`walkerlab.models.ground.landing_drops`): down stairs' level treads
+    give a passive gait (configs/stairs.yaml), up stairs none."""
+    from walkerlab.models.ground import landing_drops
+
     o = getattr(scene, "optimize", None)
-    return (scene.walker.actuation is None and scene.slope.phi_rad <= 0.0
+    try:
+        drops = landing_drops(scene.terrain)
+    except ValueError:  # footholds of their own slopes: refused by the collocation
+        drops = (0.0,)
+    descends = scene.slope.phi_rad > 0.0 or (scene.slope.phi_rad == 0.0
+                                             and sum(drops) > 0.0)
+    return (scene.walker.actuation is None and not descends
             and (o is None or o.initial_guess is None))
 
 
@@ -322,6 +332,11 @@ def _straight_legs(scene, data, x_gait, period_s) -> OptimizeData:
     """Straight legs: one step (:func:`_step`), or a stride of two steps when the legs
     differ (:func:`_stride`)."""
     spec = collocation_spec(scene)
+    if data.mirror is not None and scene.terrain is not None \
+            and scene.terrain.kind in ("stairs", "footholds"):
+        raise ValueError(f"terrain.kind: {scene.terrain.kind}: legs that differ take a stride "
+                         "of two steps, whose landing is not transcribed yet; optimise legs "
+                         "of one build, or on the slope")
     return (_step if data.mirror is None else _stride)(scene, data, spec, x_gait, period_s)
 
 
@@ -333,6 +348,7 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     from walkerlab.optimal.replay.contact import contact_replay
     from walkerlab.optimal.transcription.mode_sequence import collocate_step
     from walkerlab.optimal.transcription.step import replay, torque_of_time
+    from walkerlab.optimal.transcription.landing import step_ground
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
 
     o = scene.optimize
@@ -342,8 +358,10 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
         spec = replace(spec, push_off_n_s=guess_p)
     if guess_u is not None:  # another optimize.h5: an optimum
         spec = replace(spec, warm_start=True)
-    res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data))
-    err, replayed = replay(data, res)
+    ground = step_ground(scene)
+    res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data),
+                         ground)
+    err, replayed = replay(data, res, drop_m=0.0 if ground is None else ground.drops_m[0])
     mu = replay_multipliers(replayed, res, scene, err)
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay(scene, res))

@@ -52,12 +52,16 @@ def hip_phase_replays_of(scene, data, res, tau) -> tuple[dict, str]:
     torque of the time since the heel strike;
     :func:`walkerlab.optimal.replay.hip_phase.hip_phase_replays`, the scene's solver), and
     why there are none (``({}, "")`` unless ``optimize.phase_replay`` is on: off by default
-    here)."""
+    here; nor on stairs or footholds: the replays walk the slope)."""
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.replay.hip_phase import hip_phase_replays
 
     if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
         return {}, ""
+    t = scene.terrain
+    if t is not None and t.kind in ("stairs", "footholds", "profile"):
+        return {}, (f"not replayed: the phase-variable replays walk the slope, not "
+                    f"terrain.kind: {t.kind}")
     try:
         return hip_phase_replays(data, res, tau, Solver.from_settings(scene.solver)), ""
     except ValueError as exc:

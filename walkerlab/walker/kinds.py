@@ -263,7 +263,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_NO_ANKLES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         **_GROUNDS,
-        **_OPTIMIZE_GROUNDS,
+        # one step lands on the next tread (walkerlab.optimal.transcription.landing)
+        **{k: v for k, v in _OPTIMIZE_GROUNDS.items() if k[0] != "stairs"},
     },
     "locking_knees": {
         **_NO_ANKLES,

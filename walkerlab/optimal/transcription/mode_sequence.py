@@ -406,7 +406,8 @@ def step_phase(fns: dict):
 
 
 def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
-                   guess_u: np.ndarray | None = None, fns: dict | None = None):
+                   guess_u: np.ndarray | None = None, fns: dict | None = None,
+                   ground=None):
     """Optimise one step of straight legs (the transcription of
     :mod:`walkerlab.optimal.transcription.step`'s docstring) as the sequence of one phase
     (:func:`step_phase`) on a uniform mesh of ``spec.intervals`` intervals.
@@ -428,6 +429,11 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
     fns : dict, optional
         :func:`~walkerlab.optimal.transcription.step.step_functions` of the walker (built
         when not given).
+    ground : walkerlab.optimal.transcription.landing.StepGround, optional
+        The landing of stairs or footholds of one height (one drop:
+        :func:`walkerlab.optimal.transcription.landing.landing_phase`, its advance held to
+        ``ground.advance_m`` when given; the result's ``step_length_m`` the advance along
+        the slope); None: the slope's heel strike.
 
     Returns
     -------
@@ -451,7 +457,17 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
     x = np.stack([np.interp(tk, guess_t, guess_x[:, c]) for c in range(guess_x.shape[1])],
                  axis=1)
     u = np.interp(tk, guess_t, np.zeros_like(guess_t) if guess_u is None else guess_u)
-    res = collocate_phases({**fns, "phases": [step_phase(fns)]}, spec, [("step", tk, x)],
+    phase = step_phase(fns)
+    extra = {}
+    if ground is not None:
+        from walkerlab.optimal.transcription.landing import landing_phase
+
+        phase = landing_phase(fns, ground.drops_m[0], ground.slope_rad)
+        if ground.advance_m is not None:  # stairs: one tread a step
+            def constrain(opti, Xs, _Us, _Ts, advance=float(ground.advance_m)):
+                opti.subject_to(phase.step(Xs[-1][:, -1]) == advance)
+            extra["constrain"] = constrain
+    res = collocate_phases({**fns, "phases": [phase], **extra}, spec, [("step", tk, x)],
                            [u])
     return CollocationResult(
         t=res.t, x=res.x, u=res.u, step_period_s=res.step_period_s,

@@ -480,13 +480,16 @@ def torque_of_time(res: CollocationResult):
     return tau
 
 
-def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
+def replay(data, res: CollocationResult, solver=None,
+           drop_m: float = 0.0) -> tuple[float, object]:
     """The optimised step replayed on the rigid model (its generated code and its own
     phases, guards and reset; not the CasADi expressions the optimisation used): the walker
     of ``data`` with a hip actuator whose torque is :func:`torque_of_time` (from each step's
     heel strike) and the optimised push-off, one step from ``x_0``
     (:func:`walkerlab.integrate.rigid.integrate_step`, DOP853 at rtol = atol = 1e-12 unless
-    ``solver`` is given).
+    ``solver`` is given), its heel strike at a landing ``drop_m`` [m] below the stance
+    foot's level (stairs, footholds of one height:
+    :func:`walkerlab.models.hybrid.ground.on_landing`; 0: the slope's).
 
     Returns
     -------
@@ -511,6 +514,10 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
                      torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
                                           scaled_by="foot_mass" if massless else "none")])
     passive = make_rigid_walker(data, "biped", "derived")
+    if drop_m != 0.0:
+        from walkerlab.models.hybrid.ground import on_landing
+
+        passive = on_landing(passive, data, drop_m)
     walker = actuate(passive, data, spec)
     acts = walker.actuators
     tau = torque_of_time(res)

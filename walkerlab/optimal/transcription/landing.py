@@ -1,0 +1,128 @@
+"""The collocation's heel strike on the scene's ground: stairs (every step lands a riser below,
+or above, the stance foot's level) and footholds (step ``k`` lands ``-h_k`` below it), as the
+rigid model meets them (:mod:`walkerlab.models.hybrid.ground`).
+
+The rigid model's landing is the generated swing-foot clearance above the slope line through
+the stance foot plus a constant (:func:`walkerlab.models.hybrid.ground.on_landing`),
+
+    ``g(x) = swing_clearance(x) + drop_m cos(gamma)``  (crossed downward),
+
+with the walker's own impact map; this module gives the one-step transcription
+(:mod:`walkerlab.optimal.transcription.step`) the same guard.  A step's landing phase
+(:func:`landing_phase`) is the slope's step phase (:func:`walkerlab.optimal.transcription.
+mode_sequence.step_phase`) with that guard (its rate ``dg/dx f(x, u)``, so the swing foot
+comes down onto the tread: ``-dg/dt >= touchdown_rate``, in m/s here), its step the advance
+along the slope ``sqrt(|foot|^2 - (drop cos gamma)^2)`` (on level treads: the horizontal
+distance between the feet, the tread's depth on stairs) and its clearance measured from the
+lower of the two treads (a step down: the next one; up: the stance tread).  The reset (heel
+strike, push-off included) and the periodicity ``x_0 = reset(x_end)`` are the slope's: the
+state is the legs' angles and rates, which do not know the feet's heights.
+
+Stairs take one step per stair: a gait that repeats on them advances one tread a step, so the
+step's advance is constrained to ``terrain.tread_m`` (:class:`StepGround`); footholds are
+period-``p`` (one phase per foothold, :func:`walkerlab.optimal.transcription.mode_sequence.
+collocate_step`): each step lands at its foothold's height, the stride is the ``p`` steps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+__all__ = ["StepGround", "landing_phase", "step_ground"]
+
+
+@dataclass(frozen=True)
+class StepGround:
+    """The ground the collocation's steps land on.
+
+    Attributes
+    ----------
+    drops_m : tuple of float
+        Each step's landing depth [m] below the stance foot's level (stairs down: the
+        riser; up: minus it; footholds: ``-h_k``), one per step of the ground's period.
+    slope_rad : float
+        The slope the landings are measured on (0 on stairs' level treads) [rad].
+    advance_m : float or None
+        The step's advance along the slope every step must make [m] (stairs: the tread's
+        depth); None: free.
+    kind : str
+        ``terrain.kind`` (for messages).
+    """
+
+    drops_m: tuple
+    slope_rad: float
+    advance_m: float | None = None
+    kind: str = "stairs"
+
+
+def step_ground(scene) -> StepGround | None:
+    """The ground of ``scene``'s collocation: None on the slope (the slope's guard, bit for
+    bit), else its :class:`StepGround` (stairs: one drop, the advance the tread;
+    footholds: one drop per foothold).
+
+    Raises
+    ------
+    ValueError
+        Footholds of their own slopes (``terrain.foothold_slopes_rad``), or a target step
+        length on stairs other than the tread (one line naming the field).
+    """
+    from walkerlab.models.ground import landing_drops
+
+    t = scene.terrain
+    if t is None or t.kind not in ("stairs", "footholds"):
+        return None
+    if t.kind == "footholds" and t.foothold_slopes_rad is not None:
+        raise ValueError("terrain.foothold_slopes_rad: optimize transcribes footholds of one "
+                         "slope (the scene's), at their heights; give foothold_heights_m "
+                         "alone")
+    drops = tuple(float(d) for d in landing_drops(t))
+    advance = None
+    if t.kind == "stairs":
+        advance = float(t.tread_m)
+        d = scene.optimize.target_step_length_m if scene.optimize is not None else None
+        if d is not None and abs(float(d) - advance) > 1e-12:
+            raise ValueError(f"optimize.target_step_length_m: {float(d):g} m, but on stairs "
+                             f"the gait advances one tread a step (terrain.tread_m: "
+                             f"{advance:g} m): leave it out or give the tread")
+    if all(d == 0.0 for d in drops) and advance is None:
+        return None  # footholds at the stance foot's level: the slope itself
+    return StepGround(drops, float(scene.slope.phi_rad), advance, t.kind)
+
+
+def landing_phase(fns: dict, drop_m: float, slope_rad: float, name: str = "step"):
+    """One step of straight legs landing ``drop_m`` [m] below the stance foot's level
+    (module docstring): :func:`walkerlab.optimal.transcription.mode_sequence.step_phase`'s
+    phase with the landing's guard, its rate, the step's advance and the clearance from
+    the lower tread.
+
+    Parameters
+    ----------
+    fns : dict
+        :func:`walkerlab.optimal.transcription.step.step_functions` of the walker.
+    drop_m : float
+        Landing depth [m] (negative: above).
+    slope_rad : float
+        The slope the walker's clearance is measured from [rad].
+    name : str
+        The phase's name (footholds: ``step_<k>``).
+
+    Returns
+    -------
+    walkerlab.optimal.transcription.phases.ModePhase
+    """
+    import casadi as ca
+
+    from walkerlab.optimal.transcription.mode_sequence import step_phase
+
+    base = step_phase(fns)
+    offset = float(drop_m) * math.cos(float(slope_rad))
+    x, u = ca.MX.sym("x", 2 * fns["n"]), ca.MX.sym("u")
+    clear = fns["clearance"](x)
+    guard = clear + offset
+    rate = ca.jacobian(guard, x) @ fns["flow"](x, u)
+    advance = ca.sqrt(ca.fmax(fns["step"](x) ** 2 - offset ** 2, 0.0))
+    return replace(base, name=name, guard=ca.Function("guard", [x, u], [guard]),
+                   guard_rate=ca.Function("guard_rate", [x, u], [rate]),
+                   clearance=ca.Function("clearance", [x], [clear + max(offset, 0.0)]),
+                   step=ca.Function("step", [x], [advance]))
