@@ -128,8 +128,9 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         d["optimize"] = {**OPTIMIZE.get(kind, {}), "design": "virtual_constraints"}
     elif view == "optimize" and kind in OPTIMIZE:
         d.setdefault("optimize", dict(OPTIMIZE[kind]))
-    elif view == "optimize" and feature == "stairs":  # level treads: a step from targets
-        d["optimize"] = {"target_step_length_m": 0.41, "target_step_period_s": 0.75}
+    elif view == "optimize" and feature == "stairs":  # down the treads: the least effort
+        # from the stairs' passive gait, one tread (0.41 m) a step
+        d["optimize"] = {"objective": "effort", "intervals": 40}
     return d
 
 

@@ -346,9 +346,9 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.guess import starting_step
     from walkerlab.optimal.replay.contact import contact_replay
+    from walkerlab.optimal.transcription.landing import step_ground
     from walkerlab.optimal.transcription.mode_sequence import collocate_step
     from walkerlab.optimal.transcription.step import replay, torque_of_time
-    from walkerlab.optimal.transcription.landing import step_ground
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
 
     o = scene.optimize

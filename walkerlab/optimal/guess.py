@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["has_target", "read_guess", "simulated_step", "starting_segment", "starting_step",
-           "target_numbers", "target_step"]
+           "stairs_targets", "target_numbers", "target_step"]
 
 #: the swing leg's forward swing over the straight-line guess, as a share of the step's
 #: half-angle (a bump ``b sin(pi s)``: the swing foot clears level ground mid-step)
@@ -22,6 +22,16 @@ def has_target(o) -> bool:
     """The ``optimize`` section ``o`` gives a target speed, step length or step period."""
     return any(t is not None for t in (o.target_speed_m_per_s, o.target_step_length_m,
                                        o.target_step_period_s))
+
+
+def stairs_targets(scene):
+    """``scene``'s ``optimize`` section with, on stairs, the tread's depth as the target
+    step length when none is given (a gait on stairs advances one tread a step:
+    :mod:`walkerlab.optimal.transcription.landing`); else the section itself."""
+    o, t = scene.optimize, scene.terrain
+    if t is None or t.kind != "stairs" or o.target_step_length_m is not None:
+        return o
+    return o.model_copy(update={"target_step_length_m": float(t.tread_m)})
 
 
 def target_numbers(o, leg_length_m: float) -> tuple[float, float]:
@@ -48,7 +58,8 @@ def target_numbers(o, leg_length_m: float) -> tuple[float, float]:
 
 def target_step(scene, walker, samples: int = 400):
     """A starting step of a straight-legged walker with no gait of its own, from the targets
-    (:func:`target_numbers`): the legs swap at constant rates between the heel-strike
+    (:func:`target_numbers`; on stairs the step is the tread, :func:`stairs_targets`): the
+    legs swap at constant rates between the heel-strike
     postures of the target step - stance leg from ``alpha - phi`` to ``-alpha - phi``,
     swing leg the mirror, ``sin alpha = D / (2 l)``, ``phi`` the slope (angles from the
     vertical, positive with the foot ahead; Garcia et al. 1998's post-impact posture) -
@@ -75,7 +86,7 @@ def target_step(scene, walker, samples: int = 400):
     ValueError
         Too few targets (:func:`target_numbers`), a step longer than the legs allow.
     """
-    o = scene.optimize
+    o = stairs_targets(scene)
     length = float(walker.params["leg_length_m"])
     D, T = target_numbers(o, length)
     if D >= 2.0 * length:

@@ -164,9 +164,9 @@ def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     ground: :func:`walkerlab.optimal.driver.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
     refused at once without them."""
-    from walkerlab.optimal.guess import has_target, target_numbers
+    from walkerlab.optimal.guess import has_target, stairs_targets, target_numbers
 
-    o = scene.optimize
+    o = stairs_targets(scene)  # on stairs the step is the tread
     try:
         if not has_target(o):
             raise ValueError("the walker has no gait of its own (passive, on level or uphill "

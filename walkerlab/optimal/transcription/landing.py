@@ -90,7 +90,7 @@ def step_ground(scene) -> StepGround | None:
     return StepGround(drops, float(scene.slope.phi_rad), advance, t.kind)
 
 
-def landing_phase(fns: dict, drop_m: float, slope_rad: float, name: str = "step"):
+def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = "step"):
     """One step of straight legs landing ``drop_m`` [m] below the stance foot's level
     (module docstring): :func:`walkerlab.optimal.transcription.mode_sequence.step_phase`'s
     phase with the landing's guard, its rate, the step's advance and the clearance from
@@ -98,6 +98,9 @@ def landing_phase(fns: dict, drop_m: float, slope_rad: float, name: str = "step"
 
     Parameters
     ----------
+    base : walkerlab.optimal.transcription.phases.ModePhase
+        The slope's step phase (:func:`walkerlab.optimal.transcription.mode_sequence.
+        step_phase` of ``fns``).
     fns : dict
         :func:`walkerlab.optimal.transcription.step.step_functions` of the walker.
     drop_m : float
@@ -113,9 +116,6 @@ def landing_phase(fns: dict, drop_m: float, slope_rad: float, name: str = "step"
     """
     import casadi as ca
 
-    from walkerlab.optimal.transcription.mode_sequence import step_phase
-
-    base = step_phase(fns)
     offset = float(drop_m) * math.cos(float(slope_rad))
     x, u = ca.MX.sym("x", 2 * fns["n"]), ca.MX.sym("u")
     clear = fns["clearance"](x)

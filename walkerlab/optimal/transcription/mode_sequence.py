@@ -462,8 +462,9 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
     if ground is not None:
         from walkerlab.optimal.transcription.landing import landing_phase
 
-        phase = landing_phase(fns, ground.drops_m[0], ground.slope_rad)
-        if ground.advance_m is not None:  # stairs: one tread a step
+        phase = landing_phase(phase, fns, ground.drops_m[0], ground.slope_rad)
+        if ground.advance_m is not None and spec.target_step_length_m is None:
+            # stairs: one tread a step (a target step length is the tread, held by it)
             def constrain(opti, Xs, _Us, _Ts, advance=float(ground.advance_m)):
                 opti.subject_to(phase.step(Xs[-1][:, -1]) == advance)
             extra["constrain"] = constrain
