@@ -128,8 +128,9 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         d["optimize"] = {**OPTIMIZE.get(kind, {}), "design": "virtual_constraints"}
     elif view == "optimize" and kind in OPTIMIZE:
         d.setdefault("optimize", dict(OPTIMIZE[kind]))
-    elif view == "optimize" and feature == "stairs":  # down the treads: the least effort
-        # from the stairs' passive gait, one tread (0.41 m) a step
+    elif view == "optimize" and feature in ("stairs", "footholds"):  # the least effort
+        # from the ground's passive gait: down the treads one tread (0.41 m) a step; over
+        # the footholds its two-step period
         d["optimize"] = {"objective": "effort", "intervals": 40}
     return d
 

@@ -352,13 +352,15 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
 
     o = scene.optimize
+    ground = step_ground(scene)
+    if ground is not None and len(ground.drops_m) > 1:  # footholds that differ: a period
+        return _footholds(scene, data, spec, x_gait, period_s, ground)
     walker = build_walker(scene)
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)
     if guess_u is not None:  # another optimize.h5: an optimum
         spec = replace(spec, warm_start=True)
-    ground = step_ground(scene)
     res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data),
                          ground)
     err, replayed = replay(data, res, drop_m=0.0 if ground is None else ground.drops_m[0])
@@ -375,6 +377,66 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
                         torque_unit="N m/kg" if reported.massless_legs(data) else "N m",
                         phase_replays=phases, phase_replay_outcome=phase_note,
                         **history_and_energies(scene, walker, res))
+
+
+def _footholds(scene, data, spec, x_gait, period_s, ground) -> OptimizeData:
+    """Straight legs on footholds that differ from step to step: one period of ``p``
+    steps, each landing at its foothold
+    (:func:`walkerlab.optimal.transcription.mode_sequence.collocate_footholds`), started
+    from the scene's period-``p`` gait (``x_gait``; ``period_s`` its mean step [s]) and
+    replayed on the footholds (:func:`walkerlab.optimal.transcription.landing.
+    replay_footholds`); its ``step_period_s`` / ``step_length_m`` the mean step's, the
+    multipliers the period map's."""
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.transcription.landing import replay_footholds
+    from walkerlab.optimal.transcription.mode_sequence import (
+        collocate_footholds,
+        footholds_guess,
+    )
+    from walkerlab.optimal.transcription.step_cache import cached_step_functions
+
+    o = scene.optimize
+    if o.initial_guess is not None or x_gait is None:
+        raise ValueError("optimize.initial_guess: footholds of several heights start from "
+                         "the scene's own period gait (walkerlab fixedpoint); leave it out")
+    walker = build_walker(scene)
+    guess = footholds_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
+                            spec.intervals)
+    fns = cached_step_functions(data)
+    res = collocate_footholds(fns, spec, ground, guess)
+    err, replayed = replay_footholds(data, res, ground)
+    mu = replay_multipliers(replayed, res, scene, err)
+    p = len(ground.drops_m)
+    gait = bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded")
+    outcome = "" if gait else not_a_gait_outcome(err, res.status)
+    if gait:
+        outcome = ("not replayed: the contact replay of footholds of several heights is "
+                   "not built (the rigid replay walks them)")
+    lengths = [float(ph.step(res.x[b - 1])) for ph, b in zip(
+        _foothold_phases(fns, ground), [*res.phase_start[1:], res.t.size])]
+    states, units = reported.named_states(walker, res)
+    return OptimizeData(res.t, states, res.u, res.step_period_s / p, float(np.mean(lengths)),
+                        res.push_off_n_s, res.objective, err, mu, gait, res.status,
+                        res.iterations, res.wall_time_s, units, objective_name=o.objective,
+                        objective_unit=reported.unit_of_objective(o, data), terms=res.terms,
+                        contact_step_period_s=float("nan"), contact_outcome=outcome,
+                        cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
+                        phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
+                        build_time_s=res.build_time_s, steps=p,
+                        torque_unit="N m/kg" if reported.massless_legs(data) else "N m",
+                        phase_replay_outcome="not replayed: a period on footholds is "
+                        "replayed as a function of time only" if o.phase_replay else "",
+                        **history_and_energies(scene, walker, res))
+
+
+def _foothold_phases(fns, ground):
+    """The footholds' step phases (their advance functions, for the step lengths)."""
+    from walkerlab.optimal.transcription.landing import landing_phase
+    from walkerlab.optimal.transcription.mode_sequence import step_phase
+
+    base = step_phase(fns)
+    return [landing_phase(base, fns, d, ground.slope_rad) for d in ground.drops_m]
 
 
 # -- a step of phases (knees, flat feet) -------------------------------------------------

@@ -263,8 +263,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_NO_ANKLES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         **_GROUNDS,
-        # one step lands on the next tread (walkerlab.optimal.transcription.landing)
-        **{k: v for k, v in _OPTIMIZE_GROUNDS.items() if k[0] != "stairs"},
+        # a step lands on the next tread or foothold (walkerlab.optimal.transcription.
+        # landing)
+        ("profile", "optimize"): _OPTIMIZE_GROUND,
     },
     "locking_knees": {
         **_NO_ANKLES,

@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-__all__ = ["StepGround", "landing_phase", "step_ground"]
+__all__ = ["StepGround", "landing_phase", "replay_footholds", "step_ground"]
 
 
 @dataclass(frozen=True)
@@ -126,3 +126,60 @@ def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = 
                    guard_rate=ca.Function("guard_rate", [x, u], [rate]),
                    clearance=ca.Function("clearance", [x], [clear + max(offset, 0.0)]),
                    step=ca.Function("step", [x], [advance]))
+
+
+def replay_footholds(data, res, ground: StepGround, solver=None):
+    """The optimised period on footholds (:func:`walkerlab.optimal.transcription.
+    mode_sequence.collocate_footholds`) replayed on the rigid model on those footholds
+    (:func:`walkerlab.models.hybrid.ground.on_footholds`: step ``k``'s heel strike at its
+    foothold, the generated code and impact map): each step's walker with a hip actuator
+    whose torque is its own step's (the quadratic through its interval's points, from its
+    heel strike) and the optimised push-off, one period of the map
+    (:func:`walkerlab.analysis.gait.poincare.poincare_map`) from ``x_0`` (DOP853 at rtol =
+    atol = 1e-12 unless ``solver`` is given).
+
+    Returns
+    -------
+    error : float
+        Max-norm return error ``|x_0' - x_0|`` after the ``p`` steps (inf when a step does
+        not end in a heel strike).
+    walker : HybridWalker
+        The replayed walker (its ``cycle`` the steps' walkers).
+    """
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.analysis.gait.poincare import StepFailed, poincare_map
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.ground import on_footholds
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.transcription.step import torque_of_time
+
+    st = data.structure
+    massless = bool(st.bodies) and all(b.massless for b in st.bodies)
+    spec = Actuation(push_off=PushOff(impulse_n_s=max(res.push_off_n_s, 0.0)),
+                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
+                                          scaled_by="foot_mass" if massless else "none")])
+    passive = make_rigid_walker(data, "biped", "derived")
+    walker = on_footholds(lambda _g: passive, lambda _g: data,
+                          [(d, ground.slope_rad) for d in ground.drops_m], True,
+                          lambda w, d: actuate(w, d, spec))
+    bounds = [*res.phase_start, res.t.size]
+    zero = np.zeros((1, 2 * walker.actuators.n))
+    for k, w in enumerate(walker.cycle):
+        a, b = bounds[k], bounds[k + 1]
+        tau = torque_of_time(SimpleNamespace(t=res.t[a:b] - res.t[a], u=res.u[a:b]))
+        acts = w.actuators
+        acts.torques = (lambda tau_k, ac: lambda t, x: np.array(
+            [tau_k(float(np.real(t)) - ac.t_origin)]))(tau, acts)
+        acts.torque_jacobian = lambda t, x: zero  # a torque of time alone
+    solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    x0 = np.asarray(res.x[0], float)
+    try:
+        x1 = poincare_map(walker, x0, solver, max_step_time=3.0 * res.step_period_s)[0]
+    except StepFailed:
+        return float("inf"), walker
+    return float(np.max(np.abs(np.asarray(x1) - x0))), walker

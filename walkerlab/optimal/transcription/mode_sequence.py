@@ -27,7 +27,8 @@ from walkerlab.optimal.transcription.ipopt import (
 from walkerlab.optimal.transcription.phase_nlp import _chain_phases, _objective, _pushes
 from walkerlab.walker.kinds import KINDS
 
-__all__ = ["PhasedResult", "collocate_phases", "collocate_step", "optimized_guess",
+__all__ = ["PhasedResult", "collocate_footholds", "collocate_phases", "collocate_step",
+           "footholds_guess", "optimized_guess",
            "phase_torque_of_time", "phased_guess", "replay_phases", "step_phase"]
 
 #: objectives the phased transcription takes
@@ -476,3 +477,80 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
         objective=res.objective, status=res.status, iterations=res.iterations,
         wall_time_s=res.wall_time_s, terms={"push_off_work": 0.0, **res.terms},
         history=res.history, violations=res.violations)
+
+
+def collocate_footholds(fns: dict, spec, ground, guess: list, guess_u: list | None = None
+                        ) -> PhasedResult:
+    """Optimise one period of straight legs on footholds that differ from step to step
+    (:mod:`walkerlab.optimal.transcription.landing`): ``p = len(ground.drops_m)`` steps,
+    step ``k`` a phase ``step_<k>`` of ``spec.intervals`` intervals landing
+    ``ground.drops_m[k]`` [m] below its stance foot's level, each joined to the next by the
+    heel strike (push-off included) and the last to the first (the period-``p`` map's
+    periodicity); the targets are the mean step's (:func:`collocate_phases`).
+
+    Parameters
+    ----------
+    fns : dict
+        :func:`walkerlab.optimal.transcription.step.step_functions` of the walker.
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
+    ground : walkerlab.optimal.transcription.landing.StepGround
+    guess : list of (name, t (2N + 1,), x (2N + 1, 2n))
+        Each step's starting mesh (``step_<k>``, :func:`footholds_guess`).
+    guess_u : list of ndarray (2N + 1,), optional
+        Each step's starting hip torque [N m] (default 0).
+
+    Returns
+    -------
+    PhasedResult
+        Its phases the ``p`` steps; ``step_period_s`` the period's (all steps'),
+        ``step_length_m`` the last step's advance.
+
+    Raises
+    ------
+    ValueError
+        An objective the transcription does not take (one line).
+    """
+    from walkerlab.optimal.transcription.landing import landing_phase
+    from walkerlab.optimal.transcription.step import check_objective
+
+    check_objective(spec)
+    base = step_phase(fns)
+    phases = [landing_phase(base, fns, d, ground.slope_rad, f"step_{k}")
+              for k, d in enumerate(ground.drops_m)]
+    return collocate_phases({**fns, "phases": phases}, spec, guess, guess_u)
+
+
+def footholds_guess(walker, x0, period_s: float, solver, intervals: int):
+    """The starting period of :func:`collocate_footholds`: the rigid walker on the
+    footholds (``walker.cycle``: :func:`walkerlab.models.hybrid.ground.on_footholds`)
+    stepped ``len(walker.cycle)`` times from the post-impact state ``x0`` (2n,), each step
+    sampled on a uniform mesh of ``intervals`` intervals (its mid-points halfway).
+
+    Returns
+    -------
+    list of (``step_<k>``, t (2N + 1,) [s from the step's heel strike], x (2N + 1, 2n))
+
+    Raises
+    ------
+    ValueError
+        A step does not end in a heel strike (one line).
+    """
+    from walkerlab.integrate.rigid import simulate_steps
+
+    x0 = np.asarray(x0, float)
+    p = len(walker.cycle)
+    run = simulate_steps(walker, x0, p, solver, max_step_time=3.0 * period_s)
+    if len(run.segments) < p or any(s.termination != "heel_strike" for s in run.segments):
+        raise ValueError("optimize: the starting gait does not step over the footholds "
+                         f"({run.segments[-1].termination})")
+    out = []
+    for k, seg in enumerate(run.segments):
+        t = np.linspace(seg.t_start, seg.t_end, 2 * int(intervals) + 1)
+        x = np.empty((t.size, x0.size))
+        for j, (_ph, sol, (a, b)) in enumerate(seg.pieces):
+            last = j == len(seg.pieces) - 1
+            sel = (t >= a) & ((t <= b) if last else (t < b))
+            if sel.any():
+                x[sel] = np.asarray(sol(t[sel]), float)[:x0.size].T
+        out.append((f"step_{k}", t - t[0], x))
+    return out
