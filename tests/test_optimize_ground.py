@@ -70,8 +70,8 @@ def test_the_paper_walker_on_1_cm_and_5_cm_risers_has_two_optima_each_a_gait_on_
 def test_on_stairs_of_the_passive_gaits_tread_the_least_effort_gait_is_the_passive_one():
     """The stairs' passive gait (1 cm risers: advance 414.092 mm, shooting) on treads of its
     advance: the collocation's guard and periodicity on the stairs give it back - effort
-    <= 1e-8 N^2 m^2 s, the step period within 1e-6 (relative; Hermite-Simpson on 40
-    intervals, measured 1.4e-6 s of 0.709984 s with the tread rounded to 1e-6 m), the replay
+    <= 1e-8 N^2 m^2 s, the step period within 5e-6 (relative; Hermite-Simpson on 40
+    intervals, the tread rounded to 1e-6 m: measured 1e-6 s of 0.709984 s), the replay
     on the stairs closing to 1e-6."""
     pytest.importorskip("casadi")
     r, o = _optimum(_paper_on_stairs(0.01, tread_m=0.414092))
@@ -140,3 +140,65 @@ def test_a_kneed_walker_on_stairs_and_a_step_other_than_the_tread_are_refused_in
                                          r"stairs the gait advances one tread"):
         step_ground(_paper_on_stairs(0.01, target_step_length_m=0.5))
     assert step_ground(_paper_on_stairs(0.01, target_step_length_m=0.41)).advance_m == 0.41
+
+
+def _compass_on_footholds(heights, **optimize):
+    """configs/compass_optimal.yaml (0.0525 rad, least effort, 40 intervals) on periodic
+    footholds of these heights [m] (step k lands ``-heights[k mod p]`` below its stance
+    foot's level)."""
+    d = load_scene(CONFIGS / "compass_optimal.yaml").model_dump(mode="json",
+                                                                 exclude_none=True)
+    d["terrain"] = {"kind": "footholds", "foothold_heights_m": list(heights),
+                    "periodic": True, "lanes": "checkerboard", "patch_width_m": 0.3}
+    d["optimize"] = {**d["optimize"], **optimize}
+    return scene_from_dict(d)
+
+
+@pytest.mark.slow  # two fixed points and an optimisation (~8 s)
+def test_compass_optimal_on_2_mm_footholds_is_the_two_step_passive_gait_not_the_slopes():
+    """On +-2 mm footholds the least effort is the footholds' passive two-step gait found by
+    shooting (fixedpoint: steps of 0.764674 s and 0.689328 s): effort <= 1e-8, each step's
+    period within 1e-6 s of it (Hermite-Simpson on 40 intervals a step, measured 6e-8 s),
+    replayed on the footholds to 1e-6; not the slope's passive gait (0.734461 s a step)."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _compass_on_footholds([-0.002, 0.002])
+    r = solve_scene(scene)[1].result
+    steps = np.asarray(r.step_periods_s, float)
+    assert steps.size == 2
+    o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2)
+    assert o.gait and o.replay_error <= REPLAY, (o.status, o.replay_error)
+    assert o.objective <= 1e-8 and o.steps == 2
+    assert np.max(np.abs(np.asarray(o.phase_duration_s) - steps)) <= 1e-6
+    slope = solve_scene(load_scene(CONFIGS / "compass_optimal.yaml"))[1].result
+    assert abs(o.step_period_s - float(slope.period_s)) > 1e-3
+
+
+@pytest.mark.slow  # a fixed point and an optimisation (~6 s)
+def test_a_powered_gait_over_footholds_closes_on_them():
+    """At 0.8 m/s (faster than the passive 0.735 m/s) over +-2 mm footholds the hip works
+    (effort > 0) and the period of two steps, replayed on the footholds, returns to its
+    start within 1e-6; the mean step keeps the target speed."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _compass_on_footholds([-0.002, 0.002], target_speed_m_per_s=0.8)
+    r = solve_scene(scene)[1].result
+    o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2)
+    assert o.gait and o.replay_error <= REPLAY, (o.status, o.replay_error)
+    assert o.objective > 1e-3
+    assert o.step_length_m / o.step_period_s == pytest.approx(0.8, rel=1e-9)
+
+
+def test_footholds_of_their_own_slopes_are_refused_in_one_line():
+    """The collocation lands on footholds of the scene's slope at their heights; footholds of
+    their own slopes are refused before any stage runs, naming the field."""
+    from walkerlab.optimal.driver import check_scene
+
+    d = _compass_on_footholds([-0.002, 0.002]).model_dump(mode="json", exclude_none=True)
+    d["terrain"]["foothold_slopes_rad"] = [0.05, 0.055]
+    with pytest.raises(ValueError, match=r"^terrain\.foothold_slopes_rad: optimize "):
+        check_scene(scene_from_dict(d))

@@ -288,8 +288,10 @@ def check_scene(scene, data=None) -> None:
     Raises
     ------
     ValueError
-        ``walker: ...``, ``optimize.push_off: ...``, ``optimize.min_clearance_m: ...``
-        with the reason and what to give instead (one line).
+        ``walker: ...``, ``optimize.push_off: ...``, ``optimize.min_clearance_m: ...``,
+        a ground straight legs do not land on (``terrain.foothold_slopes_rad``, a target
+        step other than the stairs' tread: :func:`walkerlab.optimal.transcription.landing.
+        step_ground`) with the reason and what to give instead (one line).
     """
     o = getattr(scene, "optimize", None)
     if o is None:
@@ -302,6 +304,10 @@ def check_scene(scene, data=None) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
+    if data.structure.kind.name == "straight_legs":  # the ground it lands on, refused early
+        from walkerlab.optimal.transcription.landing import step_ground
+
+        step_ground(scene)
     if (o.min_clearance_m or 0.0) > 0.0 and _feet_level_when_legs_cross(scene, data):
         raise ValueError(
             "optimize.min_clearance_m: straight legs cannot clear the ground mid-swing: the "

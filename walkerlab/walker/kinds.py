@@ -236,18 +236,24 @@ _FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after one heel str
                         "(it starts without the rigid gait's double support on the tread "
                         "above); contact-sim walks flat feet on footholds")
 
-#: why ``optimize`` refuses a ground other than the slope: its transcription and its rigid
-#: replay are built on the slope alone (measured: the paper walker's least-effort step gave
-#: 154.924 N^2 m^2 s and a 37.85 N m hip torque on level ground, on 1 cm and on 5 cm risers
-#: alike; configs/compass_optimal.yaml on +-2 mm footholds and on a steep profile returned
-#: the slope's passive gait to every digit)
-_OPTIMIZE_GROUND = ("the collocation and its replay are built on the slope alone (the "
-                    "landing on stairs, footholds or a profile is not transcribed yet: on "
-                    "1 cm and 5 cm risers it gave the level ground's optimum to every digit); "
-                    "optimise on the slope (terrain.kind: slope) and walk the result on this "
-                    "ground with fixedpoint, simulate or contact-sim")
-_OPTIMIZE_GROUNDS = {(g, "optimize"): _OPTIMIZE_GROUND
-                     for g in ("stairs", "footholds", "profile")}
+#: why ``optimize`` refuses a height profile: the collocation is of a periodic gait (its
+#: boundary condition the heel strike's reset), and a profile's steps all differ (each lands
+#: where the last left the foot: :func:`walkerlab.models.hybrid.ground.check_periodic_ground`)
+_OPTIMIZE_PROFILE = ("the collocation optimises a periodic gait, and a profile's steps all "
+                     "differ (no step repeats); optimise on the slope, stairs or footholds "
+                     "and walk the result on the profile with simulate")
+#: why ``optimize`` refuses stairs and footholds for a kind other than straight legs: the
+#: landing (:mod:`walkerlab.optimal.transcription.landing`) is built on the one-step
+#: transcription; the phased and five-link ones land on the slope (measured before it was
+#: refused: the paper walker's least-effort step gave the level ground's optimum on 1 cm and
+#: on 5 cm risers alike, 154.924 N^2 m^2 s)
+_OPTIMIZE_LANDING = ("the landing on stairs and footholds is transcribed for straight legs "
+                     "(one step of one phase); this walker's transcription lands on the slope "
+                     "only: optimise on the slope (terrain.kind: slope) and walk the result on "
+                     "this ground with fixedpoint, simulate or contact-sim")
+_OPTIMIZE_GROUNDS = {("stairs", "optimize"): _OPTIMIZE_LANDING,
+                     ("footholds", "optimize"): _OPTIMIZE_LANDING,
+                     ("profile", "optimize"): _OPTIMIZE_PROFILE}
 
 #: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
 #: stands for every view of that feature.  Each reason is physical (the walker lacks the
@@ -265,7 +271,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_GROUNDS,
         # a step lands on the next tread or foothold (walkerlab.optimal.transcription.
         # landing)
-        ("profile", "optimize"): _OPTIMIZE_GROUND,
+        ("profile", "optimize"): _OPTIMIZE_PROFILE,
     },
     "locking_knees": {
         **_NO_ANKLES,
@@ -290,7 +296,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
-        ("profile", "optimize"): _OPTIMIZE_GROUND,
+        ("profile", "optimize"): _OPTIMIZE_PROFILE,
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
         # steps that walker (its contact view asks the contact cells)
