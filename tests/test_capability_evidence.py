@@ -98,24 +98,30 @@ def test_each_cells_stored_measurement_is_what_the_code_gives(kind, feature, vie
                             abs_tol=REPRODUCE * e["tolerance"]), (m.value, e["value"])
 
 
-@pytest.mark.parametrize("terrain", [
-    {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.4, "direction": "down"},
-    {"kind": "stairs", "riser_m": 0.05, "tread_m": 0.4, "direction": "down"},
-    {"kind": "footholds", "foothold_heights_m": [-0.002, 0.002], "periodic": True}])
-def test_optimize_refuses_a_ground_it_does_not_transcribe_naming_terrain_kind(terrain,
+@pytest.mark.parametrize(("scene", "terrain", "reason"), [
+    ("compass_optimal", {"kind": "profile", "lanes": "continuous",
+                         "profile_m": [[-1.0, 0.05], [0.0, 0.0], [40.0, -2.1]]},
+     "a profile's steps all differ"),
+    ("kneed_optimal", {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.4,
+                       "direction": "down"}, "lands on the slope only"),
+    ("kneed_optimal", {"kind": "footholds", "foothold_heights_m": [-0.002, 0.002],
+                       "periodic": True}, "lands on the slope only")])
+def test_optimize_refuses_a_ground_it_does_not_transcribe_naming_terrain_kind(scene, terrain,
+                                                                             reason,
                                                                              tmp_path):
-    """Before: the paper walker's least-effort step on 1 cm and 5 cm risers was the level
-    ground's to every digit (the transcription and its replay ignored the ground), and
-    compass_optimal on +-2 mm footholds printed the slope's passive gait as a gait; the
-    table said ✓.  Now the cell is refused, in one line naming terrain.kind, before any
-    transcription."""
+    """Before issue 63 every ground but the slope was refused (before that, optimised on the
+    slope: the paper walker's least-effort step on 1 cm and 5 cm risers was the level
+    ground's to every digit).  Straight legs now land on stairs and footholds
+    (tests/test_optimize_ground.py); a profile (no periodic gait) and the other kinds'
+    transcriptions on stairs and footholds are refused, in one line naming terrain.kind,
+    before any stage runs."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
     from walkerlab.config.loader import shipped_scene_path
 
-    d = yaml.safe_load(shipped_scene_path("compass_optimal").read_text())
+    d = yaml.safe_load(shipped_scene_path(scene).read_text())
     d["name"] = "ground"
     d["terrain"] = terrain
     if terrain["kind"] == "stairs":
@@ -124,5 +130,5 @@ def test_optimize_refuses_a_ground_it_does_not_transcribe_naming_terrain_kind(te
     path.write_text(yaml.safe_dump(d))
     r = CliRunner().invoke(app, ["optimize", str(path), "--runs-dir", str(tmp_path / "runs")])
     assert r.exit_code == 1
-    assert f"terrain.kind: {terrain['kind']}" in r.output and "slope alone" in r.output
-    assert not (tmp_path / "runs" / "ground" / "optimize.h5").exists()
+    assert f"terrain.kind: {terrain['kind']}" in r.output and reason in r.output
+    assert not (tmp_path / "runs" / "ground").exists()

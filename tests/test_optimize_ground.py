@@ -105,24 +105,6 @@ def test_the_replay_of_the_stairs_gait_returns_to_its_start_on_the_stairs_only()
     assert on_slope > 1e-3
 
 
-@pytest.mark.parametrize(("ground", "field"), [
-    ({"kind": "profile", "lanes": "continuous",
-      "profile_m": [[-1.0, 0.05], [0.0, 0.0], [1.0, -0.05], [40.0, -2.0]]},
-     "terrain.kind: profile"),
-])
-def test_a_ground_the_collocation_does_not_transcribe_is_refused_in_one_line(ground, field):
-    """A profile (each step lands elsewhere: no periodic gait) is refused before any stage
-    runs, in one line naming the field."""
-    from walkerlab.optimal.driver import check_scene
-
-    d = load_scene(CONFIGS / "compass_optimal.yaml").model_dump(mode="json",
-                                                                 exclude_none=True)
-    d["terrain"] = ground
-    with pytest.raises(ValueError) as err:
-        check_scene(scene_from_dict(d))
-    assert str(err.value).startswith(field) and "\n" not in str(err.value)
-
-
 def test_a_kneed_walker_on_stairs_and_a_step_other_than_the_tread_are_refused_in_one_line():
     """Knees (a step of phases) are not transcribed on stairs: refused naming
     ``terrain.kind``; straight legs on stairs with a target step length other than the
