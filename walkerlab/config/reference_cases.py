@@ -170,10 +170,19 @@ SHIPPED_OPTIMIZE = {
 }
 
 
+#: feature -> the optimize section of a ground's ``optimize`` cell, on the shipped scene
+#: that walks the kind on that ground (:data:`SHIPPED`): the least effort from its passive
+#: gait (configs/stairs.yaml: one tread a step, 1 cm risers; configs/footholds_two.yaml:
+#: its two-step period)
+GROUND_OPTIMIZE = {"stairs": {"objective": "effort", "intervals": 40},
+                   "footholds": {"objective": "effort", "intervals": 40}}
+
+
 def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     """The reference case of a cell: a shipped scene that exercises the feature on the kind
-    (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`), else the kind's base walker with the
-    feature and the ground (:func:`scene_for`).
+    (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`; a ground's ``optimize`` cell: the shipped
+    ground scene with :data:`GROUND_OPTIMIZE`'s section), else the kind's base walker with
+    the feature and the ground (:func:`scene_for`).
 
     Returns
     -------
@@ -188,6 +197,11 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     if name is not None:
         d = _shipped(name)
         return f"configs/{name}.yaml", d
+    ground = SHIPPED.get((kind, feature)) if feature in GROUND_OPTIMIZE else None
+    if view == "optimize" and ground is not None:  # the shipped ground scene, optimised
+        d = _shipped(ground)
+        d["optimize"] = dict(GROUND_OPTIMIZE[feature])
+        return f"configs/{ground}.yaml with an optimize section (least effort, 40 intervals)", d
     base = SCENES[kind].removeprefix("configs/")
     d = scene_for(kind, feature, view)
     if feature == "profile":  # the slope itself as a profile (x horizontal, y up [m]): its
