@@ -304,7 +304,7 @@ def check_scene(scene, data=None) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
-    if data.structure.kind.name in ("straight_legs", "locking_knees"):  # its ground, early
+    if data.structure.kind.name == "straight_legs":  # the ground it lands on, refused early
         from walkerlab.optimal.transcription.landing import step_ground
 
         step_ground(scene)
@@ -498,13 +498,10 @@ def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> Optimi
     import time
 
     from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.models.hybrid.ground import on_landing
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.replay.contact import contact_replay_phased
-    from walkerlab.optimal.transcription.landing import step_ground
     from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
-        on_ground,
         phase_torque_of_time,
         replay_phases,
     )
@@ -513,20 +510,16 @@ def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> Optimi
     o = scene.optimize
     spec = collocation_spec(scene)  # its push-off refused before (check_kind)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
-    ground = step_ground(scene)  # stairs (a kneed walker's one landing), or None
-    drop = 0.0 if ground is None else ground.drops_m[0]
-    if drop != 0.0:
-        walker = on_landing(walker, data, drop)
     if resolve_gait:  # fixedpoint's gait has its double support
         g = solve_scene(scene, False, walker=walker)[1].gait.result
         x_gait, period_s = g.x, float(g.period_s)
     guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
-    fns = on_ground(cached_mode_functions(data, walker, order), spec, ground)
+    fns = cached_mode_functions(data, walker, order)
     build = time.perf_counter() - t0
     res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
                            guess_u)
-    err, replayed = replay_phases(data, res, drop_m=drop)
+    err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_phased(scene, res, strides=2))

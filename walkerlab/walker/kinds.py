@@ -251,11 +251,6 @@ _OPTIMIZE_LANDING = ("the landing on stairs and footholds is transcribed for str
                      "(one step of one phase); this walker's transcription lands on the slope "
                      "only: optimise on the slope (terrain.kind: slope) and walk the result on "
                      "this ground with fixedpoint, simulate or contact-sim")
-#: why ``optimize`` refuses a kneed walker on footholds: its step of phases lands on one
-#: height (stairs); a period of steps of phases over footholds is not built
-_OPTIMIZE_KNEED_FOOTHOLDS = ("a kneed walker's step of phases lands on stairs (one landing); "
-                             "footholds that differ take a period of steps, built for "
-                             "straight legs only: optimise it on the slope or on stairs")
 _OPTIMIZE_GROUNDS = {("stairs", "optimize"): _OPTIMIZE_LANDING,
                      ("footholds", "optimize"): _OPTIMIZE_LANDING,
                      ("profile", "optimize"): _OPTIMIZE_PROFILE}
@@ -287,9 +282,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
         **_GROUNDS,
-        # the locked swing lands on the next tread (walkerlab.optimal.transcription.landing)
-        ("footholds", "optimize"): _OPTIMIZE_KNEED_FOOTHOLDS,
-        ("profile", "optimize"): _OPTIMIZE_PROFILE,
+        **_OPTIMIZE_GROUNDS,
     },
     "flat_feet": {
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "

@@ -90,7 +90,7 @@ def step_ground(scene) -> StepGround | None:
     return StepGround(drops, float(scene.slope.phi_rad), advance, t.kind)
 
 
-def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str | None = None):
+def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = "step"):
     """One step of straight legs landing ``drop_m`` [m] below the stance foot's level
     (module docstring): :func:`walkerlab.optimal.transcription.mode_sequence.step_phase`'s
     phase with the landing's guard, its rate, the step's advance and the clearance from
@@ -99,18 +99,16 @@ def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str | 
     Parameters
     ----------
     base : walkerlab.optimal.transcription.phases.ModePhase
-        The slope's phase ending in the heel strike (:func:`walkerlab.optimal.transcription.
-        mode_sequence.step_phase` of ``fns``; a kneed walker's locked swing,
-        :func:`walkerlab.optimal.transcription.phases.mode_functions`): its flow, swing-foot
-        clearance and distance are used.
+        The slope's step phase (:func:`walkerlab.optimal.transcription.mode_sequence.
+        step_phase` of ``fns``).
     fns : dict
-        The walker's collocation functions (their ``n``: coordinates).
+        :func:`walkerlab.optimal.transcription.step.step_functions` of the walker.
     drop_m : float
         Landing depth [m] (negative: above).
     slope_rad : float
         The slope the walker's clearance is measured from [rad].
-    name : str, optional
-        The phase's name (footholds: ``step_<k>``; default ``base``'s).
+    name : str
+        The phase's name (footholds: ``step_<k>``).
 
     Returns
     -------
@@ -120,12 +118,11 @@ def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str | 
 
     offset = float(drop_m) * math.cos(float(slope_rad))
     x, u = ca.MX.sym("x", 2 * fns["n"]), ca.MX.sym("u")
-    clear = base.clearance(x)
+    clear = fns["clearance"](x)
     guard = clear + offset
-    rate = ca.jacobian(guard, x) @ base.flow(x, u)
-    advance = ca.sqrt(ca.fmax(base.step(x) ** 2 - offset ** 2, 0.0))
-    return replace(base, name=base.name if name is None else name,
-                   guard=ca.Function("guard", [x, u], [guard]),
+    rate = ca.jacobian(guard, x) @ fns["flow"](x, u)
+    advance = ca.sqrt(ca.fmax(fns["step"](x) ** 2 - offset ** 2, 0.0))
+    return replace(base, name=name, guard=ca.Function("guard", [x, u], [guard]),
                    guard_rate=ca.Function("guard_rate", [x, u], [rate]),
                    clearance=ca.Function("clearance", [x], [clear + max(offset, 0.0)]),
                    step=ca.Function("step", [x], [advance]))

@@ -28,7 +28,7 @@ from walkerlab.optimal.transcription.phase_nlp import _chain_phases, _objective,
 from walkerlab.walker.kinds import KINDS
 
 __all__ = ["PhasedResult", "collocate_footholds", "collocate_phases", "collocate_step",
-           "footholds_guess", "on_ground", "optimized_guess",
+           "footholds_guess", "optimized_guess",
            "phase_torque_of_time", "phased_guess", "replay_phases", "step_phase"]
 
 #: objectives the phased transcription takes
@@ -349,13 +349,11 @@ def phase_torque_of_time(res: PhasedResult):
     return tau
 
 
-def replay_phases(data, res: PhasedResult, solver=None, drop_m: float = 0.0):
+def replay_phases(data, res: PhasedResult, solver=None):
     """The optimised step replayed on the rigid model (its generated code, its own phases,
     guards and resets; not the CasADi expressions): the walker with a hip actuator whose
     torque is :func:`phase_torque_of_time` from each step's heel strike, one step from
-    ``x_0`` (DOP853 at rtol = atol = 1e-12 unless ``solver`` is given), its heel strike at
-    a landing ``drop_m`` [m] below the stance foot's level (stairs:
-    :func:`walkerlab.models.hybrid.ground.on_landing`; 0: the slope's).
+    ``x_0`` (DOP853 at rtol = atol = 1e-12 unless ``solver`` is given).
 
     Returns
     -------
@@ -372,12 +370,8 @@ def replay_phases(data, res: PhasedResult, solver=None, drop_m: float = 0.0):
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
-    passive = make_rigid_walker(data, "biped", "derived", double_support=False)
-    if drop_m != 0.0:
-        from walkerlab.models.hybrid.ground import on_landing
-
-        passive = on_landing(passive, data, drop_m)
-    walker = actuate(passive, data, spec)  # the transcription has no double support yet
+    walker = actuate(make_rigid_walker(data, "biped", "derived", double_support=False), data,
+                     spec)  # the transcription has no double support yet
     acts = walker.actuators
     tau = phase_torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
@@ -464,53 +458,25 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
     x = np.stack([np.interp(tk, guess_t, guess_x[:, c]) for c in range(guess_x.shape[1])],
                  axis=1)
     u = np.interp(tk, guess_t, np.zeros_like(guess_t) if guess_u is None else guess_u)
-    res = collocate_phases(on_ground({**fns, "phases": [step_phase(fns)]}, spec, ground),
-                           spec, [("step", tk, x)], [u])
+    phase = step_phase(fns)
+    extra = {}
+    if ground is not None:
+        from walkerlab.optimal.transcription.landing import landing_phase
+
+        phase = landing_phase(phase, fns, ground.drops_m[0], ground.slope_rad)
+        if ground.advance_m is not None and spec.target_step_length_m is None:
+            # stairs: one tread a step (a target step length is the tread, held by it)
+            def constrain(opti, Xs, _Us, _Ts, advance=float(ground.advance_m)):
+                opti.subject_to(phase.step(Xs[-1][:, -1]) == advance)
+            extra["constrain"] = constrain
+    res = collocate_phases({**fns, "phases": [phase], **extra}, spec, [("step", tk, x)],
+                           [u])
     return CollocationResult(
         t=res.t, x=res.x, u=res.u, step_period_s=res.step_period_s,
         step_length_m=res.step_length_m, push_off_n_s=res.push_off_n_s,
         objective=res.objective, status=res.status, iterations=res.iterations,
         wall_time_s=res.wall_time_s, terms={"push_off_work": 0.0, **res.terms},
         history=res.history, violations=res.violations)
-
-
-#: the swing foot's least height above the stance tread before the last phase [m] (a kneed
-#: walker on stairs, :func:`on_ground`): the rigid model ends the unlocked swing in a fall
-#: when the foot goes 1e-9 L below it.  Measured on configs/kneed_optimal.yaml's walker down
-#: 3 cm risers, 0.4 m treads: with the bound at 0 the replay fell at 0.2997 s (the foot
-#: grazing the tread); at 0.1 mm it closed (1.6e-7) but dipped below the tread between the
-#: points, the multipliers' variational run scuffing; at 1 mm both run (|multiplier| 1.267)
-#: and the effort rises 0.5724 -> 0.5754 N^2 m^2 s
-STAIRS_CLEARANCE_M = 1e-3
-
-
-def on_ground(fns: dict, spec, ground) -> dict:
-    """``fns`` (a step's phases, the last ending in the heel strike) with that heel strike
-    on the ground of one landing ``ground`` (stairs, footholds of one height:
-    :func:`walkerlab.optimal.transcription.landing.landing_phase`) and, on stairs, the
-    step's advance held to the tread (``constrain``; a target step length, which is the
-    tread, holds it already); the phases before the last (a kneed walker's unlocked swing)
-    keep the swing foot :data:`STAIRS_CLEARANCE_M` above the stance tread's line at every
-    point (the rigid model's scuff guard ends the step there in a fall); ``ground`` None:
-    ``fns`` itself."""
-    if ground is None:
-        return fns
-    from walkerlab.optimal.transcription.landing import landing_phase
-
-    phases = list(fns["phases"])
-    last = landing_phase(phases[-1], fns, ground.drops_m[0], ground.slope_rad)
-    advance = ground.advance_m if spec.target_step_length_m is None else None
-
-    def constrain(opti, Xs, _Us, _Ts):
-        if advance is not None:
-            opti.subject_to(last.step(Xs[-1][:, -1]) == float(advance))
-        for p in range(len(phases) - 1):  # the swing foot above the stance tread before
-            for k in range(Xs[p].shape[1]):  # the last phase (the rigid model's scuffing)
-                opti.subject_to(phases[p].clearance(Xs[p][:, k]) >= STAIRS_CLEARANCE_M)
-    out = {**fns, "phases": [*phases[:-1], last]}
-    if advance is not None or len(phases) > 1:
-        out["constrain"] = constrain
-    return out
 
 
 def collocate_footholds(fns: dict, spec, ground, guess: list, guess_u: list | None = None
