@@ -65,7 +65,7 @@ def _close(a, b, rel=REL):
 
 def test_paper_statements_and_contact_as_written(paper):
     """The paper's walker: UNITS mm-kg-s, one PART per link + hip, the contact law exactly
-    as the scene writes it (1e5 N/mm^2.2, 90 N s/mm, 0.1 mm, 0.9/0.7, 100 and 1000 mm/s),
+    as the scene writes it (1e5 N/mm^2.2, 90 N s/mm, 0.1 mm, 0.9/0.7, 10 and 100 mm/s),
     every line within 80 columns, every statement within the reader's subset."""
     scene, mb, adm, acf = paper
     assert all(len(ln) <= LINE_WIDTH for ln in adm.splitlines())
@@ -84,8 +84,8 @@ def test_paper_statements_and_contact_as_written(paper):
                                          "STICTION_TRANSITION_VELOCITY",
                                          "FRICTION_TRANSITION_VELOCITY")} == {
             "STIFFNESS": 1e5, "EXPONENT": 2.2, "DAMPING": 90.0, "DMAX": 0.1,
-            "MU_STATIC": 0.9, "MU_DYNAMIC": 0.7, "STICTION_TRANSITION_VELOCITY": 100.0,
-            "FRICTION_TRANSITION_VELOCITY": 1000.0}
+            "MU_STATIC": 0.9, "MU_DYNAMIC": 0.7, "STICTION_TRANSITION_VELOCITY": 10.0,
+            "FRICTION_TRANSITION_VELOCITY": 100.0}
         si = model.contact_si(c.id)
         want = contact_si(scene.contact)[0]
         assert all(math.isclose(si[k], getattr(want, k), rel_tol=REL) for k in si)
@@ -145,13 +145,13 @@ def _round_trip(scene, mb, adm):
 
 def test_paper_round_trip(paper):
     """scene -> .adm -> the paper walker's numbers (Table 1: 10 kg hip, 5 kg legs with
-    their mass at 0.5 m, 1 m legs, zero inertia) and its start: the rigid gait with the
-    stance rate x 1.1 (contact_sim.initial_rate_scale), slope 0.0174 rad."""
+    their mass at 0.5 m, 1 m legs, zero inertia) and its start: the rigid gait unscaled
+    (contact_sim.initial_rate_scale 1, 1), slope 0.0174 rad."""
     scene, mb, adm, _ = paper
     model, start = _round_trip(scene, mb, adm)
     assert model.part_mass(2) == 10.0
     assert [model.part_mass(p) for p in (3, 4)] == [5.0, 5.0]
-    assert start.rate_scale == (1.0, 1.1)
+    assert start.rate_scale == (1.0, 1.0)
     patches = [m for mid, m in model.by_kind["MARKER"].items() if mid > 1000]
     for m in patches:  # the tilted ground: REULER = -phi about z
         assert math.isclose(-m.numbers("REULER")[0], scene.slope.phi_rad, rel_tol=REL)

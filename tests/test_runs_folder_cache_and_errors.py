@@ -144,6 +144,7 @@ def test_strict_finite_numbers_name_the_field(tmp_path, path, value, field):
 
 def test_strict_still_accepts_yaml_ints_and_nested_mappings(tmp_path):
     d = _with(_with(PAPER, "walker.leg_length_m", 1), "walker.hip_mass_kg", 10)
+    d = _with(d, "contact_sim.initial_rate_scale", [1, 1.1])
     sc = load_scene(_write(tmp_path / "s.yaml", _with(d, "contact.max_damping_n_s_per_mm", 90)))
     assert isinstance(sc.walker.leg_length_m, float) and sc.walker.leg_length_m == 1.0
     assert sc.contact_sim.initial_rate_scale == (1.0, 1.1)  # a YAML list -> tuple

@@ -227,13 +227,15 @@ def _contact(scene, d, runs: Path) -> tuple[float, str]:
     with _h5(cs) as f, _h5(sim) as s, _h5(fp) as g:
         n = _rigid_steps_per_period(g)
         strikes = int(f["summary/heel_strikes"][()])
+        why = str(f.attrs.get("outcome_message", ""))
         h = np.asarray(f["events/heel_strike_times"][:], float)
         t, x = f["samples/points/hip/time"][:], f["samples/points/hip/x"][:]
         ok = s["steps/termination"][:].astype(str) == "heel_strike"
         hr = np.asarray(s["steps/t_end"][:][ok], float)
         tr, xr = s["samples/points/hip/time"][:], s["samples/points/hip/x"][:]
     if strikes < STRIKES:
-        return math.nan, f"contact-sim walked {strikes} heel strikes of {STRIKES}"
+        return math.nan, (f"contact-sim walked {strikes} heel strikes of {STRIKES}"
+                          + (f": {' '.join(why.split())}" if why else ""))
     steps = min(h.size, hr.size)
     window = n * math.ceil(SETTLED / n)  # whole periods of the rigid gait
     if steps < window + 1:

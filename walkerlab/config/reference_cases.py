@@ -207,6 +207,11 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     if feature == "profile":  # the slope itself as a profile (x horizontal, y up [m]): its
         # walk is the slope's walk, step for step
         d["terrain"] = slope_profile(_shipped(base)["slope"])
+        # the contact periodic gait's step map lays patches (checkerboard lanes): a profile
+        # has none, so the contact view walks from the rigid gait without it
+        if d.get("contact_sim"):
+            d["contact_sim"] = {**d["contact_sim"], "periodic_gait": False}
+            d["contact_sim"].pop("start", None)
         return f"generated: configs/{base} on a profile equal to its slope", d
     return f"generated: configs/{base} with {feature}", d
 
