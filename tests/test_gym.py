@@ -254,6 +254,24 @@ def test_the_rigid_view_refuses_a_ground_drawn_per_step_and_an_actuated_profile(
         WalkerEnv(d)
 
 
+@pytest.mark.parametrize("kind", ["flat_feet", "hinged_torso"])
+def test_both_views_refuse_a_profile_as_the_tables_gym_cell_does(kind):
+    """The capability table refuses a profile in the gym for flat feet and the three-link
+    walker (the rigid walk of a profile takes neither); before, the contact view took their
+    profile reference cases anyway.  Now both views refuse it in the table's one line."""
+    from walkerlab.config.reference_cases import reference_scene
+    from walkerlab.gym.env import WalkerEnv
+    from walkerlab.walker.kinds import KINDS
+
+    why = KINDS[kind].cell("profile", "gym")
+    assert why is not None
+    d = reference_scene(kind, "profile", "gym")[1]
+    for view in ("rigid", "contact"):
+        with pytest.raises(ValueError) as exc:
+            WalkerEnv(d, view=view)
+        assert str(exc.value) == f"walkerlab.gym: terrain.kind: profile: {why}"
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name,periods", [("footholds_two", 880), ("profile", 560)])
 def test_the_contact_view_walks_footholds_and_a_profile_as_contact_sim_does(name, periods,
