@@ -15,7 +15,10 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     ``walkerlab contact-sim`` walks at least 10 heel strikes; its last 4 steps (whole
     periods of the rigid gait), past the transient of its start, against ``walkerlab
     simulate``'s same steps on the same ground: the mean step period and the hip's speed
-    (relative, 3 %), and the spread of the step periods' deviations (steady: 3 %).
+    (relative, 3 %), and the spread of the step periods' deviations (steady: 3 %).  On a
+    profile that is the scene's slope (the profile cells' generated cases) also the contact
+    walk on that slope, heel strike by heel strike (the same ground: integration
+    tolerance), and the rigid walk the slope's where the rigid view refuses the profile.
 ``mjcf``, ``osim``
     The exported file walked in its engine (MuJoCo, OpenSim) for 10 heel strikes from the
     rigid gait: the mean step period against the rigid one (relative, 3 %).
