@@ -85,8 +85,6 @@ def test_stairs_as_patches_at_the_footholds_and_as_treads_and_risers():
 
 
 @pytest.mark.parametrize("terrain, field", [
-    ({"kind": "profile", "profile_m": [[0, 0], [1, -0.01]], "riser_m": None,
-      "tread_m": None, "direction": None}, "terrain.lanes: a profile"),
     ({"kind": "footholds", "foothold_heights_m": [-0.01], "lanes": "continuous",
       "riser_m": None, "tread_m": None, "direction": None}, "terrain.lanes"),
 ])
@@ -268,7 +266,7 @@ def test_a_profile_on_checkerboard_lanes_lays_the_slopes_patches_or_says_how_far
         walker(wavy)
     msg = str(exc.value)
     assert "\n" not in msg and msg.startswith("terrain.lanes: checkerboard on a profile")
-    depth_mm = float(msg.split("departs from it by ")[1].split(" mm")[0])
+    depth_mm = float(msg.split(" m along the slope by ")[1].split(" mm")[0])
     assert 0.01 < depth_mm < 0.5
 
 

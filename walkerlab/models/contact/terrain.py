@@ -266,13 +266,10 @@ def profile_patch_heights(terrain, centres_m, half_width_m: float, phi: float,
         dev = float(np.max(np.abs(height(q) - hk)))
         if dev > PROFILE_PATCH_TOL_M:
             raise ValueError(
-                f"terrain.lanes: checkerboard on a profile lays flat patches at the footfalls "
-                f"at the profile's height (the contact model's patches are parallel to the "
-                f"slope); across the patch at s = {ck:.4g} m along the slope the profile "
-                f"departs from it by {1e3 * dev:.3g} mm, more than "
-                f"{1e3 * PROFILE_PATCH_TOL_M:g} mm: give lanes: continuous (the profile as a "
-                "polyline; a walker with knees clears it), or a profile straight along the "
-                "slope across each footfall's patch")
+                f"terrain.lanes: checkerboard on a profile lays flat patches at its height; "
+                f"the profile departs from the patch at s = {ck:.4g} m along the slope by "
+                f"{1e3 * dev:.3g} mm (more than {1e3 * PROFILE_PATCH_TOL_M:g} mm): give "
+                "lanes: continuous, or a profile straight across each footfall's patch")
     return h
 
 
