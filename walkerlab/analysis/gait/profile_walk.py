@@ -23,7 +23,10 @@ profile, named with its time and place.  One foot-through stays ignored, as the 
 ignores it (McGeer 1990; Garcia et al. 1998): straight legs' swing foot dipping below the
 ground when it passes the stance foot at the legs' alignment, as deep as it dips below the
 step's own ground line through the stance foot (the landing segment's slope); its depth is
-reported (``midstance_scuff_depth_m``), a profile above that line there is a trip.
+reported (``midstance_scuff_depth_m``), a profile above that line there is a trip.  The
+step lands only on the segment under its landing (the segment solving above): a first
+contact earlier on the way, even one the foot comes down onto (a bend up just before the
+landing segment), is reported as that trip, not solved as a landing there.
 """
 
 from __future__ import annotations
