@@ -255,6 +255,51 @@ def test_the_rigid_view_refuses_a_ground_drawn_per_step_and_an_actuated_profile(
 
 
 @pytest.mark.slow
+def test_the_rigid_view_trips_on_a_wall_where_simulate_does():
+    """The paper's walker on its slope written as a profile with a 1 m wall half-way
+    between footfalls 1 and 2 (before: the rigid view walked through it): under a zero
+    action the episode ends as a ``trip`` after 1 heel strike, as ``simulate``'s walk does
+    (:func:`walkerlab.analysis.gait.rigid_run.profile_walk`), the foot meeting the wall at
+    the same time and place (to 1e-8 s and m: the integrator restarted at each control
+    period against one step's integration)."""
+    import yaml
+
+    from walkerlab.analysis.gait.rigid_run import profile_walk
+    from walkerlab.gym.env import WalkerEnv
+
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    t = np.tan(d["slope"]["angle_rad"])
+    x0 = 0.58  # half-way between footfalls 1 and 2 (0.3867 m steps from x = 0)
+    pts = [(0.0, 0.0), (x0, 0.0), (x0 + 1e-3, 1.0), (x0 + 0.05, 1.0),
+           (x0 + 0.051, 0.0), (20.0, 0.0)]
+    d["terrain"] = {"kind": "profile", "profile_m": [[x, -x * t + h] for x, h in pts]}
+    env = WalkerEnv(d, max_episode_steps=400)  # its gait: the scene's slope's (the profile)
+    ref = profile_walk(env.rigid.scene, env.gait.x, 6)
+    assert ref.termination == "trip" and len(ref.segments) == 2
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "trip" and strikes.size == 1
+    assert np.allclose(env.sim.trip, ref.profile_trip, atol=1e-8, rtol=0)
+
+
+@pytest.mark.parametrize("kind", ["flat_feet", "hinged_torso"])
+def test_both_views_refuse_a_profile_as_the_tables_gym_cell_does(kind):
+    """The capability table refuses a profile in the gym for flat feet and the three-link
+    walker (the rigid walk of a profile takes neither); before, the contact view took their
+    profile reference cases anyway.  Now both views refuse it in the table's one line."""
+    from walkerlab.config.reference_cases import reference_scene
+    from walkerlab.gym.env import WalkerEnv
+    from walkerlab.walker.kinds import KINDS
+
+    why = KINDS[kind].cell("profile", "gym")
+    assert why is not None
+    d = reference_scene(kind, "profile", "gym")[1]
+    for view in ("rigid", "contact"):
+        with pytest.raises(ValueError) as exc:
+            WalkerEnv(d, view=view)
+        assert str(exc.value) == f"walkerlab.gym: terrain.kind: profile: {why}"
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("name,periods", [("footholds_two", 880), ("profile", 560)])
 def test_the_contact_view_walks_footholds_and_a_profile_as_contact_sim_does(name, periods,
                                                                            tmp_path):

@@ -305,6 +305,47 @@ def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fix
     assert tr.segments[-1].x_next[3] < ref.segments[-1].x_next[3] - 0.01  # faster stance
 
 
+def test_a_wall_or_a_pit_under_the_swing_foot_ends_the_profile_walk_as_a_trip(
+        paper_scene, paper_fixed_point):
+    """The paper's walker on its slope written as a profile (level scene slope): the swing
+    foot's path is checked against the profile between footfalls.  Plain, the walk is the
+    slope's and only the straight legs' mid-stance foot-through is found (ignored as the
+    ideal model ignores it; its depth reported, under 1 cm).  A 1 m wall half-way between
+    footfalls 1 and 2 (before: the same walk as the plain profile) ends the walk in step 1
+    as a trip at the wall's face, the steps before it unchanged; a 100 m pit under footfall
+    2 ends it as a trip at the pit's side (the swing foot going into the ground there)."""
+    from walkerlab.analysis.gait.profile_walk import profile_height
+    from walkerlab.analysis.gait.rigid_run import profile_walk
+
+    t = np.tan(paper_scene.slope.phi_rad)
+    d = paper_scene.model_dump(mode="json")
+    d["slope"] = {"angle_rad": 0.0}
+
+    def walk(bumps):  # bumps: (x [m], height above the slope line [m]) vertices
+        pts = sorted([(-1.0, 0.0), (0.0, 0.0), (20.0, 0.0), *bumps])
+        d["terrain"] = {"kind": "profile", "profile_m": [[x, -x * t + h] for x, h in pts]}
+        sc = scene_from_dict(d)
+        return profile_walk(sc, paper_fixed_point.x, 4), np.asarray(d["terrain"]["profile_m"])
+
+    plain, _ = walk([])
+    assert plain.termination == "heel_strike" and len(plain.segments) == 4
+    assert plain.profile_trip is None and 0.0 < plain.midstance_scuff_depth_m < 0.01
+    feet = [s.stance_foot_world[0] for s in plain.segments]
+    x_w = 0.5 * (feet[1] + feet[2])  # a 1 m wall, 1 mm faces, 5 cm thick
+    wall, P = walk([(x_w, 0.0), (x_w + 1e-3, 1.0), (x_w + 0.05, 1.0), (x_w + 0.051, 0.0)])
+    assert wall.termination == "trip" and len(wall.segments) == 2
+    tt, xt, yt = wall.profile_trip
+    seg = wall.segments[-1]
+    assert seg.t_start < tt == seg.t_end < plain.segments[1].t_end
+    assert x_w <= xt <= x_w + 1e-3 and 0.0 < yt - (-xt * t) < 1.0  # on the wall's face
+    assert abs(yt - profile_height(P, xt)) < 1e-9  # where it meets the profile
+    assert np.array_equal(wall.segments[0].x_next, plain.segments[0].x_next)
+    pit, P = walk([(feet[2] - 0.1, 0.0), (feet[2] - 0.099, -100.0), (feet[2] + 0.099, -100.0),
+                   (feet[2] + 0.1, 0.0)])
+    assert pit.termination == "trip" and len(pit.segments) == 2
+    assert feet[2] - 0.1 <= pit.profile_trip[1] <= feet[2] + 0.1
+
+
 def test_a_profile_from_a_csv_is_its_points(tmp_path):
     """``terrain.profile_csv`` (issue 49: "inline or from a CSV"; before: refused at the walk):
     read relative to the scene's folder (a header row and ``#`` lines skipped) into

@@ -85,8 +85,6 @@ def test_stairs_as_patches_at_the_footholds_and_as_treads_and_risers():
 
 
 @pytest.mark.parametrize("terrain, field", [
-    ({"kind": "profile", "profile_m": [[0, 0], [1, -0.01]], "riser_m": None,
-      "tread_m": None, "direction": None}, "terrain.lanes: a profile"),
     ({"kind": "footholds", "foothold_heights_m": [-0.01], "lanes": "continuous",
       "riser_m": None, "tread_m": None, "direction": None}, "terrain.lanes"),
 ])
@@ -215,6 +213,77 @@ def test_a_profile_is_the_contact_models_polyline_ground():
                            if -1.0 + 0.1 * i > 0.3 else 0.0)] for i in range(61)])
     c, res = _heel_strikes(bumpy)
     assert len(c) == len(a) and not np.allclose(c, a, atol=1e-4), res.message
+
+
+def _rods_on(terrain: dict, n_strides: int = 5):
+    """configs/paper_rods.yaml (straight legs: the swing foot passes below the ground at
+    mid-stance, the checkerboard's gap takes it) on ``terrain``, its own lanes."""
+    d = load_scene(ROOT / "configs" / "paper_rods.yaml").model_dump(mode="json")
+    d["terrain"] = {"lanes": "checkerboard", "patch_width_m": 0.3, **terrain}
+    d["contact_sim"]["n_strides"] = n_strides
+    return scene_from_dict(d)
+
+
+def test_a_profile_on_checkerboard_lanes_lays_the_slopes_patches_or_says_how_far_off():
+    """A profile on checkerboard lanes (before: refused; the straight-legged walkers of the
+    capability table's profile cells fell on the continuous polyline, scuffing at
+    mid-stance): flat patches at the footfalls at the profile's height, its first point at
+    the first stance foot.  The slope written as a profile gives the slope's patches
+    (heights 0 to rounding: 1e-15 m); the same line 2 mm lower from 3 m on gives patches
+    2 mm cos(phi) lower past it; a 0.5 mm sine of 0.9 m
+    wavelength is refused in one line naming terrain.lanes and the depth it departs from a
+    patch (between 0.01 and 0.5 mm, more than the 1 um allowed)."""
+    import math
+
+    from walkerlab.models.contact.model import ContactWalker
+
+    sc = _rods_on({})
+    phi = sc.slope.phi_rad
+    t = math.tan(phi)
+    xs = [float(x) for x in range(-2, 11)]
+    w0 = ContactWalker(phi=phi, data=None)
+
+    def walker(points):
+        terrain = _rods_on({"kind": "profile", "profile_m": points}).terrain
+        return w0.on_terrain(terrain, step_length=0.4, n_steps=20)
+
+    w = walker([[x, -x * t] for x in xs])
+    assert np.max(np.abs(np.concatenate([w.heights1, w.heights2]))) < 1e-15
+    assert w.ground_line is None and not w.continuous
+    ref = w0.on_terrain(sc.terrain, step_length=0.4, n_steps=20)
+    assert np.array_equal(w.lane1, ref.lane1) and np.array_equal(w.lane2, ref.lane2)
+    step = [[-2.0, 2 * t], [1.0, -t], [1.0 + 1e-6, -(1.0 + 1e-6) * t - 0.002],
+            [10.0, -10 * t - 0.002]]
+    w = walker(step)
+    s_step = 3.0 / math.cos(phi)  # x = 1 m along the slope from the first point (s = 0)
+    for lane, h in ((w.lane1, w.heights1), (w.lane2, w.heights2)):
+        assert np.allclose(h[lane > s_step + 0.15], -0.002 * math.cos(phi), atol=1e-12)
+        assert np.allclose(h[lane < s_step - 0.15], 0.0, atol=1e-12)
+        assert np.sum(lane > s_step + 0.15) >= 3 and np.sum(lane < s_step - 0.15) >= 3
+    wavy = [[0.1 * i - 2, -(0.1 * i - 2) * t + 5e-4 * math.sin(2 * math.pi * (0.1 * i - 2)
+                                                               / 0.9)] for i in range(121)]
+    with pytest.raises(ValueError) as exc:
+        walker(wavy)
+    msg = str(exc.value)
+    assert "\n" not in msg and msg.startswith("terrain.lanes: checkerboard on a profile")
+    depth_mm = float(msg.split(" m along the slope by ")[1].split(" mm")[0])
+    assert 0.01 < depth_mm < 0.5
+
+
+@pytest.mark.slow
+def test_the_straight_legged_contact_walk_on_its_slope_as_a_profile_is_the_slopes_walk():
+    """The capability table's reference case: configs/paper_rods.yaml on its slope written
+    as a profile (checkerboard lanes, as on the slope).  Before: 0 heel strikes (the
+    profile was continuous ground only).  Now its contact walk is the slope's, heel strike
+    for heel strike, to integration tolerance (1e-9 s; measured identical)."""
+    import math
+
+    phi = _rods_on({}).slope.phi_rad
+    pts = [[float(x), -x * math.tan(phi)] for x in range(-2, 21)]
+    a, _ = _heel_strikes(_rods_on({}, 3))
+    b, res = _heel_strikes(_rods_on({"kind": "profile", "profile_m": pts}, 3))
+    assert len(a) >= 6 and len(b) == len(a), res.message
+    assert np.max(np.abs(a - b)) < 1e-9
 
 
 def test_a_profile_exports_as_a_height_field_and_walks_in_mujoco(tmp_path):

@@ -204,21 +204,19 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         return f"configs/{ground}.yaml with an optimize section (least effort, 40 intervals)", d
     base = SCENES[kind].removeprefix("configs/")
     d = scene_for(kind, feature, view)
-    if feature == "profile":  # the slope itself as a profile (x horizontal, y up [m]): its
-        # walk is the slope's walk, step for step
-        d["terrain"] = slope_profile(_shipped(base)["slope"])
-        # the contact periodic gait's step map lays patches (checkerboard lanes): a profile
-        # has none, so the contact view walks from the rigid gait without it
-        if d.get("contact_sim"):
-            d["contact_sim"] = {**d["contact_sim"], "periodic_gait": False}
-            d["contact_sim"].pop("start", None)
+    if feature == "profile":  # the slope itself as a profile (x horizontal, y up [m]), on
+        # the scene's own lanes: its walk is the slope's walk, step for step
+        shipped = _shipped(base)
+        d["terrain"] = slope_profile(shipped["slope"], terrain=shipped.get("terrain"))
         return f"generated: configs/{base} on a profile equal to its slope", d
     return f"generated: configs/{base} with {feature}", d
 
 
-def slope_profile(slope: dict, x_end_m: float = 40.0) -> dict:
+def slope_profile(slope: dict, x_end_m: float = 40.0, terrain: dict | None = None) -> dict:
     """A ``terrain`` mapping: the scene's slope as a height profile, ``y = -x tan(phi)``
-    from x = -2 m to ``x_end_m`` (one point a metre).
+    from x = -2 m to ``x_end_m`` (one point a metre), on the contact lanes of the scene's
+    ``terrain`` (checkerboard patches of its width, as the slope's walk has them, or
+    continuous ground; the default lanes: checkerboard).
 
     Parameters
     ----------
@@ -226,11 +224,20 @@ def slope_profile(slope: dict, x_end_m: float = 40.0) -> dict:
         A scene's ``slope`` mapping (``angle_rad`` or ``angle_deg``).
     x_end_m : float
         The profile's last x [m].
+    terrain : dict, optional
+        The scene's ``terrain`` mapping (its ``lanes``, or ``kind: checkerboard|continuous``
+        as the shipped scenes write them, and ``patch_width_m``).
     """
     import math
 
     phi = (slope["angle_rad"] if slope.get("angle_rad") is not None
            else math.radians(slope["angle_deg"]))
     xs = [float(x) for x in range(-2, int(x_end_m) + 1)]
-    return {"kind": "profile", "lanes": "continuous",
-            "profile_m": [[x, -x * math.tan(phi)] for x in xs]}
+    t = terrain or {}
+    lanes = t.get("lanes") or (t.get("kind") if t.get("kind") in ("checkerboard",
+                                                                   "continuous") else None)
+    out = {"kind": "profile", "lanes": lanes or "checkerboard",
+           "profile_m": [[x, -x * math.tan(phi)] for x in xs]}
+    if out["lanes"] == "checkerboard" and "patch_width_m" in t:
+        out["patch_width_m"] = t["patch_width_m"]
+    return out

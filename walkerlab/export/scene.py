@@ -270,8 +270,9 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
     if terrain.kind == "profile":
         from walkerlab.models.contact.terrain import check_ground, profile_line
 
-        check_ground(terrain)  # continuous lanes, an inline profile: one line otherwise
-        profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin
+        check_ground(terrain)  # an inline profile: one line otherwise
+        if terrain.lanes == "continuous":
+            profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin
     elif not terrain.is_slope:
         lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
     if lane_heights is not None and len(ground_drops(terrain)) > 1:
@@ -284,6 +285,8 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
     notes = _walker_notes(scene, part, ideal, latch, knee, notes)
     notes += feet_part.notes_for(data)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
+    if terrain.kind == "profile" and lanes is not None:  # checkerboard patches on it
+        lane_heights = _profile_patches(terrain, lanes, ahead, float(walker.phi))
     if treads is not None or profile is not None:
         lanes = None  # continuous stairs (the treads) or a profile (a height field) is the ground
     terrain_notes += _ground_notes(terrain, treads, profile, lane_heights)
@@ -339,6 +342,26 @@ def _footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings
     return lanes, heights
 
 
+def _profile_patches(terrain: TerrainSettings, lanes: tuple, ahead_m: float,
+                     phi: float) -> tuple:
+    """The heights ``(leg1's, leg2's)`` [m] along the slope normal of the checkerboard
+    patches ``lanes`` (along-slope centres [m], leg2's contact point at the origin, the
+    profile's first point there) on a height profile: the contact model's flat patches
+    (:func:`walkerlab.models.contact.terrain.profile_patch_heights`), each box from its
+    footfall ``- w/2`` to ``+ w/2 + ahead_m``.
+
+    Raises
+    ------
+    ValueError
+        A profile not flat across a patch (one line naming ``terrain.lanes``).
+    """
+    from walkerlab.models.contact.terrain import profile_patch_heights
+
+    hw = 0.5 * (terrain.patch_width_m + ahead_m)
+    return tuple(tuple(float(h) for h in profile_patch_heights(
+        terrain, np.asarray(lane, float) + 0.5 * ahead_m, hw, phi)) for lane in lanes)
+
+
 def _ground_notes(terrain: TerrainSettings, treads, profile, lane_heights) -> tuple:
     """The MJCF's comments on a ground that is not the plain slope (stairs, a profile,
     footholds)."""
@@ -352,6 +375,11 @@ def _ground_notes(terrain: TerrainSettings, treads, profile, lane_heights) -> tu
         terrain_notes += ("Profile (terrain.kind: profile, lanes: continuous): a height field "
                           "hfield 'profile' sampled every 5 mm from its polyline, the first "
                           "stance foot on its first point (both feet touch it).",)
+    elif lane_heights is not None and terrain.kind == "profile":
+        terrain_notes += ("Profile (terrain.kind: profile, lanes: checkerboard): the "
+                          "checkerboard patches, flat, each at the profile's height under it "
+                          "(walkerlab.models.contact.terrain.profile_patch_heights), the "
+                          "first stance foot on its first point.",)
     elif lane_heights is not None and terrain.kind == "footholds" \
             and len(set(terrain.foothold_heights_m or (0.0,))) > 1:
         terrain_notes += ("Footholds of several heights (terrain.foothold_heights_m, in "

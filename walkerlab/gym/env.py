@@ -56,6 +56,9 @@ landing on the segment under its foot, :class:`walkerlab.analysis.gait.profile_w
 ProfileGround`, a step landing off the segment it was walked on walked again from its
 start on the other with its periods' actions); the contact view lays the patches as
 ``walkerlab contact-sim`` does (:mod:`walkerlab.gym.contact_view`).
+A profile is taken in both views where the capability table's gym cell of the walker's
+kind takes it (:data:`walkerlab.walker.kinds.CAPABILITIES`), refused in its one line
+elsewhere.
 ``step`` and ``render`` before the first ``reset`` raise gymnasium's ``ResetNeeded`` (as
 ``gym.make``'s order enforcing does); an action that is not ``k`` finite real numbers of shape
 ``(k,)`` (None, NaN, inf, complex, another shape) raises :class:`InvalidAction` (a
@@ -283,6 +286,10 @@ class WalkerEnv(gym.Env):
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
+        if sc.terrain is not None and sc.terrain.kind == "profile":  # its gym cell, in both
+            # views (the contact view laid any profile contact-sim walks before)
+            data.structure.kind.require("profile", "gym",
+                                        "walkerlab.gym: terrain.kind: profile")
         vc = sc.walker.actuation.virtual_constraints if sc.walker.actuation else None
         if vc is not None:
             data.structure.kind.require("virtual_constraints", "gym",

@@ -19,7 +19,11 @@ segment under the swing foot (:class:`walkerlab.analysis.gait.profile_walk.Profi
 a heel strike off that segment walks the step again from its start on the segment the
 foot landed on, each of its control periods with the action it had (the step's start and
 periods are kept), so the landing is the one ``simulate`` finds.  A finite foothold list
-or a landing past the profile's end ends the episode (``ground_end``).
+or a landing past the profile's end ends the episode (``ground_end``).  On a profile the
+step's swing-foot path is checked against it at the heel strike, as ``simulate`` checks it
+(:func:`walkerlab.analysis.gait.profile_walk.swing_clearance`): a swing foot that went into
+the profile ends the episode as a ``trip`` there (the heel strike not made; :attr:`RigidView.
+trip` says when and where the foot met the profile).
 
 The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
 ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
@@ -132,6 +136,8 @@ class RigidView:
         self.foot = np.zeros(2) if self.ground is None else self.ground.start.copy()
         self.advance_x = 0.0  # the last step's advance along x [m] (a profile's segment)
         self.ended = ""
+        #: ``(t [s], x [m], y [m])`` where the swing foot met a profile (a ``trip``), or None
+        self.trip = None
         self.ledger = dict.fromkeys(LEDGER_TERMS, 0.0)
         self.steps = 0
         self._period = (np.zeros(0), 0.0)
@@ -155,6 +161,7 @@ class RigidView:
     def _start_step(self) -> None:
         self._step_start = (self.t, self.x.copy(), dict(self.ledger))
         self._log = [self._period]  # the control periods of this step
+        self._pieces: list = []  # on a profile: the step's dense output, piece by piece
         self._enter()
 
     def _enter(self) -> None:
@@ -234,6 +241,7 @@ class RigidView:
         self.x, self.ledger = x.copy(), dict(ledger)
         self.j, self.walker = j, self.ground.walker(j, self.foot)
         self._log = [log[0]]
+        self._pieces = []
         self._enter()
         strikes: list[float] = []
         if len(log) == 1:  # the step began in the present period: it goes on from there
@@ -277,6 +285,8 @@ class RigidView:
             run = integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n, self.solver,
                                   self.backend, rhs, jac, False)
             self._work(run.dense, self.t, run.t_last, acts, act_on)
+            if self.ground is not None:
+                self._pieces.append((phase, run.dense, (self.t, run.t_last)))
             self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
             if run.failed or not np.all(np.isfinite(self.x)):
                 self.ended = "solver_failure"
@@ -308,6 +318,10 @@ class RigidView:
                         strikes += self._again(j2)
                         continue
                     on = self.ground.goes_on(self.j, land)
+                    self.trip = self._swing_trip(w)
+                    if self.trip is not None:
+                        self.ended = "trip"
+                        break
                 self._heel_strike(guard)
                 strikes.append(self.t)
                 ends = self.model.ground_steps
@@ -315,6 +329,18 @@ class RigidView:
                         ends is not None and self.steps >= ends):
                     self.ended = "ground_end"  # the walk left the ground's end
         return strikes
+
+    def _swing_trip(self, w):
+        """Where the swing foot of the step just ended met the profile (``(t, x, y)``), or
+        None (:func:`walkerlab.analysis.gait.profile_walk.swing_clearance` on the step's
+        pieces of dense output, as ``simulate`` checks it)."""
+        from walkerlab.analysis.gait.profile_walk import swing_clearance
+        from walkerlab.integrate.rigid import Segment
+
+        t0, x0, _ = self._step_start
+        seg = Segment(self.steps, self.leg, t0, self.t, x0, self.x.copy(), None, "", "", {},
+                      0, "", pieces=list(self._pieces))
+        return swing_clearance(w, seg, self.foot, self.ground.P, self.j).trip
 
     def _heel_strike(self, guard) -> None:
         """The reset map (push-off and collision, roles swapped), the next step begun."""

@@ -325,18 +325,26 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
 #: how a rigid run that did not complete its strides ended, as a verb
 _ENDED = {"fall": "fell", "solver_failure": "stopped by a solver failure",
           "t_final": "stopped (a step took longer than max_step_time_s)",
-          "no_heel_strike": "made no step (no_heel_strike)"}
+          "no_heel_strike": "made no step (no_heel_strike)",
+          "trip": "tripped (the swing foot went into the profile)"}
 
 
 def simulate_ending(sim: SimulateArtifact) -> str | None:
     """``"fell after 17 heel strikes (8.5 strides of the 20 asked)"`` for a run that did not
-    complete its strides; None for one that did."""
+    complete its strides (a trip on a height profile: where and when the swing foot met
+    it); None for one that did."""
     if sim.termination == "heel_strike":
         return None
     n = sim.heel_strike_count()
-    return (f"{_ENDED.get(sim.termination, f'ended by {sim.termination}')} after {n} heel "
-            f"strike{'' if n == 1 else 's'} ({n / 2:g} strides of the "
-            f"{sim.strides_requested} asked)")
+    out = (f"{_ENDED.get(sim.termination, f'ended by {sim.termination}')} after {n} heel "
+           f"strike{'' if n == 1 else 's'} ({n / 2:g} strides of the "
+           f"{sim.strides_requested} asked)")
+    s = sim.summary
+    if sim.termination == "trip" and "trip_time_s" in s:
+        u = sim.units
+        out += (f": at t = {num(s['trip_time_s'], 6)} {u.time}, x = {num(s['trip_x_m'], 6)} "
+                f"{u.length}, y = {num(s['trip_y_m'], 6)} {u.length}")
+    return out
 
 
 def simulate_text(sim: SimulateArtifact) -> str:
@@ -365,6 +373,10 @@ def simulate_text(sim: SimulateArtifact) -> str:
     lines.append(f"  mean hip speed    {num(s['mean_hip_speed_m_per_s'], 7)} {u.speed}")
     lines.append(f"  mean total energy {num(s['mean_total_energy_J'], 7)} "
                  f"{u.energy} (potential from the first stance foot)")
+    if "midstance_scuff_depth_m" in s:  # the ideal model's foot-through, ignored
+        lines.append(f"  mid-stance scuff  {num(s['midstance_scuff_depth_m'], 3)} {u.length} "
+                     "deep at most (straight legs' swing foot below the profile as it passes "
+                     "the stance foot: ignored, as the ideal model does)")
     lines.append(f"  RHS evaluations   {int(s['nfev'])}, "
                  f"integration {num(s['wall_time_s'], 3)} s (wall clock)")
     return "\n".join(lines)

@@ -191,9 +191,9 @@ def scuff_cause(walker) -> str:
       sinks and the swing foot meets the ground; the latch holds it as the rigid model's
       knee lock does;
     - straight legs: the swing foot passes below the ground line near mid-stance (the
-      rigid model ignores that scuffing); on continuous slope or stairs the checkerboard
-      (``terrain.lanes: checkerboard``) gives it a gap there; a profile is continuous
-      ground only (the checkerboard is refused there): knees clear it;
+      rigid model ignores that scuffing); on continuous ground (a slope, stairs, a
+      profile) the checkerboard (``terrain.lanes: checkerboard``) gives it a gap there (on a
+      profile flat across each footfall's patch), knees clear it;
     - a latched kneed walker, flat feet, free knees: nothing general to name.
 
     Parameters
@@ -226,10 +226,11 @@ def _unlatched_knee(walker) -> str:
 def _straight_leg_scuff(walker) -> str:
     """Straight legs: the swing foot below the ground line near mid-stance."""
     straight = "a straight leg's swing foot passes below the ground line near mid-stance"
-    if getattr(walker, "ground_line", None) is not None:  # a profile: continuous only
-        return (f"({straight}; a profile is continuous ground, where straight legs scuff: "
-                "a walker with knees clears it)")
-    if walker.continuous:
+    if getattr(walker, "ground_line", None) is not None:  # a polyline: stairs or a profile
+        return (f"({straight}; terrain.lanes: checkerboard gives it a gap there, on a "
+                "profile where it is flat across each footfall's patch; a walker with "
+                "knees clears continuous ground)")
+    if walker.continuous:  # a slope laid as continuous ground
         return f"({straight}; terrain.lanes: checkerboard gives it a gap there)"
     return f"({straight})"
 

@@ -31,7 +31,10 @@ class RigidRun:
         steps that ended by a heel strike ``mean_period_s`` [s], ``mean_step_length_m`` [m],
         ``mean_hip_speed_m_per_s`` [m/s] (NaN: none), ``mean_total_energy_J`` [J]; on a
         finite ground shorter than the run (``terrain.periodic: false``) ``ground_steps``,
-        its steps (the walk ends there).
+        its steps (the walk ends there); on a height profile ``trip_time_s`` [s],
+        ``trip_x_m``, ``trip_y_m`` [m] (the swing foot entered the profile there: the walk
+        ended as a ``trip``) and ``midstance_scuff_depth_m`` [m] (the ignored foot-through
+        of straight legs at mid-stance), each only when it happened.
     """
 
     trajectory: object
@@ -67,6 +70,11 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
                                    else np.nan),
         "mean_total_energy_J": float(np.mean(samples.total)),
     }
+    trip = getattr(traj, "profile_trip", None)  # a height profile's swing-foot check
+    if trip is not None:
+        summary.update(trip_time_s=trip[0], trip_x_m=trip[1], trip_y_m=trip[2])
+    if getattr(traj, "midstance_scuff_depth_m", 0.0) > 0.0:
+        summary["midstance_scuff_depth_m"] = float(traj.midstance_scuff_depth_m)
     ends = getattr(walker, "ground_steps", None)
     if ends is not None and traj.termination == "heel_strike" and ends < 2 * sim.strides:
         summary["ground_steps"] = int(ends)  # a finite ground ended the walk

@@ -10,7 +10,11 @@ strike), ``stance_leg``, ``termination``,
 ``phases`` (each phase of the step and the guard that ended it) ...;
 ``steps/states/<i>`` start/end state of each segment as attributes); ``initial_state``
 [rad, rad/s]; ``summary/<name>`` (mean step period [s], step length [m], hip speed [m/s],
-total energy [J], RHS evaluations, integration wall time [s]); ``ledger/<name>`` (the
+total energy [J], RHS evaluations, integration wall time [s]; on a height profile, where
+the swing foot entered it, ``trip_time_s`` [s], ``trip_x_m``, ``trip_y_m`` [m], and the
+deepest ignored mid-stance foot-through of straight legs ``midstance_scuff_depth_m`` [m],
+each only when it happened: :func:`walkerlab.analysis.gait.profile_walk.swing_clearance`);
+``ledger/<name>`` (the
 energy ledger on dimension ``step``: actuator work, push-off work, collision losses, damper
 and potential work, closure [J], push-off impulse [N s], ``cost_of_transport`` [-];
 :mod:`walkerlab.analysis.gait.energy`).
@@ -63,7 +67,9 @@ LEDGER_DESCRIPTIONS = {
 }
 #: unit of each ``summary/`` entry (others: "-")
 SUMMARY_UNITS = {"wall_time_s": "s", "mean_period_s": "s", "mean_step_length_m": "m",
-                 "mean_hip_speed_m_per_s": "m/s", "mean_total_energy_J": "J"}
+                 "mean_hip_speed_m_per_s": "m/s", "mean_total_energy_J": "J",
+                 "trip_time_s": "s", "trip_x_m": "m", "trip_y_m": "m",
+                 "midstance_scuff_depth_m": "m"}
 
 
 @dataclass
@@ -232,7 +238,8 @@ def strides_of(path: Path) -> int | None:
 
 def run_end(path: Path) -> str:
     """How the run of ``simulate.h5`` ended (``termination``: "heel_strike" when every step
-    completed, "fall", ...).
+    completed, "fall", ...; a trip on a height profile with its time and place: "trip (the
+    swing foot entered the profile at t = 0.42 s, x = -1.5 m, y = 0.03 m)").
 
     Raises
     ------
@@ -240,7 +247,12 @@ def run_end(path: Path) -> str:
         Missing or unreadable artifact (one line).
     """
     with open_artifact(path, STAGE) as f:
-        return str(f.attrs["termination"])
+        term = str(f.attrs["termination"])
+        if term == "trip" and "summary/trip_time_s" in f:
+            t, x, y = (float(f[f"summary/trip_{k}"][()]) for k in ("time_s", "x_m", "y_m"))
+            term += (f" (the swing foot entered the profile at t = {t:.6g} s, "
+                     f"x = {x:.6g} m, y = {y:.6g} m)")
+        return term
 
 
 def longer_run_note(path: Path, asked: int, key_of) -> str:
