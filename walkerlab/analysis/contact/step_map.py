@@ -403,7 +403,8 @@ class StepMap:
             return self._push_off_section(x0, stance_to_come, ist, isw, hth)
         self.nfev += 1
         te, xe, end = powered_to_section(self.walker, np.asarray(x0, float),
-                                         1 - stance_to_come, lambda x: x[isw] - x[ist],
+                                         1 - stance_to_come,
+                                         lambda x: x[..., isw] - x[..., ist],
                                          self.solver, self.t_max, self.deadline, hth)
         return self._powered_end(te, xe, end)
 
