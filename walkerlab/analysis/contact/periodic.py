@@ -251,8 +251,10 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         BDF over the compiled right-hand side with the section crossing found by brentq;
         ``"odeint"`` the same through scipy's odeint and a Python RHS;
         the ``solve_ivp`` methods "LSODA", "Radau", "BDF" locate it as an event).  A
-        walker with hip torques defaults to :data:`POWERED_MAP_SOLVER` (its map is Python
-        throughout).
+        powered walker's step runs on compiled segments with ``"cyrk_bdf"``
+        (:mod:`walkerlab.integrate.contact_powered_step`); one whose torque laws are no
+        compiled data (a replay's Python callables) defaults to :data:`POWERED_MAP_SOLVER`
+        (its map is Python throughout).
     jacobian_solver : walkerlab.integrate.solver.Solver
         The map's integrator for the final FD Jacobian (same method as ``solver``).
     coarse_solver : walkerlab.integrate.solver.Solver or None
