@@ -14,7 +14,6 @@ import pytest
 import walkerlab as wl
 from walkerlab.config import SceneError
 from walkerlab.io.schemas.contact_sim import load_contact_sim
-from walkerlab.models.contact.scene import ContactSceneError
 from walkerlab.stages import pipeline
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
@@ -100,7 +99,8 @@ def test_strides_are_whole_and_within_the_field_s_range(paper_contact, strides):
         paper_contact.simulate(strides=strides)
 
 
-def test_a_period_without_a_start_and_a_scene_without_contact_are_refused(paper_contact):
+def test_a_period_without_a_start_is_refused_and_a_scene_without_contact_has_defaults(
+        paper_contact):
     with pytest.raises(SceneError, match="period_s goes with x0"):
         paper_contact.simulate(period_s=0.7)
     with pytest.raises(SceneError, match="period_s=-1"):
@@ -111,9 +111,9 @@ def test_a_period_without_a_start_and_a_scene_without_contact_are_refused(paper_
              "slope": {"angle_rad": 0.0174}, "fixedpoint": {}}
     assert wl.ContactWalker is wl.api.ContactWalker is wl.api.walker.ContactWalker
     assert paper_contact.rigid.contact().rigid is paper_contact.rigid
-    with pytest.raises(ContactSceneError, match="no 'contact' section") as err:
-        wl.Walker.from_scene(scene).contact()
-    assert "\n" not in str(err.value)
+    # no contact section: the contact view on the section's defaults, the paper's law
+    cw = wl.Walker.from_scene(scene).contact()
+    assert cw.scene.contact == paper_contact.scene.contact
 
 
 @pytest.mark.slow

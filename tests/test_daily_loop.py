@@ -45,9 +45,50 @@ def test_api_fixed_point_of_a_mapping_without_the_section(tmp_path):
     assert float(gait.step_period) == pytest.approx(0.7036, abs=5e-5)
 
 
-def test_a_section_with_a_required_field_is_still_needed(tmp_path):
-    rc, err, _ = _cli("contact-sim", _scene(tmp_path, BARE), "--runs-dir", tmp_path / "runs")
-    assert rc == 1 and err.startswith("error: scene 'scene' has no 'contact' section")
+def test_a_scene_without_contact_sets_up_the_papers_contact_law():
+    """Every field of ``contact:`` has a default: leaving the section out is ``contact: {}``,
+    and both are the paper's contact law (Sec. 4, as configs/paper.yaml writes it out: k
+    1e5 N/mm^2.2, 90 N s/mm at 0.1 mm, mu 0.9 / 0.7, 100 and 1000 mm/s), to the bit."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.models.contact.scene import contact_setup
+
+    bare = contact_setup(scene_from_dict(BARE | {"name": "bare"}))
+    empty = contact_setup(scene_from_dict(BARE | {"name": "empty", "contact": {}}))
+    paper = contact_setup(scene_from_dict(BARE | {"name": "paper",
+                                                  "contact": PAPER["contact"]}))
+    assert bare.law == empty.law == paper.law
+    assert bare.law_si == paper.law_si and bare.knee_stop == paper.knee_stop
+    assert bare.solver == paper.solver  # contact_solver left out: the contact default
+
+
+def test_the_report_runs_no_contact_sim_for_a_scene_without_contact():
+    """The report produces what a scene's sections ask for: ``contact_sim`` alone (a section
+    that configures the run) opts it into no contact run; ``contact: {}`` does."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages.pipeline import report_plan
+
+    d = BARE | {"name": "s", "fixedpoint": {}, "contact_sim": {"n_strides": 1}}
+    assert "contact-sim" not in report_plan(scene_from_dict(d))
+    assert "contact-sim" in report_plan(scene_from_dict(d | {"contact": {}}))
+
+
+@pytest.mark.slow  # a whole contact-sim command (a stride): about 5 s CPU
+def test_contact_sim_without_a_contact_section_runs_on_the_defaults(tmp_path):
+    """``walkerlab contact-sim`` of a scene without ``contact`` walks (the paper's contact
+    law), and its artifact is the one of ``contact: {}``: the same key, so the run with the
+    section written out empty reuses it."""
+    runs = tmp_path / "runs"
+    rc, err, out = _cli("contact-sim", _scene(tmp_path, BARE), "--strides", "1",
+                        "--runs-dir", runs)
+    assert rc == 0, err
+    with h5py.File(runs / "scene" / "contact_sim.h5") as f:
+        assert bool(f.attrs["walks"]) and int(f["summary/heel_strikes"][()]) >= 2
+        written = yaml.safe_load(f.attrs["scene_json"])["contact"]  # the law it ran on
+    assert all(written[k] == v for k, v in PAPER["contact"].items())
+    rc, err, out = _cli("contact-sim", _scene(tmp_path, BARE | {"contact": {}}), "--strides",
+                        "1", "--runs-dir", runs)
+    assert rc == 0, err
+    assert "reused" in out and "(inputs unchanged)" in out
 
 
 # --------------------------------------------------------------- 2: no-gait advice whole

@@ -297,3 +297,64 @@ def test_a_compiled_powered_run_walks_as_the_solve_ivp_run(rigid, monkeypatch):
     assert np.max(np.abs(old.X[i] - new.X[j])) < 1e-4
     assert np.max(np.abs(old.work[-1] - new.work[-1])) < 1e-5
     assert new.work[-1, list(WORK_NAMES).index("push_off")] > 0.1  # the pulses ran
+
+
+def test_a_zero_gain_hip_laws_compiled_step_map_is_the_passive_map():
+    """The powered step map (the whole step on compiled segments: CyRK's BDF over the
+    generated powered right-hand side, the touchdown, the roles swap and the mid-stance
+    section located on its dense output) of the paper walker with a hip law of zero gains
+    is the passive map (compiled grid runs, the section by brentq on short runs): one step
+    from the passive contact gait's section state at the map's tolerances (rtol 1e-12) lands
+    on the same section state within 1e-7 of each coordinate's scale and the same step
+    period and length within 1e-10 s and m (the two locate the section differently: the
+    powered one on an interpolant; measured 1.1e-9 of the scale, 6e-13 s, 1.3e-12 m), so the
+    search finds the passive gait (0.710968 s) on it; on solve_ivp (Python RHS, LSODA at rtol
+    1e-10) its search did not converge (scaled residual 2.5e-8)."""
+    from walkerlab.analysis.contact.periodic import MAP_SOLVER, ideal_gait
+    from walkerlab.analysis.contact.sim import scene_start
+    from walkerlab.analysis.contact.step_map import StepMap, section_guess_from_ideal
+
+    paper = load_scene(SCENE.with_name("paper.yaml"))
+    hip = with_changes(paper, {"walker.actuation": {"torques": [{"joint": "hip", "law": {
+        "stiffness_n_m_per_rad": 0.0, "damping_n_m_s_per_rad": 0.0}}]}})
+    gait = ideal_gait(paper)
+    maps = []
+    for sc in (paper, hip):
+        walker = scene_start(contact_setup(sc), gait.x, 2)[0]
+        maps.append(StepMap(walker, solver=MAP_SOLVER))
+    passive, powered = maps
+    assert powered.powered and not passive.powered
+    z = section_guess_from_ideal(passive, gait.x, (1.0, 1.1))
+    z1, T1, s1 = passive(z)
+    z2, T2, s2 = powered(z)
+    assert np.max(np.abs(z2 - z1) / passive.scale) < 1e-7
+    assert T2 == pytest.approx(T1, abs=1e-10) and s2 == pytest.approx(s1, abs=1e-10)
+
+
+POWERED_SCENES = sorted(p.stem for p in SCENE.parent.glob("*.yaml")
+                        if "actuation:" in p.read_text() and "\ncontact:" in p.read_text())
+
+
+@pytest.mark.parametrize("name", POWERED_SCENES)
+def test_every_shipped_powered_scene_runs_the_compiled_contact_run_or_says_why_not(name):
+    """A powered scene's contact run is the compiled one (``contact_solver.method:
+    cyrk_bdf``, the run ``walkerlab bench powered`` times) when its actuators are data of the
+    compiled right-hand side (:func:`walkerlab.models.contact.powered_data.powered_data`);
+    a scene on a ``solve_ivp`` method says why in the comment of its ``method:`` line (a
+    virtual-constraint controller is no compiled data: cyrk_bdf would run the same solve_ivp
+    run)."""
+    from walkerlab.integrate._cyrk import CYRK_METHODS
+    from walkerlab.models.contact.powered_data import powered_data
+
+    path = SCENE.with_name(f"{name}.yaml")
+    setup = contact_setup(load_scene(path))
+    data = powered_data(setup.model())
+    if setup.solver.method in CYRK_METHODS:
+        assert data is not None, f"{name}: a compiled solver for actuators that are no data"
+        return
+    line = next(ln for ln in path.read_text().splitlines()
+                if ln.strip().startswith("method:") and setup.solver.method in ln
+                and "#" in ln)
+    assert data is None and "no compiled data" in line, (
+        f"{name}: contact_solver.method {setup.solver.method} on actuators that are compiled "
+        "data, or no reason given")

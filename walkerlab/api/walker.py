@@ -512,9 +512,10 @@ class ContactWalker:
     Parameters
     ----------
     scene : walkerlab.config.Scene
-        A validated scene with a ``contact`` section (its ``walker``, ``slope``,
-        ``contact``, ``terrain``, ``contact_sim``, ``contact_solver`` and, for the rigid
-        gait, ``solver`` and ``fixedpoint`` sections are used).
+        A validated scene (its ``walker``, ``slope``, ``contact``, ``terrain``,
+        ``contact_sim``, ``contact_solver`` and, for the rigid gait, ``solver`` and
+        ``fixedpoint`` sections are used; a ``contact`` section left out is its defaults,
+        the paper's contact law, and :attr:`scene` has it written out).
     rigid : Walker, optional
         The scene's rigid walker (default: built here).
     step_time_limit_s : float
@@ -531,7 +532,7 @@ class ContactWalker:
     Raises
     ------
     walkerlab.models.contact.scene.ContactSceneError
-        No ``contact`` section, or a walker the contact view does not carry (one line:
+        A walker the contact view does not carry (one line:
         :func:`~walkerlab.models.contact.scene.contact_setup`).
     walkerlab.config.SceneError
         A bad ``step_time_limit_s``.
@@ -539,11 +540,12 @@ class ContactWalker:
 
     def __init__(self, scene: Scene, rigid: Walker | None = None,
                  step_time_limit_s: float = STEP_TIME_LIMIT_S):
+        from walkerlab.config.sections import with_default_section
         from walkerlab.integrate.solver import Solver
         from walkerlab.models.contact.scene import contact_setup
 
-        self.scene = scene
-        self.setup = contact_setup(scene)
+        self.scene = with_default_section(scene, "contact")  # left out: its defaults
+        self.setup = contact_setup(self.scene)
         self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s)
         self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
         self.solver = Solver.from_settings(self.setup.solver)

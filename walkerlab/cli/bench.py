@@ -36,6 +36,10 @@ benchmark      what is timed                                                    
 ``powered``    a powered contact run (hip law, push-off, RABBIT's phase law) on <= 1.5x
                its compiled run against the passive run of the same walker,     passive
                CPU, medians (:mod:`walkerlab.bench.powered_contact`)
+``powered-``   ``walkerlab contact-sim --force`` of the paper walker: passive,   <= 1.5x
+``command``    zero-gain hip law, push-off 0.5 N s, whole process (periodic     passive
+               gait included), CPU, rounds in turn, medians, warm cache
+               (:mod:`walkerlab.bench.powered_command`)
 ``hzd``        the restricted Poincare map's delta^2 of RABBIT under virtual    <= 10 ms
                constraints (configs/rabbit_hzd.yaml), median; the whole zero
                dynamics and one full-order step beside it
@@ -61,10 +65,11 @@ from walkerlab.io.artifacts import atomic_write
 
 #: benchmark -> the module whose ``lines(result)`` prints it (the others: their JSON)
 _LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.optimize",
-          "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd"}
+          "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd",
+          "powered-command": "walkerlab.bench.powered_command"}
 
 BENCHMARKS = ("ideal", "fixedpoint", "sweep", "sweep-workers", "basin", "contact", "main-job",
-              "optimize", "powered", "hzd")
+              "optimize", "powered", "powered-command", "hzd")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -177,6 +182,10 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.powered_contact import bench_powered_contact
 
         return bench_powered_contact()
+    if name == "powered-command":
+        from walkerlab.bench.powered_command import bench_powered_command
+
+        return bench_powered_command()
     if name == "hzd":
         from walkerlab.bench.hzd import bench_hzd
 

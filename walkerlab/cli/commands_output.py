@@ -101,8 +101,8 @@ def export(scene: Path | None = SceneArg,
 
 @guard
 def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
-                                     " | main-job | optimize | powered | hzd | all (all but "
-                                     "basin, main-job, optimize, powered and hzd)"),
+                                     " | main-job | optimize | powered | powered-command | hzd"
+                                     " | all (ideal, fixedpoint, sweep and contact)"),
           scenes: list[Path] | None = typer.Argument(
               None, help="contact only: scene YAML files whose walkers are timed (5 contact "
               "strides at <= 1e-6 rad against a tight reference), e.g. configs/kneed.yaml "

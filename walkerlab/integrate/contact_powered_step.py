@@ -2,17 +2,45 @@
 walker from a state through its next heel strike to a section (:func:`powered_to_section`),
 and one push-off (:func:`push_off`), on the actuation hook's segments
 (:class:`walkerlab.integrate.contact_powered.ActuationHook`, whose module docstring tells the
-pulse's timing)."""
+pulse's timing).
+
+With a compiled method (``cyrk_bdf``) and torque laws that are data, the segments are compiled
+(:class:`walkerlab.integrate.compiled_segments.CompiledSegments`: CyRK's BDF over the
+generated powered right-hand side, the events bracketed on a :data:`SECTION_DT_S` grid and
+located on the dense output), in chunks of at most :data:`SECTION_CHUNK_S`; otherwise (a
+``solve_ivp`` method, a replay's Python laws) :func:`scipy.integrate.solve_ivp` with event
+location.  The periodic-gait search evaluates this map some hundred times, so the compiled
+map is what keeps a powered ``contact-sim`` as cheap as a passive one.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .contact_powered import ActuationHook, impulse_jump
+from .contact_powered import ActuationHook, compiled_segments, impulse_jump
 from .ends import RunEnd
 from .powered_events import pulse_event, pulse_lead_s
 
-__all__ = ["powered_to_section", "push_off"]
+__all__ = ["SECTION_CHUNK_S", "SECTION_DT_S", "powered_to_section", "push_off"]
+
+#: The compiled map's sample spacing [s]: its events (touchdown, pulse start, section, fall)
+#: are bracketed on these samples (the passive map's grid,
+#: :meth:`walkerlab.analysis.contact.step_map.StepMap.next_section`).
+SECTION_DT_S = 2e-3
+#: The compiled map's segments end this long after their start at most [s] (a compiled
+#: segment integrates to its end before its events are looked for).
+SECTION_CHUNK_S = 0.25
+
+
+def _hook(walker, solver, limits, deadline, t0: float, t1: float):
+    """An :class:`ActuationHook` over ``[t0, t1]`` [s] on compiled segments where they apply
+    (:func:`~walkerlab.integrate.contact_powered.compiled_segments`, a :data:`SECTION_DT_S`
+    grid), else on ``solve_ivp``."""
+    k = max(int(np.ceil((t1 - t0) / SECTION_DT_S - 1e-9)), 1)
+    grid = np.append(t0 + SECTION_DT_S * np.arange(k), t1)
+    run = ActuationHook(walker, solver, limits, deadline, grid)
+    run.segments = compiled_segments(walker, solver, grid)
+    return run
 
 
 def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
@@ -34,9 +62,13 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
         The stance leg at the start (0: leg1, 1: leg2); time-based torque laws count from
         t = 0.
     section : callable
-        ``section(x) -> float``, searched only after the heel strike (upward zero).
+        ``section(x)``: a float of a state ``x`` (2 nq,), and, on compiled segments, the
+        values (m,) of states (m, 2 nq) (e.g. ``x[..., i] - x[..., j]``); searched only
+        after the heel strike (upward zero).
     solver : Solver
-        A :data:`~walkerlab.integrate.contact_powered.IVP_METHODS` method (others run as
+        A compiled method (:data:`walkerlab.integrate._cyrk.CYRK_METHODS`: compiled
+        segments, module docstring) or a
+        :data:`~walkerlab.integrate.contact_powered.IVP_METHODS` method (others run as
         ``LSODA``), ``rtol``, ``atol``.
     t_max : float
         Give up after this time [s].
@@ -55,7 +87,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
     from .contact_events import ContactLimits
 
     limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
-    run = ActuationHook(walker, solver, limits, deadline, np.array([0.0, t_max]))
+    run = _hook(walker, solver, limits, deadline, 0.0, t_max)
     run.stance, run.t_origin = stance, 0.0
     n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     acts = walker.actuators
@@ -67,7 +99,8 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
     pushed = False  # the pulse of the heel strike to come has run (or is running)
     while t < t_max - 1e-12:
         arm = lead is not None and not struck and not pushed
-        sol = run._run(y, t, t_max, None,
+        tb = t_max if run.segments is None else min(t + SECTION_CHUNK_S, t_max)
+        sol = run._run(y, t, tb, None,
                        [run.fall, cross if struck else run.touch] + ([lead] if arm else []))
         if sol is None:
             return t, y[:n], run.term
@@ -82,6 +115,9 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
             t, y, struck = got
             continue
         if not sol.t_events[1].size:
+            if tb < t_max - 1e-12:  # a compiled chunk's end: the next chunk
+                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+                continue
             return float(sol.t[-1]), sol.y[:n, -1], RunEnd.NO_HEEL_STRIKE
         t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
         if struck:
@@ -98,10 +134,15 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
 
 def _section_event(section, n: int):
     """Event: ``section`` of the walker's state (the first ``n`` entries) crosses 0 upwards
-    (terminal)."""
+    (terminal); its ``values`` on states (m, n), ``-section``, cross 0 downwards (the
+    compiled segments' direction)."""
     def cross(t, y):
         return section(y[:n])
 
+    def values(X, tab=None):
+        return -np.asarray(section(X), float)
+
+    cross.values = values
     cross.terminal, cross.direction = True, 1.0
     return cross
 
@@ -203,8 +244,8 @@ def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.in
     if acts.pulse_s == 0.0:
         return t, impulse_jump(walker, x, trailing, P)[0], RunEnd.T_FINAL
     n, nw = 2 * walker.nq, len(walker.actuators.work_names)
-    run = ActuationHook(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m),
-                      deadline, np.array([t, t + acts.pulse_s]))
+    run = _hook(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m), deadline,
+                t, t + acts.pulse_s)
     run.stance, run.t_origin = 1 - trailing, t
     sol = run._run(np.concatenate([x, np.zeros(nw)]), t, t + acts.pulse_s,
                    (trailing, P / acts.pulse_s), [run.fall])

@@ -18,7 +18,7 @@ from walkerlab.config import Scene
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.attribution import AttributionRun, write_attribution
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.stages.common import StageOutcome, run_cached, with_defaults
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "contact", "terrain", "contact_sim",
             "contact_solver")
@@ -35,7 +35,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
-    require(scene, "contact", "attribution")
+    scene = with_defaults(scene, "contact", "attribution")  # left out: the paper's contact law
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
 
     def compute():

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, write_rigid_limit
-from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.stages.common import StageOutcome, require, run_cached, with_defaults
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 #: Default stiffness factors [-]: the scene's contact and three decades stiffer.
@@ -31,7 +31,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``contact`` or ``fixedpoint`` section (one line).
     """
-    require(scene, "contact", "rigid-limit")
+    scene = with_defaults(scene, "contact", "rigid-limit")  # left out: the paper's contact law
     require(scene, "fixedpoint", "rigid-limit")
     kappas = tuple(float(k) for k in kappas)
 

@@ -16,7 +16,7 @@ from walkerlab.config.options import map_not_applicable, stability_map_options
 from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.stability_map import load_stability_map, write_stability_map
 from walkerlab.plotting.artifact_figures import save_gait_map_figure
-from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 from walkerlab.studies.stability import MapSpec, default_spec, stability_map_run
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
@@ -39,7 +39,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     ValueError
         Unknown ``kind``.
     """
-    require(scene, "contact", "stability-map")
+    scene = with_defaults(scene, "contact", "stability-map")  # left out: the paper's contact law
     require(scene, "fixedpoint", "stability-map")
     why = map_not_applicable(scene, kind)
     if why:

@@ -46,6 +46,7 @@ from walkerlab.integrate.contact_grid import GRID_METHODS
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.powered_data import powered_data
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
 #: the step map's integrator while root finding and for the final Jacobian (CyRK's BDF over
@@ -54,8 +55,9 @@ MAP_SOLVER = Solver("cyrk_bdf", 1e-12, 1e-14)
 #: the cheap map of the two-fidelity search
 COARSE_SOLVER = Solver("cyrk_bdf", 1e-10, 1e-12)
 
-#: a powered walker's map (the powered contact integrator, solve_ivp with a Python
-#: right-hand side: looser than the passive map's) and its cheap map
+#: the map of a walker whose torque laws are no compiled data (a replay's Python callables:
+#: the powered contact integrator on solve_ivp with a Python right-hand side, looser than
+#: the passive map's) and its cheap map; laws that are data run on :data:`MAP_SOLVER`
 POWERED_MAP_SOLVER = Solver("LSODA", 1e-10, 1e-12)
 POWERED_COARSE_SOLVER = Solver("LSODA", 1e-8, 1e-10)
 
@@ -249,8 +251,10 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         BDF over the compiled right-hand side with the section crossing found by brentq;
         ``"odeint"`` the same through scipy's odeint and a Python RHS;
         the ``solve_ivp`` methods "LSODA", "Radau", "BDF" locate it as an event).  A
-        walker with hip torques defaults to :data:`POWERED_MAP_SOLVER` (its map is Python
-        throughout).
+        powered walker's step runs on compiled segments with ``"cyrk_bdf"``
+        (:mod:`walkerlab.integrate.contact_powered_step`); one whose torque laws are no
+        compiled data (a replay's Python callables) defaults to :data:`POWERED_MAP_SOLVER`
+        (its map is Python throughout).
     jacobian_solver : walkerlab.integrate.solver.Solver
         The map's integrator for the final FD Jacobian (same method as ``solver``).
     coarse_solver : walkerlab.integrate.solver.Solver or None
@@ -291,11 +295,14 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
 
 
 def _map_solvers(walker: ContactWalker, solver, jacobian_solver, coarse_solver):
-    """The map's solvers (:func:`find_contact_periodic_gait`): a walker with hip torques has
-    the whole map in Python, so the defaults become the looser :data:`POWERED_MAP_SOLVER`
-    and :data:`POWERED_COARSE_SOLVER`; a solver given stays."""
+    """The map's solvers (:func:`find_contact_periodic_gait`): a walker with torque laws that
+    are no compiled data (:func:`~walkerlab.models.contact.powered_data.powered_data`: a
+    replay's Python callables) has the whole map in Python, so the defaults become the
+    looser :data:`POWERED_MAP_SOLVER` and :data:`POWERED_COARSE_SOLVER`; laws that are data
+    run on the compiled map (:mod:`walkerlab.integrate.contact_powered_step`) at the passive
+    map's tolerances; a solver given stays."""
     acts = getattr(walker, "actuators", None)
-    if acts is not None and acts.laws:  # hip torques: the whole map in Python, looser
+    if acts is not None and acts.laws and powered_data(walker) is None:  # Python laws
         solver = POWERED_MAP_SOLVER if solver is MAP_SOLVER else solver
         jacobian_solver = POWERED_MAP_SOLVER if jacobian_solver is MAP_SOLVER else jacobian_solver
         coarse_solver = (POWERED_COARSE_SOLVER if coarse_solver is COARSE_SOLVER

@@ -39,7 +39,8 @@ push-off pulse along the trailing leg, ending at the swing foot's predicted touc
 patch ahead, on the powered contact integrator (:mod:`walkerlab.integrate.contact_powered`),
 the touchdown and the roles swap; with
 push-off alone the flow between is passive and compiled, with hip torques the whole step
-runs on the powered integrator.  Outputs besides ``P(z)``: the step period ``T`` [s] and the
+runs on the powered integrator (with ``"cyrk_bdf"`` its compiled segments: no Python per
+right-hand side either).  Outputs besides ``P(z)``: the step period ``T`` [s] and the
 step length (along-slope displacement of the stance foot from one mid-stance to the next)
 [m].
 
@@ -170,8 +171,10 @@ class StepMap:
         the crossing found by brentq), ``"odeint"`` (the same through scipy's odeint) or a
         ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``; the crossing located as
         an event); ``atol`` well below the penetration ~6e-5 m.  A powered walker's pulse
-        (and, with hip torques, its whole step) runs on the powered contact integrator with
-        this method if it is a ``solve_ivp`` one, else LSODA.
+        (and, with hip torques, its whole step) runs on the powered contact integrator: on
+        compiled segments with ``"cyrk_bdf"`` (laws that are data), on ``solve_ivp`` with
+        this method if it is a ``solve_ivp`` one, else LSODA
+        (:mod:`walkerlab.integrate.contact_powered_step`).
     t_max : float
         Give up a step after this time [s].
     """
@@ -403,7 +406,8 @@ class StepMap:
             return self._push_off_section(x0, stance_to_come, ist, isw, hth)
         self.nfev += 1
         te, xe, end = powered_to_section(self.walker, np.asarray(x0, float),
-                                         1 - stance_to_come, lambda x: x[isw] - x[ist],
+                                         1 - stance_to_come,
+                                         lambda x: x[..., isw] - x[..., ist],
                                          self.solver, self.t_max, self.deadline, hth)
         return self._powered_end(te, xe, end)
 

@@ -21,6 +21,7 @@ from walkerlab.config import (
     SolverSettings,
     TerrainSettings,
 )
+from walkerlab.config.sections import with_default_section
 
 from .actuation import ContactActuators
 from .joint_torques import JointTorqueActuators
@@ -215,10 +216,14 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         :meth:`walkerlab.api.walker.ContactWalker.periodic_gait`): the scene is checked as
         with ``contact_sim.periodic_gait: true``.
 
+    A scene without a ``contact`` section runs on the section's defaults (the paper's
+    contact law: :class:`walkerlab.config.ContactSettings`), as ``contact: {}`` does: the
+    section configures the contact model, the stage the user asks for runs it.
+
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, actuators with a pinned or non-ideal start (or a time law
+        Actuators with a pinned or non-ideal start (or a time law
         with the contact periodic gait), a joint the walker does not have, a walker with a
         massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, a pinned stance foot
@@ -233,7 +238,8 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     from walkerlab.codegen.floating import check_masses
     from walkerlab.walker.description import walker_data
 
-    if scene.contact is None:
+    scene = with_default_section(scene, "contact")  # left out: its defaults (contact: {})
+    if scene.contact is None:  # a section with a required field has no defaults
         raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
                                 "contact model needs")
     contact = scene.contact
