@@ -203,6 +203,7 @@ def _zero_walk(env, seed=0):
     return np.asarray(strikes), info
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_contact_view_keeps_the_scenes_stairs():
     """configs/stairs.yaml in the contact view (patches a riser lower each step): a zero
     action walks down them at the rigid stair gait's step period (0.70998 s) within 3 %, as
@@ -578,6 +579,7 @@ def test_flat_feet_walk_the_rigid_view_as_simulate_does(name, periods, tmp_path)
     np.testing.assert_allclose(tiny, ref[:2], rtol=0.0, atol=1e-9)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_held_hip_torque_slows_the_flat_feet_step_alike_in_the_rigid_and_contact_views():
     """configs/flat_feet.yaml with a held hip torque (0.02 of the bound: 0.39 N m): the
     first step's period grows by the same amount in the rigid view (the twin's mode mass

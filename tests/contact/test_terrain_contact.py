@@ -217,6 +217,7 @@ def test_a_profile_is_the_contact_models_polyline_ground():
     assert len(c) == len(a) and not np.allclose(c, a, atol=1e-4), res.message
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_profile_exports_as_a_height_field_and_walks_in_mujoco(tmp_path):
     """``walkerlab export --format mjcf`` of a profile (before: an internal error): a MuJoCo
     height field of the polyline.  The kneed walker on a profile along the slope line walks
