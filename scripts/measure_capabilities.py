@@ -37,7 +37,7 @@ def _commit() -> str:
 
 
 #: the order a feature's views are measured in (the rigid gait first: the others reuse it)
-ORDER = ("rigid", "gym", "contact", "mjcf", "adams", "osim", "optimize")
+ORDER = ("rigid", "gym", "contact", "mjcf", "urdf", "adams", "osim", "optimize")
 #: a rigid cell's failure that every view started from the rigid gait shares
 NO_GAIT = ("no period-1 gait", "no rigid gait", "gave up after")
 

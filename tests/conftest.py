@@ -38,6 +38,27 @@ def paper_fixed_point(paper_walker):
     return find_fixed_point(paper_walker, np.array(paper.EQ11_STATE), TIGHT)
 
 
+@pytest.fixture
+def default_signals():
+    """SIGINT and SIGTERM at Python's defaults for the test, restored after it.  A command
+    installs its handlers (:func:`walkerlab.cli.process.terminate_as_interrupt`) over the
+    defaults only, keeping an ignored SIGINT ignored, and a test process may inherit SIGINT
+    ignored: a suite started in the background (a non-interactive shell's ``&``, ``nohup``,
+    a CI runner) and its pytest-xdist workers, which inherit it.  A test of the command's
+    handling of SIGINT asks for this, so it tests the handler whatever the suite inherited;
+    the handler it leaves does not reach the tests after it."""
+    import signal
+
+    old = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, signal.SIG_DFL if h is None else h)
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Each test file runs on one pytest-xdist worker (``--dist loadgroup``, pyproject): a

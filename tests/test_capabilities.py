@@ -7,7 +7,7 @@ the cell is tried in the view, cheaply (nothing long is solved):
   built);
 - ``contact``: the compliant-contact set-up (:func:`walkerlab.models.contact.scene.
   contact_setup`, no run);
-- ``mjcf`` / ``adams`` / ``osim``: the export written into a temporary runs folder (its
+- ``mjcf`` / ``urdf`` / ``adams`` / ``osim``: the export written into a temporary runs folder (its
   keyframe's rigid gait searched as ``walkerlab export`` does; no gait is the walker's
   dynamics, not a refusal);
 - ``gym``: the Gymnasium environment built (:class:`walkerlab.gym.env.WalkerEnv`);
@@ -110,8 +110,8 @@ def _optimize(d, tmp, monkeypatch):
 
 
 PROBES = {"rigid": _rigid, "contact": _contact, "mjcf": _export("mjcf"),
-          "adams": _export("adm"), "osim": _export("osim"), "gym": _gym,
-          "optimize": _optimize}
+          "urdf": _export("urdf"), "adams": _export("adm"), "osim": _export("osim"),
+          "gym": _gym, "optimize": _optimize}
 
 #: a message that says the walker has no gait (its dynamics, not a refusal of the cell)
 NO_GAIT = ("no rigid gait", "no period-1 gait found", "FixedPointNotFound", "GaitNotFound",
@@ -293,3 +293,80 @@ def test_the_gym_contact_view_refuses_its_ground_before_any_gait_search(monkeypa
     with pytest.raises(ValueError) as exc:
         env.WalkerEnv(str(ROOT / "configs" / "flat_feet_stairs.yaml"), view="contact")
     assert KINDS["flat_feet"].cell("stairs", "contact") in str(exc.value)
+
+
+# ------------------------------------------- the URDF's column (issue 64 leftovers, item 4)
+@pytest.mark.parametrize("kind", ["straight_legs", "rolling_polygon"])
+@pytest.mark.parametrize("ground", ["stairs", "footholds", "profile"])
+def test_the_urdf_refuses_a_ground_other_than_the_slope_with_its_cells_reason(
+        kind, ground, tmp_path, monkeypatch):
+    """The URDF had no column: ``export --format urdf`` refused stairs, footholds and
+    profiles with a message of its own that the table did not show.  Now the table's urdf
+    cells of those grounds refuse them, and the export reads its one line from them (a
+    changed reason is the export's), before any gait search."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import export
+    from walkerlab.walker.kinds import URDF_GROUND
+
+    assert KINDS[kind].cell(ground, "urdf") == URDF_GROUND
+    monkeypatch.setattr(export, "_gait_scene", _no_gait_search)
+    d = scene_for(kind, ground, "urdf")
+    with pytest.raises(ValueError) as exc:
+        export.run(scene_from_dict(d), tmp_path, "urdf")
+    assert str(exc.value) == f"terrain.kind: {ground}: {URDF_GROUND}"
+    monkeypatch.setitem(CAPABILITIES[kind], (ground, "urdf"), "the table's own words")
+    with pytest.raises(ValueError, match=f"^terrain.kind: {ground}: the table's own words$"):
+        export.run(scene_from_dict(d), tmp_path, "urdf")
+    assert not list(tmp_path.rglob("*.urdf"))
+
+
+def test_the_urdf_column_supports_what_the_urdf_writer_takes():
+    """The URDF's column: the walker of every kind the URDF writer takes (not flat feet,
+    which have no foot link there), and no ground but the slope."""
+    from walkerlab.walker.kinds import VIEWS
+
+    assert "urdf" in VIEWS
+    took = {k for k in KINDS if KINDS[k].supports("walk", "urdf")}
+    assert took == set(KINDS) - {"flat_feet"}
+    for k in KINDS.values():
+        assert not any(k.supports(g, "urdf") for g in ("stairs", "footholds", "profile"))
+
+
+# ------------------------------------- the OpenSim knee latch (issue 64 leftovers, item 6)
+def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches_it():
+    """A kneed walker's OpenSim model walks only under walkerlab's stepping loop, which
+    switches its knee latch (the file alone falls); the table's ✓ did not say so.  Now every
+    supported osim cell of each kind whose export has knee stops (the latch: the export's
+    own parts table) carries the note: in the grid (a numbered note), in the JSON's
+    ``note`` and ``detail``, and on the docs' page; no other kind's cells do."""
+    import importlib.util
+
+    from walkerlab.export.parts import EXPORT_PARTS
+    from walkerlab.walker.capability_tables import kind_grid, text
+    from walkerlab.walker.kinds import KNEE_LATCH_OSIM, table_rows
+
+    latched = {k for k, part in EXPORT_PARTS.items() if part.knee_stops}
+    assert latched == {"locking_knees"}
+    for row in table_rows():
+        if row["supported"] and row["view"] == "osim":
+            has = row["kind"] in latched
+            assert (row["note"] == KNEE_LATCH_OSIM) == has, row
+            assert (KNEE_LATCH_OSIM in row["detail"]) == has, row
+        elif row["supported"]:
+            assert row["note"] == "", row
+    for kind in KINDS.values():
+        g = kind_grid(kind)
+        notes = [i + 1 for i, r in enumerate(g.reasons) if r == f"note: {KNEE_LATCH_OSIM}"]
+        col = g.views.index("osim")
+        for feature, cells in zip(g.features, g.rows):
+            if kind.supports(feature, "osim"):
+                assert cells[col].endswith(f" ({notes[0]})") if kind.name in latched \
+                    else not notes, (kind.name, feature, cells[col])
+    assert KNEE_LATCH_OSIM in text()
+    spec = importlib.util.spec_from_file_location(
+        "capability_table", ROOT / "docs" / "_ext" / "capability_table.py")
+    ext = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ext)
+    assert KNEE_LATCH_OSIM in " ".join(ext.rst().split())
+    page = " ".join((ROOT / "docs" / "reference" / "capabilities.rst").read_text().split())
+    assert "knee latch" in page

@@ -108,6 +108,7 @@ def test_a_joint_torque_is_its_generalised_forces_by_virtual_work(joint, stance,
     assert torque_generalized_forces(joint, stance, RABBIT) == expected
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_five_link_export_has_a_motor_on_every_coordinate_its_laws_move(tmp_path):
     """RABBIT's hip and knee laws move all five coordinates: the torso takes the hip torques'
     reaction (before: motors on the legs only, and none was driven)."""

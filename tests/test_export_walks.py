@@ -357,6 +357,7 @@ def test_arc_feet_get_ground_for_their_roll_with_a_warning(tmp_path, capsys):
     assert m.geom("leg1_foot").size[0] == 0.3
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens(tmp_path):
     """The rigid model's push-off is an impulse with the heel strike; the export applies it
     over one MuJoCo timestep (its ``push_off_duration_s``; the pulse's last step carries only

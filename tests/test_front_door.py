@@ -277,10 +277,33 @@ def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
 
 
 # ---------------------------------------------------------------- the example notebook
+def _tour_cells() -> list[str]:
+    nb = json.loads((ROOT / "examples" / "walkerlab_tour.ipynb").read_text())
+    return ["".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code"]
+
+
+@pytest.mark.parametrize("cwd", [".", "examples"])
+def test_the_notebooks_first_cell_finds_its_scene_from_the_root_and_from_examples(
+        tmp_path, monkeypatch, cwd):
+    """Issue 64: the tour loaded ``../configs/paper_rods.yaml``, so ``jupyter nbconvert
+    --execute examples/walkerlab_tour.ipynb`` from the repository root failed in its first
+    cell (scene file not found).  Its first cell (imports, runs folder, scene) now runs from
+    the root and from ``examples/`` and loads the shipped rod-legged walker."""
+    monkeypatch.setenv("WALKERLAB_TOUR_RUNS", str(tmp_path / "runs"))
+    monkeypatch.chdir(ROOT / cwd)
+    ns: dict = {}
+    exec(compile(_tour_cells()[0], "walkerlab_tour.ipynb[1]", "exec"), ns)  # noqa: S102
+    assert ns["scene"].name == "paper_rods"
+    assert ns["scene"] == load_scene(ROOT / "configs" / "paper_rods.yaml")
+    assert ns["runs"] == tmp_path / "runs"
+
+
 @pytest.mark.slow  # end to end: every stage the notebook calls
-def test_example_notebook_runs(tmp_path, monkeypatch):
+@pytest.mark.parametrize("cwd", [".", "examples"])
+def test_example_notebook_runs(tmp_path, monkeypatch, cwd):
     """``examples/walkerlab_tour.ipynb`` executes top to bottom (nbclient), writing only into
-    a temporary runs folder."""
+    a temporary runs folder, with its kernel started in the repository root (``jupyter
+    nbconvert --execute examples/walkerlab_tour.ipynb`` there) or in ``examples/``."""
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     monkeypatch.setenv("WALKERLAB_TOUR_RUNS", str(tmp_path / "runs"))
@@ -289,7 +312,7 @@ def test_example_notebook_runs(tmp_path, monkeypatch):
     nb = nbformat.read(ROOT / "examples" / "walkerlab_tour.ipynb", as_version=4)
     before = set((ROOT / "runs").rglob("*")) if (ROOT / "runs").exists() else set()
     nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
-                            resources={"metadata": {"path": str(ROOT / "examples")}}).execute()
+                            resources={"metadata": {"path": str(ROOT / cwd)}}).execute()
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert any("image/png" in o.get("data", {}) for o in outputs)  # the figure

@@ -2,6 +2,7 @@
 scene's own walk under a zero action in both views, seeded episodes bit for bit, a vector
 of environments, one-line refusals."""
 
+import re
 import warnings
 from pathlib import Path
 
@@ -77,6 +78,44 @@ def test_a_zero_action_walks_the_paper_gait_with_heel_strikes_at_its_step_period
     assert np.all(np.abs(strikes / 0.01 - np.round(strikes / 0.01)) > 1e-6)  # off the grid
     assert info["ledger_action_work_positive"] == info["ledger_action_work_negative"] == 0.0
     assert info["ledger_heel_strike_loss"] < 0.0
+
+
+def _documented_info_keys(page: str) -> set[str]:
+    """The keys of the docs' gym ``info`` table (its first column's backquoted names)."""
+    head = page.index("| key | type [unit] | meaning |")
+    rows = page[head:].split("\n\n", 1)[0].splitlines()[2:]
+    return {k for r in rows for k in re.findall(r"`([a-z_]+)`", r.split("|")[1])}
+
+
+def test_the_info_keys_are_the_documented_ones_with_their_types():
+    """Issue 64: ``info`` was documented in a sentence that left out half its keys.  The
+    keys ``reset`` and ``step`` return are :data:`walkerlab.gym.env.INFO_KEYS` plus one
+    ``ledger_<term>`` per ledger term, each named in the env's docstring and in the docs'
+    gym table (which lists the contact view's ledger terms too), with the types said there;
+    the time advances by the control period."""
+    import walkerlab.gym.env as genv
+    from walkerlab.gym.contact_view import CONTACT_LEDGER_TERMS
+    from walkerlab.gym.rigid_view import LEDGER_TERMS
+
+    env = _env("paper", max_episode_steps=5)
+    _, first = env.reset(seed=0)
+    *_, info = env.step(np.zeros(env.action_space.shape, np.float32))
+    keys = set(genv.INFO_KEYS) | {f"ledger_{t}" for t in LEDGER_TERMS}
+    assert set(first) == set(info) == keys
+    assert set(CONTACT_LEDGER_TERMS) <= set(LEDGER_TERMS)
+    assert first["time_s"] == 0.0 and info["time_s"] == pytest.approx(0.01, abs=1e-12)
+    assert first["heel_strike"] is False and first["heel_strike_time_s"] is None
+    assert info["heel_strike_times_s"] == [] and info["steps"] == 0
+    assert info["stance_leg"] in ("leg1", "leg2") and info["termination"] == ""
+    assert isinstance(info["hip_x_m"], float) and isinstance(info["terrain_seed"], int)
+    assert info["solver_message"] == ""
+    assert all(isinstance(info[f"ledger_{t}"], float) for t in LEDGER_TERMS)
+    for doc in (genv.__doc__, genv.WalkerEnv.__doc__):
+        missing = [k for k in genv.INFO_KEYS if f"``{k}``" not in doc]
+        assert not missing and "``ledger_<term>``" in doc, missing
+    assert all(f"``{t}``" in genv.__doc__ for t in LEDGER_TERMS)
+    page = (ROOT / "docs" / "user_guide" / "python_api.md").read_text()
+    assert _documented_info_keys(page) == keys | {f"ledger_{t}" for t in CONTACT_LEDGER_TERMS}
 
 
 @pytest.mark.slow
@@ -164,6 +203,7 @@ def _zero_walk(env, seed=0):
     return np.asarray(strikes), info
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_contact_view_keeps_the_scenes_stairs():
     """configs/stairs.yaml in the contact view (patches a riser lower each step): a zero
     action walks down them at the rigid stair gait's step period (0.70998 s) within 3 %, as
@@ -584,6 +624,7 @@ def test_flat_feet_walk_the_rigid_view_as_simulate_does(name, periods, tmp_path)
     np.testing.assert_allclose(tiny, ref[:2], rtol=0.0, atol=1e-9)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_held_hip_torque_slows_the_flat_feet_step_alike_in_the_rigid_and_contact_views():
     """configs/flat_feet.yaml with a held hip torque (0.02 of the bound: 0.39 N m): the
     first step's period grows by the same amount in the rigid view (the twin's mode mass

@@ -28,6 +28,7 @@ def paper_map(paper_scene):
     return BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-10, 1e-10)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_batched_step_matches_one_step_integration(paper_scene, paper_map, paper_fixed_point):
     """Each row of the stacked system equals integrate_step of the walker on that row's slope
     (scipy DOP853 at 1e-12 with solve_ivp's event location): the rows' tolerances are
@@ -63,6 +64,7 @@ def test_heel_strike_on_each_steps_own_slope(paper_scene, paper_map, paper_fixed
     np.testing.assert_allclose(s, -2 * gam, rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_kneed_walker_two_phases_and_knee_strike(paper_scene):
     """The kneed walker (unlocked swing, knee strike reset, locked swing) through the batched
     map equals integrate_step on two slopes."""

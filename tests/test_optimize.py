@@ -69,6 +69,7 @@ def test_a_powered_gait_at_a_target_speed_replays_on_the_rigid_model():
     assert err <= 1e-6
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_optimize_command_writes_its_artifact_and_refuses_what_it_cannot(tmp_path):
     from typer.testing import CliRunner
 

@@ -112,21 +112,30 @@ def _interrupted_in_a_ctypes_callback(signum):
     import ctypes
     import signal
 
+    from walkerlab.cli.process import _interrupt
+
     def body():
         signal.getsignal(signum)(signum, None)
 
+    handler = signal.getsignal(signum)
+    assert handler is _interrupt, f"the command's handler is not installed: {handler!r}"
     ctypes.CFUNCTYPE(None)(body)()  # the exception cannot cross the C frame: dropped
     raise ValueError("f(a) and f(b) must have different signs")
 
 
 @pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])
 def test_an_interrupt_swallowed_in_the_contact_replay_exits_130_and_writes_nothing(
-        tmp_path, monkeypatch, signum):
+        tmp_path, monkeypatch, signum, default_signals):
     """Before, an interrupt swallowed by a ctypes callback in a cold ``optimize``'s
     contact replay went unnoticed: exit 0 and an ``optimize.h5`` with a NaN contact replay
     blaming the solver, which the rerun reused.  Now the command's signal handler records
     the interrupt, the command ends ``interrupted`` with code 130, no traceback, and no
-    ``optimize.h5`` is written (nothing for a rerun to reuse)."""
+    ``optimize.h5`` is written (nothing for a rerun to reuse).
+
+    The signals start at Python's defaults (``default_signals``): a suite started in the
+    background inherits SIGINT ignored, which the command rightly keeps ignored, and this
+    test then called ``SIG_IGN`` as the handler (exit 0 and an unraisable ``TypeError``
+    at teardown, whatever the user cache held)."""
     import signal
 
     from typer.testing import CliRunner
@@ -154,6 +163,57 @@ def test_an_interrupt_swallowed_in_the_contact_replay_exits_130_and_writes_nothi
         with pytest.raises(KeyboardInterrupt):
             handler(getattr(signal, signum), None)
     assert not interrupted()
+
+
+def test_an_inherited_ignored_sigint_stays_ignored_by_the_command():
+    """A command started in the background (SIGINT ignored, as a non-interactive shell's
+    ``&`` leaves it to its children) keeps SIGINT ignored and still handles SIGTERM."""
+    import signal
+
+    from walkerlab.cli.process import _interrupt, terminate_as_interrupt
+
+    old = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        terminate_as_interrupt()
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        assert signal.getsignal(signal.SIGTERM) is _interrupt
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+def test_under_the_default_signals_fixture_the_command_handles_both(default_signals):
+    import signal
+
+    from walkerlab.cli.process import _interrupt, terminate_as_interrupt
+
+    terminate_as_interrupt()
+    assert signal.getsignal(signal.SIGINT) is _interrupt
+    assert signal.getsignal(signal.SIGTERM) is _interrupt
+
+
+@pytest.mark.slow  # a pytest of its own in a child process
+def test_the_interrupt_test_passes_in_a_suite_that_inherited_sigint_ignored(tmp_path):
+    """The quick suite started in the background (``pytest ... &`` from a script: SIGINT
+    ignored in pytest and its xdist workers) failed the SIGINT case of the interrupt test
+    (exit 0 instead of 130, and a teardown error: ctypes dropped a ``TypeError`` from
+    calling ``SIG_IGN``).  It passes there now."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import signal, sys, pytest\n"
+            "signal.signal(signal.SIGINT, signal.SIG_IGN)\n"
+            "sys.exit(pytest.main(['-q', '-n', '0', '-p', 'no:cacheprovider', "
+            f"'{Path(__file__).resolve()}', '-k', "
+            "'interrupt_swallowed_in_the_contact_replay and SIGINT']))")
+    r = subprocess.run([sys.executable, "-c", code], cwd=Path(__file__).resolve().parents[1],
+                       env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])},
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout[-3000:]
+    assert "1 passed" in r.stdout and "error" not in r.stdout.splitlines()[-1]
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget

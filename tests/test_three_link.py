@@ -169,6 +169,7 @@ def _x_gait():
     return scene, scene.fixedpoint.initial_guess.as_array(build_walker(scene).state_names())
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_contact_view_walks_it():
     """contact-sim's walker (the same PD laws as forces, the stance leg switched at each
     touchdown; checkerboard lanes: the straight swing foot passes over the gap at
@@ -234,6 +235,7 @@ def test_the_mjcf_mass_matrix_is_the_books(mjcf):
                                    atol=1e-10 * np.abs(De).max() + 4e-12)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_mjcf_export_walks_in_mujoco(mjcf):
     """The exported walker steps in MuJoCo from its ``gait`` keyframe under walkerlab's
     stepping loop (the scene's laws at the hips): 5 alternating heel strikes in 2.5 s, steps

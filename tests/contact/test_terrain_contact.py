@@ -286,6 +286,7 @@ def test_the_straight_legged_contact_walk_on_its_slope_as_a_profile_is_the_slope
     assert np.max(np.abs(a - b)) < 1e-9
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_profile_exports_as_a_height_field_and_walks_in_mujoco(tmp_path):
     """``walkerlab export --format mjcf`` of a profile (before: an internal error): a MuJoCo
     height field of the polyline.  The kneed walker on a profile along the slope line walks

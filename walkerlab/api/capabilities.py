@@ -21,7 +21,17 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     tolerance), and the rigid walk the slope's where the rigid view refuses the profile.
 ``mjcf``, ``osim``
     The exported file walked in its engine (MuJoCo, OpenSim) for 10 heel strikes from the
-    rigid gait: the mean step period against the rigid one (relative, 3 %).
+    rigid gait: the mean step period against the rigid one (relative, 3 %).  The OpenSim
+    model is walked by walkerlab's stepping loop (:mod:`walkerlab.export.opensim_walk`:
+    the joint torques, the push-off and a kneed walker's knee latch switched between the
+    Manager's windows); a kneed walker's cells say so (:data:`walkerlab.walker.kinds.
+    KNEE_LATCH_OSIM`: the file alone falls).
+``urdf``
+    ``walkerlab export --format urdf`` (its keyframe's rigid gait searched as the command
+    does) loaded by Pinocchio (``pinocchio.buildModelFromUrdf``; Carpentier et al. 2019):
+    its total mass against the walker description's (relative, 1e-9), its bodies' masses
+    listed in the detail.  URDF has no ground, contact or actuator element (its file says
+    what it leaves out), so no walk is measured.
 ``adams``
     No Adams Solver runs here: the dataset read back (:func:`walkerlab.export.adams_reader.
     read_adm`): every part's mass against the walker description's (relative, 1e-9).
@@ -48,6 +58,7 @@ import numpy as np
 
 from walkerlab.config import scene_from_dict
 from walkerlab.config.reference_cases import reference_scene
+from walkerlab.walker.kinds import KINDS
 
 __all__ = ["QUANTITIES", "Measurement", "measure"]
 
@@ -64,6 +75,9 @@ QUANTITIES = {
              "rigid gait", 0.03, "relative"),
     "osim": ("the OpenSim model walked by OpenSim: mean step period over 10 heel strikes "
              "against the rigid gait", 0.03, "relative"),
+    "urdf": ("the URDF loaded by Pinocchio: its total mass against the walker description "
+             "(URDF has no ground, contact or actuator element: the walk is not measured)",
+             1e-9, "relative"),
     "adams": ("the dataset read back: every part's mass against the walker description "
               "(no Adams Solver here: the walk is not measured)", 1e-9, "relative"),
     "gym": ("the rigid view under a zero action (or the scene's controller as its policy) "
@@ -359,6 +373,26 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     return dev, f"{len(parts)} parts, {total:.6g} kg against {want:.6g} kg"
 
 
+def _urdf(scene, d, runs: Path) -> tuple[float, str]:
+    """The exported URDF loaded by Pinocchio: its total mass against the description's."""
+    try:
+        import pinocchio
+    except ImportError:
+        return math.nan, "pinocchio is not installed (pip install pin): the URDF not loaded"
+    from walkerlab.stages import export
+    from walkerlab.walker.description import walker_data
+
+    path = export.write(scene, runs, "urdf").path
+    model = pinocchio.buildModelFromUrdf(str(path))
+    total = float(pinocchio.computeTotalMass(model))
+    want = float(walker_data(scene.walker, scene.slope.phi_rad).total_mass_kg)
+    bodies = {n: round(float(i.mass), 6) for n, i in zip(model.names, model.inertias)
+              if i.mass > 0}
+    dev = abs(total / want - 1.0)
+    return dev, (f"loaded by Pinocchio: {model.nv} joints, bodies (by joint) {bodies}; "
+                 f"{total:.6g} kg against {want:.6g} kg")
+
+
 def _gym(scene, d, runs: Path) -> tuple[float, str]:
     from walkerlab.gym.env import WalkerEnv
     from walkerlab.stages import pipeline
@@ -408,7 +442,7 @@ def _optimize(scene, d, runs: Path) -> tuple[float, str]:
     return math.nan, f"no replay error stored ({status})"
 
 
-_VIEWS = {"rigid": _rigid, "contact": _contact, "mjcf": _engine("mjcf"),
+_VIEWS = {"rigid": _rigid, "contact": _contact, "mjcf": _engine("mjcf"), "urdf": _urdf,
           "osim": _engine("osim"), "adams": _adams, "gym": _gym, "optimize": _optimize}
 
 
@@ -445,5 +479,8 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
     except Exception as exc:  # noqa: BLE001 - a cell that fails is evidence, not a crash
         value, detail = math.nan, f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
     ok = bool(math.isfinite(value) and abs(value) <= tol)
+    note = KINDS[kind].note(view)
+    if note:  # what the cell rests on beyond the number (a kneed walker's OpenSim loop)
+        detail = f"{detail}; {note}"
     return Measurement(kind, feature, view, case, quantity, float(value), tol, unit, ok,
                        detail)

@@ -53,8 +53,7 @@ __all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "arc_roll_m", "check_ex
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
 #: The capability table's view (:data:`walkerlab.walker.kinds.VIEWS`) of each export format
-#: (a URDF is the MJCF's walker without its scene).
-FORMAT_VIEWS = {"urdf": "mjcf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
+FORMAT_VIEWS = {"urdf": "urdf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
 
 
 def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,

@@ -31,12 +31,12 @@ def check_wheel_exportable(scene: Scene, kind: Kind, fmt: str,
     walkerlab.walker.kinds.KindRefused
         One line naming the field: ``walker.model`` for a format other than
         :data:`WHEEL_FORMATS` (the Adams and OpenSim writers build leg links);
-        ``terrain.kind`` for a ground other than the slope unless ``walker_only`` (the
-        wheel's MJCF has one plane).
+        ``terrain.kind`` for a ground other than the slope where the format's cell of that
+        ground refuses it, unless ``walker_only``.
     """
     kind.require("walk", FORMAT_VIEWS[fmt], f"walker.model: {scene.walker.model}")
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
-        kind.require(scene.terrain.kind, "mjcf", f"terrain.kind: {scene.terrain.kind}")
+        kind.require(scene.terrain.kind, FORMAT_VIEWS[fmt], f"terrain.kind: {scene.terrain.kind}")
 
 
 @dataclass(frozen=True)

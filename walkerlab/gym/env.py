@@ -64,14 +64,30 @@ elsewhere.
 ``(k,)`` (None, NaN, inf, complex, another shape) raises :class:`InvalidAction` (a
 ``ValueError``), one line naming the action space.
 
-``info``: ``time_s``, ``heel_strike`` (bool), ``heel_strike_time_s`` (the exact event time
-of the last heel strike inside the control period, else None), ``heel_strike_times_s`` (all
-of them), ``steps`` (heel strikes so far), ``stance_leg``, ``hip_x_m``, ``termination``
-(``""``, ``fall``, ``stall``, ``launch``, ``trip``, ``ground_end``, ``solver_failure``),
-``solver_message`` (the solver's words on a ``trip`` or ``solver_failure`` in the contact
-view, else ``""``), ``terrain_seed`` and
-the energy ledger's
-terms so far [J] (``ledger_<term>``: :data:`walkerlab.gym.rigid_view.LEDGER_TERMS`).
+Info (the dict ``reset`` and ``step`` return, the same keys in both; :data:`INFO_KEYS`):
+
+- ``time_s`` (float) [s]: the episode's time (0 at the reset);
+- ``heel_strike`` (bool): a heel strike happened inside the control period just held;
+- ``heel_strike_time_s`` (float or None) [s]: the exact event time of the period's last heel
+  strike (the rigid model's guard, the contact view's touchdown), None without one;
+- ``heel_strike_times_s`` (list of float) [s]: every heel strike inside the period;
+- ``steps`` (int): heel strikes since the reset;
+- ``stance_leg`` (str): the stance leg after the period, ``"leg1"`` or ``"leg2"``;
+- ``hip_x_m`` (float) [m]: the hip's world position along x (horizontal, downhill), the
+  reward's forward term's;
+- ``termination`` (str): ``""`` while the episode goes on, else why it was terminated:
+  ``fall``, ``stall``, ``launch``, ``trip``, ``ground_end``, ``solver_failure`` (see
+  Episode);
+- ``solver_message`` (str): the solver's words on a ``trip`` or ``solver_failure`` in the
+  contact view, else ``""``;
+- ``terrain_seed`` (int): the seed of this episode's terrain, drawn by the reset's seed;
+- ``ledger_<term>`` (float) [J]: the energy ledger's terms summed since the reset, one key
+  each: the rigid view's :data:`walkerlab.gym.rigid_view.LEDGER_TERMS`
+  (``action_work_positive``, ``action_work_negative``, ``scene_torque_work``,
+  ``push_off_work``, ``heel_strike_loss``), the contact view's
+  :data:`walkerlab.gym.contact_view.CONTACT_LEDGER_TERMS` (the same without
+  ``heel_strike_loss``: its collisions are the contact forces' work, not a ledger term).
+
 ``reset(seed=...)`` draws the terrain seed and the start's noise from the seed: the same
 seed, the same episode bit for bit.
 """
@@ -87,7 +103,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["InvalidAction", "WalkerEnv"]
+__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv"]
 
 #: the largest ``start_noise``: the start's rates times ``1 + U(-1, 1)`` (from rest to twice
 #: the gait's rates; beyond, rates change sign)
@@ -96,6 +112,11 @@ MAX_START_NOISE = 1.0
 #: bound of the observation's state entries [m, rad, m/s, rad/s] and time [s]: far beyond a
 #: walking state (an observation past it is clipped to it)
 OBS_BOUND = 1e6
+
+#: the keys of the ``info`` dict of :meth:`WalkerEnv.reset` and :meth:`WalkerEnv.step`
+#: besides the ledger's ``ledger_<term>`` (module docstring, Info: type [unit] and meaning)
+INFO_KEYS = ("time_s", "heel_strike", "heel_strike_time_s", "heel_strike_times_s", "steps",
+             "stance_leg", "hip_x_m", "termination", "solver_message", "terrain_seed")
 
 #: the fixed point of each scene, found once per process (key: the scene's JSON)
 _GAITS: dict[str, Any] = {}
@@ -200,6 +221,14 @@ def registered_env(**kwargs) -> WalkerEnv:
 class WalkerEnv(gym.Env):
     """A walkerlab scene's walker as a Gymnasium environment (module docstring: spaces,
     reward, episode, info).
+
+    ``reset`` returns ``(observation, info)``, ``step`` ``(observation, reward, terminated,
+    truncated, info)``; ``info`` is a dict with the keys :data:`INFO_KEYS` and one
+    ``ledger_<term>`` per energy-ledger term (module docstring, Info): ``time_s`` [s],
+    ``heel_strike`` (bool), ``heel_strike_time_s`` [s] (None without a heel strike in the
+    period), ``heel_strike_times_s`` [s], ``steps``, ``stance_leg`` (``"leg1"`` or
+    ``"leg2"``), ``hip_x_m`` [m], ``termination`` (``""`` or why the episode ended),
+    ``solver_message``, ``terrain_seed``, ``ledger_<term>`` [J].
 
     Parameters
     ----------

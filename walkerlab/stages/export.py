@@ -288,10 +288,11 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     ValueError
         Unknown format, a walker with a massless link (a multibody model needs positive
         masses), feet the formats cannot carry, a ground other than the slope (stairs ...)
-        unless ``walker_only``, or no rigid gait to start from; a spoked wheel to a format
-        other than urdf or mjcf (naming walker.model); footholds of several heights where
-        the capability table refuses them (the Adams dataset, the OpenSim model: naming
-        terrain.foothold_heights_m); one line.
+        in the URDF unless ``walker_only`` (the capability table's cell of that ground,
+        :data:`walkerlab.walker.kinds.URDF_GROUND`), or no rigid gait to start from; a
+        spoked wheel to a format other than urdf or mjcf (naming walker.model); footholds
+        of several heights where the capability table refuses them (the Adams dataset,
+        the OpenSim model: naming terrain.foothold_heights_m); one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
     walkerlab.io.artifacts.ArtifactError
@@ -301,11 +302,9 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     """
     export_path(scene, runs_root, fmt)  # check the format before building anything
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
-        if fmt not in ("mjcf", "osim", "adm"):
-            raise ValueError(f"terrain.kind: {scene.terrain.kind}: the {fmt} export carries a "
-                             "slope's ground only (stairs, footholds and profiles are in the "
-                             "MJCF, the OpenSim model and the Adams dataset); --walker-only "
-                             "writes the walker alone")
+        if fmt == "urdf":  # its cell of that ground (the table refuses every non-slope one)
+            walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
+                scene.terrain.kind, FORMAT_VIEWS[fmt], f"terrain.kind: {scene.terrain.kind}")
         from walkerlab.models.contact.terrain import ground_drops
 
         drops = ground_drops(scene.terrain)  # a profile: one line

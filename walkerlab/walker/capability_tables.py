@@ -32,7 +32,8 @@ class KindGrid:
     (supported and measured within its tolerance, the number measured:
     :mod:`walkerlab.walker.capability_evidence`), ``"~ n"`` (the view runs it, but its
     measurement is outside its tolerance or missing) or ``"✗ n"`` (refused), ``n`` the
-    1-based index into ``reasons``."""
+    1-based index into ``reasons``; a supported cell may end in ``" (m)"``, ``reasons[m -
+    1]`` the note it rests on (``"note: ..."``)."""
 
     kind: Kind
     features: tuple[str, ...]
@@ -43,22 +44,32 @@ class KindGrid:
 
 def kind_grid(kind: Kind) -> KindGrid:
     """The grid of one kind, its reasons numbered in the order they first appear (row by
-    row), each listed once."""
+    row), each listed once; a supported cell whose kind has a note in its view
+    (:meth:`walkerlab.walker.kinds.Kind.note`) carries the note's number in brackets
+    (``✓ +0.52 % (3)``), the note listed with the reasons (``note: ...``)."""
     reasons: list[str] = []
     rows = []
+
+    def numbered(text: str) -> int:
+        if text not in reasons:
+            reasons.append(text)
+        return reasons.index(text) + 1
+
     for feature in FEATURES:
         row = []
         for view in VIEWS:
             why = kind.cell(feature, view)
+            note = kind.note(view) if why is None else None
             mark = "✗"
             if why is None and verified(kind.name, feature, view):
-                row.append(f"{SUPPORTED} {number(cell_evidence(kind.name, feature, view))}")
-                continue
-            if why is None:
-                why, mark = unverified_reason(kind.name, feature, view), UNVERIFIED
-            if why not in reasons:
-                reasons.append(why)
-            row.append(f"{mark} {reasons.index(why) + 1}")
+                cell = f"{SUPPORTED} {number(cell_evidence(kind.name, feature, view))}"
+            else:
+                if why is None:
+                    why, mark = unverified_reason(kind.name, feature, view), UNVERIFIED
+                cell = f"{mark} {numbered(why)}"
+            if note:
+                cell += f" ({numbered(f'note: {note}')})"
+            row.append(cell)
         rows.append(tuple(row))
     return KindGrid(kind, tuple(FEATURES), tuple(VIEWS), tuple(rows), tuple(reasons))
 

@@ -47,14 +47,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CAPABILITIES", "FEATURES", "KINDS", "VIEWS", "Kind", "KindRefused", "kind_of",
-           "table_rows"]
+__all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURES", "KINDS", "KNEE_LATCH_OSIM", "URDF_GROUND",
+           "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
 
 #: the views of one walker description: name -> what it is
 VIEWS = {
     "rigid": "rigid hybrid model (fixedpoint, simulate, studies)",
     "contact": "compliant-contact model (contact-sim)",
     "mjcf": "MuJoCo export (MJCF)",
+    "urdf": ("URDF export (links, joints and masses; the gait's keyframe in a sidecar; no "
+             "ground, contact or actuator element)"),
     "adams": "MSC Adams dataset (.adm)",
     "osim": "OpenSim model (.osim)",
     "gym": "Gymnasium environment (walkerlab.gym)",
@@ -120,6 +122,11 @@ class Kind:
                 is not None:  # a view without the walker: none of its features either,
             return row[("walk", view)]  # but one listed as None (its own transcription)
         return row.get((feature, view), row.get((feature, "*")))
+
+    def note(self, view: str) -> str | None:
+        """What every supported cell of the kind in ``view`` rests on beyond its measured
+        agreement (:data:`CELL_NOTES`), or None."""
+        return CELL_NOTES.get((self.name, view))
 
     def supports(self, feature: str, view: str) -> bool:
         """Whether the kind has ``feature`` in ``view``."""
@@ -206,12 +213,21 @@ _VC_VIEWS = {
     ("virtual_constraints", "osim"): ("the OpenSim stepping loop does not evaluate the "
                                       "computed torque yet (export --format mjcf runs it)"),
 }
-#: what the views of every legged kind refuse: a profile in the OpenSim model (the contact
+#: why the URDF refuses a ground other than the slope (``walkerlab export --format urdf``
+#: reads it from the table: :func:`walkerlab.stages.export.write`)
+URDF_GROUND = ("the URDF carries the walker on a slope only (URDF has no ground or contact "
+               "element; the slope is stated in its header): stairs, footholds and "
+               "profiles are in the MJCF, the OpenSim model and the Adams dataset; "
+               "--walker-only writes the walker alone")
+_URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "profile")}
+#: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
+#: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
 #: patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
 #: simulate does)
 _GROUNDS = {
     ("profile", "osim"): _OSIM_PROFILE,
+    **_URDF_GROUNDS,
 }
 #: what the kinds without ankles (point or arc feet) refuse of the ankle's features
 _NO_ANKLES = {
@@ -297,6 +313,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
         ("profile", "optimize"): _OPTIMIZE_PROFILE,
+        ("walk", "urdf"): ("flat feet are exported to MJCF and OpenSim with the scene only "
+                           "(a URDF would hold point feet: no foot link, ankle spring or heel "
+                           "and toe contacts)"),
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
         # steps that walker (its contact view asks the contact cells)
@@ -348,10 +367,27 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # footholds have no ground between them; the wheel's contact model needs it
         ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
                                    "ground (its spokes have no lanes of their own)"),
+        **_URDF_GROUNDS,
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
     },
 }
+
+
+#: why a kneed walker's OpenSim cells hold only with walkerlab's stepping loop: the knee
+#: latch (the knee stop mirrored, ``leg<i>_knee_latch``) is a force OpenSim cannot switch
+#: by contact, so :mod:`walkerlab.export.opensim_walk` switches it between the Manager's
+#: windows (the file says so in its header)
+KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.opensim_walk), "
+                   "which switches the knee latch (contact.knee_stop.latch) between OpenSim "
+                   "Manager windows: OpenSim has no contact-switched force, and the .osim "
+                   "file alone under OpenSim's Manager does not hold the stance knee "
+                   "straight (the kneed walker falls at 0.34 s, in its first step)")
+
+#: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
+#: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
+#: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
+CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
 
 
 def kind_of(structure) -> Kind:
@@ -384,7 +420,8 @@ def table_rows() -> list[dict]:
     "view", "supported", "reason"}`` (``reason`` "" when supported), and for a supported
     cell its evidence (:mod:`walkerlab.walker.capability_evidence`): ``verified`` (measured
     within its tolerance), ``case`` (its reference case), ``quantity``, ``measured``,
-    ``tolerance``, ``unit``, ``detail`` and ``commit`` - what ``walkerlab capabilities
+    ``tolerance``, ``unit``, ``detail`` (with the cell's note, :meth:`Kind.note`, when its
+    kind has one in the view), ``note`` and ``commit`` - what ``walkerlab capabilities
     --json`` prints."""
     from walkerlab.walker.capability_evidence import cell_evidence, verified
 
@@ -397,10 +434,14 @@ def table_rows() -> list[dict]:
                        "supported": why is None, "reason": why or ""}
                 if why is None:
                     e = cell_evidence(kind.name, feature, view) or {}
+                    note = kind.note(view) or ""
+                    detail = e.get("detail", "")
+                    if note and note not in detail:
+                        detail = f"{detail}; {note}" if detail else note
                     row.update(verified=verified(kind.name, feature, view),
                                case=e.get("case", ""), quantity=e.get("quantity", ""),
                                measured=e.get("value"), tolerance=e.get("tolerance"),
-                               unit=e.get("unit", ""), detail=e.get("detail", ""),
+                               unit=e.get("unit", ""), detail=detail, note=note,
                                commit=e.get("commit", ""))
                 rows.append(row)
     return rows
