@@ -152,9 +152,20 @@ SHIPPED = {
     ("free_joints", "walk"): "rabbit",
     ("free_joints", "virtual_constraints"): "rabbit_hzd",
     ("free_joints", "footholds"): "rabbit_footholds",
+    # RABBIT walks by its joint torques (PD to phase references): its swing_hip law is the
+    # hip torque, its stance_hip law (torso to stance thigh) the torso torque, its knees'
+    # laws the knee torque; the generated case replaced that law by a weak PD about zero,
+    # which leaves the torso or the leg to fall (no gait: nothing measured)
+    ("free_joints", "hip_torque"): "rabbit",
+    ("free_joints", "torso_torque"): "rabbit",
+    ("free_joints", "knee_torque"): "rabbit",
     ("hinged_torso", "walk"): "threelink",
     ("hinged_torso", "virtual_constraints"): "threelink_hzd",
     ("hinged_torso", "footholds"): "threelink_footholds",
+    # the three-link walker walks by its two hip torques (Grizzle, Abba & Plestan 2001): the
+    # swing_hip law is the hip torque, the stance_hip law the torso torque (as for RABBIT)
+    ("hinged_torso", "hip_torque"): "threelink",
+    ("hinged_torso", "torso_torque"): "threelink",
     ("rolling_polygon", "walk"): "rimless_wheel",
 }
 
