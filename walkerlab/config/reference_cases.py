@@ -179,6 +179,45 @@ SHIPPED_OPTIMIZE = {
 }
 
 
+#: (kind, feature) -> (why, changes): the generated case of a feature on which the kind's
+#: base walker with the plain feature (:func:`scene_for`) has no gait, changed so that it
+#: walks - a case without a gait measures nothing.  ``changes`` maps a dotted scene path to
+#: its value (set after :func:`scene_for`); ``why`` closes the case's name.
+WALKING = {
+    # the slope's step as a stair: the kneed gait advances 0.4747 m and drops 0.0239 m a step
+    # on its 0.0504 rad slope (configs/kneed.yaml); on 1 cm risers of 0.41 m treads (the
+    # generic case) it has no gait, nor on 5 or 10 mm risers of 0.47 m treads: the level
+    # treads must give back what the slope gave.  Gait: 0.5461 s steps (slope: 0.5458 s),
+    # |multipliers| 0.662 (slope: 0.741); its fixed point is the search's start.
+    ("locking_knees", "stairs"): (
+        "0.47 m treads, 24 mm risers: the slope's step as a stair (1 cm risers: no gait)",
+        {"terrain.riser_m": 0.024, "terrain.tread_m": 0.47,
+         "fixedpoint.initial_guess": {
+             "swing_thigh_angle_rad": -0.2904292492, "swing_shank_angle_rad": -0.2904292492,
+             "stance_angle_rad": 0.1893805121, "swing_thigh_rate_rad_per_s": -0.1050697622,
+             "swing_shank_rate_rad_per_s": -0.1050697622,
+             "stance_rate_rad_per_s": -1.1340243030}}),
+    # the rimless wheel's spokes (pi/8 apart, 1 m) landing a riser 2 sin(pi/8) sin(0.08) =
+    # 0.0612 m below, 2 sin(pi/8) cos(0.08) = 0.763 m ahead, meet the ground as on its
+    # 0.08 rad slope (configs/rimless_wheel.yaml): the same geometry, gravity along the
+    # treads' normal.  Gait: 1.0334 s steps (slope 1.0345 s), multiplier 0.5; on 1 cm or
+    # 3 cm risers the wheel stops (no gait).
+    ("rolling_polygon", "stairs"): (
+        "0.763 m treads, 61.2 mm risers: the spokes land as on the 0.08 rad slope "
+        "(1 cm risers: the wheel stops)",
+        {"terrain.riser_m": 0.0612, "terrain.tread_m": 0.763,
+         "fixedpoint.initial_guess": {"stance_angle_rad": 0.3126519715,
+                                      "stance_rate_rad_per_s": -1.0957846504}}),
+}
+
+
+def _set(d: dict, path: str, value) -> None:
+    *head, last = path.split(".")
+    for k in head:
+        d = d.setdefault(k, {})
+    d[last] = copy.deepcopy(value)
+
+
 def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     """The reference case of a cell: a shipped scene that exercises the feature on the kind
     (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`), else the kind's base walker with the
@@ -203,6 +242,11 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         # walk is the slope's walk, step for step
         d["terrain"] = slope_profile(_shipped(base)["slope"])
         return f"generated: configs/{base} on a profile equal to its slope", d
+    if (kind, feature) in WALKING and view != "optimize":
+        why, changes = WALKING[(kind, feature)]
+        for path, value in changes.items():
+            _set(d, path, value)
+        return f"generated: configs/{base} with {feature}: {why}", d
     return f"generated: configs/{base} with {feature}", d
 
 
