@@ -196,7 +196,10 @@ WALKING = {
              "swing_thigh_angle_rad": -0.2904292492, "swing_shank_angle_rad": -0.2904292492,
              "stance_angle_rad": 0.1893805121, "swing_thigh_rate_rad_per_s": -0.1050697622,
              "swing_shank_rate_rad_per_s": -0.1050697622,
-             "stance_rate_rad_per_s": -1.1340243030}}),
+             "stance_rate_rad_per_s": -1.1340243030},
+         # the contact model's own periodic gait lays patches (checkerboard lanes); stairs
+         # on continuous lanes have none: contact-sim starts from the rigid gait
+         "contact_sim.periodic_gait": False}),
     # the rimless wheel's spokes (pi/8 apart, 1 m) landing a riser 2 sin(pi/8) sin(0.08) =
     # 0.0612 m below, 2 sin(pi/8) cos(0.08) = 0.763 m ahead, meet the ground as on its
     # 0.08 rad slope (configs/rimless_wheel.yaml): the same geometry, gravity along the
