@@ -200,6 +200,22 @@ WALKING = {
          # the contact model's own periodic gait lays patches (checkerboard lanes); stairs
          # on continuous lanes have none: contact-sim starts from the rigid gait
          "contact_sim.periodic_gait": False}),
+    # a hip PD law 10x weaker than SMALL_PD: with 0.1 N m/rad the kneed gait is gone (no
+    # fixed point from the passive gait), with 0.01 N m/rad it persists: 0.5394 s steps
+    # (passive 0.5458 s), |multipliers| 0.777 (passive 0.741).  (A PD about the passive
+    # gait's own hip angle as a table of the stance angle walks too, but its variational
+    # multipliers disagree with the map's finite differences by 0.005 at 0.1 N m/rad and
+    # 0.05 at 1 N m/rad: fixedpoint refuses that verdict - an open issue, not this case.)
+    ("locking_knees", "hip_torque"): (
+        "PD 0.01 N m/rad, 0.001 N m s/rad about 0 (at 0.1 N m/rad: no gait)",
+        {"walker.actuation.torques": [
+            {"joint": "hip", "law": {"stiffness_n_m_per_rad": 0.01,
+                                     "damping_n_m_s_per_rad": 0.001}}],
+         "fixedpoint.initial_guess": {
+             "swing_thigh_angle_rad": -0.2894504099, "swing_shank_angle_rad": -0.2894504099,
+             "stance_angle_rad": 0.1887133761, "swing_thigh_rate_rad_per_s": -0.1404460373,
+             "swing_shank_rate_rad_per_s": -0.1404460373,
+             "stance_rate_rad_per_s": -1.1432061038}}),
     # the rimless wheel's spokes (pi/8 apart, 1 m) landing a riser 2 sin(pi/8) sin(0.08) =
     # 0.0612 m below, 2 sin(pi/8) cos(0.08) = 0.763 m ahead, meet the ground as on its
     # 0.08 rad slope (configs/rimless_wheel.yaml): the same geometry, gravity along the
@@ -245,7 +261,7 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         # walk is the slope's walk, step for step
         d["terrain"] = slope_profile(_shipped(base)["slope"])
         return f"generated: configs/{base} on a profile equal to its slope", d
-    if (kind, feature) in WALKING and view != "optimize":
+    if (kind, feature) in WALKING:
         why, changes = WALKING[(kind, feature)]
         for path, value in changes.items():
             _set(d, path, value)
