@@ -216,6 +216,38 @@ WALKING = {
              "stance_angle_rad": 0.1887133761, "swing_thigh_rate_rad_per_s": -0.1404460373,
              "swing_shank_rate_rad_per_s": -0.1404460373,
              "stance_rate_rad_per_s": -1.1432061038}}),
+    # an upper body scaled to the kneed walker: configs/torso_bhm.yaml's 5 kg on a 20 kg
+    # walker is 0.4 kg on this 1.6 kg one (the generic 5 kg body with the 0.1 N m/rad law:
+    # no gait), held on the legs' bisector, and the torso law as weak as the hip's case.
+    # Gait: 0.7197 s steps, |multipliers| 0.488.
+    ("locking_knees", "torso_torque"): (
+        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
+        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
+        {"walker.torso": {"coupling": "bisecting_hip",
+                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
+                                      "from_hip_m": 0.2}]},
+         "walker.actuation.torques": [
+             {"joint": "stance_hip", "law": {"stiffness_n_m_per_rad": 0.01,
+                                             "damping_n_m_s_per_rad": 0.001}}],
+         "fixedpoint.initial_guess": {
+             "swing_thigh_angle_rad": -0.3407594714, "swing_shank_angle_rad": -0.3407594714,
+             "stance_angle_rad": 0.2400224376, "swing_thigh_rate_rad_per_s": -0.3259477384,
+             "swing_shank_rate_rad_per_s": -0.3259477384,
+             "stance_rate_rad_per_s": -1.0823455559}}),
+    # one output, the swing leg's angle, of the stance leg's (the compass walker's one
+    # actuator, the hip): a step of 0.1 rad behind to 0.1348 rad ahead (the heel strike's
+    # symmetry about the 0.0174 rad slope's normal).  The generic +-0.2 rad step stalls
+    # before its heel strike (its zero dynamics has no periodic orbit), and the passive
+    # walker's start is off the zero dynamics' surface (the search burnt 60 s); this one's
+    # start is its own gait: 0.3601 s steps, |multiplier| 0.906 (the zero dynamics').
+    ("straight_legs", "virtual_constraints"): (
+        "the swing leg from -0.1 to 0.1348 rad (the +-0.2 rad step stalls: no orbit)",
+        {"walker.actuation.virtual_constraints.outputs": [
+            {"link": "swing_leg", "bezier_rad": [-0.1, -0.0413, 0.0174, 0.0761, 0.1348]}],
+         "fixedpoint.initial_guess": {
+             "swing_angle_rad": -0.1696, "stance_angle_rad": 0.1348,
+             "swing_rate_rad_per_s": -0.9848983834,
+             "stance_rate_rad_per_s": -1.0373170165}}),
     # the rimless wheel's spokes (pi/8 apart, 1 m) landing a riser 2 sin(pi/8) sin(0.08) =
     # 0.0612 m below, 2 sin(pi/8) cos(0.08) = 0.763 m ahead, meet the ground as on its
     # 0.08 rad slope (configs/rimless_wheel.yaml): the same geometry, gravity along the
