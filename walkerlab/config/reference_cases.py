@@ -19,8 +19,8 @@ import yaml
 
 from walkerlab.config.loader import shipped_scene_path
 
-__all__ = ["JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "reference_scene",
-           "scene_for"]
+__all__ = ["JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "WALKING",
+           "reference_scene", "scene_for"]
 
 
 def _shipped(name: str) -> dict:
@@ -272,13 +272,14 @@ def _set(d: dict, path: str, value) -> None:
 def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     """The reference case of a cell: a shipped scene that exercises the feature on the kind
     (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`), else the kind's base walker with the
-    feature and the ground (:func:`scene_for`).
+    feature and the ground (:func:`scene_for`), changed as :data:`WALKING` says where that
+    walker has no gait.
 
     Returns
     -------
     case : str
-        ``configs/<name>.yaml`` or ``generated: <kind> base (configs/<base>.yaml) with
-        <feature>``.
+        ``configs/<name>.yaml`` or ``generated: configs/<base>.yaml with <feature>`` (and,
+        for a :data:`WALKING` case, ``: <what was changed and why>``).
     scene : dict
         The scene mapping.
     """
