@@ -202,8 +202,8 @@ def test_a_walking_generated_case_has_the_rigid_gait_its_comment_states(kind, fe
                                                                          tmp_path):
     """The case's fixed point is found from its own start, with the step period its
     comment gives (to 1e-6 s: the period is printed to 7 digits)."""
-    from walkerlab.stages import pipeline
     from walkerlab.io.artifacts import open_artifact
+    from walkerlab.stages import pipeline
 
     _, d = reference_scene(kind, feature, "rigid")
     path = pipeline.run("fixedpoint", scene_from_dict(d), tmp_path).path
