@@ -132,3 +132,87 @@ def test_optimize_refuses_a_ground_it_does_not_transcribe_naming_terrain_kind(sc
     assert r.exit_code == 1
     assert f"terrain.kind: {terrain['kind']}" in r.output and reason in r.output
     assert not (tmp_path / "runs" / "ground").exists()
+
+
+def test_a_torque_features_shipped_reference_case_drives_the_features_joint():
+    """A shipped scene stands for a torque feature only if it has a law at that feature's
+    joint (RABBIT's swing_hip law is its hip torque, its stance_hip law its torso torque):
+    a case without the joint's law would measure the passive walk under the feature's
+    name."""
+    from walkerlab.config.reference_cases import FIVE_LINK_JOINT, JOINT, SHIPPED, TORSO_HIPS
+
+    checked = 0
+    for (kind, feature), _ in SHIPPED.items():
+        if feature not in JOINT:
+            continue
+        joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
+                 else JOINT[feature])
+        if feature == "knee_torque":
+            joints = {"stance_knee", "swing_knee"}
+        else:
+            joints = {joint}
+        case, d = reference_scene(kind, feature, "rigid")
+        laws = {t["joint"] for t in d["walker"]["actuation"]["torques"]}
+        assert laws & joints, f"{kind}/{feature}: {case} has no law at {joints}"
+        checked += 1
+    assert checked >= 5
+
+
+def test_a_walking_generated_case_carries_its_changes_and_says_why():
+    """Each generated case changed so that it walks (reference_cases.WALKING) carries its
+    changes in the scene every view measures, validates, and names why in its case."""
+    from walkerlab.config.reference_cases import WALKING
+
+    for (kind, feature), (why, changes) in WALKING.items():
+        for view in VIEWS:
+            if not KINDS[kind].supports(feature, view):
+                continue
+            case, d = reference_scene(kind, feature, view)
+            assert case.endswith(why) and case.startswith("generated: "), case
+            for path, value in changes.items():
+                node = d
+                for k in path.split("."):
+                    node = node[k]
+                assert node == value, (kind, feature, view, path)
+        scene_from_dict(reference_scene(kind, feature, "rigid")[1])
+
+
+def test_the_stairs_cases_are_their_slopes_step_as_a_stair():
+    """The rimless wheel's stairs are its slope's geometry: spokes 2 alpha apart (alpha =
+    pi / n) landing a riser 2 l sin(alpha) sin(phi) below and a tread 2 l sin(alpha)
+    cos(phi) ahead meet the ground at the slope's angles (Coleman, Chatterjee & Ruina 1997);
+    the kneed walker's riser is its step's drop on the slope (0.4747 m x sin 0.0504)."""
+    from walkerlab.config.reference_cases import WALKING, _shipped
+
+    w = _shipped("rimless_wheel")
+    alpha, phi = math.pi / w["walker"]["spokes"], w["slope"]["angle_rad"]
+    chord = 2.0 * w["walker"]["spoke_length_m"] * math.sin(alpha)
+    ch = WALKING[("rolling_polygon", "stairs")][1]
+    assert math.isclose(ch["terrain.riser_m"], chord * math.sin(phi), abs_tol=1e-4)
+    assert math.isclose(ch["terrain.tread_m"], chord * math.cos(phi), abs_tol=1e-3)
+    k = _shipped("kneed")
+    ch = WALKING[("locking_knees", "stairs")][1]
+    assert math.isclose(ch["terrain.riser_m"], 0.4747 * math.sin(k["slope"]["angle_rad"]),
+                        abs_tol=5e-4)
+
+
+#: (kind, feature) -> the walking case's rigid step period [s] as its comment states
+WALKING_PERIODS = {("locking_knees", "stairs"): 0.5461442,
+                   ("locking_knees", "hip_torque"): 0.5394385,
+                   ("rolling_polygon", "stairs"): 1.0333695}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind,feature", sorted(WALKING_PERIODS))
+def test_a_walking_generated_case_has_the_rigid_gait_its_comment_states(kind, feature,
+                                                                         tmp_path):
+    """The case's fixed point is found from its own start, with the step period its
+    comment gives (to 1e-6 s: the period is printed to 7 digits)."""
+    from walkerlab.io.artifacts import open_artifact
+    from walkerlab.stages import pipeline
+
+    _, d = reference_scene(kind, feature, "rigid")
+    path = pipeline.run("fixedpoint", scene_from_dict(d), tmp_path).path
+    with open_artifact(path) as f:
+        period = float(f["step_period"][()])
+    assert math.isclose(period, WALKING_PERIODS[(kind, feature)], abs_tol=1e-6)

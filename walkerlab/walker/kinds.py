@@ -239,6 +239,12 @@ _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-o
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
                     "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
+#: why optimize refuses a torso on knees or flat feet (the phased transcription,
+#: :mod:`walkerlab.optimal.transcription.phases`, has no torso's symbolic form; measured on
+#: the kneed walker with a 0.4 kg upper body, whose rigid gait walks in every other view)
+_PHASED_TORSO = ("the phased transcription (knees or flat feet) takes massive legs with "
+                 "point or flat feet and no torso today: optimise the walker without "
+                 "walker.torso")
 _FLAT_LANDING = ("flat feet walk stairs and footholds in the rigid model, the MJCF export "
                  "(walkerlab fixedpoint, simulate, export --format mjcf; footholds in "
                  "contact-sim too): this view does not carry a flat foot's landing on them "
@@ -297,6 +303,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("knee_torque", "adams"): FREE_JOINT_TORQUES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("torso_torque", "optimize"): _PHASED_TORSO,
         **_GROUNDS,
         **_OPTIMIZE_GROUNDS,
     },
@@ -324,6 +331,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{("profile", v): _FLAT_PROFILE for v in ("rigid", "adams", "gym")},
         **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("torso_torque", "optimize"): _PHASED_TORSO,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "
                                          "hip torques, not together)"),
