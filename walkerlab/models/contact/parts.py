@@ -222,12 +222,11 @@ class RollingPolygonPart(ContactPart):
         spokes are not a pair of legs with a lane each) and no contact periodic gait (the
         step map's mid-stance section is a biped's)."""
         from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
-        from walkerlab.config import TerrainSettings
 
         if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
                 and scene.contact.hub_inertia_kg_m2 is None:
             return HUB_INERTIA_MESSAGE
-        terrain = scene.terrain or TerrainSettings()
+        terrain = scene.terrain_or_default()
         if terrain.lanes != "continuous":
             return (f"terrain.lanes: {terrain.lanes}: a rimless wheel's contact model runs "
                     "on continuous ground (its spokes have no lanes of their own)")

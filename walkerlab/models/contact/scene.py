@@ -262,6 +262,17 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+    if data.structure.foot == "flat" and "start" not in cs.model_fields_set \
+            and scene.walker.actuation is None and scene.terrain_or_default().is_slope:
+        # a passive flat-footed walker on its slope starts at the rigid gait's mid-stance
+        # unless the scene says otherwise (walkerlab.analysis.contact.sim.rigid_mid_stance:
+        # from the post-impact state its first steps are 8-9 % short and it trips off its
+        # patches)
+        cs = cs.model_copy(update={"start": "mid_stance"})
+    if cs.start == "mid_stance" and data.structure.foot != "flat":
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: mid_stance starts "
+                                "a flat foot flat on the ground (this walker's feet are "
+                                f"{data.structure.foot}): use start: ideal")
     why = contact_part(data.structure).check(scene, data, checked)
     if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
         raise ContactSceneError(f"scene '{scene.name}': {why}")
@@ -269,7 +280,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         # the run cannot start there (periodic_gait: true records the gait as not found)
         raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
-    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
+    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
                         scene=scene)
 
