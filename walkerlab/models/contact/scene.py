@@ -262,18 +262,19 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    if data.structure.foot == "flat" and "start" not in cs.model_fields_set \
+    part = contact_part(data.structure)
+    if part.mid_stance_start and "start" not in cs.model_fields_set \
             and scene.walker.actuation is None and scene.terrain_or_default().is_slope:
         # a passive flat-footed walker on its slope starts at the rigid gait's mid-stance
         # unless the scene says otherwise (walkerlab.analysis.contact.sim.rigid_mid_stance:
         # from the post-impact state its first steps are 8-9 % short and it trips off its
         # patches)
         cs = cs.model_copy(update={"start": "mid_stance"})
-    if cs.start == "mid_stance" and data.structure.foot != "flat":
+    if cs.start == "mid_stance" and not part.mid_stance_start:
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: mid_stance starts "
-                                "a flat foot flat on the ground (this walker's feet are "
-                                f"{data.structure.foot}): use start: ideal")
-    why = contact_part(data.structure).check(scene, data, checked)
+                                "a flat foot flat on the ground (this walker has no flat "
+                                "feet): use start: ideal")
+    why = part.check(scene, data, checked)
     if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
         raise ContactSceneError(f"scene '{scene.name}': {why}")
     if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
