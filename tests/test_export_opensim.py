@@ -437,8 +437,8 @@ def test_osim_flat_feet_walk_in_opensim(tmp_path):
     model has the multibody's mass plus the feet, and walks >= 6 alternating heel strikes
     from the default state in double support without falling; its mean step period from
     the 2nd strike on within 3 % of the rigid 0.8102 s (measured with the 0.1 kg feet the
-    scene had before: +1.1 %: 0.8225, 0.8135, 0.821 s; MuJoCo then +1.94 %), the speed within 5 % (-0.5 %).  Slow: 10-20 min (the heel
-    and toe on stiff contact)."""
+    scene had before: +1.1 %: 0.8225, 0.8135, 0.821 s; MuJoCo then +1.94 %), the speed
+    within 5 % (-0.5 %).  Slow: 10-20 min (the heel and toe on stiff contact)."""
     import re
 
     from walkerlab.export.opensim_walk import walk
