@@ -286,8 +286,9 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
 
     One step of the rigid walker (:func:`walkerlab.models.registry.build_walker`) from
     ``x_ideal``, and the instant within it where the legs are parallel (``theta_swing =
-    theta_stance``, the contact step map's section, :mod:`walkerlab.analysis.contact.
-    step_map`), found by ``scipy.optimize.brentq`` on the step's dense output.  There the
+    theta_stance``, the section of the contact step map,
+    :mod:`walkerlab.analysis.contact.step_map`), found by ``scipy.optimize.brentq`` on the
+    step's dense output.  There the
     stance foot is flat (foot flat: the sole on the ground, no impact under way): placed by
     :func:`initial_state_from_ideal` the contact walker starts as the rigid one is, heel
     and toe at the static penetration, the swing foot at its spring's rest angle.  From the
