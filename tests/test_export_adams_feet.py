@@ -119,8 +119,8 @@ def test_arc_feet_are_spheres_of_radius_R_touching_the_ground(arc):
 
 
 def test_flat_feet_parts_springs_and_contacts_read_back(flat):
-    """configs/flat_feet.yaml: a foot PART per leg with the contact model's 0.1 kg
-    and 5e-4 kg m^2 at the ankle; an ankle REVOLUTE whose markers coincide at the start; the
+    """configs/flat_feet.yaml: a foot PART per leg with the contact model's 0.01 kg
+    and 5e-5 kg m^2 at the ankle; an ankle REVOLUTE whose markers coincide at the start; the
     ankle spring as a rotational SPRINGDAMPER (120 N m/rad, 3 N m s/rad, rest 0) from the
     foot (I) to the leg (J); heel and toe spheres 0.05 m behind and 0.10 m ahead of the
     ankle along the sole; at the start (the rigid heel strike's double support, the MJCF
@@ -132,8 +132,8 @@ def test_flat_feet_parts_springs_and_contacts_read_back(flat):
     joints = model.joints()
     for k, leg in enumerate(("leg1", "leg2")):
         p = ids[f"{leg}_foot"]
-        assert model.part_mass(p) == 0.1
-        assert model.part_inertia(p)[2, 2] == pytest.approx(5e-4, rel=1e-12)
+        assert model.part_mass(p) == 0.01
+        assert model.part_inertia(p)[2, 2] == pytest.approx(5e-5, rel=1e-12)
         kind, i, j = joints[ANKLE_JOINT + k]
         assert (kind, i, j) == ("REVOLUTE", marker_id(p, "joint"), marker_id(ids[leg], "foot"))
         assert np.allclose(model.marker_pose(i)[0], model.marker_pose(j)[0], atol=1e-12)

@@ -197,3 +197,52 @@ def test_an_actuated_flat_walker_keeps_its_landing_on_stairs():
                 if g.name == "heel_strike"]
     assert len(strikes(stairs)) == 3  # one per stance mode
     assert np.allclose(np.subtract(strikes(stairs), strikes(level)), 0.0075, atol=1e-15)
+
+
+def _flat_feet_without_terrain() -> dict:
+    import yaml
+
+    d = yaml.safe_load((ROOT / "configs" / "flat_feet.yaml").read_text())
+    del d["terrain"]
+    return d
+
+
+def test_a_flat_footed_scene_without_terrain_gets_patches_that_hold_its_sole():
+    """Without a ``terrain`` section the contact model's checkerboard patches were 0.10 m
+    wide, shorter than the 0.15 m sole that lands on its heel at the patch's centre and
+    rolls its load to the toe: the walker tripped at its first step.  The default ground of
+    a flat-footed walker is now four soles wide (0.6 m here, configs/flat_feet.yaml's own
+    width): the sole's length ahead of the heel's footfall with a sole to spare at either
+    end.  A point-footed scene keeps 0.10 m (its artifacts unchanged), and a scene's own
+    terrain section is never replaced."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.models.contact.scene import contact_setup
+
+    bare = scene_from_dict(_flat_feet_without_terrain(), "flat_bare.yaml")
+    assert bare.terrain is None
+    ground = bare.terrain_or_default()
+    assert ground.lanes == "checkerboard" and ground.is_slope
+    assert ground.patch_width_m == pytest.approx(4 * (0.05 + 0.10))
+    assert ground.patch_width_m / 2 > 0.05 + 0.10  # the sole rolled to its toe fits
+    assert contact_setup(bare).terrain.patch_width_m == pytest.approx(0.6)
+    paper = load_scene(ROOT / "configs" / "paper.yaml")
+    assert paper.terrain_or_default().patch_width_m == 0.10
+    own = load_scene(ROOT / "configs" / "flat_feet_stairs.yaml")
+    assert own.terrain_or_default() is own.terrain
+
+
+@pytest.mark.slow  # ~5 s: the rigid gait, then 11 heel strikes of the contact model
+def test_a_flat_footed_scene_without_terrain_walks_in_contact_sim(tmp_path):
+    """configs/flat_feet.yaml without its terrain section: contact-sim --strides 5 walks
+    the 11 heel strikes asked for on the default ground (before: a trip at the first step
+    on 0.10 m patches)."""
+    import h5py
+    import yaml
+    from cli_run import run_cli
+
+    path = tmp_path / "flat_bare.yaml"
+    path.write_text(yaml.safe_dump(_flat_feet_without_terrain()))
+    rc, err, _ = run_cli("-q", "contact-sim", path, "--strides", "5", "--runs-dir", tmp_path)
+    assert rc == 0, err
+    with h5py.File(tmp_path / "flat_bare" / "contact_sim.h5", "r") as f:
+        assert f["events/heel_strike_times"].size >= 11

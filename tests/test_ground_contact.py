@@ -261,3 +261,44 @@ def test_a_flat_foots_friction_verdict_names_the_toe_that_would_slip():
             assert abs(total - lifts[0].function(t, x)) < 1e-5 * weight, (phase.name, t)
         checked.add(phase.name.split(":")[0])
     assert checked == {"double_support", "heel_contact", "heel_off"}
+
+
+@pytest.mark.slow  # the flat-footed gait's search and one step: ~2-5 s
+def test_the_flat_foots_trailing_toe_leaves_the_cone_only_as_it_unloads():
+    """configs/flat_feet.yaml's double support (15.5 ms): the unbounded friction ratio of
+    the verdict is the no-slip pin's own physics, not an artefact of the ratio at a vanishing
+    normal force.  The pinned trailing toe's tangential force grows (7.9 -> 26.6 N) as its
+    normal force falls (147 -> 0 N): the ratio passes mu 0.9 2.9 ms before toe off, at a
+    normal force of 25.5 N (13 % of the weight), and is 2.6 at most while the normal force
+    is above 5 % of the weight; at toe off 26.6 N still act along the ground.  A Coulomb
+    toe slides there (the contact model's does: its double-support creep), so the verdict
+    stands; the numbers bound where the rigid view's pin departs from the contact view."""
+    from pathlib import Path
+
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.codegen.cache import functions
+    from walkerlab.config import load_scene
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml")
+    walker = build_walker(scene)
+    guess = scene.fixedpoint.initial_guess.as_array(walker.state_names())
+    fp = find_fixed_point(walker, guess, Solver.from_settings(scene.solver), fd_check=False)
+    seg = simulate_steps(walker, fp.x, 1, Solver.from_settings(scene.solver)).segments[0]
+    name, ta, tb, guard = seg.phase_log[0]
+    assert name == "double_support:heel_contact" and guard == "toe_off"
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    forces = functions(data)["double_support_heel_contact_forces"]
+    ts = np.linspace(ta, tb, 501)  # every 31 us
+    X = seg.sample(ts)
+    F = np.array([forces(t, X[:, i])[:2] for i, t in enumerate(ts)])
+    fn, ft = F[:, 0], np.abs(F[:, 1])
+    weight = data.total_mass_kg * data.gravity_m_per_s2
+    assert abs(fn[-1]) < 1e-6 * weight and 20.0 < ft[-1] < 35.0  # unloaded, still pulled
+    loaded = fn > 0.05 * weight
+    assert 2.0 < np.max(ft[loaded] / fn[loaded]) < 3.0
+    out = np.flatnonzero(ft > 0.9 * fn)[0]  # the first sample outside the cone
+    assert np.all(ft[out:] > 0.9 * fn[out:])  # and it stays out until toe off
+    assert 0.002 < tb - ts[out] < 0.004 and 0.10 < fn[out] / weight < 0.16

@@ -393,12 +393,15 @@ class ContactSimSettings(BaseModel):
         "checked between its contact runs (a run under way is finished); when it is spent "
         "the search keeps the best start found so far and says so (null = none).",
         json_schema_extra={"unit": "s"})
-    start: Literal["ideal", "adjusted", "periodic_gait"] = Field(
+    start: Literal["ideal", "adjusted", "periodic_gait", "mid_stance"] = Field(
         "ideal", description="Initial state of the run: 'ideal' (the rigid fixed point, rates "
-        "times initial_rate_scale; the default), 'adjusted' (rates searched as `contact-sim "
+        "times initial_rate_scale; the default, for a passive flat-footed walker on its "
+        "slope 'mid_stance'), 'adjusted' (rates searched as `contact-sim "
         "--adjust`), 'periodic_gait' (the contact model's own periodic gait at mid-stance, "
         "on patches spaced by its step length: steady state without start-up transients; "
-        "adds the periodic-gait search, about 5-10 s).")
+        "adds the periodic-gait search, about 5-10 s), 'mid_stance' (flat feet: the rigid "
+        "gait at its mid-stance, the legs parallel and the stance foot flat at its static "
+        "deflection, rates times initial_rate_scale; no impact under way at the start).")
 
     @model_serializer(mode="wrap")
     def _drop_default_start(self, handler):

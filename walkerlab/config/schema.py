@@ -62,6 +62,10 @@ from walkerlab.config.studies import (
 )
 from walkerlab.config.walker import WalkerParams
 
+#: The default ground's patch width for flat feet, in soles (heel to toe): see
+#: :meth:`Scene.terrain_or_default`.
+FLAT_FOOT_PATCH_SOLES = 4.0
+
 
 class SlopeSettings(Strict):
     """Ramp angle phi (the walker walks downhill in +x). Give exactly one of the two fields."""
@@ -184,6 +188,34 @@ class Scene(Strict):
                              "walker's feet carry their own mass (walker.leg.foot.mass_kg, "
                              "inertia_about_ankle_kg_m2), used by every view: remove these")
         return self
+
+    def terrain_or_default(self) -> TerrainSettings:
+        """The ground every view walks on: the ``terrain`` section, or without one the
+        default ground, the scene's slope with checkerboard lanes of
+        :attr:`TerrainSettings.patch_width_m` (0.10 m), or for flat feet
+        :data:`FLAT_FOOT_PATCH_SOLES` times the sole's length (heel to toe).
+
+        A flat foot lands on its heel and rolls its load to its toe, one sole's length
+        ahead of the heel's footfall on which its patch is centred: the 0.10 m of a point
+        foot's default is shorter than the sole (configs/flat_feet.yaml's 0.15 m) and the
+        walker trips on its first step.  Four soles (0.6 m there, its terrain section's
+        width) hold the sole with a sole's length to spare at either end for the footfalls'
+        scatter and still leave the swing foot a gap in its lane at mid-stance (the lanes'
+        patches lie a stride apart; the swing foot passes half a stride from them).
+
+        Returns
+        -------
+        TerrainSettings
+            The section itself when the scene has one (never changed).
+        """
+        if self.terrain is not None:
+            return self.terrain
+        pair = getattr(self.walker, "leg_pair", None)
+        feet = [getattr(leg, "foot", None) for leg in pair()] if pair is not None else []
+        soles = [f.heel_m + f.toe_m for f in feet if getattr(f, "kind", "") == "flat"]
+        if soles:
+            return TerrainSettings(patch_width_m=FLAT_FOOT_PATCH_SOLES * max(soles))
+        return TerrainSettings()
 
     @model_validator(mode="after")
     def _ground_fits_the_walker(self) -> Scene:

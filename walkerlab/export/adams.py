@@ -145,7 +145,7 @@ from dataclasses import replace
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_actuation import (
     ACT_BLOCK,
     ACT_VARIABLES,
@@ -575,7 +575,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     feet = adams_feet(mb).scene_feet(scene, data)
     start = start or adams_start(scene, mb, data)
     settings = scene.contact or ContactSettings()
-    lanes = (scene.terrain or TerrainSettings()).lanes == "checkerboard" and \
+    lanes = scene.terrain_or_default().lanes == "checkerboard" and \
         start.lanes is not None
     law = contact_mm(settings)
     ids = part_ids(mb)

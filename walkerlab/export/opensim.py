@@ -81,7 +81,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, xml_comments
@@ -372,7 +372,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     from walkerlab.models.contact.scene import ideal_step_length
 
     settings = scene.contact or ContactSettings()
-    terrain = scene.terrain or TerrainSettings()
+    terrain = scene.terrain_or_default()
     c, knee = contact_si(settings)
     ideal = ideal_gait(scene) if ideal is None else ideal
     if terrain.kind == "profile":  # the capability table's cell (every legged kind's)

@@ -256,7 +256,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
     from walkerlab.models.contact.terrain import ground_drops
 
     settings = scene.contact or ContactSettings()
-    terrain = scene.terrain or TerrainSettings()
+    terrain = scene.terrain_or_default()
     c, knee = contact_si(settings)
     feet_part, part = SCENE_FEET[mb.kind], EXPORT_PARTS[mb.kind]
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,

@@ -29,11 +29,12 @@ from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import state_name
-from walkerlab.models.contact.scene import ContactSetup
+from walkerlab.models.contact.scene import ContactSceneError, ContactSetup
 from walkerlab.walker.layout import StateIndex
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
-           "scene_start", "simulate_contact", "simulate_from", "trajectory_names"]
+           "rigid_mid_stance", "scene_start", "simulate_contact", "simulate_from",
+           "trajectory_names"]
 
 #: A walker whose hip rises above this many leg lengths has left the ground for good
 #: (a foot can touch the ground only while the hip is within one leg length of it).
@@ -279,6 +280,72 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     return replace(limits, **upd)
 
 
+def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
+    """The rigid gait's state at its mid-stance, where a flat-footed contact run starts
+    (``contact_sim.start: mid_stance``).
+
+    One step of the rigid walker (:func:`walkerlab.models.registry.build_walker`) from
+    ``x_ideal``, and the instant within it where the legs are parallel (``theta_swing =
+    theta_stance``, the section of the contact step map,
+    :mod:`walkerlab.analysis.contact.step_map`), found by ``scipy.optimize.brentq`` on the
+    step's dense output.  There the
+    stance foot is flat (foot flat: the sole on the ground, no impact under way): placed by
+    :func:`initial_state_from_ideal` the contact walker starts as the rigid one is, heel
+    and toe at the static penetration, the swing foot at its spring's rest angle.  From the
+    post-impact state instead, the contact model starts its stance heel at rest in the
+    middle of a heel strike (and its trailing foot off the ground) that the rigid view has
+    already resolved by an impulse: on configs/flat_feet.yaml the next step is 8-9 % short
+    (the rigid gait's period-2 mode excited), from mid-stance within 1.5 %.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene of a flat-footed walker (its ``solver`` integrates the step).
+    x_ideal : ndarray, shape (2n,)
+        The rigid walker's post-impact state (its ``state_names()`` order: swing, stance,
+        stance ankle, their rates) [rad, rad/s].
+
+    Returns
+    -------
+    ndarray, shape (2n,)
+        The state at mid-stance, in the same order [rad, rad/s].
+
+    Raises
+    ------
+    walkerlab.models.contact.scene.ContactSceneError
+        The step does not reach mid-stance (it falls first), or reaches it with the stance
+        foot not flat (one line naming ``contact_sim.start``).
+    """
+    from scipy.optimize import brentq
+
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.models.registry import build_walker
+
+    walker = build_walker(scene)
+    seg = simulate_steps(walker, np.asarray(x_ideal, float), 1,
+                         Solver.from_settings(scene.solver)).segments[0]
+    if seg.termination != RunEnd.HEEL_STRIKE.value:
+        raise ContactSceneError("contact_sim.start: mid_stance: the rigid step from the "
+                                f"fixed point ends in {seg.termination} before its heel "
+                                "strike")
+
+    def apart(t):  # theta_swing - theta_stance [rad]
+        x = seg.sample(np.array([t]))[:, 0]
+        return float(x[0] - x[1])
+
+    t0, t1 = seg.t_start, seg.t_end
+    if not apart(t0) < 0.0 < apart(t1):
+        raise ContactSceneError("contact_sim.start: mid_stance: the rigid step has no "
+                                "mid-stance (its legs are never parallel)")
+    tm = brentq(apart, t0, t1, xtol=1e-13, rtol=1e-13)
+    mode = next((name for name, ta, tb, _g in seg.phase_log if ta <= tm <= tb), "")
+    if not mode.startswith("foot_flat"):
+        raise ContactSceneError(f"contact_sim.start: mid_stance: the rigid gait is in "
+                                f"{mode or '?'} at its mid-stance, not foot flat: start "
+                                "from its fixed point (start: ideal)")
+    return seg.sample(np.array([tm]))[:, 0]
+
+
 def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_scale=None,
                 step_length_m: float | None = None):
     """The contact walker of a scene, its initial state and run limits (the start of
@@ -289,7 +356,10 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     setup : ContactSetup
         The scene's contact model (:func:`walkerlab.models.contact.scene.contact_setup`).
     x_ideal : ndarray (n,)
-        Ideal post-impact state (rigid walker's ``state_names()`` order) [rad, rad/s].
+        Ideal post-impact state (rigid walker's ``state_names()`` order) [rad, rad/s]; the
+        patches are laid from it, and the run starts from it, or with ``contact_sim.start:
+        mid_stance`` from the rigid gait's mid-stance that follows it
+        (:func:`rigid_mid_stance`).
     n_strides : int
         Strides the run may take (patches are laid out for them).
     rate_scale : (float, float), optional
@@ -314,7 +384,8 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
         lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal)
     walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m, lengths)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
-    x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
+    x_start = rigid_mid_stance(setup.scene, x_ideal) if cs.start == "mid_stance" else x_ideal
+    x0 = initial_state_from_ideal(walker, *np.asarray(x_start, float), rate_scale=tuple(scale))
     limits = ContactLimits(
         sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
         pin_time_s=cs.pin_time_s,
@@ -354,7 +425,9 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
     walker, x0, limits, step_length = scene_start(setup, x_ideal, n_strides, rate_scale)
-    t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
+    # from mid-stance the first heel strike comes half a step in: one step more
+    t_final = cs.t_final_s or (2 * n_strides + (1.5 if cs.start == "mid_stance" else 0.5)
+                               ) * period
     # without an end time of its own, a run whose contact steps are slower than the rigid
     # ones goes on until its strides are made (or twice the rigid strides' time)
     t_more = 2.0 * t_final if cs.t_final_s is None else None

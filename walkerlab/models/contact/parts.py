@@ -29,9 +29,15 @@ class ContactPart:
     per_point_feet : bool
         Each contact point is a foot of its own in the gait's foot quantities (a wheel's
         spokes), not combined per leg.
+    mid_stance_start : bool
+        The contact run may start at the rigid gait's mid-stance (``contact_sim.start:
+        mid_stance``, :func:`walkerlab.analysis.contact.sim.rigid_mid_stance`: the stance
+        foot flat on the ground there), the default start of a passive walker of the kind
+        on its slope.
     """
 
     plain = True
+    mid_stance_start = False
     per_point_feet = False
 
     def flat_feet(self, data) -> list[dict]:
@@ -123,6 +129,7 @@ class FlatFeetPart(ContactPart):
     """Flat feet on ankle springs: heel and toe contacts, the feet's absolute angles."""
 
     plain = False
+    mid_stance_start = True
 
     def flat_feet(self, data) -> list[dict]:
         st = data.structure
@@ -222,12 +229,11 @@ class RollingPolygonPart(ContactPart):
         spokes are not a pair of legs with a lane each) and no contact periodic gait (the
         step map's mid-stance section is a biped's)."""
         from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
-        from walkerlab.config import TerrainSettings
 
         if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
                 and scene.contact.hub_inertia_kg_m2 is None:
             return HUB_INERTIA_MESSAGE
-        terrain = scene.terrain or TerrainSettings()
+        terrain = scene.terrain_or_default()
         if terrain.lanes != "continuous":
             return (f"terrain.lanes: {terrain.lanes}: a rimless wheel's contact model runs "
                     "on continuous ground (its spokes have no lanes of their own)")

@@ -268,14 +268,26 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    why = contact_part(data.structure).check(scene, data, checked)
+    part = contact_part(data.structure)
+    if part.mid_stance_start and "start" not in cs.model_fields_set \
+            and scene.walker.actuation is None and scene.terrain_or_default().is_slope:
+        # a passive flat-footed walker on its slope starts at the rigid gait's mid-stance
+        # unless the scene says otherwise (walkerlab.analysis.contact.sim.rigid_mid_stance:
+        # from the post-impact state its first steps are 8-9 % short and it trips off its
+        # patches)
+        cs = cs.model_copy(update={"start": "mid_stance"})
+    if cs.start == "mid_stance" and not part.mid_stance_start:
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: mid_stance starts "
+                                "a flat foot flat on the ground (this walker has no flat "
+                                "feet): use start: ideal")
+    why = part.check(scene, data, checked)
     if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
         raise ContactSceneError(f"scene '{scene.name}': {why}")
     if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
         # the run cannot start there (periodic_gait: true records the gait as not found)
         raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
-    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
+    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
                         scene=scene)
 
