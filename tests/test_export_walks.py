@@ -100,6 +100,7 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
                                            rel=PERIOD_RTOL.get(name, 0.01)), check.line
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_walk_check_reports_the_step_period_against_the_rigid_gait(tmp_path):
     """``walkerlab export --walk`` on the paper's MJCF prints one line: 11 alternating heel
     strikes, the mean step period against the rigid 0.703597 s within 1 % (measured

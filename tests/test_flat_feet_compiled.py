@@ -88,6 +88,7 @@ def test_the_variational_cfunc_is_the_flow_jacobian_times_phi(walker):
                                    atol=1e-11 * np.abs(want).max())
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_walk_and_the_fixed_point_on_compiled_flows_match_the_python_path(scene, walker):
     """Same modes in the same order; the steps' end states and times, and the fixed point,
     within the integrator's tolerance (rtol = atol = 1e-12 per step: the two paths locate

@@ -153,6 +153,7 @@ def _overwritten(good: bytes, off: int, path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_fixedpoint_damaged_in_the_middle_is_recomputed_with_a_notice(
         ideal_scene, tmp_path, capfd):
     # issue 56 item 9: a fixedpoint.h5 with bytes overwritten in its middle still opens,

@@ -103,6 +103,7 @@ def test_the_kneed_optimums_contact_replay_keeps_its_period(gait):
     assert abs(period / T - 1.0) < 0.03, period
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_contact_sim_stores_the_knee_stop_work(tmp_path):
     """``walkerlab contact-sim`` on a kneed walker with a hip actuator (a zero torque law, so
     that the rigid gait it starts from is the passive one; 0.7 s): the artifact's ledger

@@ -154,8 +154,9 @@ def test_contact_monte_carlo_same_on_dask_as_in_process(paper_start):
 
 
 def test_robustness_contact_steps_only_when_asked(paper_scene):
-    """robustness.contact off: the contact brackets are NaN (nothing runs); on, for a scene
-    without a contact section: one line naming it."""
+    """robustness.contact off: the contact brackets are NaN (nothing runs).  (A scene
+    without a contact section runs on the section's defaults, as ``contact: {}``: no longer a
+    refusal; the contact start of such a scene is tested in tests/test_daily_loop.py.)"""
     import math
 
     from walkerlab.config import RobustnessSettings
@@ -163,7 +164,3 @@ def test_robustness_contact_steps_only_when_asked(paper_scene):
 
     off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05)
     assert len(off) == 4 and all(math.isnan(v) for v in off.values())
-    bare = paper_scene.model_copy(update={"contact": None})
-    with pytest.raises(ValueError, match="robustness.contact: .*'contact' section"):
-        contact_steps(bare, paper_scene.fixedpoint and np.zeros(4),
-                      RobustnessSettings(contact=True), 0.05)

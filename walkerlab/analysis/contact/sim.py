@@ -329,9 +329,12 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
                                 f"fixed point ends in {seg.termination} before its heel "
                                 "strike")
 
+    lay = walker.layout()
+    i_swing, i_stance = lay.index("swing_angle"), lay.index("stance_angle")
+
     def apart(t):  # theta_swing - theta_stance [rad]
-        x = seg.sample(np.array([t]))[:, 0]
-        return float(x[0] - x[1])
+        state = seg.sample(np.array([t]))[:, 0]
+        return float(state[i_swing] - state[i_stance])
 
     t0, t1 = seg.t_start, seg.t_end
     if not apart(t0) < 0.0 < apart(t1):
