@@ -59,6 +59,15 @@ def default_signals():
             signal.signal(s, signal.SIG_DFL if h is None else h)
 
 
+def _slow_by_cost() -> set[str]:
+    """The quick tests moved to the slow run by their measured cost
+    (``tests/slow_by_cost.txt``, written by ``scripts/slow_by_cost.py`` from a timed quick
+    run: the README's test command keeps its CPU budget)."""
+    path = Path(__file__).with_name("slow_by_cost.txt")
+    return {line.split(maxsplit=1)[1] for line in path.read_text().splitlines()
+            if line.strip() and not line.startswith("#")}
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Each test file runs on one pytest-xdist worker (``--dist loadgroup``, pyproject): a
@@ -67,6 +76,9 @@ def pytest_collection_modifyitems(config, items):
     an ``xdist_group`` mark of their own keep it (the group then spans files).  The long
     runs (``slow``) are spread over both workers one by one: each is long beside its file's
     fixtures."""
+    by_cost = _slow_by_cost()
     for item in items:
+        if item.nodeid in by_cost:  # measured cost: the slow run's (tests/slow_by_cost.txt)
+            item.add_marker(pytest.mark.slow)
         if not any(item.iter_markers("xdist_group")) and not any(item.iter_markers("slow")):
             item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
