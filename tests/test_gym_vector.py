@@ -197,7 +197,10 @@ def test_the_ids_max_episode_steps_governs_each_sub_envs_truncation():
 
 
 def test_native_vector_env_spaces_are_the_single_spaces_batched():
-    env = _native(4, "threelink_hzd")
+    from walkerlab.gym import WalkerVectorEnv
+
+    env = _vec(None, 4, "threelink_hzd")  # no mode given: the id's vector entry point
+    assert isinstance(env, WalkerVectorEnv) and len(env.envs) == 4
     one = env.envs[0]
     assert env.single_observation_space == one.observation_space
     assert env.single_action_space == one.action_space
@@ -291,3 +294,16 @@ def test_disabled_autoreset_refuses_to_step_an_ended_sub_env_until_it_is_reset()
     env.reset(options={"reset_mask": np.array([False, True])})
     assert not env.step(zero)[3].any()
     env.close()
+
+
+def test_the_vector_benchmark_reports_a_rate_for_each_form():
+    """Not a timing: the benchmark runs and prints one line per form."""
+    from walkerlab.bench.gym_vector import FORMS, bench_vector, lines
+
+    res = bench_vector("configs/paper.yaml", num_envs=2, steps=3, repeats=1)
+    assert all(res[f"{f}_steps_per_s"] > 0 for f in FORMS)
+    text = lines(res)
+    assert len(text) == 1 + len(FORMS) and all(f in "\n".join(text) for f in FORMS)
+    with pytest.raises(ValueError) as e:
+        bench_vector(num_envs=0)
+    _one_line(e, "num_envs")
