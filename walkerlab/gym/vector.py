@@ -107,8 +107,6 @@ class WalkerVectorEnv(VectorEnv):
         except ValueError:
             raise ValueError(f"autoreset_mode={autoreset_mode!r}: give one of "
                              f"{[m.value for m in AutoresetMode]}") from None
-        if "num_envs" in env_kwargs:  # pragma: no cover - taken by the signature
-            raise ValueError("num_envs given twice")
         #: the sub-environments, each built as gym.make's entry point builds it
         self.envs: list[WalkerEnv] = [registered_env(**env_kwargs) for _ in range(n)]
         self.num_envs = n
