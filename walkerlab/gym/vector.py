@@ -1,0 +1,340 @@
+"""``walkerlab/Walker-v0`` vectorised in one process: :class:`WalkerVectorEnv`, the id's
+``vector_entry_point`` (``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")``).
+
+N walkers of one scene are stepped per call, with gymnasium's batched spaces
+(:func:`gymnasium.vector.utils.batch_space`), its autoreset convention (gymnasium 1.x:
+``AutoresetMode.NEXT_STEP`` by default, declared in ``metadata["autoreset_mode"]``), the
+id's time limit per sub-environment and ``SyncVectorEnv``'s seeding (``reset(seed=s)``
+seeds sub-environment ``i`` with ``s + i``): for the same seeds and actions its
+observations, rewards, flags and infos are those of ``gymnasium.make_vec(...,
+vectorization_mode="sync")`` bit for bit.
+
+The physics of one call is :meth:`WalkerVectorEnv._step_all` (for now a loop over
+:class:`~walkerlab.gym.env.WalkerEnv` instances, each built as ``gym.make``'s entry point
+builds it: :func:`~walkerlab.gym.env.registered_env`); a compiled batched step may replace
+it.  The time limit, the autoreset and the batching of the infos are this class's own and
+know nothing of the walker (its sizes are its spaces').
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space, create_empty_array
+
+from .env import DEFAULT_EPISODE_STEPS, InvalidAction, WalkerEnv, registered_env
+
+__all__ = ["WalkerVectorEnv"]
+
+
+def _whole(value, name: str, low: int, allow_none: bool = False) -> int | None:
+    """``value`` as a whole number >= ``low`` (or None when allowed); else a one-line
+    ``ValueError`` naming ``name``."""
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise ValueError(f"{name}={value!r}: give a whole number >= {low}"
+                         + (" or None" if allow_none else ""))
+    return int(value)
+
+
+class WalkerVectorEnv(VectorEnv):
+    """``num_envs`` walkers of one scene stepped together in one process: the native
+    vector form of ``walkerlab/Walker-v0`` (module docstring).
+
+    ``reset`` returns ``(observations, infos)``, ``step`` ``(observations, rewards,
+    terminations, truncations, infos)``, batched as gymnasium's vector environments batch
+    them: ``observations`` (N, m) float64, ``rewards`` (N,) float64, ``terminations`` and
+    ``truncations`` (N,) bool, ``infos`` a dict of arrays (N,) with a boolean mask
+    ``_<key>`` each (:meth:`gymnasium.vector.VectorEnv._add_info`; the keys are
+    :data:`walkerlab.gym.env.INFO_KEYS` and the ledger's, in their units: ``time_s`` [s],
+    ``hip_x_m`` [m], ``ledger_<term>`` [J]; ``heel_strike_time_s`` is batched as gymnasium
+    batches a value that may be None: an object array holding None, or a float array
+    holding NaN when sub-environment 0's first value was a number; read ``heel_strike``).
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of walkers N (>= 1).
+    max_episode_steps : int or None
+        Control periods after which each sub-environment is truncated (as gymnasium's
+        ``TimeLimit`` truncates: also on a period that terminated); default the id's
+        :data:`~walkerlab.gym.env.DEFAULT_EPISODE_STEPS`; None: no limit.
+    autoreset_mode : gymnasium.vector.AutoresetMode or str
+        ``"NextStep"`` (default: the step after an episode's end resets that walker and
+        returns its reset observation with reward 0 and both flags False, ignoring its
+        action), ``"SameStep"`` (reset within the ending step; ``infos["final_obs"]`` and
+        ``infos["final_info"]`` hold the end) or ``"Disabled"`` (reset ended walkers with
+        ``reset(options={"reset_mask": mask})``).
+    **env_kwargs
+        :class:`~walkerlab.gym.env.WalkerEnv`'s keywords, the same for every walker
+        (``scene`` required; ``view``, ``control_period_s``, ``start_noise``, ...).
+
+    Attributes
+    ----------
+    envs : list of WalkerEnv
+        The sub-environments (no limit of their own: this class truncates them).
+    single_observation_space, single_action_space : gymnasium.spaces.Box
+        One walker's spaces: observation (m,) float64, action (k,) float32 (fractions of
+        ``tau_max`` [-], or N m with ``normalize_action=False``).
+    observation_space, action_space : gymnasium.spaces.Box
+        The batched spaces, (N, m) and (N, k).
+
+    Raises
+    ------
+    ValueError
+        ``num_envs`` not a whole number >= 1, ``max_episode_steps`` not a whole number >= 1
+        or None, an unknown ``autoreset_mode``, or a bad ``WalkerEnv`` keyword (one line).
+    """
+
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"],
+                                "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, num_envs: int = 1,
+                 max_episode_steps: int | None = DEFAULT_EPISODE_STEPS,
+                 autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+                 **env_kwargs):
+        super().__init__()
+        n = _whole(num_envs, "num_envs", 1)
+        self.max_episode_steps = _whole(max_episode_steps, "max_episode_steps", 1,
+                                        allow_none=True)
+        try:
+            self.autoreset_mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            raise ValueError(f"autoreset_mode={autoreset_mode!r}: give one of "
+                             f"{[m.value for m in AutoresetMode]}") from None
+        #: the sub-environments, each built as gym.make's entry point builds it
+        self.envs: list[WalkerEnv] = [registered_env(**env_kwargs) for _ in range(n)]
+        self.num_envs = n
+        first = self.envs[0]
+        self.metadata = {**first.metadata, "autoreset_mode": self.autoreset_mode}
+        self.render_mode = first.render_mode
+        self.single_observation_space = first.observation_space
+        self.single_action_space = first.action_space
+        self.observation_space = batch_space(self.single_observation_space, n)
+        self.action_space = batch_space(self.single_action_space, n)
+        self._observations = create_empty_array(self.single_observation_space, n=n,
+                                                fn=np.zeros)
+        self._rewards = np.zeros(n, dtype=np.float64)
+        self._terminations = np.zeros(n, dtype=np.bool_)
+        self._truncations = np.zeros(n, dtype=np.bool_)
+        self._autoreset_envs = np.zeros(n, dtype=np.bool_)
+        #: control periods since each sub-environment's reset (its time limit's count)
+        self._elapsed = np.zeros(n, dtype=np.int64)
+        self._has_reset = False
+
+    # ------------------------------------------------------------------ the physics
+    def _step_all(self, actions: np.ndarray, mask: np.ndarray) -> list[dict | None]:
+        """Step the sub-environments ``i`` where ``mask[i]`` by one control period with
+        ``actions[i]``, writing their observation, reward and termination into
+        ``self._observations``, ``self._rewards``, ``self._terminations`` (and
+        ``self._truncations``: False, the time limit being the caller's).
+
+        The one place a walker is stepped: a compiled batched step may replace this loop
+        as long as it writes the same rows and returns the same infos.
+
+        Parameters
+        ----------
+        actions : ndarray (N, k)
+            Checked actions (:meth:`_actions`), unscaled.
+        mask : ndarray (N,) bool
+            The sub-environments to step.
+
+        Returns
+        -------
+        list of (dict or None)
+            Each stepped sub-environment's info (``WalkerEnv.step``'s), None elsewhere.
+        """
+        infos: list[dict | None] = [None] * self.num_envs
+        for i in np.flatnonzero(mask):
+            (self._observations[i], self._rewards[i], self._terminations[i],
+             self._truncations[i], infos[i]) = self.envs[i].step(actions[i])
+        return infos
+
+    def _reset_one(self, i: int, seed: int | None, options: dict | None) -> dict:
+        """Reset sub-environment ``i`` (its row of the observations, its time limit's
+        count; not its reward and flags); returns its info."""
+        obs, info = self.envs[i].reset(seed=seed, options=options)
+        self._observations[i] = obs
+        self._elapsed[i] = 0
+        return info
+
+    # ------------------------------------------------------------------ checks
+    def _actions(self, actions) -> np.ndarray:
+        """``actions`` as an array (N, k) of finite real numbers, as given (not cast).
+
+        Raises
+        ------
+        InvalidAction
+            None, not real numbers, not of shape (N, k), or NaN/inf entries (one line
+            naming the batched action space).
+        """
+        shape = self.action_space.shape
+        want = f"give {shape[0]} rows of {shape[1]} finite real numbers, {self.action_space}"
+        if actions is None:
+            raise InvalidAction(f"actions is None: {want}")
+        try:
+            a = np.asarray(actions)
+        except (ValueError, TypeError):
+            raise InvalidAction(f"actions of type {type(actions).__name__} is not an array "
+                                f"of numbers: {want}") from None
+        if a.dtype.kind not in "iuf":
+            what = "complex" if a.dtype.kind == "c" else f"of dtype {a.dtype}"
+            raise InvalidAction(f"actions is {what}: {want}")
+        if a.shape != shape:
+            raise InvalidAction(f"actions has shape {a.shape}: {want}")
+        bad = np.argwhere(~np.isfinite(a))
+        if bad.size:
+            i, j = (int(v) for v in bad[0])
+            raise InvalidAction(f"actions[{i}, {j}] is {a[i, j]}: {want}")
+        return a
+
+    def _seeds(self, seed) -> list[int | None]:
+        n = self.num_envs
+        if seed is None:
+            return [None] * n
+        if isinstance(seed, int | np.integer) and not isinstance(seed, bool):
+            return [int(seed) + i for i in range(n)]
+        if isinstance(seed, Sequence) and not isinstance(seed, str | bytes):
+            if len(seed) != n:
+                raise ValueError(f"reset: seed has {len(seed)} entries: give num_envs={n}")
+            return list(seed)
+        raise ValueError(f"reset: seed={seed!r}: give None, an int (sub-env i gets seed + i) "
+                         f"or a list of {n} ints or None")
+
+    # ------------------------------------------------------------------ gymnasium API
+    def reset(self, *, seed: int | Sequence[int | None] | None = None,
+              options: dict | None = None):
+        """Reset every walker, or those of ``options["reset_mask"]``; returns
+        ``(observations (N, m), infos)``.
+
+        Parameters
+        ----------
+        seed : None, int or sequence of N (int or None)
+            An int ``s`` seeds sub-environment ``i`` with ``s + i`` (as ``SyncVectorEnv``).
+        options : dict, optional
+            ``reset_mask``: ndarray (N,) bool, the walkers to reset (at least one); the
+            other keys (``state``) go to every reset walker's ``WalkerEnv.reset``.
+
+        Raises
+        ------
+        ValueError
+            A seed list not of N entries, a bad seed, options not a dict, or a
+            ``reset_mask`` not a bool array (N,) with a True (one line); a sub-environment's
+            own refusals (``WalkerEnv.reset``).
+        """
+        seeds = self._seeds(seed)
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"reset: options must be a dict or None, got a "
+                             f"{type(options).__name__}")
+        options = dict(options) if options is not None else None
+        mask = np.ones(self.num_envs, dtype=np.bool_)
+        if options is not None and "reset_mask" in options:
+            m = options.pop("reset_mask")
+            if not (isinstance(m, np.ndarray) and m.dtype == np.bool_
+                    and m.shape == (self.num_envs,) and m.any()):
+                raise ValueError(f"reset: options['reset_mask'] must be a bool ndarray of "
+                                 f"shape ({self.num_envs},) with at least one True, got "
+                                 f"{m!r}")
+            mask = m
+        infos: dict = {}
+        for i in np.flatnonzero(mask):
+            infos = self._add_info(infos, self._reset_one(int(i), seeds[i], options), int(i))
+        self._terminations[mask] = self._truncations[mask] = False
+        self._autoreset_envs[mask] = False
+        self._has_reset = True
+        return self._observations.copy(), infos
+
+    def step(self, actions):
+        """Hold ``actions[i]`` (k,) on walker ``i`` for one control period (a walker whose
+        episode ended is reset instead, as ``autoreset_mode`` says); returns
+        ``(observations (N, m), rewards (N,), terminations (N,), truncations (N,),
+        infos)``.
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            Before the first :meth:`reset`.
+        InvalidAction
+            ``actions`` not (N, k) finite real numbers (one line).
+        RuntimeError
+            ``autoreset_mode="Disabled"`` and a walker whose episode ended not reset.
+        """
+        if not self._has_reset:
+            raise gym.error.ResetNeeded("Cannot call step() before calling reset()")
+        a = self._actions(actions)
+        mode = self.autoreset_mode
+        if mode == AutoresetMode.NEXT_STEP:
+            resetting = self._autoreset_envs.copy()
+        else:
+            resetting = np.zeros(self.num_envs, dtype=np.bool_)
+            if mode == AutoresetMode.DISABLED and self._autoreset_envs.any():
+                raise RuntimeError(
+                    f"autoreset_mode=Disabled: sub-environments "
+                    f"{np.flatnonzero(self._autoreset_envs).tolist()} ended; reset them with "
+                    "reset(options={'reset_mask': mask}) before stepping")
+        stepping = ~resetting
+        step_infos = self._step_all(a, stepping) if stepping.any() else [None] * self.num_envs
+        if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
+            self._elapsed[stepping] += 1
+            self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
+        infos: dict = {}
+        for i in range(self.num_envs):
+            if resetting[i]:  # NEXT_STEP: the reset is this step's outcome
+                info = self._reset_one(i, None, None)
+                self._rewards[i] = 0.0
+                self._terminations[i] = self._truncations[i] = False
+            else:
+                info = step_infos[i]
+                if mode == AutoresetMode.SAME_STEP and (self._terminations[i]
+                                                        or self._truncations[i]):
+                    infos = self._add_info(infos, {"final_obs": self._observations[i].copy(),
+                                                   "final_info": info}, i)
+                    info = self._reset_one(i, None, None)  # the step's reward and flags kept
+            infos = self._add_info(infos, info, i)
+        self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
+        return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
+                self._truncations.copy(), infos)
+
+    def render(self) -> tuple:
+        """Each walker's frame (``WalkerEnv.render``: (H, W, 3) uint8 with
+        ``render_mode="rgb_array"``, else None), as a tuple of N."""
+        return tuple(env.render() for env in self.envs)
+
+    def call(self, name: str, *args, **kwargs) -> tuple:
+        """``getattr(env, name)(*args, **kwargs)`` on each walker (the attribute itself
+        when not callable), as a tuple of N."""
+        out = []
+        for env in self.envs:
+            f = getattr(env, name)
+            out.append(f(*args, **kwargs) if callable(f) else f)
+        return tuple(out)
+
+    def get_attr(self, name: str) -> tuple:
+        """Each walker's attribute ``name``, as a tuple of N."""
+        return tuple(getattr(env, name) for env in self.envs)
+
+    def set_attr(self, name: str, values) -> None:
+        """Set attribute ``name`` of each walker: ``values`` a list or tuple of N, or one
+        value for all.
+
+        Raises
+        ------
+        ValueError
+            A list or tuple not of N values (one line).
+        """
+        if not isinstance(values, list | tuple):
+            values = [values] * self.num_envs
+        if len(values) != self.num_envs:
+            raise ValueError(f"set_attr: {len(values)} values for num_envs={self.num_envs}")
+        for env, v in zip(self.envs, values, strict=True):
+            setattr(env, name, v)
+
+    def close_extras(self, **kwargs) -> None:
+        """Close every walker."""
+        for env in self.envs:
+            env.close()
