@@ -44,6 +44,12 @@ benchmark      what is timed                                                    
                constraints (configs/rabbit_hzd.yaml), median; the whole zero
                dynamics and one full-order step beside it
                (:mod:`walkerlab.bench.hzd`; ``scripts/bench_hzd.py``)
+``gym``        ``walkerlab/Walker-v0`` steps/s beside MuJoCo's ``Walker2d-v5``,  >= Walker2d
+               threelink_hzd and rabbit_hzd, rigid and contact views, zero /
+               random / scene-policy actions, the rigid view's compiled step
+               and its Python yardstick (:mod:`walkerlab.bench.gym`)
+``gym-vector`` one env against 8 in the native, sync and async vector forms     native 8 >=
+               (:mod:`walkerlab.bench.gym_vector`)                               4x one env
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -66,10 +72,11 @@ from walkerlab.io.artifacts import atomic_write
 #: benchmark -> the module whose ``lines(result)`` prints it (the others: their JSON)
 _LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.optimize",
           "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd",
-          "powered-command": "walkerlab.bench.powered_command"}
+          "powered-command": "walkerlab.bench.powered_command", "gym": "walkerlab.bench.gym",
+          "gym-vector": "walkerlab.bench.gym_vector"}
 
 BENCHMARKS = ("ideal", "fixedpoint", "sweep", "sweep-workers", "basin", "contact", "main-job",
-              "optimize", "powered", "powered-command", "hzd")
+              "optimize", "powered", "powered-command", "hzd", "gym", "gym-vector")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -190,6 +197,14 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.hzd import bench_hzd
 
         return bench_hzd()
+    if name == "gym":
+        from walkerlab.bench.gym import bench_gym
+
+        return bench_gym()
+    if name == "gym-vector":
+        from walkerlab.bench.gym_vector import bench_vector
+
+        return bench_vector()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
             "basin": B.bench_basin, "sweep-workers": B.bench_sweep_workers,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

@@ -118,6 +118,20 @@ class ActionTorques(Actuators):
         super().__post_init__()
         self.u = np.zeros(len(self.spec.torques) - self.first)
 
+    def held_work(self, xa, xb) -> float:
+        """The work of the held action :attr:`u` from the state ``xa`` to ``xb`` (2n,)
+        [J]: ``sum_k u_k (delta_k(xb) - delta_k(xa))``, exact for torques held constant (the
+        integral of :meth:`power` over any path between them).  The action alone
+        (:attr:`first` 0); 0 for torques scaled by a massless foot's mass."""
+        if self.limit or not self.spec.torques:
+            return 0.0
+        if self.hip_only:
+            da, db = self.hip_angles(xa)[0], self.hip_angles(xb)[0]
+            return float(np.real(np.sum(self.u) * (db - da)))
+        da = np.asarray(self.joint_angles(xa)[0])
+        db = np.asarray(self.joint_angles(xb)[0])
+        return float(np.real(np.sum(self.u * (db - da))))
+
     def torques(self, t, x) -> np.ndarray:
         """The scene's laws' torques (the first :attr:`first`), then the action's (k,)
         [N m] (whatever the state)."""

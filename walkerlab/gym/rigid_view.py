@@ -25,6 +25,18 @@ step's swing-foot path is checked against it at the heel strike, as ``simulate``
 the profile ends the episode as a ``trip`` there (the heel strike not made; :attr:`RigidView.
 trip` says when and where the foot met the profile).
 
+The compiled control step (``compiled``, the default): a phase of a step walker without
+torque laws of its own (the passive walker, or one powered by a push-off alone) runs its
+flow with the action's torques compiled in (:func:`walkerlab.models.hybrid.actuated.
+compiled_with`: an :class:`walkerlab.codegen.actuated.ActuatedFlow` whose laws are constant
+torques, the action written into its law block each period), integrated by CyRK's DOP853
+in C++ at the scene solver's tolerances (:mod:`walkerlab.integrate._compiled`: guards as the
+cfunc's extra outputs, located by Brent's method on the dense output): no Python per
+right-hand-side call.  Its work ledger is the held torques' exact work
+``sum_k u_k Delta delta_k`` where the action's power keeps one sign over the period's piece
+(else the Gauss-Legendre nodes below).  Other phases (flat feet's modes, a walker with torque
+laws) run the scene's solver on Python flows, as ``compiled=False`` runs every phase.
+
 The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
 ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
 
@@ -37,12 +49,15 @@ the heel strike's collision, <= 0).
 
 from __future__ import annotations
 
+import sys
 from dataclasses import replace
 
 import numpy as np
 
+from walkerlab.codegen.torque_law import HEAD
 from walkerlab.integrate.rigid import MIN_STEP_TIME_S, walker_of_step
 from walkerlab.integrate.rigid_phase import integrate_phase
+from walkerlab.integrate.solver import Solver, available_backends
 
 from .action import action_torques, flat_action_walker
 
@@ -62,6 +77,13 @@ LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_wo
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
 
+#: the compiled control step's integrator: CyRK's DOP853 (Hairer's 8(5,3) pair, the stepping
+#: in C++) on the numba-compiled flow, at the scene solver's tolerances
+COMPILED_METHOD = "DOP853"
+#: each actuator's constant torque in a law block (:mod:`walkerlab.codegen.torque_law`:
+#: ``b[3 + HEAD i + 1]``, ``constant_n_m``), for up to 64 actuators
+_CONSTANTS = 3 + HEAD * np.arange(64) + 1
+
 
 class RigidView:
     """The scene's rigid hybrid walker stepped by control periods.
@@ -80,6 +102,11 @@ class RigidView:
     ground : walkerlab.analysis.gait.profile_walk.ProfileGround, optional
         A height profile's steps (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`);
         None: the model's own ground (slope, stairs, footholds).
+    actuation : walkerlab.config.actuation.Actuation, optional
+        The scene's actuation (a flat foot's twins carry its laws).
+    compiled : bool
+        Run the compiled control step where a phase has one (module docstring); False:
+        the scene's ``solver`` on Python flows throughout.
 
     Raises
     ------
@@ -88,13 +115,23 @@ class RigidView:
     """
 
     def __init__(self, model, solver, data, joints, max_step_time: float, ground=None,
-                 actuation=None):
+                 actuation=None, compiled: bool = True):
         self.model = model
         self.ground = ground
         self.solver = solver
         backend = solver.resolved_backend()
-        # the compiled flows carry the scene's laws only: the action needs the Python flow
+        # the scene's compiled flows carry the scene's laws only: the action's Python flow,
+        # unless the compiled control step runs (below)
         self.backend = "cyrk" if backend == "cyrk_compiled" else backend
+        #: the compiled control step's integrator (:data:`COMPILED_METHOD` at the scene's
+        #: tolerances, flows compiled with the action in them), or None: the scene's solver
+        self.compiled_solver = (Solver(COMPILED_METHOD, solver.rtol, solver.atol,
+                                       solver.max_step_s, "cyrk_compiled")
+                                if compiled and "cyrk_compiled" in available_backends()
+                                else None)
+        self._compiled: dict = {}
+        #: arithmetic errors raised inside compiled flows (:meth:`_unraisable`), counted
+        self.arithmetic_errors = 0
         n = model.n_coordinates
         self.n = n
         # the action's actuators of each stance leg (legs that differ: the leg's own
@@ -110,6 +147,8 @@ class RigidView:
         self._twin_of = MODE_TWINS.get(data.structure.kind.name)
         self._twins: dict = {}
         self._data, self._joints, self._actuation = data, list(joints), actuation
+        if self._twin_of is not None:
+            self.compiled_solver = None  # a mode's own M^-1 B u: the twins' Python flows
         if self._twin_of is not None:  # the first step's now (a bad walker says so here)
             self._twins[id(model)] = self._twin_of(model, replace(data, mirror_params=None),
                                                    self._joints, actuation)
@@ -188,6 +227,38 @@ class RigidView:
                 for k, v in self.walker.points(self.x).items()}
 
     # ------------------------------------------------------------------ stepping
+    def _compiled_phase(self, w, phase, acts):
+        """``phase`` with its flow compiled with the action's torques in it (an
+        :class:`walkerlab.codegen.actuated.ActuatedFlow` whose laws are the action's
+        actuators, each a constant torque: :attr:`ActionTorques.u` written into the law
+        block before each period), or None where the compiled step does not run: a step
+        walker with torque laws of its own (their Python flows), a phase without a compiled
+        flow, or actuators acting on a massless limit's rows.  Built once per phase."""
+        key = (id(phase), id(acts))
+        if key in self._compiled:
+            return self._compiled[key]
+        from walkerlab.codegen.compiled import CompiledFlow
+        from walkerlab.models.hybrid.actuated import compiled_with
+
+        own, comp = w.actuators, phase.compiled
+        passive = own is None or (not own.spec.torques and getattr(
+            own.spec, "virtual_constraints", None) is None)
+        # the walker's own phase (no ground of a step in its guards) or a compiled phase
+        data = (self._data if w is self.model else self._data.mirror
+                if w is self.model.mirror and self.model.mirror is not None else None)
+        if comp is not None and type(comp) is CompiledFlow:
+            data = replace(self._data, params=comp.params, mirror_params=None) \
+                if data is None else data
+        flow = None
+        if passive and data is not None and (comp is None or type(comp) is CompiledFlow):
+            flow = compiled_with(phase, data, acts)  # (the phase's own guards, offsets)
+            if flow is not None and comp is not None:
+                flow = replace(flow, first_chunk_steps=comp.first_chunk_steps,
+                               chunk_rtol=comp.chunk_rtol, _memo={})
+        out = None if flow is None else (replace(phase, compiled=flow), flow.laws)
+        self._compiled[key] = out
+        return out
+
     def _flow(self, phase, acts, act_on: bool):
         if not act_on:
             return phase.flow
@@ -216,6 +287,33 @@ class RigidView:
                 self.ledger[key] += h * _GL_W[j] * p
             if scene_on:
                 self.ledger["scene_torque_work"] += h * _GL_W[j] * scene.power(tj, xj)
+
+    def _unraisable(self, args) -> None:
+        """``sys.unraisablehook`` while a compiled flow runs: an arithmetic error inside the
+        cfunc (numba reports it as unraisable: ``0.0 ** -2`` of a five-link walker's
+        virtual-leg length in a configuration it cannot reach but folded flat, while it
+        falls) is counted in :attr:`arithmetic_errors`, not printed; anything else goes to
+        the hook in force."""
+        if issubclass(args.exc_type, ArithmeticError):
+            self.arithmetic_errors += 1
+            return
+        sys.__unraisablehook__(args)
+
+    def _held_work(self, run, acts, act_on: bool) -> None:
+        """The compiled step's ledger over ``[self.t, run.t_last]`` (the action alone: the
+        step's walker has no torque laws of its own there): where the action's power has
+        one sign at both ends, the exact work of the held torques
+        (:meth:`walkerlab.gym.action.ActionTorques.held_work`, no dense output needed) on
+        that sign's side; else :meth:`_work`'s Gauss-Legendre nodes on the dense output."""
+        if not act_on or run.t_last <= self.t:
+            return
+        xb = np.asarray(run.y_last[:2 * self.n], float)
+        pa, pb = acts.power(self.t, self.x), acts.power(run.t_last, xb)
+        if pa * pb > 0.0:
+            key = "action_work_positive" if pa > 0 else "action_work_negative"
+            self.ledger[key] += acts.held_work(self.x, xb)
+        else:
+            self._work(run.dense, self.t, run.t_last, acts, act_on)
 
     def advance(self, u: np.ndarray, t_end: float) -> list[float]:
         """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
@@ -274,17 +372,33 @@ class RigidView:
             if self.ended:
                 break
             t_stop = min(t_end, self.t_step + self.max_step_time)
-            if self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
+            fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
+                    else None)
+            if fast is not None:  # the compiled control step: the action's torques held
+                fphase, laws = fast  # in the law block (each actuator's constant)
+                laws[_CONSTANTS[:acts.u.size]] = acts.u
+                hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
+                try:
+                    run = integrate_phase(fphase, self.t, self.x, None, t_stop, 2 * n,
+                                          self.compiled_solver, "cyrk_compiled", None, None,
+                                          False)
+                finally:
+                    sys.unraisablehook = hook
+            elif self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
                 tw, tacts = self._twin(w)
                 tacts.u = acts.u
                 phase = tw.phases[self.k]
                 rhs = phase.flow
             else:
                 rhs = self._flow(phase, acts, act_on)
-            jac = phase.jacobian if phase.jacobian is not None else w.variational
-            run = integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n, self.solver,
-                                  self.backend, rhs, jac, False)
-            self._work(run.dense, self.t, run.t_last, acts, act_on)
+            if fast is None:
+                jac = phase.jacobian if phase.jacobian is not None else w.variational
+                run = integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n,
+                                      self.solver, self.backend, rhs, jac, False)
+            if fast is not None:
+                self._held_work(run, acts, act_on)
+            else:
+                self._work(run.dense, self.t, run.t_last, acts, act_on)
             if self.ground is not None:
                 self._pieces.append((phase, run.dense, (self.t, run.t_last)))
             self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)

@@ -24,7 +24,7 @@ from walkerlab.models.hybrid.actuators import Actuators, torque_chain_jacobian
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian
 
-__all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
+__all__ = ["compiled_with", "Actuators", "actuate", "torque_chain_jacobian"]
 
 
 def _functions(data):
@@ -145,6 +145,16 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     return ActuatedFlow(data.structure, tuple(data.params), name, guards,
                         joints=tuple(tuple(j) for j in links), laws=acts.laws.packed(),
                         actuators=acts)
+
+
+def compiled_with(phase: Phase, data, acts):
+    """``phase``'s flow compiled with the actuators ``acts`` acting in it (their laws
+    evaluated in the cfunc: :class:`walkerlab.codegen.actuated.ActuatedFlow`), for a phase
+    of the passive walker built from ``data``; None where no compiled flow can carry them
+    (a massless limit's rows, a computed-torque controller, guards without compiled
+    outputs).  The Gymnasium environment's compiled control step holds its action so
+    (:class:`walkerlab.gym.rigid_view.RigidView`)."""
+    return _compiled_laws(phase, data, acts, False)
 
 
 def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
