@@ -118,6 +118,16 @@ class ActionTorques(Actuators):
         super().__post_init__()
         self.u = np.zeros(len(self.spec.torques) - self.first)
 
+    def joint_state(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """``(delta, ddelta)`` (k,) of the action's joints at the real state ``x`` (2n,)
+        [rad, rad/s] (the hip's for every actuator when all act at the hip)."""
+        if self.hip_only:
+            d, dd = self.hip_angles(x)[:2]
+            k = len(self.spec.torques)
+            return np.full(k, float(np.real(d))), np.full(k, float(np.real(dd)))
+        d, dd = self.joint_angles(x)[:2]
+        return np.array(d, dtype=float), np.array(dd, dtype=float)
+
     def held_work(self, xa, xb) -> float:
         """The work of the held action :attr:`u` from the state ``xa`` to ``xb`` (2n,)
         [J]: ``sum_k u_k (delta_k(xb) - delta_k(xa))``, exact for torques held constant (the

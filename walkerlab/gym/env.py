@@ -460,11 +460,12 @@ class WalkerEnv(gym.Env):
 
     def _info(self, strikes: list[float]) -> dict:
         s = self.sim
+        self._hip_x = s.hip_x()  # the next period's start (its reward's origin)
         stance = (s.leg if self.view == "rigid" else f"leg{s.stance + 1}")
         info = {"time_s": float(s.t), "heel_strike": bool(strikes),
                 "heel_strike_time_s": float(strikes[-1]) if strikes else None,
                 "heel_strike_times_s": [float(t) for t in strikes], "steps": int(s.steps),
-                "stance_leg": stance, "hip_x_m": s.hip_x(), "termination": s.ended,
+                "stance_leg": stance, "hip_x_m": self._hip_x, "termination": s.ended,
                 "solver_message": str(getattr(s, "failure", "")),
                 "terrain_seed": int(self.terrain_seed)}
         info.update({f"ledger_{k}": float(v) for k, v in s.ledger.items()})
@@ -576,7 +577,7 @@ class WalkerEnv(gym.Env):
             leg1 = (s.leg == "leg1") if self.view == "rigid" else (s.stance == 0)
             a = a + self._controller_torques(s.x, leg1)
         u = np.clip(a, -self.tau_max, self.tau_max)
-        x_before = s.hip_x()
+        x_before = self._hip_x  # the hip at the period's start: the last info's
         w_before = s.ledger["action_work_positive"]
         self._elapsed += 1
         strikes = s.advance(u, self._elapsed * self.dt)

@@ -132,6 +132,7 @@ class RigidView:
         self._compiled: dict = {}
         #: arithmetic errors raised inside compiled flows (:meth:`_unraisable`), counted
         self.arithmetic_errors = 0
+        self._joints_at: tuple = (b"", None, None, None)  # (state bytes, delta, ddelta, acts)
         n = model.n_coordinates
         self.n = n
         # the action's actuators of each stance leg (legs that differ: the leg's own
@@ -305,13 +306,18 @@ class RigidView:
         one sign at both ends, the exact work of the held torques
         (:meth:`walkerlab.gym.action.ActionTorques.held_work`, no dense output needed) on
         that sign's side; else :meth:`_work`'s Gauss-Legendre nodes on the dense output."""
-        if not act_on or run.t_last <= self.t:
+        if not act_on or run.t_last <= self.t or acts.limit:
             return
         xb = np.asarray(run.y_last[:2 * self.n], float)
-        pa, pb = acts.power(self.t, self.x), acts.power(run.t_last, xb)
+        key = self.x.tobytes()  # the last period's end state's joint angles, kept
+        da, dda = (self._joints_at[1:3] if self._joints_at[0] == key and
+                   self._joints_at[3] is acts else acts.joint_state(self.x))
+        db, ddb = acts.joint_state(xb)
+        self._joints_at = (xb.tobytes(), db, ddb, acts)
+        pa, pb = float(acts.u @ dda), float(acts.u @ ddb)  # the power at both ends [W]
         if pa * pb > 0.0:
             key = "action_work_positive" if pa > 0 else "action_work_negative"
-            self.ledger[key] += acts.held_work(self.x, xb)
+            self.ledger[key] += float(acts.u @ (db - da))
         else:
             self._work(run.dense, self.t, run.t_last, acts, act_on)
 
