@@ -275,3 +275,30 @@ def test_saved_figure_is_not_cropped(tmp_path):
     h, w = plt.imread(png).shape[:2]
     hr, wr = plt.imread(tmp_path / "ref.png").shape[:2]
     assert abs(w - wr) <= 2 and abs(h - hr) <= 2, ((w, h), (wr, hr))
+
+
+def test_a_run_begun_within_a_step_counts_neither_partial_step():
+    """A contact run from the rigid gait's mid-stance begins within a step: the step
+    periods, the speed and the step lengths come from the complete steps alone (here six
+    steps of 0.8 s between a first of 0.4 s and a last of 0.3 s; the hip moves 0.5 m/s in
+    the complete steps, 2 m/s in the partial ones)."""
+    from walkerlab.comparison.tables import gait_metrics
+
+    edges = np.array([0.0, 0.4, 1.2, 2.0, 2.8, 3.6, 4.4, 5.2, 5.5])
+    t = np.linspace(0.0, 5.5, 5501)
+    step = np.searchsorted(edges, t, side="right") - 1
+    step[-1] = step[-2]
+    stance = step % 2
+    speed = np.where((t < 0.4) | (t > 5.2), 2.0, 0.5)
+    hip = np.concatenate([[0.0], np.cumsum(speed[1:] * np.diff(t))])
+    tr = NamedTrajectory(
+        time=t, legs=["leg1", "leg2"], coordinates={}, units={}, stance_leg=stance,
+        step_index=step, kinetic=1 + 0 * t, potential=100 + 0 * t,
+        points={"hip": np.vstack([hip, 1 + 0 * t]),
+                "leg1_foot": np.vstack([hip + 0.2, 0 * t]),
+                "leg2_foot": np.vstack([hip - 0.2, 0 * t])})
+    m = gait_metrics(tr)
+    assert m["t_left_s"] == pytest.approx(0.8, abs=2e-3)
+    assert m["t_right_s"] == pytest.approx(0.8, abs=2e-3)
+    assert m["v_com_m_per_s"] == pytest.approx(0.5, rel=1e-3)
+    assert m["n_steps"] == 8

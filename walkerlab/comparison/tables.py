@@ -18,7 +18,9 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     a *left step* is a step in which the left leg (``legs[0]`` unless given) swings.  Only
     complete steps count: the last step only if it lasts at least 90 % of the median of the
     others (a rigid run ends at its last heel strike; a contact run at its end time, within
-    a step, whose length and duration are not a step's).  ``v_com`` is the hip's horizontal
+    a step, whose length and duration are not a step's), the first likewise (a contact run
+    that starts at the rigid gait's mid-stance begins within a step); ``v_com`` then counts
+    its cycles from the first complete step.  ``v_com`` is the hip's horizontal
     displacement over whole cycles divided by their duration (over a periodic cycle the
     centre of mass and the hip advance alike).
     ``E_avg`` is the time average of KE + PE over the first ``n_energy_steps`` steps with PE
@@ -47,6 +49,10 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     done = np.ones(periods.size, dtype=bool)
     if periods.size > 1 and periods[-1] < 0.9 * np.median(periods[:-1]):
         done[-1] = False  # the run ended within this step
+    # a run that began within a step (a contact run from the rigid gait's mid-stance:
+    # ``contact_sim.start: mid_stance``): its first step is no step either
+    first = 1 if periods.size > 2 and periods[0] < 0.9 * np.median(periods[1:]) else 0
+    done[:first] = False
     left_steps = periods[(stance != li) & done]  # left leg swings when it is not in stance
     right_steps = periods[(stance == li) & done]
     hip = tr.points.get("hip")
@@ -54,9 +60,9 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     out["t_left_s"] = float(np.mean(left_steps)) if left_steps.size else np.nan
     out["t_right_s"] = float(np.mean(right_steps)) if right_steps.size else np.nan
     out["t_cycle_s"] = out["t_left_s"] + out["t_right_s"]
-    n_cyc = periods.size // 2
+    n_cyc = (periods.size - first) // 2
     if hip is not None and n_cyc >= 1:
-        i0, i1 = bounds[0], bounds[2 * n_cyc]
+        i0, i1 = bounds[first], bounds[first + 2 * n_cyc]
         out["v_com_m_per_s"] = float((hip[0, i1] - hip[0, i0]) / (tr.time[i1] - tr.time[i0]))
         out.update(_step_lengths(tr, bounds, stance, done, li))
     else:
@@ -86,7 +92,7 @@ def _step_lengths(tr: NamedTrajectory, bounds, stance, done, li: int) -> dict[st
     flat = all(h is not None for h in heels)
     if all(f is not None for f in feet):
         lengths, left_step = [], []
-        for k in range(1, int(done.sum()) + 1):
+        for k in np.flatnonzero(done) + 1:
             i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
             st = int(stance[k - 1])
             d = (heels[1 - st][:, i] - heels[st][:, bounds[k - 1]] if flat
