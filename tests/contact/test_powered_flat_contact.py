@@ -211,15 +211,19 @@ def optimum_gait():
 
 
 def passive_contact_period(x, period_s: float, strides: int = 1) -> float:
-    """Mean step period [s] of configs/flat_feet.yaml's passive contact model from the rigid
+    """Mean step period [s] of configs/flat_feet_optimal.yaml's passive contact model (its
+    0.1 kg feet: configs/flat_feet.yaml's contact run has 0.01 kg ones) from the rigid
     state ``x`` (6,) (a gait's start of step period ``period_s`` [s]) over the
     ``2 strides + 1`` steps a powered replay of ``strides`` makes (the compiled passive run,
-    < 1 s CPU): the reference the flat-footed contact replays are read against."""
+    < 1 s CPU; ``start: ideal``, from ``x`` as the replay starts, not the passive flat
+    feet's default mid-stance): the reference the flat-footed contact replays are read
+    against."""
     from walkerlab.analysis.contact.sim import simulate_from
 
-    scene = load_scene(CONFIGS / "flat_feet.yaml")
+    scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
     steps = 2 * strides + 1
     sc = with_changes(scene, {"contact_sim": {"n_strides": strides + 1, "sample_rate_hz": 500,
+                                              "start": "ideal",
                                               "t_final_s": (steps + 1.6) * period_s}})
     _, res, _, _ = simulate_from(contact_setup(sc), x, period_s, strides=strides + 1)
     hs = np.asarray(res.heel_strike_times, float)[:steps + 1]
