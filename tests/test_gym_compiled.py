@@ -114,7 +114,7 @@ def test_the_held_action_work_is_the_power_integrated_along_the_path():
     acts = sim.acts[sim.leg]
     acts.u = np.array([3.0, -2.0])[:env.action_space.shape[0]]
     w, phase = sim.walker, sim.walker.phases[sim.k]
-    fphase, laws = sim._compiled_phase(w, phase, acts)
+    fphase, laws, _ = sim._compiled_phase(w, phase, acts)
     laws[3 + 8 * np.arange(acts.u.size) + 1] = acts.u
     from walkerlab.integrate.rigid_phase import integrate_phase
 
@@ -130,3 +130,12 @@ def test_the_held_action_work_is_the_power_integrated_along_the_path():
     exact = acts.held_work(sim.x, run.y_last[:n2])
     assert abs(quad) > 1e-4
     assert abs(exact - quad) <= 1e-9 * abs(quad)
+
+
+def test_flat_feet_on_footholds_take_an_action_on_every_step_walker():
+    """configs/flat_feet_footholds.yaml under a small random hip torque: each step's
+    walker of the footholds' cycle gets its action twin from the stance leg's data (before:
+    a TypeError at the first step walker that is neither the scene's walker nor its
+    mirror), and walks its heel strikes."""
+    strikes, ends, *_ = _episode("configs/flat_feet_footholds.yaml", True, 150, "random")
+    assert strikes.size >= 1 and not ends

@@ -154,12 +154,23 @@ class RigidView:
             self._twins[id(model)] = self._twin_of(model, replace(data, mirror_params=None),
                                                    self._joints, actuation)
 
+    def _step_data(self, w):
+        """The walker data of the step walker ``w``: the scene's, or its mirror's for a
+        mirrored leg (legs that differ: the step walker itself, or on a ground that
+        differs from step to step, the present stance's, as :attr:`acts` reads it)."""
+        mirror = self._data.mirror
+        if w is self.model or mirror is None:
+            return self._data
+        if w is self.model.mirror:
+            return mirror
+        return mirror if self.leg == self.model.legs[0] else self._data
+
     def _twin(self, w):
         """``(walker, actuators)``: the twin of the step's walker ``w`` with the action in
         its modes (:data:`MODE_TWINS`), its actuators' clock at the step's start."""
         key = id(w)
         if key not in self._twins:
-            d = self._data if w is self.model else self._data.mirror
+            d = self._step_data(w)
             self._twins[key] = self._twin_of(w, replace(d, mirror_params=None),
                                              self._joints, self._actuation)
         tw, tacts = self._twins[key]
@@ -245,18 +256,20 @@ class RigidView:
         passive = own is None or (not own.spec.torques and getattr(
             own.spec, "virtual_constraints", None) is None)
         # the walker's own phase (no ground of a step in its guards) or a compiled phase
-        data = (self._data if w is self.model else self._data.mirror
-                if w is self.model.mirror and self.model.mirror is not None else None)
+        # (its guards' outputs and offsets carried by the compiled flow)
+        own_walker = w is self.model or (self.model.mirror is not None
+                                         and w is self.model.mirror)
+        data = self._step_data(w) if own_walker else None
         if comp is not None and type(comp) is CompiledFlow:
-            data = replace(self._data, params=comp.params, mirror_params=None) \
-                if data is None else data
+            data = replace(self._step_data(w), params=comp.params, mirror_params=None)
         flow = None
         if passive and data is not None and (comp is None or type(comp) is CompiledFlow):
             flow = compiled_with(phase, data, acts)  # (the phase's own guards, offsets)
             if flow is not None and comp is not None:
                 flow = replace(flow, first_chunk_steps=comp.first_chunk_steps,
                                chunk_rtol=comp.chunk_rtol, _memo={})
-        out = None if flow is None else (replace(phase, compiled=flow), flow.laws)
+        # (the phase itself kept with it: its id stays its own while the entry lives)
+        out = None if flow is None else (replace(phase, compiled=flow), flow.laws, phase)
         self._compiled[key] = out
         return out
 
@@ -381,7 +394,7 @@ class RigidView:
             fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
                     else None)
             if fast is not None:  # the compiled control step: the action's torques held
-                fphase, laws = fast  # in the law block (each actuator's constant)
+                fphase, laws, _ = fast  # in the law block (each actuator's constant)
                 laws[_CONSTANTS[:acts.u.size]] = acts.u
                 hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
                 try:
