@@ -6,6 +6,7 @@ code gives.
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 
@@ -91,6 +92,8 @@ def test_each_cells_stored_measurement_is_what_the_code_gives(kind, feature, vie
     e = cell_evidence(kind, feature, view)
     if view == "osim" and not e["ok"] and "not importable" in e["detail"]:
         pytest.skip("OpenSim is not installed where the table was measured")
+    if view == "osim" and importlib.util.find_spec("opensim") is None:
+        pytest.skip("OpenSim (the osim extra, not in the test extra) is not installed here")
     m = measure(kind, feature, view, tmp_path)
     assert m.ok == e["ok"], (m.detail, e["detail"])
     if e["ok"]:
