@@ -556,9 +556,8 @@ class _FlatFeet(_LinkFeet):
         if fmt not in ("mjcf", "osim") or walker_only:
             raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF and "
                              "OpenSim with the scene only (a URDF would hold point feet: "
-                             "no foot link, ankle "
-                             "spring or heel and toe contacts; --walker-only has no foot "
-                             "mass)")
+                             "no foot link, ankle spring or heel and toe contacts); "
+                             "--walker-only has no foot mass")
 
     def foot_mass(self, settings: ContactSettings):
         """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2`` (the
