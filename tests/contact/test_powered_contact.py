@@ -358,3 +358,20 @@ def test_every_shipped_powered_scene_runs_the_compiled_contact_run_or_says_why_n
     assert data is None and "no compiled data" in line, (
         f"{name}: contact_solver.method {setup.solver.method} on actuators that are compiled "
         "data, or no reason given")
+
+
+def test_grid_inside_is_the_grids_samples_strictly_inside_the_span():
+    """:func:`walkerlab.integrate.compiled_segments.grid_inside` (bisection) selects what
+    the whole-grid mask did, on sample grids and spans of every placement (an end on a
+    sample, within 1e-12 s of one, outside the grid, an empty span)."""
+    from walkerlab.integrate.compiled_segments import grid_inside
+
+    rng = np.random.default_rng(0)
+    grid = np.arange(0.0, 3.0, 1.0 / 500)
+    spans = [(0.0, 3.0), (0.002, 0.002), (0.1, 0.1 + 1e-13), (-1.0, 0.5), (2.9, 9.0),
+             (0.004 + 5e-13, 0.01 - 5e-13)]
+    spans += [tuple(np.sort(rng.uniform(-0.1, 3.1, 2))) for _ in range(200)]
+    spans += [(grid[i], grid[j]) for i, j in rng.integers(0, grid.size, (100, 2))]
+    for t0, t1 in spans:
+        want = grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)]
+        assert np.array_equal(grid_inside(grid, t0, t1), want), (t0, t1)

@@ -23,7 +23,17 @@ import numpy as np
 
 from . import _cyrk
 
-__all__ = ["CompiledSegments", "LOCATE_XTOL_S", "Stalled", "contact_tables"]
+__all__ = ["CompiledSegments", "LOCATE_XTOL_S", "Stalled", "contact_tables", "grid_inside"]
+
+
+def grid_inside(grid: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """The sample times of the increasing ``grid`` strictly inside ``(t0, t1)`` [s] (1e-12 s
+    from either end), by bisection: ``grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)]``
+    without a pass over the whole grid (a run's or an environment's horizon of samples)."""
+    lo = np.searchsorted(grid, t0 + 1e-12, side="right")
+    hi = np.searchsorted(grid, t1 - 1e-12, side="left")
+    return grid[lo:max(lo, hi)]
+
 
 #: Event location's tolerance on the time [s] (scipy's ``solve_ivp`` locates to 4 eps).
 LOCATE_XTOL_S = 1e-13
@@ -92,7 +102,7 @@ class CompiledSegments:
         """
         s, grid = self.solver, self.grid
         d = self.pdata.data(stance, t_origin, push, ankle, switch_s, ghost=True)
-        tg = np.concatenate([[t0], grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)], [t1]])
+        tg = np.concatenate([[t0], grid_inside(grid, t0, t1), [t1]])
         X, ok, nfev, msg, dense = _cyrk.solve_chunk(
             s.method, y0, tg, d, s.rtol, self.atol, s.max_step_s or np.inf, SEGMENT_STEPS,
             kernels=self.kernels, dense=True)

@@ -68,7 +68,7 @@ import numpy as np
 
 from walkerlab.models.contact.actuation import powered_rhs
 
-from .compiled_segments import Stalled
+from .compiled_segments import Stalled, grid_inside
 from .ends import RunEnd
 from .powered_events import (
     fall_event,
@@ -79,6 +79,7 @@ from .powered_events import (
 )
 
 __all__ = ["IVP_METHODS", "STALL_CALLS", "ActuationHook", "impulse_jump", "powered_atol"]
+
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -147,7 +148,7 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
         return J
 
     kw = {} if method in ("RK45", "DOP853", "RK23") else {"jac": jac}
-    inside = grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)]
+    inside = grid_inside(grid, t0, t1)
     return solve_ivp(f, (t0, t1), y0, method=method, rtol=solver.rtol,
                      atol=powered_atol(walker, solver.atol),
                      max_step=solver.max_step_s or np.inf, t_eval=np.append(inside, t1),
