@@ -264,10 +264,26 @@ def import_generated(filename: str, module_name: str, build):
 
 
 def clear_memo() -> None:
-    """Forget modules loaded in this process (tests)."""
+    """Forget modules loaded (and functions bound) in this process (tests)."""
     _memo.clear()
+    _bound.clear()
+
+
+#: the bound functions of recent (structure, parameters): a walker rebuilt with the same
+#: numbers (a Gymnasium environment's reset, a study's points) binds them once
+_bound: dict = {}
+_BOUND_MAX = 64
 
 
 def functions(data) -> dict:
-    """Generated functions of ``data`` with its parameters bound (see codegen's table)."""
-    return generated_module(data.structure)["make"](data.params)
+    """Generated functions of ``data`` with its parameters bound (see codegen's table); a
+    new dict each call (its functions shared with earlier calls of the same structure and
+    parameters: they are pure functions of the state)."""
+    key = (cache_key(data.structure), tuple(data.params))
+    fns = _bound.get(key)
+    if fns is None:
+        fns = generated_module(data.structure)["make"](data.params)
+        if len(_bound) >= _BOUND_MAX:
+            _bound.pop(next(iter(_bound)))
+        _bound[key] = fns
+    return dict(fns)
