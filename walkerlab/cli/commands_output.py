@@ -100,8 +100,9 @@ def export(scene: Path | None = SceneArg,
 
 
 @guard
-def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
-                                     " | main-job | optimize | powered | powered-command | hzd"
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | sweep-workers"
+                                     " | basin | contact | main-job | optimize | powered"
+                                     " | powered-command | hzd | gym | gym-vector"
                                      " | all (ideal, fixedpoint, sweep and contact)"),
           scenes: list[Path] | None = typer.Argument(
               None, help="contact only: scene YAML files whose walkers are timed (5 contact "
