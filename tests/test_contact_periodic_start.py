@@ -12,12 +12,13 @@ from walkerlab.config import load_scene, scene_from_dict
 def test_run_from_the_periodic_gait_has_constant_step_periods():
     """From the gait's mid-stance state every full step lasts the gait's period.
 
-    Tolerance 2e-5 s: the periodic solve converges to a scaled residual < 1e-8 (here
+    Tolerance 5e-5 s: the periodic solve converges to a scaled residual < 1e-8 (here
     ~2e-11), so the orbit itself is periodic to far below 1 us; what remains is the run's
     integrator (the scene's contact solver, looser than the search's rtol 1e-12) and its
-    heel-strike location, measured as a steady offset of 6-7 us with a spread of ~1.5 us
-    over 6 steps.  The start from the ideal fixed point (x 1.1 rates) has a first step of
-    0.58 s against 0.71 s: 10^4 times that tolerance."""
+    heel-strike location: measured 6-7 us (spread ~1.5 us) at ADAMS's default stiction
+    velocity, 11-22 us (spread 10 us) at configs/paper.yaml's 10 mm/s, whose friction law
+    is ten times steeper.  The start from the ideal fixed point (x 1.1 rates) has a first
+    step of 0.58 s against 0.71 s: 2500 times that tolerance."""
     from walkerlab.analysis.contact.periodic import ideal_gait, simulate_from_periodic_gait
     from walkerlab.models.contact.scene import contact_setup
 
@@ -29,10 +30,12 @@ def test_run_from_the_periodic_gait_has_constant_step_periods():
     hs = np.asarray(res.heel_strike_times)
     assert hs.size == 5 and res.heel_strike_legs[:2] == ["leg1", "leg2"]
     periods = np.diff(hs)  # full steps (the first heel strike ends a half step)
-    assert np.all(np.abs(periods - gait.period_s) < 2e-5)
-    assert np.ptp(periods) < 5e-6
-    # the steady gait is the contact model's, not the rigid one (0.7036 s): > 5 ms apart
-    assert abs(gait.period_s - ideal.period_s) > 5e-3
+    assert np.all(np.abs(periods - gait.period_s) < 5e-5)
+    assert np.ptp(periods) < 2e-5
+    # the steady gait is the contact model's, not the rigid one (0.7036 s): 1.26 ms apart at
+    # the 10 mm/s stiction velocity (+0.18 %; 7 ms at ADAMS's 100 mm/s), a thousand times
+    # the periodic solve's accuracy
+    assert abs(gait.period_s - ideal.period_s) > 1e-3
 
 
 def test_start_setting_is_typed_and_the_default_keeps_the_scene_hash():
@@ -103,7 +106,9 @@ def test_contact_sim_reads_the_scene_once(tmp_path, monkeypatch):
     monkeypatch.setattr(contact_scene, "contact_si", lambda c: calls.append(c) or real(c))
     r = CliRunner().invoke(app, ["contact-sim", str(path), "--runs-dir", str(tmp_path / "r")])
     assert r.exit_code == 0, r.stderr
-    assert len(calls) == 1
+    # once by the stage's check before any computation (a refusal the scene decides comes
+    # first: issue 64 item 6), once by the run; not once more per walker built
+    assert len(calls) == 2
 
 
 def test_a_start_whose_periodic_gait_is_not_found_says_why_in_one_line(monkeypatch):
