@@ -225,6 +225,27 @@ def _hash_value(h, v) -> None:
         h.update(np.ascontiguousarray(a).tobytes())
 
 
+#: h5py's variable-length UTF-8 string: how walkerlab stores a text attribute
+_VLEN_STR = h5py.string_dtype()
+
+
+def _attr(obj, key: str):
+    """``obj.attrs[key]`` as h5py reads it; a scalar variable-length string (most of an
+    artifact's attributes: units, descriptions) read through h5py's low-level interface, as
+    the same ``str`` at a fraction of the high-level reader's cost (which converts the
+    attribute's HDF5 type to a numpy dtype and back on every read)."""
+    attr = h5py.h5a.open(obj.id, key.encode())
+    tid = attr.get_type()
+    if (tid.get_class() == h5py.h5t.STRING and tid.is_variable_str()
+            and attr.get_space().get_simple_extent_type() == h5py.h5s.SCALAR):
+        out = np.zeros((), dtype=_VLEN_STR)
+        attr.read(out, mtype=h5py.h5t.py_create(_VLEN_STR))
+        value = out[()]
+        # h5py's high-level reader decodes every variable-length string this way
+        return value.decode("utf-8", "surrogateescape") if isinstance(value, bytes) else value
+    return obj.attrs[key]
+
+
 def content_hash_of(f: h5py.File) -> str:
     """SHA-256 of an open file's datasets and attributes (volatile root attributes excluded)."""
     h = hashlib.sha256()
@@ -233,7 +254,7 @@ def content_hash_of(f: h5py.File) -> str:
     for key in sorted(f.attrs):
         if key not in VOLATILE_ATTRS:
             h.update(f"@/{key}".encode())
-            _hash_value(h, f.attrs[key])
+            _hash_value(h, _attr(f, key))
     for name in sorted(names):
         if name.rsplit("/", 1)[-1] in VOLATILE_NAMES:
             continue
@@ -245,7 +266,7 @@ def content_hash_of(f: h5py.File) -> str:
             if key in _REFERENCE_ATTRS or key in VOLATILE_NAMES:
                 continue
             h.update(f"@{key}".encode())
-            _hash_value(h, obj.attrs[key])
+            _hash_value(h, _attr(obj, key))
     return h.hexdigest()
 
 
@@ -427,12 +448,9 @@ def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "
                                  and isinstance(data[0], str)):
         data = np.asarray(data, dtype=h5py.string_dtype())
     ds = group.create_dataset(name, data=data)
-    ds.attrs["unit"] = unit
-    ds.attrs["description"] = description
-    ds.attrs["units"] = netcdf.cf_units(unit)
-    ds.attrs["long_name"] = description or name.rsplit("/", 1)[-1]
-    for k, v in attrs.items():
-        ds.attrs[k] = v
+    netcdf.set_attrs(ds, {"unit": unit, "description": description,
+                          "units": netcdf.cf_units(unit),
+                          "long_name": description or name.rsplit("/", 1)[-1], **attrs})
     if dims is not None:
         netcdf.attach(ds, dims)
     return ds
