@@ -9,6 +9,8 @@ a usage error that line too.
 
 from __future__ import annotations
 
+import sys
+
 
 def flags_take_no_value() -> None:
     """``--help`` lists an on/off flag (``--force``, ``--help``) without a value type: typer
@@ -29,9 +31,54 @@ def flags_take_no_value() -> None:
 def usage_errors_in_one_spelling() -> None:
     """A usage error (unknown option or command, a value out of range) is printed as the
     usage, the help hint and one line ``error: <message>`` on stderr, the spelling of
-    every other walkerlab error (:mod:`walkerlab.cli.errors`); its exit code stays 2."""
+    every other walkerlab error (:mod:`walkerlab.cli.errors`); its exit code stays 2.
+
+    typer imports ``typer.rich_utils`` (rich's tables, markdown and pygments) only to show
+    a help or an error: the patch waits for that import (:class:`_PatchOnImport`) rather than
+    making every command import it at start-up."""
+    if RICH_UTILS in sys.modules:
+        _one_line_usage_errors(sys.modules[RICH_UTILS])
+    elif not any(isinstance(f, _PatchOnImport) for f in sys.meta_path):
+        sys.meta_path.insert(0, _PatchOnImport())
+
+
+#: the typer module whose ``rich_format_error`` prints a usage error
+RICH_UTILS = "typer.rich_utils"
+
+
+class _PatchOnImport:
+    """Finds nothing itself: when ``typer.rich_utils`` is imported (by typer, to show a help
+    or an error, or by anyone), patches it (:func:`_one_line_usage_errors`) as soon as its
+    code has run, then leaves ``sys.meta_path`` (a finder of ``sys.meta_path``: only
+    ``find_spec``)."""
+
+    def find_spec(self, fullname, path, target=None):
+        if fullname != RICH_UTILS:
+            return None
+        if self in sys.meta_path:
+            sys.meta_path.remove(self)
+        spec = None
+        for finder in list(sys.meta_path):  # the finders after this one
+            find = getattr(finder, "find_spec", None)
+            spec = find(fullname, path, target) if find is not None else None
+            if spec is not None:
+                break
+        if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+            return spec
+        run = spec.loader.exec_module
+
+        def exec_module(module):
+            run(module)
+            _one_line_usage_errors(module)
+
+        spec.loader.exec_module = exec_module  # this spec's own loader instance
+        return spec
+
+
+def _one_line_usage_errors(rich_utils) -> None:
+    """Patch ``rich_utils.rich_format_error`` (see :func:`usage_errors_in_one_spelling`)."""
     import typer  # typer 0.29 vendors click (typer._click): no `import click` here, which
-    from typer import rich_utils  # a fresh install does not have
+    # a fresh install does not have
 
     if getattr(rich_utils.rich_format_error, "_walkerlab", False):
         return

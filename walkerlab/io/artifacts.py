@@ -225,27 +225,81 @@ def _hash_value(h, v) -> None:
         h.update(np.ascontiguousarray(a).tobytes())
 
 
+#: h5py's variable-length UTF-8 string: how walkerlab stores a text attribute
+_VLEN_STR = h5py.string_dtype()
+
+
+@lru_cache(maxsize=1)
+def _vlen_str_type():
+    """The HDF5 memory type h5py reads a variable-length string attribute with."""
+    return h5py.h5t.py_create(_VLEN_STR)
+
+
+def _attributes(oid) -> list:
+    """``(name, low-level attribute)`` of the object ``oid`` (an h5py ObjectID), sorted by
+    name as ``sorted(obj.attrs)``; opened by index (no name lookup each)."""
+    out = []
+    for i in range(h5py.h5a.get_num_attrs(oid)):
+        attr = h5py.h5a.open(oid, index=i, index_type=h5py.h5.INDEX_NAME,
+                             order=h5py.h5.ITER_INC)
+        out.append((attr.name.decode("utf-8", "surrogateescape"), attr))
+    out.sort(key=lambda item: item[0])
+    return out
+
+
+def _attr_value(obj, key: str, attr):
+    """``obj.attrs[key]`` as h5py reads it (``attr``: that attribute, opened); a scalar
+    variable-length string (most of an artifact's attributes: units, descriptions) read
+    through h5py's low-level interface, as the same ``str`` at a fraction of the high-level
+    reader's cost (which converts the attribute's HDF5 type to a numpy dtype and back)."""
+    tid = attr.get_type()
+    if (tid.get_class() == h5py.h5t.STRING and tid.is_variable_str()
+            and attr.get_space().get_simple_extent_type() == h5py.h5s.SCALAR):
+        out = np.zeros((), dtype=_VLEN_STR)  # one element: the dataspace is scalar
+        attr.read(out, mtype=_vlen_str_type())
+        value = out[()]
+        # h5py's high-level reader decodes every variable-length string this way
+        return value.decode("utf-8", "surrogateescape") if isinstance(value, bytes) else value
+    return obj().attrs[key]
+
+
 def content_hash_of(f: h5py.File) -> str:
-    """SHA-256 of an open file's datasets and attributes (volatile root attributes excluded)."""
+    """SHA-256 of an open file's datasets and attributes (volatile root attributes excluded).
+
+    What is hashed, in order: each root attribute ``@/<name>`` and its value (sorted by name),
+    then each object ``/<path>`` (sorted by path): a dataset's value, then its attributes
+    ``@<name>`` and values; the objects are opened through h5py's low-level interface, a
+    high-level object only where a value is read with it (a dataset, an attribute other
+    than a scalar text)."""
     h = hashlib.sha256()
     names: list[str] = []
     f.visit(names.append)
-    for key in sorted(f.attrs):
+    for key, attr in _attributes(f.id):
         if key not in VOLATILE_ATTRS:
             h.update(f"@/{key}".encode())
-            _hash_value(h, f.attrs[key])
+            _hash_value(h, _attr_value(lambda: f, key, attr))
     for name in sorted(names):
         if name.rsplit("/", 1)[-1] in VOLATILE_NAMES:
             continue
-        obj = f[name]
+        oid = h5py.h5o.open(f.id, name.encode())
+        kind = h5py.h5i.get_type(oid)
+        dataset = kind == h5py.h5i.DATASET
+        held: list = []
+
+        def obj(oid=oid, kind=kind, name=name, held=held):  # the high-level object, made
+            if not held:  # once, when needed
+                held.append(h5py.Dataset(oid) if kind == h5py.h5i.DATASET else
+                            h5py.Group(oid) if kind == h5py.h5i.GROUP else f[name])
+            return held[0]
+
         h.update(f"/{name}".encode())
-        if isinstance(obj, h5py.Dataset):
-            _hash_value(h, obj[()])
-        for key in sorted(obj.attrs):
+        if dataset:
+            _hash_value(h, obj()[()])
+        for key, attr in _attributes(oid):
             if key in _REFERENCE_ATTRS or key in VOLATILE_NAMES:
                 continue
             h.update(f"@{key}".encode())
-            _hash_value(h, obj.attrs[key])
+            _hash_value(h, _attr_value(obj, key, attr))
     return h.hexdigest()
 
 
@@ -427,12 +481,9 @@ def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "
                                  and isinstance(data[0], str)):
         data = np.asarray(data, dtype=h5py.string_dtype())
     ds = group.create_dataset(name, data=data)
-    ds.attrs["unit"] = unit
-    ds.attrs["description"] = description
-    ds.attrs["units"] = netcdf.cf_units(unit)
-    ds.attrs["long_name"] = description or name.rsplit("/", 1)[-1]
-    for k, v in attrs.items():
-        ds.attrs[k] = v
+    netcdf.set_attrs(ds, {"unit": unit, "description": description,
+                          "units": netcdf.cf_units(unit),
+                          "long_name": description or name.rsplit("/", 1)[-1], **attrs})
     if dims is not None:
         netcdf.attach(ds, dims)
     return ds
