@@ -371,7 +371,7 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     parts = [p for p in model.by_kind["PART"] if p != 1]
     total = sum(model.part_mass(p) for p in parts)
     want = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
-    if data.structure.foot == "flat" and not data.structure.foot_mass:
+    if data.structure.kind.name == "flat_feet" and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's
         # regularising mass (contact.flat_foot_mass_kg), as it documents
         from walkerlab.export.scene import flat_feet
