@@ -58,8 +58,12 @@ def save(fig, folder: Path, stem: str, svg: bool = True) -> list[Path]:
         # the tight bounding box (what bbox_inches="tight" finds: a tick and text layout
         # pass as long as a draw) once for both files instead of once per file; the layout
         # engine (constrained_layout) must have run first, else the box is the pre-layout
-        # one and crops tick labels and colorbars
-        fig.draw_without_rendering()
+        # one and crops tick labels and colorbars; a figure without one (laid out by
+        # tight_layout, or not at all) gets the same box without that draw
+        from matplotlib.layout_engine import PlaceHolderLayoutEngine
+
+        if not isinstance(fig.get_layout_engine(), (type(None), PlaceHolderLayoutEngine)):
+            fig.draw_without_rendering()
         bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(
             matplotlib.rcParams["savefig.pad_inches"])
         if not svg:
