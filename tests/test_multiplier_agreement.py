@@ -164,5 +164,9 @@ def test_every_scene_variational_and_difference_multipliers_agree(name):
         scene = load_scene(CONFIGS / f"{name}.yaml")
     _, search = solve_scene(scene)
     r = search.gaits[search.selected].result
-    assert r.multiplier_difference < 1e-5, (r.multipliers_variational, r.multipliers_fd)
+    # central differences of step 1e-7 of a map integrated at the scene's rtol: ~rtol / 1e-7
+    # at worst (1e-5 at 1e-12; the three-link scenes integrate at LSODA's 1e-11: 1e-4,
+    # measured 4.7e-5 on configs/threelink.yaml)
+    tol = max(1e-5, float(scene.solver.rtol) / 1e-7)
+    assert r.multiplier_difference < tol, (r.multipliers_variational, r.multipliers_fd)
     assert np.all(np.isfinite(r.multipliers_fd))

@@ -207,6 +207,7 @@ def test_the_interrupt_test_passes_in_a_suite_that_inherited_sigint_ignored(tmp_
     code = ("import signal, sys, pytest\n"
             "signal.signal(signal.SIGINT, signal.SIG_IGN)\n"
             "sys.exit(pytest.main(['-q', '-n', '0', '-p', 'no:cacheprovider', "
+            "'-m', 'slow or not slow', "  # the test may be slow by its cost (slow_by_cost.txt)
             f"'{Path(__file__).resolve()}', '-k', "
             "'interrupt_swallowed_in_the_contact_replay and SIGINT']))")
     r = subprocess.run([sys.executable, "-c", code], cwd=Path(__file__).resolve().parents[1],

@@ -390,7 +390,10 @@ def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
     rigid_change = res.step_period_s / g.step_period - 1.0
     assert rigid_change < -0.01
     # the passive contact model over the same 3 steps (the compiled passive run, < 1 s)
+    # (from the gait's heel strike as the replay starts: ``start: ideal``, not a passive
+    # flat-footed walker's default mid-stance)
     sc = with_changes(flat[0], {"contact_sim": {"n_strides": 2, "sample_rate_hz": 500,
+                                                "start": "ideal",
                                                 "t_final_s": 4.6 * g.step_period}})
     hs = simulate_from(contact_setup(sc), g.x, g.step_period, strides=2)[1].heel_strike_times
     passive = float(np.mean(np.diff(np.asarray(hs, float)[:4])))
