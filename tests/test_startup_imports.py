@@ -124,10 +124,13 @@ def test_a_recently_changed_artifact_is_always_hashed(tmp_path, monkeypatch):
 #: never in the process of a whole (warm) ``contact-sim`` run either: besides the packages
 #: above (scipy.optimize is the periodic gait's root finder and the step map's brentq), no
 #: other scipy subpackage with a heavy import, no terminal-rendering or process-pool
-#: machinery, and none of the rigid analysis or the ``--adjust`` search
+#: machinery, and none of the rigid analysis or the ``--adjust`` search (the rigid gait's
+#: friction verdict, a record fixedpoint.h5 holds, is read with it: numpy alone)
 NOT_IN_THE_RUN = tuple(m for m in NOT_ON_THE_PATH if m != "scipy.optimize") + (
     "rich", "multiprocessing", "concurrent.futures.process", "scipy.interpolate",
-    "scipy.stats", "scipy.signal", "walkerlab.analysis.gait",
+    "scipy.stats", "scipy.signal", "walkerlab.analysis.gait.search",
+    "walkerlab.analysis.gait.poincare", "walkerlab.analysis.gait.scene",
+    "walkerlab.analysis.gait.rigid_run",
     "walkerlab.analysis.contact.adjust", "walkerlab.analysis.contact.variational")
 
 _RUN = """
