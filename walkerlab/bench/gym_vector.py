@@ -40,7 +40,10 @@ def _scene_path(scene) -> str:
     return str(scene)
 
 
-def _time_single(make, steps: int) -> float:
+def _time(make, steps: int, vector: bool = False) -> float:
+    """Control periods per second of ``make()`` under zero actions: one environment (reset
+    on an episode's end) or a vector form (``vector``: it autoresets; ``num_envs`` periods a
+    call)."""
     env = make()
     try:
         env.reset(seed=0)
@@ -48,22 +51,9 @@ def _time_single(make, steps: int) -> float:
         t0 = time.perf_counter()
         for _ in range(steps):
             _, _, term, trunc, _ = env.step(zero)
-            if term or trunc:
+            if not vector and (term or trunc):
                 env.reset()
-        return steps / (time.perf_counter() - t0)
-    finally:
-        env.close()
-
-
-def _time_vector(make, steps: int) -> float:
-    env = make()
-    try:
-        env.reset(seed=0)
-        zero = np.zeros(env.action_space.shape, env.action_space.dtype)
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            env.step(zero)  # the vector forms autoreset
-        return env.num_envs * steps / (time.perf_counter() - t0)
+        return (env.num_envs if vector else 1) * steps / (time.perf_counter() - t0)
     finally:
         env.close()
 
@@ -116,12 +106,11 @@ def bench_vector(scene="configs/threelink_hzd.yaml", num_envs: int = 8, steps: i
         "sync": lambda: gym.make_vec(env_id, num_envs, "sync", **kw),
         "async": lambda: gym.make_vec(env_id, num_envs, "async", **kw),
     }
-    _time_single(makers["single"], 1)  # the walker built and its gait found, not timed
+    _time(makers["single"], 1)  # the walker built and its gait found, not timed
     runs: dict[str, list[float]] = {f: [] for f in FORMS}
     for _ in range(repeats):  # the forms in turn, each round (a shared machine's load
         for form in FORMS:    # drifts alike over all of them)
-            timer = _time_single if form == "single" else _time_vector
-            runs[form].append(timer(makers[form], steps))
+            runs[form].append(_time(makers[form], steps, vector=form != "single"))
     res: dict = {"scene": kw["scene"], "num_envs": num_envs, "steps": steps,
                  "repeats": repeats}
     for form in FORMS:

@@ -135,12 +135,7 @@ class ActionTorques(Actuators):
         (:attr:`first` 0); 0 for torques scaled by a massless foot's mass."""
         if self.limit or not self.spec.torques:
             return 0.0
-        if self.hip_only:
-            da, db = self.hip_angles(xa)[0], self.hip_angles(xb)[0]
-            return float(np.real(np.sum(self.u) * (db - da)))
-        da = np.asarray(self.joint_angles(xa)[0])
-        db = np.asarray(self.joint_angles(xb)[0])
-        return float(np.real(np.sum(self.u * (db - da))))
+        return float(self.u @ (self.joint_state(xb)[0] - self.joint_state(xa)[0]))
 
     def torques(self, t, x) -> np.ndarray:
         """The scene's laws' torques (the first :attr:`first`), then the action's (k,)
