@@ -105,6 +105,8 @@ def cache_key(structure) -> str:
         h.update(_five_link_generator_hash().encode())
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
+    if getattr(structure, "spatial", False):
+        h.update(_source_hash("spatial.py").encode())
     return h.hexdigest()[:24]
 
 
@@ -190,6 +192,10 @@ def derive_equations(structure):
     printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's
     (:mod:`walkerlab.codegen.rolling_polygon`) or a biped's
     (:func:`walkerlab.codegen.symbolic.derive`)."""
+    if structure.spatial:
+        from walkerlab.codegen import spatial
+
+        return spatial.derive_spoked(structure)
     if structure.spokes:
         from walkerlab.codegen import rolling_polygon
 

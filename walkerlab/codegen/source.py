@@ -411,6 +411,9 @@ def generate(eq: Equations, param_names, key: str) -> str:
         "import numpy as np",
         "",
     ]
+    text = "\n".join(body)
+    if " atan2(" in text or "(atan2(" in text:  # a closed-form angle (a 3D walker's section)
+        head.insert(3, "from math import atan2  # noqa: F401")
     return "\n".join(head + body) + "\n"
 
 

@@ -509,6 +509,25 @@ class RimlessWheelParams(Strict):
     hub_inertia_kg_m2: float | None = Field(None, ge=0, le=1e6, description="moment of "
                                             "inertia of the wheel about its hub [kg m^2] "
                                             "(null: a point mass, 0)")
+    space: Literal["2d", "3d"] = Field("2d", description="2d: the wheel rolls in the "
+                                       "sagittal plane; 3d: free about every axis of its "
+                                       "stance foot (heading, lean and spin; Coleman, "
+                                       "Chatterjee & Ruina 1997)")
+    diametral_inertia_kg_m2: float | None = Field(
+        None, gt=0, le=1e6, description="moment of inertia of the wheel about a diameter "
+        "through its hub [kg m^2] (space: 3d only, where it is required; the axle's is "
+        "hub_inertia_kg_m2)")
+
+    @model_validator(mode="after")
+    def _spatial_inertia(self):
+        if self.space == "3d" and self.diametral_inertia_kg_m2 is None:
+            raise ValueError("walker.diametral_inertia_kg_m2: a wheel in 3d needs its "
+                             "inertia about a diameter (> 0: the spin about the stance "
+                             "spoke has no other)")
+        if self.space == "2d" and self.diametral_inertia_kg_m2 is not None:
+            raise ValueError("walker.diametral_inertia_kg_m2: only a wheel in 3d (space: "
+                             "3d) turns about a diameter")
+        return self
 
     @property
     def actuation(self) -> None:

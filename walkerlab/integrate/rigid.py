@@ -242,7 +242,8 @@ def _enter_step(walker: HybridWalker, st: _StepState, variational: bool) -> int:
 #: the complex step on every call
 _SCIPY_RUNS_ACTUATED_COMPILED = {"straight_legs": False, "locking_knees": False,
                                  "flat_feet": False, "free_joints": True,
-                                 "hinged_torso": True, "rolling_polygon": False}
+                                 "hinged_torso": True, "rolling_polygon": False,
+                                 "rolling_polygon_3d": False}
 
 
 def _runs_compiled_on_scipy(phase: Phase) -> bool:

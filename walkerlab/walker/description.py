@@ -36,6 +36,13 @@ SPOKED_ROLES = ("stance",)
 #: Parameters of a spoked wheel: gravity, spoke length, slope, hub mass, inertia about the
 #: hub, half the angle between neighbouring spokes (``pi / n``) [SI].
 SPOKED_PARAMS = ("g", "L", "gamma", "M_hub", "I_hub", "alpha")
+#: Roles of a spoked wheel in three dimensions (``walker.space: 3d``): its heading about the
+#: slope normal, its lean about the fall line and the stance spoke's angle in the wheel's
+#: plane (:mod:`walkerlab.codegen.spatial`).
+SPATIAL_SPOKED_ROLES = ("heading", "lean", "stance")
+#: Parameters of a spoked wheel in three dimensions: :data:`SPOKED_PARAMS` (``I_hub`` about
+#: the axle) and its inertia about a diameter ``I_diam`` [kg m^2].
+SPATIAL_SPOKED_PARAMS = SPOKED_PARAMS + ("I_diam",)
 
 
 @dataclass(frozen=True)
@@ -121,6 +128,10 @@ class Structure:
         rolling about the stance spoke's foot (role ``stance``, parameters
         :data:`SPOKED_PARAMS`; :mod:`walkerlab.codegen.rolling_polygon`; its floating view
         has one contact point per spoke).  The other fields are then unused.
+    spatial : bool
+        The walker moves in three dimensions (``walker.space: 3d``;
+        :mod:`walkerlab.codegen.spatial`): a spoked wheel free about every axis of its
+        stance foot (roles :data:`SPATIAL_SPOKED_ROLES`).  False: in the sagittal plane.
     """
 
     coordinates: str
@@ -137,6 +148,7 @@ class Structure:
     hinged_torso: bool = False
     spokes: int = 0
     foot_mass: bool = False
+    spatial: bool = False
 
     @property
     def kind(self) -> Kind:
@@ -147,7 +159,7 @@ class Structure:
     @property
     def roles(self) -> tuple[str, ...]:
         if self.spokes:
-            return SPOKED_ROLES
+            return SPATIAL_SPOKED_ROLES if self.spatial else SPOKED_ROLES
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.hinged_torso:
@@ -168,7 +180,7 @@ class Structure:
     def param_names(self) -> tuple[str, ...]:
         """Names of the parameter vector, in order (SI units; ``gamma`` is the slope [rad])."""
         if self.spokes:
-            return SPOKED_PARAMS
+            return SPATIAL_SPOKED_PARAMS if self.spatial else SPOKED_PARAMS
         names = ["g", "L", "gamma"] + (["M_hip"] if self.hip_mass else [])
         tags = [f"{ROLE_TAG[r]}_" for r in ("swing", "stance")] if self.asymmetric else [""]
         for b in self.bodies:
@@ -224,6 +236,8 @@ class Structure:
             d["foot_mass"] = True
         if self.spokes:
             d = {"spokes": self.spokes}
+        if self.spatial:
+            d["space"] = "3d"
         return json.dumps(d)
 
 
@@ -340,7 +354,12 @@ def _spoked_data(w, slope_rad: float) -> WalkerData:
     params = (w.gravity_m_per_s2, w.spoke_length_m, slope_rad, w.mass_kg, inertia,
               math.pi / w.spokes)
     extra = {"spokes": w.spokes, "hub_inertia_kg_m2": inertia}
-    return WalkerData(Structure("absolute", (), hip_mass=True, spokes=w.spokes),
+    spatial = w.space == "3d"
+    if spatial:
+        params += (w.diametral_inertia_kg_m2,)
+        extra["diametral_inertia_kg_m2"] = w.diametral_inertia_kg_m2
+    return WalkerData(Structure("absolute", (), hip_mass=True, spokes=w.spokes,
+                                spatial=spatial),
                       tuple(float(v) for v in params), w.mass_kg, w.spoke_length_m,
                       w.gravity_m_per_s2, slope_rad, extra)
 

@@ -31,6 +31,10 @@ walker's :class:`Kind`:
 ``rolling_polygon``
     A rimless (spoked) wheel: one rigid body rolling on its spokes (McGeer 1990; Coleman,
     Chatterjee & Ruina 1997).  It has no joint, so no actuator.
+``rolling_polygon_3d``
+    The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
+    its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
+    rigid model only, so far; the other views' cells say so.
 
 The layers ask the kind (:func:`kind_of`, once), never the switches: a layer's code for a
 kind is reached through the kind's name in that layer's own table of parts (the rigid
@@ -167,6 +171,8 @@ KINDS = {k.name: k for k in (
          "2007"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
          "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
+    Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
+         "Coleman, Chatterjee & Ruina 1997"),
 )}
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -220,6 +226,12 @@ URDF_GROUND = ("the URDF carries the walker on a slope only (URDF has no ground 
                "profiles are in the MJCF, the OpenSim model and the Adams dataset; "
                "--walker-only writes the walker alone")
 _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "profile")}
+#: why a 3D walker's views refuse a ground other than a plane
+SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
+                  "stairs, footholds and profiles are planar walkers' grounds")
+#: why the exports refuse a 3D walker
+SPATIAL_EXPORT = ("the exports write planar walkers (a plane constraint or a sagittal "
+                  "tree); a 3D walker's free body is a later step")
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -379,6 +391,22 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
     },
+    "rolling_polygon_3d": {
+        **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
+                                         "torso_torque", "push_off", "ankle_push_off",
+                                         "virtual_constraints")},
+        **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
+        ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
+                              "later step (walk it in the rigid model: fixedpoint, "
+                              "simulate)"),
+        ("walk", "mjcf"): SPATIAL_EXPORT,
+        ("walk", "urdf"): SPATIAL_EXPORT,
+        ("walk", "adams"): SPATIAL_EXPORT,
+        ("walk", "osim"): SPATIAL_EXPORT,
+        ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
+        ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
+                               "the passive one, walkerlab fixedpoint)"),
+    },
 }
 
 
@@ -411,7 +439,7 @@ def kind_of(structure) -> Kind:
     Kind
     """
     if structure.spokes:
-        return KINDS["rolling_polygon"]
+        return KINDS["rolling_polygon_3d" if structure.spatial else "rolling_polygon"]
     if structure.free_knees:
         return KINDS["free_joints"]
     if structure.hinged_torso:

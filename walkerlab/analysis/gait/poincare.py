@@ -310,6 +310,11 @@ def map_fd_jacobian(walker: HybridWalker, x: np.ndarray, solver: Solver, h: floa
     return numerics.fd_jacobian(P, x, h), nfev
 
 
+def _neutral_positions(mult: np.ndarray, k: int) -> list[int]:
+    """Positions of the ``k`` multipliers nearest 1 (the neutral coordinates')."""
+    return [int(i) for i in np.argsort(np.abs(np.asarray(mult) - 1.0), kind="stable")[:k]]
+
+
 @dataclass
 class FixedPointResult:
     """Period-1 gait: fixed point, period, multipliers and bookkeeping.
@@ -348,10 +353,24 @@ class FixedPointResult:
     variational_maps: int = 1
     step_periods_s: tuple = ()
     step_lengths_m: tuple = ()
+    neutral: tuple = ()
+
+    @property
+    def neutral_multipliers(self) -> np.ndarray:
+        """The multipliers (variational) of the walker's neutral coordinates
+        (:attr:`HybridWalker.neutral`, in :attr:`neutral`): for each, the one nearest 1 -
+        its gaits form a family along it, so its multiplier is 1 (to the integration's
+        accuracy).  Empty for a walker without one."""
+        return self.multipliers_variational[_neutral_positions(
+            self.multipliers_variational, len(self.neutral))]
 
     @property
     def stable(self) -> bool:
-        return bool(np.max(np.abs(self.multipliers_variational)) < 1.0)
+        """Every multiplier (variational) strictly inside the unit circle, the neutral ones
+        (:attr:`neutral_multipliers`) set aside."""
+        mult = np.delete(self.multipliers_variational, _neutral_positions(
+            self.multipliers_variational, len(self.neutral)))
+        return bool(np.max(np.abs(mult)) < 1.0)
 
     @property
     def multiplier_difference(self) -> float:
@@ -427,21 +446,23 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
     F = _ReducedMap(walker, solver, max_step_time, known)
     z0 = walker.section(np.asarray(guess, float))
+    F.hold(z0)
     try:
         with search_budget(budget_s):
             if on_orbit and F.fails_at(z0):  # its gait is an orbit of the zero dynamics:
                 raise FixedPointNotFound(  # a start that does not step is not near it
                     f"the closed loop does not step from the start: {F.failure}", math.nan)
+            w0 = F.free(z0)
             if jacobian_guess is None:
-                sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
+                sol = root(F.free_residual, w0, method="hybr", options={"xtol": xtol})
             else:
                 F.start[z0.tobytes()] = _section_jacobian(
                     walker, np.asarray(jacobian_guess, float), z0)
-                sol = root(F.residual, z0, method="hybr", jac=F.jacobian,
+                sol = root(F.free_residual, w0, method="hybr", jac=F.free_jacobian,
                            options={"xtol": xtol})
     except SearchGaveUp as exc:
         raise FixedPointGaveUp(str(exc), math.nan) from None
-    x, xn, period, DP, segs = F.variational_at(sol.x, sol.message)
+    x, xn, period, DP, segs = F.variational_at(F.full(sol.x), sol.message)
     res = float(np.max(np.abs(xn - x)))
     _check_walking(walker, x, sol, res, xtol)
     mult_var = sort_multipliers(np.linalg.eigvals(DP))
@@ -461,6 +482,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         wall_time_s=time.perf_counter() - t0, variational_maps=F.counter["jacobians"] + 1,
         step_periods_s=tuple(float(sg.period) for sg in segs),
         step_lengths_m=tuple(step_length(walker, sg) for sg in segs),
+        neutral=tuple(walker.neutral),
     )
 
 
@@ -491,6 +513,45 @@ class _ReducedMap:
         self.failure = ""  # how the last failed map failed
         self._last: dict = {}  # the last iterate's residual (z bytes -> F(z))
         self._variational: dict = {}  # the last variational map asked as a Jacobian
+        self.held: list = []  # section positions held (hold: the neutral coordinates)
+        self.free_at: list = []
+
+    def hold(self, z0: np.ndarray) -> None:
+        """Hold the walker's neutral coordinates (:attr:`HybridWalker.neutral`) at their
+        values in ``z0``: its gaits form a family along each (the 3D rimless wheel's
+        heading), where ``F``'s Jacobian is singular, so the root finder solves the other
+        equations for the other coordinates (:meth:`free_residual`): the member of the
+        family at the start's heading."""
+        walker = self.walker
+        n2 = 2 * walker.n_coordinates
+        kept = [int(round(v)) for v in walker.section(np.arange(n2, dtype=float))]
+        names = walker.state_names()
+        self.held = [kept.index(names.index(c)) for c in walker.neutral]
+        self.free_at = [i for i in range(len(kept)) if i not in self.held]
+        self.z_held = np.asarray(z0, float).copy()
+
+    def free(self, z: np.ndarray) -> np.ndarray:
+        """The coordinates the root finder solves for (all but the held ones)."""
+        return np.asarray(z, float)[self.free_at] if self.held else np.asarray(z, float)
+
+    def full(self, w: np.ndarray) -> np.ndarray:
+        """Section coordinates of the free ones ``w``, the held ones at their start."""
+        if not self.held:
+            return np.asarray(w, float)
+        z = self.z_held.copy()
+        z[self.free_at] = w
+        return z
+
+    def free_residual(self, w: np.ndarray) -> np.ndarray:
+        """:meth:`residual` of the free coordinates, the held ones' equations left out (on
+        the family they hold by themselves; the fixed point's residual checks it)."""
+        r = self.residual(self.full(w))
+        return r[self.free_at] if self.held else r
+
+    def free_jacobian(self, w: np.ndarray) -> np.ndarray:
+        """:meth:`jacobian` of :meth:`free_residual`."""
+        J = self.jacobian(self.full(w))
+        return J[np.ix_(self.free_at, self.free_at)] if self.held else J
 
     def residual(self, z: np.ndarray) -> np.ndarray:
         """``F(z)`` (2n-1,), deflated; a failed step pushes the root finder away."""

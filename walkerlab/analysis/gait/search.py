@@ -120,8 +120,14 @@ class Gait:
 
     @property
     def max_multiplier(self) -> float:
-        """Largest ``|Floquet multiplier|`` (variational) [-]."""
-        return float(np.max(np.abs(self.result.multipliers_variational)))
+        """Largest ``|Floquet multiplier|`` (variational) [-], the neutral ones
+        (:attr:`FixedPointResult.neutral_multipliers`) set aside."""
+        res = self.result
+        mult = res.multipliers_variational
+        if res.neutral:
+            mult = np.delete(mult, [int(np.argmin(np.abs(mult - m)))
+                                    for m in res.neutral_multipliers])
+        return float(np.max(np.abs(mult)))
 
     def describe(self, time_unit: str = "s") -> str:
         """``long-period gait (step period 0.9398 s, max |multiplier| 0.593, stable)``."""

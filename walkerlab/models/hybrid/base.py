@@ -245,6 +245,12 @@ class HybridWalker:
         step to step (footholds of several heights or slopes,
         :func:`walkerlab.models.hybrid.ground.on_footholds`): step ``k`` of a walk is taken
         by ``cycle[k % len(cycle)]`` (:meth:`for_step`); None: :attr:`mirror` decides.
+    neutral : tuple of str
+        State names (:meth:`state_names`) of coordinates along which the walker's gaits
+        form a family - one Floquet multiplier 1 each, named and set aside by the stability
+        verdict, and held at the start by the fixed-point search (the 3D rimless wheel's
+        ``heading_angle``: it rolls steadily at every heading, Coleman, Chatterjee & Ruina
+        1997).  Empty for every planar walker.
     ground_steps : int or None
         Steps of a finite ground (``terrain.periodic: false``: a foothold list that does not
         repeat, of one height or several; a drawn rough ground): a walk stops after them.
@@ -275,6 +281,7 @@ class HybridWalker:
     step_entry: Callable[[np.ndarray], tuple] | None = None
     cycle: tuple | None = None
     ground_steps: int | None = None
+    neutral: tuple[str, ...] = ()
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)

@@ -88,6 +88,8 @@ _PARTS = {
     "flat_feet": _Part(refusal="flat feet: the rigid model's own guards check the heel's "
                                "and toe's normal forces"),
     "rolling_polygon": _Part(hub=True, trailing_point="trailing_foot"),
+    "rolling_polygon_3d": _Part(refusal="a wheel in 3D: its stance foot's reaction (a "
+                                        "force in 3D) is not computed yet"),
 }
 
 

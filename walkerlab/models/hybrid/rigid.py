@@ -269,4 +269,5 @@ BUILDERS: dict[str, Callable] = {
     "free_joints": _make_free,
     "hinged_torso": _make_free,
     "rolling_polygon": _make_polygon,
+    "rolling_polygon_3d": _make_polygon,
 }

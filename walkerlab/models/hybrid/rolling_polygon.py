@@ -63,4 +63,5 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
         variational=f["flow_jacobian"], reset_jacobian=f["reset_jacobian"],
         heel_strike_guard=f["guard_heel_strike"], leg_angles=f["leg_angles"],
         matrices=f["matrices"],
+        neutral=("heading_angle",) if structure.spatial else (),
     )

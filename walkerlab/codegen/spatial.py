@@ -1,0 +1,190 @@
+"""Symbolic equations of walkers in three dimensions, as the
+:class:`~walkerlab.codegen.equations.Equations` every generated walker has: the printers of
+:mod:`walkerlab.codegen.source` turn them into the Python module and the compiled (numba)
+module like a planar walker's, so fixed points, Floquet multipliers and simulation run on
+them unchanged.
+
+Frames and coordinates
+----------------------
+World axes as the planar walkers': ``x`` horizontal downhill, ``y`` up, and ``z = x × y``
+(to the right of a walker facing downhill).  The slope's unit normal is
+``n = (sin gamma, cos gamma, 0)``, its fall line ``s = (cos gamma, -sin gamma, 0)``.
+
+The spoked wheel (``walker.space: 3d`` of ``model: rimless_wheel``; Coleman, Chatterjee &
+Ruina 1997, "Motions of a rimless spoked wheel: a simple three-dimensional system with
+impacts", Dynamics and Stability of Systems 12(3)) is one rigid body: a hub of mass ``M``,
+inertia ``I_hub`` about its axle and ``I_diam`` about any diameter (an axisymmetric body),
+with ``n`` massless spokes of length ``L`` in the plane normal to the axle, ``2 alpha =
+2 pi / n`` apart.  In stance it turns about the stance spoke's foot, free about every axis
+(a spherical joint: the foot neither slips nor leaves the ground; Coleman et al. 1997,
+Sec. 2).  Its orientation is ``R = Rot(n, psi) Rot(s, phi) Rot(z, theta)``:
+
+- ``heading`` ``psi``: about the slope normal (0: the axle across the fall line);
+- ``lean`` ``phi``: about the fall line (0: the wheel's plane normal to the slope);
+- ``stance`` ``theta``: the spin about the axle, the stance spoke's angle from the
+  downward vertical in the wheel's plane, positive when its foot is ahead of the hub -
+  with ``psi = phi = 0`` the planar wheel's coordinate
+  (:mod:`walkerlab.codegen.rolling_polygon`), so that the upright wheel's equations are
+  the planar ones.
+
+With the hub at ``R (0, L, 0)`` from the stance foot and ``omega = n psi' + Rot(n, psi) s
+phi' + R_(n,s) z theta'`` the angular velocity, the kinetic energy is (König, about the
+fixed foot)
+
+    T = 1/2 [(M L^2 + I_diam) |omega|^2 - M (omega . r_hub)^2
+             + (I_hub - I_diam) (omega . a)^2],     a = R z (the axle),
+
+the potential ``V = M g y_hub``; the flow ``M(q) q'' + C(q, q') q' + G(q) = 0`` is
+Lagrange's (Christoffel symbols of ``M``).
+
+Heel strike: the next spoke's foot ``r_next = r_hub + R Rot(z, 2 alpha) (0, -L, 0)``
+reaching the slope, ``n . r_next`` decreasing through 0.  The impact is plastic: the new
+foot sticks and the old one leaves the ground; the impulse acts at the new foot, so the
+angular momentum about it is conserved (Coleman et al. 1997, Eq. 3):
+
+    I_cm omega+ + M d x (omega+ x d) = I_cm omega- + M d x v_hub-,   d = r_hub - r_next,
+
+in the coordinates' rates ``Mi dq+ = B dq-`` with ``omega = W(q) dq`` (each side
+premultiplied by ``W^T``, so that ``Mi`` is the mass matrix about the new foot).  The new
+stance spoke is the old one turned by a spoke: ``theta -> theta + 2 alpha``, heading and
+lean unchanged (``R Rot(z, 2 alpha)``), the rates too (``W`` does not depend on ``theta``).
+
+Poincaré section: the state just after a heel strike, the previous stance foot (the spoke
+behind, ``theta - 2 alpha``) on the slope: ``theta`` is solved from it in closed form, so
+the section coordinates are ``(psi, phi, psi', phi', theta')`` (five; the planar wheel's
+one).  The steady rolling motions form a one-parameter family by heading at a given slope
+(Coleman et al. 1997): one Floquet multiplier of every one is 1, the heading's.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import sympy as sp
+
+from walkerlab.codegen.equations import Equations
+
+
+def rotation(axis: sp.Matrix, angle) -> sp.Matrix:
+    """Rotation matrix (3, 3) by ``angle`` about the unit vector ``axis`` (Rodrigues)."""
+    k = sp.Matrix(axis)
+    K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
+
+
+def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
+    return sp.Matrix(a).cross(sp.Matrix(b))
+
+
+def _dot(a: sp.Matrix, b: sp.Matrix):
+    return (sp.Matrix(a).T * sp.Matrix(b))[0]
+
+
+def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
+    """Coriolis matrix (n, n) of the mass matrix ``M(q)``: ``C_ij = sum_k c_ijk dq_k`` with
+    ``c_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2`` (Murray, Li & Sastry 1994,
+    Eq. 4.23)."""
+    n = len(q)
+    dM = [M.diff(qk) for qk in q]
+    C = sp.zeros(n, n)
+    for i in range(n):
+        for j in range(n):
+            C[i, j] = sum(sp.Rational(1, 2) * (dM[k][i, j] + dM[j][i, k] - dM[i][j, k])
+                          * dq[k] for k in range(n))
+    return C
+
+
+def _spoke(theta_offset, L) -> sp.Matrix:
+    """A spoke from the hub in the wheel's frame at ``theta_offset`` from the stance spoke:
+    ``Rot(z, theta_offset) (0, -L, 0)``."""
+    return sp.Matrix([L * sp.sin(theta_offset), -L * sp.cos(theta_offset), 0])
+
+
+@cache
+def derive_spoked(structure) -> Equations:
+    """Flow, impact, guards, energies and points of a spoked wheel in three dimensions
+    (module docstring).
+
+    Parameters
+    ----------
+    structure : walkerlab.walker.description.Structure
+        With ``spokes`` > 0 and ``spatial`` (parameters
+        :data:`walkerlab.walker.description.SPATIAL_SPOKED_PARAMS`).
+
+    Returns
+    -------
+    Equations
+        ``n = 3`` (heading, lean, stance); points (3, 1) in world axes; ``De``, ``E`` zeros
+        (no push-off: a wheel has no joint).
+
+    Raises
+    ------
+    ValueError
+        ``structure`` is not a spatial spoked wheel.
+    """
+    if not (structure.spokes and structure.spatial):
+        raise ValueError("spatial.derive_spoked: the structure is not a 3D spoked wheel")
+    psi, phi, th = sp.symbols("q_heading q_lean q_stance", real=True)
+    dpsi, dphi, dth = sp.symbols("dq_heading dq_lean dq_stance", real=True)
+    q, dq = (psi, phi, th), (dpsi, dphi, dth)
+    par = sp.symbols(structure.param_names, real=True)
+    g, L, gamma, m, I_axle, alpha, I_diam = par
+    nrm = sp.Matrix([sp.sin(gamma), sp.cos(gamma), 0])
+    fall = sp.Matrix([sp.cos(gamma), -sp.sin(gamma), 0])
+    ez = sp.Matrix([0, 0, 1])
+    A = rotation(nrm, psi) * rotation(fall, phi)          # heading, then lean
+    # vectors in A's frame (the wheel's plane spun by theta): the energies and the impact
+    # are invariant under the rotation A, and read shortest there
+    spin = rotation(ez, th)
+    W = sp.Matrix.hstack(rotation(fall, -phi) * nrm, fall, ez)   # omega_A = W dq
+    omega = W * sp.Matrix(dq)
+    hub = spin * sp.Matrix([0, L, 0])
+    kinetic = sp.Rational(1, 2) * ((m * L ** 2 + I_diam) * _dot(omega, omega)
+                                   - m * _dot(omega, hub) ** 2
+                                   + (I_axle - I_diam) * _dot(omega, ez) ** 2)
+    Mq = sp.Matrix(3, 3, lambda i, j: sp.trigsimp(sp.expand(sp.diff(kinetic, dq[i], dq[j]))))
+    hub_w = A * hub                                         # world axes
+    potential = m * g * hub_w[1]
+    G = sp.Matrix([sp.diff(potential, qi) for qi in q])
+    C = christoffel(Mq, q, dq)
+
+    def foot(k):  # the foot of the spoke k spokes ahead of the stance spoke (world)
+        return A * (hub + spin * _spoke(2 * k * alpha, L))
+
+    nxt = foot(1)
+    d = -spin * _spoke(2 * alpha, L)                       # new foot -> hub (A's frame)
+
+    def inertia_cm(w):  # I_cm w, the axisymmetric hub
+        return I_diam * w + (I_axle - I_diam) * w[2] * ez
+
+    def h_after(w):  # angular momentum about the new foot, rotating about it at w
+        return inertia_cm(w) + m * _cross(d, _cross(w, d))
+
+    def h_before(w):  # ... of the motion about the old foot at w (hub velocity w x hub)
+        return inertia_cm(w) + m * _cross(d, _cross(w, hub))
+
+    cols = [W[:, j] for j in range(3)]
+    Mi = (W.T * sp.Matrix.hstack(*[h_after(c) for c in cols])).applyfunc(sp.trigsimp)
+    B = (W.T * sp.Matrix.hstack(*[h_before(c) for c in cols])).applyfunc(sp.trigsimp)
+    hub, axle = hub_w, A * ez
+    # the section: the spoke behind's foot on the slope, a cos(theta) + b sin(theta) = 0
+    u = W[:, 0]                                             # the normal in A's frame
+    v = sp.Matrix([0, L, 0]) + _spoke(-2 * alpha, L)       # hub -> trailing foot, wheel frame
+    a = u[0] * v[0] + u[1] * v[1]
+    b = u[1] * v[0] - u[0] * v[1]
+    theta_on = sp.atan2(a, -b)                              # = alpha - gamma upright
+    points = {"hip": hub, "stance_foot": sp.zeros(3, 1), "swing_foot": nxt,
+              "trailing_foot": foot(-1),
+              **{f"spoke{k}_foot": foot(k) for k in range(2, structure.spokes - 1)},
+              "axle_tip": hub + L * axle / 4}
+    n = 3
+    return Equations(
+        q=q, dq=dq, params=tuple(par), M=Mq, C=C, G=G, Mi=Mi, B=B,
+        relabel_q=sp.Matrix([psi, phi, th + 2 * alpha]), relabel_rate=sp.eye(n),
+        kinetic=kinetic, potential=potential,
+        guards={"heel_strike": _dot(nxt, nrm), "rolls_back": dth,
+                "hip_height": _dot(hub, nrm), "swing_clearance": _dot(nxt, nrm)},
+        points=points, leg_angles={"stance": th, "swing": th + 2 * alpha},
+        section_drop=2, drop_solution=theta_on,
+        De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
+    )
