@@ -420,7 +420,7 @@ def simulate_steps(walker: HybridWalker, x0: np.ndarray, n_steps: int, solver: S
     t0 = time.perf_counter()
     segs: list[Segment] = []
     x, t, leg = np.asarray(x0, float), 0.0, first_stance_leg
-    foot = np.zeros(2)
+    foot = np.zeros(np.shape(walker.points(x)["stance_foot"]))  # (2,), or (3,) in 3D
     for k in range(n_steps):
         if walker.ground_steps is not None and k >= walker.ground_steps:
             break  # a finite ground (a foothold list that does not repeat): it ends here

@@ -19,6 +19,7 @@ from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
     ground_contact_text,
     zero_dynamics_text,
+    neutral_multipliers_text,
     zero_multipliers_text,
 )
 from walkerlab.units import Units, for_scene
@@ -239,7 +240,8 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
                    for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
             "", f"Max difference between the two: {num(fp.max_difference, 2)}. "
             f"Verdict: **{'stable' if fp.stable else 'unstable'}** "
-            f"({zero_multipliers_text(re, im, fp.state_names, fp.scene_json)}).", ""]
+            f"({zero_multipliers_text(re, im, fp.state_names, fp.scene_json)}"
+            + (f"; {neutral_multipliers_text(fp)}" if fp.neutral else "") + ").", ""]
     if fp.zero_dynamics is not None:  # virtual constraints: the restricted map beside
         out += ["### Hybrid zero dynamics", "", "```text",
                 *zero_dynamics_text(fp.zero_dynamics), "```", ""]

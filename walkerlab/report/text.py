@@ -62,6 +62,18 @@ def zero_multipliers_text(re, im, state_names: list[str] | None = None,
             "state" + (f" ({said})" if said else ""))
 
 
+def neutral_multipliers_text(gait) -> str:
+    """The neutral multipliers of a gait that lies in a family (``gait.neutral``: the
+    coordinates along which the gaits form one, e.g. a 3D wheel's heading), set aside by
+    the verdict."""
+    mult = np.asarray(gait.multipliers)
+    pos = np.argsort(np.abs(mult - 1.0), kind="stable")[:len(gait.neutral)]
+    said = ", ".join(f"{mult[i].real:+.6f} ({name.removesuffix('_angle')})"
+                     for i, name in zip(pos, gait.neutral))
+    return (f"neutral, set aside: {said} - the gaits form a family along "
+            f"{'it' if len(pos) == 1 else 'them'} (Coleman, Chatterjee & Ruina 1997)")
+
+
 def ground_contact_problems(g, u) -> list[str]:
     """Why a gait's ground contact is not unilateral (``g``: the stored check,
     :class:`~walkerlab.io.schemas.fixedpoint.GroundContactRecord`; ``u``: the units)."""
@@ -190,11 +202,13 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     lines.append(f"Floquet multipliers (finite diff.): "
                  f"{_fmt_mult(fp.multipliers_fd.real, fp.multipliers_fd.imag)}")
     lines.append(f"  max difference {fp.max_difference:.2e} ({_fd_error_text(fp.scene_json)})")
-    mod = float(np.max(np.hypot(re, im)))
+    mod = fp.max_abs_multiplier()
     verdict = "STABLE" if fp.stable else "UNSTABLE"
     why = (zero_multipliers_text(re, im, fp.state_names, fp.scene_json)
            if fp.zero_dynamics is None else "the others are the output feedback's and the "
            "heel-strike surface's, besides delta^2 of the zero dynamics")
+    if fp.neutral:
+        why = f"{neutral_multipliers_text(fp)}; {why}"
     lines.append(f"verdict: {verdict} (largest variational |multiplier| = {mod:.6f}; {why})")
     if fp.zero_dynamics is not None:
         lines += zero_dynamics_text(fp.zero_dynamics)

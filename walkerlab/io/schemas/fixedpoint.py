@@ -180,6 +180,8 @@ def _write_result(g, walker, res, guess) -> None:
     put(g, "floquet/max_difference", res.multiplier_difference, "-",
         "max |multiplier(variational) - multiplier(finite difference)|")
     put(g, "floquet/stable", res.stable, "-", "all |multipliers| < 1")
+    if res.neutral:  # a family of gaits (a 3D wheel's heading): its multipliers set aside
+        g["floquet"].attrs["neutral"] = list(res.neutral)
     put(g, "stats/nfev", res.nfev, "-", "right-hand-side evaluations")
     put(g, "stats/map_evaluations", res.iterations, "-", "Poincare-map calls by the root finder")
     put(g, "stats/wall_time", res.wall_time_s, "s", "fixed-point search + Jacobians")
@@ -355,10 +357,16 @@ class GaitResult:
     step_lengths_m: tuple = ()
     step_swing_legs: tuple = ()
     ground_contact: GroundContactRecord | None = None
+    neutral: tuple = ()
 
     def max_abs_multiplier(self) -> float:
-        """Largest |Floquet multiplier| (variational)."""
-        return float(np.max(np.abs(self.multipliers)))
+        """Largest |Floquet multiplier| (variational), the neutral ones (:attr:`neutral`:
+        one nearest 1 for each) set aside."""
+        mult = np.asarray(self.multipliers)
+        if self.neutral and mult.size:
+            drop = np.argsort(np.abs(mult - 1.0), kind="stable")[:len(self.neutral)]
+            mult = np.delete(mult, drop)
+        return float(np.max(np.abs(mult)))
 
     @property
     def period_s(self) -> float:
@@ -379,7 +387,8 @@ def _gait(g, names: list[str]) -> GaitResult:
                         + 1j * g["floquet/finite_difference/imag"][()]),
         max_difference=float(g["floquet/max_difference"][()]),
         stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")),
-        ground_contact=_ground(g), **_stride(g))
+        ground_contact=_ground(g), **_stride(g),
+        neutral=tuple(str(v) for v in g["floquet"].attrs.get("neutral", ())))
 
 
 def _stride(g) -> dict:

@@ -1,0 +1,198 @@
+"""The rimless wheel in three dimensions (``walker.space: 3d``; Coleman, Chatterjee & Ruina
+1997) against references that share no code with its generated equations: the planar
+wheel's closed form (McGeer 1990), and a rigid body turning about a fixed point written here
+with scipy's rotations (Euler's equations in the body frame, the impact by the angular
+momentum about the new foot)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.spatial.transform import Rotation
+
+from walkerlab.analysis.gait.poincare import find_fixed_point
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.registry import build_walker
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "configs" / "rimless_wheel_3d.yaml"
+G, L, M, SLOPE, N_SPOKES, I_DIAM, I_AXLE = 9.81, 1.0, 1.0, 0.08, 8, 0.1, 0.0
+ALPHA = math.pi / N_SPOKES
+#: the planar wheel's post-impact rate (McGeer 1990): w+ = cot(2a) sqrt(4 g/L sin a sin g)
+W_PLUS = math.sqrt(4 * G / L * math.sin(ALPHA) * math.sin(SLOPE)) / math.tan(2 * ALPHA)
+
+
+def _scene(**walker):
+    import yaml
+
+    from walkerlab.config.schema import Scene
+
+    raw = yaml.safe_load(SCENE.read_text())
+    raw["walker"].update(walker)
+    return Scene.model_validate(raw)
+
+
+@pytest.fixture(scope="module")
+def wheel():
+    return build_walker(_scene())
+
+
+@pytest.fixture(scope="module")
+def gait(wheel):
+    solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    guess = np.array([0, 0, ALPHA - SLOPE, 0, 0, -1.0])
+    return find_fixed_point(wheel, guess, solver, fd_check=False)
+
+
+# ---- an independent model: a rigid body about a fixed point (scipy rotations) ----------
+
+NRM = np.array([math.sin(SLOPE), math.cos(SLOPE), 0.0])
+HUB_B = np.array([0.0, L, 0.0])                       # hub from the stance foot, body frame
+I_CM_B = np.diag([I_DIAM, I_DIAM, I_AXLE])           # axle along body z
+
+
+def _foot_b(k):  # foot of the spoke k ahead of the stance spoke, from the stance foot
+    a = 2 * k * ALPHA
+    return HUB_B + L * np.array([math.sin(a), -math.cos(a), 0.0])
+
+
+J_B = I_CM_B + M * (HUB_B @ HUB_B * np.eye(3) - np.outer(HUB_B, HUB_B))
+
+
+def _rhs(t, y):
+    R, Om = y[:9].reshape(3, 3), y[9:]
+    torque = np.cross(HUB_B, R.T @ np.array([0.0, -M * G, 0.0]))
+    dOm = np.linalg.solve(J_B, torque - np.cross(Om, J_B @ Om))
+    dR = R @ np.array([[0, -Om[2], Om[1]], [Om[2], 0, -Om[0]], [-Om[1], Om[0], 0]])
+    return np.concatenate([dR.ravel(), dOm])
+
+
+def _strike(t, y):
+    return NRM @ (y[:9].reshape(3, 3) @ _foot_b(1))
+
+
+_strike.terminal, _strike.direction = True, -1
+
+
+def _step(R, Om):
+    """(R, body rates) just after a heel strike -> the next one's, relabelled."""
+    sol = solve_ivp(_rhs, (0, 5), np.concatenate([R.ravel(), Om]), method="DOP853",
+                    rtol=1e-13, atol=1e-13, events=_strike)
+    y = sol.y_events[0][0]
+    R, Om = y[:9].reshape(3, 3), y[9:]
+    w = R @ Om
+    hub, new = R @ HUB_B, R @ _foot_b(1)
+    d = hub - new
+    I_cm = R @ I_CM_B @ R.T
+    H = I_cm @ w + M * np.cross(d, np.cross(w, hub))
+    w_plus = np.linalg.solve(I_cm + M * (d @ d * np.eye(3) - np.outer(d, d)), H)
+    R_new = R @ Rotation.from_rotvec([0, 0, 2 * ALPHA]).as_matrix()
+    return R_new, R_new.T @ w_plus, float(sol.t_events[0][0])
+
+
+def _reference_multipliers(h=1e-6):
+    R0 = Rotation.from_rotvec([0, 0, ALPHA - SLOPE]).as_matrix()
+    Om0 = np.array([0.0, 0.0, -W_PLUS])
+
+    def chart(dx):
+        return R0 @ Rotation.from_rotvec(dx[:3]).as_matrix(), Om0 + dx[3:]
+
+    def back(R, Om):
+        return np.concatenate([Rotation.from_matrix(R0.T @ R).as_rotvec(), Om - Om0])
+
+    J = np.zeros((6, 6))
+    for j in range(6):
+        e = np.zeros(6)
+        e[j] = h
+        J[:, j] = (back(*_step(*chart(e))[:2]) - back(*_step(*chart(-e))[:2])) / (2 * h)
+    return np.linalg.eigvals(J), _step(R0, Om0)
+
+
+def test_upright_3d_wheel_rolls_downhill_as_the_planar_wheel(gait):
+    names = ["heading", "lean", "stance"]
+    x = dict(zip([f"{n}_angle" for n in names] + [f"{n}_rate" for n in names], gait.x))
+    assert abs(x["stance_rate"] + W_PLUS) < 1e-10
+    assert abs(x["stance_angle"] - (ALPHA - SLOPE)) < 1e-12
+    assert max(abs(x[k]) for k in ("heading_angle", "lean_angle", "heading_rate",
+                                   "lean_rate")) < 1e-12
+    # the planar wheel's step period: the pendulum from alpha - gamma to -alpha - gamma
+    planar = build_walker(_scene(space="2d", diametral_inertia_kg_m2=None))
+    solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    flat = find_fixed_point(planar, np.array([ALPHA - SLOPE, -1.0]), solver, fd_check=False)
+    assert abs(gait.period_s - flat.period_s) < 1e-10
+    assert abs(flat.x[1] + W_PLUS) < 1e-10
+
+
+def test_3d_wheel_multipliers_match_an_independent_rigid_body_model(gait):
+    ref, (R1, Om1, period) = _reference_multipliers()
+    R0 = Rotation.from_rotvec([0, 0, ALPHA - SLOPE]).as_matrix()
+    assert np.max(np.abs(R1 - R0)) < 1e-10 and abs(Om1[2] + W_PLUS) < 1e-10  # a fixed point
+    assert abs(period - gait.period_s) < 1e-10
+    ours = np.sort_complex(np.asarray(gait.multipliers_variational))
+    theirs = np.sort_complex(ref)
+    # central differences of h = 1e-6 on maps integrated to 1e-13: error ~ 1e-7 relative
+    assert np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs))) < 1e-5
+    # the neutral heading multiplier, the planar one cos(2 alpha)^2, the trivial 0
+    assert np.min(np.abs(ours - 1.0)) < 1e-8
+    assert np.min(np.abs(ours - math.cos(2 * ALPHA) ** 2)) < 1e-8
+    assert gait.neutral == ("heading_angle",)
+    assert abs(gait.neutral_multipliers[0] - 1.0) < 1e-8
+
+
+def test_a_3d_wheel_at_another_heading_is_a_member_of_the_family(wheel):
+    """Steady rolling at a heading off the fall line (Coleman et al. 1997): a fixed point
+    with the heading held where it started, leaning, and its multiplier 1 again."""
+    solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    res = find_fixed_point(wheel, np.array([0.1, 0, ALPHA - SLOPE, 0, 0, -1.0]), solver,
+                           fd_check=False)
+    assert abs(res.x[0] - 0.1) < 1e-14 and res.residual < 1e-10
+    assert abs(res.x[1]) > 1e-3  # it leans: not the upright wheel turned
+    assert abs(res.neutral_multipliers[0] - 1.0) < 1e-6
+
+
+def test_3d_wheel_conserves_energy_in_a_passive_stance(wheel):
+    x0 = np.array([0.05, 0.02, ALPHA - SLOPE, 0.1, -0.05, -1.1])
+    sol = solve_ivp(wheel.phases[0].flow, (0, 0.6), x0, method="DOP853", rtol=1e-13,
+                    atol=1e-13, dense_output=True)
+    X = sol.sol(np.linspace(0, 0.6, 50))
+    ke, pe = wheel.energies(X)
+    total = np.asarray(ke) + np.asarray(pe)
+    assert np.max(np.abs(total - total[0])) < 1e-9
+
+
+def test_3d_wheel_impact_conserves_angular_momentum_about_the_new_foot(wheel):
+    x = np.array([0.1, -0.03, -ALPHA - SLOPE + 0.01, 0.2, 0.15, -1.2])
+    xp = wheel.reset(x)
+
+    def rot(q):
+        nrm = NRM
+        fall = np.array([math.cos(SLOPE), -math.sin(SLOPE), 0.0])
+        return (Rotation.from_rotvec(q[0] * nrm) * Rotation.from_rotvec(q[1] * fall)
+                * Rotation.from_rotvec([0, 0, q[2]])).as_matrix()
+
+    def omega(q, dq):
+        fall = np.array([math.cos(SLOPE), -math.sin(SLOPE), 0.0])
+        A = Rotation.from_rotvec(q[0] * NRM)
+        B = A * Rotation.from_rotvec(q[1] * fall)
+        return NRM * dq[0] + A.apply(fall) * dq[1] + B.apply([0, 0, 1]) * dq[2]
+
+    R = rot(x[:3])
+    hub, new = R @ HUB_B, R @ _foot_b(1)
+    w_minus, w_plus = omega(x[:3], x[3:]), omega(xp[:3], xp[3:])
+    I_cm = R @ I_CM_B @ R.T
+    d = hub - new
+    H_minus = I_cm @ w_minus + M * np.cross(d, np.cross(w_minus, hub))
+    H_plus = I_cm @ w_plus + M * np.cross(d, np.cross(w_plus, d))
+    assert np.max(np.abs(H_plus - H_minus)) < 1e-12
+    # the relabelling turns the stance spoke by one spoke: the same body orientation
+    assert np.max(np.abs(rot(xp[:3]) - R @ Rotation.from_rotvec(
+        [0, 0, 2 * ALPHA]).as_matrix())) < 1e-14
+
+
+def test_a_3d_wheel_without_its_diametral_inertia_is_refused_in_one_line():
+    with pytest.raises(Exception, match="walker.diametral_inertia_kg_m2"):
+        _scene(diametral_inertia_kg_m2=None)
