@@ -40,6 +40,7 @@ SCENES = {
     "free_joints": "configs/rabbit.yaml",
     "hinged_torso": "configs/threelink.yaml",
     "rolling_polygon": "configs/rimless_wheel.yaml",
+    "rolling_polygon_3d": "configs/rimless_wheel_3d.yaml",
 }
 
 #: a small PD law [N m/rad, N m s/rad] about the joint's zero angle
@@ -169,6 +170,8 @@ SHIPPED = {
     ("hinged_torso", "hip_torque"): "threelink",
     ("hinged_torso", "torso_torque"): "threelink",
     ("rolling_polygon", "walk"): "rimless_wheel",
+    # the disc-like wheel: stable above its critical slope (the point-mass wheel falls over)
+    ("rolling_polygon_3d", "walk"): "rimless_wheel_3d_disc",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the

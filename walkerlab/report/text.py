@@ -325,7 +325,7 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
         "" if len(labels) > 1 else " (the other gait of the long/short-period pair, if it "
         "exists, was not found)")]
     for lab, g in fp.gaits.items():
-        mod = float(np.max(np.hypot(g.multipliers.real, g.multipliers.imag)))
+        mod = g.max_abs_multiplier()  # the neutral ones (a family's) set aside
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
                      f"{g.step_period_s:.6f} {fp.units.time}, max |multiplier| {mod:.4g}, "
                      f"{'stable' if g.stable else 'UNSTABLE'}{_ground_word(g, fp.units)} "

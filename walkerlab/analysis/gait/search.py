@@ -170,7 +170,15 @@ class GaitSearch:
 
 
 def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
-    return all(float(np.max(np.abs(res.x - g.result.x))) > SAME_GAIT for g in found)
+    """Whether ``res`` differs from every gait in ``found`` (angles compared modulo 2 pi:
+    a 3D wheel's lean of 2 pi is its lean of 0)."""
+    def apart(a, b):
+        d = np.asarray(a, float) - np.asarray(b, float)
+        n = d.size // 2  # the state is [n angles, n rates]
+        d[:n] = np.remainder(d[:n] + np.pi, 2 * np.pi) - np.pi
+        return float(np.max(np.abs(d)))
+
+    return all(apart(res.x, g.result.x) > SAME_GAIT for g in found)
 
 
 def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = None,
