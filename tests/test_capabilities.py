@@ -168,8 +168,8 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
                  else JOINT[feature])
         out += [f"{joint} is not a joint of this walker (its joints: ",
                 f"{joint} is not a joint of the "]  # an export's joints (the walker's)
-    if kind == "rolling_polygon" and feature in (*JOINT, "push_off", "ankle_push_off",
-                                                 "virtual_constraints"):
+    if kind in ("rolling_polygon", "rolling_polygon_3d") and feature in (
+            *JOINT, "push_off", "ankle_push_off", "virtual_constraints"):
         out.append("walker.actuation: unknown field")
     return tuple(out)
 

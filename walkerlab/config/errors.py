@@ -152,7 +152,8 @@ class _Suggester:
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
 #: the user guide, docs/user_guide/walkers.md (one place: update it as the walker vocabulary grows)
 WALKER_VOCABULARY = (
-    "a walker today is planar: model compass_gait (hip mass, one point mass per "
+    "a walker today is planar but for the 3D rimless wheel: model compass_gait (hip mass, "
+    "one point mass per "
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee "
     "(with an optional spring-damper) or free knees (knee.lock: free), foot "
@@ -163,7 +164,8 @@ WALKER_VOCABULARY = (
     "to leg, knees, flat feet's ankles) in the rigid model (the contact model: hip torques on "
     "straight, point-footed legs and a hinged torso's walker's joints), a push-off impulse on "
     "point feet, an ankle push-off on flat feet), or "
-    "rimless_wheel (spokes, spoke_length_m, mass_kg, optional hub_inertia_kg_m2)")
+    "rimless_wheel (spokes, spoke_length_m, mass_kg, optional hub_inertia_kg_m2; space: 3d "
+    "with diametral_inertia_kg_m2: the wheel in three dimensions)")
 
 
 def _walker_vocabulary_applies(root: type[BaseModel], e: dict, suggest=None) -> bool:

@@ -258,5 +258,13 @@ PARTS: dict[str, ContactPart] = {
 
 def contact_part(structure) -> ContactPart:
     """The contact view's part of ``structure``'s kind
-    (:attr:`walkerlab.walker.description.Structure.kind`)."""
+    (:attr:`walkerlab.walker.description.Structure.kind`).
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+        The kind has no contact view (its ``walk`` cell there, one line).
+    """
+    if structure.spatial:  # the planar kinds' parts refuse what they lack themselves
+        structure.kind.require("walk", "contact", "walker.space: 3d")
     return PARTS[structure.kind.name]
