@@ -70,7 +70,7 @@ def test_the_exports_walk_check_knows_every_kind():
     from walkerlab.stages.export import _ROLLS
 
     assert set(_ROLLS) == set(KINDS)
-    assert [k for k, rolls in _ROLLS.items() if rolls] == ["rolling_polygon"]
+    assert [k for k, rolls in _ROLLS.items() if rolls] == ["rolling_polygon", "rolling_polygon_3d"]
 
 
 @pytest.mark.slow  # ~25 s: simulate and 500 control periods of the rigid view

@@ -386,7 +386,8 @@ def _walk(out: Exported, fmt: str, data, steps: int, scene: Scene) -> EngineWalk
 #: kind name -> its steps are spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`), not
 #: two legs' heel strikes
 _ROLLS = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
-          "free_joints": False, "hinged_torso": False, "rolling_polygon": True}
+          "free_joints": False, "hinged_torso": False, "rolling_polygon": True,
+          "rolling_polygon_3d": True}
 
 
 def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool,

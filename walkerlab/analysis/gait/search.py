@@ -124,7 +124,7 @@ class Gait:
         (:attr:`FixedPointResult.neutral_multipliers`) set aside."""
         res = self.result
         mult = res.multipliers_variational
-        if res.neutral:
+        if getattr(res, "neutral", ()):
             mult = np.delete(mult, [int(np.argmin(np.abs(mult - m)))
                                     for m in res.neutral_multipliers])
         return float(np.max(np.abs(mult)))
