@@ -195,7 +195,8 @@ def derive_equations(structure):
     if structure.spatial:
         from walkerlab.codegen import spatial
 
-        return spatial.derive_spoked(structure)
+        return (spatial.derive_spoked(structure) if structure.spokes
+                else spatial.derive_compass(structure))
     if structure.spokes:
         from walkerlab.codegen import rolling_polygon
 

@@ -292,10 +292,16 @@ def _section(eq: Equations) -> list[str]:
           for i in range(2 * n)]
     for i, j in tied.items():
         xs[i] = xs[j]
+    # a closed-form angle (acos, atan2 of math) takes real numbers only: complex input (a
+    # complex-step derivative) is refused, so that the caller differentiates otherwise
+    real_only = ([f"{IND}if np.iscomplexobj(z):",
+                  f"{IND}    raise TypeError('from_section: real section coordinates only')"]
+                 if eq.drop_solution.has(sp.acos, sp.atan2) else [])
     return [
         "    def section(x):",
         f"{IND}return np.asarray(x)[{keep!r}]",
         "    def from_section(z):",
+        *real_only,
         f"{IND}{', '.join(str(s) for s in z)}, = z",
         f"{IND}return {_array(xs)}",
     ]
@@ -411,9 +417,11 @@ def generate(eq: Equations, param_names, key: str) -> str:
         "import numpy as np",
         "",
     ]
-    text = "\n".join(body)
-    if " atan2(" in text or "(atan2(" in text:  # a closed-form angle (a 3D walker's section)
-        head.insert(3, "from math import atan2  # noqa: F401")
+    # a closed-form angle (a 3D walker's section): imported only where used, so that every
+    # other walker's source is unchanged
+    used = sorted(set(re.findall(r"(?<![\w.])(atan2|acos)\(", "\n".join(body))))
+    if used:
+        head.insert(3, f"from math import {', '.join(used)}  # noqa: F401")
     return "\n".join(head + body) + "\n"
 
 

@@ -188,3 +188,143 @@ def derive_spoked(structure) -> Equations:
         section_drop=2, drop_solution=theta_on,
         De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
     )
+
+
+def _point_mass_matrix(masses, q, p_foot=False):
+    """Mass matrix (n, n) of point masses ``[(m, r(q) (3, 1))]`` and, with ``p_foot``, the
+    coupling ``A = sum m J^T`` (n, 3) and the total mass of the extended system whose stance
+    foot is free (``[q, foot position]``)."""
+    n = len(q)
+    qv = sp.Matrix(q)
+    M = sp.zeros(n, n)
+    A = sp.zeros(n, 3)
+    total = 0
+    for m, r in masses:
+        J = sp.Matrix(r).jacobian(qv)
+        M += m * J.T * J
+        A += m * J.T
+        total += m
+    return M, A, total
+
+
+@cache
+def derive_compass(structure) -> Equations:
+    """Flow, impact, guards, energies and points of a straight-legged walker with hip width in
+    three dimensions (``model: compass_gait`` with ``space: 3d``; Kuo 1999, "Stabilization of
+    lateral motion in passive dynamic walking", IJRR 18(9)).
+
+    The walker: a hip (pelvis) point mass ``M_hip`` midway between two hips ``w`` apart
+    along the hip axis, and on each straight leg of length ``L`` a point mass ``m`` at
+    ``a`` from its point foot.  The stance foot neither slips nor twists: the walker rolls
+    about the fall line through it and pitches about the hip axis, but does not yaw (Kuo
+    1999 keeps roll and pitch and leaves yaw out).  Coordinates (``roles`` ``lean``,
+    ``swing``, ``stance``):
+
+    - ``lean`` ``phi``: the pelvis' roll about the fall line (0: the hip axis horizontal);
+    - ``stance``, ``swing``: each leg's pitch in the rolled sagittal plane, from the
+      vertical, positive when its foot is ahead of its hip (the planar walkers' absolute leg
+      angles: with ``phi = 0`` and ``w = 0`` the equations are the compass gait's).
+
+    Frames: ``R_leg = Rot(s, phi) Rot(z, theta)``; the stance hip at ``R_st (0, L, 0)`` from
+    the stance foot, the swing hip ``w`` along the rolled hip axis ``Rot(s, phi) z`` from it
+    (``w`` < 0: the mirror step, the swing hip on the other side), the pelvis mass midway.
+
+    Heel strike: the swing foot's height above the slope,
+    ``h = L cos(phi) (cos(theta_st + gamma) - cos(theta_sw + gamma)) - w sin(phi)``,
+    falling through 0 after mid-stance (the late-swing phase, as a planar walker's).  With
+    zero hip width the guard is the planar one, ``theta_sw + theta_st + 2 gamma`` (its zero
+    is ``h``'s in late swing, and ``h`` is 0 when the legs cross: the feet coincide).
+
+    Impact: plastic, the new stance foot sticks, the old one leaves the ground (Hurmuzlu &
+    Marghitu 1994's extended coordinates ``[q, p]``, ``p`` the old stance foot): with
+    ``J = [I; -df/dq]`` the extended rates of a motion about the new foot (``f(q)`` the
+    swing foot from the stance foot), ``J^T M_e J dq+ = J^T M_e [I; 0] dq-`` - the impulse
+    at the new foot does no work on such motions, and the no-yaw constraint's none either.
+    The roles then swap: ``theta_st+ = theta_sw-`` and back, the lean unchanged.
+
+    Poincaré section: just after a heel strike (the swing foot on the slope behind): the
+    swing angle solved from ``h = 0``.
+
+    Parameters
+    ----------
+    structure : walkerlab.walker.description.Structure
+        ``spatial`` and not ``spokes`` (parameters
+        :data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`; ``hip_width``: whether
+        ``w`` is a parameter, else 0).
+
+    Returns
+    -------
+    Equations
+        ``n = 3``; points (3, 1) in world axes.
+
+    Raises
+    ------
+    ValueError
+        ``structure`` is not a spatial straight-legged walker.
+    """
+    if not structure.spatial or structure.spokes:
+        raise ValueError("spatial.derive_compass: the structure is not a 3D straight-legged "
+                         "walker")
+    phi, th_sw, th_st = sp.symbols("q_lean q_swing q_stance", real=True)
+    dphi, dth_sw, dth_st = sp.symbols("dq_lean dq_swing dq_stance", real=True)
+    q, dq = (phi, th_sw, th_st), (dphi, dth_sw, dth_st)
+    par = sp.symbols(structure.param_names, real=True)
+    P = dict(zip(structure.param_names, par))
+    g, L, gamma, M_hip, m, a = (P[k] for k in ("g", "L", "gamma", "M_hip", "m_leg", "a_leg"))
+    w = P.get("w_hip", 0)
+    # vectors in the slope's frame (fall line s, normal n, z): there the roll is about the
+    # first axis and a leg's pitch about the third, from the normal by theta + gamma
+    ez = sp.Matrix([0, 0, 1])
+    roll = rotation(sp.Matrix([1, 0, 0]), phi)
+    axis = roll * ez                                   # the hip axis
+
+    def leg(theta, length):  # from the hip to a point at ``length`` down the leg
+        return roll * (rotation(ez, theta + gamma) * sp.Matrix([0, -length, 0]))
+
+    hip_st = -leg(th_st, L)
+    hip_sw = hip_st + w * axis
+    pelvis = hip_st + w / 2 * axis
+    m_st = hip_st + leg(th_st, L - a)                  # a from the foot
+    m_sw = hip_sw + leg(th_sw, L - a)
+    swing_foot = hip_sw + leg(th_sw, L)
+    masses = [(M_hip, pelvis), (m, m_st), (m, m_sw)]
+    M, A, total = _point_mass_matrix(masses, q)
+    M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+    C = christoffel(M, q, dq)
+    # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n
+    up = sp.Matrix([-sp.sin(gamma), sp.cos(gamma), 0])
+    potential = sum(mi * g * _dot(r, up) for mi, r in masses)
+    G = sp.Matrix([sp.expand(sp.diff(potential, qi)) for qi in q])
+    kinetic = sp.Rational(1, 2) * (sp.Matrix(dq).T * M * sp.Matrix(dq))[0]
+    # impact about the new foot (extended coordinates, the old stance foot free)
+    F = swing_foot.jacobian(sp.Matrix(q))
+    Mi = (M - A * F - F.T * A.T + total * F.T * F).applyfunc(
+        lambda e: sp.trigsimp(sp.expand(e)))
+    B = (M - F.T * A.T).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+    to_world = sp.Matrix([[sp.cos(gamma), sp.sin(gamma), 0],
+                          [-sp.sin(gamma), sp.cos(gamma), 0], [0, 0, 1]])  # columns s, n, z
+    height = swing_foot[1]
+    relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
+    relabel_rate = relabel_q.jacobian(sp.Matrix(q))
+    sigma = th_sw + th_st + 2 * gamma
+    if structure.hip_width:
+        heel = height
+        # just after heel strike the swing foot (the old stance foot) is on the slope behind
+        drop_solution = -gamma - sp.acos(sp.cos(th_st + gamma) - w * sp.tan(phi) / L)
+    else:
+        heel = sigma
+        drop_solution = -th_st - 2 * gamma
+    points = {k: to_world * v for k, v in (
+        ("hip", pelvis), ("stance_hip", hip_st), ("swing_hip", hip_sw),
+        ("stance_foot", sp.zeros(3, 1)), ("swing_foot", swing_foot), ("stance_mass", m_st),
+        ("swing_mass", m_sw))}
+    n = len(q)
+    return Equations(
+        q=q, dq=dq, params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
+        relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=kinetic, potential=potential,
+        guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
+                "hip_height": pelvis[1], "swing_clearance": height},
+        points=points, leg_angles={"stance": th_st, "swing": th_sw, "lean": phi},
+        section_drop=1, drop_solution=drop_solution,
+        De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
+    )

@@ -41,6 +41,7 @@ SCENES = {
     "hinged_torso": "configs/threelink.yaml",
     "rolling_polygon": "configs/rimless_wheel.yaml",
     "rolling_polygon_3d": "configs/rimless_wheel_3d.yaml",
+    "straight_legs_3d": "configs/hip_width.yaml",
 }
 
 #: a small PD law [N m/rad, N m s/rad] about the joint's zero angle
@@ -172,6 +173,8 @@ SHIPPED = {
     ("rolling_polygon", "walk"): "rimless_wheel",
     # the disc-like wheel: stable above its critical slope (the point-mass wheel falls over)
     ("rolling_polygon_3d", "walk"): "rimless_wheel_3d_disc",
+    # the paper's walker in 3D with zero hip width: the planar gait, rolled about nothing
+    ("straight_legs_3d", "walk"): "paper_3d",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the

@@ -44,6 +44,13 @@ class CompassGaitParams(_Actuated):
     leg_mass_from_foot_m: float = Field(
         gt=0, description="distance a of the leg mass from the foot [m]; b = L - a"
     )
+    space: Literal["2d", "3d"] = Field("2d", description="2d: the walker moves in the "
+                                       "sagittal plane; 3d: it also rolls about the fall "
+                                       "line through its stance foot, which neither slips "
+                                       "nor twists (Kuo 1999)")
+    hip_width_m: float = Field(0.0, ge=0, le=100, description="distance between the hips "
+                               "along the hip axis [m] (space: 3d only; 0: the planar "
+                               "walker embedded in 3D)")
 
     @model_validator(mode="after")
     def _a_inside_leg(self) -> CompassGaitParams:
@@ -51,6 +58,11 @@ class CompassGaitParams(_Actuated):
             raise ValueError(
                 "walker.leg_mass_from_foot_m must be smaller than walker.leg_length_m"
             )
+        if self.space == "2d" and self.hip_width_m:
+            raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
+                             "walker's hips are one point)")
+        if self.space == "3d" and self.actuation is not None:
+            raise ValueError("walker.actuation: a 3D walker is passive so far (space: 3d)")
         return self
 
     @property

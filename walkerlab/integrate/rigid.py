@@ -243,7 +243,7 @@ def _enter_step(walker: HybridWalker, st: _StepState, variational: bool) -> int:
 _SCIPY_RUNS_ACTUATED_COMPILED = {"straight_legs": False, "locking_knees": False,
                                  "flat_feet": False, "free_joints": True,
                                  "hinged_torso": True, "rolling_polygon": False,
-                                 "rolling_polygon_3d": False}
+                                 "rolling_polygon_3d": False, "straight_legs_3d": False}
 
 
 def _runs_compiled_on_scipy(phase: Phase) -> bool:

@@ -157,7 +157,7 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
 def _passive(scene) -> HybridWalker:
     """The passive walker of the scene (its actuators left out)."""
     w = scene.walker
-    if w.model == "compass_gait":
+    if w.model == "compass_gait" and w.space == "2d":
         from walkerlab.models.hybrid.printed_equations import make_compass_gait
 
         return make_compass_gait(

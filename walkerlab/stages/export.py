@@ -387,7 +387,7 @@ def _walk(out: Exported, fmt: str, data, steps: int, scene: Scene) -> EngineWalk
 #: two legs' heel strikes
 _ROLLS = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
           "free_joints": False, "hinged_torso": False, "rolling_polygon": True,
-          "rolling_polygon_3d": True}
+          "rolling_polygon_3d": True, "straight_legs_3d": False}
 
 
 def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool,

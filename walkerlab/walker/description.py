@@ -43,6 +43,13 @@ SPATIAL_SPOKED_ROLES = ("heading", "lean", "stance")
 #: Parameters of a spoked wheel in three dimensions: :data:`SPOKED_PARAMS` (``I_hub`` about
 #: the axle) and its inertia about a diameter ``I_diam`` [kg m^2].
 SPATIAL_SPOKED_PARAMS = SPOKED_PARAMS + ("I_diam",)
+#: Roles of a straight-legged walker in three dimensions (``model: compass_gait`` with
+#: ``space: 3d``; :func:`walkerlab.codegen.spatial.derive_compass`): the pelvis' roll about
+#: the fall line, then the legs' pitch angles as the planar walkers'.
+SPATIAL_COMPASS_ROLES = ("lean", "swing", "stance")
+#: Parameters of the straight-legged walker in 3D: gravity, leg length, slope, hip mass, leg
+#: mass and its distance from the foot [SI], then (``hip_width``) the hip width ``w_hip`` [m].
+SPATIAL_COMPASS_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
 
 
 @dataclass(frozen=True)
@@ -131,7 +138,12 @@ class Structure:
     spatial : bool
         The walker moves in three dimensions (``walker.space: 3d``;
         :mod:`walkerlab.codegen.spatial`): a spoked wheel free about every axis of its
-        stance foot (roles :data:`SPATIAL_SPOKED_ROLES`).  False: in the sagittal plane.
+        stance foot (roles :data:`SPATIAL_SPOKED_ROLES`), or straight legs on point feet
+        that roll and pitch (roles :data:`SPATIAL_COMPASS_ROLES`).  False: in the sagittal
+        plane.
+    hip_width : bool
+        A 3D straight-legged walker's hips are apart (parameter ``w_hip``; the steps
+        alternate sides: a stride is the Poincaré map); False: zero hip width.
     """
 
     coordinates: str
@@ -149,6 +161,7 @@ class Structure:
     spokes: int = 0
     foot_mass: bool = False
     spatial: bool = False
+    hip_width: bool = False
 
     @property
     def kind(self) -> Kind:
@@ -160,6 +173,8 @@ class Structure:
     def roles(self) -> tuple[str, ...]:
         if self.spokes:
             return SPATIAL_SPOKED_ROLES if self.spatial else SPOKED_ROLES
+        if self.spatial:
+            return SPATIAL_COMPASS_ROLES
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.hinged_torso:
@@ -181,6 +196,8 @@ class Structure:
         """Names of the parameter vector, in order (SI units; ``gamma`` is the slope [rad])."""
         if self.spokes:
             return SPATIAL_SPOKED_PARAMS if self.spatial else SPOKED_PARAMS
+        if self.spatial:
+            return SPATIAL_COMPASS_PARAMS + (("w_hip",) if self.hip_width else ())
         names = ["g", "L", "gamma"] + (["M_hip"] if self.hip_mass else [])
         tags = [f"{ROLE_TAG[r]}_" for r in ("swing", "stance")] if self.asymmetric else [""]
         for b in self.bodies:
@@ -238,6 +255,8 @@ class Structure:
             d = {"spokes": self.spokes}
         if self.spatial:
             d["space"] = "3d"
+        if self.hip_width:
+            d["hip_width"] = True
         return json.dumps(d)
 
 
@@ -364,6 +383,27 @@ def _spoked_data(w, slope_rad: float) -> WalkerData:
                       w.gravity_m_per_s2, slope_rad, extra)
 
 
+def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
+    """Structure and parameters (:data:`SPATIAL_COMPASS_PARAMS`) of a ``model:
+    compass_gait`` section with ``space: 3d``: with a hip width, the mirror step's
+    parameters (its swing hip on the other side, ``w_hip -> -w_hip``) make the map a
+    stride."""
+    width = float(w.hip_width_m)
+    params = (w.gravity_m_per_s2, w.leg_length_m, slope_rad, w.hip_mass_kg, w.leg_mass_kg,
+              w.leg_mass_from_foot_m)
+    extra = {"leg_mass_kg": w.leg_mass_kg, "hip_mass_kg": w.hip_mass_kg,
+             "leg_mass_from_foot_m": w.leg_mass_from_foot_m, "hip_width_m": width}
+    mirror = None
+    if width:
+        params, mirror = params + (width,), params + (-width,)
+    structure = Structure("absolute", (BodySpec("mass", "point_mass"),), hip_mass=True,
+                          spatial=True, hip_width=bool(width))
+    return WalkerData(structure, tuple(float(v) for v in params),
+                      w.hip_mass_kg + 2 * w.leg_mass_kg, w.leg_length_m,
+                      w.gravity_m_per_s2, slope_rad, extra,
+                      None if mirror is None else tuple(float(v) for v in mirror))
+
+
 def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     """Structure and parameters of a scene's ``walker`` section.
 
@@ -386,6 +426,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     extra = {}
     if walker_cfg.model == "rimless_wheel":
         return _spoked_data(walker_cfg, slope_rad)
+    if walker_cfg.model == "compass_gait" and walker_cfg.space == "3d":
+        return _spatial_compass_data(walker_cfg, slope_rad)
     if walker_cfg.model == "compass_gait":
         extra = {"leg_mass_kg": walker_cfg.leg_mass_kg, "hip_mass_kg": walker_cfg.hip_mass_kg,
                  "leg_mass_from_foot_m": walker_cfg.leg_mass_from_foot_m}

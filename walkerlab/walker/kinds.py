@@ -31,6 +31,11 @@ walker's :class:`Kind`:
 ``rolling_polygon``
     A rimless (spoked) wheel: one rigid body rolling on its spokes (McGeer 1990; Coleman,
     Chatterjee & Ruina 1997).  It has no joint, so no actuator.
+``straight_legs_3d``
+    Straight legs on point feet in three dimensions (``model: compass_gait`` with
+    ``space: 3d``): the walker rolls about the fall line through its stance foot and its
+    legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
+    1999).  The rigid model only, passive, so far.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
@@ -173,6 +178,8 @@ KINDS = {k.name: k for k in (
          "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
          "Coleman, Chatterjee & Ruina 1997"),
+    Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
+         "Kuo 1999"),
 )}
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -229,6 +236,9 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 #: why a 3D walker's views refuse a ground other than a plane
 SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
                   "stairs, footholds and profiles are planar walkers' grounds")
+#: why a 3D walker refuses actuators
+SPATIAL_ACTUATION = ("a walker in 3D is passive so far (its actuators, a lateral "
+                     "foot-placement or hip-roll law, are a later step)")
 #: why the exports refuse a 3D walker
 SPATIAL_EXPORT = ("the exports write planar walkers (a plane constraint or a sagittal "
                   "tree); a 3D walker's free body is a later step")
@@ -391,6 +401,23 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),
     },
+    "straight_legs_3d": {
+        **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
+                                                 "ankle_torque", "torso_torque", "push_off",
+                                                 "ankle_push_off", "virtual_constraints")},
+        **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
+        ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
+                              "later step (walk it in the rigid model: fixedpoint, "
+                              "simulate)"),
+        ("walk", "mjcf"): SPATIAL_EXPORT,
+        ("walk", "urdf"): SPATIAL_EXPORT,
+        ("walk", "adams"): SPATIAL_EXPORT,
+        ("walk", "osim"): SPATIAL_EXPORT,
+        ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
+                          "is a later step"),
+        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
+                               "is a later step"),
+    },
     "rolling_polygon_3d": {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
@@ -440,6 +467,8 @@ def kind_of(structure) -> Kind:
     """
     if structure.spokes:
         return KINDS["rolling_polygon_3d" if structure.spatial else "rolling_polygon"]
+    if structure.spatial:
+        return KINDS["straight_legs_3d"]
     if structure.free_knees:
         return KINDS["free_joints"]
     if structure.hinged_torso:

@@ -366,4 +366,5 @@ class _RollingPolygon:
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> how :func:`actuate` drives it
 _PARTS = {"straight_legs": _Joints(), "locking_knees": _LockingKnees(),
           "free_joints": _FreeJoints(), "hinged_torso": _FreeJoints(), "flat_feet": _FlatFeet(),
-          "rolling_polygon": _RollingPolygon(), "rolling_polygon_3d": _RollingPolygon()}
+          "rolling_polygon": _RollingPolygon(), "rolling_polygon_3d": _RollingPolygon(),
+          "straight_legs_3d": _RollingPolygon()}  # passive so far: the table refuses

@@ -90,6 +90,8 @@ _PARTS = {
     "rolling_polygon": _Part(hub=True, trailing_point="trailing_foot"),
     "rolling_polygon_3d": _Part(refusal="a wheel in 3D: its stance foot's reaction (a "
                                         "force in 3D) is not computed yet"),
+    "straight_legs_3d": _Part(refusal="a walker in 3D: its stance foot's reaction (a "
+                                      "force in 3D) is not computed yet"),
 }
 
 

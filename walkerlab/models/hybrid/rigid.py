@@ -178,7 +178,9 @@ def _never(structure) -> bool:
 
 #: the legged kinds' parts (:func:`_make_legged`)
 _LEGS = {"straight_legs": _Legs(_straight_leg_phases, _absolute_legs_only),
-         "locking_knees": _Legs(_kneed_phases, _never)}
+         "locking_knees": _Legs(_kneed_phases, _never),
+         # in 3D the state has the lean besides the legs' angles: the map names them
+         "straight_legs_3d": _Legs(_straight_leg_phases, _never)}
 
 
 def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
@@ -270,4 +272,5 @@ BUILDERS: dict[str, Callable] = {
     "hinged_torso": _make_free,
     "rolling_polygon": _make_polygon,
     "rolling_polygon_3d": _make_polygon,
+    "straight_legs_3d": _make_legged,
 }

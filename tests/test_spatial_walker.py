@@ -1,0 +1,242 @@
+"""The straight-legged walker in three dimensions (``model: compass_gait``, ``space: 3d``;
+Kuo 1999) against references that share no code with its generated equations: the planar
+walker of the same scene (the planar embedding), and a model written here from Newton's law
+for its three point masses (the rotation matrices' derivatives by hand, d'Alembert's
+principle projected on the coordinates) with its impact solved with the impulse at the new
+foot as an unknown (a Lagrange multiplier)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq, root
+from scipy.spatial.transform import Rotation
+
+from walkerlab.analysis.gait.poincare import find_fixed_point
+from walkerlab.config.schema import Scene
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.registry import build_walker
+
+ROOT = Path(__file__).resolve().parents[1]
+SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+
+
+def _scene(name: str, **walker) -> Scene:
+    raw = yaml.safe_load((ROOT / "configs" / name).read_text())
+    raw["walker"].update(walker)
+    return Scene.model_validate(raw)
+
+
+def _guess(scene: Scene, names) -> np.ndarray:
+    g = scene.fixedpoint.initial_guess.model_extra
+    return np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")] for n in names])
+
+
+# ---- the planar embedding ---------------------------------------------------------------
+
+def test_the_paper_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one():
+    """Started upright, the 3D walker of zero hip width is the planar walker (configs/
+    paper.yaml): the same fixed point and period, to 1e-9."""
+    flat_scene = _scene("paper.yaml")
+    flat = build_walker(flat_scene)
+    f = find_fixed_point(flat, _guess(flat_scene, flat.state_names()), SOLVER, fd_check=False)
+    sp_scene = _scene("paper_3d.yaml")
+    w3 = build_walker(sp_scene)
+    s = find_fixed_point(w3, _guess(sp_scene, w3.state_names()), SOLVER, fd_check=False)
+    x3 = dict(zip(w3.state_names(), s.x))
+    for name, value in zip(flat.state_names(), f.x):
+        assert abs(x3[name] - value) < 1e-9, name
+    assert abs(x3["lean_angle"]) < 1e-12 and abs(x3["lean_rate"]) < 1e-12
+    assert abs(s.period_s - f.period_s) < 1e-9
+    # the planar multipliers are among the 3D ones (the rest: the roll's)
+    for m in f.multipliers_variational:
+        assert np.min(np.abs(s.multipliers_variational - m)) < 1e-7
+
+
+# ---- an independent model: Newton's law for three point masses -------------------------
+
+class Reference:
+    """The walker of ``configs/hip_width.yaml`` from Newton's law (module docstring).
+
+    State ``[lean, swing, stance, rates]`` as walkerlab's (roll about the fall line, then
+    each leg's pitch in the rolled sagittal plane, from the vertical, positive with the foot
+    ahead); ``w`` the swing hip's offset along the hip axis (sign: the side)."""
+
+    def __init__(self, g, L, gamma, M, m, a):
+        self.g, self.L, self.gamma, self.M, self.m, self.a = g, L, gamma, M, m, a
+        self.s = np.array([math.cos(gamma), -math.sin(gamma), 0.0])   # the fall line
+        self.n = np.array([math.sin(gamma), math.cos(gamma), 0.0])    # the slope's normal
+        self.z = np.array([0.0, 0.0, 1.0])
+        S = self._skew(self.s)
+        Z = self._skew(self.z)
+        self.S, self.Z = S, Z
+
+    @staticmethod
+    def _skew(v):
+        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+    def _R(self, phi):
+        return Rotation.from_rotvec(phi * self.s).as_matrix()
+
+    def _T(self, th):
+        return Rotation.from_rotvec(th * self.z).as_matrix()
+
+    def terms(self, w):
+        """Each point as terms ``(leg index or None, c)``: ``R(phi) T(theta_leg) c`` (or
+        ``R(phi) c``); masses first (pelvis, stance leg's, swing leg's), then the swing foot.
+        Legs: 1 swing, 2 stance (state indices)."""
+        L, a = self.L, self.a
+        hip_st = [(2, np.array([0.0, L, 0.0]))]
+        pelvis = hip_st + [(None, w / 2 * self.z)]
+        m_st = [(2, np.array([0.0, a, 0.0]))]
+        hip_sw = hip_st + [(None, w * self.z)]
+        m_sw = hip_sw + [(1, np.array([0.0, -(L - a), 0.0]))]
+        foot = hip_sw + [(1, np.array([0.0, -L, 0.0]))]
+        return [(self.M, pelvis), (self.m, m_st), (self.m, m_sw)], foot
+
+    def kin(self, terms, q, dq):
+        """Position (3,), Jacobian (3, 3) and the velocity-product term ``Jdot dq`` (3,)."""
+        R = self._R(q[0])
+        r, J, h = np.zeros(3), np.zeros((3, 3)), np.zeros(3)
+        for leg, c in terms:
+            T = self._T(q[leg]) if leg is not None else np.eye(3)
+            p = R @ T @ c
+            r += p
+            d_phi = self.S @ p
+            J[:, 0] += d_phi
+            h += self.S @ self.S @ p * dq[0] ** 2
+            if leg is not None:
+                d_th = R @ self.Z @ T @ c
+                J[:, leg] += d_th
+                h += 2 * self.S @ d_th * dq[0] * dq[leg] + R @ self.Z @ self.Z @ T @ c * dq[leg] ** 2
+        return r, J, h
+
+    def rhs(self, w):
+        masses, _ = self.terms(w)
+        grav = np.array([0.0, -self.g, 0.0])
+
+        def f(t, x):
+            q, dq = x[:3], x[3:]
+            Mq, rhs = np.zeros((3, 3)), np.zeros(3)
+            for m, terms in masses:
+                _, J, h = self.kin(terms, q, dq)
+                Mq += m * J.T @ J
+                rhs += m * J.T @ (grav - h)
+            return np.concatenate([dq, np.linalg.solve(Mq, rhs)])
+        return f
+
+    def foot_height(self, w, x):
+        _, foot = self.terms(w)
+        return float(self.n @ self.kin(foot, x[:3], x[3:])[0])
+
+    def step(self, w, x):
+        """One step from just after a heel strike: ``(x just after the next one, period)``;
+        ``w`` this step's swing-hip offset (the next step's is ``-w``)."""
+        f = self.rhs(w)
+
+        def crossing(t, y):
+            return y[1] - y[2]
+        crossing.terminal, crossing.direction = True, 1
+
+        def strike(t, y):
+            return self.foot_height(w, y)
+        strike.terminal, strike.direction = True, -1
+        a = solve_ivp(f, (0, 5), x, method="DOP853", rtol=1e-13, atol=1e-13, events=crossing)
+        t1, y1 = a.t_events[0][0], a.y_events[0][0]
+        b = solve_ivp(f, (t1, t1 + 5), y1, method="DOP853", rtol=1e-13, atol=1e-13,
+                      events=strike)
+        t2, y = b.t_events[0][0], b.y_events[0][0]
+        return self.impact(w, y), t2
+
+    def impact(self, w, y):
+        """The plastic impact with the impulse at the new foot an unknown: extended
+        coordinates ``[q, p]`` (``p`` the old stance foot), ``M_e (dq+ - dq-) = E^T F``,
+        ``E dq+ = 0`` (the new foot at rest); then the legs' roles swap."""
+        masses, foot = self.terms(w)
+        q, dq = y[:3], y[3:]
+        Me = np.zeros((6, 6))
+        for m, terms in masses:
+            Je = np.hstack([self.kin(terms, q, dq)[1], np.eye(3)])
+            Me += m * Je.T @ Je
+        E = np.hstack([self.kin(foot, q, dq)[1], np.eye(3)])
+        K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
+        sol = np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
+                                                  np.zeros(3)]))
+        dqp = sol[:3]
+        return np.array([q[0], q[2], q[1], dqp[0], dqp[2], dqp[1]])
+
+    def on_surface(self, w, z):
+        """The state just after a heel strike of section coordinates ``z = [lean, stance,
+        rates]``: the swing foot (just lifted) on the slope behind, by Brent's method."""
+        def h(th_sw):
+            return self.foot_height(w, np.array([z[0], th_sw, z[1], 0, 0, 0]))
+        th_sw = brentq(h, -z[1] - 2 * self.gamma - 0.3, -z[1] - 2 * self.gamma + 0.05)
+        return np.array([z[0], th_sw, z[1], *z[2:]])
+
+
+HIP = dict(g=9.81, L=1.0, gamma=0.0174, M=10.0, m=5.0, a=0.5)
+
+
+@pytest.fixture(scope="module")
+def hip_width_gait():
+    scene = _scene("hip_width.yaml")
+    walker = build_walker(scene)
+    res = find_fixed_point(walker, _guess(scene, walker.state_names()), SOLVER, fd_check=False)
+    return walker, res, scene.walker.hip_width_m
+
+
+def test_hip_width_walker_conserves_energy_in_a_passive_swing(hip_width_gait):
+    walker = hip_width_gait[0]
+    x0 = np.array([0.03, -0.2, 0.17, 0.2, -0.6, -0.85])
+    sol = solve_ivp(walker.phases[0].flow, (0, 0.3), x0, method="DOP853", rtol=1e-13,
+                    atol=1e-13, dense_output=True)
+    ke, pe = walker.energies(sol.sol(np.linspace(0, 0.3, 40)))
+    total = np.asarray(ke) + np.asarray(pe)
+    assert np.max(np.abs(total - total[0])) < 1e-9
+
+
+def test_hip_width_walker_flow_and_impact_match_newtons_law(hip_width_gait):
+    """The generated flow and heel-strike map against the reference's (states with roll)."""
+    walker, _res, w = hip_width_gait
+    ref = Reference(**HIP)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        x = np.array([0.05, -0.2, 0.17, 0.3, -0.6, -0.85]) + 0.05 * rng.standard_normal(6)
+        assert np.max(np.abs(walker.phases[0].flow(0.0, x) - ref.rhs(w)(0.0, x))) < 1e-11
+        assert np.max(np.abs(walker.reset(x) - ref.impact(w, x))) < 1e-11
+
+
+@pytest.mark.slow  # ~20 s: the reference's own fixed point and central differences
+def test_hip_width_gait_and_multipliers_match_an_independent_model(hip_width_gait):
+    walker, res, w = hip_width_gait
+    ref = Reference(**HIP)
+
+    def stride(x):
+        x1, t1 = ref.step(w, x)
+        x2, t2 = ref.step(-w, x1)
+        return x2, t1 + t2
+
+    def F(z):
+        x = ref.on_surface(w, z)
+        x2 = stride(x)[0]
+        return np.array([x2[0], x2[2], *x2[3:]]) - z
+
+    z0 = np.array([res.x[0], res.x[2], *res.x[3:]])
+    sol = root(F, z0, method="hybr", options={"xtol": 1e-13})
+    x_ref = ref.on_surface(w, sol.x)
+    assert np.max(np.abs(x_ref - res.x)) < 1e-8
+    assert abs(stride(x_ref)[1] - res.period_s) < 1e-8
+    h = 1e-6
+    J = np.zeros((6, 6))
+    for j in range(6):
+        e = np.zeros(6)
+        e[j] = h
+        J[:, j] = (stride(x_ref + e)[0] - stride(x_ref - e)[0]) / (2 * h)
+    theirs = np.sort_complex(np.linalg.eigvals(J))
+    ours = np.sort_complex(np.asarray(res.multipliers_variational))
+    assert np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs))) < 1e-6
