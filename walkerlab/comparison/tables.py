@@ -97,7 +97,8 @@ def _step_lengths(tr: NamedTrajectory, bounds, stance, done, li: int) -> dict[st
             st = int(stance[k - 1])
             d = (heels[1 - st][:, i] - heels[st][:, bounds[k - 1]] if flat
                  else feet[0][:, i] - feet[1][:, i])
-            lengths.append(np.hypot(*d))
+            # in 3D the step's length along the walk, as a planar walker's (its width apart)
+            lengths.append(np.hypot(d[0], d[1]))
             left_step.append(stance[k - 1] != li)
         out["step_length_m"] = float(np.mean(lengths)) if lengths else np.nan
         lengths, left_step = np.array(lengths), np.array(left_step, dtype=bool)

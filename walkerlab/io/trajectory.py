@@ -117,6 +117,9 @@ def write_samples(f: h5py.Group, tr: NamedTrajectory) -> None:
     for name, xy in tr.points.items():
         put(g, f"points/{name}/x", xy[0], "m", f"{name} world x (downhill, horizontal)", dims=t)
         put(g, f"points/{name}/y", xy[1], "m", f"{name} world y (up)", dims=t)
+        if len(xy) > 2:  # a walker in 3D
+            put(g, f"points/{name}/z", xy[2], "m", f"{name} world z (lateral: to the right "
+                "of a walker facing downhill)", dims=t)
 
 
 def read_samples(f: h5py.Group) -> NamedTrajectory:
@@ -127,7 +130,8 @@ def read_samples(f: h5py.Group) -> NamedTrajectory:
     pts = {}
     if "points" in g:
         for name in g["points"]:
-            pts[name] = np.vstack([g[f"points/{name}/x"][()], g[f"points/{name}/y"][()]])
+            pts[name] = np.vstack([g[f"points/{name}/{c}"][()] for c in "xyz"
+                                   if c in g[f"points/{name}"]])
     return NamedTrajectory(
         time=g["time"][()], legs=legs,
         coordinates={n: g[f"coordinates/{n}"][()] for n in names},

@@ -331,10 +331,15 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
     ``*_com``) as dots.  The snapshots' colour is the time, shown by a colour bar.
     ``terrain`` (the contact walker's checkerboard, :func:`walkerlab.io.terrain.
     load_terrain`): its ground patches drawn under the slope line (:func:`draw_patches`).
+    A 3D walker's points are drawn in the sagittal plane (x, y).
     """
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 
+    if any(len(p) > 2 for p in tr.points.values()):  # a 3D walker: its sagittal view
+        from dataclasses import replace
+
+        tr = replace(tr, points={k: np.asarray(v)[:2] for k, v in tr.points.items()})
     steps = np.unique(tr.step_index)
     sel = np.isin(tr.step_index, steps[:2])
     idx = np.flatnonzero(sel)

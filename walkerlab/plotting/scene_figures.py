@@ -45,6 +45,11 @@ def trajectory_plan(trajs: dict[str, NamedTrajectory], title: str, slope_rad: fl
         ground = None if label == IDEAL_LABEL else terrain  # the contact walker's checkerboard
         plan.append((stem, partial(F.stick_diagram, tr, label, slope_rad=slope_rad,
                                    units=units, terrain=ground)))
+    if any(len(p) > 2 for tr in trajs.values() for p in tr.points.values()):
+        from walkerlab.plotting.spatial_figure import top_and_front
+
+        plan.append(("gait_3d_top_front", partial(top_and_front, trajs, title,
+                                                  units=units)))
     plan += [("fig7_angles_rates", partial(F.fig7_angles_rates, trajs, title, units=units)),
              ("fig9_limit_cycles", partial(F.fig9_limit_cycle, trajs, units=units)),
              ("fig10_energy", partial(F.fig10_energy, trajs, units=units))]
