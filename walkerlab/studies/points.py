@@ -256,7 +256,7 @@ def interleg_angle(walker, x: np.ndarray) -> float:
     x : ndarray, shape (2n,)
         State (``walker.state_names()``, [rad, rad/s]); only the feet's positions are read.
     """
-    d = float(np.hypot(*walker.points(x)["swing_foot"]))
+    d = float(np.hypot(*walker.points(x)["swing_foot"][:2]))  # sagittal (3D: width apart)
     L = float(walker.params["leg_length_m"])
     return float(2.0 * np.arcsin(min(1.0, d / (2.0 * L))))
 
@@ -380,7 +380,8 @@ def simulate_point(scene: Scene, guess, options: dict):
     cols.update(steps_completed=float(len(done)), t_end_s=float(last.t_end), nfev=float(traj.nfev))
     if done:
         per = np.array([s.period for s in done])
-        lengths = np.array([float(np.hypot(*walker.points(s.x_end)["swing_foot"])) for s in done])
+        lengths = np.array([float(np.hypot(*walker.points(s.x_end)["swing_foot"][:2]))
+                            for s in done])
         cols.update(mean_step_period_s=float(per.mean()), mean_step_length_m=float(lengths.mean()),
                     mean_hip_speed_m_per_s=float(lengths.mean() / per.mean()),
                     interleg_angle_last_rad=interleg_angle(walker, done[-1].x_end))
@@ -468,7 +469,7 @@ def contact_point(scene: Scene, guess, options: dict):
     seg = integrate_step(walker, fp.x, _solver(scene),
                          max_step_time=(scene.fixedpoint
                                         or FixedPointSettings()).max_step_time_s)
-    step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"]))
+    step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"][:2]))
     cols = {"guess_source": source, "ideal_step_length_m": step_length,
             "ideal_step_period_s": float(fp.period_s)}
     _cw, res, n_steps = contact_adapter(scene, fp.x, fp.period_s, step_length)

@@ -226,6 +226,25 @@ class BranchSystem:
         self.n_maps = 0
         self.n_variational = 0
         self._last: dict = {}
+        self._held: tuple | None = None  # the neutral coordinates: positions, values
+
+    def _hold(self, w: HybridWalker, z: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """A walker's neutral coordinates (:attr:`HybridWalker.neutral`, the 3D wheel's
+        heading: its gaits form a family along it) held at their first iterate's values:
+        their equations of ``F`` (singular along the family) replaced by ``z_i - z_i0``, so
+        the branch follows the parameter, not the family."""
+        if not w.neutral:
+            return r
+        if self._held is None:
+            names = w.state_names()
+            n2 = len(names)
+            kept = [int(round(v)) for v in w.section(np.arange(n2, dtype=float))]
+            pos = [kept.index(names.index(c)) for c in w.neutral]
+            self._held = (pos, np.asarray(z, float)[pos].copy())
+        pos, val = self._held
+        r = np.asarray(r, float).copy()
+        r[pos] = np.asarray(z, float)[pos] - val
+        return r
 
     def residual(self, z: np.ndarray, p: float) -> np.ndarray:
         """``F(z, p) = section(P^k(from_section(z); p)) - z`` (m,) [rad, rad/s] (module
@@ -245,7 +264,7 @@ class BranchSystem:
                             steps_per_map=self.family.steps(w),
                             max_step_time=self.family.max_step_time)
         self.n_maps += self.k
-        r = np.asarray(w.section(xk), float) - z
+        r = self._hold(w, z, np.asarray(w.section(xk), float) - z)
         self._last.clear()
         self._last[key] = r
         return r.copy()
@@ -294,12 +313,18 @@ class BranchSystem:
         D_from = numeric_jacobian(w.from_section, np.asarray(z, float))
         D_sec = numeric_jacobian(w.section, np.asarray(xk, float))
         M = D_sec @ J @ D_from
-        return {"x": x, "period": T, "J": J, "M": M, "Fz": M - np.eye(z.size),
+        Fz = M - np.eye(z.size)
+        if w.neutral:  # their equations held (:meth:`_hold`): unit rows
+            self._hold(w, z, np.zeros(z.size))
+            pos = self._held[0]
+            Fz[pos, :] = 0.0
+            Fz[pos, pos] = 1.0
+        return {"x": x, "period": T, "J": J, "M": M, "Fz": Fz,
                 "orbit": np.array([sg.x_start for sg in segs]),
-                "F": np.asarray(w.section(xk), float) - z, "walker": w}
+                "F": self._hold(w, z, np.asarray(w.section(xk), float) - z), "walker": w}
 
 
-def test_functions(M: np.ndarray) -> dict:
+def test_functions(M: np.ndarray, neutral: int = 0) -> dict:
     """Fold, period-doubling and Neimark-Sacker test functions of the reduced Jacobian.
 
     ``det(M - I)``, ``det(M + I)`` and the bialternate product ``prod_{i<j} (mu_i mu_j -
@@ -310,6 +335,11 @@ def test_functions(M: np.ndarray) -> dict:
     ----------
     M : ndarray, shape (m, m)
         Reduced Jacobian ``F_z + I`` (dimensionless in the section's coordinates).
+    neutral : int
+        Multipliers that are 1 on the whole branch (a walker's neutral coordinates, the 3D
+        wheel's heading): the ``neutral`` nearest 1 are left out of the three products
+        (``prod (mu_i - 1)`` for the fold, ``prod (mu_i + 1)``), else the fold's would be 0
+        everywhere.
 
     Returns
     -------
@@ -318,6 +348,15 @@ def test_functions(M: np.ndarray) -> dict:
         eigenvalues, complex ndarray of shape (m,)).
     """
     mu = np.linalg.eigvals(M)
+    if neutral:
+        keep = np.delete(mu, np.argsort(np.abs(mu - 1.0), kind="stable")[:neutral])
+        m = keep.size
+        pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
+        prod = np.array([keep[i] * keep[j] for i, j in pairs]) if pairs else np.zeros(0)
+        return {"fold": float(np.prod(keep - 1.0).real),
+                "period_doubling": float(np.prod(keep + 1.0).real),
+                "neimark_sacker": float(np.prod(prod - 1.0).real) if pairs else 1.0,
+                "mu": mu}
     m = mu.size
     pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
     prod = np.array([mu[i] * mu[j] for i, j in pairs]) if pairs else np.zeros(0)

@@ -217,7 +217,7 @@ def branch_point(sys: BranchSystem, u: np.ndarray, info: dict,
     t = _null_tangent(info["Fz"], Fp * s)
     if t_prev is not None and t @ t_prev < 0:
         t = -t
-    tests = test_functions(info["M"])
+    tests = test_functions(info["M"], len(info["walker"].neutral))
     return BranchPoint(p=float(u[-1] * s), z=u[:-1].copy(), x=info["x"],
                        period_s=float(info["period"]),
                        multipliers=sort_multipliers(np.linalg.eigvals(info["J"])),
@@ -284,7 +284,7 @@ def locate_special(sys: BranchSystem, a: BranchPoint, b_s: float, kind: str, gue
             raise MapFailed("correction failed while locating a special point")
         if kind in VALIDITY:
             return VALIDITY[kind][0](sys, u, sc)
-        return test_functions(info["M"])[kind]
+        return test_functions(info["M"], len(info["walker"].neutral))[kind]
 
     try:
         s_star = brentq(f, 0.0, b_s, xtol=1e-12, rtol=4 * np.finfo(float).eps)

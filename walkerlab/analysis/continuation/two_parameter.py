@@ -73,7 +73,7 @@ def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
 
     def psi(u):
         info = sys.full(u[:-1], u[-1] * p_scale)
-        return test_functions(info["M"])[kind], info
+        return test_functions(info["M"], len(info["walker"].neutral))[kind], info
 
     def G(u):
         try:
