@@ -113,7 +113,8 @@ class Reference:
             if leg is not None:
                 d_th = R @ self.Z @ T @ c
                 J[:, leg] += d_th
-                h += 2 * self.S @ d_th * dq[0] * dq[leg] + R @ self.Z @ self.Z @ T @ c * dq[leg] ** 2
+                h += (2 * self.S @ d_th * dq[0] * dq[leg]
+                      + R @ self.Z @ self.Z @ T @ c * dq[leg] ** 2)
         return r, J, h
 
     def rhs(self, w):

@@ -50,66 +50,75 @@ def gait(wheel):
 
 # ---- an independent model: a rigid body about a fixed point (scipy rotations) ----------
 
-NRM = np.array([math.sin(SLOPE), math.cos(SLOPE), 0.0])
-HUB_B = np.array([0.0, L, 0.0])                       # hub from the stance foot, body frame
-I_CM_B = np.diag([I_DIAM, I_DIAM, I_AXLE])           # axle along body z
+class Wheel:
+    """The spoked wheel as a rigid body turning about its stance foot: Euler's equations in
+    the body frame (axle along body z, the stance spoke along -y), the impact by the angular
+    momentum about the new foot, the next spoke's frame turned by a spoke."""
 
+    def __init__(self, slope=SLOPE, I_axle=I_AXLE, I_diam=I_DIAM):
+        self.slope = slope
+        self.n = np.array([math.sin(slope), math.cos(slope), 0.0])
+        self.hub = np.array([0.0, L, 0.0])
+        self.I_cm = np.diag([I_diam, I_diam, I_axle])
+        h = self.hub
+        self.J = self.I_cm + M * (h @ h * np.eye(3) - np.outer(h, h))
+        self.start_R = Rotation.from_rotvec([0, 0, ALPHA - slope]).as_matrix()
 
-def _foot_b(k):  # foot of the spoke k ahead of the stance spoke, from the stance foot
-    a = 2 * k * ALPHA
-    return HUB_B + L * np.array([math.sin(a), -math.cos(a), 0.0])
+    def foot(self, k):  # foot of the spoke k ahead of the stance spoke, from the stance foot
+        a = 2 * k * ALPHA
+        return self.hub + L * np.array([math.sin(a), -math.cos(a), 0.0])
 
+    def rhs(self, t, y):
+        R, Om = y[:9].reshape(3, 3), y[9:]
+        torque = np.cross(self.hub, R.T @ np.array([0.0, -M * G, 0.0]))
+        dOm = np.linalg.solve(self.J, torque - np.cross(Om, self.J @ Om))
+        dR = R @ np.array([[0, -Om[2], Om[1]], [Om[2], 0, -Om[0]], [-Om[1], Om[0], 0]])
+        return np.concatenate([dR.ravel(), dOm])
 
-J_B = I_CM_B + M * (HUB_B @ HUB_B * np.eye(3) - np.outer(HUB_B, HUB_B))
+    def step(self, R, Om):
+        """(R, body rates) just after a heel strike -> the next one's, relabelled."""
+        def strike(t, y):
+            return self.n @ (y[:9].reshape(3, 3) @ self.foot(1))
+        strike.terminal, strike.direction = True, -1
+        sol = solve_ivp(self.rhs, (0, 5), np.concatenate([R.ravel(), Om]), method="DOP853",
+                        rtol=1e-13, atol=1e-13, events=strike)
+        y = sol.y_events[0][0]
+        R, Om = y[:9].reshape(3, 3), y[9:]
+        w = R @ Om
+        hub, new = R @ self.hub, R @ self.foot(1)
+        d = hub - new
+        I_cm = R @ self.I_cm @ R.T
+        H = I_cm @ w + M * np.cross(d, np.cross(w, hub))
+        w_plus = np.linalg.solve(I_cm + M * (d @ d * np.eye(3) - np.outer(d, d)), H)
+        R_new = R @ Rotation.from_rotvec([0, 0, 2 * ALPHA]).as_matrix()
+        return R_new, R_new.T @ w_plus, float(sol.t_events[0][0])
 
+    def upright_gait(self):
+        """The straight-downhill gait: its spin rate after heel strike (Brent on the one
+        step map in the plane) and the state."""
+        from scipy.optimize import brentq
 
-def _rhs(t, y):
-    R, Om = y[:9].reshape(3, 3), y[9:]
-    torque = np.cross(HUB_B, R.T @ np.array([0.0, -M * G, 0.0]))
-    dOm = np.linalg.solve(J_B, torque - np.cross(Om, J_B @ Om))
-    dR = R @ np.array([[0, -Om[2], Om[1]], [Om[2], 0, -Om[0]], [-Om[1], Om[0], 0]])
-    return np.concatenate([dR.ravel(), dOm])
+        def gap(rate):
+            return self.step(self.start_R, np.array([0, 0, -rate]))[1][2] + rate
+        rate = brentq(gap, 1.0, 5.0, xtol=1e-15)  # (slower: it rolls back)
+        return self.start_R, np.array([0.0, 0.0, -rate])
 
+    def multipliers(self, h=1e-6):
+        R0, Om0 = self.upright_gait()
 
-def _strike(t, y):
-    return NRM @ (y[:9].reshape(3, 3) @ _foot_b(1))
+        def chart(dx):
+            return R0 @ Rotation.from_rotvec(dx[:3]).as_matrix(), Om0 + dx[3:]
 
+        def back(R, Om):
+            return np.concatenate([Rotation.from_matrix(R0.T @ R).as_rotvec(), Om - Om0])
 
-_strike.terminal, _strike.direction = True, -1
-
-
-def _step(R, Om):
-    """(R, body rates) just after a heel strike -> the next one's, relabelled."""
-    sol = solve_ivp(_rhs, (0, 5), np.concatenate([R.ravel(), Om]), method="DOP853",
-                    rtol=1e-13, atol=1e-13, events=_strike)
-    y = sol.y_events[0][0]
-    R, Om = y[:9].reshape(3, 3), y[9:]
-    w = R @ Om
-    hub, new = R @ HUB_B, R @ _foot_b(1)
-    d = hub - new
-    I_cm = R @ I_CM_B @ R.T
-    H = I_cm @ w + M * np.cross(d, np.cross(w, hub))
-    w_plus = np.linalg.solve(I_cm + M * (d @ d * np.eye(3) - np.outer(d, d)), H)
-    R_new = R @ Rotation.from_rotvec([0, 0, 2 * ALPHA]).as_matrix()
-    return R_new, R_new.T @ w_plus, float(sol.t_events[0][0])
-
-
-def _reference_multipliers(h=1e-6):
-    R0 = Rotation.from_rotvec([0, 0, ALPHA - SLOPE]).as_matrix()
-    Om0 = np.array([0.0, 0.0, -W_PLUS])
-
-    def chart(dx):
-        return R0 @ Rotation.from_rotvec(dx[:3]).as_matrix(), Om0 + dx[3:]
-
-    def back(R, Om):
-        return np.concatenate([Rotation.from_matrix(R0.T @ R).as_rotvec(), Om - Om0])
-
-    J = np.zeros((6, 6))
-    for j in range(6):
-        e = np.zeros(6)
-        e[j] = h
-        J[:, j] = (back(*_step(*chart(e))[:2]) - back(*_step(*chart(-e))[:2])) / (2 * h)
-    return np.linalg.eigvals(J), _step(R0, Om0)
+        J = np.zeros((6, 6))
+        for j in range(6):
+            e = np.zeros(6)
+            e[j] = h
+            J[:, j] = (back(*self.step(*chart(e))[:2])
+                       - back(*self.step(*chart(-e))[:2])) / (2 * h)
+        return np.linalg.eigvals(J), self.step(R0, Om0), Om0
 
 
 def test_upright_3d_wheel_rolls_downhill_as_the_planar_wheel(gait):
@@ -128,9 +137,10 @@ def test_upright_3d_wheel_rolls_downhill_as_the_planar_wheel(gait):
 
 
 def test_3d_wheel_multipliers_match_an_independent_rigid_body_model(gait):
-    ref, (R1, Om1, period) = _reference_multipliers()
+    ref, (R1, Om1, period), Om0 = Wheel().multipliers()
     R0 = Rotation.from_rotvec([0, 0, ALPHA - SLOPE]).as_matrix()
-    assert np.max(np.abs(R1 - R0)) < 1e-10 and abs(Om1[2] + W_PLUS) < 1e-10  # a fixed point
+    assert np.max(np.abs(R1 - R0)) < 1e-10 and abs(Om1[2] - Om0[2]) < 1e-10  # a fixed point
+    assert abs(Om0[2] + W_PLUS) < 1e-10
     assert abs(period - gait.period_s) < 1e-10
     ours = np.sort_complex(np.asarray(gait.multipliers_variational))
     theirs = np.sort_complex(ref)
@@ -141,6 +151,23 @@ def test_3d_wheel_multipliers_match_an_independent_rigid_body_model(gait):
     assert np.min(np.abs(ours - math.cos(2 * ALPHA) ** 2)) < 1e-8
     assert gait.neutral == ("heading_angle",)
     assert abs(gait.neutral_multipliers[0] - 1.0) < 1e-8
+
+
+def test_the_disc_wheel_rolls_stably_above_its_critical_slope_as_the_reference_says():
+    """configs/rimless_wheel_3d_disc.yaml (a disc's inertias, 0.2 rad): stable, its
+    multipliers (a complex pair: the wobble) those of the independent model."""
+    from walkerlab.cli.options import load
+
+    scene = load(str(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
+    walker = build_walker(scene)
+    solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    res = find_fixed_point(walker, np.array([0, 0, ALPHA - 0.2, 0, 0, -1.9]), solver,
+                           fd_check=False)
+    assert res.stable and abs(res.neutral_multipliers[0] - 1.0) < 1e-8
+    ref = Wheel(slope=0.2, I_axle=0.5, I_diam=0.25).multipliers()[0]
+    ours = np.sort_complex(np.asarray(res.multipliers_variational))
+    assert np.max(np.abs(ours - np.sort_complex(ref))) < 1e-5
+    assert np.sum(np.abs(ours.imag) > 0.1) == 2  # the wobble
 
 
 def test_a_3d_wheel_at_another_heading_is_a_member_of_the_family(wheel):
@@ -169,21 +196,23 @@ def test_3d_wheel_impact_conserves_angular_momentum_about_the_new_foot(wheel):
     xp = wheel.reset(x)
 
     def rot(q):
-        nrm = NRM
+        nrm = np.array([math.sin(SLOPE), math.cos(SLOPE), 0.0])
         fall = np.array([math.cos(SLOPE), -math.sin(SLOPE), 0.0])
         return (Rotation.from_rotvec(q[0] * nrm) * Rotation.from_rotvec(q[1] * fall)
                 * Rotation.from_rotvec([0, 0, q[2]])).as_matrix()
 
     def omega(q, dq):
         fall = np.array([math.cos(SLOPE), -math.sin(SLOPE), 0.0])
-        A = Rotation.from_rotvec(q[0] * NRM)
+        nrm = np.array([math.sin(SLOPE), math.cos(SLOPE), 0.0])
+        A = Rotation.from_rotvec(q[0] * nrm)
         B = A * Rotation.from_rotvec(q[1] * fall)
-        return NRM * dq[0] + A.apply(fall) * dq[1] + B.apply([0, 0, 1]) * dq[2]
+        return nrm * dq[0] + A.apply(fall) * dq[1] + B.apply([0, 0, 1]) * dq[2]
 
+    ref = Wheel()
     R = rot(x[:3])
-    hub, new = R @ HUB_B, R @ _foot_b(1)
+    hub, new = R @ ref.hub, R @ ref.foot(1)
     w_minus, w_plus = omega(x[:3], x[3:]), omega(xp[:3], xp[3:])
-    I_cm = R @ I_CM_B @ R.T
+    I_cm = R @ ref.I_cm @ R.T
     d = hub - new
     H_minus = I_cm @ w_minus + M * np.cross(d, np.cross(w_minus, hub))
     H_plus = I_cm @ w_plus + M * np.cross(d, np.cross(w_plus, d))

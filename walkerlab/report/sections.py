@@ -18,8 +18,8 @@ import numpy as np
 from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
     ground_contact_text,
-    zero_dynamics_text,
     neutral_multipliers_text,
+    zero_dynamics_text,
     zero_multipliers_text,
 )
 from walkerlab.units import Units, for_scene
