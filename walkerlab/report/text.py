@@ -74,6 +74,29 @@ def neutral_multipliers_text(gait) -> str:
             f"{'it' if len(pos) == 1 else 'them'} (Coleman, Chatterjee & Ruina 1997)")
 
 
+def unstable_modes_text(gait, state_names: list[str]) -> list[str]:
+    """One line per multiplier outside the unit circle (the neutral ones set aside): its
+    value and the state components its eigenvector (of the stored ``DP``) moves most - the
+    lean for a 3D walker's lateral mode (Kuo 1999), the legs' rates for a planar one's."""
+    J = getattr(gait, "jacobian", None)
+    if J is None or not np.all(np.isfinite(J)):
+        return []
+    mu, V = np.linalg.eig(J)
+    order = np.argsort(-np.abs(mu), kind="stable")
+    skip = set(np.argsort(np.abs(mu - 1.0), kind="stable")[:len(gait.neutral)].tolist())
+    out = []
+    for i in order:
+        if abs(mu[i]) <= 1.0 or int(i) in skip:
+            continue
+        v = np.abs(V[:, i])
+        v = v / v.max()
+        names = [state_names[k] for k in np.argsort(-v, kind="stable") if v[k] >= 0.3]
+        out.append(f"  unstable mode {mu[i].real:+.6g}"
+                   + (f"{mu[i].imag:+.3g}j" if abs(mu[i].imag) > 1e-12 else "")
+                   + f": its eigenvector moves {', '.join(names)} most")
+    return out
+
+
 def ground_contact_problems(g, u) -> list[str]:
     """Why a gait's ground contact is not unilateral (``g``: the stored check,
     :class:`~walkerlab.io.schemas.fixedpoint.GroundContactRecord`; ``u``: the units)."""
@@ -210,6 +233,7 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     if fp.neutral:
         why = f"{neutral_multipliers_text(fp)}; {why}"
     lines.append(f"verdict: {verdict} (largest variational |multiplier| = {mod:.6f}; {why})")
+    lines += unstable_modes_text(fp, fp.state_names)
     if fp.zero_dynamics is not None:
         lines += zero_dynamics_text(fp.zero_dynamics)
     if fp.ground_contact is not None:

@@ -358,6 +358,7 @@ class GaitResult:
     step_swing_legs: tuple = ()
     ground_contact: GroundContactRecord | None = None
     neutral: tuple = ()
+    jacobian: np.ndarray | None = None
 
     def max_abs_multiplier(self) -> float:
         """Largest |Floquet multiplier| (variational), the neutral ones (:attr:`neutral`:
@@ -388,7 +389,8 @@ def _gait(g, names: list[str]) -> GaitResult:
         max_difference=float(g["floquet/max_difference"][()]),
         stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")),
         ground_contact=_ground(g), **_stride(g),
-        neutral=tuple(str(v) for v in g["floquet"].attrs.get("neutral", ())))
+        neutral=tuple(str(v) for v in g["floquet"].attrs.get("neutral", ())),
+        jacobian=g["floquet/variational/jacobian"][()])
 
 
 def _stride(g) -> dict:
