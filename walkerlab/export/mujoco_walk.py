@@ -449,7 +449,10 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
     phi = 2.0 * math.atan2(float(qy), float(qw))  # the plane turned about y by phi
     nrm = np.array([math.sin(phi), 0.0, math.cos(phi)])
     tan = np.array([math.cos(phi), 0.0, -math.sin(phi)])
-    hub = int(model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")])
+    slide = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")
+    free = slide < 0  # a wheel in 3D: a free joint, its position the first three of qpos
+    hub = int(model.jnt_qposadr[slide if not free else mujoco.mj_name2id(
+        model, mujoco.mjtObj.mjOBJ_JOINT, "free")])
     mujoco.mj_forward(model, data)
     tip0 = next(g for g, k in tips.items() if k == 0)
     L = float(np.linalg.norm(data.geom_xpos[tip0] - data.xpos[model.geom_bodyid[tip0]]))
@@ -465,7 +468,8 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
             g = next(g for g, k in tips.items() if k == stance)
             pos.append(float(data.geom_xpos[g] @ tan))
         g = next(g for g, k in tips.items() if k == stance)
-        hub_x = np.array([data.qpos[hub], 0.0, data.qpos[hub + 1]])
+        hub_x = (np.array(data.qpos[hub:hub + 3]) if free
+                 else np.array([data.qpos[hub], 0.0, data.qpos[hub + 1]]))
         if (hub_x - data.geom_xpos[g]) @ nrm < 0.5 * L:  # above its stance tip (stairs,
             # a profile: the ground under the hub is the stance tip's)
             fell = True

@@ -15,8 +15,8 @@ from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
 
-__all__ = ["WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel_chord_m", "wheel_mjcf_text",
-           "wheel_urdf_text"]
+__all__ = ["TO_MUJOCO", "WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe",
+           "wheel3d_mjcf_text", "wheel_chord_m", "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
@@ -180,6 +180,131 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
     out += ["    </body>", "  </worldbody>"]
     if qpos is not None:
         qv = (0.0, 0.0, 0.0) if qvel is None else qvel
+        out += ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
+                "  </keyframe>"]
+    return "\n".join(out + ["</mujoco>", ""])
+
+
+#: walkerlab's world axes (x downhill, y up, z to the right) in MuJoCo's (x downhill, z up):
+#: ``X = x``, ``Y = -z``, ``Z = y`` (a rotation: right-handed both)
+TO_MUJOCO = ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0))
+
+
+def wheel3d_keyframe(points, velocities, x, slope_rad: float,
+                     tip_radius_m: float) -> tuple[tuple, tuple]:
+    """The ``gait`` keyframe of a 3D spoked wheel (``walker.space: 3d``) at the rigid state
+    ``x`` (just after a heel strike): its free joint's ``qpos`` (hub position [m], then
+    orientation as the unit quaternion ``w, x, y, z``) and ``qvel`` (hub velocity [m/s] in
+    world axes, angular velocity [rad/s] in the body's), MuJoCo's axes (:data:`TO_MUJOCO`).
+
+    The body's frame and rates are read from the walker's own points (the stance foot, the
+    hub, the axle's tip) and their velocities - a rigid body's, whatever its coordinates:
+    body y from the stance foot to the hub (the stance spoke), body z along the axle.  The
+    stance tip's sphere (radius ``tip_radius_m``) touches the slope at the origin.
+
+    Parameters
+    ----------
+    points, velocities : callable ``x -> dict[str, ndarray (3,)]``
+        The rigid 3D wheel's generated ``points`` and ``point_velocities``
+        (:func:`walkerlab.codegen.cache.functions`): ``stance_foot``, ``hip``, ``axle_tip``.
+    x : ndarray (2n,)
+    slope_rad : float
+    tip_radius_m : float
+
+    Returns
+    -------
+    (qpos (7,), qvel (6,)) : tuple of float
+    """
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    C = np.array(TO_MUJOCO)
+    pts = {k: np.asarray(v, float) for k, v in points(x).items()}
+    vel = {k: np.asarray(v, float) for k, v in velocities(x).items()}
+    d1 = pts["hip"] - pts["stance_foot"]
+    d2 = pts["axle_tip"] - pts["hip"]
+    ey, ez = d1 / np.linalg.norm(d1), d2 / np.linalg.norm(d2)
+    R = np.column_stack([np.cross(ey, ez), ey, ez])         # walkerlab body -> world
+
+    def skew(v):
+        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    # v_p - v_q = omega x (p - q) for the two spans: least squares (exact for a rigid body)
+    A = np.vstack([-skew(d1), -skew(d2)])
+    b = np.concatenate([vel["hip"] - vel["stance_foot"], vel["axle_tip"] - vel["hip"]])
+    omega = np.linalg.lstsq(A, b, rcond=None)[0]
+    nrm = np.array([math.sin(slope_rad), math.cos(slope_rad), 0.0])
+    # the stance tip's sphere centre at L - r along the spoke, its lowest point at the origin
+    hub = d1 * (1.0 - tip_radius_m / np.linalg.norm(d1)) + tip_radius_m * nrm
+    Rm = C @ R @ C.T                                        # MuJoCo body -> MuJoCo world
+    qx, qy, qz, qw = Rotation.from_matrix(Rm).as_quat()
+    v_hub = np.cross(omega, hub)                            # turning about the foot
+    qpos = (*(C @ hub), qw, qx, qy, qz)
+    qvel = (*(C @ v_hub), *(Rm.T @ (C @ omega)))
+    return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
+
+
+def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
+                      timestep_s: float = 1e-4, solref=(0.002, 1.0),
+                      friction: float = 1.0) -> str:
+    """A spoked wheel in three dimensions (``walker.space: 3d``) as a MuJoCo model (MJCF):
+    the ground plane tilted by the slope, the wheel one body on a free joint ``free`` (no
+    plane constraint), its axle along the body's y (MuJoCo axes, :data:`TO_MUJOCO`), the
+    inertia ``I_diam``, ``I_hub``, ``I_diam`` about body x, y, z, each spoke a capsule (no
+    contact) and a sphere ``spoke<k>_tip`` at its tip.  The tips' contact is ``condim 3``:
+    sliding friction only, no torsional or rolling friction, as the rigid model's stance
+    foot turns freely about every axis (Coleman, Chatterjee & Ruina 1997).
+
+    Parameters
+    ----------
+    data, name, version
+        The wheel (:data:`walkerlab.walker.description.SPATIAL_SPOKED_PARAMS`), model name,
+        walkerlab version.
+    qpos, qvel : sequence of 7 and 6 floats, optional
+        The ``gait`` keyframe (:func:`wheel3d_keyframe`).
+    timestep_s : float
+        Integration step [s].
+    solref : (float, float)
+        MuJoCo's contact time constant [s] and damping ratio [-].
+    friction : float
+        Sliding friction coefficient [-].
+
+    Returns
+    -------
+    str
+        MJCF XML (MuJoCo XML Reference).
+    """
+    p = dict(zip(data.structure.param_names, data.params))
+    n, L, phi = data.structure.spokes, p["L"], data.slope_rad
+    r = WHEEL_TIP_FRACTION * L
+    I_axle = p["I_hub"] if p["I_hub"] > 0.0 else MJCF_MIN_INERTIA_KG_M2
+    out = [comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (MJCF): "
+                   f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
+                   f"{num(I_axle)} kg m^2 about the axle and {num(p['I_diam'])} kg m^2 about "
+                   f"a diameter; slope {num(phi)} rad; a free body, no plane constraint"),
+           f"<mujoco model={quoteattr(name)}>",
+           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
+           f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(timestep_s)}" '
+           'integrator="implicitfast"/>',
+           f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
+           f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
+           '</default>',
+           "  <worldbody>",
+           f'    <geom name="ground" type="plane" size="400 400 0.1" euler="0 {num(phi)} 0" '
+           'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
+           '    <body name="hub" pos="0 0 0">',
+           '      <freejoint name="free"/>',
+           f'      <inertial pos="0 0 0" mass="{num(p["M_hub"])}" '
+           f'diaginertia="{nums(p["I_diam"], I_axle, p["I_diam"])}"/>',
+           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>']
+    for k in range(n):
+        tx, tz = _spoke_tip({"n": n}, k, L - r)
+        out += [f'      <geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
+                f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
+                f'      <geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
+                f'pos="{nums(tx, 0, tz)}" contype="1" conaffinity="1"/>']
+    out += ["    </body>", "  </worldbody>"]
+    if qpos is not None:
+        qv = (0.0,) * 6 if qvel is None else qvel
         out += ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
                 "  </keyframe>"]
     return "\n".join(out + ["</mujoco>", ""])

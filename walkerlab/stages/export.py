@@ -21,6 +21,7 @@ from pathlib import Path
 
 import walkerlab
 from walkerlab.config import Scene
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams import (
     ADAMS_FILES,
     acf_text,
@@ -208,6 +209,35 @@ def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
     runpaths.atomic_texts(files)  # the wheel and its keyframe: both or neither
     return Exported(path, _xml_lines(WHEEL_URDF_OMISSIONS if fmt == "urdf" else (), scene),
                     None if key is None else _step_period(ideal))
+
+
+def _run_wheel_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
+                  ) -> Exported:
+    """A spoked wheel in 3D (``walker.space: 3d``): the MJCF's free body
+    (:func:`walkerlab.export.spoked.wheel3d_mjcf_text`), the rigid gait as its ``gait``
+    keyframe (:func:`~walkerlab.export.spoked.wheel3d_keyframe`), the scene's static friction
+    coefficient on the spoke tips; the other formats as the capability table has them."""
+    from walkerlab.codegen.cache import functions
+    from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel3d_keyframe, wheel3d_mjcf_text
+
+    kind = data.structure.kind
+    kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
+    mu = (scene.contact or ContactSettings()).mu_static
+    version = walkerlab.__version__
+    if walker_only:
+        ideal, text = None, wheel3d_mjcf_text(data, name, version, friction=mu)
+    else:
+        f = functions(data)
+        r = WHEEL_TIP_FRACTION * data.leg_length_m
+
+        def build(ideal):
+            qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
+                                          data.slope_rad, r)
+            return wheel3d_mjcf_text(data, name, version, qpos, qvel, friction=mu)
+        ideal, text = _gait(scene, runs_root, _with_ideal(scene, build))
+    path = export_path(scene, runs_root, fmt, claim=True)
+    runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
+    return Exported(path, _xml_lines((), scene), None if ideal is None else _step_period(ideal))
 
 
 def _gait_scene(scene: Scene, mb, data, runs_root, options=None):
@@ -422,4 +452,6 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
 #: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> the export's writer of that kind
 _WRITERS = {"straight_legs": _run_links, "locking_knees": _run_links, "flat_feet": _run_links,
             "free_joints": _run_links, "hinged_torso": _run_links,
-            "rolling_polygon": _run_wheel}
+            "rolling_polygon": _run_wheel, "rolling_polygon_3d": _run_wheel_3d,
+            # refused before it is reached (its cells: walker.space: 3d)
+            "straight_legs_3d": _run_links}

@@ -426,7 +426,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
                               "later step (walk it in the rigid model: fixedpoint, "
                               "simulate)"),
-        ("walk", "mjcf"): SPATIAL_EXPORT,
+        # the MJCF: a free body on its spoke tips (walkerlab.export.spoked.wheel3d_mjcf_text)
         ("walk", "urdf"): SPATIAL_EXPORT,
         ("walk", "adams"): SPATIAL_EXPORT,
         ("walk", "osim"): SPATIAL_EXPORT,
