@@ -96,7 +96,8 @@ def test_the_transcription_is_reached_through_the_walker_kind():
     from walkerlab.walker.kinds import KINDS
 
     assert set(PARTS) == {k for k, kind in KINDS.items() if kind.supports("walk", "optimize")}
-    assert set(KINDS) - set(PARTS) == {"rolling_polygon", "rolling_polygon_3d", "hinged_torso"}
+    assert set(KINDS) - set(PARTS) == {"rolling_polygon", "rolling_polygon_3d", "hinged_torso",
+                                       "straight_legs_3d"}
     assert not KINDS["rolling_polygon"].supports("walk", "optimize")
     mods = sorted((PKG / "optimal").rglob("*.py")) + [PKG / "stages" / "optimize.py"]
     bad = {str(p.relative_to(PKG)): got for p in mods

@@ -152,9 +152,9 @@ class _Suggester:
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
 #: the user guide, docs/user_guide/walkers.md (one place: update it as the walker vocabulary grows)
 WALKER_VOCABULARY = (
-    "a walker today is planar but for the 3D rimless wheel: model compass_gait (hip mass, "
-    "one point mass per "
-    "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
+    "a walker today is planar but for two in 3D (space: 3d): model compass_gait (hip mass, "
+    "one point mass per leg; space: 3d with hip_width_m: the walker in three dimensions) "
+    "or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee "
     "(with an optional spring-damper) or free knees (knee.lock: free), foot "
     "kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "

@@ -61,8 +61,6 @@ class CompassGaitParams(_Actuated):
         if self.space == "2d" and self.hip_width_m:
             raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                              "walker's hips are one point)")
-        if self.space == "3d" and self.actuation is not None:
-            raise ValueError("walker.actuation: a 3D walker is passive so far (space: 3d)")
         return self
 
     @property

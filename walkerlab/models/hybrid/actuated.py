@@ -347,8 +347,18 @@ class _FlatFeet:
         return actuate_flat(walker, data, spec)
 
 
+def _torque_feature(joint: str) -> str:
+    """The capability table's feature of a torque at ``joint`` (``hip``: the hip torque;
+    ``stance_hip``/``swing_hip``: between a torso and a leg; a knee's, an ankle's)."""
+    for part in ("knee", "ankle"):
+        if part in joint:
+            return f"{part}_torque"
+    return "hip_torque" if joint == "hip" else "torso_torque"
+
+
 class _RollingPolygon:
-    """A spoked wheel: one rigid body, no joint - every actuator refused by the table."""
+    """A walker without actuators so far (a spoked wheel: one rigid body, no joint; a walker
+    in 3D) - every actuator refused by the table."""
 
     hip_spring = False
 
@@ -356,7 +366,8 @@ class _RollingPolygon:
         """Refuse the first actuator ``spec`` asks for (one line, naming its field)."""
         kind = data.structure.kind
         for i, t in enumerate(spec.torques):
-            kind.require(f"{t.joint}_torque", "rigid", f"walker.actuation.torques.{i}.joint")
+            kind.require(_torque_feature(t.joint), "rigid",
+                         f"walker.actuation.torques.{i}.joint")
         for name in ("push_off", "ankle_push_off"):
             if getattr(spec, name) is not None:
                 kind.require(name, "rigid", f"walker.actuation.{name}")
