@@ -274,3 +274,27 @@ def test_the_3d_wheels_mjcf_walks_in_mujoco_as_the_rigid_model_predicts(tmp_path
     # soft contact (2 ms) and 1 mm tip spheres against the rigid impact: a few mrad
     assert np.max(np.abs(np.array(lean[:6]) - ours)) < 3e-3
     assert np.max(np.abs(ours)) > 0.04  # the push was felt: the comparison is not of zeros
+
+
+def test_the_3d_wheels_urdf_loads_as_a_free_body_in_pinocchio_and_drake(tmp_path):
+    """The URDF: one link, a free body in both loaders, its mass and inertia the scene's
+    (the axle's along the link's y)."""
+    pin = pytest.importorskip("pinocchio")
+    from walkerlab.cli.options import load
+    from walkerlab.stages import export
+
+    scene = load(str(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
+    path = export.write(scene, tmp_path, "urdf").path
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    assert (model.nq, model.nv) == (7, 6)
+    assert abs(pin.computeTotalMass(model) - 1.0) < 1e-12
+    assert np.allclose(model.inertias[1].inertia, np.diag([0.25, 0.5, 0.25]), atol=1e-12)
+    try:
+        from pydrake.multibody.parsing import Parser
+        from pydrake.multibody.plant import MultibodyPlant
+    except ImportError:
+        return
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModels(str(path))
+    plant.Finalize()
+    assert (plant.num_positions(), plant.num_velocities()) == (7, 6)

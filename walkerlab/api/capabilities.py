@@ -392,6 +392,8 @@ def _urdf(scene, d, runs: Path) -> tuple[float, str]:
 
     path = export.write(scene, runs, "urdf").path
     model = pinocchio.buildModelFromUrdf(str(path))
+    if model.nv == 0:  # one link and no joint (a 3D wheel): a free body
+        model = pinocchio.buildModelFromUrdf(str(path), pinocchio.JointModelFreeFlyer())
     total = float(pinocchio.computeTotalMass(model))
     want = float(walker_data(scene.walker, scene.slope.phi_rad).total_mass_kg)
     bodies = {n: round(float(i.mass), 6) for n, i in zip(model.names, model.inertias)

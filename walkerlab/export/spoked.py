@@ -16,7 +16,7 @@ from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
 
 __all__ = ["TO_MUJOCO", "WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe",
-           "wheel3d_mjcf_text", "wheel_chord_m", "wheel_mjcf_text", "wheel_urdf_text"]
+           "wheel3d_mjcf_text", "wheel3d_urdf_text", "wheel_chord_m", "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
@@ -308,3 +308,49 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
         out += ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
                 "  </keyframe>"]
     return "\n".join(out + ["</mujoco>", ""])
+
+
+def wheel3d_urdf_text(data, name: str, version: str = "") -> str:
+    """A spoked wheel in three dimensions (``walker.space: 3d``) as URDF: one link ``hub``
+    (no joint: a loader gives it a floating base, Pinocchio's ``JointModelFreeFlyer``,
+    Drake's free body), its axle along the link's y (MuJoCo's and URDF's axes, z up:
+    :data:`TO_MUJOCO`), the inertia ``I_diam``, ``I_hub``, ``I_diam`` about x, y, z, each
+    spoke a cylinder (visual) and a sphere at its tip (collision).  URDF has no ground,
+    contact or keyframe element: the slope is stated in the header.
+
+    Parameters
+    ----------
+    data : WalkerData
+        The 3D wheel (:data:`walkerlab.walker.description.SPATIAL_SPOKED_PARAMS`).
+    name, version : str
+
+    Returns
+    -------
+    str
+        URDF XML (ROS URDF XML specification).
+    """
+    p = dict(zip(data.structure.param_names, data.params))
+    n, L = data.structure.spokes, p["L"]
+    r = WHEEL_TIP_FRACTION * L
+    I_axle = p["I_hub"] if p["I_hub"] > 0.0 else MJCF_MIN_INERTIA_KG_M2
+    out = ['<?xml version="1.0"?>',
+           comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (URDF): "
+                   f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
+                   f"{num(I_axle)} kg m^2 about the axle (y) and {num(p['I_diam'])} kg m^2 "
+                   f"about a diameter; slope {num(data.slope_rad)} rad (not in the file: "
+                   "URDF has no ground); a free body"),
+           f"<robot name={quoteattr(name)}>", '  <link name="hub">',
+           f'    <inertial><origin xyz="0 0 0"/><mass value="{num(p["M_hub"])}"/>'
+           f'<inertia ixx="{num(p["I_diam"])}" ixy="0" ixz="0" iyy="{num(I_axle)}" iyz="0" '
+           f'izz="{num(p["I_diam"])}"/></inertial>']
+    for k in range(n):
+        mx, mz = _spoke_tip({"n": n}, k, (L - r) / 2)
+        tx, tz = _spoke_tip({"n": n}, k, L - r)
+        pitch = -2.0 * math.pi * k / n
+        out += [f'    <visual name="spoke{k}"><origin xyz="{nums(mx, 0, mz)}" '
+                f'rpy="0 {num(pitch)} 0"/><geometry><cylinder radius="{num(L / 100)}" '
+                f'length="{num(L - r)}"/></geometry></visual>',
+                f'    <collision name="spoke{k}_tip"><origin xyz="{nums(tx, 0, tz)}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+    out += ["  </link>", "</robot>", ""]
+    return "\n".join(out)

@@ -218,13 +218,20 @@ def _run_wheel_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_onl
     keyframe (:func:`~walkerlab.export.spoked.wheel3d_keyframe`), the scene's static friction
     coefficient on the spoke tips; the other formats as the capability table has them."""
     from walkerlab.codegen.cache import functions
-    from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel3d_keyframe, wheel3d_mjcf_text
+    from walkerlab.export.spoked import (
+        WHEEL_TIP_FRACTION,
+        wheel3d_keyframe,
+        wheel3d_mjcf_text,
+        wheel3d_urdf_text,
+    )
 
     kind = data.structure.kind
     kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
     mu = (scene.contact or ContactSettings()).mu_static
     version = walkerlab.__version__
-    if walker_only:
+    if fmt == "urdf":  # no keyframe: the walker alone (its gait is the MJCF's keyframe)
+        ideal, text = None, wheel3d_urdf_text(data, name, version)
+    elif walker_only:
         ideal, text = None, wheel3d_mjcf_text(data, name, version, friction=mu)
     else:
         f = functions(data)

@@ -426,8 +426,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
                               "later step (walk it in the rigid model: fixedpoint, "
                               "simulate)"),
-        # the MJCF: a free body on its spoke tips (walkerlab.export.spoked.wheel3d_mjcf_text)
-        ("walk", "urdf"): SPATIAL_EXPORT,
+        # the MJCF and the URDF: a free body on its spoke tips
+        # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
         ("walk", "adams"): SPATIAL_EXPORT,
         ("walk", "osim"): SPATIAL_EXPORT,
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
