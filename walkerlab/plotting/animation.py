@@ -185,6 +185,13 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
     KeyError
         A trajectory without a ``hip`` point.
     """
+    from dataclasses import replace
+
+    # a walker in 3D is drawn in the sagittal plane (its top and front views: the report's
+    # gait_3d_top_front figure)
+    trajs = {k: replace(tr, points={n: np.asarray(p)[:2] for n, p in tr.points.items()})
+             if any(len(p) > 2 for p in tr.points.values()) else tr
+             for k, tr in trajs.items()}
     times = frame_times(trajs, fps, max_frames)
     n = len(trajs)
     L = max(_leg_length(tr) for tr in trajs.values())

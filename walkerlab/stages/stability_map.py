@@ -18,6 +18,7 @@ from walkerlab.io.schemas.stability_map import load_stability_map, write_stabili
 from walkerlab.plotting.artifact_figures import save_gait_map_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 from walkerlab.studies.stability import MapSpec, default_spec, stability_map_run
+from walkerlab.walker.description import walker_data
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 
@@ -41,6 +42,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     scene = with_defaults(scene, "contact", "stability-map")  # left out: the paper's contact law
     require(scene, "fixedpoint", "stability-map")
+    structure = walker_data(scene.walker, scene.slope.phi_rad).structure
+    if structure.spatial:  # a map of the contact gait: the kind's contact cell first
+        structure.kind.require("walk", "contact", "walker.space: 3d")
     why = map_not_applicable(scene, kind)
     if why:
         raise StageError(why)

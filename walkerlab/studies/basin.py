@@ -158,8 +158,29 @@ def _walker_and_settings(base: dict):
         st = scene.basin or BasinSettings()
         mst = st.max_step_time_s or (scene.fixedpoint.max_step_time_s if scene.fixedpoint
                                      else 5.0)
-        _WALKERS[key] = (build_walker(scene), st, mst)
+        walker = build_walker(scene)
+        if not {"x_axis", "y_axis"} & st.model_fields_set:  # the default axes: this walker's
+            st = st.model_copy(update=dict(zip(("x_axis", "y_axis"),
+                                               default_axes(walker, (st.x_axis, st.y_axis)))))
+        _WALKERS[key] = (walker, st, mst)
     return _WALKERS[key]
+
+
+def default_axes(walker, axes: tuple[str, str]) -> tuple[str, str]:
+    """The basin's axes when the scene names none: ``axes`` (the stance leg's angle and
+    rate) where the Poincaré section keeps both, else the first angle it keeps that is not
+    neutral (:attr:`HybridWalker.neutral`) and its rate - a 3D wheel's lean and lean rate
+    (its spin angle is fixed by the heel-strike surface, its heading neutral)."""
+    names = walker.state_names()
+    n2 = len(names)
+    kept = {names[int(round(v))] for v in walker.section(np.arange(n2, dtype=float))}
+    if set(axes) <= kept:
+        return axes
+    for name in names[:n2 // 2]:
+        rate = name.removesuffix("_angle") + "_rate"
+        if name in kept and rate in kept and name not in walker.neutral:
+            return name, rate
+    return axes
 
 
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
