@@ -16,7 +16,8 @@ from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
 
 __all__ = ["TO_MUJOCO", "WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe",
-           "wheel3d_mjcf_text", "wheel3d_urdf_text", "wheel_chord_m", "wheel_mjcf_text", "wheel_urdf_text"]
+           "wheel3d_mjcf_text", "wheel3d_urdf_text", "wheel_chord_m", "wheel_mjcf_text",
+           "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
