@@ -108,6 +108,22 @@ def bench_fixedpoint(runs: int = 5) -> dict:
         return {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
 
 
+def bench_fixedpoint_3d(runs: int = 5) -> dict:
+    """``walkerlab fixedpoint --force`` of the 3D walkers (the hip-width walker, its stride
+    map with multipliers, and the 3D rimless wheel at Drake's defaults), whole process, warm
+    (the generated code cached by a first run), medians of ``runs``; target 5 s each."""
+    from walkerlab.config.loader import shipped_scene_path
+
+    out: dict = {"target_s": 5.0, "scenes": {}}
+    with tempfile.TemporaryDirectory() as d:
+        for scene in ("hip_width", "rimless_wheel_3d"):
+            cmd = _cli("fixedpoint", str(shipped_scene_path(scene)), "--force",
+                       "--runs-dir", d)
+            subprocess.run(cmd, check=True, capture_output=True)  # the model code cached
+            out["scenes"][scene] = _time_process(cmd, runs)
+    return out
+
+
 def bench_sweep_workers(points=(8, 32), runs: int = 3) -> dict:
     """``walkerlab sweep`` of the paper scene over the slope with 1 and with 2 workers,
     whole process, for sweeps of ``points`` points (8 and 32: fixed-point points of a few ms,

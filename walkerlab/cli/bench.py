@@ -18,6 +18,9 @@ benchmark      what is timed                                                    
 ``workers``    against 2 workers, whole process, alternating runs (medians)     <= 1
 ``basin``      ``walkerlab basin --grid 200x200 --force``, paper walker,        <= 120 s
                50 steps a cell at most, 2 workers, whole process
+``fixedpoint-`` ``walkerlab fixedpoint --force`` of configs/hip_width.yaml (a     <= 5 s
+``3d``         stride map, multipliers) and rimless_wheel_3d.yaml, whole
+               process, warm, medians of 5
 ``contact``    the contact walker's work-precision benchmark
                (:func:`walkerlab.bench.contact.run_benchmark`); with scene
                files (``walkerlab bench contact configs/kneed.yaml ...``): each
@@ -75,8 +78,9 @@ _LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.o
           "powered-command": "walkerlab.bench.powered_command", "gym": "walkerlab.bench.gym",
           "gym-vector": "walkerlab.bench.gym_vector"}
 
-BENCHMARKS = ("ideal", "fixedpoint", "sweep", "sweep-workers", "basin", "contact", "main-job",
-              "optimize", "powered", "powered-command", "hzd", "gym", "gym-vector")
+BENCHMARKS = ("ideal", "fixedpoint", "fixedpoint-3d", "sweep", "sweep-workers", "basin",
+              "contact", "main-job", "optimize", "powered", "powered-command", "hzd", "gym",
+              "gym-vector")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -205,6 +209,7 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.gym_vector import bench_vector
 
         return bench_vector()
-    return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
+    return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint,
+            "fixedpoint-3d": B.bench_fixedpoint_3d, "sweep": bench_sweep,
             "basin": B.bench_basin, "sweep-workers": B.bench_sweep_workers,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()
