@@ -184,7 +184,8 @@ def derive_spoked(structure) -> Equations:
         kinetic=kinetic, potential=potential,
         guards={"heel_strike": _dot(nxt, nrm), "rolls_back": dth,
                 "hip_height": _dot(hub, nrm), "swing_clearance": _dot(nxt, nrm)},
-        points=points, leg_angles={"stance": th, "swing": th + 2 * alpha},
+        points=points,
+        leg_angles={"stance": th, "swing": th + 2 * alpha, "heading": psi, "lean": phi},
         section_drop=2, drop_solution=theta_on,
         De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
     )
