@@ -1,4 +1,4 @@
-"""walkerlab: a command-line lab for planar biped walkers, passive and powered.
+"""walkerlab: a command-line lab for biped walkers (planar, and in 3D), passive and powered.
 
 The package is split by role (lower layers first; the documentation, docs/, describes
 the product):

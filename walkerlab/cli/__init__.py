@@ -43,8 +43,8 @@ flags_take_no_value()
 usage_errors_in_one_spelling()
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="walkerlab: planar biped walkers, passive and powered, from fixed point to "
-                  "report.")
+                  help="walkerlab: biped walkers (planar; in 3D: space: 3d), passive and "
+                  "powered, from fixed point to report.")
 
 
 @app.callback()
@@ -57,7 +57,8 @@ def _main(version: bool = typer.Option(False, "--version", callback=version_call
                                      "(errors are still shown); when stderr is not a "
                                      "terminal, progress is a plain line per finished unit")
           ) -> None:
-    """walkerlab: planar biped walkers, passive and powered, from fixed point to report."""
+    """walkerlab: biped walkers (planar; in 3D: space: 3d), passive and powered, from fixed point
+    to report."""
     single_threaded_blas()
     process_settings()
     from walkerlab import progress
