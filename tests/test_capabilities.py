@@ -327,8 +327,8 @@ def test_the_urdf_column_supports_what_the_urdf_writer_takes():
 
     assert "urdf" in VIEWS
     took = {k for k in KINDS if KINDS[k].supports("walk", "urdf")}
-    # flat feet have no foot link there; the 3D straight-legged walker's URDF is a later step
-    assert took == set(KINDS) - {"flat_feet", "straight_legs_3d"}
+    # flat feet have no foot link there
+    assert took == set(KINDS) - {"flat_feet"}
     for k in KINDS.values():
         assert not any(k.supports(g, "urdf") for g in ("stairs", "footholds", "profile"))
 

@@ -241,3 +241,41 @@ def test_hip_width_gait_and_multipliers_match_an_independent_model(hip_width_gai
     theirs = np.sort_complex(np.linalg.eigvals(J))
     ours = np.sort_complex(np.asarray(res.multipliers_variational))
     assert np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs))) < 1e-6
+
+
+def test_hip_width_walkers_urdf_in_pinocchio_has_its_kinetic_energy_and_feet(tmp_path):
+    """The exported URDF (a free pelvis, two legs on hip joints) put in the walker's state:
+    Pinocchio's kinetic energy and swing foot equal the generated model's (an independent
+    computation of the 3D mass matrix: Pinocchio's articulated bodies), and the mass."""
+    pin = pytest.importorskip("pinocchio")
+    from walkerlab.cli.options import load
+    from walkerlab.codegen.cache import functions
+    from walkerlab.export.spoked import TO_MUJOCO
+    from walkerlab.stages import export
+    from walkerlab.walker.description import walker_data
+
+    scene = load(str(ROOT / "configs" / "hip_width.yaml"))
+    path = export.write(scene, tmp_path, "urdf").path
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    pdata = model.createData()
+    assert abs(sum(i.mass for i in model.inertias) - 20.0) < 1e-12
+    f = functions(walker_data(scene.walker, scene.slope.phi_rad))
+    C = np.array(TO_MUJOCO)
+    gamma = scene.slope.phi_rad
+    fall = np.array([math.cos(gamma), -math.sin(gamma), 0.0])
+    x = np.array([0.04, -0.2, 0.17, 0.3, -0.6, -0.85])   # lean, swing, stance, rates
+    pts, vel = f["points"](x), f["point_velocities"](x)
+    R_pelvis = C @ Rotation.from_rotvec(x[0] * fall).as_matrix() @ C.T
+    quat = Rotation.from_matrix(R_pelvis).as_quat()      # x, y, z, w as Pinocchio's
+    q = np.concatenate([C @ pts["hip"], quat,
+                        [math.cos(x[1]), math.sin(x[1]), math.cos(x[2]), math.sin(x[2])]])
+    v = np.concatenate([R_pelvis.T @ (C @ vel["hip"]), R_pelvis.T @ (C @ (fall * x[3])),
+                        [x[4], x[5]]])                   # base rates in the pelvis frame
+    ke_pin = pin.computeKineticEnergy(model, pdata, q, v)
+    ke, _ = f["energies"](x)
+    # the URDF's point masses carry the export's smallest inertia (1e-12 kg m^2)
+    assert abs(ke_pin - float(ke)) < 1e-9 * float(ke)
+    pin.forwardKinematics(model, pdata, q)
+    leg1 = model.getJointId("leg1_hip")
+    foot = pdata.oMi[leg1].act(np.array([0.0, 0.0, -1.0]))  # the swing leg's foot (L = 1 m)
+    assert np.max(np.abs(foot - C @ pts["swing_foot"])) < 1e-12

@@ -394,7 +394,8 @@ def _urdf(scene, d, runs: Path) -> tuple[float, str]:
     model = pinocchio.buildModelFromUrdf(str(path))
     if model.nv == 0:  # one link and no joint (a 3D wheel): a free body
         model = pinocchio.buildModelFromUrdf(str(path), pinocchio.JointModelFreeFlyer())
-    total = float(pinocchio.computeTotalMass(model))
+    # every body's mass, the root link's too (a free pelvis: a loader's base)
+    total = float(sum(i.mass for i in model.inertias))
     want = float(walker_data(scene.walker, scene.slope.phi_rad).total_mass_kg)
     bodies = {n: round(float(i.mass), 6) for n, i in zip(model.names, model.inertias)
               if i.mass > 0}

@@ -247,6 +247,20 @@ def _run_wheel_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_onl
     return Exported(path, _xml_lines((), scene), None if ideal is None else _step_period(ideal))
 
 
+def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
+                 ) -> Exported:
+    """The 3D straight-legged walker (``walker.space: 3d``): its URDF, a free pelvis and two
+    legs on hip joints (:func:`walkerlab.export.spatial_legs.spatial_legs_urdf_text`); the
+    other formats as the capability table has them (refused before this is reached)."""
+    from walkerlab.export.spatial_legs import spatial_legs_urdf_text
+
+    data.structure.kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
+    text = spatial_legs_urdf_text(data, name, walkerlab.__version__)
+    path = export_path(scene, runs_root, fmt, claim=True)
+    runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
+    return Exported(path, _xml_lines((), scene), None)
+
+
 def _gait_scene(scene: Scene, mb, data, runs_root, options=None):
     """The rigid gait and the MJCF's gait keyframe, terrain and contact (the gait of an
     up-to-date ``fixedpoint.h5``, else searched; ``options``: the MJCF's
@@ -460,5 +474,4 @@ def _run_links(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: 
 _WRITERS = {"straight_legs": _run_links, "locking_knees": _run_links, "flat_feet": _run_links,
             "free_joints": _run_links, "hinged_torso": _run_links,
             "rolling_polygon": _run_wheel, "rolling_polygon_3d": _run_wheel_3d,
-            # refused before it is reached (its cells: walker.space: 3d)
-            "straight_legs_3d": _run_links}
+            "straight_legs_3d": _run_legs_3d}

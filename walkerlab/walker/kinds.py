@@ -410,7 +410,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                               "later step (walk it in the rigid model: fixedpoint, "
                               "simulate)"),
         ("walk", "mjcf"): SPATIAL_EXPORT,
-        ("walk", "urdf"): SPATIAL_EXPORT,
+        # the URDF: a free pelvis and two legs on hip joints
+        # (walkerlab.export.spatial_legs.spatial_legs_urdf_text)
         ("walk", "adams"): SPATIAL_EXPORT,
         ("walk", "osim"): SPATIAL_EXPORT,
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "

@@ -1,0 +1,68 @@
+"""A straight-legged walker in three dimensions (``model: compass_gait`` with ``space: 3d``;
+:func:`walkerlab.codegen.spatial.derive_compass`) as URDF: a pelvis link carrying the hip
+mass, free in space (a loader gives the root link a floating base: Pinocchio's
+``JointModelFreeFlyer``, Drake's free body), and a leg on each side of it, ``hip_width / 2``
+along the hip axis, on a revolute hip joint about that axis (the legs pitch; the walker rolls
+with its pelvis).  Axes are URDF's (z up; x downhill; y = walkerlab's -z,
+:data:`walkerlab.export.spoked.TO_MUJOCO`): ``leg1`` on the side of -y (walkerlab's +z, where
+the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m`` above
+its foot and a sphere at its foot (collision); URDF has no ground, contact or state: the
+slope is stated in the header.
+"""
+
+from __future__ import annotations
+
+from xml.sax.saxutils import quoteattr
+
+from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION
+from walkerlab.export.text import comment, num, nums
+
+__all__ = ["spatial_legs_urdf_text"]
+
+
+def _point_inertial(mass: float, z: float) -> str:
+    i = num(MJCF_MIN_INERTIA_KG_M2)
+    return (f'<inertial><origin xyz="{nums(0, 0, z)}"/><mass value="{num(mass)}"/>'
+            f'<inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/></inertial>')
+
+
+def spatial_legs_urdf_text(data, name: str, version: str = "") -> str:
+    """The 3D straight-legged walker as URDF (module docstring).
+
+    Parameters
+    ----------
+    data : WalkerData
+        Its parameters (:data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`, with
+        ``w_hip`` when the hips are apart).
+    name, version : str
+
+    Returns
+    -------
+    str
+        URDF XML (ROS URDF XML specification); point masses get the export's smallest
+        inertia (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the planar
+        walkers' do.
+    """
+    p = dict(zip(data.structure.param_names, data.params))
+    L, a, w = p["L"], p["a_leg"], p.get("w_hip", 0.0)
+    r = WHEEL_TIP_FRACTION * L
+    out = ['<?xml version="1.0"?>',
+           comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): straight "
+                   f"legs of {num(L)} m, {num(p['m_leg'])} kg at {num(a)} m from each foot, "
+                   f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope "
+                   f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); the "
+                   "pelvis is the free root link"),
+           f"<robot name={quoteattr(name)}>",
+           f'  <link name="pelvis">{_point_inertial(p["M_hip"], 0.0)}</link>']
+    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
+        out += [f'  <link name="{leg}">{_point_inertial(p["m_leg"], -(L - a))}',
+                f'    <visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
+                f'radius="{num(L / 100)}" length="{num(L)}"/></geometry></visual>',
+                f'    <collision name="{leg}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>',
+                "  </link>",
+                f'  <joint name="{leg}_hip" type="continuous"><parent link="pelvis"/>'
+                f'<child link="{leg}"/><origin xyz="{nums(0, side * w / 2, 0)}"/>'
+                '<axis xyz="0 -1 0"/></joint>']
+    return "\n".join(out + ["</robot>", ""])
