@@ -581,4 +581,5 @@ class _FlatFeet(_LinkFeet):
 #: :func:`check_exportable`)
 SCENE_FEET = {"straight_legs": _LinkFeet(), "locking_knees": _LinkFeet(),
               "flat_feet": _FlatFeet(), "free_joints": _LinkFeet(),
-              "hinged_torso": _LinkFeet(), "rolling_polygon": _LinkFeet()}
+              "hinged_torso": _LinkFeet(), "rolling_polygon": _LinkFeet(),
+              "rolling_polygon_3d": _LinkFeet(), "straight_legs_3d": _LinkFeet()}

@@ -24,7 +24,7 @@ from walkerlab.models.hybrid.actuators import Actuators, torque_chain_jacobian
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian
 
-__all__ = ["compiled_with", "Actuators", "actuate", "torque_chain_jacobian"]
+__all__ = ["compiled_with", "Actuators", "actuate", "torque_chain_jacobian", "torque_feature"]
 
 
 def _functions(data):
@@ -347,7 +347,7 @@ class _FlatFeet:
         return actuate_flat(walker, data, spec)
 
 
-def _torque_feature(joint: str) -> str:
+def torque_feature(joint: str) -> str:
     """The capability table's feature of a torque at ``joint`` (``hip``: the hip torque;
     ``stance_hip``/``swing_hip``: between a torso and a leg; a knee's, an ankle's)."""
     for part in ("knee", "ankle"):
@@ -366,7 +366,7 @@ class _RollingPolygon:
         """Refuse the first actuator ``spec`` asks for (one line, naming its field)."""
         kind = data.structure.kind
         for i, t in enumerate(spec.torques):
-            kind.require(_torque_feature(t.joint), "rigid",
+            kind.require(torque_feature(t.joint), "rigid",
                          f"walker.actuation.torques.{i}.joint")
         for name in ("push_off", "ankle_push_off"):
             if getattr(spec, name) is not None:
