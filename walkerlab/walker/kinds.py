@@ -35,11 +35,12 @@ walker's :class:`Kind`:
     Straight legs on point feet in three dimensions (``model: compass_gait`` with
     ``space: 3d``): the walker rolls about the fall line through its stance foot and its
     legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
-    1999).  The rigid model only, passive, so far.
+    1999).  The rigid model and the URDF, passive, so far.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
-    rigid model only, so far; the other views' cells say so.
+    rigid model, the MJCF (a free body: it rolls in MuJoCo) and the URDF, so far; the
+    other views' cells say so.
 
 The layers ask the kind (:func:`kind_of`, once), never the switches: a layer's code for a
 kind is reached through the kind's name in that layer's own table of parts (the rigid
