@@ -374,8 +374,9 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         raise ValueError("--walk: the walker alone (--walker-only) has no gait to walk from; "
                          "drop one of them")
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    if data.structure.spatial:  # a 3D walker: the format's cell says whether it is written
-        data.structure.kind.require("walk", FORMAT_VIEWS.get(fmt, fmt), "walker.space: 3d")
+    kind = data.structure.kind
+    if kind.field != "walker":  # a kind whose walker the writers do not refuse themselves
+        kind.require("walk", FORMAT_VIEWS.get(fmt, fmt), kind.field)
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope \
             and len(drops) > 1:  # footholds of several heights: the capability table's cell
         data.structure.kind.require("footholds", FORMAT_VIEWS[fmt],

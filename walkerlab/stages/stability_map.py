@@ -42,9 +42,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     scene = with_defaults(scene, "contact", "stability-map")  # left out: the paper's contact law
     require(scene, "fixedpoint", "stability-map")
-    structure = walker_data(scene.walker, scene.slope.phi_rad).structure
-    if structure.spatial:  # a map of the contact gait: the kind's contact cell first
-        structure.kind.require("walk", "contact", "walker.space: 3d")
+    walker_kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+    walker_kind.require("walk", "contact", walker_kind.field)  # a map of the contact gait
     why = map_not_applicable(scene, kind)
     if why:
         raise StageError(why)

@@ -106,11 +106,15 @@ class Kind:
         A few words for tables and messages.
     reference : str
         Where the kind's model comes from (papers).
+    field : str
+        The scene field a refusal of the walker itself names first (``walker``; the 3D
+        kinds': ``walker.space: 3d``).
     """
 
     name: str
     title: str
     reference: str
+    field: str = "walker"
 
     def cell(self, feature: str, view: str) -> str | None:
         """None when the kind supports ``feature`` in ``view``, else the one-line reason
@@ -178,9 +182,9 @@ KINDS = {k.name: k for k in (
     Kind("rolling_polygon", "rimless (spoked) wheel",
          "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
-         "Coleman, Chatterjee & Ruina 1997"),
+         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
-         "Kuo 1999"),
+         "Kuo 1999", "walker.space: 3d"),
 )}
 
 _NO_KNEE = "the legs are straight: there is no knee"

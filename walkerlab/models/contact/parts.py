@@ -265,6 +265,5 @@ def contact_part(structure) -> ContactPart:
     walkerlab.walker.kinds.KindRefused
         The kind has no contact view (its ``walk`` cell there, one line).
     """
-    if structure.spatial:  # the planar kinds' parts refuse what they lack themselves
-        structure.kind.require("walk", "contact", "walker.space: 3d")
+    structure.kind.require("walk", "contact", structure.kind.field)
     return PARTS[structure.kind.name]
