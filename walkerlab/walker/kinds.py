@@ -245,8 +245,12 @@ SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind:
 SPATIAL_ACTUATION = ("a walker in 3D is passive so far (its actuators, a lateral "
                      "foot-placement or hip-roll law, are a later step)")
 #: why the exports refuse a 3D walker
-SPATIAL_EXPORT = ("the exports write planar walkers (a plane constraint or a sagittal "
-                  "tree); a 3D walker's free body is a later step")
+SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is written as "
+                  "URDF (--format urdf), the 3D wheel as MJCF too")
+#: why the 3D straight-legged walker has no MJCF yet
+SPATIAL_LEGS_MJCF = ("the 3D walker's MJCF (a free pelvis on footfall patches, past the "
+                     "straight legs' mid-stance foot-through) is a later step; its URDF is "
+                     "written (--format urdf)")
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -414,7 +418,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
                               "later step (walk it in the rigid model: fixedpoint, "
                               "simulate)"),
-        ("walk", "mjcf"): SPATIAL_EXPORT,
+        ("walk", "mjcf"): SPATIAL_LEGS_MJCF,
         # the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.spatial_legs.spatial_legs_urdf_text)
         ("walk", "adams"): SPATIAL_EXPORT,
