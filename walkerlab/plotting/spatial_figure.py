@@ -30,18 +30,34 @@ def top_and_front(trajs: dict[str, NamedTrajectory], title: str, units: Units):
     import matplotlib.pyplot as plt
 
     fig, (top, front) = plt.subplots(1, 2, figsize=(10, 4.2))
+    spans = []
     for label, tr in trajs.items():
         pts = {k: np.asarray(v) for k, v in tr.points.items() if len(v) > 2}
         hip = pts.get("hip")
         if hip is not None:
             top.plot(hip[0], hip[2], lw=1.5, label=f"{label}: hip")
             front.plot(hip[2], hip[1], lw=1.5, label=f"{label}: hip")
-        for name, p in pts.items():
-            if name.endswith("_foot"):
-                # a foot's footfall: where it rests (its samples that do not move)
-                rest = np.r_[False, np.all(np.abs(np.diff(p, axis=1)) < 1e-12, axis=0)]
-                top.plot(p[0][rest], p[2][rest], "o", ms=3, label=f"{label}: {name} at rest")
-                front.plot(p[2], p[1], lw=0.6, alpha=0.6, label=f"{label}: {name}")
+            spans.append(float(np.ptp(hip[1])) + float(np.max(np.abs(hip[1] - hip[1][0]))))
+        feet = [p for name, p in pts.items() if name.endswith("_foot")]
+        falls = []
+        for p in feet:
+            # a foot's footfalls: where it rests (the samples at which it does not move)
+            rest = np.r_[False, np.all(np.abs(np.diff(p, axis=1)) < 1e-12, axis=0)]
+            falls.append(p[:, rest])
+        if falls:
+            f = np.hstack(falls)
+            top.plot(f[0], f[2], "o", ms=3, label=f"{label}: footfalls")
+        for k, p in enumerate(feet):
+            front.plot(p[2], p[1], lw=0.5, color="0.6",
+                       label=f"{label}: feet" if k == 0 else None)
+    # a lateral axis of at least a tenth of the walk's height range: a gait that stays in
+    # its plane (to round-off) shows as one, not as its round-off magnified
+    half = 0.05 * max(spans) if spans and max(spans) > 0 else 0.05
+    for get, setter in ((top.get_ylim, top.set_ylim), (front.get_xlim, front.set_xlim)):
+        lo, hi = get()
+        mid = 0.5 * (lo + hi)
+        if hi - lo < 2 * half:
+            setter(mid - half, mid + half)
     u = units.length
     top.set(xlabel=f"x downhill [{u}]", ylabel=f"z lateral [{u}]", title="top view")
     front.set(xlabel=f"z lateral [{u}]", ylabel=f"y up [{u}]", title="front view (uphill)")
