@@ -21,7 +21,7 @@ Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
 ``section(x)``      state without the coordinate eliminated on the heel-strike surface (2n-1,)
 ``from_section(z)`` inverse of ``section`` on that surface (2n,)
 ``energies(X)``     ``(kinetic, potential)`` [J]
-``points(X)``       dict of named positions (2,) or (2, k) [m]
+``points(X)``       dict of named positions (2,) or (2, k) [m] ((3,) ... in 3D)
 ``point_velocities`` ``X -> dict`` of the same points' velocities (2,) or (2, k) [m/s]
 ``leg_angles(X)``   dict ``stance_angle, swing_angle, stance_rate, swing_rate`` (absolute)
 ``matrices(x)``     ``(M, C, G)`` numpy arrays

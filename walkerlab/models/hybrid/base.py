@@ -31,7 +31,8 @@ Contract of :class:`HybridWalker` (nothing outside the model layer may assume mo
     its state coordinates.  ``X`` is (2n,) or (2n, k); values are () or (k,).
 ``points(X)``
     Positions [m] relative to the step's stance reference point (the stance foot for point
-    feet), world axes (x horizontal downhill, y up); keys include ``hip``, ``stance_foot``,
+    feet), world axes (x horizontal downhill, y up; a 3D walker's also z, to the right of a
+    walker facing downhill: (3,) or (3, k)); keys include ``hip``, ``stance_foot``,
     ``swing_foot``; role-prefixed names (``swing_mass``, ...) are mapped to legs by prefix.
     ``points(x_end)["swing_foot"]`` is the world offset of the next step's reference point.
 ``energies(X)``
