@@ -1,5 +1,5 @@
 """The numerical formulas every floor shares, each written once: the finite-difference and
-complex-step Jacobians and the order of Floquet multipliers.
+complex-step Jacobians, the order of Floquet multipliers and which of them are neutral.
 
 Imports nothing of walkerlab; numpy only.
 """
@@ -10,7 +10,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["complex_step_jacobian", "fd_jacobian", "sort_multipliers"]
+__all__ = ["complex_step_jacobian", "fd_jacobian", "neutral_positions", "sort_multipliers",
+           "without_neutral"]
 
 
 def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], x, steps, *, central: bool = True,
@@ -109,3 +110,27 @@ def sort_multipliers(ev) -> np.ndarray:
     """
     ev = np.asarray(ev, dtype=complex)
     return ev[np.lexsort((-ev.real, -np.abs(ev)))]
+
+
+def neutral_positions(mult, k: int) -> np.ndarray:
+    """Positions of the ``k`` multipliers nearest 1 in ``mult``: those of a walker's neutral
+    coordinates (a family of gaits along each, :attr:`HybridWalker.neutral`), which the
+    stability verdict and the bifurcation tests set aside.
+
+    Parameters
+    ----------
+    mult : array_like, shape (m,)
+        Floquet multipliers [-].
+    k : int
+        How many are neutral (0: none).
+
+    Returns
+    -------
+    ndarray of int, shape (k,)
+    """
+    return np.argsort(np.abs(np.asarray(mult) - 1.0), kind="stable")[:k]
+
+
+def without_neutral(mult, k: int) -> np.ndarray:
+    """``mult`` (m,) without its ``k`` neutral multipliers (:func:`neutral_positions`)."""
+    return np.delete(np.asarray(mult), neutral_positions(mult, k))

@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import walkerlab as wl
+from walkerlab.numerics import without_neutral
 
 ROOT = Path(wl.__file__).resolve().parents[1]  # configs/ beside the package
 runs = Path(tempfile.mkdtemp(prefix="walkerlab-gallery-"))
@@ -26,11 +27,8 @@ runs = Path(tempfile.mkdtemp(prefix="walkerlab-gallery-"))
 
 def largest_but_neutral(mult: np.ndarray, neutral: int) -> np.ndarray:
     """Per point, the largest |multiplier| with the ``neutral`` ones nearest 1 left out."""
-    out = []
-    for row in np.atleast_2d(mult):
-        drop = np.argsort(np.abs(row - 1.0))[:neutral]
-        out.append(np.abs(np.delete(row, drop)).max())
-    return np.array(out)
+    return np.array([np.abs(without_neutral(row, neutral)).max()
+                     for row in np.atleast_2d(mult)])
 
 
 wheel = wl.load_scene(ROOT / "configs" / "rimless_wheel_3d_disc.yaml")

@@ -50,6 +50,56 @@ def _spoke_tip(p: dict, k: int, to: float) -> tuple[float, float]:
     return to * math.sin(psi), -to * math.cos(psi)
 
 
+def _urdf_spokes(p: dict) -> list[str]:
+    """Each spoke of a wheel (numbers :func:`_wheel_numbers`) as a URDF cylinder (visual) and
+    its tip's sphere (collision), in the hub link's frame."""
+    L, r, n = p["L"], p["r"], p["n"]
+    out = []
+    for k in range(n):
+        mx, mz = _spoke_tip(p, k, (L - r) / 2)
+        tx, tz = _spoke_tip(p, k, L - r)
+        pitch = -2.0 * math.pi * k / n  # the cylinder's z axis turned onto the spoke
+        out += [f'    <visual name="spoke{k}"><origin xyz="{nums(mx, 0, mz)}" '
+                f'rpy="0 {num(pitch)} 0"/><geometry><cylinder radius="{num(L / 100)}" '
+                f'length="{num(L - r)}"/></geometry></visual>',
+                f'    <collision name="spoke{k}_tip"><origin xyz="{nums(tx, 0, tz)}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+    return out
+
+
+def _mjcf_head(p: dict, timestep_s: float, solref, friction: float) -> list[str]:
+    """The MJCF's compiler, gravity and integrator, and the spokes' contact defaults."""
+    return ['  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
+            f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(timestep_s)}" '
+            'integrator="implicitfast"/>',
+            f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
+            f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
+            '</default>']
+
+
+def _mjcf_spokes(p: dict) -> list[str]:
+    """Each spoke as an MJCF capsule (no contact) and its tip's sphere ``spoke<k>_tip`` (the
+    only geoms that touch the ground), in the hub body's frame."""
+    L, r = p["L"], p["r"]
+    out = []
+    for k in range(p["n"]):
+        tx, tz = _spoke_tip(p, k, L - r)
+        out += [f'      <geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
+                f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
+                f'      <geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
+                f'pos="{nums(tx, 0, tz)}" contype="1" conaffinity="1"/>']
+    return out
+
+
+def _mjcf_keyframe(qpos, qvel) -> list[str]:
+    """The ``gait`` keyframe (none without ``qpos``; ``qvel`` None: at rest)."""
+    if qpos is None:
+        return []
+    qv = (0.0,) * len(qpos) if qvel is None else qvel
+    return ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
+            "  </keyframe>"]
+
+
 def _wheel_header(name: str, fmt: str, version: str, p: dict, slope: float) -> list[str]:
     return [comment(f"rimless wheel {name!s} exported by walkerlab {version} ({fmt})."),
             comment("Planar wheel in the x-z plane: x downhill (horizontal), z up; joints "
@@ -90,7 +140,6 @@ def wheel_urdf_text(data, name: str, version: str = "",
         URDF XML (ROS URDF XML specification).
     """
     p = _wheel_numbers(data, hub_inertia_kg_m2)
-    L, r = p["L"], p["r"]
     out = ['<?xml version="1.0"?>', *_wheel_header(name, "URDF", version, p, data.slope_rad),
            *xml_comments(WHEEL_URDF_OMISSIONS), f"<robot name={quoteattr(name)}>",
            '  <link name="world"/>',
@@ -104,16 +153,7 @@ def wheel_urdf_text(data, name: str, version: str = "",
            '  <link name="hub">',
            f'    <inertial><origin xyz="0 0 0"/><mass value="{num(p["M_hub"])}"/>'
            f'<inertia ixx="{num(p["I_hub"])}" ixy="0" ixz="0" iyy="{num(p["I_hub"])}" iyz="0" '
-           f'izz="{num(p["I_hub"])}"/></inertial>']
-    for k in range(p["n"]):
-        mx, mz = _spoke_tip(p, k, (L - r) / 2)
-        tx, tz = _spoke_tip(p, k, L - r)
-        pitch = -2.0 * math.pi * k / p["n"]  # the cylinder's z axis turned onto the spoke
-        out += [f'    <visual name="spoke{k}"><origin xyz="{nums(mx, 0, mz)}" '
-                f'rpy="0 {num(pitch)} 0"/><geometry><cylinder radius="{num(L / 100)}" '
-                f'length="{num(L - r)}"/></geometry></visual>',
-                f'    <collision name="spoke{k}_tip"><origin xyz="{nums(tx, 0, tz)}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+           f'izz="{num(p["I_hub"])}"/></inertial>', *_urdf_spokes(p)]
     out += ["  </link>", '  <joint name="wheel" type="continuous"><parent link="carriage"/>'
             '<child link="hub"/><axis xyz="0 -1 0"/></joint>', "</robot>", ""]
     return "\n".join(out)
@@ -152,14 +192,9 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
         MJCF XML (MuJoCo XML Reference).
     """
     p = _wheel_numbers(data, hub_inertia_kg_m2)
-    L, r, phi = p["L"], p["r"], data.slope_rad
+    L, phi = p["L"], data.slope_rad
     out = [*_wheel_header(name, "MJCF", version, p, phi), f"<mujoco model={quoteattr(name)}>",
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-           f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(timestep_s)}" '
-           'integrator="implicitfast"/>',
-           f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-           f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
-           '</default>',
+           *_mjcf_head(p, timestep_s, solref, friction),
            *(ground[0] if ground is not None else ()),
            "  <worldbody>",
            *([f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
@@ -171,18 +206,8 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
            f'      <joint name="wheel" type="hinge" axis="{AXIS}"/>',
            f'      <inertial pos="0 0 0" mass="{num(p["M_hub"])}" '
            f'diaginertia="{nums(p["I_hub"], p["I_hub"], p["I_hub"])}"/>',
-           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>']
-    for k in range(p["n"]):
-        tx, tz = _spoke_tip(p, k, L - r)
-        out += [f'      <geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
-                f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
-                f'      <geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
-                f'pos="{nums(tx, 0, tz)}" contype="1" conaffinity="1"/>']
-    out += ["    </body>", "  </worldbody>"]
-    if qpos is not None:
-        qv = (0.0, 0.0, 0.0) if qvel is None else qvel
-        out += ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
-                "  </keyframe>"]
+           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>', *_mjcf_spokes(p),
+           "    </body>", "  </worldbody>", *_mjcf_keyframe(qpos, qvel)]
     return "\n".join(out + ["</mujoco>", ""])
 
 
@@ -274,21 +299,13 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
     str
         MJCF XML (MuJoCo XML Reference).
     """
-    p = dict(zip(data.structure.param_names, data.params))
-    n, L, phi = data.structure.spokes, p["L"], data.slope_rad
-    r = WHEEL_TIP_FRACTION * L
-    I_axle = p["I_hub"] if p["I_hub"] > 0.0 else MJCF_MIN_INERTIA_KG_M2
+    p = _wheel_numbers(data, None)
+    n, L, phi, I_axle = p["n"], p["L"], data.slope_rad, p["I_hub"]
     out = [comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (MJCF): "
                    f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
                    f"{num(I_axle)} kg m^2 about the axle and {num(p['I_diam'])} kg m^2 about "
                    f"a diameter; slope {num(phi)} rad; a free body, no plane constraint"),
-           f"<mujoco model={quoteattr(name)}>",
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-           f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(timestep_s)}" '
-           'integrator="implicitfast"/>',
-           f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-           f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
-           '</default>',
+           f"<mujoco model={quoteattr(name)}>", *_mjcf_head(p, timestep_s, solref, friction),
            "  <worldbody>",
            f'    <geom name="ground" type="plane" size="400 400 0.1" euler="0 {num(phi)} 0" '
            'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
@@ -296,18 +313,8 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
            '      <freejoint name="free"/>',
            f'      <inertial pos="0 0 0" mass="{num(p["M_hub"])}" '
            f'diaginertia="{nums(p["I_diam"], I_axle, p["I_diam"])}"/>',
-           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>']
-    for k in range(n):
-        tx, tz = _spoke_tip({"n": n}, k, L - r)
-        out += [f'      <geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
-                f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
-                f'      <geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
-                f'pos="{nums(tx, 0, tz)}" contype="1" conaffinity="1"/>']
-    out += ["    </body>", "  </worldbody>"]
-    if qpos is not None:
-        qv = (0.0,) * 6 if qvel is None else qvel
-        out += ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
-                "  </keyframe>"]
+           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>', *_mjcf_spokes(p),
+           "    </body>", "  </worldbody>", *_mjcf_keyframe(qpos, qvel)]
     return "\n".join(out + ["</mujoco>", ""])
 
 
@@ -330,10 +337,8 @@ def wheel3d_urdf_text(data, name: str, version: str = "") -> str:
     str
         URDF XML (ROS URDF XML specification).
     """
-    p = dict(zip(data.structure.param_names, data.params))
-    n, L = data.structure.spokes, p["L"]
-    r = WHEEL_TIP_FRACTION * L
-    I_axle = p["I_hub"] if p["I_hub"] > 0.0 else MJCF_MIN_INERTIA_KG_M2
+    p = _wheel_numbers(data, None)
+    n, L, I_axle = p["n"], p["L"], p["I_hub"]
     out = ['<?xml version="1.0"?>',
            comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (URDF): "
                    f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
@@ -343,15 +348,6 @@ def wheel3d_urdf_text(data, name: str, version: str = "") -> str:
            f"<robot name={quoteattr(name)}>", '  <link name="hub">',
            f'    <inertial><origin xyz="0 0 0"/><mass value="{num(p["M_hub"])}"/>'
            f'<inertia ixx="{num(p["I_diam"])}" ixy="0" ixz="0" iyy="{num(I_axle)}" iyz="0" '
-           f'izz="{num(p["I_diam"])}"/></inertial>']
-    for k in range(n):
-        mx, mz = _spoke_tip({"n": n}, k, (L - r) / 2)
-        tx, tz = _spoke_tip({"n": n}, k, L - r)
-        pitch = -2.0 * math.pi * k / n
-        out += [f'    <visual name="spoke{k}"><origin xyz="{nums(mx, 0, mz)}" '
-                f'rpy="0 {num(pitch)} 0"/><geometry><cylinder radius="{num(L / 100)}" '
-                f'length="{num(L - r)}"/></geometry></visual>',
-                f'    <collision name="spoke{k}_tip"><origin xyz="{nums(tx, 0, tz)}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
-    out += ["  </link>", "</robot>", ""]
+           f'izz="{num(p["I_diam"])}"/></inertial>', *_urdf_spokes(p),
+           "  </link>", "</robot>", ""]
     return "\n".join(out)

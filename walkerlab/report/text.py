@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from walkerlab.integrate.ends import CONTACT_WALKED
+from walkerlab.numerics import neutral_positions
 from walkerlab.report.markdown import num
 
 if TYPE_CHECKING:  # the loaded artifacts these summaries print
@@ -67,7 +68,7 @@ def neutral_multipliers_text(gait) -> str:
     coordinates along which the gaits form one, e.g. a 3D wheel's heading), set aside by
     the verdict."""
     mult = np.asarray(gait.multipliers)
-    pos = np.argsort(np.abs(mult - 1.0), kind="stable")[:len(gait.neutral)]
+    pos = neutral_positions(mult, len(gait.neutral))
     said = ", ".join(f"{mult[i].real:+.6f} ({name.removesuffix('_angle')})"
                      for i, name in zip(pos, gait.neutral))
     return (f"neutral, set aside: {said} - the gaits form a family along "
@@ -83,7 +84,7 @@ def unstable_modes_text(gait, state_names: list[str]) -> list[str]:
         return []
     mu, V = np.linalg.eig(J)
     order = np.argsort(-np.abs(mu), kind="stable")
-    skip = set(np.argsort(np.abs(mu - 1.0), kind="stable")[:len(gait.neutral)].tolist())
+    skip = set(neutral_positions(mu, len(gait.neutral)).tolist())
     out = []
     for i in order:
         if abs(mu[i]) <= 1.0 or int(i) in skip:

@@ -256,16 +256,10 @@ def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only
 
     data.structure.kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
     check_exportable(scene, data.structure.kind, fmt, walker_only)  # numbers, ground
-    act, kind = scene.walker.actuation, data.structure.kind
-    if act is not None:  # passive so far: the table's reason for the first actuator
-        from walkerlab.models.hybrid.actuated import torque_feature
+    if scene.walker.actuation is not None:  # passive so far: the table's reason
+        from walkerlab.models.hybrid.actuated import refuse_actuators
 
-        for i, t in enumerate(act.torques):
-            kind.require(torque_feature(t.joint), FORMAT_VIEWS[fmt],
-                         f"walker.actuation.torques.{i}.joint")
-        for part in ("push_off", "ankle_push_off", "virtual_constraints"):
-            if getattr(act, part, None) is not None:
-                kind.require(part, FORMAT_VIEWS[fmt], f"walker.actuation.{part}")
+        refuse_actuators(data.structure.kind, scene.walker.actuation, FORMAT_VIEWS[fmt])
     text = spatial_legs_urdf_text(data, name, walkerlab.__version__)
     path = export_path(scene, runs_root, fmt, claim=True)
     runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])

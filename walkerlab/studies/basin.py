@@ -172,11 +172,10 @@ def default_axes(walker, axes: tuple[str, str]) -> tuple[str, str]:
     neutral (:attr:`HybridWalker.neutral`) and its rate - a 3D wheel's lean and lean rate
     (its spin angle is fixed by the heel-strike surface, its heading neutral)."""
     names = walker.state_names()
-    n2 = len(names)
-    kept = {names[int(round(v))] for v in walker.section(np.arange(n2, dtype=float))}
+    kept = set(walker.section_names())
     if set(axes) <= kept:
         return axes
-    for name in names[:n2 // 2]:
+    for name in names[:len(names) // 2]:
         rate = name.removesuffix("_angle") + "_rate"
         if name in kept and rate in kept and name not in walker.neutral:
             return name, rate

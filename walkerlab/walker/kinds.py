@@ -251,6 +251,15 @@ SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is wri
 SPATIAL_LEGS_MJCF = ("the 3D walker's MJCF (a free pelvis on footfall patches, past the "
                      "straight legs' mid-stance foot-through) is a later step; its URDF is "
                      "written (--format urdf)")
+#: what the views of both 3D kinds refuse: a ground other than a plane, the contact model,
+#: the Adams and OpenSim exports
+_SPATIAL = {
+    **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
+    ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a later "
+                          "step (walk it in the rigid model: fixedpoint, simulate)"),
+    ("walk", "adams"): SPATIAL_EXPORT,
+    ("walk", "osim"): SPATIAL_EXPORT,
+}
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -414,15 +423,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
                                                  "ankle_torque", "torso_torque", "push_off",
                                                  "ankle_push_off", "virtual_constraints")},
-        **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
-        ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
-                              "later step (walk it in the rigid model: fixedpoint, "
-                              "simulate)"),
+        **_SPATIAL,
         ("walk", "mjcf"): SPATIAL_LEGS_MJCF,
         # the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.spatial_legs.spatial_legs_urdf_text)
-        ("walk", "adams"): SPATIAL_EXPORT,
-        ("walk", "osim"): SPATIAL_EXPORT,
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
                           "is a later step"),
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
@@ -432,14 +436,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
                                          "virtual_constraints")},
-        **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
-        ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a "
-                              "later step (walk it in the rigid model: fixedpoint, "
-                              "simulate)"),
+        **_SPATIAL,
         # the MJCF and the URDF: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
-        ("walk", "adams"): SPATIAL_EXPORT,
-        ("walk", "osim"): SPATIAL_EXPORT,
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
         ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
                                "the passive one, walkerlab fixedpoint)"),

@@ -29,6 +29,7 @@ from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.numerics import without_neutral
 
 __all__ = ["RESIDUAL_TOL", "BranchSystem", "MapFailed", "WalkerFamily", "critical_vector",
            "state_from_section", "step_map", "test_functions"]
@@ -236,10 +237,7 @@ class BranchSystem:
         if not w.neutral:
             return r
         if self._held is None:
-            names = w.state_names()
-            n2 = len(names)
-            kept = [int(round(v)) for v in w.section(np.arange(n2, dtype=float))]
-            pos = [kept.index(names.index(c)) for c in w.neutral]
+            pos = w.neutral_in_section()
             self._held = (pos, np.asarray(z, float)[pos].copy())
         pos, val = self._held
         r = np.asarray(r, float).copy()
@@ -314,11 +312,9 @@ class BranchSystem:
         D_sec = numeric_jacobian(w.section, np.asarray(xk, float))
         M = D_sec @ J @ D_from
         Fz = M - np.eye(z.size)
-        if w.neutral:  # their equations held (:meth:`_hold`): unit rows
-            self._hold(w, z, np.zeros(z.size))
-            pos = self._held[0]
-            Fz[pos, :] = 0.0
-            Fz[pos, pos] = 1.0
+        pos = w.neutral_in_section()  # their equations held (:meth:`_hold`): unit rows
+        Fz[pos, :] = 0.0
+        Fz[pos, pos] = 1.0
         return {"x": x, "period": T, "J": J, "M": M, "Fz": Fz,
                 "orbit": np.array([sg.x_start for sg in segs]),
                 "F": self._hold(w, z, np.asarray(w.section(xk), float) - z), "walker": w}
@@ -349,7 +345,7 @@ def test_functions(M: np.ndarray, neutral: int = 0) -> dict:
     """
     mu = np.linalg.eigvals(M)
     if neutral:
-        keep = np.delete(mu, np.argsort(np.abs(mu - 1.0), kind="stable")[:neutral])
+        keep = without_neutral(mu, neutral)
         m = keep.size
         pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
         prod = np.array([keep[i] * keep[j] for i, j in pairs]) if pairs else np.zeros(0)

@@ -310,11 +310,6 @@ def map_fd_jacobian(walker: HybridWalker, x: np.ndarray, solver: Solver, h: floa
     return numerics.fd_jacobian(P, x, h), nfev
 
 
-def _neutral_positions(mult: np.ndarray, k: int) -> list[int]:
-    """Positions of the ``k`` multipliers nearest 1 (the neutral coordinates')."""
-    return [int(i) for i in np.argsort(np.abs(np.asarray(mult) - 1.0), kind="stable")[:k]]
-
-
 @dataclass
 class FixedPointResult:
     """Period-1 gait: fixed point, period, multipliers and bookkeeping.
@@ -361,15 +356,14 @@ class FixedPointResult:
         (:attr:`HybridWalker.neutral`, in :attr:`neutral`): for each, the one nearest 1 -
         its gaits form a family along it, so its multiplier is 1 (to the integration's
         accuracy).  Empty for a walker without one."""
-        return self.multipliers_variational[_neutral_positions(
+        return self.multipliers_variational[numerics.neutral_positions(
             self.multipliers_variational, len(self.neutral))]
 
     @property
     def stable(self) -> bool:
         """Every multiplier (variational) strictly inside the unit circle, the neutral ones
         (:attr:`neutral_multipliers`) set aside."""
-        mult = np.delete(self.multipliers_variational, _neutral_positions(
-            self.multipliers_variational, len(self.neutral)))
+        mult = numerics.without_neutral(self.multipliers_variational, len(self.neutral))
         return bool(np.max(np.abs(mult)) < 1.0)
 
     @property
@@ -522,12 +516,8 @@ class _ReducedMap:
         heading), where ``F``'s Jacobian is singular, so the root finder solves the other
         equations for the other coordinates (:meth:`free_residual`): the member of the
         family at the start's heading."""
-        walker = self.walker
-        n2 = 2 * walker.n_coordinates
-        kept = [int(round(v)) for v in walker.section(np.arange(n2, dtype=float))]
-        names = walker.state_names()
-        self.held = [kept.index(names.index(c)) for c in walker.neutral]
-        self.free_at = [i for i in range(len(kept)) if i not in self.held]
+        self.held = self.walker.neutral_in_section()
+        self.free_at = [i for i in range(np.size(z0)) if i not in self.held]
         self.z_held = np.asarray(z0, float).copy()
 
     def free(self, z: np.ndarray) -> np.ndarray:

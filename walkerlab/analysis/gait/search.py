@@ -58,6 +58,7 @@ from walkerlab.analysis.gait.starts import (
 from walkerlab.analysis.gait.zero_dynamics import gaits_on_zero_dynamics, no_orbit_reason
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.numerics import without_neutral
 
 __all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "find_gaits", "order_gaits",
            "select_gait"]
@@ -123,11 +124,8 @@ class Gait:
         """Largest ``|Floquet multiplier|`` (variational) [-], the neutral ones
         (:attr:`FixedPointResult.neutral_multipliers`) set aside."""
         res = self.result
-        mult = res.multipliers_variational
-        if getattr(res, "neutral", ()):
-            mult = np.delete(mult, [int(np.argmin(np.abs(mult - m)))
-                                    for m in res.neutral_multipliers])
-        return float(np.max(np.abs(mult)))
+        return float(np.max(np.abs(without_neutral(res.multipliers_variational,
+                                                   len(getattr(res, "neutral", ()))))))
 
     def describe(self, time_unit: str = "s") -> str:
         """``long-period gait (step period 0.9398 s, max |multiplier| 0.593, stable)``."""

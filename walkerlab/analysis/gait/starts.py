@@ -246,10 +246,7 @@ def deflation_starts(walker: HybridWalker, first: FixedPointResult) -> list[np.n
     """
     z1 = walker.section(first.x)
     shorter_first = bool(first.stable)
-    n2 = 2 * walker.n_coordinates
-    names = walker.state_names()
-    kept = [int(round(v)) for v in walker.section(np.arange(n2, dtype=float))]
-    held = {kept.index(names.index(c)) for c in walker.neutral}  # a family: no partner
+    held = set(walker.neutral_in_section())  # a family along them: no partner there
     out = []
     for j in range(z1.size):
         if j in held:

@@ -32,6 +32,7 @@ import numpy as np
 
 from walkerlab.io.artifacts import open_artifact, put
 from walkerlab.io.netcdf import coordinate
+from walkerlab.numerics import without_neutral
 from walkerlab.units import Units, for_artifact
 
 STAGE = "fixedpoint"
@@ -363,11 +364,7 @@ class GaitResult:
     def max_abs_multiplier(self) -> float:
         """Largest |Floquet multiplier| (variational), the neutral ones (:attr:`neutral`:
         one nearest 1 for each) set aside."""
-        mult = np.asarray(self.multipliers)
-        if self.neutral and mult.size:
-            drop = np.argsort(np.abs(mult - 1.0), kind="stable")[:len(self.neutral)]
-            mult = np.delete(mult, drop)
-        return float(np.max(np.abs(mult)))
+        return float(np.max(np.abs(without_neutral(self.multipliers, len(self.neutral)))))
 
     @property
     def period_s(self) -> float:

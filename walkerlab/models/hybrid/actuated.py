@@ -24,7 +24,8 @@ from walkerlab.models.hybrid.actuators import Actuators, torque_chain_jacobian
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian
 
-__all__ = ["compiled_with", "Actuators", "actuate", "torque_chain_jacobian", "torque_feature"]
+__all__ = ["compiled_with", "Actuators", "actuate", "refuse_actuators",
+           "torque_chain_jacobian", "torque_feature"]
 
 
 def _functions(data):
@@ -356,6 +357,21 @@ def torque_feature(joint: str) -> str:
     return "hip_torque" if joint == "hip" else "torso_torque"
 
 
+def refuse_actuators(kind, spec, view: str) -> None:
+    """Refuse the first actuator ``spec`` (a ``walker.actuation`` section) asks for that
+    ``kind`` does not have in ``view``, in the table's one line naming its field.
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+    """
+    for i, t in enumerate(spec.torques):
+        kind.require(torque_feature(t.joint), view, f"walker.actuation.torques.{i}.joint")
+    for name in ("push_off", "ankle_push_off", "virtual_constraints"):
+        if getattr(spec, name, None) is not None:
+            kind.require(name, view, f"walker.actuation.{name}")
+
+
 class _RollingPolygon:
     """A walker without actuators so far (a spoked wheel: one rigid body, no joint; a walker
     in 3D) - every actuator refused by the table."""
@@ -364,13 +380,7 @@ class _RollingPolygon:
 
     def actuate(self, walker: HybridWalker, data, spec) -> HybridWalker:
         """Refuse the first actuator ``spec`` asks for (one line, naming its field)."""
-        kind = data.structure.kind
-        for i, t in enumerate(spec.torques):
-            kind.require(torque_feature(t.joint), "rigid",
-                         f"walker.actuation.torques.{i}.joint")
-        for name in ("push_off", "ankle_push_off"):
-            if getattr(spec, name) is not None:
-                kind.require(name, "rigid", f"walker.actuation.{name}")
+        refuse_actuators(data.structure.kind, spec, "rigid")
         return walker
 
 

@@ -321,6 +321,21 @@ class HybridWalker:
 
         return StateLayout.rigid(self.roles)
 
+    def section_names(self) -> list[str]:
+        """The state names of :attr:`section`'s coordinates, in its order (the state without
+        the coordinates the heel-strike surface fixes)."""
+        names = self.state_names()
+        kept = self.section(np.arange(len(names), dtype=float))
+        return [names[int(round(v))] for v in kept]
+
+    def neutral_in_section(self) -> list[int]:
+        """Positions of the :attr:`neutral` coordinates among :attr:`section`'s (empty for a
+        walker without any)."""
+        if not self.neutral:
+            return []
+        names = self.section_names()
+        return [names.index(c) for c in self.neutral]
+
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
         from walkerlab.walker.description import state_names
