@@ -232,3 +232,148 @@ def output_pieces(structure, params, outputs, phase, joints, prefix):
                                prefix, key)
     return OutputPieces(cache.import_generated(f"{key}_vc_{tag}.py",
                                                f"walkerlab_vc_{key}_{tag}", build))
+
+
+#: the computed-torque law over the generated ``pieces`` and ``flow_terms`` (numba source,
+#: appended to every compiled module: :func:`generate_compiled_controller`)
+_LAW = '''
+@njit(cache=True)
+def _bezier(c, s):  # pragma: no cover - runs compiled
+    k, m1 = c.shape
+    M = m1 - 1
+    hd = np.zeros(k)
+    hd1 = np.zeros(k)
+    hd2 = np.zeros(k)
+    for j in range(M + 1):
+        b = BINOM[M, j] * s ** j * (1.0 - s) ** (M - j)
+        for i in range(k):
+            hd[i] += c[i, j] * b
+    for j in range(M):
+        b = BINOM[M - 1, j] * s ** j * (1.0 - s) ** (M - 1 - j)
+        for i in range(k):
+            hd1[i] += M * (c[i, j + 1] - c[i, j]) * b
+    for j in range(M - 1):
+        b = BINOM[M - 2, j] * s ** j * (1.0 - s) ** (M - 2 - j)
+        for i in range(k):
+            hd2[i] += M * (M - 1) * (c[i, j + 2] - 2.0 * c[i, j + 1] + c[i, j]) * b
+    return hd, hd1, hd2
+
+
+@njit(cache=True)
+def law(x, alpha, theta_plus, dtheta, B, kp, kd, limit):  # pragma: no cover - runs compiled
+    v = np.empty(NOUT)
+    pieces(x, v)
+    a = K + K * N
+    th = v[a + K]
+    ddth = v[a + K + 1 + N]
+    ds = 0.0
+    for j in range(N):
+        ds += v[a + K + 1 + j] * x[N + j]
+    ds /= dtheta
+    hd, hd1, hd2 = _bezier(alpha, (th - theta_plus) / dtheta)
+    J = np.empty((K, N))  # dh/dq
+    for i in range(K):
+        for j in range(N):
+            J[i, j] = v[K + i * N + j] - hd1[i] * v[a + K + 1 + j] / dtheta
+    Mm = np.empty((N, N))
+    f = np.empty(N)
+    flow_terms(x, Mm, f)
+    rhs = np.empty((N, K + 1))
+    rhs[:, :K] = B
+    rhs[:, K] = f
+    sol = np.linalg.solve(Mm, rhs)  # [M^-1 B, M^-1 (-C dq - G)]
+    A = np.zeros((K, K + 1))  # [L_g L_f h, -(L_f^2 h + kp y + kd y')]
+    for i in range(K):
+        dy = 0.0
+        Jf = 0.0
+        for j in range(N):
+            dy += J[i, j] * x[N + j]
+            Jf += J[i, j] * sol[j, K]
+            for m in range(K):
+                A[i, m] += J[i, j] * sol[j, m]
+        lf2 = v[K + K * N + i] - hd2[i] * ds ** 2 - hd1[i] * ddth / dtheta + Jf
+        A[i, K] = -lf2 - kp * (v[i] - hd[i]) - kd * dy
+    u = np.linalg.solve(A[:, :K].copy(), A[:, K:].copy())[:, 0].copy()
+    if limit > 0.0:
+        for i in range(K):
+            if u[i] > limit:
+                u[i] = limit
+            elif u[i] < -limit:
+                u[i] = -limit
+    acc = np.zeros(N)
+    for j in range(N):
+        for m in range(K):
+            acc[j] += sol[j, m] * u[m]
+    return u, acc
+'''
+
+
+def generate_compiled_controller(eq, params, outputs, phase, joints, prefix: str,
+                                 key: str) -> str:
+    """numba source of the computed-torque law of :class:`walkerlab.models.virtual_constraints.
+    VirtualConstraintController` (Westervelt, Grizzle & Koditschek 2003, Eq. 38) for real
+    states: ``pieces(x, v)`` writes :func:`generate_pieces`' ``out`` into ``v``,
+    ``flow_terms(x, M, f)`` the mass matrix ``M`` (n, n) and ``f = -C dq - G`` (n,) of the
+    walker's flow (the same derivation, the parameters substituted), and ``law(x, alpha,
+    theta_plus, dtheta, B, kp, kd, limit) -> (u (k,), M^-1 B u (n,))`` the saturated torques
+    [N m] (``limit`` <= 0: none) and the acceleration they add [rad/s^2]."""
+    import sympy as sp
+    from sympy.printing.pycode import PythonCodePrinter
+
+    pr = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
+    out, _foot, _B = _expressions(eq, params, outputs, phase, joints, prefix)
+    sub = dict(zip(eq.params, params))
+    n = len(eq.q)
+    f = (-eq.C * sp.Matrix(eq.dq) - eq.G).subs(sub)
+    Mm = eq.M.subs(sub)
+    args = [*eq.q, *eq.dq]
+    unpack = "\n".join(f"    {a} = x[{i}]" for i, a in enumerate(args))
+
+    def function(name, targets):
+        repl, red = sp.cse([sp.sympify(e) for _, e in targets],
+                           symbols=sp.numbered_symbols("_s"), order="none")
+        body = [f"    {pr.doprint(a)} = {pr.doprint(e)}" for a, e in repl]
+        body += [f"    {t} = {pr.doprint(e)}" for (t, _), e in zip(targets, red)]
+        sig = ", ".join(["x", *sorted({t.split("[")[0] for t, _ in targets})])
+        return ["@njit(cache=True)", f"def {name}({sig}):  # pragma: no cover - runs compiled",
+                unpack, *body, ""]
+
+    lines = [f"# walkerlab compiled virtual-constraint law (walkerlab.codegen.virtual_constraints);"
+             f" key {key}",
+             "# Do not edit: regenerated when the walker, its outputs or the generator change.",
+             "from math import sin, cos, tan, sqrt, atan, atan2, acos, asin  # noqa: F401",
+             "import math", "import numpy as np", "from numba import njit", "",
+             f"K, N, NOUT = {len(outputs)}, {n}, {len(out)}",
+             "BINOM = np.array([[float(math.comb(a, b)) for b in range(16)] for a in range(16)])",
+             ""]
+    lines += function("pieces", [(f"v[{i}]", e) for i, e in enumerate(out)])
+    lines += function("flow_terms", [(f"M[{i}, {j}]", Mm[i, j]) for i in range(n)
+                                     for j in range(n)] + [(f"f[{i}]", f[i]) for i in range(n)])
+    return "\n".join(lines) + _LAW
+
+
+def compiled_controller(structure, params, outputs, phase, joints, prefix):
+    """The imported numba module of :func:`generate_compiled_controller` (file
+    ``<key>_vcnb_<hash>.py`` in the user cache, generated on a miss; numba's machine code
+    cached there too), or None where numba cannot be imported (the numpy law is then used).
+
+    Raises
+    ------
+    ValueError
+        As :func:`output_pieces`.
+    """
+    try:
+        import numba  # noqa: F401
+    except ImportError:  # pragma: no cover - numba is a dependency
+        return None
+    from walkerlab.codegen import cache
+
+    key = cache.cache_key(structure)
+    what = repr((tuple(float(p) for p in params), tuple(outputs), phase.model_dump_json(),
+                 tuple(joints), _source_hash()))
+    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
+
+    def build() -> str:
+        return generate_compiled_controller(derive_equations(structure), params, outputs,
+                                            phase, joints, prefix, key)
+    return cache.import_generated(f"{key}_vcnb_{tag}.py", f"walkerlab_vcnb_{key}_{tag}", build)

@@ -167,12 +167,15 @@ class VirtualConstraintController:
             raise ValueError(f"{KEY}.outputs: the walker has {n} coordinates: {n - 1} outputs "
                              f"(and actuators) leave a two-dimensional zero dynamics, not {k}")
         self.pieces = output_pieces(structure, params, outputs, spec.phase, joints, KEY)
+        self._pieces_args = (structure, params, outputs, spec.phase, joints, KEY)
+        self._law = None  # the compiled law (:meth:`_compiled_law`)
         self.B = self.pieces.B()
         self.kp = spec.feedback.kp_per_s2
         self.kd = spec.feedback.kd_per_s
         self.limit = spec.max_torque_n_m
         self.design = self._design(np.array([o.bezier_rad for o in spec.outputs], float))
         self._check_path()
+        self._compiled_law()  # built here, not within the first (timed) step it speeds up
 
     # ------------------------------------------------------------------ configurations
     def chart(self, q):
@@ -359,10 +362,47 @@ class VirtualConstraintController:
 
     def acceleration(self, x):
         """``(u (k,), M^-1 B u (n,))``: the torques [N m] (saturated) and the acceleration
-        they add [rad/s^2] at the state ``x`` (2n,) (complex-safe)."""
+        they add [rad/s^2] at the state ``x`` (2n,) (complex-safe).
+
+        A real state runs the law compiled by numba
+        (:func:`walkerlab.codegen.virtual_constraints.compiled_controller`: the same
+        expressions, equal to the numpy law to round-off); a complex one (complex-step
+        derivatives) the numpy law of :meth:`terms`."""
+        if not np.iscomplexobj(x):
+            law = self._compiled_law()
+            if law is not None:
+                d = self.design
+                return law(np.asarray(x, dtype=float), d.alpha, d.theta_plus,
+                           d.theta_minus - d.theta_plus, self.B, self.kp, self.kd,
+                           -1.0 if self.limit is None else float(self.limit))
         y, dy, A, Lf2, MinvB = self.terms(x)
         u = self._saturate(np.linalg.solve(A, -Lf2 - self.kp * y - self.kd * dy))
         return u, MinvB @ u
+
+    def __getstate__(self):  # the compiled law is rebuilt (from the user cache) on first use
+        state = dict(self.__dict__)
+        state["_law"] = None
+        return state
+
+    def _compiled_law(self):
+        """The compiled ``law`` (see :meth:`acceleration`; built once, loaded from the user
+        cache), or None without numba or for Bezier polynomials of degree 16 or more (the
+        numpy law then)."""
+        if self._law is False:
+            return None
+        if self._law is None:
+            self._law = False
+            if self.design.alpha.shape[1] <= 16:
+                from walkerlab.codegen.virtual_constraints import compiled_controller
+
+                mod = compiled_controller(*self._pieces_args)
+                if mod is not None:
+                    self._law = mod.law
+                    d = self.design  # numba compiles (or loads) on the first call
+                    self._law(np.concatenate([d.q_plus, np.zeros(self.n)]), d.alpha,
+                              d.theta_plus, d.theta_minus - d.theta_plus, self.B, 0.0, 0.0,
+                              -1.0)
+        return self._law or None
 
     def _saturate(self, u):
         if self.limit is None:
