@@ -21,6 +21,7 @@ its length first), then the call counter (last, as every compiled flow's).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -220,6 +221,7 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     return "\n".join(head + body) + "\n"
 
 
+@functools.cache  # the source does not change within a process
 def _source_hash() -> str:
     here = Path(__file__).parent
     h = hashlib.sha256()

@@ -25,6 +25,7 @@ raises.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from pathlib import Path
 
@@ -210,7 +211,10 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
 # ---------------------------------------------------------------------------- cache
 
 
-def _source_hash(paths) -> str:
+# the sources do not change within a process (a gym reset builds a contact model: the files
+# were read and hashed at each)
+@functools.cache
+def _source_hash(paths: tuple) -> str:
     h = hashlib.sha256()
     for p in paths:
         h.update(Path(p).read_bytes())
@@ -225,7 +229,7 @@ def module_key(structure: Structure, tag: str, sources=()) -> str:
 
     h = hashlib.sha256(cache.cache_key(structure).encode())
     h.update(tag.encode())
-    h.update(_source_hash([__file__, floating_equations.__file__, *sources]).encode())
+    h.update(_source_hash((__file__, floating_equations.__file__, *sources)).encode())
     return h.hexdigest()[:24]
 
 

@@ -18,6 +18,7 @@ For ``h0`` (k outputs) and ``theta`` the module returns numpy functions of the s
 
 from __future__ import annotations
 
+import functools
 import hashlib
 
 __all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_expressions",
@@ -202,6 +203,7 @@ class OutputPieces:
         return np.array(self._mod.B(np.zeros(2 * self.n)), dtype=float).reshape(self.n, self.k)
 
 
+@functools.cache  # the source does not change within a process
 def _source_hash() -> str:
     from pathlib import Path
 
