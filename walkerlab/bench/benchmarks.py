@@ -100,12 +100,36 @@ def _time_process(cmd: list[str], runs: int, cwd: Path | None = None) -> dict:
             "wall_max_s": float(np.max(walls)), "runs": runs}
 
 
+def _cpu_process(cmd: list[str]) -> float:
+    """CPU time [s] (user + system) of one finished process ``cmd``."""
+    import resource
+
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, check=True, capture_output=True)
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime)
+
+
 def bench_fixedpoint(runs: int = 5) -> dict:
-    """``walkerlab fixedpoint --force`` on the paper scene, whole process."""
+    """``walkerlab fixedpoint --force`` on the paper scene, whole process: its wall time
+    (target 1 s) and, against the bare numpy + scipy script that finds the same fixed point
+    (:mod:`walkerlab.bench.bare_fixedpoint`), the median over ``runs`` pairs (alternating
+    which goes first) of the ratio of their CPU times (issue goal: <= 1.3)."""
+    bare = [sys.executable, str(Path(__file__).with_name("bare_fixedpoint.py"))]
     with tempfile.TemporaryDirectory() as d:
         cmd = _cli("fixedpoint", "--force", "--runs-dir", d)
         subprocess.run(cmd, check=True, capture_output=True)  # warm the model code cache
-        return {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
+        out = {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
+        pairs = []
+        for i in range(runs):
+            order = (cmd, bare) if i % 2 == 0 else (bare, cmd)
+            cpu = {id(c): _cpu_process(c) for c in order}
+            pairs.append((cpu[id(cmd)], cpu[id(bare)]))
+    out.update(cpu_median_s=float(np.median([p[0] for p in pairs])),
+               bare_cpu_median_s=float(np.median([p[1] for p in pairs])),
+               cpu_over_bare=float(np.median([p[0] / p[1] for p in pairs])),
+               target_over_bare=1.3)
+    return out
 
 
 def bench_fixedpoint_3d(runs: int = 5) -> dict:

@@ -10,7 +10,9 @@ benchmark      what is timed                                                    
 ``ideal``      5 strides (10 steps) of the paper walker from its fixed point,   <= 10 ms
                DOP853 rtol = atol = 1e-10, compute only (median); per backend
 ``fixedpoint`` ``walkerlab fixedpoint --force`` on the paper scene, whole       <= 1.0 s
-               process (median of runs, model code cache warm)
+               process (median of runs, model code cache warm); its CPU         <= 1.3 x
+               over the bare scipy script's (walkerlab.bench.bare_fixedpoint),
+               median of the pairs' ratios
 ``sweep``      fixed-point sweep over the slope (0.5-4.5 deg, 201 points), 2    >= 50 pt/s
                worker processes, pool start included (model code cache warm),
                to the finished artifact; the figure drawn after it timed apart
