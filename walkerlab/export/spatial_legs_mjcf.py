@@ -42,6 +42,7 @@ Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyfra
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -78,7 +79,7 @@ def _rotation(axis, angle: float) -> np.ndarray:
     return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
 
 
-def legs3d_keyframe(points, velocities, x, slope_rad: float, leg_length_m: float,
+def legs3d_keyframe(points, velocities, x, slope_rad: float,
                     foot_radius_m: float) -> tuple[tuple, tuple]:
     """The ``gait`` keyframe of the 3D straight-legged walker at the rigid state ``x`` (just
     after a heel strike, roles ``lean``, ``swing``, ``stance``; leg2 in stance, leg1 the
@@ -108,8 +109,8 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float, leg_length_m: float
     x : ndarray (6,)
         ``[lean, swing, stance]`` [rad] and their rates [rad/s].
     slope_rad : float
-    leg_length_m, foot_radius_m : float
-        ``L`` and ``r`` [m].
+    foot_radius_m : float
+        The foot sphere's radius ``r`` [m].
 
     Returns
     -------
@@ -138,7 +139,7 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float, leg_length_m: float
     return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
 
 
-def legs3d_footfalls(points, x, slope_rad: float, steps: int) -> tuple[np.ndarray, np.ndarray]:
+def legs3d_footfalls(points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
     """The rigid gait's footfalls in MuJoCo's axes [m], leg1's and leg2's, from the
     keyframe's (leg2 in stance at the origin, leg1 trailing): leg2 at ``k S``
     (``k = 0 .. steps // 2``), leg1 at ``f + k S`` (``k = 0 .. steps // 2 + 1``: the
@@ -152,7 +153,6 @@ def legs3d_footfalls(points, x, slope_rad: float, steps: int) -> tuple[np.ndarra
         The rigid walker's generated ``points``: ``swing_foot`` (the trailing foot just
         after the heel strike).
     x : ndarray (6,)
-    slope_rad : float
     steps : int
         Footfalls ahead of the keyframe (both legs'), ``EXPORT_STEPS``.
 
@@ -160,7 +160,6 @@ def legs3d_footfalls(points, x, slope_rad: float, steps: int) -> tuple[np.ndarra
     -------
     leg1, leg2 : ndarray (k, 3)
     """
-    del slope_rad  # the footfalls lie on the slope through the origin already
     C = np.array(TO_MUJOCO)
     f = np.ravel(np.asarray(points(np.asarray(x, float))["swing_foot"], float))
     stride = -2.0 * np.array([f[0], f[1], 0.0])
@@ -169,6 +168,7 @@ def legs3d_footfalls(points, x, slope_rad: float, steps: int) -> tuple[np.ndarra
     return (f + k1 * stride) @ C.T, (k2 * stride) @ C.T
 
 
+@dataclass(frozen=True)
 class Legs3dScene:
     """What the 3D walker's MJCF carries beyond the walker (:func:`legs3d_scene`).
 
@@ -181,7 +181,11 @@ class Legs3dScene:
     patch_width_m : float
         Patch length along the slope [m] (``terrain.patch_width_m``).
     timestep_s : float
-    solref, solimp : tuple of float
+        MuJoCo ``option timestep`` [s].
+    solref : (float, float)
+        Contact time constant [s] and damping ratio [-].
+    solimp : tuple of float
+        Contact ``solimp`` (d0, dwidth, width [m], midpoint, power).
     friction : float
         Sliding friction coefficient [-] (``mu_static``).
     step_period_s : float
@@ -190,12 +194,16 @@ class Legs3dScene:
         Comments written into the file.
     """
 
-    def __init__(self, qpos, qvel, lanes, patch_width_m, timestep_s, solref, solimp,
-                 friction, step_period_s, notes=()):
-        self.qpos, self.qvel, self.lanes = tuple(qpos), tuple(qvel), lanes
-        self.patch_width_m, self.timestep_s = float(patch_width_m), float(timestep_s)
-        self.solref, self.solimp, self.friction = tuple(solref), tuple(solimp), float(friction)
-        self.step_period_s, self.notes = float(step_period_s), tuple(notes)
+    qpos: tuple
+    qvel: tuple
+    lanes: tuple
+    patch_width_m: float
+    timestep_s: float
+    solref: tuple
+    solimp: tuple
+    friction: float
+    step_period_s: float
+    notes: tuple = ()
 
 
 def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
@@ -235,8 +243,8 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     p = _numbers(data)
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
-                                 data.slope_rad, p["L"], p["r"])
-    lanes = legs3d_footfalls(f["points"], ideal.x, data.slope_rad, EXPORT_STEPS)
+                                 data.slope_rad, p["r"])
+    lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
     c, _knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
                                                    data.slope_rad, options)
@@ -250,8 +258,8 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         "passes through the ground at mid-stance).",
         f"Feet: condim 4, torsional friction {TORSION_FRACTION:g} L (the rigid stance foot "
         "neither slips nor twists).")
-    return Legs3dScene(qpos, qvel, lanes, terrain.patch_width_m, dt, solref, solimp, mu,
-                       period, notes)
+    return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
+                       tuple(solref), tuple(solimp), float(mu), period, notes)
 
 
 def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:

@@ -349,7 +349,9 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     date for the scene, else found as ``walkerlab fixedpoint`` finds it, from the scene's
     ``fixedpoint`` section or, without one, from its defaults (an automatic search).
     ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
-    default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`).
+    default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`);
+    a straight-legged walker in 3D: its own URDF / MJCF, a free pelvis
+    (:func:`_run_legs_3d`).
     ``mjcf``: the MJCF's contact time constant and timestep
     (:class:`walkerlab.export.mjcf_scene.MjcfOptions`; default: the scene's contact law's).
 
