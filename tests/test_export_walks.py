@@ -40,13 +40,15 @@ def _scene(name):
 #: have no multibody form (flat feet and their ankle push-off are exported:
 #: tests/test_export_flat_feet.py).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies",
-           # the 3D straight-legged walker's MJCF is a later step (its capability cell)
-           "paper_3d": "walker.space: 3d", "hip_width": "walker.space: 3d"}
+           "simplest": "walker.leg.bodies"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.
 NO_GAIT = {"rabbit_optimal": "no rigid gait"}
+#: Shipped scenes whose rigid gait is unstable faster than a walk of 10 steps, and the heel
+#: strikes their MJCF makes before it falls: hip_width's lateral mode (x 99.9 a stride, Kuo
+#: 1999) takes it after 3 (paper_3d, its upright twin, walks: its roll starts at 0).
+FALLS = {"hip_width": 3}
 FIRST = {"rimless_wheel": "spoke1", "rimless_wheel_3d": "spoke1",
          "rimless_wheel_3d_disc": "spoke1"}
 SHIPPED = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml"))
@@ -86,7 +88,9 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
     torso_bhm -0.03 %, torso_powered -0.03 %, stairs +0.04 % (patches at the footholds,
     each a riser lower), footholds +0.17 %, footholds_two +0.09 %, threelink +0.14 %,
     threelink_footholds +0.16 %, threelink_hzd +0.21 %, rabbit +0.05 %, rabbit_footholds
-    +0.20 %, rabbit_hzd and rabbit_hzd_optimal +0.20 %.  About 5-40 s each under load."""
+    +0.20 %, rabbit_hzd and rabbit_hzd_optimal +0.20 %, paper_3d (the free pelvis in 3D)
+    -0.005 %; hip_width falls after 3 heel strikes (:data:`FALLS`).  About 5-40 s each
+    under load."""
     scene = _scene(name)
     if name in REFUSED or name in NO_GAIT:
         with pytest.raises(ValueError) as err:
@@ -96,6 +100,9 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
         return
     check = export_stage.write(scene, tmp_path, "mjcf", walk=True).walk
     assert check.engine == "MuJoCo" and check.walked, check.line
+    if name in FALLS:
+        assert check.fell and check.strikes >= FALLS[name] and check.alternating, check.line
+        return
     assert not check.fell, check.line
     assert check.strikes >= 10 and check.alternating, check.line
     assert check.first_leg == FIRST.get(name, "leg1")  # leg2 stands at the keyframe

@@ -352,10 +352,13 @@ def _at_gait_keyframe(xml_path, doing: str):
 
 
 def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
-         feedback: VirtualConstraintFeedback | None = None) -> MujocoWalk:
+         feedback: VirtualConstraintFeedback | None = None, each=None) -> MujocoWalk:
     """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s]
     (``feedback``: the scene's virtual constraints, :func:`virtual_constraint_feedback`,
-    needed when the file carries them).
+    needed when the file carries them; ``each``: a callable ``(model, data)`` called after
+    every look, e.g. to record a 3D walker's lean).  The hip is the slide joints
+    ``hip_x``, ``hip_z`` of a planar walker or the free joint ``free`` of a walker in 3D
+    (:mod:`walkerlab.export.spatial_legs_mjcf`).
 
     Returns
     -------
@@ -381,14 +384,18 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
     latched = latch[0] >= 0 and h_rel is not None
     knee = [model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{g}_knee")]
             if latch[0] >= 0 else -1 for g in LEGS]
-    hip = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")]
+    slide = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")
+    # a walker in 3D: the pelvis on a free joint, its position the first three of qpos
+    hip = model.jnt_qposadr[slide if slide >= 0 else mujoco.mj_name2id(
+        model, mujoco.mjtObj.mjOBJ_JOINT, "free")]
+    up = hip + (1 if slide >= 0 else 2)  # the hip's height (world z)
     powered = None
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
         powered = powered_loop(model, feedback)
         powered.bind(model, site)
     nstep = 1 if latched or powered else LOOK_EVERY
     mujoco.mj_forward(model, data)
-    L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, hip + 1]])))
+    L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, up]])))
     last_contact = [data.time, data.time]  # both feet at the ground at the keyframe
     times, legs, pos = [], [], []
     fell = False
@@ -411,7 +418,9 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
                         if powered is not None:
                             powered.heel_strike(data, i)
                     last_contact[i] = data.time
-        if data.qpos[hip] * n[0] + data.qpos[hip + 1] * n[2] < 0.5 * L:
+        if each is not None:
+            each(model, data)
+        if data.qpos[hip] * n[0] + data.qpos[up] * n[2] < 0.5 * L:
             fell = True
             break
     return MujocoWalk(np.array(times), legs, np.array(pos), fell, float(data.time))

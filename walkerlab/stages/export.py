@@ -247,12 +247,17 @@ def _run_wheel_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_onl
     return Exported(path, _xml_lines((), scene), None if ideal is None else _step_period(ideal))
 
 
-def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool
-                 ) -> Exported:
+def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool,
+                 options=None) -> Exported:
     """The 3D straight-legged walker (``walker.space: 3d``): its URDF, a free pelvis and two
-    legs on hip joints (:func:`walkerlab.export.spatial_legs.spatial_legs_urdf_text`); the
-    other formats as the capability table has them (refused before this is reached)."""
+    legs on hip joints (:func:`walkerlab.export.spatial_legs.spatial_legs_urdf_text`), or its
+    MJCF, the same walker on a free joint with the rigid gait as its ``gait`` keyframe, the
+    footfall patches of its lanes and the scene's contact
+    (:func:`walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text`; ``options``: the MJCF's
+    :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
+    table has them (refused before this is reached)."""
     from walkerlab.export.spatial_legs import spatial_legs_urdf_text
+    from walkerlab.export.spatial_legs_mjcf import legs3d_mjcf_text, legs3d_scene
 
     data.structure.kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
     check_exportable(scene, data.structure.kind, fmt, walker_only)  # numbers, ground
@@ -260,10 +265,19 @@ def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only
         from walkerlab.models.hybrid.actuated import refuse_actuators
 
         refuse_actuators(data.structure.kind, scene.walker.actuation, FORMAT_VIEWS[fmt])
-    text = spatial_legs_urdf_text(data, name, walkerlab.__version__)
+    version = walkerlab.__version__
+    ideal = None
+    if fmt == "urdf":
+        text = spatial_legs_urdf_text(data, name, version)
+    elif walker_only:
+        text = legs3d_mjcf_text(data, name, version)
+    else:
+        ideal, extra = _gait(scene, runs_root, _with_ideal(
+            scene, lambda ideal: legs3d_scene(scene, data, ideal, options)))
+        text = legs3d_mjcf_text(data, name, version, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
     runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
-    return Exported(path, _xml_lines((), scene), None)
+    return Exported(path, _xml_lines((), scene), None if ideal is None else _step_period(ideal))
 
 
 def _gait_scene(scene: Scene, mb, data, runs_root, options=None):
@@ -335,7 +349,9 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     date for the scene, else found as ``walkerlab fixedpoint`` finds it, from the scene's
     ``fixedpoint`` section or, without one, from its defaults (an automatic search).
     ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
-    default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`).
+    default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`);
+    a straight-legged walker in 3D: its own URDF / MJCF, a free pelvis
+    (:func:`_run_legs_3d`).
     ``mjcf``: the MJCF's contact time constant and timestep
     (:class:`walkerlab.export.mjcf_scene.MjcfOptions`; default: the scene's contact law's).
 
@@ -385,7 +401,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
             raise ValueError("--mjcf-contact-time-constant-s, --mjcf-timestep-s: options of "
                              "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
                              "has its own contact")
-        out = _run_links(scene, runs_root, data, name, fmt, walker_only, mjcf)
+        run = _run_legs_3d if data.structure.kind.name == "straight_legs_3d" else _run_links
+        out = run(scene, runs_root, data, name, fmt, walker_only, mjcf)
     else:
         out = _WRITERS[data.structure.kind.name](scene, runs_root, data, name, fmt,
                                                  walker_only)

@@ -35,7 +35,8 @@ walker's :class:`Kind`:
     Straight legs on point feet in three dimensions (``model: compass_gait`` with
     ``space: 3d``): the walker rolls about the fall line through its stance foot and its
     legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
-    1999).  The rigid model and the URDF, passive, so far.
+    1999).  The rigid model, the MJCF (a free pelvis on footfall patches: it walks in
+    MuJoCo) and the URDF, passive, so far.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
@@ -246,11 +247,7 @@ SPATIAL_ACTUATION = ("a walker in 3D is passive so far (its actuators, a lateral
                      "foot-placement or hip-roll law, are a later step)")
 #: why the exports refuse a 3D walker
 SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is written as "
-                  "URDF (--format urdf), the 3D wheel as MJCF too")
-#: why the 3D straight-legged walker has no MJCF yet
-SPATIAL_LEGS_MJCF = ("the 3D walker's MJCF (a free pelvis on footfall patches, past the "
-                     "straight legs' mid-stance foot-through) is a later step; its URDF is "
-                     "written (--format urdf)")
+                  "URDF (--format urdf) or MJCF (--format mjcf)")
 #: what the views of both 3D kinds refuse: a ground other than a plane, the contact model,
 #: the Adams and OpenSim exports
 _SPATIAL = {
@@ -424,9 +421,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                                  "ankle_torque", "torso_torque", "push_off",
                                                  "ankle_push_off", "virtual_constraints")},
         **_SPATIAL,
-        ("walk", "mjcf"): SPATIAL_LEGS_MJCF,
-        # the URDF: a free pelvis and two legs on hip joints
-        # (walkerlab.export.spatial_legs.spatial_legs_urdf_text)
+        # the MJCF and the URDF: a free pelvis and two legs on hip joints
+        # (walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text: on footfall patches, past
+        # the straight legs' mid-stance foot-through; walkerlab.export.spatial_legs.
+        # spatial_legs_urdf_text)
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
                           "is a later step"),
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "

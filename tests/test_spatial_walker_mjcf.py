@@ -1,0 +1,185 @@
+"""The 3D straight-legged walker's MJCF (``walkerlab export --format mjcf`` of a ``model:
+compass_gait`` with ``space: 3d``; :mod:`walkerlab.export.spatial_legs_mjcf`) in MuJoCo:
+its bodies and masses against the walker description, its ``gait`` keyframe against the
+rigid gait's state (MuJoCo's own kinematics: ``mj_kinematics``, ``mj_integratePos``), its
+footfall lanes, and its walk against the rigid step period."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.cli.options import load
+from walkerlab.stages import export
+
+mujoco = pytest.importorskip("mujoco")
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the rigid step period of configs/paper_3d.yaml [s] (configs/paper.yaml's: the planar
+#: embedding, tests/test_spatial_walker.py)
+PAPER_STEP_S = 0.7035968805
+
+
+def _scene(name: str):
+    return load(str(ROOT / "configs" / f"{name}.yaml"))
+
+
+@pytest.fixture(scope="module")
+def paper_3d(tmp_path_factory):
+    """configs/paper_3d.yaml exported with its gait: (scene, path, Exported)."""
+    scene = _scene("paper_3d")
+    out = export.write(scene, tmp_path_factory.mktemp("paper_3d"), "mjcf")
+    return scene, out.path, out
+
+
+@pytest.mark.parametrize("name, width", [("paper_3d", 0.0), ("hip_width", 0.1)])
+def test_the_3d_walkers_mjcf_has_the_walkers_bodies_masses_and_hips(name, width, tmp_path):
+    """The MJCF loads in MuJoCo: a free pelvis (7 + 2 coordinates, no plane constraint), the
+    hip mass on it, each leg's 5 kg point mass 0.5 m below its hip (L - a), the hips
+    ``w / 2`` either side (leg1 on -y), total 20 kg (exact: the file's numbers read back).
+    The point masses' inertias are the export's floor, 1e-12 kg m^2 (the URDF's)."""
+    path = export.write(_scene(name), tmp_path, "mjcf", walker_only=True).path
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert (model.nq, model.nv) == (9, 8)
+    assert model.jnt_type[model.joint("free").id] == mujoco.mjtJoint.mjJNT_FREE
+    mass = {model.body(i).name: float(model.body_mass[i]) for i in range(1, model.nbody)}
+    assert mass == {"pelvis": 10.0, "leg1": 5.0, "leg2": 5.0}
+    assert float(model.body_mass.sum()) == 20.0
+    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
+        b = model.body(leg)
+        assert np.array_equal(b.pos, [0.0, side * width / 2, 0.0])
+        assert np.array_equal(b.ipos, [0.0, 0.0, -0.5])
+        assert np.all(b.inertia == 1e-12)
+        assert np.array_equal(model.joint(f"{leg}_hip").axis, [0.0, -1.0, 0.0])
+    assert np.all(model.body("pelvis").inertia == 1e-12)
+
+
+def test_the_3d_walkers_keyframe_is_the_rigid_gait_on_its_foot_sphere(paper_3d):
+    """The ``gait`` keyframe put through MuJoCo's kinematics is the rigid gait's state: the
+    hinge angles are the leg angles and the pelvis unrolled (exactly: zero hip width), the
+    leg masses where the rigid model has them to the foot sphere's radius r = 1 mm (the
+    walker is moved so that the sphere, not the point foot, touches the slope at the
+    origin: ``r (e + n)``, at most 2 r), and their velocities (MuJoCo's, by
+    ``mj_integratePos`` over 1e-7 s) to 2 r |omega| (the sphere's roll, |omega| < 1.5
+    rad/s); the stance sphere's contact point at the origin (1e-12) and at rest (1e-6: the
+    finite difference; the keyframe turns the stance leg about it), the trailing sphere
+    on the slope to r theta^2 (its centre 1 mm up the leg)."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.codegen.cache import functions
+    from walkerlab.export.spoked import TO_MUJOCO
+    from walkerlab.walker.description import walker_data
+
+    scene, path, out = paper_3d
+    assert out.step_period_s == pytest.approx(PAPER_STEP_S, rel=1e-9)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("gait").id)
+    mujoco.mj_kinematics(model, data)
+    x = ideal_gait(scene).x
+    f = functions(walker_data(scene.walker, scene.slope.phi_rad))
+    C = np.array(TO_MUJOCO)
+    pts = {k: C @ np.ravel(v) for k, v in f["points"](x).items()}
+    vel = {k: C @ np.ravel(v) for k, v in f["point_velocities"](x).items()}
+    assert data.qpos[7] == x[1] and data.qpos[8] == x[2]       # leg1 swings, leg2 stands
+    assert np.max(np.abs(data.qpos[3:7] - [1, 0, 0, 0])) < 1e-15
+    r, phi = 1e-3, scene.slope.phi_rad
+    n = np.array([math.sin(phi), 0.0, math.cos(phi)])
+    mass_at = {"leg1": "swing_mass", "leg2": "stance_mass", "pelvis": "hip"}
+    for body, point in mass_at.items():
+        assert np.linalg.norm(data.xipos[model.body(body).id] - pts[point]) < 2 * r
+    foot = data.geom_xpos[model.geom("leg2_foot").id] - r * n      # the contact point
+    assert np.max(np.abs(foot)) < 1e-12
+    trailing = data.geom_xpos[model.geom("leg1_foot").id] - r * n
+    assert abs(trailing @ n) < r * x[1] ** 2
+    h = 1e-7
+    q1 = data.qpos.copy()
+    mujoco.mj_integratePos(model, q1, data.qvel, h)
+    d1 = mujoco.MjData(model)
+    d1.qpos[:] = q1
+    mujoco.mj_kinematics(model, d1)
+    for body, point in mass_at.items():
+        i = model.body(body).id
+        v = (d1.xipos[i] - data.xipos[i]) / h
+        assert np.linalg.norm(v - vel[point]) < 2 * r * 1.5
+    g = model.geom("leg2_foot").id
+    v_centre = (d1.geom_xpos[g] - data.geom_xpos[g]) / h
+    w_leg = C @ np.array([0.0, 0.0, x[5]])             # the stance leg's rate (no lean)
+    assert np.linalg.norm(v_centre + np.cross(w_leg, -r * n)) < 1e-6  # rolls, no slip
+
+
+def test_the_hip_width_walkers_lanes_lie_apart_through_each_legs_footfalls(tmp_path):
+    """With 10 cm of hip width the footfall patches lie in two lanes 0.1 m apart laterally
+    (leg1's at the rigid trailing foot's side, -y; leg2's through the origin), each patch
+    on the slope, its footfalls a rigid stride (two steps of 0.3718 m, 0.1 m across each,
+    their lateral parts cancelling) apart, each
+    lane touched by its own foot only (contact bits 2 and 4)."""
+    path = export.write(_scene("hip_width"), tmp_path, "mjcf").path
+    model = mujoco.MjModel.from_xml_path(str(path))
+    lanes = {}
+    for i in range(model.ngeom):
+        name = model.geom(i).name
+        if "_patch" in name:
+            lanes.setdefault(name.split("_")[0], []).append(i)
+    assert set(lanes) == {"leg1", "leg2"} and len(lanes["leg2"]) >= 11
+    y1 = model.geom_pos[lanes["leg1"], 1]
+    y2 = model.geom_pos[lanes["leg2"], 1]
+    assert np.ptp(y1) < 1e-12 and np.ptp(y2) < 1e-12
+    assert abs(y2[0]) < 1e-12 and y1[0] == pytest.approx(-0.1, abs=1e-5)
+    # a stride: two rigid steps of 0.37181516 m, each 0.1 m across (they cancel), the
+    # rest along the slope (its horizontal part: cos(slope))
+    stride = 2 * math.sqrt(0.37181516 ** 2 - 0.1 ** 2) * math.cos(0.0174)
+    assert np.diff(model.geom_pos[lanes["leg2"], 0]) == pytest.approx(stride, rel=1e-5)
+    assert set(model.geom_contype[lanes["leg1"]]) == {2}
+    assert set(model.geom_contype[lanes["leg2"]]) == {4}
+    assert model.geom_conaffinity[model.geom("leg1_foot").id] == 2
+    assert model.geom_conaffinity[model.geom("leg2_foot").id] == 4
+
+
+@pytest.mark.slow  # ~3 s: 8 s of a 44 us timestep (the gait search besides)
+def test_the_paper_3d_mjcf_walks_ten_heel_strikes_at_the_rigid_period_and_stays_upright(
+        paper_3d):
+    """configs/paper_3d.yaml's MJCF, the free pelvis started from the rigid gait, makes >= 10
+    alternating heel strikes in MuJoCo, each step period within 3 % of the rigid one (the
+    capability table's MJCF tolerance: MuJoCo's contact is soft and linear; measured: each
+    within 0.07 %, the heel strikes read every 5 timesteps, 0.22 ms), and its lean stays
+    below 1e-6 rad: started exactly upright the walker is mirror-symmetric and so is
+    MuJoCo's elliptic friction cone, so the only seeds of the unstable roll (x 11.2 a step)
+    are the rigid gait's ~1e-35 rad (measured: < 1e-23 rad over 11 strikes; the pyramidal
+    cone's roundoff grew to 1e-6 rad by the tenth)."""
+    from walkerlab.export.mujoco_walk import walk
+    from walkerlab.export.spatial_legs_mjcf import pelvis_lean_rad
+
+    scene, path, out = paper_3d
+    leans = []
+    run = walk(path, 11.3 * out.step_period_s, each=lambda m, d: leans.append(
+        pelvis_lean_rad(m, d, scene.slope.phi_rad)))
+    assert not run.fell and run.alternating and len(run.times_s) >= 10
+    assert np.max(np.abs(run.step_periods_s / PAPER_STEP_S - 1.0)) < 0.03
+    assert np.max(np.abs(leans)) < 1e-6
+
+
+@pytest.mark.slow  # ~3 s: the hip_width gait search and its MuJoCo walk
+def test_the_hip_width_mjcf_makes_three_heel_strikes_before_its_lateral_mode_falls(tmp_path):
+    """configs/hip_width.yaml's rigid gait has an unstable lateral mode (x 99.9 a stride):
+    its MJCF follows the rigid first step (the lean to 1.4 mrad) and then the mode takes it,
+    as the rigid model predicts: 3 alternating heel strikes, then the fall (measured: the
+    first step 0.7109 s against the rigid 0.7035 s)."""
+    out = export.write(_scene("hip_width"), tmp_path, "mjcf", walk=True)
+    w = out.walk
+    assert w.fell and w.alternating and w.strikes == 3, w.line
+
+
+def test_the_3d_walkers_mjcf_on_continuous_ground_is_refused_in_one_line(tmp_path):
+    """The swing foot passes through the ground at mid-stance (the rigid model's): the MJCF
+    lays footfall patches, so ``terrain.lanes: continuous`` is refused, one line naming it,
+    nothing written."""
+    scene = _scene("paper_3d")
+    scene = scene.model_copy(update={"terrain": scene.terrain_or_default().model_copy(
+        update={"lanes": "continuous"})})
+    with pytest.raises(ValueError) as err:
+        export.write(scene, tmp_path, "mjcf")
+    assert "terrain.lanes" in str(err.value) and "\n" not in str(err.value)
+    assert not list(tmp_path.rglob("walker.*"))

@@ -1,0 +1,376 @@
+"""A straight-legged walker in three dimensions (``model: compass_gait`` with ``space: 3d``;
+:func:`walkerlab.codegen.spatial.derive_compass`) as a MuJoCo model (MJCF) that walks from
+the rigid gait.
+
+The walker is the URDF's (:func:`walkerlab.export.spatial_legs.spatial_legs_urdf_text`): a
+pelvis body carrying the hip mass on a free joint ``free`` (no plane constraint), and a leg
+on each side of it, ``hip_width / 2`` along the hip axis (MuJoCo's body y), on a hinge
+``leg<i>_hip`` about that axis (``0 -1 0``: a positive angle moves the foot ahead, the rigid
+model's leg pitch ``theta``).  Axes are MuJoCo's (z up; x downhill; y = walkerlab's -z,
+:data:`walkerlab.export.spoked.TO_MUJOCO`); ``leg1`` on the side of -y (walkerlab's +z,
+where the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m``
+above its foot and a sphere of radius ``r = L / 1000`` whose centre is ``L - r`` down the
+leg (its lowest point at ``L`` with the leg upright, as the 3D wheel's spoke tips), with a
+site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest inertia
+(:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
+
+The ground is the planar straight-legged walker's checkerboard
+(:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
+ground at mid-stance (it is ignored there), so the slope is laid as patches
+``terrain.patch_width_m`` long centred on the rigid gait's footfalls, one lane per leg whose
+contact bits (:data:`~walkerlab.export.mjcf_scene.LANE_BITS`) only its own foot touches:
+leg2 (in stance at the keyframe, its contact point at the origin) at footfalls ``k S``,
+leg1 at ``f + k S`` (``f`` the keyframe's trailing foot, ``S`` the stride: twice the
+step's advance, its lateral part cancelling step by step).  With hip width the lanes lie
+apart laterally, each through its leg's footfalls; with none they coincide and the bits
+alone keep them apart.
+
+Contact: the planar export's (:func:`walkerlab.export.scene.mujoco_contact`: the scene's
+IMPACT law linearised at the walker's static penetration, a stiffer time constant and its
+timestep), with ``condim 4`` at the feet: sliding and torsional friction, as the rigid
+model's stance foot neither slips nor twists (it rolls and pitches freely: no rolling
+friction); the torsional coefficient is :data:`TORSION_FRACTION` of the leg length.  The
+friction cone is elliptic (MuJoCo's exact Coulomb cone): the default pyramidal cone sums
+its facets in an order that breaks the walker's mirror symmetry by roundoff (~1e-16 rad of
+lean at the first step of configs/paper_3d.yaml), which the unstable roll (x 11.2 a step)
+grows to 1e-6 rad by the tenth heel strike; the elliptic cone keeps an upright walker
+upright (< 1e-23 rad over 11 heel strikes).
+
+Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from walkerlab.export.mjcf_scene import LANE_BITS, MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.spoked import TO_MUJOCO, WHEEL_TIP_FRACTION
+from walkerlab.export.text import AXIS, comment, num, nums
+
+__all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
+           "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
+
+#: The feet's torsional friction coefficient [m] as a fraction of the leg length: the torque
+#: about the ground's normal a stance foot holds is this times its normal force (MuJoCo's
+#: ``condim 4``).  The rigid model's foot does not twist; the yaw moment of a swinging leg
+#: ``w`` off the stance foot's line is ~ ``m_leg a w`` (5 kg x 3 m/s^2 x 0.1 m = 1.5 N m on
+#: a 200 N load: 0.0075 m): 0.05 L holds it with room.
+TORSION_FRACTION = 0.05
+
+
+def _numbers(data) -> dict:
+    """The walker's numbers by name (:data:`walkerlab.walker.description.
+    SPATIAL_COMPASS_PARAMS`), ``w_hip`` 0 without hip width, and the foot sphere's radius
+    ``r`` [m]."""
+    p = dict(zip(data.structure.param_names, data.params))
+    p.setdefault("w_hip", 0.0)
+    p["r"] = WHEEL_TIP_FRACTION * p["L"]
+    return p
+
+
+def _rotation(axis, angle: float) -> np.ndarray:
+    """Rotation matrix (3, 3) by ``angle`` [rad] about the unit vector ``axis`` (3,)."""
+    k = np.asarray(axis, float)
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
+
+
+def legs3d_keyframe(points, velocities, x, slope_rad: float,
+                    foot_radius_m: float) -> tuple[tuple, tuple]:
+    """The ``gait`` keyframe of the 3D straight-legged walker at the rigid state ``x`` (just
+    after a heel strike, roles ``lean``, ``swing``, ``stance``; leg2 in stance, leg1 the
+    trailing leg): MuJoCo's ``qpos`` (9,) and ``qvel`` (8,) in its axes (:data:`TO_MUJOCO`).
+
+    ``qpos`` = the pelvis' position [m], its orientation as the unit quaternion ``w, x, y,
+    z`` (the rigid model's roll ``lean`` about the fall line ``s``: ``C Rot(s, lean) C^T``,
+    ``C`` = :data:`TO_MUJOCO`), then ``leg1_hip`` = the swing angle and ``leg2_hip`` = the
+    stance angle [rad] (the rigid legs are ``Rot(s, lean) Rot(z, theta)``: the hinge angle
+    about the pelvis' hip axis is ``theta``).  ``qvel`` = the pelvis' velocity [m/s] (world
+    axes), its angular velocity ``lean' s`` [rad/s] in the body's axes (MuJoCo's free
+    joint), then the two legs' rates [rad/s].
+
+    The stance foot's sphere (radius ``r``, centre ``L - r`` down the leg) touches the
+    slope at the origin, where the rigid point foot is: the walker is moved by
+    ``r (e + n)`` (``e`` the stance leg's unit vector from hip to foot, ``n`` the slope's
+    normal), and its velocities are the rigid ones plus ``r omega x (e + n)`` (``omega``
+    the stance leg's angular velocity, ``lean' s + theta_st' a``, ``a`` the hip axis): the
+    stance leg turning about its contact point, as the sphere rolls.
+
+    Parameters
+    ----------
+    points, velocities : callable ``x -> dict[str, ndarray (3,)]``
+        The rigid walker's generated ``points`` and ``point_velocities``
+        (:func:`walkerlab.codegen.cache.functions`; world axes of walkerlab, the stance foot
+        at the origin): ``hip`` (the pelvis), ``stance_hip``.
+    x : ndarray (6,)
+        ``[lean, swing, stance]`` [rad] and their rates [rad/s].
+    slope_rad : float
+    foot_radius_m : float
+        The foot sphere's radius ``r`` [m].
+
+    Returns
+    -------
+    (qpos (9,), qvel (8,)) : tuple of float
+    """
+    from scipy.spatial.transform import Rotation
+
+    x = np.asarray(x, float)
+    lean, sw, st, dlean, dsw, dst = x
+    C = np.array(TO_MUJOCO)
+    fall = np.array([math.cos(slope_rad), -math.sin(slope_rad), 0.0])
+    nrm = np.array([math.sin(slope_rad), math.cos(slope_rad), 0.0])
+    R = _rotation(fall, lean)                               # pelvis -> world (walkerlab)
+    axis = R @ np.array([0.0, 0.0, 1.0])                    # the hip axis
+    pts = {k: np.ravel(np.asarray(v, float)) for k, v in points(x).items()}
+    vel = {k: np.ravel(np.asarray(v, float)) for k, v in velocities(x).items()}
+    e = -pts["stance_hip"] / np.linalg.norm(pts["stance_hip"])   # stance hip -> foot
+    omega_st = dlean * fall + dst * axis
+    shift = foot_radius_m * (e + nrm)
+    pelvis = pts["hip"] + shift
+    v_pelvis = vel["hip"] + foot_radius_m * np.cross(omega_st, e + nrm)
+    Rm = C @ R @ C.T
+    qx, qy, qz, qw = Rotation.from_matrix(Rm).as_quat()
+    qpos = (*(C @ pelvis), qw, qx, qy, qz, sw, st)
+    qvel = (*(C @ v_pelvis), *(Rm.T @ (C @ (dlean * fall))), dsw, dst)
+    return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
+
+
+def legs3d_footfalls(points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """The rigid gait's footfalls in MuJoCo's axes [m], leg1's and leg2's, from the
+    keyframe's (leg2 in stance at the origin, leg1 trailing): leg2 at ``k S``
+    (``k = 0 .. steps // 2``), leg1 at ``f + k S`` (``k = 0 .. steps // 2 + 1``: the
+    trailing foot, then its landings), ``f`` the trailing foot, ``S = -2 (f - (f . z) z)``
+    the stride (the gait's two steps mirror each other about the fall line: their
+    advances add, their lateral offsets cancel).
+
+    Parameters
+    ----------
+    points : callable ``x -> dict[str, ndarray (3,)]``
+        The rigid walker's generated ``points``: ``swing_foot`` (the trailing foot just
+        after the heel strike).
+    x : ndarray (6,)
+    steps : int
+        Footfalls ahead of the keyframe (both legs'), ``EXPORT_STEPS``.
+
+    Returns
+    -------
+    leg1, leg2 : ndarray (k, 3)
+    """
+    C = np.array(TO_MUJOCO)
+    f = np.ravel(np.asarray(points(np.asarray(x, float))["swing_foot"], float))
+    stride = -2.0 * np.array([f[0], f[1], 0.0])
+    k2 = np.arange(steps // 2 + 1)[:, None]
+    k1 = np.arange(steps // 2 + 2)[:, None]
+    return (f + k1 * stride) @ C.T, (k2 * stride) @ C.T
+
+
+@dataclass(frozen=True)
+class Legs3dScene:
+    """What the 3D walker's MJCF carries beyond the walker (:func:`legs3d_scene`).
+
+    Attributes
+    ----------
+    qpos, qvel : tuple of float
+        The ``gait`` keyframe (9,), (8,) (:func:`legs3d_keyframe`).
+    lanes : (ndarray (k1, 3), ndarray (k2, 3))
+        leg1's and leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`).
+    patch_width_m : float
+        Patch length along the slope [m] (``terrain.patch_width_m``).
+    timestep_s : float
+        MuJoCo ``option timestep`` [s].
+    solref : (float, float)
+        Contact time constant [s] and damping ratio [-].
+    solimp : tuple of float
+        Contact ``solimp`` (d0, dwidth, width [m], midpoint, power).
+    friction : float
+        Sliding friction coefficient [-] (``mu_static``).
+    step_period_s : float
+        The rigid gait's step period [s].
+    notes : tuple of str
+        Comments written into the file.
+    """
+
+    qpos: tuple
+    qvel: tuple
+    lanes: tuple
+    patch_width_m: float
+    timestep_s: float
+    solref: tuple
+    solimp: tuple
+    friction: float
+    step_period_s: float
+    notes: tuple = ()
+
+
+def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
+    """The keyframe, footfall lanes and contact of ``scene``'s 3D walker at the rigid gait
+    ``ideal`` (``x``, ``period_s``; legs that alternate sides: a stride of two steps).
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    data : WalkerData
+        The 3D walker (:func:`walkerlab.walker.description.walker_data`).
+    ideal : gait
+        ``x`` (6,), ``period_s`` [s], ``step_lengths_m`` (one per step of its period).
+    options : walkerlab.export.mjcf_scene.MjcfOptions, optional
+        The contact's time constant and the timestep.
+
+    Returns
+    -------
+    Legs3dScene
+
+    Raises
+    ------
+    ValueError
+        A ground other than the slope laid as a checkerboard (one line naming
+        ``terrain.lanes``).
+    """
+    from walkerlab.codegen.cache import functions
+    from walkerlab.config.contact import ContactSettings
+    from walkerlab.export.scene import EXPORT_STEPS, mujoco_contact
+    from walkerlab.models.contact.rigid_limit import contact_si
+
+    terrain = scene.terrain_or_default()
+    if terrain.lanes != "checkerboard":
+        raise ValueError("terrain.lanes: the 3D walker's MJCF lays footfall patches "
+                         "(checkerboard): its swing foot passes through the ground at "
+                         "mid-stance, as the rigid model's does")
+    p = _numbers(data)
+    f = functions(data)
+    qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
+                                 data.slope_rad, p["r"])
+    lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
+    c, _knee = contact_si(scene.contact or ContactSettings())
+    dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
+                                                   data.slope_rad, options)
+    steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
+    period = float(ideal.period_s) / steps
+    notes = (f"Keyframe 'gait': the rigid walker's gait just after a heel strike (step "
+             f"period {period:.6g} s), leg2 in stance, its foot sphere on the slope at the "
+             "origin.",) + notes + (
+        f"Terrain: footfall patches {terrain.patch_width_m:g} m long at the rigid gait's "
+        "footfalls, leg<i>_patch<k> touched by leg<i>'s foot only (the rigid swing foot "
+        "passes through the ground at mid-stance).",
+        f"Feet: condim 4, torsional friction {TORSION_FRACTION:g} L (the rigid stance foot "
+        "neither slips nor twists).")
+    return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
+                       tuple(solref), tuple(solimp), float(mu), period, notes)
+
+
+def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
+    """Each lane's patches: boxes ``patch_width_m`` along the slope, ``0.08 L`` across,
+    their tops on the slope through the footfalls."""
+    n = np.array([math.sin(phi), 0.0, math.cos(phi)])       # MuJoCo axes
+    w = extra.patch_width_m
+    depth = w / 10
+    size = nums(w / 2, 0.04 * p["L"], depth)
+    out = []
+    for leg, falls in zip(("leg1", "leg2"), extra.lanes):
+        for k, s in enumerate(falls):
+            centre = np.asarray(s, float) - depth * n
+            out.append(f'    <geom name="{leg}_patch{k}" type="box" size="{size}" '
+                       f'pos="{nums(*centre)}" euler="{nums(0, phi, 0)}" '
+                       f'contype="{LANE_BITS[leg]}" conaffinity="0" rgba="0.8 0.8 0.8 1"/>')
+    return out
+
+
+def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | None = None
+                     ) -> str:
+    """The 3D straight-legged walker as a MuJoCo model (MJCF; module docstring).
+
+    Parameters
+    ----------
+    data : WalkerData
+        Its parameters (:data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`, with
+        ``w_hip`` when the hips are apart).
+    name, version : str
+        Model name (the scene's) and walkerlab's version (header comment).
+    extra : Legs3dScene, optional
+        The keyframe, footfall patches and contact (:func:`legs3d_scene`); without it the
+        walker alone on the slope's plane with MuJoCo's default contact and no keyframe
+        (``--walker-only``).
+
+    Returns
+    -------
+    str
+        MJCF XML (MuJoCo XML Reference): total mass ``M_hip + 2 m_leg``.
+    """
+    p = _numbers(data)
+    L, a, w, r, phi = p["L"], p["a_leg"], p["w_hip"], p["r"], data.slope_rad
+    lo = num(MJCF_MIN_INERTIA_KG_M2)
+    out = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
+                   f"legs of {num(L)} m, {num(p['m_leg'])} kg at {num(a)} m from each foot, "
+                   f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope {num(phi)} "
+                   "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
+                   "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
+                   "x downhill, z up, leg1 on the side of -y; a foot sphere of radius "
+                   f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot)."),
+           f"<mujoco model={quoteattr(name)}>",
+           *(comment(note) for note in (extra.notes if extra else ())),
+           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
+    if extra is None:
+        out += [f'  <option gravity="{nums(0, 0, -p["g"])}"/>',
+                '  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
+                '</default>', "  <worldbody>",
+                f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
+                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
+    else:
+        out += [f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(extra.timestep_s)}"'
+                ' integrator="implicitfast" cone="elliptic"/>',
+                f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
+                f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
+                f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="4"/>'
+                '</default>', "  <worldbody>", *_patches(p, extra, phi)]
+    out += ['    <body name="pelvis" pos="0 0 0">',
+            '      <freejoint name="free"/>',
+            f'      <inertial pos="0 0 0" mass="{num(p["M_hip"])}" '
+            f'diaginertia="{lo} {lo} {lo}"/>',
+            f'      <geom name="pelvis" type="sphere" size="{num(L / 25)}"/>']
+    if w > 0:
+        out.append(f'      <geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
+                   f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>')
+    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
+        out += [f'      <body name="{leg}" pos="{nums(0, side * w / 2, 0)}">',
+                f'        <joint name="{leg}_hip" type="hinge" axis="{AXIS}"/>',
+                f'        <inertial pos="{nums(0, 0, -(L - a))}" mass="{num(p["m_leg"])}" '
+                f'diaginertia="{lo} {lo} {lo}"/>',
+                f'        <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
+                f'size="{num(L / 100)}"/>',
+                f'        <site name="{leg}_foot" pos="{nums(0, 0, -(L - r))}"/>',
+                f'        <geom name="{leg}_foot" type="sphere" pos="{nums(0, 0, -(L - r))}" '
+                f'size="{num(r)}" contype="0" conaffinity="{LANE_BITS[leg]}"/>',
+                "      </body>"]
+    out += ["    </body>", "  </worldbody>",
+            "  <custom>", f'    <numeric name="slope_rad" data="{num(phi)}"/>',
+            '    <numeric name="foot_height_offset_m" data="0.0"/>', "  </custom>"]
+    if extra is not None:
+        out += ["  <keyframe>",
+                f'    <key name="gait" qpos="{nums(*extra.qpos)}" qvel="{nums(*extra.qvel)}"/>',
+                "  </keyframe>"]
+    return "\n".join(out + ["</mujoco>", ""])
+
+
+def pelvis_lean_rad(model, data, slope_rad: float) -> float:
+    """The pelvis' roll about the fall line [rad] in a MuJoCo state: the rigid model's
+    ``lean`` (``asin`` of the hip axis' component along the slope's normal; body y is the
+    hip axis, walkerlab's -z rolled).
+
+    Parameters
+    ----------
+    model, data : mujoco.MjModel, mujoco.MjData
+        The walker of :func:`legs3d_mjcf_text` (body ``pelvis``), after ``mj_forward`` or a
+        step.
+    slope_rad : float
+
+    Returns
+    -------
+    float
+    """
+    R = np.asarray(data.xmat[model.body("pelvis").id], float).reshape(3, 3)
+    n = np.array([math.sin(slope_rad), 0.0, math.cos(slope_rad)])
+    return float(math.asin(max(-1.0, min(1.0, R[:, 1] @ n))))
