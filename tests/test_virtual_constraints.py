@@ -417,11 +417,12 @@ def test_walkers_the_quadrature_does_not_hold_for_refused(name, words):
 
 @pytest.mark.parametrize("limit", [None, 40.0])
 def test_the_compiled_law_equals_the_numpy_law(walker, limit):
-    """The real-state law runs compiled by numba (issue 65: the virtual-constraint feedback
-    compiled like the flow); at states off the surface its torques and M^-1 B u equal the
-    numpy law's (the complex path, the same expressions printed apart) to 1e-12 of their
-    size, and a torque limit saturates both alike.  The closed loop's y'' = -kp y - kd y'
-    against test-side outputs is checked above on the compiled path."""
+    """The law runs compiled by numba (issue 65: the virtual-constraint feedback compiled
+    like the flow); at states off the surface its torques and M^-1 B u equal the numpy
+    law's (the same expressions printed apart) to 1e-12 of their size, real and complex
+    (the complex step along a random direction: its derivative to 1e-9, the complex step
+    being exact to round-off), and a torque limit saturates both alike.  The closed loop's
+    y'' = -kp y - kd y' against test-side outputs is checked above on the compiled path."""
     ctrl = walker.actuators.controller
     assert ctrl._compiled_law() is not None
     saved = ctrl.limit
@@ -435,12 +436,19 @@ def test_the_compiled_law_equals_the_numpy_law(walker, limit):
                                                                               size=ctrl.n)
             x = np.concatenate([q, rng.normal(scale=2.0, size=ctrl.n)])
             u, a = ctrl.acceleration(x)
-            uc, ac = ctrl.acceleration(x.astype(complex))
+            u0, a0 = ctrl.acceleration_numpy(x)
             assert isinstance(u, np.ndarray) and u.dtype == float
-            np.testing.assert_allclose(u, np.real(uc), rtol=0,
-                                       atol=1e-12 * (1 + np.abs(uc).max()))
-            np.testing.assert_allclose(a, np.real(ac), rtol=0,
-                                       atol=1e-12 * (1 + np.abs(ac).max()))
+            np.testing.assert_allclose(u, u0, rtol=0, atol=1e-12 * (1 + np.abs(u0).max()))
+            np.testing.assert_allclose(a, a0, rtol=0, atol=1e-12 * (1 + np.abs(a0).max()))
+            xc = x + 1e-30j * rng.normal(size=x.size)
+            uc, ac = ctrl.acceleration(xc)
+            uc0, ac0 = ctrl.acceleration_numpy(xc)
+            assert uc.dtype == complex
+            np.testing.assert_allclose(np.real(uc), u0, rtol=0,
+                                       atol=1e-12 * (1 + np.abs(u0).max()))
+            for c, c0 in ((uc, uc0), (ac, ac0)):
+                g, g0 = np.imag(c) / 1e-30, np.imag(c0) / 1e-30
+                np.testing.assert_allclose(g, g0, rtol=0, atol=1e-9 * (1 + np.abs(g0).max()))
             saturated += limit is not None and np.any(np.abs(u) == limit)
         assert (saturated > 0) == (limit is not None)
     finally:

@@ -243,19 +243,24 @@ _LAW = '''
 def _bezier(c, s):  # pragma: no cover - runs compiled
     k, m1 = c.shape
     M = m1 - 1
-    hd = np.zeros(k)
-    hd1 = np.zeros(k)
-    hd2 = np.zeros(k)
+    hd = np.zeros(k) + 0.0 * s  # real or complex, as s
+    hd1 = np.zeros(k) + 0.0 * s
+    hd2 = np.zeros(k) + 0.0 * s
+    ps = np.ones(m1) + 0.0 * s  # powers of s and of 1 - s by products, not **: a complex
+    qs = np.ones(m1) + 0.0 * s  # power of a negative base (s outside [0, 1]) would go
+    for j in range(M):          # through its argument and spoil the complex step
+        ps[j + 1] = ps[j] * s
+        qs[j + 1] = qs[j] * (1.0 - s)
     for j in range(M + 1):
-        b = BINOM[M, j] * s ** j * (1.0 - s) ** (M - j)
+        b = BINOM[M, j] * ps[j] * qs[M - j]
         for i in range(k):
             hd[i] += c[i, j] * b
     for j in range(M):
-        b = BINOM[M - 1, j] * s ** j * (1.0 - s) ** (M - 1 - j)
+        b = BINOM[M - 1, j] * ps[j] * qs[M - 1 - j]
         for i in range(k):
             hd1[i] += M * (c[i, j + 1] - c[i, j]) * b
     for j in range(M - 1):
-        b = BINOM[M - 2, j] * s ** j * (1.0 - s) ** (M - 2 - j)
+        b = BINOM[M - 2, j] * ps[j] * qs[M - 2 - j]
         for i in range(k):
             hd2[i] += M * (M - 1) * (c[i, j + 2] - 2.0 * c[i, j + 1] + c[i, j]) * b
     return hd, hd1, hd2
@@ -263,7 +268,7 @@ def _bezier(c, s):  # pragma: no cover - runs compiled
 
 @njit(cache=True)
 def law(x, alpha, theta_plus, dtheta, B, kp, kd, limit):  # pragma: no cover - runs compiled
-    v = np.empty(NOUT)
+    v = np.empty(NOUT, dtype=x.dtype)  # real or complex (complex-step derivatives), as x
     pieces(x, v)
     a = K + K * N
     th = v[a + K]
@@ -273,18 +278,18 @@ def law(x, alpha, theta_plus, dtheta, B, kp, kd, limit):  # pragma: no cover - r
         ds += v[a + K + 1 + j] * x[N + j]
     ds /= dtheta
     hd, hd1, hd2 = _bezier(alpha, (th - theta_plus) / dtheta)
-    J = np.empty((K, N))  # dh/dq
+    J = np.empty((K, N), dtype=x.dtype)  # dh/dq
     for i in range(K):
         for j in range(N):
             J[i, j] = v[K + i * N + j] - hd1[i] * v[a + K + 1 + j] / dtheta
-    Mm = np.empty((N, N))
-    f = np.empty(N)
+    Mm = np.empty((N, N), dtype=x.dtype)
+    f = np.empty(N, dtype=x.dtype)
     flow_terms(x, Mm, f)
-    rhs = np.empty((N, K + 1))
+    rhs = np.empty((N, K + 1), dtype=x.dtype)
     rhs[:, :K] = B
     rhs[:, K] = f
     sol = np.linalg.solve(Mm, rhs)  # [M^-1 B, M^-1 (-C dq - G)]
-    A = np.zeros((K, K + 1))  # [L_g L_f h, -(L_f^2 h + kp y + kd y')]
+    A = np.zeros((K, K + 1), dtype=x.dtype)  # [L_g L_f h, -(L_f^2 h + kp y + kd y')]
     for i in range(K):
         dy = 0.0
         Jf = 0.0
@@ -293,16 +298,16 @@ def law(x, alpha, theta_plus, dtheta, B, kp, kd, limit):  # pragma: no cover - r
             Jf += J[i, j] * sol[j, K]
             for m in range(K):
                 A[i, m] += J[i, j] * sol[j, m]
-        lf2 = v[K + K * N + i] - hd2[i] * ds ** 2 - hd1[i] * ddth / dtheta + Jf
+        lf2 = v[K + K * N + i] - hd2[i] * ds * ds - hd1[i] * ddth / dtheta + Jf
         A[i, K] = -lf2 - kp * (v[i] - hd[i]) - kd * dy
     u = np.linalg.solve(A[:, :K].copy(), A[:, K:].copy())[:, 0].copy()
     if limit > 0.0:
         for i in range(K):
-            if u[i] > limit:
+            if u[i].real > limit:  # the real parts compared, as the numpy law does
                 u[i] = limit
-            elif u[i] < -limit:
+            elif u[i].real < -limit:
                 u[i] = -limit
-    acc = np.zeros(N)
+    acc = np.zeros(N, dtype=x.dtype)
     for j in range(N):
         for m in range(K):
             acc[j] += sol[j, m] * u[m]
@@ -343,7 +348,8 @@ def generate_compiled_controller(eq, params, outputs, phase, joints, prefix: str
     lines = [f"# walkerlab compiled virtual-constraint law (walkerlab.codegen.virtual_constraints);"
              f" key {key}",
              "# Do not edit: regenerated when the walker, its outputs or the generator change.",
-             "from math import sin, cos, tan, sqrt, atan, atan2, acos, asin  # noqa: F401",
+             "from numpy import sin, cos, tan, sqrt, arctan as atan, arctan2 as atan2, "
+             "arccos as acos, arcsin as asin  # noqa: F401 (real and complex)",
              "import math", "import numpy as np", "from numba import njit", "",
              f"K, N, NOUT = {len(outputs)}, {n}, {len(out)}",
              "BINOM = np.array([[float(math.comb(a, b)) for b in range(16)] for a in range(16)])",

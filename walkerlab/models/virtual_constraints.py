@@ -364,17 +364,21 @@ class VirtualConstraintController:
         """``(u (k,), M^-1 B u (n,))``: the torques [N m] (saturated) and the acceleration
         they add [rad/s^2] at the state ``x`` (2n,) (complex-safe).
 
-        A real state runs the law compiled by numba
+        Runs the law compiled by numba
         (:func:`walkerlab.codegen.virtual_constraints.compiled_controller`: the same
-        expressions, equal to the numpy law to round-off); a complex one (complex-step
-        derivatives) the numpy law of :meth:`terms`."""
-        if not np.iscomplexobj(x):
-            law = self._compiled_law()
-            if law is not None:
-                d = self.design
-                return law(np.asarray(x, dtype=float), d.alpha, d.theta_plus,
-                           d.theta_minus - d.theta_plus, self.B, self.kp, self.kd,
-                           -1.0 if self.limit is None else float(self.limit))
+        expressions, equal to :meth:`acceleration_numpy` to round-off), for real states and
+        for complex ones (the complex-step derivatives of the variational equations)."""
+        law = self._compiled_law()
+        if law is None:
+            return self.acceleration_numpy(x)
+        d = self.design
+        x = np.ascontiguousarray(x, dtype=complex if np.iscomplexobj(x) else float)
+        return law(x, d.alpha, d.theta_plus, d.theta_minus - d.theta_plus, self.B, self.kp,
+                   self.kd, -1.0 if self.limit is None else float(self.limit))
+
+    def acceleration_numpy(self, x):
+        """:meth:`acceleration` by numpy from :meth:`terms` (the reference of the compiled
+        law; used where numba is missing)."""
         y, dy, A, Lf2, MinvB = self.terms(x)
         u = self._saturate(np.linalg.solve(A, -Lf2 - self.kp * y - self.kd * dy))
         return u, MinvB @ u
@@ -398,10 +402,11 @@ class VirtualConstraintController:
                 mod = compiled_controller(*self._pieces_args)
                 if mod is not None:
                     self._law = mod.law
-                    d = self.design  # numba compiles (or loads) on the first call
-                    self._law(np.concatenate([d.q_plus, np.zeros(self.n)]), d.alpha,
-                              d.theta_plus, d.theta_minus - d.theta_plus, self.B, 0.0, 0.0,
-                              -1.0)
+                    d = self.design  # numba compiles (or loads) on the first call: here
+                    x0 = np.concatenate([d.q_plus, np.zeros(self.n)])
+                    for x in (x0, x0.astype(complex)):  # real and complex states
+                        self._law(x, d.alpha, d.theta_plus, d.theta_minus - d.theta_plus,
+                                  self.B, 0.0, 0.0, -1.0)
         return self._law or None
 
     def _saturate(self, u):
