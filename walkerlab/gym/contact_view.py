@@ -278,7 +278,12 @@ class ContactView:
         return int(self.hook.stance)
 
     def hip_x(self) -> float:
-        """World position of the hip along x (horizontal, downhill) [m]."""
+        """World position of the hip along x (horizontal, downhill) [m]: the floating
+        coordinate ``hip_x`` (the generated ``points``' hip is that coordinate plus 0; all
+        of them were evaluated for it each period)."""
+        names = self.walker.coordinate_names()
+        if "hip_x" in names:
+            return float(self.hook.y[names.index("hip_x")]) + 0.0
         return float(self.walker.points(self.x)["hip"][0, 0])
 
     def points(self) -> dict:
