@@ -142,8 +142,9 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
 def legs3d_footfalls(points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
     """The rigid gait's footfalls in MuJoCo's axes [m], leg1's and leg2's, from the
     keyframe's (leg2 in stance at the origin, leg1 trailing): leg2 at ``k S``
-    (``k = 0 .. steps // 2``), leg1 at ``f + k S`` (``k = 0 .. steps // 2 + 1``: the
-    trailing foot, then its landings), ``f`` the trailing foot, ``S = -2 (f - (f . z) z)``
+    (``k`` from 0 to ``steps // 2``), leg1 at ``f + k S`` (``k`` from 0 to
+    ``steps // 2 + 1``: the trailing foot, then its landings), ``f`` the trailing foot,
+    ``S = -2 (f - (f·z) z)``
     the stride (the gait's two steps mirror each other about the fall line: their
     advances add, their lateral offsets cancel).
 
