@@ -88,3 +88,17 @@ def test_minimal_casadi_hzd_script_finds_walkerlabs_design():
     assert abs(w["objective"] / s["objective"] - 1) < 1e-6
     assert abs(w["period_s"] - s["period_s"]) < 1e-6
     assert abs(w["delta2"] - 0.6) < 1e-8 and abs(s["delta2"] - 0.6) < 1e-8
+
+
+def test_the_bench_commands_help_names_every_benchmark():
+    """``walkerlab bench --help`` lists each benchmark the command runs (its help is a
+    literal kept apart from :data:`walkerlab.cli.bench.BENCHMARKS`, which the CLI does not
+    import at start-up)."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.cli.bench import BENCHMARKS
+
+    out = CliRunner().invoke(app, ["bench", "--help"], terminal_width=400).output
+    missing = [b for b in BENCHMARKS if b not in out.replace("\n", " ")]
+    assert not missing, missing
