@@ -100,7 +100,8 @@ def export(scene: Path | None = SceneArg,
 
 
 @guard
-def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | fixedpoint-3d | sweep | sweep-workers"
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | fixedpoint-3d"
+                                     " | sweep | sweep-workers"
                                      " | basin | contact | main-job | optimize | powered"
                                      " | powered-command | hzd | gym | gym-vector"
                                      " | all (ideal, fixedpoint, sweep and contact)"),
