@@ -139,3 +139,28 @@ def test_flat_feet_on_footholds_take_an_action_on_every_step_walker():
     mirror), and walks its heel strikes."""
     strikes, ends, *_ = _episode("configs/flat_feet_footholds.yaml", True, 150, "random")
     assert strikes.size >= 1 and not ends
+
+
+@pytest.mark.parametrize("scene", ["configs/paper.yaml", "configs/kneed.yaml",
+                                   "configs/threelink_hzd.yaml", "configs/rabbit_hzd.yaml",
+                                   "configs/torso_powered.yaml"])
+def test_the_action_joint_state_is_the_generated_leg_angles_affine_map(scene):
+    """:attr:`ActionTorques.affine` (``delta = Bt q + c``, ``ddelta = Bt dq``), which the
+    ledger reads each period, gives the joints' angles and rates of the generated
+    ``leg_angles`` at states far from the probe's, and :meth:`rate_power` the generic
+    :meth:`power` (hip-only straight legs, knees, a five-link biped, a torso).  Bound:
+    round-off of sums of a few angles of order 1 (1e-12)."""
+    env = WalkerEnv(scene)
+    env.reset(seed=0)
+    acts = env.sim.acts[env.sim.leg]
+    assert acts.affine is not None
+    rng = np.random.default_rng(3)
+    n = acts.n
+    X = rng.uniform(-2.0, 2.0, size=(2 * n, 6))
+    acts.u = rng.uniform(-5.0, 5.0, size=acts.u.size)
+    for j in range(X.shape[1]):
+        d, dd = acts.joint_state(X[:, j])
+        d0, dd0 = acts._generated_joint_state(X[:, j])
+        np.testing.assert_allclose(d, d0, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(dd, dd0, rtol=0, atol=1e-12)
+        assert abs(acts.rate_power(X)[j] - acts.power(0.0, X[:, j])) <= 1e-11

@@ -293,6 +293,11 @@ class RigidView:
         ts = 0.5 * (tb - ta) * _GL_X + 0.5 * (ta + tb)
         X = np.atleast_2d(dense(ts))[:2 * self.n]
         h = 0.5 * (tb - ta)
+        if act_on and not acts.first and acts.affine is not None:  # the nodes' power at once
+            for w, p in zip(_GL_W, acts.rate_power(X)):
+                key = "action_work_positive" if p > 0 else "action_work_negative"
+                self.ledger[key] += h * w * p
+            act_on = False
         for j, tj in enumerate(ts):
             xj = X[:, j]
             if act_on:
