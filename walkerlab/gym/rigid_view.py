@@ -387,7 +387,7 @@ class RigidView:
             w = self.walker
             acts = self.acts[self.leg]
             acts.u = np.asarray(u, dtype=float)
-            act_on = bool(np.any(acts.u))
+            act_on = bool(acts.u.any())
             phase = w.phases[self.k]
             for g in phase.guards:  # a fall guard already violated as the phase begins
                 if (g.at_entry and g.outcome == "fall"
@@ -426,7 +426,7 @@ class RigidView:
             if self.ground is not None:
                 self._pieces.append((phase, run.dense, (self.t, run.t_last)))
             self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-            if run.failed or not np.all(np.isfinite(self.x)):
+            if run.failed or not np.isfinite(self.x).all():
                 self.ended = "solver_failure"
                 break
             if run.event is None:

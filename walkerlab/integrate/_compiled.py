@@ -115,19 +115,21 @@ def _copy_out(ptr, shape: tuple) -> np.ndarray:
 
 
 _NO_TIMES = np.empty(0)
+_NO_TIMES_PTR = _NO_TIMES.ctypes.data
 
 
-def _solve(addr, data, t0, t1, y0, method_int, rtol, atol, hmax, max_steps, first_step, dense,
+def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step, dense,
            n_extra=0):
-    """One CyRK run; returns ``(result, T (k,), Y (k, m + n_extra), ok, message, nfev)``."""
+    """One CyRK run; returns ``(result, T (k,), Y (k, m + n_extra), ok, message, nfev)``.
+    ``tols``: :attr:`_Plan.tols` (the tolerance arrays' addresses and sizes)."""
     ns = _numba_solver()
 
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     c0 = data[-1]
     ptr = ns.c_numba_cysolve_ivp(
         addr, float(t0), float(t1), y0.ctypes.data, y0.size, method_int, 0, n_extra,
-        data.ctypes.data, data.size * 8, max_steps, 2000, dense, _NO_TIMES.ctypes.data, 0,
-        None, None, 0, rtol.ctypes.data, rtol.size, atol.ctypes.data, atol.size, hmax,
+        data.ctypes.data, data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
+        None, None, 0, tols[0], tols[1], tols[2], tols[3], hmax,
         float(first_step), False)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK
         return None, np.empty(0), np.empty((0, y0.size)), False, "CyRK returned no result", 0
@@ -144,10 +146,10 @@ def _solve(addr, data, t0, t1, y0, method_int, rtol, atol, hmax, max_steps, firs
     return (res, T, Y, bool(ns.c_get_success(ptr)), buf.value.decode(errors="replace"), nfev)
 
 
-def _piece(addr, data, ta, tb, ya, method_int, rtol, atol, hmax, h0) -> list:
+def _piece(addr, data, ta, tb, ya, method_int, tols, hmax, h0) -> list:
     """A lazy dense-output piece: the run from ``ta`` to ``tb`` again, first step ``h0``."""
     h0 = h0 if 2 * h0 <= tb - ta else 0.0
-    return [float(ta), float(tb), (addr, data, ta, tb, ya, method_int, rtol, atol, hmax, 0, h0,
+    return [float(ta), float(tb), (addr, data, ta, tb, ya, method_int, tols, hmax, 0, h0,
                                    True)]
 
 
@@ -208,10 +210,24 @@ def callable_flow(compiled, n: int, variational: bool):
     return rhs, jac
 
 
+#: guard values up to which :func:`_first_crossing` compares in Python [-]
+_SMALL_CROSSING = 48
+
+
 def _first_crossing(G: np.ndarray, dirs: np.ndarray):
     """First row ``k >= 1`` of guard values ``G`` (k, g) where a guard changes sign in its
     direction between rows ``k-1`` and ``k`` (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``,
-    ``down = g0 >= 0 >= g1``), and the mask of those guards; ``(None, None)`` if none."""
+    ``down = g0 >= 0 >= g1``), and the mask of those guards; ``(None, None)`` if none.
+    A control period's few steps and guards are compared in Python (the same comparisons,
+    without numpy's per-call overhead), a long chunk's by numpy."""
+    if G.size <= _SMALL_CROSSING:
+        rows, ds = G.tolist(), dirs.tolist()
+        for k in range(1, len(rows)):
+            hit = [(d >= 0 and g0 <= 0 <= g1) or (d <= 0 and g0 >= 0 >= g1)
+                   for g0, g1, d in zip(rows[k - 1], rows[k], ds)]
+            if any(hit):
+                return k, np.array(hit)
+        return None, None
     nonpos, nonneg = G <= 0, G >= 0
     hit = nonpos[:-1] & nonneg[1:]
     hit &= dirs >= 0
@@ -253,6 +269,10 @@ class _Plan:
         self.method_int = find_ode_method_int(solver.method)
         self.rtol = np.array([float(solver.rtol)])
         self.atol = np.ascontiguousarray(np.atleast_1d(solver.atol), dtype=np.float64)
+        #: the tolerances as CyRK takes them (addresses and sizes, read once), then the
+        #: arrays themselves (kept alive by whatever holds the tuple: a lazy dense piece)
+        self.tols = (self.rtol.ctypes.data, self.rtol.size, self.atol.ctypes.data,
+                     self.atol.size, self.rtol, self.atol)
         self.hmax = float(solver.max_step_s) if solver.max_step_s else ns.MAX_SIZE
         self.K = first_chunk(compiled, solver)
         cols = compiled.guard_columns()
@@ -262,24 +282,29 @@ class _Plan:
 
     def run(self, data, ta, tb, ya, max_steps, first_step, dense):
         """:func:`_solve` from ``ya`` at ``ta`` towards ``tb`` with the flow's ``data``."""
-        return _solve(self.addr, data, ta, tb, ya, self.method_int, self.rtol, self.atol,
+        return _solve(self.addr, data, ta, tb, ya, self.method_int, self.tols,
                       self.hmax, max_steps, first_step, dense, self.n_extra)
 
     def piece(self, data, ta, tb, ya, h0) -> list:
         """:func:`_piece` of this phase."""
-        return _piece(self.addr, data, ta, tb, ya, self.method_int, self.rtol, self.atol,
+        return _piece(self.addr, data, ta, tb, ya, self.method_int, self.tols,
                       self.hmax, h0) + [self.n_extra]
 
 
 def _plan(compiled, variational: bool, solver, m: int) -> _Plan:
     """The :class:`_Plan` of ``compiled`` on ``solver`` (memoised on the flow)."""
     memo = getattr(compiled, "_memo", None)
-    key = ("plan", variational, solver.method, float(solver.rtol),
-           tuple(np.atleast_1d(solver.atol).tolist()), solver.max_step_s, m)
     if memo is None:
         return _Plan(compiled, variational, solver, m)
+    # this very (frozen) solver's plan first: its settings' key is built once
+    seen = memo.get(("plan of", id(solver), variational, m))
+    if seen is not None and seen[0] is solver:
+        return seen[1]
+    key = ("plan", variational, solver.method, float(solver.rtol),
+           tuple(np.atleast_1d(solver.atol).tolist()), solver.max_step_s, m)
     if key not in memo:
         memo[key] = _Plan(compiled, variational, solver, m)
+    memo[("plan of", id(solver), variational, m)] = (solver, memo[key])
     return memo[key]
 
 
