@@ -117,37 +117,24 @@ class ActionTorques(Actuators):
     def __post_init__(self):
         super().__post_init__()
         self.u = np.zeros(len(self.spec.torques) - self.first)
-        #: ``(Bt (k, n), c (k,))``: the joints' angles ``delta = Bt q + c`` and rates
-        #: ``ddelta = Bt dq``, affine in the coordinates (``B``'s rows, checked constant by
-        #: :func:`walkerlab.walker.joints.joint_columns`; the hip's, ``ddelta_dq``, for hip
-        #: actuators); None where the generated angles disagree with it at a probe state
-        #: beyond round-off (then every call evaluates the generated ``leg_angles``)
-        self.affine = None
-        n, k = self.n, len(self.spec.torques)
-        if k and not self.limit:
-            Bt = (np.tile(np.real(self.ddelta_dq), (k, 1)) if self.hip_only
-                  else np.real(np.asarray(self.B, float)).T)
-            c = self._generated_joint_state(np.zeros(2 * n))[0]
-            probe = np.concatenate([np.linspace(0.1, 0.3, n), np.linspace(-0.5, 0.5, n)])
-            d, dd = self._generated_joint_state(probe)
-            if (np.allclose(Bt @ probe[:n] + c, d, rtol=0.0, atol=1e-12)
-                    and np.allclose(Bt @ probe[n:], dd, rtol=0.0, atol=1e-12)):
-                self.affine = (np.ascontiguousarray(Bt), c)
+        #: ``(Bt (k, n), c (k,))`` of the joints' affine map
+        #: (:meth:`~walkerlab.models.hybrid.actuators.Actuators.affine_joint_map`; the hip's
+        #: for hip actuators), or None: the generated ``leg_angles`` at every call
+        self.affine = (self.affine_joint_map(self._generated_joint_state) if self.spec.torques
+                       and not self.limit else None)
 
     def joint_state(self, x) -> tuple[np.ndarray, np.ndarray]:
         """``(delta, ddelta)`` (k,) of the action's joints at the real state ``x`` (2n,)
         [rad, rad/s] (the hip's for every actuator when all act at the hip): the affine
         map :attr:`affine` where there is one, else the generated ``leg_angles``."""
         if self.affine is not None:
-            Bt, c = self.affine
-            n = self.n
-            return Bt @ x[:n] + c, Bt @ x[n:2 * n]
+            return self.affine_joint_state(x, self.affine)
         return self._generated_joint_state(x)
 
     def rate_power(self, X) -> np.ndarray:
         """The held action's power ``u . ddelta`` [W] at the real states ``X`` (2n, m),
         one per column (the action alone: :attr:`first` 0, :attr:`affine` set)."""
-        return (self.u @ self.affine[0]) @ X[self.n:2 * self.n]
+        return self.u @ self.affine_joint_rates(X, self.affine)
 
     def _generated_joint_state(self, x) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`joint_state` from the generated ``leg_angles``."""

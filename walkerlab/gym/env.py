@@ -567,6 +567,22 @@ class WalkerEnv(gym.Env):
         InvalidAction
             Not ``k`` finite real numbers of shape ``(k,)`` (one line).
         """
+        u, before = self.begin_period(action)
+        return self.end_period(u, self.sim.advance(u, self._elapsed * self.dt), before)
+
+    def begin_period(self, action) -> tuple[np.ndarray, tuple]:
+        """:meth:`step`'s first half: the held torques ``u`` (k,) [N m] of ``action`` (and
+        the scene policy's), the period counted, and what the reward needs of the period's
+        start; the walker is then advanced to ``period_end_s`` (by :meth:`step`, or with
+        others by the native vector environment) and :meth:`end_period` finishes.
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            Before the first :meth:`reset`.
+        InvalidAction
+            Not ``k`` finite real numbers of shape ``(k,)`` (one line).
+        """
         if not self._has_reset:
             raise gym.error.ResetNeeded("Cannot call env.step() before calling env.reset()")
         a = self._action(action)
@@ -577,10 +593,22 @@ class WalkerEnv(gym.Env):
             leg1 = (s.leg == "leg1") if self.view == "rigid" else (s.stance == 0)
             a = a + self._controller_torques(s.x, leg1)
         u = np.clip(a, -self.tau_max, self.tau_max)
-        x_before = self._hip_x  # the hip at the period's start: the last info's
-        w_before = s.ledger["action_work_positive"]
+        # the hip at the period's start (the last info's) and the positive work so far
+        before = (self._hip_x, s.ledger["action_work_positive"])
         self._elapsed += 1
-        strikes = s.advance(u, self._elapsed * self.dt)
+        return u, before
+
+    @property
+    def period_end_s(self) -> float:
+        """The end of the present control period [s] (after :meth:`begin_period`)."""
+        return self._elapsed * self.dt
+
+    def end_period(self, u: np.ndarray, strikes: list[float], before: tuple):
+        """:meth:`step`'s second half, once the walker is advanced with ``u`` held and met
+        the heel strikes ``strikes`` [s]: ``(observation, reward, terminated, truncated,
+        info)``."""
+        s = self.sim
+        x_before, w_before = before
         info = self._info(strikes)
         terminated = bool(s.ended)
         truncated = (not terminated and self.max_episode_steps is not None

@@ -130,6 +130,9 @@ class RigidView:
                                 if compiled and "cyrk_compiled" in available_backends()
                                 else None)
         self._compiled: dict = {}
+        #: what a compiled phase shares with other walkers' in a batched step
+        #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``)
+        self.row_keys: dict = {}
         #: arithmetic errors raised inside compiled flows (:meth:`_unraisable`), counted
         self.arithmetic_errors = 0
         self._joints_at: tuple = (b"", None, None, None)  # (state bytes, delta, ddelta, acts)
@@ -382,90 +385,116 @@ class RigidView:
 
     def _run(self, u: np.ndarray, t_end: float) -> list[float]:
         strikes: list[float] = []
-        n = self.n
         while self.t < t_end and not self.ended:
-            w = self.walker
-            acts = self.acts[self.leg]
-            acts.u = np.asarray(u, dtype=float)
-            act_on = bool(acts.u.any())
-            phase = w.phases[self.k]
-            for g in phase.guards:  # a fall guard already violated as the phase begins
-                if (g.at_entry and g.outcome == "fall"
-                        and g.direction * float(g.function(self.t, self.x)) > 0):
-                    self.ended = "fall"
-            if self.ended:
+            piece = self.next_piece(u, t_end)
+            if piece is None:
                 break
-            t_stop = min(t_end, self.t_step + self.max_step_time)
-            fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
-                    else None)
-            if fast is not None:  # the compiled control step: the action's torques held
-                fphase, laws, _ = fast  # in the law block (each actuator's constant)
-                laws[_CONSTANTS[:acts.u.size]] = acts.u
-                hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
-                try:
-                    run = integrate_phase(fphase, self.t, self.x, None, t_stop, 2 * n,
-                                          self.compiled_solver, "cyrk_compiled", None, None,
-                                          False)
-                finally:
-                    sys.unraisablehook = hook
-            elif self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
-                tw, tacts = self._twin(w)
-                tacts.u = acts.u
-                phase = tw.phases[self.k]
-                rhs = phase.flow
-            else:
-                rhs = self._flow(phase, acts, act_on)
-            if fast is None:
-                jac = phase.jacobian if phase.jacobian is not None else w.variational
-                run = integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n,
-                                      self.solver, self.backend, rhs, jac, False)
-            if fast is not None:
-                self._held_work(run, acts, act_on)
-            else:
-                self._work(run.dense, self.t, run.t_last, acts, act_on)
-            if self.ground is not None:
-                self._pieces.append((phase, run.dense, (self.t, run.t_last)))
-            self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-            if run.failed or not np.isfinite(self.x).all():
-                self.ended = "solver_failure"
-                break
-            if run.event is None:
-                if self.t >= self.t_step + self.max_step_time:
-                    self.ended = "stall"
-                continue
-            # the walker's own guard (a twin's are the same, in order; the heel strike's
-            # reset, a push-off's, is the scene walker's)
-            guard = w.phases[self.k].guards[run.event]
-            if guard.outcome == "fall":
+            run, phase = self._integrate(piece)
+            strikes += self.absorb(piece, run, phase)
+        return strikes
+
+    def next_piece(self, u: np.ndarray, t_end: float):
+        """The period's next piece to integrate, from the present phase with the action
+        ``u`` (k,) [N m] held: ``(walker, actuators, action on, phase, t_stop [s], fast)``,
+        ``fast`` the compiled phase (:meth:`_compiled_phase`, its law block holding ``u``)
+        or None; None when the phase's fall guard is already violated (:attr:`ended` set)."""
+        w = self.walker
+        acts = self.acts[self.leg]
+        acts.u = np.asarray(u, dtype=float)
+        act_on = bool(acts.u.any())
+        phase = w.phases[self.k]
+        for g in phase.guards:  # a fall guard already violated as the phase begins
+            if (g.at_entry and g.outcome == "fall"
+                    and g.direction * float(g.function(self.t, self.x)) > 0):
                 self.ended = "fall"
-            elif guard.outcome == "next_phase":
-                target = guard.next_phase
-                self.k = (self.k + 1 if target is None
-                          else [p.name for p in w.phases].index(target))
-                if guard.reset is not None:
-                    self.x = np.asarray(guard.reset(self.x), float)
-                if self.k >= len(w.phases):
-                    self.ended = "fall"
-            elif self.t - self.t_step <= MIN_STEP_TIME_S:
-                self.ended = "stall"  # a heel strike at the step's start: no step
-            else:
-                if self.ground is not None:  # a profile: the step's landing segment
-                    land = self.foot[0] + float(w.points(self.x)["swing_foot"][0])
-                    j2 = self.ground.retry(self.j, land, self.tried)
-                    if j2 is not None:
-                        strikes += self._again(j2)
-                        continue
-                    on = self.ground.goes_on(self.j, land)
-                    self.trip = self._swing_trip(w)
-                    if self.trip is not None:
-                        self.ended = "trip"
-                        break
-                self._heel_strike(guard)
-                strikes.append(self.t)
-                ends = self.model.ground_steps
-                if (self.ground is not None and not on) or (
-                        ends is not None and self.steps >= ends):
-                    self.ended = "ground_end"  # the walk left the ground's end
+        if self.ended:
+            return None
+        t_stop = min(t_end, self.t_step + self.max_step_time)
+        fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
+                else None)
+        if fast is not None:  # the compiled control step: the action's torques held in
+            fast[1][_CONSTANTS[:acts.u.size]] = acts.u  # the law block (each constant)
+        return w, acts, act_on, phase, t_stop, fast
+
+    def _integrate(self, piece):
+        """``(run, phase)``: :meth:`next_piece`'s piece integrated from the present state
+        (the compiled step, or the scene's solver on Python flows), and the phase that ran
+        (a flat foot's twin's under an action)."""
+        w, acts, act_on, phase, t_stop, fast = piece
+        n = self.n
+        if fast is not None:
+            hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
+            try:
+                return integrate_phase(fast[0], self.t, self.x, None, t_stop, 2 * n,
+                                       self.compiled_solver, "cyrk_compiled", None, None,
+                                       False), phase
+            finally:
+                sys.unraisablehook = hook
+        if self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
+            tw, tacts = self._twin(w)
+            tacts.u = acts.u
+            phase = tw.phases[self.k]
+            rhs = phase.flow
+        else:
+            rhs = self._flow(phase, acts, act_on)
+        jac = phase.jacobian if phase.jacobian is not None else w.variational
+        return integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n, self.solver,
+                               self.backend, rhs, jac, False), phase
+
+    def absorb(self, piece, run, phase) -> list[float]:
+        """Take the integrated ``run`` of :meth:`next_piece`'s ``piece`` (``phase``: the
+        one that ran): the ledger, the state, and the guard that ended it (a knee strike,
+        a heel strike with the next step begun, a fall, a stall); returns the heel-strike
+        times met [s] (a profile's step walked again included)."""
+        w, acts, act_on, _, _, fast = piece
+        n = self.n
+        strikes: list[float] = []
+        if fast is not None:
+            self._held_work(run, acts, act_on)
+        else:
+            self._work(run.dense, self.t, run.t_last, acts, act_on)
+        if self.ground is not None:
+            self._pieces.append((phase, run.dense, (self.t, run.t_last)))
+        self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
+        if run.failed or not np.isfinite(self.x).all():
+            self.ended = "solver_failure"
+            return strikes
+        if run.event is None:
+            if self.t >= self.t_step + self.max_step_time:
+                self.ended = "stall"
+            return strikes
+        # the walker's own guard (a twin's are the same, in order; the heel strike's
+        # reset, a push-off's, is the scene walker's)
+        guard = w.phases[self.k].guards[run.event]
+        if guard.outcome == "fall":
+            self.ended = "fall"
+        elif guard.outcome == "next_phase":
+            target = guard.next_phase
+            self.k = (self.k + 1 if target is None
+                      else [p.name for p in w.phases].index(target))
+            if guard.reset is not None:
+                self.x = np.asarray(guard.reset(self.x), float)
+            if self.k >= len(w.phases):
+                self.ended = "fall"
+        elif self.t - self.t_step <= MIN_STEP_TIME_S:
+            self.ended = "stall"  # a heel strike at the step's start: no step
+        else:
+            if self.ground is not None:  # a profile: the step's landing segment
+                land = self.foot[0] + float(w.points(self.x)["swing_foot"][0])
+                j2 = self.ground.retry(self.j, land, self.tried)
+                if j2 is not None:
+                    return self._again(j2)
+                on = self.ground.goes_on(self.j, land)
+                self.trip = self._swing_trip(w)
+                if self.trip is not None:
+                    self.ended = "trip"
+                    return strikes
+            self._heel_strike(guard)
+            strikes.append(self.t)
+            ends = self.model.ground_steps
+            if (self.ground is not None and not on) or (
+                    ends is not None and self.steps >= ends):
+                self.ended = "ground_end"  # the walk left the ground's end
         return strikes
 
     def _swing_trip(self, w):

@@ -7,13 +7,17 @@ N walkers of one scene are stepped per call, with gymnasium's batched spaces
 id's time limit per sub-environment and ``SyncVectorEnv``'s seeding (``reset(seed=s)``
 seeds sub-environment ``i`` with ``s + i``): for the same seeds and actions its
 observations, rewards, flags and infos are those of ``gymnasium.make_vec(...,
-vectorization_mode="sync")`` bit for bit.
+vectorization_mode="sync")``, bit for bit with ``batched=False``, and with the batched
+step (the default) to round-off (the same falls, resets and heel strikes).
 
-The physics of one call is :meth:`WalkerVectorEnv._step_all` (for now a loop over
-:class:`~walkerlab.gym.env.WalkerEnv` instances, each built as ``gym.make``'s entry point
-builds it: :func:`~walkerlab.gym.env.registered_env`); a compiled batched step may replace
-it.  The time limit, the autoreset and the batching of the infos are this class's own and
-know nothing of the walker (its sizes are its spaces').
+The physics of one call is :meth:`WalkerVectorEnv._step_all`: each
+:class:`~walkerlab.gym.env.WalkerEnv` (built as ``gym.make``'s entry point builds it:
+:func:`~walkerlab.gym.env.registered_env`) begins its period, the rigid view's walkers are
+advanced together (:func:`walkerlab.gym.rigid_rows.advance_rows`: their compiled pieces in
+one compiled call per flow), and each ends its period; the contact view, or
+``batched=False``, steps them one after another.  The time limit, the autoreset and the
+batching of the infos are this class's own and know nothing of the walker (its sizes are
+its spaces').
 """
 
 from __future__ import annotations
@@ -40,6 +44,45 @@ def _whole(value, name: str, low: int, allow_none: bool = False) -> int | None:
         raise ValueError(f"{name}={value!r}: give a whole number >= {low}"
                          + (" or None" if allow_none else ""))
     return int(value)
+
+
+def _batch_infos(each: list[dict]) -> dict:
+    """The sub-environments' infos ``each[i]`` (flat dicts of numbers, text, lists or None)
+    batched as :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one: per key
+    an array of ``len(each)`` whose type is the first value's (a number's dtype, else
+    objects) and its mask ``_key``, keys in the order met (a nested dict: gymnasium's own)."""
+    n = len(each)
+    out: dict = {}
+    for i, info in enumerate(each):
+        for key, value in info.items():
+            arr = out.get(key)
+            if arr is None:
+                t = type(value)
+                if t is dict:
+                    return _add_infos_one_by_one(each)
+                if t in (int, float, bool) or issubclass(t, np.number):
+                    arr = np.zeros(n, dtype=t)
+                elif isinstance(value, np.ndarray):
+                    arr = np.zeros((n, *value.shape), dtype=value.dtype)
+                else:
+                    arr = np.full(n, None, dtype=object)
+                out[key] = arr
+                out[f"_{key}"] = np.zeros(n, dtype=np.bool_)
+            elif type(value) is dict:
+                return _add_infos_one_by_one(each)
+            arr[i] = value
+            out[f"_{key}"][i] = True
+    return out
+
+
+def _add_infos_one_by_one(each: list[dict]) -> dict:
+    """gymnasium's :meth:`~gymnasium.vector.VectorEnv._add_info`, env by env."""
+    probe = VectorEnv()
+    probe.num_envs = len(each)
+    infos: dict = {}
+    for i, info in enumerate(each):
+        infos = probe._add_info(infos, info, i)
+    return infos
 
 
 class WalkerVectorEnv(VectorEnv):
@@ -70,6 +113,9 @@ class WalkerVectorEnv(VectorEnv):
         action), ``"SameStep"`` (reset within the ending step; ``infos["final_obs"]`` and
         ``infos["final_info"]`` hold the end) or ``"Disabled"`` (reset ended walkers with
         ``reset(options={"reset_mask": mask})``).
+    batched : bool
+        The rigid view's walkers advanced together (module docstring; default); False:
+        one after another.
     **env_kwargs
         :class:`~walkerlab.gym.env.WalkerEnv`'s keywords, the same for every walker
         (``scene`` required; ``view``, ``control_period_s``, ``start_noise``, ...).
@@ -97,8 +143,12 @@ class WalkerVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1,
                  max_episode_steps: int | None = DEFAULT_EPISODE_STEPS,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
-                 **env_kwargs):
+                 batched: bool = True, **env_kwargs):
         super().__init__()
+        #: the rigid view's walkers advanced together (:func:`walkerlab.gym.rigid_rows.
+        #: advance_rows`: their compiled pieces in one compiled call per flow); False: one
+        #: after another, each as ``gym.make``'s environment steps (sync's numbers bit for bit)
+        self.batched = bool(batched)
         n = _whole(num_envs, "num_envs", 1)
         self.max_episode_steps = _whole(max_episode_steps, "max_episode_steps", 1,
                                         allow_none=True)
@@ -150,9 +200,21 @@ class WalkerVectorEnv(VectorEnv):
             Each stepped sub-environment's info (``WalkerEnv.step``'s), None elsewhere.
         """
         infos: list[dict | None] = [None] * self.num_envs
-        for i in np.flatnonzero(mask):
+        idx = np.flatnonzero(mask)
+        if not self.batched or self.envs[0].view != "rigid":
+            for i in idx:
+                (self._observations[i], self._rewards[i], self._terminations[i],
+                 self._truncations[i], infos[i]) = self.envs[i].step(actions[i])
+            return infos
+        from .rigid_rows import advance_rows
+
+        envs = [self.envs[i] for i in idx]
+        begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
+        strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
+                               [env.period_end_s for env in envs])
+        for i, env, (u, before), hs in zip(idx, envs, begun, strikes):
             (self._observations[i], self._rewards[i], self._terminations[i],
-             self._truncations[i], infos[i]) = self.envs[i].step(actions[i])
+             self._truncations[i], infos[i]) = env.end_period(u, hs, before)
         return infos
 
     def _reset_one(self, i: int, seed: int | None, options: dict | None) -> dict:
@@ -283,6 +345,7 @@ class WalkerVectorEnv(VectorEnv):
             self._elapsed[stepping] += 1
             self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
         infos: dict = {}
+        each: list[dict] = []
         for i in range(self.num_envs):
             if resetting[i]:  # NEXT_STEP: the reset is this step's outcome
                 info = self._reset_one(i, None, None)
@@ -295,7 +358,12 @@ class WalkerVectorEnv(VectorEnv):
                     infos = self._add_info(infos, {"final_obs": self._observations[i].copy(),
                                                    "final_info": info}, i)
                     info = self._reset_one(i, None, None)  # the step's reward and flags kept
-            infos = self._add_info(infos, info, i)
+            each.append(info)
+        if infos:  # SAME_STEP's final observations and infos: gymnasium's own batching
+            for i, info in enumerate(each):
+                infos = self._add_info(infos, info, i)
+        else:
+            infos = _batch_infos(each)
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
         return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
                 self._truncations.copy(), infos)

@@ -54,7 +54,8 @@ import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 from scipy.integrate import DOP853 as _SCIPY_DOP853  # noqa: E402
 
-__all__ = ["TIMEOUT", "FAILED", "cfuncs", "phase_rows", "reset_rows", "walk_rows"]
+__all__ = ["TIMEOUT", "FAILED", "cfuncs", "period_rows", "phase_rows", "reset_rows",
+           "walk_rows"]
 
 #: ``which`` of a row that reached its time cap / whose step size collapsed
 TIMEOUT, FAILED = -1, -2
@@ -248,16 +249,19 @@ def _work(m, n_out, ng):  # pragma: no cover - compiled
 
 @njit(cache=True, error_model="numpy")
 def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
-         work):  # pragma: no cover - compiled
+         work, exact=False):  # pragma: no cover - compiled
     """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
     into ``yev``; ``f, fs, fg, sel``: the cfuncs (:func:`phase_rows`); ``h_first`` > 0: the
     first step size [s] (else scipy's choice); ``work``: :func:`_work`'s scratch arrays
-    (allocated once per call of the caller, not per row)."""
+    (allocated once per call of the caller, not per row).  ``exact``: the last step ends on
+    ``cap`` (``solve_ivp``'s ``t_bound``) and a :data:`TIMEOUT` row's state there goes into
+    ``yev``; else the steps run past ``cap`` as if unbounded (a cap is a walk's give-up
+    time, not a sample) and ``yev`` is left as it was."""
     m = y.size
     ng = gcols.size
     K, F, buf, ynew, tmp, G = work
     g0, g1, gv = G[0], G[1], G[2]
-    t, t_bound = 0.0, cap + 1.0
+    t, t_bound = 0.0, (cap if exact else cap + 1.0)
     f(K[0].ctypes, t, y.ctypes, d.ctypes)
     _guards(K[0], m, gcols, goffs, g0)
     if h_first > 0.0:
@@ -300,6 +304,9 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
             _dense_at(F, y, (te - t) / h, yev)
             return best, te, h_abs
         if t_new >= cap:
+            if exact:
+                for k in range(m):
+                    yev[k] = ynew[k]
             return TIMEOUT, t_new, h_abs
         for k in range(m):
             y[k] = ynew[k]
@@ -336,6 +343,25 @@ def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
             go[hs] = goffs[hs] + hoff[i]
         w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, go, dirs, rtol, atol, Yev[i],
                        H[i], work)
+        which[i] = w
+        te[i] = t
+        H[i] = h
+
+
+@njit(cache=True, error_model="numpy")
+def period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
+                Yev, H):  # pragma: no cover - compiled
+    """:func:`phase_rows` over control periods: every row of ``Y`` (N, m) from phase time 0
+    to its first guard crossing or exactly to ``cap[i]`` [s] (its period's end: the last
+    step cut to end there, the state there into ``Yev[i]``, ``which[i]`` :data:`TIMEOUT`),
+    each with its own data vector ``D[i]`` (its held torques); ``H`` (N,) [s]: first step
+    sizes (<= 0: scipy's choice), overwritten with the next."""
+    work = _work(Y.shape[1], n_out, gcols.size)
+    y = np.empty(Y.shape[1])
+    for i in range(Y.shape[0]):
+        y[:] = Y[i]
+        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol,
+                       Yev[i], H[i], work, True)
         which[i] = w
         te[i] = t
         H[i] = h

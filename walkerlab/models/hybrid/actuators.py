@@ -162,6 +162,39 @@ class Actuators:
             L[np.max(np.abs(Mg @ null), axis=1) > 1e-10 * np.max(np.abs(Mg))] = 0.0
         return L
 
+    def affine_joint_map(self, joint_state) -> tuple | None:
+        """``(Bt (k, n), c (k,))``: the actuators' joint angles ``delta = Bt q + c`` and rates
+        ``ddelta = Bt dq``, affine in the coordinates (``B``'s rows, checked constant by
+        :func:`walkerlab.walker.joints.joint_columns`; for hip actuators every row the hip's
+        ``ddelta_dq``), or None where ``joint_state`` (``x -> (delta, ddelta)``, the
+        generated ``leg_angles``' reading) disagrees with it at a probe state beyond
+        round-off (1e-12)."""
+        n, k = self.n, len(self.spec.torques)
+        Bt = (np.tile(np.real(self.ddelta_dq), (k, 1)) if self.hip_only
+              else np.real(np.asarray(self.B, float)).T)
+        c = np.asarray(joint_state(np.zeros(2 * n))[0], float)
+        probe = np.concatenate([np.linspace(0.1, 0.3, n), np.linspace(-0.5, 0.5, n)])
+        d, dd = joint_state(probe)
+        q, dq = np.split(probe, 2)
+        if (np.allclose(Bt @ q + c, d, rtol=0.0, atol=1e-12)
+                and np.allclose(Bt @ dq, dd, rtol=0.0, atol=1e-12)):
+            return np.ascontiguousarray(Bt), c
+        return None
+
+    @staticmethod
+    def affine_joint_state(x, affine) -> tuple[np.ndarray, np.ndarray]:
+        """``(delta, ddelta)`` (k,) [rad, rad/s] at the state ``x`` (2n,) by the map
+        ``affine`` (:meth:`affine_joint_map`)."""
+        Bt, c = affine
+        q, dq = np.split(x, 2)
+        return Bt @ q + c, Bt @ dq
+
+    @staticmethod
+    def affine_joint_rates(X, affine) -> np.ndarray:
+        """The joint rates ``ddelta`` (k, m) [rad/s] at the states ``X`` (2n, m), one per
+        column, by the map ``affine`` (:meth:`affine_joint_map`)."""
+        return affine[0] @ np.split(X, 2)[1]
+
     def link_angles(self, x) -> dict:
         """``{link: (angle [rad], rate [rad/s])}`` at the state ``x`` (2n,)
         (:func:`link_angles`; a bisecting torso on flat feet: the legs' mean)."""

@@ -1,0 +1,180 @@
+"""The rigid view's control periods of many walkers at once: the compiled pieces of every
+walker integrated in one compiled call per flow (the native vector environment's physics,
+:class:`walkerlab.gym.vector.WalkerVectorEnv`).
+
+Each walker (:class:`walkerlab.gym.rigid_view.RigidView`) is advanced as its own
+:meth:`~walkerlab.gym.rigid_view.RigidView.advance` advances it - the same pieces
+(:meth:`~walkerlab.gym.rigid_view.RigidView.next_piece`), the same handling of each piece's
+end (:meth:`~walkerlab.gym.rigid_view.RigidView.absorb`: the ledger, a knee strike, a heel
+strike and the next step, a fall) - but the pieces that run the compiled control step (the
+flow with the held torques compiled in) are integrated together: the walkers whose pieces
+share a flow (one cfunc, its guards and tolerances) are the rows of one call of
+:func:`walkerlab.integrate.rows_dop853.period_rows`, each row with its own data vector (its
+torques in the law block), its own state and its own end (the period's end or its step's
+time limit).  That kernel runs scipy's DOP853 (Hairer, Nørsett & Wanner 1993, sec. II.10) as
+CyRK's does, its error norm scaled to theirs (the 2-norm at tolerances times ``sqrt(2n)`` is
+the root-mean-square norm at the tolerances), so a row's steps are the single walker's to
+round-off (measured: the states after a 10 ms period within 4.4e-16 of CyRK's); the guard
+crossings are located on the step's dense output by the Illinois method to 1e-15 s (the
+single walker: Brent's method to 4 eps).  Pieces that do not run the compiled step (flat
+feet's modes, torque laws of the walker's own, a height profile's walk, which keeps each
+piece's dense output) are integrated one by one as the walker itself integrates them.
+
+The ledger's Gauss-Legendre nodes, needed where the held torques' power changes sign over a
+piece, read a dense output that the kernel does not keep: that piece is integrated again by
+the single walker's integrator on first use (:class:`_Redo`).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
+
+__all__ = ["advance_rows"]
+
+
+class _Redo:
+    """A piece's dense output made on first call: the piece from ``(t0, x0)`` integrated
+    again to ``t1`` by the walker's compiled step (CyRK's DOP853), the call answered on it
+    (scipy's ``OdeSolution`` convention)."""
+
+    def __init__(self, view, fphase, t0: float, x0: np.ndarray, t1: float):
+        self.args = (view, fphase, t0, x0, t1)  # (x0: the view's state, replaced, not
+        self.dense = None                       # written in place, when it moves on)
+
+    def __call__(self, t):
+        if self.dense is None:
+            view, fphase, t0, x0, t1 = self.args
+            self.dense = integrate_phase(fphase, t0, x0, None, t1, x0.size,
+                                         view.compiled_solver, "cyrk_compiled", None, None,
+                                         False).dense
+        return self.dense(t)
+
+
+def _flow_key(view, fphase) -> tuple:
+    """What the rows of one kernel call share: the cfunc, its guards, the tolerances
+    (kept in the view per compiled phase, which lives as long as the view)."""
+    key = view.row_keys.get(id(fphase))
+    if key is None:
+        key = view.row_keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
+    return key
+
+
+def _make_key(fphase, solver, m: int) -> tuple:
+    flow = fphase.compiled
+    n_extra, gcols, goffs = flow.guard_columns()
+    dirs = tuple(float(g.direction) for g in fphase.guards)
+    return (flow.address(False), n_extra, tuple(gcols.tolist()), tuple(goffs.tolist()), dirs,
+            float(solver.rtol), tuple(np.atleast_1d(solver.atol).tolist()), m)
+
+
+_CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out)
+
+
+def _kernel_args(key: tuple, fphase) -> tuple:
+    """:func:`walkerlab.integrate.rows_dop853.period_rows`'s shared arguments for ``key``."""
+    if key not in _CFUNCS:
+        from walkerlab.integrate.rows_dop853 import cfuncs
+
+        flow = fphase.compiled
+        module = flow.module()
+        f = module.cfunc_of(flow.name)
+        n_extra, gcols, goffs, dirs, rtol, atol, m = (key[1], key[2], key[3], key[4], key[5],
+                                                      key[6], key[7])
+        # the kernel's 2-norm at tolerances * sqrt(m) is CyRK's RMS norm at the tolerances
+        scale = np.sqrt(m)
+        if len(atol) != 1:  # pragma: no cover - the scenes' solvers give one atol
+            raise ValueError("rigid rows: one absolute tolerance for every state")
+        _CFUNCS[key] = (*cfuncs(module, flow.name, f), np.array(gcols, np.int64),
+                        np.array(goffs, float), np.array(dirs, float), rtol * scale,
+                        atol[0] * scale, m + n_extra)
+    return _CFUNCS[key]
+
+
+def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRun]:
+    """The compiled pieces ``pieces`` of walkers ``rows`` (one flow) in one kernel call."""
+    from walkerlab.integrate.rows_dop853 import FAILED, period_rows
+
+    fphase = pieces[0][5][0]
+    f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out = _kernel_args(key, fphase)
+    N, m = len(rows), key[7]
+    Y = np.empty((N, m))
+    D = np.empty((N, fphase.compiled.data().size))
+    cap = np.empty(N)
+    for r, (i, piece) in enumerate(zip(rows, pieces)):
+        v = views[i]
+        Y[r] = v.x
+        D[r] = piece[5][0].compiled.data()  # this walker's torques in its law block
+        cap[r] = piece[4] - v.t
+    which = np.empty(N, np.int64)
+    te = np.empty(N)
+    Yev = np.empty((N, m))
+    H = np.zeros(N)
+    view0 = views[rows[0]]
+    hook, sys.unraisablehook = sys.unraisablehook, view0._unraisable
+    try:
+        period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which,
+                    te, Yev, H)
+    finally:
+        sys.unraisablehook = hook
+    runs = []
+    for r, (i, piece) in enumerate(zip(rows, pieces)):
+        v, w = views[i], int(which[r])
+        failed = w == FAILED
+        event = w if w >= 0 else None
+        # a row that reached its end stops on it exactly (its time is the period's)
+        t_last = v.t + float(te[r]) if (event is not None or failed) else float(piece[4])
+        runs.append(PhaseRun(t_last, Yev[r], failed,
+                             "the step size fell below 10 ulp of t" if failed else "", event,
+                             _Redo(v, piece[5][0], v.t, v.x, t_last), 0))
+    return runs
+
+
+def advance_rows(views, actions, t_ends) -> list[list[float]]:
+    """Advance every walker ``views[i]`` to ``t_ends[i]`` [s] with the torques
+    ``actions[i]`` (k,) [N m] held, as its own
+    :meth:`~walkerlab.gym.rigid_view.RigidView.advance` does, the compiled pieces of all of
+    them integrated together (module docstring).
+
+    Parameters
+    ----------
+    views : sequence of walkerlab.gym.rigid_view.RigidView
+    actions : sequence of ndarray (k,)
+        The held torques [N m].
+    t_ends : sequence of float
+        Each walker's period end [s].
+
+    Returns
+    -------
+    list of list of float
+        Each walker's heel-strike times inside its period [s]; its ``ended`` is set when
+        its episode ended there.
+    """
+    strikes: list[list[float]] = [[] for _ in views]
+    for v, u, t_end in zip(views, actions, t_ends):
+        v._period = (np.asarray(u, dtype=float), float(t_end))
+        v._log.append(v._period)
+    live = [i for i, v in enumerate(views) if v.t < t_ends[i] and not v.ended]
+    while live:
+        groups: dict = {}
+        for i in live:
+            v = views[i]
+            piece = v.next_piece(actions[i], t_ends[i])
+            if piece is None:
+                continue
+            if piece[5] is None or v.ground is not None:  # the walker's own integration
+                run, phase = v._integrate(piece)
+                strikes[i] += v.absorb(piece, run, phase)
+                continue
+            key = _flow_key(v, piece[5][0])
+            rows, pieces = groups.setdefault(key, ([], []))
+            rows.append(i)
+            pieces.append(piece)
+        for key, (rows, pieces) in groups.items():
+            for i, piece, run in zip(rows, pieces, _integrate_rows(views, rows, pieces, key)):
+                strikes[i] += views[i].absorb(piece, run, piece[3])
+        live = [i for i in live if views[i].t < t_ends[i] and not views[i].ended]
+    return strikes
