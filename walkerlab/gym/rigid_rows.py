@@ -113,8 +113,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRu
     te = np.empty(N)
     Yev = np.empty((N, m))
     H = np.zeros(N)
-    view0 = views[rows[0]]
-    hook, sys.unraisablehook = sys.unraisablehook, view0._unraisable
+    view0 = views[rows[0]]  # (an arithmetic error inside the kernel: counted on it)
+    hook, sys.unraisablehook = sys.unraisablehook, view0.count_unraisable
     try:
         period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which,
                     te, Yev, H)
@@ -155,8 +155,7 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
     """
     strikes: list[list[float]] = [[] for _ in views]
     for v, u, t_end in zip(views, actions, t_ends):
-        v._period = (np.asarray(u, dtype=float), float(t_end))
-        v._log.append(v._period)
+        v.open_period(u, t_end)
     live = [i for i, v in enumerate(views) if v.t < t_ends[i] and not v.ended]
     while live:
         groups: dict = {}
@@ -165,8 +164,9 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
             piece = v.next_piece(actions[i], t_ends[i])
             if piece is None:
                 continue
-            if piece[5] is None or v.ground is not None:  # the walker's own integration
-                run, phase = v._integrate(piece)
+            if (piece[5] is None or v.ground is not None  # the walker's own integration
+                    or piece[5][0].compiled.guard_columns() is None):
+                run, phase = v.integrate_piece(piece)
                 strikes[i] += v.absorb(piece, run, phase)
                 continue
             key = _flow_key(v, piece[5][0])

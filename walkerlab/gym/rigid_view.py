@@ -133,7 +133,7 @@ class RigidView:
         #: what a compiled phase shares with other walkers' in a batched step
         #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``)
         self.row_keys: dict = {}
-        #: arithmetic errors raised inside compiled flows (:meth:`_unraisable`), counted
+        #: arithmetic errors raised inside compiled flows (:meth:`count_unraisable`), counted
         self.arithmetic_errors = 0
         self._joints_at: tuple = (b"", None, None, None)  # (state bytes, delta, ddelta, acts)
         n = model.n_coordinates
@@ -310,7 +310,7 @@ class RigidView:
             if scene_on:
                 self.ledger["scene_torque_work"] += h * _GL_W[j] * scene.power(tj, xj)
 
-    def _unraisable(self, args) -> None:
+    def count_unraisable(self, args) -> None:
         """``sys.unraisablehook`` while a compiled flow runs: an arithmetic error inside the
         cfunc (numba reports it as unraisable: ``0.0 ** -2`` of a five-link walker's
         virtual-leg length in a configuration it cannot reach but folded flat, while it
@@ -352,9 +352,14 @@ class RigidView:
             :attr:`ended` is set when the episode ended inside it (``fall``, ``stall``,
             ``ground_end``, ``solver_failure``).
         """
+        self.open_period(u, t_end)
+        return self._run(u, t_end)
+
+    def open_period(self, u: np.ndarray, t_end: float) -> None:
+        """A control period to ``t_end`` [s] with the torques ``u`` (k,) [N m] begins: kept
+        with the step's periods (a profile's step walked again replays them)."""
         self._period = (np.asarray(u, dtype=float), float(t_end))
         self._log.append(self._period)
-        return self._run(u, t_end)
 
     def _again(self, j: int) -> list[float]:
         """Walk the present step again from its start on a profile's segment ``j`` (the
@@ -389,7 +394,7 @@ class RigidView:
             piece = self.next_piece(u, t_end)
             if piece is None:
                 break
-            run, phase = self._integrate(piece)
+            run, phase = self.integrate_piece(piece)
             strikes += self.absorb(piece, run, phase)
         return strikes
 
@@ -416,14 +421,14 @@ class RigidView:
             fast[1][_CONSTANTS[:acts.u.size]] = acts.u  # the law block (each constant)
         return w, acts, act_on, phase, t_stop, fast
 
-    def _integrate(self, piece):
+    def integrate_piece(self, piece):
         """``(run, phase)``: :meth:`next_piece`'s piece integrated from the present state
         (the compiled step, or the scene's solver on Python flows), and the phase that ran
         (a flat foot's twin's under an action)."""
         w, acts, act_on, phase, t_stop, fast = piece
         n = self.n
         if fast is not None:
-            hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
+            hook, sys.unraisablehook = sys.unraisablehook, self.count_unraisable
             try:
                 return integrate_phase(fast[0], self.t, self.x, None, t_stop, 2 * n,
                                        self.compiled_solver, "cyrk_compiled", None, None,
