@@ -279,3 +279,27 @@ def test_hip_width_walkers_urdf_in_pinocchio_has_its_kinetic_energy_and_feet(tmp
     leg1 = model.getJointId("leg1_hip")
     foot = pdata.oMi[leg1].act(np.array([0.0, 0.0, -1.0]))  # the swing leg's foot (L = 1 m)
     assert np.max(np.abs(foot - C @ pts["swing_foot"])) < 1e-12
+
+
+def test_hip_width_steps_release_the_slopes_energy_along_the_fall_line(hip_width_gait):
+    """A step's length is its advance in the direction of walking (the sagittal plane's
+    ``x, y``), its width apart: over a step of the passive gait the ledger's slope energy
+    ``M g d sin(gamma)`` is gravity's work, the potential energy the walker loses, and the
+    heel strike takes it (the 3D foot-to-foot distance, 0.1 m hip width included, had
+    overstated it by 3.8 %).  Bound: the fixed point's tolerance (1e-12) through a step."""
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.analysis.gait.metrics import step_length
+    from walkerlab.integrate.rigid import simulate_steps
+
+    walker, res, w = hip_width_gait
+    traj = simulate_steps(walker, res.x, 2, SOLVER)
+    led = trajectory_ledger(traj)
+    for k, seg in enumerate(traj.segments):
+        foot = np.asarray(walker.for_stance(seg.stance_leg).points(seg.x_end)["swing_foot"],
+                          float).ravel()
+        assert abs(abs(foot[2]) - w) < 0.02  # the step's width: about the hip width
+        assert step_length(walker, seg) == pytest.approx(math.hypot(foot[0], foot[1]),
+                                                         rel=1e-15)
+        assert led["slope_energy"][k] == pytest.approx(led["potential_work"][k], rel=1e-9)
+        assert led["heel_strike_loss"][k] == pytest.approx(led["slope_energy"][k], rel=1e-9)
+        assert led["cost_of_transport"][k] == pytest.approx(math.sin(HIP["gamma"]), rel=1e-12)

@@ -108,8 +108,12 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
 
 def step_length(walker, seg) -> float:
     """Length of a step that ended by a heel strike [m]: the distance from the stance foot
-    to the swing foot at heel strike, with the step's own numbers (legs that differ:
-    ``walker.for_stance(seg.stance_leg)``).
+    to the swing foot at heel strike in the direction of walking, with the step's own
+    numbers (legs that differ: ``walker.for_stance(seg.stance_leg)``).  The points' first
+    two rows span the sagittal plane (``x`` downhill, ``y`` up); a 3D walker's third, the
+    lateral one, is its step width, which gait analysis keeps apart from the step's length
+    (and over which the slope releases no energy: the ledger's ``M g d sin(phi)`` is
+    gravity's work only with ``d`` along the fall line).
 
     Parameters
     ----------
@@ -121,7 +125,8 @@ def step_length(walker, seg) -> float:
     float
         [m] (the walker's length unit).
     """
-    return float(np.linalg.norm(walker.for_stance(seg.stance_leg).points(seg.x_end)["swing_foot"]))
+    foot = np.asarray(walker.for_stance(seg.stance_leg).points(seg.x_end)["swing_foot"], float)
+    return float(np.linalg.norm(foot[:2]))
 
 
 def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
