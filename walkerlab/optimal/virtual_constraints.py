@@ -365,7 +365,8 @@ def design_spec(scene, spec):
     return spec
 
 
-def design_controllers(scene, data, spec, print_level: int = 0) -> list[ControllerDesign]:
+def design_controllers(scene, data, spec, print_level: int = 0,
+                       walker=None) -> list[ControllerDesign]:
     """Optimise one controller per target speed of ``scene`` (module docstring).
 
     Parameters
@@ -383,6 +384,9 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
         :func:`walkerlab.optimal.transcription.virtual_constraints.mid_stance_window`).
     print_level : int
         IPOPT's.
+    walker : HybridWalker, optional
+        The scene's walker (:func:`walkerlab.models.registry.build_walker` of ``scene``)
+        when the caller holds it; default: built here.
 
     Returns
     -------
@@ -410,7 +414,7 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
     spec = design_spec(scene, spec)
-    walker = build_walker(scene)
+    walker = build_walker(scene) if walker is None else walker
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
     t0 = time.perf_counter()
@@ -511,9 +515,10 @@ def optimize_virtual_constraints(scene, data, spec):
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal import outcome as reported
 
-    cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec)]
+    walker = build_walker(scene)  # one build for the design and the record
+    cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec,
+                                                                   walker=walker)]
     c = cs[0]
-    walker = build_walker(scene)
     res = _AsResult(c)
     states, units = reported.named_states(walker, res)
     tol = scene.optimize.replay_tolerance
