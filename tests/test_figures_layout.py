@@ -326,8 +326,8 @@ def test_the_optimize_figure_draws_every_controllers_outputs_against_the_phase(m
                         phase_start=(0,), gait=True, status="Solve_Succeeded", iterations=3,
                         energy_unit="J", controllers=ctrl)
     drawn = {}
-    monkeypatch.setattr(figures, "save", lambda fig, folder, name, svg: drawn.setdefault(
-        "fig", fig) and [])
+    monkeypatch.setattr(figures, "save", lambda fig, folder, name, svg, key=None:
+                        drawn.setdefault("fig", fig) and [])
     optimize_figure.save_optimize_figure(d, "threelink_hzd", tmp_path)
     shown = [a for a in drawn["fig"].axes if a.axison]
     assert all(a.lines or a.texts for a in shown)  # no empty panel

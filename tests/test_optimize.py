@@ -89,6 +89,13 @@ def test_optimize_command_writes_its_artifact_and_refuses_what_it_cannot(tmp_pat
     assert d.contact_outcome == "heel_strike" and "contact model driven" in r.output
     figs = tmp_path / "compass_optimal" / "report" / "figures"  # the SVG on request (--svg)
     assert (figs / "optimize.png").is_file() and not (figs / "optimize.svg").exists()
+    # recomputed to the same result (--force): the figure drawn from it is kept, not redrawn
+    drawn = (figs / "optimize.png").stat()
+    r = CliRunner().invoke(app, ["optimize", str(CONFIGS / "compass_optimal.yaml"),
+                                 "--runs-dir", str(tmp_path), "--force"])
+    assert r.exit_code == 0 and f"figure: {figs / 'optimize.png'}" in r.output, r.output
+    kept = (figs / "optimize.png").stat()
+    assert (kept.st_ino, kept.st_mtime_ns) == (drawn.st_ino, drawn.st_mtime_ns)
     # arc feet: the generated equations transcribed as any straight-legged walker's (they
     # were refused before issue 48); their least effort on the passive slope is the passive
     # gait (tests/test_optimize_least_effort.py checks the numbers)

@@ -12,6 +12,9 @@ virtual_constraints``, configs/threelink_hzd.yaml's controller as the start, 0.8
 programme's build plus IPOPT's solve on each side (target: walkerlab <= 2x the script), and
 the whole ``walkerlab optimize`` computation (the start, the build, the solve, the written
 controller's zero dynamics and full-order fixed point; not the artifact's writing).
+The design as a whole process, too (:func:`bench_design_process`): warm ``walkerlab
+optimize`` against the minimal script as a process, given the same start and the same
+problem (the command's friction cone), pairs in turn (target: <= 2x the script).
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["bench_design", "bench_hzd", "lines"]
+__all__ = ["bench_design", "bench_design_process", "bench_hzd", "lines"]
 
 #: the issue's target for delta^2 [s]
 TARGET_S = 0.010
@@ -74,7 +77,79 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
            "step_map_s": step, "target_s": TARGET_S, "step_period_s": zd.step_period_s}
     if design:
         out["design"] = bench_design()
+        out["design_process"] = bench_design_process()
     return out
+
+
+def bench_design_process(pairs: int = 3) -> dict:
+    """The three-link design as a whole process: warm ``walkerlab optimize DESIGN.yaml
+    --force`` (configs/threelink_hzd.yaml with :data:`DESIGN` as its ``optimize``
+    section: the start, the collocation, the written controller's closed loop, its
+    contact replay, the artifact and the figure; the generated code cached by a first
+    run) against the minimal CasADi script (:mod:`walkerlab.bench.minimal_casadi_hzd`)
+    given the same start and the problem the command solves (its friction cone:
+    :func:`walkerlab.optimal.virtual_constraints.design_spec`), ``pairs`` pairs
+    alternating which runs first: wall and CPU medians, the pairs' ratios (target
+    :data:`TARGET_RATIO`), and both optima (the same one: the comparison is of the same
+    answer).
+    """
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    import yaml
+
+    from walkerlab.bench.optimize import paired, process_times
+    from walkerlab.config import load_scene
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.io.schemas.optimize import load
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.driver import collocation_spec
+    from walkerlab.optimal.virtual_constraints import controller_step, design_spec
+
+    root = Path(__file__).resolve().parents[2]
+    script = [sys.executable, str(root / "walkerlab" / "bench" / "minimal_casadi_hzd.py")]
+    this, theirs = [], []
+    with tempfile.TemporaryDirectory(prefix="wl_bench_hzd_") as d:
+        cfg = yaml.safe_load((root / "configs" / "threelink_hzd.yaml").read_text())
+        cfg.update(name="threelink_design", optimize=dict(DESIGN))
+        path = Path(d) / "threelink_design.yaml"
+        path.write_text(yaml.safe_dump(cfg))
+        scene = load_scene(path)
+        vc = scene.walker.actuation.virtual_constraints
+        spec = design_spec(scene, collocation_spec(scene))
+        t, x, u, alpha, _zd = controller_step(build_walker(scene), Solver.from_settings(
+            scene.solver), 2 * DESIGN["intervals"] + 1)
+        npz = Path(d) / "start.npz"
+        np.savez(npz, t=t, x=x, u=u, alpha=alpha, N=DESIGN["intervals"],
+                 speed=DESIGN["target_speed_m_per_s"], max_multiplier=DESIGN["max_multiplier"],
+                 kp=vc.feedback.kp_per_s2, kd=vc.feedback.kd_per_s,
+                 u_max=spec.max_torque_n_m, mu=spec.friction_coefficient)
+        script.append(str(npz))
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root),
+                                                             os.environ.get("PYTHONPATH", "")])}
+        cmd = [sys.executable, "-m", "walkerlab.cli", "optimize", str(path), "--runs-dir",
+               str(Path(d) / "runs")]
+        process_times(cmd, env, d)  # the generated code and the upstream stages cached
+        cmd.append("--force")
+        for i in range(pairs):
+            for which in ("this", "script") if i % 2 == 0 else ("script", "this"):
+                if which == "this":
+                    this.append(process_times(cmd, env, d))
+                else:
+                    theirs.append(process_times(script, cwd="/"))
+        words = subprocess.run(script, capture_output=True, text=True, check=True,
+                               cwd="/").stdout.split()
+        ours = load(Path(d) / "runs" / "threelink_design" / "optimize.h5")
+    return {"pairs": pairs, **paired(this, theirs), "target_ratio": TARGET_RATIO,
+            "walkerlab": {"status": str(ours.status), "iterations": int(ours.iterations),
+                          "objective": float(ours.objective),
+                          "period_s": float(ours.step_period_s)},
+            "script": {"status": words[0],
+                       "iterations": int(words[words.index("iterations") + 1]),
+                       "objective": float(words[words.index("objective") + 1]),
+                       "period_s": float(words[words.index("period") + 1])}}
 
 
 def bench_design(repeats: int = 3) -> dict:
@@ -183,6 +258,26 @@ def _design_lines(res: dict) -> list[str]:
     d = res.get("design")
     if not d:
         return []
+    return _build_solve_lines(d) + _process_lines(res.get("design_process"))
+
+
+def _process_lines(p: dict | None) -> list[str]:
+    if not p:
+        return []
+    ok = "met" if p["wall_ratio"]["median"] <= p["target_ratio"] else "NOT MET"
+    w, s = p["walkerlab"], p["script"]
+    return [f"hzd: three-link design as a whole process (walkerlab optimize --force, warm) "
+            f"{p['wall_s']['median']:.2f} s wall, {p['cpu_s']['median']:.2f} s CPU against "
+            f"the minimal script from the same start {p['script_wall_s']['median']:.2f} s, "
+            f"{p['script_cpu_s']['median']:.2f} s: {p['wall_ratio']['median']:.2f}x wall "
+            f"[{p['wall_ratio']['min']:.2f}, {p['wall_ratio']['max']:.2f}], "
+            f"{p['cpu_ratio']['median']:.2f}x CPU (medians of {p['pairs']} pairs in turn; "
+            f"target <= {p['target_ratio']:.0f}x: {ok}); optima: walkerlab {w['status']} "
+            f"{w['objective']:.10g} in {w['iterations']}, script {s['status']} "
+            f"{s['objective']:.10g} in {s['iterations']}"]
+
+
+def _build_solve_lines(d: dict) -> list[str]:
     ok = "met" if d["ratio"] <= d["target_ratio"] else "NOT MET"
     w, s = d["walkerlab"], d["script"]
     return [f"hzd: three-link design (0.8 m/s, delta^2 <= 0.6): walkerlab "

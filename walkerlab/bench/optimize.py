@@ -31,12 +31,16 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["GOALS_S", "SCENES", "bench_optimize", "lines"]
+__all__ = ["GOALS_S", "SCENES", "TARGET_OVER_SCRIPT", "bench_optimize", "bench_vs_script",
+           "lines"]
 
 #: the shipped optimisation scenes and their goals [s] (the optimal-gaits issue)
 GOALS_S = {"compass_optimal": 5.0, "kuo2002": 5.0, "rabbit_optimal": 60.0}
 SCENES = tuple(GOALS_S)
 _CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+#: the issue's goal for warm ``walkerlab optimize configs/compass_optimal.yaml --force``
+#: against the minimal CasADi script (:mod:`walkerlab.bench.minimal_casadi`), whole process
+TARGET_OVER_SCRIPT = 2.0
 
 
 def _run(scene_path: Path, folder: Path, force: bool, tree: Path | None = None) -> dict:
@@ -123,13 +127,79 @@ def _paired(a: list[dict], b: list[dict], key: str):
                     if x.get(key) and y.get(key)], key)
 
 
-def bench_optimize(scenes=SCENES, repeats: int = 3, vs: Path | None = None) -> dict:
-    """:func:`bench_scene` of every scene (against the code tree ``vs`` if given); the
-    load average before and after."""
+def process_times(cmd: list[str], env: dict | None = None, cwd=None) -> tuple[float, float]:
+    """(wall, CPU) [s] of the finished process ``cmd`` (CPU: user + sys, the children's
+    rusage); its output thrown away.
+
+    Raises
+    ------
+    RuntimeError
+        The process exited non-zero (its output's last lines).
+    """
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, env=env, cwd=cwd, capture_output=True, check=False)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(map(str, cmd[:4]))}: exit {proc.returncode}: "
+                           f"{proc.stderr.decode(errors='replace')[-500:]}")
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def paired(this: list[tuple[float, float]], script: list[tuple[float, float]]) -> dict:
+    """Medians [min, max] of ``this`` and ``script`` ((wall, CPU) pairs [s], run in turn)
+    and of their ratios pair by pair (the machine's drift hits both of a pair alike)."""
+    def stats(v):
+        return {"median": float(np.median(v)), "min": float(min(v)), "max": float(max(v))}
+
+    return {"wall_s": stats([a[0] for a in this]), "cpu_s": stats([a[1] for a in this]),
+            "script_wall_s": stats([b[0] for b in script]),
+            "script_cpu_s": stats([b[1] for b in script]),
+            "wall_ratio": stats([a[0] / b[0] for a, b in zip(this, script)]),
+            "cpu_ratio": stats([a[1] / b[1] for a, b in zip(this, script)])}
+
+
+def bench_vs_script(pairs: int = 5) -> dict:
+    """Warm ``walkerlab optimize configs/compass_optimal.yaml --force`` (the optimisation,
+    its rigid and contact replays, the artifact and the figure; the generated code and the
+    upstream gait cached by a first run) against the minimal CasADi + IPOPT script of the
+    same collocation (:mod:`walkerlab.bench.minimal_casadi`), whole process against whole
+    process, ``pairs`` pairs alternating which runs first: wall and CPU medians and the
+    medians of the pairs' ratios (goal :data:`TARGET_OVER_SCRIPT`)."""
+    script = [sys.executable, str(Path(__file__).with_name("minimal_casadi.py"))]
+    this, theirs = [], []
+    with tempfile.TemporaryDirectory(prefix="wl_bench_opt_") as d:
+        env = {**os.environ, "WALKERLAB_CACHE_DIR": str(Path(d) / "cache"),
+               "PYTHONPATH": os.pathsep.join([str(_CONFIGS.parent),
+                                              os.environ.get("PYTHONPATH", "")])}
+        cmd = [sys.executable, "-m", "walkerlab.cli", "optimize",
+               str(_CONFIGS / "compass_optimal.yaml"), "--runs-dir", str(Path(d) / "runs")]
+        process_times(cmd, env, d)  # cold: the generated code, the fixed point
+        cmd.append("--force")
+        process_times(cmd, env, d)  # the steady state of repeated runs
+        for i in range(pairs):
+            for which in ("this", "script") if i % 2 == 0 else ("script", "this"):
+                if which == "this":
+                    this.append(process_times(cmd, env, d))
+                else:
+                    theirs.append(process_times(script, cwd="/"))
+    return {"scene": "compass_optimal", "pairs": pairs, **paired(this, theirs),
+            "target_ratio": TARGET_OVER_SCRIPT}
+
+
+def bench_optimize(scenes=SCENES, repeats: int = 3, vs: Path | None = None,
+                   script: bool = True) -> dict:
+    """:func:`bench_scene` of every scene (against the code tree ``vs`` if given) and, with
+    ``script``, :func:`bench_vs_script`; the load average before and after."""
     load0 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
     res = [bench_scene(s, repeats, vs) for s in scenes]
+    yard = bench_vs_script() if script else None
     load1 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
-    return {"scenes": res, "loadavg_1min_before": load0, "loadavg_1min_after": load1,
+    return {"scenes": res, "vs_script": yard,
+            "loadavg_1min_before": load0, "loadavg_1min_after": load1,
             "note": "whole process (python -m walkerlab.cli optimize); cold: fresh runs "
                     "folder and code cache; warm: the same with --force; cpu: user + sys "
                     "of the process; compute: the stage's own; medians [min, max]"}
@@ -154,4 +224,12 @@ def lines(result: dict) -> list[str]:
             out.append(f"  {s['scene']} | {mode} | vs {s['vs']['tree']}: wall "
                        f"{cell(v['wall_s'])}, cpu {cell(v['cpu_s'])}; this / vs paired: "
                        f"wall {cell(r['wall_s'])}, cpu {cell(r['cpu_s'])}")
+    y = result.get("vs_script")
+    if y:
+        ok = "met" if y["wall_ratio"]["median"] <= y["target_ratio"] else "NOT MET"
+        out.append(f"  {y['scene']} | warm | vs the minimal CasADi script (whole process, "
+                   f"{y['pairs']} pairs in turn): wall {cell(y['wall_s'])} s against "
+                   f"{cell(y['script_wall_s'])} s, ratio {cell(y['wall_ratio'])} (target <= "
+                   f"{y['target_ratio']:g}: {ok}); cpu {cell(y['cpu_s'])} s against "
+                   f"{cell(y['script_cpu_s'])} s, ratio {cell(y['cpu_ratio'])}")
     return out

@@ -37,7 +37,9 @@ benchmark      what is timed                                                    
 ``optimize``   ``walkerlab optimize`` of every shipped optimisation scene,      compass,
                whole process, cold (fresh runs folder and code cache) and warm  Kuo <= 5 s,
                (``--force``), wall and CPU, medians of 3                        five-link
-               (:mod:`walkerlab.bench.optimize`; ``scripts/bench_optimize.py``) <= 60 s
+               (:mod:`walkerlab.bench.optimize`; ``scripts/bench_optimize.py``) <= 60 s;
+               and the warm compass walker against the minimal CasADi script,   <= 2 x
+               whole processes, 5 pairs in turn (``vs_script``)                 script
 ``powered``    a powered contact run (hip law, push-off, RABBIT's phase law) on <= 1.5x
                its compiled run against the passive run of the same walker,     passive
                CPU, medians (:mod:`walkerlab.bench.powered_contact`)
@@ -47,7 +49,9 @@ benchmark      what is timed                                                    
                (:mod:`walkerlab.bench.powered_command`)
 ``hzd``        the restricted Poincare map's delta^2 of RABBIT under virtual    <= 10 ms
                constraints (configs/rabbit_hzd.yaml), median; the whole zero
-               dynamics and one full-order step beside it
+               dynamics and one full-order step beside it; the three-link       design:
+               design against the minimal CasADi script from the same start:    <= 2 x
+               build + solve, and ``walkerlab optimize`` as a whole process      script
                (:mod:`walkerlab.bench.hzd`; ``scripts/bench_hzd.py``)
 ``gym``        ``walkerlab/Walker-v0`` steps/s beside MuJoCo's ``Walker2d-v5``,  >= Walker2d
                threelink_hzd and rabbit_hzd, rigid and contact views, zero /

@@ -235,7 +235,7 @@ def optimize(scene: Path | None = SceneArg,
     typer.echo(status(out))
     from walkerlab.stages.optimize import draw
 
-    typer.echo(f"figure: {draw(load(scene), runs_dir, svg)[0]}")
+    typer.echo(f"figure: {draw(load(scene), runs_dir, svg, keep_current=True)[0]}")
     if require_gait:  # the artifact stays: it holds what was found
         from walkerlab.io.schemas.optimize import load as load_optimize
 

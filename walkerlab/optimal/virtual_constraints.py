@@ -28,7 +28,7 @@ from walkerlab.io.schemas.optimize import ControllerData
 __all__ = ["CHECK_MIN_S", "CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
            "REPLAY_STRIDES", "ControllerDesign", "check_design", "clearance_report",
            "contact_scene", "controller_scene", "controller_scene_text", "controller_step",
-           "design_controllers", "design_failures", "designs_controller",
+           "design_controllers", "design_failures", "design_spec", "designs_controller",
            "optimize_virtual_constraints", "replay_in_contact"]
 
 KEY = "walker.actuation.virtual_constraints"
@@ -349,7 +349,24 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
         multipliers=mult, delta2_multiplier=near, note=note, x_star=x_star, **common)
 
 
-def design_controllers(scene, data, spec, print_level: int = 0) -> list[ControllerDesign]:
+def design_spec(scene, spec):
+    """The collocation ``spec`` of ``scene`` as :func:`design_controllers` solves it: the
+    controller's torque bound where the ``optimize`` section gives none, and the friction
+    coefficient within :data:`CONTACT_CONE_FRACTION` of the contact model's static one when
+    the scene has no contact section (:func:`contact_scene`)."""
+    vc = scene.walker.actuation.virtual_constraints
+    if spec.max_torque_n_m is None and vc.max_torque_n_m is not None:
+        spec = replace(spec, max_torque_n_m=vc.max_torque_n_m)
+    if spec.friction_coefficient is not None and scene.contact is None:
+        # the written scene's contact law is the design's (CONTROLLER_CONTACT): within a
+        # third of its cone too; a scene with its own law keeps its design's cone as given
+        mu = CONTACT_CONE_FRACTION * float(contact_scene(scene).contact.mu_static)
+        spec = replace(spec, friction_coefficient=min(float(spec.friction_coefficient), mu))
+    return spec
+
+
+def design_controllers(scene, data, spec, print_level: int = 0,
+                       walker=None) -> list[ControllerDesign]:
     """Optimise one controller per target speed of ``scene`` (module docstring).
 
     Parameters
@@ -367,6 +384,9 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
         :func:`walkerlab.optimal.transcription.virtual_constraints.mid_stance_window`).
     print_level : int
         IPOPT's.
+    walker : HybridWalker, optional
+        The scene's walker (:func:`walkerlab.models.registry.build_walker` of ``scene``)
+        when the caller holds it; default: built here.
 
     Returns
     -------
@@ -393,14 +413,8 @@ def design_controllers(scene, data, spec, print_level: int = 0) -> list[Controll
 
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
-    if spec.max_torque_n_m is None and vc.max_torque_n_m is not None:
-        spec = replace(spec, max_torque_n_m=vc.max_torque_n_m)
-    if spec.friction_coefficient is not None and scene.contact is None:
-        # the written scene's contact law is the design's (CONTROLLER_CONTACT): within a
-        # third of its cone too; a scene with its own law keeps its design's cone as given
-        mu = CONTACT_CONE_FRACTION * float(contact_scene(scene).contact.mu_static)
-        spec = replace(spec, friction_coefficient=min(float(spec.friction_coefficient), mu))
-    walker = build_walker(scene)
+    spec = design_spec(scene, spec)
+    walker = build_walker(scene) if walker is None else walker
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
     t0 = time.perf_counter()
@@ -501,9 +515,10 @@ def optimize_virtual_constraints(scene, data, spec):
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal import outcome as reported
 
-    cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec)]
+    walker = build_walker(scene)  # one build for the design and the record
+    cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec,
+                                                                   walker=walker)]
     c = cs[0]
-    walker = build_walker(scene)
     res = _AsResult(c)
     states, units = reported.named_states(walker, res)
     tol = scene.optimize.replay_tolerance

@@ -37,10 +37,12 @@ PART_COLORS = [("tab:blue", "tab:green", "tab:cyan", "navy"),
 PARTS = ("thigh", "shank", "", "foot")
 
 
-def save(fig, folder: Path, stem: str, svg: bool = True) -> list[Path]:
+def save(fig, folder: Path, stem: str, svg: bool = True, key: str | None = None
+         ) -> list[Path]:
     """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure.
     ``svg`` False: the PNG alone (an earlier ``stem.svg`` is removed: it would show an
-    older result).
+    older result).  ``key``: what the figure was drawn from, stored in the PNG (a text
+    chunk, :mod:`walkerlab.plotting.figure_cache`).
 
     Each file is written atomically (temporary name, then rename; mode 0644): an
     interrupted save leaves the previous figure or none, never a truncated file.
@@ -51,6 +53,7 @@ def save(fig, folder: Path, stem: str, svg: bool = True) -> list[Path]:
         The folder cannot be written (one line).
     """
     from walkerlab.io.artifacts import atomic_write
+    from walkerlab.plotting.figure_cache import KEY_CHUNK
 
     folder = Path(folder)
     out = []
@@ -70,8 +73,9 @@ def save(fig, folder: Path, stem: str, svg: bool = True) -> list[Path]:
             (folder / f"{stem}.svg").unlink(missing_ok=True)
         for ext in ("png", "svg") if svg else ("png",):
             p = folder / f"{stem}.{ext}"
-            atomic_write(p, lambda fh, ext=ext: fig.savefig(fh, format=ext, dpi=150,
-                                                            bbox_inches=bbox))
+            meta = {KEY_CHUNK: key} if key is not None and ext == "png" else None
+            atomic_write(p, lambda fh, ext=ext, meta=meta: fig.savefig(
+                fh, format=ext, dpi=150, bbox_inches=bbox, metadata=meta))
             out.append(p)
     finally:
         plt.close(fig)

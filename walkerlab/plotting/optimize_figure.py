@@ -13,8 +13,9 @@ __all__ = ["save_optimize_figure"]
 
 
 def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None,
-                         svg: bool = True) -> list[Path]:
-    """Draw ``optimize.png`` / ``.svg`` (``svg`` False: the PNG alone) from a loaded
+                         svg: bool = True, key: str | None = None) -> list[Path]:
+    """Draw ``optimize.png`` / ``.svg`` (``svg`` False: the PNG alone; ``key`` stored in the
+    PNG, :func:`walkerlab.plotting.figures.save`) from a loaded
     ``optimize.h5`` (``d``: :class:`walkerlab.io.schemas.optimize.OptimizeData`): left every
     torque [N m] at the collocation points (by name), middle every angle state [rad] over
     the step, and with ``sticks`` (a list of (m, 2) polylines [m], e.g. stance foot - knee -
@@ -95,7 +96,7 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
     fig.suptitle(f"{title}: optimised {'stride' if steps > 1 else 'step'} (direct collocation)"
                  + ("" if d.gait else " — NOT a gait: the replay does not close"), fontsize=10)
     fig.tight_layout()
-    return save(fig, Path(folder), "optimize", svg)
+    return save(fig, Path(folder), "optimize", svg, key)
 
 
 def _energy_and_convergence(d, axes) -> None:

@@ -216,20 +216,33 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
                       artifact=design_stem(list(bounds), objective, maximize))
 
 
-def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True) -> list[Path]:
+def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True,
+         keep_current: bool = False) -> list[Path]:
     """Draw ``optimize.png`` (PNG + SVG; ``svg`` False: the PNG alone) from
-    ``optimize.h5``."""
+    ``optimize.h5``; the PNG carries the key of what it was drawn from
+    (:mod:`walkerlab.plotting.figure_cache`).  ``keep_current`` (the PNG alone): keep a PNG
+    drawn from the artifact's result as it is now (the same result, code and matplotlib)
+    instead of drawing it again: the figure it would draw (``walkerlab optimize`` rerun on
+    a fresh artifact, or recomputed to the same result)."""
     from walkerlab.io.runpaths import figures_dir
+    from walkerlab.plotting.figure_cache import drawn_from, figure_key
+
+    art = stage_artifact(scene, runs_root, "optimize")
+    folder = figures_dir(scene, runs_root)
+    key = figure_key(art, "optimize")  # stored in the PNG drawn
+    if keep_current and not svg and drawn_from(folder / "optimize.png", key):
+        (folder / "optimize.svg").unlink(missing_ok=True)  # as a PNG-only draw does
+        return [folder / "optimize.png"]
     from walkerlab.plotting.optimize_figure import save_optimize_figure
 
-    d = schema.load(stage_artifact(scene, runs_root, "optimize"))
+    d = schema.load(art)
     sticks = None
     # a five-link biped's open-loop step: its stop action
     if d.torque_names != ("hip",) and not d.controllers:
         from walkerlab.optimal.driver import stick_figures
 
         sticks = stick_figures(scene, d)
-    return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks, svg)
+    return save_optimize_figure(d, scene.name, folder, sticks, svg, key)
 
 
 def draw_design(scene: Scene, runs_root: Path | str, fields: list[str], objective: str,
