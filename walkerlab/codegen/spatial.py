@@ -369,8 +369,9 @@ def derive_compass(structure) -> Equations:
         guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
                 "hip_height": pelvis[1], "swing_clearance": height},
         points=points, leg_angles={"stance": th_st, "swing": th_sw, "lean": phi,
-                                   **({"pelvis_roll": phi_p, "swing_roll": phi_w}
-                                      if structure.hip_roll else {})},
+                                   # each leg's roll by leg (the lean is the stance leg's)
+                                   **({"pelvis_roll": phi_p, "stance_roll": phi,
+                                       "swing_roll": phi_w} if structure.hip_roll else {})},
         section_drop=1, drop_solution=drop_solution,
         De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
     )

@@ -106,8 +106,8 @@ class CompassGaitParams(_Actuated):
             raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                              "walker's hips are one point)")
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
-            raise ValueError("walker.hip_roll: hip-roll joints need space: 3d and a "
-                             "hip_width_m > 0 (the pelvis rolls on the stance hip)")
+            raise ValueError("walker.hip_roll: hip-roll joints are a 3D straight-legged "
+                             "walker's with hip width (walker.space: 3d, hip_width_m > 0)")
         if self.hip_roll is not None and self.actuation is not None:
             raise ValueError("walker.actuation: a 3D walker's actuators are its hip_roll "
                              "law so far")
