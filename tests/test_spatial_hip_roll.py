@@ -291,7 +291,7 @@ def stabilised_gait(stabilised):
     return res
 
 
-@pytest.mark.slow  # ~10 s: the generated walker's fixed point
+@pytest.mark.slow  # ~15 s: the generated walker's fixed point
 def test_hip_roll_law_makes_the_hip_width_gait_stable(stabilised_gait):
     """The shipped law stabilises the gait whose passive twin (configs/hip_width.yaml) has a
     lateral multiplier of 99.9: every multiplier of the stride inside the unit circle (none
@@ -300,7 +300,7 @@ def test_hip_roll_law_makes_the_hip_width_gait_stable(stabilised_gait):
     assert mult.max() < 0.95
 
 
-@pytest.mark.slow  # ~60 s: the reference's own fixed point and central differences
+@pytest.mark.slow  # ~4 min: the reference's own fixed point and central differences
 def test_hip_roll_gait_and_multipliers_match_an_independent_model(stabilised,
                                                                    stabilised_gait):
     """The stabilised gait's fixed point to 1e-8 and its multipliers to 1e-6 against the

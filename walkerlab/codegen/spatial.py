@@ -274,6 +274,19 @@ def derive_compass(structure) -> Equations:
     Poincaré section: just after a heel strike (the swing foot on the slope behind): the
     swing angle solved from ``h = 0``.
 
+    Hip-roll joints (``structure.hip_roll``; Kuo 1999's lateral foot placement): each leg
+    hangs from the pelvis on a roll joint (about the pelvis' fall-line axis) below its pitch
+    hinge, so two more coordinates, ``pelvis_roll`` ``phi_p`` and ``swing_roll`` ``phi_w``
+    (each body's roll about the fall line; ``lean`` is then the stance leg's):
+    ``R_st = Rot(s, phi) Rot(z, theta_st)``, the hip axis ``Rot(s, phi_p) z``,
+    ``R_sw = Rot(s, phi_w) Rot(z, theta_sw)``.  Both hips are the same joint, so the roles
+    swap at heel strike with nothing moving: ``(phi, phi_p, phi_w) -> (phi_w, phi_p, phi)``.
+    The guard ``h = L cos(phi) cos(theta_st + gamma) - w sin(phi_p) - L cos(phi_w)
+    cos(theta_sw + gamma)``; the impact as above (the law's torques are finite: every
+    joint is free through it); the law's generalised forces (:func:`_hip_roll_forces`)
+    are subtracted from ``G``.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
+    expressions are the three-coordinate walker's.
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
@@ -284,7 +297,7 @@ def derive_compass(structure) -> Equations:
     Returns
     -------
     Equations
-        ``n = 3``; points (3, 1) in world axes.
+        ``n = 3`` (5 with ``hip_roll``); points (3, 1) in world axes.
 
     Raises
     ------
@@ -312,7 +325,6 @@ def derive_compass(structure) -> Equations:
 
     def roll_of(angle):
         return rotation(sp.Matrix([1, 0, 0]), angle)
-    roll = roll_of(phi)
     axis = roll_of(phi_p) * ez                         # the hip axis
 
     def leg(theta, length, lean=phi):  # from the hip to a point at ``length`` down the leg

@@ -245,8 +245,8 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
                   "stairs, footholds and profiles are planar walkers' grounds")
 #: why a 3D walker refuses actuators
-SPATIAL_ACTUATION = ("a walker in 3D is passive so far (its actuators, a lateral "
-                     "foot-placement or hip-roll law, are a later step)")
+SPATIAL_ACTUATION = ("a walker in 3D takes no walker.actuation so far (its lateral "
+                     "foot-placement law is walker.hip_roll: hip-roll joints)")
 #: why the kinds other than the 3D straight legs refuse hip-roll joints (the scene's check
 #: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
 NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
