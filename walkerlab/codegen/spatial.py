@@ -282,9 +282,13 @@ def derive_compass(structure) -> Equations:
     ``R_sw = Rot(s, phi_w) Rot(z, theta_sw)``.  Both hips are the same joint, so the roles
     swap at heel strike with nothing moving: ``(phi, phi_p, phi_w) -> (phi_w, phi_p, phi)``.
     The guard ``h = L cos(phi) cos(theta_st + gamma) - w sin(phi_p) - L cos(phi_w)
-    cos(theta_sw + gamma)``; the impact as above (the law's torques are finite: every
-    joint is free through it); the law's generalised forces (:func:`_hip_roll_forces`)
-    are subtracted from ``G``.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
+    cos(theta_sw + gamma)``; the pelvis has its own inertia ``I_pelvis`` about the fall
+    line (``T += I_pelvis dphi_p^2 / 2``; a rotation about ``s`` moves no foot, so the
+    impact's extended mass gets it unchanged); the impact as above (the law's torques are
+    finite: every joint is free through it); the law's generalised forces
+    (:func:`_hip_roll_forces`) are subtracted from ``G``.  The pelvis' pitch and yaw are
+    held (the coordinates have none): its roll axis, on which the legs' roll joints lie,
+    stays on the fall line.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
     expressions are the three-coordinate walker's.
 
     Parameters
@@ -338,6 +342,8 @@ def derive_compass(structure) -> Equations:
     swing_foot = hip_sw + leg(th_sw, L, phi_w)
     masses = [(M_hip, pelvis), (m, m_st), (m, m_sw)]
     M, A, total = _point_mass_matrix(masses, q)
+    if structure.hip_roll:  # the pelvis' own inertia about the fall line (it rolls by phi_p)
+        M[3, 3] += P["I_pelvis"]
     M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
     C = christoffel(M, q, dq)
     # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n

@@ -46,9 +46,15 @@ class HipRollLaw(Strict):
       lean_rate_gain dphi``: the swing leg rolls out as the body leans and falls toward it.
 
     The law is odd in the rolls, so the mirror step (the swing hip on the other side) runs
-    the same law.
+    the same law.  ``pelvis_roll_inertia_kg_m2`` is the pelvis' own inertia in roll (its
+    pitch and yaw are held: :func:`walkerlab.codegen.spatial.derive_compass`): without one
+    the impact sets the light pelvis rolling so fast that the old stance foot is driven into
+    the ground (``configs/hip_width_stabilised.yaml``'s gait at 0 kg m^2: -0.10 m/s).
     """
 
+    pelvis_roll_inertia_kg_m2: float = Field(
+        ge=0, le=1e4, description="the pelvis' moment of inertia about the fall line through "
+        "its centre [kg m^2] (the point masses' aside: an upper body's, say)")
     pelvis_stiffness_n_m_per_rad: float = Field(
         ge=0, le=1e6, description="stance hip: torque per rad of pelvis roll [N m/rad]")
     pelvis_damping_n_m_s_per_rad: float = Field(
