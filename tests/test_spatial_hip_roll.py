@@ -317,7 +317,7 @@ def test_hip_roll_gait_lifts_the_old_stance_foot_off_the_ground(stabilised, stab
     assert ref.n @ (J @ x[5:]) > 0.1
 
 
-@pytest.mark.slow  # ~4 min: the reference's own fixed point and central differences
+@pytest.mark.slow  # ~60 s: the reference's own fixed point and central differences
 def test_hip_roll_gait_and_multipliers_match_an_independent_model(stabilised,
                                                                    stabilised_gait):
     """The stabilised gait's fixed point to 1e-8 and its multipliers to 1e-6 against the

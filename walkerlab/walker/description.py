@@ -54,9 +54,11 @@ SPATIAL_COMPASS_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
 #: about the fall line (the ``lean`` is then the stance leg's).
 HIP_ROLL_ROLES = ("pelvis_roll", "swing_roll")
 #: Parameters of the hip-roll joints and law (:class:`walkerlab.config.walker.HipRollLaw`,
-#: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis roll, the swing hip's on the swing
-#: leg's, the foot-placement gains on the lean and its rate.
-HIP_ROLL_PARAMS = ("I_pelvis", "k_pelvis", "c_pelvis", "k_swing", "c_swing", "g_lean", "g_lean_rate")
+#: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis
+#: roll, the swing hip's on the swing leg's, the foot-placement gains on the lean and its
+#: rate.
+HIP_ROLL_PARAMS = ("I_pelvis", "k_pelvis", "c_pelvis", "k_swing", "c_swing", "g_lean",
+                   "g_lean_rate")
 
 
 @dataclass(frozen=True)
@@ -413,9 +415,9 @@ def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
         params, mirror = params + (width,), params + (-width,)
     law = w.hip_roll
     if law is not None:  # odd in the rolls: the mirror step runs the same gains
-        gains = (law.pelvis_roll_inertia_kg_m2, law.pelvis_stiffness_n_m_per_rad, law.pelvis_damping_n_m_s_per_rad,
-                 law.swing_stiffness_n_m_per_rad, law.swing_damping_n_m_s_per_rad,
-                 law.lean_gain, law.lean_rate_gain_s)
+        gains = (law.pelvis_roll_inertia_kg_m2, law.pelvis_stiffness_n_m_per_rad,
+                 law.pelvis_damping_n_m_s_per_rad, law.swing_stiffness_n_m_per_rad,
+                 law.swing_damping_n_m_s_per_rad, law.lean_gain, law.lean_rate_gain_s)
         params, mirror = params + gains, mirror + gains
         extra["hip_roll"] = law.model_dump()
     structure = Structure("absolute", (BodySpec("mass", "point_mass"),), hip_mass=True,

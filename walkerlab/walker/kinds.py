@@ -251,10 +251,10 @@ SPATIAL_ACTUATION = ("a walker in 3D takes no walker.actuation so far (its later
 #: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
 NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
                "(walker.space: 3d, hip_width_m > 0)")
-#: why the exports refuse the 3D walker's hip-roll joints
-SPATIAL_HIP_ROLL_EXPORT = ("the 3D walker's exports carry legs rigid to the pelvis in roll "
-                           "so far: its hip-roll joints and their law run in the rigid model "
-                           "(fixedpoint, simulate)")
+#: why the URDF refuses the 3D walker's hip-roll joints
+SPATIAL_HIP_ROLL_EXPORT = ("the URDF carries legs rigid to the pelvis in roll so far: the "
+                           "hip-roll joints and their law are in the MJCF (--format mjcf) "
+                           "and the rigid model")
 #: why the exports refuse a 3D walker
 SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is written as "
                   "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -433,7 +433,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "the passive one, walkerlab fixedpoint)"),
     },
     "straight_legs_3d": {
-        ("hip_roll", "mjcf"): SPATIAL_HIP_ROLL_EXPORT,
         ("hip_roll", "urdf"): SPATIAL_HIP_ROLL_EXPORT,
         **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
                                                  "ankle_torque", "torso_torque", "push_off",
