@@ -116,8 +116,11 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
                 vc["outputs"].append({"link": "torso", "bezier_rad": [0.1] * 5})
             vc.pop("max_torque_n_m")
         w["actuation"] = {"virtual_constraints": vc}
-    elif feature == "hip_roll":  # the stabilised 3D walker's law (on any kind: refused)
-        w["hip_roll"] = _shipped("hip_width_stabilised")["walker"]["hip_roll"]
+    elif feature == "hip_roll":  # the stabilised 3D walker's law (on any kind: refused),
+        stabilised = _shipped("hip_width_stabilised")  # and its gait's start (its 5 roles)
+        w["hip_roll"] = stabilised["walker"]["hip_roll"]
+        if kind == "straight_legs_3d":
+            d["fixedpoint"]["initial_guess"] = stabilised["fixedpoint"]["initial_guess"]
     elif feature in TERRAIN:
         terrain = copy.deepcopy(TERRAIN[feature])
         if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
