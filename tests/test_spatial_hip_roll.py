@@ -317,6 +317,28 @@ def test_hip_roll_gait_lifts_the_old_stance_foot_off_the_ground(stabilised, stab
     assert ref.n @ (J @ x[5:]) > 0.1
 
 
+@pytest.mark.slow  # ~15 s: the generated walker's fixed point (shared with the above)
+def test_hip_roll_walkers_energy_ledger_closes_with_the_laws_work(stabilised, stabilised_gait):
+    """A stride from the fixed point: each step's energy change is the law's work (its power
+    ``dV/dt - G . dq``, walkerlab.analysis.gait.energy) minus the heel strike's loss, to
+    1e-9 J (the ledger's quadrature; measured 1e-12 J; without the law's work it is
+    -0.20 J); the law
+    both drives and brakes (+0.51 J, -0.71 J a step measured) and each step of the
+    periodic gait ends with the kinetic energy it began with (the energy change is the
+    slope's potential drop, to 1e-9 J)."""
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.integrate.rigid import simulate_steps
+
+    _scene, walker, _ref, _w = stabilised
+    traj = simulate_steps(walker, np.asarray(stabilised_gait.x), 2, SOLVER)
+    ledger = trajectory_ledger(traj)
+    assert len(ledger["closure"]) == 2
+    assert np.max(np.abs(ledger["closure"])) < 1e-9
+    assert np.all(np.asarray(ledger["actuator_work_positive"]) > 0.1)
+    assert np.all(np.asarray(ledger["actuator_work_negative"]) < -0.1)
+    assert np.max(np.abs(ledger["energy_change"] + ledger["potential_work"])) < 1e-9
+
+
 @pytest.mark.slow  # ~60 s: the reference's own fixed point and central differences
 def test_hip_roll_gait_and_multipliers_match_an_independent_model(stabilised,
                                                                    stabilised_gait):

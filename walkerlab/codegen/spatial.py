@@ -200,8 +200,8 @@ def _hip_roll_forces(q, dq, P) -> sp.Matrix:
     roll joint (``-tau`` on the pelvis) is the generalised force ``tau grad(d)`` (virtual
     work ``tau delta d``).  The law::
 
-        tau_st = k_pelvis phi_p + c_pelvis dphi_p                  (holds the pelvis level)
-        tau_sw = -k_swing (phi_w - phi_ref) - c_swing (dphi_w - dphi_p),
+        tau_st = kp_pelvis phi_p + kd_pelvis dphi_p                (holds the pelvis level)
+        tau_sw = -kp_swing (phi_w - phi_ref) - kd_swing (dphi_w - dphi_p),
         phi_ref = g_lean phi + g_lean_rate dphi                    (foot placement)
 
     (Kuo 1999's lateral foot placement, realised continuously by the swing hip: the target
@@ -210,8 +210,8 @@ def _hip_roll_forces(q, dq, P) -> sp.Matrix:
     """
     phi, _sw, _st, phi_p, phi_w = q
     dphi, _dsw, _dst, dphi_p, dphi_w = dq
-    k_p, c_p, k_s, c_s, g_l, g_r = (P[k] for k in ("k_pelvis", "c_pelvis", "k_swing",
-                                                    "c_swing", "g_lean", "g_lean_rate"))
+    k_p, c_p, k_s, c_s, g_l, g_r = (P[k] for k in ("kp_pelvis", "kd_pelvis", "kp_swing",
+                                                    "kd_swing", "g_lean", "g_lean_rate"))
     tau_st = k_p * phi_p + c_p * dphi_p
     tau_sw = -k_s * (phi_w - (g_l * phi + g_r * dphi)) - c_s * (dphi_w - dphi_p)
     grad_st = sp.Matrix([1, 0, 0, -1, 0])

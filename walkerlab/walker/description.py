@@ -57,7 +57,7 @@ HIP_ROLL_ROLES = ("pelvis_roll", "swing_roll")
 #: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis
 #: roll, the swing hip's on the swing leg's, the foot-placement gains on the lean and its
 #: rate.
-HIP_ROLL_PARAMS = ("I_pelvis", "k_pelvis", "c_pelvis", "k_swing", "c_swing", "g_lean",
+HIP_ROLL_PARAMS = ("I_pelvis", "kp_pelvis", "kd_pelvis", "kp_swing", "kd_swing", "g_lean",
                    "g_lean_rate")
 
 
