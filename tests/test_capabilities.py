@@ -161,7 +161,8 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
     """The one lines in which the scene's own checks refuse a part the walker does not have,
     before its kind is asked (each says what the table's reason says): a joint the walker
     lacks (:func:`walkerlab.models.hybrid.actuators.joint_links` names the joints it has)
-    and ``walker.actuation`` on a walker model without actuators (the scene's schema)."""
+    and ``walker.actuation`` on a walker model without actuators, ``walker.hip_roll`` on
+    one other than the compass gait (the scene's schema)."""
     out = []
     if feature in JOINT:
         joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
@@ -171,6 +172,8 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
     if kind in ("rolling_polygon", "rolling_polygon_3d") and feature in (
             *JOINT, "push_off", "ankle_push_off", "virtual_constraints"):
         out.append("walker.actuation: unknown field")
+    if feature == "hip_roll":  # a field of the compass gait's section only
+        out.append("walker.hip_roll: unknown field")
     return tuple(out)
 
 

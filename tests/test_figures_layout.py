@@ -300,6 +300,21 @@ def test_fig9_titles_a_straight_legs_panel_by_the_legs_it_holds_not_leg():
     assert ax.get_title() == "legs: leg1 and leg2"
 
 
+def test_fig9_draws_a_coordinate_on_no_leg_whose_name_has_an_underscore():
+    """The 3D hip-roll walker's pelvis_roll (on no leg) failed the figure ('pelvis_roll' is
+    not in list: the colours are keyed by a name's first word); its own panel now."""
+    from types import SimpleNamespace
+
+    t = np.linspace(0, 1, 20)
+    coords = {f"{c}_{q}": np.sin(t + k) for k, c in enumerate(("leg1", "leg2", "pelvis_roll"))
+              for q in ("angle", "rate")}
+    tr = SimpleNamespace(legs=("leg1", "leg2"), coordinates=coords,
+                         phase_pairs=lambda: [(f"{c}_angle", f"{c}_rate")
+                                              for c in ("leg1", "leg2", "pelvis_roll")])
+    fig = F.fig9_limit_cycle({"ideal": tr})
+    assert [ax.get_title() for ax in fig.axes] == ["legs: leg1 and leg2", "pelvis_roll"]
+
+
 def test_the_optimize_figure_draws_every_controllers_outputs_against_the_phase(monkeypatch,
                                                                               tmp_path):
     """Issue 64 item 10: optimize.png of a design of two controllers had an empty panel,

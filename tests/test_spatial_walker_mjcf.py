@@ -183,3 +183,57 @@ def test_the_3d_walkers_mjcf_on_continuous_ground_is_refused_in_one_line(tmp_pat
         export.write(scene, tmp_path, "mjcf")
     assert "terrain.lanes" in str(err.value) and "\n" not in str(err.value)
     assert not list(tmp_path.rglob("walker.*"))
+
+
+# ---- the stabilised walker: hip-roll joints and their foot-placement law -----------------
+
+@pytest.fixture(scope="module")
+def stabilised(tmp_path_factory):
+    """configs/hip_width_stabilised.yaml exported with its gait and walked in MuJoCo:
+    (scene, path, Exported)."""
+    scene = _scene("hip_width_stabilised")
+    out = export.write(scene, tmp_path_factory.mktemp("stabilised"), "mjcf", walk=True)
+    return scene, out.path, out
+
+
+@pytest.mark.slow  # ~15 s: the rigid gait's search (shared with the walk below)
+def test_the_stabilised_walkers_keyframe_has_the_rigid_gaits_rolls(stabilised):
+    """The hip-roll walker's MJCF: the pelvis on three slides and a roll hinge (no pitch, no
+    yaw, as the rigid model's), each leg on a roll hinge then its pitch hinge (8
+    coordinates), the pelvis' roll inertia the scene's; at the ``gait`` keyframe the rolls
+    of the pelvis and the legs and their rates as the walk loop reads them from MuJoCo's
+    bodies (:class:`~walkerlab.export.mujoco_walk.HipRollLoop`: pitch axes and angular
+    velocities) are the rigid gait's state's, to 1e-12 (roundoff of the rotations)."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.export.mujoco_walk import HipRollLoop
+
+    scene, path, _out = stabilised
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert (model.nq, model.nv) == (8, 8)
+    assert [model.joint(i).name for i in range(model.njnt)] == [
+        "pelvis_x", "pelvis_y", "pelvis_z", "pelvis_roll", "leg1_roll", "leg1_hip",
+        "leg2_roll", "leg2_hip"]
+    assert model.body("pelvis").inertia[0] == scene.walker.hip_roll.pelvis_roll_inertia_kg_m2
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("gait").id)
+    mujoco.mj_forward(model, data)
+    phi, dphi = HipRollLoop(model).rolls(data)
+    x = ideal_gait(scene).x        # lean (leg2's), swing, stance, pelvis, swing (leg1's) roll
+    assert np.max(np.abs(phi - x[[3, 4, 0]])) < 1e-12
+    assert np.max(np.abs(dphi - x[[8, 9, 5]])) < 1e-12
+
+
+@pytest.mark.slow  # ~20 s: the gait search and 7.9 s of MuJoCo stepped one timestep at a time
+def test_the_stabilised_mjcf_walks_ten_heel_strikes_at_the_rigid_period(stabilised):
+    """configs/hip_width_stabilised.yaml's MJCF, its law run by the walk loop, makes >= 10
+    alternating heel strikes without falling (its passive twin, configs/hip_width.yaml,
+    falls after 3), the mean step period within 3 % of the rigid one (the capability
+    table's MJCF tolerance; measured +0.001 %) and every step within 3 %."""
+    from walkerlab.export.mujoco_walk import walk
+
+    _scene_, path, out = stabilised
+    w = out.walk
+    assert not w.fell and w.alternating and w.strikes >= 10, w.line
+    run = walk(path, 11.3 * out.step_period_s)
+    assert len(run.times_s) >= 10
+    assert np.max(np.abs(run.step_periods_s / out.step_period_s - 1.0)) < 0.03

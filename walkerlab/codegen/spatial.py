@@ -191,6 +191,34 @@ def derive_spoked(structure) -> Equations:
     )
 
 
+def _hip_roll_forces(q, dq, P) -> sp.Matrix:
+    """Generalised forces (n, 1) of the hip-roll law (:class:`walkerlab.config.walker.
+    HipRollLaw`) in the coordinates ``(lean, swing, stance, pelvis_roll, swing_roll)``.
+
+    The stance hip's roll joint angle is ``d_st = phi - phi_p`` (the stance leg from the
+    pelvis), the swing hip's ``d_sw = phi_w - phi_p``; a torque ``tau`` on a leg about its
+    roll joint (``-tau`` on the pelvis) is the generalised force ``tau grad(d)`` (virtual
+    work ``tau delta d``).  The law::
+
+        tau_st = kp_pelvis phi_p + kd_pelvis dphi_p                (holds the pelvis level)
+        tau_sw = -kp_swing (phi_w - phi_ref) - kd_swing (dphi_w - dphi_p),
+        phi_ref = g_lean phi + g_lean_rate dphi                    (foot placement)
+
+    (Kuo 1999's lateral foot placement, realised continuously by the swing hip: the target
+    roll of the swing leg a linear feedback of the lean and its rate).  Odd in the rolls:
+    the mirror step (``w_hip -> -w_hip``, the rolls negated) runs the same law.
+    """
+    phi, _sw, _st, phi_p, phi_w = q
+    dphi, _dsw, _dst, dphi_p, dphi_w = dq
+    k_p, c_p, k_s, c_s, g_l, g_r = (P[k] for k in ("kp_pelvis", "kd_pelvis", "kp_swing",
+                                                    "kd_swing", "g_lean", "g_lean_rate"))
+    tau_st = k_p * phi_p + c_p * dphi_p
+    tau_sw = -k_s * (phi_w - (g_l * phi + g_r * dphi)) - c_s * (dphi_w - dphi_p)
+    grad_st = sp.Matrix([1, 0, 0, -1, 0])
+    grad_sw = sp.Matrix([0, 0, 0, -1, 1])
+    return tau_st * grad_st + tau_sw * grad_sw
+
+
 def _point_mass_matrix(masses, q, p_foot=False):
     """Mass matrix (n, n) of point masses ``[(m, r(q) (3, 1))]`` and, with ``p_foot``, the
     coupling ``A = sum m J^T`` (n, 3) and the total mass of the extended system whose stance
@@ -246,6 +274,23 @@ def derive_compass(structure) -> Equations:
     Poincaré section: just after a heel strike (the swing foot on the slope behind): the
     swing angle solved from ``h = 0``.
 
+    Hip-roll joints (``structure.hip_roll``; Kuo 1999's lateral foot placement): each leg
+    hangs from the pelvis on a roll joint (about the pelvis' fall-line axis) below its pitch
+    hinge, so two more coordinates, ``pelvis_roll`` ``phi_p`` and ``swing_roll`` ``phi_w``
+    (each body's roll about the fall line; ``lean`` is then the stance leg's):
+    ``R_st = Rot(s, phi) Rot(z, theta_st)``, the hip axis ``Rot(s, phi_p) z``,
+    ``R_sw = Rot(s, phi_w) Rot(z, theta_sw)``.  Both hips are the same joint, so the roles
+    swap at heel strike with nothing moving: ``(phi, phi_p, phi_w) -> (phi_w, phi_p, phi)``.
+    The guard ``h = L cos(phi) cos(theta_st + gamma) - w sin(phi_p) - L cos(phi_w)
+    cos(theta_sw + gamma)``; the pelvis has its own inertia ``I_pelvis`` about the fall
+    line (``T += I_pelvis dphi_p^2 / 2``; a rotation about ``s`` moves no foot, so the
+    impact's extended mass gets it unchanged); the impact as above (the law's torques are
+    finite: every joint is free through it); the law's generalised forces
+    (:func:`_hip_roll_forces`) are subtracted from ``G``.  The pelvis' pitch and yaw are
+    held (the coordinates have none): its roll axis, on which the legs' roll joints lie,
+    stays on the fall line.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
+    expressions are the three-coordinate walker's.
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
@@ -256,7 +301,7 @@ def derive_compass(structure) -> Equations:
     Returns
     -------
     Equations
-        ``n = 3``; points (3, 1) in world axes.
+        ``n = 3`` (5 with ``hip_roll``); points (3, 1) in world axes.
 
     Raises
     ------
@@ -269,6 +314,11 @@ def derive_compass(structure) -> Equations:
     phi, th_sw, th_st = sp.symbols("q_lean q_swing q_stance", real=True)
     dphi, dth_sw, dth_st = sp.symbols("dq_lean dq_swing dq_stance", real=True)
     q, dq = (phi, th_sw, th_st), (dphi, dth_sw, dth_st)
+    phi_p = phi_w = phi                                # the legs rigid to the pelvis in roll
+    if structure.hip_roll:
+        phi_p, phi_w = sp.symbols("q_pelvis_roll q_swing_roll", real=True)
+        dphi_p, dphi_w = sp.symbols("dq_pelvis_roll dq_swing_roll", real=True)
+        q, dq = q + (phi_p, phi_w), dq + (dphi_p, dphi_w)
     par = sp.symbols(structure.param_names, real=True)
     P = dict(zip(structure.param_names, par))
     g, L, gamma, M_hip, m, a = (P[k] for k in ("g", "L", "gamma", "M_hip", "m_leg", "a_leg"))
@@ -276,26 +326,32 @@ def derive_compass(structure) -> Equations:
     # vectors in the slope's frame (fall line s, normal n, z): there the roll is about the
     # first axis and a leg's pitch about the third, from the normal by theta + gamma
     ez = sp.Matrix([0, 0, 1])
-    roll = rotation(sp.Matrix([1, 0, 0]), phi)
-    axis = roll * ez                                   # the hip axis
 
-    def leg(theta, length):  # from the hip to a point at ``length`` down the leg
-        return roll * (rotation(ez, theta + gamma) * sp.Matrix([0, -length, 0]))
+    def roll_of(angle):
+        return rotation(sp.Matrix([1, 0, 0]), angle)
+    axis = roll_of(phi_p) * ez                         # the hip axis
+
+    def leg(theta, length, lean=phi):  # from the hip to a point at ``length`` down the leg
+        return roll_of(lean) * (rotation(ez, theta + gamma) * sp.Matrix([0, -length, 0]))
 
     hip_st = -leg(th_st, L)
     hip_sw = hip_st + w * axis
     pelvis = hip_st + w / 2 * axis
     m_st = hip_st + leg(th_st, L - a)                  # a from the foot
-    m_sw = hip_sw + leg(th_sw, L - a)
-    swing_foot = hip_sw + leg(th_sw, L)
+    m_sw = hip_sw + leg(th_sw, L - a, phi_w)
+    swing_foot = hip_sw + leg(th_sw, L, phi_w)
     masses = [(M_hip, pelvis), (m, m_st), (m, m_sw)]
     M, A, total = _point_mass_matrix(masses, q)
+    if structure.hip_roll:  # the pelvis' own inertia about the fall line (it rolls by phi_p)
+        M[3, 3] += P["I_pelvis"]
     M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
     C = christoffel(M, q, dq)
     # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n
     up = sp.Matrix([-sp.sin(gamma), sp.cos(gamma), 0])
     potential = sum(mi * g * _dot(r, up) for mi, r in masses)
     G = sp.Matrix([sp.expand(sp.diff(potential, qi)) for qi in q])
+    if structure.hip_roll:
+        G = G - _hip_roll_forces(q, dq, P)
     kinetic = sp.Rational(1, 2) * (sp.Matrix(dq).T * M * sp.Matrix(dq))[0]
     # impact about the new foot (extended coordinates, the old stance foot free)
     F = swing_foot.jacobian(sp.Matrix(q))
@@ -306,12 +362,17 @@ def derive_compass(structure) -> Equations:
                           [-sp.sin(gamma), sp.cos(gamma), 0], [0, 0, 1]])  # columns s, n, z
     height = swing_foot[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
+    if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
+        relabel_q = sp.Matrix([phi_w, th_st, th_sw, phi_p, phi])   # the new swing roll
     relabel_rate = relabel_q.jacobian(sp.Matrix(q))
     sigma = th_sw + th_st + 2 * gamma
     if structure.hip_width:
         heel = height
         # just after heel strike the swing foot (the old stance foot) is on the slope behind
         drop_solution = -gamma - sp.acos(sp.cos(th_st + gamma) - w * sp.tan(phi) / L)
+        if structure.hip_roll:
+            drop_solution = -gamma - sp.acos((L * sp.cos(phi) * sp.cos(th_st + gamma)
+                                              - w * sp.sin(phi_p)) / (L * sp.cos(phi_w)))
     else:
         heel = sigma
         drop_solution = -th_st - 2 * gamma
@@ -325,7 +386,10 @@ def derive_compass(structure) -> Equations:
         relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=kinetic, potential=potential,
         guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
                 "hip_height": pelvis[1], "swing_clearance": height},
-        points=points, leg_angles={"stance": th_st, "swing": th_sw, "lean": phi},
+        points=points, leg_angles={"stance": th_st, "swing": th_sw, "lean": phi,
+                                   # each leg's roll by leg (the lean is the stance leg's)
+                                   **({"pelvis_roll": phi_p, "stance_roll": phi,
+                                       "swing_roll": phi_w} if structure.hip_roll else {})},
         section_drop=1, drop_solution=drop_solution,
         De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
     )

@@ -116,6 +116,11 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
                 vc["outputs"].append({"link": "torso", "bezier_rad": [0.1] * 5})
             vc.pop("max_torque_n_m")
         w["actuation"] = {"virtual_constraints": vc}
+    elif feature == "hip_roll":  # the stabilised 3D walker's law (on any kind: refused),
+        stabilised = _shipped("hip_width_stabilised")  # and its gait's start (its 5 roles)
+        w["hip_roll"] = stabilised["walker"]["hip_roll"]
+        if kind == "straight_legs_3d":
+            d["fixedpoint"]["initial_guess"] = stabilised["fixedpoint"]["initial_guess"]
     elif feature in TERRAIN:
         terrain = copy.deepcopy(TERRAIN[feature])
         if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
@@ -175,6 +180,9 @@ SHIPPED = {
     ("rolling_polygon_3d", "walk"): "rimless_wheel_3d_disc",
     # the paper's walker in 3D with zero hip width: the planar gait, rolled about nothing
     ("straight_legs_3d", "walk"): "paper_3d",
+    # the hip-width walker with its lateral foot-placement law: stride multipliers all
+    # inside the unit circle (largest 0.517; the passive walker's lateral one 99.9)
+    ("straight_legs_3d", "hip_roll"): "hip_width_stabilised",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the

@@ -29,6 +29,48 @@ class _Actuated(Strict):
         return drop_unset(handler(self), ("actuation",))
 
 
+class HipRollLaw(Strict):
+    """Hip-roll (abduction) joints of a 3D straight-legged walker with hip width and their
+    torque law, a lateral foot-placement controller (Kuo 1999, "Stabilization of lateral
+    motion in passive dynamic walking", IJRR 18(9)): each leg hangs from the pelvis on a
+    roll joint (about the fall line) below its pitch hinge, so the pelvis and each leg roll
+    on their own (:func:`walkerlab.codegen.spatial.derive_compass`).
+
+    With ``phi`` the stance leg's roll (the lean), ``phi_p`` the pelvis', ``phi_w`` the
+    swing leg's (rad, about the fall line):
+
+    - stance hip: ``tau_st = pelvis_stiffness (phi_p) + pelvis_damping (dphi_p)`` on the
+      stance leg (its reaction, ``-tau_st``, on the pelvis: it holds the pelvis level);
+    - swing hip: ``tau_sw = -swing_stiffness (phi_w - phi_ref) - swing_damping (dphi_w -
+      dphi_p)`` on the swing leg, with the foot-placement target ``phi_ref = lean_gain phi +
+      lean_rate_gain dphi``: the swing leg rolls out as the body leans and falls toward it.
+
+    The law is odd in the rolls, so the mirror step (the swing hip on the other side) runs
+    the same law.  ``pelvis_roll_inertia_kg_m2`` is the pelvis' own inertia in roll (its
+    pitch and yaw are held: :func:`walkerlab.codegen.spatial.derive_compass`): without one
+    the impact sets the light pelvis rolling so fast that the old stance foot is driven into
+    the ground (``configs/hip_width_stabilised.yaml``'s gait at 0 kg m^2: -0.10 m/s).
+    """
+
+    pelvis_roll_inertia_kg_m2: float = Field(
+        ge=0, le=1e4, description="the pelvis' moment of inertia about the fall line through "
+        "its centre [kg m^2] (the point masses' aside: an upper body's, say)")
+    pelvis_stiffness_n_m_per_rad: float = Field(
+        ge=0, le=1e6, description="stance hip: torque per rad of pelvis roll [N m/rad]")
+    pelvis_damping_n_m_s_per_rad: float = Field(
+        ge=0, le=1e5, description="stance hip: torque per rad/s of pelvis roll rate [N m s/rad]")
+    swing_stiffness_n_m_per_rad: float = Field(
+        ge=0, le=1e6, description="swing hip: torque per rad of the swing leg's roll from "
+        "its target [N m/rad]")
+    swing_damping_n_m_s_per_rad: float = Field(
+        ge=0, le=1e5, description="swing hip: torque per rad/s of the swing hip's roll rate "
+        "[N m s/rad]")
+    lean_gain: float = Field(ge=-100, le=100, description="foot placement: the swing leg's "
+                             "target roll per rad of lean [rad/rad]")
+    lean_rate_gain_s: float = Field(ge=-100, le=100, description="foot placement: the swing "
+                                    "leg's target roll per rad/s of lean rate [s]")
+
+
 class CompassGaitParams(_Actuated):
     """Rigid-legged compass-gait walker (paper Table 1; Goswami et al. 1996, Fig. 1).
 
@@ -51,6 +93,14 @@ class CompassGaitParams(_Actuated):
     hip_width_m: float = Field(0.0, ge=0, le=100, description="distance between the hips "
                                "along the hip axis [m] (space: 3d only; 0: the planar "
                                "walker embedded in 3D)")
+    hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
+                                        "their lateral foot-placement law (space: 3d with a "
+                                        "hip width; null: the legs rigid to the pelvis in "
+                                        "roll, a passive walker)")
+
+    @model_serializer(mode="wrap")
+    def _passive_as_before(self, handler):
+        return drop_unset(handler(self), ("actuation", "hip_roll"))
 
     @model_validator(mode="after")
     def _a_inside_leg(self) -> CompassGaitParams:
@@ -61,6 +111,12 @@ class CompassGaitParams(_Actuated):
         if self.space == "2d" and self.hip_width_m:
             raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                              "walker's hips are one point)")
+        if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
+            raise ValueError("walker.hip_roll: hip-roll joints are a 3D straight-legged "
+                             "walker's with hip width (walker.space: 3d, hip_width_m > 0)")
+        if self.hip_roll is not None and self.actuation is not None:
+            raise ValueError("walker.actuation: a 3D walker's actuators are its hip_roll "
+                             "law so far")
         return self
 
     @property

@@ -49,7 +49,7 @@ import numpy as np
 
 from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
 
-__all__ = ["MujocoWalk", "PoweredLoop", "VirtualConstraintFeedback", "latch_rule",
+__all__ = ["HipRollLoop", "MujocoWalk", "PoweredLoop", "VirtualConstraintFeedback", "latch_rule",
            "powered_loop", "roll", "virtual_constraint_feedback", "walk"]
 
 LEGS = ("leg1", "leg2")
@@ -322,6 +322,80 @@ class PoweredLoop:
         self._hip_body = int(model.body("hip").id)
 
 
+class HipRollLoop:
+    """The hip-roll law of a 3D walker's MJCF (custom text ``walkerlab_hip_roll``: the
+    scene's :class:`walkerlab.config.walker.HipRollLaw`), the rigid model's
+    (:func:`walkerlab.codegen.spatial.derive_compass`) on MuJoCo's state: before every
+    MuJoCo step each body's roll about the fall line ``s`` is read from its pitch axis
+    ``a`` (the body's ``0 -1 0``, walkerlab's ``Rot(s, phi) z``):
+    ``phi = atan2(-a . n, a . z_w)`` (``n`` the slope's normal, ``z_w`` walkerlab's z), its
+    rate ``omega . s``; with ``phi`` the stance leg's, ``phi_p`` the pelvis', ``phi_w`` the
+    swing leg's::
+
+        tau_st = k_p phi_p + c_p dphi_p,
+        tau_sw = -k_s (phi_w - g_l phi - g_r dphi) - c_s (dphi_w - dphi_p)
+
+    applied as ``data.qfrc_applied`` at the hinges ``leg<i>_roll`` (a torque on the leg
+    about the fall line, its reaction on the pelvis).  The law is odd in the rolls: the
+    same on either side.  Leg2 stands at the keyframe; the roles swap at each heel strike.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        With the custom text ``walkerlab_hip_roll`` and bodies ``pelvis``, ``leg1``,
+        ``leg2`` (:func:`walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text`).
+    """
+
+    def __init__(self, model):
+        import json
+
+        import mujoco
+
+        i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_hip_roll")
+        adr, size = int(model.text_adr[i]), int(model.text_size[i])
+        law = json.loads(bytes(model.text_data[adr:adr + size - 1]).decode())
+        self.k_p = law["pelvis_stiffness_n_m_per_rad"]
+        self.c_p = law["pelvis_damping_n_m_s_per_rad"]
+        self.k_s = law["swing_stiffness_n_m_per_rad"]
+        self.c_s = law["swing_damping_n_m_s_per_rad"]
+        self.g_l, self.g_r = law["lean_gain"], law["lean_rate_gain_s"]
+        phi = _numeric(model, "slope_rad", 0.0)
+        self.n = np.array([math.sin(phi), 0.0, math.cos(phi)])    # MuJoCo axes
+        self.s = np.array([math.cos(phi), 0.0, -math.sin(phi)])
+        self.zw = np.array([0.0, -1.0, 0.0])
+        self.bodies = [int(model.body(b).id) for b in ("pelvis", *LEGS)]
+        self.dof = [int(model.joint(f"{g}_roll").dofadr[0]) for g in LEGS]
+        self.stance = 1
+        self._model = model
+
+    def rolls(self, data) -> tuple[np.ndarray, np.ndarray]:
+        """Rolls [rad] and their rates [rad/s] of the pelvis, leg1 and leg2 (3,), (3,)."""
+        import mujoco
+
+        phi, dphi = np.zeros(3), np.zeros(3)
+        vel = np.zeros(6)
+        for k, b in enumerate(self.bodies):
+            a = -np.asarray(data.xmat[b], float).reshape(3, 3)[:, 1]
+            phi[k] = math.atan2(-(a @ self.n), a @ self.zw)
+            mujoco.mj_objectVelocity(self._model, data, mujoco.mjtObj.mjOBJ_BODY, b, vel, 0)
+            dphi[k] = vel[:3] @ self.s
+        return phi, dphi
+
+    def control(self, data) -> None:
+        """Set the roll joints' torques for the coming step."""
+        st, sw = self.stance, 1 - self.stance
+        phi, dphi = self.rolls(data)
+        tau_st = self.k_p * phi[0] + self.c_p * dphi[0]
+        ref = self.g_l * phi[1 + st] + self.g_r * dphi[1 + st]
+        tau_sw = -self.k_s * (phi[1 + sw] - ref) - self.c_s * (dphi[1 + sw] - dphi[0])
+        data.qfrc_applied[self.dof[st]] = tau_st
+        data.qfrc_applied[self.dof[sw]] = tau_sw
+
+    def heel_strike(self, data, leg: int) -> None:
+        """Leg ``leg`` (0, 1) struck: it is the stance leg now."""
+        self.stance = leg
+
+
 #: MuJoCo steps a walk takes without looking (``mj_step``'s ``nstep``) when no stepping rule
 #: acts (no latch, no motor): heel-strike times are then known to 5 timesteps (an export's
 #: timestep is tau/4 of its contact, at most 1 ms; 0.18-0.25 ms for the shipped SI scenes),
@@ -386,13 +460,17 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
             if latch[0] >= 0 else -1 for g in LEGS]
     slide = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")
     # a walker in 3D: the pelvis on a free joint, its position the first three of qpos
-    hip = model.jnt_qposadr[slide if slide >= 0 else mujoco.mj_name2id(
-        model, mujoco.mjtObj.mjOBJ_JOINT, "free")]
+    free = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "free")
+    if free < 0:  # a 3D walker with hip-roll joints: its pelvis on three slides
+        free = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "pelvis_x")
+    hip = model.jnt_qposadr[slide if slide >= 0 else free]
     up = hip + (1 if slide >= 0 else 2)  # the hip's height (world z)
     powered = None
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
         powered = powered_loop(model, feedback)
         powered.bind(model, site)
+    elif mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_hip_roll") >= 0:
+        powered = HipRollLoop(model)  # a 3D walker's hip-roll law
     nstep = 1 if latched or powered else LOOK_EVERY
     mujoco.mj_forward(model, data)
     L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, up]])))

@@ -37,10 +37,24 @@ grows to 1e-6 rad by the tenth heel strike; the elliptic cone keeps an upright w
 upright (< 1e-23 rad over 11 heel strikes).
 
 Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
+
+Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates,
+:func:`walkerlab.codegen.spatial.derive_compass`): each leg hangs on a hinge
+``leg<i>_roll`` about the fall line (the pelvis' frame: ``cos phi, 0, -sin phi``) before its
+``leg<i>_hip`` (MuJoCo composes a body's joints in order: ``pelvis Rot(s, d) Rot(z, theta)``,
+the rigid leg's ``Rot(s, phi_leg) Rot(z, theta)`` with ``d = phi_leg - phi_p``).  The rigid
+pelvis neither pitches nor yaws (its roll axis carries the legs' roll joints), so instead of
+a free joint it has three slides ``pelvis_x``, ``pelvis_y``, ``pelvis_z`` and a hinge
+``pelvis_roll`` about the fall line, and its roll inertia ``pelvis_roll_inertia_kg_m2``.
+The feet are ``condim 3``: the joints hold them from twisting, and a torsional friction on
+top is a redundant constraint (with it the stance foot's contact chatters).  The law runs
+in :class:`walkerlab.export.mujoco_walk.HipRollLoop`, which reads its gains from the custom
+text ``walkerlab_hip_roll``.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
@@ -106,25 +120,35 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
         The rigid walker's generated ``points`` and ``point_velocities``
         (:func:`walkerlab.codegen.cache.functions`; world axes of walkerlab, the stance foot
         at the origin): ``hip`` (the pelvis), ``stance_hip``.
-    x : ndarray (6,)
-        ``[lean, swing, stance]`` [rad] and their rates [rad/s].
+    x : ndarray (6,) or (10,)
+        ``[lean, swing, stance]`` [rad] and their rates [rad/s]; with hip-roll joints
+        ``[lean, swing, stance, pelvis_roll, swing_roll]`` and their rates: then ``qpos``
+        (8,) = the pelvis' slides, its roll, ``leg1_roll`` = ``swing_roll - pelvis_roll``,
+        ``leg1_hip``, ``leg2_roll`` = ``lean - pelvis_roll``, ``leg2_hip``, ``qvel`` (8,)
+        their rates (the pelvis rolled by ``pelvis_roll``, the stance leg's pitch axis
+        ``Rot(s, lean) z``).
     slope_rad : float
     foot_radius_m : float
         The foot sphere's radius ``r`` [m].
 
     Returns
     -------
-    (qpos (9,), qvel (8,)) : tuple of float
+    (qpos (9,), qvel (8,)) or, with hip-roll joints, (qpos (8,), qvel (8,)) : tuple of float
     """
     from scipy.spatial.transform import Rotation
 
     x = np.asarray(x, float)
-    lean, sw, st, dlean, dsw, dst = x
+    rolled = x.size == 10  # hip-roll joints: the pelvis' and the swing leg's own rolls
+    if rolled:
+        lean, sw, st, pelvis_roll, swing_roll, dlean, dsw, dst, dpelvis, dswing = x
+    else:
+        lean, sw, st, dlean, dsw, dst = x
+        pelvis_roll, swing_roll, dpelvis, dswing = lean, lean, dlean, dlean
     C = np.array(TO_MUJOCO)
     fall = np.array([math.cos(slope_rad), -math.sin(slope_rad), 0.0])
     nrm = np.array([math.sin(slope_rad), math.cos(slope_rad), 0.0])
-    R = _rotation(fall, lean)                               # pelvis -> world (walkerlab)
-    axis = R @ np.array([0.0, 0.0, 1.0])                    # the hip axis
+    R = _rotation(fall, pelvis_roll)                        # pelvis -> world (walkerlab)
+    axis = _rotation(fall, lean) @ np.array([0.0, 0.0, 1.0])   # the stance leg's pitch axis
     pts = {k: np.ravel(np.asarray(v, float)) for k, v in points(x).items()}
     vel = {k: np.ravel(np.asarray(v, float)) for k, v in velocities(x).items()}
     e = -pts["stance_hip"] / np.linalg.norm(pts["stance_hip"])   # stance hip -> foot
@@ -135,7 +159,10 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
     Rm = C @ R @ C.T
     qx, qy, qz, qw = Rotation.from_matrix(Rm).as_quat()
     qpos = (*(C @ pelvis), qw, qx, qy, qz, sw, st)
-    qvel = (*(C @ v_pelvis), *(Rm.T @ (C @ (dlean * fall))), dsw, dst)
+    qvel = (*(C @ v_pelvis), *(Rm.T @ (C @ (dpelvis * fall))), dsw, dst)
+    if rolled:  # the pelvis on slides, yaw (0) and roll; each leg's roll, then its hinge
+        qpos = (*qpos[:3], pelvis_roll, swing_roll - pelvis_roll, sw, lean - pelvis_roll, st)
+        qvel = (*qvel[:3], dpelvis, dswing - dpelvis, dsw, dlean - dpelvis, dst)
     return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
 
 
@@ -176,7 +203,8 @@ class Legs3dScene:
     Attributes
     ----------
     qpos, qvel : tuple of float
-        The ``gait`` keyframe (9,), (8,) (:func:`legs3d_keyframe`).
+        The ``gait`` keyframe (9,), (8,) or, with hip-roll joints, (8,), (8,)
+        (:func:`legs3d_keyframe`).
     lanes : (ndarray (k1, 3), ndarray (k2, 3))
         leg1's and leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`).
     patch_width_m : float
@@ -217,7 +245,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     data : WalkerData
         The 3D walker (:func:`walkerlab.walker.description.walker_data`).
     ideal : gait
-        ``x`` (6,), ``period_s`` [s], ``step_lengths_m`` (one per step of its period).
+        ``x`` (6,) or (10,), ``period_s`` [s], ``step_lengths_m`` (one per step of its period).
     options : walkerlab.export.mjcf_scene.MjcfOptions, optional
         The contact's time constant and the timestep.
 
@@ -258,7 +286,10 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         "footfalls, leg<i>_patch<k> touched by leg<i>'s foot only (the rigid swing foot "
         "passes through the ground at mid-stance).",
         f"Feet: condim 4, torsional friction {TORSION_FRACTION:g} L (the rigid stance foot "
-        "neither slips nor twists).")
+        "neither slips nor twists)." if not data.structure.hip_roll else
+        "Feet: condim 3 (the hip-roll walker's joints hold its feet from twisting: its "
+        "pelvis neither pitches nor yaws); the law of walker.hip_roll in the custom text "
+        "walkerlab_hip_roll, run by walkerlab's walk loop (HipRollLoop).")
     return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
                        tuple(solref), tuple(solimp), float(mu), period, notes)
 
@@ -304,6 +335,11 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
     p = _numbers(data)
     L, a, w, r, phi = p["L"], p["a_leg"], p["w_hip"], p["r"], data.slope_rad
     lo = num(MJCF_MIN_INERTIA_KG_M2)
+    law = getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
+    # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
+    # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
+    condim = 4 if law is None else 3
+    pelvis_inertia = lo if law is None else num(law["pelvis_roll_inertia_kg_m2"])
     out = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
                    f"legs of {num(L)} m, {num(p['m_leg'])} kg at {num(a)} m from each foot, "
                    f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope {num(phi)} "
@@ -325,18 +361,30 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
                 ' integrator="implicitfast" cone="elliptic"/>',
                 f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
                 f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
-                f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="4"/>'
+                f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="{condim}"/>'
                 '</default>', "  <worldbody>", *_patches(p, extra, phi)]
+    if law is None:
+        pelvis_joints = ['      <freejoint name="free"/>']
+    else:  # the rigid model's pelvis neither pitches nor yaws (the legs' roll axes stay on
+        # the fall line): three slides and a roll about the fall line
+        pelvis_joints = [
+            *(f'      <joint name="pelvis_{c}" type="slide" axis="{ax}"/>'
+              for c, ax in (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))),
+            f'      <joint name="pelvis_roll" type="hinge" axis="'
+            f'{nums(math.cos(phi), 0, -math.sin(phi))}"/>']
     out += ['    <body name="pelvis" pos="0 0 0">',
-            '      <freejoint name="free"/>',
+            *pelvis_joints,
             f'      <inertial pos="0 0 0" mass="{num(p["M_hip"])}" '
-            f'diaginertia="{lo} {lo} {lo}"/>',
+            f'diaginertia="{pelvis_inertia} {pelvis_inertia} {pelvis_inertia}"/>',
             f'      <geom name="pelvis" type="sphere" size="{num(L / 25)}"/>']
     if w > 0:
         out.append(f'      <geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
                    f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>')
+    roll_axis = nums(math.cos(phi), 0, -math.sin(phi))     # the fall line (pelvis frame)
     for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
         out += [f'      <body name="{leg}" pos="{nums(0, side * w / 2, 0)}">',
+                *([f'        <joint name="{leg}_roll" type="hinge" axis="{roll_axis}"/>']
+                  if law is not None else []),
                 f'        <joint name="{leg}_hip" type="hinge" axis="{AXIS}"/>',
                 f'        <inertial pos="{nums(0, 0, -(L - a))}" mass="{num(p["m_leg"])}" '
                 f'diaginertia="{lo} {lo} {lo}"/>',
@@ -348,7 +396,10 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
                 "      </body>"]
     out += ["    </body>", "  </worldbody>",
             "  <custom>", f'    <numeric name="slope_rad" data="{num(phi)}"/>',
-            '    <numeric name="foot_height_offset_m" data="0.0"/>', "  </custom>"]
+            '    <numeric name="foot_height_offset_m" data="0.0"/>']
+    if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop
+        out.append(f"    <text name=\"walkerlab_hip_roll\" data={quoteattr(json.dumps(law))}/>")
+    out.append("  </custom>")
     if extra is not None:
         out += ["  <keyframe>",
                 f'    <key name="gait" qpos="{nums(*extra.qpos)}" qvel="{nums(*extra.qvel)}"/>',

@@ -226,7 +226,8 @@ def fig9_limit_cycle(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS)
             for owner, a, r in members:
                 if a in tr.coordinates and r in tr.coordinates:
                     ax.plot(tr.coordinates[a], tr.coordinates[r], ls=MODEL_STYLES[mi % 4],
-                            color=LEG_COLORS[owners.index(owner) % 4], lw=1,
+                            color=LEG_COLORS[owners.index(owner.split("_", 1)[0]) % 4],
+                            lw=1,
                             label=f"{owner} - {label}")
         ax.set_xlabel(f"{panel} angle [rad]")
         ax.set_ylabel(f"{panel} rate [{units.rate}]")

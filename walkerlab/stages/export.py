@@ -260,6 +260,8 @@ def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only
     from walkerlab.export.spatial_legs_mjcf import legs3d_mjcf_text, legs3d_scene
 
     data.structure.kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
+    if data.structure.hip_roll:
+        data.structure.kind.require("hip_roll", FORMAT_VIEWS[fmt], "walker.hip_roll")
     check_exportable(scene, data.structure.kind, fmt, walker_only)  # numbers, ground
     if scene.walker.actuation is not None:  # passive so far: the table's reason
         from walkerlab.models.hybrid.actuated import refuse_actuators

@@ -50,6 +50,15 @@ SPATIAL_COMPASS_ROLES = ("lean", "swing", "stance")
 #: Parameters of the straight-legged walker in 3D: gravity, leg length, slope, hip mass, leg
 #: mass and its distance from the foot [SI], then (``hip_width``) the hip width ``w_hip`` [m].
 SPATIAL_COMPASS_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
+#: Roles added by hip-roll joints (``hip_roll``): the pelvis' and the swing leg's roll
+#: about the fall line (the ``lean`` is then the stance leg's).
+HIP_ROLL_ROLES = ("pelvis_roll", "swing_roll")
+#: Parameters of the hip-roll joints and law (:class:`walkerlab.config.walker.HipRollLaw`,
+#: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis
+#: roll, the swing hip's on the swing leg's, the foot-placement gains on the lean and its
+#: rate.
+HIP_ROLL_PARAMS = ("I_pelvis", "kp_pelvis", "kd_pelvis", "kp_swing", "kd_swing", "g_lean",
+                   "g_lean_rate")
 
 
 @dataclass(frozen=True)
@@ -144,6 +153,10 @@ class Structure:
     hip_width : bool
         A 3D straight-legged walker's hips are apart (parameter ``w_hip``; the steps
         alternate sides: a stride is the Poincaré map); False: zero hip width.
+    hip_roll : bool
+        A 3D straight-legged walker with hip width whose legs hang from the pelvis on
+        hip-roll joints driven by a foot-placement law (roles and parameters
+        :data:`HIP_ROLL_ROLES`, :data:`HIP_ROLL_PARAMS` after the others).
     """
 
     coordinates: str
@@ -162,6 +175,7 @@ class Structure:
     foot_mass: bool = False
     spatial: bool = False
     hip_width: bool = False
+    hip_roll: bool = False
 
     @property
     def kind(self) -> Kind:
@@ -174,7 +188,7 @@ class Structure:
         if self.spokes:
             return SPATIAL_SPOKED_ROLES if self.spatial else SPOKED_ROLES
         if self.spatial:
-            return SPATIAL_COMPASS_ROLES
+            return SPATIAL_COMPASS_ROLES + (HIP_ROLL_ROLES if self.hip_roll else ())
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.hinged_torso:
@@ -197,7 +211,8 @@ class Structure:
         if self.spokes:
             return SPATIAL_SPOKED_PARAMS if self.spatial else SPOKED_PARAMS
         if self.spatial:
-            return SPATIAL_COMPASS_PARAMS + (("w_hip",) if self.hip_width else ())
+            return (SPATIAL_COMPASS_PARAMS + (("w_hip",) if self.hip_width else ())
+                    + (HIP_ROLL_PARAMS if self.hip_roll else ()))
         names = ["g", "L", "gamma"] + (["M_hip"] if self.hip_mass else [])
         tags = [f"{ROLE_TAG[r]}_" for r in ("swing", "stance")] if self.asymmetric else [""]
         for b in self.bodies:
@@ -257,6 +272,8 @@ class Structure:
             d["space"] = "3d"
         if self.hip_width:
             d["hip_width"] = True
+        if self.hip_roll:
+            d["hip_roll"] = True
         return json.dumps(d)
 
 
@@ -396,8 +413,15 @@ def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
     mirror = None
     if width:
         params, mirror = params + (width,), params + (-width,)
+    law = w.hip_roll
+    if law is not None:  # odd in the rolls: the mirror step runs the same gains
+        gains = (law.pelvis_roll_inertia_kg_m2, law.pelvis_stiffness_n_m_per_rad,
+                 law.pelvis_damping_n_m_s_per_rad, law.swing_stiffness_n_m_per_rad,
+                 law.swing_damping_n_m_s_per_rad, law.lean_gain, law.lean_rate_gain_s)
+        params, mirror = params + gains, mirror + gains
+        extra["hip_roll"] = law.model_dump()
     structure = Structure("absolute", (BodySpec("mass", "point_mass"),), hip_mass=True,
-                          spatial=True, hip_width=bool(width))
+                          spatial=True, hip_width=bool(width), hip_roll=law is not None)
     return WalkerData(structure, tuple(float(v) for v in params),
                       w.hip_mass_kg + 2 * w.leg_mass_kg, w.leg_length_m,
                       w.gravity_m_per_s2, slope_rad, extra,

@@ -85,6 +85,8 @@ FEATURES = {
     "ankle_push_off": "an ankle push-off of a flat foot (walker.actuation.ankle_push_off)",
     "virtual_constraints": ("Bezier virtual constraints by output feedback "
                             "(walker.actuation.virtual_constraints)"),
+    "hip_roll": ("hip-roll joints and a lateral foot-placement law (walker.hip_roll; "
+                 "Kuo 1999)"),
     "stairs": "stairs (terrain.kind: stairs)",
     "footholds": "footholds of several heights or slopes (terrain.kind: footholds)",
     "profile": "a height profile (terrain.kind: profile)",
@@ -243,8 +245,16 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
                   "stairs, footholds and profiles are planar walkers' grounds")
 #: why a 3D walker refuses actuators
-SPATIAL_ACTUATION = ("a walker in 3D is passive so far (its actuators, a lateral "
-                     "foot-placement or hip-roll law, are a later step)")
+SPATIAL_ACTUATION = ("a walker in 3D takes no walker.actuation so far (its lateral "
+                     "foot-placement law is walker.hip_roll: hip-roll joints)")
+#: why the kinds other than the 3D straight legs refuse hip-roll joints (the scene's check
+#: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
+NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
+               "(walker.space: 3d, hip_width_m > 0)")
+#: why the URDF refuses the 3D walker's hip-roll joints
+SPATIAL_HIP_ROLL_EXPORT = ("the URDF carries legs rigid to the pelvis in roll so far: the "
+                           "hip-roll joints and their law are in the MJCF (--format mjcf) "
+                           "and the rigid model")
 #: why the exports refuse a 3D walker
 SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is written as "
                   "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -319,6 +329,7 @@ _OPTIMIZE_GROUNDS = {("stairs", "optimize"): _OPTIMIZE_LANDING,
 #: part) or says what the view's model does not carry.
 CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "straight_legs": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         ("virtual_constraints", "optimize"): ("optimize.design: virtual_constraints is built "
@@ -333,6 +344,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("profile", "optimize"): _OPTIMIZE_PROFILE,
     },
     "locking_knees": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         **_NO_ANKLES,
         ("virtual_constraints", "*"): ("a knee that locks changes the walker's degrees of "
                                        "freedom within the step (its outputs would change "
@@ -345,6 +357,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_OPTIMIZE_GROUNDS,
     },
     "flat_feet": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "
                                "(walker.leg.knee)"),
         ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
@@ -374,6 +387,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                          "hip torques, not together)"),
     },
     "free_joints": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         **_NO_ANKLES,
         **_VC_VIEWS,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
@@ -389,6 +403,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         **_NO_ANKLES,
@@ -401,6 +416,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
                                          "virtual_constraints")},
@@ -417,6 +433,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "the passive one, walkerlab fixedpoint)"),
     },
     "straight_legs_3d": {
+        ("hip_roll", "urdf"): SPATIAL_HIP_ROLL_EXPORT,
         **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
                                                  "ankle_torque", "torso_torque", "push_off",
                                                  "ankle_push_off", "virtual_constraints")},
@@ -431,6 +448,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "is a later step"),
     },
     "rolling_polygon_3d": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
                                          "virtual_constraints")},

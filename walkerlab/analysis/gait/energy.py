@@ -7,7 +7,9 @@ springs) is the sum of
 
 - ``actuator_work_positive`` / ``actuator_work_negative`` [J]: the joint torques' work,
   ``int max(tau ddelta, 0) dt`` and ``int min(tau ddelta, 0) dt``, by adaptive quadrature on
-  the step's dense output (independent of ``E``: the ledger's closure checks the flow);
+  the step's dense output (independent of ``E``: the ledger's closure checks the flow); a
+  3D walker's hip-roll law (in its generated flow) the same with its power
+  ``dV/dt - G . dq``;
 - ``damper_work`` [J] (<= 0): ``int dq . (Mdot dq / 2 - C dq) dt``, the part of ``-C dq``
   that is not Christoffel's (zero without dampers: the Christoffel part does no work);
 - ``push_off_work`` [J]: kinetic energy after the push-off impulse minus before
@@ -60,6 +62,19 @@ def _damper_power(walker, x) -> float:
     return float(dq @ (0.5 * Mdot @ dq - C @ dq))
 
 
+def _flow_law_power(walker, x) -> float:
+    """The power [W] of a torque law written into the generated flow (a 3D walker's
+    hip-roll law, ``walker.hip_roll``: its generalised forces ``Q`` are in ``G = dV/dq -
+    Q``): ``Q . dq = dV/dt - G . dq``, ``dV/dt`` by the complex step of the walker's
+    potential energy along ``dq``."""
+    n = x.size // 2
+    q, dq = x[:n], x[n:]
+    G = np.asarray(walker.matrices(x)[2], float).ravel()
+    h = 1e-30
+    dV = np.imag(walker.energies(np.concatenate([q + 1j * h * dq, dq]))[1]) / h
+    return float(dV - G @ dq)
+
+
 def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     """The energy ledger of one step.
 
@@ -92,6 +107,7 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     # joint torques that do work: the scene's laws, or a virtual-constraint controller's
     torques = acts is not None and not acts.limit and (
         bool(acts.spec.torques) or getattr(acts, "controller", None) is not None)
+    flow_law = "hip_roll" in walker.params  # its law is in the generated flow
     prev_ke = None
     n2 = seg.x_start.size
     for _ph, sol, (ta, tb) in seg.pieces:
@@ -109,6 +125,11 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
         if torques:
             wpos += quad_work(lambda t: max(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
             wneg += quad_work(lambda t: min(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
+        if flow_law:
+            wpos += quad_work(lambda t: max(_flow_law_power(walker, x_at(t)), 0.0), ta, tb,
+                              scale)
+            wneg += quad_work(lambda t: min(_flow_law_power(walker, x_at(t)), 0.0), ta, tb,
+                              scale)
         if damped:
             wdamp += quad_work(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
     ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
