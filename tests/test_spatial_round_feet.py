@@ -347,7 +347,7 @@ def test_round_feet_impact_conserves_angular_momentum_about_the_new_contact(walk
         assert abs(leg_h(va, legs_a) - leg_h(vb, legs_b)) < 1e-12
 
 
-@pytest.mark.slow  # ~30 s: the reference's own fixed point and central differences
+@pytest.mark.slow  # ~60 s: the reference's own fixed point and central differences
 def test_round_feet_hip_width_gait_and_multipliers_match_newton_euler(walkers):
     """With 0.1 l of hip width: the generated stride's fixed point and period against the
     reference's (found by scipy's root on its own stride) to 1e-8 (both roots to ~1e-12,
@@ -389,3 +389,28 @@ def _hip_width_gait(walker):
     search from the upright gait itself does not converge, even at 2.5 mm of hip width)."""
     guess = np.array([-0.0035, -0.19943828, 0.17943828, -0.04, -0.18761398, -0.23901099])
     return find_fixed_point(walker, guess, SOLVER, fd_check=False)
+
+
+@pytest.mark.parametrize(("name", "walker", "says"), [
+    ("round_feet_3d.yaml", {"space": "2d"}, "walker.foot_radius_m: needs space: 3d"),
+    ("round_feet_3d.yaml", {"foot_radius_m": 1.5}, "walker.foot_radius_m must be smaller"),
+    ("hip_width_stabilised.yaml", {"foot_radius_m": 0.1},
+     "walker.foot_radius_m: not with walker.hip_roll"),
+    ("hip_width_stabilised.yaml", {"leg_inertia_kg_m2": 0.1},
+     "walker.leg_inertia_kg_m2: not with walker.hip_roll"),
+])
+def test_round_feet_bad_input_is_refused_naming_its_field(name, walker, says):
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError, match=says):
+        _scene(name, **walker)
+
+
+@pytest.mark.parametrize("fmt", ["mjcf", "urdf"])
+def test_round_feet_3d_exports_refuse_in_one_line_naming_the_fields(tmp_path, fmt):
+    from walkerlab.cli.options import load
+    from walkerlab.stages import export
+
+    scene = load(str(ROOT / "configs" / "round_feet_3d.yaml"))
+    with pytest.raises(ValueError, match="walker.foot_radius_m, walker.leg_inertia_kg_m2"):
+        export.write(scene, tmp_path, fmt)

@@ -307,12 +307,45 @@ def derive_compass(structure) -> Equations:
     stays on the fall line.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
     expressions are the three-coordinate walker's.
 
+    Round feet (``structure.foot == "arc"``, parameter ``R_foot`` [m]; McGeer 1990,
+    "Passive dynamic walking", IJRR 9(2), in each leg's sagittal plane): each foot a thin
+    disc of radius ``R`` in its leg's rolled sagittal plane, its centre on the leg at
+    ``L - R`` from the hip (``L`` hip to the foot's lowest point, ``a`` from that point, as
+    the planar round-feet walker's), rolling on the slope without slip.  The disc's lowest
+    point is ``c - R n_phi`` (``n_phi = Rot(s, phi) n``, the rolled normal) whatever the
+    pitch; with no yaw the disc turns at ``omega = s phi' + Rot(s, phi) z theta'``, and its
+    contact point's material velocity ``v_c - R omega x n_phi = 0`` integrates: the
+    constraint is holonomic.  The contact point advances along the fall line by ``-R``
+    times the change of the leg's absolute pitch ``theta + gamma``, and a roll pivots the
+    disc about its contact point (the lowest point stays below the centre).  So the stance
+    disc's centre is ``c = -R (theta_st + gamma) s + R n_phi`` from the step's reference
+    point (the contact with the stance leg normal to the slope), every position is the
+    point-footed one's with the hip at ``c + (L - R)`` up the stance leg, and the flow is
+    Lagrange's as before (a ball foot, rolling on a plane with three angular rates, would
+    be nonholonomic: its contact's path depends on the order of roll and pitch).  The
+    impact is about the swing disc's *material* contact point, whose velocity is its lowest
+    point's plus ``R theta_sw' s`` (``F`` below); the guard and the section are the swing
+    disc's lowest point's height ``h = (L - R) cos(phi) (cos(theta_st + gamma) -
+    cos(theta_sw + gamma)) - w sin(phi)`` (the two discs' ``R cos(phi)`` cancel);
+    ``swing_foot`` is the next step's reference point, ``swing_contact`` and
+    ``swing_foot_centre``, ``stance_contact`` and ``stance_foot_centre`` the discs'.
+
+    Leg inertia (``structure.bodies[0].kind == "rod"``, parameter ``I_leg`` [kg m^2]): each
+    leg a slender rod about its mass point, ``I`` about every axis normal to the leg and
+    none about it, ``T += I (|omega|^2 - (omega . u)^2) / 2`` (``u`` the leg's axis;
+    :func:`_leg_rotation_mass`); a rotation moves no foot, so the impact's extended mass
+    gets it unchanged.  With ``phi = 0`` and ``w = 0`` round feet and a rod's inertia give
+    the planar round-feet walker (``configs/round_feet.yaml`` = ``configs/
+    round_feet_3d.yaml``, ``tests/test_spatial_round_feet.py``).  Neither goes with
+    hip-roll joints yet (the scene refuses the combination).
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
         ``spatial`` and not ``spokes`` (parameters
         :data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`; ``hip_width``: whether
-        ``w`` is a parameter, else 0).
+        ``w`` is a parameter, else 0; ``foot`` ``point`` or ``arc``; ``bodies[0].kind``
+        ``point_mass`` or ``rod``).
 
     Returns
     -------
