@@ -33,7 +33,7 @@ from walkerlab.models.registry import build_walker
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
 #: configs/round_feet_3d.yaml's walker (nondimensional, g = 1)
-ROUND = dict(g=1.0, L=1.2, gamma=0.01, M=1.0, m=0.5, a=0.7, I=0.02, R=0.2)
+ROUND = dict(g=1.0, L=1.2, gamma=0.01, M=1.0, m=0.5, a=0.7, I_leg=0.02, R=0.2)
 #: the hip width of the reference's walker [l]
 WIDTH = 0.1
 
@@ -53,9 +53,9 @@ class Reference:
     """Newton-Euler's walker (module docstring); state ``[lean, swing, stance, rates]`` as
     walkerlab's, ``w`` the swing hip's offset along the hip axis (its sign: the side)."""
 
-    def __init__(self, g, L, gamma, M, m, a, I, R):
+    def __init__(self, g, L, gamma, M, m, a, I_leg, R):
         self.g, self.L, self.gamma, self.M, self.m, self.a, self.I, self.R = (
-            g, L, gamma, M, m, a, I, R)
+            g, L, gamma, M, m, a, I_leg, R)
         self.s = np.array([math.cos(gamma), -math.sin(gamma), 0.0])   # the fall line
         self.n = np.array([math.sin(gamma), math.cos(gamma), 0.0])    # the slope's normal
         self.z = np.array([0.0, 0.0, 1.0])
@@ -340,7 +340,7 @@ def test_round_feet_impact_conserves_angular_momentum_about_the_new_contact(walk
         _, vb, _, legs_b = ref.kinematics(WIDTH, q, dq, np.zeros(3))
         _, va, _, legs_a = ref.kinematics(WIDTH, q, dqp, np.zeros(3), v_centre)
 
-        def leg_h(v, legs):
+        def leg_h(v, legs, pos=pos, e3=e3):
             u = legs[0][2]
             return e3 @ (ref.m * np.cross(pos["stance_mass"] - pos["hip"], v["stance_mass"])
                          + ref._inertia(u) @ legs[0][0])
