@@ -162,7 +162,8 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
     before its kind is asked (each says what the table's reason says): a joint the walker
     lacks (:func:`walkerlab.models.hybrid.actuators.joint_links` names the joints it has)
     and ``walker.actuation`` on a walker model without actuators, ``walker.hip_roll`` on
-    one other than the compass gait (the scene's schema)."""
+    one other than the compass gait (the scene's schema), ``walker.foot_radius_m`` on one
+    other than the compass gait or on a planar one (its check)."""
     out = []
     if feature in JOINT:
         joint = (FIVE_LINK_JOINT.get(feature, JOINT[feature]) if kind in TORSO_HIPS
@@ -174,6 +175,8 @@ def absent_part(kind: str, feature: str) -> tuple[str, ...]:
         out.append("walker.actuation: unknown field")
     if feature == "hip_roll":  # a field of the compass gait's section only
         out.append("walker.hip_roll: unknown field")
+    if feature == "round_feet_3d":  # the compass gait's, in 3D only
+        out += ["walker.foot_radius_m: unknown field", "walker.foot_radius_m: needs space: 3d"]
     return tuple(out)
 
 

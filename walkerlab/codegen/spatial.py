@@ -236,6 +236,22 @@ def _point_mass_matrix(masses, q, p_foot=False):
     return M, A, total
 
 
+def _leg_rotation_mass(q, phi, th_st, phi_w, th_sw, gamma, inertia) -> sp.Matrix:
+    """Mass matrix (n, n) of the legs' inertia normal to their axes: a leg (frame
+    ``Rot(s, lean) Rot(z, theta + gamma)`` in the slope's frame, axis ``u``) turning at
+    ``omega = s lean' + Rot(s, lean) z theta'`` has ``T = I (|omega|^2 - (omega . u)^2) / 2``
+    (a slender rod's inertia ``I`` about its mass point [kg m^2], none about its axis)."""
+    ez, es = sp.Matrix([0, 0, 1]), sp.Matrix([1, 0, 0])
+    qv = sp.Matrix(q)
+    out = sp.zeros(len(q), len(q))
+    for lean, theta in ((phi, th_st), (phi_w, th_sw)):
+        roll = rotation(es, lean)
+        u = roll * rotation(ez, theta + gamma) * sp.Matrix([0, 1, 0])
+        W = es * sp.Matrix([lean]).jacobian(qv) + roll * ez * sp.Matrix([theta]).jacobian(qv)
+        out += inertia * (W.T * W - W.T * u * u.T * W)
+    return out
+
+
 @cache
 def derive_compass(structure) -> Equations:
     """Flow, impact, guards, energies and points of a straight-legged walker with hip width in
@@ -291,12 +307,45 @@ def derive_compass(structure) -> Equations:
     stays on the fall line.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
     expressions are the three-coordinate walker's.
 
+    Round feet (``structure.foot == "arc"``, parameter ``R_foot`` [m]; McGeer 1990,
+    "Passive dynamic walking", IJRR 9(2), in each leg's sagittal plane): each foot a thin
+    disc of radius ``R`` in its leg's rolled sagittal plane, its centre on the leg at
+    ``L - R`` from the hip (``L`` hip to the foot's lowest point, ``a`` from that point, as
+    the planar round-feet walker's), rolling on the slope without slip.  The disc's lowest
+    point is ``c - R n_phi`` (``n_phi = Rot(s, phi) n``, the rolled normal) whatever the
+    pitch; with no yaw the disc turns at ``omega = s phi' + Rot(s, phi) z theta'``, and its
+    contact point's material velocity ``v_c - R omega x n_phi = 0`` integrates: the
+    constraint is holonomic.  The contact point advances along the fall line by ``-R``
+    times the change of the leg's absolute pitch ``theta + gamma``, and a roll pivots the
+    disc about its contact point (the lowest point stays below the centre).  So the stance
+    disc's centre is ``c = -R (theta_st + gamma) s + R n_phi`` from the step's reference
+    point (the contact with the stance leg normal to the slope), every position is the
+    point-footed one's with the hip at ``c + (L - R)`` up the stance leg, and the flow is
+    Lagrange's as before (a ball foot, rolling on a plane with three angular rates, would
+    be nonholonomic: its contact's path depends on the order of roll and pitch).  The
+    impact is about the swing disc's *material* contact point, whose velocity is its lowest
+    point's plus ``R theta_sw' s`` (``F`` below); the guard and the section are the swing
+    disc's lowest point's height ``h = (L - R) cos(phi) (cos(theta_st + gamma) -
+    cos(theta_sw + gamma)) - w sin(phi)`` (the two discs' ``R cos(phi)`` cancel);
+    ``swing_foot`` is the next step's reference point, ``swing_contact`` and
+    ``swing_foot_centre``, ``stance_contact`` and ``stance_foot_centre`` the discs'.
+
+    Leg inertia (``structure.bodies[0].kind == "rod"``, parameter ``I_leg`` [kg m^2]): each
+    leg a slender rod about its mass point, ``I`` about every axis normal to the leg and
+    none about it, ``T += I (|omega|^2 - (omega . u)^2) / 2`` (``u`` the leg's axis;
+    :func:`_leg_rotation_mass`); a rotation moves no foot, so the impact's extended mass
+    gets it unchanged.  With ``phi = 0`` and ``w = 0`` round feet and a rod's inertia give
+    the planar round-feet walker (``configs/round_feet.yaml`` = ``configs/
+    round_feet_3d.yaml``, ``tests/test_spatial_round_feet.py``).  Neither goes with
+    hip-roll joints yet (the scene refuses the combination).
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
         ``spatial`` and not ``spokes`` (parameters
         :data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`; ``hip_width``: whether
-        ``w`` is a parameter, else 0).
+        ``w`` is a parameter, else 0; ``foot`` ``point`` or ``arc``; ``bodies[0].kind``
+        ``point_mass`` or ``rod``).
 
     Returns
     -------
@@ -334,16 +383,27 @@ def derive_compass(structure) -> Equations:
     def leg(theta, length, lean=phi):  # from the hip to a point at ``length`` down the leg
         return roll_of(lean) * (rotation(ez, theta + gamma) * sp.Matrix([0, -length, 0]))
 
-    hip_st = -leg(th_st, L)
+    arc = structure.foot == "arc"
+    R = P["R_foot"] if arc else 0
+    e_s, e_n = sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0])
+    # the stance disc's centre from the step's reference point: its contact point rolled
+    # -R (theta_st + gamma) down the fall line, the centre R along the rolled normal above it
+    offset = (-R * (th_st + gamma) * e_s + R * roll_of(phi) * e_n) if arc else sp.zeros(3, 1)
+    hip_st = offset - leg(th_st, L - R)
     hip_sw = hip_st + w * axis
     pelvis = hip_st + w / 2 * axis
-    m_st = hip_st + leg(th_st, L - a)                  # a from the foot
+    m_st = hip_st + leg(th_st, L - a)                  # a from the foot's lowest point
     m_sw = hip_sw + leg(th_sw, L - a, phi_w)
-    swing_foot = hip_sw + leg(th_sw, L, phi_w)
+    centre_sw = hip_sw + leg(th_sw, L - R, phi_w)      # the point foot, or the disc's centre
+    swing_contact = centre_sw - R * roll_of(phi_w) * e_n
+    # the next step's reference point (where its contact is with its leg normal to the slope)
+    swing_foot = swing_contact + R * (th_sw + gamma) * e_s
     masses = [(M_hip, pelvis), (m, m_st), (m, m_sw)]
     M, A, total = _point_mass_matrix(masses, q)
     if structure.hip_roll:  # the pelvis' own inertia about the fall line (it rolls by phi_p)
         M[3, 3] += P["I_pelvis"]
+    if structure.bodies[0].kind == "rod":  # each leg's inertia normal to its axis
+        M += _leg_rotation_mass(q, phi, th_st, phi_w, th_sw, gamma, P["I_leg"])
     M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
     C = christoffel(M, q, dq)
     # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n
@@ -354,13 +414,18 @@ def derive_compass(structure) -> Equations:
         G = G - _hip_roll_forces(q, dq, P)
     kinetic = sp.Rational(1, 2) * (sp.Matrix(dq).T * M * sp.Matrix(dq))[0]
     # impact about the new foot (extended coordinates, the old stance foot free)
-    F = swing_foot.jacobian(sp.Matrix(q))
+    # the rates that keep the swing foot's material contact point at rest: a point foot's,
+    # or the disc's lowest point's velocity plus R theta_sw' s (the material point's, v_c +
+    # omega x (-R n_w) = d(contact)/dt + R theta_sw' s: the lean pivots the disc about it)
+    F = swing_contact.jacobian(sp.Matrix(q))
+    if arc:
+        F += R * e_s * sp.Matrix([[sp.diff(th_sw, k) for k in q]])
     Mi = (M - A * F - F.T * A.T + total * F.T * F).applyfunc(
         lambda e: sp.trigsimp(sp.expand(e)))
     B = (M - F.T * A.T).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
     to_world = sp.Matrix([[sp.cos(gamma), sp.sin(gamma), 0],
                           [-sp.sin(gamma), sp.cos(gamma), 0], [0, 0, 1]])  # columns s, n, z
-    height = swing_foot[1]
+    height = swing_contact[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
     if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
         relabel_q = sp.Matrix([phi_w, th_st, th_sw, phi_p, phi])   # the new swing roll
@@ -369,7 +434,7 @@ def derive_compass(structure) -> Equations:
     if structure.hip_width:
         heel = height
         # just after heel strike the swing foot (the old stance foot) is on the slope behind
-        drop_solution = -gamma - sp.acos(sp.cos(th_st + gamma) - w * sp.tan(phi) / L)
+        drop_solution = -gamma - sp.acos(sp.cos(th_st + gamma) - w * sp.tan(phi) / (L - R))
         if structure.hip_roll:
             drop_solution = -gamma - sp.acos((L * sp.cos(phi) * sp.cos(th_st + gamma)
                                               - w * sp.sin(phi_p)) / (L * sp.cos(phi_w)))
@@ -380,6 +445,10 @@ def derive_compass(structure) -> Equations:
         ("hip", pelvis), ("stance_hip", hip_st), ("swing_hip", hip_sw),
         ("stance_foot", sp.zeros(3, 1)), ("swing_foot", swing_foot), ("stance_mass", m_st),
         ("swing_mass", m_sw))}
+    if arc:
+        points.update({k: to_world * v for k, v in (
+            ("stance_contact", offset - R * roll_of(phi) * e_n), ("stance_foot_centre", offset),
+            ("swing_contact", swing_contact), ("swing_foot_centre", centre_sw))})
     n = len(q)
     return Equations(
         q=q, dq=dq, params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,

@@ -153,7 +153,8 @@ class _Suggester:
 #: the user guide, docs/user_guide/walkers.md (one place: update it as the walker vocabulary grows)
 WALKER_VOCABULARY = (
     "a walker today is planar but for two in 3D (space: 3d): model compass_gait (hip mass, "
-    "one point mass per leg; space: 3d with hip_width_m: the walker in three dimensions) "
+    "one point mass per leg; space: 3d with hip_width_m: the walker in three dimensions, "
+    "with foot_radius_m round feet, leg_inertia_kg_m2 rod legs) "
     "or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee "
     "(with an optional spring-damper) or free knees (knee.lock: free), foot "

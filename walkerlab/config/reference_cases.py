@@ -121,6 +121,8 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         w["hip_roll"] = stabilised["walker"]["hip_roll"]
         if kind == "straight_legs_3d":
             d["fixedpoint"]["initial_guess"] = stabilised["fixedpoint"]["initial_guess"]
+    elif feature == "round_feet_3d":  # configs/round_feet_3d.yaml's disc feet (refused by
+        w["foot_radius_m"] = 0.2  # any walker but the 3D straight legs: the scene's check)
     elif feature in TERRAIN:
         terrain = copy.deepcopy(TERRAIN[feature])
         if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
@@ -183,6 +185,8 @@ SHIPPED = {
     # the hip-width walker with its lateral foot-placement law: stride multipliers all
     # inside the unit circle (largest 0.517; the passive walker's lateral one 99.9)
     ("straight_legs_3d", "hip_roll"): "hip_width_stabilised",
+    # configs/round_feet.yaml's walker in 3D on disc feet, upright: the planar gait
+    ("straight_legs_3d", "round_feet_3d"): "round_feet_3d",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the

@@ -97,10 +97,20 @@ class CompassGaitParams(_Actuated):
                                         "their lateral foot-placement law (space: 3d with a "
                                         "hip width; null: the legs rigid to the pelvis in "
                                         "roll, a passive walker)")
+    foot_radius_m: float | None = Field(None, gt=0, le=100, description="radius R of each foot's "
+                                 "arc, a disc in its leg's sagittal plane rolling without "
+                                 "slip, its centre on the leg at R above the foot's lowest "
+                                 "point (McGeer 1990's round feet; space: 3d only; 0: point "
+                                 "feet: null) [m]")
+    leg_inertia_kg_m2: float | None = Field(None, ge=0, le=1e4, description="each leg's moment of "
+                                     "inertia about its mass point, about every axis normal "
+                                     "to the leg (a slender rod's: none about its own axis; "
+                                     "space: 3d only; null: a point mass) [kg m^2]")
 
     @model_serializer(mode="wrap")
     def _passive_as_before(self, handler):
-        return drop_unset(handler(self), ("actuation", "hip_roll"))
+        return drop_unset(handler(self), ("actuation", "hip_roll", "foot_radius_m",
+                                          "leg_inertia_kg_m2"))
 
     @model_validator(mode="after")
     def _a_inside_leg(self) -> CompassGaitParams:
@@ -114,6 +124,15 @@ class CompassGaitParams(_Actuated):
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
             raise ValueError("walker.hip_roll: hip-roll joints are a 3D straight-legged "
                              "walker's with hip width (walker.space: 3d, hip_width_m > 0)")
+        for name in ("foot_radius_m", "leg_inertia_kg_m2"):
+            if getattr(self, name) is not None and self.space == "2d":
+                raise ValueError(f"walker.{name}: needs space: 3d (a planar walker's round "
+                                 "feet and leg inertia are model: biped's leg.foot, bodies)")
+            if getattr(self, name) is not None and self.hip_roll is not None:
+                raise ValueError(f"walker.{name}: not with walker.hip_roll yet (round feet "
+                                 "and leg inertia are the passive 3D walker's so far)")
+        if self.foot_radius_m is not None and not self.foot_radius_m < self.leg_length_m:
+            raise ValueError("walker.foot_radius_m must be smaller than walker.leg_length_m")
         if self.hip_roll is not None and self.actuation is not None:
             raise ValueError("walker.actuation: a 3D walker's actuators are its hip_roll "
                              "law so far")

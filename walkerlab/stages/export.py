@@ -260,6 +260,11 @@ def _run_legs_3d(scene: Scene, runs_root, data, name: str, fmt: str, walker_only
     from walkerlab.export.spatial_legs_mjcf import legs3d_mjcf_text, legs3d_scene
 
     data.structure.kind.require("walk", FORMAT_VIEWS[fmt], "walker.space: 3d")
+    if data.structure.foot == "arc" or data.structure.bodies[0].kind == "rod":
+        data.structure.kind.require("round_feet_3d", FORMAT_VIEWS[fmt],
+                                    "walker.foot_radius_m, walker.leg_inertia_kg_m2")
+        raise ValueError("walker.foot_radius_m, walker.leg_inertia_kg_m2: this export "
+                         "carries point feet and point-mass legs")  # the cell's, if it ran
     if data.structure.hip_roll:
         data.structure.kind.require("hip_roll", FORMAT_VIEWS[fmt], "walker.hip_roll")
     check_exportable(scene, data.structure.kind, fmt, walker_only)  # numbers, ground

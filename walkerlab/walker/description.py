@@ -48,7 +48,10 @@ SPATIAL_SPOKED_PARAMS = SPOKED_PARAMS + ("I_diam",)
 #: the fall line, then the legs' pitch angles as the planar walkers'.
 SPATIAL_COMPASS_ROLES = ("lean", "swing", "stance")
 #: Parameters of the straight-legged walker in 3D: gravity, leg length, slope, hip mass, leg
-#: mass and its distance from the foot [SI], then (``hip_width``) the hip width ``w_hip`` [m].
+#: mass and its distance from the foot [SI], then (``hip_width``) the hip width ``w_hip`` [m],
+#: (legs with inertia: ``bodies[0].kind == "rod"``) each leg's inertia ``I_leg`` about its
+#: mass point normal to the leg [kg m^2], (round feet: ``foot == "arc"``) the feet's radius
+#: ``R_foot`` [m].
 SPATIAL_COMPASS_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
 #: Roles added by hip-roll joints (``hip_roll``): the pelvis' and the swing leg's roll
 #: about the fall line (the ``lean`` is then the stance leg's).
@@ -212,6 +215,8 @@ class Structure:
             return SPATIAL_SPOKED_PARAMS if self.spatial else SPOKED_PARAMS
         if self.spatial:
             return (SPATIAL_COMPASS_PARAMS + (("w_hip",) if self.hip_width else ())
+                    + (("I_leg",) if self.bodies[0].kind == "rod" else ())
+                    + (("R_foot",) if self.foot == "arc" else ())
                     + (HIP_ROLL_PARAMS if self.hip_roll else ()))
         names = ["g", "L", "gamma"] + (["M_hip"] if self.hip_mass else [])
         tags = [f"{ROLE_TAG[r]}_" for r in ("swing", "stance")] if self.asymmetric else [""]
@@ -413,6 +418,14 @@ def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
     mirror = None
     if width:
         params, mirror = params + (width,), params + (-width,)
+    inertia, radius = w.leg_inertia_kg_m2, w.foot_radius_m
+    tail = ((() if inertia is None else (inertia,))
+            + (() if radius is None else (radius,)))   # the rod's inertia, the arc's radius
+    params, mirror = params + tail, None if mirror is None else mirror + tail
+    if inertia is not None:
+        extra["leg_inertia_kg_m2"] = inertia
+    if radius is not None:
+        extra["foot_radius_m"] = radius
     law = w.hip_roll
     if law is not None:  # odd in the rolls: the mirror step runs the same gains
         gains = (law.pelvis_roll_inertia_kg_m2, law.pelvis_stiffness_n_m_per_rad,
@@ -420,7 +433,9 @@ def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
                  law.swing_damping_n_m_s_per_rad, law.lean_gain, law.lean_rate_gain_s)
         params, mirror = params + gains, mirror + gains
         extra["hip_roll"] = law.model_dump()
-    structure = Structure("absolute", (BodySpec("mass", "point_mass"),), hip_mass=True,
+    structure = Structure("absolute", (BodySpec("mass", "point_mass" if inertia is None
+                                                else "rod"),), hip_mass=True,
+                          foot="point" if radius is None else "arc",
                           spatial=True, hip_width=bool(width), hip_roll=law is not None)
     return WalkerData(structure, tuple(float(v) for v in params),
                       w.hip_mass_kg + 2 * w.leg_mass_kg, w.leg_length_m,

@@ -87,6 +87,9 @@ FEATURES = {
                             "(walker.actuation.virtual_constraints)"),
     "hip_roll": ("hip-roll joints and a lateral foot-placement law (walker.hip_roll; "
                  "Kuo 1999)"),
+    "round_feet_3d": ("round feet of a walker in 3D: a disc in each leg's sagittal plane, "
+                      "rolling (walker.foot_radius_m; McGeer 1990; a planar walker's round "
+                      "feet are its walk's walker.leg.foot.kind: arc)"),
     "stairs": "stairs (terrain.kind: stairs)",
     "footholds": "footholds of several heights or slopes (terrain.kind: footholds)",
     "profile": "a height profile (terrain.kind: profile)",
@@ -251,6 +254,16 @@ SPATIAL_ACTUATION = ("a walker in 3D takes no walker.actuation so far (its later
 #: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
 NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
                "(walker.space: 3d, hip_width_m > 0)")
+#: why the kinds other than the 3D straight legs refuse a 3D walker's round feet (the
+#: scene's check on a planar compass gait says it too:
+#: :class:`walkerlab.config.walker.CompassGaitParams`)
+NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
+                    "straight-legged walker's (walker.space: 3d); a planar walker's round "
+                    "feet are walker.leg.foot.kind: arc")
+#: why the 3D walker's exports refuse its round feet
+SPATIAL_ROUND_FEET_EXPORT = ("a 3D walker's export carries point feet and point-mass legs "
+                             "so far (its round feet and leg inertia run in the rigid model: "
+                             "fixedpoint, simulate)")
 #: why the URDF refuses the 3D walker's hip-roll joints
 SPATIAL_HIP_ROLL_EXPORT = ("the URDF carries legs rigid to the pelvis in roll so far: the "
                            "hip-roll joints and their law are in the MJCF (--format mjcf) "
@@ -330,6 +343,7 @@ _OPTIMIZE_GROUNDS = {("stairs", "optimize"): _OPTIMIZE_LANDING,
 CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "straight_legs": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         ("virtual_constraints", "optimize"): ("optimize.design: virtual_constraints is built "
@@ -345,6 +359,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "locking_knees": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         **_NO_ANKLES,
         ("virtual_constraints", "*"): ("a knee that locks changes the walker's degrees of "
                                        "freedom within the step (its outputs would change "
@@ -358,6 +373,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "flat_feet": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "
                                "(walker.leg.knee)"),
         ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
@@ -388,6 +404,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "free_joints": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         **_NO_ANKLES,
         **_VC_VIEWS,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
@@ -404,6 +421,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "hinged_torso": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         **_NO_ANKLES,
@@ -417,6 +435,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "rolling_polygon": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
                                          "virtual_constraints")},
@@ -434,6 +453,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "straight_legs_3d": {
         ("hip_roll", "urdf"): SPATIAL_HIP_ROLL_EXPORT,
+        ("round_feet_3d", "mjcf"): SPATIAL_ROUND_FEET_EXPORT,
+        ("round_feet_3d", "urdf"): SPATIAL_ROUND_FEET_EXPORT,
         **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
                                                  "ankle_torque", "torso_torque", "push_off",
                                                  "ankle_push_off", "virtual_constraints")},
@@ -449,6 +470,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "rolling_polygon_3d": {
         ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
                                          "virtual_constraints")},
