@@ -95,7 +95,7 @@ def png_only(monkeypatch):
 
     from walkerlab.plotting import figures
 
-    def save(fig, folder, stem, svg=True):
+    def save(fig, folder, stem, svg=True, key=None):
         p = Path(folder) / f"{stem}.png"
         p.parent.mkdir(parents=True, exist_ok=True)
         try:
