@@ -96,7 +96,12 @@ def test_each_cells_stored_measurement_is_what_the_code_gives(kind, feature, vie
         pytest.skip("OpenSim (the osim extra, not in the test extra) is not installed here")
     m = measure(kind, feature, view, tmp_path)
     assert m.ok == e["ok"], (m.detail, e["detail"])
-    if e["ok"]:
+    if e["ok"] and "return error" in e["quantity"]:
+        # an optimum's replay error is the NLP's convergence noise (IPOPT with MUMPS on the
+        # machine's BLAS: 6.7e-8 where the evidence was first written, 5.1e-7 here): the
+        # claim is its bound, not its digits
+        assert m.value <= e["tolerance"], (m.value, e["tolerance"])
+    elif e["ok"]:
         assert math.isclose(m.value, e["value"], rel_tol=0.0,
                             abs_tol=REPRODUCE * e["tolerance"]), (m.value, e["value"])
 
