@@ -263,11 +263,13 @@ def _same_ground(cs_path, slope_scene, runs: Path) -> tuple[float, str, object]:
     with _h5(cs_path) as f, _h5(ref) as g:
         h = np.asarray(f["events/heel_strike_times"][:], float)
         hs = np.asarray(g["events/heel_strike_times"][:], float)
-    if h.size != hs.size or hs.size < 2:
+    k = min(h.size, hs.size)  # each run walks the heel strikes its own scene asks for (the
+    if k < 10:                # profile's and the slope's counts of a gait period may differ)
         return math.nan, (f"the profile's contact walk made {h.size} heel strikes, the "
-                          f"slope's {hs.size}"), ref
-    dev = float(np.max(np.abs(h - hs)) / np.mean(np.diff(hs)))
-    return dev, f"heel strikes {dev:.1e} of a step period from the slope's contact walk", ref
+                          f"slope's {hs.size}: fewer than 10 to compare"), ref
+    dev = float(np.max(np.abs(h[:k] - hs[:k])) / np.mean(np.diff(hs[:k])))
+    return dev, (f"heel strikes {dev:.1e} of a step period from the slope's contact walk "
+                 f"over the {k} both made ({h.size} and {hs.size} asked for)"), ref
 
 
 def _contact(scene, d, runs: Path) -> tuple[float, str]:
