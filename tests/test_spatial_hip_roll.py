@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 import yaml
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq, root
+from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
+from tests.independent.mirror_stride import stride_against
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -348,26 +349,7 @@ def test_hip_roll_gait_and_multipliers_match_an_independent_model(stabilised,
     _scene, _walker, ref, w = stabilised
     res = stabilised_gait
 
-    def stride(x):
-        x1, t1 = ref.step(w, x)
-        x2, t2 = ref.step(-w, x1)
-        return x2, t1 + t2
-
-    keep = [0, 2, 3, 4, 5, 6, 7, 8, 9]
-
-    def F(z):
-        return stride(ref.on_surface(w, z))[0][keep] - z
-
-    sol = root(F, res.x[keep], method="hybr", options={"xtol": 1e-13})
-    x_ref = ref.on_surface(w, sol.x)
-    assert np.max(np.abs(x_ref - res.x)) < 1e-8
-    assert abs(stride(x_ref)[1] - res.period_s) < 1e-8
-    h = 1e-6
-    J = np.zeros((10, 10))
-    for j in range(10):
-        e = np.zeros(10)
-        e[j] = h
-        J[:, j] = (stride(x_ref + e)[0] - stride(x_ref - e)[0]) / (2 * h)
-    theirs = np.sort_complex(np.linalg.eigvals(J))
-    ours = np.sort_complex(np.asarray(res.multipliers_variational))
-    assert np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs))) < 1e-6
+    dx, dt, dmu = stride_against(ref, w, res, [0, 2, 3, 4, 5, 6, 7, 8, 9])
+    assert dx < 1e-8
+    assert dt < 1e-8
+    assert dmu < 1e-6

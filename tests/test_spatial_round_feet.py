@@ -22,9 +22,10 @@ import numpy as np
 import pytest
 import yaml
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq, root
+from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
+from tests.independent.mirror_stride import stride_against
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -358,29 +359,10 @@ def test_round_feet_hip_width_gait_and_multipliers_match_newton_euler(walkers):
     res = _hip_width_gait(walker)
     ref = Reference(**ROUND)
 
-    def stride(x):
-        x1, t1 = ref.step(WIDTH, x)
-        x2, t2 = ref.step(-WIDTH, x1)
-        return x2, t1 + t2
-
-    def F(z):
-        x2 = stride(ref.on_surface(WIDTH, z))[0]
-        return np.array([x2[0], x2[2], *x2[3:]]) - z
-
-    z0 = np.array([res.x[0], res.x[2], *res.x[3:]])
-    sol = root(F, z0, method="hybr", options={"xtol": 1e-13})
-    x_ref = ref.on_surface(WIDTH, sol.x)
-    assert np.max(np.abs(x_ref - res.x)) < 1e-8
-    assert abs(stride(x_ref)[1] - res.period_s) < 1e-8
-    h = 1e-6
-    J = np.zeros((6, 6))
-    for j in range(6):
-        e = np.zeros(6)
-        e[j] = h
-        J[:, j] = (stride(x_ref + e)[0] - stride(x_ref - e)[0]) / (2 * h)
-    theirs = np.sort_complex(np.linalg.eigvals(J))
-    ours = np.sort_complex(np.asarray(res.multipliers_variational))
-    assert np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs))) < 1e-6
+    dx, dt, dmu = stride_against(ref, WIDTH, res, [0, 2, 3, 4, 5])
+    assert dx < 1e-8
+    assert dt < 1e-8
+    assert dmu < 1e-6
 
 
 def _hip_width_gait(walker):

@@ -100,7 +100,7 @@ def bench_design_process(pairs: int = 3) -> dict:
 
     import yaml
 
-    from walkerlab.bench.optimize import paired, process_times
+    from walkerlab.bench.optimize import in_turn, process_times
     from walkerlab.config import load_scene
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import load
@@ -110,7 +110,6 @@ def bench_design_process(pairs: int = 3) -> dict:
 
     root = Path(__file__).resolve().parents[2]
     script = [sys.executable, str(root / "walkerlab" / "bench" / "minimal_casadi_hzd.py")]
-    this, theirs = [], []
     with tempfile.TemporaryDirectory(prefix="wl_bench_hzd_") as d:
         cfg = yaml.safe_load((root / "configs" / "threelink_hzd.yaml").read_text())
         cfg.update(name="threelink_design", optimize=dict(DESIGN))
@@ -133,16 +132,11 @@ def bench_design_process(pairs: int = 3) -> dict:
                str(Path(d) / "runs")]
         process_times(cmd, env, d)  # the generated code and the upstream stages cached
         cmd.append("--force")
-        for i in range(pairs):
-            for which in ("this", "script") if i % 2 == 0 else ("script", "this"):
-                if which == "this":
-                    this.append(process_times(cmd, env, d))
-                else:
-                    theirs.append(process_times(script, cwd="/"))
+        times = in_turn(cmd, env, d, script, pairs)
         words = subprocess.run(script, capture_output=True, text=True, check=True,
                                cwd="/").stdout.split()
         ours = load(Path(d) / "runs" / "threelink_design" / "optimize.h5")
-    return {"pairs": pairs, **paired(this, theirs), "target_ratio": TARGET_RATIO,
+    return {"pairs": pairs, **times, "target_ratio": TARGET_RATIO,
             "walkerlab": {"status": str(ours.status), "iterations": int(ours.iterations),
                           "objective": float(ours.objective),
                           "period_s": float(ours.step_period_s)},

@@ -162,6 +162,20 @@ def paired(this: list[tuple[float, float]], script: list[tuple[float, float]]) -
             "cpu_ratio": stats([a[1] / b[1] for a, b in zip(this, script)])}
 
 
+def in_turn(cmd: list[str], env: dict, cwd, script: list[str], pairs: int) -> dict:
+    """``pairs`` pairs of the command ``cmd`` (in ``env``, ``cwd``) and the yardstick
+    ``script`` (from ``/``), which runs first alternating pair by pair: :func:`paired`'s
+    medians and ratios."""
+    this, theirs = [], []
+    for i in range(pairs):
+        for which in ("this", "script") if i % 2 == 0 else ("script", "this"):
+            if which == "this":
+                this.append(process_times(cmd, env, cwd))
+            else:
+                theirs.append(process_times(script, cwd="/"))
+    return paired(this, theirs)
+
+
 def bench_vs_script(pairs: int = 5) -> dict:
     """Warm ``walkerlab optimize configs/compass_optimal.yaml --force`` (the optimisation,
     its rigid and contact replays, the artifact and the figure; the generated code and the
@@ -170,7 +184,6 @@ def bench_vs_script(pairs: int = 5) -> dict:
     process, ``pairs`` pairs alternating which runs first: wall and CPU medians and the
     medians of the pairs' ratios (goal :data:`TARGET_OVER_SCRIPT`)."""
     script = [sys.executable, str(Path(__file__).with_name("minimal_casadi.py"))]
-    this, theirs = [], []
     with tempfile.TemporaryDirectory(prefix="wl_bench_opt_") as d:
         env = {**os.environ, "WALKERLAB_CACHE_DIR": str(Path(d) / "cache"),
                "PYTHONPATH": os.pathsep.join([str(_CONFIGS.parent),
@@ -180,13 +193,8 @@ def bench_vs_script(pairs: int = 5) -> dict:
         process_times(cmd, env, d)  # cold: the generated code, the fixed point
         cmd.append("--force")
         process_times(cmd, env, d)  # the steady state of repeated runs
-        for i in range(pairs):
-            for which in ("this", "script") if i % 2 == 0 else ("script", "this"):
-                if which == "this":
-                    this.append(process_times(cmd, env, d))
-                else:
-                    theirs.append(process_times(script, cwd="/"))
-    return {"scene": "compass_optimal", "pairs": pairs, **paired(this, theirs),
+        times = in_turn(cmd, env, d, script, pairs)
+    return {"scene": "compass_optimal", "pairs": pairs, **times,
             "target_ratio": TARGET_OVER_SCRIPT}
 
 
