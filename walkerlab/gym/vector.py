@@ -46,20 +46,21 @@ def _whole(value, name: str, low: int, allow_none: bool = False) -> int | None:
     return int(value)
 
 
-def _batch_infos(each: list[dict]) -> dict:
+def _batch_infos(each: list[dict]) -> dict | None:
     """The sub-environments' infos ``each[i]`` (flat dicts of numbers, text, lists or None)
     batched as :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one: per key
     an array of ``len(each)`` whose type is the first value's (a number's dtype, else
-    objects) and its mask ``_key``, keys in the order met (a nested dict: gymnasium's own)."""
+    objects) and its mask ``_key``, keys in the order met; None where a value is a dict
+    (gymnasium's own recursion then)."""
     n = len(each)
     out: dict = {}
     for i, info in enumerate(each):
         for key, value in info.items():
+            t = type(value)
+            if t is dict:
+                return None
             arr = out.get(key)
             if arr is None:
-                t = type(value)
-                if t is dict:
-                    return _add_infos_one_by_one(each)
                 if t in (int, float, bool) or issubclass(t, np.number):
                     arr = np.zeros(n, dtype=t)
                 elif isinstance(value, np.ndarray):
@@ -68,21 +69,9 @@ def _batch_infos(each: list[dict]) -> dict:
                     arr = np.full(n, None, dtype=object)
                 out[key] = arr
                 out[f"_{key}"] = np.zeros(n, dtype=np.bool_)
-            elif type(value) is dict:
-                return _add_infos_one_by_one(each)
             arr[i] = value
             out[f"_{key}"][i] = True
     return out
-
-
-def _add_infos_one_by_one(each: list[dict]) -> dict:
-    """gymnasium's :meth:`~gymnasium.vector.VectorEnv._add_info`, env by env."""
-    probe = VectorEnv()
-    probe.num_envs = len(each)
-    infos: dict = {}
-    for i, info in enumerate(each):
-        infos = probe._add_info(infos, info, i)
-    return infos
 
 
 class WalkerVectorEnv(VectorEnv):
@@ -359,11 +348,12 @@ class WalkerVectorEnv(VectorEnv):
                                                    "final_info": info}, i)
                     info = self._reset_one(i, None, None)  # the step's reward and flags kept
             each.append(info)
-        if infos:  # SAME_STEP's final observations and infos: gymnasium's own batching
+        batched = None if infos else _batch_infos(each)
+        if batched is None:  # SAME_STEP's final observations and infos: gymnasium's own
             for i, info in enumerate(each):
                 infos = self._add_info(infos, info, i)
         else:
-            infos = _batch_infos(each)
+            infos = batched
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
         return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
                 self._truncations.copy(), infos)
