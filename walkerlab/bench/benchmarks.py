@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.bench.process_env import installed_env
 from walkerlab.io.schemas.continuation import initial_state
 
 
@@ -94,7 +95,7 @@ def _time_process(cmd: list[str], runs: int, cwd: Path | None = None) -> dict:
     walls = []
     for _ in range(runs):
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True, cwd=cwd)
+        subprocess.run(cmd, check=True, capture_output=True, cwd=cwd, env=installed_env())
         walls.append(time.perf_counter() - t0)
     return {"wall_median_s": float(np.median(walls)), "wall_min_s": float(np.min(walls)),
             "wall_max_s": float(np.max(walls)), "runs": runs}
@@ -105,7 +106,7 @@ def _cpu_process(cmd: list[str]) -> float:
     import resource
 
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run(cmd, check=True, capture_output=True)
+    subprocess.run(cmd, check=True, capture_output=True, env=installed_env())
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime)
 
@@ -118,7 +119,8 @@ def bench_fixedpoint(runs: int = 5) -> dict:
     bare = [sys.executable, str(Path(__file__).with_name("bare_fixedpoint.py"))]
     with tempfile.TemporaryDirectory() as d:
         cmd = _cli("fixedpoint", "--force", "--runs-dir", d)
-        subprocess.run(cmd, check=True, capture_output=True)  # warm the model code cache
+        # warm the model code cache (and write walkerlab's bytecode: :mod:`.process_env`)
+        subprocess.run(cmd, check=True, capture_output=True, env=installed_env())
         out = {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
         pairs = []
         for i in range(runs):
@@ -143,7 +145,8 @@ def bench_fixedpoint_3d(runs: int = 5) -> dict:
         for scene in ("hip_width", "rimless_wheel_3d"):
             cmd = _cli("fixedpoint", str(shipped_scene_path(scene)), "--force",
                        "--runs-dir", d)
-            subprocess.run(cmd, check=True, capture_output=True)  # the model code cached
+            subprocess.run(cmd, check=True, capture_output=True,
+                           env=installed_env())  # the model code cached
             out["scenes"][scene] = _time_process(cmd, runs)
     return out
 
@@ -157,7 +160,8 @@ def bench_sweep_workers(points=(8, 32), runs: int = 3) -> dict:
     :func:`walkerlab.studies.runner.pool_pays`)."""
     out: dict = {"target": "2 workers <= 1 worker (ratio <= 1)", "sweeps": []}
     with tempfile.TemporaryDirectory() as d:
-        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True)
+        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True,
+                       env=installed_env())
         for n in points:
             hi = 2.5 + 0.01 * (n - 1)
             walls: dict[int, list[float]] = {1: [], 2: []}
@@ -181,7 +185,8 @@ def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
     ``target_s`` of 120 s and the cells per outcome.
     """
     with tempfile.TemporaryDirectory() as d:
-        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True)
+        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True,
+                       env=installed_env())
         cmd = _cli("basin", "--grid", grid, "--workers", str(workers), "--force",
                    "--runs-dir", d)
         res = _time_process(cmd, 1)

@@ -101,6 +101,7 @@ def bench_design_process(pairs: int = 3) -> dict:
     import yaml
 
     from walkerlab.bench.optimize import in_turn, process_times
+    from walkerlab.bench.process_env import installed_env
     from walkerlab.config import load_scene
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import load
@@ -126,8 +127,8 @@ def bench_design_process(pairs: int = 3) -> dict:
                  kp=vc.feedback.kp_per_s2, kd=vc.feedback.kd_per_s,
                  u_max=spec.max_torque_n_m, mu=spec.friction_coefficient)
         script.append(str(npz))
-        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root),
-                                                             os.environ.get("PYTHONPATH", "")])}
+        env = installed_env(PYTHONPATH=os.pathsep.join([str(root),
+                                                        os.environ.get("PYTHONPATH", "")]))
         cmd = [sys.executable, "-m", "walkerlab.cli", "optimize", str(path), "--runs-dir",
                str(Path(d) / "runs")]
         process_times(cmd, env, d)  # the generated code and the upstream stages cached

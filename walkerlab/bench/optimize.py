@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.bench.process_env import installed_env
+
 __all__ = ["GOALS_S", "SCENES", "TARGET_OVER_SCRIPT", "bench_optimize", "bench_vs_script",
            "lines"]
 
@@ -53,9 +55,9 @@ def _run(scene_path: Path, folder: Path, force: bool, tree: Path | None = None) 
 
     # the child starts in ``folder`` (``-m`` puts the current folder first on the path)
     # with the tree's walkerlab first on PYTHONPATH (this tree's when ``tree`` is None)
-    env = {**os.environ, "WALKERLAB_CACHE_DIR": str(folder / "cache"),
-           "PYTHONPATH": os.pathsep.join([str(tree or _CONFIGS.parent),
-                                          os.environ.get("PYTHONPATH", "")])}
+    env = installed_env(WALKERLAB_CACHE_DIR=str(folder / "cache"),
+                        PYTHONPATH=os.pathsep.join([str(tree or _CONFIGS.parent),
+                                                    os.environ.get("PYTHONPATH", "")]))
     cmd = [sys.executable, "-m", "walkerlab.cli", "optimize", str(scene_path),
            "--runs-dir", str(folder / "runs")] + (["--force"] if force else [])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -172,7 +174,7 @@ def in_turn(cmd: list[str], env: dict, cwd, script: list[str], pairs: int) -> di
             if which == "this":
                 this.append(process_times(cmd, env, cwd))
             else:
-                theirs.append(process_times(script, cwd="/"))
+                theirs.append(process_times(script, installed_env(), cwd="/"))
     return paired(this, theirs)
 
 
@@ -185,9 +187,9 @@ def bench_vs_script(pairs: int = 5) -> dict:
     medians of the pairs' ratios (goal :data:`TARGET_OVER_SCRIPT`)."""
     script = [sys.executable, str(Path(__file__).with_name("minimal_casadi.py"))]
     with tempfile.TemporaryDirectory(prefix="wl_bench_opt_") as d:
-        env = {**os.environ, "WALKERLAB_CACHE_DIR": str(Path(d) / "cache"),
-               "PYTHONPATH": os.pathsep.join([str(_CONFIGS.parent),
-                                              os.environ.get("PYTHONPATH", "")])}
+        env = installed_env(WALKERLAB_CACHE_DIR=str(Path(d) / "cache"),
+                            PYTHONPATH=os.pathsep.join([str(_CONFIGS.parent),
+                                                        os.environ.get("PYTHONPATH", "")]))
         cmd = [sys.executable, "-m", "walkerlab.cli", "optimize",
                str(_CONFIGS / "compass_optimal.yaml"), "--runs-dir", str(Path(d) / "runs")]
         process_times(cmd, env, d)  # cold: the generated code, the fixed point
