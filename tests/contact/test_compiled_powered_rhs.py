@@ -3,7 +3,9 @@ reference arithmetic of walkerlab.models.contact.actuation.powered_rhs, on every
 actuated contact walker: the actuation is data of one compiled function, and it must give
 the same accelerations and ledger powers as the Python formulas (to rounding: 1e-12
 relative), with either leg in stance, a push-off pulse on, the ankle push-off on, and a heel
-strike carried in the data (the switch)."""
+strike carried in the data (the switch).  A virtual-constraint controller's torques are
+its compiled law's at the role state, written into the law block by the right-hand side
+generated for the pair (walkerlab.models.contact.virtual_constraints.compiled_rhs_module)."""
 
 from __future__ import annotations
 
@@ -33,6 +35,8 @@ CASES = {
                                                    "push_off": {"impulse_n_s": 0.5}}),
     "flat feet, ankle push-off": ("flat_feet_push_off", None),
     "free joints (RABBIT), phase laws": ("rabbit", None),
+    "three-link walker, virtual constraints": ("threelink_hzd", None),
+    "RABBIT, virtual constraints": ("rabbit_hzd", None),
 }
 QUICK = ("straight legs, push-off pulse",)
 
@@ -65,13 +69,13 @@ def test_the_compiled_powered_rhs_equals_the_reference_formulas(case):
         ref = np.concatenate([dx, pw])
         y = np.concatenate([x, np.zeros(data.ny - x.size)])
         out = np.empty(data.ny)
-        walker.kernels.powered_packed(0.25, y, data.data(stance, 0.1, push, ankle), out)
+        data.rhs(0.25, y, data.data(stance, 0.1, push, ankle), out)
         np.testing.assert_allclose(out, ref, rtol=1e-12, atol=1e-12 * np.max(np.abs(ref)))
         # the same with the heel strike at 0.2 s in the data: the other leg from then
         sw = np.empty(data.ny)
-        walker.kernels.powered_packed(0.25, y, data.data(1 - stance, 0.0, None, False, 0.2), sw)
+        data.rhs(0.25, y, data.data(1 - stance, 0.0, None, False, 0.2), sw)
         after = np.empty(data.ny)
-        walker.kernels.powered_packed(0.25, y, data.data(stance, 0.2), after)
+        data.rhs(0.25, y, data.data(stance, 0.2), after)
         np.testing.assert_array_equal(sw, after)
 
 

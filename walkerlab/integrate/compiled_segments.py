@@ -73,9 +73,9 @@ class CompiledSegments:
     def __init__(self, walker, data, solver, atol, grid):
         self.walker, self.pdata, self.solver, self.atol, self.grid = (walker, data, solver,
                                                                      atol, grid)
-        name = walker.kernels.__name__
+        name = data.module.__name__  # the walker's kernels (or its compiled-law module)
         if name not in _ADDRESS:
-            _ADDRESS[name] = walker.kernels.build_cyrk_powered()
+            _ADDRESS[name] = data.module.build_cyrk_powered()
         # a kernels stand-in for _cyrk.solve_chunk: the powered cfunc
         self.kernels = types.SimpleNamespace(__name__=f"{name}_powered",
                                              build_cyrk=lambda: _ADDRESS[name])

@@ -386,6 +386,7 @@ class VirtualConstraintController:
     def __getstate__(self):  # the compiled law is rebuilt (from the user cache) on first use
         state = dict(self.__dict__)
         state["_law"] = None
+        state.pop("_law_module", None)  # a module: set again with the law
         return state
 
     def _compiled_law(self):
@@ -402,12 +403,21 @@ class VirtualConstraintController:
                 mod = compiled_controller(*self._pieces_args)
                 if mod is not None:
                     self._law = mod.law
+                    self._law_module = mod
                     d = self.design  # numba compiles (or loads) on the first call: here
                     x0 = np.concatenate([d.q_plus, np.zeros(self.n)])
                     for x in (x0, x0.astype(complex)):  # real and complex states
                         self._law(x, d.alpha, d.theta_plus, d.theta_minus - d.theta_plus,
                                   self.B, 0.0, 0.0, -1.0)
         return self._law or None
+
+    def compiled_module(self):
+        """The generated numba module of the compiled law
+        (:func:`walkerlab.codegen.virtual_constraints.compiled_controller`: its ``law``),
+        or None where the numpy law runs (:meth:`_compiled_law`); for compiled code that
+        calls the law (the contact view's compiled right-hand side,
+        :mod:`walkerlab.models.contact.virtual_constraints`)."""
+        return getattr(self, "_law_module", None) if self._compiled_law() else None
 
     def _saturate(self, u):
         if self.limit is None:

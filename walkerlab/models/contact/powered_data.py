@@ -88,6 +88,13 @@ class PoweredData:
         head[27] = len(works)
         self.head = np.concatenate([head, works])
         self.ny = 2 * n + len(works)
+        #: the generated module of the compiled right-hand side: the walker's contact
+        #: kernels, or, for actuators with a compiled law of their own (virtual
+        #: constraints: ``powered_module``), a module calling it before them
+        self.module = getattr(acts, "powered_module", lambda w: w.kernels)(walker)
+        #: ``(t, y, d, dy)``: the compiled right-hand side as a numba function (the cfunc's
+        #: body; ``module.build_cyrk_powered()`` gives the cfunc's address)
+        self.rhs = getattr(self.module, "powered_packed_vc", None) or self.module.powered_packed
 
     def data(self, stance: int, t_origin: float, push: tuple[int, float] | None = None,
              ankle: bool = False, switch_s: float = np.inf, ghost: bool = False
