@@ -340,9 +340,9 @@ def test_every_shipped_powered_scene_runs_the_compiled_contact_run_or_says_why_n
     """A powered scene's contact run is the compiled one (``contact_solver.method:
     cyrk_bdf``, the run ``walkerlab bench powered`` times) when its actuators are data of the
     compiled right-hand side (:func:`walkerlab.models.contact.powered_data.powered_data`);
-    a scene on a ``solve_ivp`` method says why in the comment of its ``method:`` line (a
-    virtual-constraint controller is no compiled data: cyrk_bdf would run the same solve_ivp
-    run)."""
+    a scene on a ``solve_ivp`` method says why in the comment of its ``method:`` line (none
+    does since the virtual-constraint controller became compiled data: a replay's Python
+    callables would be the reason)."""
     from walkerlab.integrate._cyrk import CYRK_METHODS
     from walkerlab.models.contact.powered_data import powered_data
 

@@ -254,6 +254,7 @@ class ActuationHook:
         self.stance = 1  # leg2 carries the first stance (the contact model's convention)
         self.t_origin = float(grid[0])  # when the present step began [s]
         self.step_s = None  # the last step's duration [s] (none before the first strike)
+        self.t_strike = None  # the last heel strike's time [s] (none before the first)
         # a compiled run's next segment from before the last heel strike: (t, y, stance,
         # step start, ankle on) before it (None: from the present state)
         self.resume, self.segment = None, None
@@ -500,6 +501,7 @@ class ActuationHook:
     def _strike(self, t):
         """Heel strike at ``t`` [s]: the roles swap, the step's clock and ankle reset."""
         self.stance = 1 - self.stance
+        self.t_strike = t
         self.step_s = t - self.t_origin
         self.t_origin, self.ankle_on = t, False
 
