@@ -135,7 +135,7 @@ CONTROLLER_CONTACT = {"stiction_velocity_mm_per_s": 10.0, "friction_velocity_mm_
 #: 0.7 with mu = 0.6 pressed its foot to 0.46 (0.51 of mu_s = 0.9) before the heel strike
 #: and walked +8.4 % slow in MuJoCo; within 0.3 (a third) -1.06 % (contact model +1.21 %).
 CONTACT_CONE_FRACTION = 1.0 / 3.0
-#: Strides of a design's contact replay (12 steps: the strides cap's 13 heel strikes)
+#: Strides of a design's contact replay (12 heel strikes)
 REPLAY_STRIDES = 6
 
 
