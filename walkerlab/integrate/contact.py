@@ -368,14 +368,11 @@ def _run_hooked(hook, x0, t0, t1, limits, stop):
         if step == "end":
             break
         ta = hook.t
-        if step != "strike" or stop is None:
-            continue
-        # the heel strike just handled: not in the samples yet when the run stands at its
-        # touchdown (its state the touchdown event's root, the swing foot's penetration 0
-        # to rounding, which a sample-based count may take either way)
-        pending = 1 if hook.t == hook.t_strike else 0
-        if stop(*hook.samples(), pending=pending):
-            if pending:  # on to the next sample: the last heel strike in the samples
+        if step == "strike" and stop is not None and stop(*hook.samples()):
+            if hook.t == hook.t_strike:  # the run stands at the touchdown: on to its next
+                # sample, so that the samples show this heel strike (the touchdown event's
+                # root has the swing foot's penetration 0 to rounding: a count on the
+                # samples would take it either way)
                 after = grid_inside(hook.grid, hook.t, t1)
                 if hook.advance(float(after[0]) if after.size else t1, t1) == "end":
                     break
@@ -443,10 +440,10 @@ def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
     deadline : float
         ``time.perf_counter()`` value past which the run stops (``time_limit``).
     stop : callable or None
-        ``stop(t, X, pending=0) -> bool``, asked after each heel strike (strides cap):
-        ``pending`` the heel strikes made that the samples ``t``, ``X`` do not show yet
-        (the one just made, when the run stands at its touchdown); a run it stops goes on
-        to its next sample (the last heel strike in the samples).
+        ``stop(t, X) -> bool``, asked after each heel strike (strides cap) on the samples
+        so far (the heel strike just made not among them when the run stands at its
+        touchdown); a run it stops there goes on to its next sample, so that the samples
+        show that heel strike.
 
     Returns
     -------
@@ -481,9 +478,8 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
         the penetration depth, ~6e-5 m for the paper's contact), largest step.
     limits : ContactLimits
     stop : callable, optional
-        ``stop(t (n,), X (n, N), pending=0) -> bool``, asked after each chunk (a powered
-        walker's: after each heel strike, ``pending`` the heel strikes made that the samples
-        do not show yet, :func:`_run_hooked`); True ends the run with termination
+        ``stop(t (n,), X (n, N)) -> bool``, asked after each chunk (a powered walker's: after
+        each heel strike, :func:`_run_hooked`); True ends the run with termination
         ``heel_strike`` (the strides cap of :mod:`walkerlab.analysis.contact.sim`).
 
     Returns

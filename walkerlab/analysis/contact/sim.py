@@ -128,8 +128,8 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     limits = _with_heights(walker, limits or ContactLimits())
     stop = after = None
     if max_heel_strikes is not None:
-        def stop(t, X, pending=0):  # pending: heel strikes made, not in the samples yet
-            return heel_strike_count(walker, t, X, min_step_m, initial_stance) + pending \
+        def stop(t, X):
+            return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
                 >= max_heel_strikes
     powered = getattr(walker, "actuators", None) is not None
     if powered and t_more is not None and stop is not None:
@@ -256,8 +256,8 @@ def _go_on(walker, run, t_more: float, solver, limits, stop):
     sample until the cap or ``t_more`` [s]; the cap counts the heel strikes of both parts."""
     t0, X0 = run.t, run.X
 
-    def stop_all(t, X, pending=0):
-        return stop(np.concatenate([t0, t[1:]]), np.vstack([X0, X[1:]]), pending)
+    def stop_all(t, X):
+        return stop(np.concatenate([t0, t[1:]]), np.vstack([X0, X[1:]]))
 
     more = integrate_contact(walker, X0[-1], float(t0[-1]), t_more, solver, limits, stop_all)
     event = more.event
