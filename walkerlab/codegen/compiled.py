@@ -13,15 +13,31 @@ numba and CyRK are imported only when :meth:`CompiledFlow.address` is first call
 
 from __future__ import annotations
 
+import functools
+import hashlib
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from walkerlab.codegen import cache
 
 
+@functools.cache
+def rows_hash() -> str:
+    """sha256 (12 hex digits) of :mod:`walkerlab.integrate.rows_dop853`'s source (once per
+    process): the generated module's ``rows_kernels`` compile that loop into their own
+    machine code, which numba's cache keeps against the generated file alone, so the
+    file's name carries it (a changed loop: a new file, compiled afresh)."""
+    path = Path(__file__).parents[1] / "integrate" / "rows_dop853.py"
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:12]
+
+
 def compiled_module(structure):
-    """The imported compiled module of ``structure`` (generated on a cache miss).
+    """The imported compiled module of ``structure`` (generated on a cache miss; file
+    ``<key>_nb.py``, a flat foot's, or ``<key>_<rows_hash()>_nb.py``: the modules of
+    :func:`walkerlab.codegen.source.generate_compiled`, whose ``rows_kernels`` embed the
+    per-row integrator's loop).
 
     Raises
     ------
@@ -29,6 +45,7 @@ def compiled_module(structure):
         numba is not installed.
     """
     key = cache.cache_key(structure)
+    name = key if structure.foot == "flat" else f"{key}_{rows_hash()}"
 
     def build() -> str:
         if structure.foot == "flat":  # a flat foot's modes: their own generator
@@ -40,7 +57,7 @@ def compiled_module(structure):
         return codegen.generate_compiled(cache.derive_equations(structure),
                                          structure.param_names, key)
 
-    return cache.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)
+    return cache.import_generated(f"{name}_nb.py", f"walkerlab_compiled_{name}", build)
 
 
 @dataclass(frozen=True, eq=False)

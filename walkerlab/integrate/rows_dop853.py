@@ -51,11 +51,12 @@ from walkerlab.usercache import use_for_numba
 use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
 
 import numpy as np  # noqa: E402
-from numba import njit  # noqa: E402
+from numba import njit, types  # noqa: E402
+from numba.extending import overload  # noqa: E402
 from scipy.integrate import DOP853 as _SCIPY_DOP853  # noqa: E402
 
-__all__ = ["TIMEOUT", "FAILED", "cfuncs", "period_rows", "phase_rows", "reset_rows",
-           "walk_rows"]
+__all__ = ["TIMEOUT", "FAILED", "cfuncs", "kernels", "period_rows", "phase_rows",
+           "reset_rows", "walk_rows"]
 
 #: ``which`` of a row that reached its time cap / whose step size collapsed
 TIMEOUT, FAILED = -1, -2
@@ -81,6 +82,34 @@ def cfuncs(module, name: str, flow) -> tuple:
     return (flow, flow, flow, False)
 
 
+def _call(fn, dy, t, y, d):
+    """The flow ``fn`` of the walker at ``(t, y)`` (data vector ``d``) into ``dy``: a cfunc
+    ``(dy, t, y, d)`` on pointers, or an ``@njit`` function on the arrays (compiled into
+    its caller, specialised per function)."""
+    fn(dy.ctypes.data, t, y.ctypes.data, d.ctypes.data)  # pragma: no cover - compiled
+
+
+@overload(_call, inline="always", jit_options={"error_model": "numpy"})
+def _call_impl(fn, dy, t, y, d):  # pragma: no cover - compiled
+    if isinstance(fn, types.Dispatcher):
+        def on_arrays(fn, dy, t, y, d):
+            fn(dy, t, y, d)
+        return on_arrays
+
+    def on_pointers(fn, dy, t, y, d):
+        fn(dy.ctypes, t, y.ctypes, d.ctypes)
+    return on_pointers
+
+
+def kernels(module, name: str):
+    """``(walk_rows, phase_rows)`` specialised to the flow ``name`` of the compiled
+    ``module`` (its ``rows_kernels``: :func:`walk_rows` and :func:`phase_rows` given the
+    module's functions as ``@njit`` functions, their other arguments the same; the same
+    numbers bit for bit), or None for a module without them (then :func:`cfuncs`)."""
+    get = getattr(module, "rows_kernels", None)
+    return None if get is None else get(name)
+
+
 @njit(cache=True, error_model="numpy")
 def _guards(buf, m, gcols, goffs, g):  # pragma: no cover - compiled
     for j in range(gcols.size):
@@ -102,7 +131,7 @@ def _dense_at(F, y_old, x, out):  # pragma: no cover - compiled
         out[k] += y_old[k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _stage(fs, t, h, y, K, d, s, out):  # pragma: no cover - compiled
     """Stage ``s`` of the step (the flow ``fs``): its state ``out = y + h sum_j A[s, j]
     K[j]`` (j < s), its slope into ``K[s]``."""
@@ -111,10 +140,10 @@ def _stage(fs, t, h, y, K, d, s, out):  # pragma: no cover - compiled
         for j in range(s):
             acc += A[s, j] * K[j, k]
         out[k] = y[k] + h * acc
-    fs(K[s].ctypes, t + C[s] * h, out.ctypes, d.ctypes)
+    _call(fs, K[s], t + C[s] * h, out, d)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compiled
     """The 3 extra stages (flow ``fs``) and the interpolant's coefficients ``F`` (7, m)
     of the step."""
@@ -133,20 +162,20 @@ def _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compil
             F[3 + r, k] = h * acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _guard_at(f, fg, sel, t, y, d, buf, gcols, goffs, j, gv):  # pragma: no cover - compiled
     """Guard ``j``'s value at ``(t, y)``: by the guard cfunc ``fg`` alone when ``sel``,
     else from the flow ``f``'s extra outputs (the same value)."""
     if sel:
         buf[0] = gcols[j]
-        fg(buf.ctypes, t, y.ctypes, d.ctypes)
+        _call(fg, buf, t, y, d)
         return buf[0] + goffs[j]
-    f(buf.ctypes, t, y.ctypes, d.ctypes)
+    _call(f, buf, t, y, d)
     _guards(buf, y.size, gcols, goffs, gv)
     return gv[j]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _locate(f, fg, sel, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
             gv):  # pragma: no cover - compiled
     """Time of guard ``j``'s crossing in the step ``[t_old, t_old + h]`` (values ``g0``,
@@ -182,7 +211,7 @@ def _locate(f, fg, sel, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp
     return t_old + x * h
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
     """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)), its stages by the
     flow ``fs``: ``ynew`` and the FSAL evaluation by ``f`` (flow and extra outputs) into
@@ -195,7 +224,7 @@ def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - comp
         for j in range(NS):
             acc += B[j] * K[j, k]
         ynew[k] = y[k] + h * acc
-    f(K[NS].ctypes, t + h, ynew.ctypes, d.ctypes)
+    _call(f, K[NS], t + h, ynew, d)
     e5, e3 = 0.0, 0.0
     for k in range(m):
         sc = atol + rtol * max(abs(y[k]), abs(ynew[k]))
@@ -210,7 +239,7 @@ def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - comp
     return abs(h) * e5 / np.sqrt(e5 + 0.01 * e3)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _first_step(f, y, f0, d, buf, tmp, rtol, atol, span):  # pragma: no cover - compiled
     """scipy's ``select_initial_step`` (order 7, RMS norms)."""
     m = y.size
@@ -224,7 +253,7 @@ def _first_step(f, y, f0, d, buf, tmp, rtol, atol, span):  # pragma: no cover - 
     h0 = min(h0, span)
     for k in range(m):
         tmp[k] = y[k] + h0 * f0[k]
-    f(buf.ctypes, h0, tmp.ctypes, d.ctypes)
+    _call(f, buf, h0, tmp, d)
     d2 = 0.0
     for k in range(m):
         sc = atol + abs(y[k]) * rtol
@@ -247,7 +276,7 @@ def _work(m, n_out, ng):  # pragma: no cover - compiled
             np.empty(m), np.empty((3, ng)))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
          work, exact=False):  # pragma: no cover - compiled
     """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
@@ -262,7 +291,7 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
     K, F, buf, ynew, tmp, G = work
     g0, g1, gv = G[0], G[1], G[2]
     t, t_bound = 0.0, (cap if exact else cap + 1.0)
-    f(K[0].ctypes, t, y.ctypes, d.ctypes)
+    _call(f, K[0], t, y, d)
     _guards(K[0], m, gcols, goffs, g0)
     if h_first > 0.0:
         h_abs = min(h_first, t_bound)
@@ -316,7 +345,7 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
         t = t_new
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
                Yev, H, hs, hoff):  # pragma: no cover - compiled
     """Integrate every row of ``Y`` (N, m) [state units] with its data vector ``D[i]`` from
@@ -348,7 +377,7 @@ def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
         H[i] = h
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
                 Yev, H):  # pragma: no cover - compiled
     """:func:`phase_rows` over control periods: every row of ``Y`` (N, m) from phase time 0
@@ -375,11 +404,11 @@ def reset_rows(reset, X, D, out):  # pragma: no cover - compiled
         x = np.ascontiguousarray(X[i])
         d = np.ascontiguousarray(D[i])
         o = np.empty(X.shape[1])
-        reset(o.ctypes, 0.0, x.ctypes, d.ctypes)
+        _call(reset, o, 0.0, x, d)
         out[i] = o
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs,
               gout, rtol, atol, n_out, steps, fell, per_step,
               hoff):  # pragma: no cover - compiled
@@ -422,7 +451,7 @@ def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, gof
                     break
                 T += te
                 if gout[a + which] == 0:
-                    reset(x.ctypes, 0.0, yev.ctypes, d.ctypes)
+                    _call(reset, x, 0.0, yev, d)
                     steps[w] += 1
                     break
                 y[:] = yev
