@@ -532,53 +532,6 @@ def _stage_cfuncs(flows) -> list[str]:
             "    return _lazy('_guard_one')", ""]
 
 
-def _rows_kernels(flows) -> list[str]:
-    """``rows_kernels(name)``: the per-row DOP853 loops of
-    :mod:`walkerlab.integrate.rows_dop853` (``walk_rows``, ``phase_rows``) specialised to
-    the flow ``name``: entry points that pass the module's flow, plain flow, one-guard and
-    reset functions as ``@njit`` functions on arrays (numba compiles the loop once per
-    function it is given, so LLVM inlines the flow into the loop), compiled on first use
-    and kept by numba's cache (``cache=True``, this module's file; the loop's own source is
-    in the file's name, :func:`walkerlab.codegen.compiled.compiled_module`).  The loop is
-    rows_dop853's, written once: the entry points only name its arguments (read from its
-    signature here)."""
-    import inspect
-
-    from walkerlab.integrate import rows_dop853 as rows
-
-    lead = {"walk_rows": ("f", "fs", "fg", "sel", "reset"), "phase_rows": ("f", "fs", "fg", "sel")}
-    out = ["_rows = None  # walkerlab.integrate.rows_dop853: set by rows_kernels() (first use)",
-           "_NJ = njit(error_model='numpy')",
-           "_guard_one_nb = _NJ(_guard_one)", "_reset_flow_nb = _NJ(_reset_flow)"]
-    out += [ln for k in flows for ln in (f"_{k}_full_nb = _NJ(_{k}_full)",
-                                        f"_{k}_plain_nb = _NJ(_{k}_plain)")]
-    table = []
-    for k in flows:
-        fns = (f"_{k}_full_nb", f"_{k}_plain_nb", "_guard_one_nb", "True", "_reset_flow_nb")
-        names = []
-        for loop, first in lead.items():
-            params = list(inspect.signature(getattr(rows, loop).py_func).parameters)
-            assert tuple(params[:len(first)]) == first, (loop, params)
-            args = ", ".join(params[len(first):])
-            names.append(f"_{loop}_{k}")
-            out += ["", "", "@njit(cache=True, error_model='numpy')",
-                    f"def _{loop}_{k}({args}):  # pragma: no cover - runs compiled",
-                    f"    _rows.{loop}({', '.join(fns[:len(first)])}, {args})"]
-        table.append(f"{k!r}: ({', '.join(names)})")
-    return out + [
-        "", "",
-        "def rows_kernels(name):",
-        '    """``(walk_rows, phase_rows)`` of :mod:`walkerlab.integrate.rows_dop853` for the flow',
-        "    ``name``, specialised to this module's functions (their arguments after the",
-        '    functions\'; the same numbers bit for bit)."""',
-        "    global _rows",
-        "    if _rows is None:",
-        "        from walkerlab.integrate import rows_dop853",
-        "",
-        "        _rows = rows_dop853",
-        f"    return {{{', '.join(table)}}}[name]", ""]
-
-
 def generate_compiled(eq: Equations, param_names, key: str) -> str:
     """Source of the compiled module of a walker: numba ``cfunc`` right-hand sides for CyRK's
     C++ integrators (``CyRK.nb.numba_solver.cyjit_sig``), ``cache=True``.
@@ -595,9 +548,11 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     the per-row integrator (:mod:`walkerlab.integrate.rows_dop853`), made on first use:
     ``plain_flow(name)``, the flow ``name`` without the guard outputs (its stages), and
     ``guard_one()``, one guard's value (its crossing's location), the same lines and values
-    bit for bit; ``rows_kernels(name)``, that integrator's loops specialised to these
-    functions (:func:`_rows_kernels`).  The equations are those of :func:`generate` (same
-    expressions, same key).
+    bit for bit.  ``FLOWS`` names the flows and each flow's functions stay plain Python
+    functions too (``_<name>_full`` with the guard outputs, ``_<name>_plain``, beside
+    ``_guard_one`` and ``_reset_flow``): the per-row integrator's loops specialised to them
+    (:func:`walkerlab.codegen.compiled.rows_kernels`).  The equations are those of
+    :func:`generate` (same expressions, same key).
     """
     start_module(eq.params)
     flows = {"flow": eq}
@@ -630,7 +585,7 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     body += _guard_cfunc(eq, consts, guards)
     body += _stage_cfuncs(flows)
     body += _reset_cfunc(eq, consts, reset)
-    body += _rows_kernels(flows)
+    body += [f"FLOWS = {tuple(flows)!r}  # _<name>_full, _<name>_plain: plain functions", ""]
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
