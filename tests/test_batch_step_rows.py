@@ -160,7 +160,7 @@ def test_phase_rows_with_stage_cfuncs_equal_the_flow_alone(paper_map, paper_fixe
 @pytest.mark.parametrize("scene", ["paper.yaml", "kneed.yaml"])
 def test_loops_specialised_to_the_flow_give_the_cfunc_loops_numbers(scene):
     """The per-row loops compiled with the walker's flow inlined
-    (:func:`walkerlab.codegen.compiled.rows_kernels`) give the heel strikes, falls, states,
+    (:func:`walkerlab.integrate.rows_dop853.kernels`) give the heel strikes, falls, states,
     times and step sizes of the same loops calling the flow's cfuncs, bit for bit (the same
     operations in the same order: inlining changes no rounding), for whole walks (on slopes
     and on landing heights) and for single steps over every phase (the kneed walker: two
@@ -206,15 +206,15 @@ def test_the_kernels_file_is_named_by_the_loop_it_compiles(paper_walker):
     import hashlib
 
     from walkerlab.codegen import cache
-    from walkerlab.codegen.compiled import rows_hash, rows_kernels
+    from walkerlab.integrate.rows_dop853 import kernels, source_hash
 
     cf = paper_walker.phases[0].compiled
     src = (ROOT / "walkerlab" / "integrate" / "rows_dop853.py").read_bytes()
-    assert rows_hash() == hashlib.sha256(src).hexdigest()[:12]
-    walk, phase = rows_kernels(cf.structure, cf.name)
+    assert source_hash() == hashlib.sha256(src).hexdigest()[:12]
+    walk, phase = kernels(cf.structure, cf.name)
     key = cache.cache_key(cf.structure)
     for k in (walk, phase):
-        assert Path(k.py_func.__code__.co_filename).name == f"{key}_rows_{rows_hash()}_nb.py"
+        assert Path(k.py_func.__code__.co_filename).name == f"{key}_rows_{source_hash()}_nb.py"
     assert Path(compiled_module(cf.structure).__file__).name == f"{key}_nb.py"
 
 

@@ -4,10 +4,10 @@ The source comes from :func:`walkerlab.codegen.source.generate_compiled` (the sa
 equations as the Python module of :mod:`walkerlab.codegen.cache`) and is cached next to it as
 ``<key>_nb.py`` in the per-user cache (same key, same ownership/mode and sha256 checks,
 atomic write); the per-row integrator's loops specialised to its flows
-(:func:`rows_kernels`) in ``<key>_rows_<rows hash>_nb.py``.  Each is imported as a real
-module so that numba's own disk cache (``cache=True``, in ``<user cache>/numba``,
-:func:`walkerlab.usercache.use_for_numba`) keeps the machine code: a new process pays the
-numba import and a cache load, not a compile.
+(:func:`walkerlab.integrate.rows_dop853.kernels`) in ``<key>_rows_<hash>_nb.py``.  Each is
+imported as a real module so that numba's own disk cache (``cache=True``, in ``<user
+cache>/numba``, :func:`walkerlab.usercache.use_for_numba`) keeps the machine code: a new
+process pays the numba import and a cache load, not a compile.
 
 numba and CyRK are imported only when :meth:`CompiledFlow.address` is first called (the
 ``cyrk_compiled`` solver backend); building a walker does not import them.
@@ -15,10 +15,7 @@ numba and CyRK are imported only when :meth:`CompiledFlow.address` is first call
 
 from __future__ import annotations
 
-import functools
-import hashlib
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -46,76 +43,6 @@ def compiled_module(structure):
                                          structure.param_names, key)
 
     return cache.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)
-
-
-@functools.cache
-def rows_hash() -> str:
-    """sha256 (12 hex digits) of :mod:`walkerlab.integrate.rows_dop853`'s source (once per
-    process): :func:`rows_kernels` compile that loop into their own machine code, which
-    numba's cache keeps against the kernels' file alone, so the file's name carries it (a
-    changed loop: a new file, compiled afresh)."""
-    path = Path(__file__).parents[1] / "integrate" / "rows_dop853.py"
-    return hashlib.sha256(path.read_bytes()).hexdigest()[:12]
-
-
-#: the loops of :mod:`walkerlab.integrate.rows_dop853` specialised, and the functions they
-#: take first (the rest of their arguments are passed on as they are)
-_LOOPS = {"walk_rows": ("f", "fs", "fg", "sel", "reset"),
-          "phase_rows": ("f", "fs", "fg", "sel")}
-
-
-def kernels_source(module_name: str, flows) -> str:
-    """Source of the kernels module of the compiled module ``module_name`` (imported) with
-    the flows ``flows``: for each flow ``k`` and each loop of :data:`_LOOPS`, ``<loop>_<k>``,
-    an ``@njit(cache=True)`` entry point calling that loop of
-    :mod:`walkerlab.integrate.rows_dop853` with the module's ``_<k>_full``, ``_<k>_plain``,
-    ``_guard_one`` and ``_reset_flow`` made ``@njit`` functions on arrays, its other
-    arguments named as the loop names them (read from its signature)."""
-    import inspect
-
-    from walkerlab.integrate import rows_dop853 as rows
-
-    out = [f"# walkerlab per-row kernels of {module_name} (walkerlab.codegen.compiled); "
-           f"rows_dop853 {rows_hash()}",
-           "# Do not edit: regenerated when the model or walkerlab/integrate/rows_dop853.py "
-           "changes.",
-           "import sys", "", "from numba import njit", "",
-           "from walkerlab.integrate import rows_dop853 as _rows", "",
-           f"_m = sys.modules[{module_name!r}]",
-           "_NJ = njit(error_model='numpy')",
-           "_guard_one = _NJ(_m._guard_one)", "_reset_flow = _NJ(_m._reset_flow)"]
-    for k in flows:
-        out += [f"_{k}_full = _NJ(_m._{k}_full)", f"_{k}_plain = _NJ(_m._{k}_plain)"]
-    for k in flows:
-        fns = (f"_{k}_full", f"_{k}_plain", "_guard_one", "True", "_reset_flow")
-        for loop, first in _LOOPS.items():
-            params = list(inspect.signature(getattr(rows, loop).py_func).parameters)
-            if tuple(params[:len(first)]) != first:  # pragma: no cover - a changed loop
-                raise RuntimeError(f"rows_dop853.{loop}{tuple(params)}: not {first} first")
-            args = ", ".join(params[len(first):])
-            out += ["", "", "@njit(cache=True, error_model='numpy')",
-                    f"def {loop}_{k}({args}):  # pragma: no cover - runs compiled",
-                    f"    _rows.{loop}({', '.join(fns[:len(first)])}, {args})"]
-    return "\n".join(out) + "\n"
-
-
-def rows_kernels(structure, name: str) -> tuple | None:
-    """``(walk_rows, phase_rows)`` of :mod:`walkerlab.integrate.rows_dop853` specialised to
-    the flow ``name`` of ``structure``'s compiled module, or None for a module without the
-    plain functions they need (a flat foot's): :func:`kernels_source`'s entry points, their
-    arguments those of the loops after the functions, the same numbers bit for bit (the
-    flow inlined into the loop).  The kernels module is generated and imported once
-    (``<key>_rows_<rows_hash()>_nb.py`` beside the compiled module, the same checks) and
-    compiled on first call or loaded from numba's cache (``cache=True``: its file)."""
-    mod = compiled_module(structure)
-    flows = getattr(mod, "FLOWS", ())
-    if name not in flows:
-        return None
-    key = cache.cache_key(structure)
-    kern = cache.import_generated(f"{key}_rows_{rows_hash()}_nb.py",
-                                  f"walkerlab_rows_{key}_{rows_hash()}",
-                                  lambda: kernels_source(mod.__name__, flows))
-    return tuple(getattr(kern, f"{loop}_{name}") for loop in _LOOPS)
 
 
 @dataclass(frozen=True, eq=False)

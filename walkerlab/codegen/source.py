@@ -551,7 +551,7 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     bit for bit.  ``FLOWS`` names the flows and each flow's functions stay plain Python
     functions too (``_<name>_full`` with the guard outputs, ``_<name>_plain``, beside
     ``_guard_one`` and ``_reset_flow``): the per-row integrator's loops specialised to them
-    (:func:`walkerlab.codegen.compiled.rows_kernels`).  The equations are those of
+    (:func:`walkerlab.integrate.rows_dop853.kernels`).  The equations are those of
     :func:`generate` (same expressions, same key).
     """
     start_module(eq.params)

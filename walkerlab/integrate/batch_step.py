@@ -107,7 +107,7 @@ class BatchStepMap:
         A step longer than this ends as ``timeout`` (a fall: no heel strike) [s].
     specialised : bool
         Run the per-row loops specialised to the walker's flow where its compiled module
-        allows them (:func:`walkerlab.codegen.compiled.rows_kernels`: the flow inlined into
+        allows them (:func:`walkerlab.integrate.rows_dop853.kernels`: the flow inlined into
         the loop); False: the loops calling the flow's cfuncs.  The same numbers either way.
 
     Raises
@@ -299,16 +299,16 @@ class BatchStepMap:
 
     def _kernels(self, k: int):
         """Phase ``k``'s loops specialised to its flow
-        (:func:`walkerlab.codegen.compiled.rows_kernels`), or None (not :attr:`specialised`,
+        (:func:`walkerlab.integrate.rows_dop853.kernels`), or None (not :attr:`specialised`,
         or a module without them)."""
         if not self.specialised:
             return None
-        from walkerlab.codegen.compiled import rows_kernels
+        from walkerlab.integrate.rows_dop853 import kernels
 
         key = ("kernels", k)
         if key not in self._fns:
             cf = self.phases[k][0].compiled
-            self._fns[key] = rows_kernels(cf.structure, cf.name)
+            self._fns[key] = kernels(cf.structure, cf.name)
         return self._fns[key]
 
     def _guard_table(self):

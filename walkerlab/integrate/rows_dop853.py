@@ -16,7 +16,7 @@ extra outputs are the guards (``G[gcols] + goffs``).  Where the generated module
 (:func:`cfuncs`), a step's inner stages call the flow without its guard outputs and a
 crossing is located on one guard's cfunc: the same values bit for bit, fewer operations
 (the guards are needed only at the ends of a step).  Where the generated module has them
-(:func:`walkerlab.codegen.compiled.rows_kernels`), the same loops are compiled with that
+(:func:`kernels`), the same loops are compiled with that
 module's functions as ``@njit`` functions on arrays instead (:func:`_call` takes either kind): numba
 compiles a loop once per function it is given, so the flow is inlined into the loop
 (measured on the paper walker's Monte Carlo walks: ~40 % less CPU per heel strike than
@@ -58,13 +58,18 @@ from walkerlab.usercache import use_for_numba
 
 use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
 
+import functools  # noqa: E402
+import hashlib  # noqa: E402
+import inspect  # noqa: E402
+from pathlib import Path  # noqa: E402
+
 import numpy as np  # noqa: E402
 from numba import njit, types  # noqa: E402
 from numba.extending import overload  # noqa: E402
 from scipy.integrate import DOP853 as _SCIPY_DOP853  # noqa: E402
 
-__all__ = ["TIMEOUT", "FAILED", "cfuncs", "period_rows", "phase_rows", "reset_rows",
-           "walk_rows"]
+__all__ = ["TIMEOUT", "FAILED", "cfuncs", "kernels", "kernels_source", "period_rows",
+           "phase_rows", "reset_rows", "source_hash", "walk_rows"]
 
 #: ``which`` of a row that reached its time cap / whose step size collapsed
 TIMEOUT, FAILED = -1, -2
@@ -462,3 +467,72 @@ def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, gof
                 fell[w] = True
                 break
         X[w] = x
+
+
+@functools.cache
+def source_hash() -> str:
+    """sha256 (12 hex digits) of this module's source (once per process): :func:`kernels`
+    compile its loops into their own machine code, which numba's cache keeps against the
+    kernels' file alone, so the file's name carries it (a changed loop: a new file,
+    compiled afresh)."""
+    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:12]
+
+
+#: the loops :func:`kernels` specialises, each with the functions it takes first (its other
+#: arguments passed on as they are)
+_LOOPS = {"walk_rows": (walk_rows, ("f", "fs", "fg", "sel", "reset")),
+          "phase_rows": (phase_rows, ("f", "fs", "fg", "sel"))}
+
+
+def kernels_source(module_name: str, flows) -> str:
+    """Source of the kernels module of the compiled module ``module_name`` (imported; its
+    flows ``flows``): for each flow ``k`` and each loop of :data:`_LOOPS`, ``<loop>_<k>``,
+    an ``@njit(cache=True)`` entry point calling that loop of this module with the
+    compiled module's ``_<k>_full``, ``_<k>_plain``, ``_guard_one`` and ``_reset_flow``
+    made ``@njit`` functions on arrays, its other arguments named as the loop names them
+    (read from its signature)."""
+    out = [f"# walkerlab per-row kernels of {module_name} (walkerlab.integrate.rows_dop853 "
+           f"{source_hash()})",
+           "# Do not edit: regenerated when the model or walkerlab/integrate/rows_dop853.py "
+           "changes.",
+           "import sys", "", "from numba import njit", "",
+           "from walkerlab.integrate import rows_dop853 as _rows", "",
+           f"_m = sys.modules[{module_name!r}]",
+           "_NJ = njit(error_model='numpy')",
+           "_guard_one = _NJ(_m._guard_one)", "_reset_flow = _NJ(_m._reset_flow)"]
+    for k in flows:
+        out += [f"_{k}_full = _NJ(_m._{k}_full)", f"_{k}_plain = _NJ(_m._{k}_plain)"]
+    for k in flows:
+        fns = (f"_{k}_full", f"_{k}_plain", "_guard_one", "True", "_reset_flow")
+        for loop, (fn, first) in _LOOPS.items():
+            params = list(inspect.signature(fn.py_func).parameters)
+            if tuple(params[:len(first)]) != first:  # pragma: no cover - a changed loop
+                raise RuntimeError(f"rows_dop853.{loop}{tuple(params)}: not {first} first")
+            args = ", ".join(params[len(first):])
+            out += ["", "", "@njit(cache=True, error_model='numpy')",
+                    f"def {loop}_{k}({args}):  # pragma: no cover - runs compiled",
+                    f"    _rows.{loop}({', '.join(fns[:len(first)])}, {args})"]
+    return "\n".join(out) + "\n"
+
+
+def kernels(structure, name: str) -> tuple | None:
+    """``(walk_rows, phase_rows)`` specialised to the flow ``name`` of ``structure``'s
+    compiled module (:func:`walkerlab.codegen.compiled.compiled_module`), or None for a
+    module without the plain functions they need (a flat foot's): :func:`kernels_source`'s
+    entry points, their arguments those of :func:`walk_rows` and :func:`phase_rows` after
+    the functions, the same numbers bit for bit (the flow inlined into the loop).  The
+    kernels module is generated and imported once (``<key>_rows_<source_hash()>_nb.py``
+    beside the compiled module, :func:`walkerlab.codegen.cache.import_generated`'s checks)
+    and compiled on first call or loaded from numba's cache (``cache=True``: its file)."""
+    from walkerlab.codegen import cache
+    from walkerlab.codegen.compiled import compiled_module
+
+    mod = compiled_module(structure)
+    flows = getattr(mod, "FLOWS", ())
+    if name not in flows:
+        return None
+    key = cache.cache_key(structure)
+    kern = cache.import_generated(f"{key}_rows_{source_hash()}_nb.py",
+                                  f"walkerlab_rows_{key}_{source_hash()}",
+                                  lambda: kernels_source(mod.__name__, flows))
+    return tuple(getattr(kern, f"{loop}_{name}") for loop in _LOOPS)
