@@ -216,35 +216,3 @@ def test_the_kernels_file_is_named_by_the_loop_it_compiles(paper_walker):
     for k in (walk, phase):
         assert Path(k.py_func.__code__.co_filename).name == f"{key}_rows_{source_hash()}_nb.py"
     assert Path(compiled_module(cf.structure).__file__).name == f"{key}_nb.py"
-
-
-_LOAD = """
-import json, numpy as np
-from walkerlab.config import load_scene
-from walkerlab.integrate.batch_step import BatchStepMap
-from walkerlab.models.registry import build_walker
-from walkerlab.studies.mfpt import scene_walker_at
-sc = load_scene({scene!r})
-sm = BatchStepMap(build_walker(sc), scene_walker_at(sc), 1e-9, 1e-9)
-x = np.array([0.2, -0.2, -0.3, -1.2])
-r = sm.step(x[None], None)
-sm.walk(x[None], np.full((1, 2), sm.slope_rad))
-walk, phase = sm._kernels(0)
-print(json.dumps([sum(k.stats.cache_misses.values()) for k in (walk, phase)]))
-"""
-
-
-@pytest.mark.slow  # two processes
-def test_a_new_process_loads_the_specialised_loops_from_numbas_cache():
-    """The specialised loops are compiled once: a second process loads them from numba's
-    on-disk cache (no compile: none of its calls misses the cache), which needs them free of
-    process addresses (a function value handed from one compiled function to another)."""
-    import json
-    import subprocess
-    import sys
-
-    code = _LOAD.format(scene=str(ROOT / "configs" / "paper.yaml"))
-    for _ in range(2):
-        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                             check=True, cwd=ROOT)
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == [0, 0], out.stderr
