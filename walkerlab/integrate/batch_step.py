@@ -4,7 +4,9 @@ own slope: the workhorse of the metastability studies (:mod:`walkerlab.analysis.
 One step of ``N`` walkers: each row is integrated on its own, phase after phase, by a
 compiled DOP853 calling the walker's compiled flow (the numba ``cfunc`` of
 :class:`walkerlab.codegen.compiled.CompiledFlow`, the same generated equations as every other
-rigid integration) to its first guard crossing, located on the step's dense output
+rigid integration; where the generated module allows it, that loop compiled with the flow
+inlined, :func:`walkerlab.integrate.rows_dop853.kernels`, the same numbers) to its first
+guard crossing, located on the step's dense output
 (:func:`walkerlab.integrate.rows_dop853.phase_rows`: one compiled call per phase for all
 rows, so a row's numbers do not depend on the other rows of its batch); heel strikes are
 reset by the generated module's compiled reset (``reset_rows``) when it is the walker's own
