@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from walkerlab.analysis.gait.scene import solve_scene
 from walkerlab.codegen.compiled import compiled_module
 from walkerlab.config import load_scene
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
@@ -152,3 +153,66 @@ def test_phase_rows_with_stage_cfuncs_equal_the_flow_alone(paper_map, paper_fixe
         res.append((which, te, Yev, H))
     for a, b in zip(*res):
         np.testing.assert_array_equal(a, b)
+
+
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
+@pytest.mark.parametrize("scene", ["paper.yaml", "kneed.yaml"])
+def test_loops_specialised_to_the_flow_give_the_cfunc_loops_numbers(scene):
+    """The per-row loops compiled with the walker's flow inlined
+    (:func:`walkerlab.integrate.rows_dop853.kernels`) give the heel strikes, falls, states,
+    times and step sizes of the same loops calling the flow's cfuncs, bit for bit (the same
+    operations in the same order: inlining changes no rounding), for whole walks (on slopes
+    and on landing heights) and for single steps over every phase (the kneed walker: two
+    flows, a knee strike between them)."""
+    from walkerlab.models.hybrid.ground import with_clearance_guard
+    from walkerlab.walker.description import walker_data
+
+    sc = load_scene(ROOT / "configs" / scene)
+    w = build_walker(sc)
+    w_hts = with_clearance_guard(w, walker_data(sc.walker, sc.slope.phi_rad))
+    maps = [[BatchStepMap(wk, scene_walker_at(sc), 1e-9, 1e-9, specialised=s)
+             for wk in (w, w_hts)] for s in (True, False)]
+    assert all(maps[0][0]._kernels(k) is not None for k in range(len(w.phases)))
+    assert all(maps[1][0]._kernels(k) is None for k in range(len(w.phases)))
+    rng = np.random.default_rng(3)
+    x0 = np.asarray(solve_scene(sc, fd_check=False)[1].gait.result.x, float)
+    gam = maps[0][0].slope_rad + 0.006 * rng.standard_normal((30, 10))
+    hts = 0.002 * rng.standard_normal((30, 10))
+    X = x0 + 0.005 * rng.standard_normal((30, x0.size))
+    got = []
+    for sm, sm_hts in maps:
+        out = [sm.step(X, gam[:, 0])]
+        if sm.can_walk:
+            out.append(sm.walk(np.tile(x0, (30, 1)), gam))
+            out.append(sm_hts.walk(np.tile(x0, (30, 1)), gam, hts))
+        got.append(out)
+    a, b = got
+    np.testing.assert_array_equal(a[0].outcome, b[0].outcome)
+    for k in ("x_pre", "x_next", "step_time_s"):
+        np.testing.assert_array_equal(getattr(a[0], k), getattr(b[0], k))
+    assert (a[0].outcome == HEEL_STRIKE).sum() >= 20
+    for wa, wb in zip(a[1:], b[1:]):
+        for u, v in zip(wa, wb):
+            np.testing.assert_array_equal(u, v)
+        assert 0 < wa[1].sum() < 30  # walks that fall and walks that do not
+
+
+def test_the_kernels_file_is_named_by_the_loop_it_compiles(paper_walker):
+    """The specialised loops live in a generated file whose name carries the sha256 of
+    ``rows_dop853.py`` (numba's cache checks only the file a function is in: a changed loop
+    must be a new file, not stale machine code) and the model's cache key; the compiled
+    model's own file does not (editing the loop does not re-derive the model)."""
+    import hashlib
+
+    from walkerlab.codegen import cache
+    from walkerlab.integrate.rows_dop853 import kernels, source_hash
+
+    cf = paper_walker.phases[0].compiled
+    src = (ROOT / "walkerlab" / "integrate" / "rows_dop853.py").read_bytes()
+    assert source_hash() == hashlib.sha256(src).hexdigest()[:12]
+    walk, phase = kernels(cf.structure, cf.name)
+    key = cache.cache_key(cf.structure)
+    for k in (walk, phase):
+        assert Path(k.py_func.__code__.co_filename).name == f"{key}_rows_{source_hash()}_nb.py"
+    assert Path(compiled_module(cf.structure).__file__).name == f"{key}_nb.py"

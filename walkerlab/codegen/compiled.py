@@ -3,9 +3,11 @@
 The source comes from :func:`walkerlab.codegen.source.generate_compiled` (the same symbolic
 equations as the Python module of :mod:`walkerlab.codegen.cache`) and is cached next to it as
 ``<key>_nb.py`` in the per-user cache (same key, same ownership/mode and sha256 checks,
-atomic write).  It is imported as a real module so that numba's own disk cache
-(``cache=True``, in ``<user cache>/numba``, :func:`walkerlab.usercache.use_for_numba`) keeps
-the machine code: a new process pays the numba import and a cache load, not a compile.
+atomic write); the per-row integrator's loops specialised to its flows
+(:func:`walkerlab.integrate.rows_dop853.kernels`) in ``<key>_rows_<hash>_nb.py``.  Each is
+imported as a real module so that numba's own disk cache (``cache=True``, in ``<user
+cache>/numba``, :func:`walkerlab.usercache.use_for_numba`) keeps the machine code: a new
+process pays the numba import and a cache load, not a compile.
 
 numba and CyRK are imported only when :meth:`CompiledFlow.address` is first called (the
 ``cyrk_compiled`` solver backend); building a walker does not import them.

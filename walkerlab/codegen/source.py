@@ -548,7 +548,11 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     the per-row integrator (:mod:`walkerlab.integrate.rows_dop853`), made on first use:
     ``plain_flow(name)``, the flow ``name`` without the guard outputs (its stages), and
     ``guard_one()``, one guard's value (its crossing's location), the same lines and values
-    bit for bit.  The equations are those of :func:`generate` (same expressions, same key).
+    bit for bit.  ``FLOWS`` names the flows and each flow's functions stay plain Python
+    functions too (``_<name>_full`` with the guard outputs, ``_<name>_plain``, beside
+    ``_guard_one`` and ``_reset_flow``): the per-row integrator's loops specialised to them
+    (:func:`walkerlab.integrate.rows_dop853.kernels`).  The equations are those of
+    :func:`generate` (same expressions, same key).
     """
     start_module(eq.params)
     flows = {"flow": eq}
@@ -573,13 +577,15 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
             "    for i in range(P.shape[0]):",
             "        out[i] = _constants_jit(P[i])",
             "    return out", ""]
-    for k, e in flows.items():
-        body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
+    for k, e in flows.items():  # the flow: a plain function, its cfunc, its njit (kernels)
+        body += _cfunc(f"_{k}_full", e, consts, parts[k], False, guards, lazy=True) + [""]
+        body += [f"{k} = cfunc(SIG, cache=True, error_model='numpy')(_{k}_full)", ""]
         body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
         body += _cfunc(f"_{k}_plain", e, consts, parts[k], False, None, lazy=True) + [""]
     body += _guard_cfunc(eq, consts, guards)
     body += _stage_cfuncs(flows)
     body += _reset_cfunc(eq, consts, reset)
+    body += [f"FLOWS = {tuple(flows)!r}  # _<name>_full, _<name>_plain: plain functions", ""]
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",

@@ -4,7 +4,9 @@ own slope: the workhorse of the metastability studies (:mod:`walkerlab.analysis.
 One step of ``N`` walkers: each row is integrated on its own, phase after phase, by a
 compiled DOP853 calling the walker's compiled flow (the numba ``cfunc`` of
 :class:`walkerlab.codegen.compiled.CompiledFlow`, the same generated equations as every other
-rigid integration) to its first guard crossing, located on the step's dense output
+rigid integration; where the generated module allows it, that loop compiled with the flow
+inlined, :func:`walkerlab.integrate.rows_dop853.kernels`, the same numbers) to its first
+guard crossing, located on the step's dense output
 (:func:`walkerlab.integrate.rows_dop853.phase_rows`: one compiled call per phase for all
 rows, so a row's numbers do not depend on the other rows of its batch); heel strikes are
 reset by the generated module's compiled reset (``reset_rows``) when it is the walker's own
@@ -105,6 +107,10 @@ class BatchStepMap:
         Per-walker tolerances of DOP853 (see the module docstring).
     max_step_time_s : float
         A step longer than this ends as ``timeout`` (a fall: no heel strike) [s].
+    specialised : bool
+        Run the per-row loops specialised to the walker's flow where its compiled module
+        allows them (:func:`walkerlab.integrate.rows_dop853.kernels`: the flow inlined into
+        the loop); False: the loops calling the flow's cfuncs.  The same numbers either way.
 
     Raises
     ------
@@ -115,10 +121,11 @@ class BatchStepMap:
     """
 
     def __init__(self, walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,
-                 max_step_time_s: float = 5.0):
+                 max_step_time_s: float = 5.0, specialised: bool = True):
         from walkerlab.codegen.compiled import compiled_module
 
         self.walker, self.walker_at = walker, walker_at
+        self.specialised = specialised
         self.rtol, self.atol, self.max_step_time_s = rtol, atol, max_step_time_s
         self.n = walker.layout().size
         self.phases = []
@@ -162,7 +169,7 @@ class BatchStepMap:
         #: rows integrated by the compiled per-row integrator (phases), for the record
         self.integrated = 0
         self._walkers: dict[float, object] = {}
-        self._fns: dict[int, tuple] = {}  # the per-row integrator's cfuncs, by phase
+        self._fns: dict = {}  # the per-row integrator's cfuncs (by phase) and kernels
 
     # -- slope handling -------------------------------------------------------------------
     def _probe_slope_dependence(self) -> bool:
@@ -255,9 +262,13 @@ class BatchStepMap:
         fell = np.zeros(W, np.bool_)
         hoff = (np.zeros((1, 1)) if height_m is None else
                 self._height_offsets(height_m, gamma).reshape(W, S))
-        walk_rows(*self._cfuncs(0), self._reset_flow, X, D, S, float(self.max_step_time_s),
-                  *g, float(self.rtol), float(self.atol), self.n + self.phases[0][2], steps,
-                  fell, height_m is not None, hoff)
+        args = (X, D, S, float(self.max_step_time_s), *g, float(self.rtol), float(self.atol),
+                self.n + self.phases[0][2], steps, fell, height_m is not None, hoff)
+        kern = self._kernels(0)
+        if kern is not None:  # (its reset: the module's, as self._reset_flow is)
+            kern[0](*args)
+        else:
+            walk_rows(*self._cfuncs(0), self._reset_flow, *args)
         return steps, fell, X
 
     def _height_offsets(self, height_m, gamma) -> np.ndarray:
@@ -287,6 +298,20 @@ class BatchStepMap:
             cf = ph[0].compiled
             self._fns[k] = cfuncs(compiled_module(cf.structure), cf.name, ph[1])
         return self._fns[k]
+
+    def _kernels(self, k: int):
+        """Phase ``k``'s loops specialised to its flow
+        (:func:`walkerlab.integrate.rows_dop853.kernels`), or None (not :attr:`specialised`,
+        or a module without them)."""
+        if not self.specialised:
+            return None
+        from walkerlab.integrate.rows_dop853 import kernels
+
+        key = ("kernels", k)
+        if key not in self._fns:
+            cf = self.phases[k][0].compiled
+            self._fns[key] = kernels(cf.structure, cf.name)
+        return self._fns[key]
 
     def _guard_table(self):
         """``(gstart, gcols, goffs, dirs, gout)``: every phase's guards in flat arrays."""
@@ -462,11 +487,15 @@ class BatchStepMap:
         H = self._h_rows[rows]
         hoff = getattr(self, "_hoff", None)
         hs = self._hs_phase[k] if hoff is not None else -1
-        phase_rows(*self._cfuncs(k), np.ascontiguousarray(Y, dtype=float),
-                   np.ascontiguousarray(Dk),
-                   np.ascontiguousarray(cap, dtype=float), self._gcols[k], self._goffs[k],
-                   self._dirs[k], float(self.rtol), float(self.atol), m + n_extra, which, te,
-                   Yev, H, hs, hoff[rows] if hs >= 0 else np.zeros(1))
+        args = (np.ascontiguousarray(Y, dtype=float), np.ascontiguousarray(Dk),
+                np.ascontiguousarray(cap, dtype=float), self._gcols[k], self._goffs[k],
+                self._dirs[k], float(self.rtol), float(self.atol), m + n_extra, which, te,
+                Yev, H, hs, hoff[rows] if hs >= 0 else np.zeros(1))
+        kern = self._kernels(k)
+        if kern is not None:
+            kern[1](*args)
+        else:
+            phase_rows(*self._cfuncs(k), *args)
         self._h_rows[rows] = H
         out.outcome[rows[which == FAILED]] = SOLVER_FAILURE  # (TIMEOUT: already set)
         self.integrated += N
