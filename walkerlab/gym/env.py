@@ -103,7 +103,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv"]
+__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
+           "end_periods"]
 
 #: the largest ``start_noise``: the start's rates times ``1 + U(-1, 1)`` (from rest to twice
 #: the gait's rates; beyond, rates change sign)
@@ -757,34 +758,35 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     n = len(envs)
     X = np.array([v.x for v in views])
     m = X.shape[1]
+    t = np.array([v.t for v in views], dtype=np.float64)
     obs = np.empty((n, m + 3))
     obs[:, :m] = X
     obs[:, m] = [v.leg == "leg1" for v in views]
     obs[:, m + 1] = [v.k for v in views]
-    obs[:, m + 2] = np.array([v.t for v in views]) - np.array([v.t_step for v in views])
+    obs[:, m + 2] = t - np.array([v.t_step for v in views])
     np.clip(obs, p["low"], p["high"], out=obs)
-    hip = hip_xs(views)
+    hip = hip_xs(views, X)
     for e, h in zip(envs, hip.tolist()):
         e._hip_x = h  # the next period's start (its reward's origin)
     ended = [v.ended for v in views]
-    terminated = np.array([bool(s) for s in ended])
-    elapsed = np.array([e._elapsed for e in envs])
+    terminated = np.array([s != "" for s in ended], dtype=np.bool_)
     limit = p["limit"]
-    truncated = ~terminated & (limit >= 0) & (elapsed >= limit)
-    ledger = {k: np.array([v.ledger[k] for v in views]) for k in views[0].ledger}
+    truncated = ~terminated & (limit >= 0) & (np.array([e._elapsed for e in envs]) >= limit)
+    terms = list(views[0].ledger)
+    L = np.array([[v.ledger[k] for k in terms] for v in views], dtype=np.float64).T.copy()
     dt = p["dt"]
     reward = (p["fw"] * (hip - x_before) / dt
               + np.where(terminated, 0.0, p["healthy"])
-              - p["cw"] * np.sum((U / p["tau"]) ** 2, axis=1)
-              - p["ww"] * (ledger["action_work_positive"] - w_before) / dt)
-    columns = {"time_s": np.array([v.t for v in views], dtype=np.float64),
+              - p["cw"] * np.add.reduce((U / p["tau"]) ** 2, axis=1)
+              - p["ww"] * (L[terms.index("action_work_positive")] - w_before) / dt)
+    columns = {"time_s": t,
                "heel_strike": [bool(s) for s in strikes],
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
-               "heel_strike_times_s": [[float(t) for t in s] for s in strikes],
+               "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
                "steps": [int(v.steps) for v in views],
                "stance_leg": [v.leg for v in views], "hip_x_m": hip,
                "termination": ended,
                "solver_message": [str(getattr(v, "failure", "")) for v in views],
                "terrain_seed": [int(e.terrain_seed) for e in envs]}
-    columns.update({f"ledger_{k}": a for k, a in ledger.items()})
+    columns.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
     return obs, reward, terminated, truncated, columns

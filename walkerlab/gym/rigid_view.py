@@ -406,7 +406,7 @@ class RigidView:
         w = self.walker
         acts = self.acts[self.leg]
         acts.u = np.asarray(u, dtype=float)
-        act_on = bool(acts.u.any())
+        act_on = np.count_nonzero(acts.u) > 0
         phase = w.phases[self.k]
         for g in phase.guards:  # a fall guard already violated as the phase begins
             if (g.at_entry and g.outcome == "fall"
@@ -461,7 +461,7 @@ class RigidView:
         if self.ground is not None:
             self._pieces.append((phase, run.dense, (self.t, run.t_last)))
         self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-        if run.failed or not np.isfinite(self.x).all():
+        if run.failed or not np.logical_and.reduce(np.isfinite(self.x)):
             self.ended = "solver_failure"
             return strikes
         if run.event is None:
@@ -565,7 +565,7 @@ def _hips(points, X: np.ndarray):
     return np.asarray(points(X.T)["hip"], float)[0]
 
 
-def hip_xs(views) -> np.ndarray:
+def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
     """:meth:`RigidView.hip_x` of every view in ``views`` (N), the views whose step walkers
     share a ``points`` function in one call of it where it takes states as columns (the
     same numbers).
@@ -573,6 +573,8 @@ def hip_xs(views) -> np.ndarray:
     Parameters
     ----------
     views : sequence of RigidView
+    X : ndarray (N, 2n), optional
+        Their states (``views[i].x``), when already stacked.
 
     Returns
     -------
@@ -584,8 +586,12 @@ def hip_xs(views) -> np.ndarray:
     for i, v in enumerate(views):
         groups.setdefault(id(v.walker.points), []).append(i)
     for rows in groups.values():
-        hx = (_hips(views[rows[0]].walker.points, np.array([views[i].x for i in rows]))
-              if len(rows) > 1 else None)
+        if len(rows) < 2:
+            hx = None
+        elif X is not None and len(rows) == len(views):
+            hx = _hips(views[rows[0]].walker.points, X)
+        else:
+            hx = _hips(views[rows[0]].walker.points, np.array([views[i].x for i in rows]))
         if hx is None:
             out[rows] = [views[i].hip_x() for i in rows]
         else:

@@ -10,14 +10,21 @@ observations, rewards, flags and infos are those of ``gymnasium.make_vec(...,
 vectorization_mode="sync")``, bit for bit with ``batched=False``, and with the batched
 step (the default) to round-off (the same falls, resets and heel strikes).
 
-The physics of one call is :meth:`WalkerVectorEnv._step_all`: each
-:class:`~walkerlab.gym.env.WalkerEnv` (built as ``gym.make``'s entry point builds it:
-:func:`~walkerlab.gym.env.registered_env`) begins its period, the rigid view's walkers are
-advanced together (:func:`walkerlab.gym.rigid_rows.advance_rows`: their compiled pieces in
-one compiled call per flow), and each ends its period; the contact view, or
-``batched=False``, steps them one after another.  The time limit, the autoreset and the
-batching of the infos are this class's own and know nothing of the walker (its sizes are
-its spaces').
+The physics of one call is :meth:`WalkerVectorEnv._step_all`: the rigid view's walkers
+(built as ``gym.make``'s entry point builds each :class:`~walkerlab.gym.env.WalkerEnv`:
+:func:`~walkerlab.gym.env.registered_env`) are stepped as arrays over the walkers - the
+held torques of all of them scaled and clipped at once
+(:func:`~walkerlab.gym.env.begin_periods`), their compiled pieces advanced together
+(:func:`walkerlab.gym.rigid_rows.advance_rows`: one compiled call per flow), their
+observations, rewards, flags and ledger read at once and their infos kept as columns
+(:func:`~walkerlab.gym.env.end_periods`), batched straight into gymnasium's form (an array
+and a mask ``_key`` per key, as ``VectorEnv._add_info`` batches N dicts, without building
+them); the same element-wise operations as each walker's own ``step``, so that these
+numbers are those of each walker ending its own period on the same physics, bit for bit.
+A ``reward_fn`` (it is given each walker's info dict) has each walker begin and end its
+own period around the batched physics; the contact view, or ``batched=False``, steps them
+one after another.  The time limit, the autoreset and the batching of the infos are this
+class's own and know nothing of the walker (its sizes are its spaces').
 """
 
 from __future__ import annotations
@@ -30,8 +37,15 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, create_empty_array
 
-from .env import (DEFAULT_EPISODE_STEPS, InvalidAction, WalkerEnv, batch_parameters,
-                  begin_periods, end_periods, registered_env)
+from .env import (
+    DEFAULT_EPISODE_STEPS,
+    InvalidAction,
+    WalkerEnv,
+    batch_parameters,
+    begin_periods,
+    end_periods,
+    registered_env,
+)
 
 __all__ = ["WalkerVectorEnv"]
 
