@@ -334,3 +334,151 @@ def test_batched_native_form_steps_flat_feet_one_by_one_as_sync():
             _same(u, v, f"output {k}, item {j}")
     sync.close()
     native.close()
+
+
+def _walker_by_walker(env, monkeypatch):
+    """``env``'s batched step with each walker beginning and ending its own period
+    (``WalkerEnv.begin_period``/``end_period``: the physics the same batched call) and the
+    infos batched by gymnasium's own ``VectorEnv._add_info``, one sub-env at a time."""
+    import walkerlab.gym.vector as vector
+
+    monkeypatch.setattr(vector, "batch_parameters", lambda envs: None)
+
+    def add_info(stepped, resets):
+        out: dict = {}
+        for i, info in enumerate(env._info_dicts(stepped, resets)):
+            out = env._add_info(out, info, i)
+        return out
+    monkeypatch.setattr(env, "_batched_infos", add_info)
+
+
+def _arrays_and_one_by_one(monkeypatch, scene, mode, steps, scale=0.1, n=3, **kw):
+    """Both forms of ``_native(n, scene, ...)`` through ``steps`` random actions (times
+    ``scale``; the last sub-env pushed over: it falls), every output compared bit for
+    bit."""
+    arrays = _native(n, scene, autoreset_mode=mode, **kw)
+    one = _native(n, scene, autoreset_mode=mode, **kw)
+    actions = _random_actions(arrays, steps) * scale
+    actions[:, -1] = 0.6 + 0.4 * np.abs(actions[:, -1])
+    a = _run(arrays, actions, 3, mode)
+    with monkeypatch.context() as mp:
+        _walker_by_walker(one, mp)
+        b = _run(one, actions, 3, mode)
+    for k, (x, y) in enumerate(zip(a, b, strict=True)):
+        for j, (u, v) in enumerate(zip(x, y, strict=True)):
+            _same(u, v, f"output {k}, item {j}")
+            if isinstance(u, dict):
+                assert list(u) == list(v), f"output {k}: the keys' order"
+    arrays.close()
+    one.close()
+    return a
+
+
+@pytest.mark.parametrize("mode", ["NextStep", "SameStep", "Disabled"])
+def test_array_step_equals_each_walker_ending_its_period_bit_for_bit(monkeypatch, mode):
+    """The batched step's walkers begun and ended as arrays over the walkers (held torques,
+    observations, rewards, flags, infos batched from columns) give the numbers of each
+    walker's own ``begin_period``/``end_period`` on the same batched physics, and infos
+    equal to gymnasium's ``_add_info`` batching of each walker's dict, bit for bit: falls,
+    heel strikes, the time limit (66) and their autoresets included."""
+    out = _arrays_and_one_by_one(monkeypatch, "threelink_hzd", mode, 70, n=2,
+                                 max_episode_steps=66, start_noise=0.1)
+    steps = [o for o in out if len(o) == 5]
+    assert np.array([o[2] for o in steps]).any() and np.array([o[3] for o in steps]).any()
+    assert any(o[4]["heel_strike"].any() for o in steps)
+
+
+@pytest.mark.slow
+def test_batched_infos_equal_gymnasiums_add_info_batching_over_300_steps_with_autoresets(
+        monkeypatch):
+    """300 periods of three walkers under random actions (one pushed over: falls and
+    autoresets on the next step), the time limit 100: every output of the array step equals
+    the walker-by-walker step's with gymnasium's ``_add_info`` batching, bit for bit, both
+    forms of ``heel_strike_time_s`` (None first: objects; a number first: NaN) met."""
+    out = _arrays_and_one_by_one(monkeypatch, "threelink_hzd", "NextStep", 300,
+                                 max_episode_steps=100, start_noise=0.1)
+    kinds = {o[4]["heel_strike_time_s"].dtype.kind for o in out[1:]}
+    assert kinds == {"O", "f"}
+
+
+@pytest.mark.parametrize("kw", [{"policy": "scene"}, {"normalize_action": False},
+                                {"ctrl_cost_weight": 0.3, "work_cost_weight": 0.05}])
+def test_array_step_takes_the_scene_policy_raw_torques_and_reward_weights(monkeypatch, kw):
+    """The scene's controller added to each action, actions in N m, and other reward
+    weights: the array step equals each walker's own ending of its period bit for bit."""
+    _arrays_and_one_by_one(monkeypatch, "threelink_hzd", "NextStep", 15, scale=1.0,
+                           max_episode_steps=10, **kw)
+
+
+def test_a_reward_fn_steps_the_batch_walker_by_walker():
+    """A ``reward_fn`` (given each walker's info dict) leaves the array step: the batched
+    physics with each walker ending its own period, equal to sync's to round-off."""
+    def reward_fn(env, info):
+        return info["hip_x_m"] + 10.0 * info["heel_strike"]
+
+    sync = _vec("sync", 2, "threelink_hzd", reward_fn=reward_fn, max_episode_steps=10)
+    native = _native(2, "threelink_hzd", reward_fn=reward_fn, max_episode_steps=10)
+    assert native._batch_parameters() is None
+    actions = _random_actions(sync, 12)
+    a, b = _run(sync, actions, 1), _run(native, actions, 1)
+    for k, (x, y) in enumerate(zip(a, b, strict=True)):
+        for j, (u, v) in enumerate(zip(x, y, strict=True)):
+            _same(u, v, f"output {k}, item {j}", 1e-9)
+    sync.close()
+    native.close()
+
+
+def test_set_attr_is_read_by_the_next_array_step():
+    """Weights changed by ``set_attr`` between steps: the array step reads them again
+    (each walker's own reward, walker by walker, the same numbers)."""
+    env = _native(2, "threelink_hzd")
+    env.reset(seed=0)
+    zero = np.zeros(env.action_space.shape, np.float32)
+    env.step(zero)
+    env.set_attr("weights", [(0.0, 5.0, 0.0, 0.0), (0.0, 7.0, 0.0, 0.0)])
+    _, r, term, _, _ = env.step(zero)
+    assert not term.any() and r.tolist() == [5.0, 7.0]
+    env.close()
+
+
+def test_hip_xs_are_each_views_hip_x_bit_for_bit():
+    """The hips of many rigid walkers from one call of the step walker's ``points`` on the
+    states as columns equal each walker's own, bit for bit; a ``points`` of one state only
+    is called state by state."""
+    from walkerlab.gym.rigid_view import _hips, hip_xs
+
+    env = _native(4, "threelink_hzd", start_noise=0.3)
+    env.reset(seed=2)
+    for _ in range(30):
+        env.step(_random_actions(env, 1)[0] * 0.2)
+    views = [e.sim for e in env.envs]
+    np.testing.assert_array_equal(hip_xs(views), [v.hip_x() for v in views])
+    np.testing.assert_array_equal(hip_xs(views[1:3]), [v.hip_x() for v in views[1:3]])
+    points = views[0].walker.points
+
+    def one_state(x):
+        if np.ndim(x) != 1:
+            raise ValueError("one state")
+        return points(x)
+    assert _hips(one_state, np.array([v.x for v in views])) is None
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene", ["rabbit_hzd", "paper"])
+def test_batched_native_form_walks_rabbit_and_a_passive_walker_as_sync(scene):
+    """RABBIT (five links, its controller out: it falls) and the passive compass walker:
+    the batched array step's outputs equal sync's to round-off over 40 periods of random
+    actions and autoresets (the same falls, resets and heel strikes)."""
+    n, steps = 3, 40
+    kw = dict(max_episode_steps=15, start_noise=0.05)
+    sync = _vec("sync", n, scene, **kw)
+    native = _native(n, scene, **kw)
+    actions = _random_actions(sync, steps) * 0.3
+    a, b = _run(sync, actions, 2), _run(native, actions, 2)
+    for k, (x, y) in enumerate(zip(a, b, strict=True)):
+        for j, (u, v) in enumerate(zip(x, y, strict=True)):
+            _same(u, v, f"output {k}, item {j}", 1e-9)
+    assert np.array([o[3] for o in a[1:]]).any()
+    sync.close()
+    native.close()

@@ -294,8 +294,24 @@ class ActuatedFlow(CompiledFlow):
     def data(self) -> np.ndarray:
         """Constants, the law block (with the present step's start time) and a zeroed
         call counter."""
+        out = np.empty(self.data_size())
+        self.data_into(out)
+        return out
+
+    def data_size(self) -> int:
+        """The length of :meth:`data`'s vector."""
         if "consts" not in self._memo:
             self._memo["consts"] = self.module().constants(self.params)
-        laws = self.laws.copy()
-        laws[2] = float(getattr(self.actuators, "t_origin", 0.0))
-        return np.concatenate([self._memo["consts"], laws, [0.0]])
+        return self._memo["consts"].size + self.laws.size + 1
+
+    def data_into(self, out: np.ndarray) -> None:
+        """:meth:`data` written into ``out`` (:meth:`data_size`,) (a row of many walkers'
+        data vectors: :mod:`walkerlab.gym.rigid_rows`), the same numbers."""
+        if "consts" not in self._memo:
+            self._memo["consts"] = self.module().constants(self.params)
+        c = self._memo["consts"]
+        nc = c.size
+        out[:nc] = c
+        out[nc:-1] = self.laws
+        out[nc + 2] = float(getattr(self.actuators, "t_origin", 0.0))
+        out[-1] = 0.0

@@ -103,7 +103,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv"]
+__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
+           "end_periods"]
 
 #: the largest ``start_noise``: the start's rates times ``1 + U(-1, 1)`` (from rest to twice
 #: the gait's rates; beyond, rates change sign)
@@ -640,3 +641,152 @@ class WalkerEnv(gym.Env):
 
         return draw(self.sim.points(), float(self.scene.slope.phi_rad),
                     float(self.rigid.model.params["leg_length_m"]), self.sim.t)
+
+
+# ---------------------------------------------------------------------- many walkers at once
+def batch_parameters(envs) -> dict | None:
+    """What :func:`begin_periods` and :func:`end_periods` read of each environment, stacked
+    over ``envs`` (N rigid-view :class:`WalkerEnv`); None when they cannot step these walkers
+    together (a contact view, a ``reward_fn``, or action sizes that differ): each is then
+    stepped by its own :meth:`WalkerEnv.step`.
+
+    Returns
+    -------
+    dict or None
+        ``tau`` (N, k) [N m] the action bounds; ``scale`` (N, k) [N m or -] what an action
+        is multiplied by (``tau`` with ``normalize_action``, else 1); ``policy`` (N,) bool
+        ``policy="scene"``; ``fw``, ``healthy``, ``cw``, ``ww``, ``dt`` (N,) the reward's
+        weights and the control period [s]; ``limit`` (N,) int the environment's own
+        ``max_episode_steps`` (-1: none); ``low``, ``high`` (N, m + 3) the observation's
+        bounds.
+    """
+    if any(e.view != "rigid" or e.reward_fn is not None for e in envs):
+        return None
+    if len({e.tau_max.shape for e in envs}) != 1 or len(
+            {e.observation_space.shape for e in envs}) != 1:
+        return None
+    tau = np.array([e.tau_max for e in envs], dtype=np.float64)
+    w = np.array([e.weights for e in envs], dtype=np.float64)
+    return {"tau": tau,
+            "scale": np.where(np.array([[e.normalize_action] for e in envs]), tau, 1.0),
+            "normalize": np.array([e.normalize_action for e in envs]),
+            "policy": np.array([e.policy == "scene" for e in envs]),
+            "fw": w[:, 0], "healthy": w[:, 1], "cw": w[:, 2], "ww": w[:, 3],
+            "dt": np.array([e.dt for e in envs], dtype=np.float64),
+            "limit": np.array([-1 if e.max_episode_steps is None else e.max_episode_steps
+                               for e in envs], dtype=np.int64),
+            "low": np.array([e.observation_space.low for e in envs]),
+            "high": np.array([e.observation_space.high for e in envs])}
+
+
+def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
+    """:meth:`WalkerEnv.begin_period` of N rigid-view environments at once: the held
+    torques of every row of ``actions``, each period counted.
+
+    Parameters
+    ----------
+    envs : sequence of WalkerEnv
+        N environments, each reset.
+    actions : ndarray (N, k)
+        Checked finite actions (fractions of ``tau_max``, or N m), any real dtype.
+    p : dict
+        :func:`batch_parameters` of ``envs``.
+
+    Returns
+    -------
+    U : ndarray (N, k)
+        The held torques [N m] (the action scaled, the scene policy's added, clipped to the
+        bounds: the same operations as one environment's, element by element).
+    x_before, w_before : ndarray (N,)
+        The hip's x at the period's start [m] and the positive action work so far [J].
+    t_ends : list of float
+        Each period's end [s].
+    """
+    a = np.asarray(actions).astype(np.float64)
+    norm = p["normalize"]
+    if norm.all():
+        a = a * p["tau"]
+    elif norm.any():
+        a[norm] = a[norm] * p["tau"][norm]
+    if p["policy"].any():
+        for r in np.flatnonzero(p["policy"]):
+            e = envs[r]
+            s = e.sim
+            a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
+    tau = p["tau"]
+    U = np.clip(a, -tau, tau)
+    x_before = np.array([e._hip_x for e in envs])
+    w_before = np.array([e.sim.ledger["action_work_positive"] for e in envs])
+    t_ends = []
+    for e in envs:
+        e._elapsed += 1
+        t_ends.append(e._elapsed * e.dt)
+    return U, x_before, w_before, t_ends
+
+
+def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
+                w_before: np.ndarray, p: dict) -> tuple:
+    """:meth:`WalkerEnv.end_period` of N rigid-view environments at once, their walkers
+    advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`): observations, rewards, flags
+    and the infos as columns.
+
+    Parameters
+    ----------
+    envs : sequence of WalkerEnv
+    U : ndarray (N, k)
+        The held torques [N m] (:func:`begin_periods`).
+    strikes : list of list of float
+        Each walker's heel-strike times in the period [s].
+    x_before, w_before : ndarray (N,)
+        :func:`begin_periods`' hip x [m] and positive work [J] at the period's start.
+    p : dict
+        :func:`batch_parameters` of ``envs``.
+
+    Returns
+    -------
+    obs : ndarray (N, m + 3) float64
+    reward : ndarray (N,) float64
+    terminated, truncated : ndarray (N,) bool
+    columns : dict
+        The infos by key (:data:`INFO_KEYS`, then ``ledger_<term>``, in the order of
+        :meth:`WalkerEnv._info`'s dict), each a list or array of N values of the types
+        that dict holds (floats, bools, ints, text, None, lists).
+    """
+    from .rigid_view import hip_xs
+
+    views = [e.sim for e in envs]
+    n = len(envs)
+    X = np.array([v.x for v in views])
+    m = X.shape[1]
+    t = np.array([v.t for v in views], dtype=np.float64)
+    obs = np.empty((n, m + 3))
+    obs[:, :m] = X
+    obs[:, m] = [v.leg == "leg1" for v in views]
+    obs[:, m + 1] = [v.k for v in views]
+    obs[:, m + 2] = t - np.array([v.t_step for v in views])
+    np.clip(obs, p["low"], p["high"], out=obs)
+    hip = hip_xs(views, X)
+    for e, h in zip(envs, hip.tolist()):
+        e._hip_x = h  # the next period's start (its reward's origin)
+    ended = [v.ended for v in views]
+    terminated = np.array([s != "" for s in ended], dtype=np.bool_)
+    limit = p["limit"]
+    truncated = ~terminated & (limit >= 0) & (np.array([e._elapsed for e in envs]) >= limit)
+    terms = list(views[0].ledger)
+    L = np.array([[v.ledger[k] for k in terms] for v in views], dtype=np.float64).T.copy()
+    dt = p["dt"]
+    reward = (p["fw"] * (hip - x_before) / dt
+              + np.where(terminated, 0.0, p["healthy"])
+              - p["cw"] * np.add.reduce((U / p["tau"]) ** 2, axis=1)
+              - p["ww"] * (L[terms.index("action_work_positive")] - w_before) / dt)
+    columns = {"time_s": t,
+               "heel_strike": [bool(s) for s in strikes],
+               "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
+               "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
+               "steps": [int(v.steps) for v in views],
+               "stance_leg": [v.leg for v in views], "hip_x_m": hip,
+               "termination": ended,
+               "solver_message": [str(getattr(v, "failure", "")) for v in views],
+               "terrain_seed": [int(e.terrain_seed) for e in envs]}
+    columns.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
+    return obs, reward, terminated, truncated, columns

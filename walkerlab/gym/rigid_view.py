@@ -61,7 +61,7 @@ from walkerlab.integrate.solver import Solver, available_backends
 
 from .action import action_torques, flat_action_walker
 
-__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
+__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView", "hip_xs"]
 
 #: the walker kinds (:data:`walkerlab.walker.kinds.KINDS`) whose phases each have a mass
 #: matrix of their own (a flat foot's stance modes: heel or toe pinned, the foot locked
@@ -406,7 +406,7 @@ class RigidView:
         w = self.walker
         acts = self.acts[self.leg]
         acts.u = np.asarray(u, dtype=float)
-        act_on = bool(acts.u.any())
+        act_on = np.count_nonzero(acts.u) > 0
         phase = w.phases[self.k]
         for g in phase.guards:  # a fall guard already violated as the phase begins
             if (g.at_entry and g.outcome == "fall"
@@ -461,7 +461,7 @@ class RigidView:
         if self.ground is not None:
             self._pieces.append((phase, run.dense, (self.t, run.t_last)))
         self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-        if run.failed or not np.isfinite(self.x).all():
+        if run.failed or not np.logical_and.reduce(np.isfinite(self.x)):
             self.ended = "solver_failure"
             return strikes
         if run.event is None:
@@ -540,3 +540,60 @@ class RigidView:
         self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
         self.t_step = self.t
         self._start_step()
+
+
+#: per ``points`` function (by id): ``(points, whether it takes states as columns)``
+_COLUMN_POINTS: dict = {}
+
+
+def _hips(points, X: np.ndarray):
+    """The hip's x relative to the stance foot [m] of the states ``X`` (r, 2n), one call of
+    the step walker's ``points`` on the states as columns (its contract:
+    :mod:`walkerlab.models.hybrid.base`); None when it does not take them (checked once
+    per function against a call per state: the same numbers bit for bit, or not used)."""
+    entry = _COLUMN_POINTS.get(id(points))
+    if entry is None:
+        try:
+            hx = np.asarray(points(X.T)["hip"], float)[0]
+            ok = hx.shape == (X.shape[0],) and np.array_equal(
+                hx, [float(points(x)["hip"][0]) for x in X])
+        except Exception:  # noqa: BLE001 - a points of one state only
+            ok = False
+        entry = _COLUMN_POINTS[id(points)] = (points, ok)  # (kept: its id stays its own)
+    if not entry[1]:
+        return None
+    return np.asarray(points(X.T)["hip"], float)[0]
+
+
+def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
+    """:meth:`RigidView.hip_x` of every view in ``views`` (N), the views whose step walkers
+    share a ``points`` function in one call of it where it takes states as columns (the
+    same numbers).
+
+    Parameters
+    ----------
+    views : sequence of RigidView
+    X : ndarray (N, 2n), optional
+        Their states (``views[i].x``), when already stacked.
+
+    Returns
+    -------
+    ndarray (N,)
+        The hips' world x [m].
+    """
+    out = np.empty(len(views))
+    groups: dict = {}
+    for i, v in enumerate(views):
+        groups.setdefault(id(v.walker.points), []).append(i)
+    for rows in groups.values():
+        if len(rows) < 2:
+            hx = None
+        elif X is not None and len(rows) == len(views):
+            hx = _hips(views[rows[0]].walker.points, X)
+        else:
+            hx = _hips(views[rows[0]].walker.points, np.array([views[i].x for i in rows]))
+        if hx is None:
+            out[rows] = [views[i].hip_x() for i in rows]
+        else:
+            out[rows] = np.array([views[i].foot[0] for i in rows]) + hx
+    return out

@@ -10,14 +10,21 @@ observations, rewards, flags and infos are those of ``gymnasium.make_vec(...,
 vectorization_mode="sync")``, bit for bit with ``batched=False``, and with the batched
 step (the default) to round-off (the same falls, resets and heel strikes).
 
-The physics of one call is :meth:`WalkerVectorEnv._step_all`: each
-:class:`~walkerlab.gym.env.WalkerEnv` (built as ``gym.make``'s entry point builds it:
-:func:`~walkerlab.gym.env.registered_env`) begins its period, the rigid view's walkers are
-advanced together (:func:`walkerlab.gym.rigid_rows.advance_rows`: their compiled pieces in
-one compiled call per flow), and each ends its period; the contact view, or
-``batched=False``, steps them one after another.  The time limit, the autoreset and the
-batching of the infos are this class's own and know nothing of the walker (its sizes are
-its spaces').
+The physics of one call is :meth:`WalkerVectorEnv._step_all`: the rigid view's walkers
+(built as ``gym.make``'s entry point builds each :class:`~walkerlab.gym.env.WalkerEnv`:
+:func:`~walkerlab.gym.env.registered_env`) are stepped as arrays over the walkers - the
+held torques of all of them scaled and clipped at once
+(:func:`~walkerlab.gym.env.begin_periods`), their compiled pieces advanced together
+(:func:`walkerlab.gym.rigid_rows.advance_rows`: one compiled call per flow), their
+observations, rewards, flags and ledger read at once and their infos kept as columns
+(:func:`~walkerlab.gym.env.end_periods`), batched straight into gymnasium's form (an array
+and a mask ``_key`` per key, as ``VectorEnv._add_info`` batches N dicts, without building
+them); the same element-wise operations as each walker's own ``step``, so that these
+numbers are those of each walker ending its own period on the same physics, bit for bit.
+A ``reward_fn`` (it is given each walker's info dict) has each walker begin and end its
+own period around the batched physics; the contact view, or ``batched=False``, steps them
+one after another.  The time limit, the autoreset and the batching of the infos are this
+class's own and know nothing of the walker (its sizes are its spaces').
 """
 
 from __future__ import annotations
@@ -30,7 +37,15 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, create_empty_array
 
-from .env import DEFAULT_EPISODE_STEPS, InvalidAction, WalkerEnv, registered_env
+from .env import (
+    DEFAULT_EPISODE_STEPS,
+    InvalidAction,
+    WalkerEnv,
+    batch_parameters,
+    begin_periods,
+    end_periods,
+    registered_env,
+)
 
 __all__ = ["WalkerVectorEnv"]
 
@@ -71,6 +86,37 @@ def _batch_infos(each: list[dict]) -> dict | None:
                 out[f"_{key}"] = np.zeros(n, dtype=np.bool_)
             arr[i] = value
             out[f"_{key}"][i] = True
+    return out
+
+
+def _batch_columns(columns: dict, n: int) -> dict | None:
+    """Infos given by key, ``columns[key]`` the N sub-environments' values (a list, or an
+    array of numbers), batched as :func:`_batch_infos` batches the same infos given one
+    dict per sub-environment (every sub-environment holding every key): per key an array
+    (N,) whose type is sub-environment 0's value's (a number's dtype: a float array holds
+    NaN for None; else objects) and its mask ``_key`` (all True); None where a value is a
+    dict."""
+    out: dict = {}
+    masks = np.ones((len(columns), n), dtype=np.bool_)
+    for j, (key, vals) in enumerate(columns.items()):
+        if isinstance(vals, np.ndarray) and vals.dtype.kind in "fi":
+            arr = vals  # numbers of one dtype: the first one's
+        else:
+            v0 = vals[0]
+            t = type(v0)
+            if t is dict:
+                return None
+            if t in (int, float, bool) or issubclass(t, np.number):
+                arr = np.array(vals, dtype=t)
+            elif isinstance(v0, np.ndarray):
+                arr = np.zeros((n, *v0.shape), dtype=v0.dtype)
+                arr[:] = vals
+            else:
+                arr = np.empty(n, dtype=object)
+                for i, v in enumerate(vals):
+                    arr[i] = v
+        out[key] = arr
+        out[f"_{key}"] = masks[j]
     return out
 
 
@@ -165,16 +211,24 @@ class WalkerVectorEnv(VectorEnv):
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
         self._has_reset = False
+        #: :func:`walkerlab.gym.env.batch_parameters` of the walkers (False: not yet read)
+        self._params: dict | None | bool = False
 
     # ------------------------------------------------------------------ the physics
-    def _step_all(self, actions: np.ndarray, mask: np.ndarray) -> list[dict | None]:
+    def _step_all(self, actions: np.ndarray, mask: np.ndarray) -> dict:
         """Step the sub-environments ``i`` where ``mask[i]`` by one control period with
         ``actions[i]``, writing their observation, reward and termination into
         ``self._observations``, ``self._rewards``, ``self._terminations`` (and
         ``self._truncations``: False, the time limit being the caller's).
 
-        The one place a walker is stepped: a compiled batched step may replace this loop
-        as long as it writes the same rows and returns the same infos.
+        The one place a walker is stepped.  The rigid view's walkers (batched) are stepped
+        as arrays over the walkers: the held torques of all of them at once
+        (:func:`walkerlab.gym.env.begin_periods`), their compiled pieces integrated
+        together (:func:`walkerlab.gym.rigid_rows.advance_rows`), and their observations,
+        rewards, flags and infos at once (:func:`walkerlab.gym.env.end_periods`); where
+        that cannot be (a ``reward_fn``, the contact view, ``batched=False``) each
+        :class:`~walkerlab.gym.env.WalkerEnv` steps (or begins and ends its period)
+        itself.
 
         Parameters
         ----------
@@ -185,26 +239,57 @@ class WalkerVectorEnv(VectorEnv):
 
         Returns
         -------
-        list of (dict or None)
-            Each stepped sub-environment's info (``WalkerEnv.step``'s), None elsewhere.
+        dict
+            The stepped sub-environments' infos by row: ``{"rows": idx (r,), "columns":
+            {key: r values}}`` (the values ``WalkerEnv.step``'s info holds, in its key
+            order), or ``{"rows": idx, "dicts": [info, ...]}``.
         """
-        infos: list[dict | None] = [None] * self.num_envs
         idx = np.flatnonzero(mask)
+        envs = [self.envs[i] for i in idx]
         if not self.batched or self.envs[0].view != "rigid":
-            for i in idx:
+            dicts = []
+            for i, env in zip(idx, envs):
                 (self._observations[i], self._rewards[i], self._terminations[i],
-                 self._truncations[i], infos[i]) = self.envs[i].step(actions[i])
-            return infos
+                 self._truncations[i], info) = env.step(actions[i])
+                dicts.append(info)
+            return {"rows": idx, "dicts": dicts}
         from .rigid_rows import advance_rows
 
-        envs = [self.envs[i] for i in idx]
-        begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
-        strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
-                               [env.period_end_s for env in envs])
-        for i, env, (u, before), hs in zip(idx, envs, begun, strikes):
-            (self._observations[i], self._rewards[i], self._terminations[i],
-             self._truncations[i], infos[i]) = env.end_period(u, hs, before)
-        return infos
+        p = self._batch_parameters()
+        if p is None:  # each walker's own begin and end of its period
+            begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
+            strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
+                                   [env.period_end_s for env in envs])
+            dicts = []
+            for i, env, (u, before), hs in zip(idx, envs, begun, strikes):
+                (self._observations[i], self._rewards[i], self._terminations[i],
+                 self._truncations[i], info) = env.end_period(u, hs, before)
+                dicts.append(info)
+            return {"rows": idx, "dicts": dicts}
+        if idx.size < self.num_envs:
+            p = {k: v[idx] for k, v in p.items()}
+        U, x_before, w_before, t_ends = begin_periods(envs, actions[idx], p)
+        strikes = advance_rows([env.sim for env in envs], U, t_ends)
+        obs, reward, term, trunc, columns = end_periods(envs, U, strikes, x_before,
+                                                        w_before, p)
+        if idx.size == self.num_envs:
+            self._observations[:] = obs
+            self._rewards[:] = reward
+            self._terminations[:] = term
+            self._truncations[:] = trunc
+        else:
+            self._observations[idx] = obs
+            self._rewards[idx] = reward
+            self._terminations[idx] = term
+            self._truncations[idx] = trunc
+        return {"rows": idx, "columns": columns}
+
+    def _batch_parameters(self) -> dict | None:
+        """:func:`walkerlab.gym.env.batch_parameters` of every walker, kept until
+        :meth:`set_attr` or :meth:`call` may have changed them."""
+        if self._params is False:
+            self._params = batch_parameters(self.envs)
+        return self._params
 
     def _reset_one(self, i: int, seed: int | None, options: dict | None) -> dict:
         """Reset sub-environment ``i`` (its row of the observations, its time limit's
@@ -225,6 +310,9 @@ class WalkerVectorEnv(VectorEnv):
             naming the batched action space).
         """
         shape = self.action_space.shape
+        if (type(actions) is np.ndarray and actions.shape == shape
+                and actions.dtype.kind in "iuf" and np.isfinite(actions).all()):
+            return actions  # the common case: no message built
         want = f"give {shape[0]} rows of {shape[1]} finite real numbers, {self.action_space}"
         if actions is None:
             raise InvalidAction(f"actions is None: {want}")
@@ -329,34 +417,85 @@ class WalkerVectorEnv(VectorEnv):
                     f"{np.flatnonzero(self._autoreset_envs).tolist()} ended; reset them with "
                     "reset(options={'reset_mask': mask}) before stepping")
         stepping = ~resetting
-        step_infos = self._step_all(a, stepping) if stepping.any() else [None] * self.num_envs
+        stepped = (self._step_all(a, stepping) if stepping.any()
+                   else {"rows": np.zeros(0, np.int64), "dicts": []})
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
             self._elapsed[stepping] += 1
             self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
-        infos: dict = {}
-        each: list[dict] = []
-        for i in range(self.num_envs):
-            if resetting[i]:  # NEXT_STEP: the reset is this step's outcome
-                info = self._reset_one(i, None, None)
-                self._rewards[i] = 0.0
-                self._terminations[i] = self._truncations[i] = False
-            else:
-                info = step_infos[i]
-                if mode == AutoresetMode.SAME_STEP and (self._terminations[i]
-                                                        or self._truncations[i]):
-                    infos = self._add_info(infos, {"final_obs": self._observations[i].copy(),
-                                                   "final_info": info}, i)
-                    info = self._reset_one(i, None, None)  # the step's reward and flags kept
-            each.append(info)
-        batched = None if infos else _batch_infos(each)
-        if batched is None:  # SAME_STEP's final observations and infos: gymnasium's own
+        resets: dict = {}
+        for i in np.flatnonzero(resetting).tolist():  # NEXT_STEP: the reset is the outcome
+            resets[i] = self._reset_one(i, None, None)
+            self._rewards[i] = 0.0
+            self._terminations[i] = self._truncations[i] = False
+        ends = (self._terminations | self._truncations) & stepping
+        if mode == AutoresetMode.SAME_STEP and ends.any():
+            # final observations and infos: gymnasium's own batching
+            each = self._info_dicts(stepped, resets)
+            infos: dict = {}
+            for i in np.flatnonzero(ends).tolist():
+                infos = self._add_info(infos, {"final_obs": self._observations[i].copy(),
+                                               "final_info": each[i]}, i)
+                each[i] = self._reset_one(i, None, None)  # the step's reward and flags kept
             for i, info in enumerate(each):
                 infos = self._add_info(infos, info, i)
         else:
-            infos = batched
+            infos = self._batched_infos(stepped, resets)
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
         return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
                 self._truncations.copy(), infos)
+
+    def _info_dicts(self, stepped: dict, resets: dict) -> list[dict]:
+        """Every sub-environment's info as a dict (N): the stepped ones' (:meth:`_step_all`'s
+        rows), the reset ones' (``resets``: row -> info)."""
+        each: list = [None] * self.num_envs
+        rows = stepped["rows"].tolist()
+        if "dicts" in stepped:
+            for i, info in zip(rows, stepped["dicts"]):
+                each[i] = info
+        else:
+            cols = stepped["columns"]
+            lists = {k: v.tolist() if isinstance(v, np.ndarray) else v
+                     for k, v in cols.items()}
+            for r, i in enumerate(rows):
+                each[i] = {k: v[r] for k, v in lists.items()}
+        for i, info in resets.items():
+            each[i] = info
+        return each
+
+    def _batched_infos(self, stepped: dict, resets: dict) -> dict:
+        """The step's infos (every sub-environment's: stepped or reset) batched as
+        :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one
+        (:func:`_batch_columns`, else :func:`_batch_infos`, else ``_add_info`` itself)."""
+        n = self.num_envs
+        if "columns" in stepped:
+            cols = stepped["columns"]
+            if not resets:
+                out = _batch_columns(cols, n)
+                if out is not None:
+                    return out
+            else:
+                keys = list(cols)
+                if all(list(info) == keys for info in resets.values()):
+                    rows = stepped["rows"].tolist()
+                    merged = {}
+                    for k, v in cols.items():
+                        vals: list = [None] * n
+                        for i, x in zip(rows, v.tolist() if isinstance(v, np.ndarray)
+                                        else v):
+                            vals[i] = x
+                        for i, info in resets.items():
+                            vals[i] = info[k]
+                        merged[k] = vals
+                    out = _batch_columns(merged, n)
+                    if out is not None:
+                        return out
+        each = self._info_dicts(stepped, resets)
+        out = _batch_infos(each)
+        if out is None:  # a nested dict: gymnasium's own recursion
+            out = {}
+            for i, info in enumerate(each):
+                out = self._add_info(out, info, i)
+        return out
 
     def render(self) -> tuple:
         """Each walker's frame (``WalkerEnv.render``: (H, W, 3) uint8 with
@@ -366,6 +505,7 @@ class WalkerVectorEnv(VectorEnv):
     def call(self, name: str, *args, **kwargs) -> tuple:
         """``getattr(env, name)(*args, **kwargs)`` on each walker (the attribute itself
         when not callable), as a tuple of N."""
+        self._params = False  # (a method may change what the batched step reads)
         out = []
         for env in self.envs:
             f = getattr(env, name)
@@ -389,6 +529,7 @@ class WalkerVectorEnv(VectorEnv):
             values = [values] * self.num_envs
         if len(values) != self.num_envs:
             raise ValueError(f"set_attr: {len(values)} values for num_envs={self.num_envs}")
+        self._params = False  # read again by the next batched step
         for env, v in zip(self.envs, values, strict=True):
             setattr(env, name, v)
 
