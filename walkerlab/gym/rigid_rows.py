@@ -94,28 +94,6 @@ def _kernel_args(key: tuple, fphase) -> tuple:
     return _CFUNCS[key]
 
 
-_ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument types
-
-
-def _rows_call(key: tuple, kernel):
-    """``kernel`` (the numba dispatcher ``period_rows``) for the rows of flow ``key``: after
-    its first call, its compiled entry point for that call's argument types (the same
-    machine code, called without the dispatcher's typing of the three cfunc arguments:
-    ~17 us a call), else the dispatcher."""
-    entry = _ENTRY.get(key)
-    if entry is not None and entry[0] is kernel:
-        return entry[1]
-
-    def first(*args):
-        kernel(*args)
-        try:  # the overload the dispatcher just chose, by the arguments' numba types
-            cres = kernel.overloads.get(tuple(kernel.typeof_pyval(a) for a in args))
-            _ENTRY[key] = (kernel, kernel if cres is None else cres.entry_point)
-        except Exception:  # noqa: BLE001 - a dispatcher without them: itself
-            _ENTRY[key] = (kernel, kernel)
-    return first
-
-
 def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRun]:
     """The compiled pieces ``pieces`` of walkers ``rows`` (one flow) in one kernel call."""
     from walkerlab.integrate.rows_dop853 import FAILED, period_rows
@@ -142,8 +120,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRu
     view0 = views[rows[0]]  # (an arithmetic error inside the kernel: counted on it)
     hook, sys.unraisablehook = sys.unraisablehook, view0.count_unraisable
     try:
-        _rows_call(key, period_rows)(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol,
-                                     atol, n_out, which, te, Yev, H)
+        period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which,
+                    te, Yev, H)
     finally:
         sys.unraisablehook = hook
     runs = []
