@@ -383,7 +383,9 @@ class ContactSimSettings(BaseModel):
         json_schema_extra={"unit": "s"})
     stop_after_strides: bool = Field(
         True, description="Strides cap: stop once 2 * n_strides + 1 heel strikes have "
-        "happened, even if t_final_s is longer.")
+        "happened, even if t_final_s is longer (a passive run at the end of that integration "
+        "chunk; a powered run, which asks after each heel strike on the samples before it, "
+        "at the heel strike after: 2 * n_strides + 2, its last step complete).")
     periodic_time_limit_s: float | None = Field(
         120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
         "runs out the gait is reported as 'time_limit' (null = none).",

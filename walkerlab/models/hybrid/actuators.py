@@ -186,14 +186,14 @@ class Actuators:
         """``(delta, ddelta)`` (k,) [rad, rad/s] at the state ``x`` (2n,) by the map
         ``affine`` (:meth:`affine_joint_map`)."""
         Bt, c = affine
-        q, dq = np.split(x, 2)
-        return Bt @ q + c, Bt @ dq
+        n = len(x) // 2  # (slices: np.split's views, without its Python)
+        return Bt @ x[:n] + c, Bt @ x[n:]
 
     @staticmethod
     def affine_joint_rates(X, affine) -> np.ndarray:
         """The joint rates ``ddelta`` (k, m) [rad/s] at the states ``X`` (2n, m), one per
         column, by the map ``affine`` (:meth:`affine_joint_map`)."""
-        return affine[0] @ np.split(X, 2)[1]
+        return affine[0] @ X[len(X) // 2:]
 
     def link_angles(self, x) -> dict:
         """``{link: (angle [rad], rate [rad/s])}`` at the state ``x`` (2n,)
