@@ -135,7 +135,8 @@ CONTROLLER_CONTACT = {"stiction_velocity_mm_per_s": 10.0, "friction_velocity_mm_
 #: 0.7 with mu = 0.6 pressed its foot to 0.46 (0.51 of mu_s = 0.9) before the heel strike
 #: and walked +8.4 % slow in MuJoCo; within 0.3 (a third) -1.06 % (contact model +1.21 %).
 CONTACT_CONE_FRACTION = 1.0 / 3.0
-#: Strides of a design's contact replay (12 heel strikes)
+#: Strides of a design's contact replay (the strides cap stops a powered run at heel strike
+#: 2N + 2: 14, its 13 steps complete)
 REPLAY_STRIDES = 6
 
 
