@@ -18,7 +18,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
-from tests.independent.mirror_stride import stride_against
+from tests.independent.mirror_stride import stride_against, to_heel_strike
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -150,20 +150,8 @@ class Reference:
     def step(self, w, x):
         """One step from just after a heel strike: ``(x just after the next one, period)``;
         ``w`` this step's swing-hip offset (the next step's is ``-w``)."""
-        f = self.rhs(w)
-
-        def crossing(t, y):
-            return y[SWING] - y[STANCE]
-        crossing.terminal, crossing.direction = True, 1
-
-        def strike(t, y):
-            return self.foot_height(w, y)
-        strike.terminal, strike.direction = True, -1
-        a = solve_ivp(f, (0, 5), x, method="DOP853", rtol=1e-13, atol=1e-13, events=crossing)
-        t1, y1 = a.t_events[0][0], a.y_events[0][0]
-        b = solve_ivp(f, (t1, t1 + 5), y1, method="DOP853", rtol=1e-13, atol=1e-13,
-                      events=strike)
-        t2, y = b.t_events[0][0], b.y_events[0][0]
+        y, t2 = to_heel_strike(self.rhs(w), x, SWING, STANCE,
+                               lambda y: self.foot_height(w, y), 5.0)
         return self.impact(w, y), t2
 
     def impact_rates(self, w, y):

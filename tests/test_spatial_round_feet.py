@@ -25,7 +25,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
-from tests.independent.mirror_stride import stride_against
+from tests.independent.mirror_stride import stride_against, to_heel_strike
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -191,20 +191,8 @@ class Reference:
 
     def step(self, w, x):
         """One step from just after a heel strike: ``(x just after the next one, period)``."""
-        f = self.rhs(w)
-
-        def crossing(t, y):
-            return y[1] - y[2]
-        crossing.terminal, crossing.direction = True, 1
-
-        def strike(t, y):
-            return self.foot_height(w, y)
-        strike.terminal, strike.direction = True, -1
-        a = solve_ivp(f, (0, 10), x, method="DOP853", rtol=1e-13, atol=1e-13, events=crossing)
-        t1, y1 = a.t_events[0][0], a.y_events[0][0]
-        b = solve_ivp(f, (t1, t1 + 10), y1, method="DOP853", rtol=1e-13, atol=1e-13,
-                      events=strike)
-        return self.impact(w, b.y_events[0][0]), b.t_events[0][0]
+        y, t2 = to_heel_strike(self.rhs(w), x, 1, 2, lambda y: self.foot_height(w, y), 10.0)
+        return self.impact(w, y), t2
 
     def on_surface(self, w, z):
         """The state just after a heel strike from ``z = [lean, stance, rates]``: the swing

@@ -1,11 +1,13 @@
 """The symmetric period-2 gait of an independent 3D walker reference, found and linearised
 by scipy alone: shared by the references of tests/test_spatial_walker.py,
 tests/test_spatial_hip_roll.py and tests/test_spatial_round_feet.py (each model its own;
-this is only the root finding and the central differences on its stride)."""
+this is only the step's two event searches, the root finding and the central differences
+on its stride)."""
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 
@@ -44,3 +46,23 @@ def stride_against(ref, w: float, res, keep) -> tuple[float, float, float]:
     return (float(np.max(np.abs(x_ref - np.asarray(res.x)))),
             abs(stride(x_ref)[1] - res.period_s),
             float(np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs)))))
+
+
+def to_heel_strike(f, x, swing: int, stance: int, foot_height, span: float):
+    """A reference's step from just after a heel strike to just before the next, by scipy's
+    DOP853 (rtol = atol = 1e-13) on its flow ``f(t, y)``: to mid-stance (state entries
+    ``swing`` and ``stance``, the legs' pitch angles, crossing upwards), then to the swing
+    foot's ground contact (``foot_height(y)`` through zero downwards), each within ``span``
+    [s].  Returns ``(state before the impact, its time [s])``."""
+    def crossing(t, y):
+        return y[swing] - y[stance]
+    crossing.terminal, crossing.direction = True, 1
+
+    def strike(t, y):
+        return foot_height(y)
+    strike.terminal, strike.direction = True, -1
+    a = solve_ivp(f, (0, span), x, method="DOP853", rtol=1e-13, atol=1e-13, events=crossing)
+    t1, y1 = a.t_events[0][0], a.y_events[0][0]
+    b = solve_ivp(f, (t1, t1 + span), y1, method="DOP853", rtol=1e-13, atol=1e-13,
+                  events=strike)
+    return b.y_events[0][0], b.t_events[0][0]
