@@ -94,7 +94,7 @@ class PoweredData:
         self.module = getattr(acts, "powered_module", lambda w: w.kernels)(walker)
         #: ``(t, y, d, dy)``: the compiled right-hand side as a numba function (the cfunc's
         #: body; ``module.build_cyrk_powered()`` gives the cfunc's address)
-        self.rhs = getattr(self.module, "powered_packed_vc", None) or self.module.powered_packed
+        self.rhs = self.module.powered_packed
 
     def data(self, stance: int, t_origin: float, push: tuple[int, float] | None = None,
              ankle: bool = False, switch_s: float = np.inf, ghost: bool = False

@@ -44,6 +44,10 @@ scenes ask LSODA).
 
 from __future__ import annotations
 
+import functools
+import hashlib
+from pathlib import Path
+
 import numpy as np
 
 from walkerlab.models.contact.joint_torques import JointTorqueActuators
@@ -181,8 +185,8 @@ _RHS_SOURCE = '''# walkerlab: a contact walker's compiled right-hand side under 
 import numpy as np
 from numba import carray, cfunc, njit
 
-from {kernels} import (A_HEAD, D_N1, D_N2, D_P, HEAD, NP, NQ, powered_ny, powered_packed,
-                       powered_size)
+from {kernels} import A_HEAD, D_N1, D_N2, D_P, HEAD, NP, NQ, powered_ny, powered_size
+from {kernels} import powered_packed as _kernels_powered_packed
 from {law} import law as _vc_law
 
 
@@ -215,43 +219,47 @@ def vc_torques(t, y, d):
 
 
 @njit(cache=True, error_model="numpy")
-def powered_packed_vc(t, y, d, dy):
-    """powered_packed with the virtual constraints' torques (``d`` as powered_packed's)."""
+def powered_packed(t, y, d, dy):
+    """The kernels' powered_packed with the virtual constraints' torques in its law block
+    (``d`` as that function's)."""
     vc_torques(t, y, d)
-    powered_packed(t, y, d, dy)
+    _kernels_powered_packed(t, y, d, dy)
 
 
 def build_cyrk_powered():
-    """Address of a CyRK ``cyjit_sig`` cfunc of powered_packed_vc (numba disk cache)."""
+    """Address of a CyRK ``cyjit_sig`` cfunc of powered_packed (numba disk cache)."""
     from CyRK.nb.numba_solver import cyjit_sig
 
     @cfunc(cyjit_sig, cache=True)
     def rhs_c(dy, t, y, d):  # pragma: no cover - runs compiled
         dd = carray(d, (powered_size(d),))
         ny = powered_ny(dd)
-        powered_packed_vc(t, carray(y, (ny,)), dd, carray(dy, (ny,)))
+        powered_packed(t, carray(y, (ny,)), dd, carray(dy, (ny,)))
 
     return rhs_c.address
 '''
 
 
+@functools.cache
+def _this_source_hash() -> str:
+    """sha256 of this module's source (read once per process)."""
+    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+
+
 def compiled_rhs_module(kernels, law_module):
     """The generated module of a contact walker's compiled right-hand side under virtual
-    constraints (module docstring, "Compiled"): ``powered_packed_vc(t, y, d, dy)`` (the
-    walker's ``powered_packed`` after the controller's torques) and
+    constraints (module docstring, "Compiled"), with the kernels' interface:
+    ``powered_packed(t, y, d, dy)`` (the walker's, after the controller's torques) and
     ``build_cyrk_powered()`` (its CyRK cfunc's address), for the walker's generated
     contact module ``kernels`` and the controller's compiled module ``law_module``
     (:meth:`VirtualConstraintController.compiled_module`); file
     ``<hash>_vcrhs.py`` in the user cache, its hash of both modules' names (each a hash of
     its own source) and this module's source; numba's machine code cached there too."""
-    import hashlib
-    from pathlib import Path
-
     from walkerlab.codegen import cache
 
     source = _RHS_SOURCE.format(kernels=kernels.__name__, law=law_module.__name__)
     h = hashlib.sha256(source.encode())
-    h.update(Path(__file__).read_bytes())
+    h.update(_this_source_hash().encode())
     tag = h.hexdigest()[:24]
     return cache.import_generated(f"{tag}_vcrhs.py", f"walkerlab_vcrhs_{tag}",
                                   lambda: source)
