@@ -20,6 +20,7 @@ problem (the command's friction cone), pairs in turn (target: <= 2x the script).
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -45,8 +46,10 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
     -------
     dict
         ``delta2`` [-], ``delta2_s``, ``delta2_min_s``, ``zero_dynamics_s``,
-        ``build_s`` (the walker with its controller), ``step_map_s`` (one full-order step)
-        [s], ``target_s``, ``step_period_s`` (by quadrature) [s].
+        ``build_s`` (the walker with its controller), ``step_map_s`` (one full-order step
+        on the scene's solver), ``step_map_compiled_s`` (the same step on the compiled
+        closed loop, DOP853 at the scene's tolerances) [s], ``target_s``, ``step_period_s``
+        (by quadrature) [s].
     """
     from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.analysis.gait.zero_dynamics import impact_multiplier, zero_dynamics
@@ -71,10 +74,19 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
     t = time.perf_counter()
     poincare_map(walker, zd.x_plus, Solver.from_settings(scene.solver))
     step = time.perf_counter() - t
+    # the same step on the compiled closed loop (DOP853 at the scene's tolerances on CyRK:
+    # walkerlab.codegen.virtual_constraint_flow), its cfuncs loaded by a first run
+    compiled = replace(Solver.from_settings(scene.solver), method="DOP853",
+                       backend="cyrk_compiled")
+    poincare_map(walker, zd.x_plus, compiled)
+    t = time.perf_counter()
+    poincare_map(walker, zd.x_plus, compiled)
+    step_compiled = time.perf_counter() - t
     out = {"scene": scene.name, "repeats": repeats, "delta2": d2,
            "delta2_s": float(np.median(d2_times)), "delta2_min_s": float(np.min(d2_times)),
            "zero_dynamics_s": float(np.median(zd_times)), "build_s": build,
-           "step_map_s": step, "target_s": TARGET_S, "step_period_s": zd.step_period_s}
+           "step_map_s": step, "step_map_compiled_s": step_compiled, "target_s": TARGET_S,
+           "step_period_s": zd.step_period_s}
     if design:
         out["design"] = bench_design()
         out["design_process"] = bench_design_process()
@@ -246,7 +258,9 @@ def lines(res: dict) -> list[str]:
             f"{1e3 * res['target_s']:.0f} ms: {ok})",
             f"hzd: zero dynamics (V, V_max, zeta*, period {res['step_period_s']:.10f} s) "
             f"{1e3 * res['zero_dynamics_s']:.1f} ms; controller build {res['build_s']:.2f} s; "
-            f"one full-order step map {res['step_map_s']:.3f} s"] + _design_lines(res)
+            f"one full-order step map {res['step_map_s']:.3f} s (the scene's solver; "
+            f"on the compiled closed loop, DOP853: {res['step_map_compiled_s']:.3f} s)"
+            ] + _design_lines(res)
 
 
 def _design_lines(res: dict) -> list[str]:

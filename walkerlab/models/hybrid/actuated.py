@@ -135,7 +135,13 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     if limit or acts.rows is not None:  # the force in the massless limit's rows: Python
         return None
     if getattr(spec_of(acts), "virtual_constraints", None) is not None:  # computed torque:
-        return None  # the Python flow (the controller's numpy terms)
+        if phase.constraint is not None:  # a held constraint's rows: the Python flow
+            return None
+        from walkerlab.codegen.virtual_constraint_flow import VirtualConstraintFlow
+
+        # the closed loop compiled, for the cyrk_compiled backend (None where the
+        # controller's law is not compiled)
+        return VirtualConstraintFlow.of(acts.controller, data.structure, data.params)
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None:  # a passive flow run in Python: the guards' outputs from the kind
         guards = _PARTS[data.structure.kind.name].guard_outputs(phase, data)
