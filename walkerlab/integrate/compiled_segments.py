@@ -17,6 +17,7 @@ Python runs per segment and per event (a handful per step), never per integrator
 
 from __future__ import annotations
 
+import math
 import types
 
 import numpy as np
@@ -79,6 +80,10 @@ class CompiledSegments:
         # a kernels stand-in for _cyrk.solve_chunk: the powered cfunc
         self.kernels = types.SimpleNamespace(__name__=f"{name}_powered",
                                              build_cyrk=lambda: _ADDRESS[name])
+        #: the compiled solver at the run's tolerances (its constant arguments converted once)
+        self.solve = _cyrk.ChunkSolver(solver.method, solver.rtol, atol,
+                                       solver.max_step_s or np.inf, SEGMENT_STEPS,
+                                       kernels=self.kernels)
 
     def run(self, y0, t0: float, t1: float, events, stance: int, t_origin: float,
             push=None, ankle: bool = False, switch_s: float = np.inf):
@@ -100,12 +105,11 @@ class CompiledSegments:
         Stalled
             The compiled solver stopped before ``t1`` (its step limit or a failure).
         """
-        s, grid = self.solver, self.grid
         d = self.pdata.data(stance, t_origin, push, ankle, switch_s, ghost=True)
-        tg = np.concatenate([[t0], grid_inside(grid, t0, t1), [t1]])
-        X, ok, nfev, msg, dense = _cyrk.solve_chunk(
-            s.method, y0, tg, d, s.rtol, self.atol, s.max_step_s or np.inf, SEGMENT_STEPS,
-            kernels=self.kernels, dense=True)
+        inside = grid_inside(self.grid, t0, t1)
+        tg = np.empty(inside.size + 2)
+        tg[0], tg[1:-1], tg[-1] = t0, inside, t1
+        X, ok, nfev, msg, dense = self.solve(y0, tg, d, dense=True)
         self._extra = []
         try:
             out = self._answer(X, ok, nfev, msg, dense, tg, events, len(y0), switch_s, d)
@@ -113,7 +117,7 @@ class CompiledSegments:
             for interp in [dense, *self._extra]:
                 if interp is not None:
                     interp.free()
-        if np.isfinite(switch_s):  # the samples after the heel strike only
+        if math.isfinite(switch_s):  # the samples after the heel strike only
             keep = out.t > switch_s + 1e-12
             out.t, out.y = out.t[keep], out.y[:, keep]
         return out
@@ -141,10 +145,7 @@ class CompiledSegments:
             k = int(rows[0])
             if not ok:  # a stopped run's dense output is not the solution's: the interval
                 # integrated again from its first sample
-                _, ok_k, nf_k, _, dense = _cyrk.solve_chunk(
-                    self.solver.method, X[k], tg[k:k + 2], d, self.solver.rtol, self.atol,
-                    self.solver.max_step_s or np.inf, SEGMENT_STEPS, kernels=self.kernels,
-                    dense=True)
+                _, ok_k, nf_k, _, dense = self.solve(X[k], tg[k:k + 2], d, dense=True)
                 out.nfev += nf_k
                 self._extra.append(dense)
             j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(hit[k]),
