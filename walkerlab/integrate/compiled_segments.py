@@ -42,6 +42,7 @@ LOCATE_XTOL_S = 1e-13
 SEGMENT_STEPS = 100_000
 
 _ADDRESS: dict = {}  # generated kernels module name -> powered cfunc address
+_EMPTY = np.empty(0)  # no event time (an answer's entries are replaced, never written into)
 
 
 def contact_tables(walker, X) -> np.ndarray:
@@ -126,29 +127,37 @@ class CompiledSegments:
         """:meth:`run`'s answer from the segment's samples ``X`` at ``tg`` and its dense
         output: cut at the first event located on it."""
         n = 2 * self.walker.nq
-        out = types.SimpleNamespace(t_events=[np.empty(0) for _ in events],
-                                    y_events=[np.empty((0, ny)) for _ in events],
+        out = types.SimpleNamespace(t_events=[_EMPTY] * len(events),
+                                    y_events=[np.empty((0, ny))] * len(events),
                                     nfev=nfev, njev=0, status=0, message=msg)
         m = len(X)
-        if events and m:
-            tab = contact_tables(self.walker, X[:, :n])  # once for every event
-            G = np.column_stack([ev.values(X[:, :n], tab) for ev in events])
+        if events and m > 1:
+            Xn = np.ascontiguousarray(X[:, :n])  # the walker's states, one copy for all
+            tab = contact_tables(self.walker, Xn)  # once for every event
+            G = np.empty((m, len(events)))
+            for j, ev in enumerate(events):
+                G[:, j] = ev.values(Xn, tab)
+            hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
+            rows = np.flatnonzero(hit.any(axis=1))
+        else:  # no events, or no sample interval
+            rows = ()
+        switch = math.isfinite(switch_s)
+        for k in rows:  # the first interval with a sign change the rules keep
+            k = int(k)
+            keep = hit[k] & (G[0] > 0.0) if k == 0 else hit[k]  # one at the start: the
+            if switch and not tg[k] >= switch_s - 1e-12:  # last segment's; before the
+                continue  # switch: the last step's
+            if keep.any():
+                break
         else:
-            G = np.empty((m, 0))
-        hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
-        if len(hit):
-            hit[0] &= G[0] > 0.0  # an event at the start was the last segment's
-        if len(hit) and np.isfinite(switch_s):  # before the switch: the last step's
-            hit &= (tg[:m - 1] >= switch_s - 1e-12)[:, None]
-        rows = np.flatnonzero(hit.any(axis=1))
-        if rows.size:
-            k = int(rows[0])
+            k = None
+        if k is not None:
             if not ok:  # a stopped run's dense output is not the solution's: the interval
                 # integrated again from its first sample
                 _, ok_k, nf_k, _, dense = self.solve(X[k], tg[k:k + 2], d, dense=True)
                 out.nfev += nf_k
                 self._extra.append(dense)
-            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(hit[k]),
+            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(keep),
                                 n)
             out.t, out.y = tg[1:k + 1], X[1:k + 1].T
             out.t_events[j], out.y_events[j] = np.array([te]), ye[None]
