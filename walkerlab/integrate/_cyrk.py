@@ -118,12 +118,16 @@ class _Buffer:
     def __init__(self):
         self.array, self.address = np.empty(0), 0
 
-    def put(self, values: np.ndarray) -> int:
-        """Copy ``values`` (1-D) in; returns the address of the copy."""
-        n = len(values)
+    def reserve(self, n: int) -> None:
+        """Room for at least ``n`` numbers."""
         if n > self.array.size:
             self.array = np.empty(max(n, 2 * self.array.size))
             self.address = self.array.ctypes.data
+
+    def put(self, values: np.ndarray) -> int:
+        """Copy ``values`` (1-D) in; returns the address of the copy."""
+        n = len(values)
+        self.reserve(n)
         self.array[:n] = values
         return self.address
 
@@ -155,6 +159,8 @@ class ChunkSolver:
         self._y0, self._te, self._data = _Buffer(), _Buffer(), _Buffer()
         self._msg = ctypes.create_string_buffer(256)
         self._msg_p = ctypes.addressof(self._msg)
+        self._last_msg = (None, "")
+        self._dense_y = _Buffer()  # the dense outputs' state (each of their calls copies it)
 
     def __call__(self, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
                  dense: bool = False, first_step: float | None = None):
@@ -186,10 +192,13 @@ class ChunkSolver:
             nfev = int(ctypes.c_double.from_address(args + 8 * (nd - 1)).value
                        - float(data[-1]))
             ns.c_get_msg_buf(ptr, self._msg_p, 256)
-            msg = self._msg.value.decode(errors="replace")
+            raw = self._msg.value
+            if raw != self._last_msg[0]:  # (most calls end with the same message)
+                self._last_msg = (raw, raw.decode(errors="replace"))
+            msg = self._last_msg[1]
             if dense:
                 kept = True
-                return X, ok, nfev, msg, DenseInterval(ptr, ny)
+                return X, ok, nfev, msg, DenseInterval(ptr, ny, self._dense_y)
         finally:
             if not kept:
                 ns.c_free(ptr)
@@ -201,14 +210,16 @@ class DenseInterval:
     at a time [s] inside the integrated span for the state (N,); :meth:`free` releases
     CyRK's solution."""
 
-    def __init__(self, ptr, n: int):
+    def __init__(self, ptr, n: int, buffer: _Buffer | None = None):
         self.ptr, self.n = ptr, n
-        self._y = np.empty(n)  # CyRK writes the state here (its address read once)
-        self._y_p = self._y.ctypes.data
+        # where CyRK writes the state (a caller's buffer that dense outputs may share: each
+        # call copies the state out at once)
+        self._buffer = _Buffer() if buffer is None else buffer
+        self._buffer.reserve(n)
 
     def __call__(self, t: float) -> np.ndarray:
-        _api()[0].c_call(self.ptr, float(t), self._y_p)
-        return self._y.copy()
+        _api()[0].c_call(self.ptr, float(t), self._buffer.address)
+        return self._buffer.array[:self.n].copy()
 
     def free(self) -> None:
         if self.ptr:

@@ -31,8 +31,8 @@ def grid_inside(grid: np.ndarray, t0: float, t1: float) -> np.ndarray:
     """The sample times of the increasing ``grid`` strictly inside ``(t0, t1)`` [s] (1e-12 s
     from either end), by bisection: ``grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)]``
     without a pass over the whole grid (a run's or an environment's horizon of samples)."""
-    lo = np.searchsorted(grid, t0 + 1e-12, side="right")
-    hi = np.searchsorted(grid, t1 - 1e-12, side="left")
+    lo = grid.searchsorted(t0 + 1e-12, side="right")
+    hi = grid.searchsorted(t1 - 1e-12, side="left")
     return grid[lo:max(lo, hi)]
 
 
@@ -138,7 +138,7 @@ class CompiledSegments:
             for j, ev in enumerate(events):
                 G[:, j] = ev.values(Xn, tab)
             hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
-            rows = np.flatnonzero(hit.any(axis=1))
+            rows = np.logical_or.reduce(hit, axis=1).nonzero()[0]
         else:  # no events, or no sample interval
             rows = ()
         switch = math.isfinite(switch_s)
@@ -157,8 +157,7 @@ class CompiledSegments:
                 _, ok_k, nf_k, _, dense = self.solve(X[k], tg[k:k + 2], d, dense=True)
                 out.nfev += nf_k
                 self._extra.append(dense)
-            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(keep),
-                                n)
+            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, keep.nonzero()[0], n)
             out.t, out.y = tg[1:k + 1], X[1:k + 1].T
             out.t_events[j], out.y_events[j] = np.array([te]), ye[None]
             out.status = 1
