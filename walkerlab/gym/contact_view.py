@@ -157,6 +157,7 @@ class ContactView:
             leg = {"stance": f"leg{stance + 1}", "swing": f"leg{2 - stance}"}
             self.index.append([(_link_coordinate(a, leg, names),
                                 _link_coordinate(b, leg, names)) for a, b in links])
+        self._last_held = (None, None)  # the last torques (k,) and their held force
         # the coordinate hip_x's index (None: the hip read from the walker's points)
         self._hip_x = names.index("hip_x") if "hip_x" in names else None
         s = setup.solver
@@ -308,6 +309,8 @@ class ContactView:
         """The action's generalised force (nq,) with leg1, then leg2 in stance (the torques
         ``u`` (k,) summed in floats, joint by joint)."""
         u = [float(tau) for tau in u]
+        if self._last_held[0] == u:  # the same torques as the last period's (a zero action)
+            return self._last_held[1]
         out = []
         for stance in (0, 1):
             Q = [0.0] * self.nq
@@ -315,7 +318,8 @@ class ContactView:
                 Q[b] += tau
                 Q[a] -= tau
             out.append(np.array(Q))
-        return tuple(out)
+        self._last_held = (u, tuple(out))
+        return self._last_held[1]
 
     def advance(self, u: np.ndarray, t_end: float) -> list[float]:
         """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
