@@ -35,7 +35,7 @@ __all__ = ["CYRK_METHODS", "ChunkSolver", "DenseInterval", "solve_chunk"]
 CYRK_METHODS = {"cyrk_bdf": "BDF"}
 
 _FPTR: dict = {}  # generated kernels module name -> cfunc address
-FIRST = [0.0]  # CyRK's first step [s] of a call that gives none (0: its own estimate)
+FIRST = [0.0]  # CyRK's first step [s] of every call (0: its own estimate)
 
 
 def address(kernels, ready=None) -> int:
@@ -136,9 +136,7 @@ class ChunkSolver:
     """:func:`solve_chunk` with the method, tolerances, step limits and right-hand side
     fixed: the arguments that do not change between calls are converted once (a run that
     calls CyRK for every short segment, such as a Gymnasium control period).  Calling it
-    as ``solver(x0, t_eval, data, dense=False, first_step=0.0)`` answers as
-    :func:`solve_chunk` does; ``first_step`` [s] is CyRK's first step (0: its own
-    estimate, as :func:`solve_chunk` always starts).
+    as ``solver(x0, t_eval, data, dense=False)`` answers as :func:`solve_chunk` does.
 
     Parameters
     ----------
@@ -163,17 +161,16 @@ class ChunkSolver:
         self._dense_y = _Buffer()  # the dense outputs' state (each of their calls copies it)
 
     def __call__(self, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
-                 dense: bool = False, first_step: float | None = None):
+                 dense: bool = False):
         ns = self._ns
         ny, nt, nd = len(x0), len(t_eval), len(data)
-        first = float(FIRST[0]) if first_step is None else float(first_step)
         # the C entry point that CyRK's njit `nbsolve2_ivp` calls, called here through
         # ctypes (one call per chunk; avoids compiling that njit wrapper in every process)
         ptr = ns.c_numba_cysolve_ivp(
             self._fptr, float(t_eval[0]), float(t_eval[-1]), self._y0.put(x0), ny,
             self._method, 0, 0, self._data.put(data), nd * 8, self._steps, 2000, bool(dense),
             self._te.put(t_eval), nt, None, None, 0, self._rt_p, 1, self._at_p,
-            self._at.size, self._hmax, first, True)
+            self._at.size, self._hmax, float(FIRST[0]), True)
         if not ptr:  # pragma: no cover - allocation failure inside CyRK
             out = np.empty((0, ny)), False, 0, "CyRK returned no result"
             return (*out, None) if dense else out
