@@ -147,6 +147,8 @@ class ContactView:
         self._first_layout = max(1, min(int(n_steps), LAYOUT_STEPS))
         self._roughness, self._seed = 0.0, 0
         self._track = None  # footholds: the episode's footfalls (:class:`_Footfalls`)
+        self._layouts = {}  # steps laid out for -> the scene's walker, start, limits, step
+        self._built = None  # (walker, its run's walker, its compiled segments): _start's
         self.x_start, self.limits, self.step_length = self._lay_out(self._first_layout)
         names = tuple(self.walker.coordinate_names())
         self.nq = len(names)
@@ -155,6 +157,9 @@ class ContactView:
             leg = {"stance": f"leg{stance + 1}", "swing": f"leg{2 - stance}"}
             self.index.append([(_link_coordinate(a, leg, names),
                                 _link_coordinate(b, leg, names)) for a, b in links])
+        self._last_held = (None, None)  # the last torques (k,) and their held force
+        # the coordinate hip_x's index (None: the hip read from the walker's points)
+        self._hip_x = names.index("hip_x") if "hip_x" in names else None
         s = setup.solver
         #: the run's integrator: the compiled one at the scene's tolerances
         self.solver = s.model_copy(update={"method": "cyrk_bdf"})
@@ -166,13 +171,16 @@ class ContactView:
         the episode's roughness on them; returns the scene's start, limits, step length."""
         from walkerlab.analysis.contact.sim import scene_start
 
-        walker, x0, limits, step_length = scene_start(self._setup, self._x_gait,
-                                                      n_steps // 2 + 1)
-        if self._setup.sim.start == "periodic_gait":  # contact-sim's start: the contact
-            gait = _periodic_gait(self._setup, walker, self._x_gait)  # model's own gait,
-            walker, step_length = self._setup.build(  # its patches at the gait's steps
-                self._x_gait, 2 * (n_steps // 2 + 1), step_length_m=gait.step_length_m)
-            x0 = np.asarray(gait.full_state, float)
+        if n_steps not in self._layouts:  # the scene's patches for n_steps: the same each
+            walker, x0, limits, step_length = scene_start(  # episode, laid out once
+                self._setup, self._x_gait, n_steps // 2 + 1)
+            if self._setup.sim.start == "periodic_gait":  # contact-sim's start: the contact
+                gait = _periodic_gait(self._setup, walker, self._x_gait)  # model's own
+                walker, step_length = self._setup.build(  # gait, its patches at its steps
+                    self._x_gait, 2 * (n_steps // 2 + 1), step_length_m=gait.step_length_m)
+                x0 = np.asarray(gait.full_state, float)
+            self._layouts[n_steps] = walker, x0, limits, step_length
+        walker, x0, limits, step_length = self._layouts[n_steps]
         self._laid = n_steps
         self._at_rigid = walker  # the patches at the rigid gait's footfalls
         self._use(self._own_footfalls(walker))
@@ -245,17 +253,24 @@ class ContactView:
         step start, ankle push-off and work integrals carried over (a new layout)."""
         from walkerlab.integrate.contact_powered import ActuationHook
 
-        w = self.walker
-        if w.actuators is None:  # the action alone: actuators with no law of the scene's
-            w = dataclasses.replace(w, actuators=self._setup.held_actuators())
+        if self._built is not None and self._built[0] is self.walker:  # the walker of
+            _, w, segments = self._built  # the last run (a new episode on the same
+        else:  # ground): its run's walker and compiled segments again
+            w, segments = self.walker, None
+            if w.actuators is None:  # the action alone: actuators with no law of the scene's
+                w = dataclasses.replace(w, actuators=self._setup.held_actuators())
         self.hook = ActuationHook(w, self.solver, self.limits, np.inf, self.grid,
                                   held_force=True, launch_height_m=self._launch_height)
-        self.hook.start(x, t)
+        self.hook.start(x, t, segments)
+        self._built = (self.walker, w, self.hook.segments)
         if keep is not None:
             h = self.hook
             h.stance, h.t_origin, h.ankle_on, h.step_s = keep[:4]
             h.y[2 * self.nq:] = keep[4]
-        self._works = list(self.hook.work_names)
+        works = list(self.hook.work_names)
+        #: each ledger term's work integrals (their indices after the walker's state)
+        self._ledger_index = [(term, [works.index(k) for k in names if k in works])
+                              for term, names in _LEDGER.items()]
 
     @property
     def x(self) -> np.ndarray:
@@ -281,9 +296,8 @@ class ContactView:
         """World position of the hip along x (horizontal, downhill) [m]: the floating
         coordinate ``hip_x`` (the generated ``points``' hip is that coordinate plus 0; all
         of them were evaluated for it each period)."""
-        names = self.walker.coordinate_names()
-        if "hip_x" in names:
-            return float(self.hook.y[names.index("hip_x")]) + 0.0
+        if self._hip_x is not None:
+            return float(self.hook.y[self._hip_x]) + 0.0
         return float(self.walker.points(self.x)["hip"][0, 0])
 
     def points(self) -> dict:
@@ -292,15 +306,20 @@ class ContactView:
 
     # ------------------------------------------------------------------ stepping
     def _held(self, u) -> tuple[np.ndarray, np.ndarray]:
-        """The action's generalised force (nq,) with leg1, then leg2 in stance."""
+        """The action's generalised force (nq,) with leg1, then leg2 in stance (the torques
+        ``u`` (k,) summed in floats, joint by joint)."""
+        u = [float(tau) for tau in u]
+        if self._last_held[0] == u:  # the same torques as the last period's (a zero action)
+            return self._last_held[1]
         out = []
         for stance in (0, 1):
-            Q = np.zeros(self.nq)
+            Q = [0.0] * self.nq
             for tau, (a, b) in zip(u, self.index[stance]):
                 Q[b] += tau
                 Q[a] -= tau
-            out.append(Q)
-        return tuple(out)
+            out.append(np.array(Q))
+        self._last_held = (u, tuple(out))
+        return self._last_held[1]
 
     def advance(self, u: np.ndarray, t_end: float) -> list[float]:
         """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
@@ -316,12 +335,11 @@ class ContactView:
 
         h, n = self.hook, 2 * self.nq
         h.segments.pdata.held = self._held(np.asarray(u, float))
-        before = h.y[n:].copy()
+        before = h.y[n:].tolist()
         strikes = h.run_until(t_end)
-        gained = h.y[n:] - before
-        for term, names in _LEDGER.items():
-            self.ledger[term] += float(sum(gained[self._works.index(k)] for k in names
-                                           if k in self._works))
+        gained = [b - a for a, b in zip(before, h.y[n:].tolist())]
+        for term, index in self._ledger_index:
+            self.ledger[term] += float(sum(gained[k] for k in index))
         self.steps += len(strikes)
         if h.t < t_end - 1e-12 or h.term is not RunEnd.T_FINAL:
             self._ended(h)

@@ -25,7 +25,7 @@ import ctypes
 
 import numpy as np
 
-__all__ = ["CYRK_METHODS", "DenseInterval", "solve_chunk"]
+__all__ = ["CYRK_METHODS", "ChunkSolver", "DenseInterval", "solve_chunk"]
 
 #: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (RHS calls
 #: of ``walkerlab bench contact``): CyRK's LSODA needs ~1.3x the RHS calls of numbalsoda's, its
@@ -34,8 +34,8 @@ __all__ = ["CYRK_METHODS", "DenseInterval", "solve_chunk"]
 #: ~ -1e5 1/s).
 CYRK_METHODS = {"cyrk_bdf": "BDF"}
 
-_FPTR: dict = {}
-FIRST = [0.0]  # generated kernels module name -> cfunc address
+_FPTR: dict = {}  # generated kernels module name -> cfunc address
+FIRST = [0.0]  # CyRK's first step [s] of every call (0: its own estimate)
 
 
 def address(kernels, ready=None) -> int:
@@ -94,44 +94,112 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     message : str
         CyRK's status message.
     """
-    from CyRK.cy.pyhelpers import find_ode_method_int
-    from CyRK.nb import numba_solver as ns
+    return ChunkSolver(method, rtol, atol, max_step, max_num_steps, kernels=kernels,
+                       ready=ready)(x0, t_eval, data, dense)
 
-    fptr = address(kernels, ready)
-    u0 = np.ascontiguousarray(x0, dtype=np.float64)
-    te = np.ascontiguousarray(t_eval, dtype=np.float64)
-    rt = np.array([float(rtol)])
-    at = np.ascontiguousarray(np.atleast_1d(atol), dtype=np.float64)
-    hmax = float(max_step) if np.isfinite(max_step) else ns.MAX_SIZE
-    # the C entry point that CyRK's njit `nbsolve2_ivp` calls, called here through ctypes
-    # (one call per chunk; avoids compiling that njit wrapper in every process)
-    ptr = ns.c_numba_cysolve_ivp(
-        fptr, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
-        0, 0, data.ctypes.data, data.size * 8, int(max_num_steps), 2000, bool(dense),
-        te.ctypes.data, te.size, None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data,
-        at.size, hmax, float(FIRST[0]), True)
-    if not ptr:  # pragma: no cover - allocation failure inside CyRK
-        out = np.empty((0, u0.size)), False, 0, "CyRK returned no result"
-        return (*out, None) if dense else out
-    kept = False
-    try:
-        ok = bool(ns.c_get_success(ptr))
-        n = int(ns.c_get_size(ptr))
-        ndy = int(ns.c_get_num_dy(ptr))
-        X = (np.ctypeslib.as_array(ns.c_get_y_ptr(ptr), (n, ndy))[:, :u0.size].copy() if n
-             else np.empty((0, u0.size)))
-        args = ctypes.cast(ns.c_get_args_ptr(ptr), ctypes.POINTER(ctypes.c_double))
-        nfev = int(args[data.size - 1] - data[-1])
-        buf = ctypes.create_string_buffer(256)
-        ns.c_get_msg_buf(ptr, ctypes.addressof(buf), 256)
-        msg = buf.value.decode(errors="replace")
-        if dense:
-            kept = True
-            return X, ok, nfev, msg, DenseInterval(ptr, u0.size)
-    finally:
-        if not kept:
-            ns.c_free(ptr)
-    return X, ok, nfev, msg
+
+_API: list = []  # CyRK's numba bridge and the method numbers, imported on first use
+
+
+def _api():
+    """``(numba_solver module, {walkerlab method: CyRK method number})``, imported once."""
+    if not _API:
+        from CyRK.cy.pyhelpers import find_ode_method_int
+        from CyRK.nb import numba_solver as ns
+
+        _API.append((ns, {k: find_ode_method_int(v) for k, v in CYRK_METHODS.items()}))
+    return _API[0]
+
+
+class _Buffer:
+    """A float64 array whose C address is read once (not at every call): the inputs CyRK
+    copies (the start state, the sample times, the data vector) are copied into it."""
+
+    def __init__(self):
+        self.array, self.address = np.empty(0), 0
+
+    def reserve(self, n: int) -> None:
+        """Room for at least ``n`` numbers."""
+        if n > self.array.size:
+            self.array = np.empty(max(n, 2 * self.array.size))
+            self.address = self.array.ctypes.data
+
+    def put(self, values: np.ndarray) -> int:
+        """Copy ``values`` (1-D) in; returns the address of the copy."""
+        n = len(values)
+        self.reserve(n)
+        self.array[:n] = values
+        return self.address
+
+
+class ChunkSolver:
+    """:func:`solve_chunk` with the method, tolerances, step limits and right-hand side
+    fixed: the arguments that do not change between calls are converted once (a run that
+    calls CyRK for every short segment, such as a Gymnasium control period).  Calling it
+    as ``solver(x0, t_eval, data, dense=False)`` answers as :func:`solve_chunk` does.
+
+    Parameters
+    ----------
+    method, rtol, atol, max_step, max_num_steps, kernels, ready
+        As :func:`solve_chunk`'s.
+    """
+
+    def __init__(self, method: str, rtol: float, atol, max_step: float = np.inf,
+                 max_num_steps: int = 0, *, kernels=None, ready=None):
+        ns, methods = _api()
+        self._ns, self._method = ns, methods[method]
+        self._fptr = address(kernels, ready)
+        self._rt = np.array([float(rtol)])
+        self._at = np.ascontiguousarray(np.atleast_1d(atol), dtype=np.float64).copy()
+        self._rt_p, self._at_p = self._rt.ctypes.data, self._at.ctypes.data
+        self._hmax = float(max_step) if np.isfinite(max_step) else ns.MAX_SIZE
+        self._steps = int(max_num_steps)
+        self._y0, self._te, self._data = _Buffer(), _Buffer(), _Buffer()
+        self._msg = ctypes.create_string_buffer(256)
+        self._msg_p = ctypes.addressof(self._msg)
+        self._last_msg = (None, "")
+        self._dense_y = _Buffer()  # the dense outputs' state (each of their calls copies it)
+
+    def __call__(self, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
+                 dense: bool = False):
+        ns = self._ns
+        ny, nt, nd = len(x0), len(t_eval), len(data)
+        # the C entry point that CyRK's njit `nbsolve2_ivp` calls, called here through
+        # ctypes (one call per chunk; avoids compiling that njit wrapper in every process)
+        ptr = ns.c_numba_cysolve_ivp(
+            self._fptr, float(t_eval[0]), float(t_eval[-1]), self._y0.put(x0), ny,
+            self._method, 0, 0, self._data.put(data), nd * 8, self._steps, 2000, bool(dense),
+            self._te.put(t_eval), nt, None, None, 0, self._rt_p, 1, self._at_p,
+            self._at.size, self._hmax, float(FIRST[0]), True)
+        if not ptr:  # pragma: no cover - allocation failure inside CyRK
+            out = np.empty((0, ny)), False, 0, "CyRK returned no result"
+            return (*out, None) if dense else out
+        kept = False
+        try:
+            ok = bool(ns.c_get_success(ptr))
+            n = int(ns.c_get_size(ptr))
+            if n:
+                ndy = int(ns.c_get_num_dy(ptr))
+                at = ctypes.addressof(ns.c_get_y_ptr(ptr).contents)
+                X = np.frombuffer((ctypes.c_double * (n * ndy)).from_address(at),
+                                  np.float64).reshape(n, ndy)[:, :ny].copy()
+            else:
+                X = np.empty((0, ny))
+            args = ctypes.addressof(ns.c_get_args_ptr(ptr).contents)
+            nfev = int(ctypes.c_double.from_address(args + 8 * (nd - 1)).value
+                       - float(data[-1]))
+            ns.c_get_msg_buf(ptr, self._msg_p, 256)
+            raw = self._msg.value
+            if raw != self._last_msg[0]:  # (most calls end with the same message)
+                self._last_msg = (raw, raw.decode(errors="replace"))
+            msg = self._last_msg[1]
+            if dense:
+                kept = True
+                return X, ok, nfev, msg, DenseInterval(ptr, ny, self._dense_y)
+        finally:
+            if not kept:
+                ns.c_free(ptr)
+        return X, ok, nfev, msg
 
 
 class DenseInterval:
@@ -139,19 +207,18 @@ class DenseInterval:
     at a time [s] inside the integrated span for the state (N,); :meth:`free` releases
     CyRK's solution."""
 
-    def __init__(self, ptr, n: int):
+    def __init__(self, ptr, n: int, buffer: _Buffer | None = None):
         self.ptr, self.n = ptr, n
+        # where CyRK writes the state (a caller's buffer that dense outputs may share: each
+        # call copies the state out at once)
+        self._buffer = _Buffer() if buffer is None else buffer
+        self._buffer.reserve(n)
 
     def __call__(self, t: float) -> np.ndarray:
-        from CyRK.nb import numba_solver as ns
-
-        y = np.empty(self.n)
-        ns.c_call(self.ptr, float(t), y.ctypes.data)
-        return y
+        _api()[0].c_call(self.ptr, float(t), self._buffer.address)
+        return self._buffer.array[:self.n].copy()
 
     def free(self) -> None:
-        from CyRK.nb import numba_solver as ns
-
         if self.ptr:
-            ns.c_free(self.ptr)
+            _api()[0].c_free(self.ptr)
             self.ptr = None

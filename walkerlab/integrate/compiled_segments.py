@@ -17,6 +17,7 @@ Python runs per segment and per event (a handful per step), never per integrator
 
 from __future__ import annotations
 
+import math
 import types
 
 import numpy as np
@@ -30,8 +31,8 @@ def grid_inside(grid: np.ndarray, t0: float, t1: float) -> np.ndarray:
     """The sample times of the increasing ``grid`` strictly inside ``(t0, t1)`` [s] (1e-12 s
     from either end), by bisection: ``grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)]``
     without a pass over the whole grid (a run's or an environment's horizon of samples)."""
-    lo = np.searchsorted(grid, t0 + 1e-12, side="right")
-    hi = np.searchsorted(grid, t1 - 1e-12, side="left")
+    lo = grid.searchsorted(t0 + 1e-12, side="right")
+    hi = grid.searchsorted(t1 - 1e-12, side="left")
     return grid[lo:max(lo, hi)]
 
 
@@ -41,6 +42,7 @@ LOCATE_XTOL_S = 1e-13
 SEGMENT_STEPS = 100_000
 
 _ADDRESS: dict = {}  # generated kernels module name -> powered cfunc address
+_EMPTY = np.empty(0)  # no event time (an answer's entries are replaced, never written into)
 
 
 def contact_tables(walker, X) -> np.ndarray:
@@ -79,6 +81,10 @@ class CompiledSegments:
         # a kernels stand-in for _cyrk.solve_chunk: the powered cfunc
         self.kernels = types.SimpleNamespace(__name__=f"{name}_powered",
                                              build_cyrk=lambda: _ADDRESS[name])
+        #: the compiled solver at the run's tolerances (its constant arguments converted once)
+        self.solve = _cyrk.ChunkSolver(solver.method, solver.rtol, atol,
+                                       solver.max_step_s or np.inf, SEGMENT_STEPS,
+                                       kernels=self.kernels)
 
     def run(self, y0, t0: float, t1: float, events, stance: int, t_origin: float,
             push=None, ankle: bool = False, switch_s: float = np.inf):
@@ -100,12 +106,11 @@ class CompiledSegments:
         Stalled
             The compiled solver stopped before ``t1`` (its step limit or a failure).
         """
-        s, grid = self.solver, self.grid
         d = self.pdata.data(stance, t_origin, push, ankle, switch_s, ghost=True)
-        tg = np.concatenate([[t0], grid_inside(grid, t0, t1), [t1]])
-        X, ok, nfev, msg, dense = _cyrk.solve_chunk(
-            s.method, y0, tg, d, s.rtol, self.atol, s.max_step_s or np.inf, SEGMENT_STEPS,
-            kernels=self.kernels, dense=True)
+        inside = grid_inside(self.grid, t0, t1)
+        tg = np.empty(inside.size + 2)
+        tg[0], tg[1:-1], tg[-1] = t0, inside, t1
+        X, ok, nfev, msg, dense = self.solve(y0, tg, d, dense=True)
         self._extra = []
         try:
             out = self._answer(X, ok, nfev, msg, dense, tg, events, len(y0), switch_s, d)
@@ -113,7 +118,7 @@ class CompiledSegments:
             for interp in [dense, *self._extra]:
                 if interp is not None:
                     interp.free()
-        if np.isfinite(switch_s):  # the samples after the heel strike only
+        if math.isfinite(switch_s):  # the samples after the heel strike only
             keep = out.t > switch_s + 1e-12
             out.t, out.y = out.t[keep], out.y[:, keep]
         return out
@@ -122,33 +127,37 @@ class CompiledSegments:
         """:meth:`run`'s answer from the segment's samples ``X`` at ``tg`` and its dense
         output: cut at the first event located on it."""
         n = 2 * self.walker.nq
-        out = types.SimpleNamespace(t_events=[np.empty(0) for _ in events],
-                                    y_events=[np.empty((0, ny)) for _ in events],
+        out = types.SimpleNamespace(t_events=[_EMPTY] * len(events),
+                                    y_events=[np.empty((0, ny))] * len(events),
                                     nfev=nfev, njev=0, status=0, message=msg)
         m = len(X)
-        if events and m:
-            tab = contact_tables(self.walker, X[:, :n])  # once for every event
-            G = np.column_stack([ev.values(X[:, :n], tab) for ev in events])
+        if events and m > 1:
+            Xn = np.ascontiguousarray(X[:, :n])  # the walker's states, one copy for all
+            tab = contact_tables(self.walker, Xn)  # once for every event
+            G = np.empty((m, len(events)))
+            for j, ev in enumerate(events):
+                G[:, j] = ev.values(Xn, tab)
+            hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
+            rows = np.logical_or.reduce(hit, axis=1).nonzero()[0]
+        else:  # no events, or no sample interval
+            rows = ()
+        switch = math.isfinite(switch_s)
+        for k in rows:  # the first interval with a sign change the rules keep
+            k = int(k)
+            keep = hit[k] & (G[0] > 0.0) if k == 0 else hit[k]  # one at the start: the
+            if switch and not tg[k] >= switch_s - 1e-12:  # last segment's; before the
+                continue  # switch: the last step's
+            if keep.any():
+                break
         else:
-            G = np.empty((m, 0))
-        hit = (G[:-1] >= 0.0) & (G[1:] <= 0.0)
-        if len(hit):
-            hit[0] &= G[0] > 0.0  # an event at the start was the last segment's
-        if len(hit) and np.isfinite(switch_s):  # before the switch: the last step's
-            hit &= (tg[:m - 1] >= switch_s - 1e-12)[:, None]
-        rows = np.flatnonzero(hit.any(axis=1))
-        if rows.size:
-            k = int(rows[0])
+            k = None
+        if k is not None:
             if not ok:  # a stopped run's dense output is not the solution's: the interval
                 # integrated again from its first sample
-                _, ok_k, nf_k, _, dense = _cyrk.solve_chunk(
-                    self.solver.method, X[k], tg[k:k + 2], d, self.solver.rtol, self.atol,
-                    self.solver.max_step_s or np.inf, SEGMENT_STEPS, kernels=self.kernels,
-                    dense=True)
+                _, ok_k, nf_k, _, dense = self.solve(X[k], tg[k:k + 2], d, dense=True)
                 out.nfev += nf_k
                 self._extra.append(dense)
-            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, np.flatnonzero(hit[k]),
-                                n)
+            j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, keep.nonzero()[0], n)
             out.t, out.y = tg[1:k + 1], X[1:k + 1].T
             out.t_events[j], out.y_events[j] = np.array([te]), ye[None]
             out.status = 1

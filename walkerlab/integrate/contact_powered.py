@@ -324,6 +324,10 @@ class ActuationHook:
         """Store the samples before ``t_end`` (and ``(t_end, y_end)`` itself if given)."""
         ts = np.asarray(sol.t, float)  # solve_ivp answers a list if no sample came
         Y = sol.y.T if ts.size else np.empty((0, self.Ys[0].shape[1]))
+        if y_end is None and t_end == np.inf:  # all of them (the answer's own arrays)
+            self.ts.append(ts)
+            self.Ys.append(Y)
+            return
         keep = ts < t_end - 1e-12
         self.ts.append(ts[keep] if y_end is None else np.append(ts[keep], t_end))
         self.Ys.append(Y[keep] if y_end is None else np.vstack([Y[keep], y_end[None]]))
@@ -353,11 +357,13 @@ class ActuationHook:
         k = sum(len(a) for a in self.ts) - 1
         self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
 
-    def start(self, x0, t):
-        """Start a run at ``(t, x0)`` (leg2 in stance, the work integrals 0)."""
+    def start(self, x0, t, segments=None):
+        """Start a run at ``(t, x0)`` (leg2 in stance, the work integrals 0); ``segments``:
+        the compiled segments of an earlier run of this hook's walker, solver, grid and held
+        force, used again (None: built for this run where they apply)."""
         acts = self.walker.actuators
-        self.segments = compiled_segments(self.walker, self.solver, self.grid,
-                                          self.held_force)
+        self.segments = (compiled_segments(self.walker, self.solver, self.grid,
+                                           self.held_force) if segments is None else segments)
         self.work_names = (tuple(acts.work_names) if self.segments is None
                            else self.segments.pdata.work_names)
         nw = len(self.work_names)

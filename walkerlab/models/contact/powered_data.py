@@ -95,6 +95,20 @@ class PoweredData:
         #: ``(t, y, d, dy)``: the compiled right-hand side as a numba function (the cfunc's
         #: body; ``module.build_cyrk_powered()`` gives the cfunc's address)
         self.rhs = self.module.powered_packed
+        # the data vector but its discrete state and held force, laid out once (data() fills
+        # those in): ``[base, block (head, B leg1, B leg2, held leg1, held leg2, laws),
+        # scratch, counter]``
+        a, nh = self.base.size, self.head.size
+        self._block = a  # where the block starts
+        self._held_at = a + nh + self.B[0].size + self.B[1].size
+        h = self.head.copy()
+        h[3:5] = self.phase[0]
+        h[31] = self.phase[1][1]
+        h[5], h[6] = -1.0, 0.0
+        block = np.concatenate([h, self.B[0], self.B[1], *self.held, self.laws])
+        block[0] = block.size
+        scratch = np.zeros(n + 12)  # the compiled call's force and powers
+        self._template = np.concatenate([self.base, block, scratch, [0.0]]).astype(np.float64)
 
     def data(self, stance: int, t_origin: float, push: tuple[int, float] | None = None,
              ankle: bool = False, switch_s: float = np.inf, ghost: bool = False
@@ -107,10 +121,8 @@ class PoweredData:
         switch, or with none pending: :mod:`walkerlab.models.contact.powered_source`);
         shape (len,), float64, the call counter 0."""
         acts = self.walker.actuators
-        h = self.head.copy()
-        h[3:5] = self.phase[0]
-        h[31] = self.phase[1][1]
-        h[5], h[6] = -1.0, 0.0
+        out = self._template.copy()
+        h = out[self._block:]  # the block's head (a view)
         h[28:31] = (stance, switch_s, t_origin)
         h[35] = float(acts.min_step_m) if ghost else -1.0
         if push is not None:
@@ -121,10 +133,9 @@ class PoweredData:
         if ankle:
             h[9:12] = (1.0, self.foot[0], acts.ankle_leg[0])
             h[32:34] = (self.foot[1], acts.ankle_leg[1])
-        block = np.concatenate([h, self.B[0], self.B[1], *self.held, self.laws])
-        block[0] = block.size
-        scratch = np.zeros(self.walker.nq + 12)  # the compiled call's force and powers
-        return np.concatenate([self.base, block, scratch, [0.0]]).astype(np.float64)
+        k, n = self._held_at, self.walker.nq
+        out[k:k + n], out[k + n:k + 2 * n] = self.held
+        return out
 
 
 def powered_data(walker, held_force: bool = False) -> PoweredData | None:
