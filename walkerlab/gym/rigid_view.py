@@ -234,7 +234,13 @@ class RigidView:
 
     def hip_x(self) -> float:
         """World position of the hip along x (horizontal, downhill) [m]."""
-        return float(self.foot[0] + self.walker.points(self.x)["hip"][0])
+        points = self.walker.points
+        hx = _HIP_X.get(id(points))
+        if hx is None:
+            hx = _HIP_X[id(points)] = (points, point_coordinate(points, "hip", 0, self.x))
+        if hx[1] is None:
+            return float(self.foot[0] + points(self.x)["hip"][0])
+        return float(self.foot[0] + hx[1](self.x))
 
     def points(self) -> dict:
         """World positions (2,) [m] of the walker's named points, by role."""
@@ -540,6 +546,115 @@ class RigidView:
         self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
         self.t_step = self.t
         self._start_step()
+
+
+#: per ``points`` function (by id): ``(points, its hip's x alone or None)``
+#: (:func:`point_coordinate`; the function kept: its id stays its own)
+_HIP_X: dict = {}
+
+
+def _function_source(fn) -> str | None:
+    """The source of a function of a generated module (:func:`walkerlab.codegen.cache.
+    read_source`: the checked text it was compiled from), dedented, or None."""
+    from pathlib import Path
+
+    from walkerlab.codegen.cache import read_source
+
+    code = fn.__code__
+    body = read_source(Path(code.co_filename))
+    if body is None:
+        return None
+    lines = body.splitlines()[code.co_firstlineno - 1:]
+    head = lines[0]
+    indent = len(head) - len(head.lstrip())
+    block = [head]
+    for line in lines[1:]:
+        if line.strip() and len(line) - len(line.lstrip()) <= indent:
+            break
+        block.append(line)
+    return "\n".join(line[indent:] for line in block)
+
+
+def point_coordinate(points, name: str, axis: int, probe: np.ndarray):
+    """One coordinate of one named point of a generated ``points`` function, alone:
+    ``x -> points(x)[name][axis]`` computing only what that entry needs, or None.
+
+    The generated function (:func:`walkerlab.codegen.source.numpy_fn`: the state unpacked,
+    assignments, ``return {name: np.array((c0, c1, ...)), ...}``) is read from the checked
+    text of its module (:func:`walkerlab.codegen.cache.read_source`) and the assignments
+    the entry does not use are left out: the same expressions on the same numbers (its
+    closure's constants bound as they are), so the same value bit for bit.  None where the
+    function is not of that form, its text is not found, or the text read does not give
+    ``points(probe)`` bit for bit (checked once here).
+
+    Parameters
+    ----------
+    points : callable
+        ``x (2n,) -> {name: ndarray}``.
+    name : str
+        The point (``"hip"``).
+    axis : int
+        The coordinate (0: x).
+    probe : ndarray (2n,)
+        A state the text read is checked at.
+
+    Returns
+    -------
+    callable or None
+        ``x (2n,) -> float`` (a numpy scalar).
+    """
+    import ast
+
+    try:
+        src = _function_source(points)
+        if src is None:
+            return None
+        fn = ast.parse(src).body[0]
+        body, ret = fn.body[:-1], fn.body[-1]
+        if not (isinstance(fn, ast.FunctionDef) and fn.name == points.__code__.co_name
+                and isinstance(ret, ast.Return) and isinstance(ret.value, ast.Dict)
+                and len(fn.args.args) == 1 and body and not fn.decorator_list
+                and all(isinstance(a, ast.Assign) and len(a.targets) == 1 for a in body)):
+            return None
+        arg = fn.args.args[0].arg
+        value = None
+        for k, v in zip(ret.value.keys, ret.value.values):
+            if isinstance(k, ast.Constant) and k.value == name:
+                value = v
+        if not (isinstance(value, ast.Call) and len(value.args) == 1 and not value.keywords
+                and isinstance(value.args[0], ast.Tuple)
+                and axis < len(value.args[0].elts)):
+            return None
+        expr = value.args[0].elts[axis]
+        unpack = body[0]  # the state unpacked: ``a, b, ..., = x``
+        if not (isinstance(unpack.targets[0], ast.Tuple) and isinstance(unpack.value, ast.Name)
+                and unpack.value.id == arg):
+            return None
+        need = {n.id for n in ast.walk(expr) if isinstance(n, ast.Name)}
+        kept = []
+        for a in reversed(body[1:]):  # the assignments the entry needs, in order
+            if not isinstance(a.targets[0], ast.Name):
+                return None
+            if a.targets[0].id in need:
+                kept.append(a)
+                need |= {n.id for n in ast.walk(a.value) if isinstance(n, ast.Name)}
+        whole = ast.FunctionDef(name="_whole", args=fn.args, body=list(fn.body),
+                                decorator_list=[])
+        fn.body = [unpack, *reversed(kept), ast.Return(expr)]
+        code = compile(ast.fix_missing_locations(ast.Module([whole, fn], [])),
+                       points.__code__.co_filename, "exec")
+        scope = dict(points.__globals__)
+        scope.update(zip(points.__code__.co_freevars,
+                         (c.cell_contents for c in points.__closure__ or ())))
+        exec(code, scope)  # noqa: S102 - the generated function's own text, sliced
+        one, x = scope[fn.name], np.array(probe, float)
+        ref, again = points(x), scope["_whole"](x)  # the text read is the function's
+        if (set(ref) != set(again) or not all(np.array_equal(ref[k], again[k]) for k in ref)
+                or np.shape(one(x)) != () or not float(one(x)) == float(ref[name][axis])):
+            return None
+        return one
+    except Exception:  # noqa: BLE001 - not a generated function: the whole points then
+        return None
 
 
 #: per ``points`` function (by id): ``(points, whether it takes states as columns)``
