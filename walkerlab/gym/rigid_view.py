@@ -49,7 +49,9 @@ the heel strike's collision, <= 0).
 
 from __future__ import annotations
 
+import math
 import sys
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -235,12 +237,15 @@ class RigidView:
     def hip_x(self) -> float:
         """World position of the hip along x (horizontal, downhill) [m]."""
         points = self.walker.points
-        hx = _HIP_X.get(id(points))
+        try:
+            hx = _HIP_X[points]
+        except KeyError:
+            hx = _HIP_X[points] = point_coordinate(points, "hip", 0, self.x)
+        except TypeError:  # (not weakly referable: the whole points)
+            hx = None
         if hx is None:
-            hx = _HIP_X[id(points)] = (points, point_coordinate(points, "hip", 0, self.x))
-        if hx[1] is None:
             return float(self.foot[0] + points(self.x)["hip"][0])
-        return float(self.foot[0] + hx[1](self.x))
+        return float(self.foot[0] + hx(self.x))
 
     def points(self) -> dict:
         """World positions (2,) [m] of the walker's named points, by role."""
@@ -467,7 +472,7 @@ class RigidView:
         if self.ground is not None:
             self._pieces.append((phase, run.dense, (self.t, run.t_last)))
         self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-        if run.failed or not np.logical_and.reduce(np.isfinite(self.x)):
+        if run.failed or not all(map(math.isfinite, self.x.tolist())):
             self.ended = "solver_failure"
             return strikes
         if run.event is None:
@@ -548,19 +553,18 @@ class RigidView:
         self._start_step()
 
 
-#: per ``points`` function (by id): ``(points, its hip's x alone or None)``
-#: (:func:`point_coordinate`; the function kept: its id stays its own)
-_HIP_X: dict = {}
+#: per ``points`` function: its hip's x alone (:func:`point_coordinate`) or None
+_HIP_X: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _function_source(fn) -> str | None:
-    """The source of a function of a generated module (:func:`walkerlab.codegen.cache.
-    read_source`: the checked text it was compiled from), dedented, or None."""
+def _function_source(code) -> str | None:
+    """The source of a function of a generated module by its code object
+    (:func:`walkerlab.codegen.cache.read_source`: the checked text it was compiled from),
+    dedented, or None."""
     from pathlib import Path
 
     from walkerlab.codegen.cache import read_source
 
-    code = fn.__code__
     body = read_source(Path(code.co_filename))
     if body is None:
         return None
@@ -575,6 +579,54 @@ def _function_source(fn) -> str | None:
     return "\n".join(line[indent:] for line in block)
 
 
+def _sliced(code, name: str, axis: int):
+    """The module code defining ``_whole`` (the generated function of ``code``, read from
+    its module's checked text) and the function of the one coordinate (:func:`point_coordinate`),
+    with that function's name; None where the function is not of the generated form."""
+    import ast
+
+    src = _function_source(code)
+    if src is None:
+        return None
+    fn = ast.parse(src).body[0]
+    body, ret = fn.body[:-1], fn.body[-1]
+    if not (isinstance(fn, ast.FunctionDef) and fn.name == code.co_name
+            and isinstance(ret, ast.Return) and isinstance(ret.value, ast.Dict)
+            and len(fn.args.args) == 1 and body and not fn.decorator_list
+            and all(isinstance(a, ast.Assign) and len(a.targets) == 1 for a in body)):
+        return None
+    arg = fn.args.args[0].arg
+    value = None
+    for k, v in zip(ret.value.keys, ret.value.values):
+        if isinstance(k, ast.Constant) and k.value == name:
+            value = v
+    if not (isinstance(value, ast.Call) and len(value.args) == 1 and not value.keywords
+            and isinstance(value.args[0], ast.Tuple) and axis < len(value.args[0].elts)):
+        return None
+    expr = value.args[0].elts[axis]
+    unpack = body[0]  # the state unpacked: ``a, b, ..., = x``
+    if not (isinstance(unpack.targets[0], ast.Tuple) and isinstance(unpack.value, ast.Name)
+            and unpack.value.id == arg):
+        return None
+    need = {n.id for n in ast.walk(expr) if isinstance(n, ast.Name)}
+    kept = []
+    for a in reversed(body[1:]):  # the assignments the entry needs, in order
+        if not isinstance(a.targets[0], ast.Name):
+            return None
+        if a.targets[0].id in need:
+            kept.append(a)
+            need |= {n.id for n in ast.walk(a.value) if isinstance(n, ast.Name)}
+    whole = ast.FunctionDef(name="_whole", args=fn.args, body=list(fn.body), decorator_list=[])
+    fn.body = [unpack, *reversed(kept), ast.Return(expr)]
+    return (compile(ast.fix_missing_locations(ast.Module([whole, fn], [])), code.co_filename,
+                    "exec"), fn.name)
+
+
+#: per generated function's code, name and axis: :func:`_sliced`'s, and whether its text was
+#: checked against the function
+_SLICED: dict = {}
+
+
 def point_coordinate(points, name: str, axis: int, probe: np.ndarray):
     """One coordinate of one named point of a generated ``points`` function, alone:
     ``x -> points(x)[name][axis]`` computing only what that entry needs, or None.
@@ -582,10 +634,10 @@ def point_coordinate(points, name: str, axis: int, probe: np.ndarray):
     The generated function (:func:`walkerlab.codegen.source.numpy_fn`: the state unpacked,
     assignments, ``return {name: np.array((c0, c1, ...)), ...}``) is read from the checked
     text of its module (:func:`walkerlab.codegen.cache.read_source`) and the assignments
-    the entry does not use are left out: the same expressions on the same numbers (its
-    closure's constants bound as they are), so the same value bit for bit.  None where the
-    function is not of that form, its text is not found, or the text read does not give
-    ``points(probe)`` bit for bit (checked once here).
+    the entry does not use are left out: the same expressions on the same numbers (the
+    function's closure bound as it is), so the same value bit for bit.  None where the
+    function is not of that form or its text is not found, or where the text read does
+    not give ``points(probe)`` bit for bit (checked once per generated function).
 
     Parameters
     ----------
@@ -596,61 +648,35 @@ def point_coordinate(points, name: str, axis: int, probe: np.ndarray):
     axis : int
         The coordinate (0: x).
     probe : ndarray (2n,)
-        A state the text read is checked at.
+        A state the result is checked at.
 
     Returns
     -------
     callable or None
         ``x (2n,) -> float`` (a numpy scalar).
     """
-    import ast
-
     try:
-        src = _function_source(points)
-        if src is None:
+        code = points.__code__
+        key = (code, name, axis)
+        if key not in _SLICED:
+            _SLICED[key] = [_sliced(code, name, axis), False]
+        entry = _SLICED[key]
+        if entry[0] is None:
             return None
-        fn = ast.parse(src).body[0]
-        body, ret = fn.body[:-1], fn.body[-1]
-        if not (isinstance(fn, ast.FunctionDef) and fn.name == points.__code__.co_name
-                and isinstance(ret, ast.Return) and isinstance(ret.value, ast.Dict)
-                and len(fn.args.args) == 1 and body and not fn.decorator_list
-                and all(isinstance(a, ast.Assign) and len(a.targets) == 1 for a in body)):
-            return None
-        arg = fn.args.args[0].arg
-        value = None
-        for k, v in zip(ret.value.keys, ret.value.values):
-            if isinstance(k, ast.Constant) and k.value == name:
-                value = v
-        if not (isinstance(value, ast.Call) and len(value.args) == 1 and not value.keywords
-                and isinstance(value.args[0], ast.Tuple)
-                and axis < len(value.args[0].elts)):
-            return None
-        expr = value.args[0].elts[axis]
-        unpack = body[0]  # the state unpacked: ``a, b, ..., = x``
-        if not (isinstance(unpack.targets[0], ast.Tuple) and isinstance(unpack.value, ast.Name)
-                and unpack.value.id == arg):
-            return None
-        need = {n.id for n in ast.walk(expr) if isinstance(n, ast.Name)}
-        kept = []
-        for a in reversed(body[1:]):  # the assignments the entry needs, in order
-            if not isinstance(a.targets[0], ast.Name):
-                return None
-            if a.targets[0].id in need:
-                kept.append(a)
-                need |= {n.id for n in ast.walk(a.value) if isinstance(n, ast.Name)}
-        whole = ast.FunctionDef(name="_whole", args=fn.args, body=list(fn.body),
-                                decorator_list=[])
-        fn.body = [unpack, *reversed(kept), ast.Return(expr)]
-        code = compile(ast.fix_missing_locations(ast.Module([whole, fn], [])),
-                       points.__code__.co_filename, "exec")
+        module, fname = entry[0]
         scope = dict(points.__globals__)
-        scope.update(zip(points.__code__.co_freevars,
-                         (c.cell_contents for c in points.__closure__ or ())))
-        exec(code, scope)  # noqa: S102 - the generated function's own text, sliced
-        one, x = scope[fn.name], np.array(probe, float)
-        ref, again = points(x), scope["_whole"](x)  # the text read is the function's
-        if (set(ref) != set(again) or not all(np.array_equal(ref[k], again[k]) for k in ref)
-                or np.shape(one(x)) != () or not float(one(x)) == float(ref[name][axis])):
+        scope.update(zip(code.co_freevars, (c.cell_contents for c in points.__closure__ or ())))
+        exec(module, scope)  # noqa: S102 - the generated function's own text, sliced
+        one, x = scope[fname], np.array(probe, float)
+        ref = points(x)
+        if not entry[1]:  # the text read is the function's (the whole of it, bit for bit)
+            again = scope["_whole"](x)
+            if set(ref) != set(again) or not all(np.array_equal(ref[k], again[k])
+                                                 for k in ref):
+                entry[0] = None
+                return None
+            entry[1] = True
+        if np.shape(one(x)) != () or not float(one(x)) == float(ref[name][axis]):
             return None
         return one
     except Exception:  # noqa: BLE001 - not a generated function: the whole points then

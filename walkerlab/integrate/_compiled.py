@@ -89,7 +89,7 @@ class CompiledDense:
         if last < 0:
             raise ValueError("no dense output")  # pragma: no cover
         row = np.empty(self.m)
-        addr = row.ctypes.data
+        addr = _address(row)
         for c, t in enumerate(times.tolist()):
             for j, piece in enumerate(self.pieces):
                 ta, tb = piece[0], piece[1]
@@ -105,12 +105,25 @@ class CompiledDense:
         return out[:, 0] if t.ndim == 0 else out
 
 
+_BYTE = ctypes.c_char.from_buffer
+_ADDRESS = ctypes.addressof
+
+
+def _address(a: np.ndarray) -> int:
+    """The address of the data of the writable C-contiguous array ``a`` (as ``a.ctypes.data``,
+    without building numpy's ctypes helper object per call)."""
+    try:
+        return _ADDRESS(_BYTE(a))
+    except (TypeError, ValueError, BufferError):  # empty or read-only: numpy's way
+        return a.ctypes.data
+
+
 def _copy_out(ptr, shape: tuple) -> np.ndarray:
     """A float64 array of ``shape`` copied from C memory at ``ptr`` (a ctypes pointer):
     one memmove, no ctypes array type built per call as ``np.ctypeslib.as_array`` does."""
     out = np.empty(shape)
     if out.size:
-        ctypes.memmove(out.ctypes.data, ptr, out.nbytes)
+        ctypes.memmove(_address(out), ptr, out.nbytes)
     return out
 
 
@@ -127,8 +140,8 @@ def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     c0 = data[-1]
     ptr = ns.c_numba_cysolve_ivp(
-        addr, float(t0), float(t1), y0.ctypes.data, y0.size, method_int, 0, n_extra,
-        data.ctypes.data, data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
+        addr, float(t0), float(t1), _address(y0), y0.size, method_int, 0, n_extra,
+        _address(data), data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
         None, None, 0, tols[0], tols[1], tols[2], tols[3], hmax,
         float(first_step), False)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK
@@ -222,11 +235,14 @@ def _first_crossing(G: np.ndarray, dirs: np.ndarray):
     without numpy's per-call overhead), a long chunk's by numpy."""
     if G.size <= _SMALL_CROSSING:
         rows, ds = G.tolist(), dirs.tolist()
+        before = rows[0]
         for k in range(1, len(rows)):
-            hit = [(d >= 0 and g0 <= 0 <= g1) or (d <= 0 and g0 >= 0 >= g1)
-                   for g0, g1, d in zip(rows[k - 1], rows[k], ds)]
-            if any(hit):
-                return k, np.array(hit)
+            after = rows[k]
+            for g0, g1, d in zip(before, after, ds):
+                if (d >= 0 and g0 <= 0 <= g1) or (d <= 0 and g0 >= 0 >= g1):
+                    return k, np.array([(d >= 0 and a <= 0 <= b) or (d <= 0 and a >= 0 >= b)
+                                        for a, b, d in zip(before, after, ds)])
+            before = after
         return None, None
     nonpos, nonneg = G <= 0, G >= 0
     hit = nonpos[:-1] & nonneg[1:]
@@ -279,6 +295,16 @@ class _Plan:
         self.cols = cols is not None
         self.n_extra, self.gcol, self.goff = (cols[0], cols[1] + m, cols[2]) if cols \
             else (0, None, None)
+        self._guards = None  # (guards, their directions, their functions): guard_arrays
+
+    def guard_arrays(self, guards) -> tuple:
+        """``(directions (g,), functions)`` of the phase's ``guards`` (the last guards'
+        kept: the same guards, the same arrays)."""
+        key = tuple(guards)
+        if self._guards is None or self._guards[0] != key:
+            self._guards = (key, np.array([g.direction for g in key]),
+                            [g.function for g in key])
+        return self._guards[1], self._guards[2]
 
     def run(self, data, ta, tb, ya, max_steps, first_step, dense):
         """:func:`_solve` from ``ya`` at ``ta`` towards ``tb`` with the flow's ``data``."""
@@ -327,7 +353,7 @@ def _crossing(plan: _Plan, data, T, Y, k: int, active, fns, n: int, m: int, dens
         dense.pieces.append(plan.piece(data, T[0], T[k - 1], Y[0, :m], h0))
     dense.pieces.append([float(T[k - 1]), float(T[k]), step])
     out = np.empty(m + plan.n_extra)
-    call, sp, op = plan.ns.c_call, step.ptr, out.ctypes.data
+    call, sp, op = plan.ns.c_call, step.ptr, _address(out)
     roots = []
     for i in np.flatnonzero(active):  # each g is used (by brentq) in its iteration only
         if plan.cols:
@@ -373,8 +399,7 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     m = y0.size
     plan = _plan(compiled, variational, solver, m)
     data = compiled.data()  # CyRK copies it: never written here
-    dirs = np.array([g.direction for g in guards])
-    fns = [g.function for g in guards]
+    dirs, fns = plan.guard_arrays(guards)
     if plan.cols:
         def values(T, Y):
             return Y[:, plan.gcol] + plan.goff
