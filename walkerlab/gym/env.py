@@ -482,7 +482,7 @@ class WalkerEnv(gym.Env):
         stance = (s.leg if self.view == "rigid" else f"leg{s.stance + 1}")
         info = {"time_s": float(s.t), "heel_strike": bool(strikes),
                 "heel_strike_time_s": float(strikes[-1]) if strikes else None,
-                "heel_strike_times_s": [float(t) for t in strikes], "steps": int(s.steps),
+                "heel_strike_times_s": list(map(float, strikes)), "steps": int(s.steps),
                 "stance_leg": stance, "hip_x_m": self._hip_x, "termination": s.ended,
                 "solver_message": str(getattr(s, "failure", "")),
                 "terrain_seed": int(self.terrain_seed)}

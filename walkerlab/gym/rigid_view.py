@@ -82,9 +82,9 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
 #: the compiled control step's integrator: CyRK's DOP853 (Hairer's 8(5,3) pair, the stepping
 #: in C++) on the numba-compiled flow, at the scene solver's tolerances
 COMPILED_METHOD = "DOP853"
-#: each actuator's constant torque in a law block (:mod:`walkerlab.codegen.torque_law`:
-#: ``b[3 + HEAD i + 1]``, ``constant_n_m``), for up to 64 actuators
-_CONSTANTS = 3 + HEAD * np.arange(64) + 1
+#: the first actuator's constant torque in a law block (:mod:`walkerlab.codegen.torque_law`:
+#: ``b[3 + HEAD i + 1]``, ``constant_n_m``; actuator ``i``'s ``HEAD i`` further on)
+_CONSTANT_0 = 3 + 1
 
 
 class RigidView:
@@ -429,7 +429,8 @@ class RigidView:
         fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
                 else None)
         if fast is not None:  # the compiled control step: the action's torques held in
-            fast[1][_CONSTANTS[:acts.u.size]] = acts.u  # the law block (each constant)
+            fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * acts.u.size:HEAD] = acts.u  # the law
+            # block (each actuator's constant)
         return w, acts, act_on, phase, t_stop, fast
 
     def integrate_piece(self, piece):

@@ -140,7 +140,8 @@ def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     c0 = data[-1]
     ptr = ns.c_numba_cysolve_ivp(
-        addr, float(t0), float(t1), _address(y0), y0.size, method_int, 0, n_extra,
+        addr, float(t0), float(t1), _address(y0), y0.size, method_int,
+        max_steps + 1 if max_steps else 0, n_extra,  # storage for a chunk's steps (0: CyRK's)
         _address(data), data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
         None, None, 0, tols[0], tols[1], tols[2], tols[3], hmax,
         float(first_step), False)
@@ -227,14 +228,15 @@ def callable_flow(compiled, n: int, variational: bool):
 _SMALL_CROSSING = 48
 
 
-def _first_crossing(G: np.ndarray, dirs: np.ndarray):
-    """First row ``k >= 1`` of guard values ``G`` (k, g) where a guard changes sign in its
-    direction between rows ``k-1`` and ``k`` (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``,
-    ``down = g0 >= 0 >= g1``), and the mask of those guards; ``(None, None)`` if none.
-    A control period's few steps and guards are compared in Python (the same comparisons,
-    without numpy's per-call overhead), a long chunk's by numpy."""
-    if G.size <= _SMALL_CROSSING:
-        rows, ds = G.tolist(), dirs.tolist()
+def _first_crossing(G, dirs: np.ndarray):
+    """First row ``k >= 1`` of guard values ``G`` (k, g) (an array, or its rows as lists)
+    where a guard changes sign in its direction between rows ``k-1`` and ``k``
+    (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``, ``down = g0 >= 0 >= g1``), and the mask
+    of those guards; ``(None, None)`` if none.  A control period's few steps and guards are
+    compared in Python (the same comparisons, without numpy's per-call overhead), a long
+    chunk's by numpy."""
+    if type(G) is list or G.size <= _SMALL_CROSSING:
+        rows, ds = (G if type(G) is list else G.tolist()), dirs.tolist()
         before = rows[0]
         for k in range(1, len(rows)):
             after = rows[k]
@@ -296,6 +298,8 @@ class _Plan:
         self.n_extra, self.gcol, self.goff = (cols[0], cols[1] + m, cols[2]) if cols \
             else (0, None, None)
         self._guards = None  # (guards, their directions, their functions): guard_arrays
+        #: each guard's (column, offset) as Python numbers (a few step points' values)
+        self.guard_cols = list(zip(self.gcol.tolist(), self.goff.tolist())) if cols else []
 
     def guard_arrays(self, guards) -> tuple:
         """``(directions (g,), functions)`` of the phase's ``guards`` (the last guards'
@@ -402,6 +406,9 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     dirs, fns = plan.guard_arrays(guards)
     if plan.cols:
         def values(T, Y):
+            if T.size * len(plan.guard_cols) <= _SMALL_CROSSING:  # a few step points: the
+                cols = plan.guard_cols                             # same sums in Python
+                return [[r[c] + o for c, o in cols] for r in Y.tolist()]
             return Y[:, plan.gcol] + plan.goff
     else:
         def values(T, Y):
