@@ -140,8 +140,7 @@ def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     c0 = data[-1]
     ptr = ns.c_numba_cysolve_ivp(
-        addr, float(t0), float(t1), _address(y0), y0.size, method_int,
-        max_steps + 1 if max_steps else 0, n_extra,  # storage for a chunk's steps (0: CyRK's)
+        addr, float(t0), float(t1), _address(y0), y0.size, method_int, 0, n_extra,
         _address(data), data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
         None, None, 0, tols[0], tols[1], tols[2], tols[3], hmax,
         float(first_step), False)
