@@ -258,9 +258,6 @@ def actuated_module(structure, joints):
                                   build)
 
 
-_ZERO = np.zeros(1)  # the data vector's call counter
-
-
 @dataclass(frozen=True, eq=False)
 class ActuatedFlow(CompiledFlow):
     """Handle on an actuated walker's compiled flow (:class:`CompiledFlow` with laws).
@@ -297,11 +294,15 @@ class ActuatedFlow(CompiledFlow):
     def data(self) -> np.ndarray:
         """Constants, the law block (with the present step's start time) and a zeroed
         call counter."""
-        c = self._memo.get("consts")
-        if c is None:
-            c = self._memo["consts"] = self.module().constants(self.params)
-        out = np.concatenate((c, self.laws, _ZERO), dtype=np.float64)  # (data_into's numbers)
-        out[c.size + 2] = float(getattr(self.actuators, "t_origin", 0.0))
+        blank = self._memo.get("blank")
+        if blank is None:  # the constants and a zeroed counter, kept (data_into's numbers)
+            blank = np.empty(self.data_size())
+            self.data_into(blank)
+            blank = self._memo["blank"] = (blank, blank.size - 1 - self.laws.size)
+        out = blank[0].copy()
+        nc = blank[1]
+        out[nc:-1] = self.laws
+        out[nc + 2] = float(getattr(self.actuators, "t_origin", 0.0))
         return out
 
     def data_size(self) -> int:

@@ -309,6 +309,20 @@ class _Plan:
                             [g.function for g in key])
         return self._guards[1], self._guards[2]
 
+    def guard_values(self, T, Y):
+        """The guards' values at the step points ``Y`` (k, m + n_extra): an array (k, g),
+        or for a few step points their rows as lists (the same sums in Python), or None
+        when no guard can change sign between them (each guard's values all above 0, or
+        all below: :func:`_first_crossing` would find nothing)."""
+        cols = self.guard_cols
+        if T.size * len(cols) > _SMALL_CROSSING:
+            return Y[:, self.gcol] + self.goff
+        by_guard = [[v + o for v in Y[:, c].tolist()] for c, o in cols]
+        for col in by_guard:  # (a NaN makes min or max NaN, or is left out of both)
+            if not (min(col) > 0.0 or max(col) < 0.0):
+                return [list(g) for g in zip(*by_guard)]
+        return None
+
     def run(self, data, ta, tb, ya, max_steps, first_step, dense):
         """:func:`_solve` from ``ya`` at ``ta`` towards ``tb`` with the flow's ``data``."""
         return _solve(self.addr, data, ta, tb, ya, self.method_int, self.tols,
@@ -404,11 +418,7 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     data = compiled.data()  # CyRK copies it: never written here
     dirs, fns = plan.guard_arrays(guards)
     if plan.cols:
-        def values(T, Y):
-            if T.size * len(plan.guard_cols) <= _SMALL_CROSSING:  # a few step points: the
-                cols = plan.guard_cols                             # same sums in Python
-                return [[r[c] + o for c, o in cols] for r in Y.tolist()]
-            return Y[:, plan.gcol] + plan.goff
+        values = plan.guard_values
     else:
         def values(T, Y):
             return np.array([[f(t, y[:n]) for f in fns] for t, y in zip(T, Y)])
@@ -417,7 +427,8 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     while True:
         _res, T, Y, ok, msg, nf = plan.run(data, ta, t1, ya, K, h0, False)
         nfev += nf
-        k, active = _first_crossing(values(T, Y), dirs) if T.size > 1 else (None, None)
+        G = values(T, Y) if T.size > 1 else None
+        k, active = (None, None) if G is None else _first_crossing(G, dirs)
         if k is not None:
             te, ye, failed, msg1, i, nf1 = _crossing(plan, data, T, Y, k, active, fns, n, m,
                                                      dense, h0)
