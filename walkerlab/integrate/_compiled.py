@@ -118,15 +118,6 @@ def _address(a: np.ndarray) -> int:
         return a.ctypes.data
 
 
-def _copy_out(ptr, shape: tuple) -> np.ndarray:
-    """A float64 array of ``shape`` copied from C memory at ``ptr`` (a ctypes pointer):
-    one memmove, no ctypes array type built per call as ``np.ctypeslib.as_array`` does."""
-    out = np.empty(shape)
-    if out.size:
-        ctypes.memmove(_address(out), ptr, out.nbytes)
-    return out
-
-
 _NO_TIMES = np.empty(0)
 _NO_TIMES_PTR = _NO_TIMES.ctypes.data
 
@@ -149,8 +140,14 @@ def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step
     res = _Result(ptr, ns)
     k = int(ns.c_get_size(ptr))
     ndy = int(ns.c_get_num_dy(ptr))
-    T = _copy_out(ns.c_get_t_ptr(ptr), (k,))
-    Y = _copy_out(ns.c_get_y_ptr(ptr), (k, ndy))
+    if k:  # the times and states copied into one block (one allocation)
+        out = np.empty(k * (1 + ndy))
+        at = _ADDRESS(_BYTE(out))
+        ctypes.memmove(at, ns.c_get_t_ptr(ptr), 8 * k)
+        ctypes.memmove(at + 8 * k, ns.c_get_y_ptr(ptr), 8 * k * ndy)
+        T, Y = out[:k], out[k:].reshape(k, ndy)
+    else:
+        T, Y = np.empty(0), np.empty((0, ndy))
     # the call counter: the last entry of CyRK's copy of the data vector
     args = ctypes.addressof(ns.c_get_args_ptr(ptr).contents)
     nfev = int(ctypes.c_double.from_address(args + 8 * (data.size - 1)).value - c0)
