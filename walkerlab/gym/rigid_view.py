@@ -240,7 +240,7 @@ class RigidView:
         try:
             hx = _HIP_X[points]
         except KeyError:
-            hx = _HIP_X[points] = point_coordinate(points, "hip", 0, self.x)
+            hx = _HIP_X[points] = _point_coordinate(points, "hip", 0, self.x)
         except TypeError:  # (not weakly referable: the whole points)
             hx = None
         if hx is None:
@@ -554,7 +554,7 @@ class RigidView:
         self._start_step()
 
 
-#: per ``points`` function: its hip's x alone (:func:`point_coordinate`) or None
+#: per ``points`` function: its hip's x alone (:func:`_point_coordinate`) or None
 _HIP_X: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -582,8 +582,9 @@ def _function_source(code) -> str | None:
 
 def _sliced(code, name: str, axis: int):
     """The module code defining ``_whole`` (the generated function of ``code``, read from
-    its module's checked text) and the function of the one coordinate (:func:`point_coordinate`),
-    with that function's name; None where the function is not of the generated form."""
+    its module's checked text) and the function of the one coordinate
+    (:func:`_point_coordinate`), with that function's name; None where the function is not
+    of the generated form."""
     import ast
 
     src = _function_source(code)
@@ -628,7 +629,7 @@ def _sliced(code, name: str, axis: int):
 _SLICED: dict = {}
 
 
-def point_coordinate(points, name: str, axis: int, probe: np.ndarray):
+def _point_coordinate(points, name: str, axis: int, probe: np.ndarray):
     """One coordinate of one named point of a generated ``points`` function, alone:
     ``x -> points(x)[name][axis]`` computing only what that entry needs, or None.
 

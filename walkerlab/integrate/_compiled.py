@@ -300,11 +300,11 @@ class _Plan:
     def guard_arrays(self, guards) -> tuple:
         """``(directions (g,), functions)`` of the phase's ``guards`` (the last guards'
         kept: the same guards, the same arrays)."""
-        key = tuple(guards)
-        if self._guards is None or self._guards[0] != key:
-            self._guards = (key, np.array([g.direction for g in key]),
-                            [g.function for g in key])
-        return self._guards[1], self._guards[2]
+        key, seen = tuple(guards), self._guards
+        if seen is None or seen[0] != key:
+            seen = self._guards = (key, np.array([g.direction for g in key]),
+                                   [g.function for g in key])
+        return seen[1], seen[2]
 
     def guard_values(self, T, Y):
         """The guards' values at the step points ``Y`` (k, m + n_extra): an array (k, g),
