@@ -144,7 +144,7 @@ def test_each_phase_ends_in_its_first_chunk_with_few_steps_wasted(walker, scene,
 
     def spy(G, dirs):
         out = first(G, dirs)
-        seen.append((G.shape[0] - 1, out[0]))
+        seen.append((len(G) - 1, out[0]))  # (G: an array, or a few step points' rows)
         return out
 
     mp = pytest.MonkeyPatch()

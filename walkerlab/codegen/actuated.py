@@ -294,8 +294,16 @@ class ActuatedFlow(CompiledFlow):
     def data(self) -> np.ndarray:
         """Constants, the law block (with the present step's start time) and a zeroed
         call counter."""
-        out = np.empty(self.data_size())
-        self.data_into(out)
+        key = ("blank", self.laws.size)  # (a flow replaced with other laws: its own)
+        blank = self._memo.get(key)
+        if blank is None:  # the constants and a zeroed counter, kept (data_into's numbers)
+            blank = np.empty(self.data_size())
+            self.data_into(blank)
+            blank = self._memo[key] = (blank, blank.size - 1 - self.laws.size)
+        out = blank[0].copy()
+        nc = blank[1]
+        out[nc:-1] = self.laws
+        out[nc + 2] = float(getattr(self.actuators, "t_origin", 0.0))
         return out
 
     def data_size(self) -> int:

@@ -123,6 +123,15 @@ INFO_KEYS = ("time_s", "heel_strike", "heel_strike_time_s", "heel_strike_times_s
 _GAITS: dict[str, Any] = {}
 
 
+#: ``term -> "ledger_<term>"`` (:meth:`WalkerEnv._info`'s keys, made once)
+_LEDGER_KEYS: dict[str, str] = {}
+
+
+def _ledger_key(term: str) -> str:
+    key = _LEDGER_KEYS[term] = f"ledger_{term}"
+    return key
+
+
 def _gait(walker):
     key = walker.scene.model_dump_json()
     if key not in _GAITS:
@@ -393,6 +402,7 @@ class WalkerEnv(gym.Env):
             np.concatenate([np.full(m, -OBS_BOUND), [0.0, 0.0, 0.0]]),
             np.concatenate([np.full(m, OBS_BOUND), [1.0, max(nphase - 1.0, 1.0), OBS_BOUND]]),
             dtype=np.float64)
+        self._checked_start = None  # the last start that passed the rigid walker's check
         self.terrain_seed = 0
         self._elapsed = 0
         self._has_reset = False
@@ -456,8 +466,16 @@ class WalkerEnv(gym.Env):
             leg1, k = float(s.leg == "leg1"), float(s.k)
         else:
             leg1, k = float(s.stance == 0), 0.0
-        obs = np.concatenate([s.x, [leg1, k, s.t - s.t_step]]).astype(np.float64)
-        return np.clip(obs, self.observation_space.low, self.observation_space.high)
+        x = s.x
+        m = x.size
+        obs = np.empty(m + 3)
+        obs[:m] = x
+        obs[m:] = (leg1, k, s.t - s.t_step)
+        low, high = self.observation_space.low, self.observation_space.high
+        for v, a, b in zip(obs.tolist(), low.tolist(), high.tolist()):
+            if not a <= v <= b:  # (NaN too) clipped to the bounds
+                return np.clip(obs, low, high)
+        return obs
 
     def _info(self, strikes: list[float]) -> dict:
         s = self.sim
@@ -465,11 +483,12 @@ class WalkerEnv(gym.Env):
         stance = (s.leg if self.view == "rigid" else f"leg{s.stance + 1}")
         info = {"time_s": float(s.t), "heel_strike": bool(strikes),
                 "heel_strike_time_s": float(strikes[-1]) if strikes else None,
-                "heel_strike_times_s": [float(t) for t in strikes], "steps": int(s.steps),
+                "heel_strike_times_s": list(map(float, strikes)), "steps": int(s.steps),
                 "stance_leg": stance, "hip_x_m": self._hip_x, "termination": s.ended,
                 "solver_message": str(getattr(s, "failure", "")),
                 "terrain_seed": int(self.terrain_seed)}
-        info.update({f"ledger_{k}": float(v) for k, v in s.ledger.items()})
+        for k, v in s.ledger.items():
+            info[_LEDGER_KEYS.get(k) or _ledger_key(k)] = float(v)
         return info
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -510,8 +529,12 @@ class WalkerEnv(gym.Env):
             h = x0.size // 2  # before the check: the noisy start is checked
             x0[h:] *= 1.0 + self.np_random.uniform(-self.start_noise, self.start_noise, h)
         if self.view == "rigid":
-            x0 = self.rigid.check_state(x0, "options['state']" if state is not None
-                                        else "the start with start_noise")
+            seen = self._checked_start
+            if not (seen is not None and isinstance(x0, np.ndarray) and x0.dtype == seen.dtype
+                    and x0.shape == seen.shape and x0.tobytes() == seen.tobytes()):
+                x0 = self.rigid.check_state(x0, "options['state']" if state is not None
+                                            else "the start with start_noise")
+                self._checked_start = x0  # (the same numbers pass again: not checked twice)
         elif not (isinstance(x0, np.ndarray) and x0.shape == self.sim.x_start.shape
                   and np.all(np.isfinite(x0))):
             from walkerlab.config import SceneError
@@ -533,8 +556,9 @@ class WalkerEnv(gym.Env):
             entries (one line naming the action space).
         """
         k = self.tau_max.size
-        if (type(action) is np.ndarray and action.shape == (k,)
-                and action.dtype.kind == "f" and np.isfinite(action).all()):
+        if (type(action) is np.ndarray and action.shape == (k,) and action.dtype.kind == "f"
+                and (all(map(math.isfinite, action.tolist())) if action.dtype.char in "fd"
+                     else np.isfinite(action).all())):
             return action.astype(np.float64)  # the common case: no message built
         want = (f"give {k} finite real number{'s' if k > 1 else ''} "
                 f"({', '.join(self.joints)}), shape ({k},), in {self.action_space}")
@@ -593,7 +617,11 @@ class WalkerEnv(gym.Env):
         if self.policy == "scene":  # the controller's torque at the period's start, held
             leg1 = (s.leg == "leg1") if self.view == "rigid" else (s.stance == 0)
             a = a + self._controller_torques(s.x, leg1)
-        u = np.clip(a, -self.tau_max, self.tau_max)
+        for v, t in zip(a.tolist(), self.tau_max.tolist()):
+            if not -t <= v <= t:  # (NaN too) clipped to the bounds
+                a = np.clip(a, -self.tau_max, self.tau_max)
+                break
+        u = a  # (a new array: the action is copied above)
         # the hip at the period's start (the last info's) and the positive work so far
         before = (self._hip_x, s.ledger["action_work_positive"])
         self._elapsed += 1
@@ -620,7 +648,7 @@ class WalkerEnv(gym.Env):
             fw, healthy, cw, ww = self.weights
             reward = (fw * (info["hip_x_m"] - x_before) / self.dt
                       + (0.0 if terminated else healthy)
-                      - cw * float(np.sum((u / self.tau_max) ** 2))
+                      - cw * float(np.add.reduce((u / self.tau_max) ** 2))
                       - ww * (s.ledger["action_work_positive"] - w_before) / self.dt)
         return self._obs(), float(reward), terminated, truncated, info
 

@@ -49,7 +49,9 @@ the heel strike's collision, <= 0).
 
 from __future__ import annotations
 
+import math
 import sys
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -80,9 +82,9 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
 #: the compiled control step's integrator: CyRK's DOP853 (Hairer's 8(5,3) pair, the stepping
 #: in C++) on the numba-compiled flow, at the scene solver's tolerances
 COMPILED_METHOD = "DOP853"
-#: each actuator's constant torque in a law block (:mod:`walkerlab.codegen.torque_law`:
-#: ``b[3 + HEAD i + 1]``, ``constant_n_m``), for up to 64 actuators
-_CONSTANTS = 3 + HEAD * np.arange(64) + 1
+#: the first actuator's constant torque in a law block (:mod:`walkerlab.codegen.torque_law`:
+#: ``b[3 + HEAD i + 1]``, ``constant_n_m``; actuator ``i``'s ``HEAD i`` further on)
+_CONSTANT_0 = 3 + 1
 
 
 class RigidView:
@@ -234,7 +236,16 @@ class RigidView:
 
     def hip_x(self) -> float:
         """World position of the hip along x (horizontal, downhill) [m]."""
-        return float(self.foot[0] + self.walker.points(self.x)["hip"][0])
+        points = self.walker.points
+        try:
+            hx = _HIP_X[points]
+        except KeyError:
+            hx = _HIP_X[points] = _point_coordinate(points, "hip", 0, self.x)
+        except TypeError:  # (not weakly referable: the whole points)
+            hx = None
+        if hx is None:
+            return float(self.foot[0] + points(self.x)["hip"][0])
+        return float(self.foot[0] + hx(self.x))
 
     def points(self) -> dict:
         """World positions (2,) [m] of the walker's named points, by role."""
@@ -418,7 +429,8 @@ class RigidView:
         fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
                 else None)
         if fast is not None:  # the compiled control step: the action's torques held in
-            fast[1][_CONSTANTS[:acts.u.size]] = acts.u  # the law block (each constant)
+            fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * acts.u.size:HEAD] = acts.u  # the law
+            # block (each actuator's constant)
         return w, acts, act_on, phase, t_stop, fast
 
     def integrate_piece(self, piece):
@@ -461,7 +473,7 @@ class RigidView:
         if self.ground is not None:
             self._pieces.append((phase, run.dense, (self.t, run.t_last)))
         self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-        if run.failed or not np.logical_and.reduce(np.isfinite(self.x)):
+        if run.failed or not all(map(math.isfinite, self.x.tolist())):
             self.ended = "solver_failure"
             return strikes
         if run.event is None:
@@ -540,6 +552,137 @@ class RigidView:
         self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
         self.t_step = self.t
         self._start_step()
+
+
+#: per ``points`` function: its hip's x alone (:func:`_point_coordinate`) or None
+_HIP_X: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _function_source(code) -> str | None:
+    """The source of a function of a generated module by its code object
+    (:func:`walkerlab.codegen.cache.read_source`: the checked text it was compiled from),
+    dedented, or None."""
+    from pathlib import Path
+
+    from walkerlab.codegen.cache import read_source
+
+    body = read_source(Path(code.co_filename))
+    if body is None:
+        return None
+    lines = body.splitlines()[code.co_firstlineno - 1:]
+    head = lines[0]
+    indent = len(head) - len(head.lstrip())
+    block = [head]
+    for line in lines[1:]:
+        if line.strip() and len(line) - len(line.lstrip()) <= indent:
+            break
+        block.append(line)
+    return "\n".join(line[indent:] for line in block)
+
+
+def _sliced(code, name: str, axis: int):
+    """The module code defining ``_whole`` (the generated function of ``code``, read from
+    its module's checked text) and the function of the one coordinate
+    (:func:`_point_coordinate`), with that function's name; None where the function is not
+    of the generated form."""
+    import ast
+
+    src = _function_source(code)
+    if src is None:
+        return None
+    fn = ast.parse(src).body[0]
+    body, ret = fn.body[:-1], fn.body[-1]
+    if not (isinstance(fn, ast.FunctionDef) and fn.name == code.co_name
+            and isinstance(ret, ast.Return) and isinstance(ret.value, ast.Dict)
+            and len(fn.args.args) == 1 and body and not fn.decorator_list
+            and all(isinstance(a, ast.Assign) and len(a.targets) == 1 for a in body)):
+        return None
+    arg = fn.args.args[0].arg
+    value = None
+    for k, v in zip(ret.value.keys, ret.value.values):
+        if isinstance(k, ast.Constant) and k.value == name:
+            value = v
+    if not (isinstance(value, ast.Call) and len(value.args) == 1 and not value.keywords
+            and isinstance(value.args[0], ast.Tuple) and axis < len(value.args[0].elts)):
+        return None
+    expr = value.args[0].elts[axis]
+    unpack = body[0]  # the state unpacked: ``a, b, ..., = x``
+    if not (isinstance(unpack.targets[0], ast.Tuple) and isinstance(unpack.value, ast.Name)
+            and unpack.value.id == arg):
+        return None
+    need = {n.id for n in ast.walk(expr) if isinstance(n, ast.Name)}
+    kept = []
+    for a in reversed(body[1:]):  # the assignments the entry needs, in order
+        if not isinstance(a.targets[0], ast.Name):
+            return None
+        if a.targets[0].id in need:
+            kept.append(a)
+            need |= {n.id for n in ast.walk(a.value) if isinstance(n, ast.Name)}
+    whole = ast.FunctionDef(name="_whole", args=fn.args, body=list(fn.body), decorator_list=[])
+    fn.body = [unpack, *reversed(kept), ast.Return(expr)]
+    return (compile(ast.fix_missing_locations(ast.Module([whole, fn], [])), code.co_filename,
+                    "exec"), fn.name)
+
+
+#: per generated function's code, name and axis: :func:`_sliced`'s, and whether its text was
+#: checked against the function
+_SLICED: dict = {}
+
+
+def _point_coordinate(points, name: str, axis: int, probe: np.ndarray):
+    """One coordinate of one named point of a generated ``points`` function, alone:
+    ``x -> points(x)[name][axis]`` computing only what that entry needs, or None.
+
+    The generated function (:func:`walkerlab.codegen.source.numpy_fn`: the state unpacked,
+    assignments, ``return {name: np.array((c0, c1, ...)), ...}``) is read from the checked
+    text of its module (:func:`walkerlab.codegen.cache.read_source`) and the assignments
+    the entry does not use are left out: the same expressions on the same numbers (the
+    function's closure bound as it is), so the same value bit for bit.  None where the
+    function is not of that form or its text is not found, or where the text read does
+    not give ``points(probe)`` bit for bit (checked once per generated function).
+
+    Parameters
+    ----------
+    points : callable
+        ``x (2n,) -> {name: ndarray}``.
+    name : str
+        The point (``"hip"``).
+    axis : int
+        The coordinate (0: x).
+    probe : ndarray (2n,)
+        A state the result is checked at.
+
+    Returns
+    -------
+    callable or None
+        ``x (2n,) -> float`` (a numpy scalar).
+    """
+    try:
+        code = points.__code__
+        key = (code, name, axis)
+        if key not in _SLICED:
+            _SLICED[key] = [_sliced(code, name, axis), False]
+        entry = _SLICED[key]
+        if entry[0] is None:
+            return None
+        module, fname = entry[0]
+        scope = dict(points.__globals__)
+        scope.update(zip(code.co_freevars, (c.cell_contents for c in points.__closure__ or ())))
+        exec(module, scope)  # noqa: S102 - the generated function's own text, sliced
+        one, x = scope[fname], np.array(probe, float)
+        ref = points(x)
+        if not entry[1]:  # the text read is the function's (the whole of it, bit for bit)
+            again = scope["_whole"](x)
+            if set(ref) != set(again) or not all(np.array_equal(ref[k], again[k])
+                                                 for k in ref):
+                entry[0] = None
+                return None
+            entry[1] = True
+        if np.shape(one(x)) != () or not float(one(x)) == float(ref[name][axis]):
+            return None
+        return one
+    except Exception:  # noqa: BLE001 - not a generated function: the whole points then
+        return None
 
 
 #: per ``points`` function (by id): ``(points, whether it takes states as columns)``

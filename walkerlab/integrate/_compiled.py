@@ -89,7 +89,7 @@ class CompiledDense:
         if last < 0:
             raise ValueError("no dense output")  # pragma: no cover
         row = np.empty(self.m)
-        addr = row.ctypes.data
+        addr = _address(row)
         for c, t in enumerate(times.tolist()):
             for j, piece in enumerate(self.pieces):
                 ta, tb = piece[0], piece[1]
@@ -105,13 +105,17 @@ class CompiledDense:
         return out[:, 0] if t.ndim == 0 else out
 
 
-def _copy_out(ptr, shape: tuple) -> np.ndarray:
-    """A float64 array of ``shape`` copied from C memory at ``ptr`` (a ctypes pointer):
-    one memmove, no ctypes array type built per call as ``np.ctypeslib.as_array`` does."""
-    out = np.empty(shape)
-    if out.size:
-        ctypes.memmove(out.ctypes.data, ptr, out.nbytes)
-    return out
+_BYTE = ctypes.c_char.from_buffer
+_ADDRESS = ctypes.addressof
+
+
+def _address(a: np.ndarray) -> int:
+    """The address of the data of the writable C-contiguous array ``a`` (as ``a.ctypes.data``,
+    without building numpy's ctypes helper object per call)."""
+    try:
+        return _ADDRESS(_BYTE(a))
+    except (TypeError, ValueError, BufferError):  # empty or read-only: numpy's way
+        return a.ctypes.data
 
 
 _NO_TIMES = np.empty(0)
@@ -127,8 +131,8 @@ def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     c0 = data[-1]
     ptr = ns.c_numba_cysolve_ivp(
-        addr, float(t0), float(t1), y0.ctypes.data, y0.size, method_int, 0, n_extra,
-        data.ctypes.data, data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
+        addr, float(t0), float(t1), _address(y0), y0.size, method_int, 0, n_extra,
+        _address(data), data.size * 8, max_steps, 2000, dense, _NO_TIMES_PTR, 0,
         None, None, 0, tols[0], tols[1], tols[2], tols[3], hmax,
         float(first_step), False)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK
@@ -136,8 +140,14 @@ def _solve(addr, data, t0, t1, y0, method_int, tols, hmax, max_steps, first_step
     res = _Result(ptr, ns)
     k = int(ns.c_get_size(ptr))
     ndy = int(ns.c_get_num_dy(ptr))
-    T = _copy_out(ns.c_get_t_ptr(ptr), (k,))
-    Y = _copy_out(ns.c_get_y_ptr(ptr), (k, ndy))
+    if k:  # the times and states copied into one block (one allocation)
+        out = np.empty(k * (1 + ndy))
+        at = _ADDRESS(_BYTE(out))
+        ctypes.memmove(at, ns.c_get_t_ptr(ptr), 8 * k)
+        ctypes.memmove(at + 8 * k, ns.c_get_y_ptr(ptr), 8 * k * ndy)
+        T, Y = out[:k], out[k:].reshape(k, ndy)
+    else:
+        T, Y = np.empty(0), np.empty((0, ndy))
     # the call counter: the last entry of CyRK's copy of the data vector
     args = ctypes.addressof(ns.c_get_args_ptr(ptr).contents)
     nfev = int(ctypes.c_double.from_address(args + 8 * (data.size - 1)).value - c0)
@@ -214,19 +224,23 @@ def callable_flow(compiled, n: int, variational: bool):
 _SMALL_CROSSING = 48
 
 
-def _first_crossing(G: np.ndarray, dirs: np.ndarray):
-    """First row ``k >= 1`` of guard values ``G`` (k, g) where a guard changes sign in its
-    direction between rows ``k-1`` and ``k`` (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``,
-    ``down = g0 >= 0 >= g1``), and the mask of those guards; ``(None, None)`` if none.
-    A control period's few steps and guards are compared in Python (the same comparisons,
-    without numpy's per-call overhead), a long chunk's by numpy."""
-    if G.size <= _SMALL_CROSSING:
-        rows, ds = G.tolist(), dirs.tolist()
+def _first_crossing(G, dirs: np.ndarray):
+    """First row ``k >= 1`` of guard values ``G`` (k, g) (an array, or its rows as lists)
+    where a guard changes sign in its direction between rows ``k-1`` and ``k``
+    (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``, ``down = g0 >= 0 >= g1``), and the mask
+    of those guards; ``(None, None)`` if none.  A control period's few steps and guards are
+    compared in Python (the same comparisons, without numpy's per-call overhead), a long
+    chunk's by numpy."""
+    if type(G) is list or G.size <= _SMALL_CROSSING:
+        rows, ds = (G if type(G) is list else G.tolist()), dirs.tolist()
+        before = rows[0]
         for k in range(1, len(rows)):
-            hit = [(d >= 0 and g0 <= 0 <= g1) or (d <= 0 and g0 >= 0 >= g1)
-                   for g0, g1, d in zip(rows[k - 1], rows[k], ds)]
-            if any(hit):
-                return k, np.array(hit)
+            after = rows[k]
+            for g0, g1, d in zip(before, after, ds):
+                if (d >= 0 and g0 <= 0 <= g1) or (d <= 0 and g0 >= 0 >= g1):
+                    return k, np.array([(d >= 0 and a <= 0 <= b) or (d <= 0 and a >= 0 >= b)
+                                        for a, b, d in zip(before, after, ds)])
+            before = after
         return None, None
     nonpos, nonneg = G <= 0, G >= 0
     hit = nonpos[:-1] & nonneg[1:]
@@ -279,6 +293,32 @@ class _Plan:
         self.cols = cols is not None
         self.n_extra, self.gcol, self.goff = (cols[0], cols[1] + m, cols[2]) if cols \
             else (0, None, None)
+        self._guards = None  # (guards, their directions, their functions): guard_arrays
+        #: each guard's (column, offset) as Python numbers (a few step points' values)
+        self.guard_cols = list(zip(self.gcol.tolist(), self.goff.tolist())) if cols else []
+
+    def guard_arrays(self, guards) -> tuple:
+        """``(directions (g,), functions)`` of the phase's ``guards`` (the last guards'
+        kept: the same guards, the same arrays)."""
+        key, seen = tuple(guards), self._guards
+        if seen is None or seen[0] != key:
+            seen = self._guards = (key, np.array([g.direction for g in key]),
+                                   [g.function for g in key])
+        return seen[1], seen[2]
+
+    def guard_values(self, T, Y):
+        """The guards' values at the step points ``Y`` (k, m + n_extra): an array (k, g),
+        or for a few step points their rows as lists (the same sums in Python), or None
+        when no guard can change sign between them (each guard's values all above 0, or
+        all below: :func:`_first_crossing` would find nothing)."""
+        cols = self.guard_cols
+        if T.size * len(cols) > _SMALL_CROSSING:
+            return Y[:, self.gcol] + self.goff
+        by_guard = [[v + o for v in Y[:, c].tolist()] for c, o in cols]
+        for col in by_guard:  # (a NaN makes min or max NaN, or is left out of both)
+            if not (min(col) > 0.0 or max(col) < 0.0):
+                return [list(g) for g in zip(*by_guard)]
+        return None
 
     def run(self, data, ta, tb, ya, max_steps, first_step, dense):
         """:func:`_solve` from ``ya`` at ``ta`` towards ``tb`` with the flow's ``data``."""
@@ -327,7 +367,7 @@ def _crossing(plan: _Plan, data, T, Y, k: int, active, fns, n: int, m: int, dens
         dense.pieces.append(plan.piece(data, T[0], T[k - 1], Y[0, :m], h0))
     dense.pieces.append([float(T[k - 1]), float(T[k]), step])
     out = np.empty(m + plan.n_extra)
-    call, sp, op = plan.ns.c_call, step.ptr, out.ctypes.data
+    call, sp, op = plan.ns.c_call, step.ptr, _address(out)
     roots = []
     for i in np.flatnonzero(active):  # each g is used (by brentq) in its iteration only
         if plan.cols:
@@ -373,11 +413,9 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     m = y0.size
     plan = _plan(compiled, variational, solver, m)
     data = compiled.data()  # CyRK copies it: never written here
-    dirs = np.array([g.direction for g in guards])
-    fns = [g.function for g in guards]
+    dirs, fns = plan.guard_arrays(guards)
     if plan.cols:
-        def values(T, Y):
-            return Y[:, plan.gcol] + plan.goff
+        values = plan.guard_values
     else:
         def values(T, Y):
             return np.array([[f(t, y[:n]) for f in fns] for t, y in zip(T, Y)])
@@ -386,7 +424,8 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     while True:
         _res, T, Y, ok, msg, nf = plan.run(data, ta, t1, ya, K, h0, False)
         nfev += nf
-        k, active = _first_crossing(values(T, Y), dirs) if T.size > 1 else (None, None)
+        G = values(T, Y) if T.size > 1 else None
+        k, active = (None, None) if G is None else _first_crossing(G, dirs)
         if k is not None:
             te, ye, failed, msg1, i, nf1 = _crossing(plan, data, T, Y, k, active, fns, n, m,
                                                      dense, h0)

@@ -169,6 +169,18 @@ def phase_rhs(walker: HybridWalker, phase: Phase, n: int, variational: bool):
     return rhs, None
 
 
+_SOLVE_PHASE: list = []  # walkerlab.integrate._compiled.solve_phase, once imported
+
+
+def _compiled_solve_phase():
+    """:func:`walkerlab.integrate._compiled.solve_phase`, imported on first use (numba and
+    CyRK load with it)."""
+    from walkerlab.integrate._compiled import solve_phase
+
+    _SOLVE_PHASE.append(solve_phase)
+    return solve_phase
+
+
 def integrate_phase(phase: Phase, t0: float, x: np.ndarray, Phi: np.ndarray, t_stop: float,
                     n: int, solver: Solver, backend: str, rhs, jac,
                     variational: bool) -> PhaseRun:
@@ -177,8 +189,7 @@ def integrate_phase(phase: Phase, t0: float, x: np.ndarray, Phi: np.ndarray, t_s
     the phase's compiled flow; a phase without one runs on CyRK)."""
     y0 = np.concatenate([x, Phi.ravel()]) if variational else x
     if backend == "cyrk_compiled" and phase.compiled is not None:
-        from walkerlab.integrate._compiled import solve_phase
-
+        solve_phase = _SOLVE_PHASE[0] if _SOLVE_PHASE else _compiled_solve_phase()
         check_time_limit(t0, x)  # no Python in the compiled flow: checked at each phase start
 
         return PhaseRun(*solve_phase(phase.compiled, variational, t0, t_stop, y0,
