@@ -352,7 +352,7 @@ def _crossing(plan: _Plan, data, T, Y, k: int, active, fns, n: int, m: int, dens
     """The phase's end at the first crossing, between steps ``k-1`` and ``k`` of the chunk
     ``(T, Y)``: that step again with dense output, the earliest root of the ``active``
     guards on it (Brent).  Returns ``(t, y (m,), failed, message or '', event, nfev)``."""
-    from scipy.optimize import brentq
+    from walkerlab.integrate.brentq import brentq
 
     # the step T[k-1] -> T[k] again, with dense output (CyRK wants a first step of at most
     # half the span, so the span is a little over 2 steps: T[k-1] + 2 hk can round below

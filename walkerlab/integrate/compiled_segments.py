@@ -175,7 +175,7 @@ def _locate(dense, x0, ta: float, tb: float, events, which, n: int):
     event that changes sign on the samples but not on the interpolant is located at the
     interval's end where the interpolant is past it (the interpolant agrees with the samples
     to the solver's tolerance)."""
-    from scipy.optimize import brentq
+    from walkerlab.integrate.brentq import brentq
 
     best = None
     for j in which:

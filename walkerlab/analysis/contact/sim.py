@@ -316,7 +316,7 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
         The step does not reach mid-stance (it falls first), or reaches it with the stance
         foot not flat (one line naming ``contact_sim.start``).
     """
-    from scipy.optimize import brentq
+    from walkerlab.integrate.brentq import brentq
 
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.models.registry import build_walker
