@@ -72,6 +72,26 @@ def _make_key(fphase, solver, m: int) -> tuple:
 
 
 _CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out)
+_ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument types
+
+
+def _period_rows(key: tuple, args: tuple) -> None:
+    """:func:`walkerlab.integrate.rows_dop853.period_rows` of ``args``, through its compiled
+    entry for their types once the dispatcher has chosen it: numba's dispatcher types every
+    argument of every call, and the type of a first-class function (the flow's three
+    cfuncs) costs about 80 us a call of the 8-walker benchmark, more than the kernel's 8
+    rows (65 us); the arrays are made alike on every call (C order, writable, one dtype),
+    so the types, and the entry, are the first call's."""
+    from walkerlab.integrate.rows_dop853 import period_rows
+
+    entry = _ENTRY.get(key)
+    if entry is not None:
+        entry(*args)
+        return
+    period_rows(*args)
+    cres = period_rows.overloads.get(tuple(period_rows.typeof_pyval(a) for a in args))
+    if cres is not None:
+        _ENTRY[key] = cres.entry_point
 
 
 def _kernel_args(key: tuple, fphase) -> tuple:
@@ -96,7 +116,7 @@ def _kernel_args(key: tuple, fphase) -> tuple:
 
 def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRun]:
     """The compiled pieces ``pieces`` of walkers ``rows`` (one flow) in one kernel call."""
-    from walkerlab.integrate.rows_dop853 import FAILED, period_rows
+    from walkerlab.integrate.rows_dop853 import FAILED
 
     fphase = pieces[0][5][0]
     f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out = _kernel_args(key, fphase)
@@ -120,8 +140,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRu
     view0 = views[rows[0]]  # (an arithmetic error inside the kernel: counted on it)
     hook, sys.unraisablehook = sys.unraisablehook, view0.count_unraisable
     try:
-        period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which,
-                    te, Yev, H)
+        _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
+                           which, te, Yev, H))
     finally:
         sys.unraisablehook = hook
     runs = []
