@@ -685,27 +685,38 @@ def _point_coordinate(points, name: str, axis: int, probe: np.ndarray):
         return None
 
 
-#: per ``points`` function (by id): ``(points, whether it takes states as columns)``
+#: per ``points`` function (by id): ``(points, its hips' x of states as columns or None)``
 _COLUMN_POINTS: dict = {}
 
 
 def _hips(points, X: np.ndarray):
-    """The hip's x relative to the stance foot [m] of the states ``X`` (r, 2n), one call of
-    the step walker's ``points`` on the states as columns (its contract:
-    :mod:`walkerlab.models.hybrid.base`); None when it does not take them (checked once
-    per function against a call per state: the same numbers bit for bit, or not used)."""
+    """The hip's x relative to the stance foot [m] of the states ``X`` (r, 2n), one call on
+    the states as columns (the contract of ``points``: :mod:`walkerlab.models.hybrid.base`)
+    of the hip's x alone (:func:`_point_coordinate`, the expressions that entry needs) or
+    of the step walker's whole ``points``; None when neither takes them (checked once per
+    function against a call of ``points`` per state: the same numbers bit for bit, or not
+    used)."""
     entry = _COLUMN_POINTS.get(id(points))
     if entry is None:
-        try:
-            hx = np.asarray(points(X.T)["hip"], float)[0]
-            ok = hx.shape == (X.shape[0],) and np.array_equal(
-                hx, [float(points(x)["hip"][0]) for x in X])
-        except Exception:  # noqa: BLE001 - a points of one state only
-            ok = False
-        entry = _COLUMN_POINTS[id(points)] = (points, ok)  # (kept: its id stays its own)
-    if not entry[1]:
+        fns = []
+        one = _point_coordinate(points, "hip", 0, X[0])
+        if one is not None:
+            fns.append(one)
+        fns.append(lambda Xt: points(Xt)["hip"][0])
+        each = [float(points(x)["hip"][0]) for x in X]
+        fn = None
+        for f in fns:
+            try:
+                hx = np.asarray(f(X.T), float)
+                if hx.shape == (X.shape[0],) and np.array_equal(hx, each):
+                    fn = f
+                    break
+            except Exception:  # noqa: BLE001 - a function of one state only
+                pass
+        entry = _COLUMN_POINTS[id(points)] = (points, fn)  # (kept: its id stays its own)
+    if entry[1] is None:
         return None
-    return np.asarray(points(X.T)["hip"], float)[0]
+    return np.asarray(entry[1](X.T), float)
 
 
 def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
