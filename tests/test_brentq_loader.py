@@ -65,3 +65,16 @@ def test_a_located_root_imports_no_scipy_optimize():
                          check=True).stdout.split()
     assert float(out[0]) == scipy_brentq(lambda x: x * x - 2.0, 0.0, 2.0, xtol=1e-14)
     assert out[1] == "False"
+
+
+def test_a_later_plain_import_gets_the_whole_package():
+    code = ("import sys; from walkerlab.integrate.brentq import brentq; "
+            "r = brentq(lambda x: x * x - 2.0, 0.0, 2.0, 1e-14); "
+            "loaded = 'scipy.optimize._zeros' in sys.modules; "
+            "import scipy.optimize as so; "
+            "print(loaded, so._zeros is sys.modules['scipy.optimize._zeros'], "
+            "so.brentq(lambda x: x * x - 2.0, 0.0, 2.0, xtol=1e-14) == r, "
+            "abs(so.root_scalar(lambda x: x * x - 2.0, bracket=(0.0, 2.0)).root ** 2 - 2) < 1e-12)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["False", "True", "True", "True"]

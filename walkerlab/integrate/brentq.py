@@ -17,7 +17,8 @@ routine, the same arguments; ``tests/test_brentq_loader.py`` compares the two):
 
 1. if ``scipy.optimize`` is already imported, its ``brentq`` is called;
 2. else the extension ``scipy.optimize._zeros`` is loaded from its file under its own name
-   (not entered in ``sys.modules``: a later ``import scipy.optimize`` loads it as usual) and
+   (and taken out of ``sys.modules`` again: a later ``import scipy.optimize`` loads it as
+   usual, the package's ``_zeros`` set) and
    its ``_brentq`` called as scipy's wrapper calls it (the function value checked for NaN,
    scipy's defaults ``rtol = 4 eps``, 100 iterations);
 3. if step 2 fails in any way (a scipy release that moved or renamed the extension), the
@@ -60,10 +61,16 @@ def _load_core():
         else:
             return None
         name = "scipy.optimize._zeros"
+        had = name in sys.modules
         loader = importlib.machinery.ExtensionFileLoader(name, str(path))
         ext = importlib.util.spec_from_file_location(name, str(path), loader=loader)
-        module = importlib.util.module_from_spec(ext)
-        loader.exec_module(module)
+        try:
+            module = importlib.util.module_from_spec(ext)
+            loader.exec_module(module)
+        finally:
+            if not had:  # CPython enters a single-phase extension in sys.modules: taken
+                sys.modules.pop(name, None)  # out, so a later ``import scipy.optimize``
+                # loads it as usual (and sets the package's ``_zeros``)
         return module._brentq
     except Exception:  # any failure: the plain import (speed only)
         return None
