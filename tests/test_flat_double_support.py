@@ -240,3 +240,36 @@ def test_the_ledger_closes_with_a_hip_torque_in_double_support(flat):
     _ph, dense, (ta, tb) = seg.pieces[0]
     work = quad(lambda t: w.actuators.power(t, np.ravel(dense(t))[:6]), ta, tb)[0]
     assert abs(work) > 1e-4
+
+
+#: configs/flat_feet_stairs.yaml's gait (walkerlab fixedpoint, residual 1e-12): a double
+#: support of 0.089 s
+X_STAIRS = np.array([-0.2085977875988514, 0.19788858329242512, 0.0, -0.678053594293201,
+                     -0.6909968032500822, -3.626474337081283])
+#: its three largest Floquet multipliers, from the variational equations with every row at
+#: DOP853's rtol = atol = 1e-12 (63,883 right-hand sides, 51 s)
+MULT_STAIRS = np.array([-0.9463292629637, 0.6084184220007, -6.247620381946e-04])
+
+
+def test_the_variational_map_through_double_support_costs_as_much_as_the_map():
+    """The double support's Jacobian is central differences (round-off ~2e-10): its
+    variational rows integrated at the scene's 1e-12 made DOP853 chase that noise (48x the
+    map's right-hand sides, 51 s, past the gait search's 60 s CPU budget on a busy
+    machine); at the floor ``Phase.jacobian_rtol`` the variational map costs about what
+    the map does, and its multipliers equal the tight integration's to 1e-8 and the
+    map's central differences to their own error bound."""
+    import walkerlab as wl
+    from walkerlab.analysis.gait.poincare import (map_fd_jacobian, multiplier_check_tolerance,
+                                                  poincare_map)
+
+    w = wl.Walker.from_scene(ROOT / "configs/flat_feet_stairs.yaml")
+    _x, _T, nfev_plain = poincare_map(w.model, X_STAIRS, w.solver)
+    _x, _T, DP, nfev_var = poincare_map(w.model, X_STAIRS, w.solver, jacobian=True)
+    assert nfev_var < 2 * nfev_plain, (nfev_var, nfev_plain)
+    mult = np.linalg.eigvals(DP)
+    mult = mult[np.argsort(-np.abs(mult))][:3]
+    assert np.max(np.abs(mult.imag)) == 0.0
+    np.testing.assert_allclose(mult.real, MULT_STAIRS, rtol=0, atol=1e-8)
+    J_fd, _nfev = map_fd_jacobian(w.model, X_STAIRS, w.solver)
+    assert np.max(np.abs(DP - J_fd)) < multiplier_check_tolerance(w.solver, 1e-7) * (
+        1 + np.max(np.abs(DP)))

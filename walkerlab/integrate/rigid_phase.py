@@ -80,10 +80,15 @@ IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
 
 
 def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
-             solver: Solver, backend: str, jac=None) -> PhaseRun:
+             solver: Solver, backend: str, jac=None,
+             rows_rtol: float | None = None) -> PhaseRun:
     """Integrate ``rhs`` from ``t0`` until the first guard (state rows ``:n``) fires or ``t1``.
 
-    ``jac`` (``(t, y) -> (m, m)``) is handed to scipy's implicit methods."""
+    ``jac`` (``(t, y) -> (m, m)``) is handed to scipy's implicit methods.  ``rows_rtol``
+    [-], if given, is the floor of the tolerances (relative and absolute) of the rows past
+    ``n`` (the variational state of a phase with a numerical Jacobian,
+    :attr:`~walkerlab.models.hybrid.base.Phase.jacobian_rtol`); the state's rows keep the
+    solver's."""
     evs = []
     whole = len(y0) == n  # no variational rows: the guard sees y itself (no slicing)
     for gd in guards:
@@ -97,6 +102,11 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
         ev.direction = gd.direction
         evs.append(ev)
     y0 = np.ascontiguousarray(y0, dtype=float)
+    rtol, atol = solver.rtol, solver.atol
+    if rows_rtol is not None and len(y0) > n:
+        rtol, atol = np.full(len(y0), rtol), np.full(len(y0), atol)
+        rtol[n:] = np.maximum(rtol[n:], rows_rtol)
+        atol[n:] = np.maximum(atol[n:], rows_rtol)
     rhs = limited(rhs)  # inside an integration_time_limit only: the clock checked
     if backend == "cyrk":
         from walkerlab.integrate.cyrk_loader import pysolve_ivp as cyrk_solver
@@ -108,8 +118,7 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
             count[0] += 1
             return rhs(t, y)
         res = pysolve_ivp(counted, (float(t0), float(t1)), y0, method=solver.method,
-                          dense_output=True, events=evs or None, rtol=solver.rtol,
-                          atol=solver.atol,
+                          dense_output=True, events=evs or None, rtol=rtol, atol=atol,
                           max_step=solver.max_step_s if solver.max_step_s else np.inf)
         t_events = res.t_events if evs else []
         y_events = [np.asarray(ye).T for ye in res.y_events] if evs else []  # (k, m)
@@ -121,7 +130,7 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
     else:
         from scipy.integrate import solve_ivp
 
-        kw = solver.kwargs()
+        kw = {**solver.kwargs(), "rtol": rtol, "atol": atol}
         if jac is not None and solver.method in IMPLICIT_METHODS:
             kw["jac"] = jac
         sol = solve_ivp(rhs, (t0, t1), y0, events=evs or None, dense_output=True, **kw)
@@ -195,4 +204,5 @@ def integrate_phase(phase: Phase, t0: float, x: np.ndarray, Phi: np.ndarray, t_s
         return PhaseRun(*solve_phase(phase.compiled, variational, t0, t_stop, y0,
                                      phase.guards, n, solver))
     return solve_on(rhs, t0, t_stop, y0, phase.guards, n, solver,
-                    "cyrk" if backend == "cyrk_compiled" else backend, jac)
+                    "cyrk" if backend == "cyrk_compiled" else backend, jac,
+                    phase.jacobian_rtol if variational else None)

@@ -329,6 +329,13 @@ def _flow_jacobian(flow, t, x):
     return _jacobian(partial(flow, t), x)
 
 
+#: The relative accuracy [-] the double support's variational rows are integrated to
+#: (:attr:`Phase.jacobian_rtol`): :func:`_jacobian`'s central differences err by the
+#: round-off ``eps / h ~ 2e-10`` of their step ``h ~ 1e-6`` (their truncation error
+#: ``h^2 ~ 1e-12`` is below it), so tighter tolerances on ``Phi`` only chase that noise.
+DOUBLE_SUPPORT_JACOBIAN_RTOL = 1e-9
+
+
 def _held(f: dict, c: float, level: float, x) -> tuple[float, float]:
     """The trailing ankle's spring energy [J] (with feet of mass plus its sole's kinetic
     energy beyond turning with its leg, which the walker's ``energies`` leave out) and its
@@ -377,14 +384,16 @@ def double_support_phases(f: dict, c_trailing: float = 0.0,
         Guard("foot_slap", f["guard_foot_angle"], -1, "next_phase", f["grad_foot_angle"],
               slap, partial(_jacobian, slap), next_phase=DOUBLE_SUPPORT[1]),
         Guard("stance_foot_lifts", partial(_force, heel, 2), -1, "fall", at_entry=True),
-        hip), jacobian=partial(_flow_jacobian, fl_heel), held_energy=held)
+        hip), jacobian=partial(_flow_jacobian, fl_heel), held_energy=held,
+        jacobian_rtol=DOUBLE_SUPPORT_JACOBIAN_RTOL)
     on_flat = Phase(DOUBLE_SUPPORT[1], fl_flat, (
         Guard("toe_off", partial(_force, flat, 0), -1, "next_phase",
               next_phase="foot_flat:early_swing"),
         Guard("trailing_toe_pulls", partial(_pulls, flat), -1, "fall", at_entry=True),
         Guard("stance_toe_lifts", partial(_force, flat, 3), -1, "fall", at_entry=True),
         Guard("stance_heel_lifts", partial(_lead_heel, flat), -1, "fall", at_entry=True),
-        hip), jacobian=partial(_flow_jacobian, fl_flat), held_energy=held)
+        hip), jacobian=partial(_flow_jacobian, fl_flat), held_energy=held,
+        jacobian_rtol=DOUBLE_SUPPORT_JACOBIAN_RTOL)
     return on_heel, on_flat
 
 
