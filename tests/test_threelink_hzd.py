@@ -446,13 +446,22 @@ NO_WALK_CASES = {
 }
 
 
+#: the CPU time [s] those cases stay under: a budget of 60 s, a step, the imports and a cold
+#: code cache.  The CPU time of the same work is not fixed on a busy machine (shared
+#: caches, a virtual CPU's host core shared): impossible_design took 50 s alone with a cold
+#: cache and 98 s beside the two-worker slow suite on a 2-vCPU machine, so the bound is 2.5
+#: budgets, still well under the 300-590 s the slowest of them ran before
+NO_WALK_CPU_S = 150.0
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("case", list(NO_WALK_CASES))
 def test_a_controller_that_does_not_walk_ends_within_its_budget(case, tmp_path):
     """Every gait search, sweep point and design of these cases ends within its budget
-    (60 s of CPU per search or designed controller) and a step: under 90 s of this
-    process's CPU time (the sweep on one worker, in this process), with at most one error
-    line and no traceback (they ran 60 s to 590 s, and the design at 3 m/s past 300 s)."""
+    (60 s of CPU per search or designed controller) and a step: under
+    :data:`NO_WALK_CPU_S` of this process's CPU time (the sweep on one worker, in this
+    process), with at most one error line and no traceback (they ran 60 s to 590 s, and the
+    design at 3 m/s past 300 s)."""
     import time
 
     from typer.testing import CliRunner
@@ -465,7 +474,7 @@ def test_a_controller_that_does_not_walk_ends_within_its_budget(case, tmp_path):
     r = CliRunner().invoke(app, ["-q", command, scene, "--runs-dir", str(tmp_path / "runs"),
                                  *extra])
     cpu = time.process_time() - t0
-    assert cpu < 90.0, (case, cpu)
+    assert cpu < NO_WALK_CPU_S, (case, cpu)
     assert "Traceback" not in r.output
     errors = [ln for ln in r.output.splitlines() if ln.lower().startswith("error")]
     assert len(errors) <= 1 and (r.exit_code == 0) == (not errors), r.output

@@ -245,7 +245,8 @@ def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
         fast = make_rigid_walker(sprung, walker.name, walker.variant)
         base_jac = fast.variational
         phases = [Phase(ph.name, ph.flow, ph.guards, jacobian=ph.jacobian,
-                        variational=ph.variational, compiled=ph.compiled)
+                        variational=ph.variational, compiled=ph.compiled,
+                        jacobian_rtol=ph.jacobian_rtol)
                   for ph in fast.phases]
     # virtual constraints: a step ends as a fall once its phase leaves the polynomials'
     extra = acts.phase_guards() if hasattr(acts, "phase_guards") else ()
@@ -254,7 +255,8 @@ def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
                             jacobian=jac_of(ph.jacobian or base_jac, ph.constraint),
                             variational=None if has_torque else ph.variational,
                             compiled=(_compiled_laws(ph, data, acts, limit) if has_torque
-                                      else ph.compiled), constraint=ph.constraint))
+                                      else ph.compiled), constraint=ph.constraint,
+                            jacobian_rtol=ph.jacobian_rtol))
     reset = walker.reset
     reset_jac = walker.reset_jacobian
     if spec.push_off is not None:

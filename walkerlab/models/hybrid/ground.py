@@ -234,7 +234,7 @@ def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
             comp = replace(comp, guards=tuple(cg), _memo={})
         phases.append(Phase(ph.name, ph.flow, tuple(guards), jacobian=ph.jacobian,
                             variational=ph.variational, compiled=comp,
-                            constraint=ph.constraint))
+                            constraint=ph.constraint, jacobian_rtol=ph.jacobian_rtol))
     mirror = walker.mirror
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
         mirror = _on_clearance(mirror, replace(data.mirror, mirror_params=None), drop_m)
