@@ -273,3 +273,25 @@ def test_the_variational_map_through_double_support_costs_as_much_as_the_map():
     J_fd, _nfev = map_fd_jacobian(w.model, X_STAIRS, w.solver)
     assert np.max(np.abs(DP - J_fd)) < multiplier_check_tolerance(w.solver, 1e-7) * (
         1 + np.max(np.abs(DP)))
+
+
+@pytest.mark.parametrize("method,backend", [("DOP853", "cyrk"), ("DOP853", "scipy"),
+                                            ("Radau", "scipy"), ("BDF", "scipy"),
+                                            ("LSODA", "scipy")])
+def test_variational_rows_with_a_tolerance_floor_run_on_every_method(method, backend):
+    """``solve_on``'s per-row floor (``rows_rtol``) on every integrator a scene can name:
+    scipy's Radau and BDF take one ``rtol`` (the floor goes on ``atol`` there); the linear
+    test system ``x' = -2 x`` with ``Phi' = -2 Phi`` ends at ``exp(-2)`` in both, the state
+    to the solver's tolerance and ``Phi`` to the floor."""
+    from walkerlab.integrate.rigid_phase import solve_on
+
+    def rhs(t, y):
+        return -2.0 * y
+
+    y0 = np.array([1.0, 1.0])
+    run = solve_on(rhs, 0.0, 1.0, y0, (), 1, Solver(method, 1e-10, 1e-10), backend,
+                   rows_rtol=1e-6)
+    assert not run.failed
+    assert run.t_last == 1.0
+    assert abs(run.y_last[0] - np.exp(-2.0)) < 1e-8
+    assert abs(run.y_last[1] - np.exp(-2.0)) < 1e-4

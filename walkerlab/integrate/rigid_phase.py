@@ -77,6 +77,9 @@ class _CyDense:
 
 
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+#: scipy's methods that take one relative tolerance only (their Newton iteration's
+#: tolerance is computed from it): per-row floors go on ``atol`` alone there
+_SCALAR_RTOL = ("Radau", "BDF")
 
 
 def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
@@ -88,7 +91,9 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
     [-], if given, is the floor of the tolerances (relative and absolute) of the rows past
     ``n`` (the variational state of a phase with a numerical Jacobian,
     :attr:`~walkerlab.models.hybrid.base.Phase.jacobian_rtol`); the state's rows keep the
-    solver's."""
+    solver's.  scipy's Radau and BDF take one ``rtol``: there the floor is on ``atol``
+    alone (the variational entries are O(1) and larger, so ``atol`` then rules their
+    error scale)."""
     evs = []
     whole = len(y0) == n  # no variational rows: the guard sees y itself (no slicing)
     for gd in guards:
@@ -104,9 +109,11 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
     y0 = np.ascontiguousarray(y0, dtype=float)
     rtol, atol = solver.rtol, solver.atol
     if rows_rtol is not None and len(y0) > n:
-        rtol, atol = np.full(len(y0), rtol), np.full(len(y0), atol)
-        rtol[n:] = np.maximum(rtol[n:], rows_rtol)
+        atol = np.full(len(y0), atol)
         atol[n:] = np.maximum(atol[n:], rows_rtol)
+        if backend != "scipy" or solver.method not in _SCALAR_RTOL:
+            rtol = np.full(len(y0), rtol)
+            rtol[n:] = np.maximum(rtol[n:], rows_rtol)
     rhs = limited(rhs)  # inside an integration_time_limit only: the clock checked
     if backend == "cyrk":
         from walkerlab.integrate.cyrk_loader import pysolve_ivp as cyrk_solver
