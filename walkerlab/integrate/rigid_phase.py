@@ -77,9 +77,40 @@ class _CyDense:
 
 
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+#: |guard| [its unit: m, rad, N] at a phase's start below which a fall guard counts as
+#: zero there, by construction (heel off begins with the foot flat: ``phi = 0``, ``phi' =
+#: 0``): such a guard is not crossed until it has left that band.  Exactly 0 at the start,
+#: an implicit method's first step can leave it at 0 or a round-off on that side, and
+#: scipy counts ``g <= 0 <= g_new`` as a crossing at the start (LSODA at 1e-12 on
+#: configs/flat_feet_stairs.yaml's gait: a false fall as heel off begins).  Other guards
+#: are left as they are: a transition or heel strike that fires at the step's start is
+#: how a walker that does not move is told (``rigid._end_step``: no step)
+ENTRY_ZERO = 1e-12
 #: scipy's methods that take one relative tolerance only (their Newton iteration's
 #: tolerance is computed from it): per-row floors go on ``atol`` alone there
 _SCALAR_RTOL = ("Radau", "BDF")
+
+
+def _armed_once_off_zero(guard, direction: int, n: int):
+    """The event of a guard within :data:`ENTRY_ZERO` of 0 as its phase begins: inside
+    that band it reads ``-direction * ENTRY_ZERO`` (its non-firing side) until it has once
+    left the band, and at any time up to the last one it read so (the solver's root search
+    then sees the values it detected the crossing on); otherwise the guard itself, so a
+    crossing after it left the band is located on the guard's own values (a kneed
+    walker's knee strike, 0 as the step begins, fires where it did)."""
+    armed, held = [False], [-np.inf]  # left the band; the last time read on its side
+
+    def ev(t, y):
+        v = guard(t, y[:n])
+        if abs(v) <= ENTRY_ZERO:
+            if not armed[0]:
+                held[0] = max(held[0], t)
+                return -direction * ENTRY_ZERO
+            if t <= held[0]:
+                return -direction * ENTRY_ZERO
+        armed[0] = True
+        return v
+    return ev
 
 
 def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
@@ -93,11 +124,17 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
     :attr:`~walkerlab.models.hybrid.base.Phase.jacobian_rtol`); the state's rows keep the
     solver's.  scipy's Radau and BDF take one ``rtol``: there the floor is on ``atol``
     alone (the variational entries are O(1) and larger, so ``atol`` then rules their
-    error scale)."""
+    error scale).  A fall guard within :data:`ENTRY_ZERO` of 0 at ``t0`` is not crossed while
+    it stays within that band (:func:`_armed_once_off_zero`: a crossing at the start itself
+    is round-off)."""
     evs = []
     whole = len(y0) == n  # no variational rows: the guard sees y itself (no slicing)
+    x0 = np.asarray(y0[:n], dtype=float)
     for gd in guards:
-        if whole:
+        if (gd.outcome == "fall" and gd.direction
+                and abs(float(gd.function(t0, x0))) <= ENTRY_ZERO):
+            ev = _armed_once_off_zero(gd.function, gd.direction, n)
+        elif whole:
             def ev(t, y, _g=gd.function):
                 return _g(t, y)
         else:

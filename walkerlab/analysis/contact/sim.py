@@ -317,7 +317,6 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
         foot not flat (one line naming ``contact_sim.start``).
     """
     from walkerlab.integrate.brentq import brentq
-
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.models.registry import build_walker
 
