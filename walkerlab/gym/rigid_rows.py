@@ -108,7 +108,10 @@ def _kernel_args(key: tuple, fphase) -> tuple:
         scale = np.sqrt(m)
         if len(atol) != 1:  # pragma: no cover - the scenes' solvers give one atol
             raise ValueError("rigid rows: one absolute tolerance for every state")
-        _CFUNCS[key] = (*cfuncs(module, flow.name, f), np.array(gcols, np.int64),
+        f, fs, fg, sel = cfuncs(module, flow.name, f)
+        # the cfuncs by address (rows_dop853._call_address): no boxing of three function
+        # values on every call
+        _CFUNCS[key] = (f.address, fs.address, fg.address, sel, np.array(gcols, np.int64),
                         np.array(goffs, float), np.array(dirs, float), rtol * scale,
                         atol[0] * scale, m + n_extra)
     return _CFUNCS[key]
