@@ -155,6 +155,32 @@ def test_phase_rows_with_stage_cfuncs_equal_the_flow_alone(paper_map, paper_fixe
         np.testing.assert_array_equal(a, b)
 
 
+def test_cfuncs_called_by_address_give_the_first_class_calls_numbers(paper_map,
+                                                                     paper_fixed_point):
+    """``period_rows`` given the flow's cfuncs as process addresses (``int``: the native
+    vector environment's call, :func:`walkerlab.integrate.rows_dop853._call_address`)
+    crosses the same guards at the same times and states with the same next step sizes,
+    bit for bit, as given the cfuncs themselves (numba's first-class functions); rows that
+    end on a guard and rows that reach their cap are both met."""
+    from walkerlab.integrate.rows_dop853 import TIMEOUT, period_rows
+
+    rng = np.random.default_rng(11)
+    X = paper_fixed_point.x + 0.01 * rng.standard_normal((8, 4))
+    D = paper_map.data(paper_map.slope_rad + 0.003 * rng.standard_normal(8))
+    fns = paper_map._cfuncs(0)
+    cap = np.where(np.arange(8) % 2 == 0, 5.0, 0.05)  # half the rows stop at 50 ms
+    res = []
+    for f in (fns, (fns[0].address, fns[1].address, fns[2].address, fns[3])):
+        which, te, Yev, H = np.empty(8, np.int64), np.empty(8), np.empty((8, 4)), np.zeros(8)
+        period_rows(*f, X.copy(), D.copy(), cap, paper_map._gcols[0], paper_map._goffs[0],
+                    paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2], which, te,
+                    Yev, H)
+        res.append((which, te, Yev, H))
+    assert (res[0][0] == TIMEOUT).any() and (res[0][0] >= 0).any()
+    for a, b in zip(*res):
+        np.testing.assert_array_equal(a, b)
+
+
 # the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
 @pytest.mark.slow
 @pytest.mark.parametrize("scene", ["paper.yaml", "kneed.yaml"])

@@ -482,3 +482,42 @@ def test_batched_native_form_walks_rabbit_and_a_passive_walker_as_sync(scene):
     assert np.array([o[3] for o in a[1:]]).any()
     sync.close()
     native.close()
+
+
+def test_a_steps_infos_are_batched_when_first_read_and_equal_the_batching():
+    """The native step's infos (:class:`walkerlab.gym.vector.LazyInfos`) are batched by the
+    first read, not before, and are then the entries the batching gives, whatever reads
+    them first (a key, ``in``, ``len``, iteration, a copy, a pickle: plain dicts of the
+    same entries)."""
+    import copy
+    import pickle
+
+    from walkerlab.gym.vector import LazyInfos
+
+    calls = []
+
+    def make():
+        calls.append(1)
+        return {"time_s": np.array([0.1, 0.2]), "_time_s": np.ones(2, np.bool_),
+                "stance_leg": np.array(["leg1", "leg2"], dtype=object)}
+
+    want = make()
+    calls.clear()
+    readers = [lambda d: d["time_s"], lambda d: "time_s" in d, len, list, dict,
+               copy.deepcopy, lambda d: pickle.loads(pickle.dumps(d)), lambda d: d == {},
+               lambda d: {**d}, repr, lambda d: d.get("x")]
+    for read in readers:
+        infos = LazyInfos(make)
+        assert calls == [] and isinstance(infos, dict)
+        read(infos)
+        assert calls == [1]
+        calls.clear()
+        _same(want, dict(infos))
+        assert calls == []  # made once
+    assert type(copy.deepcopy(LazyInfos(make))) is dict
+    env = _native(2, "threelink_hzd")
+    env.reset(seed=0)
+    infos = env.step(np.zeros(env.action_space.shape))[4]
+    assert isinstance(infos, LazyInfos) and infos._make is not None
+    assert infos["_time_s"].all() and infos._make is None
+    env.close()

@@ -703,8 +703,21 @@ def batch_parameters(envs) -> dict | None:
             "dt": np.array([e.dt for e in envs], dtype=np.float64),
             "limit": np.array([-1 if e.max_episode_steps is None else e.max_episode_steps
                                for e in envs], dtype=np.int64),
+            "limited": np.array([e.max_episode_steps is not None for e in envs]),
             "low": np.array([e.observation_space.low for e in envs]),
             "high": np.array([e.observation_space.high for e in envs])}
+
+
+def _rigid_view():
+    """:mod:`walkerlab.gym.rigid_view` (imported on first use: the models it reads are
+    not needed to register the environment), kept for the per-period calls."""
+    global _RIGID_VIEW
+    if _RIGID_VIEW is None:
+        from . import rigid_view as _RIGID_VIEW
+    return _RIGID_VIEW
+
+
+_RIGID_VIEW = None
 
 
 def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
@@ -742,7 +755,7 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
             s = e.sim
             a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
     tau = p["tau"]
-    U = np.clip(a, -tau, tau)
+    U = a.clip(-tau, tau)  # (np.clip's own method)
     x_before = np.array([e._hip_x for e in envs])
     w_before = np.array([e.sim.ledger["action_work_positive"] for e in envs])
     t_ends = []
@@ -780,28 +793,28 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
         :meth:`WalkerEnv._info`'s dict), each a list or array of N values of the types
         that dict holds (floats, bools, ints, text, None, lists).
     """
-    from .rigid_view import hip_xs
-
     views = [e.sim for e in envs]
     n = len(envs)
     X = np.array([v.x for v in views])
     m = X.shape[1]
-    t = np.array([v.t for v in views], dtype=np.float64)
+    # each walker's time, stance leg, phase and its step's start, as the observation has
+    # them (leg1's stance as 1.0, the phase's index as a float)
+    S = np.array([(v.t, v.leg == "leg1", v.k, v.t_step) for v in views], dtype=np.float64)
+    t = S[:, 0].copy()
     obs = np.empty((n, m + 3))
     obs[:, :m] = X
-    obs[:, m] = [v.leg == "leg1" for v in views]
-    obs[:, m + 1] = [v.k for v in views]
-    obs[:, m + 2] = t - np.array([v.t_step for v in views])
-    np.clip(obs, p["low"], p["high"], out=obs)
-    hip = hip_xs(views, X)
+    obs[:, m:m + 2] = S[:, 1:3]
+    np.subtract(t, S[:, 3], out=obs[:, m + 2])
+    obs.clip(p["low"], p["high"], out=obs)  # (np.clip's own method, a layer less)
+    hip = _rigid_view().hip_xs(views, X)
     for e, h in zip(envs, hip.tolist()):
         e._hip_x = h  # the next period's start (its reward's origin)
     ended = [v.ended for v in views]
     terminated = np.array([s != "" for s in ended], dtype=np.bool_)
     limit = p["limit"]
-    truncated = ~terminated & (limit >= 0) & (np.array([e._elapsed for e in envs]) >= limit)
-    terms = list(views[0].ledger)
-    L = np.array([[v.ledger[k] for k in terms] for v in views], dtype=np.float64).T.copy()
+    truncated = ~terminated & p["limited"] & (np.array([e._elapsed for e in envs]) >= limit)
+    terms = list(views[0].ledger)  # (every walker's ledger holds LEDGER_TERMS in order)
+    L = np.array([list(v.ledger.values()) for v in views], dtype=np.float64).T.copy()
     dt = p["dt"]
     reward = (p["fw"] * (hip - x_before) / dt
               + np.where(terminated, 0.0, p["healthy"])

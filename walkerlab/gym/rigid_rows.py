@@ -32,6 +32,7 @@ import sys
 import numpy as np
 
 from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
+from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 
 __all__ = ["advance_rows"]
 
@@ -82,8 +83,6 @@ def _period_rows(key: tuple, args: tuple) -> None:
     cfuncs) costs about 80 us a call of the 8-walker benchmark, more than the kernel's 8
     rows (65 us); the arrays are made alike on every call (C order, writable, one dtype),
     so the types, and the entry, are the first call's."""
-    from walkerlab.integrate.rows_dop853 import period_rows
-
     entry = _ENTRY.get(key)
     if entry is not None:
         entry(*args)
@@ -97,8 +96,6 @@ def _period_rows(key: tuple, args: tuple) -> None:
 def _kernel_args(key: tuple, fphase) -> tuple:
     """:func:`walkerlab.integrate.rows_dop853.period_rows`'s shared arguments for ``key``."""
     if key not in _CFUNCS:
-        from walkerlab.integrate.rows_dop853 import cfuncs
-
         flow = fphase.compiled
         module = flow.module()
         f = module.cfunc_of(flow.name)
@@ -117,47 +114,62 @@ def _kernel_args(key: tuple, fphase) -> tuple:
     return _CFUNCS[key]
 
 
-def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> list[PhaseRun]:
-    """The compiled pieces ``pieces`` of walkers ``rows`` (one flow) in one kernel call."""
-    from walkerlab.integrate.rows_dop853 import FAILED
-
+def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> tuple:
+    """The compiled pieces ``pieces`` of walkers ``rows`` (one flow) in one kernel call:
+    ``(which, te, Yev)`` (:func:`walkerlab.integrate.rows_dop853.period_rows`'s outcome,
+    time from the piece's start [s] and state of each row)."""
     fphase = pieces[0][5][0]
     f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out = _kernel_args(key, fphase)
     N, m = len(rows), key[7]
-    Y = np.empty((N, m))
+    walkers = [views[i] for i in rows]
+    Y = np.array([v.x for v in walkers], dtype=float)
+    if Y.shape != (N, m):  # pragma: no cover - every view's state is (2n,)
+        raise ValueError(f"rigid rows: states of shape {Y.shape[1:]}, not ({m},)")
     into = hasattr(fphase.compiled, "data_into")
     D = np.empty((N, fphase.compiled.data_size() if into else fphase.compiled.data().size))
-    cap = np.empty(N)
-    for r, (i, piece) in enumerate(zip(rows, pieces)):
-        v = views[i]
-        Y[r] = v.x
+    for r, piece in enumerate(pieces):
         if into:  # this walker's torques in its law block
             piece[5][0].compiled.data_into(D[r])
         else:
             D[r] = piece[5][0].compiled.data()
-        cap[r] = piece[4] - v.t
+    cap = np.array([piece[4] for piece in pieces], dtype=float) - np.array(
+        [v.t for v in walkers], dtype=float)
     which = np.empty(N, np.int64)
     te = np.empty(N)
     Yev = np.empty((N, m))
     H = np.zeros(N)
-    view0 = views[rows[0]]  # (an arithmetic error inside the kernel: counted on it)
-    hook, sys.unraisablehook = sys.unraisablehook, view0.count_unraisable
-    try:
+    hook, sys.unraisablehook = sys.unraisablehook, walkers[0].count_unraisable
+    try:  # (an arithmetic error inside the kernel: counted on the first row's walker)
         _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
                            which, te, Yev, H))
     finally:
         sys.unraisablehook = hook
-    runs = []
-    for r, (i, piece) in enumerate(zip(rows, pieces)):
-        v, w = views[i], int(which[r])
+    return which, te, Yev
+
+
+def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> None:
+    """Each row's piece ended (:func:`_integrate_rows`' ``out``) taken by its walker, as
+    :meth:`~walkerlab.gym.rigid_view.RigidView.absorb` takes a run: a row that reached its
+    period's end with no action on (no work to count) settles there
+    (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, the states' finiteness checked
+    for all rows at once); any other is absorbed as a :class:`PhaseRun`, its dense output
+    made on first use (:class:`_Redo`)."""
+    which, te, Yev = out
+    X = Yev.copy()  # (each settled walker's state: its row)
+    finite = np.isfinite(X).all(axis=1).tolist()
+    for r, (i, piece, w) in enumerate(zip(rows, pieces, which.tolist())):
+        v = views[i]
+        if w == TIMEOUT and not piece[2]:
+            v.settle(float(piece[4]), X[r], finite[r])
+            continue
         failed = w == FAILED
         event = w if w >= 0 else None
         # a row that reached its end stops on it exactly (its time is the period's)
         t_last = v.t + float(te[r]) if (event is not None or failed) else float(piece[4])
-        runs.append(PhaseRun(t_last, Yev[r], failed,
-                             "the step size fell below 10 ulp of t" if failed else "", event,
-                             _Redo(v, piece[5][0], v.t, v.x, t_last), 0))
-    return runs
+        run = PhaseRun(t_last, Yev[r], failed,
+                       "the step size fell below 10 ulp of t" if failed else "", event,
+                       _Redo(v, piece[5][0], v.t, v.x, t_last), 0)
+        strikes[i] += v.absorb(piece, run, piece[3])
 
 
 def advance_rows(views, actions, t_ends) -> list[list[float]]:
@@ -201,7 +213,7 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
             rows.append(i)
             pieces.append(piece)
         for key, (rows, pieces) in groups.items():
-            for i, piece, run in zip(rows, pieces, _integrate_rows(views, rows, pieces, key)):
-                strikes[i] += views[i].absorb(piece, run, piece[3])
+            _absorb_rows(views, rows, pieces, _integrate_rows(views, rows, pieces, key),
+                         strikes)
         live = [i for i in live if views[i].t < t_ends[i] and not views[i].ended]
     return strikes

@@ -132,6 +132,8 @@ class RigidView:
                                 if compiled and "cyrk_compiled" in available_backends()
                                 else None)
         self._compiled: dict = {}
+        #: :meth:`next_piece`'s memo of the present walker, phase and leg (:meth:`_lane_of`)
+        self._lane: tuple | None = None
         #: what a compiled phase shares with other walkers' in a batched step
         #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``)
         self.row_keys: dict = {}
@@ -415,23 +417,33 @@ class RigidView:
         ``fast`` the compiled phase (:meth:`_compiled_phase`, its law block holding ``u``)
         or None; None when the phase's fall guard is already violated (:attr:`ended` set)."""
         w = self.walker
-        acts = self.acts[self.leg]
+        lane = self._lane
+        if lane is None or lane[0] is not w or lane[1] != self.k or lane[2] != self.leg:
+            lane = self._lane = self._lane_of(w)
+        acts, phase, falls, fast = lane[3:]
         acts.u = np.asarray(u, dtype=float)
         act_on = np.count_nonzero(acts.u) > 0
-        phase = w.phases[self.k]
-        for g in phase.guards:  # a fall guard already violated as the phase begins
-            if (g.at_entry and g.outcome == "fall"
-                    and g.direction * float(g.function(self.t, self.x)) > 0):
+        for g in falls:  # a fall guard already violated as the phase begins
+            if g.direction * float(g.function(self.t, self.x)) > 0:
                 self.ended = "fall"
         if self.ended:
             return None
         t_stop = min(t_end, self.t_step + self.max_step_time)
-        fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
-                else None)
         if fast is not None:  # the compiled control step: the action's torques held in
             fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * acts.u.size:HEAD] = acts.u  # the law
             # block (each actuator's constant)
         return w, acts, act_on, phase, t_stop, fast
+
+    def _lane_of(self, w) -> tuple:
+        """What :meth:`next_piece` reads of the present step walker ``w``, phase and
+        stance leg (kept while they stay: :attr:`_lane`): ``(w, k, leg, actuators, phase,
+        its fall guards checked at entry, the compiled phase or None)``."""
+        acts = self.acts[self.leg]
+        phase = w.phases[self.k]
+        falls = tuple(g for g in phase.guards if g.at_entry and g.outcome == "fall")
+        fast = (self._compiled_phase(w, phase, acts) if self.compiled_solver is not None
+                else None)
+        return (w, self.k, self.leg, acts, phase, falls, fast)
 
     def integrate_piece(self, piece):
         """``(run, phase)``: :meth:`next_piece`'s piece integrated from the present state
@@ -472,14 +484,12 @@ class RigidView:
             self._work(run.dense, self.t, run.t_last, acts, act_on)
         if self.ground is not None:
             self._pieces.append((phase, run.dense, (self.t, run.t_last)))
-        self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
-        if run.failed or not all(map(math.isfinite, self.x.tolist())):
-            self.ended = "solver_failure"
+        x = np.array(run.y_last[:2 * n], float)
+        finite = not run.failed and all(map(math.isfinite, x.tolist()))
+        if run.event is None or not finite:
+            self.settle(run.t_last, x, finite)
             return strikes
-        if run.event is None:
-            if self.t >= self.t_step + self.max_step_time:
-                self.ended = "stall"
-            return strikes
+        self.t, self.x = run.t_last, x
         # the walker's own guard (a twin's are the same, in order; the heel strike's
         # reset, a push-off's, is the scene walker's)
         guard = w.phases[self.k].guards[run.event]
@@ -513,6 +523,17 @@ class RigidView:
                     ends is not None and self.steps >= ends):
                 self.ended = "ground_end"  # the walk left the ground's end
         return strikes
+
+    def settle(self, t_last: float, x: np.ndarray, finite: bool) -> None:
+        """A piece that ended without a guard crossing (:meth:`absorb`): the walker at
+        ``(t_last [s], x (2n,))`` (``x`` kept, not copied), ``finite`` False for a failed
+        integration or a state not finite (the episode ends: ``solver_failure``); a step
+        that has lasted ``max_step_time`` ends it as a ``stall``."""
+        self.t, self.x = t_last, x
+        if not finite:
+            self.ended = "solver_failure"
+        elif self.t >= self.t_step + self.max_step_time:
+            self.ended = "stall"
 
     def _swing_trip(self, w):
         """Where the swing foot of the step just ended met the profile (``(t, x, y)``), or
@@ -736,9 +757,13 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
         The hips' world x [m].
     """
     out = np.empty(len(views))
-    groups: dict = {}
-    for i, v in enumerate(views):
-        groups.setdefault(id(v.walker.points), []).append(i)
+    pts = [v.walker.points for v in views]
+    if all(f is pts[0] for f in pts):
+        groups: dict = {id(pts[0]): list(range(len(views)))}
+    else:
+        groups = {}
+        for i, f in enumerate(pts):
+            groups.setdefault(id(f), []).append(i)
     for rows in groups.values():
         if len(rows) < 2:
             hx = None
@@ -748,6 +773,8 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
             hx = _hips(views[rows[0]].walker.points, np.array([views[i].x for i in rows]))
         if hx is None:
             out[rows] = [views[i].hip_x() for i in rows]
+        elif len(rows) == len(views):
+            out = np.array([v.foot[0] for v in views], dtype=float) + hx
         else:
             out[rows] = np.array([views[i].foot[0] for i in rows]) + hx
     return out
