@@ -79,10 +79,11 @@ _ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument ty
 def _period_rows(key: tuple, args: tuple) -> None:
     """:func:`walkerlab.integrate.rows_dop853.period_rows` of ``args``, through its compiled
     entry for their types once the dispatcher has chosen it: numba's dispatcher types every
-    argument of every call, and the type of a first-class function (the flow's three
-    cfuncs) costs about 80 us a call of the 8-walker benchmark, more than the kernel's 8
-    rows (65 us); the arrays are made alike on every call (C order, writable, one dtype),
-    so the types, and the entry, are the first call's."""
+    argument of every call (17 here); the arrays are made alike on every call (C order,
+    writable, one dtype) and the flow's cfuncs are given by address (integers:
+    :func:`walkerlab.integrate.rows_dop853._call_address`; as first-class functions their
+    boxing cost about 50 us a call of the 8-walker benchmark, more than its 8 rows), so the
+    types, and the entry, are the first call's."""
     entry = _ENTRY.get(key)
     if entry is not None:
         entry(*args)

@@ -11,7 +11,8 @@ the scaled error (``atol + rtol max(|y|, |y_new|)``): the criterion
 equals scipy's RMS norm at tolerances divided by ``sqrt(2n)``).
 
 The flow is the walker's compiled ``cfunc`` ``(dy, t, y, d)``
-(:class:`walkerlab.codegen.compiled.CompiledFlow`), called as a first-class function; its
+(:class:`walkerlab.codegen.compiled.CompiledFlow`), called as a first-class function or by
+its process address (an ``int``: :func:`_call_address`, the same machine code); its
 extra outputs are the guards (``G[gcols] + goffs``).  Where the generated module has them
 (:func:`cfuncs`), a step's inner stages call the flow without its guard outputs and a
 crossing is located on one guard's cfunc: the same values bit for bit, fewer operations
