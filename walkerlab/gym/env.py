@@ -795,39 +795,49 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     """
     views = [e.sim for e in envs]
     n = len(envs)
-    X = np.array([v.x for v in views])
+    # what is read of each walker, in one pass: its state, time, stance leg, phase, its
+    # step's start, how its episode ended, its steps and ledger
+    rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
+    xs, ts, legs, ks, t_steps, ended, steps, ledgers = (list(c) for c in zip(*rows))
+    X = np.array(xs)
     m = X.shape[1]
-    # each walker's time, stance leg, phase and its step's start, as the observation has
-    # them (leg1's stance as 1.0, the phase's index as a float)
-    S = np.array([(v.t, v.leg == "leg1", v.k, v.t_step) for v in views], dtype=np.float64)
-    t = S[:, 0].copy()
+    t = np.array(ts, dtype=np.float64)
     obs = np.empty((n, m + 3))
     obs[:, :m] = X
-    obs[:, m:m + 2] = S[:, 1:3]
-    np.subtract(t, S[:, 3], out=obs[:, m + 2])
+    # (leg1's stance as 1.0, the phase's index as a float, the time in the step)
+    obs[:, m:] = [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in
+                  zip(legs, ks, ts, t_steps)]
     obs.clip(p["low"], p["high"], out=obs)  # (np.clip's own method, a layer less)
     hip = _rigid_view().hip_xs(views, X)
-    for e, h in zip(envs, hip.tolist()):
+    hips = hip.tolist()
+    for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
-    ended = [v.ended for v in views]
-    terminated = np.array([s != "" for s in ended], dtype=np.bool_)
-    limit = p["limit"]
-    truncated = ~terminated & p["limited"] & (np.array([e._elapsed for e in envs]) >= limit)
-    terms = list(views[0].ledger)  # (every walker's ledger holds LEDGER_TERMS in order)
-    L = np.array([list(v.ledger.values()) for v in views], dtype=np.float64).T.copy()
-    dt = p["dt"]
-    reward = (p["fw"] * (hip - x_before) / dt
-              + np.where(terminated, 0.0, p["healthy"])
-              - p["cw"] * np.add.reduce((U / p["tau"]) ** 2, axis=1)
-              - p["ww"] * (L[terms.index("action_work_positive")] - w_before) / dt)
+    terminated = [s != "" for s in ended]
+    elapsed = [e._elapsed for e in envs]
+    truncated = [not te and lim >= 0 and el >= lim
+                 for te, lim, el in zip(terminated, p["limit"].tolist(), elapsed)]
+    terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
+    L = np.array([list(led.values()) for led in ledgers], dtype=np.float64).T.copy()
+    # the reward of each walker as its own end_period computes it, on Python floats (the
+    # same IEEE operations in the same order as there)
+    effort = np.add.reduce((U / p["tau"]) ** 2, axis=1).tolist()
+    work = L[terms.index("action_work_positive")].tolist()
+    reward = np.array([
+        fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
+        for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
+            p["fw"].tolist(), hips, x_before.tolist(), p["dt"].tolist(), terminated,
+            p["healthy"].tolist(), p["cw"].tolist(), effort, p["ww"].tolist(), work,
+            w_before.tolist())], dtype=np.float64)
     columns = {"time_s": t,
                "heel_strike": [bool(s) for s in strikes],
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
                "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
-               "steps": [int(v.steps) for v in views],
-               "stance_leg": [v.leg for v in views], "hip_x_m": hip,
+               "steps": [int(s) for s in steps],
+               "stance_leg": legs, "hip_x_m": hip,
                "termination": ended,
                "solver_message": [str(getattr(v, "failure", "")) for v in views],
                "terrain_seed": [int(e.terrain_seed) for e in envs]}
     columns.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
+    terminated = np.array(terminated, dtype=np.bool_)
+    truncated = np.array(truncated, dtype=np.bool_)
     return obs, reward, terminated, truncated, columns

@@ -756,8 +756,12 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
     ndarray (N,)
         The hips' world x [m].
     """
-    out = np.empty(len(views))
     pts = [v.walker.points for v in views]
+    if len(views) > 1 and X is not None and all(f is pts[0] for f in pts):
+        hx = _hips(pts[0], X)  # one step walker's points for all: one call
+        if hx is not None:
+            return np.array([v.foot[0] for v in views], dtype=float) + hx
+    out = np.empty(len(views))
     if all(f is pts[0] for f in pts):
         groups: dict = {id(pts[0]): list(range(len(views)))}
     else:
