@@ -146,20 +146,37 @@ def generate_pieces(eq, params, outputs, phase, joints, prefix: str, key: str) -
     code by :func:`sympy.lambdify`, common subexpressions eliminated) and ``K``, ``N``."""
     import inspect
 
+    import numpy
     import sympy as sp
 
     out, foot, B = _expressions(eq, params, outputs, phase, joints, prefix)
     args = [*eq.q, *eq.dq]
-    text = [f"# walkerlab virtual-constraint pieces (walkerlab.codegen.virtual_constraints); "
-            f"key {key}",
-            "# Do not edit: regenerated when the walker, its outputs or the generator change.",
-            "import numpy", "from numpy import *  # noqa: F401,F403 (lambdify's names)", "",
-            f"K, N = {len(outputs)}, {len(eq.q)}", ""]
+    body, names = [], set()
     for name, exprs in (("out", out), ("foot", foot), ("B", B)):
         fn = sp.lambdify(args, exprs, "numpy", cse=True)
         src = inspect.getsource(fn).replace("def _lambdifygenerated(", f"def _{name}(", 1)
-        text += [src, "", f"def {name}(x):", f"    return _{name}(*x)", ""]
-    return "\n".join(text) + "\n"
+        body += [src, "", f"def {name}(x):", f"    return _{name}(*x)", ""]
+        names |= _global_names(fn.__code__)
+    # the names of numpy's star import that the functions use (lambdify's ``sin``, ``cos``,
+    # ...): the same objects, without the star import's cost (it loads every lazy numpy
+    # submodule, ~0.15 s a process)
+    used = sorted(names & set(numpy.__all__))
+    head = [f"# walkerlab virtual-constraint pieces (walkerlab.codegen.virtual_constraints); "
+            f"key {key}",
+            "# Do not edit: regenerated when the walker, its outputs or the generator change.",
+            "import numpy"]
+    if used:
+        head.append(f"from numpy import {', '.join(used)}  # noqa: F401 (lambdify's names)")
+    return "\n".join([*head, "", f"K, N = {len(outputs)}, {len(eq.q)}", "", *body]) + "\n"
+
+
+def _global_names(code) -> set[str]:
+    """The names a code object (and those nested in it) reads as globals or attributes."""
+    names = set(code.co_names)
+    for c in code.co_consts:
+        if hasattr(c, "co_names"):
+            names |= _global_names(c)
+    return names
 
 
 class OutputPieces:
