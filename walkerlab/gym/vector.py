@@ -151,7 +151,7 @@ def _filling(name: str):
     def read(self, *args, **kwargs):
         return method(self._filled(), *args, **kwargs)
     read.__name__ = name
-    read.__doc__ = method.__doc__
+    read.__doc__ = f"``dict.{name}`` of the entries (made first)."
     return read
 
 
