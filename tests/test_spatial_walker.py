@@ -271,3 +271,25 @@ def test_hip_width_steps_release_the_slopes_energy_along_the_fall_line(hip_width
         assert led["slope_energy"][k] == pytest.approx(led["potential_work"][k], rel=1e-9)
         assert led["heel_strike_loss"][k] == pytest.approx(led["slope_energy"][k], rel=1e-9)
         assert led["cost_of_transport"][k] == pytest.approx(math.sin(HIP["gamma"]), rel=1e-12)
+
+
+def test_a_3d_derivation_draws_from_a_seeded_generator_and_restores_its_state():
+    """The 3D walkers' derivations (``derive_compass``, ``derive_spoked``) run with sympy's
+    random number generator seeded (``trigsimp``'s factorisation draws from it: its time,
+    not its factors, depends on the draws), so every derivation draws the same numbers,
+    and the caller's generator state is as it was."""
+    import sympy.core.random as srand
+
+    from walkerlab.codegen.spatial import _seeded, derive_compass, derive_spoked
+
+    assert derive_compass.__wrapped__ is not None and derive_spoked.__wrapped__ is not None
+    draws = []
+    derive = _seeded(lambda s: draws.append((s, srand.rng.random(), srand.randint(0, 10**9))))
+    srand.rng.seed(123)
+    before = srand.rng.getstate()
+    derive("a")
+    srand.rng.random()  # the caller draws between two derivations
+    after = srand.rng.getstate()
+    derive("b")
+    assert draws[0][1:] == draws[1][1:]
+    assert srand.rng.getstate() == after != before

@@ -64,6 +64,35 @@ import sympy as sp
 
 from walkerlab.codegen.equations import Equations
 
+#: the seed of sympy's random choices while a 3D walker is derived (:func:`_seeded`)
+SYMPY_SEED = 0
+
+
+def _seeded(derive):
+    """``derive`` with sympy's random number generator (``sympy.core.random.rng``) seeded
+    with :data:`SYMPY_SEED` while it runs, its state restored after.
+
+    ``trigsimp`` (the mass and impact matrices here) calls ``factor``, whose multivariate
+    factorisation (Wang's, ``dmp_zz_wang``) draws its evaluation points at random.  The
+    factors are the same whatever it draws (measured: the same generated text from eight
+    generator states), but its time is not: in a test process whose generator had been
+    drawn from before, the Hensel lifting of the round-feet walker's impact matrix ran for
+    over 30 minutes, where a fresh process derives the walker in 45 s.  Seeded, a
+    derivation takes the same time in every process and on every machine."""
+    import functools
+
+    import sympy.core.random as srand
+
+    @functools.wraps(derive)
+    def seeded(structure):
+        state = srand.rng.getstate()
+        srand.rng.seed(SYMPY_SEED)
+        try:
+            return derive(structure)
+        finally:
+            srand.rng.setstate(state)
+    return seeded
+
 
 def rotation(axis: sp.Matrix, angle) -> sp.Matrix:
     """Rotation matrix (3, 3) by ``angle`` about the unit vector ``axis`` (Rodrigues)."""
@@ -101,6 +130,7 @@ def _spoke(theta_offset, L) -> sp.Matrix:
 
 
 @cache
+@_seeded
 def derive_spoked(structure) -> Equations:
     """Flow, impact, guards, energies and points of a spoked wheel in three dimensions
     (module docstring).
@@ -253,6 +283,7 @@ def _leg_rotation_mass(q, phi, th_st, phi_w, th_sw, gamma, inertia) -> sp.Matrix
 
 
 @cache
+@_seeded
 def derive_compass(structure) -> Equations:
     """Flow, impact, guards, energies and points of a straight-legged walker with hip width in
     three dimensions (``model: compass_gait`` with ``space: 3d``; Kuo 1999, "Stabilization of
