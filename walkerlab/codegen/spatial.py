@@ -58,7 +58,7 @@ one).  The steady rolling motions form a one-parameter family by heading at a gi
 
 from __future__ import annotations
 
-from functools import cache
+from functools import cache, wraps
 
 import sympy as sp
 
@@ -79,11 +79,9 @@ def _seeded(derive):
     drawn from before, the Hensel lifting of the round-feet walker's impact matrix ran for
     over 30 minutes, where a fresh process derives the walker in 45 s.  Seeded, a
     derivation takes the same time in every process and on every machine."""
-    import functools
-
     import sympy.core.random as srand
 
-    @functools.wraps(derive)
+    @wraps(derive)
     def seeded(structure):
         state = srand.rng.getstate()
         srand.rng.seed(SYMPY_SEED)

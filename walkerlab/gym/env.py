@@ -703,7 +703,6 @@ def batch_parameters(envs) -> dict | None:
             "dt": np.array([e.dt for e in envs], dtype=np.float64),
             "limit": np.array([-1 if e.max_episode_steps is None else e.max_episode_steps
                                for e in envs], dtype=np.int64),
-            "limited": np.array([e.max_episode_steps is not None for e in envs]),
             "low": np.array([e.observation_space.low for e in envs]),
             "high": np.array([e.observation_space.high for e in envs])}
 

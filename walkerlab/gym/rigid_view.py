@@ -762,12 +762,9 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
         if hx is not None:
             return np.array([v.foot[0] for v in views], dtype=float) + hx
     out = np.empty(len(views))
-    if all(f is pts[0] for f in pts):
-        groups: dict = {id(pts[0]): list(range(len(views)))}
-    else:
-        groups = {}
-        for i, f in enumerate(pts):
-            groups.setdefault(id(f), []).append(i)
+    groups: dict = {}
+    for i, f in enumerate(pts):
+        groups.setdefault(id(f), []).append(i)
     for rows in groups.values():
         if len(rows) < 2:
             hx = None
@@ -777,8 +774,6 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
             hx = _hips(views[rows[0]].walker.points, np.array([views[i].x for i in rows]))
         if hx is None:
             out[rows] = [views[i].hip_x() for i in rows]
-        elif len(rows) == len(views):
-            out = np.array([v.foot[0] for v in views], dtype=float) + hx
         else:
             out[rows] = np.array([views[i].foot[0] for i in rows]) + hx
     return out

@@ -124,7 +124,6 @@ def _call_address(typingctx, addr, dy, t, y, d):  # pragma: no cover - compiled
 
         def data(ty, val):
             return context.make_array(ty)(context, builder, val).data
-        tv = context.cast(builder, tv, signature.args[2], types.float64)
         builder.call(fp, [data(signature.args[1], dya), tv, data(signature.args[3], ya),
                           data(signature.args[4], da)])
         return context.get_dummy_value()
