@@ -174,11 +174,63 @@ def test_cfuncs_called_by_address_give_the_first_class_calls_numbers(paper_map,
         which, te, Yev, H = np.empty(8, np.int64), np.empty(8), np.empty((8, 4)), np.zeros(8)
         period_rows(*f, X.copy(), D.copy(), cap, paper_map._gcols[0], paper_map._goffs[0],
                     paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2], which, te,
-                    Yev, H)
+                    Yev, H, np.full((8, 0), np.nan), np.empty((8, 0, 4)))
         res.append((which, te, Yev, H))
     assert (res[0][0] == TIMEOUT).any() and (res[0][0] >= 0).any()
     for a, b in zip(*res):
         np.testing.assert_array_equal(a, b)
+
+
+def test_period_rows_write_their_dense_output_at_sample_times_without_changing_the_steps(
+        paper_map, paper_fixed_point):
+    """``period_rows`` given sample times (the native vector environment's Gauss-Legendre
+    nodes) writes each row's states there from its steps' dense output: scipy's DOP853
+    at 1e-12 gives the same states within the run's tolerance (1e-9 on a state of order
+    1: 1e-8), a time left NaN is not written, and the steps' outcomes (guards, times,
+    end states, next step sizes) are bit for bit those without samples."""
+    from ctypes import POINTER, c_double
+
+    from scipy.integrate import solve_ivp
+
+    from walkerlab.integrate.rows_dop853 import TIMEOUT, period_rows
+
+    rng = np.random.default_rng(5)
+    X = paper_fixed_point.x + 0.01 * rng.standard_normal((4, 4))
+    D = paper_map.data(paper_map.slope_rad + 0.003 * rng.standard_normal(4))
+    fns = paper_map._cfuncs(0)
+    cap = np.array([0.05, 0.2, 0.05, 0.3])
+    nodes = 0.5 * cap[:, None] * (1 + np.polynomial.legendre.leggauss(4)[0])
+    nodes[2] = np.nan  # row 2: no samples
+    out = []
+    for Tn, Yn in ((np.full((4, 0), np.nan), np.empty((4, 0, 4))),
+                   (nodes, np.full((4, 4, 4), -7.0))):
+        which, te, Yev, H = np.empty(4, np.int64), np.empty(4), np.empty((4, 4)), np.zeros(4)
+        period_rows(*fns, X.copy(), D.copy(), cap, paper_map._gcols[0], paper_map._goffs[0],
+                    paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2], which, te,
+                    Yev, H, Tn, Yn)
+        out.append((which, te, Yev, H, Yn))
+    for a, b in zip(out[0][:4], out[1][:4]):
+        np.testing.assert_array_equal(a, b)
+    which, Yn = out[1][0], out[1][4]
+    assert (which == TIMEOUT).all()  # every row reached its cap: all its nodes were passed
+    assert (Yn[2] == -7.0).all()
+    f = fns[0]  # the flow's cfunc (dy, t, y, d): its 4 rates, then its guard outputs
+    dy = np.empty(4 + paper_map.phases[0][2])
+
+    def ptr(v):
+        return v.ctypes.data_as(POINTER(c_double))
+
+    for i in (0, 1, 3):
+        d = np.ascontiguousarray(D[i])
+
+        def rhs(t, y, d=d):
+            y = np.ascontiguousarray(y, dtype=float)
+            f.ctypes(ptr(dy), t, ptr(y), ptr(d))
+            return dy[:4].copy()
+
+        ref = solve_ivp(rhs, (0.0, cap[i]), X[i], method="DOP853", rtol=1e-12, atol=1e-12,
+                        t_eval=nodes[i]).y.T
+        np.testing.assert_allclose(Yn[i], ref, rtol=0, atol=1e-8)
 
 
 # the quick suite's CPU budget (README): a longer run, in `pytest -m slow`

@@ -20,9 +20,18 @@ single walker: Brent's method to 4 eps).  Pieces that do not run the compiled st
 feet's modes, torque laws of the walker's own, a height profile's walk, which keeps each
 piece's dense output) are integrated one by one as the walker itself integrates them.
 
-The ledger's Gauss-Legendre nodes, needed where the held torques' power changes sign over a
-piece, read a dense output that the kernel does not keep: that piece is integrated again by
-the single walker's integrator on first use (:class:`_Redo`).
+The ledger of a row that reaches its period's end with the action on is taken for all such
+rows at once (:func:`_held_rows`), as each walker's
+:meth:`~walkerlab.gym.rigid_view.RigidView._held_work` takes it: the held torques' exact
+work ``sum_k u_k Delta delta_k`` where their power has one sign at both ends, else the
+power at the piece's 4 Gauss-Legendre nodes, whose states the kernel's dense output wrote as
+its steps passed them (the same steps: the period's states are those without the nodes).
+The same sums as the walker's own to round-off (its nodes are read from CyRK's dense output
+of the same DOP853 steps, its joint maps applied state by state).  Other rows (a guard
+crossing, a failed step, a walker whose joints are not affine in its coordinates) are
+absorbed walker by walker; the Gauss-Legendre nodes of such a row's piece read a dense
+output made on first use, the piece integrated again by the single walker's integrator
+(:class:`_Redo`).
 """
 
 from __future__ import annotations
@@ -35,6 +44,10 @@ from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
 from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 
 __all__ = ["advance_rows"]
+
+#: the ledger's 4-point Gauss-Legendre rule on [-1, 1] (:mod:`walkerlab.gym.rigid_view`)
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
+_GL_WL = _GL_W.tolist()
 
 
 class _Redo:
@@ -139,13 +152,52 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> tuple:
     te = np.empty(N)
     Yev = np.empty((N, m))
     H = np.zeros(N)
+    # the Gauss-Legendre nodes of the rows with the action on (their ledger's, should the
+    # power change sign over the period: _held_rows), NaN for the others
+    on = [piece[2] for piece in pieces]
+    if any(on):
+        Tn = 0.5 * cap[:, None] * _GL_X + 0.5 * cap[:, None]
+        if not all(on):
+            Tn[[not a for a in on]] = np.nan
+        Yn = np.empty((N, _GL_X.size, m))
+    else:
+        Tn, Yn = np.empty((N, 0)), np.empty((N, 0, m))
     hook, sys.unraisablehook = sys.unraisablehook, walkers[0].count_unraisable
     try:  # (an arithmetic error inside the kernel: counted on the first row's walker)
         _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
-                           which, te, Yev, H))
+                           which, te, Yev, H, Tn, Yn))
     finally:
         sys.unraisablehook = hook
-    return which, te, Yev
+    return which, te, Yev, Y, cap, Yn
+
+
+def _held_rows(views, rows: list, pieces: list, sel: list, X: np.ndarray, Y: np.ndarray,
+               cap: np.ndarray, Yn: np.ndarray) -> None:
+    """The ledger of the rows ``sel`` (indices into ``rows``), each of which reached its
+    period's end with the action on (its walker's
+    :meth:`~walkerlab.gym.rigid_view.RigidView._held_work`, all at once): from ``Y`` to
+    ``X`` (r, 2n) over ``cap`` [s], the held torques' exact work ``u . (delta_b -
+    delta_a)`` where their power ``u . ddelta`` has one sign at both ends, else the power
+    at the Gauss-Legendre nodes' states ``Yn`` (r, 4, 2n) weighted (module docstring).
+    With the joints' map ``ddelta = Bt dq`` (``delta = Bt q + c``), both are ``w . dq``
+    and ``w . Delta q`` with ``w = Bt^T u`` (n,) [N m]."""
+    n = X.shape[1] // 2
+    W = np.array([pieces[r][1].u @ pieces[r][1].affine[0] for r in sel])  # (r, n)
+    Xa, Xb = Y[sel], X[sel]
+    exact = ((Xb[:, :n] - Xa[:, :n]) * W).sum(axis=1).tolist()
+    pa = (Xa[:, n:] * W).sum(axis=1)  # the power at both ends [W]
+    pb = (Xb[:, n:] * W).sum(axis=1)
+    one_sign = (pa * pb > 0.0).tolist()
+    positive = (pa > 0.0).tolist()
+    for j, r in enumerate(sel):
+        ledger = views[rows[r]].ledger
+        if one_sign[j]:
+            ledger["action_work_positive" if positive[j] else "action_work_negative"] += \
+                exact[j]
+            continue
+        h = 0.5 * float(cap[r])
+        for w, p in zip(_GL_WL, (Yn[r, :, n:] @ W[j]).tolist()):  # at the nodes [W]
+            ledger["action_work_positive" if p > 0 else "action_work_negative"] += h * w * p
 
 
 def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> None:
@@ -155,12 +207,18 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, the states' finiteness checked
     for all rows at once); any other is absorbed as a :class:`PhaseRun`, its dense output
     made on first use (:class:`_Redo`)."""
-    which, te, Yev = out
+    which, te, Yev, Y, cap, Yn = out
     X = Yev.copy()  # (each settled walker's state: its row)
     finite = np.isfinite(X).all(axis=1).tolist()
-    for r, (i, piece, w) in enumerate(zip(rows, pieces, which.tolist())):
+    ends = which.tolist()
+    held = [r for r, (piece, w) in enumerate(zip(pieces, ends))
+            if w == TIMEOUT and piece[2] and finite[r] and _affine(piece[1])]
+    if held:
+        _held_rows(views, rows, pieces, held, X, Y, cap, Yn)
+    held = set(held)
+    for r, (i, piece, w) in enumerate(zip(rows, pieces, ends)):
         v = views[i]
-        if w == TIMEOUT and not piece[2]:
+        if w == TIMEOUT and (not piece[2] or r in held):
             v.settle(float(piece[4]), X[r], finite[r])
             continue
         failed = w == FAILED
@@ -171,6 +229,13 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
                        "the step size fell below 10 ulp of t" if failed else "", event,
                        _Redo(v, piece[5][0], v.t, v.x, t_last), 0)
         strikes[i] += v.absorb(piece, run, piece[3])
+
+
+def _affine(acts) -> bool:
+    """The action's ledger of ``acts`` (an :class:`walkerlab.gym.action.ActionTorques`)
+    is :func:`_held_rows`': the action alone, its joints affine in the coordinates, not
+    scaled by a massless foot's mass (whose torques do no work)."""
+    return acts.affine is not None and not acts.first and not acts.limit
 
 
 def advance_rows(views, actions, t_ends) -> list[list[float]]:

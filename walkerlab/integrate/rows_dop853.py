@@ -317,14 +317,17 @@ def _work(m, n_out, ng):  # pragma: no cover - compiled
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
-         work, exact=False):  # pragma: no cover - compiled
+         work, exact, tn, yn):  # pragma: no cover - compiled
     """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
     into ``yev``; ``f, fs, fg, sel``: the cfuncs (:func:`phase_rows`); ``h_first`` > 0: the
     first step size [s] (else scipy's choice); ``work``: :func:`_work`'s scratch arrays
     (allocated once per call of the caller, not per row).  ``exact``: the last step ends on
     ``cap`` (``solve_ivp``'s ``t_bound``) and a :data:`TIMEOUT` row's state there goes into
     ``yev``; else the steps run past ``cap`` as if unbounded (a cap is a walk's give-up
-    time, not a sample) and ``yev`` is left as it was."""
+    time, not a sample) and ``yev`` is left as it was.  ``tn`` (q,) [s]: times inside the
+    row's span (NaN: none) whose states the accepted steps' dense output writes into ``yn``
+    (q, m) as the steps pass them (a step with no guard crossing; the steps are the same
+    with or without them)."""
     m = y.size
     ng = gcols.size
     K, F, buf, ynew, tmp, G = work
@@ -371,6 +374,12 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
         if best >= 0:
             _dense_at(F, y, (te - t) / h, yev)
             return best, te, h_abs
+        for q in range(tn.size):  # the samples inside this step
+            if t < tn[q] <= t_new:
+                if not dense:
+                    _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp)
+                    dense = True
+                _dense_at(F, y, (tn[q] - t) / h, yn[q])
         if t_new >= cap:
             if exact:
                 for k in range(m):
@@ -405,12 +414,13 @@ def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
     work = _work(Y.shape[1], n_out, gcols.size)
     y = np.empty(Y.shape[1])
     go = goffs.copy()
+    tn, yn = np.empty(0), np.empty((0, Y.shape[1]))
     for i in range(Y.shape[0]):
         y[:] = Y[i]
         if hs >= 0:
             go[hs] = goffs[hs] + hoff[i]
         w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, go, dirs, rtol, atol, Yev[i],
-                       H[i], work)
+                       H[i], work, False, tn, yn)
         which[i] = w
         te[i] = t
         H[i] = h
@@ -418,18 +428,20 @@ def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
 
 @njit(cache=True, error_model="numpy", inline="always")
 def period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
-                Yev, H):  # pragma: no cover - compiled
+                Yev, H, Tn, Yn):  # pragma: no cover - compiled
     """:func:`phase_rows` over control periods: every row of ``Y`` (N, m) from phase time 0
     to its first guard crossing or exactly to ``cap[i]`` [s] (its period's end: the last
     step cut to end there, the state there into ``Yev[i]``, ``which[i]`` :data:`TIMEOUT`),
     each with its own data vector ``D[i]`` (its held torques); ``H`` (N,) [s]: first step
-    sizes (<= 0: scipy's choice), overwritten with the next."""
+    sizes (<= 0: scipy's choice), overwritten with the next.  ``Tn`` (N, q) [s]: times of
+    each row (NaN: none) whose states its dense output writes into ``Yn`` (N, q, m) (the
+    native vector environment's Gauss-Legendre nodes of the period: :func:`_row`)."""
     work = _work(Y.shape[1], n_out, gcols.size)
     y = np.empty(Y.shape[1])
     for i in range(Y.shape[0]):
         y[:] = Y[i]
         w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol,
-                       Yev[i], H[i], work, True)
+                       Yev[i], H[i], work, True, Tn[i], Yn[i])
         which[i] = w
         te[i] = t
         H[i] = h
@@ -469,6 +481,7 @@ def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, gof
     y = np.empty(m)
     work = _work(m, n_out, np.max(gstart[1:] - gstart[:-1]))
     go = goffs.copy()
+    tn, yn = np.empty(0), np.empty((0, m))
     for w in range(W):
         x[:] = X[w]
         for s in range(n_steps):
@@ -484,7 +497,7 @@ def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, gof
                     ended = True
                     break
                 which, te, h = _row(f, fs, fg, sel, y, d, max_time - T, gcols[a:b], go[a:b],
-                                    dirs[a:b], rtol, atol, yev, h, work)
+                                    dirs[a:b], rtol, atol, yev, h, work, False, tn, yn)
                 if which < 0 or gout[a + which] == 1:
                     ended = True
                     break
