@@ -19,6 +19,13 @@ from walkerlab.studies.mfpt import scene_walker_at
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _one_guard_set(sm, rows: int) -> tuple:
+    """``period_rows``' guard arguments for ``rows`` rows of the phase 0 of the step map
+    ``sm``: one guard set, every row's."""
+    return (sm._gcols[0][None], sm._goffs[0][None], sm._dirs[0][None].astype(float),
+            np.array([sm._gcols[0].size]), np.zeros(rows, np.int64))
+
+
 @pytest.fixture(scope="module")
 def paper_map(paper_scene):
     return BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-9, 1e-9)
@@ -172,13 +179,60 @@ def test_cfuncs_called_by_address_give_the_first_class_calls_numbers(paper_map,
     res = []
     for f in (fns, (fns[0].address, fns[1].address, fns[2].address, fns[3])):
         which, te, Yev, H = np.empty(8, np.int64), np.empty(8), np.empty((8, 4)), np.zeros(8)
-        period_rows(*f, X.copy(), D.copy(), cap, paper_map._gcols[0], paper_map._goffs[0],
-                    paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2], which, te,
-                    Yev, H, np.full((8, 0), np.nan), np.empty((8, 0, 4)))
+        period_rows(*f, X.copy(), D.copy(), cap, *_one_guard_set(paper_map, 8), 1e-9, 1e-9,
+                    4 + paper_map.phases[0][2], which, te, Yev, H, np.full((8, 0), np.nan),
+                    np.empty((8, 0, 4)))
         res.append((which, te, Yev, H))
     assert (res[0][0] == TIMEOUT).any() and (res[0][0] >= 0).any()
     for a, b in zip(*res):
         np.testing.assert_array_equal(a, b)
+
+
+def test_period_rows_give_each_row_its_own_guard_set(paper_map, paper_fixed_point):
+    """Rows of one flow in different phases (the same cfunc, guards of their own: the
+    native vector environment's walkers out of step) integrated in one ``period_rows``
+    call, each by its guard set (``gi``), give bit for bit what each set's rows give in a
+    call of their own; a set without the paper walker's midstance guard (its first
+    phase's end) walks its rows on past it."""
+    from walkerlab.integrate.rows_dop853 import TIMEOUT, period_rows
+
+    rng = np.random.default_rng(3)
+    N = 6
+    X = paper_fixed_point.x + 0.01 * rng.standard_normal((N, 4))
+    D = paper_map.data(np.full(N, paper_map.slope_rad))
+    fns = paper_map._cfuncs(0)
+    cap = np.full(N, 2.0)
+    gc, go, gd = paper_map._gcols[0], paper_map._goffs[0], paper_map._dirs[0].astype(float)
+    g = gc.size
+    mid = [k.outcome for k in paper_map.phases[0][0].guards].index("next_phase")
+    keep = np.arange(g) != mid  # set 1: every guard but midstance's
+    tables = (np.zeros((2, g), np.int64), np.zeros((2, g)), np.zeros((2, g)))
+    for table, full in zip(tables, (gc, go, gd)):
+        table[0] = full
+        table[1, :keep.sum()] = full[keep]
+    ng = np.array([g, keep.sum()])
+    gi = np.array([0, 1, 1, 0, 1, 0])
+
+    def call(Xr, Dr, capr, *guards):
+        r = len(Xr)
+        out = np.empty(r, np.int64), np.empty(r), np.empty((r, 4)), np.zeros(r)
+        period_rows(*fns, Xr.copy(), Dr.copy(), capr, *guards, 1e-9, 1e-9,
+                    4 + paper_map.phases[0][2], *out, np.full((r, 0), np.nan),
+                    np.empty((r, 0, 4)))
+        return out
+
+    mixed = call(X, D, cap, *tables, ng, gi)
+    for s in (0, 1):
+        rows = gi == s
+        alone = call(X[rows], D[rows], cap[rows], tables[0][s:s + 1], tables[1][s:s + 1],
+                     tables[2][s:s + 1], ng[s:s + 1], np.zeros(rows.sum(), np.int64))
+        for a, b in zip(alone, mixed):
+            np.testing.assert_array_equal(a, b[rows])
+    which = mixed[0]
+    assert (which[gi == 0] == mid).all()  # set 0: midstance
+    past = which[gi == 1]  # set 1: on past it, to a fall (its guards' own index) or the cap
+    assert all(w == TIMEOUT or np.flatnonzero(keep)[w] != mid for w in past)
+    assert (mixed[1][gi == 1] > mixed[1][gi == 0].max()).all()
 
 
 def test_period_rows_write_their_dense_output_at_sample_times_without_changing_the_steps(
@@ -205,9 +259,8 @@ def test_period_rows_write_their_dense_output_at_sample_times_without_changing_t
     for Tn, Yn in ((np.full((4, 0), np.nan), np.empty((4, 0, 4))),
                    (nodes, np.full((4, 4, 4), -7.0))):
         which, te, Yev, H = np.empty(4, np.int64), np.empty(4), np.empty((4, 4)), np.zeros(4)
-        period_rows(*fns, X.copy(), D.copy(), cap, paper_map._gcols[0], paper_map._goffs[0],
-                    paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2], which, te,
-                    Yev, H, Tn, Yn)
+        period_rows(*fns, X.copy(), D.copy(), cap, *_one_guard_set(paper_map, 4), 1e-9,
+                    1e-9, 4 + paper_map.phases[0][2], which, te, Yev, H, Tn, Yn)
         out.append((which, te, Yev, H, Yn))
     for a, b in zip(out[0][:4], out[1][:4]):
         np.testing.assert_array_equal(a, b)

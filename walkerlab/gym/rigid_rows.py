@@ -8,7 +8,7 @@ Each walker (:class:`walkerlab.gym.rigid_view.RigidView`) is advanced as its own
 end (:meth:`~walkerlab.gym.rigid_view.RigidView.absorb`: the ledger, a knee strike, a heel
 strike and the next step, a fall) - but the pieces that run the compiled control step (the
 flow with the held torques compiled in) are integrated together: the walkers whose pieces
-share a flow (one cfunc, its guards and tolerances) are the rows of one call of
+share a flow (one cfunc and tolerances; each phase's own guards) are the rows of one call of
 :func:`walkerlab.integrate.rows_dop853.period_rows`, each row with its own data vector (its
 torques in the law block), its own state and its own end (the period's end or its step's
 time limit).  That kernel runs scipy's DOP853 (Hairer, Nørsett & Wanner 1993, sec. II.10) as
@@ -69,8 +69,9 @@ class _Redo:
 
 
 def _flow_key(view, fphase) -> tuple:
-    """What the rows of one kernel call share: the cfunc, its guards, the tolerances
-    (kept in the view per compiled phase, which lives as long as the view)."""
+    """``(key, guards)``: what the rows of one kernel call share (the cfunc, the
+    tolerances) and this phase's guards (columns, offsets, directions: each row's own),
+    kept in the view per compiled phase, which lives as long as the view."""
     key = view.row_keys.get(id(fphase))
     if key is None:
         key = view.row_keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
@@ -81,18 +82,20 @@ def _make_key(fphase, solver, m: int) -> tuple:
     flow = fphase.compiled
     n_extra, gcols, goffs = flow.guard_columns()
     dirs = tuple(float(g.direction) for g in fphase.guards)
-    return (flow.address(False), n_extra, tuple(gcols.tolist()), tuple(goffs.tolist()), dirs,
-            float(solver.rtol), tuple(np.atleast_1d(solver.atol).tolist()), m)
+    return ((flow.address(False), n_extra, float(solver.rtol),
+             tuple(np.atleast_1d(solver.atol).tolist()), m),
+            (tuple(gcols.tolist()), tuple(goffs.tolist()), dirs))
 
 
-_CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out)
+_CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, rtol, atol, n_out)
+_GUARD_SETS: dict = {}  # the rows' distinct guards, in order -> period_rows' guard tables
 _ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument types
 
 
 def _period_rows(key: tuple, args: tuple) -> None:
     """:func:`walkerlab.integrate.rows_dop853.period_rows` of ``args``, through its compiled
     entry for their types once the dispatcher has chosen it: numba's dispatcher types every
-    argument of every call (17 here); the arrays are made alike on every call (C order,
+    argument of every call (21 here); the arrays are made alike on every call (C order,
     writable, one dtype) and the flow's cfuncs are given by address (integers:
     :func:`walkerlab.integrate.rows_dop853._call_address`; as first-class functions their
     boxing cost about 50 us a call of the 8-walker benchmark, more than its 8 rows), so the
@@ -113,8 +116,7 @@ def _kernel_args(key: tuple, fphase) -> tuple:
         flow = fphase.compiled
         module = flow.module()
         f = module.cfunc_of(flow.name)
-        n_extra, gcols, goffs, dirs, rtol, atol, m = (key[1], key[2], key[3], key[4], key[5],
-                                                      key[6], key[7])
+        n_extra, rtol, atol, m = key[1], key[2], key[3], key[4]
         # the kernel's 2-norm at tolerances * sqrt(m) is CyRK's RMS norm at the tolerances
         scale = np.sqrt(m)
         if len(atol) != 1:  # pragma: no cover - the scenes' solvers give one atol
@@ -122,19 +124,39 @@ def _kernel_args(key: tuple, fphase) -> tuple:
         f, fs, fg, sel = cfuncs(module, flow.name, f)
         # the cfuncs by address (rows_dop853._call_address): no boxing of three function
         # values on every call
-        _CFUNCS[key] = (f.address, fs.address, fg.address, sel, np.array(gcols, np.int64),
-                        np.array(goffs, float), np.array(dirs, float), rtol * scale,
+        _CFUNCS[key] = (f.address, fs.address, fg.address, sel, rtol * scale,
                         atol[0] * scale, m + n_extra)
     return _CFUNCS[key]
 
 
-def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> tuple:
-    """The compiled pieces ``pieces`` of walkers ``rows`` (one flow) in one kernel call:
-    ``(which, te, Yev)`` (:func:`walkerlab.integrate.rows_dop853.period_rows`'s outcome,
-    time from the piece's start [s] and state of each row)."""
+def _guard_tables(guards: list) -> tuple:
+    """:func:`walkerlab.integrate.rows_dop853.period_rows`' guard arguments for rows whose
+    phases have ``guards`` (each ``(columns, offsets, directions)``): the distinct sets as
+    tables (S, g) (padded), their sizes (S,) and each row's set (N,)."""
+    sets: dict = {}
+    gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
+    key = tuple(sets)
+    if key not in _GUARD_SETS:
+        g = max(len(c) for c, _, _ in key)
+        tables = (np.zeros((len(key), g), np.int64), np.zeros((len(key), g)),
+                  np.zeros((len(key), g)))
+        for s, entry in enumerate(key):
+            for table, values in zip(tables, entry):
+                table[s, :len(values)] = values
+        _GUARD_SETS[key] = (*tables, np.array([len(c) for c, _, _ in key], np.int64))
+    return (*_GUARD_SETS[key], gi)
+
+
+def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -> tuple:
+    """The compiled pieces ``pieces`` of walkers ``rows`` (one flow; the guards of each
+    row's phase ``guards``) in one kernel call: ``(which, te, Yev, Y, cap, Yn)``
+    (:func:`walkerlab.integrate.rows_dop853.period_rows`'s outcome, time from the
+    piece's start [s] and state of each row; the rows' start states, time caps [s] and
+    Gauss-Legendre nodes' states)."""
     fphase = pieces[0][5][0]
-    f, fs, fg, sel, gcols, goffs, dirs, rtol, atol, n_out = _kernel_args(key, fphase)
-    N, m = len(rows), key[7]
+    f, fs, fg, sel, rtol, atol, n_out = _kernel_args(key, fphase)
+    gcols, goffs, dirs, ng, gi = _guard_tables(guards)
+    N, m = len(rows), key[4]
     walkers = [views[i] for i in rows]
     Y = np.array([v.x for v in walkers], dtype=float)
     if Y.shape != (N, m):  # pragma: no cover - every view's state is (2n,)
@@ -164,8 +186,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple) -> tuple:
         Tn, Yn = np.empty((N, 0)), np.empty((N, 0, m))
     hook, sys.unraisablehook = sys.unraisablehook, walkers[0].count_unraisable
     try:  # (an arithmetic error inside the kernel: counted on the first row's walker)
-        _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
-                           which, te, Yev, H, Tn, Yn))
+        _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
+                           n_out, which, te, Yev, H, Tn, Yn))
     finally:
         sys.unraisablehook = hook
     return which, te, Yev, Y, cap, Yn
@@ -274,12 +296,13 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
                 run, phase = v.integrate_piece(piece)
                 strikes[i] += v.absorb(piece, run, phase)
                 continue
-            key = _flow_key(v, piece[5][0])
-            rows, pieces = groups.setdefault(key, ([], []))
+            key, guards = _flow_key(v, piece[5][0])
+            rows, pieces, gs = groups.setdefault(key, ([], [], []))
             rows.append(i)
             pieces.append(piece)
-        for key, (rows, pieces) in groups.items():
-            _absorb_rows(views, rows, pieces, _integrate_rows(views, rows, pieces, key),
+            gs.append(guards)
+        for key, (rows, pieces, gs) in groups.items():
+            _absorb_rows(views, rows, pieces, _integrate_rows(views, rows, pieces, key, gs),
                          strikes)
         live = [i for i in live if views[i].t < t_ends[i] and not views[i].ended]
     return strikes

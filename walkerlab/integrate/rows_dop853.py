@@ -427,21 +427,25 @@ def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
-                Yev, H, Tn, Yn):  # pragma: no cover - compiled
+def period_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol, n_out,
+                which, te, Yev, H, Tn, Yn):  # pragma: no cover - compiled
     """:func:`phase_rows` over control periods: every row of ``Y`` (N, m) from phase time 0
     to its first guard crossing or exactly to ``cap[i]`` [s] (its period's end: the last
     step cut to end there, the state there into ``Yev[i]``, ``which[i]`` :data:`TIMEOUT`),
-    each with its own data vector ``D[i]`` (its held torques); ``H`` (N,) [s]: first step
-    sizes (<= 0: scipy's choice), overwritten with the next.  ``Tn`` (N, q) [s]: times of
-    each row (NaN: none) whose states its dense output writes into ``Yn`` (N, q, m) (the
-    native vector environment's Gauss-Legendre nodes of the period: :func:`_row`)."""
-    work = _work(Y.shape[1], n_out, gcols.size)
+    each with its own data vector ``D[i]`` (its held torques) and its own guards: the set
+    ``gi[i]`` of the guard sets ``gcols``, ``goffs``, ``dirs`` (S, g), set ``s`` the first
+    ``ng[s]`` of its row (the phases of one flow: the same cfunc, guards of their own);
+    ``H`` (N,) [s]: first step sizes (<= 0: scipy's choice), overwritten with the next.
+    ``Tn`` (N, q) [s]: times of each row (NaN: none) whose states its dense output writes
+    into ``Yn`` (N, q, m) (the native vector environment's Gauss-Legendre nodes of the
+    period: :func:`_row`)."""
+    work = _work(Y.shape[1], n_out, gcols.shape[1])
     y = np.empty(Y.shape[1])
     for i in range(Y.shape[0]):
         y[:] = Y[i]
-        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol,
-                       Yev[i], H[i], work, True, Tn[i], Yn[i])
+        s, k = gi[i], ng[gi[i]]
+        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols[s, :k], goffs[s, :k],
+                       dirs[s, :k], rtol, atol, Yev[i], H[i], work, True, Tn[i], Yn[i])
         which[i] = w
         te[i] = t
         H[i] = h
