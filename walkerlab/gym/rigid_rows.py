@@ -70,8 +70,9 @@ class _Redo:
 
 def _flow_key(view, fphase) -> tuple:
     """``(key, guards)``: what the rows of one kernel call share (the cfunc, the
-    tolerances) and this phase's guards (columns, offsets, directions: each row's own),
-    kept in the view per compiled phase, which lives as long as the view."""
+    tolerances) and the number of this phase's guards (columns, offsets, directions: each
+    row's own; :data:`_GUARDS`), kept in the view per compiled phase, which lives as long
+    as the view."""
     key = view.row_keys.get(id(fphase))
     if key is None:
         key = view.row_keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
@@ -82,13 +83,15 @@ def _make_key(fphase, solver, m: int) -> tuple:
     flow = fphase.compiled
     n_extra, gcols, goffs = flow.guard_columns()
     dirs = tuple(float(g.direction) for g in fphase.guards)
+    guards = (tuple(gcols.tolist()), tuple(goffs.tolist()), dirs)
     return ((flow.address(False), n_extra, float(solver.rtol),
              tuple(np.atleast_1d(solver.atol).tolist()), m),
-            (tuple(gcols.tolist()), tuple(goffs.tolist()), dirs))
+            _GUARDS.setdefault(guards, len(_GUARDS)))
 
 
 _CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, rtol, atol, n_out)
-_GUARD_SETS: dict = {}  # the rows' distinct guards, in order -> period_rows' guard tables
+_GUARDS: dict = {}  # a phase's guards (columns, offsets, directions) -> their number
+_GUARD_SETS: dict = {}  # the rows' guards' numbers, in order -> period_rows' guard arguments
 _ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument types
 
 
@@ -131,25 +134,34 @@ def _kernel_args(key: tuple, fphase) -> tuple:
 
 def _guard_tables(guards: list) -> tuple:
     """:func:`walkerlab.integrate.rows_dop853.period_rows`' guard arguments for rows whose
-    phases have ``guards`` (each ``(columns, offsets, directions)``): the distinct sets as
-    tables (S, g) (padded), their sizes (S,) and each row's set (N,)."""
-    sets: dict = {}
-    gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
-    key = tuple(sets)
-    if key not in _GUARD_SETS:
-        g = max(len(c) for c, _, _ in key)
-        tables = (np.zeros((len(key), g), np.int64), np.zeros((len(key), g)),
-                  np.zeros((len(key), g)))
-        for s, entry in enumerate(key):
+    phases have the guards numbered ``guards`` (:data:`_GUARDS`): the distinct sets as
+    tables (S, g) (padded), their sizes (S,) and each row's set (N,) (kept per ``guards``:
+    the kernel only reads them)."""
+    key = tuple(guards)
+    out = _GUARD_SETS.get(key)
+    if out is None:
+        sets: dict = {}
+        gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
+        numbered = {j: g for g, j in _GUARDS.items()}
+        chosen = [numbered[j] for j in sets]
+        g = max(len(c) for c, _, _ in chosen)
+        tables = (np.zeros((len(sets), g), np.int64), np.zeros((len(sets), g)),
+                  np.zeros((len(sets), g)))
+        for s, entry in enumerate(chosen):
             for table, values in zip(tables, entry):
                 table[s, :len(values)] = values
-        _GUARD_SETS[key] = (*tables, np.array([len(c) for c, _, _ in key], np.int64))
-    return (*_GUARD_SETS[key], gi)
+        out = _GUARD_SETS[key] = (*tables, np.array([len(c) for c, _, _ in chosen],
+                                                     np.int64), gi)
+    return out
+
+
+#: (rows, states) -> period_rows' node arguments for no nodes (zero-size: never written)
+_NO_NODES: dict = {}
 
 
 def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -> tuple:
     """The compiled pieces ``pieces`` of walkers ``rows`` (one flow; the guards of each
-    row's phase ``guards``) in one kernel call: ``(which, te, Yev, Y, cap, Yn)``
+    row's phase numbered ``guards``) in one kernel call: ``(which, te, Yev, Y, cap, Yn)``
     (:func:`walkerlab.integrate.rows_dop853.period_rows`'s outcome, time from the
     piece's start [s] and state of each row; the rows' start states, time caps [s] and
     Gauss-Legendre nodes' states)."""
@@ -183,7 +195,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
             Tn[[not a for a in on]] = np.nan
         Yn = np.empty((N, _GL_X.size, m))
     else:
-        Tn, Yn = np.empty((N, 0)), np.empty((N, 0, m))
+        Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
+            (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
     hook, sys.unraisablehook = sys.unraisablehook, walkers[0].count_unraisable
     try:  # (an arithmetic error inside the kernel: counted on the first row's walker)
         _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
@@ -233,11 +246,13 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     X = Yev.copy()  # (each settled walker's state: its row)
     finite = np.isfinite(X).all(axis=1).tolist()
     ends = which.tolist()
-    held = [r for r, (piece, w) in enumerate(zip(pieces, ends))
-            if w == TIMEOUT and piece[2] and finite[r] and _affine(piece[1])]
-    if held:
-        _held_rows(views, rows, pieces, held, X, Y, cap, Yn)
-    held = set(held)
+    held: list | set = []
+    if Yn.shape[1]:  # rows with the action on
+        held = [r for r, (piece, w) in enumerate(zip(pieces, ends))
+                if w == TIMEOUT and piece[2] and finite[r] and _affine(piece[1])]
+        if held:
+            _held_rows(views, rows, pieces, held, X, Y, cap, Yn)
+        held = set(held)
     for r, (i, piece, w) in enumerate(zip(rows, pieces, ends)):
         v = views[i]
         if w == TIMEOUT and (not piece[2] or r in held):

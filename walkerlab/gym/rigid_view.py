@@ -422,7 +422,7 @@ class RigidView:
             lane = self._lane = self._lane_of(w)
         acts, phase, falls, fast = lane[3:]
         acts.u = np.asarray(u, dtype=float)
-        act_on = np.count_nonzero(acts.u) > 0
+        act_on = any(acts.u.tolist())
         for g in falls:  # a fall guard already violated as the phase begins
             if g.direction * float(g.function(self.t, self.x)) > 0:
                 self.ended = "fall"
