@@ -787,10 +787,12 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     obs : ndarray (N, m + 3) float64
     reward : ndarray (N,) float64
     terminated, truncated : ndarray (N,) bool
-    columns : dict
-        The infos by key (:data:`INFO_KEYS`, then ``ledger_<term>``, in the order of
-        :meth:`WalkerEnv._info`'s dict), each a list or array of N values of the types
-        that dict holds (floats, bools, ints, text, None, lists).
+    columns : callable
+        ``columns()``: the infos by key (:data:`INFO_KEYS`, then ``ledger_<term>``, in the
+        order of :meth:`WalkerEnv._info`'s dict), each a list or array of N values of the
+        types that dict holds (floats, bools, ints, text, None, lists), made when called
+        (a step whose infos are not read does not make them) from what this call read of
+        the walkers: the same entries whenever called.
     """
     views = [e.sim for e in envs]
     n = len(envs)
@@ -816,27 +818,35 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     truncated = [not te and lim >= 0 and el >= lim
                  for te, lim, el in zip(terminated, p["limit"].tolist(), elapsed)]
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
-    L = np.array([list(led.values()) for led in ledgers], dtype=np.float64).T.copy()
+    sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
     effort = np.add.reduce((U / p["tau"]) ** 2, axis=1).tolist()
-    work = L[terms.index("action_work_positive")].tolist()
+    j_work = terms.index("action_work_positive")
+    work = [row[j_work] for row in sums]
     reward = np.array([
         fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
             p["fw"].tolist(), hips, x_before.tolist(), p["dt"].tolist(), terminated,
             p["healthy"].tolist(), p["cw"].tolist(), effort, p["ww"].tolist(), work,
             w_before.tolist())], dtype=np.float64)
-    columns = {"time_s": t,
+    messages = [getattr(v, "failure", "") for v in views]
+    seeds = [e.terrain_seed for e in envs]
+
+    def columns() -> dict:  # (of the values read above, whenever called)
+        L = np.array(sums, dtype=np.float64).T.copy()
+        out = {"time_s": t,
                "heel_strike": [bool(s) for s in strikes],
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
                "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
                "steps": [int(s) for s in steps],
                "stance_leg": legs, "hip_x_m": hip,
                "termination": ended,
-               "solver_message": [str(getattr(v, "failure", "")) for v in views],
-               "terrain_seed": [int(e.terrain_seed) for e in envs]}
-    columns.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
+               "solver_message": [str(m) for m in messages],
+               "terrain_seed": [int(s) for s in seeds]}
+        out.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
+        return out
+
     terminated = np.array(terminated, dtype=np.bool_)
     truncated = np.array(truncated, dtype=np.bool_)
     return obs, reward, terminated, truncated, columns

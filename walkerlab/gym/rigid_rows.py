@@ -180,8 +180,7 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
             piece[5][0].compiled.data_into(D[r])
         else:
             D[r] = piece[5][0].compiled.data()
-    cap = np.array([piece[4] for piece in pieces], dtype=float) - np.array(
-        [v.t for v in walkers], dtype=float)
+    cap = np.array([piece[4] - v.t for piece, v in zip(pieces, walkers)], dtype=float)
     which = np.empty(N, np.int64)
     te = np.empty(N)
     Yev = np.empty((N, m))

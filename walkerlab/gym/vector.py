@@ -120,6 +120,18 @@ def _batch_columns(columns: dict, n: int) -> dict | None:
     return out
 
 
+def _advance_rows():
+    """:func:`walkerlab.gym.rigid_rows.advance_rows` (its module imported on first use:
+    the integrators it reads are not needed to build the environment), kept."""
+    global _ADVANCE_ROWS
+    if _ADVANCE_ROWS is None:
+        from .rigid_rows import advance_rows as _ADVANCE_ROWS
+    return _ADVANCE_ROWS
+
+
+_ADVANCE_ROWS = None
+
+
 class LazyInfos(dict):
     """A step's infos, batched on first use: a ``dict`` whose entries are ``make()``'s,
     made (once) by the first thing that reads or changes it - a key, its length, its keys,
@@ -253,6 +265,8 @@ class WalkerVectorEnv(VectorEnv):
         self._autoreset_envs = np.zeros(n, dtype=np.bool_)
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
+        #: every row and sub-environment (a step of all of them)
+        self._all = (np.arange(n), list(self.envs))
         self._has_reset = False
         #: :func:`walkerlab.gym.env.batch_parameters` of the walkers (False: not yet read)
         self._params: dict | None | bool = False
@@ -283,12 +297,16 @@ class WalkerVectorEnv(VectorEnv):
         Returns
         -------
         dict
-            The stepped sub-environments' infos by row: ``{"rows": idx (r,), "columns":
-            {key: r values}}`` (the values ``WalkerEnv.step``'s info holds, in its key
-            order), or ``{"rows": idx, "dicts": [info, ...]}``.
+            The stepped sub-environments' infos by row: ``{"rows": idx (r,),
+            "make_columns": f}``, ``f()`` giving ``{key: r values}`` (the values
+            ``WalkerEnv.step``'s info holds, in its key order; :meth:`_columns`), or
+            ``{"rows": idx, "dicts": [info, ...]}``.
         """
-        idx = np.flatnonzero(mask)
-        envs = [self.envs[i] for i in idx]
+        if mask.all():  # (every walker: the rows and walkers kept)
+            idx, envs = self._all
+        else:
+            idx = np.flatnonzero(mask)
+            envs = [self.envs[i] for i in idx]
         if not self.batched or self.envs[0].view != "rigid":
             dicts = []
             for i, env in zip(idx, envs):
@@ -296,8 +314,7 @@ class WalkerVectorEnv(VectorEnv):
                  self._truncations[i], info) = env.step(actions[i])
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
-        from .rigid_rows import advance_rows
-
+        advance_rows = _advance_rows()
         p = self._batch_parameters()
         if p is None:  # each walker's own begin and end of its period
             begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
@@ -325,7 +342,15 @@ class WalkerVectorEnv(VectorEnv):
             self._rewards[idx] = reward
             self._terminations[idx] = term
             self._truncations[idx] = trunc
-        return {"rows": idx, "columns": columns}
+        return {"rows": idx, "make_columns": columns}
+
+    @staticmethod
+    def _columns(stepped: dict) -> dict:
+        """The stepped walkers' info columns (:meth:`_step_all`'s ``make_columns()``, made
+        once)."""
+        if "columns" not in stepped:
+            stepped["columns"] = stepped.pop("make_columns")()
+        return stepped["columns"]
 
     def _batch_parameters(self) -> dict | None:
         """:func:`walkerlab.gym.env.batch_parameters` of every walker, kept until
@@ -496,7 +521,7 @@ class WalkerVectorEnv(VectorEnv):
             for i, info in zip(rows, stepped["dicts"]):
                 each[i] = info
         else:
-            cols = stepped["columns"]
+            cols = self._columns(stepped)
             lists = {k: v.tolist() if isinstance(v, np.ndarray) else v
                      for k, v in cols.items()}
             for r, i in enumerate(rows):
@@ -510,8 +535,8 @@ class WalkerVectorEnv(VectorEnv):
         :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one
         (:func:`_batch_columns`, else :func:`_batch_infos`, else ``_add_info`` itself)."""
         n = self.num_envs
-        if "columns" in stepped:
-            cols = stepped["columns"]
+        if "dicts" not in stepped:
+            cols = self._columns(stepped)
             if not resets:
                 out = _batch_columns(cols, n)
                 if out is not None:
