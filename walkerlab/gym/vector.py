@@ -487,12 +487,17 @@ class WalkerVectorEnv(VectorEnv):
         stepping = ~resetting
         stepped = (self._step_all(a, stepping) if stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
+        some_reset = bool(resetting.any())
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
-            self._elapsed[stepping] += 1
-            self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
+            if some_reset:
+                self._elapsed[stepping] += 1
+                self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
+            else:  # (every walker stepped)
+                self._elapsed += 1
+                self._truncations |= self._elapsed >= self.max_episode_steps
         resets: dict = {}
-        for i in np.flatnonzero(resetting).tolist():  # NEXT_STEP: the reset is the outcome
-            resets[i] = self._reset_one(i, None, None)
+        for i in np.flatnonzero(resetting).tolist() if some_reset else ():  # NEXT_STEP: the
+            resets[i] = self._reset_one(i, None, None)  # reset is the outcome
             self._rewards[i] = 0.0
             self._terminations[i] = self._truncations[i] = False
         ends = (self._terminations | self._truncations) & stepping
