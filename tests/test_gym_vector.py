@@ -308,15 +308,20 @@ def test_disabled_autoreset_refuses_to_step_an_ended_sub_env_until_it_is_reset()
 
 def test_the_vector_benchmark_reports_a_rate_for_each_form():
     """Not a timing: the benchmark runs and prints one line per form."""
-    from walkerlab.bench.gym_vector import FORMS, bench_vector, lines
+    from walkerlab.bench.gym_vector import ACTIONS, FORMS, bench_vector, lines
 
-    res = bench_vector("configs/paper.yaml", num_envs=2, steps=3, repeats=1)
-    assert all(res[f"{f}_steps_per_s"] > 0 for f in FORMS)
+    res = bench_vector("configs/paper.yaml", num_envs=2, steps=3, repeats=1, warmup=1)
+    assert all(res[f"{f}_steps_per_s"] > 0 and res[f"random_{f}_steps_per_s"] > 0
+               for f in FORMS)
     text = lines(res)
-    assert len(text) == 1 + len(FORMS) and all(f in "\n".join(text) for f in FORMS)
+    assert len(text) == 1 + len(ACTIONS) * len(FORMS)
+    assert all(f in "\n".join(text) for f in FORMS + ACTIONS)
     with pytest.raises(ValueError) as e:
         bench_vector(num_envs=0)
     _one_line(e, "num_envs")
+    with pytest.raises(ValueError) as e:
+        bench_vector(warmup=-1)
+    _one_line(e, "warmup")
 
 
 @pytest.mark.slow

@@ -57,8 +57,8 @@ benchmark      what is timed                                                    
                threelink_hzd and rabbit_hzd, rigid and contact views, zero /
                random / scene-policy actions, the rigid view's compiled step
                and its Python yardstick (:mod:`walkerlab.bench.gym`)
-``gym-vector`` one env against 8 in the native, sync and async vector forms     native 8 >=
-               (:mod:`walkerlab.bench.gym_vector`)                               4x one env
+``gym-vector`` one env against 8 in the native, sync and async vector forms,    native 8 >=
+               zero and random actions (:mod:`walkerlab.bench.gym_vector`)       4x one env
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
