@@ -686,7 +686,8 @@ def batch_parameters(envs) -> dict | None:
         ``policy="scene"``; ``fw``, ``healthy``, ``cw``, ``ww``, ``dt`` (N,) the reward's
         weights and the control period [s]; ``limit`` (N,) int the environment's own
         ``max_episode_steps`` (-1: none); ``low``, ``high`` (N, m + 3) the observation's
-        bounds.
+        bounds.  :func:`begin_periods` and :func:`end_periods` keep Python forms of some of
+        them in it (``flags``, ``lists``: not arrays over the walkers).
     """
     if any(e.view != "rigid" or e.reward_fn is not None for e in envs):
         return None
@@ -719,6 +720,27 @@ def _rigid_view():
 _RIGID_VIEW = None
 
 
+def _flags(p: dict) -> tuple:
+    """``(every walker's action normalised, some are, some run the scene's policy)`` of
+    :func:`batch_parameters`' ``p``, kept in it (as Python values: they are read every
+    period)."""
+    flags = p.get("flags")
+    if flags is None:
+        norm = p["normalize"]
+        flags = p["flags"] = (bool(norm.all()), bool(norm.any()), bool(p["policy"].any()))
+    return flags
+
+
+def _lists(p: dict) -> tuple:
+    """The reward's weights and the limits of :func:`batch_parameters`' ``p`` as lists of
+    Python numbers ``(fw, healthy, cw, ww, dt, limit)``, kept in it."""
+    lists = p.get("lists")
+    if lists is None:
+        lists = p["lists"] = tuple(p[k].tolist() for k in ("fw", "healthy", "cw", "ww",
+                                                           "dt", "limit"))
+    return lists
+
+
 def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     """:meth:`WalkerEnv.begin_period` of N rigid-view environments at once: the held
     torques of every row of ``actions``, each period counted.
@@ -744,11 +766,12 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     """
     a = np.asarray(actions).astype(np.float64)
     norm = p["normalize"]
-    if norm.all():
+    every, some, policy = _flags(p)
+    if every:
         a = a * p["tau"]
-    elif norm.any():
+    elif some:
         a[norm] = a[norm] * p["tau"][norm]
-    if p["policy"].any():
+    if policy:
         for r in np.flatnonzero(p["policy"]):
             e = envs[r]
             s = e.sim
@@ -815,8 +838,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
         e._hip_x = h  # the next period's start (its reward's origin)
     terminated = [s != "" for s in ended]
     elapsed = [e._elapsed for e in envs]
+    fws, healthy, cws, wws, dts, limits = _lists(p)
     truncated = [not te and lim >= 0 and el >= lim
-                 for te, lim, el in zip(terminated, p["limit"].tolist(), elapsed)]
+                 for te, lim, el in zip(terminated, limits, elapsed)]
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
     sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
@@ -827,8 +851,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     reward = np.array([
         fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
-            p["fw"].tolist(), hips, x_before.tolist(), p["dt"].tolist(), terminated,
-            p["healthy"].tolist(), p["cw"].tolist(), effort, p["ww"].tolist(), work,
+            fws, hips, x_before.tolist(), dts, terminated, healthy, cws, effort, wws, work,
             w_before.tolist())], dtype=np.float64)
     messages = [getattr(v, "failure", "") for v in views]
     seeds = [e.terrain_seed for e in envs]

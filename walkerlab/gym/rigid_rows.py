@@ -243,7 +243,8 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     made on first use (:class:`_Redo`)."""
     which, te, Yev, Y, cap, Yn = out
     X = Yev.copy()  # (each settled walker's state: its row)
-    finite = np.isfinite(X).all(axis=1).tolist()
+    finite = ([True] * len(rows) if np.isfinite(X).all()
+              else np.isfinite(X).all(axis=1).tolist())
     ends = which.tolist()
     held: list | set = []
     if Yn.shape[1]:  # rows with the action on

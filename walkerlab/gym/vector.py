@@ -272,7 +272,7 @@ class WalkerVectorEnv(VectorEnv):
         self._params: dict | None | bool = False
 
     # ------------------------------------------------------------------ the physics
-    def _step_all(self, actions: np.ndarray, mask: np.ndarray) -> dict:
+    def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
         """Step the sub-environments ``i`` where ``mask[i]`` by one control period with
         ``actions[i]``, writing their observation, reward and termination into
         ``self._observations``, ``self._rewards``, ``self._terminations`` (and
@@ -293,6 +293,8 @@ class WalkerVectorEnv(VectorEnv):
             Checked actions (:meth:`_actions`), unscaled.
         mask : ndarray (N,) bool
             The sub-environments to step.
+        every : bool
+            ``mask`` is known to be all True.
 
         Returns
         -------
@@ -302,7 +304,7 @@ class WalkerVectorEnv(VectorEnv):
             ``WalkerEnv.step``'s info holds, in its key order; :meth:`_columns`), or
             ``{"rows": idx, "dicts": [info, ...]}``.
         """
-        if mask.all():  # (every walker: the rows and walkers kept)
+        if every or mask.all():  # (every walker: the rows and walkers kept)
             idx, envs = self._all
         else:
             idx = np.flatnonzero(mask)
@@ -327,7 +329,7 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         if idx.size < self.num_envs:
-            p = {k: v[idx] for k, v in p.items()}
+            p = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
         U, x_before, w_before, t_ends = begin_periods(envs, actions[idx], p)
         strikes = advance_rows([env.sim for env in envs], U, t_ends)
         obs, reward, term, trunc, columns = end_periods(envs, U, strikes, x_before,
@@ -485,9 +487,10 @@ class WalkerVectorEnv(VectorEnv):
                     f"{np.flatnonzero(self._autoreset_envs).tolist()} ended; reset them with "
                     "reset(options={'reset_mask': mask}) before stepping")
         stepping = ~resetting
-        stepped = (self._step_all(a, stepping) if stepping.any()
-                   else {"rows": np.zeros(0, np.int64), "dicts": []})
         some_reset = bool(resetting.any())
+        stepped = (self._step_all(a, stepping, not some_reset)
+                   if not some_reset or stepping.any()
+                   else {"rows": np.zeros(0, np.int64), "dicts": []})
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
             if some_reset:
                 self._elapsed[stepping] += 1
@@ -500,8 +503,9 @@ class WalkerVectorEnv(VectorEnv):
             resets[i] = self._reset_one(i, None, None)  # reset is the outcome
             self._rewards[i] = 0.0
             self._terminations[i] = self._truncations[i] = False
-        ends = (self._terminations | self._truncations) & stepping
-        if mode == AutoresetMode.SAME_STEP and ends.any():
+        ends = ((self._terminations | self._truncations) & stepping
+                if mode == AutoresetMode.SAME_STEP else None)
+        if ends is not None and ends.any():
             # final observations and infos: gymnasium's own batching
             each = self._info_dicts(stepped, resets)
             infos: dict = {}
