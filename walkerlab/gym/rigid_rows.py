@@ -72,15 +72,18 @@ def _flow_key(view, fphase) -> tuple:
     """``(key, guards)``: what the rows of one kernel call share (the cfunc, the
     tolerances) and the number of this phase's guards (columns, offsets, directions: each
     row's own; :data:`_GUARDS`), kept in the view per compiled phase, which lives as long
-    as the view."""
-    key = view.row_keys.get(id(fphase))
-    if key is None:
-        key = view.row_keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
-    return key
+    as the view; None for a compiled phase without guard outputs (integrated by the
+    walker itself)."""
+    keys = view.row_keys
+    if id(fphase) not in keys:
+        keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
+    return keys[id(fphase)]
 
 
-def _make_key(fphase, solver, m: int) -> tuple:
+def _make_key(fphase, solver, m: int) -> tuple | None:
     flow = fphase.compiled
+    if flow.guard_columns() is None:  # (no guard outputs: not a row of the kernel)
+        return None
     n_extra, gcols, goffs = flow.guard_columns()
     dirs = tuple(float(g.direction) for g in fphase.guards)
     guards = (tuple(gcols.tolist()), tuple(goffs.tolist()), dirs)
@@ -306,12 +309,13 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
             piece = v.next_piece(actions[i], t_ends[i])
             if piece is None:
                 continue
-            if (piece[5] is None or v.ground is not None  # the walker's own integration
-                    or piece[5][0].compiled.guard_columns() is None):
+            kg = (None if piece[5] is None or v.ground is not None
+                  else _flow_key(v, piece[5][0]))
+            if kg is None:  # the walker's own integration
                 run, phase = v.integrate_piece(piece)
                 strikes[i] += v.absorb(piece, run, phase)
                 continue
-            key, guards = _flow_key(v, piece[5][0])
+            key, guards = kg
             rows, pieces, gs = groups.setdefault(key, ([], [], []))
             rows.append(i)
             pieces.append(piece)

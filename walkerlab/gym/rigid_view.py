@@ -134,6 +134,8 @@ class RigidView:
         self._compiled: dict = {}
         #: :meth:`next_piece`'s memo of the present walker, phase and leg (:meth:`_lane_of`)
         self._lane: tuple | None = None
+        #: ``(compiled phase, torques' bytes)``: what its law block holds, as last written
+        self._held: tuple = (None, b"")
         #: what a compiled phase shares with other walkers' in a batched step
         #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``)
         self.row_keys: dict = {}
@@ -430,8 +432,12 @@ class RigidView:
             return None
         t_stop = min(t_end, self.t_step + self.max_step_time)
         if fast is not None:  # the compiled control step: the action's torques held in
-            fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * acts.u.size:HEAD] = acts.u  # the law
-            # block (each actuator's constant)
+            # the law block (each actuator's constant), written where they are not the
+            # very numbers it holds (this phase's last ones, bit for bit: -0.0 is written)
+            held, bits = self._held, acts.u.tobytes()
+            if held[0] is not fast or held[1] != bits:
+                fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * acts.u.size:HEAD] = acts.u
+                self._held = (fast, bits)
         return w, acts, act_on, phase, t_stop, fast
 
     def _lane_of(self, w) -> tuple:
