@@ -219,7 +219,12 @@ def _held_rows(views, rows: list, pieces: list, sel: list, X: np.ndarray, Y: np.
     With the joints' map ``ddelta = Bt dq`` (``delta = Bt q + c``), both are ``w . dq``
     and ``w . Delta q`` with ``w = Bt^T u`` (n,) [N m]."""
     n = X.shape[1] // 2
-    W = np.array([pieces[r][1].u @ pieces[r][1].affine[0] for r in sel])  # (r, n)
+    maps = [_joint_map(views[rows[r]], pieces[r][1]) for r in sel]
+    U = np.array([pieces[r][1].u for r in sel])  # (r, k) [N m]
+    if all(M is maps[0] for M in maps):  # one walker's map for all (its rows (k, n))
+        W = U @ maps[0]  # (r, n)
+    else:
+        W = np.array([u @ M for u, M in zip(U, maps)])
     Xa, Xb = Y[sel], X[sel]
     exact = ((Xb[:, :n] - Xa[:, :n]) * W).sum(axis=1).tolist()
     pa = (Xa[:, n:] * W).sum(axis=1)  # the power at both ends [W]
@@ -251,8 +256,9 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     ends = which.tolist()
     held: list | set = []
     if Yn.shape[1]:  # rows with the action on
-        held = [r for r, (piece, w) in enumerate(zip(pieces, ends))
-                if w == TIMEOUT and piece[2] and finite[r] and _affine(piece[1])]
+        held = [r for r, (i, piece, w) in enumerate(zip(rows, pieces, ends))
+                if w == TIMEOUT and piece[2] and finite[r]
+                and _joint_map(views[i], piece[1]) is not None]
         if held:
             _held_rows(views, rows, pieces, held, X, Y, cap, Yn)
         held = set(held)
@@ -271,11 +277,24 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
         strikes[i] += v.absorb(piece, run, piece[3])
 
 
-def _affine(acts) -> bool:
-    """The action's ledger of ``acts`` (an :class:`walkerlab.gym.action.ActionTorques`)
-    is :func:`_held_rows`': the action alone, its joints affine in the coordinates, not
-    scaled by a massless foot's mass (whose torques do no work)."""
-    return acts.affine is not None and not acts.first and not acts.limit
+#: the action's joint maps ``Bt`` (k, n), one array per value (the walkers of a scene share it)
+_MAPS: dict = {}
+
+
+def _joint_map(view, acts):
+    """The rows ``Bt`` (k, n) of the joints' map ``ddelta = Bt dq`` of the action ``acts``
+    (an :class:`walkerlab.gym.action.ActionTorques` of ``view``), one array for every
+    walker with the same map (:data:`_MAPS`), kept in the view; None where the ledger is
+    not :func:`_held_rows`': the action not alone, its joints not affine in the
+    coordinates, or its torques scaled by a massless foot's mass (they do no work)."""
+    key = ("map", id(acts))
+    if key not in view.row_keys:  # (acts lives as long as the view)
+        Bt = None
+        if acts.affine is not None and not acts.first and not acts.limit:
+            Bt = np.ascontiguousarray(acts.affine[0], dtype=float)
+            Bt = _MAPS.setdefault((Bt.shape, Bt.tobytes()), Bt)
+        view.row_keys[key] = Bt
+    return view.row_keys[key]
 
 
 def advance_rows(views, actions, t_ends) -> list[list[float]]:

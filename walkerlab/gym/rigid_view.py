@@ -137,7 +137,8 @@ class RigidView:
         #: ``(compiled phase, torques' bytes)``: what its law block holds, as last written
         self._held: tuple = (None, b"")
         #: what a compiled phase shares with other walkers' in a batched step
-        #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``)
+        #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``),
+        #: and the action's joint map by its actuators' (they live in ``acts``)
         self.row_keys: dict = {}
         #: arithmetic errors raised inside compiled flows (:meth:`count_unraisable`), counted
         self.arithmetic_errors = 0
