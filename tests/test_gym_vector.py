@@ -563,3 +563,28 @@ def test_batched_ledger_equals_each_walkers_own_where_the_actions_power_changes_
     assert (work[:, 0] > 0).any() and (work[:, 1] < 0).any()
     sync.close()
     native.close()
+
+
+def test_a_crossing_rows_dense_output_run_again_by_the_kernel_is_cyrks(monkeypatch):
+    """A batched row ended by a guard crossing (a heel strike, a fall) with the action on
+    reads its ledger's Gauss-Legendre nodes from the same kernel run again with the nodes
+    as samples (:class:`walkerlab.gym.rigid_rows._RowRedo`): the states equal those of
+    the single walker's integrator over the same piece (CyRK's DOP853, its own dense
+    output) within 1e-9, over 60 periods of random actions on RABBIT (such rows met)."""
+    from walkerlab.gym import rigid_rows
+
+    seen = []
+    own = rigid_rows._RowRedo.__call__
+
+    def compared(self, t):
+        got = own(self, t)
+        ref = np.atleast_2d(self.args[3](t))[:got.shape[0]]
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9)
+        seen.append(got.shape)
+        return got
+
+    monkeypatch.setattr(rigid_rows._RowRedo, "__call__", compared)
+    native = _native(4, "rabbit_hzd", max_episode_steps=30, start_noise=0.05)
+    _run(native, _random_actions(native, 60, seed=4), 5)
+    assert seen and all(s[1] == 4 for s in seen)  # the 4 nodes of each such piece
+    native.close()

@@ -30,8 +30,9 @@ The same sums as the walker's own to round-off (its nodes are read from CyRK's d
 of the same DOP853 steps, its joint maps applied state by state).  Other rows (a guard
 crossing, a failed step, a walker whose joints are not affine in its coordinates) are
 absorbed walker by walker; the Gauss-Legendre nodes of such a row's piece read a dense
-output made on first use, the piece integrated again by the single walker's integrator
-(:class:`_Redo`).
+output made on first use: a row ended by a guard crossing integrated again by the same
+kernel, its nodes as samples (:class:`_RowRedo`: the same steps), a failed row by the
+single walker's integrator (:class:`_Redo`).
 """
 
 from __future__ import annotations
@@ -164,10 +165,10 @@ _NO_NODES: dict = {}
 
 def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -> tuple:
     """The compiled pieces ``pieces`` of walkers ``rows`` (one flow; the guards of each
-    row's phase numbered ``guards``) in one kernel call: ``(which, te, Yev, Y, cap, Yn)``
-    (:func:`walkerlab.integrate.rows_dop853.period_rows`'s outcome, time from the
+    row's phase numbered ``guards``) in one kernel call: ``(which, te, Yev, Y, cap, Yn,
+    call)`` (:func:`walkerlab.integrate.rows_dop853.period_rows`'s outcome, time from the
     piece's start [s] and state of each row; the rows' start states, time caps [s] and
-    Gauss-Legendre nodes' states)."""
+    Gauss-Legendre nodes' states; the call's arguments, for :class:`_RowRedo`)."""
     fphase = pieces[0][5][0]
     f, fs, fg, sel, rtol, atol, n_out = _kernel_args(key, fphase)
     gcols, goffs, dirs, ng, gi = _guard_tables(guards)
@@ -205,7 +206,36 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
                            n_out, which, te, Yev, H, Tn, Yn))
     finally:
         sys.unraisablehook = hook
-    return which, te, Yev, Y, cap, Yn
+    call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
+    return which, te, Yev, Y, cap, Yn, call
+
+
+class _RowRedo:
+    """The dense output of row ``r`` of a kernel call (``call``: what
+    :func:`_integrate_rows` gave it) up to its guard crossing, made when called: the row
+    integrated again by the same kernel from the same state, data and cap (the same steps)
+    with the asked times as its samples (:func:`walkerlab.integrate.rows_dop853._row`);
+    ``t0`` [s]: the row's start.  Called as ``dense(t)`` with times ``t`` (q,) [s] inside
+    the row's span up to its crossing: the states (m, q); a time not reached falls back on
+    ``fallback`` (a :class:`_Redo`)."""
+
+    def __init__(self, call, r: int, t0: float, fallback):
+        self.args = (call, r, t0, fallback)
+
+    def __call__(self, t):
+        call, r, t0, fallback = self.args
+        key, fns, Y, D, cap, guards, gi, tol = call
+        m = Y.shape[1]
+        Tn = np.atleast_2d(np.asarray(t, dtype=float) - t0).copy()
+        Yn = np.full((1, Tn.shape[1], m), np.nan)
+        out = np.empty(1, np.int64), np.empty(1), np.empty((1, m)), np.zeros(1)
+        rows = slice(r, r + 1)
+        _period_rows(key, (*fns, np.ascontiguousarray(Y[rows]), np.ascontiguousarray(D[rows]),
+                           np.ascontiguousarray(cap[rows]), *guards,
+                           np.ascontiguousarray(gi[rows]), *tol, *out, Tn, Yn))
+        if not np.isfinite(Yn).all():  # pragma: no cover - a time past the crossing
+            return fallback(t)
+        return Yn[0].T
 
 
 def _held_rows(views, rows: list, pieces: list, sel: list, X: np.ndarray, Y: np.ndarray,
@@ -249,7 +279,7 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, the states' finiteness checked
     for all rows at once); any other is absorbed as a :class:`PhaseRun`, its dense output
     made on first use (:class:`_Redo`)."""
-    which, te, Yev, Y, cap, Yn = out
+    which, te, Yev, Y, cap, Yn, call = out
     X = Yev.copy()  # (each settled walker's state: its row)
     finite = ([True] * len(rows) if np.isfinite(X).all()
               else np.isfinite(X).all(axis=1).tolist())
@@ -271,9 +301,12 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
         event = w if w >= 0 else None
         # a row that reached its end stops on it exactly (its time is the period's)
         t_last = v.t + float(te[r]) if (event is not None or failed) else float(piece[4])
+        redo = _Redo(v, piece[5][0], v.t, v.x, t_last)
+        if event is not None and not failed:  # its dense output: the kernel's, run again
+            redo = _RowRedo(call, r, v.t, redo)
         run = PhaseRun(t_last, Yev[r], failed,
                        "the step size fell below 10 ulp of t" if failed else "", event,
-                       _Redo(v, piece[5][0], v.t, v.x, t_last), 0)
+                       redo, 0)
         strikes[i] += v.absorb(piece, run, piece[3])
 
 

@@ -326,8 +326,8 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
     ``yev``; else the steps run past ``cap`` as if unbounded (a cap is a walk's give-up
     time, not a sample) and ``yev`` is left as it was.  ``tn`` (q,) [s]: times inside the
     row's span (NaN: none) whose states the accepted steps' dense output writes into ``yn``
-    (q, m) as the steps pass them (a step with no guard crossing; the steps are the same
-    with or without them)."""
+    (q, m) as the steps pass them, up to a guard crossing (the steps are the same with or
+    without them)."""
     m = y.size
     ng = gcols.size
     K, F, buf, ynew, tmp, G = work
@@ -373,6 +373,9 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
                 best, te = j, tj
         if best >= 0:
             _dense_at(F, y, (te - t) / h, yev)
+            for q in range(tn.size):  # the samples inside this step, up to the crossing
+                if t < tn[q] <= te:
+                    _dense_at(F, y, (tn[q] - t) / h, yn[q])
             return best, te, h_abs
         for q in range(tn.size):  # the samples inside this step
             if t < tn[q] <= t_new:
