@@ -95,7 +95,7 @@ def _make_key(fphase, solver, m: int) -> tuple | None:
 
 _CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, rtol, atol, n_out)
 _GUARDS: dict = {}  # a phase's guards (columns, offsets, directions) -> their number
-_GUARD_SETS: dict = {}  # the rows' guards' numbers, in order -> period_rows' guard arguments
+_GUARD_SETS: dict = {}  # distinct guards' numbers, in order -> period_rows' guard tables
 _ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument types
 
 
@@ -139,24 +139,24 @@ def _kernel_args(key: tuple, fphase) -> tuple:
 def _guard_tables(guards: list) -> tuple:
     """:func:`walkerlab.integrate.rows_dop853.period_rows`' guard arguments for rows whose
     phases have the guards numbered ``guards`` (:data:`_GUARDS`): the distinct sets as
-    tables (S, g) (padded), their sizes (S,) and each row's set (N,) (kept per ``guards``:
-    the kernel only reads them)."""
-    key = tuple(guards)
+    tables (S, g) (padded; kept per distinct sets in order: the kernel only reads them),
+    their sizes (S,) and each row's set (N,)."""
+    sets: dict = {}
+    gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
+    key = tuple(sets)
     out = _GUARD_SETS.get(key)
     if out is None:
-        sets: dict = {}
-        gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
         numbered = {j: g for g, j in _GUARDS.items()}
-        chosen = [numbered[j] for j in sets]
+        chosen = [numbered[j] for j in key]
         g = max(len(c) for c, _, _ in chosen)
-        tables = (np.zeros((len(sets), g), np.int64), np.zeros((len(sets), g)),
-                  np.zeros((len(sets), g)))
+        tables = (np.zeros((len(key), g), np.int64), np.zeros((len(key), g)),
+                  np.zeros((len(key), g)))
         for s, entry in enumerate(chosen):
             for table, values in zip(tables, entry):
                 table[s, :len(values)] = values
         out = _GUARD_SETS[key] = (*tables, np.array([len(c) for c, _, _ in chosen],
-                                                     np.int64), gi)
-    return out
+                                                     np.int64))
+    return (*out, gi)
 
 
 #: (rows, states) -> period_rows' node arguments for no nodes (zero-size: never written)
@@ -275,10 +275,11 @@ def _held_rows(views, rows: list, pieces: list, sel: list, X: np.ndarray, Y: np.
 def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> None:
     """Each row's piece ended (:func:`_integrate_rows`' ``out``) taken by its walker, as
     :meth:`~walkerlab.gym.rigid_view.RigidView.absorb` takes a run: a row that reached its
-    period's end with no action on (no work to count) settles there
-    (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, the states' finiteness checked
-    for all rows at once); any other is absorbed as a :class:`PhaseRun`, its dense output
-    made on first use (:class:`_Redo`)."""
+    period's end settles there (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, the
+    states' finiteness checked for all rows at once), the ledger of those with the action
+    on taken for all of them (:func:`_held_rows`); any other is absorbed as a
+    :class:`PhaseRun`, its dense output made on first use (:class:`_RowRedo` for a guard
+    crossing, else :class:`_Redo`)."""
     which, te, Yev, Y, cap, Yn, call = out
     X = Yev.copy()  # (each settled walker's state: its row)
     finite = ([True] * len(rows) if np.isfinite(X).all()
