@@ -44,10 +44,11 @@ import numpy as np
 from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
 from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 
+from .rigid_view import _GL_W, _GL_X  # the ledger's Gauss-Legendre rule, the walker's own
+
 __all__ = ["advance_rows"]
 
-#: the ledger's 4-point Gauss-Legendre rule on [-1, 1] (:mod:`walkerlab.gym.rigid_view`)
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
+#: the ledger's 4-point Gauss-Legendre weights as floats (the walker's own rule)
 _GL_WL = _GL_W.tolist()
 
 

@@ -371,18 +371,16 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
                          gv)
             if tj < te:
                 best, te = j, tj
-        if best >= 0:
-            _dense_at(F, y, (te - t) / h, yev)
-            for q in range(tn.size):  # the samples inside this step, up to the crossing
-                if t < tn[q] <= te:
-                    _dense_at(F, y, (tn[q] - t) / h, yn[q])
-            return best, te, h_abs
-        for q in range(tn.size):  # the samples inside this step
-            if t < tn[q] <= t_new:
+        t_hi = te if best >= 0 else t_new
+        for q in range(tn.size):  # the samples inside this step, up to a crossing
+            if t < tn[q] <= t_hi:
                 if not dense:
                     _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp)
                     dense = True
                 _dense_at(F, y, (tn[q] - t) / h, yn[q])
+        if best >= 0:
+            _dense_at(F, y, (te - t) / h, yev)
+            return best, te, h_abs
         if t_new >= cap:
             if exact:
                 for k in range(m):
