@@ -258,6 +258,11 @@ def actuated_module(structure, joints):
                                   build)
 
 
+#: constants of compiled flows by their numbers (:meth:`ActuatedFlow.constants`: one array
+#: per value)
+_CONSTANTS: dict = {}
+
+
 @dataclass(frozen=True, eq=False)
 class ActuatedFlow(CompiledFlow):
     """Handle on an actuated walker's compiled flow (:class:`CompiledFlow` with laws).
@@ -308,18 +313,42 @@ class ActuatedFlow(CompiledFlow):
 
     def data_size(self) -> int:
         """The length of :meth:`data`'s vector."""
-        if "consts" not in self._memo:
-            self._memo["consts"] = self.module().constants(self.params)
-        return self._memo["consts"].size + self.laws.size + 1
+        return self.constants().size + self.laws.size + 1
+
+    def constants(self) -> np.ndarray:
+        """The constants at the head of :meth:`data`'s vector (read only), one array for
+        every flow with the same numbers (:data:`_CONSTANTS`: the walkers of a scene share
+        it, so :meth:`data_rows` writes it once for all)."""
+        c = self._memo.get("consts")
+        if c is None:
+            c = np.array(self.module().constants(self.params), dtype=float)
+            c.flags.writeable = False
+            c = self._memo["consts"] = _CONSTANTS.setdefault((c.size, c.tobytes()), c)
+        return c
 
     def data_into(self, out: np.ndarray) -> None:
         """:meth:`data` written into ``out`` (:meth:`data_size`,) (a row of many walkers'
         data vectors: :mod:`walkerlab.gym.rigid_rows`), the same numbers."""
-        if "consts" not in self._memo:
-            self._memo["consts"] = self.module().constants(self.params)
-        c = self._memo["consts"]
+        c = self.constants()
         nc = c.size
         out[:nc] = c
         out[nc:-1] = self.laws
         out[nc + 2] = float(getattr(self.actuators, "t_origin", 0.0))
         out[-1] = 0.0
+
+    @staticmethod
+    def data_rows(flows, out: np.ndarray) -> None:
+        """Each flow's :meth:`data` written into its row of ``out`` (N, size) (``flows``:
+        N flows of one module and law block size, each row the numbers :meth:`data_into`
+        writes), the rows' shared parts at once where the flows share their constants
+        (:meth:`constants`), else row by row."""
+        c = flows[0].constants()
+        if any(f.constants() is not c for f in flows):
+            for f, row in zip(flows, out):
+                f.data_into(row)
+            return
+        nc = c.size
+        out[:, :nc] = c
+        out[:, nc:-1] = [f.laws for f in flows]
+        out[:, nc + 2] = [float(getattr(f.actuators, "t_origin", 0.0)) for f in flows]
+        out[:, -1] = 0.0

@@ -764,12 +764,13 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     t_ends : list of float
         Each period's end [s].
     """
-    a = np.asarray(actions).astype(np.float64)
     norm = p["normalize"]
     every, some, policy = _flags(p)
-    if every:
-        a = a * p["tau"]
-    elif some:
+    if every:  # (the actions read as float64, then scaled: numpy's casting of any real
+        a = np.multiply(actions, p["tau"], dtype=np.float64)  # dtype, in one operation)
+    else:
+        a = np.asarray(actions).astype(np.float64)
+    if not every and some:
         a[norm] = a[norm] * p["tau"][norm]
     if policy:
         for r in np.flatnonzero(p["policy"]):
@@ -788,7 +789,7 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
 
 
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
-                w_before: np.ndarray, p: dict) -> tuple:
+                w_before: np.ndarray, p: dict, views=None) -> tuple:
     """:meth:`WalkerEnv.end_period` of N rigid-view environments at once, their walkers
     advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`): observations, rewards, flags
     and the infos as columns.
@@ -804,6 +805,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
         :func:`begin_periods`' hip x [m] and positive work [J] at the period's start.
     p : dict
         :func:`batch_parameters` of ``envs``.
+    views : list of RigidView, optional
+        ``[e.sim for e in envs]``, when the caller has it.
 
     Returns
     -------
@@ -817,7 +820,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
         (a step whose infos are not read does not make them) from what this call read of
         the walkers: the same entries whenever called.
     """
-    views = [e.sim for e in envs]
+    if views is None:
+        views = [e.sim for e in envs]
     n = len(envs)
     # what is read of each walker, in one pass: its state, time, stance leg, phase, its
     # step's start, how its episode ended, its steps and ledger

@@ -45,6 +45,7 @@ from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
 from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 
 from .rigid_view import _GL_W, _GL_X  # the ledger's Gauss-Legendre rule, the walker's own
+from .small_arrays import all_finite
 
 __all__ = ["advance_rows"]
 
@@ -77,9 +78,10 @@ def _flow_key(view, fphase) -> tuple:
     as the view; None for a compiled phase without guard outputs (integrated by the
     walker itself)."""
     keys = view.row_keys
-    if id(fphase) not in keys:
-        keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
-    return keys[id(fphase)]
+    out = keys.get(id(fphase), keys)  # (the dict itself: no entry yet)
+    if out is keys:
+        out = keys[id(fphase)] = _make_key(fphase, view.compiled_solver, 2 * view.n)
+    return out
 
 
 def _make_key(fphase, solver, m: int) -> tuple | None:
@@ -137,11 +139,28 @@ def _kernel_args(key: tuple, fphase) -> tuple:
     return _CFUNCS[key]
 
 
+#: most entries of :data:`_GUARD_ROWS` (rows' guard numbers in order; cleared when full)
+GUARD_ROWS_KEPT = 4096
+_GUARD_ROWS: dict = {}  # rows' guard numbers (tuple) -> _guard_tables' answer
+
+
 def _guard_tables(guards: list) -> tuple:
     """:func:`walkerlab.integrate.rows_dop853.period_rows`' guard arguments for rows whose
     phases have the guards numbered ``guards`` (:data:`_GUARDS`): the distinct sets as
     tables (S, g) (padded; kept per distinct sets in order: the kernel only reads them),
-    their sizes (S,) and each row's set (N,)."""
+    their sizes (S,) and each row's set (N,) (the whole answer kept per rows' numbers,
+    :data:`_GUARD_ROWS`)."""
+    key = tuple(guards)
+    out = _GUARD_ROWS.get(key)
+    if out is None:
+        if len(_GUARD_ROWS) >= GUARD_ROWS_KEPT:
+            _GUARD_ROWS.clear()
+        out = _GUARD_ROWS[key] = _guard_sets(guards)
+    return out
+
+
+def _guard_sets(guards: list) -> tuple:
+    """:func:`_guard_tables`' answer, made."""
     sets: dict = {}
     gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
     key = tuple(sets)
@@ -178,13 +197,12 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
     Y = np.array([v.x for v in walkers], dtype=float)
     if Y.shape != (N, m):  # pragma: no cover - every view's state is (2n,)
         raise ValueError(f"rigid rows: states of shape {Y.shape[1:]}, not ({m},)")
-    into = hasattr(fphase.compiled, "data_into")
-    D = np.empty((N, fphase.compiled.data_size() if into else fphase.compiled.data().size))
-    for r, piece in enumerate(pieces):
-        if into:  # this walker's torques in its law block
-            piece[5][0].compiled.data_into(D[r])
-        else:
-            D[r] = piece[5][0].compiled.data()
+    flows = [piece[5][0].compiled for piece in pieces]
+    if hasattr(flows[0], "data_rows"):  # each walker's torques in its law block
+        D = np.empty((N, flows[0].data_size()))
+        flows[0].data_rows(flows, D)
+    else:
+        D = np.array([flow.data() for flow in flows], dtype=float)
     cap = np.array([piece[4] - v.t for piece, v in zip(pieces, walkers)], dtype=float)
     which = np.empty(N, np.int64)
     te = np.empty(N)
@@ -283,7 +301,7 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     crossing, else :class:`_Redo`)."""
     which, te, Yev, Y, cap, Yn, call = out
     X = Yev.copy()  # (each settled walker's state: its row)
-    finite = ([True] * len(rows) if np.isfinite(X).all()
+    finite = ([True] * len(rows) if all_finite(X)
               else np.isfinite(X).all(axis=1).tolist())
     ends = which.tolist()
     held: list | set = []
@@ -353,9 +371,11 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
         its episode ended there.
     """
     strikes: list[list[float]] = [[] for _ in views]
-    for v, u, t_end in zip(views, actions, t_ends):
+    live = []
+    for i, (v, u, t_end) in enumerate(zip(views, actions, t_ends)):
         v.open_period(u, t_end)
-    live = [i for i, v in enumerate(views) if v.t < t_ends[i] and not v.ended]
+        if v.t < t_end and not v.ended:
+            live.append(i)
     while live:
         groups: dict = {}
         for i in live:
@@ -370,10 +390,13 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
                 strikes[i] += v.absorb(piece, run, phase)
                 continue
             key, guards = kg
-            rows, pieces, gs = groups.setdefault(key, ([], [], []))
-            rows.append(i)
-            pieces.append(piece)
-            gs.append(guards)
+            group = groups.get(key)
+            if group is None:
+                groups[key] = ([i], [piece], [guards])
+            else:
+                group[0].append(i)
+                group[1].append(piece)
+                group[2].append(guards)
         for key, (rows, pieces, gs) in groups.items():
             _absorb_rows(views, rows, pieces, _integrate_rows(views, rows, pieces, key, gs),
                          strikes)

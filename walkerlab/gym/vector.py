@@ -46,6 +46,7 @@ from .env import (
     end_periods,
     registered_env,
 )
+from .small_arrays import all_finite, any_true
 
 __all__ = ["WalkerVectorEnv"]
 
@@ -328,13 +329,17 @@ class WalkerVectorEnv(VectorEnv):
                  self._truncations[i], info) = env.end_period(u, hs, before)
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
-        if idx.size < self.num_envs:
+        whole = idx.size == self.num_envs
+        if not whole:
             p = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
-        U, x_before, w_before, t_ends = begin_periods(envs, actions[idx], p)
-        strikes = advance_rows([env.sim for env in envs], U, t_ends)
+        # (begin_periods reads the actions into an array of its own: every row as given)
+        U, x_before, w_before, t_ends = begin_periods(envs, actions if whole else actions[idx],
+                                                      p)
+        views = [env.sim for env in envs]
+        strikes = advance_rows(views, U, t_ends)
         obs, reward, term, trunc, columns = end_periods(envs, U, strikes, x_before,
-                                                        w_before, p)
-        if idx.size == self.num_envs:
+                                                        w_before, p, views)
+        if whole:
             self._observations[:] = obs
             self._rewards[:] = reward
             self._terminations[:] = term
@@ -381,7 +386,7 @@ class WalkerVectorEnv(VectorEnv):
         """
         shape = self.action_space.shape
         if (type(actions) is np.ndarray and actions.shape == shape
-                and actions.dtype.kind in "iuf" and np.isfinite(actions).all()):
+                and actions.dtype.kind in "iuf" and all_finite(actions)):
             return actions  # the common case: no message built
         want = f"give {shape[0]} rows of {shape[1]} finite real numbers, {self.action_space}"
         if actions is None:
@@ -487,7 +492,7 @@ class WalkerVectorEnv(VectorEnv):
                     f"{np.flatnonzero(self._autoreset_envs).tolist()} ended; reset them with "
                     "reset(options={'reset_mask': mask}) before stepping")
         stepping = ~resetting
-        some_reset = bool(resetting.any())
+        some_reset = any_true(resetting)
         stepped = (self._step_all(a, stepping, not some_reset)
                    if not some_reset or stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
