@@ -759,7 +759,7 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     U : ndarray (N, k)
         The held torques [N m] (the action scaled, the scene policy's added, clipped to the
         bounds: the same operations as one environment's, element by element).
-    x_before, w_before : ndarray (N,)
+    x_before, w_before : list of float (N)
         The hip's x at the period's start [m] and the positive action work so far [J].
     t_ends : list of float
         Each period's end [s].
@@ -779,8 +779,8 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
             a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
     tau = p["tau"]
     U = a.clip(-tau, tau)  # (np.clip's own method)
-    x_before = np.array([e._hip_x for e in envs])
-    w_before = np.array([e.sim.ledger["action_work_positive"] for e in envs])
+    x_before = [e._hip_x for e in envs]
+    w_before = [e.sim.ledger["action_work_positive"] for e in envs]
     t_ends = []
     for e in envs:
         e._elapsed += 1
@@ -788,8 +788,8 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     return U, x_before, w_before, t_ends
 
 
-def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
-                w_before: np.ndarray, p: dict, views=None) -> tuple:
+def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
+                p: dict, views=None) -> tuple:
     """:meth:`WalkerEnv.end_period` of N rigid-view environments at once, their walkers
     advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`): observations, rewards, flags
     and the infos as columns.
@@ -801,7 +801,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
         The held torques [N m] (:func:`begin_periods`).
     strikes : list of list of float
         Each walker's heel-strike times in the period [s].
-    x_before, w_before : ndarray (N,)
+    x_before, w_before : list of float (N)
         :func:`begin_periods`' hip x [m] and positive work [J] at the period's start.
     p : dict
         :func:`batch_parameters` of ``envs``.
@@ -826,10 +826,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     # what is read of each walker, in one pass: its state, time, stance leg, phase, its
     # step's start, how its episode ended, its steps and ledger
     rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
-    xs, ts, legs, ks, t_steps, ended, steps, ledgers = (list(c) for c in zip(*rows))
+    xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
     X = np.array(xs)
     m = X.shape[1]
-    t = np.array(ts, dtype=np.float64)
     obs = np.empty((n, m + 3))
     obs[:, :m] = X
     # (leg1's stance as 1.0, the phase's index as a float, the time in the step)
@@ -855,20 +854,20 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: np.ndarray,
     reward = np.array([
         fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
-            fws, hips, x_before.tolist(), dts, terminated, healthy, cws, effort, wws, work,
-            w_before.tolist())], dtype=np.float64)
+            fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
+            w_before)], dtype=np.float64)
     messages = [getattr(v, "failure", "") for v in views]
     seeds = [e.terrain_seed for e in envs]
 
     def columns() -> dict:  # (of the values read above, whenever called)
         L = np.array(sums, dtype=np.float64).T.copy()
-        out = {"time_s": t,
+        out = {"time_s": np.array(ts, dtype=np.float64),
                "heel_strike": [bool(s) for s in strikes],
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
                "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
                "steps": [int(s) for s in steps],
-               "stance_leg": legs, "hip_x_m": hip,
-               "termination": ended,
+               "stance_leg": list(legs), "hip_x_m": hip,
+               "termination": list(ended),
                "solver_message": [str(m) for m in messages],
                "terrain_seed": [int(s) for s in seeds]}
         out.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
