@@ -111,6 +111,22 @@ def _api():
     return _API[0]
 
 
+_ADDRESSES: list = []  # the result's solution and argument addresses as integers
+
+
+def _addresses():
+    """``(solution address, arguments address)``: CyRK's getters of a result's solution
+    and its copy of the arguments (the numba bridge's ``get_y_func_ptr`` and
+    ``get_args_ptr_func_ptr``) called as functions that return the address as an integer
+    (the bridge's own prototypes return typed pointers, read through ``.contents``)."""
+    if not _ADDRESSES:
+        from CyRK.nb import numba_c_api as api
+
+        sig = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p)
+        _ADDRESSES.append((sig(api.get_y_func_ptr()), sig(api.get_args_ptr_func_ptr())))
+    return _ADDRESSES[0]
+
+
 class _Buffer:
     """A float64 array whose C address is read once (not at every call): the inputs CyRK
     copies (the start state, the sample times, the data vector) are copied into it."""
@@ -157,8 +173,10 @@ class ChunkSolver:
         self._y0, self._te, self._data = _Buffer(), _Buffer(), _Buffer()
         self._msg = ctypes.create_string_buffer(256)
         self._msg_p = ctypes.addressof(self._msg)
-        self._last_msg = (None, "")
+        self._messages: dict = {}  # CyRK's status code -> its message (a function of it)
         self._dense_y = _Buffer()  # the dense outputs' state (each of their calls copies it)
+        self._out = _Buffer()  # the solution copied out of CyRK's result
+        self._y_at, self._args_at = _addresses()
 
     def __call__(self, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
                  dense: bool = False):
@@ -178,21 +196,21 @@ class ChunkSolver:
         try:
             ok = bool(ns.c_get_success(ptr))
             n = int(ns.c_get_size(ptr))
-            if n:
+            if n:  # the solution (n, ndy) copied into a kept buffer, then out of it
                 ndy = int(ns.c_get_num_dy(ptr))
-                at = ctypes.addressof(ns.c_get_y_ptr(ptr).contents)
-                X = np.frombuffer((ctypes.c_double * (n * ndy)).from_address(at),
-                                  np.float64).reshape(n, ndy)[:, :ny].copy()
+                out = self._out
+                out.reserve(n * ndy)
+                ctypes.memmove(out.address, self._y_at(ptr), 8 * n * ndy)
+                X = out.array[:n * ndy].reshape(n, ndy)[:, :ny].copy()
             else:
                 X = np.empty((0, ny))
-            args = ctypes.addressof(ns.c_get_args_ptr(ptr).contents)
-            nfev = int(ctypes.c_double.from_address(args + 8 * (nd - 1)).value
+            nfev = int(ctypes.c_double.from_address(self._args_at(ptr) + 8 * (nd - 1)).value
                        - float(data[-1]))
-            ns.c_get_msg_buf(ptr, self._msg_p, 256)
-            raw = self._msg.value
-            if raw != self._last_msg[0]:  # (most calls end with the same message)
-                self._last_msg = (raw, raw.decode(errors="replace"))
-            msg = self._last_msg[1]
+            status = int(ns.c_get_status(ptr))
+            msg = self._messages.get(status)
+            if msg is None:  # (CyRK sets the message from the status code: read once each)
+                ns.c_get_msg_buf(ptr, self._msg_p, 256)
+                msg = self._messages[status] = self._msg.value.decode(errors="replace")
             if dense:
                 kept = True
                 return X, ok, nfev, msg, DenseInterval(ptr, ny, self._dense_y)
