@@ -588,3 +588,66 @@ def test_a_crossing_rows_dense_output_run_again_by_the_kernel_is_cyrks(monkeypat
     _run(native, _random_actions(native, 60, seed=4), 5)
     assert seen and all(s[1] == 4 for s in seen)  # the 4 nodes of each such piece
     native.close()
+
+
+def test_small_array_tests_answer_as_numpys_reductions():
+    """:mod:`walkerlab.gym.small_arrays` answers as ``ndarray.any()`` and
+    ``np.isfinite(a).all()`` do: small and large arrays, NaN and infinities anywhere,
+    huge finite entries (float64 1e200, float32 1e20: finite, though their squares are
+    not), integer and empty arrays; no floating-point warning (the suite raises them)."""
+    from walkerlab.gym.small_arrays import SMALL, all_finite, any_true
+
+    rng = np.random.default_rng(0)
+    for n in (0, 1, 8, SMALL, SMALL + 1, 500):
+        for p in (0.0, 0.05, 1.0):
+            b = rng.random(n) < p
+            assert any_true(b) == bool(b.any())
+            assert any_true(b.reshape(-1, 1)) == bool(b.any())
+    cases = [np.zeros((8, 2)), np.full((3, 4), 1e200), np.full(5, 1e20, np.float32),
+             np.arange(6), np.zeros(0), rng.normal(size=(200, 3))]
+    for a in list(cases):
+        for bad in (np.nan, np.inf, -np.inf):
+            if a.size and a.dtype.kind == "f":
+                b = a.copy()
+                b.flat[int(rng.integers(b.size))] = bad
+                cases.append(b)
+    for a in cases:
+        assert all_finite(a) == bool(np.isfinite(a).all()), a
+
+
+def test_rows_data_vectors_written_at_once_are_each_flows_own(monkeypatch):
+    """``ActuatedFlow.data_rows`` (the native rows' data vectors, the shared constants
+    written once) gives each row the numbers of the flow's own ``data_into``, after
+    random actions have written the walkers' law blocks, and so does its row-by-row path
+    (flows whose constants are equal numbers in different arrays)."""
+    env = _native(4, "threelink_hzd", start_noise=0.05)
+    env.reset(seed=1)
+    for a in _random_actions(env, 3, seed=2):
+        env.step(a)
+    flows = [e.sim._lane[6][0].compiled for e in env.envs]
+    ref = np.empty((4, flows[0].data_size()))
+    for f, row in zip(flows, ref):
+        f.data_into(row)
+    assert len({f.laws.tobytes() for f in flows}) > 1  # the walkers' own torques
+    D = np.full_like(ref, np.nan)
+    flows[0].data_rows(flows, D)
+    np.testing.assert_array_equal(D, ref)
+    monkeypatch.setitem(flows[2]._memo, "consts", flows[2].constants().copy())
+    D = np.full_like(ref, np.nan)
+    flows[0].data_rows(flows, D)
+    np.testing.assert_array_equal(D, ref)
+    env.close()
+
+
+def test_one_stacked_reduction_gives_the_separate_row_sums():
+    """The batched ledger's three sums of each row (:func:`walkerlab.gym.rigid_rows.
+    _held_rows`: one reduction over a stacked (3, r, n) array) equal numpy's separate
+    ``(r, n).sum(axis=1)`` bit for bit, as the walkers' own ledgers sum them: rows of 1
+    to 23 terms (numpy's pairwise summation begins at 8), 4,000 random cases."""
+    rng = np.random.default_rng(5)
+    for _ in range(4000):
+        r, n = int(rng.integers(1, 17)), int(rng.integers(1, 24))
+        A = rng.normal(size=(3, r, n)) * 10.0 ** rng.uniform(-6, 6, size=(3, r, 1))
+        S = A.sum(axis=2)
+        for k in range(3):
+            np.testing.assert_array_equal(S[k], A[k].sum(axis=1))

@@ -55,3 +55,37 @@ def test_cyrk_bdf_failure_is_finished_by_odeint(monkeypatch):
     np.testing.assert_array_equal(b.t, _grid(0.0, 0.5, 1000.0))
     assert b.njev > 0 and b.nfev > sum(nbdf) > 0
     assert np.abs(b.x[:, leg_angle_columns(w)] - a.x[:, leg_angle_columns(w)]).max() < 1e-7
+
+
+def test_chunk_solver_reads_cyrks_states_calls_and_messages():
+    """The chunk solver's reading of CyRK's result (its solution copied through its
+    address into a kept buffer, the call counter from the argument copy, the message per
+    status code) against CyRK's own other paths: each sample equals CyRK's dense output
+    at its time bit for bit, an answer is not overwritten by the next call, the call
+    count is positive and a call stopped by its step limit says so with CyRK's message
+    for its status code (read through the bridge's status-to-message function)."""
+    import ctypes
+
+    w, x0, _ = _bench_case()
+    solve = _cyrk.ChunkSolver("cyrk_bdf", 1e-8, 1e-10, kernels=w.kernels)
+    tg = np.linspace(0.0, 0.02, 11)
+    X, ok, nfev, msg, dense = solve(x0, tg, w.pack(), dense=True)
+    try:
+        assert ok and X.shape == (11, len(x0)) and nfev > 0
+        for k in (0, 3, 10):
+            np.testing.assert_array_equal(X[k], dense(tg[k]))
+    finally:
+        dense.free()
+    first = X.copy()
+    X2, ok2, _, msg2 = solve(x0 + 1e-3, tg, w.pack())  # the same buffer, other numbers
+    assert ok2 and msg2 == msg and not np.array_equal(X2, first)
+    np.testing.assert_array_equal(X, first)
+
+    ns = _cyrk._api()[0]
+    stopped = _cyrk.ChunkSolver("cyrk_bdf", 1e-8, 1e-10, max_num_steps=2, kernels=w.kernels)
+    Xs, oks, _, msgs = stopped(x0, tg, w.pack())
+    assert not oks and len(Xs) < len(tg) and msgs != msg
+    code = next(c for c, m in stopped._messages.items() if m == msgs)
+    buf = ctypes.create_string_buffer(256)
+    ns.c_get_status_msg_buf(code, ctypes.addressof(buf), 256)
+    assert buf.value.decode() == msgs
