@@ -651,3 +651,27 @@ def test_one_stacked_reduction_gives_the_separate_row_sums():
         S = A.sum(axis=2)
         for k in range(3):
             np.testing.assert_array_equal(S[k], A[k].sum(axis=1))
+
+
+def test_the_vector_benchmarks_speedup_pairs_each_round_with_its_own_single_env(
+        monkeypatch):
+    """A speedup is the median of each round's form rate over the same round's single
+    environment (a shared machine's load drifts between rounds): single 1, 10, 2 and
+    native 3, 20, 10 steps/s give 3 (the pairs 3, 2, 5), not the medians' ratio 5."""
+    from walkerlab.bench import gym_vector
+
+    rates = {"single": iter([1.0, 10.0, 2.0]), "native": iter([3.0, 20.0, 10.0])}
+    monkeypatch.setattr(gym, "make", lambda env_id, **kw: "single")
+    monkeypatch.setattr(gym, "make_vec", lambda env_id, n, mode, **kw: {
+        "vector_entry_point": "native"}.get(mode, mode))
+
+    def timed(make, steps, vector=False, action="zero", warmup=0):
+        form = make()
+        if steps == 5 and action == "zero" and form in rates:  # (not the first, untimed call)
+            return next(rates[form])
+        return 1.0
+
+    monkeypatch.setattr(gym_vector, "_time", timed)
+    res = gym_vector.bench_vector(num_envs=2, steps=5, repeats=3, warmup=0)
+    assert res["single_steps_per_s"] == 2.0 and res["native_steps_per_s"] == 10.0
+    assert res["speedup_native"] == 3.0

@@ -16,9 +16,11 @@ Walker2d-v5 runs ``zero`` and ``random`` (it has no scene policy).  Each case: t
 environment built and reset (seed 0) and ``warmup`` steps taken before the clock starts (the
 walker's gait search, code generation and numba's cache load are set-up, not throughput);
 then ``steps`` calls of ``step``, reset on an episode's end; wall time
-(:func:`time.perf_counter`).  The cases run in turn, ``repeats`` rounds (a shared machine's
-load falls on all alike); per case the median rate and the median over the rounds of
-Walker2d's rate (same kind of action; ``scene`` against ``zero``) divided by it.
+(:func:`time.perf_counter`), the clock started after a full garbage collection (the cases
+timed before leave theirs; a case's own garbage is collected inside its clock).  The cases
+run in turn, ``repeats`` rounds (a shared machine's load falls on all alike); per case the
+median rate and the median over the rounds of Walker2d's rate (same kind of action;
+``scene`` against ``zero``) divided by it.
 
 The rigid view runs its compiled control step (:class:`walkerlab.gym.rigid_view.RigidView`:
 the flow with the action's torques compiled by numba, CyRK's DOP853 in C++); ``compiled:
@@ -31,6 +33,7 @@ the Walker2d rows say so and the ratios are left out).
 
 from __future__ import annotations
 
+import gc
 import statistics
 import time
 from pathlib import Path
@@ -64,6 +67,7 @@ def _rate(env, action: str, steps: int, warmup: int) -> float:
         if term or trunc:
             env.reset()
     env.reset(seed=0)
+    gc.collect()  # the garbage of the environments timed before: not inside this clock
     t0 = time.perf_counter()
     for _ in range(steps):
         _, _, term, trunc, _ = env.step(act())

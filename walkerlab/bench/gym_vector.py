@@ -13,13 +13,19 @@ and ``random`` (uniform over the action space, ``numpy`` generator seeded 0: the
 fall out of step with each other, as a policy's early episodes do), the single environment
 reset on an episode's end as the vector forms autoreset.  A rate counts walker control
 periods: ``steps / t`` for the single environment, ``num_envs * steps / t`` for the vector
-forms.  Medians of ``repeats`` runs, wall time (:func:`time.perf_counter`).
+forms.  Medians of ``repeats`` runs, wall time (:func:`time.perf_counter`), each clock
+started after a full garbage collection (the forms built and closed before it leave
+theirs; a run's own garbage is collected inside its clock as it comes).  A speedup is
+the median over the rounds of the form's rate over the single environment's in the same
+round (each round times the forms in turn, so a pair meets the same load of a shared
+machine; the rates' own medians, taken apart, may come from different rounds).
 
 Needs gymnasium (the ``gym`` extra).
 """
 
 from __future__ import annotations
 
+import gc
 import statistics
 import time
 from pathlib import Path
@@ -65,7 +71,8 @@ def _time(make, steps: int, vector: bool = False, action: str = "zero",
             return zero
 
         for k in range(warmup + steps):
-            if k == warmup:
+            if k == warmup:  # the garbage of the forms built and closed before this one
+                gc.collect()  # collected now, not inside this one's clock
                 t0 = time.perf_counter()
             _, _, term, trunc, _ = env.step(act())
             if not vector and (term or trunc):
@@ -75,8 +82,8 @@ def _time(make, steps: int, vector: bool = False, action: str = "zero",
         env.close()
 
 
-def bench_vector(scene="configs/threelink_hzd.yaml", num_envs: int = 8, steps: int = 200,
-                 repeats: int = 3, warmup: int = 20, **env_kwargs) -> dict:
+def bench_vector(scene="configs/threelink_hzd.yaml", num_envs: int = 8, steps: int = 300,
+                 repeats: int = 5, warmup: int = 20, **env_kwargs) -> dict:
     """Environment steps per second of one ``walkerlab/Walker-v0`` and of ``num_envs`` of
     them in the native, sync and async vector forms (module docstring).
 
@@ -102,8 +109,9 @@ def bench_vector(scene="configs/threelink_hzd.yaml", num_envs: int = 8, steps: i
     dict
         ``scene``, ``num_envs``, ``steps``, ``repeats``, ``warmup``; under zero actions
         ``<form>_steps_per_s`` for each of :data:`FORMS` [walker control periods / s,
-        median], ``<form>_runs`` (every run's rate), ``speedup_<form>`` (the form's rate
-        over the single environment's) [-] for the vector forms; the same under random
+        median], ``<form>_runs`` (every run's rate), ``speedup_<form>`` (the median over
+        the rounds of the form's rate over the single environment's in the same round)
+        [-] for the vector forms; the same under random
         actions as ``random_<form>_steps_per_s``, ``random_<form>_runs`` and
         ``random_speedup_<form>``.
 
@@ -142,9 +150,9 @@ def bench_vector(scene="configs/threelink_hzd.yaml", num_envs: int = 8, steps: i
         for form in FORMS:
             res[f"{pre}{form}_steps_per_s"] = statistics.median(runs[action, form])
             res[f"{pre}{form}_runs"] = runs[action, form]
-        for form in FORMS[1:]:
-            res[f"{pre}speedup_{form}"] = (res[f"{pre}{form}_steps_per_s"]
-                                           / res[f"{pre}single_steps_per_s"])
+        for form in FORMS[1:]:  # paired: the same round's single environment
+            res[f"{pre}speedup_{form}"] = statistics.median(
+                v / s for v, s in zip(runs[action, form], runs[action, "single"]))
     return res
 
 
@@ -153,7 +161,8 @@ def lines(res: dict) -> list[str]:
     action."""
     out = [f"gym-vector: {Path(res['scene']).name}, {res['num_envs']} walkers, "
            f"{res['steps']} steps a run after {res.get('warmup', 0)}, medians of "
-           f"{res['repeats']} (walker control periods per second)"]
+           f"{res['repeats']} (walker control periods per second; a speedup: the median "
+           f"of the rounds' ratios to the same round's one env)"]
     for action in ACTIONS:
         pre = "" if action == "zero" else f"{action}_"
         if f"{pre}single_steps_per_s" not in res:
