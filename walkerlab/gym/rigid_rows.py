@@ -280,7 +280,7 @@ def _held_rows(views, rows: list, pieces: list, sel: list, maps: list, X: np.nda
         W = U @ maps[0]  # (r, n)
     else:
         W = np.array([u @ M for u, M in zip(U, maps)])
-    Xa, Xb = Y[sel], X[sel]
+    Xa, Xb = (Y, X) if len(sel) == len(Y) else (Y[sel], X[sel])  # (every row: in order)
     P = np.empty((3, len(sel), n))
     np.subtract(Xb[:, :n], Xa[:, :n], out=P[0])
     np.multiply(P[0], W, out=P[0])  # the work's terms
