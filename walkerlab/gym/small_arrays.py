@@ -22,15 +22,35 @@ SMALL = 64
 
 
 def any_true(flags: np.ndarray) -> bool:
-    """``bool(flags.any())`` of a boolean array ``flags``."""
+    """``bool(flags.any())``.
+
+    Parameters
+    ----------
+    flags : ndarray of bool, any shape
+
+    Returns
+    -------
+    bool
+        Some entry is True (False for an empty array).
+    """
     if flags.size <= SMALL:
         return any(flags.ravel().tolist())
     return bool(flags.any())
 
 
 def all_finite(a: np.ndarray) -> bool:
-    """``bool(np.isfinite(a).all())`` of a real array ``a`` (``math.isfinite`` of each
-    Python value of a small float array: no floating-point operation, so no overflow)."""
+    """``bool(np.isfinite(a).all())`` (``math.isfinite`` of each Python value of a small
+    float array: no floating-point operation, so no overflow warning).
+
+    Parameters
+    ----------
+    a : ndarray of real numbers (bool, integer or float), any shape
+
+    Returns
+    -------
+    bool
+        No entry is NaN or infinite (True for an empty or integer array).
+    """
     if a.dtype.kind != "f":
         return a.dtype.kind in "iub" or bool(np.isfinite(a).all())
     if a.size <= SMALL:
