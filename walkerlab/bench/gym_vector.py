@@ -53,6 +53,11 @@ def _scene_path(scene) -> str:
 ACTIONS = ("zero", "random")
 
 
+def _prefix(action: str) -> str:
+    """The result's key prefix of ``action`` (none for ``zero``)."""
+    return "" if action == "zero" else f"{action}_"
+
+
 def _time(make, steps: int, vector: bool = False, action: str = "zero",
           warmup: int = 0) -> float:
     """Control periods per second of ``make()`` under ``action`` (module docstring): one
@@ -146,7 +151,7 @@ def bench_vector(scene="configs/threelink_hzd.yaml", num_envs: int = 8, steps: i
     res: dict = {"scene": kw["scene"], "num_envs": num_envs, "steps": steps,
                  "repeats": repeats, "warmup": warmup}
     for action in ACTIONS:
-        pre = "" if action == "zero" else f"{action}_"
+        pre = _prefix(action)
         for form in FORMS:
             res[f"{pre}{form}_steps_per_s"] = statistics.median(runs[action, form])
             res[f"{pre}{form}_runs"] = runs[action, form]
@@ -164,7 +169,7 @@ def lines(res: dict) -> list[str]:
            f"{res['repeats']} (walker control periods per second; a speedup: the median "
            f"of the rounds' ratios to the same round's one env)"]
     for action in ACTIONS:
-        pre = "" if action == "zero" else f"{action}_"
+        pre = _prefix(action)
         if f"{pre}single_steps_per_s" not in res:
             continue
         for form in FORMS:

@@ -98,7 +98,6 @@ def _make_key(fphase, solver, m: int) -> tuple | None:
 
 _CFUNCS: dict = {}  # flow key -> (f, fs, fg, sel, rtol, atol, n_out)
 _GUARDS: dict = {}  # a phase's guards (columns, offsets, directions) -> their number
-_GUARD_SETS: dict = {}  # distinct guards' numbers, in order -> period_rows' guard tables
 _ENTRY: dict = {}  # flow key -> period_rows' compiled entry for its argument types
 
 
@@ -147,9 +146,8 @@ _GUARD_ROWS: dict = {}  # rows' guard numbers (tuple) -> _guard_tables' answer
 def _guard_tables(guards: list) -> tuple:
     """:func:`walkerlab.integrate.rows_dop853.period_rows`' guard arguments for rows whose
     phases have the guards numbered ``guards`` (:data:`_GUARDS`): the distinct sets as
-    tables (S, g) (padded; kept per distinct sets in order: the kernel only reads them),
-    their sizes (S,) and each row's set (N,) (the whole answer kept per rows' numbers,
-    :data:`_GUARD_ROWS`)."""
+    tables (S, g) (padded), their sizes (S,) and each row's set (N,), kept per rows'
+    numbers (:data:`_GUARD_ROWS`: the kernel only reads them)."""
     key = tuple(guards)
     out = _GUARD_ROWS.get(key)
     if out is None:
@@ -163,20 +161,15 @@ def _guard_sets(guards: list) -> tuple:
     """:func:`_guard_tables`' answer, made."""
     sets: dict = {}
     gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
-    key = tuple(sets)
-    out = _GUARD_SETS.get(key)
-    if out is None:
-        numbered = {j: g for g, j in _GUARDS.items()}
-        chosen = [numbered[j] for j in key]
-        g = max(len(c) for c, _, _ in chosen)
-        tables = (np.zeros((len(key), g), np.int64), np.zeros((len(key), g)),
-                  np.zeros((len(key), g)))
-        for s, entry in enumerate(chosen):
-            for table, values in zip(tables, entry):
-                table[s, :len(values)] = values
-        out = _GUARD_SETS[key] = (*tables, np.array([len(c) for c, _, _ in chosen],
-                                                     np.int64))
-    return (*out, gi)
+    numbered = {j: g for g, j in _GUARDS.items()}
+    chosen = [numbered[j] for j in sets]
+    g = max(len(c) for c, _, _ in chosen)
+    tables = (np.zeros((len(sets), g), np.int64), np.zeros((len(sets), g)),
+              np.zeros((len(sets), g)))
+    for s, entry in enumerate(chosen):
+        for table, values in zip(tables, entry):
+            table[s, :len(values)] = values
+    return (*tables, np.array([len(c) for c, _, _ in chosen], np.int64), gi)
 
 
 #: (rows, states) -> period_rows' node arguments for no nodes (zero-size: never written)

@@ -195,7 +195,6 @@ class RigidView:
         self.leg = self.model.legs[-1]
         self.x = np.array(x0, dtype=float)
         self.foot = np.zeros(2) if self.ground is None else self.ground.start.copy()
-        self.foot_x = float(self.foot[0])  # (its x as a float: hip_xs reads many at once)
         self.advance_x = 0.0  # the last step's advance along x [m] (a profile's segment)
         self.ended = ""
         #: ``(t [s], x [m], y [m])`` where the swing foot met a profile (a ``trip``), or None
@@ -571,7 +570,6 @@ class RigidView:
             x_plus = w.reset(x_minus)
         step = np.asarray(w.points(x_minus)["swing_foot"], float)
         self.foot = self.foot + step
-        self.foot_x = float(self.foot[0])
         self.advance_x = float(step[0])
         self.leg = [g for g in self.model.legs if g != self.leg][0]
         self.x = np.asarray(x_plus, float)
@@ -770,7 +768,7 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
         if all(v.walker.points is first for v in views):
             hx = _hips(first, X)  # one step walker's points for all: one call
             if hx is not None:
-                return np.array([v.foot_x for v in views]) + hx
+                return np.array([v.foot[0] for v in views], dtype=float) + hx
     pts = [v.walker.points for v in views]
     out = np.empty(len(views))
     groups: dict = {}
