@@ -162,6 +162,9 @@ def measure(scene_path: str, walks: int = 500, steps: int = 100, sigma: float = 
     """CPU per heel strike [us] of the three loops (module docstring), their ratios to the
     minimal loop (medians and each repeat's), and the walks that differ from it."""
     sys.path.insert(0, str(ROOT))
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # the yardstick's numba cache in the user cache, not by its source
     spec = importlib.util.spec_from_file_location(
         "monte_carlo_yardstick", ROOT / "walkerlab" / "bench" / "monte_carlo_yardstick.py")
     mc = importlib.util.module_from_spec(spec)

@@ -102,3 +102,30 @@ def test_the_bench_commands_help_names_every_benchmark():
     out = CliRunner().invoke(app, ["bench", "--help"], terminal_width=400).output
     missing = [b for b in BENCHMARKS if b not in out.replace("\n", " ")]
     assert not missing, missing
+
+
+@pytest.mark.slow
+def test_the_monte_carlo_benchmarks_yardstick_caches_its_numba_code_in_the_user_cache(
+        tmp_path):
+    """The main-job benchmark's Monte Carlo child loads the numba yardstick by its file; its
+    ``cache=True`` functions go to walkerlab's private user cache, never beside the source
+    (an installed package's folder: nothing is written outside the runs folder and the user
+    cache).  A copy of the yardstick in a fresh folder (numba keys its cache by the source's
+    path) is run for 2 walks of 3 steps; the copy's folder holds no numba cache file after,
+    the user cache's numba folder does (the copy's entries)."""
+    import shutil
+
+    from walkerlab.bench.main_job import MC_CHILD, TREE, child
+    from walkerlab.usercache import private_dir
+
+    src = tmp_path / "yardstick"
+    src.mkdir()
+    copy = src / "monte_carlo_yardstick.py"
+    shutil.copy(ROOT / "walkerlab" / "bench" / "monte_carlo_yardstick.py", copy)
+    out = child(TREE, MC_CHILD, str(ROOT / "configs" / "paper.yaml"), 0.002, 2, 3, 1, copy)
+    assert out["steps"] > 0
+    beside = [p.name for p in src.rglob("*") if p.suffix in (".nbi", ".nbc")]
+    assert beside == []
+    cache = private_dir("numba")
+    assert cache is not None
+    assert any(p.name.startswith("monte_carlo_yardstick") for p in cache.rglob("*.nbi"))

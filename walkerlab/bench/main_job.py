@@ -77,6 +77,8 @@ import importlib.util, json, sys, time
 import numpy as np
 scene_path, sd, W, S, reps, base_file = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), \
     int(sys.argv[4]), int(sys.argv[5]), sys.argv[6]
+from walkerlab.usercache import use_for_numba
+use_for_numba()  # the yardstick's numba cache in the private user cache, not by its source
 spec = importlib.util.spec_from_file_location("monte_carlo_yardstick", base_file)
 mc = importlib.util.module_from_spec(spec); spec.loader.exec_module(mc)
 from walkerlab.analysis.gait.scene import solve_scene
