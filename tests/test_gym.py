@@ -130,6 +130,51 @@ def test_a_zero_action_walks_the_paper_contact_walker_near_the_rigid_step_period
     assert abs(mean / PAPER_PERIOD_S - 1.0) < 0.03, (strikes, mean)
 
 
+def test_the_contact_views_heel_strikes_are_located_on_the_first_runs_interpolant(
+        monkeypatch):
+    """A control period's compiled segment keeps no dense output; where an event (the heel
+    strike) is to be located it runs the segment again with one
+    (:mod:`walkerlab.integrate.compiled_segments`).  Against the same periods with every
+    segment's dense output kept from its first run and that one used: the same heel-strike
+    times, observations and rewards bit for bit (the scene's controller as the policy, 120
+    periods of the three-link walker: two heel strikes)."""
+    import gymnasium as gym
+
+    import walkerlab.gym  # noqa: F401 - registers walkerlab/Walker-v0
+    from walkerlab.integrate import _cyrk
+
+    def walk():
+        env = gym.make("walkerlab/Walker-v0", scene=str(ROOT / "configs" / "threelink_hzd.yaml"),
+                       view="contact", policy="scene")
+        obs, _ = env.reset(seed=0)
+        zero = np.zeros(env.action_space.shape, env.action_space.dtype)
+        rows, strikes = [obs], []
+        for _ in range(120):
+            obs, reward, term, trunc, info = env.step(zero)
+            rows.append(np.append(obs, reward))
+            strikes += list(info["heel_strike_times_s"])
+            assert not (term or trunc), info
+        env.close()
+        return np.concatenate(rows), strikes
+
+    replayed = walk()
+    call, kept = _cyrk.ChunkSolver.__call__, {}  # a solver's last run, with its dense output
+
+    def first_runs_dense(self, x0, t_eval, data, dense=False):
+        if dense:  # an event's interpolant: the segment's first run's, whatever is asked
+            return kept.pop(id(self))  # (no segment stops early here)
+        if id(self) in kept:
+            kept.pop(id(self))[4].free()
+        out = kept[id(self)] = call(self, x0, t_eval, data, True)
+        return out[:4]
+
+    monkeypatch.setattr(_cyrk.ChunkSolver, "__call__", first_runs_dense)
+    kept_first = walk()
+    assert len(replayed[1]) >= 2
+    assert replayed[1] == kept_first[1]
+    np.testing.assert_array_equal(replayed[0], kept_first[0])
+
+
 def test_the_same_seed_gives_the_same_episode_bit_for_bit():
     """Start noise and random actions drawn from the seed: two environments, one seed, the
     same observations, rewards and ends to the last bit; another seed, another episode."""

@@ -89,3 +89,25 @@ def test_chunk_solver_reads_cyrks_states_calls_and_messages():
     buf = ctypes.create_string_buffer(256)
     ns.c_get_status_msg_buf(code, ctypes.addressof(buf), 256)
     assert buf.value.decode() == msgs
+
+
+def test_a_chunk_run_without_its_dense_output_takes_the_steps_of_one_with_it():
+    """A compiled segment asks CyRK for its dense output only where an event is to be
+    located, by running the segment again with it (:mod:`walkerlab.integrate.
+    compiled_segments`); that is the first run's interpolant only if keeping a dense output
+    leaves CyRK's steps alone: the samples and the call count of a run without it equal a
+    run's with it bit for bit, and two runs with it give the same interpolant everywhere."""
+    w, x0, _ = _bench_case()
+    solve = _cyrk.ChunkSolver("cyrk_bdf", 1e-8, 1e-10, kernels=w.kernels)
+    tg = np.linspace(0.0, 0.02, 11)
+    X1, ok1, n1, _ = solve(x0, tg, w.pack())
+    X2, ok2, n2, _, dense = solve(x0, tg, w.pack(), dense=True)
+    again = solve(x0, tg, w.pack(), dense=True)[4]
+    try:
+        assert ok1 and ok2 and n1 == n2 > 0
+        np.testing.assert_array_equal(X1, X2)
+        for t in np.linspace(0.0, 0.02, 37):
+            np.testing.assert_array_equal(dense(t), again(t))
+    finally:
+        dense.free()
+        again.free()

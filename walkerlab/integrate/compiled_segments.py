@@ -6,9 +6,13 @@ call (no Python inside it); the run's event functions (:mod:`walkerlab.integrate
 contact_powered`: the swing foot's touchdown, the push-off pulse's start, a flat foot's heel
 lift-off, a fall) are evaluated on its samples at once, vectorised over the contact table.
 In the first sample interval where one of them changes sign in its direction (the rule of
-:func:`scipy.integrate.solve_ivp`: ``g >= 0`` then ``g <= 0`` for direction -1) the interval
-is integrated again with CyRK's dense output, and the event is located on that interpolant by
-:func:`scipy.optimize.brentq` (``xtol`` 1e-13 s); the state there is the interpolant's.  The
+:func:`scipy.integrate.solve_ivp`: ``g >= 0`` then ``g <= 0`` for direction -1) the event is
+located by :func:`scipy.optimize.brentq` (``xtol`` 1e-13 s) on CyRK's dense output of the
+segment; the state there is the interpolant's.  That dense output is asked for only then:
+the segment is run again from the same start with it (the same call, so the same steps and
+samples, the interpolant the first run would have kept; CyRK keeps a dense output only for
+a finished run, and keeping it costs about a tenth of a segment that has no event, most of
+a Gymnasium environment's control periods).  The
 answer has :func:`~scipy.integrate.solve_ivp`'s shape (``t``, ``y``, ``t_events``,
 ``y_events``, ``status``, ``nfev``), so the event loop is the same for either integrator.
 
@@ -93,7 +97,8 @@ class CompiledSegments:
         -1).  Returns a namespace like :func:`scipy.integrate.solve_ivp`'s: ``t`` (k,) the
         samples after ``t0`` up to the event or ``t1``, ``y`` (N, k), ``t_events`` and
         ``y_events`` (one list entry per event, at most one located), ``status`` (0 the
-        end, 1 an event), ``nfev``, ``njev`` (0).
+        end, 1 an event), ``nfev`` (the solution's right-hand-side calls: the run again for
+        an event's dense output takes the same steps and is not counted), ``njev`` (0).
 
         ``switch_s`` [s]: a heel strike located before, inside ``(t0, t1)``: the other leg
         in stance from then (the data's switch); the answer starts after it (its samples
@@ -110,22 +115,22 @@ class CompiledSegments:
         inside = grid_inside(self.grid, t0, t1)
         tg = np.empty(inside.size + 2)
         tg[0], tg[1:-1], tg[-1] = t0, inside, t1
-        X, ok, nfev, msg, dense = self.solve(y0, tg, d, dense=True)
+        X, ok, nfev, msg = self.solve(y0, tg, d)
         self._extra = []
         try:
-            out = self._answer(X, ok, nfev, msg, dense, tg, events, len(y0), switch_s, d)
+            out = self._answer(X, ok, nfev, msg, y0, tg, events, len(y0), switch_s, d)
         finally:
-            for interp in [dense, *self._extra]:
-                if interp is not None:
-                    interp.free()
+            for interp in self._extra:
+                interp.free()
         if math.isfinite(switch_s):  # the samples after the heel strike only
             keep = out.t > switch_s + 1e-12
             out.t, out.y = out.t[keep], out.y[:, keep]
         return out
 
-    def _answer(self, X, ok, nfev, msg, dense, tg, events, ny, switch_s, d):
-        """:meth:`run`'s answer from the segment's samples ``X`` at ``tg`` and its dense
-        output: cut at the first event located on it."""
+    def _answer(self, X, ok, nfev, msg, y0, tg, events, ny, switch_s, d):
+        """:meth:`run`'s answer from the segment's samples ``X`` at ``tg`` (integrated from
+        ``y0`` with the data ``d``): cut at the first event, located on the segment's dense
+        output (the segment run again with it: the same steps)."""
         n = 2 * self.walker.nq
         out = types.SimpleNamespace(t_events=[_EMPTY] * len(events),
                                     y_events=[np.empty((0, ny))] * len(events),
@@ -152,11 +157,14 @@ class CompiledSegments:
         else:
             k = None
         if k is not None:
-            if not ok:  # a stopped run's dense output is not the solution's: the interval
+            if ok:  # the segment again with its dense output: the same call, the same
+                # steps (its calls not counted: ``nfev`` counts the solution's)
+                dense = self.solve(y0, tg, d, dense=True)[4]
+            else:  # a stopped run's dense output is not the solution's: the interval
                 # integrated again from its first sample
                 _, ok_k, nf_k, _, dense = self.solve(X[k], tg[k:k + 2], d, dense=True)
                 out.nfev += nf_k
-                self._extra.append(dense)
+            self._extra.append(dense)
             j, te, ye = _locate(dense, X[k], tg[k], tg[k + 1], events, keep.nonzero()[0], n)
             out.t, out.y = tg[1:k + 1], X[1:k + 1].T
             out.t_events[j], out.y_events[j] = np.array([te]), ye[None]
