@@ -8,13 +8,13 @@ lift-off, a fall) are evaluated on its samples at once, vectorised over the cont
 In the first sample interval where one of them changes sign in its direction (the rule of
 :func:`scipy.integrate.solve_ivp`: ``g >= 0`` then ``g <= 0`` for direction -1) the event is
 located by :func:`scipy.optimize.brentq` (``xtol`` 1e-13 s) on CyRK's dense output of the
-segment; the state there is the interpolant's.  That dense output is asked for only then:
-the segment is run again from the same start with it (the same call, so the same steps and
-samples, the interpolant the first run would have kept; CyRK keeps a dense output only for
-a finished run, and keeping it costs about a tenth of a segment that has no event, most of
-a Gymnasium environment's control periods).  The
-answer has :func:`~scipy.integrate.solve_ivp`'s shape (``t``, ``y``, ``t_events``,
-``y_events``, ``status``, ``nfev``), so the event loop is the same for either integrator.
+segment; the state there is the interpolant's.  That dense output is asked for only then,
+by running the segment again with the same start, times and data: CyRK takes the same steps,
+so the interpolant is the one the first run would have kept.  (Keeping it on every segment
+cost about a tenth of each integration, nearly all of it on segments without an event, such
+as most of a Gymnasium environment's control periods.)  The answer has
+:func:`~scipy.integrate.solve_ivp`'s shape (``t``, ``y``, ``t_events``, ``y_events``,
+``status``, ``nfev``), so the event loop is the same for either integrator.
 
 Python runs per segment and per event (a handful per step), never per integrator step.
 """
