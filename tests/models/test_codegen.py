@@ -51,3 +51,26 @@ def test_variational_rhs_is_flow_and_jacobian_times_phi(case):
         got = f["flow_variational"](0.0, np.concatenate([x, Phi.ravel()]))
         assert got.shape == (20,)
         assert np.max(np.abs(got - ref)) < 1e-13 * (1 + np.max(np.abs(ref)))
+
+
+@pytest.mark.parametrize("scene", ["paper", "kneed", "rabbit", "threelink", "rimless_wheel",
+                                   "asymmetric_legs"])
+def test_the_generated_hip_x_is_the_points_hip_x_bit_for_bit(scene):
+    """The generator's ``hip_x`` (the hip's x alone, the same printed expressions as
+    ``points``' entry) equals ``points(x)["hip"][0]`` exactly, at one state and at states as
+    columns, on straight legs, knees, five links, three links, a wheel and legs that differ
+    (both step walkers); 0 ulp, since the gym's reward reads one where it read the other."""
+    from pathlib import Path
+
+    from walkerlab.api import Walker
+
+    root = Path(__file__).resolve().parents[2]
+    model = Walker.from_scene(str(root / "configs" / f"{scene}.yaml")).model
+    rng = np.random.default_rng(7)
+    for w in (model, model.mirror) if model.mirror is not None else (model,):
+        assert w.hip_x is not None
+        n = len(w.state_names())
+        X = rng.normal(size=(n, 5)) * 0.3
+        for x in X.T:
+            assert w.hip_x(x) == w.points(x)["hip"][0]
+        np.testing.assert_array_equal(w.hip_x(X), w.points(X)["hip"][0])

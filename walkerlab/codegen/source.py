@@ -307,8 +307,31 @@ def _section(eq: Equations) -> list[str]:
     ]
 
 
-def numpy_fn(name: str, eq: Equations, named: dict, args: str = "x") -> list[str]:
-    """A numpy function returning ``{key: expr or Matrix}`` for states (2n,) or (2n, k)."""
+def numpy_fn(name: str, eq: Equations, named: dict, args: str = "x",
+             slices: dict | None = None) -> list[str]:
+    """A numpy function returning ``{key: expr or Matrix}`` for states (2n,) or (2n, k).
+
+    Parameters
+    ----------
+    name : str
+        The function's name.
+    eq : Equations
+    named : dict
+        ``{key: sympy expression or Matrix}``, the returned dict's entries.
+    args : {"x", "q"}
+        The argument: the state ``x = [q, dq]`` (2n,) or the coordinates ``q`` (n,).
+    slices : dict, optional
+        ``{function name: (key, index)}``: beside the function, one function per entry
+        returning the ``index``-th element (flattened, row-major) of ``named[key]`` alone,
+        with only the common subexpressions it needs - the same printed expressions on the
+        same numbers, so the same value bit for bit as ``name(x)[key][index]`` (a point's
+        coordinate for a reward, without the other points).
+
+    Returns
+    -------
+    list of str
+        The source lines (indented for :func:`generate`'s ``make``).
+    """
     keys = list(named)
     flat, shapes = [], []
     for k in keys:
@@ -348,7 +371,28 @@ def numpy_fn(name: str, eq: Equations, named: dict, args: str = "x") -> list[str
                 out.append(f"{k!r}: np.array(({', '.join(rows)},))")
     unpack = f"{IND}{', '.join(str(s) for s in (*eq.q, *eq.dq))}, = x" if args == "x" else \
         f"{IND}{', '.join(str(s) for s in eq.q)}, = q"
-    return [f"    def {name}({args}):", unpack, *lines, f"{IND}return {{{', '.join(out)}}}"]
+    fns = [f"    def {name}({args}):", unpack, *lines, f"{IND}return {{{', '.join(out)}}}"]
+    starts, at = {}, 0
+    for k, shp in zip(keys, shapes):
+        starts[k] = at
+        at += 1 if shp is None else shp[0] * shp[1]
+    for fname, (key, index) in (slices or {}).items():
+        fns += _slice_fn(fname, args, unpack, repl, red[starts[key] + index], pr)
+    return fns
+
+
+def _slice_fn(fname: str, args: str, unpack: str, repl: list, expr, pr) -> list[str]:
+    """One entry of :func:`numpy_fn`'s output as a function of its own: the common
+    subexpressions ``expr`` needs (``repl``'s, in their order) and ``expr`` printed as the
+    whole function prints it (``pr``)."""
+    need = set(expr.free_symbols)
+    kept = []
+    for a, e in reversed(repl):
+        if a in need:
+            kept.append((a, e))
+            need |= e.free_symbols
+    lines = [f"{IND}{_NP.doprint(a)} = {_NP.doprint(e)}" for a, e in reversed(kept)]
+    return [f"    def {fname}({args}):", unpack, *lines, f"{IND}return {pr(expr)}"]
 
 
 def _point_velocities(eq: Equations) -> dict:
@@ -393,7 +437,8 @@ def generate(eq: Equations, param_names, key: str) -> str:
         "    def energies(x):",
         f"{IND}d = _energies(x)",
         f"{IND}return d['kinetic'], d['potential']",
-        *numpy_fn("points", eq, eq.points),
+        *numpy_fn("points", eq, eq.points,
+                  slices={"hip_x": ("hip", 0)} if "hip" in eq.points else None),
         *numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
                                       **{f"{k}_rate": v for k, v in rates.items()}}),
         *numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),

@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import math
 import sys
-import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -241,16 +240,10 @@ class RigidView:
 
     def hip_x(self) -> float:
         """World position of the hip along x (horizontal, downhill) [m]."""
-        points = self.walker.points
-        try:
-            hx = _HIP_X[points]
-        except KeyError:
-            hx = _HIP_X[points] = _point_coordinate(points, "hip", 0, self.x)
-        except TypeError:  # (not weakly referable: the whole points)
-            hx = None
-        if hx is None:
-            return float(self.foot[0] + points(self.x)["hip"][0])
-        return float(self.foot[0] + hx(self.x))
+        w = self.walker
+        if w.hip_x is None:
+            return float(self.foot[0] + w.points(self.x)["hip"][0])
+        return float(self.foot[0] + w.hip_x(self.x))
 
     def points(self) -> dict:
         """World positions (2,) [m] of the walker's named points, by role."""
@@ -582,154 +575,21 @@ class RigidView:
         self._start_step()
 
 
-#: per ``points`` function: its hip's x alone (:func:`_point_coordinate`) or None
-_HIP_X: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _function_source(code) -> str | None:
-    """The source of a function of a generated module by its code object
-    (:func:`walkerlab.codegen.cache.read_source`: the checked text it was compiled from),
-    dedented, or None."""
-    from pathlib import Path
-
-    from walkerlab.codegen.cache import read_source
-
-    body = read_source(Path(code.co_filename))
-    if body is None:
-        return None
-    lines = body.splitlines()[code.co_firstlineno - 1:]
-    head = lines[0]
-    indent = len(head) - len(head.lstrip())
-    block = [head]
-    for line in lines[1:]:
-        if line.strip() and len(line) - len(line.lstrip()) <= indent:
-            break
-        block.append(line)
-    return "\n".join(line[indent:] for line in block)
-
-
-def _sliced(code, name: str, axis: int):
-    """The module code defining ``_whole`` (the generated function of ``code``, read from
-    its module's checked text) and the function of the one coordinate
-    (:func:`_point_coordinate`), with that function's name; None where the function is not
-    of the generated form."""
-    import ast
-
-    src = _function_source(code)
-    if src is None:
-        return None
-    fn = ast.parse(src).body[0]
-    body, ret = fn.body[:-1], fn.body[-1]
-    if not (isinstance(fn, ast.FunctionDef) and fn.name == code.co_name
-            and isinstance(ret, ast.Return) and isinstance(ret.value, ast.Dict)
-            and len(fn.args.args) == 1 and body and not fn.decorator_list
-            and all(isinstance(a, ast.Assign) and len(a.targets) == 1 for a in body)):
-        return None
-    arg = fn.args.args[0].arg
-    value = None
-    for k, v in zip(ret.value.keys, ret.value.values):
-        if isinstance(k, ast.Constant) and k.value == name:
-            value = v
-    if not (isinstance(value, ast.Call) and len(value.args) == 1 and not value.keywords
-            and isinstance(value.args[0], ast.Tuple) and axis < len(value.args[0].elts)):
-        return None
-    expr = value.args[0].elts[axis]
-    unpack = body[0]  # the state unpacked: ``a, b, ..., = x``
-    if not (isinstance(unpack.targets[0], ast.Tuple) and isinstance(unpack.value, ast.Name)
-            and unpack.value.id == arg):
-        return None
-    need = {n.id for n in ast.walk(expr) if isinstance(n, ast.Name)}
-    kept = []
-    for a in reversed(body[1:]):  # the assignments the entry needs, in order
-        if not isinstance(a.targets[0], ast.Name):
-            return None
-        if a.targets[0].id in need:
-            kept.append(a)
-            need |= {n.id for n in ast.walk(a.value) if isinstance(n, ast.Name)}
-    whole = ast.FunctionDef(name="_whole", args=fn.args, body=list(fn.body), decorator_list=[])
-    fn.body = [unpack, *reversed(kept), ast.Return(expr)]
-    return (compile(ast.fix_missing_locations(ast.Module([whole, fn], [])), code.co_filename,
-                    "exec"), fn.name)
-
-
-#: per generated function's code, name and axis: :func:`_sliced`'s, and whether its text was
-#: checked against the function
-_SLICED: dict = {}
-
-
-def _point_coordinate(points, name: str, axis: int, probe: np.ndarray):
-    """One coordinate of one named point of a generated ``points`` function, alone:
-    ``x -> points(x)[name][axis]`` computing only what that entry needs, or None.
-
-    The generated function (:func:`walkerlab.codegen.source.numpy_fn`: the state unpacked,
-    assignments, ``return {name: np.array((c0, c1, ...)), ...}``) is read from the checked
-    text of its module (:func:`walkerlab.codegen.cache.read_source`) and the assignments
-    the entry does not use are left out: the same expressions on the same numbers (the
-    function's closure bound as it is), so the same value bit for bit.  None where the
-    function is not of that form or its text is not found, or where the text read does
-    not give ``points(probe)`` bit for bit (checked once per generated function).
-
-    Parameters
-    ----------
-    points : callable
-        ``x (2n,) -> {name: ndarray}``.
-    name : str
-        The point (``"hip"``).
-    axis : int
-        The coordinate (0: x).
-    probe : ndarray (2n,)
-        A state the result is checked at.
-
-    Returns
-    -------
-    callable or None
-        ``x (2n,) -> float`` (a numpy scalar).
-    """
-    try:
-        code = points.__code__
-        key = (code, name, axis)
-        if key not in _SLICED:
-            _SLICED[key] = [_sliced(code, name, axis), False]
-        entry = _SLICED[key]
-        if entry[0] is None:
-            return None
-        module, fname = entry[0]
-        scope = dict(points.__globals__)
-        scope.update(zip(code.co_freevars, (c.cell_contents for c in points.__closure__ or ())))
-        exec(module, scope)  # noqa: S102 - the generated function's own text, sliced
-        one, x = scope[fname], np.array(probe, float)
-        ref = points(x)
-        if not entry[1]:  # the text read is the function's (the whole of it, bit for bit)
-            again = scope["_whole"](x)
-            if set(ref) != set(again) or not all(np.array_equal(ref[k], again[k])
-                                                 for k in ref):
-                entry[0] = None
-                return None
-            entry[1] = True
-        if np.shape(one(x)) != () or not float(one(x)) == float(ref[name][axis]):
-            return None
-        return one
-    except Exception:  # noqa: BLE001 - not a generated function: the whole points then
-        return None
-
-
-#: per ``points`` function (by id): ``(points, its hips' x of states as columns or None)``
+#: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``
 _COLUMN_POINTS: dict = {}
 
 
-def _hips(points, X: np.ndarray):
+def _hips(walker, X: np.ndarray):
     """The hip's x relative to the stance foot [m] of the states ``X`` (r, 2n), one call on
     the states as columns (the contract of ``points``: :mod:`walkerlab.models.hybrid.base`)
-    of the hip's x alone (:func:`_point_coordinate`, the expressions that entry needs) or
-    of the step walker's whole ``points``; None when neither takes them (checked once per
-    function against a call of ``points`` per state: the same numbers bit for bit, or not
-    used)."""
+    of the walker's generated hip's x alone (:attr:`HybridWalker.hip_x`) or of its whole
+    ``points``; None when neither takes them (checked once per function against a call of
+    ``points`` per state: the same numbers bit for bit - numpy's vector loops may round
+    differently from its scalar ones - or not used)."""
+    points = walker.points
     entry = _COLUMN_POINTS.get(id(points))
     if entry is None:
-        fns = []
-        one = _point_coordinate(points, "hip", 0, X[0])
-        if one is not None:
-            fns.append(one)
+        fns = [] if walker.hip_x is None else [walker.hip_x]
         fns.append(lambda Xt: points(Xt)["hip"][0])
         each = [float(points(x)["hip"][0]) for x in X]
         fn = None
@@ -766,7 +626,7 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
     if len(views) > 1 and X is not None:
         first = views[0].walker.points
         if all(v.walker.points is first for v in views):
-            hx = _hips(first, X)  # one step walker's points for all: one call
+            hx = _hips(views[0].walker, X)  # one step walker's points for all: one call
             if hx is not None:
                 return np.array([v.foot[0] for v in views], dtype=float) + hx
     pts = [v.walker.points for v in views]
@@ -778,9 +638,9 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
         if len(rows) < 2:
             hx = None
         elif X is not None and len(rows) == len(views):
-            hx = _hips(views[rows[0]].walker.points, X)
+            hx = _hips(views[rows[0]].walker, X)
         else:
-            hx = _hips(views[rows[0]].walker.points, np.array([views[i].x for i in rows]))
+            hx = _hips(views[rows[0]].walker, np.array([views[i].x for i in rows]))
         if hx is None:
             out[rows] = [views[i].hip_x() for i in rows]
         else:

@@ -264,6 +264,11 @@ class HybridWalker:
         Steps of a finite ground (``terrain.periodic: false``: a foothold list that does not
         repeat, of one height or several; a drawn rough ground): a walk stops after them.
         None: the ground goes on (:attr:`cycle`, if any, repeats).
+    hip_x : callable or None
+        ``x (2n,) or (2n, k) -> float or (k,)``: the hip's x [m] relative to the stance
+        foot alone, ``points(x)["hip"][0]`` bit for bit (generated beside ``points``:
+        :func:`walkerlab.codegen.source.numpy_fn`'s slices); None: read it from
+        ``points``.
     """
 
     name: str
@@ -291,6 +296,7 @@ class HybridWalker:
     cycle: tuple | None = None
     ground_steps: int | None = None
     neutral: tuple[str, ...] = ()
+    hip_x: Callable[[np.ndarray], float] | None = None
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)

@@ -217,6 +217,7 @@ def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
         reset=reset or f["reset"], energies=f["energies"], points=f["points"],
+        hip_x=f.get("hip_x"),
         section=f["section"], from_section=f["from_section"], role_to_leg=role_to_leg,
         total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
         variational=flow_jacobian or f["flow_jacobian"],

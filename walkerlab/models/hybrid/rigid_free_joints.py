@@ -96,8 +96,8 @@ def make_five_link_walker(data: WalkerData, name: str = "biped",
               **dict(zip(structure.param_names, data.params))}
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=(early, late),
-        reset=f["reset"], energies=f["energies"], points=f["points"], section=f["section"],
-        from_section=f["from_section"], role_to_leg=role_to_leg,
+        reset=f["reset"], energies=f["energies"], points=f["points"], hip_x=f.get("hip_x"),
+        section=f["section"], from_section=f["from_section"], role_to_leg=role_to_leg,
         total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
         variational=jac, reset_jacobian=f["reset_jacobian"],
         heel_strike_guard=f["guard_heel_strike"], leg_angles=f["leg_angles"],

@@ -57,7 +57,7 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
               **dict(zip(structure.param_names, data.params))}
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=(stance,),
-        reset=f["reset"], energies=f["energies"], points=f["points"],
+        reset=f["reset"], energies=f["energies"], points=f["points"], hip_x=f.get("hip_x"),
         section=f["section"], from_section=f["from_section"], role_to_leg=role_to_leg,
         total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
         variational=f["flow_jacobian"], reset_jacobian=f["reset_jacobian"],
