@@ -74,3 +74,30 @@ def test_the_generated_hip_x_is_the_points_hip_x_bit_for_bit(scene):
         for x in X.T:
             assert w.hip_x(x) == w.points(x)["hip"][0]
         np.testing.assert_array_equal(w.hip_x(X), w.points(X)["hip"][0])
+
+
+def test_the_christoffel_core_makes_dm_dt_minus_2c_skew_symmetric():
+    """The one Coriolis matrix every generator reads (:func:`~walkerlab.codegen.lagrange.
+    christoffel`): ``dM/dt - 2 C`` is skew-symmetric for a symmetric ``M(q)`` (the passivity
+    property, Spong, Hutchinson & Vidyasagar 2006, Property 7.2), exactly in sympy, on a
+    3-coordinate mass matrix with every entry depending on q; and ``C dq`` equals the
+    Lagrangian's ``d/dt dT/ddq - dT/dq - M qdd``, derived here without it."""
+    import sympy as sp
+
+    from walkerlab.codegen.lagrange import christoffel
+
+    q = sp.symbols("q0:3")
+    dq = sp.symbols("dq0:3")
+    ddq = sp.symbols("ddq0:3")
+    M = sp.Matrix([[3 + sp.cos(q[1]), sp.sin(q[0] - q[2]), q[1] * q[2]],
+                   [sp.sin(q[0] - q[2]), 2 + q[0] ** 2, sp.cos(q[2])],
+                   [q[1] * q[2], sp.cos(q[2]), 4 + sp.sin(q[1]) ** 2]])
+    C = christoffel(M, q, dq)
+    Mdot = M.applyfunc(lambda e: sum(sp.diff(e, qk) * dqk for qk, dqk in zip(q, dq)))
+    N = Mdot - 2 * C
+    assert sp.simplify(N + N.T) == sp.zeros(3, 3)
+    T = (sp.Matrix(dq).T * M * sp.Matrix(dq))[0] / 2
+    dT = [sp.diff(T, v) for v in dq]
+    ddt = [sum(sp.diff(e, a) * b for a, b in zip((*q, *dq), (*dq, *ddq))) for e in dT]
+    lhs = sp.Matrix([ddt[i] - sp.diff(T, q[i]) for i in range(3)]) - M * sp.Matrix(ddq)
+    assert sp.simplify(lhs - C * sp.Matrix(dq)) == sp.zeros(3, 1)

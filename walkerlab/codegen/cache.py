@@ -29,7 +29,7 @@ from walkerlab import usercache
 ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
                     "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
-                    "codegen/equations.py")
+                    "codegen/equations.py", "codegen/lagrange.py")
 _memo: dict[str, dict] = {}
 
 

@@ -70,6 +70,7 @@ from walkerlab.codegen.double_support import (
     derive_double_support,
     double_support_lines,
 )
+from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.link_sums import add_length, dot_terms, position_of, velocity_terms
 from walkerlab.codegen.push_off import push_off_systems
 from walkerlab.codegen.source import (
@@ -365,12 +366,7 @@ def _pinned_dynamics(w: _Walker, bodies: list, at, link_angle: dict):
         V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
     M = M.applyfunc(sp.factor_terms)
     G = sp.Matrix([sp.diff(V, s) for s in q])
-    C = sp.zeros(3, 3)
-    for i in range(3):
-        for j in range(3):
-            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(M[i, j], q[k]) + sp.diff(M[i, k], q[j])
-                                               - sp.diff(M[j, k], q[i])) * dq[k]
-                          for k in range(3))
+    C = christoffel(M, q, dq)
     C[ANKLE, ANKLE] += c_a  # the ankle damper: torque -c da/dt on the ankle coordinate
     for i, (first, second) in enumerate(structure.springs):
         delta = link_angle[second] - link_angle[first]

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.link_sums import add_mass_terms, position_of
 from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
@@ -256,14 +257,8 @@ def derive_five_link(structure: Structure) -> Equations:
     else:
         M, Mi, B, V = _matrices(q, bodies, lin["swing_foot"], g)
         points = {k: position_of(v) for k, v in point_lin.items()}
-    n = len(q)
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
-    C = sp.zeros(n, n)
-    for i in range(n):
-        for j in range(n):
-            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(M[i, j], q[k]) + sp.diff(M[i, k], q[j])
-                                               - sp.diff(M[j, k], q[i])) * dq[k]
-                          for k in range(n))
+    C = christoffel(M, q, dq)
     G = sp.Matrix([sp.diff(V, k) for k in q])
     hip, foot = points["hip"], points["swing_foot"]
     clearance = ((points["swing_contact"] if arc else foot).T * normal)[0]

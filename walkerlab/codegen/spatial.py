@@ -63,6 +63,7 @@ from functools import cache, wraps
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
+from walkerlab.codegen.lagrange import christoffel
 
 #: the seed of sympy's random choices while a 3D walker is derived (:func:`_seeded`)
 SYMPY_SEED = 0
@@ -105,20 +106,6 @@ def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
 
 def _dot(a: sp.Matrix, b: sp.Matrix):
     return (sp.Matrix(a).T * sp.Matrix(b))[0]
-
-
-def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
-    """Coriolis matrix (n, n) of the mass matrix ``M(q)``: ``C_ij = sum_k c_ijk dq_k`` with
-    ``c_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2`` (Murray, Li & Sastry 1994,
-    Eq. 4.23)."""
-    n = len(q)
-    dM = [M.diff(qk) for qk in q]
-    C = sp.zeros(n, n)
-    for i in range(n):
-        for j in range(n):
-            C[i, j] = sum(sp.Rational(1, 2) * (dM[k][i, j] + dM[j][i, k] - dM[i][j, k])
-                          * dq[k] for k in range(n))
-    return C
 
 
 def _spoke(theta_offset, L) -> sp.Matrix:

@@ -49,6 +49,7 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
+from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.link_sums import (
     add_length,
     add_mass_terms,
@@ -359,12 +360,7 @@ def _lagrange(s: _Symbols, Mp, Mi, Bm, V, D) -> _Dynamics:
     n, psv, dps, beta = s.n, s.psv, s.dps, s.beta
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
     G = sp.Matrix([sp.diff(V, k) for k in psv])
-    C = sp.zeros(n, n)
-    for i in range(n):
-        for j in range(n):
-            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[k]) + sp.diff(Mp[i, k], psv[j])
-                                               - sp.diff(Mp[j, k], psv[i])) * dps[k]
-                          for k in range(n))  # Christoffel symbols of the first kind
+    C = christoffel(Mp, psv, dps)  # Christoffel symbols of the first kind
     C += D
     structure = s.structure
     if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
