@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from walkerlab.numerics import per_map
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
@@ -379,6 +380,10 @@ def sweep_figure(data: dict, title: str = ""):
         unit = column_unit(c, units)
         name = _COLUMN_LABELS.get(c) or c.removesuffix("_mm").removesuffix("_s") \
             .removesuffix("_m_per_s").replace("_", " ")
+        if c == "max_abs_multiplier" and per_map(data["attrs"].get("steps_per_map")):
+            # the map every point's multipliers are of (the sweep's one: a stride if any
+            # point's is); an artifact without the attribute says nothing it does not know
+            name = name.replace("|\n", f"|\n{per_map(data['attrs']['steps_per_map'])} ")
         ax.set_ylabel(name + (f" [{unit}]" if unit else ""))
         if c == "max_abs_multiplier":
             ax.axhline(1.0, color="0.4", ls="--", lw=0.8)
