@@ -15,6 +15,7 @@ from types import ModuleType
 
 import numpy as np
 
+from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
     ground_contact_text,
@@ -62,8 +63,10 @@ def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
     bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
                    f"{num(fp.residual, 2)}), step period "
                    f"{num(fp.step_period_s)} {u.time}.")
+    per = per_map(getattr(fp, "steps_per_map", 0))  # the artifact's map: step or stride
     bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
-                   f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
+                   f"|Floquet multiplier|{' ' + per if per else ''} "
+                   f"{num(fp.max_abs_multiplier())}).")
     g = getattr(fp, "ground_contact", None)
     if g is not None:  # a gait that needs the ground to pull is no gait on real ground
         bullets.append("- **Ground reaction**: " + ground_contact_text(g, u).split(
@@ -75,7 +78,8 @@ def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
         rows.append([f"fixed point {n}", un, num(v, dig),
                      printed(eq[n]) if n in eq else "—"])
     rows.append(["step period", u.time, num(fp.step_period_s), "—"])
-    rows.append(["max abs(multiplier)", "-", num(fp.max_abs_multiplier()), "—"])
+    rows.append([f"max abs(multiplier){' ' + per if per else ''}", "-",
+                 num(fp.max_abs_multiplier()), "—"])
 
 
 def _contact_verdict(c) -> str:
