@@ -349,9 +349,10 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
     if not fp.gaits:
         return []
     labels, sel = list(fp.gaits), fp.gait
+    skipped = any("other_gait: false" in n for n in fp.gait_notes)  # not looked for
     lines = [f"period-1 gaits found: {len(labels)}" + (
         "" if len(labels) > 1 else " (the other gait of the long/short-period pair, if it "
-        "exists, was not found)")]
+        f"exists, was {'not looked for' if skipped else 'not found'})")]
     for lab, g in fp.gaits.items():
         mod = g.max_abs_multiplier()  # the neutral ones (a family's) set aside
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "

@@ -241,12 +241,13 @@ def _searched_gait(walker, solver, fp, guess):
     """The scene's period-1 gait as the fixedpoint stage chooses it (``fixedpoint.gait``):
     from the scene's initial guess (no seeds when it fails: a sweep point stays cheap), or
     without one from the scale-free seeds; the other gait of the pair is looked for only
-    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)."""
+    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)
+    and the scene allows it (``fixedpoint.other_gait``)."""
     from walkerlab.analysis.gait.search import find_gaits
 
     return find_gaits(walker, solver, guess, policy=fp.gait, other_gait=False,
-                      xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
-                      fd_check=False, seeds=False).result
+                      partner_if_needed=fp.other_gait, xtol=fp.tolerance, fd_step=fp.fd_step,
+                      max_step_time=fp.max_step_time_s, fd_check=False, seeds=False).result
 
 
 def on_study_map(scene: Scene, walker, res, steps_per_map: int | None):
