@@ -98,7 +98,8 @@ def bifurcation_figure(data: dict, title: str = ""):
     ax2.axhline(-1.0, color="tab:red", lw=0.8)
     ax2.axhline(1.0, color="0.6", lw=0.6)
     ax2.set_xlabel(xlabel)
-    ax2.set_ylabel("Floquet multiplier [-]")
+    per = per_map(data.get("steps_per_map"))  # the artifact's map: step or stride
+    ax2.set_ylabel(f"Floquet multiplier{' ' + per if per else ''} [-]")
     ax2.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout()
     return fig
