@@ -208,9 +208,10 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
         rows.append([f"walkerlab `{v}`" + (" (this scene)" if v == main else ""),
                      *[num(a) for a in g.x], num(float(g.step_period_s)),
                      num(float(np.max(np.hypot(re, im)))), num(g.residual, 2)])
+    per = per_map(getattr(fp, "steps_per_map", 0))  # the artifact's map: step or stride
     out.append(table(["model", *[f"{n} [{u}]" for n, u in zip(names, units)],
-                      f"step period [{fp.units.time}]", "max abs(multiplier)",
-                      "residual"], rows))
+                      f"step period [{fp.units.time}]",
+                      f"max abs(multiplier){' ' + per if per else ''}", "residual"], rows))
     out.append("")
     out.append("State right after heel strike, role-ordered (the swing leg is the one that "
                "just left the ground).")
@@ -237,7 +238,7 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
             "reproduce Eq. (11) at all, so that sign is a typesetting error only.")
     re, im = fp.multipliers.real, fp.multipliers.imag
     re2, im2 = fp.multipliers_fd.real, fp.multipliers_fd.imag
-    out += ["", f"### Floquet multipliers (`{main}`)", "",
+    out += ["", f"### Floquet multipliers (`{main}`{', ' + per if per else ''})", "",
             table(["#", "variational equations", "finite differences", "abs value"],
                   [[i + 1, f"{a:+.6f}{b:+.6f}j", f"{c:+.6f}{d:+.6f}j",
                     num(float(np.hypot(a, b)))]

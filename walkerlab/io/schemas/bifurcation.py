@@ -77,7 +77,7 @@ def load_bifurcation_summary(path: Path) -> BifurcationSummary:
         dim = "slope" if ppath == SLOPE_PATH else ppath
         values = f[dim][()]
         data = {"parameter_path": ppath, "parameter_unit": str(f[dim].attrs.get("unit", "deg")),
-                dim: values}
+                dim: values, "steps_per_map": int(f.attrs.get("steps_per_map", 0))}
         for name in ("onset/onset_slope", "onset/onset_value"):
             if name in f:
                 data[name] = f[name][()]
