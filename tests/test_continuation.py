@@ -555,3 +555,32 @@ def test_the_disc_wheels_critical_slope_is_a_branch_point_the_family_passes_thro
         m = np.sort(np.abs(r.multipliers_variational))[::-1]
         side.append(m[0] if m[0] > 1 + 1e-6 else m[1])  # the largest besides the neutral 1
     assert side[0] > 1.01 and side[1] < 0.995
+
+
+
+@pytest.mark.slow  # ~35 s: a stride-map branch over 10 cm of hip width
+def test_a_3d_continuation_over_hip_width_is_per_stride_from_the_planar_embedding_on(
+        tmp_path):
+    """Issue 82 item 1, the continuation's side: over the hip width from 0 (a step map of
+    its own) to 0.1 m the branch has one map, a stride, recorded in the artifact and named
+    on the figure: at zero width its largest multiplier is the zero-width walker's per-step
+    11.2303 (configs/paper_3d.yaml on its own step map: an independent run) squared, and it
+    falls with the hip width to the hip-width walker's 99.93."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.io.schemas.continuation import load_continuation
+    from walkerlab.plotting.continuation_figures import continuation_figure
+    from walkerlab.stages import continuation as stage
+
+    out = stage.run(load_scene(ROOT / "configs" / "hip_width.yaml"), "walker.hip_width_m",
+                    0.0, 0.1, runs_root=tmp_path)
+    data = load_continuation(out.path)
+    assert data.steps_per_map == 2
+    br = data.branches[0]
+    p, big = br["param"], np.max(np.abs(br["multipliers"]), axis=1)
+    _w, search = solve_scene(load_scene(ROOT / "configs" / "paper_3d.yaml"), fd_check=False)
+    step = np.max(np.abs(search.result.multipliers_variational))
+    assert big[np.argmin(p)] == pytest.approx(step ** 2, rel=1e-6)
+    assert big[np.argmax(p)] == pytest.approx(99.9294, rel=1e-5)
+    assert np.all(np.diff(big[np.argsort(p)]) < 0)  # the instability falls with the width
+    fig = continuation_figure(data)
+    assert any("per stride" in ax.get_ylabel() for ax in fig.axes)

@@ -539,3 +539,35 @@ def test_a_sweep_artifact_without_its_map_makes_no_claim():
     assert "per st" not in sweep_text(data)
     data["attrs"]["steps_per_map"] = 1
     assert "(per step, every point)" in sweep_text(data)
+
+
+@pytest.mark.slow  # ~40 s: the hip-roll walker's and the zero-width walker's gaits
+def test_a_stable_3d_gait_and_the_planar_embedding_sweep_on_their_own_maps(tmp_path):
+    """Issue 82 item 1's checks on a stable 3D gait and on the planar embedding: the
+    stabilised hip-width walker (configs/hip_width_stabilised.yaml, its map a stride at
+    every width) sweeps per stride, every point stable, its scene's point the documented
+    0.5463; the zero-width walker (configs/paper_3d.yaml) over the slope stays on its own
+    step map (per step: 11.23 at the paper's slope), its planar multipliers among them."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.report.sweep_text import sweep_text
+
+    stab = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    data = load_sweep(sweep_stage.run(stab, ["walker.hip_width_m=0.1,0.12"], "fixedpoint",
+                                      workers=1, runs_root=tmp_path, progress=False,
+                                      figure=False))
+    rows = data["points"]
+    assert int(data["attrs"]["steps_per_map"]) == 2 and set(rows["stable"]) == {1.0}
+    assert rows["max_abs_multiplier"][0] == pytest.approx(0.5463, abs=1e-4)
+    assert "(per stride, every point)" in sweep_text(data)
+    flat = load_scene(ROOT / "configs" / "paper_3d.yaml")
+    data = load_sweep(sweep_stage.run(flat, ["slope.angle_rad=0.0174"], "fixedpoint",
+                                      workers=1, runs_root=tmp_path, progress=False,
+                                      figure=False))
+    assert int(data["attrs"]["steps_per_map"]) == 1
+    assert data["points"]["max_abs_multiplier"][0] == pytest.approx(11.23, abs=0.01)
+    assert "(per step, every point)" in sweep_text(data)
+    _w, planar = solve_scene(load_scene(ROOT / "configs" / "paper.yaml"), fd_check=False)
+    mult = np.array([data["points"][f"multiplier_{k}_re"][0]
+                     + 1j * data["points"][f"multiplier_{k}_im"][0] for k in range(6)])
+    for m in planar.result.multipliers_variational:  # the planar ones among the 3D ones
+        assert np.min(np.abs(mult - m)) < 1e-7
