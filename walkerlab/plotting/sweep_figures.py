@@ -20,9 +20,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
-from walkerlab.numerics import per_map
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
+from walkerlab.numerics import per_map
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.studies.bifurcation import fall_onset, onset_value, parameter_values
 from walkerlab.studies.outcomes import OUTCOMES

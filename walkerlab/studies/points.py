@@ -31,13 +31,13 @@ from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.studies.guess import Continuation, guess_from_json, guess_to_json
 from walkerlab.studies.outcomes import empty_row
+from walkerlab.studies.params import apply_point
 from walkerlab.studies.point_columns import (  # noqa: F401  (re-exported)
     _fp_columns,
     _ground_columns,
     _state_columns,
     interleg_angle,
 )
-from walkerlab.studies.params import apply_point
 
 __all__ = ["Task", "Continuation", "guess_from_json", "guess_to_json", "run_chunk",
            "fixedpoint_point", "simulate_point", "contact_point", "contact_adapter",

@@ -14,9 +14,10 @@ Layout
   and ``multipliers/imag`` (points, 2n) of ``D(P^k)``, ``stable`` (points,) 0/1;
 - ``special_points/``: ``kind`` (strings ``fold`` (a multiplier through +1, the branch
   turning back), ``branch_point`` (through +1, the branch passing through: transcritical
-  or pitchfork), ``period_doubling``, ``neimark_sacker``, ``branch_end``), ``param`` [field unit], ``period`` (1, 2, 4: the
-  branch it lies on), ``branch`` (index into ``branches``), ``cause`` (why a branch ends;
-  else empty), ``state/<name>``, ``multipliers/real``/``imag`` (specials, 2n);
+  or pitchfork), ``period_doubling``, ``neimark_sacker``, ``branch_end``), ``param``
+  [field unit], ``period`` (1, 2, 4: the branch it lies on), ``branch`` (index into
+  ``branches``), ``cause`` (why a branch ends; else empty), ``state/<name>``,
+  ``multipliers/real``/``imag`` (specials, 2n);
 - ``two_parameter/<j>/`` (optional): ``param`` [field unit], ``param2`` [second field's
   unit] of a fold or period-doubling curve (attributes ``kind``, ``period``, ``path2``,
   ``unit2``), ``critical_multiplier/real``/``imag``;
@@ -46,7 +47,6 @@ def continuation_writer(res, curves=()):
     """``writer(h5file)`` for a :class:`walkerlab.analysis.continuation.branch.ContinuationResult`
     and optional :class:`~walkerlab.analysis.continuation.two_parameter.TwoParameterCurve` s."""
     from walkerlab.io.artifacts import put
-
     from walkerlab.numerics import map_name
 
     names, units = list(res.state_names), list(res.state_units)
