@@ -132,3 +132,27 @@ def test_field_units_from_metadata_or_name():
     assert unit(paper, "contact.stiffness_n_per_m_pow_e") == "N/m^e"
     assert unit(paper, "contact.stiction_velocity_mm_per_s") == "mm/s"
     assert unit(paper, "contact.mu_static") == "-"
+
+
+
+def test_a_3d_bifurcation_over_hip_width_is_on_one_stride_map(tmp_path):
+    """Issue 82 item 1, the bifurcation diagram's side: over a 3D walker's hip width from 0
+    (its own map a step) to 0.1 m (a stride) every value is on the study's one map, a
+    stride (126.1 at zero width: the step's 11.2303 squared, configs/paper_3d.yaml; 99.93
+    at 0.1 m), the artifact records it and the figure's multiplier axis says "per
+    stride"."""
+    from walkerlab.io.schemas.bifurcation import load_bifurcation
+    from walkerlab.plotting.sweep_figures import bifurcation_figure
+
+    scene = load_scene(ROOT / "configs" / "hip_width.yaml")
+    out = bif_stage.run(scene, [0.0, 0.1], tmp_path, n_transient=4, n_keep=2, workers=1,
+                        param="walker.hip_width_m")
+    data = load_bifurcation(out.path)
+    assert data["steps_per_map"] == 2
+    big = np.max(np.abs(data["floquet/real"] + 1j * data["floquet/imag"]), axis=1)
+    assert big[0] == pytest.approx(11.2303 ** 2, rel=1e-5)
+    assert big[1] == pytest.approx(99.9294, rel=1e-5)
+    # the step period stays a step's (the stride's halved)
+    assert data["fixed_point/step_period"][0] == pytest.approx(0.7035969, rel=1e-6)
+    fig = bifurcation_figure(data)
+    assert any("per stride" in ax.get_ylabel() for ax in fig.axes)

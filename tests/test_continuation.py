@@ -490,6 +490,7 @@ def test_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_pat
     assert orbit.ndim == 2 and orbit.shape[1] == 2  # two heel strikes a map at every point
     d = load_continuation(path)
     assert np.all(np.isfinite(d.branches[0]["param"]))
+    assert d.steps_per_map == 2  # the one map, recorded: its multipliers are per stride
 
 
 def test_a_homotopy_turned_back_by_a_fold_says_how_far_it_got_not_only_where_it_ended(
@@ -520,3 +521,66 @@ def test_the_from_option_says_the_two_walkers_must_share_their_structure():
     code, _err, out = _cli("fixedpoint", "--help")
     assert code == 0
     assert "must have the same structure" in " ".join(out.replace("│", " ").split())
+
+
+def test_the_disc_wheels_critical_slope_is_a_branch_point_the_family_passes_through():
+    """Issue 82 item 14: the disc wheel's (configs/rimless_wheel_3d_disc.yaml) loss of
+    stability at 0.18567 rad was labelled a fold, a turning point in the parameter.  The
+    family passes straight through it (the slope grows monotonically along the branch) while
+    a real multiplier, besides the heading's neutral 1, crosses +1: a branch point
+    (transcritical or pitchfork), no fold.  The kneed walker's fold, where the branch does
+    turn back, stays a fold (test_kneed_gait_ends_in_a_fold_where_a_scan_loses_it)."""
+    scene = load_scene(ROOT / "configs" / "rimless_wheel_3d_disc.yaml")
+    res, _ = run_continuation(scene, "slope.angle_rad", 0.18, 0.19)
+    assert res.steps_per_map == 1  # the wheel's map is one step: multipliers per step
+    assert [s.kind for s in res.specials] == ["branch_point"]
+    bp = res.specials[0]
+    assert bp.p == pytest.approx(0.18567, abs=1e-5)
+    mu = bp.multipliers
+    # two at +1: the neutral heading's and the critical one (a double eigenvalue: the
+    # computed pair splits by ~sqrt(machine eps) of the Jacobian's error, hence 1e-5)
+    near_one = np.sort(np.abs(mu - 1.0))
+    assert near_one[1] < 1e-5 and near_one[2] > 0.1
+    p = res.branches[0].params()
+    assert np.all(np.diff(p) > 0)  # no turning back: the branch passes through
+    # either side of it the critical multiplier is off +1 the other way (1.07 below,
+    # 0.99 above): stability is lost through +1 (an independent root finder's run each)
+    s = Solver.from_settings(scene.solver)
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+
+    side = []
+    for a in (0.18, 0.19):
+        w = build_walker(apply_point(scene.model_dump(mode="json"), ["slope.angle_rad"], (a,)))
+        r = find_fixed_point(w, bp.x, s, fd_check=False)
+        m = np.sort(np.abs(r.multipliers_variational))[::-1]
+        side.append(m[0] if m[0] > 1 + 1e-6 else m[1])  # the largest besides the neutral 1
+    assert side[0] > 1.01 and side[1] < 0.995
+
+
+
+@pytest.mark.slow  # ~35 s: a stride-map branch over 10 cm of hip width
+def test_a_3d_continuation_over_hip_width_is_per_stride_from_the_planar_embedding_on(
+        tmp_path):
+    """Issue 82 item 1, the continuation's side: over the hip width from 0 (a step map of
+    its own) to 0.1 m the branch has one map, a stride, recorded in the artifact and named
+    on the figure: at zero width its largest multiplier is the zero-width walker's per-step
+    11.2303 (configs/paper_3d.yaml on its own step map: an independent run) squared, and it
+    falls with the hip width to the hip-width walker's 99.93."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.io.schemas.continuation import load_continuation
+    from walkerlab.plotting.continuation_figures import continuation_figure
+    from walkerlab.stages import continuation as stage
+
+    out = stage.run(load_scene(ROOT / "configs" / "hip_width.yaml"), "walker.hip_width_m",
+                    0.0, 0.1, runs_root=tmp_path)
+    data = load_continuation(out.path)
+    assert data.steps_per_map == 2
+    br = data.branches[0]
+    p, big = br["param"], np.max(np.abs(br["multipliers"]), axis=1)
+    _w, search = solve_scene(load_scene(ROOT / "configs" / "paper_3d.yaml"), fd_check=False)
+    step = np.max(np.abs(search.result.multipliers_variational))
+    assert big[np.argmin(p)] == pytest.approx(step ** 2, rel=1e-6)
+    assert big[np.argmax(p)] == pytest.approx(99.9294, rel=1e-5)
+    assert np.all(np.diff(big[np.argsort(p)]) < 0)  # the instability falls with the width
+    fig = continuation_figure(data)
+    assert any("per stride" in ax.get_ylabel() for ax in fig.axes)

@@ -293,3 +293,54 @@ def test_a_3d_derivation_draws_from_a_seeded_generator_and_restores_its_state():
     derive("b")
     assert draws[0][1:] == draws[1][1:]
     assert srand.rng.getstate() == after != before
+
+
+def test_a_stride_map_of_the_zero_width_walker_squares_its_step_multipliers():
+    """Issue 82 item 1: a study puts the zero-width 3D walker (a step map of its own) on the
+    stride map of its other points (``HybridWalker.with_steps_per_map``).  Its legs are
+    mirror images, so the stride is two identical steps: the same fixed point, twice the
+    period, every Floquet multiplier squared - each found by its own root finder and
+    variational equations, not one computed from the other."""
+    scene = _scene("paper_3d.yaml")
+    step = build_walker(scene)
+    assert step.steps_per_map == 1
+    stride = step.with_steps_per_map(2)
+    assert stride.steps_per_map == 2 and step.with_steps_per_map(1) is step
+    a = find_fixed_point(step, _guess(scene, step.state_names()), SOLVER, fd_check=False)
+    b = find_fixed_point(stride, a.x, SOLVER, fd_check=False)
+    assert np.max(np.abs(b.x - a.x)) < 1e-10
+    assert b.period_s == pytest.approx(2 * a.period_s, rel=1e-12)
+    # relative 1e-7: the two Jacobians each to the integrator's tolerance (1e-12)
+    assert np.sort(np.abs(b.multipliers_variational)) == pytest.approx(
+        np.sort(np.abs(a.multipliers_variational) ** 2), rel=1e-7, abs=1e-9)
+    with pytest.raises(ValueError, match="not made of this walker's maps"):
+        build_walker(_scene("hip_width.yaml")).with_steps_per_map(3)
+
+
+def test_other_gait_false_stops_the_second_gait_search_of_a_3d_walker(tmp_path):
+    """Issue 82 item 14: the hip-width walker's passive gait is unstable (its lateral mode),
+    so ``fixedpoint.gait: stable`` went on to look for the other gait of the pair (and
+    found a short-period one) although the scene says ``other_gait: false``.  Now the
+    scene's word is kept: one gait, the one from its guess, and a note that says why; the
+    fixedpoint text gives its multipliers per stride (the walker's map)."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.report.text import fixedpoint_text
+    from walkerlab.stages import fixedpoint as fixedpoint_stage
+
+    scene = _scene("hip_width.yaml")
+    assert scene.fixedpoint.other_gait is False and scene.fixedpoint.gait == "stable"
+    walker, search = solve_scene(scene, fd_check=False)
+    assert len(search.gaits) == 1 and not search.result.stable
+    assert any("other_gait: false" in n for n in search.notes)
+    assert "deflated" not in " ".join(search.tried) and "seed" not in " ".join(search.tried)
+    # the scene's own word is what stops it: with other_gait true the pair is looked for
+    both = scene.model_copy(update={"fixedpoint": scene.fixedpoint.model_copy(
+        update={"other_gait": True})})
+    assert len(solve_scene(both, fd_check=False)[1].gaits) == 2
+    fp = load_fixedpoint(fixedpoint_stage.run(scene, runs_root=tmp_path).path)
+    assert fp.steps_per_map == 2
+    text = fixedpoint_text(fp)
+    assert "Floquet multipliers (variational, per stride)" in text
+    assert "largest variational |multiplier| per stride = 99.92" in text
+    assert "was not looked for" in text

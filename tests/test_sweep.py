@@ -465,3 +465,109 @@ def test_a_sweeps_summary_names_its_failed_points_by_their_parameters():
                        "max_abs_multiplier": np.array([0.5, np.nan, 0.6, np.nan])}}
     text = sweep_text(data)
     assert "  no_fixed_point at slope.angle_deg = 1.500; slope.angle_deg = 2.500" in text
+
+
+# ----------------------------------------------------------------------------- one map
+def test_a_studys_map_is_a_stride_when_any_point_needs_one():
+    """Issue 82 item 1: the map is decided for the whole study before any point is solved:
+    a 3D walker's hip width from 0 (a step map) to 0.1 m (a stride) makes it a stride; a
+    study of zero widths alone, or of the slope of a planar walker, keeps the step."""
+    from walkerlab.studies.map_length import study_steps_per_map
+
+    hip = load_scene(ROOT / "configs" / "hip_width.yaml").model_dump(mode="json")
+    path = ["walker.hip_width_m"]
+    assert study_steps_per_map(hip, path, [(0.0,), (0.1,)]) == 2
+    assert study_steps_per_map(hip, path, [(0.1,), (0.0,)]) == 2
+    assert study_steps_per_map(hip, path, [(0.0,)]) == 1
+    goswami = load_scene(SCENE).model_dump(mode="json")
+    assert study_steps_per_map(goswami, ["slope.angle_deg"], [(1.0,), (3.0,)]) == 1
+    # a point whose scene does not validate is left out (its row says why)
+    assert study_steps_per_map(hip, path, [(-1.0,), (0.0,)]) == 1
+
+
+def test_a_3d_sweep_reports_every_point_per_stride(tmp_path):
+    """Issue 82 item 1: ``walkerlab sweep`` of the hip-width walker over 0 and 0.1 m gave
+    11.23 at zero width (a step map) beside 99.93 at 0.1 m (a stride map).  Now every point
+    is on the study's one map, a stride: at zero width the multipliers are those of the
+    walker's own step map squared - checked against the zero-width 3D paper walker
+    (configs/paper_3d.yaml) on its own step map, an independent run - the artifact records
+    the map (``steps_per_map``), and the summary and the figure say "per stride"."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.plotting.sweep_figures import sweep_figure
+    from walkerlab.report.sweep_text import sweep_text
+
+    sc = load_scene(ROOT / "configs" / "hip_width.yaml")
+    out = sweep_stage.run(sc, ["walker.hip_width_m=0,0.1"], "fixedpoint", workers=1,
+                          runs_root=tmp_path, progress=False, figure=False)
+    data = load_sweep(out)
+    rows = data["points"]
+    assert list(rows["outcome"]) == ["ok", "ok"]
+    assert int(data["attrs"]["steps_per_map"]) == 2
+    walker, search = solve_scene(load_scene(ROOT / "configs" / "paper_3d.yaml"),
+                                 fd_check=False)
+    assert walker.steps_per_map == 1  # zero width: the walker's own map is a step
+    step = np.abs(search.result.multipliers_variational)
+    assert step.max() == pytest.approx(11.23, abs=0.01)  # the old sweep's row at w = 0
+    # per stride = per step squared (legs that are mirror images), to the integration's and
+    # the root finder's error (rtol 1e-12: ~1e-9 relative; 1e-7 leaves a margin)
+    assert rows["max_abs_multiplier"][0] == pytest.approx(step.max() ** 2, rel=1e-7)
+    stride = np.array([rows[f"multiplier_{k}_re"][0] + 1j * rows[f"multiplier_{k}_im"][0]
+                       for k in range(step.size)])
+    assert np.sort(np.abs(stride)) == pytest.approx(np.sort(step ** 2), rel=1e-7, abs=1e-8)
+    assert rows["max_abs_multiplier"][1] == pytest.approx(99.93, abs=0.01)
+    # the instability falls with the hip width (126 -> 100 per stride), as continuation says
+    assert rows["max_abs_multiplier"][0] > rows["max_abs_multiplier"][1]
+    # the step period stays a step's on the stride map (the stride's halved)
+    assert rows["step_period_s"][0] == pytest.approx(search.result.period_s, rel=1e-9)
+    text = sweep_text(data)
+    assert "max_abs_multiplier" in text and "(per stride, every point)" in text
+    fig = sweep_figure(data)
+    assert any("per stride" in ax.get_ylabel() for ax in fig.axes)
+
+
+def test_a_sweep_artifact_without_its_map_makes_no_claim():
+    """An artifact written before the map was recorded (no ``steps_per_map``) is summarised
+    without "per step" or "per stride": it does not say what it does not know."""
+    from walkerlab.report.sweep_text import sweep_text
+
+    deg = np.array([1.0, 2.0])
+    data = {"attrs": {"sweep_stage": "fixedpoint", "scene_units": "SI"},
+            "axes": [("slope.angle_deg", deg)],
+            "points": {"outcome": np.array(["ok", "ok"]), "param/slope.angle_deg": deg,
+                       "step_period_s": np.array([0.7, 0.72]),
+                       "max_abs_multiplier": np.array([0.5, 0.6])}}
+    assert "per st" not in sweep_text(data)
+    data["attrs"]["steps_per_map"] = 1
+    assert "(per step, every point)" in sweep_text(data)
+
+
+@pytest.mark.slow  # ~40 s: the hip-roll walker's and the zero-width walker's gaits
+def test_a_stable_3d_gait_and_the_planar_embedding_sweep_on_their_own_maps(tmp_path):
+    """Issue 82 item 1's checks on a stable 3D gait and on the planar embedding: the
+    stabilised hip-width walker (configs/hip_width_stabilised.yaml, its map a stride at
+    every width) sweeps per stride, every point stable, its scene's point the documented
+    0.5463; the zero-width walker (configs/paper_3d.yaml) over the slope stays on its own
+    step map (per step: 11.23 at the paper's slope), its planar multipliers among them."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.report.sweep_text import sweep_text
+
+    stab = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    data = load_sweep(sweep_stage.run(stab, ["walker.hip_width_m=0.1,0.12"], "fixedpoint",
+                                      workers=1, runs_root=tmp_path, progress=False,
+                                      figure=False))
+    rows = data["points"]
+    assert int(data["attrs"]["steps_per_map"]) == 2 and set(rows["stable"]) == {1.0}
+    assert rows["max_abs_multiplier"][0] == pytest.approx(0.5463, abs=1e-4)
+    assert "(per stride, every point)" in sweep_text(data)
+    flat = load_scene(ROOT / "configs" / "paper_3d.yaml")
+    data = load_sweep(sweep_stage.run(flat, ["slope.angle_rad=0.0174"], "fixedpoint",
+                                      workers=1, runs_root=tmp_path, progress=False,
+                                      figure=False))
+    assert int(data["attrs"]["steps_per_map"]) == 1
+    assert data["points"]["max_abs_multiplier"][0] == pytest.approx(11.23, abs=0.01)
+    assert "(per step, every point)" in sweep_text(data)
+    _w, planar = solve_scene(load_scene(ROOT / "configs" / "paper.yaml"), fd_check=False)
+    mult = np.array([data["points"][f"multiplier_{k}_re"][0]
+                     + 1j * data["points"][f"multiplier_{k}_im"][0] for k in range(6)])
+    for m in planar.result.multipliers_variational:  # the planar ones among the 3D ones
+        assert np.min(np.abs(mult - m)) < 1e-7

@@ -8,6 +8,7 @@ import typer
 
 from walkerlab.cli.errors import fail, guard
 from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load, status
+from walkerlab.numerics import map_name, per_map
 
 
 @guard
@@ -142,6 +143,10 @@ def continuation(scene: Path | None = SceneArg,
                    f"{float(sp['param'][i]):.10g}{unit}{cause}")
     if not len(sp["kind"]):
         typer.echo("no special point in the range")
+    if map_name(data.steps_per_map):  # the one map of every branch: multipliers per it
+        typer.echo(f"Poincaré map: one {map_name(data.steps_per_map)} on every branch "
+                   f"(period k: k {map_name(data.steps_per_map)}s; Floquet multipliers "
+                   f"{per_map(data.steps_per_map)} for period 1)")
     for c in data.curves:
         typer.echo(f"{c['kind']} curve over {c['path2']}: {len(c['param2'])} points")
     typer.echo(status(out))
@@ -183,8 +188,10 @@ def target(scene: Path | None = SceneArg,
     typer.echo(f"{vary} = {scene_value(w.scene, vary):.10g} {u(field_unit(vary) or '-')} "
                f"gives {name.rsplit('_', 1)[0].rsplit('_m', 1)[0]} = {value:g} "
                f"{u(field_unit(name) or '-')}")
+    per = per_map(w.model.steps_per_map)  # the walker's own map: a step or a stride
     typer.echo(f"  step period {gait.step_period:.6g} {u.time}, max |Floquet multiplier| "
-               f"{max(abs(gait.multipliers)):.4g} ({'stable' if gait.stable else 'unstable'})")
+               f"{per} {max(abs(gait.multipliers)):.4g} "
+               f"({'stable' if gait.stable else 'unstable'})")
     for n, v in gait.state.items():
         typer.echo(f"  {n:14s} {v:+.8f}")
 

@@ -119,12 +119,16 @@ class SweepStore:
     @classmethod
     def create(cls, final: Path, scene, stage: str, axes: list, columns: SweepColumns,
                options: dict, input_hash: str,
-               plan: list[list[int]] | None = None) -> SweepStore:
+               plan: list[list[int]] | None = None,
+               steps_per_map: int | None = None) -> SweepStore:
         """Start a new partial file (an old one is overwritten).
 
         ``scene`` (a :class:`walkerlab.config.Scene`) is stored as JSON; ``stage`` names the
         stage each point runs; ``plan``: the chains of grid indices, in evaluation order
-        (stored for resume).
+        (stored for resume); ``steps_per_map``: steps of the one Poincaré map every point's
+        Floquet multipliers are of (1: a step, 2: a stride;
+        :func:`walkerlab.studies.map_length.study_steps_per_map`), the root attribute
+        ``steps_per_map`` the summary and figures label them with (none: not written).
 
         Raises
         ------
@@ -156,6 +160,8 @@ class SweepStore:
             "grid_shape": np.array([len(a) for a in axes], dtype=np.int64),
             "n_points": int(np.prod([len(a) for a in axes])), "complete": False,
         })
+        if steps_per_map is not None:
+            f.attrs["steps_per_map"] = int(steps_per_map)
         for i, a in enumerate(axes):
             data = np.asarray(a.values, float) if a.numeric else \
                 np.asarray([str(v) for v in a.values], dtype=STR)

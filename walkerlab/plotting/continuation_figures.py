@@ -20,10 +20,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from walkerlab.numerics import per_map
+
 __all__ = ["continuation_figure", "two_parameter_figure", "stability_pieces"]
 
 PERIOD_COLORS = {1: "tab:blue", 2: "tab:orange", 4: "tab:green", 8: "tab:purple"}
-MARKERS = {"fold": ("s", "tab:red", "F"), "period_doubling": ("o", "tab:red", "PD"),
+MARKERS = {"fold": ("s", "tab:red", "F"), "branch_point": ("^", "tab:red", "BP"),
+           "period_doubling": ("o", "tab:red", "PD"),
            "neimark_sacker": ("D", "tab:brown", "NS"), "branch_end": ("X", "k", "end")}
 
 
@@ -125,7 +128,9 @@ def _draw_special_points(ax1, ax2, data, seen: set) -> None:
         mk, col, short = MARKERS.get(str(kind), ("*", "k", str(kind)))
         y, _ = _y(data, {n: np.atleast_1d(v)[i:i + 1] for n, v in sp["states"].items()})
         pv = float(sp["param"][i])
-        lab = {"fold": "fold (multiplier +1)", "period_doubling": "period doubling (-1)",
+        lab = {"fold": "fold (multiplier +1, turning back)",
+               "branch_point": "branch point (multiplier +1, passing through)",
+               "period_doubling": "period doubling (-1)",
                "neimark_sacker": "Neimark-Sacker (|complex pair| 1)",
                "branch_end": "branch end"}.get(str(kind), str(kind))
         ax1.plot([pv], y, mk, color=col, ms=7, mfc="none", mew=1.6, zorder=5,
@@ -180,7 +185,8 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
     big = [np.max(np.abs(b["multipliers"])) for b in data.branches if len(b["param"])]
     if big and max(big) > 20:  # an unstable branch far out: log scale keeps |mu| = 1 visible
         ax2.set_yscale("log")
-    ax2.set_ylabel("max |Floquet multiplier| [-]")
+    per = per_map(getattr(data, "steps_per_map", 0))  # the artifact's map: step or stride
+    ax2.set_ylabel(f"max |Floquet multiplier|{' ' + per if per else ''} [-]")
     ax2.set_xlabel(f"{data.path}{unit}")
     return _finished(fig, ax1, title)
 

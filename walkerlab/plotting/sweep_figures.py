@@ -22,6 +22,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
+from walkerlab.numerics import per_map
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.studies.bifurcation import fall_onset, onset_value, parameter_values
 from walkerlab.studies.outcomes import OUTCOMES
@@ -97,7 +98,8 @@ def bifurcation_figure(data: dict, title: str = ""):
     ax2.axhline(-1.0, color="tab:red", lw=0.8)
     ax2.axhline(1.0, color="0.6", lw=0.6)
     ax2.set_xlabel(xlabel)
-    ax2.set_ylabel("Floquet multiplier [-]")
+    per = per_map(data.get("steps_per_map"))  # the artifact's map: step or stride
+    ax2.set_ylabel(f"Floquet multiplier{' ' + per if per else ''} [-]")
     ax2.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout()
     return fig
@@ -379,6 +381,10 @@ def sweep_figure(data: dict, title: str = ""):
         unit = column_unit(c, units)
         name = _COLUMN_LABELS.get(c) or c.removesuffix("_mm").removesuffix("_s") \
             .removesuffix("_m_per_s").replace("_", " ")
+        if c == "max_abs_multiplier" and per_map(data["attrs"].get("steps_per_map")):
+            # the map every point's multipliers are of (the sweep's one: a stride if any
+            # point's is); an artifact without the attribute says nothing it does not know
+            name = name.replace("|\n", f"|\n{per_map(data['attrs']['steps_per_map'])} ")
         ax.set_ylabel(name + (f" [{unit}]" if unit else ""))
         if c == "max_abs_multiplier":
             ax.axhline(1.0, color="0.4", ls="--", lw=0.8)

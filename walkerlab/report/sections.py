@@ -15,6 +15,7 @@ from types import ModuleType
 
 import numpy as np
 
+from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
     ground_contact_text,
@@ -62,8 +63,10 @@ def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
     bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
                    f"{num(fp.residual, 2)}), step period "
                    f"{num(fp.step_period_s)} {u.time}.")
+    per = per_map(getattr(fp, "steps_per_map", 0))  # the artifact's map: step or stride
     bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
-                   f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
+                   f"|Floquet multiplier|{' ' + per if per else ''} "
+                   f"{num(fp.max_abs_multiplier())}).")
     g = getattr(fp, "ground_contact", None)
     if g is not None:  # a gait that needs the ground to pull is no gait on real ground
         bullets.append("- **Ground reaction**: " + ground_contact_text(g, u).split(
@@ -75,7 +78,8 @@ def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
         rows.append([f"fixed point {n}", un, num(v, dig),
                      printed(eq[n]) if n in eq else "—"])
     rows.append(["step period", u.time, num(fp.step_period_s), "—"])
-    rows.append(["max abs(multiplier)", "-", num(fp.max_abs_multiplier()), "—"])
+    rows.append([f"max abs(multiplier){' ' + per if per else ''}", "-",
+                 num(fp.max_abs_multiplier()), "—"])
 
 
 def _contact_verdict(c) -> str:
@@ -204,9 +208,10 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
         rows.append([f"walkerlab `{v}`" + (" (this scene)" if v == main else ""),
                      *[num(a) for a in g.x], num(float(g.step_period_s)),
                      num(float(np.max(np.hypot(re, im)))), num(g.residual, 2)])
+    per = per_map(getattr(fp, "steps_per_map", 0))  # the artifact's map: step or stride
     out.append(table(["model", *[f"{n} [{u}]" for n, u in zip(names, units)],
-                      f"step period [{fp.units.time}]", "max abs(multiplier)",
-                      "residual"], rows))
+                      f"step period [{fp.units.time}]",
+                      f"max abs(multiplier){' ' + per if per else ''}", "residual"], rows))
     out.append("")
     out.append("State right after heel strike, role-ordered (the swing leg is the one that "
                "just left the ground).")
@@ -233,7 +238,7 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
             "reproduce Eq. (11) at all, so that sign is a typesetting error only.")
     re, im = fp.multipliers.real, fp.multipliers.imag
     re2, im2 = fp.multipliers_fd.real, fp.multipliers_fd.imag
-    out += ["", f"### Floquet multipliers (`{main}`)", "",
+    out += ["", f"### Floquet multipliers (`{main}`{', ' + per if per else ''})", "",
             table(["#", "variational equations", "finite differences", "abs value"],
                   [[i + 1, f"{a:+.6f}{b:+.6f}j", f"{c:+.6f}{d:+.6f}j",
                     num(float(np.hypot(a, b)))]

@@ -7,6 +7,7 @@ from types import ModuleType
 
 import numpy as np
 
+from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num, printed, table
 
 
@@ -33,9 +34,11 @@ def _bifurcation_lines(b, onsets: tuple[float, float], pub: ModuleType | None) -
     path, unit = data["parameter_path"], data["parameter_unit"]
     onset, falls = onsets
     periods = sorted(set(int(v) for v in per if v > 0))
+    mult = " ".join(filter(None, ("the most negative real Floquet multiplier",  # its map
+                                  per_map(data.get("steps_per_map")))))
     if path == SLOPE_PATH:
         text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
-                "where the most negative real Floquet multiplier crosses −1"
+                f"where {mult} crosses −1"
                 if np.isfinite(onset) else "no period doubling on the grid")
         out = ["## Bifurcation over the slope", "",
                f"Grid {printed(values[0])}–{printed(values[-1])}° ({values.size} slopes): "
@@ -49,8 +52,8 @@ def _bifurcation_lines(b, onsets: tuple[float, float], pub: ModuleType | None) -
                        f"({printed(round(np.degrees(rng[1]), 4))}°).")
         return out + [""]
     u = "" if unit in ("", "-") else f" {unit}"
-    text = (f"period-doubling onset at {path} = {num(onset)}{u}, where the most negative "
-            "real Floquet multiplier crosses −1" if np.isfinite(onset)
+    text = (f"period-doubling onset at {path} = {num(onset)}{u}, where {mult} crosses −1"
+            if np.isfinite(onset)
             else "no period doubling on the grid")
     return [f"## Bifurcation over `{path}`", "",
             f"Grid {printed(values[0])}–{printed(values[-1])}{u} ({values.size} values, "

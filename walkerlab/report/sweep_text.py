@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num
 from walkerlab.units import Units
 
@@ -15,6 +16,9 @@ MAIN_COLUMNS = {
     "contact-sim": ("heel_strikes", "mean_step_period_s", "max_slip_mm",
                     "peak_penetration_mm"),
 }
+#: columns of a Poincaré map's Floquet multipliers: labelled with the sweep's one map
+#: (the artifact's ``steps_per_map``: "per step", "per stride")
+PER_MAP_COLUMNS = ("max_abs_multiplier",)
 #: SI unit of a result column by its suffix (labelled through :class:`Units`)
 _SUFFIX = (("_m_per_s", "m/s"), ("_mm", "mm"), ("_s", "s"), ("_m", "m"))
 
@@ -57,6 +61,8 @@ def sweep_text(data: dict) -> str:
         u = column_unit(c, units)
         rng = (f"{num(v.min())} .. {num(v.max())}" + (f" {u}" if u else "")
                if v.size else "no point walks")
+        if c in PER_MAP_COLUMNS and per_map(data["attrs"].get("steps_per_map")):
+            rng += f" ({per_map(data['attrs']['steps_per_map'])}, every point)"
         lines.append(f"  {c:<28s} {rng}")
     lines += _failed_points(data, outcome)
     return "\n".join(lines)

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from walkerlab.integrate.ends import CONTACT_WALKED
-from walkerlab.numerics import neutral_positions
+from walkerlab.numerics import neutral_positions, per_map
 from walkerlab.report.markdown import num
 
 if TYPE_CHECKING:  # the loaded artifacts these summaries print
@@ -222,7 +222,9 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
                          f"length {d:.10f} {u.length}")
     lines.append(f"  residual        {fp.residual:.2e}  (max |P(x*) - x*|)")
     re, im = fp.multipliers.real, fp.multipliers.imag
-    lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
+    per = _per(fp)  # the artifact's map: " per step" or " per stride"
+    lines.append(f"Floquet multipliers (variational{',' + per if per else ''}): "
+                 f"{_fmt_mult(re, im)}")
     lines.append(f"Floquet multipliers (finite diff.): "
                  f"{_fmt_mult(fp.multipliers_fd.real, fp.multipliers_fd.imag)}")
     lines.append(f"  max difference {fp.max_difference:.2e} ({_fd_error_text(fp.scene_json)})")
@@ -233,7 +235,8 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
            "heel-strike surface's, besides delta^2 of the zero dynamics")
     if fp.neutral:
         why = f"{neutral_multipliers_text(fp)}; {why}"
-    lines.append(f"verdict: {verdict} (largest variational |multiplier| = {mod:.6f}; {why})")
+    lines.append(f"verdict: {verdict} (largest variational |multiplier|{per} = {mod:.6f}; "
+                 f"{why})")
     lines += unstable_modes_text(fp, fp.state_names)
     if fp.zero_dynamics is not None:
         lines += zero_dynamics_text(fp.zero_dynamics)
@@ -303,12 +306,21 @@ def zero_dynamics_text(z: dict) -> list[str]:
     return lines
 
 
+def _per(gait) -> str:
+    """``" per step"`` or ``" per stride"``: the map of a stored gait's multipliers
+    (:attr:`~walkerlab.io.schemas.fixedpoint.GaitResult.steps_per_map`); ``""`` when not
+    known."""
+    per = per_map(getattr(gait, "steps_per_map", 0))
+    return f" {per}" if per else ""
+
+
 def unstable_gait_line(fp: FixedPointArtifact) -> str:
     """One line on an unstable selected gait: its largest |Floquet multiplier| and whether
     any stable period-1 gait was found (``walkerlab fixedpoint --require-stable``)."""
     mod = float(np.max(np.abs(fp.multipliers)))
     n = max(len(fp.gaits), 1)
-    head = (f"the gait found is unstable (largest |Floquet multiplier| {mod:.4g} > 1, step "
+    head = (f"the gait found is unstable (largest |Floquet multiplier|{_per(fp)} "
+            f"{mod:.4g} > 1, step "
             f"period {fp.step_period_s:.6g} {fp.units.time}); ")
     stable = [lab.replace("_", "-") for lab, g in fp.gaits.items() if g.stable]
     if stable:  # the scene's policy chose another: say so
@@ -346,13 +358,15 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
     if not fp.gaits:
         return []
     labels, sel = list(fp.gaits), fp.gait
+    skipped = any("other_gait: false" in n for n in fp.gait_notes)  # not looked for
     lines = [f"period-1 gaits found: {len(labels)}" + (
         "" if len(labels) > 1 else " (the other gait of the long/short-period pair, if it "
-        "exists, was not found)")]
+        f"exists, was {'not looked for' if skipped else 'not found'})")]
     for lab, g in fp.gaits.items():
         mod = g.max_abs_multiplier()  # the neutral ones (a family's) set aside
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
-                     f"{g.step_period_s:.6f} {fp.units.time}, max |multiplier| {mod:.4g}, "
+                     f"{g.step_period_s:.6f} {fp.units.time}, max |multiplier|"
+                     f"{_per(g)} {mod:.4g}, "
                      f"{'stable' if g.stable else 'UNSTABLE'}{_ground_word(g, fp.units)} "
                      f"({_GAIT_SOURCES.get(g.source, g.source)})")
     notes = fp.gait_notes

@@ -28,6 +28,7 @@ artifact is :mod:`walkerlab.stages.bifurcation`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -37,6 +38,7 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.execution.executor import run_each
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH, onset_name, parameter_dim
+from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.params import ParamAxis
 from walkerlab.studies.runner import plan_chunks, sweep_executor
 
@@ -52,6 +54,7 @@ class _BifTask:
     n_keep: int
     steady_state: bool
     path: str = SLOPE_PATH
+    steps_per_map: int = 0   # the study's one map (0: each walker's own)
 
 
 def _scene_at(base: dict, value: float, path: str = SLOPE_PATH) -> Scene:
@@ -89,7 +92,13 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point, interleg_angle, warm_up
+    from walkerlab.studies.points import (
+        PointOutcome,
+        ideal_fixed_point,
+        interleg_angle,
+        on_study_map,
+        warm_up,
+    )
 
     warm_up()
     from walkerlab.studies.continuation import scene_family
@@ -110,14 +119,18 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
             try:
                 if fam is None:  # the walker over the grid's field, built once a chunk
                     fam = scene_family(scene, task.path)
+                    if task.steps_per_map:  # the study's one map at every value
+                        fam = dataclasses.replace(fam, steps_per_map=task.steps_per_map,
+                                                  _cache={})
                 q = _arclength_step(fam, prev, value)
                 if q is not None:  # the neighbour's branch followed to this value
                     walker = build_walker(scene)
                     row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
-                               period_s=q.period_s / walker.steps_per_map)  # per step
+                               period_s=q.period_s / fam.steps(walker))  # per step
                 else:
                     walker, res, _src = ideal_fixed_point(scene, guess)
-                    row.update(x=res.x, period_s=res.period_s / walker.steps_per_map,
+                    on_map, res = on_study_map(scene, walker, res, task.steps_per_map)
+                    row.update(x=res.x, period_s=res.period_s / on_map.steps_per_map,
                                multipliers=np.asarray(res.multipliers_variational, complex))
                 guess = row["x"]
                 prev = (value, q if q is not None else row["x"])
@@ -189,11 +202,13 @@ def _arclength_step(fam, prev, value: float):
     return last if abs(last.p - value) <= 1e-12 * max(1.0, abs(value)) else None
 
 
-def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH
-       ) -> tuple[float, np.ndarray]:
-    from walkerlab.studies.points import ideal_fixed_point
+def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH,
+       steps_per_map: int = 0) -> tuple[float, np.ndarray]:
+    from walkerlab.studies.points import ideal_fixed_point, on_study_map
 
-    _w, res, _s = ideal_fixed_point(_scene_at(scene_base, value, path), guess)
+    scene = _scene_at(scene_base, value, path)
+    w, res, _s = ideal_fixed_point(scene, guess)
+    _w, res = on_study_map(scene, w, res, steps_per_map)  # the study's one map
     return 1.0 + min_real_multiplier(res.multipliers_variational), res.x
 
 
@@ -207,7 +222,7 @@ def _onset_dict(onset: float, bracket, mult_at: float, n: int, path: str) -> dic
 
 def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
                            x: np.ndarray, xtol_deg: float = 1e-4,
-                           path: str = SLOPE_PATH) -> dict:
+                           path: str = SLOPE_PATH, steps_per_map: int = 0) -> dict:
     """Parameter value where the most negative real multiplier crosses -1.
 
     The first grid interval where ``g = 1 + min real multiplier`` goes from > 0 to <= 0
@@ -228,6 +243,8 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
         brentq tolerance on the parameter (its unit: deg for the slope).
     path : str
         The dotted scene field of the grid (default :data:`SLOPE_PATH`).
+    steps_per_map : int
+        The study's one Poincaré map (``mult``'s; 0: each walker's own).
 
     Returns
     -------
@@ -247,7 +264,7 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
         state = {"guess": x[k] if rising else x[k + 1], "n": 0}
 
         def f(s, state=state):
-            val, xs = _g(base, s, state["guess"], path)
+            val, xs = _g(base, s, state["guess"], path, steps_per_map)
             state["n"] += 1
             state["guess"] = xs
             return val
@@ -300,6 +317,9 @@ class BifurcationResult:
         The dotted scene field of the grid (:data:`SLOPE_PATH` by default).
     unit : str
         Its SI unit (``deg`` for the slope; :func:`walkerlab.studies.params.axis_unit`).
+    steps_per_map : int
+        Steps of the one Poincaré map every value's multipliers are of (1: a step, 2: a
+        stride; :func:`walkerlab.studies.map_length.study_steps_per_map`).
     """
 
     values: np.ndarray
@@ -320,6 +340,7 @@ class BifurcationResult:
     n_keep: int
     param: str = SLOPE_PATH
     unit: str = "deg"
+    steps_per_map: int = 1
 
     @property
     def slopes_deg(self) -> np.ndarray:
@@ -384,16 +405,20 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         span = float(np.ptp(slopes)) if slopes.size > 1 else 1.0
         xtol_deg = 1e-4 if param == SLOPE_PATH else 1e-5 * (span or 1.0)
     base = scene.model_dump(mode="json")
-    rows = _grid_rows(base, axis, n_transient, n_keep, steady_state, workers, scheduler)
+    # one map for every value (a stride where any value's walker needs one)
+    steps = study_steps_per_map(base, [param], [(float(s),) for s in slopes], "<bifurcation>")
+    rows = _grid_rows(base, axis, n_transient, n_keep, steady_state, workers, scheduler, steps)
     x = np.array([r["x"] for r in rows])
     mult = np.array([r["multipliers"] for r in rows])
-    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param)
-    return _diagram_result(scene, slopes, rows, x, mult, onset, n_transient, n_keep, param,
-                           unit)
+    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param, steps)
+    res = _diagram_result(scene, slopes, rows, x, mult, onset, n_transient, n_keep, param,
+                          unit)
+    res.steps_per_map = steps
+    return res
 
 
 def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, steady_state: bool,
-               workers: int, scheduler) -> list[dict]:
+               workers: int, scheduler, steps_per_map: int = 0) -> list[dict]:
     """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
     state; :func:`_bif_chunk`), in grid order: the grid of ``axis`` is cut into runs
     (:func:`walkerlab.studies.runner.plan_chunks`) evaluated on
@@ -402,7 +427,7 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
 
     param, n = axis.path, len(axis.values)
     chunks = plan_chunks([axis], base, workers=max(1, workers))
-    tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state, param)
+    tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state, param, steps_per_map)
              for c in chunks]
     rows = []
     with progress.task(f"bifurcation: {n} values of {param}", n) as bar:

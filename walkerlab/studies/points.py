@@ -30,8 +30,14 @@ from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.studies.guess import Continuation, guess_from_json, guess_to_json
-from walkerlab.studies.outcomes import empty_row, state_column
+from walkerlab.studies.outcomes import empty_row
 from walkerlab.studies.params import apply_point
+from walkerlab.studies.point_columns import (  # noqa: F401  (re-exported)
+    _fp_columns,
+    _ground_columns,
+    _state_columns,
+    interleg_angle,
+)
 
 __all__ = ["Task", "Continuation", "guess_from_json", "guess_to_json", "run_chunk",
            "fixedpoint_point", "simulate_point", "contact_point", "contact_adapter",
@@ -235,75 +241,54 @@ def _searched_gait(walker, solver, fp, guess):
     """The scene's period-1 gait as the fixedpoint stage chooses it (``fixedpoint.gait``):
     from the scene's initial guess (no seeds when it fails: a sweep point stays cheap), or
     without one from the scale-free seeds; the other gait of the pair is looked for only
-    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)."""
+    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)
+    and the scene allows it (``fixedpoint.other_gait``)."""
     from walkerlab.analysis.gait.search import find_gaits
 
     return find_gaits(walker, solver, guess, policy=fp.gait, other_gait=False,
-                      xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
-                      fd_check=False, seeds=False).result
+                      partner_if_needed=fp.other_gait, xtol=fp.tolerance, fd_step=fp.fd_step,
+                      max_step_time=fp.max_step_time_s, fd_check=False, seeds=False).result
 
 
-def interleg_angle(walker, x: np.ndarray) -> float:
-    """Angle [rad] between the legs, from the foot-to-foot distance ``d`` of state ``x``.
+def on_study_map(scene: Scene, walker, res, steps_per_map: int | None):
+    """The gait ``res`` of ``walker`` (found on the walker's own Poincaré map) on the
+    study's one map of ``steps_per_map`` steps
+    (:func:`walkerlab.studies.map_length.study_steps_per_map`): the same fixed point,
+    solved again on that map from it (MINPACK, converged at once) and its Floquet
+    multipliers from that map's variational equations (a stride's are the step's squared,
+    computed, not squared).  ``walker`` and ``res`` themselves when the maps agree (None:
+    the walker's own map).  Found on the walker's own map first: a stride map from a far
+    guess squares an unstable multiplier and falls where the step map converges.
 
-    ``2 asin(d / 2L)`` with ``L = walker.params["leg_length_m"]``: for straight legs this is
-    ``|theta_swing - theta_stance|`` exactly; for any walker it is the angle of the isosceles
-    triangle hip-feet with the same step, so it needs no state row.
-
-    Parameters
-    ----------
-    walker : HybridWalker
-    x : ndarray, shape (2n,)
-        State (``walker.state_names()``, [rad, rad/s]); only the feet's positions are read.
+    Raises
+    ------
+    PointOutcome
+        ``invalid_config`` (the study's map is not made of the walker's) or
+        ``no_fixed_point`` (the fixed point is not one of the longer map: not expected).
     """
-    d = float(np.hypot(*walker.points(x)["swing_foot"][:2]))  # sagittal (3D: width apart)
-    L = float(walker.params["leg_length_m"])
-    return float(2.0 * np.arcsin(min(1.0, d / (2.0 * L))))
+    if not steps_per_map or int(steps_per_map) == walker.steps_per_map:
+        return walker, res
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
+    from walkerlab.config import FixedPointSettings
+
+    fp = scene.fixedpoint or FixedPointSettings()
+    try:
+        long = walker.with_steps_per_map(int(steps_per_map))
+        return long, find_fixed_point(long, res.x, _solver(scene), xtol=fp.tolerance,
+                                      fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
+                                      fd_check=False)
+    except ValueError as exc:
+        raise PointOutcome("invalid_config", f"the study's map: {exc}") from None
+    except FixedPointNotFound as exc:
+        raise PointOutcome("no_fixed_point", f"the gait on the study's map of "
+                           f"{steps_per_map} steps: {exc}", residual=exc.residual) from None
 
 
-def _state_columns(walker, x, prefix: str = "") -> dict:
-    return {prefix + state_column(n, u): float(v)
-            for n, u, v in zip(walker.state_names(), walker.state_units(), x)}
-
-
-def _fp_columns(walker, res) -> dict:
-    cols = _state_columns(walker, res.x)
-    mult = np.asarray(res.multipliers_variational, complex)
-    for k in range(len(walker.state_names())):
-        z = mult[k] if k < mult.size else complex(math.nan, math.nan)
-        cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
-    # per step: a stride map's period (legs that differ) is two steps'
-    cols.update(step_period_s=float(res.period_s) / walker.steps_per_map,
-                residual=float(res.residual),
-                max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
-                map_evaluations=float(res.iterations),
-                variational_maps=float(res.variational_maps), nfev=float(res.nfev))
-    ctrl = getattr(getattr(walker, "actuators", None), "controller", None)
-    if ctrl is not None:  # virtual constraints: the restricted map beside the full one
-        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
-
-        z = zero_dynamics(ctrl)
-        cols.update(delta2=z.delta2, v_minus=z.v_minus, v_max=z.v_max,
-                    existence_margin=z.existence_margin, hzd_step_period_s=z.step_period_s)
-    return cols
-
-
-def _ground_columns(ground) -> dict:
-    """The chosen gait's ground verdict: the stance foot's smallest normal force and the
-    friction it needs against the ground's (NaN where not checked)."""
-    fr = getattr(ground, "friction", None)
-    inside = None if fr is None else fr.inside
-    return {"min_normal_force_n": float(getattr(ground, "min_normal_force_n", math.nan)),
-            "max_friction_ratio": math.nan if fr is None else float(fr.max_ratio),
-            "friction_coefficient": math.nan if fr is None else float(fr.mu),
-            "inside_friction_cone": math.nan if inside is None else float(inside)}
-
-
-# ----------------------------------------------------------------------------- stages
 def fixedpoint_point(scene: Scene, guess, options: dict):
     """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``): the gait
     ``walkerlab fixedpoint`` finds and chooses for the point's scene (:func:`scene_gait`;
-    ``guess`` is not used: a point's row is a function of the point alone).
+    ``guess`` is not used: a point's row is a function of the point alone), on the study's
+    one Poincaré map (``options["steps_per_map"]``, :func:`on_study_map`).
 
     Returns
     -------
@@ -314,7 +299,7 @@ def fixedpoint_point(scene: Scene, guess, options: dict):
         The chosen gait's.
     """
     walker, search, source = scene_gait(scene, options)
-    res = search.result
+    walker, res = on_study_map(scene, walker, search.result, (options or {}).get("steps_per_map"))
     cols = _fp_columns(walker, res)
     cols.update(_ground_columns(search.gait.ground))
     cols.update(outcome="ok", guess_source=source,

@@ -75,6 +75,7 @@ from walkerlab.io.sweep_store import (
     complete_sweep,
     partial_path,
 )
+from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.outcomes import OUTCOMES, STAGES, STRING_COLUMNS, walker_columns
 from walkerlab.studies.params import ParamAxis, SweepError, grid_points
 from walkerlab.studies.points import (
@@ -369,7 +370,8 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
                            chunk_size, progress, on_chunk, pool, n_total)
 
 
-def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_chains):
+def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_chains,
+                steps_per_map=None):
     """The sweep's partial file: resumed (its plan and each chain's checkpoint) or created
     with a new plan of ``n_chains`` chains.
 
@@ -390,7 +392,8 @@ def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_c
     base = scene.model_dump(mode="json")
     plan = [[i for i, _ in c] for c in plan_chunks(axes, base, frozenset(), chunk_size,
                                                    n_chains)]
-    return SweepStore.create(out_path, scene, stage, axes, columns, opts, key, plan), plan, {}
+    return SweepStore.create(out_path, scene, stage, axes, columns, opts, key, plan,
+                             steps_per_map=steps_per_map), plan, {}
 
 
 def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
@@ -402,11 +405,15 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     if resume and out_path.is_file() and not partial_path(out_path).is_file():
         if complete_sweep(out_path, key):
             return out_path
-    store, plan, start = _open_store(scene, axes, stage, out_path, resume, opts, key,
-                                     chunk_size, 1 if scheduler is None and workers <= 1
-                                     else max(2, workers))
     values_of = dict(enumerate(grid_points(axes)))
     origin = scene.name or "<scene>"
+    steps = None
+    if stage == "fixedpoint":  # one map for every point's multipliers, decided before any
+        steps = study_steps_per_map(base, paths, values_of.values(), origin)
+        opts = {**opts, "steps_per_map": steps}  # not in the input hash: the scene decides it
+    store, plan, start = _open_store(scene, axes, stage, out_path, resume, opts, key,
+                                     chunk_size, 1 if scheduler is None and workers <= 1
+                                     else max(2, workers), steps)
     offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
     done = {i for c, chain in enumerate(plan) for i in chain[:offset[c]]}
     chains = [[Task(stage, base, tuple(paths),

@@ -192,7 +192,8 @@ def ideal_gait(scene):
         zd = zero_dynamics(ctrl)
         guess = zd.x_plus if zd.exists else None
     return find_gaits(iw, Solver.from_settings(sc.solver), guess,
-                      policy=fp.gait, other_gait=False, xtol=fp.tolerance,
+                      policy=fp.gait, other_gait=False, partner_if_needed=fp.other_gait,
+                      xtol=fp.tolerance,
                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
 
 

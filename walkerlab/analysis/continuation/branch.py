@@ -23,8 +23,11 @@ folds because ``p`` is an unknown like the state.
 Special points (test functions on the reduced Jacobian ``M = F_z + I``, whose eigenvalues
 are the Floquet multipliers without the one that is zero by construction):
 
-- fold: a multiplier through +1; period doubling: through -1; Neimark-Sacker: a complex
-  pair through the unit circle;
+- fold: a multiplier through +1 where the branch turns back in the parameter (the
+  tangent's parameter component changes sign); branch point: a multiplier through +1
+  where the branch passes straight through (a transcritical or pitchfork bifurcation:
+  another branch crosses this one); period doubling: through -1; Neimark-Sacker: a
+  complex pair through the unit circle;
 - branch end: the step map fails (fall, no heel strike, swing foot scuffing, the knee
   strike lost, the section's coordinates leaving their domain) - located by bisection in
   the arclength down to ``1e-9``; or a validity check turning negative
@@ -80,7 +83,7 @@ from walkerlab.analysis.continuation.validity import VALIDITY
 __all__ = ["Branch", "ContinuationResult", "SPECIAL_KINDS", "continue_branch", "continuation",
            "first_point", "fixed_point_at"]
 
-SPECIAL_KINDS = ("fold", "period_doubling", "neimark_sacker", "branch_end")
+SPECIAL_KINDS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "branch_end")
 
 
 @dataclass
@@ -125,6 +128,9 @@ class ContinuationResult:
     start : float             the scene's own value of the parameter
     wall_time_s : float
     maps, variational_maps : int      step maps integrated (plain / with variational eqs)
+    steps_per_map : int       steps of the one Poincaré map of every branch (1: a step, 2:
+                              a stride; :meth:`WalkerFamily.steps`): a period-``k``
+                              branch's multipliers are of ``k`` such maps
     """
 
     path: str
@@ -137,6 +143,7 @@ class ContinuationResult:
     wall_time_s: float = 0.0
     maps: int = 0
     variational_maps: int = 0
+    steps_per_map: int = 1
 
 
 
@@ -277,6 +284,8 @@ def _specials_between(sys: BranchSystem, a: BranchPoint, b: BranchPoint, u: np.n
             sp = locate_special(sys, a, s_b, kind, u, k) if at_bound is None else \
                 locate_on_bound(sys, a, b, kind, k)
             if sp is not None:
+                if kind == "fold" and _passes_through(a, b):
+                    sp = dataclasses.replace(sp, kind="branch_point")
                 specials.append(sp)
                 if sp.point is not None:  # the branch passes through it
                     pts.append(dataclasses.replace(sp.point, tangent=a.tangent))
@@ -290,6 +299,16 @@ def _specials_between(sys: BranchSystem, a: BranchPoint, b: BranchPoint, u: np.n
             pts.append(sp.point if sp is not None else b)
             return True
     return False
+
+
+def _passes_through(a: BranchPoint, b: BranchPoint) -> bool:
+    """Whether the branch passes straight through between ``a`` and ``b`` (the parameter
+    goes on the same way: the tangents' parameter components, oriented along the branch,
+    have one sign) - a multiplier through +1 there is then a branch point (transcritical
+    or pitchfork: another branch crosses this one), not a fold (a turning point, where the
+    parameter turns back; Kuznetsov 2004, sec. 10.2 and 10.4; Allgower & Georg 2003,
+    ch. 8)."""
+    return float(a.tangent[-1]) * float(b.tangent[-1]) > 0
 
 
 def first_point(family: WalkerFamily, p: float, x: np.ndarray, k: int, p_scale: float
@@ -401,7 +420,7 @@ def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple
         path=family.path, unit=unit, state_names=w.state_names(),
         state_units=w.state_units(), branches=branches, specials=specials, start=p0,
         wall_time_s=time.perf_counter() - t0, maps=stats.get("maps", 0),
-        variational_maps=stats.get("variational_maps", 0))
+        variational_maps=stats.get("variational_maps", 0), steps_per_map=family.steps(w))
 
 
 def _doubled(q: BranchPoint) -> BranchPoint:

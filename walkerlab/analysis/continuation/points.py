@@ -85,7 +85,9 @@ class SpecialPoint:
 
     Attributes
     ----------
-    kind : str          ``fold``, ``period_doubling``, ``neimark_sacker`` or ``branch_end``
+    kind : str          ``fold``, ``branch_point`` (a multiplier through +1, the branch
+                        passing through), ``period_doubling``, ``neimark_sacker`` or
+                        ``branch_end``
     p : float           located parameter value [the field's unit]
     period : int        steps of the branch it lies on (1, 2, 4, ...)
     x : ndarray (2n,)   state (NaN for a branch end without a gait)

@@ -115,7 +115,9 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     (:func:`gait_ground_contact`; each :class:`~walkerlab.analysis.gait.search.Gait` carries
     its verdict and the selection prefers the gaits that need no pull).  ``other_gait``
     (default ``fixedpoint.other_gait``): look for the other gait of the pair even when the
-    choice does not need it; ``partner_off_ground``: without it, still when the first gait
+    choice does not need it (the scene's ``fixedpoint.other_gait: false``: not even when it
+    does, :func:`~walkerlab.analysis.gait.search.find_gaits` ``partner_if_needed``);
+    ``partner_off_ground``: without it, still when the first gait
     needs a pull or more friction than the ground has
     (:func:`~walkerlab.analysis.gait.search.find_gaits`).
 
@@ -144,7 +146,8 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
                         fd_check=fd_check,
                         ground_check=(lambda x: gait_ground_contact(scene, walker, x))
-                        if ground else None, partner_off_ground=partner_off_ground)
+                        if ground else None, partner_off_ground=partner_off_ground,
+                        partner_if_needed=fp.other_gait)
     return walker, search
 
 

@@ -183,7 +183,8 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
                policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
                fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
                time_unit: str = "s", seeds: bool = True,
-               ground_check=None, partner_off_ground: bool = False) -> GaitSearch:
+               ground_check=None, partner_off_ground: bool = False,
+               partner_if_needed: bool = True) -> GaitSearch:
     """Find the walker's period-1 gait(s) and choose one.
 
     Parameters
@@ -219,6 +220,14 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         the ground to pull or more friction than it has (with ``ground_check``, under
         ``stable``): the choice ``other_gait`` would make, at the cost of a second search
         only where it can change (a sweep point).
+    partner_if_needed : bool
+        Without ``other_gait``: still look for the other gait (and, under ``stable``, the
+        seeds) where the choice needs it (``stable`` and the first gait unstable or off
+        the ground).  False (a scene's ``fixedpoint.other_gait: false``): never - the gait
+        from the guess is the one (a note says so), as for a 3D walker whose passive gaits
+        are all unstable, or a family of gaits (the 3D wheel's headings) that is no pair;
+        only ``long_period``/``short_period``, which cannot choose without both, still
+        look.
 
     Returns
     -------
@@ -242,7 +251,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         with search_budget():  # every start, seed and root finder: one time budget
             return _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step,
                                max_step_time, fd_check, time_unit, seeds, ground_check,
-                               partner_off_ground)
+                               partner_off_ground, partner_if_needed)
     except (SearchGaveUp, FixedPointGaveUp) as exc:
         why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
         raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
@@ -250,7 +259,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
 
 def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_step_time,
                 fd_check, time_unit, seeds, ground_check=None,
-                partner_off_ground=False) -> GaitSearch:
+                partner_off_ground=False, partner_if_needed=True) -> GaitSearch:
     s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
                                      "max_step_time": max_step_time, "fd_check": fd_check})
     if guess is not None:
@@ -283,10 +292,13 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
             and policy == "stable":
         first.ground = ground_check(first.result.x)
         off_ground = not (first.on_real_ground and first.inside_friction_cone)
-    if other_gait or policy in ("long_period", "short_period") or (
-            policy == "stable" and (not first.result.stable or off_ground)):
+    needed = policy == "stable" and (not first.result.stable or off_ground)
+    if other_gait or policy in ("long_period", "short_period") or (needed and partner_if_needed):
         s.other_gait()
-    if policy == "stable" and seeds and s.seeded is False \
+    elif needed:  # fixedpoint.other_gait: false - the scene's word is kept
+        s.notes.append("the other gait of the pair and the seeds were not tried "
+                       "(fixedpoint.other_gait: false)")
+    if policy == "stable" and seeds and s.seeded is False and (other_gait or partner_if_needed) \
             and not any(g.result.stable for g in s.found):
         # the guess and its partner are both unstable: the seeds may reach a stable gait
         # (a gait found already is not taken twice: the seeds go on to a new one)

@@ -77,7 +77,7 @@ def load_bifurcation_summary(path: Path) -> BifurcationSummary:
         dim = "slope" if ppath == SLOPE_PATH else ppath
         values = f[dim][()]
         data = {"parameter_path": ppath, "parameter_unit": str(f[dim].attrs.get("unit", "deg")),
-                dim: values}
+                dim: values, "steps_per_map": int(f.attrs.get("steps_per_map", 0))}
         for name in ("onset/onset_slope", "onset/onset_value"):
             if name in f:
                 data[name] = f[name][()]
@@ -141,6 +141,8 @@ def bifurcation_writer(res):  # res: walkerlab.studies.bifurcation.BifurcationRe
         put(f, "stats/wall_time", res.wall_time_s, "s", f"wall time per {what}", dims=s)
         f.attrs["n_transient"] = res.n_transient
         f.attrs["n_keep"] = res.n_keep
+        # the one map every value's multipliers are of (1: a step, 2: a stride)
+        f.attrs["steps_per_map"] = int(getattr(res, "steps_per_map", 1))
 
     return writer
 
@@ -156,7 +158,8 @@ def load_bifurcation(path: Path) -> dict:
         dim = parameter_dim(ppath)
         unit = f[dim].attrs.get("unit", "deg")
         out.update(parameter_path=ppath, parameter_dim=dim,
-                   parameter_unit=unit.decode() if isinstance(unit, bytes) else str(unit))
+                   parameter_unit=unit.decode() if isinstance(unit, bytes) else str(unit),
+                   steps_per_map=int(f.attrs.get("steps_per_map", 0)))  # 0: not recorded
 
         def visit(name, obj):
             if isinstance(obj, h5py.Dataset):

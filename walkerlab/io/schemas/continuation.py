@@ -4,16 +4,20 @@ loader side by side.
 Layout
 ------
 - root attributes ``parameter_path``, ``parameter_unit``, ``state_names``,
-  ``parameter_start`` (the scene's own value, where the continuation started);
-- ``branches/<i>/`` for each branch ``i`` (attribute ``branch_period``: 1, 2, 4 steps):
+  ``parameter_start`` (the scene's own value, where the continuation started),
+  ``steps_per_map`` (steps of the one Poincaré map ``P`` of every branch: 1 a step, 2 a
+  stride; absent in artifacts written before it was recorded);
+- ``branches/<i>/`` for each branch ``i`` (attribute ``branch_period``: 1, 2, 4 maps):
   ``param`` [field unit] (points,), ``state/<name>`` [rad or rad/s] (points,) just after
-  heel strike, ``orbit/<name>`` (points, k) after each of the orbit's heel strikes,
-  ``period`` [s] (duration of the branch's ``k`` steps), ``multipliers/real``
+  heel strike, ``orbit/<name>`` (points, k) after each of the orbit's maps,
+  ``period`` [s] (duration of the branch's ``k`` maps), ``multipliers/real``
   and ``multipliers/imag`` (points, 2n) of ``D(P^k)``, ``stable`` (points,) 0/1;
-- ``special_points/``: ``kind`` (strings ``fold``, ``period_doubling``,
-  ``neimark_sacker``, ``branch_end``), ``param`` [field unit], ``period`` (1, 2, 4: the
-  branch it lies on), ``branch`` (index into ``branches``), ``cause`` (why a branch ends;
-  else empty), ``state/<name>``, ``multipliers/real``/``imag`` (specials, 2n);
+- ``special_points/``: ``kind`` (strings ``fold`` (a multiplier through +1, the branch
+  turning back), ``branch_point`` (through +1, the branch passing through: transcritical
+  or pitchfork), ``period_doubling``, ``neimark_sacker``, ``branch_end``), ``param``
+  [field unit], ``period`` (1, 2, 4: the branch it lies on), ``branch`` (index into
+  ``branches``), ``cause`` (why a branch ends; else empty), ``state/<name>``,
+  ``multipliers/real``/``imag`` (specials, 2n);
 - ``two_parameter/<j>/`` (optional): ``param`` [field unit], ``param2`` [second field's
   unit] of a fold or period-doubling curve (attributes ``kind``, ``period``, ``path2``,
   ``unit2``), ``critical_multiplier/real``/``imag``;
@@ -43,8 +47,10 @@ def continuation_writer(res, curves=()):
     """``writer(h5file)`` for a :class:`walkerlab.analysis.continuation.branch.ContinuationResult`
     and optional :class:`~walkerlab.analysis.continuation.two_parameter.TwoParameterCurve` s."""
     from walkerlab.io.artifacts import put
+    from walkerlab.numerics import map_name
 
     names, units = list(res.state_names), list(res.state_units)
+    per = map_name(getattr(res, "steps_per_map", 1))
 
     def states(g, X, what):
         X = np.asarray(X, float).reshape(-1, len(names))
@@ -61,6 +67,7 @@ def continuation_writer(res, curves=()):
         f.attrs["parameter_unit"] = res.unit
         f.attrs["state_names"] = names
         f.attrs["parameter_start"] = float(res.start)
+        f.attrs["steps_per_map"] = int(getattr(res, "steps_per_map", 1))
         for i, br in enumerate(res.branches):
             g = f.create_group(f"branches/{i}")
             g.attrs["branch_period"] = int(br.period)
@@ -68,11 +75,12 @@ def continuation_writer(res, curves=()):
             states(g, [q.x for q in br.points], f"period-{br.period} fixed point")
             orb = np.array([q.orbit for q in br.points], float)  # (points, k, 2n)
             for k, (n, u) in enumerate(zip(names, units)):
-                put(g, f"orbit/{n}", orb[:, :, k], u, f"{n} just after each of the "
-                    f"orbit's {br.period} heel strikes (points, heel strike)")
+                put(g, f"orbit/{n}", orb[:, :, k], u, f"{n} at the start of each of the "
+                    f"orbit's {br.period} map(s) of a {per} (points, map)")
             put(g, "period", [q.period_s for q in br.points], "s",
-                f"duration of the {br.period} step(s) of the gait")
-            mults(g, [q.multipliers for q in br.points], f"the {br.period}-step map")
+                f"duration of the {br.period} {per}(s) of the gait")
+            mults(g, [q.multipliers for q in br.points],
+                  f"{br.period} composed map(s) of a {per} (per {per} for period 1)")
             put(g, "stable", [int(q.stable) for q in br.points], "-",
                 "1 if every multiplier is inside the unit circle")
             for k, (u, what) in GAIT_MEASURES.items():
@@ -81,7 +89,7 @@ def continuation_writer(res, curves=()):
         sp = res.specials
         g = f.create_group("special_points")
         put(g, "kind", [s.kind for s in sp] or np.zeros(0, "S1"), "-",
-            "fold, period_doubling, neimark_sacker or branch_end")
+            "fold, branch_point, period_doubling, neimark_sacker or branch_end")
         put(g, "param", np.array([s.p for s in sp], float), res.unit,
             f"located value of {res.path}")
         put(g, "period", np.array([s.period for s in sp], int), "steps",
@@ -118,6 +126,8 @@ class ContinuationData:
     ``special``: dict of arrays ``kind``, ``param``, ``period``, ``branch``, ``cause``,
     ``states`` (name -> (S,)), ``multipliers`` (S, 2n).  ``curves``: list of dicts ``kind``,
     ``period``, ``param``, ``param2``, ``path2``, ``unit2``, ``multiplier``.
+    ``steps_per_map``: steps of the one Poincaré map of every branch (1 a step, 2 a
+    stride; 0: not recorded, an artifact written before).
     """
 
     path: str
@@ -127,6 +137,7 @@ class ContinuationData:
     branches: list = field(default_factory=list)
     special: dict = field(default_factory=dict)
     curves: list = field(default_factory=list)
+    steps_per_map: int = 0
 
     def state_at(self, value: float, branch: int = 0) -> np.ndarray:
         """The state (2n,) [rad, rad/s] of branch ``branch`` at the parameter ``value`` (in
@@ -174,7 +185,8 @@ def load_continuation(path: Path) -> ContinuationData:
     with open_artifact(Path(path), STAGE) as f:
         names = [_s(n) for n in f.attrs["state_names"]]
         out = ContinuationData(_s(f.attrs["parameter_path"]), _s(f.attrs["parameter_unit"]),
-                               names, float(f.attrs["parameter_start"]))
+                               names, float(f.attrs["parameter_start"]),
+                               steps_per_map=int(f.attrs.get("steps_per_map", 0)))
 
         def mult(g):
             return np.asarray(g["multipliers/real"][()]) + 1j * np.asarray(

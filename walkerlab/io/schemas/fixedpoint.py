@@ -148,6 +148,7 @@ def _write_result(g, walker, res, guess) -> None:
     g.attrs["variant"] = walker.variant
     g.attrs["roles"] = list(walker.roles)
     g.attrs["legs_by_role"] = json.dumps(walker.role_to_leg("leg2"))
+    g.attrs["steps_per_map"] = int(walker.steps_per_map)  # the multipliers' map: step, stride
     for name, val, u in zip(names, res.x, units):
         put(g, f"fixed_point/{name}", float(val), u, f"{name} just after heel strike")
     for name, val, u in zip(names, guess, units):
@@ -342,6 +343,9 @@ class GaitResult:
     ground_contact : GroundContactRecord or None
         Whether this gait needs only a ground that pushes (``gaits/<label>/ground_contact/``;
         None where not checked: equation variants, older artifacts).
+    steps_per_map : int
+        Steps of the Poincaré map the multipliers are of (1: a step, 2: a stride;
+        attribute ``steps_per_map``, in older artifacts from ``stride_period``).
     """
 
     x: np.ndarray
@@ -360,6 +364,7 @@ class GaitResult:
     ground_contact: GroundContactRecord | None = None
     neutral: tuple = ()
     jacobian: np.ndarray | None = None
+    steps_per_map: int = 1
 
     def max_abs_multiplier(self) -> float:
         """Largest |Floquet multiplier| (variational), the neutral ones (:attr:`neutral`:
@@ -387,7 +392,9 @@ def _gait(g, names: list[str]) -> GaitResult:
         stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")),
         ground_contact=_ground(g), **_stride(g),
         neutral=tuple(str(v) for v in g["floquet"].attrs.get("neutral", ())),
-        jacobian=g["floquet/variational/jacobian"][()])
+        jacobian=g["floquet/variational/jacobian"][()],
+        steps_per_map=int(g.attrs.get("steps_per_map", len(g["steps/period"])
+                                      if "stride_period" in g else 1)))
 
 
 def _stride(g) -> dict:

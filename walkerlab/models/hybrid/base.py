@@ -48,7 +48,7 @@ Contract of :class:`HybridWalker` (nothing outside the model layer may assume mo
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -323,6 +323,37 @@ class HybridWalker:
         if self.cycle is not None:
             return len(self.cycle)
         return 1 if self.mirror is None else 2
+
+    def with_steps_per_map(self, steps: int) -> HybridWalker:
+        """This walker with a Poincaré map of ``steps`` steps: its own map composed
+        ``steps / steps_per_map`` times (:attr:`cycle` the walkers of those steps, in order,
+        :meth:`for_step`), so that a study whose members differ (a 3D walker's hip width
+        from zero, a step map, to any other, a stride) compares one map at every point.
+        The fixed points are the same; the Floquet multipliers are the ``steps /
+        steps_per_map``-th powers of the walker's own (per stride: the squares of per step).
+
+        Parameters
+        ----------
+        steps : int
+            Steps of the map wanted (>= 1).
+
+        Returns
+        -------
+        HybridWalker
+            This walker itself when its map already has ``steps`` steps.
+
+        Raises
+        ------
+        ValueError
+            ``steps`` is not a multiple of :attr:`steps_per_map` (one line).
+        """
+        own = self.steps_per_map
+        if steps == own:
+            return self
+        if steps < 1 or steps % own:
+            raise ValueError(f"a map of {steps} steps is not made of this walker's maps of "
+                             f"{own} step{'s' if own > 1 else ''}")
+        return replace(self, cycle=tuple(self.for_step(k) for k in range(steps)))
 
     @property
     def n_coordinates(self) -> int:
