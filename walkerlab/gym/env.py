@@ -103,6 +103,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from .episode_state import capture, restore
+
 __all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
            "end_periods"]
 
@@ -304,9 +306,15 @@ class WalkerEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
     def __reduce__(self):
-        """Pickled as the arguments it was built from (a vector env's subprocess rebuilds
-        it; its episode state is not carried: reset it after unpickling)."""
-        return (_rebuild_env, (type(self), self._init_args))
+        """Pickled (and copied by ``copy.deepcopy``) as the arguments it was built from and
+        its episode (:func:`walkerlab.gym.episode_state.capture`): the copy is built again
+        from the arguments and continues the episode bit for bit."""
+        return (_rebuild_env, (type(self), self._init_args), capture(self))
+
+    def __setstate__(self, state: dict) -> None:
+        """The episode of a pickled or copied environment
+        (:func:`walkerlab.gym.episode_state.restore`)."""
+        restore(self, state)
 
     def __init__(self, scene, view: str = "rigid", control_period_s: float = 0.01,
                  max_episode_steps: int | None = 1000, max_torque_n_m=None,
