@@ -89,7 +89,9 @@ Info (the dict ``reset`` and ``step`` return, the same keys in both; :data:`INFO
   ``heel_strike_loss``: its collisions are the contact forces' work, not a ledger term).
 
 ``reset(seed=...)`` draws the terrain seed and the start's noise from the seed: the same
-seed, the same episode bit for bit.
+seed, the same episode bit for bit.  ``copy.deepcopy`` or a pickle round trip of a
+mid-episode environment continues its episode bit for bit (:mod:`walkerlab.gym.
+episode_state`).
 """
 
 from __future__ import annotations

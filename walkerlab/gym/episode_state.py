@@ -59,7 +59,8 @@ def capture(env) -> dict | None:
     else:
         h = s.hook
         out["contact"] = {
-            "roughness": s._roughness, "seed": s._seed, "laid": s._laid, "lanes": tuple(a.copy() for a in s._lanes),
+            "roughness": s._roughness, "seed": s._seed, "laid": s._laid,
+            "lanes": tuple(a.copy() for a in s._lanes),
             "track": copy.deepcopy(s._track), "ended": s.ended, "failure": s.failure,
             "ledger": dict(s.ledger), "steps": s.steps, "t": float(h.t), "y": h.y.copy(),
             "keep": (h.stance, h.t_origin, h.ankle_on, h.step_s),
