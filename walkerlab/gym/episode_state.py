@@ -5,7 +5,8 @@
 The environment itself is rebuilt from the arguments it was built from (its compiled flows,
 the scene's generated code and compiled segments are not copied: the copy builds its own,
 from the same cache), then :func:`restore` puts the episode in it: the control periods
-counted, the reset's random generator, and the view's state.
+counted, the reset's random generator (``np_random``; the copy's ``np_random_seed`` reads
+-1, gymnasium's value for a generator set directly), and the view's state.
 
 - Rigid view (:class:`walkerlab.gym.rigid_view.RigidView`): the state, time, stance leg,
   phase, stance foot, the step's start and its control periods, the ledger; the step's walker
@@ -44,11 +45,12 @@ _HOOK = ("t_strike", "resume", "pulse_end", "pushed", "term", "msg", "event", "n
 
 def capture(env) -> dict | None:
     """The episode of ``env`` (a :class:`~walkerlab.gym.env.WalkerEnv`) as plain data
-    (numbers, arrays, text, tuples, dicts), or None before its first reset."""
-    out = {"np_random": env._np_random,
-           "np_random_seed": getattr(env, "_np_random_seed", None)}
-    if not env._has_reset:
-        return out
+    (numbers, arrays, text, tuples, dicts, the reset's ``numpy.random.Generator``); an
+    empty dict before its first reset."""
+    if not env._has_reset:  # (its generator, made on first use, is drawn afresh)
+        return {}
+    # the reset's generator (gymnasium's public property: made by the reset, read as it is)
+    out = {"np_random": env.np_random}
     s = env.sim
     out.update(elapsed=env._elapsed, terrain_seed=env.terrain_seed, hip_x=env._hip_x,
                checked_start=env._checked_start)
@@ -78,11 +80,9 @@ def restore(env, state: dict) -> None:
         On a height profile, the step walked again from its start does not end on the
         state copied (one line; not met on the shipped scenes).
     """
-    env._np_random = state["np_random"]
-    if "np_random_seed" in state and hasattr(env, "_np_random_seed"):
-        env._np_random_seed = state["np_random_seed"]
-    if "elapsed" not in state:
+    if not state:  # never reset: it still asks for a reset
         return
+    env.np_random = state["np_random"]  # (gymnasium's setter: np_random_seed reads -1)
     env._elapsed, env.terrain_seed = state["elapsed"], state["terrain_seed"]
     env._hip_x, env._checked_start = state["hip_x"], state["checked_start"]
     if env.view == "rigid":
