@@ -5,10 +5,11 @@ where every other walkerlab error is one line ``error: ...``;
 :func:`usage_errors_in_one_spelling` makes a usage error that line too, where typer shows it
 through ``typer.rich_utils.rich_format_error`` (a typer without it keeps its own box).
 
-No private name of typer or click is read or replaced here (``tests/test_layers.py``): the
-help of typer 0.2x beside click 8.2+ shows ``<bool>`` beside an on/off flag (``--force``,
-``--help``), typer's own rendering, left as it is (a patch of ``TyperOption.
-display_type_rich`` hid it and broke the CLI's import on typer versions without it).
+No private name of typer or click is read or replaced here (tests/test_config_messages.py):
+the help of typer 0.2x beside click 8.2+ shows ``<bool>`` beside an on/off flag
+(``--force``, ``--help``), typer's own rendering, left as it is (a patch of
+``TyperOption.display_type_rich`` hid it and broke the CLI's import on typer versions
+without it).
 """
 
 from __future__ import annotations
