@@ -199,10 +199,29 @@ def test_a_bad_slopes_option_is_quoted_as_typed(tmp_path):
     assert rc == 1 and err == "error: --slopes '1:5': a range is START:STOP:STEP"
 
 
-def test_help_shows_flags_without_a_value():
+def test_help_lists_the_options_and_their_value_types():
     r = CliRunner().invoke(app, ["simulate", "--help"], env={"COLUMNS": "120"})
     assert r.exit_code == 0
-    assert "<bool>" not in r.stdout and "--force" in r.stdout and "<int>" in r.stdout
+    assert "--force" in r.stdout and "<int>" in r.stdout
+
+
+def test_the_cli_uses_no_private_typer_names():
+    """Before: the CLI replaced ``TyperOption.display_type_rich`` (typer's internals, to hide
+    ``<bool>`` beside flags in ``--help``), and its import crashed on typer versions without
+    it (0.27).  Now no method of typer's classes is the package's, and no source file of
+    the package reads a private name (``._x``) of typer or click."""
+    import re
+
+    import typer.core
+
+    for cls in (typer.core.TyperOption, typer.core.TyperArgument, typer.core.TyperCommand,
+                typer.core.TyperGroup):
+        for name, value in vars(cls).items():
+            assert not getattr(value, "__module__", "").startswith("walkerlab"), (cls, name)
+    private = re.compile(r"\b(typer|click|_click|core|rich_utils|Typer\w*)\._[a-z]")
+    bad = [f"{f.relative_to(ROOT)}:{i}" for f in (ROOT / "walkerlab").rglob("*.py")
+           for i, line in enumerate(f.read_text().splitlines(), 1) if private.search(line)]
+    assert not bad, bad
 
 
 def test_an_integer_field_over_a_range_of_whole_numbers(tmp_path):

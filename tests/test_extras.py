@@ -56,6 +56,28 @@ def test_every_extra_is_named_by_its_purpose_and_the_tests_get_all_but_numbalsod
     assert {_name(r) for r in extras["test"]} >= {"pytest", "pytest-xdist"}
 
 
+def test_the_gym_and_test_extras_bring_gymnasiums_mujoco_part_for_walker2d():
+    """``gym.make("Walker2d-v5")``, which the docs and ``scripts/bench_gym.py`` compare the
+    walker against, needs mujoco and imageio: ``gymnasium[mujoco]`` (before: ``gymnasium``
+    alone, and Walker2d failed on ``import imageio``)."""
+    extras = PROJECT["optional-dependencies"]
+    for name in ("gym", "test", "docs"):
+        assert any(r.replace(" ", "").startswith("gymnasium[mujoco]") for r in extras[name]), name
+
+
+def test_ci_runs_the_main_job_on_the_lowest_versions_pyproject_allows():
+    """The declared versions are the tested versions: after the quick suite, .ci/run installs
+    the main job with uv's lowest-direct resolution in a second venv and runs it (before:
+    ``typer>=0.12`` and ``numpy>=1.26`` were declared, and the CLI did not start on them)."""
+    ci = (ROOT / ".ci" / "run").read_text()
+    lines = ci.splitlines()
+    quick = lines.index(". .venv/bin/activate && pip install -e '.[test]' && pytest")
+    rest = "\n".join(lines[quick + 1:])
+    assert "pip install --quiet uv" in rest
+    assert "--resolution lowest-direct -e ." in rest
+    assert 'walkerlab" report --runs-dir "$lowest/runs"' in rest
+
+
 def test_the_readme_installs_the_main_job_then_the_tests_and_ci_runs_that_command():
     readme = (ROOT / "README.md").read_text()
     first, second = _commands(readme)[:2]

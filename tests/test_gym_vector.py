@@ -679,3 +679,36 @@ def test_the_vector_benchmarks_speedup_pairs_each_round_with_its_own_single_env(
     res = gym_vector.bench_vector(num_envs=2, steps=5, repeats=3, warmup=0)
     assert res["single_steps_per_s"] == 2.0 and res["native_steps_per_s"] == 10.0
     assert res["speedup_native"] == 3.0
+
+
+def test_the_native_vector_envs_first_batched_step_says_in_one_line_when_it_compiles(
+        monkeypatch, capfd):
+    """Its first batched step compiles its kernels (about 13 s on an idle machine, once):
+    a first step still running after ``COMPILE_NOTICE_S`` says so in one line on stderr; a
+    quick first step and every later step say nothing."""
+    import time
+
+    from walkerlab.gym import rigid_rows, vector
+
+    envs = _native(2)
+    envs.reset(seed=0)
+    real = vector._advance_rows()
+
+    def slow(*args, **kwargs):  # a first call as long as a compile, scaled down
+        time.sleep(0.5)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(vector, "_ADVANCE_ROWS", slow)
+    monkeypatch.setattr(rigid_rows, "COMPILE_NOTICE_S", 0.05)
+    a = np.zeros((2, *envs.single_action_space.shape), np.float32)
+    capfd.readouterr()
+    envs.step(a)
+    envs.step(a)
+    err = capfd.readouterr().err
+    assert err.splitlines() == [rigid_rows.COMPILE_NOTICE]
+    quick = _native(2)  # a first step shorter than the wait: nothing said
+    quick.reset(seed=0)
+    monkeypatch.setattr(vector, "_ADVANCE_ROWS", real)
+    monkeypatch.setattr(rigid_rows, "COMPILE_NOTICE_S", 60.0)
+    quick.step(a)
+    assert capfd.readouterr().err == ""

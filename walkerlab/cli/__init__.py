@@ -13,7 +13,7 @@ module                    what
 ``options``               the shared arguments, loading the scene, the status line
 ``errors``                the exit policy (:func:`walkerlab.cli.errors.guard`)
 ``process``               process settings (OpenBLAS threads, numba cache) and --version
-``typer_flags``           the help shows on/off flags without a value type
+``typer_flags``           typer's usage errors as one line ``error: ...``
 ========================  ===========================================================
 
 Errors and exit codes
@@ -37,9 +37,8 @@ from walkerlab.cli import (
     commands_runs,
 )
 from walkerlab.cli.process import process_settings, single_threaded_blas, version_callback
-from walkerlab.cli.typer_flags import flags_take_no_value, usage_errors_in_one_spelling
+from walkerlab.cli.typer_flags import usage_errors_in_one_spelling
 
-flags_take_no_value()
 usage_errors_in_one_spelling()
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,

@@ -1,31 +1,20 @@
-"""Patches of typer's help and usage errors.
+"""typer's usage errors in walkerlab's one spelling.
 
-typer 0.29 with click 8.2+ shows ``<bool>`` beside ``--force`` and ``--help`` in ``--help``,
-as if they took a value; :func:`flags_take_no_value` makes them show none.  typer boxes a
-usage error under the title "Error" (click without rich prints ``Error: ...``) where every
-other walkerlab error is one line ``error: ...``; :func:`usage_errors_in_one_spelling` makes
-a usage error that line too.
+typer boxes a usage error under the title "Error" (click without rich prints ``Error: ...``)
+where every other walkerlab error is one line ``error: ...``;
+:func:`usage_errors_in_one_spelling` makes a usage error that line too, where typer shows it
+through ``typer.rich_utils.rich_format_error`` (a typer without it keeps its own box).
+
+No private name of typer or click is read or replaced here (tests/test_config_messages.py):
+the help of typer 0.2x beside click 8.2+ shows ``<bool>`` beside an on/off flag
+(``--force``, ``--help``), typer's own rendering, left as it is (a patch of
+``TyperOption.display_type_rich`` hid it and broke the CLI's import on typer versions
+without it).
 """
 
 from __future__ import annotations
 
 import sys
-
-
-def flags_take_no_value() -> None:
-    """``--help`` lists an on/off flag (``--force``, ``--help``) without a value type: typer
-    0.29 with click 8.2+ shows ``<bool>`` beside it, as if it took a value."""
-    from typer.core import TyperOption
-
-    shown = TyperOption.display_type_rich
-    if getattr(shown, "_walkerlab", False):
-        return
-
-    def display_type_rich(self, ctx):
-        return None if self.is_flag and self.metavar is None else shown(self, ctx)
-
-    display_type_rich._walkerlab = True
-    TyperOption.display_type_rich = display_type_rich
 
 
 def usage_errors_in_one_spelling() -> None:
@@ -77,10 +66,11 @@ class _PatchOnImport:
 
 def _one_line_usage_errors(rich_utils) -> None:
     """Patch ``rich_utils.rich_format_error`` (see :func:`usage_errors_in_one_spelling`)."""
-    import typer  # typer 0.29 vendors click (typer._click): no `import click` here, which
+    import typer  # typer 0.29 carries its own copy of click: no `import click` here, which
     # a fresh install does not have
 
-    if getattr(rich_utils.rich_format_error, "_walkerlab", False):
+    shown = getattr(rich_utils, "rich_format_error", None)
+    if shown is None or getattr(shown, "_walkerlab", False):
         return
 
     def plain_error(exc) -> None:  # a (vendored) click.ClickException

@@ -89,7 +89,9 @@ Info (the dict ``reset`` and ``step`` return, the same keys in both; :data:`INFO
   ``heel_strike_loss``: its collisions are the contact forces' work, not a ledger term).
 
 ``reset(seed=...)`` draws the terrain seed and the start's noise from the seed: the same
-seed, the same episode bit for bit.
+seed, the same episode bit for bit.  ``copy.deepcopy`` or a pickle round trip of a
+mid-episode environment continues its episode bit for bit (:mod:`walkerlab.gym.
+episode_state`).
 """
 
 from __future__ import annotations
@@ -102,6 +104,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+
+from .episode_state import capture, restore
 
 __all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
            "end_periods"]
@@ -304,9 +308,15 @@ class WalkerEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
     def __reduce__(self):
-        """Pickled as the arguments it was built from (a vector env's subprocess rebuilds
-        it; its episode state is not carried: reset it after unpickling)."""
-        return (_rebuild_env, (type(self), self._init_args))
+        """Pickled (and copied by ``copy.deepcopy``) as the arguments it was built from and
+        its episode (:func:`walkerlab.gym.episode_state.capture`): the copy is built again
+        from the arguments and continues the episode bit for bit."""
+        return (_rebuild_env, (type(self), self._init_args), capture(self))
+
+    def __setstate__(self, state: dict) -> None:
+        """The episode of a pickled or copied environment
+        (:func:`walkerlab.gym.episode_state.restore`)."""
+        restore(self, state)
 
     def __init__(self, scene, view: str = "rigid", control_period_s: float = 0.01,
                  max_episode_steps: int | None = 1000, max_torque_n_m=None,

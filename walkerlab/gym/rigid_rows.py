@@ -38,16 +38,44 @@ single walker's integrator (:class:`_Redo`).
 from __future__ import annotations
 
 import sys
+import threading
 
 import numpy as np
 
+from walkerlab import progress
 from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
 from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 
 from .rigid_view import _GL_W, _GL_X  # the ledger's Gauss-Legendre rule, the walker's own
 from .small_arrays import all_finite
 
-__all__ = ["advance_rows"]
+__all__ = ["COMPILE_NOTICE_S", "advance_rows", "compile_notice"]
+
+#: a first batched call still running after this long [s] is compiling its kernels (numba:
+#: about 13 s on an idle 2-core machine; about 2 s when its cache holds them): said in one line
+COMPILE_NOTICE_S = 3.0
+
+#: :func:`compile_notice`'s line
+COMPILE_NOTICE = ("walkerlab.gym: compiling the native vector env's batched step for this "
+                  "walker (numba, about 13 s once: numba's cache in the user cache keeps it)")
+
+
+def compile_notice(call, after_s: float | None = None):
+    """``call`` (:func:`advance_rows`) whose run says :data:`COMPILE_NOTICE` in one line
+    (:func:`walkerlab.progress.note`: stderr unless a sink takes it) when it is still running
+    after ``after_s`` [s] (default :data:`COMPILE_NOTICE_S`): the native vector env's first
+    batched step, whose kernels numba compiles (or loads from its cache) on first call."""
+    def first(*args, **kwargs):
+        wait = COMPILE_NOTICE_S if after_s is None else after_s
+        timer = threading.Timer(wait, progress.note, (COMPILE_NOTICE,))
+        timer.daemon = True
+        timer.start()
+        try:
+            return call(*args, **kwargs)
+        finally:
+            timer.cancel()
+    return first
+
 
 #: the ledger's 4-point Gauss-Legendre weights as floats (the walker's own rule)
 _GL_WL = _GL_W.tolist()

@@ -269,6 +269,7 @@ class WalkerVectorEnv(VectorEnv):
         #: every row and sub-environment (a step of all of them)
         self._all = (np.arange(n), list(self.envs))
         self._has_reset = False
+        self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.env.batch_parameters` of the walkers (False: not yet read)
         self._params: dict | None | bool = False
 
@@ -318,6 +319,11 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         advance_rows = _advance_rows()
+        if not self._batched_before:  # its kernels compiled or loaded: a long wait said
+            self._batched_before = True
+            from .rigid_rows import compile_notice  # (advance_rows' module: imported)
+
+            advance_rows = compile_notice(advance_rows)
         p = self._batch_parameters()
         if p is None:  # each walker's own begin and end of its period
             begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
