@@ -9,9 +9,8 @@ the same order of floating-point operations, so the two are compared exactly
 boundary does not change a float64 either, so it too is compared exactly.
 """
 
-from pathlib import Path
-
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
