@@ -6,36 +6,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from walkerlab.rigid_walker import STEP_TIME_LIMIT_S, positive, short
+
 if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
 __all__ = ["STEP_TIME_LIMIT_S", "check_target", "clear_step_failure", "positive", "short",
            "simulate_options"]
-
-#: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
-#: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
-#: search's budget (:data:`walkerlab.analysis.gait.poincare.ROOT_BUDGET_S`)
-STEP_TIME_LIMIT_S = 60.0
-
-
-def short(value) -> str:
-    """``repr(value)``, cut to 40 characters."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-def positive(value, name: str) -> float:
-    """``value`` as a positive finite float, else one line naming ``name``."""
-    import math
-    import numbers
-
-    from walkerlab.config import SceneError
-
-    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
-            or not math.isfinite(value) or value <= 0):
-        raise SceneError(f"{name}={short(value)}: give a positive number of seconds")
-    return float(value)
-
 
 def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
     """``(strides, sample_rate_hz)`` checked by the ``simulate`` section's own fields

@@ -42,17 +42,10 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
         each, unknown keys first with the closest field name); ``name`` not a string or not
         a safe folder name (empty, path separators).
     """
-    from walkerlab.config import Scene, SceneError, scene_from_dict
-    from walkerlab.config import load_scene as _load
+    from walkerlab.config import SceneError
+    from walkerlab.rigid_walker import scene_of
 
-    if isinstance(path_or_dict, Scene):
-        sc = path_or_dict
-    elif isinstance(path_or_dict, dict):
-        data = dict(path_or_dict)
-        data.setdefault("name", "scene")
-        sc = scene_from_dict(data)
-    else:
-        sc = _load(path_or_dict)
+    sc = scene_of(path_or_dict)
     if name is not None:
         from walkerlab.io.runpaths import check_name
 

@@ -36,7 +36,7 @@ Reward (Walker2d-v5's convention, every weight a keyword)::
 ``reward_fn(env, info) -> float`` in its place.
 
 Episode: from the scene's gait (its fixed point, found once per scene and process and
-cached; :meth:`walkerlab.api.walker.Walker.fixed_point`), leg1 swinging, unless
+cached; :meth:`walkerlab.rigid_walker.SceneWalker.fixed_point`), leg1 swinging, unless
 ``reset(options={"state": x})`` gives the state (the rigid walker's post-impact state (2n,),
 or in the contact view its floating state (N,)); ``start_noise`` (at most 1) multiplies the
 start's rates by ``1 + U(-s, s)`` drawn by the reset's seed, before the start is checked.
@@ -286,7 +286,7 @@ class WalkerEnv(gym.Env):
         The action's joints.
     state_names, observation_names : list of str
         The walker's state's names; the observation's (the state's, then the phase's).
-    gait : walkerlab.api.walker.Gait
+    gait : walkerlab.rigid_walker.Gait
         The scene's gait (the episodes' start).
 
     Raises
@@ -317,7 +317,7 @@ class WalkerEnv(gym.Env):
                  policy: str | None = None, compiled_step: bool = True):
         #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
-        from walkerlab.api.walker import Walker
+        from walkerlab.rigid_walker import SceneWalker, scene_of
         from walkerlab.walker.description import walker_data
 
         from .action import action_joints, action_limits, action_torques
@@ -328,7 +328,7 @@ class WalkerEnv(gym.Env):
         if policy not in (None, "scene"):
             raise ValueError(f"policy={policy!r}: give None or 'scene' (the scene's feedback "
                              "controller acting with the action)")
-        self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
+        self.rigid = SceneWalker(scene_of(scene if not isinstance(scene, Path) else str(scene)))
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
@@ -365,7 +365,7 @@ class WalkerEnv(gym.Env):
         #: the scene's feedback controller (virtual constraints; None: the scene has none):
         #: out of the walker's flow, the policy (:meth:`scene_policy`)
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
-        plant = self.rigid if vc is None else Walker.from_scene(_plant(sc))
+        plant = self.rigid if vc is None else SceneWalker(_plant(sc))
         model = plant.model
         self.joints = action_joints(sc, self.controller)
         if view == "rigid":
