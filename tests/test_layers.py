@@ -39,6 +39,31 @@ FRONT = ("cli", "api", "cli/bench.py")
 CHAINS = ("pipeline.py", "report_dag.py", "report.py")
 
 
+#: the floors of the package, bottom first: a module imports (at module level or inside a
+#: function) only modules of its own floor or of floors below it; every top-level package or
+#: module of ``walkerlab/`` stands on one (a new one must be placed here).  The plumbing of the
+#: ground floor imports nothing of the others; ``io/`` (the artifacts' schemas) lies below the
+#: analysis that writes them; ``rigid_walker`` (a scene's rigid walker and its gait) below the
+#: two front doors that hold one, the gym and the API.
+LAYERS = (
+    ("numerics", "units", "safefs", "usercache", "extras", "freshstack", "progress",
+     "published", "execution"),
+    ("config",),
+    ("walker",),
+    ("codegen",),
+    ("models",),
+    ("integrate",),
+    ("io",),
+    ("analysis",),
+    ("studies", "comparison", "export", "report"),
+    ("rigid_walker",),
+    ("optimal", "gym", "plotting"),
+    ("bench",),
+    ("stages",),
+    ("cli", "api", "__init__"),
+)
+
+
 @functools.cache
 def _tree(path: Path) -> ast.Module:
     """``path`` parsed once for every rule (the rules read the same files)."""
