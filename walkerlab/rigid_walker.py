@@ -40,7 +40,7 @@ def scene_of(scene) -> Scene:
     walkerlab.config.SceneError
         File missing, malformed YAML, or fields that do not validate (one line each).
     """
-    from walkerlab.config import Scene, load_scene, scene_from_dict
+    from walkerlab.config import Scene, load_scene, scene_from_dict  # light
 
     if isinstance(scene, Scene):
         return scene
@@ -56,7 +56,7 @@ def positive(value, name: str) -> float:
     import math
     import numbers
 
-    from walkerlab.config import SceneError
+    from walkerlab.config import SceneError  # light
 
     if (isinstance(value, bool) or not isinstance(value, numbers.Real)
             or not math.isfinite(value) or value <= 0):
@@ -160,7 +160,7 @@ class SceneWalker:
 
     def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
         from walkerlab.integrate.solver import Solver
-        from walkerlab.models.registry import build_walker
+        from walkerlab.models.registry import build_walker  # light
 
         self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")
         self.scene = scene
@@ -205,8 +205,8 @@ class SceneWalker:
 
         import numpy as np
 
-        from walkerlab.analysis.gait.scene import MAX_GUESS_RATE
-        from walkerlab.config import SceneError
+        from walkerlab.analysis.gait.scene import MAX_GUESS_RATE  # light
+        from walkerlab.config import SceneError  # light
 
         names = self.state_names()
         want = (f"give the state as {len(names)} numbers ({', '.join(names)}) "
@@ -266,8 +266,8 @@ class SceneWalker:
         """
         import numpy as np
 
-        from walkerlab.analysis.gait.energy import gait_ledger
-        from walkerlab.analysis.gait.scene import solve_scene
+        from walkerlab.analysis.gait.energy import gait_ledger  # light
+        from walkerlab.analysis.gait.scene import solve_scene  # light
 
         _, search = solve_scene(self.scene, guess=self._known_start(), walker=self.model,
                                 solver=self.solver, ground=True)
@@ -288,8 +288,8 @@ class SceneWalker:
         fp = self.scene.fixedpoint
         if fp is None or fp.from_ is None:
             return None
-        from walkerlab.config import SceneError
-        from walkerlab.studies.continuation import homotopy_start, known_scene
+        from walkerlab.config import SceneError  # light
+        from walkerlab.studies.continuation import homotopy_start, known_scene  # light
 
         try:
             src = known_scene(self.scene)

@@ -146,7 +146,7 @@ class Walker(SceneWalker):
         return ContactWalker(self.scene, self)
 
     def _map(self, x, jacobian: bool = False, steps: list | None = None):
-        from walkerlab.analysis.gait.poincare import poincare_map
+        from walkerlab.analysis.gait.poincare import poincare_map  # light
 
         x = self.check_state(x)
         with self._bounded():
@@ -157,7 +157,7 @@ class Walker(SceneWalker):
     def _bounded(self):
         """Each walking step inside bounded to ``step_time_limit_s`` of CPU time; a failed
         step said in one line (how and when it ended, what to do)."""
-        from walkerlab.analysis.gait.poincare import StepFailed
+        from walkerlab.analysis.gait.poincare import StepFailed  # light
         from walkerlab.integrate.time_limit import IntegrationTimeLimit, integration_time_limit
 
         try:
@@ -222,7 +222,7 @@ class Walker(SceneWalker):
         """
         import numpy as np
 
-        from walkerlab.numerics import sort_multipliers
+        from walkerlab.numerics import sort_multipliers  # light
 
         return sort_multipliers(np.linalg.eigvals(self.jacobian(x)))
 
@@ -257,8 +257,8 @@ class Walker(SceneWalker):
         walkerlab.analysis.continuation.target.TargetNotReached
             No gait meets the target near the start (one line).
         """
-        from walkerlab.analysis.continuation.target import MEASURES, solve_target
-        from walkerlab.studies.continuation import scene_family, scene_value
+        from walkerlab.analysis.continuation.target import MEASURES, solve_target  # light
+        from walkerlab.studies.continuation import scene_family, scene_value  # light
 
         name, value = check_target(self.scene, vary, target)
         fam = scene_family(self.scene, vary)
@@ -322,9 +322,9 @@ class Walker(SceneWalker):
             A step used up ``step_time_limit_s`` of CPU time (a fall is recorded in
             ``termination``, not raised).
         """
-        from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene
-        from walkerlab.config import SceneError
-        from walkerlab.config.options import with_terrain_seed
+        from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene  # light
+        from walkerlab.config import SceneError  # light
+        from walkerlab.config.options import with_terrain_seed  # light
 
         strides, rate = simulate_options(strides, sample_rate_hz)
         x0 = self.check_state(x0, "x0")
@@ -395,9 +395,9 @@ class ContactWalker:
 
     def __init__(self, scene: Scene, rigid: Walker | None = None,
                  step_time_limit_s: float = STEP_TIME_LIMIT_S):
-        from walkerlab.config.sections import with_default_section
+        from walkerlab.config.sections import with_default_section  # light
         from walkerlab.integrate.solver import Solver
-        from walkerlab.models.contact.scene import contact_setup
+        from walkerlab.models.contact.scene import contact_setup  # light
 
         self.scene = with_default_section(scene, "contact")  # left out: its defaults
         self.setup = contact_setup(self.scene)
@@ -470,8 +470,8 @@ class ContactWalker:
         """The rigid start ``x0`` (default the rigid gait) and its step period [s]."""
         import numbers
 
-        from walkerlab.analysis.gait.poincare import StepFailed
-        from walkerlab.config import SceneError
+        from walkerlab.analysis.gait.poincare import StepFailed  # light
+        from walkerlab.config import SceneError  # light
 
         if x0 is None:
             if period_s is not None:
@@ -498,7 +498,7 @@ class ContactWalker:
         field is)."""
         import numbers
 
-        from walkerlab.config import MAX_CONTACT_STRIDES, SceneError
+        from walkerlab.config import MAX_CONTACT_STRIDES, SceneError  # light
 
         if strides is None:
             return self.setup
@@ -550,8 +550,8 @@ class ContactWalker:
         """
         import numpy as np
 
-        from walkerlab.analysis.contact.ledger import contact_step_ledger
-        from walkerlab.analysis.contact.record import contact_walk
+        from walkerlab.analysis.contact.ledger import contact_step_ledger  # light
+        from walkerlab.analysis.contact.record import contact_walk  # light
 
         setup = self._with_strides(strides)
         x_ideal, period = self._start(x0, period_s)
@@ -616,7 +616,7 @@ class ContactWalker:
             one line), as the stage reports it.
         """
         from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
-        from walkerlab.analysis.contact.sim import scene_start
+        from walkerlab.analysis.contact.sim import scene_start  # light
 
         self._check_periodic()
         x = self.rigid_gait().x if x0 is None else self.rigid.check_state(x0, "x0")
@@ -630,7 +630,7 @@ class ContactWalker:
         cs = self.setup.sim
         if cs.periodic_gait or cs.start == "periodic_gait" or self._periodic_checked:
             return
-        from walkerlab.models.contact.scene import contact_setup
+        from walkerlab.models.contact.scene import contact_setup  # light
 
         contact_setup(self.scene, periodic=True)
         self._periodic_checked = True

@@ -101,9 +101,9 @@ def sampled_walk(traj, rate: float) -> Walk:
     """
     import numpy as np
 
-    from walkerlab.analysis.gait.energy import trajectory_ledger
-    from walkerlab.analysis.gait.metrics import step_table
-    from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
+    from walkerlab.analysis.gait.energy import trajectory_ledger  # light
+    from walkerlab.analysis.gait.metrics import step_table  # light
+    from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError  # light
 
     counts = [max(2, int(np.ceil((seg.t_end - seg.t_start) * rate)) + 1)
               for seg in traj.segments]

@@ -161,7 +161,7 @@ def _rigid_ground(scene):
                          "--terrain-seed draws it); leave terrain.per_step out")
     if t.kind != "profile":
         return None
-    from walkerlab.analysis.gait.rigid_run import profile_ground
+    from walkerlab.analysis.gait.rigid_run import profile_ground  # light
 
     try:
         return profile_ground(scene)
@@ -320,8 +320,8 @@ class WalkerEnv(gym.Env):
         from walkerlab.rigid_walker import SceneWalker, scene_of
         from walkerlab.walker.description import walker_data
 
-        from .action import action_joints, action_limits, action_torques
-        from .rigid_view import RigidView
+        from .action import action_joints, action_limits, action_torques  # light
+        from .rigid_view import RigidView  # light
 
         _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
                          terrain_roughness_m)
@@ -348,7 +348,7 @@ class WalkerEnv(gym.Env):
         ground = _rigid_ground(sc) if view == "rigid" else None
         if view == "contact":  # the contact view's refusals (the table's contact cells for
             # the scene's features, its ground): from the scene alone, before the gait search
-            from walkerlab.models.contact.scene import contact_setup
+            from walkerlab.models.contact.scene import contact_setup  # light
 
             setup = contact_setup(sc)
         self.scene, self.view = sc, view
@@ -517,7 +517,7 @@ class WalkerEnv(gym.Env):
         start = self.gait.x if self.view == "rigid" else self.sim.x_start
         if state is not None and any(isinstance(v, str | bytes) for v in
                                      np.ravel(np.asarray(state, dtype=object))):
-            from walkerlab.config import SceneError
+            from walkerlab.config import SceneError  # light
 
             raise SceneError(f"options['state']: give {len(self.state_names)} numbers "
                              f"({', '.join(self.state_names)}), not text")
@@ -537,7 +537,7 @@ class WalkerEnv(gym.Env):
                 self._checked_start = x0  # (the same numbers pass again: not checked twice)
         elif not (isinstance(x0, np.ndarray) and x0.shape == self.sim.x_start.shape
                   and np.all(np.isfinite(x0))):
-            from walkerlab.config import SceneError
+            from walkerlab.config import SceneError  # light
 
             raise SceneError(f"options['state']: give {len(self.state_names)} finite "
                              f"numbers ({', '.join(self.state_names)})")
@@ -713,7 +713,7 @@ def _rigid_view():
     not needed to register the environment), kept for the per-period calls."""
     global _RIGID_VIEW
     if _RIGID_VIEW is None:
-        from . import rigid_view as _RIGID_VIEW
+        from . import rigid_view as _RIGID_VIEW  # light
     return _RIGID_VIEW
 
 

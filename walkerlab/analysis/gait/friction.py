@@ -72,7 +72,7 @@ def scene_friction(scene) -> tuple[float, str]:
     from (the contact section's ``mu_static``, or the contact model's default)."""
     if getattr(scene, "contact", None) is not None:
         return float(scene.contact.mu_static), "contact.mu_static"
-    from walkerlab.config import ContactSettings
+    from walkerlab.config import ContactSettings  # light
 
     return float(ContactSettings.model_fields["mu_static"].default), \
         "the contact model's default"
