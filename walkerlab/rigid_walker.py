@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from walkerlab.integrate.solver import Solver
+
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
@@ -159,7 +161,6 @@ class SceneWalker:
         return (type(self), (self.scene, self.step_time_limit_s))
 
     def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
-        from walkerlab.integrate.solver import Solver
         from walkerlab.models.registry import build_walker  # light
 
         self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")

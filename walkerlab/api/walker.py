@@ -48,6 +48,7 @@ from walkerlab.api.checks import (
     short,
     simulate_options,
 )
+from walkerlab.api.scenes import as_scene, with_changes
 from walkerlab.api.walks import STEP_FIELDS, ContactWalk, Gait, Step, Walk, sampled_walk
 from walkerlab.rigid_walker import SceneWalker
 
@@ -117,8 +118,6 @@ class Walker(SceneWalker):
             The file is missing or the scene does not validate (one line per field), or a
             bad ``step_time_limit_s``.
         """
-        from walkerlab.api.scenes import as_scene
-
         return cls(as_scene(scene), step_time_limit_s)
 
     def with_changes(self, changes: dict[str, Any]) -> Walker:
@@ -130,8 +129,6 @@ class Walker(SceneWalker):
         walkerlab.config.SceneError
             An unknown field (with the closest name) or a value the field does not accept.
         """
-        from walkerlab.api.scenes import with_changes
-
         return Walker(with_changes(self.scene, changes), self.step_time_limit_s)
 
     def contact(self) -> ContactWalker:
@@ -420,8 +417,6 @@ class ContactWalker:
         walkerlab.models.contact.scene.ContactSceneError
             As :class:`ContactWalker`.
         """
-        from walkerlab.api.scenes import as_scene
-
         return cls(as_scene(scene), step_time_limit_s=step_time_limit_s)
 
     def with_changes(self, changes: dict[str, Any]) -> ContactWalker:

@@ -103,6 +103,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from walkerlab.rigid_walker import SceneWalker, scene_of
+
 __all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
            "end_periods"]
 
@@ -137,7 +139,6 @@ def _gait(walker):
     if key not in _GAITS:
         _GAITS[key] = walker.fixed_point()
     return _GAITS[key]
-
 
 
 def _rigid_ground(scene):
@@ -317,7 +318,6 @@ class WalkerEnv(gym.Env):
                  policy: str | None = None, compiled_step: bool = True):
         #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
-        from walkerlab.rigid_walker import SceneWalker, scene_of
         from walkerlab.walker.description import walker_data
 
         from .action import action_joints, action_limits, action_torques  # light
