@@ -76,16 +76,6 @@ def _strings(tree: ast.Module):
             and isinstance(n.value, str) and id(n) not in docs]
 
 
-def _code_lines(text: str, tree: ast.Module) -> int:
-    """Lines holding code: not blank, not only a comment, not in a docstring."""
-    skip = set()
-    for n in ast.walk(tree):
-        if id(n) in _docstrings(tree) and hasattr(n, "end_lineno"):
-            skip |= set(range(n.lineno, n.end_lineno + 1))
-    return sum(1 for i, line in enumerate(text.splitlines(), 1)
-               if i not in skip and line.strip() and not line.strip().startswith("#"))
-
-
 def _is_diff(n) -> bool:
     """A derivative of a matrix entry: ``sp.diff(M[i, j], q)`` or ``dM[k][i, j]``."""
     if isinstance(n, ast.BinOp) and isinstance(n.op, ast.Mult):  # ... * dq[k]
