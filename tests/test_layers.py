@@ -641,7 +641,8 @@ def _kind_compares(tree: ast.Module, kinds: set[str]) -> list[int]:
 
 def test_no_walker_kind_name_is_compared_outside_the_kinds_home():
     kinds = _kind_names()
-    probe = 'if k == "flat_feet" or k in ("free_joints",): pass\nmatch k:\n  case "straight_legs": pass\n'
+    probe = ('if k == "flat_feet" or k in ("free_joints",): pass\n'
+             'match k:\n  case "straight_legs": pass\n')
     assert len(_kind_compares(ast.parse(probe), kinds)) == 3
     found = {_rel(p): v for p in _modules() if _top(_rel(p)) != "walker"
              and (v := _kind_compares(_tree(p), kinds))}
