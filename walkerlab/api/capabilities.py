@@ -141,7 +141,7 @@ class Measurement:
 
 
 def _h5(path):
-    from walkerlab.io.artifacts import open_artifact
+    from walkerlab.io.artifacts import open_artifact  # light
 
     return open_artifact(Path(path))
 
@@ -283,7 +283,7 @@ def _contact(scene, d, runs: Path) -> tuple[float, str]:
     walker driven by torques: the same ground)."""
     from walkerlab.config import scene_from_dict
     from walkerlab.stages import pipeline
-    from walkerlab.stages.common import StageError
+    from walkerlab.stages.common import StageError  # light
 
     cs = pipeline.run("contact-sim", scene, runs).path
     same, note = None, ""
@@ -348,7 +348,7 @@ def _contact_against_rigid(cs, fp, sim) -> tuple[float, str]:
 
 def _engine(fmt):
     def run(scene, d, runs: Path) -> tuple[float, str]:
-        from walkerlab.stages import export
+        from walkerlab.stages import export  # light
 
         ex = export.write(scene, runs, fmt, walk=True, walk_steps=STRIKES)
         w = ex.walk
@@ -362,7 +362,7 @@ def _engine(fmt):
 
 def _adams(scene, d, runs: Path) -> tuple[float, str]:
     from walkerlab.export.adams_reader import read_adm
-    from walkerlab.stages import export
+    from walkerlab.stages import export  # light
     from walkerlab.walker.description import walker_data
     from walkerlab.walker.multibody import multibody
 
@@ -389,7 +389,7 @@ def _urdf(scene, d, runs: Path) -> tuple[float, str]:
         import pinocchio
     except ImportError:
         return math.nan, "pinocchio is not installed (pip install pin): the URDF not loaded"
-    from walkerlab.stages import export
+    from walkerlab.stages import export  # light
     from walkerlab.walker.description import walker_data
 
     path = export.write(scene, runs, "urdf").path
@@ -407,7 +407,7 @@ def _urdf(scene, d, runs: Path) -> tuple[float, str]:
 
 
 def _gym(scene, d, runs: Path) -> tuple[float, str]:
-    from walkerlab.gym.env import WalkerEnv
+    from walkerlab.gym.env import WalkerEnv  # light
     from walkerlab.stages import pipeline
 
     sim = pipeline.run("simulate", scene, runs).path

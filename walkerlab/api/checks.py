@@ -6,36 +6,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from walkerlab.rigid_walker import STEP_TIME_LIMIT_S, positive, short
+
 if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
 __all__ = ["STEP_TIME_LIMIT_S", "check_target", "clear_step_failure", "positive", "short",
            "simulate_options"]
-
-#: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
-#: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
-#: search's budget (:data:`walkerlab.analysis.gait.poincare.ROOT_BUDGET_S`)
-STEP_TIME_LIMIT_S = 60.0
-
-
-def short(value) -> str:
-    """``repr(value)``, cut to 40 characters."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-def positive(value, name: str) -> float:
-    """``value`` as a positive finite float, else one line naming ``name``."""
-    import math
-    import numbers
-
-    from walkerlab.config import SceneError
-
-    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
-            or not math.isfinite(value) or value <= 0):
-        raise SceneError(f"{name}={short(value)}: give a positive number of seconds")
-    return float(value)
-
 
 def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
     """``(strides, sample_rate_hz)`` checked by the ``simulate`` section's own fields
@@ -44,8 +21,8 @@ def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
 
     from pydantic import ValidationError
 
-    from walkerlab.config import SceneError
-    from walkerlab.config.studies import SimulateSettings
+    from walkerlab.config import SceneError  # light
+    from walkerlab.config.studies import SimulateSettings  # light
 
     if isinstance(strides, bool) or not isinstance(strides, numbers.Integral):
         raise SceneError(f"simulate: strides={short(strides)}: give a whole number of "
@@ -68,7 +45,7 @@ def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
 def clear_step_failure(exc, max_step_time: float):
     """A :class:`StepFailed` of the map said in the walker's terms (one line: how the step
     ended, when, and what to do), not in the integrator's."""
-    from walkerlab.analysis.gait.poincare import StepFailed
+    from walkerlab.analysis.gait.poincare import StepFailed  # light
 
     t = f"t = {exc.t:.4g} s"
     why = {
@@ -121,10 +98,10 @@ def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
     import math
     import numbers
 
-    from walkerlab.analysis.continuation.target import MEASURES
-    from walkerlab.config import SceneError
-    from walkerlab.studies.continuation import scene_family, scene_value
-    from walkerlab.studies.params import ParamAxis, takes_whole_numbers
+    from walkerlab.analysis.continuation.target import MEASURES  # light
+    from walkerlab.config import SceneError  # light
+    from walkerlab.studies.continuation import scene_family, scene_value  # light
+    from walkerlab.studies.params import ParamAxis, takes_whole_numbers  # light
 
     if len(target) != 1 or next(iter(target)) not in MEASURES:
         raise SceneError(f"target: give exactly one of {', '.join(MEASURES)} (got "
@@ -139,7 +116,7 @@ def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
         raise SceneError(f"target --vary {short(vary)}: vary a numeric field of the walker "
                          "or the slope (e.g. walker.actuation.push_off.impulse_n_s); the "
                          "gait depends on no other section")
-    from walkerlab.studies.params import SweepError
+    from walkerlab.studies.params import SweepError  # light
 
     try:
         scene_family(scene, vary)  # an unknown field: SweepError with the closest name

@@ -56,7 +56,7 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     ImportError
         xarray/h5netcdf missing (``pip install -e '.[api]'``).
     """
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     return read_dataset(pipeline.run("fixedpoint", as_scene(scene), runs_folder(runs_dir),
                                      force).path)
@@ -81,8 +81,8 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
     StageError, SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.io.datasets import load_fixed_points
-    from walkerlab.stages import pipeline
+    from walkerlab.io.datasets import load_fixed_points  # light
+    from walkerlab.stages import pipeline  # light
 
     return load_fixed_points(pipeline.run("fixedpoint", as_scene(scene), runs_folder(runs_dir),
                                           force).path)
@@ -122,7 +122,7 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     return read_dataset(pipeline.run("simulate", as_scene(scene), runs_folder(runs_dir), force,
                               strides=strides).path)
@@ -162,7 +162,7 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     return read_dataset(pipeline.run("contact-sim", as_scene(scene), runs_folder(runs_dir),
                                      force, adjust=adjust, periodic=periodic).path)
@@ -187,7 +187,7 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     StageError, SceneError, ImportError
         As :func:`contact_simulate`.
     """
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     return read_dataset(pipeline.run("compare", as_scene(scene), runs_folder(runs_dir), force).path)
 
@@ -200,7 +200,7 @@ def _design_bounds(design) -> dict:
     import math
     import numbers
 
-    from walkerlab.config import SceneError
+    from walkerlab.config import SceneError  # light
 
     if not isinstance(design, dict) or not design:
         raise SceneError(f"optimize: design={design!r}: give a mapping of fields to bounds, "
@@ -269,9 +269,9 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
     ImportError
         CasADi missing (``pip install -e '.[optimize]'``), or as :func:`fixed_point`.
     """
-    from walkerlab.config import SceneError
-    from walkerlab.optimal.design.search import MEASURES
-    from walkerlab.stages import pipeline
+    from walkerlab.config import SceneError  # light
+    from walkerlab.optimal.design.search import MEASURES  # light
+    from walkerlab.stages import pipeline  # light
 
     sc, runs = as_scene(scene), runs_folder(runs_dir)
     if design is None:
@@ -285,13 +285,13 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
         raise SceneError(f"optimize: objective={objective!r}: one of {', '.join(MEASURES)}")
     if not isinstance(maximize, bool):
         raise SceneError(f"optimize: maximize={maximize!r}: give True or False")
-    from walkerlab.studies.params import ParamAxis, SweepError, check_axes
+    from walkerlab.studies.params import ParamAxis, SweepError, check_axes  # light
 
     try:
         check_axes(sc, [ParamAxis(f, (), f) for f in bounds], values=False)  # before any run
     except SweepError as exc:
         raise SweepError(str(exc).replace("--param ", "optimize: design field ", 1)) from None
-    from walkerlab.stages import optimize as stage
+    from walkerlab.stages import optimize as stage  # light
 
     pipeline.run_upstream("optimize", sc, runs)
     return read_dataset(stage.run_design(sc, runs, force, bounds, objective, maximize).path)
@@ -329,8 +329,8 @@ def robustness(scene: Scene | str | Path | dict, *, workers: int = 1,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import pipeline
-    from walkerlab.stages.robustness import check
+    from walkerlab.stages import pipeline  # light
+    from walkerlab.stages.robustness import check  # light
 
     sc = as_scene(scene)
     check(sc, workers)  # before the upstream gait search
@@ -370,9 +370,9 @@ def export_scene(scene: Scene | str | Path | dict, fmt: str = "urdf", *,
     walkerlab.io.artifacts.ArtifactError
         A file cannot be written (disk full, a folder in a file's place): nothing replaced.
     """
-    from walkerlab.config import SceneError
-    from walkerlab.export.multibody import FORMATS
-    from walkerlab.stages import export as stage
+    from walkerlab.config import SceneError  # light
+    from walkerlab.export.multibody import FORMATS  # light
+    from walkerlab.stages import export as stage  # light
 
     if not isinstance(fmt, str) or fmt not in (*FORMATS, "adm"):
         raise SceneError(f"export: fmt={fmt!r}: one of {', '.join(FORMATS)}, adm")

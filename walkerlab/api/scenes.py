@@ -42,19 +42,12 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
         each, unknown keys first with the closest field name); ``name`` not a string or not
         a safe folder name (empty, path separators).
     """
-    from walkerlab.config import Scene, SceneError, scene_from_dict
-    from walkerlab.config import load_scene as _load
+    from walkerlab.config import SceneError  # light
+    from walkerlab.rigid_walker import scene_of
 
-    if isinstance(path_or_dict, Scene):
-        sc = path_or_dict
-    elif isinstance(path_or_dict, dict):
-        data = dict(path_or_dict)
-        data.setdefault("name", "scene")
-        sc = scene_from_dict(data)
-    else:
-        sc = _load(path_or_dict)
+    sc = scene_of(path_or_dict)
     if name is not None:
-        from walkerlab.io.runpaths import check_name
+        from walkerlab.io.runpaths import check_name  # light
 
         if not isinstance(name, str):
             raise SceneError(f"name={name!r}: give the run folder name as a string, e.g. "
@@ -101,8 +94,8 @@ def with_changes(scene: Scene | str | Path | dict, changes: dict[str, Any]) -> S
     >>> steeper = wl.with_changes(wl.load_scene("configs/paper.yaml"),
     ...                           {"slope.angle_deg": 2})          # doctest: +SKIP
     """
-    from walkerlab.config import SceneError
-    from walkerlab.studies.params import ParamAxis, SweepError, apply_point, check_axes
+    from walkerlab.config import SceneError  # light
+    from walkerlab.studies.params import ParamAxis, SweepError, apply_point, check_axes  # light
 
     base = as_scene(scene)
     if not isinstance(changes, dict) or not all(isinstance(k, str) for k in changes):
@@ -124,7 +117,7 @@ def with_changes(scene: Scene | str | Path | dict, changes: dict[str, Any]) -> S
 
 def as_scene(scene) -> Scene:
     """``scene`` itself, or the scene :func:`load_scene` reads from it."""
-    from walkerlab.config import Scene
+    from walkerlab.config import Scene  # light
 
     return scene if isinstance(scene, Scene) else load_scene(scene)
 
@@ -153,6 +146,6 @@ def read_dataset(path: Path) -> xarray.Dataset:
     ImportError
         xarray/h5netcdf missing (``pip install -e '.[api]'``).
     """
-    from walkerlab.io.datasets import load_dataset
+    from walkerlab.io.datasets import load_dataset  # light
 
     return load_dataset(path)

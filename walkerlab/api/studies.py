@@ -27,7 +27,7 @@ def _axis_spec(param: str, values: Sequence) -> str:
             return str(v)
         return str(int(v)) if isinstance(v, numbers.Integral) else repr(float(v))
 
-    from walkerlab.studies.params import SweepError
+    from walkerlab.studies.params import SweepError  # light
 
     if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
         raise SweepError(f"sweep {param}: values={values!r}: give a sequence of values, e.g. "
@@ -79,7 +79,7 @@ def sweep(scene: Scene | str | Path | dict, param: str, values: Sequence, *,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import sweep as stage_mod
+    from walkerlab.stages import sweep as stage_mod  # light
 
     path = stage_mod.run(as_scene(scene), [_axis_spec(param, values)], stage=stage,
                          workers=workers, runs_root=runs_folder(runs_dir), name=name,
@@ -124,7 +124,7 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("basin", as_scene(scene), runs_folder(runs_dir), force,
                        grid=grid, workers=workers)
@@ -176,8 +176,8 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
     walkerlab.studies.params.SweepError
         ``param`` names no field of the scene.
     """
-    from walkerlab.io.schemas.continuation import load_continuation
-    from walkerlab.stages import continuation as stage
+    from walkerlab.io.schemas.continuation import load_continuation  # light
+    from walkerlab.stages import continuation as stage  # light
 
     out = stage.run(as_scene(scene), param, start, stop, 2 if switch else 0, param2, range2,
                     runs_folder(runs_dir), force)
@@ -220,7 +220,7 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
     ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("mfpt", as_scene(scene), runs_folder(runs_dir), force, sigma_rad=sigma_rad,
                        method=method, workers=workers)

@@ -81,7 +81,7 @@ def target(scene: Scene | str | Path | dict[str, Any], vary: str, *,
     ...               "walker.actuation.push_off.impulse_n_s", speed_m_per_s=0.45)  # doctest: +SKIP
     >>> t.value, t.gait.step_period, t.gait.cost_of_transport                      # doctest: +SKIP
     """
-    from walkerlab.studies.continuation import scene_value
+    from walkerlab.studies.continuation import scene_value  # light
     from walkerlab.units import field_unit
 
     given = {k: v for k, v in (("speed_m_per_s", speed_m_per_s),

@@ -45,11 +45,12 @@ from walkerlab.api.checks import (
     STEP_TIME_LIMIT_S,
     check_target,
     clear_step_failure,
-    positive,
     short,
     simulate_options,
 )
+from walkerlab.api.scenes import as_scene, with_changes
 from walkerlab.api.walks import STEP_FIELDS, ContactWalk, Gait, Step, Walk, sampled_walk
+from walkerlab.rigid_walker import SceneWalker
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
@@ -60,7 +61,7 @@ __all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Gait", "Step", 
            "Walker", "check_target"]
 
 
-class Walker:
+class Walker(SceneWalker):
     """The rigid hybrid walker of a scene, in memory.
 
     Build it with :meth:`from_scene`; it holds the validated scene, the generated model
@@ -105,25 +106,6 @@ class Walker:
         an actuated walker, printed equations on stairs, ...).
     """
 
-    def __reduce__(self):
-        """Pickled as its scene and step time limit (the model is built again: a compiled
-        flow does not pickle; a process pool or a vector env's subprocess gets the same
-        walker)."""
-        return (type(self), (self.scene, self.step_time_limit_s))
-
-    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
-        from walkerlab.integrate.solver import Solver
-        from walkerlab.models.registry import build_walker
-
-        self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")
-        self.scene = scene
-        self.model = build_walker(scene)
-        self.solver = Solver.from_settings(scene.solver)
-        fp = scene.fixedpoint
-        self.max_step_time = 5.0 if fp is None else fp.max_step_time_s
-        sim = scene.simulate
-        self.walk_step_time = self.max_step_time if sim is None else sim.max_step_time_s
-
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
                    step_time_limit_s: float = STEP_TIME_LIMIT_S) -> Walker:
@@ -136,8 +118,6 @@ class Walker:
             The file is missing or the scene does not validate (one line per field), or a
             bad ``step_time_limit_s``.
         """
-        from walkerlab.api.scenes import as_scene
-
         return cls(as_scene(scene), step_time_limit_s)
 
     def with_changes(self, changes: dict[str, Any]) -> Walker:
@@ -149,8 +129,6 @@ class Walker:
         walkerlab.config.SceneError
             An unknown field (with the closest name) or a value the field does not accept.
         """
-        from walkerlab.api.scenes import with_changes
-
         return Walker(with_changes(self.scene, changes), self.step_time_limit_s)
 
     def contact(self) -> ContactWalker:
@@ -164,75 +142,8 @@ class Walker:
         """
         return ContactWalker(self.scene, self)
 
-    def state_names(self) -> list[str]:
-        """Names of the role-ordered state (2n,), coordinates then rates."""
-        return list(self.model.state_names())
-
-    def state_units(self) -> list[str]:
-        """Units of the state's entries (``rad``, ``rad/s``)."""
-        return list(self.model.state_units())
-
-    def check_state(self, x, what: str = "x") -> np.ndarray:
-        """``x`` as the walker's state: a float array (2n,) of finite numbers, rates within
-        :data:`~walkerlab.analysis.gait.scene.MAX_GUESS_RATE` sqrt(g/l) and angles within
-        [-pi, pi] (beyond them no walking gait is near: a leg that fast would leave the
-        ground, and the integrator crawls; the bounds of ``fixedpoint.initial_guess``).
-
-        Parameters
-        ----------
-        x : array_like, shape (2n,)
-            A role-ordered state (:meth:`state_names`) [rad, rad/s].
-        what : str
-            The argument's name in the message.
-
-        Returns
-        -------
-        ndarray, shape (2n,)
-
-        Raises
-        ------
-        walkerlab.config.SceneError
-            One line naming the shape, the entry or the value.
-        """
-        import math
-
-        import numpy as np
-
-        from walkerlab.analysis.gait.scene import MAX_GUESS_RATE
-        from walkerlab.config import SceneError
-
-        names = self.state_names()
-        want = (f"give the state as {len(names)} numbers ({', '.join(names)}) "
-                "[rad, rad/s], e.g. gait.x")
-        if x is None or isinstance(x, (str, bytes, dict)):
-            raise SceneError(f"{what}={short(x)}: {want}")
-        try:
-            arr = np.asarray(x)
-            if arr.dtype.kind not in "biuf" or arr.dtype.kind == "b":
-                raise TypeError
-            arr = arr.astype(float)
-        except (TypeError, ValueError):
-            raise SceneError(f"{what}={short(x)}: not numbers; {want}") from None
-        if arr.shape != (len(names),):
-            raise SceneError(f"{what} has shape {arr.shape}; the walker's state is "
-                             f"({len(names)},): {want}")
-        p = self.model.params
-        max_rate = MAX_GUESS_RATE * math.sqrt(float(p["gravity_m_per_s2"])
-                                              / float(p["leg_length_m"]))
-        for i, (name, v) in enumerate(zip(names, arr)):
-            if not math.isfinite(v):
-                raise SceneError(f"{what}[{i}] ({name}) = {v}: give finite numbers")
-            if name.endswith("_rate") and abs(v) > max_rate:
-                raise SceneError(f"{what}[{i}] ({name}) = {v:g} rad/s is not a walking state: "
-                                 f"at most {max_rate:.3g} ({MAX_GUESS_RATE:g} sqrt(g/l); a "
-                                 "leg this fast would leave the ground)")
-            if name.endswith("_angle") and abs(v) > math.pi:
-                raise SceneError(f"{what}[{i}] ({name}) = {v:g} rad is more than half a "
-                                 "turn: give an angle within [-pi, pi]")
-        return arr
-
     def _map(self, x, jacobian: bool = False, steps: list | None = None):
-        from walkerlab.analysis.gait.poincare import poincare_map
+        from walkerlab.analysis.gait.poincare import poincare_map  # light
 
         x = self.check_state(x)
         with self._bounded():
@@ -243,7 +154,7 @@ class Walker:
     def _bounded(self):
         """Each walking step inside bounded to ``step_time_limit_s`` of CPU time; a failed
         step said in one line (how and when it ended, what to do)."""
-        from walkerlab.analysis.gait.poincare import StepFailed
+        from walkerlab.analysis.gait.poincare import StepFailed  # light
         from walkerlab.integrate.time_limit import IntegrationTimeLimit, integration_time_limit
 
         try:
@@ -308,68 +219,9 @@ class Walker:
         """
         import numpy as np
 
-        from walkerlab.numerics import sort_multipliers
+        from walkerlab.numerics import sort_multipliers  # light
 
         return sort_multipliers(np.linalg.eigvals(self.jacobian(x)))
-
-    def fixed_point(self) -> Gait:
-        """The period-1 gait the ``fixedpoint`` stage finds, bit for bit (the same search:
-        :func:`walkerlab.analysis.gait.scene.solve_scene`, on this walker's own model
-        :attr:`model` and integrator :attr:`solver`: nothing is rebuilt from the scene; with
-        the stage's check of each gait's ground contact, which the choice among several
-        gaits prefers, and the stage's start: ``fixedpoint.initial_guess``, or the gait of
-        the scene ``fixedpoint.from`` names carried here by homotopy,
-        :func:`walkerlab.studies.continuation.homotopy_start`), without writing anything.
-
-        Returns
-        -------
-        Gait
-            The selected gait: ``x`` (2n,) [rad, rad/s], step and map periods [s], Floquet
-            multipliers (2n,), the map's Jacobian (2n, 2n), step length [m], speed [m/s],
-            cost of transport [-] and the energy ledger of the map's steps.
-
-        Raises
-        ------
-        walkerlab.analysis.gait.search.GaitNotFound
-            No gait (one line: what was tried, what to try next).
-        walkerlab.config.SceneError
-            ``fixedpoint.from`` names a scene that does not load (one line).
-        ValueError
-            A malformed initial guess or gait choice, or a ``fixedpoint.from`` gait that
-            does not reach this walker (one line naming the field).
-        """
-        import numpy as np
-
-        from walkerlab.analysis.gait.energy import gait_ledger
-        from walkerlab.analysis.gait.scene import solve_scene
-
-        _, search = solve_scene(self.scene, guess=self._known_start(), walker=self.model,
-                                solver=self.solver, ground=True)
-        chosen = search.gaits[search.selected]
-        r = chosen.result
-        m, ledger = gait_ledger(self.model, r.x, self.model.steps_per_map, self.solver,
-                                self.max_step_time)
-        return Gait(np.asarray(r.x, float), tuple(self.state_names()),
-                    float(r.period_s) / self.model.steps_per_map, float(r.period_s),
-                    np.asarray(r.multipliers_variational),
-                    np.asarray(r.jacobian_variational), float(r.residual), chosen.label,
-                    m["step_length"], m["speed"], m["cost_of_transport"], ledger)
-
-    def _known_start(self):
-        """The start of the gait search carried from ``fixedpoint.from`` (as the
-        ``fixedpoint`` stage: :func:`walkerlab.studies.continuation.known_scene`,
-        :func:`~walkerlab.studies.continuation.homotopy_start`), None without one."""
-        fp = self.scene.fixedpoint
-        if fp is None or fp.from_ is None:
-            return None
-        from walkerlab.config import SceneError
-        from walkerlab.studies.continuation import homotopy_start, known_scene
-
-        try:
-            src = known_scene(self.scene)
-        except SceneError as exc:
-            raise SceneError(f"fixedpoint.from: {exc}") from None
-        return homotopy_start(self.scene, src)[0]
 
     def find_gait_for(self, vary: str, **target: float) -> tuple[Walker, Gait]:
         """The walker whose period-1 gait meets a target, one field freed (Kuo's
@@ -402,8 +254,8 @@ class Walker:
         walkerlab.analysis.continuation.target.TargetNotReached
             No gait meets the target near the start (one line).
         """
-        from walkerlab.analysis.continuation.target import MEASURES, solve_target
-        from walkerlab.studies.continuation import scene_family, scene_value
+        from walkerlab.analysis.continuation.target import MEASURES, solve_target  # light
+        from walkerlab.studies.continuation import scene_family, scene_value  # light
 
         name, value = check_target(self.scene, vary, target)
         fam = scene_family(self.scene, vary)
@@ -467,9 +319,9 @@ class Walker:
             A step used up ``step_time_limit_s`` of CPU time (a fall is recorded in
             ``termination``, not raised).
         """
-        from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene
-        from walkerlab.config import SceneError
-        from walkerlab.config.options import with_terrain_seed
+        from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene  # light
+        from walkerlab.config import SceneError  # light
+        from walkerlab.config.options import with_terrain_seed  # light
 
         strides, rate = simulate_options(strides, sample_rate_hz)
         x0 = self.check_state(x0, "x0")
@@ -540,9 +392,9 @@ class ContactWalker:
 
     def __init__(self, scene: Scene, rigid: Walker | None = None,
                  step_time_limit_s: float = STEP_TIME_LIMIT_S):
-        from walkerlab.config.sections import with_default_section
+        from walkerlab.config.sections import with_default_section  # light
         from walkerlab.integrate.solver import Solver
-        from walkerlab.models.contact.scene import contact_setup
+        from walkerlab.models.contact.scene import contact_setup  # light
 
         self.scene = with_default_section(scene, "contact")  # left out: its defaults
         self.setup = contact_setup(self.scene)
@@ -565,8 +417,6 @@ class ContactWalker:
         walkerlab.models.contact.scene.ContactSceneError
             As :class:`ContactWalker`.
         """
-        from walkerlab.api.scenes import as_scene
-
         return cls(as_scene(scene), step_time_limit_s=step_time_limit_s)
 
     def with_changes(self, changes: dict[str, Any]) -> ContactWalker:
@@ -615,8 +465,8 @@ class ContactWalker:
         """The rigid start ``x0`` (default the rigid gait) and its step period [s]."""
         import numbers
 
-        from walkerlab.analysis.gait.poincare import StepFailed
-        from walkerlab.config import SceneError
+        from walkerlab.analysis.gait.poincare import StepFailed  # light
+        from walkerlab.config import SceneError  # light
 
         if x0 is None:
             if period_s is not None:
@@ -643,7 +493,7 @@ class ContactWalker:
         field is)."""
         import numbers
 
-        from walkerlab.config import MAX_CONTACT_STRIDES, SceneError
+        from walkerlab.config import MAX_CONTACT_STRIDES, SceneError  # light
 
         if strides is None:
             return self.setup
@@ -695,8 +545,8 @@ class ContactWalker:
         """
         import numpy as np
 
-        from walkerlab.analysis.contact.ledger import contact_step_ledger
-        from walkerlab.analysis.contact.record import contact_walk
+        from walkerlab.analysis.contact.ledger import contact_step_ledger  # light
+        from walkerlab.analysis.contact.record import contact_walk  # light
 
         setup = self._with_strides(strides)
         x_ideal, period = self._start(x0, period_s)
@@ -761,7 +611,7 @@ class ContactWalker:
             one line), as the stage reports it.
         """
         from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
-        from walkerlab.analysis.contact.sim import scene_start
+        from walkerlab.analysis.contact.sim import scene_start  # light
 
         self._check_periodic()
         x = self.rigid_gait().x if x0 is None else self.rigid.check_state(x0, "x0")
@@ -775,7 +625,7 @@ class ContactWalker:
         cs = self.setup.sim
         if cs.periodic_gait or cs.start == "periodic_gait" or self._periodic_checked:
             return
-        from walkerlab.models.contact.scene import contact_setup
+        from walkerlab.models.contact.scene import contact_setup  # light
 
         contact_setup(self.scene, periodic=True)
         self._periodic_checked = True

@@ -9,77 +9,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from walkerlab.rigid_walker import Gait
+
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
 __all__ = ["STEP_FIELDS", "ContactWalk", "Gait", "Step", "Walk", "sampled_walk"]
-
-
-@dataclass(frozen=True)
-class Gait:
-    """A period-1 gait (fixed point of the Poincaré map), as ``walkerlab fixedpoint`` finds it.
-
-    Attributes
-    ----------
-    x : ndarray, shape (2n,)
-        State just after heel strike (role order of ``names``) [rad, rad/s].
-    names : tuple of str
-        State names (:meth:`~walkerlab.api.walker.Walker.state_names`).
-    step_period : float
-        Step period [s, or √(l/g) in a nondimensional scene]; for a walker whose legs
-        differ (a stride map), the mean of its two steps.
-    map_period : float
-        Period of the Poincaré map [s]: the step period, or the stride period.
-    multipliers : ndarray, shape (2n,), complex
-        Floquet multipliers (variational equations with saltation), by decreasing modulus.
-    jacobian : ndarray, shape (2n, 2n)
-        Jacobian of the Poincaré map at ``x``.
-    residual : float
-        max ``|P(x) - x|`` [state units].
-    label : str
-        Which gait of the search (``long_period``, ``short_period``, ...).
-    step_length : float
-        Mean step length [m]: stance foot to swing foot at heel strike
-        (:func:`walkerlab.analysis.gait.metrics.step_length`).
-    speed : float
-        Distance along the ground over the map's period [m/s].
-    cost_of_transport : float
-        Mean over the map's steps of (positive actuator work + push-off work + slope
-        energy if > 0) / (M g d) [-] (Kuo 2002; Collins et al. 2005); a passive gait's is
-        sin(slope).  NaN without a ledger (flat feet on legs that differ).
-    ledger : dict[str, ndarray (steps,)]
-        The energy ledger of each step of the map, as ``simulate.h5``'s ``ledger/``
-        (:func:`walkerlab.analysis.gait.energy.gait_ledger`): ``actuator_work_positive``,
-        ``actuator_work_negative``, ``push_off_work``, ``heel_strike_loss``,
-        ``internal_collision_loss``, ``damper_work``, ``potential_work``, ``energy_change``,
-        ``closure``, ``slope_energy`` [J], ``push_off_impulse`` [N s],
-        ``cost_of_transport`` [-].
-    """
-
-    x: np.ndarray
-    names: tuple
-    step_period: float
-    map_period: float
-    multipliers: np.ndarray
-    jacobian: np.ndarray
-    residual: float
-    label: str
-    step_length: float = float("nan")
-    speed: float = float("nan")
-    cost_of_transport: float = float("nan")
-    ledger: dict = field(default_factory=dict)
-
-    @property
-    def state(self) -> dict[str, float]:
-        """The fixed point by state name."""
-        return {n: float(v) for n, v in zip(self.names, self.x)}
-
-    @property
-    def stable(self) -> bool:
-        """All ``|Floquet multipliers|`` < 1."""
-        import numpy as np
-
-        return bool(np.max(np.abs(self.multipliers)) < 1.0)
 
 
 @dataclass(frozen=True)
@@ -166,9 +101,9 @@ def sampled_walk(traj, rate: float) -> Walk:
     """
     import numpy as np
 
-    from walkerlab.analysis.gait.energy import trajectory_ledger
-    from walkerlab.analysis.gait.metrics import step_table
-    from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
+    from walkerlab.analysis.gait.energy import trajectory_ledger  # light
+    from walkerlab.analysis.gait.metrics import step_table  # light
+    from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError  # light
 
     counts = [max(2, int(np.ceil((seg.t_end - seg.t_start) * rate)) + 1)
               for seg in traj.segments]

@@ -38,15 +38,15 @@ def paper_scene():
     SceneError
         The scene file is missing or does not validate (:func:`load_scene`).
     """
-    from walkerlab.config import default_scene_path as default_scene
-    from walkerlab.config import load_scene
+    from walkerlab.config import default_scene_path as default_scene  # light
+    from walkerlab.config import load_scene  # light
 
     return load_scene(default_scene())
 
 
 def bench_ideal(repeats: int = 7) -> dict:
     """5 ideal strides at rtol 1e-10 per integrator backend, and the fixed-point search."""
-    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point  # light
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
@@ -138,7 +138,7 @@ def bench_fixedpoint_3d(runs: int = 5) -> dict:
     """``walkerlab fixedpoint --force`` of the 3D walkers (the hip-width walker, its stride
     map with multipliers, and the 3D rimless wheel at Drake's defaults), whole process, warm
     (the generated code cached by a first run), medians of ``runs``; target 5 s each."""
-    from walkerlab.config.loader import shipped_scene_path
+    from walkerlab.config.loader import shipped_scene_path  # light
 
     out: dict = {"target_s": 5.0, "scenes": {}}
     with tempfile.TemporaryDirectory() as d:
@@ -226,8 +226,8 @@ def bench_contact_scenes(scenes) -> dict:
     ConfigError
         A scene file is missing or invalid (one line, from :func:`load_scene`).
     """
-    from walkerlab.bench.contact import run_scene_benchmark
-    from walkerlab.config import load_scene
+    from walkerlab.bench.contact import run_scene_benchmark  # light
+    from walkerlab.config import load_scene  # light
 
     loaded = [load_scene(p) for p in scenes]  # every file checked before the first run
     return {"scenes": [run_scene_benchmark(sc) for sc in loaded]}

@@ -257,7 +257,7 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     ContactSceneError
         The scene has no ``contact`` section or a massless body.
     """
-    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.analysis.contact.sim import scene_start
     from walkerlab.models.contact.scene import contact_setup
 

@@ -113,7 +113,7 @@ def bench_gym(scenes=SCENES, views=("rigid", "contact"), steps: int = 1000,
         ``rates``) or ``walker2d_missing`` (why not).
     """
     import walkerlab.gym  # noqa: F401 - registers walkerlab/Walker-v0
-    from walkerlab.gym import WalkerEnv
+    from walkerlab.gym import WalkerEnv  # light
 
     envs, rows = {}, []
     for sc in scenes:

@@ -51,9 +51,9 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
         closed loop, DOP853 at the scene's tolerances) [s], ``target_s``, ``step_period_s``
         (by quadrature) [s].
     """
-    from walkerlab.analysis.gait.poincare import poincare_map
-    from walkerlab.analysis.gait.zero_dynamics import impact_multiplier, zero_dynamics
-    from walkerlab.config import load_scene
+    from walkerlab.analysis.gait.poincare import poincare_map  # light
+    from walkerlab.analysis.gait.zero_dynamics import impact_multiplier, zero_dynamics  # light
+    from walkerlab.config import load_scene  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
@@ -114,12 +114,12 @@ def bench_design_process(pairs: int = 3) -> dict:
 
     from walkerlab.bench.optimize import in_turn, process_times
     from walkerlab.bench.process_env import installed_env
-    from walkerlab.config import load_scene
+    from walkerlab.config import load_scene  # light
     from walkerlab.integrate.solver import Solver
-    from walkerlab.io.schemas.optimize import load
+    from walkerlab.io.schemas.optimize import load  # light
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.driver import collocation_spec
-    from walkerlab.optimal.virtual_constraints import controller_step, design_spec
+    from walkerlab.optimal.driver import collocation_spec  # light
+    from walkerlab.optimal.virtual_constraints import controller_step, design_spec  # light
 
     root = Path(__file__).resolve().parents[2]
     script = [sys.executable, str(root / "walkerlab" / "bench" / "minimal_casadi_hzd.py")]
@@ -184,15 +184,15 @@ def bench_design(repeats: int = 3) -> dict:
     import yaml
 
     from walkerlab.codegen.casadi_functions import clear_memo
-    from walkerlab.config import scene_from_dict
+    from walkerlab.config import scene_from_dict  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.driver import collocation_spec, optimize_scene
+    from walkerlab.optimal.driver import collocation_spec, optimize_scene  # light
     from walkerlab.optimal.transcription.virtual_constraints import (
         collocate_virtual_constraints,
         hzd_functions,
     )
-    from walkerlab.optimal.virtual_constraints import controller_step
+    from walkerlab.optimal.virtual_constraints import controller_step  # light
     from walkerlab.walker.description import walker_data
 
     root = Path(__file__).resolve().parents[2]

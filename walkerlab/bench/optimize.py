@@ -74,7 +74,7 @@ def _run(scene_path: Path, folder: Path, force: bool, tree: Path | None = None) 
            "tail": text.strip().splitlines()[-3:]}
     art = folder / "runs" / scene_path.stem / "optimize.h5"
     if proc.returncode == 0 and art.exists():  # not an earlier run's artifact
-        from walkerlab.io.schemas.optimize import load
+        from walkerlab.io.schemas.optimize import load  # light
 
         d = load(art)
         res.update(ipopt_wall_s=float(d.wall_time_s), ipopt_iterations=int(d.iterations),

@@ -33,7 +33,7 @@ PUSH_OFF = {"push_off": {"impulse_n_s": 0.5}}
 
 
 def _scene(name: str, actuation):
-    from walkerlab.config import Scene, load_scene
+    from walkerlab.config import Scene, load_scene  # light
 
     d = load_scene(CONFIGS / name).model_dump(mode="json", exclude_none=True)
     d["walker"].pop("actuation", None)
@@ -45,8 +45,8 @@ def _scene(name: str, actuation):
 def _timed(scene, x_ideal, steps_s: float, repeats: int, method: str | None = None):
     """Median CPU time [s] of the scene's contact run from ``x_ideal`` over ``steps_s``,
     its simulated time [s] and heel strikes."""
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact
-    from walkerlab.models.contact.scene import contact_setup
+    from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
+    from walkerlab.models.contact.scene import contact_setup  # light
 
     setup = contact_setup(scene)
     walker, x0, limits, _ = scene_start(setup, x_ideal, 3)
@@ -70,7 +70,7 @@ def bench_powered_contact(repeats: int = 7) -> dict:
         Per case: CPU time [s], simulated time [s], heel strikes, the ratio to the passive
         run (per simulated second for RABBIT) and the solve_ivp run's time and ratio.
     """
-    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
 
     out = {"repeats": repeats, "target_ratio": 1.5, "cases": {}}
     paper = _scene("paper.yaml", None)
@@ -99,7 +99,7 @@ def bench_powered_contact(repeats: int = 7) -> dict:
 
 
 def _rabbit_actuation():
-    from walkerlab.config import load_scene
+    from walkerlab.config import load_scene  # light
 
     return load_scene(CONFIGS / "rabbit.yaml").walker.actuation.model_dump(
         mode="json", exclude_none=True)

@@ -103,10 +103,10 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     (:func:`walkerlab.analysis.contact.sim.scene_start`); the CPU time is the thread's
     around :func:`walkerlab.analysis.contact.sim.simulate_contact` alone.
     """
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact
-    from walkerlab.bench.contact import leg_angle_columns
-    from walkerlab.config import SolverSettings
-    from walkerlab.models.contact.scene import contact_setup
+    from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
+    from walkerlab.bench.contact import leg_angle_columns  # light
+    from walkerlab.config import SolverSettings  # light
+    from walkerlab.models.contact.scene import contact_setup  # light
     from walkerlab.walker.layout import StateIndex
 
     setup = contact_setup(scene)
@@ -161,7 +161,7 @@ _RUNNERS: dict = {}
 
 
 def _build_runner(model: str, scene_json: str, step_period: float, x0: tuple, strides: int):
-    from walkerlab.config import scene_from_dict
+    from walkerlab.config import scene_from_dict  # light
 
     scene = scene_from_dict(json.loads(scene_json))
     if model == "ideal":
@@ -297,7 +297,7 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
     def store(key, res, n_lanes):
         res = {**res, "measured_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                "parallel_workers": n_lanes}
-        from walkerlab.io.artifacts import atomic_write
+        from walkerlab.io.artifacts import atomic_write  # light
 
         text = json.dumps(res).encode()
         atomic_write(cache_dir / f"{key}.json", lambda fh: fh.write(text))

@@ -101,7 +101,7 @@ def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True
     sweep run in this process (one worker).
     """
     from walkerlab.io.sweep_store import load_sweep
-    from walkerlab.stages.sweep import draw, run
+    from walkerlab.stages.sweep import draw, run  # light
 
     scene = B.paper_scene()
     param = [f"slope.angle_deg={slopes}"]
@@ -184,7 +184,7 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
 
 def _run_one(name: str, scenes) -> dict:
     if name == "contact" and not scenes:
-        from walkerlab.bench.contact import run_benchmark
+        from walkerlab.bench.contact import run_benchmark  # light
 
         return run_benchmark()
     if name == "main-job":
@@ -200,7 +200,7 @@ def _run_one(name: str, scenes) -> dict:
 
         return bench_powered_contact()
     if name == "powered-command":
-        from walkerlab.bench.powered_command import bench_powered_command
+        from walkerlab.bench.powered_command import bench_powered_command  # light
 
         return bench_powered_command()
     if name == "hzd":

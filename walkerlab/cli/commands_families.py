@@ -24,9 +24,9 @@ def sweep(scene: Path | None = SceneArg,
           name: str | None = typer.Option(None, "--name", help="artifact name"),
           runs_dir: Path = RunsOpt) -> None:
     """Run a stage over a grid of scene fields; one row per point, failures recorded."""
-    from walkerlab.io.sweep_store import load_sweep
-    from walkerlab.report.sweep_text import sweep_text
-    from walkerlab.stages import sweep as stage_mod
+    from walkerlab.io.sweep_store import load_sweep  # light
+    from walkerlab.report.sweep_text import sweep_text  # light
+    from walkerlab.stages import sweep as stage_mod  # light
 
     sc = load(scene)
     path = stage_mod.run(sc, param, stage=stage, workers=workers,
@@ -57,8 +57,8 @@ def bifurcation(scene: Path | None = SceneArg,
                 runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Bifurcation diagram over the slope (or any numeric scene field, --param): fixed
     points, multipliers, period-doubling onset."""
-    from walkerlab.stages import bifurcation as stage
-    from walkerlab.studies.params import (
+    from walkerlab.stages import bifurcation as stage  # light
+    from walkerlab.studies.params import (  # light
         SweepError,
         check_axes,
         parse_param,
@@ -99,7 +99,7 @@ def bifurcation(scene: Path | None = SceneArg,
 def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
     """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise (the numbers
     are checked by the stage, as for a call from Python)."""
-    from walkerlab.studies.params import SweepError
+    from walkerlab.studies.params import SweepError  # light
 
     path, _, rhs = text.partition("=")
     parts = rhs.split(":")
@@ -128,7 +128,7 @@ def continuation(scene: Path | None = SceneArg,
     """Pseudo-arclength continuation of the scene's gait over a field: folds, period
     doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5
     (continuation_<FIELD>+<FIELD2>.h5 with --param2)."""
-    from walkerlab.stages import continuation as stage
+    from walkerlab.stages import continuation as stage  # light
 
     path, a, b = _range_spec(param, "--param")
     p2 = _range_spec(param2, "--param2") if param2 else None
@@ -172,8 +172,8 @@ def target(scene: Path | None = SceneArg,
     if len(given) != 1:
         fail(ValueError("target: give exactly one of --speed-m-per-s, --step-length-m, "
                         f"--step-period-s (got {len(given) or 'none'})"))
-    from walkerlab.analysis.continuation.target import TargetNotReached
-    from walkerlab.analysis.gait.search import GaitNotFound
+    from walkerlab.analysis.continuation.target import TargetNotReached  # light
+    from walkerlab.analysis.gait.search import GaitNotFound  # light
 
     try:
         w, gait = wl.Walker.from_scene(load(scene)).find_gait_for(vary, **given)
@@ -181,7 +181,7 @@ def target(scene: Path | None = SceneArg,
         raise ValueError(f"target: {exc}; try a target nearer the scene's own gait, or "
                          f"follow it with walkerlab continuation --param {vary}=...") from None
     (name, value), = given.items()
-    from walkerlab.studies.continuation import scene_value
+    from walkerlab.studies.continuation import scene_value  # light
     from walkerlab.units import field_unit, for_scene
 
     u = for_scene(w.scene)
@@ -223,7 +223,7 @@ def optimize(scene: Path | None = SceneArg,
     their bounds that minimise (--maximize: maximise) a measure of the scene's own gait,
     followed from the scene's values, gradients through the fixed point; writes
     optimize_design_<fields>_<objective>[_maximize].h5 (one per fields and objective)."""
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     if design:
         if require_gait:
@@ -232,7 +232,7 @@ def optimize(scene: Path | None = SceneArg,
         _optimize_design(scene, design, objective, maximize, runs_dir, force)
         return
 
-    from walkerlab.report.figures_section import not_a_gait_reason
+    from walkerlab.report.figures_section import not_a_gait_reason  # light
 
     sc = load(scene)
     out = pipeline.run("optimize", sc, runs_dir, force)
@@ -240,11 +240,11 @@ def optimize(scene: Path | None = SceneArg,
     if d is not None:
         _echo_optimum(sc, d)
     typer.echo(status(out))
-    from walkerlab.stages.optimize import draw
+    from walkerlab.stages.optimize import draw  # light
 
     typer.echo(f"figure: {draw(load(scene), runs_dir, svg, keep_current=True)[0]}")
     if require_gait:  # the artifact stays: it holds what was found
-        from walkerlab.io.schemas.optimize import load as load_optimize
+        from walkerlab.io.schemas.optimize import load as load_optimize  # light
 
         d = d if d is not None else load_optimize(out.path)
         if not d.gait:
@@ -256,7 +256,7 @@ def _echo_optimum(sc, d) -> None:
     """Print the optimum ``d`` (an ``OptimizeData``) of ``walkerlab optimize`` in the scene's
     units: IPOPT's status, the step, the objective, the replays (rigid, phase-variable laws,
     contact model) and whether it is a gait."""
-    from walkerlab.report.figures_section import cot_terms_text, not_a_gait_reason
+    from walkerlab.report.figures_section import cot_terms_text, not_a_gait_reason  # light
     from walkerlab.units import for_scene
 
     u = for_scene(sc)  # the scene's units (a nondimensional scene: l, sqrt(l/g), ...)
@@ -315,9 +315,9 @@ def _echo_optimum(sc, d) -> None:
 
 def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> None:
     """``walkerlab optimize --design``: parse FIELD=LO:HI, run, print the optimum."""
-    from walkerlab.optimal.design.search import MEASURES, design_bounds
-    from walkerlab.stages import optimize as stage
-    from walkerlab.stages import pipeline
+    from walkerlab.optimal.design.search import MEASURES, design_bounds  # light
+    from walkerlab.stages import optimize as stage  # light
+    from walkerlab.stages import pipeline  # light
 
     if objective not in MEASURES:
         raise ValueError(f"--objective: one of {', '.join(MEASURES)}, not {objective!r}")

@@ -14,7 +14,7 @@ from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load
 @guard
 def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
     """Draw the figures (PNG + SVG) from the scene's existing artifacts."""
-    from walkerlab.stages import plot as stage
+    from walkerlab.stages import plot as stage  # light
 
     for p in stage.run(load(scene), runs_dir):
         typer.echo(f"wrote {p}")
@@ -28,7 +28,7 @@ def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                                      "the Section-5 attribution (contact scenes; ~17 s CPU)"),
            ) -> None:
     """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
-    from walkerlab.stages import report as stage
+    from walkerlab.stages import report as stage  # light
 
     out = stage.run(load(scene), runs_dir, force, echo=typer.echo, full=full)
     typer.echo(f"report: {out}")
@@ -40,7 +40,7 @@ def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
     """The walker walking (rigid, and contact beside it where contact_sim.h5 exists):
     report/figures/animation.gif, and .mp4 if ffmpeg is installed."""
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("animate", load(scene), runs_dir)
     for p in out.paths:
@@ -79,7 +79,7 @@ def export(scene: Path | None = SceneArg,
     heel strikes and prints the step period against the rigid gait's (exit code 0 either way;
     a walk that falls or misses 1 % adds a warning on stderr)."""
     from walkerlab.export.mjcf_scene import MjcfOptions
-    from walkerlab.stages import export as stage
+    from walkerlab.stages import export as stage  # light
 
     sc = load(scene)
     out = stage.write(sc, runs_dir, fmt, walker_only=walker_only, walk=walk,
@@ -93,7 +93,7 @@ def export(scene: Path | None = SceneArg,
             typer.echo(f"warning: {out.path.name} does not walk {out.walk.steps} steps "
                        f"within {100 * out.walk.tolerance:g} % of the rigid gait", err=True)
     if fmt == "adm":  # the dataset is not the scene's walker: say so here, not in a comment
-        from walkerlab.export.adams import actuation_warning
+        from walkerlab.export.adams import actuation_warning  # light
 
         if warning := actuation_warning(sc):
             typer.echo(warning, err=True)
@@ -111,7 +111,7 @@ def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | fixedpoin
               "configs/paper.yaml", show_default=False),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
-    from walkerlab.cli.bench import run_bench
+    from walkerlab.cli.bench import run_bench  # light
 
     for line in run_bench(what, out, scenes=scenes or None):
         typer.echo(line)

@@ -33,14 +33,14 @@ def basin(scene: Path | None = SceneArg,
             fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
                              f"got {grid!r}"))
         g = (nx, ny)
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("basin", load(scene), runs_dir, force, grid=g, workers=workers,
                        scheduler=scheduler, resume=resume)
     if out.summary:
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(status(out))
-    from walkerlab.stages.basin import figure_path
+    from walkerlab.stages.basin import figure_path  # light
 
     typer.echo(f"figure: {figure_path(load(scene), runs_dir, g)}")
 
@@ -57,7 +57,7 @@ def mfpt(scene: Path | None = SceneArg,
                                                help="Dask scheduler address (tcp://host:port)"),
          runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Mean first-passage time (steps before the fall) on per-step random slopes."""
-    from walkerlab.stages import mfpt as stage
+    from walkerlab.stages import mfpt as stage  # light
 
     sig = None
     if sigma_rad is not None:
@@ -66,17 +66,17 @@ def mfpt(scene: Path | None = SceneArg,
         except ValueError:
             fail(ValueError(f"--sigma-rad: expected numbers separated by commas, got "
                              f"{sigma_rad!r}"))
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     sc = load(scene)
     out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
                        workers=workers, scheduler=scheduler)
-    from walkerlab.report.text import mfpt_text
+    from walkerlab.report.text import mfpt_text  # light
 
     summary = out.summary
     if not summary and out.path.is_file():  # reused: the same lines from the artifact
-        from walkerlab.io.schemas.mfpt import load as load_mfpt
-        from walkerlab.studies.mfpt import mfpt_summary
+        from walkerlab.io.schemas.mfpt import load as load_mfpt  # light
+        from walkerlab.studies.mfpt import mfpt_summary  # light
 
         summary = mfpt_summary(load_mfpt(out.path), stage.check(sc)[0].mesh_rel_change)
     if summary:
@@ -94,9 +94,9 @@ def robustness(scene: Path | None = SceneArg,
                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Gait sensitivity norms, largest step-down/up and MFPT at the scene's sigma
     (the scene's robustness section); writes robustness.h5."""
-    from walkerlab.io.schemas import robustness as schema
-    from walkerlab.io.schemas.robustness import per_unit
-    from walkerlab.stages import pipeline
+    from walkerlab.io.schemas import robustness as schema  # light
+    from walkerlab.io.schemas.robustness import per_unit  # light
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("robustness", load(scene), runs_dir, force, workers=workers,
                        scheduler=scheduler)
@@ -124,9 +124,9 @@ def stability_map(scene: Path | None = SceneArg,
                   runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Stability maps of the contact gait: does a periodic gait exist, is it stable, max
     |Floquet multiplier|, or why not (cached stage)."""
-    from walkerlab.config.options import map_not_applicable
-    from walkerlab.stages import stability_map as stage
-    from walkerlab.studies.stability import MAP_KINDS
+    from walkerlab.config.options import map_not_applicable  # light
+    from walkerlab.stages import stability_map as stage  # light
+    from walkerlab.studies.stability import MAP_KINDS  # light
 
     sc = load(scene)
     kinds = list(MAP_KINDS) if kind == "all" else [kind]

@@ -26,9 +26,9 @@ def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                                                    "gait found is unstable: no stable "
                                                    "period-1 gait was found")) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
-    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-    from walkerlab.report.text import fixedpoint_text, unstable_gait_line
-    from walkerlab.stages import pipeline
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint  # light
+    from walkerlab.report.text import fixedpoint_text, unstable_gait_line  # light
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("fixedpoint", load(scene), runs_dir, force, known=known)
     fp = load_fixedpoint(out.path)
@@ -49,9 +49,9 @@ def simulate(scene: Path | None = SceneArg,
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or from the state given
     as simulate.initial_state in the scene)."""
-    from walkerlab.io.schemas.simulate import load_simulate
-    from walkerlab.report.text import simulate_ending, simulate_text
-    from walkerlab.stages import pipeline
+    from walkerlab.io.schemas.simulate import load_simulate  # light
+    from walkerlab.report.text import simulate_ending, simulate_text  # light
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("simulate", load(scene), runs_dir, force, strides=strides,
                        terrain_seed=terrain_seed)
@@ -77,9 +77,9 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                     "(default: contact_sim.n_strides of the scene)")
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
-    from walkerlab.io.schemas.contact_sim import load_contact_sim
-    from walkerlab.report.text import contact_text
-    from walkerlab.stages import pipeline
+    from walkerlab.io.schemas.contact_sim import load_contact_sim  # light
+    from walkerlab.report.text import contact_text  # light
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("contact-sim", load(scene), runs_dir, force, adjust=adjust,
                        periodic=periodic, strides=strides)
@@ -96,14 +96,14 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                 False, "--rigid-limit", help="instead: the contact periodic gait along the "
                 "rigid-limit family (rigid_limit.h5 and its figure)")) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
-    from walkerlab.io.schemas.compare import load_compare
-    from walkerlab.report.text import compare_text
-    from walkerlab.stages import pipeline
+    from walkerlab.io.schemas.compare import load_compare  # light
+    from walkerlab.report.text import compare_text  # light
+    from walkerlab.stages import pipeline  # light
 
     if rigid_limit:
-        from walkerlab.io.schemas.rigid_limit import load_rigid_limit
-        from walkerlab.report.text import rigid_limit_text
-        from walkerlab.stages import rigid_limit as rl
+        from walkerlab.io.schemas.rigid_limit import load_rigid_limit  # light
+        from walkerlab.report.text import rigid_limit_text  # light
+        from walkerlab.stages import rigid_limit as rl  # light
 
         sc = load(scene)
         out = rl.run(sc, runs_dir, force)
@@ -122,9 +122,9 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                   force: bool = ForceOpt) -> None:
     """Work-precision study: error vs wall time for every solver and tolerance."""
-    from walkerlab.io.schemas.workprecision import load_workprecision
-    from walkerlab.report.text import workprecision_text
-    from walkerlab.stages import pipeline
+    from walkerlab.io.schemas.workprecision import load_workprecision  # light
+    from walkerlab.report.text import workprecision_text  # light
+    from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("workprecision", load(scene), runs_dir, force)
     typer.echo(workprecision_text(load_workprecision(out.path)))

@@ -112,11 +112,11 @@ def guard(fn):
     @functools.wraps(fn)
     def wrapper(*a, **k):
         from walkerlab import progress
-        from walkerlab.config import SceneError
-        from walkerlab.io.artifacts import ArtifactError, is_disk_full
-        from walkerlab.io.runpaths import ArtifactBusy
+        from walkerlab.config import SceneError  # light
+        from walkerlab.io.artifacts import ArtifactError, is_disk_full  # light
+        from walkerlab.io.runpaths import ArtifactBusy  # light
         from walkerlab.safefs import interrupted, raise_if_interrupted, watching_interrupts
-        from walkerlab.stages.common import StageError
+        from walkerlab.stages.common import StageError  # light
 
         debug = _debug()
 

@@ -27,14 +27,14 @@ ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact i
 
 def default_scene() -> Path:
     """``configs/paper.yaml`` (see :func:`walkerlab.config.default_scene_path`)."""
-    from walkerlab.config import default_scene_path
+    from walkerlab.config import default_scene_path  # light
 
     return default_scene_path()
 
 
 def load(scene: Path | None):
     """The scene at ``scene`` (default :func:`default_scene`), validated (SceneError)."""
-    from walkerlab.config import load_scene
+    from walkerlab.config import load_scene  # light
 
     return load_scene(scene or default_scene())
 

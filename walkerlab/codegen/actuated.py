@@ -96,7 +96,7 @@ def _body(eq, joints, variational, guards, printer, locked: bool = False) -> lis
     :data:`KNEE_LOCK_BASIS`)."""
     import sympy as sp
 
-    from walkerlab.codegen.source import cse_lines, flow_lines
+    from walkerlab.codegen.source import cse_lines, flow_lines  # light
 
     n = len(eq.q)
     m = 2 * n
@@ -179,7 +179,7 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     key : str
         Written into the header.
     """
-    from walkerlab.codegen.source import PRINTER, cse_lines, start_module
+    from walkerlab.codegen.source import PRINTER, cse_lines, start_module  # light
     from walkerlab.codegen.torque_law import kernel_source
 
     hoisted = start_module(eq.params)  # filled as the bodies are generated
@@ -245,11 +245,11 @@ def actuated_module(structure, joints):
 
     def build() -> str:
         if structure.kind.name in cache.FREE_JOINTED:
-            from walkerlab.codegen.free_joints import derive_five_link
+            from walkerlab.codegen.free_joints import derive_five_link  # light
 
             eq = derive_five_link(structure)
         else:
-            from walkerlab.codegen import symbolic
+            from walkerlab.codegen import symbolic  # light
 
             eq = symbolic.derive(structure)
         return generate_actuated(eq, structure.param_names, tuple(joints), key)

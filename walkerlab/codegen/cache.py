@@ -162,21 +162,21 @@ def generated_module(structure) -> dict:
     path = folder / f"{key}.py" if folder is not None else None
     ns = _read(path) if path is not None else None
     if ns is None and structure.foot == "flat":
-        from walkerlab.codegen import foot_modes as flatfoot
+        from walkerlab.codegen import foot_modes as flatfoot  # light
 
         body = flatfoot.generate_flat(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)
     if ns is None and _free_jointed(structure):
-        from walkerlab.codegen import free_joints as five_link
+        from walkerlab.codegen import free_joints as five_link  # light
 
         body = five_link.generate_five_link(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)
     if ns is None:
-        from walkerlab.codegen import source as codegen
+        from walkerlab.codegen import source as codegen  # light
 
         eq = derive_equations(structure)
         body = codegen.generate(eq, structure.param_names, key)
@@ -193,15 +193,15 @@ def derive_equations(structure):
     (:mod:`walkerlab.codegen.rolling_polygon`) or a biped's
     (:func:`walkerlab.codegen.symbolic.derive`)."""
     if structure.spatial:
-        from walkerlab.codegen import spatial
+        from walkerlab.codegen import spatial  # light
 
         return (spatial.derive_spoked(structure) if structure.spokes
                 else spatial.derive_compass(structure))
     if structure.spokes:
-        from walkerlab.codegen import rolling_polygon
+        from walkerlab.codegen import rolling_polygon  # light
 
         return rolling_polygon.derive(structure)
-    from walkerlab.codegen import symbolic
+    from walkerlab.codegen import symbolic  # light
 
     return symbolic.derive(structure)
 

@@ -34,10 +34,10 @@ def compiled_module(structure):
 
     def build() -> str:
         if structure.foot == "flat":  # a flat foot's modes: their own generator
-            from walkerlab.codegen import foot_modes as flatfoot
+            from walkerlab.codegen import foot_modes as flatfoot  # light
 
             return flatfoot.generate_flat_compiled(structure, key)
-        from walkerlab.codegen import source as codegen
+        from walkerlab.codegen import source as codegen  # light
 
         return codegen.generate_compiled(cache.derive_equations(structure),
                                          structure.param_names, key)

@@ -254,7 +254,7 @@ def _legs(s: _Symbols) -> tuple[list, list, dict]:
     without a trigonometric simplifier."""
     import sympy as sp
 
-    from walkerlab.codegen.link_sums import e
+    from walkerlab.codegen.link_sums import e  # light
 
     structure, q, P, tags = s.structure, s.q, s.P, s.tags
     L, gamma, lt, R, knee = P["L"], P["gamma"], s.lt, s.R, s.knee
@@ -322,7 +322,7 @@ def _torso(s: _Symbols, bodies: list, points: dict):
     ``torso_angle``; a point ``d`` up its axis is at ``hip - d e(t)``."""
     import sympy as sp
 
-    from walkerlab.codegen.link_sums import e
+    from walkerlab.codegen.link_sums import e  # light
 
     structure, q, P, hip_links = s.structure, s.q, s.P, s.hip_links
     hip = points["hip"]

@@ -33,10 +33,10 @@ def derive_equations(structure):
     from walkerlab.codegen import cache
 
     if structure.kind.name in cache.FREE_JOINTED:
-        from walkerlab.codegen.free_joints import derive_five_link
+        from walkerlab.codegen.free_joints import derive_five_link  # light
 
         return derive_five_link(structure)
-    from walkerlab.codegen import symbolic
+    from walkerlab.codegen import symbolic  # light
 
     return symbolic.derive(structure)
 
@@ -61,7 +61,7 @@ def resolve_link(leg_angles: dict, link: str, where: str):
 
 
 def _joint_expr(leg_angles: dict, joint: str, where: str):
-    from walkerlab.walker.joints import joint_links
+    from walkerlab.walker.joints import joint_links  # light
 
     first, second = joint_links(leg_angles, joint, where)
     return leg_angles[second] - leg_angles[first]

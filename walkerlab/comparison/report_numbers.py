@@ -43,12 +43,12 @@ def report_numbers(scene, arts: dict) -> dict:
     out: dict = {}
     sim, contact = arts.get("simulate"), arts.get("contact-sim")
     if sim is not None:
-        from walkerlab.analysis.gait.checks import (
+        from walkerlab.analysis.gait.checks import (  # light
             energy_drift_in_swing,
             run_ground,
             swing_foot_clearance,
         )
-        from walkerlab.comparison.tables import table3
+        from walkerlab.comparison.tables import table3  # light
 
         out["energy_drift"] = energy_drift_in_swing(sim.samples)
         ground = run_ground(scene, sim.samples)

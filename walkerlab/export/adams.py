@@ -276,7 +276,7 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
     walkerlab.analysis.gait.search.GaitNotFound
         No rigid gait (:func:`walkerlab.analysis.contact.periodic.ideal_gait`).
     """
-    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.export.scene import mjcf_scene
 
     ideal = ideal_gait(scene) if ideal is None else ideal

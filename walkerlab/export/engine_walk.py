@@ -160,11 +160,11 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
         return not_walked(f"{engine} is not importable here (pip install -e '.[{extra}]')")
     duration = (steps + 1.3) * rigid_period_s
     if fmt == "mjcf" and spokes:
-        from walkerlab.export.mujoco_walk import roll as walk
+        from walkerlab.export.mujoco_walk import roll as walk  # light
     elif fmt == "mjcf":
-        from walkerlab.export.mujoco_walk import walk
+        from walkerlab.export.mujoco_walk import walk  # light
     else:
-        from walkerlab.export.opensim_walk import walk
+        from walkerlab.export.opensim_walk import walk  # light
     run = walk(path, duration) if feedback is None else walk(path, duration, feedback=feedback)
     periods = run.step_periods_s
     return EngineWalk(engine, strikes=len(run.times_s), alternating=run.alternating,

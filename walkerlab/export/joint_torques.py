@@ -86,7 +86,7 @@ def torque_generalized_forces(joint: str, stance: int, coordinates) -> dict[str,
     dict
         Coordinate name -> coefficient (zeros dropped).
     """
-    from walkerlab.config.actuation import JOINTS
+    from walkerlab.config.actuation import JOINTS  # light
 
     first, second = JOINTS[joint]
     out = dict(link_angle(second, stance, coordinates))

@@ -197,9 +197,9 @@ class PoweredLoop:
 
         import mujoco
 
-        from walkerlab.config.actuation import Actuation
+        from walkerlab.config.actuation import Actuation  # light
         from walkerlab.export.joint_torques import torque_generalized_forces
-        from walkerlab.models.actuation import TorqueLaws
+        from walkerlab.models.actuation import TorqueLaws  # light
 
         i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
         adr, size = int(model.text_adr[i]), int(model.text_size[i])
@@ -304,7 +304,7 @@ class PoweredLoop:
 
     def heel_strike(self, data, leg: int) -> None:
         """Leg ``leg`` (0, 1) struck: roles swap, the push-off starts at the other foot."""
-        from walkerlab.models.actuation import push_off_impulse
+        from walkerlab.models.actuation import push_off_impulse  # light
 
         self.stance, self.t_step, self.heel_off, self.off_steps = leg, float(data.time), \
             False, 0

@@ -365,7 +365,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     walkerlab.analysis.gait.poincare.FixedPointNotFound
         No rigid gait.
     """
-    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.export.scene import SCENE_FEET, mjcf_scene
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si

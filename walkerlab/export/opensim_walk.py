@@ -156,7 +156,7 @@ class _Drive:
         import opensim as osim
 
         from walkerlab.export.joint_torques import torque_generalized_forces
-        from walkerlab.models.actuation import TorqueLaws
+        from walkerlab.models.actuation import TorqueLaws  # light
 
         self.laws = TorqueLaws(spec.torques)
         self.gf = [[torque_generalized_forces(t.joint, st, coords) for t in spec.torques]
@@ -317,8 +317,8 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     push_law = None
     spec = None
     if "actuation" in info:
-        from walkerlab.config.actuation import Actuation
-        from walkerlab.models.actuation import push_off_impulse
+        from walkerlab.config.actuation import Actuation  # light
+        from walkerlab.models.actuation import push_off_impulse  # light
 
         spec = Actuation.model_validate(info["actuation"])
         push_law = spec.push_off

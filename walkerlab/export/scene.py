@@ -250,7 +250,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
     ValueError
         No ``fixedpoint`` section (one line).
     """
-    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.terrain import ground_drops

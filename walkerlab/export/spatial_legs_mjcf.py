@@ -260,9 +260,9 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         ``terrain.lanes``).
     """
     from walkerlab.codegen.cache import functions
-    from walkerlab.config.contact import ContactSettings
-    from walkerlab.export.scene import EXPORT_STEPS, mujoco_contact
-    from walkerlab.models.contact.rigid_limit import contact_si
+    from walkerlab.config.contact import ContactSettings  # light
+    from walkerlab.export.scene import EXPORT_STEPS, mujoco_contact  # light
+    from walkerlab.models.contact.rigid_limit import contact_si  # light
 
     terrain = scene.terrain_or_default()
     if terrain.lanes != "checkerboard":

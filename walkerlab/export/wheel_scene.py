@@ -87,7 +87,7 @@ def wheel_keyframe(scene: Scene, data, ideal=None) -> WheelKeyframe:
         A point-mass hub without ``contact.hub_inertia_kg_m2`` (one line,
         :data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`: the file's hub needs it too).
     """
-    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
 

@@ -169,7 +169,7 @@ class ContactView:
     def _lay_out(self, n_steps: int):
         """Patches for ``n_steps`` steps (:func:`walkerlab.analysis.contact.sim.scene_start`),
         the episode's roughness on them; returns the scene's start, limits, step length."""
-        from walkerlab.analysis.contact.sim import scene_start
+        from walkerlab.analysis.contact.sim import scene_start  # light
 
         if n_steps not in self._layouts:  # the scene's patches for n_steps: the same each
             walker, x0, limits, step_length = scene_start(  # episode, laid out once
@@ -251,7 +251,7 @@ class ContactView:
     def _start(self, x, t: float, keep=None) -> None:
         """The run's hook on the present walker from ``(t, x)``; ``keep``: the stance leg,
         step start, ankle push-off and work integrals carried over (a new layout)."""
-        from walkerlab.integrate.contact_powered import ActuationHook
+        from walkerlab.integrate.contact_powered import ActuationHook  # light
 
         if self._built is not None and self._built[0] is self.walker:  # the walker of
             _, w, segments = self._built  # the last run (a new episode on the same

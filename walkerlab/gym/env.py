@@ -36,7 +36,7 @@ Reward (Walker2d-v5's convention, every weight a keyword)::
 ``reward_fn(env, info) -> float`` in its place.
 
 Episode: from the scene's gait (its fixed point, found once per scene and process and
-cached; :meth:`walkerlab.api.walker.Walker.fixed_point`), leg1 swinging, unless
+cached; :meth:`walkerlab.rigid_walker.SceneWalker.fixed_point`), leg1 swinging, unless
 ``reset(options={"state": x})`` gives the state (the rigid walker's post-impact state (2n,),
 or in the contact view its floating state (N,)); ``start_noise`` (at most 1) multiplies the
 start's rates by ``1 + U(-s, s)`` drawn by the reset's seed, before the start is checked.
@@ -105,6 +105,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from walkerlab.rigid_walker import SceneWalker, scene_of
+
 from .episode_state import capture, restore
 
 __all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
@@ -143,7 +145,6 @@ def _gait(walker):
     return _GAITS[key]
 
 
-
 def _rigid_ground(scene):
     """The rigid view's ground beyond its walker's own (:func:`walkerlab.integrate.rigid.
     walker_of_step`: a slope, stairs, footholds of one or several heights or slopes, as
@@ -165,7 +166,7 @@ def _rigid_ground(scene):
                          "--terrain-seed draws it); leave terrain.per_step out")
     if t.kind != "profile":
         return None
-    from walkerlab.analysis.gait.rigid_run import profile_ground
+    from walkerlab.analysis.gait.rigid_run import profile_ground  # light
 
     try:
         return profile_ground(scene)
@@ -290,7 +291,7 @@ class WalkerEnv(gym.Env):
         The action's joints.
     state_names, observation_names : list of str
         The walker's state's names; the observation's (the state's, then the phase's).
-    gait : walkerlab.api.walker.Gait
+    gait : walkerlab.rigid_walker.Gait
         The scene's gait (the episodes' start).
 
     Raises
@@ -327,18 +328,17 @@ class WalkerEnv(gym.Env):
                  policy: str | None = None, compiled_step: bool = True):
         #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
-        from walkerlab.api.walker import Walker
         from walkerlab.walker.description import walker_data
 
-        from .action import action_joints, action_limits, action_torques
-        from .rigid_view import RigidView
+        from .action import action_joints, action_limits, action_torques  # light
+        from .rigid_view import RigidView  # light
 
         _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
                          terrain_roughness_m)
         if policy not in (None, "scene"):
             raise ValueError(f"policy={policy!r}: give None or 'scene' (the scene's feedback "
                              "controller acting with the action)")
-        self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
+        self.rigid = SceneWalker(scene_of(scene if not isinstance(scene, Path) else str(scene)))
         sc = self.rigid.scene
         data = walker_data(sc.walker, sc.slope.phi_rad)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
@@ -358,7 +358,7 @@ class WalkerEnv(gym.Env):
         ground = _rigid_ground(sc) if view == "rigid" else None
         if view == "contact":  # the contact view's refusals (the table's contact cells for
             # the scene's features, its ground): from the scene alone, before the gait search
-            from walkerlab.models.contact.scene import contact_setup
+            from walkerlab.models.contact.scene import contact_setup  # light
 
             setup = contact_setup(sc)
         self.scene, self.view = sc, view
@@ -375,7 +375,7 @@ class WalkerEnv(gym.Env):
         #: the scene's feedback controller (virtual constraints; None: the scene has none):
         #: out of the walker's flow, the policy (:meth:`scene_policy`)
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
-        plant = self.rigid if vc is None else Walker.from_scene(_plant(sc))
+        plant = self.rigid if vc is None else SceneWalker(_plant(sc))
         model = plant.model
         self.joints = action_joints(sc, self.controller)
         if view == "rigid":
@@ -527,7 +527,7 @@ class WalkerEnv(gym.Env):
         start = self.gait.x if self.view == "rigid" else self.sim.x_start
         if state is not None and any(isinstance(v, str | bytes) for v in
                                      np.ravel(np.asarray(state, dtype=object))):
-            from walkerlab.config import SceneError
+            from walkerlab.config import SceneError  # light
 
             raise SceneError(f"options['state']: give {len(self.state_names)} numbers "
                              f"({', '.join(self.state_names)}), not text")
@@ -547,7 +547,7 @@ class WalkerEnv(gym.Env):
                 self._checked_start = x0  # (the same numbers pass again: not checked twice)
         elif not (isinstance(x0, np.ndarray) and x0.shape == self.sim.x_start.shape
                   and np.all(np.isfinite(x0))):
-            from walkerlab.config import SceneError
+            from walkerlab.config import SceneError  # light
 
             raise SceneError(f"options['state']: give {len(self.state_names)} finite "
                              f"numbers ({', '.join(self.state_names)})")
@@ -723,7 +723,7 @@ def _rigid_view():
     not needed to register the environment), kept for the per-period calls."""
     global _RIGID_VIEW
     if _RIGID_VIEW is None:
-        from . import rigid_view as _RIGID_VIEW
+        from . import rigid_view as _RIGID_VIEW  # light
     return _RIGID_VIEW
 
 

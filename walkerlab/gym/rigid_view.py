@@ -539,7 +539,7 @@ class RigidView:
         """Where the swing foot of the step just ended met the profile (``(t, x, y)``), or
         None (:func:`walkerlab.analysis.gait.profile_walk.swing_clearance` on the step's
         pieces of dense output, as ``simulate`` checks it)."""
-        from walkerlab.analysis.gait.profile_walk import swing_clearance
+        from walkerlab.analysis.gait.profile_walk import swing_clearance  # light
         from walkerlab.integrate.rigid import Segment
 
         t0, x0, _ = self._step_start

@@ -126,7 +126,7 @@ def _advance_rows():
     the integrators it reads are not needed to build the environment), kept."""
     global _ADVANCE_ROWS
     if _ADVANCE_ROWS is None:
-        from .rigid_rows import advance_rows as _ADVANCE_ROWS
+        from .rigid_rows import advance_rows as _ADVANCE_ROWS  # light
     return _ADVANCE_ROWS
 
 

@@ -194,7 +194,7 @@ class BatchStepMap:
         """The generated module's compiled heel-strike reset if it gives the walker's own
         reset bit for bit on a probe state on two slopes (a walker built with another reset,
         e.g. an impulse at push-off, keeps its own), else None."""
-        from walkerlab.integrate.rows_dop853 import reset_rows
+        from walkerlab.integrate.rows_dop853 import reset_rows  # light
 
         make = getattr(mod, "reset_flow", None)
         if make is None:  # pragma: no cover - a module generated before reset_flow
@@ -247,7 +247,7 @@ class BatchStepMap:
         ValueError
             A walker :attr:`can_walk` says no to.
         """
-        from walkerlab.integrate.rows_dop853 import walk_rows
+        from walkerlab.integrate.rows_dop853 import walk_rows  # light
 
         if not self.can_walk:
             raise ValueError(f"{self.walker.name}: compiled walks need one compiled flow for "
@@ -291,7 +291,7 @@ class BatchStepMap:
         """Phase ``k``'s cfuncs for the per-row integrator
         (:func:`walkerlab.integrate.rows_dop853.cfuncs`; made on first use)."""
         from walkerlab.codegen.compiled import compiled_module
-        from walkerlab.integrate.rows_dop853 import cfuncs
+        from walkerlab.integrate.rows_dop853 import cfuncs  # light
 
         if k not in self._fns:
             ph = self.phases[k]
@@ -305,7 +305,7 @@ class BatchStepMap:
         or a module without them)."""
         if not self.specialised:
             return None
-        from walkerlab.integrate.rows_dop853 import kernels
+        from walkerlab.integrate.rows_dop853 import kernels  # light
 
         key = ("kernels", k)
         if key not in self._fns:
@@ -477,7 +477,7 @@ class BatchStepMap:
         """Phase ``k`` of rows without a footfall drop, each row integrated alone by the
         compiled DOP853 (:func:`walkerlab.integrate.rows_dop853.phase_rows`); returns the
         rows that go on to phase k + 1 (their entry states and times)."""
-        from walkerlab.integrate.rows_dop853 import FAILED, phase_rows
+        from walkerlab.integrate.rows_dop853 import FAILED, phase_rows  # light
 
         ph, _, n_extra, gcols, goffs, dirs = phase
         N, m = Y.shape
@@ -531,7 +531,7 @@ class BatchStepMap:
         compiled (``reset_rows`` of the generated module) when the walker's reset is the
         generated one, else the walker's reset row by row."""
         if self._reset_flow is not None:
-            from walkerlab.integrate.rows_dop853 import reset_rows
+            from walkerlab.integrate.rows_dop853 import reset_rows  # light
 
             out = np.empty_like(Y)
             reset_rows(self._reset_flow, np.ascontiguousarray(Y), np.ascontiguousarray(D), out)

@@ -452,7 +452,7 @@ def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
         (n, len(work_names)) [J] the integrals of ``walker.actuators.work_names`` at the
         samples.
     """
-    from .contact_powered import ActuationHook
+    from .contact_powered import ActuationHook  # light
 
     hook = ActuationHook(walker, solver, limits, deadline,
                          sample_grid(t0, t1, limits.sample_rate_hz))
@@ -518,7 +518,7 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
     if term is RunEnd.T_FINAL and t_pin < t_final - 1e-12:
         hook = None
         if getattr(walker, "actuators", None) is not None:  # (never pinned: the scene refuses)
-            from .contact_powered import ActuationHook
+            from .contact_powered import ActuationHook  # light
 
             hook = ActuationHook(walker, solver, limits, deadline,
                                  sample_grid(t_pin, t_final, limits.sample_rate_hz))

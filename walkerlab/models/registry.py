@@ -44,7 +44,7 @@ def build_walker(scene) -> HybridWalker:
     walker = _on_ground(scene, _passive(scene))
     if act is None or walker.cycle is not None:  # footholds: each step's walker actuated
         return walker
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.walker.description import walker_data
 
     if scene.ideal.variant != "derived":
@@ -137,7 +137,7 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
         if scene.ideal.variant != "derived":
             raise ValueError("walker.actuation: only with ideal.variant: derived (the "
                              "printed Appendix A equations are passive)")
-        from walkerlab.models.hybrid.actuated import actuate
+        from walkerlab.models.hybrid.actuated import actuate  # light
 
         def finish(w, d):
             return actuate(w, d, act)

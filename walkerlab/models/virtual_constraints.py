@@ -81,7 +81,7 @@ def default_joints(link_names, hinged_torso: bool) -> list[str]:
     coordinate of its own), torso to each leg (``stance_hip``, ``swing_hip``), else the hip
     between the legs (a bisecting torso follows the legs); each knee on a walker whose knees
     are free links."""
-    from walkerlab.walker.joints import joint_links
+    from walkerlab.walker.joints import joint_links  # light
 
     names = set(link_names)
     out = ["stance_hip", "swing_hip"] if hinged_torso and "torso" in names else ["hip"]
@@ -141,7 +141,7 @@ class VirtualConstraintController:
 
     def __init__(self, spec, fns, structure, params):
         from walkerlab.codegen.virtual_constraints import output_pieces
-        from walkerlab.walker.joints import link_angles
+        from walkerlab.walker.joints import link_angles  # light
 
         self.spec, self.fns = spec, fns
         if any(b.massless for b in structure.bodies):

@@ -357,7 +357,7 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     mass): :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`."""
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.guess import starting_step
-    from walkerlab.optimal.replay.contact import contact_replay
+    from walkerlab.optimal.replay.contact import contact_replay  # light
     from walkerlab.optimal.transcription.landing import step_ground
     from walkerlab.optimal.transcription.mode_sequence import collocate_step
     from walkerlab.optimal.transcription.step import replay, torque_of_time
@@ -503,9 +503,9 @@ def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> Optimi
     unused)."""
     import time
 
-    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.contact import contact_replay_phased
+    from walkerlab.optimal.replay.contact import contact_replay_phased  # light
     from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
         phase_torque_of_time,
@@ -608,7 +608,7 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.contact import contact_replay_stride
+    from walkerlab.optimal.replay.contact import contact_replay_stride  # light
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
 
@@ -653,8 +653,8 @@ def _guide(walker, data, spec):
     ``fixedpoint``, is the pushed walker's)."""
     if not spec.push_off_n_s:
         return walker
-    from walkerlab.config.actuation import Actuation, PushOff
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.config.actuation import Actuation, PushOff  # light
+    from walkerlab.models.hybrid.actuated import actuate  # light
 
     return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=spec.push_off_n_s)))
 

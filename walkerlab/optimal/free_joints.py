@@ -80,7 +80,7 @@ def five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple
     model's ``(step period [s], outcome)`` under the feed-forward + PD law from its closed
     start; an optimum that is not a gait is not replayed there (``not_gait``: why, the
     contact outcome)."""
-    from walkerlab.optimal.replay.contact import contact_replay_five_link
+    from walkerlab.optimal.replay.contact import contact_replay_five_link  # light
     from walkerlab.optimal.replay.virtual_constraints import phase_replays
 
     if scene.optimize.phase_replay is False:  # None (the default) or True: replayed

@@ -232,7 +232,7 @@ def read_guess(scene, names: list):
         The artifact is missing, damaged, of another stage or walker, or ``at`` is off its
         branch (one line naming the field).
     """
-    from walkerlab.io.artifacts import ArtifactError, open_artifact
+    from walkerlab.io.artifacts import ArtifactError, open_artifact  # light
 
     g = scene.optimize.initial_guess
     path = Path(g.from_)
@@ -240,7 +240,7 @@ def read_guess(scene, names: list):
         with open_artifact(path) as f:
             kind = str(f.attrs.get("stage"))
         if kind == "optimize":
-            from walkerlab.io.schemas.optimize import load
+            from walkerlab.io.schemas.optimize import load  # light
 
             d = load(path)
             if list(d.states) != names:
@@ -248,8 +248,8 @@ def read_guess(scene, names: list):
             return "optimize", d
         if kind != "continuation" or g.at is None:
             raise ValueError("give an optimize.h5, or a continuation artifact with 'at'")
-        from walkerlab.config.studies import GuessFromArtifact
-        from walkerlab.io.schemas.continuation import load_continuation
+        from walkerlab.config.studies import GuessFromArtifact  # light
+        from walkerlab.io.schemas.continuation import load_continuation  # light
 
         return "continuation", GuessFromArtifact(from_=g.from_, at=g.at, branch=g.branch).pick(
             load_continuation(path), names)

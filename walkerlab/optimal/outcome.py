@@ -119,7 +119,7 @@ def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
     ndarray, shape (n,), complex
         The multipliers, NaN when the replay or the map failed (a report, not a gate).
     """
-    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.analysis.gait.poincare import poincare_map  # light
     from walkerlab.integrate.solver import Solver
 
     mu = np.full(res.x.shape[1], np.nan, complex)

@@ -145,7 +145,7 @@ def contact_scene(scene):
     sections, or (none) :data:`CONTROLLER_CONTACT` and the run's defaults; ``terrain`` and
     ``contact_solver`` as they are (their defaults when absent: a checkerboard of the
     footfalls, over whose gaps the straight swing foot passes at mid-stance)."""
-    from walkerlab.config.contact import ContactSettings, ContactSimSettings
+    from walkerlab.config.contact import ContactSettings, ContactSimSettings  # light
 
     update = {}
     if scene.contact is None:
@@ -256,7 +256,7 @@ def controller_step(walker, solver, points: int):
         The scene's controller has no periodic orbit or its step does not end in a heel
         strike (one line naming the key).
     """
-    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
     from walkerlab.integrate.rigid import integrate_step
 
     ctrl = walker.actuators.controller
@@ -293,9 +293,9 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
     swing foot's (:func:`clearance_report`).  IPOPT's last
     iterate whose coefficients make no controller (a failed design) is recorded as it is,
     with the reason in ``note``."""
-    from walkerlab.analysis.gait.poincare import search_budget
-    from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+    from walkerlab.analysis.gait.poincare import search_budget  # light
+    from walkerlab.analysis.gait.scene import solve_scene  # light
+    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
@@ -479,7 +479,7 @@ def replay_in_contact(scene, c: ControllerDesign) -> ControllerDesign:
     """``c`` with its contact replay (:func:`walkerlab.optimal.replay.contact.
     contact_replay_controller` of :func:`controller_scene`, :data:`REPLAY_STRIDES`
     strides from the rigid fixed point); not replayed without one."""
-    from walkerlab.optimal.replay.contact import contact_replay_controller
+    from walkerlab.optimal.replay.contact import contact_replay_controller  # light
 
     if c.x_star is None or not np.isfinite(c.full_order_step_period_s):
         return replace(c, contact_outcome="not replayed: the rigid closed loop has no "

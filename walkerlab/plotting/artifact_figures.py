@@ -28,8 +28,8 @@ def save_mfpt_figure(d, scene_name: str, folder: Path | str) -> list[Path]:
     list of Path
         The PNG and SVG written.
     """
-    from walkerlab.plotting.figures import save
-    from walkerlab.plotting.mfpt_figures import mfpt_figure
+    from walkerlab.plotting.figures import save  # light
+    from walkerlab.plotting.mfpt_figures import mfpt_figure  # light
 
     fig = mfpt_figure(d, f"Mean first-passage time - scene '{scene_name}'")
     return save(fig, Path(folder), "mfpt")
@@ -50,8 +50,8 @@ def save_basin_figure(d, scene_name: str, folder: Path | str, stem: str = "basin
     stem : str
         ``basin`` or ``basin_<nx>x<ny>``.
     """
-    from walkerlab.plotting.basin_figures import basin_figure
-    from walkerlab.plotting.figures import save
+    from walkerlab.plotting.basin_figures import basin_figure  # light
+    from walkerlab.plotting.figures import save  # light
 
     title = f"Basin of attraction - scene '{scene_name}'" + (
         "" if stem == "basin" else f" ({d.x.size}x{d.y.size} cells)")
@@ -69,8 +69,8 @@ def save_bifurcation_figure(data: dict, walker_model: str, scene_name: str,
     data : dict
         :func:`walkerlab.io.schemas.bifurcation.load_bifurcation`'s result.
     """
-    from walkerlab.plotting.figures import save
-    from walkerlab.plotting.sweep_figures import bifurcation_figure
+    from walkerlab.plotting.figures import save  # light
+    from walkerlab.plotting.sweep_figures import bifurcation_figure  # light
 
     model = walker_model.replace("_", " ")
     return save(bifurcation_figure(data, f"{model}, scene {scene_name}"), Path(folder), stem)
@@ -85,7 +85,7 @@ def save_gait_map_figure(data, folder: Path | str, stem: str) -> list[Path]:
     data : walkerlab.io.schemas.stability_map.StabilityMap
         A loaded ``stability_map_<kind>.h5``.
     """
-    from walkerlab.plotting.figures import save
-    from walkerlab.plotting.sweep_figures import gait_map_figure
+    from walkerlab.plotting.figures import save  # light
+    from walkerlab.plotting.sweep_figures import gait_map_figure  # light
 
     return save(gait_map_figure(data), Path(folder), stem)

@@ -167,7 +167,7 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
                                    gridspec_kw={"height_ratios": [3, 2]})
     unit = "" if data.unit in ("-", "") else f" [{data.unit}]"
     if brute is not None and "steady_state/stance_angle_after_impact" in brute:
-        from walkerlab.studies.bifurcation import parameter_values
+        from walkerlab.studies.bifurcation import parameter_values  # light
 
         s = parameter_values(brute)[0]
         st = np.asarray(brute["steady_state/stance_angle_after_impact"], float)

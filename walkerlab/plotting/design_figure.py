@@ -38,7 +38,7 @@ def save_design_figure(d, title: str, folder: Path,
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from walkerlab.plotting.figures import save
+    from walkerlab.plotting.figures import save  # light
 
     k = len(d.fields)
     fig, axes = plt.subplots(1, 1 + k, figsize=(4.6 * (1 + k), 3.6), squeeze=False)

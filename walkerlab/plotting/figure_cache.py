@@ -29,8 +29,8 @@ def figure_key(artifact: Path, figure: str) -> str | None:
     matplotlib's version is unknown (the figure is then drawn)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    from walkerlab.io.artifacts import code_hash
-    from walkerlab.io.result_key import result_key
+    from walkerlab.io.artifacts import code_hash  # light
+    from walkerlab.io.result_key import result_key  # light
 
     try:
         mpl = version("matplotlib")

@@ -30,7 +30,7 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from walkerlab.plotting.figures import save
+    from walkerlab.plotting.figures import save  # light
 
     rows = 2 if (d.energy or d.ipopt_history) else 1
     ctrl_row = rows if d.controllers else None  # the designed controllers' row
@@ -142,7 +142,7 @@ def _controllers(d, axes) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from walkerlab.models.virtual_constraints import bezier
+    from walkerlab.models.virtual_constraints import bezier  # light
 
     ax = axes[0]
     s = np.linspace(0.0, 1.0, 101)

@@ -60,7 +60,7 @@ def trajectory_plan(trajs: dict[str, NamedTrajectory], title: str, slope_rad: fl
                                             "contact - ideal", scene_units=units,
                                             phase=phase)))
     if drop is not None:
-        from walkerlab.plotting.sweep_figures import restitution_figure
+        from walkerlab.plotting.sweep_figures import restitution_figure  # light
 
         plan.append(("drop_restitution", partial(
             restitution_figure, drop.stiffness, drop.restitution, unit=drop.unit,

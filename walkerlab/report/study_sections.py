@@ -28,7 +28,7 @@ def bifurcation_section(arts: dict, onsets: dict, pub: ModuleType | None = None)
 
 
 def _bifurcation_lines(b, onsets: tuple[float, float], pub: ModuleType | None) -> list[str]:
-    from walkerlab.io.schemas.bifurcation import SLOPE_PATH
+    from walkerlab.io.schemas.bifurcation import SLOPE_PATH  # light
 
     p, data, values, per = b.path, b.data, b.values, b.attractor_period
     path, unit = data["parameter_path"], data["parameter_unit"]

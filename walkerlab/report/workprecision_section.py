@@ -33,7 +33,7 @@ def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
 
 
 def _solver_text(scene, model: str) -> str:
-    from walkerlab.config import SolverSettings
+    from walkerlab.config import SolverSettings  # light
 
     sv = (scene.solver if model == "ideal"
           else scene.contact_solver or SolverSettings.for_contact())

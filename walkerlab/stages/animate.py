@@ -52,7 +52,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     from matplotlib import pyplot as plt
     from matplotlib.animation import FFMpegWriter, writers
 
-    from walkerlab.plotting.animation import gif_writer, save_frames, walker_animation
+    from walkerlab.plotting.animation import gif_writer, save_frames, walker_animation  # light
 
     sim = load_simulate(stage_artifact(scene, runs_root, "simulate"))
     trajs, ground, notes = {IDEAL_LABEL: sim.samples}, {}, []

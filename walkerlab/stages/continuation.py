@@ -40,12 +40,12 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     from walkerlab.io.runpaths import bifurcation_artifacts, continuation_stem
     from walkerlab.io.schemas.bifurcation import load_bifurcation
     from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
-    from walkerlab.plotting.continuation_figures import (
+    from walkerlab.plotting.continuation_figures import (  # light
         continuation_figure,
         cost_of_transport_figure,
         two_parameter_figure,
     )
-    from walkerlab.plotting.figures import save
+    from walkerlab.plotting.figures import save  # light
     from walkerlab.studies.continuation import check_continuation, run_continuation
 
     require(scene, "fixedpoint", "continuation")

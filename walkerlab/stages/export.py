@@ -147,7 +147,7 @@ def _with_ideal(scene: Scene, build):
     """``build`` that also returns the rigid gait it was given (searched when None, as the
     writers search it)."""
     def both(ideal):
-        from walkerlab.analysis.contact.periodic import ideal_gait
+        from walkerlab.analysis.contact.periodic import ideal_gait  # light
 
         ideal = ideal_gait(scene) if ideal is None else ideal
         return ideal, build(ideal)

@@ -34,7 +34,7 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
             and scene.simulate.initial_state != "fixed_point":
         return ()
     if stage == "optimize":
-        from walkerlab.optimal.driver import needs_gait
+        from walkerlab.optimal.driver import needs_gait  # light
 
         if not needs_gait(scene):  # a five-link biped: its guess is built from the targets
             return ()

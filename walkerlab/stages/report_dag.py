@@ -34,8 +34,8 @@ def _named(stage: str, run, *args, **kwargs):
         anything else pass unchanged.
     """
     from walkerlab.config import SceneError
-    from walkerlab.io.artifacts import ArtifactError
-    from walkerlab.stages.common import StageError
+    from walkerlab.io.artifacts import ArtifactError  # light
+    from walkerlab.stages.common import StageError  # light
 
     try:
         return run(*args, **kwargs)
@@ -50,9 +50,9 @@ def _study(scene: Scene, runs_root, force: bool):
     """The work-precision stage in a thread of the report, overlapping the untimed stages
     (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
     the contact model's kernels are compiled."""
-    from walkerlab.bench.workprecision import start_worker
+    from walkerlab.bench.workprecision import start_worker  # light
     from walkerlab.execution.background import BackgroundStudy
-    from walkerlab.io.runpaths import stage_artifact
+    from walkerlab.io.runpaths import stage_artifact  # light
 
     wp = stage_module("workprecision")
     first_run = not stage_artifact(scene, runs_root, "workprecision").is_file()
@@ -76,12 +76,12 @@ def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
     (``ready`` None) the side process compiles, or loads, all of them
     (:func:`walkerlab.stages.contact_sim.warm_up`) and the run here waits for it first.
     """
-    from walkerlab.io.runpaths import stage_artifact
+    from walkerlab.io.runpaths import stage_artifact  # light
 
     if "contact-sim" not in plan or not (
             force or not stage_artifact(scene, runs_root, "contact-sim").is_file()):
         return None
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup  # light
 
     cs = stage_module("contact-sim")
     try:
@@ -105,7 +105,7 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     (list of StageOutcome, list of str)
         What each stage did, in order, and one line per figure group drawn or reused.
     """
-    from walkerlab.stages.plot import draw_ideal_ahead, draw_if_changed
+    from walkerlab.stages.plot import draw_ideal_ahead, draw_if_changed  # light
 
     plan = report_plan(scene, full)
     for name in plan:  # what the scene alone refuses (the capability table's cells, bad

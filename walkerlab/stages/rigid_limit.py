@@ -36,8 +36,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     kappas = tuple(float(k) for k in kappas)
 
     def compute():
-        from walkerlab.analysis.contact.periodic import ideal_gait
-        from walkerlab.analysis.contact.rigid_limit import convergence, observed_order
+        from walkerlab.analysis.contact.periodic import ideal_gait  # light
+        from walkerlab.analysis.contact.rigid_limit import convergence, observed_order  # light
         from walkerlab.models.contact.rigid_limit import expected_order
         from walkerlab.models.contact.scene import build
 
@@ -62,8 +62,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 def draw(scene: Scene, runs_root: Path | str, path: Path) -> list[Path]:
     """Draw ``rigid_limit.png/svg`` into the scene's figures folder from the artifact."""
     from walkerlab.io.runpaths import figures_dir
-    from walkerlab.plotting.figures import save
-    from walkerlab.plotting.rigid_limit_figure import rigid_limit_figure
+    from walkerlab.plotting.figures import save  # light
+    from walkerlab.plotting.rigid_limit_figure import rigid_limit_figure  # light
 
     return save(rigid_limit_figure(load_rigid_limit(path), scene.name or "walker"),
                 figures_dir(scene, runs_root, claim=True), "rigid_limit")

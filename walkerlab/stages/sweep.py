@@ -76,7 +76,7 @@ def draw(scene: Scene, path: Path, runs_root: str | Path = "runs") -> list[Path]
     """Draw the sweep's main results against its first swept field (PNG + SVG) from the
     artifact ``path`` (:func:`walkerlab.plotting.sweep_figures.sweep_figure`)."""
     from walkerlab.io.sweep_store import load_sweep
-    from walkerlab.plotting.sweep_figures import save, sweep_figure
+    from walkerlab.plotting.sweep_figures import save, sweep_figure  # light
 
     fig = sweep_figure(load_sweep(path), f"scene '{scene.name}'")
     return save(fig, figures_dir(scene, runs_root, claim=True), Path(path).stem)

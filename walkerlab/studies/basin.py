@@ -250,7 +250,7 @@ def _resumed_cells(part: Path, key: str, nx: int, ny: int):
     """``(arrays, row_hash)`` of a partial basin file of input hash ``key`` and grid
     ``(ny, nx)``, keeping only grid rows whose cells still match the hash written with them
     (the others are set back to not done); ``(None, None)`` without a usable file."""
-    from walkerlab.io.basin_partial import read_basin_partial
+    from walkerlab.io.basin_partial import read_basin_partial  # light
 
     arrays, stored = read_basin_partial(part, key, (ny, nx))
     if arrays is None:
@@ -317,7 +317,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     xs, ys = axis_values(st, walker, x_star, grid)
     x_pre = _start_pre_impact(walker, x_star, st, mst, xs, ys)
     nx, ny = xs.size, ys.size
-    from walkerlab.io.runpaths import refuse_link
+    from walkerlab.io.runpaths import refuse_link  # light
 
     part = refuse_link(_partial(Path(out_path)))  # never written through a link
     part.parent.mkdir(parents=True, exist_ok=True)
@@ -381,8 +381,8 @@ def _run_basin_tasks(tasks: list[BasinTask], part: Path, key: str, arrays: dict,
     partial file ``part`` and reporting progress after each; returns the cells computed."""
     from walkerlab import progress
     from walkerlab.execution.executor import run_each
-    from walkerlab.io.basin_partial import basin_partial_writer
-    from walkerlab.studies.runner import sweep_executor
+    from walkerlab.io.basin_partial import basin_partial_writer  # light
+    from walkerlab.studies.runner import sweep_executor  # light
 
     total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
     computed = 0
@@ -426,7 +426,7 @@ def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
         Bad axes or ranges (one line).
     """
     from walkerlab.config import BasinSettings
-    from walkerlab.io.schemas.basin import BasinRun
+    from walkerlab.io.schemas.basin import BasinRun  # light
 
     res = compute_basin(scene, x_star, key, out_path, grid, workers, scheduler, resume=resume,
                         on_chunk=on_chunk)

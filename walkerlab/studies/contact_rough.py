@@ -40,7 +40,7 @@ def run_contact_walk(task: ContactWalkTask):
 
 def _walk_all(tasks, workers, scheduler, done=None):
     from walkerlab.execution.executor import run_each
-    from walkerlab.studies.runner import sweep_executor
+    from walkerlab.studies.runner import sweep_executor  # light
 
     out = {}
     with sweep_executor(workers, scheduler) as ex:

@@ -170,7 +170,7 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     :attr:`~walkerlab.analysis.robustness.mfpt.MonteCarloResult.mfpt` [steps].
     """
     from walkerlab.execution.executor import run_each
-    from walkerlab.studies.runner import sweep_executor
+    from walkerlab.studies.runner import sweep_executor  # light
 
     base = scene.model_dump(mode="json")
     tasks = [WalkTask(base, tuple(float(v) for v in x0), float(sd),
@@ -294,7 +294,7 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
             done = np.flatnonzero(c["done"])
             partial.put(name, {"pool_sha256": pool_sha, "done_rows": done,
                                "x_next": c["x"][done], "ok": c["ok"][done].astype(np.int8)})
-    from walkerlab.studies.runner import sweep_executor
+    from walkerlab.studies.runner import sweep_executor  # light
 
     with sweep_executor(workers, scheduler) as ex:
         return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
@@ -326,7 +326,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
         without patches or without a periodic gait (one line).
     """
 
-    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
     if scene.terrain is not None and not scene.terrain.is_slope:
@@ -417,7 +417,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
     slope drawn with ``terrain.per_step.slope_sd_rad``): Monte Carlo at each level."""
     import time
 
-    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
     walker = build_walker(scene)
@@ -502,7 +502,7 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
         kept).
     """
     from walkerlab.execution.dask import DaskLost
-    from walkerlab.io.mfpt_partial import MfptPartial
+    from walkerlab.io.mfpt_partial import MfptPartial  # light
 
     partial = MfptPartial(partial_path, key, resume=resume)
     try:

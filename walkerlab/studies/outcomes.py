@@ -157,7 +157,7 @@ def walker_columns(stage: str, scene) -> dict[str, tuple]:
     description: :func:`walkerlab.models.registry.state_layout`, no walker built)."""
     if stage not in ("fixedpoint", "simulate"):
         return dict(COLUMNS[stage])
-    from walkerlab.models.registry import state_layout
+    from walkerlab.models.registry import state_layout  # light
 
     out = columns(stage, *state_layout(scene))
     act = scene.walker.actuation if hasattr(scene.walker, "actuation") else None

@@ -41,11 +41,11 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
         :class:`~walkerlab.integrate.python_step.PythonStepMap` (a Python right-hand
         side: slower).
     """
-    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.analysis.gait.poincare import poincare_map  # light
     from walkerlab.config import RobustnessSettings
     from walkerlab.integrate.python_step import make_step_map
     from walkerlab.integrate.solver import Solver
-    from walkerlab.io.schemas.robustness import RobustnessData
+    from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
 

@@ -155,11 +155,11 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
     Never raises (every failure becomes a ``reason``).  Top-level so it pickles for a
     process pool.
     """
-    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
     from walkerlab.analysis.contact.step_map import PeriodicGaitError
     from walkerlab.config import SceneError
     from walkerlab.models.contact.scene import build
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point
+    from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
 
     y = spec.y_values[iy]
     row, z_prev, x_ideal_prev = [], None, None
@@ -286,7 +286,7 @@ def stability_map_run(scene, spec: MapSpec, workers: int = 2,
 
     from walkerlab import progress as _progress
     from walkerlab.config.options import map_axis_value
-    from walkerlab.io.schemas.stability_map import StabilityMapRun
+    from walkerlab.io.schemas.stability_map import StabilityMapRun  # light
 
     ny = len(spec.y_values)
     with _progress.task(f"stability map {spec.kind}: {ny}x{len(spec.slopes_deg)} cells "

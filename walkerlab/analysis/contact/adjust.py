@@ -155,7 +155,7 @@ class _Trials:
         self.errors = []  # (scale, exception) of trial runs that ended in an error
 
     def __call__(self, s, bar):
-        from walkerlab.analysis.contact.sim import simulate_from
+        from walkerlab.analysis.contact.sim import simulate_from  # light
 
         best, runs, budget = self.best, self.runs, self.budget
         spent = time.process_time() - self.cpu0

@@ -77,7 +77,7 @@ def _no_creep(walker, factor: float = CREEP_OFF):
 
 def _gap_or_nan(find, T0, L0):
     """(period gap, step gap, z) of a periodic-gait search; NaN gaps if it fails."""
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         g = find()
@@ -99,7 +99,7 @@ def energy_by_sink(walker, z, n_samples: int = 20000) -> dict[str, float]:
     n_samples : int
         Samples of the step's dense output for the trapezoidal integrals.
     """
-    from walkerlab.analysis.contact.step_map import StepMap
+    from walkerlab.analysis.contact.step_map import StepMap  # light
 
     sm = StepMap(walker)
     run = sm.integrate(sm.to_state(z), stance_to_come=0, dense=True)
@@ -140,9 +140,9 @@ def attribute(walker, ideal, **search) -> Attribution:
     **search
         Passed to :func:`~walkerlab.analysis.contact.periodic.find_contact_periodic_gait`.
     """
-    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
-    from walkerlab.models.contact.rigid_limit import scale_walker
-    from walkerlab.models.contact.scene import ideal_step_length
+    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
+    from walkerlab.models.contact.rigid_limit import scale_walker  # light
+    from walkerlab.models.contact.scene import ideal_step_length  # light
 
     search.setdefault("check_fd", False)
     T0, L0 = float(ideal.period_s), ideal_step_length(walker, ideal.x)
@@ -177,10 +177,10 @@ def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
         ``rigid_from_adjusted`` (the rigid run's termination after ``2 strides`` steps),
         ``rigid_heel_strikes``.
     """
-    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.analysis.contact.sim import simulate_from  # light
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.contact.scene import contact_setup
+    from walkerlab.models.contact.scene import contact_setup  # light
     from walkerlab.models.registry import build_walker
 
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)

@@ -55,7 +55,7 @@ def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
     """
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.contact.scene import ideal_step_length
+    from walkerlab.models.contact.scene import ideal_step_length  # light
     from walkerlab.models.contact.terrain import ground_drops
     from walkerlab.models.registry import build_walker
 

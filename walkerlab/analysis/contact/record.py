@@ -145,7 +145,7 @@ def contact_walk(setup: ContactSetup, x_ideal: np.ndarray, period: float,
     tried = {}  # the --adjust search's runs of the scene's start and the best start
     adjust = adjust or cs.start == "adjusted"
     if adjust:
-        from walkerlab.analysis.contact.adjust import adjust_rates, better_start
+        from walkerlab.analysis.contact.adjust import adjust_rates, better_start  # light
 
         adj = adjust_rates(setup, x_ideal, period)
         tried = adj.pop("runs", None) or {}  # not made again
@@ -173,7 +173,7 @@ def _periodic_start(setup: ContactSetup, x_ideal, solver):
     (``contact_sim.start: periodic_gait``): ``(walker, result, x0, step_length, gait)`` of
     :func:`~walkerlab.analysis.contact.periodic.simulate_from_periodic_gait`; its
     ``PeriodicGaitError`` again with the scene and the field named."""
-    from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
+    from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait  # light
     from walkerlab.analysis.contact.step_map import PeriodicGaitError
 
     try:
@@ -203,7 +203,7 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
         ``start: periodic_gait`` and the gait was not found (one line naming the field).
     """
     from walkerlab.analysis.contact import sim as contact_run
-    from walkerlab.io.schemas.contact_sim import ContactSimRun
+    from walkerlab.io.schemas.contact_sim import ContactSimRun  # light
 
     cs = setup.sim
     gait_error = None
@@ -216,7 +216,7 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
         # the step map is one step's; this ground's gait is of several (not searched)
         gait_error = PeriodicGaitError(SEVERAL_STEPS_OUTCOME, SEVERAL_STEPS_PERIODIC)
     elif periodic and gait is None:
-        from walkerlab.analysis.contact.periodic import (
+        from walkerlab.analysis.contact.periodic import (  # light
             converged_gait,
             find_contact_periodic_gait,
         )

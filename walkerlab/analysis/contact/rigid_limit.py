@@ -130,7 +130,7 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
     -------
     RigidLimitTable
     """
-    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
     from walkerlab.models.contact.scene import ideal_step_length
 
     lam_r = np.asarray(ideal.multipliers_variational, complex)

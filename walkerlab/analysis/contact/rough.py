@@ -65,8 +65,8 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
         No ``contact`` section.
     """
     from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
-    from walkerlab.analysis.contact.sim import scene_start
-    from walkerlab.models.contact.scene import contact_setup
+    from walkerlab.analysis.contact.sim import scene_start  # light
+    from walkerlab.models.contact.scene import contact_setup  # light
 
     setup = contact_setup(scene)
     cs = setup.sim
@@ -106,9 +106,9 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
         ``fell`` False: the walk reached ``max_steps`` (censored); ``outcome`` the run's
         end (:data:`walkerlab.analysis.contact.gait.CONTACT_OUTCOMES`).
     """
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact
-    from walkerlab.config import scene_from_dict
-    from walkerlab.models.contact.scene import contact_setup
+    from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
+    from walkerlab.config import scene_from_dict  # light
+    from walkerlab.models.contact.scene import contact_setup  # light
 
     setup = contact_setup(scene_from_dict(start.scene))
     sv = setup.solver

@@ -551,7 +551,7 @@ def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
     and feet from its stance and next contact points (:func:`_legs_from_points`): ``<leg>_angle``,
     ``<leg>_rate`` and the points ``<leg>_foot``.
     """
-    from walkerlab.io.trajectory import NamedTrajectory
+    from walkerlab.io.trajectory import NamedTrajectory  # light
 
     legs = list(legs)
     t = res.t

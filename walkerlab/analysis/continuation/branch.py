@@ -441,7 +441,7 @@ def _join(down: Branch, up: Branch) -> Branch:
 def add_gait_measures(family: WalkerFamily, res: ContinuationResult) -> None:
     """Fill every branch's :attr:`Branch.measures`: step length, speed and cost of transport
     of the gait at each point (one period simulated per point)."""
-    from walkerlab.analysis.gait.energy import gait_measures
+    from walkerlab.analysis.gait.energy import gait_measures  # light
 
     for br in res.branches:
         rows = []

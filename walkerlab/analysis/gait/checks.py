@@ -110,7 +110,7 @@ def run_ground(scene, tr: NamedTrajectory):
         slopes = [g for _d, g in steps] if steps is not None else [phi]
     elif sim is not None and sim.terrain_seed is not None and terrain is not None \
             and terrain.per_step is not None:
-        from walkerlab.analysis.gait.rigid_run import rough_ground_steps
+        from walkerlab.analysis.gait.rigid_run import rough_ground_steps  # light
 
         n = int(np.unique(tr.step_index).size)
         slopes = [g for _d, g in rough_ground_steps(scene, n)]

@@ -221,7 +221,7 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = No
         A profile only in a CSV file, a walker with actuators or printed equations (one
         line).
     """
-    from walkerlab.analysis.gait.profile_walk import simulate_on_profile
+    from walkerlab.analysis.gait.profile_walk import simulate_on_profile  # light
 
     ground = profile_ground(scene)
     solver = Solver.from_settings(scene.solver) if solver is None else solver
@@ -242,7 +242,7 @@ def profile_ground(scene):
         A profile only in a CSV file, a walker with actuators or printed equations (one
         line).
     """
-    from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points
+    from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points  # light
     from walkerlab.models.registry import passive_walker_at
     from walkerlab.walker.kinds import PROFILE_PASSIVE
 

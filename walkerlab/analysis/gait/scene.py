@@ -238,7 +238,7 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     ground = search.gait.ground  # every gait found carries its check (solve_scene)
     treads = None
     if scene.terrain is not None and scene.terrain.kind == "stairs":
-        from walkerlab.analysis.gait.treads import tread_landing
+        from walkerlab.analysis.gait.treads import tread_landing  # light
 
         treads = tread_landing(walker, main.x, scene.terrain, Solver.from_settings(scene.solver))
     hzd = None

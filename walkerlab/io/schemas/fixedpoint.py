@@ -32,6 +32,7 @@ import numpy as np
 
 from walkerlab.io.artifacts import open_artifact, put
 from walkerlab.io.netcdf import coordinate
+from walkerlab.io.schemas.friction import FrictionVerdict
 from walkerlab.numerics import without_neutral
 from walkerlab.units import Units, for_artifact
 
@@ -298,7 +299,7 @@ class GroundContactRecord:
     ok: bool | None
     not_checked: str
     values: dict
-    friction: object | None = None  # walkerlab.analysis.gait.friction.FrictionVerdict
+    friction: FrictionVerdict | None = None
 
 
 def _ground(f) -> GroundContactRecord | None:
@@ -308,8 +309,6 @@ def _ground(f) -> GroundContactRecord | None:
     ok = int(g.attrs["ok"])
     friction = None
     if "friction" in g:  # artifacts written before the friction verdict have none
-        from walkerlab.analysis.gait.friction import FrictionVerdict
-
         h = g["friction"]
         friction = FrictionVerdict(
             **{a: float(h[name][()]) for a, (name, _, _) in FRICTION_FIELDS.items()

@@ -106,7 +106,7 @@ class ContactPart:
         """The contact view's actuators: joint torques at the links' joints, a push-off
         pulse, an ankle push-off (:class:`walkerlab.models.contact.actuation.
         ContactActuators`)."""
-        from .actuation import ContactActuators
+        from .actuation import ContactActuators  # light
 
         st = data.structure
         return ContactActuators(spec, coordinates, pulse_s, st.kind,
@@ -191,10 +191,10 @@ class FreeJointsPart(KneedPart):
         constraints: the rigid view's computed torque at the role state,
         :class:`walkerlab.models.contact.virtual_constraints.VirtualConstraintJointTorques`)."""
         if getattr(spec, "virtual_constraints", None) is not None:  # computed torque
-            from .virtual_constraints import VirtualConstraintJointTorques
+            from .virtual_constraints import VirtualConstraintJointTorques  # light
 
             return VirtualConstraintJointTorques(data, spec, coordinates, pulse_s)
-        from .joint_torques import JointTorqueActuators
+        from .joint_torques import JointTorqueActuators  # light
 
         return JointTorqueActuators(data, spec, coordinates, pulse_s)
 

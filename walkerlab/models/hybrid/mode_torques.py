@@ -80,7 +80,7 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None,
         mass (flat feet carry massive legs) (one line).
     """
     from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.actuators import Actuators
+    from walkerlab.models.hybrid.actuators import Actuators  # light
     from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
     for i, t in enumerate(spec.torques):

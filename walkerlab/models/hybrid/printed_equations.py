@@ -183,7 +183,7 @@ def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
 # --------------------------------------------------------------------------- builder
 def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
           slope_rad):
-    from walkerlab.config import CompassGaitParams
+    from walkerlab.config import CompassGaitParams  # light
     from walkerlab.walker.description import walker_data
 
     w = CompassGaitParams(leg_length_m=leg_length_m, leg_mass_kg=leg_mass_kg,

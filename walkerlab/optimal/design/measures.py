@@ -40,21 +40,21 @@ def robustness_measure(name: str, scene, walker, x_star, A) -> float:
     if name == "gait_sensitivity_norm":
         from walkerlab.analysis.robustness.measures import linearise
         from walkerlab.integrate.python_step import make_step_map
-        from walkerlab.studies.mfpt import scene_walker_at
+        from walkerlab.studies.mfpt import scene_walker_at  # light
 
         dist = scene.robustness.disturbances[0] if scene.robustness is not None else "slope"
         sm = make_step_map(walker, scene_walker_at(scene), 1e-12, 1e-12)
         return linearise(sm, x_star, np.asarray(A, float), dist).gsn()
     if name == "basin_share":
-        from walkerlab.studies.basin import CODE, compute_basin
+        from walkerlab.studies.basin import CODE, compute_basin  # light
 
         with tempfile.TemporaryDirectory() as tmp:
             cells = compute_basin(scene, x_star, "design", Path(tmp) / "basin.h5",
                                   workers=1, resume=False)
         return float(np.mean(np.asarray(cells["outcome"]) == CODE["converged"]))
     if name == "mfpt":
-        from walkerlab.config.studies import MfptSettings
-        from walkerlab.studies.mfpt import monte_carlo
+        from walkerlab.config.studies import MfptSettings  # light
+        from walkerlab.studies.mfpt import monte_carlo  # light
 
         st = scene.mfpt or MfptSettings()
         return float(monte_carlo(scene, x_star, st.sigma_rad[0], st.walks, st.max_steps,

@@ -93,7 +93,7 @@ class _Gaits:
 
     def __init__(self, scene, fields, x0, max_step=None, bounds=None):
         from walkerlab.integrate.solver import Solver
-        from walkerlab.studies.continuation import scene_value
+        from walkerlab.studies.continuation import scene_value  # light
 
         self.scene, self.fields = scene, list(fields)
         self.solver = Solver.from_settings(scene.solver)
@@ -124,7 +124,7 @@ class _Gaits:
         return pp, pm, pp[j] - p[j], p[j] - pm[j]
 
     def scene_at(self, p):
-        from walkerlab.studies.params import apply_point
+        from walkerlab.studies.params import apply_point  # light
 
         return apply_point(self.scene.model_dump(mode="json"), self.fields,
                            tuple(map(float, p)), "optimize --design")
@@ -164,7 +164,7 @@ class _Gaits:
         than ``max_step`` is walked in equal sub-steps, so the root finder never jumps to
         another gait of the same walker (the paper walker has an unstable one, |λ| 2.5,
         a root-finder's jump away at 15 kg)."""
-        from walkerlab.analysis.gait.poincare import find_fixed_point
+        from walkerlab.analysis.gait.poincare import find_fixed_point  # light
 
         p = np.asarray(p, float)
         n = 1
@@ -182,8 +182,8 @@ class _Gaits:
 
 def _measures(walker, x, solver) -> dict[str, float]:
     """The smooth measures of one map from ``x`` (not only at a fixed point)."""
-    from walkerlab.analysis.gait.energy import gait_measures
-    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.analysis.gait.energy import gait_measures  # light
+    from walkerlab.analysis.gait.poincare import poincare_map  # light
 
     steps = walker.steps_per_map
     _, period, _ = poincare_map(walker, np.asarray(x, float), solver)
@@ -231,7 +231,7 @@ def _gait_shift(gaits: _Gaits, p, j: int, h: float, x, J):
     ``(s+, s-)`` and the fixed point's shift ``dx*/dp_j = (I - DP)⁻¹ ∂P/∂p_j`` (2n,) from
     a difference of single maps at the fixed point ``x`` (``J``: its ``DP``; central
     inside the bounds, one-sided at a bound)."""
-    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.analysis.gait.poincare import poincare_map  # light
 
     pp, pm, sp, sm = gaits.stencil(p, j, h)
     wp, wm = gaits.walker(pp), gaits.walker(pm)
@@ -272,7 +272,7 @@ def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.nd
     """
     from scipy.linalg import eig
 
-    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.analysis.gait.poincare import poincare_map  # light
 
     p, w, x, J = _gait_at(gaits, p)
     ev, W, V = eig(J, left=True, right=True)
@@ -312,9 +312,9 @@ def design_bounds(scene, items: list[str]) -> dict:
     """
     import math
 
-    from walkerlab.config.errors import SceneError
-    from walkerlab.studies.continuation import scene_value
-    from walkerlab.studies.params import ParamAxis, apply_point, takes_whole_numbers
+    from walkerlab.config.errors import SceneError  # light
+    from walkerlab.studies.continuation import scene_value  # light
+    from walkerlab.studies.params import ParamAxis, apply_point, takes_whole_numbers  # light
 
     bounds: dict = {}
     base = scene.model_dump(mode="json")
@@ -373,7 +373,7 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
     ValueError
         An unknown objective (one line).
     """
-    from walkerlab.studies.continuation import scene_value
+    from walkerlab.studies.continuation import scene_value  # light
 
     if objective not in MEASURES:
         raise ValueError(f"optimize --objective: one of {', '.join(MEASURES)}, not "

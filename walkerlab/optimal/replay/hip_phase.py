@@ -112,8 +112,8 @@ def hip_walker(data, law, push_off_n_s: float = 0.0):
     in Python (``law`` called) and, where the walker has compiled actuated flows (massive
     legs: straight or kneed, point feet), compiled with the law's block (``law.packed``,
     the same splines); without a law (None) no compiled flow."""
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
+    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     st = data.structure

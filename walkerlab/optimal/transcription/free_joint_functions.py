@@ -44,8 +44,8 @@ def _build(structure) -> dict:
     import numpy as np
 
     from walkerlab.codegen.casadi_functions import casadi_matrix
-    from walkerlab.codegen.free_joints import derive_five_link
-    from walkerlab.config.actuation import FIVE_LINK_JOINTS
+    from walkerlab.codegen.free_joints import derive_five_link  # light
+    from walkerlab.config.actuation import FIVE_LINK_JOINTS  # light
 
     eq = derive_five_link(structure)
     n, roles = len(eq.q), list(structure.roles)

@@ -241,10 +241,10 @@ def replay_five_link(data, res: FiveLinkResult, x0: np.ndarray | None = None, so
     segment : walkerlab.integrate.rigid segment
         The replayed step.
     """
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw  # light
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 

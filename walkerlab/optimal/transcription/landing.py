@@ -67,7 +67,7 @@ def step_ground(scene) -> StepGround | None:
         Footholds of their own slopes (``terrain.foothold_slopes_rad``), or a target step
         length on stairs other than the tread (one line naming the field).
     """
-    from walkerlab.models.ground import landing_drops
+    from walkerlab.models.ground import landing_drops  # light
 
     t = scene.terrain
     if t is None or t.kind not in ("stairs", "footholds"):
@@ -150,13 +150,13 @@ def replay_footholds(data, res, ground: StepGround, solver=None):
 
     import numpy as np
 
-    from walkerlab.analysis.gait.poincare import StepFailed, poincare_map
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
+    from walkerlab.analysis.gait.poincare import StepFailed, poincare_map  # light
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.hybrid.actuated import actuate
-    from walkerlab.models.hybrid.ground import on_footholds
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.transcription.step import torque_of_time
+    from walkerlab.models.hybrid.actuated import actuate  # light
+    from walkerlab.models.hybrid.ground import on_footholds  # light
+    from walkerlab.models.hybrid.rigid import make_rigid_walker  # light
+    from walkerlab.optimal.transcription.step import torque_of_time  # light
 
     st = data.structure
     massless = bool(st.bodies) and all(b.massless for b in st.bodies)

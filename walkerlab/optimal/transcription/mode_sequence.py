@@ -363,10 +363,10 @@ def replay_phases(data, res: PhasedResult, solver=None):
     walker : HybridWalker
         The replayed walker.
     """
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw  # light
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])

@@ -283,7 +283,7 @@ class _KneedModes(_Modes):
     (the plain impact: the rigid kneed model's push-off is not transcribed)."""
 
     def __init__(self, data):
-        from walkerlab.codegen import symbolic
+        from walkerlab.codegen import symbolic  # light
 
         eq = symbolic.derive(data.structure)
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
@@ -358,7 +358,7 @@ class _FlatModes(_Modes):
     PIN = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
     def __init__(self, data):
-        from walkerlab.codegen.foot_modes import derive_flat
+        from walkerlab.codegen.foot_modes import derive_flat  # light
 
         eq = derive_flat(data.structure)
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)

@@ -500,10 +500,10 @@ def replay(data, res: CollocationResult, solver=None,
         The replayed walker (its Floquet multipliers: :func:`walkerlab.analysis.gait.
         poincare.find_fixed_point` from ``x_0``).
     """
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     # a saturated law is never a generated spring (models.hybrid.actuated.spring_equivalent):

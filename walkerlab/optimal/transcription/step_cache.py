@@ -36,8 +36,8 @@ def _key(data, kind: str = "steps", extra=()) -> str:
     import casadi as ca
 
     from walkerlab.codegen.cache import cache_key
-    from walkerlab.optimal.transcription import phases
-    from walkerlab.optimal.transcription import step as collocation
+    from walkerlab.optimal.transcription import phases  # light
+    from walkerlab.optimal.transcription import step as collocation  # light
 
     h = hashlib.sha256(repr((tuple(float(v) for v in data.params), float(data.slope_rad),
                              float(data.gravity_m_per_s2),
@@ -71,7 +71,7 @@ def _decode(text: str) -> dict:
     """:func:`_encode`'s inverse (raises on a damaged text)."""
     import casadi as ca
 
-    from walkerlab.optimal.transcription.phases import ModePhase
+    from walkerlab.optimal.transcription.phases import ModePhase  # light
 
     def phase(p):
         return ModePhase(p["name"], p["guard_name"], int(p["direction"]),
@@ -107,7 +107,7 @@ def cached_mode_functions(data, walker, order=None) -> dict:
         A walker or phase the transcription has no symbolic form for (one line; nothing
         cached).
     """
-    from walkerlab.optimal.transcription import phases
+    from walkerlab.optimal.transcription import phases  # light
 
     order = [tuple(o) for o in (order if order is not None else phases.phase_order(walker))]
     return _cached(_key(data, "modes", order),
@@ -128,7 +128,7 @@ def cached_step_functions(data) -> dict:
     ValueError
         A walker the transcription does not handle (one line; nothing cached).
     """
-    from walkerlab.optimal.transcription import step as collocation
+    from walkerlab.optimal.transcription import step as collocation  # light
 
     def build():
         from walkerlab.codegen import symbolic  # sympy: only on a miss (a slow import)

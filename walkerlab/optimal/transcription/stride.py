@@ -144,8 +144,8 @@ def stride_walker(data, res):
     phase_torque_of_time` of :func:`step_of`) from that step's heel strike, and the
     stride's push-off impulse ``res.push_off_n_s`` [N s] before each heel strike (if
     any)."""
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
-    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
+    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
 
@@ -174,7 +174,7 @@ def replay_stride(data, res, solver=None):
     walker : HybridWalker
         The replayed walker (with its mirror).
     """
-    from walkerlab.analysis.gait.poincare import StepFailed, poincare_map
+    from walkerlab.analysis.gait.poincare import StepFailed, poincare_map  # light
     from walkerlab.integrate.solver import Solver
 
     walker = stride_walker(data, res)
