@@ -417,7 +417,10 @@ def simulate_text(sim: SimulateArtifact) -> str:
                      "deep at most (straight legs' swing foot below the profile as it passes "
                      "the stance foot: ignored, as the ideal model does)")
     lines.append(f"  RHS evaluations   {int(s['nfev'])}, "
-                 f"integration {num(s['wall_time_s'], 3)} s (wall clock)")
+                 f"integration {num(s['wall_time_s'], 3)} s (wall clock)"
+                 + (f" of the run kept ({int(s['cut_from_strides'])} strides asked; the "
+                    f"means above: its first {sim.strides_requested})"
+                    if "cut_from_strides" in s else ""))
     return "\n".join(lines)
 
 
