@@ -65,7 +65,7 @@ class EngineWalk:
         The contact model's mean step period [s] over the last steps of the scene's
         up-to-date ``contact_sim.h5`` (NaN: none), the other reference the walk is set
         against.
-    spokes : bool
+    rolling : bool
         A spoked wheel's roll: its strikes are spokes landing one after another (no legs
         to alternate: :attr:`line` does not call them alternating).
     """
@@ -82,7 +82,7 @@ class EngineWalk:
     steps: int = DEFAULT_STEPS
     tolerance: float = DEFAULT_TOLERANCE
     contact_period_s: float = math.nan
-    spokes: bool = False
+    rolling: bool = False
 
     @property
     def walked(self) -> bool:
@@ -106,8 +106,8 @@ class EngineWalk:
         """The walk in one line (or why there was none)."""
         if not self.walked:
             return f"not walked: {self.reason}"
-        how = ("each by the next spoke" if self.spokes and self.alternating else
-               "not each by the next spoke" if self.spokes else
+        how = ("each by the next spoke" if self.rolling and self.alternating else
+               "not each by the next spoke" if self.rolling else
                "alternating" if self.alternating else "not alternating")
         head = (f"walked in {self.engine}: {self.strikes} heel strikes ({how}) in "
                 f"{self.t_end_s:.4g} s")
@@ -178,4 +178,4 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
                       t_end_s=float(run.t_end_s),
                       period_s=float(periods.mean()) if len(periods) else math.nan,
                       rigid_period_s=float(rigid_period_s), steps=steps, tolerance=tolerance,
-                      spokes=bool(fmt == "mjcf" and spokes))
+                      rolling=bool(fmt == "mjcf" and spokes))

@@ -411,7 +411,9 @@ def simulate_text(sim: SimulateArtifact) -> str:
     lines.append(f"  mean step length  {num(s['mean_step_length_m'], 7)} {u.length}")
     lines.append(f"  mean hip speed    {num(s['mean_hip_speed_m_per_s'], 7)} {u.speed}")
     lines.append(f"  mean total energy {num(s['mean_total_energy_J'], 7)} "
-                 f"{u.energy} (potential from the first stance foot)")
+                 f"{u.energy} (the mean of the samples over all {n} steps; potential "
+                 "from the first stance foot; compare's E_avg: a time average over the "
+                 "first 5)")
     if "midstance_scuff_depth_m" in s:  # the ideal model's foot-through, ignored
         lines.append(f"  mid-stance scuff  {num(s['midstance_scuff_depth_m'], 3)} {u.length} "
                      "deep at most (straight legs' swing foot below the profile as it passes "
@@ -491,6 +493,13 @@ def compare_text(c: Comparison) -> str:
                 lines.append(f"  {k:<22s} {num(m['ideal'][k]):>11s} "
                              f"{num(m['contact'][k]):>11s}"
                              + (f" {unit}" if unit not in ("", "-") else ""))
+        if "E_avg_J" in m["ideal"]:
+            steps = m["ideal"].get("E_avg_steps")
+            over = (f"the first {int(steps)} steps" if steps is not None and np.isfinite(steps)
+                    else "the first 5 steps")
+            lines.append(f"  (E_avg: time averages over {over} of each run (E_avg_steps); "
+                         "simulate's 'mean total energy' is the mean of its samples over all "
+                         "its steps)")
     return "\n".join(lines)
 
 
