@@ -11,8 +11,8 @@ renamed, with each measured cell's commit (``git rev-parse --short HEAD``, ``+``
 package's tracked files had uncommitted changes: the cell was measured on that commit plus
 those edits; the table says "with uncommitted changes").  Each cell also records the kind of
 check behind its number (``check``) and a check of its view that did not run on its case
-(``not_checked``: never counted as passed).  The slow test ``tests/test_capability_evidence.py`` re-measures every
-cell against what this wrote.
+(``not_checked``: never counted as passed).  The slow test
+``tests/test_capability_evidence.py`` re-measures every cell against what this wrote.
 """
 
 from __future__ import annotations

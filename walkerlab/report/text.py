@@ -205,8 +205,7 @@ def _fd_error_text(scene_json: str) -> str:
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
-    lines = [f"fixed point ({fp.model}, {fp.variant} equations), "
-             "state just after heel strike:"]
+    lines = [f"fixed point ({fp.model}, {fp.variant} equations), {fp.section_words}:"]
     for n, x, unit in zip(fp.state_names, fp.x, fp.state_units):
         coord = n.rsplit("_", 1)[0]
         role = next((r for r in sorted(legs, key=len, reverse=True)

@@ -264,6 +264,10 @@ class HybridWalker:
         Steps of a finite ground (``terrain.periodic: false``: a foothold list that does not
         repeat, of one height or several; a drawn rough ground): a walk stops after them.
         None: the ground goes on (:attr:`cycle`, if any, repeats).
+    section_words : str
+        What the Poincaré section's state is, in words for the outputs that print it
+        (``fixedpoint``): "state just after heel strike"; flat feet with a double support:
+        after the heel strike's impulse, before the trailing toe is pinned.
     """
 
     name: str
@@ -291,6 +295,7 @@ class HybridWalker:
     cycle: tuple | None = None
     ground_steps: int | None = None
     neutral: tuple[str, ...] = ()
+    section_words: str = "state just after heel strike"
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)
