@@ -35,9 +35,10 @@ class KindGrid:
     <check>"`` (supported and measured within its tolerance, the number measured and the
     kind of check behind it: :mod:`walkerlab.walker.capability_evidence`), ``"~ n"``
     (the view runs it, but its measurement is outside its tolerance or missing) or
-    ``"✗ n"`` (refused), ``n`` the 1-based index into ``reasons``; a supported cell may end in ``" (m)"``, ``reasons[m -
-    1]`` the note it rests on (``"note: ..."``) or a check of its view that did not run
-    on its case (``"... not checked: ... (not part of the ✓)"``)."""
+    ``"✗ n"`` (refused), ``n`` the 1-based index into ``reasons``; a supported cell may
+    end in ``" (m)"``, ``reasons[m - 1]`` the note it rests on (``"note: ..."``) or a
+    check of its view that did not run on its case (``"... not checked: ... (not part of
+    the ✓)"``)."""
 
     kind: Kind
     features: tuple[str, ...]
