@@ -8,8 +8,11 @@ evidence beside the table (``walkerlab/walker/capability_evidence.json``):
 Each cell runs in a process of its own (:func:`walkerlab.api.capabilities.measure`, its
 artifacts in a temporary runs folder); the file is rewritten under a temporary name, then
 renamed, with each measured cell's commit (``git rev-parse --short HEAD``, ``+`` when the
-tree had changes).  The slow test ``tests/test_capability_evidence.py`` re-measures every
-cell against what this wrote.
+package's tracked files had uncommitted changes: the cell was measured on that commit plus
+those edits; the table says "with uncommitted changes").  Each cell also records the kind of
+check behind its number (``check``) and a check of its view that did not run on its case
+(``not_checked``: never counted as passed).  The slow test
+``tests/test_capability_evidence.py`` re-measures every cell against what this wrote.
 """
 
 from __future__ import annotations
@@ -70,7 +73,8 @@ def _timed(measure, kind, feature, view, tmp) -> dict:
         case = reference_scene(kind, feature, view)[0]
         return {"kind": kind, "feature": feature, "view": view, "case": case, "quantity": q,
                 "value": None, "tolerance": tol, "unit": unit, "ok": False,
-                "detail": f"not measured: the cell ran past {CELL_LIMIT_S} s"}
+                "detail": f"not measured: the cell ran past {CELL_LIMIT_S} s", "check": "",
+                "not_checked": ""}
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)

@@ -75,6 +75,61 @@ def test_the_json_carries_each_supported_cells_case_measurement_and_tolerance():
                 row["kind"], row["feature"], row["view"])
 
 
+@pytest.mark.parametrize("friction", [None, -1])
+def test_a_missing_friction_verdict_is_not_counted_as_inside_the_cone(tmp_path, friction):
+    """A fixed point without a friction verdict (a walker in 3D: no ``ground_contact/
+    friction`` group; or one whose verdict was not made: ``inside`` -1) is read as not
+    checked, never as inside the cone (before: "" = inside, and the rigid cell's quantity
+    claimed the cone); a verdict inside / outside reads as such."""
+    import h5py
+
+    from walkerlab.api.capabilities import _friction_verdict
+
+    with h5py.File(tmp_path / "fp.h5", "w") as f:
+        g = f.create_group("ground_contact")
+        g.attrs["not_checked"] = "a walker in 3D: its stance foot's reaction is not computed"
+        if friction is not None:
+            h = g.create_group("friction")
+            h.attrs["inside"] = friction
+            h.attrs["not_checked"] = "no friction coefficient"
+        inside, why = _friction_verdict(f)
+        assert inside is None and why.startswith("ground forces (the friction cone) not "
+                                                 "checked: ")
+        if friction is None:
+            h = g.create_group("friction")
+        h.attrs["inside"] = 1
+        assert _friction_verdict(f) == (True, "")
+        h.attrs["inside"] = 0
+        h["max_ratio"], h["friction_coefficient"] = 1.2, 0.9
+        assert _friction_verdict(f)[0] is False
+
+
+def test_a_cells_quantity_names_only_what_was_checked_and_its_check_kind():
+    """Every stored cell names the kind of check behind its number
+    (:data:`~walkerlab.walker.capability_evidence.CHECK_KINDS`); a rigid cell names the
+    friction cone in its quantity only when the fixed point's verdict was made (its detail
+    says inside or outside), and the 3D walkers' rigid cells, which have none, say "not
+    checked" beside their ✓ (a numbered note ending "(not part of the ✓)")."""
+    from walkerlab.walker.capability_evidence import CHECK_KINDS, check_of, not_checked
+
+    cells = evidence()["cells"]
+    for key, e in cells.items():
+        assert check_of(e) in CHECK_KINDS, key
+        if key.endswith("/rigid") and e["ok"]:
+            claims = "friction cone" in e["quantity"]
+            assert claims != bool(not_checked(e)), key
+            assert claims == ("inside the friction cone" in e["detail"]), key
+    for key in ("straight_legs_3d/walk/rigid", "straight_legs_3d/hip_roll/rigid",
+                "straight_legs_3d/round_feet_3d/rigid", "rolling_polygon_3d/walk/rigid"):
+        assert "friction cone" not in cells[key]["quantity"], key
+        assert "not computed yet" in not_checked(cells[key]), key
+    g = next(g for g in grids() if g.kind.name == "straight_legs_3d")
+    cell = g.rows[g.features.index("walk")][g.views.index("rigid")]
+    assert cell.startswith(f"{SUPPORTED} ") and " self (" in cell, cell
+    note = g.reasons[int(cell.rsplit("(", 1)[1].rstrip(")")) - 1]
+    assert "not checked" in note and note.endswith("(not part of the ✓)")
+
+
 #: a re-measured number agrees with the stored one to this fraction of the tolerance (the
 #: stored run and the re-run share the code; the slack absorbs a machine's last digits)
 REPRODUCE = 0.1
@@ -96,6 +151,9 @@ def test_each_cells_stored_measurement_is_what_the_code_gives(kind, feature, vie
         pytest.skip("OpenSim (the osim extra, not in the test extra) is not installed here")
     m = measure(kind, feature, view, tmp_path)
     assert m.ok == e["ok"], (m.detail, e["detail"])
+    if e["ok"]:  # what was measured, by which kind of check, and what did not run
+        assert (m.quantity, m.check, m.not_checked) == (
+            e["quantity"], e["check"], e.get("not_checked", "")), (m.quantity, e["quantity"])
     if e["ok"] and "return error" in e["quantity"]:
         # an optimum's replay error is the NLP's convergence noise (IPOPT with MUMPS on the
         # machine's BLAS: 6.7e-8 where the evidence was first written, 5.1e-7 here): the

@@ -471,3 +471,17 @@ def test_an_engine_walk_is_set_against_the_contact_model_too():
     w = EngineWalk("MuJoCo", strikes=11, alternating=True, t_end_s=10.0, period_s=0.88,
                    rigid_period_s=0.89, contact_period_s=0.9)
     assert "the contact model's 0.9 s (-2.22 %)" in w.line
+
+
+def test_a_wheels_walk_line_says_spokes_not_alternating_legs_and_its_own_tolerance():
+    """A spoked wheel has no legs to alternate: its strikes are "each by the next spoke";
+    the line's verdict is against the tolerance the walk is held to (the capability cell's
+    3 %: +2.63 % is within it, not "outside 1 %")."""
+    from walkerlab.export.engine_walk import EngineWalk
+
+    wheel = EngineWalk("MuJoCo", strikes=11, alternating=True, t_end_s=11.69, period_s=1.02947,
+                       rigid_period_s=1.03455, rolling=True)
+    assert "(each by the next spoke)" in wheel.line and "alternating" not in wheel.line
+    legs = EngineWalk("MuJoCo", strikes=11, alternating=True, t_end_s=8.502,
+                      period_s=0.772177, rigid_period_s=0.752381, tolerance=0.03)
+    assert "(alternating)" in legs.line and "(+2.63 %, within 3 %)" in legs.line

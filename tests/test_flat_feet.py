@@ -522,3 +522,20 @@ def test_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_path, 
     lines = err.splitlines()
     assert code == 1 and len(lines) == 1, lines
     assert f"foot.{field}" in lines[0] and "internal error" not in lines[0], lines
+
+
+def test_the_flat_foot_fixed_point_is_printed_as_the_state_before_the_toe_is_pinned(
+        scene, tmp_path):
+    """The flat-foot walker's section state is the one just after the heel strike's impulse,
+    before the trailing toe is pinned for the double support (its ankle rate -12.6 rad/s is
+    that state's); ``fixedpoint`` says so where it prints the state (before: "state just
+    after heel strike", as for a walker without a double support), and the artifact keeps
+    the words (``section_words``)."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.report.text import fixedpoint_text
+    from walkerlab.stages import fixedpoint
+
+    fp = load_fixedpoint(fixedpoint.run(scene, tmp_path).path)
+    assert fp.section_words.startswith("state just after the heel strike's impulse, before "
+                                       "the trailing toe is pinned")
+    assert fixedpoint_text(fp).splitlines()[0].endswith(f"{fp.section_words}:")

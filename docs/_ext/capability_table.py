@@ -1,7 +1,8 @@
 """``.. capability-table::``: the walker kinds' capability table, read from
 :data:`walkerlab.walker.kinds.CAPABILITIES` at build time (the grids of
 :mod:`walkerlab.walker.capability_tables`), so the page cannot go stale: per kind a
-section with a row per feature, a column per view, ``✓`` or a numbered refusal, and the
+section with a row per feature, a column per view, ``✓`` (its number and the kind of
+check behind it) or a numbered refusal, and the
 refusals' one-line reasons listed below it.
 
 :func:`rst` is plain Python (no docutils): ``tests/test_capabilities.py`` checks it.
@@ -17,6 +18,7 @@ def _cell(text: str) -> str:
 def rst() -> str:
     """The page's body as reStructuredText: the views and features, then per kind a
     section (title, reference, list-table, numbered reasons)."""
+    from walkerlab.walker.capability_evidence import CHECK_KINDS
     from walkerlab.walker.capability_tables import grids
     from walkerlab.walker.kinds import FEATURES, VIEWS
 
@@ -24,6 +26,8 @@ def rst() -> str:
     out += [f"- ``{v}``: {_cell(what)}" for v, what in VIEWS.items()]
     out += ["", "Features:", ""]
     out += [f"- ``{f}``: {_cell(what)}" for f, what in FEATURES.items()]
+    out += ["", "Checks (the word after a ✓'s number):", ""]
+    out += [f"- ``{c}``: {_cell(what)}" for c, what in CHECK_KINDS.items()]
     out.append("")
     for g in grids():
         title = f"{g.kind.name}: {g.kind.title}"

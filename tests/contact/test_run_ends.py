@@ -284,3 +284,43 @@ def test_a_run_that_fails_after_its_strides_asked_for_still_walked(monkeypatch, 
     r = simulate_contact(w, x0, 5.0, limits=limits, max_heel_strikes=5)
     assert r.termination == end and not r.outcome.walked, r.outcome
     assert len(r.heel_strike_times) == 2
+
+
+def test_an_integrators_stop_message_is_said_in_walkerlabs_words():
+    """odeint's (ODEPACK's) "Excess work done on this call (perhaps wrong Dfun type)." is
+    said as what happened (the step budget spent: a contact too stiff to step through) with
+    the rigid-limit study's advice, the integrator's own words kept in brackets; a message
+    walkerlab does not know passes unchanged, and a translated one is not translated
+    twice."""
+    from walkerlab.analysis.contact.step_map import FELL_ADVICE
+    from walkerlab.integrate.ends import solver_words
+
+    raw = "Excess work done on this call (perhaps wrong Dfun type)."
+    said = solver_words(raw)
+    assert said.startswith("the integrator spent its step budget")
+    assert "walkerlab compare --rigid-limit" in said and said.endswith(f"[the integrator's "
+                                                                      f"message: {raw}]")
+    assert solver_words(said) == said
+    assert solver_words("the walker fell") == "the walker fell"
+    # the advice after a fall follows the rigid-limit study: not a stiffer law alone
+    assert "make the contact law stiffer" not in FELL_ADVICE
+    assert "rigid-limit family" in FELL_ADVICE and "elastic" in FELL_ADVICE
+
+
+@pytest.mark.slow  # ~20 s: the rigid gait and 4 s of contact walk
+def test_a_contact_fall_from_an_unstable_rigid_gait_names_the_instability_first(tmp_path):
+    """configs/paper.yaml on a 0.11 rad slope: its rigid gait is unstable (largest
+    |multiplier| 2.59); the contact walk from it falls after 4 heel strikes.  The stage's
+    failure names the unstable rigid gait first (before: only "fall ..."), then the fall."""
+    from walkerlab.api.scenes import with_changes
+    from walkerlab.config import load_scene
+    from walkerlab.stages import pipeline
+
+    scene = with_changes(load_scene(Path(__file__).resolve().parents[2] / "configs"
+                                    / "paper.yaml"),
+                         {"slope.angle_rad": 0.11, "fixedpoint.initial_guess": None,
+                          "contact_sim.periodic_gait": False, "name": "steep"})
+    out = pipeline.run("contact-sim", scene, tmp_path)
+    assert out.failure.startswith("the rigid gait it starts from is unstable (largest "
+                                  "|Floquet multiplier| 2.59"), out.failure
+    assert "did not complete the run: fall" in out.failure

@@ -143,3 +143,17 @@ def test_the_powered_compass_off_its_patches(tmp_path, impulse, strides, heel_st
     assert "after the strides asked for" in res.outcome.message
     assert "do not suit this gait's step" in res.outcome.message
     assert not res.verdict[0]
+
+
+def test_a_footfall_still_on_its_patch_is_not_blamed_on_the_patches():
+    """0.1 m patches at 0.37 m spacing (the paper's checkerboard): the footfall's room is its
+    patch (±0.05 m; the swing foot has ±0.32 m over the gap).  A last footfall 0.03 m from
+    its patch's centre has used most of it, but landed on it: the note says so and does not
+    say the patches do not suit the step (a steep slope's unstable gait falls from there)."""
+    fit = PatchFit(0.37, 0.05, np.array([0.0, 0.004, 0.012, 0.03]), np.full(4, 0.375))
+    note = fit.note()
+    assert "the last still on its patch" in note and "heel strike 4 landed +0.030 m" in note
+    assert "do not suit" not in note
+    # off its patch: the patches are named
+    off = PatchFit(0.37, 0.05, np.array([0.0, 0.02, 0.04, 0.06]), np.full(4, 0.39))
+    assert "do not suit this gait's step" in off.note()

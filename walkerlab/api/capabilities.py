@@ -10,7 +10,11 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     each step's period and length against the fixed point's (the Poincaré map's root,
     found by a root finder, against an integration with event location; relative, 1e-6);
     on a profile, where the gait changes from step to step, the footfalls against the
-    profile's height under them [m].
+    profile's height under them [m].  The fixed point's friction verdict (the gait's
+    ground forces inside the friction cone) where it made one: a cell's quantity names it
+    only then, and a cell without one (a walker in 3D: its stance foot's reaction is not
+    computed yet; a profile) says "not checked" (``Measurement.not_checked``), never
+    passed.
 ``contact``
     ``walkerlab contact-sim`` walks at least 10 heel strikes; its last 4 steps (whole
     periods of the rigid gait), past the transient of its start, against ``walkerlab
@@ -43,6 +47,13 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     ``walkerlab optimize``: its optimum replayed on the rigid model returns to its start
     (max-norm return error, 1e-6).
 
+Each cell records the kind of check behind its number (:data:`CHECKS`; the words:
+:data:`walkerlab.walker.capability_evidence.CHECK_KINDS`): another engine (MuJoCo,
+OpenSim), another model (the compliant-contact walker against the rigid one), an
+independent reference (a profile's given heights), a mass read back (Pinocchio, the Adams
+reader), or self-consistency (the same model by another algorithm: a root finder against
+event location, the gym's loop against simulate's, an optimum replayed).
+
 Runs every stage into a runs folder of its own (``runs_root``); nothing else is written.
 """
 
@@ -51,7 +62,7 @@ from __future__ import annotations
 import copy
 import math
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -60,13 +71,12 @@ from walkerlab.config import scene_from_dict
 from walkerlab.config.reference_cases import reference_scene
 from walkerlab.walker.kinds import KINDS
 
-__all__ = ["QUANTITIES", "Measurement", "measure"]
+__all__ = ["CHECKS", "CONE", "QUANTITIES", "Measurement", "measure"]
 
 #: view -> (quantity, tolerance, unit)
 QUANTITIES = {
     "rigid": ("simulate's step periods and lengths over 10 heel strikes against the fixed "
-              "point's (a profile: footfall height against the profile), and the gait's "
-              "ground forces inside the friction cone", 1e-6, "relative"),
+              "point's", 1e-6, "relative"),
     "contact": ("contact-sim walks >= 10 heel strikes; over its last 4 steps (whole gait "
                 "periods), the mean step period and the hip's speed against simulate's same "
                 "steps on the same ground, and the spread of the step periods' deviations "
@@ -87,6 +97,15 @@ QUANTITIES = {
     "optimize": ("the optimum replayed on the rigid model: its return error (max norm)",
                  1e-6, "state"),
 }
+#: the rigid view's second check, named in a cell's quantity only where it ran: the fixed
+#: point's friction verdict (:mod:`walkerlab.analysis.gait.friction`; a walker in 3D has none:
+#: its stance foot's reaction is not computed yet)
+CONE = "and the gait's ground forces inside the friction cone (the fixed point's verdict)"
+#: the kind of check behind each view's number
+#: (:data:`walkerlab.walker.capability_evidence.CHECK_KINDS`); the rigid view on a profile is
+#: held to the profile's given heights (``reference``)
+CHECKS = {"rigid": "self", "gym": "self", "optimize": "self", "contact": "model",
+          "mjcf": "engine", "osim": "engine", "urdf": "mass", "adams": "mass"}
 #: the gym's tolerance when the scene's controller is the policy (its torque sampled once
 #: per control period and held: a zero-order hold of the continuous feedback)
 GYM_POLICY_TOLERANCE = 0.03
@@ -120,6 +139,14 @@ class Measurement:
         ``|value| <= tolerance`` and the walk reached what it must.
     detail : str
         One line: what was seen (heel strikes, numbers) or why nothing was measured.
+    check : str
+        The kind of check behind the number (a key of
+        :data:`walkerlab.walker.capability_evidence.CHECK_KINDS`: ``engine``, ``model``,
+        ``reference``, ``mass``, ``self``).
+    not_checked : str
+        A check of the view that did not run on this case, and why ("" when none): it is
+        not in ``quantity`` and not counted as passed (the rigid view's friction cone of a
+        walker in 3D).
     """
 
     kind: str
@@ -132,6 +159,8 @@ class Measurement:
     unit: str
     ok: bool
     detail: str
+    check: str = ""
+    not_checked: str = ""
 
     def as_dict(self) -> dict:
         """The measurement as a JSON-ready mapping (NaN as None)."""
@@ -166,7 +195,10 @@ def _strides_for(d: dict, view: str) -> None:
         d["simulate"]["strides"] = max(d["simulate"]["strides"], cs["n_strides"])
 
 
-def _rigid(scene, d, runs: Path) -> tuple[float, str]:
+def _rigid(scene, d, runs: Path) -> tuple[float, str, dict]:
+    """simulate's steps against the fixed point's, and the fixed point's friction verdict
+    where it made one: with the cell's quantity as measured (``quantity``: the friction cone
+    named only when its verdict exists; ``not_checked``: why not) and its ``check``."""
     from walkerlab.stages import pipeline
 
     fp = pipeline.run("fixedpoint", scene, runs).path
@@ -175,10 +207,16 @@ def _rigid(scene, d, runs: Path) -> tuple[float, str]:
         term = s["steps/termination"][:].astype(str)
         n = int(np.sum(term == "heel_strike"))
         if n < STRIKES:
-            return math.nan, f"simulate reached {n} heel strikes of {STRIKES}"
+            return math.nan, f"simulate reached {n} heel strikes of {STRIKES}", {}
         ok = term == "heel_strike"
         if (d.get("terrain") or {}).get("kind") == "profile":
-            return _profile_footfalls(s, d, ok)
+            quantity = ("simulate's footfalls over 10 heel strikes against the profile's "
+                        "height under them")
+            return (*_profile_footfalls(s, d, ok),
+                    {"quantity": quantity, "check": "reference",
+                     "not_checked": "ground forces (the friction cone) not checked: on a "
+                                    "profile the rigid cell holds the footfalls to the "
+                                    "profile only"})
         lengths = s["steps/step_length"][:][ok]
         if "steps" in f:  # a gait of n steps: each step's period and length in turn
             dev_t = _cyclic_deviation(s["steps/period"][:][ok], f["steps/period"][:])
@@ -187,28 +225,39 @@ def _rigid(scene, d, runs: Path) -> tuple[float, str]:
             dev_t = _cyclic_deviation(s["steps/period"][:][ok],
                                       np.array([f["step_period"][()]]))
             dev_l = _cyclic_deviation(lengths, lengths[:1])
-        cone = _friction_verdict(f)
+        inside, cone = _friction_verdict(f)
     dev = max(dev_t, dev_l)
     detail = (f"{n} heel strikes; step periods {dev_t:.1e}, lengths {dev_l:.1e} from the "
               "fixed point's")
-    if cone:  # the model's gait, but not one on real ground (the fixed point's verdict)
-        return math.nan, f"{detail}; but {cone}"
-    return dev, detail
+    if inside is None:  # no verdict: the cone is neither claimed nor counted as passed
+        return dev, f"{detail}; {cone}", {"not_checked": cone}
+    extra = {"quantity": f"{QUANTITIES['rigid'][0]}, {CONE}"}
+    if not inside:  # the model's gait, but not one on real ground (the fixed point's verdict)
+        return math.nan, f"{detail}; but {cone}", extra
+    return dev, f"{detail}; ground forces inside the friction cone", extra
 
 
-def _friction_verdict(f) -> str:
-    """Why the fixed point's gait leaves the friction cone ("" when it does not, or when
-    the artifact has no verdict): the foot, the ratio needed and the ground's mu."""
+def _friction_verdict(f) -> tuple[bool | None, str]:
+    """The fixed point's friction verdict: ``(True, "")`` inside the cone; ``(False,
+    why)`` when the gait leaves it (the foot, the ratio needed and the ground's mu);
+    ``(None, why)`` when the artifact holds no verdict or one not made (a walker in 3D, a
+    map that does not end in heel strikes): not checked, never counted as inside."""
     if "ground_contact/friction" not in f:
-        return ""
+        why = (str(f["ground_contact"].attrs.get("not_checked", "")) if "ground_contact" in f
+               else "") or "the fixed point made no friction verdict"
+        return None, f"ground forces (the friction cone) not checked: {why}"
     g = f["ground_contact/friction"]
-    if int(g.attrs.get("inside", 1)):
-        return ""
+    inside = int(g.attrs.get("inside", -1))
+    if inside < 0:
+        why = str(g.attrs.get("not_checked", "")) or "no friction coefficient"
+        return None, f"ground forces (the friction cone) not checked: {why}"
+    if inside:
+        return True, ""
     need = float(g["max_ratio"][()])
     mu = float(g["friction_coefficient"][()])
     need_s = "an unbounded ratio" if not math.isfinite(need) else f"mu >= {need:.3g}"
-    return (f"the gait leaves the friction cone: its {g.attrs.get('foot', 'foot')} needs "
-            f"{need_s} against the ground's mu {mu:g}")
+    return False, (f"the gait leaves the friction cone: its {g.attrs.get('foot', 'foot')} "
+                   f"needs {need_s} against the ground's mu {mu:g}")
 
 
 def _profile_footfalls(s, d, ok) -> tuple[float, str]:
@@ -351,7 +400,8 @@ def _engine(fmt):
         from walkerlab.stages import export  # light
 
         ex = export.write(scene, runs, fmt, walk=True, walk_steps=STRIKES)
-        w = ex.walk
+        # the cell's tolerance in the walk's line (the export command's own is 1 %)
+        w = ex.walk if ex.walk is None else replace(ex.walk, tolerance=QUANTITIES[fmt][1])
         if w is None or not w.walked:
             return math.nan, (w.line if w is not None else "not walked")
         if w.fell or w.strikes < STRIKES or not w.alternating:
@@ -488,12 +538,15 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
         scene = scene_from_dict(d)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            value, detail = _VIEWS[view](scene, d, Path(runs_root))
+            value, detail, *extra = _VIEWS[view](scene, d, Path(runs_root))
     except Exception as exc:  # noqa: BLE001 - a cell that fails is evidence, not a crash
-        value, detail = math.nan, f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
+        value, detail, extra = (math.nan, f"{type(exc).__name__}: "
+                                f"{' '.join(str(exc).split())}"[:300], [])
+    extra = extra[0] if extra else {}  # what the view says it measured, where it varies
     ok = bool(math.isfinite(value) and abs(value) <= tol)
     note = KINDS[kind].note(view)
     if note:  # what the cell rests on beyond the number (a kneed walker's OpenSim loop)
         detail = f"{detail}; {note}"
-    return Measurement(kind, feature, view, case, quantity, float(value), tol, unit, ok,
-                       detail)
+    return Measurement(kind, feature, view, case, extra.get("quantity", quantity),
+                       float(value), tol, unit, ok, detail,
+                       extra.get("check", CHECKS[view]), extra.get("not_checked", ""))

@@ -70,7 +70,8 @@ def export(scene: Path | None = SceneArg,
                None, "--mjcf-timestep-s", min=1e-7, max=0.01,
                help="mjcf: MuJoCo's timestep in s (default: a quarter of the contact's time "
                "constant, at most 1 ms)")) -> None:
-    """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
+    """Write the walker as a floating multibody model (planar, or in 3D for a walker in
+    3D): runs/<scene>/walker.urdf,
     walker.xml, walker.adm + walker.acf (Adams Solver) or walker.osim (OpenSim).  The URDF,
     MJCF and OpenSim model carry the rigid gait (found as `walkerlab fixedpoint` finds it) as
     a keyframe (OpenSim: the default state).  What the file leaves out is printed, one line

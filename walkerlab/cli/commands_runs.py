@@ -53,9 +53,11 @@ def simulate(scene: Path | None = SceneArg,
     from walkerlab.report.text import simulate_ending, simulate_text  # light
     from walkerlab.stages import pipeline  # light
 
-    out = pipeline.run("simulate", load(scene), runs_dir, force, strides=strides,
+    sc = load(scene)
+    out = pipeline.run("simulate", sc, runs_dir, force, strides=strides,
                        terrain_seed=terrain_seed)
-    sim = load_simulate(out.path)
+    # a longer run kept for the scene: its verdict and means over the scene's strides
+    sim = load_simulate(out.path, strides or sc.simulate.strides)
     ending = simulate_ending(sim)  # a fall: no success-style summary
     if ending is None:
         typer.echo(simulate_text(sim))

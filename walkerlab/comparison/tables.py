@@ -37,7 +37,8 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
         ``E_avg_stance_frame_J``, ``step_length_m`` (the feet's distance at heel strike; flat
         feet: from the stance heel's touchdown point to the swing heel's; and per leg,
         ``step_length_left_m``, ``step_length_right_m``: the steps the left / right leg's
-        swing ends), ``n_steps``.
+        swing ends), ``n_steps``, ``E_avg_steps`` (the steps the energies are averaged
+        over: the first ``n_energy_steps``, fewer when the run has fewer).
     """
     left = left_leg or tr.legs[0]
     li = tr.legs.index(left)
@@ -68,7 +69,8 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     else:
         out["v_com_m_per_s"] = np.nan
     out.setdefault("step_length_m", np.nan)
-    out.update(_energies(tr, bounds[min(n_energy_steps, periods.size)], mass_kg, g))
+    out["E_avg_steps"] = int(min(n_energy_steps, periods.size))  # the steps E_avg is over
+    out.update(_energies(tr, bounds[out["E_avg_steps"]], mass_kg, g))
     return out
 
 

@@ -65,6 +65,9 @@ class EngineWalk:
         The contact model's mean step period [s] over the last steps of the scene's
         up-to-date ``contact_sim.h5`` (NaN: none), the other reference the walk is set
         against.
+    rolling : bool
+        A spoked wheel's roll: its strikes are spokes landing one after another (no legs
+        to alternate: :attr:`line` does not call them alternating).
     """
 
     engine: str
@@ -79,6 +82,7 @@ class EngineWalk:
     steps: int = DEFAULT_STEPS
     tolerance: float = DEFAULT_TOLERANCE
     contact_period_s: float = math.nan
+    rolling: bool = False
 
     @property
     def walked(self) -> bool:
@@ -102,7 +106,9 @@ class EngineWalk:
         """The walk in one line (or why there was none)."""
         if not self.walked:
             return f"not walked: {self.reason}"
-        how = ("alternating" if self.alternating else "not alternating")
+        how = ("each by the next spoke" if self.rolling and self.alternating else
+               "not each by the next spoke" if self.rolling else
+               "alternating" if self.alternating else "not alternating")
         head = (f"walked in {self.engine}: {self.strikes} heel strikes ({how}) in "
                 f"{self.t_end_s:.4g} s")
         if self.fell:
@@ -171,4 +177,5 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
                       first_leg=run.legs[0] if run.legs else "", fell=bool(run.fell),
                       t_end_s=float(run.t_end_s),
                       period_s=float(periods.mean()) if len(periods) else math.nan,
-                      rigid_period_s=float(rigid_period_s), steps=steps, tolerance=tolerance)
+                      rigid_period_s=float(rigid_period_s), steps=steps, tolerance=tolerance,
+                      rolling=bool(fmt == "mjcf" and spokes))

@@ -74,6 +74,16 @@ __all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyfra
 #: ``w`` off the stance foot's line is ~ ``m_leg a w`` (5 kg x 3 m/s^2 x 0.1 m = 1.5 N m on
 #: a 200 N load: 0.0075 m): 0.05 L holds it with room.
 TORSION_FRACTION = 0.05
+#: footfall patches across the slope, as a fraction of the leg length: a passive walker's
+#: (its lateral mode falls under any push: the patches only carry the exact gait)
+PATCH_ACROSS_L = 0.08
+#: ... and a walker whose hip-roll law stabilises its gait: its gait pushed at its keyframe
+#: by +-5 % of its lateral velocity settles 6.9 cm (-5 %) and 9.3 cm (+5 %) sideways of the
+#: nominal footfalls (configs/hip_width_stabilised.yaml in MuJoCo, measured; a push at the
+#: third step's mid-stance: 0.2 cm), off 8 cm patches (it falls), so its patches are 0.30 L
+#: across: the larger excursion with 5.7 cm to spare each side
+#: (tests/test_spatial_walker_mjcf.py)
+PATCH_ACROSS_PUSHED_L = 0.30
 
 
 def _numbers(data) -> dict:
@@ -209,6 +219,9 @@ class Legs3dScene:
         leg1's and leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`).
     patch_width_m : float
         Patch length along the slope [m] (``terrain.patch_width_m``).
+    patch_across_m : float
+        Patch width across the slope [m] (:data:`PATCH_ACROSS_L`,
+        :data:`PATCH_ACROSS_PUSHED_L` of the leg length).
     timestep_s : float
         MuJoCo ``option timestep`` [s].
     solref : (float, float)
@@ -233,6 +246,7 @@ class Legs3dScene:
     friction: float
     step_period_s: float
     notes: tuple = ()
+    patch_across_m: float = 0.08  # PATCH_ACROSS_L of a 1 m leg
 
 
 def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
@@ -279,28 +293,38 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
                                                    data.slope_rad, options)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     period = float(ideal.period_s) / steps
+    if data.structure.hip_roll:
+        across = PATCH_ACROSS_PUSHED_L * p["L"]
+        why = (f"{across:g} m across: the stabilised gait pushed by +-5 % of its lateral "
+               "velocity settles 6.9-9.3 cm sideways of these footfalls (measured in "
+               "MuJoCo; on 8 cm patches it falls)")
+    else:
+        across = PATCH_ACROSS_L * p["L"]
+        why = (f"{across:g} m across (a passive walker in 3D: its lateral mode falls under "
+               "any push)")
     notes = (f"Keyframe 'gait': the rigid walker's gait just after a heel strike (step "
              f"period {period:.6g} s), leg2 in stance, its foot sphere on the slope at the "
              "origin.",) + notes + (
-        f"Terrain: footfall patches {terrain.patch_width_m:g} m long at the rigid gait's "
-        "footfalls, leg<i>_patch<k> touched by leg<i>'s foot only (the rigid swing foot "
-        "passes through the ground at mid-stance).",
+        f"Terrain: footfall patches {terrain.patch_width_m:g} m long and {why}, centred "
+        "on the rigid gait's footfalls, leg<i>_patch<k> touched by leg<i>'s foot only (the "
+        "rigid swing foot passes through the ground at mid-stance).",
         f"Feet: condim 4, torsional friction {TORSION_FRACTION:g} L (the rigid stance foot "
         "neither slips nor twists)." if not data.structure.hip_roll else
         "Feet: condim 3 (the hip-roll walker's joints hold its feet from twisting: its "
         "pelvis neither pitches nor yaws); the law of walker.hip_roll in the custom text "
         "walkerlab_hip_roll, run by walkerlab's walk loop (HipRollLoop).")
     return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
-                       tuple(solref), tuple(solimp), float(mu), period, notes)
+                       tuple(solref), tuple(solimp), float(mu), period, notes, float(across))
 
 
 def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
-    """Each lane's patches: boxes ``patch_width_m`` along the slope, ``0.08 L`` across,
-    their tops on the slope through the footfalls."""
+    """Each lane's patches: boxes ``patch_width_m`` along the slope, ``patch_across_m``
+    across (:data:`PATCH_ACROSS_L`, :data:`PATCH_ACROSS_PUSHED_L`), their tops on the
+    slope through the footfalls."""
     n = np.array([math.sin(phi), 0.0, math.cos(phi)])       # MuJoCo axes
     w = extra.patch_width_m
     depth = w / 10
-    size = nums(w / 2, 0.04 * p["L"], depth)
+    size = nums(w / 2, extra.patch_across_m / 2, depth)
     out = []
     for leg, falls in zip(("leg1", "leg2"), extra.lanes):
         for k, s in enumerate(falls):

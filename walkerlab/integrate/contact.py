@@ -71,7 +71,7 @@ from .contact_events import (
     sample_grid,
     trip_or_failure,
 )
-from .ends import RunEnd
+from .ends import RunEnd, solver_words
 from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
@@ -531,6 +531,7 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
         nfev += nf
         njev += nj
     return ContactIntegration(t=np.concatenate(ts), X=np.vstack(Xs), termination=term.value,
-                              message=str(msg), event=event, nfev=int(nfev), njev=int(njev),
+                              message=solver_words(str(msg)), event=event, nfev=int(nfev),
+                              njev=int(njev),
                               wall_time_s=time.perf_counter() - wall,
                               pin_end_time=float(t_pin), work=work)

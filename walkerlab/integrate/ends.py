@@ -38,7 +38,8 @@ from __future__ import annotations
 
 from enum import StrEnum
 
-__all__ = ["CONTACT_WALKED", "RIGID_ENDS", "RUN_ENDS", "RUN_END_NAMES", "RunEnd", "describe"]
+__all__ = ["CONTACT_WALKED", "RIGID_ENDS", "RUN_ENDS", "RUN_END_NAMES", "RunEnd", "describe",
+           "solver_words"]
 
 
 class RunEnd(StrEnum):
@@ -95,3 +96,39 @@ def describe(name: str) -> str:
         ``name`` is not one of :data:`RUN_END_NAMES`.
     """
     return RUN_ENDS[RunEnd(name)]
+
+
+#: an integrator's own stop messages (ODEPACK's LSODA through scipy's odeint, solve_ivp's
+#: methods) -> walkerlab's words: what happened to the run and what to look at
+_SOLVER_WORDS = (
+    ("Excess work done", "the integrator spent its step budget (LSODA's mxstep) without "
+     "reaching the next sample: the contact became too stiff to step through at its "
+     "tolerances (a foot chattering or pressed deep into a patch: a contact law far "
+     "stiffer than its damping, which the rigid-limit family scales with it: walkerlab "
+     "compare --rigid-limit; or a gait that barely lifts its swing foot)"),
+    ("Excess accuracy requested", "the integrator cannot meet its tolerances in floating "
+     "point (loosen contact_solver.rtol / atol)"),
+    ("Repeated error test failures", "the integrator's step failed its error test again "
+     "and again (a discontinuity it cannot step across: a contact switching on and off)"),
+    ("Repeated convergence failures", "the integrator's corrector did not converge again "
+     "and again (a contact law too stiff for its Jacobian)"),
+    ("Required step size is less than spacing between numbers", "the integrator's step "
+     "shrank below the resolution of time (a contact law too stiff to step through)"),
+)
+
+
+def solver_words(message: str) -> str:
+    """An integrator's stop message in walkerlab's words (unchanged when it is not one of
+    :data:`_SOLVER_WORDS`' known messages): what happened, then the integrator's own words
+    in brackets for a search.
+
+    Parameters
+    ----------
+    message : str
+        The message (e.g. odeint's "Excess work done on this call (perhaps wrong Dfun
+        type).").
+    """
+    for head, words in _SOLVER_WORDS:
+        if head in message and not message.startswith(words):
+            return f"{words} [the integrator's message: {message.strip()}]"
+    return message

@@ -15,7 +15,8 @@ Where each number is printed
   to 1e-10", with the eigenvalues in the comment), as redistributed in public repositories;
   a public Floquet study (``floquet_Garcia.m``) attributes the same digits to the paper's
   Table 1.  We could not read the journal's table itself; the digits agree with our own
-  computation to 1e-10 (fixed point) - see ``tests/models/test_simplest.py``.
+  computation to 1e-10 (fixed point) - see ``tests/models/test_scenes.py``
+  (``test_simplest_walker_long_period_gait_matches_garcia``).
   The eigenvalues in that comment (-0.19121 +- 0.55633i) differ from ours (-0.19010 +-
   0.55760i, |lambda| 0.5883 vs 0.5891) by 1e-3; an independent script with Garcia's printed
   equations and a tight-tolerance finite-difference stride map gives ours, so we attribute

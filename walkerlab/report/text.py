@@ -205,8 +205,7 @@ def _fd_error_text(scene_json: str) -> str:
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
-    lines = [f"fixed point ({fp.model}, {fp.variant} equations), "
-             "state just after heel strike:"]
+    lines = [f"fixed point ({fp.model}, {fp.variant} equations), {fp.section_words}:"]
     for n, x, unit in zip(fp.state_names, fp.x, fp.state_units):
         coord = n.rsplit("_", 1)[0]
         role = next((r for r in sorted(legs, key=len, reverse=True)
@@ -425,13 +424,18 @@ def simulate_text(sim: SimulateArtifact) -> str:
     lines.append(f"  mean step length  {num(s['mean_step_length_m'], 7)} {u.length}")
     lines.append(f"  mean hip speed    {num(s['mean_hip_speed_m_per_s'], 7)} {u.speed}")
     lines.append(f"  mean total energy {num(s['mean_total_energy_J'], 7)} "
-                 f"{u.energy} (potential from the first stance foot)")
+                 f"{u.energy} (the mean of the samples over all {n} steps; potential "
+                 "from the first stance foot; compare's E_avg: a time average over the "
+                 "first 5)")
     if "midstance_scuff_depth_m" in s:  # the ideal model's foot-through, ignored
         lines.append(f"  mid-stance scuff  {num(s['midstance_scuff_depth_m'], 3)} {u.length} "
                      "deep at most (straight legs' swing foot below the profile as it passes "
                      "the stance foot: ignored, as the ideal model does)")
     lines.append(f"  RHS evaluations   {int(s['nfev'])}, "
-                 f"integration {num(s['wall_time_s'], 3)} s (wall clock)")
+                 f"integration {num(s['wall_time_s'], 3)} s (wall clock)"
+                 + (f" of the run kept ({int(s['cut_from_strides'])} strides asked; the "
+                    f"means above: its first {sim.strides_requested})"
+                    if "cut_from_strides" in s else ""))
     return "\n".join(lines)
 
 
@@ -502,6 +506,13 @@ def compare_text(c: Comparison) -> str:
                 lines.append(f"  {k:<22s} {num(m['ideal'][k]):>11s} "
                              f"{num(m['contact'][k]):>11s}"
                              + (f" {unit}" if unit not in ("", "-") else ""))
+        if "E_avg_J" in m["ideal"]:
+            steps = m["ideal"].get("E_avg_steps")
+            over = (f"the first {int(steps)} steps" if steps is not None and np.isfinite(steps)
+                    else "the first 5 steps")
+            lines.append(f"  (E_avg: time averages over {over} of each run (E_avg_steps); "
+                         "simulate's 'mean total energy' is the mean of its samples over all "
+                         "its steps)")
     return "\n".join(lines)
 
 

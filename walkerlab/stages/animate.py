@@ -54,7 +54,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
 
     from walkerlab.plotting.animation import gif_writer, save_frames, walker_animation  # light
 
-    sim = load_simulate(stage_artifact(scene, runs_root, "simulate"))
+    sim = load_simulate(stage_artifact(scene, runs_root, "simulate"),
+                        scene.simulate.strides if scene.simulate is not None else None)
     trajs, ground, notes = {IDEAL_LABEL: sim.samples}, {}, []
     contact = stage_artifact(scene, runs_root, "contact-sim")
     # any of the contact stage's variants: plain, --adjust, --periodic

@@ -20,6 +20,7 @@ from walkerlab.analysis.contact.record import contact_sim_run
 from walkerlab.config import Scene, SceneError
 from walkerlab.config.options import with_contact_strides
 from walkerlab.integrate.ends import CONTACT_WALKED
+from walkerlab.io.artifacts import ArtifactError
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
@@ -177,7 +178,29 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if kind not in CONTACT_WALKED:
         out.failure = (f"the contact walker did not complete the run: {kind}"
                        + (f" ({why})" if why else ""))
+        unstable = _unstable_rigid_gait(up[0]) if kind in _LEFT_THE_GAIT else ""
+        if unstable:  # the cause named first: the patches or the contact law come after it
+            out.failure = f"{unstable}; {out.failure}"
     return out
+
+
+#: ends of a contact run that an unstable rigid gait explains (the walk leaves the gait)
+_LEFT_THE_GAIT = ("fall", "trip", "scuff", "airborne")
+
+
+def _unstable_rigid_gait(fixedpoint_path: Path) -> str:
+    """The rigid gait's instability in one clause ("" when it is stable or unreadable): the
+    contact walk starts near it and, with a multiplier above 1, leaves it as the rigid walk
+    would, whatever the patches and the contact law."""
+    try:
+        mu = load_fixedpoint(fixedpoint_path).max_abs_multiplier()
+    except (ArtifactError, ValueError, KeyError):
+        return ""
+    if not mu > 1.0:
+        return ""
+    return (f"the rigid gait it starts from is unstable (largest |Floquet multiplier| "
+            f"{mu:.3g}: a deviation grows x{mu:.2g} a step), so the contact walker, which "
+            "starts a little off it, leaves it as the rigid walker would")
 
 
 def warm_up(scene: Scene) -> bool:

@@ -30,6 +30,11 @@ PARTS = {"trajectories": ("simulate", "contact-sim", "compare"),
          "workprecision": ("workprecision",)}
 
 
+def _strides(scene: Scene) -> int | None:
+    """The scene's strides (a longer ``simulate.h5`` kept for it is drawn as its own run)."""
+    return scene.simulate.strides if scene.simulate is not None else None
+
+
 def figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
     """Stamp file of a drawn figure group (:data:`PARTS`) and its key
     (:func:`walkerlab.io.freshness.drawing_key` of the artifacts it is drawn from)."""
@@ -62,7 +67,7 @@ def draw_ideal_ahead(scene: Scene, runs_root, force: bool) -> list[Path]:
     stamp.unlink(missing_ok=True)  # no stamp while the group is half drawn
     folder = runpaths.figures_dir(scene, runs_root, claim=True)
     return scene_figures.scene_trajectory_figures(
-        scene, load_simulate(require_unedited(p)), None, None, None, folder,
+        scene, load_simulate(require_unedited(p), _strides(scene)), None, None, None, folder,
         only=scene_figures.IDEAL_ONLY)
 
 
@@ -79,7 +84,8 @@ def _draw(scene: Scene, runs_root, part: str, side: SideWorker | None = None,
         wp = load("workprecision", load_workprecision)
         return [] if wp is None else scene_figures.workprecision_figures(wp, folder,
                                                                          for_scene(scene))
-    sim, contact = load("simulate", load_simulate), load("contact-sim", load_contact_sim)
+    sim = load("simulate", lambda p: load_simulate(p, _strides(scene)))
+    contact = load("contact-sim", load_contact_sim)
     if sim is None and contact is None:
         raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "
                          f"{runpaths.scene_dir(scene, runs_root)}; run 'walkerlab simulate' "

@@ -42,6 +42,8 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
         paths = paths | {p.stem: p for p in maps
                          if p.is_file() and (figures / f"{p.stem}.png").is_file()}
     arts = {key: load_artifact(key, p) for key, p in paths.items()}
+    if "simulate" in arts and scene.simulate is not None:  # a longer run kept: the scene's
+        arts["simulate"] = arts["simulate"].first_strides(scene.simulate.strides)
     onsets = {k: (onset_value(a.data), fall_onset(a.data)) for k, a in arts.items()
               if k.startswith("bifurcation")}
     return ReportInputs(arts, **report_numbers(scene, arts), bifurcation_onsets=onsets)

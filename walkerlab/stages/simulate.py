@@ -37,7 +37,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     :mod:`walkerlab.stages.pipeline` runs it first) or the scene's explicit state.  Without
     ``strides`` (the scene's number), an existing run of the same walker with *more* strides
     (``simulate --strides 20``) is reused, and said so in ``StageOutcome.note``
-    (:func:`walkerlab.io.schemas.simulate.longer_run_note`), rather than replaced.
+    (:func:`walkerlab.io.schemas.simulate.longer_run_note`), rather than replaced, and
+    judged on the scene's own strides (a longer run that falls after them walks the
+    scene's: ``failure`` stays empty).
     ``terrain_seed`` (``--terrain-seed``): walk the per-step ground of ``terrain.per_step``
     drawn from that seed (:func:`walkerlab.analysis.gait.rigid_run.rough_ground_steps`).
 
@@ -62,7 +64,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     out = (StageOutcome("simulate", path, True, 0.0, {}, note) if note else
            run_cached("simulate", scene, runs_root, secs, upstream,
                       lambda: _compute(scene, upstream), force))
-    term = run_end(out.path)
+    term = run_end(out.path, scene.simulate.strides if note else None)
     if term != "heel_strike":
         out.failure = f"the walker did not complete the run: {term}"
     return out

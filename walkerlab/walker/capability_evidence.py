@@ -5,10 +5,17 @@ the tolerance, and the commit it was measured at (``capability_evidence.json`` n
 module, written by ``scripts/measure_capabilities.py`` through
 :func:`walkerlab.api.capabilities.measure`).
 
-A supported cell is *verified* (``✓`` with its number, e.g. ``✓ -0.4 %``) when its
-measurement is within its tolerance; otherwise the view still runs it, but the table marks it
-``~ n`` (runs, not verified) with the measured number or why nothing was measured, listed
-under the kind's grid as the refusals are.  Nothing here runs a model.
+A supported cell is *verified* (``✓`` with its number and the kind of check behind it,
+e.g. ``✓ -0.40 % engine``: :data:`CHECK_KINDS`) when its measurement is within its
+tolerance; otherwise the view still runs it, but the table marks it ``~ n`` (runs, not
+verified) with the measured number or why nothing was measured, listed under the kind's
+grid as the refusals are.  A check of the view that did not run on the cell's case (the
+rigid view's friction cone of a walker in 3D: ``not_checked``) is not in its quantity and
+never counted as passed: the ``✓`` carries a note saying so.  Nothing here runs a model.
+
+A cell's ``commit`` is ``git rev-parse --short HEAD`` when it was measured, with ``+`` when
+the package's tracked files had uncommitted changes then (the measurement is of that commit
+plus those edits; ``scripts/measure_capabilities.py``).
 """
 
 from __future__ import annotations
@@ -18,12 +25,22 @@ import math
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["EVIDENCE_FILE", "UNVERIFIED", "cell_evidence", "evidence", "number", "verified"]
+__all__ = ["CHECK_KINDS", "EVIDENCE_FILE", "UNVERIFIED", "cell_evidence", "check_of",
+           "commit_words", "evidence", "not_checked", "number", "verified"]
 
 #: the data file
 EVIDENCE_FILE = Path(__file__).with_name("capability_evidence.json")
 #: the mark of a cell the view runs whose measurement is missing or outside its tolerance
 UNVERIFIED = "~"
+#: the kinds of check behind a cell's number: the word the table prints -> what it means
+CHECK_KINDS = {
+    "engine": "another engine walks the exported file (MuJoCo, OpenSim)",
+    "model": "another model: the compliant-contact walker against the rigid one",
+    "reference": "an independent reference the cell does not compute (a profile's heights)",
+    "mass": "a mass read back from the exported file (Pinocchio, the Adams reader): no walk",
+    "self": "self-consistency: the same model by another algorithm (a root finder against "
+            "event location, the gym's loop against simulate's, an optimum replayed)",
+}
 
 
 @lru_cache(maxsize=1)
@@ -42,10 +59,23 @@ def cell_evidence(kind: str, feature: str, view: str) -> dict | None:
 
 
 def verified(kind: str, feature: str, view: str) -> bool:
-    """Whether the cell's measurement is within its tolerance."""
+    """Whether the cell's measurement is within its tolerance (what its quantity names; a
+    check that did not run, :func:`not_checked`, is not part of it)."""
     e = cell_evidence(kind, feature, view)
     return bool(e and e["ok"] and e["value"] is not None
                 and abs(e["value"]) <= e["tolerance"])
+
+
+def check_of(e: dict) -> str:
+    """The kind of check behind a measurement (a key of :data:`CHECK_KINDS`; "" when the
+    evidence does not say)."""
+    return e.get("check", "") if e.get("check", "") in CHECK_KINDS else ""
+
+
+def not_checked(e: dict | None) -> str:
+    """The view's check that did not run on the cell's case, and why ("" when none): never
+    counted as passed."""
+    return str((e or {}).get("not_checked", ""))
 
 
 def number(e: dict) -> str:
@@ -69,4 +99,12 @@ def unverified_reason(kind: str, feature: str, view: str) -> str:
         return "runs; not measured yet (no reference case measured)"
     tol = number({"value": e["tolerance"], "unit": e["unit"], "tolerance": e["tolerance"]})
     return (f"runs, not verified: {e['case']}: {e['detail']} (tolerance {tol.lstrip('+')}; "
-            f"measured at {e['commit'] or 'an uncommitted tree'})")
+            f"measured at {commit_words(e['commit'])})")
+
+
+def commit_words(commit: str) -> str:
+    """A measurement's commit as the table says it: ``4f1505ba+`` (``+``: the package had
+    uncommitted changes when it was measured) as "4f1505ba with uncommitted changes"."""
+    if not commit:
+        return "an uncommitted tree"
+    return (f"{commit[:-1]} with uncommitted changes" if commit.endswith("+") else commit)

@@ -12,8 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from walkerlab.walker.capability_evidence import (
+    CHECK_KINDS,
     UNVERIFIED,
     cell_evidence,
+    check_of,
+    not_checked,
     number,
     unverified_reason,
     verified,
@@ -28,12 +31,14 @@ SUPPORTED = "✓"
 
 @dataclass(frozen=True)
 class KindGrid:
-    """One kind's cells: ``rows[i][j]`` is feature ``i`` in view ``j``: ``"✓ <number>"``
-    (supported and measured within its tolerance, the number measured:
-    :mod:`walkerlab.walker.capability_evidence`), ``"~ n"`` (the view runs it, but its
-    measurement is outside its tolerance or missing) or ``"✗ n"`` (refused), ``n`` the
-    1-based index into ``reasons``; a supported cell may end in ``" (m)"``, ``reasons[m -
-    1]`` the note it rests on (``"note: ..."``)."""
+    """One kind's cells: ``rows[i][j]`` is feature ``i`` in view ``j``: ``"✓ <number>
+    <check>"`` (supported and measured within its tolerance, the number measured and the
+    kind of check behind it: :mod:`walkerlab.walker.capability_evidence`), ``"~ n"``
+    (the view runs it, but its measurement is outside its tolerance or missing) or
+    ``"✗ n"`` (refused), ``n`` the 1-based index into ``reasons``; a supported cell may
+    end in ``" (m)"``, ``reasons[m - 1]`` the note it rests on (``"note: ..."``) or a
+    check of its view that did not run on its case (``"... not checked: ... (not part of
+    the ✓)"``)."""
 
     kind: Kind
     features: tuple[str, ...]
@@ -62,7 +67,10 @@ def kind_grid(kind: Kind) -> KindGrid:
             note = kind.note(view) if why is None else None
             mark = "✗"
             if why is None and verified(kind.name, feature, view):
-                cell = f"{SUPPORTED} {number(cell_evidence(kind.name, feature, view))}"
+                e = cell_evidence(kind.name, feature, view)
+                cell = f"{SUPPORTED} {number(e)} {check_of(e)}".rstrip()
+                if not_checked(e):  # said beside the tick: never counted as passed
+                    cell += f" ({numbered(f'{not_checked(e)} (not part of the ✓)')})"
             else:
                 if why is None:
                     why, mark = unverified_reason(kind.name, feature, view), UNVERIFIED
@@ -81,7 +89,9 @@ def grids() -> list[KindGrid]:
 
 def _legend() -> list[str]:
     return ["views: " + "; ".join(f"{v}: {what}" for v, what in VIEWS.items()),
-            "features: " + "; ".join(f"{f}: {what}" for f, what in FEATURES.items())]
+            "features: " + "; ".join(f"{f}: {what}" for f, what in FEATURES.items()),
+            "checks (the word after a ✓'s number): "
+            + "; ".join(f"{c}: {what}" for c, what in CHECK_KINDS.items())]
 
 
 def _tolerances() -> str:
@@ -95,8 +105,9 @@ def text() -> str:
     """The table as plain text (``walkerlab capabilities``): per kind its title, the grid
     (columns padded) and its numbered reasons; the views and features explained first."""
     out = ["walker kind x feature x view: ✓ supported, with the agreement measured on its "
-           "reference case (within its view's tolerance); ~ n runs, not verified; ✗ n "
-           "refused (reason n below the kind's grid)", *_legend(), _tolerances(), ""]
+           "reference case (within its view's tolerance) and the kind of check behind it; "
+           "~ n runs, not verified; ✗ n refused (reason n below the kind's grid)",
+           *_legend(), _tolerances(), ""]
     for g in grids():
         head = ("feature", *g.views)
         rows = [(f, *r) for f, r in zip(g.features, g.rows)]

@@ -533,8 +533,10 @@ def table_rows() -> list[dict]:
     cell its evidence (:mod:`walkerlab.walker.capability_evidence`): ``verified`` (measured
     within its tolerance), ``case`` (its reference case), ``quantity``, ``measured``,
     ``tolerance``, ``unit``, ``detail`` (with the cell's note, :meth:`Kind.note`, when its
-    kind has one in the view), ``note`` and ``commit`` - what ``walkerlab capabilities
-    --json`` prints."""
+    kind has one in the view), ``note``, ``commit``, ``check`` (the kind of check behind
+    the number: :data:`walkerlab.walker.capability_evidence.CHECK_KINDS`) and
+    ``not_checked`` (a check of the view that did not run on the case: not counted as
+    passed) - what ``walkerlab capabilities --json`` prints."""
     from walkerlab.walker.capability_evidence import cell_evidence, verified
 
     rows = []
@@ -554,6 +556,7 @@ def table_rows() -> list[dict]:
                                case=e.get("case", ""), quantity=e.get("quantity", ""),
                                measured=e.get("value"), tolerance=e.get("tolerance"),
                                unit=e.get("unit", ""), detail=detail, note=note,
-                               commit=e.get("commit", ""))
+                               commit=e.get("commit", ""), check=e.get("check", ""),
+                               not_checked=e.get("not_checked", ""))
                 rows.append(row)
     return rows

@@ -79,7 +79,7 @@ from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.contact import ContactLimits, run_powered
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
 from walkerlab.integrate.contact_powered_step import powered_to_section, push_off
-from walkerlab.integrate.ends import RunEnd
+from walkerlab.integrate.ends import RunEnd, solver_words
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.powered_events import pulse_lead, pulse_lead_s
 from walkerlab.integrate.solver import Solver
@@ -109,8 +109,11 @@ class PeriodicGaitError(RuntimeError):
 #: (placed on the contact model) and iterates the map from it
 FELL_ADVICE = ("the contact gait, if there is one, is far from the rigid gait the search "
                "starts from; check that walkerlab contact-sim walks from the rigid gait (its "
-               "outcome says why not), make the contact law stiffer (closer to the rigid "
-               "model), or start the search elsewhere (ContactWalker.periodic_gait(x0))")
+               "outcome says why not), move the contact law toward the rigid model along "
+               "its rigid-limit family (stiffness, damping and stiction velocity scaled "
+               "together: walkerlab compare --rigid-limit; a stiffer law alone makes the heel "
+               "strike elastic: restitution 0.03 at the paper's stiffness, 0.99 at 1e4 times "
+               "it), or start the search elsewhere (ContactWalker.periodic_gait(x0))")
 #: a step of the map that fell
 FELL = f"step map: the walker fell (hip below L/2): {FELL_ADVICE}"
 
@@ -356,7 +359,7 @@ class StepMap:
         def run(x, tg):
             X, end, message, _ = contact_grid(self.walker, x, tg, solver, self._data)
             if end is RunEnd.SOLVER_FAILURE:
-                raise PeriodicGaitError("solver_failure", f"step map: {message}")
+                raise PeriodicGaitError("solver_failure", f"step map: {solver_words(message)}")
             return X
 
         ta, xa = t0, np.asarray(x0, float)
@@ -471,7 +474,7 @@ class StepMap:
             if run.end is RunEnd.FALL:
                 raise PeriodicGaitError("fall", FELL)
             if run.end is RunEnd.SOLVER_FAILURE:
-                raise PeriodicGaitError("solver_failure", f"step map: {run.message}")
+                raise PeriodicGaitError("solver_failure", f"step map: {solver_words(run.message)}")
             raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
                                     f"{self.t_max:g} s")
         z1, s1 = self.to_section(run.y_event, 0)

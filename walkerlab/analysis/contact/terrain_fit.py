@@ -12,11 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PATCH_MARGIN_USED", "PatchFit", "patch_fit"]
+__all__ = ["PATCH_EDGE", "PATCH_MARGIN_USED", "PatchFit", "patch_fit"]
 
 #: a footfall this far (as a fraction of the smaller margin of :class:`PatchFit`) from its
 #: patch's centre has used up most of the room the checkerboard gives it
 PATCH_MARGIN_USED = 0.5
+#: ... and this far, at its patch's edge: the patches are what the run met (nearer the
+#: centre the footfall landed on its patch, and the note does not blame them)
+PATCH_EDGE = 0.9
 
 
 @dataclass
@@ -64,7 +67,9 @@ class PatchFit:
 
     def note(self) -> str:
         """Why the checkerboard does not suit the gait, when the last footfall used more
-        than :data:`PATCH_MARGIN_USED` of :attr:`margin_m` ("" otherwise): its offset, the
+        than :data:`PATCH_MARGIN_USED` of :attr:`margin_m` ("" otherwise; a footfall short
+        of :data:`PATCH_EDGE` of its patch's room is said to be on its patch, not blamed on
+        the patches): its offset, the
         drift per step, the contact steps against the spacing, both margins, and the
         patch width that balances them."""
         if self.offsets_m.size < 2 or not np.isfinite(self.margin_m) or self.margin_m <= 0:
@@ -74,8 +79,13 @@ class PatchFit:
             return ""
         sp, h = self.spacing_m, self.half_width_m
         mean = float(np.mean(self.steps_m))
-        return (f"the patches ({2 * h:.3g} m wide at {sp:.4g} m spacing, the rigid gait's "
-                f"step) do not suit this gait's step: its contact steps average {mean:.4g} m, "
+        head = (f"the patches ({2 * h:.3g} m wide at {sp:.4g} m spacing, the rigid gait's "
+                "step) do not suit this gait's step"
+                if abs(last) >= PATCH_EDGE * self.margin_m or sp - h < h else
+                # well on its patch, whose room binds (not the gap's): not the patches' doing
+                f"the footfalls drift on the patches ({2 * h:.3g} m wide at {sp:.4g} m "
+                "spacing, the rigid gait's step), the last still on its patch")
+        return (f"{head}: its contact steps average {mean:.4g} m, "
                 f"its footfalls drifted {1e3 * self.drift_m_per_step:+.3g} mm a step and "
                 f"heel strike {self.offsets_m.size} landed {last:+.3f} m from its patch's "
                 f"centre, where a footfall has ±{h:.3g} m on its patch and the swing foot "

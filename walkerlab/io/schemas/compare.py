@@ -25,7 +25,7 @@ STAGE = "compare"
 METRIC_UNITS = {"t_left_s": "s", "t_right_s": "s", "t_cycle_s": "s", "v_com_m_per_s": "m/s",
                 "E_avg_J": "J", "E_avg_stance_frame_J": "J", "step_length_m": "m",
                 "step_length_left_m": "m", "step_length_right_m": "m",
-                "n_steps": "-"}
+                "n_steps": "-", "E_avg_steps": "-"}
 
 
 @dataclass

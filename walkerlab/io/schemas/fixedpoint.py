@@ -195,6 +195,7 @@ def write_fixedpoint(f, run: FixedPointRun) -> None:
     walker, search = run.walker, run.search
     f.attrs["model"] = walker.name
     f.attrs["variant"] = walker.variant
+    f.attrs["section_words"] = walker.section_words  # what the state x is, in words
     f.attrs["state_names"] = walker.state_names()
     names = walker.state_names()
     coordinate(f, "state", names, "-", "state component (role-ordered)")
@@ -418,6 +419,10 @@ class FixedPointArtifact(GaitResult):
         The scene's unit system.
     model, variant : str
         Walker model and the scene's equation variant.
+    section_words : str
+        What the state ``x`` is (attribute ``section_words``: "state just after heel
+        strike"; flat feet: after the heel strike's impulse, before the trailing toe is
+        pinned).
     state_names, state_units : list of str
         Role-ordered state names and their units.
     legs_by_role : dict[str, str]
@@ -442,6 +447,7 @@ class FixedPointArtifact(GaitResult):
     units: Units | None = None
     model: str = ""
     variant: str = ""
+    section_words: str = "state just after heel strike"
     state_names: list = field(default_factory=list)
     state_units: list = field(default_factory=list)
     legs_by_role: dict = field(default_factory=dict)
@@ -493,6 +499,7 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
         return FixedPointArtifact(
             **vars(main), path=Path(path), units=for_artifact(f), model=str(f.attrs["model"]),
             variant=str(f.attrs["variant"]), state_names=names,
+            section_words=str(f.attrs.get("section_words", "state just after heel strike")),
             state_units=[str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names],
             legs_by_role=(json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs
                           else {}),

@@ -194,10 +194,61 @@ class SimulateArtifact:
         """Number of steps that ended by a heel strike."""
         return int(np.sum(self.steps["termination"] == "heel_strike"))
 
+    def first_strides(self, strides: int) -> SimulateArtifact:
+        """The run as a scene asking ``strides`` strides sees it: a longer run (an earlier
+        ``simulate --strides N`` kept for the scene, :func:`longer_run_note`) cut to its
+        first ``2 * strides`` steps.  The steps are the same run's, so the cut has the
+        fresh run's verdict (``termination``: "heel_strike" when those steps all ended by
+        one, however the longer run ended later) and its means: ``mean_period_s``,
+        ``mean_step_length_m``, ``mean_hip_speed_m_per_s`` over the kept heel strikes,
+        ``mean_total_energy_J`` over the kept samples (each step is sampled from its own
+        start: the same samples).  ``nfev`` and ``wall_time_s`` stay the longer run's (the
+        cut's ``summary["cut_from_strides"]`` says from how many strides); a trip after the
+        kept steps is dropped.  ``self`` when the run is not longer.
 
-def load_simulate(path: Path) -> SimulateArtifact:
+        Parameters
+        ----------
+        strides : int
+            Strides the scene asks for (``simulate.strides``), >= 1.
+        """
+        k = 2 * int(strides)
+        n = len(self.steps.get("termination", ()))
+        if self.strides_requested <= strides or n <= k:
+            return self  # not longer, or it ended within the scene's steps: its own verdict
+        import dataclasses
+
+        cut = {key: v[:k] for key, v in self.steps.items()}
+        ok = cut["termination"] == "heel_strike"
+        keep = self.samples.step_index < k
+        sm = self.samples
+        samples = dataclasses.replace(
+            sm, time=sm.time[keep], coordinates={c: v[keep] for c, v in sm.coordinates.items()},
+            stance_leg=sm.stance_leg[keep], step_index=sm.step_index[keep],
+            kinetic=sm.kinetic[keep], potential=sm.potential[keep],
+            points={c: v[..., keep] for c, v in sm.points.items()},
+            phase=None if sm.phase is None else sm.phase[keep])
+        summary = {key: v for key, v in self.summary.items()
+                   if not key.startswith("trip_") and key != "ground_steps"}
+
+        def mean(col):
+            return float(np.mean(cut[col][ok])) if ok.any() and col in cut else np.nan
+
+        summary.update(steps_completed=int(ok.sum()), mean_period_s=mean("period"),
+                       mean_step_length_m=mean("step_length"),
+                       mean_hip_speed_m_per_s=mean("hip_speed"),
+                       mean_total_energy_J=float(np.mean(samples.total)),
+                       cut_from_strides=self.strides_requested)
+        term = "heel_strike" if ok.all() else str(cut["termination"][~ok][0])
+        return dataclasses.replace(
+            self, termination=term, strides_requested=int(strides), samples=samples,
+            steps=cut, summary=summary, ledger={key: v[:k] for key, v in self.ledger.items()})
+
+
+def load_simulate(path: Path, strides: int | None = None) -> SimulateArtifact:
     """Load ``simulate.h5`` (a hand-built artifact may hold only ``samples/``: what it lacks
-    of the rest is empty or NaN).
+    of the rest is empty or NaN); with ``strides`` (the scene's ``simulate.strides``), a
+    longer run kept for the scene is seen as the scene's own run
+    (:meth:`SimulateArtifact.first_strides`).
 
     Raises
     ------
@@ -212,7 +263,7 @@ def load_simulate(path: Path) -> SimulateArtifact:
                 continue  # the states/ group
             steps[k] = ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]
         a = f.attrs
-        return SimulateArtifact(
+        sim = SimulateArtifact(
             path=Path(path), units=for_artifact(f), termination=str(a.get("termination", "")),
             strides_requested=int(a.get("strides_requested", 0)),
             total_mass_kg=float(a.get("total_mass_kg", np.nan)),
@@ -222,6 +273,7 @@ def load_simulate(path: Path) -> SimulateArtifact:
             ledger={k: f["ledger"][k][()] for k in f["ledger"] if k != "step"}
             if "ledger" in f else {},
             scene_json=str(a["scene_json"]))
+    return sim if strides is None else sim.first_strides(strides)
 
 
 def strides_of(path: Path) -> int | None:
@@ -236,10 +288,12 @@ def strides_of(path: Path) -> int | None:
         return None
 
 
-def run_end(path: Path) -> str:
+def run_end(path: Path, strides: int | None = None) -> str:
     """How the run of ``simulate.h5`` ended (``termination``: "heel_strike" when every step
     completed, "fall", ...; a trip on a height profile with its time and place: "trip (the
-    swing foot entered the profile at t = 0.42 s, x = -1.5 m, y = 0.03 m)").
+    swing foot entered the profile at t = 0.42 s, x = -1.5 m, y = 0.03 m)"); with
+    ``strides``, how its first ``strides`` strides ended (a longer run kept for a scene
+    that asks fewer: "heel_strike" when they all completed, whatever came after them).
 
     Raises
     ------
@@ -248,6 +302,12 @@ def run_end(path: Path) -> str:
     """
     with open_artifact(path, STAGE) as f:
         term = str(f.attrs["termination"])
+        if strides is not None and int(f.attrs["strides_requested"]) > strides:
+            ends = f["steps/termination"].asstr()[()]
+            if ends.size > 2 * strides:  # it went past the scene's steps: theirs decide
+                first = ends[:2 * strides]
+                bad = first[first != "heel_strike"]
+                return "heel_strike" if bad.size == 0 else str(bad[0])
         if term == "trip" and "summary/trip_time_s" in f:
             t, x, y = (float(f[f"summary/trip_{k}"][()]) for k in ("time_s", "x_m", "y_m"))
             term += (f" (the swing foot entered the profile at t = {t:.6g} s, "

@@ -16,7 +16,8 @@ Sources
   checkerboard terrain; :mod:`walkerlab.published.paper`).
 
 Scalar, numba-compiled twins of these functions live in :mod:`walkerlab.models.contact._kernels`;
-``tests/contact/test_laws.py`` checks that both agree.
+``tests/contact/test_laws_config.py`` checks that both agree
+(``test_the_scalar_impact_law_is_the_array_law_bit_for_bit``).
 """
 
 from __future__ import annotations

@@ -269,6 +269,10 @@ class HybridWalker:
         foot alone, ``points(x)["hip"][0]`` bit for bit (generated beside ``points``:
         :func:`walkerlab.codegen.source.numpy_fn`'s slices); None: read it from
         ``points``.
+    section_words : str
+        What the Poincaré section's state is, in words for the outputs that print it
+        (``fixedpoint``): "state just after heel strike"; flat feet with a double support:
+        after the heel strike's impulse, before the trailing toe is pinned.
     """
 
     name: str
@@ -297,6 +301,7 @@ class HybridWalker:
     ground_steps: int | None = None
     neutral: tuple[str, ...] = ()
     hip_x: Callable[[np.ndarray], float] | None = None
+    section_words: str = "state just after heel strike"
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)

@@ -228,6 +228,9 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
                            else f["guard_swing_heel_height_heel"]),
         leg_angles=f["leg_angles"],
         mirror=mirror, step_entry=entry,
+        section_words=("state just after the heel strike's impulse, before the trailing toe "
+                       "is pinned (the double support starts from it)" if entry is not None
+                       else "state just after heel strike"),
     )
 
 
