@@ -1,5 +1,5 @@
 """Compiled flows of a walker driven by joint-torque laws: numba ``cfunc`` right-hand sides
-(CyRK's signature, as :func:`walkerlab.codegen.source.generate_compiled`) in which the laws
+(CyRK's signature, as :func:`walkerlab.codegen.compiled_source.generate_compiled`) in which the laws
 are evaluated (:mod:`walkerlab.codegen.torque_law`), so a phase-reference (virtual
 constraint), time-table or saturated law runs without a Python callback.
 
@@ -164,7 +164,7 @@ def _variational_lines(eq, acts, grads, fl, rows, printer, cse_lines) -> list[st
 def generate_actuated(eq, param_names, joints, key: str) -> str:
     """Source of the compiled module of an actuated walker (module docstring): ``constants``,
     ``NCONST``, ``GUARDS`` (``eq.guards``' names, written after the outputs as
-    :func:`walkerlab.codegen.source.generate_compiled` does) and the right-hand sides
+    :func:`walkerlab.codegen.compiled_source.generate_compiled` does) and the right-hand sides
     ``flow`` (2n outputs) and ``flow_variational`` (``2n + (2n)^2``), and for a kneed walker
     ``flow_locked`` and ``flow_locked_variational`` (its swing knee locked), each made a
     cfunc by ``cfunc_of(name)`` on first use (the five-link biped's variational cfunc is

@@ -29,7 +29,8 @@ from walkerlab import usercache
 ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
                     "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
-                    "codegen/equations.py", "codegen/lagrange.py")
+                    "codegen/equations.py", "codegen/lagrange.py",
+                    "codegen/compiled_source.py")
 _memo: dict[str, dict] = {}
 
 

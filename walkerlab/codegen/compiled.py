@@ -1,6 +1,6 @@
 """Compiled right-hand sides of a walker's flow: numba ``cfunc``s for CyRK's C++ integrators.
 
-The source comes from :func:`walkerlab.codegen.source.generate_compiled` (the same symbolic
+The source comes from :func:`walkerlab.codegen.compiled_source.generate_compiled` (the same symbolic
 equations as the Python module of :mod:`walkerlab.codegen.cache`) and is cached next to it as
 ``<key>_nb.py`` in the per-user cache (same key, same ownership/mode and sha256 checks,
 atomic write); the per-row integrator's loops specialised to its flows
@@ -37,9 +37,9 @@ def compiled_module(structure):
             from walkerlab.codegen import foot_modes as flatfoot  # light
 
             return flatfoot.generate_flat_compiled(structure, key)
-        from walkerlab.codegen import source as codegen  # light
+        from walkerlab.codegen.compiled_source import generate_compiled  # light
 
-        return codegen.generate_compiled(cache.derive_equations(structure),
+        return generate_compiled(cache.derive_equations(structure),
                                          structure.param_names, key)
 
     return cache.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)

@@ -564,8 +564,8 @@ def generate_flat_compiled(structure: Structure, key: str) -> str:
     C++ integrators, the same equations as :func:`generate_flat` (same lines, same key),
     each writing ``GUARDS`` after its outputs (the state guards, then :data:`FORCES`);
     ``constants(p)`` (the data vector: parameters, parameter-only subexpressions, a zeroed
-    call counter) and ``NCONST``, as :func:`walkerlab.codegen.source.generate_compiled`."""
-    from walkerlab.codegen.source import _cfunc  # (same package: the compass gait's cfuncs)
+    call counter) and ``NCONST``, as :func:`walkerlab.codegen.compiled_source.generate_compiled`."""
+    from walkerlab.codegen.compiled_source import cfunc_lines  # light
 
     eq = derive_flat(structure)
     hoisted = start_module(eq.params)  # filled as the lines below are generated
@@ -580,7 +580,7 @@ def generate_flat_compiled(structure: Structure, key: str) -> str:
     for mode, system in eq.flows.items():
         for var in (False, True):
             name = f"flow_{mode}_variational" if var else f"flow_{mode}"
-            body += _cfunc(name, system, consts, parts[mode], var, extras[mode]) + [""]
+            body += cfunc_lines(name, system, consts, parts[mode], var, extras[mode]) + [""]
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.foot_modes); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",

@@ -1,0 +1,199 @@
+"""Numba source of a walker's equations: the compiled twin of :mod:`walkerlab.codegen.source`.
+
+:func:`generate_compiled` prints the same symbolic equations (the same ``cse`` lines, so the
+same round-off) as numba ``cfunc`` right-hand sides of CyRK's signature ``(dy, t, y, d)``:
+the flow, its variational form, the guards as CyRK's extra outputs and the heel-strike reset
+(:mod:`walkerlab.codegen.compiled` imports and caches the module).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+from walkerlab.codegen.source import (
+    IND,
+    PRINTER,
+    cse_lines,
+    flow_lines,
+    reset_lines,
+    start_module,
+)
+from walkerlab.codegen.symbolic import Equations
+
+__all__ = ["cfunc_lines", "generate_compiled"]
+
+
+def _reset_cfunc(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
+    """``reset_flow()``: the heel-strike reset (``reset_lines``' equations, same
+    expressions) of the pre-impact state ``y`` into ``dy``, a numba ``cfunc`` ``(dy, t, y,
+    d)`` of the flows' signature (``d`` the data vector; ``t`` unused), compiled on the
+    first call of ``reset_flow()`` (cfuncs compile when made: lazily, as every njit)."""
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    ret = reset[-1].strip()
+    assert ret.startswith("return np.array((") and ret.endswith(",))")
+    out = ["def _reset_flow(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    out += [ln[4:] for ln in reset[2:-1]]
+    out += [f"    _res = ({ret[len('return np.array(('):-3]},)",
+            f"    for _k in range({len(names)}):", "        dy[_k] = _res[_k]", "", "",
+            "_RESET_FLOW = []", "", "",
+            "def reset_flow():",
+            '    """The heel-strike reset, a cfunc of the flows\' signature (compiled on first',
+            '    use: a walker that never walks on per-step slopes does not compile it)."""',
+            "    if not _RESET_FLOW:",
+            "        _RESET_FLOW.append(cfunc(SIG, cache=True, error_model='numpy')(_reset_flow))",
+            "    return _RESET_FLOW[0]"]
+    return out + [""]
+
+
+def cfunc_lines(name: str, eq: Equations, consts: list[str], parts: list, variational: bool,
+           guards: tuple[list[str], list] | None, lazy: bool = False) -> list[str]:
+    """A numba ``cfunc`` ``(dy, t, y, d)`` (CyRK's ``cyjit_sig``) writing the flow (and with
+    ``variational`` the product ``A Phi`` of the flow Jacobian with ``y[2n:]``, row-major
+    (2n, 2n)) into ``dy``, then the guard values (CyRK's extra outputs; none when ``guards``
+    is None); ``d`` holds the constants, then a call counter.  ``lazy``: the plain Python
+    function (no decorator), made a cfunc on first use (:func:`_stage_cfuncs`)."""
+    m = 2 * len(eq.q)
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    out = [] if lazy else ["@cfunc(SIG, cache=True, error_model='numpy')"]
+    out += [f"def {name}(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    (fl, fo) = parts[0]
+    out += [ln[4:] for ln in fl]
+    out += [f"    dy[{i}] = {e}" for i, e in enumerate(fo)]
+    if variational:
+        jl, rows = parts[1]
+        out += [ln[4:] for ln in jl]
+        for i in range(m):
+            for j in range(m):
+                terms = []
+                for k in range(m):
+                    a = rows[i][k].strip("()")
+                    if a in ("0", "0.0"):
+                        continue
+                    phi = f"y[{m + k * m + j}]"
+                    terms.append(phi if a == "1.0" else f"({a}) * {phi}")
+                out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms) or '0.0'}")
+    k0 = m + m * m if variational else m
+    if guards is not None:
+        out += [ln[4:] for ln in guards[0]]
+        out += [f"    dy[{k0 + j}] = {PRINTER.doprint(e)}" for j, e in enumerate(guards[1])]
+    out.append(f"    d[{len(consts)}] += 1.0")
+    return out
+
+
+def _needed(lines: list[str], expr: str) -> list[str]:
+    """The assignments of ``lines`` (``name = rhs``, in order) that ``expr`` needs."""
+    need = set(re.findall(r"[A-Za-z_]\w*", expr))
+    keep = []
+    for ln in reversed(lines):
+        name, rhs = ln.strip().split(" = ", 1)
+        if name in need:
+            keep.append(ln)
+            need |= set(re.findall(r"[A-Za-z_]\w*", rhs))
+    return keep[::-1]
+
+
+def _guard_cfunc(eq: Equations, consts: list[str], guards: tuple[list[str], list]) -> list[str]:
+    """``_guard_one(dy, t, y, d)``: the guard number ``int(dy[0])`` (its index in ``GUARDS``)
+    of the state ``y`` into ``dy[0]``, with the lines and expressions of the flows' guard
+    outputs (the same values bit for bit), only those that guard needs; no call counted."""
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    out = ["def _guard_one(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    out.append("    j = int(dy[0])")
+    for j, e in enumerate(guards[1]):
+        text = PRINTER.doprint(e)
+        out.append(f"    {'if' if j == 0 else 'elif'} j == {j}:")
+        out += _needed(guards[0], text) + [f"{IND}dy[0] = {text}"]
+    return out + [""]
+
+
+def _stage_cfuncs(flows) -> list[str]:
+    """``plain_flow(name)`` and ``guard_one()``: made cfuncs on first use (a walker that never
+    runs the per-row integrator does not compile them)."""
+    return ["_LAZY = {}", "", "",
+            "def _lazy(name):",
+            "    if name not in _LAZY:",
+            "        _LAZY[name] = cfunc(SIG, cache=True, error_model='numpy')(globals()[name])",
+            "    return _LAZY[name]", "", "",
+            "def plain_flow(name):",
+            '    """The cfunc ``name`` (one of ' + ", ".join(f"``{k}``" for k in flows)
+            + ') without its guard',
+            '    outputs: the same 2n values and call count (the DOP853 stages)."""',
+            "    return _lazy(f'_{name}_plain')", "", "",
+            "def guard_one():",
+            '    """The cfunc writing guard ``int(dy[0])`` of ``y`` into ``dy[0]``."""',
+            "    return _lazy('_guard_one')", ""]
+
+
+def generate_compiled(eq: Equations, param_names, key: str) -> str:
+    """Source of the compiled module of a walker: numba ``cfunc`` right-hand sides for CyRK's
+    C++ integrators (``CyRK.nb.numba_solver.cyjit_sig``), ``cache=True``.
+
+    Defines ``constants(p) -> ndarray (NCONST + 1,)`` (the parameters, the parameter-only
+    subexpressions and a zeroed call counter: the data vector of every cfunc), its compiled
+    twin for many parameter rows ``constants_rows(P (N, NP)) -> (N, NCONST + 1)`` (numba,
+    lazy), ``NCONST``, the heel-strike reset as a cfunc of the flows' signature
+    (``reset_flow()`` makes it on first use),
+    ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
+    ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
+    ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
+    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  For
+    the per-row integrator (:mod:`walkerlab.integrate.rows_dop853`), made on first use:
+    ``plain_flow(name)``, the flow ``name`` without the guard outputs (its stages), and
+    ``guard_one()``, one guard's value (its crossing's location), the same lines and values
+    bit for bit.  ``FLOWS`` names the flows and each flow's functions stay plain Python
+    functions too (``_<name>_full`` with the guard outputs, ``_<name>_plain``, beside
+    ``_guard_one`` and ``_reset_flow``): the per-row integrator's loops specialised to them
+    (:func:`walkerlab.integrate.rows_dop853.kernels`).  The equations are those of
+    :func:`walkerlab.codegen.source.generate` (same expressions, same key).
+    """
+    hoisted = start_module(eq.params)
+    flows = {"flow": eq}
+    if eq.locked is not None:
+        flows["flow_locked"] = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
+    parts = {k: (flow_lines(e, False, parts=True), flow_lines(e, True, parts=True))
+             for k, e in flows.items()}
+    guards = cse_lines(list(eq.guards.values()), PRINTER)
+    reset = reset_lines(eq, False)  # (its parameter-only subexpressions join the constants)
+    consts = list(param_names) + [h.split("=")[0].strip() for h in hoisted]
+    body = ["def constants(p):",
+            f"    {', '.join(param_names)}, = p",
+            *hoisted,
+            f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)",
+            "", f"NCONST = {len(consts)}",
+            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", "",
+            "_constants_jit = njit(cache=True)(constants)", "", "",
+            "@njit(cache=True)",
+            "def constants_rows(P):  # pragma: no cover - runs compiled",
+            '    """Data vectors (N, NCONST + 1) of the parameter rows P (N, NP)."""',
+            "    out = np.empty((P.shape[0], NCONST + 1))",
+            "    for i in range(P.shape[0]):",
+            "        out[i] = _constants_jit(P[i])",
+            "    return out", ""]
+    for k, e in flows.items():  # the flow: a plain function, its cfunc, its njit (kernels)
+        body += cfunc_lines(f"_{k}_full", e, consts, parts[k], False, guards, lazy=True) + [""]
+        body += [f"{k} = cfunc(SIG, cache=True, error_model='numpy')(_{k}_full)", ""]
+        body += cfunc_lines(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
+        body += cfunc_lines(f"_{k}_plain", e, consts, parts[k], False, None, lazy=True) + [""]
+    body += _guard_cfunc(eq, consts, guards)
+    body += _stage_cfuncs(flows)
+    body += _reset_cfunc(eq, consts, reset)
+    body += [f"FLOWS = {tuple(flows)!r}  # _<name>_full, _<name>_plain: plain functions", ""]
+    head = [
+        f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
+        "# Do not edit: regenerated when the walker description or the generator changes.",
+        "from math import sin, cos, tan, sqrt  # noqa: F401",
+        "import numpy as np",
+        "from numba import cfunc, njit, types",
+        "",
+        "SIG = types.void(types.CPointer(types.float64), types.float64,",
+        "                 types.CPointer(types.float64), types.CPointer(types.float64))",
+        "",
+    ]
+    return "\n".join(head + body) + "\n"
