@@ -382,7 +382,7 @@ def test_work_precision_choice_respects_timing_noise():
     """Overlapping repeat ranges: no setting is named fastest, the tied ones are listed;
     clearly separated: the fastest is named with its spread."""
     from walkerlab.bench.workprecision_results import summarize
-    from walkerlab.report.text import workprecision_choice
+    from walkerlab.report.workprecision_section import workprecision_choice
 
     noisy = summarize(_wp_rows({"DOP853": [[1.0, 1.4, 2.0], [0.9, 1.3, 1.8]],
                                 "RK45": [[5.0, 5.1, 5.2], [1.2, 1.5, 2.2]]}), 1e-5)

@@ -125,7 +125,7 @@ def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                   force: bool = ForceOpt) -> None:
     """Work-precision study: error vs wall time for every solver and tolerance."""
     from walkerlab.io.schemas.workprecision import load_workprecision  # light
-    from walkerlab.report.text import workprecision_text  # light
+    from walkerlab.report.workprecision_section import workprecision_text  # light
     from walkerlab.stages import pipeline  # light
 
     out = pipeline.run("workprecision", load(scene), runs_dir, force)

@@ -9,10 +9,45 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from walkerlab.report.markdown import num, table
-from walkerlab.report.text import workprecision_choice
 
 if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
     from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
+
+
+def _ms(t: float) -> str:
+    return f"{num(1e3 * t, 3)} ms"
+
+
+def workprecision_choice(attrs) -> str:
+    """The work-precision study's choice for one model (attributes of its group), in one
+    sentence that says how noisy the timing was: a setting is named fastest only when its
+    slowest run beats every other qualifying setting's fastest run; otherwise the
+    timings cannot separate them."""
+    if "best_method" not in attrs:
+        return f"no setting reaches the target error {attrs['target_error']:.0e}."
+    target = f"{attrs['target_error']:.0e}"  # settings, printed as given
+    name = f"{attrs['best_method']} rtol {attrs['best_rtol']:.0e}"
+    if "best_separated" not in attrs:  # an artifact from before the spread was stored
+        return (f"fastest median run reaching the target error {target}: {name} "
+                f"({_ms(attrs['best_time'])}; timing spread not recorded).")
+    spread = (f"median {_ms(attrs['best_time'])} CPU, {_ms(attrs['best_time_min'])}–"
+              f"{_ms(attrs['best_time_max'])} over {int(attrs['best_repeats'])} runs")
+    if bool(attrs["best_separated"]):
+        return (f"fastest setting reaching the target error {target}: **{name}** ({spread}; "
+                "faster than every run of any other setting that reaches it).")
+    tied = [f"{m} rtol {r:.0e} ({_ms(a)}–{_ms(b)})" for m, r, a, b in zip(
+        attrs["tied_methods"], attrs["tied_rtol"], attrs["tied_time_min"],
+        attrs["tied_time_max"])]
+    return (f"the timings cannot separate the settings reaching the target error {target}: "
+            + ", ".join(tied) + " (min–max CPU time of the integration over the repeats "
+            "overlap, or a setting was timed once): indistinguishable; the lowest median is "
+            + name + ".")
+
+
+def workprecision_text(wp: WorkPrecisionArtifact) -> str:
+    """One line per model of a workprecision artifact: its choice and the timing noise."""
+    return "\n".join(f"{model}: {workprecision_choice(m.choice)}"
+                     for model, m in wp.models.items())
 
 
 def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
