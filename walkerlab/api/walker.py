@@ -353,7 +353,8 @@ class Walker:
                     float(r.period_s) / self.model.steps_per_map, float(r.period_s),
                     np.asarray(r.multipliers_variational),
                     np.asarray(r.jacobian_variational), float(r.residual), chosen.label,
-                    m["step_length"], m["speed"], m["cost_of_transport"], ledger)
+                    m["step_length"], m["speed"], m["cost_of_transport"], ledger,
+                    tuple(getattr(r, "neutral", ())))
 
     def _known_start(self):
         """The start of the gait search carried from ``fixedpoint.from`` (as the

@@ -184,7 +184,7 @@ def target(scene: Path | None = SceneArg,
                f"gives {name.rsplit('_', 1)[0].rsplit('_m', 1)[0]} = {value:g} "
                f"{u(field_unit(name) or '-')}")
     typer.echo(f"  step period {gait.step_period:.6g} {u.time}, max |Floquet multiplier| "
-               f"{max(abs(gait.multipliers)):.4g} ({'stable' if gait.stable else 'unstable'})")
+               f"{gait.max_abs_multiplier:.4g} ({'stable' if gait.stable else 'unstable'})")
     for n, v in gait.state.items():
         typer.echo(f"  {n:14s} {v:+.8f}")
 
