@@ -341,8 +341,13 @@ def test_a_3d_wheels_target_gait_is_judged_with_its_neutral_multiplier_set_aside
     """The disc wheel's gait at 1.9 m/s lies at 0.1944 rad, above its critical slope
     (0.1857 rad, where the lateral multiplier crosses +1): stable, its largest |multiplier|
     besides the neutral 1 (the heading) 0.93, as the fixed-point search's verdict; with the
-    neutral 1 counted it was called unstable at max |multiplier| 1."""
+    neutral 1 counted it was called unstable at max |multiplier| 1.  The slope is the planar
+    wheel's with the disc's axle inertia (to 1e-9 relative, as above)."""
     slope, gait = _target_slope(ROOT / "configs" / "rimless_wheel_3d_disc.yaml", speed=1.9)
+    planar, _ = _target_slope(ROOT / "configs" / "rimless_wheel.yaml", speed=1.9,
+                              **{"walker.hub_inertia_kg_m2": 0.5, "slope.angle_rad": 0.2,
+                                 "fixedpoint.initial_guess.stance_rate_rad_per_s": -1.9})
+    assert abs(slope - planar) <= 1e-9 * planar
     assert 0.1857 < slope < 0.2 and gait.neutral == ("heading_angle",)
     assert 0.9 < gait.max_abs_multiplier < 0.95 and gait.stable
     assert abs(np.max(np.abs(gait.multipliers)) - 1.0) < 1e-8  # the neutral 1 is there
