@@ -153,3 +153,95 @@ def test_heel_strike_basin_of_the_simplest_walker_is_thin(tmp_path):
     jy, ix = np.nonzero(conv)
     ev = np.linalg.eigvalsh(np.cov(np.c_[x[ix], y[jy]].T))
     assert np.sqrt(ev[1] / ev[0]) > 8
+
+
+# ---- on a 3D walker: the rimless wheel (its heading neutral, Coleman et al. 1997) -------
+
+DISC = ROOT / "configs" / "rimless_wheel_3d_disc.yaml"
+
+
+def _wheel_scene(tmp_path, d: dict, name: str, **basin):
+    d = {**d, "name": name, "basin": basin}
+    p = tmp_path / f"{name}.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return load_scene(p)
+
+
+def test_a_3d_wheel_that_settles_rolling_at_another_heading_has_converged():
+    """The disc wheel's steady rolling motions form a family along the heading (multiplier
+    1): the member at heading 0.05 rad (leaning -0.0101 rad, found with the heading held) is
+    a cell that has converged at its first heel strike, not another attractor (as it was
+    judged against the gait at heading 0: 0.05 rad away)."""
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    w = build_walker(load_scene(DISC))
+    st = BasinSettings(max_steps=10)
+    sv = Solver("DOP853", st.rtol, st.atol)
+    guess = np.array([0.0, 0.0, np.pi / 8 - 0.2, 0.0, 0.0, -1.9])
+    fp = find_fixed_point(w, guess, sv, fd_check=False).x
+    guess[0] = 0.05
+    member = find_fixed_point(w, guess, sv, fd_check=False).x
+    assert member[0] == 0.05 and abs(member[1] + 0.0101) < 1e-4  # it leans: not x* turned
+    assert classify_cell(w, member, fp, sv, st) == (CODE["converged"], 1, 1)
+
+
+def test_a_3d_wheels_basin_names_and_draws_the_lean_axes_its_cells_were_computed_on(
+        tmp_path):
+    """The disc wheel (stable: |multipliers| 0.918 besides the neutral 1) on its default
+    axes: its section fixes the stance angle, so the cells lie in lean and lean rate and the
+    artifact and the figure say so; the star is the fixed point there (upright: 0, 0), in
+    the middle cell.  Every cell of a small window (lean +-1 mrad, lean rate +-4 mrad/s)
+    converges, each to straight rolling at its own heading (a lean of 1 mrad settles at
+    -0.071 rad heading in ~70 steps): with the heading set aside they have converged."""
+    from walkerlab.io.schemas.basin import load_basin
+    from walkerlab.plotting.basin_figures import basin_figure
+    from walkerlab.stages import pipeline
+
+    d = yaml.safe_load(DISC.read_text())
+    sc = _wheel_scene(tmp_path, d, "disc", x_range=[-0.0015, 0.0015],
+                      y_range=[-0.006, 0.006], grid=[3, 3], max_steps=150)
+    b = load_basin(pipeline.run("basin", sc, tmp_path / "runs", workers=1).path)
+    assert (b.x_axis, b.y_axis, b.x_unit, b.y_unit) == ("lean_angle", "lean_rate", "rad",
+                                                        "rad/s")
+    star = (b.fixed_point[b.x_axis], b.fixed_point[b.y_axis])
+    assert np.max(np.abs(star)) < 1e-12
+    assert np.argmin(abs(b.x - star[0])) == 1 and np.argmin(abs(b.y - star[1])) == 1
+    assert np.all(b.outcome == CODE["converged"]), b.outcome
+    fig = basin_figure(b)
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "lean angle [rad]" and ax.get_ylabel() == "lean rate [rad/s]"
+    np.testing.assert_array_equal(ax.lines[0].get_xydata(), [star])
+
+
+def test_a_3d_wheels_basin_in_its_stance_plane_is_the_planar_wheels(tmp_path):
+    """Its planar embedding: the upright disc wheel started in the stance phase's phase plane
+    (Coleman, Chatterjee & Ruina 1997; lean, heading and their rates 0) rolls as the planar
+    wheel with the disc's axle inertia (0.5 kg m^2), so the two basin maps on the same 4 x 4
+    grid agree cell by cell, in outcome and in steps (the 3D wheel's lateral coordinates stay
+    at round-off, ~1e-20, far below the 1e-4 convergence test)."""
+    from walkerlab.io.schemas.basin import load_basin
+    from walkerlab.stages import pipeline
+
+    a, g = np.pi / 8, 0.2
+    basin = {"start": "phase_plane", "x_axis": "stance_angle", "y_axis": "stance_rate",
+             "x_range": [-a - g, a - g], "y_range": [-4.0, 0.5], "grid": [4, 4],
+             "max_steps": 50}
+    d3 = yaml.safe_load(DISC.read_text())
+    dp = yaml.safe_load((ROOT / "configs" / "rimless_wheel.yaml").read_text())
+    for k in ("contact", "terrain", "contact_sim", "mfpt"):
+        dp.pop(k, None)
+    dp["walker"]["hub_inertia_kg_m2"] = 0.5
+    dp["slope"]["angle_rad"] = g
+    dp["fixedpoint"]["initial_guess"] = {"stance_angle_rad": a - g,
+                                         "stance_rate_rad_per_s": -1.9}
+    b3, bp = (load_basin(pipeline.run("basin", _wheel_scene(tmp_path, d, n, **basin),
+                                      tmp_path / "runs", workers=1).path)
+              for d, n in ((d3, "disc3d"), (dp, "planar")))
+    np.testing.assert_array_equal(b3.x, bp.x)
+    np.testing.assert_array_equal(b3.y, bp.y)
+    np.testing.assert_array_equal(b3.outcome, bp.outcome)
+    np.testing.assert_array_equal(b3.steps, bp.steps)
+    found = set(b3.outcome.ravel())
+    assert {CODE["converged"], CODE["fell_backward"]} <= found  # not one outcome throughout

@@ -105,6 +105,11 @@ class Gait:
         ``internal_collision_loss``, ``damper_work``, ``potential_work``, ``energy_change``,
         ``closure``, ``slope_energy`` [J], ``push_off_impulse`` [N s],
         ``cost_of_transport`` [-].
+    neutral : tuple of str
+        The walker's neutral coordinates (:attr:`HybridWalker.neutral`, the 3D wheel's
+        heading: its gaits form a family along it); their multipliers (1 on the family,
+        the ``len(neutral)`` nearest 1) are set aside by :attr:`stable` and
+        :attr:`max_abs_multiplier`.
     """
 
     x: np.ndarray
@@ -119,6 +124,7 @@ class Gait:
     speed: float = float("nan")
     cost_of_transport: float = float("nan")
     ledger: dict = field(default_factory=dict)
+    neutral: tuple = ()
 
     @property
     def state(self) -> dict[str, float]:
@@ -126,11 +132,19 @@ class Gait:
         return {n: float(v) for n, v in zip(self.names, self.x)}
 
     @property
-    def stable(self) -> bool:
-        """All ``|Floquet multipliers|`` < 1."""
+    def max_abs_multiplier(self) -> float:
+        """Largest ``|Floquet multiplier|`` [-], the neutral ones (:attr:`neutral`) set
+        aside."""
         import numpy as np
 
-        return bool(np.max(np.abs(self.multipliers)) < 1.0)
+        from walkerlab.numerics import without_neutral  # light: numpy only
+
+        return float(np.max(np.abs(without_neutral(self.multipliers, len(self.neutral)))))
+
+    @property
+    def stable(self) -> bool:
+        """All ``|Floquet multipliers|`` < 1, the neutral ones (:attr:`neutral`) set aside."""
+        return self.max_abs_multiplier < 1.0
 
 
 class SceneWalker:
@@ -280,7 +294,8 @@ class SceneWalker:
                     float(r.period_s) / self.model.steps_per_map, float(r.period_s),
                     np.asarray(r.multipliers_variational),
                     np.asarray(r.jacobian_variational), float(r.residual), chosen.label,
-                    m["step_length"], m["speed"], m["cost_of_transport"], ledger)
+                    m["step_length"], m["speed"], m["cost_of_transport"], ledger,
+                    tuple(getattr(r, "neutral", ())))
 
     def _known_start(self):
         """The start of the gait search carried from ``fixedpoint.from`` (as the

@@ -263,10 +263,13 @@ class Walker(SceneWalker):
                            MEASURES[name][0], value)
         found = self.with_changes({vary: res.p})
         fp = self.scene.fixedpoint
-        if fp is not None and fp.initial_guess is not None:  # start from the solution
+        if fp is not None and fp.initial_guess is not None:  # start from the solution,
+            # its gait the one reported (under ``stable`` an unstable solution would send
+            # the search to another gait, which does not meet the target, or to the seeds)
             found = found.with_changes({
                 f"fixedpoint.initial_guess.{n}_{'rad' if n.endswith('_angle') else 'rad_per_s'}":
-                float(v) for n, v in zip(found.state_names(), res.x)})
+                float(v) for n, v in zip(found.state_names(), res.x)} |
+                {"fixedpoint.gait": "nearest_guess"})
         return found, found.fixed_point()
 
     def simulate(self, x0, strides: int, sample_rate_hz: float = 500.0, *,

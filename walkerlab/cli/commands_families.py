@@ -190,7 +190,7 @@ def target(scene: Path | None = SceneArg,
                f"{u(field_unit(name) or '-')}")
     per = per_map(w.model.steps_per_map)  # the walker's own map: a step or a stride
     typer.echo(f"  step period {gait.step_period:.6g} {u.time}, max |Floquet multiplier| "
-               f"{per} {max(abs(gait.multipliers)):.4g} "
+               f"{per} {gait.max_abs_multiplier:.4g} "
                f"({'stable' if gait.stable else 'unstable'})")
     for n, v in gait.state.items():
         typer.echo(f"  {n:14s} {v:+.8f}")

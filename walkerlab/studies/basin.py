@@ -25,7 +25,11 @@ map and record where each cell goes.  Here a cell's state takes its two axis coo
 Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
 
 ``converged``
-    ``max|x_k - x*| < converge_tol`` after ``k`` steps (the period-1 gait)
+    ``max|x_k - x*| < converge_tol`` after ``k`` steps (the period-1 gait); for a
+    walker with neutral coordinates (:attr:`HybridWalker.neutral`, the 3D rimless
+    wheel's heading: its gaits form a family along it) also within ``converge_tol`` of
+    the family's member at ``x_k``'s neutral values (:func:`family_member`: the wheel
+    rolling straight at another heading has converged)
 ``other_attractor``
     ``max|x_k - x_{k-p}| < period_tol`` for some ``1 <= p <= max_period``
     away from ``x*`` (a period-``p`` gait; ``p`` is stored)
@@ -73,7 +77,7 @@ CODE = {name: i for i, name in enumerate(OUTCOMES)}
 NOT_DONE = -1
 
 __all__ = ["OUTCOMES", "CODE", "NOT_DONE", "BasinError", "BasinTask", "slice_state",
-           "HeelStrikeSlice", "heel_strike_slice", "axis_values", "classify_cell",
+           "HeelStrikeSlice", "heel_strike_slice", "axis_values", "classify_cell", "family_member",
            "run_basin_chunk", "compute_basin", "basin_run"]
 
 
@@ -116,11 +120,48 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
             continue
         if float(np.max(np.abs(x - x_star))) < settings.converge_tol:
             return CODE["converged"], k, 1
+        if walker.neutral and float(np.max(np.abs(x - hist[-1]))) < settings.converge_tol:
+            # settling (a step shorter than the tolerance): near the gait's family?
+            member = family_member(walker, x, solver, max_step_time)
+            if member is not None and \
+                    float(np.max(np.abs(x - member))) < settings.converge_tol:
+                return CODE["converged"], k, 1
         for p in range(1, min(settings.max_period, len(hist)) + 1):
             if float(np.max(np.abs(x - hist[-p]))) < settings.period_tol:
                 return CODE["other_attractor"], k, p
         hist.append(x)
     return CODE["max_steps"], settings.max_steps, 0
+
+
+def family_member(walker, x: np.ndarray, solver, max_step_time: float = 5.0
+                  ) -> np.ndarray | None:
+    """The period-1 gait at the neutral values of ``x`` (:attr:`HybridWalker.neutral`, the 3D
+    wheel's heading: the steady rolling motions form a family along it, Coleman, Chatterjee
+    & Ruina 1997), found from ``x`` with them held
+    (:func:`walkerlab.analysis.gait.poincare.find_fixed_point`, MINPACK hybrd, xtol 1e-12).
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x : ndarray, shape (2n,)
+        A post-impact state near the family (``walker.state_names()``, [rad, rad/s]).
+    solver : Solver
+    max_step_time : float
+        Longest step [s].
+
+    Returns
+    -------
+    ndarray, shape (2n,) or None
+        The member's post-impact state [rad, rad/s]; None where the root finder finds none.
+    """
+    # light: only a walker with neutral coordinates needs the root finder
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
+
+    try:
+        res = find_fixed_point(walker, x, solver, fd_check=False, max_step_time=max_step_time)
+    except (FixedPointNotFound, ValueError, ArithmeticError):
+        return None
+    return np.asarray(res.x, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -313,6 +354,10 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         Bad axes or ranges.
     """
     base = scene.model_dump(mode="json")
+    if scene.basin is not None and not {"x_axis", "y_axis"} & scene.basin.model_fields_set:
+        # no axes named: left unset for the workers too (the dump would set the defaults),
+        # so each takes this walker's (:func:`default_axes`)
+        base["basin"] = scene.basin.model_dump(mode="json", exclude_unset=True)
     walker, st, mst = _walker_and_settings(base)
     xs, ys = axis_values(st, walker, x_star, grid)
     x_pre = _start_pre_impact(walker, x_star, st, mst, xs, ys)
@@ -425,12 +470,12 @@ def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
     BasinError
         Bad axes or ranges (one line).
     """
-    from walkerlab.config import BasinSettings
     from walkerlab.io.schemas.basin import BasinRun  # light
 
     res = compute_basin(scene, x_star, key, out_path, grid, workers, scheduler, resume=resume,
                         on_chunk=on_chunk)
     counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
-    run = BasinRun(res["walker"], res, x_star, scene.basin or BasinSettings(), list(OUTCOMES),
-                   counts)
+    # the settings the cells were computed with: the axes this walker's default ones
+    # (:func:`default_axes`: a 3D wheel's lean and lean rate) where the scene names none
+    run = BasinRun(res["walker"], res, x_star, res["settings"], list(OUTCOMES), counts)
     return run, res["partial"]

@@ -6,6 +6,17 @@ Unknowns ``u = (z, p)``: the section coordinates ``z`` (2n - 1) of the post-impa
 the parameter ``p``; equations ``section(P(from_section(z); p)) - z = 0`` and
 ``measure(z, p) - target = 0`` (one step map gives both), solved by ``scipy.optimize.root``
 (MINPACK hybr) from the gait at the parameter's own value.
+
+A walker with neutral coordinates (:attr:`HybridWalker.neutral`, the 3D rimless wheel's
+heading: its gaits form a family along it) has them held at the start's values, as
+:func:`walkerlab.analysis.gait.poincare.find_fixed_point` and the continuation's
+:class:`~walkerlab.analysis.continuation.gait_map.BranchSystem` hold them: their equations
+are left out and the root finder solves the others for the other coordinates and ``p``, so
+the answer is the member of the scene's own family (the upright wheel rolling at the
+start's heading), not one the measure prefers along the family (freed, the heading changes
+the distance travelled downhill and the root finder drifts along the family: a wheel
+rolling off the fall line, or uphill).  The held equations are checked in the final
+residual (on the family they hold by themselves).
 """
 
 from __future__ import annotations
@@ -106,6 +117,17 @@ def solve_target(family: WalkerFamily, p0: float, x0, measure: str, value: float
     z0 = np.asarray(w0.section(np.asarray(x0, float)), float)
     scale_p = max(abs(p0), 1e-3)
     maps = 0
+    held = w0.neutral_in_section()  # the neutral coordinates: held at the start's values
+    free = [i for i in range(z0.size) if i not in held]
+    rows = free + [z0.size]  # the equations solved: the free ones' and the target's
+
+    def full(u):
+        """``u`` of the root finder (the free coordinates, ``p / scale_p``) -> all of them."""
+        if not held:
+            return u
+        z = np.append(z0, 0.0)
+        z[rows] = u
+        return z
 
     def F(u):
         nonlocal maps
@@ -119,9 +141,14 @@ def solve_target(family: WalkerFamily, p0: float, x0, measure: str, value: float
         maps += 1
         return np.concatenate([w.section(x1) - z, [(m[measure] - value) / abs(value)]])
 
-    sol = root(F, np.concatenate([z0, [p0 / scale_p]]), method="hybr",
-               options={"xtol": xtol})
-    res = float(np.max(np.abs(F(sol.x))))
+    u0 = np.concatenate([z0, [p0 / scale_p]])
+    if held:
+        sol = root(lambda v: F(full(v))[rows], u0[rows], method="hybr",
+                   options={"xtol": xtol})
+        sol.x = full(sol.x)
+    else:
+        sol = root(F, u0, method="hybr", options={"xtol": xtol})
+    res = float(np.max(np.abs(F(sol.x))))  # every equation, the held ones' too
     if not sol.success or res > 1e-8:
         raise TargetNotReached(f"no gait with {measure} = {value:g} near the start "
                                f"(residual {res:.2g}; {' '.join(str(sol.message).split())})")
