@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.report.markdown import num
 from walkerlab.units import Units
 
@@ -12,7 +13,7 @@ from walkerlab.units import Units
 MAIN_COLUMNS = {
     "fixedpoint": ("step_period_s", "max_abs_multiplier"),
     "simulate": ("steps_completed", "mean_step_period_s", "mean_hip_speed_m_per_s"),
-    "contact-sim": ("heel_strikes", "mean_step_period_s", "max_slip_mm",
+    CONTACT_SIM.name: ("heel_strikes", "mean_step_period_s", "max_slip_mm",
                     "peak_penetration_mm"),
 }
 #: SI unit of a result column by its suffix (labelled through :class:`Units`)

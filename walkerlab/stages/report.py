@@ -20,6 +20,7 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir, report_dir
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.common import StageError
 from walkerlab.stages.pipeline import report_plan
@@ -36,8 +37,8 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     from walkerlab.io.schemas.loaders import load_artifact
     from walkerlab.studies.bifurcation import fall_onset, onset_value
 
-    if "contact-sim" in paths:
-        maps = (paths["contact-sim"].parent / f"stability_map_{k}.h5"
+    if CONTACT_SIM.name in paths:
+        maps = (paths[CONTACT_SIM.name].parent / f"stability_map_{k}.h5"
                 for k in ("stiffness", "friction", "patch_width"))
         paths = paths | {p.stem: p for p in maps
                          if p.is_file() and (figures / f"{p.stem}.png").is_file()}
@@ -68,7 +69,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                   f"reused ({o.note})" if o.reused else
                   f"computed in {o.wall_time_s:.2f} s")  # why: said when it started
         echo(f"{o.stage:>13s}: {status} -> {o.path}")
-    if not any(o.stage in ("simulate", "contact-sim") for o in done):
+    if not any(o.stage in ("simulate", CONTACT_SIM.name) for o in done):
         echo(f"{'plot':>13s}: no trajectory figures (the report ran no 'simulate' or "
              "'contact-sim')")
     for line in drawn:
