@@ -257,7 +257,7 @@ def _same_ground(cs_path, slope_scene, runs: Path) -> tuple[float, str, object]:
     that slope (the same ground: equal to integration tolerance): the largest difference of
     their heel-strike times over the walk, relative to the slope walk's mean step period;
     with the slope walk's artifact path."""
-    from walkerlab.io.stage_files import CONTACT_SIM
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.stages import pipeline
 
     ref = pipeline.run(CONTACT_SIM.name, slope_scene, runs).path
@@ -283,7 +283,7 @@ def _contact(scene, d, runs: Path) -> tuple[float, str]:
     rigid walk is the slope's where the rigid view does not walk the profile (flat feet, a
     walker driven by torques: the same ground)."""
     from walkerlab.config import scene_from_dict
-    from walkerlab.io.stage_files import CONTACT_SIM
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.stages import pipeline
     from walkerlab.stages.common import StageError
 

@@ -162,7 +162,7 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.io.stage_files import CONTACT_SIM
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.stages import pipeline
 
     return read_dataset(pipeline.run(CONTACT_SIM.name, as_scene(scene), runs_folder(runs_dir),

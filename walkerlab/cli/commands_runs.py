@@ -78,7 +78,7 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
     from walkerlab.io.schemas.contact_sim import load_contact_sim
-    from walkerlab.io.stage_files import CONTACT_SIM
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.report.text import contact_text
     from walkerlab.stages import pipeline
 

@@ -172,12 +172,21 @@ class Writer:
         Its column of the capability table (:data:`walkerlab.walker.kinds.VIEWS`).
     write : callable
         ``write(job, writer) -> Written``.
+    ground : bool
+        The file carries a ground (the URDF has no ground element: a ground other than the
+        slope is refused by its column's cell before anything else).
     """
 
     name: str
     file: str
     view: str
     write: Callable[[ExportJob, Writer], Written]
+    ground: bool = True
+
+    @property
+    def suffix(self) -> str:
+        """The export file's suffix (``.urdf``, ``.xml``, ``.adm``, ``.osim``)."""
+        return Path(self.file).suffix
 
 
 def step_period(ideal) -> float | None:
@@ -381,7 +390,7 @@ def _osim(job: ExportJob, w: Writer) -> Written:
 
 #: ``--format`` name -> its writer
 WRITERS: dict[str, Writer] = {w.name: w for w in (
-    Writer("urdf", FORMATS["urdf"], FORMAT_VIEWS["urdf"], _by_body),
+    Writer("urdf", FORMATS["urdf"], FORMAT_VIEWS["urdf"], _by_body, ground=False),
     Writer("mjcf", FORMATS["mjcf"], FORMAT_VIEWS["mjcf"], _by_body),
     Writer("adm", ADAMS_FILES["adm"], FORMAT_VIEWS["adm"], _adams),
     Writer("osim", OSIM_FILE, FORMAT_VIEWS["osim"], _osim),

@@ -68,6 +68,7 @@ def stored_gait(scene: Scene, runs_root: Path | str):
 def _gait(scene: Scene, runs_root, build):
     """``(ideal, build(ideal))``: the rigid gait (:func:`stored_gait`, else searched as the
     writers search it) and what ``build`` makes of it; no rigid gait: one line."""
+    # light: the gait search's modules, only when a writer asks for the gait
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.analysis.gait.poincare import FixedPointNotFound
 
@@ -131,7 +132,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     writer = WRITERS[fmt]
     ground = scene.terrain is not None and not scene.terrain.is_slope and not walker_only
     if ground:
-        if fmt == "urdf":  # its cell of that ground (the table refuses every non-slope one)
+        if not writer.ground:  # its cell of that ground (the URDF's refuses every one)
             walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
                 scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")
         from walkerlab.models.contact.terrain import ground_drops

@@ -14,7 +14,14 @@ from walkerlab.config import Scene
 from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
 from walkerlab.io.freshness import changed_fields, drawing_key, input_hash, stamp_matches
 from walkerlab.io.runpaths import bifurcation_artifacts, figures_dir, stage_artifact
-from walkerlab.io.stage_files import COMPARE, CONTACT_SIM, SIMULATE, WORKPRECISION
+from walkerlab.io.stage_files import (
+    ATTRIBUTION,
+    BIFURCATION,
+    COMPARE,
+    CONTACT_SIM,
+    SIMULATE,
+    WORKPRECISION,
+)
 from walkerlab.stages.pipeline import contact_walks_ground, needs, stage_module
 from walkerlab.stages.registry import STAGES, shown
 
@@ -92,11 +99,11 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 
 def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
     """'' when the artifact ``p`` the report did not produce is shown all the same."""
-    kind = "bifurcation" if stage.startswith("bifurcation") else stage
+    kind = BIFURCATION.name if stage.startswith(BIFURCATION.name) else stage
     if kind not in EARLIER or (kind == WORKPRECISION.name and (scene.workprecision is None or full)
-                               ) or (kind == "attribution" and (scene.contact is None or full)):
+                               ) or (kind == ATTRIBUTION.name and (scene.contact is None or full)):
         return f"an earlier standalone run: the scene has {not_run(scene, stage)}"
-    if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
+    if kind == BIFURCATION.name and not stored_content_hash_matches(p):  # edited by hand (26)
         return "changed after it was written: rerun 'walkerlab bifurcation'"
     return EARLIER[kind] if changed_fields(p, scene, stage_sections(kind, scene)) else ""
 
