@@ -260,11 +260,11 @@ def test_the_command_and_the_docs_show_the_table():
 def test_every_per_kind_table_of_the_stages_and_integrators_names_every_kind():
     """The part tables keyed by kind name name every kind (the three-link walker's
     ``export --walk`` failed with KeyError 'hinged_torso' in the export stage's table)."""
+    from walkerlab.export.writers import BODIES
     from walkerlab.integrate.rigid import _SCIPY_RUNS_ACTUATED_COMPILED
-    from walkerlab.stages.export import _ROLLS
 
-    for table in (_ROLLS, _SCIPY_RUNS_ACTUATED_COMPILED):
-        assert set(table) == set(KINDS)
+    assert set(_SCIPY_RUNS_ACTUATED_COMPILED) == set(KINDS)
+    assert {kind.body for kind in KINDS.values()} <= set(BODIES)  # the export's writers
 
 
 # ------------------------------------------- a refusal the table decides comes first (64, 6)
@@ -315,7 +315,7 @@ def test_the_urdf_refuses_a_ground_other_than_the_slope_with_its_cells_reason(
     from walkerlab.walker.kinds import URDF_GROUND
 
     assert KINDS[kind].cell(ground, "urdf") == URDF_GROUND
-    monkeypatch.setattr(export, "_gait_scene", _no_gait_search)
+    monkeypatch.setattr(export, "_gait", _no_gait_search)
     d = scene_for(kind, ground, "urdf")
     with pytest.raises(ValueError) as exc:
         export.run(scene_from_dict(d), tmp_path, "urdf")

@@ -490,3 +490,42 @@ def test_export_reads_the_gait_of_an_up_to_date_fixedpoint_artifact(tmp_path, mo
     assert fixedpoint.fresh_artifact(other, tmp_path / "b") is None  # stale for this scene
     export.run(other, tmp_path / "b", "mjcf")
     assert calls  # searched again
+
+
+# ------------------------------------------------------- the formats as a registry of writers
+def test_a_format_is_one_writer_in_the_registry(tmp_path, monkeypatch):
+    """A writer added to :data:`walkerlab.export.writers.WRITERS` alone is a format of
+    ``export``: its file written where the registry says, in its capability table's column
+    (a 3D walker refused in that column's words), with what the writer says it leaves
+    out."""
+    from walkerlab.export import writers
+    from walkerlab.walker.kinds import KINDS
+
+    def write(job, w):
+        return writers.Written(((w.file, f"{job.name} {job.kind.name}"),), ("a: b",), 1.5)
+
+    monkeypatch.setitem(writers.WRITERS, "txt", writers.Writer("txt", "walker.txt",
+                                                               "adams", write))
+    out = export_stage.write(load_scene(ROOT / "configs" / "paper.yaml"), tmp_path, "txt")
+    assert out.path == tmp_path / "paper" / "walker.txt"
+    assert out.path.read_text() == "paper straight_legs"
+    assert (out.left_out, out.step_period_s) == (("a: b",), 1.5)
+    with pytest.raises(ValueError) as exc:  # the adams column refuses the 3D walker
+        export_stage.write(load_scene(ROOT / "configs" / "paper_3d.yaml"), tmp_path, "txt")
+    assert str(exc.value) == ("walker.space: 3d: "
+                              + KINDS["straight_legs_3d"].cell("walk", "adams"))
+
+
+def test_mjcf_options_are_refused_for_either_spoked_wheel_in_one_line(tmp_path):
+    """The MJCF's contact time constant and timestep are a legged walker's options: the
+    3D rimless wheel refuses them as the planar one does (it used to reach the leg-link
+    writer and fail there with a line about the planar wheel's writers), before any gait
+    search."""
+    from walkerlab.export.mjcf_scene import MjcfOptions
+
+    for name in ("rimless_wheel", "rimless_wheel_3d"):
+        with pytest.raises(ValueError, match=r"^--mjcf-contact-time-constant-s, "
+                           r"--mjcf-timestep-s: options of a legged walker's MJCF"):
+            export_stage.write(load_scene(ROOT / "configs" / f"{name}.yaml"), tmp_path,
+                               "mjcf", mjcf=MjcfOptions(timestep_s=5e-5))
+    assert not list(tmp_path.rglob("walker.*"))

@@ -65,12 +65,14 @@ def test_a_pushed_off_compass_walker_lands_each_step_at_its_footholds_height():
 
 
 def test_the_exports_walk_check_knows_every_kind():
-    """``export --walk`` picks heel strikes or spoke strikes by the walker's kind: every
-    kind has its entry (the three-link walker's was missing: a KeyError on its walk)."""
-    from walkerlab.stages.export import _ROLLS
+    """``export --walk`` picks heel strikes or spoke strikes by the walker's kind (its
+    ``spoked``), and every kind's multibody has a writer (the three-link walker's entry was
+    missing from a table keyed by kind name: a KeyError on its walk)."""
+    from walkerlab.export.writers import BODIES
 
-    assert set(_ROLLS) == set(KINDS)
-    assert [k for k, rolls in _ROLLS.items() if rolls] == ["rolling_polygon", "rolling_polygon_3d"]
+    assert {k.body for k in KINDS.values()} <= set(BODIES)
+    assert [k.name for k in KINDS.values() if k.spoked] == ["rolling_polygon",
+                                                            "rolling_polygon_3d"]
 
 
 @pytest.mark.slow  # ~25 s: simulate and 500 control periods of the rigid view

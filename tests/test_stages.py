@@ -302,3 +302,48 @@ def test_a_run_begun_within_a_step_counts_neither_partial_step():
     assert m["t_right_s"] == pytest.approx(0.8, abs=2e-3)
     assert m["v_com_m_per_s"] == pytest.approx(0.5, rel=1e-3)
     assert m["n_steps"] == 8
+
+
+# ------------------------------------------------------- the stages as objects (registry)
+def test_every_registered_stage_has_its_module_and_its_artifacts_loader():
+    """Each :class:`~walkerlab.stages.registry.Stage` names a module with a ``run``, an
+    artifact whose schema module has its loader and whose file the run paths build, and
+    upstream stages that are registered and never lead back to it (a wrong entry would
+    fail the pipeline at run time, not here)."""
+    import importlib
+
+    from walkerlab.io.runpaths import stage_artifact
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.registry import PHASES, STAGES
+
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    for name, st in STAGES.items():
+        assert callable(pipeline.stage_module(name).run), name
+        assert st.phase in PHASES, name
+        assert set(st.needs) <= set(STAGES), name
+        assert name not in pipeline.order(name, scene)[:-1], name  # no circle
+        if st.artifact is not None:
+            module = importlib.import_module(f"walkerlab.io.schemas.{st.artifact.schema}")
+            assert callable(getattr(module, st.artifact.loader)), name
+            assert stage_artifact(scene, "runs", name).name == st.artifact.file
+
+
+def test_the_reports_plan_and_what_it_shows_are_read_from_the_registry(monkeypatch):
+    """A stage added to the registry alone (a plan predicate, a line for the report) is in
+    the report's plan and among the artifacts it shows, with its reason when not run: no
+    tuple elsewhere to edit."""
+    from dataclasses import replace
+
+    from walkerlab.io.stage_files import BASIN
+    from walkerlab.stages import pipeline, registry, report_inputs
+
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    new = replace(registry.STAGES[BASIN.name], name="new-stage", phase="after",
+                  not_run="no 'new' section", in_plan=lambda scene, full, plan:
+                  plan["fixedpoint"] and not full)
+    monkeypatch.setitem(registry.STAGES, "new-stage", new)
+    assert pipeline.report_plan(scene)[-1] == "new-stage"
+    assert "new-stage" not in pipeline.report_plan(scene, full=True)
+    assert "new-stage" in registry.shown()
+    assert report_inputs.not_run(scene, "new-stage") == "no 'new' section"
+    assert [s.name for s in registry.in_phase("after")][-1] == "new-stage"

@@ -306,9 +306,10 @@ def _same_ground(cs_path, slope_scene, runs: Path) -> tuple[float, str, object]:
     that slope (the same ground: equal to integration tolerance): the largest difference of
     their heel-strike times over the walk, relative to the slope walk's mean step period;
     with the slope walk's artifact path."""
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.stages import pipeline
 
-    ref = pipeline.run("contact-sim", slope_scene, runs).path
+    ref = pipeline.run(CONTACT_SIM.name, slope_scene, runs).path
     with _h5(cs_path) as f, _h5(ref) as g:
         h = np.asarray(f["events/heel_strike_times"][:], float)
         hs = np.asarray(g["events/heel_strike_times"][:], float)
@@ -331,10 +332,11 @@ def _contact(scene, d, runs: Path) -> tuple[float, str]:
     rigid walk is the slope's where the rigid view does not walk the profile (flat feet, a
     walker driven by torques: the same ground)."""
     from walkerlab.config import scene_from_dict
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.stages import pipeline
     from walkerlab.stages.common import StageError  # light
 
-    cs = pipeline.run("contact-sim", scene, runs).path
+    cs = pipeline.run(CONTACT_SIM.name, scene, runs).path
     same, note = None, ""
     slope_d = _slope_of_profile(d)
     if slope_d is not None:

@@ -162,9 +162,10 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.stages import pipeline  # light
 
-    return read_dataset(pipeline.run("contact-sim", as_scene(scene), runs_folder(runs_dir),
+    return read_dataset(pipeline.run(CONTACT_SIM.name, as_scene(scene), runs_folder(runs_dir),
                                      force, adjust=adjust, periodic=periodic).path)
 
 

@@ -63,6 +63,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.bench.process_env import installed_env
+from walkerlab.io.stage_files import CONTACT_SIM
 
 __all__ = ["run_main_job", "MC_CHILD", "MESH_CHILD"]
 
@@ -200,7 +201,7 @@ def contact_sim(code: Path, scene: str) -> dict:
         env = _env(code, str(Path(d) / "cache"))
         runs = str(Path(d) / "runs")
         _run(_cli("fixedpoint", scene, "--runs-dir", runs), env, code)
-        cmd = _cli("contact-sim", scene, "--force", "--runs-dir", runs)
+        cmd = _cli(CONTACT_SIM.name, scene, "--force", "--runs-dir", runs)
         cold = _run(cmd, env, code)[:2]
         warm = _run(cmd, env, code)[:2]
         again = _run(cmd, env, code)[:2]
@@ -215,7 +216,7 @@ def warm_vs_bare(code: Path, scene: str, pairs: int = 5) -> dict:
         env = _env(code, str(Path(d) / "cache"))
         runs = str(Path(d) / "runs")
         _run(_cli("fixedpoint", scene, "--runs-dir", runs), env, code)
-        warm = _cli("contact-sim", scene, "--force", "--runs-dir", runs)
+        warm = _cli(CONTACT_SIM.name, scene, "--force", "--runs-dir", runs)
         _run(warm, env, code)
         _run(warm, env, code)  # the steady state (see contact_sim_warm_again)
         out: dict = {"warm": [], "bare": []}

@@ -34,6 +34,7 @@ import numpy as np
 import yaml
 
 from walkerlab.bench.main_job import TREE, _cli, _env, _run
+from walkerlab.io.stage_files import CONTACT_SIM
 
 __all__ = ["CASES", "bench_powered_command", "lines"]
 
@@ -90,7 +91,7 @@ def bench_powered_command(repeats: int = 5, code: Path = TREE) -> dict:
         env = _env(code, str(folder / "cache"))
         runs = str(folder / "runs")
         scenes = _scene_files(folder)
-        cmds = {k: _cli("contact-sim", str(p), "--force", "--runs-dir", runs)
+        cmds = {k: _cli(CONTACT_SIM.name, str(p), "--force", "--runs-dir", runs)
                 for k, p in scenes.items()}
         for cmd in cmds.values():  # warm: generated code, machine code, rigid gait
             _run(cmd, env, folder)

@@ -80,10 +80,11 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
     from walkerlab.io.schemas.contact_sim import load_contact_sim  # light
+    from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
     from walkerlab.report.text import contact_text  # light
     from walkerlab.stages import pipeline  # light
 
-    out = pipeline.run("contact-sim", load(scene), runs_dir, force, adjust=adjust,
+    out = pipeline.run(CONTACT_SIM.name, load(scene), runs_dir, force, adjust=adjust,
                        periodic=periodic, strides=strides)
     typer.echo(contact_text(load_contact_sim(out.path)))
     typer.echo(status(out))

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.io.stage_files import CONTACT_SIM
+
 
 def report_numbers(scene, arts: dict) -> dict:
     """What the report computes from the loaded artifacts ``arts`` (``{stage: artifact}``,
@@ -41,7 +43,7 @@ def report_numbers(scene, arts: dict) -> dict:
     from walkerlab.published import for_scene
 
     out: dict = {}
-    sim, contact = arts.get("simulate"), arts.get("contact-sim")
+    sim, contact = arts.get("simulate"), arts.get(CONTACT_SIM.name)
     if sim is not None:
         from walkerlab.analysis.gait.checks import (  # light
             energy_drift_in_swing,

@@ -38,6 +38,7 @@ import h5py
 import numpy as np
 
 from walkerlab.io.artifacts import READ_ERRORS, ArtifactError
+from walkerlab.io.stage_files import CONTACT_SIM
 
 __all__ = ["load_dataset", "load_fixed_points", "xarray"]
 
@@ -255,7 +256,7 @@ def load_dataset(path: str | Path):
         ds = _fixedpoint_view(ds)
     elif stage == "sweep":
         ds = _sweep_view(ds)
-    elif stage == "contact-sim":
+    elif stage == CONTACT_SIM.name:
         ds = _complex(ds, "periodic_gait_multipliers_", "periodic_gait_multipliers",
                       "multiplier")
     return ds

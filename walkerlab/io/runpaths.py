@@ -39,6 +39,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from walkerlab.io.stage_files import ARTIFACTS
 from walkerlab.safefs import RunPathError, refuse_link  # noqa: F401 (part of this API)
 
 try:  # POSIX; elsewhere runs are not locked
@@ -54,9 +55,10 @@ __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_art
 NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
 MAX_NAME = 100
 
-# File stems that belong to stages (a sweep or any free --name may not take them).
-STAGE_FILES = frozenset({"fixedpoint", "simulate", "contact_sim", "compare", "workprecision",
-                         "bifurcation", "basin", "report", "plot", "sweep", "rigid_limit"})
+# File stems that belong to stages (a sweep or any free --name may not take them): every
+# stage artifact's (walkerlab.io.stage_files.ARTIFACTS) and the other commands' names
+STAGE_FILES = frozenset({a.schema for a in ARTIFACTS.values()}
+                        | {"report", "plot", "sweep", "rigid_limit"})
 STAGE_PREFIXES = ("stability_map", "stability-map",  # stability_map_<kind>.h5
                   "bifurcation_",                      # bifurcation_<field>.h5
                   "optimize_design")                   # optimize_design_<fields>_<measure>
@@ -184,8 +186,12 @@ def _mkdir(d: Path) -> None:
 
 
 def stage_artifact(scene, runs_root: Path | str, stage: str, claim: bool = False) -> Path:
-    """``<runs>/<scene>/<stage>.h5`` (``contact-sim`` -> ``contact_sim.h5``)."""
-    return scene_dir(scene, runs_root, claim) / f"{stage.replace('-', '_')}.h5"
+    """``<runs>/<scene>/<stage>.h5``: the stage's artifact file
+    (:data:`walkerlab.io.stage_files.ARTIFACTS`: ``contact-sim`` -> ``contact_sim.h5``; another
+    name, ``-`` as ``_``)."""
+    a = ARTIFACTS.get(stage)
+    return scene_dir(scene, runs_root, claim) / (
+        a.file if a is not None else f"{stage.replace('-', '_')}.h5")
 
 
 def bifurcation_stem(path: str) -> str:

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.stage_files import CONTACT_SIM
 
 
 def load_terrain(path: Path | str) -> dict | None:
@@ -25,7 +26,7 @@ def load_terrain(path: Path | str) -> dict | None:
     walkerlab.io.artifacts.ArtifactError
         Missing or not a contact-sim artifact.
     """
-    with open_artifact(path, "contact-sim") as f:
+    with open_artifact(path, CONTACT_SIM.name) as f:
         if "terrain" not in f:
             return None
         g = f["terrain"]

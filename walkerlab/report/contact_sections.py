@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.published import for_scene
 from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
@@ -32,7 +33,7 @@ def initial_states_section(scene, arts) -> list[str]:
     """The initial states of the ideal and contact walkers (the paper's Table 2 where the
     scene has published ones): before the gait characteristics (Table 3), in the paper's
     order."""
-    c = arts.get("contact-sim")
+    c = arts.get(CONTACT_SIM.name)
     if c is None:
         return []
     pub = for_scene(scene)
@@ -61,7 +62,7 @@ def _outcome_sentence(outcome: tuple, walks: bool | None, reason: str) -> str:
 def contact_section(scene, arts) -> list[str]:
     """The contact walker's run: its summary, parameters, outcome, slips, periodic gait,
     drop test and stability maps (the initial states: :func:`initial_states_section`)."""
-    c = arts.get("contact-sim")
+    c = arts.get(CONTACT_SIM.name)
     if c is None:
         return []
     summ, stage_wall, cp = c.summary, c.stage_wall_time_s, c.contact_params_si

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.report.markdown import details, num, table
 from walkerlab.report.workprecision_section import workprecision_table
 from walkerlab.units import Units
@@ -223,8 +224,8 @@ def _drawn_from(stem: str, arts: dict) -> bool:
     """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
     plot`` drew from an artifact the report leaves out is not shown)."""
     for prefix, stages in (("fig2_", ("simulate",)), ("energy_ledger", ("simulate",)),
-                           ("fig6_", ("contact-sim",)),
-                           ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
+                           ("fig6_", (CONTACT_SIM.name,)),
+                           ("fig8_", ("compare",)), ("fig", ("simulate", CONTACT_SIM.name)),
                            ("work_precision", ("workprecision",)),
                            ("bifurcation", ("bifurcation",)), ("basin", ("basin",)),
                            ("mfpt", ("mfpt",)), ("optimize", ("optimize",))):

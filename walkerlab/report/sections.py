@@ -15,6 +15,7 @@ from types import ModuleType
 
 import numpy as np
 
+from walkerlab.io.stage_files import CONTACT_SIM, SIMULATE
 from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
@@ -162,7 +163,7 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                            + clearance_text(clear, u, inputs.clearance_ground) + ".")
             rows.append(["lowest swing-foot clearance (negative: penetration)", u.small_length,
                          num(u.small_scale * clear, 3), "—"])
-    c = arts.get("contact-sim")
+    c = arts.get(CONTACT_SIM.name)
     if c is not None:
         bullets.append(_contact_verdict(c))
     cols = inputs.gait_columns
@@ -283,7 +284,8 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                          *(num(v[i]) for v in per_leg)])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
-           + ", ".join(f"`{arts[s].path.name}`" for s in ("simulate", "contact-sim") if s in arts)
+           + ", ".join(f"`{arts[s].path.name}`" for s in (SIMULATE.name, CONTACT_SIM.name)
+                       if s in arts)
            + ").", "", table(header, rows)]
     if "ours, contact" in cols:
         out += ["", "*ours, contact* averages every complete step of the contact run, which "

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num
 from walkerlab.units import Units
@@ -13,7 +14,7 @@ from walkerlab.units import Units
 MAIN_COLUMNS = {
     "fixedpoint": ("step_period_s", "max_abs_multiplier"),
     "simulate": ("steps_completed", "mean_step_period_s", "mean_hip_speed_m_per_s"),
-    "contact-sim": ("heel_strikes", "mean_step_period_s", "max_slip_mm",
+    CONTACT_SIM.name: ("heel_strikes", "mean_step_period_s", "max_slip_mm",
                     "peak_penetration_mm"),
 }
 #: columns of a Poincaré map's Floquet multipliers: labelled with the sweep's one map

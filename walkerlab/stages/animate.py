@@ -26,6 +26,7 @@ from walkerlab.io.freshness import drawing_key
 from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.io.terrain import load_terrain
 from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
 from walkerlab.stages.report_inputs import ANIMATION_STAMP, computed_for
@@ -57,9 +58,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     sim = load_simulate(stage_artifact(scene, runs_root, "simulate"),
                         scene.simulate.strides if scene.simulate is not None else None)
     trajs, ground, notes = {IDEAL_LABEL: sim.samples}, {}, []
-    contact = stage_artifact(scene, runs_root, "contact-sim")
+    contact = stage_artifact(scene, runs_root, CONTACT_SIM.name)
     # any of the contact stage's variants: plain, --adjust, --periodic
-    why = computed_for(scene, runs_root, "contact-sim", ("adjust", "periodic")) \
+    why = computed_for(scene, runs_root, CONTACT_SIM.name, ("adjust", "periodic")) \
         if contact.is_file() else ""
     if why:
         notes.append(f"animated the rigid walker only: {why} (rerun 'walkerlab contact-sim' "
@@ -91,7 +92,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
         plt.close(frames.fig)
     drawn_from = {"simulate": stage_artifact(scene, runs_root, "simulate")}
     if CONTACT_LABEL in trajs:
-        drawn_from["contact-sim"] = contact
+        drawn_from[CONTACT_SIM.name] = contact
     runpaths.atomic_text(stamp, drawing_key(drawn_from))  # what the report checks it by
     return out
 

@@ -20,6 +20,7 @@ from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import METRIC_UNITS, Comparison, write_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.stages.common import StageOutcome, run_cached
 
 
@@ -54,7 +55,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     """Compare ``simulate.h5`` with ``contact_sim.h5`` (both must exist:
     :mod:`walkerlab.stages.pipeline` runs them first)."""
     up = (stage_artifact(scene, runs_root, "simulate"),
-          stage_artifact(scene, runs_root, "contact-sim"))
+          stage_artifact(scene, runs_root, CONTACT_SIM.name))
 
     def compute():
         c = compare_files(*up)

@@ -24,6 +24,7 @@ from walkerlab.io.artifacts import ArtifactError
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.models.contact.scene import ContactSetup, contact_setup
 from walkerlab.stages.common import (
     StageError,
@@ -163,14 +164,14 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         raise StageError(str(exc)) from None
     # asked for, the stage runs without a 'contact' section: on its defaults, the artifact
     # keyed and recorded as with 'contact: {}' (the report asks only with the section)
-    scene = with_defaults(scene, "contact", "contact-sim")
+    scene = with_defaults(scene, "contact", CONTACT_SIM.name)
     setup = contact_setup(scene, periodic)  # the scene read once: all the run needs, typed
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
     with _rhs_beside(setup, rhs_ready) as run_setup:  # started now: the freshness check
         # runs meanwhile
-        out = run_cached("contact-sim", scene, runs_root, sections, up,
+        out = run_cached(CONTACT_SIM.name, scene, runs_root, sections, up,
                          lambda: _compute(run_setup, up[0], adjust, periodic), force)
     kind, why = run_end(out.path)
     # like simulate: a walker that does not walk fails the run (the shared run ends,

@@ -21,13 +21,16 @@ from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.schemas.workprecision import load_workprecision
+from walkerlab.io.stage_files import COMPARE, CONTACT_SIM, SIMULATE, WORKPRECISION
 from walkerlab.io.terrain import load_terrain
 from walkerlab.stages.common import StageError
+from walkerlab.stages.registry import STAGES
 from walkerlab.units import for_scene
 
 #: figure groups and the stage artifacts each is drawn from
-PARTS = {"trajectories": ("simulate", "contact-sim", "compare"),
-         "workprecision": ("workprecision",)}
+#: (:attr:`walkerlab.stages.registry.Stage.figures`)
+PARTS = {part: tuple(s.name for s in STAGES.values() if s.figures == part)
+         for part in ("trajectories", "workprecision")}
 
 
 def _strides(scene: Scene) -> int | None:
@@ -59,7 +62,7 @@ def draw_ideal_ahead(scene: Scene, runs_root, force: bool) -> list[Path]:
     (``ahead``).  ``walkerlab report`` draws them while the side process compiles the
     contact model's kernels."""
     stamp, _ = figures_key(scene, runs_root, "trajectories")
-    p = stage_artifact(scene, runs_root, "simulate")
+    p = stage_artifact(scene, runs_root, SIMULATE.name)
     if not p.is_file() or not (force or not stamp.exists()):
         return []
     from walkerlab.plotting import scene_figures  # matplotlib: only when drawing
@@ -81,17 +84,17 @@ def _draw(scene: Scene, runs_root, part: str, side: SideWorker | None = None,
 
     folder = runpaths.figures_dir(scene, runs_root, claim=True)
     if part == "workprecision":
-        wp = load("workprecision", load_workprecision)
+        wp = load(WORKPRECISION.name, load_workprecision)
         return [] if wp is None else scene_figures.workprecision_figures(wp, folder,
                                                                          for_scene(scene))
-    sim = load("simulate", lambda p: load_simulate(p, _strides(scene)))
-    contact = load("contact-sim", load_contact_sim)
+    sim = load(SIMULATE.name, lambda p: load_simulate(p, _strides(scene)))
+    contact = load(CONTACT_SIM.name, load_contact_sim)
     if sim is None and contact is None:
         raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "
                          f"{runpaths.scene_dir(scene, runs_root)}; run 'walkerlab simulate' "
                          "first")
-    terrain = load("contact-sim", load_terrain) if contact is not None else None
-    loaded = (sim, contact, terrain, load("compare", load_compare))
+    terrain = load(CONTACT_SIM.name, load_terrain) if contact is not None else None
+    loaded = (sim, contact, terrain, load(COMPARE.name, load_compare))
     stems = [stem for stem, _ in scene_figures.scene_figure_plan(scene, *loaded)]
     done = {p.stem: p for p in ahead}
     # each figure is drawn once, here or in the side process: the same files either way

@@ -18,7 +18,9 @@ import importlib
 
 from walkerlab.config import Scene
 from walkerlab.execution.side import SideWorker
+from walkerlab.io.stage_files import SIMULATE, WORKPRECISION
 from walkerlab.stages.pipeline import report_plan, stage_module
+from walkerlab.stages.registry import STAGES, in_phase
 
 
 def _named(stage: str, run, *args, **kwargs):
@@ -54,18 +56,24 @@ def _study(scene: Scene, runs_root, force: bool):
     from walkerlab.execution.background import BackgroundStudy
     from walkerlab.io.runpaths import stage_artifact  # light
 
-    wp = stage_module("workprecision")
-    first_run = not stage_artifact(scene, runs_root, "workprecision").is_file()
+    wp = stage_module(WORKPRECISION.name)
+    first_run = not stage_artifact(scene, runs_root, WORKPRECISION.name).is_file()
     return BackgroundStudy(lambda lanes: wp.run(scene, runs_root, force, lanes=lanes),
                            start_worker, first_run,
                            ("contact",) if scene.contact is not None else ())
 
 
+def _warmed(plan: list[str]) -> str | None:
+    """The stage of ``plan`` whose kernels the side process compiles before it runs
+    (:attr:`walkerlab.stages.registry.Stage.warm_up`: ``contact-sim``), or None."""
+    return next((s for s in plan if STAGES[s].warm_up), None)
+
+
 def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
     """Start compiling the contact model's kernels in the side process when the report
-    will compute ``contact-sim`` (no artifact yet, or ``force``; a reused artifact needs no
-    kernels), then have the side process load matplotlib for its share of the figures
-    while this process runs the contact walker.
+    will compute ``contact-sim`` (:func:`_warmed`; no artifact yet, or ``force``; a reused
+    artifact needs no kernels), then have the side process load matplotlib for its share of
+    the figures while this process runs the contact walker.
 
     Returns ``(future, ready)``, or None when nothing was started.  On a walker
     structure's first contact run with a compiled walk (``ready``, the hand-off
@@ -78,12 +86,13 @@ def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
     """
     from walkerlab.io.runpaths import stage_artifact  # light
 
-    if "contact-sim" not in plan or not (
-            force or not stage_artifact(scene, runs_root, "contact-sim").is_file()):
+    warmed = _warmed(plan)
+    if warmed is None or not (
+            force or not stage_artifact(scene, runs_root, warmed).is_file()):
         return None
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup  # light
 
-    cs = stage_module("contact-sim")
+    cs = stage_module(warmed)
     try:
         beside = cs.rhs_beside(contact_setup(scene), lambda: side) if side.enabled else None
     except (ContactSceneError, ValueError):  # the stage says so, in its turn
@@ -119,34 +128,37 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
         done.append(o)
         on_done(o)
     drawn: list[str] = []
-    study = _study(scene, runs_root, force) if "workprecision" in plan else None
+    study = _study(scene, runs_root, force) if WORKPRECISION.name in plan else None
     # the study times its cases on both cores: no side process beside it; nor on a busy
     # machine (it would take turns with this process and add its own start-up)
     side = SideWorker(enabled=study is None, idle_only=True)
     module = None
     try:
         warm, module = _warm_up(scene, runs_root, force, plan, side) or (None, None)
-        if "fixedpoint" in plan:
-            add(_named("fixedpoint", stage_module("fixedpoint").run, scene, runs_root, force,
+        warmed = _warmed(plan)
+        for st in (st for st in in_phase("gait") if st.name in plan):
+            add(_named(st.name, stage_module(st.name).run, scene, runs_root, force,
                        compare_variants=True))
         if study is not None:
             study.start()
         if study is not None and study.needs("contact"):
             # numba compiles here, once
-            stage_module("workprecision").warm_up(scene, runs_root, "contact")
+            stage_module(WORKPRECISION.name).warm_up(scene, runs_root, "contact")
             study.ready("contact")
         ahead = []
-        for name in ("simulate", "contact-sim", "compare"):
-            if name == "contact-sim" and warm is not None:
-                if "simulate" in plan and not warm.done():  # this core's turn meanwhile
+        trajectories = in_phase("trajectories")
+        for name in (st.name for st in trajectories):
+            if name == warmed and warm is not None:
+                if SIMULATE.name in plan and not warm.done():  # this core's turn meanwhile
                     ahead = draw_ideal_ahead(scene, runs_root, force)
                 if module is None:  # (else the walk waits for its right-hand side)
                     side.wait(warm)  # compiled there (or failed: compiled here), never twice
             if name in plan:
                 add(_named(name, stage_module(name).run, scene, runs_root, force,
                            **({"rhs_ready": module} if module is not None
-                              and name == "contact-sim" else {})))
-        if any(o.stage in ("simulate", "contact-sim") for o in done):
+                              and name == warmed else {})))
+        if any(getattr(STAGES.get(o.stage), "figures", None) == "trajectories"
+               for o in done):
             # shared only with a side process already up (matplotlib loaded): one started
             # for the figures alone costs about what it saves
             drawn.append(draw_if_changed(scene, runs_root, force, "trajectories",
@@ -159,13 +171,14 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     side.close()
     if study is not None:
         study.release()
-        add(_named("workprecision", study.join))
-        drawn.append(draw_if_changed(scene, runs_root, force, "workprecision"))
+        add(_named(WORKPRECISION.name, study.join))
+        drawn.append(draw_if_changed(scene, runs_root, force,
+                                     STAGES[WORKPRECISION.name].figures))
     # after the study: the basin's worker processes and the attribution's timed cases would
     # share the timed cases' cores
-    for name in ("basin", "robustness", "attribution", "optimize"):
-        if name in plan:
-            add(_named(name, stage_module(name).run, scene, runs_root, force))
-    if "optimize" in plan:
-        stage_module("optimize").draw(scene, runs_root)
+    after = [st for st in in_phase("after") if st.name in plan]
+    for st in after:
+        add(_named(st.name, stage_module(st.name).run, scene, runs_root, force))
+    for st in (st for st in after if st.figures == "own"):
+        stage_module(st.name).draw(scene, runs_root)
     return done, drawn

@@ -14,48 +14,41 @@ from walkerlab.config import Scene
 from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
 from walkerlab.io.freshness import changed_fields, drawing_key, input_hash, stamp_matches
 from walkerlab.io.runpaths import bifurcation_artifacts, figures_dir, stage_artifact
+from walkerlab.io.stage_files import (
+    ATTRIBUTION,
+    BIFURCATION,
+    COMPARE,
+    CONTACT_SIM,
+    SIMULATE,
+    WORKPRECISION,
+)
 from walkerlab.stages.pipeline import contact_walks_ground, needs, stage_module
+from walkerlab.stages.registry import STAGES, shown
 
-REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin", "robustness", "mfpt", "attribution", "optimize")
-#: why a report leaves out an artifact of a stage the scene does not run (the contact
-#: stages: :func:`not_run`)
-NOT_RUN = {"fixedpoint": "no 'fixedpoint' section (nor a 'simulate' or 'contact_sim' that "
-                         "starts from the gait)",
-           "simulate": "no 'simulate' section",
-           "workprecision": "no 'workprecision' section",
-           "basin": "no 'basin' section (or no 'fixedpoint')",
-           "robustness": "no 'robustness' section (or no 'fixedpoint')",
-           "mfpt": "no 'mfpt' section (or no 'fixedpoint')",
-           "attribution": "no 'contact' or 'fixedpoint' section",
-           "optimize": "no 'optimize' section (or no 'fixedpoint')"}
+REPORT_STAGES = shown()
 
 
 def not_run(scene: Scene, stage: str) -> str:
     """Why the report does not run ``stage`` for ``scene`` (completing "the scene has ...");
     the contact stages by what the scene lacks, or the capability table's cell that
     refuses its ground (:func:`walkerlab.stages.pipeline.report_plan`)."""
-    if stage == "compare" and scene.simulate is None:
-        return "no 'simulate' section (compare needs 'simulate' and 'contact-sim')"
-    if stage in ("contact-sim", "compare"):
+    if stage == COMPARE.name and scene.simulate is None:
+        return (f"no 'simulate' section (compare needs '{SIMULATE.name}' and "
+                f"'{CONTACT_SIM.name}')")
+    if stage in (CONTACT_SIM.name, COMPARE.name):
         if scene.contact is None:
             return "no 'contact' section"
         if not contact_walks_ground(scene):
             ground = scene.terrain.kind if scene.terrain is not None else "slope"
             return (f"a walker the contact view does not walk on {ground} "
                     "(`walkerlab capabilities`)")
-        return "a 'contact' section but no 'contact_sim' or 'fixedpoint' section"
-    return NOT_RUN.get(stage, "no section for it")
+        return str(STAGES[CONTACT_SIM.name].not_run)
+    return (STAGES[stage].not_run if stage in STAGES else None) or "no section for it"
 
 
 #: artifacts shown although this report did not compute them, when computed for the
 #: scene's current sections: (their stage, why one is left out)
-EARLIER = {"workprecision": "measured for other settings; `walkerlab report --full` "
-                            "measures it again",
-           "attribution": "computed for other settings; `walkerlab report --full` computes "
-                          "it again",
-           "bifurcation": "computed for another walker, slope or solver",
-           "mfpt": "computed for other settings: rerun `walkerlab mfpt`"}
+EARLIER = {s.name: s.earlier for s in STAGES.values() if s.earlier}
 
 
 #: the stamp beside ``animation.gif``: the drawing key of the artifacts it was drawn from
@@ -68,12 +61,13 @@ def animation_current(scene: Scene, runs_root) -> str:
     ('' if it may): no stamp (drawn before stamps were written, or half written), or drawn
     from other artifacts than the ``simulate.h5`` (and ``contact_sim.h5``) there now."""
     stamp = figures_dir(scene, runs_root) / ANIMATION_STAMP
-    sim, contact = (stage_artifact(scene, runs_root, s) for s in ("simulate", "contact-sim"))
+    sim, contact = (stage_artifact(scene, runs_root, s) for s in (SIMULATE.name,
+                                                                   CONTACT_SIM.name))
     if not stamp.is_file() or not sim.is_file():
         return "not drawn from this run folder's simulate.h5: rerun `walkerlab animate`"
-    keys = [drawing_key({"simulate": sim})]
+    keys = [drawing_key({SIMULATE.name: sim})]
     if contact.is_file():
-        keys.append(drawing_key({"simulate": sim, "contact-sim": contact}))
+        keys.append(drawing_key({SIMULATE.name: sim, CONTACT_SIM.name: contact}))
     if not any(stamp_matches(stamp, k) for k in keys):
         return "drawn from an earlier simulate.h5 or contact_sim.h5: rerun `walkerlab animate`"
     return ""
@@ -105,11 +99,11 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 
 def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
     """'' when the artifact ``p`` the report did not produce is shown all the same."""
-    kind = "bifurcation" if stage.startswith("bifurcation") else stage
-    if kind not in EARLIER or (kind == "workprecision" and (scene.workprecision is None or full)
-                               ) or (kind == "attribution" and (scene.contact is None or full)):
+    kind = BIFURCATION.name if stage.startswith(BIFURCATION.name) else stage
+    if kind not in EARLIER or (kind == WORKPRECISION.name and (scene.workprecision is None or full)
+                               ) or (kind == ATTRIBUTION.name and (scene.contact is None or full)):
         return f"an earlier standalone run: the scene has {not_run(scene, stage)}"
-    if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
+    if kind == BIFURCATION.name and not stored_content_hash_matches(p):  # edited by hand (26)
         return "changed after it was written: rerun 'walkerlab bifurcation'"
     return EARLIER[kind] if changed_fields(p, scene, stage_sections(kind, scene)) else ""
 

@@ -13,12 +13,13 @@ from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, load_scene, validate_option
 from walkerlab.io.runpaths import figures_dir, named_artifact
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.studies.params import ParamAxis, SweepError, params_hash, parse_param, sweep_axes
 from walkerlab.studies.runner import run_sweep
 
 __all__ = ["run", "parse_param", "sweep_path", "SweepError", "STAGE_NAMES"]
 
-STAGE_NAMES = ("fixedpoint", "simulate", "contact-sim")
+STAGE_NAMES = ("fixedpoint", "simulate", CONTACT_SIM.name)
 
 
 def sweep_path(scene: Scene, axes: list[ParamAxis], stage: str, runs_root: Path | str = "runs",

@@ -31,6 +31,7 @@ a run that walked is ``ok``; the others are a sweep's own verdicts:
 from __future__ import annotations
 
 from walkerlab.integrate.ends import RUN_END_NAMES
+from walkerlab.io.stage_files import CONTACT_SIM
 
 #: Run ends that are a verdict of their own (the others, heel_strike / t_final, are ``ok``).
 RUN_END_OUTCOMES = tuple(k for k in RUN_END_NAMES if k not in ("heel_strike", "t_final"))
@@ -100,7 +101,7 @@ _CONTACT = {
 }
 
 COLUMNS: dict[str, dict[str, tuple[str, str]]] = {
-    "fixedpoint": _FP, "simulate": _SIM, "contact-sim": _CONTACT,
+    "fixedpoint": _FP, "simulate": _SIM, CONTACT_SIM.name: _CONTACT,
 }
 
 # string columns shared by every stage

@@ -25,6 +25,7 @@ from typing import Any
 
 from walkerlab.config import MAX_SWEEP_POINTS, Scene, SceneError, scene_from_dict
 from walkerlab.config.contact import CONTACT_QUANTITIES, renamed_contact_field
+from walkerlab.io.stage_files import CONTACT_SIM
 
 __all__ = ["SweepError", "ParamAxis", "parse_param", "grid_points", "apply_point",
            "check_axes", "axis_unit", "list_item", "params_hash", "EXCLUSIVE_FIELDS"]
@@ -406,7 +407,7 @@ def params_hash(axes: list[ParamAxis], stage: str) -> str:
 
 
 def sweep_axes(scene: Scene, params: list, stage: str,
-               stages: tuple[str, ...] = ("fixedpoint", "simulate", "contact-sim")
+               stages: tuple[str, ...] = ("fixedpoint", "simulate", CONTACT_SIM.name)
                ) -> list[ParamAxis]:
     """The axes of a sweep of ``stage`` over ``params`` (``--param`` strings or ParamAxis),
     checked against the scene before anything runs (:func:`check_axes`; the values of a grid

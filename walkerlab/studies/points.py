@@ -29,6 +29,7 @@ import numpy as np
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.io.schemas.continuation import initial_state
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.studies.guess import Continuation, guess_from_json, guess_to_json
 from walkerlab.studies.outcomes import empty_row
 from walkerlab.studies.params import apply_point
@@ -492,7 +493,7 @@ def contact_point(scene: Scene, guess, options: dict):
 
 
 POINT_FUNCTIONS: dict[str, Callable] = {
-    "fixedpoint": fixedpoint_point, "simulate": simulate_point, "contact-sim": contact_point,
+    "fixedpoint": fixedpoint_point, "simulate": simulate_point, CONTACT_SIM.name: contact_point,
 }
 
 

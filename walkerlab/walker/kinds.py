@@ -115,12 +115,24 @@ class Kind:
     field : str
         The scene field a refusal of the walker itself names first (``walker``; the 3D
         kinds': ``walker.space: 3d``).
+    body : str
+        The multibody its exports write (:data:`walkerlab.export.writers.BODIES`):
+        ``links``, a tree of leg links (:func:`walkerlab.walker.multibody.multibody`);
+        ``wheel`` and ``wheel_3d``, one rigid body on its spokes; ``legs_3d``, a free
+        pelvis and two legs on hip joints.
     """
 
     name: str
     title: str
     reference: str
     field: str = "walker"
+    body: str = "links"
+
+    @property
+    def spoked(self) -> bool:
+        """Whether the walker rolls on its spokes (its steps are spoke strikes, not two
+        legs' heel strikes): one rigid body, no legs."""
+        return self.body in ("wheel", "wheel_3d")
 
     def cell(self, feature: str, view: str) -> str | None:
         """None when the kind supports ``feature`` in ``view``, else the one-line reason
@@ -186,11 +198,11 @@ KINDS = {k.name: k for k in (
          "Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau, Choi & Morris "
          "2007"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
-         "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
+         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", body="wheel"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
-         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d"),
+         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
-         "Kuo 1999", "walker.space: 3d"),
+         "Kuo 1999", "walker.space: 3d", "legs_3d"),
 )}
 
 _NO_KNEE = "the legs are straight: there is no knee"

@@ -35,10 +35,11 @@ import numpy as np
 
 from walkerlab.io.artifacts import open_artifact, put
 from walkerlab.io.netcdf import coordinate
+from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.io.trajectory import NamedTrajectory, read_samples, write_samples
 from walkerlab.units import Units, for_artifact
 
-STAGE = "contact-sim"
+STAGE = CONTACT_SIM.name
 #: unit of each ``summary/`` entry (others: "-")
 SUMMARY_UNITS = {"mean_abs_stance_slip_mm": "mm", "peak_penetration_mm": "mm",
                  "max_abs_stance_slip_mm": "mm", "total_double_support_creep_mm": "mm",

@@ -1,0 +1,72 @@
+"""The stages' artifacts: stage name -> its file in ``runs/<scene>/`` and its schema loader.
+
+The lowest place that names the stages: :mod:`walkerlab.io.runpaths` (the file names a
+sweep may not take), :mod:`walkerlab.io.schemas.loaders` (any artifact by stage name), the
+studies' per-stage tables and the stage registry
+(:data:`walkerlab.stages.registry.STAGES`) read their names here.  Nothing here imports a
+schema: a loader is imported on first use (:meth:`StageArtifact.load`).
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class StageArtifact:
+    """One stage's artifact.
+
+    Attributes
+    ----------
+    name : str
+        The stage's name: its CLI command (``walkerlab contact-sim``) and its key in a
+        ``{stage: artifact}`` mapping.
+    schema : str
+        Its schema module under :mod:`walkerlab.io.schemas` (also the artifact's file
+        stem: ``contact_sim`` -> ``contact_sim.h5``).
+    loader : str
+        The schema module's loader (``load_contact_sim``).
+    """
+
+    name: str
+    schema: str
+    loader: str
+
+    @property
+    def file(self) -> str:
+        """The artifact's file name in ``runs/<scene>/`` (``contact_sim.h5``)."""
+        return f"{self.schema}.h5"
+
+    def load(self, path: Path):
+        """The loaded artifact at ``path`` (the schema's typed result).
+
+        Raises
+        ------
+        walkerlab.io.artifacts.ArtifactError
+            As the schema's loader (a missing or unreadable file, a wrong stage).
+        """
+        module = importlib.import_module(f"walkerlab.io.schemas.{self.schema}")
+        return getattr(module, self.loader)(path)
+
+
+FIXEDPOINT = StageArtifact("fixedpoint", "fixedpoint", "load_fixedpoint")
+SIMULATE = StageArtifact("simulate", "simulate", "load_simulate")
+CONTACT_SIM = StageArtifact("contact-sim", "contact_sim", "load_contact_sim")
+COMPARE = StageArtifact("compare", "compare", "load_compare")
+WORKPRECISION = StageArtifact("workprecision", "workprecision", "load_workprecision")
+BASIN = StageArtifact("basin", "basin", "load_basin")
+ROBUSTNESS = StageArtifact("robustness", "robustness", "load")
+MFPT = StageArtifact("mfpt", "mfpt", "load")
+ATTRIBUTION = StageArtifact("attribution", "attribution", "load_attribution")
+OPTIMIZE = StageArtifact("optimize", "optimize", "load")
+#: ``bifurcation`` and ``bifurcation_<field>`` load as summaries
+BIFURCATION = StageArtifact("bifurcation", "bifurcation", "load_bifurcation_summary")
+#: ``stability_map_<kind>.h5``
+STABILITY_MAP = StageArtifact("stability_map", "stability_map", "load_stability_map")
+
+#: stage name -> its artifact
+ARTIFACTS: dict[str, StageArtifact] = {a.name: a for a in (
+    FIXEDPOINT, SIMULATE, CONTACT_SIM, COMPARE, WORKPRECISION, BASIN, ROBUSTNESS, MFPT,
+    ATTRIBUTION, OPTIMIZE, BIFURCATION, STABILITY_MAP)}
