@@ -8,7 +8,8 @@ from __future__ import annotations
 import math
 
 from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
-from walkerlab.analysis.gait.search import find_gaits
+from walkerlab.analysis.gait.planar_start import planar_start
+from walkerlab.analysis.gait.search import GaitNotFound, find_gaits
 from walkerlab.config import Scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
@@ -137,15 +138,27 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     start = initial_guess(scene, walker) if guess is None else guess
     if start is None:  # virtual constraints: the zero dynamics' periodic orbit, if any
         start = hzd_start(walker)
-    search = find_gaits(walker, solver, start,
-                        policy=fp.gait,
-                        other_gait=fp.other_gait if other_gait is None else other_gait,
-                        xtol=fp.tolerance,
-                        fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
-                        fd_check=fd_check,
-                        ground_check=(lambda x: gait_ground_contact(scene, walker, x))
-                        if ground else None, partner_off_ground=partner_off_ground)
-    return walker, search
+
+    def search_from(x, seeds=True, policy=fp.gait):
+        return find_gaits(walker, solver, x, policy=policy,
+                          other_gait=fp.other_gait if other_gait is None else other_gait,
+                          xtol=fp.tolerance, fd_step=fp.fd_step,
+                          max_step_time=fp.max_step_time_s, fd_check=fd_check,
+                          ground_check=(lambda x: gait_ground_contact(scene, walker, x))
+                          if ground else None, partner_off_ground=partner_off_ground,
+                          seeds=seeds)
+
+    planar = planar_start(scene, walker, solver) if start is None else None
+    if planar is not None:  # a 3D walker: from its planar twin's gait (the seeds are planar)
+        # the twin's only gait (a closed form): no partner to look for, the one found is it
+        policy = "nearest_guess" if planar.unique and fp.gait == "stable" else fp.gait
+        try:
+            search = search_from(planar.x, seeds=False, policy=policy)
+        except GaitNotFound:
+            return walker, search_from(None)
+        search.notes.append(planar.note)
+        return walker, search
+    return walker, search_from(start)
 
 
 def controller(walker):

@@ -264,6 +264,11 @@ class HybridWalker:
         Steps of a finite ground (``terrain.periodic: false``: a foothold list that does not
         repeat, of one height or several; a drawn rough ground): a walk stops after them.
         None: the ground goes on (:attr:`cycle`, if any, repeats).
+    closed_form_gait : callable or None
+        ``() -> ndarray (2n,) or None``: the walker's period-1 gait in closed form, where
+        one is known (the planar rimless wheel's, McGeer 1990), None when it has none at
+        these numbers (it cannot roll over its stance foot); the attribute None: no closed
+        form.
     """
 
     name: str
@@ -291,6 +296,7 @@ class HybridWalker:
     cycle: tuple | None = None
     ground_steps: int | None = None
     neutral: tuple[str, ...] = ()
+    closed_form_gait: Callable[[], np.ndarray | None] | None = None
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)
