@@ -38,14 +38,15 @@ from walkerlab.analysis.gait.poincare import (
     find_fixed_point,
 )
 from walkerlab.analysis.gait.search import COARSE_XTOL, GaitNotFound, find_gaits
-from walkerlab.analysis.gait.starts import coarse_solver
+from walkerlab.analysis.gait.starts import FallbackStart, coarse_solver
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.planar import planar_twin
 
-__all__ = ["PlanarStart", "planar_start", "embed", "carry_width", "FIRST_WIDTH"]
+__all__ = ["PlanarStart", "planar_start", "planar_fallback", "embed", "carry_width",
+           "FIRST_WIDTH"]
 
 #: a walker that needs a hip width (hip-roll joints) is carried from this fraction of it
 FIRST_WIDTH = 0.01
@@ -238,3 +239,37 @@ def planar_start(scene: Scene, walker: HybridWalker, solver: Solver) -> PlanarSt
         return None
     return PlanarStart(x1, f"{note}, carried from walker.{field} {w0:g} to {w1:g} in "
                            f"{points} continuation points", unique)
+
+
+def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver
+                    ) -> FallbackStart | None:
+    """The planar-twin start (:func:`planar_start`) as a fallback of the gait search
+    (:class:`~walkerlab.analysis.gait.starts.FallbackStart`: found only when tried), or None
+    for a walker without a planar twin (a planar one).
+
+    Parameters
+    ----------
+    scene : Scene
+    walker, solver
+        The scene's rigid walker and integrator.
+
+    Returns
+    -------
+    FallbackStart or None
+    """
+    twin = planar_twin(scene.walker)
+    if twin is None:
+        return None
+    label = "the planar twin's gait" + (f" carried in walker.{twin.width_field}"
+                                        if twin.width_field is not None else ", upright")
+    fb = FallbackStart(label, "planar_twin", None)
+
+    def find():
+        start = planar_start(scene, walker, solver)
+        if start is None:
+            return None
+        fb.unique = start.unique
+        return start.x, start.note
+
+    fb.find = find
+    return fb
