@@ -113,7 +113,8 @@ def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
         make, _ = homotopy_family(known.scene, scene)
         try:
             x, points = carry_width(lambda lam: make({"lambda": lam}), x0, 0.0, 1.0, solver,
-                                    max_step, fd_step, f"homotopy over {over}")
+                                    max_step, fd_step, "lambda",
+                                    f"homotopy from {known.where} over {over}")
         except MapFailed:
             return None
         if x is None or not np.all(np.isfinite(x)):

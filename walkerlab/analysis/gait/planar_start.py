@@ -129,7 +129,8 @@ def _planar_gait(twin: Scene) -> tuple[np.ndarray, str, bool] | None:
 
 def carry_width(make, x0: np.ndarray, w0: float, w1: float, solver: Solver,
                 max_step_time: float = 5.0, fd_step: float = 1e-7,
-                label: str = "width") -> tuple[np.ndarray | None, int]:
+                label: str = "width", task: str | None = None
+                ) -> tuple[np.ndarray | None, int]:
     """Carry a fixed point from ``make(w0)`` to ``make(w1)`` by natural-parameter
     continuation (module docstring, step 3).
 
@@ -144,6 +145,9 @@ def carry_width(make, x0: np.ndarray, w0: float, w1: float, solver: Solver,
         The scene's (the continuation runs at its screening tolerance).
     label : str
         The parameter's name in the progress lines.
+    task : str, optional
+        What the progress lines call the continuation (default ``continuation in <label>
+        to <w1>``).
 
     Returns
     -------
@@ -157,7 +161,7 @@ def carry_width(make, x0: np.ndarray, w0: float, w1: float, solver: Solver,
     kw = {"xtol": COARSE_XTOL, "fd_step": fd_step, "max_step_time": max_step_time,
           "fd_check": False}
     t0 = time.perf_counter()
-    with progress.task(f"continuation in {label} to {w1:g}") as bar:
+    with progress.task(task or f"continuation in {label} to {w1:g}") as bar:
         try:
             res = find_fixed_point(make(w0), x0, coarse, **kw)
         except (FixedPointNotFound, FixedPointGaveUp):
