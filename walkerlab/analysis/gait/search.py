@@ -93,8 +93,9 @@ class Gait:
         ``"long_period"``/``"short_period"`` (two gaits found) or ``"period_1"`` (one).
     result : FixedPointResult
     source : str
-        Where the root finder started: ``"initial_guess"``, ``"seed"`` (scale-free seed) or
-        ``"deflation"`` (near the other gait, deflated).
+        Where the root finder started: ``"initial_guess"``, ``"seed"`` (scale-free seed),
+        ``"deflation"`` (near the other gait, deflated) or a fallback start's
+        (``"stored_gait"``, ``"planar_twin"``: ``FallbackStart.source``).
     start : ndarray (2n,)
         The root finder's starting state.
     ground : walkerlab.analysis.gait.checks.GroundContact or None
