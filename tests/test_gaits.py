@@ -362,3 +362,33 @@ def test_the_nearest_stored_gait_is_the_walker_with_fewest_and_smallest_differen
     assert got.where == "near"
     assert fields == {"walker.hip_roll.lean_rate_gain_s": (-0.18, -0.25)}
     assert nearest_stored(new, stored[:1]) is None
+
+
+def test_a_scene_whose_guess_fails_starts_from_the_gait_stored_for_a_nearby_walker(tmp_path):
+    """The paper walker's run stored; the same walker at 3.5 deg with a guess far from any
+    gait: ``walkerlab fixedpoint`` says it tries the stored gait (found through the runs
+    folder: its scene read back from the artifact), carried over the slope, and the gait it
+    records comes from it, on the section to the scene's tolerance."""
+    runs = tmp_path / "runs"
+    base = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    base["name"] = "paper"
+    (tmp_path / "paper.yaml").write_text(yaml.safe_dump(base))
+    r = CliRunner().invoke(app, ["fixedpoint", str(tmp_path / "paper.yaml"), "--runs-dir",
+                                 str(runs)])
+    assert r.exit_code == 0, r.output
+    steep = yaml.safe_load(yaml.safe_dump(base))
+    steep["name"] = "steep"
+    steep["slope"] = {"angle_deg": 3.5}
+    steep["fixedpoint"]["initial_guess"] = {"swing_angle_rad": -0.9, "stance_angle_rad": 0.8,
+                                            "swing_rate_rad_per_s": 2.0,
+                                            "stance_rate_rad_per_s": 2.5}
+    (tmp_path / "steep.yaml").write_text(yaml.safe_dump(steep))
+    r = CliRunner().invoke(app, ["fixedpoint", str(tmp_path / "steep.yaml"), "--runs-dir",
+                                 str(runs)])
+    assert r.exit_code == 0, r.output
+    assert ("gait search: trying the gait stored in paper/fixedpoint.h5, carried in "
+            "slope.angle_rad") in r.stderr
+    with h5py.File(runs / "steep" / "fixedpoint.h5") as f:
+        assert f.attrs["gait_source"] == "stored_gait"
+    fp = load_fixedpoint(runs / "steep" / "fixedpoint.h5")
+    assert fp.residual < 1e-10
