@@ -304,3 +304,91 @@ def test_a_walk_round_where_no_seed_lasts_its_steps_says_none_lasted(monkeypatch
     monkeypatch.setattr(starts, "attempt", lambda *a, **k: None)
     starts.from_seeds()
     assert starts.tried[-1] == f"23 seeds walked to last {WALK_STEPS} steps (none lasted them)"
+
+
+def test_a_failed_search_names_the_fallback_starts_it_tried_and_says_each_in_a_notice():
+    """A start tried after the guess (here none: the paper walker on level ground, no gait)
+    is named in the failure message as what it was, not as "the initial guess", and said in
+    one notice as it is tried (issue 82 item 9)."""
+    from walkerlab import progress
+    from walkerlab.analysis.gait.starts import FallbackStart
+
+    class Notes:
+        def __init__(self):
+            self.notes = []
+
+        def start(self, *a):
+            pass
+
+        update = finish = start
+
+        def note(self, message):
+            self.notes.append(message)
+
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    d["slope"] = {"angle_rad": 0.0}
+    del d["fixedpoint"]["initial_guess"]
+    scene = scene_from_dict(d)
+    walker = build_walker(scene)
+    label = "the planar twin's gait carried in walker.hip_width_m"
+    with progress.use(Notes()) as sink, pytest.raises(GaitNotFound) as exc:
+        find_gaits(walker, Solver.from_settings(scene.solver), None, fd_check=False,
+                   fallbacks=[FallbackStart(label, "planar_twin", lambda: None)])
+    msg = str(exc.value)
+    assert f"tried {label} (no start found) and" in msg and "scale-free seeds" in msg
+    assert "the initial guess" not in msg
+    assert sink.notes == [f"gait search: trying {label}"]
+
+
+def test_the_nearest_stored_gait_is_the_walker_with_fewest_and_smallest_differences():
+    """Of stored walkers, the one differing from the scene in fewest fields, then by the
+    smallest relative difference, is chosen; one of another structure never is."""
+    from walkerlab.studies.warm_start import StoredGait, nearest_stored
+
+    d = yaml.safe_load((ROOT / "configs" / "hip_width_stabilised.yaml").read_text())
+
+    def scene(**gains):
+        e = yaml.safe_load(yaml.safe_dump(d))
+        e["walker"]["hip_roll"].update(gains)
+        return scene_from_dict(e)
+
+    planar = scene_from_dict(yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text()))
+    new = scene(lean_rate_gain_s=-0.25)
+    stored = [StoredGait(planar, lambda: None, "planar"),
+              StoredGait(scene(lean_rate_gain_s=-0.18, lean_gain=-0.9), lambda: None, "two"),
+              StoredGait(scene(lean_rate_gain_s=-0.10), lambda: None, "far"),
+              StoredGait(scene(lean_rate_gain_s=-0.18), lambda: None, "near")]
+    got, fields = nearest_stored(new, stored)
+    assert got.where == "near"
+    assert fields == {"walker.hip_roll.lean_rate_gain_s": (-0.18, -0.25)}
+    assert nearest_stored(new, stored[:1]) is None
+
+
+def test_a_scene_whose_guess_fails_starts_from_the_gait_stored_for_a_nearby_walker(tmp_path):
+    """The paper walker's run stored; the same walker at 3.5 deg with a guess far from any
+    gait: ``walkerlab fixedpoint`` says it tries the stored gait (found through the runs
+    folder: its scene read back from the artifact), carried over the slope, and the gait it
+    records comes from it, on the section to the scene's tolerance."""
+    runs = tmp_path / "runs"
+    base = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    base["name"] = "paper"
+    (tmp_path / "paper.yaml").write_text(yaml.safe_dump(base))
+    r = CliRunner().invoke(app, ["fixedpoint", str(tmp_path / "paper.yaml"), "--runs-dir",
+                                 str(runs)])
+    assert r.exit_code == 0, r.output
+    steep = yaml.safe_load(yaml.safe_dump(base))
+    steep["name"] = "steep"
+    steep["slope"] = {"angle_deg": 3.5}
+    steep["fixedpoint"]["initial_guess"] = {"swing_angle_rad": -0.9, "stance_angle_rad": 0.8,
+                                            "swing_rate_rad_per_s": 2.0,
+                                            "stance_rate_rad_per_s": 2.5}
+    (tmp_path / "steep.yaml").write_text(yaml.safe_dump(steep))
+    r = CliRunner().invoke(app, ["fixedpoint", str(tmp_path / "steep.yaml"), "--runs-dir",
+                                 str(runs)])
+    assert r.exit_code == 0, r.output
+    assert ("gait search: trying the gait stored in paper/fixedpoint.h5, carried in "
+            "slope.angle_rad") in r.stderr
+    with h5py.File(runs / "steep" / "fixedpoint.h5") as f:
+        assert f.attrs["gait_source"] == "stored_gait"
+    fp = load_fixedpoint(runs / "steep" / "fixedpoint.h5")
+    assert fp.residual < 1e-10

@@ -344,3 +344,82 @@ def test_other_gait_false_stops_the_second_gait_search_of_a_3d_walker(tmp_path):
     assert "Floquet multipliers (variational, per stride)" in text
     assert "largest variational |multiplier| per stride = 99.92" in text
     assert "was not looked for" in text
+def _without_guess(tmp_path: Path, name: str, **walker) -> Path:
+    """configs/<name> copied to ``tmp_path`` without its ``fixedpoint.initial_guess`` (and
+    its ``gait: nearest_guess``, which needs one), ``walker`` fields replaced."""
+    data = yaml.safe_load((ROOT / "configs" / name).read_text())
+    data["fixedpoint"].pop("initial_guess")
+    data["fixedpoint"].pop("gait", None)
+    data["walker"].update(walker)
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+#: two roots of the same map at xtol 1e-12 (MINPACK's relative step) and residual < 1e-11
+#: differ by at most |(I - DP)^-1| times that: the lateral multiplier (up to ~20) and the
+#: 1e-12 integration give ~1e-10; 1e-8 leaves room and is still far below any gait's scale
+SAME_GAIT_TOL = 1e-8
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["hip_width.yaml", "hip_width_stabilised.yaml"])
+def test_a_3d_walker_without_initial_guess_finds_the_shipped_gait(tmp_path, name):
+    """Without a guess, a 3D walker with hip width starts from its planar twin's gait
+    (lateral states zero) carried in hip width: it reaches the gait the shipped scene finds
+    from its own guess (before: 0 of 45 scale-free seeds, no gait)."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.config import load_scene
+
+    _w, shipped = solve_scene(load_scene(ROOT / "configs" / name), fd_check=False)
+    _w, found = solve_scene(load_scene(_without_guess(tmp_path, name)), fd_check=False)
+    assert any("planar twin" in n for n in found.notes)
+    np.testing.assert_allclose(found.result.x, shipped.result.x, rtol=0, atol=SAME_GAIT_TOL)
+
+
+def test_a_3d_walker_not_shipped_finds_a_gait_without_initial_guess(tmp_path):
+    """A hip width of 7 cm and other masses (no scene ships it, no guess): a gait, on the
+    heel-strike section to the scene's tolerance, near the planar twin's sagittally and
+    leaning (the hip width's lateral motion), found in seconds."""
+    import time
+
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.config import load_scene
+
+    scene = load_scene(_without_guess(tmp_path, "hip_width.yaml", hip_width_m=0.07,
+                                      leg_mass_kg=3.0, hip_mass_kg=12.0))
+    t0 = time.process_time()
+    walker, search = solve_scene(scene, fd_check=False)
+    assert time.process_time() - t0 < 30.0
+    res = search.result
+    assert res.residual < 1e-10
+    x = dict(zip(walker.state_names(), res.x))
+    assert abs(x["lean_rate"]) > 1e-3  # out of the plane: not the upright embedding
+    assert -0.3 < x["swing_angle"] < -0.1 and 0.1 < x["stance_angle"] < 0.3
+
+
+@pytest.mark.slow
+def test_a_changed_gain_falls_back_to_the_stored_gait_and_finds_the_gait(tmp_path):
+    """lean_rate_gain_s -0.18 -> -0.25 with the shipped scene's guess (the gait at -0.18):
+    Newton from the guess does not converge (before: then 0 of 45 seeds, no gait); the gait
+    stored for -0.18, carried over the gain, is the start of a gait at -0.25 on the
+    heel-strike section to the scene's tolerance, far from the guess (issue 82 item 9)."""
+    from walkerlab.analysis.gait.scene import initial_guess, solve_scene
+    from walkerlab.config import load_scene
+    from walkerlab.models.registry import build_walker
+    from walkerlab.studies.warm_start import StoredGait, stored_gait_start
+
+    data = yaml.safe_load((ROOT / "configs" / "hip_width_stabilised.yaml").read_text())
+    data["walker"]["hip_roll"]["lean_rate_gain_s"] = -0.25
+    path = tmp_path / "lrg025.yaml"
+    path.write_text(yaml.safe_dump(data))
+    scene = load_scene(path)
+    known = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    guess = initial_guess(known, build_walker(known))
+    nearby = stored_gait_start(scene, [StoredGait(known, lambda: guess, "known")])
+    walker, search = solve_scene(scene, fd_check=False, nearby=nearby)
+    assert any("initial guess did not converge" in n for n in search.notes)
+    assert search.gait.source == "stored_gait"
+    res = search.result
+    assert res.residual < 1e-10
+    assert np.max(np.abs(res.x - guess)) > 0.1  # a gait of its own, not the guess's

@@ -351,3 +351,43 @@ def test_a_3d_wheels_target_gait_is_judged_with_its_neutral_multiplier_set_aside
     assert 0.1857 < slope < 0.2 and gait.neutral == ("heading_angle",)
     assert 0.9 < gait.max_abs_multiplier < 0.95 and gait.stable
     assert abs(np.max(np.abs(gait.multipliers)) - 1.0) < 1e-8  # the neutral 1 is there
+@pytest.mark.parametrize("name", ["rimless_wheel_3d.yaml", "rimless_wheel_3d_disc.yaml"])
+def test_a_3d_wheel_without_initial_guess_finds_the_shipped_gait(tmp_path, name):
+    """Without a guess, the 3D wheel starts from the planar wheel's closed-form gait
+    (McGeer 1990: w+ = eta sqrt(4 M g L sin(alpha) sin(gamma) / ((M L^2 + I)(1 - eta^2))),
+    upright, heading 0) and reaches the gait the shipped scene finds from its guess, to the
+    root finder's tolerance (xtol 1e-12 relative; 1e-9 rad/s leaves room for the lateral
+    multiplier 22)."""
+    import yaml
+
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.config import load_scene
+
+    data = yaml.safe_load((ROOT / "configs" / name).read_text())
+    data["fixedpoint"].pop("initial_guess")
+    data["fixedpoint"].pop("gait", None)
+    (tmp_path / name).write_text(yaml.safe_dump(data))
+    _w, shipped = solve_scene(load_scene(ROOT / "configs" / name), fd_check=False)
+    _w, found = solve_scene(load_scene(tmp_path / name), fd_check=False)
+    assert any("closed form" in n for n in found.notes)
+    np.testing.assert_allclose(found.result.x, shipped.result.x, rtol=0, atol=1e-9)
+
+
+def test_the_planar_wheel_closed_form_gait_is_a_fixed_point():
+    """The planar wheel's closed form (with a hub inertia: eta = (M L^2 cos 2a + I) /
+    (M L^2 + I)) is its map's fixed point to the integrator's tolerance, and for a point
+    mass it is McGeer's cot(2 alpha) sqrt(4 g/L sin(alpha) sin(gamma))."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.config import load_scene
+
+    scene = load_scene(ROOT / "configs" / "rimless_wheel.yaml")
+    w = build_walker(scene)
+    x = w.closed_form_gait()
+    assert x[1] == pytest.approx(-W_PLUS, rel=1e-14)
+    for inertia in (0.0, 0.5):
+        sc = scene.model_copy(update={"walker": scene.walker.model_copy(
+            update={"hub_inertia_kg_m2": inertia})})
+        wi = build_walker(sc)
+        xi = wi.closed_form_gait()
+        xn, _, _ = poincare_map(wi, xi, Solver(method="DOP853", rtol=1e-12, atol=1e-12))
+        np.testing.assert_allclose(xn, xi, atol=1e-10)

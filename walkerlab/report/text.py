@@ -330,7 +330,9 @@ def unstable_gait_line(fp: FixedPointArtifact) -> str:
 
 _GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",
                  "seed": "root finder from a scale-free seed",
-                 "deflation": "deflated root finder near the other gait"}
+                 "deflation": "deflated root finder near the other gait",
+                 "stored_gait": "root finder from a stored gait carried here",
+                 "planar_twin": "root finder from the planar twin's gait"}
 
 
 def _ground_word(g, u) -> str:

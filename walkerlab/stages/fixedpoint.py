@@ -93,6 +93,43 @@ def fresh_artifact(scene: Scene, runs_root: Path | str = "runs") -> Path | None:
     return None
 
 
+def stored_gaits(scene: Scene, runs_root: Path | str) -> list:
+    """The gaits of the other ``fixedpoint.h5`` in the runs folder (up to date or not, this
+    scene's own stale one too) whose walker model is the scene's, as
+    :class:`walkerlab.studies.warm_start.StoredGait` (the fixed point read only when one is
+    chosen); unreadable ones are passed over."""
+    from walkerlab.io.artifacts import root_attrs
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.studies.warm_start import StoredGait  # only when the guess failed
+
+    root = Path(runs_root)
+    out = []
+    try:
+        paths = sorted(root.glob("*/fixedpoint.h5"))
+    except OSError:
+        return out
+    for path in paths:
+        attrs = root_attrs(path, "scene_json")
+        try:
+            stored = Scene.model_validate(json.loads(attrs["scene_json"]))
+        except (KeyError, ValueError, SceneError):
+            continue
+        if stored.walker.model != scene.walker.model:
+            continue
+        out.append(StoredGait(stored, lambda p=path: load_fixedpoint(p).x,
+                              f"{path.parent.name}/{path.name}"))
+    return out
+
+
+def _nearby(scene: Scene, runs_root):
+    """The nearest stored gait as a fallback start of the gait search (carried here), or
+    None."""
+    from walkerlab.studies.warm_start import stored_gait_start  # only for a compute
+
+    stored = stored_gaits(scene, runs_root)
+    return stored_gait_start(scene, stored) if stored else None
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         compare_variants: bool = True, known: Scene | Path | str | None = None
         ) -> StageOutcome:
@@ -122,13 +159,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         from walkerlab.analysis.gait.scene import fixed_point_run
         from walkerlab.analysis.gait.search import GaitNotFound
 
-        guess = note = None
+        guess = note = nearby = None
         try:
             if src is not None:  # the known gait carried here
                 from walkerlab.studies.continuation import homotopy_start
 
                 guess, note = homotopy_start(scene, src)
-            run, summary = fixed_point_run(scene, compare_variants, guess, note)
+            else:  # a gait stored nearby: a start should the scene's own guess fail
+                nearby = _nearby(scene, runs_root)
+            run, summary = fixed_point_run(scene, compare_variants, guess, note, nearby)
         except GaitNotFound as exc:
             raise StageError(f"fixedpoint: {exc}") from None
         except ValueError as exc:  # a malformed initial guess or gait choice (one line)

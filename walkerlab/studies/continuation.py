@@ -317,7 +317,8 @@ def homotopy_gait(known: Scene, new: Scene):
         raise MapFailed("no gait for the known scene", exc.message) from None
     fp = new.fixedpoint or known.fixedpoint
     res = homotopy(make, gait.x, Solver.from_settings(new.solver),
-                   fp.max_step_time_s if fp is not None else 5.0)
+                   fp.max_step_time_s if fp is not None else 5.0,
+                   label=f"homotopy from scene {known.name} over {', '.join(fields)}")
     res.fields = fields
     return res
 

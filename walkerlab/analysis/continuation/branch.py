@@ -152,7 +152,7 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
                     p_scale: float, direction: int = 1, ds: float = 0.02,
                     ds_min: float = 1e-6, ds_max: float = 0.1, max_points: int = 400,
                     checks: tuple = (), away_from: np.ndarray | None = None,
-                    stats: dict | None = None) -> Branch:
+                    stats: dict | None = None, on_point=None) -> Branch:
     """Follow the period-``k`` branch through ``first`` until ``p`` leaves ``p_range`` or the
     branch ends.
 
@@ -176,6 +176,9 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
         branch ends where one of them reaches 0 (located by brentq along the branch).
     away_from : ndarray (m + 1,), optional
         Orient the first tangent away from this scaled point (branch switching).
+    on_point : callable, optional
+        ``on_point(point)`` after each point added to the branch (a
+        :class:`BranchPoint`: progress lines of a long continuation).
 
     Returns
     -------
@@ -215,6 +218,8 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
                 sys, a, b, u, s_b, at_bound, checks, pts, specials):
             break
         pts.append(b)
+        if on_point is not None:
+            on_point(b)
         if at_bound is not None:
             break
         ds_cur = min(ds_max, ds_cur * 1.5) if b.tangent @ a.tangent > 0.995 else ds_cur

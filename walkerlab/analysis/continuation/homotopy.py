@@ -6,11 +6,13 @@ met on the way (a fold: the gait ends on this path; a period doubling) are repor
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab import progress
 from walkerlab.analysis.continuation.branch import (
     Branch,
     WalkerFamily,
@@ -44,7 +46,8 @@ class HomotopyResult:
 
 
 def homotopy(make: Callable[[dict], HybridWalker], x_known: np.ndarray, solver: Solver,
-             max_step_time: float = 5.0, ds: float = 0.05) -> HomotopyResult:
+             max_step_time: float = 5.0, ds: float = 0.05,
+             label: str = "homotopy") -> HomotopyResult:
     """Continue the known walker's gait (``lambda = 0``) to the new walker (``lambda = 1``)
     along a one-parameter family ``make({"lambda": value})`` (the straight line between two
     scenes' numeric fields, :func:`walkerlab.studies.continuation.homotopy_family`).
@@ -54,6 +57,9 @@ def homotopy(make: Callable[[dict], HybridWalker], x_known: np.ndarray, solver: 
     make : callable ``{"lambda": float} -> HybridWalker``
     x_known : ndarray (2n,)
         A fixed point (or a good guess) of the known walker.
+    label : str
+        What the progress lines call the homotopy (:func:`walkerlab.progress.task`: one
+        per continuation point, ``lambda`` and the elapsed time).
 
     Returns
     -------
@@ -66,8 +72,14 @@ def homotopy(make: Callable[[dict], HybridWalker], x_known: np.ndarray, solver: 
         No fixed point at ``lambda = 0``.
     """
     fam = WalkerFamily(make, "lambda", solver, max_step_time)
-    first = first_point(fam, 0.0, x_known, 1, 1.0)
-    br = continue_branch(fam, first, 1, (0.0, 1.0), 1.0, 1, ds=ds, ds_max=0.2)
+    t0 = time.perf_counter()
+    with progress.task(label) as bar:  # a line per continuation point without a terminal
+        first = first_point(fam, 0.0, x_known, 1, 1.0)
+        bar.advance(1, info=f"lambda 0 ({time.perf_counter() - t0:.1f} s)")
+        br = continue_branch(fam, first, 1, (0.0, 1.0), 1.0, 1, ds=ds, ds_max=0.2,
+                             on_point=lambda q: bar.advance(
+                                 1, info=f"lambda {q.p:.4g} "
+                                         f"({time.perf_counter() - t0:.1f} s)"))
     last = br.points[-1]
     reached = abs(last.p - 1.0) < 1e-12
     return HomotopyResult(last.x, {}, br, br.specials, reached)

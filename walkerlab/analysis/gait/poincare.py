@@ -75,9 +75,11 @@ class SearchGaveUp(Exception):
 
 
 @contextmanager
-def search_budget(seconds: float | None = None) -> Iterator[None]:
+def search_budget(seconds: float | None = None, fresh: bool = False) -> Iterator[None]:
     """Bound every step map started inside to ``seconds`` of this thread's CPU time from now
-    (default :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline): past it,
+    (default :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline, unless
+    ``fresh``: a start tried after the search's own ones failed, with a budget of its own
+    and the outer deadline back after it): past it,
     :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map, and stops
     the map under way (:func:`walkerlab.integrate.time_limit.integration_deadline`: its
     right-hand side looks at the clock every 64 evaluations; the compiled CyRK flow at each
@@ -86,9 +88,10 @@ def search_budget(seconds: float | None = None) -> Iterator[None]:
     (:func:`walkerlab.progress.note`)."""
     outer = _BUDGET.deadline
     now = _clock()
-    if not math.isfinite(outer):  # the outermost budget counts the maps of all inside
+    if not math.isfinite(outer) or fresh:  # the outermost budget counts the maps inside
         _BUDGET.maps, _BUDGET.slowest, _BUDGET.started = 0, 0.0, now
-    _BUDGET.deadline = min(outer, now + (ROOT_BUDGET_S if seconds is None else seconds))
+    own = now + (ROOT_BUDGET_S if seconds is None else seconds)
+    _BUDGET.deadline = own if fresh else min(outer, own)
     try:
         yield
     finally:

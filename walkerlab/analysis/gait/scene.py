@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+from walkerlab.analysis.gait.planar_start import planar_fallback
 from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.analysis.gait.search import find_gaits
 from walkerlab.config import Scene
@@ -101,7 +102,7 @@ def with_variant(scene: Scene, variant: str) -> Scene:
 
 def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None,
                 ground: bool = False, other_gait: bool | None = None,
-                partner_off_ground: bool = False):
+                partner_off_ground: bool = False, nearby=None):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
@@ -121,6 +122,15 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     needs a pull or more friction than the ground has
     (:func:`~walkerlab.analysis.gait.search.find_gaits`).
 
+    Without ``guess``, when the scene's initial guess does not converge (it may be the gait
+    of other parameters) or the scene has none, the root finder is started, before the
+    scale-free seeds, from ``nearby`` (a
+    :class:`~walkerlab.analysis.gait.starts.FallbackStart`, e.g. a stored gait of a walker
+    nearby carried here: :func:`walkerlab.studies.warm_start.stored_gait_start`) and then,
+    for a 3D walker, from its planar twin's gait carried in hip width
+    (:func:`~walkerlab.analysis.gait.planar_start.planar_fallback`).  A guess that
+    converges takes the search as before: no fallback is built further than its label.
+
     Returns
     -------
     walker : HybridWalker
@@ -139,16 +149,24 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     start = initial_guess(scene, walker) if guess is None else guess
     if start is None:  # virtual constraints: the zero dynamics' periodic orbit, if any
         start = hzd_start(walker)
-    search = find_gaits(walker, solver, start,
-                        policy=fp.gait,
-                        other_gait=fp.other_gait if other_gait is None else other_gait,
-                        xtol=fp.tolerance,
-                        fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
-                        fd_check=fd_check,
-                        ground_check=(lambda x: gait_ground_contact(scene, walker, x))
-                        if ground else None, partner_off_ground=partner_off_ground,
-                        partner_if_needed=fp.other_gait)
-    return walker, search
+
+    def search_from(x, fallbacks):
+        return find_gaits(walker, solver, x, policy=fp.gait,
+                          other_gait=fp.other_gait if other_gait is None else other_gait,
+                          xtol=fp.tolerance, fd_step=fp.fd_step,
+                          max_step_time=fp.max_step_time_s, fd_check=fd_check,
+                          ground_check=(lambda x: gait_ground_contact(scene, walker, x))
+                          if ground else None, partner_off_ground=partner_off_ground,
+                          partner_if_needed=fp.other_gait, fallbacks=fallbacks)
+
+    fallbacks = []  # when the scene's own guess fails (or it has none), before the seeds
+    if guess is None:
+        if nearby is not None:  # a gait stored nearby, carried here
+            fallbacks.append(nearby)
+        planar = planar_fallback(scene, walker, solver)  # a 3D walker: from its planar twin
+        if planar is not None:
+            fallbacks.append(planar)
+    return walker, search_from(start, fallbacks)
 
 
 def controller(walker):
@@ -191,7 +209,7 @@ def solve_variant(scene: Scene, variant: str, guess=None):
 
 
 def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
-                    note: str | None = None):
+                    note: str | None = None, nearby=None):
     """The period-1 gait of the scene's own equation variant and, with ``compare_variants``
     (a compass gait compared with published numbers), the fixed points of the other
     variants from the same start - what the ``fixedpoint`` artifact stores.
@@ -204,6 +222,8 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         guess or the scale-free seeds.
     note : str, optional
         How ``guess`` was found, added to the search's notes.
+    nearby : FallbackStart, optional
+        A start tried when the scene's own guess fails (:func:`solve_scene`).
 
     Returns
     -------
@@ -223,7 +243,7 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     """
     from walkerlab.io.schemas.fixedpoint import FixedPointRun
 
-    walker, search = solve_scene(scene, guess=guess, ground=True)
+    walker, search = solve_scene(scene, guess=guess, ground=True, nearby=nearby)
     if note:
         search.notes.append(note)
     main = search.result

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab import progress
 from walkerlab.analysis.gait.poincare import (
     FixedPointGaveUp,
     FixedPointNotFound,
@@ -92,8 +93,9 @@ class Gait:
         ``"long_period"``/``"short_period"`` (two gaits found) or ``"period_1"`` (one).
     result : FixedPointResult
     source : str
-        Where the root finder started: ``"initial_guess"``, ``"seed"`` (scale-free seed) or
-        ``"deflation"`` (near the other gait, deflated).
+        Where the root finder started: ``"initial_guess"``, ``"seed"`` (scale-free seed),
+        ``"deflation"`` (near the other gait, deflated) or a fallback start's
+        (``"stored_gait"``, ``"planar_twin"``: ``FallbackStart.source``).
     start : ndarray (2n,)
         The root finder's starting state.
     ground : walkerlab.analysis.gait.checks.GroundContact or None
@@ -184,7 +186,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
                fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
                time_unit: str = "s", seeds: bool = True,
                ground_check=None, partner_off_ground: bool = False,
-               partner_if_needed: bool = True) -> GaitSearch:
+               partner_if_needed: bool = True, fallbacks=()) -> GaitSearch:
     """Find the walker's period-1 gait(s) and choose one.
 
     Parameters
@@ -228,6 +230,12 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         are all unstable, or a family of gaits (the 3D wheel's headings) that is no pair;
         only ``long_period``/``short_period``, which cannot choose without both, still
         look.
+    fallbacks : sequence of FallbackStart
+        Starts tried in order when the guess does not converge (or without a guess), before
+        the seeds (:class:`~walkerlab.analysis.gait.starts.FallbackStart`: a stored gait
+        carried here, a 3D walker's planar twin); each is said in a notice
+        (:func:`walkerlab.progress.note`) and has a time budget of its own.  A gait found
+        from one is not bettered by the seeds (they are a planar passive walker's).
 
     Returns
     -------
@@ -251,7 +259,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         with search_budget():  # every start, seed and root finder: one time budget
             return _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step,
                                max_step_time, fd_check, time_unit, seeds, ground_check,
-                               partner_off_ground, partner_if_needed)
+                               partner_off_ground, partner_if_needed, fallbacks)
     except (SearchGaveUp, FixedPointGaveUp) as exc:
         why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
         raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
@@ -259,7 +267,8 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
 
 def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_step_time,
                 fd_check, time_unit, seeds, ground_check=None,
-                partner_off_ground=False, partner_if_needed=True) -> GaitSearch:
+                partner_off_ground=False, partner_if_needed=True,
+                fallbacks=()) -> GaitSearch:
     s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
                                      "max_step_time": max_step_time, "fd_check": fd_check})
     if guess is not None:
@@ -269,6 +278,11 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
             s.found.append(g)
         else:
             s.notes.append(f"the initial guess did not converge ({_short(s.last_msg)})")
+    fell_back = None if s.found else s.from_fallbacks(fallbacks)
+    if fell_back is not None:  # the seeds cannot better it; a unique gait has no partner
+        seeds = False
+        if fell_back.unique and policy == "stable":
+            policy, guess = "nearest_guess", s.found[0].start
     if not s.found and (seeds or guess is None):
         no_orbit = no_orbit_reason(walker)
         if no_orbit:  # the seeds are a passive walker's: none can find what is not there
@@ -355,6 +369,27 @@ class _RootStarts:
         if not _is_new(res, self.found):
             return None
         return Gait("period_1", res, source, np.asarray(x0, float))
+
+    def from_fallbacks(self, fallbacks):
+        """Root from each fallback start in turn (:func:`find_gaits`), each under a time
+        budget of its own; the first that converges (a :class:`FallbackStart`), or None."""
+        for fb in fallbacks:
+            progress.note(f"gait search: trying {fb.label}")
+            self.tried.append(fb.label)
+            try:
+                with search_budget(fresh=True):
+                    got = fb.find()
+                    g = None if got is None else self.attempt(got[0], fb.source)
+            except (SearchGaveUp, FixedPointGaveUp):
+                self.tried[-1] += " (its time budget ran out)"
+                continue
+            if got is None:
+                self.tried[-1] += " (no start found)"
+            elif g is not None:
+                self.found.append(g)
+                self.notes.append(got[1])
+                return fb
+        return None
 
     def from_orbit(self, guess) -> None:
         """Root from the zero dynamics' periodic orbit (a walker whose gaits lie on it:

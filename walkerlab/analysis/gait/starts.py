@@ -27,8 +27,34 @@ from walkerlab.analysis.gait.poincare import FixedPointResult, StepFailed, poinc
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker, OffSection
 
-__all__ = ["coarse_solver", "deflation_starts", "screen_seeds", "seed_states",
+__all__ = ["FallbackStart", "coarse_solver", "deflation_starts", "screen_seeds", "seed_states",
            "state_from_legs", "step_length", "walked_start"]
+
+@dataclasses.dataclass
+class FallbackStart:
+    """A start of the root finder tried when the initial guess fails (or without one),
+    before the scale-free seeds (:func:`walkerlab.analysis.gait.search.find_gaits`).
+
+    Attributes
+    ----------
+    label : str
+        What is tried, for the notice and the failure message (``"the planar twin's gait
+        carried in walker.hip_width_m"``).
+    source : str
+        The gait's :attr:`~walkerlab.analysis.gait.search.Gait.source` when it converges
+        (``"planar_twin"``, ``"stored_gait"``).
+    find : callable ``() -> (x, note) or None``
+        The start (a state (2n,) [rad, rad/s]) and how it was found (a note for the
+        search), or None; called only when the start is tried (it may run a continuation).
+    unique : bool
+        The start is the walker's only gait's (a closed form): no partner to look for.
+    """
+
+    label: str
+    source: str
+    find: object
+    unique: bool = False
+
 
 #: seed grid: step angle / gamma^(1/3), stance rate / (alpha sqrt(g/l)), swing / stance rate
 SEED_STEP = (0.5, 0.7, 0.9, 1.1, 1.3)

@@ -273,6 +273,11 @@ class HybridWalker:
         What the Poincaré section's state is, in words for the outputs that print it
         (``fixedpoint``): "state just after heel strike"; flat feet with a double support:
         after the heel strike's impulse, before the trailing toe is pinned.
+    closed_form_gait : callable or None
+        ``() -> ndarray (2n,) or None``: the walker's period-1 gait in closed form, where
+        one is known (the planar rimless wheel's, McGeer 1990), None when it has none at
+        these numbers (it cannot roll over its stance foot); the attribute None: no closed
+        form.
     """
 
     name: str
@@ -302,6 +307,7 @@ class HybridWalker:
     neutral: tuple[str, ...] = ()
     hip_x: Callable[[np.ndarray], float] | None = None
     section_words: str = "state just after heel strike"
+    closed_form_gait: Callable[[], np.ndarray | None] | None = None
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)

@@ -18,6 +18,11 @@ spokes' absolute angles on every step.
 
 from __future__ import annotations
 
+import math
+from functools import partial
+
+import numpy as np
+
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
@@ -64,4 +69,46 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
         heel_strike_guard=f["guard_heel_strike"], leg_angles=f["leg_angles"],
         matrices=f["matrices"],
         neutral=("heading_angle",) if structure.spatial else (),
+        closed_form_gait=None if structure.spatial else partial(rolling_gait, params),
     )
+
+
+def rolling_gait(params: dict) -> np.ndarray | None:
+    """The planar spoked wheel's steady rolling gait in closed form: its state just after
+    heel strike ``[stance_angle, stance_rate]`` [rad, rad/s], or None when the wheel
+    cannot roll over its stance foot at this slope.
+
+    Between heel strikes the wheel turns about the stance foot from ``q = alpha - gamma``
+    to ``q = -alpha - gamma``, gaining ``2 M g L sin(alpha) sin(gamma)`` of kinetic energy;
+    the heel strike keeps the angular momentum about the new foot, ``w+ = eta w-`` with
+    ``eta = (M L^2 cos(2 alpha) + I) / (M L^2 + I)``.  The fixed point
+    (McGeer 1990, "Passive dynamic walking", IJRR 9(2), Sec. 2; Coleman, Chatterjee & Ruina
+    1997, Eq. for the steady rolling rate; a point mass, ``I = 0``:
+    ``w+ = cot(2 alpha) sqrt(4 g/L sin(alpha) sin(gamma))``):
+
+    ``w+ = eta sqrt(4 M g L sin(alpha) sin(gamma) / ((M L^2 + I) (1 - eta^2)))``,
+
+    downhill (``stance_rate = -w+``).  It rolls on when its energy at ``w+`` lifts the hub
+    over the stance foot: ``(M L^2 + I) w+^2 / 2 > M g L (1 - cos(alpha - gamma))``.
+
+    Parameters
+    ----------
+    params : dict
+        The wheel's ``M_hub`` [kg], ``I_hub`` [kg m^2], ``L`` [m], ``g`` [m/s^2],
+        ``alpha`` (half the angle between spokes) and ``gamma`` (slope) [rad].
+
+    Returns
+    -------
+    ndarray (2,) or None
+    """
+    m, inertia, length = float(params["M_hub"]), float(params["I_hub"]), float(params["L"])
+    g, alpha, gamma = float(params["g"]), float(params["alpha"]), float(params["gamma"])
+    about = m * length ** 2 + inertia
+    eta = (m * length ** 2 * math.cos(2 * alpha) + inertia) / about
+    gain = 4 * m * g * length * math.sin(alpha) * math.sin(gamma)
+    if not (gain > 0 and 0 < eta < 1):
+        return None
+    rate = eta * math.sqrt(gain / (about * (1 - eta ** 2)))
+    if not about * rate ** 2 / 2 > m * g * length * (1 - math.cos(alpha - gamma)):
+        return None
+    return np.array([alpha - gamma, -rate])
