@@ -197,13 +197,13 @@ def test_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
     import time as _time
 
     from walkerlab import progress
-    from walkerlab.analysis.gait import poincare
+    from walkerlab.analysis.gait import budget, poincare
     from walkerlab.analysis.gait import search as gait_search
     from walkerlab.integrate.solver import Solver
     from walkerlab.published import paper
 
-    monkeypatch.setattr(poincare, "ROOT_BUDGET_S", 0.6, raising=False)
-    monkeypatch.setattr(poincare, "SLOW_MAP_S", 0.2, raising=False)
+    monkeypatch.setattr(budget, "ROOT_BUDGET_S", 0.6, raising=False)
+    monkeypatch.setattr(budget, "SLOW_MAP_S", 0.2, raising=False)
     steps, notes = [], []
     real = poincare.integrate_step
 
@@ -233,11 +233,11 @@ def test_a_step_map_under_way_is_stopped_at_the_search_budget(paper_walker, monk
     ``solve_on`` wraps them) and the search ends inside the map, in one line saying where
     the map was and why it crawls - for a walker with no spring, not a spring."""
     from walkerlab import progress
-    from walkerlab.analysis.gait import poincare
+    from walkerlab.analysis.gait import budget, poincare
     from walkerlab.integrate.solver import Solver
     from walkerlab.integrate.time_limit import limited
 
-    monkeypatch.setattr(poincare, "ROOT_BUDGET_S", 0.3, raising=False)
+    monkeypatch.setattr(budget, "ROOT_BUDGET_S", 0.3, raising=False)
     notes = []
     monkeypatch.setattr(progress, "note", notes.append)
 
@@ -259,7 +259,7 @@ def test_a_step_map_under_way_is_stopped_at_the_search_budget(paper_walker, monk
 def test_the_slow_map_reason_names_what_the_walker_has():
     """The notice of a slow map names the walker's spring (a torque law with a stiffness),
     its virtual-constraint controller, or neither."""
-    from walkerlab.analysis.gait.poincare import slow_step_reason
+    from walkerlab.analysis.gait.budget import slow_step_reason
     from walkerlab.models.registry import build_walker
 
     root = Path(__file__).resolve().parents[1] / "configs"
@@ -276,20 +276,20 @@ def test_search_budgets_nest_and_end_with_their_search():
     maps to the search's count; after the search no map is bounded (per thread)."""
     import threading
 
-    from walkerlab.analysis.gait import poincare as P
+    from walkerlab.analysis.gait import budget as B
 
-    with P.search_budget(1000.0):
-        outer = P._BUDGET.deadline
-        with P.search_budget(2000.0):
-            assert P._BUDGET.deadline == outer
-            P._map_started()
-        with P.search_budget(0.0):
-            with pytest.raises(P.SearchGaveUp, match="gave up after 1 step map"):
-                P._map_started()
-        assert P._BUDGET.deadline == outer
+    with B.search_budget(1000.0):
+        outer = B.deadline()
+        with B.search_budget(2000.0):
+            assert B.deadline() == outer
+            B.map_started()
+        with B.search_budget(0.0):
+            with pytest.raises(B.SearchGaveUp, match="gave up after 1 step map"):
+                B.map_started()
+        assert B.deadline() == outer
         seen = []
-        t = threading.Thread(target=lambda: seen.append(P._BUDGET.deadline))
+        t = threading.Thread(target=lambda: seen.append(B.deadline()))
         t.start()
         t.join()
         assert seen == [float("inf")]  # another thread's search has its own budget
-    assert P._BUDGET.deadline == float("inf")
+    assert B.deadline() == float("inf")

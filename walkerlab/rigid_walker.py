@@ -23,7 +23,7 @@ __all__ = ["STEP_TIME_LIMIT_S", "Gait", "SceneWalker", "positive", "scene_of", "
 
 #: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
 #: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
-#: search's budget (:data:`walkerlab.analysis.gait.poincare.ROOT_BUDGET_S`)
+#: search's budget (:data:`walkerlab.analysis.gait.budget.ROOT_BUDGET_S`)
 STEP_TIME_LIMIT_S = 60.0
 
 

@@ -4,6 +4,7 @@ map's failures said in the walker's terms."""
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from walkerlab.rigid_walker import STEP_TIME_LIMIT_S, positive, short
@@ -11,8 +12,8 @@ from walkerlab.rigid_walker import STEP_TIME_LIMIT_S, positive, short
 if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "check_target", "clear_step_failure", "positive", "short",
-           "simulate_options"]
+__all__ = ["STEP_TIME_LIMIT_S", "bounded_steps", "check_target", "clear_step_failure",
+           "positive", "short", "simulate_options"]
 
 def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
     """``(strides, sample_rate_hz)`` checked by the ``simulate`` section's own fields
@@ -127,3 +128,33 @@ def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
                          "solved over a real-valued field")
     scene_value(scene, vary)  # unset or not a number: one line
     return name, float(value)
+
+
+@contextmanager
+def bounded_steps(step_time_limit_s: float, max_step_time: float):
+    """Each walking step inside bounded to ``step_time_limit_s`` of CPU time [s]; a failed
+    step said in one line (how and when it ended, what to do: :func:`clear_step_failure`).
+
+    Raises
+    ------
+    walkerlab.analysis.gait.poincare.StepFailed
+        A step used up its CPU time (``time_limit``), or ended otherwise than at a heel
+        strike (its one line).
+    """
+    from walkerlab.analysis.gait.poincare import StepFailed  # light
+    from walkerlab.integrate.time_limit import (  # light
+        IntegrationTimeLimit,
+        integration_time_limit,
+    )
+
+    try:
+        with integration_time_limit(step_time_limit_s):
+            yield
+    except IntegrationTimeLimit:
+        out = StepFailed("time_limit", float("nan"), None)
+        out.args = (f"step: a walking step used up its {step_time_limit_s:g} s of "
+                    "CPU time (Walker(..., step_time_limit_s=...)): a state far from any "
+                    "gait, or a very stiff spring, makes the integrator crawl",)
+        raise out from None
+    except StepFailed as exc:
+        raise clear_step_failure(exc, max_step_time) from None

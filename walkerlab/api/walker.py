@@ -37,14 +37,13 @@ in a ``units: nondimensional`` scene every quantity is in the walker's own units
 from __future__ import annotations
 
 import dataclasses
-from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from walkerlab.api.checks import (
     STEP_TIME_LIMIT_S,
+    bounded_steps,
     check_target,
-    clear_step_failure,
     short,
     simulate_options,
 )
@@ -146,28 +145,9 @@ class Walker(SceneWalker):
         from walkerlab.analysis.gait.poincare import poincare_map  # light
 
         x = self.check_state(x)
-        with self._bounded():
+        with bounded_steps(self.step_time_limit_s, self.max_step_time):
             return poincare_map(self.model, x, self.solver, self.max_step_time,
                                 jacobian=jacobian, steps=steps)
-
-    @contextmanager
-    def _bounded(self):
-        """Each walking step inside bounded to ``step_time_limit_s`` of CPU time; a failed
-        step said in one line (how and when it ended, what to do)."""
-        from walkerlab.analysis.gait.poincare import StepFailed  # light
-        from walkerlab.integrate.time_limit import IntegrationTimeLimit, integration_time_limit
-
-        try:
-            with integration_time_limit(self.step_time_limit_s):
-                yield
-        except IntegrationTimeLimit:
-            out = StepFailed("time_limit", float("nan"), None)
-            out.args = (f"step: a walking step used up its {self.step_time_limit_s:g} s of "
-                        "CPU time (Walker(..., step_time_limit_s=...)): a state far from any "
-                        "gait, or a very stiff spring, makes the integrator crawl",)
-            raise out from None
-        except StepFailed as exc:
-            raise clear_step_failure(exc, self.max_step_time) from None
 
     def step(self, x) -> Step:
         """One Poincaré map step ``x -> P(x)`` (paper Eq. 10; a stride when legs differ).
@@ -337,7 +317,7 @@ class Walker(SceneWalker):
         try:
             if scene.simulate is not None and scene.simulate.terrain_seed is not None:
                 walker = rough_ground_walker(scene, 2 * strides)
-            with self._bounded():
+            with bounded_steps(self.step_time_limit_s, self.max_step_time):
                 traj = walk_scene(scene, walker, x0, 2 * strides, self.solver,
                                   self.walk_step_time)
         except SceneError:

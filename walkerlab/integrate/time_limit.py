@@ -10,7 +10,7 @@ right-hand-side evaluation of the ``scipy`` and ``cyrk`` backends (every 64th, a
 phase start of the ``cyrk_compiled`` backend, whose flow calls no Python) checks this
 thread's CPU time, and past the limit raises :class:`IntegrationTimeLimit` out of the
 integration.  Inside :func:`integration_deadline` (a gait search's CPU-time budget,
-:func:`walkerlab.analysis.gait.poincare.search_budget`) the same checks raise
+:func:`walkerlab.analysis.gait.budget.search_budget`) the same checks raise
 :class:`IntegrationDeadline` once the thread's CPU clock passes an absolute deadline, so that
 one walking step cannot outlast the budget of the search it belongs to.  Outside such blocks
 nothing is checked and nothing is wrapped; inside them the right-hand side returns the same

@@ -293,7 +293,7 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
     swing foot's (:func:`clearance_report`).  IPOPT's last
     iterate whose coefficients make no controller (a failed design) is recorded as it is,
     with the reason in ``note``."""
-    from walkerlab.analysis.gait.poincare import search_budget  # light
+    from walkerlab.analysis.gait.budget import search_budget  # light
     from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
     from walkerlab.integrate.solver import Solver

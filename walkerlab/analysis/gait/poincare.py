@@ -11,16 +11,14 @@ multiplier is zero by construction because ``P`` lands on the guard surface.
 from __future__ import annotations
 
 import math
-import re
-import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
 from walkerlab import numerics
+from walkerlab.analysis.gait import budget
+from walkerlab.analysis.gait.budget import SearchGaveUp, search_budget
 from walkerlab.analysis.gait.metrics import step_length
 from walkerlab.analysis.gait.zero_dynamics import gaits_on_zero_dynamics, no_orbit_reason
 from walkerlab.freshstack import import_on_fresh_stack
@@ -31,18 +29,6 @@ from walkerlab.integrate.time_limit import IntegrationDeadline, integration_dead
 from walkerlab.models.hybrid.base import HybridWalker, OffSection
 from walkerlab.numerics import sort_multipliers
 
-#: longest CPU time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
-#: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes
-#: need a small part of it; a spring or damper at its cap (1e6), or a virtual-constraint
-#: controller started far from its designed step, makes the integrator crawl (stiff), and the
-#: search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it busy, silent, for
-#: many minutes before it says "no gait found"
-ROOT_BUDGET_S = 60.0
-#: the budget's clock: this thread's CPU time, so that a loaded machine (other processes on
-#: the same cores) does not make a search give up that would finish on a quiet one
-_clock = time.thread_time
-#: a step map slower than this [s] is said in one notice (the search is not silent)
-SLOW_MAP_S = 5.0
 #: a fixed point whose residual max ``|P(x) - x|`` is below this (or the root finder's ``xtol``,
 #: if larger) is converged, whatever MINPACK's status says (its "not making good progress"
 #: comes once the residual is at the integrator's round-off)
@@ -52,105 +38,6 @@ RESIDUAL_TOL = 1e-10
 #: :func:`multiplier_check_tolerance`): a larger gap means one Jacobian is wrong, and the
 #: stability verdict with it
 MULTIPLIER_AGREEMENT = 1e-5
-
-
-class _Budget(threading.local):
-    """The CPU-time budget of the search under way in this thread (:func:`search_budget`;
-    per thread: the report runs the work-precision study in a thread of its own)."""
-
-    deadline = math.inf  # _clock() after which no step map starts
-    maps = 0  # step maps started under the budget
-    slowest = 0.0  # slowest of them [s]
-    started = 0.0
-
-
-_BUDGET = _Budget()
-
-
-class SearchGaveUp(Exception):
-    """A search for a gait spent its CPU-time budget (:func:`search_budget`); raised
-    before a step map would start, or from the step map under way (its integration checks
-    the clock).  The message says after how many maps, how slow, and why a map of this
-    walker can crawl (:func:`slow_step_reason`)."""
-
-
-@contextmanager
-def search_budget(seconds: float | None = None, fresh: bool = False) -> Iterator[None]:
-    """Bound every step map started inside to ``seconds`` of this thread's CPU time from now
-    (default :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline, unless
-    ``fresh``: a start tried after the search's own ones failed, with a budget of its own
-    and the outer deadline back after it): past it,
-    :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map, and stops
-    the map under way (:func:`walkerlab.integrate.time_limit.integration_deadline`: its
-    right-hand side looks at the clock every 64 evaluations; the compiled CyRK flow at each
-    phase's start), so that a search ends within its budget and a few evaluations.  A map
-    slower than :data:`SLOW_MAP_S` is said once in a notice
-    (:func:`walkerlab.progress.note`)."""
-    outer = _BUDGET.deadline
-    now = _clock()
-    if not math.isfinite(outer) or fresh:  # the outermost budget counts the maps inside
-        _BUDGET.maps, _BUDGET.slowest, _BUDGET.started = 0, 0.0, now
-    own = now + (ROOT_BUDGET_S if seconds is None else seconds)
-    _BUDGET.deadline = own if fresh else min(outer, own)
-    try:
-        yield
-    finally:
-        _BUDGET.deadline = outer
-
-
-def slow_step_reason(walker: HybridWalker) -> str:
-    """Why a step map of ``walker`` can crawl, said in the gait search's notices: its
-    virtual-constraint controller, its springs or dampers (``walker.springs`` and the knee's,
-    generated parameters ``k_s<i>``, ``c_s<i>``, ``k_knee``, ``c_knee``; torque laws of
-    ``walker.actuation.torques`` with a stiffness or damping), or, for a walker with
-    neither, its rates alone."""
-    acts = getattr(walker, "actuators", None)
-    if getattr(acts, "controller", None) is not None:
-        return ("the virtual-constraint controller drives a start far from its designed "
-                "step to rates the integrator crawls through")
-    params = getattr(walker, "params", None) or {}
-    sprung = [k for k, v in params.items() if v and re.fullmatch(r"[kc]_(s\d+|knee)", k)]
-    laws = [getattr(t, "law", None) for t in
-            getattr(getattr(acts, "spec", None), "torques", None) or ()]
-    if any(getattr(law, "stiffness_n_m_per_rad", 0.0) or getattr(law, "damping_n_m_s_per_rad",
-                                                                 0.0) for law in laws):
-        sprung.append("walker.actuation.torques")
-    if sprung:
-        where = ("walker.actuation.torques" if sprung == ["walker.actuation.torques"]
-                 else "walker.springs or the knee's")
-        return (f"a very stiff or heavily damped spring ({where}) makes the integrator "
-                "crawl: soften it")
-    return "the step's rates grow so large that the integrator crawls"
-
-
-def _gave_up(walker: HybridWalker | None, where: str = "") -> SearchGaveUp:
-    """The :class:`SearchGaveUp` of a search whose budget is spent (``where``: how the map
-    under way was stopped, if one was)."""
-    where = where or f"the slowest map {_BUDGET.slowest:.1f} s"
-    return SearchGaveUp(
-        f"the search gave up after {_BUDGET.maps} step map(s), its "
-        f"{_BUDGET.deadline - _BUDGET.started:.0f} s CPU budget spent ({where}): "
-        f"{slow_step_reason(walker)}; start nearer the gait")
-
-
-def _map_started(walker: HybridWalker | None = None) -> float:
-    t = _clock()
-    if t > _BUDGET.deadline:
-        raise _gave_up(walker)
-    _BUDGET.maps += 1
-    return t
-
-
-def _map_ended(walker: HybridWalker, t: float) -> None:
-    dt = _clock() - t
-    if dt > SLOW_MAP_S and _BUDGET.slowest <= SLOW_MAP_S and math.isfinite(_BUDGET.deadline):
-        from walkerlab import progress
-
-        progress.note(f"gait search: one step map took {dt:.0f} s ({slow_step_reason(walker)});"
-                      f" the search gives up once it has spent "
-                      f"{_BUDGET.deadline - _BUDGET.started:.0f} s of CPU time (a step under "
-                      "way included: on a busy machine the wall time is longer)")
-    _BUDGET.slowest = max(_BUDGET.slowest, dt)
 
 
 class StepFailed(RuntimeError):
@@ -236,21 +123,21 @@ def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
         Inside a :func:`search_budget` whose time is spent: no map is started, and a map
         under way is stopped (its integration checks the clock).
     """
-    t = _map_started(walker)
+    t = budget.map_started(walker)
     try:  # a step under way is stopped at the budget's end too (nothing checked outside one)
-        with integration_deadline(_BUDGET.deadline):
+        with integration_deadline(budget.deadline()):
             out = _step_map(walker, x, solver, max_step_time, jacobian, steps)
     except IntegrationDeadline as exc:
-        where = f"the last one stopped after {_clock() - t:.1f} s"
+        where = f"the last one stopped after {budget.clock() - t:.1f} s"
         if exc.x is not None:
             n = np.size(x) // 2
             where += (f" at t = {exc.t:.3g} s, rates "
                       f"{float(np.max(np.abs(np.asarray(exc.x)[n:2 * n]))):.2g} rad/s")
-        raise _gave_up(walker, where) from None
+        raise budget.gave_up(walker, where) from None
     except BaseException:
-        _map_ended(walker, t)
+        budget.map_ended(walker, t)
         raise
-    _map_ended(walker, t)
+    budget.map_ended(walker, t)
     return out
 
 
@@ -410,7 +297,8 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         from a start near a known gait it converges to another one.  Not with
         ``jacobian_guess``.
     budget_s : float, optional
-        Longest CPU time of the search in this thread [s] (default :data:`ROOT_BUDGET_S`;
+        Longest CPU time of the search in this thread [s] (default
+        :data:`~walkerlab.analysis.gait.budget.ROOT_BUDGET_S`;
         an enclosing :func:`search_budget` keeps its earlier deadline), checked before each
         step map and inside it: once spent, the search gives up and says why.
 

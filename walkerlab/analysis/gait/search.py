@@ -41,13 +41,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from walkerlab import progress
+from walkerlab.analysis.gait.budget import SearchGaveUp, search_budget
+from walkerlab.analysis.gait.failure_text import failure_message, solver_words
 from walkerlab.analysis.gait.poincare import (
     FixedPointGaveUp,
     FixedPointNotFound,
     FixedPointResult,
-    SearchGaveUp,
     find_fixed_point,
-    search_budget,
 )
 from walkerlab.analysis.gait.starts import (
     WALK_STEPS,
@@ -246,7 +246,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     GaitNotFound
         No gait from the guess nor from the seeds, or the policy's gait was not found; the
         one-line message says what was tried and what to try next.  The whole search has
-        one time budget (:func:`~walkerlab.analysis.gait.poincare.search_budget`): spent,
+        one time budget (:func:`~walkerlab.analysis.gait.budget.search_budget`): spent,
         it gives up and says after how many step maps and how slow they were.
     ValueError
         Unknown ``policy``, or ``nearest_guess`` without a guess.
@@ -277,7 +277,7 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
         if g is not None:
             s.found.append(g)
         else:
-            s.notes.append(f"the initial guess did not converge ({_short(s.last_msg)})")
+            s.notes.append(f"the initial guess did not converge ({solver_words(s.last_msg)})")
     fell_back = None if s.found else s.from_fallbacks(fallbacks)
     if fell_back is not None:  # the seeds cannot better it; a unique gait has no partner
         seeds = False
@@ -293,12 +293,12 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
                 raise GaitNotFound(
                     "no period-1 gait found: walker.actuation.virtual_constraints: no gait "
                     "at its zero dynamics' orbit, where with invariant: true every gait lies"
-                    f" ({_short(s.last_msg)}); change the outputs' Bezier coefficients",
+                    f" ({solver_words(s.last_msg)}); change the outputs' Bezier coefficients",
                     s.best)
         else:
             s.from_seeds()
     if not s.found:
-        raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
+        raise GaitNotFound(failure_message(walker, s.tried, s.best, s.last_msg, guess is not None),
                            s.best)
     first = s.found[0]
     off_ground = False  # the first gait needs a pull or more friction than the ground has
@@ -558,52 +558,3 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
                         + ("the one nearest the initial guess" if guess is not None
                            else "the least unstable one"))
     return nearest(pool)
-
-
-def _short(msg: str) -> str:
-    """scipy's message, one line, without the prefix and the residual (given apart)."""
-    import re
-
-    text = " ".join(str(msg).removeprefix("no fixed point found: ").split())
-    return re.sub(r" \(residual [^)]*\)$", "", text)
-
-
-def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
-             had_guess: bool) -> str:
-    res = f", best residual {best:.2g}" if math.isfinite(best) else ""
-    last = _short(last)
-    if last and "standing" not in last:
-        last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
-    drop = walker.params.get("landing_drop_m", 0.0)
-    downhill = walker.slope_rad > 0 or drop > 0
-    if drop < 0 and walker.slope_rad <= 0 and walker.actuators is None:
-        # every step lands higher: gravity cannot pay the climb (nor the heel strikes' loss)
-        why = ("a passive walker cannot climb stairs or step up (each step up takes energy "
-               "only actuators give: walker.actuation; passive, walk stairs down)")
-    elif not downhill and walker.actuators is None:
-        why = ("a passive walker needs a downhill slope (slope > 0), stairs down or "
-               "walker.actuation")
-    elif walker.actuators is not None and had_guess:
-        why = ("the initial guess did not converge and the seeds are a passive walker's: "
-               "the walker may have no period-1 gait here")
-    elif walker.actuators is not None:
-        why = "the seeds are a passive walker's, and a powered gait may lie far from them"
-    else:
-        why = "the walker may have no period-1 gait here"
-    if "standing" in last:  # walkerlab's own diagnosis, not a solver's detail: in the text
-        why, last = f"{why}; {last}", ""
-    # the advice first, the solver's detail last: a one-line display that must shorten the
-    # message cuts the detail, never the advice; with a guess given, the advice is not to
-    # give one
-    nearer = ("start from a gait known nearby (walkerlab fixedpoint --from KNOWN_SCENE, or "
-              "its gait as fixedpoint.initial_guess)" if had_guess
-              else "give fixedpoint.initial_guess (a gait at a nearby push-off or slope, or "
-              "walkerlab fixedpoint --from KNOWN_SCENE)"
-              if walker.actuators is not None else "give fixedpoint.initial_guess (or start "
-              "from a gait known nearby: walkerlab fixedpoint --from KNOWN_SCENE)")
-    return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
-            "from a walker whose gait is known (walkerlab continuation SCENE --param "
-            f"FIELD=KNOWN:THIS, e.g. slope.angle_deg), or {nearer}"
-            + f" [tried {' and '.join(tried)}{res}"
-            + (f"; last: {last}]" if last else "]" if "standing" in why
-               else "; last: every start fell]"))
