@@ -121,6 +121,16 @@ class CompassGaitParams(_Actuated):
         if self.space == "2d" and self.hip_width_m:
             raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                              "walker's hips are one point)")
+        if not self.hip_width_m < 2 * self.leg_length_m:
+            # leaning its centre of mass over the stance foot, tan(lean) ~ w / (2 L) (the
+            # pelvis midway between the hips), lifts the swing foot w tan(lean) = w^2 / (2 L)
+            # off the slope, and legs of length L reach down at most 2 L (the heel-strike
+            # surface, walkerlab.codegen.spatial.derive_compass): w < 2 L
+            raise ValueError(f"walker.hip_width_m: {self.hip_width_m:g} m on legs of "
+                             f"{self.leg_length_m:g} m: hips twice the leg length apart or "
+                             "more cannot stand on one leg and reach the slope with the "
+                             "other (w^2 / (2 L) > 2 L); give hip_width_m below "
+                             f"{2 * self.leg_length_m:g} m (2 leg_length_m)")
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
             raise ValueError("walker.hip_roll: hip-roll joints are a 3D straight-legged "
                              "walker's with hip width (walker.space: 3d, hip_width_m > 0)")
