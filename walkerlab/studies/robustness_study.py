@@ -49,7 +49,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
 
-    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.description import walker_data  # light
 
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
     walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require_stage("robustness")

@@ -18,6 +18,8 @@ spokes' absolute angles on every step.
 
 from __future__ import annotations
 
+import math
+
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
@@ -65,3 +67,53 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
         matrices=f["matrices"],
         neutral=("heading_angle",) if structure.spatial else (),
     )
+
+
+def steady_roll(data: WalkerData) -> tuple[float, float] | None:
+    """The steady roll's post-impact rate and the rate needed to vault the hub over the
+    stance spoke, in closed form (McGeer 1990, "Passive dynamic walking", IJRR 9(2);
+    Coleman, Chatterjee & Ruina 1997): with ``J = I_hub + M L^2`` and the impact's ratio
+    ``eta = (I_hub + M L^2 cos 2 alpha) / J`` (angular momentum about the new foot),
+    ``w+^2 = eta^2 (4 M g L / J) sin(alpha) sin(gamma) / (1 - eta^2)``; the hub, ``alpha -
+    gamma`` behind the vertical through the new foot after the impact, goes over it if
+    ``J w+^2 / 2 > M g L (1 - cos(alpha - gamma))``.  The 3D wheel's upright roll is the
+    same motion (its rates about the axle).
+
+    Parameters
+    ----------
+    data : WalkerData
+        Of a spoked wheel (planar or 3D).
+
+    Returns
+    -------
+    (w_plus, w_vault) : float, float
+        [rad/s]; ``w_vault`` 0 on a slope at least the spokes' half angle.  None: not a
+        spoked wheel, or fewer than 5 spokes (``eta <= 0``: the closed form does not hold).
+    """
+    st = data.structure
+    if not st.spokes:
+        return None
+    p = dict(zip(st.param_names, data.params))
+    g, L, gamma, M, I, alpha = (p[k] for k in ("g", "L", "gamma", "M_hub", "I_hub", "alpha"))
+    J = I + M * L * L
+    eta = (I + M * L * L * math.cos(2 * alpha)) / J
+    if eta <= 0 or gamma <= 0:
+        return None
+    w_plus = math.sqrt(eta * eta * 4 * M * g * L / J * math.sin(alpha) * math.sin(gamma)
+                       / (1 - eta * eta))
+    barrier = M * g * L * (1 - math.cos(alpha - gamma)) if alpha > gamma else 0.0
+    return w_plus, math.sqrt(2 * barrier / J)
+
+
+def cannot_roll(data: WalkerData, field: str = "walker.spokes") -> str | None:
+    """Why the spoked wheel has no steady roll on its slope (:func:`steady_roll`: its
+    post-impact rate cannot vault the hub over the stance spoke), one line naming
+    ``field``; None when it can or the closed form does not apply."""
+    r = steady_roll(data)
+    if r is None or r[0] > r[1]:
+        return None
+    p = dict(zip(data.structure.param_names, data.params))
+    return (f"{field}: {data.structure.spokes} spokes on a {p['gamma']:g} rad slope cannot "
+            f"roll steadily: the post-impact rate {r[0]:.4g} rad/s is below the {r[1]:.4g} "
+            "rad/s that vaults the hub over a spoke (McGeer 1990); give more spokes or a "
+            "steeper slope")
