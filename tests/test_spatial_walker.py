@@ -293,3 +293,16 @@ def test_a_3d_derivation_draws_from_a_seeded_generator_and_restores_its_state():
     derive("b")
     assert draws[0][1:] == draws[1][1:]
     assert srand.rng.getstate() == after != before
+
+
+@pytest.mark.parametrize("width", [2.0, 100.0])
+def test_a_hip_width_of_twice_the_leg_or_more_is_refused_naming_the_field(width):
+    """Leaning its centre of mass over the stance foot (tan(lean) ~ w / 2L) lifts the swing
+    foot w^2 / 2L, and legs of length L reach down 2 L at most: hips 2 L apart or more
+    cannot walk.  ``hip_width_m: 100`` on a 1 m leg took 57 s to a 'math domain error';
+    now the scene refuses it in one line naming the field; 1.9 m is accepted."""
+    from walkerlab.config import SceneError
+
+    with pytest.raises((SceneError, ValueError), match=r"walker\.hip_width_m: .* below 2 m"):
+        _scene("hip_width.yaml", hip_width_m=width)
+    assert _scene("hip_width.yaml", hip_width_m=1.9).walker.hip_width_m == 1.9
