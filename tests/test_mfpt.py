@@ -466,6 +466,7 @@ def hip_roll_walk():
 
 
 @pytest.mark.slow  # ~2 min on a cold numba cache (the hip-roll walker's batched flow)
+@pytest.mark.xdist_group("hip_roll_walk")  # one worker compiles the map for both tests
 def test_a_3d_monte_carlo_walk_matches_simulate_on_the_same_slopes(hip_roll_walk):
     """A 3D walker with hip width steps on alternate sides: the mirror step's walker has
     ``w_hip -> -w_hip``.  The per-step map walks it in reflected coordinates (``y_k = S^k
@@ -494,6 +495,7 @@ def test_a_3d_monte_carlo_walk_matches_simulate_on_the_same_slopes(hip_roll_walk
 
 
 @pytest.mark.slow  # shares the compiled map of the test above
+@pytest.mark.xdist_group("hip_roll_walk")
 def test_a_stable_3d_walker_does_not_fall_at_a_vanishing_sigma(hip_roll_walk):
     """configs/hip_width_stabilised.yaml (largest multiplier 0.546) on slopes of sigma
     1e-9 rad: every Monte Carlo walk reaches the step cap (the issue's run: '10 of 10 walks
