@@ -116,12 +116,16 @@ class Kind:
     field : str
         The scene field a refusal of the walker itself names first (``walker``; the 3D
         kinds': ``walker.space: 3d``).
+    spoked : bool
+        A spoked wheel (rolling on its spokes; its steady roll has a closed form:
+        :func:`walkerlab.models.hybrid.rolling_polygon.steady_roll`).
     """
 
     name: str
     title: str
     reference: str
     field: str = "walker"
+    spoked: bool = False
 
     def cell(self, feature: str, view: str) -> str | None:
         """None when the kind supports ``feature`` in ``view``, else the one-line reason
@@ -203,9 +207,9 @@ KINDS = {k.name: k for k in (
          "Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau, Choi & Morris "
          "2007"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
-         "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
+         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", spoked=True),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
-         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d"),
+         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", spoked=True),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d"),
 )}

@@ -91,7 +91,7 @@ def steady_roll(data: WalkerData) -> tuple[float, float] | None:
         spoked wheel, or fewer than 5 spokes (``eta <= 0``: the closed form does not hold).
     """
     st = data.structure
-    if not st.spokes:
+    if not st.kind.spoked:
         return None
     p = dict(zip(st.param_names, data.params))
     g, L, gamma, M, I, alpha = (p[k] for k in ("g", "L", "gamma", "M_hub", "I_hub", "alpha"))
@@ -113,7 +113,7 @@ def cannot_roll(data: WalkerData, field: str = "walker.spokes") -> str | None:
     if r is None or r[0] > r[1]:
         return None
     p = dict(zip(data.structure.param_names, data.params))
-    return (f"{field}: {data.structure.spokes} spokes on a {p['gamma']:g} rad slope cannot "
+    return (f"{field}: {round(math.pi / p['alpha'])} spokes on a {p['gamma']:g} rad slope cannot "
             f"roll steadily: the post-impact rate {r[0]:.4g} rad/s is below the {r[1]:.4g} "
             "rad/s that vaults the hub over a spoke (McGeer 1990); give more spokes or a "
             "steeper slope")
