@@ -519,3 +519,19 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
     for i, n in enumerate(names):
         assert s[i] == (-x[i] if ("lean" in n or "roll" in n) else x[i])
     assert build_walker(load_scene(ROOT / "configs" / "paper_3d.yaml")).mirror is None
+
+
+def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):
+    """``mfpt.model: contact`` walks the compliant-contact walker, which a 3D walker does not
+    have (the table's contact cell): refused in one line naming both fields before the gait
+    is searched, nothing written."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageError
+
+    raw = yaml.safe_load((ROOT / "configs" / "paper_3d.yaml").read_text())
+    raw["mfpt"] = {"model": "contact", "method": "montecarlo"}
+
+    with pytest.raises(StageError, match=r"^mfpt\.model: contact: walker\.space: 3d: "):
+        pipeline.run("mfpt", scene_from_dict(raw), tmp_path)
+    assert not any(tmp_path.iterdir())
