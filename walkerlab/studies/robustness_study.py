@@ -48,7 +48,6 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     from walkerlab.io.schemas.robustness import RobustnessData
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
-
     from walkerlab.walker.description import walker_data  # light
 
     # the kind's refusal (a 3D walker: walker.space) before the walker is built

@@ -94,9 +94,10 @@ def steady_roll(data: WalkerData) -> tuple[float, float] | None:
     if not st.kind.spoked:
         return None
     p = dict(zip(st.param_names, data.params))
-    g, L, gamma, M, I, alpha = (p[k] for k in ("g", "L", "gamma", "M_hub", "I_hub", "alpha"))
-    J = I + M * L * L
-    eta = (I + M * L * L * math.cos(2 * alpha)) / J
+    g, L, gamma, M, i_hub, alpha = (p[k] for k in ("g", "L", "gamma", "M_hub", "I_hub",
+                                                   "alpha"))
+    J = i_hub + M * L * L
+    eta = (i_hub + M * L * L * math.cos(2 * alpha)) / J
     if eta <= 0 or gamma <= 0:
         return None
     w_plus = math.sqrt(eta * eta * 4 * M * g * L / J * math.sin(alpha) * math.sin(gamma)
