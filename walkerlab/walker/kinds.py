@@ -518,17 +518,17 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`Kind.require_stage`; ``compare`` reads the contact walk)
 STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
-               "stability-map": ("walk", "contact"), "optimize": ("walk", "optimize")}
+               "stability-map": ("walk", "contact")}
 #: why the robustness study refuses a 3D walker (:mod:`walkerlab.studies.robustness_study`)
 SPATIAL_ROBUSTNESS = ("the robustness study (gait sensitivity norms, largest step-down/up "
                       "and push) is of planar walkers so far: its disturbances and state "
                       "norms are sagittal; a 3D walker's metastability is walkerlab mfpt's")
-#: kind -> {stage: reason}: the rigid model's studies (stages of
-#: :mod:`walkerlab.stages.pipeline`) a kind does not take; a stage not listed takes it
+#: kind -> {stage: reason}: the studies (stages of :mod:`walkerlab.stages.pipeline`) a kind
+#: does not take at all; a stage not listed takes it (``optimize`` of a kind whose ``walk``
+#: it refuses may still design virtual constraints, so only the 3D kinds' is here)
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    "straight_legs_3d": {"robustness": SPATIAL_ROBUSTNESS},
-    "rolling_polygon_3d": {"robustness": SPATIAL_ROBUSTNESS},
-}
+    k: {"robustness": SPATIAL_ROBUSTNESS, "optimize": CAPABILITIES[k][("walk", "optimize")]}
+    for k in ("straight_legs_3d", "rolling_polygon_3d")}
 
 #: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
