@@ -377,3 +377,41 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     assert KNEE_LATCH_OSIM in " ".join(ext.rst().split())
     page = " ".join((ROOT / "docs" / "reference" / "capabilities.rst").read_text().split())
     assert "knee latch" in page
+
+
+@pytest.mark.parametrize("name", ["paper_3d", "hip_width", "rimless_wheel_3d"])
+@pytest.mark.parametrize("stage", ["contact-sim", "compare", "optimize", "robustness"])
+def test_a_stage_a_3d_walker_does_not_take_is_refused_before_any_work(tmp_path, name, stage):
+    """Every pipeline stage a 3D kind does not take - its view's cell
+    (:data:`walkerlab.walker.kinds.STAGE_VIEWS`: compare reads the contact walk) or its
+    study's (:data:`~walkerlab.walker.kinds.STAGE_CELLS`) - is refused in one line naming
+    walker.space before any upstream stage runs (compare ran the fixed point first), and
+    nothing is written."""
+    from walkerlab.config import load_scene
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageError
+
+    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+    with pytest.raises(StageError, match=r"^walker\.space: 3d: "):
+        pipeline.run(stage, scene, tmp_path)
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_3d_walkers_contact_work_precision_is_refused_before_the_gait(tmp_path):
+    """``workprecision`` with its contact model on a 3D walker: refused by the stage's check
+    (the table's contact cell) in one line naming both fields, before the fixed point
+    upstream runs (it ran first, then failed); without a ``workprecision`` section the
+    same check says so at once."""
+    import yaml
+
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageError
+
+    raw = yaml.safe_load((ROOT / "configs" / "paper_3d.yaml").read_text())
+    with pytest.raises(StageError, match="has no 'workprecision' section"):
+        pipeline.run("workprecision", scene_from_dict(raw), tmp_path)
+    raw.update(workprecision={"models": ["ideal", "contact"]}, contact={})
+    with pytest.raises(StageError, match=r"^workprecision\.models: contact: walker\.space: 3d"):
+        pipeline.run("workprecision", scene_from_dict(raw), tmp_path)
+    assert not any(tmp_path.iterdir())

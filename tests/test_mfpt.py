@@ -448,3 +448,90 @@ def test_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report(
     report = "\n".join(mfpt_section({"mfpt": data}))
     assert "NOT converged" in report and "10.6 %" in report
     assert "NOT converged" not in "\n".join(mfpt_section({"mfpt": _mfpt_data(1.0)}))
+
+
+@pytest.fixture(scope="module")
+def hip_roll_walk():
+    """The stabilised 3D walker with hip width (configs/hip_width_stabilised.yaml: steps on
+    alternate sides, largest multiplier 0.546), its step map for per-step slopes and its
+    initial guess (the gait to 6 decimals: post-impact, step 0 with leg1 swinging)."""
+    from walkerlab.integrate.python_step import make_step_map
+
+    scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    walker = build_walker(scene)
+    g = scene.fixedpoint.initial_guess.model_extra
+    x0 = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                   for n in walker.state_names()])
+    return scene, walker, make_step_map(walker, scene_walker_at(scene), 1e-12, 1e-12), x0
+
+
+@pytest.mark.slow  # ~2 min on a cold numba cache (the hip-roll walker's batched flow)
+@pytest.mark.xdist_group("hip_roll_walk")  # one worker compiles the map for both tests
+def test_a_3d_monte_carlo_walk_matches_simulate_on_the_same_slopes(hip_roll_walk):
+    """A 3D walker with hip width steps on alternate sides: the mirror step's walker has
+    ``w_hip -> -w_hip``.  The per-step map walks it in reflected coordinates (``y_k = S^k
+    x_k``, :class:`~walkerlab.integrate.python_step.ReflectedStepMap`); reflected back, its
+    post-impact states equal the rigid integrator's walk of each step's own walker
+    (``walker.for_step(k)`` on that step's slope, as ``simulate`` walks it; DOP853 at
+    1e-12, both) to 1e-9 over 12 steps at sigma 0.002 rad.  The old map walked every step
+    as the first step's walker: it fell at the second step."""
+    from walkerlab.analysis.robustness.slope_stream import slope_rows
+    from walkerlab.integrate.python_step import ReflectedStepMap
+
+    scene, walker, sm, x0 = hip_roll_walk
+    assert isinstance(sm, ReflectedStepMap)
+    n = 12
+    gam = slope_rows(3, [0], 0, n, scene.slope.phi_rad, 0.002)[0]
+    at = scene_walker_at(scene)
+    y, x = x0.copy(), x0.copy()
+    for k in range(n):
+        r = sm.step(y[None], gam[k:k + 1])
+        seg = integrate_step(at(float(gam[k])).for_step(k), x, TIGHT, max_step_time=5.0)
+        assert r.outcome[0] == HEEL_STRIKE and seg.termination == "heel_strike", k
+        y, x = r.x_next[0], seg.x_next
+        x_from_y = walker.reflect(y) if k % 2 == 0 else y  # x_{k+1} = S^(k+1) y_{k+1}
+        np.testing.assert_allclose(x_from_y, x, rtol=0, atol=1e-9)
+        assert abs(r.step_time_s[0] - seg.period) < 1e-9
+
+
+@pytest.mark.slow  # shares the compiled map of the test above
+@pytest.mark.xdist_group("hip_roll_walk")
+def test_a_stable_3d_walker_does_not_fall_at_a_vanishing_sigma(hip_roll_walk):
+    """configs/hip_width_stabilised.yaml (largest multiplier 0.546) on slopes of sigma
+    1e-9 rad: every Monte Carlo walk reaches the step cap (the issue's run: '10 of 10 walks
+    fell', 2 steps each, all of them the mirrored second step)."""
+    scene, walker, sm, x0 = hip_roll_walk
+    res = M.monte_carlo(sm, x0, 1e-9, range(4), 40, 0)
+    assert not res.fell.any() and (res.steps == 40).all()
+
+
+def test_the_mirror_of_a_3d_step_is_its_reflection():
+    """The 3D walker with hip width: its mirror is the reflection across the sagittal plane
+    (lean and hip rolls negated, pitches kept); planar legs that differ have none."""
+    scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    walker = build_walker(scene)
+    names = walker.state_names()
+    assert set(walker.mirror_reflection) == {f"{r}_{k}" for r in ("lean", "pelvis_roll",
+                                                                  "swing_roll")
+                                             for k in ("angle", "rate")}
+    x = np.arange(1.0, len(names) + 1)
+    s = walker.reflect(x)
+    for i, n in enumerate(names):
+        assert s[i] == (-x[i] if ("lean" in n or "roll" in n) else x[i])
+    assert build_walker(load_scene(ROOT / "configs" / "paper_3d.yaml")).mirror is None
+
+
+def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):
+    """``mfpt.model: contact`` walks the compliant-contact walker, which a 3D walker does not
+    have (the table's contact cell): refused in one line naming both fields before the gait
+    is searched, nothing written."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageError
+
+    raw = yaml.safe_load((ROOT / "configs" / "paper_3d.yaml").read_text())
+    raw["mfpt"] = {"model": "contact", "method": "montecarlo"}
+
+    with pytest.raises(StageError, match=r"^mfpt\.model: contact: walker\.space: 3d: "):
+        pipeline.run("mfpt", scene_from_dict(raw), tmp_path)
+    assert not any(tmp_path.iterdir())

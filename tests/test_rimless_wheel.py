@@ -471,3 +471,37 @@ def test_rimless_wheel_export_stage_mjcf_rolls_in_mujoco(wheel_runs):
             strikes.append(d.time)
     assert len(strikes) == 5, strikes
     assert np.all(np.abs(np.diff(strikes) / period - 1) < 0.02), np.diff(strikes)
+
+
+@pytest.mark.parametrize("inertia", [0.0, 0.25])
+def test_the_steady_roll_in_closed_form_is_the_gaits_rate(inertia):
+    """:func:`~walkerlab.models.hybrid.rolling_polygon.steady_roll`'s post-impact rate is
+    the closed form of this module (McGeer 1990; the shipped wheel's documented 1.095463
+    rad/s at no hub inertia), and the shipped wheel vaults its spokes."""
+    from walkerlab.models.hybrid.rolling_polygon import cannot_roll, steady_roll
+    from walkerlab.walker.description import walker_data
+
+    scene = _scene(**{"walker.hub_inertia_kg_m2": inertia})
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    w_plus, w_vault = steady_roll(dict(zip(data.structure.param_names, data.params)))
+    assert w_plus == pytest.approx(_closed_form(inertia)[0], rel=1e-12)
+    assert w_plus > w_vault > 0 and cannot_roll(data) is None
+
+
+def test_a_wheel_that_cannot_vault_a_spoke_is_refused_at_once():
+    """6 spokes on a 0.12 rad slope: the steady roll's post-impact rate (0.885 rad/s) is
+    below the 1.256 rad/s that brings the hub over the stance spoke (J w^2 / 2 = M g L (1 -
+    cos(alpha - slope))), so there is no gait: the search refuses in one line naming
+    walker.spokes before building the walker (it took 3 min 46 s to 'rates nan')."""
+    import time
+
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.analysis.gait.search import GaitNotFound
+
+    scene = _scene(**{"walker.spokes": 6, "slope.angle_rad": 0.12})
+    t0 = time.perf_counter()
+    with pytest.raises(GaitNotFound, match=r"^walker\.spokes: 6 spokes on a 0\.12 rad slope "
+                                           r"cannot roll steadily: the post-impact rate "
+                                           r"0\.8848 rad/s is below the 1\.256 rad/s"):
+        solve_scene(scene)
+    assert time.perf_counter() - t0 < 1.0

@@ -161,3 +161,26 @@ def test_stability_map_prints_the_path_of_the_figure_it_drew(tmp_path, monkeypat
     assert code == 0, err
     assert f"figure: {tmp_path / 'paper' / 'report' / 'figures' / 'stability_map_friction.png'}" \
         in out
+
+
+@pytest.mark.parametrize("name", ["paper_3d", "hip_width", "rimless_wheel_3d"])
+def test_robustness_refuses_a_3d_walker_before_any_work(tmp_path, name):
+    """The robustness study is of planar walkers (its disturbances and state norms are
+    sagittal): a 3D walker is refused in one line naming walker.space, from the table
+    (:data:`walkerlab.walker.kinds.STAGE_CELLS`), before the gait is searched or the walker
+    built (paper_3d took 106 s to 'use a smaller e', hip_width 78 s to 'legs that differ');
+    the study's own entry refuses it too, and nothing is written."""
+    import time
+
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageError
+    from walkerlab.studies.robustness_study import scene_robustness
+    from walkerlab.walker.kinds import KindRefused
+
+    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+    t0 = time.perf_counter()
+    with pytest.raises(StageError, match=r"^walker\.space: 3d: the robustness study"):
+        pipeline.run("robustness", scene, tmp_path)
+    with pytest.raises(KindRefused, match=r"^walker\.space: 3d: the robustness study"):
+        scene_robustness(scene, np.zeros(6))
+    assert time.perf_counter() - t0 < 2.0 and not any(tmp_path.iterdir())

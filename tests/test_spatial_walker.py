@@ -423,3 +423,14 @@ def test_a_changed_gain_falls_back_to_the_stored_gait_and_finds_the_gait(tmp_pat
     res = search.result
     assert res.residual < 1e-10
     assert np.max(np.abs(res.x - guess)) > 0.1  # a gait of its own, not the guess's
+@pytest.mark.parametrize("width", [2.0, 100.0])
+def test_a_hip_width_of_twice_the_leg_or_more_is_refused_naming_the_field(width):
+    """Leaning its centre of mass over the stance foot (tan(lean) ~ w / 2L) lifts the swing
+    foot w^2 / 2L, and legs of length L reach down 2 L at most: hips 2 L apart or more
+    cannot walk.  ``hip_width_m: 100`` on a 1 m leg took 57 s to a 'math domain error';
+    now the scene refuses it in one line naming the field; 1.9 m is accepted."""
+    from walkerlab.config import SceneError
+
+    with pytest.raises((SceneError, ValueError), match=r"walker\.hip_width_m: .* below 2 m"):
+        _scene("hip_width.yaml", hip_width_m=width)
+    assert _scene("hip_width.yaml", hip_width_m=1.9).walker.hip_width_m == 1.9

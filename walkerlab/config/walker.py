@@ -1,6 +1,6 @@
 """The walker sections of a scene (``walker:``): the compass gait of the paper's Table 1,
 the generic biped described as data (legs, bodies, feet, knees, torso, springs) and the
-rimless wheel (spokes on a hub).
+rimless wheel (spokes on a hub: :mod:`walkerlab.config.wheel`).
 
 Every numeric field carries its unit in its name (``leg_length_m``) and a description;
 unknown keys are rejected (:class:`~walkerlab.config.base.Strict`).  The walker is expanded
@@ -15,6 +15,7 @@ from pydantic import Discriminator, Field, Tag, field_validator, model_serialize
 
 from walkerlab.config.actuation import Actuation
 from walkerlab.config.base import Strict, drop_unset
+from walkerlab.config.wheel import RimlessWheelParams
 
 
 class _Actuated(Strict):
@@ -121,6 +122,16 @@ class CompassGaitParams(_Actuated):
         if self.space == "2d" and self.hip_width_m:
             raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                              "walker's hips are one point)")
+        if not self.hip_width_m < 2 * self.leg_length_m:
+            # leaning its centre of mass over the stance foot, tan(lean) ~ w / (2 L) (the
+            # pelvis midway between the hips), lifts the swing foot w tan(lean) = w^2 / (2 L)
+            # off the slope, and legs of length L reach down at most 2 L (the heel-strike
+            # surface, walkerlab.codegen.spatial.derive_compass): w < 2 L
+            raise ValueError(f"walker.hip_width_m: {self.hip_width_m:g} m on legs of "
+                             f"{self.leg_length_m:g} m: hips twice the leg length apart or "
+                             "more cannot stand on one leg and reach the slope with the "
+                             "other (w^2 / (2 L) > 2 L); give hip_width_m below "
+                             f"{2 * self.leg_length_m:g} m (2 leg_length_m)")
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
             raise ValueError("walker.hip_roll: hip-roll joints are a 3D straight-legged "
                              "walker's with hip width (walker.space: 3d, hip_width_m > 0)")
@@ -572,53 +583,6 @@ class BipedParams(_Actuated):
     def leg_pair(self) -> tuple[LegSpec, LegSpec]:
         """``(leg1, leg2)``: the ``legs`` pair, or ``leg`` twice."""
         return (self.leg, self.leg) if self.leg is not None else tuple(self.legs)
-
-
-class RimlessWheelParams(Strict):
-    """A rimless wheel (McGeer 1990, "Passive dynamic walking", IJRR 9(2); Coleman,
-    Chatterjee & Ruina 1997, "Motions of a rimless spoked wheel", Dynamics and Stability
-    of Systems 12(3)): one rigid body, a hub of mass ``mass_kg`` (a point mass unless
-    ``hub_inertia_kg_m2`` is given) with ``spokes`` massless spokes of length
-    ``spoke_length_m``, ``2 pi / spokes`` apart.  It rolls about the stance spoke's foot;
-    the next spoke's foot striking the slope is the heel strike (plastic, angular momentum
-    about the new contact point conserved).  Drake's ``RimlessWheel`` example has the same
-    parameters (mass, length, gravity, number_of_spokes)."""
-
-    model: Literal["rimless_wheel"] = Field(description="walker model name")
-    spokes: int = Field(ge=3, le=360, description="number of spokes n [-] (the angle "
-                        "between neighbouring spokes is 2 pi / n)")
-    spoke_length_m: float = Field(gt=0, le=100, description="spoke length L, hub to "
-                                  "foot [m]")
-    mass_kg: float = Field(gt=0, le=1e4, description="hub mass M [kg]")
-    gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
-    hub_inertia_kg_m2: float | None = Field(None, ge=0, le=1e6, description="moment of "
-                                            "inertia of the wheel about its hub [kg m^2] "
-                                            "(null: a point mass, 0)")
-    space: Literal["2d", "3d"] = Field("2d", description="2d: the wheel rolls in the "
-                                       "sagittal plane; 3d: free about every axis of its "
-                                       "stance foot (heading, lean and spin; Coleman, "
-                                       "Chatterjee & Ruina 1997)")
-    diametral_inertia_kg_m2: float | None = Field(
-        None, gt=0, le=1e6, description="moment of inertia of the wheel about a diameter "
-        "through its hub [kg m^2] (space: 3d only, where it is required; the axle's is "
-        "hub_inertia_kg_m2)")
-
-    @model_validator(mode="after")
-    def _spatial_inertia(self):
-        if self.space == "3d" and self.diametral_inertia_kg_m2 is None:
-            raise ValueError("walker.diametral_inertia_kg_m2: a wheel in 3d needs its "
-                             "inertia about a diameter (> 0: the spin about the stance "
-                             "spoke has no other)")
-        if self.space == "2d" and self.diametral_inertia_kg_m2 is not None:
-            raise ValueError("walker.diametral_inertia_kg_m2: only a wheel in 3d (space: "
-                             "3d) turns about a diameter")
-        return self
-
-    @property
-    def actuation(self) -> None:
-        """The wheel is passive: no ``actuation`` section (a key given is refused as any
-        unknown key)."""
-        return None
 
 
 # ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a

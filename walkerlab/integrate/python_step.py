@@ -25,6 +25,7 @@ taken for the landing).
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import replace
 
 import numpy as np
 
@@ -60,11 +61,71 @@ def make_step_map(walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,
     ValueError
         As :class:`~walkerlab.integrate.batch_step.BatchStepMap` (slope-relative coordinates).
     """
+    if walker.mirror is not None and walker.cycle is None:
+        if walker.mirror_reflection is None:
+            raise ValueError("per-step terrain: legs that differ (a stride map) are not "
+                             "supported: the step map is one step's walker")
+        return ReflectedStepMap(make_step_map(replace(walker, mirror=None), walker_at, rtol,
+                                              atol, max_step_time_s), walker)
     if needs_python_path(walker):
         return PythonStepMap(walker, walker_at, rtol, atol, max_step_time_s)
     from walkerlab.integrate.batch_step import BatchStepMap
 
     return BatchStepMap(walker, walker_at, rtol, atol, max_step_time_s)
+
+
+class ReflectedStepMap:
+    """The step map of a walker whose steps alternate sides (a 3D walker with hip width,
+    :attr:`~walkerlab.models.hybrid.base.HybridWalker.mirror_reflection`) in reflected
+    coordinates: ``Q(y) = S P(y)``, ``P`` the first step's map and ``S`` the reflection
+    across the sagittal plane (:meth:`~walkerlab.models.hybrid.base.HybridWalker.reflect`).
+
+    The mirror step's map is ``P_mirror(x) = S P(S x)``, so a walk ``x_{k+1} = P_k(x_k)``
+    (``P_k`` the walker of step ``k``: ``P``, ``P_mirror``, ``P``, ...) is ``y_k = S^k x_k``,
+    ``y_{k+1} = Q(y_k)`` with ``y_0 = x_0``: one map of one state, whose heel strikes and
+    falls are the walk's, on per-step slopes that the reflection keeps (a pitch about the
+    hip axis' direction).  A symmetric period-2 gait (``x_1 = S x_0``) is a fixed point of
+    ``Q``.  The Monte Carlo walks, the MFPT mesh and the robustness measures run on it
+    unchanged (each step one call of the first step's batched map).
+
+    Parameters
+    ----------
+    inner : BatchStepMap or PythonStepMap
+        The first step's map (the walker without its mirror).
+    walker : HybridWalker
+        The walker with its mirror (:attr:`walker`).
+    """
+
+    #: whole walks are stepped by :meth:`step` (the compiled walk has no reflection)
+    can_walk = False
+
+    def __init__(self, inner, walker):
+        self.inner, self.walker = inner, walker
+        self.n, self.slope_rad = inner.n, inner.slope_rad
+        self.rtol, self.atol = inner.rtol, inner.atol
+        self.max_step_time_s = inner.max_step_time_s
+
+    def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None,
+             drop_m: np.ndarray | float | None = None, **kw) -> BatchStep:
+        """One step of every row: :meth:`BatchStepMap.step`'s, with ``x_next`` reflected
+        (``x_pre`` is the step's own, in the coordinates of ``X``).
+
+        Parameters
+        ----------
+        X : ndarray, shape (N, 2n)
+            Reflected post-impact states ``y_k`` [rad, rad/s].
+        gamma, drop_m, **kw
+            As the inner map's (slope [rad], step-down [m], ``height_m`` [m]).
+
+        Returns
+        -------
+        BatchStep
+            ``x_next`` is ``y_{k+1} = S x_{k+1}`` (NaN where the step did not end in heel
+            strike).
+        """
+        r = self.inner.step(X, gamma, drop_m, **kw)
+        r.x_next = self.walker.reflect(r.x_next)
+        return r
 
 
 def _lowered(walker, drop_m: float):

@@ -36,9 +36,20 @@ def check(scene: Scene, sigma_rad: list[float] | None = None, method: str | None
           workers: int = 2, **_options):
     """``(MfptSettings, workers)`` with the command-line overrides, checked before anything
     runs (:func:`walkerlab.config.options.mfpt_options`).  Raises StageError: no
-    ``fixedpoint`` section; SceneError: an option out of bounds (one line)."""
+    ``fixedpoint`` section, or ``mfpt.model: contact`` for a walker without a contact view
+    (a 3D walker); SceneError: an option out of bounds (one line)."""
     require(scene, "fixedpoint", "mfpt")
-    return mfpt_options(scene, sigma_rad, method, workers)
+    st, workers = mfpt_options(scene, sigma_rad, method, workers)
+    if st.model == "contact":  # the contact walker's Monte Carlo: the table's contact cell
+        from walkerlab.walker.description import walker_data  # light
+        from walkerlab.walker.kinds import KindRefused  # light
+
+        kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+        try:
+            kind.require("walk", "contact", f"mfpt.model: contact: {kind.field}")
+        except KindRefused as exc:
+            raise StageError(str(exc)) from None
+    return st, workers
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,

@@ -52,11 +52,34 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
     StageError, walkerlab.io.artifacts.ArtifactError
         As the stages do (one line).
     """
+    require_kind(stage, scene)
     mod = stage_module(stage)
     if hasattr(mod, "check"):
         mod.check(scene, **options)
     run_upstream(stage, scene, runs_root)
     return mod.run(scene, runs_root, *args, **options)
+
+
+def require_kind(stage: str, scene: Scene) -> None:
+    """Refuse ``stage`` before any work when the walker's kind does not take it or a stage
+    upstream of it (:meth:`walkerlab.walker.kinds.Kind.require_stage`: ``compare`` of a 3D
+    walker is refused for its contact walk, ``robustness`` for its study).
+
+    Raises
+    ------
+    StageError
+        One line naming the scene field (``walker.space: 3d``, ``walker``).
+    """
+    from walkerlab.stages.common import StageError  # light
+    from walkerlab.walker.description import walker_data  # light
+    from walkerlab.walker.kinds import KindRefused  # light
+
+    try:
+        kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+        for s in order(stage, scene):
+            kind.require_stage(s)
+    except KindRefused as exc:
+        raise StageError(str(exc)) from None
 
 
 def fresh_fixedpoint(scene: Scene, runs_root: Path | str = "runs") -> Path | None:

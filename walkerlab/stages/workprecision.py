@@ -35,10 +35,35 @@ from walkerlab.execution.lanes import Lanes
 from walkerlab.io.runpaths import run_cache_dir, stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.workprecision import WorkPrecisionRun, write_workprecision
-from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "fixedpoint", "workprecision", "contact", "terrain",
             "contact_sim")
+
+
+def check(scene: Scene, **_options) -> None:
+    """Refuse before anything runs (the fixed point upstream included).
+
+    Raises
+    ------
+    StageError
+        No ``workprecision`` section, or its contact model asked of a walker without a
+        contact view (a 3D walker: the capability table's contact cell), one line.
+    """
+    require(scene, "workprecision", "workprecision")
+    try:
+        models = plan(scene)
+    except ValueError as exc:  # no workprecision section (one line)
+        raise StageError(str(exc)) from None
+    if "contact" in models:
+        from walkerlab.walker.description import walker_data  # light
+        from walkerlab.walker.kinds import KindRefused  # light
+
+        kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+        try:
+            kind.require("walk", "contact", f"workprecision.models: contact: {kind.field}")
+        except KindRefused as exc:
+            raise StageError(str(exc)) from None
 
 
 def warm_up(scene: Scene, runs_root: Path | str, model: str) -> None:

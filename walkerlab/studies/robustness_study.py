@@ -48,12 +48,15 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
+    from walkerlab.walker.description import walker_data  # light
 
+    # the kind's refusal (a 3D walker: walker.space) before the walker is built
+    walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require_stage("robustness")
     st = scene.robustness or RobustnessSettings()
     walker = build_walker(scene)
-    sm = make_step_map(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
     if walker.steps_per_map != 1:
         raise ValueError("robustness: legs that differ (a stride map) are not supported")
+    sm = make_step_map(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
     A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
                      jacobian=True)[2]
     names = walker.state_names()

@@ -21,7 +21,7 @@ from walkerlab.walker.capability_evidence import (
     unverified_reason,
     verified,
 )
-from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS, Kind
+from walkerlab.walker.kinds import FEATURES, KINDS, STAGE_CELLS, VIEWS, Kind
 
 __all__ = ["SUPPORTED", "KindGrid", "grids", "kind_grid", "markdown", "text"]
 
@@ -116,6 +116,8 @@ def text() -> str:
         for r in (head, *rows):
             out.append("  " + "  ".join(c.ljust(w) for c, w in zip(r, width)).rstrip())
         out += [f"  {i}. {why}" for i, why in enumerate(g.reasons, 1)]
+        out += [f"  walkerlab {stage}: refused: {why}"
+                for stage, why in STAGE_CELLS.get(g.kind.name, {}).items()]
         out.append("")
     return "\n".join(out).rstrip() + "\n"
 

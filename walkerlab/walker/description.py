@@ -201,6 +201,23 @@ class Structure:
         return KNEED_ROLES if self.knee else ROLES[self.coordinates]
 
     @property
+    def mirror_odd_roles(self) -> tuple[str, ...] | None:
+        """Roles whose angle and rate change sign under the reflection across the sagittal
+        plane (the slope's fall line and normal) that carries a step of this walker onto
+        the next step's (:attr:`WalkerData.mirror`), or None when the next step is not such a
+        reflection.
+
+        A 3D straight-legged walker with hip width steps on alternate sides (``w_hip ->
+        -w_hip``, Kuo 1999): reflected, its hip axis turns over and the rolls (``lean``,
+        the hip-roll joints' ``pelvis_roll`` and ``swing_roll``) change sign while the legs'
+        pitches keep theirs, so the mirror step's map is ``P_mirror(x) = S P(S x)`` with ``S``
+        negating those roles' angles and rates (the hip-roll law is odd in the rolls).
+        Planar legs that differ are not a reflection of each other (None)."""
+        if self.spatial and not self.spokes and self.hip_width:
+            return ("lean",) + (HIP_ROLL_ROLES if self.hip_roll else ())
+        return None
+
+    @property
     def swing_foot_clears(self) -> bool:
         """Whether the swing foot can clear the ground through the step (a knee flexes it):
         a free-jointed walker's early swing then ends in a fall if the foot scuffs; straight

@@ -58,8 +58,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURES", "KINDS", "KNEE_LATCH_OSIM", "URDF_GROUND",
-           "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
+__all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURES", "KINDS", "KNEE_LATCH_OSIM", "STAGE_CELLS",
+           "STAGE_VIEWS", "URDF_GROUND", "VIEWS", "Kind", "KindRefused", "kind_of",
+           "table_rows"]
 
 #: the views of one walker description: name -> what it is
 VIEWS = {
@@ -131,7 +132,8 @@ class Kind:
     @property
     def spoked(self) -> bool:
         """Whether the walker rolls on its spokes (its steps are spoke strikes, not two
-        legs' heel strikes): one rigid body, no legs."""
+        legs' heel strikes): one rigid body, no legs; its steady roll has a closed form
+        (:func:`walkerlab.models.hybrid.rolling_polygon.steady_roll`)."""
         return self.body in ("wheel", "wheel_3d")
 
     def cell(self, feature: str, view: str) -> str | None:
@@ -182,6 +184,22 @@ class Kind:
         why = self.cell(feature, view)
         if why is not None:
             raise KindRefused(f"{field}: {why}")
+
+    def require_stage(self, stage: str) -> None:
+        """Refuse the pipeline stage ``stage`` (``walkerlab <stage>``) if the kind does not
+        take it: its view's cell (:data:`STAGE_VIEWS`) or its study's (:data:`STAGE_CELLS`),
+        naming :attr:`field` - asked before any work.
+
+        Raises
+        ------
+        KindRefused
+            ``"<field>: <reason>"``, one line.
+        """
+        if stage in STAGE_VIEWS:
+            self.require(*STAGE_VIEWS[stage], self.field)
+        why = STAGE_CELLS.get(self.name, {}).get(stage)
+        if why is not None:
+            raise KindRefused(f"{self.field}: {why}")
 
 
 #: every kind, in the order tables list them
@@ -505,6 +523,21 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
                    "Manager windows: OpenSim has no contact-switched force, and the .osim "
                    "file alone under OpenSim's Manager does not hold the stance knee "
                    "straight (the kneed walker falls at 0.34 s, in its first step)")
+
+#: the pipeline's stages that are a view of the table, or that read one: stage ->
+#: ``(feature, view)`` (:meth:`Kind.require_stage`; ``compare`` reads the contact walk)
+STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
+               "stability-map": ("walk", "contact")}
+#: why the robustness study refuses a 3D walker (:mod:`walkerlab.studies.robustness_study`)
+SPATIAL_ROBUSTNESS = ("the robustness study (gait sensitivity norms, largest step-down/up "
+                      "and push) is of planar walkers so far: its disturbances and state "
+                      "norms are sagittal; a 3D walker's metastability is walkerlab mfpt's")
+#: kind -> {stage: reason}: the studies (stages of :mod:`walkerlab.stages.pipeline`) a kind
+#: does not take at all; a stage not listed takes it (``optimize`` of a kind whose ``walk``
+#: it refuses may still design virtual constraints, so only the 3D kinds' is here)
+STAGE_CELLS: dict[str, dict[str, str]] = {
+    k: {"robustness": SPATIAL_ROBUSTNESS, "optimize": CAPABILITIES[k][("walk", "optimize")]}
+    for k in ("straight_legs_3d", "rolling_polygon_3d")}
 
 #: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under

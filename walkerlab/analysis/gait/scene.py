@@ -9,11 +9,13 @@ import math
 
 from walkerlab.analysis.gait.planar_start import planar_fallback
 from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
-from walkerlab.analysis.gait.search import find_gaits
+from walkerlab.analysis.gait.search import GaitNotFound, find_gaits
 from walkerlab.config import Scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
+from walkerlab.models.hybrid.rolling_polygon import cannot_roll
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.description import walker_data
 
 
 def _settings(scene: Scene):
@@ -144,6 +146,10 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
         A malformed initial guess or gait choice, or no ``fixedpoint`` section (one line).
     """
     fp = _settings(scene)
+    if scene.terrain is None or scene.terrain.is_slope:  # a wheel that cannot roll: at once
+        why = cannot_roll(walker_data(scene.walker, scene.slope.phi_rad))
+        if why is not None:
+            raise GaitNotFound(why, math.nan)
     walker = build_walker(scene) if walker is None else walker
     solver = Solver.from_settings(scene.solver) if solver is None else solver
     start = initial_guess(scene, walker) if guess is None else guess

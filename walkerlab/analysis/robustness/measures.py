@@ -170,7 +170,13 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
     for k in range(steps):
         xn, y, ok = one_step(sm, X, disturbance, ee if k == 0 else np.zeros(3))
         if not ok.all():
-            raise ValueError("gsn_nonlinear: the disturbed walker fell; use a smaller e")
+            if not ok[0]:  # the gait itself, undisturbed
+                raise ValueError(f"gsn_nonlinear: the undisturbed gait falls within {steps} "
+                                 "steps (an unstable gait, see fixedpoint's multipliers): its "
+                                 "gait sensitivity norm is not defined")
+            raise ValueError(f"gsn_nonlinear: the walker disturbed by {disturbance} "
+                             f"+/-{e:g} fell within {steps} steps (its basin is narrower "
+                             "than the check's disturbance)")
         dy = (y[1] - y[2]) / 2
         acc += float(dy @ dy)
         X = xn

@@ -238,6 +238,12 @@ class HybridWalker:
         (legs that differ: same roles and state, other numbers); None when the legs are
         mirror images.  This walker takes the steps with ``legs[1]`` in stance (``legs[0]``
         swings first, paper Eq. 11); with a mirror the Poincaré map is a stride (two steps).
+    mirror_reflection : tuple of str or None
+        With a :attr:`mirror`: the state names (:meth:`state_names`) the reflection across
+        the sagittal plane negates when it carries this walker's step onto the mirror's,
+        ``P_mirror(x) = S P(S x)`` (:meth:`reflect`; a 3D walker with hip width, whose steps
+        alternate sides: :attr:`walkerlab.walker.description.Structure.mirror_odd_roles`);
+        None: the mirror is not a reflection (planar legs that differ) or there is none.
     actuators : walkerlab.models.hybrid.actuated.Actuators or None
         The walker's actuators (joint torques, push-off) bound to its model; None: passive.
     matrices : callable or None
@@ -299,6 +305,7 @@ class HybridWalker:
     heel_strike_guard: Callable[[float, np.ndarray], float] | None = None
     leg_angles: Callable[[np.ndarray], dict[str, np.ndarray]] | None = None
     mirror: HybridWalker | None = None
+    mirror_reflection: tuple[str, ...] | None = None
     actuators: object | None = None
     matrices: Callable[[np.ndarray], tuple] | None = None
     step_entry: Callable[[np.ndarray], tuple] | None = None
@@ -326,6 +333,21 @@ class HybridWalker:
         if self.mirror is not None and stance_leg == self.legs[0]:
             return self.mirror
         return self
+
+    def reflect(self, X: np.ndarray) -> np.ndarray:
+        """``S X``: the states ``X`` (2n,) or (N, 2n) with the :attr:`mirror_reflection`
+        coordinates negated (a copy).
+
+        Raises
+        ------
+        ValueError
+            A walker whose mirror is not a reflection (``mirror_reflection`` None).
+        """
+        if self.mirror_reflection is None:
+            raise ValueError(f"{self.name}: the next step is not a reflection of this one")
+        names = self.state_names()
+        S = np.array([-1.0 if n in self.mirror_reflection else 1.0 for n in names])
+        return np.asarray(X, dtype=float) * S
 
     @property
     def steps_per_map(self) -> int:

@@ -212,8 +212,12 @@ def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
               **dict(zip(structure.param_names, data.params))}
     coords = None if legs.angles_are_coordinates(structure) else f["leg_angles"]
     mirror = data.mirror
+    odd = None
     if mirror is not None:  # legs that differ: the next step's walker (leg2 swinging)
         mirror = make_rigid_walker(replace(mirror, mirror_params=None), name, variant)
+        roles = structure.mirror_odd_roles  # a 3D walker's steps on alternate sides
+        odd = None if roles is None else tuple(f"{r}_{k}" for k in ("angle", "rate")
+                                                for r in roles)
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
         reset=reset or f["reset"], energies=f["energies"], points=f["points"],
@@ -223,7 +227,7 @@ def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
         variational=flow_jacobian or f["flow_jacobian"],
         reset_jacobian=reset_jacobian or f["reset_jacobian"],
         heel_strike_guard=f["guard_heel_strike"], leg_angles=coords, mirror=mirror,
-        matrices=f["matrices"],
+        mirror_reflection=odd, matrices=f["matrices"],
     )
 
 

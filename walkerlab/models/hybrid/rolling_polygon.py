@@ -73,42 +73,73 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
     )
 
 
+def steady_roll(p: dict) -> tuple[float, float] | None:
+    """The steady roll's post-impact rate and the rate needed to vault the hub over the
+    stance spoke, in closed form (McGeer 1990, "Passive dynamic walking", IJRR 9(2), Sec. 2;
+    Coleman, Chatterjee & Ruina 1997): with ``J = I_hub + M L^2`` and the impact's ratio
+    ``eta = (I_hub + M L^2 cos 2 alpha) / J`` (angular momentum about the new foot),
+    ``w+^2 = eta^2 (4 M g L / J) sin(alpha) sin(gamma) / (1 - eta^2)``; the hub, ``alpha -
+    gamma`` behind the vertical through the new foot after the impact, goes over it if
+    ``J w+^2 / 2 > M g L (1 - cos(alpha - gamma))``.  The 3D wheel's upright roll is the
+    same motion (its rates about the axle).
+
+    Parameters
+    ----------
+    p : dict
+        The wheel's generated parameters by name: ``M_hub`` [kg], ``I_hub`` [kg m^2], ``L``
+        [m], ``g`` [m/s^2], ``alpha`` (half the angle between spokes) and ``gamma`` (slope)
+        [rad].
+
+    Returns
+    -------
+    (w_plus, w_vault) : float, float
+        [rad/s]; ``w_vault`` 0 on a slope at least the spokes' half angle.  None: no slope
+        down, or fewer than 5 spokes (``eta <= 0``: the closed form does not hold).
+    """
+    g, L, gamma, M, i_hub, alpha = (float(p[k]) for k in ("g", "L", "gamma", "M_hub",
+                                                          "I_hub", "alpha"))
+    J = i_hub + M * L * L
+    eta = (i_hub + M * L * L * math.cos(2 * alpha)) / J
+    if eta <= 0 or gamma <= 0:
+        return None
+    w_plus = math.sqrt(eta * eta * 4 * M * g * L / J * math.sin(alpha) * math.sin(gamma)
+                       / (1 - eta * eta))
+    barrier = M * g * L * (1 - math.cos(alpha - gamma)) if alpha > gamma else 0.0
+    return w_plus, math.sqrt(2 * barrier / J)
+
+
 def rolling_gait(params: dict) -> np.ndarray | None:
-    """The planar spoked wheel's steady rolling gait in closed form: its state just after
-    heel strike ``[stance_angle, stance_rate]`` [rad, rad/s], or None when the wheel
-    cannot roll over its stance foot at this slope.
-
-    Between heel strikes the wheel turns about the stance foot from ``q = alpha - gamma``
-    to ``q = -alpha - gamma``, gaining ``2 M g L sin(alpha) sin(gamma)`` of kinetic energy;
-    the heel strike keeps the angular momentum about the new foot, ``w+ = eta w-`` with
-    ``eta = (M L^2 cos(2 alpha) + I) / (M L^2 + I)``.  The fixed point
-    (McGeer 1990, "Passive dynamic walking", IJRR 9(2), Sec. 2; Coleman, Chatterjee & Ruina
-    1997, Eq. for the steady rolling rate; a point mass, ``I = 0``:
-    ``w+ = cot(2 alpha) sqrt(4 g/L sin(alpha) sin(gamma))``):
-
-    ``w+ = eta sqrt(4 M g L sin(alpha) sin(gamma) / ((M L^2 + I) (1 - eta^2)))``,
-
-    downhill (``stance_rate = -w+``).  It rolls on when its energy at ``w+`` lifts the hub
-    over the stance foot: ``(M L^2 + I) w+^2 / 2 > M g L (1 - cos(alpha - gamma))``.
+    """The planar spoked wheel's steady rolling gait in closed form (:func:`steady_roll`):
+    its state just after heel strike ``[stance_angle, stance_rate]`` =
+    ``[alpha - gamma, -w+]`` [rad, rad/s] (downhill), or None when the wheel cannot roll
+    over its stance foot at this slope (``w+`` not above the vaulting rate).
 
     Parameters
     ----------
     params : dict
-        The wheel's ``M_hub`` [kg], ``I_hub`` [kg m^2], ``L`` [m], ``g`` [m/s^2],
-        ``alpha`` (half the angle between spokes) and ``gamma`` (slope) [rad].
+        As :func:`steady_roll`'s.
 
     Returns
     -------
     ndarray (2,) or None
     """
-    m, inertia, length = float(params["M_hub"]), float(params["I_hub"]), float(params["L"])
-    g, alpha, gamma = float(params["g"]), float(params["alpha"]), float(params["gamma"])
-    about = m * length ** 2 + inertia
-    eta = (m * length ** 2 * math.cos(2 * alpha) + inertia) / about
-    gain = 4 * m * g * length * math.sin(alpha) * math.sin(gamma)
-    if not (gain > 0 and 0 < eta < 1):
+    r = steady_roll(params)
+    if r is None or not r[0] > r[1]:
         return None
-    rate = eta * math.sqrt(gain / (about * (1 - eta ** 2)))
-    if not about * rate ** 2 / 2 > m * g * length * (1 - math.cos(alpha - gamma)):
+    return np.array([float(params["alpha"]) - float(params["gamma"]), -r[0]])
+
+
+def cannot_roll(data: WalkerData, field: str = "walker.spokes") -> str | None:
+    """Why the spoked wheel has no steady roll on its slope (:func:`steady_roll`: its
+    post-impact rate cannot vault the hub over the stance spoke), one line naming
+    ``field``; None when it can or the closed form does not apply."""
+    if not data.structure.kind.spoked:
         return None
-    return np.array([alpha - gamma, -rate])
+    p = dict(zip(data.structure.param_names, data.params))
+    r = steady_roll(p)
+    if r is None or r[0] > r[1]:
+        return None
+    return (f"{field}: {round(math.pi / p['alpha'])} spokes on a {p['gamma']:g} rad slope cannot "
+            f"roll steadily: the post-impact rate {r[0]:.4g} rad/s is below the {r[1]:.4g} "
+            "rad/s that vaults the hub over a spoke (McGeer 1990); give more spokes or a "
+            "steeper slope")
