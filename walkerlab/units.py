@@ -147,3 +147,22 @@ def field_unit(name: str) -> str | None:
         if leaf.endswith(suffix):
             return unit
     return None
+
+
+def map_name(steps_per_map) -> str:
+    """The Poincaré map of ``steps_per_map`` steps in the field's words: ``"step"`` (1),
+    ``"stride"`` (2), ``"3-step cycle"`` (a ground that repeats every 3 steps); ``""`` when
+    unknown (None, 0: an artifact written before the map's length was recorded)."""
+    try:
+        k = int(steps_per_map)
+    except (TypeError, ValueError):
+        return ""
+    return {0: "", 1: "step", 2: "stride"}.get(k, f"{k}-step cycle" if k > 0 else "")
+
+
+def per_map(steps_per_map) -> str:
+    """``"per step"``, ``"per stride"``, ``"per 3-step cycle"`` (:func:`map_name`) - the
+    qualifier every Floquet multiplier shown to a reader carries (a stride's multipliers
+    are the step's squared, for legs that are mirror images) - or ``""`` when unknown."""
+    name = map_name(steps_per_map)
+    return f"per {name}" if name else ""

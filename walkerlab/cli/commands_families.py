@@ -8,7 +8,7 @@ import typer
 
 from walkerlab.cli.errors import fail, guard
 from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load, status
-from walkerlab.numerics import map_name, per_map
+from walkerlab.units import map_name, per_map
 
 
 @guard

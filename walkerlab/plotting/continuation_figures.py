@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from walkerlab.numerics import per_map
+from walkerlab.units import per_map
 
 __all__ = ["continuation_figure", "two_parameter_figure", "stability_pieces"]
 

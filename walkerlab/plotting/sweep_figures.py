@@ -22,11 +22,10 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
-from walkerlab.numerics import per_map
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.studies.bifurcation import fall_onset, onset_value, parameter_values
 from walkerlab.studies.outcomes import OUTCOMES
-from walkerlab.units import Units
+from walkerlab.units import Units, per_map
 
 OUTCOME_COLORS = {
     "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuff": "#9467bd",

@@ -16,7 +16,6 @@ from types import ModuleType
 import numpy as np
 
 from walkerlab.io.stage_files import CONTACT_SIM, SIMULATE
-from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
     ground_contact_text,
@@ -24,7 +23,7 @@ from walkerlab.report.text import (
     zero_dynamics_text,
     zero_multipliers_text,
 )
-from walkerlab.units import Units, for_scene
+from walkerlab.units import Units, for_scene, per_map
 
 #: Table 3 rows (keys of :func:`walkerlab.comparison.tables.gait_metrics`): name, symbol, unit
 TABLE3_ROWS = {

@@ -7,8 +7,8 @@ from types import ModuleType
 
 import numpy as np
 
-from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num, printed, table
+from walkerlab.units import per_map
 
 
 # --------------------------------------------------------------------------- bifurcation

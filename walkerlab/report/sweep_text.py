@@ -6,9 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.io.stage_files import CONTACT_SIM
-from walkerlab.numerics import per_map
 from walkerlab.report.markdown import num
-from walkerlab.units import Units
+from walkerlab.units import Units, per_map
 
 #: the main results of each swept stage (columns of ``points``), in the order printed
 MAIN_COLUMNS = {

@@ -7,8 +7,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from walkerlab.integrate.ends import CONTACT_WALKED
-from walkerlab.numerics import neutral_positions, per_map
+from walkerlab.numerics import neutral_positions
 from walkerlab.report.markdown import num
+from walkerlab.units import per_map
 
 if TYPE_CHECKING:  # the loaded artifacts these summaries print
     from walkerlab.io.schemas.compare import Comparison

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from walkerlab.io.schemas.friction import FrictionVerdict
+from walkerlab.io.friction import FrictionVerdict
 
 __all__ = ["FrictionVerdict", "scene_friction", "flat_foot_friction", "stance_friction",
            "UNLOADED"]

@@ -47,7 +47,7 @@ def continuation_writer(res, curves=()):
     """``writer(h5file)`` for a :class:`walkerlab.analysis.continuation.branch.ContinuationResult`
     and optional :class:`~walkerlab.analysis.continuation.two_parameter.TwoParameterCurve` s."""
     from walkerlab.io.artifacts import put
-    from walkerlab.numerics import map_name
+    from walkerlab.units import map_name
 
     names, units = list(res.state_names), list(res.state_units)
     per = map_name(getattr(res, "steps_per_map", 1))

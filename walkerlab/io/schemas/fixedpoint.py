@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.friction import FrictionVerdict
 from walkerlab.io.netcdf import coordinate
-from walkerlab.io.schemas.friction import FrictionVerdict
 from walkerlab.numerics import without_neutral
 from walkerlab.units import Units, for_artifact
 
