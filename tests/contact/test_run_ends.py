@@ -307,6 +307,25 @@ def test_an_integrators_stop_message_is_said_in_walkerlabs_words():
     assert "rigid-limit family" in FELL_ADVICE and "elastic" in FELL_ADVICE
 
 
+def test_a_trip_stays_the_diagnosis_when_the_solvers_words_inside_it_are_translated():
+    """flat_feet_push_off's contact run ends in a trip (a heel entering a patch from its
+    side), which CyRK met as "Required step size is less than spacing between numbers":
+    the trip stays first, the solver's sentence is said in walkerlab's words where it
+    stood (naming a patch's side beside a stiff law), its own words kept in brackets."""
+    from walkerlab.integrate.ends import solver_words
+
+    raw = ("trip: leg2_heel's foot, 0.00241 m below the patch tops in a gap, entered a patch "
+           "from its side (the solver stopped there: the compiled solver stopped at t = "
+           "9.164 s (Error in step size calculation: Required step size is less than "
+           "spacing between numbers.))")
+    said = solver_words(raw)
+    assert said.startswith("trip: leg2_heel's foot") and said.endswith("]))")
+    assert "a foot striking a patch's side" in said
+    assert ("[the integrator's message: Required step size is less than spacing between "
+            "numbers.]") in said
+    assert solver_words(said) == said
+
+
 @pytest.mark.slow  # ~20 s: the rigid gait and 4 s of contact walk
 def test_a_contact_fall_from_an_unstable_rigid_gait_names_the_instability_first(tmp_path):
     """configs/paper.yaml on a 0.11 rad slope: its rigid gait is unstable (largest

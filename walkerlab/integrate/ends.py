@@ -113,22 +113,33 @@ _SOLVER_WORDS = (
     ("Repeated convergence failures", "the integrator's corrector did not converge again "
      "and again (a contact law too stiff for its Jacobian)"),
     ("Required step size is less than spacing between numbers", "the integrator's step "
-     "shrank below the resolution of time (a contact law too stiff to step through)"),
+     "shrank below the resolution of time (a force it cannot step through: a contact law "
+     "too stiff, or a foot striking a patch's side)"),
 )
 
 
 def solver_words(message: str) -> str:
-    """An integrator's stop message in walkerlab's words (unchanged when it is not one of
-    :data:`_SOLVER_WORDS`' known messages): what happened, then the integrator's own words
-    in brackets for a search.
+    """An integrator's stop message in walkerlab's words (unchanged when it holds none of
+    :data:`_SOLVER_WORDS`' known messages): the integrator's sentence is replaced, where it
+    stands, by what happened, with its own words after it in brackets for a search; a
+    diagnosis walkerlab wrote around it (a trip, a fall) keeps its place first.
 
     Parameters
     ----------
     message : str
         The message (e.g. odeint's "Excess work done on this call (perhaps wrong Dfun
-        type).").
+        type).", or a run end's diagnosis quoting CyRK's "Required step size is less than
+        spacing between numbers.").
     """
     for head, words in _SOLVER_WORDS:
-        if head in message and not message.startswith(words):
-            return f"{words} [the integrator's message: {message.strip()}]"
+        at = message.find(head)
+        if at < 0 or words in message:  # not this one, or said already
+            continue
+        ends = [i for i in (message.find(".", at), message.find(")", at)) if i >= 0]
+        end = min(ends) + 1 if ends else len(message)
+        if message[end - 1:end] == ")" and "(" in message[at:end - 1]:  # its own bracket
+            end = message.find(")", end) + 1 or len(message)
+            end = end if message[end - 1:end] == ")" else len(message)
+        said = f"{words} [the integrator's message: {message[at:end].strip()}]"
+        return message[:at] + said + message[end:]
     return message
