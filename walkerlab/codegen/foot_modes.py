@@ -446,9 +446,7 @@ def _grad_fn(name: str, eq: FlatEquations, expr) -> list[str]:
 
 
 def _fast_lines(eq) -> list[str]:
-    """The flat-footed module's flows (with their Jacobians and variational equations),
-    resets, guards and gradients, ground reactions and double-support functions
-    (:func:`generate_flat`; ``eq`` :func:`derive_flat`'s), in this order."""
+    """:func:`generate_flat`'s flows, resets, guards, ground reactions, double supports."""
     fast = []
     for mode, system in eq.flows.items():
         fast += flow_lines(system, False, f"flow_{mode}")
@@ -536,7 +534,6 @@ def generate_flat(structure: Structure, key: str) -> str:
         "",
     ]
     return "\n".join(head + body) + "\n"
-
 
 
 #: Ground reactions each compiled flow writes after the state guards (extra outputs) [N]:
