@@ -655,7 +655,7 @@ def test_no_walker_kind_name_is_compared_outside_the_kinds_home():
 BIG_MODULES = {"analysis/gait/poincare.py": 648, "api/walker.py": 636,
                "config/walker.py": 635, "gym/env.py": 878,
                "gym/rigid_view.py": 788, "gym/vector.py": 621, "io/artifacts.py": 634,
-               "models/contact/generated.py": 745, "optimal/driver.py": 700,
+               "models/contact/generated.py": 626, "optimal/driver.py": 700,
                "studies/points.py": 611}
 
 
