@@ -652,9 +652,9 @@ def test_no_walker_kind_name_is_compared_outside_the_kinds_home():
 
 #: modules over 600 lines today, each with its size as a ceiling (split by role to go below)
 BIG_MODULES = {"api/walker.py": 619,
-               "config/walker.py": 635, "export/adams.py": 628, "gym/env.py": 878,
+               "config/walker.py": 635, "gym/env.py": 878,
                "gym/rigid_view.py": 648, "gym/vector.py": 621, "io/artifacts.py": 634,
-               "models/contact/generated.py": 745, "optimal/driver.py": 700}
+               "models/contact/generated.py": 626, "optimal/driver.py": 700}
 
 
 def test_modules_stay_within_600_lines_or_their_ceiling():

@@ -78,11 +78,17 @@ import numpy as np
 from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
 
-#: benchmark -> the module whose ``lines(result)`` prints it (the others: their JSON)
-_LINES = {"main-job": "walkerlab.bench.main_job", "optimize": "walkerlab.bench.optimize",
-          "powered": "walkerlab.bench.powered_contact", "hzd": "walkerlab.bench.hzd",
-          "powered-command": "walkerlab.bench.powered_command", "gym": "walkerlab.bench.gym",
-          "gym-vector": "walkerlab.bench.gym_vector"}
+#: benchmark -> ``module:function`` that runs it with no arguments (imported when it runs:
+#: CasADi, MuJoCo, Gymnasium, ...)
+_RUNS = {"contact": "walkerlab.bench.contact:run_benchmark",
+         "main-job": "walkerlab.bench.main_job:run_main_job",
+         "optimize": "walkerlab.bench.optimize:bench_optimize",
+         "powered": "walkerlab.bench.powered_contact:bench_powered_contact",
+         "powered-command": "walkerlab.bench.powered_command:bench_powered_command",
+         "hzd": "walkerlab.bench.hzd:bench_hzd", "gym": "walkerlab.bench.gym:bench_gym",
+         "gym-vector": "walkerlab.bench.gym_vector:bench_vector"}
+#: benchmarks whose module prints their result (its ``lines(result)``; the others: their JSON)
+_LINES = tuple(n for n in _RUNS if n != "contact")
 
 BENCHMARKS = ("ideal", "fixedpoint", "fixedpoint-3d", "sweep", "sweep-workers", "basin",
               "contact", "main-job", "optimize", "powered", "powered-command", "hzd", "gym",
@@ -176,46 +182,19 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
         if name == "contact" and scenes:
             lines += [B.scene_line(r) for r in res["result"]["scenes"]]
         if name in _LINES:  # the benchmark's own printable lines
-            lines += importlib.import_module(_LINES[name]).lines(res["result"])
+            module = _RUNS[name].partition(":")[0]
+            lines += importlib.import_module(module).lines(res["result"])
             continue
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines
 
 
 def _run_one(name: str, scenes) -> dict:
-    if name == "contact" and not scenes:
-        from walkerlab.bench.contact import run_benchmark  # light
-
-        return run_benchmark()
-    if name == "main-job":
-        from walkerlab.bench.main_job import run_main_job
-
-        return run_main_job()
-    if name == "optimize":
-        from walkerlab.bench.optimize import bench_optimize
-
-        return bench_optimize()
-    if name == "powered":
-        from walkerlab.bench.powered_contact import bench_powered_contact
-
-        return bench_powered_contact()
-    if name == "powered-command":
-        from walkerlab.bench.powered_command import bench_powered_command  # light
-
-        return bench_powered_command()
-    if name == "hzd":
-        from walkerlab.bench.hzd import bench_hzd
-
-        return bench_hzd()
-    if name == "gym":
-        from walkerlab.bench.gym import bench_gym
-
-        return bench_gym()
-    if name == "gym-vector":
-        from walkerlab.bench.gym_vector import bench_vector
-
-        return bench_vector()
+    if name == "contact" and scenes:
+        return B.bench_contact_scenes(scenes)
+    if name in _RUNS:
+        module, _, function = _RUNS[name].partition(":")
+        return getattr(importlib.import_module(module), function)()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint,
             "fixedpoint-3d": B.bench_fixedpoint_3d, "sweep": bench_sweep,
-            "basin": B.bench_basin, "sweep-workers": B.bench_sweep_workers,
-            "contact": lambda: B.bench_contact_scenes(scenes)}[name]()
+            "basin": B.bench_basin, "sweep-workers": B.bench_sweep_workers}[name]()

@@ -17,6 +17,34 @@ from walkerlab.codegen.source import IND, PRINTER, cse_lines, unpack
 DOUBLE_SUPPORT_LEADS = ("heel_contact", "foot_flat")
 
 
+def _lead_system(lead: str, M4, rhs, J, dJ, M, g_row, Jl, dq, foot_inertia) -> dict:
+    """One leading-foot mode's double support (:func:`derive_double_support`): the flow's
+    system ``K [Qdd; lam] = rhs`` (``M4``, the toe's ``J``, ``dJ dQ``; foot flat adds the
+    lock's row) and the entry's ``Ki [dq+; Lam] = Ki_rhs`` (on ``q`` with the pin's row
+    ``g_row``, ``M`` the heel contact's mass matrix; with ``foot_inertia`` the impact on
+    ``Q``, ``entry_on_Q``)."""
+    rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
+    gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
+    m = rows.rows
+    K = sp.zeros(4 + m, 4 + m)
+    K[:4, :4] = M4
+    K[:4, 4:] = -rows.T
+    K[4:, :4] = rows
+    imp_rows = g_row if lead == "heel_contact" else g_row.col_join(Jl)
+    mi = imp_rows.rows
+    Ki = sp.zeros(3 + mi, 3 + mi)
+    Ki[:3, :3] = M
+    Ki[:3, 3:] = -imp_rows.T
+    Ki[3:, :3] = imp_rows
+    out = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
+           "Ki_rhs": (M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
+    if foot_inertia != 0:  # the toe pinned on Q (see derive_double_support)
+        out["Ki"] = K
+        out["Ki_rhs"] = (M4 * sp.Matrix([*dq, 0])).col_join(sp.zeros(m, 1))
+        out["entry_on_Q"] = True
+    return out
+
+
 def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma, normal,
                     tangent, Jl, foot_inertia=0) -> dict:
     """Double support after heel strike (roles already swapped): the leading (stance) foot
@@ -79,25 +107,7 @@ def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, 
     out = {"b": b, "db": db, "b_of": b_of, "b_of_level": b_of_level, "db_of": db_of, "u": u,
            "toe": toe, "trailing_spring": held, "foot_angle": theta + gamma}
     for lead in DOUBLE_SUPPORT_LEADS:
-        rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
-        gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
-        m = rows.rows
-        K = sp.zeros(4 + m, 4 + m)
-        K[:4, :4] = M4
-        K[:4, 4:] = -rows.T
-        K[4:, :4] = rows
-        imp_rows = g_row if lead == "heel_contact" else g_row.col_join(Jl)
-        mi = imp_rows.rows
-        Ki = sp.zeros(3 + mi, 3 + mi)
-        Ki[:3, :3] = hc.M
-        Ki[:3, 3:] = -imp_rows.T
-        Ki[3:, :3] = imp_rows
-        out[lead] = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
-                     "Ki_rhs": (hc.M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
-        if foot_inertia != 0:  # the toe pinned on Q (see above)
-            out[lead]["Ki"] = K
-            out[lead]["Ki_rhs"] = (M4 * sp.Matrix([*dq, 0])).col_join(sp.zeros(m, 1))
-            out[lead]["entry_on_Q"] = True
+        out[lead] = _lead_system(lead, M4, rhs, J, dJ, hc.M, g_row, Jl, dq, foot_inertia)
     # the leading foot's ground force: Newton's total (feet massless) less the toe's; in
     # foot flat its toe's share from the moment balance about its heel, less the trailing
     # toe's moment (the lock's multiplier is that moment: its toe force times the sole)

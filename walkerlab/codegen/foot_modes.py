@@ -445,6 +445,26 @@ def _grad_fn(name: str, eq: FlatEquations, expr) -> list[str]:
             f"{IND}return np.array(({', '.join(PRINTER.doprint(e) for e in red)},))"]
 
 
+def _fast_lines(eq) -> list[str]:
+    """:func:`generate_flat`'s flows, resets, guards, ground reactions, double supports."""
+    fast = []
+    for mode, system in eq.flows.items():
+        fast += flow_lines(system, False, f"flow_{mode}")
+        fast += flow_lines(system, True, f"flow_{mode}_jacobian",
+                           variational=f"flow_{mode}_variational")
+    for name, system in eq.resets.items():
+        fast += reset_lines(system, False, f"reset_{name}")
+        fast += reset_lines(system, True, f"reset_{name}_jacobian")
+    for name, expr in eq.guards.items():
+        fast += _scalar_fn(f"guard_{name}", eq, [expr], False)
+        fast += _grad_fn(f"grad_{name}", eq, expr)
+    for pin, exprs in eq.ground.items():
+        fast += _scalar_fn(f"ground_{pin}", eq, exprs, True)
+    for lead in DOUBLE_SUPPORT_LEADS:
+        fast += double_support_lines(eq, lead)
+    return fast
+
+
 def generate_flat(structure: Structure, key: str) -> str:
     """Source text of a flat-footed walker's generated module (``make(p)`` returns, by name:
     ``flow_<mode>``, ``flow_<mode>_jacobian``, ``flow_<mode>_variational`` for the three
@@ -465,21 +485,7 @@ def generate_flat(structure: Structure, key: str) -> str:
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)
     hoisted = codegen.start_module(eq.params)
-    fast = []
-    for mode, system in eq.flows.items():
-        fast += flow_lines(system, False, f"flow_{mode}")
-        fast += flow_lines(system, True, f"flow_{mode}_jacobian",
-                      variational=f"flow_{mode}_variational")
-    for name, system in eq.resets.items():
-        fast += reset_lines(system, False, f"reset_{name}")
-        fast += reset_lines(system, True, f"reset_{name}_jacobian")
-    for name, expr in eq.guards.items():
-        fast += _scalar_fn(f"guard_{name}", eq, [expr], False)
-        fast += _grad_fn(f"grad_{name}", eq, expr)
-    for pin, exprs in eq.ground.items():
-        fast += _scalar_fn(f"ground_{pin}", eq, exprs, True)
-    for lead in DOUBLE_SUPPORT_LEADS:
-        fast += double_support_lines(eq, lead)
+    fast = _fast_lines(eq)
     rest = "r_st_ankle" if structure.asymmetric else "r_ankle"
     section = [
         "    def section(x):",
@@ -528,7 +534,6 @@ def generate_flat(structure: Structure, key: str) -> str:
         "",
     ]
     return "\n".join(head + body) + "\n"
-
 
 
 #: Ground reactions each compiled flow writes after the state guards (extra outputs) [N]:

@@ -207,6 +207,33 @@ def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, t
             sp.hessian(Te, dqe), E])
 
 
+def _guards(structure: Structure, points: dict, psi: dict, gamma, normal, tangent) -> dict:
+    """The five-link biped's guards (:func:`derive_five_link`): ``heel_strike``,
+    ``swing_foot_ahead``, ``hip_height``, ``swing_clearance`` of its ``points`` (arc feet:
+    their contact points) on the slope ``gamma`` (its ``normal`` and ``tangent``)."""
+    arc = structure.foot == "arc"
+    hip, foot = points["hip"], points["swing_foot"]
+    clearance = ((points["swing_contact"] if arc else foot).T * normal)[0]
+    # the heel strike: the swing foot reaching the slope (its height); straight legs, whose
+    # swing foot passes through the ground at mid-stance (ignored, as the compass gait's,
+    # Goswami et al. 1996), reach it when the legs are symmetric about the slope's normal
+    strike = clearance if structure.knee else psi["stance"] + psi["swing"] + 2 * gamma
+    ahead = ((points["swing_contact"] - points["stance_contact"]) if arc else foot).T * tangent
+    return {"heel_strike": strike, "swing_foot_ahead": ahead[0],
+            "hip_height": (hip.T * normal)[0], "swing_clearance": clearance}
+
+
+def _leg_angles(hip, foot, psi: dict) -> dict:
+    """The generated ``leg_angles`` (:func:`derive_five_link`): the stance leg's (stance
+    foot to ``hip``) and the swing leg's (``hip`` to swing ``foot``) angle from the frame's
+    y axis [rad], and every coordinate by its role (``psi``)."""
+    # atan, not atan2: complex-safe (the complex-step Jacobians of torque laws that read the
+    # phase variable), and exact while the hip is above both feet
+    return {"stance": sp.atan(-hip[0] / hip[1]),
+            "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
+            **psi}
+
+
 def derive_five_link(structure: Structure) -> Equations:
     """Flow, impact, guards, section, energies, points and leg angles of a free-jointed biped
     (see the module docstring).
@@ -261,14 +288,7 @@ def derive_five_link(structure: Structure) -> Equations:
     C = christoffel(M, q, dq)
     G = sp.Matrix([sp.diff(V, k) for k in q])
     hip, foot = points["hip"], points["swing_foot"]
-    clearance = ((points["swing_contact"] if arc else foot).T * normal)[0]
-    # the heel strike: the swing foot reaching the slope (its height); straight legs, whose
-    # swing foot passes through the ground at mid-stance (ignored, as the compass gait's,
-    # Goswami et al. 1996), reach it when the legs are symmetric about the slope's normal
-    strike = clearance if structure.knee else st + ws + 2 * gamma
-    ahead = ((points["swing_contact"] - points["stance_contact"]) if arc else foot).T * tangent
-    guards = {"heel_strike": strike, "swing_foot_ahead": ahead[0],
-              "hip_height": (hip.T * normal)[0], "swing_clearance": clearance}
+    guards = _guards(structure, points, psi, gamma, normal, tangent)
     if structure.knee:
         relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])  # legs swap, the torso keeps its
         reach = (ls * sp.cos(ss + gamma) + lt * sp.cos(st + gamma)  # angle
@@ -277,11 +297,7 @@ def derive_five_link(structure: Structure) -> Equations:
     else:
         relabel_q = sp.Matrix([ws, st, q[2]])  # the legs swap, the torso keeps its angle
         drop, drop_solution = STRAIGHT_SECTION_DROP, -st - 2 * gamma
-    # atan, not atan2: complex-safe (the complex-step Jacobians of torque laws that read the
-    # phase variable), and exact while the hip is above both feet
-    leg_angles = {"stance": sp.atan(-hip[0] / hip[1]),
-                  "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
-                  **{r: psi[r] for r in roles}}
+    leg_angles = _leg_angles(hip, foot, psi)
     if not arc:
         De, E = _extended(q, dq, bodies, foot)
     return Equations(

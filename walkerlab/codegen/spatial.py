@@ -114,6 +114,35 @@ def _spoke(theta_offset, L) -> sp.Matrix:
     return sp.Matrix([L * sp.sin(theta_offset), -L * sp.cos(theta_offset), 0])
 
 
+def _spoked_impact(W, hub, spin, par):
+    """The spoked wheel's impact (:func:`derive_spoked`): ``Mi dq+ = B dq-``, the angular
+    momentum about the new foot conserved (``Mi``: rotating about it, ``B``: the motion
+    about the old foot), in the frame ``A`` of heading and lean (``omega_A = W dq``; ``hub``
+    the hub in it, ``spin`` the wheel's rotation by its angle; ``par`` the parameters).
+
+    Returns
+    -------
+    Mi, B : sympy.Matrix (3, 3)
+    """
+    _g, L, _gamma, m, I_axle, alpha, I_diam = par
+    ez = sp.Matrix([0, 0, 1])
+    d = -spin * _spoke(2 * alpha, L)                       # new foot -> hub (A's frame)
+
+    def inertia_cm(w):  # I_cm w, the axisymmetric hub
+        return I_diam * w + (I_axle - I_diam) * w[2] * ez
+
+    def h_after(w):  # angular momentum about the new foot, rotating about it at w
+        return inertia_cm(w) + m * _cross(d, _cross(w, d))
+
+    def h_before(w):  # ... of the motion about the old foot at w (hub velocity w x hub)
+        return inertia_cm(w) + m * _cross(d, _cross(w, hub))
+
+    cols = [W[:, j] for j in range(3)]
+    Mi = (W.T * sp.Matrix.hstack(*[h_after(c) for c in cols])).applyfunc(sp.trigsimp)
+    B = (W.T * sp.Matrix.hstack(*[h_before(c) for c in cols])).applyfunc(sp.trigsimp)
+    return Mi, B
+
+
 @cache
 @_seeded
 def derive_spoked(structure) -> Equations:
@@ -167,20 +196,7 @@ def derive_spoked(structure) -> Equations:
         return A * (hub + spin * _spoke(2 * k * alpha, L))
 
     nxt = foot(1)
-    d = -spin * _spoke(2 * alpha, L)                       # new foot -> hub (A's frame)
-
-    def inertia_cm(w):  # I_cm w, the axisymmetric hub
-        return I_diam * w + (I_axle - I_diam) * w[2] * ez
-
-    def h_after(w):  # angular momentum about the new foot, rotating about it at w
-        return inertia_cm(w) + m * _cross(d, _cross(w, d))
-
-    def h_before(w):  # ... of the motion about the old foot at w (hub velocity w x hub)
-        return inertia_cm(w) + m * _cross(d, _cross(w, hub))
-
-    cols = [W[:, j] for j in range(3)]
-    Mi = (W.T * sp.Matrix.hstack(*[h_after(c) for c in cols])).applyfunc(sp.trigsimp)
-    B = (W.T * sp.Matrix.hstack(*[h_before(c) for c in cols])).applyfunc(sp.trigsimp)
+    Mi, B = _spoked_impact(W, hub, spin, par)
     hub, axle = hub_w, A * ez
     # the section: the spoke behind's foot on the slope, a cos(theta) + b sin(theta) = 0
     u = W[:, 0]                                             # the normal in A's frame

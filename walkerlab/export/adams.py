@@ -139,7 +139,6 @@ times the stop's IMPACT law, no SENSOR (:mod:`walkerlab.export.adams_latch`).
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import numpy as np
@@ -174,6 +173,7 @@ from walkerlab.export.adams_feet import (
     leg_end,
     part_ids,
 )
+from walkerlab.export.adams_ground import ground_patches, ground_statements
 from walkerlab.export.adams_latch import LATCH_SFORCE, LATCH_VARIABLES, TREAD_BLOCK, knee_latches
 from walkerlab.export.adams_statements import (
     LANE_Z,
@@ -188,7 +188,6 @@ from walkerlab.export.adams_statements import (
     marker_id,
     part_statement,
 )
-from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, adams_comments
 from walkerlab.export.parts import export_part
 from walkerlab.units import for_scene
@@ -313,6 +312,17 @@ def _link_frames(mb, start: AdamsStart) -> dict[str, tuple]:
     return out
 
 
+def _stance_pin(mb, start: AdamsStart) -> tuple[float, float]:
+    """Where the temporary stance-foot pin holds leg2 [m]: at its foot point (flat feet:
+    heel), the origin, or, on an arc foot, at its arc's centre, R above the contact point
+    at the origin."""
+    if not (mb.foot == "arc" and mb.foot_radius_m > 0):
+        return (0.0, 0.0)
+    ln = next(x for x in mb.links if x.name == leg_end(mb, "leg2"))
+    joint = _link_frames(mb, start)[ln.name][0]
+    return tuple(joint + np.array(_rot(start.angles[ln.name], (0.0, -ln.foot_m))))
+
+
 def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = None
            ) -> list[str]:
     """The PART and MARKER statements of the hip and the links, and the foot spheres (flat
@@ -387,85 +397,6 @@ def _joints(mb, start: AdamsStart, ids: dict) -> list[str]:
     pin = adams_feet(mb).pin(mb, ids)  # leg2's foot marker (flat feet: its heel)
     out.append("! temporary stance-foot pin (Section 4): deactivated by walker.acf")
     out.append(f"JOINT/{PIN_JOINT}, REVOLUTE, I={pin}, J=102")
-    return out
-
-
-def _line_patches(line, r: float, L: float) -> list[str]:
-    """Continuous ground (a profile, continuous stairs) as the polyline ``line`` (m, 2) [m]
-    of patches: segment ``i`` a box whose top face lies on it, lowered by the foot
-    sphere's radius ``r`` [m] along its normal (as the checkerboard's patches), turned by
-    the segment's angle (``REULER``), ``L / 5`` wide across the plane; each foot touches
-    every segment (its CONTACTs)."""
-    out, gid = [], 1001
-    for i, (a, b) in enumerate(zip(line[:-1], line[1:])):
-        d = b - a
-        length = float(np.hypot(*d))
-        if length <= 0.0:
-            continue
-        g = math.atan2(float(d[1]), float(d[0]))  # the segment's angle (downhill: < 0)
-        depth = min(length, 1.0) / 10
-        nrm = (-math.sin(g), math.cos(g))  # its upward normal
-        corner = (a[0] - (r + depth) * nrm[0], a[1] - (r + depth) * nrm[1], -L / 10)
-        out.append(f"! segment {i} of the ground line from ({a[0]:.6g}, {a[1]:.6g}) m "
-                   f"to ({b[0]:.6g}, {b[1]:.6g}) m")
-        out += _stmt(f"MARKER/{gid}, PART=1", f"QP={_fs(*(x * MM for x in corner))}",
-                     f"REULER={_deg(g)}, 0.0D, 0.0D")
-        out += _stmt(f"GRAPHICS/{gid}, BOX, CORNER={gid}",
-                     f"X={_f(length * MM)}, Y={_f(depth * MM)}, Z={_f(L / 5 * MM)}")
-        gid += 1
-    return out
-
-
-def ground_patches(start: AdamsStart) -> int:
-    """The patches of the dataset's ground when it is a polyline (segments of positive
-    length of :attr:`AdamsStart.ground_line`); 1 (the slope's plane) otherwise."""
-    if start.ground_line is None:
-        return 1
-    d = np.diff(np.asarray(start.ground_line, float), axis=0)
-    return int(np.count_nonzero(np.hypot(d[:, 0], d[:, 1]) > 0.0))
-
-
-def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
-    """PART/1 (ground), its markers, ACCGRAV and the checkerboard's patches (or one plane)."""
-    arc = mb.foot == "arc" and mb.foot_radius_m > 0  # the sphere is the arc: no offset
-    phi, r = mb.slope_rad, 0.0 if arc else point_foot_radius(mb)
-    L = mb.leg_length_m
-    pin = (0.0, 0.0)  # the pin at leg2's foot point (flat feet: heel) at the origin
-    if arc:  # ... or at its arc's centre, R above the contact point at the origin
-        ln = next(x for x in mb.links if x.name == leg_end(mb, "leg2"))
-        joint = _link_frames(mb, start)[ln.name][0]
-        pin = tuple(joint + np.array(_rot(start.angles[ln.name], (0.0, -ln.foot_m))))
-    out = ["!", "! ---- ground, gravity (along -y) and the tilted ground's patches ----",
-           "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
-           f"MARKER/102, PART=1, QP={_fs(pin[0] * MM, pin[1] * MM)}, "
-           f"{_f(LANE_Z['leg2'] * L * MM if lanes else 0.0)}",
-           "MARKER/103, PART=1, QP=0.0, 0.0, 0.0",
-           f"ACCGRAV/IGRAVITY=0.0, JGRAVITY={_f(-mb.gravity_m_per_s2 * MM)}, KGRAVITY=0.0"]
-    if start.ground_line is not None:  # continuous ground: a box per segment
-        return out + _line_patches(start.ground_line, r, L)
-    t, n = (math.cos(phi), -math.sin(phi)), (math.sin(phi), math.cos(phi))
-    w = start.patch_width_m
-    depth = w / 10
-    centres = start.lanes if start.lanes is not None else ((0.0,),)
-    length = w if start.lanes is not None else 40 * L
-    legs = ("leg1", "leg2") if start.lanes is not None else ("both",)
-    heights = start.lane_heights or ((), ())
-    gid = 1001
-    for i, (leg, lane) in enumerate(zip(legs, centres)):
-        zw = 0.04 * L if lanes else L / 5
-        zc = LANE_Z.get(leg, 0.0) * L if lanes else 0.0
-        for j, s in enumerate(lane):
-            s0 = s - length / 2 if lanes else -length / 4
-            h = heights[i][j] if i < len(heights) and j < len(heights[i]) else 0.0
-            d = r + depth - h  # the box's bottom below the ground line (a tread: h lower)
-            corner = (s0 * t[0] - d * n[0], s0 * t[1] - d * n[1], zc - zw / 2)
-            out.append(f"! patch of {leg} at s = {s:.6g} m"
-                       + (f", {h:.6g} m along the normal" if h else ""))
-            out += _stmt(f"MARKER/{gid}, PART=1", f"QP={_fs(*(x * MM for x in corner))}",
-                         f"REULER={_deg(-phi)}, 0.0D, 0.0D")
-            out += _stmt(f"GRAPHICS/{gid}, BOX, CORNER={gid}",
-                         f"X={_f(length * MM)}, Y={_f(depth * MM)}, Z={_f(zw * MM)}")
-            gid += 1
     return out
 
 
@@ -594,7 +525,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     if scene.walker.actuation is not None:
         out += ["! walker.actuation: its joint torques (SFORCE) and push-off (GFORCE",
                 "! pulses) are written below, after the contacts"]
-    out += _ground(mb, start, lanes)
+    out += ground_statements(mb, start, lanes, _stance_pin(mb, start))
     out += _parts(mb, start, ids, lanes, feet)
     out += _joints(mb, start, ids)
     out += _forces(mb, scene, ids, feet, start if lanes else None)

@@ -136,19 +136,7 @@ def header_comments(mb, gait, name: str, version: str, total: float, contact_not
                "small enough that the tread behind falls clear of the swing foot's path "
                "(walkerlab.export.opensim.terrain_patch_radius)") + "."))
     if gait.flat_feet:
-        (h1, t1, k1, c1, r1, m1, i1), (h2, t2, k2, c2, r2, m2, i2) = gait.flat_feet
-        out.append(comment(
-            "Flat feet: bodies leg<i>_sole on PinJoints leg<i>_ankle at the legs' ends (the "
-            "angle from the leg's perpendicular, positive toe up), each of mass "
-            f"{num(m1)} and {num(m2)} kg at the ankle with inertia {num(i1)} and {num(i2)} "
-            "kg m^2 about it (walker.leg.foot.mass_kg, or the contact model's regularising "
-            "contact.flat_foot_mass_kg for massless feet: the MJCF's); the ankle springs "
-            "SpringGeneralizedForce leg<i>_ankle_spring (stiffness "
-            f"{num(k1)} and {num(k2)} N m/rad, rest {num(r1)} and {num(r2)} rad, damping "
-            f"{num(c1)} and {num(c2)} N m s/rad); contact spheres at the heel (leg<i>_foot, "
-            f"{num(h1)} and {num(h2)} m behind the ankle) and the toe (leg<i>_toe, "
-            f"{num(t1)} and {num(t2)} m ahead); the default state has the trailing foot on "
-            "its toe (the rigid gait's double support as it begins)."))
+        out.append(_flat_feet_comment(gait.flat_feet))
     if gait.push_off is not None:
         out.append(comment(
             "Push-off (walker.actuation.push_off, walkerlab_actuation below): PrescribedForce "
@@ -169,20 +157,44 @@ def header_comments(mb, gait, name: str, version: str, total: float, contact_not
     if gait.actuation is not None:
         out.append(comment(f"walkerlab_actuation: {actuation_text(gait.actuation)}"))
     if knee_stops:
-        out.append(comment(
-            "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
-            f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "
-            f"{gait.knee.cmax:.6g} N m s/rad, dmax = {gait.knee.dmax:.4g} rad; pushing only); "
-            "knee latch leg<i>_knee_latch (the same law acting in flexion) applies no force by "
-            "default: "
-            f"a stepping loop switches it on while the leg's foot is less than "
-            f"{gait.knee.latch_height:.4g} m above the ground and its knee within "
-            f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk). "
-            "The foot's height is its contact point's (the contact model's latch reads the "
-            "foot's penetration): the height of the sphere leg<i>_foot's centre above the "
-            f"slope line less {num(latch_foot_offset(r_foot, gait.ground_offset_m))} m (the "
-            "sphere's radius less the ground's offset below the slope line)."))
+        out.append(_knee_comment(gait, r_foot))
     return out
+
+
+def _flat_feet_comment(feet) -> str:
+    """The flat feet's comment: ``feet`` a pair (leg1, leg2) of (heel [m], toe [m], ankle
+    stiffness [N m/rad], damping [N m s/rad], rest angle [rad], mass [kg], inertia about the
+    ankle [kg m^2]) (:attr:`OsimGait.flat_feet`)."""
+    (h1, t1, k1, c1, r1, m1, i1), (h2, t2, k2, c2, r2, m2, i2) = feet
+    return comment(
+        "Flat feet: bodies leg<i>_sole on PinJoints leg<i>_ankle at the legs' ends (the "
+        "angle from the leg's perpendicular, positive toe up), each of mass "
+        f"{num(m1)} and {num(m2)} kg at the ankle with inertia {num(i1)} and {num(i2)} "
+        "kg m^2 about it (walker.leg.foot.mass_kg, or the contact model's regularising "
+        "contact.flat_foot_mass_kg for massless feet: the MJCF's); the ankle springs "
+        "SpringGeneralizedForce leg<i>_ankle_spring (stiffness "
+        f"{num(k1)} and {num(k2)} N m/rad, rest {num(r1)} and {num(r2)} rad, damping "
+        f"{num(c1)} and {num(c2)} N m s/rad); contact spheres at the heel (leg<i>_foot, "
+        f"{num(h1)} and {num(h2)} m behind the ankle) and the toe (leg<i>_toe, "
+        f"{num(t1)} and {num(t2)} m ahead); the default state has the trailing foot on "
+        "its toe (the rigid gait's double support as it begins).")
+
+
+def _knee_comment(gait, r_foot: float) -> str:
+    """The knee stop's and latch's comment (``gait.knee``; foot sphere ``r_foot`` [m])."""
+    return comment(
+        "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
+        f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "
+        f"{gait.knee.cmax:.6g} N m s/rad, dmax = {gait.knee.dmax:.4g} rad; pushing only); "
+        "knee latch leg<i>_knee_latch (the same law acting in flexion) applies no force by "
+        "default: "
+        f"a stepping loop switches it on while the leg's foot is less than "
+        f"{gait.knee.latch_height:.4g} m above the ground and its knee within "
+        f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk). "
+        "The foot's height is its contact point's (the contact model's latch reads the "
+        "foot's penetration): the height of the sphere leg<i>_foot's centre above the "
+        f"slope line less {num(latch_foot_offset(r_foot, gait.ground_offset_m))} m (the "
+        "sphere's radius less the ground's offset below the slope line).")
 
 
 def latch_foot_offset(r_foot: float, ground_offset_m: float) -> float:

@@ -335,6 +335,67 @@ def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
     return out
 
 
+def _world_head(p: dict, extra, phi: float, condim: int) -> list[str]:
+    """The MJCF's option and default lines and the world body's ground: the slope's plane
+    with MuJoCo's default contact when ``extra`` is None, else the footfall patches under
+    the scene's contact (timestep, solref, solimp, friction; ``condim``); ``p`` the walker's
+    numbers (:func:`_numbers`), ``phi`` the slope [rad]."""
+    L = p["L"]
+    if extra is None:
+        return [f'  <option gravity="{nums(0, 0, -p["g"])}"/>',
+                '  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
+                '</default>', "  <worldbody>",
+                f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
+                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
+    return [f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(extra.timestep_s)}"'
+            ' integrator="implicitfast" cone="elliptic"/>',
+            f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
+            f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
+            f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="{condim}"/>'
+            '</default>', "  <worldbody>", *_patches(p, extra, phi)]
+
+
+def _pelvis_and_legs(p: dict, law: dict | None, phi: float) -> list[str]:
+    """The pelvis body (a free joint, or with the hip-roll ``law`` three slides and a roll
+    about the fall line) with the legs' bodies in it (``p``: :func:`_numbers`; ``phi`` the
+    slope [rad])."""
+    L, a, w, r = p["L"], p["a_leg"], p["w_hip"], p["r"]
+    lo = num(MJCF_MIN_INERTIA_KG_M2)
+    pelvis_inertia = lo if law is None else num(law["pelvis_roll_inertia_kg_m2"])
+    if law is None:
+        pelvis_joints = ['      <freejoint name="free"/>']
+    else:  # the rigid model's pelvis neither pitches nor yaws (the legs' roll axes stay on
+        # the fall line): three slides and a roll about the fall line
+        pelvis_joints = [
+            *(f'      <joint name="pelvis_{c}" type="slide" axis="{ax}"/>'
+              for c, ax in (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))),
+            f'      <joint name="pelvis_roll" type="hinge" axis="'
+            f'{nums(math.cos(phi), 0, -math.sin(phi))}"/>']
+    out = ['    <body name="pelvis" pos="0 0 0">',
+           *pelvis_joints,
+           f'      <inertial pos="0 0 0" mass="{num(p["M_hip"])}" '
+           f'diaginertia="{pelvis_inertia} {pelvis_inertia} {pelvis_inertia}"/>',
+           f'      <geom name="pelvis" type="sphere" size="{num(L / 25)}"/>']
+    if w > 0:
+        out.append(f'      <geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
+                   f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>')
+    roll_axis = nums(math.cos(phi), 0, -math.sin(phi))     # the fall line (pelvis frame)
+    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
+        out += [f'      <body name="{leg}" pos="{nums(0, side * w / 2, 0)}">',
+                *([f'        <joint name="{leg}_roll" type="hinge" axis="{roll_axis}"/>']
+                  if law is not None else []),
+                f'        <joint name="{leg}_hip" type="hinge" axis="{AXIS}"/>',
+                f'        <inertial pos="{nums(0, 0, -(L - a))}" mass="{num(p["m_leg"])}" '
+                f'diaginertia="{lo} {lo} {lo}"/>',
+                f'        <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
+                f'size="{num(L / 100)}"/>',
+                f'        <site name="{leg}_foot" pos="{nums(0, 0, -(L - r))}"/>',
+                f'        <geom name="{leg}_foot" type="sphere" pos="{nums(0, 0, -(L - r))}" '
+                f'size="{num(r)}" contype="0" conaffinity="{LANE_BITS[leg]}"/>',
+                "      </body>"]
+    return out + ["    </body>"]
+
+
 def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | None = None
                      ) -> str:
     """The 3D straight-legged walker as a MuJoCo model (MJCF; module docstring).
@@ -358,12 +419,10 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
     """
     p = _numbers(data)
     L, a, w, r, phi = p["L"], p["a_leg"], p["w_hip"], p["r"], data.slope_rad
-    lo = num(MJCF_MIN_INERTIA_KG_M2)
     law = getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
     # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
     # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
     condim = 4 if law is None else 3
-    pelvis_inertia = lo if law is None else num(law["pelvis_roll_inertia_kg_m2"])
     out = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
                    f"legs of {num(L)} m, {num(p['m_leg'])} kg at {num(a)} m from each foot, "
                    f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope {num(phi)} "
@@ -374,51 +433,9 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
            f"<mujoco model={quoteattr(name)}>",
            *(comment(note) for note in (extra.notes if extra else ())),
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
-    if extra is None:
-        out += [f'  <option gravity="{nums(0, 0, -p["g"])}"/>',
-                '  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
-                '</default>', "  <worldbody>",
-                f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
-                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
-    else:
-        out += [f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(extra.timestep_s)}"'
-                ' integrator="implicitfast" cone="elliptic"/>',
-                f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-                f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
-                f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="{condim}"/>'
-                '</default>', "  <worldbody>", *_patches(p, extra, phi)]
-    if law is None:
-        pelvis_joints = ['      <freejoint name="free"/>']
-    else:  # the rigid model's pelvis neither pitches nor yaws (the legs' roll axes stay on
-        # the fall line): three slides and a roll about the fall line
-        pelvis_joints = [
-            *(f'      <joint name="pelvis_{c}" type="slide" axis="{ax}"/>'
-              for c, ax in (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))),
-            f'      <joint name="pelvis_roll" type="hinge" axis="'
-            f'{nums(math.cos(phi), 0, -math.sin(phi))}"/>']
-    out += ['    <body name="pelvis" pos="0 0 0">',
-            *pelvis_joints,
-            f'      <inertial pos="0 0 0" mass="{num(p["M_hip"])}" '
-            f'diaginertia="{pelvis_inertia} {pelvis_inertia} {pelvis_inertia}"/>',
-            f'      <geom name="pelvis" type="sphere" size="{num(L / 25)}"/>']
-    if w > 0:
-        out.append(f'      <geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
-                   f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>')
-    roll_axis = nums(math.cos(phi), 0, -math.sin(phi))     # the fall line (pelvis frame)
-    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
-        out += [f'      <body name="{leg}" pos="{nums(0, side * w / 2, 0)}">',
-                *([f'        <joint name="{leg}_roll" type="hinge" axis="{roll_axis}"/>']
-                  if law is not None else []),
-                f'        <joint name="{leg}_hip" type="hinge" axis="{AXIS}"/>',
-                f'        <inertial pos="{nums(0, 0, -(L - a))}" mass="{num(p["m_leg"])}" '
-                f'diaginertia="{lo} {lo} {lo}"/>',
-                f'        <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
-                f'size="{num(L / 100)}"/>',
-                f'        <site name="{leg}_foot" pos="{nums(0, 0, -(L - r))}"/>',
-                f'        <geom name="{leg}_foot" type="sphere" pos="{nums(0, 0, -(L - r))}" '
-                f'size="{num(r)}" contype="0" conaffinity="{LANE_BITS[leg]}"/>',
-                "      </body>"]
-    out += ["    </body>", "  </worldbody>",
+    out += _world_head(p, extra, phi, condim)
+    out += _pelvis_and_legs(p, law, phi)
+    out += ["  </worldbody>",
             "  <custom>", f'    <numeric name="slope_rad" data="{num(phi)}"/>',
             '    <numeric name="foot_height_offset_m" data="0.0"/>']
     if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop

@@ -43,6 +43,29 @@ def _hook(walker, solver, limits, deadline, t0: float, t1: float):
     return run
 
 
+def _section_run(walker, stance: int, section, solver, t_max: float, deadline: float,
+                 fall_hip_height_m: float):
+    """:func:`powered_to_section`'s run from t = 0 with leg ``stance`` in stance, its event
+    of the section's upward zero and its pulse's lead event (None: a pulse that does not
+    start ahead of the touchdown).
+
+    Returns
+    -------
+    run : ActuationHook
+    cross, lead : callable, callable or None
+    """
+    from .contact_events import ContactLimits
+
+    limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
+    run = _hook(walker, solver, limits, deadline, 0.0, t_max)
+    run.stance, run.t_origin = stance, 0.0
+    acts = walker.actuators
+    cross = _section_event(section, 2 * walker.nq)
+    lead = (pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
+            else None)
+    return run, cross, lead
+
+
 def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
                        deadline: float = np.inf, fall_hip_height_m: float = 0.5):
     """Integrate a powered walker from ``x0`` (leg ``stance`` in stance) through the next heel
@@ -84,19 +107,12 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
         (``t_e``, ``x_e`` then where the run stopped), or ``NO_HEEL_STRIKE`` when neither a
         heel strike and the section came within ``t_max``.
     """
-    from .contact_events import ContactLimits
-
-    limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
-    run = _hook(walker, solver, limits, deadline, 0.0, t_max)
-    run.stance, run.t_origin = stance, 0.0
-    n, nw = 2 * walker.nq, len(walker.actuators.work_names)
-    acts = walker.actuators
-
-    cross = _section_event(section, n)
-    y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
-    lead = (pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
-            else None)
-    pushed = False  # the pulse of the heel strike to come has run (or is running)
+    run, cross, lead = _section_run(walker, stance, section, solver, t_max, deadline,
+                                    fall_hip_height_m)
+    n, acts = 2 * walker.nq, walker.actuators
+    y = np.concatenate([np.asarray(x0, float), np.zeros(len(acts.work_names))])
+    # pushed: the pulse of the heel strike to come has run (or is running)
+    t, struck, pushed = 0.0, False, False
     while t < t_max - 1e-12:
         arm = lead is not None and not struck and not pushed
         tb = t_max if run.segments is None else min(t + SECTION_CHUNK_S, t_max)

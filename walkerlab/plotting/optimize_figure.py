@@ -39,23 +39,7 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
     fig, grid = plt.subplots(rows, cols, figsize=(5 * cols, 3.8 * rows), squeeze=False)
     axes = grid[0]
     ax, ax2 = axes[0], axes[1]
-    tq = d.torque.reshape(len(d.time), -1)
-    for k, name in enumerate(d.torque_names):
-        ax.plot(d.time, tq[:, k], "o-", ms=2, label=name,
-                color="tab:red" if len(d.torque_names) == 1 else None)
-    ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.set_xlabel("time since heel strike [s]")
-    if d.torque_names == ("hip",):
-        ax.set_ylabel(f"hip torque [{d.torque_unit}] (+ on the swing leg)")
-    else:
-        ax.set_ylabel(f"joint torque [{d.torque_unit}] (+ on the joint's second link)")
-        ax.legend(fontsize=8, loc="best")
-    work = d.terms.get("push_off_work", 0.0)
-    cot = (f" (CoT {float(d.terms['cost_of_transport']):.3g} + effort term)"
-           if d.objective_name == "cost_of_transport" and "cost_of_transport" in d.terms
-           else "")
-    ax.set_title(f"{d.objective_name} = {d.objective:.3g} {d.objective_unit}{cot}"
-                 + (f"; push-off work {work:.3g} J" if work > 0 else ""), fontsize=10)
+    _torque_panel(ax, d)
     for name, v in d.states.items():
         if d.state_units.get(name) == "rad":
             ax2.plot(d.time, v, label=name)
@@ -97,6 +81,28 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
                  + ("" if d.gait else " — NOT a gait: the replay does not close"), fontsize=10)
     fig.tight_layout()
     return save(fig, Path(folder), "optimize", svg, key)
+
+
+def _torque_panel(ax, d) -> None:
+    """First panel: every torque [``d.torque_unit``] at the collocation points (by name)
+    over the step, titled with the objective (and the push-off's work)."""
+    tq = d.torque.reshape(len(d.time), -1)
+    for k, name in enumerate(d.torque_names):
+        ax.plot(d.time, tq[:, k], "o-", ms=2, label=name,
+                color="tab:red" if len(d.torque_names) == 1 else None)
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("time since heel strike [s]")
+    if d.torque_names == ("hip",):
+        ax.set_ylabel(f"hip torque [{d.torque_unit}] (+ on the swing leg)")
+    else:
+        ax.set_ylabel(f"joint torque [{d.torque_unit}] (+ on the joint's second link)")
+        ax.legend(fontsize=8, loc="best")
+    work = d.terms.get("push_off_work", 0.0)
+    cot = (f" (CoT {float(d.terms['cost_of_transport']):.3g} + effort term)"
+           if d.objective_name == "cost_of_transport" and "cost_of_transport" in d.terms
+           else "")
+    ax.set_title(f"{d.objective_name} = {d.objective:.3g} {d.objective_unit}{cot}"
+                 + (f"; push-off work {work:.3g} J" if work > 0 else ""), fontsize=10)
 
 
 def _energy_and_convergence(d, axes) -> None:

@@ -89,16 +89,8 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     """Fixed point + steady state along one run of parameter values (worker side)."""
     import warnings
 
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import (
-        PointOutcome,
-        ideal_fixed_point,
-        interleg_angle,
-        on_study_map,
-        warm_up,
-    )
+    from walkerlab.studies.points import PointOutcome, ideal_fixed_point, on_study_map, warm_up
 
     warm_up()
     from walkerlab.studies.continuation import scene_family
@@ -141,37 +133,57 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
                 row.update(fp_outcome="error", message=f"{type(exc).__name__}: {exc}")
                 walker = build_walker(scene)
             if task.steady_state:
-                if x_att is not None:
-                    x0 = walker.from_section(walker.section(x_att))
-                elif row["fp_outcome"] == "ok":
-                    x0 = row["x"] + _rate_nudge(walker, 1e-6)
-                    x0 = walker.from_section(walker.section(x0))
-                else:
-                    x0 = None
-                if x0 is not None:
-                    try:
-                        traj = simulate_steps(walker, x0, task.n_transient,
-                                              Solver.from_settings(scene.solver),
-                                              max_step_time=5.0)
-                        segs = [s for s in traj.segments if s.termination == "heel_strike"]
-                        row["steps"] = len(segs)
-                        row["ss_outcome"] = traj.termination
-                        if len(segs) == task.n_transient:
-                            keep = segs[-task.n_keep:]
-                            row["hs_interleg"] = np.array([interleg_angle(walker, s.x_end)
-                                                           for s in keep])
-                            row["hs_stance"] = np.array([_stance_angle(walker, s.x_next)
-                                                         for s in keep])
-                            x_att = segs[-1].x_next
-                            row["ss_outcome"] = "walks"
-                        else:
-                            x_att = None
-                    except Exception as exc:  # noqa: BLE001
-                        row["ss_outcome"] = f"error: {type(exc).__name__}"
-                        x_att = None
+                x_att = _steady_state(task, scene, walker, row, x_att)
         row["wall_time_s"] = time.perf_counter() - t0
         out.append(row)
     return out
+
+
+def _steady_state(task: _BifTask, scene, walker, row: dict, x_att):
+    """The steady state at one value (:func:`_bif_chunk`): ``task.n_transient`` steps from
+    the previous value's attractor ``x_att`` (else from the fixed point in ``row``, its
+    rates nudged), the last ``task.n_keep`` heel strikes' inter-leg and stance angles into
+    ``row`` (``hs_interleg``, ``hs_stance``, ``steps``, ``ss_outcome``).
+
+    Returns
+    -------
+    ndarray or None
+        The attractor's last post-impact state (the next value's start), None when the walk
+        did not last (or did not start).
+    """
+    from walkerlab.integrate.rigid import simulate_steps  # light: worker side
+    from walkerlab.integrate.solver import Solver  # light: worker side
+    from walkerlab.studies.points import interleg_angle  # light: worker side
+
+    if x_att is not None:
+        x0 = walker.from_section(walker.section(x_att))
+    elif row["fp_outcome"] == "ok":
+        x0 = row["x"] + _rate_nudge(walker, 1e-6)
+        x0 = walker.from_section(walker.section(x0))
+    else:
+        x0 = None
+    if x0 is not None:
+        try:
+            traj = simulate_steps(walker, x0, task.n_transient,
+                                  Solver.from_settings(scene.solver),
+                                  max_step_time=5.0)
+            segs = [s for s in traj.segments if s.termination == "heel_strike"]
+            row["steps"] = len(segs)
+            row["ss_outcome"] = traj.termination
+            if len(segs) == task.n_transient:
+                keep = segs[-task.n_keep:]
+                row["hs_interleg"] = np.array([interleg_angle(walker, s.x_end)
+                                               for s in keep])
+                row["hs_stance"] = np.array([_stance_angle(walker, s.x_next)
+                                             for s in keep])
+                x_att = segs[-1].x_next
+                row["ss_outcome"] = "walks"
+            else:
+                x_att = None
+        except Exception as exc:  # noqa: BLE001
+            row["ss_outcome"] = f"error: {type(exc).__name__}"
+            x_att = None
+    return x_att
 
 
 def _arclength_step(fam, prev, value: float):

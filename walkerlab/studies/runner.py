@@ -57,6 +57,7 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from contextlib import nullcontext
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -396,6 +397,33 @@ def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_c
                              steps_per_map=steps_per_map), plan, {}
 
 
+def _piece_tasks(task: Task, plan, offset, values_of) -> list[list[Task]]:
+    """The sweep's pieces: each chain of ``plan`` (lists of row indices in continuation
+    order) from its first point not done (``offset``: points done per chain) in pieces of
+    :data:`PIECE_POINTS`, each ``task`` with its points ``(row, values_of[row])``."""
+    return [[replace(task, points=tuple((i, values_of[i])
+                                        for i in chain[offset[c]:][k:k + PIECE_POINTS]))
+             for k in range(0, len(chain) - offset[c], PIECE_POINTS)]
+            for c, chain in enumerate(plan)]
+
+
+def _keep_on_interrupt(store, write, t0: float) -> None:
+    """On an interruption of the sweep: the rows computed before it written (``write``,
+    None: none pending) for --resume, the wall time since ``t0`` added, the store closed;
+    an error of these is passed over (the interruption's is the one to report)."""
+    if write is not None and store.is_open:
+        try:
+            write()
+        except Exception:  # noqa: BLE001 - the original error is the one to report
+            pass
+    try:
+        store.add_wall_time(time.perf_counter() - t0)
+    except Exception:  # noqa: BLE001 - a full disk: the original error is reported
+        pass
+    finally:
+        store.close()
+
+
 def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
                 progress, on_chunk, pool, n_total) -> Path:
     paths = [a.path for a in axes]
@@ -416,11 +444,8 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
                                      else max(2, workers), steps)
     offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
     done = {i for c, chain in enumerate(plan) for i in chain[:offset[c]]}
-    chains = [[Task(stage, base, tuple(paths),
-                    tuple((i, values_of[i]) for i in chain[offset[c]:][k:k + PIECE_POINTS]),
-                    opts, origin)
-               for k in range(0, len(chain) - offset[c], PIECE_POINTS)]
-              for c, chain in enumerate(plan)]
+    chains = _piece_tasks(Task(stage, base, tuple(paths), (), opts, origin), plan, offset,
+                          values_of)
     guesses = [start.get(c, (0, None))[1] for c in range(len(plan))]
     t0 = time.perf_counter()
     counts = {o: 0 for o in OUTCOMES}
@@ -459,17 +484,7 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
                     if on_chunk is not None:
                         on_chunk(n_written, n_total)
     except BaseException:
-        if pending and store.is_open:
-            try:
-                write()  # rows computed before the interruption are kept for --resume
-            except Exception:  # noqa: BLE001 - the original error is the one to report
-                pass
-        try:
-            store.add_wall_time(time.perf_counter() - t0)
-        except Exception:  # noqa: BLE001 - a full disk: the original error is reported
-            pass
-        finally:
-            store.close()
+        _keep_on_interrupt(store, write if pending else None, t0)
         raise
     if pending:  # an executor that stopped early (the rows it gave are kept)
         write()

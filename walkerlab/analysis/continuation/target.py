@@ -152,11 +152,17 @@ def solve_target(family: WalkerFamily, p0: float, x0, measure: str, value: float
     if not sol.success or res > 1e-8:
         raise TargetNotReached(f"no gait with {measure} = {value:g} near the start "
                                f"(residual {res:.2g}; {' '.join(str(sol.message).split())})")
-    p = float(sol.x[-1] * scale_p)
+    return _result_at(family, float(sol.x[-1] * scale_p), sol.x[:-1], res, maps)
+
+
+def _result_at(family: WalkerFamily, p: float, z, residual: float, maps: int
+               ) -> TargetResult:
+    """The :class:`TargetResult` of the root at the field's value ``p`` and section
+    coordinates ``z`` (:func:`solve_target`): its gait's measures from one more map."""
     w = family.walker(p)
-    x = w.from_section(sol.x[:-1])
+    x = w.from_section(z)
     try:
         _, m = _measures(w, x, family.solver, family.max_step_time)
     except (MapFailed, StepFailed) as exc:  # pragma: no cover - its last map walked
         raise TargetNotReached(str(exc)) from None
-    return TargetResult(p, np.asarray(x, float), m, res, maps)
+    return TargetResult(p, np.asarray(x, float), m, residual, maps)

@@ -72,7 +72,7 @@ swing foot of one call: the right-hand side allocates nothing), then the call co
 
 from __future__ import annotations
 
-__all__ = ["A_HEAD", "W_INDEX", "powered_source"]
+__all__ = ["A_HEAD", "CYRK_POWERED_SOURCE", "W_INDEX", "powered_source"]
 
 #: Fixed fields of the actuation block before the work map (module docstring).
 A_HEAD = 36
@@ -195,6 +195,23 @@ def actuate(t, x, A, p, S):
         S[NQ + 5] = -A[18] * (r1 * r1 + r2 * r2) - A[19] * hp * hp
 '''
 
+#: ``build_cyrk_powered()``: the address of a CyRK ``cyjit_sig`` cfunc of the module's
+#: ``powered_packed`` (a generated contact module's, and the virtual constraints' right-hand
+#: side's, :mod:`walkerlab.models.contact.virtual_constraints`)
+CYRK_POWERED_SOURCE = '''def build_cyrk_powered():
+    """Address of a CyRK ``cyjit_sig`` cfunc of powered_packed (numba disk cache)."""
+    from CyRK.nb.numba_solver import cyjit_sig
+    from numba import carray, cfunc
+
+    @cfunc(cyjit_sig, cache=True)
+    def rhs_c(dy, t, y, d):  # pragma: no cover - runs compiled
+        dd = carray(d, (powered_size(d),))
+        ny = powered_ny(dd)
+        powered_packed(t, carray(y, (ny,)), dd, carray(dy, (ny,)))
+
+    return rhs_c.address
+'''
+
 _PACKED = '''
 
 @njit(cache=True, error_model='numpy')
@@ -243,19 +260,7 @@ def powered_ny(d):
     return NX + int(d[a3 + 27])
 
 
-def build_cyrk_powered():
-    """Address of a CyRK ``cyjit_sig`` cfunc of powered_packed (numba disk cache)."""
-    from CyRK.nb.numba_solver import cyjit_sig
-    from numba import carray, cfunc
-
-    @cfunc(cyjit_sig, cache=True)
-    def rhs_c(dy, t, y, d):  # pragma: no cover - runs compiled
-        dd = carray(d, (powered_size(d),))
-        ny = powered_ny(dd)
-        powered_packed(t, carray(y, (ny,)), dd, carray(dy, (ny,)))
-
-    return rhs_c.address
-'''
+''' + CYRK_POWERED_SOURCE
 
 
 def powered_source() -> str:

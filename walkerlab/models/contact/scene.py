@@ -269,6 +269,29 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     part = contact_part(data.structure)
+    cs = _start_of(scene, part, cs)
+    why = part.check(scene, data, checked)
+    if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
+        raise ContactSceneError(f"scene '{scene.name}': {why}")
+    if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
+        # the run cannot start there (periodic_gait: true records the gait as not found)
+        raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
+    si, knee = contact_si(contact)  # the contact law in SI: once per run
+    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
+                        cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
+                        scene=scene)
+
+
+def _start_of(scene: Scene, part, cs: ContactSimSettings) -> ContactSimSettings:
+    """The run's settings ``cs`` with its start decided (:func:`contact_setup`): a passive
+    walker whose contact part starts at mid-stance (``part.mid_stance_start``: flat feet)
+    on its slope starts there unless the scene says otherwise.
+
+    Raises
+    ------
+    ContactSceneError
+        ``contact_sim.start: mid_stance`` for a walker without flat feet (one line).
+    """
     if part.mid_stance_start and "start" not in cs.model_fields_set \
             and scene.walker.actuation is None and scene.terrain_or_default().is_slope:
         # a passive flat-footed walker on its slope starts at the rigid gait's mid-stance
@@ -280,16 +303,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: mid_stance starts "
                                 "a flat foot flat on the ground (this walker has no flat "
                                 "feet): use start: ideal")
-    why = part.check(scene, data, checked)
-    if why is not None:  # the kind's own refusal (a flat foot's mass, a wheel's ground)
-        raise ContactSceneError(f"scene '{scene.name}': {why}")
-    if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
-        # the run cannot start there (periodic_gait: true records the gait as not found)
-        raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
-    si, knee = contact_si(contact)  # the contact law in SI: once per run
-    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
-                        cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
-                        scene=scene)
+    return cs
 
 
 def _actuators(scene: Scene, data, cs: ContactSimSettings

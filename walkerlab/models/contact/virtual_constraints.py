@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.models.contact.joint_torques import JointTorqueActuators
+from walkerlab.models.contact.powered_source import CYRK_POWERED_SOURCE
 from walkerlab.models.virtual_constraints import VirtualConstraintController
 
 __all__ = ["VirtualConstraintJointTorques", "VirtualConstraintLaw", "compiled_rhs_module",
@@ -183,7 +184,7 @@ def vc_tail(controller: VirtualConstraintController, index) -> np.ndarray:
 _RHS_SOURCE = '''# walkerlab: a contact walker's compiled right-hand side under virtual constraints
 # (walkerlab.models.contact.virtual_constraints.compiled_rhs_module)
 import numpy as np
-from numba import carray, cfunc, njit
+from numba import carray, njit
 
 from {kernels} import A_HEAD, D_N1, D_N2, D_P, HEAD, NP, NQ, powered_ny, powered_size
 from {kernels} import powered_packed as _kernels_powered_packed
@@ -226,18 +227,7 @@ def powered_packed(t, y, d, dy):
     _kernels_powered_packed(t, y, d, dy)
 
 
-def build_cyrk_powered():
-    """Address of a CyRK ``cyjit_sig`` cfunc of powered_packed (numba disk cache)."""
-    from CyRK.nb.numba_solver import cyjit_sig
-
-    @cfunc(cyjit_sig, cache=True)
-    def rhs_c(dy, t, y, d):  # pragma: no cover - runs compiled
-        dd = carray(d, (powered_size(d),))
-        ny = powered_ny(dd)
-        powered_packed(t, carray(y, (ny,)), dd, carray(dy, (ny,)))
-
-    return rhs_c.address
-'''
+''' + CYRK_POWERED_SOURCE
 
 
 @functools.cache

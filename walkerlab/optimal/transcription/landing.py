@@ -151,19 +151,12 @@ def replay_footholds(data, res, ground: StepGround, solver=None):
     import numpy as np
 
     from walkerlab.analysis.gait.poincare import StepFailed, poincare_map  # light
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.ground import on_footholds  # light
-    from walkerlab.models.hybrid.rigid import make_rigid_walker  # light
-    from walkerlab.optimal.transcription.step import torque_of_time  # light
+    from walkerlab.optimal.transcription.step import replay_actuation, torque_of_time  # light
 
-    st = data.structure
-    massless = bool(st.bodies) and all(b.massless for b in st.bodies)
-    spec = Actuation(push_off=PushOff(impulse_n_s=max(res.push_off_n_s, 0.0)),
-                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
-                                          scaled_by="foot_mass" if massless else "none")])
-    passive = make_rigid_walker(data, "biped", "derived")
+    spec, passive = replay_actuation(data, res.push_off_n_s)
     walker = on_footholds(lambda _g: passive, lambda _g: data,
                           [(d, ground.slope_rad) for d in ground.drops_m], True,
                           lambda w, d: actuate(w, d, spec))

@@ -55,7 +55,7 @@ from walkerlab.codegen.casadi_functions import casadi_function
 
 __all__ = ["OBJECTIVES", "ONE_STEP_KINDS", "CollocationResult", "CollocationSpec",
            "check_objective", "ipopt_options", "number", "positive_power", "replay",
-           "step_functions", "target_constraints", "torque_of_time"]
+           "replay_actuation", "step_functions", "target_constraints", "torque_of_time"]
 
 
 @dataclass(frozen=True)
@@ -480,6 +480,37 @@ def torque_of_time(res: CollocationResult):
     return tau
 
 
+def replay_actuation(data, push_off_n_s: float) -> tuple[object, object]:
+    """What a replay of an optimised step acts with: a hip torque law to be replaced by the
+    optimised torque of time and the optimised push-off, and the passive rigid walker.
+
+    Parameters
+    ----------
+    data : WalkerData
+        The walker's parameters (massless legs: the torque scales with the foot mass).
+    push_off_n_s : float
+        The optimised push-off impulse [N s] (a negative one is taken as 0).
+
+    Returns
+    -------
+    spec : walkerlab.config.actuation.Actuation
+        The actuation (``max_torque_n_m`` 1e6: a saturated law is never a generated spring,
+        :func:`walkerlab.models.hybrid.actuated.spring_equivalent`, so its torque is the
+        Actuators' own, which the replay replaces by the optimised one).
+    passive : HybridWalker
+        The passive rigid walker of ``data`` (the derived model).
+    """
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
+    from walkerlab.models.hybrid.rigid import make_rigid_walker  # light
+
+    st = data.structure
+    massless = bool(st.bodies) and all(b.massless for b in st.bodies)
+    spec = Actuation(push_off=PushOff(impulse_n_s=max(push_off_n_s, 0.0)),
+                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
+                                          scaled_by="foot_mass" if massless else "none")])
+    return spec, make_rigid_walker(data, "biped", "derived")
+
+
 def replay(data, res: CollocationResult, solver=None,
            drop_m: float = 0.0) -> tuple[float, object]:
     """The optimised step replayed on the rigid model (its generated code and its own
@@ -500,20 +531,11 @@ def replay(data, res: CollocationResult, solver=None,
         The replayed walker (its Floquet multipliers: :func:`walkerlab.analysis.gait.
         poincare.find_fixed_point` from ``x_0``).
     """
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.hybrid.actuated import actuate  # light
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
 
-    # a saturated law is never a generated spring (models.hybrid.actuated.spring_equivalent):
-    # its torque is the Actuators' own, which is replaced by the optimised one below
-    st = data.structure
-    massless = bool(st.bodies) and all(b.massless for b in st.bodies)
-    spec = Actuation(push_off=PushOff(impulse_n_s=max(res.push_off_n_s, 0.0)),
-                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
-                                          scaled_by="foot_mass" if massless else "none")])
-    passive = make_rigid_walker(data, "biped", "derived")
+    spec, passive = replay_actuation(data, res.push_off_n_s)
     if drop_m != 0.0:
         from walkerlab.models.hybrid.ground import on_landing
 

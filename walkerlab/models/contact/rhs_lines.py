@@ -1,0 +1,157 @@
+"""The straight-line numba source of a compliant-contact walker's right-hand side
+(:func:`rhs_source`), part of its generated contact module
+(:func:`walkerlab.models.contact.generated.contact_source`, whose cache key reads this
+file too)."""
+
+from __future__ import annotations
+
+__all__ = ["rhs_source"]
+
+
+def _cholesky_lines(nq: int, nz: set) -> list[str]:
+    """:func:`rhs_source`'s solve ``M a = Q`` (``_M<i>_<j>``, ``_Q<i>`` -> ``_a<i>``): an
+    unrolled Cholesky ``M = L L^T`` with the structural zeros ``nz`` of ``M``'s lower
+    triangle (and the fill-in) tracked, then the two triangular solves."""
+    lines, Lnz = [], set()
+    for j in range(nq):
+        terms = [f" - _L{j}_{k} * _L{j}_{k}" for k in range(j) if (j, k) in Lnz]
+        lines.append(f"    _L{j}_{j} = sqrt(_M{j}_{j}{''.join(terms)})")
+        lines.append(f"    _d{j} = 1.0 / _L{j}_{j}")
+        for i in range(j + 1, nq):
+            terms = [f" - _L{i}_{k} * _L{j}_{k}" for k in range(j)
+                     if (i, k) in Lnz and (j, k) in Lnz]
+            if (i, j) in nz or terms:
+                Lnz.add((i, j))
+                head = f"_M{i}_{j}" if (i, j) in nz else "0.0"
+                lines.append(f"    _L{i}_{j} = ({head}{''.join(terms)}) * _d{j}")
+    for i in range(nq):
+        terms = [f" - _L{i}_{k} * _y{k}" for k in range(i) if (i, k) in Lnz]
+        lines.append(f"    _y{i} = (_Q{i}{''.join(terms)}) * _d{i}")
+    for i in reversed(range(nq)):
+        terms = [f" - _L{k}_{i} * _a{k}" for k in range(i + 1, nq) if (k, i) in Lnz]
+        lines.append(f"    _a{i} = (_y{i}{''.join(terms)}) * _d{i}")
+    return lines
+
+
+def _force_lines(point_legs, Fs, forced: bool) -> list[str]:
+    """:func:`rhs_source`'s contact forces ``Fs`` (x, y per point) in the world from each
+    point's ``_point`` result ``_r<i>`` (normal and friction force along the ground's normal
+    and tangent); ``forced``: a ghost point's (of leg ``G[0]``, ``G[1]`` ahead of the other
+    leg's points) zero."""
+    lines = []
+    for i, leg in enumerate(point_legs):
+        # (Fn, Ff) in the world, along the ground's normal (the slope's: _sp, _cp)
+        fx = f"_r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]"
+        fy = f"_r{i}[4] * _r{i}[11] - _r{i}[5] * _r{i}[10]"
+        if forced:  # a ghost point: of leg G[0], ahead of the other leg's points by G[1]
+            others = ", ".join(f"_r{j}[3]" for j, lg in enumerate(point_legs) if lg != leg)
+            front = f"max({others}, -1e300)" if others.count(",") else f"{others}"
+            lines.append(f"    _ghost{i} = S[NQ + 10] == {float(leg)} and "
+                         f"_r{i}[3] - {front} >= S[NQ + 11]")
+            fx, fy = f"0.0 if _ghost{i} else {fx}", f"0.0 if _ghost{i} else {fy}"
+        lines += [f"    {Fs[2 * i]} = {fx}", f"    {Fs[2 * i + 1]} = {fy}"]
+    return lines
+
+
+def _knee_lines(eq, red, pr, Q, power: list) -> list[str]:
+    """:func:`rhs_source`'s knee-stop torques ``_T<k>`` of each leg's knee (none without
+    knees), from its extension and rate and its foot's penetration (``red``: the feet's
+    reduced kinematics, printed by ``pr``); each added into ``Q`` (+ on the thigh, - on the
+    shank) and its power ``-T d(ext)/dt`` appended to ``power``."""
+    import sympy as sp
+
+    lines = []
+    for k, (t, sh) in enumerate(eq.knees or ()):  # (thigh, shank) in q; leg k: point k
+        T = sp.Symbol(f"_T{k}", real=True)
+        # penetration of leg k's foot, -(p . n)
+        # (a polyline ground: the penetration into it, _point's)
+        dl = (f"(_r{k}[0] if PC[I_CONT] > 1.5 else "
+              f"-(({pr.doprint(red[4 * k])}) * _sp + ({pr.doprint(red[4 * k + 1])}) * _cp))")
+        lines.append(f"    {T} = _knee_torque({eq.q[sh]} - {eq.q[t]}, "
+                     f"{eq.dq[sh]} - {eq.dq[t]}, PC, {dl})")
+        Q[t] += T
+        Q[sh] -= T
+        power.append(f"-{T} * ({eq.dq[sh]} - {eq.dq[t]})")
+    return lines
+
+
+def rhs_source(eq, forced: bool = False) -> str:
+    """Straight-line numba source of ``rhs(x, PC, p, c1, c2)`` for the floating equations
+    ``eq`` (:class:`walkerlab.codegen.floating.FloatingEquations`): the feet's contact points
+    and material velocities, the contact forces and knee-stop torques from the laws, then
+    ``M`` and ``Q - h`` (common subexpressions shared) and an unrolled Cholesky solve that
+    skips the structural zeros of ``M`` (fill-in tracked).  Same equations as the array
+    functions ``dyn``/``feet`` (tests check the two agree), cheaper per call, which is
+    what CyRK's BDF pays per step.
+
+    The generated ``rhs`` takes the state ``x`` of shape (2 nq,) [m, rad, m/s, rad/s], the
+    contact parameters ``PC`` (SI), the walker's parameters ``p`` (SI) and the kernel lanes
+    ``c1``, ``c2`` [m], and returns dx/dt of shape (2 nq,).
+
+    ``forced``: the source of ``rhs_q(x, PC, p, c1, c2, S, out)`` instead (dx/dt written
+    into ``out``, the first 2 nq entries; ``S`` the scratch of
+    :mod:`walkerlab.models.contact.powered_source`), the same arithmetic with the
+    generalised force ``S[:nq]`` [N, N m] added to ``Q - h`` before the solve (an actuated
+    walker's forces), and ``S[nq + 6]``, ``S[nq + 7]`` filled with the contact forces' power
+    ``sum F . v`` over the contact points (their material velocities) and the knee stops'
+    power ``-T d(ext)/dt`` [W]; ``S[nq + 10:nq + 12]`` = ``G``:
+    the contact points of leg ``G[0]`` (0: leg1, 1: leg2; -1: none) at least ``G[1]`` [m]
+    ahead (along the ground) of every point of the other leg carry no contact force (a
+    *ghost* swing foot: up to its touchdown ahead the run is the same, and a compiled run
+    locates that touchdown without integrating the collision it starts,
+    :mod:`walkerlab.integrate.compiled_segments`).
+    """
+    import sympy as sp
+    from sympy.printing.pycode import PythonCodePrinter
+
+    pr = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
+    nq = len(eq.q)
+    dqv = sp.Matrix(eq.dq)
+    head = ("def rhs_q(x, PC, p, c1, c2, S, out):" if forced
+            else "def rhs(x, PC, p, c1, c2):")
+    lines = ["@njit(cache=True, error_model='numpy')", head,
+             '    """dx/dt (NX,) of the free-floating walker (generated straight-line code)."""',
+             f"    {', '.join(str(s) for s in eq.params)}, = p"]
+    lines += [f"    {s} = x[{i}]" for i, s in enumerate(eq.q)]
+    lines += [f"    {s} = x[{nq + i}]" for i, s in enumerate(eq.dq)]
+    lines += ["    _sp = _sin(PC[I_PHI])", "    _cp = _cos(PC[I_PHI])"]
+    kin = []
+    for pos, J in eq.feet:
+        v = J * dqv
+        kin += [pos[0], pos[1], v[0], v[1]]
+    repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
+    lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
+    Fs = sp.symbols(" ".join(f"_Fx{i} _Fy{i}" for i in range(len(eq.feet))), real=True)
+    power = []  # forced: each point's F . v
+    for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
+        args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
+        power.append(f"{Fs[2 * i]} * ({pr.doprint(red[4 * i + 2])}) + "
+                     f"{Fs[2 * i + 1]} * ({pr.doprint(red[4 * i + 3])})")
+        lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
+    lines += _force_lines(eq.point_legs, Fs, forced)
+    Q = -eq.h
+    for i, (_, J) in enumerate(eq.feet):
+        Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])
+    lines += _knee_lines(eq, red, pr, Q, power)
+    nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}
+    mexprs = [eq.M[i, j] for i in range(nq) for j in range(i + 1) if (i, j) in nz]
+    repl, red = sp.cse(mexprs + list(Q), symbols=sp.numbered_symbols("_m"), order="none")
+    lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
+    it = iter(red)
+    for i in range(nq):
+        for j in range(i + 1):
+            if (i, j) in nz:
+                lines.append(f"    _M{i}_{j} = {pr.doprint(next(it))}")
+    for i in range(nq):
+        lines.append(f"    _Q{i} = {pr.doprint(next(it))}" + (f" + S[{i}]" if forced else ""))
+    if forced:
+        nf = len(eq.feet)
+        lines.append(f"    S[NQ + 6] = {' + '.join(power[:nf])}")
+        lines.append(f"    S[NQ + 7] = {' + '.join(power[nf:]) or '0.0'}")
+    lines += _cholesky_lines(nq, nz)
+    outs = [str(s) for s in eq.dq] + [f"_a{i}" for i in range(nq)]
+    if forced:  # into the caller's array (no allocation per call)
+        lines += [f"    out[{i}] = {o}" for i, o in enumerate(outs)]
+    else:
+        lines.append(f"    return np.array(({', '.join(outs)},))")
+    return "\n".join(lines) + "\n"
