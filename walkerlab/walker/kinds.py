@@ -120,6 +120,37 @@ class Kind:
         ``links``, a tree of leg links (:func:`walkerlab.walker.multibody.multibody`);
         ``wheel`` and ``wheel_3d``, one rigid body on its spokes; ``legs_3d``, a free
         pelvis and two legs on hip joints.
+    rigid : str
+        The rigid model's maker (:data:`walkerlab.models.hybrid.rigid.BUILDERS`): ``legs``,
+        a generated flow and the heel-strike reset of straight or locking-knee legs;
+        ``flat``, the flat feet's foot-mode phase graph; ``free``, every joint free (one
+        flow per step); ``wheel``, a spoked wheel.
+    knees : str
+        ``none`` (straight legs), ``locking`` (free in early swing, locked at the knee
+        strike) or ``free`` (a free joint all along, driven by torques).
+    feet : str
+        ``leg_ends`` (point or arc feet at the legs' ends) or ``flat`` (a foot body on an
+        ankle spring, with foot modes): the exports' feet
+        (:data:`walkerlab.export.scene.SCENE_FEET`, :data:`walkerlab.export.adams_feet.
+        ADAMS_FEET`).
+    landing : str or None
+        How the rigid view lands on stairs and footholds
+        (:data:`walkerlab.models.hybrid.ground.LANDINGS`): ``clearance``, the generated
+        swing clearance; ``flat``, a guard per stance mode; None, not at all (the
+        capability table refuses it first).
+    contact : str or None
+        The contact view's part (:data:`walkerlab.models.contact.parts.PARTS`), None for a
+        walker the contact view refuses.
+    actuators : str
+        How the rigid model drives it (:mod:`walkerlab.models.hybrid.actuated`): ``hips``,
+        ``latched_knees``, ``joints`` (every joint free), ``ankles`` (flat feet) or
+        ``none`` (passive: the capability table refuses every actuator).
+    collocation : str or None
+        Its transcription in the direct collocation (:data:`walkerlab.optimal.driver.PARTS`):
+        ``legs`` (one step, straight legs), ``kneed`` and ``flat`` (phased), ``five_link``
+        (the five-link biped's own); None, not transcribed.
+    scene : str
+        Its shipped reference scene (:data:`walkerlab.config.reference_cases.SCENES`).
     """
 
     name: str
@@ -127,6 +158,31 @@ class Kind:
     reference: str
     field: str = "walker"
     body: str = "links"
+    rigid: str = "legs"
+    knees: str = "none"
+    feet: str = "leg_ends"
+    landing: str | None = "clearance"
+    contact: str | None = None
+    actuators: str = "none"
+    collocation: str | None = None
+    scene: str = ""
+
+    @property
+    def in_3d(self) -> bool:
+        """Whether the walker moves in three dimensions (``walker.space: 3d``)."""
+        return self.body in ("wheel_3d", "legs_3d")
+
+    @property
+    def joints_free(self) -> bool:
+        """Whether every joint is free, driven by torques (the five-link biped, the
+        three-link walker): their models are derived alike."""
+        return self.rigid == "free"
+
+    @property
+    def feet_have_modes(self) -> bool:
+        """Whether the stance foot goes through foot modes (flat feet: heel contact, foot
+        flat, heel off)."""
+        return self.feet == "flat"
 
     @property
     def spoked(self) -> bool:
@@ -187,22 +243,34 @@ class Kind:
 #: every kind, in the order tables list them
 KINDS = {k.name: k for k in (
     Kind("straight_legs", "straight legs (point or arc feet)",
-         "Goswami, Thuilot & Espiau 1996; Garcia et al. 1998; Kuo 2002"),
+         "Goswami, Thuilot & Espiau 1996; Garcia et al. 1998; Kuo 2002",
+         contact="legs", actuators="hips", collocation="legs",
+         scene="configs/paper_rods.yaml"),
     Kind("locking_knees", "knees that lock at the knee strike",
-         "McGeer 1990 (passive walking with knees); Hsu Chen 2007"),
+         "McGeer 1990 (passive walking with knees); Hsu Chen 2007", knees="locking",
+         contact="kneed", actuators="latched_knees", collocation="kneed",
+         scene="configs/kneed.yaml"),
     Kind("flat_feet", "flat feet on ankle springs (foot modes)",
-         "McGeer 1990; Collins, Wisse & Ruina 2001"),
+         "McGeer 1990; Collins, Wisse & Ruina 2001", rigid="flat", feet="flat",
+         landing="flat", contact="flat", actuators="ankles", collocation="flat",
+         scene="configs/flat_feet.yaml"),
     Kind("free_joints", "free hips and knees, hinged torso (five-link biped)",
-         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)"),
+         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)", rigid="free", knees="free",
+         contact="five_link", actuators="joints", collocation="five_link",
+         scene="configs/rabbit.yaml"),
     Kind("hinged_torso", "a torso hinged on straight legs (three-link walker)",
          "Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau, Choi & Morris "
-         "2007"),
+         "2007", rigid="free", contact="three_link", actuators="joints",
+         scene="configs/threelink.yaml"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
-         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", body="wheel"),
+         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", body="wheel", rigid="wheel",
+         contact="wheel", scene="configs/rimless_wheel.yaml"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
-         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d"),
+         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d", rigid="wheel",
+         landing=None, scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
-         "Kuo 1999", "walker.space: 3d", "legs_3d"),
+         "Kuo 1999", "walker.space: 3d", "legs_3d", landing=None,
+         scene="configs/hip_width.yaml"),
 )}
 
 _NO_KNEE = "the legs are straight: there is no knee"
