@@ -359,11 +359,11 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     ``note`` and ``detail``, and on the docs' page; no other kind's cells do."""
     import importlib.util
 
-    from walkerlab.export.parts import EXPORT_PARTS
+    from walkerlab.export.parts import kind_part
     from walkerlab.walker.capability_tables import kind_grid, text
     from walkerlab.walker.kinds import KNEE_LATCH_OSIM, table_rows
 
-    latched = {k for k, part in EXPORT_PARTS.items() if part.knee_stops}
+    latched = {k for k, kind in KINDS.items() if kind_part(kind).knee_stops}
     assert latched == {"locking_knees"}
     for row in table_rows():
         if row["supported"] and row["view"] == "osim":

@@ -425,12 +425,12 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     parts = [p for p in model.by_kind["PART"] if p != 1]
     total = sum(model.part_mass(p) for p in parts)
     want = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
-    if data.structure.kind.name == "flat_feet" and not data.structure.foot_mass:
+    if data.structure.kind.feet_have_modes and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's
         # regularising mass (contact.flat_foot_mass_kg), as it documents
-        from walkerlab.export.scene import flat_feet
+        from walkerlab.export.scene import flat_foot_bodies
 
-        want += sum(f[5] for f in flat_feet(scene, data))
+        want += sum(f[5] for f in flat_foot_bodies(scene, data))
     dev = abs(total / want - 1.0)
     return dev, f"{len(parts)} parts, {total:.6g} kg against {want:.6g} kg"
 
