@@ -33,7 +33,7 @@ from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
 
 ROOT = Path(__file__).resolve().parents[1]
 
-from walkerlab.config.reference_cases import (  # noqa: E402 - the cases the table is tried on
+from walkerlab.walker.reference_cases import (  # noqa: E402 - the cases the table is tried on
     FIVE_LINK_JOINT,
     JOINT,
     SCENES,

@@ -1,6 +1,6 @@
 """The capability table's evidence, measured: each supported cell (a kind's feature in a
 view, :data:`walkerlab.walker.kinds.CAPABILITIES`) run on its reference case
-(:func:`walkerlab.config.reference_cases.reference_scene`) and checked against a reference
+(:func:`walkerlab.walker.reference_cases.reference_scene`) and checked against a reference
 the cell does not compute itself.
 
 By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
@@ -68,7 +68,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import scene_from_dict
-from walkerlab.config.reference_cases import reference_scene
+from walkerlab.walker.reference_cases import reference_scene
 from walkerlab.walker.kinds import KINDS
 
 __all__ = ["CHECKS", "CONE", "QUANTITIES", "Measurement", "measure"]
@@ -284,7 +284,7 @@ def _rigid_steps_per_period(fp) -> int:
 def _slope_of_profile(d: dict) -> dict | None:
     """The scene ``d`` on its own slope, when its ground is a profile that is that slope (a
     straight line of the scene's slope to 1e-12 m: the profile reference cases,
-    :func:`walkerlab.config.reference_cases.slope_profile`), on the same lanes; else
+    :func:`walkerlab.walker.reference_cases.slope_profile`), on the same lanes; else
     None."""
     t = d.get("terrain") or {}
     if t.get("kind") != "profile" or not t.get("profile_m"):

@@ -150,7 +150,7 @@ class Kind:
         ``legs`` (one step, straight legs), ``kneed`` and ``flat`` (phased), ``five_link``
         (the five-link biped's own); None, not transcribed.
     scene : str
-        Its shipped reference scene (:data:`walkerlab.config.reference_cases.SCENES`).
+        Its shipped reference scene (:data:`walkerlab.walker.reference_cases.SCENES`).
     """
 
     name: str
