@@ -13,10 +13,10 @@ import math
 import pytest
 
 from walkerlab.config import scene_from_dict
-from walkerlab.walker.reference_cases import reference_scene
 from walkerlab.walker.capability_evidence import cell_evidence, evidence, verified
 from walkerlab.walker.capability_tables import SUPPORTED, grids
 from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS, table_rows
+from walkerlab.walker.reference_cases import reference_scene
 
 SUPPORTED_CELLS = [(r["kind"], r["feature"], r["view"]) for r in table_rows()
                    if r["supported"]]

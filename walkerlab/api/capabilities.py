@@ -68,8 +68,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import scene_from_dict
-from walkerlab.walker.reference_cases import reference_scene
 from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.reference_cases import reference_scene
 
 __all__ = ["CHECKS", "CONE", "QUANTITIES", "Measurement", "measure"]
 
