@@ -690,9 +690,8 @@ class Collocation:
     legs_cross_level: bool = False
 
 
-#: the collocation's part for each walker kind it takes, by
-#: :attr:`walkerlab.walker.kinds.Kind.collocation` (the spoked wheel has none: refused from
-#: the capability table, :func:`_part`)
+#: the collocation's part of each kind it takes, by :attr:`Kind.collocation` (the spoked
+#: wheel has none: refused from the capability table, :func:`_part`)
 PARTS = {
     "legs": Collocation(_straight_legs, target_step=True, legs_cross_level=True),
     "kneed": Collocation(_phased),
