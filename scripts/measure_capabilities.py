@@ -67,7 +67,7 @@ def _timed(measure, kind, feature, view, tmp) -> dict:
     try:
         return measure(kind, feature, view, tmp).as_dict()
     except _Timeout:
-        from walkerlab.config.reference_cases import reference_scene
+        from walkerlab.walker.reference_cases import reference_scene
 
         q, tol, unit = QUANTITIES[view]
         case = reference_scene(kind, feature, view)[0]

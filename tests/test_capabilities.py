@@ -33,7 +33,7 @@ from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
 
 ROOT = Path(__file__).resolve().parents[1]
 
-from walkerlab.config.reference_cases import (  # noqa: E402 - the cases the table is tried on
+from walkerlab.walker.reference_cases import (  # noqa: E402 - the cases the table is tried on
     FIVE_LINK_JOINT,
     JOINT,
     SCENES,
@@ -257,14 +257,25 @@ def test_the_command_and_the_docs_show_the_table():
     assert "capability-table" in (ROOT / "docs" / "reference" / "capabilities.rst").read_text()
 
 
-def test_every_per_kind_table_of_the_stages_and_integrators_names_every_kind():
-    """The part tables keyed by kind name name every kind (the three-link walker's
-    ``export --walk`` failed with KeyError 'hinged_torso' in the export stage's table)."""
+def test_every_part_table_has_the_part_of_every_kind_it_takes():
+    """Each layer's table of parts, keyed by the kind's part word for that layer, has the
+    part of every kind (the three-link walker's ``export --walk`` failed with KeyError
+    'hinged_torso' in the export stage's table, when the tables were keyed by kind name)."""
     from walkerlab.export.writers import BODIES
-    from walkerlab.integrate.rigid import _SCIPY_RUNS_ACTUATED_COMPILED
+    from walkerlab.models.contact.parts import PARTS as CONTACT
+    from walkerlab.models.hybrid.actuated import _PARTS as ACTUATORS
+    from walkerlab.models.hybrid.ground import LANDINGS
+    from walkerlab.models.hybrid.rigid import BUILDERS
 
-    assert set(_SCIPY_RUNS_ACTUATED_COMPILED) == set(KINDS)
-    assert {kind.body for kind in KINDS.values()} <= set(BODIES)  # the export's writers
+    kinds = KINDS.values()
+    assert {kind.body for kind in kinds} <= set(BODIES)  # the export's writers
+    assert {kind.rigid for kind in kinds} == set(BUILDERS)
+    assert {kind.actuators for kind in kinds} == set(ACTUATORS)
+    assert {kind.landing for kind in kinds} - {None} == set(LANDINGS)
+    assert {kind.contact for kind in kinds} - {None} == set(CONTACT)
+    for kind in kinds:  # a view without a part for the kind refuses the walker itself
+        assert (kind.landing is None) == (kind.cell("stairs", "rigid") is not None), kind
+        assert (kind.contact is None) == (kind.cell("walk", "contact") is not None), kind
 
 
 # ------------------------------------------- a refusal the table decides comes first (64, 6)
@@ -348,11 +359,11 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     ``note`` and ``detail``, and on the docs' page; no other kind's cells do."""
     import importlib.util
 
-    from walkerlab.export.parts import EXPORT_PARTS
+    from walkerlab.export.parts import kind_part
     from walkerlab.walker.capability_tables import kind_grid, text
     from walkerlab.walker.kinds import KNEE_LATCH_OSIM, table_rows
 
-    latched = {k for k, part in EXPORT_PARTS.items() if part.knee_stops}
+    latched = {k for k, kind in KINDS.items() if kind_part(kind).knee_stops}
     assert latched == {"locking_knees"}
     for row in table_rows():
         if row["supported"] and row["view"] == "osim":

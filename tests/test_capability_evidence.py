@@ -13,10 +13,10 @@ import math
 import pytest
 
 from walkerlab.config import scene_from_dict
-from walkerlab.config.reference_cases import reference_scene
 from walkerlab.walker.capability_evidence import cell_evidence, evidence, verified
 from walkerlab.walker.capability_tables import SUPPORTED, grids
 from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS, table_rows
+from walkerlab.walker.reference_cases import reference_scene
 
 SUPPORTED_CELLS = [(r["kind"], r["feature"], r["view"]) for r in table_rows()
                    if r["supported"]]
@@ -205,7 +205,7 @@ def test_a_torque_features_shipped_reference_case_drives_the_features_joint():
     joint (RABBIT's swing_hip law is its hip torque, its stance_hip law its torso torque):
     a case without the joint's law would measure the passive walk under the feature's
     name."""
-    from walkerlab.config.reference_cases import FIVE_LINK_JOINT, JOINT, SHIPPED, TORSO_HIPS
+    from walkerlab.walker.reference_cases import FIVE_LINK_JOINT, JOINT, SHIPPED, TORSO_HIPS
 
     checked = 0
     for (kind, feature), _ in SHIPPED.items():
@@ -227,7 +227,7 @@ def test_a_torque_features_shipped_reference_case_drives_the_features_joint():
 def test_a_walking_generated_case_carries_its_changes_and_says_why():
     """Each generated case changed so that it walks (reference_cases.WALKING) carries its
     changes in the scene every view measures, validates, and names why in its case."""
-    from walkerlab.config.reference_cases import WALKING
+    from walkerlab.walker.reference_cases import WALKING
 
     for (kind, feature), (why, changes) in WALKING.items():
         for view in VIEWS:
@@ -248,7 +248,7 @@ def test_the_stairs_cases_are_their_slopes_step_as_a_stair():
     pi / n) landing a riser 2 l sin(alpha) sin(phi) below and a tread 2 l sin(alpha)
     cos(phi) ahead meet the ground at the slope's angles (Coleman, Chatterjee & Ruina 1997);
     the kneed walker's riser is its step's drop on the slope (0.4747 m x sin 0.0504)."""
-    from walkerlab.config.reference_cases import WALKING, _shipped
+    from walkerlab.walker.reference_cases import WALKING, _shipped
 
     w = _shipped("rimless_wheel")
     alpha, phi = math.pi / w["walker"]["spokes"], w["slope"]["angle_rad"]

@@ -371,9 +371,9 @@ def test_both_views_refuse_a_profile_as_the_tables_gym_cell_does(kind):
     """The capability table refuses a profile in the gym for flat feet and the three-link
     walker (the rigid walk of a profile takes neither); before, the contact view took their
     profile reference cases anyway.  Now both views refuse it in the table's one line."""
-    from walkerlab.config.reference_cases import reference_scene
     from walkerlab.gym.env import WalkerEnv
     from walkerlab.walker.kinds import KINDS
+    from walkerlab.walker.reference_cases import reference_scene
 
     why = KINDS[kind].cell("profile", "gym")
     assert why is not None

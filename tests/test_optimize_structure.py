@@ -88,16 +88,19 @@ def _switch_reads(tree) -> list:
 
 def test_the_transcription_is_reached_through_the_walker_kind():
     """The driver has one part per walker kind it takes (:data:`walkerlab.optimal.driver.
-    PARTS`, by the kind's name: every kind whose ``walk`` the capability table supports in
-    ``optimize``); no module of ``walkerlab/optimal/`` reads a switch of the description to
-    choose its code (nor ``getattr`` for the walker's actuation); the spoked wheel and the
-    torso hinged on straight legs are refused from the capability table."""
+    PARTS`, by the kind's collocation part, :attr:`walkerlab.walker.kinds.Kind.collocation`:
+    every kind whose ``walk`` the capability table supports in ``optimize``); no module of
+    ``walkerlab/optimal/`` reads a switch of the description to choose its code (nor
+    ``getattr`` for the walker's actuation); the spoked wheel and the torso hinged on
+    straight legs are refused from the capability table."""
     from walkerlab.optimal.driver import PARTS
     from walkerlab.walker.kinds import KINDS
 
-    assert set(PARTS) == {k for k, kind in KINDS.items() if kind.supports("walk", "optimize")}
-    assert set(KINDS) - set(PARTS) == {"rolling_polygon", "rolling_polygon_3d", "hinged_torso",
-                                       "straight_legs_3d"}
+    taken = {k for k, kind in KINDS.items() if kind.collocation in PARTS}
+    assert taken == {k for k, kind in KINDS.items() if kind.supports("walk", "optimize")}
+    assert {kind.collocation for kind in KINDS.values()} - {None} == set(PARTS)
+    assert set(KINDS) - taken == {"rolling_polygon", "rolling_polygon_3d", "hinged_torso",
+                                  "straight_legs_3d"}
     assert not KINDS["rolling_polygon"].supports("walk", "optimize")
     mods = sorted((PKG / "optimal").rglob("*.py")) + [PKG / "stages" / "optimize.py"]
     bad = {str(p.relative_to(PKG)): got for p in mods

@@ -1,6 +1,6 @@
 """The capability table's evidence, measured: each supported cell (a kind's feature in a
 view, :data:`walkerlab.walker.kinds.CAPABILITIES`) run on its reference case
-(:func:`walkerlab.config.reference_cases.reference_scene`) and checked against a reference
+(:func:`walkerlab.walker.reference_cases.reference_scene`) and checked against a reference
 the cell does not compute itself.
 
 By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
@@ -68,8 +68,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import scene_from_dict
-from walkerlab.config.reference_cases import reference_scene
 from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.reference_cases import reference_scene
 
 __all__ = ["CHECKS", "CONE", "QUANTITIES", "Measurement", "measure"]
 
@@ -284,7 +284,7 @@ def _rigid_steps_per_period(fp) -> int:
 def _slope_of_profile(d: dict) -> dict | None:
     """The scene ``d`` on its own slope, when its ground is a profile that is that slope (a
     straight line of the scene's slope to 1e-12 m: the profile reference cases,
-    :func:`walkerlab.config.reference_cases.slope_profile`), on the same lanes; else
+    :func:`walkerlab.walker.reference_cases.slope_profile`), on the same lanes; else
     None."""
     t = d.get("terrain") or {}
     if t.get("kind") != "profile" or not t.get("profile_m"):
@@ -425,12 +425,12 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     parts = [p for p in model.by_kind["PART"] if p != 1]
     total = sum(model.part_mass(p) for p in parts)
     want = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
-    if data.structure.kind.name == "flat_feet" and not data.structure.foot_mass:
+    if data.structure.kind.feet_have_modes and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's
         # regularising mass (contact.flat_foot_mass_kg), as it documents
-        from walkerlab.export.scene import flat_feet
+        from walkerlab.export.scene import flat_foot_bodies
 
-        want += sum(f[5] for f in flat_feet(scene, data))
+        want += sum(f[5] for f in flat_foot_bodies(scene, data))
     dev = abs(total / want - 1.0)
     return dev, f"{len(parts)} parts, {total:.6g} kg against {want:.6g} kg"
 

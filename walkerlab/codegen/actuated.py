@@ -244,7 +244,7 @@ def actuated_module(structure, joints):
     tag = hashlib.sha256(f"{joints!r}{_source_hash()}".encode()).hexdigest()[:12]
 
     def build() -> str:
-        if structure.kind.name in cache.FREE_JOINTED:
+        if structure.kind.joints_free:
             from walkerlab.codegen.free_joints import derive_five_link  # light
 
             eq = derive_five_link(structure)

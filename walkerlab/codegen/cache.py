@@ -81,14 +81,11 @@ def _five_link_generator_hash() -> str:
     return hashlib.sha256((Path(__file__).parent / "free_joints.py").read_bytes()).hexdigest()
 
 
-#: the walker kinds :mod:`walkerlab.codegen.free_joints` derives
-FREE_JOINTED = ("free_joints", "hinged_torso")
-
-
 def _free_jointed(structure) -> bool:
-    """Whether :mod:`walkerlab.codegen.free_joints` derives the walker (its kinds
-    ``free_joints``, free knees, and ``hinged_torso``, a hinged torso on straight legs)."""
-    return structure.kind.name in FREE_JOINTED
+    """Whether :mod:`walkerlab.codegen.free_joints` derives the walker (the free-jointed
+    kinds, :attr:`walkerlab.walker.kinds.Kind.joints_free`: free knees, and a hinged torso
+    on straight legs)."""
+    return structure.kind.joints_free
 
 
 def cache_key(structure) -> str:

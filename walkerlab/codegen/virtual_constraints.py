@@ -28,11 +28,9 @@ __all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_expres
 def derive_equations(structure):
     """The walker's symbolic equations (:class:`walkerlab.codegen.symbolic.Equations`), as
     its generated flow derives them (the free-jointed kinds, free knees or a hinged torso:
-    the free-joint generator, :data:`walkerlab.codegen.cache.FREE_JOINTED`; else the biped
+    the free-joint generator, :attr:`walkerlab.walker.kinds.Kind.joints_free`; else the biped
     generator)."""
-    from walkerlab.codegen import cache
-
-    if structure.kind.name in cache.FREE_JOINTED:
+    if structure.kind.joints_free:
         from walkerlab.codegen.free_joints import derive_five_link  # light
 
         return derive_five_link(structure)

@@ -374,7 +374,7 @@ def actuation_statements(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: b
             out += _hip_torques(act, hips["leg1"], hips["leg2"], hip)
         out += _ankle_torques(mb, act, ids, hips, ankle, phase=not hip)
     elif any(t.joint != "hip" for t in act.torques):
-        if "torso" not in ids or mb.kind not in ("free_joints", "hinged_torso"):
+        if "torso" not in ids or not KINDS[mb.kind].joints_free:
             raise ValueError(f"walker.actuation.torques: {FREE_JOINT_TORQUES}")
         if any(t.joint == "hip" for t in act.torques):
             raise ValueError("walker.actuation.torques: the Adams dataset drives a hinged "

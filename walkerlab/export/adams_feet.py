@@ -24,6 +24,7 @@ from walkerlab.export.adams_statements import (
     part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.walker.kinds import KINDS
 
 __all__ = ["ADAMS_FEET", "ANKLE_JOINT", "ANKLE_SPRING", "FOOT_FORCES", "FlatFeet",
            "LegEndFeet", "adams_feet", "contact_pairs", "hip_link", "leg_end", "part_ids"]
@@ -141,10 +142,10 @@ class FlatFeet(LegEndFeet):
         return {"leg1_foot": first, "leg2_foot": first + 1}
 
     def scene_feet(self, scene: Scene, data):
-        """:func:`walkerlab.export.scene.flat_feet`."""
-        from walkerlab.export.scene import flat_feet
+        """:func:`walkerlab.export.scene.flat_foot_bodies`."""
+        from walkerlab.export.scene import flat_foot_bodies
 
-        return flat_feet(scene, data)
+        return flat_foot_bodies(scene, data)
 
     def start(self, scene: Scene, mb, data, ideal, extra, lanes, heights) -> AdamsStart:
         """The MJCF keyframe: the rigid heel strike's double support (rates not scaled)."""
@@ -195,16 +196,14 @@ class FlatFeet(LegEndFeet):
                 {g: marker_id(ids[f"{g}_foot"], "foot") for g in LEGS})
 
 
-#: kind name -> the dataset's feet of that kind (the rolling polygon has no Adams dataset:
-#: :data:`walkerlab.walker.kinds.CAPABILITIES`)
-ADAMS_FEET = {"straight_legs": LegEndFeet(), "locking_knees": LegEndFeet(),
-              "flat_feet": FlatFeet(), "free_joints": LegEndFeet(),
-              "hinged_torso": LegEndFeet()}
+#: feet (:attr:`walkerlab.walker.kinds.Kind.feet`) -> the dataset's feet of that kind (the
+#: rolling polygon has no Adams dataset: :data:`walkerlab.walker.kinds.CAPABILITIES`)
+ADAMS_FEET = {"leg_ends": LegEndFeet(), "flat": FlatFeet()}
 
 
 def adams_feet(mb) -> LegEndFeet:
     """The feet of the multibody walker's kind (``mb.kind``)."""
-    return ADAMS_FEET[mb.kind]
+    return ADAMS_FEET[KINDS[mb.kind].feet]
 
 
 def part_ids(mb) -> dict[str, int]:
@@ -242,7 +241,7 @@ def _flat_foot_parts(mb, start: AdamsStart, ids: dict, lanes: bool, frames: dict
     revolute's markers coincide), contact spheres at heel (``foot`` marker) and toe
     (``toe`` marker),
     radius :func:`walkerlab.export.mjcf_scene.point_foot_radius` as a point foot's.
-    ``feet``: :func:`walkerlab.export.scene.flat_feet`."""
+    ``feet``: :func:`walkerlab.export.scene.flat_foot_bodies`."""
     out = ["!", "! ---- flat feet: parts on the ankles (the contact model's mass) ----"]
     for k, leg in enumerate(LEGS):
         heel, toe, _k, _c, _rest, mass, inertia = feet[k]

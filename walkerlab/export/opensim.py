@@ -18,7 +18,7 @@ Bodies and joints:
 - ``PinJoint`` ``leg<i>_hip`` (coordinate = the absolute link angle, the base does not
   rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``;
 - flat feet: a ``Body`` ``leg<i>_sole`` per leg (the MJCF's foot mass and inertia at the
-  ankle, :func:`walkerlab.export.scene.flat_feet`) on a ``PinJoint`` ``leg<i>_ankle`` at
+  ankle, :func:`walkerlab.export.scene.flat_foot_bodies`) on a ``PinJoint`` ``leg<i>_ankle`` at
   the leg's end (the angle from the leg's perpendicular, positive toe up), its ankle spring
   a ``SpringGeneralizedForce``, contact spheres at its heel (``leg<i>_foot``) and toe
   (``leg<i>_toe``).
@@ -151,7 +151,7 @@ class OsimGait:
     flat_feet : tuple or None
         Flat feet, per leg (leg1, leg2) ``(heel [m], toe [m], ankle stiffness [N m/rad],
         damping [N m s/rad], rest angle [rad], foot mass [kg], inertia about the ankle
-        [kg m^2])`` (:func:`walkerlab.export.scene.flat_feet`, the MJCF's); then ``qpos`` and
+        [kg m^2])`` (:func:`walkerlab.export.scene.flat_foot_bodies`, the MJCF's); then ``qpos`` and
         ``qvel`` hold the ankles after their legs (:func:`osim_coordinates`).  None: no
         foot bodies.
     """
@@ -384,7 +384,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
                          "patches on the treads")
     ms = mjcf_scene(scene, mb, data, ideal)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
-                           flat_foot=SCENE_FEET[mb.kind].foot_mass(settings))
+                           flat_foot=SCENE_FEET[KINDS[mb.kind].feet].foot_mass(settings))
     ell = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:

@@ -1,8 +1,8 @@
 """The export's part of each walker kind: what the writers (URDF, MJCF, Adams, OpenSim) do
-differently for a kind, reached through the kind's name (:mod:`walkerlab.walker.kinds`).
+differently for a kind, made from the kind's parts (:mod:`walkerlab.walker.kinds`).
 
 The writers never ask the description's switches (flat feet, free knees, spokes) which code
-runs: they look the walker's kind up in :data:`EXPORT_PARTS` (the Adams dataset's foot
+runs: they ask the walker's kind for its part, :func:`export_part` (the Adams dataset's foot
 statements in :data:`walkerlab.export.adams_feet.ADAMS_FEET`, the MJCF scene's feet in
 :data:`walkerlab.export.scene.SCENE_FEET`, the export stage's writer per kind in
 ``walkerlab.stages.export``).  Whether a kind is exported in a format at all is the
@@ -13,7 +13,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["EXPORT_PARTS", "ExportPart", "export_part"]
+from walkerlab.walker.kinds import KINDS, Kind
+
+__all__ = ["ExportPart", "export_part", "kind_part"]
 
 _HIP_SIDECAR = ("hip torques act +tau on the swing leg's hip joint and -tau on the stance "
                 "leg's; the push-off is an impulse along the trailing leg at its foot at each "
@@ -53,46 +55,53 @@ class ExportPart:
     ankles: bool = False
 
 
-#: kind name -> its export part (:data:`walkerlab.walker.kinds.KINDS`)
-EXPORT_PARTS = {
-    "straight_legs": ExportPart(),
-    "locking_knees": ExportPart(knee_stops=True),
-    "flat_feet": ExportPart(ankles=True),
-    "free_joints": ExportPart(
-        mjcf_actuators=(
-            "Actuators (walker.actuation, in the custom text walkerlab_actuation): "
-            "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip and "
-            "leg<i>_knee_motor on the knees, for a controller of one's own; "
-            "walkerlab's stepping loop applies each law's torque in its joint's present "
-            "role (stance_hip, swing_knee, ...: leg2 stands at the keyframe, the roles "
-            "swap at each heel strike) as generalised forces (qfrc_applied), the phase "
-            "variable the virtual stance leg's angle (hip to stance foot) "
-            "(walkerlab.export.mujoco_walk)."),
-        sidecar_actuators=(
-            "joint torques on a five-link biped: stance_hip / swing_hip act +tau on the "
-            "stance / swing leg's hip joint and -tau on torso_hip, stance_knee / swing_knee "
-            "+tau on that leg's knee; leg2 stands at the keyframe, the roles swap at each "
-            "heel strike; the phase variable is the angle of the line from the hip to the "
-            "stance foot from the downward vertical")),
-    "hinged_torso": ExportPart(
-        mjcf_actuators=(
-            "Actuators (walker.actuation, in the custom text walkerlab_actuation): "
-            "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip, for a "
-            "controller of one's own; walkerlab's stepping loop applies each law's torque "
-            "in its joint's present role (stance_hip, swing_hip: leg2 stands at the "
-            "keyframe, the roles swap at each heel strike) as generalised forces "
-            "(qfrc_applied), the phase variable the stance leg's angle "
-            "(walkerlab.export.mujoco_walk)."),
-        sidecar_actuators=(
-            "joint torques between a hinged torso and straight legs: stance_hip / swing_hip "
-            "act +tau on the stance / swing leg's hip joint and -tau on torso_hip; leg2 "
-            "stands at the keyframe, the roles swap at each heel strike; the phase variable "
-            "is the stance leg's angle from the downward vertical")),
-    "rolling_polygon": ExportPart(),
-}
+#: the actuator notes of a free-jointed walker
+#: (:attr:`walkerlab.walker.kinds.Kind.joints_free`) on free knees (the five-link biped)
+_FREE_KNEES = {
+    "mjcf_actuators": (
+        "Actuators (walker.actuation, in the custom text walkerlab_actuation): "
+        "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip and "
+        "leg<i>_knee_motor on the knees, for a controller of one's own; "
+        "walkerlab's stepping loop applies each law's torque in its joint's present "
+        "role (stance_hip, swing_knee, ...: leg2 stands at the keyframe, the roles "
+        "swap at each heel strike) as generalised forces (qfrc_applied), the phase "
+        "variable the virtual stance leg's angle (hip to stance foot) "
+        "(walkerlab.export.mujoco_walk)."),
+    "sidecar_actuators": (
+        "joint torques on a five-link biped: stance_hip / swing_hip act +tau on the "
+        "stance / swing leg's hip joint and -tau on torso_hip, stance_knee / swing_knee "
+        "+tau on that leg's knee; leg2 stands at the keyframe, the roles swap at each "
+        "heel strike; the phase variable is the angle of the line from the hip to the "
+        "stance foot from the downward vertical")}
+
+#: the actuator notes of a free-jointed walker on straight legs (the three-link walker)
+_STRAIGHT_LEGS = {
+    "mjcf_actuators": (
+        "Actuators (walker.actuation, in the custom text walkerlab_actuation): "
+        "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip, for a "
+        "controller of one's own; walkerlab's stepping loop applies each law's torque "
+        "in its joint's present role (stance_hip, swing_hip: leg2 stands at the "
+        "keyframe, the roles swap at each heel strike) as generalised forces "
+        "(qfrc_applied), the phase variable the stance leg's angle "
+        "(walkerlab.export.mujoco_walk)."),
+    "sidecar_actuators": (
+        "joint torques between a hinged torso and straight legs: stance_hip / swing_hip "
+        "act +tau on the stance / swing leg's hip joint and -tau on torso_hip; leg2 "
+        "stands at the keyframe, the roles swap at each heel strike; the phase variable "
+        "is the stance leg's angle from the downward vertical")}
+
+
+def kind_part(kind: Kind) -> ExportPart:
+    """The export part of a walker kind (:class:`walkerlab.walker.kinds.Kind`): knee stops
+    for knees that lock, ankles for flat feet, a free-jointed walker's actuator notes."""
+    notes = {}
+    if kind.joints_free:
+        notes = _FREE_KNEES if kind.knees == "free" else _STRAIGHT_LEGS
+    return ExportPart(knee_stops=kind.knees == "locking", ankles=kind.feet_have_modes,
+                      **notes)
 
 
 def export_part(mb) -> ExportPart:
     """The export part of a multibody walker's kind (``mb.kind``,
-    :class:`walkerlab.walker.multibody.Multibody`)."""
-    return EXPORT_PARTS[mb.kind]
+    :class:`walkerlab.walker.multibody.Multibody`): :func:`kind_part`."""
+    return kind_part(KINDS[mb.kind])

@@ -43,12 +43,12 @@ from walkerlab.export.mjcf_scene import (
     MjcfScene,
     point_foot_radius,
 )
-from walkerlab.export.parts import EXPORT_PARTS
+from walkerlab.export.parts import export_part
 from walkerlab.models.contact.laws import ContactParamsSI
-from walkerlab.walker.kinds import Kind
+from walkerlab.walker.kinds import KINDS, Kind
 
 __all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "arc_roll_m", "check_exportable",
-           "flat_feet", "joint_state", "mjcf_scene", "mujoco_contact"]
+           "flat_foot_bodies", "joint_state", "mjcf_scene", "mujoco_contact"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -76,7 +76,7 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
         ankle push-off (flat feet) is exported: motors ``leg<i>_ankle_motor`` that
         :mod:`walkerlab.export.mujoco_walk` drives.
     """
-    SCENE_FEET[kind.name].check_format(fmt, walker_only)
+    SCENE_FEET[kind.feet].check_format(fmt, walker_only)
     act = scene.walker.actuation
     if not walker_only and act is not None and act.virtual_constraints is not None:
         kind.require("virtual_constraints", FORMAT_VIEWS.get(fmt or "mjcf", "mjcf"),
@@ -258,7 +258,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain_or_default()
     c, knee = contact_si(settings)
-    feet_part, part = SCENE_FEET[mb.kind], EXPORT_PARTS[mb.kind]
+    feet_part, part = SCENE_FEET[KINDS[mb.kind].feet], export_part(mb)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
                            flat_foot=feet_part.foot_mass(settings))
     ideal = ideal_gait(scene) if ideal is None else ideal
@@ -441,7 +441,7 @@ def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
                        for i in range(0, len(line), 2))
 
 
-def flat_feet(scene: Scene, data) -> tuple:
+def flat_foot_bodies(scene: Scene, data) -> tuple:
     """Per leg (leg1, leg2: leg1 the swing role's numbers when the legs differ) ``(heel,
     toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot mass
     [kg], inertia about the ankle [kg m^2])`` of a flat-footed walker; mass and inertia the
@@ -481,7 +481,7 @@ def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
     from walkerlab.models.hybrid.ground import on_landing
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
-    feet = flat_feet(scene, data)
+    feet = flat_foot_bodies(scene, data)
     drop = landing_drops(scene.terrain)[-1]  # the step that ended at the keyframe [m]
     rigid = on_landing(make_rigid_walker(data), data, drop)
     x, phase = rigid.step_entry(np.asarray(x_ideal, float))
@@ -529,7 +529,7 @@ class _LinkFeet:
 
 class _FlatFeet(_LinkFeet):
     """The MJCF scene's flat feet: foot bodies on ankle hinges with the contact model's
-    regularising mass (:func:`flat_feet`), the rigid heel strike's double support as the
+    regularising mass (:func:`flat_foot_bodies`), the rigid heel strike's double support as the
     keyframe (:func:`_flat_keyframe`), patches centred on the soles."""
 
     notes = ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
@@ -576,10 +576,7 @@ class _FlatFeet(_LinkFeet):
                      for lane, off in zip(lanes, footprint_offsets(data)))
 
 
-#: kind name -> the MJCF scene's feet of that kind (a spoked wheel's keyframe is
-#: :func:`walkerlab.export.wheel_scene.wheel_keyframe`'s; its entry only passes
-#: :func:`check_exportable`)
-SCENE_FEET = {"straight_legs": _LinkFeet(), "locking_knees": _LinkFeet(),
-              "flat_feet": _FlatFeet(), "free_joints": _LinkFeet(),
-              "hinged_torso": _LinkFeet(), "rolling_polygon": _LinkFeet(),
-              "rolling_polygon_3d": _LinkFeet(), "straight_legs_3d": _LinkFeet()}
+#: feet (:attr:`walkerlab.walker.kinds.Kind.feet`) -> the MJCF scene's feet of that kind (a
+#: spoked wheel's keyframe is :func:`walkerlab.export.wheel_scene.wheel_keyframe`'s; its
+#: entry only passes :func:`check_exportable`)
+SCENE_FEET = {"leg_ends": _LinkFeet(), "flat": _FlatFeet()}

@@ -64,13 +64,13 @@ from .action import action_torques, flat_action_walker
 
 __all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView", "hip_xs"]
 
-#: the walker kinds (:data:`walkerlab.walker.kinds.KINDS`) whose phases each have a mass
+#: the feet (:attr:`walkerlab.walker.kinds.Kind.feet`) whose phases each have a mass
 #: matrix of their own (a flat foot's stance modes: heel or toe pinned, the foot locked
-#: flat): the action acts through a twin of each step's walker, built by the kind's entry
+#: flat): the action acts through a twin of each step's walker, built by the feet's entry
 #: ``(walker, data, joints, actuation) -> (walker, ActionTorques)``, whose phases are the
 #: walker's with ``M_mode^-1 B u`` in each flow and in its guards' ground forces; the other
 #: kinds' flows gain the generic ``M^-1 B u``
-MODE_TWINS = {"flat_feet": flat_action_walker}
+MODE_TWINS = {"flat": flat_action_walker}
 
 #: the ledger's terms (:mod:`walkerlab.gym.rigid_view` docstring) [J]
 LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_work",
@@ -154,7 +154,7 @@ class RigidView:
         self.state_names = list(model.state_names())
         # a kind whose phases have their own mass matrices: each step's walker's twin with
         # the action in its modes (MODE_TWINS), built on first use
-        self._twin_of = MODE_TWINS.get(data.structure.kind.name)
+        self._twin_of = MODE_TWINS.get(data.structure.kind.feet)
         self._twins: dict = {}
         self._data, self._joints, self._actuation = data, list(joints), actuation
         if self._twin_of is not None:

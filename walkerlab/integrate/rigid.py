@@ -236,24 +236,16 @@ def _enter_step(walker: HybridWalker, st: _StepState, variational: bool) -> int:
     return 0 if name is None else [p.name for p in walker.phases].index(name)
 
 
-#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> whether scipy runs its actuated
-#: phases on their compiled flow (:func:`_runs_compiled_on_scipy`): the free-jointed
-#: walker's (five-link biped's) Python flow evaluates the laws and differentiates them by
-#: the complex step on every call
-_SCIPY_RUNS_ACTUATED_COMPILED = {"straight_legs": False, "locking_knees": False,
-                                 "flat_feet": False, "free_joints": True,
-                                 "hinged_torso": True, "rolling_polygon": False,
-                                 "rolling_polygon_3d": False, "straight_legs_3d": False}
-
-
 def _runs_compiled_on_scipy(phase: Phase) -> bool:
     """Whether a phase run by scipy (a stiff method, e.g. LSODA) calls its compiled flow
-    instead of its Python one: an actuated flow of a kind whose Python flow is slow
-    (:data:`_SCIPY_RUNS_ACTUATED_COMPILED`; the compiled flow is the same function, to
+    instead of its Python one: an actuated flow of a kind whose Python flow is slow (the
+    free-jointed walkers', :attr:`walkerlab.walker.kinds.Kind.joints_free`: the five-link
+    biped's and the three-link walker's Python flow evaluates the laws and differentiates
+    them by the complex step on every call; the compiled flow is the same function, to
     round-off)."""
     c = phase.compiled
     return (c is not None and getattr(c, "actuators", None) is not None
-            and _SCIPY_RUNS_ACTUATED_COMPILED[c.structure.kind.name])
+            and c.structure.kind.joints_free)
 
 
 def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, n: int,

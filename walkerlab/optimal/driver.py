@@ -106,7 +106,7 @@ def _part(structure) -> Collocation:
         A kind the collocation does not take (the capability table's line, ``walker: ...``).
     """
     structure.kind.require("walk", "optimize", "walker")
-    return PARTS[structure.kind.name]
+    return PARTS[structure.kind.collocation]
 
 
 def needs_gait(scene) -> bool:
@@ -118,7 +118,7 @@ def needs_gait(scene) -> bool:
     needs none (the stage refuses it at once)."""
     if designs_controller(scene):  # starts from the scene's own controller
         return False
-    part = PARTS.get(_structure(scene).kind.name)
+    part = PARTS.get(_structure(scene).kind.collocation)
     return part is not None and not part.from_targets and not no_gait_of_its_own(scene)
 
 
@@ -310,7 +310,7 @@ def check_scene(scene, data=None) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
-    if data.structure.kind.name == "straight_legs":  # the ground it lands on, refused early
+    if data.structure.kind.collocation == "legs":  # the ground it lands on, refused early
         from walkerlab.optimal.transcription.landing import step_ground
 
         step_ground(scene)
@@ -665,7 +665,7 @@ def _guide(walker, data, spec):
 class Collocation:
     """How ``walkerlab optimize`` finds and replays the optimal gait of one walker kind
     (:class:`walkerlab.walker.kinds.Kind`): its transcription, starting guess and replay
-    laws, reached through :data:`PARTS` by the kind's name.
+    laws, reached through :data:`PARTS` by the kind's collocation part.
 
     Attributes
     ----------
@@ -690,11 +690,11 @@ class Collocation:
     legs_cross_level: bool = False
 
 
-#: the collocation's part for each walker kind it takes, by :attr:`Kind.name` (the spoked
+#: the collocation's part of each kind it takes, by :attr:`Kind.collocation` (the spoked
 #: wheel has none: refused from the capability table, :func:`_part`)
 PARTS = {
-    "straight_legs": Collocation(_straight_legs, target_step=True, legs_cross_level=True),
-    "locking_knees": Collocation(_phased),
-    "flat_feet": Collocation(partial(_phased, resolve_gait=True)),
-    "free_joints": Collocation(optimize_five_link, from_targets=True),
+    "legs": Collocation(_straight_legs, target_step=True, legs_cross_level=True),
+    "kneed": Collocation(_phased),
+    "flat": Collocation(partial(_phased, resolve_gait=True)),
+    "five_link": Collocation(optimize_five_link, from_targets=True),
 }

@@ -117,10 +117,6 @@ FELL_ADVICE = ("the contact gait, if there is one, is far from the rigid gait th
 #: a step of the map that fell
 FELL = f"step map: the walker fell (hip below L/2): {FELL_ADVICE}"
 
-#: the kinds whose swing leg is flexed at mid-stance (knees): a continuous ground is kept
-#: for them (module docstring), the straight-legged kinds' lanes follow the footfalls
-_FLEXED_SWING = frozenset({"locking_knees", "free_joints"})
-
 #: the step map's default integrator (LSODA with the analytic Jacobian)
 DEFAULT_SOLVER = Solver("LSODA", 1e-11, 1e-13)
 
@@ -199,8 +195,9 @@ class StepMap:
                 patch_spacing = 0.372
         self.spacing = float(patch_spacing)
         # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
-        # a kneed swing leg is flexed there, so its continuous ground is kept
-        keep_ground = walker.continuous and walker.structure.kind.name in _FLEXED_SWING
+        # a kneed swing leg (knees that lock or free knees) is flexed there, so its
+        # continuous ground is kept
+        keep_ground = walker.continuous and walker.structure.kind.knees != "none"
         # each patch centred on its foot's footprint (a flat foot's lies ahead of its heel)
         o2 = footprint_offsets(walker.data)[1]
         #: height [m] of the swing lane's patch above the stance patch (stairs, footholds)

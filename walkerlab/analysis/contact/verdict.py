@@ -206,7 +206,7 @@ def scuff_cause(walker) -> str:
     -------
     str
     """
-    return _SCUFF_CAUSES.get(walker.data.structure.kind.name, _no_cause)(walker)
+    return _SCUFF_CAUSES.get(walker.data.structure.kind.contact, _no_cause)(walker)
 
 
 def _no_cause(walker) -> str:
@@ -235,9 +235,9 @@ def _straight_leg_scuff(walker) -> str:
     return f"({straight})"
 
 
-#: kind name -> the likely cause of its swing foot's scuffs (:func:`scuff_cause`; a kind
-#: not listed has none to name)
-_SCUFF_CAUSES = {"straight_legs": _straight_leg_scuff, "locking_knees": _unlatched_knee}
+#: contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) -> the likely cause of its
+#: swing foot's scuffs (:func:`scuff_cause`; a part not listed has none to name)
+_SCUFF_CAUSES = {"legs": _straight_leg_scuff, "kneed": _unlatched_knee}
 
 
 def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,

@@ -213,7 +213,7 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
             reaction[id(walker.mirror)] = StanceReaction(walker.mirror, data.mirror)
     except ValueError as exc:
         friction = None
-        if mu is not None and data.structure.kind.name == "flat_feet":
+        if mu is not None and data.structure.kind.feet_have_modes:
             from walkerlab.analysis.gait.friction import flat_foot_friction
 
             friction = flat_foot_friction(walker, data, x, solver, mu, mu_source, samples)

@@ -245,14 +245,14 @@ class RollingPolygonPart(ContactPart):
         return None
 
 
-#: kind name -> the contact view's part
+#: contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) -> the contact view's part
 PARTS: dict[str, ContactPart] = {
-    "straight_legs": ContactPart(),
-    "locking_knees": KneedPart(),
-    "flat_feet": FlatFeetPart(),
-    "free_joints": FreeJointsPart(),
-    "hinged_torso": HingedTorsoPart(),
-    "rolling_polygon": RollingPolygonPart(),
+    "legs": ContactPart(),
+    "kneed": KneedPart(),
+    "flat": FlatFeetPart(),
+    "five_link": FreeJointsPart(),
+    "three_link": HingedTorsoPart(),
+    "wheel": RollingPolygonPart(),
 }
 
 
@@ -266,4 +266,4 @@ def contact_part(structure) -> ContactPart:
         The kind has no contact view (its ``walk`` cell there, one line).
     """
     structure.kind.require("walk", "contact", structure.kind.field)
-    return PARTS[structure.kind.name]
+    return PARTS[structure.kind.contact]

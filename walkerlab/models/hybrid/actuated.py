@@ -104,7 +104,7 @@ def spring_equivalent(data, spec):
 
     st = data.structure
     laws = [t for t in spec.torques]
-    if not laws or not _PARTS[st.kind.name].hip_spring or st.knee_spring or st.torso \
+    if not laws or not _PARTS[st.kind.actuators].hip_spring or st.knee_spring or st.torso \
             or any(b.massless for b in st.bodies) or any(
             t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
             or t.law.reference is not None or t.law.time_reference is not None for t in laws):
@@ -144,7 +144,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
         return VirtualConstraintFlow.of(acts.controller, data.structure, data.params)
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None:  # a passive flow run in Python: the guards' outputs from the kind
-        guards = _PARTS[data.structure.kind.name].guard_outputs(phase, data)
+        guards = _PARTS[data.structure.kind.actuators].guard_outputs(phase, data)
     if guards is None:
         return None
     links = acts.links  # each actuator's (first, second) link: keys of ``leg_angles``
@@ -194,7 +194,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     if getattr(spec, "virtual_constraints", None) is not None:  # the kind's table
         data.structure.kind.require("virtual_constraints", "rigid",
                                     "walker.actuation.virtual_constraints")
-    return _PARTS[data.structure.kind.name].actuate(walker, data, spec)
+    return _PARTS[data.structure.kind.actuators].actuate(walker, data, spec)
 
 
 def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
@@ -392,8 +392,7 @@ class _RollingPolygon:
         return walker
 
 
-#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> how :func:`actuate` drives it
-_PARTS = {"straight_legs": _Joints(), "locking_knees": _LockingKnees(),
-          "free_joints": _FreeJoints(), "hinged_torso": _FreeJoints(), "flat_feet": _FlatFeet(),
-          "rolling_polygon": _RollingPolygon(), "rolling_polygon_3d": _RollingPolygon(),
-          "straight_legs_3d": _RollingPolygon()}  # passive so far: the table refuses
+#: actuators part (:attr:`walkerlab.walker.kinds.Kind.actuators`) -> how :func:`actuate`
+#: drives it (``none``: passive so far, the table refuses)
+_PARTS = {"hips": _Joints(), "latched_knees": _LockingKnees(), "joints": _FreeJoints(),
+          "ankles": _FlatFeet(), "none": _RollingPolygon()}

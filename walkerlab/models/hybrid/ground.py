@@ -96,14 +96,6 @@ class _Mirrored:
         return _flip(np.asarray(out), self.n) if self.gradient else out
 
 
-#: kind name -> whether the post-impact section's clearance is the generated one read at
-#: the state's mirror image (:class:`_Mirrored`: a spoked wheel's old stance spoke is
-#: behind, its generated clearance the spoke's ahead); the legged kinds' swing foot is the
-#: old stance foot
-_SECTION_MIRRORED = {"straight_legs": False, "locking_knees": False, "flat_feet": False,
-                     "free_joints": False, "hinged_torso": False, "rolling_polygon": True}
-
-
 class _LandingSection:
     """``from_section`` of the post-impact surface ``swing_clearance(x) = level`` (see the
     module docstring): the walker's own ``from_section`` (its slope's surface) as the start,
@@ -209,7 +201,7 @@ def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     """:func:`on_landing`'s walker for any ``drop_m`` (0 included): the kind's part of
     :data:`LANDINGS`."""
     data.structure.kind.require("stairs", "rigid", "terrain.kind")
-    return LANDINGS[data.structure.kind.name](walker, data, drop_m)
+    return LANDINGS[data.structure.kind.landing](walker, data, drop_m)
 
 
 def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
@@ -239,7 +231,9 @@ def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
         mirror = _on_clearance(mirror, replace(data.mirror, mirror_params=None), drop_m)
     s_clear, s_grad = clear, grad
-    if _SECTION_MIRRORED[data.structure.kind.name]:
+    if data.structure.kind.spoked:  # (:class:`_Mirrored`): a spoked wheel's old stance
+        # spoke is behind, its generated clearance the spoke's ahead; the legged kinds'
+        # swing foot is the old stance foot
         n = walker.n_coordinates
         g = float(data.slope_rad)
         s_clear, s_grad = _Mirrored(clear, n, False, g), _Mirrored(grad, n, True, g)
@@ -258,12 +252,11 @@ def _on_flat_feet(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     return on_landing_flat(walker, data, drop_m)
 
 
-#: kind name -> its landing part ``(walker, data, drop_m) -> HybridWalker``: the kinds whose
-#: rigid view lands on stairs and footholds (the rimless wheel's rolling polygon and the
-#: legged kinds with the generated swing clearance; flat feet, a guard per stance mode)
-LANDINGS = {"straight_legs": _on_clearance, "locking_knees": _on_clearance,
-            "free_joints": _on_clearance, "hinged_torso": _on_clearance,
-            "rolling_polygon": _on_clearance, "flat_feet": _on_flat_feet}
+#: landing part (:attr:`walkerlab.walker.kinds.Kind.landing`) -> ``(walker, data, drop_m) ->
+#: HybridWalker``: the kinds whose rigid view lands on stairs and footholds (the rimless
+#: wheel's rolling polygon and the legged kinds with the generated swing clearance; flat
+#: feet, a guard per stance mode)
+LANDINGS = {"clearance": _on_clearance, "flat": _on_flat_feet}
 
 
 def on_footholds(walker_at, data_at, steps, periodic: bool = True,

@@ -79,20 +79,24 @@ class _Part:
     refusal: str | None = None
 
 
-#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> its part of the stance reaction
+#: rigid model part (:attr:`walkerlab.walker.kinds.Kind.rigid`) -> its part of the stance
+#: reaction, in the plane (:func:`_part`)
 _PARTS = {
-    "straight_legs": _Part(),
-    "locking_knees": _Part(),
-    "free_joints": _Part(),
-    "hinged_torso": _Part(),
-    "flat_feet": _Part(refusal="flat feet: the rigid model's own guards check the heel's "
-                               "and toe's normal forces"),
-    "rolling_polygon": _Part(hub=True, trailing_point="trailing_foot"),
-    "rolling_polygon_3d": _Part(refusal="a wheel in 3D: its stance foot's reaction (a "
-                                        "force in 3D) is not computed yet"),
-    "straight_legs_3d": _Part(refusal="a walker in 3D: its stance foot's reaction (a "
-                                      "force in 3D) is not computed yet"),
+    "legs": _Part(),
+    "free": _Part(),
+    "flat": _Part(refusal="flat feet: the rigid model's own guards check the heel's "
+                          "and toe's normal forces"),
+    "wheel": _Part(hub=True, trailing_point="trailing_foot"),
 }
+
+
+def _part(kind) -> _Part:
+    """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): a walker
+    in 3D is refused (its reaction is a force in 3D), a planar one is its rigid model's."""
+    if kind.in_3d:
+        return _Part(refusal=f"{'a wheel' if kind.spoked else 'a walker'} in 3D: its stance "
+                             "foot's reaction (a force in 3D) is not computed yet")
+    return _PARTS[kind.rigid]
 
 
 class _View:
@@ -195,7 +199,7 @@ class StanceReaction:
 
     def __init__(self, walker, data):
         st = data.structure
-        self.part = _PARTS[st.kind.name]
+        self.part = _part(st.kind)
         if self.part.refusal is not None:
             raise ValueError(self.part.refusal)
         self.walker = walker

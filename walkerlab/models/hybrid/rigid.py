@@ -152,7 +152,7 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     """
     printed = {"flow": flow, "flow_jacobian": flow_jacobian, "reset": reset,
                "reset_jacobian": reset_jacobian}
-    return BUILDERS[data.structure.kind.name](data, name, variant, printed, double_support)
+    return BUILDERS[data.structure.kind.rigid](data, name, variant, printed, double_support)
 
 
 @dataclass(frozen=True)
@@ -176,18 +176,27 @@ def _never(structure) -> bool:
     return False
 
 
-#: the legged kinds' parts (:func:`_make_legged`)
-_LEGS = {"straight_legs": _Legs(_straight_leg_phases, _absolute_legs_only),
-         "locking_knees": _Legs(_kneed_phases, _never),
-         # in 3D the state has the lean besides the legs' angles: the map names them
-         "straight_legs_3d": _Legs(_straight_leg_phases, _never)}
+#: the legged kinds' parts (:func:`_make_legged`, :func:`_legs`): straight legs, knees that
+#: lock, straight legs in 3D (the state has the lean besides the legs' angles: the map names
+#: them)
+_STRAIGHT = _Legs(_straight_leg_phases, _absolute_legs_only)
+_LOCKING = _Legs(_kneed_phases, _never)
+_STRAIGHT_3D = _Legs(_straight_leg_phases, _never)
+
+
+def _legs(kind) -> _Legs:
+    """The legged part of a kind (:class:`walkerlab.walker.kinds.Kind`) whose rigid model
+    is ``legs``."""
+    if kind.knees == "locking":
+        return _LOCKING
+    return _STRAIGHT_3D if kind.in_3d else _STRAIGHT
 
 
 def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
                  double_support: bool) -> HybridWalker:
-    """Straight legs or locking knees (:data:`_LEGS`): one generated flow, its phases, the
+    """Straight legs or locking knees (:func:`_legs`): one generated flow, its phases, the
     heel-strike reset (``printed``: the printed equations' replacements)."""
-    legs = _LEGS[data.structure.kind.name]
+    legs = _legs(data.structure.kind)
     flow, flow_jacobian = printed["flow"], printed["flow_jacobian"]
     reset, reset_jacobian = printed["reset"], printed["reset_jacobian"]
     f = functions(data)
@@ -267,15 +276,11 @@ def _make_polygon(data: WalkerData, name: str, variant: str, printed: dict,
     return make_spoked_walker(data, name, variant)
 
 
-#: kind name (:data:`walkerlab.walker.kinds.KINDS`) -> its builder ``(data, name, variant,
-#: printed, double_support) -> HybridWalker``
+#: rigid model part (:attr:`walkerlab.walker.kinds.Kind.rigid`) -> its builder ``(data,
+#: name, variant, printed, double_support) -> HybridWalker``
 BUILDERS: dict[str, Callable] = {
-    "straight_legs": _make_legged,
-    "locking_knees": _make_legged,
-    "flat_feet": _make_flat,
-    "free_joints": _make_free,
-    "hinged_torso": _make_free,
-    "rolling_polygon": _make_polygon,
-    "rolling_polygon_3d": _make_polygon,
-    "straight_legs_3d": _make_legged,
+    "legs": _make_legged,
+    "flat": _make_flat,
+    "free": _make_free,
+    "wheel": _make_polygon,
 }

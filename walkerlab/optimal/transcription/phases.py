@@ -177,7 +177,7 @@ def mode_functions(data, walker, order=None) -> dict:
     import casadi as ca
 
     st = data.structure
-    modes = _MODES.get(st.kind.name)
+    modes = _MODES.get(st.kind.collocation)
     if modes is None or st.torso or st.foot == "arc" or any(b.massless for b in st.bodies):
         raise ValueError("optimize: the phased transcription takes massive legs with point "
                          "or flat feet and no torso today")
@@ -437,5 +437,4 @@ class _Impact:
 #: the phases' symbolic pieces of each walker kind the phased transcription takes, by
 #: :attr:`walkerlab.walker.kinds.Kind.name` (a five-link biped has its own transcription,
 #: :mod:`walkerlab.optimal.transcription.free_joints`; a spoked wheel none)
-_MODES = {"straight_legs": _StraightModes, "locking_knees": _KneedModes,
-          "flat_feet": _FlatModes}
+_MODES = {"legs": _StraightModes, "kneed": _KneedModes, "flat": _FlatModes}

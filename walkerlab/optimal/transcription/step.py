@@ -53,7 +53,7 @@ import numpy as np
 
 from walkerlab.codegen.casadi_functions import casadi_function
 
-__all__ = ["OBJECTIVES", "ONE_STEP_KINDS", "CollocationResult", "CollocationSpec",
+__all__ = ["OBJECTIVES", "ONE_STEP_COLLOCATIONS", "CollocationResult", "CollocationSpec",
            "check_objective", "ipopt_options", "number", "positive_power", "replay",
            "replay_actuation", "step_functions", "target_constraints", "torque_of_time"]
 
@@ -128,7 +128,7 @@ class CollocationSpec:
 #: the walker kinds (:attr:`walkerlab.walker.kinds.Kind.name`) one step of one phase
 #: transcribes: straight legs (a kneed or flat-footed step is a sequence of phases,
 #: :mod:`walkerlab.optimal.transcription.phases`)
-ONE_STEP_KINDS = ("straight_legs",)
+ONE_STEP_COLLOCATIONS = ("legs",)
 
 #: Objectives of one step, with their units (``u`` per foot mass on massless legs).
 OBJECTIVES = {"effort": "N^2 m^2 s", "push_off_work": "J", "cost_of_transport": "-",
@@ -211,7 +211,7 @@ def step_functions(data, eq):
     st = data.structure
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
-    if st.kind.name not in ONE_STEP_KINDS:
+    if st.kind.collocation not in ONE_STEP_COLLOCATIONS:
         raise ValueError("optimize: knees and flat feet take a step of phases "
                          "(walkerlab.optimal.transcription.phases.mode_functions)")
     if any(massless) and not limit:

@@ -18,6 +18,7 @@ import copy
 import yaml
 
 from walkerlab.config.loader import shipped_scene_path
+from walkerlab.walker.kinds import KINDS
 
 __all__ = ["JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "WALKING",
            "reference_scene", "scene_for"]
@@ -32,17 +33,8 @@ def _shipped(name: str) -> dict:
         return yaml.safe_load(fh)
 
 
-#: kind -> its shipped scene
-SCENES = {
-    "straight_legs": "configs/paper_rods.yaml",
-    "locking_knees": "configs/kneed.yaml",
-    "flat_feet": "configs/flat_feet.yaml",
-    "free_joints": "configs/rabbit.yaml",
-    "hinged_torso": "configs/threelink.yaml",
-    "rolling_polygon": "configs/rimless_wheel.yaml",
-    "rolling_polygon_3d": "configs/rimless_wheel_3d.yaml",
-    "straight_legs_3d": "configs/hip_width.yaml",
-}
+#: kind name -> its shipped scene (:attr:`walkerlab.walker.kinds.Kind.scene`)
+SCENES = {name: kind.scene for name, kind in KINDS.items()}
 
 #: a small PD law [N m/rad, N m s/rad] about the joint's zero angle
 SMALL_PD = {"stiffness_n_m_per_rad": 0.1, "damping_n_m_s_per_rad": 0.01}

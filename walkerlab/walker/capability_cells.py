@@ -1,0 +1,338 @@
+"""The capability table's cells, as data: for each walker kind (:data:`walkerlab.walker.kinds.
+KINDS`), the features it lacks in each view and why (:data:`CAPABILITIES`), and what each
+supported cell rests on beyond its measurement (:data:`CELL_NOTES`).
+
+The kinds and their questions (:meth:`walkerlab.walker.kinds.Kind.cell`,
+:meth:`~walkerlab.walker.kinds.Kind.require`) are in :mod:`walkerlab.walker.kinds`, which
+re-exports every public name here; the layers import them from there.
+"""
+
+from __future__ import annotations
+
+__all__ = ["CAPABILITIES", "CELL_NOTES", "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES",
+           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
+           "SEVERAL_FOOTHOLDS", "SPATIAL_ACTUATION", "SPATIAL_EXPORT", "SPATIAL_GROUND",
+           "SPATIAL_HIP_ROLL_EXPORT", "SPATIAL_ROUND_FEET_EXPORT", "STAGE_CELLS", "STAGE_VIEWS",
+           "URDF_GROUND"]
+
+_NO_KNEE = "the legs are straight: there is no knee"
+_NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
+             "feet have none")
+_NO_ANKLE_PUSH = ("needs flat feet (leg.foot.kind: flat); point feet take push_off, the "
+                  "impulse along the leg")
+_NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
+#: why a view refuses footholds that differ from step to step
+#: (:func:`walkerlab.models.ground.landing_drop` says it, after the field's name)
+SEVERAL_FOOTHOLDS = ("footholds that differ from step to step run in the rigid and contact "
+                     "models, the MJCF, OpenSim and Adams exports and the gym (walkerlab "
+                     "fixedpoint, simulate, contact-sim, report, export, walkerlab.gym): give "
+                     "footholds of one height for this view")
+_ONE_LANDING = SEVERAL_FOOTHOLDS
+#: why every view but the rigid one refuses footholds of their own slopes
+#: (``terrain.foothold_slopes_rad``; :func:`walkerlab.models.ground.landing_drops`)
+FOOTHOLD_SLOPES = ("footholds of their own slopes run in the rigid model only (walkerlab "
+                   "fixedpoint, simulate, the gym's rigid view): the contact model and the "
+                   "exports lay every patch parallel to the scene's slope; give "
+                   "foothold_heights_m alone for this view")
+#: why the rigid walk on a height profile (walkerlab simulate, the gym's rigid view) takes
+#: a passive walker only (:func:`walkerlab.analysis.gait.rigid_run.profile_ground` says it,
+#: after ``terrain.kind: profile: ``)
+PROFILE_PASSIVE = ("walked by the passive walker of the generated model only (no "
+                   "walker.actuation, ideal.variant: derived)")
+_OSIM_PROFILE = ("not in the OpenSim export (its Hunt-Crossley contact takes spheres and "
+                 "half-spaces, not a polyline: spheres that follow profile.yaml's to 0.05 "
+                 "mm take 524, one every 2 cm, and OpenSim then runs about 100 times "
+                 "slower; --format mjcf writes it as a height field)")
+_OSIM_ANKLE_PUSH = ("not in the OpenSim export (the model would walk passively); export the "
+                    "scene without it")
+#: why the Adams dataset refuses joint torques other than the hip's on a walker that is not
+#: free-jointed (:mod:`walkerlab.export.adams_actuation` says it too)
+FREE_JOINT_TORQUES = ("stance_hip, swing_hip, stance_knee and swing_knee need a free-jointed "
+                      "biped (a hinged torso, on free knees or straight legs)")
+#: why a view refuses virtual constraints (the rigid model, the contact model, the MJCF's
+#: stepping loop and the Gymnasium environment - the controller as its policy - run the
+#: computed torque; the issue's remaining views are to carry them)
+_VC_VIEWS = {
+    ("virtual_constraints", "adams"): ("the Adams dataset carries torque laws of the joint "
+                                       "angles and the phase, not a computed torque on the "
+                                       "rigid model (run contact-sim or --format mjcf)"),
+    ("virtual_constraints", "osim"): ("the OpenSim stepping loop does not evaluate the "
+                                      "computed torque yet (export --format mjcf runs it)"),
+}
+#: why the URDF refuses a ground other than the slope (``walkerlab export --format urdf``
+#: reads it from the table: :func:`walkerlab.stages.export.write`)
+URDF_GROUND = ("the URDF carries the walker on a slope only (URDF has no ground or contact "
+               "element; the slope is stated in its header): stairs, footholds and "
+               "profiles are in the MJCF, the OpenSim model and the Adams dataset; "
+               "--walker-only writes the walker alone")
+_URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "profile")}
+#: why a 3D walker's views refuse a ground other than a plane
+SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
+                  "stairs, footholds and profiles are planar walkers' grounds")
+#: why a 3D walker refuses actuators
+SPATIAL_ACTUATION = ("a walker in 3D takes no walker.actuation so far (its lateral "
+                     "foot-placement law is walker.hip_roll: hip-roll joints)")
+#: why the kinds other than the 3D straight legs refuse hip-roll joints (the scene's check
+#: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
+NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
+               "(walker.space: 3d, hip_width_m > 0)")
+#: why the kinds other than the 3D straight legs refuse a 3D walker's round feet (the
+#: scene's check on a planar compass gait says it too:
+#: :class:`walkerlab.config.walker.CompassGaitParams`)
+NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
+                    "straight-legged walker's (walker.space: 3d); a planar walker's round "
+                    "feet are walker.leg.foot.kind: arc")
+#: why the 3D walker's exports refuse its round feet
+SPATIAL_ROUND_FEET_EXPORT = ("a 3D walker's export carries point feet and point-mass legs "
+                             "so far (its round feet and leg inertia run in the rigid model: "
+                             "fixedpoint, simulate)")
+#: why the URDF refuses the 3D walker's hip-roll joints
+SPATIAL_HIP_ROLL_EXPORT = ("the URDF carries legs rigid to the pelvis in roll so far: the "
+                           "hip-roll joints and their law are in the MJCF (--format mjcf) "
+                           "and the rigid model")
+#: why the exports refuse a 3D walker
+SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is written as "
+                  "URDF (--format urdf) or MJCF (--format mjcf)")
+#: what the views of both 3D kinds refuse: a ground other than a plane, the contact model,
+#: the Adams and OpenSim exports
+_SPATIAL = {
+    **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
+    ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a later "
+                          "step (walk it in the rigid model: fixedpoint, simulate)"),
+    ("walk", "adams"): SPATIAL_EXPORT,
+    ("walk", "osim"): SPATIAL_EXPORT,
+}
+#: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
+#: other than the slope in the URDF (the contact
+#: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
+#: patches at the rigid period-n gait's footfalls; the gym's rigid view steps them as
+#: simulate does)
+_GROUNDS = {
+    ("profile", "osim"): _OSIM_PROFILE,
+    **_URDF_GROUNDS,
+}
+#: what the kinds without ankles (point or arc feet) refuse of the ankle's features
+_NO_ANKLES = {
+    ("ankle_torque", "*"): _NO_ANKLE,
+    ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
+    ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
+}
+_PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
+                    "its heel strike is the plain impact (the rigid kneed model's push-off "
+                    "runs in fixedpoint and simulate, not here); optimise the hip torque "
+                    "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
+#: why optimize refuses a torso on knees or flat feet (the phased transcription,
+#: :mod:`walkerlab.optimal.transcription.phases`, has no torso's symbolic form; measured on
+#: the kneed walker with a 0.4 kg upper body, whose rigid gait walks in every other view)
+_PHASED_TORSO = ("the phased transcription (knees or flat feet) takes massive legs with "
+                 "point or flat feet and no torso today: optimise the walker without "
+                 "walker.torso")
+_FLAT_LANDING = ("flat feet walk stairs and footholds in the rigid model, the MJCF export "
+                 "(walkerlab fixedpoint, simulate, export --format mjcf; footholds in "
+                 "contact-sim too): this view does not carry a flat foot's landing on them "
+                 "yet")
+#: why the rigid walk of a profile refuses flat feet
+_FLAT_PROFILE = ("a profile is walked step by step from the landing of point and arc feet "
+                 "(walkerlab.analysis.gait.profile_walk); a flat foot lands on a height per "
+                 "step only (stairs, footholds)")
+#: why the contact model refuses flat feet on stairs
+_FLAT_STAIRS_CONTACT = ("the flat-footed contact walker falls after one heel strike on stairs "
+                        "(it starts without the rigid gait's double support on the tread "
+                        "above); contact-sim walks flat feet on footholds")
+
+#: why ``optimize`` refuses a height profile: the collocation is of a periodic gait (its
+#: boundary condition the heel strike's reset), and a profile's steps all differ (each lands
+#: where the last left the foot: :func:`walkerlab.models.hybrid.ground.check_periodic_ground`)
+_OPTIMIZE_PROFILE = ("the collocation optimises a periodic gait, and a profile's steps all "
+                     "differ (no step repeats); optimise on the slope, stairs or footholds "
+                     "and walk the result on the profile with simulate")
+#: why ``optimize`` refuses stairs and footholds for a kind other than straight legs: the
+#: landing (:mod:`walkerlab.optimal.transcription.landing`) is built on the one-step
+#: transcription; the phased and five-link ones land on the slope (measured before it was
+#: refused: the paper walker's least-effort step gave the level ground's optimum on 1 cm and
+#: on 5 cm risers alike, 154.924 N^2 m^2 s)
+_OPTIMIZE_LANDING = ("the landing on stairs and footholds is transcribed for straight legs "
+                     "(one step of one phase); this walker's transcription lands on the slope "
+                     "only: optimise on the slope (terrain.kind: slope) and walk the result on "
+                     "this ground with fixedpoint, simulate or contact-sim")
+_OPTIMIZE_GROUNDS = {("stairs", "optimize"): _OPTIMIZE_LANDING,
+                     ("footholds", "optimize"): _OPTIMIZE_LANDING,
+                     ("profile", "optimize"): _OPTIMIZE_PROFILE}
+
+#: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
+#: stands for every view of that feature.  Each reason is physical (the walker lacks the
+#: part) or says what the view's model does not carry.
+CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
+    "straight_legs": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        ("knee_torque", "*"): _NO_KNEE,
+        **_VC_VIEWS,
+        ("virtual_constraints", "optimize"): ("optimize.design: virtual_constraints is built "
+                                              "for a torso hinged on the legs (the three-link "
+                                              "walker, RABBIT): a walker of one actuator is not "
+                                              "transcribed yet; leave them out"),
+        **_NO_ANKLES,
+        ("torso_torque", "adams"): FREE_JOINT_TORQUES,
+        **_GROUNDS,
+        # a step lands on the next tread or foothold (walkerlab.optimal.transcription.
+        # landing)
+        ("profile", "optimize"): _OPTIMIZE_PROFILE,
+    },
+    "locking_knees": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_NO_ANKLES,
+        ("virtual_constraints", "*"): ("a knee that locks changes the walker's degrees of "
+                                       "freedom within the step (its outputs would change "
+                                       "in number): give free knees (knee.lock: free)"),
+        ("knee_torque", "adams"): FREE_JOINT_TORQUES,
+        ("torso_torque", "adams"): FREE_JOINT_TORQUES,
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("torso_torque", "optimize"): _PHASED_TORSO,
+        **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
+    },
+    "flat_feet": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        ("knee_torque", "*"): ("flat feet are not available with a knee yet "
+                               "(walker.leg.knee)"),
+        ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
+                                       "degrees of freedom within the step: give point "
+                                       "feet"),
+        ("push_off", "osim"): ("the contact view holds a flat foot's ankle through the "
+                               "push-off pulse; the OpenSim stepping loop does not yet "
+                               "(--format mjcf, contact-sim)"),
+        ("ankle_push_off", "osim"): ("the OpenSim stepping loop has no heel-off latch for "
+                                     "ankle motors yet (--format mjcf, contact-sim)"),
+        ("profile", "osim"): _OSIM_PROFILE,
+        ("profile", "optimize"): _OPTIMIZE_PROFILE,
+        ("walk", "urdf"): ("flat feet are exported to MJCF and OpenSim with the scene only "
+                           "(a URDF would hold point feet: no foot link, ankle spring or heel "
+                           "and toe contacts)"),
+        # the rigid view lands its heel strike on stairs and footholds of several heights
+        # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
+        # steps that walker (its contact view asks the contact cells)
+        **{("stairs", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
+        ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
+        **{("profile", v): _FLAT_PROFILE for v in ("rigid", "adams", "gym")},
+        **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("torso_torque", "optimize"): _PHASED_TORSO,
+        ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
+                                         "(the rigid flat feet take an ankle push-off or "
+                                         "hip torques, not together)"),
+    },
+    "free_joints": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_NO_ANKLES,
+        **_VC_VIEWS,
+        ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
+                                   "has no push-off"),
+        **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
+        # the OpenSim stepping loop drives joint torques (its walks: the powered compass,
+        # RABBIT's laws); a walker held up by them on footholds is walked in the rigid and
+        # contact models, the MJCF and the gym, and written to Adams
+        ("footholds", "osim"): ("footholds of several heights under joint torques run in the "
+                                "rigid and contact models, the MJCF, Adams and the gym; no "
+                                "OpenSim walk has checked them yet (export --format mjcf)"),
+        ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
+    },
+    "hinged_torso": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        ("knee_torque", "*"): _NO_KNEE,
+        **_VC_VIEWS,
+        **_NO_ANKLES,
+        ("walk", "optimize"): ("open-loop torques of a torso hinged on straight legs are "
+                               "not transcribed yet; its virtual constraints are "
+                               "(optimize.design: virtual_constraints)"),
+        ("virtual_constraints", "optimize"): None,  # optimize.design: virtual_constraints
+        **_GROUNDS,
+        **_OPTIMIZE_GROUNDS,
+        ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
+    },
+    "rolling_polygon": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
+                                         "torso_torque", "push_off", "ankle_push_off",
+                                         "virtual_constraints")},
+        ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
+                            "(one rigid body) is exported as urdf or mjcf"),
+        ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
+                           "(one rigid body) is exported as urdf or mjcf"),
+        ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
+        # footholds have no ground between them; the wheel's contact model needs it
+        ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
+                                   "ground (its spokes have no lanes of their own)"),
+        **_URDF_GROUNDS,
+        ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
+                               "the passive one, walkerlab fixedpoint)"),
+    },
+    "straight_legs_3d": {
+        ("hip_roll", "urdf"): SPATIAL_HIP_ROLL_EXPORT,
+        ("round_feet_3d", "mjcf"): SPATIAL_ROUND_FEET_EXPORT,
+        ("round_feet_3d", "urdf"): SPATIAL_ROUND_FEET_EXPORT,
+        **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
+                                                 "ankle_torque", "torso_torque", "push_off",
+                                                 "ankle_push_off", "virtual_constraints")},
+        **_SPATIAL,
+        # the MJCF and the URDF: a free pelvis and two legs on hip joints
+        # (walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text: on footfall patches, past
+        # the straight legs' mid-stance foot-through; walkerlab.export.spatial_legs.
+        # spatial_legs_urdf_text)
+        ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
+                          "is a later step"),
+        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
+                               "is a later step"),
+    },
+    "rolling_polygon_3d": {
+        ("hip_roll", "*"): NO_HIP_ROLL,
+        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
+                                         "torso_torque", "push_off", "ankle_push_off",
+                                         "virtual_constraints")},
+        **_SPATIAL,
+        # the MJCF and the URDF: a free body on its spoke tips
+        # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
+        ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
+        ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
+                               "the passive one, walkerlab fixedpoint)"),
+    },
+}
+
+
+#: why a kneed walker's OpenSim cells hold only with walkerlab's stepping loop: the knee
+#: latch (the knee stop mirrored, ``leg<i>_knee_latch``) is a force OpenSim cannot switch
+#: by contact, so :mod:`walkerlab.export.opensim_walk` switches it between the Manager's
+#: windows (the file says so in its header)
+KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.opensim_walk), "
+                   "which switches the knee latch (contact.knee_stop.latch) between OpenSim "
+                   "Manager windows: OpenSim has no contact-switched force, and the .osim "
+                   "file alone under OpenSim's Manager does not hold the stance knee "
+                   "straight (the kneed walker falls at 0.34 s, in its first step)")
+
+#: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
+#: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
+#: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
+CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
+
+#: the pipeline's stages that are a view of the table, or that read one: stage ->
+#: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``
+#: reads the contact walk)
+STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
+               "stability-map": ("walk", "contact")}
+#: why the robustness study refuses a 3D walker (:mod:`walkerlab.studies.robustness_study`)
+SPATIAL_ROBUSTNESS = ("the robustness study (gait sensitivity norms, largest step-down/up "
+                      "and push) is of planar walkers so far: its disturbances and state "
+                      "norms are sagittal; a 3D walker's metastability is walkerlab mfpt's")
+#: kind -> {stage: reason}: the studies (stages of :mod:`walkerlab.stages.pipeline`) a kind
+#: does not take at all; a stage not listed takes it (``optimize`` of a kind whose ``walk``
+#: it refuses may still design virtual constraints, so only the 3D kinds' is here)
+STAGE_CELLS: dict[str, dict[str, str]] = {
+    k: {"robustness": SPATIAL_ROBUSTNESS, "optimize": CAPABILITIES[k][("walk", "optimize")]}
+    for k in ("straight_legs_3d", "rolling_polygon_3d")}
