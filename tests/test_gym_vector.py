@@ -451,7 +451,7 @@ def test_hip_xs_are_each_views_hip_x_bit_for_bit():
     """The hips of many rigid walkers from one call of the step walker's ``points`` on the
     states as columns equal each walker's own, bit for bit; a ``points`` of one state only
     is called state by state."""
-    from walkerlab.gym.rigid_view import _hips, hip_xs
+    from walkerlab.gym.batch import _hips, hip_xs
 
     env = _native(4, "threelink_hzd", start_noise=0.3)
     env.reset(seed=2)
@@ -493,14 +493,14 @@ def test_batched_native_form_walks_rabbit_and_a_passive_walker_as_sync(scene):
 
 
 def test_a_steps_infos_are_batched_when_first_read_and_equal_the_batching():
-    """The native step's infos (:class:`walkerlab.gym.vector.LazyInfos`) are batched by the
+    """The native step's infos (:class:`walkerlab.gym.infos.LazyInfos`) are batched by the
     first read, not before, and are then the entries the batching gives, whatever reads
     them first (a key, ``in``, ``len``, iteration, a copy, a pickle: plain dicts of the
     same entries)."""
     import copy
     import pickle
 
-    from walkerlab.gym.vector import LazyInfos
+    from walkerlab.gym.infos import LazyInfos
 
     calls = []
 

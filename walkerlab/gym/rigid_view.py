@@ -62,7 +62,7 @@ from walkerlab.integrate.solver import Solver, available_backends
 
 from .action import action_torques, flat_action_walker
 
-__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView", "hip_xs"]
+__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
 
 #: the walker kinds (:data:`walkerlab.walker.kinds.KINDS`) whose phases each have a mass
 #: matrix of their own (a flat foot's stance modes: heel or toe pinned, the foot locked
@@ -573,76 +573,3 @@ class RigidView:
         self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
         self.t_step = self.t
         self._start_step()
-
-
-#: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``
-_COLUMN_POINTS: dict = {}
-
-
-def _hips(walker, X: np.ndarray):
-    """The hip's x relative to the stance foot [m] of the states ``X`` (r, 2n), one call on
-    the states as columns (the contract of ``points``: :mod:`walkerlab.models.hybrid.base`)
-    of the walker's generated hip's x alone (:attr:`HybridWalker.hip_x`) or of its whole
-    ``points``; None when neither takes them (checked once per function against a call of
-    ``points`` per state: the same numbers bit for bit - numpy's vector loops may round
-    differently from its scalar ones - or not used)."""
-    points = walker.points
-    entry = _COLUMN_POINTS.get(id(points))
-    if entry is None:
-        fns = [] if walker.hip_x is None else [walker.hip_x]
-        fns.append(lambda Xt: points(Xt)["hip"][0])
-        each = [float(points(x)["hip"][0]) for x in X]
-        fn = None
-        for f in fns:
-            try:
-                hx = np.asarray(f(X.T), float)
-                if hx.shape == (X.shape[0],) and np.array_equal(hx, each):
-                    fn = f
-                    break
-            except Exception:  # noqa: BLE001 - a function of one state only
-                pass
-        entry = _COLUMN_POINTS[id(points)] = (points, fn)  # (kept: its id stays its own)
-    if entry[1] is None:
-        return None
-    return np.asarray(entry[1](X.T), float)
-
-
-def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
-    """:meth:`RigidView.hip_x` of every view in ``views`` (N), the views whose step walkers
-    share a ``points`` function in one call of it where it takes states as columns (the
-    same numbers).
-
-    Parameters
-    ----------
-    views : sequence of RigidView
-    X : ndarray (N, 2n), optional
-        Their states (``views[i].x``), when already stacked.
-
-    Returns
-    -------
-    ndarray (N,)
-        The hips' world x [m].
-    """
-    if len(views) > 1 and X is not None:
-        first = views[0].walker.points
-        if all(v.walker.points is first for v in views):
-            hx = _hips(views[0].walker, X)  # one step walker's points for all: one call
-            if hx is not None:
-                return np.array([v.foot[0] for v in views], dtype=float) + hx
-    pts = [v.walker.points for v in views]
-    out = np.empty(len(views))
-    groups: dict = {}
-    for i, f in enumerate(pts):
-        groups.setdefault(id(f), []).append(i)
-    for rows in groups.values():
-        if len(rows) < 2:
-            hx = None
-        elif X is not None and len(rows) == len(views):
-            hx = _hips(views[rows[0]].walker, X)
-        else:
-            hx = _hips(views[rows[0]].walker, np.array([views[i].x for i in rows]))
-        if hx is None:
-            out[rows] = [views[i].hip_x() for i in rows]
-        else:
-            out[rows] = np.array([views[i].foot[0] for i in rows]) + hx
-    return out
