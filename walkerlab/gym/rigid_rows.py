@@ -37,7 +37,6 @@ single walker's integrator (:class:`_Redo`).
 
 from __future__ import annotations
 
-import sys
 import threading
 
 import numpy as np
@@ -241,12 +240,8 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
     else:
         Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
             (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
-    hook, sys.unraisablehook = sys.unraisablehook, walkers[0].count_unraisable
-    try:  # (an arithmetic error inside the kernel: counted on the first row's walker)
-        _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
-                           n_out, which, te, Yev, H, Tn, Yn))
-    finally:
-        sys.unraisablehook = hook
+    _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
+                       n_out, which, te, Yev, H, Tn, Yn))
     call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
     return which, te, Yev, Y, cap, Yn, call
 

@@ -50,7 +50,6 @@ the heel strike's collision, <= 0).
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -139,8 +138,6 @@ class RigidView:
         #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``),
         #: and the action's joint map by its actuators' (they live in ``acts``)
         self.row_keys: dict = {}
-        #: arithmetic errors raised inside compiled flows (:meth:`count_unraisable`), counted
-        self.arithmetic_errors = 0
         self._joints_at: tuple = (b"", None, None, None)  # (state bytes, delta, ddelta, acts)
         n = model.n_coordinates
         self.n = n
@@ -319,17 +316,6 @@ class RigidView:
             if scene_on:
                 self.ledger["scene_torque_work"] += h * _GL_W[j] * scene.power(tj, xj)
 
-    def count_unraisable(self, args) -> None:
-        """``sys.unraisablehook`` while a compiled flow runs: an arithmetic error inside the
-        cfunc (numba reports it as unraisable: ``0.0 ** -2`` of a five-link walker's
-        virtual-leg length in a configuration it cannot reach but folded flat, while it
-        falls) is counted in :attr:`arithmetic_errors`, not printed; anything else goes to
-        the hook in force."""
-        if issubclass(args.exc_type, ArithmeticError):
-            self.arithmetic_errors += 1
-            return
-        sys.__unraisablehook__(args)
-
     def _held_work(self, run, acts, act_on: bool) -> None:
         """The compiled step's ledger over ``[self.t, run.t_last]`` (the action alone: the
         step's walker has no torque laws of its own there): where the action's power has
@@ -452,13 +438,9 @@ class RigidView:
         w, acts, act_on, phase, t_stop, fast = piece
         n = self.n
         if fast is not None:
-            hook, sys.unraisablehook = sys.unraisablehook, self.count_unraisable
-            try:
-                return integrate_phase(fast[0], self.t, self.x, None, t_stop, 2 * n,
-                                       self.compiled_solver, "cyrk_compiled", None, None,
-                                       False), phase
-            finally:
-                sys.unraisablehook = hook
+            return integrate_phase(fast[0], self.t, self.x, None, t_stop, 2 * n,
+                                   self.compiled_solver, "cyrk_compiled", None, None,
+                                   False), phase
         if self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
             tw, tacts = self._twin(w)
             tacts.u = acts.u
