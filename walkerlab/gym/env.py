@@ -208,8 +208,9 @@ class WalkerEnv(gym.Env):
         (:meth:`scene_policy`); None: the action alone drives the controller's joints.
     compiled_step : bool
         Rigid view: each control period on the compiled control step (default: the flow
-        with the action's torques compiled by numba, integrated by CyRK's DOP853 in C++ at
-        the scene solver's tolerances: :class:`walkerlab.gym.rigid_view.RigidView`; heel
+        with the action's torques compiled by numba, integrated by DOP853 in compiled code
+        at the scene solver's tolerances, as the native vector environment integrates one
+        walker: :class:`walkerlab.gym.rigid_view.RigidView`; heel
         strikes within 1e-9 s of the scene's solver on the shipped scenes, 5-20x the
         steps per second), where the step's walker has one (no torque laws of its own, no
         flat feet); False: the scene's ``solver`` with Python flows everywhere.

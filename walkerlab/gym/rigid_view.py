@@ -29,13 +29,21 @@ The compiled control step (``compiled``, the default): a phase of a step walker 
 torque laws of its own (the passive walker, or one powered by a push-off alone) runs its
 flow with the action's torques compiled in (:func:`walkerlab.models.hybrid.actuated.
 compiled_with`: an :class:`walkerlab.codegen.actuated.ActuatedFlow` whose laws are constant
-torques, the action written into its law block each period), integrated by CyRK's DOP853
-in C++ at the scene solver's tolerances (:mod:`walkerlab.integrate._compiled`: guards as the
-cfunc's extra outputs, located by Brent's method on the dense output): no Python per
-right-hand-side call.  Its work ledger is the held torques' exact work
-``sum_k u_k Delta delta_k`` where the action's power keeps one sign over the period's piece
-(else the Gauss-Legendre nodes below).  Other phases (flat feet's modes, a walker with torque
-laws) run the scene's solver on Python flows, as ``compiled=False`` runs every phase.
+torques, the action written into its law block each period), integrated by DOP853 at the
+scene solver's tolerances in compiled code: no Python per right-hand-side call.  It is the
+native vector environment's step of one walker (:meth:`RigidView.advance`:
+:func:`walkerlab.gym.rigid_rows.advance_rows`, the kernel
+:func:`walkerlab.integrate.rows_dop853.period_rows` with a batch of one, guards as the
+cfunc's extra outputs located on each step's dense output), so one environment and the
+vector environment with one walker are the same numbers bit for bit; CyRK's DOP853
+(:mod:`walkerlab.integrate._compiled`, the same steps to round-off) runs only a profile's
+compiled pieces (their dense output kept for the swing foot's check), a compiled phase
+without guard outputs, and the dense output the kernel does not keep, made again when read
+(a failed step's piece; the ledger of joints not affine in the coordinates).  Its
+work ledger is the held torques' exact work ``sum_k u_k Delta delta_k`` where the action's
+power keeps one sign over the period's piece (else the Gauss-Legendre nodes below).  Other
+phases (flat feet's modes, a walker with torque laws) run the scene's solver on Python
+flows, as ``compiled=False`` runs every phase.
 
 The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
 ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
@@ -59,7 +67,7 @@ from walkerlab.integrate.rigid import MIN_STEP_TIME_S, walker_of_step
 from walkerlab.integrate.rigid_phase import integrate_phase
 from walkerlab.integrate.solver import Solver, available_backends
 
-from .action import action_torques, flat_action_walker
+from .action import GL_W, GL_X, action_torques, flat_action_walker
 
 __all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
 
@@ -75,14 +83,25 @@ MODE_TWINS = {"flat_feet": flat_action_walker}
 LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_work",
                 "push_off_work", "heel_strike_loss")
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
-
 #: the compiled control step's integrator: CyRK's DOP853 (Hairer's 8(5,3) pair, the stepping
 #: in C++) on the numba-compiled flow, at the scene solver's tolerances
 COMPILED_METHOD = "DOP853"
 #: the first actuator's constant torque in a law block (:mod:`walkerlab.codegen.torque_law`:
 #: ``b[3 + HEAD i + 1]``, ``constant_n_m``; actuator ``i``'s ``HEAD i`` further on)
 _CONSTANT_0 = 3 + 1
+
+
+_ADVANCE_ROWS = None
+
+
+def _advance_rows():
+    """:func:`walkerlab.gym.rigid_rows.advance_rows`, imported on first use (the kernels'
+    module it reads is not needed to build a view), kept."""
+    global _ADVANCE_ROWS
+    from .rigid_rows import advance_rows  # light: read on the first step
+
+    _ADVANCE_ROWS = advance_rows
+    return advance_rows
 
 
 class RigidView:
@@ -299,11 +318,11 @@ class RigidView:
         scene_on = scene is not None and bool(scene.spec.torques)
         if tb <= ta or not (act_on or scene_on):
             return
-        ts = 0.5 * (tb - ta) * _GL_X + 0.5 * (ta + tb)
+        ts = 0.5 * (tb - ta) * GL_X + 0.5 * (ta + tb)
         X = np.atleast_2d(dense(ts))[:2 * self.n]
         h = 0.5 * (tb - ta)
         if act_on and not acts.first and acts.affine is not None:  # the nodes' power at once
-            for w, p in zip(_GL_W, acts.rate_power(X)):
+            for w, p in zip(GL_W, acts.rate_power(X)):
                 key = "action_work_positive" if p > 0 else "action_work_negative"
                 self.ledger[key] += h * w * p
             act_on = False
@@ -312,9 +331,9 @@ class RigidView:
             if act_on:
                 p = acts.power(tj, xj)
                 key = "action_work_positive" if p > 0 else "action_work_negative"
-                self.ledger[key] += h * _GL_W[j] * p
+                self.ledger[key] += h * GL_W[j] * p
             if scene_on:
-                self.ledger["scene_torque_work"] += h * _GL_W[j] * scene.power(tj, xj)
+                self.ledger["scene_torque_work"] += h * GL_W[j] * scene.power(tj, xj)
 
     def _held_work(self, run, acts, act_on: bool) -> None:
         """The compiled step's ledger over ``[self.t, run.t_last]`` (the action alone: the
@@ -338,7 +357,11 @@ class RigidView:
             self._work(run.dense, self.t, run.t_last, acts, act_on)
 
     def advance(self, u: np.ndarray, t_end: float) -> list[float]:
-        """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
+        """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held: the
+        native vector environment's step of one walker
+        (:func:`walkerlab.gym.rigid_rows.advance_rows`), so the compiled control step's
+        pieces run on its kernel (``rows_dop853``) as a batch of one, and one environment
+        is the vector environment with one walker, bit for bit.
 
         Returns
         -------
@@ -347,8 +370,7 @@ class RigidView:
             :attr:`ended` is set when the episode ended inside it (``fall``, ``stall``,
             ``ground_end``, ``solver_failure``).
         """
-        self.open_period(u, t_end)
-        return self._run(u, t_end)
+        return (_ADVANCE_ROWS or _advance_rows())([self], (u,), (t_end,))[0]
 
     def open_period(self, u: np.ndarray, t_end: float) -> None:
         """A control period to ``t_end`` [s] with the torques ``u`` (k,) [N m] begins: kept
