@@ -155,9 +155,9 @@ def test_the_gym_takes_the_same_footholds():
     contact-sim do): the table's cell is supported and the rigid view's ground check passes
     (before: one line, "the gym's views step one walker on a ground whose every step is
     alike")."""
-    from walkerlab.gym.env import _rigid_ground
+    from walkerlab.gym.arguments import rigid_ground
 
-    assert _rigid_ground(scene_from_dict(TWO)) is None  # the walker's own per-step cycle
+    assert rigid_ground(scene_from_dict(TWO)) is None  # the walker's own per-step cycle
     for kind in ("straight_legs", "locking_knees"):
         assert KINDS[kind].supports("footholds", "gym")
         assert KINDS[kind].supports("profile", "gym")

@@ -451,7 +451,7 @@ def test_hip_xs_are_each_views_hip_x_bit_for_bit():
     """The hips of many rigid walkers from one call of the step walker's ``points`` on the
     states as columns equal each walker's own, bit for bit; a ``points`` of one state only
     is called state by state."""
-    from walkerlab.gym.rigid_view import _hips, hip_xs
+    from walkerlab.gym.batch import _hips, hip_xs
 
     env = _native(4, "threelink_hzd", start_noise=0.3)
     env.reset(seed=2)
@@ -493,14 +493,14 @@ def test_batched_native_form_walks_rabbit_and_a_passive_walker_as_sync(scene):
 
 
 def test_a_steps_infos_are_batched_when_first_read_and_equal_the_batching():
-    """The native step's infos (:class:`walkerlab.gym.vector.LazyInfos`) are batched by the
+    """The native step's infos (:class:`walkerlab.gym.infos.LazyInfos`) are batched by the
     first read, not before, and are then the entries the batching gives, whatever reads
     them first (a key, ``in``, ``len``, iteration, a copy, a pickle: plain dicts of the
     same entries)."""
     import copy
     import pickle
 
-    from walkerlab.gym.vector import LazyInfos
+    from walkerlab.gym.infos import LazyInfos
 
     calls = []
 
@@ -536,9 +536,11 @@ def test_batched_ledger_equals_each_walkers_own_where_the_actions_power_changes_
     """The batched rows' held-torque ledger (:func:`walkerlab.gym.rigid_rows._held_rows`:
     the exact work where the action's power keeps its sign over a period, else the power at
     the period's Gauss-Legendre nodes read from the kernel's dense output) equals each
-    walker's own (sync: CyRK's dense output at the same nodes, the joint maps applied
-    state by state) within 1e-9 J, over 60 periods of full-range random actions on the
-    three-link walker, periods of both kinds met (the sync walkers' node ledger counted)."""
+    walker's own ledger of its own integration (sync, each walker's pieces on CyRK's
+    DOP853, :meth:`RigidView._run`: its dense output at the same nodes, the joint maps
+    applied state by state) within 1e-9 J, over 60 periods of full-range random actions
+    on the three-link walker, periods of both kinds met (the sync walkers' node ledger
+    counted)."""
     from walkerlab.gym import rigid_view
 
     nodes = []
@@ -548,7 +550,12 @@ def test_batched_ledger_equals_each_walkers_own_where_the_actions_power_changes_
         nodes.append(1)
         return own(self, *a, **k)
 
+    def by_itself(self, u, t_end):  # the walker's own integration, piece by piece
+        self.open_period(u, t_end)
+        return self._run(u, t_end)
+
     monkeypatch.setattr(rigid_view.RigidView, "_work", counted)
+    monkeypatch.setattr(rigid_view.RigidView, "advance", by_itself)
     n, steps = 4, 60
     kw = dict(max_episode_steps=30, start_noise=0.05)
     sync = _vec("sync", n, "threelink_hzd", **kw)
@@ -711,3 +718,38 @@ def test_the_native_vector_envs_first_batched_step_says_in_one_line_when_it_comp
     monkeypatch.setattr(rigid_rows, "COMPILE_NOTICE_S", 60.0)
     quick.step(a)
     assert capfd.readouterr().err == ""
+
+
+@pytest.mark.parametrize("scene", ["threelink_hzd", "rabbit_hzd"])
+def test_one_environment_is_the_vector_environment_with_one_walker_bit_for_bit(scene):
+    """Issue 80 item 4, one integrator per view: ``gym.make``'s environment advances its
+    rigid walker as the native vector environment advances each of its walkers
+    (:func:`walkerlab.gym.rigid_rows.advance_rows`, the compiled pieces on
+    :func:`walkerlab.integrate.rows_dop853.period_rows`, here a batch of one), so its
+    observations, rewards, flags and infos are the one-walker vector environment's bit for
+    bit: the scene's controller with random actions through heel strikes to the episode's
+    end (before: CyRK's DOP853 against the kernel's, within 1e-9 after 50 periods)."""
+    import walkerlab.gym  # noqa: F401 - registers walkerlab/Walker-v0
+
+    kw = dict(start_noise=0.05, max_episode_steps=120, policy="scene")
+    single = gym.make(ID, scene=_scene(scene), **kw)
+    native = _native(1, scene, **kw)
+    actions = 0.3 * _random_actions(native, 120, seed=7)
+    obs, info = single.reset(seed=3)
+    vobs, vinfo = native.reset(seed=3)
+    np.testing.assert_array_equal(vobs[0], obs)
+    strikes = 0
+    for a in actions:
+        obs, r, term, trunc, info = single.step(a[0])
+        vobs, vr, vterm, vtrunc, vinfo = native.step(a)
+        assert obs.tobytes() == vobs[0].tobytes() and r == vr[0]
+        assert (term, trunc) == (vterm[0], vtrunc[0])
+        for k, v in info.items():
+            w = vinfo[k][0]
+            assert (w is None or np.isnan(w)) if v is None else v == w, k
+        strikes += info["heel_strike"]
+        if term or trunc:
+            break
+    assert strikes > 1 and (term or trunc)
+    single.close()
+    native.close()

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -161,6 +162,33 @@ def _variational_lines(eq, acts, grads, fl, rows, printer, cse_lines) -> list[st
     return out
 
 
+#: a name's negative whole power in a generated line (``_c2_3**(-2)``: :func:`_reciprocal_power`)
+_NEGATIVE_POWER = re.compile(r"\b([A-Za-z_]\w*)\*\*\(-(\d+)\)")
+
+
+def _reciprocal_power(match) -> str:
+    """``x**(-k)`` (``match`` of :data:`_NEGATIVE_POWER`) written as numba computes it,
+    ``1/(x*x)`` for ``k = 2`` (its power by a whole-number literal: the product of the
+    squarings by binary exponentiation, then its reciprocal; the same operations in the same
+    order, so the same number bit for bit), without numba's zero test: numba compiles that
+    reciprocal with Python's error model whatever the cfunc's (``error_model='numpy'``), so
+    ``0.0**(-2)`` raised ``ZeroDivisionError`` inside the cfunc, which a cfunc cannot
+    return: it was written to ``sys.unraisablehook``, the call's outputs left as the last
+    call's.  Written so, ``1/(0.0*0.0)`` is ``inf`` as every other division by zero in the
+    cfunc (the integrator's step then fails its error test, or the piece ends not finite:
+    the view's ``solver_failure``)."""
+    name, k = match.group(1), int(match.group(2))
+    res, val = None, name
+    while k:
+        if k & 1:  # (numba's first product, 1.0 * val, is val itself)
+            res = val if res is None else f"{res}*{val}"
+        k >>= 1
+        if k:
+            val = f"({val}*{val})"
+    # (in parentheses: the power's precedence, as in a / x**(-2))
+    return f"(1/{res})" if res.startswith("(") and res == val else f"(1/({res}))"
+
+
 def generate_actuated(eq, param_names, joints, key: str) -> str:
     """Source of the compiled module of an actuated walker (module docstring): ``constants``,
     ``NCONST``, ``GUARDS`` (``eq.guards``' names, written after the outputs as
@@ -194,7 +222,8 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     text = []
     for nm, lines in bodies.items():  # plain functions: made cfuncs on first use
         text += [f"def {nm}(dy, t, y, d):  # pragma: no cover - runs compiled",
-                 *[f"    {c} = d[{i}]" for i, c in enumerate(consts)], *lines, ""]
+                 *[f"    {c} = d[{i}]" for i, c in enumerate(consts)],
+                 *[_NEGATIVE_POWER.sub(_reciprocal_power, ln) for ln in lines], ""]
     text += ["_LAZY = {}", "", "",
              "def cfunc_of(name):",
              '    """The cfunc ``name`` (compiled, or loaded from numba\'s cache, on first use: a',

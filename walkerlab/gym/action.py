@@ -32,8 +32,13 @@ import numpy as np
 
 from walkerlab.models.hybrid.actuators import Actuators
 
-__all__ = ["DEFAULT_TORQUE_FRACTION", "ActionTorques", "action_joints", "action_limits",
-           "action_torques"]
+__all__ = ["DEFAULT_TORQUE_FRACTION", "GL_W", "GL_X", "ActionTorques", "action_joints",
+           "action_limits", "action_torques"]
+
+#: the 4-point Gauss-Legendre rule on [-1, 1] (nodes, weights) of the action's work over an
+#: integrated piece (the rigid view's ledger: :mod:`walkerlab.gym.rigid_view`, and the
+#: native vector environment's rows, :mod:`walkerlab.gym.rigid_rows`)
+GL_X, GL_W = np.polynomial.legendre.leggauss(4)
 
 #: Default bound of an action torque whose joint has no ``max_torque_n_m`` [-], a fraction
 #: of ``M g l`` (a tenth of the weight's moment at a leg's length).

@@ -107,14 +107,16 @@ from gymnasium import spaces
 
 from walkerlab.rigid_walker import SceneWalker, scene_of
 
+from .arguments import (
+    InvalidAction,
+    check_arguments,
+    checked_action,
+    plant_scene,
+    rigid_ground,
+)
 from .episode_state import capture, restore
 
-__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv", "batch_parameters", "begin_periods",
-           "end_periods"]
-
-#: the largest ``start_noise``: the start's rates times ``1 + U(-1, 1)`` (from rest to twice
-#: the gait's rates; beyond, rates change sign)
-MAX_START_NOISE = 1.0
+__all__ = ["INFO_KEYS", "InvalidAction", "WalkerEnv"]
 
 #: bound of the observation's state entries [m, rad, m/s, rad/s] and time [s]: far beyond a
 #: walking state (an observation past it is clipped to it)
@@ -144,75 +146,6 @@ def _gait(walker):
         _GAITS[key] = walker.fixed_point()
     return _GAITS[key]
 
-
-def _rigid_ground(scene):
-    """The rigid view's ground beyond its walker's own (:func:`walkerlab.integrate.rigid.
-    walker_of_step`: a slope, stairs, footholds of one or several heights or slopes, as
-    ``walkerlab simulate`` steps them): a height profile's steps
-    (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`), else None.
-
-    Raises
-    ------
-    ValueError
-        A per-step random ground (``terrain.per_step``), or a profile the rigid walk does
-        not read (one line).
-    """
-    t = scene.terrain
-    if t is None:
-        return None
-    if getattr(t, "per_step", None) is not None:
-        raise ValueError("walkerlab.gym: terrain.per_step: the rigid view walks the scene's "
-                         "own ground, not one drawn per step (walkerlab simulate "
-                         "--terrain-seed draws it); leave terrain.per_step out")
-    if t.kind != "profile":
-        return None
-    from walkerlab.analysis.gait.rigid_run import profile_ground  # light
-
-    try:
-        return profile_ground(scene)
-    except ValueError as exc:
-        raise ValueError(f"walkerlab.gym: {exc}") from None
-
-
-def _plant(scene):
-    """``scene`` without its feedback controller (``walker.actuation: None``): the walker
-    the environment steps when the controller is the policy (:meth:`WalkerEnv.
-    scene_policy`)."""
-    return scene.model_copy(update={"walker": scene.walker.model_copy(
-        update={"actuation": None})})
-
-
-class InvalidAction(ValueError, gym.error.InvalidAction):
-    """An action that is not the environment's ``k`` finite real torques of shape ``(k,)``
-    (a ``ValueError`` and gymnasium's ``InvalidAction``)."""
-
-
-def _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
-                     terrain_roughness_m) -> None:
-    """Refuse :class:`WalkerEnv`'s arguments out of their ranges (one line naming the
-    argument)."""
-    if view not in ("rigid", "contact"):
-        raise ValueError(f"view={view!r}: give 'rigid' or 'contact'")
-    if not (isinstance(control_period_s, (int, float)) and not isinstance(
-            control_period_s, bool) and 0 < control_period_s <= 1.0
-            and math.isfinite(control_period_s)):
-        raise ValueError(f"control_period_s={control_period_s!r}: give a positive number "
-                         "of seconds, at most 1")
-    if max_episode_steps is not None and (
-            isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, int)
-            or max_episode_steps < 1):
-        raise ValueError(f"max_episode_steps={max_episode_steps!r}: give a whole number "
-                         ">= 1")
-    if render_mode not in (None, "rgb_array"):
-        raise ValueError(f"render_mode={render_mode!r}: give None or 'rgb_array'")
-    for name, v in (("start_noise", start_noise),
-                    ("terrain_roughness_m", terrain_roughness_m)):
-        if not (isinstance(v, (int, float)) and not isinstance(v, bool)
-                and math.isfinite(v) and v >= 0):
-            raise ValueError(f"{name}={v!r}: give a number >= 0")
-    if start_noise > MAX_START_NOISE:
-        raise ValueError(f"start_noise={start_noise!r}: give a relative noise in [0, "
-                         f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
 
 
 #: the episode's length in control periods when none is given (``WalkerEnv``'s default; the
@@ -277,8 +210,9 @@ class WalkerEnv(gym.Env):
         (:meth:`scene_policy`); None: the action alone drives the controller's joints.
     compiled_step : bool
         Rigid view: each control period on the compiled control step (default: the flow
-        with the action's torques compiled by numba, integrated by CyRK's DOP853 in C++ at
-        the scene solver's tolerances: :class:`walkerlab.gym.rigid_view.RigidView`; heel
+        with the action's torques compiled by numba, integrated by DOP853 in compiled code
+        at the scene solver's tolerances, as the native vector environment integrates one
+        walker: :class:`walkerlab.gym.rigid_view.RigidView`; heel
         strikes within 1e-9 s of the scene's solver on the shipped scenes, 5-20x the
         steps per second), where the step's walker has one (no torque laws of its own, no
         flat feet); False: the scene's ``solver`` with Python flows everywhere.
@@ -330,11 +264,11 @@ class WalkerEnv(gym.Env):
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
         from walkerlab.walker.description import walker_data
 
-        from .action import action_joints, action_limits, action_torques  # light
-        from .rigid_view import RigidView  # light
+        from .action import action_joints, action_limits, action_torques
+        from .rigid_view import RigidView
 
-        _check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
-                         terrain_roughness_m)
+        check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
+                        terrain_roughness_m)
         if policy not in (None, "scene"):
             raise ValueError(f"policy={policy!r}: give None or 'scene' (the scene's feedback "
                              "controller acting with the action)")
@@ -355,10 +289,10 @@ class WalkerEnv(gym.Env):
                              "(walker.actuation.virtual_constraints) to act as the policy; "
                              "its torque laws act in the walker with policy=None")
         self.policy = policy
-        ground = _rigid_ground(sc) if view == "rigid" else None
+        ground = rigid_ground(sc) if view == "rigid" else None
         if view == "contact":  # the contact view's refusals (the table's contact cells for
             # the scene's features, its ground): from the scene alone, before the gait search
-            from walkerlab.models.contact.scene import contact_setup  # light
+            from walkerlab.models.contact.scene import contact_setup
 
             setup = contact_setup(sc)
         self.scene, self.view = sc, view
@@ -375,7 +309,7 @@ class WalkerEnv(gym.Env):
         #: the scene's feedback controller (virtual constraints; None: the scene has none):
         #: out of the walker's flow, the policy (:meth:`scene_policy`)
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
-        plant = self.rigid if vc is None else SceneWalker(_plant(sc))
+        plant = self.rigid if vc is None else SceneWalker(plant_scene(sc))
         model = plant.model
         self.joints = action_joints(sc, self.controller)
         if view == "rigid":
@@ -527,7 +461,7 @@ class WalkerEnv(gym.Env):
         start = self.gait.x if self.view == "rigid" else self.sim.x_start
         if state is not None and any(isinstance(v, str | bytes) for v in
                                      np.ravel(np.asarray(state, dtype=object))):
-            from walkerlab.config import SceneError  # light
+            from walkerlab.config import SceneError
 
             raise SceneError(f"options['state']: give {len(self.state_names)} numbers "
                              f"({', '.join(self.state_names)}), not text")
@@ -547,7 +481,7 @@ class WalkerEnv(gym.Env):
                 self._checked_start = x0  # (the same numbers pass again: not checked twice)
         elif not (isinstance(x0, np.ndarray) and x0.shape == self.sim.x_start.shape
                   and np.all(np.isfinite(x0))):
-            from walkerlab.config import SceneError  # light
+            from walkerlab.config import SceneError
 
             raise SceneError(f"options['state']: give {len(self.state_names)} finite "
                              f"numbers ({', '.join(self.state_names)})")
@@ -570,25 +504,7 @@ class WalkerEnv(gym.Env):
                 and (all(map(math.isfinite, action.tolist())) if action.dtype.char in "fd"
                      else np.isfinite(action).all())):
             return action.astype(np.float64)  # the common case: no message built
-        want = (f"give {k} finite real number{'s' if k > 1 else ''} "
-                f"({', '.join(self.joints)}), shape ({k},), in {self.action_space}")
-        if action is None:
-            raise InvalidAction(f"action is None: {want}")
-        try:
-            a = np.asarray(action)
-        except (ValueError, TypeError):  # ragged nesting
-            raise InvalidAction(f"action of type {type(action).__name__} is not an array of "
-                                f"numbers: {want}") from None
-        if a.dtype.kind not in "iuf":
-            what = "complex" if a.dtype.kind == "c" else f"of dtype {a.dtype}"
-            raise InvalidAction(f"action is {what}: {want}")
-        if a.shape != (k,):
-            raise InvalidAction(f"action has shape {a.shape}: {want}")
-        a = a.astype(np.float64)
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise InvalidAction(f"action[{int(bad[0])}] is {a[bad[0]]}: {want}")
-        return a
+        return checked_action(action, k, self.joints, self.action_space)
 
     def step(self, action):
         """Hold ``action`` (k,) (fractions of :attr:`tau_max`, or N m), clipped to the
@@ -679,210 +595,3 @@ class WalkerEnv(gym.Env):
 
         return draw(self.sim.points(), float(self.scene.slope.phi_rad),
                     float(self.rigid.model.params["leg_length_m"]), self.sim.t)
-
-
-# ---------------------------------------------------------------------- many walkers at once
-def batch_parameters(envs) -> dict | None:
-    """What :func:`begin_periods` and :func:`end_periods` read of each environment, stacked
-    over ``envs`` (N rigid-view :class:`WalkerEnv`); None when they cannot step these walkers
-    together (a contact view, a ``reward_fn``, or action sizes that differ): each is then
-    stepped by its own :meth:`WalkerEnv.step`.
-
-    Returns
-    -------
-    dict or None
-        ``tau`` (N, k) [N m] the action bounds; ``scale`` (N, k) [N m or -] what an action
-        is multiplied by (``tau`` with ``normalize_action``, else 1); ``policy`` (N,) bool
-        ``policy="scene"``; ``fw``, ``healthy``, ``cw``, ``ww``, ``dt`` (N,) the reward's
-        weights and the control period [s]; ``limit`` (N,) int the environment's own
-        ``max_episode_steps`` (-1: none); ``low``, ``high`` (N, m + 3) the observation's
-        bounds.  :func:`begin_periods` and :func:`end_periods` keep Python forms of some of
-        them in it (``flags``, ``lists``: not arrays over the walkers).
-    """
-    if any(e.view != "rigid" or e.reward_fn is not None for e in envs):
-        return None
-    if len({e.tau_max.shape for e in envs}) != 1 or len(
-            {e.observation_space.shape for e in envs}) != 1:
-        return None
-    tau = np.array([e.tau_max for e in envs], dtype=np.float64)
-    w = np.array([e.weights for e in envs], dtype=np.float64)
-    return {"tau": tau,
-            "scale": np.where(np.array([[e.normalize_action] for e in envs]), tau, 1.0),
-            "normalize": np.array([e.normalize_action for e in envs]),
-            "policy": np.array([e.policy == "scene" for e in envs]),
-            "fw": w[:, 0], "healthy": w[:, 1], "cw": w[:, 2], "ww": w[:, 3],
-            "dt": np.array([e.dt for e in envs], dtype=np.float64),
-            "limit": np.array([-1 if e.max_episode_steps is None else e.max_episode_steps
-                               for e in envs], dtype=np.int64),
-            "low": np.array([e.observation_space.low for e in envs]),
-            "high": np.array([e.observation_space.high for e in envs])}
-
-
-def _rigid_view():
-    """:mod:`walkerlab.gym.rigid_view` (imported on first use: the models it reads are
-    not needed to register the environment), kept for the per-period calls."""
-    global _RIGID_VIEW
-    if _RIGID_VIEW is None:
-        from . import rigid_view as _RIGID_VIEW  # light
-    return _RIGID_VIEW
-
-
-_RIGID_VIEW = None
-
-
-def _flags(p: dict) -> tuple:
-    """``(every walker's action normalised, some are, some run the scene's policy)`` of
-    :func:`batch_parameters`' ``p``, kept in it (as Python values: they are read every
-    period)."""
-    flags = p.get("flags")
-    if flags is None:
-        norm = p["normalize"]
-        flags = p["flags"] = (bool(norm.all()), bool(norm.any()), bool(p["policy"].any()))
-    return flags
-
-
-def _lists(p: dict) -> tuple:
-    """The reward's weights and the limits of :func:`batch_parameters`' ``p`` as lists of
-    Python numbers ``(fw, healthy, cw, ww, dt, limit)``, kept in it."""
-    lists = p.get("lists")
-    if lists is None:
-        lists = p["lists"] = tuple(p[k].tolist() for k in ("fw", "healthy", "cw", "ww",
-                                                           "dt", "limit"))
-    return lists
-
-
-def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
-    """:meth:`WalkerEnv.begin_period` of N rigid-view environments at once: the held
-    torques of every row of ``actions``, each period counted.
-
-    Parameters
-    ----------
-    envs : sequence of WalkerEnv
-        N environments, each reset.
-    actions : ndarray (N, k)
-        Checked finite actions (fractions of ``tau_max``, or N m), any real dtype.
-    p : dict
-        :func:`batch_parameters` of ``envs``.
-
-    Returns
-    -------
-    U : ndarray (N, k)
-        The held torques [N m] (the action scaled, the scene policy's added, clipped to the
-        bounds: the same operations as one environment's, element by element).
-    x_before, w_before : list of float (N)
-        The hip's x at the period's start [m] and the positive action work so far [J].
-    t_ends : list of float
-        Each period's end [s].
-    """
-    norm = p["normalize"]
-    every, some, policy = _flags(p)
-    if every:  # (the actions read as float64, then scaled: numpy's casting of any real
-        a = np.multiply(actions, p["tau"], dtype=np.float64)  # dtype, in one operation)
-    else:
-        a = np.asarray(actions).astype(np.float64)
-    if not every and some:
-        a[norm] = a[norm] * p["tau"][norm]
-    if policy:
-        for r in np.flatnonzero(p["policy"]):
-            e = envs[r]
-            s = e.sim
-            a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
-    tau = p["tau"]
-    U = a.clip(-tau, tau)  # (np.clip's own method)
-    x_before = [e._hip_x for e in envs]
-    w_before = [e.sim.ledger["action_work_positive"] for e in envs]
-    t_ends = []
-    for e in envs:
-        e._elapsed += 1
-        t_ends.append(e._elapsed * e.dt)
-    return U, x_before, w_before, t_ends
-
-
-def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
-                p: dict, views=None) -> tuple:
-    """:meth:`WalkerEnv.end_period` of N rigid-view environments at once, their walkers
-    advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`): observations, rewards, flags
-    and the infos as columns.
-
-    Parameters
-    ----------
-    envs : sequence of WalkerEnv
-    U : ndarray (N, k)
-        The held torques [N m] (:func:`begin_periods`).
-    strikes : list of list of float
-        Each walker's heel-strike times in the period [s].
-    x_before, w_before : list of float (N)
-        :func:`begin_periods`' hip x [m] and positive work [J] at the period's start.
-    p : dict
-        :func:`batch_parameters` of ``envs``.
-    views : list of RigidView, optional
-        ``[e.sim for e in envs]``, when the caller has it.
-
-    Returns
-    -------
-    obs : ndarray (N, m + 3) float64
-    reward : ndarray (N,) float64
-    terminated, truncated : ndarray (N,) bool
-    columns : callable
-        ``columns()``: the infos by key (:data:`INFO_KEYS`, then ``ledger_<term>``, in the
-        order of :meth:`WalkerEnv._info`'s dict), each a list or array of N values of the
-        types that dict holds (floats, bools, ints, text, None, lists), made when called
-        (a step whose infos are not read does not make them) from what this call read of
-        the walkers: the same entries whenever called.
-    """
-    if views is None:
-        views = [e.sim for e in envs]
-    n = len(envs)
-    # what is read of each walker, in one pass: its state, time, stance leg, phase, its
-    # step's start, how its episode ended, its steps and ledger
-    rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
-    xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
-    X = np.array(xs)
-    m = X.shape[1]
-    obs = np.empty((n, m + 3))
-    obs[:, :m] = X
-    # (leg1's stance as 1.0, the phase's index as a float, the time in the step)
-    obs[:, m:] = [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in
-                  zip(legs, ks, ts, t_steps)]
-    obs.clip(p["low"], p["high"], out=obs)  # (np.clip's own method, a layer less)
-    hip = _rigid_view().hip_xs(views, X)
-    hips = hip.tolist()
-    for e, h in zip(envs, hips):
-        e._hip_x = h  # the next period's start (its reward's origin)
-    terminated = [s != "" for s in ended]
-    elapsed = [e._elapsed for e in envs]
-    fws, healthy, cws, wws, dts, limits = _lists(p)
-    truncated = [not te and lim >= 0 and el >= lim
-                 for te, lim, el in zip(terminated, limits, elapsed)]
-    terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
-    sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
-    # the reward of each walker as its own end_period computes it, on Python floats (the
-    # same IEEE operations in the same order as there)
-    effort = np.add.reduce((U / p["tau"]) ** 2, axis=1).tolist()
-    j_work = terms.index("action_work_positive")
-    work = [row[j_work] for row in sums]
-    reward = np.array([
-        fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
-        for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
-            fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
-            w_before)], dtype=np.float64)
-    messages = [getattr(v, "failure", "") for v in views]
-    seeds = [e.terrain_seed for e in envs]
-
-    def columns() -> dict:  # (of the values read above, whenever called)
-        L = np.array(sums, dtype=np.float64).T.copy()
-        out = {"time_s": np.array(ts, dtype=np.float64),
-               "heel_strike": [bool(s) for s in strikes],
-               "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
-               "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
-               "steps": [int(s) for s in steps],
-               "stance_leg": list(legs), "hip_x_m": hip,
-               "termination": list(ended),
-               "solver_message": [str(m) for m in messages],
-               "terrain_seed": [int(s) for s in seeds]}
-        out.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
-        return out
-
-    terminated = np.array(terminated, dtype=np.bool_)
-    truncated = np.array(truncated, dtype=np.bool_)
-    return obs, reward, terminated, truncated, columns

@@ -38,7 +38,7 @@ __all__ = ["capture", "restore"]
 
 #: the rigid view's plain episode attributes (copied as they are)
 _RIGID = ("t", "t_step", "leg", "x", "foot", "advance_x", "ended", "trip", "ledger", "steps",
-          "_period", "k", "arithmetic_errors", "_step_start", "_log")
+          "_period", "k", "_step_start", "_log")
 #: the contact run's hook's attributes besides its state, time and what ``_start`` carries
 _HOOK = ("t_strike", "resume", "pulse_end", "pushed", "term", "msg", "event", "nfev", "njev")
 

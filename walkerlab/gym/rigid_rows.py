@@ -2,8 +2,9 @@
 walker integrated in one compiled call per flow (the native vector environment's physics,
 :class:`walkerlab.gym.vector.WalkerVectorEnv`).
 
-Each walker (:class:`walkerlab.gym.rigid_view.RigidView`) is advanced as its own
-:meth:`~walkerlab.gym.rigid_view.RigidView.advance` advances it - the same pieces
+Each walker (:class:`walkerlab.gym.rigid_view.RigidView`; its own
+:meth:`~walkerlab.gym.rigid_view.RigidView.advance` is this function on it alone) is advanced
+piece by piece - the same pieces
 (:meth:`~walkerlab.gym.rigid_view.RigidView.next_piece`), the same handling of each piece's
 end (:meth:`~walkerlab.gym.rigid_view.RigidView.absorb`: the ledger, a knee strike, a heel
 strike and the next step, a fall) - but the pieces that run the compiled control step (the
@@ -13,12 +14,13 @@ share a flow (one cfunc and tolerances; each phase's own guards) are the rows of
 torques in the law block), its own state and its own end (the period's end or its step's
 time limit).  That kernel runs scipy's DOP853 (Hairer, Nørsett & Wanner 1993, sec. II.10) as
 CyRK's does, its error norm scaled to theirs (the 2-norm at tolerances times ``sqrt(2n)`` is
-the root-mean-square norm at the tolerances), so a row's steps are the single walker's to
-round-off (measured: the states after a 10 ms period within 4.4e-16 of CyRK's); the guard
-crossings are located on the step's dense output by the Illinois method to 1e-15 s (the
-single walker: Brent's method to 4 eps).  Pieces that do not run the compiled step (flat
-feet's modes, torque laws of the walker's own, a height profile's walk, which keeps each
-piece's dense output) are integrated one by one as the walker itself integrates them.
+the root-mean-square norm at the tolerances), so a row's steps are CyRK's to round-off
+(measured: the states after a 10 ms period within 4.4e-16 of CyRK's; CyRK still runs a
+profile's compiled pieces); the guard crossings are located on the step's dense output by
+the Illinois method to 1e-15 s (CyRK's runs: Brent's method to 4 eps).  Pieces that do
+not run the compiled step (flat feet's modes, torque laws of the walker's own, a height
+profile's walk, which keeps each piece's dense output) are integrated one by one as the
+walker itself integrates them.
 
 The ledger of a row that reaches its period's end with the action on is taken for all such
 rows at once (:func:`_held_rows`), as each walker's
@@ -37,7 +39,6 @@ single walker's integrator (:class:`_Redo`).
 
 from __future__ import annotations
 
-import sys
 import threading
 
 import numpy as np
@@ -46,7 +47,7 @@ from walkerlab import progress
 from walkerlab.integrate.rigid_phase import PhaseRun, integrate_phase
 from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 
-from .rigid_view import _GL_W, _GL_X  # the ledger's Gauss-Legendre rule, the walker's own
+from .action import GL_W, GL_X  # the ledger's Gauss-Legendre rule, the walker's own
 from .small_arrays import all_finite
 
 __all__ = ["COMPILE_NOTICE_S", "advance_rows", "compile_notice"]
@@ -78,7 +79,7 @@ def compile_notice(call, after_s: float | None = None):
 
 
 #: the ledger's 4-point Gauss-Legendre weights as floats (the walker's own rule)
-_GL_WL = _GL_W.tolist()
+_GL_WL = GL_W.tolist()
 
 
 class _Redo:
@@ -234,19 +235,15 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
     on = [piece[2] for piece in pieces]
     if any(on):
         half = 0.5 * cap[:, None]
-        Tn = half * _GL_X + half
+        Tn = half * GL_X + half
         if not all(on):
             Tn[[not a for a in on]] = np.nan
-        Yn = np.empty((N, _GL_X.size, m))
+        Yn = np.empty((N, GL_X.size, m))
     else:
         Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
             (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
-    hook, sys.unraisablehook = sys.unraisablehook, walkers[0].count_unraisable
-    try:  # (an arithmetic error inside the kernel: counted on the first row's walker)
-        _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
-                           n_out, which, te, Yev, H, Tn, Yn))
-    finally:
-        sys.unraisablehook = hook
+    _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
+                       n_out, which, te, Yev, H, Tn, Yn))
     call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
     return which, te, Yev, Y, cap, Yn, call
 
@@ -384,9 +381,9 @@ def _joint_map(view, acts):
 
 def advance_rows(views, actions, t_ends) -> list[list[float]]:
     """Advance every walker ``views[i]`` to ``t_ends[i]`` [s] with the torques
-    ``actions[i]`` (k,) [N m] held, as its own
-    :meth:`~walkerlab.gym.rigid_view.RigidView.advance` does, the compiled pieces of all of
-    them integrated together (module docstring).
+    ``actions[i]`` (k,) [N m] held, the compiled pieces of all of them integrated together
+    (module docstring; one walker's :meth:`~walkerlab.gym.rigid_view.RigidView.advance`
+    is this function on it alone).
 
     Parameters
     ----------

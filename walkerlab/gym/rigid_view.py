@@ -29,13 +29,21 @@ The compiled control step (``compiled``, the default): a phase of a step walker 
 torque laws of its own (the passive walker, or one powered by a push-off alone) runs its
 flow with the action's torques compiled in (:func:`walkerlab.models.hybrid.actuated.
 compiled_with`: an :class:`walkerlab.codegen.actuated.ActuatedFlow` whose laws are constant
-torques, the action written into its law block each period), integrated by CyRK's DOP853
-in C++ at the scene solver's tolerances (:mod:`walkerlab.integrate._compiled`: guards as the
-cfunc's extra outputs, located by Brent's method on the dense output): no Python per
-right-hand-side call.  Its work ledger is the held torques' exact work
-``sum_k u_k Delta delta_k`` where the action's power keeps one sign over the period's piece
-(else the Gauss-Legendre nodes below).  Other phases (flat feet's modes, a walker with torque
-laws) run the scene's solver on Python flows, as ``compiled=False`` runs every phase.
+torques, the action written into its law block each period), integrated by DOP853 at the
+scene solver's tolerances in compiled code: no Python per right-hand-side call.  It is the
+native vector environment's step of one walker (:meth:`RigidView.advance`:
+:func:`walkerlab.gym.rigid_rows.advance_rows`, the kernel
+:func:`walkerlab.integrate.rows_dop853.period_rows` with a batch of one, guards as the
+cfunc's extra outputs located on each step's dense output), so one environment and the
+vector environment with one walker are the same numbers bit for bit; CyRK's DOP853
+(:mod:`walkerlab.integrate._compiled`, the same steps to round-off) runs only a profile's
+compiled pieces (their dense output kept for the swing foot's check), a compiled phase
+without guard outputs, and the dense output the kernel does not keep, made again when read
+(a failed step's piece; the ledger of joints not affine in the coordinates).  Its
+work ledger is the held torques' exact work ``sum_k u_k Delta delta_k`` where the action's
+power keeps one sign over the period's piece (else the Gauss-Legendre nodes below).  Other
+phases (flat feet's modes, a walker with torque laws) run the scene's solver on Python
+flows, as ``compiled=False`` runs every phase.
 
 The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
 ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
@@ -50,7 +58,6 @@ the heel strike's collision, <= 0).
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -60,9 +67,9 @@ from walkerlab.integrate.rigid import MIN_STEP_TIME_S, walker_of_step
 from walkerlab.integrate.rigid_phase import integrate_phase
 from walkerlab.integrate.solver import Solver, available_backends
 
-from .action import action_torques, flat_action_walker
+from .action import GL_W, GL_X, action_torques, flat_action_walker
 
-__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView", "hip_xs"]
+__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
 
 #: the feet (:attr:`walkerlab.walker.kinds.Kind.feet`) whose phases each have a mass
 #: matrix of their own (a flat foot's stance modes: heel or toe pinned, the foot locked
@@ -76,8 +83,6 @@ MODE_TWINS = {"flat": flat_action_walker}
 LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_work",
                 "push_off_work", "heel_strike_loss")
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
-
 #: the compiled control step's integrator: CyRK's DOP853 (Hairer's 8(5,3) pair, the stepping
 #: in C++) on the numba-compiled flow, at the scene solver's tolerances
 COMPILED_METHOD = "DOP853"
@@ -86,13 +91,26 @@ COMPILED_METHOD = "DOP853"
 _CONSTANT_0 = 3 + 1
 
 
+_ADVANCE_ROWS = None
+
+
+def _advance_rows():
+    """:func:`walkerlab.gym.rigid_rows.advance_rows`, imported on first use (the kernels'
+    module it reads is not needed to build a view), kept."""
+    global _ADVANCE_ROWS
+    from .rigid_rows import advance_rows  # light: read on the first step
+
+    _ADVANCE_ROWS = advance_rows
+    return advance_rows
+
+
 class RigidView:
     """The scene's rigid hybrid walker stepped by control periods.
 
     Parameters
     ----------
     model : walkerlab.models.hybrid.HybridWalker
-        The scene's walker with its own actuators (:attr:`walkerlab.api.walker.Walker.model`).
+        The scene's walker with its own actuators (:attr:`walkerlab.rigid_walker.SceneWalker.model`).
     solver : walkerlab.integrate.solver.Solver
     data : walkerlab.walker.description.WalkerData
         The walker's description (the action's actuators are built from it).
@@ -139,8 +157,6 @@ class RigidView:
         #: (:mod:`walkerlab.gym.rigid_rows`), by the phase's id (it lives in ``_compiled``),
         #: and the action's joint map by its actuators' (they live in ``acts``)
         self.row_keys: dict = {}
-        #: arithmetic errors raised inside compiled flows (:meth:`count_unraisable`), counted
-        self.arithmetic_errors = 0
         self._joints_at: tuple = (b"", None, None, None)  # (state bytes, delta, ddelta, acts)
         n = model.n_coordinates
         self.n = n
@@ -302,11 +318,11 @@ class RigidView:
         scene_on = scene is not None and bool(scene.spec.torques)
         if tb <= ta or not (act_on or scene_on):
             return
-        ts = 0.5 * (tb - ta) * _GL_X + 0.5 * (ta + tb)
+        ts = 0.5 * (tb - ta) * GL_X + 0.5 * (ta + tb)
         X = np.atleast_2d(dense(ts))[:2 * self.n]
         h = 0.5 * (tb - ta)
         if act_on and not acts.first and acts.affine is not None:  # the nodes' power at once
-            for w, p in zip(_GL_W, acts.rate_power(X)):
+            for w, p in zip(GL_W, acts.rate_power(X)):
                 key = "action_work_positive" if p > 0 else "action_work_negative"
                 self.ledger[key] += h * w * p
             act_on = False
@@ -315,20 +331,9 @@ class RigidView:
             if act_on:
                 p = acts.power(tj, xj)
                 key = "action_work_positive" if p > 0 else "action_work_negative"
-                self.ledger[key] += h * _GL_W[j] * p
+                self.ledger[key] += h * GL_W[j] * p
             if scene_on:
-                self.ledger["scene_torque_work"] += h * _GL_W[j] * scene.power(tj, xj)
-
-    def count_unraisable(self, args) -> None:
-        """``sys.unraisablehook`` while a compiled flow runs: an arithmetic error inside the
-        cfunc (numba reports it as unraisable: ``0.0 ** -2`` of a five-link walker's
-        virtual-leg length in a configuration it cannot reach but folded flat, while it
-        falls) is counted in :attr:`arithmetic_errors`, not printed; anything else goes to
-        the hook in force."""
-        if issubclass(args.exc_type, ArithmeticError):
-            self.arithmetic_errors += 1
-            return
-        sys.__unraisablehook__(args)
+                self.ledger["scene_torque_work"] += h * GL_W[j] * scene.power(tj, xj)
 
     def _held_work(self, run, acts, act_on: bool) -> None:
         """The compiled step's ledger over ``[self.t, run.t_last]`` (the action alone: the
@@ -352,7 +357,11 @@ class RigidView:
             self._work(run.dense, self.t, run.t_last, acts, act_on)
 
     def advance(self, u: np.ndarray, t_end: float) -> list[float]:
-        """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
+        """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held: the
+        native vector environment's step of one walker
+        (:func:`walkerlab.gym.rigid_rows.advance_rows`), so the compiled control step's
+        pieces run on its kernel (``rows_dop853``) as a batch of one, and one environment
+        is the vector environment with one walker, bit for bit.
 
         Returns
         -------
@@ -361,8 +370,7 @@ class RigidView:
             :attr:`ended` is set when the episode ended inside it (``fall``, ``stall``,
             ``ground_end``, ``solver_failure``).
         """
-        self.open_period(u, t_end)
-        return self._run(u, t_end)
+        return (_ADVANCE_ROWS or _advance_rows())([self], (u,), (t_end,))[0]
 
     def open_period(self, u: np.ndarray, t_end: float) -> None:
         """A control period to ``t_end`` [s] with the torques ``u`` (k,) [N m] begins: kept
@@ -452,13 +460,9 @@ class RigidView:
         w, acts, act_on, phase, t_stop, fast = piece
         n = self.n
         if fast is not None:
-            hook, sys.unraisablehook = sys.unraisablehook, self.count_unraisable
-            try:
-                return integrate_phase(fast[0], self.t, self.x, None, t_stop, 2 * n,
-                                       self.compiled_solver, "cyrk_compiled", None, None,
-                                       False), phase
-            finally:
-                sys.unraisablehook = hook
+            return integrate_phase(fast[0], self.t, self.x, None, t_stop, 2 * n,
+                                   self.compiled_solver, "cyrk_compiled", None, None,
+                                   False), phase
         if self._twin_of is not None and act_on:  # the mode's own M^-1 B u: the twin's
             tw, tacts = self._twin(w)
             tacts.u = acts.u
@@ -573,76 +577,3 @@ class RigidView:
         self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
         self.t_step = self.t
         self._start_step()
-
-
-#: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``
-_COLUMN_POINTS: dict = {}
-
-
-def _hips(walker, X: np.ndarray):
-    """The hip's x relative to the stance foot [m] of the states ``X`` (r, 2n), one call on
-    the states as columns (the contract of ``points``: :mod:`walkerlab.models.hybrid.base`)
-    of the walker's generated hip's x alone (:attr:`HybridWalker.hip_x`) or of its whole
-    ``points``; None when neither takes them (checked once per function against a call of
-    ``points`` per state: the same numbers bit for bit - numpy's vector loops may round
-    differently from its scalar ones - or not used)."""
-    points = walker.points
-    entry = _COLUMN_POINTS.get(id(points))
-    if entry is None:
-        fns = [] if walker.hip_x is None else [walker.hip_x]
-        fns.append(lambda Xt: points(Xt)["hip"][0])
-        each = [float(points(x)["hip"][0]) for x in X]
-        fn = None
-        for f in fns:
-            try:
-                hx = np.asarray(f(X.T), float)
-                if hx.shape == (X.shape[0],) and np.array_equal(hx, each):
-                    fn = f
-                    break
-            except Exception:  # noqa: BLE001 - a function of one state only
-                pass
-        entry = _COLUMN_POINTS[id(points)] = (points, fn)  # (kept: its id stays its own)
-    if entry[1] is None:
-        return None
-    return np.asarray(entry[1](X.T), float)
-
-
-def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
-    """:meth:`RigidView.hip_x` of every view in ``views`` (N), the views whose step walkers
-    share a ``points`` function in one call of it where it takes states as columns (the
-    same numbers).
-
-    Parameters
-    ----------
-    views : sequence of RigidView
-    X : ndarray (N, 2n), optional
-        Their states (``views[i].x``), when already stacked.
-
-    Returns
-    -------
-    ndarray (N,)
-        The hips' world x [m].
-    """
-    if len(views) > 1 and X is not None:
-        first = views[0].walker.points
-        if all(v.walker.points is first for v in views):
-            hx = _hips(views[0].walker, X)  # one step walker's points for all: one call
-            if hx is not None:
-                return np.array([v.foot[0] for v in views], dtype=float) + hx
-    pts = [v.walker.points for v in views]
-    out = np.empty(len(views))
-    groups: dict = {}
-    for i, f in enumerate(pts):
-        groups.setdefault(id(f), []).append(i)
-    for rows in groups.values():
-        if len(rows) < 2:
-            hx = None
-        elif X is not None and len(rows) == len(views):
-            hx = _hips(views[rows[0]].walker, X)
-        else:
-            hx = _hips(views[rows[0]].walker, np.array([views[i].x for i in rows]))
-        if hx is None:
-            out[rows] = [views[i].hip_x() for i in rows]
-        else:
-            out[rows] = np.array([views[i].foot[0] for i in rows]) + hx
-    return out

@@ -14,10 +14,10 @@ The physics of one call is :meth:`WalkerVectorEnv._step_all`: the rigid view's w
 (built as ``gym.make``'s entry point builds each :class:`~walkerlab.gym.env.WalkerEnv`:
 :func:`~walkerlab.gym.env.registered_env`) are stepped as arrays over the walkers - the
 held torques of all of them scaled and clipped at once
-(:func:`~walkerlab.gym.env.begin_periods`), their compiled pieces advanced together
+(:func:`~walkerlab.gym.batch.begin_periods`), their compiled pieces advanced together
 (:func:`walkerlab.gym.rigid_rows.advance_rows`: one compiled call per flow), their
 observations, rewards, flags and ledger read at once and their infos kept as columns
-(:func:`~walkerlab.gym.env.end_periods`), batched straight into gymnasium's form (an array
+(:func:`~walkerlab.gym.batch.end_periods`), batched straight into gymnasium's form (an array
 and a mask ``_key`` per key, as ``VectorEnv._add_info`` batches N dicts, without building
 them); the same element-wise operations as each walker's own ``step``, so that these
 numbers are those of each walker ending its own period on the same physics, bit for bit.
@@ -37,15 +37,9 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, create_empty_array
 
-from .env import (
-    DEFAULT_EPISODE_STEPS,
-    InvalidAction,
-    WalkerEnv,
-    batch_parameters,
-    begin_periods,
-    end_periods,
-    registered_env,
-)
+from .batch import batch_parameters, begin_periods, end_periods
+from .env import DEFAULT_EPISODE_STEPS, InvalidAction, WalkerEnv, registered_env
+from .infos import LazyInfos, batch_columns, batch_infos
 from .small_arrays import all_finite, any_true
 
 __all__ = ["WalkerVectorEnv"]
@@ -62,65 +56,6 @@ def _whole(value, name: str, low: int, allow_none: bool = False) -> int | None:
     return int(value)
 
 
-def _batch_infos(each: list[dict]) -> dict | None:
-    """The sub-environments' infos ``each[i]`` (flat dicts of numbers, text, lists or None)
-    batched as :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one: per key
-    an array of ``len(each)`` whose type is the first value's (a number's dtype, else
-    objects) and its mask ``_key``, keys in the order met; None where a value is a dict
-    (gymnasium's own recursion then)."""
-    n = len(each)
-    out: dict = {}
-    for i, info in enumerate(each):
-        for key, value in info.items():
-            t = type(value)
-            if t is dict:
-                return None
-            arr = out.get(key)
-            if arr is None:
-                if t in (int, float, bool) or issubclass(t, np.number):
-                    arr = np.zeros(n, dtype=t)
-                elif isinstance(value, np.ndarray):
-                    arr = np.zeros((n, *value.shape), dtype=value.dtype)
-                else:
-                    arr = np.full(n, None, dtype=object)
-                out[key] = arr
-                out[f"_{key}"] = np.zeros(n, dtype=np.bool_)
-            arr[i] = value
-            out[f"_{key}"][i] = True
-    return out
-
-
-def _batch_columns(columns: dict, n: int) -> dict | None:
-    """Infos given by key, ``columns[key]`` the N sub-environments' values (a list, or an
-    array of numbers), batched as :func:`_batch_infos` batches the same infos given one
-    dict per sub-environment (every sub-environment holding every key): per key an array
-    (N,) whose type is sub-environment 0's value's (a number's dtype: a float array holds
-    NaN for None; else objects) and its mask ``_key`` (all True); None where a value is a
-    dict."""
-    out: dict = {}
-    masks = np.ones((len(columns), n), dtype=np.bool_)
-    for j, (key, vals) in enumerate(columns.items()):
-        if isinstance(vals, np.ndarray) and vals.dtype.kind in "fi":
-            arr = vals  # numbers of one dtype: the first one's
-        else:
-            v0 = vals[0]
-            t = type(v0)
-            if t is dict:
-                return None
-            if t in (int, float, bool) or issubclass(t, np.number):
-                arr = np.array(vals, dtype=t)
-            elif isinstance(v0, np.ndarray):
-                arr = np.zeros((n, *v0.shape), dtype=v0.dtype)
-                arr[:] = vals
-            else:
-                arr = np.empty(n, dtype=object)
-                for i, v in enumerate(vals):
-                    arr[i] = v
-        out[key] = arr
-        out[f"_{key}"] = masks[j]
-    return out
-
-
 def _advance_rows():
     """:func:`walkerlab.gym.rigid_rows.advance_rows` (its module imported on first use:
     the integrators it reads are not needed to build the environment), kept."""
@@ -131,49 +66,6 @@ def _advance_rows():
 
 
 _ADVANCE_ROWS = None
-
-
-class LazyInfos(dict):
-    """A step's infos, batched on first use: a ``dict`` whose entries are ``make()``'s,
-    made (once) by the first thing that reads or changes it - a key, its length, its keys,
-    a copy, a comparison, ``repr``, pickling - so a training loop that does not read the
-    infos of a step does not pay for their batching (about a tenth of the 8-walker call).
-    ``make`` takes only what the step has already copied out of the walkers (their
-    columns, the reset walkers' infos), so the entries are the step's, whenever made."""
-
-    __slots__ = ("_make",)
-
-    def __init__(self, make):
-        super().__init__()
-        self._make = make
-
-    def _filled(self) -> LazyInfos:
-        make = self._make
-        if make is not None:
-            self._make = None
-            dict.update(self, make())
-        return self
-
-    def __reduce_ex__(self, protocol):  # a copy or a pickle: the plain dict of entries
-        return (dict, (dict.copy(self._filled()),))
-
-
-def _filling(name: str):
-    method = getattr(dict, name)
-
-    def read(self, *args, **kwargs):
-        return method(self._filled(), *args, **kwargs)
-    read.__name__ = name
-    read.__doc__ = f"``dict.{name}`` of the entries (made first)."
-    return read
-
-
-for _name in ("__getitem__", "__iter__", "__len__", "__contains__", "__eq__", "__ne__",
-              "__repr__", "__reversed__", "__or__", "__ror__", "__ior__", "__setitem__",
-              "__delitem__", "__sizeof__", "keys", "values", "items",
-              "get", "pop", "popitem", "setdefault", "update", "copy", "clear"):
-    setattr(LazyInfos, _name, _filling(_name))
-del _name
 
 
 class WalkerVectorEnv(VectorEnv):
@@ -270,7 +162,7 @@ class WalkerVectorEnv(VectorEnv):
         self._all = (np.arange(n), list(self.envs))
         self._has_reset = False
         self._batched_before = False  # a batched step made (the first: compile_notice)
-        #: :func:`walkerlab.gym.env.batch_parameters` of the walkers (False: not yet read)
+        #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
         self._params: dict | None | bool = False
 
     # ------------------------------------------------------------------ the physics
@@ -282,9 +174,9 @@ class WalkerVectorEnv(VectorEnv):
 
         The one place a walker is stepped.  The rigid view's walkers (batched) are stepped
         as arrays over the walkers: the held torques of all of them at once
-        (:func:`walkerlab.gym.env.begin_periods`), their compiled pieces integrated
+        (:func:`walkerlab.gym.batch.begin_periods`), their compiled pieces integrated
         together (:func:`walkerlab.gym.rigid_rows.advance_rows`), and their observations,
-        rewards, flags and infos at once (:func:`walkerlab.gym.env.end_periods`); where
+        rewards, flags and infos at once (:func:`walkerlab.gym.batch.end_periods`); where
         that cannot be (a ``reward_fn``, the contact view, ``batched=False``) each
         :class:`~walkerlab.gym.env.WalkerEnv` steps (or begins and ends its period)
         itself.
@@ -366,7 +258,7 @@ class WalkerVectorEnv(VectorEnv):
         return stepped["columns"]
 
     def _batch_parameters(self) -> dict | None:
-        """:func:`walkerlab.gym.env.batch_parameters` of every walker, kept until
+        """:func:`walkerlab.gym.batch.batch_parameters` of every walker, kept until
         :meth:`set_attr` or :meth:`call` may have changed them."""
         if self._params is False:
             self._params = batch_parameters(self.envs)
@@ -553,12 +445,13 @@ class WalkerVectorEnv(VectorEnv):
     def _batched_infos(self, stepped: dict, resets: dict) -> dict:
         """The step's infos (every sub-environment's: stepped or reset) batched as
         :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one
-        (:func:`_batch_columns`, else :func:`_batch_infos`, else ``_add_info`` itself)."""
+        (:func:`~walkerlab.gym.infos.batch_columns`, else
+        :func:`~walkerlab.gym.infos.batch_infos`, else ``_add_info`` itself)."""
         n = self.num_envs
         if "dicts" not in stepped:
             cols = self._columns(stepped)
             if not resets:
-                out = _batch_columns(cols, n)
+                out = batch_columns(cols, n)
                 if out is not None:
                     return out
             else:
@@ -574,11 +467,11 @@ class WalkerVectorEnv(VectorEnv):
                         for i, info in resets.items():
                             vals[i] = info[k]
                         merged[k] = vals
-                    out = _batch_columns(merged, n)
+                    out = batch_columns(merged, n)
                     if out is not None:
                         return out
         each = self._info_dicts(stepped, resets)
-        out = _batch_infos(each)
+        out = batch_infos(each)
         if out is None:  # a nested dict: gymnasium's own recursion
             out = {}
             for i, info in enumerate(each):
