@@ -56,8 +56,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Gait", "Step", "Walk",
-           "Walker", "check_target"]
+__all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Step", "Walk", "Walker",
+           "check_target"]
 
 
 class Walker(SceneWalker):

@@ -398,9 +398,9 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
 
 
 def walk_file(out: Exported, fmt: str, kind, steps: int, scene: Scene) -> EngineWalk:
-    """The written file walked in its engine (:func:`walkerlab.export.engine_walk.
-    walk_export`; a spoked wheel rolls on its spokes, :attr:`walkerlab.walker.kinds.Kind.
-    spoked`; virtual constraints by their computed torque,
+    """The written file walked in its engine
+    (:func:`walkerlab.export.engine_walk.walk_export`; a spoked wheel rolls on its spokes,
+    :attr:`walkerlab.walker.kinds.Kind.spoked`; virtual constraints by their computed torque,
     :func:`walkerlab.export.mujoco_walk.virtual_constraint_feedback`), or why not."""
     if out.step_period_s is None and fmt in ENGINES:
         return not_walked("the file has no gait to start from")

@@ -20,9 +20,9 @@ MAX_START_NOISE = 1.0
 
 
 def rigid_ground(scene):
-    """The rigid view's ground beyond its walker's own (:func:`walkerlab.integrate.rigid.
-    walker_of_step`: a slope, stairs, footholds of one or several heights or slopes, as
-    ``walkerlab simulate`` steps them): a height profile's steps
+    """The rigid view's ground beyond its walker's own
+    (:func:`walkerlab.integrate.rigid.walker_of_step`: a slope, stairs, footholds of one or
+    several heights or slopes, as ``walkerlab simulate`` steps them): a height profile's steps
     (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`), else None.
 
     Raises
@@ -50,8 +50,8 @@ def rigid_ground(scene):
 
 def plant_scene(scene):
     """``scene`` without its feedback controller (``walker.actuation: None``): the walker
-    the environment steps when the controller is the policy (:meth:`walkerlab.gym.env.
-    WalkerEnv.scene_policy`)."""
+    the environment steps when the controller is the policy
+    (:meth:`walkerlab.gym.env.WalkerEnv.scene_policy`)."""
     return scene.model_copy(update={"walker": scene.walker.model_copy(
         update={"actuation": None})})
 

@@ -71,8 +71,9 @@ def capture(env) -> dict | None:
 
 
 def restore(env, state: dict) -> None:
-    """Put the episode ``state`` (:func:`capture`'s) in ``env``, a :class:`~walkerlab.gym.
-    env.WalkerEnv` built from the same arguments as the one it was captured from.
+    """Put the episode ``state`` (:func:`capture`'s) in ``env``, a
+    :class:`~walkerlab.gym.env.WalkerEnv` built from the same arguments as the one it was
+    captured from.
 
     Raises
     ------

@@ -110,7 +110,8 @@ class RigidView:
     Parameters
     ----------
     model : walkerlab.models.hybrid.HybridWalker
-        The scene's walker with its own actuators (:attr:`walkerlab.rigid_walker.SceneWalker.model`).
+        The scene's walker with its own actuators
+        (:attr:`walkerlab.rigid_walker.SceneWalker.model`).
     solver : walkerlab.integrate.solver.Solver
     data : walkerlab.walker.description.WalkerData
         The walker's description (the action's actuators are built from it).

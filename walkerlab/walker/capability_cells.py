@@ -1,6 +1,7 @@
-"""The capability table's cells, as data: for each walker kind (:data:`walkerlab.walker.kinds.
-KINDS`), the features it lacks in each view and why (:data:`CAPABILITIES`), and what each
-supported cell rests on beyond its measurement (:data:`CELL_NOTES`).
+"""The capability table's cells, as data: for each walker kind
+(:data:`walkerlab.walker.kinds.KINDS`), the features it lacks in each view and why
+(:data:`CAPABILITIES`), and what each supported cell rests on beyond its measurement
+(:data:`CELL_NOTES`).
 
 The kinds and their questions (:meth:`walkerlab.walker.kinds.Kind.cell`,
 :meth:`~walkerlab.walker.kinds.Kind.require`) are in :mod:`walkerlab.walker.kinds`, which

@@ -1,5 +1,6 @@
-"""The words of a gait search that found nothing (:func:`walkerlab.analysis.gait.search.
-find_gaits`): the solver's message in one line, and the one-line failure with its advice."""
+"""The words of a gait search that found nothing
+(:func:`walkerlab.analysis.gait.search.find_gaits`): the solver's message in one line, and
+the one-line failure with its advice."""
 
 from __future__ import annotations
 
