@@ -34,7 +34,8 @@ def _items(f: h5py.File) -> dict:
         for k, v in obj.attrs.items():
             if not RUN_RECORDS.search(k) and k not in REFERENCES:
                 out[f"{name}@{k}"] = v
-        if isinstance(obj, h5py.Dataset) and not RUN_RECORDS.search(name.rsplit("/", 1)[-1]):
+        if isinstance(obj, h5py.Dataset) and not RUN_RECORDS.search(name.rsplit("/", 1)[-1]) \
+                and "/timing/" not in f"/{name}":  # a group of timings (zero_dynamics/timing)
             out[name] = obj[()]
 
     for k, v in f.attrs.items():
