@@ -4,10 +4,9 @@ before/after comparison by ``scripts/compare_artifacts.py``.
     python scripts/shipped_artifacts.py RUNS_DIR [--stages fixedpoint,simulate,contact-sim]
                                         [--scenes paper,kneed]
 
-Runs, for each scene in ``configs/`` (of the current folder: run it from the checkout whose scenes and code
-are compared), ``walkerlab fixedpoint``, ``simulate`` and
-``contact-sim`` (and ``optimize`` for a scene that has an ``optimize`` section), each in its
-own process; a stage the scene's walker does not take ends in its one-line refusal, which is
+Runs, for each scene in ``configs/`` (of the current folder: run it from the checkout whose
+scenes and code are compared), ``walkerlab fixedpoint``, ``simulate`` and ``contact-sim``
+(and ``optimize`` for a scene that has an ``optimize`` section), each in its own process; a stage the scene's walker does not take ends in its one-line refusal, which is
 recorded beside the others in ``RUNS_DIR/exit_codes.tsv`` (scene, stage, exit code, seconds),
 so a before/after pair also compares which stages refused.
 """
