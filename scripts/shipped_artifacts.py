@@ -6,9 +6,10 @@ before/after comparison by ``scripts/compare_artifacts.py``.
 
 Runs, for each scene in ``configs/`` (of the current folder: run it from the checkout whose
 scenes and code are compared), ``walkerlab fixedpoint``, ``simulate`` and ``contact-sim``
-(and ``optimize`` for a scene that has an ``optimize`` section), each in its own process; a stage the scene's walker does not take ends in its one-line refusal, which is
-recorded beside the others in ``RUNS_DIR/exit_codes.tsv`` (scene, stage, exit code, seconds),
-so a before/after pair also compares which stages refused.
+(and ``optimize`` for a scene that has an ``optimize`` section), each in its own process;
+a stage the scene's walker does not take ends in its one-line refusal, which is recorded
+beside the others in ``RUNS_DIR/exit_codes.tsv`` (scene, stage, exit code, seconds), so a
+before/after pair also compares which stages refused.
 """
 
 from __future__ import annotations
