@@ -5,13 +5,14 @@ and the library (issue 51, items 16 and 17)."""
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from tests.scripts_loader import load_file
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -39,10 +40,7 @@ def test_cyrk_monte_carlo_walks_as_the_minimal_loop():
     minimal loop and the library on the same slopes (what makes its timing comparable; at
     the benchmark's sigma 0.002 rad none of 500 walks of 100 steps differed; at 0.004 rad a
     walk at the edge of a fall may go either way on another integrator)."""
-    spec = importlib.util.spec_from_file_location("bench_mc_cyrk",
-                                                  ROOT / "scripts" / "bench_mc_cyrk.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = load_file("scripts/bench_mc_cyrk.py")
     out = mod.measure(str(ROOT / "configs" / "paper.yaml"), walks=20, steps=10, sigma=0.002,
                       repeats=1)
     assert out["walks_differing_from_minimal"] == {"library": 0, "cyrk": 0, "minimal": 0}

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.scripts_loader import load_file
 from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -232,7 +233,6 @@ def test_every_kind_has_a_row_and_a_scene():
 
 def test_the_command_and_the_docs_show_the_table():
     """``walkerlab capabilities`` (text and --json) and the docs' page are the table."""
-    import importlib.util
     import json
 
     from typer.testing import CliRunner
@@ -248,10 +248,7 @@ def test_the_command_and_the_docs_show_the_table():
         assert f"{kind.name}: {kind.title}" in r.output
         for row in CAPABILITIES[kind.name].values():
             assert row is None or row in r.output  # None: supported past a refused walk
-    spec = importlib.util.spec_from_file_location(
-        "capability_table", ROOT / "docs" / "_ext" / "capability_table.py")
-    ext = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(ext)
+    ext = load_file("docs/_ext/capability_table.py")
     page = ext.rst()
     assert all(kind.name in page for kind in KINDS.values())
     assert "capability-table" in (ROOT / "docs" / "reference" / "capabilities.rst").read_text()
@@ -357,7 +354,6 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     supported osim cell of each kind whose export has knee stops (the latch: the export's
     own parts table) carries the note: in the grid (a numbered note), in the JSON's
     ``note`` and ``detail``, and on the docs' page; no other kind's cells do."""
-    import importlib.util
 
     from walkerlab.export.parts import kind_part
     from walkerlab.walker.capability_tables import kind_grid, text
@@ -381,10 +377,7 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
                 assert cells[col].endswith(f" ({notes[0]})") if kind.name in latched \
                     else not notes, (kind.name, feature, cells[col])
     assert KNEE_LATCH_OSIM in text()
-    spec = importlib.util.spec_from_file_location(
-        "capability_table", ROOT / "docs" / "_ext" / "capability_table.py")
-    ext = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(ext)
+    ext = load_file("docs/_ext/capability_table.py")
     assert KNEE_LATCH_OSIM in " ".join(ext.rst().split())
     page = " ".join((ROOT / "docs" / "reference" / "capabilities.rst").read_text().split())
     assert "knee latch" in page

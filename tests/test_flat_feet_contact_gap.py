@@ -12,12 +12,12 @@ from the rigid gait's mid-stance) is checked last."""
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.scripts_loader import load_file
 from walkerlab.config import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -25,11 +25,7 @@ STEPS = 6
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location(
-        "flat_feet_contact_gap", ROOT / "scripts" / "flat_feet_contact_gap.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_file("scripts/flat_feet_contact_gap.py")
 
 
 @pytest.fixture(scope="module")

@@ -6,23 +6,19 @@ B q'-`` and the bodies' mass points), on configs/rabbit_hzd.yaml's closed loop."
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.scripts_loader import load_file
 from walkerlab.config import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location("hzd_heel_strike",
-                                                  ROOT / "scripts" / "hzd_heel_strike.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_file("scripts/hzd_heel_strike.py")
 
 
 def test_heel_strike_impulse_equals_the_momentum_change():

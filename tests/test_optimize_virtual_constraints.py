@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.scripts_loader import load_file
 from walkerlab.config import SceneError, scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -352,14 +353,10 @@ def test_rabbit_controllers_heel_strike_impulse_inside_the_friction_cone(rabbit_
     the stance force holds the strike's impulse too, unconstrained) and the trailing foot
     lifts off (measured 0.56, 0.51 m/s).  The stance force along the written controller's
     step stays in the cone to the transcription's error (2e-3; measured 0.446, 0.6003)."""
-    import importlib.util
 
     from walkerlab.config import load_scene
 
-    spec = importlib.util.spec_from_file_location("hzd_heel_strike",
-                                                  ROOT / "scripts" / "hzd_heel_strike.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = load_file("scripts/hzd_heel_strike.py")
     d, folder, _runs = rabbit_designed
     for c in d.controllers:
         r = mod.rigid(load_scene(folder / c.scene_file))

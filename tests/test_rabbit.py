@@ -5,12 +5,12 @@ monotonic, and the energy ledger closes with the cost of transport from the posi
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.scripts_loader import load_file
 from walkerlab.analysis.gait.energy import step_ledger
 from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import simulate_steps
@@ -23,11 +23,7 @@ STEP_PERIOD_S = 0.37093
 
 
 def _design():
-    spec = importlib.util.spec_from_file_location("rabbit_references",
-                                                  ROOT / "scripts" / "rabbit_references.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_file("scripts/rabbit_references.py")
 
 
 @pytest.fixture(scope="module")

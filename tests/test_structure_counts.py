@@ -4,21 +4,18 @@ goal stay there."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import pytest
 
+from tests.scripts_loader import load_file
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location("structure_counts",
-                                                  ROOT / "scripts" / "structure_counts.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_file("scripts/structure_counts.py")
 
 
 @pytest.fixture(scope="module")
