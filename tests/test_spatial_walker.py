@@ -423,6 +423,64 @@ def test_a_changed_gain_falls_back_to_the_stored_gait_and_finds_the_gait(tmp_pat
     res = search.result
     assert res.residual < 1e-10
     assert np.max(np.abs(res.x - guess)) > 0.1  # a gait of its own, not the guess's
+
+
+def _copy_with(tmp_path, name: str, edit) -> Path:
+    data = yaml.safe_load((ROOT / "configs" / name).read_text())
+    edit(data)
+    path = tmp_path / f"copy_of_{name}"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_a_copied_scene_names_the_shipped_scene_its_initial_guess_was_written_for(tmp_path):
+    """A scene copied from a shipped one and a gain changed keeps the shipped scene's
+    initial guess: the guess's own walker is that scene (``guess_owners``, the start of
+    the homotopy when Newton from the guess fails); a guess of its own, or another walker
+    model, names none (issue 82 item 9)."""
+    from walkerlab.config import load_scene
+    from walkerlab.stages.fixedpoint import guess_owners
+
+    def gain(d):
+        d["walker"]["hip_roll"]["lean_rate_gain_s"] = -0.25
+
+    owners = guess_owners(load_scene(_copy_with(tmp_path, "hip_width_stabilised.yaml", gain)))
+    assert [o.where for o in owners] == ["hip_width_stabilised.yaml"]
+    assert owners[0].scene.walker.hip_roll.lean_rate_gain_s == -0.18
+
+    def guess(d):
+        gain(d)
+        d["fixedpoint"]["initial_guess"]["lean_angle_rad"] = 0.02
+
+    assert guess_owners(load_scene(_copy_with(tmp_path, "hip_width_stabilised.yaml",
+                                              guess))) == []
+    paper = [o.where for o in guess_owners(load_scene(ROOT / "configs" / "paper.yaml"))]
+    assert "hip_width_stabilised.yaml" not in paper and "paper.yaml" not in paper
+
+
+@pytest.mark.slow
+def test_a_changed_gain_with_an_empty_runs_folder_finds_the_gait_from_the_scenes_own_guess(
+        tmp_path):
+    """lean_rate_gain_s -0.18 -> -0.25 in a copy of the stabilised walker, nothing stored:
+    before, 'no period-1 gait found' (the guess fails, the planar twin's width continuation
+    stalls at 0.072 m); now the gait of the scene the guess was written for, carried over
+    the gain, starts the search.  The gait equals the one ``--from`` finds (a homotopy of
+    10 points from the known scene, another path) to 1e-9 (issue 82 item 9)."""
+    from walkerlab.config import load_scene
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.stages import fixedpoint
+
+    def gain(d):
+        d["walker"]["hip_roll"]["lean_rate_gain_s"] = -0.25
+
+    scene = load_scene(_copy_with(tmp_path, "hip_width_stabilised.yaml", gain))
+    plain = fixedpoint.run(scene, tmp_path / "plain")
+    known = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    via = fixedpoint.run(scene, tmp_path / "from", known=known)
+    a, b = load_fixedpoint(plain.path), load_fixedpoint(via.path)
+    assert np.max(np.abs(a.x - b.x)) < 1e-9
+    assert a.residual < 1e-10 and np.max(np.abs(a.multipliers)) > 1.5  # unstable at -0.25
+    assert [g.source for g in a.gaits.values()] == ["stored_gait"]
 @pytest.mark.parametrize("width", [2.0, 100.0])
 def test_a_hip_width_of_twice_the_leg_or_more_is_refused_naming_the_field(width):
     """Leaning its centre of mass over the stance foot (tan(lean) ~ w / 2L) lifts the swing

@@ -121,12 +121,70 @@ def stored_gaits(scene: Scene, runs_root: Path | str) -> list:
     return out
 
 
+def guess_owners(scene: Scene) -> list:
+    """The scenes the scene's initial guess was written for: the scene files beside it and
+    the shipped ones (``configs/``) of the same walker model with the same
+    ``fixedpoint.initial_guess`` (a scene copied, then a number changed), as
+    :class:`walkerlab.studies.warm_start.StoredGait` whose gait is found from that guess
+    (only when chosen); unreadable files are passed over.
+
+    Returns
+    -------
+    list of StoredGait
+    """
+    from walkerlab.config import load_scene
+    from walkerlab.config.loader import default_scene_path
+    from walkerlab.studies.warm_start import StoredGait  # only when the guess failed
+
+    fp = scene.fixedpoint
+    if fp is None or fp.initial_guess is None:
+        return []
+    mine = json.dumps(scene.model_dump(mode="json")["fixedpoint"]["initial_guess"],
+                      sort_keys=True)
+    folders = {default_scene_path().parent}
+    if scene.origin is not None:
+        folders.add(scene.origin.parent)
+    out = []
+    for path in sorted({f.resolve() for d in folders for f in d.glob("*.yaml")}):
+        if path == scene.origin:
+            continue
+        try:
+            other = load_scene(path)
+        except (SceneError, OSError, ValueError):
+            continue
+        if (other.walker.model != scene.walker.model or other.fixedpoint is None
+                or json.dumps(other.model_dump(mode="json")["fixedpoint"]["initial_guess"],
+                              sort_keys=True) != mine):
+            continue
+        out.append(StoredGait(other, lambda o=other: _own_gait(o), path.name,
+                              f"the gait of {path.name} (the scene whose initial guess this "
+                              "scene's is: found from it)"))
+    return out
+
+
+def _own_gait(scene: Scene):
+    """The gait ``scene``'s own initial guess converges to (no fallback starts: a guess
+    that fails there says so); ValueError when it does not."""
+    from walkerlab.analysis.gait.scene import initial_guess, solve_scene
+    from walkerlab.analysis.gait.search import GaitNotFound
+    from walkerlab.models.registry import build_walker
+
+    walker = build_walker(scene)
+    try:
+        _, search = solve_scene(scene, fd_check=False, guess=initial_guess(scene, walker),
+                                walker=walker, other_gait=False)
+    except GaitNotFound as exc:
+        raise ValueError(str(exc)) from None
+    return search.result.x
+
+
 def _nearby(scene: Scene, runs_root):
-    """The nearest stored gait as a fallback start of the gait search (carried here), or
+    """The nearest stored gait, or the gait of the scene the initial guess was written for
+    (:func:`guess_owners`), as a fallback start of the gait search (carried here), or
     None."""
     from walkerlab.studies.warm_start import stored_gait_start  # only for a compute
 
-    stored = stored_gaits(scene, runs_root)
+    stored = stored_gaits(scene, runs_root) + guess_owners(scene)
     return stored_gait_start(scene, stored) if stored else None
 
 

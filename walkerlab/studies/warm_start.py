@@ -38,10 +38,14 @@ class StoredGait:
         chosen).
     where : str
         Where it is stored (for the notes).
+    what : str
+        What it is, for the notes (default ``the gait stored in <where>``).
     """
 
-    def __init__(self, scene: Scene, load: Callable[[], np.ndarray], where: str):
+    def __init__(self, scene: Scene, load: Callable[[], np.ndarray], where: str,
+                 what: str | None = None):
         self.scene, self.load, self.where = scene, load, where
+        self.what = what or f"the gait stored in {where}"
 
 
 def _distance(fields: dict) -> tuple[int, float]:
@@ -101,7 +105,7 @@ def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
     max_step = fp.max_step_time_s if fp is not None else 5.0
     fd_step = fp.fd_step if fp is not None else 1e-7
     over = ", ".join(fields)
-    label = (f"the gait stored in {known.where}" + (f", carried in {over}" if fields else ""))
+    label = known.what + (f", carried in {over}" if fields else "")
 
     def find():
         try:
@@ -109,7 +113,7 @@ def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
         except (OSError, ValueError, KeyError):
             return None
         if not fields:  # the same walker: its gait is this one's
-            return x0, f"initial guess: the gait stored in {known.where} (same walker)"
+            return x0, f"initial guess: {known.what} (same walker)"
         make, _ = homotopy_family(known.scene, scene)
         try:
             x, points = carry_width(lambda lam: make({"lambda": lam}), x0, 0.0, 1.0, solver,
@@ -119,7 +123,7 @@ def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
             return None
         if x is None or not np.all(np.isfinite(x)):
             return None
-        return x, (f"initial guess: the gait stored in {known.where}, carried over {over} "
+        return x, (f"initial guess: {known.what}, carried over {over} "
                    f"({points} continuation points at the screening tolerance)")
 
     return FallbackStart(label, "stored_gait", find)
