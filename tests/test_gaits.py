@@ -392,3 +392,24 @@ def test_a_scene_whose_guess_fails_starts_from_the_gait_stored_for_a_nearby_walk
         assert f.attrs["gait_source"] == "stored_gait"
     fp = load_fixedpoint(runs / "steep" / "fixedpoint.h5")
     assert fp.residual < 1e-10
+
+
+def test_the_root_finders_stop_message_is_said_in_walkerlabs_words_once():
+    """A gait search's notes said MINPACK's "The iteration is not making good progress, as
+    measured by the improvement from the last five Jacobian evaluations." as it stood; now
+    what happened comes first, MINPACK's own sentence after it in brackets, the residual
+    (given apart) left out, an unknown message unchanged, and a said one not said twice
+    (issue 82 item 11)."""
+    from walkerlab.analysis.gait.failure_text import solver_words
+
+    raw = ("no fixed point found: The iteration is not making good progress, as measured by "
+           "the improvement from the last five Jacobian evaluations. (residual 0.0096)")
+    said = solver_words(raw)
+    assert said == ("the root finder stalled: its last five Jacobians brought no progress "
+                    "[MINPACK: The iteration is not making good progress, as measured by the "
+                    "improvement from the last five Jacobian evaluations.]")
+    assert solver_words(said) == said
+    assert solver_words("The number of calls to function has reached maxfev = 400.") == (
+        "the root finder ran out of map evaluations [MINPACK: The number of calls to "
+        "function has reached maxfev = 400.]")
+    assert solver_words("the map fails at the guess") == "the map fails at the guess"

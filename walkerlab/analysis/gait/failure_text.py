@@ -12,10 +12,31 @@ from walkerlab.models.hybrid.base import HybridWalker
 __all__ = ["failure_message", "solver_words"]
 
 
+#: MINPACK's (``scipy.optimize.root``, hybrd/hybrj) stop messages in walkerlab's words
+_MINPACK_WORDS = (
+    ("The iteration is not making good progress, as measured by the improvement from the "
+     "last five Jacobian evaluations.", "the root finder stalled: its last five Jacobians "
+     "brought no progress"),
+    ("The iteration is not making good progress, as measured by the improvement from the "
+     "last ten iterations.", "the root finder stalled: its last ten steps brought no "
+     "progress"),
+    ("The number of calls to function has reached maxfev", "the root finder ran out of "
+     "map evaluations"),
+)
+
+
 def solver_words(msg: str) -> str:
-    """scipy's message, one line, without the prefix and the residual (given apart)."""
+    """The root finder's message, one line, without the prefix and the residual (given
+    apart); MINPACK's stop messages in walkerlab's words, MINPACK's own after them in
+    brackets (:data:`_MINPACK_WORDS`)."""
     text = " ".join(str(msg).removeprefix("no fixed point found: ").split())
-    return re.sub(r" \(residual [^)]*\)$", "", text)
+    text = re.sub(r" \(residual [^)]*\)$", "", text)
+    for head, words in _MINPACK_WORDS:
+        at = text.find(head)
+        if at >= 0 and words not in text:  # not said already
+            end = text.find(".", at + len(head) - 1) + 1 or len(text)
+            return f"{text[:at]}{words} [MINPACK: {text[at:end].strip()}]{text[end:]}"
+    return text
 
 
 def failure_message(walker: HybridWalker, tried: list[str], best: float, last: str,
