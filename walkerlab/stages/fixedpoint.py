@@ -122,11 +122,14 @@ def stored_gaits(scene: Scene, runs_root: Path | str) -> list:
 
 
 def guess_owners(scene: Scene) -> list:
-    """The scenes the scene's initial guess was written for: the scene files beside it and
-    the shipped ones (``configs/``) of the same walker model with the same
+    """The scenes a 3D walker's initial guess was written for: the scene files beside it
+    and the shipped ones (``configs/``) of the same walker model with the same
     ``fixedpoint.initial_guess`` (a scene copied, then a number changed), as
     :class:`walkerlab.studies.warm_start.StoredGait` whose gait is found from that guess
     (only when chosen); unreadable files are passed over.
+
+    A planar walker's search has its scale-free seeds after the guess; a 3D walker's seeds
+    are a planar walker's (its lateral mode is unstable): it gets none here.
 
     Returns
     -------
@@ -135,10 +138,13 @@ def guess_owners(scene: Scene) -> list:
     from walkerlab.config import load_scene
     from walkerlab.config.loader import default_scene_path
     from walkerlab.studies.warm_start import StoredGait  # only when the guess failed
+    from walkerlab.walker.description import walker_data  # light
 
     fp = scene.fixedpoint
     if fp is None or fp.initial_guess is None:
         return []
+    if not walker_data(scene.walker, scene.slope.phi_rad).structure.kind.in_3d:
+        return []  # a planar walker's search has its scale-free seeds
     mine = json.dumps(scene.model_dump(mode="json")["fixedpoint"]["initial_guess"],
                       sort_keys=True)
     folders = {default_scene_path().parent}

@@ -39,6 +39,24 @@ def solver_words(msg: str) -> str:
     return text
 
 
+def no_energy_reason(walker: HybridWalker) -> str:
+    """Why a passive walker can have no gait here ("" when it may): no actuators and no
+    drop to pay the heel strikes' loss - level or uphill ground, stairs up (each step up
+    takes energy only actuators give).  No start of the root finder can find what is not
+    there: the gait search says so instead of carrying gaits to it."""
+    if walker.actuators is not None:
+        return ""
+    drop = walker.params.get("landing_drop_m", 0.0)
+    if drop < 0 and walker.slope_rad <= 0:
+        # every step lands higher: gravity cannot pay the climb (nor the heel strikes' loss)
+        return ("a passive walker cannot climb stairs or step up (each step up takes energy "
+                "only actuators give: walker.actuation; passive, walk stairs down)")
+    if not (walker.slope_rad > 0 or drop > 0):
+        return ("a passive walker needs a downhill slope (slope > 0), stairs down or "
+                "walker.actuation")
+    return ""
+
+
 def failure_message(walker: HybridWalker, tried: list[str], best: float, last: str,
                     had_guess: bool) -> str:
     """The one line of a gait search that found nothing: why (the walker's slope, stairs,
@@ -67,22 +85,12 @@ def failure_message(walker: HybridWalker, tried: list[str], best: float, last: s
     last = solver_words(last)
     if last and "standing" not in last:
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
-    drop = walker.params.get("landing_drop_m", 0.0)
-    downhill = walker.slope_rad > 0 or drop > 0
-    if drop < 0 and walker.slope_rad <= 0 and walker.actuators is None:
-        # every step lands higher: gravity cannot pay the climb (nor the heel strikes' loss)
-        why = ("a passive walker cannot climb stairs or step up (each step up takes energy "
-               "only actuators give: walker.actuation; passive, walk stairs down)")
-    elif not downhill and walker.actuators is None:
-        why = ("a passive walker needs a downhill slope (slope > 0), stairs down or "
-               "walker.actuation")
-    elif walker.actuators is not None and had_guess:
+    if walker.actuators is not None:
         why = ("the initial guess did not converge and the seeds are a passive walker's: "
-               "the walker may have no period-1 gait here")
-    elif walker.actuators is not None:
-        why = "the seeds are a passive walker's, and a powered gait may lie far from them"
+               "the walker may have no period-1 gait here" if had_guess else
+               "the seeds are a passive walker's, and a powered gait may lie far from them")
     else:
-        why = "the walker may have no period-1 gait here"
+        why = no_energy_reason(walker) or "the walker may have no period-1 gait here"
     if "standing" in last:  # walkerlab's own diagnosis, not a solver's detail: in the text
         why, last = f"{why}; {last}", ""
     # the advice first, the solver's detail last: a one-line display that must shorten the

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+from walkerlab.analysis.gait.failure_text import no_energy_reason
 from walkerlab.analysis.gait.planar_start import planar_fallback
 from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.analysis.gait.search import GaitNotFound, find_gaits
@@ -166,7 +167,7 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
                           partner_if_needed=fp.other_gait, fallbacks=fallbacks)
 
     fallbacks = []  # when the scene's own guess fails (or it has none), before the seeds
-    if guess is None:
+    if guess is None and not no_energy_reason(walker):  # (none where no gait can be)
         if nearby is not None:  # a gait stored nearby, carried here
             fallbacks.append(nearby)
         planar = planar_fallback(scene, walker, solver)  # a 3D walker: from its planar twin
