@@ -316,10 +316,10 @@ class Walker(SceneWalker):
         walker = self.model
         try:
             if scene.simulate is not None and scene.simulate.terrain_seed is not None:
-                walker = rough_ground_walker(scene, 2 * strides)
+                walker = rough_ground_walker(scene, 2 * strides, self.plant)
             with bounded_steps(self.step_time_limit_s, self.max_step_time):
                 traj = walk_scene(scene, walker, x0, 2 * strides, self.solver,
-                                  self.walk_step_time)
+                                  self.walk_step_time, self.plant)
         except SceneError:
             raise
         except ValueError as exc:  # a ground this walk does not read (one line, its key)

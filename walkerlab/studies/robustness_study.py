@@ -20,7 +20,8 @@ from walkerlab.analysis.robustness.measures import (
 )
 
 
-def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None):
+def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None,
+                     plant=None):
     """Everything ``robustness.h5`` holds for a scene with a ``robustness`` section and its
     gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
     angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
@@ -28,6 +29,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     forward and backward mid-stance pushes (:func:`walkerlab.analysis.robustness.push.apply_push`)
     and
     the Monte Carlo MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.studies.mfpt.monte_carlo`).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the stage's; default:
+    described here).
 
     Returns
     -------
@@ -48,15 +51,16 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
-    from walkerlab.walker.description import walker_data  # light
+    from walkerlab.walker.plant import Plant  # light
 
+    plant = Plant.from_scene(scene) if plant is None else plant
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
-    walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require_stage("robustness")
+    plant.kind.require_stage("robustness")
     st = scene.robustness or RobustnessSettings()
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant)
     if walker.steps_per_map != 1:
         raise ValueError("robustness: legs that differ (a stride map) are not supported")
-    sm = make_step_map(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
+    sm = make_step_map(walker, work.scene_walker_at(scene, plant), 1e-12, 1e-12)
     A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
                      jacobian=True)[2]
     names = walker.state_names()

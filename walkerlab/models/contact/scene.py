@@ -203,7 +203,7 @@ class ContactSetup:
                                 n_steps=n_steps + 4), step_length
 
 
-def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
+def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSetup:
     """The scene turned once into what a contact run needs (any walker with positive leg
     masses): its walker data, the contact law and knee stop in SI, terrain, run options and
     solver settings.
@@ -215,6 +215,9 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         The run also finds the contact periodic gait (``contact-sim --periodic``,
         :meth:`walkerlab.api.walker.ContactWalker.periodic_gait`): the scene is checked as
         with ``contact_sim.periodic_gait: true``.
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once, by the caller that holds it (a stage, the API);
+        default: described here from ``scene``.
 
     A scene without a ``contact`` section runs on the section's defaults (the paper's
     contact law: :class:`walkerlab.config.ContactSettings`), as ``contact: {}`` does: the
@@ -236,7 +239,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         not found, with that reason) (one line).
     """
     from walkerlab.codegen.floating import check_masses
-    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.plant import Plant  # light
 
     scene = with_default_section(scene, "contact")  # left out: its defaults (contact: {})
     if scene.contact is None:  # a section with a required field has no defaults
@@ -250,7 +253,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     cs = scene.contact_sim or ContactSimSettings()
     # checked as the run uses it: with its periodic gait when the caller asks for one
     checked = cs.model_copy(update={"periodic_gait": True}) if periodic else cs
-    data = walker_data(scene.walker, scene.slope.phi_rad)
+    data = (Plant.from_scene(scene) if plant is None else plant).data
     ground = "slope" if scene.terrain is None else scene.terrain.kind
     if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
         from walkerlab.walker.kinds import KindRefused
