@@ -41,10 +41,8 @@ import numpy as np
 
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import complex_step_jacobian
-from walkerlab.walker.description import (
-    compass_gait_data,
-    compass_gait_structure,  # noqa: F401
-)
+from walkerlab.walker.description import compass_gait_structure  # noqa: F401
+from walkerlab.walker.plant import compass_gait_data
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 
