@@ -160,6 +160,9 @@ class SceneWalker:
         A validated scene.
     step_time_limit_s : float
         CPU time each walking step may take [s] (:data:`STEP_TIME_LIMIT_S`).
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described, when the caller holds it (the API's contact view);
+        default: described here.
 
     Raises
     ------
@@ -175,13 +178,15 @@ class SceneWalker:
         walker)."""
         return (type(self), (self.scene, self.step_time_limit_s))
 
-    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
+    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S,
+                 plant=None):
         from walkerlab.models.registry import build_walker  # light
         from walkerlab.walker.plant import Plant  # light
 
         self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")
         self.scene = scene
-        self.plant = Plant.from_scene(scene)  # described once, handed to every analysis
+        # described once, handed to every analysis
+        self.plant = Plant.from_scene(scene) if plant is None else plant
         self.model = build_walker(scene, self.plant)
         self.solver = Solver.from_settings(scene.solver)
         fp = scene.fixedpoint
