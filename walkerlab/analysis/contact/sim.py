@@ -383,7 +383,7 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     if step_length_m is None and setup.steps_differ:  # the rigid period-n gait's footfalls
         from walkerlab.analysis.contact.footfalls import rigid_step_lengths
 
-        lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal)
+        lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal, setup.plant)
     walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m, lengths)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
     x_start = rigid_mid_stance(setup.scene, x_ideal) if cs.start == "mid_stance" else x_ideal

@@ -22,6 +22,7 @@ from walkerlab.config import (
     TerrainSettings,
 )
 from walkerlab.config.sections import with_default_section
+from walkerlab.walker.plant import Plant
 
 from .actuation import ContactActuators
 from .joint_torques import JointTorqueActuators
@@ -103,6 +104,9 @@ class ContactSetup:
     scene : Scene or None
         The scene read (its rigid walker lays footholds of several heights at the rigid
         gait's footfalls: :mod:`walkerlab.analysis.contact.footfalls`); None: not kept.
+    plant : walkerlab.walker.plant.Plant or None
+        The scene's walker described once (``walker`` is its ``data``), for the rigid
+        walker built from it; None: not kept.
     """
 
     name: str
@@ -116,6 +120,7 @@ class ContactSetup:
     actuators: ContactActuators | JointTorqueActuators | None = None
     rhs_ready: CompiledElsewhere | None = None
     scene: Scene | None = None
+    plant: Plant | None = None
 
     @property
     def steps_differ(self) -> bool:
@@ -239,7 +244,6 @@ def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSe
         not found, with that reason) (one line).
     """
     from walkerlab.codegen.floating import check_masses
-    from walkerlab.walker.plant import Plant  # light
 
     scene = with_default_section(scene, "contact")  # left out: its defaults (contact: {})
     if scene.contact is None:  # a section with a required field has no defaults
@@ -253,7 +257,8 @@ def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSe
     cs = scene.contact_sim or ContactSimSettings()
     # checked as the run uses it: with its periodic gait when the caller asks for one
     checked = cs.model_copy(update={"periodic_gait": True}) if periodic else cs
-    data = (Plant.from_scene(scene) if plant is None else plant).data
+    plant = Plant.from_scene(scene) if plant is None else plant
+    data = plant.data
     ground = "slope" if scene.terrain is None else scene.terrain.kind
     if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
         from walkerlab.walker.kinds import KindRefused
@@ -282,7 +287,7 @@ def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSe
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
-                        scene=scene)
+                        scene=scene, plant=plant)
 
 
 def _start_of(scene: Scene, part, cs: ContactSimSettings) -> ContactSimSettings:
