@@ -126,7 +126,7 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
         return p.relative_to(pkg).as_posix()
 
     tables, kind_files, cs_files, wd_calls, christoffel = [], set(), set(), {}, []
-    plant_builds = {}  # module -> ["line (default)" or "line"]
+    plant_builds = {}  # module -> ["line (plant=None default)" or "line"]
     long_strings, gym_parse, gym_hook = [], [], []
     for p in files:
         r, tree = rel(p), trees[p]
@@ -144,7 +144,12 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
                 wd_calls.setdefault(r, []).append(n.lineno)
             if isinstance(n, ast.Call) and _call_name(n) == "from_scene" \
                     and getattr(n.func.value, "id", "") == "Plant":
-                plant_builds.setdefault(r, []).append(n.lineno)
+                lines = texts[p].splitlines()  # a default: built only when none is given
+                line, before = lines[n.lineno - 1], lines[n.lineno - 2].strip()
+                default = " is None" in line or "plant or " in line or (
+                    before.startswith("if ") and before.endswith(" is None:"))
+                plant_builds.setdefault(r, []).append(
+                    f"{n.lineno} (plant=None default)" if default else str(n.lineno))
             if top == "gym" and isinstance(n, ast.Call) and _call_name(n) == "parse" \
                     and getattr(n.func, "value", None) is not None \
                     and getattr(n.func.value, "id", "") == "ast":
