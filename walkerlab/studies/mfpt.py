@@ -347,7 +347,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     contact = getattr(st, "model", "rigid") == "contact"
     start = None
     if contact:
-        start = _contact_start(scene, x_star, st)
+        start = _contact_start(scene, x_star, st, plant)
     else:
         from walkerlab.integrate.python_step import needs_python_path
 
@@ -443,7 +443,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
                     sigma_m=sig_m)
 
 
-def _contact_start(scene, x_star: np.ndarray, st):
+def _contact_start(scene, x_star: np.ndarray, st, plant):
     """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
     from walkerlab.analysis.contact.rough import contact_start
     from walkerlab.analysis.contact.step_map import PeriodicGaitError
@@ -453,7 +453,7 @@ def _contact_start(scene, x_star: np.ndarray, st):
         raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
                          "model's); set mfpt.method: montecarlo")
     try:
-        return contact_start(scene, x_star)
+        return contact_start(scene, x_star, plant=plant)
     except (ContactSceneError, PeriodicGaitError) as exc:
         raise ValueError(f"mfpt.model: contact: {exc}") from None
 

@@ -359,7 +359,8 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
 
 
-def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
+def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None,
+          plant: Plant | None = None):
     """ContactWalker of the scene (:func:`contact_setup`, then :meth:`ContactSetup.build`)
     with checkerboard patches from the ideal step length.
 
@@ -369,6 +370,8 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     x_ideal, n_steps, step_length_m
         As :meth:`ContactSetup.build`'s: the ideal fixed point (2n,) [rad, rad/s], the
         steps the run may take, the patch spacing [m] instead of the ideal step length.
+    plant : walkerlab.walker.plant.Plant, optional
+        As :func:`contact_setup`'s (the scene's walker described once, by the caller).
 
     Returns
     -------
@@ -381,4 +384,4 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     ContactSceneError
         As :func:`contact_setup` (a scene the contact model does not take; one line).
     """
-    return contact_setup(scene).build(x_ideal, n_steps, step_length_m)
+    return contact_setup(scene, plant=plant).build(x_ideal, n_steps, step_length_m)
