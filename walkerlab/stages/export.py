@@ -65,7 +65,7 @@ def stored_gait(scene: Scene, runs_root: Path | str):
     return fp if fp.variant == "derived" and not fp.error else None
 
 
-def _gait(scene: Scene, runs_root, build):
+def _gait(scene: Scene, runs_root, build, plant):
     """``(ideal, build(ideal))``: the rigid gait (:func:`stored_gait`, else searched as the
     writers search it) and what ``build`` makes of it; no rigid gait: one line."""
     # light: the gait search's modules, only when a writer asks for the gait
@@ -74,7 +74,7 @@ def _gait(scene: Scene, runs_root, build):
 
     try:
         ideal = stored_gait(scene, runs_root)
-        ideal = ideal_gait(scene) if ideal is None else ideal
+        ideal = ideal_gait(scene, plant) if ideal is None else ideal
         return ideal, build(ideal)
     except FixedPointNotFound as exc:
         where = ("its fixedpoint section" if scene.fixedpoint is not None
@@ -155,7 +155,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                          "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
                          "has its own contact")
     job = ExportJob(scene, data, scene.name or "walker", walker_only,
-                    lambda build: _gait(scene, runs_root, build),
+                    lambda build: _gait(scene, runs_root, build, plant),
                     lambda: stored_gait(scene, runs_root),
                     mjcf if mjcf is not None and mjcf != MjcfOptions() else None)
     built = writer.write(job, writer)
