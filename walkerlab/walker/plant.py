@@ -39,6 +39,10 @@ class Plant:
     Build it with :meth:`from_scene`.  The descriptions on other slopes (a ground of several
     slopes: footholds, a height profile, a drawn rough ground) are built on first asking
     (:meth:`data_at`) and kept in this plant, so that one plant describes each slope once.
+    The kind's parts are reached from :attr:`kind` (the capability table's cells, the
+    collocation's and contact model's parts); the integrator
+    (:class:`walkerlab.integrate.solver.Solver`, a floor above this one) stays with the
+    caller (the API's walker holds both: :class:`walkerlab.rigid_walker.SceneWalker`).
     """
 
     scene: Any
