@@ -1,5 +1,6 @@
 """The package's structure in numbers: each row of the structure table (per-kind tables, walker
-kinds named as strings, ``"contact-sim"`` literals, ``walker_data`` callers, the places that
+kinds named as strings, ``"contact-sim"`` literals, ``walker_data`` callers, the modules
+that describe a walker themselves (``Plant.from_scene``) below the front doors, the places that
 write the Christoffel symbols, code kept as text, module and function sizes, duplicates, arrows
 back up and import circles, the gym's run-time parsing and hook swapping), with its goal and
 pass/fail.
@@ -125,6 +126,7 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
         return p.relative_to(pkg).as_posix()
 
     tables, kind_files, cs_files, wd_calls, christoffel = [], set(), set(), {}, []
+    plant_builds = {}  # module -> ["line (plant=None default)" or "line"]
     long_strings, gym_parse, gym_hook = [], [], []
     for p in files:
         r, tree = rel(p), trees[p]
@@ -140,6 +142,14 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
                     tables.append(f"{r}:{n.lineno}")
             if isinstance(n, ast.Call) and _call_name(n) == "walker_data":
                 wd_calls.setdefault(r, []).append(n.lineno)
+            if isinstance(n, ast.Call) and _call_name(n) == "from_scene" \
+                    and getattr(n.func.value, "id", "") == "Plant":
+                lines = texts[p].splitlines()  # a default: built only when none is given
+                line, before = lines[n.lineno - 1], lines[n.lineno - 2].strip()
+                default = " is None" in line or "plant or " in line or (
+                    before.startswith("if ") and before.endswith(" is None:"))
+                plant_builds.setdefault(r, []).append(
+                    f"{n.lineno} (plant=None default)" if default else str(n.lineno))
             if top == "gym" and isinstance(n, ast.Call) and _call_name(n) == "parse" \
                     and getattr(n.func, "value", None) is not None \
                     and getattr(n.func.value, "id", "") == "ast":
@@ -166,6 +176,10 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
              and n.end_lineno - n.lineno + 1 > 80]
     wd_out = {r: v for r, v in wd_calls.items()
               if r.split("/")[0] not in ("walker", "stages", "api")}
+    # the front: the stages, the API (and its rigid walker, rigid_walker.SceneWalker), the CLI
+    plant_out = {r: v for r, v in plant_builds.items()
+                 if r.removesuffix(".py").split("/")[0]
+                 not in ("walker", "stages", "api", "cli", "rigid_walker")}
 
     # arrows back up, by the floors of tests/test_layers.py's LAYERS
     layers = tl.LAYERS
@@ -195,6 +209,8 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
         ("modules calling walker_data(...) outside walker/, stages/, api/", len(wd_out), 0,
          {"modules": sorted(wd_out), "calls in all": sum(map(len, wd_calls.values())),
           "files in all": len(wd_calls)}),
+        ("modules building a Plant (Plant.from_scene) below the front", len(plant_out), 3,
+         {f"{r}": v for r, v in sorted(plant_out.items())}),
         ("modules writing the Christoffel symbols", len(christoffel), 1, christoffel),
         ("strings of >= 60 lines outside codegen/", len(long_strings), 0, long_strings),
         ("modules > 800 lines", sum(v > 800 for v in sizes.values()), 0,

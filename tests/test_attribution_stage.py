@@ -68,7 +68,7 @@ def test_attribution_stage_writes_and_reuses(tmp_path, monkeypatch):
     calls = []
     run = _fake_run()
     monkeypatch.setattr(A, "attribute", lambda w, ideal: calls.append(ideal) or run.attribution)
-    monkeypatch.setattr(A, "adjustment_effect", lambda s, ideal: run.adjustment)
+    monkeypatch.setattr(A, "adjustment_effect", lambda s, ideal, **_: run.adjustment)
     scene = load_scene(ROOT / "configs" / "paper.yaml")
     out = pipeline.run("attribution", scene, tmp_path)
     assert not out.reused and len(calls) == 1

@@ -148,7 +148,8 @@ class Gait:
 
 
 class SceneWalker:
-    """The rigid hybrid walker of a scene: the validated scene, the generated model
+    """The rigid hybrid walker of a scene: the validated scene, its walker described
+    (:attr:`plant`, a :class:`~walkerlab.walker.plant.Plant`), the generated model
     (:func:`walkerlab.models.registry.build_walker`) and the scene's integrator, built once
     (the parameters, attributes and errors of :class:`walkerlab.api.walker.Walker`, which
     extends it).
@@ -159,6 +160,9 @@ class SceneWalker:
         A validated scene.
     step_time_limit_s : float
         CPU time each walking step may take [s] (:data:`STEP_TIME_LIMIT_S`).
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described, when the caller holds it (the API's contact view);
+        default: described here.
 
     Raises
     ------
@@ -174,12 +178,16 @@ class SceneWalker:
         walker)."""
         return (type(self), (self.scene, self.step_time_limit_s))
 
-    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
+    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S,
+                 plant=None):
         from walkerlab.models.registry import build_walker  # light
+        from walkerlab.walker.plant import Plant  # light
 
         self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")
         self.scene = scene
-        self.model = build_walker(scene)
+        # described once, handed to every analysis
+        self.plant = Plant.from_scene(scene) if plant is None else plant
+        self.model = build_walker(scene, self.plant)
         self.solver = Solver.from_settings(scene.solver)
         fp = scene.fixedpoint
         self.max_step_time = 5.0 if fp is None else fp.max_step_time_s
@@ -285,7 +293,7 @@ class SceneWalker:
         from walkerlab.analysis.gait.scene import solve_scene  # light
 
         _, search = solve_scene(self.scene, guess=self._known_start(), walker=self.model,
-                                solver=self.solver, ground=True)
+                                solver=self.solver, ground=True, plant=self.plant)
         chosen = search.gaits[search.selected]
         r = chosen.result
         m, ledger = gait_ledger(self.model, r.x, self.model.steps_per_map, self.solver,

@@ -33,7 +33,6 @@ in a ``units: nondimensional`` scene every quantity is in the walker's own units
 √(l/g)).  Nothing here knows how many states a walker has.
 """
 
-
 from __future__ import annotations
 
 import dataclasses
@@ -316,10 +315,10 @@ class Walker(SceneWalker):
         walker = self.model
         try:
             if scene.simulate is not None and scene.simulate.terrain_seed is not None:
-                walker = rough_ground_walker(scene, 2 * strides)
+                walker = rough_ground_walker(scene, 2 * strides, self.plant)
             with bounded_steps(self.step_time_limit_s, self.max_step_time):
                 traj = walk_scene(scene, walker, x0, 2 * strides, self.solver,
-                                  self.walk_step_time)
+                                  self.walk_step_time, self.plant)
         except SceneError:
             raise
         except ValueError as exc:  # a ground this walk does not read (one line, its key)
@@ -329,8 +328,6 @@ class Walker(SceneWalker):
     def __repr__(self) -> str:
         return (f"Walker({self.scene.name!r}, states={self.state_names()}, "
                 f"slope={self.model.params.get('slope_rad', 'n/a')})")
-
-
 
 
 class ContactWalker:
@@ -378,10 +375,12 @@ class ContactWalker:
         from walkerlab.config.sections import with_default_section  # light
         from walkerlab.integrate.solver import Solver
         from walkerlab.models.contact.scene import contact_setup  # light
+        from walkerlab.walker.plant import Plant  # light
 
         self.scene = with_default_section(scene, "contact")  # left out: its defaults
-        self.setup = contact_setup(self.scene)
-        self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s)
+        plant = Plant.from_scene(scene) if rigid is None else rigid.plant  # described once
+        self.setup = contact_setup(self.scene, plant=plant)
+        self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s, plant)
         self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
         self.solver = Solver.from_settings(self.setup.solver)
         self._gait = None  # the rigid gait, found on first use
@@ -610,7 +609,7 @@ class ContactWalker:
             return
         from walkerlab.models.contact.scene import contact_setup  # light
 
-        contact_setup(self.scene, periodic=True)
+        contact_setup(self.scene, periodic=True, plant=self.rigid.plant)
         self._periodic_checked = True
 
     def __repr__(self) -> str:

@@ -193,16 +193,17 @@ def bench_design(repeats: int = 3) -> dict:
         hzd_functions,
     )
     from walkerlab.optimal.virtual_constraints import controller_step  # light
-    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.plant import Plant  # light
 
     root = Path(__file__).resolve().parents[2]
     cfg = yaml.safe_load((root / "configs" / "threelink_hzd.yaml").read_text())
     cfg.update(name="threelink_design", optimize=dict(DESIGN))
     scene = scene_from_dict(cfg)
     vc = scene.walker.actuation.virtual_constraints
-    data = walker_data(scene.walker, scene.slope.phi_rad)
+    plant = Plant.from_scene(scene)  # the bench's scene, described once
+    data = plant.data
     K = 2 * DESIGN["intervals"] + 1
-    t, x, u, alpha, _zd = controller_step(build_walker(scene), Solver.from_settings(
+    t, x, u, alpha, _zd = controller_step(build_walker(scene, plant), Solver.from_settings(
         scene.solver), K)
     spec = collocation_spec(scene)
     ours, res = [], None
@@ -231,7 +232,7 @@ def bench_design(repeats: int = 3) -> dict:
             theirs.append(float(words[words.index("build_s") + 1])
                           + float(words[words.index("solve_s") + 1]))
     t0 = time.perf_counter()
-    optimize_scene(scene, None, None)  # the stage's computation (not its file writing)
+    optimize_scene(scene, None, None, plant)  # the stage's computation (not its file writing)
     stage = time.perf_counter() - t0
 
     def word(key):

@@ -153,9 +153,11 @@ class VirtualConstraintFeedback:
         return np.real(self.controller.torques(self.role_state(q, v, stance)))
 
 
-def virtual_constraint_feedback(scene) -> VirtualConstraintFeedback | None:
+def virtual_constraint_feedback(scene, data=None) -> VirtualConstraintFeedback | None:
     """:class:`VirtualConstraintFeedback` of ``scene``'s walker (None without
-    ``walker.actuation.virtual_constraints``).
+    ``walker.actuation.virtual_constraints``); ``data``: its description
+    (:attr:`walkerlab.walker.plant.Plant.data` of the caller's plant; default: described here
+    from ``scene``).
 
     Raises
     ------
@@ -168,9 +170,9 @@ def virtual_constraint_feedback(scene) -> VirtualConstraintFeedback | None:
         return None
     from walkerlab.codegen.cache import functions
     from walkerlab.models.virtual_constraints import VirtualConstraintController
-    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.plant import Plant  # light
 
-    data = walker_data(scene.walker, scene.slope.phi_rad)
+    data = Plant.from_scene(scene).data if data is None else data
     ctrl = VirtualConstraintController(act.virtual_constraints, functions(data),
                                        data.structure, data.params)
     return VirtualConstraintFeedback(ctrl, data.structure.roles)

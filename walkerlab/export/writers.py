@@ -397,17 +397,20 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
 )}
 
 
-def walk_file(out: Exported, fmt: str, kind, steps: int, scene: Scene) -> EngineWalk:
+def walk_file(out: Exported, fmt: str, kind, steps: int, scene: Scene,
+              data=None) -> EngineWalk:
     """The written file walked in its engine
     (:func:`walkerlab.export.engine_walk.walk_export`; a spoked wheel rolls on its spokes,
     :attr:`walkerlab.walker.kinds.Kind.spoked`; virtual constraints by their computed torque,
-    :func:`walkerlab.export.mujoco_walk.virtual_constraint_feedback`), or why not."""
+    :func:`walkerlab.export.mujoco_walk.virtual_constraint_feedback` of ``data``, the scene's
+    walker description from the stage's :class:`~walkerlab.walker.plant.Plant`), or why
+    not."""
     if out.step_period_s is None and fmt in ENGINES:
         return not_walked("the file has no gait to start from")
     feedback = None
     if fmt == "mjcf":
         from walkerlab.export.mujoco_walk import virtual_constraint_feedback  # light: mjcf
 
-        feedback = virtual_constraint_feedback(scene)
+        feedback = virtual_constraint_feedback(scene, data)
     return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,
                        spokes=kind.spoked, feedback=feedback)

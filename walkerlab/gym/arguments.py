@@ -19,11 +19,12 @@ __all__ = ["MAX_START_NOISE", "InvalidAction", "check_arguments", "checked_actio
 MAX_START_NOISE = 1.0
 
 
-def rigid_ground(scene):
+def rigid_ground(scene, plant=None):
     """The rigid view's ground beyond its walker's own
     (:func:`walkerlab.integrate.rigid.walker_of_step`: a slope, stairs, footholds of one or
     several heights or slopes, as ``walkerlab simulate`` steps them): a height profile's steps
-    (:func:`walkerlab.analysis.gait.rigid_run.profile_ground`), else None.
+    (:func:`walkerlab.analysis.gait.rigid_run.profile_ground` of ``plant``, the scene's
+    :class:`~walkerlab.walker.plant.Plant`), else None.
 
     Raises
     ------
@@ -43,7 +44,7 @@ def rigid_ground(scene):
     from walkerlab.analysis.gait.rigid_run import profile_ground
 
     try:
-        return profile_ground(scene)
+        return profile_ground(scene, plant)
     except ValueError as exc:
         raise ValueError(f"walkerlab.gym: {exc}") from None
 

@@ -262,8 +262,6 @@ class WalkerEnv(gym.Env):
                  policy: str | None = None, compiled_step: bool = True):
         #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
-        from walkerlab.walker.description import walker_data
-
         from .action import action_joints, action_limits, action_torques
         from .rigid_view import RigidView
 
@@ -274,7 +272,7 @@ class WalkerEnv(gym.Env):
                              "controller acting with the action)")
         self.rigid = SceneWalker(scene_of(scene if not isinstance(scene, Path) else str(scene)))
         sc = self.rigid.scene
-        data = walker_data(sc.walker, sc.slope.phi_rad)
+        data = self.rigid.plant.data  # the scene's walker, described once (SceneWalker)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
         if sc.terrain is not None and sc.terrain.kind == "profile":  # its gym cell, in both
             # views (the contact view laid any profile contact-sim walks before)
@@ -289,12 +287,12 @@ class WalkerEnv(gym.Env):
                              "(walker.actuation.virtual_constraints) to act as the policy; "
                              "its torque laws act in the walker with policy=None")
         self.policy = policy
-        ground = rigid_ground(sc) if view == "rigid" else None
+        ground = rigid_ground(sc, self.rigid.plant) if view == "rigid" else None
         if view == "contact":  # the contact view's refusals (the table's contact cells for
             # the scene's features, its ground): from the scene alone, before the gait search
             from walkerlab.models.contact.scene import contact_setup
 
-            setup = contact_setup(sc)
+            setup = contact_setup(sc, plant=self.rigid.plant)
         self.scene, self.view = sc, view
         self.dt = float(control_period_s)
         self.max_episode_steps = max_episode_steps

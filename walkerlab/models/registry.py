@@ -5,24 +5,28 @@ from __future__ import annotations
 from dataclasses import replace
 
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.walker.plant import Plant
 
 
-def state_layout(scene) -> tuple[list[str], list[str]]:
+def state_layout(scene, plant: Plant | None = None) -> tuple[list[str], list[str]]:
     """State names and units of the rigid walker of ``scene``, from its description alone
     (no equations derived, no code loaded): what :func:`build_walker` ``(scene)``'s
     ``state_names()`` and ``state_units()`` return.
+
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` when the caller holds it
+    (default: built here from ``scene``, for a caller at the front: a stage, the API).
 
     Returns
     -------
     names, units : list of str, length 2n
     """
-    from walkerlab.walker.description import state_names, state_units, walker_data
+    from walkerlab.walker.description import state_names, state_units
 
-    roles = walker_data(scene.walker, scene.slope.phi_rad).structure.roles
+    roles = _plant(scene, plant).structure.roles
     return state_names(roles), state_units(roles)
 
 
-def build_walker(scene) -> HybridWalker:
+def build_walker(scene, plant: Plant | None = None) -> HybridWalker:
     """Build the rigid hybrid walker of a :class:`~walkerlab.config.Scene`.
 
     ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
@@ -34,26 +38,35 @@ def build_walker(scene) -> HybridWalker:
     A ``walker.actuation`` section adds its actuators (:func:`walkerlab.models.hybrid.
     actuated.actuate`).
 
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once)
+    when the caller holds it; default: built here from ``scene`` (a caller at the front: a
+    stage, the API, or one that has just made ``scene``, a sweep's point).
+
     Raises
     ------
     ValueError
         The scene names a walker model or variant that has no rigid hybrid implementation,
         or actuators the walker cannot carry (one line).
     """
+    plant = _plant(scene, plant)
     act = scene.walker.actuation
-    walker = _on_ground(scene, _passive(scene))
+    walker = _on_ground(scene, plant, _passive(scene, plant))
     if act is None or walker.cycle is not None:  # footholds: each step's walker actuated
         return walker
     from walkerlab.models.hybrid.actuated import actuate  # light
-    from walkerlab.walker.description import walker_data
 
     if scene.ideal.variant != "derived":
         raise ValueError("walker.actuation: only with ideal.variant: derived (the printed "
                          "Appendix A equations are passive)")
-    return actuate(walker, walker_data(scene.walker, scene.slope.phi_rad), act)
+    return actuate(walker, plant.data, act)
 
 
-def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
+def _plant(scene, plant: Plant | None) -> Plant:
+    """``plant``, or the plant of ``scene`` when the caller (at the front) holds none."""
+    return Plant.from_scene(scene) if plant is None else plant
+
+
+def _on_ground(scene, plant: Plant, walker: HybridWalker) -> HybridWalker:
     """The walker on the scene's ``terrain`` (stairs: the heel strike at the next tread,
     :func:`walkerlab.models.hybrid.ground.on_landing`); a slope: ``walker`` itself."""
     from walkerlab.models.hybrid.ground import (
@@ -65,15 +78,13 @@ def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
 
     steps = foothold_steps(scene.terrain, scene.slope.phi_rad)
     if steps is not None:  # footholds that differ from step to step
-        return _on_footholds(scene, walker, steps, on_footholds)
+        return _on_footholds(scene, plant, walker, steps, on_footholds)
     drop = landing_drop(scene.terrain)
     if drop != 0.0:
-        from walkerlab.walker.description import walker_data
-
         if walker.variant != "derived":
             raise ValueError("terrain.kind: stairs and footholds need ideal.variant: derived "
                              "(the printed Appendix A equations know only the slope)")
-        walker = on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
+        walker = on_landing(walker, plant.data, drop)
     t = scene.terrain
     if t is not None and t.kind == "footholds" and t.periodic is False:
         # footholds of one height that do not repeat: the gait is the one-step map's, the
@@ -82,29 +93,36 @@ def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
     return walker
 
 
-def passive_walker_at(scene):
+def passive_walker_at(scene, plant: Plant | None = None):
     """``(walker_at, data_at)``: ``slope [rad] -> HybridWalker`` (the scene's passive rigid
-    walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``."""
-    from walkerlab.walker.description import walker_data
-
+    walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``
+    (:meth:`walkerlab.walker.plant.Plant.data_at` of ``plant``, the scene's plant; default:
+    built here from ``scene``)."""
+    plant = _plant(scene, plant)
     own = {}
 
     def at(g: float) -> HybridWalker:
         if g == scene.slope.phi_rad:
             if "w" not in own:
-                own["w"] = _passive(scene)
+                own["w"] = _passive(scene, plant)
             return own["w"]
-        return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
-            update={"angle_rad": float(g), "angle_deg": None})}))
+        return _passive_on(scene, plant, g)
 
-    return at, (lambda g: walker_data(scene.walker, g))
+    return at, plant.data_at
 
 
-def build_walker_on_steps(scene, steps) -> HybridWalker:
+def _passive_on(scene, plant: Plant, g: float) -> HybridWalker:
+    """The scene's passive walker on a slope of ``g`` [rad]."""
+    return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
+        update={"angle_rad": float(g), "angle_deg": None})}), plant, float(g))
+
+
+def build_walker_on_steps(scene, steps, plant: Plant | None = None) -> HybridWalker:
     """The scene's rigid walker on a finite list of per-step grounds (a drawn rough ground,
     ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the stance
     foot's level on ground of slope ``steps[k][1]`` [rad]; the walk ends after the list
-    (:func:`walkerlab.models.hybrid.ground.on_footholds`).
+    (:func:`walkerlab.models.hybrid.ground.on_footholds`).  ``plant``: the scene's
+    :class:`~walkerlab.walker.plant.Plant` (default: built here from ``scene``).
 
     Raises
     ------
@@ -116,20 +134,20 @@ def build_walker_on_steps(scene, steps) -> HybridWalker:
     if scene.terrain is not None and not scene.terrain.is_slope:
         raise ValueError(f"terrain.kind: {scene.terrain.kind}: per-step draws are of a slope "
                          "(terrain.per_step on kind: slope)")
-    return _on_footholds(scene, _passive(scene), steps, on_footholds, periodic=False)
+    plant = _plant(scene, plant)
+    return _on_footholds(scene, plant, _passive(scene, plant), steps, on_footholds,
+                         periodic=False)
 
 
-def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
+def _on_footholds(scene, plant: Plant, walker: HybridWalker, steps, on_footholds,
                   periodic: bool | None = None) -> HybridWalker:
     """The walker on footholds of several heights or slopes (``on_footholds``:
     :func:`walkerlab.models.hybrid.ground.on_footholds`), each slope's walker built as the
     scene's on that slope."""
-    from walkerlab.walker.description import walker_data
-
     if walker.variant != "derived":
         raise ValueError("terrain.kind: footholds need ideal.variant: derived (the printed "
                          "Appendix A equations know only the slope)")
-    walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
+    plant.kind.require(
         "footholds", "rigid", "terrain.kind")
     finish = None
     act = scene.walker.actuation
@@ -145,17 +163,17 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
     def at(g: float) -> HybridWalker:
         if g == scene.slope.phi_rad:
             return walker
-        return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
-            update={"angle_rad": float(g), "angle_deg": None})}))
+        return _passive_on(scene, plant, g)
 
     if periodic is None:
         periodic = scene.terrain.periodic is not False
-    return on_footholds(at, lambda g: walker_data(scene.walker, g), steps, periodic,
-                        finish)
+    return on_footholds(at, plant.data_at, steps, periodic, finish)
 
 
-def _passive(scene) -> HybridWalker:
-    """The passive walker of the scene (its actuators left out)."""
+def _passive(scene, plant: Plant, slope_rad: float | None = None) -> HybridWalker:
+    """The passive walker of the scene (its actuators left out), on its slope or, given
+    ``slope_rad`` (``scene``'s own, a copy of the plant's scene on another slope), on
+    ``slope_rad`` [rad] (described by ``plant``)."""
     w = scene.walker
     if w.model == "compass_gait" and w.space == "2d":
         from walkerlab.models.hybrid.printed_equations import make_compass_gait
@@ -167,9 +185,9 @@ def _passive(scene) -> HybridWalker:
     # any other walker is described as data: its kind builds it
     # (walkerlab.models.hybrid.rigid.BUILDERS; a rimless wheel: the rolling polygon)
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.walker.description import walker_data
 
     if scene.ideal.variant != "derived":
         raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
                          "model: compass_gait (the paper's printed equations)")
-    return make_rigid_walker(walker_data(w, scene.slope.phi_rad), w.model, "derived")
+    data = plant.data if slope_rad is None else plant.data_at(slope_rad)
+    return make_rigid_walker(data, w.model, "derived")

@@ -54,6 +54,7 @@ from walkerlab.optimal.virtual_constraints import (
     designs_controller,
     optimize_virtual_constraints,
 )
+from walkerlab.walker.plant import Plant
 
 __all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
            "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
@@ -89,14 +90,6 @@ def collocation_spec(scene):
                            touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
 
 
-def _structure(scene):
-    """The walker structure of ``scene`` (:class:`walkerlab.walker.description.Structure`;
-    its kind: ``.kind``)."""
-    from walkerlab.walker.description import walker_data
-
-    return walker_data(scene.walker, scene.slope.phi_rad).structure
-
-
 def _part(structure) -> Collocation:
     """The collocation's part for the walker kind of ``structure`` (:data:`PARTS`).
 
@@ -109,30 +102,32 @@ def _part(structure) -> Collocation:
     return PARTS[structure.kind.collocation]
 
 
-def needs_gait(scene) -> bool:
+def needs_gait(scene, plant: Plant | None = None) -> bool:
     """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
     walker kind but one whose guess is built from the targets (a five-link biped:
     :attr:`Collocation.from_targets`) and a walker with no gait of its own
     (:func:`no_gait_of_its_own`), whose step is built from them too
     (:func:`walkerlab.optimal.guess.target_step`).  A kind the collocation does not take
-    needs none (the stage refuses it at once)."""
+    needs none (the stage refuses it at once).  ``plant``: the scene's
+    :class:`~walkerlab.walker.plant.Plant` (default: described here)."""
     if designs_controller(scene):  # starts from the scene's own controller
         return False
-    part = PARTS.get(_structure(scene).kind.collocation)
+    part = PARTS.get((plant or Plant.from_scene(scene)).kind.collocation)
     return part is not None and not part.from_targets and not no_gait_of_its_own(scene)
 
 
-def guess_from_targets(scene) -> bool:
+def guess_from_targets(scene, plant: Plant | None = None) -> bool:
     """Whether the scene's walker kind starts its optimisation from the targets alone, with
     no upstream gait, and needs them (:func:`check_targets`): a five-link biped
-    (:attr:`Collocation.from_targets`).
+    (:attr:`Collocation.from_targets`).  ``plant``: the scene's
+    :class:`~walkerlab.walker.plant.Plant` (default: described here).
 
     Raises
     ------
     walkerlab.walker.kinds.KindRefused
         A kind the collocation does not take (one line).
     """
-    return _part(_structure(scene)).from_targets
+    return _part((plant or Plant.from_scene(scene)).structure).from_targets
 
 
 def no_gait_of_its_own(scene) -> bool:
@@ -181,7 +176,7 @@ def check_targets(o) -> None:
 # -- the one entry point -----------------------------------------------------------------
 
 def optimize_scene(scene, x_gait: np.ndarray | None = None,
-                   period_s: float | None = None) -> OptimizeData:
+                   period_s: float | None = None, plant: Plant | None = None) -> OptimizeData:
     """Optimise the scene's gait (the ``optimize`` section) by its walker kind's part
     (:data:`PARTS`): a step, a step of phases, a stride of two steps (legs that differ) or
     a five-link biped's step (module docstring).
@@ -197,6 +192,8 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
         from the targets.
     period_s : float or None
         Its step period [s].
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once (by the stage); default: described here.
 
     Returns
     -------
@@ -219,12 +216,11 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
         import casadi  # noqa: F401 - the collocation's modelling layer and IPOPT
     except ImportError:
         raise ValueError("optimize needs CasADi: pip install -e '.[optimize]'") from None
-    from walkerlab.walker.description import walker_data
-
-    data = walker_data(scene.walker, scene.slope.phi_rad)
+    plant = plant or Plant.from_scene(scene)  # the stage's, or described here
+    data = plant.data
     if designs_controller(scene):  # virtual constraints: any kind the table lets through
         check_scene(scene, data)
-        return optimize_virtual_constraints(scene, data, collocation_spec(scene))
+        return optimize_virtual_constraints(scene, plant, collocation_spec(scene))
     part = _part(data.structure)
     check_scene(scene, data)
     if x_gait is None and not part.from_targets and (data.mirror is not None
@@ -235,7 +231,7 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
                          "(another optimize.h5) or a downhill slope")
     if part.from_targets:
         check_targets(scene.optimize)
-    return part.optimize(scene, data, x_gait, period_s)
+    return part.optimize(scene, plant, x_gait, period_s)
 
 
 def check_kind(scene, kind) -> None:
@@ -303,9 +299,7 @@ def check_scene(scene, data=None) -> None:
     if o is None:
         return
     if data is None:
-        from walkerlab.walker.description import walker_data
-
-        data = walker_data(scene.walker, scene.slope.phi_rad)
+        data = Plant.from_scene(scene).data
     if designs_controller(scene):
         check_design(scene, data.structure.kind)
         return
@@ -340,19 +334,21 @@ def _feet_level_when_legs_cross(scene, data) -> bool:
 
 # -- one step of straight legs -----------------------------------------------------------
 
-def _straight_legs(scene, data, x_gait, period_s) -> OptimizeData:
+def _straight_legs(scene, plant, x_gait, period_s) -> OptimizeData:
     """Straight legs: one step (:func:`_step`), or a stride of two steps when the legs
     differ (:func:`_stride`)."""
+    data = plant.data
     spec = collocation_spec(scene)
     if data.mirror is not None and scene.terrain is not None \
             and scene.terrain.kind in ("stairs", "footholds"):
         raise ValueError(f"terrain.kind: {scene.terrain.kind}: legs that differ take a stride "
                          "of two steps, whose landing is not transcribed yet; optimise legs "
                          "of one build, or on the slope")
-    return (_step if data.mirror is None else _stride)(scene, data, spec, x_gait, period_s)
+    return (_step(scene, plant, spec, x_gait, period_s) if data.mirror is None
+            else _stride(scene, data, spec, x_gait, period_s))
 
 
-def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
+def _step(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     """One step of straight legs (point or arc feet, a torso, massless legs with a hip
     mass): :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`."""
     from walkerlab.models.registry import build_walker
@@ -363,11 +359,11 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
     from walkerlab.optimal.transcription.step import replay, torque_of_time
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
 
-    o = scene.optimize
+    data, o = plant.data, scene.optimize
     ground = step_ground(scene)
     if ground is not None and len(ground.drops_m) > 1:  # footholds that differ: a period
-        return _footholds(scene, data, spec, x_gait, period_s, ground)
-    walker = build_walker(scene)
+        return _footholds(scene, plant, spec, x_gait, period_s, ground)
+    walker = build_walker(scene, plant)
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)
@@ -391,7 +387,7 @@ def _step(scene, data, spec, x_gait, period_s) -> OptimizeData:
                         **history_and_energies(scene, walker, res))
 
 
-def _footholds(scene, data, spec, x_gait, period_s, ground) -> OptimizeData:
+def _footholds(scene, plant, spec, x_gait, period_s, ground) -> OptimizeData:
     """Straight legs on footholds that differ from step to step: one period of ``p``
     steps, each landing at its foothold
     (:func:`walkerlab.optimal.transcription.mode_sequence.collocate_footholds`), started
@@ -408,11 +404,12 @@ def _footholds(scene, data, spec, x_gait, period_s, ground) -> OptimizeData:
     )
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
 
+    data = plant.data
     o = scene.optimize
     if o.initial_guess is not None or x_gait is None:
         raise ValueError("optimize.initial_guess: footholds of several heights start from "
                          "the scene's own period gait (walkerlab fixedpoint); leave it out")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant)
     guess = footholds_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
                             spec.intervals)
     fns = cached_step_functions(data)
@@ -493,7 +490,7 @@ def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
     return (*optimized_guess(got, [n for n, _g, _d in order], intervals), order)
 
 
-def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> OptimizeData:
+def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> OptimizeData:
     """One step of a kneed or flat-footed walker phase by phase
     (:func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`), replayed on
     the rigid model and in the contact model (2 strides; the hip torque acts between a
@@ -513,11 +510,12 @@ def _phased(scene, data, x_gait, period_s, resolve_gait: bool = False) -> Optimi
     )
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
+    data = plant.data
     o = scene.optimize
     spec = collocation_spec(scene)  # its push-off refused before (check_kind)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
     if resolve_gait:  # fixedpoint's gait has its double support
-        g = solve_scene(scene, False, walker=walker)[1].gait.result
+        g = solve_scene(scene, False, walker=walker, plant=plant)[1].gait.result
         x_gait, period_s = g.x, float(g.period_s)
     guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
@@ -670,8 +668,8 @@ class Collocation:
     Attributes
     ----------
     optimize : callable
-        ``(scene, data, x_gait, period_s) -> OptimizeData``: set up, started, solved and
-        replayed (``data``: the scene's :class:`~walkerlab.walker.description.WalkerData`;
+        ``(scene, plant, x_gait, period_s) -> OptimizeData``: set up, started, solved and
+        replayed (``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`;
         ``x_gait`` (2n,), ``period_s`` [s]: the scene's gait, or None).
     from_targets : bool
         The guess is built from the targets alone, which are required

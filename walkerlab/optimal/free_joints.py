@@ -19,7 +19,7 @@ __all__ = ["CONTACT_STRIDES", "STICK", "five_link_replays", "optimize_five_link"
 CONTACT_STRIDES = 2
 
 
-def optimize_five_link(scene, data, x_gait=None, period_s=None) -> OptimizeData:
+def optimize_five_link(scene, plant, x_gait=None, period_s=None) -> OptimizeData:
     """Optimise, close and replay one step of the scene's five-link walker: collocated
     (:mod:`walkerlab.optimal.transcription.free_joints`, its four joint torques), closed by
     shooting under its own torques (:mod:`walkerlab.optimal.replay.shooting`), replayed on
@@ -28,7 +28,8 @@ def optimize_five_link(scene, data, x_gait=None, period_s=None) -> OptimizeData:
     :mod:`walkerlab.optimal.replay.virtual_constraints`) on the rigid model and - the PD
     law - in the contact model (~35 rigid step maps and 2 contact strides).  Needs no
     upstream gait: the guess is built from the targets (Kelly 2017's set-up), which the
-    driver requires first (:func:`walkerlab.optimal.driver.check_targets`).
+    driver requires first (:func:`walkerlab.optimal.driver.check_targets`).  ``plant``:
+    the scene's :class:`~walkerlab.walker.plant.Plant`.
 
     Raises
     ------
@@ -47,6 +48,7 @@ def optimize_five_link(scene, data, x_gait=None, period_s=None) -> OptimizeData:
     )
     from walkerlab.optimal.transcription.step import CollocationSpec
 
+    data = plant.data  # the scene's walker, described once (walkerlab.walker.plant.Plant)
     o = scene.optimize
     fns = five_link_functions(data.structure)
     spec = CollocationSpec(intervals=o.intervals, max_torque_n_m=o.max_torque_n_m,
@@ -105,14 +107,14 @@ def five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple
 STICK = ("stance_foot", "stance_knee", "hip", "torso_top", "hip", "swing_knee", "swing_foot")
 
 
-def stick_figures(scene, d, frames: int = 8) -> list:
-    """The five-link walker of ``scene`` at ``frames`` instants of the stored step ``d``
-    (a loaded ``optimize.h5``): polylines (7, 2) [m] through :data:`STICK` (the torso's
-    top: its centre of mass, the generated ``torso_*`` point)."""
+def stick_figures(data, d, frames: int = 8) -> list:
+    """The five-link walker ``data`` (its :class:`~walkerlab.walker.description.WalkerData`,
+    from the caller's :class:`~walkerlab.walker.plant.Plant`) at ``frames`` instants of the
+    stored step ``d`` (a loaded ``optimize.h5``): polylines (7, 2) [m] through :data:`STICK`
+    (the torso's top: its centre of mass, the generated ``torso_*`` point)."""
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.walker.description import walker_data
 
-    w = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad), "biped", "derived")
+    w = make_rigid_walker(data, "biped", "derived")
     names = w.state_names()
     out = []
     for k in np.linspace(0, len(d.time) - 1, frames).round().astype(int):

@@ -495,7 +495,7 @@ def replay_in_contact(scene, c: ControllerDesign) -> ControllerDesign:
                    contact_outcome=r["outcome"])
 
 
-def optimize_virtual_constraints(scene, data, spec):
+def optimize_virtual_constraints(scene, plant, spec):
     """``optimize.h5``'s record of the designed controllers
     (:class:`walkerlab.io.schemas.optimize.OptimizeData`: the first controller's step as
     its optimum, every controller in ``controllers``; a gait when IPOPT converged, the
@@ -504,7 +504,8 @@ def optimize_virtual_constraints(scene, data, spec):
     Parameters
     ----------
     scene : Scene
-    data : WalkerData
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (by the stage).
     spec : walkerlab.optimal.transcription.step.CollocationSpec
 
     Raises
@@ -516,7 +517,8 @@ def optimize_virtual_constraints(scene, data, spec):
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal import outcome as reported
 
-    walker = build_walker(scene)  # one build for the design and the record
+    data = plant.data
+    walker = build_walker(scene, plant)  # one build for the design and the record
     cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec,
                                                                    walker=walker)]
     c = cs[0]

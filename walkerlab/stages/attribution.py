@@ -41,12 +41,14 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     def compute():
         from walkerlab.analysis.contact.attribution import adjustment_effect, attribute
         from walkerlab.models.contact.scene import build
+        from walkerlab.walker.plant import Plant  # light
 
         fp = load_fixedpoint(up[0])
         ideal = SimpleNamespace(x=fp.x, period_s=float(fp.step_period_s))
-        walker, _ = build(scene, fp.x, 2)
-        res = AttributionRun(attribute(walker, ideal), adjustment_effect(scene, ideal),
-                             ideal.period_s)
+        plant = Plant.from_scene(scene)  # the walker described once, handed down
+        walker, _ = build(scene, fp.x, 2, plant=plant)
+        res = AttributionRun(attribute(walker, ideal),
+                             adjustment_effect(scene, ideal, plant=plant), ideal.period_s)
         a = res.attribution
         summary = {"period_gap_s": a.period_gap_s, "creep_s": a.creep_s,
                    "compliance_s": a.compliance_s, "residual_s": a.residual_s}

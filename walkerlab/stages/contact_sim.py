@@ -32,6 +32,7 @@ from walkerlab.stages.common import (
     run_cached,
     with_defaults,
 )
+from walkerlab.walker.plant import Plant
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -130,7 +131,7 @@ def check(scene: Scene, strides: int | None = None, periodic: bool = False,
         scene = with_contact_strides(scene, strides)
     except SceneError as exc:
         raise StageError(str(exc)) from None
-    contact_setup(scene, periodic)
+    contact_setup(scene, periodic, Plant.from_scene(scene))
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -165,7 +166,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     # asked for, the stage runs without a 'contact' section: on its defaults, the artifact
     # keyed and recorded as with 'contact: {}' (the report asks only with the section)
     scene = with_defaults(scene, "contact", CONTACT_SIM.name)
-    setup = contact_setup(scene, periodic)  # the scene read once: all the run needs, typed
+    # the scene read once, its walker described once: all the run needs, typed
+    setup = contact_setup(scene, periodic, Plant.from_scene(scene))
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
@@ -219,7 +221,7 @@ def warm_up(scene: Scene) -> bool:
     from walkerlab.usercache import use_for_numba
 
     use_for_numba()  # the same cache folder as the run's (set before numba is imported)
-    return compile_run_kernels(contact_setup(scene))
+    return compile_run_kernels(contact_setup(scene, plant=Plant.from_scene(scene)))
 
 
 def _compiled_walk(setup: ContactSetup) -> bool:

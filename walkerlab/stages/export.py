@@ -27,7 +27,7 @@ from walkerlab.export.multibody import SIDECAR  # noqa: F401 (part of this API)
 from walkerlab.export.writers import WRITERS, Exported, ExportJob, walk_file
 from walkerlab.io import runpaths
 from walkerlab.io.stage_files import CONTACT_SIM
-from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 
 def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = False) -> Path:
@@ -65,7 +65,7 @@ def stored_gait(scene: Scene, runs_root: Path | str):
     return fp if fp.variant == "derived" and not fp.error else None
 
 
-def _gait(scene: Scene, runs_root, build):
+def _gait(scene: Scene, runs_root, build, plant):
     """``(ideal, build(ideal))``: the rigid gait (:func:`stored_gait`, else searched as the
     writers search it) and what ``build`` makes of it; no rigid gait: one line."""
     # light: the gait search's modules, only when a writer asks for the gait
@@ -74,7 +74,7 @@ def _gait(scene: Scene, runs_root, build):
 
     try:
         ideal = stored_gait(scene, runs_root)
-        ideal = ideal_gait(scene) if ideal is None else ideal
+        ideal = ideal_gait(scene, plant) if ideal is None else ideal
         return ideal, build(ideal)
     except FixedPointNotFound as exc:
         where = ("its fixedpoint section" if scene.fixedpoint is not None
@@ -130,10 +130,11 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     """
     export_path(scene, runs_root, fmt)  # check the format before building anything
     writer = WRITERS[fmt]
+    plant = Plant.from_scene(scene)  # the walker described once, handed down
     ground = scene.terrain is not None and not scene.terrain.is_slope and not walker_only
     if ground:
         if not writer.ground:  # its cell of that ground (the URDF's refuses every one)
-            walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
+            plant.kind.require(
                 scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")
         from walkerlab.models.contact.terrain import ground_drops
 
@@ -141,8 +142,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     if walk and walker_only:
         raise ValueError("--walk: the walker alone (--walker-only) has no gait to walk from; "
                          "drop one of them")
-    data = walker_data(scene.walker, scene.slope.phi_rad)
-    kind = data.structure.kind
+    data = plant.data
+    kind = plant.kind
     if kind.field != "walker":  # a kind whose walker the writers do not refuse themselves
         kind.require("walk", writer.view, kind.field)
     if ground and len(drops) > 1:  # footholds of several heights: the table's cell
@@ -154,7 +155,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                          "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
                          "has its own contact")
     job = ExportJob(scene, data, scene.name or "walker", walker_only,
-                    lambda build: _gait(scene, runs_root, build),
+                    lambda build: _gait(scene, runs_root, build, plant),
                     lambda: stored_gait(scene, runs_root),
                     mjcf if mjcf is not None and mjcf != MjcfOptions() else None)
     built = writer.write(job, writer)
@@ -164,7 +165,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     out = Exported(files[0][0], built.left_out, built.step_period_s)
     if not walk:
         return out
-    walked = walk_file(out, fmt, kind, walk_steps, scene)
+    walked = walk_file(out, fmt, kind, walk_steps, scene, data)
     return replace(out, walk=replace(walked, contact_period_s=contact_period(scene,
                                                                              runs_root)))
 

@@ -174,11 +174,13 @@ def _own_gait(scene: Scene):
     from walkerlab.analysis.gait.scene import initial_guess, solve_scene
     from walkerlab.analysis.gait.search import GaitNotFound
     from walkerlab.models.registry import build_walker
+    from walkerlab.walker.plant import Plant  # light
 
-    walker = build_walker(scene)
+    plant = Plant.from_scene(scene)  # the walker described once, handed down
+    walker = build_walker(scene, plant)
     try:
         _, search = solve_scene(scene, fd_check=False, guess=initial_guess(scene, walker),
-                                walker=walker, other_gait=False)
+                                walker=walker, other_gait=False, plant=plant)
     except GaitNotFound as exc:
         raise ValueError(str(exc)) from None
     return search.result.x
@@ -222,7 +224,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         # (every downstream stage's upstream check) imports none of it
         from walkerlab.analysis.gait.scene import fixed_point_run
         from walkerlab.analysis.gait.search import GaitNotFound
+        from walkerlab.walker.plant import Plant  # light
 
+        plant = Plant.from_scene(scene)  # the walker described once, handed down
         guess = note = nearby = None
         try:
             if src is not None:  # the known gait carried here
@@ -231,7 +235,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 guess, note = homotopy_start(scene, src)
             else:  # a gait stored nearby: a start should the scene's own guess fail
                 nearby = _nearby(scene, runs_root)
-            run, summary = fixed_point_run(scene, compare_variants, guess, note, nearby)
+            run, summary = fixed_point_run(scene, compare_variants, guess, note, nearby,
+                                           plant=plant)
         except GaitNotFound as exc:
             raise StageError(f"fixedpoint: {exc}") from None
         except ValueError as exc:  # a malformed initial guess or gait choice (one line)

@@ -41,10 +41,10 @@ def check(scene: Scene, sigma_rad: list[float] | None = None, method: str | None
     require(scene, "fixedpoint", "mfpt")
     st, workers = mfpt_options(scene, sigma_rad, method, workers)
     if st.model == "contact":  # the contact walker's Monte Carlo: the table's contact cell
-        from walkerlab.walker.description import walker_data  # light
         from walkerlab.walker.kinds import KindRefused  # light
+        from walkerlab.walker.plant import Plant  # light
 
-        kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+        kind = Plant.from_scene(scene).kind
         try:
             kind.require("walk", "contact", f"mfpt.model: contact: {kind.field}")
         except KindRefused as exc:
@@ -73,12 +73,14 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     done = []  # the resume file, removed once the artifact is written
 
     def work():
+        from walkerlab.walker.plant import Plant  # light
+
         x_star = load_fixedpoint(up).x
         try:
             data, partial = resumable_mfpt_study(
                 scene, x_star, st, path.with_name(path.name + ".partial"),
                 input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"), not force,
-                workers, scheduler)
+                workers, scheduler, Plant.from_scene(scene))  # described once, handed down
         except MfptStudyError as exc:
             raise StageError(str(exc)) from None
         done.append(partial)

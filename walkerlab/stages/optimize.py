@@ -25,6 +25,7 @@ from walkerlab.stages.common import (
     run_cached,
     with_defaults,
 )
+from walkerlab.walker.plant import Plant
 
 #: the sections optimize.h5 depends on (the contact ones: its contact replay)
 SECTIONS = ("walker", "slope", "ideal", "solver", "optimize", "contact", "terrain",
@@ -47,7 +48,7 @@ def check(scene: Scene, **options) -> None:
     from walkerlab.optimal.driver import check_scene
 
     require("casadi", "optimize", "walkerlab optimize")
-    check_scene(scene)
+    check_scene(scene, Plant.from_scene(scene).data)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
@@ -68,16 +69,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
+    plant = Plant.from_scene(scene)  # the walker described once, handed down
     if designs_controller(scene):  # starts from the scene's own controller, no upstream
         try:
             check(scene)
         except ValueError as exc:
             raise StageError(str(exc)) from exc
-        out = _run_optimum(scene, runs_root, force, None, ())
+        out = _run_optimum(scene, runs_root, force, None, (), plant)
         write_controller_scenes(scene, out.path)
         return out
     try:
-        from_targets = guess_from_targets(scene)
+        from_targets = guess_from_targets(scene, plant)
     except ValueError as exc:  # a kind the collocation does not take
         raise StageError(str(exc)) from exc
     if from_targets:  # a five-link biped: its guess is built from the targets
@@ -86,7 +88,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         except ValueError as exc:
             raise StageError((f"scene '{scene.name}' has no 'optimize' section; "
                               if missing else "optimize: ") + str(exc)) from exc
-        return _run_optimum(scene, runs_root, force, None, ())
+        return _run_optimum(scene, runs_root, force, None, (), plant)
     if missing:
         from walkerlab import progress
 
@@ -94,17 +96,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                       "defaults (least effort int u^2 dt over 40 intervals, the scene's "
                       "push-off fixed, no targets or limits)")
     if no_gait_of_its_own(scene):  # no gait to start from: a step from the targets
-        return _run_from_targets(scene, runs_root, force)
+        return _run_from_targets(scene, runs_root, force, plant)
     require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
 
-    return _run_optimum(scene, runs_root, force, up, (up,))
+    return _run_optimum(scene, runs_root, force, up, (up,), plant)
 
 
-def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream) -> StageOutcome:
+def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream,
+                 plant: Plant) -> StageOutcome:
     """``optimize.h5`` of the scene's optimum (:func:`walkerlab.optimal.driver.
-    optimize_scene`, started from the gait of the artifact ``gait``, or from the targets
-    when None), its records built here (:func:`walkerlab.io.schemas.optimize.
+    optimize_scene` of ``plant``, started from the gait of the artifact ``gait``, or from
+    the targets when None), its records built here (:func:`walkerlab.io.schemas.optimize.
     optimize_record`, the energies in the scene's unit)."""
     from walkerlab.optimal.driver import optimize_scene
     from walkerlab.units import for_scene
@@ -115,7 +118,7 @@ def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream) -> StageO
             fp = load_fixedpoint(gait)
             start = (fp.x, fp.step_period_s)
         try:
-            optimum = optimize_scene(scene, *start)
+            optimum = optimize_scene(scene, *start, plant=plant)
         except ValueError as exc:
             raise StageError(str(exc)) from exc
         data = schema.optimize_record(optimum, for_scene(scene).energy)
@@ -159,7 +162,7 @@ def write_controller_scenes(scene: Scene, artifact: Path) -> list[Path]:
     return paths
 
 
-def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
+def _run_from_targets(scene: Scene, runs_root, force: bool, plant: Plant) -> StageOutcome:
     """``optimize.h5`` of a walker with no gait of its own (a passive walker on level
     ground: :func:`walkerlab.optimal.driver.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
@@ -177,7 +180,7 @@ def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     except ValueError as exc:
         raise StageError(f"optimize: {exc}".replace("optimize: optimize: ", "optimize: ")) \
             from exc
-    return _run_optimum(scene, runs_root, force, None, ())
+    return _run_optimum(scene, runs_root, force, None, (), plant)
 
 
 def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
@@ -241,7 +244,7 @@ def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True,
     if d.torque_names != ("hip",) and not d.controllers:
         from walkerlab.optimal.driver import stick_figures
 
-        sticks = stick_figures(scene, d)
+        sticks = stick_figures(Plant.from_scene(scene).data, d)
     return save_optimize_figure(d, scene.name, folder, sticks, svg, key)
 
 

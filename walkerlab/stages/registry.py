@@ -103,8 +103,10 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
         return ()
     if stage == art.OPTIMIZE.name:
         from walkerlab.optimal.driver import needs_gait  # light: the optimal layer
+        from walkerlab.walker.plant import Plant  # light
 
-        if not needs_gait(scene):  # a five-link biped: its guess is built from the targets
+        # a five-link biped: its guess is built from the targets
+        if not needs_gait(scene, Plant.from_scene(scene)):
             return ()
     return STAGES[stage].needs if stage in STAGES else ()
 

@@ -91,10 +91,12 @@ def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
             force or not stage_artifact(scene, runs_root, warmed).is_file()):
         return None
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup  # light
+    from walkerlab.walker.plant import Plant  # light
 
     cs = stage_module(warmed)
     try:
-        beside = cs.rhs_beside(contact_setup(scene), lambda: side) if side.enabled else None
+        beside = (cs.rhs_beside(contact_setup(scene, plant=Plant.from_scene(scene)),
+                                lambda: side) if side.enabled else None)
     except (ContactSceneError, ValueError):  # the stage says so, in its turn
         return None
     module, _, fut = beside or (None, side, side.submit(cs.warm_up, scene))

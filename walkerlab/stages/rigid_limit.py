@@ -40,9 +40,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         from walkerlab.analysis.contact.rigid_limit import convergence, observed_order  # light
         from walkerlab.models.contact.rigid_limit import expected_order
         from walkerlab.models.contact.scene import build
+        from walkerlab.walker.plant import Plant  # light
 
-        ideal = ideal_gait(scene)
-        walker, _ = build(scene, ideal.x, 2)
+        plant = Plant.from_scene(scene)  # the walker described once, handed down
+        ideal = ideal_gait(scene, plant)
+        walker, _ = build(scene, ideal.x, 2, plant=plant)
         tab = convergence(walker, ideal, kappas)
         orders = {"period": observed_order(tab.kappa, tab.period_gap_s),
                   "step_length": observed_order(tab.kappa, tab.step_gap_m)}

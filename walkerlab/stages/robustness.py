@@ -17,6 +17,7 @@ from walkerlab.io.schemas import robustness as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
 
@@ -53,7 +54,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
 
     def compute():
         try:
-            data = scene_robustness(scene, load_fixedpoint(up).x, workers, scheduler)
+            data = scene_robustness(scene, load_fixedpoint(up).x, workers, scheduler,
+                                    Plant.from_scene(scene))  # described once, handed down
         except ValueError as exc:
             raise StageError(str(exc)) from None
         return (lambda f: schema.write(f, data)), {"data": data}

@@ -16,6 +16,7 @@ from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.simulate import longer_run_note, run_end, write_simulate
 from walkerlab.stages.common import StageError, StageOutcome, run_cached
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
@@ -73,7 +74,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 def _compute(scene: Scene, upstream: tuple[Path, ...]):
     fp = load_fixedpoint(upstream[0]) if scene.simulate.initial_state == "fixed_point" else None
     try:
-        run = simulate_run(scene, fp)
+        run = simulate_run(scene, fp, Plant.from_scene(scene))  # described once, handed down
     except ValueError as exc:
         raise StageError(str(exc)) from None
     return (lambda f: write_simulate(f, run)), run.summary

@@ -26,14 +26,18 @@ ROWS_PER_TASK = 4000
 _MAPS: dict[str, BatchStepMap] = {}
 
 
-def scene_walker_at(scene):
-    """``gamma -> HybridWalker``: the scene's rigid walker on another slope."""
+def scene_walker_at(scene, plant=None):
+    """``gamma -> HybridWalker``: the scene's rigid walker on another slope, described by
+    ``plant`` (the scene's :class:`~walkerlab.walker.plant.Plant`,
+    :meth:`~walkerlab.walker.plant.Plant.on_slope`; default: described here)."""
     from walkerlab.models.registry import build_walker
+    from walkerlab.walker.plant import Plant  # light
+
+    plant = Plant.from_scene(scene) if plant is None else plant
 
     def at(gamma: float):
-        return build_walker(scene.model_copy(update={
-            "slope": scene.slope.model_copy(update={"angle_rad": float(gamma),
-                                                    "angle_deg": None})}))
+        on = plant.on_slope(gamma)
+        return build_walker(on.scene, on)
     return at
 
 
@@ -53,24 +57,24 @@ def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
     from walkerlab.config import MfptSettings, scene_from_dict
     from walkerlab.integrate.python_step import make_step_map
     from walkerlab.models.registry import build_walker
+    from walkerlab.walker.plant import Plant  # light
 
     key = json.dumps(base, sort_keys=True) + ("/heights" if heights else "")
     if key not in _MAPS:
-        scene = scene_from_dict(base)
+        scene = scene_from_dict(base)  # the worker's scene: its plant is built here, once
+        plant = Plant.from_scene(scene)
         st = scene.mfpt or MfptSettings()
-        walker = build_walker(scene)
+        walker = build_walker(scene, plant)
         if heights:
             from walkerlab.integrate.python_step import needs_python_path
             from walkerlab.models.hybrid.ground import with_clearance_guard
-            from walkerlab.walker.description import walker_data
 
             if needs_python_path(walker) or walker.variant != "derived":
                 raise ValueError("mfpt.sigma_m: per-step heights need the compiled, generated "
                                  "model (ideal.variant: derived; not flat feet)")
-            walker = with_clearance_guard(walker, walker_data(scene.walker,
-                                                              scene.slope.phi_rad))
+            walker = with_clearance_guard(walker, plant.data)
         _MAPS.clear()
-        _MAPS[key] = make_step_map(walker, scene_walker_at(scene), st.rtol,
+        _MAPS[key] = make_step_map(walker, scene_walker_at(scene, plant), st.rtol,
                                    st.atol, st.max_step_time_s)
     return _MAPS[key]
 
@@ -305,7 +309,7 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
 
 
 def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
-               partial=None):
+               partial=None, plant=None):
     """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` (``st``: the scene's
     :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``
     (Byl & Tedrake 2009; :mod:`walkerlab.analysis.robustness.mfpt`).  ``x_star`` (2n,): the
@@ -317,7 +321,8 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     ones stored, so a killed study resumes where it stopped and gives the same numbers.
     ``st.model == "contact"``: Monte Carlo of the compliant-contact model on patches at the
     drawn heights (:func:`walkerlab.studies.contact_rough.contact_monte_carlo`), from its
-    periodic gait.
+    periodic gait.  ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the
+    stage's; default: described here).
 
     Raises
     ------
@@ -336,12 +341,13 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     dist = per.slope_distribution if per is not None else "normal"
     seed = per.seed if per is not None else st.seed
     if getattr(st, "sigma_m", None) is not None:
-        return _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial)
-    walker = build_walker(scene)
+        return _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial,
+                             plant)
+    walker = build_walker(scene, plant)
     contact = getattr(st, "model", "rigid") == "contact"
     start = None
     if contact:
-        start = _contact_start(scene, x_star, st)
+        start = _contact_start(scene, x_star, st, plant)
     else:
         from walkerlab.integrate.python_step import needs_python_path
 
@@ -412,7 +418,7 @@ def _record_monte_carlo(vals: dict, i: int, mc, wall_s: float) -> None:
     vals["montecarlo_wall_time_s"][i] = wall_s
 
 
-def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial):
+def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial, plant):
     """:func:`mfpt_study` over per-step landing heights (``st.sigma_m`` [m], each step's
     slope drawn with ``terrain.per_step.slope_sd_rad``): Monte Carlo at each level."""
     import time
@@ -420,7 +426,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant)
     step_map_for(scene.model_dump(mode="json"), True)  # validates the walker here
     hdist = per.heights[0] if per is not None else "normal"
     slope_sd = float(per.slope_sd_rad) if per is not None else 0.0
@@ -437,7 +443,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
                     sigma_m=sig_m)
 
 
-def _contact_start(scene, x_star: np.ndarray, st):
+def _contact_start(scene, x_star: np.ndarray, st, plant):
     """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
     from walkerlab.analysis.contact.rough import contact_start
     from walkerlab.analysis.contact.step_map import PeriodicGaitError
@@ -447,7 +453,7 @@ def _contact_start(scene, x_star: np.ndarray, st):
         raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
                          "model's); set mfpt.method: montecarlo")
     try:
-        return contact_start(scene, x_star)
+        return contact_start(scene, x_star, plant=plant)
     except (ContactSceneError, PeriodicGaitError) as exc:
         raise ValueError(f"mfpt.model: contact: {exc}") from None
 
@@ -465,7 +471,7 @@ class MfptStudyError(ValueError):
 
 
 def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
-                         resume: bool = True, workers: int = 1, scheduler=None):
+                         resume: bool = True, workers: int = 1, scheduler=None, plant=None):
     """:func:`mfpt_study` that resumes an interrupted run of the same inputs.
 
     The finished pieces (Monte Carlo chunks, mesh images) are kept in ``partial_path``
@@ -484,6 +490,8 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
         Input hash the partial file is kept under.
     resume : bool
         False (``--force``): start afresh.
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once (the stage's; :func:`mfpt_study`).
 
     Returns
     -------
@@ -506,7 +514,7 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
 
     partial = MfptPartial(partial_path, key, resume=resume)
     try:
-        data = mfpt_study(scene, x_star, st, workers, scheduler, partial)
+        data = mfpt_study(scene, x_star, st, workers, scheduler, partial, plant)
     except DaskLost as exc:  # not bad input: the finished pieces are kept for the rerun
         raise exc.advising(RERUN) from None
     except ValueError as exc:  # bad input: nothing to resume

@@ -20,7 +20,8 @@ from walkerlab.analysis.robustness.measures import (
 )
 
 
-def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None):
+def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None,
+                     plant=None):
     """Everything ``robustness.h5`` holds for a scene with a ``robustness`` section and its
     gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
     angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
@@ -28,6 +29,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     forward and backward mid-stance pushes (:func:`walkerlab.analysis.robustness.push.apply_push`)
     and
     the Monte Carlo MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.studies.mfpt.monte_carlo`).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the stage's; default:
+    described here).
 
     Returns
     -------
@@ -48,15 +51,16 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
-    from walkerlab.walker.description import walker_data  # light
+    from walkerlab.walker.plant import Plant  # light
 
+    plant = Plant.from_scene(scene) if plant is None else plant
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
-    walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require_stage("robustness")
+    plant.kind.require_stage("robustness")
     st = scene.robustness or RobustnessSettings()
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant)
     if walker.steps_per_map != 1:
         raise ValueError("robustness: legs that differ (a stride map) are not supported")
-    sm = make_step_map(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
+    sm = make_step_map(walker, work.scene_walker_at(scene, plant), 1e-12, 1e-12)
     A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
                      jacobian=True)[2]
     names = walker.state_names()
@@ -86,19 +90,20 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
           "push_backward_m_per_s/hi": back[1], "sigma_rad": st.sigma_rad, "mfpt_steps": m,
           "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
           "montecarlo_falls": int(mc.fell.sum())}
-    sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler))
+    sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler, plant))
     return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
                           gsn, gnl, norm, sc, names)
 
 
 def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
-                  scheduler=None) -> dict:
+                  scheduler=None, plant=None) -> dict:
     """The contact model's largest single step-down and step-up (``robustness.contact``):
     bisection brackets [m] (search cap ``cap_m``; the stage uses a twentieth of the leg
     length) of the step at the first heel strike, from the contact model's
     periodic gait, surviving ``robustness.contact_survival_steps`` heel strikes
     (:func:`walkerlab.studies.contact_rough.contact_largest_step`, walks on the executor);
-    NaN when not asked for.
+    NaN when not asked for.  ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`
+    (the study's; default: described by the contact set-up).
 
     Raises
     ------
@@ -115,7 +120,7 @@ def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
     from walkerlab.studies.contact_rough import contact_largest_step
 
     try:
-        start = contact_start(scene, x_star)
+        start = contact_start(scene, x_star, plant=plant)
     except (ContactSceneError, PeriodicGaitError) as exc:
         raise ValueError(f"robustness.contact: {exc}") from None
     out = {}

@@ -165,10 +165,11 @@ def attribute(walker, ideal, **search) -> Attribution:
                        energy_by_sink(walker, g.z))
 
 
-def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
+def adjustment_effect(scene, ideal, strides: int = 5, plant=None) -> dict:
     """Mean step period [s] of the scene's contact run from its adjusted start and from the
     unadjusted ideal start, and whether the rigid walker started from the adjusted state
-    walks (stays in the rigid walker's basin).
+    walks (stays in the rigid walker's basin).  ``plant``: the scene's
+    :class:`~walkerlab.walker.plant.Plant`, from the stage (default: described here).
 
     Returns
     -------
@@ -185,7 +186,7 @@ def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
 
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
     out = {"rate_scale": scale}
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=plant)
     for key, rs in (("adjusted_s", scale), ("unadjusted_s", (1.0, 1.0))):
         _, r, _, _ = simulate_from(setup, ideal.x, ideal.period_s, rate_scale=rs,
                                    strides=strides)
@@ -193,7 +194,7 @@ def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
         out[key] = float(np.mean(T)) if T.size and r.termination in ("t_final",
                                                                      "heel_strike") \
             else float("nan")
-    iw = build_walker(scene)
+    iw = build_walker(scene, setup.plant)  # the set-up's plant: the walker described once
     # leg1 swings first (paper Eq. 11): its rates take scale[0], the stance leg's scale[1]
     x = iw.layout().scale_rates(ideal.x, {"swing": scale[0], "stance": scale[1]})
     run = simulate_steps(iw, x, 2 * strides, Solver.from_settings(scene.solver))

@@ -25,7 +25,7 @@ import numpy as np
 __all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_step_lengths"]
 
 
-def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
+def rigid_step_lengths(scene, walker, x_ideal, plant=None) -> tuple[float, ...] | None:
     """Each step's advance along the slope [m] of one period of the scene's rigid gait on a
     ground whose steps differ, from its fixed point ``x_ideal``; None on a ground whose every
     step is alike (the one spacing of
@@ -41,6 +41,9 @@ def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
     x_ideal : ndarray (2n,)
         The rigid gait's fixed point (post-impact state before step 0 of the cycle, role
         order) [rad, rad/s].
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once (:attr:`walkerlab.models.contact.scene.
+        ContactSetup.plant`); default: described from ``scene``.
 
     Returns
     -------
@@ -61,7 +64,7 @@ def rigid_step_lengths(scene, walker, x_ideal) -> tuple[float, ...] | None:
 
     if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:
         return None
-    rigid = build_walker(scene)
+    rigid = build_walker(scene, plant)
     m = len(rigid.cycle) if rigid.cycle is not None else 1
     traj = simulate_steps(rigid, np.asarray(x_ideal, float), m,
                           Solver.from_settings(scene.solver))

@@ -159,8 +159,10 @@ def converged_gait(gait: ContactPeriodicGait) -> ContactPeriodicGait:
                             f"(scaled residual {gait.residual:.3g} > {tol:g}: {why})")
 
 
-def ideal_gait(scene):
-    """The rigid (derived) periodic gait of ``scene`` from its ``fixedpoint`` section.
+def ideal_gait(scene, plant=None):
+    """The rigid (derived) periodic gait of ``scene`` from its ``fixedpoint`` section
+    (``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from the caller; default:
+    described here).
 
     Returns
     -------
@@ -179,7 +181,7 @@ def ideal_gait(scene):
     from walkerlab.config import FixedPointSettings
 
     fp = sc.fixedpoint or FixedPointSettings()  # every field optional: the defaults
-    iw = build_walker(sc)
+    iw = build_walker(sc, plant)  # the variant changes the equations, not the description
     guess = None if fp.initial_guess is None else initial_state(fp.initial_guess,
                                                                 iw.state_names())
     ctrl = getattr(getattr(iw, "actuators", None), "controller", None) if guess is None \

@@ -47,7 +47,8 @@ class ContactStart:
     slope_rad: float
 
 
-def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactStart:
+def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
+                  plant=None) -> ContactStart:
     """The contact periodic gait of ``scene`` found from the rigid gait ``x_ideal``
     (within ``contact_sim.periodic_time_limit_s``); ``periodic=False``: the contact run's
     own start instead (:func:`walkerlab.analysis.contact.sim.scene_start`: the rigid gait
@@ -68,14 +69,14 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
     from walkerlab.analysis.contact.sim import scene_start  # light
     from walkerlab.models.contact.scene import contact_setup  # light
 
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=plant)  # plant: the caller's (default: described)
     cs = setup.sim
     probe, x0, _, step_length = scene_start(setup, x_ideal, 2)
     if not periodic:
         from walkerlab.integrate.rigid import Solver, integrate_step
         from walkerlab.models.registry import build_walker
 
-        period = integrate_step(build_walker(scene), np.asarray(x_ideal, float),
+        period = integrate_step(build_walker(scene, setup.plant), np.asarray(x_ideal, float),
                                 Solver("DOP853", 1e-10, 1e-10)).period
         return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                             tuple(map(float, x0)), float(step_length), float(period),

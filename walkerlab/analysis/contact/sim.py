@@ -280,7 +280,7 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     return replace(limits, **upd)
 
 
-def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
+def rigid_mid_stance(scene, x_ideal: np.ndarray, plant=None) -> np.ndarray:
     """The rigid gait's state at its mid-stance, where a flat-footed contact run starts
     (``contact_sim.start: mid_stance``).
 
@@ -304,6 +304,8 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
     x_ideal : ndarray, shape (2n,)
         The rigid walker's post-impact state (its ``state_names()`` order: swing, stance,
         stance ankle, their rates) [rad, rad/s].
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once (the contact set-up's); default: described here.
 
     Returns
     -------
@@ -320,7 +322,7 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray) -> np.ndarray:
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant)
     seg = simulate_steps(walker, np.asarray(x_ideal, float), 1,
                          Solver.from_settings(scene.solver)).segments[0]
     if seg.termination != RunEnd.HEEL_STRIKE.value:
@@ -383,10 +385,11 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     if step_length_m is None and setup.steps_differ:  # the rigid period-n gait's footfalls
         from walkerlab.analysis.contact.footfalls import rigid_step_lengths
 
-        lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal)
+        lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal, setup.plant)
     walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m, lengths)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
-    x_start = rigid_mid_stance(setup.scene, x_ideal) if cs.start == "mid_stance" else x_ideal
+    x_start = (rigid_mid_stance(setup.scene, x_ideal, setup.plant)
+               if cs.start == "mid_stance" else x_ideal)
     x0 = initial_state_from_ideal(walker, *np.asarray(x_start, float), rate_scale=tuple(scale))
     limits = ContactLimits(
         sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,

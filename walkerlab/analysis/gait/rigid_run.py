@@ -43,9 +43,10 @@ class RigidRun:
     summary: dict
 
 
-def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
+def simulate_scene(scene: Scene, walker, x0: np.ndarray, plant=None) -> RigidRun:
     """Simulate ``2 * simulate.strides`` steps of ``walker`` (the scene's) from ``x0`` with
-    the scene's solver and sample them.
+    the scene's solver and sample them (``plant``: the scene's
+    :class:`~walkerlab.walker.plant.Plant`, for a height profile's walkers, :func:`walk_scene`).
 
     Raises
     ------
@@ -55,7 +56,7 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
     """
     sim = scene.simulate
     traj = walk_scene(scene, walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
-                      sim.max_step_time_s)
+                      sim.max_step_time_s, plant)
     samples = sample_trajectory(traj, sim.sample_rate_hz)
     steps = step_table(traj)
     ok = steps["termination"] == "heel_strike"
@@ -82,7 +83,7 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
 
 
 def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solver,
-               max_step_time: float):
+               max_step_time: float, plant=None):
     """``n_steps`` steps of the scene's rigid walker from ``x0`` on the scene's ground: the
     walk of the ``simulate`` stage and of :meth:`walkerlab.api.walker.Walker.simulate`.
 
@@ -105,6 +106,9 @@ def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solve
         The scene's integrator (``solver`` section).
     max_step_time : float
         Longest simulated time of one step [s].
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once (the caller's); a height profile's walkers are
+        built from it (default: described here from the scene).
 
     Returns
     -------
@@ -117,14 +121,16 @@ def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solve
         field).
     """
     if scene.terrain is not None and scene.terrain.kind == "profile":
-        return profile_walk(scene, x0, n_steps, solver, max_step_time)
+        return profile_walk(scene, x0, n_steps, solver, max_step_time, plant)
     return simulate_steps(walker, x0, n_steps, solver, max_step_time=max_step_time)
 
 
-def simulate_run(scene: Scene, fixed_point=None):
+def simulate_run(scene: Scene, fixed_point=None, plant=None):
     """The ``simulate`` stage's run: the scene's walker from the fixed point ``fixed_point``
     (a loaded ``fixedpoint.h5``, when ``simulate.initial_state`` is ``fixed_point``) or from
-    the scene's explicit initial state, simulated and sampled (:func:`simulate_scene`).
+    the scene's explicit initial state, simulated and sampled (:func:`simulate_scene`);
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from the stage (default:
+    described here).
 
     Returns
     -------
@@ -141,9 +147,11 @@ def simulate_run(scene: Scene, fixed_point=None):
     from walkerlab.config import MAX_SIMULATE_SAMPLES
     from walkerlab.io.schemas.simulate import SimulateRun
     from walkerlab.models.registry import build_walker
+    from walkerlab.walker.plant import Plant  # light
 
     sim = scene.simulate
-    walker = build_walker(scene)
+    plant = Plant.from_scene(scene) if plant is None else plant
+    walker = build_walker(scene, plant)
     if sim.initial_state == "fixed_point":
         x0, period = fixed_point.x, fixed_point.step_period_s
         # refuse before integrating what could not be sampled (sample_trajectory checks
@@ -160,8 +168,8 @@ def simulate_run(scene: Scene, fixed_point=None):
         except ValueError as exc:
             raise ValueError(f"simulate.initial_state: {exc}") from None
     if sim.terrain_seed is not None:
-        walker = rough_ground_walker(scene, 2 * sim.strides)
-    r = simulate_scene(scene, walker, x0)
+        walker = rough_ground_walker(scene, 2 * sim.strides, plant)
+    r = simulate_scene(scene, walker, x0, plant)
     from walkerlab.analysis.gait.energy import trajectory_ledger
 
     return SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
@@ -195,8 +203,10 @@ def rough_ground_steps(scene, n_steps: int) -> list[tuple[float, float]]:
     return [(-float(hk), float(gk)) for hk, gk in zip(h, g)]
 
 
-def rough_ground_walker(scene, n_steps: int):
-    """The scene's rigid walker on :func:`rough_ground_steps` (its walk ends after them).
+def rough_ground_walker(scene, n_steps: int, plant=None):
+    """The scene's rigid walker on :func:`rough_ground_steps` (its walk ends after them;
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, default: described by
+    :func:`~walkerlab.models.registry.build_walker_on_steps`).
 
     Raises
     ------
@@ -206,14 +216,15 @@ def rough_ground_walker(scene, n_steps: int):
     """
     from walkerlab.models.registry import build_walker_on_steps
 
-    return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps))
+    return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps), plant)
 
 
 def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = None,
-                 max_step_time: float | None = None):
+                 max_step_time: float | None = None, plant=None):
     """``n_steps`` steps of the scene's rigid walker on its height profile from ``x0``
     (:func:`walkerlab.analysis.gait.profile_walk.simulate_on_profile`), with ``solver``
-    (default the scene's) and ``max_step_time`` [s] (default ``simulate.max_step_time_s``).
+    (default the scene's) and ``max_step_time`` [s] (default ``simulate.max_step_time_s``);
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (:func:`profile_ground`).
 
     Raises
     ------
@@ -223,7 +234,7 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = No
     """
     from walkerlab.analysis.gait.profile_walk import simulate_on_profile  # light
 
-    ground = profile_ground(scene)
+    ground = profile_ground(scene, plant)
     solver = Solver.from_settings(scene.solver) if solver is None else solver
     if max_step_time is None:
         max_step_time = scene.simulate.max_step_time_s
@@ -231,10 +242,12 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = No
                                solver, max_step_time=max_step_time)
 
 
-def profile_ground(scene):
+def profile_ground(scene, plant=None):
     """The scene's height profile as the steps of a rigid walk
     (:class:`walkerlab.analysis.gait.profile_walk.ProfileGround`: each step's walker on its
     landing segment), for :func:`profile_walk` and the Gymnasium environment's rigid view.
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once,
+    by the caller; default: described here from the scene).
 
     Raises
     ------
@@ -245,14 +258,13 @@ def profile_ground(scene):
     from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points  # light
     from walkerlab.models.registry import passive_walker_at
     from walkerlab.walker.kinds import PROFILE_PASSIVE
+    from walkerlab.walker.plant import Plant
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
+    plant = Plant.from_scene(scene) if plant is None else plant
     if scene.walker.model != "compass_gait":  # a described walker: its kind's cell
-        from walkerlab.walker.description import walker_data
-
-        walker_data(scene.walker, scene.slope.phi_rad).structure.kind.require(
-            "profile", "rigid", "terrain.kind: profile")
+        plant.kind.require("profile", "rigid", "terrain.kind: profile")
     P = profile_points(scene.terrain)
-    at, data_at = passive_walker_at(scene)
+    at, data_at = passive_walker_at(scene, plant)
     return ProfileGround(at, data_at, P)

@@ -16,7 +16,7 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.hybrid.rolling_polygon import cannot_roll
 from walkerlab.models.registry import build_walker
-from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 
 def _settings(scene: Scene):
@@ -105,7 +105,7 @@ def with_variant(scene: Scene, variant: str) -> Scene:
 
 def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None,
                 ground: bool = False, other_gait: bool | None = None,
-                partner_off_ground: bool = False, nearby=None):
+                partner_off_ground: bool = False, nearby=None, plant: Plant | None = None):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
@@ -115,6 +115,9 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     :class:`~walkerlab.integrate.solver.Solver`) are the scene's model and integrator when
     the caller holds them already (the in-memory :class:`walkerlab.api.walker.Walker`);
     default: built here from the scene (:func:`build_walker`, ``Solver.from_settings``).
+    ``plant`` (a :class:`~walkerlab.walker.plant.Plant`): the scene's walker described once,
+    by the caller that holds it (a stage, the API); default: described here from the scene
+    (for a caller that has just made ``scene``).
     ``ground``: check every gait found for a ground that only pushes
     (:func:`gait_ground_contact`; each :class:`~walkerlab.analysis.gait.search.Gait` carries
     its verdict and the selection prefers the gaits that need no pull).  ``other_gait``
@@ -147,11 +150,12 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
         A malformed initial guess or gait choice, or no ``fixedpoint`` section (one line).
     """
     fp = _settings(scene)
+    plant = Plant.from_scene(scene) if plant is None else plant
     if scene.terrain is None or scene.terrain.is_slope:  # a wheel that cannot roll: at once
-        why = cannot_roll(walker_data(scene.walker, scene.slope.phi_rad))
+        why = cannot_roll(plant.data)
         if why is not None:
             raise GaitNotFound(why, math.nan)
-    walker = build_walker(scene) if walker is None else walker
+    walker = build_walker(scene, plant) if walker is None else walker
     solver = Solver.from_settings(scene.solver) if solver is None else solver
     start = initial_guess(scene, walker) if guess is None else guess
     if start is None:  # virtual constraints: the zero dynamics' periodic orbit, if any
@@ -162,7 +166,7 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
                           other_gait=fp.other_gait if other_gait is None else other_gait,
                           xtol=fp.tolerance, fd_step=fp.fd_step,
                           max_step_time=fp.max_step_time_s, fd_check=fd_check,
-                          ground_check=(lambda x: gait_ground_contact(scene, walker, x))
+                          ground_check=(lambda x: gait_ground_contact(scene, walker, x, plant))
                           if ground else None, partner_off_ground=partner_off_ground,
                           partner_if_needed=fp.other_gait, fallbacks=fallbacks)
 
@@ -195,9 +199,10 @@ def hzd_start(walker):
     return zd.x_plus.copy() if zd.exists else None
 
 
-def solve_variant(scene: Scene, variant: str, guess=None):
+def solve_variant(scene: Scene, variant: str, guess=None, plant: Plant | None = None):
     """Fixed point of one equation variant of the scene's walker, from ``guess`` (default:
-    the scene's initial guess) - for the comparison of printed equations.
+    the scene's initial guess) - for the comparison of printed equations.  ``plant``: the
+    scene's :class:`~walkerlab.walker.plant.Plant` (the variant does not change it).
 
     Raises
     ------
@@ -205,7 +210,7 @@ def solve_variant(scene: Scene, variant: str, guess=None):
         No fixed point from the guess (or no guess).
     """
     sc = with_variant(scene, variant)
-    walker = build_walker(sc)
+    walker = build_walker(sc, plant)
     fp = _settings(scene)
     g = initial_guess(scene, walker) if guess is None else guess
     if g is None:
@@ -216,7 +221,7 @@ def solve_variant(scene: Scene, variant: str, guess=None):
 
 
 def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
-                    note: str | None = None, nearby=None):
+                    note: str | None = None, nearby=None, plant: Plant | None = None):
     """The period-1 gait of the scene's own equation variant and, with ``compare_variants``
     (a compass gait compared with published numbers), the fixed points of the other
     variants from the same start - what the ``fixedpoint`` artifact stores.
@@ -231,6 +236,8 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         How ``guess`` was found, added to the search's notes.
     nearby : FallbackStart, optional
         A start tried when the scene's own guess fails (:func:`solve_scene`).
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once (by the stage); default: described here.
 
     Returns
     -------
@@ -250,7 +257,8 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     """
     from walkerlab.io.schemas.fixedpoint import FixedPointRun
 
-    walker, search = solve_scene(scene, guess=guess, ground=True, nearby=nearby)
+    plant = Plant.from_scene(scene) if plant is None else plant
+    walker, search = solve_scene(scene, guess=guess, ground=True, nearby=nearby, plant=plant)
     if note:
         search.notes.append(note)
     main = search.result
@@ -259,7 +267,7 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     other_guess = main.x if init is None else init
     for variant in variants_for(scene, compare_variants)[1:]:
         try:
-            results[variant] = solve_variant(scene, variant, other_guess)
+            results[variant] = solve_variant(scene, variant, other_guess, plant)
         except FixedPointNotFound as exc:
             results[variant] = exc
     ground = search.gait.ground  # every gait found carries its check (solve_scene)
@@ -282,11 +290,13 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     return run, summary
 
 
-def gait_ground_contact(scene: Scene, walker, x):
+def gait_ground_contact(scene: Scene, walker, x, plant: Plant | None = None):
     """Whether the gait from ``x`` (the scene's walker's fixed point) needs only a ground that
     pushes, and the friction it needs against the scene's ``mu``
     (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver;
     :func:`walkerlab.analysis.gait.friction.scene_friction`).
+
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (default: described here).
 
     Returns
     -------
@@ -294,8 +304,8 @@ def gait_ground_contact(scene: Scene, walker, x):
     """
     from walkerlab.analysis.gait.checks import ground_contact
     from walkerlab.analysis.gait.friction import scene_friction
-    from walkerlab.walker.description import walker_data
 
+    plant = Plant.from_scene(scene) if plant is None else plant
     mu, mu_source = scene_friction(scene)
-    return ground_contact(walker, walker_data(scene.walker, scene.slope.phi_rad), x,
+    return ground_contact(walker, plant.data, x,
                           Solver.from_settings(scene.solver), mu=mu, mu_source=mu_source)

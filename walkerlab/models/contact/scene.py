@@ -22,6 +22,7 @@ from walkerlab.config import (
     TerrainSettings,
 )
 from walkerlab.config.sections import with_default_section
+from walkerlab.walker.plant import Plant
 
 from .actuation import ContactActuators
 from .joint_torques import JointTorqueActuators
@@ -103,6 +104,9 @@ class ContactSetup:
     scene : Scene or None
         The scene read (its rigid walker lays footholds of several heights at the rigid
         gait's footfalls: :mod:`walkerlab.analysis.contact.footfalls`); None: not kept.
+    plant : walkerlab.walker.plant.Plant or None
+        The scene's walker described once (``walker`` is its ``data``), for the rigid
+        walker built from it; None: not kept.
     """
 
     name: str
@@ -116,6 +120,7 @@ class ContactSetup:
     actuators: ContactActuators | JointTorqueActuators | None = None
     rhs_ready: CompiledElsewhere | None = None
     scene: Scene | None = None
+    plant: Plant | None = None
 
     @property
     def steps_differ(self) -> bool:
@@ -203,7 +208,7 @@ class ContactSetup:
                                 n_steps=n_steps + 4), step_length
 
 
-def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
+def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSetup:
     """The scene turned once into what a contact run needs (any walker with positive leg
     masses): its walker data, the contact law and knee stop in SI, terrain, run options and
     solver settings.
@@ -215,6 +220,9 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         The run also finds the contact periodic gait (``contact-sim --periodic``,
         :meth:`walkerlab.api.walker.ContactWalker.periodic_gait`): the scene is checked as
         with ``contact_sim.periodic_gait: true``.
+    plant : walkerlab.walker.plant.Plant, optional
+        The scene's walker described once, by the caller that holds it (a stage, the API);
+        default: described here from ``scene``.
 
     A scene without a ``contact`` section runs on the section's defaults (the paper's
     contact law: :class:`walkerlab.config.ContactSettings`), as ``contact: {}`` does: the
@@ -236,7 +244,6 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
         not found, with that reason) (one line).
     """
     from walkerlab.codegen.floating import check_masses
-    from walkerlab.walker.description import walker_data
 
     scene = with_default_section(scene, "contact")  # left out: its defaults (contact: {})
     if scene.contact is None:  # a section with a required field has no defaults
@@ -250,7 +257,8 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     cs = scene.contact_sim or ContactSimSettings()
     # checked as the run uses it: with its periodic gait when the caller asks for one
     checked = cs.model_copy(update={"periodic_gait": True}) if periodic else cs
-    data = walker_data(scene.walker, scene.slope.phi_rad)
+    plant = Plant.from_scene(scene) if plant is None else plant
+    data = plant.data
     ground = "slope" if scene.terrain is None else scene.terrain.kind
     if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
         from walkerlab.walker.kinds import KindRefused
@@ -279,7 +287,7 @@ def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
-                        scene=scene)
+                        scene=scene, plant=plant)
 
 
 def _start_of(scene: Scene, part, cs: ContactSimSettings) -> ContactSimSettings:
@@ -351,7 +359,8 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
 
 
-def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
+def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None,
+          plant: Plant | None = None):
     """ContactWalker of the scene (:func:`contact_setup`, then :meth:`ContactSetup.build`)
     with checkerboard patches from the ideal step length.
 
@@ -361,6 +370,8 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     x_ideal, n_steps, step_length_m
         As :meth:`ContactSetup.build`'s: the ideal fixed point (2n,) [rad, rad/s], the
         steps the run may take, the patch spacing [m] instead of the ideal step length.
+    plant : walkerlab.walker.plant.Plant, optional
+        As :func:`contact_setup`'s (the scene's walker described once, by the caller).
 
     Returns
     -------
@@ -373,4 +384,4 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     ContactSceneError
         As :func:`contact_setup` (a scene the contact model does not take; one line).
     """
-    return contact_setup(scene).build(x_ideal, n_steps, step_length_m)
+    return contact_setup(scene, plant=plant).build(x_ideal, n_steps, step_length_m)

@@ -42,6 +42,7 @@ import numpy as np
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import complex_step_jacobian
 from walkerlab.walker.description import compass_gait_structure  # noqa: F401
+from walkerlab.walker.plant import compass_gait_data
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 
@@ -181,24 +182,13 @@ def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
 
 
 # --------------------------------------------------------------------------- builder
-def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
-          slope_rad):
-    from walkerlab.config import CompassGaitParams  # light
-    from walkerlab.walker.description import walker_data
-
-    w = CompassGaitParams(leg_length_m=leg_length_m, leg_mass_kg=leg_mass_kg,
-                          hip_mass_kg=hip_mass_kg, gravity_m_per_s2=gravity_m_per_s2,
-                          leg_mass_from_foot_m=leg_mass_from_foot_m)
-    return walker_data(w, slope_rad)
-
-
 @cache
 def _generated(p: tuple) -> dict:
     """Generated functions for ``p = (m, M_H, L, a, g)`` (slope 0: flow, impact, energies)."""
     from walkerlab.codegen.cache import functions
 
     m, mh, L, a, g = p
-    return functions(_data(L, m, mh, g, a, 0.0))
+    return functions(compass_gait_data(L, m, mh, g, a, 0.0))
 
 
 def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: float,
@@ -220,8 +210,8 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
 
     if variant not in VARIANTS:
         raise ValueError(f"ideal.variant: unknown variant {variant!r}; choose from {VARIANTS}")
-    data = _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
-                 slope_rad)
+    data = compass_gait_data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2,
+                             leg_mass_from_foot_m, slope_rad)
     if variant == "derived":
         return make_rigid_walker(data, "compass_gait", variant)
     # printed flow (A.4-A.6): generated like any other, from the derived equations with the

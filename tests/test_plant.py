@@ -1,0 +1,50 @@
+"""The plant (:class:`walkerlab.walker.plant.Plant`): a scene's walker described once, by the
+front (a stage, the API's walker), and handed down to the models, analyses and studies."""
+
+from __future__ import annotations
+
+import collections
+from pathlib import Path
+
+import walkerlab.walker.description as description
+import walkerlab.walker.plant as plant_module
+from walkerlab.api.walker import Walker
+from walkerlab.config import load_scene
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+
+def test_a_plant_is_its_scenes_description_and_keeps_each_other_slope():
+    scene = load_scene(CONFIGS / "kneed.yaml")
+    plant = Plant.from_scene(scene)
+    ref = walker_data(scene.walker, scene.slope.phi_rad)
+    assert plant.data.params == ref.params and plant.data.structure == ref.structure
+    assert plant.kind == ref.structure.kind and plant.slope_rad == scene.slope.phi_rad
+    assert plant.data_at(scene.slope.phi_rad) is plant.data  # its own slope: no new one
+    g = scene.slope.phi_rad + 0.01
+    assert plant.data_at(g) is plant.data_at(g)  # another slope: described once, kept
+    assert plant.data_at(g).params == walker_data(scene.walker, g).params
+    on = plant.on_slope(g)
+    assert on.scene.slope.phi_rad == g and on.data is plant.data_at(g)
+    assert on.scene.walker == scene.walker
+
+
+def test_the_api_walker_describes_each_slope_of_a_profile_once(monkeypatch):
+    """The gait search, its ground check and a walk over a height profile (a walker per
+    landing segment's slope) share the walker's plant: each slope is described once (before
+    the plant, each was described two to six times)."""
+    calls = collections.Counter()
+    real = description.walker_data
+
+    def counted(walker_cfg, slope_rad):
+        calls[repr(float(slope_rad))] += 1
+        return real(walker_cfg, slope_rad)
+
+    monkeypatch.setattr(description, "walker_data", counted)
+    monkeypatch.setattr(plant_module, "walker_data", counted)
+    w = Walker(load_scene(CONFIGS / "profile.yaml"))
+    w.simulate(w.fixed_point().x, strides=2)
+    assert len(calls) >= 3, calls  # the scene's slope and the profile's segments
+    assert max(calls.values()) == 1, calls
