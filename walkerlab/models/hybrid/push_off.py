@@ -9,7 +9,7 @@ heel strike pins the leading foot.  The contact point is
 - a point foot: the foot;
 - an arc foot: the arc's lowest point (the rolling contact, ``stance_contact``);
 - a flat foot: the trailing toe
-  (:class:`walkerlab.models.hybrid.flat_push_off.FlatPushOff`).
+  (:class:`walkerlab.models.hybrid.toe_push_off.FlatPushOff`).
 
 Point and arc feet share one form.  In the extended coordinates ``qe = (q, x_f, y_f)`` (the
 stance foot free, :func:`walkerlab.codegen.symbolic.derive`'s ``De, E``: ``De`` the mass
@@ -28,7 +28,7 @@ nothing: its generated ``De, E`` (:func:`walkerlab.codegen.free_joints.derive_fi
 carry every link, the push-off along the virtual trailing leg (stance foot to hip).  A
 walker with massless legs (only the hip carries mass) has a singular ``De``: its
 transition is written for the hip mass directly (Kuo 2002, Eq. 2 and its appendix).
-Flat feet: :mod:`walkerlab.models.hybrid.flat_push_off`.
+Flat feet: :mod:`walkerlab.models.hybrid.toe_push_off`.
 
 States stay the walker's own (role-ordered ``(2n,)``): nothing here knows their number.
 """
