@@ -310,12 +310,13 @@ def test_round_feet_stick_diagram_draws_the_arc_not_a_stub():
     """Each leg runs straight to its arc centre and on to the arc (no segment to the off-axis
     contact point); the arc lies at radius R = |contact - centre| around the centre."""
     from walkerlab.plotting import figures as F
+    from walkerlab.plotting import stick
 
     tr = _walker_trajectory(round_feet=True)
-    chains = dict(F._chains(tr))
+    chains = dict(stick._chains(tr))
     assert chains["leg1"][-1] == "leg1_foot_centre"
     assert not any(n.endswith("_contact") for c in chains.values() for n in c)
-    arcs = F._arc_feet(tr, 5)
+    arcs = stick._arc_feet(tr, 5)
     assert len(arcs) == 2
     c = tr.points["leg1_foot_centre"][:, 5]
     arc = arcs[0][:, 3:]  # after the spoke and its break

@@ -29,33 +29,35 @@ Bodies and joints:
 
 Forces:
 
-- **ground contact**: one ``HuntCrossleyForce`` per leg between its foot sphere and its own
-  ground (the paper's checkerboard lanes: a leg touches only its lane).  A point foot is a
-  sphere of radius :func:`walkerlab.export.mjcf_scene.point_foot_radius` with the ground
-  lowered by that radius; an arc foot is the sphere of its arc.  Continuous terrain is a
-  ``ContactHalfSpace`` along the slope; a checkerboard patch is a ``ContactSphere`` of radius
-  :func:`patch_radius` whose top touches the slope line at the footfall (its surface stays
-  within one foot-sphere radius of the line over the patch's width and falls away beyond, so
-  the swing foot passes over the other lane's footfalls; OpenSim's Hunt-Crossley force takes
-  spheres and half-spaces only).  On stairs and footholds (``terrain.lanes: checkerboard``)
-  each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
-  is :func:`terrain_patch_radius`; footholds of several heights in turn have their patches
-  at the rigid period-n gait's footfalls, step by step, each at its own foothold's height
-  (as the MJCF's, :func:`walkerlab.export.scene.mjcf_scene`); continuous stairs are
-  refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated
-  by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static penetration; stated in
-  the file).
+- **ground contact**: one ``HuntCrossleyForce`` per leg between its foot sphere and its own ground
+  (the paper's checkerboard lanes: a leg touches only its lane).  A point foot is a sphere of radius
+  :func:`walkerlab.export.mjcf_scene.point_foot_radius` with the ground lowered by that radius; an
+  arc foot is the sphere of its arc.  Continuous terrain is a ``ContactHalfSpace`` along the slope;
+  a checkerboard patch is a ``ContactSphere`` of radius
+  :func:`~walkerlab.export.opensim_contact.patch_radius` whose top touches the slope line at the
+  footfall (its surface stays within one foot-sphere radius of the line over the patch's width and
+  falls away beyond, so the swing foot passes over the other lane's footfalls; OpenSim's
+  Hunt-Crossley force takes spheres and half-spaces only).  On stairs and footholds
+  (``terrain.lanes: checkerboard``) each patch's top is at its footfall's height (the MJCF's
+  ``lane_heights``) and the radius is
+  :func:`~walkerlab.export.opensim_contact.terrain_patch_radius`; footholds of several heights in
+  turn have their patches at the rigid period-n gait's footfalls, step by step, each at its own
+  foothold's height (as the MJCF's, :func:`walkerlab.export.scene.mjcf_scene`); continuous stairs
+  are refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated by
+  :func:`~walkerlab.export.opensim_contact.hunt_crossley` (Hertz ``d^1.5``, matched at the static
+  penetration; stated in the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
   and damping about z; the rest angle in the second frame's orientation).
-- **knee stop**: an ``ExpressionBasedCoordinateForce`` ``leg<i>_knee_stop``, the stop's
-  IMPACT law on the knee's hyperextension, clamped to push only (:func:`knee_stop_expression`,
-  walkerlab's own law: a ``CoordinateLimitForce``'s damping is not clamped and holds a knee
-  that the stance load left hyperextended, so the new swing knee stays straight and the foot
-  scuffs).  The knee latch of ``contact.knee_stop.latch`` (the stop acting in flexion too
-  while the leg's foot is on the ground) is a second, mirrored force ``leg<i>_knee_latch``
-  that applies no force by default: OpenSim has no contact-switched force, a stepping loop
-  switches it (``Force.setAppliesForce``, :mod:`walkerlab.export.opensim_walk`).
+- **knee stop**: an ``ExpressionBasedCoordinateForce`` ``leg<i>_knee_stop``, the stop's IMPACT law
+  on the knee's hyperextension, clamped to push only
+  (:func:`~walkerlab.export.opensim_contact.knee_stop_expression`, walkerlab's own law: a
+  ``CoordinateLimitForce``'s damping is not clamped and holds a knee that the stance load left
+  hyperextended, so the new swing knee stays straight and the foot scuffs).  The knee latch of
+  ``contact.knee_stop.latch`` (the stop acting in flexion too while the leg's foot is on the ground)
+  is a second, mirrored force ``leg<i>_knee_latch`` that applies no force by default: OpenSim has no
+  contact-switched force, a stepping loop switches it (``Force.setAppliesForce``,
+  :mod:`walkerlab.export.opensim_walk`).
 - **actuators**: the joint torque laws of ``walker.actuation.torques`` are exported as a
   ``CoordinateActuator`` ``<coordinate>_motor`` on every coordinate a law's joint moves
   (:func:`walkerlab.export.joint_torques.torque_generalized_forces`: a torque between the
@@ -85,6 +87,12 @@ from walkerlab.config.contact import ContactSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, xml_comments
+from walkerlab.export.opensim_contact import (
+    hunt_crossley,
+    knee_stop_expression,
+    patch_radius,
+    terrain_patch_radius,
+)
 from walkerlab.export.opensim_xml import (
     ankle_springs,
     body_set,
@@ -224,125 +232,6 @@ def osim_coordinates(mb) -> list[str]:
         if ankles and ln.foot_m is not None:
             out.append(f"{ln.name.split('_')[0]}_ankle")
     return out
-
-
-def hunt_crossley(c: ContactParamsSI, weight_n: float, radius_m: float
-                  ) -> tuple[float, float, float, str]:
-    """OpenSim Hunt-Crossley parameters for the scene's IMPACT law.
-
-    Simbody's Hunt-Crossley force between a sphere of effective radius ``R`` and a surface
-    (Hunt & Crossley 1975; Simbody ``HuntCrossleyForce``, both surfaces with the same
-    parameters ``s``, ``c``) is ``f = (4/3) k^(3/2) sqrt(R) d^(3/2) (1 + 3/2 c v)`` with
-    ``k = s^(2/3) / 2``, i.e. ``f = K d^(3/2) (1 + 3/2 c v)``, ``K = (4/3) s sqrt(R) /
-    2^(3/2)``.  The IMPACT law ``k_I d^e + STEP(d, 0, 0, dmax, cmax) d'`` of the walker's
-    weight ``W`` on one foot rests at ``d_s = (W / k_I)^(1/e)``; the translation keeps that
-    static point (``K d_s^(3/2) = W``) and the damping there (``3/2 c W = cmax STEP(d_s)``).
-    Friction: ``static_friction`` = ``mu_static``, ``dynamic_friction`` = ``mu_dynamic``,
-    ``transition_velocity`` = the stiction velocity (Simbody's friction peaks at the static
-    coefficient there, as IMPACT's STEP does), no viscous friction.
-
-    Limits: the exponent is Hertz's 3/2 (IMPACT's ``e`` is exact only at ``d_s``: the tangent
-    stiffness there is ``3/2 W / d_s`` against ``e W / d_s``), the damping grows with
-    ``d^(3/2)`` rather than IMPACT's cubic step, and the load on a foot is not always ``W``.
-
-    Parameters
-    ----------
-    c : ContactParamsSI
-        The scene's contact law in SI.
-    weight_n : float
-        The walker's weight normal to the slope ``M g cos(phi)`` [N].
-    radius_m : float
-        Effective contact radius ``R`` [m] (the foot sphere's; against a sphere of radius
-        ``Rg``: ``r Rg / (r + Rg)``).
-
-    Returns
-    -------
-    stiffness_pa, dissipation_s_per_m, transition_velocity_m_per_s, note
-    """
-    ds = (weight_n / c.k) ** (1.0 / c.e)
-    K = weight_n / ds ** 1.5
-    s_param = K * 2 ** 1.5 * 3 / (4 * math.sqrt(radius_m))
-    x = min(ds / c.dmax, 1.0)
-    cs = c.cmax * x * x * (3 - 2 * x)
-    diss = cs / (1.5 * weight_n)
-    note = (f"Contact from the scene's IMPACT law (walkerlab.export.opensim.hunt_crossley): "
-            f"k = {c.k:.6g} N/m^{c.e:g}, cmax = {c.cmax:.6g} N s/m, dmax = {c.dmax:.6g} m; the "
-            f"weight W = {weight_n:.6g} N on one foot rests at d_s = {ds:.4g} m; Hertz "
-            f"K d^1.5 with K = {K:.6g} N/m^1.5 through that point (Simbody: K = (4/3) s "
-            f"sqrt(R) / 2^1.5, R = {radius_m:.4g} m, s = {s_param:.6g} Pa), damping "
-            f"{cs:.4g} N s/m there (dissipation c = {diss:.4g} s/m); friction mu_static "
-            f"{c.mu_s:g}, mu_dynamic {c.mu_d:g}, transition velocity = stiction velocity "
-            f"{c.v_s:g} m/s. Limits: exponent 1.5 (tangent stiffness 1.5 W/d_s against "
-            f"{c.e:g} W/d_s), damping ~ d^1.5 instead of a cubic step.")
-    return s_param, diss, float(c.v_s), note
-
-
-def knee_stop_expression(knee: KneeStopSI, side: str) -> str:
-    """The knee stop's IMPACT law as an ``ExpressionBasedCoordinateForce`` expression in the
-    knee coordinate ``q`` [rad] (0 straight, < 0 flexed) and its rate ``qdot`` [rad/s].
-
-    With ``d`` the penetration (``q`` for the stop, ``-q`` for the latch) the torque's size is
-    ``max(0, k max(d, 0)^e + STEP(d, 0, 0, dmax, cmax) d')`` (ADAMS IMPACT; the cubic STEP
-    written out), the contact model's knee stop (``contact.knee_stop``) without the
-    latch's engagement weight (the stepping loop switches the latch on and off): it pushes
-    only, so its damping never holds a knee leaving the stop.
-
-    Parameters
-    ----------
-    knee : KneeStopSI
-    side : {"stop", "latch"}
-        ``"stop"``: against hyperextension (torque <= 0); ``"latch"``: against flexion
-        (torque >= 0).
-
-    Returns
-    -------
-    str
-        A Lepton expression (OpenSim's expression parser).
-
-    Raises
-    ------
-    ValueError
-        ``side`` is neither.
-    """
-    if side not in ("stop", "latch"):
-        raise ValueError(f"side: 'stop' or 'latch', not {side!r}")
-    d, dd, sign = ("q", "qdot", "-") if side == "stop" else ("(-q)", "(-qdot)", "")
-    x = f"min(max({d}/{knee.dmax!r},0),1)"
-    return (f"{sign}max(0,{knee.k!r}*max({d},0)^{knee.e!r}"
-            f"+{knee.cmax!r}*{x}^2*(3-2*{x})*{dd})")
-
-
-def patch_radius(patch_width_m: float, foot_sphere_m: float) -> float:
-    """Radius [m] of the sphere standing for a checkerboard patch: its surface falls
-    ``(w/2)^2 / (2 Rg)`` below the slope line at the patch's edge; that drop is one foot-sphere
-    radius (``L / 1000``), ``Rg = (w/2)^2 / (2 r)``."""
-    return (patch_width_m / 2) ** 2 / (2 * foot_sphere_m)
-
-
-def terrain_patch_radius(gait: OsimGait, foot_sphere_m: float) -> float:
-    """Radius [m] of the patch spheres: :func:`patch_radius` on a slope's patches; on stairs
-    and footholds no larger than the radius whose surface falls ``h`` plus two foot-sphere
-    radii below its top at ``d = max(w/2, l/3)`` from its centre, ``Rg <= d^2 / (2 (h + 2 r))``
-    (``h`` the largest rise between consecutive footfalls, ``w`` the patch width, ``l`` the
-    step length).  A sphere does not end at the patch's edge: on stairs.yaml, at the flat
-    patches' radius (11.25 m), the tread behind reached into the swing foot's path, which
-    falls below the tread it left about half a step (0.22 of 0.41 m) from it.
-
-    Flat feet: no larger than the patch of the sole's length, ``patch_radius(heel + toe,
-    r)`` (the sole's ends one foot-sphere radius below the top, the foot flat on it to that):
-    at the 0.6 m patches' 45 m of configs/flat_feet.yaml the swing toe, which the rigid
-    model lets pass 2 mm below the slope line early in the swing, touched the trailing
-    patch's flank 0.1 m beyond its edge and the walker fell; at 2.81 m it walks."""
-    rg = patch_radius(gait.patch_width_m, foot_sphere_m)
-    if gait.flat_feet:
-        rg = min(rg, patch_radius(max(f[0] + f[1] for f in gait.flat_feet), foot_sphere_m))
-    if gait.lane_heights is None:
-        return rg
-    falls = sorted((s, h) for lane, hs in zip(gait.lanes, gait.lane_heights)
-                   for s, h in zip(lane, hs))
-    rise = max((abs(a[1] - b[1]) for a, b in zip(falls, falls[1:])), default=0.0)
-    d = max(gait.patch_width_m / 2, gait.step_length_m / 3)
-    return min(rg, d ** 2 / (2 * (rise + 2 * foot_sphere_m)))
 
 
 def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:

@@ -1,7 +1,9 @@
 """What an exported MuJoCo walker needs to walk: its gait, its terrain, its contact, its latch.
 
-:func:`mjcf_scene` turns a validated scene into :class:`walkerlab.export.mjcf_scene.MjcfScene`
-(written by :func:`walkerlab.export.multibody.mjcf_text`):
+:func:`mjcf_scene` turns a validated scene (its feet by :mod:`walkerlab.export.scene_feet`,
+its ground by :mod:`walkerlab.export.scene_ground`) into
+:class:`walkerlab.export.mjcf_scene.MjcfScene` (written by
+:func:`walkerlab.export.multibody.mjcf_text`):
 
 - **gait keyframe**: the rigid walker's fixed point (just after heel strike, leg2 in stance,
   its foot's contact point at the origin on the ground line) as the export's joint
@@ -31,8 +33,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.export.mjcf_scene import (
@@ -44,14 +44,21 @@ from walkerlab.export.mjcf_scene import (
     point_foot_radius,
 )
 from walkerlab.export.parts import export_part
+from walkerlab.export.scene_feet import SCENE_FEET, flat_foot_bodies, joint_state
+from walkerlab.export.scene_ground import (
+    EXPORT_STEPS,
+    checkerboard,
+    footfalls_per_step,
+    ground_notes,
+    ground_pieces,
+    profile_patches,
+)
 from walkerlab.models.contact.laws import ContactParamsSI
 from walkerlab.walker.kinds import KINDS, Kind
 
 __all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "arc_roll_m", "check_exportable",
            "flat_foot_bodies", "joint_state", "mjcf_scene", "mujoco_contact"]
 
-#: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
-EXPORT_STEPS = 40
 #: The capability table's view (:data:`walkerlab.walker.kinds.VIEWS`) of each export format
 FORMAT_VIEWS = {"urdf": "urdf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
 
@@ -165,31 +172,6 @@ def mujoco_contact(c: ContactParamsSI, mass_kg: float, g: float, phi: float,
     return dt, (tau, z), (0.99, 0.99, 0.001, 0.5, 2.0), float(c.mu_s), notes
 
 
-def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
-    """The export's joint coordinates and rates from a floating state ``x`` (2 nq,) of the
-    contact walker (state names of :meth:`ContactWalker.state_names`).
-
-    Returns
-    -------
-    qpos, qvel : ndarray (2 + len(mb.links),)
-        ``hip_x``, ``hip_z`` [m, m/s], then each link's joint [rad, rad/s]; a coupled joint
-        (the torso's) from its coupling.
-    """
-    q, v = walker.layout().coordinate_values(x)
-
-    coupled = {cp.joint: cp.terms for cp in mb.couplings}  # e.g. the torso's bisecting hip
-    link_of = {ln.joint: ln.name for ln in mb.links}
-
-    def joint(vals, ln):
-        if ln.joint in coupled:  # of hip joints: absolute link (leg or thigh) angles
-            return sum(c * vals[f"{link_of[j]}_angle"] for j, c in coupled[ln.joint])
-        own = vals[f"{ln.name}_angle"]
-        return own - vals[f"{ln.parent}_angle"] if ln.joint.endswith("_knee") else own
-
-    return (np.array([q["hip_x"], q["hip_y"], *(joint(q, ln) for ln in mb.links)]),
-            np.array([v["hip_x"], v["hip_y"], *(joint(v, ln) for ln in mb.links)]))
-
-
 def arc_roll_m(mb, qpos) -> float:
     """How far an arc foot rolls its contact point ahead of its footfall during a stance [m]:
     ``R (psi_start - psi_end)``, the stance shank's turn from heel strike to the next (rolling
@@ -273,123 +255,27 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
         if terrain.lanes == "continuous":
             profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin
     elif not terrain.is_slope:
-        lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
+        lane_heights, treads = ground_pieces(terrain, walker, ideal.x)
     if lane_heights is not None and len(ground_drops(terrain)) > 1:
         # footholds of several heights: the rigid period-n gait's footfalls, step by step
-        lanes, lane_heights = _footfalls_per_step(scene, walker, ideal.x, terrain)
+        lanes, lane_heights = footfalls_per_step(scene, walker, ideal.x, terrain)
         lanes = feet_part.footprints(lanes, data)
     elif terrain.lanes == "checkerboard":
-        lanes = feet_part.footprints(_checkerboard(walker, ideal, terrain), data)
+        lanes = feet_part.footprints(checkerboard(walker, ideal, terrain), data)
     latch = (knee.latch_height, knee.latch_capture) if part.knee_stops else None
     notes = _walker_notes(scene, part, ideal, latch, knee, notes)
     notes += feet_part.notes_for(data)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     if terrain.kind == "profile" and lanes is not None:  # checkerboard patches on it
-        lane_heights = _profile_patches(terrain, lanes, ahead, float(walker.phi))
+        lane_heights = profile_patches(terrain, lanes, ahead, float(walker.phi))
     if treads is not None or profile is not None:
         lanes = None  # continuous stairs (the treads) or a profile (a height field) is the ground
-    terrain_notes += _ground_notes(terrain, treads, profile, lane_heights)
+    terrain_notes += ground_notes(terrain, treads, profile, lane_heights)
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
                      dt, solref, solimp, mu, latch, notes + terrain_notes, scene.walker.actuation,
                      dt, ahead,  # the push-off over one timestep: the rigid model's impulse
                      feet, lane_heights, treads, profile)
-
-
-def _checkerboard(walker, ideal, terrain: TerrainSettings) -> tuple:
-    """The checkerboard's footfalls ``(leg1's, leg2's)`` along the ground [m], before the
-    feet's :meth:`footprints`: the keyframe's feet are one step apart, leg2's step (the last
-    of the gait's map; stairs, footholds: the footholds' spacing, along the slope)."""
-    from walkerlab.models.contact.scene import ideal_step_length
-
-    ell2 = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
-    ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
-    # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
-    # (exact for point feet), else footfalls drift off the patches stride by stride
-    k = np.arange(EXPORT_STEPS // 2 + 1)
-    if len(ells) == 2:
-        ell1 = ell2 + (ells[0] - ells[1])
-        return (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
-    return (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
-
-
-def _footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings
-                        ) -> tuple[tuple, tuple]:
-    """The checkerboard of footholds of several heights: ``(lanes, lane_heights)``, each
-    ``(leg1's, leg2's)`` [m], the patches at the rigid period-n gait's footfalls step by step
-    (:func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`) and their heights along
-    the slope normal (:func:`walkerlab.models.contact.terrain.footfall_heights`).  The
-    keyframe's stance foot (leg2) is footfall 0 at the origin, its trailing foot (leg1)
-    footfall -1, the last step of the rigid map (``l_{m-1}`` behind, ``d_{m-1} cos(phi)``
-    above); leg2's lane holds footfalls 0, 2, ..., leg1's -1, 1, 3, ...."""
-    from walkerlab.analysis.contact.footfalls import rigid_step_lengths
-    from walkerlab.models.contact.terrain import (
-        footfall_heights,
-        footfall_positions,
-        ground_drops,
-    )
-
-    ells = rigid_step_lengths(scene, walker, x_ideal)
-    drops = ground_drops(terrain)
-    n = EXPORT_STEPS + 1  # footfalls 0 .. EXPORT_STEPS
-    s = footfall_positions(ells, n)
-    h = footfall_heights(drops, n, float(walker.phi))
-    s_back = -ells[-1]
-    h_back = drops[(len(ells) - 1) % len(drops)] * math.cos(float(walker.phi))
-    lanes = (tuple(float(v) for v in (s_back, *s[1::2])), tuple(float(v) for v in s[0::2]))
-    heights = (tuple(float(v) for v in (h_back, *h[1::2])), tuple(float(v) for v in h[0::2]))
-    return lanes, heights
-
-
-def _profile_patches(terrain: TerrainSettings, lanes: tuple, ahead_m: float,
-                     phi: float) -> tuple:
-    """The heights ``(leg1's, leg2's)`` [m] along the slope normal of the checkerboard
-    patches ``lanes`` (along-slope centres [m], leg2's contact point at the origin, the
-    profile's first point there) on a height profile: the contact model's flat patches
-    (:func:`walkerlab.models.contact.terrain.profile_patch_heights`), each box from its
-    footfall ``- w/2`` to ``+ w/2 + ahead_m``.
-
-    Raises
-    ------
-    ValueError
-        A profile not flat across a patch (one line naming ``terrain.lanes``).
-    """
-    from walkerlab.models.contact.terrain import profile_patch_heights
-
-    hw = 0.5 * (terrain.patch_width_m + ahead_m)
-    return tuple(tuple(float(h) for h in profile_patch_heights(
-        terrain, np.asarray(lane, float) + 0.5 * ahead_m, hw, phi)) for lane in lanes)
-
-
-def _ground_notes(terrain: TerrainSettings, treads, profile, lane_heights) -> tuple:
-    """The MJCF's comments on a ground that is not the plain slope (stairs, a profile,
-    footholds)."""
-    terrain_notes = ()
-    if treads is not None:
-        terrain_notes += (f"Stairs (terrain: riser {terrain.riser_m:g} m "
-                          f"{terrain.direction or 'down'}, tread {terrain.tread_m:g} m): a box "
-                          "per tread (geoms tread<i>), its top the tread, its faces the "
-                          "risers.",)
-    elif profile is not None:
-        terrain_notes += ("Profile (terrain.kind: profile, lanes: continuous): a height field "
-                          "hfield 'profile' sampled every 5 mm from its polyline, the first "
-                          "stance foot on its first point (both feet touch it).",)
-    elif lane_heights is not None and terrain.kind == "profile":
-        terrain_notes += ("Profile (terrain.kind: profile, lanes: checkerboard): the "
-                          "checkerboard patches, flat, each at the profile's height under it "
-                          "(walkerlab.models.contact.terrain.profile_patch_heights), the "
-                          "first stance foot on its first point.",)
-    elif lane_heights is not None and terrain.kind == "footholds" \
-            and len(set(terrain.foothold_heights_m or (0.0,))) > 1:
-        terrain_notes += ("Footholds of several heights (terrain.foothold_heights_m, in "
-                          "turn): the checkerboard patches at the rigid period-n gait's "
-                          "footfalls step by step (walkerlab.analysis.contact.footfalls), "
-                          "each the step's height below the last along the vertical.",)
-    elif lane_heights is not None:
-        terrain_notes += ("Footholds (terrain.kind: " + terrain.kind + "): the checkerboard "
-                          "patches at the rigid gait's footholds, each at its tread's height "
-                          "(a riser below or above the last).",)
-    return terrain_notes
 
 
 def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) -> tuple:
@@ -415,168 +301,3 @@ def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) 
                   "(a - rest_angle_rad) - constant_n_m until the next heel strike "
                   "(walkerlab.export.mujoco_walk), the contact model's AnklePushOff.",)
     return notes
-
-
-def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
-    """The MJCF's ground on stairs or footholds (:class:`MjcfScene` ``lane_heights``,
-    ``treads``): the checkerboard patches' heights along the slope normal (footfall ``j``
-    at ``-j drop cos(phi)``, leg2's lane holding footfalls 0, 2, ..., leg1's -1, 1, 3, ...:
-    the keyframe's trailing foot stands on the tread behind), or continuous stairs' treads
-    (:func:`walkerlab.models.contact.terrain.stairs_line`, the stance foot at the origin).
-
-    Raises
-    ------
-    ValueError
-        A ground the contact model does not build (one line,
-        :func:`walkerlab.models.contact.terrain.check_ground`).
-    """
-    from walkerlab.models.contact.terrain import check_ground, stairs_line
-
-    drop = check_ground(terrain) * math.cos(float(walker.phi))
-    if terrain.lanes == "checkerboard":
-        k = np.arange(EXPORT_STEPS // 2 + 1)
-        return (tuple(-(2 * k - 1) * drop), tuple(-(2 * k) * drop)), None
-    line = stairs_line(terrain, 0.0, EXPORT_STEPS + 2)
-    return None, tuple((float(line[i, 0]), float(line[i + 1, 0]), float(line[i, 1]))
-                       for i in range(0, len(line), 2))
-
-
-def flat_foot_bodies(scene: Scene, data) -> tuple:
-    """Per leg (leg1, leg2: leg1 the swing role's numbers when the legs differ) ``(heel,
-    toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot mass
-    [kg], inertia about the ankle [kg m^2])`` of a flat-footed walker; mass and inertia the
-    walker's (``walker.leg.foot.mass_kg``, ``inertia_about_ankle_kg_m2``) or, for massless
-    feet, the contact model's (``contact.flat_foot_mass_kg``,
-    ``contact.flat_foot_inertia_kg_m2``).
-
-    Raises
-    ------
-    ValueError
-        The scene has no foot mass or inertia (one line naming the fields).
-    """
-    settings = scene.contact or ContactSettings()
-    st = data.structure
-    P = dict(zip(st.param_names, data.params))
-    # the walker's own feet (walker.leg.foot.mass_kg) or the contact model's regularising ones
-    mi = (P["m_foot"], P["I_foot"]) if st.foot_mass else settings.flat_foot()
-    if mi is None:
-        raise ValueError("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: an "
-                         "MJCF's flat feet need their mass and inertia (the rigid view's "
-                         "feet are massless)")
-    tags = ("sw_", "st_") if st.asymmetric else ("", "")
-    return tuple((P[f"heel_{t}m"], P[f"toe_{t}m"], P[f"k_{t}ankle"], P[f"c_{t}ankle"],
-                  P[f"r_{t}ankle"], *mi) for t in tags)
-
-
-def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
-    """The ``gait`` keyframe of flat feet (MuJoCo's tree order, :attr:`MjcfScene.flat_feet`)
-    from the rigid fixed point ``x_ideal`` with the rest of its heel strike applied (the
-    walker's :attr:`~walkerlab.models.hybrid.base.HybridWalker.step_entry`: the trailing
-    toe kept on the ground in double support, its foot at the angle that puts the toe on
-    the slope, or on stairs and footholds on the tread it stood on: the landing of the step
-    before the keyframe, the last of the ground's period, above the new stance heel's line)
-    or, where the gait has none, the trailing foot at its rest angle."""
-    from walkerlab.codegen.cache import functions
-    from walkerlab.models.ground import landing_drops
-    from walkerlab.models.hybrid.ground import on_landing
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-
-    feet = flat_foot_bodies(scene, data)
-    drop = landing_drops(scene.terrain)[-1]  # the step that ended at the keyframe [m]
-    rigid = on_landing(make_rigid_walker(data), data, drop)
-    x, phase = rigid.step_entry(np.asarray(x_ideal, float))
-    X = walker.pinned_to_full(walker.link_state_from_ideal(x), np.zeros(2))
-    q, v = walker.layout().coordinate_values(X)
-    ankle1 = (feet[0][4], 0.0)
-    if phase is not None:  # double support: the trailing (leg1) foot on its toe
-        level = drop * float(np.cos(data.slope_rad))  # the trailing toe's tread
-        b, db, _e, _phi = functions(data)["double_support_trailing"](x, level)
-        ankle1 = (b, db)
-    qpos = [q["hip_x"], q["hip_y"], q["leg1_angle"], ankle1[0], q["leg2_angle"],
-            q["leg2_foot_angle"] - q["leg2_angle"]]
-    qvel = [v["hip_x"], v["hip_y"], v["leg1_angle"], ankle1[1], v["leg2_angle"],
-            v["leg2_foot_angle"] - v["leg2_angle"]]
-    return np.array(qpos, float), np.array(qvel, float), feet
-
-
-class _LinkFeet:
-    """The MJCF scene's feet on a tree of leg links whose legs end in point or arc feet
-    (no foot bodies): the keyframe of the links' joints, patches centred on the footfalls."""
-
-    notes: tuple = ()
-
-    def notes_for(self, data) -> tuple:
-        """:attr:`notes` of the walker ``data``."""
-        return self.notes
-
-    def check_format(self, fmt: str | None, walker_only: bool) -> None:
-        """Every format carries these feet."""
-
-    def foot_mass(self, settings: ContactSettings):
-        """The contact walker's regularising foot mass and inertia: none."""
-        return None
-
-    def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
-        """``qpos``, ``qvel`` (:func:`joint_state`) and no foot bodies."""
-        z = walker.link_state_from_ideal(x_ideal)
-        qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
-        return qpos, qvel, None
-
-    def footprints(self, lanes: tuple, data) -> tuple:
-        """The checkerboard's patch centres: the footfalls."""
-        return lanes
-
-
-class _FlatFeet(_LinkFeet):
-    """The MJCF scene's flat feet: foot bodies on ankle hinges with the contact model's
-    regularising mass (:func:`flat_foot_bodies`), the rigid heel strike's double support as the
-    keyframe (:func:`_flat_keyframe`), patches centred on the soles."""
-
-    notes = ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
-             "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
-             "the contact model's regularising foot mass and inertia at the ankle "
-             "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
-             "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
-             "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
-             "gait's double support as it begins).",)
-
-    def notes_for(self, data) -> tuple:
-        """:attr:`notes`; feet with mass (``walker.leg.foot.mass_kg``): the walker's own."""
-        if not data.structure.foot_mass:
-            return self.notes
-        return (self.notes[0].replace(
-            "the contact model's regularising foot mass and inertia at the ankle "
-            "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
-            "view's feet are massless)", "the walker's foot mass and inertia at the ankle "
-            "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)"),)
-
-    def check_format(self, fmt: str | None, walker_only: bool) -> None:
-        """Flat feet go to an MJCF or an OpenSim model with its scene only (one line
-        naming the field)."""
-        if fmt not in ("mjcf", "osim") or walker_only:
-            raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF and "
-                             "OpenSim with the scene only (a URDF would hold point feet: "
-                             "no foot link, ankle spring or heel and toe contacts); "
-                             "--walker-only has no foot mass")
-
-    def foot_mass(self, settings: ContactSettings):
-        """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2`` (the
-        contact walker uses them for massless feet only: feet with mass carry their own)."""
-        return settings.flat_foot()
-
-    def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
-        """:func:`_flat_keyframe`."""
-        return _flat_keyframe(scene, mb, data, walker, x_ideal)
-
-    def footprints(self, lanes: tuple, data) -> tuple:
-        """A flat foot's patch centred on its sole, not on its heel's touchdown."""
-        from walkerlab.models.contact.model import footprint_offsets
-
-        return tuple(tuple(s + off for s in lane)
-                     for lane, off in zip(lanes, footprint_offsets(data)))
-
-
-#: feet (:attr:`walkerlab.walker.kinds.Kind.feet`) -> the MJCF scene's feet of that kind (a
-#: spoked wheel's keyframe is :func:`walkerlab.export.wheel_scene.wheel_keyframe`'s; its
-#: entry only passes :func:`check_exportable`)
-SCENE_FEET = {"leg_ends": _LinkFeet(), "flat": _FlatFeet()}

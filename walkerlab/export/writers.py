@@ -45,11 +45,8 @@ from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
     comments_in_scene_units,
-    keyframe_json,
     mjcf_omissions,
     mjcf_text,
-    urdf_omissions,
-    urdf_text,
     wheel_mjcf_text,
     wheel_urdf_text,
 )
@@ -63,6 +60,7 @@ from walkerlab.export.opensim import (
 from walkerlab.export.scene import FORMAT_VIEWS, check_exportable, mjcf_scene
 from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS, wheel_chord_m
 from walkerlab.export.text import comment
+from walkerlab.export.urdf import keyframe_json, urdf_omissions, urdf_text
 from walkerlab.export.wheel_scene import (
     check_wheel_exportable,
     wheel_keyframe,

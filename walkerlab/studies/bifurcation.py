@@ -28,9 +28,7 @@ artifact is :mod:`walkerlab.stages.bifurcation`.
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +36,12 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.execution.executor import run_each
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH, onset_name, parameter_dim
+from walkerlab.studies.bifurcation_point import (
+    BifurcationTask,
+    bifurcation_chunk,
+    min_real_multiplier,
+    scene_at,
+)
 from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.params import ParamAxis
 from walkerlab.studies.runner import plan_chunks, sweep_executor
@@ -46,179 +50,11 @@ __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
            "min_real_multiplier", "parameter_values", "onset_value", "fall_onset", "grid_key",
            "diagram_summary"]
 
-@dataclass(frozen=True)
-class _BifTask:
-    base: dict
-    points: tuple            # ((index, (value,)), ...)
-    n_transient: int
-    n_keep: int
-    steady_state: bool
-    path: str = SLOPE_PATH
-    steps_per_map: int = 0   # the study's one map (0: each walker's own)
-
-
-def _scene_at(base: dict, value: float, path: str = SLOPE_PATH) -> Scene:
-    from walkerlab.studies.params import apply_point
-
-    return apply_point(base, [path], (value,), "<bifurcation>")
-
-
-def min_real_multiplier(mult: np.ndarray, tol: float = 1e-9) -> float:
-    """Most negative real Floquet multiplier (``|imag| <= tol``) of a set [-]."""
-    mult = np.asarray(mult, complex)
-    real = mult[np.abs(mult.imag) <= tol].real
-    return float(real.min()) if real.size else math.nan
-
-
-def _rate_nudge(walker, size: float) -> np.ndarray:
-    """A state offset of ``size`` [rad/s] on the stance rate (by name), to leave the fixed point."""
-    names = walker.state_names()
-    dx = np.zeros(len(names))
-    dx[names.index("stance_rate") if "stance_rate" in names else
-       [k for k, n in enumerate(names) if n.endswith("_rate")][-1]] = size
-    return dx
-
-
-def _stance_angle(walker, x: np.ndarray) -> float:
-    """The ``stance_angle`` state of ``x`` [rad] (NaN for a walker without one)."""
-    names = walker.state_names()
-    return float(x[names.index("stance_angle")]) if "stance_angle" in names else math.nan
-
-
-def _bif_chunk(task: _BifTask) -> list[dict]:
-    """Fixed point + steady state along one run of parameter values (worker side)."""
-    import warnings
-
-    from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point, on_study_map, warm_up
-
-    warm_up()
-    from walkerlab.studies.continuation import scene_family
-
-    out = []
-    guess = prev = fam = None
-    x_att = None
-    for index, (value,) in task.points:
-        t0 = time.perf_counter()
-        n = len(build_walker(_scene_at(task.base, value, task.path)).state_names())
-        row = {"index": index, "value": value, "x": np.full(n, np.nan),
-               "multipliers": np.full(n, np.nan, complex), "period_s": math.nan,
-               "fp_outcome": "ok", "message": "", "hs_interleg": np.full(task.n_keep, np.nan),
-               "hs_stance": np.full(task.n_keep, np.nan), "ss_outcome": "", "steps": 0}
-        with warnings.catch_warnings(), np.errstate(all="ignore"):
-            warnings.simplefilter("ignore")
-            scene = _scene_at(task.base, value, task.path)
-            try:
-                if fam is None:  # the walker over the grid's field, built once a chunk
-                    fam = scene_family(scene, task.path)
-                    if task.steps_per_map:  # the study's one map at every value
-                        fam = dataclasses.replace(fam, steps_per_map=task.steps_per_map,
-                                                  _cache={})
-                q = _arclength_step(fam, prev, value)
-                if q is not None:  # the neighbour's branch followed to this value
-                    walker = build_walker(scene)
-                    row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
-                               period_s=q.period_s / fam.steps(walker))  # per step
-                else:
-                    walker, res, _src = ideal_fixed_point(scene, guess)
-                    on_map, res = on_study_map(scene, walker, res, task.steps_per_map)
-                    row.update(x=res.x, period_s=res.period_s / on_map.steps_per_map,
-                               multipliers=np.asarray(res.multipliers_variational, complex))
-                guess = row["x"]
-                prev = (value, q if q is not None else row["x"])
-            except PointOutcome as exc:
-                row.update(fp_outcome=exc.outcome, message=exc.message)
-                walker = build_walker(scene)
-            except Exception as exc:  # noqa: BLE001
-                row.update(fp_outcome="error", message=f"{type(exc).__name__}: {exc}")
-                walker = build_walker(scene)
-            if task.steady_state:
-                x_att = _steady_state(task, scene, walker, row, x_att)
-        row["wall_time_s"] = time.perf_counter() - t0
-        out.append(row)
-    return out
-
-
-def _steady_state(task: _BifTask, scene, walker, row: dict, x_att):
-    """The steady state at one value (:func:`_bif_chunk`): ``task.n_transient`` steps from
-    the previous value's attractor ``x_att`` (else from the fixed point in ``row``, its
-    rates nudged), the last ``task.n_keep`` heel strikes' inter-leg and stance angles into
-    ``row`` (``hs_interleg``, ``hs_stance``, ``steps``, ``ss_outcome``).
-
-    Returns
-    -------
-    ndarray or None
-        The attractor's last post-impact state (the next value's start), None when the walk
-        did not last (or did not start).
-    """
-    from walkerlab.integrate.rigid import simulate_steps  # light: worker side
-    from walkerlab.integrate.solver import Solver  # light: worker side
-    from walkerlab.studies.points import interleg_angle  # light: worker side
-
-    if x_att is not None:
-        x0 = walker.from_section(walker.section(x_att))
-    elif row["fp_outcome"] == "ok":
-        x0 = row["x"] + _rate_nudge(walker, 1e-6)
-        x0 = walker.from_section(walker.section(x0))
-    else:
-        x0 = None
-    if x0 is not None:
-        try:
-            traj = simulate_steps(walker, x0, task.n_transient,
-                                  Solver.from_settings(scene.solver),
-                                  max_step_time=5.0)
-            segs = [s for s in traj.segments if s.termination == "heel_strike"]
-            row["steps"] = len(segs)
-            row["ss_outcome"] = traj.termination
-            if len(segs) == task.n_transient:
-                keep = segs[-task.n_keep:]
-                row["hs_interleg"] = np.array([interleg_angle(walker, s.x_end)
-                                               for s in keep])
-                row["hs_stance"] = np.array([_stance_angle(walker, s.x_next)
-                                             for s in keep])
-                x_att = segs[-1].x_next
-                row["ss_outcome"] = "walks"
-            else:
-                x_att = None
-        except Exception as exc:  # noqa: BLE001
-            row["ss_outcome"] = f"error: {type(exc).__name__}"
-            x_att = None
-    return x_att
-
-
-def _arclength_step(fam, prev, value: float):
-    """The fixed point at ``value`` on the branch of the previous grid value's
-    (``prev = (value, BranchPoint or state)``), by pseudo-arclength continuation
-    (:func:`walkerlab.analysis.continuation.branch.continue_branch`), which does not jump to the
-    other gait of a long/short-period pair as a large natural-parameter step can (paper_rods
-    at 3 kg).  None when there is no previous point or the branch does not reach
-    ``value`` (a fold in between): the caller falls back to the root finder.
-    """
-    from walkerlab.analysis.continuation.branch import continue_branch, first_point
-    from walkerlab.analysis.continuation.gait_map import MapFailed
-
-    if prev is None:
-        return None
-    v0, q0 = prev
-    span = abs(value - v0)
-    if span == 0:
-        return None
-    try:
-        if isinstance(q0, np.ndarray):
-            q0 = first_point(fam, v0, q0, 1, span)
-        br = continue_branch(fam, q0, 1, (min(v0, value), max(v0, value)), span,
-                             1 if value > v0 else -1, ds=1.0, ds_max=1.0)
-    except MapFailed:
-        return None
-    last = br.points[-1]
-    return last if abs(last.p - value) <= 1e-12 * max(1.0, abs(value)) else None
-
-
 def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH,
        steps_per_map: int = 0) -> tuple[float, np.ndarray]:
     from walkerlab.studies.points import ideal_fixed_point, on_study_map
 
-    scene = _scene_at(scene_base, value, path)
+    scene = scene_at(scene_base, value, path)
     w, res, _s = ideal_fixed_point(scene, guess)
     _w, res = on_study_map(scene, w, res, steps_per_map)  # the study's one map
     return 1.0 + min_real_multiplier(res.multipliers_variational), res.x
@@ -432,19 +268,19 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
 def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, steady_state: bool,
                workers: int, scheduler, steps_per_map: int = 0) -> list[dict]:
     """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
-    state; :func:`_bif_chunk`), in grid order: the grid of ``axis`` is cut into runs
+    state; :func:`bifurcation_chunk`), in grid order: the grid of ``axis`` is cut into runs
     (:func:`walkerlab.studies.runner.plan_chunks`) evaluated on
     :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
     from walkerlab import progress
 
     param, n = axis.path, len(axis.values)
     chunks = plan_chunks([axis], base, workers=max(1, workers))
-    tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state, param, steps_per_map)
-             for c in chunks]
+    tasks = [BifurcationTask(base, tuple(c), n_transient, n_keep, steady_state, param,
+                             steps_per_map) for c in chunks]
     rows = []
     with progress.task(f"bifurcation: {n} values of {param}", n) as bar:
         with sweep_executor(workers, scheduler) as ex:
-            for _, rs in run_each(ex, _bif_chunk, [(t,) for t in tasks]):
+            for _, rs in run_each(ex, bifurcation_chunk, [(t,) for t in tasks]):
                 rows += rs
                 bar.update(len(rows))
     rows.sort(key=lambda r: r["index"])

@@ -7,7 +7,9 @@ typed outcome.  :func:`simulate_from` runs the contact walker of a scene (its
 path of the ``contact-sim`` stage, the adjustment
 (:mod:`walkerlab.analysis.contact.adjust`), the sweeps and the work-precision study, so a
 scene means the same contact run everywhere.  States are read by name
-(``walker.state_names()``), never by row.
+(``walker.state_names()``), never by row.  Where a run starts from the rigid gait is
+:mod:`walkerlab.analysis.contact.start`, its samples in the shared named layout
+:mod:`walkerlab.analysis.contact.named` (their names re-exported here).
 """
 
 from __future__ import annotations
@@ -24,13 +26,13 @@ from walkerlab.analysis.contact.gait import (
     patch_fit,
     scuff_cause,
 )
+from walkerlab.analysis.contact.named import named_trajectory, trajectory_names
+from walkerlab.analysis.contact.start import initial_state_from_ideal, rigid_mid_stance
 from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.contact.model import state_name
-from walkerlab.models.contact.scene import ContactSceneError, ContactSetup
-from walkerlab.walker.layout import StateIndex
+from walkerlab.models.contact.scene import ContactSetup
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
            "rigid_mid_stance", "scene_start", "simulate_contact", "simulate_from",
@@ -39,33 +41,6 @@ __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajecto
 #: A walker whose hip rises above this many leg lengths has left the ground for good
 #: (a foot can touch the ground only while the hip is within one leg length of it).
 AIRBORNE_HEIGHT_FACTOR = 1.5
-
-
-def initial_state_from_ideal(walker, *x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
-    """Floating-walker state from an ideal-model state (leg1 = swing, leg2 = stance).
-
-    The stance foot (leg2) is placed at s = 0 at its static penetration
-    ``(M g cos phi / k)^(1/e)`` [m] (along -n) and held at rest there: the hip follows from
-    the stance leg's links (``walker.pinned_to_full``).  ``rate_scale`` multiplies leg1's
-    and leg2's rates first.
-
-    Parameters
-    ----------
-    *x_ideal : float
-        The rigid model's state in the order of its ``state_names()``, e.g. ``theta1,
-        theta2, dtheta1, dtheta2`` (swing / stance leg angles [rad] and rates [rad/s]) for
-        the compass gait (``walker.link_state_from_ideal``).
-    rate_scale : (float, float)
-        Multipliers [-] on leg1's (swing) and leg2's (stance) rates.
-
-    Returns
-    -------
-    ndarray (N,)
-        Named by ``walker.state_names()``.
-    """
-    foot2 = -walker.static_penetration() * walker.normal
-    z = walker.link_state_from_ideal(np.asarray(x_ideal, float).ravel(), rate_scale)
-    return walker.pinned_to_full(z, foot2)
 
 
 def simulate_contact(walker, x0: np.ndarray, t_final: float,
@@ -280,76 +255,6 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     return replace(limits, **upd)
 
 
-def rigid_mid_stance(scene, x_ideal: np.ndarray, plant=None) -> np.ndarray:
-    """The rigid gait's state at its mid-stance, where a flat-footed contact run starts
-    (``contact_sim.start: mid_stance``).
-
-    One step of the rigid walker (:func:`walkerlab.models.registry.build_walker`) from
-    ``x_ideal``, and the instant within it where the legs are parallel (``theta_swing =
-    theta_stance``, the section of the contact step map,
-    :mod:`walkerlab.analysis.contact.step_map`), found by ``scipy.optimize.brentq`` on the
-    step's dense output.  There the
-    stance foot is flat (foot flat: the sole on the ground, no impact under way): placed by
-    :func:`initial_state_from_ideal` the contact walker starts as the rigid one is, heel
-    and toe at the static penetration, the swing foot at its spring's rest angle.  From the
-    post-impact state instead, the contact model starts its stance heel at rest in the
-    middle of a heel strike (and its trailing foot off the ground) that the rigid view has
-    already resolved by an impulse: on configs/flat_feet.yaml the next step is 8-9 % short
-    (the rigid gait's period-2 mode excited), from mid-stance within 1.5 %.
-
-    Parameters
-    ----------
-    scene : Scene
-        A scene of a flat-footed walker (its ``solver`` integrates the step).
-    x_ideal : ndarray, shape (2n,)
-        The rigid walker's post-impact state (its ``state_names()`` order: swing, stance,
-        stance ankle, their rates) [rad, rad/s].
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described once (the contact set-up's); default: described here.
-
-    Returns
-    -------
-    ndarray, shape (2n,)
-        The state at mid-stance, in the same order [rad, rad/s].
-
-    Raises
-    ------
-    walkerlab.models.contact.scene.ContactSceneError
-        The step does not reach mid-stance (it falls first), or reaches it with the stance
-        foot not flat (one line naming ``contact_sim.start``).
-    """
-    from walkerlab.integrate.brentq import brentq
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.models.registry import build_walker
-
-    walker = build_walker(scene, plant)
-    seg = simulate_steps(walker, np.asarray(x_ideal, float), 1,
-                         Solver.from_settings(scene.solver)).segments[0]
-    if seg.termination != RunEnd.HEEL_STRIKE.value:
-        raise ContactSceneError("contact_sim.start: mid_stance: the rigid step from the "
-                                f"fixed point ends in {seg.termination} before its heel "
-                                "strike")
-
-    lay = walker.layout()
-    i_swing, i_stance = lay.index("swing_angle"), lay.index("stance_angle")
-
-    def apart(t):  # theta_swing - theta_stance [rad]
-        state = seg.sample(np.array([t]))[:, 0]
-        return float(state[i_swing] - state[i_stance])
-
-    t0, t1 = seg.t_start, seg.t_end
-    if not apart(t0) < 0.0 < apart(t1):
-        raise ContactSceneError("contact_sim.start: mid_stance: the rigid step has no "
-                                "mid-stance (its legs are never parallel)")
-    tm = brentq(apart, t0, t1, xtol=1e-13, rtol=1e-13)
-    mode = next((name for name, ta, tb, _g in seg.phase_log if ta <= tm <= tb), "")
-    if not mode.startswith("foot_flat"):
-        raise ContactSceneError(f"contact_sim.start: mid_stance: the rigid gait is in "
-                                f"{mode or '?'} at its mid-stance, not foot flat: start "
-                                "from its fixed point (start: ideal)")
-    return seg.sample(np.array([tm]))[:, 0]
-
-
 def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_scale=None,
                 step_length_m: float | None = None):
     """The contact walker of a scene, its initial state and run limits (the start of
@@ -467,124 +372,3 @@ def _at_own_footfalls(setup: ContactSetup, walker, res, run):
             break
         walker, res = moved, again
     return walker, res
-
-
-def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
-    """State name -> name in the shared trajectory layout for every leg coordinate of the
-    walker (the hip position and velocity are points): the floating coordinate's name
-    (``<leg>_angle``, kneed ``<leg>_thigh_angle``, ``<leg>_shank_angle``; the same names as
-    the rigid walker's ``leg_coordinates``) and ``..._rate`` for its rate (angles [rad],
-    rates [rad/s]).
-    """
-    idx = StateIndex(walker)
-    n = idx.coordinates.stop
-    out = {}
-    for i, coord in enumerate(walker.coordinate_names()):
-        if coord in ("hip_x", "hip_y"):
-            continue
-        leg = coord.split("_", 1)[0]
-        new = coord if leg not in ("leg1", "leg2") else legs[int(leg[-1]) - 1] + coord[4:]
-        out[idx.names[i]] = new
-        out[idx.names[n + i]] = new.removesuffix("_angle") + "_rate"
-    return out
-
-
-def _stance_points(walker, res: ContactResult, t) -> tuple[list, list]:
-    """The contact points of a walker whose feet are not its legs (a spoked wheel's spoke
-    tips) that stand for the legs, per sample: the stance point (the last heel strike's, at
-    first the run's initial stance point) and the point that strikes next (the next heel
-    strike's; after the last one the contact point listed after the stance point,
-    ``walker.contact_names()`` being in the order the points touch down)."""
-    names = list(walker.contact_names())
-    order = [res.steps[0].stance_leg if res.steps else names[0], *res.heel_strike_legs]
-    nxt = order[1:] + [names[(names.index(order[-1]) + 1) % len(names)]]
-    k = np.searchsorted(np.asarray(res.heel_strike_times, float), t, side="right")
-    return ([names.index(order[j]) for j in k], [names.index(nxt[j]) for j in k])
-
-
-def _legs_from_points(walker, res: ContactResult, stance, legs) -> tuple[dict, dict]:
-    """Leg coordinates and feet of a walker whose feet are not its legs (a spoked wheel,
-    whose legs are the spokes of a step): per sample, the stance leg's foot is the stance
-    contact point, the other leg's the point that strikes next (:func:`_stance_points`),
-    each leg's angle that of the line from the hip to its foot from the downward vertical
-    (positive: the foot ahead), ``psi = atan2(dx, -dy)``, and its rate
-    ``(dx dvy - dy dvx) / (dx^2 + dy^2)`` from the points' velocities (the rigid view's leg
-    angles: :meth:`HybridWalker.leg_coordinates`).
-
-    Returns
-    -------
-    coordinates : dict[str, ndarray (n,)]
-        ``<leg>_angle`` [rad], ``<leg>_rate`` [rad/s].
-    feet : dict[str, ndarray (2, n)]
-        ``<leg>_foot`` [m].
-    """
-    t, X = res.t, np.ascontiguousarray(np.atleast_2d(res.x), dtype=float)
-    st_pt, sw_pt = _stance_points(walker, res, t)
-    nf, n = len(walker.contact_names()), walker.nq
-    P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
-    pos, vel = np.empty((t.size, nf, 2)), np.empty((t.size, nf, 2))
-    for r in range(t.size):
-        walker.kernels.feet(X[r], walker.walker_params, P, V, J)
-        pos[r], vel[r] = P, V
-    col = dict(zip(walker.state_names(), X.T))
-    hip = np.vstack([col[state_name(c)] for c in ("hip_x", "hip_y")])
-    hip_v = np.vstack([col[state_name(c, rate=True)] for c in ("hip_x", "hip_y")])
-    rows = np.arange(t.size)
-    coords, feet = {}, {}
-    for i, leg in enumerate(legs):
-        pt = np.where(stance == i, st_pt, sw_pt)
-        foot, foot_v = pos[rows, pt].T, vel[rows, pt].T
-        (dx, dy), (dvx, dvy) = foot - hip, foot_v - hip_v
-        coords[f"{leg}_angle"] = np.arctan2(dx, -dy)
-        coords[f"{leg}_rate"] = (dx * dvy - dy * dvx) / (dx ** 2 + dy ** 2)
-        feet[f"{leg}_foot"] = foot
-    return coords, feet
-
-
-def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
-    """A :class:`ContactResult` in the shared named layout of
-    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes;
-    coordinates by :func:`trajectory_names`, points from the generated floating view: hip,
-    each body ``<leg>_<body>``, feet, knees; points in [m], angles [rad], rates [rad/s],
-    times [s]).
-
-    A walker whose feet are not its legs (a spoked wheel: its heel strikes are contact points
-    ``spoke<k>``, the legs of the vocabulary are the spokes of a step) alternates its stance
-    leg at each heel strike as the rigid view does, and gets the rigid view's leg coordinates
-    and feet from its stance and next contact points (:func:`_legs_from_points`): ``<leg>_angle``,
-    ``<leg>_rate`` and the points ``<leg>_foot``.
-    """
-    from walkerlab.io.trajectory import NamedTrajectory  # light
-
-    legs = list(legs)
-    t = res.t
-    stance = np.full(t.size, legs.index("leg2"))
-    step = np.zeros(t.size, dtype=int)
-    by_points = False
-    for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
-        m = t >= ths
-        if leg not in legs:  # a contact point, not a leg (a wheel's spoke): the other leg
-            by_points = True
-            leg = legs[1 - int(stance[m][0])] if m.any() else leg
-        if leg in legs:
-            stance[m] = legs.index(leg)
-        step[m] = k + 1
-    by_points = by_points or bool(res.steps) and res.steps[0].stance_leg not in legs
-    X = res.x
-    en = walker.energies(X)
-    pts = {k: np.asarray(v, float).reshape(2, -1) for k, v in walker.points(X).items()}
-    names = trajectory_names(walker, legs)
-    units = dict(zip(walker.state_names(), walker.state_units()))
-    coords = {new: res.column(old) for old, new in names.items()}
-    units = {names[o]: units[o] for o in names}
-    if by_points:
-        leg_coords, feet = _legs_from_points(walker, res, stance, legs)
-        for name, v in leg_coords.items():
-            coords.setdefault(name, v)
-            units.setdefault(name, "rad" if name.endswith("_angle") else "rad/s")
-        for name, v in feet.items():
-            pts.setdefault(name, v)
-    return NamedTrajectory(
-        time=t, legs=legs, coordinates=coords, units=units,
-        stance_leg=stance, step_index=step, kinetic=en["kinetic"], potential=en["potential"],
-        points=pts)

@@ -1,5 +1,5 @@
 """The per-walk slope streams of the Monte Carlo walks for many walks at once: the numbers of
-:func:`walkerlab.analysis.robustness.mfpt.draw_slopes` bit for bit, drawn into one array.
+:func:`walkerlab.analysis.robustness.montecarlo.draw_slopes` bit for bit, drawn into one array.
 
 Walk ``w`` of seed ``s`` draws from ``Generator(PCG64(SeedSequence(s, spawn_key=(w,))))``,
 NumPy's public seeding (``numpy.random.SeedSequence``, whose streams NumPy keeps stable), so
@@ -23,7 +23,7 @@ def slope_rows(seed: int, walks, start: int, n: int, mean: float, sd: float,
                distribution: str = "normal") -> np.ndarray:
     """Slopes [rad] of steps ``start`` to ``start + n - 1`` of each walk in ``walks``: row ``i``
     is ``draw_slopes(seed, walks[i], start + n, mean, sd, distribution)[start:]`` bit for bit
-    (:func:`walkerlab.analysis.robustness.mfpt.draw_slopes`).
+    (:func:`walkerlab.analysis.robustness.montecarlo.draw_slopes`).
 
     Parameters
     ----------

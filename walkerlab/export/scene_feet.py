@@ -1,0 +1,179 @@
+"""The exported MuJoCo scene's feet, per kind of feet (:data:`SCENE_FEET`): the ``gait``
+keyframe in the export's joint coordinates (:func:`joint_state`) and, for flat feet, the foot
+bodies on their ankle hinges (:func:`flat_foot_bodies`) with the rigid heel strike's double
+support as the keyframe, and the checkerboard's patches centred on the soles.
+
+:mod:`walkerlab.export.scene` builds the whole scene from them (and re-exports these names).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.config.contact import ContactSettings
+
+
+def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
+    """The export's joint coordinates and rates from a floating state ``x`` (2 nq,) of the
+    contact walker (state names of :meth:`ContactWalker.state_names`).
+
+    Returns
+    -------
+    qpos, qvel : ndarray (2 + len(mb.links),)
+        ``hip_x``, ``hip_z`` [m, m/s], then each link's joint [rad, rad/s]; a coupled joint
+        (the torso's) from its coupling.
+    """
+    q, v = walker.layout().coordinate_values(x)
+
+    coupled = {cp.joint: cp.terms for cp in mb.couplings}  # e.g. the torso's bisecting hip
+    link_of = {ln.joint: ln.name for ln in mb.links}
+
+    def joint(vals, ln):
+        if ln.joint in coupled:  # of hip joints: absolute link (leg or thigh) angles
+            return sum(c * vals[f"{link_of[j]}_angle"] for j, c in coupled[ln.joint])
+        own = vals[f"{ln.name}_angle"]
+        return own - vals[f"{ln.parent}_angle"] if ln.joint.endswith("_knee") else own
+
+    return (np.array([q["hip_x"], q["hip_y"], *(joint(q, ln) for ln in mb.links)]),
+            np.array([v["hip_x"], v["hip_y"], *(joint(v, ln) for ln in mb.links)]))
+
+def flat_foot_bodies(scene: Scene, data) -> tuple:
+    """Per leg (leg1, leg2: leg1 the swing role's numbers when the legs differ) ``(heel,
+    toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot mass
+    [kg], inertia about the ankle [kg m^2])`` of a flat-footed walker; mass and inertia the
+    walker's (``walker.leg.foot.mass_kg``, ``inertia_about_ankle_kg_m2``) or, for massless
+    feet, the contact model's (``contact.flat_foot_mass_kg``,
+    ``contact.flat_foot_inertia_kg_m2``).
+
+    Raises
+    ------
+    ValueError
+        The scene has no foot mass or inertia (one line naming the fields).
+    """
+    settings = scene.contact or ContactSettings()
+    st = data.structure
+    P = dict(zip(st.param_names, data.params))
+    # the walker's own feet (walker.leg.foot.mass_kg) or the contact model's regularising ones
+    mi = (P["m_foot"], P["I_foot"]) if st.foot_mass else settings.flat_foot()
+    if mi is None:
+        raise ValueError("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: an "
+                         "MJCF's flat feet need their mass and inertia (the rigid view's "
+                         "feet are massless)")
+    tags = ("sw_", "st_") if st.asymmetric else ("", "")
+    return tuple((P[f"heel_{t}m"], P[f"toe_{t}m"], P[f"k_{t}ankle"], P[f"c_{t}ankle"],
+                  P[f"r_{t}ankle"], *mi) for t in tags)
+
+
+def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
+    """The ``gait`` keyframe of flat feet (MuJoCo's tree order, :attr:`MjcfScene.flat_feet`)
+    from the rigid fixed point ``x_ideal`` with the rest of its heel strike applied (the
+    walker's :attr:`~walkerlab.models.hybrid.base.HybridWalker.step_entry`: the trailing
+    toe kept on the ground in double support, its foot at the angle that puts the toe on
+    the slope, or on stairs and footholds on the tread it stood on: the landing of the step
+    before the keyframe, the last of the ground's period, above the new stance heel's line)
+    or, where the gait has none, the trailing foot at its rest angle."""
+    from walkerlab.codegen.cache import functions
+    from walkerlab.models.ground import landing_drops
+    from walkerlab.models.hybrid.ground import on_landing
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+
+    feet = flat_foot_bodies(scene, data)
+    drop = landing_drops(scene.terrain)[-1]  # the step that ended at the keyframe [m]
+    rigid = on_landing(make_rigid_walker(data), data, drop)
+    x, phase = rigid.step_entry(np.asarray(x_ideal, float))
+    X = walker.pinned_to_full(walker.link_state_from_ideal(x), np.zeros(2))
+    q, v = walker.layout().coordinate_values(X)
+    ankle1 = (feet[0][4], 0.0)
+    if phase is not None:  # double support: the trailing (leg1) foot on its toe
+        level = drop * float(np.cos(data.slope_rad))  # the trailing toe's tread
+        b, db, _e, _phi = functions(data)["double_support_trailing"](x, level)
+        ankle1 = (b, db)
+    qpos = [q["hip_x"], q["hip_y"], q["leg1_angle"], ankle1[0], q["leg2_angle"],
+            q["leg2_foot_angle"] - q["leg2_angle"]]
+    qvel = [v["hip_x"], v["hip_y"], v["leg1_angle"], ankle1[1], v["leg2_angle"],
+            v["leg2_foot_angle"] - v["leg2_angle"]]
+    return np.array(qpos, float), np.array(qvel, float), feet
+
+
+class _LinkFeet:
+    """The MJCF scene's feet on a tree of leg links whose legs end in point or arc feet
+    (no foot bodies): the keyframe of the links' joints, patches centred on the footfalls."""
+
+    notes: tuple = ()
+
+    def notes_for(self, data) -> tuple:
+        """:attr:`notes` of the walker ``data``."""
+        return self.notes
+
+    def check_format(self, fmt: str | None, walker_only: bool) -> None:
+        """Every format carries these feet."""
+
+    def foot_mass(self, settings: ContactSettings):
+        """The contact walker's regularising foot mass and inertia: none."""
+        return None
+
+    def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
+        """``qpos``, ``qvel`` (:func:`joint_state`) and no foot bodies."""
+        z = walker.link_state_from_ideal(x_ideal)
+        qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
+        return qpos, qvel, None
+
+    def footprints(self, lanes: tuple, data) -> tuple:
+        """The checkerboard's patch centres: the footfalls."""
+        return lanes
+
+
+class _FlatFeet(_LinkFeet):
+    """The MJCF scene's flat feet: foot bodies on ankle hinges with the contact model's
+    regularising mass (:func:`flat_foot_bodies`), the rigid heel strike's double support as the
+    keyframe (:func:`_flat_keyframe`), patches centred on the soles."""
+
+    notes = ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
+             "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
+             "the contact model's regularising foot mass and inertia at the ankle "
+             "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+             "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
+             "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
+             "gait's double support as it begins).",)
+
+    def notes_for(self, data) -> tuple:
+        """:attr:`notes`; feet with mass (``walker.leg.foot.mass_kg``): the walker's own."""
+        if not data.structure.foot_mass:
+            return self.notes
+        return (self.notes[0].replace(
+            "the contact model's regularising foot mass and inertia at the ankle "
+            "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+            "view's feet are massless)", "the walker's foot mass and inertia at the ankle "
+            "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)"),)
+
+    def check_format(self, fmt: str | None, walker_only: bool) -> None:
+        """Flat feet go to an MJCF or an OpenSim model with its scene only (one line
+        naming the field)."""
+        if fmt not in ("mjcf", "osim") or walker_only:
+            raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF and "
+                             "OpenSim with the scene only (a URDF would hold point feet: "
+                             "no foot link, ankle spring or heel and toe contacts); "
+                             "--walker-only has no foot mass")
+
+    def foot_mass(self, settings: ContactSettings):
+        """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2`` (the
+        contact walker uses them for massless feet only: feet with mass carry their own)."""
+        return settings.flat_foot()
+
+    def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
+        """:func:`_flat_keyframe`."""
+        return _flat_keyframe(scene, mb, data, walker, x_ideal)
+
+    def footprints(self, lanes: tuple, data) -> tuple:
+        """A flat foot's patch centred on its sole, not on its heel's touchdown."""
+        from walkerlab.models.contact.model import footprint_offsets
+
+        return tuple(tuple(s + off for s in lane)
+                     for lane, off in zip(lanes, footprint_offsets(data)))
+
+
+#: feet (:attr:`walkerlab.walker.kinds.Kind.feet`) -> the MJCF scene's feet of that kind (a
+#: spoked wheel's keyframe is :func:`walkerlab.export.wheel_scene.wheel_keyframe`'s; its
+#: entry only passes :func:`check_exportable`)
+SCENE_FEET = {"leg_ends": _LinkFeet(), "flat": _FlatFeet()}
