@@ -588,29 +588,29 @@ def test_every_package_stands_on_a_floor_and_no_import_climbs():
 #: hip-roll joints: read in the kinds' home (``walker/``) and ``config/``; the readers
 #: outside, each with its reason (a new one fails: ask the kind, its parts or the capability
 #: table instead)
-SPATIAL_SWITCH_READERS = {
-    "codegen/spatial.py": "derives the 3D walker's equations: hip roll adds coordinates",
-    "export/spatial_legs_mjcf.py": "writes one MJCF joint per hip roll",
+SWITCH_3D_READERS = {
+    "codegen/derive_3d.py": "derives the 3D walker's equations: hip roll adds coordinates",
+    "export/legs_3d_mjcf.py": "writes one MJCF joint per hip roll",
     "models/registry.py": "builds a 3D compass gait from its 2D scene's kind",
     "export/writers.py": "refuses a hip-roll walker per format (the capability table's cell)",
 }
 
 
-def _spatial_switch_reads(tree: ast.Module) -> list[int]:
+def _switch_3d_reads(tree: ast.Module) -> list[int]:
     """Lines reading ``.space``, ``.hip_width`` or ``.hip_roll``."""
     return [n.lineno for n in ast.walk(tree) if isinstance(n, ast.Attribute)
             and n.attr in ("space", "hip_width", "hip_roll") and isinstance(n.ctx, ast.Load)]
 
 
-def test_the_spatial_switches_are_read_only_at_home_and_by_the_listed_readers():
-    assert _spatial_switch_reads(ast.parse("a = s.hip_roll or w.space == '3d'\n")) == [1, 1]
+def test_the_3d_switches_are_read_only_at_home_and_by_the_listed_readers():
+    assert _switch_3d_reads(ast.parse("a = s.hip_roll or w.space == '3d'\n")) == [1, 1]
     found = {}
     for p in _modules():
         if _top(_rel(p)) in ("walker", "config"):
             continue
-        if lines := _spatial_switch_reads(_tree(p)):
+        if lines := _switch_3d_reads(_tree(p)):
             found[_rel(p)] = lines
-    assert set(found) <= set(SPATIAL_SWITCH_READERS), found
+    assert set(found) <= set(SWITCH_3D_READERS), found
 
 
 def _kind_names() -> set[str]:
@@ -645,8 +645,7 @@ def test_no_walker_kind_name_is_compared_outside_the_kinds_home():
 
 
 #: modules over 600 lines today, each with its size as a ceiling (split by role to go below)
-BIG_MODULES = {"api/walker.py": 619, "io/artifacts.py": 634,
-               "models/contact/generated.py": 626, "optimal/driver.py": 700}
+BIG_MODULES = {"models/contact/generated.py": 626, "optimal/driver.py": 700}
 
 
 def test_modules_stay_within_600_lines_or_their_ceiling():

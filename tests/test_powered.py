@@ -21,7 +21,7 @@ from walkerlab.models.registry import build_walker
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 #: scenes without actuators or a control law of any kind (a 3D walker's hip-roll law acts
-#: inside its flow: tests/test_spatial_hip_roll.py closes that walker's ledger)
+#: inside its flow: tests/test_hip_roll_3d.py closes that walker's ledger)
 PASSIVE = sorted(p.stem for p in CONFIGS.glob("*.yaml")
                  if load_scene(p).walker.actuation is None
                  and getattr(load_scene(p).walker, "hip_roll", None) is None)

@@ -144,7 +144,7 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     working = act is not None and (any(t.scaled_by == "none" for t in act.torques)
                                    or act.ankle_push_off is not None
                                    or act.virtual_constraints is not None)
-    # a 3D walker's hip-roll law works too (its ledger: tests/test_spatial_hip_roll.py)
+    # a 3D walker's hip-roll law works too (its ledger: tests/test_hip_roll_3d.py)
     working = working or getattr(scene.walker, "hip_roll", None) is not None
     for k in np.unique(step) if not working else ():
         for ph in np.unique(phase[step == k]):

@@ -1,6 +1,6 @@
 """The symmetric period-2 gait of an independent 3D walker reference, found and linearised
-by scipy alone: shared by the references of tests/test_spatial_walker.py,
-tests/test_spatial_hip_roll.py and tests/test_spatial_round_feet.py (each model its own;
+by scipy alone: shared by the references of tests/test_walker_3d.py,
+tests/test_hip_roll_3d.py and tests/test_round_feet_3d.py (each model its own;
 this is only the step's two event searches, the root finding and the central differences
 on its stride)."""
 

@@ -47,7 +47,7 @@ from walkerlab.api.checks import (
     simulate_options,
 )
 from walkerlab.api.scenes import as_scene, with_changes
-from walkerlab.api.walks import STEP_FIELDS, ContactWalk, Gait, Step, Walk, sampled_walk
+from walkerlab.api.walks import ContactWalk, Gait, Step, Walk, recorded_contact_walk, sampled_walk
 from walkerlab.rigid_walker import SceneWalker
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -525,39 +525,15 @@ class ContactWalker:
         walkerlab.analysis.gait.search.GaitNotFound
             No rigid gait to start from (``x0`` left out).
         """
-        import numpy as np
-
-        from walkerlab.analysis.contact.ledger import contact_step_ledger  # light
         from walkerlab.analysis.contact.record import contact_walk  # light
 
         setup = self._with_strides(strides)
         x_ideal, period = self._start(x0, period_s)
         walker, res, x_start, step_length, scale, gait, _ = contact_walk(
             setup, x_ideal, period, solver=self.solver)
-        steps = {k: np.array([getattr(s, k) for s in res.steps], dtype=float)
-                 for k in STEP_FIELDS}
-        steps["stance_leg"] = np.array([s.stance_leg for s in res.steps], dtype=str)
-        points = res.points or res.feet
-        work, ledger = {}, {}
-        if res.work is not None:
-            names = tuple(walker.actuators.work_names)
-            work = {n: res.work[:, k] for k, n in enumerate(names)}
-            ledger = contact_step_ledger(walker, res.t, res.x, res.work,
-                                         res.heel_strike_times)
-        return ContactWalk(
-            t=res.t, x=res.x, state_names=tuple(res.state_names),
-            heel_strikes=np.asarray(res.heel_strike_times, float),
-            heel_strike_legs=tuple(res.heel_strike_legs), steps=steps,
-            normal_force={n: p.normal_force for n, p in points.items()},
-            friction_force={n: p.friction_force for n, p in points.items()},
-            penetration={n: p.penetration for n, p in points.items()},
-            termination=res.termination, outcome=res.outcome.kind,
-            message=res.outcome.message, walks=bool(res.verdict[0]),
-            x0=np.asarray(x_start, float), x_ideal=np.asarray(x_ideal, float),
-            initial_rate_scale=np.asarray(scale if scale is not None
-                                          else setup.sim.initial_rate_scale, float),
-            step_length_m=float(step_length), gait=gait, work=work, step_ledger=ledger,
-            result=res)
+        return recorded_contact_walk(walker, res, x_start, x_ideal, step_length,
+                                     scale if scale is not None
+                                     else setup.sim.initial_rate_scale, gait)
 
     def periodic_gait(self, x0=None):
         """The contact model's own periodic gait (fixed point of its mid-stance step map)

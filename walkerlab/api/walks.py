@@ -14,7 +14,8 @@ from walkerlab.rigid_walker import Gait
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
-__all__ = ["STEP_FIELDS", "ContactWalk", "Gait", "Step", "Walk", "sampled_walk"]
+__all__ = ["STEP_FIELDS", "ContactWalk", "Gait", "Step", "Walk", "recorded_contact_walk",
+           "sampled_walk"]
 
 
 @dataclass(frozen=True)
@@ -230,3 +231,42 @@ STEP_FIELDS = ("t_start", "t_end", "period", "stance_slip_mm", "double_support_c
                 "bounce_count", "scuff_count", "peak_penetration_m", "liftoff_time",
                 "stance_slip_path_mm", "friction_work_j")
 
+
+def recorded_contact_walk(walker, res, x_start, x_ideal, step_length: float, scale,
+                          gait) -> ContactWalk:
+    """The :class:`ContactWalk` of a contact run
+    (:meth:`walkerlab.api.walker.ContactWalker.simulate`; the outputs of
+    :func:`walkerlab.analysis.contact.record.contact_walk`): ``walker`` the run's contact
+    model, ``res`` its :class:`~walkerlab.analysis.contact.gait.ContactResult`, ``x_start``
+    (N,) its initial state, ``x_ideal`` (2n,) the rigid state it started from,
+    ``step_length`` [m] the patches' spacing, ``scale`` (2,) the rates' multipliers and
+    ``gait`` the periodic gait it started from (or None); the step table by
+    :data:`STEP_FIELDS`, the contact forces by point and, powered, the work integrals and
+    the energy ledger per step."""
+    import numpy as np
+
+    from walkerlab.analysis.contact.ledger import contact_step_ledger  # light
+
+    steps = {k: np.array([getattr(s, k) for s in res.steps], dtype=float)
+             for k in STEP_FIELDS}
+    steps["stance_leg"] = np.array([s.stance_leg for s in res.steps], dtype=str)
+    points = res.points or res.feet
+    work, ledger = {}, {}
+    if res.work is not None:
+        names = tuple(walker.actuators.work_names)
+        work = {n: res.work[:, k] for k, n in enumerate(names)}
+        ledger = contact_step_ledger(walker, res.t, res.x, res.work,
+                                     res.heel_strike_times)
+    return ContactWalk(
+        t=res.t, x=res.x, state_names=tuple(res.state_names),
+        heel_strikes=np.asarray(res.heel_strike_times, float),
+        heel_strike_legs=tuple(res.heel_strike_legs), steps=steps,
+        normal_force={n: p.normal_force for n, p in points.items()},
+        friction_force={n: p.friction_force for n, p in points.items()},
+        penetration={n: p.penetration for n, p in points.items()},
+        termination=res.termination, outcome=res.outcome.kind,
+        message=res.outcome.message, walks=bool(res.verdict[0]),
+        x0=np.asarray(x_start, float), x_ideal=np.asarray(x_ideal, float),
+        initial_rate_scale=np.asarray(scale, float),
+        step_length_m=float(step_length), gait=gait, work=work, step_ledger=ledger,
+        result=res)

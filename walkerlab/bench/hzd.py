@@ -134,10 +134,7 @@ def bench_design_process(pairs: int = 3) -> dict:
         t, x, u, alpha, _zd = controller_step(build_walker(scene), Solver.from_settings(
             scene.solver), 2 * DESIGN["intervals"] + 1)
         npz = Path(d) / "start.npz"
-        np.savez(npz, t=t, x=x, u=u, alpha=alpha, N=DESIGN["intervals"],
-                 speed=DESIGN["target_speed_m_per_s"], max_multiplier=DESIGN["max_multiplier"],
-                 kp=vc.feedback.kp_per_s2, kd=vc.feedback.kd_per_s,
-                 u_max=spec.max_torque_n_m, mu=spec.friction_coefficient)
+        _write_start(npz, (t, x, u, alpha), vc, spec.max_torque_n_m, spec.friction_coefficient)
         script.append(str(npz))
         env = installed_env(PYTHONPATH=os.pathsep.join([str(root),
                                                         os.environ.get("PYTHONPATH", "")]))
@@ -176,22 +173,12 @@ def bench_design(repeats: int = 3) -> dict:
         ``stage_s`` [s], the two optima (``objective`` [N^2 m s], ``delta2``, ``period_s``),
         IPOPT's status and iterations on each side.
     """
-    import subprocess
-    import sys
-    import tempfile
-    import time
-
     import yaml
 
-    from walkerlab.codegen.casadi_functions import clear_memo
     from walkerlab.config import scene_from_dict  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.driver import collocation_spec, optimize_scene  # light
-    from walkerlab.optimal.transcription.virtual_constraints import (
-        collocate_virtual_constraints,
-        hzd_functions,
-    )
+    from walkerlab.optimal.driver import optimize_scene  # light
     from walkerlab.optimal.virtual_constraints import controller_step  # light
     from walkerlab.walker.plant import Plant  # light
 
@@ -201,36 +188,12 @@ def bench_design(repeats: int = 3) -> dict:
     scene = scene_from_dict(cfg)
     vc = scene.walker.actuation.virtual_constraints
     plant = Plant.from_scene(scene)  # the bench's scene, described once
-    data = plant.data
     K = 2 * DESIGN["intervals"] + 1
-    t, x, u, alpha, _zd = controller_step(build_walker(scene, plant), Solver.from_settings(
-        scene.solver), K)
-    spec = collocation_spec(scene)
-    ours, res = [], None
-    for _ in range(repeats):
-        clear_memo()  # each run reads its functions as a new process would (disk cache)
-        t0 = time.perf_counter()
-        fns = hzd_functions(data, vc)
-        res = collocate_virtual_constraints(
-            fns, spec, t, x, u, alpha, DESIGN["max_multiplier"],
-            (vc.feedback.kp_per_s2, vc.feedback.kd_per_s))
-        ours.append(time.perf_counter() - t0)
-    script = root / "walkerlab" / "bench" / "minimal_casadi_hzd.py"
-    theirs, words = [], []
-    with tempfile.TemporaryDirectory() as d:
-        npz = Path(d) / "start.npz"
-        np.savez(npz, t=t, x=x, u=u, alpha=alpha, N=DESIGN["intervals"],
-                 speed=DESIGN["target_speed_m_per_s"], max_multiplier=DESIGN["max_multiplier"],
-                 kp=vc.feedback.kp_per_s2, kd=vc.feedback.kd_per_s,
-                 u_max=DESIGN["max_torque_n_m"], mu=DESIGN["friction_coefficient"])
-        for _ in range(repeats):
-            run = subprocess.run([sys.executable, str(script), str(npz)], capture_output=True,
-                                 text=True, timeout=600, cwd="/")
-            if run.returncode != 0:
-                raise RuntimeError(f"bench hzd: the minimal script failed: {run.stderr[-500:]}")
-            words = run.stdout.split()
-            theirs.append(float(words[words.index("build_s") + 1])
-                          + float(words[words.index("solve_s") + 1]))
+    start = controller_step(build_walker(scene, plant), Solver.from_settings(scene.solver),
+                            K)[:4]
+    ours, res = _time_collocation(scene, plant.data, start, repeats)
+    theirs, words = _time_script(root / "walkerlab" / "bench" / "minimal_casadi_hzd.py",
+                                 start, vc, repeats)
     t0 = time.perf_counter()
     optimize_scene(scene, None, None, plant)  # the stage's computation (not its file writing)
     stage = time.perf_counter() - t0
@@ -249,6 +212,72 @@ def bench_design(repeats: int = 3) -> dict:
             "script": {"status": words[0], "iterations": int(word("iterations")),
                        "objective": word("objective"), "delta2": word("delta2"),
                        "period_s": word("period")}}
+
+
+def _write_start(npz: Path, start: tuple, vc, u_max: float, mu: float) -> None:
+    """The minimal script's input: the start ``(t, x, u, alpha)`` (the scene's controller's
+    step), :data:`DESIGN`'s numbers, the controller's feedback gains ``vc.feedback``, the
+    torque bound ``u_max`` [N m] and the friction coefficient ``mu`` [-], as ``npz``."""
+    t, x, u, alpha = start
+    np.savez(npz, t=t, x=x, u=u, alpha=alpha, N=DESIGN["intervals"],
+             speed=DESIGN["target_speed_m_per_s"], max_multiplier=DESIGN["max_multiplier"],
+             kp=vc.feedback.kp_per_s2, kd=vc.feedback.kd_per_s, u_max=u_max, mu=mu)
+
+
+def _time_collocation(scene, data, start: tuple, repeats: int
+                      ) -> tuple[list[float], object]:
+    """Wall times [s] of ``repeats`` runs of walkerlab's build and solve of the design of
+    the walker ``data`` (its plant's description) from ``start`` ``(t, x, u, alpha)`` (each
+    reading its CasADi functions from the disk cache, as a new process does), and the last
+    run's result."""
+    from walkerlab.codegen.casadi_functions import clear_memo
+    from walkerlab.optimal.driver import collocation_spec  # light
+    from walkerlab.optimal.transcription.virtual_constraints import (
+        collocate_virtual_constraints,
+        hzd_functions,
+    )
+
+    vc = scene.walker.actuation.virtual_constraints
+    spec = collocation_spec(scene)
+    t, x, u, alpha = start
+    ours, res = [], None
+    for _ in range(repeats):
+        clear_memo()  # each run reads its functions as a new process would (disk cache)
+        t0 = time.perf_counter()
+        fns = hzd_functions(data, vc)
+        res = collocate_virtual_constraints(
+            fns, spec, t, x, u, alpha, DESIGN["max_multiplier"],
+            (vc.feedback.kp_per_s2, vc.feedback.kd_per_s))
+        ours.append(time.perf_counter() - t0)
+    return ours, res
+
+
+def _time_script(script: Path, start: tuple, vc, repeats: int) -> tuple[list[float], list[str]]:
+    """Build-plus-solve times [s] of ``repeats`` runs of the minimal CasADi ``script`` from
+    ``start`` (as processes), and the words the last run printed.
+
+    Raises
+    ------
+    RuntimeError
+        If the script fails.
+    """
+    import subprocess
+    import sys
+    import tempfile
+
+    theirs, words = [], []
+    with tempfile.TemporaryDirectory() as d:
+        npz = Path(d) / "start.npz"
+        _write_start(npz, start, vc, DESIGN["max_torque_n_m"], DESIGN["friction_coefficient"])
+        for _ in range(repeats):
+            run = subprocess.run([sys.executable, str(script), str(npz)], capture_output=True,
+                                 text=True, timeout=600, cwd="/")
+            if run.returncode != 0:
+                raise RuntimeError(f"bench hzd: the minimal script failed: {run.stderr[-500:]}")
+            words = run.stdout.split()
+            theirs.append(float(words[words.index("build_s") + 1])
+                          + float(words[words.index("solve_s") + 1]))
+    return theirs, words
 
 
 def lines(res: dict) -> list[str]:

@@ -99,13 +99,14 @@ def bezier(alpha, s):
     return hd, hd1
 
 
-def main(path: str) -> None:
-    z = np.load(path)
-    N, speed, mmax = int(z["N"]), float(z["speed"]), float(z["max_multiplier"])
-    kp, kd, umax, mu = (float(z[k]) for k in ("kp", "kd", "u_max", "mu"))
-    t0 = time.perf_counter()
+def model_functions(columns: int, kp: float, kd: float) -> tuple:
+    """The walker's CasADi functions for Bezier coefficients of ``columns`` columns and the
+    outputs' feedback gains ``kp`` [1/s^2], ``kd`` [1/s]: ``flow(x, u)``, ``reset(x)``,
+    ``out(x, u, a, theta+, theta-)`` (y, y', the closed loop's output equation),
+    ``grf(x, u)`` (the stance foot's force [N]), ``ahead(x)`` (the swing foot's lead [m]) and
+    ``delta2(q-, a)``."""
     x, u = ca.SX.sym("x", 6), ca.SX.sym("u", 2)
-    a = ca.SX.sym("a", 2, z["alpha"].shape[1])
+    a = ca.SX.sym("a", 2, columns)
     tp, tm = ca.SX.sym("tp"), ca.SX.sym("tm")
     qdd = ca.solve(mass_matrix(x[:3]), ca.mtimes(ca.DM(B), u) - bias(x[:3], x[3:]))
     f = ca.vertcat(x[3:], qdd)
@@ -124,12 +125,22 @@ def main(path: str) -> None:
     grf = ca.Function("grf", [x, u], [mtot * (acc + ca.vertcat(0, G_))])
     ahead = ca.Function("ahead", [x], [foot[0]])
     qm = ca.SX.sym("qm", 3)
-    qd = ca.vertcat(1.0, (z["alpha"].shape[1] - 1) * (a[:, -1] - a[:, -2]) / (qm[0] - qm[1]))
+    qd = ca.vertcat(1.0, (columns - 1) * (a[:, -1] - a[:, -2]) / (qm[0] - qm[1]))
     xp = impact(ca.vertcat(qm, qd))  # theta+ = q1+ = q2-
     sig = (ca.mtimes([b.reshape(1, -1), mass_matrix(xp[:3]), xp[3:]])
            / ca.mtimes([b.reshape(1, -1), mass_matrix(qm), qd]))
     delta2 = ca.Function("delta2", [qm, a], [sig ** 2])
+    return flow, reset, out, grf, ahead, delta2
 
+
+def problem(z, fns: tuple) -> tuple:
+    """The collocation (module docstring) on the start ``z`` (the loaded GUESS.npz) with the
+    functions ``fns`` of :func:`model_functions`: the IPOPT-ready ``Opti`` and its
+    expressions ``T`` (period [s]), ``D`` (step length [m]), the objective, ``delta^2`` and
+    ``A`` (the coefficients)."""
+    flow, reset, out, grf, ahead, delta2 = fns
+    N, speed, mmax = int(z["N"]), float(z["speed"]), float(z["max_multiplier"])
+    umax, mu = float(z["u_max"]), float(z["mu"])
     K = 2 * N + 1
     opti = ca.Opti()
     X, U, T = opti.variable(6, K), opti.variable(2, K), opti.variable()
@@ -174,6 +185,14 @@ def main(path: str) -> None:
     opti.solver("ipopt", {"expand": True, "print_time": False},
                 {"print_level": 0, "tol": 1e-10, "constr_viol_tol": 1e-11, "max_iter": 1000,
                  "sb": "yes"})
+    return opti, T, D, objective, d2, A
+
+
+def main(path: str) -> None:
+    z = np.load(path)
+    t0 = time.perf_counter()
+    fns = model_functions(z["alpha"].shape[1], float(z["kp"]), float(z["kd"]))
+    opti, T, D, objective, d2, A = problem(z, fns)
     build = time.perf_counter() - t0
     t1 = time.perf_counter()
     try:

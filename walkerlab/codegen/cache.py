@@ -103,8 +103,8 @@ def cache_key(structure) -> str:
         h.update(_five_link_generator_hash().encode())
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
-    if getattr(structure, "spatial", False):
-        h.update(_source_hash("spatial.py").encode())
+    if getattr(structure, "in_3d", False):
+        h.update(_source_hash("derive_3d.py").encode())
     return h.hexdigest()[:24]
 
 
@@ -190,11 +190,11 @@ def derive_equations(structure):
     printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's
     (:mod:`walkerlab.codegen.rolling_polygon`) or a biped's
     (:func:`walkerlab.codegen.symbolic.derive`)."""
-    if structure.spatial:
-        from walkerlab.codegen import spatial  # light
+    if structure.in_3d:
+        from walkerlab.codegen import derive_3d  # light
 
-        return (spatial.derive_spoked(structure) if structure.spokes
-                else spatial.derive_compass(structure))
+        return (derive_3d.derive_spoked(structure) if structure.spokes
+                else derive_3d.derive_compass(structure))
     if structure.spokes:
         from walkerlab.codegen import rolling_polygon  # light
 

@@ -34,7 +34,7 @@ class Equations:
         ``heel_strike``, ``swing_foot_ahead``, ``hip_height``.
     points : dict[str, Matrix (2, 1) or (3, 1)]
         Named points relative to the stance foot (world axes, x downhill, y up; in 3D also
-        z, :mod:`walkerlab.codegen.spatial`).
+        z, :mod:`walkerlab.codegen.derive_3d`).
     leg_angles : dict[str, Expr]
         ``stance`` and ``swing`` absolute leg angles from the vertical.
     section_drop : int

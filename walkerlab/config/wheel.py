@@ -42,7 +42,7 @@ class RimlessWheelParams(Strict):
         "hub_inertia_kg_m2)")
 
     @model_validator(mode="after")
-    def _spatial_inertia(self):
+    def _inertia_3d(self):
         if self.space == "3d" and self.diametral_inertia_kg_m2 is None:
             raise ValueError("walker.diametral_inertia_kg_m2: a wheel in 3d needs its "
                              "inertia about a diameter (> 0: the spin about the stance "

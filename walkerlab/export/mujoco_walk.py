@@ -327,7 +327,7 @@ class PoweredLoop:
 class HipRollLoop:
     """The hip-roll law of a 3D walker's MJCF (custom text ``walkerlab_hip_roll``: the
     scene's :class:`walkerlab.config.walker.HipRollLaw`), the rigid model's
-    (:func:`walkerlab.codegen.spatial.derive_compass`) on MuJoCo's state: before every
+    (:func:`walkerlab.codegen.derive_3d.derive_compass`) on MuJoCo's state: before every
     MuJoCo step each body's roll about the fall line ``s`` is read from its pitch axis
     ``a`` (the body's ``0 -1 0``, walkerlab's ``Rot(s, phi) z``):
     ``phi = atan2(-a . n, a . z_w)`` (``n`` the slope's normal, ``z_w`` walkerlab's z), its
@@ -345,7 +345,7 @@ class HipRollLoop:
     ----------
     model : mujoco.MjModel
         With the custom text ``walkerlab_hip_roll`` and bodies ``pelvis``, ``leg1``,
-        ``leg2`` (:func:`walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text`).
+        ``leg2`` (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`).
     """
 
     def __init__(self, model):
@@ -434,7 +434,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
     needed when the file carries them; ``each``: a callable ``(model, data)`` called after
     every look, e.g. to record a 3D walker's lean).  The hip is the slide joints
     ``hip_x``, ``hip_z`` of a planar walker or the free joint ``free`` of a walker in 3D
-    (:mod:`walkerlab.export.spatial_legs_mjcf`).
+    (:mod:`walkerlab.export.legs_3d_mjcf`).
 
     Returns
     -------

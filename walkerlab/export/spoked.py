@@ -283,7 +283,7 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
     Parameters
     ----------
     data, name, version
-        The wheel (:data:`walkerlab.walker.description.SPATIAL_SPOKED_PARAMS`), model name,
+        The wheel (:data:`walkerlab.walker.description.SPOKED_3D_PARAMS`), model name,
         walkerlab version.
     qpos, qvel : sequence of 7 and 6 floats, optional
         The ``gait`` keyframe (:func:`wheel3d_keyframe`).
@@ -329,7 +329,7 @@ def wheel3d_urdf_text(data, name: str, version: str = "") -> str:
     Parameters
     ----------
     data : WalkerData
-        The 3D wheel (:data:`walkerlab.walker.description.SPATIAL_SPOKED_PARAMS`).
+        The 3D wheel (:data:`walkerlab.walker.description.SPOKED_3D_PARAMS`).
     name, version : str
 
     Returns

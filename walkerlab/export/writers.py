@@ -10,7 +10,7 @@ The URDF and MJCF writers write the walker's multibody as its kind has it
 (:attr:`walkerlab.walker.kinds.Kind.body`, :data:`BODIES`): a tree of leg links
 (:mod:`walkerlab.export.multibody`), a spoked wheel (planar, or in 3D:
 :mod:`walkerlab.export.spoked`), or the 3D straight-legged walker's free pelvis
-(:mod:`walkerlab.export.spatial_legs`, :mod:`walkerlab.export.spatial_legs_mjcf`).  The
+(:mod:`walkerlab.export.legs_3d`, :mod:`walkerlab.export.legs_3d_mjcf`).  The
 Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
 (:mod:`walkerlab.export.opensim`) write a tree of leg links.
 
@@ -300,14 +300,14 @@ def _wheel_3d(job: ExportJob, w: Writer) -> Written:
 
 def _legs_3d(job: ExportJob, w: Writer) -> Written:
     """The 3D straight-legged walker (``walker.space: 3d``): its URDF, a free pelvis and two
-    legs on hip joints (:func:`walkerlab.export.spatial_legs.spatial_legs_urdf_text`), or its
+    legs on hip joints (:func:`walkerlab.export.legs_3d.legs_3d_urdf_text`), or its
     MJCF, the same walker on a free joint with the rigid gait as its ``gait`` keyframe, the
     footfall patches of its lanes and the scene's contact
-    (:func:`walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text`; ``job.options``: the MJCF's
+    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`; ``job.options``: the MJCF's
     :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
     table has them (refused before this is reached)."""
-    from walkerlab.export.spatial_legs import spatial_legs_urdf_text  # light: 3D only
-    from walkerlab.export.spatial_legs_mjcf import legs3d_mjcf_text, legs3d_scene
+    from walkerlab.export.legs_3d import legs_3d_urdf_text  # light: 3D only
+    from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene
 
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
@@ -325,7 +325,7 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     version = walkerlab.__version__
     ideal = None
     if w.name == "urdf":
-        text = spatial_legs_urdf_text(data, job.name, version)
+        text = legs_3d_urdf_text(data, job.name, version)
     elif job.walker_only:
         text = legs3d_mjcf_text(data, job.name, version)
     else:

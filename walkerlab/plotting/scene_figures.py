@@ -46,7 +46,7 @@ def trajectory_plan(trajs: dict[str, NamedTrajectory], title: str, slope_rad: fl
         plan.append((stem, partial(F.stick_diagram, tr, label, slope_rad=slope_rad,
                                    units=units, terrain=ground)))
     if any(len(p) > 2 for tr in trajs.values() for p in tr.points.values()):
-        from walkerlab.plotting.spatial_figure import top_and_front
+        from walkerlab.plotting.figure_3d import top_and_front
 
         plan.append(("gait_3d_top_front", partial(top_and_front, trajs, title,
                                                   units=units)))

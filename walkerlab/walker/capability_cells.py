@@ -10,11 +10,10 @@ re-exports every public name here; the layers import them from there.
 
 from __future__ import annotations
 
-__all__ = ["CAPABILITIES", "CELL_NOTES", "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES",
-           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "SEVERAL_FOOTHOLDS", "SPATIAL_ACTUATION", "SPATIAL_EXPORT", "SPATIAL_GROUND",
-           "SPATIAL_HIP_ROLL_EXPORT", "SPATIAL_ROUND_FEET_EXPORT", "STAGE_CELLS", "STAGE_VIEWS",
-           "URDF_GROUND"]
+__all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
+           "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D", "KNEE_LATCH_OSIM",
+           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE", "ROUND_FEET_EXPORT_3D",
+           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -68,11 +67,11 @@ URDF_GROUND = ("the URDF carries the walker on a slope only (URDF has no ground 
                "--walker-only writes the walker alone")
 _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "profile")}
 #: why a 3D walker's views refuse a ground other than a plane
-SPATIAL_GROUND = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
-                  "stairs, footholds and profiles are planar walkers' grounds")
+GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
+             "stairs, footholds and profiles are planar walkers' grounds")
 #: why a 3D walker refuses actuators
-SPATIAL_ACTUATION = ("a walker in 3D takes no walker.actuation so far (its lateral "
-                     "foot-placement law is walker.hip_roll: hip-roll joints)")
+ACTUATION_3D = ("a walker in 3D takes no walker.actuation so far (its lateral "
+                "foot-placement law is walker.hip_roll: hip-roll joints)")
 #: why the kinds other than the 3D straight legs refuse hip-roll joints (the scene's check
 #: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
 NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
@@ -84,24 +83,24 @@ NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a
                     "straight-legged walker's (walker.space: 3d); a planar walker's round "
                     "feet are walker.leg.foot.kind: arc")
 #: why the 3D walker's exports refuse its round feet
-SPATIAL_ROUND_FEET_EXPORT = ("a 3D walker's export carries point feet and point-mass legs "
-                             "so far (its round feet and leg inertia run in the rigid model: "
-                             "fixedpoint, simulate)")
+ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass legs "
+                        "so far (its round feet and leg inertia run in the rigid model: "
+                        "fixedpoint, simulate)")
 #: why the URDF refuses the 3D walker's hip-roll joints
-SPATIAL_HIP_ROLL_EXPORT = ("the URDF carries legs rigid to the pelvis in roll so far: the "
-                           "hip-roll joints and their law are in the MJCF (--format mjcf) "
-                           "and the rigid model")
+HIP_ROLL_EXPORT_3D = ("the URDF carries legs rigid to the pelvis in roll so far: the "
+                      "hip-roll joints and their law are in the MJCF (--format mjcf) "
+                      "and the rigid model")
 #: why the exports refuse a 3D walker
-SPATIAL_EXPORT = ("this format carries planar walkers so far: a 3D walker is written as "
-                  "URDF (--format urdf) or MJCF (--format mjcf)")
+EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
+             "URDF (--format urdf) or MJCF (--format mjcf)")
 #: what the views of both 3D kinds refuse: a ground other than a plane, the contact model,
 #: the Adams and OpenSim exports
-_SPATIAL = {
-    **{(g, "*"): SPATIAL_GROUND for g in ("stairs", "footholds", "profile")},
+_CELLS_3D = {
+    **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
     ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a later "
                           "step (walk it in the rigid model: fixedpoint, simulate)"),
-    ("walk", "adams"): SPATIAL_EXPORT,
-    ("walk", "osim"): SPATIAL_EXPORT,
+    ("walk", "adams"): EXPORT_3D,
+    ("walk", "osim"): EXPORT_3D,
 }
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
@@ -275,17 +274,17 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "the passive one, walkerlab fixedpoint)"),
     },
     "straight_legs_3d": {
-        ("hip_roll", "urdf"): SPATIAL_HIP_ROLL_EXPORT,
-        ("round_feet_3d", "mjcf"): SPATIAL_ROUND_FEET_EXPORT,
-        ("round_feet_3d", "urdf"): SPATIAL_ROUND_FEET_EXPORT,
-        **{(f, "*"): SPATIAL_ACTUATION for f in ("hip_torque", "knee_torque",
-                                                 "ankle_torque", "torso_torque", "push_off",
-                                                 "ankle_push_off", "virtual_constraints")},
-        **_SPATIAL,
+        ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
+        ("round_feet_3d", "mjcf"): ROUND_FEET_EXPORT_3D,
+        ("round_feet_3d", "urdf"): ROUND_FEET_EXPORT_3D,
+        **{(f, "*"): ACTUATION_3D for f in ("hip_torque", "knee_torque",
+                                            "ankle_torque", "torso_torque", "push_off",
+                                            "ankle_push_off", "virtual_constraints")},
+        **_CELLS_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
-        # (walkerlab.export.spatial_legs_mjcf.legs3d_mjcf_text: on footfall patches, past
-        # the straight legs' mid-stance foot-through; walkerlab.export.spatial_legs.
-        # spatial_legs_urdf_text)
+        # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
+        # the straight legs' mid-stance foot-through; walkerlab.export.legs_3d.
+        # legs_3d_urdf_text)
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
                           "is a later step"),
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
@@ -297,7 +296,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
                                          "torso_torque", "push_off", "ankle_push_off",
                                          "virtual_constraints")},
-        **_SPATIAL,
+        **_CELLS_3D,
         # the MJCF and the URDF: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
         ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
@@ -328,12 +327,12 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
 STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
                "stability-map": ("walk", "contact")}
 #: why the robustness study refuses a 3D walker (:mod:`walkerlab.studies.robustness_study`)
-SPATIAL_ROBUSTNESS = ("the robustness study (gait sensitivity norms, largest step-down/up "
-                      "and push) is of planar walkers so far: its disturbances and state "
-                      "norms are sagittal; a 3D walker's metastability is walkerlab mfpt's")
+ROBUSTNESS_3D = ("the robustness study (gait sensitivity norms, largest step-down/up "
+                 "and push) is of planar walkers so far: its disturbances and state "
+                 "norms are sagittal; a 3D walker's metastability is walkerlab mfpt's")
 #: kind -> {stage: reason}: the studies (stages of :mod:`walkerlab.stages.pipeline`) a kind
 #: does not take at all; a stage not listed takes it (``optimize`` of a kind whose ``walk``
 #: it refuses may still design virtual constraints, so only the 3D kinds' is here)
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    k: {"robustness": SPATIAL_ROBUSTNESS, "optimize": CAPABILITIES[k][("walk", "optimize")]}
+    k: {"robustness": ROBUSTNESS_3D, "optimize": CAPABILITIES[k][("walk", "optimize")]}
     for k in ("straight_legs_3d", "rolling_polygon_3d")}

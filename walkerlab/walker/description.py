@@ -38,21 +38,21 @@ SPOKED_ROLES = ("stance",)
 SPOKED_PARAMS = ("g", "L", "gamma", "M_hub", "I_hub", "alpha")
 #: Roles of a spoked wheel in three dimensions (``walker.space: 3d``): its heading about the
 #: slope normal, its lean about the fall line and the stance spoke's angle in the wheel's
-#: plane (:mod:`walkerlab.codegen.spatial`).
-SPATIAL_SPOKED_ROLES = ("heading", "lean", "stance")
+#: plane (:mod:`walkerlab.codegen.derive_3d`).
+SPOKED_3D_ROLES = ("heading", "lean", "stance")
 #: Parameters of a spoked wheel in three dimensions: :data:`SPOKED_PARAMS` (``I_hub`` about
 #: the axle) and its inertia about a diameter ``I_diam`` [kg m^2].
-SPATIAL_SPOKED_PARAMS = SPOKED_PARAMS + ("I_diam",)
+SPOKED_3D_PARAMS = SPOKED_PARAMS + ("I_diam",)
 #: Roles of a straight-legged walker in three dimensions (``model: compass_gait`` with
-#: ``space: 3d``; :func:`walkerlab.codegen.spatial.derive_compass`): the pelvis' roll about
+#: ``space: 3d``; :func:`walkerlab.codegen.derive_3d.derive_compass`): the pelvis' roll about
 #: the fall line, then the legs' pitch angles as the planar walkers'.
-SPATIAL_COMPASS_ROLES = ("lean", "swing", "stance")
+COMPASS_3D_ROLES = ("lean", "swing", "stance")
 #: Parameters of the straight-legged walker in 3D: gravity, leg length, slope, hip mass, leg
 #: mass and its distance from the foot [SI], then (``hip_width``) the hip width ``w_hip`` [m],
 #: (legs with inertia: ``bodies[0].kind == "rod"``) each leg's inertia ``I_leg`` about its
 #: mass point normal to the leg [kg m^2], (round feet: ``foot == "arc"``) the feet's radius
 #: ``R_foot`` [m].
-SPATIAL_COMPASS_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
+COMPASS_3D_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
 #: Roles added by hip-roll joints (``hip_roll``): the pelvis' and the swing leg's roll
 #: about the fall line (the ``lean`` is then the stance leg's).
 HIP_ROLL_ROLES = ("pelvis_roll", "swing_roll")
@@ -147,11 +147,11 @@ class Structure:
         rolling about the stance spoke's foot (role ``stance``, parameters
         :data:`SPOKED_PARAMS`; :mod:`walkerlab.codegen.rolling_polygon`; its floating view
         has one contact point per spoke).  The other fields are then unused.
-    spatial : bool
+    in_3d : bool
         The walker moves in three dimensions (``walker.space: 3d``;
-        :mod:`walkerlab.codegen.spatial`): a spoked wheel free about every axis of its
-        stance foot (roles :data:`SPATIAL_SPOKED_ROLES`), or straight legs on point feet
-        that roll and pitch (roles :data:`SPATIAL_COMPASS_ROLES`).  False: in the sagittal
+        :mod:`walkerlab.codegen.derive_3d`): a spoked wheel free about every axis of its
+        stance foot (roles :data:`SPOKED_3D_ROLES`), or straight legs on point feet
+        that roll and pitch (roles :data:`COMPASS_3D_ROLES`).  False: in the sagittal
         plane.
     hip_width : bool
         A 3D straight-legged walker's hips are apart (parameter ``w_hip``; the steps
@@ -176,7 +176,7 @@ class Structure:
     hinged_torso: bool = False
     spokes: int = 0
     foot_mass: bool = False
-    spatial: bool = False
+    in_3d: bool = False
     hip_width: bool = False
     hip_roll: bool = False
 
@@ -189,9 +189,9 @@ class Structure:
     @property
     def roles(self) -> tuple[str, ...]:
         if self.spokes:
-            return SPATIAL_SPOKED_ROLES if self.spatial else SPOKED_ROLES
-        if self.spatial:
-            return SPATIAL_COMPASS_ROLES + (HIP_ROLL_ROLES if self.hip_roll else ())
+            return SPOKED_3D_ROLES if self.in_3d else SPOKED_ROLES
+        if self.in_3d:
+            return COMPASS_3D_ROLES + (HIP_ROLL_ROLES if self.hip_roll else ())
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.hinged_torso:
@@ -213,7 +213,7 @@ class Structure:
         pitches keep theirs, so the mirror step's map is ``P_mirror(x) = S P(S x)`` with ``S``
         negating those roles' angles and rates (the hip-roll law is odd in the rolls).
         Planar legs that differ are not a reflection of each other (None)."""
-        if self.spatial and not self.spokes and self.hip_width:
+        if self.in_3d and not self.spokes and self.hip_width:
             return ("lean",) + (HIP_ROLL_ROLES if self.hip_roll else ())
         return None
 
@@ -229,9 +229,9 @@ class Structure:
     def param_names(self) -> tuple[str, ...]:
         """Names of the parameter vector, in order (SI units; ``gamma`` is the slope [rad])."""
         if self.spokes:
-            return SPATIAL_SPOKED_PARAMS if self.spatial else SPOKED_PARAMS
-        if self.spatial:
-            return (SPATIAL_COMPASS_PARAMS + (("w_hip",) if self.hip_width else ())
+            return SPOKED_3D_PARAMS if self.in_3d else SPOKED_PARAMS
+        if self.in_3d:
+            return (COMPASS_3D_PARAMS + (("w_hip",) if self.hip_width else ())
                     + (("I_leg",) if self.bodies[0].kind == "rod" else ())
                     + (("R_foot",) if self.foot == "arc" else ())
                     + (HIP_ROLL_PARAMS if self.hip_roll else ()))
@@ -290,7 +290,7 @@ class Structure:
             d["foot_mass"] = True
         if self.spokes:
             d = {"spokes": self.spokes}
-        if self.spatial:
+        if self.in_3d:
             d["space"] = "3d"
         if self.hip_width:
             d["hip_width"] = True
@@ -412,18 +412,18 @@ def _spoked_data(w, slope_rad: float) -> WalkerData:
     params = (w.gravity_m_per_s2, w.spoke_length_m, slope_rad, w.mass_kg, inertia,
               math.pi / w.spokes)
     extra = {"spokes": w.spokes, "hub_inertia_kg_m2": inertia}
-    spatial = w.space == "3d"
-    if spatial:
+    in_3d = w.space == "3d"
+    if in_3d:
         params += (w.diametral_inertia_kg_m2,)
         extra["diametral_inertia_kg_m2"] = w.diametral_inertia_kg_m2
     return WalkerData(Structure("absolute", (), hip_mass=True, spokes=w.spokes,
-                                spatial=spatial),
+                                in_3d=in_3d),
                       tuple(float(v) for v in params), w.mass_kg, w.spoke_length_m,
                       w.gravity_m_per_s2, slope_rad, extra)
 
 
-def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
-    """Structure and parameters (:data:`SPATIAL_COMPASS_PARAMS`) of a ``model:
+def _compass_3d_data(w, slope_rad: float) -> WalkerData:
+    """Structure and parameters (:data:`COMPASS_3D_PARAMS`) of a ``model:
     compass_gait`` section with ``space: 3d``: with a hip width, the mirror step's
     parameters (its swing hip on the other side, ``w_hip -> -w_hip``) make the map a
     stride."""
@@ -453,7 +453,7 @@ def _spatial_compass_data(w, slope_rad: float) -> WalkerData:
     structure = Structure("absolute", (BodySpec("mass", "point_mass" if inertia is None
                                                 else "rod"),), hip_mass=True,
                           foot="point" if radius is None else "arc",
-                          spatial=True, hip_width=bool(width), hip_roll=law is not None)
+                          in_3d=True, hip_width=bool(width), hip_roll=law is not None)
     return WalkerData(structure, tuple(float(v) for v in params),
                       w.hip_mass_kg + 2 * w.leg_mass_kg, w.leg_length_m,
                       w.gravity_m_per_s2, slope_rad, extra,
@@ -483,7 +483,7 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     if walker_cfg.model == "rimless_wheel":
         return _spoked_data(walker_cfg, slope_rad)
     if walker_cfg.model == "compass_gait" and walker_cfg.space == "3d":
-        return _spatial_compass_data(walker_cfg, slope_rad)
+        return _compass_3d_data(walker_cfg, slope_rad)
     if walker_cfg.model == "compass_gait":
         extra = {"leg_mass_kg": walker_cfg.leg_mass_kg, "hip_mass_kg": walker_cfg.hip_mass_kg,
                  "leg_mass_from_foot_m": walker_cfg.leg_mass_from_foot_m}

@@ -64,31 +64,30 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from walkerlab.walker.capability_cells import (  # the table's cells, re-exported
+    ACTUATION_3D,
     CAPABILITIES,
     CELL_NOTES,
+    EXPORT_3D,
     FOOTHOLD_SLOPES,
     FREE_JOINT_TORQUES,
+    GROUND_3D,
+    HIP_ROLL_EXPORT_3D,
     KNEE_LATCH_OSIM,
     NO_HIP_ROLL,
     NO_ROUND_FEET_3D,
     PROFILE_PASSIVE,
+    ROUND_FEET_EXPORT_3D,
     SEVERAL_FOOTHOLDS,
-    SPATIAL_ACTUATION,
-    SPATIAL_EXPORT,
-    SPATIAL_GROUND,
-    SPATIAL_HIP_ROLL_EXPORT,
-    SPATIAL_ROUND_FEET_EXPORT,
     STAGE_CELLS,
     STAGE_VIEWS,
     URDF_GROUND,
 )
 
-__all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURES", "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES",
-           "KINDS", "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "SEVERAL_FOOTHOLDS", "SPATIAL_ACTUATION", "SPATIAL_EXPORT", "SPATIAL_GROUND",
-           "SPATIAL_HIP_ROLL_EXPORT", "SPATIAL_ROUND_FEET_EXPORT", "STAGE_CELLS",
-           "STAGE_VIEWS", "URDF_GROUND", "VIEWS",
-           "Kind", "KindRefused", "kind_of", "table_rows"]
+__all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURES",
+           "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D", "KINDS",
+           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
+           "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
+           "URDF_GROUND", "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
 
 #: the views of one walker description: name -> what it is
 VIEWS = {
@@ -333,8 +332,8 @@ def kind_of(structure) -> Kind:
     Kind
     """
     if structure.spokes:
-        return KINDS["rolling_polygon_3d" if structure.spatial else "rolling_polygon"]
-    if structure.spatial:
+        return KINDS["rolling_polygon_3d" if structure.in_3d else "rolling_polygon"]
+    if structure.in_3d:
         return KINDS["straight_legs_3d"]
     if structure.free_knees:
         return KINDS["free_joints"]

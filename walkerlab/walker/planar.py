@@ -17,7 +17,7 @@ from dataclasses import dataclass
 __all__ = ["PlanarTwin", "planar_twin"]
 
 #: fields of a 3D walker section that only a 3D walker has, left out of its planar twin
-SPATIAL_ONLY = ("space", "hip_width_m", "hip_roll", "diametral_inertia_kg_m2")
+ONLY_IN_3D = ("space", "hip_width_m", "hip_roll", "diametral_inertia_kg_m2")
 #: fields a planar twin cannot carry (a 3D walker with one of them set has no planar twin
 #: here: a planar walker's round feet are ``model: biped``'s ``leg.foot``)
 NO_TWIN = ("foot_radius_m", "leg_inertia_kg_m2")
@@ -68,7 +68,7 @@ def planar_twin(walker) -> PlanarTwin | None:
     data = walker.model_dump(mode="json")
     if any(data.get(k) is not None for k in NO_TWIN):
         return None
-    twin = {k: v for k, v in data.items() if k not in SPATIAL_ONLY}
+    twin = {k: v for k, v in data.items() if k not in ONLY_IN_3D}
     width = data.get(WIDTH_FIELD)
     if not width:
         return PlanarTwin(twin, None, 0.0, True)

@@ -97,11 +97,37 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     out = dict.fromkeys(LEDGER_NAMES, np.nan)
     if seg.termination != "heel_strike":
         return out
-    acts = walker.actuators
     g = float(walker.params["gravity_m_per_s2"])
     m = float(walker.total_mass_kg)
     ke0, pe0 = (float(v) for v in walker.energies(seg.x_start))
-    scale = max(ke0, 1e-12)
+    wpos, wneg, wdamp, internal = _flow_work(walker, seg, max(ke0, 1e-12))
+    ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
+    pts = walker.points(seg.x_end)
+    step = np.asarray(pts["swing_foot"], float)
+    nxt = walker if next_walker is None else next_walker
+    push, loss, impulse, ke_plus = _heel_strike(walker, nxt, seg, ke_end)
+    # the next stance foot (this step's swing foot) is step[1] higher in the world
+    pe_plus = float(nxt.energies(seg.x_next)[1]) + m * g * float(step[1])
+    d_e = (ke_plus + pe_plus) - (ke0 + pe0)
+    closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
+    d = step_length(walker, seg)
+    slope_energy = released_energy(walker, d, float(step[1]))
+    cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
+    out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
+               push_off_impulse=impulse, heel_strike_loss=loss,
+               internal_collision_loss=internal, damper_work=wdamp,
+               potential_work=-(pe_plus - pe0), energy_change=d_e, closure=closure,
+               slope_energy=slope_energy, cost_of_transport=cot)
+    return out
+
+
+def _flow_work(walker, seg, scale: float) -> tuple[float, float, float, float]:
+    """The works over the step's continuous pieces [J]: the joint torques' positive and
+    negative work (the scene's laws, a virtual-constraint controller's, a law in the
+    generated flow), the dampers' work and the kinetic energy lost at the resets inside
+    the step (knee strike, foot slap); quadratures to a tolerance relative to ``scale``
+    [J]."""
+    acts = walker.actuators
     wpos = wneg = wdamp = internal = 0.0
     damped = _damped(walker)
     # joint torques that do work: the scene's laws, or a virtual-constraint controller's
@@ -132,31 +158,21 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
                               scale)
         if damped:
             wdamp += quad_work(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
-    ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
-    pts = walker.points(seg.x_end)
-    step = np.asarray(pts["swing_foot"], float)
-    nxt = walker if next_walker is None else next_walker
+    return wpos, wneg, wdamp, internal
+
+
+def _heel_strike(walker, nxt, seg, ke_end: float) -> tuple[float, float, float, float]:
+    """The heel strike's push-off work, kinetic energy loss [J], push-off impulse [N s] and
+    the kinetic energy after it [J] (on the next step's walker ``nxt``), from the step's
+    kinetic energy at its end ``ke_end`` [J]."""
+    acts = walker.actuators
     if acts is not None and acts.spec.push_off is not None:
         tr = acts.transition(seg.x_end)
         push, loss, impulse = tr["ke_push_off"] - tr["ke_minus"], \
             tr["ke_push_off"] - tr["ke_plus"], float(tr["impulse"])
-        ke_plus = float(tr["ke_plus"])
-    else:
-        ke_plus = float(nxt.energies(seg.x_next)[0])
-        push, loss, impulse = 0.0, ke_end - ke_plus, 0.0
-    # the next stance foot (this step's swing foot) is step[1] higher in the world
-    pe_plus = float(nxt.energies(seg.x_next)[1]) + m * g * float(step[1])
-    d_e = (ke_plus + pe_plus) - (ke0 + pe0)
-    closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
-    d = step_length(walker, seg)
-    slope_energy = released_energy(walker, d, float(step[1]))
-    cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
-    out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
-               push_off_impulse=impulse, heel_strike_loss=loss,
-               internal_collision_loss=internal, damper_work=wdamp,
-               potential_work=-(pe_plus - pe0), energy_change=d_e, closure=closure,
-               slope_energy=slope_energy, cost_of_transport=cot)
-    return out
+        return push, loss, impulse, float(tr["ke_plus"])
+    ke_plus = float(nxt.energies(seg.x_next)[0])
+    return 0.0, ke_end - ke_plus, 0.0, ke_plus
 
 
 def trajectory_ledger(traj) -> dict[str, np.ndarray]:

@@ -319,34 +319,13 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         With ``fd_check``: the variational and the central-difference multipliers disagree
         beyond :func:`multiplier_check_tolerance` (a wrong Jacobian: no verdict).
     """
-    root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
-
     no_orbit = no_orbit_reason(walker)  # invariant virtual constraints: none to find
     if no_orbit:
         raise FixedPointNotFound(no_orbit, math.nan)
     on_orbit = gaits_on_zero_dynamics(walker)
     t0 = time.perf_counter()
-    known = [walker.section(np.asarray(xk, float)) for xk in deflate]
-    if known and jacobian_guess is not None:
-        raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
-    F = _ReducedMap(walker, solver, max_step_time, known)
-    z0 = walker.section(np.asarray(guess, float))
-    F.hold(z0)
-    try:
-        with search_budget(budget_s):
-            if on_orbit and F.fails_at(z0):  # its gait is an orbit of the zero dynamics:
-                raise FixedPointNotFound(  # a start that does not step is not near it
-                    f"the closed loop does not step from the start: {F.failure}", math.nan)
-            w0 = F.free(z0)
-            if jacobian_guess is None:
-                sol = root(F.free_residual, w0, method="hybr", options={"xtol": xtol})
-            else:
-                F.start[z0.tobytes()] = _section_jacobian(
-                    walker, np.asarray(jacobian_guess, float), z0)
-                sol = root(F.free_residual, w0, method="hybr", jac=F.free_jacobian,
-                           options={"xtol": xtol})
-    except SearchGaveUp as exc:
-        raise FixedPointGaveUp(str(exc), math.nan) from None
+    F, sol = _root_on_section(walker, guess, solver, max_step_time, xtol, jacobian_guess,
+                              deflate, budget_s, on_orbit)
     x, xn, period, DP, segs = F.variational_at(F.full(sol.x), sol.message)
     res = float(np.max(np.abs(xn - x)))
     _check_walking(walker, x, sol, res, xtol)
@@ -369,6 +348,49 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         step_lengths_m=tuple(step_length(walker, sg) for sg in segs),
         neutral=tuple(walker.neutral),
     )
+
+
+def _root_on_section(walker: HybridWalker, guess, solver: Solver, max_step_time: float,
+                     xtol: float, jacobian_guess, deflate, budget_s: float | None,
+                     on_orbit: bool):
+    """:func:`find_fixed_point`'s root finder: MINPACK hybr on the reduced map (deflated by
+    ``deflate``; hybrj from ``jacobian_guess``) within the time budget ``budget_s`` [s];
+    returns the reduced map (its counters and the variational map) and scipy's result.
+
+    Raises
+    ------
+    FixedPointNotFound
+        A closed loop whose gaits are orbits of its zero dynamics (``on_orbit``) does not
+        step from the guess.
+    FixedPointGaveUp
+        The budget was spent.
+    ValueError
+        Both ``deflate`` and ``jacobian_guess``.
+    """
+    root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
+
+    known = [walker.section(np.asarray(xk, float)) for xk in deflate]
+    if known and jacobian_guess is not None:
+        raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
+    F = _ReducedMap(walker, solver, max_step_time, known)
+    z0 = walker.section(np.asarray(guess, float))
+    F.hold(z0)
+    try:
+        with search_budget(budget_s):
+            if on_orbit and F.fails_at(z0):  # its gait is an orbit of the zero dynamics:
+                raise FixedPointNotFound(  # a start that does not step is not near it
+                    f"the closed loop does not step from the start: {F.failure}", math.nan)
+            w0 = F.free(z0)
+            if jacobian_guess is None:
+                sol = root(F.free_residual, w0, method="hybr", options={"xtol": xtol})
+            else:
+                F.start[z0.tobytes()] = _section_jacobian(
+                    walker, np.asarray(jacobian_guess, float), z0)
+                sol = root(F.free_residual, w0, method="hybr", jac=F.free_jacobian,
+                           options={"xtol": xtol})
+    except SearchGaveUp as exc:
+        raise FixedPointGaveUp(str(exc), math.nan) from None
+    return F, sol
 
 
 class _ReducedMap:

@@ -165,6 +165,40 @@ def zero_dynamics(ctrl) -> ZeroDynamics:
     k = np.arange(NODES)
     s = np.sort((1 - np.cos(np.pi * (k + 0.5) / NODES)) / 2)  # Chebyshev points in (0, 1)
     qs, ts = ctrl.path(s)
+    I_, bG, W = _node_terms(ctrl, b, qs, ts)
+    theta = th_p + s * dth
+    dom = sorted((th_p, th_m))
+    integrand = Chebyshev.fit(theta, I_ * bG, NODES - 1, domain=dom)
+    V = integrand.integ(lbnd=th_p)
+    inertia = Chebyshev.fit(theta, I_, NODES - 1, domain=dom)
+    v_minus = float(V(th_m))
+    v_max = _v_max(V, integrand, th_p, th_m)
+    margin = (delta2 / (1 - delta2) * v_minus + v_max) if delta2 < 1 else np.inf
+    exists = bool(delta2 < 1 and margin < 0)
+    zeta = -v_minus / (1 - delta2) if delta2 < 1 else np.nan
+    rate_m = rate_p = period = np.nan
+    x_plus = np.full(2 * n, np.nan)
+    umax = np.nan
+    if exists:
+        rate_m, rate_p, period, x_plus, umax = _orbit(ctrl, V, inertia, delta2 * zeta, zeta,
+                                                      (qs, ts, theta))
+    return ZeroDynamics(
+        delta2=delta2, v_minus=v_minus, v_max=v_max, zeta_star=float(zeta), exists=exists,
+        existence_margin=float(margin), theta_plus=th_p, theta_minus=th_m,
+        phase_rate_minus=rate_m, phase_rate_plus=rate_p, step_period_s=period, x_plus=x_plus,
+        max_torque_n_m=umax, saturates=bool(ctrl.limit is not None and umax > ctrl.limit),
+        kinetic_invariance=float(np.max(np.abs(W)) / np.max(np.abs(I_))),
+        timing_delta2_s=t_delta, timing_total_s=time.perf_counter() - t0,
+        min_clearance_m=min(ctrl.pieces.foot(q)[0] for q in qs),
+        phase_unit="m" if ctrl.spec.phase.point is not None else "rad", design=d,
+        output_names=tuple(ctrl.output_names), joints=tuple(ctrl.joints))
+
+
+def _node_terms(ctrl, b: np.ndarray, qs, ts) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """At the nodes' configurations ``qs`` and tangents ``ts`` of the path: ``b^T M q'``
+    (the zero dynamics' inertia), ``b^T G`` and ``q'^T (dM/dq b) q'`` (kinetic invariance's
+    residual, by a complex step), each (NODES,)."""
+    n = ctrl.n
     I_ = np.empty(NODES)
     bG = np.empty(NODES)
     W = np.empty(NODES)
@@ -178,12 +212,12 @@ def zero_dynamics(ctrl) -> ZeroDynamics:
         xc[:n] += 1j * h * b
         dM = np.imag(ctrl.fns["matrices"](xc)[0]) / h
         W[j] = qp @ dM @ qp
-    theta = th_p + s * dth
-    dom = sorted((th_p, th_m))
-    integrand = Chebyshev.fit(theta, I_ * bG, NODES - 1, domain=dom)
-    V = integrand.integ(lbnd=th_p)
-    inertia = Chebyshev.fit(theta, I_, NODES - 1, domain=dom)
-    v_minus = float(V(th_m))
+    return I_, bG, W
+
+
+def _v_max(V, integrand, th_p: float, th_m: float) -> float:
+    """The zero dynamics' potential's maximum over the step (at least 0), on a grid refined
+    by brentq where it is inside (``V' = I b^T G = 0``)."""
     grid = np.linspace(th_p, th_m, 2001)
     vals = V(grid)
     j = int(np.argmax(vals))
@@ -195,40 +229,32 @@ def zero_dynamics(ctrl) -> ZeroDynamics:
         if integrand(a) * integrand(c) < 0:
             r = brentq(integrand, a, c, xtol=1e-15)
             v_max = max(v_max, float(V(r)))
-    v_max = max(v_max, 0.0)
-    margin = (delta2 / (1 - delta2) * v_minus + v_max) if delta2 < 1 else np.inf
-    exists = bool(delta2 < 1 and margin < 0)
-    zeta = -v_minus / (1 - delta2) if delta2 < 1 else np.nan
-    rate_m = rate_p = period = np.nan
-    x_plus = np.full(2 * n, np.nan)
-    umax = np.nan
-    if exists:
-        zeta_p = delta2 * zeta
-        sign = np.sign(dth)
-        rate_m = float(sign * np.sqrt(2 * zeta) / abs(inertia(th_m)))
-        rate_p = float(sign * np.sqrt(2 * zeta_p) / abs(inertia(th_p)))
-        xg, wg = np.polynomial.legendre.leggauss(NODES)
-        tg = th_p + (xg + 1) / 2 * dth
-        period = float(abs(dth) / 2 * np.sum(wg * np.abs(inertia(tg))
-                                             / np.sqrt(2 * (zeta_p - V(tg)))))
-        qp0 = ctrl.tangent(d.q_plus, bezier(d.alpha, 0.0)[1], dth)
-        x_plus = np.concatenate([d.q_plus, qp0 * rate_p])
-        us = []
-        for q, qp, th in zip(qs, ts, theta):
-            rate = sign * np.sqrt(2 * max(zeta_p - V(th), 0.0)) / abs(inertia(th))
-            _y, _dy, A, Lf2, _mb = ctrl.terms(np.concatenate([q, qp * rate]))
-            us.append(np.linalg.solve(np.real(A), -np.real(Lf2)))
-        umax = float(np.max(np.abs(us)))
-    return ZeroDynamics(
-        delta2=delta2, v_minus=v_minus, v_max=v_max, zeta_star=float(zeta), exists=exists,
-        existence_margin=float(margin), theta_plus=th_p, theta_minus=th_m,
-        phase_rate_minus=rate_m, phase_rate_plus=rate_p, step_period_s=period, x_plus=x_plus,
-        max_torque_n_m=umax, saturates=bool(ctrl.limit is not None and umax > ctrl.limit),
-        kinetic_invariance=float(np.max(np.abs(W)) / np.max(np.abs(I_))),
-        timing_delta2_s=t_delta, timing_total_s=time.perf_counter() - t0,
-        min_clearance_m=min(ctrl.pieces.foot(q)[0] for q in qs),
-        phase_unit="m" if ctrl.spec.phase.point is not None else "rad", design=d,
-        output_names=tuple(ctrl.output_names), joints=tuple(ctrl.joints))
+    return max(v_max, 0.0)
+
+
+def _orbit(ctrl, V, inertia, zeta_p: float, zeta: float, nodes: tuple) -> tuple:
+    """The fixed point's step on the zero dynamics (``zeta_p = delta^2 zeta``, ``zeta`` the
+    energies after and before the heel strike): the phase rates before and after the heel
+    strike, the step period [s] (Gauss-Legendre quadrature), the state after the heel
+    strike (2n,) and the largest torque [N m] at the path's ``nodes`` ``(qs, ts, theta)``."""
+    qs, ts, theta = nodes
+    d = ctrl.design
+    th_p, dth = d.theta_plus, d.theta_minus - d.theta_plus
+    sign = np.sign(dth)
+    rate_m = float(sign * np.sqrt(2 * zeta) / abs(inertia(d.theta_minus)))
+    rate_p = float(sign * np.sqrt(2 * zeta_p) / abs(inertia(th_p)))
+    xg, wg = np.polynomial.legendre.leggauss(NODES)
+    tg = th_p + (xg + 1) / 2 * dth
+    period = float(abs(dth) / 2 * np.sum(wg * np.abs(inertia(tg))
+                                         / np.sqrt(2 * (zeta_p - V(tg)))))
+    qp0 = ctrl.tangent(d.q_plus, bezier(d.alpha, 0.0)[1], dth)
+    x_plus = np.concatenate([d.q_plus, qp0 * rate_p])
+    us = []
+    for q, qp, th in zip(qs, ts, theta):
+        rate = sign * np.sqrt(2 * max(zeta_p - V(th), 0.0)) / abs(inertia(th))
+        _y, _dy, A, Lf2, _mb = ctrl.terms(np.concatenate([q, qp * rate]))
+        us.append(np.linalg.solve(np.real(A), -np.real(Lf2)))
+    return rate_m, rate_p, period, x_plus, float(np.max(np.abs(us)))
 
 
 def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:

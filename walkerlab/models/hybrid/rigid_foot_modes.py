@@ -136,68 +136,23 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     base = functions(data)
     off = base if heel_off_data is None else functions(heel_off_data)
     level = float(landing_m) * float(np.cos(data.slope_rad)) if landing_m else 0.0
-    pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
-
-    def compiled(mode: str, part: str, guards: list[Guard]):
-        # the phase's flow compiled, its guards the cfunc's extra outputs (GUARD_OUTPUT);
-        # an ankle push-off's heel off (other numbers than the guards') stays in Python
-        if heel_off_data is not None:
-            return None
-        if flow_of is not None:
-            return None
-        return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
-                            tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]),
-                                   level if g.name == "heel_strike" else 0.0)
-                                  for g in guards),
-                            first_chunk_steps=FIRST_CHUNK_STEPS[f"{mode}:{part}"],
-                            chunk_rtol=CHUNK_RTOL)
 
     def phase(mode: str, part: str) -> Phase:
         # an ankle push-off acts in heel off: its flow (and the ground forces, read through
         # it) from the released spring's numbers; guards and resets are the walker's own
         # (the new stance ankle lands at the walker's rest angle)
-        f, g = (off if mode == "heel_off" else base), base
-        fl, jac, p = f[f"flow_{mode}"], f[f"flow_{mode}_jacobian"], pin[mode]
+        f = off if mode == "heel_off" else base
+        fl, jac = f[f"flow_{mode}"], f[f"flow_{mode}_jacobian"]
         var = f[f"flow_{mode}_variational"]
         if flow_of is not None:
             (fl, jac), var = flow_of(mode, fl, jac), None
-        late = part == "late_swing"
-        guards = []
-        if late:
-            hs = g[f"guard_swing_heel_height_{p}"]
-            guards.append(Guard("heel_strike", partial(_above, hs, level) if level else hs, -1,
-                                "heel_strike", g[f"grad_swing_heel_height_{p}"],
-                                g[f"reset_heel_strike_{p}"],
-                                g[f"reset_heel_strike_{p}_jacobian"]))
-        if mode == "heel_contact":
-            guards.append(Guard("foot_slap", f["guard_foot_angle"], -1, "next_phase",
-                                f["grad_foot_angle"], f["reset_foot_slap"],
-                                f["reset_foot_slap_jacobian"], next_phase=f"foot_flat:{part}"))
-            guards.append(Guard("stance_foot_lifts",
-                                partial(_normal_force, f["ground_heel"], fl, 0), -1, "fall",
-                                at_entry=True))
-        elif mode == "foot_flat":
-            guards.append(Guard("heel_off", partial(_heel_force, f["ground_heel"], fl), -1,
-                                "next_phase", next_phase=f"heel_off:{part}"))
-            guards.append(Guard("stance_toe_lifts",
-                                partial(_normal_force, f["ground_heel"], fl, 1), -1, "fall",
-                                at_entry=True))
-        else:
-            guards.append(Guard("stance_heel_touches_down", f["guard_foot_angle"], +1, "fall",
-                                f["grad_foot_angle"]))
-            guards.append(Guard("stance_foot_lifts",
-                                partial(_normal_force, f["ground_toe"], fl, 0), -1, "fall",
-                                at_entry=True))
-        if late:
-            guards.append(Guard("swing_leg_falls_back", f["guard_swing_foot_ahead"], -1, "fall",
-                                f["grad_swing_foot_ahead"]))
-        else:
-            guards.append(Guard("midstance", f["guard_swing_foot_ahead"], +1, "next_phase",
-                                f["grad_swing_foot_ahead"], next_phase=f"{mode}:late_swing"))
-        guards.append(Guard("fall", f[f"guard_hip_height_{p}"], -1, "fall",
-                            f[f"grad_hip_height_{p}"]))
+        guards = _phase_guards(f, base, mode, part, fl, level)
+        # the phase's flow compiled, its guards the cfunc's extra outputs (GUARD_OUTPUT);
+        # an ankle push-off's heel off (other numbers than the guards') stays in Python
+        compiled = None if heel_off_data is not None or flow_of is not None else \
+            _compiled_flow(data, mode, part, guards, level)
         return Phase(f"{mode}:{part}", fl, tuple(guards), jacobian=jac, variational=var,
-                     compiled=compiled(mode, part, guards))
+                     compiled=compiled)
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
     entry = None
@@ -206,33 +161,98 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
             "c_sw_ankle" if data.structure.asymmetric else "c_ankle", 0.0)
         phases += double_support_phases(base, float(trailing_c), force, level)
         entry = partial(_step_entry, base, force, step_clock, level)
-    f = base
-    structure = data.structure
-    params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
-              "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
-              **dict(zip(structure.param_names, data.params))}
-    if landing_m:
-        params["landing_drop_m"] = float(landing_m)
     mirror = data.mirror
     if mirror is not None:  # legs that differ: the next step's walker (leg2 swinging)
         mirror = make_flat_walker(replace(mirror, mirror_params=None), name, variant,
                                   double_support=double_support, landing_m=landing_m)
     return HybridWalker(
-        name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
-        reset=f["reset_heel_strike_heel"], energies=f["energies"], points=f["points"],
-        section=f["section"], from_section=f["from_section"], role_to_leg=role_to_leg,
-        total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
-        variational=f["flow_heel_contact_jacobian"],
-        reset_jacobian=f["reset_heel_strike_heel_jacobian"],
-        heel_strike_guard=(partial(_above, f["guard_swing_heel_height_heel"], level) if level
-                           else f["guard_swing_heel_height_heel"]),
-        leg_angles=f["leg_angles"],
+        name=name, variant=variant, roles=data.structure.roles, legs=LEGS, phases=phases,
+        reset=base["reset_heel_strike_heel"], energies=base["energies"], points=base["points"],
+        section=base["section"], from_section=base["from_section"], role_to_leg=role_to_leg,
+        total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad,
+        params=_walker_params(data, landing_m),
+        variational=base["flow_heel_contact_jacobian"],
+        reset_jacobian=base["reset_heel_strike_heel_jacobian"],
+        heel_strike_guard=(partial(_above, base["guard_swing_heel_height_heel"], level) if level
+                           else base["guard_swing_heel_height_heel"]),
+        leg_angles=base["leg_angles"],
         mirror=mirror, step_entry=entry,
         section_words=("state just after the heel strike's impulse, before the trailing toe "
                        "is pinned (the double support starts from it)" if entry is not None
                        else "state just after heel strike"),
     )
 
+
+
+
+def _walker_params(data: WalkerData, landing_m: float) -> dict:
+    """The walker's numbers by name (:attr:`HybridWalker.params`): SI scalars, the extras,
+    the structure's parameters and, landing below the slope line, ``landing_drop_m``."""
+    params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
+              "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
+              **dict(zip(data.structure.param_names, data.params))}
+    if landing_m:
+        params["landing_drop_m"] = float(landing_m)
+    return params
+
+#: the stance foot's pinned point in each mode
+_PIN = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
+
+
+def _compiled_flow(data: WalkerData, mode: str, part: str, guards: list[Guard],
+                   level: float) -> CompiledFlow:
+    """The phase ``<mode>:<part>``'s flow compiled, its ``guards`` the cfunc's extra outputs
+    (:data:`GUARD_OUTPUT`; the heel strike's shifted by the landing ``level`` [m])."""
+    return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
+                        tuple((GUARD_OUTPUT[g.name].format(pin=_PIN[mode]),
+                               level if g.name == "heel_strike" else 0.0)
+                              for g in guards),
+                        first_chunk_steps=FIRST_CHUNK_STEPS[f"{mode}:{part}"],
+                        chunk_rtol=CHUNK_RTOL)
+
+
+def _phase_guards(f: dict, g: dict, mode: str, part: str, fl, level: float) -> list[Guard]:
+    """The guards of the phase ``<mode>:<part>``: ``f`` the mode's generated functions (an
+    ankle push-off's heel off: the released spring's), ``g`` the walker's own (the heel
+    strike and its reset), ``fl`` the phase's flow (the ground forces are read through it),
+    ``level`` [m] the landing's height below the slope line (:func:`make_flat_walker`)."""
+    p = _PIN[mode]
+    late = part == "late_swing"
+    guards = []
+    if late:
+        hs = g[f"guard_swing_heel_height_{p}"]
+        guards.append(Guard("heel_strike", partial(_above, hs, level) if level else hs, -1,
+                            "heel_strike", g[f"grad_swing_heel_height_{p}"],
+                            g[f"reset_heel_strike_{p}"],
+                            g[f"reset_heel_strike_{p}_jacobian"]))
+    if mode == "heel_contact":
+        guards.append(Guard("foot_slap", f["guard_foot_angle"], -1, "next_phase",
+                            f["grad_foot_angle"], f["reset_foot_slap"],
+                            f["reset_foot_slap_jacobian"], next_phase=f"foot_flat:{part}"))
+        guards.append(Guard("stance_foot_lifts",
+                            partial(_normal_force, f["ground_heel"], fl, 0), -1, "fall",
+                            at_entry=True))
+    elif mode == "foot_flat":
+        guards.append(Guard("heel_off", partial(_heel_force, f["ground_heel"], fl), -1,
+                            "next_phase", next_phase=f"heel_off:{part}"))
+        guards.append(Guard("stance_toe_lifts",
+                            partial(_normal_force, f["ground_heel"], fl, 1), -1, "fall",
+                            at_entry=True))
+    else:
+        guards.append(Guard("stance_heel_touches_down", f["guard_foot_angle"], +1, "fall",
+                            f["grad_foot_angle"]))
+        guards.append(Guard("stance_foot_lifts",
+                            partial(_normal_force, f["ground_toe"], fl, 0), -1, "fall",
+                            at_entry=True))
+    if late:
+        guards.append(Guard("swing_leg_falls_back", f["guard_swing_foot_ahead"], -1, "fall",
+                            f["grad_swing_foot_ahead"]))
+    else:
+        guards.append(Guard("midstance", f["guard_swing_foot_ahead"], +1, "next_phase",
+                            f["grad_swing_foot_ahead"], next_phase=f"{mode}:late_swing"))
+    guards.append(Guard("fall", f[f"guard_hip_height_{p}"], -1, "fall",
+                        f[f"grad_hip_height_{p}"]))
+    return guards
 
 def _above(height, level: float, t, x):
     """``height(t, x) + level``: the swing heel's height above a landing ``level`` [m] below

@@ -68,8 +68,8 @@ def make_spoked_walker(data: WalkerData, name: str = "rimless_wheel",
         variational=f["flow_jacobian"], reset_jacobian=f["reset_jacobian"],
         heel_strike_guard=f["guard_heel_strike"], leg_angles=f["leg_angles"],
         matrices=f["matrices"],
-        neutral=("heading_angle",) if structure.spatial else (),
-        closed_form_gait=None if structure.spatial else partial(rolling_gait, params),
+        neutral=("heading_angle",) if structure.in_3d else (),
+        closed_form_gait=None if structure.in_3d else partial(rolling_gait, params),
     )
 
 

@@ -152,8 +152,8 @@ def derive_spoked(structure) -> Equations:
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
-        With ``spokes`` > 0 and ``spatial`` (parameters
-        :data:`walkerlab.walker.description.SPATIAL_SPOKED_PARAMS`).
+        With ``spokes`` > 0 and ``in_3d`` (parameters
+        :data:`walkerlab.walker.description.SPOKED_3D_PARAMS`).
 
     Returns
     -------
@@ -164,10 +164,10 @@ def derive_spoked(structure) -> Equations:
     Raises
     ------
     ValueError
-        ``structure`` is not a spatial spoked wheel.
+        ``structure`` is not a 3D spoked wheel.
     """
-    if not (structure.spokes and structure.spatial):
-        raise ValueError("spatial.derive_spoked: the structure is not a 3D spoked wheel")
+    if not (structure.spokes and structure.in_3d):
+        raise ValueError("derive_3d.derive_spoked: the structure is not a 3D spoked wheel")
     psi, phi, th = sp.symbols("q_heading q_lean q_stance", real=True)
     dpsi, dphi, dth = sp.symbols("dq_heading dq_lean dq_stance", real=True)
     q, dq = (psi, phi, th), (dpsi, dphi, dth)
@@ -368,14 +368,14 @@ def derive_compass(structure) -> Equations:
     :func:`_leg_rotation_mass`); a rotation moves no foot, so the impact's extended mass
     gets it unchanged.  With ``phi = 0`` and ``w = 0`` round feet and a rod's inertia give
     the planar round-feet walker (``configs/round_feet.yaml`` = ``configs/
-    round_feet_3d.yaml``, ``tests/test_spatial_round_feet.py``).  Neither goes with
+    round_feet_3d.yaml``, ``tests/test_round_feet_3d.py``).  Neither goes with
     hip-roll joints yet (the scene refuses the combination).
 
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
-        ``spatial`` and not ``spokes`` (parameters
-        :data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`; ``hip_width``: whether
+        ``in_3d`` and not ``spokes`` (parameters
+        :data:`walkerlab.walker.description.COMPASS_3D_PARAMS`; ``hip_width``: whether
         ``w`` is a parameter, else 0; ``foot`` ``point`` or ``arc``; ``bodies[0].kind``
         ``point_mass`` or ``rod``).
 
@@ -387,10 +387,10 @@ def derive_compass(structure) -> Equations:
     Raises
     ------
     ValueError
-        ``structure`` is not a spatial straight-legged walker.
+        ``structure`` is not a 3D straight-legged walker.
     """
-    if not structure.spatial or structure.spokes:
-        raise ValueError("spatial.derive_compass: the structure is not a 3D straight-legged "
+    if not structure.in_3d or structure.spokes:
+        raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
                          "walker")
     phi, th_sw, th_st = sp.symbols("q_lean q_swing q_stance", real=True)
     dphi, dth_sw, dth_st = sp.symbols("dq_lean dq_swing dq_stance", real=True)

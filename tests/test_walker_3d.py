@@ -280,7 +280,7 @@ def test_a_3d_derivation_draws_from_a_seeded_generator_and_restores_its_state():
     and the caller's generator state is as it was."""
     import sympy.core.random as srand
 
-    from walkerlab.codegen.spatial import _seeded, derive_compass, derive_spoked
+    from walkerlab.codegen.derive_3d import _seeded, derive_compass, derive_spoked
 
     assert derive_compass.__wrapped__ is not None and derive_spoked.__wrapped__ is not None
     draws = []

@@ -1,5 +1,5 @@
 """The 3D straight-legged walker's MJCF (``walkerlab export --format mjcf`` of a ``model:
-compass_gait`` with ``space: 3d``; :mod:`walkerlab.export.spatial_legs_mjcf`) in MuJoCo:
+compass_gait`` with ``space: 3d``; :mod:`walkerlab.export.legs_3d_mjcf`) in MuJoCo:
 its bodies and masses against the walker description, its ``gait`` keyframe against the
 rigid gait's state (MuJoCo's own kinematics: ``mj_kinematics``, ``mj_integratePos``), its
 footfall lanes, and its walk against the rigid step period."""
@@ -19,7 +19,7 @@ mujoco = pytest.importorskip("mujoco")
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the rigid step period of configs/paper_3d.yaml [s] (configs/paper.yaml's: the planar
-#: embedding, tests/test_spatial_walker.py)
+#: embedding, tests/test_walker_3d.py)
 PAPER_STEP_S = 0.7035968805
 
 
@@ -149,8 +149,8 @@ def test_the_paper_3d_mjcf_walks_ten_heel_strikes_at_the_rigid_period_and_stays_
     MuJoCo's elliptic friction cone, so the only seeds of the unstable roll (x 11.2 a step)
     are the rigid gait's ~1e-35 rad (measured: < 1e-23 rad over 11 strikes; the pyramidal
     cone's roundoff grew to 1e-6 rad by the tenth)."""
+    from walkerlab.export.legs_3d_mjcf import pelvis_lean_rad
     from walkerlab.export.mujoco_walk import walk
-    from walkerlab.export.spatial_legs_mjcf import pelvis_lean_rad
 
     scene, path, out = paper_3d
     leans = []

@@ -1,8 +1,8 @@
 """A straight-legged walker in three dimensions (``model: compass_gait`` with ``space: 3d``;
-:func:`walkerlab.codegen.spatial.derive_compass`) as a MuJoCo model (MJCF) that walks from
+:func:`walkerlab.codegen.derive_3d.derive_compass`) as a MuJoCo model (MJCF) that walks from
 the rigid gait.
 
-The walker is the URDF's (:func:`walkerlab.export.spatial_legs.spatial_legs_urdf_text`): a
+The walker is the URDF's (:func:`walkerlab.export.legs_3d.legs_3d_urdf_text`): a
 pelvis body carrying the hip mass on a free joint ``free`` (no plane constraint), and a leg
 on each side of it, ``hip_width / 2`` along the hip axis (MuJoCo's body y), on a hinge
 ``leg<i>_hip`` about that axis (``0 -1 0``: a positive angle moves the foot ahead, the rigid
@@ -39,7 +39,7 @@ upright (< 1e-23 rad over 11 heel strikes).
 Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
 
 Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates,
-:func:`walkerlab.codegen.spatial.derive_compass`): each leg hangs on a hinge
+:func:`walkerlab.codegen.derive_3d.derive_compass`): each leg hangs on a hinge
 ``leg<i>_roll`` about the fall line (the pelvis' frame: ``cos phi, 0, -sin phi``) before its
 ``leg<i>_hip`` (MuJoCo composes a body's joints in order: ``pelvis Rot(s, d) Rot(z, theta)``,
 the rigid leg's ``Rot(s, phi_leg) Rot(z, theta)`` with ``d = phi_leg - phi_p``).  The rigid
@@ -82,13 +82,13 @@ PATCH_ACROSS_L = 0.08
 #: nominal footfalls (configs/hip_width_stabilised.yaml in MuJoCo, measured; a push at the
 #: third step's mid-stance: 0.2 cm), off 8 cm patches (it falls), so its patches are 0.30 L
 #: across: the larger excursion with 5.7 cm to spare each side
-#: (tests/test_spatial_walker_mjcf.py)
+#: (tests/test_walker_3d_mjcf.py)
 PATCH_ACROSS_PUSHED_L = 0.30
 
 
 def _numbers(data) -> dict:
     """The walker's numbers by name (:data:`walkerlab.walker.description.
-    SPATIAL_COMPASS_PARAMS`), ``w_hip`` 0 without hip width, and the foot sphere's radius
+    COMPASS_3D_PARAMS`), ``w_hip`` 0 without hip width, and the foot sphere's radius
     ``r`` [m]."""
     p = dict(zip(data.structure.param_names, data.params))
     p.setdefault("w_hip", 0.0)
@@ -403,7 +403,7 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
     Parameters
     ----------
     data : WalkerData
-        Its parameters (:data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`, with
+        Its parameters (:data:`walkerlab.walker.description.COMPASS_3D_PARAMS`, with
         ``w_hip`` when the hips are apart).
     name, version : str
         Model name (the scene's) and walkerlab's version (header comment).

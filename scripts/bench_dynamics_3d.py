@@ -1,7 +1,7 @@
 """The 3D walker's dynamics from the generated equations against Pinocchio's, per call, in
-one run (the choice of walkerlab.codegen.spatial: sympy's generated code or Pinocchio).
+one run (the choice of walkerlab.codegen.derive_3d: sympy's generated code or Pinocchio).
 
-    python scripts/bench_spatial_dynamics.py [--calls 20000]
+    python scripts/bench_dynamics_3d.py [--calls 20000]
 
 For configs/hip_width.yaml: the generated Python flow ``flow(t, x)`` (what scipy's
 integrators call; CyRK's integrators call its numba twin, compiled from the same equations),

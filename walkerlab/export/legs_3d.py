@@ -1,5 +1,5 @@
 """A straight-legged walker in three dimensions (``model: compass_gait`` with ``space: 3d``;
-:func:`walkerlab.codegen.spatial.derive_compass`) as URDF: a pelvis link carrying the hip
+:func:`walkerlab.codegen.derive_3d.derive_compass`) as URDF: a pelvis link carrying the hip
 mass, free in space (a loader gives the root link a floating base: Pinocchio's
 ``JointModelFreeFlyer``, Drake's free body), and a leg on each side of it, ``hip_width / 2``
 along the hip axis, on a revolute hip joint about that axis (the legs pitch; the walker rolls
@@ -18,7 +18,7 @@ from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
 
-__all__ = ["spatial_legs_urdf_text"]
+__all__ = ["legs_3d_urdf_text"]
 
 
 def _point_inertial(mass: float, z: float) -> str:
@@ -27,13 +27,13 @@ def _point_inertial(mass: float, z: float) -> str:
             f'<inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/></inertial>')
 
 
-def spatial_legs_urdf_text(data, name: str, version: str = "") -> str:
+def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
     """The 3D straight-legged walker as URDF (module docstring).
 
     Parameters
     ----------
     data : WalkerData
-        Its parameters (:data:`walkerlab.walker.description.SPATIAL_COMPASS_PARAMS`, with
+        Its parameters (:data:`walkerlab.walker.description.COMPASS_3D_PARAMS`, with
         ``w_hip`` when the hips are apart).
     name, version : str
 
