@@ -177,7 +177,7 @@ class PushOffPulse:
         point along the line to the hip, and its power [W].
 
         On a flat foot the ankle holds through the push-off, as in the rigid view
-        (:class:`walkerlab.models.hybrid.push_off.FlatPushOff`: a massless foot passes a
+        (:class:`walkerlab.models.hybrid.toe_push_off.FlatPushOff`: a massless foot passes a
         push off its ankle's line only with an ankle torque; the joint holds): the force at
         the toe comes with the ankle torque ``lam`` (``+lam`` on the foot, ``-lam`` on the
         leg) that leaves the ankle's angular acceleration from them at 0, ``a M^-1 (J^T F +

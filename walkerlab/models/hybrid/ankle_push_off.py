@@ -83,7 +83,7 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
     """The flat-footed walker with its actuators, any of them together: joint torques
     (:func:`walkerlab.models.hybrid.mode_torques.actuate_flat_hips`), the ankle push-off
     in heel off (module docstring) and the push-off impulse at the trailing toe before heel
-    strike (:func:`walkerlab.models.hybrid.push_off.push_off_flat`).  Legs that differ:
+    strike (:func:`walkerlab.models.hybrid.toe_push_off.push_off_flat`).  Legs that differ:
     each step's walker on its own numbers (``mirror``).
 
     Returns
@@ -91,7 +91,7 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
     HybridWalker
         Its ``actuators``: the torques' :class:`walkerlab.models.hybrid.actuators.Actuators`
         (torques alone), an :class:`AnklePushOffActuator` (the ankle push-off alone) or a
-        :class:`walkerlab.models.hybrid.push_off.FlatPushOff` carrying every one given.
+        :class:`walkerlab.models.hybrid.toe_push_off.FlatPushOff` carrying every one given.
 
     Raises
     ------
