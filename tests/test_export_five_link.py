@@ -55,7 +55,7 @@ def _known_gait(x, period_s):
     ideal_gait`), returning the post-impact state ``x`` (role order) and its period."""
     from types import SimpleNamespace
 
-    return lambda scene: SimpleNamespace(x=np.asarray(x, float), period_s=period_s)
+    return lambda scene, plant=None: SimpleNamespace(x=np.asarray(x, float), period_s=period_s)
 
 
 @pytest.fixture(scope="module")

@@ -512,10 +512,10 @@ def test_the_mfpt_study_reports_each_sigma_it_finishes(monkeypatch):
 
     from walkerlab.studies import mfpt as study
 
-    monkeypatch.setattr(study, "build_walker", lambda scene: SimpleNamespace(
+    monkeypatch.setattr(study, "build_walker", lambda scene, plant=None: SimpleNamespace(
         state_names=lambda: ["a"]), raising=False)
     monkeypatch.setattr("walkerlab.models.registry.build_walker",
-                        lambda scene: SimpleNamespace(state_names=lambda: ["a"]))
+                        lambda scene, plant=None: SimpleNamespace(state_names=lambda: ["a"]))
     monkeypatch.setattr("walkerlab.integrate.python_step.needs_python_path", lambda w: False)
     monkeypatch.setattr(study, "step_map_for", lambda *a, **k: None)
 

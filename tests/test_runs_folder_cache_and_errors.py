@@ -222,7 +222,7 @@ def _read_only(monkeypatch):
     import errno
     import tempfile
 
-    from walkerlab.io import runpaths
+    from walkerlab.io import locks
 
     def no_lock(lock):
         raise RunPathError(f"{lock.parent}: cannot write the run folder (Read-only file "
@@ -231,7 +231,7 @@ def _read_only(monkeypatch):
     def no_temp(suffix=None, prefix=None, dir=None, text=False):
         raise OSError(errno.EROFS, "Read-only file system", f"{dir}/{prefix}x1y2{suffix}")
 
-    monkeypatch.setattr(runpaths, "_open_lock", no_lock)
+    monkeypatch.setattr(locks, "_open_lock", no_lock)
     monkeypatch.setattr(tempfile, "mkstemp", no_temp)
 
 

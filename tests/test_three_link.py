@@ -198,7 +198,7 @@ def mjcf(tmp_path_factory):
     scene, x = _x_gait()
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr("walkerlab.analysis.contact.periodic.ideal_gait",
-                   lambda sc: SimpleNamespace(x=x, period_s=0.4630145360))
+                   lambda sc, plant=None: SimpleNamespace(x=x, period_s=0.4630145360))
         return export_stage.run(scene, tmp_path_factory.mktemp("mjcf"), "mjcf")
 
 
