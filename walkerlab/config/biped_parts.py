@@ -1,5 +1,5 @@
-"""The parts of a biped described as data (``model: biped``, :class:`walkerlab.config.walker.
-BipedParams`): its legs (:class:`LegSpec`: bodies on the links, a knee, a foot), feet (point,
+"""The parts of a biped described as data (``model: biped``,
+:class:`walkerlab.config.walker.BipedParams`): its legs (:class:`LegSpec`: bodies on the links, a knee, a foot), feet (point,
 arc, flat with an ankle), knees (locked or free, a knee spring), torso (a point mass or a rigid
 body, coupled or hinged) and torsional springs between links.
 
