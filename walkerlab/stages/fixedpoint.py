@@ -138,13 +138,8 @@ def guess_owners(scene: Scene) -> list:
     from walkerlab.config import load_scene
     from walkerlab.config.loader import default_scene_path
     from walkerlab.studies.warm_start import StoredGait  # only when the guess failed
-    from walkerlab.walker.description import walker_data  # light
-
-    fp = scene.fixedpoint
-    if fp is None or fp.initial_guess is None:
+    if not _may_have_guess_owner(scene):
         return []
-    if not walker_data(scene.walker, scene.slope.phi_rad).structure.kind.in_3d:
-        return []  # a planar walker's search has its scale-free seeds
     mine = json.dumps(scene.model_dump(mode="json")["fixedpoint"]["initial_guess"],
                       sort_keys=True)
     folders = {default_scene_path().parent}
@@ -168,6 +163,16 @@ def guess_owners(scene: Scene) -> list:
     return out
 
 
+def _may_have_guess_owner(scene: Scene) -> bool:
+    """A 3D walker with an initial guess (a planar walker's search has its scale-free
+    seeds): :func:`guess_owners` may find the scene its guess was written for."""
+    from walkerlab.walker.description import walker_data  # light
+
+    fp = scene.fixedpoint
+    return (fp is not None and fp.initial_guess is not None
+            and walker_data(scene.walker, scene.slope.phi_rad).structure.kind.in_3d)
+
+
 def _own_gait(scene: Scene):
     """The gait ``scene``'s own initial guess converges to (no fallback starts: a guess
     that fails there says so); ValueError when it does not."""
@@ -189,11 +194,20 @@ def _own_gait(scene: Scene):
 def _nearby(scene: Scene, runs_root):
     """The nearest stored gait, or the gait of the scene the initial guess was written for
     (:func:`guess_owners`), as a fallback start of the gait search (carried here), or
-    None."""
-    from walkerlab.studies.warm_start import stored_gait_start  # only for a compute
+    None; the scene files are read only when the start is tried."""
+    from walkerlab.analysis.gait.starts import FallbackStart  # only for a compute
+    from walkerlab.studies.warm_start import stored_gait_start
 
-    stored = stored_gaits(scene, runs_root) + guess_owners(scene)
-    return stored_gait_start(scene, stored) if stored else None
+    stored = stored_gaits(scene, runs_root)
+    if not _may_have_guess_owner(scene):
+        return stored_gait_start(scene, stored) if stored else None
+
+    def find():  # the scene files are read only when the guess has failed
+        start = stored_gait_start(scene, stored + guess_owners(scene))
+        return None if start is None else start.find()
+
+    return FallbackStart("the nearest stored gait, or the gait of the scene the initial "
+                         "guess was written for", "stored_gait", find)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
