@@ -33,6 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 
 def rigid(scene) -> dict:
     """The rigid heel strike's numbers (module docstring): ``impulse_n``, ``impulse_t``
@@ -139,7 +141,7 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
                 raise SystemExit(f"--sub {a!r}: not in {path}")
         path = path.with_name("walker_sub.xml")
         path.write_text(text)
-    fb = mw.virtual_constraint_feedback(scene)
+    fb = mw.virtual_constraint_feedback(scene, Plant.from_scene(scene).data)
     ctrl, n = fb.controller, fb.controller.n
     b = annihilator(ctrl.B)
 

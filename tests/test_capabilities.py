@@ -31,6 +31,7 @@ import pytest
 
 from tests.scripts_loader import load_file
 from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -64,7 +65,7 @@ def _rigid(d, tmp):
 
         sc = w.scene
         if sc.walker.actuation is None:
-            profile_ground(sc)
+            profile_ground(sc, Plant.from_scene(sc))
         on_landing(w.model, walker_data(sc.walker, sc.slope.phi_rad), 0.001)
 
 

@@ -22,6 +22,7 @@ from walkerlab.walker.kinds import (
     KINDS,
     SEVERAL_FOOTHOLDS,
 )
+from walkerlab.walker.plant import Plant
 
 #: configs/footholds_two.yaml: the paper walker on footholds of two heights (stable rigid
 #: gait) with the paper's contact law and 0.3 m patches
@@ -157,7 +158,8 @@ def test_the_gym_takes_the_same_footholds():
     alike")."""
     from walkerlab.gym.arguments import rigid_ground
 
-    assert rigid_ground(scene_from_dict(TWO)) is None  # the walker's own per-step cycle
+    two = scene_from_dict(TWO)
+    assert rigid_ground(two, Plant.from_scene(two)) is None  # the walker's own per-step cycle
     for kind in ("straight_legs", "locking_knees"):
         assert KINDS[kind].supports("footholds", "gym")
         assert KINDS[kind].supports("profile", "gym")

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 GAMMA, P = 0.005, 0.04  # rad, N s: tests/test_push_off_feet.py's pushed round-foot gait
@@ -38,7 +39,8 @@ def test_least_effort_with_an_arc_foot_push_off_is_the_rigid_pushed_gait():
     scene = type(scene).model_validate(d)
     _, search = solve_scene(scene)  # shooting on the rigid model with its push-off
     r = search.gaits[search.selected].result
-    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s))
+    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s),
+                         plant=Plant.from_scene(scene))
     assert out.gait, (out.status, out.replay_error)  # its replay with the push-off closes
     assert out.objective <= 1e-8
     assert out.step_period_s == pytest.approx(float(r.period_s), rel=2e-7)

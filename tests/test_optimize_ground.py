@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 #: the optimize view's tolerance: the replay returns to its start within it
@@ -42,7 +43,8 @@ def _optimum(scene):
     from walkerlab.optimal.driver import optimize_scene
 
     r = solve_scene(scene)[1].result  # the fixedpoint stage's gait: the start
-    return r, optimize_scene(scene, np.asarray(r.x, float), float(r.period_s))
+    return r, optimize_scene(scene, np.asarray(r.x, float), float(r.period_s),
+                         plant=Plant.from_scene(scene))
 
 
 @pytest.mark.slow  # two optimisations with their fixed points and replays (~20 s)
@@ -116,7 +118,7 @@ def test_a_kneed_walker_on_stairs_and_a_step_other_than_the_tread_are_refused_in
     d["slope"] = {"angle_rad": 0.0}
     d["terrain"] = {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.41}
     with pytest.raises(ValueError, match=r"^terrain\.kind: stairs: ") as err:
-        check_scene(scene_from_dict(d))
+        check_scene(scene_from_dict(d), Plant.from_scene(scene_from_dict(d)).data)
     assert "\n" not in str(err.value)
     with pytest.raises(ValueError, match=r"^optimize\.target_step_length_m: 0\.5 m, but on "
                                          r"stairs the gait advances one tread"):
@@ -150,7 +152,8 @@ def test_compass_optimal_on_2_mm_footholds_is_the_two_step_passive_gait_not_the_
     r = solve_scene(scene)[1].result
     steps = np.asarray(r.step_periods_s, float)
     assert steps.size == 2
-    o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2)
+    o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2,
+                         plant=Plant.from_scene(scene))
     assert o.gait and o.replay_error <= REPLAY, (o.status, o.replay_error)
     assert o.objective <= 1e-8 and o.steps == 2
     assert np.max(np.abs(np.asarray(o.phase_duration_s) - steps)) <= 1e-6
@@ -169,7 +172,8 @@ def test_a_powered_gait_over_footholds_closes_on_them():
 
     scene = _compass_on_footholds([-0.002, 0.002], target_speed_m_per_s=0.8)
     r = solve_scene(scene)[1].result
-    o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2)
+    o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2,
+                         plant=Plant.from_scene(scene))
     assert o.gait and o.replay_error <= REPLAY, (o.status, o.replay_error)
     assert o.objective > 1e-3
     assert o.step_length_m / o.step_period_s == pytest.approx(0.8, rel=1e-9)
@@ -183,4 +187,4 @@ def test_footholds_of_their_own_slopes_are_refused_in_one_line():
     d = _compass_on_footholds([-0.002, 0.002]).model_dump(mode="json", exclude_none=True)
     d["terrain"]["foothold_slopes_rad"] = [0.05, 0.055]
     with pytest.raises(ValueError, match=r"^terrain\.foothold_slopes_rad: optimize "):
-        check_scene(scene_from_dict(d))
+        check_scene(scene_from_dict(d), Plant.from_scene(scene_from_dict(d)).data)

@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -66,7 +67,8 @@ def test_the_least_effort_gait_on_a_passive_slope_is_the_passive_gait(name, fact
     _, search = solve_scene(scene, walker=walker)  # the fixedpoint stage's search (shooting)
     r = search.gaits[search.selected].result
     periods = np.asarray(r.step_periods_s, float)
-    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods))
+    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
+                         plant=Plant.from_scene(scene))
     assert out.gait, (out.status, out.replay_error)
     assert out.objective <= 1e-8
     if len(periods) == 1:

@@ -16,6 +16,7 @@ from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 FLAT_ORDER = [("heel_contact:early_swing", "foot_slap", -1),
@@ -371,5 +372,5 @@ def test_an_ankle_push_off_is_refused_in_one_line():
     d["optimize"] = {"objective": "effort"}
     scene = type(scene).model_validate(d)
     with pytest.raises(ValueError, match="walker.actuation.ankle_push_off") as e:
-        optimize_scene(scene, np.zeros(6), 0.75)
+        optimize_scene(scene, np.zeros(6), 0.75, plant=Plant.from_scene(scene))
     assert "\n" not in str(e.value)

@@ -20,6 +20,7 @@ from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -227,7 +228,8 @@ def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
     for field, value, says in (("objective", "push_off_work", "optimize.objective"),
                                ("initial_guess", {"from": "x.h5"}, "optimize.initial_guess")):
         with pytest.raises(ValueError, match=says) as exc:
-            optimize_scene(with_(field, value), g.x, g.step_period)
+            sc = with_(field, value)
+            optimize_scene(sc, g.x, g.step_period, plant=Plant.from_scene(sc))
         assert "\n" not in str(exc.value)
     for field, value in (("objective", "cost_of_transport"), ("friction_coefficient", 0.8),
                          ("push_off", "free")):
@@ -576,7 +578,8 @@ def test_the_stride_scene_takes_the_cost_of_transport_a_cone_and_a_guess(asym, f
     d["optimize"].update(objective="cost_of_transport", cost_of_transport_effort_weight=1e-2,
                          target_speed_m_per_s=0.6, friction_coefficient=0.5,
                          initial_guess={"from": str(path)})
-    out = optimize_scene(type(scene).model_validate(d), g.x, g.step_period)
+    sc = type(scene).model_validate(d)
+    out = optimize_scene(sc, g.x, g.step_period, plant=Plant.from_scene(sc))
     assert out.gait and out.replay_error <= 1e-6 and out.status == "Solve_Succeeded"
     assert out.objective_name == "cost_of_transport"
     assert out.objective == pytest.approx(out.terms["cost_of_transport"]

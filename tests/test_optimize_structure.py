@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 PKG = Path(__file__).resolve().parents[1] / "walkerlab"
 
 #: what builds or writes optimize.h5's records (the stage's, never optimal/'s)
@@ -122,9 +124,9 @@ def test_a_spoked_wheel_is_refused_from_the_table():
 
     scene = with_defaults(load_scene(PKG.parent / "configs" / "rimless_wheel.yaml"),
                           "optimize", "optimize")
-    assert not needs_gait(scene)  # refused at once: no fixed point first
+    assert not needs_gait(scene, Plant.from_scene(scene))  # refused at once: no fixed point first
     with pytest.raises(KindRefused, match=r"^walker: a spoked wheel is one rigid body"):
-        check_scene(scene)
+        check_scene(scene, Plant.from_scene(scene).data)
 
 
 def _calls(path: Path, name: str) -> set:

@@ -20,6 +20,7 @@ import yaml
 
 from tests.scripts_loader import load_file
 from walkerlab.config import SceneError, scene_from_dict
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 THREELINK = yaml.safe_load((ROOT / "configs" / "threelink_hzd.yaml").read_text())
@@ -131,7 +132,7 @@ def test_design_on_a_walker_without_virtual_constraints_refused():
     cfg = yaml.safe_load((ROOT / "configs" / "threelink.yaml").read_text())
     sc = scene_from_dict(_scene(cfg, DESIGN))
     with pytest.raises(ValueError) as e:
-        check_scene(sc)
+        check_scene(sc, Plant.from_scene(sc).data)
     assert one_line(e).startswith("optimize.design")
 
 
@@ -141,7 +142,7 @@ def test_virtual_constraints_without_design_refused():
 
     sc = scene_from_dict(_scene(RABBIT, {"target_speed_m_per_s": 0.6}))
     with pytest.raises(ValueError) as e:
-        check_scene(sc)
+        check_scene(sc, Plant.from_scene(sc).data)
     assert one_line(e).startswith("optimize.design")
 
 
@@ -157,7 +158,7 @@ def test_design_refused_where_the_table_refuses_it():
         "feedback": {"kind": "input_output_linearization", "kp_per_s2": 100, "kd_per_s": 20}}}
     sc = scene_from_dict(_scene(cfg, DESIGN))
     with pytest.raises(ValueError) as e:
-        check_scene(sc)
+        check_scene(sc, Plant.from_scene(sc).data)
     assert KINDS["straight_legs"].cell("virtual_constraints", "optimize") in one_line(e)
 
 
@@ -389,7 +390,7 @@ def test_rabbit_controller_walks_in_mujoco(rabbit_designed, i, tmp_path):
     sc = load_scene(folder / c.scene_file)
     out = export_stage.write(sc, tmp_path, "mjcf")
     run = walk(out.path, 21.5 * c.full_order_step_period_s,
-               feedback=virtual_constraint_feedback(sc))
+               feedback=virtual_constraint_feedback(sc, Plant.from_scene(sc).data))
     assert not run.fell
     assert len(run.times_s) >= 20
     speed = (run.positions_m[-1] - run.positions_m[1]) / (run.times_s[-1] - run.times_s[1])
@@ -498,7 +499,7 @@ def test_a_slow_three_link_design_walks_in_mujoco_within_3_percent(slow_designed
     pipeline.run("fixedpoint", sc, runs, False)
     out = export_stage.write(sc, runs, "mjcf")
     run = walk(out.path, 21.5 * c.full_order_step_period_s,
-               feedback=virtual_constraint_feedback(sc))
+               feedback=virtual_constraint_feedback(sc, Plant.from_scene(sc).data))
     assert not run.fell and len(run.times_s) >= 20
     T = np.mean(np.diff(run.times_s[1:]))
     assert T == pytest.approx(c.full_order_step_period_s, rel=0.03)

@@ -13,6 +13,7 @@ from walkerlab.config import load_scene
 from walkerlab.integrate.batch_step import BatchStepMap
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -182,5 +183,5 @@ def test_robustness_refuses_a_3d_walker_before_any_work(tmp_path, name):
     with pytest.raises(StageError, match=r"^walker\.space: 3d: the robustness study"):
         pipeline.run("robustness", scene, tmp_path)
     with pytest.raises(KindRefused, match=r"^walker\.space: 3d: the robustness study"):
-        scene_robustness(scene, np.zeros(6))
+        scene_robustness(scene, np.zeros(6), plant=Plant.from_scene(scene))
     assert time.perf_counter() - t0 < 2.0 and not any(tmp_path.iterdir())

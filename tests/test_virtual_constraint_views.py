@@ -21,6 +21,7 @@ import pytest
 import yaml
 
 from walkerlab.config import scene_from_dict
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = yaml.safe_load((ROOT / "configs" / "rabbit_hzd.yaml").read_text())
@@ -169,7 +170,7 @@ def test_mujoco_export_walks_at_the_rigid_closed_loops_speed(scene, rigid_gait):
 
     runs, period, speed = rigid_gait
     out = write(scene, runs, "mjcf")
-    fb = virtual_constraint_feedback(scene)
+    fb = virtual_constraint_feedback(scene, Plant.from_scene(scene).data)
     model = mujoco.MjModel.from_xml_path(str(out.path))
     key = model.key("gait")
     names = [model.joint(i).name for i in range(model.njnt)]

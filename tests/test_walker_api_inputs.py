@@ -16,6 +16,7 @@ import pytest
 import walkerlab as wl
 from walkerlab.analysis.gait.poincare import StepFailed, poincare_map
 from walkerlab.config import SceneError
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -129,8 +130,9 @@ def test_a_powered_gait_s_ledger_is_the_simulate_stage_s_bit_for_bit():
 
     w = wl.Walker.from_scene(CONFIGS / "powered_compass.yaml")
     gait = w.fixed_point()
-    run = simulate_run(with_strides(w.scene, 1),
-                       SimpleNamespace(x=gait.x, step_period_s=gait.step_period))
+    one = with_strides(w.scene, 1)
+    run = simulate_run(one, SimpleNamespace(x=gait.x, step_period_s=gait.step_period),
+                       Plant.from_scene(one))
     for k, v in run.ledger.items():
         assert gait.ledger[k][0] == v[0], k
     assert gait.step_length == run.steps["step_length"][0]

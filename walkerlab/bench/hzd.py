@@ -195,7 +195,7 @@ def bench_design(repeats: int = 3) -> dict:
     theirs, words = _time_script(root / "walkerlab" / "bench" / "minimal_casadi_hzd.py",
                                  start, vc, repeats)
     t0 = time.perf_counter()
-    optimize_scene(scene, None, None, plant)  # the stage's computation (not its file writing)
+    optimize_scene(scene, None, None, plant=plant)  # the stage's computation (not its file writing)
     stage = time.perf_counter() - t0
 
     def word(key):

@@ -1,7 +1,8 @@
 """The parts of a biped described as data (``model: biped``,
-:class:`walkerlab.config.walker.BipedParams`): its legs (:class:`LegSpec`: bodies on the links, a knee, a foot), feet (point,
-arc, flat with an ankle), knees (locked or free, a knee spring), torso (a point mass or a rigid
-body, coupled or hinged) and torsional springs between links.
+:class:`walkerlab.config.walker.BipedParams`): its legs (:class:`LegSpec`: bodies on the
+links, a knee, a foot), feet (point, arc, flat with an ankle), knees (locked or free, a knee
+spring), torso (a point mass or a rigid body, coupled or hinged) and torsional springs
+between links.
 
 Every numeric field carries its unit in its name (``from_hip_m``) and a description; unknown
 keys are rejected (:class:`~walkerlab.config.base.Strict`).  The parts are expanded into

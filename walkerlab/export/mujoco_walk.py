@@ -153,11 +153,10 @@ class VirtualConstraintFeedback:
         return np.real(self.controller.torques(self.role_state(q, v, stance)))
 
 
-def virtual_constraint_feedback(scene, data=None) -> VirtualConstraintFeedback | None:
+def virtual_constraint_feedback(scene, data) -> VirtualConstraintFeedback | None:
     """:class:`VirtualConstraintFeedback` of ``scene``'s walker (None without
     ``walker.actuation.virtual_constraints``); ``data``: its description
-    (:attr:`walkerlab.walker.plant.Plant.data` of the caller's plant; default: described here
-    from ``scene``).
+    (:attr:`walkerlab.walker.plant.Plant.data` of the caller's plant).
 
     Raises
     ------
@@ -170,9 +169,7 @@ def virtual_constraint_feedback(scene, data=None) -> VirtualConstraintFeedback |
         return None
     from walkerlab.codegen.cache import functions
     from walkerlab.models.virtual_constraints import VirtualConstraintController
-    from walkerlab.walker.plant import Plant  # light
 
-    data = Plant.from_scene(scene).data if data is None else data
     ctrl = VirtualConstraintController(act.virtual_constraints, functions(data),
                                        data.structure, data.params)
     return VirtualConstraintFeedback(ctrl, data.structure.roles)

@@ -19,7 +19,7 @@ __all__ = ["MAX_START_NOISE", "InvalidAction", "check_arguments", "checked_actio
 MAX_START_NOISE = 1.0
 
 
-def rigid_ground(scene, plant=None):
+def rigid_ground(scene, plant):
     """The rigid view's ground beyond its walker's own
     (:func:`walkerlab.integrate.rigid.walker_of_step`: a slope, stairs, footholds of one or
     several heights or slopes, as ``walkerlab simulate`` steps them): a height profile's steps

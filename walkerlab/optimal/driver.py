@@ -102,32 +102,32 @@ def _part(structure) -> Collocation:
     return PARTS[structure.kind.collocation]
 
 
-def needs_gait(scene, plant: Plant | None = None) -> bool:
+def needs_gait(scene, plant: Plant) -> bool:
     """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
     walker kind but one whose guess is built from the targets (a five-link biped:
     :attr:`Collocation.from_targets`) and a walker with no gait of its own
     (:func:`no_gait_of_its_own`), whose step is built from them too
     (:func:`walkerlab.optimal.guess.target_step`).  A kind the collocation does not take
     needs none (the stage refuses it at once).  ``plant``: the scene's
-    :class:`~walkerlab.walker.plant.Plant` (default: described here)."""
+    :class:`~walkerlab.walker.plant.Plant`."""
     if designs_controller(scene):  # starts from the scene's own controller
         return False
-    part = PARTS.get((plant or Plant.from_scene(scene)).kind.collocation)
+    part = PARTS.get(plant.kind.collocation)
     return part is not None and not part.from_targets and not no_gait_of_its_own(scene)
 
 
-def guess_from_targets(scene, plant: Plant | None = None) -> bool:
+def guess_from_targets(scene, plant: Plant) -> bool:
     """Whether the scene's walker kind starts its optimisation from the targets alone, with
     no upstream gait, and needs them (:func:`check_targets`): a five-link biped
     (:attr:`Collocation.from_targets`).  ``plant``: the scene's
-    :class:`~walkerlab.walker.plant.Plant` (default: described here).
+    :class:`~walkerlab.walker.plant.Plant`.
 
     Raises
     ------
     walkerlab.walker.kinds.KindRefused
         A kind the collocation does not take (one line).
     """
-    return _part((plant or Plant.from_scene(scene)).structure).from_targets
+    return _part(plant.structure).from_targets
 
 
 def no_gait_of_its_own(scene) -> bool:
@@ -176,7 +176,7 @@ def check_targets(o) -> None:
 # -- the one entry point -----------------------------------------------------------------
 
 def optimize_scene(scene, x_gait: np.ndarray | None = None,
-                   period_s: float | None = None, plant: Plant | None = None) -> OptimizeData:
+                   period_s: float | None = None, *, plant: Plant) -> OptimizeData:
     """Optimise the scene's gait (the ``optimize`` section) by its walker kind's part
     (:data:`PARTS`): a step, a step of phases, a stride of two steps (legs that differ) or
     a five-link biped's step (module docstring).
@@ -192,8 +192,8 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
         from the targets.
     period_s : float or None
         Its step period [s].
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described once (by the stage); default: described here.
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (by the stage).
 
     Returns
     -------
@@ -216,7 +216,6 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
         import casadi  # noqa: F401 - the collocation's modelling layer and IPOPT
     except ImportError:
         raise ValueError("optimize needs CasADi: pip install -e '.[optimize]'") from None
-    plant = plant or Plant.from_scene(scene)  # the stage's, or described here
     data = plant.data
     if designs_controller(scene):  # virtual constraints: any kind the table lets through
         check_scene(scene, data)
@@ -274,7 +273,7 @@ def check_kind(scene, kind) -> None:
             kind.require("ankle_torque", "optimize", f"walker.actuation.torques.{i}.joint")
 
 
-def check_scene(scene, data=None) -> None:
+def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
     kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
     flat-footed or five-link walker) and a clearance that cannot hold
@@ -284,8 +283,8 @@ def check_scene(scene, data=None) -> None:
     Parameters
     ----------
     scene : Scene
-    data : WalkerData, optional
-        The scene's walker (built from ``scene`` if not given).
+    data : WalkerData
+        The scene's walker (:attr:`walkerlab.walker.plant.Plant.data` of the stage's plant).
 
     Raises
     ------
@@ -298,8 +297,6 @@ def check_scene(scene, data=None) -> None:
     o = getattr(scene, "optimize", None)
     if o is None:
         return
-    if data is None:
-        data = Plant.from_scene(scene).data
     if designs_controller(scene):
         check_design(scene, data.structure.kind)
         return

@@ -55,7 +55,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
     def compute():
         try:
             data = scene_robustness(scene, load_fixedpoint(up).x, workers, scheduler,
-                                    Plant.from_scene(scene))  # described once, handed down
+                                    plant=Plant.from_scene(scene))  # described once, handed down
         except ValueError as exc:
             raise StageError(str(exc)) from None
         return (lambda f: schema.write(f, data)), {"data": data}

@@ -21,7 +21,7 @@ from walkerlab.analysis.robustness.measures import (
 
 
 def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None,
-                     plant=None):
+                     *, plant):
     """Everything ``robustness.h5`` holds for a scene with a ``robustness`` section and its
     gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
     angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
@@ -29,8 +29,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     forward and backward mid-stance pushes (:func:`walkerlab.analysis.robustness.push.apply_push`)
     and
     the Monte Carlo MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.studies.mfpt.monte_carlo`).
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the stage's; default:
-    described here).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the stage's).
 
     Returns
     -------
@@ -51,9 +50,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
     from walkerlab.studies import mfpt as work
-    from walkerlab.walker.plant import Plant  # light
 
-    plant = Plant.from_scene(scene) if plant is None else plant
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
     plant.kind.require_stage("robustness")
     st = scene.robustness or RobustnessSettings()

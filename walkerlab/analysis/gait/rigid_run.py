@@ -125,12 +125,11 @@ def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solve
     return simulate_steps(walker, x0, n_steps, solver, max_step_time=max_step_time)
 
 
-def simulate_run(scene: Scene, fixed_point=None, plant=None):
+def simulate_run(scene: Scene, fixed_point, plant):
     """The ``simulate`` stage's run: the scene's walker from the fixed point ``fixed_point``
     (a loaded ``fixedpoint.h5``, when ``simulate.initial_state`` is ``fixed_point``) or from
     the scene's explicit initial state, simulated and sampled (:func:`simulate_scene`);
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from the stage (default:
-    described here).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from the stage.
 
     Returns
     -------
@@ -147,10 +146,7 @@ def simulate_run(scene: Scene, fixed_point=None, plant=None):
     from walkerlab.config import MAX_SIMULATE_SAMPLES
     from walkerlab.io.schemas.simulate import SimulateRun
     from walkerlab.models.registry import build_walker
-    from walkerlab.walker.plant import Plant  # light
-
     sim = scene.simulate
-    plant = Plant.from_scene(scene) if plant is None else plant
     walker = build_walker(scene, plant)
     if sim.initial_state == "fixed_point":
         x0, period = fixed_point.x, fixed_point.step_period_s
@@ -242,12 +238,12 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = No
                                solver, max_step_time=max_step_time)
 
 
-def profile_ground(scene, plant=None):
+def profile_ground(scene, plant):
     """The scene's height profile as the steps of a rigid walk
     (:class:`walkerlab.analysis.gait.profile_walk.ProfileGround`: each step's walker on its
     landing segment), for :func:`profile_walk` and the Gymnasium environment's rigid view.
     ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once,
-    by the caller; default: described here from the scene).
+    by the caller).
 
     Raises
     ------
@@ -258,11 +254,9 @@ def profile_ground(scene, plant=None):
     from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points  # light
     from walkerlab.models.registry import passive_walker_at
     from walkerlab.walker.kinds import PROFILE_PASSIVE
-    from walkerlab.walker.plant import Plant
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
-    plant = Plant.from_scene(scene) if plant is None else plant
     if scene.walker.model != "compass_gait":  # a described walker: its kind's cell
         plant.kind.require("profile", "rigid", "terrain.kind: profile")
     P = profile_points(scene.terrain)

@@ -199,7 +199,7 @@ def hzd_start(walker):
     return zd.x_plus.copy() if zd.exists else None
 
 
-def solve_variant(scene: Scene, variant: str, guess=None, plant: Plant | None = None):
+def solve_variant(scene: Scene, variant: str, guess, plant: Plant):
     """Fixed point of one equation variant of the scene's walker, from ``guess`` (default:
     the scene's initial guess) - for the comparison of printed equations.  ``plant``: the
     scene's :class:`~walkerlab.walker.plant.Plant` (the variant does not change it).
@@ -221,7 +221,7 @@ def solve_variant(scene: Scene, variant: str, guess=None, plant: Plant | None = 
 
 
 def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
-                    note: str | None = None, nearby=None, plant: Plant | None = None):
+                    note: str | None = None, nearby=None, *, plant: Plant):
     """The period-1 gait of the scene's own equation variant and, with ``compare_variants``
     (a compass gait compared with published numbers), the fixed points of the other
     variants from the same start - what the ``fixedpoint`` artifact stores.
@@ -236,8 +236,8 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         How ``guess`` was found, added to the search's notes.
     nearby : FallbackStart, optional
         A start tried when the scene's own guess fails (:func:`solve_scene`).
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described once (by the stage); default: described here.
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (by the stage).
 
     Returns
     -------
@@ -257,7 +257,6 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     """
     from walkerlab.io.schemas.fixedpoint import FixedPointRun
 
-    plant = Plant.from_scene(scene) if plant is None else plant
     walker, search = solve_scene(scene, guess=guess, ground=True, nearby=nearby, plant=plant)
     if note:
         search.notes.append(note)
@@ -290,13 +289,13 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     return run, summary
 
 
-def gait_ground_contact(scene: Scene, walker, x, plant: Plant | None = None):
+def gait_ground_contact(scene: Scene, walker, x, plant: Plant):
     """Whether the gait from ``x`` (the scene's walker's fixed point) needs only a ground that
     pushes, and the friction it needs against the scene's ``mu``
     (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver;
     :func:`walkerlab.analysis.gait.friction.scene_friction`).
 
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (default: described here).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`.
 
     Returns
     -------
@@ -305,7 +304,6 @@ def gait_ground_contact(scene: Scene, walker, x, plant: Plant | None = None):
     from walkerlab.analysis.gait.checks import ground_contact
     from walkerlab.analysis.gait.friction import scene_friction
 
-    plant = Plant.from_scene(scene) if plant is None else plant
     mu, mu_source = scene_friction(scene)
     return ground_contact(walker, plant.data, x,
                           Solver.from_settings(scene.solver), mu=mu, mu_source=mu_source)
