@@ -11,15 +11,16 @@ from walkerlab.analysis.contact.attribution import adjustment_effect, attribute
 from walkerlab.analysis.contact.periodic import ideal_gait
 from walkerlab.config import load_scene
 from walkerlab.models.contact.scene import build
+from walkerlab.walker.plant import Plant
 
 
 def main(paths):
     for path in paths:
         scene = load_scene(path)
-        ideal = ideal_gait(scene)
-        walker, _ = build(scene, ideal.x, 2)
+        ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
+        walker, _ = build(scene, ideal.x, 2, plant=Plant.from_scene(scene))
         a = attribute(walker, ideal)
-        adj = adjustment_effect(scene, ideal)
+        adj = adjustment_effect(scene, ideal, plant=Plant.from_scene(scene))
         print(f"## {scene.name}: rigid step period {ideal.period_s:.6f} s")
         print("| cause | period gap [ms] | step-length gap [mm] |")
         print("|---|---|---|")

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 
 def _cvode_functions(phase):
     """CVODE's ``rhs(t, y, yp)`` and ``events(t, y, e)`` for one phase (3 arguments each:
@@ -53,7 +55,7 @@ def main() -> None:
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(default_scene())
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     names = w.state_names()
     try:
         guess = scene.fixedpoint.initial_guess.as_array(names)

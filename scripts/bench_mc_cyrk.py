@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -176,7 +178,7 @@ def measure(scene_path: str, walks: int = 500, steps: int = 100, sigma: float = 
     from walkerlab.studies import mfpt as work
 
     scene = load_scene(scene_path)
-    _, search = solve_scene(scene, fd_check=False)
+    _, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
     x = np.asarray(search.gait.result.x, float)
     st = scene.mfpt or MfptSettings()
     W, S = walks, steps

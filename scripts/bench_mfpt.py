@@ -15,6 +15,8 @@ import json
 import time
 from pathlib import Path
 
+from walkerlab.walker.plant import Plant
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -43,7 +45,7 @@ def main() -> None:
     from walkerlab.studies import mfpt as work
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    _, search = solve_scene(scene, fd_check=False)
+    _, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
     x = search.gait.result.x
     out = {}
     t, c = time.perf_counter(), cpu_s()

@@ -17,6 +17,8 @@ import json
 import time
 from pathlib import Path
 
+from walkerlab.walker.plant import Plant
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -31,7 +33,7 @@ def main() -> None:
     from walkerlab.studies.mfpt import step_map_for
 
     sc = load_scene(ROOT / "configs" / "paper.yaml")
-    _, search = solve_scene(sc)
+    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
     x = search.result.x
     base = sc.model_dump(mode="json")
     cases = {"slopes": (step_map_for(base), 0.004, None),

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 
 def per_call_us(fn, number: int) -> float:
@@ -23,7 +24,7 @@ def per_call_us(fn, number: int) -> float:
 def main(paths: list[str]) -> None:
     for p in paths or ["configs/paper.yaml", "configs/paper_rods.yaml", "configs/simplest.yaml"]:
         sc = load_scene(p)
-        w = build_walker(sc)
+        w = build_walker(sc, plant=Plant.from_scene(sc))
         names = w.state_names()
         try:
             x = sc.fixedpoint.initial_guess.as_array(names)

@@ -23,6 +23,7 @@ from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver
+from walkerlab.walker.plant import Plant
 
 
 def _best(fn, repeats: int) -> float:
@@ -42,14 +43,15 @@ def main() -> None:
     a = ap.parse_args()
     sc = load_scene(a.scene)
     solver = Solver.from_settings(sc.solver)
-    w_slope, s = solve_scene(sc)
+    w_slope, s = solve_scene(sc, plant=Plant.from_scene(sc))
     x = s.result.x
     seg = integrate_step(w_slope, x, solver)
     foot = w_slope.points(seg.x_end)["swing_foot"]
     d = sc.model_dump(mode="json")
     d["slope"] = {"angle_rad": 0.0}
     d["terrain"] = {"kind": "stairs", "riser_m": -float(foot[1]), "tread_m": float(foot[0])}
-    w_stairs, s2 = solve_scene(scene_from_dict(d))
+    sc1 = scene_from_dict(d)
+    w_stairs, s2 = solve_scene(sc1, plant=Plant.from_scene(sc1))
     print(f"{a.scene}: riser {-1e3 * float(foot[1]):.4f} mm; same gait: "
           f"{np.max(np.abs(s2.result.x - x)):.1e} rad")
     out = {}

@@ -41,6 +41,7 @@ from walkerlab.models.contact.scene import contact_setup
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml"
 #: samples per second of each step's run: the heel strike is read at the first sample at or
@@ -60,7 +61,7 @@ def rigid_gait(scene, double_support: bool = True):
     """The rigid view's fixed point (role order) and step period [s]; ``double_support``
     False: the rigid view without its double support (the trailing foot released at heel
     strike, walkerlab before issue 48)."""
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     if not double_support:
         walker = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad),
                                    double_support=False)
@@ -89,7 +90,7 @@ def step_periods(scene, x_ideal, steps: int, rigid_rule: bool,
     ``foot_mass_scale`` scales the flat feet's mass and inertia; ``spacing_m`` [m] lays the
     patches at that step instead of the rigid gait's (:data:`CONTACT_STEP_M`: the contact
     gait's own, so that its footfalls stay on their patches)."""
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     law = setup.law.model_copy(update={
         "flat_foot_mass_kg": FOOT_KG * foot_mass_scale,
         "flat_foot_inertia_kg_m2": FOOT_KG_M2 * foot_mass_scale})

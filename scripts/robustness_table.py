@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 ROOT = Path(__file__).resolve().parents[1]
 WALKERS = ("paper", "goswami1996", "paper_rods", "round_feet", "kneed", "simplest",
            "schwab_wisse2001", "hip_spring", "torso_bhm", "asymmetric_legs")
@@ -37,10 +39,11 @@ def row(name: str) -> str:
     t = time.perf_counter()
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
     try:
-        sm = BatchStepMap(build_walker(sc), scene_walker_at(sc), 1e-12, 1e-12)
+        sm = BatchStepMap(build_walker(sc, plant=Plant.from_scene(sc)), scene_walker_at(sc,
+                plant=Plant.from_scene(sc)), 1e-12, 1e-12)
     except ValueError as exc:
         return f"| {name} | not supported: {exc} |"
-    w, s = solve_scene(sc, fd_check=False)
+    w, s = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
     if w.steps_per_map != 1:
         return f"| {name} | not supported: legs that differ (a stride map) |"
     g = s.gait.result
@@ -75,12 +78,12 @@ def contact_row(name: str) -> str:
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
     if sc.contact is None:
         return f"| {name} | no contact section |"
-    _, s = solve_scene(sc, fd_check=False)
+    _, s = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
     start = "periodic gait"
     try:
-        st = contact_start(sc, s.gait.result.x)
+        st = contact_start(sc, s.gait.result.x, plant=Plant.from_scene(sc))
     except Exception:  # no periodic gait in time: the contact run's own start (a transient)
-        st = contact_start(sc, s.gait.result.x, periodic=False)
+        st = contact_start(sc, s.gait.result.x, periodic=False, plant=Plant.from_scene(sc))
         start = "contact-sim start (no periodic gait found in time)"
     cells = [name, f"{st.period_s:.6f} ({start})"]
     for sign in (1.0, -1.0):

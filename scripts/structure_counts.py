@@ -1,6 +1,7 @@
 """The package's structure in numbers: each row of the structure table (per-kind tables, walker
-kinds named as strings, ``"contact-sim"`` literals, ``walker_data`` callers, the modules
-that describe a walker themselves (``Plant.from_scene``) below the front doors, the places that
+kinds named as strings, ``"contact-sim"`` literals, ``walker_data`` callers, the functions
+below the front doors that describe the walker themselves when handed no plant (a
+``plant=None`` fallback to ``Plant.from_scene``), the places that
 write the Christoffel symbols, code kept as text, module and function sizes, duplicates, arrows
 back up and import circles, the gym's run-time parsing and hook swapping), with its goal and
 pass/fail.
@@ -127,6 +128,7 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
 
     tables, kind_files, cs_files, wd_calls, christoffel = [], set(), set(), {}, []
     plant_builds = {}  # module -> ["line (plant=None default)" or "line"]
+    plant_fallbacks = {}  # module -> ["function:line"]: a plant parameter defaulting to None
     long_strings, gym_parse, gym_hook = [], [], []
     for p in files:
         r, tree = rel(p), trees[p]
@@ -142,6 +144,16 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
                     tables.append(f"{r}:{n.lineno}")
             if isinstance(n, ast.Call) and _call_name(n) == "walker_data":
                 wd_calls.setdefault(r, []).append(n.lineno)
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                a = n.args
+                pos = a.posonlyargs + a.args
+                defaults = dict(zip([x.arg for x in pos][len(pos) - len(a.defaults):],
+                                    a.defaults))
+                defaults.update({x.arg: d for x, d in zip(a.kwonlyargs, a.kw_defaults)
+                                 if d is not None})
+                d = defaults.get("plant")
+                if isinstance(d, ast.Constant) and d.value is None:
+                    plant_fallbacks.setdefault(r, []).append(f"{n.name}:{n.lineno}")
             if isinstance(n, ast.Call) and _call_name(n) == "from_scene" \
                     and getattr(n.func.value, "id", "") == "Plant":
                 lines = texts[p].splitlines()  # a default: built only when none is given
@@ -177,9 +189,11 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
     wd_out = {r: v for r, v in wd_calls.items()
               if r.split("/")[0] not in ("walker", "stages", "api")}
     # the front: the stages, the API (and its rigid walker, rigid_walker.SceneWalker), the CLI
+    front = ("walker", "stages", "api", "cli", "rigid_walker")
     plant_out = {r: v for r, v in plant_builds.items()
-                 if r.removesuffix(".py").split("/")[0]
-                 not in ("walker", "stages", "api", "cli", "rigid_walker")}
+                 if r.removesuffix(".py").split("/")[0] not in front}
+    fallback_out = {r: v for r, v in plant_fallbacks.items()
+                    if r.removesuffix(".py").split("/")[0] not in front}
 
     # arrows back up, by the floors of tests/test_layers.py's LAYERS
     layers = tl.LAYERS
@@ -209,8 +223,11 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
         ("modules calling walker_data(...) outside walker/, stages/, api/", len(wd_out), 0,
          {"modules": sorted(wd_out), "calls in all": sum(map(len, wd_calls.values())),
           "files in all": len(wd_calls)}),
-        ("modules building a Plant (Plant.from_scene) below the front", len(plant_out), 3,
-         {f"{r}": v for r, v in sorted(plant_out.items())}),
+        ("functions below the front describing the walker when handed no plant",
+         sum(map(len, fallback_out.values())), 0,
+         {"fallbacks (plant=None)": {r: v for r, v in sorted(fallback_out.items())},
+          "modules describing a scene they made (Plant.from_scene: a study's point, a "
+          "search's planar twin, a bench)": sorted(plant_out)}),
         ("modules writing the Christoffel symbols", len(christoffel), 1, christoffel),
         ("strings of >= 60 lines outside codegen/", len(long_strings), 0, long_strings),
         ("modules > 800 lines", sum(v > 800 for v in sizes.values()), 0,

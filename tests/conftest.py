@@ -18,6 +18,7 @@ from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.published import paper
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 TIGHT = Solver("DOP853", 1e-12, 1e-12)
@@ -30,7 +31,7 @@ def paper_scene():
 
 @pytest.fixture(scope="session")
 def paper_walker(paper_scene):
-    return build_walker(paper_scene)
+    return build_walker(paper_scene, plant=Plant.from_scene(paper_scene))
 
 
 @pytest.fixture(scope="session")

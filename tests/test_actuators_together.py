@@ -20,6 +20,7 @@ from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -30,7 +31,7 @@ def _flat_push_off() -> dict:
 
 def _step(d: dict, n: int = 1, x0=None):
     scene = scene_from_dict(d)
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     if x0 is None:
         x0 = scene.fixedpoint.initial_guess.as_array(w.state_names())
     traj = simulate_steps(w, x0, n, Solver.from_settings(scene.solver), max_step_time=3.0)
@@ -134,13 +135,15 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
                                                 "rest_angle_rad": 0.3,
                                                 "damping_n_m_s_per_rad": 0.5}}],
            "push_off": {"impulse_n_s": 1.0}}
-    w0, w1 = build_walker(_partly_massless(act)), build_walker(_partly_massless(act, 1e-10))
+    s0, s1 = _partly_massless(act), _partly_massless(act, 1e-10)
+    w0, w1 = (build_walker(s, plant=Plant.from_scene(s)) for s in (s0, s1))
     rng = np.random.default_rng(7)
     for _ in range(3):
         x = np.array([0.2, 0.4, -0.9, 0.3]) + rng.normal(0.0, 0.05, 4)
         f0, f1 = w0.phases[0].flow(0.0, x), w1.phases[0].flow(0.0, x)
         np.testing.assert_allclose(f0, f1, rtol=0, atol=1e-8)
-        assert np.max(np.abs(f0[2:] - build_walker(_partly_massless(None)).phases[0].flow(
+        sc = _partly_massless(None)
+        assert np.max(np.abs(f0[2:] - build_walker(sc, plant=Plant.from_scene(sc)).phases[0].flow(
             0.0, x)[2:])) > 0.1  # the torque acts
         np.testing.assert_allclose(w0.reset(x), w1.reset(x), rtol=0, atol=1e-8)
         # the energy's rate along the flow is the torque's power (central differences of
@@ -155,19 +158,23 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
     light = copy.deepcopy(torso)
     torso["walker"]["leg"]["bodies"][0]["mass_kg"] = 0.0
     light["walker"]["leg"]["bodies"][0]["mass_kg"] = 1e-10
-    t0, t1 = (build_walker(scene_from_dict(c)) for c in (torso, light))
+    t0, t1 = (build_walker(sc, plant=Plant.from_scene(sc))
+              for sc in (scene_from_dict(c) for c in (torso, light)))
     x = np.array([-0.2, 0.2, -1.0, -0.9])
     np.testing.assert_allclose(t0.phases[0].flow(0.0, x), t1.phases[0].flow(0.0, x),
                                rtol=1e-8, atol=1e-8)  # O(1e-10 kg): seen 8e-10 relative
     torso["walker"]["actuation"]["push_off"] = act["push_off"]
     with pytest.raises(ValueError, match=r"actuation\.push_off") as e:
-        build_walker(scene_from_dict(torso))
+        sc = scene_from_dict(torso)
+        build_walker(sc, plant=Plant.from_scene(sc))
     assert "\n" not in str(e.value)
     with pytest.raises(ValueError, match=r"torques\.0\.joint") as e:
-        build_walker(_partly_massless({"torques": act["torques"]}, from_hip_a=0.0))
+        sc = _partly_massless({"torques": act["torques"]}, from_hip_a=0.0)
+        build_walker(sc, plant=Plant.from_scene(sc))
     assert "\n" not in str(e.value)
     with pytest.raises(ValueError, match=r"actuation\.push_off") as e:
-        build_walker(_partly_massless({"push_off": act["push_off"]}, from_hip_a=0.0))
+        sc = _partly_massless({"push_off": act["push_off"]}, from_hip_a=0.0)
+        build_walker(sc, plant=Plant.from_scene(sc))
     assert "\n" not in str(e.value)
 
 
@@ -180,6 +187,6 @@ def test_the_contact_view_carries_a_five_link_push_off():
     d = load_scene(CONFIGS / "rabbit.yaml").model_dump(exclude_none=True)
     d["walker"]["actuation"]["push_off"] = {"impulse_n_s": 1.0}
     scene = scene_from_dict(d)
-    build_walker(scene)  # the rigid view takes it
-    acts = contact_setup(scene).actuators
+    build_walker(scene, plant=Plant.from_scene(scene))  # the rigid view takes it
+    acts = contact_setup(scene, plant=Plant.from_scene(scene)).actuators
     assert acts is not None and acts.spec.push_off.impulse_n_s == 1.0

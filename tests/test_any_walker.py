@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from walkerlab.models.hybrid.base import Guard, HybridWalker, Phase
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 K, C, TORSO_M = 40.0, 8.0, 0.3  # spring [1/s^2], damping [1/s], drawn torso length [m]
@@ -92,7 +93,7 @@ def scene():
 def walker(scene):
     from walkerlab.models.registry import build_walker
 
-    return torso_walker(build_walker(scene))
+    return torso_walker(build_walker(scene, plant=Plant.from_scene(scene)))
 
 
 @pytest.fixture(scope="module")

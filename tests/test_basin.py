@@ -8,6 +8,7 @@ import yaml
 
 from walkerlab.config import BasinSettings, load_scene
 from walkerlab.studies.basin import CODE, NOT_DONE, BasinError, classify_cell, slice_state
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -108,7 +109,7 @@ def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
     from walkerlab.studies.basin import heel_strike_slice, pre_impact_fixed_point
 
     sc = _simplest(tmp_path)
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     names = w.state_names()
     th, ph, thd, phd = (names.index(n) for n in ("stance_angle", "hip_angle", "stance_rate",
                                                    "hip_rate"))
@@ -176,7 +177,8 @@ def test_a_3d_wheel_that_settles_rolling_at_another_heading_has_converged():
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
-    w = build_walker(load_scene(DISC))
+    sc = load_scene(DISC)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     st = BasinSettings(max_steps=10)
     sv = Solver("DOP853", st.rtol, st.atol)
     guess = np.array([0.0, 0.0, np.pi / 8 - 0.2, 0.0, 0.0, -1.9])

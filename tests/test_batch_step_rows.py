@@ -15,6 +15,7 @@ from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.integrate.rows_dop853 import reset_rows
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -28,7 +29,8 @@ def _one_guard_set(sm, rows: int) -> tuple:
 
 @pytest.fixture(scope="module")
 def paper_map(paper_scene):
-    return BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-9, 1e-9)
+    return BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+                        scene_walker_at(paper_scene, plant), 1e-9, 1e-9)
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
@@ -54,13 +56,13 @@ def test_compiled_reset_is_the_walkers_reset(scene):
     Python ``reset``), applied row by row by ``rows_dop853.reset_rows``, gives the walker's
     heel-strike reset bit for bit, on two slopes."""
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     cf = w.phases[-1].compiled
     mod = compiled_module(cf.structure)
     n = w.layout().size
     X = 0.3 * np.random.default_rng(1).standard_normal((5, n))
     for gamma in (w.slope_rad, w.slope_rad + 0.02):
-        wg = scene_walker_at(sc)(gamma)
+        wg = scene_walker_at(sc, plant=Plant.from_scene(sc))(gamma)
         D = np.tile(wg.phases[-1].compiled.data(), (5, 1))
         out = np.empty_like(X)
         reset_rows(mod.reset_flow(), X, D, out)
@@ -98,7 +100,8 @@ def test_kneed_walker_keeps_the_step_by_step_walks():
     """A kneed walker (two flows, the knee strike's reset between phases) is not walked in
     one compiled call: ``can_walk`` is False and ``walk`` says why in one line."""
     sc = load_scene(ROOT / "configs" / "kneed.yaml")
-    sm = BatchStepMap(build_walker(sc), scene_walker_at(sc), 1e-9, 1e-9)
+    sm = BatchStepMap(build_walker(sc, plant=Plant.from_scene(sc)), scene_walker_at(sc,
+            plant=Plant.from_scene(sc)), 1e-9, 1e-9)
     assert not sm.can_walk
     with pytest.raises(ValueError, match="compiled walks need"):
         sm.walk(np.zeros((1, sm.n)), np.zeros((1, 1)))
@@ -117,7 +120,7 @@ def test_stage_and_guard_cfuncs_are_the_flows_values(scene):
         return v.ctypes.data_as(POINTER(c_double))
 
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     cf = w.phases[0].compiled
     mod = compiled_module(cf.structure)
     n, ng = w.layout().size, len(mod.GUARDS)
@@ -300,14 +303,16 @@ def test_loops_specialised_to_the_flow_give_the_cfunc_loops_numbers(scene):
     from walkerlab.walker.description import walker_data
 
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     w_hts = with_clearance_guard(w, walker_data(sc.walker, sc.slope.phi_rad))
-    maps = [[BatchStepMap(wk, scene_walker_at(sc), 1e-9, 1e-9, specialised=s)
+    maps = [[BatchStepMap(wk, scene_walker_at(sc,
+            plant=Plant.from_scene(sc)), 1e-9, 1e-9, specialised=s)
              for wk in (w, w_hts)] for s in (True, False)]
     assert all(maps[0][0]._kernels(k) is not None for k in range(len(w.phases)))
     assert all(maps[1][0]._kernels(k) is None for k in range(len(w.phases)))
     rng = np.random.default_rng(3)
-    x0 = np.asarray(solve_scene(sc, fd_check=False)[1].gait.result.x, float)
+    x0 = np.asarray(solve_scene(sc, fd_check=False,
+                                plant=Plant.from_scene(sc))[1].gait.result.x, float)
     gam = maps[0][0].slope_rad + 0.006 * rng.standard_normal((30, 10))
     hts = 0.002 * rng.standard_normal((30, 10))
     X = x0 + 0.005 * rng.standard_normal((30, x0.size))

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from tests.scripts_loader import load_file
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -29,7 +30,7 @@ def test_bare_script_finds_the_paper_walkers_fixed_point(paper_scene):
     assert out.returncode == 0, out.stderr[-2000:]
     words = out.stdout.split()
     bare = np.array([float(w) for w in words[2:6]])
-    _, search = solve_scene(paper_scene, fd_check=False)
+    _, search = solve_scene(paper_scene, fd_check=False, plant=Plant.from_scene(paper_scene))
     np.testing.assert_allclose(bare, search.gait.result.x, rtol=0, atol=1e-9)
     assert "walkerlab" not in out.stderr
 

@@ -77,7 +77,8 @@ def _contact(d, tmp):
     # contact-sim starts from the rigid gait (fixedpoint.h5; on a profile the slope's): its
     # walker
     assert Walker.from_scene(d).model is not None
-    contact_setup(scene_from_dict(d))
+    sc = scene_from_dict(d)
+    contact_setup(sc, plant=Plant.from_scene(sc))
 
 
 def _export(fmt):

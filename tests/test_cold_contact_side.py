@@ -19,6 +19,7 @@ from walkerlab.codegen import pending
 from walkerlab.config import load_scene
 from walkerlab.models.contact.scene import contact_setup
 from walkerlab.stages import contact_sim
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -76,7 +77,8 @@ def test_the_right_hand_side_is_compiled_beside_only_on_a_cold_run(cached, fake_
                                                                    monkeypatch):
     from walkerlab.models.contact import generated
 
-    setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_x", cached))
     used: list[bool] = []
     with contact_sim._rhs_beside(setup, None) as run_setup:
@@ -103,7 +105,8 @@ def test_a_run_whose_kernel_a_caller_compiles_beside_starts_nothing(fake_side, m
     walk waits for the report's."""
     from walkerlab.models.contact import generated
 
-    setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_r", False))
     seen: list[str] = []
     ready = pending.CompiledElsewhere("mod_r", "build_cyrk", lambda: seen.append("report's"))
@@ -120,7 +123,8 @@ def test_a_side_process_that_was_never_needed_is_stopped(fake_side, monkeypatch)
 
     from walkerlab.models.contact import generated
 
-    setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_y", False))
     monkeypatch.setattr(_FakeSide, "submit", lambda self, fn, *a: Future())  # still running
     with contact_sim._rhs_beside(setup, None):
@@ -133,10 +137,11 @@ def test_a_side_process_that_was_never_needed_is_stopped(fake_side, monkeypatch)
 
 def test_a_compiled_walk_is_what_the_side_process_serves():
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    assert contact_sim._compiled_walk(contact_setup(scene))  # cyrk_bdf
+    assert contact_sim._compiled_walk(contact_setup(scene,
+                                                    plant=Plant.from_scene(scene)))  # cyrk_bdf
     odeint = scene.model_copy(update={"contact_solver": scene.contact_solver.model_copy(
         update={"method": "odeint"})})
-    assert not contact_sim._compiled_walk(contact_setup(odeint))
+    assert not contact_sim._compiled_walk(contact_setup(odeint, plant=Plant.from_scene(odeint)))
 
 
 _COLD = r"""

@@ -18,6 +18,7 @@ from walkerlab.integrate.python_step import needs_python_path
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 PHASE = [-0.18, -0.12, -0.06, 0.0, 0.06, 0.12, 0.18]
 HIP = [0.3469, 0.3257, 0.2367, 0.0, -0.2367, -0.3257, -0.3469]  # the push-off gait's
@@ -55,7 +56,8 @@ CASES = {"linear": _pd("linear"), "cubic": _pd("cubic"),
 def test_the_law_block_evaluates_the_laws_as_torque_laws(name):
     """Plain Python (no numba): ``law_torque`` on the packed block against
     ``TorqueLaws.each``, its partial derivatives against the complex step through it."""
-    w = build_walker(scene_from_dict(_scene(CASES[name])))
+    sc = scene_from_dict(_scene(CASES[name]))
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     laws = w.actuators.laws
     b = laws.packed()
     rng = np.random.default_rng(5)
@@ -90,7 +92,8 @@ def test_the_actuated_cfuncs_are_the_python_flow_and_jacobian(name):
     before or after the solve) and ``(J + chain) Phi`` to 1e-11 of the complex-step
     Jacobian; the guards' outputs are the Python guards'."""
     pytest.importorskip("numba")
-    w = build_walker(scene_from_dict(_scene(CASES[name])))
+    sc = scene_from_dict(_scene(CASES[name]))
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     w.actuators.begin_step(0.1)
     for ph in w.phases:
         cf = ph.compiled
@@ -118,7 +121,8 @@ def test_steps_on_compiled_laws_agree_with_the_python_path(name):
     same heel strikes to the integrator's tolerance (rtol = atol = 1e-11 per step; the
     paths take different steps and locate the guards on different dense outputs)."""
     pytest.importorskip("numba")
-    w = build_walker(scene_from_dict(_scene(CASES[name])))
+    sc = scene_from_dict(_scene(CASES[name]))
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     assert needs_python_path(w)  # the batched map would run the passive cfuncs
     runs = [simulate_steps(w, X0, 2, Solver("DOP853", 1e-11, 1e-11, None, b))
             for b in ("cyrk", "cyrk_compiled")]
@@ -138,7 +142,7 @@ def test_rabbit_runs_its_virtual_constraints_on_compiled_flows():
     from walkerlab.config import load_scene
 
     sc = load_scene("configs/rabbit.yaml")
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     x0 = sc.fixedpoint.initial_guess.as_array(w.state_names())
     cf = w.phases[0].compiled
     mod = cf.module()

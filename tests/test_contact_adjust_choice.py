@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 
 from walkerlab.analysis.contact import adjust as contact_adjust
 from walkerlab.cli import app
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -92,7 +93,8 @@ def _paper_setup(**sim):
     from walkerlab.config import scene_from_dict
     from walkerlab.models.contact.scene import contact_setup
     d = {**PAPER, "name": "paper", "contact_sim": {**PAPER["contact_sim"], **sim}}
-    return contact_setup(scene_from_dict(d))
+    sc = scene_from_dict(d)
+    return contact_setup(sc, plant=Plant.from_scene(sc))
 
 
 def test_adjust_search_on_a_walker_that_always_falls_keeps_the_scenes_start(monkeypatch):

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.walker.plant import Plant
 
 
 @pytest.mark.slow  # a periodic-gait search (~3 s CPU) and a 2-stride contact run
@@ -23,8 +24,9 @@ def test_run_from_the_periodic_gait_has_constant_step_periods():
     from walkerlab.models.contact.scene import contact_setup
 
     scene = load_scene("configs/paper.yaml")
-    ideal = ideal_gait(scene)
-    _, res, _, _, gait = simulate_from_periodic_gait(contact_setup(scene), ideal.x,
+    ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
+    _, res, _, _, gait = simulate_from_periodic_gait(contact_setup(scene,
+            plant=Plant.from_scene(scene)), ideal.x,
                                                      strides=2)
     assert gait.converged and gait.residual < 1e-8
     hs = np.asarray(res.heel_strike_times)
@@ -126,7 +128,8 @@ def test_a_start_whose_periodic_gait_is_not_found_says_why_in_one_line(monkeypat
         raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit reached")
 
     monkeypatch.setattr(periodic, "simulate_from_periodic_gait", fails)
-    setup = contact_setup(load_scene("configs/torso_bhm.yaml"))
+    sc = load_scene("configs/torso_bhm.yaml")
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     with pytest.raises(PeriodicGaitError, match="contact_sim.start: periodic_gait") as e:
         contact_sim_run(setup, SimpleNamespace(x=np.zeros(4), step_period_s=np.nan))
     assert e.value.kind == "time_limit" and "wall-time limit" in str(e.value)

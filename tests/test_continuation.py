@@ -29,12 +29,14 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.continuation import run_continuation
 from walkerlab.studies.params import apply_point
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _walker(scene, path, p):
-    return build_walker(apply_point(scene.model_dump(mode="json"), [path], (p,)))
+    sc = apply_point(scene.model_dump(mode="json"), [path], (p,))
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 def _kmap(walker, x, solver, k, tmax):
@@ -305,7 +307,8 @@ def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.config import scene_from_dict
 
-    _w, search = solve_scene(scene_from_dict(rod), fd_check=False)
+    sc = scene_from_dict(rod)
+    _w, search = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
     ref = _independent_orbit(scene_from_dict(rod), "walker.leg.bodies.rod.mass_kg", 3.5,
                              data.state_at(3.5), 1)[0]
     assert np.max(np.abs(search.result.x - ref)) < 1e-9
@@ -324,7 +327,7 @@ def test_stance_foot_normal_force_from_the_equations_of_motion():
     from walkerlab.analysis.continuation.validity import normal_force_ratio
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     s = Solver.from_settings(scene.solver)
     x0 = np.array([-0.3234, 0.2187, -0.3801, -1.0932])  # near the gait: any step will do
     segs = step_map(w, w.from_section(w.section(x0)), s, 1, segments=True)[3]
@@ -550,7 +553,8 @@ def test_the_disc_wheels_critical_slope_is_a_branch_point_the_family_passes_thro
 
     side = []
     for a in (0.18, 0.19):
-        w = build_walker(apply_point(scene.model_dump(mode="json"), ["slope.angle_rad"], (a,)))
+        sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_rad"], (a,))
+        w = build_walker(sc, plant=Plant.from_scene(sc))
         r = find_fixed_point(w, bp.x, s, fd_check=False)
         m = np.sort(np.abs(r.multipliers_variational))[::-1]
         side.append(m[0] if m[0] > 1 + 1e-6 else m[1])  # the largest besides the neutral 1
@@ -577,7 +581,8 @@ def test_a_3d_continuation_over_hip_width_is_per_stride_from_the_planar_embeddin
     assert data.steps_per_map == 2
     br = data.branches[0]
     p, big = br["param"], np.max(np.abs(br["multipliers"]), axis=1)
-    _w, search = solve_scene(load_scene(ROOT / "configs" / "paper_3d.yaml"), fd_check=False)
+    sc = load_scene(ROOT / "configs" / "paper_3d.yaml")
+    _w, search = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
     step = np.max(np.abs(search.result.multipliers_variational))
     assert big[np.argmin(p)] == pytest.approx(step ** 2, rel=1e-6)
     assert big[np.argmax(p)] == pytest.approx(99.9294, rel=1e-5)

@@ -9,6 +9,7 @@ import yaml
 from typer.testing import CliRunner
 
 from walkerlab.cli import app
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -54,12 +55,15 @@ def test_a_scene_without_contact_sets_up_the_papers_contact_law():
     from walkerlab.config import scene_from_dict
     from walkerlab.models.contact.scene import contact_setup
 
-    bare = contact_setup(scene_from_dict(BARE | {"name": "bare"}))
-    empty = contact_setup(scene_from_dict(BARE | {"name": "empty", "contact": {}}))
-    paper = contact_setup(scene_from_dict(BARE | {"name": "paper",
+    sc = scene_from_dict(BARE | {"name": "bare"})
+    bare = contact_setup(sc, plant=Plant.from_scene(sc))
+    sc1 = scene_from_dict(BARE | {"name": "empty", "contact": {}})
+    empty = contact_setup(sc1, plant=Plant.from_scene(sc1))
+    sc2 = scene_from_dict(BARE | {"name": "paper",
                                                   "contact": PAPER["contact"] | {
                                                       "stiction_velocity_mm_per_s": 100.0,
-                                                      "friction_velocity_mm_per_s": 1000.0}}))
+                                                      "friction_velocity_mm_per_s": 1000.0}})
+    paper = contact_setup(sc2, plant=Plant.from_scene(sc2))
     assert bare.law == empty.law == paper.law
     assert bare.law_si == paper.law_si and bare.knee_stop == paper.knee_stop
     assert bare.solver == paper.solver  # contact_solver left out: the contact default

@@ -36,6 +36,7 @@ from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.multibody import multibody
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 REL = 1e-12
@@ -102,7 +103,7 @@ def _round_trip(scene, mb, adm):
     from walkerlab.export.adams import adams_start
 
     model = read_adm(adm)
-    start = adams_start(scene, mb, walker_data(scene.walker, scene.slope.phi_rad))
+    start = adams_start(scene, mb, Plant.from_scene(scene))
     ids = part_ids(mb)
     total = sum(model.part_mass(p) for p in model.by_kind["PART"] if p != 1)
     assert math.isclose(total, mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links),

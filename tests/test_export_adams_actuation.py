@@ -43,6 +43,7 @@ from walkerlab.integrate.powered_events import pulse_lead
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.multibody import multibody
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 MM = 1000.0
@@ -86,7 +87,7 @@ def compass_start():
     scene = load_scene(ROOT / "configs" / "powered_compass.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
-    return scene, mb, data, adams_start(scene, mb, data)
+    return scene, mb, data, adams_start(scene, mb, Plant.from_scene(scene))
 
 
 @pytest.fixture(scope="module")
@@ -101,7 +102,7 @@ def powered(tmp_path_factory, compass_start):
         "slope.angle_rad": 0.02, "contact.push_off_duration_s": 0.005})
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
-    return scene, mb, adm_text(scene, mb, data, "powered_hip", "test", start)
+    return scene, mb, adm_text(scene, mb, Plant.from_scene(scene), "powered_hip", "test", start)
 
 
 class AdamsState:
@@ -320,7 +321,7 @@ def test_powered_compass_carries_its_push_off(compass_start):
     (contact.push_off_duration_s), no hip torque SFORCE (it has none), no "NOT exported"
     line; the passive statements before it as they were."""
     scene, mb, data, start = compass_start
-    adm = adm_text(scene, mb, data, "powered_compass", "test", start)
+    adm = adm_text(scene, mb, Plant.from_scene(scene), "powered_compass", "test", start)
     assert "NOT exported" not in adm
     model = read_adm(adm)
     v = model.functions()
@@ -369,7 +370,7 @@ def test_five_link_joint_torques_equal_walkerlab_laws():
     # a stand-in start (the laws do not read it): the gait search is not this test's
     start = AdamsStart((0.1, 0.75), (0.7, 0.0), dict.fromkeys(names, 0.1),
                        dict.fromkeys(names, 0.0), None, 0.1, 0.37, (1.0, 1.0))
-    adm = adm_text(scene, mb, data, "rabbit", "test", start)
+    adm = adm_text(scene, mb, Plant.from_scene(scene), "rabbit", "test", start)
     assert all(len(ln) <= LINE_WIDTH for ln in adm.splitlines())
     model = read_adm(adm)
     v = model.functions()

@@ -40,6 +40,7 @@ from walkerlab.models.hybrid.ankle_push_off import AnklePushOffActuator
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.multibody import multibody
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 MM = 1000.0
@@ -191,8 +192,8 @@ def test_ankle_push_off_function_equals_walkerlab_law(flat_push, tmp_path_factor
     scene1 = load_scene(path)
     from walkerlab.export.adams import adams_start, adm_text
 
-    start = adams_start(scene0, mb, walker_data(scene0.walker, scene0.slope.phi_rad))
-    model1 = read_adm(adm_text(scene1, mb, walker_data(scene1.walker, 0.0), "s", "t", start))
+    start = adams_start(scene0, mb, Plant.from_scene(scene0))
+    model1 = read_adm(adm_text(scene1, mb, Plant.from_scene(scene1).on_slope(0.0), "s", "t", start))
     ids = part_ids(mb)
     rng = np.random.default_rng(48)
     on_seen = 0
@@ -284,8 +285,8 @@ def test_ankle_and_hip_torques_on_flat_feet_equal_walkerlab_laws(flat, tmp_path_
     path = tmp_path_factory.mktemp("ankle_t") / "flat_torques.yaml"
     path.write_text(yaml.safe_dump(raw))
     scene = load_scene(path)
-    start = adams_start(scene0, mb, data0)
-    model = read_adm(adm_text(scene, mb, walker_data(scene.walker, scene.slope.phi_rad),
+    start = adams_start(scene0, mb, Plant.from_scene(scene0))
+    model = read_adm(adm_text(scene, mb, Plant.from_scene(scene),
                               "t", "t", start))
     v = model.functions()
     ids = part_ids(mb)

@@ -25,6 +25,7 @@ from walkerlab.export.adams_reader import read_adm
 from walkerlab.export.adams_statements import MM
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.multibody import multibody
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -74,7 +75,7 @@ def test_adams_knee_latch_equals_the_contact_models(foot):
     scene = _kneed(foot)
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
-    model = read_adm(adm_text(scene, mb, data, "k", "test"))
+    model = read_adm(adm_text(scene, mb, Plant.from_scene(scene), "k", "test"))
     sforces = model.functions("SFORCE")
     variables = model.functions()
     assert set(LATCH_SFORCE.values()) <= set(sforces)
@@ -136,9 +137,9 @@ def test_adams_knee_latch_on_footholds_reads_the_tread_under_the_foot(foot):
     scene = _kneed(foot, kind="footholds", foothold_heights_m=[-0.005])
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
-    start = adams_start(scene, mb, data)
+    start = adams_start(scene, mb, Plant.from_scene(scene))
     assert start.lane_heights is not None and adams_omissions(scene, mb) == ()
-    model = read_adm(adm_text(scene, mb, data, "k", "test", start))
+    model = read_adm(adm_text(scene, mb, Plant.from_scene(scene), "k", "test", start))
     sforces, variables = model.functions("SFORCE"), model.functions()
     from walkerlab.config.contact import ContactSettings
     from walkerlab.models.contact.model import ContactWalker

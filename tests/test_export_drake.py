@@ -36,6 +36,7 @@ from tests.test_export import _joint_map, _states
 from walkerlab.config import load_scene
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 # found, not imported: pydrake (with its own Eigen, urdfdom, ...) loads only in the worker
 # that runs these tests
@@ -154,7 +155,8 @@ def test_compass_limit_cycle_matches_drakes_compass_gait(tmp_path):
                     "leg_mass_from_foot_m": p.length_leg() - p.center_of_mass_leg()},
          "slope": {"angle_rad": p.slope()}}  # no fixedpoint section: the automatic search
     (tmp_path / "drake.yaml").write_text(yaml.safe_dump(d))
-    x = ideal_gait(load_scene(tmp_path / "drake.yaml")).x  # swing, stance, their rates
+    sc = load_scene(tmp_path / "drake.yaml")
+    x = ideal_gait(sc, plant=Plant.from_scene(sc)).x  # swing, stance, their rates
     ours = -np.array([x[1], x[0], x[3], x[2]])  # Drake's stance, swing, stancedot, swingdot
     start = ours * np.array([1.0, 1.0, 1.01, 1.0])
     theirs, slope = _drake_limit_cycle_point(start, 20.0)

@@ -20,6 +20,7 @@ from walkerlab.codegen.floating import floating_view
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 #: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
 #: of CPU to build): one worker builds it once
@@ -215,7 +216,8 @@ def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / "rabbit.yaml")
-    x = scene.fixedpoint.initial_guess.as_array(build_walker(scene).state_names())
+    x = scene.fixedpoint.initial_guess.as_array(build_walker(scene,
+            plant=Plant.from_scene(scene)).state_names())
     monkeypatch.setattr("walkerlab.analysis.contact.periodic.ideal_gait",
                         _known_gait(x, 0.37093))
     path = export_stage.run(scene, tmp_path, "mjcf")

@@ -24,6 +24,7 @@ import pytest
 
 from walkerlab.config import load_scene
 from walkerlab.stages import export as export_stage
+from walkerlab.walker.plant import Plant
 
 #: OpenSim's own tests; whether it is installed is asked without importing it: its Moco
 #: links a CasADi of its own, and an ``import opensim`` in the test process breaks every
@@ -67,7 +68,7 @@ def test_osim_export_carries_the_walker_and_its_gait(paper_osim):
     sc = _scene("paper")
     data = walker_data(sc.walker, sc.slope.phi_rad)
     mb = multibody(data)
-    ms = mjcf_scene(sc, mb, data)
+    ms = mjcf_scene(sc, mb, Plant.from_scene(sc))
     names = ["hip_x", "hip_y", "leg1_hip", "leg2_hip"]
     assert coords == {n: (q, v) for n, q, v in zip(names, ms.qpos, ms.qvel)}
     assert [p.find("geometry").text.split()[0] for p in model.iter(
@@ -416,7 +417,7 @@ def test_osim_walks_footholds_of_two_heights_in_the_rigid_period_2_gait(tmp_path
     from walkerlab.export.opensim_walk import walk
 
     sc = _scene("footholds_two")
-    rigid = ideal_gait(sc)
+    rigid = ideal_gait(sc, plant=Plant.from_scene(sc))
     steps = np.asarray(rigid.step_periods_s)
     ell = np.mean(rigid.step_lengths_m)
     w = walk(export_stage.run(sc, tmp_path, "osim"), 11.5 * steps.mean())

@@ -27,6 +27,7 @@ import yaml
 
 from walkerlab.config import load_scene
 from walkerlab.stages import export as export_stage
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 mujoco = pytest.importorskip("mujoco")
@@ -190,7 +191,8 @@ def test_gait_keyframe_is_the_rigid_fixed_point_and_urdf_sidecar_carries_it(tmp_
     mujoco.mj_resetDataKeyframe(m, d, m.key("gait").id)
     mujoco.mj_forward(m, d)
     np.testing.assert_allclose(d.site("leg2_foot").xpos, [0, 0, 0], atol=1e-12)
-    x = ideal_gait(scene).x  # [th_swing, th_stance, w_swing, w_stance]
+    x = ideal_gait(scene,
+                   plant=Plant.from_scene(scene)).x  # [th_swing, th_stance, w_swing, w_stance]
     assert d.qpos[m.joint("leg1_hip").qposadr[0]] == pytest.approx(x[0], abs=1e-12)
     assert d.qpos[m.joint("leg2_hip").qposadr[0]] == pytest.approx(x[1], abs=1e-12)
     assert d.qvel[m.joint("leg2_hip").dofadr[0]] == pytest.approx(x[3], abs=1e-12)
@@ -259,7 +261,7 @@ def test_asymmetric_legs_walk_both_steps_in_mujoco(tmp_path):
     from walkerlab.export.mujoco_walk import walk
 
     scene = _scene("asymmetric_legs")
-    rigid = ideal_gait(scene)
+    rigid = ideal_gait(scene, plant=Plant.from_scene(scene))
     run = walk(export_stage.run(scene, tmp_path, "mjcf"), 12.0)
     assert not run.fell and len(run.times_s) >= 12 and run.alternating
     # strike i -> i + 1 after a leg1 strike is leg2's step (rigid step 2), and vice versa
@@ -386,7 +388,7 @@ def test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens(tmp_path):
     path = Path(export_stage.run(scene, tmp_path, "mjcf"))
     m = mujoco.MjModel.from_xml_path(str(path))
     text = path.read_text()
-    step_s = ideal_gait(scene).period_s
+    step_s = ideal_gait(scene, plant=Plant.from_scene(scene)).period_s
     assert m.numeric("push_off_duration_s").data[0] == pytest.approx(m.opt.timestep, rel=1e-9)
     run = walk(path, 11.3 * step_s)
     assert not run.fell and len(run.times_s) >= 10 and run.alternating

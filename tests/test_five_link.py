@@ -15,6 +15,7 @@ from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.config.loader import SceneError
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 #: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
 #: of CPU to build): one worker builds it once
@@ -57,7 +58,8 @@ def from_ref(r):
 
 @pytest.fixture(scope="module")
 def walker():
-    return build_walker(scene_from_dict(SCENE))
+    sc = scene_from_dict(SCENE)
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 def states(k=4, seed=3):
@@ -188,7 +190,7 @@ def test_the_five_link_step_map_on_lsoda_calls_no_python_flow_and_agrees_with_it
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / "rabbit.yaml")
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     calls = []
 
     def counted(f):

@@ -15,6 +15,7 @@ from tests.test_five_link import SCENE, P, from_ref, states, to_ref
 from walkerlab.config import scene_from_dict
 from walkerlab.models.actuation import TorqueLaws
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 #: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
 #: of CPU to build): one worker builds it once
@@ -34,8 +35,9 @@ def scene_with(torques, push_off=None):
 
 @pytest.fixture(scope="module")
 def constant_walker():
-    return build_walker(scene_with([{"joint": j, "law": {"constant_n_m": CONSTANT[j]}}
-                                    for j in JOINTS]))
+    sc = scene_with([{"joint": j, "law": {"constant_n_m": CONSTANT[j]}}
+                                    for j in JOINTS])
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 def test_constant_torques_match_generalised_forces_of_joint_coordinates(constant_walker):
@@ -67,10 +69,11 @@ def test_pd_law_reads_the_joint_angle_and_the_virtual_stance_leg():
     the line from the hip to the stance foot (atan(-hip_x / hip_y)), ds its rate."""
     K, D, a, b = 300.0, 20.0, 0.3, -0.7  # reference h(s) = a + b s
     phase = [-0.6, 0.6]
-    w = build_walker(scene_with([{"joint": "stance_knee", "law": {
+    sc = scene_with([{"joint": "stance_knee", "law": {
         "stiffness_n_m_per_rad": K, "damping_n_m_s_per_rad": D,
         "reference": {"phase_rad": phase, "angle_rad": [a + b * s for s in phase],
-                      "interpolation": "linear"}}}]))
+                      "interpolation": "linear"}}}])
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     for x in states():
         hip = w.points(x)["hip"]
         s = np.arctan(-hip[0] / hip[1])
@@ -91,7 +94,8 @@ def test_shared_spline_equals_each_laws_own():
         "stiffness_n_m_per_rad": 500.0, "damping_n_m_s_per_rad": 30.0,
         "reference": {"phase_rad": phase, "angle_rad": [np.sin(3 * s + i) for s in phase]}}}
         for i, j in enumerate(JOINTS)]
-    w = build_walker(scene_with(torques))
+    sc = scene_with(torques)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     acts = w.actuators
     own = TorqueLaws(acts.spec.torques)
     for x in states():
@@ -110,7 +114,8 @@ def test_refusals_name_the_field(edit, message):
     cfg["walker"]["actuation"] = {"torques": [{"joint": "stance_hip", "law": {}}]}
     edit(cfg["walker"])
     with pytest.raises(ValueError) as e:
-        build_walker(scene_from_dict(cfg))
+        sc = scene_from_dict(cfg)
+        build_walker(sc, plant=Plant.from_scene(sc))
     assert message in str(e.value) and "\n" not in str(e.value)
 
 
@@ -120,7 +125,8 @@ def test_five_link_joint_on_a_straight_legged_walker_is_refused():
                       "actuation": {"torques": [{"joint": "swing_knee", "law": {}}]}},
            "slope": {"angle_rad": 0.0}}
     with pytest.raises(ValueError, match=r"torques\.0\.joint: swing_knee"):
-        build_walker(scene_from_dict(cfg))
+        sc = scene_from_dict(cfg)
+        build_walker(sc, plant=Plant.from_scene(sc))
 
 
 def test_reference_tables_take_angle_rad_or_hip_angle_rad_once():
@@ -142,9 +148,12 @@ def test_push_off_matches_an_independent_impulse_and_is_the_heel_strike_at_zero(
     (tests/independent/five_link.py, its own De, E) to round-off; at P = 0 it is the passive
     heel strike; the plastic heel strike after it loses kinetic energy."""
     impulse = 4.0
-    w = build_walker(scene_with([], push_off={"impulse_n_s": impulse}))
-    w0 = build_walker(scene_with([], push_off={"impulse_n_s": 0.0}))
-    passive = build_walker(scene_from_dict(SCENE))
+    sc = scene_with([], push_off={"impulse_n_s": impulse})
+    w = build_walker(sc, plant=Plant.from_scene(sc))
+    sc1 = scene_with([], push_off={"impulse_n_s": 0.0})
+    w0 = build_walker(sc1, plant=Plant.from_scene(sc1))
+    sc2 = scene_from_dict(SCENE)
+    passive = build_walker(sc2, plant=Plant.from_scene(sc2))
     for x in states():
         r, dr = to_ref(x)
         r_new, dr_new = ref.push_off_heel_strike(r, dr, P, impulse)

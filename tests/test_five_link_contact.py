@@ -18,6 +18,7 @@ from tests.test_five_link import SCENE, P, states, to_ref
 from walkerlab.config import scene_from_dict
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 #: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
 #: of CPU to build): one worker builds it once
@@ -197,7 +198,8 @@ def test_contact_view_carries_a_push_off_on_a_five_link_biped():
 
     cfg = yaml.safe_load((ROOT / "configs" / "rabbit.yaml").read_text())
     cfg["walker"]["actuation"]["push_off"] = {"impulse_n_s": 1.0}
-    acts = contact_setup(scene_from_dict(cfg)).actuators
+    sc = scene_from_dict(cfg)
+    acts = contact_setup(sc, plant=Plant.from_scene(sc)).actuators
     assert acts.spec.push_off is not None and acts.pulse_s > 0.0
 
 
@@ -212,9 +214,11 @@ def test_a_five_link_contact_periodic_gait_is_refused_in_one_line(start):
     cfg = yaml.safe_load((ROOT / "configs" / "rabbit.yaml").read_text())
     cfg["contact_sim"].update(start)
     with pytest.raises(ContactSceneError, match="contact_sim.start / periodic_gait") as e:
-        contact_setup(scene_from_dict(cfg))
+        sc = scene_from_dict(cfg)
+        contact_setup(sc, plant=Plant.from_scene(sc))
     assert "\n" not in str(e.value)
-    contact_setup(scene_from_dict(cfg | {"contact_sim": {}}))  # the rigid start: carried
+    sc = scene_from_dict(cfg | {"contact_sim": {}})
+    contact_setup(sc, plant=Plant.from_scene(sc))  # the rigid start: carried
 
 
 @pytest.mark.slow  # 80-130 s: 11 heel strikes of RABBIT on compliant contact (solve_ivp,
@@ -233,8 +237,10 @@ def test_rabbit_walks_on_contact_at_its_rigid_step_period():
     from walkerlab.models.registry import build_walker
 
     sc = load_scene(ROOT / "configs" / "rabbit.yaml")
-    x = sc.fixedpoint.initial_guess.as_array(build_walker(sc).state_names())
-    walker, res, _x0, _sl = simulate_from(contact_setup(sc), x, RIGID_PERIOD_S, strides=5)
+    x = sc.fixedpoint.initial_guess.as_array(build_walker(sc,
+                                                          plant=Plant.from_scene(sc)).state_names())
+    walker, res, _x0, _sl = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), x, RIGID_PERIOD_S, strides=5)
     assert res.outcome.kind == "heel_strike", res.message
     hs = res.heel_strike_times
     assert len(hs) >= 11  # >= 10 step periods

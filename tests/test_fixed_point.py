@@ -13,6 +13,7 @@ from walkerlab.cli import app
 from walkerlab.config import load_scene
 from walkerlab.models.hybrid.printed_equations import make_compass_gait
 from walkerlab.published import paper
+from walkerlab.walker.plant import Plant
 
 EQ11 = np.array(paper.EQ11_STATE)  # role-ordered, as printed
 
@@ -263,9 +264,12 @@ def test_the_slow_map_reason_names_what_the_walker_has():
     from walkerlab.models.registry import build_walker
 
     root = Path(__file__).resolve().parents[1] / "configs"
-    sprung = slow_step_reason(build_walker(load_scene(root / "hip_spring.yaml")))
-    hzd = slow_step_reason(build_walker(load_scene(root / "threelink_hzd.yaml")))
-    bare = slow_step_reason(build_walker(load_scene(root / "paper.yaml")))
+    sc = load_scene(root / "hip_spring.yaml")
+    sprung = slow_step_reason(build_walker(sc, plant=Plant.from_scene(sc)))
+    sc1 = load_scene(root / "threelink_hzd.yaml")
+    hzd = slow_step_reason(build_walker(sc1, plant=Plant.from_scene(sc1)))
+    sc2 = load_scene(root / "paper.yaml")
+    bare = slow_step_reason(build_walker(sc2, plant=Plant.from_scene(sc2)))
     assert "spring" in sprung and "walker.springs" in sprung
     assert "virtual-constraint controller" in hzd and "spring" not in hzd
     assert "spring" not in bare and "controller" not in bare

@@ -17,6 +17,7 @@ from walkerlab.integrate.python_step import needs_python_path
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 pytest.importorskip("numba")
 pytest.importorskip("CyRK")
@@ -29,7 +30,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def walker(scene):
-    return build_walker(scene)
+    return build_walker(scene, plant=Plant.from_scene(scene))
 
 
 def _call(cfunc, x: np.ndarray, data: np.ndarray, m: int) -> np.ndarray:

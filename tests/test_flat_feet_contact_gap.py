@@ -19,6 +19,7 @@ import pytest
 
 from tests.scripts_loader import load_file
 from walkerlab.config import load_scene
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 STEPS = 6
@@ -127,14 +128,14 @@ def test_the_flat_footed_contact_run_starts_at_the_rigid_mid_stance():
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / "flat_feet.yaml")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     guess = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     fp = find_fixed_point(walker, guess, Solver.from_settings(scene.solver), fd_check=False)
-    x = rigid_mid_stance(scene, fp.x)
+    x = rigid_mid_stance(scene, fp.x, plant=Plant.from_scene(scene))
     assert x[0] == pytest.approx(x[1], abs=1e-10)  # swing = stance: legs parallel
     assert x[1] + x[2] == pytest.approx(-scene.slope.angle_rad, abs=1e-9)  # the sole flat
     assert x[5] == pytest.approx(-x[4], abs=1e-9)  # and at rest
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     assert setup.sim.start == "mid_stance"
     w, _ = setup.build(fp.x, 4)
     pts = w.points(initial_state_from_ideal(w, *x))
@@ -154,5 +155,6 @@ def test_a_mid_stance_start_without_flat_feet_is_one_line_naming_the_field():
     d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
     d.setdefault("contact_sim", {})["start"] = "mid_stance"
     with pytest.raises(ContactSceneError) as exc:
-        contact_setup(scene_from_dict(d, "paper.yaml"))
+        sc = scene_from_dict(d, "paper.yaml")
+        contact_setup(sc, plant=Plant.from_scene(sc))
     assert "contact_sim.start" in str(exc.value) and "\n" not in str(exc.value)

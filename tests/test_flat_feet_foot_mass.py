@@ -22,6 +22,7 @@ from scipy.integrate import solve_ivp
 from walkerlab.codegen.cache import functions
 from walkerlab.config import load_scene
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "flat_feet_foot_mass.yaml"
@@ -226,7 +227,8 @@ def test_feet_of_vanishing_mass_give_the_massless_walker(tmp_path):
     np.testing.assert_allclose(i_l, i_n, atol=1e-5)
     scene = load_scene(_scene_with(tmp_path, lambda d: d["walker"]["leg"]["foot"].update(
         mass_kg=1e-7, inertia_about_ankle_kg_m2=1e-10)))
-    assert float(ideal_gait(scene).period_s) == pytest.approx(0.8101592422, abs=1e-5)
+    assert float(ideal_gait(scene,
+            plant=Plant.from_scene(scene)).period_s) == pytest.approx(0.8101592422, abs=1e-5)
 
 
 def test_energy_ledger_closes_with_the_feet_kinetic_energy(tmp_path):
@@ -307,7 +309,7 @@ def test_rigid_contact_and_mujoco_agree_within_one_percent_on_feet_with_mass(tmp
     from walkerlab.analysis.contact.periodic import ideal_gait
 
     scene = load_scene(SCENE)
-    rigid = float(ideal_gait(scene).period_s)
+    rigid = float(ideal_gait(scene, plant=Plant.from_scene(scene)).period_s)
     assert rigid == pytest.approx(0.8290, abs=1e-4)
     code, err, _out = run_cli("-q", "contact-sim", SCENE, "--runs-dir", tmp_path)
     assert code == 0, err

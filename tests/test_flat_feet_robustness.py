@@ -16,6 +16,7 @@ from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
+from walkerlab.walker.plant import Plant
 
 #: the gait of configs/flat_feet.yaml (reports/22a.md; 10 digits on the angles, 8 on rates)
 X_STAR = np.array([-0.3473790834, 0.2559008258, 0.0, -1.3354750, -1.1909763, -11.3443774])
@@ -25,8 +26,9 @@ SOLVER = Solver("DOP853", 1e-12, 1e-12, None, "scipy")
 @pytest.fixture(scope="module")
 def flat():
     scene = load_scene("configs/flat_feet.yaml")
-    walker = build_walker(scene)
-    return walker, make_step_map(walker, scene_walker_at(scene), 1e-10, 1e-10)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    return walker, make_step_map(walker, scene_walker_at(scene,
+            plant=Plant.from_scene(scene)), 1e-10, 1e-10)
 
 
 def test_flat_feet_get_the_python_step_map_with_the_integrators_step(flat):

@@ -24,6 +24,7 @@ from walkerlab.models.hybrid.rigid_foot_modes import mode_of
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the heel strike's event is located to the solver's tolerance (rtol 1e-12 on ~1 m): the
@@ -54,7 +55,7 @@ def _swing_heel_by_hand(x, pin: str, foot, gamma: float, length: float = 1.0):
 
 def _run(name: str, steps: int):
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     traj = simulate_steps(walker, x0, steps, Solver.from_settings(scene.solver))
     assert len(traj.segments) == steps
@@ -186,9 +187,11 @@ def test_an_actuated_flat_walker_keeps_its_landing_on_stairs():
 
     d = load_scene(ROOT / "configs" / "flat_feet_push_off.yaml").model_dump(
         mode="json", exclude_none=True)
-    level = build_walker(scene_from_dict(d))
+    sc = scene_from_dict(d)
+    level = build_walker(sc, plant=Plant.from_scene(sc))
     d["terrain"] = {"kind": "stairs", "riser_m": 0.0075, "tread_m": 0.405}
-    stairs = build_walker(scene_from_dict(d))
+    sc1 = scene_from_dict(d)
+    stairs = build_walker(sc1, plant=Plant.from_scene(sc1))
     assert stairs.actuators is not None and stairs.params["landing_drop_m"] == 0.0075
     x = np.array([-0.2, 0.2, 0.0, -0.7, -0.7, -3.0])
 
@@ -224,7 +227,8 @@ def test_a_flat_footed_scene_without_terrain_gets_patches_that_hold_its_sole():
     assert ground.lanes == "checkerboard" and ground.is_slope
     assert ground.patch_width_m == pytest.approx(4 * (0.05 + 0.10))
     assert ground.patch_width_m / 2 > 0.05 + 0.10  # the sole rolled to its toe fits
-    assert contact_setup(bare).terrain.patch_width_m == pytest.approx(0.6)
+    assert contact_setup(bare,
+                         plant=Plant.from_scene(bare)).terrain.patch_width_m == pytest.approx(0.6)
     paper = load_scene(ROOT / "configs" / "paper.yaml")
     assert paper.terrain_or_default().patch_width_m == 0.10
     own = load_scene(ROOT / "configs" / "flat_feet_stairs.yaml")

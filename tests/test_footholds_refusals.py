@@ -114,7 +114,8 @@ def test_footholds_of_their_own_slopes_are_refused_by_the_contact_model_in_one_l
                     "foothold_slopes_rad": [0.0174, 0.02]}
     d["terrain"] = {k: v for k, v in d["terrain"].items() if v is not None}
     with pytest.raises(ContactSceneError) as err:
-        contact_setup(scene_from_dict(d))
+        sc = scene_from_dict(d)
+        contact_setup(sc, plant=Plant.from_scene(sc))
     assert str(err.value) == ("scene 'footholds2': terrain.foothold_slopes_rad: "
                               + FOOTHOLD_SLOPES)
 
@@ -126,7 +127,8 @@ def test_a_contact_walker_laid_at_a_fixed_spacing_on_two_heights_is_refused_in_o
 
     sc = scene_from_dict(TWO)
     with pytest.raises(ValueError) as err:
-        contact_setup(sc).build(np.array([-0.249, 0.187, -0.552, -0.966]), 10)
+        contact_setup(sc,
+                plant=Plant.from_scene(sc)).build(np.array([-0.249, 0.187, -0.552, -0.966]), 10)
     assert str(err.value).startswith("terrain.foothold_heights_m: footholds of several "
                                      "heights are laid at the rigid gait's footfalls")
     assert not any(s in str(err.value) for s in INTERNAL)
@@ -141,8 +143,8 @@ def test_a_contact_walker_laid_on_new_lanes_drops_the_old_patch_heights():
     d = copy.deepcopy(TWO)
     d["terrain"]["foothold_heights_m"] = [-0.005]  # one height: one spacing
     sc = scene_from_dict(d)
-    _, search = solve_scene(sc)
-    walker, step = contact_setup(sc).build(search.result.x, 10)
+    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
+    walker, step = contact_setup(sc, plant=Plant.from_scene(sc)).build(search.result.x, 10)
     assert walker.heights1 is not None and walker.heights1.size == walker.lane1.size
     again = walker.on_terrain(sc.terrain, step_length=step, n_steps=40)
     assert again.heights1.size == again.lane1.size > walker.lane1.size

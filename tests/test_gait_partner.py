@@ -13,13 +13,14 @@ from walkerlab.analysis.gait.starts import deflation_starts, step_length
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _search(name: str):
     scene = load_scene(ROOT / "configs" / name)
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     fp = scene.fixedpoint
     guess = fp.initial_guess.as_array(walker.state_names())
     return walker, find_gaits(walker, Solver.from_settings(scene.solver), guess,

@@ -15,6 +15,7 @@ import pytest
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.io.trajectory import NamedTrajectory
 from walkerlab.models.ground import scene_ground
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the report samples the run at simulate.sample_rate_hz (500 Hz) where the fixed point's
@@ -29,10 +30,12 @@ def _run(scene, strides: int):
     from walkerlab.analysis.gait.rigid_run import simulate_scene
     from walkerlab.analysis.gait.scene import solve_scene
 
-    walker, search = solve_scene(scene)
+    walker, search = solve_scene(scene, plant=Plant.from_scene(scene))
     d = scene.model_dump(mode="json")
     d["simulate"] = {**d["simulate"], "strides": strides}
-    return walker, search.result, simulate_scene(scene_from_dict(d), walker, search.result.x)
+    sc = scene_from_dict(d)
+    return walker, search.result, simulate_scene(sc, walker, search.result.x,
+                                                 plant=Plant.from_scene(sc))
 
 
 def _report_clearance(scene, run) -> tuple[float, str]:

@@ -14,6 +14,7 @@ from walkerlab.config import scene_from_dict
 from walkerlab.models.hybrid.ground_reaction import StanceReaction
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 G = ref.PAPER["g"]
 
@@ -30,7 +31,7 @@ def _compass(push_off_n_s: float, slope: float = 0.0) -> dict:
 
 def _reaction(push_off_n_s: float, slope: float = 0.0):
     scene = scene_from_dict(_compass(push_off_n_s, slope))
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     return w, StanceReaction(w, walker_data(scene.walker, scene.slope.phi_rad))
 
 
@@ -193,7 +194,7 @@ def test_the_friction_ratio_is_newtons_from_the_com_trajectory(push_off, slope):
     if push_off == 0.0:  # the passive paper walker on its slope
         scene = scene_from_dict({**_compass(0.0, slope), "walker": {
             k: v for k, v in _compass(0.0, slope)["walker"].items() if k != "actuation"}})
-    w, search = solve_scene(scene, fd_check=False, ground=True)
+    w, search = solve_scene(scene, fd_check=False, ground=True, plant=Plant.from_scene(scene))
     fr = search.gait.ground.friction
     assert fr.inside and fr.mu == 0.9 and fr.mu_source == "the contact model's default"
     p = ref.PAPER
@@ -236,7 +237,8 @@ def test_a_flat_foots_friction_verdict_names_the_toe_that_would_slip():
     from walkerlab.integrate.solver import Solver
 
     scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml")
-    w, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False)
+    w, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False,
+                            plant=Plant.from_scene(scene))
     fr = search.gait.ground.friction
     assert fr.inside is False and math.isinf(fr.max_ratio) and fr.foot == "trailing toe"
     assert 20.0 < abs(fr.unloaded_tangential_n) < 35.0 and 0 < fr.exit_time_s < fr.time_s
@@ -283,7 +285,7 @@ def test_the_flat_foots_trailing_toe_leaves_the_cone_only_as_it_unloads():
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     guess = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     fp = find_fixed_point(walker, guess, Solver.from_settings(scene.solver), fd_check=False)
     seg = simulate_steps(walker, fp.x, 1, Solver.from_settings(scene.solver)).segments[0]

@@ -13,6 +13,8 @@ gym = pytest.importorskip("gymnasium")
 
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 
+from walkerlab.walker.plant import Plant  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 #: the paper walker's step period [s] (walkerlab fixedpoint configs/paper.yaml)
 PAPER_PERIOD_S = 0.70359688
@@ -359,7 +361,7 @@ def test_the_rigid_view_trips_on_a_wall_where_simulate_does():
            (x0 + 0.051, 0.0), (20.0, 0.0)]
     d["terrain"] = {"kind": "profile", "profile_m": [[x, -x * t + h] for x, h in pts]}
     env = WalkerEnv(d, max_episode_steps=400)  # its gait: the scene's slope's (the profile)
-    ref = profile_walk(env.rigid.scene, env.gait.x, 6)
+    ref = profile_walk(env.rigid.scene, env.gait.x, 6, plant=Plant.from_scene(env.rigid.scene))
     assert ref.termination == "trip" and len(ref.segments) == 2
     strikes, info = _zero_walk(env)
     assert info["termination"] == "trip" and strikes.size == 1

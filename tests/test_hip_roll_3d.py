@@ -23,6 +23,7 @@ from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
@@ -192,7 +193,7 @@ class Reference:
 
 def _walker_and_reference(law=None):
     scene = Scene.model_validate(_raw(law))
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     wc = scene.walker
     h = wc.hip_roll
     gains = (h.pelvis_stiffness_n_m_per_rad, h.pelvis_damping_n_m_s_per_rad,

@@ -31,6 +31,7 @@ from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver("DOP853", 1e-12, 1e-12)
@@ -121,7 +122,8 @@ def gaits():
              "torso": [-0.3198, -0.3198, 0.2190, -0.235, -0.235, -1.104]}
     out = {}
     for name, x0 in guess.items():
-        w = build_walker(_scene(name))
+        sc = _scene(name)
+        w = build_walker(sc, plant=Plant.from_scene(sc))
         out[name] = (w, find_fixed_point(w, np.array(x0), SOLVER, fd_check=False))
     return out
 
@@ -151,7 +153,8 @@ def test_torso_on_a_kneed_walker_bisects_the_thighs(gaits):
 def test_flows_and_impacts_match_the_kneed_prototype(variant):
     """Knee free, knee locked, knee strike, heel strike: ours = the prototype's at random
     states, for both steps of a stride (``walker.for_stance``)."""
-    w0 = build_walker(_scene(variant))
+    sc = _scene(variant)
+    w0 = build_walker(sc, plant=Plant.from_scene(sc))
     rng = np.random.default_rng(7)
     gamma = w0.slope_rad
     for stance in ("leg2", "leg1"):

@@ -19,6 +19,7 @@ import walkerlab as wl
 from tests.independent.kneed_reference import KneedReference
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 GAMMA = 0.045           # rad: gentler than the shipped asin(7.25/144) = 0.0504
@@ -66,8 +67,10 @@ def _to_ours(xr):
 
 
 def test_a_push_off_of_zero_is_the_passive_heel_strike():
-    w0 = build_walker(scene_from_dict(_scene(None)))
-    w = build_walker(scene_from_dict(_scene({"impulse_n_s": 0.0})))
+    sc = scene_from_dict(_scene(None))
+    w0 = build_walker(sc, plant=Plant.from_scene(sc))
+    sc1 = scene_from_dict(_scene({"impulse_n_s": 0.0}))
+    w = build_walker(sc1, plant=Plant.from_scene(sc1))
     rng = np.random.default_rng(2)
     for _ in range(5):
         q = np.array([0.2, 0.2, -0.25]) + rng.normal(0, 0.02, 3)
@@ -79,7 +82,8 @@ def test_a_push_off_of_zero_is_the_passive_heel_strike():
 
 
 def test_the_pushed_heel_strike_is_the_independent_one():
-    w = build_walker(scene_from_dict(_scene({"impulse_n_s": P})))
+    sc = scene_from_dict(_scene({"impulse_n_s": P}))
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     ref = _PushedKneed(P=P)
     ref.p["gamma"] = GAMMA
     rng = np.random.default_rng(3)

@@ -18,6 +18,7 @@ from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.integrate.rigid import Solver, integrate_step
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 TIGHT = Solver("DOP853", 1e-12, 1e-12)
@@ -25,7 +26,8 @@ TIGHT = Solver("DOP853", 1e-12, 1e-12)
 
 @pytest.fixture(scope="module")
 def paper_map(paper_scene):
-    return BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-10, 1e-10)
+    return BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+                        scene_walker_at(paper_scene, plant), 1e-10, 1e-10)
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
@@ -40,7 +42,7 @@ def test_batched_step_matches_one_step_integration(paper_scene, paper_map, paper
     names = paper_map.walker.state_names()
     X[6:, names.index("stance_rate")] *= [0.5, 1.8]  # too slow (falls back), too fast
     r = paper_map.step(X, gam)
-    at = scene_walker_at(paper_scene)
+    at = scene_walker_at(paper_scene, plant=Plant.from_scene(paper_scene))
     ends = []
     for i in range(8):
         seg = integrate_step(at(gam[i]), X[i], TIGHT)
@@ -69,15 +71,15 @@ def test_kneed_walker_two_phases_and_knee_strike(paper_scene):
     """The kneed walker (unlocked swing, knee strike reset, locked swing) through the batched
     map equals integrate_step on two slopes."""
     sc = load_scene(ROOT / "configs" / "kneed.yaml")
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     from walkerlab.analysis.gait.poincare import find_fixed_point
 
     g = sc.fixedpoint.initial_guess.as_array(w.state_names())
     x = find_fixed_point(w, g, TIGHT, fd_check=False).x
-    bm = BatchStepMap(w, scene_walker_at(sc), 1e-10, 1e-10)
+    bm = BatchStepMap(w, scene_walker_at(sc, plant=Plant.from_scene(sc)), 1e-10, 1e-10)
     gam = sc.slope.phi_rad + np.array([-0.002, 0.002])
     r = bm.step(np.tile(x, (2, 1)), gam)
-    at = scene_walker_at(sc)
+    at = scene_walker_at(sc, plant=Plant.from_scene(sc))
     for i in range(2):
         seg = integrate_step(at(gam[i]), x, TIGHT)
         np.testing.assert_allclose(r.x_next[i], seg.x_next, rtol=0, atol=1e-8)
@@ -112,7 +114,7 @@ def test_no_noise_no_fall_and_unstable_gait_falls(paper_scene, paper_map):
     walks fall within a few steps (those that do not fall drift to the stable gait)."""
     from walkerlab.analysis.gait.scene import solve_scene
 
-    _, search = solve_scene(paper_scene, fd_check=False)
+    _, search = solve_scene(paper_scene, fd_check=False, plant=Plant.from_scene(paper_scene))
     gaits = {g.label: g.result for g in search.gaits}
     stable, unstable = gaits["long_period"], gaits["short_period"]
     assert np.max(np.abs(unstable.multipliers_variational)) > 1 > \
@@ -326,7 +328,8 @@ def test_gait_sensitivity_norm_linear_equals_nonlinear(paper_scene, paper_fixed_
     (measured ~1e-6: central differences with steps 1e-6, impulse response O(e^2))."""
     from walkerlab.analysis.robustness import measures as R
 
-    sm = BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-12, 1e-12)
+    sm = BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+                        scene_walker_at(paper_scene, plant), 1e-12, 1e-12)
     lin = R.linearise(sm, paper_fixed_point.x, paper_fixed_point.jacobian_variational,
                       disturbance)
     g_lin = lin.gsn()
@@ -341,7 +344,7 @@ def test_state_norm_depends_on_coordinates_multipliers_do_not(paper_fixed_point,
     from walkerlab.analysis.robustness import measures as R
 
     A = paper_fixed_point.jacobian_variational
-    names = build_walker(paper_scene).state_names()
+    names = build_walker(paper_scene, plant=Plant.from_scene(paper_scene)).state_names()
     T = R.relative_coordinates(names)
     ev = np.sort(np.abs(np.linalg.eigvals(A)))
     evT = np.sort(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T))))
@@ -458,11 +461,12 @@ def hip_roll_walk():
     from walkerlab.integrate.python_step import make_step_map
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     g = scene.fixedpoint.initial_guess.model_extra
     x0 = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
                    for n in walker.state_names()])
-    return scene, walker, make_step_map(walker, scene_walker_at(scene), 1e-12, 1e-12), x0
+    return scene, walker, make_step_map(walker, scene_walker_at(scene,
+            plant=Plant.from_scene(scene)), 1e-12, 1e-12), x0
 
 
 @pytest.mark.slow  # ~2 min on a cold numba cache (the hip-roll walker's batched flow)
@@ -482,7 +486,7 @@ def test_a_3d_monte_carlo_walk_matches_simulate_on_the_same_slopes(hip_roll_walk
     assert isinstance(sm, ReflectedStepMap)
     n = 12
     gam = slope_rows(3, [0], 0, n, scene.slope.phi_rad, 0.002)[0]
-    at = scene_walker_at(scene)
+    at = scene_walker_at(scene, plant=Plant.from_scene(scene))
     y, x = x0.copy(), x0.copy()
     for k in range(n):
         r = sm.step(y[None], gam[k:k + 1])
@@ -509,7 +513,7 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
     """The 3D walker with hip width: its mirror is the reflection across the sagittal plane
     (lean and hip rolls negated, pitches kept); planar legs that differ have none."""
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     names = walker.state_names()
     assert set(walker.mirror_reflection) == {f"{r}_{k}" for r in ("lean", "pelvis_roll",
                                                                   "swing_roll")
@@ -518,7 +522,8 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
     s = walker.reflect(x)
     for i, n in enumerate(names):
         assert s[i] == (-x[i] if ("lean" in n or "roll" in n) else x[i])
-    assert build_walker(load_scene(ROOT / "configs" / "paper_3d.yaml")).mirror is None
+    sc = load_scene(ROOT / "configs" / "paper_3d.yaml")
+    assert build_walker(sc, plant=Plant.from_scene(sc)).mirror is None
 
 
 def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):

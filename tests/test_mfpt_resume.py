@@ -12,6 +12,7 @@ import pytest
 from walkerlab.config import MfptSettings
 from walkerlab.io.mfpt_partial import MfptPartial
 from walkerlab.studies import mfpt as work
+from walkerlab.walker.plant import Plant
 
 SIGMA = [0.008, 0.006]
 
@@ -54,7 +55,7 @@ def few_nodes(monkeypatch):
 def _study(scene, x, method, partial=None, sigma=SIGMA):
     st = MfptSettings(sigma_rad=sigma, method=method, walks=10, max_steps=15,
                       mesh_cells=40, mesh_max_cells=80, quadrature_nodes=5)
-    return work.mfpt_study(scene, x, st, workers=1, partial=partial)
+    return work.mfpt_study(scene, x, st, workers=1, partial=partial, plant=Plant.from_scene(scene))
 
 
 def _mesh(scene, x, partial=None):
@@ -195,7 +196,8 @@ def _mc(scene, x, part, key="key"):
     from walkerlab.studies import mfpt as work
 
     st = MfptSettings(sigma_rad=[0.008], method="montecarlo", walks=12, max_steps=10)
-    return work.resumable_mfpt_study(scene, x, st, part, key, workers=1)
+    return work.resumable_mfpt_study(scene, x, st, part, key, workers=1,
+                                     plant=Plant.from_scene(scene))
 
 
 def _damage_a_group(part: Path, which: int) -> None:

@@ -26,6 +26,7 @@ from walkerlab.analysis.gait import poincare
 from walkerlab.analysis.gait.scene import solve_scene
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 GUESS_FIELDS = ("stance_angle_rad", "hip_angle_rad", "stance_rate_rad_per_s",
@@ -98,7 +99,7 @@ def test_target_and_fixedpoint_give_one_verdict():
 def test_a_disagreement_is_an_error():
     """A wrong reset Jacobian (as the massless-leg one was) stops the run with one line."""
     scene = load_scene(CONFIGS / "paper.yaml")
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     right = w.reset_jacobian
     wrong = replace(w, reset_jacobian=lambda x: right(x) + 0.05)
     from walkerlab.integrate.solver import Solver
@@ -113,7 +114,8 @@ def test_a_disagreement_is_an_error():
 def test_convergence_is_judged_by_the_residual():
     """MINPACK's "not making good progress" at a residual 18x below the tolerance is a gait;
     a residual above it is not."""
-    w = build_walker(load_scene(CONFIGS / "paper.yaml"))
+    sc = load_scene(CONFIGS / "paper.yaml")
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     x = np.array([-0.3238, 0.2187, -0.3777, -1.0924])
     stalled = SimpleNamespace(success=False, message="The iteration is not making good "
                                                      "progress")
@@ -162,7 +164,7 @@ def test_every_scene_variational_and_difference_multipliers_agree(name):
             scene = scene_from_dict(VARIANTS[name])
     else:
         scene = load_scene(CONFIGS / f"{name}.yaml")
-    _, search = solve_scene(scene)
+    _, search = solve_scene(scene, plant=Plant.from_scene(scene))
     r = search.gaits[search.selected].result
     # central differences of step 1e-7 of a map integrated at the scene's rtol: ~rtol / 1e-7
     # at worst (1e-5 at 1e-12; the three-link scenes integrate at LSODA's 1e-11: 1e-4,

@@ -35,6 +35,7 @@ ev.register("numba:compile", Count())
 import numpy as np
 from numba.core.registry import CPUDispatcher
 from walkerlab.config import load_scene
+from walkerlab.walker.plant import Plant
 from walkerlab.models.contact import scene as S
 from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
 from walkerlab.analysis.gait.poincare import poincare_map
@@ -49,7 +50,7 @@ x = initial_state_from_ideal(w, *ideal)
 w.rhs(0.0, x); w.jac(0.0, x); w.hip_height(x[None])
 w.kernels.contact_table(x[None], *w._args())
 simulate_contact(w, x, 0.05)
-rw = build_walker(sc)
+rw = build_walker(sc, Plant.from_scene(sc))
 xs = sc.fixedpoint.initial_guess.as_array(rw.state_names())
 poincare_map(rw, xs, Solver("DOP853", 1e-10, 1e-10, None, "cyrk_compiled"), jacobian=True)
 sm = step_map_for(sc.model_dump(mode="json"))

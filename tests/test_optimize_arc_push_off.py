@@ -37,7 +37,8 @@ def test_least_effort_with_an_arc_foot_push_off_is_the_rigid_pushed_gait():
     d["fixedpoint"]["initial_guess"] = dict(zip(d["fixedpoint"]["initial_guess"], GUESS))
     d["optimize"] = {"intervals": 60}
     scene = type(scene).model_validate(d)
-    _, search = solve_scene(scene)  # shooting on the rigid model with its push-off
+    _, search = solve_scene(scene,
+            plant=Plant.from_scene(scene))  # shooting on the rigid model with its push-off
     r = search.gaits[search.selected].result
     out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s),
                          plant=Plant.from_scene(scene))

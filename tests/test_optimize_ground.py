@@ -42,7 +42,8 @@ def _optimum(scene):
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.optimal.driver import optimize_scene
 
-    r = solve_scene(scene)[1].result  # the fixedpoint stage's gait: the start
+    r = solve_scene(scene,
+            plant=Plant.from_scene(scene))[1].result  # the fixedpoint stage's gait: the start
     return r, optimize_scene(scene, np.asarray(r.x, float), float(r.period_s),
                          plant=Plant.from_scene(scene))
 
@@ -93,7 +94,7 @@ def test_the_replay_of_the_stairs_gait_returns_to_its_start_on_the_stairs_only()
     from walkerlab.walker.description import walker_data
 
     scene = _paper_on_stairs(0.01)
-    r = solve_scene(scene)[1].result
+    r = solve_scene(scene, plant=Plant.from_scene(scene))[1].result
     T = float(r.period_s)
     t = np.linspace(0.0, T, 81)
     res = CollocationResult(t=t, x=np.tile(np.asarray(r.x, float), (t.size, 1)),
@@ -149,7 +150,7 @@ def test_compass_optimal_on_2_mm_footholds_is_the_two_step_passive_gait_not_the_
     from walkerlab.optimal.driver import optimize_scene
 
     scene = _compass_on_footholds([-0.002, 0.002])
-    r = solve_scene(scene)[1].result
+    r = solve_scene(scene, plant=Plant.from_scene(scene))[1].result
     steps = np.asarray(r.step_periods_s, float)
     assert steps.size == 2
     o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2,
@@ -157,7 +158,8 @@ def test_compass_optimal_on_2_mm_footholds_is_the_two_step_passive_gait_not_the_
     assert o.gait and o.replay_error <= REPLAY, (o.status, o.replay_error)
     assert o.objective <= 1e-8 and o.steps == 2
     assert np.max(np.abs(np.asarray(o.phase_duration_s) - steps)) <= 1e-6
-    slope = solve_scene(load_scene(CONFIGS / "compass_optimal.yaml"))[1].result
+    sc = load_scene(CONFIGS / "compass_optimal.yaml")
+    slope = solve_scene(sc, plant=Plant.from_scene(sc))[1].result
     assert abs(o.step_period_s - float(slope.period_s)) > 1e-3
 
 
@@ -171,7 +173,7 @@ def test_a_powered_gait_over_footholds_closes_on_them():
     from walkerlab.optimal.driver import optimize_scene
 
     scene = _compass_on_footholds([-0.002, 0.002], target_speed_m_per_s=0.8)
-    r = solve_scene(scene)[1].result
+    r = solve_scene(scene, plant=Plant.from_scene(scene))[1].result
     o = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / 2,
                          plant=Plant.from_scene(scene))
     assert o.gait and o.replay_error <= REPLAY, (o.status, o.replay_error)

@@ -64,7 +64,8 @@ def test_the_least_effort_gait_on_a_passive_slope_is_the_passive_gait(name, fact
     walker = None  # the scene's rigid model; flat feet: the optimised one, no double support
     if data.structure.foot == "flat":
         walker = make_rigid_walker(data, double_support=False)
-    _, search = solve_scene(scene, walker=walker)  # the fixedpoint stage's search (shooting)
+    _, search = solve_scene(scene, walker=walker,
+            plant=Plant.from_scene(scene))  # the fixedpoint stage's search (shooting)
     r = search.gaits[search.selected].result
     periods = np.asarray(r.step_periods_s, float)
     out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),

@@ -20,6 +20,7 @@ from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -50,7 +51,7 @@ def _gait(walker_fixture):
     scene, data, walker = walker_fixture
     if data.structure.foot != "flat":
         return wl.Walker.from_scene(scene).fixed_point()
-    r = solve_scene(scene, False, walker=walker)[1].gait.result
+    r = solve_scene(scene, False, walker=walker, plant=Plant.from_scene(scene))[1].gait.result
     return SimpleNamespace(x=np.asarray(r.x, float), step_period=float(r.period_s))
 
 
@@ -129,7 +130,8 @@ def test_a_mode_graph_without_a_fixed_sequence_is_refused_in_one_line():
     from walkerlab.optimal.transcription.phases import phase_order
 
     with pytest.raises(ValueError, match="no fixed phase sequence"):
-        phase_order(build_walker(load_scene(CONFIGS / "flat_feet.yaml")))
+        sc = load_scene(CONFIGS / "flat_feet.yaml")
+        phase_order(build_walker(sc, plant=Plant.from_scene(sc)))
 
 
 #: the flat-footed passive gait's phases (configs/flat_feet.yaml's note): the sequence
@@ -395,7 +397,8 @@ def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
     sc = with_changes(flat[0], {"contact_sim": {"n_strides": 2, "sample_rate_hz": 500,
                                                 "start": "ideal",
                                                 "t_final_s": 4.6 * g.step_period}})
-    hs = simulate_from(contact_setup(sc), g.x, g.step_period, strides=2)[1].heel_strike_times
+    hs = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), g.x, g.step_period, strides=2)[1].heel_strike_times
     passive = float(np.mean(np.diff(np.asarray(hs, float)[:4])))
     assert abs(period / passive - 1.0 - rigid_change) < 0.003, (period, passive)
     assert 0.06 < period / res.step_period_s - 1.0 < 0.08

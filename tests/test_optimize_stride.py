@@ -34,7 +34,8 @@ def asym():
 
     scene = load_scene(CONFIGS / "asymmetric_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    _, search = solve_scene(scene)  # the fixedpoint stage's search: the stride map's
+    _, search = solve_scene(scene,
+            plant=Plant.from_scene(scene))  # the fixedpoint stage's search: the stride map's
     r = search.gaits[search.selected].result
     g = SimpleNamespace(x=np.asarray(r.x, float), step_period=r.period_s / 2,
                         step_periods=np.asarray(r.step_periods_s, float),
@@ -151,7 +152,8 @@ def test_a_stride_with_a_push_off_is_the_rigid_walkers_pushed_gait(asym):
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, g, fns = asym
-    _, search = solve_scene(_pushed(scene, 0.5))
+    sc = _pushed(scene, 0.5)
+    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
     r = search.gaits[search.selected].result
     res = collocate_phases(fns, CollocationSpec(intervals=40, push_off_n_s=0.5),
                            _guess(asym))
@@ -187,7 +189,7 @@ def test_a_free_push_off_stride_on_level_ground(asym):
     from walkerlab.optimal.transcription.stride import stride_functions, stride_guess
 
     ldata = walker_data(level.walker, level.slope.phi_rad)
-    _, search = solve_scene(level)
+    _, search = solve_scene(level, plant=Plant.from_scene(level))
     r = search.gaits[search.selected].result
     lw = make_rigid_walker(ldata)
     guess = stride_guess(actuate(lw, ldata, level.walker.actuation), np.asarray(r.x),

@@ -19,6 +19,7 @@ from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 SOLVER = Solver("DOP853", 1e-12, 1e-12)
 GUESS = np.array([-0.2022, 0.1674, -0.60, -0.84])
@@ -34,7 +35,8 @@ SHIPPED = {"asymmetric_legs": (1.3928103873, 0.3531098),  # a stride: 0.67839 + 
 
 
 def _walker(name):
-    return build_walker(load_scene(f"configs/{name}.yaml"))
+    sc = load_scene(f"configs/{name}.yaml")
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 def _with(walker_extra: dict, base="torso_bhm"):
@@ -80,8 +82,9 @@ def test_off_axis_rigid_upper_body_matches_the_reference():
                                         "from_hip_m": 0.5}]}
     heavy = {**leg, "bodies": [{**leg["bodies"][0], "mass_kg": 6.0, "from_hip_m": 0.4,
                                 "off_axis_m": 0.03}]}
-    w = build_walker(_with({"leg": None, "legs": [leg, heavy],
-                            "torso": {"bodies": [body]}}))
+    sc = _with({"leg": None, "legs": [leg, heavy],
+                            "torso": {"bodies": [body]}})
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     ref = PartsReference(Parts(legs={"A": (5.0, 0.5), "B": (6.0, 0.4, 0.03)},
                                torso=(4.0, 0.3, 0.05, 0.2)))
     rng = np.random.default_rng(3)
@@ -119,9 +122,11 @@ def test_legs_that_differ_make_a_stride_map_and_others_one_step():
     assert _walker("torso_bhm").steps_per_map == 1
     # a rest angle breaks the mirror symmetry of equal legs; a torso-to-leg spring too
     spring = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 5.0, "rest_angle_rad": 0.1}
-    assert build_walker(_with({"springs": [spring]})).steps_per_map == 2
+    sc = _with({"springs": [spring]})
+    assert build_walker(sc, plant=Plant.from_scene(sc)).steps_per_map == 2
     spring = {"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 5.0}
-    assert build_walker(_with({"springs": [spring]})).steps_per_map == 2
+    sc1 = _with({"springs": [spring]})
+    assert build_walker(sc1, plant=Plant.from_scene(sc1)).steps_per_map == 2
 
 
 def test_leg_shorthand_expands_to_the_same_walker_as_an_equal_pair():
@@ -180,7 +185,8 @@ def test_energy_with_spring_potential_is_conserved_in_swing(fixed_points):
 def test_damper_dissipates_exactly_c_times_relative_rate_squared():
     spring = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 20.0,
               "damping_n_m_s_per_rad": 0.5}
-    w = build_walker(_with({"springs": [spring]}, base="hip_spring"))
+    sc = _with({"springs": [spring]}, base="hip_spring")
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     x0 = np.array([-0.18, 0.15, -0.7, -0.9])
     seg = integrate_step(w, x0, SOLVER)
     t = np.linspace(seg.t_start, seg.t_end, 4001)
@@ -328,7 +334,8 @@ def test_contact_view_walks_the_hip_spring_walker_near_its_rigid_gait(fixed_poin
 
     w, fp = fixed_points["hip_spring"]
     sc = load_scene("configs/hip_spring.yaml")
-    _cw, res, _x0, _d = simulate_from(contact_setup(sc), fp.x, fp.period_s, strides=2)
+    _cw, res, _x0, _d = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), fp.x, fp.period_s, strides=2)
     periods = np.diff(np.concatenate([[0.0], res.heel_strike_times]))
     assert len(periods) >= 3
     assert np.all(np.abs(periods / fp.period_s - 1) < 0.02)

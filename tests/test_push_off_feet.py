@@ -20,6 +20,7 @@ import walkerlab as wl
 from tests.independent.round_feet_push_off import PushedRoundFeet
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 GAMMA = 0.005  # rad: half the round-foot walker's passive slope (0.01)
@@ -48,9 +49,11 @@ def test_a_push_off_of_zero_is_the_generated_heel_strike(scene):
     """``P = 0``: the extended impact system (stance foot free, leading foot's material
     contact point pinned) is the generated passive heel strike, to round-off."""
     d = _kneed_arc() if scene == "kneed_arc" else _scene(scene, None)
-    w0 = build_walker(scene_from_dict(d))
+    sc = scene_from_dict(d)
+    w0 = build_walker(sc, plant=Plant.from_scene(sc))
     d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.0}}
-    w = build_walker(scene_from_dict(d))
+    sc1 = scene_from_dict(d)
+    w = build_walker(sc1, plant=Plant.from_scene(sc1))
     n = len(w.roles)
     rng = np.random.default_rng(4)
     for _ in range(4):
@@ -63,7 +66,8 @@ def test_a_push_off_of_zero_is_the_generated_heel_strike(scene):
 def test_the_arc_foot_push_off_is_the_independent_one():
     """The pushed transition (impulse at the rolling contact, towards the hip) equals the
     prototype's, and its complex-step Jacobian the central differences."""
-    w = build_walker(scene_from_dict(_scene("round_feet", {"impulse_n_s": P}, GAMMA)))
+    sc = scene_from_dict(_scene("round_feet", {"impulse_n_s": P}, GAMMA))
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     ref = PushedRoundFeet(P=P)
     ref.p["gamma"] = GAMMA
     rng = np.random.default_rng(5)
@@ -118,9 +122,11 @@ def test_a_toe_push_off_of_zero_is_the_generated_heel_strike():
     """Every flat-foot phase's heel-strike guard: ``P = 0`` gives its generated passive
     heel strike (heel- or toe-pinned kinematics) to round-off."""
     d = _scene("flat_feet", None)
-    w0 = build_walker(scene_from_dict(d))
+    sc = scene_from_dict(d)
+    w0 = build_walker(sc, plant=Plant.from_scene(sc))
     d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.0}}
-    w = build_walker(scene_from_dict(d))
+    sc1 = scene_from_dict(d)
+    w = build_walker(sc1, plant=Plant.from_scene(sc1))
     rng = np.random.default_rng(6)
     gamma = float(w.slope_rad)
     for ph0, ph in zip(w0.phases, w.phases):
@@ -148,7 +154,7 @@ def test_the_toe_push_off_is_the_independent_one_and_balances_momentum():
     Pf = 3.0  # N s: the walker weighs ~ 8 kg
     d = _scene("flat_feet", {"impulse_n_s": Pf})
     scene = scene_from_dict(d)
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     wk, leg = scene.walker, scene.walker.leg
     ankle = leg.foot.ankle
     ref = FlatFeetReference(dict(
@@ -220,5 +226,6 @@ def test_a_push_off_on_massless_arc_legs_is_refused_in_one_line():
     d["walker"]["coordinates"] = "absolute"
     d["walker"]["leg"]["foot"] = {"kind": "arc", "radius_m": 0.1}
     with pytest.raises(ValueError, match="give the legs mass") as e:
-        build_walker(scene_from_dict(d))
+        sc = scene_from_dict(d)
+        build_walker(sc, plant=Plant.from_scene(sc))
     assert "\n" not in str(e.value) and "walker.actuation.push_off" in str(e.value)

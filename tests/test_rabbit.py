@@ -16,6 +16,7 @@ from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the gait's step period [s] (walkerlab fixedpoint configs/rabbit.yaml; the closing note)
@@ -33,7 +34,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def step(scene):
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     x0 = scene.fixedpoint.initial_guess.as_array(w.state_names())
     traj = simulate_steps(w, x0, 1, Solver.from_settings(scene.solver), max_step_time=2.0)
     return w, x0, traj.segments[0]

@@ -37,6 +37,7 @@ from walkerlab.stages import common
 from walkerlab.studies import basin as basin_mod
 from walkerlab.studies import runner
 from walkerlab.studies.outcomes import empty_row
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -531,7 +532,7 @@ def test_the_mfpt_study_reports_each_sigma_it_finishes(monkeypatch):
         def update(self, key, completed, total, info):
             got.append((completed, total, info))
     with progress.use(Rec()):
-        study.mfpt_study(scene, np.zeros(2), st)
+        study.mfpt_study(scene, np.zeros(2), st, plant=None)  # build_walker stood in
     assert got == [(1, 2, "sigma 0.01 rad: Monte Carlo MFPT 100 steps"),
                    (2, 2, "sigma 0.02 rad: Monte Carlo MFPT 200 steps")]
 
@@ -579,7 +580,8 @@ def test_progress_adjust_counts_contact_runs(monkeypatch):
     monkeypatch.setattr(contact_sim, "simulate_from", fake_simulate_from)
     rec = Recorder()
     with progress.use(rec):
-        out = adjust.adjust_rates(contact_setup(scene_from_dict({**PAPER, "name": "paper"})),
+        sc = scene_from_dict({**PAPER, "name": "paper"})
+        out = adjust.adjust_rates(contact_setup(sc, plant=Plant.from_scene(sc)),
                                   X_GUESS, 0.7, grid=(0.8, 1.5, 3))
     t = rec.one("adjust")
     c = t["counts"]

@@ -27,6 +27,7 @@ import pytest
 from scipy.integrate import quad
 
 from walkerlab.config import SceneError, load_scene, scene_from_dict
+from walkerlab.walker.plant import Plant
 
 SCENE = "configs/rimless_wheel.yaml"
 G, L, M, N, PHI = 9.81, 1.0, 1.0, 8, 0.08   # Drake RimlessWheelParams defaults
@@ -134,7 +135,8 @@ def test_rimless_wheel_mfpt_matches_independent_monte_carlo():
 
     scene = load_scene(SCENE)
     x0 = _walker().fixed_point().x
-    sm = make_step_map(build_walker(scene), scene_walker_at(scene), 1e-9, 1e-9, 5.0)
+    sm = make_step_map(build_walker(scene, plant=Plant.from_scene(scene)), scene_walker_at(scene,
+            plant=Plant.from_scene(scene)), 1e-9, 1e-9, 5.0)
     for sd in (0.008, 0.012):
         ours = monte_carlo(sm, x0, sd, range(1500), 4000, seed=3).mfpt
         ref = _independent_mfpt(sd, 6000, 20000, seed=11)
@@ -193,7 +195,8 @@ def test_rimless_wheel_floating_view():
     point per spoke at hub + L e(theta + 2 pi k / n), spoke 1 the next ahead of spoke 0."""
     from walkerlab.models.contact.scene import contact_setup
 
-    setup = contact_setup(load_scene(SCENE))
+    sc = load_scene(SCENE)
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     walker, step = setup.build(np.array([math.pi / N - PHI, -1.0]), 4)
     assert walker.coordinate_names() == ("hip_x", "hip_y", "wheel_angle")
     assert walker.contact_names() == tuple(f"spoke{k}" for k in range(N))
@@ -220,7 +223,8 @@ def test_rimless_wheel_contact_refusals_are_one_line(changes, field):
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup
 
     with pytest.raises(ContactSceneError) as exc:
-        contact_setup(_scene(**changes))
+        sc = _scene(**changes)
+        contact_setup(sc, plant=Plant.from_scene(sc))
     assert field in str(exc.value) and "\n" not in str(exc.value)
 
 
@@ -242,7 +246,8 @@ def test_rimless_wheel_contact_step_period_matches_rigid(inertia, rigid_period):
     scene = _scene(**({"walker.hub_inertia_kg_m2": inertia} if inertia else {}))
     gait = _rigid(scene)
     assert gait.step_period == pytest.approx(rigid_period, abs=1e-5)
-    _, res, _, _ = simulate_from(contact_setup(scene), gait.x, gait.step_period, strides=5)
+    _, res, _, _ = simulate_from(contact_setup(scene,
+            plant=Plant.from_scene(scene)), gait.x, gait.step_period, strides=5)
     assert res.outcome.kind in ("heel_strike", "t_final"), res.outcome.message
     assert len(res.heel_strike_times) >= 10
     assert list(res.heel_strike_legs[:9]) == [f"spoke{k % N}" for k in range(1, 10)]
@@ -267,7 +272,7 @@ def test_rimless_wheel_mjcf_rolls_in_mujoco():
 
     scene = load_scene(SCENE)
     gait = _rigid(scene)
-    walker, _ = contact_setup(scene).build(gait.x, 4)
+    walker, _ = contact_setup(scene, plant=Plant.from_scene(scene)).build(gait.x, 4)
     x0 = initial_state_from_ideal(walker, *gait.x)
     data = walker_data(scene.walker, scene.slope.phi_rad)
     urdf = ET.fromstring(wheel_urdf_text(data, "rimless_wheel"))
@@ -503,5 +508,5 @@ def test_a_wheel_that_cannot_vault_a_spoke_is_refused_at_once():
     with pytest.raises(GaitNotFound, match=r"^walker\.spokes: 6 spokes on a 0\.12 rad slope "
                                            r"cannot roll steadily: the post-impact rate "
                                            r"0\.8848 rad/s is below the 1\.256 rad/s"):
-        solve_scene(scene)
+        solve_scene(scene, plant=Plant.from_scene(scene))
     assert time.perf_counter() - t0 < 1.0

@@ -30,6 +30,7 @@ from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
@@ -212,8 +213,10 @@ def _states(seed, k=5):
 @pytest.fixture(scope="module")
 def walkers():
     """The walker of configs/round_feet_3d.yaml, upright, and with a hip width of 0.1 l."""
-    return (build_walker(_scene("round_feet_3d.yaml")),
-            build_walker(_scene("round_feet_3d.yaml", hip_width_m=WIDTH)))
+    sc = _scene("round_feet_3d.yaml")
+    sc1 = _scene("round_feet_3d.yaml", hip_width_m=WIDTH)
+    return (build_walker(sc, plant=Plant.from_scene(sc)),
+            build_walker(sc1, plant=Plant.from_scene(sc1)))
 
 
 # ---- the planar embedding ---------------------------------------------------------------
@@ -226,7 +229,7 @@ def test_round_feet_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one(wal
     tolerance 1e-12), its planar multipliers among the 3D ones to 1e-7 (the variational
     equations' accuracy)."""
     flat_scene = _scene("round_feet.yaml")
-    flat = build_walker(flat_scene)
+    flat = build_walker(flat_scene, plant=Plant.from_scene(flat_scene))
     f = find_fixed_point(flat, _guess(flat_scene, flat.state_names()), SOLVER, fd_check=False)
     sp_scene = _scene("round_feet_3d.yaml")
     w3 = walkers[0]

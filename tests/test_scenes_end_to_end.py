@@ -20,6 +20,7 @@ import yaml
 from walkerlab.config import load_scene
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.stages.pipeline import report_plan
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "configs").glob("*.yaml"))
@@ -196,7 +197,8 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     # also in a nondimensional scene whose artifacts label rates rad/√(l/g)
     from walkerlab.models.registry import build_walker
 
-    for n, u in zip(art.state_names, build_walker(scene).state_units()):
+    for n, u in zip(art.state_names, build_walker(scene,
+                                                  plant=Plant.from_scene(scene)).state_units()):
         col = f"{n}_{u.replace('/', '_per_')}"
         assert col in data  # one column per state, named by the walker
     mid = data["outcome"] == "ok"

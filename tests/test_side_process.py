@@ -14,6 +14,7 @@ from tests.test_stages import _fake_trajectory, ideal_scene  # noqa: F401 (fixtu
 from walkerlab.config import load_scene
 from walkerlab.execution.side import SideWorker
 from walkerlab.io.trajectory import write_samples
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -139,7 +140,8 @@ def test_warm_up_without_numba_compiles_nothing(monkeypatch):
     find = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec",
                         lambda name, *a: None if name == "numba" else find(name, *a))
-    setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     assert compile_run_kernels(setup) is False
 
 

@@ -16,6 +16,7 @@ from walkerlab.studies.outcomes import COLUMNS, OUTCOMES
 from walkerlab.studies.params import SweepError, apply_point, parse_param
 from walkerlab.studies.points import evaluate
 from walkerlab.studies.runner import plan_chunks
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "goswami1996.yaml"
@@ -105,7 +106,7 @@ def test_a_sweeps_rows_are_the_fixed_points_from_the_scenes_guess_bit_for_bit(sc
                                                                    < 0.35))
     for k, v in enumerate(slopes):
         sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_deg"], (float(v),))
-        w = build_walker(sc)
+        w = build_walker(sc, plant=Plant.from_scene(sc))
         ref = find_fixed_point(w, sc.fixedpoint.initial_guess.as_array(w.state_names()),
                                Solver.from_settings(sc.solver), xtol=sc.fixedpoint.tolerance,
                                fd_check=False)
@@ -503,8 +504,9 @@ def test_a_3d_sweep_reports_every_point_per_stride(tmp_path):
     rows = data["points"]
     assert list(rows["outcome"]) == ["ok", "ok"]
     assert int(data["attrs"]["steps_per_map"]) == 2
-    walker, search = solve_scene(load_scene(ROOT / "configs" / "paper_3d.yaml"),
-                                 fd_check=False)
+    sc1 = load_scene(ROOT / "configs" / "paper_3d.yaml")
+    walker, search = solve_scene(sc1,
+                                 fd_check=False, plant=Plant.from_scene(sc1))
     assert walker.steps_per_map == 1  # zero width: the walker's own map is a step
     step = np.abs(search.result.multipliers_variational)
     assert step.max() == pytest.approx(11.23, abs=0.01)  # the old sweep's row at w = 0
@@ -566,7 +568,8 @@ def test_a_stable_3d_gait_and_the_planar_embedding_sweep_on_their_own_maps(tmp_p
     assert int(data["attrs"]["steps_per_map"]) == 1
     assert data["points"]["max_abs_multiplier"][0] == pytest.approx(11.23, abs=0.01)
     assert "(per step, every point)" in sweep_text(data)
-    _w, planar = solve_scene(load_scene(ROOT / "configs" / "paper.yaml"), fd_check=False)
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    _w, planar = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
     mult = np.array([data["points"][f"multiplier_{k}_re"][0]
                      + 1j * data["points"][f"multiplier_{k}_im"][0] for k in range(6)])
     for m in planar.result.multipliers_variational:  # the planar ones among the 3D ones

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import scene_from_dict
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 INDEPENDENT = 1e-8  # the "fixed points and multipliers ... to 1e-8"
@@ -44,7 +45,7 @@ def test_periodic_two_height_footholds_give_a_period_2_gait_of_an_independent_mo
     from walkerlab.analysis.gait.scene import solve_scene
 
     sc = _on_footholds(paper_scene, [-0.008, -0.012])
-    walker, search = solve_scene(sc)
+    walker, search = solve_scene(sc, plant=Plant.from_scene(sc))
     r = search.result
     assert walker.steps_per_map == 2 and r.residual < 1e-10
     ref = _independent().FootholdsCompass([0.008, 0.012])
@@ -68,9 +69,10 @@ def test_a_finite_foothold_list_ends_the_walk(paper_scene, paper_fixed_point):
     solver = Solver.from_settings(paper_scene.solver)
     sc = _on_footholds(paper_scene, [0.0, 0.0, 0.0], phi, periodic=False,
                        foothold_slopes_rad=[phi] * 3)
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     tr = simulate_steps(w, paper_fixed_point.x, 10, solver)
-    ref = simulate_steps(build_walker(paper_scene), paper_fixed_point.x, 3, solver)
+    ref = simulate_steps(build_walker(paper_scene,
+            plant=Plant.from_scene(paper_scene)), paper_fixed_point.x, 3, solver)
     assert len(tr.segments) == 3 and tr.termination == "heel_strike"
     for a, b in zip(tr.segments, ref.segments):
         np.testing.assert_array_equal(a.x_next, b.x_next)
@@ -135,7 +137,8 @@ def test_a_finite_foothold_list_of_one_height_ends_the_walk(tmp_path):
     assert sim.heel_strike_count() == 3 and sim.termination == "heel_strike"
     assert out.splitlines()[0] == ("the ground ends after its 3 footholds (terrain.periodic: "
                                    "false): 3 heel strikes of the 10 asked (5 strides)")
-    w = build_walker(load_scene(f))
+    sc = load_scene(f)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     assert w.steps_per_map == 1 and w.ground_steps == 3
     (tmp_path / "endless").mkdir()
     endless = _footholds_file(tmp_path / "endless", [-0.005])  # periodic: true
@@ -241,7 +244,9 @@ def test_terrain_seed_walks_the_same_ground_bit_for_bit(paper_scene, paper_fixed
     runs = []
     for seed in (11, 11, 12):
         sc = _rough(paper_scene, seed)
-        runs.append(simulate_scene(sc, rough_ground_walker(sc, 6), paper_fixed_point.x))
+        plant = Plant.from_scene(sc)
+        runs.append(simulate_scene(sc, rough_ground_walker(sc, 6, plant=plant),
+                                   paper_fixed_point.x, plant=plant))
     a, b, c = ([s.x_next for s in r.trajectory.segments] for r in runs)
     assert len(a) == 6 and all(s.termination == "heel_strike"
                                for s in runs[0].trajectory.segments)
@@ -284,8 +289,9 @@ def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fix
     d["slope"] = {"angle_rad": 0.0}
     sc = scene_from_dict(d)
     x0 = paper_fixed_point.x
-    tr = profile_walk(sc, x0, 8)
-    ref = simulate_steps(build_walker(paper_scene), x0, 8, Solver.from_settings(sc.solver))
+    tr = profile_walk(sc, x0, 8, plant=Plant.from_scene(sc))
+    ref = simulate_steps(build_walker(paper_scene,
+            plant=Plant.from_scene(paper_scene)), x0, 8, Solver.from_settings(sc.solver))
     assert len(tr.segments) == 8 and tr.termination == "heel_strike"
     for a, b in zip(tr.segments, ref.segments):
         assert np.max(np.abs(a.x_next - b.x_next)) < 1e-9
@@ -297,7 +303,8 @@ def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fix
     P = np.array([[-1.0, np.tan(phi)], [1.5, -1.5 * np.tan(phi)], [40.0, 0.0]])
     P[2, 1] = P[1, 1] - (40.0 - 1.5) * np.tan(0.03)
     d["terrain"] = {"kind": "profile", "profile_m": P.tolist()}
-    tr = profile_walk(scene_from_dict(d), x0, 8)
+    sc1 = scene_from_dict(d)
+    tr = profile_walk(sc1, x0, 8, plant=Plant.from_scene(sc1))
     assert len(tr.segments) == 8
     for a in tr.segments:
         xw, yw = a.stance_foot_world
@@ -325,7 +332,8 @@ def test_a_wall_or_a_pit_under_the_swing_foot_ends_the_profile_walk_as_a_trip(
         pts = sorted([(-1.0, 0.0), (0.0, 0.0), (20.0, 0.0), *bumps])
         d["terrain"] = {"kind": "profile", "profile_m": [[x, -x * t + h] for x, h in pts]}
         sc = scene_from_dict(d)
-        return profile_walk(sc, paper_fixed_point.x, 4), np.asarray(d["terrain"]["profile_m"])
+        return profile_walk(sc, paper_fixed_point.x, 4,
+                            plant=Plant.from_scene(sc)), np.asarray(d["terrain"]["profile_m"])
 
     plain, _ = walk([])
     assert plain.termination == "heel_strike" and len(plain.segments) == 4
@@ -372,7 +380,7 @@ def test_a_profile_from_a_csv_is_its_points(tmp_path):
     g = base["fixedpoint"]["initial_guess"]  # paper Eq. (11), near the gait
     x0 = np.array([g["swing_angle_rad"], g["stance_angle_rad"], g["swing_rate_rad_per_s"],
                    g["stance_rate_rad_per_s"]])
-    assert len(profile_walk(b, x0, 2).segments) == 2
+    assert len(profile_walk(b, x0, 2, plant=Plant.from_scene(b)).segments) == 2
     (tmp_path / "ground" / "p.csv").write_text("0, 0\n1, x\n")
     with pytest.raises(SceneError, match=r"terrain\.profile_csv: ground/p\.csv: line 2: give "
                        r"two numbers x, y \[m\] \(got '1,x'\)$"):

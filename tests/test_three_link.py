@@ -19,6 +19,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "threelink.yaml"
@@ -120,7 +121,8 @@ def test_torque_columns_and_the_closed_loop_flow_are_the_books(p, slope):
     ``D^-1 (B u - h)`` of the reference with its own spline of the same tables, at random
     states inside the tables, to 1e-9 of the accelerations."""
     d = _scene(p, slope)
-    walker = build_walker(scene_from_dict(d))
+    sc = scene_from_dict(d)
+    walker = build_walker(sc, plant=Plant.from_scene(sc))
     np.testing.assert_array_equal(walker.actuators.B, ref.B)
     law = _law(d)
     rng = np.random.default_rng(5)
@@ -166,7 +168,8 @@ def test_the_shipped_gait_is_a_stable_fixed_point():
 
 def _x_gait():
     scene = load_scene(SCENE)
-    return scene, scene.fixedpoint.initial_guess.as_array(build_walker(scene).state_names())
+    return scene, scene.fixedpoint.initial_guess.as_array(build_walker(scene,
+            plant=Plant.from_scene(scene)).state_names())
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
@@ -255,7 +258,8 @@ def _refusal(change) -> str:
     d = yaml.safe_load(SCENE.read_text())
     change(d["walker"])
     with pytest.raises((SceneError, ValueError)) as exc:
-        build_walker(scene_from_dict(d))
+        sc = scene_from_dict(d)
+        build_walker(sc, plant=Plant.from_scene(sc))
     line = str(exc.value)
     assert "\n" not in line
     return line
@@ -323,7 +327,7 @@ def test_the_adams_hip_torques_equal_walkerlab_laws():
     assert names == ["leg1", "leg2", "torso"]
     start = AdamsStart((0.1, 0.95), (0.7, 0.0), dict.fromkeys(names, 0.1),
                        dict.fromkeys(names, 0.0), None, 0.1, 0.46, (1.0, 1.0))
-    adm = adm_text(scene, mb, data, "threelink", "test", start)
+    adm = adm_text(scene, mb, Plant.from_scene(scene), "threelink", "test", start)
     assert all(len(ln) <= LINE_WIDTH for ln in adm.splitlines())
     model = read_adm(adm)
     v = model.functions()

@@ -26,6 +26,7 @@ from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
 from walkerlab.config import scene_from_dict
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = yaml.safe_load((ROOT / "configs" / "threelink_hzd.yaml").read_text())
@@ -42,7 +43,8 @@ b = np.ones(3)
 
 @pytest.fixture(scope="module")
 def walker():
-    return build_walker(scene_from_dict(copy.deepcopy(SCENE)))
+    sc = scene_from_dict(copy.deepcopy(SCENE))
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 @pytest.fixture(scope="module")
@@ -342,7 +344,8 @@ def test_a_hip_position_phase_puts_the_step_ends_within_half_a_turn():
     configurations as with the stance leg's angle (c_4 = 0.181051 rad puts the heel strike
     at -+0.181051 rad, to the Newton solve's 1e-11), so c_0 is the swing leg's post-impact
     angle, -0.181051 rad."""
-    d = build_walker(scene_with_c4(0.181051, point="hip")).actuators.controller.design
+    sc = scene_with_c4(0.181051, point="hip")
+    d = build_walker(sc, plant=Plant.from_scene(sc)).actuators.controller.design
     np.testing.assert_allclose(d.q_minus, [-0.181051, 0.181051, -0.106052], atol=1e-9)
     np.testing.assert_allclose(d.q_plus, [0.181051, -0.181051, -0.106052], atol=1e-9)
     assert abs(d.alpha[0, 0] + 0.181051) < 1e-9
@@ -367,7 +370,8 @@ def test_a_controller_whose_zero_dynamics_has_no_orbit_is_refused_at_once():
         mp.setattr(gait_search, "find_fixed_point", counted)
         mp.setattr(gait_search, "screen_seeds", lambda *a: pytest.fail("seeds tried"))
         with pytest.raises(gait_search.GaitNotFound) as e:
-            solve_scene(scene_with_c4(0.3), False)
+            sc = scene_with_c4(0.3)
+            solve_scene(sc, False, plant=Plant.from_scene(sc))
     text = str(e.value)
     assert len(text.splitlines()) == 1 and not started
     assert "zero dynamics has no periodic orbit" in text and "existence margin 249.5" in text
@@ -409,7 +413,7 @@ def test_a_closed_loop_that_does_not_step_from_its_orbit_fails_at_its_first_map(
         mp.setattr(P, "poincare_map", counted)
         mp.setattr(gait_search, "screen_seeds", lambda *a: pytest.fail("seeds tried"))
         with pytest.raises(gait_search.GaitNotFound) as e:
-            solve_scene(sc, False)
+            solve_scene(sc, False, plant=Plant.from_scene(sc))
     text = str(e.value)
     assert len(text.splitlines()) == 1 and len(maps) == 1
     assert "zero dynamics' orbit" in text and "phase_past_step_end" in text

@@ -14,6 +14,7 @@ import pytest
 
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -27,8 +28,10 @@ COMPASS = {"name": "t", "walker": {"model": "compass_gait", "leg_length_m": 1.0,
 
 
 def _walkers():
-    return {"compass": build_walker(scene_from_dict(COMPASS)),  # massive legs
-            "kuo2002": build_walker(load_scene(CONFIGS / "kuo2002.yaml"))}  # massless legs
+    sc = scene_from_dict(COMPASS)
+    sc1 = load_scene(CONFIGS / "kuo2002.yaml")
+    return {"compass": build_walker(sc, plant=Plant.from_scene(sc)),  # massive legs
+            "kuo2002": build_walker(sc1, plant=Plant.from_scene(sc1))}  # massless legs
 
 
 @pytest.fixture(scope="module")

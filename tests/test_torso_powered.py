@@ -30,6 +30,7 @@ from scipy.optimize import fsolve
 import walkerlab as wl
 from walkerlab.analysis.gait.energy import trajectory_ledger
 from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[1] / "configs" / "torso_powered.yaml"
 #: the scene's push-off [N s] and hip PD law [N m/rad, N m s/rad, rad]
@@ -159,7 +160,8 @@ def test_the_contact_view_carries_the_torso_walkers_actuators():
     from walkerlab.models.contact.actuation import ContactActuators
     from walkerlab.models.contact.scene import contact_setup
 
-    acts = contact_setup(load_scene(SCENE)).actuators
+    sc = load_scene(SCENE)
+    acts = contact_setup(sc, plant=Plant.from_scene(sc)).actuators
     assert isinstance(acts, ContactActuators) and acts.spec.push_off.impulse_n_s == P
     x = np.array([0.0, 0.97, -0.1, 0.2, 0.4, 0.0, 0.3, -0.5])  # leg2 in stance
     Q, power = acts.hip_torque(x, stance=1)

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,7 +32,7 @@ def walker_and_scene(request):
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / f"{request.param}.yaml")
-    return build_walker(scene), scene
+    return build_walker(scene, plant=Plant.from_scene(scene)), scene
 
 
 def test_compiled_closed_loop_is_the_python_flow_and_jacobian(walker_and_scene):
@@ -76,10 +77,10 @@ def test_compiled_fixed_point_is_the_lsoda_one(walker_and_scene):
     from walkerlab.integrate.solver import Solver
 
     walker, scene = walker_and_scene
-    lsoda = solve_scene(scene, False, walker=walker)[1].gait.result
+    lsoda = solve_scene(scene, False, walker=walker, plant=Plant.from_scene(scene))[1].gait.result
     s = Solver.from_settings(scene.solver)
     compiled = solve_scene(scene, False, walker=walker, solver=replace(
-        s, method="DOP853", backend="cyrk_compiled"))[1].gait.result
+        s, method="DOP853", backend="cyrk_compiled"), plant=Plant.from_scene(scene))[1].gait.result
     np.testing.assert_allclose(compiled.x, lsoda.x, rtol=0, atol=1e-8)
     assert abs(compiled.period_s - lsoda.period_s) < 1e-8
     a = np.asarray(lsoda.multipliers_variational)

@@ -25,6 +25,7 @@ from walkerlab.config import SceneError, scene_from_dict
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.virtual_constraints import bezier
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = yaml.safe_load((ROOT / "configs" / "rabbit_hzd.yaml").read_text())
@@ -39,7 +40,8 @@ def scene_with(**vc):
 
 @pytest.fixture(scope="module")
 def walker():
-    return build_walker(scene_from_dict(copy.deepcopy(SCENE)))
+    sc = scene_from_dict(copy.deepcopy(SCENE))
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 @pytest.fixture(scope="module")
@@ -127,7 +129,8 @@ def test_invariant_coefficients_zero_outputs_after_impact(walker, hzd):
 def test_non_invariant_coefficients_report_their_residual():
     """invariant: false keeps the given c_0, c_1: the outputs jump at the heel strike by
     the reported residual."""
-    w = build_walker(scene_with(invariant=False))
+    sc = scene_with(invariant=False)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     d = w.actuators.controller.design
     np.testing.assert_array_equal(d.alpha, d.given)
     dth = d.theta_minus - d.theta_plus
@@ -146,7 +149,8 @@ def test_non_invariant_coefficients_report_their_residual():
 def hip_phase_walker():
     """The outputs on the hip's horizontal position: a phase variable nonlinear in the
     angles (its second derivative enters L_f^2 h)."""
-    return build_walker(scene_with(phase={"point": "hip"}))
+    sc = scene_with(phase={"point": "hip"})
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 @pytest.mark.parametrize("which", ["stance_leg", "hip"])
@@ -230,7 +234,8 @@ def one_line(exc) -> str:
 
 def test_too_few_actuators_refused():
     with pytest.raises(ValueError) as e:
-        build_walker(scene_with(joints=["stance_hip", "swing_hip"]))
+        sc = scene_with(joints=["stance_hip", "swing_hip"])
+        build_walker(sc, plant=Plant.from_scene(sc))
     msg = one_line(e)
     assert "virtual_constraints.outputs" in msg and "2 actuators" in msg
 
@@ -238,7 +243,8 @@ def test_too_few_actuators_refused():
 def test_phase_not_monotone_refused():
     """The torso's angle keeps its value across the heel strike: theta+ = theta-."""
     with pytest.raises(ValueError) as e:
-        build_walker(scene_with(phase={"link": "torso"}))
+        sc = scene_with(phase={"link": "torso"})
+        build_walker(sc, plant=Plant.from_scene(sc))
     msg = one_line(e)
     assert "virtual_constraints.phase" in msg and "not monotone" in msg
 
@@ -247,7 +253,8 @@ def test_singular_decoupling_matrix_refused_naming_outputs():
     """Actuators at both hips and between the thighs (dependent columns of B) cannot drive
     four outputs: the decoupling matrix is singular."""
     with pytest.raises(ValueError) as e:
-        build_walker(scene_with(joints=["stance_hip", "swing_hip", "stance_knee", "hip"]))
+        sc = scene_with(joints=["stance_hip", "swing_hip", "stance_knee", "hip"])
+        build_walker(sc, plant=Plant.from_scene(sc))
     msg = one_line(e)
     assert "virtual_constraints.outputs" in msg and "decoupling matrix" in msg
     assert "joint:" in msg
@@ -271,7 +278,8 @@ def test_unknown_link_refused():
     cfg = copy.deepcopy(SCENE)
     cfg["walker"]["actuation"]["virtual_constraints"]["phase"] = {"coordinates": {"foo": 1.0}}
     with pytest.raises(ValueError) as e:
-        build_walker(scene_from_dict(cfg))
+        sc = scene_from_dict(cfg)
+        build_walker(sc, plant=Plant.from_scene(sc))
     assert "phase.coordinates.foo" in one_line(e)
 
 
@@ -295,7 +303,7 @@ def test_views_without_the_controller_refuse_it(tmp_path):
     from walkerlab.walker.kinds import KINDS, KindRefused
 
     scene = scene_from_dict(copy.deepcopy(SCENE))
-    assert contact_setup(scene).actuators.controller is not None
+    assert contact_setup(scene, plant=Plant.from_scene(scene)).actuators.controller is not None
     check_exportable(scene, KINDS["free_joints"], "mjcf")
     for fmt in ("adm", "osim"):
         with pytest.raises(KindRefused) as e:
@@ -384,7 +392,7 @@ def test_compass_gait_under_one_virtual_constraint():
         "feedback": {"kind": "input_output_linearization", "kp_per_s2": 2500,
                      "kd_per_s": 100}}}
     scene = scene_from_dict(cfg)
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     ctrl = w.actuators.controller
     assert ctrl.joints == ["hip"]
     z = zero_dynamics(ctrl)
@@ -410,7 +418,8 @@ def test_walkers_the_quadrature_does_not_hold_for_refused(name, words):
         "feedback": {"kind": "input_output_linearization", "kp_per_s2": 400,
                      "kd_per_s": 40}}}
     with pytest.raises(ValueError) as e:
-        build_walker(scene_from_dict(cfg))
+        sc = scene_from_dict(cfg)
+        build_walker(sc, plant=Plant.from_scene(sc))
     msg = one_line(e)
     assert msg.startswith("walker.actuation.virtual_constraints: ") and words in msg
 

@@ -22,6 +22,7 @@ from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
@@ -44,10 +45,10 @@ def test_the_paper_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one():
     """Started upright, the 3D walker of zero hip width is the planar walker (configs/
     paper.yaml): the same fixed point and period, to 1e-9."""
     flat_scene = _scene("paper.yaml")
-    flat = build_walker(flat_scene)
+    flat = build_walker(flat_scene, plant=Plant.from_scene(flat_scene))
     f = find_fixed_point(flat, _guess(flat_scene, flat.state_names()), SOLVER, fd_check=False)
     sp_scene = _scene("paper_3d.yaml")
-    w3 = build_walker(sp_scene)
+    w3 = build_walker(sp_scene, plant=Plant.from_scene(sp_scene))
     s = find_fixed_point(w3, _guess(sp_scene, w3.state_names()), SOLVER, fd_check=False)
     x3 = dict(zip(w3.state_names(), s.x))
     for name, value in zip(flat.state_names(), f.x):
@@ -174,7 +175,7 @@ HIP = dict(g=9.81, L=1.0, gamma=0.0174, M=10.0, m=5.0, a=0.5)
 @pytest.fixture(scope="module")
 def hip_width_gait():
     scene = _scene("hip_width.yaml")
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     res = find_fixed_point(walker, _guess(scene, walker.state_names()), SOLVER, fd_check=False)
     return walker, res, scene.walker.hip_width_m
 
@@ -302,7 +303,7 @@ def test_a_stride_map_of_the_zero_width_walker_squares_its_step_multipliers():
     period, every Floquet multiplier squared - each found by its own root finder and
     variational equations, not one computed from the other."""
     scene = _scene("paper_3d.yaml")
-    step = build_walker(scene)
+    step = build_walker(scene, plant=Plant.from_scene(scene))
     assert step.steps_per_map == 1
     stride = step.with_steps_per_map(2)
     assert stride.steps_per_map == 2 and step.with_steps_per_map(1) is step
@@ -314,7 +315,8 @@ def test_a_stride_map_of_the_zero_width_walker_squares_its_step_multipliers():
     assert np.sort(np.abs(b.multipliers_variational)) == pytest.approx(
         np.sort(np.abs(a.multipliers_variational) ** 2), rel=1e-7, abs=1e-9)
     with pytest.raises(ValueError, match="not made of this walker's maps"):
-        build_walker(_scene("hip_width.yaml")).with_steps_per_map(3)
+        sc = _scene("hip_width.yaml")
+        build_walker(sc, plant=Plant.from_scene(sc)).with_steps_per_map(3)
 
 
 def test_other_gait_false_stops_the_second_gait_search_of_a_3d_walker(tmp_path):
@@ -330,14 +332,14 @@ def test_other_gait_false_stops_the_second_gait_search_of_a_3d_walker(tmp_path):
 
     scene = _scene("hip_width.yaml")
     assert scene.fixedpoint.other_gait is False and scene.fixedpoint.gait == "stable"
-    walker, search = solve_scene(scene, fd_check=False)
+    walker, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
     assert len(search.gaits) == 1 and not search.result.stable
     assert any("other_gait: false" in n for n in search.notes)
     assert "deflated" not in " ".join(search.tried) and "seed" not in " ".join(search.tried)
     # the scene's own word is what stops it: with other_gait true the pair is looked for
     both = scene.model_copy(update={"fixedpoint": scene.fixedpoint.model_copy(
         update={"other_gait": True})})
-    assert len(solve_scene(both, fd_check=False)[1].gaits) == 2
+    assert len(solve_scene(both, fd_check=False, plant=Plant.from_scene(both))[1].gaits) == 2
     fp = load_fixedpoint(fixedpoint_stage.run(scene, runs_root=tmp_path).path)
     assert fp.steps_per_map == 2
     text = fixedpoint_text(fp)
@@ -371,8 +373,10 @@ def test_a_3d_walker_without_initial_guess_finds_the_shipped_gait(tmp_path, name
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.config import load_scene
 
-    _w, shipped = solve_scene(load_scene(ROOT / "configs" / name), fd_check=False)
-    _w, found = solve_scene(load_scene(_without_guess(tmp_path, name)), fd_check=False)
+    sc = load_scene(ROOT / "configs" / name)
+    _w, shipped = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
+    sc1 = load_scene(_without_guess(tmp_path, name))
+    _w, found = solve_scene(sc1, fd_check=False, plant=Plant.from_scene(sc1))
     assert any("planar twin" in n for n in found.notes)
     np.testing.assert_allclose(found.result.x, shipped.result.x, rtol=0, atol=SAME_GAIT_TOL)
 
@@ -389,7 +393,7 @@ def test_a_3d_walker_not_shipped_finds_a_gait_without_initial_guess(tmp_path):
     scene = load_scene(_without_guess(tmp_path, "hip_width.yaml", hip_width_m=0.07,
                                       leg_mass_kg=3.0, hip_mass_kg=12.0))
     t0 = time.process_time()
-    walker, search = solve_scene(scene, fd_check=False)
+    walker, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
     assert time.process_time() - t0 < 30.0
     res = search.result
     assert res.residual < 1e-10
@@ -415,9 +419,10 @@ def test_a_changed_gain_falls_back_to_the_stored_gait_and_finds_the_gait(tmp_pat
     path.write_text(yaml.safe_dump(data))
     scene = load_scene(path)
     known = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    guess = initial_guess(known, build_walker(known))
+    guess = initial_guess(known, build_walker(known, plant=Plant.from_scene(known)))
     nearby = stored_gait_start(scene, [StoredGait(known, lambda: guess, "known")])
-    walker, search = solve_scene(scene, fd_check=False, nearby=nearby)
+    walker, search = solve_scene(scene, fd_check=False, nearby=nearby,
+                                 plant=Plant.from_scene(scene))
     assert any("initial guess did not converge" in n for n in search.notes)
     assert search.gait.source == "stored_gait"
     res = search.result

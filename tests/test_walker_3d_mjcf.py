@@ -14,6 +14,7 @@ import pytest
 
 from walkerlab.cli.options import load
 from walkerlab.stages import export
+from walkerlab.walker.plant import Plant
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -78,7 +79,7 @@ def test_the_3d_walkers_keyframe_is_the_rigid_gait_on_its_foot_sphere(paper_3d):
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key("gait").id)
     mujoco.mj_kinematics(model, data)
-    x = ideal_gait(scene).x
+    x = ideal_gait(scene, plant=Plant.from_scene(scene)).x
     f = functions(walker_data(scene.walker, scene.slope.phi_rad))
     C = np.array(TO_MUJOCO)
     pts = {k: C @ np.ravel(v) for k, v in f["points"](x).items()}
@@ -218,7 +219,8 @@ def test_the_stabilised_walkers_keyframe_has_the_rigid_gaits_rolls(stabilised):
     mujoco.mj_resetDataKeyframe(model, data, model.key("gait").id)
     mujoco.mj_forward(model, data)
     phi, dphi = HipRollLoop(model).rolls(data)
-    x = ideal_gait(scene).x        # lean (leg2's), swing, stance, pelvis, swing (leg1's) roll
+    # lean (leg2's), swing, stance, pelvis, swing (leg1's) roll
+    x = ideal_gait(scene, plant=Plant.from_scene(scene)).x
     assert np.max(np.abs(phi - x[[3, 4, 0]])) < 1e-12
     assert np.max(np.abs(dphi - x[[8, 9, 5]])) < 1e-12
 

@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "rimless_wheel_3d.yaml"
@@ -38,7 +39,8 @@ def _scene(**walker):
 
 @pytest.fixture(scope="module")
 def wheel():
-    return build_walker(_scene())
+    sc = _scene()
+    return build_walker(sc, plant=Plant.from_scene(sc))
 
 
 @pytest.fixture(scope="module")
@@ -129,7 +131,8 @@ def test_upright_3d_wheel_rolls_downhill_as_the_planar_wheel(gait):
     assert max(abs(x[k]) for k in ("heading_angle", "lean_angle", "heading_rate",
                                    "lean_rate")) < 1e-12
     # the planar wheel's step period: the pendulum from alpha - gamma to -alpha - gamma
-    planar = build_walker(_scene(space="2d", diametral_inertia_kg_m2=None))
+    sc = _scene(space="2d", diametral_inertia_kg_m2=None)
+    planar = build_walker(sc, plant=Plant.from_scene(sc))
     solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     flat = find_fixed_point(planar, np.array([ALPHA - SLOPE, -1.0]), solver, fd_check=False)
     assert abs(gait.period_s - flat.period_s) < 1e-10
@@ -159,7 +162,7 @@ def test_the_disc_wheel_rolls_stably_above_its_critical_slope_as_the_reference_s
     from walkerlab.cli.options import load
 
     scene = load(str(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     res = find_fixed_point(walker, np.array([0, 0, ALPHA - 0.2, 0, 0, -1.9]), solver,
                            fd_check=False)
@@ -241,7 +244,7 @@ def test_the_3d_wheels_mjcf_walks_in_mujoco_as_the_rigid_model_predicts(tmp_path
     from walkerlab.walker.description import walker_data
 
     scene = load(str(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     gait = find_fixed_point(walker, np.array([0, 0, ALPHA - 0.2, 0, 0, -1.9]), solver,
                             fd_check=False)
@@ -367,8 +370,10 @@ def test_a_3d_wheel_without_initial_guess_finds_the_shipped_gait(tmp_path, name)
     data["fixedpoint"].pop("initial_guess")
     data["fixedpoint"].pop("gait", None)
     (tmp_path / name).write_text(yaml.safe_dump(data))
-    _w, shipped = solve_scene(load_scene(ROOT / "configs" / name), fd_check=False)
-    _w, found = solve_scene(load_scene(tmp_path / name), fd_check=False)
+    sc = load_scene(ROOT / "configs" / name)
+    _w, shipped = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
+    sc1 = load_scene(tmp_path / name)
+    _w, found = solve_scene(sc1, fd_check=False, plant=Plant.from_scene(sc1))
     assert any("closed form" in n for n in found.notes)
     np.testing.assert_allclose(found.result.x, shipped.result.x, rtol=0, atol=1e-9)
 
@@ -381,13 +386,13 @@ def test_the_planar_wheel_closed_form_gait_is_a_fixed_point():
     from walkerlab.config import load_scene
 
     scene = load_scene(ROOT / "configs" / "rimless_wheel.yaml")
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     x = w.closed_form_gait()
     assert x[1] == pytest.approx(-W_PLUS, rel=1e-14)
     for inertia in (0.0, 0.5):
         sc = scene.model_copy(update={"walker": scene.walker.model_copy(
             update={"hub_inertia_kg_m2": inertia})})
-        wi = build_walker(sc)
+        wi = build_walker(sc, plant=Plant.from_scene(sc))
         xi = wi.closed_form_gait()
         xn, _, _ = poincare_map(wi, xi, Solver(method="DOP853", rtol=1e-12, atol=1e-12))
         np.testing.assert_allclose(xn, xi, atol=1e-10)

@@ -14,6 +14,7 @@ import pytest
 from walkerlab.config import load_scene
 from walkerlab.models.contact.actuation import ANKLE_WORK_NAMES, powered_rhs
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "flat_feet_push_off.yaml"
 
@@ -31,7 +32,8 @@ def contact_walker(rigid):
     from walkerlab.analysis.contact.sim import initial_state_from_ideal
 
     _, gait = rigid
-    walker, _ = contact_setup(load_scene(SCENE)).build(gait.x, 4)
+    sc = load_scene(SCENE)
+    walker, _ = contact_setup(sc, plant=Plant.from_scene(sc)).build(gait.x, 4)
     return walker, initial_state_from_ideal(walker, gait.x)
 
 
@@ -85,7 +87,8 @@ def walk(rigid):
     from walkerlab.analysis.contact.sim import simulate_from
 
     _, gait = rigid
-    walker, res, _, _ = simulate_from(contact_setup(load_scene(SCENE)), gait.x,
+    sc = load_scene(SCENE)
+    walker, res, _, _ = simulate_from(contact_setup(sc, plant=Plant.from_scene(sc)), gait.x,
                                       gait.step_period)
     return walker, res
 

@@ -15,6 +15,7 @@ from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
 from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import load_scene
 from walkerlab.models.contact.scene import build
+from walkerlab.walker.plant import Plant
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
@@ -24,8 +25,8 @@ def test_sinks_add_up_to_gravity_work_over_the_step():
     Tolerance 2e-3 relative: the trapezoidal rule on 20,000 samples of a step with ~10 ms
     impacts (measured agreement ~1e-4)."""
     sc = load_scene(SCENE)
-    ideal = solve_variant(sc, "derived")[1]
-    walker, _ = build(sc, ideal.x, 2)
+    ideal = solve_variant(sc, "derived", plant=Plant.from_scene(sc))[1]
+    walker, _ = build(sc, ideal.x, 2, plant=Plant.from_scene(sc))
     g = find_contact_periodic_gait(walker, ideal.x, check_fd=False)
     e = energy_by_sink(walker, g.z)
     assert all(v > 0 for v in e.values()), e  # every sink dissipates

@@ -20,6 +20,7 @@ from walkerlab.config import Scene, load_scene
 from walkerlab.models.contact.actuation import powered_rhs
 from walkerlab.models.contact.powered_data import powered_data
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -47,8 +48,9 @@ def _walker(name, act):
     if act is not None:
         d["walker"]["actuation"] = act
     scene = Scene.model_validate(d)
-    gait = ideal_gait(base)  # a state near the walker's gait (the passive one's if added)
-    walker, x0, _, _ = scene_start(contact_setup(scene), gait.x, 2)
+    # a state near the walker's gait (the passive one's if added)
+    gait = ideal_gait(base, plant=Plant.from_scene(base))
+    walker, x0, _, _ = scene_start(contact_setup(scene, plant=Plant.from_scene(scene)), gait.x, 2)
     return walker, x0
 
 

@@ -14,6 +14,7 @@ from walkerlab.api.scenes import with_changes
 from walkerlab.config import load_scene
 from walkerlab.models.contact.actuation import powered_rhs
 from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -45,13 +46,15 @@ def test_every_actuator_the_walker_allows_is_carried():
             (FLAT[0], {"walker.actuation": {**FLAT[1]["walker.actuation"],
                                             "ankle_push_off": {"constant_n_m": 5.0}}}),
             ("rabbit.yaml", {"walker.actuation.push_off": {"impulse_n_s": 1.0}})):
-        acts = contact_setup(_scene(case)).actuators
+        sc = _scene(case)
+        acts = contact_setup(sc, plant=Plant.from_scene(sc)).actuators
         assert acts is not None and acts.spec.push_off is not None
     bad = (KNEED[0], {"walker.actuation": {"torques": [{"joint": "stance_ankle",
                                                         "law": {}}]}})
     with pytest.raises(ContactSceneError, match=r"^scene .*walker\.actuation\.torques\.0\."
                        r"joint: stance_ankle is not a joint of this walker[^\n]*$"):
-        contact_setup(_scene(bad))
+        sc = _scene(bad)
+        contact_setup(sc, plant=Plant.from_scene(sc))
 
 
 def test_a_knee_torque_is_a_generalised_force_on_the_stance_shank_and_thigh():
@@ -65,7 +68,7 @@ def test_a_knee_torque_is_a_generalised_force_on_the_stance_shank_and_thigh():
     sc = _scene((KNEED[0], {"walker.actuation": {"torques": [
         {"joint": "stance_knee", "law": {"constant_n_m": tau}}]}}))
     gait = wl.Walker.from_scene(load_scene(CONFIGS / KNEED[0])).fixed_point()
-    walker, x, _, _ = scene_start(contact_setup(sc), gait.x, 1)
+    walker, x, _, _ = scene_start(contact_setup(sc, plant=Plant.from_scene(sc)), gait.x, 1)
     n, names = walker.nq, walker.coordinate_names()
     for stance in (1, 0):
         dx, p = powered_rhs(walker, x, stance=stance)
@@ -86,7 +89,8 @@ def _run(case, strides):
 
     sc = _scene(case, strides)
     g = wl.Walker.from_scene(sc).fixed_point()
-    walker, res, _, _ = simulate_from(contact_setup(sc), g.x, g.step_period, strides=strides)
+    walker, res, _, _ = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), g.x, g.step_period, strides=strides)
     assert res.outcome.kind == "heel_strike", res.message
     E = walker.energies(res.x)
     resid = (E["total"] - E["total"][0]) - res.work.sum(axis=1)

@@ -13,6 +13,7 @@ from walkerlab.integrate.contact_grid import contact_grid
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
 
@@ -24,8 +25,8 @@ def test_compiled_grid_agrees_with_odeint_and_counts_its_calls():
     rtol 1e-13); the compiled one counts its RHS calls (measured 1786), odeint's Python RHS
     is not counted (0)."""
     scene = load_scene(SCENE)
-    ideal = solve_variant(scene, "derived")[1]
-    walker, x0, _, _ = scene_start(contact_setup(scene), ideal.x, 1)
+    ideal = solve_variant(scene, "derived", plant=Plant.from_scene(scene))[1]
+    walker, x0, _, _ = scene_start(contact_setup(scene, plant=Plant.from_scene(scene)), ideal.x, 1)
     tg = np.linspace(0.0, 0.4, 201)
     Xc, end_c, _, nf_c = contact_grid(walker, x0, tg, Solver("cyrk_bdf", 1e-11, 1e-13))
     Xo, end_o, _, nf_o = contact_grid(walker, x0, tg, Solver("odeint", 1e-11, 1e-13))

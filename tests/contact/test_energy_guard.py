@@ -17,6 +17,7 @@ from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import load_scene
 from walkerlab.models.contact.energy import energy_rise_bound, total_energy
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 RODS = SCENE.parent / "paper_rods.yaml"
 
@@ -30,8 +31,9 @@ def test_frictionless_rods_end_as_a_trip_without_blown_up_samples():
     sc = sc.model_copy(update={"contact": sc.contact.model_copy(
         update={"mu_static": 0.0, "mu_dynamic": 0.0}), "contact_sim": sc.contact_sim.model_copy(
         update={"initial_rate_scale": [1.506, 1.101]})})
-    ideal = solve_variant(sc, "derived")[1]
-    walker, r, x0, _ = simulate_from(contact_setup(sc), ideal.x, ideal.period_s)
+    ideal = solve_variant(sc, "derived", plant=Plant.from_scene(sc))[1]
+    walker, r, x0, _ = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), ideal.x, ideal.period_s)
     E = total_energy(walker, r.x)
     bound = energy_rise_bound(walker, x0, sc.contact_solver.rtol)
     assert np.all(E <= E[0] + bound), E.max() - E[0]
@@ -48,8 +50,8 @@ def test_total_energy_counts_the_stored_elastic_energy():
     from walkerlab.models.contact.scene import build
 
     sc = load_scene(SCENE)
-    ideal = solve_variant(sc, "derived")[1]
-    walker, _ = build(sc, ideal.x, 2)
+    ideal = solve_variant(sc, "derived", plant=Plant.from_scene(sc))[1]
+    walker, _ = build(sc, ideal.x, 2, plant=Plant.from_scene(sc))
     z = walker.link_state_from_ideal(ideal.x)
     d = 1e-4
     x = walker.pinned_to_full(z, -d * walker.normal)

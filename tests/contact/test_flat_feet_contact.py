@@ -17,6 +17,7 @@ from walkerlab.models.contact.model import ContactWalker
 from walkerlab.models.contact.scene import ContactSceneError, build
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.layout import StateIndex
+from walkerlab.walker.plant import Plant
 
 FOOT = {"kind": "flat", "heel_m": 0.05, "toe_m": 0.10,
         "ankle": {"stiffness_n_m_per_rad": 90.0, "rest_angle_rad": 0.03,
@@ -271,7 +272,7 @@ def test_standing_foot_carries_its_load_by_moment_balance():
 def test_flat_feet_need_their_mass_in_the_contact_section():
     sc = _scene(contact=False)
     with pytest.raises(ContactSceneError) as exc:
-        build(sc, np.array([-0.45, 0.34, 0.0, -1.79, -1.47, -19.3]), 4)
+        build(sc, np.array([-0.45, 0.34, 0.0, -1.79, -1.47, -19.3]), 4, plant=Plant.from_scene(sc))
     msg = str(exc.value)
     assert "\n" not in msg and "contact.flat_foot_mass_kg" in msg
     with pytest.raises(ValueError, match="flat_foot_mass_kg"):
@@ -284,7 +285,9 @@ def test_a_flat_stance_foot_cannot_be_pinned():
     d["contact_sim"] = {"pin_stance_until": "first_touchdown"}
     with pytest.raises(ContactSceneError, match="pin_stance_until: pinning the stance foot "
                        "needs point feet") as exc:
-        build(scene_from_dict(d, "f.yaml"), np.array([-0.35, 0.26, 0.0, -1.3, -1.2, -11.3]), 4)
+        sc = scene_from_dict(d, "f.yaml")
+        build(sc,
+              np.array([-0.35, 0.26, 0.0, -1.3, -1.2, -11.3]), 4, plant=Plant.from_scene(sc))
     assert "\n" not in str(exc.value)
 
 

@@ -18,14 +18,15 @@ from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import FOOT_RATE_ATOL_FACTOR
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
 def _start(name: str):
     scene = load_scene(CONFIGS / f"{name}.yaml")
-    ideal = solve_variant(scene, "derived")[1]
-    return scene_start(contact_setup(scene), ideal.x, 1)
+    ideal = solve_variant(scene, "derived", plant=Plant.from_scene(scene))[1]
+    return scene_start(contact_setup(scene, plant=Plant.from_scene(scene)), ideal.x, 1)
 
 
 @pytest.fixture(scope="module")

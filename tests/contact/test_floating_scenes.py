@@ -11,6 +11,7 @@ from walkerlab.analysis.contact.sim import initial_state_from_ideal
 from walkerlab.config import scene_from_dict
 from walkerlab.models.contact.scene import ContactSceneError, build
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 CONTACT = ("contact", "terrain", "contact_sim", "contact_solver")
@@ -27,9 +28,9 @@ def _scene(name):
 @pytest.mark.parametrize("name", ["paper", "paper_rods", "kneed", "round_feet", "goswami1996"])
 def test_build_any_walker(name):
     sc = _scene(name)
-    rigid = build_walker(sc)
+    rigid = build_walker(sc, plant=Plant.from_scene(sc))
     x = sc.fixedpoint.initial_guess.as_array(rigid.state_names())
-    w, step = build(sc, x, 4)
+    w, step = build(sc, x, 4, plant=Plant.from_scene(sc))
     n = 6 if name == "kneed" else 4
     assert len(w.state_names()) == 2 * n and len(w.state_units()) == 2 * n
     assert 0.2 < step < 0.8
@@ -49,5 +50,6 @@ def test_build_any_walker(name):
 
 def test_massless_walker_one_line():
     with pytest.raises(ContactSceneError, match="needs positive leg masses") as err:
-        build(_scene("simplest"), np.zeros(4), 4)
+        sc = _scene("simplest")
+        build(sc, np.zeros(4), 4, plant=Plant.from_scene(sc))
     assert "\n" not in str(err.value)

@@ -33,6 +33,7 @@ import pytest
 import yaml
 
 from walkerlab.config import scene_from_dict
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[2]
 TWO = yaml.safe_load((ROOT / "configs" / "footholds_two.yaml").read_text())
@@ -57,7 +58,7 @@ def _rigid(sc):
     """The rigid period-n gait: (fixed point, each step's period [s])."""
     from walkerlab.analysis.gait.scene import solve_scene
 
-    _, search = solve_scene(sc)
+    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
     res = search.result
     assert res.stable
     return res.x, np.asarray(res.step_periods_s)
@@ -83,9 +84,9 @@ def test_the_patches_lie_at_the_rigid_gaits_footfalls_at_their_heights(heights):
 
     sc = _scene(heights)
     x, _ = _rigid(sc)
-    walker, _, _, _ = scene_start(contact_setup(sc), x, 3)
+    walker, _, _, _ = scene_start(contact_setup(sc, plant=Plant.from_scene(sc)), x, 3)
     # the reference: the rigid model's own footfalls (its swing foot at each heel strike)
-    rigid = build_walker(sc)
+    rigid = build_walker(sc, plant=Plant.from_scene(sc))
     n = 2 * walker.lane1.size
     traj = simulate_steps(rigid, x, n - 1, Solver.from_settings(
         SolverSettings(method="DOP853", rtol=1e-12, atol=1e-12)))
@@ -116,7 +117,7 @@ def test_the_contact_walker_keeps_the_rigid_period_n_gait_on_footholds(heights):
 
     sc = _scene(heights)
     x, T = _rigid(sc)
-    _, res, _, _ = simulate_from(contact_setup(sc), x, float(T.mean()))
+    _, res, _, _ = simulate_from(contact_setup(sc, plant=Plant.from_scene(sc)), x, float(T.mean()))
     assert str(res.outcome.kind) in ("t_final", "heel_strike"), res.message
     assert len(res.heel_strike_times) >= 10
     got = _per_step_of_cycle(res.heel_strike_times, T.size)
@@ -156,7 +157,7 @@ def test_a_contact_run_that_drifts_off_the_rigid_footfalls_walks_on_its_own(heig
     sc = _scene(heights, contact=ADAMS_FRICTION, n_strides=15)
     assert sc.terrain.patch_width_m == 0.10
     x, T = _rigid(sc)
-    setup = contact_setup(sc)
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     rigid_laid, _, _, _ = scene_start(setup, x, 15)
     walker, res, _, _ = simulate_from(setup, x, float(T.mean()))
     assert str(res.outcome.kind) in ("t_final", "heel_strike"), res.message

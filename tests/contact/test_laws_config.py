@@ -13,6 +13,7 @@ from walkerlab.models.contact.laws import (
     coulomb_friction_coefficient,
     impact_normal_force,
 )
+from walkerlab.walker.plant import Plant
 
 
 def test_step_values_and_derivative():
@@ -170,7 +171,8 @@ def test_a_run_converts_its_contact_law_to_si_once(monkeypatch):
     monkeypatch.setattr(rigid_limit, "contact_params_si",
                         lambda s: calls.append(s) or real(s))
     scene = load_scene("configs/paper.yaml")
-    walker, step_length = build(scene, np.array([0.19, -0.19, -1.1, -0.4]), 10)
+    walker, step_length = build(scene, np.array([0.19, -0.19, -1.1, -0.4]), 10,
+                                plant=Plant.from_scene(scene))
     assert len(calls) == 1
     assert walker.contact == real(scene.contact) and 0.3 < step_length < 0.45
 

@@ -15,6 +15,7 @@ from walkerlab.config import SolverSettings, load_scene
 from walkerlab.models.contact.model import checkerboard_lanes
 from walkerlab.models.contact.rigid_limit import expected_order
 from walkerlab.models.contact.scene import build
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
 
@@ -22,8 +23,8 @@ SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
 @pytest.fixture(scope="module")
 def setup():
     scene = load_scene(SCENE)
-    ideal = solve_variant(scene, "derived")[1]
-    walker, _ = build(scene, ideal.x, 2)
+    ideal = solve_variant(scene, "derived", plant=Plant.from_scene(scene))[1]
+    walker, _ = build(scene, ideal.x, 2, plant=Plant.from_scene(scene))
     return scene, ideal, walker
 
 

@@ -13,6 +13,7 @@ from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import SolverSettings, load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import build
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "kneed.yaml"
 
@@ -30,8 +31,8 @@ PERIOD_S, STEP_M = 0.5505094193, 0.4687958598
 @pytest.fixture(scope="module")
 def kneed():
     scene = load_scene(SCENE)
-    ideal = solve_variant(scene, "derived")[1]
-    walker, _ = build(scene, ideal.x, 2)
+    ideal = solve_variant(scene, "derived", plant=Plant.from_scene(scene))[1]
+    walker, _ = build(scene, ideal.x, 2, plant=Plant.from_scene(scene))
     return ideal, walker
 
 

@@ -18,6 +18,7 @@ from walkerlab.integrate.contact import integrate_contact
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.actuation import WORK_NAMES
 from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "powered_compass.yaml"
 
@@ -33,7 +34,7 @@ def rigid():
 def _run(scene, x_ideal, t_final, strides=1):
     from walkerlab.analysis.contact.sim import scene_start
 
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     walker, x0, limits, _ = scene_start(setup, x_ideal, strides)
     limits = replace(limits, fall_hip_height_m=0.5 * walker.L)
     run = integrate_contact(walker, x0, 0.0, t_final, Solver.from_settings(setup.solver),
@@ -99,7 +100,8 @@ def test_impulse_work_equals_the_rigid_push_off(rigid):
     x_pre = walk.x[np.flatnonzero(first)[-1]]  # the first step's last sample: heel strike
     tr = w.model.actuators.transition(x_pre)
     assert np.allclose(tr["x_plus"], walk.x[np.flatnonzero(~first)[0]], atol=1e-9)
-    setup = contact_setup(load_scene(SCENE))
+    sc = load_scene(SCENE)
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     walker, _ = setup.build(gait.x, 2)
     x = walker.pinned_to_full(walker.link_state_from_ideal(x_pre), np.zeros(2))
     _, work = impulse_jump(walker, x, 1, tr["impulse"])
@@ -117,7 +119,8 @@ def stage_run(rigid):
     w, gait = rigid
     fp = SimpleNamespace(x=gait.x, step_period_s=gait.step_period,
                          state_names=list(w.state_names()))
-    return contact_sim_run(contact_setup(load_scene(SCENE)), fp)
+    sc = load_scene(SCENE)
+    return contact_sim_run(contact_setup(sc, plant=Plant.from_scene(sc)), fp)
 
 
 @pytest.fixture(scope="module")
@@ -182,9 +185,11 @@ def test_contact_ledger_closes_with_the_contact_term_named(walk):
 def test_refusals_are_one_line(tmp_path):
     base = load_scene(SCENE)
     with pytest.raises(ContactSceneError, match="pin_stance_until"):
-        contact_setup(with_changes(base, {"contact_sim.pin_stance_until": "first_touchdown"}))
+        sc = with_changes(base, {"contact_sim.pin_stance_until": "first_touchdown"})
+        contact_setup(sc, plant=Plant.from_scene(sc))
     with pytest.raises(ContactSceneError, match="contact_sim.start"):
-        contact_setup(with_changes(base, {"contact_sim.start": "adjusted"}))
+        sc = with_changes(base, {"contact_sim.start": "adjusted"})
+        contact_setup(sc, plant=Plant.from_scene(sc))
     # the contact periodic gait needs state-based laws: time since the heel strike is not
     # a state of the mid-stance section
     law = {"stiffness_n_m_per_rad": 30.0, "damping_n_m_s_per_rad": 1.0,
@@ -192,7 +197,7 @@ def test_refusals_are_one_line(tmp_path):
     timed = with_changes(base, {"walker.actuation.torques": [{"joint": "hip", "law": law}],
                                 "contact_sim.start": "periodic_gait"})
     with pytest.raises(ContactSceneError, match="time since the heel strike"):
-        contact_setup(timed)
+        contact_setup(timed, plant=Plant.from_scene(timed))
 
 
 @pytest.mark.slow  # ~10 s CPU: 40 step maps, each with a pulse on solve_ivp
@@ -210,7 +215,8 @@ def test_the_powered_contact_periodic_gait_returns_to_itself_near_the_rigid_one(
     from walkerlab.analysis.contact.step_map import StepMap
 
     _, gait = rigid
-    setup = contact_setup(load_scene(SCENE))
+    sc = load_scene(SCENE)
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     probe = scene_start(setup, gait.x, 2)[0]
     g = find_contact_periodic_gait(probe, gait.x, check_fd=False, warmup_steps=4)
     assert g.converged and g.residual < 1e-8
@@ -239,7 +245,7 @@ def test_a_powered_run_is_the_passive_loop_with_an_actuation_hook(rigid, monkeyp
     scene = with_changes(load_scene(SCENE), {
         "walker.actuation.push_off": None,
         "walker.actuation.torques": [{"joint": "hip", "law": {}}]})
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     assert setup.actuators is not None and setup.actuators.spec.push_off is None
     hooks = []
     loop = contact._run_free
@@ -317,10 +323,10 @@ def test_a_zero_gain_hip_laws_compiled_step_map_is_the_passive_map():
     paper = load_scene(SCENE.with_name("paper.yaml"))
     hip = with_changes(paper, {"walker.actuation": {"torques": [{"joint": "hip", "law": {
         "stiffness_n_m_per_rad": 0.0, "damping_n_m_s_per_rad": 0.0}}]}})
-    gait = ideal_gait(paper)
+    gait = ideal_gait(paper, plant=Plant.from_scene(paper))
     maps = []
     for sc in (paper, hip):
-        walker = scene_start(contact_setup(sc), gait.x, 2)[0]
+        walker = scene_start(contact_setup(sc, plant=Plant.from_scene(sc)), gait.x, 2)[0]
         maps.append(StepMap(walker, solver=MAP_SOLVER))
     passive, powered = maps
     assert powered.powered and not passive.powered
@@ -347,7 +353,8 @@ def test_every_shipped_powered_scene_runs_the_compiled_contact_run_or_says_why_n
     from walkerlab.models.contact.powered_data import powered_data
 
     path = SCENE.with_name(f"{name}.yaml")
-    setup = contact_setup(load_scene(path))
+    sc = load_scene(path)
+    setup = contact_setup(sc, plant=Plant.from_scene(sc))
     data = powered_data(setup.model())
     if setup.solver.method in CYRK_METHODS:
         assert data is not None, f"{name}: a compiled solver for actuators that are no data"

@@ -15,6 +15,7 @@ from walkerlab.api.scenes import with_changes
 from walkerlab.config import load_scene
 from walkerlab.models.contact.actuation import FLAT_HIP_WORK_NAMES, powered_rhs
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 #: a constant hip torque with a damper on the hip angle's rate [N m, N m s/rad]
@@ -41,7 +42,8 @@ def start(gait):
     in stance, heel contact), the legs and feet moving."""
     from walkerlab.analysis.contact.sim import scene_start
 
-    walker, x, _, _ = scene_start(contact_setup(_scene()), gait.x, 1)
+    sc = _scene()
+    walker, x, _, _ = scene_start(contact_setup(sc, plant=Plant.from_scene(sc)), gait.x, 1)
     return walker, x
 
 
@@ -139,7 +141,8 @@ def test_flat_hip_torques_take_push_offs_and_the_periodic_gait():
     for extra in ({"walker.actuation.ankle_push_off": {"constant_n_m": 10.0}},
                   {"walker.actuation.push_off": {"impulse_n_s": 0.1}},
                   {"contact_sim.periodic_gait": True}):
-        assert contact_setup(_scene(**extra)).actuators is not None
+        sc = _scene(**extra)
+        assert contact_setup(sc, plant=Plant.from_scene(sc)).actuators is not None
 
 
 def test_the_flat_hip_ledger_closes(gait):
@@ -151,7 +154,8 @@ def test_the_flat_hip_ledger_closes(gait):
     from walkerlab.analysis.contact.sim import simulate_from
 
     sc = _scene(**{"contact_sim.t_final_s": 0.9})
-    walker, res, _, _ = simulate_from(contact_setup(sc), gait.x, gait.step_period, strides=1)
+    walker, res, _, _ = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), gait.x, gait.step_period, strides=1)
     assert res.work.shape == (len(res.t), len(FLAT_HIP_WORK_NAMES))
     assert len(res.heel_strike_times) >= 1, res.message
     E = walker.energies(res.x)["total"]
@@ -206,7 +210,8 @@ def optimum_gait():
 
     scene = load_scene(CONFIGS / "flat_feet.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    r = solve_scene(scene, False, walker=make_rigid_walker(data, double_support=False))[1]
+    r = solve_scene(scene, False, walker=make_rigid_walker(data, double_support=False),
+                    plant=Plant.from_scene(scene))[1]
     return np.asarray(r.gait.result.x, float), float(r.gait.result.period_s)
 
 
@@ -225,7 +230,8 @@ def passive_contact_period(x, period_s: float, strides: int = 1) -> float:
     sc = with_changes(scene, {"contact_sim": {"n_strides": strides + 1, "sample_rate_hz": 500,
                                               "start": "ideal",
                                               "t_final_s": (steps + 1.6) * period_s}})
-    _, res, _, _ = simulate_from(contact_setup(sc), x, period_s, strides=strides + 1)
+    _, res, _, _ = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), x, period_s, strides=strides + 1)
     hs = np.asarray(res.heel_strike_times, float)[:steps + 1]
     assert hs.size == steps + 1, res.message
     return float(np.mean(np.diff(hs)))

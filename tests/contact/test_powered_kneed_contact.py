@@ -15,6 +15,7 @@ from walkerlab.api.scenes import with_changes
 from walkerlab.config import load_scene
 from walkerlab.models.contact.actuation import KNEE_WORK_NAMES, powered_rhs
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 #: a small constant hip torque with a damper on the hip angle's rate [N m, N m s/rad]
@@ -42,7 +43,8 @@ def test_the_hip_torque_acts_between_the_thighs(gait):
     ledger's last term."""
     from walkerlab.analysis.contact.sim import scene_start
 
-    walker, x, _, _ = scene_start(contact_setup(_scene()), gait.x, 1)
+    sc = _scene()
+    walker, x, _, _ = scene_start(contact_setup(sc, plant=Plant.from_scene(sc)), gait.x, 1)
     n, names = walker.nq, walker.coordinate_names()
     th1, th2 = names.index("leg1_thigh_angle"), names.index("leg2_thigh_angle")
     assert walker.actuators.knee and walker.actuators.work_names == KNEE_WORK_NAMES
@@ -67,7 +69,8 @@ def test_the_kneed_ledger_closes_with_the_knee_stop_term(gait):
     from walkerlab.analysis.contact.sim import simulate_from
 
     sc = _scene(**{"contact_sim.t_final_s": 0.7})
-    walker, res, _, _ = simulate_from(contact_setup(sc), gait.x, gait.step_period, strides=1)
+    walker, res, _, _ = simulate_from(contact_setup(sc,
+            plant=Plant.from_scene(sc)), gait.x, gait.step_period, strides=1)
     assert res.work.shape == (len(res.t), len(KNEE_WORK_NAMES))
     assert len(res.heel_strike_times) >= 1, res.message
     E = walker.energies(res.x)["total"]
@@ -81,9 +84,11 @@ def test_the_kneed_ledger_closes_with_the_knee_stop_term(gait):
 def test_a_kneed_walker_takes_a_push_off_and_the_periodic_gait():
     """A push-off on knees and the contact periodic gait (refused before issue 48's
     contact actuation) are carried."""
-    assert contact_setup(_scene(**{"walker.actuation.push_off": {"impulse_n_s": 0.1}})
+    sc1 = _scene(**{"walker.actuation.push_off": {"impulse_n_s": 0.1}})
+    assert contact_setup(sc1, plant=Plant.from_scene(sc1)
                          ).actuators.spec.push_off is not None
-    assert contact_setup(_scene(**{"contact_sim.periodic_gait": True})).actuators is not None
+    sc = _scene(**{"contact_sim.periodic_gait": True})
+    assert contact_setup(sc, plant=Plant.from_scene(sc)).actuators is not None
 
 
 def test_the_kneed_optimums_contact_replay_keeps_its_period(gait):

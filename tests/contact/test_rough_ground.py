@@ -13,6 +13,7 @@ from walkerlab.config import ContactSettings
 from walkerlab.models.contact import terrain as T
 from walkerlab.models.contact.laws import contact_params_si
 from walkerlab.models.contact.model import ContactWalker
+from walkerlab.walker.plant import Plant
 
 SPACING = 0.372
 
@@ -120,7 +121,8 @@ def test_heights_are_checked_and_footfalls_map_to_lanes():
 @pytest.fixture(scope="module")
 def paper_start(paper_scene, paper_fixed_point):
     """The paper contact walker's own contact-sim start (no periodic-gait search)."""
-    return C.contact_start(paper_scene, paper_fixed_point.x, periodic=False)
+    return C.contact_start(paper_scene, paper_fixed_point.x, periodic=False,
+                           plant=Plant.from_scene(paper_scene))
 
 
 @pytest.mark.slow
@@ -162,5 +164,6 @@ def test_robustness_contact_steps_only_when_asked(paper_scene):
     from walkerlab.config import RobustnessSettings
     from walkerlab.studies.robustness_study import contact_steps
 
-    off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05)
+    off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05,
+                        plant=Plant.from_scene(paper_scene))
     assert len(off) == 4 and all(math.isnan(v) for v in off.values())

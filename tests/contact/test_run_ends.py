@@ -19,6 +19,7 @@ from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
 from walkerlab.models.contact import ContactWalker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -130,14 +131,15 @@ def test_a_run_asked_for_n_strides_goes_on_until_it_makes_them_or_says_why_not()
     from walkerlab.models.contact.scene import contact_setup
 
     scene = load_scene(ROOT / "configs" / "asymmetric_legs.yaml")
-    ideal = ideal_gait(scene)
+    ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
     step = float(np.mean(ideal.step_periods_s))  # the stride map's two steps
     horizon = (2 * scene.contact_sim.n_strides + 0.5) * step
     narrow = with_changes(scene, {"terrain.patch_width_m": 0.10})
-    _, res, _, _ = simulate_from(contact_setup(narrow), ideal.x, step)
+    _, res, _, _ = simulate_from(contact_setup(narrow,
+                                               plant=Plant.from_scene(narrow)), ideal.x, step)
     assert res.t[-1] > horizon and res.outcome.kind == "fall", res.outcome
     assert "after 9 heel strikes" in res.outcome.message
-    _, res, _, _ = simulate_from(contact_setup(scene), ideal.x, step)
+    _, res, _, _ = simulate_from(contact_setup(scene, plant=Plant.from_scene(scene)), ideal.x, step)
     assert res.outcome.walked and len(res.heel_strike_times) >= 2 * scene.contact_sim.n_strides
 
 
@@ -153,8 +155,9 @@ def test_a_fall_on_continuous_ground_names_the_scuffs_and_the_checkerboard():
 
     scene = with_changes(load_scene(ROOT / "configs" / "paper.yaml"),
                          {"terrain.kind": "continuous"})
-    ideal = ideal_gait(scene)
-    _, res, _, _ = simulate_from(contact_setup(scene), ideal.x, ideal.period_s)
+    ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
+    _, res, _, _ = simulate_from(contact_setup(scene,
+            plant=Plant.from_scene(scene)), ideal.x, ideal.period_s)
     assert res.outcome.kind == "fall"
     assert "scuffed the ground" in res.outcome.message
     assert "terrain.lanes: checkerboard" in res.outcome.message  # the field's own name
@@ -165,7 +168,7 @@ def _contact_walker(scene):
     not enter the advice)."""
     from walkerlab.models.contact.scene import contact_setup
 
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     n = 2 * len(setup.walker.structure.bodies) + 2  # a state of the walker's size
     return setup.build(np.zeros(max(n, 4)), 4, step_length_m=0.4)[0]
 
@@ -243,7 +246,9 @@ def test_the_upper_body_walker_makes_five_strides_from_its_contact_periodic_gait
 
     scene = load_scene(ROOT / "configs" / "torso_bhm.yaml")
     assert scene.contact_sim.n_strides == 5 and scene.contact_sim.start == "periodic_gait"
-    _, res, *_ = simulate_from_periodic_gait(contact_setup(scene), ideal_gait(scene).x)
+    plant = Plant.from_scene(scene)
+    _, res, *_ = simulate_from_periodic_gait(contact_setup(scene, plant=plant),
+                                             ideal_gait(scene, plant=plant).x)
     assert res.outcome.kind == "heel_strike", res.outcome
     assert len(res.heel_strike_times) >= 10
 

@@ -22,6 +22,7 @@ from walkerlab.analysis.contact.sim import simulate_from
 from walkerlab.config import load_scene
 from walkerlab.config.solver import SolverSettings
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -29,8 +30,8 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 @pytest.mark.slow
 def test_every_integrators_powered_run_reports_the_heel_strike_the_strides_cap_stops_at():
     scene = load_scene(CONFIGS / "threelink_hzd.yaml")
-    gait = ideal_gait(scene)
-    setup = contact_setup(scene)
+    gait = ideal_gait(scene, plant=Plant.from_scene(scene))
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     strides = 2
     times = {}
     for method in ("cyrk_bdf", "LSODA"):

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -94,7 +95,8 @@ def test_ground_the_contact_model_does_not_build_is_refused_in_one_line(terrain,
     d = _stairs().model_dump(mode="json")
     d["terrain"] = {k: v for k, v in {**d["terrain"], **terrain}.items() if v is not None}
     with pytest.raises(ContactSceneError) as err:
-        contact_setup(scene_from_dict(d))
+        sc = scene_from_dict(d)
+        contact_setup(sc, plant=Plant.from_scene(sc))
     assert field in str(err.value) and "\n" not in str(err.value)
 
 
@@ -114,8 +116,9 @@ def test_the_contact_periodic_gait_on_stairs_is_laid_per_step():
     d = sc.model_dump(mode="json")
     d["contact_sim"] = {**d["contact_sim"], "start": "periodic_gait", "n_strides": 2}
     sc = scene_from_dict(d)
-    _, search = solve_scene(sc)
-    _, res, _, _, gait = simulate_from_periodic_gait(contact_setup(sc), search.result.x)
+    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
+    _, res, _, _, gait = simulate_from_periodic_gait(contact_setup(sc,
+            plant=Plant.from_scene(sc)), search.result.x)
     assert gait.converged and gait.stable
     periods = np.diff(res.heel_strike_times)
     assert periods.size >= 3
@@ -157,9 +160,10 @@ def test_contact_run_down_stairs_keeps_the_rigid_stair_gait():
     from walkerlab.models.contact.scene import contact_setup
 
     sc = load_scene(ROOT / "configs" / "stairs.yaml")
-    _, search = solve_scene(sc)
+    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
     rigid = search.result
-    _, res, _, _ = simulate_from(contact_setup(sc), rigid.x, rigid.period_s)
+    _, res, _, _ = simulate_from(contact_setup(sc,
+                                               plant=Plant.from_scene(sc)), rigid.x, rigid.period_s)
     assert str(res.outcome.kind) in ("t_final", "heel_strike"), res.message
     assert len(res.heel_strike_times) >= 10
     period = float(np.mean(np.diff(res.heel_strike_times)[2:]))
@@ -180,8 +184,9 @@ def _heel_strikes(scene):
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.models.contact.scene import contact_setup
 
-    _, search = solve_scene(scene)
-    _, res, _, _ = simulate_from(contact_setup(scene), search.result.x,
+    _, search = solve_scene(scene, plant=Plant.from_scene(scene))
+    _, res, _, _ = simulate_from(contact_setup(scene,
+                                               plant=Plant.from_scene(scene)), search.result.x,
                                  search.result.period_s)
     return np.asarray(res.heel_strike_times), res
 
@@ -320,8 +325,9 @@ def test_a_profile_exports_as_a_height_field_and_walks_in_mujoco(tmp_path):
         assert not w.fell and w.alternating and len(w.times_s) >= 10, name
         periods[name] = np.diff(w.times_s)
     assert np.mean(periods["line"]) == pytest.approx(np.mean(periods["plane"]), rel=5e-3)
-    _, search = solve_scene(bumpy)
-    T = np.array([seg.period for seg in profile_walk(bumpy, search.result.x, 12).segments])
+    _, search = solve_scene(bumpy, plant=Plant.from_scene(bumpy))
+    T = np.array([seg.period for seg in profile_walk(bumpy, search.result.x, 12,
+                                                     plant=Plant.from_scene(bumpy)).segments])
     k = min(len(T) - 1, len(periods["bumpy"]))
     assert np.allclose(periods["bumpy"][:k], T[1:k + 1], rtol=0.015)
     with pytest.raises(ValueError, match=r"^terrain\.kind: profile: not in the OpenSim"):

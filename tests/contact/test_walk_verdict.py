@@ -13,6 +13,7 @@ from walkerlab.analysis.contact.gait import Outcome, PatchFit, step_trend, walk_
 from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, TerrainSettings
 from walkerlab.models.contact import ContactWalker
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -141,8 +142,9 @@ def test_the_powered_compass_off_its_patches(tmp_path, impulse, strides, heel_st
                           "fixedpoint.initial_guess": None, "contact_sim.n_strides": strides,
                           "contact.stiction_velocity_mm_per_s": 100.0,
                           "contact.friction_velocity_mm_per_s": 1000.0})
-    ideal = ideal_gait(scene)
-    _, res, _, _ = simulate_from(contact_setup(scene), ideal.x, ideal.period_s)
+    ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
+    _, res, _, _ = simulate_from(contact_setup(scene,
+            plant=Plant.from_scene(scene)), ideal.x, ideal.period_s)
     assert len(res.heel_strike_times) == heel_strikes
     assert "then fell" in res.outcome.message
     assert "after the strides asked for" in res.outcome.message

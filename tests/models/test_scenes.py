@@ -11,6 +11,7 @@ from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.models.registry import build_walker
 from walkerlab.published import garcia1998 as G
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -19,7 +20,7 @@ def _fixed_point(name, slope_rad=None, guess=None):
     sc = load_scene(CONFIGS / f"{name}.yaml")
     if slope_rad is not None:
         sc = sc.model_copy(update={"slope": sc.slope.model_copy(update={"angle_rad": slope_rad})})
-    w = build_walker(sc)
+    w = build_walker(sc, plant=Plant.from_scene(sc))
     fp = sc.fixedpoint
     if guess is None:
         guess = fp.initial_guess.as_array(w.state_names())

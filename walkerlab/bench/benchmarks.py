@@ -20,6 +20,7 @@ import numpy as np
 
 from walkerlab.bench.process_env import installed_env
 from walkerlab.io.schemas.continuation import initial_state
+from walkerlab.walker.plant import Plant
 
 
 def machine() -> dict:
@@ -53,7 +54,7 @@ def bench_ideal(repeats: int = 7) -> dict:
 
     scene = paper_scene()
     t0 = time.perf_counter()
-    w = build_walker(scene)
+    w = build_walker(scene, plant=Plant.from_scene(scene))
     build_s = time.perf_counter() - t0
     guess = np.asarray(initial_state(scene.fixedpoint.initial_guess, w.state_names()))
     sv = Solver.from_settings(scene.solver)

@@ -17,6 +17,7 @@ from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.config.solver import SolverSettings
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.walker.layout import StateIndex
+from walkerlab.walker.plant import Plant
 
 __all__ = ["BAND_FACTORS", "EXAMPLE_IDEAL", "SCAN_RTOLS", "TARGET_RTOLS", "leg_angle_columns",
            "rhs_cost", "run_benchmark", "run_scene_benchmark"]
@@ -261,8 +262,9 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     from walkerlab.analysis.contact.sim import scene_start
     from walkerlab.models.contact.scene import contact_setup
 
-    ideal = ideal_gait(scene)
-    walker, x0, limits, _ = scene_start(contact_setup(scene), ideal.x, n_strides + 1)
+    ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
+    walker, x0, limits, _ = scene_start(contact_setup(scene,
+            plant=Plant.from_scene(scene)), ideal.x, n_strides + 1)
     t_final = 1.03 * 2 * n_strides * ideal.period_s
     case = _Case(walker, x0, t_final, limits, reference_rtol, 1e-2 * reference_rtol,
                  reference_method)

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 __all__ = ["bench_design", "bench_design_process", "bench_hzd", "lines"]
 
 #: the issue's target for delta^2 [s]
@@ -60,7 +62,7 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
     path = scene_path or Path(__file__).resolve().parents[2] / "configs" / "rabbit_hzd.yaml"
     scene = load_scene(path)
     t = time.perf_counter()
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     build = time.perf_counter() - t
     ctrl = walker.actuators.controller
     d2_times, zd_times = [], []
@@ -131,7 +133,8 @@ def bench_design_process(pairs: int = 3) -> dict:
         scene = load_scene(path)
         vc = scene.walker.actuation.virtual_constraints
         spec = design_spec(scene, collocation_spec(scene))
-        t, x, u, alpha, _zd = controller_step(build_walker(scene), Solver.from_settings(
+        t, x, u, alpha, _zd = controller_step(build_walker(scene,
+                plant=Plant.from_scene(scene)), Solver.from_settings(
             scene.solver), 2 * DESIGN["intervals"] + 1)
         npz = Path(d) / "start.npz"
         _write_start(npz, (t, x, u, alpha), vc, spec.max_torque_n_m, spec.friction_coefficient)
@@ -180,7 +183,6 @@ def bench_design(repeats: int = 3) -> dict:
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.driver import optimize_scene  # light
     from walkerlab.optimal.virtual_constraints import controller_step  # light
-    from walkerlab.walker.plant import Plant  # light
 
     root = Path(__file__).resolve().parents[2]
     cfg = yaml.safe_load((root / "configs" / "threelink_hzd.yaml").read_text())

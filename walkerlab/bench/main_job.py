@@ -85,9 +85,10 @@ mc = importlib.util.module_from_spec(spec); spec.loader.exec_module(mc)
 from walkerlab.analysis.gait.scene import solve_scene
 from walkerlab.analysis.robustness.mfpt import draw_slopes
 from walkerlab.config import MfptSettings, load_scene
+from walkerlab.walker.plant import Plant
 from walkerlab.studies import mfpt as work
 scene = load_scene(scene_path)
-_, search = solve_scene(scene, fd_check=False)
+_, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
 x = np.asarray(search.gait.result.x, float)
 st = scene.mfpt or MfptSettings()
 base = scene.model_dump(mode="json")
@@ -123,9 +124,10 @@ import json, sys, time
 import numpy as np
 from walkerlab.analysis.gait.scene import solve_scene
 from walkerlab.config import MfptSettings, load_scene
+from walkerlab.walker.plant import Plant
 from walkerlab.studies import mfpt as work
 scene = load_scene(sys.argv[1]); sd = float(sys.argv[2]); workers = int(sys.argv[3])
-_, search = solve_scene(scene, fd_check=False)
+_, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
 x = np.asarray(search.gait.result.x, float)
 import resource
 def cpu():

@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 __all__ = ["bench_powered_contact", "lines"]
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
@@ -48,7 +50,7 @@ def _timed(scene, x_ideal, steps_s: float, repeats: int, method: str | None = No
     from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
     from walkerlab.models.contact.scene import contact_setup  # light
 
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     walker, x0, limits, _ = scene_start(setup, x_ideal, 3)
     solver = setup.solver.model_copy(update={"method": method or "cyrk_bdf"})
     simulate_contact(walker, x0, steps_s, solver, limits)  # warm: compiled
@@ -74,7 +76,7 @@ def bench_powered_contact(repeats: int = 7) -> dict:
 
     out = {"repeats": repeats, "target_ratio": 1.5, "cases": {}}
     paper = _scene("paper.yaml", None)
-    gait = ideal_gait(paper)
+    gait = ideal_gait(paper, plant=Plant.from_scene(paper))
     span = 5.0 * gait.period_s
     base, _, _ = _timed(paper, gait.x, span, repeats)
     out["cases"]["paper passive"] = {"cpu_s": base}
@@ -86,7 +88,7 @@ def bench_powered_contact(repeats: int = 7) -> dict:
         out["cases"][label] = {"cpu_s": t, "heel_strikes": n, "ratio": t / base,
                                "solve_ivp_cpu_s": t_ivp, "solve_ivp_ratio": t_ivp / base}
     rabbit = _scene("rabbit.yaml", _rabbit_actuation())
-    rgait = ideal_gait(rabbit)
+    rgait = ideal_gait(rabbit, plant=Plant.from_scene(rabbit))
     rspan = 4.0 * rgait.period_s
     t, s, n = _timed(rabbit, rgait.x, rspan, repeats)
     tp, sp, _ = _timed(_scene("rabbit.yaml", None), rgait.x, rspan, repeats)

@@ -32,6 +32,7 @@ from typing import NamedTuple
 import numpy as np
 
 from walkerlab.execution.lanes import Lanes, pinned_worker, run_on_lanes
+from walkerlab.walker.plant import Plant
 
 CYRK_PREFIX = "CyRK "
 
@@ -49,7 +50,7 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
 
     def run(method, rtol, atol):
         backend = "scipy"
@@ -109,7 +110,7 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     from walkerlab.models.contact.scene import contact_setup  # light
     from walkerlab.walker.layout import StateIndex
 
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     cs = setup.sim
     walker, z0, limits, _ = scene_start(setup, x0, strides)
     t_final = cs.t_final_s or (2 * strides + 0.5) * step_period

@@ -252,16 +252,16 @@ def check_adams_exportable(mb) -> None:
                              "the hip joints, which a COUPLER of the hip revolutes cannot hold")
 
 
-def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
+def adams_start(scene: Scene, mb, plant, ideal=None) -> AdamsStart:
     """The rigid gait's post-impact state (leg2 in stance, its foot at the origin), its rates
     times ``contact_sim.initial_rate_scale`` (the paper's Table 2 adjustment), and the
     checkerboard of :func:`walkerlab.export.scene.mjcf_scene` cut to the run's strides.
 
     Parameters
     ----------
-    scene, mb, data
+    scene, mb, plant
         The scene, its walker as a :class:`~walkerlab.walker.multibody.Multibody` and its
-        ``WalkerData``.
+        :class:`~walkerlab.walker.plant.Plant` (the stage's).
     ideal : gait, optional
         The rigid gait (as :func:`walkerlab.export.scene.mjcf_scene` takes it); default:
         searched.
@@ -278,8 +278,9 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.export.scene import mjcf_scene
 
-    ideal = ideal_gait(scene) if ideal is None else ideal
-    extra = mjcf_scene(scene, mb, data, ideal)  # the same gait: one search, not two
+    data = plant.data
+    ideal = ideal_gait(scene, plant=plant) if ideal is None else ideal
+    extra = mjcf_scene(scene, mb, plant, ideal)  # the same gait: one search, not two
     n = _strides(scene) + 2
     lanes = None if extra.lanes is None else tuple(tuple(lane[:n]) for lane in extra.lanes)
     heights = (None if extra.lane_heights is None or lanes is None else
@@ -476,7 +477,7 @@ def _requests(mb, ids: dict, feet: tuple | None = None) -> list[str]:
     return out
 
 
-def adm_text(scene: Scene, mb, data, name: str, version: str = "",
+def adm_text(scene: Scene, mb, plant, name: str, version: str = "",
              start: AdamsStart | None = None) -> str:
     """The Adams Solver dataset of the scene's walker (mm-kg-s).
 
@@ -485,7 +486,8 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     scene : Scene
     mb : Multibody
         From :func:`walkerlab.walker.multibody.multibody`.
-    data : WalkerData
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (the stage's).
     name, version : str
         For the title line and the header comments.
     start : AdamsStart, optional
@@ -501,10 +503,11 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     ValueError
         A walker :func:`check_adams_exportable` refuses (one line).
     """
+    data = plant.data
     check_adams_exportable(mb)
     check_adams_actuation(scene)
     feet = adams_feet(mb).scene_feet(scene, data)
-    start = start or adams_start(scene, mb, data)
+    start = start or adams_start(scene, mb, plant)
     settings = scene.contact or ContactSettings()
     lanes = scene.terrain_or_default().lanes == "checkerboard" and \
         start.lanes is not None

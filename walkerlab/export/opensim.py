@@ -234,14 +234,15 @@ def osim_coordinates(mb) -> list[str]:
     return out
 
 
-def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
+def osim_gait(scene: Scene, mb, plant, ideal=None) -> OsimGait:
     """The rigid gait, ground and contact of ``scene`` for the OpenSim export.
 
     Parameters
     ----------
     scene : Scene
     mb : Multibody
-    data : WalkerData
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (the stage's); its ``data``.
     ideal : gait, optional
         The rigid gait (a stored ``fixedpoint.h5`` gait); default: searched.
 
@@ -260,10 +261,11 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.scene import ideal_step_length
 
+    data = plant.data
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain_or_default()
     c, knee = contact_si(settings)
-    ideal = ideal_gait(scene) if ideal is None else ideal
+    ideal = ideal_gait(scene, plant=plant) if ideal is None else ideal
     if terrain.kind == "profile":  # the capability table's cell (every legged kind's)
         KINDS[mb.kind].require("profile", "osim", "terrain.kind: profile")
     if not terrain.is_slope and terrain.lanes != "checkerboard":
@@ -271,7 +273,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
                          "in the OpenSim export (its Hunt-Crossley contact takes spheres and "
                          "half-spaces, not a tread's box); lanes: checkerboard puts the "
                          "patches on the treads")
-    ms = mjcf_scene(scene, mb, data, ideal)
+    ms = mjcf_scene(scene, mb, plant, ideal)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
                            flat_foot=SCENE_FEET[KINDS[mb.kind].feet].foot_mass(settings))
     ell = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)

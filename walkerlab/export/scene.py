@@ -204,7 +204,7 @@ def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[f
     return ahead, (f"Terrain: {line} (walkerlab.export.scene.arc_roll_m).",)
 
 
-def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None = None
+def mjcf_scene(scene: Scene, mb, plant, ideal=None, options: MjcfOptions | None = None
                ) -> MjcfScene:
     """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
 
@@ -214,7 +214,8 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
         With a ``fixedpoint`` section (the rigid gait); ``contact`` and ``terrain`` default
         to the paper's law and a checkerboard of 0.1 m patches.
     mb : Multibody
-    data : WalkerData
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (the stage's); its ``data``.
     ideal : gait, optional
         The rigid (derived-variant) gait: ``x`` (role-order post-impact state), ``period_s``
         [s] and, for legs that differ, ``step_lengths_m`` (a stored ``fixedpoint.h5`` gait,
@@ -237,13 +238,14 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.terrain import ground_drops
 
+    data = plant.data
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain_or_default()
     c, knee = contact_si(settings)
     feet_part, part = SCENE_FEET[KINDS[mb.kind].feet], export_part(mb)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
                            flat_foot=feet_part.foot_mass(settings))
-    ideal = ideal_gait(scene) if ideal is None else ideal
+    ideal = ideal_gait(scene, plant=plant) if ideal is None else ideal
     qpos, qvel, feet = feet_part.keyframe(scene, mb, data, walker, ideal.x)
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi,
                                                    options)
@@ -258,7 +260,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None, options: MjcfOptions | None =
         lane_heights, treads = ground_pieces(terrain, walker, ideal.x)
     if lane_heights is not None and len(ground_drops(terrain)) > 1:
         # footholds of several heights: the rigid period-n gait's footfalls, step by step
-        lanes, lane_heights = footfalls_per_step(scene, walker, ideal.x, terrain)
+        lanes, lane_heights = footfalls_per_step(scene, walker, ideal.x, terrain, plant)
         lanes = feet_part.footprints(lanes, data)
     elif terrain.lanes == "checkerboard":
         lanes = feet_part.footprints(checkerboard(walker, ideal, terrain), data)

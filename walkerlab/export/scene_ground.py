@@ -36,15 +36,16 @@ def checkerboard(walker, ideal, terrain: TerrainSettings) -> tuple:
     return (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
 
 
-def footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings
-                        ) -> tuple[tuple, tuple]:
+def footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings,
+                       plant) -> tuple[tuple, tuple]:
     """The checkerboard of footholds of several heights: ``(lanes, lane_heights)``, each
     ``(leg1's, leg2's)`` [m], the patches at the rigid period-n gait's footfalls step by step
     (:func:`walkerlab.analysis.contact.footfalls.rigid_step_lengths`) and their heights along
     the slope normal (:func:`walkerlab.models.contact.terrain.footfall_heights`).  The
     keyframe's stance foot (leg2) is footfall 0 at the origin, its trailing foot (leg1)
     footfall -1, the last step of the rigid map (``l_{m-1}`` behind, ``d_{m-1} cos(phi)``
-    above); leg2's lane holds footfalls 0, 2, ..., leg1's -1, 1, 3, ...."""
+    above); leg2's lane holds footfalls 0, 2, ..., leg1's -1, 1, 3, ....  ``plant``: the
+    scene's :class:`~walkerlab.walker.plant.Plant` (the stage's)."""
     from walkerlab.analysis.contact.footfalls import rigid_step_lengths
     from walkerlab.models.contact.terrain import (
         footfall_heights,
@@ -52,7 +53,7 @@ def footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings
         ground_drops,
     )
 
-    ells = rigid_step_lengths(scene, walker, x_ideal)
+    ells = rigid_step_lengths(scene, walker, x_ideal, plant=plant)
     drops = ground_drops(terrain)
     n = EXPORT_STEPS + 1  # footfalls 0 .. EXPORT_STEPS
     s = footfall_positions(ells, n)

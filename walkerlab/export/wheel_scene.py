@@ -65,7 +65,7 @@ class WheelKeyframe:
     hub_inertia_kg_m2: float | None
 
 
-def wheel_keyframe(scene: Scene, data, ideal=None) -> WheelKeyframe:
+def wheel_keyframe(scene: Scene, plant, ideal=None) -> WheelKeyframe:
     """The ``gait`` keyframe of a spoked wheel: the rigid fixed point (just after heel
     strike, spoke 0 in stance, its tip at the origin on the ground line) as the floating
     view's state (:meth:`ContactWalker.link_state_from_ideal`, pinned at the origin),
@@ -74,8 +74,8 @@ def wheel_keyframe(scene: Scene, data, ideal=None) -> WheelKeyframe:
     Parameters
     ----------
     scene : Scene
-    data : WalkerData
-        The scene's wheel (``data.structure.spokes`` > 0).
+    plant : walkerlab.walker.plant.Plant
+        The scene's wheel described once (``plant.data.structure.spokes`` > 0).
     ideal : gait, optional
         The rigid gait (``x``: post-impact ``[stance_angle, stance_rate]`` [rad, rad/s],
         ``period_s`` [s]); default: searched
@@ -91,11 +91,12 @@ def wheel_keyframe(scene: Scene, data, ideal=None) -> WheelKeyframe:
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
 
+    data = plant.data
     settings = scene.contact or ContactSettings()
     c, knee = contact_si(settings)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
                            hub_inertia=settings.hub_inertia_kg_m2)
-    ideal = ideal_gait(scene) if ideal is None else ideal
+    ideal = ideal_gait(scene, plant=plant) if ideal is None else ideal
     x = walker.pinned_to_full(walker.link_state_from_ideal(ideal.x), np.zeros(2))
     q, v = walker.layout().coordinate_values(x)
     names = ("hip_x", "hip_y", "wheel_angle")

@@ -24,7 +24,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import walkerlab
 from walkerlab.config import Scene
@@ -68,6 +67,7 @@ from walkerlab.export.wheel_scene import (
 )
 from walkerlab.units import for_scene
 from walkerlab.walker.multibody import multibody
+from walkerlab.walker.plant import Plant
 
 
 @dataclass(frozen=True)
@@ -77,8 +77,8 @@ class ExportJob:
     Attributes
     ----------
     scene : Scene
-    data : walkerlab.walker.description.WalkerData
-        The scene's walker (its kind: ``data.structure.kind``).
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once, by the stage (its ``data``, its ``kind``).
     name : str
         The model's name in the file (the scene's name, else ``walker``).
     walker_only : bool
@@ -95,7 +95,7 @@ class ExportJob:
     """
 
     scene: Scene
-    data: Any
+    plant: Plant
     name: str
     walker_only: bool
     gait: Callable
@@ -105,7 +105,12 @@ class ExportJob:
     @property
     def kind(self):
         """The walker's kind (:class:`walkerlab.walker.kinds.Kind`)."""
-        return self.data.structure.kind
+        return self.plant.kind
+
+    @property
+    def data(self):
+        """The walker's description (:attr:`walkerlab.walker.plant.Plant.data`)."""
+        return self.plant.data
 
 
 @dataclass(frozen=True)
@@ -218,7 +223,7 @@ def _links(job: ExportJob, w: Writer) -> Written:
     scene, mb = job.scene, multibody(job.data)
     check_exportable(scene, job.kind, w.name, job.walker_only)
     ideal, extra = (None, None) if job.walker_only else job.gait(
-        lambda ideal: mjcf_scene(scene, mb, job.data, ideal, job.options))
+        lambda ideal: mjcf_scene(scene, mb, job.plant, ideal, job.options))
     version = walkerlab.__version__
     if w.name == "urdf":
         text = urdf_text(mb, job.name, version, scene.walker.actuation)
@@ -245,7 +250,7 @@ def _wheel(job: ExportJob, w: Writer) -> Written:
     check_exportable(scene, job.kind, w.name, job.walker_only)
     hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
     ideal, key = (None, None) if job.walker_only else job.gait(
-        lambda ideal: wheel_keyframe(scene, data, ideal))
+        lambda ideal: wheel_keyframe(scene, job.plant, ideal))
     version = walkerlab.__version__
     if w.name == "urdf":
         text = wheel_urdf_text(data, job.name, version, hub)
@@ -363,8 +368,8 @@ def _adams(job: ExportJob, w: Writer) -> Written:
         job.kind.require("virtual_constraints", w.view, "walker.actuation.virtual_constraints")
     check_adams_exportable(mb)  # before the gait search
     check_adams_actuation(scene)
-    start = adams_start(scene, mb, data, job.stored())
-    adm = adm_text(scene, mb, data, job.name, walkerlab.__version__, start)
+    start = adams_start(scene, mb, job.plant, job.stored())
+    adm = adm_text(scene, mb, job.plant, job.name, walkerlab.__version__, start)
     acf = acf_text(scene, start)
     return Written(((w.file, adm), (ADAMS_FILES["acf"], acf)),
                    tuple(o.line for o in adams_omissions(scene, mb)))
@@ -380,7 +385,7 @@ def _osim(job: ExportJob, w: Writer) -> Written:
                          "contact (its default state is the rigid gait); drop --walker-only")
     check_osim_exportable(scene, mb)  # before the gait search
     check_exportable(scene, job.kind, w.name)
-    ideal, gait = job.gait(lambda ideal: osim_gait(scene, mb, data, ideal))
+    ideal, gait = job.gait(lambda ideal: osim_gait(scene, mb, job.plant, ideal))
     text = osim_text(mb, gait, job.name, walkerlab.__version__)
     return Written((_xml(job, w, text),), xml_lines(osim_omissions(mb, gait), scene),
                    step_period(ideal))

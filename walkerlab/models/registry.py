@@ -8,13 +8,13 @@ from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.walker.plant import Plant
 
 
-def state_layout(scene, plant: Plant | None = None) -> tuple[list[str], list[str]]:
+def state_layout(scene, plant: Plant) -> tuple[list[str], list[str]]:
     """State names and units of the rigid walker of ``scene``, from its description alone
     (no equations derived, no code loaded): what :func:`build_walker` ``(scene)``'s
     ``state_names()`` and ``state_units()`` return.
 
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` when the caller holds it
-    (default: built here from ``scene``, for a caller at the front: a stage, the API).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once,
+    by the caller).
 
     Returns
     -------
@@ -22,11 +22,11 @@ def state_layout(scene, plant: Plant | None = None) -> tuple[list[str], list[str
     """
     from walkerlab.walker.description import state_names, state_units
 
-    roles = _plant(scene, plant).structure.roles
+    roles = plant.structure.roles
     return state_names(roles), state_units(roles)
 
 
-def build_walker(scene, plant: Plant | None = None) -> HybridWalker:
+def build_walker(scene, plant: Plant) -> HybridWalker:
     """Build the rigid hybrid walker of a :class:`~walkerlab.config.Scene`.
 
     ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
@@ -38,9 +38,9 @@ def build_walker(scene, plant: Plant | None = None) -> HybridWalker:
     A ``walker.actuation`` section adds its actuators (:func:`walkerlab.models.hybrid.
     actuated.actuate`).
 
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once)
-    when the caller holds it; default: built here from ``scene`` (a caller at the front: a
-    stage, the API, or one that has just made ``scene``, a sweep's point).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once:
+    by a stage, the API, or the caller that has just made ``scene``, a sweep's point, with
+    :meth:`~walkerlab.walker.plant.Plant.from_scene`).
 
     Raises
     ------
@@ -48,7 +48,6 @@ def build_walker(scene, plant: Plant | None = None) -> HybridWalker:
         The scene names a walker model or variant that has no rigid hybrid implementation,
         or actuators the walker cannot carry (one line).
     """
-    plant = _plant(scene, plant)
     act = scene.walker.actuation
     walker = _on_ground(scene, plant, _passive(scene, plant))
     if act is None or walker.cycle is not None:  # footholds: each step's walker actuated
@@ -59,11 +58,6 @@ def build_walker(scene, plant: Plant | None = None) -> HybridWalker:
         raise ValueError("walker.actuation: only with ideal.variant: derived (the printed "
                          "Appendix A equations are passive)")
     return actuate(walker, plant.data, act)
-
-
-def _plant(scene, plant: Plant | None) -> Plant:
-    """``plant``, or the plant of ``scene`` when the caller (at the front) holds none."""
-    return Plant.from_scene(scene) if plant is None else plant
 
 
 def _on_ground(scene, plant: Plant, walker: HybridWalker) -> HybridWalker:
@@ -93,12 +87,10 @@ def _on_ground(scene, plant: Plant, walker: HybridWalker) -> HybridWalker:
     return walker
 
 
-def passive_walker_at(scene, plant: Plant | None = None):
+def passive_walker_at(scene, plant: Plant):
     """``(walker_at, data_at)``: ``slope [rad] -> HybridWalker`` (the scene's passive rigid
     walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``
-    (:meth:`walkerlab.walker.plant.Plant.data_at` of ``plant``, the scene's plant; default:
-    built here from ``scene``)."""
-    plant = _plant(scene, plant)
+    (:meth:`walkerlab.walker.plant.Plant.data_at` of ``plant``, the scene's plant)."""
     own = {}
 
     def at(g: float) -> HybridWalker:
@@ -117,12 +109,12 @@ def _passive_on(scene, plant: Plant, g: float) -> HybridWalker:
         update={"angle_rad": float(g), "angle_deg": None})}), plant, float(g))
 
 
-def build_walker_on_steps(scene, steps, plant: Plant | None = None) -> HybridWalker:
+def build_walker_on_steps(scene, steps, plant: Plant) -> HybridWalker:
     """The scene's rigid walker on a finite list of per-step grounds (a drawn rough ground,
     ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the stance
     foot's level on ground of slope ``steps[k][1]`` [rad]; the walk ends after the list
     (:func:`walkerlab.models.hybrid.ground.on_footholds`).  ``plant``: the scene's
-    :class:`~walkerlab.walker.plant.Plant` (default: built here from ``scene``).
+    :class:`~walkerlab.walker.plant.Plant`.
 
     Raises
     ------
@@ -134,7 +126,6 @@ def build_walker_on_steps(scene, steps, plant: Plant | None = None) -> HybridWal
     if scene.terrain is not None and not scene.terrain.is_slope:
         raise ValueError(f"terrain.kind: {scene.terrain.kind}: per-step draws are of a slope "
                          "(terrain.per_step on kind: slope)")
-    plant = _plant(scene, plant)
     return _on_footholds(scene, plant, _passive(scene, plant), steps, on_footholds,
                          periodic=False)
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from walkerlab import progress
 from walkerlab.io.schemas.optimize import ControllerData
+from walkerlab.walker.plant import Plant
 
 __all__ = ["CHECK_MIN_S", "CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
            "REPLAY_STRIDES", "ControllerDesign", "check_design", "clearance_report",
@@ -309,8 +310,9 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
         wall_time_s=res.wall_time_s, build_time_s=res.build_time_s, scene_file=name,
         t=res.t, x=res.x, u=res.u, history=res.history,
         violations=getattr(res, "violations", ""), **clearance)
+    plant = Plant.from_scene(sc)  # the designed controller's walker, described once
     try:
-        walker = build_walker(sc)
+        walker = build_walker(sc, plant)
     except ValueError as exc:  # a failed design's last iterate: no controller to check
         if res.status == "Solve_Succeeded":
             raise
@@ -330,7 +332,7 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
         try:
             with search_budget(budget_s):
                 fp = solve_scene(sc, False, guess=zd.x_plus, walker=walker,
-                                 solver=Solver.from_settings(sc.solver))[1].gait.result
+                                 solver=Solver.from_settings(sc.solver), plant=plant)[1].gait.result
             period = float(fp.period_s)
             length = float(fp.step_lengths_m[0]) if fp.step_lengths_m else np.nan
             mult = np.asarray(fp.multipliers_variational, complex)
@@ -415,7 +417,7 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
     spec = design_spec(scene, spec)
-    walker = build_walker(scene) if walker is None else walker
+    walker = build_walker(scene, plant=Plant.from_scene(scene)) if walker is None else walker
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
     t0 = time.perf_counter()

@@ -131,7 +131,7 @@ def check(scene: Scene, strides: int | None = None, periodic: bool = False,
         scene = with_contact_strides(scene, strides)
     except SceneError as exc:
         raise StageError(str(exc)) from None
-    contact_setup(scene, periodic, Plant.from_scene(scene))
+    contact_setup(scene, periodic, plant=Plant.from_scene(scene))
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -167,7 +167,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     # keyed and recorded as with 'contact: {}' (the report asks only with the section)
     scene = with_defaults(scene, "contact", CONTACT_SIM.name)
     # the scene read once, its walker described once: all the run needs, typed
-    setup = contact_setup(scene, periodic, Plant.from_scene(scene))
+    setup = contact_setup(scene, periodic, plant=Plant.from_scene(scene))
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())

@@ -154,7 +154,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         raise ValueError("--mjcf-contact-time-constant-s, --mjcf-timestep-s: options of "
                          "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
                          "has its own contact")
-    job = ExportJob(scene, data, scene.name or "walker", walker_only,
+    job = ExportJob(scene, plant, scene.name or "walker", walker_only,
                     lambda build: _gait(scene, runs_root, build, plant),
                     lambda: stored_gait(scene, runs_root),
                     mjcf if mjcf is not None and mjcf != MjcfOptions() else None)

@@ -80,7 +80,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             data, partial = resumable_mfpt_study(
                 scene, x_star, st, path.with_name(path.name + ".partial"),
                 input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"), not force,
-                workers, scheduler, Plant.from_scene(scene))  # described once, handed down
+                workers, scheduler, plant=Plant.from_scene(scene))  # described once, handed down
         except MfptStudyError as exc:
             raise StageError(str(exc)) from None
         done.append(partial)

@@ -45,6 +45,7 @@ from walkerlab.studies.bifurcation_point import (
 from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.params import ParamAxis
 from walkerlab.studies.runner import plan_chunks, sweep_executor
+from walkerlab.walker.plant import Plant
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
            "min_real_multiplier", "parameter_values", "onset_value", "fall_onset", "grid_key",
@@ -299,7 +300,7 @@ def _diagram_result(scene: Scene, slopes: np.ndarray, rows: list[dict], x: np.nd
     from walkerlab.studies.points import interleg_angle
 
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     fp_il = np.degrees([interleg_angle(walker, xi) if np.all(np.isfinite(xi)) else math.nan
                         for xi in x])
     return BifurcationResult(

@@ -23,6 +23,7 @@ from walkerlab.analysis.continuation.two_parameter import two_parameter
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.studies.params import ParamAxis, apply_point, axis_unit, check_axes
+from walkerlab.walker.plant import Plant
 
 __all__ = ["scene_family", "scene_value", "check_continuation", "run_continuation",
            "numeric_fields", "homotopy_family", "homotopy_gait", "known_scene",
@@ -53,7 +54,7 @@ def scene_family(scene: Scene, path: str) -> WalkerFamily:
         except SceneError as exc:
             raise MapFailed("parameter leaves the scene's domain",
                             str(exc).split("]: ", 1)[-1]) from None
-        return build_walker(sc)
+        return build_walker(sc, plant=Plant.from_scene(sc))
 
     return WalkerFamily(make, path, Solver.from_settings(scene.solver),
                         fp.max_step_time_s if fp is not None else 5.0)
@@ -287,7 +288,7 @@ def homotopy_family(known: Scene, new: Scene):
         except SceneError as exc:
             raise MapFailed("parameter leaves the scene's domain",
                             str(exc).split("]: ", 1)[-1]) from None
-        return build_walker(sc)
+        return build_walker(sc, plant=Plant.from_scene(sc))
 
     return make, fields
 

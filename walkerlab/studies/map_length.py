@@ -19,6 +19,7 @@ import math
 from walkerlab.config import SceneError
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.params import apply_point
+from walkerlab.walker.plant import Plant
 
 __all__ = ["MODEL_SECTIONS", "study_steps_per_map"]
 
@@ -66,7 +67,8 @@ def study_steps_per_map(base: dict, paths: list[str], points, origin: str = "<st
         seen.add(key)
         at = tuple(values[i] if i in model else first[i] for i in range(len(values)))
         try:
-            own = build_walker(apply_point(base, list(paths), at, origin)).steps_per_map
+            sc = apply_point(base, list(paths), at, origin)
+            own = build_walker(sc, Plant.from_scene(sc)).steps_per_map
         except (SceneError, ValueError):
             continue
         steps = math.lcm(steps, own)

@@ -26,14 +26,11 @@ ROWS_PER_TASK = 4000
 _MAPS: dict[str, BatchStepMap] = {}
 
 
-def scene_walker_at(scene, plant=None):
+def scene_walker_at(scene, plant):
     """``gamma -> HybridWalker``: the scene's rigid walker on another slope, described by
     ``plant`` (the scene's :class:`~walkerlab.walker.plant.Plant`,
-    :meth:`~walkerlab.walker.plant.Plant.on_slope`; default: described here)."""
+    :meth:`~walkerlab.walker.plant.Plant.on_slope`)."""
     from walkerlab.models.registry import build_walker
-    from walkerlab.walker.plant import Plant  # light
-
-    plant = Plant.from_scene(scene) if plant is None else plant
 
     def at(gamma: float):
         on = plant.on_slope(gamma)
@@ -309,7 +306,7 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
 
 
 def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
-               partial=None, plant=None):
+               partial=None, *, plant):
     """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` (``st``: the scene's
     :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``
     (Byl & Tedrake 2009; :mod:`walkerlab.analysis.robustness.mfpt`).  ``x_star`` (2n,): the
@@ -322,7 +319,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     ``st.model == "contact"``: Monte Carlo of the compliant-contact model on patches at the
     drawn heights (:func:`walkerlab.studies.contact_rough.contact_monte_carlo`), from its
     periodic gait.  ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the
-    stage's; default: described here).
+    stage's).
 
     Raises
     ------
@@ -471,7 +468,7 @@ class MfptStudyError(ValueError):
 
 
 def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
-                         resume: bool = True, workers: int = 1, scheduler=None, plant=None):
+                         resume: bool = True, workers: int = 1, scheduler=None, *, plant):
     """:func:`mfpt_study` that resumes an interrupted run of the same inputs.
 
     The finished pieces (Monte Carlo chunks, mesh images) are kept in ``partial_path``
@@ -514,7 +511,7 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
 
     partial = MfptPartial(partial_path, key, resume=resume)
     try:
-        data = mfpt_study(scene, x_star, st, workers, scheduler, partial, plant)
+        data = mfpt_study(scene, x_star, st, workers, scheduler, partial, plant=plant)
     except DaskLost as exc:  # not bad input: the finished pieces are kept for the rerun
         raise exc.advising(RERUN) from None
     except ValueError as exc:  # bad input: nothing to resume

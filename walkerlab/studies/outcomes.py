@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.io.stage_files import CONTACT_SIM
+from walkerlab.walker.plant import Plant
 
 #: Run ends that are a verdict of their own (the others, heel_strike / t_final, are ``ok``).
 RUN_END_OUTCOMES = tuple(k for k in RUN_END_NAMES if k not in ("heel_strike", "t_final"))
@@ -160,7 +161,7 @@ def walker_columns(stage: str, scene) -> dict[str, tuple]:
         return dict(COLUMNS[stage])
     from walkerlab.models.registry import state_layout  # light
 
-    out = columns(stage, *state_layout(scene))
+    out = columns(stage, *state_layout(scene, plant=Plant.from_scene(scene)))
     act = scene.walker.actuation if hasattr(scene.walker, "actuation") else None
     if stage == "fixedpoint" and act is not None and act.virtual_constraints is not None:
         out.update(ZERO_DYNAMICS_COLUMNS)  # a scene under virtual constraints: its HZD too

@@ -17,6 +17,7 @@ from walkerlab.config import Scene
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.studies.guess import Continuation
 from walkerlab.studies.point_columns import interleg_angle
+from walkerlab.walker.plant import Plant
 
 #: the sweep options' defaults (every point function reads them)
 DEFAULT_OPTIONS: dict[str, Any] = {
@@ -82,7 +83,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     from walkerlab.config import FixedPointSettings
 
     fp = scene.fixedpoint or FixedPointSettings()  # every field optional: the defaults
-    walker = build_walker(scene)
+    walker = build_walker(scene, plant=Plant.from_scene(scene))
     solver = scene_solver(scene)
     tries = []
     if isinstance(guess, Continuation) and guess.states:
@@ -162,7 +163,8 @@ def scene_gait(scene: Scene, options: dict | None = None):
     try:
         fp = scene.fixedpoint
         walker, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False,
-                                     partner_off_ground=fp is None or fp.other_gait)
+                                     partner_off_ground=fp is None or fp.other_gait,
+                                     plant=Plant.from_scene(scene))
     except GaitNotFound as exc:
         r = exc.residual
         raise PointOutcome("no_fixed_point", str(exc),

@@ -48,6 +48,7 @@ from walkerlab.studies.point_gait import (  # noqa: F401 (part of this API)
     scene_gait,
     scene_solver,
 )
+from walkerlab.walker.plant import Plant
 
 __all__ = ["Task", "Continuation", "guess_from_json", "guess_to_json", "run_chunk",
            "fixedpoint_point", "simulate_point", "contact_point", "contact_adapter",
@@ -153,7 +154,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         x0, next_guess = res.x, res
         cols["guess_source"] = source
     else:
-        walker = build_walker(scene)
+        walker = build_walker(scene, plant=Plant.from_scene(scene))
         x0 = initial_state(sim.initial_state, walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, scene_solver(scene),
@@ -217,7 +218,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     from walkerlab.models.contact.scene import contact_setup
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
-    setup = contact_setup(scene)
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     cw, res, _, _ = simulate_from(setup, np.asarray(x_ideal, float), ideal_period_s)
     return cw, res, 2 * setup.sim.n_strides
 

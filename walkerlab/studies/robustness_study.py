@@ -87,20 +87,20 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
           "push_backward_m_per_s/hi": back[1], "sigma_rad": st.sigma_rad, "mfpt_steps": m,
           "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
           "montecarlo_falls": int(mc.fell.sum())}
-    sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler, plant))
+    sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler, plant=plant))
     return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
                           gsn, gnl, norm, sc, names)
 
 
 def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
-                  scheduler=None, plant=None) -> dict:
+                  scheduler=None, *, plant) -> dict:
     """The contact model's largest single step-down and step-up (``robustness.contact``):
     bisection brackets [m] (search cap ``cap_m``; the stage uses a twentieth of the leg
     length) of the step at the first heel strike, from the contact model's
     periodic gait, surviving ``robustness.contact_survival_steps`` heel strikes
     (:func:`walkerlab.studies.contact_rough.contact_largest_step`, walks on the executor);
     NaN when not asked for.  ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`
-    (the study's; default: described by the contact set-up).
+    (the study's).
 
     Raises
     ------

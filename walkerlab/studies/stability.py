@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.integrate.solver import Solver
+from walkerlab.walker.plant import Plant
 
 __all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
            "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS", "stability_map_run"]
@@ -171,7 +172,7 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
             scene = _cell_scene(base, spec, y, slope)
             _w, fp, _src = ideal_fixed_point(scene, x_ideal_prev)
             x_ideal_prev = fp.x
-            walker, _ = build(scene, fp.x, 2)
+            walker, _ = build(scene, fp.x, 2, plant=Plant.from_scene(scene))
             tries = ([("neighbour", z_prev, 0)] if z_prev is not None else []) \
                 + [("ideal", fp.x, 6)]
             gait, why = None, ""

@@ -165,11 +165,11 @@ def attribute(walker, ideal, **search) -> Attribution:
                        energy_by_sink(walker, g.z))
 
 
-def adjustment_effect(scene, ideal, strides: int = 5, plant=None) -> dict:
+def adjustment_effect(scene, ideal, strides: int = 5, *, plant) -> dict:
     """Mean step period [s] of the scene's contact run from its adjusted start and from the
     unadjusted ideal start, and whether the rigid walker started from the adjusted state
     walks (stays in the rigid walker's basin).  ``plant``: the scene's
-    :class:`~walkerlab.walker.plant.Plant`, from the stage (default: described here).
+    :class:`~walkerlab.walker.plant.Plant`, from the stage.
 
     Returns
     -------

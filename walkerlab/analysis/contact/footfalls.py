@@ -25,7 +25,7 @@ import numpy as np
 __all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_step_lengths"]
 
 
-def rigid_step_lengths(scene, walker, x_ideal, plant=None) -> tuple[float, ...] | None:
+def rigid_step_lengths(scene, walker, x_ideal, plant) -> tuple[float, ...] | None:
     """Each step's advance along the slope [m] of one period of the scene's rigid gait on a
     ground whose steps differ, from its fixed point ``x_ideal``; None on a ground whose every
     step is alike (the one spacing of
@@ -41,9 +41,9 @@ def rigid_step_lengths(scene, walker, x_ideal, plant=None) -> tuple[float, ...] 
     x_ideal : ndarray (2n,)
         The rigid gait's fixed point (post-impact state before step 0 of the cycle, role
         order) [rad, rad/s].
-    plant : walkerlab.walker.plant.Plant, optional
+    plant : walkerlab.walker.plant.Plant
         The scene's walker described once (:attr:`walkerlab.models.contact.scene.
-        ContactSetup.plant`); default: described from ``scene``.
+        ContactSetup.plant`).
 
     Returns
     -------

@@ -159,10 +159,9 @@ def converged_gait(gait: ContactPeriodicGait) -> ContactPeriodicGait:
                             f"(scaled residual {gait.residual:.3g} > {tol:g}: {why})")
 
 
-def ideal_gait(scene, plant=None):
+def ideal_gait(scene, plant):
     """The rigid (derived) periodic gait of ``scene`` from its ``fixedpoint`` section
-    (``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from the caller; default:
-    described here).
+    (``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from the caller).
 
     Returns
     -------

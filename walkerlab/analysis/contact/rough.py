@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from walkerlab.models.contact.terrain import footfall_lanes, slope_heights
+from walkerlab.walker.plant import Plant
 
 __all__ = ["ContactStart", "contact_start", "contact_walk"]
 
@@ -48,7 +49,7 @@ class ContactStart:
 
 
 def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
-                  plant=None) -> ContactStart:
+                  *, plant) -> ContactStart:
     """The contact periodic gait of ``scene`` found from the rigid gait ``x_ideal``
     (within ``contact_sim.periodic_time_limit_s``); ``periodic=False``: the contact run's
     own start instead (:func:`walkerlab.analysis.contact.sim.scene_start`: the rigid gait
@@ -69,7 +70,7 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
     from walkerlab.analysis.contact.sim import scene_start  # light
     from walkerlab.models.contact.scene import contact_setup  # light
 
-    setup = contact_setup(scene, plant=plant)  # plant: the caller's (default: described)
+    setup = contact_setup(scene, plant=plant)  # plant: the caller's
     cs = setup.sim
     probe, x0, _, step_length = scene_start(setup, x_ideal, 2)
     if not periodic:
@@ -111,7 +112,8 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     from walkerlab.config import scene_from_dict  # light
     from walkerlab.models.contact.scene import contact_setup  # light
 
-    setup = contact_setup(scene_from_dict(start.scene))
+    scene = scene_from_dict(start.scene)  # the worker's scene, described here
+    setup = contact_setup(scene, plant=Plant.from_scene(scene))
     sv = setup.solver
     x_ideal = np.asarray(start.x_ideal, float)
     _, _, limits, _ = scene_start(setup, x_ideal, 2)

@@ -42,7 +42,7 @@ def initial_state_from_ideal(walker, *x_ideal, rate_scale=(1.0, 1.0)) -> np.ndar
     return walker.pinned_to_full(z, foot2)
 
 
-def rigid_mid_stance(scene, x_ideal: np.ndarray, plant=None) -> np.ndarray:
+def rigid_mid_stance(scene, x_ideal: np.ndarray, plant) -> np.ndarray:
     """The rigid gait's state at its mid-stance, where a flat-footed contact run starts
     (``contact_sim.start: mid_stance``).
 
@@ -66,8 +66,8 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray, plant=None) -> np.ndarray:
     x_ideal : ndarray, shape (2n,)
         The rigid walker's post-impact state (its ``state_names()`` order: swing, stance,
         stance ankle, their rates) [rad, rad/s].
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described once (the contact set-up's); default: described here.
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (the contact set-up's).
 
     Returns
     -------

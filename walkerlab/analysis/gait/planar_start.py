@@ -44,6 +44,7 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.planar import planar_twin
+from walkerlab.walker.plant import Plant
 
 __all__ = ["PlanarStart", "planar_start", "planar_fallback", "embed", "carry_width",
            "FIRST_WIDTH"]
@@ -113,7 +114,7 @@ def embed(planar: HybridWalker, x_planar: np.ndarray, walker: HybridWalker
 
 def _planar_gait(twin: Scene) -> tuple[np.ndarray, str, bool] | None:
     """The planar twin's gait and how it was found, or None."""
-    w = build_walker(twin)
+    w = build_walker(twin, plant=Plant.from_scene(twin))
     closed = w.closed_form_gait() if w.closed_form_gait is not None else None
     if closed is not None:
         return np.asarray(closed, float), "its gait in closed form", True
@@ -220,7 +221,7 @@ def planar_start(scene: Scene, walker: HybridWalker, solver: Solver) -> PlanarSt
     if found is None:
         return None
     x_planar, how, unique = found
-    planar = build_walker(twin_scene)
+    planar = build_walker(twin_scene, plant=Plant.from_scene(twin_scene))
     x = embed(planar, x_planar, walker)
     if x is None:
         return None
@@ -233,7 +234,8 @@ def planar_start(scene: Scene, walker: HybridWalker, solver: Solver) -> PlanarSt
 
     def make(width: float) -> HybridWalker:
         data["walker"][field] = float(width)
-        return build_walker(Scene.model_validate(data))
+        sc = Scene.model_validate(data)
+        return build_walker(sc, Plant.from_scene(sc))
 
     fp = scene.fixedpoint
     max_step = fp.max_step_time_s if fp is not None else 5.0

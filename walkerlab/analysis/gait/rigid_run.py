@@ -43,7 +43,7 @@ class RigidRun:
     summary: dict
 
 
-def simulate_scene(scene: Scene, walker, x0: np.ndarray, plant=None) -> RigidRun:
+def simulate_scene(scene: Scene, walker, x0: np.ndarray, plant) -> RigidRun:
     """Simulate ``2 * simulate.strides`` steps of ``walker`` (the scene's) from ``x0`` with
     the scene's solver and sample them (``plant``: the scene's
     :class:`~walkerlab.walker.plant.Plant`, for a height profile's walkers, :func:`walk_scene`).
@@ -83,7 +83,7 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray, plant=None) -> RigidRun
 
 
 def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solver,
-               max_step_time: float, plant=None):
+               max_step_time: float, plant):
     """``n_steps`` steps of the scene's rigid walker from ``x0`` on the scene's ground: the
     walk of the ``simulate`` stage and of :meth:`walkerlab.api.walker.Walker.simulate`.
 
@@ -106,9 +106,9 @@ def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solve
         The scene's integrator (``solver`` section).
     max_step_time : float
         Longest simulated time of one step [s].
-    plant : walkerlab.walker.plant.Plant, optional
+    plant : walkerlab.walker.plant.Plant
         The scene's walker described once (the caller's); a height profile's walkers are
-        built from it (default: described here from the scene).
+        built from it.
 
     Returns
     -------
@@ -121,7 +121,7 @@ def walk_scene(scene: Scene, walker, x0: np.ndarray, n_steps: int, solver: Solve
         field).
     """
     if scene.terrain is not None and scene.terrain.kind == "profile":
-        return profile_walk(scene, x0, n_steps, solver, max_step_time, plant)
+        return profile_walk(scene, x0, n_steps, solver, max_step_time, plant=plant)
     return simulate_steps(walker, x0, n_steps, solver, max_step_time=max_step_time)
 
 
@@ -199,10 +199,9 @@ def rough_ground_steps(scene, n_steps: int) -> list[tuple[float, float]]:
     return [(-float(hk), float(gk)) for hk, gk in zip(h, g)]
 
 
-def rough_ground_walker(scene, n_steps: int, plant=None):
+def rough_ground_walker(scene, n_steps: int, plant):
     """The scene's rigid walker on :func:`rough_ground_steps` (its walk ends after them;
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, default: described by
-    :func:`~walkerlab.models.registry.build_walker_on_steps`).
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`).
 
     Raises
     ------
@@ -216,7 +215,7 @@ def rough_ground_walker(scene, n_steps: int, plant=None):
 
 
 def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = None,
-                 max_step_time: float | None = None, plant=None):
+                 max_step_time: float | None = None, *, plant):
     """``n_steps`` steps of the scene's rigid walker on its height profile from ``x0``
     (:func:`walkerlab.analysis.gait.profile_walk.simulate_on_profile`), with ``solver``
     (default the scene's) and ``max_step_time`` [s] (default ``simulate.max_step_time_s``);

@@ -105,7 +105,7 @@ def with_variant(scene: Scene, variant: str) -> Scene:
 
 def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None,
                 ground: bool = False, other_gait: bool | None = None,
-                partner_off_ground: bool = False, nearby=None, plant: Plant | None = None):
+                partner_off_ground: bool = False, nearby=None, *, plant: Plant):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
@@ -116,8 +116,7 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     the caller holds them already (the in-memory :class:`walkerlab.api.walker.Walker`);
     default: built here from the scene (:func:`build_walker`, ``Solver.from_settings``).
     ``plant`` (a :class:`~walkerlab.walker.plant.Plant`): the scene's walker described once,
-    by the caller that holds it (a stage, the API); default: described here from the scene
-    (for a caller that has just made ``scene``).
+    by the caller that holds it (a stage, the API, or one that has just made ``scene``).
     ``ground``: check every gait found for a ground that only pushes
     (:func:`gait_ground_contact`; each :class:`~walkerlab.analysis.gait.search.Gait` carries
     its verdict and the selection prefers the gaits that need no pull).  ``other_gait``
@@ -150,7 +149,6 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
         A malformed initial guess or gait choice, or no ``fixedpoint`` section (one line).
     """
     fp = _settings(scene)
-    plant = Plant.from_scene(scene) if plant is None else plant
     if scene.terrain is None or scene.terrain.is_slope:  # a wheel that cannot roll: at once
         why = cannot_roll(plant.data)
         if why is not None:
@@ -199,7 +197,7 @@ def hzd_start(walker):
     return zd.x_plus.copy() if zd.exists else None
 
 
-def solve_variant(scene: Scene, variant: str, guess, plant: Plant):
+def solve_variant(scene: Scene, variant: str, guess=None, *, plant: Plant):
     """Fixed point of one equation variant of the scene's walker, from ``guess`` (default:
     the scene's initial guess) - for the comparison of printed equations.  ``plant``: the
     scene's :class:`~walkerlab.walker.plant.Plant` (the variant does not change it).
@@ -266,7 +264,7 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     other_guess = main.x if init is None else init
     for variant in variants_for(scene, compare_variants)[1:]:
         try:
-            results[variant] = solve_variant(scene, variant, other_guess, plant)
+            results[variant] = solve_variant(scene, variant, other_guess, plant=plant)
         except FixedPointNotFound as exc:
             results[variant] = exc
     ground = search.gait.ground  # every gait found carries its check (solve_scene)

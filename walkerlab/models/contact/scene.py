@@ -208,7 +208,7 @@ class ContactSetup:
                                 n_steps=n_steps + 4), step_length
 
 
-def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSetup:
+def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetup:
     """The scene turned once into what a contact run needs (any walker with positive leg
     masses): its walker data, the contact law and knee stop in SI, terrain, run options and
     solver settings.
@@ -220,9 +220,8 @@ def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSe
         The run also finds the contact periodic gait (``contact-sim --periodic``,
         :meth:`walkerlab.api.walker.ContactWalker.periodic_gait`): the scene is checked as
         with ``contact_sim.periodic_gait: true``.
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described once, by the caller that holds it (a stage, the API);
-        default: described here from ``scene``.
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once, by the caller that holds it (a stage, the API).
 
     A scene without a ``contact`` section runs on the section's defaults (the paper's
     contact law: :class:`walkerlab.config.ContactSettings`), as ``contact: {}`` does: the
@@ -257,7 +256,6 @@ def contact_setup(scene: Scene, periodic: bool = False, plant=None) -> ContactSe
     cs = scene.contact_sim or ContactSimSettings()
     # checked as the run uses it: with its periodic gait when the caller asks for one
     checked = cs.model_copy(update={"periodic_gait": True}) if periodic else cs
-    plant = Plant.from_scene(scene) if plant is None else plant
     data = plant.data
     ground = "slope" if scene.terrain is None else scene.terrain.kind
     if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
@@ -360,7 +358,7 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
 
 
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None,
-          plant: Plant | None = None):
+          *, plant: Plant):
     """ContactWalker of the scene (:func:`contact_setup`, then :meth:`ContactSetup.build`)
     with checkerboard patches from the ideal step length.
 

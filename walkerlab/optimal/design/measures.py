@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 __all__ = ["ROBUSTNESS_MEASURES", "robustness_measure"]
 
 #: measure -> unit
@@ -43,7 +45,8 @@ def robustness_measure(name: str, scene, walker, x_star, A) -> float:
         from walkerlab.studies.mfpt import scene_walker_at  # light
 
         dist = scene.robustness.disturbances[0] if scene.robustness is not None else "slope"
-        sm = make_step_map(walker, scene_walker_at(scene), 1e-12, 1e-12)
+        sm = make_step_map(walker, scene_walker_at(scene,
+                                                   plant=Plant.from_scene(scene)), 1e-12, 1e-12)
         return linearise(sm, x_star, np.asarray(A, float), dist).gsn()
     if name == "basin_share":
         from walkerlab.studies.basin import CODE, compute_basin  # light

@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.walker.plant import Plant
+
 __all__ = ["MEASURES", "DesignResult", "design_bounds", "design_optimize",
            "measure_gradient", "multiplier_gradient"]
 
@@ -132,7 +134,8 @@ class _Gaits:
     def walker(self, p):
         from walkerlab.models.registry import build_walker
 
-        return build_walker(self.scene_at(p))
+        sc = self.scene_at(p)  # the design point's walker, described here
+        return build_walker(sc, Plant.from_scene(sc))
 
     def value(self, p, name: str) -> float:
         """A measure that is not one map's (``max_abs_multiplier`` and

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.models.actuation import TorqueOfTime
+from walkerlab.walker.plant import Plant
 
 __all__ = ["REPLAY_WALL_TIME_LIMIT_S", "SETTLED_STEPS", "contact_replay",
            "contact_replay_controller", "contact_replay_five_link",
@@ -236,7 +237,8 @@ def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = Fa
         d.setdefault("terrain", {})
     d["contact_sim"] = contact_sim
     try:
-        return contact_setup(type(scene).model_validate(d)), ""
+        sc = type(scene).model_validate(d)  # the replay's scene, described here
+        return contact_setup(sc, plant=Plant.from_scene(sc)), ""
     except (ContactSceneError, ValueError) as exc:
         return None, f"not replayed: {exc}"
 
@@ -344,7 +346,7 @@ def contact_replay_controller(scene, x_star, period_s: float, step_length_m: flo
     out = {"periods": np.zeros(0), "step_period_s": nan, "speed_m_per_s": nan,
            "heel_strikes": 0, "trend": "", "walks": False}
     try:
-        setup = contact_setup(scene)
+        setup = contact_setup(scene, plant=Plant.from_scene(scene))
         walker, run, _, _ = simulate_from(setup, np.asarray(x_star, float), period_s,
                                           strides=strides)
     except (ContactSceneError, ValueError, ArithmeticError, RuntimeError) as exc:
