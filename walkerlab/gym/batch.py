@@ -275,7 +275,7 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
         if all(v.walker.points is first for v in views):
             hx = _hips(views[0].walker, X)  # one step walker's points for all: one call
             if hx is not None:
-                return np.array([v.foot[0] for v in views], dtype=float) + hx
+                return np.array([v.foot.item(0) for v in views]) + hx  # (x's floats)
     pts = [v.walker.points for v in views]
     out = np.empty(len(views))
     groups: dict = {}
