@@ -291,6 +291,12 @@ def actuated_module(structure, joints):
 #: per value)
 _CONSTANTS: dict = {}
 
+#: most entries of :data:`_SHARED_ROWS` (cleared when full)
+SHARED_ROWS_KEPT = 4096
+#: :meth:`ActuatedFlow.data_rows`' flows (by their ids, in order) -> ``(the flows, their
+#: shared constants or None)``: whether a batch of flows shares its constants, found once
+_SHARED_ROWS: dict = {}
+
 
 @dataclass(frozen=True, eq=False)
 class ActuatedFlow(CompiledFlow):
@@ -371,8 +377,16 @@ class ActuatedFlow(CompiledFlow):
         N flows of one module and law block size, each row the numbers :meth:`data_into`
         writes), the rows' shared parts at once where the flows share their constants
         (:meth:`constants`), else row by row."""
-        c = flows[0].constants()
-        if any(f.constants() is not c for f in flows):
+        key = tuple(map(id, flows))
+        shared = _SHARED_ROWS.get(key)
+        if shared is None:  # (the flows kept with their answer: their ids stay theirs)
+            if len(_SHARED_ROWS) >= SHARED_ROWS_KEPT:
+                _SHARED_ROWS.clear()
+            c = flows[0].constants()
+            shared = _SHARED_ROWS[key] = (tuple(flows), None if any(
+                f.constants() is not c for f in flows) else c)
+        c = shared[1]
+        if c is None:
             for f, row in zip(flows, out):
                 f.data_into(row)
             return

@@ -96,26 +96,40 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     """
     norm = p["normalize"]
     every, some, policy = _flags(p)
+    tau = p["tau"]
     if every:  # (the actions read as float64, then scaled: numpy's casting of any real
-        a = np.multiply(actions, p["tau"], dtype=np.float64)  # dtype, in one operation)
+        a = np.multiply(actions, tau, dtype=np.float64)  # dtype, in one operation)
     else:
         a = np.asarray(actions).astype(np.float64)
     if not every and some:
-        a[norm] = a[norm] * p["tau"][norm]
+        a[norm] = a[norm] * tau[norm]
     if policy:
         for r in np.flatnonzero(p["policy"]):
             e = envs[r]
             s = e.sim
             a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
-    tau = p["tau"]
-    U = a.clip(-tau, tau)  # (np.clip's own method)
-    x_before = [e._hip_x for e in envs]
-    w_before = [e.sim.ledger["action_work_positive"] for e in envs]
-    t_ends = []
+    # (np.clip's own ufunc, into the new array a: ndarray.clip(-tau, tau)'s numbers)
+    U = _CLIP(a, _neg_tau(p), tau, out=a)
+    x_before, w_before, t_ends = [], [], []
     for e in envs:
-        e._elapsed += 1
-        t_ends.append(e._elapsed * e.dt)
+        x_before.append(e._hip_x)
+        w_before.append(e.sim.ledger["action_work_positive"])
+        e._elapsed = k = e._elapsed + 1
+        t_ends.append(k * e.dt)
     return U, x_before, w_before, t_ends
+
+
+#: the ufunc ``ndarray.clip(lo, hi)`` calls (numpy's ``_methods._clip``: ``umath.clip``),
+#: without its Python layer (numpy's own function where its module is not there)
+_CLIP = getattr(getattr(getattr(np, "_core", None), "umath", None), "clip", np.clip)
+
+
+def _neg_tau(p: dict) -> np.ndarray:
+    """``-p["tau"]``, kept in :func:`batch_parameters`' ``p``."""
+    neg = p.get("neg_tau")
+    if neg is None:
+        neg = p["neg_tau"] = -p["tau"]
+    return neg
 
 
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
@@ -153,25 +167,23 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     """
     if views is None:
         views = [e.sim for e in envs]
-    n = len(envs)
     # what is read of each walker, in one pass: its state, time, stance leg, phase, its
     # step's start, how its episode ended, its steps and ledger
     rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
     xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
     X = np.array(xs)
-    m = X.shape[1]
-    obs = np.empty((n, m + 3))
-    obs[:, :m] = X
-    # (leg1's stance as 1.0, the phase's index as a float, the time in the step)
-    obs[:, m:] = [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in
-                  zip(legs, ks, ts, t_steps)]
-    obs.clip(p["low"], p["high"], out=obs)  # (np.clip's own method, a layer less)
+    # (leg1's stance as 1.0, the phase's index as a float, the time in the step: the
+    # float64 of each, side by side with the states)
+    obs = np.concatenate((X, [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in
+                              zip(legs, ks, ts, t_steps)]), axis=1)
+    _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
     hip = hip_xs(views, X)
     hips = hip.tolist()
+    elapsed = []
     for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
+        elapsed.append(e._elapsed)
     terminated = [s != "" for s in ended]
-    elapsed = [e._elapsed for e in envs]
     fws, healthy, cws, wws, dts, limits = _lists(p)
     truncated = [not te and lim >= 0 and el >= lim
                  for te, lim, el in zip(terminated, limits, elapsed)]
@@ -179,7 +191,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
-    effort = np.add.reduce((U / p["tau"]) ** 2, axis=1).tolist()
+    effort = U / p["tau"]
+    effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2: square)
     j_work = terms.index("action_work_positive")
     work = [row[j_work] for row in sums]
     reward = np.array([
@@ -262,7 +275,7 @@ def hip_xs(views, X: np.ndarray | None = None) -> np.ndarray:
         if all(v.walker.points is first for v in views):
             hx = _hips(views[0].walker, X)  # one step walker's points for all: one call
             if hx is not None:
-                return np.array([v.foot[0] for v in views], dtype=float) + hx
+                return np.array([v.foot.item(0) for v in views]) + hx  # (x's floats)
     pts = [v.walker.points for v in views]
     out = np.empty(len(views))
     groups: dict = {}

@@ -212,20 +212,24 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
     piece's start [s] and state of each row; the rows' start states, time caps [s] and
     Gauss-Legendre nodes' states; the call's arguments, for :class:`_RowRedo`)."""
     fphase = pieces[0][5][0]
-    f, fs, fg, sel, rtol, atol, n_out = _kernel_args(key, fphase)
+    f, fs, fg, sel, rtol, atol, n_out = _CFUNCS.get(key) or _kernel_args(key, fphase)
     gcols, goffs, dirs, ng, gi = _guard_tables(guards)
     N, m = len(rows), key[4]
-    walkers = [views[i] for i in rows]
-    Y = np.array([v.x for v in walkers], dtype=float)
+    xs, caps, flows = [], [], []  # each row's state, time cap [s] and flow, in one pass
+    for i, piece in zip(rows, pieces):
+        v = views[i]
+        xs.append(v.x)
+        caps.append(piece[4] - v.t)
+        flows.append(piece[5][0].compiled)
+    Y = np.array(xs, dtype=float)
     if Y.shape != (N, m):  # pragma: no cover - every view's state is (2n,)
         raise ValueError(f"rigid rows: states of shape {Y.shape[1:]}, not ({m},)")
-    flows = [piece[5][0].compiled for piece in pieces]
     if hasattr(flows[0], "data_rows"):  # each walker's torques in its law block
         D = np.empty((N, flows[0].data_size()))
         flows[0].data_rows(flows, D)
     else:
         D = np.array([flow.data() for flow in flows], dtype=float)
-    cap = np.array([piece[4] - v.t for piece, v in zip(pieces, walkers)], dtype=float)
+    cap = np.array(caps, dtype=float)
     which = np.empty(N, np.int64)
     te = np.empty(N)
     Yev = np.empty((N, m))
@@ -325,7 +329,7 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     :class:`PhaseRun`, its dense output made on first use (:class:`_RowRedo` for a guard
     crossing, else :class:`_Redo`)."""
     which, te, Yev, Y, cap, Yn, call = out
-    X = Yev.copy()  # (each settled walker's state: its row)
+    X = Yev  # (each settled walker's state: its row; the array is this call's own)
     finite = ([True] * len(rows) if all_finite(X)
               else np.isfinite(X).all(axis=1).tolist())
     ends = which.tolist()
@@ -400,9 +404,12 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
         its episode ended there.
     """
     strikes: list[list[float]] = [[] for _ in views]
+    if type(actions) is np.ndarray:  # (its rows made once: each is read twice)
+        actions = list(actions)
     live = []
-    for i, (v, u, t_end) in enumerate(zip(views, actions, t_ends)):
-        v.open_period(u, t_end)
+    for i, v in enumerate(views):
+        t_end = t_ends[i]
+        v.open_period(actions[i], t_end)
         if v.t < t_end and not v.ended:
             live.append(i)
     while live:
@@ -412,8 +419,14 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
             piece = v.next_piece(actions[i], t_ends[i])
             if piece is None:
                 continue
-            kg = (None if piece[5] is None or v.ground is not None
-                  else _flow_key(v, piece[5][0]))
+            fast = piece[5]
+            if fast is None or v.ground is not None:
+                kg = None
+            else:  # (_flow_key's entry, read here: once per walker and piece)
+                keys = v.row_keys
+                kg = keys.get(id(fast[0]), keys)
+                if kg is keys:
+                    kg = _flow_key(v, fast[0])
             if kg is None:  # the walker's own integration
                 run, phase = v.integrate_piece(piece)
                 strikes[i] += v.absorb(piece, run, phase)

@@ -425,21 +425,23 @@ class RigidView:
         lane = self._lane
         if lane is None or lane[0] is not w or lane[1] != self.k or lane[2] != self.leg:
             lane = self._lane = self._lane_of(w)
-        acts, phase, falls, fast = lane[3:]
-        acts.u = np.asarray(u, dtype=float)
-        act_on = any(acts.u.tolist())
+        _, _, _, acts, phase, falls, fast = lane
+        u = acts.u = np.asarray(u, dtype=float)
+        act_on = any(u.tolist())
         for g in falls:  # a fall guard already violated as the phase begins
             if g.direction * float(g.function(self.t, self.x)) > 0:
                 self.ended = "fall"
         if self.ended:
             return None
-        t_stop = min(t_end, self.t_step + self.max_step_time)
+        t_stop = self.t_step + self.max_step_time
+        if not t_stop < t_end:  # (min(t_end, t_stop): t_end unless t_stop is below it)
+            t_stop = t_end
         if fast is not None:  # the compiled control step: the action's torques held in
             # the law block (each actuator's constant), written where they are not the
             # very numbers it holds (this phase's last ones, bit for bit: -0.0 is written)
-            held, bits = self._held, acts.u.tobytes()
+            held, bits = self._held, u.tobytes()
             if held[0] is not fast or held[1] != bits:
-                fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * acts.u.size:HEAD] = acts.u
+                fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * u.size:HEAD] = u
                 self._held = (fast, bits)
         return w, acts, act_on, phase, t_stop, fast
 

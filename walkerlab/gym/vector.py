@@ -156,6 +156,8 @@ class WalkerVectorEnv(VectorEnv):
         self._terminations = np.zeros(n, dtype=np.bool_)
         self._truncations = np.zeros(n, dtype=np.bool_)
         self._autoreset_envs = np.zeros(n, dtype=np.bool_)
+        self._every = np.ones(n, dtype=np.bool_)  # (every walker stepped; read only)
+        self._every.flags.writeable = False
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
         #: every row and sub-environment (a step of all of them)
@@ -380,8 +382,8 @@ class WalkerVectorEnv(VectorEnv):
             raise gym.error.ResetNeeded("Cannot call step() before calling reset()")
         a = self._actions(actions)
         mode = self.autoreset_mode
-        if mode == AutoresetMode.NEXT_STEP:
-            resetting = self._autoreset_envs.copy()
+        if mode == AutoresetMode.NEXT_STEP:  # (not copied: replaced below, not written)
+            resetting = self._autoreset_envs
         else:
             resetting = np.zeros(self.num_envs, dtype=np.bool_)
             if mode == AutoresetMode.DISABLED and self._autoreset_envs.any():
@@ -389,8 +391,8 @@ class WalkerVectorEnv(VectorEnv):
                     f"autoreset_mode=Disabled: sub-environments "
                     f"{np.flatnonzero(self._autoreset_envs).tolist()} ended; reset them with "
                     "reset(options={'reset_mask': mask}) before stepping")
-        stepping = ~resetting
         some_reset = any_true(resetting)
+        stepping = ~resetting if some_reset else self._every  # (every walker: not read)
         stepped = (self._step_all(a, stepping, not some_reset)
                    if not some_reset or stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
