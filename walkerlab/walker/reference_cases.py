@@ -199,6 +199,22 @@ GROUND_OPTIMIZE = {"stairs": {"objective": "effort", "intervals": 40},
                    "footholds": {"objective": "effort", "intervals": 40}}
 
 
+def _pd(joint: str, stiffness_n_m_per_rad: float, damping_n_m_s_per_rad: float) -> dict:
+    """A ``walker.actuation.torques`` entry: a PD law about 0 at ``joint``."""
+    return {"joint": joint, "law": {"stiffness_n_m_per_rad": stiffness_n_m_per_rad,
+                                    "damping_n_m_s_per_rad": damping_n_m_s_per_rad}}
+
+
+def _locked_knee_guess(thigh_rad: float, stance_rad: float, thigh_rate_rad_per_s: float,
+                       stance_rate_rad_per_s: float) -> dict:
+    """A kneed walker's ``fixedpoint.initial_guess`` with the swing knee locked straight
+    (shank angle and rate those of the thigh) [rad, rad/s]."""
+    return {"swing_thigh_angle_rad": thigh_rad, "swing_shank_angle_rad": thigh_rad,
+            "stance_angle_rad": stance_rad, "swing_thigh_rate_rad_per_s": thigh_rate_rad_per_s,
+            "swing_shank_rate_rad_per_s": thigh_rate_rad_per_s,
+            "stance_rate_rad_per_s": stance_rate_rad_per_s}
+
+
 #: (kind, feature) -> (why, changes): the generated case of a feature on which the kind's
 #: base walker with the plain feature (:func:`scene_for`) has no gait, changed so that it
 #: walks - a case without a gait measures nothing.  ``changes`` maps a dotted scene path to
@@ -212,11 +228,8 @@ WALKING = {
     ("locking_knees", "stairs"): (
         "0.47 m treads, 24 mm risers: the slope's step as a stair (1 cm risers: no gait)",
         {"terrain.riser_m": 0.024, "terrain.tread_m": 0.47,
-         "fixedpoint.initial_guess": {
-             "swing_thigh_angle_rad": -0.2904292492, "swing_shank_angle_rad": -0.2904292492,
-             "stance_angle_rad": 0.1893805121, "swing_thigh_rate_rad_per_s": -0.1050697622,
-             "swing_shank_rate_rad_per_s": -0.1050697622,
-             "stance_rate_rad_per_s": -1.1340243030},
+         "fixedpoint.initial_guess": _locked_knee_guess(-0.2904292492, 0.1893805121,
+                                                        -0.1050697622, -1.1340243030),
          # the contact model's own periodic gait lays patches (checkerboard lanes); stairs
          # on continuous lanes have none: contact-sim starts from the rigid gait
          "contact_sim.periodic_gait": False}),
@@ -228,14 +241,9 @@ WALKING = {
     # 0.05 at 1 N m/rad: fixedpoint refuses that verdict - an open issue, not this case.)
     ("locking_knees", "hip_torque"): (
         "PD 0.01 N m/rad, 0.001 N m s/rad about 0 (at 0.1 N m/rad: no gait)",
-        {"walker.actuation.torques": [
-            {"joint": "hip", "law": {"stiffness_n_m_per_rad": 0.01,
-                                     "damping_n_m_s_per_rad": 0.001}}],
-         "fixedpoint.initial_guess": {
-             "swing_thigh_angle_rad": -0.2894504099, "swing_shank_angle_rad": -0.2894504099,
-             "stance_angle_rad": 0.1887133761, "swing_thigh_rate_rad_per_s": -0.1404460373,
-             "swing_shank_rate_rad_per_s": -0.1404460373,
-             "stance_rate_rad_per_s": -1.1432061038}}),
+        {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": _locked_knee_guess(-0.2894504099, 0.1887133761,
+                                                        -0.1404460373, -1.1432061038)}),
     # an upper body scaled to the kneed walker: configs/torso_bhm.yaml's 5 kg on a 20 kg
     # walker is 0.4 kg on this 1.6 kg one (the generic 5 kg body with the 0.1 N m/rad law:
     # no gait), held on the legs' bisector, and the torso law as weak as the hip's case.
@@ -246,14 +254,9 @@ WALKING = {
         {"walker.torso": {"coupling": "bisecting_hip",
                           "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
                                       "from_hip_m": 0.2}]},
-         "walker.actuation.torques": [
-             {"joint": "stance_hip", "law": {"stiffness_n_m_per_rad": 0.01,
-                                             "damping_n_m_s_per_rad": 0.001}}],
-         "fixedpoint.initial_guess": {
-             "swing_thigh_angle_rad": -0.3407594714, "swing_shank_angle_rad": -0.3407594714,
-             "stance_angle_rad": 0.2400224376, "swing_thigh_rate_rad_per_s": -0.3259477384,
-             "swing_shank_rate_rad_per_s": -0.3259477384,
-             "stance_rate_rad_per_s": -1.0823455559}}),
+         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": _locked_knee_guess(-0.3407594714, 0.2400224376,
+                                                        -0.3259477384, -1.0823455559)}),
     # one output, the swing leg's angle, of the stance leg's (the compass walker's one
     # actuator, the hip): a step of 0.1 rad behind to 0.1348 rad ahead (the heel strike's
     # symmetry about the 0.0174 rad slope's normal).  The generic +-0.2 rad step stalls

@@ -29,27 +29,34 @@ COORDINATES = ("absolute", "relative")
 def per_unit(unit: str) -> str:
     """Unit of a sensitivity per unit disturbance (``m/s`` -> ``s/m``)."""
     return "s/m" if unit == "m/s" else f"1/{unit}"
+
+
+def _bracket(name: str, unit: str, lo: str, hi: str) -> dict[str, tuple[str, str]]:
+    """The ``{name}/lo`` and ``{name}/hi`` rows of a bisection bracket (lo survives, hi
+    falls), both in ``unit``, described by ``lo`` and ``hi``."""
+    return {f"{name}/lo": (unit, lo), f"{name}/hi": (unit, hi)}
+
+
+#: scalar dataset -> (unit, description), in the artifact's order
 SCALARS = {
-    "step_down_m/lo": ("m", "largest step-down survived (bisection bracket, lower end)"),
-    "step_down_m/hi": ("m", "smallest step-down that falls (upper end; inf: none up to "
-                       "the search cap)"),
-    "step_up_m/lo": ("m", "largest step-up survived (lower end)"),
-    "step_up_m/hi": ("m", "smallest step-up that falls (upper end)"),
-    "push_forward_m_per_s/lo": ("m/s", "largest forward mid-stance push survived (hip "
-                                "velocity change; lower end)"),
-    "push_forward_m_per_s/hi": ("m/s", "smallest forward push that falls (upper end)"),
-    "push_backward_m_per_s/lo": ("m/s", "largest backward mid-stance push survived"),
-    "push_backward_m_per_s/hi": ("m/s", "smallest backward push that falls"),
+    **_bracket("step_down_m", "m", "largest step-down survived (bisection bracket, lower end)",
+               "smallest step-down that falls (upper end; inf: none up to the search cap)"),
+    **_bracket("step_up_m", "m", "largest step-up survived (lower end)",
+               "smallest step-up that falls (upper end)"),
+    **_bracket("push_forward_m_per_s", "m/s", "largest forward mid-stance push survived (hip "
+               "velocity change; lower end)", "smallest forward push that falls (upper end)"),
+    **_bracket("push_backward_m_per_s", "m/s", "largest backward mid-stance push survived",
+               "smallest backward push that falls"),
     "sigma_rad": ("rad", "per-step slope standard deviation of the MFPT"),
     "mfpt_steps": ("steps", "Monte Carlo MFPT: heel strikes before the fall"),
     "mfpt_steps_stderr": ("steps", "standard error of mfpt_steps"),
     "montecarlo_walks": ("-", "Monte Carlo walks"),
     "montecarlo_falls": ("-", "walks that fell (the rest reached the step cap)"),
-    "contact_step_down_m/lo": ("m", "contact model: largest step-down survived (lower end; "
-                               "NaN: robustness.contact not asked for)"),
-    "contact_step_down_m/hi": ("m", "contact model: smallest step-down that falls"),
-    "contact_step_up_m/lo": ("m", "contact model: largest step-up survived (lower end)"),
-    "contact_step_up_m/hi": ("m", "contact model: smallest step-up that falls"),
+    **_bracket("contact_step_down_m", "m", "contact model: largest step-down survived (lower "
+               "end; NaN: robustness.contact not asked for)",
+               "contact model: smallest step-down that falls"),
+    **_bracket("contact_step_up_m", "m", "contact model: largest step-up survived (lower end)",
+               "contact model: smallest step-up that falls"),
 }
 
 
