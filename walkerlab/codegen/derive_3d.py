@@ -63,7 +63,7 @@ from functools import cache, wraps
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.lagrange import christoffel
+from walkerlab.codegen.lagrange import christoffel, rotation
 
 #: the seed of sympy's random choices while a 3D walker is derived (:func:`_seeded`)
 SYMPY_SEED = 0
@@ -91,13 +91,6 @@ def _seeded(derive):
         finally:
             srand.rng.setstate(state)
     return seeded
-
-
-def rotation(axis: sp.Matrix, angle) -> sp.Matrix:
-    """Rotation matrix (3, 3) by ``angle`` about the unit vector ``axis`` (Rodrigues)."""
-    k = sp.Matrix(axis)
-    K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
 
 
 def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:

@@ -18,7 +18,6 @@ from pydantic import Field, field_validator, model_serializer, model_validator
 
 from walkerlab.config.base import Strict, drop_unset
 
-
 # ---- generic walker description (``model: biped``): bodies, joints, feet as data.
 # A kneed leg (``knee``) and round feet (``foot.kind: arc``) extend these classes.
 
