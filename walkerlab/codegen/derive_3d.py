@@ -63,6 +63,7 @@ from functools import cache, wraps
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
+from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
 from walkerlab.codegen.lagrange import christoffel
 
 #: the seed of sympy's random choices while a 3D walker is derived (:func:`_seeded`)
@@ -91,13 +92,6 @@ def _seeded(derive):
         finally:
             srand.rng.setstate(state)
     return seeded
-
-
-def rotation(axis: sp.Matrix, angle) -> sp.Matrix:
-    """Rotation matrix (3, 3) by ``angle`` about the unit vector ``axis`` (Rodrigues)."""
-    k = sp.Matrix(axis)
-    K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
 
 
 def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
@@ -439,7 +433,7 @@ def derive_compass(structure) -> Equations:
     M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
     C = christoffel(M, q, dq)
     # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n
-    up = sp.Matrix([-sp.sin(gamma), sp.cos(gamma), 0])
+    up = slope_up(gamma)
     potential = sum(mi * g * _dot(r, up) for mi, r in masses)
     G = sp.Matrix([sp.expand(sp.diff(potential, qi)) for qi in q])
     if structure.hip_roll:
@@ -455,8 +449,7 @@ def derive_compass(structure) -> Equations:
     Mi = (M - A * F - F.T * A.T + total * F.T * F).applyfunc(
         lambda e: sp.trigsimp(sp.expand(e)))
     B = (M - F.T * A.T).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
-    to_world = sp.Matrix([[sp.cos(gamma), sp.sin(gamma), 0],
-                          [-sp.sin(gamma), sp.cos(gamma), 0], [0, 0, 1]])  # columns s, n, z
+    to_world = slope_to_world(gamma)                   # columns s, n, z
     height = swing_contact[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
     if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
