@@ -24,7 +24,7 @@ from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root
-from walkerlab.walker.tree_compass import compass_3d_tree, planar_compass_tree
+from walkerlab.walker.trees import compass_3d_tree, planar_compass_tree
 
 RTOL = 1e-12
 

@@ -1,4 +1,4 @@
-"""The straight-legged walkers as body trees (:mod:`walkerlab.walker.tree`): the 3D compass
+"""Today's straight-legged walkers as body trees (:mod:`walkerlab.walker.tree`): the 3D compass
 with hip width, with and without hip-roll joints (Kuo 1999, "Stabilization of lateral motion
 in passive dynamic walking", IJRR 18(9); today derived by hand in
 :func:`walkerlab.codegen.derive_3d.derive_compass`), and the planar compass gait as its
