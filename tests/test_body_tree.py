@@ -141,9 +141,9 @@ def test_the_3d_tree_upright_and_narrow_is_the_planar_compass_gait():
     planar = derive(Structure("absolute", (BodySpec("mass", "point_mass"),), hip_mass=True))
     P3, P2 = dict(zip(map(str, te.params), te.params)), dict(zip(map(str, planar.params),
                                                                  planar.params))
-    sub = {te.q[0]: 0, P3["w_hip"]: 0, P3["m_leg"]: P2["m_mass"], P3["a_leg"]: P2["L"] - P2["d_mass"],
-           P3["g"]: P2["g"], P3["L"]: P2["L"], P3["gamma"]: P2["gamma"], P3["M_hip"]: P2["M_hip"],
-           te.q[1]: planar.q[0], te.q[2]: planar.q[1]}
+    sub = {te.q[0]: 0, P3["w_hip"]: 0, P3["m_leg"]: P2["m_mass"],
+           P3["a_leg"]: P2["L"] - P2["d_mass"], te.q[1]: planar.q[0], te.q[2]: planar.q[1],
+           **{P3[k]: P2[k] for k in ("g", "L", "gamma", "M_hip")}}
     pitch = te.M[1:, 1:].subs(sub)
     assert sp.simplify(pitch - planar.M) == sp.zeros(2, 2)
     assert te.M[0, 1].subs(sub) == 0   # no coupling of lean and pitch when upright

@@ -58,40 +58,14 @@ one).  The steady rolling motions form a one-parameter family by heading at a gi
 
 from __future__ import annotations
 
-from functools import cache, wraps
+from functools import cache
 
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
 from walkerlab.codegen.lagrange import christoffel
-
-#: the seed of sympy's random choices while a 3D walker is derived (:func:`_seeded`)
-SYMPY_SEED = 0
-
-
-def _seeded(derive):
-    """``derive`` with sympy's random number generator (``sympy.core.random.rng``) seeded
-    with :data:`SYMPY_SEED` while it runs, its state restored after.
-
-    ``trigsimp`` (the mass and impact matrices here) calls ``factor``, whose multivariate
-    factorisation (Wang's, ``dmp_zz_wang``) draws its evaluation points at random.  The
-    factors are the same whatever it draws (measured: the same generated text from eight
-    generator states), but its time is not: in a test process whose generator had been
-    drawn from before, the Hensel lifting of the round-feet walker's impact matrix ran for
-    over 30 minutes, where a fresh process derives the walker in 45 s.  Seeded, a
-    derivation takes the same time in every process and on every machine."""
-    import sympy.core.random as srand
-
-    @wraps(derive)
-    def seeded(structure):
-        state = srand.rng.getstate()
-        srand.rng.seed(SYMPY_SEED)
-        try:
-            return derive(structure)
-        finally:
-            srand.rng.setstate(state)
-    return seeded
+from walkerlab.codegen.seeded import seeded as _seeded
 
 
 def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:

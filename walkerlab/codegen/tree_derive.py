@@ -47,6 +47,7 @@ import sympy as sp
 
 from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
 from walkerlab.codegen.lagrange import christoffel
+from walkerlab.codegen.seeded import seeded
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
 __all__ = ["TreeEquations", "TreeKinematics", "derive_tree", "heel_strike", "kinematics",
@@ -202,7 +203,7 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
             w += _product(chain[k + 1:]).T * sp.Matrix(axis) * rate
         omega[b.name] = w
         mass[b.name] = num(b.mass_kg)
-        inertia[b.name] = sp.Matrix(3, 3, lambda r, c: num(b.inertia_kg_m2[r][c]))
+        inertia[b.name] = sp.Matrix([[num(v) for v in row] for row in b.inertia_kg_m2])
     contacts = {c.name: origin[c.body] + R[c.body] * vec(c.point_m) for c in tree.contacts}
     return TreeKinematics(q=q, dq=dq, params=par, rotations={k: R[k] for k in com},
                           origins={k: origin[k] for k in com}, coms=com, omegas=omega,
@@ -210,6 +211,7 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
                           gamma=num(tree.root.slope_rad), g=num(tree.root.gravity_m_per_s2))
 
 
+@seeded
 def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
                 simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify) -> TreeEquations:
     """Lagrange's flow, the energies and the points of ``tree`` (module docstring).
@@ -220,7 +222,8 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
     coords : walkerlab.walker.tree.CoordinateMap, optional
         The walker's coordinates; default the joints' own.
     simplify : callable
-        Applied to every entry of ``M`` (and of ``A``) before the Christoffel symbols.
+        Applied to every entry of ``M`` (and of ``A``) before the Christoffel symbols
+        (sympy's random choices seeded meanwhile: :func:`walkerlab.codegen.seeded.seeded`).
 
     Returns
     -------
@@ -263,6 +266,7 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
                          potential=V, A=A, total_mass=total, points=points, kinematics=kin)
 
 
+@seeded
 def plastic_impact(M: sp.Matrix, A: sp.Matrix, total_mass, F: sp.Matrix,
                    simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify
                    ) -> tuple[sp.Matrix, sp.Matrix]:
