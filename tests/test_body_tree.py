@@ -19,12 +19,16 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from walkerlab.codegen.derive_3d import derive_compass
+from walkerlab.codegen.derive_3d import derive_compass, derive_spoked
 from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root
-from walkerlab.walker.trees import compass_3d_tree, planar_compass_tree
+from walkerlab.walker.trees import (
+    compass_3d_tree,
+    planar_compass_tree,
+    spoked_wheel_3d_tree,
+)
 
 RTOL = 1e-12
 
@@ -42,7 +46,9 @@ def _params(names, rng, *, mirror=False) -> dict:
              "a_leg": rng.uniform(0.2, 0.8) * L, "w_hip": rng.uniform(0.05, 0.4)
              * (-1 if mirror else 1), "I_leg": rng.uniform(0.01, 0.5),
              "I_pelvis": rng.uniform(0.01, 0.5), "m_mass": rng.uniform(0.5, 8.0),
-             "d_mass": rng.uniform(0.2, 0.8) * L, "I_mass": rng.uniform(0.01, 0.5)}
+             "d_mass": rng.uniform(0.2, 0.8) * L, "I_mass": rng.uniform(0.01, 0.5),
+             "M_hub": rng.uniform(0.5, 20.0), "I_hub": rng.uniform(0.01, 2.0),
+             "I_diam": rng.uniform(0.01, 2.0), "alpha": rng.uniform(0.2, 0.8)}
     return {n: value.get(n, 0.0) for n in names}
 
 
@@ -117,6 +123,18 @@ def test_the_hip_roll_walker_tree_reproduces_derive_compass():
     te = derive_tree(tree, coords)
     Mi, B = heel_strike(te, "swing_foot")
     _compare(e, te, Mi, B, np.random.default_rng(810))
+
+
+@pytest.mark.slow
+def test_the_spoked_wheel_tree_reproduces_derive_spoked():
+    """The 3D spoked wheel (Coleman, Chatterjee & Ruina 1997) as one body on a spherical
+    joint (heading, lean, spin): its flow and its impact at the next spoke's foot equal
+    ``derive_spoked``'s at random states (35 s: ``derive_spoked``'s simplification)."""
+    e = derive_spoked(Structure("absolute", (), hip_mass=True, spokes=6, in_3d=True))
+    tree, coords = spoked_wheel_3d_tree()
+    te = derive_tree(tree, coords, simplify=_same)
+    Mi, B = heel_strike(te, "next_foot", simplify=_same)
+    _compare(e, te, Mi, B, np.random.default_rng(97))
 
 
 @pytest.mark.parametrize("rod", [False, True], ids=["point_legs", "rod_legs"])

@@ -2,7 +2,8 @@
 with hip width, with and without hip-roll joints (Kuo 1999, "Stabilization of lateral motion
 in passive dynamic walking", IJRR 18(9); today derived by hand in
 :func:`walkerlab.codegen.derive_3d.derive_compass`), and the planar compass gait as its
-special case (every axis along ``z``, no hip width; :func:`walkerlab.codegen.symbolic.derive`).
+special case (every axis along ``z``, no hip width; :func:`walkerlab.codegen.symbolic.derive`),
+and the 3D spoked wheel (:func:`spoked_wheel_3d_tree`).
 
 The 3D tree, from the stance foot (the root, in the slope's frame):
 
@@ -36,7 +37,7 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["compass_3d_tree", "planar_compass_tree"]
+__all__ = ["compass_3d_tree", "planar_compass_tree", "spoked_wheel_3d_tree"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 #: the parameters the 3D compass's tree reads, before the hip-roll law's gains (the order
@@ -120,3 +121,33 @@ def planar_compass_tree(*, leg_inertia: bool = False) -> tuple[BodyTree, Coordin
     return tree, CoordinateMap(("swing", "stance"),
                                (("stance_ankle_pitch", "stance + gamma"),
                                 ("hip_angle", "swing - stance")))
+
+
+def spoked_wheel_3d_tree() -> tuple[BodyTree, CoordinateMap]:
+    """The spoked wheel in three dimensions (Coleman, Chatterjee & Ruina 1997; today
+    :func:`walkerlab.codegen.derive_3d.derive_spoked`) as a tree: one body on a spherical
+    joint at the stance spoke's foot, turned by the heading ``psi`` about the slope's normal,
+    the lean ``phi`` about the fall line and the spin about the axle
+    (``Rot(n, psi) Rot(s, phi) Rot(z, theta + gamma)`` in the slope's frame, ``theta`` the
+    stance spoke's angle from the vertical); the hub ``M_hub`` at ``(0, L, 0)`` in the
+    wheel's frame, ``I_hub`` about the axle ``z`` and ``I_diam`` about any diameter; the next
+    spoke's foot at ``(0, L, 0) + Rot(z, 2 alpha) (0, -L, 0)``.
+
+    Returns
+    -------
+    BodyTree, CoordinateMap
+        Parameters ``g, L, gamma, M_hub, I_hub, alpha, I_diam``; coordinates ``heading,
+        lean, stance``.
+    """
+    params = ("g", "L", "gamma", "M_hub", "I_hub", "alpha", "I_diam")
+    wheel = Body("wheel", "M_hub", diagonal("I_diam", "I_diam", "I_hub"), (0, "L", 0),
+                 Joint("stance_spoke", "spherical", "slope", (0, 0, 0), ((0, 1, 0), S, Z),
+                       ("wheel_heading", "wheel_lean", "wheel_spin")))
+    tree = BodyTree(params, Root(), (wheel,),
+                    (ContactPoint("stance_foot", "wheel", (0, 0, 0)),
+                     ContactPoint("next_foot", "wheel",
+                                  ("L * sin(2 * alpha)", "L - L * cos(2 * alpha)", 0))))
+    # the spin from the slope's normal is the stance spoke's angle from the vertical + gamma
+    return tree, CoordinateMap(("heading", "lean", "stance"),
+                               (("wheel_heading", "heading"), ("wheel_lean", "lean"),
+                                ("wheel_spin", "stance + gamma")))
