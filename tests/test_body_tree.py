@@ -111,6 +111,15 @@ def test_the_3d_compass_tree_reproduces_derive_compass(rod):
     te = derive_tree(tree, coords, simplify=_same)
     Mi, B = heel_strike(te, "swing_foot", simplify=_same)
     _compare(e, te, Mi, B, np.random.default_rng(81 + rod))
+    # the named points (world axes) and the swing foot's height above the slope
+    args = e.q + e.dq + e.params
+    pts = _states(e, np.random.default_rng(7))
+    for ours, theirs in (("swing_foot", "swing_foot"), ("pelvis_com", "hip"),
+                         ("stance_leg_com", "stance_mass"), ("swing_leg_com", "swing_mass"),
+                         ("pelvis_origin", "stance_hip"), ("swing_leg_origin", "swing_hip")):
+        _close(ours, e.points[theirs], te.points[ours], args, pts)
+    _close("clearance", sp.Matrix([e.guards["swing_clearance"]]),
+           sp.Matrix([te.kinematics.contacts["swing_foot"][1]]), args, pts)
 
 
 @pytest.mark.slow

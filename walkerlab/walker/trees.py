@@ -1,6 +1,6 @@
-"""Today's straight-legged walkers as body trees (:mod:`walkerlab.walker.tree`): the 3D compass
-with hip width, with and without hip-roll joints (Kuo 1999, "Stabilization of lateral motion
-in passive dynamic walking", IJRR 18(9); today derived by hand in
+"""Today's 3D walkers and the planar compass gait as body trees (:mod:`walkerlab.walker.tree`):
+the 3D compass with hip width, with and without hip-roll joints (Kuo 1999, "Stabilization of
+lateral motion in passive dynamic walking", IJRR 18(9); today derived by hand in
 :func:`walkerlab.codegen.derive_3d.derive_compass`), and the planar compass gait as its
 special case (every axis along ``z``, no hip width; :func:`walkerlab.codegen.symbolic.derive`),
 and the 3D spoked wheel (:func:`spoked_wheel_3d_tree`).
