@@ -21,7 +21,7 @@ import sympy as sp
 
 from walkerlab.codegen.derive_3d import derive_compass, derive_spoked
 from walkerlab.codegen.symbolic import derive
-from walkerlab.codegen.tree_derive import derive_tree, heel_strike
+from walkerlab.codegen.tree_derive import derive_tree, heel_strike, kinematics
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root
 from walkerlab.walker.trees import (
@@ -174,6 +174,28 @@ def test_the_3d_tree_upright_and_narrow_is_the_planar_compass_gait():
     pitch = te.M[1:, 1:].subs(sub)
     assert sp.simplify(pitch - planar.M) == sp.zeros(2, 2)
     assert te.M[0, 1].subs(sub) == 0   # no coupling of lean and pitch when upright
+
+
+@pytest.mark.parametrize("make", [lambda: compass_3d_tree(hip_roll=True),
+                                  spoked_wheel_3d_tree], ids=["hip_roll_walker", "wheel"])
+def test_each_body_turns_at_its_body_frame_angular_velocity(make):
+    """Each body's angular velocity in its own frame is the body velocity ``R^T R'``
+    (Murray, Li & Sastry 1994, Eq. 2.49): independent of the tree's unrolled recursion,
+    and seen by every inertia, not only by the symmetric ones of today's walkers."""
+    kin = kinematics(*make())
+    qv, dqv = sp.Matrix(kin.q), sp.Matrix(kin.dq)
+    rng = np.random.default_rng(49)
+    args = kin.q + kin.dq + kin.params
+    for name, R in kin.rotations.items():
+        Rdot = sum((R.diff(qi) * dqi for qi, dqi in zip(qv, dqv)), sp.zeros(3, 3))
+        fR, fRd = sp.lambdify(args, R), sp.lambdify(args, Rdot)
+        fw = sp.lambdify(args, kin.omegas[name])
+        for _ in range(3):
+            x = rng.uniform(-1.0, 1.0, len(args))
+            body = np.array(fR(*x), float).T @ np.array(fRd(*x), float)
+            assert np.allclose(body, -body.T, atol=1e-13)
+            w = np.array([body[2, 1], body[0, 2], body[1, 0]])
+            assert np.allclose(np.ravel(np.array(fw(*x), float)), w, rtol=0, atol=1e-13), name
 
 
 def test_a_misplaced_pelvis_mass_is_seen_by_the_comparison():
