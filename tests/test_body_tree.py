@@ -101,7 +101,8 @@ def _structure_3d(*, hip_roll=False, rod=False) -> Structure:
                      hip_mass=True, in_3d=True, hip_width=True, hip_roll=hip_roll)
 
 
-@pytest.mark.parametrize("rod", [False, True], ids=["point_legs", "rod_legs"])
+@pytest.mark.parametrize("rod", [False, pytest.param(True, marks=pytest.mark.slow)],
+                         ids=["point_legs", "rod_legs"])
 def test_the_3d_compass_tree_reproduces_derive_compass(rod):
     """The 3D compass with hip width (Kuo 1999) as a tree: its mass matrix, Coriolis matrix
     and bias, gravity, potential and heel-strike impact equal ``derive_compass``'s at random

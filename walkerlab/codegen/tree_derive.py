@@ -222,7 +222,7 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
     coords : walkerlab.walker.tree.CoordinateMap, optional
         The walker's coordinates; default the joints' own.
     simplify : callable
-        Applied to every entry of ``M`` (and of ``A``) before the Christoffel symbols
+        Applied to every entry of ``M`` before the Christoffel symbols
         (sympy's random choices seeded meanwhile: :func:`walkerlab.codegen.seeded.seeded`).
 
     Returns
@@ -253,7 +253,6 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
             Jw = kin.omegas[name].jacobian(dqv)
             M += Jw.T * inertia * Jw
     M = M.applyfunc(simplify)
-    A = A.applyfunc(simplify)
     C = christoffel(M, q, dq)
     G = sp.Matrix([sp.expand(sp.diff(V, qi)) for qi in q])
     kinetic = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
