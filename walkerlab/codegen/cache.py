@@ -104,7 +104,7 @@ def cache_key(structure) -> str:
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
     if getattr(structure, "in_3d", False):
-        h.update(_source_hash("derive_3d.py").encode())
+        h.update(_source_hash("derive_3d.py", "frames.py").encode())
     return h.hexdigest()[:24]
 
 

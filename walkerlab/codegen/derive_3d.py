@@ -58,39 +58,14 @@ one).  The steady rolling motions form a one-parameter family by heading at a gi
 
 from __future__ import annotations
 
-from functools import cache, wraps
+from functools import cache
 
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.lagrange import christoffel, rotation
-
-#: the seed of sympy's random choices while a 3D walker is derived (:func:`_seeded`)
-SYMPY_SEED = 0
-
-
-def _seeded(derive):
-    """``derive`` with sympy's random number generator (``sympy.core.random.rng``) seeded
-    with :data:`SYMPY_SEED` while it runs, its state restored after.
-
-    ``trigsimp`` (the mass and impact matrices here) calls ``factor``, whose multivariate
-    factorisation (Wang's, ``dmp_zz_wang``) draws its evaluation points at random.  The
-    factors are the same whatever it draws (measured: the same generated text from eight
-    generator states), but its time is not: in a test process whose generator had been
-    drawn from before, the Hensel lifting of the round-feet walker's impact matrix ran for
-    over 30 minutes, where a fresh process derives the walker in 45 s.  Seeded, a
-    derivation takes the same time in every process and on every machine."""
-    import sympy.core.random as srand
-
-    @wraps(derive)
-    def seeded(structure):
-        state = srand.rng.getstate()
-        srand.rng.seed(SYMPY_SEED)
-        try:
-            return derive(structure)
-        finally:
-            srand.rng.setstate(state)
-    return seeded
+from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
+from walkerlab.codegen.lagrange import christoffel
+from walkerlab.codegen.seeded import seeded as _seeded
 
 
 def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
@@ -432,7 +407,7 @@ def derive_compass(structure) -> Equations:
     M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
     C = christoffel(M, q, dq)
     # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n
-    up = sp.Matrix([-sp.sin(gamma), sp.cos(gamma), 0])
+    up = slope_up(gamma)
     potential = sum(mi * g * _dot(r, up) for mi, r in masses)
     G = sp.Matrix([sp.expand(sp.diff(potential, qi)) for qi in q])
     if structure.hip_roll:
@@ -448,8 +423,7 @@ def derive_compass(structure) -> Equations:
     Mi = (M - A * F - F.T * A.T + total * F.T * F).applyfunc(
         lambda e: sp.trigsimp(sp.expand(e)))
     B = (M - F.T * A.T).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
-    to_world = sp.Matrix([[sp.cos(gamma), sp.sin(gamma), 0],
-                          [-sp.sin(gamma), sp.cos(gamma), 0], [0, 0, 1]])  # columns s, n, z
+    to_world = slope_to_world(gamma)                   # columns s, n, z
     height = swing_contact[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
     if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's

@@ -1,5 +1,5 @@
 """The Lagrangian core every walker generator shares: the Coriolis matrix of a mass matrix
-from its Christoffel symbols, and the rotation about an axis (Rodrigues), written once.
+from its Christoffel symbols, written once.
 
 Lagrange's equations of a walker with coordinates ``q`` (n,), kinetic energy
 ``T = dq^T M(q) dq / 2`` and potential ``V(q)`` are ``M qdd + C(q, dq) dq + G(q) = 0`` with
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["christoffel", "rotation"]
+__all__ = ["christoffel"]
 
 
 def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
@@ -43,12 +43,3 @@ def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
                                                - sp.diff(M[j, k], q[i])) * dq[k]
                           for k in range(n))
     return C
-
-
-def rotation(axis: sp.Matrix, angle) -> sp.Matrix:
-    """Rotation matrix (3, 3) by ``angle`` [rad] about the unit vector ``axis`` (3,):
-    Rodrigues' formula ``I + sin(a) K + (1 - cos(a)) K^2``, ``K`` the cross-product matrix of
-    ``axis`` (Murray, Li & Sastry 1994, Eq. 2.14)."""
-    k = sp.Matrix(axis)
-    K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K

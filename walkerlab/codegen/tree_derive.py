@@ -1,146 +1,313 @@
-"""Lagrange's equations of a body tree (:class:`walkerlab.walker.tree.BodyTree`): the one
-derivation that reads bodies, 3x3 inertias and joint axes, for planar and 3D walkers alike.
+"""One Lagrangian derivation of a walker from its body tree (:mod:`walkerlab.walker.tree`):
+forward kinematics, the energies, Lagrange's flow and the heel-strike impact, for planar and
+3D trees alike.
 
-Forward kinematics (Featherstone 2008, *Rigid Body Dynamics Algorithms*, ch. 4): each
-body's rotation ``R_b`` (3, 3) and frame origin ``o_b`` in the root (slope) frame, from its
-parent's and its joint's origin and rotations (:func:`walkerlab.codegen.lagrange.rotation`,
-Rodrigues).  Each body's angular velocity is linear in the rates, ``omega_b = W_b dq``, the
-sum over the joints from the root of each rotation's axis (in the root frame) times its
-angle's rate; its centre of mass ``c_b`` has the Jacobian ``J_b = dc_b/dq``.  Then
+Kinematics (Featherstone 2008, *Rigid Body Dynamics Algorithms*, Sec. 4.1-4.2, in its
+rotational and positional parts).  Every body's orientation is the chain of elementary
+rotations ``Rot(u_k, a_k)`` (Rodrigues, :func:`walkerlab.codegen.frames.rotation`) of the
+joints from the root to it; consecutive rotations about the same axis are merged (their
+angles summed, zero angles dropped) before the chain is multiplied out, so a pitch undone
+by the next joint leaves no ``sin^2 + cos^2`` behind.  With ``R_b = R_<k Rot(u_k, a_k)
+R_>k`` the body's angular velocity in its own frame is ``omega_b = sum_k R_>k^T u_k a_k'``
+(Featherstone's ``omega_i = R^T omega_parent + S_i q_i'``, unrolled); its origin is its
+parent's plus ``R_parent origin``, its centre of mass ``r_c = p_b + R_b c_b``.
 
-    M = sum_b m_b J_b^T J_b + W_b^T R_b I_b R_b^T W_b,
-    V = sum_b m_b g (up . c_b),   up = (-sin gamma, cos gamma, 0) in the slope frame,
+Energies (Murray, Li & Sastry 1994, *A Mathematical Introduction to Robotic Manipulation*,
+Sec. 4.3): ``T = sum_b [m_b |r_c'|^2 + omega_b^T I_b omega_b] / 2`` with ``I_b`` about the
+centre of mass in the body's frame, so ``M = sum_b m_b J_c^T J_c + J_w^T I_b J_w``
+(``J_c = dr_c/dq``, ``J_w = d omega_b / dq'``); ``V = sum_b m_b g up . r_c`` with ``up``
+the vertical in the slope's frame (:func:`~walkerlab.codegen.frames.slope_up`).  The flow
+``M qdd + C dq + G = 0``: ``C`` from the Christoffel symbols
+(:func:`walkerlab.codegen.lagrange.christoffel`), ``G = dV/dq``.
 
-``C`` from ``M``'s Christoffel symbols (:func:`walkerlab.codegen.lagrange.christoffel`) and
-``G = dV/dq`` (Murray, Li & Sastry 1994, ch. 4).  The plastic heel strike at a contact
-point ``f(q)`` is the extended-coordinates impact (Hurmuzlu & Marghitu 1994): with the
-stance foot free (its position ``p`` three more coordinates, moving every body by ``dp``,
-turning none), ``M_e = [[M, A], [A^T, m_tot I]]``, ``A = sum_b m_b J_b^T``, and the rates
-that keep the new foot at rest ``[I; -F]``, ``F = df/dq``:
+Heel strike (:func:`plastic_impact`; Hurmuzlu & Marghitu 1994, "Rigid body collisions of
+planar kinematic chains with multiple contact points", IJRR 13(1); Westervelt et al. 2007,
+*Feedback Control of Dynamic Bipedal Robot Locomotion*, Sec. 3.4.2).  In extended
+coordinates ``[q, p]`` (``p`` the root's origin, the old stance foot, free) the mass matrix
+is ``M_e = [[M, A], [A^T, m I]]``, ``A = sum_b m_b J_c^T`` (a translation of the root moves
+every centre of mass with it and turns no body), ``m`` the total mass.  The impact is
+plastic: the new stance foot ``f(q)`` sticks, the old one leaves the ground (no impulse
+there).  The motions about the new foot have the extended rates ``J dq`` with
+``J = [I; -F]``, ``F = df/dq`` (the new foot at rest), and the impulse at the new foot does
+no work on them, so ``J^T M_e J dq+ = J^T M_e [I; 0] dq-``:
 
-    Mi = M - A F - F^T A^T + m_tot F^T F,    B = M - F^T A^T,    Mi dq+ = B dq-.
+    Mi = M - A F - F^T A^T + m F^T F,        B = M - F^T A^T.
+
+The planar generators' ``Mi, B`` (:mod:`walkerlab.codegen.symbolic`, ``add_mass_terms``) and
+the 3D compass's (:func:`walkerlab.codegen.derive_3d.derive_compass`) are this formula on
+their own bodies.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
 
-from walkerlab.codegen.lagrange import christoffel, rotation
-from walkerlab.walker.tree import ROOT, BodyTree
+from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
+from walkerlab.codegen.lagrange import christoffel
+from walkerlab.codegen.seeded import seeded
+from walkerlab.walker.tree import BodyTree, CoordinateMap
 
-__all__ = ["TreeEquations", "derive_tree", "tree_impact", "tree_kinematics"]
+__all__ = ["TreeEquations", "TreeKinematics", "derive_tree", "heel_strike", "kinematics",
+           "plastic_impact", "trig_simplify"]
+
+
+def trig_simplify(e: sp.Expr) -> sp.Expr:
+    """The simplification of the mass and impact matrices' entries: ``trigsimp(expand(e))``
+    (as :func:`walkerlab.codegen.derive_3d.derive_compass`'s)."""
+    return sp.trigsimp(sp.expand(e))
 
 
 @dataclass(frozen=True)
-class TreeEquations:
-    """A body tree's flow and energies (sympy, ``n`` coordinates).
+class TreeKinematics:
+    """Forward kinematics of a tree in a walker's coordinates (sympy; frames in the slope's).
 
     Attributes
     ----------
     q, dq : tuple of Symbol (n,)
-    params : dict[str, Symbol]
-    M, C : Matrix (n, n); G : Matrix (n, 1)
-        ``M qdd + C dq + G = 0``.
-    kinetic, potential : Expr
-        [J]; the potential from the stance foot's height.
-    points : dict[str, Matrix (3, 1)]
-        The tree's named points in the slope frame [m].
-    A : Matrix (n, 3); total_mass : Expr
-        ``sum m_b J_b^T`` and ``sum m_b`` (the extended impact's).
+        ``q_<name>``, ``dq_<name>`` for the coordinate map's names [rad, rad/s].
+    params : tuple of Symbol
+        The tree's parameters, in order.
+    rotations : dict[str, Matrix (3, 3)]
+        Each body's frame to the slope's frame.
+    origins, coms : dict[str, Matrix (3, 1)]
+        Each body's frame origin and centre of mass from the root's origin [m].
+    omegas : dict[str, Matrix (3, 1)]
+        Each body's angular velocity in its own frame [rad/s], linear in ``dq``.
+    contacts : dict[str, Matrix (3, 1)]
+        Each contact point from the root's origin [m].
+    masses : dict[str, Expr]; inertias : dict[str, Matrix (3, 3)]
+    gamma, g : Expr
+        The slope [rad] and gravity [m/s^2].
     """
 
     q: tuple
     dq: tuple
-    params: dict
+    params: tuple
+    rotations: dict
+    origins: dict
+    coms: dict
+    omegas: dict
+    contacts: dict
+    masses: dict
+    inertias: dict
+    gamma: sp.Expr
+    g: sp.Expr
+
+
+@dataclass(frozen=True)
+class TreeEquations:
+    """The flow, energies and points of a tree (:func:`derive_tree`; ``n = len(q)``).
+
+    Attributes
+    ----------
+    q, dq, params : tuple of Symbol
+    M, C : Matrix (n, n); G : Matrix (n, 1)
+        ``M qdd + C dq + G = 0`` (gravity only in ``G``).
+    kinetic, potential : Expr
+        [J]; the potential from the heights above the horizontal through the stance foot.
+    A : Matrix (n, 3); total_mass : Expr
+        The extended mass matrix's coupling ``sum_b m_b J_c^T`` and total mass (module
+        docstring), for :func:`heel_strike`.
+    points : dict[str, Matrix (3, 1)]
+        Every contact point, body origin (``<body>_origin``) and centre of mass
+        (``<body>_com``) from the stance foot in world axes (``x`` downhill, ``y`` up).
+    kinematics : TreeKinematics
+    """
+
+    q: tuple
+    dq: tuple
+    params: tuple
     M: sp.Matrix
     C: sp.Matrix
     G: sp.Matrix
     kinetic: sp.Expr
     potential: sp.Expr
-    points: dict
     A: sp.Matrix
     total_mass: sp.Expr
+    points: dict
+    kinematics: TreeKinematics
 
 
-def _expr(x, names: dict):
-    """A tree scalar (float or expression string) as a sympy expression of ``names``."""
-    return sp.sympify(x, locals=names) if isinstance(x, str) else sp.nsimplify(x)
+def _merged(chain: list) -> list:
+    """Consecutive elementary rotations ``(axis tuple, angle)`` about the same axis merged,
+    zero angles dropped (the product is unchanged)."""
+    out: list = []
+    for axis, angle in chain:
+        if out and out[-1][0] == axis:
+            angle = out.pop()[1] + angle
+        if angle != 0:
+            out.append((axis, angle))
+    return out
 
 
-def tree_kinematics(tree: BodyTree, names: dict, q) -> dict:
-    """Each body's ``(R, o, W)``: rotation (3, 3) and frame origin (3, 1) in the slope frame,
-    and its angular velocity's Jacobian ``W`` (3, n) (``omega = W dq``)."""
-    qv = sp.Matrix(q)
-    frames = {ROOT: (sp.eye(3), sp.zeros(3, 1), sp.zeros(3, len(q)))}
-    for j in tree.joints:
-        R, o, W = frames[j.parent]
-        o = o + R * sp.Matrix([_expr(v, names) for v in j.origin])
-        for axis, angle in j.rotations:
-            a = _expr(angle, names)
-            k = R * sp.Matrix(axis)           # the axis in the slope frame
-            W = W + k * sp.Matrix([a]).jacobian(qv)
-            R = R * rotation(sp.Matrix(axis), a)
-        frames[j.child] = (R, o, W)
-    return frames
+def _product(chain: list) -> sp.Matrix:
+    R = sp.eye(3)
+    for axis, angle in chain:
+        R = R * rotation(sp.Matrix(axis), angle)
+    return R
 
 
-def derive_tree(tree: BodyTree) -> TreeEquations:
-    """The flow, energies and points of ``tree`` (module docstring).
+def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinematics:
+    """Forward kinematics of ``tree`` (module docstring) in the coordinates ``coords``.
 
     Parameters
     ----------
-    tree : BodyTree
+    tree : walkerlab.walker.tree.BodyTree
+    coords : walkerlab.walker.tree.CoordinateMap, optional
+        The walker's coordinates and the joints' angles in them; default the joints' own.
+
+    Returns
+    -------
+    TreeKinematics
+
+    Raises
+    ------
+    ValueError
+        ``coords`` does not fit ``tree`` (:meth:`~walkerlab.walker.tree.CoordinateMap.check`).
+    """
+    coords = coords or CoordinateMap.identity(tree)
+    coords.check(tree)
+    par = tuple(sp.Symbol(p, real=True) for p in tree.params)
+    q = tuple(sp.Symbol(f"q_{c}", real=True) for c in coords.names)
+    dq = tuple(sp.Symbol(f"dq_{c}", real=True) for c in coords.names)
+    ns = {**dict(zip(tree.params, par)), **dict(zip(coords.names, q)),
+          "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt, "pi": sp.pi}
+
+    def num(v):  # an expression in the names, or a number (whole numbers exact)
+        if isinstance(v, str):
+            return sp.sympify(v, locals=ns)
+        return sp.Integer(int(v)) if float(v).is_integer() else sp.Float(v)
+
+    def vec(v):
+        return sp.Matrix([num(c) for c in v])
+
+    angle = {c: num(e) for c, e in coords.joint_angles}
+    chains, R, origin, com, omega, mass, inertia = {}, {}, {}, {}, {}, {}, {}
+    root = tree.root.name
+    chains[root], R[root], origin[root] = [], sp.eye(3), sp.zeros(3, 1)
+    for b in tree.bodies:
+        j = b.joint
+        steps = [(tuple(num(c) for c in axis), angle[c]) for axis, c in
+                 zip(j.axes, j.coordinates)]
+        chain = _merged(chains[j.parent] + steps)
+        chains[b.name] = chain
+        R[b.name] = _product(chain)
+        origin[b.name] = origin[j.parent] + R[j.parent] * vec(j.origin_m)
+        com[b.name] = origin[b.name] + R[b.name] * vec(b.com_m)
+        w = sp.zeros(3, 1)
+        for k, (axis, a) in enumerate(chain):   # omega_b = sum_k R_>k^T u_k a_k'
+            rate = sum(sp.diff(a, qi) * dqi for qi, dqi in zip(q, dq))
+            w += _product(chain[k + 1:]).T * sp.Matrix(axis) * rate
+        omega[b.name] = w
+        mass[b.name] = num(b.mass_kg)
+        inertia[b.name] = sp.Matrix([[num(v) for v in row] for row in b.inertia_kg_m2])
+    contacts = {c.name: origin[c.body] + R[c.body] * vec(c.point_m) for c in tree.contacts}
+    return TreeKinematics(q=q, dq=dq, params=par, rotations={k: R[k] for k in com},
+                          origins={k: origin[k] for k in com}, coms=com, omegas=omega,
+                          contacts=contacts, masses=mass, inertias=inertia,
+                          gamma=num(tree.root.slope_rad), g=num(tree.root.gravity_m_per_s2))
+
+
+@seeded
+def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
+                simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify) -> TreeEquations:
+    """Lagrange's flow, the energies and the points of ``tree`` (module docstring).
+
+    Parameters
+    ----------
+    tree : walkerlab.walker.tree.BodyTree
+    coords : walkerlab.walker.tree.CoordinateMap, optional
+        The walker's coordinates; default the joints' own.
+    simplify : callable
+        Applied to every entry of ``M`` before the Christoffel symbols
+        (sympy's random choices seeded meanwhile: :func:`walkerlab.codegen.seeded.seeded`).
 
     Returns
     -------
     TreeEquations
+
+    Raises
+    ------
+    ValueError
+        ``coords`` does not fit ``tree``.
     """
-    q = sp.symbols(" ".join(tree.coordinates), real=True, seq=True)
-    dq = sp.symbols(" ".join("d" + c for c in tree.coordinates), real=True, seq=True)
-    params = {p: sp.Symbol(p, real=True) for p in tree.params}
-    names = {**dict(zip(tree.coordinates, q)), **params}
-    frames = tree_kinematics(tree, names, q)
-    qv, n = sp.Matrix(q), len(q)
-    M, A, total, V = sp.zeros(n, n), sp.zeros(n, 3), 0, 0
-    gamma, g = params["gamma"], params["g"]
-    up = sp.Matrix([-sp.sin(gamma), sp.cos(gamma), 0])
-    for b in tree.bodies:
-        R, o, W = frames[b.name]
-        m = _expr(b.mass, names)
-        c = o + R * sp.Matrix([_expr(v, names) for v in b.com])
-        J = c.jacobian(qv)
-        M += m * J.T * J
-        A += m * J.T
-        total += m
-        V += m * g * (up.T * c)[0]
-        inertia = sp.Matrix([[_expr(v, names) for v in row] for row in b.inertia])
+    kin = kinematics(tree, coords)
+    q, dq = kin.q, kin.dq
+    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    n = len(q)
+    M, A, total = sp.zeros(n, n), sp.zeros(n, 3), sp.Integer(0)
+    V = sp.Integer(0)
+    up = slope_up(kin.gamma)
+    for name, r in kin.coms.items():
+        m, inertia = kin.masses[name], kin.inertias[name]
+        if m != 0:
+            Jc = r.jacobian(qv)
+            M += m * Jc.T * Jc
+            A += m * Jc.T
+            total += m
+            V += m * kin.g * (up.T * r)[0]
         if inertia != sp.zeros(3, 3):
-            M += W.T * (R * inertia * R.T) * W
-    M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+            Jw = kin.omegas[name].jacobian(dqv)
+            M += Jw.T * inertia * Jw
+    M = M.applyfunc(simplify)
+    C = christoffel(M, q, dq)
     G = sp.Matrix([sp.expand(sp.diff(V, qi)) for qi in q])
-    points = {}
-    for p in tree.points:
-        R, o, _ = frames[p.body]
-        points[p.name] = o + R * sp.Matrix([_expr(v, names) for v in p.offset])
-    kinetic = sp.Rational(1, 2) * (sp.Matrix(dq).T * M * sp.Matrix(dq))[0]
-    return TreeEquations(q=tuple(q), dq=tuple(dq), params=params, M=M,
-                         C=christoffel(M, q, dq), G=G, kinetic=kinetic, potential=V,
-                         points=points, A=A, total_mass=total)
+    kinetic = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+    to_world = slope_to_world(kin.gamma)
+    points = {k: to_world * v for k, v in kin.contacts.items()}
+    for k in kin.coms:
+        points[f"{k}_origin"] = to_world * kin.origins[k]
+        points[f"{k}_com"] = to_world * kin.coms[k]
+    return TreeEquations(q=q, dq=dq, params=kin.params, M=M, C=C, G=G, kinetic=kinetic,
+                         potential=V, A=A, total_mass=total, points=points, kinematics=kin)
 
 
-def tree_impact(eq: TreeEquations, point: str) -> tuple[sp.Matrix, sp.Matrix]:
-    """``(Mi, B)`` (n, n) of the plastic impact at the named contact point, the old stance
-    foot leaving the ground: ``Mi dq+ = B dq-`` in the pre-impact labelling (module
-    docstring; Hurmuzlu & Marghitu 1994's extended coordinates).
+@seeded
+def plastic_impact(M: sp.Matrix, A: sp.Matrix, total_mass, F: sp.Matrix,
+                   simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify
+                   ) -> tuple[sp.Matrix, sp.Matrix]:
+    """The plastic impact at a new stance foot, the old one leaving the ground, in extended
+    coordinates (module docstring; Hurmuzlu & Marghitu 1994; Westervelt et al. 2007,
+    Sec. 3.4.2).
+
+    Parameters
+    ----------
+    M : Matrix (n, n)
+        Mass matrix about the old stance foot.
+    A : Matrix (n, 3); total_mass : Expr
+        The extended mass matrix's coupling and total mass [kg m, kg].
+    F : Matrix (3, n)
+        The new stance foot's velocity Jacobian (its material contact point's) [m].
+    simplify : callable
+        Applied to every entry of the results.
+
+    Returns
+    -------
+    Mi, B : Matrix (n, n)
+        ``Mi dq+ = B dq-`` in the pre-impact coordinates.
+    """
+    Mi = (M - A * F - F.T * A.T + total_mass * F.T * F).applyfunc(simplify)
+    B = (M - F.T * A.T).applyfunc(simplify)
+    return Mi, B
+
+
+def heel_strike(eqs: TreeEquations, contact: str,
+                simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify
+                ) -> tuple[sp.Matrix, sp.Matrix]:
+    """:func:`plastic_impact` at the tree's contact point ``contact`` (a point foot: its
+    material point is the contact point).
+
+    Returns
+    -------
+    Mi, B : Matrix (n, n)
 
     Raises
     ------
     KeyError
-        ``point`` is not a point of the tree.
+        ``contact`` is not a contact point of the tree.
     """
-    F = eq.points[point].jacobian(sp.Matrix(eq.q))
-    Mi = eq.M - eq.A * F - F.T * eq.A.T + eq.total_mass * F.T * F
-    B = eq.M - F.T * eq.A.T
-    return Mi, B
+    F = eqs.kinematics.contacts[contact].jacobian(sp.Matrix(eqs.q))
+    return plastic_impact(eqs.M, eqs.A, eqs.total_mass, F, simplify)

@@ -1,196 +1,327 @@
-"""The walker as a body tree: bodies with a mass, a centre of mass and a 3x3 inertia, hung on
-joints with axes, rooted at the stance foot; the description one Lagrangian derivation reads
-for planar and 3D walkers alike (:mod:`walkerlab.codegen.tree_derive`).
+"""A walker as a tree of rigid bodies joined by joints (no numbers computed, nothing derived):
+the description :func:`walkerlab.codegen.tree_derive.derive_tree` derives the equations from.
 
-As Drake's ``MultibodyPlant`` and Pinocchio's ``Model``, a tree is bodies and the joints
-between them (Featherstone 2008, *Rigid Body Dynamics Algorithms*, ch. 4: a kinematic tree,
-each body's frame placed by its parent joint).  A joint is a sequence of rotations about
-axes of the frame before it, each by an angle that is an expression of the walker's
-coordinates and parameters: a revolute joint is one rotation, a universal joint two, and a
-coordinate that is a linear combination of others (walkerlab's absolute leg angles, a
-bisecting hip's torso angle) needs no constraint.  A planar walker is the special case whose
-axes are all the slope frame's ``z``.
+The form follows the multibody descriptions of Drake (``MultibodyPlant``: bodies with a
+spatial inertia, joints with a parent and a child frame) and Pinocchio (joint models with
+their own coordinates), in Featherstone's regular numbering (Featherstone 2008, *Rigid Body
+Dynamics Algorithms*, Sec. 4.1.2): every body hangs from one joint whose parent is the root
+or a body listed before it.
 
-Every scalar is a float or a string: an expression of the coordinate and parameter names
-(``"-(q_stance + gamma)"``, ``"w_hip/2"``), read by the derivation with sympy.  Frames: the
-root is the slope frame at the stance foot, ``x`` along the fall line (downhill), ``y`` the
-slope's outward normal, ``z = x x y``.
+- :class:`Root`: the stance foot on the slope.  Its frame is the slope's (fall line ``s``,
+  normal ``n``, ``z``; :mod:`walkerlab.codegen.frames`), its origin the stance foot's contact
+  point, fixed through a step; gravity ``g`` points along world ``-y``.
+- :class:`Joint`: ``revolute`` (one axis), ``universal`` (two axes, the second turned by the
+  first's angle), ``spherical`` (three axes in sequence: Euler angles, singular where two
+  consecutive axes align) or ``fixed`` (none).  Its rotation is ``Rot(a_1, q_1) ...
+  Rot(a_k, q_k)``, each axis a unit vector in the frame left by the ones before it; its
+  origin is in the parent body's frame.
+- :class:`Body`: mass, inertia (3×3 about the centre of mass, in the body's frame), centre of
+  mass in the body's frame, the joint it hangs from (the body's frame is the joint's child
+  frame, at the joint's origin).
+- :class:`ContactPoint`: a named point on a body (a foot).
 
-Raises
-------
-ValueError
-    A tree whose joints name a body that is not in it, or a body hung on two joints, or an
-    inertia that is not 3x3 and symmetric (one line naming the body or joint).
+A number is a float or a string: an expression (Python/sympy syntax) in the tree's
+parameter names (:attr:`BodyTree.params`) and ``sin``, ``cos``, ``tan``, ``sqrt``, ``pi``,
+so one tree stands for every walker of its form (the parameters are the generated code's).
 """
 
 from __future__ import annotations
 
+import ast
+import math
 from dataclasses import dataclass, field
 
-__all__ = ["Body", "BodyTree", "Joint", "Point", "ROOT", "compass_3d_tree"]
+__all__ = ["Body", "BodyTree", "ContactPoint", "CoordinateMap", "Joint", "Root", "JOINT_AXES",
+           "ZERO_INERTIA", "diagonal"]
 
-#: The name of the root frame (the slope frame at the stance foot).
-ROOT = "ground"
+#: number of axes (and coordinates) of each joint kind
+JOINT_AXES = {"fixed": 0, "revolute": 1, "universal": 2, "spherical": 3}
+#: names an expression may use besides the tree's parameters
+FUNCTIONS = frozenset({"sin", "cos", "tan", "sqrt", "pi"})
 
-Scalar = float | str
+Scalar = float | int | str
+Vector = tuple[Scalar, Scalar, Scalar]
 
 
 @dataclass(frozen=True)
 class Joint:
-    """The placement of a body's frame in its parent's.
+    """A joint: the child body's frame relative to its parent's.
 
     Attributes
     ----------
     name : str
+    kind : {"revolute", "universal", "spherical", "fixed"}
     parent : str
-        The parent body's name, or :data:`ROOT`.
-    child : str
-        The body the joint places.
-    origin : tuple of 3 Scalar
-        The child frame's origin in the parent's frame [m].
-    rotations : tuple of ((float, float, float), Scalar)
-        The child frame's orientation: the rotations, in order, each about a unit axis of the
-        frame as rotated so far (parent first) by an angle [rad].
+        The parent body's name, or the root's.
+    origin_m : tuple (3,)
+        The joint's (and the child frame's) origin in the parent's frame [m].
+    axes : tuple of tuple (3,)
+        One unit axis per coordinate (:data:`JOINT_AXES`), each in the frame left by the
+        rotations about the axes before it (the first in the parent's frame).
+    coordinates : tuple of str
+        The joint's angles [rad], one per axis, named uniquely in the tree.
     """
 
     name: str
+    kind: str
     parent: str
-    child: str
-    origin: tuple = (0.0, 0.0, 0.0)
-    rotations: tuple = ()
+    origin_m: Vector = (0.0, 0.0, 0.0)
+    axes: tuple[Vector, ...] = ()
+    coordinates: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
 class Body:
-    """A rigid body in its own frame.
+    """A rigid body hanging from its joint.
 
     Attributes
     ----------
     name : str
-    mass : Scalar
-        [kg].
-    com : tuple of 3 Scalar
+    mass_kg : Scalar
+    inertia_kg_m2 : tuple (3, 3)
+        Inertia tensor about the centre of mass, in the body's frame [kg m^2] (symmetric).
+    com_m : tuple (3,)
         Centre of mass in the body's frame [m].
-    inertia : tuple of 3 tuples of 3 Scalar
-        Inertia about the centre of mass in the body's frame [kg m^2] (symmetric).
+    joint : Joint
+        The joint the body hangs from (its parent: the root or an earlier body).
     """
 
     name: str
-    mass: Scalar
-    com: tuple = (0.0, 0.0, 0.0)
-    inertia: tuple = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    mass_kg: Scalar
+    inertia_kg_m2: tuple[Vector, Vector, Vector]
+    com_m: Vector
+    joint: Joint
 
 
 @dataclass(frozen=True)
-class Point:
-    """A named point on a body (a foot's contact point, the hip) in the body's frame [m]."""
+class ContactPoint:
+    """A named point (a foot) at ``point_m`` (3,) [m] in the frame of ``body``."""
 
     name: str
     body: str
-    offset: tuple = (0.0, 0.0, 0.0)
+    point_m: Vector
+
+
+@dataclass(frozen=True)
+class Root:
+    """The stance foot on the slope: the slope's frame (:mod:`walkerlab.codegen.frames`)
+    with its origin at the contact point ``stance_contact`` (a :class:`ContactPoint`'s name),
+    the slope ``slope_rad`` [rad] and gravity ``gravity_m_per_s2`` (along world ``-y``)."""
+
+    name: str = "slope"
+    slope_rad: Scalar = "gamma"
+    gravity_m_per_s2: Scalar = "g"
+    stance_contact: str = "stance_foot"
+
+
+ZERO_INERTIA: tuple[Vector, Vector, Vector] = ((0, 0, 0), (0, 0, 0), (0, 0, 0))
+
+
+def diagonal(ixx: Scalar, iyy: Scalar, izz: Scalar) -> tuple[Vector, Vector, Vector]:
+    """A diagonal inertia tensor (3, 3) [kg m^2] in a body's principal axes."""
+    return ((ixx, 0, 0), (0, iyy, 0), (0, 0, izz))
 
 
 @dataclass(frozen=True)
 class BodyTree:
-    """Bodies, the joints that place them, and named points, for coordinates ``q``.
+    """A walker's bodies, joints and contact points (module docstring).
 
     Attributes
     ----------
-    coordinates : tuple of str
-        The generalised coordinates' names (in the state's order).
     params : tuple of str
-        The parameters' names the expressions read (``gamma`` the slope [rad], ``g``
-        gravity [m/s^2] among them).
-    bodies, joints, points : tuple
-        :class:`Body`, :class:`Joint` (parents before children), :class:`Point`.
+        Parameter names the numbers may use (the generated code's parameter vector, in
+        order).
+    root : Root
+    bodies : tuple of Body
+        In Featherstone's regular numbering: each body's joint's parent is the root or a
+        body before it.
+    contacts : tuple of ContactPoint
+
+    Raises
+    ------
+    ValueError
+        On construction, one line naming the field (``tree.bodies[2].joint.axes: ...``):
+        a duplicate name, a parent not yet defined, a joint's axes or coordinates that do
+        not match its kind, an axis not of unit length, an inertia not symmetric, a negative
+        mass, a number that is neither a float nor an expression in ``params``, a contact on
+        no body, the root's stance contact missing.
     """
 
-    coordinates: tuple
-    params: tuple
-    bodies: tuple
-    joints: tuple
-    points: tuple = field(default=())
+    params: tuple[str, ...]
+    root: Root
+    bodies: tuple[Body, ...]
+    contacts: tuple[ContactPoint, ...] = field(default=())
 
     def __post_init__(self):
-        names = {b.name for b in self.bodies}
-        placed = set()
-        for j in self.joints:
-            if j.parent != ROOT and j.parent not in placed:
-                raise ValueError(f"joint {j.name}: parent {j.parent!r} is not placed before it")
-            if j.child not in names:
-                raise ValueError(f"joint {j.name}: child {j.child!r} is not a body of the tree")
-            if j.child in placed:
-                raise ValueError(f"joint {j.name}: body {j.child!r} hangs on two joints")
-            placed.add(j.child)
-        for b in self.bodies:
-            if b.name not in placed:
-                raise ValueError(f"body {b.name}: no joint places it")
-            rows = b.inertia
-            if len(rows) != 3 or any(len(r) != 3 for r in rows) or any(
-                    rows[i][k] != rows[k][i] for i in range(3) for k in range(3)):
-                raise ValueError(f"body {b.name}: inertia must be a symmetric 3x3")
-        for p in self.points:
-            if p.body not in names:
-                raise ValueError(f"point {p.name}: body {p.body!r} is not in the tree")
+        _validate(self)
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        """Every joint's coordinates, in body order."""
+        return tuple(c for b in self.bodies for c in b.joint.coordinates)
 
     def body(self, name: str) -> Body:
-        """The body called ``name``."""
-        return next(b for b in self.bodies if b.name == name)
+        """The body called ``name`` (KeyError if there is none)."""
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+    def contact(self, name: str) -> ContactPoint:
+        """The contact point called ``name`` (KeyError if there is none)."""
+        for c in self.contacts:
+            if c.name == name:
+                return c
+        raise KeyError(name)
 
 
-_X, _Z = (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)
+def _check_scalar(value, where: str, params: frozenset) -> float | None:
+    """``value``'s float if it is a number, None if an expression in ``params``; else
+    ValueError naming ``where``."""
+    if isinstance(value, bool):
+        raise ValueError(f"{where}: {value!r} is not a number")
+    if isinstance(value, int | float):
+        if not math.isfinite(value):
+            raise ValueError(f"{where}: {value!r} is not finite")
+        return float(value)
+    if not isinstance(value, str):
+        raise ValueError(f"{where}: {value!r} is neither a number nor an expression")
+    try:
+        tree = ast.parse(value, mode="eval")
+    except SyntaxError:
+        raise ValueError(f"{where}: {value!r} is not an expression") from None
+    unknown = sorted({n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+                     - params - FUNCTIONS)
+    if unknown:
+        raise ValueError(f"{where}: {value!r} uses {', '.join(unknown)}, not among the "
+                         "tree's params")
+    return None
 
 
-def compass_3d_tree(hip_roll: bool = False, leg_rod: bool = False) -> BodyTree:
-    """The straight-legged walker with hip width in three dimensions (Kuo 1999, "Stabilization
-    of lateral motion in passive dynamic walking", IJRR 18(9); the point-footed walker of
-    :func:`walkerlab.codegen.derive_3d.derive_compass`) as a body tree.
+def _check_vector(value, where: str, params: frozenset) -> tuple:
+    if not isinstance(value, tuple | list) or len(value) != 3:
+        raise ValueError(f"{where}: expected 3 components, got {value!r}")
+    return tuple(_check_scalar(v, f"{where}[{i}]", params) for i, v in enumerate(value))
 
-    The stance leg turns about the stance foot by the lean (roll about the fall line) and
-    its pitch ``q_stance + gamma`` about the rolled ``z``; the pelvis hangs at its hip with
-    the pitch undone (and, with ``hip_roll``, rolled to ``q_pelvis_roll``), a point mass
-    ``M_hip`` halfway to the swing hip ``w_hip`` along its ``z``; the swing leg hangs at the
-    swing hip by its own pitch (and roll).  Each leg carries ``m_leg`` at ``a_leg`` from its
-    foot, and with ``leg_rod`` the inertia ``I_leg`` about every axis normal to it.
 
-    Parameters
+def _check_joint(j: Joint, where: str, params: frozenset, known: set, coords: set):
+    if j.kind not in JOINT_AXES:
+        raise ValueError(f"{where}.kind: {j.kind!r} is not one of {', '.join(JOINT_AXES)}")
+    if j.parent not in known:
+        raise ValueError(f"{where}.parent: {j.parent!r} is neither the root nor a body "
+                         "listed before")
+    _check_vector(j.origin_m, f"{where}.origin_m", params)
+    k = JOINT_AXES[j.kind]
+    if len(j.axes) != k:
+        raise ValueError(f"{where}.axes: a {j.kind} joint has {k} axes, got {len(j.axes)}")
+    if len(j.coordinates) != k:
+        raise ValueError(f"{where}.coordinates: a {j.kind} joint has {k} coordinates, got "
+                         f"{len(j.coordinates)}")
+    for i, axis in enumerate(j.axes):
+        vals = _check_vector(axis, f"{where}.axes[{i}]", params)
+        if None not in vals and abs(math.fsum(v * v for v in vals) - 1.0) > 1e-12:
+            raise ValueError(f"{where}.axes[{i}]: {axis!r} is not a unit vector")
+    for c in j.coordinates:
+        if not isinstance(c, str) or not c.isidentifier():
+            raise ValueError(f"{where}.coordinates: {c!r} is not a name")
+        if c in coords or c in params:
+            raise ValueError(f"{where}.coordinates: {c!r} is already a coordinate or a "
+                             "parameter")
+        coords.add(c)
+
+
+def _validate(tree: BodyTree):
+    params = frozenset(tree.params)
+    if len(params) != len(tree.params):
+        raise ValueError("tree.params: a name is listed twice")
+    r = tree.root
+    _check_scalar(r.slope_rad, "tree.root.slope_rad", params)
+    _check_scalar(r.gravity_m_per_s2, "tree.root.gravity_m_per_s2", params)
+    known, coords = {r.name}, set()
+    for i, b in enumerate(tree.bodies):
+        where = f"tree.bodies[{i}]"
+        if not isinstance(b, Body):
+            raise ValueError(f"{where}: not a Body")
+        if b.name in known:
+            raise ValueError(f"{where}.name: {b.name!r} is already a body or the root")
+        mass = _check_scalar(b.mass_kg, f"{where}.mass_kg", params)
+        if mass is not None and mass < 0:
+            raise ValueError(f"{where}.mass_kg: {b.mass_kg!r} is negative")
+        _check_vector(b.com_m, f"{where}.com_m", params)
+        inertia = b.inertia_kg_m2
+        if not isinstance(inertia, tuple | list) or len(inertia) != 3:
+            raise ValueError(f"{where}.inertia_kg_m2: expected 3 rows, got {inertia!r}")
+        for k, row in enumerate(inertia):
+            _check_vector(row, f"{where}.inertia_kg_m2[{k}]", params)
+        for k in range(3):
+            for m in range(k):
+                if inertia[k][m] != inertia[m][k]:
+                    raise ValueError(f"{where}.inertia_kg_m2: not symmetric ([{k}][{m}] "
+                                     f"{inertia[k][m]!r} != [{m}][{k}] {inertia[m][k]!r})")
+        _check_joint(b.joint, f"{where}.joint", params, known, coords)
+        known.add(b.name)
+    names = set()
+    for i, c in enumerate(tree.contacts):
+        where = f"tree.contacts[{i}]"
+        if c.name in names:
+            raise ValueError(f"{where}.name: {c.name!r} is listed twice")
+        names.add(c.name)
+        if c.body not in known - {r.name}:
+            raise ValueError(f"{where}.body: {c.body!r} is not a body of the tree")
+        _check_vector(c.point_m, f"{where}.point_m", params)
+    if r.stance_contact not in names:
+        raise ValueError(f"tree.root.stance_contact: {r.stance_contact!r} is not a contact "
+                         "point of the tree")
+
+
+@dataclass(frozen=True)
+class CoordinateMap:
+    """A walker's coordinates and every joint coordinate of its tree as an expression of them
+    (affine: a sum of coordinates and parameters), so that a tree derives in the coordinates
+    a walker already has (the absolute leg angles of :mod:`walkerlab.codegen.derive_3d`,
+    say) rather than in its joints' relative angles.
+
+    Attributes
     ----------
-    hip_roll : bool
-        Hip-roll joints: coordinates ``q_pelvis_roll``, ``q_swing_roll`` and the pelvis'
-        inertia ``I_pelvis`` about the fall line.
-    leg_rod : bool
-        Each leg a slender rod about its mass point (``I_leg`` [kg m^2]).
+    names : tuple of str
+        The walker's coordinates (its roles), in order.
+    joint_angles : tuple of (str, str)
+        ``(joint coordinate, expression)`` for every joint coordinate of the tree; the
+        expression uses ``names``, the tree's params and the functions of :data:`FUNCTIONS`
+        (``"0"`` holds a joint coordinate still).
 
-    Returns
-    -------
-    BodyTree
-        Coordinates ``q_lean, q_swing, q_stance`` (and the two rolls); parameters ``g, L,
-        gamma, M_hip, m_leg, a_leg, w_hip`` (and ``I_pelvis``, ``I_leg``); points
-        ``stance_foot``, ``swing_foot``, ``stance_hip``, ``swing_hip``, ``hip``.
+    Raises
+    ------
+    ValueError
+        From :meth:`check`: a joint coordinate unmapped or mapped twice, a name not a
+        coordinate of the tree, an expression with an unknown name.
     """
-    q = ("q_lean", "q_swing", "q_stance") + (("q_pelvis_roll", "q_swing_roll") if hip_roll
-                                             else ())
-    params = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg", "w_hip") + (
-        ("I_pelvis",) if hip_roll else ()) + (("I_leg",) if leg_rod else ())
-    rod = (("I_leg", 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, "I_leg")) if leg_rod else None
-    zero = ((0.0,) * 3,) * 3
-    pelvis_roll = ((_X, "q_pelvis_roll - q_lean"),) if hip_roll else ()
-    swing_roll = ((_X, "q_swing_roll - q_pelvis_roll"),) if hip_roll else ()
-    bodies = (
-        Body("stance_leg", "m_leg", (0.0, "a_leg", 0.0), rod or zero),
-        Body("pelvis", "M_hip", (0.0, 0.0, "w_hip/2"),
-             (("I_pelvis", 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)) if hip_roll else zero),
-        Body("swing_leg", "m_leg", (0.0, "a_leg - L", 0.0), rod or zero),
-    )
-    joints = (
-        Joint("stance_ankle", ROOT, "stance_leg", (0.0, 0.0, 0.0),
-              ((_X, "q_lean"), (_Z, "q_stance + gamma"))),
-        Joint("stance_hip", "stance_leg", "pelvis", (0.0, "L", 0.0),
-              ((_Z, "-(q_stance + gamma)"),) + pelvis_roll),
-        Joint("swing_hip", "pelvis", "swing_leg", (0.0, 0.0, "w_hip"),
-              swing_roll + ((_Z, "q_swing + gamma"),)),
-    )
-    points = (Point("stance_foot", "stance_leg"), Point("stance_hip", "stance_leg", (0, "L", 0)),
-              Point("hip", "pelvis", (0.0, 0.0, "w_hip/2")),
-              Point("swing_hip", "swing_leg"), Point("swing_foot", "swing_leg", (0, "-L", 0)))
-    return BodyTree(q, params, bodies, joints, points)
+
+    names: tuple[str, ...]
+    joint_angles: tuple[tuple[str, str], ...]
+
+    @classmethod
+    def identity(cls, tree: BodyTree) -> CoordinateMap:
+        """The joints' own coordinates as the walker's."""
+        return cls(tree.coordinates, tuple((c, c) for c in tree.coordinates))
+
+    def check(self, tree: BodyTree) -> None:
+        """Raise ValueError (naming the field) unless this map fits ``tree``."""
+        params = frozenset(tree.params)
+        if len(set(self.names)) != len(self.names):
+            raise ValueError("coordinates.names: a name is listed twice")
+        clash = sorted(set(self.names) & params)
+        if clash:
+            raise ValueError(f"coordinates.names: {', '.join(clash)} also a parameter")
+        mapped = [c for c, _ in self.joint_angles]
+        missing = sorted(set(tree.coordinates) - set(mapped))
+        if missing:
+            raise ValueError(f"coordinates.joint_angles: no expression for {', '.join(missing)}")
+        extra = sorted(set(mapped) - set(tree.coordinates))
+        if extra or len(set(mapped)) != len(mapped):
+            raise ValueError("coordinates.joint_angles: "
+                             + (f"{', '.join(extra)} not a joint coordinate of the tree"
+                                if extra else "a joint coordinate is mapped twice"))
+        known = params | frozenset(self.names)
+        for c, expr in self.joint_angles:
+            _check_scalar(expr, f"coordinates.joint_angles[{c}]", known)
