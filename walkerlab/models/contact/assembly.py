@@ -1,0 +1,395 @@
+"""The compliant-contact walker's assembly: contact geometry (points, their velocities and
+Jacobians, the mass matrix and bias) in, forces and accelerations out; numba, on arrays.
+
+Internal module.  Everything is SI.  These kernels do the walker-independent work of a
+compliant-contact walker's compiled model with the laws of
+:mod:`walkerlab.models.contact._kernels` (IMPACT normal force, ADAMS Coulomb friction, patch
+membership): the contact of each point from its position and material velocity
+(:func:`point`), the generalised forces ``Q = J^T F - h`` with the knee stops and latch
+(:func:`contact_forces`, :func:`knee`), the solve of ``M qdd = Q - h`` (:func:`chol`,
+:func:`chol_solve`), the analytic Jacobian's assembly (:func:`jac_assembly`), the pinned
+stance foot's reduced dynamics (:func:`pinned_dynamics`) and the per-point and per-knee
+tables.  They take arrays only (no compiled function is an argument: numba's disk cache
+keys a function on its arguments' types); the generated module of each walker structure
+(:func:`walkerlab.models.contact.generated.contact_source`) calls its generated kinematics
+(``dyn``, ``feet``, ``feet_jac``) and hands their arrays to these kernels
+(:mod:`walkerlab.codegen.contact_glue`).
+
+Shapes: ``nq`` generalised coordinates, ``nf`` contact points; ``P``, ``V`` (nf, 2) the
+points' positions [m] and material velocities [m/s], ``J`` (nf, 2, nq) their Jacobians,
+``point_leg`` (nf,) each point's leg (0: leg1, on lane ``c1``; 1: leg2, on ``c2``), ``info``
+(nf, 12) each point's :func:`point` result, ``knees`` (2, 5) each knee's :func:`knee` result.
+The contact parameter vector ``PC`` is read through the named indices ``I_*``
+(:mod:`walkerlab.models.contact.generated`'s table).
+"""
+
+from __future__ import annotations
+
+from math import cos as _cos
+from math import sin as _sin
+
+import numpy as np
+from numba import njit
+
+from walkerlab.models.contact._kernels import (
+    friction_mu,
+    ground_line,
+    normal_force,
+    patch_height,
+    step,
+)
+
+I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
+I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
+I_KK, I_KE, I_KC, I_KD, I_KL, I_KF, I_KA = 11, 12, 13, 14, 15, 16, 17
+#: Number of contact parameters.
+NPC = 18
+#: The packed data vector's head: ``[n1, n2, PC (NPC), p, ...]``.
+D_N1, D_N2, D_PC = 0, 1, 2
+D_P = D_PC + NPC
+
+
+@njit(cache=True)
+def chol(M):
+    """Lower Cholesky factor of the SPD matrix M (NQ, NQ)."""
+    n = M.shape[0]
+    L = np.zeros((n, n))
+    for j in range(n):
+        s = M[j, j]
+        for k in range(j):
+            s -= L[j, k] * L[j, k]
+        d = np.sqrt(s)
+        L[j, j] = d
+        for i in range(j + 1, n):
+            s = M[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            L[i, j] = s / d
+    return L
+
+
+@njit(cache=True)
+def chol_solve(L, B):
+    """Solve (L L^T) X = B, B (n, m), in place of a copy."""
+    n, m = B.shape
+    X = B.copy()
+    for c in range(m):
+        for i in range(n):
+            s = X[i, c]
+            for k in range(i):
+                s -= L[i, k] * X[k, c]
+            X[i, c] = s / L[i, i]
+        for i in range(n - 1, -1, -1):
+            s = X[i, c]
+            for k in range(i + 1, n):
+                s -= L[k, i] * X[k, c]
+            X[i, c] = s / L[i, i]
+    return X
+
+
+@njit(cache=True)
+def slope(PC):
+    """The slope's (sin phi, cos phi)."""
+    return _sin(PC[I_PHI]), _cos(PC[I_PHI])
+
+
+@njit(cache=True)
+def point(px, py, vx, vy, sp, cp, PC, cen):
+    """Contact of a point at (px, py) [m] whose material velocity is (vx, vy) [m/s] on the
+    lane ``cen``, the slope's (sin, cos) = (sp, cp): (delta, ddot, vt, s, Fn, Ff, dFn/ddelta,
+    dFn/dddot, mu, dmu/dvt, nx, ny), (nx, ny) the ground's outward normal there (the
+    friction acts along (ny, -nx)).  The one contact kernel of the right-hand side, the
+    Jacobian, the pinned dynamics and the tables (one compile).  On a polyline ground
+    (``PC[I_CONT] == 2``: ``cen`` its vertices, :func:`ground_line`) the penetration and
+    normal are the nearest segment's."""
+    if PC[I_CONT] > 1.5:
+        return on_line(px, py, vx, vy, sp, cp, PC, cen)
+    delta = -(px * sp + py * cp)
+    ddot = -(vx * sp + vy * cp)
+    vt = vx * cp - vy * sp
+    s = px * cp - py * sp
+    fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
+    # a patch at height hp: penetration below its top (cen[-1], the lane's highest patch,
+    # skips the lookup for a foot above every patch; all heights 0: the flat ground)
+    hp = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5) if delta + cen[-1] > 0.0 else np.nan
+    if hp == hp:
+        delta += hp
+    if delta > 0.0 and hp == hp:
+        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
+        if fn > 0.0:
+            mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
+    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, sp, cp
+
+
+@njit(cache=True)
+def on_line(px, py, vx, vy, sp, cp, PC, line):
+    """:func:`point` on the polyline ground ``line`` (stairs' treads and risers): the
+    IMPACT and Coulomb laws on the penetration into the nearest segment, along its normal."""
+    delta, nx, ny = ground_line(px, py, line)
+    ddot = -(vx * nx + vy * ny)
+    vt = vx * ny - vy * nx
+    s = px * cp - py * sp
+    fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
+    if delta > 0.0:
+        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
+        if fn > 0.0:
+            mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
+    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, nx, ny
+
+
+@njit(cache=True)
+def latch_weight(delta, ext, PC):
+    """Latch engagement in [0, 1] of a knee at extension ext [rad] (< 0 flexed) whose foot
+    has the penetration delta [m] (< 0: above the ground)."""
+    if PC[I_KL] < 0.5:
+        return 0.0
+    return (step(delta, -PC[I_KF], 0.0, 0.0, 1.0)[0]
+            * step(ext, -PC[I_KA], 0.0, -0.5 * PC[I_KA], 1.0)[0])
+
+
+@njit(cache=True)
+def knee(x, k, PC, delta, nq):
+    """Knee stop (and latch, its foot at penetration delta [m]) of knee k of the state
+    ``x`` (``nq`` coordinates, then their rates): (extension, rate, torque, dT/dext,
+    dT/drate)."""
+    t, s = 2 + 2 * k, 3 + 2 * k
+    ext = x[s] - x[t]
+    rate = x[nq + s] - x[nq + t]
+    if ext < 0.0:
+        w = latch_weight(delta, ext, PC)
+        if w <= 0.0:
+            return ext, rate, 0.0, 0.0, 0.0
+        T, dd, dr = normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])
+        return ext, rate, -w * T, w * dd, w * dr
+    if ext == 0.0:
+        return ext, rate, 0.0, 0.0, 0.0
+    T, dd, dr = normal_force(ext, rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])
+    return ext, rate, T, dd, dr
+
+
+@njit(cache=True)
+def knee_torque(ext, rate, PC, delta):
+    """Knee-stop torque [N m] (>= 0 past straight) at hyperextension ``ext`` [rad], rate
+    [rad/s]; with the latch on and the leg's foot at penetration delta [m] (near or on the
+    ground), also < 0 in flexion."""
+    if ext < 0.0:
+        w = latch_weight(delta, ext, PC)
+        if w <= 0.0:
+            return 0.0
+        return -w * normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
+    if ext == 0.0:
+        return 0.0
+    return normal_force(ext, rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
+
+
+@njit(cache=True)
+def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg,
+                   has_knees):
+    """Q - h (nq,) from the bias ``h`` (nq,) with the contact forces of the points of the
+    legs used (``use1``, ``use2``) and, ``has_knees``, the knee stops (knee k's foot: point
+    k); fills ``info`` and ``knees``."""
+    nq = h.shape[0]
+    Q = -h
+    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
+    for i in range(P.shape[0]):
+        leg = point_leg[i]
+        if not ((leg == 0 and use1) or (leg == 1 and use2)):
+            continue
+        res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, c1 if leg == 0 else c2)
+        for k in range(12):
+            info[i, k] = res[k]
+        fn, ff = res[4], res[5]
+        if fn > 0.0:
+            nx, ny = res[10], res[11]  # the ground's normal (the slope's: sp, cp)
+            Fx = fn * nx + ff * ny
+            Fy = fn * ny - ff * nx
+            for k in range(nq):
+                Q[k] += J[i, 0, k] * Fx + J[i, 1, k] * Fy
+    if has_knees:
+        for k in range(2):
+            used = (k == 0 and use1) or (k == 1 and use2)
+            res = knee(x, k, PC, info[k, 0] if used else np.inf, nq)  # pinned: on the ground
+            for j in range(5):
+                knees[k, j] = res[j]
+            T = res[2]
+            Q[2 + 2 * k] += T
+            Q[3 + 2 * k] -= T
+    return Q
+
+
+@njit(cache=True)
+def buffers(nq, nf):
+    """The arrays :func:`contact_forces` and the kinematics fill: M (nq, nq), the points'
+    P, V (nf, 2), J (nf, 2, nq), their info (nf, 12) and the knees' (2, 5)."""
+    return (np.empty((nq, nq)), np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, nq)),
+            np.zeros((nf, 12)), np.zeros((2, 5)))
+
+
+@njit(cache=True)
+def point_buffers(nq, nf):
+    """The points' P, V (nf, 2) and J (nf, 2, nq), to be filled by the kinematics."""
+    return np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, nq))
+
+
+@njit(cache=True)
+def world_forces(info):
+    """(nf, 2) each point's contact force [N] in the world from its ``info`` row."""
+    F = np.zeros((info.shape[0], 2))
+    for i in range(info.shape[0]):
+        fn, ff = info[i, 4], info[i, 5]
+        if fn > 0.0:
+            sp, cp = info[i, 10], info[i, 11]  # the ground's normal at the point
+            F[i, 0] = fn * sp + ff * cp
+            F[i, 1] = fn * cp - ff * sp
+    return F
+
+
+@njit(cache=True)
+def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
+    """d rhs / dx (2 nq, 2 nq) from the Cholesky factor ``L`` of M, the partials ``Dq``,
+    ``Dv`` (nq, nq) of ``M a + h`` at the acceleration ``a``, ``dJtF`` (nq, nq) of ``J^T F``
+    at the forces held, the points' Jacobians ``J`` and their rates' partials ``dV``
+    (nf, 2, nq); patch membership and each point's normal locally constant."""
+    nq = L.shape[0]
+    B = np.empty((nq, 2 * nq))
+    for r in range(nq):
+        for k in range(nq):
+            B[r, k] = dJtF[r, k] - Dq[r, k]
+            B[r, nq + k] = -Dv[r, k]
+    for i in range(info.shape[0]):
+        fn = info[i, 4]
+        if fn <= 0.0:
+            continue
+        dfd, dfdd, mu, dmu = info[i, 6], info[i, 7], info[i, 8], info[i, 9]
+        sp, cp = info[i, 10], info[i, 11]  # the normal, locally constant
+        dFx = np.empty(2 * nq)
+        dFy = np.empty(2 * nq)
+        for k in range(nq):
+            d_delta = -(sp * J[i, 0, k] + cp * J[i, 1, k])  # = d ddot / d dq_k
+            d_ddot = -(sp * dV[i, 0, k] + cp * dV[i, 1, k])
+            d_vt_q = cp * dV[i, 0, k] - sp * dV[i, 1, k]
+            d_vt_v = cp * J[i, 0, k] - sp * J[i, 1, k]
+            dfn_q = dfd * d_delta + dfdd * d_ddot
+            dfn_v = dfdd * d_delta
+            dff_q = mu * dfn_q + fn * dmu * d_vt_q
+            dff_v = mu * dfn_v + fn * dmu * d_vt_v
+            dFx[k] = sp * dfn_q + cp * dff_q
+            dFy[k] = cp * dfn_q - sp * dff_q
+            dFx[nq + k] = sp * dfn_v + cp * dff_v
+            dFy[nq + k] = cp * dfn_v - sp * dff_v
+        for r in range(nq):
+            for k in range(2 * nq):
+                B[r, k] += J[i, 0, r] * dFx[k] + J[i, 1, r] * dFy[k]
+    if has_knees:
+        for kk in range(2):
+            t, s = 2 + 2 * kk, 3 + 2 * kk
+            dd, dr = knees[kk, 3], knees[kk, 4]
+            # Q[t] += T, Q[s] -= T with T(ext = q_s - q_t, rate = dq_s - dq_t)
+            for off, d in ((0, dd), (nq, dr)):
+                B[t, off + s] += d
+                B[t, off + t] -= d
+                B[s, off + s] -= d
+                B[s, off + t] += d
+    X = chol_solve(L, B)
+    nx = 2 * nq
+    out = np.zeros((nx, nx))
+    for k in range(nq):
+        out[k, nq + k] = 1.0
+        for c in range(nx):
+            out[nq + k, c] = X[k, c]
+    return out
+
+
+@njit(cache=True)
+def pinned_angles(z, nq):
+    """The state (2 nq,) with the link angles and rates ``z`` (2 (nq - 2),), the hip at the
+    origin and at rest."""
+    x = np.zeros(2 * nq)
+    for k in range(nq - 2):
+        x[2 + k] = z[k]
+        x[nq + 2 + k] = z[nq - 2 + k]
+    return x
+
+
+@njit(cache=True)
+def pin_at(x, P, V, pin, foot2):
+    """Move the state ``x`` of :func:`pinned_angles` (its points at ``P``, ``V``) so that
+    its point ``pin`` is at ``foot2`` (2,) and at rest."""
+    nq = x.shape[0] // 2
+    x[0] = foot2[0] - P[pin, 0]
+    x[1] = foot2[1] - P[pin, 1]
+    x[nq] = -V[pin, 0]
+    x[nq + 1] = -V[pin, 1]
+
+
+@njit(cache=True)
+def pinned_dynamics(z, x, Q, M, J, dV, pin):
+    """dz/dt of the reduced dynamics with point ``pin`` held: ``q = Phi(z)``,
+    ``dq = Jp dz``, ``qdd = Jp zdd + gam``; ``Jp^T M Jp zdd = Jp^T (Q - h - M gam)``, from
+    the full state ``x``, its ``Q - h``, ``M`` and the points' ``J``, ``dV``."""
+    nq = M.shape[0]
+    m = nq - 2
+    Jp = np.zeros((nq, m))
+    for k in range(m):
+        Jp[0, k] = -J[pin, 0, 2 + k]
+        Jp[1, k] = -J[pin, 1, 2 + k]
+        Jp[2 + k, k] = 1.0
+    gam = np.zeros(nq)
+    for r in range(2):
+        s = 0.0
+        for k in range(nq):
+            s += dV[pin, r, k] * x[nq + k]
+        gam[r] = -s
+    rhs_q = Q.copy()
+    for i in range(nq):
+        for k in range(nq):
+            rhs_q[i] -= M[i, k] * gam[k]
+    MJ = np.zeros((nq, m))
+    for i in range(nq):
+        for c in range(m):
+            for k in range(nq):
+                MJ[i, c] += M[i, k] * Jp[k, c]
+    r = np.zeros(m)
+    Mr = np.zeros((m, m))
+    for a in range(m):
+        for i in range(nq):
+            r[a] += Jp[i, a] * rhs_q[i]
+            for c in range(m):
+                Mr[a, c] += Jp[i, a] * MJ[i, c]
+    zdd = chol_solve(chol(Mr), r.reshape((m, 1)))[:, 0]
+    out = np.empty(2 * m)
+    for k in range(m):
+        out[k] = z[m + k]
+        out[m + k] = zdd[k]
+    return out
+
+
+@njit(cache=True)
+def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out):
+    """One row of the contact table into ``out`` (nf, 8): per point penetration [m], its
+    rate [m/s], slip velocity [m/s], s [m], Fn [N], Ff [N], power F . v [W], on_ground."""
+    for i in range(P.shape[0]):
+        cen = c1 if point_leg[i] == 0 else c2
+        res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
+        fn, ff = res[4], res[5]
+        Fx = fn * res[10] + ff * res[11]
+        Fy = fn * res[11] - ff * res[10]
+        for k in range(6):
+            out[i, k] = res[k]
+        out[i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
+        hq = patch_height(res[3], cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
+        out[i, 7] = 1.0 if hq == hq else 0.0
+
+
+@njit(cache=True)
+def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out):
+    """One row of the knee table into ``out`` (2, 4): per knee extension [rad], its rate
+    [rad/s], stop torque [N m] and the stop's power [W] (knee k's foot: point k) of the
+    state ``x`` (``nq`` coordinates, then their rates)."""
+    for k in range(2):
+        delta = point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC, c1 if k == 0 else c2)[0]
+        ext, rate, T, _, _ = knee(x, k, PC, delta, nq)
+        out[k, 0] = ext
+        out[k, 1] = rate
+        out[k, 2] = T
+        out[k, 3] = -T * rate
