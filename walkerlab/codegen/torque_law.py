@@ -165,8 +165,10 @@ def law_torque(b, i, delta, ddelta, s, ds, t):
     """Actuator ``i``'s torque [N m] of the law block ``b`` and its partial derivatives
     ``(tau, dtau/ddelta, dtau/dddelta, dtau/ds, dtau/dds)``: ``delta``, ``ddelta`` the joint
     angle [rad] and rate [rad/s], ``s``, ``ds`` the phase variable [rad] and its rate
-    [rad/s], ``t`` the time [s] (the step began at ``b[2]``).  Plain Python on floats and
-    numba-compilable as it is (:func:`kernel_source`)."""
+    [rad/s], ``t`` the time [s] (the step began at ``b[2]``).  Plain Python on floats,
+    callable from numba code as it is (``register_jitable``: the contact actuators'
+    :mod:`walkerlab.models.contact.powered_kernels`) and copied into generated modules
+    (:func:`kernel_source`)."""
     h = 3 + HEAD * i
     kind, c0, K, D = b[h], b[h + 1], b[h + 2], b[h + 3]
     g_s, g_ds = 0.0, 0.0

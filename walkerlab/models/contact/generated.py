@@ -1,13 +1,19 @@
 """The compliant-contact walker's compiled kernels, generated per walker structure.
 
 The generated module is the floating view of the walker (:mod:`walkerlab.codegen.floating`:
-``dyn``, ``dyn_jac``, ``feet``, ``feet_jac``, numba) followed by :data:`ASSEMBLY`, the
-walker-independent code that turns contact geometry into forces with the laws of
-:mod:`walkerlab.models.contact._kernels` (IMPACT normal force, ADAMS Coulomb friction, patch
-membership) and solves ``M qdd = Q - h`` (no mechanics is written by hand here: every
-position, velocity, Jacobian, mass matrix and bias comes from the generator).  It is cached
-on disk next to the rigid models' code (:func:`walkerlab.codegen.cache.cache_dir`), keyed on
-the structure, the generators and this file.
+``dyn``, ``dyn_jac``, ``feet``, ``feet_jac``, numba), the straight-line right-hand sides
+``rhs`` and ``rhs_q`` (:mod:`walkerlab.models.contact.rhs_lines`) and a few lines of glue
+(:mod:`walkerlab.codegen.contact_glue`) that hand the generated positions, velocities,
+Jacobians, mass matrix and bias, as arrays, to the walker-independent kernels of two
+ordinary numba modules: :mod:`walkerlab.models.contact.assembly` (contact geometry into
+forces with the laws of :mod:`walkerlab.models.contact._kernels` - IMPACT normal force,
+ADAMS Coulomb friction, patch membership -, the knee stops and latch, ``Q = J^T F - h``,
+the solve of ``M qdd = Q - h``, the tables) and
+:mod:`walkerlab.models.contact.powered_kernels` (the actuators of
+:mod:`walkerlab.models.contact.powered_source`).  No mechanics is written by hand: every
+position, velocity, Jacobian, mass matrix and bias comes from the generator.  The module is
+cached on disk next to the rigid models' code (:func:`walkerlab.codegen.cache.cache_dir`),
+keyed on the structure, the generators, the glue and the kernels' files (``_SOURCES``).
 
 Contact parameter vector ``PC`` (float64, (NPC,)), read through named indices:
 
@@ -57,22 +63,29 @@ feet, ``('leg1_heel', 'leg1_toe', 'leg2_heel', 'leg2_toe')`` for flat feet), eac
 IMPACT and Coulomb laws on its leg's lane (``POINT_LEG``); ``PIN`` is leg2's first point
 (the point a pinned stance foot holds).
 
-Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating` for ``q``):
+The module's functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating` for
+``q``; ``rhs`` generated straight-line code, the others glue on the kernels named):
 
 =======================================  =================================================
-``rhs(x, PC, p, c1, c2)``                dx/dt (NX,)
-``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX), patch membership locally constant
+``rhs(x, PC, p, c1, c2)``                dx/dt (NX,) (``assembly.point``, ``knee_torque``)
+``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX), patch membership locally
+                                         constant (``assembly.contact_forces``,
+                                         ``jac_assembly``)
 ``rhs_pinned(z, PC, p, c1, c2, foot2)``  leg2's point PIN held at ``foot2``:
                                          ``z = [link angles, their rates]`` -> dz/dt
+                                         (``assembly.pinned_dynamics``)
 ``pinned_to_full(z, p, foot2)``          full state (NX,) of a pinned state
 ``contact_table(X, PC, p, c1, c2)``      (n, NF, 8) per point: penetration, its rate, slip
                                          velocity, s, Fn, Ff, power, on_ground
-``knee_table(X, PC, p)``                 (n, 2, 4) per knee: extension, its rate, stop torque,
-                                         power
+                                         (``assembly.contact_row``)
+``knee_table(X, PC, p, c1, c2)``         (n, 2, 4) per knee: extension, its rate, stop
+                                         torque, power (``assembly.knee_row``)
 ``rhs_packed(y, d, dy)``                 rhs from the packed data vector, counts calls
 ``powered_rhs(x, PC, p, c1, c2, ...)``   a powered walker's rhs and ledger powers (hip
                                          torque, push-off force; compiled actuation hook)
 ``build_cyrk()``, ``build_lsoda(sig)``   addresses of cfuncs of ``rhs_packed``
+``powered_packed(t, y, d, dy)``          a powered walker's rhs from the data vector
+                                         (``powered_kernels``; ``build_cyrk_powered()``)
 =======================================  =================================================
 """
 
