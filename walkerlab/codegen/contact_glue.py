@@ -102,7 +102,7 @@ def contact_table(X, PC, p, c1, c2):
     P, V, J = _asm.point_buffers(NQ, NF)
     for r in range(X.shape[0]):
         feet(X[r], p, P, V, J)
-        _asm.contact_row(P, V, sp, cp, PC, c1, c2, POINT_LEG, out[r])
+        _asm.contact_row(P, V, sp, cp, PC, c1, c2, POINT_LEG, out, r)
     return out
 
 
@@ -116,7 +116,7 @@ def knee_table(X, PC, p, c1, c2):
         P, V, J = _asm.point_buffers(NQ, NF)
         for r in range(X.shape[0]):
             feet(X[r], p, P, V, J)
-            _asm.knee_row(X[r], NQ, P, V, sp, cp, PC, c1, c2, out[r])
+            _asm.knee_row(X[r], NQ, P, V, sp, cp, PC, c1, c2, out, r)
     return out
 '''
 

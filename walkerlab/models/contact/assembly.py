@@ -365,8 +365,8 @@ def pinned_dynamics(z, x, Q, M, J, dV, pin):
 
 
 @njit(cache=True)
-def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out):
-    """One row of the contact table into ``out`` (nf, 8): per point penetration [m], its
+def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r):
+    """Row ``r`` of the contact table ``out`` (n, nf, 8): per point penetration [m], its
     rate [m/s], slip velocity [m/s], s [m], Fn [N], Ff [N], power F . v [W], on_ground."""
     for i in range(P.shape[0]):
         cen = c1 if point_leg[i] == 0 else c2
@@ -375,21 +375,21 @@ def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out):
         Fx = fn * res[10] + ff * res[11]
         Fy = fn * res[11] - ff * res[10]
         for k in range(6):
-            out[i, k] = res[k]
-        out[i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
+            out[r, i, k] = res[k]
+        out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
         hq = patch_height(res[3], cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
-        out[i, 7] = 1.0 if hq == hq else 0.0
+        out[r, i, 7] = 1.0 if hq == hq else 0.0
 
 
 @njit(cache=True)
-def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out):
-    """One row of the knee table into ``out`` (2, 4): per knee extension [rad], its rate
+def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out, r):
+    """Row ``r`` of the knee table ``out`` (n, 2, 4): per knee extension [rad], its rate
     [rad/s], stop torque [N m] and the stop's power [W] (knee k's foot: point k) of the
     state ``x`` (``nq`` coordinates, then their rates)."""
     for k in range(2):
         delta = point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC, c1 if k == 0 else c2)[0]
         ext, rate, T, _, _ = knee(x, k, PC, delta, nq)
-        out[k, 0] = ext
-        out[k, 1] = rate
-        out[k, 2] = T
-        out[k, 3] = -T * rate
+        out[r, k, 0] = ext
+        out[r, k, 1] = rate
+        out[r, k, 2] = T
+        out[r, k, 3] = -T * rate
