@@ -174,11 +174,10 @@ def test_drop_restitution_monotone_per_family_rigid_limit_near_plastic():
 
 
 def test_kernels_read_parameters_through_named_indices():
-    from walkerlab.codegen.contact_glue import contact_glue_source
+    from walkerlab.codegen.contact_glue import contact_glue
 
     for src in ((PKG / "models" / "contact" / "_kernels.py").read_text(),
-                (PKG / "models" / "contact" / "assembly.py").read_text(),
-                contact_glue_source()):
+                (PKG / "models" / "contact" / "assembly.py").read_text(), contact_glue()):
         assert not re.findall(r"\bPC?\[\d+\]", src), "bare P[number] in the contact kernels"
 
 

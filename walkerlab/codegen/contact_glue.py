@@ -1,167 +1,127 @@
-"""The per-structure glue of a compliant-contact walker's generated module: the structure's
-generated functions (``dyn``, ``dyn_jac``, ``feet``, ``feet_jac`` of
-:mod:`walkerlab.codegen.floating`) evaluated and handed to the walker-independent kernels of
-:mod:`walkerlab.models.contact.assembly`.
+"""The per-structure glue of a compliant-contact walker's generated module: short numba
+functions that call the structure's generated kinematics (``dyn``, ``dyn_jac``, ``feet``,
+``feet_jac`` of :mod:`walkerlab.codegen.floating`, and the straight-line ``rhs``,
+``rhs_q``) and hand their arrays to the walker-independent kernels of
+:mod:`walkerlab.models.contact.assembly` (contact forces, knee stops, solves, tables) and
+:mod:`walkerlab.models.contact.powered_kernels` (the actuators' forces and powers).
 
-The glue holds no arithmetic of its own: each function allocates the arrays the generated
-functions fill, calls them, and passes the arrays to a kernel (the Cholesky solve, the
-contact forces, the Jacobian's assembly, the pinned dynamics, the tables).  It must be
-generated per structure only because numba's on-disk cache cannot hold a kernel that takes
-a compiled function as an argument; the kernels themselves are an ordinary module.
-
-Generated functions (``x = [q, dq]`` (NX,)):
-
-=======================================  =================================================
-``_force(x, PC, p, c1, c2, use1, use2,   ``Q - h`` (NQ,), filling ``M`` and the points'
-M, P, V, J, info, knees)``               arrays (``assembly.contact_q``)
-``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX) (``assembly.jac_assemble``)
-``pinned_to_full(z, p, foot2)``          full state (NX,) of a pinned state
-``rhs_pinned(z, PC, p, c1, c2, foot2)``  leg2's point PIN held: dz/dt
-``contact_table(X, PC, p, c1, c2)``      (n, NF, 8) per point (``assembly.contact_row``)
-``knee_table(X, PC, p, c1, c2)``         (n, 2, 4) per knee (``assembly.knee_row``)
-``push_force(x, p, leg, F, hx, hy)``     a push-off force's generalised force and power
-``powered_rhs(x, PC, p, c1, c2, ...)``   a powered walker's rhs and ledger powers
-``packed_size(d)``, ``rhs_packed``       rhs from the packed data vector, counts calls
-``build_cyrk()``, ``build_lsoda(sig)``   addresses of cfuncs of ``rhs_packed``
-=======================================  =================================================
+The glue is text because numba needs the generated functions as globals of the functions
+that call them (a compiled function passed as an argument defeats numba's disk cache); it
+holds no arithmetic of its own beyond indexing.  :func:`contact_glue` is appended to the
+floating module by :func:`walkerlab.models.contact.generated.contact_source`, which also
+defines the constants it reads (``NQ``, ``NP``, ``NF``, ``KNEE``, ``POINT_LEG``, ``PIN``).
 """
 
 from __future__ import annotations
 
-__all__ = ["contact_glue_source"]
+__all__ = ["CYRK_POWERED_SOURCE", "contact_glue", "powered_glue"]
 
 _HEAD = '''
 # ---------------------------------------------------------------- contact assembly
-# (walkerlab.codegen.contact_glue: this structure's functions handed to the kernels of
-# walkerlab.models.contact.assembly)
+# (walker-independent kernels: walkerlab.models.contact.assembly and .powered_kernels;
+# this glue hands them the generated kinematics: walkerlab.codegen.contact_glue)
 from math import sin as _sin, cos as _cos
-from walkerlab.models.contact.assembly import (  # noqa: F401
-    I_PHI, I_K, I_E, I_CMAX, I_DMAX, I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT, I_KK, I_KE,
-    I_KC, I_KD, I_KL, I_KF, I_KA, NPC, D_N1, D_N2, D_PC, D_P, point as _point,
-    knee_torque as _knee_torque, chol as _chol, chol_solve as _chol_solve,
-    buffers as _buffers, contact_q as _contact_q, world_forces as _world_forces,
-    jac_assemble as _jac_assemble, link_state as _link_state, place_pin as _place_pin,
-    pinned_accelerations as _pinned_accelerations, contact_row as _contact_row,
-    knee_row as _knee_row, push_q as _push_q, powered_q as _powered_q,
-    powered_out as _powered_out)
+from walkerlab.models.contact import assembly as _asm
+from walkerlab.models.contact import powered_kernels as _pk
+from walkerlab.models.contact._kernels import (normal_force, friction_mu, patch_height,
+                                               step, ground_line)
+from walkerlab.models.contact.assembly import (I_PHI, I_K, I_E, I_CMAX, I_DMAX, I_MUS,
+                                               I_MUD, I_VS, I_VD, I_HW, I_CONT, I_KK, I_KE,
+                                               I_KC, I_KD, I_KL, I_KF, I_KA, NPC, D_N1,
+                                               D_N2, D_PC, D_P)
+from walkerlab.models.contact.assembly import chol as _chol, chol_solve as _chol_solve
+from walkerlab.models.contact.assembly import point as _point, knee_torque as _knee_torque
+from walkerlab.models.contact.powered_kernels import A_HEAD
+from walkerlab.codegen.torque_law import HEAD
 
 NX = 2 * NQ
 '''
 
 _FORCE = '''
+
 @njit(cache=True)
 def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
-    """Q - h (NQ,) with the contact forces of the legs' points used and the knee stops."""
+    """Q - h (NQ,) with the contact forces of the legs' points used and the knee stops;
+    fills M, the points' P, V, J, per-point ``info`` (NF, 12) and ``knees`` (2, 5)."""
     h = np.empty(NQ)
     dyn(x, p, M, h)
     feet(x, p, P, V, J)
-    return _contact_q(x, PC, c1, c2, use1, use2, h, P, V, J, info, knees, POINT_LEG, KNEE)
+    return _asm.contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees,
+                               POINT_LEG, KNEE)
 
 
 @njit(cache=True)
 def jac(x, PC, p, c1, c2):
     """Analytic d rhs / dx (NX, NX); patch membership locally constant."""
-    M, P, V, J, info, knees = _buffers(NQ, NF)
+    M, P, V, J, info, knees = _asm.buffers(NQ, NF)
     Q = _force(x, PC, p, c1, c2, True, True, M, P, V, J, info, knees)
     L = _chol(M)
     a = _chol_solve(L, Q.reshape((NQ, 1)))[:, 0]
     Dq = np.empty((NQ, NQ))
     Dv = np.empty((NQ, NQ))
     dyn_jac(x, a, p, Dq, Dv)
-    F = _world_forces(info)
     dV = np.empty((NF, 2, NQ))
     dJtF = np.empty((NQ, NQ))
-    feet_jac(x, F, p, dV, dJtF)
-    return _jac_assemble(L, J, dV, dJtF, Dq, Dv, info, knees, KNEE)
+    feet_jac(x, _asm.world_forces(info), p, dV, dJtF)
+    return _asm.jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, KNEE)
 '''
 
 _PINNED = '''
+
 @njit(cache=True)
 def pinned_to_full(z, p, foot2):
-    """Full state (NX,) with leg2's (first) contact point PIN at ``foot2`` (2,), at rest."""
-    x = _link_state(z, NQ)
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, NQ))
+    """Full state (NX,) with leg2's (first) contact point PIN at ``foot2`` (2,) and at
+    rest; ``z = [link angles (NQ - 2), their rates]``."""
+    x = _asm.pinned_angles(z, NQ)
+    P, V, J = _asm.point_buffers(NQ, NF)
     feet(x, p, P, V, J)  # hip at the origin, at rest: foot offset and velocity
-    return _place_pin(x, P, V, foot2, PIN)
+    _asm.pin_at(x, P, V, PIN, foot2)
+    return x
 
 
 @njit(cache=True)
 def rhs_pinned(z, PC, p, c1, c2, foot2):
-    """Reduced dynamics with leg2's foot pinned (leg1 keeps its contact): dz/dt."""
+    """Reduced dynamics with leg2's foot pinned (leg1 keeps its contact)."""
     x = pinned_to_full(z, p, foot2)
-    M, P, V, J, info, knees = _buffers(NQ, NF)
+    M, P, V, J, info, knees = _asm.buffers(NQ, NF)
     Q = _force(x, PC, p, c1, c2, True, False, M, P, V, J, info, knees)
     dV = np.empty((NF, 2, NQ))
     dJtF = np.empty((NQ, NQ))
     feet_jac(x, np.zeros((NF, 2)), p, dV, dJtF)
-    return _pinned_accelerations(z, x, Q, M, J, dV, PIN)
+    return _asm.pinned_dynamics(z, x, Q, M, J, dV, PIN)
 '''
 
 _TABLES = '''
+
 @njit(cache=True)
 def contact_table(X, PC, p, c1, c2):
-    """(n, NF, 8) per contact point (walkerlab.models.contact.assembly.contact_row)."""
-    n = X.shape[0]
-    out = np.zeros((n, NF, 8))
-    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, NQ))
-    for r in range(n):
+    """(n, NF, 8): per contact point penetration [m], its rate [m/s], slip velocity [m/s],
+    s [m], Fn [N], Ff [N], power F . v [W], on_ground (1/0)."""
+    out = np.zeros((X.shape[0], NF, 8))
+    sp, cp = _asm.slope(PC)
+    P, V, J = _asm.point_buffers(NQ, NF)
+    for r in range(X.shape[0]):
         feet(X[r], p, P, V, J)
-        _contact_row(out[r], P, V, sp, cp, PC, c1, c2, POINT_LEG)
+        _asm.contact_row(P, V, sp, cp, PC, c1, c2, POINT_LEG, out, r)
     return out
 
 
 @njit(cache=True)
 def knee_table(X, PC, p, c1, c2):
-    """(n, 2, 4) per knee (walkerlab.models.contact.assembly.knee_row)."""
-    n = X.shape[0]
-    out = np.zeros((n, 2, 4))
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, NQ))
-    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
+    """(n, 2, 4): per knee extension [rad], its rate [rad/s], stop torque [N m] and the
+    stop's power [W] (zeros without knee stops)."""
+    out = np.zeros((X.shape[0], 2, 4))
     if KNEE:
-        for r in range(n):
+        sp, cp = _asm.slope(PC)
+        P, V, J = _asm.point_buffers(NQ, NF)
+        for r in range(X.shape[0]):
             feet(X[r], p, P, V, J)
-            _knee_row(out[r], X[r], P, V, sp, cp, PC, c1, c2)
+            _asm.knee_row(X[r], NQ, P, V, sp, cp, PC, c1, c2, out, r)
     return out
 '''
 
-_POWERED = '''
-@njit(cache=True, error_model='numpy')
-def push_force(x, p, push_leg, force, hx, hy):
-    """The generalised force (NQ,) and power [W] of a push-off force at point push_leg."""
-    P = np.empty((NF, 2))
-    V = np.empty((NF, 2))
-    J = np.empty((NF, 2, NQ))
-    feet(x, p, P, V, J)
-    return _push_q(x, P, V, J, push_leg, force, hx, hy)
-
-
-@njit(cache=True, error_model='numpy')
-def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy, out):
-    """A powered walker's rhs and ledger powers into ``out`` (NX + 4,)."""
-    r = rhs(x, PC, p, c1, c2)
-    tab = contact_table(x.reshape((1, NX)), PC, p, c1, c2)
-    Qp = np.zeros(NQ)
-    p_po = 0.0
-    if push_leg >= 0:
-        Qp, p_po = push_force(x, p, push_leg, force, hx, hy)
-    Q, p_tau, moved = _powered_q(x, NQ, has_tau, sw, st, tau, push_leg >= 0, Qp)
-    M = np.empty((NQ, NQ))
-    if moved:
-        xz = np.zeros(NX)
-        xz[:NQ] = x[:NQ]
-        h = np.empty(NQ)
-        dyn(xz, p, M, h)
-    _powered_out(r, tab, Q, p_tau, moved, p_po, M, out)
-'''
-
 _PACKED = '''
+
 @njit(cache=True)
 def packed_size(d):
     """Length of the data vector (``d`` may be a raw pointer in a cfunc)."""
@@ -170,14 +130,48 @@ def packed_size(d):
 
 @njit(cache=True)
 def rhs_packed(y, d, dy):
-    """rhs of ``y`` (NX,) unpacked from the data vector ``d`` into ``dy``; counts the call."""
+    """rhs of ``y`` (NX,) with everything unpacked from the data vector ``d``, into ``dy``;
+    counts the call in ``d[-1]``."""
     a1 = D_P + NP
     a2 = a1 + int(d[D_N1])
     r = rhs(y, d[D_PC:D_P], d[D_P:a1], d[a1:a2], d[a2:d.size - 1])
     for i in range(NX):
         dy[i] = r[i]
     d[d.size - 1] += 1.0
+'''
 
+_POWERED_RHS = '''
+
+@njit(cache=True, error_model='numpy')
+def push_force(x, p, push_leg, force, hx, hy):
+    """The generalised force (NQ,) of a force ``force`` [N] at contact point ``push_leg``
+    along the line from it to the hip (coordinates ``hx``, ``hy``), and its power [W]."""
+    P, V, J = _asm.point_buffers(NQ, NF)
+    feet(x, p, P, V, J)
+    return _pk.push_along_leg(x, P, V, J, push_leg, force, hx, hy)
+
+
+@njit(cache=True, error_model='numpy')
+def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy, out):
+    """A powered walker's right-hand side with its ledger's powers, into ``out``
+    (NX + 4,): ``[dx, hip torque's positive and negative power, push-off's, contact
+    forces']`` (:func:`walkerlab.models.contact.actuation.powered_rhs`'s arithmetic)."""
+    r = rhs(x, PC, p, c1, c2)
+    tab = contact_table(x.reshape((1, NX)), PC, p, c1, c2)
+    Q = _pk.hip_torque_ledger(x, r, tab, has_tau, sw, st, tau, out)
+    p_po = 0.0
+    if push_leg >= 0:
+        Qp, p_po = push_force(x, p, push_leg, force, hx, hy)
+        Q = Q + Qp
+    out[NX + 2] = p_po
+    if _pk.moves(Q):
+        M = np.empty((NQ, NQ))
+        h = np.empty(NQ)
+        dyn(_pk.at_rest(x, NQ), p, M, h)
+        _pk.add_accelerations(M, Q, out)
+'''
+
+_CFUNCS = '''
 
 def build_cyrk():
     """Address of a CyRK ``cyjit_sig`` cfunc of rhs_packed (numba disk cache)."""
@@ -202,9 +196,118 @@ def build_lsoda(sig):
     return rhs_c.address
 '''
 
+_ACTUATE = '''
 
-def contact_glue_source() -> str:
-    """The glue's source (module docstring), appended to a structure's generated floating
-    module and its constants (``NQ``, ``NP``, ``NF``, ``KNEE``, ``POINT_LEG``, ``PIN``) by
-    :func:`walkerlab.models.contact.generated.contact_source`."""
-    return "\n".join((_HEAD, _FORCE, _PINNED, _TABLES, _POWERED, _PACKED))
+@njit(cache=True, error_model='numpy')
+def _phase(x, A, p, st):
+    """The phase variable [rad] and its rate [rad/s] with leg ``st`` in stance: a
+    coordinate, or the virtual stance leg's angle."""
+    c = int(A[4]) if st == 0 else int(A[31])
+    if A[3] < 0.5:
+        return x[c], x[NQ + c]
+    P, V, J = _asm.point_buffers(NQ, NF)
+    feet(x, p, P, V, J)
+    return _pk.virtual_leg_phase(x, A, P, V, c, NQ)
+
+
+@njit(cache=True, error_model='numpy')
+def _pulse(x, A, p, S):
+    """The push-off pulse's force into ``S[:NQ]`` and its power into ``S[NQ + 4]``."""
+    Qp, pp = push_force(x, p, int(A[5]), A[6], int(A[7]), int(A[8]))
+    if A[15] > 0.5:  # a flat foot's ankle holds through the pulse
+        M = np.empty((NQ, NQ))
+        h = np.empty(NQ)
+        dyn(_pk.at_rest(x, NQ), p, M, h)
+        pp = _pk.hold_ankle(x, A, M, Qp, pp)
+    _pk.add_pulse(S, Qp, pp)
+
+
+@njit(cache=True, error_model='numpy')
+def actuate(t, x, A, p, S):
+    """The actuators' generalised force into ``S[:NQ]`` and the powers ``W`` into
+    ``S[NQ:NQ + 10]`` at the time ``t`` [s] and state ``x`` from the actuation block ``A``
+    (:mod:`walkerlab.models.contact.powered_source`)."""
+    st, switched = _pk.stance(t, A, NQ)
+    if int(A[2]) > 0:
+        s, ds = _phase(x, A, p, st)
+        _pk.joint_torques(t, x, A, S, st, s, ds, NQ)
+    if A[9] > 0.5 and not switched:  # the ankle push-off
+        _pk.ankle_push_off(x, A, S, st, NQ)
+    if A[5] >= 0.0:
+        _pulse(x, A, p, S)
+    _pk.held_force_and_dampers(x, A, S, st, NQ)
+'''
+
+_POWERED_PACKED = '''
+
+@njit(cache=True, error_model='numpy')
+def powered_packed(t, y, d, dy):
+    """dy/dt of a powered walker's state and work integrals from the data vector ``d``
+    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 12), calls]``); counts the call in
+    ``d[-1]``."""
+    a1 = D_P + NP
+    a2 = a1 + int(d[D_N1])
+    a3 = a2 + int(d[D_N2])
+    la = int(d[a3])
+    A = d[a3:a3 + la]
+    p = d[D_P:a1]
+    # scratch in the data vector (no allocation per call): the force Q (NQ), the powers W
+    # (10), the ghost swing foot G (2)
+    S = d[a3 + la:a3 + la + NQ + 12]
+    for i in range(NQ + 10):
+        S[i] = 0.0
+    actuate(t, y, A, p, S)
+    _pk.ghost_foot(t, A, S, NQ)
+    rhs_q(y, d[D_PC:D_P], p, d[a1:a2], d[a2:a3], S, dy)
+    _pk.work_rates(A, S, dy, NQ)
+    d[d.size - 1] += 1.0
+
+
+@njit(cache=True)
+def powered_size(d):
+    """Length of a powered data vector (``d`` may be a raw pointer in a cfunc)."""
+    a3 = D_P + NP + int(d[D_N1]) + int(d[D_N2])
+    return a3 + int(d[a3]) + NQ + 12 + 1
+
+
+@njit(cache=True)
+def powered_ny(d):
+    """The state's length of a powered data vector: NX and the work integrals."""
+    a3 = D_P + NP + int(d[D_N1]) + int(d[D_N2])
+    return NX + int(d[a3 + 27])
+
+'''
+
+#: ``build_cyrk_powered()``: the address of a CyRK ``cyjit_sig`` cfunc of the module's
+#: ``powered_packed`` (a generated contact module's, and the virtual constraints' right-hand
+#: side's, :mod:`walkerlab.models.contact.virtual_constraints`)
+CYRK_POWERED_SOURCE = '''def build_cyrk_powered():
+    """Address of a CyRK ``cyjit_sig`` cfunc of powered_packed (numba disk cache)."""
+    from CyRK.nb.numba_solver import cyjit_sig
+    from numba import carray, cfunc
+
+    @cfunc(cyjit_sig, cache=True)
+    def rhs_c(dy, t, y, d):  # pragma: no cover - runs compiled
+        dd = carray(d, (powered_size(d),))
+        ny = powered_ny(dd)
+        powered_packed(t, carray(y, (ny,)), dd, carray(dy, (ny,)))
+
+    return rhs_c.address
+'''
+
+
+def contact_glue() -> str:
+    """The glue of the passive model: imports of the kernels and the contact parameters'
+    indices, ``_force``, ``jac``, ``pinned_to_full``, ``rhs_pinned``, ``contact_table``,
+    ``knee_table``, ``packed_size``, ``rhs_packed``, ``push_force``, ``powered_rhs``,
+    ``build_cyrk`` and ``build_lsoda`` (their contracts:
+    :mod:`walkerlab.models.contact.generated`)."""
+    return _HEAD + _FORCE + _PINNED + _TABLES + _PACKED + _POWERED_RHS + _CFUNCS
+
+
+def powered_glue() -> str:
+    """The glue of the powered model: ``actuate`` (the actuators' forces and powers from
+    the actuation block), ``powered_packed`` (the powered right-hand side from the data
+    vector), ``powered_size``, ``powered_ny`` and ``build_cyrk_powered`` (its CyRK cfunc's
+    address); :mod:`walkerlab.models.contact.powered_source`."""
+    return _ACTUATE + _POWERED_PACKED + CYRK_POWERED_SOURCE

@@ -49,6 +49,7 @@ after the first begins), each piece's offset from the table's start, then each p
 from __future__ import annotations
 
 import numpy as np
+from numba.extending import register_jitable
 
 __all__ = ["FIELDS", "HEAD", "cubic_at", "feedforward_terms", "interval", "kernel_source",
            "law_torque", "pack_laws", "table_value"]
@@ -97,6 +98,7 @@ def pack_laws(laws) -> np.ndarray:
     return np.concatenate([[3.0 + body.size, float(len(laws)), 0.0], body])
 
 
+@register_jitable
 def table_value(b, off, n, u):
     """``(h, h', h'')`` of the table at ``b[off:]`` (``n`` knots) at ``u``, held outside."""
     s0, s1 = b[off], b[off + n - 1]
@@ -113,6 +115,7 @@ def table_value(b, off, n, u):
     return h, (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2], 6.0 * b[c] * x + 2.0 * b[c + 1]
 
 
+@register_jitable
 def interval(b, off, n, u):
     """Index ``j`` of the interval of the knots ``b[off:off + n]`` that holds ``u``
     (``knots[j] <= u < knots[j + 1]``; the end intervals outside, as
@@ -127,6 +130,7 @@ def interval(b, off, n, u):
     return lo
 
 
+@register_jitable
 def cubic_at(b, off, n, u):
     """``(p, p', p'')`` at ``u`` of the piecewise cubic with knots ``b[off:off + n]`` and
     coefficients after them, extrapolated with its end intervals."""
@@ -137,6 +141,7 @@ def cubic_at(b, off, n, u):
             (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2], 6.0 * b[c] * x + 2.0 * b[c + 1])
 
 
+@register_jitable
 def feedforward_terms(b, off, n, delta, ddelta, s, ds, K, D):
     """A kind-3 table at ``b[off:]`` (``n`` knots): ``(U(T(s)), delta - h(s), ddelta -
     h'(s) ds, dtau/ds, dtau/dds)`` (the last two the law's partials with gains ``K``,
@@ -155,12 +160,15 @@ def feedforward_terms(b, off, n, delta, ddelta, s, ds, K, D):
     return u, delta - r, ddelta - r1 * ds, du * dtt + K * r1 + D * r2 * ds, D * r1
 
 
+@register_jitable
 def law_torque(b, i, delta, ddelta, s, ds, t):
     """Actuator ``i``'s torque [N m] of the law block ``b`` and its partial derivatives
     ``(tau, dtau/ddelta, dtau/dddelta, dtau/ds, dtau/dds)``: ``delta``, ``ddelta`` the joint
     angle [rad] and rate [rad/s], ``s``, ``ds`` the phase variable [rad] and its rate
-    [rad/s], ``t`` the time [s] (the step began at ``b[2]``).  Plain Python on floats and
-    numba-compilable as it is (:func:`kernel_source`)."""
+    [rad/s], ``t`` the time [s] (the step began at ``b[2]``).  Plain Python on floats,
+    callable from numba code as it is (``register_jitable``: the contact actuators'
+    :mod:`walkerlab.models.contact.powered_kernels`) and copied into generated modules
+    (:func:`kernel_source`)."""
     h = 3 + HEAD * i
     kind, c0, K, D = b[h], b[h + 1], b[h + 2], b[h + 3]
     g_s, g_ds = 0.0, 0.0
@@ -207,7 +215,7 @@ def kernel_source() -> list[str]:
            f"{TIME}, {FEEDFORWARD}, {PIECEWISE}", f"TIME_FEEDFORWARD = {TIME_FEEDFORWARD}", ""]
     for fn in (table_value, interval, cubic_at, feedforward_terms, law_torque):
         src = inspect.getsource(fn).splitlines()
-        body = [ln for ln in src if ln.strip()]
+        body = [ln for ln in src if ln.strip() and not ln.startswith("@")]
         doc_end = next(k for k, ln in enumerate(body[1:], 1) if ln.rstrip().endswith('"""'))
         out += ["@njit(cache=True)", body[0] + "  # pragma: no cover - runs compiled",
                 *body[doc_end + 1:], ""]

@@ -1,28 +1,26 @@
-"""The compliant-contact walker's assembly: contact geometry into forces, and the solve.
+"""The compliant-contact walker's assembly: contact geometry (points, their velocities and
+Jacobians, the mass matrix and bias) in, forces and accelerations out; numba, on arrays.
 
-Walker-independent numba kernels that turn the contact points' positions ``P`` (NF, 2) [m],
-material velocities ``V`` (NF, 2) [m/s] and Jacobians ``J`` (NF, 2, NQ), and the mass
-matrix ``M`` (NQ, NQ) and bias ``h`` (NQ,) of a walker's floating view, into generalised
-forces and accelerations with the laws of :mod:`walkerlab.models.contact._kernels` (IMPACT
-normal force, ADAMS Coulomb friction, patch membership, the polyline ground).  No mechanics
-is written here: the arrays come from a walker's generated module
-(:mod:`walkerlab.codegen.floating`: ``dyn``, ``dyn_jac``, ``feet``, ``feet_jac``), whose thin
-per-structure glue (:mod:`walkerlab.codegen.contact_glue`) evaluates them and hands them to
-these kernels (:mod:`walkerlab.models.contact.generated`).
+Internal module.  Everything is SI.  These kernels do the walker-independent work of a
+compliant-contact walker's compiled model with the laws of
+:mod:`walkerlab.models.contact._kernels` (IMPACT normal force, ADAMS Coulomb friction, patch
+membership): the contact of each point from its position and material velocity
+(:func:`point`), the generalised forces ``Q = J^T F - h`` with the knee stops and latch
+(:func:`contact_forces`, :func:`knee`), the solve of ``M qdd = Q - h`` (:func:`chol`,
+:func:`chol_solve`), the analytic Jacobian's assembly (:func:`jac_assembly`), the pinned
+stance foot's reduced dynamics (:func:`pinned_dynamics`) and the per-point and per-knee
+tables.  They take arrays only (no compiled function is an argument: numba's disk cache
+keys a function on its arguments' types); the generated module of each walker structure
+(:func:`walkerlab.models.contact.generated.contact_source`) calls its generated kinematics
+(``dyn``, ``feet``, ``feet_jac``) and hands their arrays to these kernels
+(:mod:`walkerlab.codegen.contact_glue`).
 
-The contact parameter vector ``PC`` (float64, (NPC,)) is read through the named indices
-``I_*`` (:mod:`walkerlab.models.contact.generated` tables them); ``point_leg`` (tuple of
-int, (NF,)) is each contact point's leg (0: leg1, whose lane is ``c1``; 1: leg2, ``c2``).
-A contact point's result (:func:`point`) is the 12-tuple ``(delta, ddot, vt, s, Fn, Ff,
-dFn/ddelta, dFn/dddot, mu, dmu/dvt, nx, ny)``: its penetration [m] below the top of the
-patch under it, its rate [m/s], the slip velocity [m/s] along the ground, its position
-``s`` [m] along the slope, the normal and friction forces [N], their partial derivatives,
-the friction coefficient and its derivative [s/m], and the ground's outward normal
-``(nx, ny)`` there (the friction acts along ``(ny, -nx)``).
-
-Everything is SI.  Knees (``knee_on``): kneed legs whose knees are not free, one contact
-point per leg (point ``k`` is leg ``k``'s), thigh and shank coordinates ``2 + 2 k``,
-``3 + 2 k``.
+Shapes: ``nq`` generalised coordinates, ``nf`` contact points; ``P``, ``V`` (nf, 2) the
+points' positions [m] and material velocities [m/s], ``J`` (nf, 2, nq) their Jacobians,
+``point_leg`` (nf,) each point's leg (0: leg1, on lane ``c1``; 1: leg2, on ``c2``), ``info``
+(nf, 12) each point's :func:`point` result, ``knees`` (2, 5) each knee's :func:`knee` result.
+The contact parameter vector ``PC`` is read through the named indices ``I_*``
+(:mod:`walkerlab.models.contact.generated`'s table).
 """
 
 from __future__ import annotations
@@ -30,14 +28,10 @@ from __future__ import annotations
 from math import cos as _cos
 from math import sin as _sin
 
-from walkerlab.usercache import use_for_numba
+import numpy as np
+from numba import njit
 
-use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
-
-import numpy as np  # noqa: E402
-from numba import njit  # noqa: E402
-
-from walkerlab.models.contact._kernels import (  # noqa: E402
+from walkerlab.models.contact._kernels import (
     friction_mu,
     ground_line,
     normal_force,
@@ -45,26 +39,19 @@ from walkerlab.models.contact._kernels import (  # noqa: E402
     step,
 )
 
-__all__ = ["I_CMAX", "I_CONT", "I_DMAX", "I_E", "I_HW", "I_K", "I_KA", "I_KC", "I_KD",
-           "I_KE", "I_KF", "I_KK", "I_KL", "I_MUD", "I_MUS", "I_PHI", "I_VD", "I_VS", "NPC",
-           "D_N1", "D_N2", "D_P", "D_PC", "buffers", "chol", "chol_solve", "contact_q",
-           "contact_row", "jac_assemble", "knee", "knee_row", "knee_torque", "latch_weight",
-           "link_state", "on_line", "pinned_accelerations", "place_pin", "point",
-           "powered_out", "powered_q", "push_q", "world_forces"]
-
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
 I_KK, I_KE, I_KC, I_KD, I_KL, I_KF, I_KA = 11, 12, 13, 14, 15, 16, 17
 #: Number of contact parameters.
 NPC = 18
-#: The packed data vector of the compiled integrators: ``[n1, n2, PC (NPC), p, c1, c2, nfev]``.
+#: The packed data vector's head: ``[n1, n2, PC (NPC), p, ...]``.
 D_N1, D_N2, D_PC = 0, 1, 2
 D_P = D_PC + NPC
 
 
 @njit(cache=True)
 def chol(M):
-    """Lower Cholesky factor (n, n) of the symmetric positive definite ``M`` (n, n)."""
+    """Lower Cholesky factor of the SPD matrix M (NQ, NQ)."""
     n = M.shape[0]
     L = np.zeros((n, n))
     for j in range(n):
@@ -83,7 +70,7 @@ def chol(M):
 
 @njit(cache=True)
 def chol_solve(L, B):
-    """Solve ``(L L^T) X = B`` for ``X`` (n, m), ``B`` (n, m) left unchanged."""
+    """Solve (L L^T) X = B, B (n, m), in place of a copy."""
     n, m = B.shape
     X = B.copy()
     for c in range(m):
@@ -101,13 +88,20 @@ def chol_solve(L, B):
 
 
 @njit(cache=True)
+def slope(PC):
+    """The slope's (sin phi, cos phi)."""
+    return _sin(PC[I_PHI]), _cos(PC[I_PHI])
+
+
+@njit(cache=True)
 def point(px, py, vx, vy, sp, cp, PC, cen):
-    """Contact of a point at ``(px, py)`` [m] whose material velocity is ``(vx, vy)`` [m/s]
-    on the lane ``cen``, the slope's ``(sin, cos) = (sp, cp)``: the 12-tuple of the module
-    docstring.  The one contact kernel of the right-hand side, the Jacobian, the pinned
-    dynamics and the tables.  On a polyline ground (``PC[I_CONT] == 2``: ``cen`` its
-    vertices, :func:`walkerlab.models.contact._kernels.ground_line`) the penetration and
-    normal are the nearest segment's (:func:`on_line`)."""
+    """Contact of a point at (px, py) [m] whose material velocity is (vx, vy) [m/s] on the
+    lane ``cen``, the slope's (sin, cos) = (sp, cp): (delta, ddot, vt, s, Fn, Ff, dFn/ddelta,
+    dFn/dddot, mu, dmu/dvt, nx, ny), (nx, ny) the ground's outward normal there (the
+    friction acts along (ny, -nx)).  The one contact kernel of the right-hand side, the
+    Jacobian, the pinned dynamics and the tables (one compile).  On a polyline ground
+    (``PC[I_CONT] == 2``: ``cen`` its vertices, :func:`ground_line`) the penetration and
+    normal are the nearest segment's."""
     if PC[I_CONT] > 1.5:
         return on_line(px, py, vx, vy, sp, cp, PC, cen)
     delta = -(px * sp + py * cp)
@@ -145,8 +139,8 @@ def on_line(px, py, vx, vy, sp, cp, PC, line):
 
 @njit(cache=True)
 def latch_weight(delta, ext, PC):
-    """Latch engagement in [0, 1] of a knee at extension ``ext`` [rad] (< 0 flexed) whose
-    foot has the penetration ``delta`` [m] (< 0: above the ground)."""
+    """Latch engagement in [0, 1] of a knee at extension ext [rad] (< 0 flexed) whose foot
+    has the penetration delta [m] (< 0: above the ground)."""
     if PC[I_KL] < 0.5:
         return 0.0
     return (step(delta, -PC[I_KF], 0.0, 0.0, 1.0)[0]
@@ -155,8 +149,9 @@ def latch_weight(delta, ext, PC):
 
 @njit(cache=True)
 def knee(x, k, PC, delta, nq):
-    """Knee stop (and latch, its foot at penetration ``delta`` [m]) of knee ``k`` of the
-    state ``x`` (2 nq,): (extension [rad], rate [rad/s], torque [N m], dT/dext, dT/drate)."""
+    """Knee stop (and latch, its foot at penetration delta [m]) of knee k of the state
+    ``x`` (``nq`` coordinates, then their rates): (extension, rate, torque, dT/dext,
+    dT/drate)."""
     t, s = 2 + 2 * k, 3 + 2 * k
     ext = x[s] - x[t]
     rate = x[nq + s] - x[nq + t]
@@ -173,11 +168,26 @@ def knee(x, k, PC, delta, nq):
 
 
 @njit(cache=True)
-def contact_q(x, PC, c1, c2, use1, use2, h, P, V, J, info, knees, point_leg, knee_on):
-    """``Q - h`` (NQ,) with the contact forces of the legs' points used (``use1``,
-    ``use2``) and the knee stops, from the bias ``h`` and the points' ``P``, ``V``, ``J``;
-    fills each used point's :func:`point` result into ``info`` (NF, 12) and the knees'
-    :func:`knee` into ``knees`` (2, 5)."""
+def knee_torque(ext, rate, PC, delta):
+    """Knee-stop torque [N m] (>= 0 past straight) at hyperextension ``ext`` [rad], rate
+    [rad/s]; with the latch on and the leg's foot at penetration delta [m] (near or on the
+    ground), also < 0 in flexion."""
+    if ext < 0.0:
+        w = latch_weight(delta, ext, PC)
+        if w <= 0.0:
+            return 0.0
+        return -w * normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
+    if ext == 0.0:
+        return 0.0
+    return normal_force(ext, rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
+
+
+@njit(cache=True)
+def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg,
+                   has_knees):
+    """Q - h (nq,) from the bias ``h`` (nq,) with the contact forces of the points of the
+    legs used (``use1``, ``use2``) and, ``has_knees``, the knee stops (knee k's foot: point
+    k); fills ``info`` and ``knees``."""
     nq = h.shape[0]
     Q = -h
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
@@ -195,7 +205,7 @@ def contact_q(x, PC, c1, c2, use1, use2, h, P, V, J, info, knees, point_leg, kne
             Fy = fn * ny - ff * nx
             for k in range(nq):
                 Q[k] += J[i, 0, k] * Fx + J[i, 1, k] * Fy
-    if knee_on:
+    if has_knees:
         for k in range(2):
             used = (k == 0 and use1) or (k == 1 and use2)
             res = knee(x, k, PC, info[k, 0] if used else np.inf, nq)  # pinned: on the ground
@@ -208,31 +218,22 @@ def contact_q(x, PC, c1, c2, use1, use2, h, P, V, J, info, knees, point_leg, kne
 
 
 @njit(cache=True)
-def knee_torque(ext, rate, PC, delta):
-    """Knee-stop torque [N m] (>= 0 past straight) at hyperextension ``ext`` [rad], rate
-    [rad/s]; with the latch on and the leg's foot at penetration ``delta`` [m] (near or on
-    the ground), also < 0 in flexion."""
-    if ext < 0.0:
-        w = latch_weight(delta, ext, PC)
-        if w <= 0.0:
-            return 0.0
-        return -w * normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
-    if ext == 0.0:
-        return 0.0
-    return normal_force(ext, rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
-
-
-@njit(cache=True)
 def buffers(nq, nf):
-    """The arrays :func:`contact_q`'s caller fills: M (nq, nq), the points' P, V (nf, 2),
-    J (nf, 2, nq), their info (nf, 12) and the knees' (2, 5)."""
+    """The arrays :func:`contact_forces` and the kinematics fill: M (nq, nq), the points'
+    P, V (nf, 2), J (nf, 2, nq), their info (nf, 12) and the knees' (2, 5)."""
     return (np.empty((nq, nq)), np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, nq)),
             np.zeros((nf, 12)), np.zeros((2, 5)))
 
 
 @njit(cache=True)
+def point_buffers(nq, nf):
+    """The points' P, V (nf, 2) and J (nf, 2, nq), to be filled by the kinematics."""
+    return np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, nq))
+
+
+@njit(cache=True)
 def world_forces(info):
-    """The contact forces (NF, 2) [N] in the world from the points' ``info`` (NF, 12)."""
+    """(nf, 2) each point's contact force [N] in the world from its ``info`` row."""
     F = np.zeros((info.shape[0], 2))
     for i in range(info.shape[0]):
         fn, ff = info[i, 4], info[i, 5]
@@ -244,14 +245,12 @@ def world_forces(info):
 
 
 @njit(cache=True)
-def jac_assemble(L, J, dV, dJtF, Dq, Dv, info, knees, knee_on):
-    """The analytic d rhs / dx (NX, NX) from the Cholesky factor ``L`` of ``M``, the
-    points' Jacobians ``J`` and their rates' ``dV`` (NF, 2, NQ), ``d(J^T F)/dq`` at fixed
-    ``F`` (``dJtF``, NQ x NQ), ``d(M a + h)/dq`` and ``/d dq`` at fixed ``a`` (``Dq``, ``Dv``),
-    the points' ``info`` and the knees' (patch membership and the ground's normal locally
-    constant)."""
+def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
+    """d rhs / dx (2 nq, 2 nq) from the Cholesky factor ``L`` of M, the partials ``Dq``,
+    ``Dv`` (nq, nq) of ``M a + h`` at the acceleration ``a``, ``dJtF`` (nq, nq) of ``J^T F``
+    at the forces held, the points' Jacobians ``J`` and their rates' partials ``dV``
+    (nf, 2, nq); patch membership and each point's normal locally constant."""
     nq = L.shape[0]
-    nx = 2 * nq
     B = np.empty((nq, 2 * nq))
     for r in range(nq):
         for k in range(nq):
@@ -281,7 +280,7 @@ def jac_assemble(L, J, dV, dJtF, Dq, Dv, info, knees, knee_on):
         for r in range(nq):
             for k in range(2 * nq):
                 B[r, k] += J[i, 0, r] * dFx[k] + J[i, 1, r] * dFy[k]
-    if knee_on:
+    if has_knees:
         for kk in range(2):
             t, s = 2 + 2 * kk, 3 + 2 * kk
             dd, dr = knees[kk, 3], knees[kk, 4]
@@ -292,6 +291,7 @@ def jac_assemble(L, J, dV, dJtF, Dq, Dv, info, knees, knee_on):
                 B[s, off + s] -= d
                 B[s, off + t] += d
     X = chol_solve(L, B)
+    nx = 2 * nq
     out = np.zeros((nx, nx))
     for k in range(nq):
         out[k, nq + k] = 1.0
@@ -301,9 +301,9 @@ def jac_assemble(L, J, dV, dJtF, Dq, Dv, info, knees, knee_on):
 
 
 @njit(cache=True)
-def link_state(z, nq):
-    """The full state (2 nq,) of the link angles and rates ``z`` (2 (nq - 2),), the hip at
-    the origin and at rest (the pinned state's, :func:`place_pin` then moves it)."""
+def pinned_angles(z, nq):
+    """The state (2 nq,) with the link angles and rates ``z`` (2 (nq - 2),), the hip at the
+    origin and at rest."""
     x = np.zeros(2 * nq)
     for k in range(nq - 2):
         x[2 + k] = z[k]
@@ -312,22 +312,21 @@ def link_state(z, nq):
 
 
 @njit(cache=True)
-def place_pin(x, P, V, foot2, pin):
-    """Move the hip of ``x`` (from :func:`link_state`, its points ``P``, ``V`` there) so that
-    contact point ``pin`` is at ``foot2`` (2,) [m] and at rest; returns ``x``."""
+def pin_at(x, P, V, pin, foot2):
+    """Move the state ``x`` of :func:`pinned_angles` (its points at ``P``, ``V``) so that
+    its point ``pin`` is at ``foot2`` (2,) and at rest."""
     nq = x.shape[0] // 2
     x[0] = foot2[0] - P[pin, 0]
     x[1] = foot2[1] - P[pin, 1]
     x[nq] = -V[pin, 0]
     x[nq + 1] = -V[pin, 1]
-    return x
 
 
 @njit(cache=True)
-def pinned_accelerations(z, x, Q, M, J, dV, pin):
-    """dz/dt (2 m,) of the reduced dynamics with contact point ``pin`` held: ``q = Phi(z)``,
-    ``dq = Jp dz``, ``qdd = Jp zdd + gam``; ``Jp^T M Jp zdd = Jp^T (Q - h - M gam)`` from the
-    full state ``x``, its ``Q - h`` and ``M``, the points' ``J`` and ``dV``."""
+def pinned_dynamics(z, x, Q, M, J, dV, pin):
+    """dz/dt of the reduced dynamics with point ``pin`` held: ``q = Phi(z)``,
+    ``dq = Jp dz``, ``qdd = Jp zdd + gam``; ``Jp^T M Jp zdd = Jp^T (Q - h - M gam)``, from
+    the full state ``x``, its ``Q - h``, ``M`` and the points' ``J``, ``dV``."""
     nq = M.shape[0]
     m = nq - 2
     Jp = np.zeros((nq, m))
@@ -366,10 +365,9 @@ def pinned_accelerations(z, x, Q, M, J, dV, pin):
 
 
 @njit(cache=True)
-def contact_row(out, P, V, sp, cp, PC, c1, c2, point_leg):
-    """One sample of the contact table into ``out`` (NF, 8): per contact point (``P``,
-    ``V``) penetration [m], its rate [m/s], slip velocity [m/s], s [m], Fn [N], Ff [N],
-    power F . v [W], on_ground (1/0)."""
+def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r):
+    """Row ``r`` of the contact table ``out`` (n, nf, 8): per point penetration [m], its
+    rate [m/s], slip velocity [m/s], s [m], Fn [N], Ff [N], power F . v [W], on_ground."""
     for i in range(P.shape[0]):
         cen = c1 if point_leg[i] == 0 else c2
         res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
@@ -377,83 +375,21 @@ def contact_row(out, P, V, sp, cp, PC, c1, c2, point_leg):
         Fx = fn * res[10] + ff * res[11]
         Fy = fn * res[11] - ff * res[10]
         for k in range(6):
-            out[i, k] = res[k]
-        out[i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
+            out[r, i, k] = res[k]
+        out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
         hq = patch_height(res[3], cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
-        out[i, 7] = 1.0 if hq == hq else 0.0
+        out[r, i, 7] = 1.0 if hq == hq else 0.0
 
 
 @njit(cache=True)
-def knee_row(out, x, P, V, sp, cp, PC, c1, c2):
-    """One sample of the knee table into ``out`` (2, 4): per knee extension [rad], its rate
-    [rad/s], stop torque [N m] and the stop's power [W] (its foot point ``k``'s penetration
-    from ``P``, ``V``)."""
-    nq = x.shape[0] // 2
+def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out, r):
+    """Row ``r`` of the knee table ``out`` (n, 2, 4): per knee extension [rad], its rate
+    [rad/s], stop torque [N m] and the stop's power [W] (knee k's foot: point k) of the
+    state ``x`` (``nq`` coordinates, then their rates)."""
     for k in range(2):
         delta = point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC, c1 if k == 0 else c2)[0]
         ext, rate, T, _, _ = knee(x, k, PC, delta, nq)
-        out[k, 0] = ext
-        out[k, 1] = rate
-        out[k, 2] = T
-        out[k, 3] = -T * rate
-
-
-@njit(cache=True, error_model='numpy')
-def push_q(x, P, V, J, push_leg, force, hx, hy):
-    """The generalised force (NQ,) of a force ``force`` [N] at contact point ``push_leg``
-    (its ``P``, ``V``, ``J``) along the line from it to the hip (coordinates ``hx``, ``hy``
-    of ``x``), and its power [W]."""
-    rr = np.empty(2)
-    rr[0] = x[hx] - P[push_leg, 0]
-    rr[1] = x[hy] - P[push_leg, 1]
-    e = rr / np.sqrt(np.dot(rr, rr))
-    F = force * e
-    Jt = np.ascontiguousarray(J[push_leg].T)
-    return np.dot(Jt, F), np.dot(F, V[push_leg].copy())
-
-
-@njit(cache=True, error_model='numpy')
-def powered_q(x, n, has_tau, sw, st, tau, pushed, Qp):
-    """A powered walker's actuators' generalised force ``Q`` (n,): the hip torque ``tau``
-    [N m] (``has_tau``: +tau on coordinate ``sw``, -tau on ``st``) and the push-off's ``Qp``
-    (``pushed``); with the hip torque's power [W] and whether ``Q`` is not zero (the
-    arithmetic of :func:`walkerlab.models.contact.actuation.powered_rhs` in the same
-    order: the same numbers)."""
-    Q = np.zeros(n)
-    p_tau = 0.0
-    if has_tau:
-        Q[sw] = Q[sw] + tau
-        Q[st] = Q[st] - tau
-        p_tau = tau * (x[n + sw] - x[n + st])
-    if pushed:
-        Q = Q + Qp
-    moved = False
-    for i in range(n):
-        if Q[i] != 0.0:
-            moved = True
-    return Q, p_tau, moved
-
-
-@njit(cache=True, error_model='numpy')
-def powered_out(r, tab, Q, p_tau, moved, p_po, M, out):
-    """A powered walker's right-hand side with its ledger's powers into ``out`` (NX + 4,):
-    ``[dx, hip torque's positive and negative power, push-off's, contact forces']`` from the
-    passive ``r`` (NX,), the contact table ``tab`` (1, NF, 8), the actuators' :func:`powered_q`
-    and ``M`` at the configuration (read only when ``moved``), the push-off's power ``p_po``
-    [W]."""
-    nx = r.shape[0]
-    n = nx // 2
-    for i in range(nx):
-        out[i] = r[i]
-    rest = 0.0  # numpy's sum of the column: the first entry, then the others from 0.0
-    for i in range(1, tab.shape[1]):
-        rest += tab[0, i, 6]
-    p_contact = tab[0, 0, 6] + rest
-    if moved:
-        a = np.linalg.solve(M, Q)
-        for i in range(n):
-            out[n + i] = out[n + i] + a[i]
-    out[nx] = 0.0 if 0.0 > p_tau else p_tau  # Python's max(p_tau, 0.0), min(p_tau, 0.0)
-    out[nx + 1] = 0.0 if 0.0 < p_tau else p_tau
-    out[nx + 2] = p_po
-    out[nx + 3] = p_contact
+        out[r, k, 0] = ext
+        out[r, k, 1] = rate
+        out[r, k, 2] = T
+        out[r, k, 3] = -T * rate

@@ -1,16 +1,19 @@
 """The compliant-contact walker's compiled kernels, generated per walker structure.
 
 The generated module is the floating view of the walker (:mod:`walkerlab.codegen.floating`:
-``dyn``, ``dyn_jac``, ``feet``, ``feet_jac``, numba) followed by the glue of
-:mod:`walkerlab.codegen.contact_glue`, which hands their arrays (the contact points'
-positions, velocities and Jacobians, the mass matrix and bias) to the walker-independent
-kernels of :mod:`walkerlab.models.contact.assembly`: contact geometry into forces with the
-laws of :mod:`walkerlab.models.contact._kernels` (IMPACT normal force, ADAMS Coulomb
-friction, patch membership), and the solve of ``M qdd = Q - h`` (no mechanics is written by
-hand: every position, velocity, Jacobian, mass matrix and bias comes from the generator).
-It is cached on disk next to the rigid models' code
-(:func:`walkerlab.codegen.cache.cache_dir`), keyed on the structure, the generators and the
-files that make its source.
+``dyn``, ``dyn_jac``, ``feet``, ``feet_jac``, numba), the straight-line right-hand sides
+``rhs`` and ``rhs_q`` (:mod:`walkerlab.models.contact.rhs_lines`) and a few lines of glue
+(:mod:`walkerlab.codegen.contact_glue`) that hand the generated positions, velocities,
+Jacobians, mass matrix and bias, as arrays, to the walker-independent kernels of two
+ordinary numba modules: :mod:`walkerlab.models.contact.assembly` (contact geometry into
+forces with the laws of :mod:`walkerlab.models.contact._kernels` - IMPACT normal force,
+ADAMS Coulomb friction, patch membership -, the knee stops and latch, ``Q = J^T F - h``,
+the solve of ``M qdd = Q - h``, the tables) and
+:mod:`walkerlab.models.contact.powered_kernels` (the actuators of
+:mod:`walkerlab.models.contact.powered_source`).  No mechanics is written by hand: every
+position, velocity, Jacobian, mass matrix and bias comes from the generator.  The module is
+cached on disk next to the rigid models' code (:func:`walkerlab.codegen.cache.cache_dir`),
+keyed on the structure, the generators, the glue and the kernels' files (``_SOURCES``).
 
 Contact parameter vector ``PC`` (float64, (NPC,)), read through named indices:
 
@@ -60,22 +63,29 @@ feet, ``('leg1_heel', 'leg1_toe', 'leg2_heel', 'leg2_toe')`` for flat feet), eac
 IMPACT and Coulomb laws on its leg's lane (``POINT_LEG``); ``PIN`` is leg2's first point
 (the point a pinned stance foot holds).
 
-Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating` for ``q``):
+The module's functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating` for
+``q``; ``rhs`` generated straight-line code, the others glue on the kernels named):
 
 =======================================  =================================================
-``rhs(x, PC, p, c1, c2)``                dx/dt (NX,)
-``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX), patch membership locally constant
+``rhs(x, PC, p, c1, c2)``                dx/dt (NX,) (``assembly.point``, ``knee_torque``)
+``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX), patch membership locally
+                                         constant (``assembly.contact_forces``,
+                                         ``jac_assembly``)
 ``rhs_pinned(z, PC, p, c1, c2, foot2)``  leg2's point PIN held at ``foot2``:
                                          ``z = [link angles, their rates]`` -> dz/dt
+                                         (``assembly.pinned_dynamics``)
 ``pinned_to_full(z, p, foot2)``          full state (NX,) of a pinned state
 ``contact_table(X, PC, p, c1, c2)``      (n, NF, 8) per point: penetration, its rate, slip
                                          velocity, s, Fn, Ff, power, on_ground
-``knee_table(X, PC, p)``                 (n, 2, 4) per knee: extension, its rate, stop torque,
-                                         power
+                                         (``assembly.contact_row``)
+``knee_table(X, PC, p, c1, c2)``         (n, 2, 4) per knee: extension, its rate, stop
+                                         torque, power (``assembly.knee_row``)
 ``rhs_packed(y, d, dy)``                 rhs from the packed data vector, counts calls
 ``powered_rhs(x, PC, p, c1, c2, ...)``   a powered walker's rhs and ledger powers (hip
                                          torque, push-off force; compiled actuation hook)
 ``build_cyrk()``, ``build_lsoda(sig)``   addresses of cfuncs of ``rhs_packed``
+``powered_packed(t, y, d, dy)``          a powered walker's rhs from the data vector
+                                         (``powered_kernels``; ``build_cyrk_powered()``)
 =======================================  =================================================
 """
 
@@ -83,28 +93,29 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from walkerlab.codegen.contact_glue import contact_glue_source
+from walkerlab.codegen.contact_glue import contact_glue
 from walkerlab.models.contact.assembly import NPC
 from walkerlab.models.contact.rhs_lines import rhs_source
 from walkerlab.walker.description import Structure
 
 __all__ = ["NPC", "contact_module", "contact_source", "rhs_source"]
 
-#: The files whose text the generated module's source is made of (its cache key; the
-#: kernels it imports, :mod:`walkerlab.models.contact.assembly` and ``_kernels``, are
-#: numba's own cache's, keyed on their files).
-_SOURCES = (Path(__file__), Path(__file__).with_name("powered_source.py"),
-            Path(__file__).with_name("rhs_lines.py"),
-            Path(__file__).parents[2] / "codegen" / "torque_law.py",
-            Path(__file__).parents[2] / "codegen" / "contact_glue.py")
-
+_HERE = Path(__file__).parent
+#: The files whose text the generated module's source is made of, or whose compiled code
+#: numba links into it (its cache key): the glue, the straight-line rhs, the kernels.
+_SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
+            _HERE / "assembly.py", _HERE / "powered_kernels.py", _HERE / "_kernels.py",
+            _HERE.parent.parent / "codegen" / "torque_law.py",
+            _HERE.parent.parent / "codegen" / "contact_glue.py")
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
     constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``NF``,
     ``POINT_LEG``, ``PIN``, ``CONTACTS``, then the glue of
-    :func:`walkerlab.codegen.contact_glue.contact_glue_source` and the straight-line
-    ``rhs``).
+    :func:`walkerlab.codegen.contact_glue.contact_glue` that hands the generated
+    kinematics to :mod:`walkerlab.models.contact.assembly`, the straight-line ``rhs`` and
+    ``rhs_q``, and the powered glue of
+    :func:`~walkerlab.models.contact.powered_source.powered_source`).
 
     Raises
     ------
@@ -122,9 +133,8 @@ def contact_source(structure: Structure, key: str) -> str:
     legs = tuple(eq.point_legs)
     return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(eq.knees)}\n"
             f"NF = {len(eq.feet)}\nPOINT_LEG = {legs!r}\nPIN = {legs.index(1)}\n"
-            f"CONTACTS = {tuple(eq.contacts)!r}\n" + contact_glue_source() + "\n\n"
-            + rhs_source(eq) + "\n\n" + rhs_source(eq, forced=True) + "\n\n"
-            + powered_source())
+            f"CONTACTS = {tuple(eq.contacts)!r}\n" + contact_glue() + "\n\n" + rhs_source(eq)
+            + "\n\n" + rhs_source(eq, forced=True) + "\n\n" + powered_source())
 
 
 def contact_module(structure: Structure):
