@@ -45,7 +45,7 @@ from walkerlab.studies.mfpt import step_map_for
 
 sc = load_scene("configs/paper.yaml")
 ideal = np.array([-0.2022, 0.1674, -0.6, -0.84])
-w, _ = S.build(sc, ideal, 4)
+w, _ = S.build(sc, ideal, 4, plant=Plant.from_scene(sc))
 x = initial_state_from_ideal(w, *ideal)
 w.rhs(0.0, x); w.jac(0.0, x); w.hip_height(x[None])
 w.kernels.contact_table(x[None], *w._args())

@@ -22,15 +22,15 @@ from walkerlab.config.base import Strict, drop_unset
 # A kneed leg (``knee``) and round feet (``foot.kind: arc``) extend these classes.
 
 #: a body's mass [kg] (every body of a leg or the torso)
-BodyMassKg = Annotated[float, Field(gt=0, le=1e4, description="mass [kg]")]
+_BodyMassKg = Annotated[float, Field(gt=0, le=1e4, description="mass [kg]")]
 #: a torso body's name (its point: ``torso_<name>``)
-TorsoBodyName = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$",
+_TorsoBodyName = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$",
                                      description="body name (point: torso_<name>)")]
 #: a leg body's name (its points: ``swing_<name>``)
-LegBodyName = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$",
+_LegBodyName = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$",
                                    description="body name (points: swing_<name>)")]
 #: the leg link carrying a body
-LegLink = Annotated[Literal["leg", "thigh", "shank"],
+_LegLink = Annotated[Literal["leg", "thigh", "shank"],
                     Field(description="leg link carrying the body ('thigh'/'shank' need a knee)")]
 
 
@@ -38,8 +38,8 @@ class PointMassBody(Strict):
     """A point mass on a leg link, at ``from_hip_m`` along the link from the hip."""
 
     kind: Literal["point_mass"] = Field(description="body type")
-    name: LegBodyName
-    link: LegLink = "leg"
+    name: _LegBodyName
+    link: _LegLink = "leg"
     mass_kg: float = Field(ge=0, le=1e4, description="mass [kg]; 0 = the limit m/M -> 0, "
                            "taken symbolically (Garcia et al. 1998), not a small number")
     from_hip_m: float = Field(ge=0, le=100, description="distance from the hip along the link [m]")
@@ -52,9 +52,9 @@ class RodBody(Strict):
     """A rigid rod on a leg link: mass, centre of mass along the link, inertia about the COM."""
 
     kind: Literal["rod"] = Field(description="body type")
-    name: LegBodyName
-    link: LegLink = "leg"
-    mass_kg: BodyMassKg
+    name: _LegBodyName
+    link: _LegLink = "leg"
+    mass_kg: _BodyMassKg
     com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass from the hip [m]")
     inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
                                            "the centre of mass [kg m^2] (uniform rod: m l^2/12)")
@@ -260,8 +260,8 @@ class TorsoPointMass(Strict):
     """A point mass on the upper body, ``from_hip_m`` up its axis from the hip."""
 
     kind: Literal["point_mass"] = Field(description="body type")
-    name: TorsoBodyName
-    mass_kg: BodyMassKg
+    name: _TorsoBodyName
+    mass_kg: _BodyMassKg
     from_hip_m: float = Field(ge=0, le=100, description="distance from the hip up the torso's "
                               "axis [m]")
     off_axis_m: float = Field(0.0, ge=-100, le=100, description="distance from the torso's axis "
@@ -272,8 +272,8 @@ class TorsoRigidBody(Strict):
     """A rigid body on the upper body: mass, centre of mass (on or off the axis), inertia."""
 
     kind: Literal["rigid_body"] = Field(description="body type")
-    name: TorsoBodyName
-    mass_kg: BodyMassKg
+    name: _TorsoBodyName
+    mass_kg: _BodyMassKg
     com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass up the torso's axis "
                                   "from the hip [m]")
     com_off_axis_m: float = Field(0.0, ge=-100, le=100, description="centre of mass off the "
