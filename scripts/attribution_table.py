@@ -17,10 +17,11 @@ from walkerlab.walker.plant import Plant
 def main(paths):
     for path in paths:
         scene = load_scene(path)
-        ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
-        walker, _ = build(scene, ideal.x, 2, plant=Plant.from_scene(scene))
+        plant = Plant.from_scene(scene)
+        ideal = ideal_gait(scene, plant=plant)
+        walker, _ = build(scene, ideal.x, 2, plant=plant)
         a = attribute(walker, ideal)
-        adj = adjustment_effect(scene, ideal, plant=Plant.from_scene(scene))
+        adj = adjustment_effect(scene, ideal, plant=plant)
         print(f"## {scene.name}: rigid step period {ideal.period_s:.6f} s")
         print("| cause | period gap [ms] | step-length gap [mm] |")
         print("|---|---|---|")

@@ -141,7 +141,8 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
                 raise SystemExit(f"--sub {a!r}: not in {path}")
         path = path.with_name("walker_sub.xml")
         path.write_text(text)
-    fb = mw.virtual_constraint_feedback(scene, Plant.from_scene(scene).data)
+    plant = Plant.from_scene(scene)
+    fb = mw.virtual_constraint_feedback(scene, plant.data)
     ctrl, n = fb.controller, fb.controller.n
     b = annihilator(ctrl.B)
 
@@ -189,8 +190,7 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
         a = x[np.searchsorted(tt, t0 + 0.03)]
         slip.append((a - x[0], x[-1] - a))
     slip = 1e3 * np.array(slip[1:])
-    walker, solver = build_walker(scene,
-                                  plant=Plant.from_scene(scene)), Solver.from_settings(scene.solver)
+    walker, solver = build_walker(scene, plant=plant), Solver.from_settings(scene.solver)
 
     def rigid_after(xr):  # the rigid closed loop 3 ms after its impact
         seg = integrate_step(walker, xr, solver, max_step_time=0.003)

@@ -38,12 +38,13 @@ def row(name: str) -> str:
 
     t = time.perf_counter()
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
+    plant = Plant.from_scene(sc)
     try:
-        sm = BatchStepMap(build_walker(sc, plant=Plant.from_scene(sc)), scene_walker_at(sc,
-                plant=Plant.from_scene(sc)), 1e-12, 1e-12)
+        sm = BatchStepMap(build_walker(sc, plant=plant), scene_walker_at(sc, plant=plant),
+                          1e-12, 1e-12)
     except ValueError as exc:
         return f"| {name} | not supported: {exc} |"
-    w, s = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
+    w, s = solve_scene(sc, fd_check=False, plant=plant)
     if w.steps_per_map != 1:
         return f"| {name} | not supported: legs that differ (a stride map) |"
     g = s.gait.result
@@ -78,12 +79,13 @@ def contact_row(name: str) -> str:
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
     if sc.contact is None:
         return f"| {name} | no contact section |"
-    _, s = solve_scene(sc, fd_check=False, plant=Plant.from_scene(sc))
+    plant = Plant.from_scene(sc)
+    _, s = solve_scene(sc, fd_check=False, plant=plant)
     start = "periodic gait"
     try:
-        st = contact_start(sc, s.gait.result.x, plant=Plant.from_scene(sc))
+        st = contact_start(sc, s.gait.result.x, plant=plant)
     except Exception:  # no periodic gait in time: the contact run's own start (a transient)
-        st = contact_start(sc, s.gait.result.x, periodic=False, plant=Plant.from_scene(sc))
+        st = contact_start(sc, s.gait.result.x, periodic=False, plant=plant)
         start = "contact-sim start (no periodic gait found in time)"
     cells = [name, f"{st.period_s:.6f} ({start})"]
     for sign in (1.0, -1.0):

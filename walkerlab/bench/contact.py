@@ -262,9 +262,10 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     from walkerlab.analysis.contact.sim import scene_start
     from walkerlab.models.contact.scene import contact_setup
 
-    ideal = ideal_gait(scene, plant=Plant.from_scene(scene))
-    walker, x0, limits, _ = scene_start(contact_setup(scene,
-            plant=Plant.from_scene(scene)), ideal.x, n_strides + 1)
+    plant = Plant.from_scene(scene)  # the bench's scene, described once
+    ideal = ideal_gait(scene, plant=plant)
+    walker, x0, limits, _ = scene_start(contact_setup(scene, plant=plant), ideal.x,
+                                        n_strides + 1)
     t_final = 1.03 * 2 * n_strides * ideal.period_s
     case = _Case(walker, x0, t_final, limits, reference_rtol, 1e-2 * reference_rtol,
                  reference_method)

@@ -91,6 +91,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
             scene = scene_at(task.base, value, task.path)
+            plant = Plant.from_scene(scene)  # this value's walker, described once
             try:
                 if fam is None:  # the walker over the grid's field, built once a chunk
                     fam = scene_family(scene, task.path)
@@ -99,7 +100,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
                                                   _cache={})
                 q = _arclength_step(fam, prev, value)
                 if q is not None:  # the neighbour's branch followed to this value
-                    walker = build_walker(scene, plant=Plant.from_scene(scene))
+                    walker = build_walker(scene, plant=plant)
                     row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
                                period_s=q.period_s / fam.steps(walker))  # per step
                 else:
@@ -111,10 +112,10 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
                 prev = (value, q if q is not None else row["x"])
             except PointOutcome as exc:
                 row.update(fp_outcome=exc.outcome, message=exc.message)
-                walker = build_walker(scene, plant=Plant.from_scene(scene))
+                walker = build_walker(scene, plant=plant)
             except Exception as exc:  # noqa: BLE001
                 row.update(fp_outcome="error", message=f"{type(exc).__name__}: {exc}")
-                walker = build_walker(scene, plant=Plant.from_scene(scene))
+                walker = build_walker(scene, plant=plant)
             if task.steady_state:
                 x_att = _steady_state(task, scene, walker, row, x_att)
         row["wall_time_s"] = time.perf_counter() - t0
