@@ -63,9 +63,11 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
+from walkerlab.codegen.frames import rotation, slope_to_world
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.seeded import seeded as _seeded
+from walkerlab.codegen.tree_derive import derive_tree, plastic_impact
+from walkerlab.walker.trees import legs_3d_tree
 
 
 def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
@@ -360,70 +362,34 @@ def derive_compass(structure) -> Equations:
     if not structure.in_3d or structure.spokes:
         raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
                          "walker")
-    phi, th_sw, th_st = sp.symbols("q_lean q_swing q_stance", real=True)
-    dphi, dth_sw, dth_st = sp.symbols("dq_lean dq_swing dq_stance", real=True)
-    q, dq = (phi, th_sw, th_st), (dphi, dth_sw, dth_st)
-    phi_p = phi_w = phi                                # the legs rigid to the pelvis in roll
-    if structure.hip_roll:
-        phi_p, phi_w = sp.symbols("q_pelvis_roll q_swing_roll", real=True)
-        dphi_p, dphi_w = sp.symbols("dq_pelvis_roll dq_swing_roll", real=True)
-        q, dq = q + (phi_p, phi_w), dq + (dphi_p, dphi_w)
-    par = sp.symbols(structure.param_names, real=True)
-    P = dict(zip(structure.param_names, par))
-    g, L, gamma, M_hip, m, a = (P[k] for k in ("g", "L", "gamma", "M_hip", "m_leg", "a_leg"))
+    tree, coords = legs_3d_tree(structure)
+    te = derive_tree(tree, coords)
+    kin, q, dq = te.kinematics, te.q, te.dq
+    phi, th_sw, th_st = q[:3]
+    phi_p, phi_w = q[3:] if structure.hip_roll else (phi, phi)
+    P = dict(zip(structure.param_names, te.params))
+    L, gamma = P["L"], P["gamma"]
     w = P.get("w_hip", 0)
-    # vectors in the slope's frame (fall line s, normal n, z): there the roll is about the
-    # first axis and a leg's pitch about the third, from the normal by theta + gamma
-    ez = sp.Matrix([0, 0, 1])
-
-    def roll_of(angle):
-        return rotation(sp.Matrix([1, 0, 0]), angle)
-    axis = roll_of(phi_p) * ez                         # the hip axis
-
-    def leg(theta, length, lean=phi):  # from the hip to a point at ``length`` down the leg
-        return roll_of(lean) * (rotation(ez, theta + gamma) * sp.Matrix([0, -length, 0]))
-
     arc = structure.foot == "arc"
     R = P["R_foot"] if arc else 0
     e_s, e_n = sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0])
-    # the stance disc's centre from the step's reference point: its contact point rolled
-    # -R (theta_st + gamma) down the fall line, the centre R along the rolled normal above it
-    offset = (-R * (th_st + gamma) * e_s + R * roll_of(phi) * e_n) if arc else sp.zeros(3, 1)
-    hip_st = offset - leg(th_st, L - R)
-    hip_sw = hip_st + w * axis
-    pelvis = hip_st + w / 2 * axis
-    m_st = hip_st + leg(th_st, L - a)                  # a from the foot's lowest point
-    m_sw = hip_sw + leg(th_sw, L - a, phi_w)
-    centre_sw = hip_sw + leg(th_sw, L - R, phi_w)      # the point foot, or the disc's centre
-    swing_contact = centre_sw - R * roll_of(phi_w) * e_n
+    G = te.G - _hip_roll_forces(q, dq, P) if structure.hip_roll else te.G
+    # the swing foot's contact point, and the rates that keep its material point at rest: a
+    # point foot's, or the disc's lowest point's velocity plus R theta_sw' s (the material
+    # point's, v_c + omega x (-R n_w) = d(contact)/dt + R theta_sw' s: the lean pivots the
+    # disc about it)
+    if arc:
+        centre_sw = kin.contacts["swing_foot_centre"]
+        swing_contact = centre_sw - R * rotation(e_s, phi_w) * e_n
+        F = swing_contact.jacobian(sp.Matrix(q)) + R * e_s * sp.Matrix(
+            [[sp.diff(th_sw, k) for k in q]])
+    else:
+        swing_contact = kin.contacts["swing_foot"]
+        F = swing_contact.jacobian(sp.Matrix(q))
+    Mi, B = plastic_impact(te.M, te.A, te.total_mass, F)
     # the next step's reference point (where its contact is with its leg normal to the slope)
     swing_foot = swing_contact + R * (th_sw + gamma) * e_s
-    masses = [(M_hip, pelvis), (m, m_st), (m, m_sw)]
-    M, A, total = _point_mass_matrix(masses, q)
-    if structure.hip_roll:  # the pelvis' own inertia about the fall line (it rolls by phi_p)
-        M[3, 3] += P["I_pelvis"]
-    if structure.bodies[0].kind == "rod":  # each leg's inertia normal to its axis
-        M += _leg_rotation_mass(q, phi, th_st, phi_w, th_sw, gamma, P["I_leg"])
-    M = M.applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
-    C = christoffel(M, q, dq)
-    # height above the horizontal of a point r (slope frame): -sin(gamma) r_s + cos(gamma) r_n
-    up = slope_up(gamma)
-    potential = sum(mi * g * _dot(r, up) for mi, r in masses)
-    G = sp.Matrix([sp.expand(sp.diff(potential, qi)) for qi in q])
-    if structure.hip_roll:
-        G = G - _hip_roll_forces(q, dq, P)
-    kinetic = sp.Rational(1, 2) * (sp.Matrix(dq).T * M * sp.Matrix(dq))[0]
-    # impact about the new foot (extended coordinates, the old stance foot free)
-    # the rates that keep the swing foot's material contact point at rest: a point foot's,
-    # or the disc's lowest point's velocity plus R theta_sw' s (the material point's, v_c +
-    # omega x (-R n_w) = d(contact)/dt + R theta_sw' s: the lean pivots the disc about it)
-    F = swing_contact.jacobian(sp.Matrix(q))
-    if arc:
-        F += R * e_s * sp.Matrix([[sp.diff(th_sw, k) for k in q]])
-    Mi = (M - A * F - F.T * A.T + total * F.T * F).applyfunc(
-        lambda e: sp.trigsimp(sp.expand(e)))
-    B = (M - F.T * A.T).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
-    to_world = slope_to_world(gamma)                   # columns s, n, z
+    pelvis = kin.coms["pelvis"]
     height = swing_contact[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
     if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
@@ -440,24 +406,33 @@ def derive_compass(structure) -> Equations:
     else:
         heel = sigma
         drop_solution = -th_st - 2 * gamma
-    points = {k: to_world * v for k, v in (
-        ("hip", pelvis), ("stance_hip", hip_st), ("swing_hip", hip_sw),
-        ("stance_foot", sp.zeros(3, 1)), ("swing_foot", swing_foot), ("stance_mass", m_st),
-        ("swing_mass", m_sw))}
+    to_world = slope_to_world(gamma)                   # columns s, n, z
+    named = [("hip", pelvis), ("stance_hip", kin.origins["pelvis"]),
+             ("swing_hip", kin.origins["swing_leg"]), ("stance_foot", sp.zeros(3, 1)),
+             ("swing_foot", swing_foot)]
+    named += [(f"{role}_{b.name}", kin.coms[f"{role}_leg_{b.name}"])
+              for b in structure.bodies for role in ("stance", "swing")]
+    named += [(f"torso_{b.name}", kin.coms[f"torso_{b.name}"]) for b in structure.torso]
     if arc:
-        points.update({k: to_world * v for k, v in (
-            ("stance_contact", offset - R * roll_of(phi) * e_n), ("stance_foot_centre", offset),
-            ("swing_contact", swing_contact), ("swing_foot_centre", centre_sw))})
+        centre_st = kin.origins["stance_leg"]
+        named += [("stance_contact", centre_st - R * rotation(e_s, phi) * e_n),
+                  ("stance_foot_centre", centre_st), ("swing_contact", swing_contact),
+                  ("swing_foot_centre", centre_sw)]
+    points = {k: to_world * v for k, v in named}
+    leg_angles = {"stance": th_st, "swing": th_sw, "lean": phi,
+                  # each leg's roll by leg (the lean is the stance leg's)
+                  **({"pelvis_roll": phi_p, "stance_roll": phi, "swing_roll": phi_w}
+                     if structure.hip_roll else {})}
+    if structure.torso:   # the bisecting hip: the upper body's pitch from the upward vertical
+        leg_angles["torso"] = (th_sw + th_st) / 2
     n = len(q)
     return Equations(
-        q=q, dq=dq, params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
-        relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=kinetic, potential=potential,
+        q=q, dq=dq, params=te.params, M=te.M, C=te.C, G=G, Mi=Mi, B=B,
+        relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=te.kinetic,
+        potential=te.potential,
         guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
                 "hip_height": pelvis[1], "swing_clearance": height},
-        points=points, leg_angles={"stance": th_st, "swing": th_sw, "lean": phi,
-                                   # each leg's roll by leg (the lean is the stance leg's)
-                                   **({"pelvis_roll": phi_p, "stance_roll": phi,
-                                       "swing_roll": phi_w} if structure.hip_roll else {})},
+        points=points, leg_angles=leg_angles,
         section_drop=1, drop_solution=drop_solution,
         De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
     )

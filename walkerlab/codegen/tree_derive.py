@@ -190,12 +190,15 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
     chains[root], R[root], origin[root] = [], sp.eye(3), sp.zeros(3, 1)
     for b in tree.bodies:
         j = b.joint
-        steps = [(tuple(num(c) for c in axis), angle[c]) for axis, c in
-                 zip(j.axes, j.coordinates)]
+        slide = j.kind == "prismatic"   # the origin moves along the axis, nothing turns
+        steps = [] if slide else [(tuple(num(c) for c in axis), angle[c]) for axis, c in
+                                  zip(j.axes, j.coordinates)]
         chain = _merged(chains[j.parent] + steps)
         chains[b.name] = chain
         R[b.name] = _product(chain)
-        origin[b.name] = origin[j.parent] + R[j.parent] * vec(j.origin_m)
+        at = vec(j.origin_m) + (vec(j.axes[0]) * angle[j.coordinates[0]] if slide else
+                                sp.zeros(3, 1))
+        origin[b.name] = origin[j.parent] + R[j.parent] * at
         com[b.name] = origin[b.name] + R[b.name] * vec(b.com_m)
         w = sp.zeros(3, 1)
         for k, (axis, a) in enumerate(chain):   # omega_b = sum_k R_>k^T u_k a_k'

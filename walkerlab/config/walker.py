@@ -209,6 +209,17 @@ class BipedParams(_Actuated):
     torso: TorsoSpec | None = Field(None, description="upper body on the hip (null: none)")
     springs: list[SpringSpec] = Field(default_factory=list, description="torsional springs "
                                       "and dampers between links at the hip")
+    space: Literal["2d", "3d"] = Field("2d", description="2d: the walker moves in the "
+                                       "sagittal plane; 3d: it also rolls about the fall "
+                                       "line through its stance foot, which neither slips "
+                                       "nor twists (Kuo 1999; straight legs)")
+    hip_width_m: float = Field(0.0, ge=0, le=100, description="distance between the hips "
+                               "along the hip axis [m] (space: 3d only; the hip mass and "
+                               "the upper body midway; 0: the planar walker embedded in 3D)")
+
+    @model_serializer(mode="wrap")
+    def _planar_as_before(self, handler):
+        return drop_unset(handler(self), ("actuation", "space", "hip_width_m"))
 
     @model_validator(mode="after")
     def _has_mass(self) -> BipedParams:
@@ -252,7 +263,38 @@ class BipedParams(_Actuated):
         if any("torso" in s.between for s in self.springs) and self.torso is None:
             raise ValueError("springs: a spring on the torso needs a 'torso'")
         self._free_joints_check(pair)
+        self._space_check(pair)
         return self
+
+    def _space_check(self, pair) -> None:
+        """``space: 3d`` (the legs' parts in three dimensions,
+        :func:`walkerlab.walker.trees.straight_legs_3d_tree`): what it supports today, one
+        line otherwise."""
+        if self.space == "2d":
+            if self.hip_width_m:
+                raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
+                                 "walker's hips are one point)")
+            return
+        leg = pair[0]
+        for field, bad, what in (
+                ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
+                ("walker.legs", self.legs is not None and pair[0] != pair[1],
+                 "both legs identical (give 'leg')"),
+                ("walker.leg.knee", leg.knee is not None, "straight legs (no knee)"),
+                ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc"),
+                 "point or arc feet"),
+                ("walker.leg.bodies", any(b.mass_kg == 0 for b in leg.bodies),
+                 "massive leg bodies (mass_kg > 0)"),
+                ("walker.springs", bool(self.springs), "no springs"),
+                ("walker.torso.coupling", self.torso is not None
+                 and self.torso.coupling != "bisecting_hip", "a bisecting_hip torso"),
+                ("walker.actuation", self.actuation is not None, "a passive walker")):
+            if bad:
+                raise ValueError(f"{field}: a walker in space: 3d needs {what} today")
+        if not self.hip_width_m < 2 * leg.length_m:   # as CompassGaitParams' check
+            raise ValueError(f"walker.hip_width_m: {self.hip_width_m:g} m on legs of "
+                             f"{leg.length_m:g} m: give hip_width_m below "
+                             f"{2 * leg.length_m:g} m (2 leg.length_m)")
 
     def _free_joints_check(self, pair) -> None:
         """Free knees (``knee.lock: free``) and a hinged torso: a chain of free joints (the

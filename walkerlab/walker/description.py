@@ -13,7 +13,7 @@ mass and one point mass per leg at ``b = L - a`` from the hip.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from walkerlab.walker.kinds import Kind, kind_of
 
@@ -179,6 +179,7 @@ class Structure:
     in_3d: bool = False
     hip_width: bool = False
     hip_roll: bool = False
+    parts_3d: bool = False
 
     @property
     def kind(self) -> Kind:
@@ -230,7 +231,7 @@ class Structure:
         """Names of the parameter vector, in order (SI units; ``gamma`` is the slope [rad])."""
         if self.spokes:
             return SPOKED_3D_PARAMS if self.in_3d else SPOKED_PARAMS
-        if self.in_3d:
+        if self.in_3d and not self.parts_3d:
             return (COMPASS_3D_PARAMS + (("w_hip",) if self.hip_width else ())
                     + (("I_leg",) if self.bodies[0].kind == "rod" else ())
                     + (("R_foot",) if self.foot == "arc" else ())
@@ -266,7 +267,7 @@ class Structure:
             names += [f"k_s{i}", f"r_s{i}", f"c_s{i}"]
         if self.knee_spring:
             names += ["k_knee", "r_knee", "c_knee"]
-        return tuple(names)
+        return tuple(names) + (("w_hip",) if self.hip_width else ())
 
     def key(self) -> str:
         """Canonical JSON of the structure (part of the generated-code cache key)."""
@@ -296,6 +297,8 @@ class Structure:
             d["hip_width"] = True
         if self.hip_roll:
             d["hip_roll"] = True
+        if self.parts_3d:
+            d["parts_3d"] = True
         return json.dumps(d)
 
 
@@ -532,6 +535,11 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
              + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ()))
              + (2 * foot_mass[0] if foot_mass is not None else 0.0))
+    if walker_cfg.space == "3d":   # the parts in 3D: the hip width last, mirrored a step on
+        width = float(walker_cfg.hip_width_m)
+        structure = replace(structure, in_3d=True, hip_width=bool(width), parts_3d=True)
+        extra["hip_width_m"] = width
+        p1, p2 = (p1 + (width,), p1 + (-width,)) if width else (p1, p1)
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
                       slope_rad, extra, None if p2 == p1 else p2)
 

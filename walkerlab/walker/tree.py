@@ -12,7 +12,8 @@ or a body listed before it.
   point, fixed through a step; gravity ``g`` points along world ``-y``.
 - :class:`Joint`: ``revolute`` (one axis), ``universal`` (two axes, the second turned by the
   first's angle), ``spherical`` (three axes in sequence: Euler angles, singular where two
-  consecutive axes align) or ``fixed`` (none).  Its rotation is ``Rot(a_1, q_1) ...
+  consecutive axes align), ``prismatic`` (a slide along one axis: the child's origin moves
+  by ``q a`` and does not turn) or ``fixed`` (none).  Its rotation is ``Rot(a_1, q_1) ...
   Rot(a_k, q_k)``, each axis a unit vector in the frame left by the ones before it; its
   origin is in the parent body's frame.
 - :class:`Body`: mass, inertia (3×3 about the centre of mass, in the body's frame), centre of
@@ -35,7 +36,7 @@ __all__ = ["Body", "BodyTree", "ContactPoint", "CoordinateMap", "Joint", "Root",
            "ZERO_INERTIA", "diagonal"]
 
 #: number of axes (and coordinates) of each joint kind
-JOINT_AXES = {"fixed": 0, "revolute": 1, "universal": 2, "spherical": 3}
+JOINT_AXES = {"fixed": 0, "revolute": 1, "prismatic": 1, "universal": 2, "spherical": 3}
 #: names an expression may use besides the tree's parameters
 FUNCTIONS = frozenset({"sin", "cos", "tan", "sqrt", "pi"})
 
@@ -50,7 +51,7 @@ class Joint:
     Attributes
     ----------
     name : str
-    kind : {"revolute", "universal", "spherical", "fixed"}
+    kind : {"revolute", "prismatic", "universal", "spherical", "fixed"}
     parent : str
         The parent body's name, or the root's.
     origin_m : tuple (3,)
@@ -59,7 +60,8 @@ class Joint:
         One unit axis per coordinate (:data:`JOINT_AXES`), each in the frame left by the
         rotations about the axes before it (the first in the parent's frame).
     coordinates : tuple of str
-        The joint's angles [rad], one per axis, named uniquely in the tree.
+        The joint's angles [rad] (a prismatic joint's travel [m]), one per axis, named
+        uniquely in the tree.
     """
 
     name: str

@@ -26,6 +26,8 @@ normal to it and none about it.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from walkerlab.walker.tree import (
     ZERO_INERTIA,
     Body,
@@ -37,7 +39,8 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["compass_3d_tree", "planar_compass_tree", "spoked_wheel_3d_tree"]
+__all__ = ["Part", "compass_3d_tree", "legs_3d_tree", "planar_compass_tree", "spoked_wheel_3d_tree",
+           "straight_legs_3d_tree"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 #: the parameters the 3D compass's tree reads, before the hip-roll law's gains (the order
@@ -47,11 +50,145 @@ _HIP_ROLL_LAW = ("I_pelvis", "kp_pelvis", "kd_pelvis", "kp_swing", "kd_swing", "
                  "g_lean_rate")
 
 
+@dataclass(frozen=True)
+class Part:
+    """One body of a leg or of the upper body, by the names of its numbers in the tree's
+    parameters (strings: expressions in them).
+
+    Attributes
+    ----------
+    name : str
+    mass : str
+        [kg].
+    from_hip : str
+        Distance from the hip along the link [m]: down a leg, up the upper body.
+    inertia : str or None
+        Inertia about the centre of mass about every axis normal to the link [kg m^2] (a
+        slender rod's; none about the link's own axis), or None: a point mass.
+    ahead : str or None
+        Distance of the centre of mass ahead of the link's axis, in its sagittal plane [m].
+    """
+
+    name: str
+    mass: str
+    from_hip: str
+    inertia: str | None = None
+    ahead: str | None = None
+
+    def com(self, along: str) -> tuple:
+        return (self.ahead or 0, along, 0)
+
+    def inertia_tensor(self):
+        return ZERO_INERTIA if self.inertia is None else diagonal(self.inertia, 0,
+                                                                  self.inertia)
+
+
+def straight_legs_3d_tree(params: tuple[str, ...], legs: tuple[Part, ...],
+                          torso: tuple[Part, ...] = (), *, hip_width: str | float = 0,
+                          hip_roll: bool = False, foot_radius: str | None = None
+                          ) -> tuple[BodyTree, CoordinateMap]:
+    """A straight-legged walker in three dimensions (Kuo 1999) as a tree (module docstring),
+    from its parts: each leg a frame carrying ``legs`` (welded), the pelvis with ``M_hip``
+    midway between the hips, and an upper body carrying ``torso`` held on the bisector of
+    the legs by a bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007, IEEE Trans.
+    Robotics 23(1)): its pitch from the upward vertical is the mean of the legs' pitches
+    (leaning back when the feet are ahead; no coordinate of its own), its roll the pelvis'.
+
+    Parameters
+    ----------
+    params : tuple of str
+        The parameter names (the generated code's vector, in order); they include ``g, L,
+        gamma, M_hip`` and every name the parts use.
+    legs, torso : tuple of Part
+        The bodies on each leg (both legs alike) and on the upper body.
+    hip_width : str or float
+        The distance between the hips along the hip axis [m] (a parameter name, or 0).
+    hip_roll : bool
+        The legs hang from the pelvis on roll joints (coordinates ``pelvis_roll,
+        swing_roll``; the pelvis' roll inertia ``I_pelvis``).
+    foot_radius : str or None
+        Round feet: each foot a disc of this radius [m] in its leg's rolled sagittal plane
+        rolling on the slope without slip (its centre ``L - R`` from the hip; the stance
+        disc's centre ``-R (theta_st + gamma)`` along the fall line and ``R`` along the
+        rolled normal from the step's reference point: a slide ``stance_travel``, then the
+        roll, then the pitch about the centre); None: point feet.
+
+    Returns
+    -------
+    BodyTree, CoordinateMap
+        Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (and ``torso``), each part
+        ``<link>_<part>``; contacts ``stance_foot`` and ``swing_foot`` (round feet:
+        ``swing_foot_centre``, the swing disc's centre); coordinates ``lean, swing, stance``
+        (and ``pelvis_roll, swing_roll``).
+
+    Raises
+    ------
+    ValueError
+        The tree does not validate (:class:`~walkerlab.walker.tree.BodyTree`).
+    """
+    R = foot_radius
+    up_leg = "L" if R is None else f"L - {R}"     # from the frame's origin to the hip
+    bodies: list = []
+    if R is None:
+        bodies.append(Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                           Joint("stance_ankle", "universal", "slope", (0, 0, 0), (S, Z),
+                                 ("stance_ankle_roll", "stance_ankle_pitch"))))
+    else:   # the rolling disc: a slide along the fall line, the roll, the pitch about its centre
+        bodies += [Body("stance_travel", 0, ZERO_INERTIA, (0, 0, 0),
+                        Joint("stance_roll_travel", "prismatic", "slope", (0, 0, 0), (S,),
+                              ("stance_travel",))),
+                   Body("stance_roll", 0, ZERO_INERTIA, (0, 0, 0),
+                        Joint("stance_ankle_roll", "revolute", "stance_travel", (0, 0, 0),
+                              (S,), ("stance_ankle_roll",))),
+                   Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                        Joint("stance_ankle_pitch", "revolute", "stance_roll", (0, R, 0),
+                              (Z,), ("stance_ankle_pitch",)))]
+    # each leg's parts hang from its hip (their frames there, the leg's axes)
+    bodies += [Body(f"stance_leg_{p.name}", p.mass, p.inertia_tensor(),
+                    p.com(f"-({p.from_hip})"),
+                    Joint(f"stance_leg_{p.name}_weld", "fixed", "stance_leg", (0, up_leg, 0)))
+               for p in legs]
+    half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
+    bodies.append(Body("pelvis", "M_hip",
+                       diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
+                       (0, 0, half),
+                       Joint("stance_hip", "universal", "stance_leg", (0, up_leg, 0), (Z, S),
+                             ("stance_hip_pitch", "stance_hip_roll"))))
+    bodies.append(Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                       Joint("swing_hip", "universal", "pelvis", (0, 0, hip_width), (S, Z),
+                             ("swing_hip_roll", "swing_hip_pitch"))))
+    bodies += [Body(f"swing_leg_{p.name}", p.mass, p.inertia_tensor(),
+                    p.com(f"-({p.from_hip})"),
+                    Joint(f"swing_leg_{p.name}_weld", "fixed", "swing_leg")) for p in legs]
+    if torso:
+        bodies.append(Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
+                           Joint("torso_pitch", "revolute", "pelvis", (0, 0, half), (Z,),
+                                 ("torso_pitch",))))
+        bodies += [Body(f"torso_{p.name}", p.mass, p.inertia_tensor(), p.com(p.from_hip),
+                        Joint(f"torso_{p.name}_weld", "fixed", "torso")) for p in torso]
+    swing_end = ((ContactPoint("swing_foot", "swing_leg", (0, "-L", 0)),) if R is None else
+                 (ContactPoint("swing_foot_centre", "swing_leg", (0, f"-({up_leg})", 0)),))
+    tree = BodyTree(params, Root(), tuple(bodies),
+                    (ContactPoint("stance_foot", "stance_leg" if R is None else
+                                  "stance_travel", (0, 0, 0)),) + swing_end)
+    names = ("lean", "swing", "stance") + (("pelvis_roll", "swing_roll") if hip_roll else ())
+    pelvis_roll, swing_roll = ("pelvis_roll", "swing_roll") if hip_roll else ("lean", "lean")
+    angles = ((("stance_travel", f"-{R} * (stance + gamma)"),) if R is not None else ()) + (
+        ("stance_ankle_roll", "lean"), ("stance_ankle_pitch", "stance + gamma"),
+        ("stance_hip_pitch", "-(stance + gamma)"),
+        ("stance_hip_roll", f"{pelvis_roll} - lean"),
+        ("swing_hip_roll", f"{swing_roll} - {pelvis_roll}"),
+        ("swing_hip_pitch", "swing + gamma")) + (
+        (("torso_pitch", "(swing + stance) / 2 + gamma"),) if torso else ())
+    return tree, CoordinateMap(names, angles)
+
+
 def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
                     ) -> tuple[BodyTree, CoordinateMap]:
-    """The 3D straight-legged walker with hip width ``w_hip`` as a tree, and the coordinates
-    of :func:`walkerlab.codegen.derive_3d.derive_compass` (``lean, swing, stance`` and, with
-    ``hip_roll``, ``pelvis_roll, swing_roll``) as its joint angles' map.
+    """The 3D straight-legged walker with hip width ``w_hip`` as a tree
+    (:func:`straight_legs_3d_tree`: a point mass ``m_leg`` on each leg ``a_leg`` from its
+    foot), and the coordinates ``lean, swing, stance`` (and, with ``hip_roll``,
+    ``pelvis_roll, swing_roll``) as its joint angles' map.
 
     Parameters
     ----------
@@ -64,34 +201,45 @@ def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
     Returns
     -------
     BodyTree, CoordinateMap
-        Parameters in ``derive_compass``'s order (``g, L, gamma, M_hip, m_leg, a_leg,
-        w_hip[, I_leg][, I_pelvis, kp_pelvis, ...]``).
+        Parameters ``g, L, gamma, M_hip, m_leg, a_leg, w_hip[, I_leg][, I_pelvis, kp_pelvis,
+        ...]`` (:data:`walkerlab.walker.description.COMPASS_3D_PARAMS` and its tails).
     """
     params = _BASE + ("w_hip",) + (("I_leg",) if leg_inertia else ()) + (
         _HIP_ROLL_LAW if hip_roll else ())
-    leg_i = diagonal("I_leg", 0, "I_leg") if leg_inertia else ZERO_INERTIA
-    stance_leg = Body("stance_leg", "m_leg", leg_i, (0, "a_leg", 0),
-                      Joint("stance_ankle", "universal", "slope", (0, 0, 0), (S, Z),
-                            ("stance_ankle_roll", "stance_ankle_pitch")))
-    pelvis = Body("pelvis", "M_hip",
-                  diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
-                  (0, 0, "w_hip / 2"),
-                  Joint("stance_hip", "universal", "stance_leg", (0, "L", 0), (Z, S),
-                        ("stance_hip_pitch", "stance_hip_roll")))
-    swing_leg = Body("swing_leg", "m_leg", leg_i, (0, "-(L - a_leg)", 0),
-                     Joint("swing_hip", "universal", "pelvis", (0, 0, "w_hip"), (S, Z),
-                           ("swing_hip_roll", "swing_hip_pitch")))
-    tree = BodyTree(params, Root(), (stance_leg, pelvis, swing_leg),
-                    (ContactPoint("stance_foot", "stance_leg", (0, 0, 0)),
-                     ContactPoint("swing_foot", "swing_leg", (0, "-L", 0))))
-    names = ("lean", "swing", "stance") + (("pelvis_roll", "swing_roll") if hip_roll else ())
-    pelvis_roll, swing_roll = ("pelvis_roll", "swing_roll") if hip_roll else ("lean", "lean")
-    angles = (("stance_ankle_roll", "lean"), ("stance_ankle_pitch", "stance + gamma"),
-              ("stance_hip_pitch", "-(stance + gamma)"),
-              ("stance_hip_roll", f"{pelvis_roll} - lean"),
-              ("swing_hip_roll", f"{swing_roll} - {pelvis_roll}"),
-              ("swing_hip_pitch", "swing + gamma"))
-    return tree, CoordinateMap(names, angles)
+    leg = Part("mass", "m_leg", "L - a_leg", "I_leg" if leg_inertia else None)
+    return straight_legs_3d_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
+
+
+def legs_3d_tree(structure) -> tuple[BodyTree, CoordinateMap]:
+    """The tree of a 3D straight-legged walker's structure
+    (:class:`walkerlab.walker.description.Structure`, ``in_3d`` without spokes): the
+    ``model: compass_gait`` shorthand (one mass ``m_leg`` on each leg ``a_leg`` from its
+    foot, a rod's ``I_leg``, round feet ``R_foot``) or a biped from parts (``parts_3d``:
+    each leg body ``m_<name>, d_<name>[, I_<name>][, e_<name>]``, each upper-body body
+    ``m_torso_<name>, d_torso_<name>[, e_torso_<name>][, I_torso_<name>]``), with the hip
+    width ``w_hip`` and the hip-roll joints as the structure has them
+    (:func:`straight_legs_3d_tree`).
+
+    Returns
+    -------
+    BodyTree, CoordinateMap
+    """
+    if structure.parts_3d:
+        legs = tuple(Part(b.name, f"m_{b.name}", f"d_{b.name}",
+                          f"I_{b.name}" if b.kind == "rod" else None,
+                          f"e_{b.name}" if b.off_axis else None) for b in structure.bodies)
+        torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
+                           f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
+                           f"e_torso_{b.name}" if b.off_axis else None)
+                      for b in structure.torso)
+    else:
+        legs = (Part(structure.bodies[0].name, "m_leg", "L - a_leg",
+                     "I_leg" if structure.bodies[0].kind == "rod" else None),)
+        torso = ()
+    return straight_legs_3d_tree(structure.param_names, legs, torso,
+                                 hip_width="w_hip" if structure.hip_width else 0,
+                                 hip_roll=structure.hip_roll,
+                                 foot_radius="R_foot" if structure.foot == "arc" else None)
 
 
 def planar_compass_tree(*, leg_inertia: bool = False) -> tuple[BodyTree, CoordinateMap]:
