@@ -14,17 +14,12 @@ from __future__ import annotations
 
 from xml.sax.saxutils import quoteattr
 
-from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.legs_3d_mjcf import walker_tree
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
+from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, urdf_link_lines
 
 __all__ = ["legs_3d_urdf_text"]
-
-
-def _point_inertial(mass: float, z: float) -> str:
-    i = num(MJCF_MIN_INERTIA_KG_M2)
-    return (f'<inertial><origin xyz="{nums(0, 0, z)}"/><mass value="{num(mass)}"/>'
-            f'<inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/></inertial>')
 
 
 def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
@@ -53,16 +48,17 @@ def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
                    f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope "
                    f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); the "
                    "pelvis is the free root link"),
-           f"<robot name={quoteattr(name)}>",
-           f'  <link name="pelvis">{_point_inertial(p["M_hip"], 0.0)}</link>']
-    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
-        out += [f'  <link name="{leg}">{_point_inertial(p["m_leg"], -(L - a))}',
-                f'    <visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
+           f"<robot name={quoteattr(name)}>"]
+    tree, coords, p = walker_tree(data)
+    roles = PelvisRoles()
+    root, _couplings = export_bodies(tree, coords, p, roles)
+
+    def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere
+        if b.tree_body != roles.leg:
+            return []
+        return [f'{pad}<visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
                 f'radius="{num(L / 100)}" length="{num(L)}"/></geometry></visual>',
-                f'    <collision name="{leg}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>',
-                "  </link>",
-                f'  <joint name="{leg}_hip" type="continuous"><parent link="pelvis"/>'
-                f'<child link="{leg}"/><origin xyz="{nums(0, side * w / 2, 0)}"/>'
-                '<axis xyz="0 -1 0"/></joint>']
+                f'{pad}<collision name="{b.name}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+    out += urdf_link_lines(root, visuals)
     return "\n".join(out + ["</robot>", ""])

@@ -71,7 +71,7 @@ from walkerlab.export.text import num, nums
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
 __all__ = ["Coupling", "ExportBody", "ExportJoint", "PelvisRoles", "export_bodies",
-           "mjcf_body_lines", "mjcf_coupling_lines", "tree_mjcf_text"]
+           "mjcf_body_lines", "mjcf_coupling_lines", "tree_mjcf_text", "urdf_link_lines"]
 
 
 @dataclass(frozen=True)
@@ -440,6 +440,46 @@ def mjcf_coupling_lines(couplings) -> list[str]:
     out += ["  </tendon>", "  <equality>"]
     out += [f'    <tendon name="{c.name}" tendon1="{c.name}"/>' for c in couplings]
     return out + ["  </equality>"]
+
+
+def _urdf_inertial(b: ExportBody) -> str:
+    """URDF's ``inertial`` of ``b`` (zero products of inertia written ``0``)."""
+    J = b.inertia_kg_m2
+
+    def v(x: float) -> str:
+        return "0" if x == 0 else num(x)
+    return (f'<inertial><origin xyz="{nums(*b.com_m)}"/><mass value="{num(b.mass_kg)}"/>'
+            f'<inertia ixx="{num(J[0, 0])}" ixy="{v(J[0, 1])}" ixz="{v(J[0, 2])}" '
+            f'iyy="{num(J[1, 1])}" iyz="{v(J[1, 2])}" izz="{num(J[2, 2])}"/></inertial>')
+
+
+def urdf_link_lines(b: ExportBody, visuals=lambda b, pad: [], parent: str | None = None
+                    ) -> list[str]:
+    """URDF's ``link`` of ``b`` (its ``inertial`` and the lines ``visuals(b, pad)``
+    returns), the joint from ``parent`` (``continuous`` on one hinge, ``fixed`` on none;
+    none for the root, a floating base), then its children's.
+
+    Raises
+    ------
+    ValueError
+        A body on more than one hinge (URDF's joints have one axis: one line naming it).
+    """
+    extra = visuals(b, "    ")
+    out = [f'  <link name="{b.name}">{_urdf_inertial(b)}' + ("" if extra else "</link>"),
+           *extra, *(["  </link>"] if extra else [])]
+    if parent is not None:
+        if len(b.joints) > 1:
+            raise ValueError(f"{b.name}: {len(b.joints)} joints on one body (a URDF joint "
+                             "has one axis)")
+        head = (f'  <joint name="{b.joints[0].name}" type="continuous">' if b.joints else
+                f'  <joint name="{b.name}_weld" type="fixed">')
+        out.append(head + f'<parent link="{parent}"/><child link="{b.name}"/>'
+                   f'<origin xyz="{nums(*b.pos_m)}"/>'
+                   + (f'<axis xyz="{_axis_text(b.joints[0].axis)}"/>' if b.joints else "")
+                   + "</joint>")
+    for c in b.children:
+        out += urdf_link_lines(c, visuals, b.name)
+    return out
 
 
 def tree_mjcf_text(tree: BodyTree, coords: CoordinateMap, values: dict,
