@@ -7,7 +7,9 @@ with its pelvis).  Axes are URDF's (z up; x downhill; y = walkerlab's -z,
 :data:`walkerlab.export.spoked.TO_MUJOCO`): ``leg1`` on the side of -y (walkerlab's +z, where
 the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m`` above
 its foot and a sphere at its foot (collision); URDF has no ground, contact or state: the
-slope is stated in the header.
+slope is stated in the header.  The links' masses, inertias and joint axes are read from the
+walker's body tree, as the MJCF's (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`,
+:mod:`walkerlab.export.tree_bodies`).
 """
 
 from __future__ import annotations

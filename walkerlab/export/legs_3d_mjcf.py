@@ -12,7 +12,10 @@ where the first step's swing hip is).  Each leg has its point mass ``leg_mass_fr
 above its foot and a sphere of radius ``r = L / 1000`` whose centre is ``L - r`` down the
 leg (its lowest point at ``L`` with the leg upright, as the 3D wheel's spoke tips), with a
 site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest inertia
-(:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
+(:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).  The bodies, their masses,
+inertias and joint axes are read from the walker's body tree (:func:`walker_tree`;
+:mod:`walkerlab.export.tree_bodies`, where walkerlab's axes meet MuJoCo's); this module adds
+the geoms, the ground, the contact and the keyframe.
 
 The ground is the planar straight-legged walker's checkerboard
 (:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
