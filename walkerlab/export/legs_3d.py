@@ -4,7 +4,7 @@ mass, free in space (a loader gives the root link a floating base: Pinocchio's
 ``JointModelFreeFlyer``, Drake's free body), and a leg on each side of it, ``hip_width / 2``
 along the hip axis, on a revolute hip joint about that axis (the legs pitch; the walker rolls
 with its pelvis).  Axes are URDF's (z up; x downhill; y = walkerlab's -z,
-:data:`walkerlab.export.spoked.TO_MUJOCO`): ``leg1`` on the side of -y (walkerlab's +z, where
+:data:`walkerlab.export.axes_3d.TO_MUJOCO`): ``leg1`` on the side of -y (walkerlab's +z, where
 the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m`` above
 its foot and a sphere at its foot (collision); URDF has no ground, contact or state: the
 slope is stated in the header.  The links' masses, inertias and joint axes are read from the

@@ -7,7 +7,7 @@ pelvis body carrying the hip mass on a free joint ``free`` (no plane constraint)
 on each side of it, ``hip_width / 2`` along the hip axis (MuJoCo's body y), on a hinge
 ``leg<i>_hip`` about that axis (``0 -1 0``: a positive angle moves the foot ahead, the rigid
 model's leg pitch ``theta``).  Axes are MuJoCo's (z up; x downhill; y = walkerlab's -z,
-:data:`walkerlab.export.spoked.TO_MUJOCO`); ``leg1`` on the side of -y (walkerlab's +z,
+:data:`walkerlab.export.axes_3d.TO_MUJOCO`); ``leg1`` on the side of -y (walkerlab's +z,
 where the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m``
 above its foot and a sphere of radius ``r = L / 1000`` whose centre is ``L - r`` down the
 leg (its lowest point at ``L`` with the leg upright, as the 3D wheel's spoke tips), with a
@@ -64,8 +64,9 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.export.mjcf_scene import LANE_BITS
-from walkerlab.export.spoked import TO_MUJOCO, WHEEL_TIP_FRACTION
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import (
     PelvisRoles,

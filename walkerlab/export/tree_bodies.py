@@ -5,12 +5,13 @@ exports' axes.  The MJCF and URDF writers of walkers in 3D write these bodies
 (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`); :func:`mjcf_body_lines` and
 :func:`mjcf_coupling_lines` are the MJCF's text of them.
 
-Axes (the one place walkerlab's axes meet MuJoCo's and URDF's)
----------------------------------------------------------------
+Axes
+----
 walkerlab's world has ``x`` downhill (horizontal), ``y`` up, ``z = x × y``; the exports'
 have ``z`` up, ``x`` downhill and ``y`` = walkerlab's ``-z``: a vector ``v`` reads
-``TO_MUJOCO @ v`` (:data:`TO_MUJOCO`), so walkerlab's pitch axis ``z`` is the exports'
-``0 -1 0`` (a positive angle moves a foot ahead).
+``TO_MUJOCO @ v`` (:data:`walkerlab.export.axes_3d.TO_MUJOCO`, the conventions' one place),
+so walkerlab's pitch axis ``z`` is the exports' ``0 -1 0`` (a positive angle moves a foot
+ahead).
 
 The export's reference pose is the tree at the walker's coordinates all zero (the
 :class:`~walkerlab.walker.tree.CoordinateMap`'s names: upright, no lean, legs vertical):
@@ -65,8 +66,8 @@ import sympy as sp
 
 from walkerlab.codegen.frames import rotation, slope_to_world
 from walkerlab.codegen.tree_derive import kinematics
+from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
-from walkerlab.export.spoked import TO_MUJOCO
 from walkerlab.export.text import num, nums
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
