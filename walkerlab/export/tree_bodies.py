@@ -49,7 +49,7 @@ on it.
 
 Inertias: MuJoCo wants a positive-definite inertia on a body that moves; a tree's point mass
 (zero inertia) gets the export's floor :data:`~walkerlab.export.mjcf_scene.
-MJCF_MIN_INERTIA_KG_M2` about every axis, a zero principal moment of a rigid body (a rod
+MJCF_MIN_INERTIA_KG_M2` about every axis, a principal moment of a rigid body below it (a rod
 about its own axis) the floor; a root that turns about one axis only (the hip-roll pelvis on
 its roll hinge) carries its moment about that axis about every axis (the others act on
 nothing).
@@ -258,10 +258,10 @@ def _inertia(ev: _Evaluator, body: str, Q: sp.Matrix, about=None) -> np.ndarray:
     J = ev.matrix(Q * I_b * Q.T)
     if not J.any():
         return np.eye(3) * floor
-    for i in range(3):
-        if J[i, i] == 0.0 and not J[i].any():
-            J[i, i] = floor
-    return J
+    if not (J - np.diag(np.diag(J))).any():          # principal axes along the export's
+        return np.diag(np.maximum(np.diag(J), floor))
+    w, V = np.linalg.eigh(J)
+    return V @ np.diag(np.maximum(w, floor)) @ V.T if w[0] < floor else J
 
 
 def _subtree(ev, tree, roles, body, name, pos, rename, swap) -> ExportBody:
