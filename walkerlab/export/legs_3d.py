@@ -4,27 +4,24 @@ mass, free in space (a loader gives the root link a floating base: Pinocchio's
 ``JointModelFreeFlyer``, Drake's free body), and a leg on each side of it, ``hip_width / 2``
 along the hip axis, on a revolute hip joint about that axis (the legs pitch; the walker rolls
 with its pelvis).  Axes are URDF's (z up; x downhill; y = walkerlab's -z,
-:data:`walkerlab.export.spoked.TO_MUJOCO`): ``leg1`` on the side of -y (walkerlab's +z, where
+:data:`walkerlab.export.axes_3d.TO_MUJOCO`): ``leg1`` on the side of -y (walkerlab's +z, where
 the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m`` above
 its foot and a sphere at its foot (collision); URDF has no ground, contact or state: the
-slope is stated in the header.
+slope is stated in the header.  The links' masses, inertias and joint axes are read from the
+walker's body tree, as the MJCF's (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`,
+:mod:`walkerlab.export.tree_bodies`).
 """
 
 from __future__ import annotations
 
 from xml.sax.saxutils import quoteattr
 
-from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.legs_3d_mjcf import walker_tree
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
+from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, urdf_link_lines
 
 __all__ = ["legs_3d_urdf_text"]
-
-
-def _point_inertial(mass: float, z: float) -> str:
-    i = num(MJCF_MIN_INERTIA_KG_M2)
-    return (f'<inertial><origin xyz="{nums(0, 0, z)}"/><mass value="{num(mass)}"/>'
-            f'<inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/></inertial>')
 
 
 def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
@@ -53,16 +50,17 @@ def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
                    f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope "
                    f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); the "
                    "pelvis is the free root link"),
-           f"<robot name={quoteattr(name)}>",
-           f'  <link name="pelvis">{_point_inertial(p["M_hip"], 0.0)}</link>']
-    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
-        out += [f'  <link name="{leg}">{_point_inertial(p["m_leg"], -(L - a))}',
-                f'    <visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
+           f"<robot name={quoteattr(name)}>"]
+    tree, coords, p = walker_tree(data)
+    roles = PelvisRoles()
+    root, _couplings = export_bodies(tree, coords, p, roles)
+
+    def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere
+        if b.tree_body != roles.leg:
+            return []
+        return [f'{pad}<visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
                 f'radius="{num(L / 100)}" length="{num(L)}"/></geometry></visual>',
-                f'    <collision name="{leg}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>',
-                "  </link>",
-                f'  <joint name="{leg}_hip" type="continuous"><parent link="pelvis"/>'
-                f'<child link="{leg}"/><origin xyz="{nums(0, side * w / 2, 0)}"/>'
-                '<axis xyz="0 -1 0"/></joint>']
+                f'{pad}<collision name="{b.name}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+    out += urdf_link_lines(root, visuals)
     return "\n".join(out + ["</robot>", ""])

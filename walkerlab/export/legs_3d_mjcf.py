@@ -7,12 +7,15 @@ pelvis body carrying the hip mass on a free joint ``free`` (no plane constraint)
 on each side of it, ``hip_width / 2`` along the hip axis (MuJoCo's body y), on a hinge
 ``leg<i>_hip`` about that axis (``0 -1 0``: a positive angle moves the foot ahead, the rigid
 model's leg pitch ``theta``).  Axes are MuJoCo's (z up; x downhill; y = walkerlab's -z,
-:data:`walkerlab.export.spoked.TO_MUJOCO`); ``leg1`` on the side of -y (walkerlab's +z,
+:data:`walkerlab.export.axes_3d.TO_MUJOCO`); ``leg1`` on the side of -y (walkerlab's +z,
 where the first step's swing hip is).  Each leg has its point mass ``leg_mass_from_foot_m``
 above its foot and a sphere of radius ``r = L / 1000`` whose centre is ``L - r`` down the
 leg (its lowest point at ``L`` with the leg upright, as the 3D wheel's spoke tips), with a
 site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest inertia
-(:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
+(:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).  The bodies, their masses,
+inertias and joint axes are read from the walker's body tree (:func:`walker_tree`;
+:mod:`walkerlab.export.tree_bodies`, where walkerlab's axes meet MuJoCo's); this module adds
+the geoms, the ground, the contact and the keyframe.
 
 The ground is the planar straight-legged walker's checkerboard
 (:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
@@ -61,9 +64,17 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from walkerlab.export.mjcf_scene import LANE_BITS, MJCF_MIN_INERTIA_KG_M2
-from walkerlab.export.spoked import TO_MUJOCO, WHEEL_TIP_FRACTION
-from walkerlab.export.text import AXIS, comment, num, nums
+from walkerlab.export.axes_3d import TO_MUJOCO
+from walkerlab.export.mjcf_scene import LANE_BITS
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION
+from walkerlab.export.text import comment, num, nums
+from walkerlab.export.tree_bodies import (
+    PelvisRoles,
+    export_bodies,
+    mjcf_body_lines,
+    mjcf_coupling_lines,
+)
+from walkerlab.walker.trees import compass_3d_tree
 
 __all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
            "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
@@ -355,45 +366,49 @@ def _world_head(p: dict, extra, phi: float, condim: int) -> list[str]:
             '</default>', "  <worldbody>", *_patches(p, extra, phi)]
 
 
-def _pelvis_and_legs(p: dict, law: dict | None, phi: float) -> list[str]:
+def walker_tree(data) -> tuple:
+    """The 3D straight-legged walker's body tree, its coordinate map and numbers
+    (:func:`walkerlab.walker.trees.compass_3d_tree`; ``data``'s parameters by name,
+    :func:`_numbers`)."""
+    p = _numbers(data)
+    tree, coords = compass_3d_tree(hip_roll=bool(data.structure.hip_roll),
+                                   leg_inertia="I_leg" in p)
+    return tree, coords, p
+
+
+def _geoms(p: dict, roles: PelvisRoles):
+    """The geoms (no mass: ``inertiafromgeom`` is off) of each export body
+    (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`): the pelvis' sphere and hip
+    axis, each leg's capsule, foot site and foot sphere (its contact bits its lane's), a
+    sphere at each other massive body's centre of mass."""
+    L, w, r = p["L"], p["w_hip"], p["r"]
+
+    def geoms(b, pad: str) -> list[str]:
+        if b.tree_body == roles.pelvis:
+            return [f'{pad}<geom name="{b.name}" type="sphere" size="{num(L / 25)}"/>'] + (
+                [f'{pad}<geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
+                 f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>'] if w > 0 else [])
+        if b.tree_body == roles.leg:
+            return [f'{pad}<geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
+                    f'size="{num(L / 100)}"/>',
+                    f'{pad}<site name="{b.name}_foot" pos="{nums(0, 0, -(L - r))}"/>',
+                    f'{pad}<geom name="{b.name}_foot" type="sphere" '
+                    f'pos="{nums(0, 0, -(L - r))}" size="{num(r)}" contype="0" '
+                    f'conaffinity="{LANE_BITS[b.name]}"/>']
+        return ([f'{pad}<geom name="{b.name}" type="sphere" pos="{nums(*b.com_m)}" '
+                 f'size="{num(L / 25)}"/>'] if b.mass_kg > 0 else [])
+    return geoms
+
+
+def _pelvis_and_legs(data, law: dict | None) -> tuple[list[str], list[str]]:
     """The pelvis body (a free joint, or with the hip-roll ``law`` three slides and a roll
-    about the fall line) with the legs' bodies in it (``p``: :func:`_numbers`; ``phi`` the
-    slope [rad])."""
-    L, a, w, r = p["L"], p["a_leg"], p["w_hip"], p["r"]
-    lo = num(MJCF_MIN_INERTIA_KG_M2)
-    pelvis_inertia = lo if law is None else num(law["pelvis_roll_inertia_kg_m2"])
-    if law is None:
-        pelvis_joints = ['      <freejoint name="free"/>']
-    else:  # the rigid model's pelvis neither pitches nor yaws (the legs' roll axes stay on
-        # the fall line): three slides and a roll about the fall line
-        pelvis_joints = [
-            *(f'      <joint name="pelvis_{c}" type="slide" axis="{ax}"/>'
-              for c, ax in (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))),
-            f'      <joint name="pelvis_roll" type="hinge" axis="'
-            f'{nums(math.cos(phi), 0, -math.sin(phi))}"/>']
-    out = ['    <body name="pelvis" pos="0 0 0">',
-           *pelvis_joints,
-           f'      <inertial pos="0 0 0" mass="{num(p["M_hip"])}" '
-           f'diaginertia="{pelvis_inertia} {pelvis_inertia} {pelvis_inertia}"/>',
-           f'      <geom name="pelvis" type="sphere" size="{num(L / 25)}"/>']
-    if w > 0:
-        out.append(f'      <geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
-                   f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>')
-    roll_axis = nums(math.cos(phi), 0, -math.sin(phi))     # the fall line (pelvis frame)
-    for leg, side in (("leg1", -1.0), ("leg2", 1.0)):
-        out += [f'      <body name="{leg}" pos="{nums(0, side * w / 2, 0)}">',
-                *([f'        <joint name="{leg}_roll" type="hinge" axis="{roll_axis}"/>']
-                  if law is not None else []),
-                f'        <joint name="{leg}_hip" type="hinge" axis="{AXIS}"/>',
-                f'        <inertial pos="{nums(0, 0, -(L - a))}" mass="{num(p["m_leg"])}" '
-                f'diaginertia="{lo} {lo} {lo}"/>',
-                f'        <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
-                f'size="{num(L / 100)}"/>',
-                f'        <site name="{leg}_foot" pos="{nums(0, 0, -(L - r))}"/>',
-                f'        <geom name="{leg}_foot" type="sphere" pos="{nums(0, 0, -(L - r))}" '
-                f'size="{num(r)}" contype="0" conaffinity="{LANE_BITS[leg]}"/>',
-                "      </body>"]
-    return out + ["    </body>"]
+    about the fall line) with the legs' bodies and any upper body in it, read from the
+    walker's tree (:func:`walkerlab.export.tree_bodies.export_bodies`), and the MJCF lines
+    of its couplings (none without an upper body)."""
+    tree, coords, p = walker_tree(data)
+    roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
+    root, couplings = export_bodies(tree, coords, p, roles)
+    return (mjcf_body_lines(root, _geoms(p, roles)), mjcf_coupling_lines(couplings))
 
 
 def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | None = None
@@ -434,8 +449,9 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
            *(comment(note) for note in (extra.notes if extra else ())),
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
     out += _world_head(p, extra, phi, condim)
-    out += _pelvis_and_legs(p, law, phi)
-    out += ["  </worldbody>",
+    bodies, couplings = _pelvis_and_legs(data, law)
+    out += bodies
+    out += ["  </worldbody>", *couplings,
             "  <custom>", f'    <numeric name="slope_rad" data="{num(phi)}"/>',
             '    <numeric name="foot_height_offset_m" data="0.0"/>']
     if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from xml.sax.saxutils import quoteattr
 
+from walkerlab.export.axes_3d import TO_MUJOCO  # the axes' one place (re-exported)
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import AXIS, comment, num, nums
@@ -211,9 +212,6 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
     return "\n".join(out + ["</mujoco>", ""])
 
 
-#: walkerlab's world axes (x downhill, y up, z to the right) in MuJoCo's (x downhill, z up):
-#: ``X = x``, ``Y = -z``, ``Z = y`` (a rotation: right-handed both)
-TO_MUJOCO = ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0))
 
 
 def wheel3d_keyframe(points, velocities, x, slope_rad: float,

@@ -1,0 +1,504 @@
+"""A walker's bodies for its exports, read from its body tree (:mod:`walkerlab.walker.tree`):
+the floating pelvis with a leg on each hip and any upper body on its own joint, every body's
+mass, centre of mass, inertia and joint axes evaluated from the tree's expressions, in the
+exports' axes.  The MJCF and URDF writers of walkers in 3D write these bodies
+(:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`); :func:`mjcf_body_lines` and
+:func:`mjcf_coupling_lines` are the MJCF's text of them.
+
+Axes
+----
+walkerlab's world has ``x`` downhill (horizontal), ``y`` up, ``z = x × y``; the exports'
+have ``z`` up, ``x`` downhill and ``y`` = walkerlab's ``-z``: a vector ``v`` reads
+``TO_MUJOCO @ v`` (:data:`walkerlab.export.axes_3d.TO_MUJOCO`, the conventions' one place),
+so walkerlab's pitch axis ``z`` is the exports' ``0 -1 0`` (a positive angle moves a foot
+ahead).
+
+The export's reference pose is the tree at the walker's coordinates all zero (the
+:class:`~walkerlab.walker.tree.CoordinateMap`'s names: upright, no lean, legs vertical):
+there every export body's frame is the world's (MJCF writes no body ``quat``), so a body
+``b`` whose tree frame has the world orientation ``R_b`` at the reference pose (the slope's
+frame ``slope_to_world(gamma)`` times the tree's rotation, :func:`walkerlab.codegen.
+tree_derive.kinematics`) carries its tree vectors as ``Q_b v`` and its inertia as
+``Q_b I Q_b^T``, ``Q_b = TO_MUJOCO R_b``.  A joint's axis ``k`` is ``Q_parent Rot(a_1, r_1)
+... Rot(a_{k-1}, r_{k-1}) a_k`` (``r`` the joint's angles at the reference pose), and the
+export's joint angle is the tree's less ``r_k`` (MuJoCo turns a body's joints in order,
+each about its axis turned by the ones before, as the tree's joints do), so a leg's hinge
+reads the leg's pitch from the vertical (the tree's pitch from the slope's normal less
+``gamma``).  Numbers are sympy expressions of the tree simplified (``trigsimp``) before
+they are evaluated, so an axis or a centre of mass that is exact in the tree is exact in
+the file (the slope's ``cos^2 + sin^2`` leaves no roundoff).
+
+Bodies
+------
+- the pelvis (``roles.pelvis``), the export's floating root: its frame at the hips'
+  midpoint (the stance hip is the pelvis' joint, the swing hip the leg's), on a free joint
+  or on three slides and hinges on the pelvis' own joint coordinates ``roles.
+  pelvis_hinges`` (its other turns held);
+- each leg the swing leg's subtree (``roles.leg``), ``legs[0]`` at the swing hip and
+  ``legs[1]`` at the stance hip, on the swing hip's joint's axes;
+- every other body hung from the pelvis (an upper body) on its own joint;
+- a joint coordinate whose map does not depend on the walker's coordinates is held (no
+  export joint), a ``fixed`` joint welds its body to its parent (a child without joints).
+
+A hinge whose angle (as the coordinate map gives it, leg ``legs[1]``'s read with
+``roles.stance_roles``) is a sum of the hinges' before it is coupled to them
+(:class:`Coupling`; the bisecting hip mechanism's torso, Wisse, Hobbelen & Schwab 2007,
+"Adding an upper body to passive dynamic walking robots by means of a bisecting hip
+mechanism", IEEE T-RO 23(1)); MJCF holds it by a fixed tendon of zero length and an equality
+on it.
+
+Inertias: MuJoCo wants a positive-definite inertia on a body that moves; a tree's point mass
+(zero inertia) gets the export's floor :data:`~walkerlab.export.mjcf_scene.
+MJCF_MIN_INERTIA_KG_M2` about every axis, a principal moment of a rigid body below it (a rod
+about its own axis) the floor; a root that turns about one axis only (the hip-roll pelvis on
+its roll hinge) carries its moment about that axis about every axis (the others act on
+nothing).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import numpy as np
+import sympy as sp
+
+from walkerlab.codegen.frames import rotation, slope_to_world
+from walkerlab.codegen.tree_derive import kinematics
+from walkerlab.export.axes_3d import TO_MUJOCO
+from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.text import num, nums
+from walkerlab.walker.tree import BodyTree, CoordinateMap
+
+__all__ = ["Coupling", "ExportBody", "ExportJoint", "PelvisRoles", "export_bodies",
+           "mjcf_body_lines", "mjcf_coupling_lines", "tree_mjcf_text", "urdf_link_lines"]
+
+
+@dataclass(frozen=True)
+class PelvisRoles:
+    """Which of a tree's bodies the export's pelvis and legs are, and their joints' names.
+
+    Attributes
+    ----------
+    pelvis : str
+        The body the export floats (its joint is the stance hip).
+    leg : str
+        The swing leg: its subtree is each export leg.
+    legs : (str, str)
+        The export legs' names: at the swing hip, at the stance hip.
+    pelvis_hinges : tuple of str
+        Coordinates of the pelvis' joint the export turns it on (with three slides); empty:
+        a free joint.
+    stance_roles : tuple of (str, str)
+        The walker coordinates ``legs[1]``'s joints read in place of ``legs[0]``'s
+        (``swing -> stance``): the stance leg's angles are the swing leg's with the roles
+        swapped.
+    joint_names : tuple of (str, str)
+        Export joint names by tree coordinate (``{leg}`` the export leg's name); other
+        coordinates keep their names.
+    """
+
+    pelvis: str = "pelvis"
+    leg: str = "swing_leg"
+    legs: tuple[str, str] = ("leg1", "leg2")
+    pelvis_hinges: tuple[str, ...] = ()
+    stance_roles: tuple[tuple[str, str], ...] = (("swing", "stance"), ("swing_roll", "lean"))
+    joint_names: tuple[tuple[str, str], ...] = (
+        ("swing_hip_roll", "{leg}_roll"), ("swing_hip_pitch", "{leg}_hip"),
+        ("stance_hip_roll", "pelvis_roll"))
+
+
+@dataclass(frozen=True)
+class ExportJoint:
+    """A joint of an export body: ``kind`` "free", "slide" or "hinge", its ``axis`` (3,) in
+    the body's frame (none for "free") and ``angle``, its angle (or the slide's travel) in
+    the walker's coordinates (a sympy expression; None for the pelvis' own)."""
+
+    name: str
+    kind: str
+    axis: tuple = ()
+    angle: sp.Expr | None = None
+
+
+@dataclass(frozen=True)
+class ExportBody:
+    """A body in the exports' axes (module docstring).
+
+    Attributes
+    ----------
+    name : str
+    tree_body : str
+        The tree's body it is.
+    pos_m : ndarray (3,)
+        Its frame's origin in its parent's frame [m] (the world's for the root: zero).
+    joints : tuple of ExportJoint
+    mass_kg : float
+    com_m : ndarray (3,)
+        Centre of mass in its frame [m].
+    inertia_kg_m2 : ndarray (3, 3)
+        About its centre of mass, in its frame [kg m^2], with the floor (module docstring).
+    children : tuple of ExportBody
+    """
+
+    name: str
+    tree_body: str
+    pos_m: np.ndarray
+    joints: tuple
+    mass_kg: float
+    com_m: np.ndarray
+    inertia_kg_m2: np.ndarray
+    children: tuple = field(default=())
+
+    def walk(self):
+        """This body and every body below it, parents first."""
+        yield self
+        for c in self.children:
+            yield from c.walk()
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """A hinge held at a sum of others: ``sum(coef * angle) = 0`` over ``terms``
+    ((joint name, integer coefficient), the coupled hinge's first)."""
+
+    name: str
+    terms: tuple[tuple[str, int], ...]
+
+
+class _Evaluator:
+    """The tree's expressions at the walker's reference pose, simplified, then evaluated at
+    the parameters' values (``math``'s functions: as the hand-written writers compute)."""
+
+    def __init__(self, tree: BodyTree, coords: CoordinateMap, values: dict):
+        missing = sorted(set(tree.params) - set(values))
+        if missing:
+            raise ValueError(f"values: no number for {', '.join(missing)}")
+        self.kin = kinematics(tree, coords)
+        self.params = self.kin.params
+        self.values = tuple(float(values[p]) for p in tree.params)
+        self.zero = {q: 0 for q in self.kin.q}
+        self.names = dict(zip(coords.names, self.kin.q))
+        ns = {**dict(zip(tree.params, self.params)), **self.names,
+              "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt, "pi": sp.pi}
+        self.sym = lambda v: sp.sympify(v, locals=ns) if isinstance(v, str) else (
+            sp.Integer(int(v)) if float(v).is_integer() else sp.Float(v))
+        self.angle = {c: self.sym(e) for c, e in coords.joint_angles}
+        self.C = sp.Matrix(TO_MUJOCO).applyfunc(lambda v: sp.Integer(int(v)))
+        self.W = slope_to_world(self.kin.gamma)
+
+    def frame(self, body: str) -> sp.Matrix:
+        """``Q_b`` (module docstring): the body's tree frame in the exports' axes at the
+        reference pose."""
+        R = self.kin.rotations[body].subs(self.zero)
+        return (self.C * self.W * R).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+
+    def number(self, e) -> float:
+        e = sp.trigsimp(sp.expand(sp.sympify(e)))
+        return float(sp.lambdify(self.params, e, modules="math")(*self.values)) + 0.0
+
+    def vector(self, m) -> np.ndarray:
+        return np.array([self.number(v) for v in m], float)
+
+    def matrix(self, m) -> np.ndarray:
+        return np.array([[self.number(m[i, k]) for k in range(3)] for i in range(3)], float)
+
+
+def _joint_axes(ev: _Evaluator, tree: BodyTree, body: str) -> list:
+    """Each held-or-free axis of ``body``'s joint: ``(coordinate, export axis (sympy 3x1),
+    angle in the walker's coordinates less its reference, held?)``."""
+    j = tree.body(body).joint
+    Q = ev.frame(j.parent) if j.parent != tree.root.name else ev.C * ev.W
+    out, turn = [], sp.eye(3)
+    for axis, c in zip(j.axes, j.coordinates):
+        a = sp.Matrix([ev.sym(v) for v in axis])
+        angle = ev.angle[c]
+        ref = angle.subs(ev.zero)
+        export_axis = (Q * turn * a).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+        held = not (angle.free_symbols & set(ev.kin.q))
+        out.append((c, export_axis, sp.expand(angle - ref), held))
+        turn = turn * rotation(a, ref)
+    return out
+
+
+def _absolute_angle(ev: _Evaluator, tree: BodyTree, body: str, coordinate: str):
+    """The root's turn about the axis of its joint's ``coordinate`` from the world, in the
+    walker's coordinates, when its tree rotation is that turn alone (the chain of the
+    joints from the tree's root, consecutive turns about one axis summed and zero turns
+    dropped, as :func:`walkerlab.codegen.tree_derive.kinematics` merges them); else None."""
+    path, name = [], body
+    while name != tree.root.name:
+        b = tree.body(name)
+        path.insert(0, b.joint)
+        name = b.joint.parent
+    chain: list = []
+    for j in path:
+        for axis, c in zip(j.axes, j.coordinates):
+            key = tuple(ev.sym(v) for v in axis)
+            angle = ev.angle[c]
+            if chain and chain[-1][0] == key:
+                angle = chain.pop()[1] + angle
+            if sp.expand(angle) != 0:
+                chain.append((key, sp.expand(angle)))
+    j = tree.body(body).joint
+    axis = tuple(ev.sym(v) for v in j.axes[j.coordinates.index(coordinate)])
+    if len(chain) == 1 and chain[0][0] == axis:
+        return chain[0][1] - chain[0][1].subs(ev.zero)
+    return None
+
+
+def _inertia(ev: _Evaluator, body: str, Q: sp.Matrix, about=None) -> np.ndarray:
+    """The body's inertia in its export frame with the floor (module docstring); ``about``:
+    the one axis a root turns about."""
+    floor = MJCF_MIN_INERTIA_KG_M2
+    I_b = ev.kin.inertias[body]
+    if about is not None:
+        moment = ev.number((about.T * Q * I_b * Q.T * about)[0, 0])
+        return np.eye(3) * (moment if moment > 0 else floor)
+    J = ev.matrix(Q * I_b * Q.T)
+    if not J.any():
+        return np.eye(3) * floor
+    if not (J - np.diag(np.diag(J))).any():          # principal axes along the export's
+        return np.diag(np.maximum(np.diag(J), floor))
+    w, V = np.linalg.eigh(J)
+    return V @ np.diag(np.maximum(w, floor)) @ V.T if w[0] < floor else J
+
+
+def _subtree(ev, tree, roles, body, name, pos, rename, swap) -> ExportBody:
+    """``body`` and the bodies hung below it, ``body`` named ``name`` at ``pos`` (its
+    parent's export frame); ``rename`` a body name's export name, ``swap`` the walker
+    coordinates read in place of others (the stance leg's)."""
+    b = tree.body(body)
+    Q = ev.frame(body)
+    joints = []
+    for c, axis, angle, held in _joint_axes(ev, tree, body):
+        if held:
+            continue
+        template = dict(roles.joint_names).get(c, c)
+        joints.append(ExportJoint(template.format(leg=name), "hinge",
+                                  tuple(ev.vector(axis)), angle.subs(swap, simultaneous=True)))
+    children = tuple(
+        _subtree(ev, tree, roles, k.name, rename(k.name),
+                 ev.vector(Q * sp.Matrix([ev.sym(v) for v in k.joint.origin_m])), rename, swap)
+        for k in tree.bodies if k.joint.parent == body)
+    return ExportBody(name, body, np.asarray(pos, float), tuple(joints),
+                      ev.number(ev.kin.masses[body]),
+                      ev.vector(Q * sp.Matrix([ev.sym(v) for v in b.com_m])),
+                      _inertia(ev, body, Q), children)
+
+
+def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
+                  roles: PelvisRoles = PelvisRoles()) -> tuple[ExportBody, tuple[Coupling, ...]]:
+    """The walker's export bodies (module docstring) and its hinges' couplings.
+
+    Parameters
+    ----------
+    tree : walkerlab.walker.tree.BodyTree
+    coords : walkerlab.walker.tree.CoordinateMap
+    values : dict[str, float]
+        A number for every one of ``tree.params`` (SI).
+    roles : PelvisRoles
+
+    Returns
+    -------
+    ExportBody, tuple of Coupling
+        The pelvis (with every other body below it) and the couplings.
+
+    Raises
+    ------
+    ValueError
+        A parameter without a number; ``roles`` naming no body of the tree, a leg not
+        hung from the pelvis, a pelvis hinge not a coordinate of the pelvis' joint.
+    """
+    names = {b.name for b in tree.bodies}
+    for field_, v in (("pelvis", roles.pelvis), ("leg", roles.leg)):
+        if v not in names:
+            raise ValueError(f"roles.{field_}: {v!r} is not a body of the tree")
+    if tree.body(roles.leg).joint.parent != roles.pelvis:
+        raise ValueError(f"roles.leg: {roles.leg!r} does not hang from {roles.pelvis!r}")
+    ev = _Evaluator(tree, coords, values)
+    pelvis = tree.body(roles.pelvis)
+    Q = ev.frame(roles.pelvis)
+    hip = sp.Matrix([ev.sym(v) for v in tree.body(roles.leg).joint.origin_m]) / 2
+    axes = {c: (axis, angle) for c, axis, angle, _ in _joint_axes(ev, tree, roles.pelvis)}
+    unknown = sorted(set(roles.pelvis_hinges) - set(axes))
+    if unknown:
+        raise ValueError(f"roles.pelvis_hinges: {', '.join(unknown)} not a coordinate of "
+                         f"{roles.pelvis!r}'s joint")
+    names_of = dict(roles.joint_names)
+    if roles.pelvis_hinges:
+        joints = [ExportJoint(f"{roles.pelvis}_{c}", "slide", ax) for c, ax in
+                  (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0)))]
+        joints += [ExportJoint(names_of.get(c, c), "hinge", tuple(ev.vector(axes[c][0])),
+                               _absolute_angle(ev, tree, roles.pelvis, c))
+                   for c in roles.pelvis_hinges]
+        about = axes[roles.pelvis_hinges[0]][0] if len(roles.pelvis_hinges) == 1 else None
+    else:
+        joints, about = [ExportJoint("free", "free")], None
+    swap = {ev.names[a]: ev.names[b] for a, b in roles.stance_roles if a in ev.names}
+    children = []
+    for k in tree.bodies:
+        if k.joint.parent != roles.pelvis:
+            continue
+        at = Q * (sp.Matrix([ev.sym(v) for v in k.joint.origin_m]) - hip)
+        if k.name == roles.leg:
+            leg1, leg2 = roles.legs
+            ren1 = lambda n, leg=leg1: leg if n == roles.leg else f"{leg}_{n}"  # noqa: E731
+            ren2 = lambda n, leg=leg2: leg if n == roles.leg else f"{leg}_{n}"  # noqa: E731
+            children.append(_subtree(ev, tree, roles, k.name, leg1, ev.vector(at), ren1, {}))
+            children.append(_subtree(ev, tree, roles, k.name, leg2, ev.vector(Q * -hip), ren2,
+                                     swap))
+        else:
+            children.append(_subtree(ev, tree, roles, k.name, k.name, ev.vector(at),
+                                     lambda n: n, {}))
+    root = ExportBody(roles.pelvis, roles.pelvis, np.zeros(3), tuple(joints),
+                      ev.number(ev.kin.masses[roles.pelvis]),
+                      ev.vector(Q * (sp.Matrix([ev.sym(v) for v in pelvis.com_m]) - hip)),
+                      _inertia(ev, roles.pelvis, Q, about), tuple(children))
+    return root, _couplings(ev, root)
+
+
+def _couplings(ev: _Evaluator, root: ExportBody) -> tuple[Coupling, ...]:
+    """Each hinge whose angle is a rational sum of the earlier hinges' (module docstring)."""
+    hinges = [j for b in root.walk() for j in b.joints
+              if j.kind == "hinge" and j.angle is not None]
+    q = list(ev.kin.q)
+
+    def row(e):
+        return [sp.nsimplify(sp.diff(e, qi)) for qi in q]
+
+    out, free = [], []
+    for j in hinges:
+        target = sp.Matrix(row(j.angle))
+        if free:
+            A = sp.Matrix([row(h.angle) for h in free]).T
+            sol = sp.linsolve((A, target))
+            if sol and sp.expand(j.angle.subs(ev.zero)) == 0:
+                (c,) = sol
+                if all(v.is_rational for v in c):
+                    coef = [Fraction(str(v)) for v in c]
+                    scale = math.lcm(*(f.denominator for f in coef))
+                    terms = ((j.name, scale),) + tuple(
+                        (h.name, -int(f * scale)) for h, f in zip(free, coef) if f != 0)
+                    out.append(Coupling(f"{j.name}_coupling", terms))
+                    continue
+        free.append(j)
+    return tuple(out)
+
+
+def _inertial(b: ExportBody, root: bool) -> str:
+    """MJCF's ``inertial`` of ``b``: ``diaginertia`` when its inertia is diagonal, else
+    ``fullinertia`` (MuJoCo's order ``ixx iyy izz ixy ixz iyz``); the root's centre of mass
+    at its origin ``0 0 0``."""
+    J = b.inertia_kg_m2
+    pos = "0 0 0" if root and not b.com_m.any() else nums(*b.com_m)
+    if np.count_nonzero(J - np.diag(np.diag(J))) == 0:
+        inertia = f'diaginertia="{nums(*np.diag(J))}"'
+    else:
+        inertia = f'fullinertia="{nums(J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2])}"'
+    return f'<inertial pos="{pos}" mass="{num(b.mass_kg)}" {inertia}/>'
+
+
+def _axis_text(axis) -> str:
+    """An axis whose components are whole numbers as integers (``0 -1 0``), else each as
+    :func:`~walkerlab.export.text.num` writes it."""
+    if all(float(v).is_integer() for v in axis):
+        return " ".join(str(int(v)) for v in axis)
+    return nums(*axis)
+
+
+def mjcf_body_lines(b: ExportBody, geoms=lambda b, pad: [], indent: int = 4,
+                    root: bool = True) -> list[str]:
+    """The MJCF ``body`` element of ``b`` and its children: joints, ``inertial``, the
+    geoms ``geoms(b, pad)`` returns (lines at the indent ``pad``), then the children."""
+    pad = " " * indent
+    inner = pad + "  "
+    pos = "0 0 0" if root else nums(*b.pos_m)
+    out = [f'{pad}<body name="{b.name}" pos="{pos}">']
+    for j in b.joints:
+        if j.kind == "free":
+            out.append(f'{inner}<freejoint name="{j.name}"/>')
+        else:
+            out.append(f'{inner}<joint name="{j.name}" type="{j.kind}" '
+                       f'axis="{_axis_text(j.axis)}"/>')
+    out.append(inner + _inertial(b, root))
+    out += geoms(b, inner)
+    for c in b.children:
+        out += mjcf_body_lines(c, geoms, indent + 2, root=False)
+    return out + [f"{pad}</body>"]
+
+
+def mjcf_coupling_lines(couplings) -> list[str]:
+    """Each coupling as a fixed tendon held at zero length by an equality (MuJoCo XML
+    Reference: ``tendon/fixed``, ``equality/tendon``)."""
+    if not couplings:
+        return []
+    out = ["  <tendon>"]
+    for c in couplings:
+        out.append(f'    <fixed name="{c.name}">')
+        out += [f'      <joint joint="{j}" coef="{k}"/>' for j, k in c.terms]
+        out.append("    </fixed>")
+    out += ["  </tendon>", "  <equality>"]
+    out += [f'    <tendon name="{c.name}" tendon1="{c.name}"/>' for c in couplings]
+    return out + ["  </equality>"]
+
+
+def _urdf_inertial(b: ExportBody) -> str:
+    """URDF's ``inertial`` of ``b`` (zero products of inertia written ``0``)."""
+    J = b.inertia_kg_m2
+
+    def v(x: float) -> str:
+        return "0" if x == 0 else num(x)
+    return (f'<inertial><origin xyz="{nums(*b.com_m)}"/><mass value="{num(b.mass_kg)}"/>'
+            f'<inertia ixx="{num(J[0, 0])}" ixy="{v(J[0, 1])}" ixz="{v(J[0, 2])}" '
+            f'iyy="{num(J[1, 1])}" iyz="{v(J[1, 2])}" izz="{num(J[2, 2])}"/></inertial>')
+
+
+def urdf_link_lines(b: ExportBody, visuals=lambda b, pad: [], parent: str | None = None
+                    ) -> list[str]:
+    """URDF's ``link`` of ``b`` (its ``inertial`` and the lines ``visuals(b, pad)``
+    returns), the joint from ``parent`` (``continuous`` on one hinge, ``fixed`` on none;
+    none for the root, a floating base), then its children's.
+
+    Raises
+    ------
+    ValueError
+        A body on more than one hinge (URDF's joints have one axis: one line naming it).
+    """
+    extra = visuals(b, "    ")
+    out = [f'  <link name="{b.name}">{_urdf_inertial(b)}' + ("" if extra else "</link>"),
+           *extra, *(["  </link>"] if extra else [])]
+    if parent is not None:
+        if len(b.joints) > 1:
+            raise ValueError(f"{b.name}: {len(b.joints)} joints on one body (a URDF joint "
+                             "has one axis)")
+        head = (f'  <joint name="{b.joints[0].name}" type="continuous">' if b.joints else
+                f'  <joint name="{b.name}_weld" type="fixed">')
+        out.append(head + f'<parent link="{parent}"/><child link="{b.name}"/>'
+                   f'<origin xyz="{nums(*b.pos_m)}"/>'
+                   + (f'<axis xyz="{_axis_text(b.joints[0].axis)}"/>' if b.joints else "")
+                   + "</joint>")
+    for c in b.children:
+        out += urdf_link_lines(c, visuals, b.name)
+    return out
+
+
+def tree_mjcf_text(tree: BodyTree, coords: CoordinateMap, values: dict,
+                   roles: PelvisRoles = PelvisRoles(), name: str = "walker") -> str:
+    """The walker's bodies alone as MJCF (no ground, contact or keyframe; gravity ``g``
+    along -z): the bodies of :func:`export_bodies` and their couplings.
+
+    Returns
+    -------
+    str
+        MJCF XML.
+    """
+    root, couplings = export_bodies(tree, coords, values, roles)
+    g = float(values[tree.root.gravity_m_per_s2]) if isinstance(
+        tree.root.gravity_m_per_s2, str) else float(tree.root.gravity_m_per_s2)
+    out = [f'<mujoco model="{name}">',
+           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
+           f'  <option gravity="{nums(0, 0, -g)}"/>', "  <worldbody>",
+           *mjcf_body_lines(root), "  </worldbody>", *mjcf_coupling_lines(couplings)]
+    return "\n".join(out + ["</mujoco>", ""])
+
