@@ -41,8 +41,10 @@ VALUES = dict(g=9.81, L=1.0, gamma=0.0174, M_hip=10.0, m_leg=5.0, a_leg=0.5, w_h
 #: a state of the walker's coordinates away from every symmetry [rad]
 STATE = dict(lean=0.07, swing=-0.31, stance=0.22)
 #: MuJoCo's body -> the tree's body it is (the stance leg is the swing leg's copy)
-TREE_BODY = {"pelvis": "pelvis", "leg1": "swing_leg", "leg2": "stance_leg", "torso": "torso",
-             "torso_trunk": "torso_trunk", "torso_head": "torso_head"}
+#: and the parts welded to it, folded into its inertial
+TREE_BODY = {"pelvis": ("pelvis",), "leg1": ("swing_leg", "swing_leg_mass"),
+             "leg2": ("stance_leg", "stance_leg_mass"),
+             "torso": ("torso", "torso_trunk", "torso_head")}
 
 
 def torso_tree(parts=(("trunk", True), ("head", False))) -> tuple[BodyTree, CoordinateMap]:
@@ -124,21 +126,29 @@ def test_the_torso_walkers_mjcf_has_the_trees_masses_centres_of_mass_and_inertia
     _R, _R0, _origin, com, inertia = _tree_at(tree, coords, STATE)
     masses = {b.name: float(sp.sympify(b.mass_kg).subs(VALUES)) for b in tree.bodies}
     assert float(model.body_mass.sum()) == pytest.approx(sum(masses.values()), abs=1e-12)
-    for name, tree_body in TREE_BODY.items():
+    assert model.nbody - 1 == len(TREE_BODY)      # every welded part folded into its body
+    for name, parts in TREE_BODY.items():
         i = model.body(name).id
-        assert float(model.body_mass[i]) == masses[tree_body], name
-        if masses[tree_body] > 0:
-            np.testing.assert_allclose(data.xipos[i], com[tree_body], rtol=0, atol=1e-12,
-                                       err_msg=name)
+        mass = sum(masses[b] for b in parts)
+        assert float(model.body_mass[i]) == pytest.approx(mass, abs=1e-12), name
+        centre = sum(masses[b] * com[b] for b in parts) / mass
+        np.testing.assert_allclose(data.xipos[i], centre, rtol=0, atol=1e-12, err_msg=name)
     total = sum(masses[b] * com[b] for b in masses) / sum(masses.values())
     np.testing.assert_allclose(data.subtree_com[0], total, rtol=0, atol=1e-12)
-    i = model.body("torso_trunk").id
+    # the upper body's inertia about its centre of mass, world axes: the trunk's turned
+    # with it and both parts' moved there (the parallel-axis theorem, written here)
+    parts = TREE_BODY["torso"]
+    centre = sum(masses[b] * com[b] for b in parts) / sum(masses[b] for b in parts)
+    expected = sum(inertia[b] + masses[b] * (np.dot(com[b] - centre, com[b] - centre)
+                                             * np.eye(3) - np.outer(com[b] - centre,
+                                                                    com[b] - centre))
+                   for b in parts)
+    i = model.body("torso").id
     X = data.ximat[i].reshape(3, 3)
     world = X @ np.diag(model.body_inertia[i]) @ X.T
-    expected = inertia["torso_trunk"]
-    # the trunk's zero moment about its own axis is the export's floor (1e-12 kg m^2)
-    np.testing.assert_allclose(world, expected, rtol=0, atol=2e-12)
-    assert np.linalg.eigvalsh(world)[-1] == pytest.approx(VALUES["I_torso_trunk"], abs=1e-12)
+    # the frame's and the trunk's floors (1e-12 kg m^2) about the torso's own axis
+    np.testing.assert_allclose(world, expected, rtol=0, atol=3e-12)
+    assert np.linalg.eigvalsh(world)[-1] > VALUES["I_torso_trunk"]   # the head's on top
 
 
 def test_the_bisecting_hip_tendon_holds_the_torso_at_the_legs_mean_pitch():

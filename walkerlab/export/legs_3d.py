@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from xml.sax.saxutils import quoteattr
 
-from walkerlab.export.legs_3d_mjcf import walker_tree
+from walkerlab.export.legs_3d_mjcf import legs_summary, walker_tree
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, urdf_link_lines
@@ -42,12 +42,11 @@ def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
         walkers' do.
     """
     p = dict(zip(data.structure.param_names, data.params))
-    L, a, w = p["L"], p["a_leg"], p.get("w_hip", 0.0)
+    L, w = p["L"], p.get("w_hip", 0.0)
     r = WHEEL_TIP_FRACTION * L
     out = ['<?xml version="1.0"?>',
            comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): straight "
-                   f"legs of {num(L)} m, {num(p['m_leg'])} kg at {num(a)} m from each foot, "
-                   f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope "
+                   f"{legs_summary(data, p)}, hips {num(w)} m apart; slope "
                    f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); the "
                    "pelvis is the free root link"),
            f"<robot name={quoteattr(name)}>"]

@@ -74,7 +74,7 @@ from walkerlab.export.tree_bodies import (
     mjcf_body_lines,
     mjcf_coupling_lines,
 )
-from walkerlab.walker.trees import compass_3d_tree
+from walkerlab.walker.trees import legs_3d_tree
 
 __all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
            "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
@@ -298,6 +298,11 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
                                  data.slope_rad, p["r"])
+    if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order):
+        # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma)
+        x = np.asarray(ideal.x, float)
+        n = x.size // 2
+        qpos, qvel = qpos + ((x[1] + x[2]) / 2,), qvel + ((x[n + 1] + x[n + 2]) / 2,)
     lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
     c, _knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
@@ -368,12 +373,20 @@ def _world_head(p: dict, extra, phi: float, condim: int) -> list[str]:
 
 def walker_tree(data) -> tuple:
     """The 3D straight-legged walker's body tree, its coordinate map and numbers
-    (:func:`walkerlab.walker.trees.compass_3d_tree`; ``data``'s parameters by name,
+    (:func:`walkerlab.walker.trees.legs_3d_tree`; ``data``'s parameters by name,
     :func:`_numbers`)."""
-    p = _numbers(data)
-    tree, coords = compass_3d_tree(hip_roll=bool(data.structure.hip_roll),
-                                   leg_inertia="I_leg" in p)
-    return tree, coords, p
+    return (*legs_3d_tree(data.structure), _numbers(data))
+
+
+def legs_summary(data, p: dict) -> str:
+    """The walker's numbers in a line for the files' header comment: the ``compass_gait``
+    shorthand's (each leg's mass and its distance from the foot), or a walker from parts'
+    (its total mass)."""
+    if "m_leg" in p:
+        return (f"legs of {num(p['L'])} m, {num(p['m_leg'])} kg at {num(p['a_leg'])} m from "
+                f"each foot, hip mass {num(p['M_hip'])} kg")
+    return (f"legs of {num(p['L'])} m, {num(data.total_mass_kg)} kg in all (hip mass "
+            f"{num(p['M_hip'])} kg{', an upper body' if data.structure.torso else ''})")
 
 
 def _geoms(p: dict, roles: PelvisRoles):
@@ -433,14 +446,13 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
         MJCF XML (MuJoCo XML Reference): total mass ``M_hip + 2 m_leg``.
     """
     p = _numbers(data)
-    L, a, w, r, phi = p["L"], p["a_leg"], p["w_hip"], p["r"], data.slope_rad
+    w, r, phi = p["w_hip"], p["r"], data.slope_rad
     law = getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
     # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
     # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
     condim = 4 if law is None else 3
     out = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
-                   f"legs of {num(L)} m, {num(p['m_leg'])} kg at {num(a)} m from each foot, "
-                   f"hip mass {num(p['M_hip'])} kg, hips {num(w)} m apart; slope {num(phi)} "
+                   f"{legs_summary(data, p)}, hips {num(w)} m apart; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
                    "x downhill, z up, leg1 on the side of -y; a foot sphere of radius "

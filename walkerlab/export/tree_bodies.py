@@ -58,7 +58,7 @@ nothing).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 import numpy as np
@@ -281,10 +281,36 @@ def _subtree(ev, tree, roles, body, name, pos, rename, swap) -> ExportBody:
         _subtree(ev, tree, roles, k.name, rename(k.name),
                  ev.vector(Q * sp.Matrix([ev.sym(v) for v in k.joint.origin_m])), rename, swap)
         for k in tree.bodies if k.joint.parent == body)
-    return ExportBody(name, body, np.asarray(pos, float), tuple(joints),
-                      ev.number(ev.kin.masses[body]),
-                      ev.vector(Q * sp.Matrix([ev.sym(v) for v in b.com_m])),
-                      _inertia(ev, body, Q), children)
+    welded = {k.name for k in tree.bodies if k.joint.parent == body and k.joint.kind == "fixed"}
+    return _folded(ExportBody(name, body, np.asarray(pos, float), tuple(joints),
+                              ev.number(ev.kin.masses[body]),
+                              ev.vector(Q * sp.Matrix([ev.sym(v) for v in b.com_m])),
+                              _inertia(ev, body, Q), children), welded)
+
+
+def _folded(b: ExportBody, welded: set) -> ExportBody:
+    """``b`` with its welded children (``welded``: the tree bodies on fixed joints, frames
+    parallel to ``b``'s) folded into its inertial: their masses summed, the centre of mass
+    their mean, the inertias moved to it (the parallel-axis theorem); their children become
+    ``b``'s.  A massless ``b`` with one massive welded child takes the child's numbers as
+    they are (a leg of one part exports as one body, as a leg of one mass always did)."""
+    parts = [c for c in b.children if c.tree_body in welded]
+    if not parts:
+        return b
+    rest = tuple(c for c in b.children if c.tree_body not in welded)
+    rest += tuple(replace(g, pos_m=c.pos_m + g.pos_m) for c in parts for g in c.children)
+    massive = [c for c in parts if c.mass_kg > 0]
+    if b.mass_kg == 0 and len(massive) == 1 and not massive[0].pos_m.any():
+        c = massive[0]
+        return replace(b, mass_kg=c.mass_kg, com_m=c.com_m, inertia_kg_m2=c.inertia_kg_m2,
+                       children=rest)
+    bodies = [(b.mass_kg, b.com_m, b.inertia_kg_m2)] + [
+        (c.mass_kg, c.pos_m + c.com_m, c.inertia_kg_m2) for c in parts]
+    mass = sum(m for m, _, _ in bodies)
+    com = sum(m * r for m, r, _ in bodies) / mass if mass > 0 else b.com_m
+    inertia = sum(j + m * (np.dot(r - com, r - com) * np.eye(3) - np.outer(r - com, r - com))
+                  for m, r, j in bodies)
+    return replace(b, mass_kg=mass, com_m=com, inertia_kg_m2=inertia, children=rest)
 
 
 def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,

@@ -6,8 +6,8 @@ coordinates, which masses are taken in the limit m -> 0) decides the equations; 
 (masses, lengths, inertia, slope, gravity) are arguments of the generated functions.  A sweep
 over the hip mass therefore shares one cached module.
 
-``model: compass_gait`` (paper Table 1) is a shorthand: it expands to a biped with a hip point
-mass and one point mass per leg at ``b = L - a`` from the hip.
+``model: compass_gait`` (paper Table 1) is a shorthand: a biped with a hip point mass and one
+point mass per leg at ``b = L - a`` from the hip (in 3D: its own parameters, ``a_leg``).
 """
 
 from __future__ import annotations
@@ -100,9 +100,7 @@ class Structure:
         stance-leg angle from the slope normal and the hip angle ``stance - swing`` between
         the legs (Garcia et al. 1998, Fig. 1).
     bodies : tuple of BodySpec
-        Bodies on each leg (both legs identical), in YAML order.
-    hip_mass : bool
-        True if there is a hip point mass.
+        Bodies on each leg (both legs identical), in YAML order.  ``hip_mass``: a hip mass.
     foot : str
         ``"point"``, ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip) or
         ``"flat"`` (a massless flat foot on an ankle spring: heel ``heel_m`` behind and toe
@@ -113,7 +111,7 @@ class Structure:
         ``"derived"``; ``"appendix_a"`` only for the paper's compass gait: the flow with the
         Coriolis matrix as printed in the paper (A.5, sign of ``C[1, 0]`` flipped).
     knee : bool
-        True if the leg has a knee at ``L_thigh`` from the hip (roles :data:`KNEED_ROLES`).
+        A knee at ``L_thigh`` from the hip (roles :data:`KNEED_ROLES`).
     asymmetric : bool
         The legs' numbers may differ: each body's parameters exist per role
         (``m_sw_<name>``, ``m_st_<name>``, ...), bound per step (the swing leg's numbers
@@ -160,6 +158,8 @@ class Structure:
         A 3D straight-legged walker with hip width whose legs hang from the pelvis on
         hip-roll joints driven by a foot-placement law (roles and parameters
         :data:`HIP_ROLL_ROLES`, :data:`HIP_ROLL_PARAMS` after the others).
+    parts_3d : bool
+        In 3D from parts (``model: biped``): the planar biped's parameters and ``w_hip``.
     """
 
     coordinates: str
@@ -209,11 +209,10 @@ class Structure:
         reflection.
 
         A 3D straight-legged walker with hip width steps on alternate sides (``w_hip ->
-        -w_hip``, Kuo 1999): reflected, its hip axis turns over and the rolls (``lean``,
-        the hip-roll joints' ``pelvis_roll`` and ``swing_roll``) change sign while the legs'
-        pitches keep theirs, so the mirror step's map is ``P_mirror(x) = S P(S x)`` with ``S``
-        negating those roles' angles and rates (the hip-roll law is odd in the rolls).
-        Planar legs that differ are not a reflection of each other (None)."""
+        -w_hip``, Kuo 1999): reflected, the rolls (``lean``, ``pelvis_roll``, ``swing_roll``)
+        change sign, the pitches do not: ``P_mirror(x) = S P(S x)``, ``S`` negating those
+        roles' angles and rates (the hip-roll law is odd in the rolls); None for planar
+        legs that differ (not a reflection of each other)."""
         if self.in_3d and not self.spokes and self.hip_width:
             return ("lean",) + (HIP_ROLL_ROLES if self.hip_roll else ())
         return None
@@ -354,8 +353,8 @@ class WalkerData:
     @property
     def mirror(self) -> WalkerData | None:
         """The walker of the next step (leg2 swinging) when it differs from this one (legs
-        that differ, a spring with a rest angle ...): a stride is then the Poincaré map's
-        period; None when the legs are mirror images (one step)."""
+        that differ, a spring's rest angle, a hip width ...): the Poincaré map is a stride;
+        None when the legs are mirror images (one step)."""
         if self.mirror_params is None:
             return None
         return WalkerData(self.structure, self.mirror_params, self.total_mass_kg,
@@ -536,10 +535,9 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
              + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ()))
              + (2 * foot_mass[0] if foot_mass is not None else 0.0))
     if walker_cfg.space == "3d":   # the parts in 3D: the hip width last, mirrored a step on
-        width = float(walker_cfg.hip_width_m)
-        structure = replace(structure, in_3d=True, hip_width=bool(width), parts_3d=True)
-        extra["hip_width_m"] = width
-        p1, p2 = (p1 + (width,), p1 + (-width,)) if width else (p1, p1)
+        extra["hip_width_m"] = w = float(walker_cfg.hip_width_m)
+        structure = replace(structure, in_3d=True, hip_width=bool(w), parts_3d=True)
+        p1, p2 = (p1 + (w,), p1 + (-w,)) if w else (p1, p1)
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
                       slope_rad, extra, None if p2 == p1 else p2)
 
