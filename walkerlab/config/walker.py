@@ -38,6 +38,16 @@ from walkerlab.config.biped_parts import (  # noqa: F401 (part of this API)
 )
 from walkerlab.config.wheel import RimlessWheelParams
 
+#: ``walker.space`` of the straight-legged walkers (the shorthand's and the parts')
+Space = Annotated[Literal["2d", "3d"], Field(
+    description="2d: the walker moves in the sagittal plane; 3d: it also rolls about the "
+    "fall line through its stance foot, which neither slips nor twists (Kuo 1999; straight "
+    "legs)")]
+#: ``walker.hip_width_m``
+HipWidth = Annotated[float, Field(
+    ge=0, le=100, description="distance between the hips along the hip axis [m] (space: 3d "
+    "only; the hip mass, and an upper body, midway; 0: the planar walker embedded in 3D)")]
+
 
 class _Actuated(Strict):
     """A walker section with optional actuators; a passive walker serialises as before (no
@@ -108,13 +118,8 @@ class CompassGaitParams(_Actuated):
     leg_mass_from_foot_m: float = Field(
         gt=0, description="distance a of the leg mass from the foot [m]; b = L - a"
     )
-    space: Literal["2d", "3d"] = Field("2d", description="2d: the walker moves in the "
-                                       "sagittal plane; 3d: it also rolls about the fall "
-                                       "line through its stance foot, which neither slips "
-                                       "nor twists (Kuo 1999)")
-    hip_width_m: float = Field(0.0, ge=0, le=100, description="distance between the hips "
-                               "along the hip axis [m] (space: 3d only; 0: the planar "
-                               "walker embedded in 3D)")
+    space: Space = "2d"
+    hip_width_m: HipWidth = 0.0
     hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
                                         "their lateral foot-placement law (space: 3d with a "
                                         "hip width; null: the legs rigid to the pelvis in "
@@ -209,13 +214,8 @@ class BipedParams(_Actuated):
     torso: TorsoSpec | None = Field(None, description="upper body on the hip (null: none)")
     springs: list[SpringSpec] = Field(default_factory=list, description="torsional springs "
                                       "and dampers between links at the hip")
-    space: Literal["2d", "3d"] = Field("2d", description="2d: the walker moves in the "
-                                       "sagittal plane; 3d: it also rolls about the fall "
-                                       "line through its stance foot, which neither slips "
-                                       "nor twists (Kuo 1999; straight legs)")
-    hip_width_m: float = Field(0.0, ge=0, le=100, description="distance between the hips "
-                               "along the hip axis [m] (space: 3d only; the hip mass and "
-                               "the upper body midway; 0: the planar walker embedded in 3D)")
+    space: Space = "2d"
+    hip_width_m: HipWidth = 0.0
 
     @model_serializer(mode="wrap")
     def _planar_as_before(self, handler):

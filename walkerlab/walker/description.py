@@ -292,12 +292,7 @@ class Structure:
             d = {"spokes": self.spokes}
         if self.in_3d:
             d["space"] = "3d"
-        if self.hip_width:
-            d["hip_width"] = True
-        if self.hip_roll:
-            d["hip_roll"] = True
-        if self.parts_3d:
-            d["parts_3d"] = True
+        d.update({k: True for k in ("hip_width", "hip_roll", "parts_3d") if getattr(self, k)})
         return json.dumps(d)
 
 
