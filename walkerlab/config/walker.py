@@ -218,8 +218,14 @@ class BipedParams(_Actuated):
     hip_width_m: HipWidth = 0.0
 
     @model_serializer(mode="wrap")
-    def _planar_as_before(self, handler):
-        return drop_unset(handler(self), ("actuation", "space", "hip_width_m"))
+    def _passive_as_before(self, handler):
+        """A planar walker serialises as before ``space`` existed (the same scene JSON and
+        input hashes): ``space: 2d`` and a zero hip width are left out."""
+        d = drop_unset(handler(self), ("actuation",))
+        if isinstance(d, dict) and self.space == "2d" and not self.hip_width_m:
+            d.pop("space", None)
+            d.pop("hip_width_m", None)
+        return d
 
     @model_validator(mode="after")
     def _has_mass(self) -> BipedParams:
