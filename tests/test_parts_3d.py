@@ -175,3 +175,19 @@ def test_a_3d_biped_refuses_what_it_cannot_walk_yet_naming_the_field(change, fie
                                                "hip_width_m": 0.1, **change}}
     with pytest.raises(ValueError, match=field.replace(".", r"\.")):
         Scene.model_validate(raw)
+
+
+def test_a_3d_torso_walkers_urdf_names_the_bisecting_hip_it_cannot_hold(torso_3d):
+    """URDF has no joint held at the mean of two others: the torso walker's URDF carries the
+    upper body on its hinge and names the coupling it leaves out (``2 torso_pitch - leg1_hip
+    - leg2_hip = 0``); its masses add up to the walker's."""
+    import xml.etree.ElementTree as ET
+
+    from walkerlab.export.legs_3d import legs_3d_urdf_text
+
+    _walker_, scene = torso_3d
+    data = Plant.from_scene(scene).data
+    text = legs_3d_urdf_text(data, "torso_bhm_3d")
+    assert "2 * torso_pitch + -1 * leg1_hip + -1 * leg2_hip = 0" in text
+    masses = [float(m.get("value")) for m in ET.fromstring(text.split("\n", 1)[1]).iter("mass")]
+    assert sum(masses) == pytest.approx(data.total_mass_kg, abs=1e-9)

@@ -52,7 +52,13 @@ def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
            f"<robot name={quoteattr(name)}>"]
     tree, coords, p = walker_tree(data)
     roles = PelvisRoles()
-    root, _couplings = export_bodies(tree, coords, p, roles)
+    root, couplings = export_bodies(tree, coords, p, roles)
+    # URDF holds no joint at a sum of others (``mimic`` follows one joint): each coupling is
+    # named in a comment for the simulator that loads the file to add (MJCF has it as an
+    # equality on a fixed tendon)
+    out += [comment("coupling " + c.name + " left out (URDF cannot hold it): "
+                    + " + ".join(f"{k} * {j}" for j, k in c.terms) + " = 0")
+            for c in couplings]
 
     def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere
         if b.tree_body != roles.leg:
