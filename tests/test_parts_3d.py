@@ -110,6 +110,40 @@ def test_the_paper_walker_from_parts_in_3d_is_the_compass_shorthands_walker():
     assert 50 < np.max(np.abs(mu_a)) < 200
 
 
+#: configs/hip_width_stabilised.yaml's hip-roll law
+LAW = _raw("hip_width_stabilised.yaml")["walker"]["hip_roll"]
+
+
+def _stabilised_parts() -> dict:
+    return {**PAPER_PARTS, "hip_roll": LAW}
+
+
+@pytest.mark.slow  # 1-2 min each: the hip-roll walker's and the round feet's derivations
+@pytest.mark.parametrize("shorthand, parts, width", [
+    ("hip_width_stabilised.yaml", _stabilised_parts, 0.1),
+    ("round_feet_3d.yaml", lambda: _raw("round_feet.yaml")["walker"], 0.0)],
+    ids=["hip_roll_law", "round_feet_rod_legs"])
+def test_a_3d_walker_from_parts_finds_the_shorthands_gait(shorthand, parts, width):
+    """The same walker written from parts finds the ``compass_gait`` shorthand's gait with
+    every 3D part the tree has: hip-roll joints and their foot-placement law (configs/
+    hip_width_stabilised.yaml: the paper's legs with the scene's law), and round feet on rod
+    legs (configs/round_feet.yaml's parts in 3D: configs/round_feet_3d.yaml): fixed point
+    and period to 1e-10, the multipliers to 1e-8 relative."""
+    short = Scene.model_validate(_raw(shorthand))
+    ws = _walker(short)
+    a = find_fixed_point(ws, _guess(short, ws.state_names()), SOLVER, fd_check=False)
+    raw = _raw(shorthand)
+    raw["walker"] = {**parts(), "space": "3d", "hip_width_m": width}
+    wp = _walker(Scene.model_validate(raw))
+    assert wp.state_names() == ws.state_names()
+    b = find_fixed_point(wp, np.asarray(a.x), SOLVER, fd_check=False)
+    assert np.max(np.abs(np.asarray(b.x) - np.asarray(a.x))) < 1e-10
+    assert abs(b.period_s - a.period_s) < 1e-10
+    mu_a = np.sort_complex(np.asarray(a.multipliers_variational))
+    mu_b = np.sort_complex(np.asarray(b.multipliers_variational))
+    assert np.max(np.abs(mu_a - mu_b) / np.maximum(1.0, np.abs(mu_a))) < 1e-8
+
+
 #: configs/torso_bhm_3d.yaml's walker in the reference's terms
 TORSO = dict(g=9.81, L=1.0, gamma=0.0174, M_hip=10.0, legs=[(5.0, 0.5)], torso=[(5.0, 0.2)])
 
@@ -169,6 +203,10 @@ def test_the_shipped_3d_torso_gait_and_multipliers_match_an_independent_model(to
      "walker.torso.coupling"),
     ({"hip_width_m": 2.5}, "walker.hip_width_m"),
     ({"space": "2d", "hip_width_m": 0.1}, "walker.hip_width_m"),
+    ({"hip_width_m": 0.0, "hip_roll": LAW}, "walker.hip_roll"),
+    ({"leg": {"length_m": 1.0, "foot": {"kind": "arc", "radius_m": 0.2}, "bodies": [
+        {"kind": "point_mass", "name": "mass", "mass_kg": 5.0, "from_hip_m": 0.5}]},
+      "hip_roll": LAW}, "walker.hip_roll"),
 ])
 def test_a_3d_biped_refuses_what_it_cannot_walk_yet_naming_the_field(change, field):
     raw = {**_raw("hip_width.yaml"), "walker": {**PAPER_PARTS, "space": "3d",

@@ -216,12 +216,16 @@ class BipedParams(_Actuated):
                                       "and dampers between links at the hip")
     space: Space = "2d"
     hip_width_m: HipWidth = 0.0
+    hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
+                                        "their lateral foot-placement law (space: 3d with a "
+                                        "hip width; null: the legs rigid to the pelvis in "
+                                        "roll)")
 
     @model_serializer(mode="wrap")
     def _passive_as_before(self, handler):
         """A planar walker serialises as before ``space`` existed (the same scene JSON and
         input hashes): ``space: 2d`` and a zero hip width are left out."""
-        d = drop_unset(handler(self), ("actuation",))
+        d = drop_unset(handler(self), ("actuation", "hip_roll"))
         if isinstance(d, dict) and self.space == "2d" and not self.hip_width_m:
             d.pop("space", None)
             d.pop("hip_width_m", None)
@@ -277,9 +281,10 @@ class BipedParams(_Actuated):
         :func:`walkerlab.walker.trees.straight_legs_3d_tree`): what it supports today, one
         line otherwise."""
         if self.space == "2d":
-            if self.hip_width_m:
-                raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
-                                 "walker's hips are one point)")
+            for name in ("hip_width_m", "hip_roll"):
+                if getattr(self, name):
+                    raise ValueError(f"walker.{name}: needs space: 3d (a planar walker's "
+                                     "hips are one point)")
             return
         leg = pair[0]
         for field, bad, what in (
@@ -294,7 +299,13 @@ class BipedParams(_Actuated):
                 ("walker.springs", bool(self.springs), "no springs"),
                 ("walker.torso.coupling", self.torso is not None
                  and self.torso.coupling != "bisecting_hip", "a bisecting_hip torso"),
-                ("walker.actuation", self.actuation is not None, "a passive walker")):
+                ("walker.actuation", self.actuation is not None, "a passive walker"),
+                ("walker.hip_roll", self.hip_roll is not None and not self.hip_width_m,
+                 "a hip width for hip-roll joints"),
+                ("walker.hip_roll", self.hip_roll is not None and (
+                    leg.foot.kind != "point" or any(b.kind != "point_mass"
+                                                    for b in leg.bodies)),
+                 "point feet and point masses on the legs with hip-roll joints")):
             if bad:
                 raise ValueError(f"{field}: a walker in space: 3d needs {what} today")
         if not self.hip_width_m < 2 * leg.length_m:   # as CompassGaitParams' check

@@ -25,8 +25,7 @@ KNEED_ROLES = ("swing_thigh", "swing_shank", "stance")
 #: foot up the chain and down to the swing foot; a hinged torso's angle is appended.
 FREE_KNEE_ROLES = ("stance_shank", "stance_thigh", "swing_thigh", "swing_shank")
 #: Roles of straight legs under a hinged torso (the three-link walker; Grizzle, Abba &
-#: Plestan 2001): every link's absolute angle, stance leg, swing leg, torso (the chain's
-#: order, as :data:`FREE_KNEE_ROLES` then ``torso``).
+#: Plestan 2001): every link's absolute angle in the chain's order, as :data:`FREE_KNEE_ROLES`.
 HINGED_ROLES = ("stance", "swing", "torso")
 #: Roles with flat feet: the absolute leg angles and the stance ankle's angle (the swing
 #: foot is massless and sits at its spring's rest angle: no coordinate).
@@ -36,30 +35,25 @@ SPOKED_ROLES = ("stance",)
 #: Parameters of a spoked wheel: gravity, spoke length, slope, hub mass, inertia about the
 #: hub, half the angle between neighbouring spokes (``pi / n``) [SI].
 SPOKED_PARAMS = ("g", "L", "gamma", "M_hub", "I_hub", "alpha")
-#: Roles of a spoked wheel in three dimensions (``walker.space: 3d``): its heading about the
-#: slope normal, its lean about the fall line and the stance spoke's angle in the wheel's
-#: plane (:mod:`walkerlab.codegen.derive_3d`).
+#: Roles of a spoked wheel in 3D (``walker.space: 3d``): its heading about the slope normal,
+#: its lean about the fall line, the stance spoke's angle in the wheel's plane.
 SPOKED_3D_ROLES = ("heading", "lean", "stance")
 #: Parameters of a spoked wheel in three dimensions: :data:`SPOKED_PARAMS` (``I_hub`` about
 #: the axle) and its inertia about a diameter ``I_diam`` [kg m^2].
 SPOKED_3D_PARAMS = SPOKED_PARAMS + ("I_diam",)
-#: Roles of a straight-legged walker in three dimensions (``model: compass_gait`` with
-#: ``space: 3d``; :func:`walkerlab.codegen.derive_3d.derive_compass`): the pelvis' roll about
-#: the fall line, then the legs' pitch angles as the planar walkers'.
+#: Roles of a straight-legged walker in 3D (``space: 3d``; :mod:`walkerlab.codegen.derive_3d`):
+#: the roll about the fall line, then the legs' pitch angles as the planar walkers'.
 COMPASS_3D_ROLES = ("lean", "swing", "stance")
-#: Parameters of the straight-legged walker in 3D: gravity, leg length, slope, hip mass, leg
-#: mass and its distance from the foot [SI], then (``hip_width``) the hip width ``w_hip`` [m],
-#: (legs with inertia: ``bodies[0].kind == "rod"``) each leg's inertia ``I_leg`` about its
-#: mass point normal to the leg [kg m^2], (round feet: ``foot == "arc"``) the feet's radius
-#: ``R_foot`` [m].
+#: Parameters of the ``compass_gait`` shorthand in 3D: gravity, leg length, slope, hip mass,
+#: leg mass and its distance from the foot [SI], then the hip width ``w_hip`` [m], a rod's
+#: ``I_leg`` [kg m^2] normal to the leg, round feet's ``R_foot`` [m] (each if any).
 COMPASS_3D_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
 #: Roles added by hip-roll joints (``hip_roll``): the pelvis' and the swing leg's roll
 #: about the fall line (the ``lean`` is then the stance leg's).
 HIP_ROLL_ROLES = ("pelvis_roll", "swing_roll")
 #: Parameters of the hip-roll joints and law (:class:`walkerlab.config.walker.HipRollLaw`,
-#: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis
-#: roll, the swing hip's on the swing leg's, the foot-placement gains on the lean and its
-#: rate.
+#: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis roll,
+#: the swing hip's on the swing leg's, the foot-placement gains on the lean and its rate.
 HIP_ROLL_PARAMS = ("I_pelvis", "kp_pelvis", "kd_pelvis", "kp_swing", "kd_swing", "g_lean",
                    "g_lean_rate")
 
@@ -266,7 +260,8 @@ class Structure:
             names += [f"k_s{i}", f"r_s{i}", f"c_s{i}"]
         if self.knee_spring:
             names += ["k_knee", "r_knee", "c_knee"]
-        return tuple(names) + (("w_hip",) if self.hip_width else ())
+        return (tuple(names) + (("w_hip",) if self.hip_width else ())
+                + (HIP_ROLL_PARAMS if self.hip_roll else ()))
 
     def key(self) -> str:
         """Canonical JSON of the structure (part of the generated-code cache key)."""
@@ -419,6 +414,13 @@ def _spoked_data(w, slope_rad: float) -> WalkerData:
                       w.gravity_m_per_s2, slope_rad, extra)
 
 
+def _hip_roll_gains(law) -> tuple[float, ...]:
+    """The hip-roll law's numbers in :data:`HIP_ROLL_PARAMS` order."""
+    return (law.pelvis_roll_inertia_kg_m2, law.pelvis_stiffness_n_m_per_rad,
+            law.pelvis_damping_n_m_s_per_rad, law.swing_stiffness_n_m_per_rad,
+            law.swing_damping_n_m_s_per_rad, law.lean_gain, law.lean_rate_gain_s)
+
+
 def _compass_3d_data(w, slope_rad: float) -> WalkerData:
     """Structure and parameters (:data:`COMPASS_3D_PARAMS`) of a ``model:
     compass_gait`` section with ``space: 3d``: with a hip width, the mirror step's
@@ -442,9 +444,7 @@ def _compass_3d_data(w, slope_rad: float) -> WalkerData:
         extra["foot_radius_m"] = radius
     law = w.hip_roll
     if law is not None:  # odd in the rolls: the mirror step runs the same gains
-        gains = (law.pelvis_roll_inertia_kg_m2, law.pelvis_stiffness_n_m_per_rad,
-                 law.pelvis_damping_n_m_s_per_rad, law.swing_stiffness_n_m_per_rad,
-                 law.swing_damping_n_m_s_per_rad, law.lean_gain, law.lean_rate_gain_s)
+        gains = _hip_roll_gains(law)
         params, mirror = params + gains, mirror + gains
         extra["hip_roll"] = law.model_dump()
     structure = Structure("absolute", (BodySpec("mass", "point_mass" if inertia is None
@@ -529,10 +529,15 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
              + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ()))
              + (2 * foot_mass[0] if foot_mass is not None else 0.0))
-    if walker_cfg.space == "3d":   # the parts in 3D: the hip width last, mirrored a step on
+    if walker_cfg.space == "3d":   # the parts in 3D: the hip width, mirrored a step on
         extra["hip_width_m"] = w = float(walker_cfg.hip_width_m)
-        structure = replace(structure, in_3d=True, hip_width=bool(w), parts_3d=True)
+        law = walker_cfg.hip_roll
+        structure = replace(structure, in_3d=True, hip_width=bool(w), parts_3d=True,
+                            hip_roll=law is not None)
         p1, p2 = (p1 + (w,), p1 + (-w,)) if w else (p1, p1)
+        if law is not None:  # odd in the rolls: the mirror step runs the same gains
+            extra["hip_roll"], gains = law.model_dump(), _hip_roll_gains(law)
+            p1, p2 = p1 + gains, p2 + gains
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
                       slope_rad, extra, None if p2 == p1 else p2)
 
