@@ -39,12 +39,12 @@ from walkerlab.config.biped_parts import (  # noqa: F401 (part of this API)
 from walkerlab.config.wheel import RimlessWheelParams
 
 #: ``walker.space`` of the straight-legged walkers (the shorthand's and the parts')
-Space = Annotated[Literal["2d", "3d"], Field(
+_Space = Annotated[Literal["2d", "3d"], Field(
     description="2d: the walker moves in the sagittal plane; 3d: it also rolls about the "
     "fall line through its stance foot, which neither slips nor twists (Kuo 1999; straight "
     "legs)")]
 #: ``walker.hip_width_m``
-HipWidth = Annotated[float, Field(
+_HipWidth = Annotated[float, Field(
     ge=0, le=100, description="distance between the hips along the hip axis [m] (space: 3d "
     "only; the hip mass, and an upper body, midway; 0: the planar walker embedded in 3D)")]
 
@@ -118,8 +118,8 @@ class CompassGaitParams(_Actuated):
     leg_mass_from_foot_m: float = Field(
         gt=0, description="distance a of the leg mass from the foot [m]; b = L - a"
     )
-    space: Space = "2d"
-    hip_width_m: HipWidth = 0.0
+    space: _Space = "2d"
+    hip_width_m: _HipWidth = 0.0
     hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
                                         "their lateral foot-placement law (space: 3d with a "
                                         "hip width; null: the legs rigid to the pelvis in "
@@ -214,8 +214,8 @@ class BipedParams(_Actuated):
     torso: TorsoSpec | None = Field(None, description="upper body on the hip (null: none)")
     springs: list[SpringSpec] = Field(default_factory=list, description="torsional springs "
                                       "and dampers between links at the hip")
-    space: Space = "2d"
-    hip_width_m: HipWidth = 0.0
+    space: _Space = "2d"
+    hip_width_m: _HipWidth = 0.0
     hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
                                         "their lateral foot-placement law (space: 3d with a "
                                         "hip width; null: the legs rigid to the pelvis in "
