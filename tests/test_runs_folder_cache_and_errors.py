@@ -9,6 +9,8 @@ behaviour under test (paths, cache, CLI layer, sweep plumbing) does not depend o
 from __future__ import annotations
 
 import copy
+import importlib
+import inspect
 import math
 import os
 import re
@@ -25,6 +27,7 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+import walkerlab
 from tests.cli_run import IDEAL, PAPER
 from tests.cli_run import run_cli as _cli
 from walkerlab.cli import app
@@ -32,6 +35,7 @@ from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.io import freshness
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
 from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock, stage_artifact
+from walkerlab.io.stage_files import ARTIFACTS
 from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.safefs import process_alive
 from walkerlab.stages import common
@@ -634,3 +638,24 @@ def test_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monk
     with pytest.raises(RunPathError, match="symbolic link"):
         write_if_stale(stage, sc, runs, ("walker",), (), compute, tell=told.append)
     assert not computed and not told  # before: "recomputing ... changed" and the computation
+
+
+@pytest.mark.parametrize("stage", sorted(ARTIFACTS))
+def test_every_stage_loader_refuses_an_absent_or_foreign_artifact_in_one_line(tmp_path, stage):
+    """Each stage's loader (made by walkerlab.io.artifacts.artifact_loader) takes the path,
+    documents its ArtifactError and refuses in one line naming the file: an absent file,
+    and an empty file written as another stage's (a stage-bound loader refuses the stage; the
+    stability map's, bound to none, finds nothing it reads)."""
+    art = ARTIFACTS[stage]
+    loader = getattr(importlib.import_module(f"walkerlab.io.schemas.{art.schema}"), art.loader)
+    assert next(iter(inspect.signature(loader).parameters)) == "path"
+    assert "Raises\n------\nwalkerlab.io.artifacts.ArtifactError" in inspect.getdoc(loader)
+    absent = tmp_path / "absent.h5"
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f.attrs["stage"] = "another-stage"
+        f.attrs["walkerlab_version"] = walkerlab.__version__
+    for path in (absent, foreign):
+        with pytest.raises(ArtifactError) as err:
+            art.load(path)
+        assert str(path) in str(err.value) and "\n" not in str(err.value)

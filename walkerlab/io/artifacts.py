@@ -32,12 +32,13 @@ from __future__ import annotations
 
 import datetime as _dt
 import hashlib
+import inspect
 import itertools
 import os
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from functools import lru_cache
+from functools import lru_cache, wraps
 from pathlib import Path
 
 import h5py
@@ -492,6 +493,50 @@ def open_artifact(path: Path, stage: str | None = None,
     finally:
         f.close()
 
+
+
+#: the ``Raises`` section :func:`artifact_loader` gives every loader it makes
+_LOADER_RAISES = """
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing or unreadable (truncated or damaged), written by another walkerlab version,
+        lacking a dataset or attribute this reader needs, or not {stage} (one line
+        naming the file; as :func:`walkerlab.io.artifacts.open_artifact`).
+"""
+
+
+def artifact_loader(stage: str | None) -> Callable:
+    """Make a schema's reading of an open artifact into its loader: the one place a loader
+    opens its file, checks its stage and version and turns a missing dataset or a damaged
+    file into one line (:func:`open_artifact`), its ``Raises`` written once.
+
+    Decorates ``read(f, path, *args, **kwargs)`` (``f``: the open :class:`h5py.File`;
+    ``path``: its :class:`~pathlib.Path`); the loader takes ``(path, *args, **kwargs)``,
+    keeps ``read``'s name and docstring and adds the ``Raises`` section.
+
+    Parameters
+    ----------
+    stage : str or None
+        The artifact's ``stage`` attribute (None: any stage's).
+    """
+    what = "an HDF5 artifact" if stage is None else f"a ``{stage}`` artifact"
+
+    def make(read: Callable) -> Callable:
+        @wraps(read)
+        def load(path, *args, **kwargs):
+            path = Path(path)
+            with open_artifact(path, stage) as f:
+                return read(f, path, *args, **kwargs)
+
+        load.__doc__ = (read.__doc__ or "").rstrip() + _LOADER_RAISES.format(stage=what)
+        sig = inspect.signature(read)
+        params = list(sig.parameters.values())
+        load.__signature__ = sig.replace(parameters=params[1:])  # help(): (path, ...)
+        return load
+
+    return make
 
 def stored_hash(path: Path) -> str | None:
     """``input_hash`` of an artifact, or None when it is absent or unreadable."""

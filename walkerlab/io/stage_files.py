@@ -25,14 +25,21 @@ class StageArtifact:
         ``{stage: artifact}`` mapping.
     schema : str
         Its schema module under :mod:`walkerlab.io.schemas` (also the artifact's file
-        stem: ``contact_sim`` -> ``contact_sim.h5``).
+        stem: ``contact_sim`` -> ``contact_sim.h5``); by default the name with ``_`` for
+        ``-``.
     loader : str
-        The schema module's loader (``load_contact_sim``).
+        The schema module's loader; by default ``load_<schema>`` (``load_contact_sim``).
     """
 
     name: str
-    schema: str
-    loader: str
+    schema: str = ""
+    loader: str = ""
+
+    def __post_init__(self):
+        if not self.schema:
+            object.__setattr__(self, "schema", self.name.replace("-", "_"))
+        if not self.loader:
+            object.__setattr__(self, "loader", f"load_{self.schema}")
 
     @property
     def file(self) -> str:
@@ -51,20 +58,20 @@ class StageArtifact:
         return getattr(module, self.loader)(path)
 
 
-FIXEDPOINT = StageArtifact("fixedpoint", "fixedpoint", "load_fixedpoint")
-SIMULATE = StageArtifact("simulate", "simulate", "load_simulate")
-CONTACT_SIM = StageArtifact("contact-sim", "contact_sim", "load_contact_sim")
-COMPARE = StageArtifact("compare", "compare", "load_compare")
-WORKPRECISION = StageArtifact("workprecision", "workprecision", "load_workprecision")
-BASIN = StageArtifact("basin", "basin", "load_basin")
-ROBUSTNESS = StageArtifact("robustness", "robustness", "load")
-MFPT = StageArtifact("mfpt", "mfpt", "load")
-ATTRIBUTION = StageArtifact("attribution", "attribution", "load_attribution")
-OPTIMIZE = StageArtifact("optimize", "optimize", "load")
+FIXEDPOINT = StageArtifact("fixedpoint")
+SIMULATE = StageArtifact("simulate")
+CONTACT_SIM = StageArtifact("contact-sim")
+COMPARE = StageArtifact("compare")
+WORKPRECISION = StageArtifact("workprecision")
+BASIN = StageArtifact("basin")
+ROBUSTNESS = StageArtifact("robustness", loader="load")
+MFPT = StageArtifact("mfpt", loader="load")
+ATTRIBUTION = StageArtifact("attribution")
+OPTIMIZE = StageArtifact("optimize", loader="load")
 #: ``bifurcation`` and ``bifurcation_<field>`` load as summaries
-BIFURCATION = StageArtifact("bifurcation", "bifurcation", "load_bifurcation_summary")
+BIFURCATION = StageArtifact("bifurcation", loader="load_bifurcation_summary")
 #: ``stability_map_<kind>.h5``
-STABILITY_MAP = StageArtifact("stability_map", "stability_map", "load_stability_map")
+STABILITY_MAP = StageArtifact("stability_map")
 
 #: stage name -> its artifact
 ARTIFACTS: dict[str, StageArtifact] = {a.name: a for a in (

@@ -7,11 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.artifacts import artifact_loader
 from walkerlab.io.stage_files import CONTACT_SIM
 
 
-def load_terrain(path: Path | str) -> dict | None:
+@artifact_loader(CONTACT_SIM.name)
+def load_terrain(f, path: Path | str) -> dict | None:
     """The ground the contact walker of ``contact_sim.h5`` walked on.
 
     Returns
@@ -20,17 +21,11 @@ def load_terrain(path: Path | str) -> dict | None:
         ``lanes``: {leg: patch centres (n,) [m, along the slope from the first stance
         foot]}, ``half_width`` [m], ``continuous`` (bool); None for an artifact without a
         ``terrain`` group.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing or not a contact-sim artifact.
     """
-    with open_artifact(path, CONTACT_SIM.name) as f:
-        if "terrain" not in f:
-            return None
-        g = f["terrain"]
-        lanes = {k.removeprefix("lane_"): np.asarray(g[k][()], float)
-                 for k in g if k.startswith("lane_")}
-        return {"lanes": lanes, "half_width": float(g["patch_half_width"][()]),
-                "continuous": bool(g["continuous"][()])}
+    if "terrain" not in f:
+        return None
+    g = f["terrain"]
+    lanes = {k.removeprefix("lane_"): np.asarray(g[k][()], float)
+             for k in g if k.startswith("lane_")}
+    return {"lanes": lanes, "half_width": float(g["patch_half_width"][()]),
+            "continuous": bool(g["continuous"][()])}

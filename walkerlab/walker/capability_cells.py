@@ -117,6 +117,20 @@ _NO_ANKLES = {
     ("ankle_push_off", "*"): _NO_ANKLE_PUSH,
     ("ankle_push_off", "osim"): _OSIM_ANKLE_PUSH,
 }
+#: what every planar kind (and the 3D wheel, which has no hips or legs) refuses of the 3D
+#: walker's features
+_PLANAR = {
+    ("hip_roll", "*"): NO_HIP_ROLL,
+    ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+}
+#: what the rimless wheels (planar and 3D: one rigid body) refuse: every driven joint, a
+#: Gymnasium walk and an optimisation (nothing to drive)
+_WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
+                                              "torso_torque", "push_off", "ankle_push_off",
+                                              "virtual_constraints")}
+_WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
+_WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
+                   "one, walkerlab fixedpoint)")
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
                     "its heel strike is the plain impact (the rigid kneed model's push-off "
                     "runs in fixedpoint and simulate, not here); optimise the hip torque "
@@ -164,8 +178,7 @@ _OPTIMIZE_GROUNDS = {("stairs", "optimize"): _OPTIMIZE_LANDING,
 #: part) or says what the view's model does not carry.
 CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "straight_legs": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_PLANAR,
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         ("virtual_constraints", "optimize"): ("optimize.design: virtual_constraints is built "
@@ -180,8 +193,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("profile", "optimize"): _OPTIMIZE_PROFILE,
     },
     "locking_knees": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_PLANAR,
         **_NO_ANKLES,
         ("virtual_constraints", "*"): ("a knee that locks changes the walker's degrees of "
                                        "freedom within the step (its outputs would change "
@@ -194,8 +206,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_OPTIMIZE_GROUNDS,
     },
     "flat_feet": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_PLANAR,
         ("knee_torque", "*"): ("flat feet are not available with a knee yet "
                                "(walker.leg.knee)"),
         ("virtual_constraints", "*"): ("a flat foot's stance modes change the walker's "
@@ -225,8 +236,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                          "hip torques, not together)"),
     },
     "free_joints": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_PLANAR,
         **_NO_ANKLES,
         **_VC_VIEWS,
         ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
@@ -242,8 +252,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "hinged_torso": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
+        **_PLANAR,
         ("knee_torque", "*"): _NO_KNEE,
         **_VC_VIEWS,
         **_NO_ANKLES,
@@ -256,22 +265,18 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("profile", "gym"): PROFILE_PASSIVE,  # the shipped walker is driven by its torques
     },
     "rolling_polygon": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
-        **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
-                                         "torso_torque", "push_off", "ankle_push_off",
-                                         "virtual_constraints")},
+        **_PLANAR,
+        **_WHEEL_JOINTS,
         ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
                             "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
-        ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
+        ("walk", "gym"): _WHEEL_GYM,
         # footholds have no ground between them; the wheel's contact model needs it
         ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
                                    "ground (its spokes have no lanes of their own)"),
         **_URDF_GROUNDS,
-        ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
-                               "the passive one, walkerlab fixedpoint)"),
+        ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
     "straight_legs_3d": {
         ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
@@ -291,17 +296,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "is a later step"),
     },
     "rolling_polygon_3d": {
-        ("hip_roll", "*"): NO_HIP_ROLL,
-        ("round_feet_3d", "*"): NO_ROUND_FEET_3D,
-        **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
-                                         "torso_torque", "push_off", "ankle_push_off",
-                                         "virtual_constraints")},
+        **_PLANAR,
+        **_WHEEL_JOINTS,
         **_CELLS_3D,
         # the MJCF and the URDF: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
-        ("walk", "gym"): "the rimless wheel is one rigid body: it has no joint to drive",
-        ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
-                               "the passive one, walkerlab fixedpoint)"),
+        ("walk", "gym"): _WHEEL_GYM,
+        ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
 }
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 
 STAGE = "attribution"
 CAUSES = ("gap", "creep", "compliance", "residual")
@@ -100,21 +100,15 @@ class AttributionArtifact:
     rigid_heel_strikes: int
 
 
-def load_attribution(path: Path) -> AttributionArtifact:
-    """Load ``attribution.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        gaps = {c: (float(f[f"{c}/period"][()]), float(f[f"{c}/step_length"][()]))
-                for c in CAUSES}
-        energy = {s: float(f[f"energy/{s}"][()]) for s in SINKS}
-        return AttributionArtifact(
-            Path(path), gaps, energy, float(f["adjustment/adjusted_period"][()]),
-            float(f["adjustment/unadjusted_period"][()]),
-            np.asarray(f["adjustment/rate_scale"][()], float),
-            float(f.attrs["rigid_period_s"]), str(f.attrs["rigid_from_adjusted"]),
-            int(f.attrs["rigid_heel_strikes"]))
+@artifact_loader(STAGE)
+def load_attribution(f, path: Path) -> AttributionArtifact:
+    """Load ``attribution.h5``."""
+    gaps = {c: (float(f[f"{c}/period"][()]), float(f[f"{c}/step_length"][()]))
+            for c in CAUSES}
+    energy = {s: float(f[f"energy/{s}"][()]) for s in SINKS}
+    return AttributionArtifact(
+        Path(path), gaps, energy, float(f["adjustment/adjusted_period"][()]),
+        float(f["adjustment/unadjusted_period"][()]),
+        np.asarray(f["adjustment/rate_scale"][()], float),
+        float(f.attrs["rigid_period_s"]), str(f.attrs["rigid_from_adjusted"]),
+        int(f.attrs["rigid_heel_strikes"]))

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 from walkerlab.io.netcdf import coordinate
 
 STAGE = "basin"
@@ -122,23 +122,17 @@ class BasinArtifact:
     counts: dict = field(default_factory=dict)
 
 
-def load_basin(path: Path) -> BasinArtifact:
-    """Load ``basin.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        names = [str(n) for n in f.attrs["state_names"]]
-        outcomes = [str(o) for o in f.attrs["outcomes"]]
-        return BasinArtifact(
-            **{k: f[k][()] for k in ("x", "y", "outcome", "steps", "period")},
-            x_unit=str(f["x"].attrs["unit"]), y_unit=str(f["y"].attrs["unit"]),
-            x_axis=str(f.attrs["x_axis"]), y_axis=str(f.attrs["y_axis"]), outcomes=outcomes,
-            fixed_point={n: float(f[f"fixed_point/{n}"][()]) for n in names},
-            max_steps=int(f["settings/max_steps"][()]),
-            start=str(f.attrs.get("start", "fixed_point")),
-            scene=str(f.attrs.get("scene_name", "")),
-            counts={o: int(f[f"counts/{o}"][()]) for o in outcomes})
+@artifact_loader(STAGE)
+def load_basin(f, path: Path) -> BasinArtifact:
+    """Load ``basin.h5``."""
+    names = [str(n) for n in f.attrs["state_names"]]
+    outcomes = [str(o) for o in f.attrs["outcomes"]]
+    return BasinArtifact(
+        **{k: f[k][()] for k in ("x", "y", "outcome", "steps", "period")},
+        x_unit=str(f["x"].attrs["unit"]), y_unit=str(f["y"].attrs["unit"]),
+        x_axis=str(f.attrs["x_axis"]), y_axis=str(f.attrs["y_axis"]), outcomes=outcomes,
+        fixed_point={n: float(f[f"fixed_point/{n}"][()]) for n in names},
+        max_steps=int(f["settings/max_steps"][()]),
+        start=str(f.attrs.get("start", "fixed_point")),
+        scene=str(f.attrs.get("scene_name", "")),
+        counts={o: int(f[f"counts/{o}"][()]) for o in outcomes})

@@ -17,7 +17,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put, read_named
+from walkerlab.io.artifacts import artifact_loader, put, read_named
 from walkerlab.io.netcdf import coordinate
 
 STAGE = "bifurcation"
@@ -63,28 +63,22 @@ class BifurcationSummary:
     attractor_period: np.ndarray
 
 
-def load_bifurcation_summary(path: Path) -> BifurcationSummary:
-    """Load what the report shows of a bifurcation artifact.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        ppath = f.attrs.get("parameter_path", SLOPE_PATH)
-        ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
-        dim = "slope" if ppath == SLOPE_PATH else ppath
-        values = f[dim][()]
-        data = {"parameter_path": ppath, "parameter_unit": str(f[dim].attrs.get("unit", "deg")),
-                dim: values, "steps_per_map": int(f.attrs.get("steps_per_map", 0))}
-        for name in ("onset/onset_slope", "onset/onset_value"):
-            if name in f:
-                data[name] = f[name][()]
-        data["steady_state/outcome"] = (list(f["steady_state/outcome"].asstr()[()])
-                                        if "steady_state/outcome" in f else None)
-        return BifurcationSummary(Path(path), data, values,
-                                  f["steady_state/attractor_period"][()])
+@artifact_loader(STAGE)
+def load_bifurcation_summary(f, path: Path) -> BifurcationSummary:
+    """Load what the report shows of a bifurcation artifact."""
+    ppath = f.attrs.get("parameter_path", SLOPE_PATH)
+    ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
+    dim = "slope" if ppath == SLOPE_PATH else ppath
+    values = f[dim][()]
+    data = {"parameter_path": ppath, "parameter_unit": str(f[dim].attrs.get("unit", "deg")),
+            dim: values, "steps_per_map": int(f.attrs.get("steps_per_map", 0))}
+    for name in ("onset/onset_slope", "onset/onset_value"):
+        if name in f:
+            data[name] = f[name][()]
+    data["steady_state/outcome"] = (list(f["steady_state/outcome"].asstr()[()])
+                                    if "steady_state/outcome" in f else None)
+    return BifurcationSummary(Path(path), data, values,
+                              f["steady_state/attractor_period"][()])
 
 
 def bifurcation_writer(res):  # res: walkerlab.studies.bifurcation.BifurcationResult
@@ -147,23 +141,23 @@ def bifurcation_writer(res):  # res: walkerlab.studies.bifurcation.BifurcationRe
     return writer
 
 
-def load_bifurcation(path: Path) -> dict:
+@artifact_loader("bifurcation")
+def load_bifurcation(f, path: Path) -> dict:
     """Arrays of a ``bifurcation`` artifact as a dict (names as in the file), with
     ``parameter_path``, ``parameter_dim`` and ``parameter_unit`` (the grid's field, its
     coordinate's name and unit; the slope in an artifact without them)."""
     out = {}
-    with open_artifact(Path(path), "bifurcation") as f:
-        ppath = f.attrs.get("parameter_path", SLOPE_PATH)
-        ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
-        dim = parameter_dim(ppath)
-        unit = f[dim].attrs.get("unit", "deg")
-        out.update(parameter_path=ppath, parameter_dim=dim,
-                   parameter_unit=unit.decode() if isinstance(unit, bytes) else str(unit),
-                   steps_per_map=int(f.attrs.get("steps_per_map", 0)))  # 0: not recorded
+    ppath = f.attrs.get("parameter_path", SLOPE_PATH)
+    ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
+    dim = parameter_dim(ppath)
+    unit = f[dim].attrs.get("unit", "deg")
+    out.update(parameter_path=ppath, parameter_dim=dim,
+               parameter_unit=unit.decode() if isinstance(unit, bytes) else str(unit),
+               steps_per_map=int(f.attrs.get("steps_per_map", 0)))  # 0: not recorded
 
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset):
-                out[name] = read_named(f, name)
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            out[name] = read_named(f, name)
 
-        f.visititems(visit)
+    f.visititems(visit)
     return out

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.units import Units, for_artifact
 
@@ -99,37 +99,31 @@ def write_compare(f, c: Comparison) -> None:
             put(f, f"metrics/{model}/{k}", v, METRIC_UNITS.get(k, "-"), k)
 
 
-def load_compare(path: Path) -> Comparison:
-    """Load ``compare.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        g = f["errors"]
-        names = [str(x) for x in g.attrs["coordinates"]]
-        metrics, munits = {}, {}
-        if "metrics" in f:
-            for model in f["metrics"]:
-                m = f["metrics"][model]
-                metrics[model] = {k: m[k][()] for k in m}
-                munits.update({k: str(m[k].attrs.get("unit", "")) for k in m})
-        step_phase = phase_errors = None
-        if "errors_phase_aligned" in f:
-            p = f["errors_phase_aligned"]
-            step_phase = p["step_phase"][()]
-            phase_errors = {n: p[f"coordinates/{n}"][()] for n in
-                            (str(x) for x in p.attrs["coordinates"])}
-        return Comparison(
-            legs=[str(x) for x in g.attrs["legs"]], time=g["time"][()],
-            step_phase=step_phase, phase_errors=phase_errors,
-            errors={n: g[f"coordinates/{n}"][()] for n in names},
-            error_units={n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names},
-            limit_cycle_distance=({k: float(g["limit_cycle_distance"][k][()])
-                                   for k in g["limit_cycle_distance"]}
-                                  if "limit_cycle_distance" in g else {}),
-            max_abs_angle_rad=float(g["max_abs_angle"][()]),
-            max_abs_rate_rad_per_s=float(g["max_abs_rate"][()]),
-            metrics=metrics, metric_units=munits, path=Path(path), units=for_artifact(f))
+@artifact_loader(STAGE)
+def load_compare(f, path: Path) -> Comparison:
+    """Load ``compare.h5``."""
+    g = f["errors"]
+    names = [str(x) for x in g.attrs["coordinates"]]
+    metrics, munits = {}, {}
+    if "metrics" in f:
+        for model in f["metrics"]:
+            m = f["metrics"][model]
+            metrics[model] = {k: m[k][()] for k in m}
+            munits.update({k: str(m[k].attrs.get("unit", "")) for k in m})
+    step_phase = phase_errors = None
+    if "errors_phase_aligned" in f:
+        p = f["errors_phase_aligned"]
+        step_phase = p["step_phase"][()]
+        phase_errors = {n: p[f"coordinates/{n}"][()] for n in
+                        (str(x) for x in p.attrs["coordinates"])}
+    return Comparison(
+        legs=[str(x) for x in g.attrs["legs"]], time=g["time"][()],
+        step_phase=step_phase, phase_errors=phase_errors,
+        errors={n: g[f"coordinates/{n}"][()] for n in names},
+        error_units={n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names},
+        limit_cycle_distance=({k: float(g["limit_cycle_distance"][k][()])
+                               for k in g["limit_cycle_distance"]}
+                              if "limit_cycle_distance" in g else {}),
+        max_abs_angle_rad=float(g["max_abs_angle"][()]),
+        max_abs_rate_rad_per_s=float(g["max_abs_rate"][()]),
+        metrics=metrics, metric_units=munits, path=Path(path), units=for_artifact(f))

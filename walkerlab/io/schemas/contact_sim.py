@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.io.trajectory import NamedTrajectory, read_samples, write_samples
@@ -420,76 +420,64 @@ def _periodic(f) -> PeriodicGait | None:
                         bool(g["stable"][()]))
 
 
-def load_contact_sim(path: Path) -> ContactSimArtifact:
+@artifact_loader(STAGE)
+def load_contact_sim(f, path: Path) -> ContactSimArtifact:
     """Load ``contact_sim.h5`` (a hand-built artifact may lack the setup records: they are
-    then empty).
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        term = str(f.attrs["termination"])
-        drop = None
-        if "drop_test" in f:
-            g = f["drop_test"]
-            drop = DropTest(g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
-                            {fam: g[f"{fam}/restitution"][()]
-                             for fam in ("paper", "rigid_limit")},
-                            float(g.attrs.get("mass_kg", 20.0)))
-        steps = {k: f[f"steps/{k}"][()] for k in ("stance_slip_mm", "double_support_creep_mm",
-                                                   "period", "stance_slip_path_mm",
-                                                   "friction_work_j") if f"steps/{k}" in f}
-        return ContactSimArtifact(
-            path=Path(path), units=for_artifact(f), termination=term,
-            outcome=str(f.attrs.get("outcome", term)),
-            outcome_message=str(f.attrs.get("outcome_message", "")),
-            walks=bool(f.attrs["walks"]) if "walks" in f.attrs else None,
-            walks_reason=str(f.attrs.get("walks_reason", "")),
-            outcome_after=(str(f["outcome"].attrs.get("after", "")) if "outcome" in f
-                           else ""),
-            stiffness_family=str(f.attrs.get("stiffness_family", "paper")),
-            samples=read_samples(f),
-            summary={k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))
-                     for k in f["summary"]} if "summary" in f else {},
-            stage_wall_time_s=float(f.attrs.get("wall_time_s", np.nan)),
-            contact_params_si={k: (f["contact_params_si"][k][()],
-                                   str(f["contact_params_si"][k].attrs["unit"]))
-                               for k in f["contact_params_si"]}
-            if "contact_params_si" in f else {},
-            initial_rate_scale=(f["initial_rate_scale"][()] if "initial_rate_scale" in f
-                                else np.ones(2)),
-            rate_names=([str(v) for v in f["rate"][()].astype(str)] if "rate" in f else None),
-            heel_strike_times=(f["events/heel_strike_times"][()]
-                               if "events/heel_strike_times" in f else np.zeros(0)),
-            steps=steps, drop=drop, periodic=_periodic(f),
-            adjust={**{k: f["adjust"][k][()] for k in f["adjust"]},
-                    **{k: str(v) for k, v in f["adjust"].attrs.items()}}
-            if "adjust" in f else None,
-            ledger=({**{k: f["ledger/work"][k][()] for k in f["ledger/work"] if k != "time"},
-                     "residual": f["ledger/residual"][()]} if "ledger" in f else None),
-            ledger_steps=({k: f["ledger/steps"][k][()] for k in f["ledger/steps"]
-                           if k != "ledger_step"} if "ledger/steps" in f else None))
+    then empty)."""
+    term = str(f.attrs["termination"])
+    drop = None
+    if "drop_test" in f:
+        g = f["drop_test"]
+        drop = DropTest(g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
+                        {fam: g[f"{fam}/restitution"][()]
+                         for fam in ("paper", "rigid_limit")},
+                        float(g.attrs.get("mass_kg", 20.0)))
+    steps = {k: f[f"steps/{k}"][()] for k in ("stance_slip_mm", "double_support_creep_mm",
+                                               "period", "stance_slip_path_mm",
+                                               "friction_work_j") if f"steps/{k}" in f}
+    return ContactSimArtifact(
+        path=Path(path), units=for_artifact(f), termination=term,
+        outcome=str(f.attrs.get("outcome", term)),
+        outcome_message=str(f.attrs.get("outcome_message", "")),
+        walks=bool(f.attrs["walks"]) if "walks" in f.attrs else None,
+        walks_reason=str(f.attrs.get("walks_reason", "")),
+        outcome_after=(str(f["outcome"].attrs.get("after", "")) if "outcome" in f
+                       else ""),
+        stiffness_family=str(f.attrs.get("stiffness_family", "paper")),
+        samples=read_samples(f),
+        summary={k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))
+                 for k in f["summary"]} if "summary" in f else {},
+        stage_wall_time_s=float(f.attrs.get("wall_time_s", np.nan)),
+        contact_params_si={k: (f["contact_params_si"][k][()],
+                               str(f["contact_params_si"][k].attrs["unit"]))
+                           for k in f["contact_params_si"]}
+        if "contact_params_si" in f else {},
+        initial_rate_scale=(f["initial_rate_scale"][()] if "initial_rate_scale" in f
+                            else np.ones(2)),
+        rate_names=([str(v) for v in f["rate"][()].astype(str)] if "rate" in f else None),
+        heel_strike_times=(f["events/heel_strike_times"][()]
+                           if "events/heel_strike_times" in f else np.zeros(0)),
+        steps=steps, drop=drop, periodic=_periodic(f),
+        adjust={**{k: f["adjust"][k][()] for k in f["adjust"]},
+                **{k: str(v) for k, v in f["adjust"].attrs.items()}}
+        if "adjust" in f else None,
+        ledger=({**{k: f["ledger/work"][k][()] for k in f["ledger/work"] if k != "time"},
+                 "residual": f["ledger/residual"][()]} if "ledger" in f else None),
+        ledger_steps=({k: f["ledger/steps"][k][()] for k in f["ledger/steps"]
+                       if k != "ledger_step"} if "ledger/steps" in f else None))
 
 
-def run_end(path: Path) -> tuple[str, str]:
+@artifact_loader(STAGE)
+def run_end(f, path: Path) -> tuple[str, str]:
     """``(outcome, message)`` of a contact run (the outcome's name, e.g. "walked", "trip";
     the message may be "")."""
-    with open_artifact(path, STAGE) as f:
-        return (str(f.attrs.get("outcome", f.attrs["termination"])),
-                str(f.attrs.get("outcome_message", "")))
+    return (str(f.attrs.get("outcome", f.attrs["termination"])),
+            str(f.attrs.get("outcome_message", "")))
 
 
-def load_step_periods(path: Path) -> np.ndarray:
+@artifact_loader(STAGE)
+def load_step_periods(f, path: Path) -> np.ndarray:
     """The step periods [s] of ``contact_sim.h5`` at ``path`` (``steps/period``; NaN: a
-    step the run did not finish).
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        As :func:`walkerlab.io.artifacts.open_artifact` (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        return np.asarray(f["steps/period"][()], float) if "steps/period" in f else \
-            np.zeros(0)
+    step the run did not finish)."""
+    return np.asarray(f["steps/period"][()], float) if "steps/period" in f else \
+        np.zeros(0)

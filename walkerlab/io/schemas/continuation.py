@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.io.artifacts import artifact_loader, read_named
+
 __all__ = ["continuation_writer", "load_continuation", "initial_state", "ContinuationData", "STAGE"]
 
 STAGE = "continuation"
@@ -172,51 +174,43 @@ def _s(v) -> str:
     return v.decode() if isinstance(v, bytes) else str(v)
 
 
-def load_continuation(path: Path) -> ContinuationData:
-    """Read a ``continuation`` artifact.
+@artifact_loader(STAGE)
+def load_continuation(f, path: Path) -> ContinuationData:
+    """Read a ``continuation`` artifact."""
+    names = [_s(n) for n in f.attrs["state_names"]]
+    out = ContinuationData(_s(f.attrs["parameter_path"]), _s(f.attrs["parameter_unit"]),
+                           names, float(f.attrs["parameter_start"]),
+                           steps_per_map=int(f.attrs.get("steps_per_map", 0)))
 
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, damaged, or another stage's file (one line).
-    """
-    from walkerlab.io.artifacts import open_artifact, read_named
+    def mult(g):
+        return np.asarray(g["multipliers/real"][()]) + 1j * np.asarray(
+            g["multipliers/imag"][()])
 
-    with open_artifact(Path(path), STAGE) as f:
-        names = [_s(n) for n in f.attrs["state_names"]]
-        out = ContinuationData(_s(f.attrs["parameter_path"]), _s(f.attrs["parameter_unit"]),
-                               names, float(f.attrs["parameter_start"]),
-                               steps_per_map=int(f.attrs.get("steps_per_map", 0)))
-
-        def mult(g):
-            return np.asarray(g["multipliers/real"][()]) + 1j * np.asarray(
-                g["multipliers/imag"][()])
-
-        for key in sorted(f["branches"], key=int):
-            g = f["branches"][key]
-            out.branches.append({
-                "period": int(g.attrs["branch_period"]), "param": g["param"][()],
-                "states": {n: g[f"state/{n}"][()] for n in names},
-                "orbit": {n: g[f"orbit/{n}"][()] for n in names},
-                "step_period": g["period"][()], "multipliers": mult(g),
-                "stable": g["stable"][()].astype(bool),
-                "gait": {k: g[f"gait/{k}"][()] for k in GAIT_MEASURES
-                         if f"gait/{k}" in g}})
-        g = f["special_points"]
-        out.special = {k: np.asarray(read_named(g, k)) for k in
-                       ("kind", "param", "period", "branch", "cause")}
-        out.special["kind"] = np.array([_s(k) for k in np.atleast_1d(out.special["kind"])])
-        out.special["cause"] = np.array([_s(k) for k in np.atleast_1d(out.special["cause"])])
-        out.special["states"] = {n: g[f"state/{n}"][()] for n in names}
-        out.special["multipliers"] = mult(g)
-        for key in sorted(f.get("two_parameter", {}), key=int):
-            h = f["two_parameter"][key]
-            out.curves.append({
-                "kind": _s(h.attrs["kind"]), "period": int(h.attrs["period"]),
-                "path2": _s(h.attrs["path2"]), "unit2": _s(h.attrs["unit2"]),
-                "param": h["param"][()], "param2": h["param2"][()],
-                "multiplier": h["critical_multiplier/real"][()]
-                + 1j * h["critical_multiplier/imag"][()]})
+    for key in sorted(f["branches"], key=int):
+        g = f["branches"][key]
+        out.branches.append({
+            "period": int(g.attrs["branch_period"]), "param": g["param"][()],
+            "states": {n: g[f"state/{n}"][()] for n in names},
+            "orbit": {n: g[f"orbit/{n}"][()] for n in names},
+            "step_period": g["period"][()], "multipliers": mult(g),
+            "stable": g["stable"][()].astype(bool),
+            "gait": {k: g[f"gait/{k}"][()] for k in GAIT_MEASURES
+                     if f"gait/{k}" in g}})
+    g = f["special_points"]
+    out.special = {k: np.asarray(read_named(g, k)) for k in
+                   ("kind", "param", "period", "branch", "cause")}
+    out.special["kind"] = np.array([_s(k) for k in np.atleast_1d(out.special["kind"])])
+    out.special["cause"] = np.array([_s(k) for k in np.atleast_1d(out.special["cause"])])
+    out.special["states"] = {n: g[f"state/{n}"][()] for n in names}
+    out.special["multipliers"] = mult(g)
+    for key in sorted(f.get("two_parameter", {}), key=int):
+        h = f["two_parameter"][key]
+        out.curves.append({
+            "kind": _s(h.attrs["kind"]), "period": int(h.attrs["period"]),
+            "path2": _s(h.attrs["path2"]), "unit2": _s(h.attrs["unit2"]),
+            "param": h["param"][()], "param2": h["param2"][()],
+            "multiplier": h["critical_multiplier/real"][()]
+            + 1j * h["critical_multiplier/imag"][()]})
     return out
 
 

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 from walkerlab.io.friction import FrictionVerdict
 from walkerlab.io.netcdf import coordinate
 from walkerlab.numerics import without_neutral
@@ -485,30 +485,24 @@ def _zero_dynamics(f) -> dict | None:
     return out
 
 
-def load_fixedpoint(path: Path) -> FixedPointArtifact:
-    """Load ``fixedpoint.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        names = [str(n) for n in f.attrs["state_names"]]
-        main = _gait(f, names)
-        return FixedPointArtifact(
-            **vars(main), path=Path(path), units=for_artifact(f), model=str(f.attrs["model"]),
-            variant=str(f.attrs["variant"]), state_names=names,
-            section_words=str(f.attrs.get("section_words", "state just after heel strike")),
-            state_units=[str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names],
-            legs_by_role=(json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs
-                          else {}),
-            gait=str(f.attrs.get("gait", "")), gait_policy=str(f.attrs.get("gait_policy", "")),
-            gait_notes=json.loads(f.attrs.get("gait_notes", "[]")),
-            gaits={str(lab): _gait(f[f"gaits/{lab}"], names)
-                   for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
-            variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
-            if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
-            footholds={k: (v.item() if hasattr(v, "item") else v)
-                       for k, v in f["footholds"].attrs.items()} if "footholds" in f else None,
-            zero_dynamics=_zero_dynamics(f))
+@artifact_loader(STAGE)
+def load_fixedpoint(f, path: Path) -> FixedPointArtifact:
+    """Load ``fixedpoint.h5``."""
+    names = [str(n) for n in f.attrs["state_names"]]
+    main = _gait(f, names)
+    return FixedPointArtifact(
+        **vars(main), path=Path(path), units=for_artifact(f), model=str(f.attrs["model"]),
+        variant=str(f.attrs["variant"]), state_names=names,
+        section_words=str(f.attrs.get("section_words", "state just after heel strike")),
+        state_units=[str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names],
+        legs_by_role=(json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs
+                      else {}),
+        gait=str(f.attrs.get("gait", "")), gait_policy=str(f.attrs.get("gait_policy", "")),
+        gait_notes=json.loads(f.attrs.get("gait_notes", "[]")),
+        gaits={str(lab): _gait(f[f"gaits/{lab}"], names)
+               for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
+        variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
+        if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
+        footholds={k: (v.item() if hasattr(v, "item") else v)
+                   for k, v in f["footholds"].attrs.items()} if "footholds" in f else None,
+        zero_dynamics=_zero_dynamics(f))

@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.io.artifacts import artifact_loader
+
 STAGE = "mfpt"
 
 #: variable -> (unit, description); every one lies on the sigma_rad dimension
@@ -122,23 +124,15 @@ def write(f, data: MfptData) -> None:
             f"every mesh computed: {c}", dims=("mesh",))
 
 
-def load(path: Path) -> MfptData:
-    """Read ``mfpt.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, damaged or another stage's file.
-    """
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(path, STAGE) as f:
-        sigma = f["sigma_rad"][()]
-        values = {k: f[k][()] for k in VARIABLES}
-        hist_cols = ("sigma_rad", "h", "cells", "mfpt_steps", "change")
-        arrays = {c: f[f"mesh_history/{c}"][()] for c in hist_cols}
-        hist = [{c: float(arrays[c][i]) for c in hist_cols}
-                for i in range(len(arrays["sigma_rad"]))]
-        return MfptData(sigma, values, str(f.attrs["method"]),
-                        [str(s) for s in f.attrs["state_names"]], hist,
-                        f["sigma_m"][()] if "sigma_m" in f else None)
+@artifact_loader(STAGE)
+def load(f, path: Path) -> MfptData:
+    """Read ``mfpt.h5``."""
+    sigma = f["sigma_rad"][()]
+    values = {k: f[k][()] for k in VARIABLES}
+    hist_cols = ("sigma_rad", "h", "cells", "mfpt_steps", "change")
+    arrays = {c: f[f"mesh_history/{c}"][()] for c in hist_cols}
+    hist = [{c: float(arrays[c][i]) for c in hist_cols}
+            for i in range(len(arrays["sigma_rad"]))]
+    return MfptData(sigma, values, str(f.attrs["method"]),
+                    [str(s) for s in f.attrs["state_names"]], hist,
+                    f["sigma_m"][()] if "sigma_m" in f else None)

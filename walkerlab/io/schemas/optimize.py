@@ -79,6 +79,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.io.artifacts import artifact_loader
+
 STAGE = "optimize"
 
 __all__ = ["CONTROLLER_VALUES", "ControllerData", "DESIGN_STAGE", "DesignData", "OptimizeData",
@@ -455,50 +457,42 @@ def _write_history_and_energy(f, d: OptimizeData) -> None:
             dims=("time",))
 
 
-def load(path: Path) -> OptimizeData:
-    """Read ``optimize.h5``.
+@artifact_loader(STAGE)
+def load(f, path: Path) -> OptimizeData:
+    """Read ``optimize.h5``."""
+    names = [str(s) for s in f.attrs["state_names"]]
+    joints = tuple(str(s) for s in f.attrs.get("torque_names", ["hip"]))
+    tq = np.stack([f[f"torque/{j}"][()] for j in joints], axis=1)
 
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, damaged or another stage's file (one line).
-    """
-    from walkerlab.io.artifacts import open_artifact
+    def opt(key):
+        return float(f[f"replay/{key}"][()]) if f"replay/{key}" in f else float("nan")
 
-    with open_artifact(path, STAGE) as f:
-        names = [str(s) for s in f.attrs["state_names"]]
-        joints = tuple(str(s) for s in f.attrs.get("torque_names", ["hip"]))
-        tq = np.stack([f[f"torque/{j}"][()] for j in joints], axis=1)
-
-        def opt(key):
-            return float(f[f"replay/{key}"][()]) if f"replay/{key}" in f else float("nan")
-
-        return OptimizeData(
-            f["time"][()], {n: f[f"states/{n}"][()] for n in names},
-            tq[:, 0] if joints == ("hip",) else tq,
-            float(f["step_period"][()]), float(f["step_length"][()]),
-            float(f["push_off"][()]), float(f["objective"][()]),
-            float(f["replay/max_state_error"][()]),
-            f["replay/multipliers/real"][()] + 1j * f["replay/multipliers/imag"][()],
-            bool(f.attrs["gait"]), str(f.attrs["ipopt_status"]),
-            int(f.attrs["ipopt_iterations"]), float(f.attrs["ipopt_wall_time_s"]),
-            {n: str(f[f"states/{n}"].attrs["unit"]) for n in names},
-            str(f.attrs["objective_name"]), str(f["objective"].attrs["unit"]),
-            {k: float(v[()]) for k, v in f["terms"].items()} if "terms" in f else {},
-            float(f["contact_replay/step_period"][()]),
-            str(f.attrs["contact_replay_outcome"]), str(f[f"torque/{joints[0]}"].attrs["unit"]),
-            joints, opt("start_shift"), opt("step_period"), opt("collocated_start_error"),
-            float(f.attrs.get("ipopt_cpu_time_s", float("nan"))),
-            {k: v[()] for k, v in f["ipopt"].items()} if "ipopt" in f else {},
-            {k: v[()] for k, v in f["energy"].items()} if "energy" in f else {},
-            str(next(iter(f["energy"].values())).attrs["unit"]) if "energy" in f else "J",
-            tuple(str(s) for s in f.attrs.get("phase_names", [])),
-            f["phases/start_index"][()] if "phases" in f else None,
-            f["phases/duration"][()] if "phases" in f else None,
-            float(f.attrs.get("ipopt_build_time_s", float("nan"))),
-            {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
-            int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")),
-            str(f.attrs.get("ipopt_violations", "")), _load_controllers(f))
+    return OptimizeData(
+        f["time"][()], {n: f[f"states/{n}"][()] for n in names},
+        tq[:, 0] if joints == ("hip",) else tq,
+        float(f["step_period"][()]), float(f["step_length"][()]),
+        float(f["push_off"][()]), float(f["objective"][()]),
+        float(f["replay/max_state_error"][()]),
+        f["replay/multipliers/real"][()] + 1j * f["replay/multipliers/imag"][()],
+        bool(f.attrs["gait"]), str(f.attrs["ipopt_status"]),
+        int(f.attrs["ipopt_iterations"]), float(f.attrs["ipopt_wall_time_s"]),
+        {n: str(f[f"states/{n}"].attrs["unit"]) for n in names},
+        str(f.attrs["objective_name"]), str(f["objective"].attrs["unit"]),
+        {k: float(v[()]) for k, v in f["terms"].items()} if "terms" in f else {},
+        float(f["contact_replay/step_period"][()]),
+        str(f.attrs["contact_replay_outcome"]), str(f[f"torque/{joints[0]}"].attrs["unit"]),
+        joints, opt("start_shift"), opt("step_period"), opt("collocated_start_error"),
+        float(f.attrs.get("ipopt_cpu_time_s", float("nan"))),
+        {k: v[()] for k, v in f["ipopt"].items()} if "ipopt" in f else {},
+        {k: v[()] for k, v in f["energy"].items()} if "energy" in f else {},
+        str(next(iter(f["energy"].values())).attrs["unit"]) if "energy" in f else "J",
+        tuple(str(s) for s in f.attrs.get("phase_names", [])),
+        f["phases/start_index"][()] if "phases" in f else None,
+        f["phases/duration"][()] if "phases" in f else None,
+        float(f.attrs.get("ipopt_build_time_s", float("nan"))),
+        {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
+        int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")),
+        str(f.attrs.get("ipopt_violations", "")), _load_controllers(f))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)
@@ -550,21 +544,13 @@ class DesignData:
     evaluations: int
 
 
-def load_design(path: Path) -> DesignData:
+@artifact_loader(DESIGN_STAGE)
+def load_design(f, path: Path) -> DesignData:
     """Read a design artifact ``optimize_design_<fields>_<objective>.h5``
-    (:func:`write_design`).
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Not a readable design artifact (one line naming the file).
-    """
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(path, DESIGN_STAGE) as f:
-        return DesignData(
-            tuple(str(x) for x in f.attrs["fields"]), f["values"][()],
-            str(f.attrs["objective"]), str(f.attrs.get("objective_unit", "-")),
-            float(f["objective_value"][()]), f["gradient"][()], f["history/values"][()],
-            f["history/objective"][()], bool(f.attrs["success"]), str(f.attrs["message"]),
-            int(f.attrs["evaluations"]))
+    (:func:`write_design`)."""
+    return DesignData(
+        tuple(str(x) for x in f.attrs["fields"]), f["values"][()],
+        str(f.attrs["objective"]), str(f.attrs.get("objective_unit", "-")),
+        float(f["objective_value"][()]), f["gradient"][()], f["history/values"][()],
+        f["history/objective"][()], bool(f.attrs["success"]), str(f.attrs["message"]),
+        int(f.attrs["evaluations"]))

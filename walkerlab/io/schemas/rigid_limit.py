@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 from walkerlab.io.netcdf import coordinate
 
 STAGE = "rigid-limit"
@@ -63,23 +63,17 @@ def write_rigid_limit(f, run: RigidLimitRun) -> None:
             "log(gap_i / gap_i+1) / log(kappa_i+1 / kappa_i)", dims=("interval",))
 
 
-def load_rigid_limit(path: Path) -> dict:
+@artifact_loader(STAGE)
+def load_rigid_limit(f, path: Path) -> dict:
     """The artifact as arrays: ``kappa`` (n,), ``period`` [s], ``step_length`` [m],
     ``multipliers`` (complex (n, r)), ``rigid_period`` [s], ``rigid_step_length`` [m],
-    ``rigid_multipliers`` (r,), ``observed_order`` ({"period", "step_length"}: (n - 1,)).
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        return {"kappa": f["kappa"][()], "period": f["period"][()],
-                "step_length": f["step_length"][()],
-                "multipliers": f["multipliers/real"][()] + 1j * f["multipliers/imag"][()],
-                "rigid_period": float(f["rigid/period"][()]),
-                "rigid_step_length": float(f["rigid/step_length"][()]),
-                "rigid_multipliers": (f["rigid/multipliers/real"][()]
-                                      + 1j * f["rigid/multipliers/imag"][()]),
-                "observed_order": {k: f["observed_order"][k][()]
-                                   for k in f["observed_order"]}}
+    ``rigid_multipliers`` (r,), ``observed_order`` ({"period", "step_length"}: (n - 1,))."""
+    return {"kappa": f["kappa"][()], "period": f["period"][()],
+            "step_length": f["step_length"][()],
+            "multipliers": f["multipliers/real"][()] + 1j * f["multipliers/imag"][()],
+            "rigid_period": float(f["rigid/period"][()]),
+            "rigid_step_length": float(f["rigid/step_length"][()]),
+            "rigid_multipliers": (f["rigid/multipliers/real"][()]
+                                  + 1j * f["rigid/multipliers/imag"][()]),
+            "observed_order": {k: f["observed_order"][k][()]
+                               for k in f["observed_order"]}}

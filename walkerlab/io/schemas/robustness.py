@@ -22,6 +22,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from walkerlab.io.artifacts import artifact_loader
+from walkerlab.io.schemas.mfpt import VARIABLES as MFPT_VARIABLES
+
 STAGE = "robustness"
 COORDINATES = ("absolute", "relative")
 
@@ -50,8 +53,8 @@ SCALARS = {
     "sigma_rad": ("rad", "per-step slope standard deviation of the MFPT"),
     "mfpt_steps": ("steps", "Monte Carlo MFPT: heel strikes before the fall"),
     "mfpt_steps_stderr": ("steps", "standard error of mfpt_steps"),
-    "montecarlo_walks": ("-", "Monte Carlo walks"),
-    "montecarlo_falls": ("-", "walks that fell (the rest reached the step cap)"),
+    # the same Monte Carlo walks as mfpt.h5's: described there
+    **{k: MFPT_VARIABLES[k] for k in ("montecarlo_walks", "montecarlo_falls")},
     **_bracket("contact_step_down_m", "m", "contact model: largest step-down survived (lower "
                "end; NaN: robustness.contact not asked for)",
                "contact model: smallest step-down that falls"),
@@ -115,24 +118,16 @@ def write(f, d: RobustnessData) -> None:
     f.attrs["state_names"] = list(d.state_names)
 
 
-def load(path: Path) -> RobustnessData:
-    """Read ``robustness.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, damaged or another stage's file.
-    """
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(path, STAGE) as f:
-        dists = [str(s) for s in f.attrs["disturbances"]]
-        units = dict(zip(dists, (str(s) for s in f.attrs["disturbance_units"])))
-        return RobustnessData(
-            dists, units,
-            {c: float(f[f"max_abs_multiplier/{c}"][()]) for c in COORDINATES},
-            {k: float(f[f"gsn/{k}"][()]) for k in dists},
-            {k: float(f[f"gsn_nonlinear/{k}"][()]) for k in dists},
-            {c: {k: float(f[f"state_norm/{c}/{k}"][()]) for k in dists} for c in COORDINATES},
-            {k: float(f[k][()]) if k in f else float("nan") for k in SCALARS},
-            [str(s) for s in f.attrs["state_names"]])
+@artifact_loader(STAGE)
+def load(f, path: Path) -> RobustnessData:
+    """Read ``robustness.h5``."""
+    dists = [str(s) for s in f.attrs["disturbances"]]
+    units = dict(zip(dists, (str(s) for s in f.attrs["disturbance_units"])))
+    return RobustnessData(
+        dists, units,
+        {c: float(f[f"max_abs_multiplier/{c}"][()]) for c in COORDINATES},
+        {k: float(f[f"gsn/{k}"][()]) for k in dists},
+        {k: float(f[f"gsn_nonlinear/{k}"][()]) for k in dists},
+        {c: {k: float(f[f"state_norm/{c}/{k}"][()]) for k in dists} for c in COORDINATES},
+        {k: float(f[k][()]) if k in f else float("nan") for k in SCALARS},
+        [str(s) for s in f.attrs["state_names"]])

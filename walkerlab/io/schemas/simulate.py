@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import READ_ERRORS, open_artifact, put
+from walkerlab.io.artifacts import READ_ERRORS, artifact_loader, put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.trajectory import NamedTrajectory, read_samples, write_samples
 from walkerlab.units import Units, for_artifact
@@ -244,35 +244,29 @@ class SimulateArtifact:
             steps=cut, summary=summary, ledger={key: v[:k] for key, v in self.ledger.items()})
 
 
-def load_simulate(path: Path, strides: int | None = None) -> SimulateArtifact:
+@artifact_loader(STAGE)
+def load_simulate(f, path: Path, strides: int | None = None) -> SimulateArtifact:
     """Load ``simulate.h5`` (a hand-built artifact may hold only ``samples/``: what it lacks
     of the rest is empty or NaN); with ``strides`` (the scene's ``simulate.strides``), a
     longer run kept for the scene is seen as the scene's own run
-    (:meth:`SimulateArtifact.first_strides`).
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        steps = {}
-        for k in f["steps"] if "steps" in f else ():
-            ds = f["steps"][k]
-            if not hasattr(ds, "dtype"):
-                continue  # the states/ group
-            steps[k] = ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]
-        a = f.attrs
-        sim = SimulateArtifact(
-            path=Path(path), units=for_artifact(f), termination=str(a.get("termination", "")),
-            strides_requested=int(a.get("strides_requested", 0)),
-            total_mass_kg=float(a.get("total_mass_kg", np.nan)),
-            gravity_m_per_s2=float(a.get("gravity_m_per_s2", np.nan)),
-            samples=read_samples(f), steps=steps,
-            summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {},
-            ledger={k: f["ledger"][k][()] for k in f["ledger"] if k != "step"}
-            if "ledger" in f else {},
-            scene_json=str(a["scene_json"]))
+    (:meth:`SimulateArtifact.first_strides`)."""
+    steps = {}
+    for k in f["steps"] if "steps" in f else ():
+        ds = f["steps"][k]
+        if not hasattr(ds, "dtype"):
+            continue  # the states/ group
+        steps[k] = ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]
+    a = f.attrs
+    sim = SimulateArtifact(
+        path=Path(path), units=for_artifact(f), termination=str(a.get("termination", "")),
+        strides_requested=int(a.get("strides_requested", 0)),
+        total_mass_kg=float(a.get("total_mass_kg", np.nan)),
+        gravity_m_per_s2=float(a.get("gravity_m_per_s2", np.nan)),
+        samples=read_samples(f), steps=steps,
+        summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {},
+        ledger={k: f["ledger"][k][()] for k in f["ledger"] if k != "step"}
+        if "ledger" in f else {},
+        scene_json=str(a["scene_json"]))
     return sim if strides is None else sim.first_strides(strides)
 
 
@@ -288,31 +282,25 @@ def strides_of(path: Path) -> int | None:
         return None
 
 
-def run_end(path: Path, strides: int | None = None) -> str:
+@artifact_loader(STAGE)
+def run_end(f, path: Path, strides: int | None = None) -> str:
     """How the run of ``simulate.h5`` ended (``termination``: "heel_strike" when every step
     completed, "fall", ...; a trip on a height profile with its time and place: "trip (the
     swing foot entered the profile at t = 0.42 s, x = -1.5 m, y = 0.03 m)"); with
     ``strides``, how its first ``strides`` strides ended (a longer run kept for a scene
-    that asks fewer: "heel_strike" when they all completed, whatever came after them).
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing or unreadable artifact (one line).
-    """
-    with open_artifact(path, STAGE) as f:
-        term = str(f.attrs["termination"])
-        if strides is not None and int(f.attrs["strides_requested"]) > strides:
-            ends = f["steps/termination"].asstr()[()]
-            if ends.size > 2 * strides:  # it went past the scene's steps: theirs decide
-                first = ends[:2 * strides]
-                bad = first[first != "heel_strike"]
-                return "heel_strike" if bad.size == 0 else str(bad[0])
-        if term == "trip" and "summary/trip_time_s" in f:
-            t, x, y = (float(f[f"summary/trip_{k}"][()]) for k in ("time_s", "x_m", "y_m"))
-            term += (f" (the swing foot entered the profile at t = {t:.6g} s, "
-                     f"x = {x:.6g} m, y = {y:.6g} m)")
-        return term
+    that asks fewer: "heel_strike" when they all completed, whatever came after them)."""
+    term = str(f.attrs["termination"])
+    if strides is not None and int(f.attrs["strides_requested"]) > strides:
+        ends = f["steps/termination"].asstr()[()]
+        if ends.size > 2 * strides:  # it went past the scene's steps: theirs decide
+            first = ends[:2 * strides]
+            bad = first[first != "heel_strike"]
+            return "heel_strike" if bad.size == 0 else str(bad[0])
+    if term == "trip" and "summary/trip_time_s" in f:
+        t, x, y = (float(f[f"summary/trip_{k}"][()]) for k in ("time_s", "x_m", "y_m"))
+        term += (f" (the swing foot entered the profile at t = {t:.6g} s, "
+                 f"x = {x:.6g} m, y = {y:.6g} m)")
+    return term
 
 
 def longer_run_note(path: Path, asked: int, key_of) -> str:

@@ -17,7 +17,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 
 _UNITS = {"max_abs_multiplier": "-", "step_period_s": "s", "patch_margin_m": "m",
           "residual": "-", "wall_time_s": "s", "exists": "-", "stable": "-"}
@@ -94,26 +94,20 @@ class StabilityMap:
     summary: dict = field(default_factory=dict)
 
 
-def load_stability_map(path: Path | str) -> StabilityMap:
-    """Load a ``stability_map_<kind>.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another walkerlab version, or lacking a dataset (one line).
-    """
-    with open_artifact(path) as f:
-        cells = {}
-        for k in f:  # every (ny, nx) cell array (the writer's cell fields)
-            if k in ("y_values", "slopes_deg") or not hasattr(f[k], "shape") \
-                    or f[k].ndim != 2:
-                continue
-            v = f[k][()]
-            if v.dtype.kind in ("S", "O"):
-                v = np.array([[x.decode() if isinstance(x, bytes) else str(x) for x in r]
-                              for r in v], dtype=object)
-            cells[k] = v
-        return StabilityMap(
-            attrs={k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()},
-            y_values=f["y_values"][()], slopes_deg=f["slopes_deg"][()], cells=cells,
-            summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {})
+@artifact_loader(None)
+def load_stability_map(f, path: Path | str) -> StabilityMap:
+    """Load a ``stability_map_<kind>.h5``."""
+    cells = {}
+    for k in f:  # every (ny, nx) cell array (the writer's cell fields)
+        if k in ("y_values", "slopes_deg") or not hasattr(f[k], "shape") \
+                or f[k].ndim != 2:
+            continue
+        v = f[k][()]
+        if v.dtype.kind in ("S", "O"):
+            v = np.array([[x.decode() if isinstance(x, bytes) else str(x) for x in r]
+                          for r in v], dtype=object)
+        cells[k] = v
+    return StabilityMap(
+        attrs={k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()},
+        y_values=f["y_values"][()], slopes_deg=f["slopes_deg"][()], cells=cells,
+        summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {})

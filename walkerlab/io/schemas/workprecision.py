@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import artifact_loader, put
 
 STAGE = "workprecision"
 
@@ -121,23 +121,17 @@ class WorkPrecisionArtifact:
     models: dict
 
 
-def load_workprecision(path: Path) -> WorkPrecisionArtifact:
-    """Load ``workprecision.h5``.
-
-    Raises
-    ------
-    walkerlab.io.artifacts.ArtifactError
-        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
-    """
+@artifact_loader(STAGE)
+def load_workprecision(f, path: Path) -> WorkPrecisionArtifact:
+    """Load ``workprecision.h5``."""
     models = {}
-    with open_artifact(path, STAGE) as f:
-        for model in f:
-            g = f[model]
-            rows = {m: {k: g[m][k][()] for k in ("time", "time_min", "time_max", "error",
-                                                 "rtol", "nfev", "repeats", "wall_time")
-                        if k in g[m]}
-                    for m in g if isinstance(g[m], type(g))}
-            models[model] = WorkPrecisionModel(rows, {k: g.attrs[k] for k in g.attrs})
+    for model in f:
+        g = f[model]
+        rows = {m: {k: g[m][k][()] for k in ("time", "time_min", "time_max", "error",
+                                             "rtol", "nfev", "repeats", "wall_time")
+                    if k in g[m]}
+                for m in g if isinstance(g[m], type(g))}
+        models[model] = WorkPrecisionModel(rows, {k: g.attrs[k] for k in g.attrs})
     return WorkPrecisionArtifact(Path(path), models)
 
 

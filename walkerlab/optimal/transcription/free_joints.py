@@ -30,50 +30,32 @@ heel strike (:func:`torques_of_time`), one step from ``x_0`` (scipy's DOP853 at 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
+
+from walkerlab.optimal.transcription.ipopt import CollocatedStep
 
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
            "step_sequence", "torques_of_time"]
 
 
-@dataclass
-class FiveLinkResult:
-    """An optimised step of a five-link biped.
+@dataclass(kw_only=True)
+class FiveLinkResult(CollocatedStep):
+    """An optimised step of a five-link biped: the fields of
+    :class:`~walkerlab.optimal.transcription.ipopt.CollocatedStep` (``x`` (m, 10); ``u``
+    (m, 4), the joint torques in
+    :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` order; ``objective``
+    ``int |u|^2 dt`` [N^2 m^2 s], Simpson's rule on the points) and this.
 
     Attributes
     ----------
-    t : ndarray (2N + 1,)
-        Collocation times [s].
-    x : ndarray (2N + 1, 10)
-        States there (the walker's ``state_names()`` order).
-    u : ndarray (2N + 1, 4)
-        Joint torques [N m] (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`
-        order).
-    step_period_s, step_length_m : float
-    objective : float
-        ``int |u|^2 dt`` [N^2 m^2 s] (Simpson's rule on the points).
-    status : str
-        IPOPT's return status.
-    iterations : int
-    wall_time_s, cpu_time_s : float
-        The solve's (IPOPT and the function evaluations; not the set-up).
-    history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
+    cpu_time_s : float
+        The solve's CPU time [s] (IPOPT and the function evaluations; not the set-up; as
+        ``wall_time_s``).
     """
 
-    t: np.ndarray
-    x: np.ndarray
-    u: np.ndarray
-    step_period_s: float
-    step_length_m: float
-    objective: float
-    status: str
-    iterations: int
-    wall_time_s: float
     cpu_time_s: float
-    history: dict = field(default_factory=dict)
 
 
 def kelly_guess(leg_length_m: float, step_length_m: float, period_s: float, points: int):

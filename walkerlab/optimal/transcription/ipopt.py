@@ -1,19 +1,61 @@
-"""IPOPT's iteration history from CasADi's solver statistics (``Opti.stats()``)."""
+"""IPOPT's iteration history from CasADi's solver statistics (``Opti.stats()``), and what
+every transcription's optimised step holds (:class:`CollocatedStep`)."""
 
 from __future__ import annotations
 
 import os
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["CONSTRAINT_GROUPS", "HISTORY", "iteration_history", "largest_violations", "solve"]
+__all__ = ["CONSTRAINT_GROUPS", "HISTORY", "CollocatedStep", "iteration_history",
+           "largest_violations", "solve"]
 
 #: the stored series and CasADi's names for them (IPOPT's iteration output: ``objective``,
 #: ``inf_pr`` the largest constraint violation, ``inf_du`` the dual infeasibility, ``mu`` the
 #: barrier parameter; Wächter & Biegler 2006, §3)
 HISTORY = {"objective": "obj", "primal_infeasibility": "inf_pr",
            "dual_infeasibility": "inf_du", "barrier": "mu"}
+
+
+@dataclass(kw_only=True)
+class CollocatedStep:
+    """An optimised step as IPOPT left it: what every transcription's result holds (each
+    result adds its own fields; all are given by keyword).
+
+    Attributes
+    ----------
+    t : ndarray (m,)
+        Collocation times since the heel strike [s] (one phase of ``N`` intervals:
+        ``m = 2N + 1``).
+    x : ndarray (m, 2n)
+        States there (the walker's ``state_names()`` order).
+    u : ndarray (m,) or (m, k)
+        Torques there [N m] (one hip torque: (m,)).
+    step_period_s, step_length_m : float
+        The step's period [s] and length [m].
+    objective : float
+        The objective at the optimum (its unit: the transcription's).
+    status : str
+        IPOPT's return status.
+    iterations : int
+    wall_time_s : float
+        IPOPT's wall time [s].
+    history : dict of str -> ndarray
+        IPOPT's iteration history (:func:`iteration_history`).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    step_period_s: float
+    step_length_m: float
+    objective: float
+    status: str
+    iterations: int
+    wall_time_s: float
+    history: dict = field(default_factory=dict)
 
 
 def iteration_history(stats: dict) -> dict[str, np.ndarray]:

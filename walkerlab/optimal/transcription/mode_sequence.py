@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from walkerlab.optimal.transcription.ipopt import (
+    CollocatedStep,
     iteration_history,
     largest_violations,
     solve,
@@ -35,56 +36,37 @@ __all__ = ["PhasedResult", "collocate_footholds", "collocate_phases", "collocate
 #: (:data:`walkerlab.optimal.transcription.step.OBJECTIVES`)
 PHASED_OBJECTIVES = ("effort", "cost_of_transport", "peak_torque")
 
-@dataclass
-class PhasedResult:
-    """An optimised step of a walker with phases.
+@dataclass(kw_only=True)
+class PhasedResult(CollocatedStep):
+    """An optimised step of a walker with phases: the fields of
+    :class:`~walkerlab.optimal.transcription.ipopt.CollocatedStep` (``t`` every phase's
+    ``2 N_p + 1`` points in turn, a phase's first time repeating the previous phase's last:
+    the state jumps there; ``u`` (m,) the hip torque) and these.
 
     Attributes
     ----------
-    t : ndarray (m,)
-        Collocation times since the heel strike [s], every phase's ``2 N_p + 1`` points in
-        turn (a phase's first time repeats the previous phase's last: the state jumps there).
-    x : ndarray (m, 2n)
-        States there (``state_names()`` order).
-    u : ndarray (m,)
-        Hip torque [N m].
     phase_names : tuple of str
     phase_start : ndarray (P,) of int
         Index in ``t`` of each phase's first point.
     phase_duration_s : ndarray (P,)
-    step_period_s, step_length_m, objective : float
-    status : str
-    iterations : int
-    build_time_s, wall_time_s, cpu_time_s : float
-        Building the programme; IPOPT's wall and CPU (user + sys) time.
+    build_time_s, cpu_time_s : float
+        Building the programme; IPOPT's CPU (user + sys) time.
     terms : dict
         ``effort`` [N^2 m^2 s], ``cost_of_transport`` [-] (the hip's positive work per
         weight and step length; exact, ``max(p, 0)`` at the points) and ``peak_torque``
         [N m] at the optimum.
-    history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
     violations : str
         When IPOPT did not converge: the constraint groups with the largest violation at
         its last iterate (:func:`walkerlab.optimal.transcription.ipopt.largest_violations`;
         ``""``: none, or it converged).
     """
 
-    t: np.ndarray
-    x: np.ndarray
-    u: np.ndarray
     phase_names: tuple
     phase_start: np.ndarray
     phase_duration_s: np.ndarray
-    step_period_s: float
-    step_length_m: float
-    objective: float
-    status: str
-    iterations: int
     build_time_s: float
-    wall_time_s: float
     cpu_time_s: float
     terms: dict = field(default_factory=dict)
-    history: dict = field(default_factory=dict)
     push_off_n_s: float = 0.0
     violations: str = ""
 

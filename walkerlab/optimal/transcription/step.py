@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from walkerlab.codegen.casadi_functions import casadi_function
+from walkerlab.optimal.transcription.ipopt import CollocatedStep
 
 __all__ = ["OBJECTIVES", "ONE_STEP_COLLOCATIONS", "CollocationResult", "CollocationSpec",
            "check_objective", "ipopt_options", "number", "positive_power", "replay",
@@ -135,19 +136,16 @@ OBJECTIVES = {"effort": "N^2 m^2 s", "push_off_work": "J", "cost_of_transport": 
               "peak_torque": "N m"}
 
 
-@dataclass
-class CollocationResult:
-    """An optimised step.
+@dataclass(kw_only=True)
+class CollocationResult(CollocatedStep):
+    """An optimised step (``N`` intervals: ``m = 2N + 1`` points; ``u`` (m,) the hip
+    torque): the fields of :class:`~walkerlab.optimal.transcription.ipopt.CollocatedStep`
+    and these.
 
     Attributes
     ----------
-    t : ndarray (2N + 1,)
-        Collocation times [s].
-    x : ndarray (2N + 1, 2n)
-        States there (the rigid walker's ``state_names()`` order).
-    u : ndarray (2N + 1,)
-        Hip torque [N m].
-    step_period_s, step_length_m, push_off_n_s : float
+    push_off_n_s : float
+        The push-off impulse [N s].
     objective : float
         The spec's objective at the optimum (its unit: :data:`OBJECTIVES`; ``effort``
         with a free push-off adds ``push_off_weight P^2``, ``cost_of_transport``
@@ -155,32 +153,16 @@ class CollocationResult:
     terms : dict
         Every objective of :data:`OBJECTIVES` evaluated there (the cost of transport's
         positive work exact, ``max(p, 0)`` at the points; ``peak_torque`` ``max |u|``).
-    status : str
-        IPOPT's return status.
-    iterations : int
-    wall_time_s : float
     replay_error : float
         Max-norm return error of the replay (module docstring).
-    history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
     violations : str
         When IPOPT did not converge: the constraint groups with the largest violation
         (:func:`walkerlab.optimal.transcription.ipopt.largest_violations`).
     """
 
-    t: np.ndarray
-    x: np.ndarray
-    u: np.ndarray
-    step_period_s: float
-    step_length_m: float
     push_off_n_s: float
-    objective: float
-    status: str
-    iterations: int
-    wall_time_s: float
     replay_error: float = np.nan
     terms: dict = field(default_factory=dict)
-    history: dict = field(default_factory=dict)
     violations: str = ""
 
 

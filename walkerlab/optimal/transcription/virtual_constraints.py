@@ -46,10 +46,12 @@ The objective is the book's: ``int |u|^2 dt / step length`` [N^2 m s] (Westervel
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from math import comb
 
 import numpy as np
+
+from walkerlab.optimal.transcription.ipopt import CollocatedStep
 
 __all__ = ["MID_STANCE_DIP_M", "HzdDesign", "HzdFunctions", "clearance_bound",
            "collocate_virtual_constraints", "hzd_functions", "mid_stance_window"]
@@ -309,21 +311,16 @@ def _build(data, vc, prefix: str) -> dict:
             "consts": ca.Function("consts", [], [consts])}
 
 
-@dataclass
-class HzdDesign:
-    """One optimised controller: the step and its coefficients.
+@dataclass(kw_only=True)
+class HzdDesign(CollocatedStep):
+    """One optimised controller: the step (the fields of
+    :class:`~walkerlab.optimal.transcription.ipopt.CollocatedStep`; ``u`` (m, k), the
+    ``k`` actuated joints' torques) and its coefficients.
 
     Attributes
     ----------
-    t : ndarray (2N + 1,)
-        Collocation times [s].
-    x : ndarray (2N + 1, 2n)
-        The states there.
-    u : ndarray (2N + 1, k)
-        The torques there [N m].
     alpha : ndarray (k, M + 1)
         The Bezier coefficients [rad].
-    step_period_s, step_length_m : float
     objective : float
         ``int |u|^2 dt / step length`` [N^2 m s].
     effort : float
@@ -337,22 +334,14 @@ class HzdDesign:
         heel-strike guard; the collocated ``q_2N`` to the transcription's error).
     max_output, max_output_rate : float
         ``max |y|``, ``max |y'|`` over the points (the constraints' residual).
-    status : str
-    iterations : int
-    wall_time_s, cpu_time_s, build_time_s : float
-    history : dict
+    cpu_time_s, build_time_s : float
+        IPOPT's CPU time and the programme's build time [s].
     violations : str
         When IPOPT did not converge: the constraint groups it left violated at its last
         iterate (:func:`walkerlab.optimal.transcription.ipopt.largest_violations`).
     """
 
-    t: np.ndarray
-    x: np.ndarray
-    u: np.ndarray
     alpha: np.ndarray
-    step_period_s: float
-    step_length_m: float
-    objective: float
     effort: float
     delta2: float
     theta_plus: float
@@ -360,12 +349,8 @@ class HzdDesign:
     q_minus: np.ndarray
     max_output: float
     max_output_rate: float
-    status: str
-    iterations: int
-    wall_time_s: float
     cpu_time_s: float
     build_time_s: float = 0.0
-    history: dict = field(default_factory=dict)
     violations: str = ""
 
 
