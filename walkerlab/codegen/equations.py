@@ -12,8 +12,8 @@ import sympy as sp
 
 
 @dataclass(frozen=True)
-class Equations:
-    """Symbolic results of :func:`walkerlab.codegen.symbolic.derive` (all sympy; ``n = len(q)``).
+class Flow:
+    """A walker's flow in its coordinates (all sympy; ``n = len(q)``).
 
     Attributes
     ----------
@@ -22,6 +22,23 @@ class Equations:
         In ``structure.param_names`` order.
     M, C : Matrix (n, n); G : Matrix (n, 1)
         Flow ``M qdd + C dq + G = 0`` (after the massless limit, if any).
+    """
+
+    q: tuple
+    dq: tuple
+    params: tuple
+    M: sp.Matrix
+    C: sp.Matrix
+    G: sp.Matrix
+
+
+@dataclass(frozen=True)
+class Equations(Flow):
+    """Symbolic results of :func:`walkerlab.codegen.symbolic.derive` (all sympy): the
+    :class:`Flow` and
+
+    Attributes
+    ----------
     Mi, B : Matrix (n, n)
         Impact ``Mi dq+ = B dq-`` in the pre-impact labelling.
     relabel_q : Matrix (n, 1)
@@ -52,12 +69,6 @@ class Equations:
         Plastic knee strike ``Mk dq+ = Bk dq-``.
     """
 
-    q: tuple
-    dq: tuple
-    params: tuple
-    M: sp.Matrix
-    C: sp.Matrix
-    G: sp.Matrix
     Mi: sp.Matrix
     B: sp.Matrix
     relabel_q: sp.Matrix

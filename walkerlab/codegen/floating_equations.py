@@ -55,7 +55,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cache
 
-from walkerlab.walker.description import Structure, check_floating_view
+from walkerlab.walker.description import Structure
+from walkerlab.walker.multibody import check_floating_view
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
@@ -173,7 +174,7 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     ValueError
         Massless bodies (:func:`check_masses`), a foot kind other than point / arc /
         flat, or free knees on feet other than points, legs that differ or with springs
-        (:func:`walkerlab.walker.description.check_floating_view`).
+        (:func:`walkerlab.walker.multibody.check_floating_view`).
     """
     import sympy as sp
 

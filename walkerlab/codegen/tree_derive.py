@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from walkerlab.codegen.equations import Flow
 from walkerlab.codegen.frames import rotation, slope_to_world, slope_up
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.seeded import seeded
@@ -98,14 +99,12 @@ class TreeKinematics:
 
 
 @dataclass(frozen=True)
-class TreeEquations:
-    """The flow, energies and points of a tree (:func:`derive_tree`; ``n = len(q)``).
+class TreeEquations(Flow):
+    """The flow (:class:`~walkerlab.codegen.equations.Flow`: gravity only in ``G``),
+    energies and points of a tree (:func:`derive_tree`; ``n = len(q)``).
 
     Attributes
     ----------
-    q, dq, params : tuple of Symbol
-    M, C : Matrix (n, n); G : Matrix (n, 1)
-        ``M qdd + C dq + G = 0`` (gravity only in ``G``).
     kinetic, potential : Expr
         [J]; the potential from the heights above the horizontal through the stance foot.
     A : Matrix (n, 3); total_mass : Expr
@@ -117,12 +116,6 @@ class TreeEquations:
     kinematics : TreeKinematics
     """
 
-    q: tuple
-    dq: tuple
-    params: tuple
-    M: sp.Matrix
-    C: sp.Matrix
-    G: sp.Matrix
     kinetic: sp.Expr
     potential: sp.Expr
     A: sp.Matrix

@@ -103,6 +103,12 @@ class HipRollLaw(Strict):
                                     "leg's target roll per rad/s of lean rate [s]")
 
 
+#: ``walker.hip_roll`` of the straight-legged walkers in 3D
+_HipRoll = Annotated[HipRollLaw | None, Field(
+    description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "
+    "with a hip width; null: the legs rigid to the pelvis in roll, a passive walker)")]
+
+
 class CompassGaitParams(_Actuated):
     """Rigid-legged compass-gait walker (paper Table 1; Goswami et al. 1996, Fig. 1).
 
@@ -120,10 +126,7 @@ class CompassGaitParams(_Actuated):
     )
     space: _Space = "2d"
     hip_width_m: _HipWidth = 0.0
-    hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
-                                        "their lateral foot-placement law (space: 3d with a "
-                                        "hip width; null: the legs rigid to the pelvis in "
-                                        "roll, a passive walker)")
+    hip_roll: _HipRoll = None
     foot_radius_m: float | None = Field(None, gt=0, le=100, description="radius R of each foot's "
                                  "arc, a disc in its leg's sagittal plane rolling without "
                                  "slip, its centre on the leg at R above the foot's lowest "
@@ -216,10 +219,7 @@ class BipedParams(_Actuated):
                                       "and dampers between links at the hip")
     space: _Space = "2d"
     hip_width_m: _HipWidth = 0.0
-    hip_roll: HipRollLaw | None = Field(None, description="hip-roll (abduction) joints and "
-                                        "their lateral foot-placement law (space: 3d with a "
-                                        "hip width; null: the legs rigid to the pelvis in "
-                                        "roll)")
+    hip_roll: _HipRoll = None
 
     @model_serializer(mode="wrap")
     def _passive_as_before(self, handler):

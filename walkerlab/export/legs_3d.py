@@ -29,10 +29,8 @@ def legs_3d_urdf_text(data, name: str, version: str = "") -> str:
 
     Parameters
     ----------
-    data : WalkerData
-        Its parameters (:data:`walkerlab.walker.description.COMPASS_3D_PARAMS`, with
-        ``w_hip`` when the hips are apart).
-    name, version : str
+    data, name, version
+        As :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`'s.
 
     Returns
     -------

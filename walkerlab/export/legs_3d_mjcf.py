@@ -431,8 +431,8 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
     Parameters
     ----------
     data : WalkerData
-        Its parameters (:data:`walkerlab.walker.description.COMPASS_3D_PARAMS`, with
-        ``w_hip`` when the hips are apart).
+        Its structure and parameters by name (the ``compass_gait`` shorthand's or the parts'
+        in 3D; :func:`walker_tree`), ``w_hip`` when the hips are apart.
     name, version : str
         Model name (the scene's) and walkerlab's version (header comment).
     extra : Legs3dScene, optional

@@ -291,31 +291,6 @@ class Structure:
         return json.dumps(d)
 
 
-def check_floating_view(structure: Structure) -> None:
-    """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
-    knees (the five-link biped) on legs that differ, on feet other than points, or with
-    springs, a hinged torso on straight legs that differ, on flat feet or with springs (what
-    their rigid view, :mod:`walkerlab.codegen.free_joints`, refuses too).
-
-    A spoked wheel (``model: rimless_wheel``) has one: the hub's position and the wheel's
-    angle with one contact point per spoke (:mod:`walkerlab.codegen.floating`).
-
-    Raises
-    ------
-    ValueError
-    """
-    if structure.free_knees and (structure.foot != "point" or structure.asymmetric
-                                 or structure.springs or structure.knee_spring):
-        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "
-                         "floating view (contact model, export) with identical point-footed "
-                         "legs and no springs only")
-    if structure.hinged_torso and (structure.foot not in ("point", "arc")
-                                   or structure.asymmetric or structure.springs):
-        raise ValueError("walker.torso.coupling: a hinged torso has a floating view (contact "
-                         "model, export) with identical point- or arc-footed legs and no "
-                         "springs only")
-
-
 def state_names(roles) -> list[str]:
     """Role-ordered state names of a walker with coordinate ``roles``: every role's angle, then
     every role's rate (``['swing_angle', 'stance_angle', 'swing_rate', 'stance_rate']``)."""
@@ -529,17 +504,24 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
              + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ()))
              + (2 * foot_mass[0] if foot_mass is not None else 0.0))
-    if walker_cfg.space == "3d":   # the parts in 3D: the hip width, mirrored a step on
-        extra["hip_width_m"] = w = float(walker_cfg.hip_width_m)
-        law = walker_cfg.hip_roll
-        structure = replace(structure, in_3d=True, hip_width=bool(w), parts_3d=True,
-                            hip_roll=law is not None)
-        p1, p2 = (p1 + (w,), p1 + (-w,)) if w else (p1, p1)
-        if law is not None:  # odd in the rolls: the mirror step runs the same gains
-            extra["hip_roll"], gains = law.model_dump(), _hip_roll_gains(law)
-            p1, p2 = p1 + gains, p2 + gains
+    if walker_cfg.space == "3d":
+        structure, p1, p2 = _parts_in_3d(walker_cfg, structure, p1, extra)
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
                       slope_rad, extra, None if p2 == p1 else p2)
+
+
+def _parts_in_3d(walker_cfg, structure, p1, extra) -> tuple:
+    """A walker from parts in 3D: its structure, and the numbers of its steps with the hip
+    width (the mirror step's on the other side) and the hip-roll law's gains last."""
+    extra["hip_width_m"] = w = float(walker_cfg.hip_width_m)
+    law = walker_cfg.hip_roll
+    structure = replace(structure, in_3d=True, hip_width=bool(w), parts_3d=True,
+                        hip_roll=law is not None)
+    p1, p2 = (p1 + (w,), p1 + (-w,)) if w else (p1, p1)
+    if law is not None:  # odd in the rolls: the mirror step runs the same gains
+        extra["hip_roll"], gains = law.model_dump(), _hip_roll_gains(law)
+        p1, p2 = p1 + gains, p2 + gains
+    return structure, p1, p2
 
 
 def _leg_block(bodies, asym: bool, swing_vals, stance_vals) -> list[float]:

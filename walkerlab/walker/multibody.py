@@ -40,7 +40,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from walkerlab.walker.description import WalkerData, check_floating_view
+from walkerlab.walker.description import WalkerData
 
 __all__ = ["Coupling", "Link", "Multibody", "Spring", "multibody"]
 
@@ -226,7 +226,7 @@ def multibody(data: WalkerData) -> Multibody:
     ------
     ValueError
         A link carries no mass (naming it), or free knees the floating view does not carry
-        (:func:`walkerlab.walker.description.check_floating_view`; one line, both).
+        (:func:`check_floating_view`; one line, both).
     """
     s = data.structure
     check_floating_view(s)
@@ -316,3 +316,29 @@ def _springs(s, p: dict) -> list[Spring]:
                                   ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
                                   p["c_knee"]))
     return springs
+
+
+def check_floating_view(structure) -> None:
+    """Refuse (one line) a walker that has no floating view (contact model, export) yet
+    (``structure``: :class:`walkerlab.walker.description.Structure`): free
+    knees (the five-link biped) on legs that differ, on feet other than points, or with
+    springs, a hinged torso on straight legs that differ, on flat feet or with springs (what
+    their rigid view, :mod:`walkerlab.codegen.free_joints`, refuses too).
+
+    A spoked wheel (``model: rimless_wheel``) has one: the hub's position and the wheel's
+    angle with one contact point per spoke (:mod:`walkerlab.codegen.floating`).
+
+    Raises
+    ------
+    ValueError
+    """
+    if structure.free_knees and (structure.foot != "point" or structure.asymmetric
+                                 or structure.springs or structure.knee_spring):
+        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "
+                         "floating view (contact model, export) with identical point-footed "
+                         "legs and no springs only")
+    if structure.hinged_torso and (structure.foot not in ("point", "arc")
+                                   or structure.asymmetric or structure.springs):
+        raise ValueError("walker.torso.coupling: a hinged torso has a floating view (contact "
+                         "model, export) with identical point- or arc-footed legs and no "
+                         "springs only")

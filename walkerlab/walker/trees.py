@@ -128,21 +128,7 @@ def straight_legs_3d_tree(params: tuple[str, ...], legs: tuple[Part, ...],
     """
     R = foot_radius
     up_leg = "L" if R is None else f"L - {R}"     # from the frame's origin to the hip
-    bodies: list = []
-    if R is None:
-        bodies.append(Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
-                           Joint("stance_ankle", "universal", "slope", (0, 0, 0), (S, Z),
-                                 ("stance_ankle_roll", "stance_ankle_pitch"))))
-    else:   # the rolling disc: a slide along the fall line, the roll, the pitch about its centre
-        bodies += [Body("stance_travel", 0, ZERO_INERTIA, (0, 0, 0),
-                        Joint("stance_roll_travel", "prismatic", "slope", (0, 0, 0), (S,),
-                              ("stance_travel",))),
-                   Body("stance_roll", 0, ZERO_INERTIA, (0, 0, 0),
-                        Joint("stance_ankle_roll", "revolute", "stance_travel", (0, 0, 0),
-                              (S,), ("stance_ankle_roll",))),
-                   Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
-                        Joint("stance_ankle_pitch", "revolute", "stance_roll", (0, R, 0),
-                              (Z,), ("stance_ankle_pitch",)))]
+    bodies = _stance_foot(R)
     # each leg's parts hang from its hip (their frames there, the leg's axes)
     bodies += [Body(f"stance_leg_{p.name}", p.mass, p.inertia_tensor(),
                     p.com(f"-({p.from_hip})"),
@@ -181,6 +167,25 @@ def straight_legs_3d_tree(params: tuple[str, ...], legs: tuple[Part, ...],
         ("swing_hip_pitch", "swing + gamma")) + (
         (("torso_pitch", "(swing + stance) / 2 + gamma"),) if torso else ())
     return tree, CoordinateMap(names, angles)
+
+
+def _stance_foot(R: str | None) -> list:
+    """The stance leg's frame on the slope: on a universal ankle (roll, then pitch) at a
+    point foot, or on the rolling disc of radius ``R`` (a slide along the fall line, the
+    roll, the pitch about the disc's centre)."""
+    if R is None:
+        return [Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                     Joint("stance_ankle", "universal", "slope", (0, 0, 0), (S, Z),
+                           ("stance_ankle_roll", "stance_ankle_pitch")))]
+    return [Body("stance_travel", 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint("stance_roll_travel", "prismatic", "slope", (0, 0, 0), (S,),
+                       ("stance_travel",))),
+            Body("stance_roll", 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint("stance_ankle_roll", "revolute", "stance_travel", (0, 0, 0), (S,),
+                       ("stance_ankle_roll",))),
+            Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint("stance_ankle_pitch", "revolute", "stance_roll", (0, R, 0), (Z,),
+                       ("stance_ankle_pitch",)))]
 
 
 def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
