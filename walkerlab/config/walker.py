@@ -103,6 +103,9 @@ class HipRollLaw(Strict):
                                     "leg's target roll per rad/s of lean rate [s]")
 
 
+#: the one line refusing hip-roll joints elsewhere (the capability table's reason)
+HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged walker's with "
+                  "hip width (walker.space: 3d, hip_width_m > 0)")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "
@@ -162,8 +165,7 @@ class CompassGaitParams(_Actuated):
                              "other (w^2 / (2 L) > 2 L); give hip_width_m below "
                              f"{2 * self.leg_length_m:g} m (2 leg_length_m)")
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
-            raise ValueError("walker.hip_roll: hip-roll joints are a 3D straight-legged "
-                             "walker's with hip width (walker.space: 3d, hip_width_m > 0)")
+            raise ValueError(HIP_ROLL_NEEDS)
         for name in ("foot_radius_m", "leg_inertia_kg_m2"):
             if getattr(self, name) is not None and self.space == "2d":
                 raise ValueError(f"walker.{name}: needs space: 3d (a planar walker's round "
@@ -280,11 +282,12 @@ class BipedParams(_Actuated):
         """``space: 3d`` (the legs' parts in three dimensions,
         :func:`walkerlab.walker.trees.straight_legs_3d_tree`): what it supports today, one
         line otherwise."""
+        if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
+            raise ValueError(HIP_ROLL_NEEDS)
         if self.space == "2d":
-            for name in ("hip_width_m", "hip_roll"):
-                if getattr(self, name):
-                    raise ValueError(f"walker.{name}: needs space: 3d (a planar walker's "
-                                     "hips are one point)")
+            if self.hip_width_m:
+                raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
+                                 "walker's hips are one point)")
             return
         leg = pair[0]
         for field, bad, what in (
@@ -300,8 +303,6 @@ class BipedParams(_Actuated):
                 ("walker.torso.coupling", self.torso is not None
                  and self.torso.coupling != "bisecting_hip", "a bisecting_hip torso"),
                 ("walker.actuation", self.actuation is not None, "a passive walker"),
-                ("walker.hip_roll", self.hip_roll is not None and not self.hip_width_m,
-                 "a hip width for hip-roll joints"),
                 ("walker.hip_roll", self.hip_roll is not None and (
                     leg.foot.kind != "point" or any(b.kind != "point_mass"
                                                     for b in leg.bodies)),

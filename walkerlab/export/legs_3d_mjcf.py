@@ -74,6 +74,7 @@ from walkerlab.export.tree_bodies import (
     mjcf_body_lines,
     mjcf_coupling_lines,
 )
+from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_3d_tree
 
 __all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
@@ -300,9 +301,9 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
                                  data.slope_rad, p["r"])
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order):
         # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma)
-        x = np.asarray(ideal.x, float)
-        n = x.size // 2
-        qpos, qvel = qpos + ((x[1] + x[2]) / 2,), qvel + ((x[n + 1] + x[n + 2]) / 2,)
+        s = dict(zip(state_names(data.structure.roles), np.asarray(ideal.x, float)))
+        qpos += ((s["swing_angle"] + s["stance_angle"]) / 2,)
+        qvel += ((s["swing_rate"] + s["stance_rate"]) / 2,)
     lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
     c, _knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],

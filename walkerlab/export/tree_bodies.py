@@ -358,7 +358,8 @@ def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
         joints += [ExportJoint(names_of.get(c, c), "hinge", tuple(ev.vector(axes[c][0])),
                                _absolute_angle(ev, tree, roles.pelvis, c))
                    for c in roles.pelvis_hinges]
-        about = axes[roles.pelvis_hinges[0]][0] if len(roles.pelvis_hinges) == 1 else None
+        hinge, *more = roles.pelvis_hinges          # a root turning about one axis only
+        about = None if more else axes[hinge][0]
     else:
         joints, about = [ExportJoint("free", "free")], None
     swap = {ev.names[a]: ev.names[b] for a, b in roles.stance_roles if a in ev.names}
