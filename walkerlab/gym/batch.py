@@ -133,7 +133,7 @@ def _neg_tau(p: dict) -> np.ndarray:
 
 
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
-                p: dict, views=None) -> tuple:
+                p: dict, views=None, X: np.ndarray | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -151,6 +151,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         :func:`batch_parameters` of ``envs``.
     views : list of RigidView, optional
         ``[e.sim for e in envs]``, when the caller has it.
+    X : ndarray (N, 2n), optional
+        The walkers' states stacked, when the caller has them (``views[i].x`` is
+        ``X[i]``: :func:`walkerlab.gym.rows_common.advance_common`).
 
     Returns
     -------
@@ -171,7 +174,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     # step's start, how its episode ended, its steps and ledger
     rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
     xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
-    X = np.array(xs)
+    if X is None:
+        X = np.array(xs)
     # (leg1's stance as 1.0, the phase's index as a float, the time in the step: the
     # float64 of each, side by side with the states)
     obs = np.concatenate((X, [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in

@@ -50,7 +50,7 @@ from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 from .action import GL_W, GL_X  # the ledger's Gauss-Legendre rule, the walker's own
 from .small_arrays import all_finite
 
-__all__ = ["COMPILE_NOTICE_S", "advance_rows", "compile_notice"]
+__all__ = ["COMPILE_NOTICE_S", "advance_live", "advance_rows", "compile_notice"]
 
 #: a first batched call still running after this long [s] is compiling its kernels (numba:
 #: about 13 s on an idle 2-core machine; about 2 s when its cache holds them): said in one line
@@ -412,6 +412,16 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
         v.open_period(actions[i], t_end)
         if v.t < t_end and not v.ended:
             live.append(i)
+    advance_live(views, actions, t_ends, live, strikes)
+    return strikes
+
+
+def advance_live(views, actions, t_ends, live: list, strikes: list) -> None:
+    """:func:`advance_rows`' pieces of the walkers ``live`` (indices into ``views``,
+    their periods opened), each walker's heel-strike times added to ``strikes[i]``, until
+    every one reached its period's end or its episode's (the native vector env's common
+    step, :func:`walkerlab.gym.rows_common.advance_common`, goes on here after its first
+    pieces)."""
     while live:
         groups: dict = {}
         for i in live:
@@ -443,4 +453,3 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
             _absorb_rows(views, rows, pieces, _integrate_rows(views, rows, pieces, key, gs),
                          strikes)
         live = [i for i in live if views[i].t < t_ends[i] and not views[i].ended]
-    return strikes

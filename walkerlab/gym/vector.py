@@ -68,6 +68,18 @@ def _advance_rows():
 _ADVANCE_ROWS = None
 
 
+def _advance_common():
+    """:func:`walkerlab.gym.rows_common.advance_common` (imported on first use, as
+    :func:`_advance_rows`), kept."""
+    global _ADVANCE_COMMON
+    if _ADVANCE_COMMON is None:
+        from .rows_common import advance_common as _ADVANCE_COMMON  # light
+    return _ADVANCE_COMMON
+
+
+_ADVANCE_COMMON = None
+
+
 class WalkerVectorEnv(VectorEnv):
     """``num_envs`` walkers of one scene stepped together in one process: the native
     vector form of ``walkerlab/Walker-v0`` (module docstring).
@@ -166,6 +178,9 @@ class WalkerVectorEnv(VectorEnv):
         self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
         self._params: dict | None | bool = False
+        #: the walkers' kernel data rows by their flows (:func:`walkerlab.gym.rows_common.
+        #: advance_common`)
+        self._data_rows: dict = {}
 
     # ------------------------------------------------------------------ the physics
     def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
@@ -213,7 +228,8 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         advance_rows = _advance_rows()
-        if not self._batched_before:  # its kernels compiled or loaded: a long wait said
+        first = not self._batched_before
+        if first:  # its kernels compiled or loaded: a long wait said
             self._batched_before = True
             from .rigid_rows import compile_notice  # (advance_rows' module: imported)
 
@@ -236,9 +252,13 @@ class WalkerVectorEnv(VectorEnv):
         U, x_before, w_before, t_ends = begin_periods(envs, actions if whole else actions[idx],
                                                       p)
         views = [env.sim for env in envs]
-        strikes = advance_rows(views, U, t_ends)
+        # (a step of every walker after the first: the common period's batch arrays)
+        if first or not whole:
+            strikes, X = advance_rows(views, U, t_ends), None
+        else:
+            strikes, X = _advance_common()(views, U, t_ends, self._data_rows)
         obs, reward, term, trunc, columns = end_periods(envs, U, strikes, x_before,
-                                                        w_before, p, views)
+                                                        w_before, p, views, X)
         if whole:
             self._observations[:] = obs
             self._rewards[:] = reward
