@@ -51,23 +51,29 @@ def _hold(view, fast, u: np.ndarray) -> None:
 
 
 class _DataRows:
-    """The kernel's data rows (N, size) of N walkers' flows (one module and law block
-    size), as :meth:`walkerlab.codegen.actuated.ActuatedFlow.data_rows` writes them: kept
-    from the first period, this period's held torques (the law block's constants, each
-    actuator's ``HEAD``-th slot from :data:`~walkerlab.gym.rigid_view._CONSTANT_0`) and step
-    clocks (``t_origin``, the block's third slot) written as columns.  The first period
-    writes the law blocks and compares these rows with ``data_rows``' bit for bit; rows
-    that differ (a flow of another layout) are then ``data_rows``' every period."""
+    """What a common period of the same walkers' flows (one per walker, in order) reads
+    every period, kept: the kernel's data rows (N, size) as
+    :meth:`walkerlab.codegen.actuated.ActuatedFlow.data_rows` writes them, this period's
+    held torques (the law block's constants, each actuator's ``HEAD``-th slot from
+    :data:`~walkerlab.gym.rigid_view._CONSTANT_0`) and step clocks (``t_origin``, the
+    block's third slot) written as columns; the kernel's compiled functions, tolerances and
+    guard tables.  The first period writes the law blocks and compares these rows with
+    ``data_rows``' bit for bit; rows that differ (a flow of another layout) are then
+    ``data_rows``' every period."""
 
-    def __init__(self, flows: list, k: int):
+    def __init__(self, flows: list, k: int, key: tuple, fphase, guards: list):
         self.flows = tuple(flows)  # (kept: their ids key this entry)
         nc = flows[0].constants().size
         self.base = np.empty((len(flows), flows[0].data_size()))
         flows[0].data_rows(flows, self.base)
-        self.u_cols = nc + _CONSTANT_0 + HEAD * np.arange(k)
+        first = nc + _CONSTANT_0
+        self.u_cols = slice(first, first + HEAD * k, HEAD)
         self.t_col = nc + 2
+        self.origins = self.base[:, self.t_col].tolist()
         self.checked = False  # (the first period compares; False after: data_rows')
         self.same = True
+        self.kernel = _CFUNCS.get(key) or _kernel_args(key, fphase)
+        self.guards = _guard_tables(guards)
 
     def rows(self, views, lanes: list, U: np.ndarray, origins: list) -> np.ndarray:
         """The data rows of this period's torques ``U`` (N, k) [N m] and step clocks
@@ -75,7 +81,8 @@ class _DataRows:
         if self.checked and self.same:
             D = self.base.copy()
             D[:, self.u_cols] = U
-            D[:, self.t_col] = origins
+            if origins != self.origins:
+                D[:, self.t_col] = origins
             return D
         for v, lane, u in zip(views, lanes, U):  # the law blocks written, as next_piece
             _hold(v, lane[6], u)
@@ -89,8 +96,32 @@ class _DataRows:
         return D
 
 
-#: most entries of a vector env's data rows cache (cleared when full)
-DATA_ROWS_KEPT = 256
+#: most entries of a vector env's caches (:func:`advance_common`'s ``cache``; cleared when
+#: full)
+KEPT = 256
+
+
+def _lane_entry(v, lane, cache: dict):
+    """``(lane, key, guards, flow)`` of a walker's kept lane (``RigidView._lane``: its step
+    walker, phase and stance leg) when a common period can run it (its compiled phase on
+    the kernel, a flow with a law block, no height profile, no fall guard checked at the
+    phase's entry), the flow key one object for equal keys; ``(lane, None)`` when not;
+    kept in ``cache`` by the lane's id (the lane kept with it: its id stays its own)."""
+    lanes = cache.setdefault("lanes", {})
+    if len(lanes) >= KEPT:
+        lanes.clear()
+    out = (lane, None)
+    fast = lane[6]
+    if v.ground is None and not lane[5] and fast is not None:
+        kg = v.row_keys.get(id(fast[0]), v.row_keys)
+        if kg is v.row_keys:  # (its key not made yet: made by advance_rows, asked again)
+            return out
+        flow = fast[0].compiled
+        if kg is not None and hasattr(flow, "data_rows"):
+            keys = cache.setdefault("keys", {})
+            out = (lane, keys.setdefault(kg[0], kg[0]), kg[1], flow)
+    lanes[id(lane)] = out
+    return out
 
 
 def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
@@ -107,7 +138,7 @@ def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
     t_ends : list of float
         Each walker's period end [s].
     cache : dict
-        The vector env's own: the walkers' data rows (:class:`_DataRows`) by their flows.
+        The vector env's own (what a common period of its walkers reads, kept).
 
     Returns
     -------
@@ -117,56 +148,57 @@ def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
         The walkers' states at the period's end, rows of one array, when every walker
         reached it in the batch (``views[i].x`` is ``X[i]``); else None.
     """
-    key0 = None
-    lanes, guards, xs, caps, stops, flows, origins = [], [], [], [], [], [], []
+    lanes_kept = cache.get("lanes") or {}
+    key = None
+    entries, xs, caps, stops, origins = [], [], [], [], []
     for v, t_end in zip(views, t_ends):  # (read only: a period not common is not touched)
         lane = v._lane
-        if (lane is None or v.ended or not v.t < t_end or v.ground is not None
-                or lane[0] is not v.walker or lane[1] != v.k or lane[2] != v.leg
-                or lane[5] or lane[6] is None):
+        if (lane is None or lane[0] is not v.walker or lane[1] != v.k or lane[2] != v.leg
+                or v.ended or not v.t < t_end):
             return advance_rows(views, U, t_ends), None
-        kg = v.row_keys.get(id(lane[6][0]))
-        if kg is None:  # (no key kept yet, or a phase the kernel does not run)
-            return advance_rows(views, U, t_ends), None
-        if key0 is None:
-            key0 = kg[0]
-        elif kg[0] is not key0 and kg[0] != key0:  # (walkers of several flows)
-            return advance_rows(views, U, t_ends), None
-        flow = lane[6][0].compiled
-        if not hasattr(flow, "data_rows"):
+        e = lanes_kept.get(id(lane)) or _lane_entry(v, lane, cache)
+        if e[1] is not key:
+            if key is not None or e[1] is None:  # (walkers of several flows; a lane the
+                return advance_rows(views, U, t_ends), None  # common period cannot run)
+            key = e[1]
+        elif key is None:  # (the first walker's lane: one the common period cannot run)
             return advance_rows(views, U, t_ends), None
         t_stop = v.t_step + v.max_step_time  # (next_piece's end of the piece)
         if not t_stop < t_end:
             t_stop = t_end
-        lanes.append(lane)
-        guards.append(kg[1])
+        entries.append(e)
         xs.append(v.x)
         caps.append(t_stop - v.t)
         stops.append(t_stop)
-        flows.append(flow)
-        origins.append(float(getattr(flow.actuators, "t_origin", 0.0)))
-    key = key0
+        origins.append(float(getattr(e[3].actuators, "t_origin", 0.0)))
     N = len(views)
     rows_u = list(U)
-    for v, lane, u, t_end in zip(views, lanes, rows_u, t_ends):  # (open_period, next_piece)
+    lanes = []
+    for v, e, u, t_end in zip(views, entries, rows_u, t_ends):  # (open_period, next_piece)
         per = (u, t_end)  # (u a float64 row, t_end a float)
         v._period = per
         v._log.append(per)
+        lane = e[0]
         lane[3].u = u
+        lanes.append(lane)
     on = [any(r) for r in U.tolist()]
     some_on = any(on)
-    fid = tuple(map(id, flows))
+    fid = tuple(map(id, entries))
     data = cache.get(fid)
     if data is None:
-        if len(cache) >= DATA_ROWS_KEPT:
+        if len(cache) >= KEPT:
             cache.clear()
-        data = cache[fid] = _DataRows(flows, U.shape[1])
+        data = cache[fid] = _DataRows([e[3] for e in entries], U.shape[1], key,
+                                      lanes[0][6][0], [e[2] for e in entries])
     D = data.rows(views, lanes, U, origins)
-    f, fs, fg, sel, rtol, atol, n_out = (_CFUNCS.get(key)
-                                         or _kernel_args(key, lanes[0][6][0]))
-    gcols, goffs, dirs, ng, gi = _guard_tables(guards)
+    f, fs, fg, sel, rtol, atol, n_out = data.kernel
+    gcols, goffs, dirs, ng, gi = data.guards
     m = key[4]
-    Y = np.array(xs, dtype=float)
+    last = cache.get("X")  # (the last common period's states: the walkers' own rows)
+    if last is not None and all(x is r for x, r in zip(xs, last[1])):
+        Y = last[0]
+    else:
+        Y = np.array(xs, dtype=float)
     cap = np.array(caps, dtype=float)
     which = np.empty(N, np.int64)
     te = np.empty(N)
@@ -186,17 +218,18 @@ def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
     ends = which.tolist()
     if min(ends) == TIMEOUT == max(ends) and all_finite(Yev):
         # every row reached its piece's end (_absorb_rows' settled rows, all of them)
-        held = [r for r in range(N) if on[r]]
+        held = [r for r in range(N) if on[r]] if some_on else ()
         maps = [_joint_map(views[r], lanes[r][3]) for r in held]
         if not any(M is None for M in maps):
             if held:
-                _held_rows(views, list(range(N)), [(None, lanes[r][3]) if on[r] else None
-                                                   for r in range(N)],
+                _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes],
                            held, maps, Yev, Y, cap, Yn)
-            for v, x, t_stop in zip(views, list(Yev), stops):  # RigidView.settle
+            X = list(Yev)
+            for v, x, t_stop in zip(views, X, stops):  # RigidView.settle
                 v.t, v.x = t_stop, x
                 if t_stop >= v.t_step + v.max_step_time:
                     v.ended = "stall"
+            cache["X"] = (Yev, X)
             return [[] for _ in views], Yev
     # some row absorbed by its walker (a crossing, a failed step, the ledger on the dense
     # output): it may integrate its piece again with the walker's own flow, whose law
