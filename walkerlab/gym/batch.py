@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["batch_parameters", "begin_periods", "end_periods", "hip_xs"]
+__all__ = ["batch_parameters", "begin_periods", "end_periods", "held_torques", "hip_xs"]
 
 
 def batch_parameters(envs) -> dict | None:
@@ -94,6 +94,20 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     t_ends : list of float
         Each period's end [s].
     """
+    U = held_torques(envs, actions, p)
+    x_before, w_before, t_ends = [], [], []
+    for e in envs:
+        x_before.append(e._hip_x)
+        w_before.append(e.sim.ledger["action_work_positive"])
+        e._elapsed = k = e._elapsed + 1
+        t_ends.append(k * e.dt)
+    return U, x_before, w_before, t_ends
+
+
+def held_torques(envs, actions: np.ndarray, p: dict) -> np.ndarray:
+    """The held torques (N, k) [N m] of ``actions`` (N, k) (:func:`begin_periods`' first
+    half: scaled, the scene policy's added at the walkers' present states, clipped; a new
+    array)."""
     norm = p["normalize"]
     every, some, policy = _flags(p)
     tau = p["tau"]
@@ -109,14 +123,7 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
             s = e.sim
             a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
     # (np.clip's own ufunc, into the new array a: ndarray.clip(-tau, tau)'s numbers)
-    U = _CLIP(a, _neg_tau(p), tau, out=a)
-    x_before, w_before, t_ends = [], [], []
-    for e in envs:
-        x_before.append(e._hip_x)
-        w_before.append(e.sim.ledger["action_work_positive"])
-        e._elapsed = k = e._elapsed + 1
-        t_ends.append(k * e.dt)
-    return U, x_before, w_before, t_ends
+    return _CLIP(a, _neg_tau(p), tau, out=a)
 
 
 #: the ufunc ``ndarray.clip(lo, hi)`` calls (numpy's ``_methods._clip``: ``umath.clip``),
@@ -133,7 +140,8 @@ def _neg_tau(p: dict) -> np.ndarray:
 
 
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
-                p: dict, views=None, X: np.ndarray | None = None) -> tuple:
+                p: dict, views=None, X: np.ndarray | None = None,
+                rows: list | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -153,7 +161,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         ``[e.sim for e in envs]``, when the caller has it.
     X : ndarray (N, 2n), optional
         The walkers' states stacked, when the caller has them (``views[i].x`` is
-        ``X[i]``: :func:`walkerlab.gym.rows_common.advance_common`).
+        ``X[i]``: :func:`walkerlab.gym.rows_common.step_common`).
+    rows : list of tuple, optional
+        What is read of each walker (below), when the caller has read it.
 
     Returns
     -------
@@ -172,14 +182,18 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         views = [e.sim for e in envs]
     # what is read of each walker, in one pass: its state, time, stance leg, phase, its
     # step's start, how its episode ended, its steps and ledger
-    rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
+    if rows is None:
+        rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
     xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
     if X is None:
         X = np.array(xs)
     # (leg1's stance as 1.0, the phase's index as a float, the time in the step: the
     # float64 of each, side by side with the states)
-    obs = np.concatenate((X, [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in
-                              zip(legs, ks, ts, t_steps)]), axis=1)
+    m = X.shape[1]
+    obs = np.empty((len(rows), m + 3))
+    obs[:, :m] = X
+    obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
+                  zip(legs, ks, ts, t_steps)]
     _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
     hip = hip_xs(views, X)
     hips = hip.tolist()
@@ -204,7 +218,10 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
             fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
             w_before)], dtype=np.float64)
-    messages = [getattr(v, "failure", "") for v in views]
+    # (a view's own words, when it has them: the rigid view's are its instance's)
+    messages = ([v.__dict__.get("failure", "") for v in views]
+                if not any(hasattr(t, "failure") for t in set(map(type, views)))
+                else [getattr(v, "failure", "") for v in views])
     seeds = [e.terrain_seed for e in envs]
 
     def columns() -> dict:  # (of the values read above, whenever called)

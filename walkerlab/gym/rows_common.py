@@ -32,12 +32,13 @@ from walkerlab.codegen.torque_law import HEAD
 from walkerlab.integrate.rows_dop853 import TIMEOUT
 
 from .action import GL_X
+from .batch import end_periods, held_torques
 from .rigid_rows import (_CFUNCS, _NO_NODES, _absorb_rows, _guard_tables, _held_rows,
                          _joint_map, _kernel_args, _period_rows, advance_live, advance_rows)
 from .rigid_view import _CONSTANT_0
 from .small_arrays import all_finite
 
-__all__ = ["advance_common"]
+__all__ = ["step_common"]
 
 
 def _hold(view, fast, u: np.ndarray) -> None:
@@ -124,61 +125,85 @@ def _lane_entry(v, lane, cache: dict):
     return out
 
 
-def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
-    """:func:`walkerlab.gym.rigid_rows.advance_rows` of ``views`` with the held torques
-    ``U`` (N, k) [N m] to ``t_ends`` (N) [s], its first pieces as one batch when the period
-    is common (module docstring): the same numbers bit for bit.
+def _common(envs, views, cache: dict):
+    """What a common period reads of the walkers, in one pass, before anything changes:
+    ``(key, entries, xs, caps, stops, origins, t_ends, x_before, w_before)`` (the flow key
+    they share; each walker's lane entry (:func:`_lane_entry`), state, piece's span [s],
+    its end [s], step clock [s], period end [s] (:func:`~walkerlab.gym.batch.begin_periods`'
+    ``k dt``), hip x [m] and positive action work [J] at the period's start); None when the
+    period is not common."""
+    lanes_kept = cache.get("lanes") or {}
+    key = None
+    entries, xs, caps, stops, origins, t_ends, x_before, w_before = ([] for _ in range(8))
+    for e, v in zip(envs, views):
+        t_end = (e._elapsed + 1) * e.dt
+        lane = v._lane
+        if (lane is None or lane[0] is not v.walker or lane[1] != v.k or lane[2] != v.leg
+                or v.ended or not v.t < t_end):
+            return None
+        en = lanes_kept.get(id(lane)) or _lane_entry(v, lane, cache)
+        if en[1] is not key:
+            if key is not None or en[1] is None:  # (walkers of several flows; a lane the
+                return None  # common period cannot run)
+            key = en[1]
+        elif key is None:  # (the first walker's lane: one the common period cannot run)
+            return None
+        t_stop = v.t_step + v.max_step_time  # (next_piece's end of the piece)
+        if not t_stop < t_end:
+            t_stop = t_end
+        entries.append(en)
+        xs.append(v.x)
+        caps.append(t_stop - v.t)
+        stops.append(t_stop)
+        origins.append(float(getattr(en[3].actuators, "t_origin", 0.0)))
+        t_ends.append(t_end)
+        x_before.append(e._hip_x)
+        w_before.append(v.ledger["action_work_positive"])
+    return key, entries, xs, caps, stops, origins, t_ends, x_before, w_before
+
+
+def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
+    """One control period of every walker when it is common (module docstring), from the
+    actions to the step's outputs: :func:`~walkerlab.gym.batch.begin_periods`,
+    :func:`walkerlab.gym.rigid_rows.advance_rows` and :func:`~walkerlab.gym.batch.
+    end_periods` of ``envs`` (their walkers ``views``), the same numbers bit for bit, with
+    one read of the walkers before the period, one write as it opens and one read and
+    write as it ends.
 
     Parameters
     ----------
+    envs : sequence of walkerlab.gym.env.WalkerEnv
+        N rigid-view environments, each reset.
     views : sequence of walkerlab.gym.rigid_view.RigidView
-    U : ndarray (N, k)
-        The held torques [N m], float64 (its rows are held by the walkers: not written
-        after).
-    t_ends : list of float
-        Each walker's period end [s].
+        ``[e.sim for e in envs]``.
+    actions : ndarray (N, k)
+        Checked finite actions (:func:`~walkerlab.gym.batch.begin_periods`).
+    p : dict
+        :func:`~walkerlab.gym.batch.batch_parameters` of ``envs``.
     cache : dict
         The vector env's own (what a common period of its walkers reads, kept).
 
     Returns
     -------
-    strikes : list of list of float
-        Each walker's heel-strike times inside its period [s].
-    X : ndarray (N, 2n) or None
-        The walkers' states at the period's end, rows of one array, when every walker
-        reached it in the batch (``views[i].x`` is ``X[i]``); else None.
+    tuple or None
+        :func:`~walkerlab.gym.batch.end_periods`' ``(obs, reward, terminated, truncated,
+        columns)``; None when the period is not common (nothing changed: the caller steps
+        the walkers its own way).
     """
-    lanes_kept = cache.get("lanes") or {}
-    key = None
-    entries, xs, caps, stops, origins = [], [], [], [], []
-    for v, t_end in zip(views, t_ends):  # (read only: a period not common is not touched)
-        lane = v._lane
-        if (lane is None or lane[0] is not v.walker or lane[1] != v.k or lane[2] != v.leg
-                or v.ended or not v.t < t_end):
-            return advance_rows(views, U, t_ends), None
-        e = lanes_kept.get(id(lane)) or _lane_entry(v, lane, cache)
-        if e[1] is not key:
-            if key is not None or e[1] is None:  # (walkers of several flows; a lane the
-                return advance_rows(views, U, t_ends), None  # common period cannot run)
-            key = e[1]
-        elif key is None:  # (the first walker's lane: one the common period cannot run)
-            return advance_rows(views, U, t_ends), None
-        t_stop = v.t_step + v.max_step_time  # (next_piece's end of the piece)
-        if not t_stop < t_end:
-            t_stop = t_end
-        entries.append(e)
-        xs.append(v.x)
-        caps.append(t_stop - v.t)
-        stops.append(t_stop)
-        origins.append(float(getattr(e[3].actuators, "t_origin", 0.0)))
+    got = _common(envs, views, cache)
+    if got is None:
+        return None
+    key, entries, xs, caps, stops, origins, t_ends, x_before, w_before = got
+    U = held_torques(envs, actions, p)  # (the policy's at the present states)
     N = len(views)
     rows_u = list(U)
     lanes = []
-    for v, e, u, t_end in zip(views, entries, rows_u, t_ends):  # (open_period, next_piece)
+    for e, v, en, u, t_end in zip(envs, views, entries, rows_u, t_ends):
+        e._elapsed += 1  # (begin_periods, open_period, next_piece)
         per = (u, t_end)  # (u a float64 row, t_end a float)
         v._period = per
         v._log.append(per)
-        lane = e[0]
+        lane = en[0]
         lane[3].u = u
         lanes.append(lane)
     on = [any(r) for r in U.tolist()]
@@ -188,8 +213,8 @@ def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
     if data is None:
         if len(cache) >= KEPT:
             cache.clear()
-        data = cache[fid] = _DataRows([e[3] for e in entries], U.shape[1], key,
-                                      lanes[0][6][0], [e[2] for e in entries])
+        data = cache[fid] = _DataRows([en[3] for en in entries], U.shape[1], key,
+                                      lanes[0][6][0], [en[2] for en in entries])
     D = data.rows(views, lanes, U, origins)
     f, fs, fg, sel, rtol, atol, n_out = data.kernel
     gcols, goffs, dirs, ng, gi = data.guards
@@ -203,7 +228,6 @@ def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
     which = np.empty(N, np.int64)
     te = np.empty(N)
     Yev = np.empty((N, m))
-    H = np.zeros(N)
     if some_on:  # the Gauss-Legendre nodes of the rows with the action on (_integrate_rows)
         half = 0.5 * cap[:, None]
         Tn = half * GL_X + half
@@ -214,35 +238,63 @@ def advance_common(views, U: np.ndarray, t_ends: list, cache: dict) -> tuple:
         Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
             (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
     _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
-                       n_out, which, te, Yev, H, Tn, Yn))
+                       n_out, which, te, Yev, np.zeros(N), Tn, Yn))
     ends = which.tolist()
-    if min(ends) == TIMEOUT == max(ends) and all_finite(Yev):
-        # every row reached its piece's end (_absorb_rows' settled rows, all of them)
-        held = [r for r in range(N) if on[r]] if some_on else ()
-        maps = [_joint_map(views[r], lanes[r][3]) for r in held]
-        if not any(M is None for M in maps):
-            if held:
-                _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes],
-                           held, maps, Yev, Y, cap, Yn)
-            X = list(Yev)
-            for v, x, t_stop in zip(views, X, stops):  # RigidView.settle
-                v.t, v.x = t_stop, x
-                if t_stop >= v.t_step + v.max_step_time:
-                    v.ended = "stall"
-            cache["X"] = (Yev, X)
-            return [[] for _ in views], Yev
-    # some row absorbed by its walker (a crossing, a failed step, the ledger on the dense
-    # output): it may integrate its piece again with the walker's own flow, whose law
+    finite = ([True] * N if all_finite(Yev) else np.isfinite(Yev).all(axis=1).tolist())
+    # the rows that reached their piece's end, each settled there as _absorb_rows settles
+    # it (the ledger of those with the action on at once: _held_rows); the others (a
+    # guard crossing, a failed step, a state not finite, the ledger on the dense output)
+    # absorbed by their walkers
+    if min(ends) == TIMEOUT == max(ends) and not some_on and all(finite):
+        settled, slow = range(N), []
+    else:
+        settled, slow, held, maps = [], [], [], []
+        for r in range(N):
+            if ends[r] != TIMEOUT or not finite[r]:
+                slow.append(r)
+            elif on[r]:
+                M = _joint_map(views[r], lanes[r][3])
+                if M is None:
+                    slow.append(r)
+                else:
+                    settled.append(r)
+                    held.append(r)
+                    maps.append(M)
+            else:
+                settled.append(r)
+        if held:
+            _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes], held,
+                       maps, Yev, Y, cap, Yn)
+    X = list(Yev)
+    if not slow:
+        rows = []
+        for v, x, t_stop in zip(views, X, stops):  # RigidView.settle; end_periods' read
+            v.t, v.x = t_stop, x
+            if t_stop >= v.t_step + v.max_step_time:
+                v.ended = "stall"
+            rows.append((x, t_stop, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger))
+        cache["X"] = (Yev, X)
+        return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
+                           Yev, rows)
+    for r in settled:  # RigidView.settle
+        v, t_stop = views[r], stops[r]
+        v.t, v.x = t_stop, X[r]
+        if t_stop >= v.t_step + v.max_step_time:
+            v.ended = "stall"
+    # a walker's own absorbing may integrate its piece again with its own flow, whose law
     # block then holds the torques (as next_piece leaves it)
-    for v, lane, u in zip(views, lanes, rows_u):
-        _hold(v, lane[6], u)
-    pieces = [(lane[0], lane[3], a, lane[4], t_stop, lane[6])
-              for lane, a, t_stop in zip(lanes, on, stops)]
+    pieces = []
+    for r, (v, lane, u, a, t_stop) in enumerate(zip(views, lanes, rows_u, on, stops)):
+        if r in slow:
+            _hold(v, lane[6], u)
+        pieces.append((lane[0], lane[3], a, lane[4], t_stop, lane[6]))
     rows = list(range(N))
     call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
     strikes: list[list[float]] = [[] for _ in views]
-    _absorb_rows(views, rows, pieces, (which, te, Yev, Y, cap, Yn, call), strikes)
-    live = [i for i in rows if views[i].t < t_ends[i] and not views[i].ended]
+    _absorb_rows(views, rows, pieces, (which, te, Yev, Y, cap, Yn, call), strikes,
+                 set(slow))
+    live = [i for i in slow if views[i].t < t_ends[i] and not views[i].ended]
     if live:
         advance_live(views, rows_u, t_ends, live, strikes)
-    return strikes, None
+    cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
+    return end_periods(envs, U, strikes, x_before, w_before, p, views)

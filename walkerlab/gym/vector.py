@@ -68,16 +68,16 @@ def _advance_rows():
 _ADVANCE_ROWS = None
 
 
-def _advance_common():
-    """:func:`walkerlab.gym.rows_common.advance_common` (imported on first use, as
+def _step_common():
+    """:func:`walkerlab.gym.rows_common.step_common` (imported on first use, as
     :func:`_advance_rows`), kept."""
-    global _ADVANCE_COMMON
-    if _ADVANCE_COMMON is None:
-        from .rows_common import advance_common as _ADVANCE_COMMON  # light
-    return _ADVANCE_COMMON
+    global _STEP_COMMON
+    if _STEP_COMMON is None:
+        from .rows_common import step_common as _STEP_COMMON  # light
+    return _STEP_COMMON
 
 
-_ADVANCE_COMMON = None
+_STEP_COMMON = None
 
 
 class WalkerVectorEnv(VectorEnv):
@@ -178,9 +178,9 @@ class WalkerVectorEnv(VectorEnv):
         self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
         self._params: dict | None | bool = False
-        #: the walkers' kernel data rows by their flows (:func:`walkerlab.gym.rows_common.
-        #: advance_common`)
-        self._data_rows: dict = {}
+        #: what a common period of the walkers reads, kept (:func:`walkerlab.gym.
+        #: rows_common.step_common`)
+        self._common: dict = {}
 
     # ------------------------------------------------------------------ the physics
     def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
@@ -246,24 +246,23 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         whole = idx.size == self.num_envs
-        if not whole:
-            p = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
-        # (begin_periods reads the actions into an array of its own: every row as given)
-        U, x_before, w_before, t_ends = begin_periods(envs, actions if whole else actions[idx],
-                                                      p)
         views = [env.sim for env in envs]
-        # (a step of every walker after the first: the common period's batch arrays)
-        if first or not whole:
-            strikes, X = advance_rows(views, U, t_ends), None
-        else:
-            strikes, X = _advance_common()(views, U, t_ends, self._data_rows)
-        obs, reward, term, trunc, columns = end_periods(envs, U, strikes, x_before,
-                                                        w_before, p, views, X)
-        if whole:
-            self._observations[:] = obs
-            self._rewards[:] = reward
-            self._terminations[:] = term
-            self._truncations[:] = trunc
+        # a step of every walker after the first: a common period's batch
+        # (walkerlab.gym.rows_common.step_common), when it is one
+        out = (None if first or not whole
+               else _step_common()(envs, views, actions, p, self._common))
+        if out is None:
+            if not whole:
+                p = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
+            # (begin_periods reads the actions into an array of its own: every row as given)
+            U, x_before, w_before, t_ends = begin_periods(
+                envs, actions if whole else actions[idx], p)
+            out = end_periods(envs, U, advance_rows(views, U, t_ends), x_before, w_before, p,
+                              views)
+        obs, reward, term, trunc, columns = out
+        if whole:  # (new arrays of this step's: kept as they are)
+            self._observations, self._rewards = obs, reward
+            self._terminations, self._truncations = term, trunc
         else:
             self._observations[idx] = obs
             self._rewards[idx] = reward
