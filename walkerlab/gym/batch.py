@@ -141,7 +141,7 @@ def _neg_tau(p: dict) -> np.ndarray:
 
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
                 p: dict, views=None, X: np.ndarray | None = None,
-                rows: list | None = None) -> tuple:
+                cols: tuple | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -162,8 +162,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     X : ndarray (N, 2n), optional
         The walkers' states stacked, when the caller has them (``views[i].x`` is
         ``X[i]``: :func:`walkerlab.gym.rows_common.step_common`).
-    rows : list of tuple, optional
-        What is read of each walker (below), when the caller has read it.
+    cols : tuple, optional
+        What is read of the walkers (below: states, times, stance legs, phases, steps'
+        starts, ends, steps, ledgers, each a sequence of N), when the caller has read it.
 
     Returns
     -------
@@ -182,15 +183,16 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         views = [e.sim for e in envs]
     # what is read of each walker, in one pass: its state, time, stance leg, phase, its
     # step's start, how its episode ended, its steps and ledger
-    if rows is None:
-        rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
-    xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
+    if cols is None:
+        cols = zip(*[(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger)
+                     for v in views])
+    xs, ts, legs, ks, t_steps, ended, steps, ledgers = cols  # (sequences)
     if X is None:
         X = np.array(xs)
     # (leg1's stance as 1.0, the phase's index as a float, the time in the step: the
     # float64 of each, side by side with the states)
     m = X.shape[1]
-    obs = np.empty((len(rows), m + 3))
+    obs = np.empty((len(views), m + 3))
     obs[:, :m] = X
     obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
                   zip(legs, ks, ts, t_steps)]
@@ -209,8 +211,11 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
-    effort = U / p["tau"]
-    effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2: square)
+    if any(U.ravel().tolist()):
+        effort = U / p["tau"]
+        effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2)
+    else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
+        effort = [0.0] * len(views)
     j_work = terms.index("action_work_positive")
     work = [row[j_work] for row in sums]
     reward = np.array([
@@ -220,7 +225,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
             w_before)], dtype=np.float64)
     # (a view's own words, when it has them: the rigid view's are its instance's)
     messages = ([v.__dict__.get("failure", "") for v in views]
-                if not any(hasattr(t, "failure") for t in set(map(type, views)))
+                if not any(map(_class_failure, set(map(type, views))))
                 else [getattr(v, "failure", "") for v in views])
     seeds = [e.terrain_seed for e in envs]
 
@@ -241,6 +246,17 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     terminated = np.array(terminated, dtype=np.bool_)
     truncated = np.array(truncated, dtype=np.bool_)
     return obs, reward, terminated, truncated, columns
+
+
+_CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
+
+
+def _class_failure(cls) -> bool:
+    """Whether the class ``cls`` has an attribute ``failure`` (kept per class)."""
+    out = _CLASS_FAILURE.get(cls)
+    if out is None:
+        out = _CLASS_FAILURE[cls] = hasattr(cls, "failure")
+    return out
 
 
 #: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``

@@ -26,6 +26,8 @@ fall guard checked at a phase's entry, walkers of several flows) is
 
 from __future__ import annotations
 
+from operator import attrgetter
+
 import numpy as np
 
 from walkerlab.codegen.torque_law import HEAD
@@ -125,41 +127,45 @@ def _lane_entry(v, lane, cache: dict):
     return out
 
 
+#: what a common period reads of each walker (its view, its environment), in C
+_VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
+                   "x", "ledger", "_log", "steps")
+_ENV = attrgetter("_elapsed", "dt", "_hip_x")
+
+
 def _common(envs, views, cache: dict):
     """What a common period reads of the walkers, in one pass, before anything changes:
-    ``(key, entries, xs, caps, stops, origins, t_ends, x_before, w_before)`` (the flow key
-    they share; each walker's lane entry (:func:`_lane_entry`), state, piece's span [s],
-    its end [s], step clock [s], period end [s] (:func:`~walkerlab.gym.batch.begin_periods`'
-    ``k dt``), hip x [m] and positive action work [J] at the period's start); None when the
-    period is not common."""
+    ``(key, entries, read, caps, stops, t_ends, env_read)`` (the flow key they share; each
+    walker's lane entry (:func:`_lane_entry`), what is read of its view (:data:`_VIEW`),
+    its piece's span [s] and end [s], its period's end [s]
+    (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of its
+    environment (:data:`_ENV`)); None when the period is not common."""
     lanes_kept = cache.get("lanes") or {}
     key = None
-    entries, xs, caps, stops, origins, t_ends, x_before, w_before = ([] for _ in range(8))
-    for e, v in zip(envs, views):
-        t_end = (e._elapsed + 1) * e.dt
-        lane = v._lane
-        if (lane is None or lane[0] is not v.walker or lane[1] != v.k or lane[2] != v.leg
-                or v.ended or not v.t < t_end):
+    entries, caps, stops, t_ends = [], [], [], []
+    read = list(map(_VIEW, views))
+    env_read = list(map(_ENV, envs))
+    for r, ((lane, w, k, leg, ended, t, t_step, mst, *_), (elapsed, dt, _)) in enumerate(
+            zip(read, env_read)):
+        t_end = (elapsed + 1) * dt
+        if (lane is None or lane[0] is not w or lane[1] != k or lane[2] != leg or ended
+                or not t < t_end):
             return None
-        en = lanes_kept.get(id(lane)) or _lane_entry(v, lane, cache)
+        en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
         if en[1] is not key:
             if key is not None or en[1] is None:  # (walkers of several flows; a lane the
                 return None  # common period cannot run)
             key = en[1]
         elif key is None:  # (the first walker's lane: one the common period cannot run)
             return None
-        t_stop = v.t_step + v.max_step_time  # (next_piece's end of the piece)
+        t_stop = t_step + mst  # (next_piece's end of the piece)
         if not t_stop < t_end:
             t_stop = t_end
         entries.append(en)
-        xs.append(v.x)
-        caps.append(t_stop - v.t)
+        caps.append(t_stop - t)
         stops.append(t_stop)
-        origins.append(float(getattr(en[3].actuators, "t_origin", 0.0)))
         t_ends.append(t_end)
-        x_before.append(e._hip_x)
-        w_before.append(v.ledger["action_work_positive"])
-    return key, entries, xs, caps, stops, origins, t_ends, x_before, w_before
+    return key, entries, read, caps, stops, t_ends, env_read
 
 
 def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
@@ -193,19 +199,22 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     got = _common(envs, views, cache)
     if got is None:
         return None
-    key, entries, xs, caps, stops, origins, t_ends, x_before, w_before = got
+    key, entries, read, caps, stops, t_ends, env_read = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     N = len(views)
     rows_u = list(U)
-    lanes = []
-    for e, v, en, u, t_end in zip(envs, views, entries, rows_u, t_ends):
-        e._elapsed += 1  # (begin_periods, open_period, next_piece)
+    lanes = [en[0] for en in entries]
+    for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
+                                          env_read):
+        e._elapsed = er[0] + 1  # (begin_periods, open_period, next_piece)
         per = (u, t_end)  # (u a float64 row, t_end a float)
         v._period = per
-        v._log.append(per)
-        lane = en[0]
+        r[10].append(per)
         lane[3].u = u
-        lanes.append(lane)
+    (_, _, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps) = zip(*read)
+    x_before = [er[2] for er in env_read]  # (the reward's origins, before the period)
+    w_before = [led["action_work_positive"] for led in ledgers]
+    origins = [float(getattr(en[3].actuators, "t_origin", 0.0)) for en in entries]
     on = [any(r) for r in U.tolist()]
     some_on = any(on)
     fid = tuple(map(id, entries))
@@ -267,15 +276,17 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
                        maps, Yev, Y, cap, Yn)
     X = list(Yev)
     if not slow:
-        rows = []
-        for v, x, t_stop in zip(views, X, stops):  # RigidView.settle; end_periods' read
-            v.t, v.x = t_stop, x
-            if t_stop >= v.t_step + v.max_step_time:
+        ended = []
+        for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
+            v.t, v.x = t_stop, x  # (RigidView.settle)
+            if t_stop >= t_step + mst:
                 v.ended = "stall"
-            rows.append((x, t_stop, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger))
+                ended.append("stall")
+            else:
+                ended.append("")
         cache["X"] = (Yev, X)
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
-                           Yev, rows)
+                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers))
     for r in settled:  # RigidView.settle
         v, t_stop = views[r], stops[r]
         v.t, v.x = t_stop, X[r]
