@@ -35,8 +35,17 @@ from walkerlab.integrate.rows_dop853 import TIMEOUT
 
 from .action import GL_X
 from .batch import end_periods, held_torques
-from .rigid_rows import (_CFUNCS, _NO_NODES, _absorb_rows, _guard_tables, _held_rows,
-                         _joint_map, _kernel_args, _period_rows, advance_live, advance_rows)
+from .rigid_rows import (
+    _CFUNCS,
+    _NO_NODES,
+    _absorb_rows,
+    _guard_tables,
+    _held_rows,
+    _joint_map,
+    _kernel_args,
+    _period_rows,
+    advance_live,
+)
 from .rigid_view import _CONSTANT_0
 from .small_arrays import all_finite
 
@@ -145,11 +154,11 @@ def _common(envs, views, cache: dict):
     entries, caps, stops, t_ends = [], [], [], []
     read = list(map(_VIEW, views))
     env_read = list(map(_ENV, envs))
-    for r, ((lane, w, k, leg, ended, t, t_step, mst, *_), (elapsed, dt, _)) in enumerate(
-            zip(read, env_read)):
-        t_end = (elapsed + 1) * dt
-        if (lane is None or lane[0] is not w or lane[1] != k or lane[2] != leg or ended
-                or not t < t_end):
+    for r, (got, er) in enumerate(zip(read, env_read)):
+        lane, t = got[0], got[5]
+        t_end = (er[0] + 1) * er[1]
+        if (lane is None or lane[0] is not got[1] or lane[1] != got[2]
+                or lane[2] != got[3] or got[4] or not t < t_end):
             return None
         en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
         if en[1] is not key:
@@ -158,7 +167,7 @@ def _common(envs, views, cache: dict):
             key = en[1]
         elif key is None:  # (the first walker's lane: one the common period cannot run)
             return None
-        t_stop = t_step + mst  # (next_piece's end of the piece)
+        t_stop = got[6] + got[7]  # (next_piece's end of the piece: t_step + max_step_time)
         if not t_stop < t_end:
             t_stop = t_end
         entries.append(en)
@@ -229,7 +238,8 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     gcols, goffs, dirs, ng, gi = data.guards
     m = key[4]
     last = cache.get("X")  # (the last common period's states: the walkers' own rows)
-    if last is not None and all(x is r for x, r in zip(xs, last[1])):
+    if (last is not None and len(last[1]) == N
+            and all(x is r for x, r in zip(xs, last[1]))):
         Y = last[0]
     else:
         Y = np.array(xs, dtype=float)

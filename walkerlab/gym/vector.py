@@ -247,13 +247,20 @@ class WalkerVectorEnv(VectorEnv):
             return {"rows": idx, "dicts": dicts}
         whole = idx.size == self.num_envs
         views = [env.sim for env in envs]
-        # a step of every walker after the first: a common period's batch
-        # (walkerlab.gym.rows_common.step_common), when it is one
-        out = (None if first or not whole
-               else _step_common()(envs, views, actions, p, self._common))
+        if not whole:  # (the stepped walkers' parameters, kept per set of rows)
+            some = p.setdefault("some", {})
+            rows = idx.tobytes()
+            if rows not in some:
+                if len(some) >= 256:
+                    some.clear()
+                some[rows] = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
+            p = some[rows]
+        # a step after the first: a common period's batch (walkerlab.gym.rows_common.
+        # step_common), when it is one
+        out = (None if first
+               else _step_common()(envs, views, actions if whole else actions[idx], p,
+                                   self._common))
         if out is None:
-            if not whole:
-                p = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
             # (begin_periods reads the actions into an array of its own: every row as given)
             U, x_before, w_before, t_ends = begin_periods(
                 envs, actions if whole else actions[idx], p)
