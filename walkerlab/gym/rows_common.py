@@ -10,7 +10,7 @@ every walker is where its last period left it - the same step walker, phase and 
 its compiled phase and flow key known (kept in the walker: ``RigidView._lane``,
 ``row_keys``), all of one flow - so that work is the same every period: here the walkers'
 states, times and caps are read in one pass, the data rows are the flows' rows kept from the
-first such period (:class:`_DataRows`) with this period's torques and step clocks written
+first such period (:func:`_flow_row`) with this period's torques and step clocks written
 as columns over the walkers, and the kernel
 (:func:`walkerlab.integrate.rows_dop853.period_rows`) is called on them; each row's piece is
 then absorbed as :func:`walkerlab.gym.rigid_rows.advance_rows` absorbs it (the same code:
@@ -62,50 +62,34 @@ def _hold(view, fast, u: np.ndarray) -> None:
         view._held = (fast, bits)
 
 
-class _DataRows:
-    """What a common period of the same walkers' flows (one per walker, in order) reads
-    every period, kept: the kernel's data rows (N, size) as
-    :meth:`walkerlab.codegen.actuated.ActuatedFlow.data_rows` writes them, this period's
-    held torques (the law block's constants, each actuator's ``HEAD``-th slot from
-    :data:`~walkerlab.gym.rigid_view._CONSTANT_0`) and step clocks (``t_origin``, the
-    block's third slot) written as columns; the kernel's compiled functions, tolerances and
-    guard tables.  The first period writes the law blocks and compares these rows with
-    ``data_rows``' bit for bit; rows that differ (a flow of another layout) are then
-    ``data_rows``' every period."""
-
-    def __init__(self, flows: list, k: int, key: tuple, fphase, guards: list):
-        self.flows = tuple(flows)  # (kept: their ids key this entry)
-        nc = flows[0].constants().size
-        self.base = np.empty((len(flows), flows[0].data_size()))
-        flows[0].data_rows(flows, self.base)
-        first = nc + _CONSTANT_0
-        self.u_cols = slice(first, first + HEAD * k, HEAD)
-        self.t_col = nc + 2
-        self.origins = self.base[:, self.t_col].tolist()
-        self.checked = False  # (the first period compares; False after: data_rows')
-        self.same = True
-        self.kernel = _CFUNCS.get(key) or _kernel_args(key, fphase)
-        self.guards = _guard_tables(guards)
-
-    def rows(self, views, lanes: list, U: np.ndarray, origins: list) -> np.ndarray:
-        """The data rows of this period's torques ``U`` (N, k) [N m] and step clocks
-        ``origins`` (N) [s]."""
-        if self.checked and self.same:
-            D = self.base.copy()
-            D[:, self.u_cols] = U
-            if origins != self.origins:
-                D[:, self.t_col] = origins
-            return D
-        for v, lane, u in zip(views, lanes, U):  # the law blocks written, as next_piece
-            _hold(v, lane[6], u)
-        D = np.empty_like(self.base)
-        self.flows[0].data_rows(list(self.flows), D)
-        if not self.checked:
-            mine = self.base.copy()
-            mine[:, self.u_cols] = U
-            mine[:, self.t_col] = origins
-            self.checked, self.same = True, mine.tobytes() == D.tobytes()
-        return D
+def _flow_row(flow, acts) -> tuple:
+    """``(row, u_cols, t_col, same)``: the kernel's data row (1, size) of a walker's
+    compiled flow as :meth:`walkerlab.codegen.actuated.ActuatedFlow.data_rows` writes it
+    (its constants, its law block, its step clock), where the held torques of ``acts``
+    go (the law block's constants: each actuator's ``HEAD``-th slot from
+    :data:`~walkerlab.gym.rigid_view._CONSTANT_0`, as columns ``u_cols``) and its step
+    clock (``t_origin``, the block's third slot: column ``t_col``); ``same``: a torque
+    written into the law block (as :meth:`~walkerlab.gym.rigid_view.RigidView.next_piece`
+    writes it) gives ``data_rows``' row bit for bit as the row with the torque written
+    into its columns (checked once, the law block put back as it was; False: a flow of
+    another layout, whose rows are ``data_rows``' every period)."""
+    nc = flow.constants().size
+    row = np.empty((1, flow.data_size()))
+    flow.data_rows([flow], row)
+    k = acts.u.size
+    u_cols = slice(nc + _CONSTANT_0, nc + _CONSTANT_0 + HEAD * k, HEAD)
+    t_col = nc + 2
+    laws = flow.laws
+    kept = laws.copy()
+    test = 0.5 + np.arange(k, dtype=float)
+    laws[_CONSTANT_0:_CONSTANT_0 + HEAD * k:HEAD] = test
+    ref = np.empty_like(row)
+    flow.data_rows([flow], ref)
+    laws[:] = kept
+    mine = row.copy()
+    mine[:, u_cols] = test
+    mine[:, t_col] = float(getattr(flow.actuators, "t_origin", 0.0))
+    return row, u_cols, t_col, mine.tobytes() == ref.tobytes()
 
 
 #: most entries of a vector env's caches (:func:`advance_common`'s ``cache``; cleared when
@@ -131,7 +115,7 @@ def _lane_entry(v, lane, cache: dict):
         flow = fast[0].compiled
         if kg is not None and hasattr(flow, "data_rows"):
             keys = cache.setdefault("keys", {})
-            out = (lane, keys.setdefault(kg[0], kg[0]), kg[1], flow)
+            out = (lane, keys.setdefault(kg[0], kg[0]), kg[1], flow, _flow_row(flow, lane[3]))
     lanes[id(lane)] = out
     return out
 
@@ -227,15 +211,30 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     on = [any(r) for r in U.tolist()]
     some_on = any(on)
     fid = tuple(map(id, entries))
-    data = cache.get(fid)
-    if data is None:
+    rows = cache.get(fid)
+    if rows is None:  # (the walkers' rows stacked, their clocks, the kernel's arguments)
         if len(cache) >= KEPT:
             cache.clear()
-        data = cache[fid] = _DataRows([en[3] for en in entries], U.shape[1], key,
-                                      lanes[0][6][0], [en[2] for en in entries])
-    D = data.rows(views, lanes, U, origins)
-    f, fs, fg, sel, rtol, atol, n_out = data.kernel
-    gcols, goffs, dirs, ng, gi = data.guards
+        t_col = entries[0][4][2]
+        rows = cache[fid] = (
+            np.concatenate([en[4][0] for en in entries]),
+            [float(en[4][0][0, t_col]) for en in entries],
+            all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
+            _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
+            _guard_tables([en[2] for en in entries]))
+    base, clocks, same, kernel, guard_tables = rows
+    if same:
+        D = base.copy()
+        D[:, entries[0][4][1]] = U
+        if origins != clocks:
+            D[:, entries[0][4][2]] = origins
+    else:  # (the law blocks written, as next_piece writes them, and read back)
+        for v, lane, u in zip(views, lanes, rows_u):
+            _hold(v, lane[6], u)
+        D = np.empty_like(base)
+        entries[0][3].data_rows([en[3] for en in entries], D)
+    f, fs, fg, sel, rtol, atol, n_out = kernel
+    gcols, goffs, dirs, ng, gi = guard_tables
     m = key[4]
     last = cache.get("X")  # (the last common period's states: the walkers' own rows)
     if (last is not None and len(last[1]) == N
@@ -309,10 +308,10 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         if r in slow:
             _hold(v, lane[6], u)
         pieces.append((lane[0], lane[3], a, lane[4], t_stop, lane[6]))
-    rows = list(range(N))
+    idx = list(range(N))
     call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
     strikes: list[list[float]] = [[] for _ in views]
-    _absorb_rows(views, rows, pieces, (which, te, Yev, Y, cap, Yn, call), strikes,
+    _absorb_rows(views, idx, pieces, (which, te, Yev, Y, cap, Yn, call), strikes,
                  set(slow))
     live = [i for i in slow if views[i].t < t_ends[i] and not views[i].ended]
     if live:
