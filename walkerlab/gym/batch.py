@@ -141,7 +141,7 @@ def _neg_tau(p: dict) -> np.ndarray:
 
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
                 p: dict, views=None, X: np.ndarray | None = None,
-                cols: tuple | None = None) -> tuple:
+                cols: tuple | None = None, hips: list | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -165,6 +165,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     cols : tuple, optional
         What is read of the walkers (below: states, times, stance legs, phases, steps'
         starts, ends, steps, ledgers, each a sequence of N), when the caller has read it.
+    hips : list of float, optional
+        The hips' world x [m] (:func:`hip_xs`' numbers), when the caller has them.
 
     Returns
     -------
@@ -197,8 +199,11 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
                   zip(legs, ks, ts, t_steps)]
     _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
-    hip = hip_xs(views, X)
-    hips = hip.tolist()
+    if hips is None:
+        hip = hip_xs(views, X)
+        hips = hip.tolist()
+    else:
+        hip = None  # (made of hips when the infos are)
     elapsed = []
     for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
@@ -236,7 +241,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
                "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
                "steps": [int(s) for s in steps],
-               "stance_leg": list(legs), "hip_x_m": hip,
+               "stance_leg": list(legs),
+               "hip_x_m": np.array(hips, dtype=np.float64) if hip is None else hip,
                "termination": list(ended),
                "solver_message": [str(m) for m in messages],
                "terrain_seed": [int(s) for s in seeds]}

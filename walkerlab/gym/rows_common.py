@@ -34,7 +34,7 @@ from walkerlab.codegen.torque_law import HEAD
 from walkerlab.integrate.rows_dop853 import TIMEOUT
 
 from .action import GL_X
-from .batch import end_periods, held_torques
+from .batch import _hips, end_periods, held_torques
 from .rigid_rows import (
     _CFUNCS,
     _NO_NODES,
@@ -115,14 +115,18 @@ def _lane_entry(v, lane, cache: dict):
         flow = fast[0].compiled
         if kg is not None and hasattr(flow, "data_rows"):
             keys = cache.setdefault("keys", {})
-            out = (lane, keys.setdefault(kg[0], kg[0]), kg[1], flow, _flow_row(flow, lane[3]))
+            flows = cache.setdefault("flows", {})  # (a flow's row, once: the flow kept)
+            row = flows.get(id(flow))
+            if row is None:
+                row = flows[id(flow)] = (flow, _flow_row(flow, lane[3]))
+            out = (lane, keys.setdefault(kg[0], kg[0]), kg[1], flow, row[1])
     lanes[id(lane)] = out
     return out
 
 
 #: what a common period reads of each walker (its view, its environment), in C
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
-                   "x", "ledger", "_log", "steps")
+                   "x", "ledger", "_log", "steps", "foot")
 _ENV = attrgetter("_elapsed", "dt", "_hip_x")
 
 
@@ -204,7 +208,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         v._period = per
         r[10].append(per)
         lane[3].u = u
-    (_, _, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps) = zip(*read)
+    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
     x_before = [er[2] for er in env_read]  # (the reward's origins, before the period)
     w_before = [led["action_work_positive"] for led in ledgers]
     origins = [float(getattr(en[3].actuators, "t_origin", 0.0)) for en in entries]
@@ -221,8 +225,9 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
             [float(en[4][0][0, t_col]) for en in entries],
             all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
-            _guard_tables([en[2] for en in entries]))
-    base, clocks, same, kernel, guard_tables = rows
+            _guard_tables([en[2] for en in entries]),
+            all(w.points is walkers[0].points for w in walkers))
+    base, clocks, same, kernel, guard_tables, one_points = rows
     if same:
         D = base.copy()
         D[:, entries[0][4][1]] = U
@@ -294,8 +299,13 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
             else:
                 ended.append("")
         cache["X"] = (Yev, X)
+        # the hips' x: one call of the walkers' one points function on the states as
+        # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
+        hx = _hips(walkers[0], Yev) if one_points else None
+        hips = (None if hx is None
+                else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
-                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers))
+                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips)
     for r in settled:  # RigidView.settle
         v, t_stop = views[r], stops[r]
         v.t, v.x = t_stop, X[r]

@@ -172,6 +172,8 @@ class WalkerVectorEnv(VectorEnv):
         self._every.flags.writeable = False
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
+        #: at least the largest of ``_elapsed`` (a reset only lowers a count)
+        self._most = 0
         #: every row and sub-environment (a step of all of them)
         self._all = (np.arange(n), list(self.envs))
         self._has_reset = False
@@ -181,6 +183,13 @@ class WalkerVectorEnv(VectorEnv):
         #: what a common period of the walkers reads, kept (:func:`walkerlab.gym.
         #: rows_common.step_common`)
         self._common: dict = {}
+
+    def __getstate__(self) -> dict:
+        """Its attributes for a copy or a pickle, without what its common periods keep of
+        its walkers (by their objects' ids: the copy's walkers are its own)."""
+        state = self.__dict__.copy()
+        state["_common"] = {}
+        return state
 
     # ------------------------------------------------------------------ the physics
     def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
@@ -423,12 +432,15 @@ class WalkerVectorEnv(VectorEnv):
                    if not some_reset or stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
+            self._most += 1  # (a bound on the counts: none can be at the limit below it)
             if some_reset:
                 self._elapsed[stepping] += 1
                 self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
             else:  # (every walker stepped)
                 self._elapsed += 1
-                self._truncations |= self._elapsed >= self.max_episode_steps
+                if self._most >= self.max_episode_steps:
+                    self._truncations |= self._elapsed >= self.max_episode_steps
+                    self._most = int(self._elapsed.max())
         resets: dict = {}
         for i in np.flatnonzero(resetting).tolist() if some_reset else ():  # NEXT_STEP: the
             resets[i] = self._reset_one(i, None, None)  # reset is the outcome
