@@ -758,7 +758,7 @@ def test_one_environment_is_the_vector_environment_with_one_walker_bit_for_bit(s
 @pytest.mark.parametrize("policy, action_scale", [("scene", 0.3), (None, 1.0)])
 def test_native_vector_env_of_8_walkers_is_8_single_envs_bit_for_bit(policy, action_scale):
     """The native vector env's batched step (the common period's batch arrays,
-    :func:`walkerlab.gym.rows_common.advance_common`, and the array step around it) against
+    :func:`walkerlab.gym.rows_common.step_common`, and the array step around it) against
     8 ``gym.make`` environments seeded ``s + i`` and stepped with the same actions, each
     reset on the step after its episode's end (gymnasium's NEXT_STEP): over 200 periods
     (the scene's controller walking through heel strikes, or random pushes without it: falls;

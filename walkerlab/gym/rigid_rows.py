@@ -426,7 +426,7 @@ def advance_live(views, actions, t_ends, live: list, strikes: list) -> None:
     """:func:`advance_rows`' pieces of the walkers ``live`` (indices into ``views``,
     their periods opened), each walker's heel-strike times added to ``strikes[i]``, until
     every one reached its period's end or its episode's (the native vector env's common
-    step, :func:`walkerlab.gym.rows_common.advance_common`, goes on here after its first
+    step, :func:`walkerlab.gym.rows_common.step_common`, goes on here after its first
     pieces)."""
     while live:
         groups: dict = {}

@@ -1,27 +1,34 @@
-"""The native vector environment's common control period: every walker in a compiled phase
-of one flow, its first pieces integrated as one batch read from arrays over the walkers
-(:class:`walkerlab.gym.vector.WalkerVectorEnv`'s physics; :func:`advance_common`).
+"""The native vector environment's common control period, from the actions to the step's
+outputs in one pass over the walkers (:class:`walkerlab.gym.vector.WalkerVectorEnv`'s
+physics: :func:`step_common`).
 
 :func:`walkerlab.gym.rigid_rows.advance_rows` advances any set of walkers piece by piece,
 asking each walker for its piece (:meth:`~walkerlab.gym.rigid_view.RigidView.next_piece`),
 grouping the pieces by flow, writing each walker's held torques into its law block and
-reading the law blocks back into the kernel's data rows.  In a vector env's common period
-every walker is where its last period left it - the same step walker, phase and stance leg,
-its compiled phase and flow key known (kept in the walker: ``RigidView._lane``,
-``row_keys``), all of one flow - so that work is the same every period: here the walkers'
-states, times and caps are read in one pass, the data rows are the flows' rows kept from the
-first such period (:func:`_flow_row`) with this period's torques and step clocks written
-as columns over the walkers, and the kernel
-(:func:`walkerlab.integrate.rows_dop853.period_rows`) is called on them; each row's piece is
-then absorbed as :func:`walkerlab.gym.rigid_rows.advance_rows` absorbs it (the same code:
-the ledger of the rows that reached the period's end at once, a guard crossing or a failed
-step by its walker), and a walker whose period goes on (a heel strike inside it) goes on
-through :func:`walkerlab.gym.rigid_rows.advance_live`.  The same kernel on the same rows,
-states, data and caps, so the same numbers bit for bit as each walker's own period
-(``gym.make``'s environment is :func:`~walkerlab.gym.rigid_rows.advance_rows` on one
-walker); a period that is not common (a walker in a new step or phase, a height profile, a
-fall guard checked at a phase's entry, walkers of several flows) is
-:func:`~walkerlab.gym.rigid_rows.advance_rows`' own.
+reading the law blocks back into the kernel's data rows, around
+:func:`~walkerlab.gym.batch.begin_periods` and :func:`~walkerlab.gym.batch.end_periods`, which
+read the walkers again.  In a common period every walker is where its last period left it -
+the same step walker, phase and stance leg, its compiled phase and flow key known (kept in
+the walker: ``RigidView._lane``, ``row_keys``), all of one flow - so that work is the same
+every period.  Here the walkers are read once (``operator.attrgetter``, one C call per
+walker), the kernel's data rows are each walker's flow's row made once
+(:func:`_flow_row`, checked against ``data_rows``) stacked per set of lanes with this
+period's torques and step clocks written as columns, the states are the last common
+period's array when the walkers still hold its rows, and the kernel
+(:func:`walkerlab.integrate.rows_dop853.period_rows`) is called on them; the rows that
+reached their piece's end are settled at once (their ledger by
+:func:`~walkerlab.gym.rigid_rows._held_rows`, as the walker's own), the others (a guard
+crossing, a failed step) absorbed by their walkers as
+:func:`~walkerlab.gym.rigid_rows.advance_rows` absorbs them, their periods going on through
+:func:`~walkerlab.gym.rigid_rows.advance_live`; the outputs are
+:func:`~walkerlab.gym.batch.end_periods`' of what was read.  The same kernel on the same
+rows, states, data and caps, and the same element-wise operations, so the same numbers bit
+for bit as each walker's own period (``gym.make``'s environment is
+:func:`~walkerlab.gym.rigid_rows.advance_rows` on one walker).  A period that is not common
+(a walker in a new step or phase, one whose episode ended, a height profile, a fall guard
+checked at a phase's entry, walkers of several flows) is left to the general step, nothing
+changed.  Nothing here knows a walker's size: the states' width is the flow key's, the
+torques' the action's.
 """
 
 from __future__ import annotations
@@ -92,7 +99,7 @@ def _flow_row(flow, acts) -> tuple:
     return row, u_cols, t_col, mine.tobytes() == ref.tobytes()
 
 
-#: most entries of a vector env's caches (:func:`advance_common`'s ``cache``; cleared when
+#: most entries of a vector env's caches (:func:`step_common`'s ``cache``; cleared when
 #: full)
 KEPT = 256
 
