@@ -8,6 +8,8 @@ of them at once: :func:`hip_xs`) - the same element-wise operations as each
 
 from __future__ import annotations
 
+from operator import attrgetter
+
 import numpy as np
 
 __all__ = ["batch_parameters", "begin_periods", "end_periods", "held_torques", "hip_xs"]
@@ -139,9 +141,14 @@ def _neg_tau(p: dict) -> np.ndarray:
     return neg
 
 
+#: what :func:`end_periods` reads of each environment
+_ENV_READ = attrgetter("_elapsed", "terrain_seed")
+
+
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
                 p: dict, views=None, X: np.ndarray | None = None,
-                cols: tuple | None = None, hips: list | None = None) -> tuple:
+                cols: tuple | None = None, hips: list | None = None,
+                fixed: np.ndarray | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -167,6 +174,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         starts, ends, steps, ledgers, each a sequence of N), when the caller has read it.
     hips : list of float, optional
         The hips' world x [m] (:func:`hip_xs`' numbers), when the caller has them.
+    fixed : ndarray (N, 2), optional
+        The observations' stance-leg and phase columns (leg1's stance as 1.0, the phase's
+        index), when the caller has them.
 
     Returns
     -------
@@ -196,18 +206,21 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     m = X.shape[1]
     obs = np.empty((len(views), m + 3))
     obs[:, :m] = X
-    obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
-                  zip(legs, ks, ts, t_steps)]
+    if fixed is None:
+        obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
+                      zip(legs, ks, ts, t_steps)]
+    else:
+        obs[:, m:m + 2] = fixed
+        obs[:, m + 2] = [tv - ts0 for tv, ts0 in zip(ts, t_steps)]
     _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
     if hips is None:
         hip = hip_xs(views, X)
         hips = hip.tolist()
     else:
         hip = None  # (made of hips when the infos are)
-    elapsed = []
     for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
-        elapsed.append(e._elapsed)
+    elapsed, seeds = zip(*map(_ENV_READ, envs))  # (each environment's count and seed)
     terminated = [s != "" for s in ended]
     fws, healthy, cws, wws, dts, limits = _lists(p)
     truncated = [not te and lim >= 0 and el >= lim
@@ -232,7 +245,6 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     messages = ([v.__dict__.get("failure", "") for v in views]
                 if not any(map(_class_failure, set(map(type, views))))
                 else [getattr(v, "failure", "") for v in views])
-    seeds = [e.terrain_seed for e in envs]
 
     def columns() -> dict:  # (of the values read above, whenever called)
         L = np.array(sums, dtype=np.float64).T.copy()

@@ -44,6 +44,7 @@ from .action import GL_X
 from .batch import _hips, end_periods, held_torques
 from .rigid_rows import (
     _CFUNCS,
+    _ENTRY,
     _NO_NODES,
     _absorb_rows,
     _guard_tables,
@@ -233,8 +234,10 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
             all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
             _guard_tables([en[2] for en in entries]),
-            all(w.points is walkers[0].points for w in walkers))
-    base, clocks, same, kernel, guard_tables, one_points = rows
+            all(w.points is walkers[0].points for w in walkers),
+            # (the observations' stance-leg and phase columns: the lanes')
+            np.array([(1.0 if lane[2] == "leg1" else 0.0, lane[1]) for lane in lanes]))
+    base, clocks, same, kernel, guard_tables, one_points, fixed = rows
     if same:
         D = base.copy()
         D[:, entries[0][4][1]] = U
@@ -267,8 +270,13 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     else:
         Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
             (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
-    _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
-                       n_out, which, te, Yev, np.zeros(N), Tn, Yn))
+    args = (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol, n_out, which,
+            te, Yev, np.zeros(N), Tn, Yn)
+    entry = _ENTRY.get(key)  # (the kernel's compiled entry for these types, once chosen)
+    if entry is None:
+        _period_rows(key, args)
+    else:
+        entry(*args)
     ends = which.tolist()
     finite = ([True] * N if all_finite(Yev) else np.isfinite(Yev).all(axis=1).tolist())
     # the rows that reached their piece's end, each settled there as _absorb_rows settles
@@ -312,7 +320,8 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         hips = (None if hx is None
                 else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
-                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips)
+                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
+                           fixed)
     for r in settled:  # RigidView.settle
         v, t_stop = views[r], stops[r]
         v.t, v.x = t_stop, X[r]
