@@ -141,6 +141,23 @@ def _neg_tau(p: dict) -> np.ndarray:
     return neg
 
 
+def _observations(X: np.ndarray, ts, legs, ks, t_steps, p: dict, fixed=None) -> np.ndarray:
+    """The observations (N, m + 3) of the states ``X`` (N, m): each state, then leg1's
+    stance as 1.0, the phase's index as a float and the time in the step [s] (``ts``
+    minus ``t_steps``; the float64 of each; the first two ``fixed`` (N, 2) when given),
+    clipped to :func:`batch_parameters`' bounds."""
+    m = X.shape[1]
+    obs = np.empty((X.shape[0], m + 3))
+    obs[:, :m] = X
+    if fixed is None:
+        obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
+                      zip(legs, ks, ts, t_steps)]
+    else:
+        obs[:, m:m + 2] = fixed
+        obs[:, m + 2] = [tv - ts0 for tv, ts0 in zip(ts, t_steps)]
+    return _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
+
+
 #: what :func:`end_periods` reads of each environment
 _ENV_READ = attrgetter("_elapsed", "terrain_seed")
 
@@ -201,18 +218,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     xs, ts, legs, ks, t_steps, ended, steps, ledgers = cols  # (sequences)
     if X is None:
         X = np.array(xs)
-    # (leg1's stance as 1.0, the phase's index as a float, the time in the step: the
-    # float64 of each, side by side with the states)
-    m = X.shape[1]
-    obs = np.empty((len(views), m + 3))
-    obs[:, :m] = X
-    if fixed is None:
-        obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
-                      zip(legs, ks, ts, t_steps)]
-    else:
-        obs[:, m:m + 2] = fixed
-        obs[:, m + 2] = [tv - ts0 for tv, ts0 in zip(ts, t_steps)]
-    _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
+    obs = _observations(X, ts, legs, ks, t_steps, p, fixed)
     if hips is None:
         hip = hip_xs(views, X)
         hips = hip.tolist()

@@ -206,7 +206,6 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         return None
     key, entries, read, caps, stops, t_ends, env_read = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
-    N = len(views)
     rows_u = list(U)
     lanes = [en[0] for en in entries]
     for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
@@ -219,25 +218,92 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
     x_before = [er[2] for er in env_read]  # (the reward's origins, before the period)
     w_before = [led["action_work_positive"] for led in ledgers]
-    origins = [float(getattr(en[3].actuators, "t_origin", 0.0)) for en in entries]
     on = [any(r) for r in U.tolist()]
-    some_on = any(on)
+    batch = _batch(cache, key, entries, lanes, walkers)
+    out = _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache)
+    which, te, Yev, Y, cap, Yn, call = out
+    settled, slow = _settle_rows(views, lanes, on, which.tolist(), Yev, Y, cap, Yn)
+    X = list(Yev)
+    if not slow:
+        ended = []
+        for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
+            v.t, v.x = t_stop, x  # (RigidView.settle)
+            if t_stop >= t_step + mst:
+                v.ended = "stall"
+                ended.append("stall")
+            else:
+                ended.append("")
+        cache["X"] = (Yev, X)
+        # the hips' x: one call of the walkers' one points function on the states as
+        # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
+        hx = _hips(walkers[0], Yev) if batch[5] else None
+        hips = (None if hx is None
+                else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
+        return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
+                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
+                           batch[6])
+    strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
+    cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
+    return end_periods(envs, U, strikes, x_before, w_before, p, views)
+
+
+def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out) -> list:
+    """The walkers ``settled`` settled at their pieces' ends ``stops`` [s] in the states
+    ``X`` (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`), the rows ``slow`` absorbed
+    by their walkers (:func:`~walkerlab.gym.rigid_rows._absorb_rows` of the kernel's
+    ``out``) and their periods gone on (:func:`~walkerlab.gym.rigid_rows.advance_live`);
+    returns each walker's heel-strike times [s]."""
+    for r in settled:  # RigidView.settle
+        v, t_stop = views[r], stops[r]
+        v.t, v.x = t_stop, X[r]
+        if t_stop >= v.t_step + v.max_step_time:
+            v.ended = "stall"
+    # a walker's own absorbing may integrate its piece again with its own flow, whose law
+    # block then holds the torques (as next_piece leaves it)
+    pieces = []
+    for r, (v, lane, u, a, t_stop) in enumerate(zip(views, lanes, rows_u, on, stops)):
+        if r in slow:
+            _hold(v, lane[6], u)
+        pieces.append((lane[0], lane[3], a, lane[4], t_stop, lane[6]))
+    strikes: list[list[float]] = [[] for _ in views]
+    _absorb_rows(views, list(range(len(views))), pieces, out, strikes, set(slow))
+    live = [i for i in slow if views[i].t < t_ends[i] and not views[i].ended]
+    if live:
+        advance_live(views, rows_u, t_ends, live, strikes)
+    return strikes
+
+def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers) -> tuple:
+    """What a common period of these lanes reads every period, made once and kept by the
+    lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed)`` - the
+    walkers' data rows stacked (:func:`_flow_row`) and their step clocks, whether each row
+    takes its torques and clock as columns, the kernel's compiled functions and tolerances,
+    its guard tables, whether the walkers share one ``points`` function, and the
+    observations' stance-leg and phase columns (N, 2)."""
     fid = tuple(map(id, entries))
-    rows = cache.get(fid)
-    if rows is None:  # (the walkers' rows stacked, their clocks, the kernel's arguments)
+    out = cache.get(fid)
+    if out is None:
         if len(cache) >= KEPT:
             cache.clear()
         t_col = entries[0][4][2]
-        rows = cache[fid] = (
+        out = cache[fid] = (
             np.concatenate([en[4][0] for en in entries]),
             [float(en[4][0][0, t_col]) for en in entries],
             all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
             _guard_tables([en[2] for en in entries]),
             all(w.points is walkers[0].points for w in walkers),
-            # (the observations' stance-leg and phase columns: the lanes')
             np.array([(1.0 if lane[2] == "leg1" else 0.0, lane[1]) for lane in lanes]))
-    base, clocks, same, kernel, guard_tables, one_points, fixed = rows
+    return out
+
+
+def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache) -> tuple:
+    """The kernel on every walker's piece: ``(which, te, Yev, Y, cap, Yn, call)`` as
+    :func:`walkerlab.gym.rigid_rows._integrate_rows` gives them (its arguments the same:
+    the data rows with this period's torques and clocks, the start states - the last
+    common period's array when the walkers hold its rows -, the caps [s], the
+    Gauss-Legendre nodes of the rows with the action on)."""
+    base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi), _, _ = batch
+    origins = [float(getattr(en[3].actuators, "t_origin", 0.0)) for en in entries]
     if same:
         D = base.copy()
         D[:, entries[0][4][1]] = U
@@ -249,8 +315,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         D = np.empty_like(base)
         entries[0][3].data_rows([en[3] for en in entries], D)
     f, fs, fg, sel, rtol, atol, n_out = kernel
-    gcols, goffs, dirs, ng, gi = guard_tables
-    m = key[4]
+    N, m = len(views), key[4]
     last = cache.get("X")  # (the last common period's states: the walkers' own rows)
     if (last is not None and len(last[1]) == N
             and all(x is r for x, r in zip(xs, last[1]))):
@@ -261,7 +326,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     which = np.empty(N, np.int64)
     te = np.empty(N)
     Yev = np.empty((N, m))
-    if some_on:  # the Gauss-Legendre nodes of the rows with the action on (_integrate_rows)
+    if any(on):  # the Gauss-Legendre nodes of the rows with the action on (_integrate_rows)
         half = 0.5 * cap[:, None]
         Tn = half * GL_X + half
         if not all(on):
@@ -277,70 +342,35 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         _period_rows(key, args)
     else:
         entry(*args)
-    ends = which.tolist()
+    call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
+    return which, te, Yev, Y, cap, Yn, call
+
+
+def _settle_rows(views, lanes, on, ends, Yev, Y, cap, Yn) -> tuple:
+    """``(settled, slow)``: the rows that reached their piece's end, each to be settled
+    there as :func:`~walkerlab.gym.rigid_rows._absorb_rows` settles it (the ledger of those
+    with the action on taken here at once: :func:`~walkerlab.gym.rigid_rows._held_rows`),
+    and the others (a guard crossing, a failed step, a state not finite, the ledger on the
+    dense output), to be absorbed by their walkers."""
+    N = len(views)
     finite = ([True] * N if all_finite(Yev) else np.isfinite(Yev).all(axis=1).tolist())
-    # the rows that reached their piece's end, each settled there as _absorb_rows settles
-    # it (the ledger of those with the action on at once: _held_rows); the others (a
-    # guard crossing, a failed step, a state not finite, the ledger on the dense output)
-    # absorbed by their walkers
-    if min(ends) == TIMEOUT == max(ends) and not some_on and all(finite):
-        settled, slow = range(N), []
-    else:
-        settled, slow, held, maps = [], [], [], []
-        for r in range(N):
-            if ends[r] != TIMEOUT or not finite[r]:
+    if min(ends) == TIMEOUT == max(ends) and not any(on) and all(finite):
+        return range(N), []
+    settled, slow, held, maps = [], [], [], []
+    for r in range(N):
+        if ends[r] != TIMEOUT or not finite[r]:
+            slow.append(r)
+        elif on[r]:
+            M = _joint_map(views[r], lanes[r][3])
+            if M is None:
                 slow.append(r)
-            elif on[r]:
-                M = _joint_map(views[r], lanes[r][3])
-                if M is None:
-                    slow.append(r)
-                else:
-                    settled.append(r)
-                    held.append(r)
-                    maps.append(M)
             else:
                 settled.append(r)
-        if held:
-            _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes], held,
-                       maps, Yev, Y, cap, Yn)
-    X = list(Yev)
-    if not slow:
-        ended = []
-        for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
-            v.t, v.x = t_stop, x  # (RigidView.settle)
-            if t_stop >= t_step + mst:
-                v.ended = "stall"
-                ended.append("stall")
-            else:
-                ended.append("")
-        cache["X"] = (Yev, X)
-        # the hips' x: one call of the walkers' one points function on the states as
-        # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
-        hx = _hips(walkers[0], Yev) if one_points else None
-        hips = (None if hx is None
-                else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
-        return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
-                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
-                           fixed)
-    for r in settled:  # RigidView.settle
-        v, t_stop = views[r], stops[r]
-        v.t, v.x = t_stop, X[r]
-        if t_stop >= v.t_step + v.max_step_time:
-            v.ended = "stall"
-    # a walker's own absorbing may integrate its piece again with its own flow, whose law
-    # block then holds the torques (as next_piece leaves it)
-    pieces = []
-    for r, (v, lane, u, a, t_stop) in enumerate(zip(views, lanes, rows_u, on, stops)):
-        if r in slow:
-            _hold(v, lane[6], u)
-        pieces.append((lane[0], lane[3], a, lane[4], t_stop, lane[6]))
-    idx = list(range(N))
-    call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
-    strikes: list[list[float]] = [[] for _ in views]
-    _absorb_rows(views, idx, pieces, (which, te, Yev, Y, cap, Yn, call), strikes,
-                 set(slow))
-    live = [i for i in slow if views[i].t < t_ends[i] and not views[i].ended]
-    if live:
-        advance_live(views, rows_u, t_ends, live, strikes)
-    cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
-    return end_periods(envs, U, strikes, x_before, w_before, p, views)
+                held.append(r)
+                maps.append(M)
+        else:
+            settled.append(r)
+    if held:
+        _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes], held, maps,
+                   Yev, Y, cap, Yn)
+    return settled, slow
