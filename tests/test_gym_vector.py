@@ -753,3 +753,44 @@ def test_one_environment_is_the_vector_environment_with_one_walker_bit_for_bit(s
     assert strikes > 1 and (term or trunc)
     single.close()
     native.close()
+
+
+@pytest.mark.parametrize("policy, action_scale", [("scene", 0.3), (None, 1.0)])
+def test_native_vector_env_of_8_walkers_is_8_single_envs_bit_for_bit(policy, action_scale):
+    """The native vector env's batched step (the common period's batch arrays,
+    :func:`walkerlab.gym.rows_common.step_common`, and the array step around it) against
+    8 ``gym.make`` environments seeded ``s + i`` and stepped with the same actions, each
+    reset on the step after its episode's end (gymnasium's NEXT_STEP): over 200 periods
+    (the scene's controller walking through heel strikes, or random pushes without it: falls;
+    the time limit and resets on the way) the observations and rewards are equal with
+    ``==``, and the flags and heel strikes exactly."""
+    import walkerlab.gym  # noqa: F401 - registers walkerlab/Walker-v0
+
+    n, steps = 8, 200
+    kw = dict(start_noise=0.05, max_episode_steps=60, policy=policy)
+    native = _native(n, "threelink_hzd", **kw)
+    singles = [gym.make(ID, scene=_scene("threelink_hzd"), **kw) for _ in range(n)]
+    actions = action_scale * _random_actions(native, steps, seed=5)
+    vobs, _ = native.reset(seed=11)
+    for i, env in enumerate(singles):
+        obs, _ = env.reset(seed=11 + i)
+        assert (obs == vobs[i]).all()
+    ended = [False] * n
+    strikes = ends = 0
+    for a in actions:
+        vobs, vr, vterm, vtrunc, vinfo = native.step(a)
+        for i, env in enumerate(singles):
+            if ended[i]:
+                obs, r, term, trunc, hs = (*env.reset()[:1], 0.0, False, False, False)
+            else:
+                obs, r, term, trunc, info = env.step(a[i])
+                hs = info["heel_strike"]
+            assert (obs == vobs[i]).all() and r == vr[i], i
+            assert (term, trunc, hs) == (vterm[i], vtrunc[i], vinfo["heel_strike"][i]), i
+            ended[i] = term or trunc
+            strikes += hs
+            ends += term or trunc
+    assert ends > 8 and strikes > (8 if policy else 0)  # episode ends, heel strikes
+    native.close()
+    for env in singles:
+        env.close()

@@ -8,9 +8,11 @@ of them at once: :func:`hip_xs`) - the same element-wise operations as each
 
 from __future__ import annotations
 
+from operator import attrgetter
+
 import numpy as np
 
-__all__ = ["batch_parameters", "begin_periods", "end_periods", "hip_xs"]
+__all__ = ["batch_parameters", "begin_periods", "end_periods", "held_torques", "hip_xs"]
 
 
 def batch_parameters(envs) -> dict | None:
@@ -94,6 +96,20 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     t_ends : list of float
         Each period's end [s].
     """
+    U = held_torques(envs, actions, p)
+    x_before, w_before, t_ends = [], [], []
+    for e in envs:
+        x_before.append(e._hip_x)
+        w_before.append(e.sim.ledger["action_work_positive"])
+        e._elapsed = k = e._elapsed + 1
+        t_ends.append(k * e.dt)
+    return U, x_before, w_before, t_ends
+
+
+def held_torques(envs, actions: np.ndarray, p: dict) -> np.ndarray:
+    """The held torques (N, k) [N m] of ``actions`` (N, k) (:func:`begin_periods`' first
+    half: scaled, the scene policy's added at the walkers' present states, clipped; a new
+    array)."""
     norm = p["normalize"]
     every, some, policy = _flags(p)
     tau = p["tau"]
@@ -109,14 +125,7 @@ def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
             s = e.sim
             a[r] = a[r] + e._controller_torques(s.x, s.leg == "leg1")
     # (np.clip's own ufunc, into the new array a: ndarray.clip(-tau, tau)'s numbers)
-    U = _CLIP(a, _neg_tau(p), tau, out=a)
-    x_before, w_before, t_ends = [], [], []
-    for e in envs:
-        x_before.append(e._hip_x)
-        w_before.append(e.sim.ledger["action_work_positive"])
-        e._elapsed = k = e._elapsed + 1
-        t_ends.append(k * e.dt)
-    return U, x_before, w_before, t_ends
+    return _CLIP(a, _neg_tau(p), tau, out=a)
 
 
 #: the ufunc ``ndarray.clip(lo, hi)`` calls (numpy's ``_methods._clip``: ``umath.clip``),
@@ -132,8 +141,31 @@ def _neg_tau(p: dict) -> np.ndarray:
     return neg
 
 
+def _observations(X: np.ndarray, ts, legs, ks, t_steps, p: dict, fixed=None) -> np.ndarray:
+    """The observations (N, m + 3) of the states ``X`` (N, m): each state, then leg1's
+    stance as 1.0, the phase's index as a float and the time in the step [s] (``ts``
+    minus ``t_steps``; the float64 of each; the first two ``fixed`` (N, 2) when given),
+    clipped to :func:`batch_parameters`' bounds."""
+    m = X.shape[1]
+    obs = np.empty((X.shape[0], m + 3))
+    obs[:, :m] = X
+    if fixed is None:
+        obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
+                      zip(legs, ks, ts, t_steps)]
+    else:
+        obs[:, m:m + 2] = fixed
+        obs[:, m + 2] = [tv - ts0 for tv, ts0 in zip(ts, t_steps)]
+    return _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
+
+
+#: what :func:`end_periods` reads of each environment
+_ENV_READ = attrgetter("_elapsed", "terrain_seed")
+
+
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
-                p: dict, views=None) -> tuple:
+                p: dict, views=None, X: np.ndarray | None = None,
+                cols: tuple | None = None, hips: list | None = None,
+                fixed: np.ndarray | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -151,6 +183,17 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         :func:`batch_parameters` of ``envs``.
     views : list of RigidView, optional
         ``[e.sim for e in envs]``, when the caller has it.
+    X : ndarray (N, 2n), optional
+        The walkers' states stacked, when the caller has them (``views[i].x`` is
+        ``X[i]``: :func:`walkerlab.gym.rows_common.step_common`).
+    cols : tuple, optional
+        What is read of the walkers (below: states, times, stance legs, phases, steps'
+        starts, ends, steps, ledgers, each a sequence of N), when the caller has read it.
+    hips : list of float, optional
+        The hips' world x [m] (:func:`hip_xs`' numbers), when the caller has them.
+    fixed : ndarray (N, 2), optional
+        The observations' stance-leg and phase columns (leg1's stance as 1.0, the phase's
+        index), when the caller has them.
 
     Returns
     -------
@@ -169,20 +212,21 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         views = [e.sim for e in envs]
     # what is read of each walker, in one pass: its state, time, stance leg, phase, its
     # step's start, how its episode ended, its steps and ledger
-    rows = [(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger) for v in views]
-    xs, ts, legs, ks, t_steps, ended, steps, ledgers = zip(*rows)  # (tuples)
-    X = np.array(xs)
-    # (leg1's stance as 1.0, the phase's index as a float, the time in the step: the
-    # float64 of each, side by side with the states)
-    obs = np.concatenate((X, [(leg == "leg1", k, tv - ts0) for leg, k, tv, ts0 in
-                              zip(legs, ks, ts, t_steps)]), axis=1)
-    _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
-    hip = hip_xs(views, X)
-    hips = hip.tolist()
-    elapsed = []
+    if cols is None:
+        cols = zip(*[(v.x, v.t, v.leg, v.k, v.t_step, v.ended, v.steps, v.ledger)
+                     for v in views])
+    xs, ts, legs, ks, t_steps, ended, steps, ledgers = cols  # (sequences)
+    if X is None:
+        X = np.array(xs)
+    obs = _observations(X, ts, legs, ks, t_steps, p, fixed)
+    if hips is None:
+        hip = hip_xs(views, X)
+        hips = hip.tolist()
+    else:
+        hip = None  # (made of hips when the infos are)
     for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
-        elapsed.append(e._elapsed)
+    elapsed, seeds = zip(*map(_ENV_READ, envs))  # (each environment's count and seed)
     terminated = [s != "" for s in ended]
     fws, healthy, cws, wws, dts, limits = _lists(p)
     truncated = [not te and lim >= 0 and el >= lim
@@ -191,8 +235,11 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
-    effort = U / p["tau"]
-    effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2: square)
+    if any(U.ravel().tolist()):
+        effort = U / p["tau"]
+        effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2)
+    else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
+        effort = [0.0] * len(views)
     j_work = terms.index("action_work_positive")
     work = [row[j_work] for row in sums]
     reward = np.array([
@@ -200,8 +247,10 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
             fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
             w_before)], dtype=np.float64)
-    messages = [getattr(v, "failure", "") for v in views]
-    seeds = [e.terrain_seed for e in envs]
+    # (a view's own words, when it has them: the rigid view's are its instance's)
+    messages = ([v.__dict__.get("failure", "") for v in views]
+                if not any(map(_class_failure, set(map(type, views))))
+                else [getattr(v, "failure", "") for v in views])
 
     def columns() -> dict:  # (of the values read above, whenever called)
         L = np.array(sums, dtype=np.float64).T.copy()
@@ -210,7 +259,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
                "heel_strike_times_s": [[float(x) for x in s] for s in strikes],
                "steps": [int(s) for s in steps],
-               "stance_leg": list(legs), "hip_x_m": hip,
+               "stance_leg": list(legs),
+               "hip_x_m": np.array(hips, dtype=np.float64) if hip is None else hip,
                "termination": list(ended),
                "solver_message": [str(m) for m in messages],
                "terrain_seed": [int(s) for s in seeds]}
@@ -220,6 +270,17 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     terminated = np.array(terminated, dtype=np.bool_)
     truncated = np.array(truncated, dtype=np.bool_)
     return obs, reward, terminated, truncated, columns
+
+
+_CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
+
+
+def _class_failure(cls) -> bool:
+    """Whether the class ``cls`` has an attribute ``failure`` (kept per class)."""
+    out = _CLASS_FAILURE.get(cls)
+    if out is None:
+        out = _CLASS_FAILURE[cls] = hasattr(cls, "failure")
+    return out
 
 
 #: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``

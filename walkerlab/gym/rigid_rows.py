@@ -50,7 +50,7 @@ from walkerlab.integrate.rows_dop853 import FAILED, TIMEOUT, cfuncs, period_rows
 from .action import GL_W, GL_X  # the ledger's Gauss-Legendre rule, the walker's own
 from .small_arrays import all_finite
 
-__all__ = ["COMPILE_NOTICE_S", "advance_rows", "compile_notice"]
+__all__ = ["COMPILE_NOTICE_S", "advance_live", "advance_rows", "compile_notice"]
 
 #: a first batched call still running after this long [s] is compiling its kernels (numba:
 #: about 13 s on an idle 2-core machine; about 2 s when its cache holds them): said in one line
@@ -320,14 +320,16 @@ def _held_rows(views, rows: list, pieces: list, sel: list, maps: list, X: np.nda
             ledger["action_work_positive" if p > 0 else "action_work_negative"] += h * w * p
 
 
-def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> None:
+def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list,
+                 only=None) -> None:
     """Each row's piece ended (:func:`_integrate_rows`' ``out``) taken by its walker, as
     :meth:`~walkerlab.gym.rigid_view.RigidView.absorb` takes a run: a row that reached its
     period's end settles there (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, the
     states' finiteness checked for all rows at once), the ledger of those with the action
     on taken for all of them (:func:`_held_rows`); any other is absorbed as a
     :class:`PhaseRun`, its dense output made on first use (:class:`_RowRedo` for a guard
-    crossing, else :class:`_Redo`)."""
+    crossing, else :class:`_Redo`).  ``only``: the rows (indices into ``rows``) to absorb,
+    when not all (the others taken by the caller: :mod:`walkerlab.gym.rows_common`)."""
     which, te, Yev, Y, cap, Yn, call = out
     X = Yev  # (each settled walker's state: its row; the array is this call's own)
     finite = ([True] * len(rows) if all_finite(X)
@@ -337,6 +339,8 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
     if Yn.shape[1]:  # rows with the action on
         maps = []
         for r, (i, piece, w) in enumerate(zip(rows, pieces, ends)):
+            if only is not None and r not in only:
+                continue
             if w == TIMEOUT and piece[2] and finite[r]:
                 M = _joint_map(views[i], piece[1])
                 if M is not None:
@@ -346,6 +350,8 @@ def _absorb_rows(views, rows: list, pieces: list, out: tuple, strikes: list) -> 
             _held_rows(views, rows, pieces, held, maps, X, Y, cap, Yn)
         held = set(held)
     for r, (i, piece, w) in enumerate(zip(rows, pieces, ends)):
+        if only is not None and r not in only:
+            continue
         v = views[i]
         if w == TIMEOUT and (not piece[2] or r in held):
             v.settle(float(piece[4]), X[r], finite[r])
@@ -412,6 +418,16 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
         v.open_period(actions[i], t_end)
         if v.t < t_end and not v.ended:
             live.append(i)
+    advance_live(views, actions, t_ends, live, strikes)
+    return strikes
+
+
+def advance_live(views, actions, t_ends, live: list, strikes: list) -> None:
+    """:func:`advance_rows`' pieces of the walkers ``live`` (indices into ``views``,
+    their periods opened), each walker's heel-strike times added to ``strikes[i]``, until
+    every one reached its period's end or its episode's (the native vector env's common
+    step, :func:`walkerlab.gym.rows_common.step_common`, goes on here after its first
+    pieces)."""
     while live:
         groups: dict = {}
         for i in live:
@@ -443,4 +459,3 @@ def advance_rows(views, actions, t_ends) -> list[list[float]]:
             _absorb_rows(views, rows, pieces, _integrate_rows(views, rows, pieces, key, gs),
                          strikes)
         live = [i for i in live if views[i].t < t_ends[i] and not views[i].ended]
-    return strikes

@@ -21,6 +21,9 @@ observations, rewards, flags and ledger read at once and their infos kept as col
 and a mask ``_key`` per key, as ``VectorEnv._add_info`` batches N dicts, without building
 them); the same element-wise operations as each walker's own ``step``, so that these
 numbers are those of each walker ending its own period on the same physics, bit for bit.
+A common period (every stepped walker where its last period left it, in a compiled phase of
+one flow: most periods) runs all of this in one pass over the walkers
+(:func:`walkerlab.gym.rows_common.step_common`).
 A ``reward_fn`` (it is given each walker's info dict) has each walker begin and end its
 own period around the batched physics; the contact view, or ``batched=False``, steps them
 one after another.  The time limit, the autoreset and the batching of the infos are this
@@ -66,6 +69,18 @@ def _advance_rows():
 
 
 _ADVANCE_ROWS = None
+
+
+def _step_common():
+    """:func:`walkerlab.gym.rows_common.step_common` (imported on first use, as
+    :func:`_advance_rows`), kept."""
+    global _STEP_COMMON
+    if _STEP_COMMON is None:
+        from .rows_common import step_common as _STEP_COMMON  # light
+    return _STEP_COMMON
+
+
+_STEP_COMMON = None
 
 
 class WalkerVectorEnv(VectorEnv):
@@ -160,12 +175,24 @@ class WalkerVectorEnv(VectorEnv):
         self._every.flags.writeable = False
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
+        #: at least the largest of ``_elapsed`` (a reset only lowers a count)
+        self._most = 0
         #: every row and sub-environment (a step of all of them)
         self._all = (np.arange(n), list(self.envs))
         self._has_reset = False
         self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
         self._params: dict | None | bool = False
+        #: what a common period of the walkers reads, kept (:func:`walkerlab.gym.
+        #: rows_common.step_common`)
+        self._common: dict = {}
+
+    def __getstate__(self) -> dict:
+        """Its attributes for a copy or a pickle, without what its common periods keep of
+        its walkers (by their objects' ids: the copy's walkers are its own)."""
+        state = self.__dict__.copy()
+        state["_common"] = {}
+        return state
 
     # ------------------------------------------------------------------ the physics
     def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
@@ -213,7 +240,8 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         advance_rows = _advance_rows()
-        if not self._batched_before:  # its kernels compiled or loaded: a long wait said
+        first = not self._batched_before
+        if first:  # its kernels compiled or loaded: a long wait said
             self._batched_before = True
             from .rigid_rows import compile_notice  # (advance_rows' module: imported)
 
@@ -230,20 +258,30 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         whole = idx.size == self.num_envs
-        if not whole:
-            p = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
-        # (begin_periods reads the actions into an array of its own: every row as given)
-        U, x_before, w_before, t_ends = begin_periods(envs, actions if whole else actions[idx],
-                                                      p)
         views = [env.sim for env in envs]
-        strikes = advance_rows(views, U, t_ends)
-        obs, reward, term, trunc, columns = end_periods(envs, U, strikes, x_before,
-                                                        w_before, p, views)
-        if whole:
-            self._observations[:] = obs
-            self._rewards[:] = reward
-            self._terminations[:] = term
-            self._truncations[:] = trunc
+        if not whole:  # (the stepped walkers' parameters, kept per set of rows)
+            some = p.setdefault("some", {})
+            rows = idx.tobytes()
+            if rows not in some:
+                if len(some) >= 256:
+                    some.clear()
+                some[rows] = {k: v[idx] for k, v in p.items() if isinstance(v, np.ndarray)}
+            p = some[rows]
+        # a step after the first: a common period's batch (walkerlab.gym.rows_common.
+        # step_common), when it is one
+        out = (None if first
+               else _step_common()(envs, views, actions if whole else actions[idx], p,
+                                   self._common))
+        if out is None:
+            # (begin_periods reads the actions into an array of its own: every row as given)
+            U, x_before, w_before, t_ends = begin_periods(
+                envs, actions if whole else actions[idx], p)
+            out = end_periods(envs, U, advance_rows(views, U, t_ends), x_before, w_before, p,
+                              views)
+        obs, reward, term, trunc, columns = out
+        if whole:  # (new arrays of this step's: kept as they are)
+            self._observations, self._rewards = obs, reward
+            self._terminations, self._truncations = term, trunc
         else:
             self._observations[idx] = obs
             self._rewards[idx] = reward
@@ -397,12 +435,15 @@ class WalkerVectorEnv(VectorEnv):
                    if not some_reset or stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
+            self._most += 1  # (a bound on the counts: none can be at the limit below it)
             if some_reset:
                 self._elapsed[stepping] += 1
                 self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
             else:  # (every walker stepped)
                 self._elapsed += 1
-                self._truncations |= self._elapsed >= self.max_episode_steps
+                if self._most >= self.max_episode_steps:
+                    self._truncations |= self._elapsed >= self.max_episode_steps
+                    self._most = int(self._elapsed.max())
         resets: dict = {}
         for i in np.flatnonzero(resetting).tolist() if some_reset else ():  # NEXT_STEP: the
             resets[i] = self._reset_one(i, None, None)  # reset is the outcome

@@ -1,0 +1,376 @@
+"""The native vector environment's common control period, from the actions to the step's
+outputs in one pass over the walkers (:class:`walkerlab.gym.vector.WalkerVectorEnv`'s
+physics: :func:`step_common`).
+
+:func:`walkerlab.gym.rigid_rows.advance_rows` advances any set of walkers piece by piece,
+asking each walker for its piece (:meth:`~walkerlab.gym.rigid_view.RigidView.next_piece`),
+grouping the pieces by flow, writing each walker's held torques into its law block and
+reading the law blocks back into the kernel's data rows, around
+:func:`~walkerlab.gym.batch.begin_periods` and :func:`~walkerlab.gym.batch.end_periods`, which
+read the walkers again.  In a common period every walker is where its last period left it -
+the same step walker, phase and stance leg, its compiled phase and flow key known (kept in
+the walker: ``RigidView._lane``, ``row_keys``), all of one flow - so that work is the same
+every period.  Here the walkers are read once (``operator.attrgetter``, one C call per
+walker), the kernel's data rows are each walker's flow's row made once
+(:func:`_flow_row`, checked against ``data_rows``) stacked per set of lanes with this
+period's torques and step clocks written as columns, the states are the last common
+period's array when the walkers still hold its rows, and the kernel
+(:func:`walkerlab.integrate.rows_dop853.period_rows`) is called on them; the rows that
+reached their piece's end are settled at once (their ledger by
+:func:`~walkerlab.gym.rigid_rows._held_rows`, as the walker's own), the others (a guard
+crossing, a failed step) absorbed by their walkers as
+:func:`~walkerlab.gym.rigid_rows.advance_rows` absorbs them, their periods going on through
+:func:`~walkerlab.gym.rigid_rows.advance_live`; the outputs are
+:func:`~walkerlab.gym.batch.end_periods`' of what was read.  The same kernel on the same
+rows, states, data and caps, and the same element-wise operations, so the same numbers bit
+for bit as each walker's own period (``gym.make``'s environment is
+:func:`~walkerlab.gym.rigid_rows.advance_rows` on one walker).  A period that is not common
+(a walker in a new step or phase, one whose episode ended, a height profile, a fall guard
+checked at a phase's entry, walkers of several flows) is left to the general step, nothing
+changed.  Nothing here knows a walker's size: the states' width is the flow key's, the
+torques' the action's.
+"""
+
+from __future__ import annotations
+
+from operator import attrgetter
+
+import numpy as np
+
+from walkerlab.codegen.torque_law import HEAD
+from walkerlab.integrate.rows_dop853 import TIMEOUT
+
+from .action import GL_X
+from .batch import _hips, end_periods, held_torques
+from .rigid_rows import (
+    _CFUNCS,
+    _ENTRY,
+    _NO_NODES,
+    _absorb_rows,
+    _guard_tables,
+    _held_rows,
+    _joint_map,
+    _kernel_args,
+    _period_rows,
+    advance_live,
+)
+from .rigid_view import _CONSTANT_0
+from .small_arrays import all_finite
+
+__all__ = ["step_common"]
+
+
+def _hold(view, fast, u: np.ndarray) -> None:
+    """Write the held torques ``u`` into the compiled phase ``fast``'s law block as
+    :meth:`~walkerlab.gym.rigid_view.RigidView.next_piece` writes them (where it does not
+    hold these very numbers), its memo kept."""
+    held, bits = view._held, u.tobytes()
+    if held[0] is not fast or held[1] != bits:
+        fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * u.size:HEAD] = u
+        view._held = (fast, bits)
+
+
+def _flow_row(flow, acts) -> tuple:
+    """``(row, u_cols, t_col, same)``: the kernel's data row (1, size) of a walker's
+    compiled flow as :meth:`walkerlab.codegen.actuated.ActuatedFlow.data_rows` writes it
+    (its constants, its law block, its step clock), where the held torques of ``acts``
+    go (the law block's constants: each actuator's ``HEAD``-th slot from
+    :data:`~walkerlab.gym.rigid_view._CONSTANT_0`, as columns ``u_cols``) and its step
+    clock (``t_origin``, the block's third slot: column ``t_col``); ``same``: a torque
+    written into the law block (as :meth:`~walkerlab.gym.rigid_view.RigidView.next_piece`
+    writes it) gives ``data_rows``' row bit for bit as the row with the torque written
+    into its columns (checked once, the law block put back as it was; False: a flow of
+    another layout, whose rows are ``data_rows``' every period)."""
+    nc = flow.constants().size
+    row = np.empty((1, flow.data_size()))
+    flow.data_rows([flow], row)
+    k = acts.u.size
+    u_cols = slice(nc + _CONSTANT_0, nc + _CONSTANT_0 + HEAD * k, HEAD)
+    t_col = nc + 2
+    laws = flow.laws
+    kept = laws.copy()
+    test = 0.5 + np.arange(k, dtype=float)
+    laws[_CONSTANT_0:_CONSTANT_0 + HEAD * k:HEAD] = test
+    ref = np.empty_like(row)
+    flow.data_rows([flow], ref)
+    laws[:] = kept
+    mine = row.copy()
+    mine[:, u_cols] = test
+    mine[:, t_col] = float(getattr(flow.actuators, "t_origin", 0.0))
+    return row, u_cols, t_col, mine.tobytes() == ref.tobytes()
+
+
+#: most entries of a vector env's caches (:func:`step_common`'s ``cache``; cleared when
+#: full)
+KEPT = 256
+
+
+def _lane_entry(v, lane, cache: dict):
+    """``(lane, key, guards, flow)`` of a walker's kept lane (``RigidView._lane``: its step
+    walker, phase and stance leg) when a common period can run it (its compiled phase on
+    the kernel, a flow with a law block, no height profile, no fall guard checked at the
+    phase's entry), the flow key one object for equal keys; ``(lane, None)`` when not;
+    kept in ``cache`` by the lane's id (the lane kept with it: its id stays its own)."""
+    lanes = cache.setdefault("lanes", {})
+    if len(lanes) >= KEPT:
+        lanes.clear()
+    out = (lane, None)
+    fast = lane[6]
+    if v.ground is None and not lane[5] and fast is not None:
+        kg = v.row_keys.get(id(fast[0]), v.row_keys)
+        if kg is v.row_keys:  # (its key not made yet: made by advance_rows, asked again)
+            return out
+        flow = fast[0].compiled
+        if kg is not None and hasattr(flow, "data_rows"):
+            keys = cache.setdefault("keys", {})
+            flows = cache.setdefault("flows", {})  # (a flow's row, once: the flow kept)
+            row = flows.get(id(flow))
+            if row is None:
+                row = flows[id(flow)] = (flow, _flow_row(flow, lane[3]))
+            out = (lane, keys.setdefault(kg[0], kg[0]), kg[1], flow, row[1])
+    lanes[id(lane)] = out
+    return out
+
+
+#: what a common period reads of each walker (its view, its environment), in C
+_VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
+                   "x", "ledger", "_log", "steps", "foot")
+_ENV = attrgetter("_elapsed", "dt", "_hip_x")
+
+
+def _common(envs, views, cache: dict):
+    """What a common period reads of the walkers, in one pass, before anything changes:
+    ``(key, entries, read, caps, stops, t_ends, env_read)`` (the flow key they share; each
+    walker's lane entry (:func:`_lane_entry`), what is read of its view (:data:`_VIEW`),
+    its piece's span [s] and end [s], its period's end [s]
+    (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of its
+    environment (:data:`_ENV`)); None when the period is not common."""
+    lanes_kept = cache.get("lanes") or {}
+    key = None
+    entries, caps, stops, t_ends = [], [], [], []
+    read = list(map(_VIEW, views))
+    env_read = list(map(_ENV, envs))
+    for r, (got, er) in enumerate(zip(read, env_read)):
+        lane, t = got[0], got[5]
+        t_end = (er[0] + 1) * er[1]
+        if (lane is None or lane[0] is not got[1] or lane[1] != got[2]
+                or lane[2] != got[3] or got[4] or not t < t_end):
+            return None
+        en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
+        if en[1] is not key:
+            if key is not None or en[1] is None:  # (walkers of several flows; a lane the
+                return None  # common period cannot run)
+            key = en[1]
+        elif key is None:  # (the first walker's lane: one the common period cannot run)
+            return None
+        t_stop = got[6] + got[7]  # (next_piece's end of the piece: t_step + max_step_time)
+        if not t_stop < t_end:
+            t_stop = t_end
+        entries.append(en)
+        caps.append(t_stop - t)
+        stops.append(t_stop)
+        t_ends.append(t_end)
+    return key, entries, read, caps, stops, t_ends, env_read
+
+
+def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
+    """One control period of every walker when it is common (module docstring), from the
+    actions to the step's outputs: :func:`~walkerlab.gym.batch.begin_periods`,
+    :func:`walkerlab.gym.rigid_rows.advance_rows` and :func:`~walkerlab.gym.batch.
+    end_periods` of ``envs`` (their walkers ``views``), the same numbers bit for bit, with
+    one read of the walkers before the period, one write as it opens and one read and
+    write as it ends.
+
+    Parameters
+    ----------
+    envs : sequence of walkerlab.gym.env.WalkerEnv
+        N rigid-view environments, each reset.
+    views : sequence of walkerlab.gym.rigid_view.RigidView
+        ``[e.sim for e in envs]``.
+    actions : ndarray (N, k)
+        Checked finite actions (:func:`~walkerlab.gym.batch.begin_periods`).
+    p : dict
+        :func:`~walkerlab.gym.batch.batch_parameters` of ``envs``.
+    cache : dict
+        The vector env's own (what a common period of its walkers reads, kept).
+
+    Returns
+    -------
+    tuple or None
+        :func:`~walkerlab.gym.batch.end_periods`' ``(obs, reward, terminated, truncated,
+        columns)``; None when the period is not common (nothing changed: the caller steps
+        the walkers its own way).
+    """
+    got = _common(envs, views, cache)
+    if got is None:
+        return None
+    key, entries, read, caps, stops, t_ends, env_read = got
+    U = held_torques(envs, actions, p)  # (the policy's at the present states)
+    rows_u = list(U)
+    lanes = [en[0] for en in entries]
+    for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
+                                          env_read):
+        e._elapsed = er[0] + 1  # (begin_periods, open_period, next_piece)
+        per = (u, t_end)  # (u a float64 row, t_end a float)
+        v._period = per
+        r[10].append(per)
+        lane[3].u = u
+    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
+    x_before = [er[2] for er in env_read]  # (the reward's origins, before the period)
+    w_before = [led["action_work_positive"] for led in ledgers]
+    on = [any(r) for r in U.tolist()]
+    batch = _batch(cache, key, entries, lanes, walkers)
+    out = _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache)
+    which, te, Yev, Y, cap, Yn, call = out
+    settled, slow = _settle_rows(views, lanes, on, which.tolist(), Yev, Y, cap, Yn)
+    X = list(Yev)
+    if not slow:
+        ended = []
+        for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
+            v.t, v.x = t_stop, x  # (RigidView.settle)
+            if t_stop >= t_step + mst:
+                v.ended = "stall"
+                ended.append("stall")
+            else:
+                ended.append("")
+        cache["X"] = (Yev, X)
+        # the hips' x: one call of the walkers' one points function on the states as
+        # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
+        hx = _hips(walkers[0], Yev) if batch[5] else None
+        hips = (None if hx is None
+                else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
+        return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
+                           Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
+                           batch[6])
+    strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
+    cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
+    return end_periods(envs, U, strikes, x_before, w_before, p, views)
+
+
+def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out) -> list:
+    """The walkers ``settled`` settled at their pieces' ends ``stops`` [s] in the states
+    ``X`` (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`), the rows ``slow`` absorbed
+    by their walkers (:func:`~walkerlab.gym.rigid_rows._absorb_rows` of the kernel's
+    ``out``) and their periods gone on (:func:`~walkerlab.gym.rigid_rows.advance_live`);
+    returns each walker's heel-strike times [s]."""
+    for r in settled:  # RigidView.settle
+        v, t_stop = views[r], stops[r]
+        v.t, v.x = t_stop, X[r]
+        if t_stop >= v.t_step + v.max_step_time:
+            v.ended = "stall"
+    # a walker's own absorbing may integrate its piece again with its own flow, whose law
+    # block then holds the torques (as next_piece leaves it)
+    pieces = []
+    for r, (v, lane, u, a, t_stop) in enumerate(zip(views, lanes, rows_u, on, stops)):
+        if r in slow:
+            _hold(v, lane[6], u)
+        pieces.append((lane[0], lane[3], a, lane[4], t_stop, lane[6]))
+    strikes: list[list[float]] = [[] for _ in views]
+    _absorb_rows(views, list(range(len(views))), pieces, out, strikes, set(slow))
+    live = [i for i in slow if views[i].t < t_ends[i] and not views[i].ended]
+    if live:
+        advance_live(views, rows_u, t_ends, live, strikes)
+    return strikes
+
+def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers) -> tuple:
+    """What a common period of these lanes reads every period, made once and kept by the
+    lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed)`` - the
+    walkers' data rows stacked (:func:`_flow_row`) and their step clocks, whether each row
+    takes its torques and clock as columns, the kernel's compiled functions and tolerances,
+    its guard tables, whether the walkers share one ``points`` function, and the
+    observations' stance-leg and phase columns (N, 2)."""
+    fid = tuple(map(id, entries))
+    out = cache.get(fid)
+    if out is None:
+        if len(cache) >= KEPT:
+            cache.clear()
+        t_col = entries[0][4][2]
+        out = cache[fid] = (
+            np.concatenate([en[4][0] for en in entries]),
+            [float(en[4][0][0, t_col]) for en in entries],
+            all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
+            _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
+            _guard_tables([en[2] for en in entries]),
+            all(w.points is walkers[0].points for w in walkers),
+            np.array([(1.0 if lane[2] == "leg1" else 0.0, lane[1]) for lane in lanes]))
+    return out
+
+
+def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache) -> tuple:
+    """The kernel on every walker's piece: ``(which, te, Yev, Y, cap, Yn, call)`` as
+    :func:`walkerlab.gym.rigid_rows._integrate_rows` gives them (its arguments the same:
+    the data rows with this period's torques and clocks, the start states - the last
+    common period's array when the walkers hold its rows -, the caps [s], the
+    Gauss-Legendre nodes of the rows with the action on)."""
+    base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi), _, _ = batch
+    origins = [float(getattr(en[3].actuators, "t_origin", 0.0)) for en in entries]
+    if same:
+        D = base.copy()
+        D[:, entries[0][4][1]] = U
+        if origins != clocks:
+            D[:, entries[0][4][2]] = origins
+    else:  # (the law blocks written, as next_piece writes them, and read back)
+        for v, lane, u in zip(views, lanes, rows_u):
+            _hold(v, lane[6], u)
+        D = np.empty_like(base)
+        entries[0][3].data_rows([en[3] for en in entries], D)
+    f, fs, fg, sel, rtol, atol, n_out = kernel
+    N, m = len(views), key[4]
+    last = cache.get("X")  # (the last common period's states: the walkers' own rows)
+    if (last is not None and len(last[1]) == N
+            and all(x is r for x, r in zip(xs, last[1]))):
+        Y = last[0]
+    else:
+        Y = np.array(xs, dtype=float)
+    cap = np.array(caps, dtype=float)
+    which = np.empty(N, np.int64)
+    te = np.empty(N)
+    Yev = np.empty((N, m))
+    if any(on):  # the Gauss-Legendre nodes of the rows with the action on (_integrate_rows)
+        half = 0.5 * cap[:, None]
+        Tn = half * GL_X + half
+        if not all(on):
+            Tn[[not a for a in on]] = np.nan
+        Yn = np.empty((N, GL_X.size, m))
+    else:
+        Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
+            (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
+    args = (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol, n_out, which,
+            te, Yev, np.zeros(N), Tn, Yn)
+    entry = _ENTRY.get(key)  # (the kernel's compiled entry for these types, once chosen)
+    if entry is None:
+        _period_rows(key, args)
+    else:
+        entry(*args)
+    call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
+    return which, te, Yev, Y, cap, Yn, call
+
+
+def _settle_rows(views, lanes, on, ends, Yev, Y, cap, Yn) -> tuple:
+    """``(settled, slow)``: the rows that reached their piece's end, each to be settled
+    there as :func:`~walkerlab.gym.rigid_rows._absorb_rows` settles it (the ledger of those
+    with the action on taken here at once: :func:`~walkerlab.gym.rigid_rows._held_rows`),
+    and the others (a guard crossing, a failed step, a state not finite, the ledger on the
+    dense output), to be absorbed by their walkers."""
+    N = len(views)
+    finite = ([True] * N if all_finite(Yev) else np.isfinite(Yev).all(axis=1).tolist())
+    if min(ends) == TIMEOUT == max(ends) and not any(on) and all(finite):
+        return range(N), []
+    settled, slow, held, maps = [], [], [], []
+    for r in range(N):
+        if ends[r] != TIMEOUT or not finite[r]:
+            slow.append(r)
+        elif on[r]:
+            M = _joint_map(views[r], lanes[r][3])
+            if M is None:
+                slow.append(r)
+            else:
+                settled.append(r)
+                held.append(r)
+                maps.append(M)
+        else:
+            settled.append(r)
+    if held:
+        _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes], held, maps,
+                   Yev, Y, cap, Yn)
+    return settled, slow
