@@ -229,14 +229,21 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
         flows[0].data_rows(flows, D)
     else:
         D = np.array([flow.data() for flow in flows], dtype=float)
+    cap, which, te, Yev, Tn, Yn = period_buffers(caps, [piece[2] for piece in pieces], N, m)
+    _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
+                       n_out, which, te, Yev, np.zeros(N), Tn, Yn))
+    call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
+    return which, te, Yev, Y, cap, Yn, call
+
+
+def period_buffers(caps, on, N: int, m: int) -> tuple:
+    """The period kernel's caps ``(N,)`` [s] and output buffers (the event's row ``which``
+    (N,), time ``te`` (N,) and state ``Yev`` (N, m)), and the Gauss-Legendre nodes ``Tn``
+    (N, k) [s] and their states ``Yn`` (N, k, m) of the rows with the action on (``on``,
+    per row: their ledger's, should the power change sign over the period: _held_rows),
+    NaN for the others; none (k = 0) when no row's action is on."""
     cap = np.array(caps, dtype=float)
-    which = np.empty(N, np.int64)
-    te = np.empty(N)
-    Yev = np.empty((N, m))
-    H = np.zeros(N)
-    # the Gauss-Legendre nodes of the rows with the action on (their ledger's, should the
-    # power change sign over the period: _held_rows), NaN for the others
-    on = [piece[2] for piece in pieces]
+    which, te, Yev = np.empty(N, np.int64), np.empty(N), np.empty((N, m))
     if any(on):
         half = 0.5 * cap[:, None]
         Tn = half * GL_X + half
@@ -246,10 +253,7 @@ def _integrate_rows(views, rows: list, pieces: list, key: tuple, guards: list) -
     else:
         Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
             (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
-    _period_rows(key, (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol,
-                       n_out, which, te, Yev, H, Tn, Yn))
-    call = (key, (f, fs, fg, sel), Y, D, cap, (gcols, goffs, dirs, ng), gi, (rtol, atol, n_out))
-    return which, te, Yev, Y, cap, Yn, call
+    return cap, which, te, Yev, Tn, Yn
 
 
 class _RowRedo:

@@ -40,12 +40,10 @@ import numpy as np
 from walkerlab.codegen.torque_law import HEAD
 from walkerlab.integrate.rows_dop853 import TIMEOUT
 
-from .action import GL_X
 from .batch import _hips, end_periods, held_torques
 from .rigid_rows import (
     _CFUNCS,
     _ENTRY,
-    _NO_NODES,
     _absorb_rows,
     _guard_tables,
     _held_rows,
@@ -53,6 +51,7 @@ from .rigid_rows import (
     _kernel_args,
     _period_rows,
     advance_live,
+    period_buffers,
 )
 from .rigid_view import _CONSTANT_0
 from .small_arrays import all_finite
@@ -322,19 +321,7 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
         Y = last[0]
     else:
         Y = np.array(xs, dtype=float)
-    cap = np.array(caps, dtype=float)
-    which = np.empty(N, np.int64)
-    te = np.empty(N)
-    Yev = np.empty((N, m))
-    if any(on):  # the Gauss-Legendre nodes of the rows with the action on (_integrate_rows)
-        half = 0.5 * cap[:, None]
-        Tn = half * GL_X + half
-        if not all(on):
-            Tn[[not a for a in on]] = np.nan
-        Yn = np.empty((N, GL_X.size, m))
-    else:
-        Tn, Yn = _NO_NODES.get((N, m)) or _NO_NODES.setdefault(
-            (N, m), (np.empty((N, 0)), np.empty((N, 0, m))))
+    cap, which, te, Yev, Tn, Yn = period_buffers(caps, on, N, m)
     args = (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol, n_out, which,
             te, Yev, np.zeros(N), Tn, Yn)
     entry = _ENTRY.get(key)  # (the kernel's compiled entry for these types, once chosen)
