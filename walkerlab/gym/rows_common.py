@@ -175,8 +175,9 @@ def _common(envs, views, cache: dict):
 def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     """One control period of every walker when it is common (module docstring), from the
     actions to the step's outputs: :func:`~walkerlab.gym.batch.begin_periods`,
-    :func:`walkerlab.gym.rigid_rows.advance_rows` and :func:`~walkerlab.gym.batch.
-    end_periods` of ``envs`` (their walkers ``views``), the same numbers bit for bit, with
+    :func:`walkerlab.gym.rigid_rows.advance_rows` and
+    :func:`~walkerlab.gym.batch.end_periods` of ``envs`` (their walkers ``views``), the same
+    numbers bit for bit, with
     one read of the walkers before the period, one write as it opens and one read and
     write as it ends.
 
