@@ -316,10 +316,12 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
 
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
-    if data.structure.foot == "arc" or data.structure.bodies[0].kind == "rod":
-        kind.require("round_feet_3d", w.view, "walker.foot_radius_m, walker.leg_inertia_kg_m2")
-        raise ValueError("walker.foot_radius_m, walker.leg_inertia_kg_m2: this export "
-                         "carries point feet and point-mass legs")  # the cell's, if it ran
+    st = data.structure
+    if st.foot == "arc" or any(b.kind == "rod" for b in st.bodies):
+        fields = ("walker.leg.foot, walker.leg.bodies" if st.parts_3d   # the parts' fields
+                  else "walker.foot_radius_m, walker.leg_inertia_kg_m2")
+        kind.require("round_feet_3d", w.view, fields)
+        raise ValueError(f"{fields}: this export carries point feet and point-mass legs")
     if data.structure.hip_roll:
         kind.require("hip_roll", w.view, "walker.hip_roll")
     check_exportable(scene, kind, w.name, job.walker_only)  # numbers, ground
