@@ -220,39 +220,6 @@ def _hip_roll_forces(q, dq, P) -> sp.Matrix:
     return tau_st * grad_st + tau_sw * grad_sw
 
 
-def _point_mass_matrix(masses, q, p_foot=False):
-    """Mass matrix (n, n) of point masses ``[(m, r(q) (3, 1))]`` and, with ``p_foot``, the
-    coupling ``A = sum m J^T`` (n, 3) and the total mass of the extended system whose stance
-    foot is free (``[q, foot position]``)."""
-    n = len(q)
-    qv = sp.Matrix(q)
-    M = sp.zeros(n, n)
-    A = sp.zeros(n, 3)
-    total = 0
-    for m, r in masses:
-        J = sp.Matrix(r).jacobian(qv)
-        M += m * J.T * J
-        A += m * J.T
-        total += m
-    return M, A, total
-
-
-def _leg_rotation_mass(q, phi, th_st, phi_w, th_sw, gamma, inertia) -> sp.Matrix:
-    """Mass matrix (n, n) of the legs' inertia normal to their axes: a leg (frame
-    ``Rot(s, lean) Rot(z, theta + gamma)`` in the slope's frame, axis ``u``) turning at
-    ``omega = s lean' + Rot(s, lean) z theta'`` has ``T = I (|omega|^2 - (omega . u)^2) / 2``
-    (a slender rod's inertia ``I`` about its mass point [kg m^2], none about its axis)."""
-    ez, es = sp.Matrix([0, 0, 1]), sp.Matrix([1, 0, 0])
-    qv = sp.Matrix(q)
-    out = sp.zeros(len(q), len(q))
-    for lean, theta in ((phi, th_st), (phi_w, th_sw)):
-        roll = rotation(es, lean)
-        u = roll * rotation(ez, theta + gamma) * sp.Matrix([0, 1, 0])
-        W = es * sp.Matrix([lean]).jacobian(qv) + roll * ez * sp.Matrix([theta]).jacobian(qv)
-        out += inertia * (W.T * W - W.T * u * u.T * W)
-    return out
-
-
 @cache
 @_seeded
 def derive_compass(structure) -> Equations:
@@ -334,10 +301,10 @@ def derive_compass(structure) -> Equations:
 
     Leg inertia (``structure.bodies[0].kind == "rod"``, parameter ``I_leg`` [kg m^2]): each
     leg a slender rod about its mass point, ``I`` about every axis normal to the leg and
-    none about it, ``T += I (|omega|^2 - (omega . u)^2) / 2`` (``u`` the leg's axis;
-    :func:`_leg_rotation_mass`); a rotation moves no foot, so the impact's extended mass
-    gets it unchanged.  With ``phi = 0`` and ``w = 0`` round feet and a rod's inertia give
-    the planar round-feet walker (``configs/round_feet.yaml`` = ``configs/
+    none about it, ``T += I (|omega|^2 - (omega . u)^2) / 2`` (``u`` the leg's axis; in the
+    tree a body with ``diag(I, 0, I)`` in the leg's frame); a rotation moves no foot, so the
+    impact's extended mass gets it unchanged.  With ``phi = 0`` and ``w = 0`` round feet and
+    a rod's inertia give the planar round-feet walker (``configs/round_feet.yaml`` = ``configs/
     round_feet_3d.yaml``, ``tests/test_round_feet_3d.py``).  Neither goes with
     hip-roll joints yet (the scene refuses the combination).
 
