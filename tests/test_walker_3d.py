@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 import yaml
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
-from tests.independent.mirror_stride import stride_against, to_heel_strike
+from tests.independent.mirror_stride import stride_against
+from tests.independent.parts_3d_newton import PartsReference
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -62,111 +62,13 @@ def test_the_paper_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one():
 
 # ---- an independent model: Newton's law for three point masses -------------------------
 
-class Reference:
-    """The walker of ``configs/hip_width.yaml`` from Newton's law (module docstring).
-
-    State ``[lean, swing, stance, rates]`` as walkerlab's (roll about the fall line, then
-    each leg's pitch in the rolled sagittal plane, from the vertical, positive with the foot
-    ahead); ``w`` the swing hip's offset along the hip axis (sign: the side)."""
-
-    def __init__(self, g, L, gamma, M, m, a):
-        self.g, self.L, self.gamma, self.M, self.m, self.a = g, L, gamma, M, m, a
-        self.s = np.array([math.cos(gamma), -math.sin(gamma), 0.0])   # the fall line
-        self.n = np.array([math.sin(gamma), math.cos(gamma), 0.0])    # the slope's normal
-        self.z = np.array([0.0, 0.0, 1.0])
-        S = self._skew(self.s)
-        Z = self._skew(self.z)
-        self.S, self.Z = S, Z
-
-    @staticmethod
-    def _skew(v):
-        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-
-    def _R(self, phi):
-        return Rotation.from_rotvec(phi * self.s).as_matrix()
-
-    def _T(self, th):
-        return Rotation.from_rotvec(th * self.z).as_matrix()
-
-    def terms(self, w):
-        """Each point as terms ``(leg index or None, c)``: ``R(phi) T(theta_leg) c`` (or
-        ``R(phi) c``); masses first (pelvis, stance leg's, swing leg's), then the swing foot.
-        Legs: 1 swing, 2 stance (state indices)."""
-        L, a = self.L, self.a
-        hip_st = [(2, np.array([0.0, L, 0.0]))]
-        pelvis = hip_st + [(None, w / 2 * self.z)]
-        m_st = [(2, np.array([0.0, a, 0.0]))]
-        hip_sw = hip_st + [(None, w * self.z)]
-        m_sw = hip_sw + [(1, np.array([0.0, -(L - a), 0.0]))]
-        foot = hip_sw + [(1, np.array([0.0, -L, 0.0]))]
-        return [(self.M, pelvis), (self.m, m_st), (self.m, m_sw)], foot
-
-    def kin(self, terms, q, dq):
-        """Position (3,), Jacobian (3, 3) and the velocity-product term ``Jdot dq`` (3,)."""
-        R = self._R(q[0])
-        r, J, h = np.zeros(3), np.zeros((3, 3)), np.zeros(3)
-        for leg, c in terms:
-            T = self._T(q[leg]) if leg is not None else np.eye(3)
-            p = R @ T @ c
-            r += p
-            d_phi = self.S @ p
-            J[:, 0] += d_phi
-            h += self.S @ self.S @ p * dq[0] ** 2
-            if leg is not None:
-                d_th = R @ self.Z @ T @ c
-                J[:, leg] += d_th
-                h += (2 * self.S @ d_th * dq[0] * dq[leg]
-                      + R @ self.Z @ self.Z @ T @ c * dq[leg] ** 2)
-        return r, J, h
-
-    def rhs(self, w):
-        masses, _ = self.terms(w)
-        grav = np.array([0.0, -self.g, 0.0])
-
-        def f(t, x):
-            q, dq = x[:3], x[3:]
-            Mq, rhs = np.zeros((3, 3)), np.zeros(3)
-            for m, terms in masses:
-                _, J, h = self.kin(terms, q, dq)
-                Mq += m * J.T @ J
-                rhs += m * J.T @ (grav - h)
-            return np.concatenate([dq, np.linalg.solve(Mq, rhs)])
-        return f
-
-    def foot_height(self, w, x):
-        _, foot = self.terms(w)
-        return float(self.n @ self.kin(foot, x[:3], x[3:])[0])
-
-    def step(self, w, x):
-        """One step from just after a heel strike: ``(x just after the next one, period)``;
-        ``w`` this step's swing-hip offset (the next step's is ``-w``)."""
-        y, t2 = to_heel_strike(self.rhs(w), x, 1, 2, lambda y: self.foot_height(w, y), 5.0)
-        return self.impact(w, y), t2
-
-    def impact(self, w, y):
-        """The plastic impact with the impulse at the new foot an unknown: extended
-        coordinates ``[q, p]`` (``p`` the old stance foot), ``M_e (dq+ - dq-) = E^T F``,
-        ``E dq+ = 0`` (the new foot at rest); then the legs' roles swap."""
-        masses, foot = self.terms(w)
-        q, dq = y[:3], y[3:]
-        Me = np.zeros((6, 6))
-        for m, terms in masses:
-            Je = np.hstack([self.kin(terms, q, dq)[1], np.eye(3)])
-            Me += m * Je.T @ Je
-        E = np.hstack([self.kin(foot, q, dq)[1], np.eye(3)])
-        K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
-        sol = np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
-                                                  np.zeros(3)]))
-        dqp = sol[:3]
-        return np.array([q[0], q[2], q[1], dqp[0], dqp[2], dqp[1]])
-
-    def on_surface(self, w, z):
-        """The state just after a heel strike of section coordinates ``z = [lean, stance,
-        rates]``: the swing foot (just lifted) on the slope behind, by Brent's method."""
-        def h(th_sw):
-            return self.foot_height(w, np.array([z[0], th_sw, z[1], 0, 0, 0]))
-        th_sw = brentq(h, -z[1] - 2 * self.gamma - 0.3, -z[1] - 2 * self.gamma + 0.05)
-        return np.array([z[0], th_sw, z[1], *z[2:]])
+def Reference(g, L, gamma, M, m, a) -> PartsReference:
+    """The walker of ``configs/hip_width.yaml`` from Newton's law (module docstring;
+    tests/independent/parts_3d_newton.py): the hip mass ``M`` midway between the hips, on
+    each leg a mass ``m`` at ``a`` from its foot (``L - a`` from its hip).  State ``[lean,
+    swing, stance, rates]`` as walkerlab's; ``w`` (a method's argument) the swing hip's offset
+    along the hip axis (sign: the side)."""
+    return PartsReference(g, L, gamma, M, legs=[(m, L - a)])
 
 
 HIP = dict(g=9.81, L=1.0, gamma=0.0174, M=10.0, m=5.0, a=0.5)
