@@ -1,27 +1,32 @@
-"""Today's 3D walkers and the planar compass gait as body trees (:mod:`walkerlab.walker.tree`):
-the 3D compass with hip width, with and without hip-roll joints (Kuo 1999, "Stabilization of
-lateral motion in passive dynamic walking", IJRR 18(9); today derived by hand in
-:func:`walkerlab.codegen.derive_3d.derive_compass`), and the planar compass gait as its
-special case (every axis along ``z``, no hip width; :func:`walkerlab.codegen.symbolic.derive`),
-and the 3D spoked wheel (:func:`spoked_wheel_3d_tree`).
+"""The 3D walkers and the planar compass gait as body trees (:mod:`walkerlab.walker.tree`):
+the straight-legged walker in 3D from its parts (:func:`straight_legs_3d_tree`; Kuo 1999,
+"Stabilization of lateral motion in passive dynamic walking", IJRR 18(9)), which production
+derives (:func:`walkerlab.codegen.derive_3d.derive_compass`) for the ``compass_gait``
+shorthand and for a biped from parts alike (:func:`legs_3d_tree`), the planar compass gait
+as a planar tree (every axis along ``z``, no hip width; :func:`planar_compass_tree`, held to
+:func:`walkerlab.codegen.symbolic.derive` by the tests), and the 3D spoked wheel
+(:func:`spoked_wheel_3d_tree`).
 
 The 3D tree, from the stance foot (the root, in the slope's frame):
 
 - ``stance_leg`` on a universal ankle at the stance foot: roll about the fall line ``s``,
   then pitch about the rolled ``z`` by ``theta_st + gamma`` (``theta`` from the vertical,
-  positive foot ahead); its frame's ``y`` up the leg, the hip at ``(0, L, 0)``, its mass at
-  ``(0, a, 0)``;
+  positive foot ahead); its frame's ``y`` up the leg, the hip at ``(0, L, 0)``;
 - ``pelvis`` on a universal stance hip at the hip: pitch back by ``-(theta_st + gamma)``,
   then roll by ``phi_p - phi`` about ``s``, so that the pelvis rolls by ``phi_p`` and
-  neither pitches nor yaws (:func:`~walkerlab.codegen.derive_3d.derive_compass`); its mass
-  midway between the hips, at ``(0, 0, w / 2)``, its inertia ``I_pelvis`` about ``s``;
+  neither pitches nor yaws; its mass ``M_hip`` midway between the hips, at ``(0, 0,
+  w / 2)``, its inertia ``I_pelvis`` about ``s``;
 - ``swing_leg`` on a universal swing hip ``w`` along the hip axis: roll by ``phi_w - phi_p``
-  about ``s``, then pitch by ``theta_sw + gamma``; its mass at ``(0, -(L - a), 0)``, its
-  foot at ``(0, -L, 0)``.
+  about ``s``, then pitch by ``theta_sw + gamma``; its foot at ``(0, -L, 0)``;
+- each leg's bodies welded to it, their frames at its hip (a body ``d`` from the hip at
+  ``(e, -d, 0)``, ``e`` ahead of the leg's axis; a rod's inertia about every axis normal
+  to the leg);
+- an upper body ``torso`` on a pitch joint at the hips' midpoint, its angle the legs' mean
+  (a bisecting hip), its bodies welded to it at ``(e, d, 0)``.
 
 Without hip-roll joints the rolls are held (``phi_p = phi_w = phi``: the joints' roll
-coordinates map to 0).  With a leg inertia (``rod``) each leg has ``I_leg`` about every axis
-normal to it and none about it.
+coordinates map to 0).  Round feet put the stance leg on a slide along the fall line (the
+disc's roll), then the roll, then the pitch about the disc's centre.
 """
 
 from __future__ import annotations
