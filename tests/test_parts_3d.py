@@ -262,3 +262,23 @@ def test_a_3d_torso_walkers_urdf_names_the_bisecting_hip_it_cannot_hold(torso_3d
     assert "2 * torso_pitch + -1 * leg1_hip + -1 * leg2_hip = 0" in text
     masses = [float(m.get("value")) for m in ET.fromstring(text.split("\n", 1)[1]).iter("mass")]
     assert sum(masses) == pytest.approx(data.total_mass_kg, abs=1e-9)
+
+
+@pytest.mark.slow   # ~2 min: both gaits of the pair searched in 3D
+def test_a_3d_torso_scene_of_zero_hip_width_selects_the_planar_gait():
+    """configs/torso_bhm.yaml with ``space: 3d`` and ``hip_width_m: 0`` run as a user runs
+    it (its own initial guess, which does not converge in 3D, and ``fixedpoint.gait:
+    stable``): the search falls back to the planar twin's gait and, both 3D gaits being
+    unstable in roll, selects the one nearest that start - the planar gait (step period
+    0.850906 s), not the short-period one (0.706 s) nearer the scene's failed guess."""
+    from walkerlab.analysis.gait.scene import solve_scene
+
+    raw = _raw("torso_bhm.yaml")
+    raw["fixedpoint"]["initial_guess"].update(lean_angle_rad=0.0, lean_rate_rad_per_s=0.0)
+    scene = _in_3d(raw, 0.0)
+    _w, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
+    chosen = search.gaits[search.selected].result
+    flat = Scene.model_validate(_raw("torso_bhm.yaml"))
+    wf = _walker(flat)
+    f = find_fixed_point(wf, _guess(flat, wf.state_names()), SOLVER, fd_check=False)
+    assert abs(chosen.period_s - f.period_s) <= 1e-9 * f.period_s

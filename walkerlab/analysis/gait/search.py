@@ -281,8 +281,11 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
     fell_back = None if s.found else s.from_fallbacks(fallbacks)
     if fell_back is not None:  # the seeds cannot better it; a unique gait has no partner
         seeds = False
+        # the start that led to a gait (a 3D walker's planar twin's gait, a stored gait)
+        # stands for the guess that did not converge: "nearest the guess" is nearest it
+        guess = s.found[0].start
         if fell_back.unique and policy == "stable":
-            policy, guess = "nearest_guess", s.found[0].start
+            policy = "nearest_guess"
     if not s.found and (seeds or guess is None):
         no_orbit = no_orbit_reason(walker)
         if no_orbit:  # the seeds are a passive walker's: none can find what is not there
