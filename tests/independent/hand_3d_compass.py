@@ -2,7 +2,7 @@
 dynamic walking", IJRR 18(9)) derived by hand from its point masses, as walkerlab derived it
 before the body tree (kept as an independent reference for the tree's derivation,
 ``walkerlab.codegen.derive_3d.derive_compass``; not walkerlab code: its own rotations, its
-own Christoffel symbols).
+own Christoffel symbols; only the hip-roll law, a controller's torques, is the generator's).
 
 Frames: world ``x`` downhill, ``y`` up; the slope's frame has the fall line ``s``, the
 normal ``n`` and ``z``.  Coordinates ``lean`` (the pelvis' roll about the fall line), then
@@ -15,30 +15,12 @@ coordinates, written out.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from types import SimpleNamespace
 
 import sympy as sp
 
-
-@dataclass(frozen=True)
-class HandEquations:
-    q: tuple
-    dq: tuple
-    params: tuple
-    M: sp.Matrix
-    C: sp.Matrix
-    G: sp.Matrix
-    Mi: sp.Matrix
-    B: sp.Matrix
-    relabel_q: sp.Matrix
-    relabel_rate: sp.Matrix
-    kinetic: sp.Expr
-    potential: sp.Expr
-    guards: dict
-    points: dict
-    leg_angles: dict
-    section_drop: int
-    drop_solution: sp.Expr
+# the hip-roll law is the walker's controller, not the mechanics this checks: the scene's own
+from walkerlab.codegen.derive_3d import _hip_roll_forces
 
 
 def rotation(axis, angle):
@@ -74,34 +56,6 @@ def christoffel(M, q, dq):
     return C
 
 
-def _hip_roll_forces(q, dq, P) -> sp.Matrix:
-    """Generalised forces (n, 1) of the hip-roll law (:class:`walkerlab.config.walker.
-    HipRollLaw`) in the coordinates ``(lean, swing, stance, pelvis_roll, swing_roll)``.
-
-    The stance hip's roll joint angle is ``d_st = phi - phi_p`` (the stance leg from the
-    pelvis), the swing hip's ``d_sw = phi_w - phi_p``; a torque ``tau`` on a leg about its
-    roll joint (``-tau`` on the pelvis) is the generalised force ``tau grad(d)`` (virtual
-    work ``tau delta d``).  The law::
-
-        tau_st = kp_pelvis phi_p + kd_pelvis dphi_p                (holds the pelvis level)
-        tau_sw = -kp_swing (phi_w - phi_ref) - kd_swing (dphi_w - dphi_p),
-        phi_ref = g_lean phi + g_lean_rate dphi                    (foot placement)
-
-    (Kuo 1999's lateral foot placement, realised continuously by the swing hip: the target
-    roll of the swing leg a linear feedback of the lean and its rate).  Odd in the rolls:
-    the mirror step (``w_hip -> -w_hip``, the rolls negated) runs the same law.
-    """
-    phi, _sw, _st, phi_p, phi_w = q
-    dphi, _dsw, _dst, dphi_p, dphi_w = dq
-    k_p, c_p, k_s, c_s, g_l, g_r = (P[k] for k in ("kp_pelvis", "kd_pelvis", "kp_swing",
-                                                    "kd_swing", "g_lean", "g_lean_rate"))
-    tau_st = k_p * phi_p + c_p * dphi_p
-    tau_sw = -k_s * (phi_w - (g_l * phi + g_r * dphi)) - c_s * (dphi_w - dphi_p)
-    grad_st = sp.Matrix([1, 0, 0, -1, 0])
-    grad_sw = sp.Matrix([0, 0, 0, -1, 1])
-    return tau_st * grad_st + tau_sw * grad_sw
-
-
 def _point_mass_matrix(masses, q, p_foot=False):
     """Mass matrix (n, n) of point masses ``[(m, r(q) (3, 1))]`` and, with ``p_foot``, the
     coupling ``A = sum m J^T`` (n, 3) and the total mass of the extended system whose stance
@@ -135,7 +89,7 @@ def _leg_rotation_mass(q, phi, th_st, phi_w, th_sw, gamma, inertia) -> sp.Matrix
     return out
 
 
-def derive_compass(structure) -> HandEquations:
+def derive_compass(structure) -> SimpleNamespace:
     """The hand derivation of the 3D straight-legged walker (module docstring)."""
     if not structure.in_3d or structure.spokes:
         raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
@@ -229,7 +183,7 @@ def derive_compass(structure) -> HandEquations:
             ("stance_contact", offset - R * roll_of(phi) * e_n), ("stance_foot_centre", offset),
             ("swing_contact", swing_contact), ("swing_foot_centre", centre_sw))})
     len(q)
-    return HandEquations(
+    return SimpleNamespace(
         q=q, dq=dq, params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=kinetic, potential=potential,
         guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,

@@ -99,9 +99,8 @@ PATCH_ACROSS_PUSHED_L = 0.30
 
 
 def _numbers(data) -> dict:
-    """The walker's numbers by name (:data:`walkerlab.walker.description.
-    COMPASS_3D_PARAMS`), ``w_hip`` 0 without hip width, and the foot sphere's radius
-    ``r`` [m]."""
+    """The walker's numbers by parameter name (the ``compass_gait`` shorthand's or the
+    parts'), ``w_hip`` 0 without hip width, and the foot sphere's radius ``r`` [m]."""
     p = dict(zip(data.structure.param_names, data.params))
     p.setdefault("w_hip", 0.0)
     p["r"] = WHEEL_TIP_FRACTION * p["L"]
