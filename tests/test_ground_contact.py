@@ -304,3 +304,69 @@ def test_the_flat_foots_trailing_toe_leaves_the_cone_only_as_it_unloads():
     out = np.flatnonzero(ft > 0.9 * fn)[0]  # the first sample outside the cone
     assert np.all(ft[out:] > 0.9 * fn[out:])  # and it stays out until toe off
     assert 0.002 < tb - ts[out] < 0.004 and 0.10 < fn[out] / weight < 0.16
+
+
+# ---- a walker in 3D: the force, the twist and the heel strike's impulse -------------------
+#: the 3D walkers of the shipped scenes in the independent reference's terms
+#: (tests/independent/parts_3d_newton.py: point masses, the upper body on the legs' bisector)
+REFS_3D = {"hip_width": dict(g=9.81, L=1.0, gamma=0.0174, M_hip=10.0, legs=[(5.0, 0.5)]),
+           "torso_bhm_3d": dict(g=9.81, L=1.0, gamma=0.0174, M_hip=10.0, legs=[(5.0, 0.5)],
+                                torso=[(5.0, 0.2)])}
+
+
+def _walker_3d(name: str):
+    from walkerlab.cli.options import load
+
+    scene = load(f"configs/{name}.yaml")
+    plant = Plant.from_scene(scene)
+    return build_walker(scene, plant=plant), plant.data, scene.walker.hip_width_m
+
+
+@pytest.mark.parametrize("name", sorted(REFS_3D))
+def test_a_3d_stance_foots_force_and_twist_are_newtons_and_eulers_on_its_masses(name):
+    """The force on a 3D walker's stance foot and its moment about the slope's normal, from
+    the rows of the free slides and heading of its floating view (generated from the body
+    tree), against Newton's and Euler's laws on the reference's point masses with the
+    reference's own accelerations, at rolled states of both steps of the stride (the mirror
+    step's swing hip on the other side).  Both models are exact: the difference is
+    round-off (measured 1e-12 N, 1e-13 N m)."""
+    from tests.independent.parts_3d_newton import PartsReference
+
+    walker, data, w = _walker_3d(name)
+    ref = PartsReference(**REFS_3D[name])
+    n_world = ref.n
+    rng = np.random.default_rng(7)
+    for side, model, d in ((1.0, walker, data), (-1.0, walker.mirror, data.mirror)):
+        reaction = StanceReaction(model, d)
+        for _ in range(4):
+            x = np.array([0.04, -0.2, 0.17, 0.3, -0.6, -0.85]) + 0.05 * rng.standard_normal(6)
+            F, twist = reaction.force_and_twist(0.0, x, model.phases[0].flow)
+            F_ref, M_ref = ref.ground_wrench(side * w, x)
+            weight = (10.0 + 2 * 5.0 + 5.0 * (name == "torso_bhm_3d")) * 9.81
+            assert np.max(np.abs(F - F_ref)) < 1e-10 * weight
+            assert abs(twist - M_ref @ n_world) < 1e-10 * weight
+            fn, ft = reaction.normal_and_tangential(F)
+            assert fn == pytest.approx(F_ref @ n_world, rel=1e-12)
+            assert ft == pytest.approx(np.linalg.norm(F_ref - (F_ref @ n_world) * n_world),
+                                       rel=1e-9)
+
+
+def test_a_3d_heel_strikes_impulse_is_the_references_lagrange_multiplier():
+    """configs/hip_width.yaml's heel strike: the ground's impulse from the floating view's
+    momentum (the post-impact rates from the walker's reset, relabelled back) against the
+    reference's impulse at the new foot (a multiplier of its own impact equations), on
+    both steps; the old stance foot leaves the ground (its normal velocity > 0)."""
+    from tests.independent.parts_3d_newton import PartsReference
+
+    walker, data, w = _walker_3d("hip_width")
+    ref = PartsReference(**REFS_3D["hip_width"])
+    for side, model, d in ((1.0, walker, data), (-1.0, walker.mirror, data.mirror)):
+        reaction = StanceReaction(model, d)
+        # late swing, the swing foot on the slope: the section's state, its rates rolled
+        z = np.array([0.01, 0.17, -0.15, -0.6, -0.85])
+        x = ref.on_surface(side * w, np.array([z[0], z[1], z[2], z[3], z[4]]))
+        x = np.array([x[0], x[2], x[1], x[3], x[4], x[5]])   # the legs swapped: pre-impact
+        imp = reaction.transition(x)
+        assert np.max(np.abs(imp.heel_strike - ref.impact_impulse(side * w, x))) < 1e-11
+        assert np.all(imp.push_off == 0.0)
+        assert imp.heel_strike_normal > 0

@@ -118,6 +118,39 @@ class PartsReference:
         dqp = sol[:3]
         return np.array([q[0], q[2], q[1], dqp[0], dqp[2], dqp[1]])
 
+    def ground_wrench(self, w, x):
+        """The ground's force (3,) [N] and its moment about the stance foot (3,) [N m] at the
+        state ``x`` of a step, world axes: Newton's and Euler's laws on the point masses,
+        ``sum m (a - g)`` and ``sum r x m (a - g)``, with ``a = J qdd + Jdot dq`` and this
+        model's own ``qdd`` (the rigid stance foot: no slip, no turn)."""
+        masses, _ = self.points(w)
+        q, dq = x[:3], x[3:]
+        qdd = self.rhs(w)(0.0, x)[3:]
+        grav = np.array([0.0, -self.g, 0.0])
+        force, moment = np.zeros(3), np.zeros(3)
+        for m, terms in masses:
+            r, J, h = self.kin(terms, q, dq)
+            f = m * (J @ qdd + h - grav)
+            force += f
+            moment += np.cross(r, f)
+        return force, moment
+
+    def impact_impulse(self, w, y):
+        """The ground's impulse (3,) [N s] at the new stance foot in the heel strike from the
+        pre-impact state ``y`` (the Lagrange multiplier of :meth:`impact`; the old foot
+        leaves with none), world axes."""
+        masses, foot = self.points(w)
+        q, dq = y[:3], y[3:]
+        Me = np.zeros((6, 6))
+        for m, terms in masses:
+            Je = np.hstack([self.kin(terms, q, dq)[1], np.eye(3)])
+            Me += m * Je.T @ Je
+        E = np.hstack([self.kin(foot, q, dq)[1], np.eye(3)])
+        K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
+        sol = np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
+                                                  np.zeros(3)]))
+        return sol[6:]
+
     def on_surface(self, w, z):
         """The state just after a heel strike of section coordinates ``z = [lean, stance,
         rates]``: the swing foot on the slope behind, by Brent's method."""

@@ -11,13 +11,17 @@ Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
 =====================================  ========================================================
 ``dyn(x, p, M, h)``                    ``M`` (nq, nq) [kg, kg m, kg m^2], ``h`` (nq,) [N, N m]
 ``dyn_jac(x, a, p, Dq, Dv)``           ``d(M a + h)/dq``, ``dh/d dq`` (nq, nq), ``a`` fixed
-``feet(x, p, P, V, J)``                contact points ``P`` (nf, 2) [m], material velocities
-                                       ``V`` (nf, 2) [m/s], Jacobians ``J`` (nf, 2, nq)
-``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (nf, 2, nq) and
-                                       ``dJtF = d(sum_i J_i^T F_i)/dq`` (nq, nq), ``F`` (nf, 2)
+``feet(x, p, P, V, J)``                contact points ``P`` (nf, d) [m], material velocities
+                                       ``V`` (nf, d) [m/s], Jacobians ``J`` (nf, d, nq)
+``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (nf, d, nq) and
+                                       ``dJtF = d(sum_i J_i^T F_i)/dq`` (nq, nq), ``F`` (nf, d)
 ``energies(X, p)``                     numpy: kinetic, potential [J] of states (2 nq, k)
-``points(X, p)``                       numpy: named points (2, k) [m]
+``points(X, p)``                       numpy: named points (d, k) [m]
 =====================================  ========================================================
+
+``d`` (the module's ``DIM``) is 2 for a planar walker (world axes ``x`` downhill, ``y`` up) and
+3 for a walker in 3D (:func:`walkerlab.codegen.floating_equations.derive_floating`; ``z``
+lateral).
 
 Massless bodies (the simplest walker's legs) have no floating model: :func:`check_masses`
 raises.
@@ -33,7 +37,9 @@ import numpy as np
 
 from walkerlab.codegen.floating_equations import (
     FOOT_PARAMS,
+    FREE_3D,
     MASSLESS_MESSAGE,
+    ROLES_3D,
     WHEEL_COORDINATES,
     FloatingEquations,
     check_masses,
@@ -44,7 +50,8 @@ from walkerlab.codegen.floating_equations import (
 )
 from walkerlab.walker.description import Structure, WalkerData
 
-__all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "HUB_INERTIA_MESSAGE", "MASSLESS_MESSAGE",
+__all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "FREE_3D", "HUB_INERTIA_MESSAGE",
+           "MASSLESS_MESSAGE", "ROLES_3D",
            "WHEEL_COORDINATES", "FloatingEquations",
            "FloatingView", "check_masses", "contact_names", "coordinate_names",
            "derive_floating", "floating_module", "floating_params", "floating_view",
@@ -174,27 +181,28 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
     lines.insert(2, f"    {', '.join(str(s) for s in a)}, = a[0], "
                  + ", ".join(f"a[{i}]" for i in range(1, nq)))
     body += lines
-    # feet
+    # feet (2 or 3 components: a planar or a 3D walker's)
+    d = eq.feet[0][0].shape[0]
     outs = []
     for i, (pos, J) in enumerate(eq.feet):
         v = J * dqv
-        outs += [(f"P[{i}, {r}]", pos[r]) for r in range(2)]
-        outs += [(f"V[{i}, {r}]", v[r]) for r in range(2)]
-        outs += [(f"J[{i}, {r}, {k}]", J[r, k]) for r in range(2) for k in range(nq)]
+        outs += [(f"P[{i}, {r}]", pos[r]) for r in range(d)]
+        outs += [(f"V[{i}, {r}]", v[r]) for r in range(d)]
+        outs += [(f"J[{i}, {r}, {k}]", J[r, k]) for r in range(d) for k in range(nq)]
     body += _fn("feet", "x, p, P, V, J", eq, outs, pr)
     nf = len(eq.feet)
-    F = sp.Matrix(nf, 2, sp.symbols(f"F0:{2 * nf}", real=True))
+    F = sp.Matrix(nf, d, sp.symbols(f"F0:{d * nf}", real=True))
     outs = []
     JtF = sp.zeros(nq, 1)
     for i, (_, J) in enumerate(eq.feet):
         dV = (J * dqv).jacobian(qv)
-        outs += [(f"dV[{i}, {r}, {k}]", dV[r, k]) for r in range(2) for k in range(nq)]
+        outs += [(f"dV[{i}, {r}, {k}]", dV[r, k]) for r in range(d) for k in range(nq)]
         JtF += J.T * F[i, :].T
     dJ = JtF.jacobian(qv)
     outs += [(f"dJtF[{i}, {k}]", dJ[i, k]) for i in range(nq) for k in range(nq)]
     lines = _fn("feet_jac", "x, F, p, dV, dJtF", eq, outs, pr)
     lines.insert(2, f"    {', '.join(str(f) for f in F)} = "
-                 + ", ".join(f"F[{i}, {r}]" for i in range(nf) for r in range(2)))
+                 + ", ".join(f"F[{i}, {r}]" for i in range(nf) for r in range(d)))
     body += lines
     body += _numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential})
     body += ["def energies(X, p):", "    d = _energies(X, p)",
@@ -204,7 +212,7 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
             "# Do not edit: regenerated when the walker description or the generator changes.",
             "from math import sin, cos, tan, sqrt  # noqa: F401",
             "import numpy  # noqa: F401", "import numpy as np", "from numba import njit", "",
-            f"NQ = {nq}", f"COORDINATES = {tuple(str(s) for s in eq.q)!r}", ""]
+            f"NQ = {nq}", f"DIM = {d}", f"COORDINATES = {tuple(str(s) for s in eq.q)!r}", ""]
     return "\n".join(head + body) + "\n"
 
 

@@ -63,6 +63,14 @@ LEGS = ("leg1", "leg2")
 #: Floating-view parameters of a flat foot (not in the walker description, whose foot is
 #: massless): its mass at the ankle [kg] and its inertia about the ankle [kg m^2].
 FOOT_PARAMS = ("m_foot", "I_foot")
+#: A 3D walker's free coordinates (:func:`walkerlab.walker.tree.free_root`): leg2's foot in
+#: world axes (``x`` downhill, ``y`` up, ``z`` lateral) [m], and the heading, a turn about the
+#: slope's normal [rad]; the rigid roles' coordinates follow, renamed by :data:`ROLES_3D`.
+FREE_3D = ("leg2_foot_x", "leg2_foot_y", "leg2_foot_z", "heading")
+#: A 3D walker's rigid roles (leg1 swinging, leg2 standing) -> its floating coordinates
+#: (:func:`walkerlab.codegen.derive_3d.derive_compass`'s: the lean is the stance leg's roll)
+ROLES_3D = {"lean": "leg2_roll", "swing": "leg1_angle", "stance": "leg2_angle",
+            "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll"}
 #: The floating view's coordinates of a spoked wheel (``model: rimless_wheel``): the hub's
 #: position [m] and the absolute angle of spoke 0 [rad] (from the downward vertical,
 #: positive when its tip is ahead of the hub).
@@ -71,6 +79,8 @@ WHEEL_COORDINATES = ("hip_x", "hip_y", "wheel_angle")
 
 def coordinate_names(structure: Structure) -> tuple[str, ...]:
     """Names of the floating view's generalised coordinates (module docstring)."""
+    if structure.in_3d:
+        return FREE_3D + tuple(ROLES_3D[r] for r in structure.roles)
     if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
         return WHEEL_COORDINATES
     if structure.knee:
@@ -178,8 +188,12 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     """
     import sympy as sp
 
+    from walkerlab.codegen.lagrange import bias  # light: sympy on first derivation only
+
     check_floating_view(structure)
     check_masses(structure)
+    if structure.in_3d:
+        return _derive_3d(structure)
     if structure.spokes:
         return _derive_spoked(structure)
     if structure.foot not in ("point", "arc", "flat"):
@@ -189,12 +203,10 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     bodies, feet, points = _legs(s)
     psi_t = _torso(s, bodies, points)
     M, V = _mass_and_potential(s, bodies)
-    dqv, qv = sp.Matrix(dq), sp.Matrix(q)
+    dqv = sp.Matrix(dq)
     T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
     V, damping = _springs(s, V, psi_t)
-    h = (M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, v) for v in q]) \
-        + sp.Matrix([sp.diff(V, v) for v in q]) + damping * dqv
-    h = h.applyfunc(sp.expand)
+    h = (bias(M, V, q, dq) + damping * dqv).applyfunc(sp.expand)
     return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(s.par), M=M, h=h,
                              feet=tuple(feet), kinetic=T, potential=V, points=points,
                              knees=tuple((names.index(f"{leg}_thigh_angle"),
@@ -447,3 +459,62 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
                              point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
 
 
+
+
+def _derive_3d(structure: Structure) -> FloatingEquations:
+    """The floating view of a 3D straight-legged walker from its body tree
+    (:func:`walkerlab.walker.trees.legs_3d_tree`, Kuo 1999), set free at leg2's foot
+    (:func:`walkerlab.walker.tree.free_root`: slides along ``s, n, z`` and a heading, then
+    the rigid tree's joints in its own coordinates renamed by :data:`ROLES_3D`): the mass
+    matrix and potential of :func:`walkerlab.codegen.tree_derive.mass_and_potential`, the
+    bias of :func:`walkerlab.codegen.lagrange.bias`, unsimplified (common subexpressions
+    are the generated code's).  Positions in world axes (``x`` downhill, ``y`` up, ``z``
+    lateral), as a planar walker's; the feet ``leg1`` (the rigid model's swing foot) and
+    ``leg2`` (its stance foot, the root's contact).
+    The hip-roll law's torques act between bodies (no force on the free coordinates): the
+    view leaves them out.
+
+    Raises
+    ------
+    ValueError
+        Round feet or a spoked wheel (a rolling contact's material point is not yet a
+        contact point of the tree).
+    """
+    import sympy as sp
+
+    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
+    from walkerlab.codegen.lagrange import bias  # light
+    from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
+    from walkerlab.walker.tree import free_root
+    from walkerlab.walker.trees import legs_3d_tree
+
+    if structure.spokes or structure.foot != "point":
+        raise ValueError("walker.leg.foot: a walker in 3D has a floating view (its ground "
+                         "reaction) with point feet only so far")
+    rigid, coords = legs_3d_tree(structure)
+    tree, fcoords = free_root(rigid, coords, FREE_3D)
+    kin = kinematics(tree, fcoords)
+    names = coordinate_names(structure)
+    q = sp.symbols(names, real=True)
+    dq = sp.symbols([f"d_{n}" for n in names], real=True)
+    rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
+    M, _, _, V = mass_and_potential(kin)
+    M, V = M.xreplace(rename), V.xreplace(rename)
+    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    h = bias(M, V, q, dq)
+    to_world = slope_to_world(kin.gamma)
+    feet, points = [], {}
+    for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
+        pos = to_world * kin.contacts[contact].xreplace(rename)
+        feet.append((pos, pos.jacobian(qv)))
+        points[f"{leg}_foot"] = pos
+    points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
+    for b in structure.bodies:
+        for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
+            points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)
+    for b in structure.torso:
+        points[f"torso_{b.name}"] = to_world * kin.coms[f"torso_{b.name}"].xreplace(rename)
+    return FloatingEquations(q=tuple(q), dq=tuple(dq),
+                             params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
+                             kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
+                             points=points, contacts=LEGS, point_legs=(0, 1))

@@ -1,5 +1,5 @@
 """The Lagrangian core every walker generator shares: the Coriolis matrix of a mass matrix
-from its Christoffel symbols, written once.
+from its Christoffel symbols, and the bias of a floating view, each written once.
 
 Lagrange's equations of a walker with coordinates ``q`` (n,), kinetic energy
 ``T = dq^T M(q) dq / 2`` and potential ``V(q)`` are ``M qdd + C(q, dq) dq + G(q) = 0`` with
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["christoffel"]
+__all__ = ["bias", "christoffel"]
 
 
 def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
@@ -43,3 +43,27 @@ def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
                                                - sp.diff(M[j, k], q[i])) * dq[k]
                           for k in range(n))
     return C
+
+
+def bias(M: sp.Matrix, V, q, dq) -> sp.Matrix:
+    """The bias ``h = d(M dq)/dq dq - dT/dq + dV/dq`` (``= C(q, dq) dq + G(q)``) of the mass
+    matrix ``M(q)`` and potential ``V(q)``, without the Christoffel symbols: what a floating
+    view integrates (``M qdd + h = J^T F``), where ``C`` itself is never needed.
+
+    Parameters
+    ----------
+    M : sympy Matrix (n, n)
+        Symmetric mass matrix, a function of ``q``.
+    V : Expr
+        Potential energy [J].
+    q, dq : sequence of Symbol (n,)
+
+    Returns
+    -------
+    sympy Matrix (n, 1)
+        [N, N m by coordinate].
+    """
+    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+    return ((M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, v) for v in q])
+            + sp.Matrix([sp.diff(V, v) for v in q]))

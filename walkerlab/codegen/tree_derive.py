@@ -52,7 +52,7 @@ from walkerlab.codegen.seeded import seeded
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
 __all__ = ["TreeEquations", "TreeKinematics", "derive_tree", "heel_strike", "kinematics",
-           "plastic_impact", "trig_simplify"]
+           "mass_and_potential", "plastic_impact", "trig_simplify"]
 
 
 def trig_simplify(e: sp.Expr) -> sp.Expr:
@@ -207,6 +207,40 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
                           gamma=num(tree.root.slope_rad), g=num(tree.root.gravity_m_per_s2))
 
 
+def mass_and_potential(kin: TreeKinematics) -> tuple[sp.Matrix, sp.Matrix, sp.Expr, sp.Expr]:
+    """The mass matrix, the extended mass matrix's coupling, the total mass and the potential
+    of a tree's kinematics (module docstring), unsimplified.
+
+    Returns
+    -------
+    M : Matrix (n, n)
+        ``sum_b m_b J_c^T J_c + J_w^T I_b J_w`` [kg m^2, kg m, kg by coordinate].
+    A : Matrix (n, 3)
+        ``sum_b m_b J_c^T`` [kg m or kg].
+    total_mass : Expr
+        [kg].
+    V : Expr
+        ``sum_b m_b g up . r_c`` [J], from the root's origin.
+    """
+    qv, dqv = sp.Matrix(kin.q), sp.Matrix(kin.dq)
+    n = len(kin.q)
+    M, A, total = sp.zeros(n, n), sp.zeros(n, 3), sp.Integer(0)
+    V = sp.Integer(0)
+    up = slope_up(kin.gamma)
+    for name, r in kin.coms.items():
+        m, inertia = kin.masses[name], kin.inertias[name]
+        if m != 0:
+            Jc = r.jacobian(qv)
+            M += m * Jc.T * Jc
+            A += m * Jc.T
+            total += m
+            V += m * kin.g * (up.T * r)[0]
+        if inertia != sp.zeros(3, 3):
+            Jw = kin.omegas[name].jacobian(dqv)
+            M += Jw.T * inertia * Jw
+    return M, A, total, V
+
+
 @seeded
 def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
                 simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify) -> TreeEquations:
@@ -232,22 +266,8 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
     """
     kin = kinematics(tree, coords)
     q, dq = kin.q, kin.dq
-    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
-    n = len(q)
-    M, A, total = sp.zeros(n, n), sp.zeros(n, 3), sp.Integer(0)
-    V = sp.Integer(0)
-    up = slope_up(kin.gamma)
-    for name, r in kin.coms.items():
-        m, inertia = kin.masses[name], kin.inertias[name]
-        if m != 0:
-            Jc = r.jacobian(qv)
-            M += m * Jc.T * Jc
-            A += m * Jc.T
-            total += m
-            V += m * kin.g * (up.T * r)[0]
-        if inertia != sp.zeros(3, 3):
-            Jw = kin.omegas[name].jacobian(dqv)
-            M += Jw.T * inertia * Jw
+    dqv = sp.Matrix(dq)
+    M, A, total, V = mass_and_potential(kin)
     M = M.applyfunc(simplify)
     C = christoffel(M, q, dq)
     G = sp.Matrix([sp.expand(sp.diff(V, qi)) for qi in q])

@@ -20,6 +20,7 @@ from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
     ground_contact_text,
     neutral_multipliers_text,
+    twist_text,
     zero_dynamics_text,
     zero_multipliers_text,
 )
@@ -71,6 +72,9 @@ def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
     if g is not None:  # a gait that needs the ground to pull is no gait on real ground
         bullets.append("- **Ground reaction**: " + ground_contact_text(g, u).split(
             ": ", 1)[1] + ".")
+        twist = twist_text(g, u)
+        if twist is not None:  # a 3D gait: the stance foot's moment about the normal
+            bullets.append("- **Stance foot twist**: " + twist.split(": ", 1)[1] + ".")
     eq = dict(zip(*published_fixed_point(pub)))
     for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
         # as many digits as the published value has, so the two can be compared digit by digit

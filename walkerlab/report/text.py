@@ -138,6 +138,28 @@ def ground_contact_text(g, u) -> str:
             + f"; friction coefficient needed {v['max_friction_ratio']:.3g})")
 
 
+#: a twist at most this [N m] is none (round-off of a gait that needs none)
+TWIST_NONE_N_M = 1e-9
+
+
+def twist_text(g, u) -> str | None:
+    """One line on the moment about the slope's normal a 3D gait's stance foot carries (``g``:
+    the stored check, ``u``: the units), or None (a planar gait, or not checked)."""
+    v = g.values
+    if "max_twist_n_m" not in v:
+        return None
+    r = v.get("twist_patch_radius_m", float("nan"))
+    if v["max_twist_n_m"] <= TWIST_NONE_N_M:  # e.g. a walker of zero hip width, upright
+        return (f"stance foot twist: none (at most {v['max_twist_n_m']:.2g} {u('N m')} about "
+                "the slope's normal: a point foot holds this gait)")
+    hold = ("" if r != r else f", a round foot patch of radius >= "
+            f"{r * u.small_scale:.3g} {u.small_length} could by friction with the ground's mu")
+    return (f"stance foot twist: up to {v['max_twist_n_m']:.4g} {u('N m')} about the slope's "
+            f"normal at t = {v['max_twist_time_s']:.4g} {u.time}, carried by the rigid "
+            f"model's stance joint (it lets the foot roll and pitch, not turn); a point foot "
+            f"cannot hold it{hold}")
+
+
 def footholds_text(fh: dict) -> str:
     """Lines on a stair gait's footholds (``fixedpoint.h5``'s ``footholds/``, SI): step
     advance, tread drift, the footfall that would miss a tread, the swing foot's clearances
@@ -248,6 +270,9 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
         lines.append(ground_contact_text(fp.ground_contact, u))
         if fp.ground_contact.friction is not None:
             lines.append(fp.ground_contact.friction.text())
+        twist = twist_text(fp.ground_contact, u)
+        if twist is not None:
+            lines.append(twist)
     if _terrain_kind(fp.scene_json) == "profile":
         lines.append("ground: terrain.kind: profile: this is the gait of the scene's slope, "
                      "where the walk on the profile starts (walkerlab simulate walks the "

@@ -33,6 +33,7 @@ import math
 from dataclasses import dataclass, field
 
 __all__ = ["Body", "BodyTree", "ContactPoint", "CoordinateMap", "Joint", "Root", "JOINT_AXES",
+           "free_root",
            "ZERO_INERTIA", "diagonal"]
 
 #: number of axes (and coordinates) of each joint kind
@@ -327,3 +328,57 @@ class CoordinateMap:
         known = params | frozenset(self.names)
         for c, expr in self.joint_angles:
             _check_scalar(expr, f"coordinates.joint_angles[{c}]", known)
+
+
+def free_root(tree: BodyTree, coords: CoordinateMap, names: tuple[str, str, str, str]
+              ) -> tuple[BodyTree, CoordinateMap]:
+    """The floating view of a tree: its root's contact point set free, as Drake's
+    ``MultibodyPlant`` floats a body the world does not weld (a free joint).
+
+    Three slides along the world's axes ``x`` (horizontal, downhill), ``y`` (up) and ``z``
+    (lateral), written in the slope's frame through the root's slope, and a turn about the
+    slope's normal ``n`` (a heading) carry every body that hung from the root; with all
+    four at zero the tree is ``tree``.  The turn comes after the slides, then the tree's
+    own joints (a universal ankle's roll and pitch: Euler angles heading, roll, pitch,
+    singular only with the leg lying on the slope).  The root's origin stays the slope's:
+    the slides are the stance contact's position from it in world axes [m], the heading
+    its turn [rad].
+
+    Parameters
+    ----------
+    tree : BodyTree
+    coords : CoordinateMap
+        The walker's coordinates of ``tree``.
+    names : tuple of 4 str
+        The free coordinates' names (slides along world ``x``, ``y``, ``z``, then the
+        heading).
+
+    Returns
+    -------
+    BodyTree, CoordinateMap
+        The tree with the free joints first (massless bodies ``<name>``), and the map with
+        the free coordinates first (each its own joint's).
+
+    Raises
+    ------
+    ValueError
+        A name already a body, coordinate or parameter of the tree (from the validation).
+    """
+    gamma = tree.root.slope_rad      # world x and y in the slope's frame (s, n, z)
+    c, s = (f"cos({gamma})", f"sin({gamma})") if isinstance(gamma, str) else (
+        math.cos(gamma), math.sin(gamma))
+    minus_s = f"-sin({gamma})" if isinstance(gamma, str) else -s
+    axes = ((c, s, 0), (minus_s, c, 0), (0, 0, 1), (0, 1, 0))
+    kinds = ("prismatic",) * 3 + ("revolute",)
+    free, parent = [], tree.root.name
+    for name, kind, axis in zip(names, kinds, axes):
+        free.append(Body(name, 0, ZERO_INERTIA, (0, 0, 0),
+                         Joint(name, kind, parent, (0, 0, 0), (axis,), (name,))))
+        parent = name
+    bodies = tuple(b if b.joint.parent != tree.root.name else
+                   Body(b.name, b.mass_kg, b.inertia_kg_m2, b.com_m,
+                        Joint(b.joint.name, b.joint.kind, parent, b.joint.origin_m,
+                              b.joint.axes, b.joint.coordinates)) for b in tree.bodies)
+    floating = BodyTree(tree.params, tree.root, tuple(free) + bodies, tree.contacts)
+    return floating, CoordinateMap(tuple(names) + coords.names,
+                                   tuple((n, n) for n in names) + coords.joint_angles)

@@ -154,6 +154,19 @@ class GroundContact:
         The friction the gait needs at every foot on the ground against the ground's
         ``mu`` (None: no ``mu`` given); made for flat feet too, whose normal forces the
         rigid model's own guards check.
+    max_twist_n_m : float
+        A walker in 3D: the largest moment about the slope's normal the stance foot carries
+        over the map's continuous phases [N m] (the rigid model's stance joint lets the foot
+        roll and pitch but never turn; a point foot on real ground cannot hold any); NaN in
+        the plane.
+    max_twist_time_s : float
+        When it occurs, from the start of the map [s].
+    twist_patch_radius_m : float
+        A walker in 3D: the radius of the smallest round, evenly pressed foot patch whose
+        Coulomb friction holds that twist, the largest over the samples of ``3 |M_n| /
+        (2 mu F_n)`` (a disc of radius ``r`` pressed by ``F_n`` resists a turn with at most
+        ``2 mu F_n r / 3``: the torsional friction of a uniform pressure disc); NaN in the
+        plane or without ``mu``.
     """
 
     min_normal_force_n: float = np.nan
@@ -164,6 +177,9 @@ class GroundContact:
     trailing_foot_normal_velocity_m_per_s: float = np.nan
     not_checked: str = ""
     friction: object | None = None
+    max_twist_n_m: float = np.nan
+    max_twist_time_s: float = np.nan
+    twist_patch_radius_m: float = np.nan
 
     @property
     def ok(self) -> bool | None:
@@ -221,6 +237,7 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
     traj = simulate_steps(walker, np.asarray(x, float), walker.steps_per_map, solver)
     n = np.asarray(x).size
     n_min, t_min, ratio = np.inf, np.nan, 0.0
+    twist, t_twist, radius = np.nan, np.nan, np.nan
     hs, po, vt = np.inf, np.inf, np.inf
     forces = []  # (t, F_n, F_t) of the stance foot: the friction verdict's samples
     for seg in traj.segments:
@@ -230,8 +247,14 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
         for phase, sol, (ta, tb) in seg.pieces:
             for t in np.linspace(ta, tb, samples):
                 xs = np.ravel(sol(t))[:n]
-                fn, ft = sr.normal_and_tangential(sr.force(t, xs, phase.flow))
+                F, moment = sr.force_and_twist(t, xs, phase.flow)
+                fn, ft = sr.normal_and_tangential(F)
                 forces.append((float(t), float(fn), float(ft)))
+                if not np.isnan(moment):  # a walker in 3D: the twist its stance foot needs
+                    if np.isnan(twist) or abs(moment) > twist:
+                        twist, t_twist = abs(moment), float(t)
+                    if mu is not None and fn > 0:
+                        radius = np.nanmax([radius, 1.5 * abs(moment) / (mu * fn)])
                 if fn < n_min:
                     n_min, t_min = fn, float(t)
                 if fn > 0:
@@ -246,4 +269,5 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
         friction = stance_friction(forces, mu, mu_source,
                                    float(data.total_mass_kg) * float(data.gravity_m_per_s2))
     return GroundContact(float(n_min), t_min, float(ratio), float(hs), float(po), float(vt),
-                         friction=friction)
+                         friction=friction, max_twist_n_m=float(twist),
+                         max_twist_time_s=t_twist, twist_patch_radius_m=float(radius))

@@ -12,7 +12,9 @@ variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 ``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
 evaluations, wall time [s]); ``ground_contact/`` (the selected gait: whether the ground only
 pushes, :data:`GROUND_FIELDS`; ``ground_contact/friction/``: the friction it needs at
-every foot on the ground against the ground's ``mu``, :data:`FRICTION_FIELDS`); on stairs
+every foot on the ground against the ground's ``mu``, :data:`FRICTION_FIELDS`; for a walker
+in 3D ``ground_contact/twist/``: the moment about the normal the stance foot carries,
+:data:`TWIST_FIELDS`); on stairs
 ``footholds/`` (attributes of :class:`walkerlab.analysis.gait.treads.TreadLanding`: step
 advance [m], tread drift per step [m], steps until a foot misses a tread, clearances [m]);
 under virtual constraints
@@ -249,6 +251,19 @@ GROUND_FIELDS = {
 }
 
 
+#: ``ground_contact/twist/`` datasets (a walker in 3D only): attribute of the check -> (name,
+#: unit, meaning)
+TWIST_FIELDS = {
+    "max_twist_n_m": ("max_twist", "N m", "largest moment about the slope's normal on the "
+                      "stance foot (the rigid stance joint lets it roll and pitch, never "
+                      "turn: a point foot cannot hold it)"),
+    "max_twist_time_s": ("max_twist_time", "s", "when it occurs, from the map's start"),
+    "twist_patch_radius_m": ("patch_radius", "m", "radius of the smallest round, evenly "
+                             "pressed foot patch whose friction holds the twist (3 |M_n| / "
+                             "(2 mu F_n), largest over the phase; NaN: no mu)"),
+}
+
+
 #: ``ground_contact/friction/`` datasets: attribute of the verdict -> (name, unit, meaning)
 FRICTION_FIELDS = {
     "max_ratio": ("max_ratio", "-", "largest |tangential| / normal force over every foot on "
@@ -279,6 +294,10 @@ def _write_ground(g, ground) -> None:
     g.attrs["not_checked"] = ground.not_checked
     for attr, (name, unit, what) in GROUND_FIELDS.items():
         put(g, name, float(getattr(ground, attr)), unit, what)
+    if not np.isnan(getattr(ground, "max_twist_n_m", np.nan)):  # 3D: planar ones unchanged
+        t = g.create_group("twist")
+        for attr, (name, unit, what) in TWIST_FIELDS.items():
+            put(t, name, float(getattr(ground, attr)), unit, what)
     fr = getattr(ground, "friction", None)
     if fr is not None:  # new beside the datasets above (which stay as they were)
         h = g.create_group("friction")
@@ -316,9 +335,12 @@ def _ground(f) -> GroundContactRecord | None:
                if name in h},
             foot=str(h.attrs["foot"]), mu_source=str(h.attrs["mu_source"]),
             not_checked=str(h.attrs["not_checked"]))
+    values = {a: float(g[name][()]) for a, (name, _, _) in GROUND_FIELDS.items() if name in g}
+    if "twist" in g:  # a walker in 3D
+        values.update({a: float(g["twist"][name][()]) for a, (name, _, _) in
+                       TWIST_FIELDS.items()})
     return GroundContactRecord(None if ok < 0 else bool(ok), str(g.attrs["not_checked"]),
-                               {a: float(g[name][()]) for a, (name, _, _) in
-                                GROUND_FIELDS.items() if name in g}, friction)
+                               values, friction)
 
 
 @dataclass

@@ -44,6 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.codegen.floating import (
+    FREE_3D,
+    ROLES_3D,
     contact_names,
     coordinate_names,
     floating_params,
@@ -91,11 +93,12 @@ _PARTS = {
 
 
 def _part(kind) -> _Part:
-    """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): a walker
-    in 3D is refused (its reaction is a force in 3D), a planar one is its rigid model's."""
-    if kind.in_3d:
-        return _Part(refusal=f"{'a wheel' if kind.spoked else 'a walker'} in 3D: its stance "
-                             "foot's reaction (a force in 3D) is not computed yet")
+    """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): a wheel
+    in 3D is refused (its floating view is not yet its tree's), any other its rigid
+    model's."""
+    if kind.in_3d and kind.spoked:
+        return _Part(refusal="a wheel in 3D: its stance foot's reaction (a force in 3D) is "
+                             "not computed yet")
     return _PARTS[kind.rigid]
 
 
@@ -108,7 +111,7 @@ class _View:
     def __init__(self, data):
         mod = floating_plain(data.structure)  # raises for a massless body
         self.params = np.asarray(floating_params(data), float)
-        self.nq = int(mod["NQ"])
+        self.nq, self.dim = int(mod["NQ"]), int(mod["DIM"])
         self.names = contact_names(data.structure)
         self.coordinates = coordinate_names(data.structure)
         self._dyn, self._feet, self._feet_jac = mod["dyn"], mod["feet"], mod["feet_jac"]
@@ -123,18 +126,18 @@ class _View:
         return M, h
 
     def contact_points(self, q, dq=None):
-        """Contact points (nf, 2) [m], material velocities (nf, 2) [m/s], Jacobians
-        (nf, 2, nq)."""
-        nf = len(self.names)
-        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, self.nq))
+        """Contact points (nf, d) [m], material velocities (nf, d) [m/s], Jacobians
+        (nf, d, nq) (``d`` 2 in the plane, 3 in 3D: world axes)."""
+        nf, d = len(self.names), self.dim
+        P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, self.nq))
         self._feet(self._x(q, dq), self.params, P, V, J)
         return P, V, J
 
     def velocity_gradient(self, q, dq) -> np.ndarray:
-        """``d V_i / dq`` (nf, 2, nq) at fixed rates: ``(dV/dq) dq = Jdot dq``."""
-        nf = len(self.names)
-        dV, dJtF = np.empty((nf, 2, self.nq)), np.empty((self.nq, self.nq))
-        self._feet_jac(self._x(q, dq), np.zeros((nf, 2)), self.params, dV, dJtF)
+        """``d V_i / dq`` (nf, d, nq) at fixed rates: ``(dV/dq) dq = Jdot dq``."""
+        nf, d = len(self.names), self.dim
+        dV, dJtF = np.empty((nf, d, self.nq)), np.empty((self.nq, self.nq))
+        self._feet_jac(self._x(q, dq), np.zeros((nf, d)), self.params, dV, dJtF)
         return dV
 
 
@@ -206,7 +209,7 @@ class StanceReaction:
         phi = float(walker.slope_rad)
         self.normal = np.array([np.sin(phi), np.cos(phi)])
         self.tangent = np.array([np.cos(phi), -np.sin(phi)])
-        self.view = None
+        self.view, self._roles, self._heading = None, None, None
         if self.part.hub or any(b.massless for b in st.bodies):  # all the mass at the hub
             if not st.hip_mass or any(not b.massless for b in (*st.bodies, *st.torso)):
                 floating_plain(st)  # raises: a massless body beside massive ones
@@ -216,11 +219,17 @@ class StanceReaction:
             return
         self.view = _View(data)
         coords = tuple(self.view.coordinates)
+        self._feet = {r: self.view.names.index(f) for r, f in _FOOT_OF_ROLE.items()}
+        if self.view.dim == 3:  # free at the stance foot: its slides, its heading, the roles
+            self.normal, self.tangent = np.append(self.normal, 0.0), None
+            self._hip, self._heading = list(range(3)), coords.index(FREE_3D[3])
+            self._roles = [coords.index(ROLES_3D[r]) for r in walker.roles]
+            self._links = [i for i in range(len(coords)) if i not in self._hip]
+            return
         self._layout = StateLayout.floating(coords, coords + tuple(f"d_{c}" for c in coords),
                                             ("",) * (2 * len(coords)))
         self._hip = [coords.index("hip_x"), coords.index("hip_y")]
         self._links = [i for i in range(len(coords)) if i not in self._hip]
-        self._feet = {r: self.view.names.index(f) for r, f in _FOOT_OF_ROLE.items()}
 
     # ------------------------------------------------------------------ state maps
     def _values(self, x) -> dict:
@@ -242,6 +251,8 @@ class StanceReaction:
         stance foot's material point at rest (``swapped``: ``x`` is a post-impact state,
         roles swapped, and is expressed in the pre-impact labels: its stance leg in the
         swing leg's place).  The hip's position is 0 (nothing here depends on it)."""
+        if self._roles is not None:  # 3D: the view's coordinates are the roles'
+            return self._floating_3d(x, "swing" if swapped else "stance")
         vals = self._values(x)
         if swapped:
             flip = {"swing": "stance", "stance": "swing"}
@@ -253,6 +264,18 @@ class StanceReaction:
         q[self._links], dq[self._links] = z[:m], z[m:]
         _, V, _ = self.view.contact_points(q, dq)
         dq[self._hip] = -V[self._feet["swing" if swapped else "stance"]]
+        return q, dq
+
+    def _floating_3d(self, x, rest: str) -> tuple[np.ndarray, np.ndarray]:
+        """A 3D walker's :meth:`floating_state`: the rigid coordinates (``x`` (2n,) in the
+        labels of this step) by role, no heading, the free slides' rates those that hold
+        the foot of the role ``rest`` at rest."""
+        x = np.asarray(x, float)
+        n = x.size // 2
+        q, dq = np.zeros(self.view.nq), np.zeros(self.view.nq)
+        q[self._roles], dq[self._roles] = x[:n], x[n:]
+        _, V, _ = self.view.contact_points(q, dq)
+        dq[self._hip] = -V[self._feet[rest]]
         return q, dq
 
     def _link_acceleration(self, x, xdot) -> np.ndarray:
@@ -288,26 +311,48 @@ class StanceReaction:
 
     # ------------------------------------------------------------------ forces
     def force(self, t: float, x, flow) -> np.ndarray:
-        """The ground's force on the stance foot (2,) [N], world axes, at state ``x`` (2n,)
-        of a phase whose flow is ``flow(t, x) -> xdot (2n,)``."""
+        """The ground's force on the stance foot (d,) [N], world axes (``d`` 2 in the plane,
+        3 in 3D: ``z`` lateral), at state ``x`` (2n,) of a phase whose flow is
+        ``flow(t, x) -> xdot (2n,)``."""
+        return self.force_and_twist(t, x, flow)[0]
+
+    def force_and_twist(self, t: float, x, flow) -> tuple[np.ndarray, float]:
+        """The ground's force on the stance foot (d,) [N] (:meth:`force`) and, in 3D, its
+        moment about the slope's normal through the foot [N m] (the twist the rigid
+        model's stance joint carries: it lets the foot roll and pitch, never turn); NaN in
+        the plane, where no moment can turn the foot.
+
+        The force and the moment are the rows of the free slides and of the heading of
+        ``M qdd + h`` in the floating view (module docstring): a slide of the whole walker
+        is worked on by the ground's force alone, a turn about the normal through the
+        stance foot by its moment alone (joint torques are between the walker's bodies)."""
         xdot = np.asarray(flow(t, np.asarray(x, float)), float)
         if self.view is None:  # all the mass at the hip
             return self.hip_mass_kg * (self._hip_acceleration(x, xdot)
-                                       + np.array([0.0, self.g]))
+                                       + np.array([0.0, self.g])), np.nan
         q, dq = self.floating_state(x)
         qdd = np.zeros(self.view.nq)
-        qdd[self._links] = self._link_acceleration(x, xdot)
+        if self._roles is not None:
+            qdd[self._roles] = xdot[xdot.size // 2:]
+        else:
+            qdd[self._links] = self._link_acceleration(x, xdot)
         i = self._feet["stance"]
         _, _, J = self.view.contact_points(q, dq)
         dV = self.view.velocity_gradient(q, dq)
         qdd[self._hip] = -(J[i][:, self._links] @ qdd[self._links] + dV[i] @ dq)
         M, h = self.view.dynamics(q, dq)
-        return (M @ qdd + h)[self._hip]
+        rows = M @ qdd + h
+        return rows[self._hip], (np.nan if self._heading is None else
+                                 float(rows[self._heading]))
 
     def normal_and_tangential(self, F) -> tuple[float, float]:
-        """``(F . n, F . t)`` [N] of a force (2,) (n outward, t down the slope)."""
+        """``(F . n, F . t)`` [N] of a force (2,) (n outward, t down the slope); in 3D, of a
+        force (3,), ``(F . n, |F - (F . n) n|)`` (the tangential force's magnitude)."""
         F = np.asarray(F, float)
-        return float(F @ self.normal), float(F @ self.tangent)
+        fn = float(F @ self.normal)
+        if self.tangent is None:
+            return fn, float(np.linalg.norm(F - fn * self.normal))
+        return fn, float(F @ self.tangent)
 
     def transition(self, x_minus, x_plus=None) -> TransitionImpulses:
         """The impulses of the transition from the pre-impact state ``x_minus`` (2n,) to
@@ -334,6 +379,8 @@ class StanceReaction:
             push = self._push_off(x_minus, e)
             return TransitionImpulses(total - push, push, trail, self.normal.copy())
         q0, v0 = self.floating_state(x_minus)
+        if self._roles is not None:  # 3D: x_plus in this step's labels (a relabelling)
+            x_plus = self._before_relabel(x_minus, x_plus)
         q1, v1 = self.floating_state(x_plus, swapped=True)
         if not np.allclose(q0[self._links], q1[self._links], atol=1e-8):
             raise ValueError("the post-impact state is not the pre-impact configuration "
@@ -345,11 +392,30 @@ class StanceReaction:
         return TransitionImpulses(total - push, push, V[self._feet["stance"]].copy(),
                                   self.normal.copy())
 
+    def _before_relabel(self, x_minus, x_plus) -> np.ndarray:
+        """A 3D walker's post-impact state ``x_plus`` in the pre-impact labels: its reset's
+        configuration block (``walker.reset_jacobian``) is the roles' permutation ``R``
+        (``q+ = R q-``), so ``x = [R^T q+, R^T dq+]``.
+
+        Raises
+        ------
+        ValueError
+            The block is not a permutation."""
+        n = self.walker.n_coordinates
+        R = np.asarray(self.walker.reset_jacobian(np.asarray(x_minus, float)), float)[:n, :n]
+        P = np.rint(R)
+        if not (np.allclose(R, P, atol=1e-12) and np.all(P.sum(0) == 1)
+                and np.all(P.sum(1) == 1)):
+            raise ValueError("the heel strike's reset does not relabel the coordinates by a "
+                             "permutation")
+        x_plus = np.asarray(x_plus, float)
+        return np.concatenate([P.T @ x_plus[:n], P.T @ x_plus[n:]])
+
     def _push_off(self, x_minus, e) -> np.ndarray:
         """The push-off's impulse (2,) [N s]: ``P`` (``walker.actuators.impulse``) along
         ``e`` (from the trailing foot to the hip); zeros without a push-off."""
         acts = getattr(self.walker, "actuators", None)
         if acts is None or getattr(acts.spec, "push_off", None) is None:
-            return np.zeros(2)
+            return np.zeros(self.normal.size)
         e = np.asarray(e, float)
         return float(acts.impulse(x_minus)) * e / np.sqrt(e @ e)
