@@ -12,9 +12,10 @@ and the slope.  Every numeric field carries its unit in its name (``leg_length_m
 description; validation always runs and unknown keys are rejected (``extra="forbid"``).
 
 Modules: :mod:`~walkerlab.config.schema` (:class:`Scene`, the slope, the model variant and
-the command-line sizes), :mod:`~walkerlab.config.walker` (compass gait, biped; its legs, bodies,
-feet, knee, torso, springs in :mod:`~walkerlab.config.biped_parts`), :mod:`~walkerlab.config.studies` (fixed point, simulation,
-work-precision, basin, MFPT, robustness; a state by name), :mod:`~walkerlab.config.base`
+the command-line sizes), :mod:`~walkerlab.config.walker` (compass gait, biped; its legs,
+bodies, feet, knee, torso, springs in :mod:`~walkerlab.config.biped_parts`),
+:mod:`~walkerlab.config.studies` (fixed point, simulation, work-precision, basin, MFPT,
+robustness; a state by name), :mod:`~walkerlab.config.base`
 (the strict base of every section), :mod:`~walkerlab.config.errors` (error lines,
 :class:`SceneError`),
 :mod:`~walkerlab.config.loader` (YAML reading, validation, error lines),
