@@ -12,9 +12,10 @@ and the slope.  Every numeric field carries its unit in its name (``leg_length_m
 description; validation always runs and unknown keys are rejected (``extra="forbid"``).
 
 Modules: :mod:`~walkerlab.config.schema` (:class:`Scene`, the slope, the model variant and
-the command-line sizes), :mod:`~walkerlab.config.walker` (compass gait, biped: legs, bodies,
-feet, knee, torso, springs), :mod:`~walkerlab.config.studies` (fixed point, simulation,
-work-precision, basin, MFPT, robustness; a state by name), :mod:`~walkerlab.config.base`
+the command-line sizes), :mod:`~walkerlab.config.walker` (compass gait, biped; its legs,
+bodies, feet, knee, torso, springs in :mod:`~walkerlab.config.biped_parts`),
+:mod:`~walkerlab.config.studies` (fixed point, simulation, work-precision, basin, MFPT,
+robustness; a state by name), :mod:`~walkerlab.config.base`
 (the strict base of every section), :mod:`~walkerlab.config.errors` (error lines,
 :class:`SceneError`),
 :mod:`~walkerlab.config.loader` (YAML reading, validation, error lines),
@@ -30,6 +31,24 @@ SceneError
 """
 
 from walkerlab.config.base import AsTuple
+from walkerlab.config.biped_parts import (
+    AnkleSpec,
+    ArcFoot,
+    Body,
+    FlatFoot,
+    Foot,
+    KneeSpec,
+    KneeSpringSpec,
+    LegSpec,
+    PointFoot,
+    PointMassBody,
+    RodBody,
+    SpringSpec,
+    TorsoBody,
+    TorsoPointMass,
+    TorsoRigidBody,
+    TorsoSpec,
+)
 from walkerlab.config.contact import (
     MAX_CONTACT_STRIDES,
     ContactSettings,
@@ -79,28 +98,8 @@ from walkerlab.config.studies import (
     StateSpec,
     WorkPrecisionSettings,
 )
-from walkerlab.config.walker import (
-    AnkleSpec,
-    ArcFoot,
-    BipedParams,
-    Body,
-    CompassGaitParams,
-    FlatFoot,
-    Foot,
-    KneeSpec,
-    KneeSpringSpec,
-    LegSpec,
-    PointFoot,
-    PointMassBody,
-    RimlessWheelParams,
-    RodBody,
-    SpringSpec,
-    TorsoBody,
-    TorsoPointMass,
-    TorsoRigidBody,
-    TorsoSpec,
-    WalkerParams,
-)
+from walkerlab.config.walker import BipedParams, CompassGaitParams, WalkerParams
+from walkerlab.config.wheel import RimlessWheelParams
 
 __all__ = [
     "AnkleSpec",

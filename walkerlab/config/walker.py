@@ -1,6 +1,6 @@
 """The walker sections of a scene (``walker:``): the compass gait of the paper's Table 1,
 the generic biped described as data (its parts - legs, bodies, feet, knees, torso,
-springs - in :mod:`walkerlab.config.biped_parts`, re-exported here) and the
+springs - in :mod:`walkerlab.config.biped_parts`, exported from :mod:`walkerlab.config`) and the
 rimless wheel (spokes on a hub: :mod:`walkerlab.config.wheel`).
 
 Every numeric field carries its unit in its name (``leg_length_m``) and a description;
@@ -16,26 +16,7 @@ from pydantic import Discriminator, Field, Tag, model_serializer, model_validato
 
 from walkerlab.config.actuation import Actuation
 from walkerlab.config.base import Strict, drop_unset
-from walkerlab.config.biped_parts import (  # noqa: F401 (part of this API)
-    MIN_SOLE_FRACTION,
-    AnkleSpec,
-    ArcFoot,
-    Body,
-    FlatFoot,
-    Foot,
-    KneeSpec,
-    KneeSpringSpec,
-    LegSpec,
-    PointFoot,
-    PointMassBody,
-    RodBody,
-    SpringSpec,
-    TorsionalSpring,
-    TorsoBody,
-    TorsoPointMass,
-    TorsoRigidBody,
-    TorsoSpec,
-)
+from walkerlab.config.biped_parts import LegSpec, SpringSpec, TorsoSpec
 from walkerlab.config.wheel import RimlessWheelParams
 
 #: ``walker.space`` of the straight-legged walkers (the shorthand's and the parts')
