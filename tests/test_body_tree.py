@@ -2,8 +2,8 @@
 (walkerlab/codegen/tree_derive.py) against hand derivations that share no code with it: the
 3D compass with hip width, with and without hip-roll joints, with rod legs and round feet
 (``tests/independent/hand_3d_compass.py``: point masses summed, written out as walkerlab
-derived it before the tree), the 3D spoked wheel (``derive_3d.derive_spoked``) and the
-planar compass gait (``symbolic.derive``), numerically at random states and parameters.
+derived it before the tree), the 3D spoked wheel (``tests/independent/hand_3d_wheel.py``) and
+the planar compass gait (``symbolic.derive``), numerically at random states and parameters.
 
 Tolerance: 1e-12 relative to the largest entry of the compared matrix - the two derivations
 are the same mechanics in different expression trees, so they differ by round-off only
@@ -21,6 +21,7 @@ import pytest
 import sympy as sp
 
 from tests.independent.hand_3d_compass import derive_compass
+from tests.independent.hand_3d_wheel import derive_spoked as hand_spoked
 from walkerlab.codegen import derive_3d
 from walkerlab.codegen.derive_3d import derive_spoked
 from walkerlab.codegen.symbolic import derive
@@ -179,15 +180,28 @@ def test_production_3d_equations_from_the_tree_equal_the_hand_derivation(width, 
 
 
 @pytest.mark.slow
-def test_the_spoked_wheel_tree_reproduces_derive_spoked():
-    """The 3D spoked wheel (Coleman, Chatterjee & Ruina 1997) as one body on a spherical
-    joint (heading, lean, spin): its flow and its impact at the next spoke's foot equal
-    ``derive_spoked``'s at random states (35 s: ``derive_spoked``'s simplification)."""
-    e = derive_spoked(Structure("absolute", (), hip_mass=True, spokes=6, in_3d=True))
-    tree, coords = spoked_wheel_3d_tree()
-    te = derive_tree(tree, coords, simplify=_same)
-    Mi, B = heel_strike(te, "next_foot", simplify=_same)
-    _compare(e, te, Mi, B, np.random.default_rng(97))
+@pytest.mark.parametrize("spokes", [6, 9])
+def test_production_spoked_wheel_from_the_tree_equals_the_hand_derivation(spokes):
+    """The equations production generates for the 3D spoked wheel (Coleman, Chatterjee &
+    Ruina 1997; ``derive_3d.derive_spoked``, now one body on a spherical joint in its tree)
+    equal the hand derivation's (``tests/independent/hand_3d_wheel.py``: the kinetic energy
+    by König, the impact as the angular momentum about the new foot) at random states: flow,
+    impact and its post-impact rates, potential, the heel-strike surface, the section's
+    solved spin and every named point (35 s: the hand derivation's simplification)."""
+    st = Structure("absolute", (), hip_mass=True, spokes=spokes, in_3d=True)
+    e, ours = hand_spoked(st), derive_spoked(st)
+    _compare(e, ours, ours.Mi, ours.B, np.random.default_rng(97 + spokes))
+    args = e.q + e.dq + e.params
+    pts = _states(e, np.random.default_rng(spokes))
+    assert set(ours.points) == set(e.points)
+    assert ours.relabel_q == e.relabel_q and ours.relabel_rate == e.relabel_rate
+    for name, ref, cand in (("heel", sp.Matrix([e.guards["heel_strike"]]),
+                             sp.Matrix([ours.guards["heel_strike"]])),
+                            ("drop", sp.Matrix([e.drop_solution]),
+                             sp.Matrix([ours.drop_solution])),
+                            *((k, e.points[k], ours.points[k]) for k in e.points
+                              if k != "stance_foot")):
+        _close(name, ref, cand, args, pts)
 
 
 @pytest.mark.parametrize("rod", [False, True], ids=["point_legs", "rod_legs"])

@@ -370,3 +370,42 @@ def test_a_3d_heel_strikes_impulse_is_the_references_lagrange_multiplier():
         assert np.max(np.abs(imp.heel_strike - ref.impact_impulse(side * w, x))) < 1e-11
         assert np.all(imp.push_off == 0.0)
         assert imp.heel_strike_normal > 0
+
+
+@pytest.mark.parametrize("name", ["hip_width_stabilised", "rimless_wheel_3d_disc"])
+def test_a_3d_gaits_ground_impulse_over_its_period_is_its_weight_times_the_period(name):
+    """Over one period of a 3D gait (a stride of the mirrored steps; the disc wheel's step)
+    the walker's momentum returns, so the ground's impulse - the stance foot's force
+    integrated over every continuous phase plus each heel strike's impulse - is the weight
+    times the period, ``m g T`` straight up, with no lateral or downhill part (Newton's
+    second law over the period).  The walker's force from its floating view (hip roll), the
+    wheel's from its hub's acceleration; the quadrature's error ~1e-10 N s."""
+    from scipy.integrate import quad_vec
+
+    from tests.test_walker_3d import SOLVER, _guess
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.cli.options import load
+    from walkerlab.integrate.rigid import simulate_steps
+
+    scene = load(f"configs/{name}.yaml")
+    plant = Plant.from_scene(scene)
+    walker = build_walker(scene, plant=plant)
+    res = find_fixed_point(walker, _guess(scene, walker.state_names()), SOLVER, fd_check=False)
+    traj = simulate_steps(walker, res.x, walker.steps_per_map, SOLVER)
+    reaction = {id(walker): StanceReaction(walker, plant.data)}
+    if walker.mirror is not None:
+        reaction[id(walker.mirror)] = StanceReaction(walker.mirror, plant.data.mirror)
+    n = res.x.size
+    impulse, period = np.zeros(3), 0.0
+    for seg in traj.segments:
+        sr = reaction[id(walker.for_stance(seg.stance_leg))]
+        for phase, sol, (ta, tb) in seg.pieces:
+            def force(t, sr=sr, sol=sol, flow=phase.flow):
+                return sr.force(t, np.ravel(sol(t))[:n], flow)
+
+            impulse += quad_vec(force, ta, tb, epsabs=1e-10)[0]
+            period += tb - ta
+        imp = sr.transition(seg.x_end, seg.x_next)
+        impulse += imp.heel_strike + imp.push_off
+    weight = float(plant.data.total_mass_kg) * float(plant.data.gravity_m_per_s2)
+    assert np.max(np.abs(impulse - np.array([0.0, weight * period, 0.0]))) < 1e-6 * weight * period

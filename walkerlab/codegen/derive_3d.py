@@ -64,60 +64,27 @@ import sympy as sp
 
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
-from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.seeded import seeded as _seeded
-from walkerlab.codegen.tree_derive import derive_tree, plastic_impact
-from walkerlab.walker.trees import legs_3d_tree
-
-
-def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
-    return sp.Matrix(a).cross(sp.Matrix(b))
-
-
-def _dot(a: sp.Matrix, b: sp.Matrix):
-    return (sp.Matrix(a).T * sp.Matrix(b))[0]
-
-
-def _spoke(theta_offset, L) -> sp.Matrix:
-    """A spoke from the hub in the wheel's frame at ``theta_offset`` from the stance spoke:
-    ``Rot(z, theta_offset) (0, -L, 0)``."""
-    return sp.Matrix([L * sp.sin(theta_offset), -L * sp.cos(theta_offset), 0])
-
-
-def _spoked_impact(W, hub, spin, par):
-    """The spoked wheel's impact (:func:`derive_spoked`): ``Mi dq+ = B dq-``, the angular
-    momentum about the new foot conserved (``Mi``: rotating about it, ``B``: the motion
-    about the old foot), in the frame ``A`` of heading and lean (``omega_A = W dq``; ``hub``
-    the hub in it, ``spin`` the wheel's rotation by its angle; ``par`` the parameters).
-
-    Returns
-    -------
-    Mi, B : sympy.Matrix (3, 3)
-    """
-    _g, L, _gamma, m, I_axle, alpha, I_diam = par
-    ez = sp.Matrix([0, 0, 1])
-    d = -spin * _spoke(2 * alpha, L)                       # new foot -> hub (A's frame)
-
-    def inertia_cm(w):  # I_cm w, the axisymmetric hub
-        return I_diam * w + (I_axle - I_diam) * w[2] * ez
-
-    def h_after(w):  # angular momentum about the new foot, rotating about it at w
-        return inertia_cm(w) + m * _cross(d, _cross(w, d))
-
-    def h_before(w):  # ... of the motion about the old foot at w (hub velocity w x hub)
-        return inertia_cm(w) + m * _cross(d, _cross(w, hub))
-
-    cols = [W[:, j] for j in range(3)]
-    Mi = (W.T * sp.Matrix.hstack(*[h_after(c) for c in cols])).applyfunc(sp.trigsimp)
-    B = (W.T * sp.Matrix.hstack(*[h_before(c) for c in cols])).applyfunc(sp.trigsimp)
-    return Mi, B
+from walkerlab.codegen.tree_derive import derive_tree, heel_strike, plastic_impact
+from walkerlab.walker.trees import legs_3d_tree, spoked_wheel_3d_tree
 
 
 @cache
 @_seeded
 def derive_spoked(structure) -> Equations:
     """Flow, impact, guards, energies and points of a spoked wheel in three dimensions
-    (module docstring).
+    (module docstring), derived from its body tree
+    (:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`: one body on a spherical joint at
+    the stance spoke's foot) by :func:`walkerlab.codegen.tree_derive.derive_tree`; the
+    impact is :func:`~walkerlab.codegen.tree_derive.heel_strike` at the next spoke's foot
+    (the extended-coordinates form of the angular momentum about the new foot conserved:
+    the wheel turns freely about it).
+
+    The section's spin solves the trailing spoke's foot on the slope in closed form: that
+    foot is ``R (v_x, v_y, 0)`` from the stance foot, ``v`` its place in the wheel's frame
+    and ``R = Rot(n, psi) Rot(s, phi) Rot(z, beta)``, ``beta = theta + gamma``, so its height
+    is ``cos(phi) (v_x sin(beta) + v_y cos(beta))``: zero at ``beta = atan2(v_y, -v_x)``
+    (``= alpha``, whatever the heading and lean).
 
     Parameters
     ----------
@@ -138,53 +105,31 @@ def derive_spoked(structure) -> Equations:
     """
     if not (structure.spokes and structure.in_3d):
         raise ValueError("derive_3d.derive_spoked: the structure is not a 3D spoked wheel")
-    psi, phi, th = sp.symbols("q_heading q_lean q_stance", real=True)
-    dpsi, dphi, dth = sp.symbols("dq_heading dq_lean dq_stance", real=True)
-    q, dq = (psi, phi, th), (dpsi, dphi, dth)
-    par = sp.symbols(structure.param_names, real=True)
-    g, L, gamma, m, I_axle, alpha, I_diam = par
-    nrm = sp.Matrix([sp.sin(gamma), sp.cos(gamma), 0])
-    fall = sp.Matrix([sp.cos(gamma), -sp.sin(gamma), 0])
-    ez = sp.Matrix([0, 0, 1])
-    A = rotation(nrm, psi) * rotation(fall, phi)          # heading, then lean
-    # vectors in A's frame (the wheel's plane spun by theta): the energies and the impact
-    # are invariant under the rotation A, and read shortest there
-    spin = rotation(ez, th)
-    W = sp.Matrix.hstack(rotation(fall, -phi) * nrm, fall, ez)   # omega_A = W dq
-    omega = W * sp.Matrix(dq)
-    hub = spin * sp.Matrix([0, L, 0])
-    kinetic = sp.Rational(1, 2) * ((m * L ** 2 + I_diam) * _dot(omega, omega)
-                                   - m * _dot(omega, hub) ** 2
-                                   + (I_axle - I_diam) * _dot(omega, ez) ** 2)
-    Mq = sp.Matrix(3, 3, lambda i, j: sp.trigsimp(sp.expand(sp.diff(kinetic, dq[i], dq[j]))))
-    hub_w = A * hub                                         # world axes
-    potential = m * g * hub_w[1]
-    G = sp.Matrix([sp.diff(potential, qi) for qi in q])
-    C = christoffel(Mq, q, dq)
-
-    def foot(k):  # the foot of the spoke k spokes ahead of the stance spoke (world)
-        return A * (hub + spin * _spoke(2 * k * alpha, L))
-
-    nxt = foot(1)
-    Mi, B = _spoked_impact(W, hub, spin, par)
-    hub, axle = hub_w, A * ez
-    # the section: the spoke behind's foot on the slope, a cos(theta) + b sin(theta) = 0
-    u = W[:, 0]                                             # the normal in A's frame
-    v = sp.Matrix([0, L, 0]) + _spoke(-2 * alpha, L)       # hub -> trailing foot, wheel frame
-    a = u[0] * v[0] + u[1] * v[1]
-    b = u[1] * v[0] - u[0] * v[1]
-    theta_on = sp.atan2(a, -b)                              # = alpha - gamma upright
+    tree, coords = spoked_wheel_3d_tree(structure.spokes)
+    te = derive_tree(tree, coords)
+    psi, phi, th = te.q
+    P = dict(zip(structure.param_names, te.params))
+    alpha, gamma = P["alpha"], P["gamma"]
+    Mi, B = heel_strike(te, "next_foot")
+    nrm = sp.Matrix([sp.sin(gamma), sp.cos(gamma), 0])   # the slope's normal (world)
+    pts = te.points
+    nxt, hub = pts["next_foot"], pts["wheel_com"]
+    axle = slope_to_world(gamma) * te.kinematics.rotations["wheel"] * sp.Matrix([0, 0, 1])
+    L = P["L"]
+    v = sp.Matrix([-L * sp.sin(2 * alpha), L - L * sp.cos(2 * alpha)])  # trailing foot
+    theta_on = sp.atan2(v[1], -v[0]) - gamma
     points = {"hip": hub, "stance_foot": sp.zeros(3, 1), "swing_foot": nxt,
-              "trailing_foot": foot(-1),
-              **{f"spoke{k}_foot": foot(k) for k in range(2, structure.spokes - 1)},
+              "trailing_foot": pts["trailing_foot"],
+              **{f"spoke{k}_foot": pts[f"spoke{k}_foot"] for k in range(2, structure.spokes - 1)},
               "axle_tip": hub + L * axle / 4}
     n = 3
+    dth = te.dq[2]
     return Equations(
-        q=q, dq=dq, params=tuple(par), M=Mq, C=C, G=G, Mi=Mi, B=B,
+        q=te.q, dq=te.dq, params=te.params, M=te.M, C=te.C, G=te.G, Mi=Mi, B=B,
         relabel_q=sp.Matrix([psi, phi, th + 2 * alpha]), relabel_rate=sp.eye(n),
-        kinetic=kinetic, potential=potential,
-        guards={"heel_strike": _dot(nxt, nrm), "rolls_back": dth,
-                "hip_height": _dot(hub, nrm), "swing_clearance": _dot(nxt, nrm)},
+        kinetic=te.kinetic, potential=te.potential,
+        guards={"heel_strike": (nxt.T * nrm)[0], "rolls_back": dth,
+                "hip_height": (hub.T * nrm)[0], "swing_clearance": (nxt.T * nrm)[0]},
         points=points,
         leg_angles={"stance": th, "swing": th + 2 * alpha, "heading": psi, "lean": phi},
         section_drop=2, drop_solution=theta_on,

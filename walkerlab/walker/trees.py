@@ -281,7 +281,7 @@ def planar_compass_tree(*, leg_inertia: bool = False) -> tuple[BodyTree, Coordin
                                 ("hip_angle", "swing - stance")))
 
 
-def spoked_wheel_3d_tree() -> tuple[BodyTree, CoordinateMap]:
+def spoked_wheel_3d_tree(spokes: int | None = None) -> tuple[BodyTree, CoordinateMap]:
     """The spoked wheel in three dimensions (Coleman, Chatterjee & Ruina 1997; today
     :func:`walkerlab.codegen.derive_3d.derive_spoked`) as a tree: one body on a spherical
     joint at the stance spoke's foot, turned by the heading ``psi`` about the slope's normal,
@@ -290,6 +290,13 @@ def spoked_wheel_3d_tree() -> tuple[BodyTree, CoordinateMap]:
     stance spoke's angle from the vertical); the hub ``M_hub`` at ``(0, L, 0)`` in the
     wheel's frame, ``I_hub`` about the axle ``z`` and ``I_diam`` about any diameter; the next
     spoke's foot at ``(0, L, 0) + Rot(z, 2 alpha) (0, -L, 0)``.
+
+    Parameters
+    ----------
+    spokes : int, optional
+        The number of spokes: each spoke's foot a contact point, ``spoke<k>_foot`` ``k``
+        spokes ahead of the stance spoke (``next_foot`` the first, ``trailing_foot`` the
+        last, behind); None: the stance and next feet only.
 
     Returns
     -------
@@ -301,10 +308,15 @@ def spoked_wheel_3d_tree() -> tuple[BodyTree, CoordinateMap]:
     wheel = Body("wheel", "M_hub", diagonal("I_diam", "I_diam", "I_hub"), (0, "L", 0),
                  Joint("stance_spoke", "spherical", "slope", (0, 0, 0), ((0, 1, 0), S, Z),
                        ("wheel_heading", "wheel_lean", "wheel_spin")))
+
+    def foot(k):  # the foot of the spoke k spokes ahead: hub + Rot(z, 2 k alpha) (0, -L, 0)
+        return (f"L * sin({2 * k} * alpha)", f"L - L * cos({2 * k} * alpha)", 0)
+
+    names = {1: "next_foot"} if spokes is None else {
+        1: "next_foot", -1: "trailing_foot", **{k: f"spoke{k}_foot" for k in range(2, spokes - 1)}}
     tree = BodyTree(params, Root(), (wheel,),
                     (ContactPoint("stance_foot", "wheel", (0, 0, 0)),
-                     ContactPoint("next_foot", "wheel",
-                                  ("L * sin(2 * alpha)", "L - L * cos(2 * alpha)", 0))))
+                     *(ContactPoint(name, "wheel", foot(k)) for k, name in names.items())))
     # the spin from the slope's normal is the stance spoke's angle from the vertical + gamma
     return tree, CoordinateMap(("heading", "lean", "stance"),
                                (("wheel_heading", "heading"), ("wheel_lean", "lean"),

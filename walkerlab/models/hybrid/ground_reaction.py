@@ -93,12 +93,8 @@ _PARTS = {
 
 
 def _part(kind) -> _Part:
-    """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): a wheel
-    in 3D is refused (its floating view is not yet its tree's), any other its rigid
-    model's."""
-    if kind.in_3d and kind.spoked:
-        return _Part(refusal="a wheel in 3D: its stance foot's reaction (a force in 3D) is "
-                             "not computed yet")
+    """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): its
+    rigid model's, planar or 3D."""
     return _PARTS[kind.rigid]
 
 
@@ -216,6 +212,10 @@ class StanceReaction:
             # massless legs, all the mass at the hip (module docstring)
             self.hip_mass_kg = float(data.total_mass_kg)
             self.g = float(data.gravity_m_per_s2)
+            self._up_g = np.array([0.0, self.g])
+            if st.in_3d:  # a wheel in 3D: its hub's acceleration in 3D
+                self.normal, self.tangent = np.append(self.normal, 0.0), None
+                self._up_g = np.array([0.0, self.g, 0.0])
             return
         self.view = _View(data)
         coords = tuple(self.view.coordinates)
@@ -328,8 +328,9 @@ class StanceReaction:
         stance foot by its moment alone (joint torques are between the walker's bodies)."""
         xdot = np.asarray(flow(t, np.asarray(x, float)), float)
         if self.view is None:  # all the mass at the hip
-            return self.hip_mass_kg * (self._hip_acceleration(x, xdot)
-                                       + np.array([0.0, self.g])), np.nan
+            # a wheel in 3D turns on a spherical joint at its stance foot: no twist
+            return (self.hip_mass_kg * (self._hip_acceleration(x, xdot) + self._up_g),
+                    np.nan if self.tangent is not None else 0.0)
         q, dq = self.floating_state(x)
         qdd = np.zeros(self.view.nq)
         if self._roles is not None:
