@@ -27,15 +27,14 @@ Sec. 2).  Its orientation is ``R = Rot(n, psi) Rot(s, phi) Rot(z, theta)``:
   (:mod:`walkerlab.codegen.rolling_polygon`), so that the upright wheel's equations are
   the planar ones.
 
-With the hub at ``R (0, L, 0)`` from the stance foot and ``omega = n psi' + Rot(n, psi) s
-phi' + R_(n,s) z theta'`` the angular velocity, the kinetic energy is (König, about the
-fixed foot)
-
-    T = 1/2 [(M L^2 + I_diam) |omega|^2 - M (omega . r_hub)^2
-             + (I_hub - I_diam) (omega . a)^2],     a = R z (the axle),
-
-the potential ``V = M g y_hub``; the flow ``M(q) q'' + C(q, q') q' + G(q) = 0`` is
-Lagrange's (Christoffel symbols of ``M``).
+The wheel is one body of its tree (:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`:
+the hub at ``R (0, L, 0)`` from the stance foot, on a spherical joint there), derived by the
+one Lagrangian derivation of :mod:`walkerlab.codegen.tree_derive` - the kinetic energy of
+its centre of mass and of its rotation, ``omega^T I omega / 2`` with ``I = diag(I_diam,
+I_diam, I_hub)`` in the wheel's frame, the potential ``V = M g y_hub``, the flow
+``M(q) q'' + C(q, q') q' + G(q) = 0`` from the Christoffel symbols of ``M``.  (The hand
+derivation it replaced, by König's theorem about the fixed foot, is kept as an independent
+test reference; they agree to round-off.)
 
 Heel strike: the next spoke's foot ``r_next = r_hub + R Rot(z, 2 alpha) (0, -L, 0)``
 reaching the slope, ``n . r_next`` decreasing through 0.  The impact is plastic: the new
@@ -44,10 +43,11 @@ angular momentum about it is conserved (Coleman et al. 1997, Eq. 3):
 
     I_cm omega+ + M d x (omega+ x d) = I_cm omega- + M d x v_hub-,   d = r_hub - r_next,
 
-in the coordinates' rates ``Mi dq+ = B dq-`` with ``omega = W(q) dq`` (each side
-premultiplied by ``W^T``, so that ``Mi`` is the mass matrix about the new foot).  The new
+which is the plastic impact in extended coordinates at the new foot
+(:func:`walkerlab.codegen.tree_derive.heel_strike`: the wheel turns freely about it, so the
+motions the impulse does no work on are every rotation about it).  The new
 stance spoke is the old one turned by a spoke: ``theta -> theta + 2 alpha``, heading and
-lean unchanged (``R Rot(z, 2 alpha)``), the rates too (``W`` does not depend on ``theta``).
+lean unchanged (``R Rot(z, 2 alpha)``), the rates too (no rate depends on which spoke stands).
 
 Poincaré section: the state just after a heel strike, the previous stance foot (the spoke
 behind, ``theta - 2 alpha``) on the slope: ``theta`` is solved from it in closed form, so
