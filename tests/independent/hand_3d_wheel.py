@@ -117,8 +117,9 @@ def derive_spoked(structure) -> SimpleNamespace:
     nxt = foot(1)
     Mi, B = _spoked_impact(W, hub, spin, par)
     # world axes from here (walkerlab's derivation before the tree rebound ``hub`` here, so
-    # that foot(k) below, its closure, added the hub's world position to the wheel-frame
-    # hub: its trailing_foot and spoke<k>_foot points were off by the hub's height)
+    # that foot(k) below, its closure, turned the hub's world position once more: its
+    # trailing_foot and spoke<k>_foot points were off by (A - I) hub, wrong once the wheel
+    # leaned or turned)
     hub_world, axle = hub_w, A * ez
     # the section: the spoke behind's foot on the slope, a cos(theta) + b sin(theta) = 0
     u = W[:, 0]                                             # the normal in A's frame
