@@ -108,9 +108,9 @@ def test_a_cells_quantity_names_only_what_was_checked_and_its_check_kind():
     """Every stored cell names the kind of check behind its number
     (:data:`~walkerlab.walker.capability_evidence.CHECK_KINDS`); a rigid cell names the
     friction cone in its quantity only when the fixed point's verdict was made (its detail
-    says inside or outside): the 3D walkers on point feet and the 3D wheel have it (their
-    stance foot's reaction from the floating view, the wheel's hub), the round-footed 3D
-    walker, which has none yet, says "not checked" beside its ✓ (a numbered note ending
+    says inside or outside): the 3D walkers and the 3D wheel have it (their stance foot's
+    reaction from the floating view of their tree, the wheel's from its hub); a walk on a
+    profile, which has none, says "not checked" beside its ✓ (a numbered note ending
     "(not part of the ✓)")."""
     from walkerlab.walker.capability_evidence import CHECK_KINDS, check_of, not_checked
 
@@ -122,15 +122,15 @@ def test_a_cells_quantity_names_only_what_was_checked_and_its_check_kind():
             assert claims != bool(not_checked(e)), key
             assert claims == ("inside the friction cone" in e["detail"]), key
     for key in ("straight_legs_3d/walk/rigid", "straight_legs_3d/hip_roll/rigid",
-                "rolling_polygon_3d/walk/rigid"):
+                "straight_legs_3d/round_feet_3d/rigid", "rolling_polygon_3d/walk/rigid"):
         assert "inside the friction cone" in cells[key]["detail"], key
         assert not not_checked(cells[key]), key
-    round_feet = cells["straight_legs_3d/round_feet_3d/rigid"]
-    assert "friction cone" not in round_feet["quantity"]
-    assert "point feet only so far" in not_checked(round_feet)
-    g = next(g for g in grids() if g.kind.name == "straight_legs_3d")
-    cell = g.rows[g.features.index("round_feet_3d")][g.views.index("rigid")]
-    assert cell.startswith(f"{SUPPORTED} ") and " self (" in cell, cell
+    profile = cells["straight_legs/profile/rigid"]
+    assert "friction cone" not in profile["quantity"]
+    assert "on a profile" in not_checked(profile)
+    g = next(g for g in grids() if g.kind.name == "straight_legs")
+    cell = g.rows[g.features.index("profile")][g.views.index("rigid")]
+    assert cell.startswith(f"{SUPPORTED} ") and " reference (" in cell, cell
     note = g.reasons[int(cell.rsplit("(", 1)[1].rstrip(")")) - 1]
     assert "not checked" in note and note.endswith("(not part of the ✓)")
 

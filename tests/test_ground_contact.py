@@ -409,3 +409,31 @@ def test_a_3d_gaits_ground_impulse_over_its_period_is_its_weight_times_the_perio
         impulse += imp.heel_strike + imp.push_off
     weight = float(plant.data.total_mass_kg) * float(plant.data.gravity_m_per_s2)
     assert np.max(np.abs(impulse - np.array([0.0, weight * period, 0.0]))) < 1e-6 * weight * period
+
+
+def test_a_round_footed_3d_walker_upright_has_the_planar_walkers_ground_reaction():
+    """configs/round_feet_3d.yaml (McGeer's discs in 3D, zero hip width) upright is
+    configs/round_feet.yaml's walker: at the planar gait's states its stance disc's force
+    (from the 3D floating view of its tree: the disc's lowest point, its material point's
+    Jacobian) equals the planar floating view's (a separate derivation in the plane), with
+    no lateral part and no twist; the heel strike's impulse too."""
+    from walkerlab.cli.options import load
+
+    flat, solid = (load(f"configs/{n}.yaml") for n in ("round_feet", "round_feet_3d"))
+    p_flat, p_solid = Plant.from_scene(flat), Plant.from_scene(solid)
+    w2, w3 = build_walker(flat, plant=p_flat), build_walker(solid, plant=p_solid)
+    r2, r3 = StanceReaction(w2, p_flat.data), StanceReaction(w3, p_solid.data)
+    rng = np.random.default_rng(11)
+    for _ in range(4):
+        sw, st, dsw, dst = np.array([-0.2, 0.17, -0.6, -0.85]) + 0.05 * rng.standard_normal(4)
+        x2 = np.array([sw, st, dsw, dst])
+        x3 = np.array([0.0, sw, st, 0.0, dsw, dst])
+        F2 = r2.force(0.0, x2, w2.phases[0].flow)
+        F3, twist = r3.force_and_twist(0.0, x3, w3.phases[0].flow)
+        assert np.max(np.abs(F3 - [*F2, 0.0])) < 1e-10 * np.max(np.abs(F2))
+        assert abs(twist) < 1e-12 * np.max(np.abs(F2))
+    x2 = np.array([0.2, -0.17, -0.6, -0.85])   # late swing: the swing disc ahead
+    i2, i3 = r2.transition(x2), r3.transition(np.array([0.0, 0.2, -0.17, 0.0, -0.6, -0.85]))
+    assert np.max(np.abs(i3.heel_strike - [*i2.heel_strike, 0.0])) < 1e-10
+    assert i3.trailing_foot_normal_velocity == pytest.approx(i2.trailing_foot_normal_velocity,
+                                                             rel=1e-9)

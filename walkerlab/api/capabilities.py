@@ -12,8 +12,7 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     on a profile, where the gait changes from step to step, the footfalls against the
     profile's height under them [m].  The fixed point's friction verdict (the gait's
     ground forces inside the friction cone) where it made one: a cell's quantity names it
-    only then, and a cell without one (a round-footed walker in 3D: its stance foot's
-    reaction is not computed yet; a profile) says "not checked"
+    only then, and a cell without one (a walk on a profile) says "not checked"
     (``Measurement.not_checked``), never passed.
 ``contact``
     ``walkerlab contact-sim`` walks at least 10 heel strikes; its last 4 steps (whole
@@ -98,8 +97,8 @@ QUANTITIES = {
                  1e-6, "state"),
 }
 #: the rigid view's second check, named in a cell's quantity only where it ran: the fixed
-#: point's friction verdict (:mod:`walkerlab.analysis.gait.friction`; a round-footed walker in
-#: 3D has none: its stance foot's reaction is not computed yet)
+#: point's friction verdict (:mod:`walkerlab.analysis.gait.friction`; a walk on a profile has
+#: none)
 CONE = "and the gait's ground forces inside the friction cone (the fixed point's verdict)"
 #: the kind of check behind each view's number
 #: (:data:`walkerlab.walker.capability_evidence.CHECK_KINDS`); the rigid view on a profile is

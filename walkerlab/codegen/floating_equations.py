@@ -470,15 +470,15 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
     bias of :func:`walkerlab.codegen.lagrange.bias`, unsimplified (common subexpressions
     are the generated code's).  Positions in world axes (``x`` downhill, ``y`` up, ``z``
     lateral), as a planar walker's; the feet ``leg1`` (the rigid model's swing foot) and
-    ``leg2`` (its stance foot, the root's contact).
+    ``leg2`` (its stance foot, the root's contact); round feet's the discs' lowest points
+    with their material points' Jacobians (:func:`_disc_contact`).
     The hip-roll law's torques act between bodies (no force on the free coordinates): the
     view leaves them out.
 
     Raises
     ------
     ValueError
-        Round feet or a spoked wheel (a rolling contact's material point is not yet a
-        contact point of the tree).
+        A spoked wheel (its floating view is not yet its tree's).
     """
     import sympy as sp
 
@@ -488,9 +488,8 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
     from walkerlab.walker.tree import free_root
     from walkerlab.walker.trees import legs_3d_tree
 
-    if structure.spokes or structure.foot != "point":
-        raise ValueError("walker.leg.foot: a walker in 3D has a floating view (its ground "
-                         "reaction) with point feet only so far")
+    if structure.spokes:
+        raise ValueError("walker.spokes: a wheel in 3D has no floating view of its tree yet")
     rigid, coords = legs_3d_tree(structure)
     tree, fcoords = free_root(rigid, coords, FREE_3D)
     kin = kinematics(tree, fcoords)
@@ -504,10 +503,20 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
     h = bias(M, V, q, dq)
     to_world = slope_to_world(kin.gamma)
     feet, points = [], {}
-    for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
-        pos = to_world * kin.contacts[contact].xreplace(rename)
-        feet.append((pos, pos.jacobian(qv)))
-        points[f"{leg}_foot"] = pos
+    if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
+        radius = dict(zip(tree.params, kin.params))["R_foot"]
+        for leg, link, centre in (("leg1", "swing_leg", kin.contacts["swing_foot_centre"]),
+                                  ("leg2", "stance_leg", kin.origins["stance_leg"])):
+            low, J = _disc_contact(kin, link, centre, radius)
+            pos = to_world * low.xreplace(rename)
+            feet.append((pos, (to_world * J).xreplace(rename)))
+            points[f"{leg}_contact"] = pos
+            points[f"{leg}_foot_centre"] = to_world * centre.xreplace(rename)
+    else:
+        for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
+            pos = to_world * kin.contacts[contact].xreplace(rename)
+            feet.append((pos, pos.jacobian(qv)))
+            points[f"{leg}_foot"] = pos
     points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
     for b in structure.bodies:
         for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
@@ -518,3 +527,24 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
                              params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
                              kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
                              points=points, contacts=LEGS, point_legs=(0, 1))
+
+
+def _disc_contact(kin, body: str, centre, radius):
+    """A round foot's contact on the slope: the lowest point of the disc of ``radius``
+    about ``centre`` (3, 1) in the plane normal to ``body``'s ``z`` axis (its leg's
+    sagittal plane; McGeer 1990), ``centre - R u / |u|`` with ``u = n - (n . a) a`` the
+    slope's normal ``n`` without its part along the disc's axis ``a``, and the Jacobian
+    (3, nq) of the disc's material point there, ``v = v_centre + omega x (low - centre)``
+    (``omega`` the body's angular velocity: a disc that rolls without slip has that point
+    at rest).  Slope frame, the tree's own coordinates (``kin``:
+    :class:`walkerlab.codegen.tree_derive.TreeKinematics`)."""
+    import sympy as sp
+
+    R_b = kin.rotations[body]
+    a = R_b * sp.Matrix([0, 0, 1])
+    u = sp.Matrix([0, 1, 0]) - a[1] * a
+    low = centre - radius * u / sp.sqrt(1 - a[1] ** 2)
+    r = low - centre
+    skew = sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+    omega = R_b * kin.omegas[body].jacobian(sp.Matrix(kin.dq))
+    return low, centre.jacobian(sp.Matrix(kin.q)) - skew * omega

@@ -338,13 +338,17 @@ class StanceReaction:
         else:
             qdd[self._links] = self._link_acceleration(x, xdot)
         i = self._feet["stance"]
-        _, _, J = self.view.contact_points(q, dq)
+        P, _, J = self.view.contact_points(q, dq)
         dV = self.view.velocity_gradient(q, dq)
         qdd[self._hip] = -(J[i][:, self._links] @ qdd[self._links] + dV[i] @ dq)
         M, h = self.view.dynamics(q, dq)
         rows = M @ qdd + h
-        return rows[self._hip], (np.nan if self._heading is None else
-                                 float(rows[self._heading]))
+        F = rows[self._hip]
+        if self._heading is None:
+            return F, np.nan
+        # the heading's row is the moment about the normal through the root's origin (a
+        # point foot's contact; a round foot's rolls along the fall line from it)
+        return F, float(rows[self._heading] - self.normal @ np.cross(P[i], F))
 
     def normal_and_tangential(self, F) -> tuple[float, float]:
         """``(F . n, F . t)`` [N] of a force (2,) (n outward, t down the slope); in 3D, of a
