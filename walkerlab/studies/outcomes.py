@@ -61,6 +61,9 @@ _FP = {
                              "mu_static or its default)"),
     "inside_friction_cone": ("-", "1 if max_friction_ratio <= friction_coefficient, 0 if "
                              "not, NaN if not checked"),
+    "max_twist_n_m": ("N m", "a walker in 3D: largest moment about the slope's normal on "
+                      "the stance foot (its rigid stance joint turns no further; NaN in the "
+                      "plane)"),
     "residual": ("rad or rad/s", "max |P(x) - x| at the last iterate"),
     "max_abs_multiplier": ("-", "largest |Floquet multiplier|"),
     "stable": ("-", "1 if all |multipliers| < 1, else 0"),

@@ -61,14 +61,16 @@ def _fp_columns(walker, res) -> dict:
 
 
 def _ground_columns(ground) -> dict:
-    """The chosen gait's ground verdict: the stance foot's smallest normal force and the
-    friction it needs against the ground's (NaN where not checked)."""
+    """The chosen gait's ground verdict: the stance foot's smallest normal force, the
+    friction it needs against the ground's and, in 3D, the twist it carries (NaN where not
+    checked)."""
     fr = getattr(ground, "friction", None)
     inside = None if fr is None else fr.inside
     return {"min_normal_force_n": float(getattr(ground, "min_normal_force_n", math.nan)),
             "max_friction_ratio": math.nan if fr is None else float(fr.max_ratio),
             "friction_coefficient": math.nan if fr is None else float(fr.mu),
-            "inside_friction_cone": math.nan if inside is None else float(inside)}
+            "inside_friction_cone": math.nan if inside is None else float(inside),
+            "max_twist_n_m": float(getattr(ground, "max_twist_n_m", math.nan))}
 
 
 # ----------------------------------------------------------------------------- stages
