@@ -268,3 +268,68 @@ def test_the_stabilised_mjcf_walks_ten_steps_after_a_5_percent_lateral_push(
     run = walk(path, 12.3 * out.step_period_s, each=push)
     assert pushed and not run.fell and run.alternating and len(run.times_s) >= 10, (
         len(run.times_s), run.fell)
+
+
+#: the window [s] a MuJoCo contact force is averaged over (about 110 timesteps)
+WINDOW_S = 0.005
+
+
+@pytest.mark.slow  # ~20 s: the gait search, the floating view, 0.7 s of MuJoCo
+def test_the_3d_stance_foots_force_and_twist_are_mujocos_contact_force_and_torsion(tmp_path):
+    """configs/hip_width.yaml's first step in MuJoCo (its MJCF from the gait keyframe; feet
+    ``condim 4``: the torsional friction holds the foot from turning, as the rigid model's
+    stance joint does): the stance foot's contact force and its torque about the slope's
+    normal (``mj_contactForce``) against the rigid model's ground reaction and twist
+    (:class:`~walkerlab.models.hybrid.ground_reaction.StanceReaction`, from the walker's
+    floating view) at the same times of the step - an engine's soft contact against the
+    rigid model (measured: force within 0.09 N of a 196 N weight, twist within 0.009 N m of
+    a 1.0 N m peak; the twist changes sign at mid-stance in both)."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.hybrid.ground_reaction import StanceReaction
+    from walkerlab.models.registry import build_walker
+
+    scene = _scene("hip_width")
+    out = export.write(scene, tmp_path, "mjcf")
+    model = mujoco.MjModel.from_xml_path(str(out.path))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("gait").id)
+    phi = scene.slope.phi_rad
+    up = np.array([math.sin(phi), 0.0, math.cos(phi)])   # the slope's normal, MuJoCo axes
+    foot, f6 = model.geom("leg2_foot").id, np.zeros(6)
+    times = 0.7034879 * np.array([0.1, 0.3, 0.5, 0.7, 0.9])
+    rows = []   # per timestep: time, the force on the foot (our axes), its torque about n
+    while data.time < times[-1] + WINDOW_S:
+        mujoco.mj_step(model, data)
+        F, torque = np.zeros(3), 0.0
+        for i in range(data.ncon):
+            c = data.contact[i]
+            if foot in (c.geom1, c.geom2):
+                mujoco.mj_contactForce(model, data, i, f6)
+                frame = c.frame.reshape(3, 3)
+                sign = 1.0 if c.geom2 == foot else -1.0   # the force on the foot
+                F += sign * frame.T @ f6[:3]
+                torque += sign * f6[3] * float(frame[0] @ up)
+        rows.append((data.time, F[0], F[2], -F[1], torque))   # ours: y up, z = -MuJoCo's y
+    rows = np.array(rows)
+    # the soft contact chatters at ~1e-9 m of penetration (a one-step spike of +50 %): the
+    # mean over a window of WINDOW_S about each time, where the rigid force is a line
+    seen = {k: rows[np.abs(rows[:, 0] - t) < WINDOW_S / 2, 1:].mean(axis=0)
+            for k, t in enumerate(times)}
+    plant = Plant.from_scene(scene)
+    walker = build_walker(scene, plant=plant)
+    reaction = StanceReaction(walker, plant.data)
+    x0 = ideal_gait(scene, plant=plant).x
+    seg = simulate_steps(walker, x0, 1, Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+                         ).segments[0]
+    weight = float(plant.data.total_mass_kg) * float(plant.data.gravity_m_per_s2)
+    twists = []
+    for k, t in enumerate(times):
+        phase, sol, _ = next(p for p in seg.pieces if p[2][0] <= t <= p[2][1])
+        F, twist = reaction.force_and_twist(t, np.ravel(sol(t))[:x0.size], phase.flow)
+        F_mj, twist_mj = seen[k][:3], seen[k][3]
+        assert np.max(np.abs(F - F_mj)) < 0.002 * weight, (t, F, F_mj)
+        assert abs(twist - twist_mj) < 0.02, (t, twist, twist_mj)
+        twists.append(twist)
+    assert twists[0] > 0.5 and twists[-1] < -0.5   # it turns the other way late in stance
