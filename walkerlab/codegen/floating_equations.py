@@ -57,6 +57,8 @@ from functools import cache
 
 from walkerlab.walker.description import Structure
 from walkerlab.walker.multibody import check_floating_view
+from walkerlab.walker.tree import free_root
+from walkerlab.walker.trees import legs_3d_tree
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
@@ -485,8 +487,6 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
     from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
     from walkerlab.codegen.lagrange import bias  # light
     from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
-    from walkerlab.walker.tree import free_root
-    from walkerlab.walker.trees import legs_3d_tree
 
     if structure.spokes:
         raise ValueError("walker.spokes: a wheel in 3D has no floating view of its tree yet")
