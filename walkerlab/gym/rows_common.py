@@ -33,7 +33,7 @@ torques' the action's.
 
 from __future__ import annotations
 
-from operator import attrgetter, is_
+from operator import attrgetter, is_, itemgetter
 
 import numpy as np
 
@@ -135,6 +135,8 @@ def _lane_entry(v, lane, cache: dict):
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
                    "x", "ledger", "_log", "steps", "foot")
 _ENV = attrgetter("_elapsed", "dt", "_hip_x")
+_FIRST, _THIRD = itemgetter(0), itemgetter(2)
+_WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [J])
 
 
 def _common(envs, views, cache: dict):
@@ -207,7 +209,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     key, entries, read, caps, stops, t_ends, env_read = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
-    lanes = [en[0] for en in entries]
+    lanes = list(map(_FIRST, entries))
     for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
                                           env_read):
         e._elapsed = er[0] + 1  # (begin_periods, open_period, next_piece)
@@ -216,9 +218,9 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         r[10].append(per)
         lane[3].u = u
     (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
-    x_before = [er[2] for er in env_read]  # (the reward's origins, before the period)
-    w_before = [led["action_work_positive"] for led in ledgers]
-    on = [any(r) for r in U.tolist()]
+    x_before = list(map(_THIRD, env_read))  # (the reward's origins, before the period)
+    w_before = list(map(_WORK, ledgers))
+    on = list(map(any, U.tolist()))
     batch = _batch(cache, key, entries, lanes, walkers, views)
     out = _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache)
     which, te, Yev, Y, cap, Yn, call = out
