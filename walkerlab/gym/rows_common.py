@@ -276,29 +276,51 @@ def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
 
 def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) -> tuple:
     """What a common period of these lanes reads every period, made once and kept by the
-    lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed, maps)`` -
-    the walkers' data rows stacked (:func:`_flow_row`) and their step clocks, whether each
-    row takes its torques and clock as columns, the kernel's compiled functions and
-    tolerances, its guard tables, whether the walkers share one ``points`` function, the
-    observations' stance-leg and phase columns (N, 2), and each walker's joints' map with
-    whether every walker has one (:func:`~walkerlab.gym.rigid_rows._joint_map`: kept in
-    the walker, for the lane's actuators)."""
+    lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed, maps,
+    origins)`` - the walkers' data rows stacked (:func:`_flow_row`) and their step clocks,
+    whether each row takes its torques and clock as columns, the kernel's compiled
+    functions and tolerances, its guard tables, whether the walkers share one ``points``
+    function, the observations' stance-leg and phase columns (N, 2), each walker's joints'
+    map with whether every walker has one (:func:`~walkerlab.gym.rigid_rows._joint_map`:
+    kept in the walker, for the lane's actuators), and the flows' actuators
+    (:func:`_origins`).  Made of each walker's own part (:func:`_part`, kept by its lane
+    entry's id: the walkers falling out of step with each other make many sets of lanes,
+    each walker few lanes)."""
     fid = tuple(map(id, entries))
     out = cache.get(fid)
     if out is None:
         if len(cache) >= KEPT:
             cache.clear()
-        t_col = entries[0][4][2]
+        got = cache.get("parts")
+        if got is None or len(got) >= KEPT:
+            got = cache["parts"] = {}
+        parts = [got.get(i) or _part(got, en, v, lane)
+                 for i, en, v, lane in zip(fid, entries, views, lanes)]
+        rows, clocks, oks, points, fixed, maps, acts, _ = zip(*parts)
+        first = entries[0][4][1:3]
         out = cache[fid] = (
-            np.concatenate([en[4][0] for en in entries]),
-            [float(en[4][0][0, t_col]) for en in entries],
-            all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
+            np.concatenate(rows), list(clocks),
+            all(ok and en[4][1:3] == first for ok, en in zip(oks, entries)),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
             _guard_tables([en[2] for en in entries]),
-            all(w.points is walkers[0].points for w in walkers),
-            np.array([(1.0 if lane[2] == "leg1" else 0.0, lane[1]) for lane in lanes]),
-            _maps(views, lanes),
-            _origins([en[3].actuators for en in entries]))
+            all(f is points[0] for f in points),
+            np.array(fixed),
+            (list(maps), all(M is not None for M in maps)),
+            _origins(list(acts)))
+    return out
+
+
+def _part(parts: dict, en: tuple, v, lane: tuple) -> tuple:
+    """One walker's part of :func:`_batch` (its lane entry ``en``, view ``v``, lane
+    ``lane``): ``(data row (1, size), step clock [s], row takes its torques and clock as
+    columns, points function, (leg1's stance as 1.0, phase's index), joints' map or None,
+    its flow's actuators)``, kept in ``parts`` by the entry's id (the entry kept with it:
+    its id stays its own)."""
+    row = en[4][0]
+    out: tuple = (row, float(row[0, en[4][2]]), en[4][3], lane[0].points,
+           (1.0 if lane[2] == "leg1" else 0.0, lane[1]), _joint_map(v, lane[3]),
+           en[3].actuators)
+    out = parts[id(en)] = out + (en,)
     return out
 
 
@@ -311,13 +333,6 @@ def _origins(acts: list) -> tuple:
     ``t_origin`` (read as 0.0 each period), else ``(True, acts)`` (each read with
     :data:`_T_ORIGIN`)."""
     return (True if all(hasattr(a, "t_origin") for a in acts) else None), acts
-
-
-def _maps(views, lanes) -> tuple:
-    """``(maps, every)``: each walker's joints' map of its lane's actuators
-    (:func:`~walkerlab.gym.rigid_rows._joint_map`, or None), and whether none is None."""
-    maps = [_joint_map(v, lane[3]) for v, lane in zip(views, lanes)]
-    return maps, all(M is not None for M in maps)
 
 
 def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache) -> tuple:
