@@ -73,6 +73,15 @@ def _lists(p: dict) -> tuple:
     return lists
 
 
+def _no_limit(p: dict, limits: list) -> bool:
+    """Whether no environment of :func:`batch_parameters`' ``p`` has a limit of its own
+    (``limits``: its ``limit`` as a list), kept in it."""
+    out = p.get("no_limit")
+    if out is None:
+        out = p["no_limit"] = all(lim < 0 for lim in limits)
+    return out
+
+
 def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.begin_period` of N rigid-view environments at
     once: the held torques of every row of ``actions``, each period counted.
@@ -229,8 +238,11 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     elapsed, seeds = zip(*map(_ENV_READ, envs))  # (each environment's count and seed)
     terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
     fws, healthy, cws, wws, dts, limits = _lists(p)
-    truncated = [not te and lim >= 0 and el >= lim
-                 for te, lim, el in zip(terminated, limits, elapsed)]
+    if _no_limit(p, limits):  # (no environment's own limit: a vector env's walkers)
+        truncated = [False] * len(terminated)
+    else:
+        truncated = [not te and lim >= 0 and el >= lim
+                     for te, lim, el in zip(terminated, limits, elapsed)]
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
     sums = list(map(list, map(dict.values, ledgers)))  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
