@@ -8,7 +8,7 @@ of them at once: :func:`hip_xs`) - the same element-wise operations as each
 
 from __future__ import annotations
 
-from operator import attrgetter
+from operator import attrgetter, itemgetter
 
 import numpy as np
 
@@ -71,6 +71,15 @@ def _lists(p: dict) -> tuple:
         lists = p["lists"] = tuple(p[k].tolist() for k in ("fw", "healthy", "cw", "ww",
                                                            "dt", "limit"))
     return lists
+
+
+def _no_limit(p: dict, limits: list) -> bool:
+    """Whether no environment of :func:`batch_parameters`' ``p`` has a limit of its own
+    (``limits``: its ``limit`` as a list), kept in it."""
+    out = p.get("no_limit")
+    if out is None:
+        out = p["no_limit"] = all(lim < 0 for lim in limits)
+    return out
 
 
 def begin_periods(envs, actions: np.ndarray, p: dict) -> tuple:
@@ -227,12 +236,15 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
     elapsed, seeds = zip(*map(_ENV_READ, envs))  # (each environment's count and seed)
-    terminated = [s != "" for s in ended]
+    terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
     fws, healthy, cws, wws, dts, limits = _lists(p)
-    truncated = [not te and lim >= 0 and el >= lim
-                 for te, lim, el in zip(terminated, limits, elapsed)]
+    if _no_limit(p, limits):  # (no environment's own limit: a vector env's walkers)
+        truncated = [False] * len(terminated)
+    else:
+        truncated = [not te and lim >= 0 and el >= lim
+                     for te, lim, el in zip(terminated, limits, elapsed)]
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
-    sums = [list(led.values()) for led in ledgers]  # (the ledgers' values now)
+    sums = list(map(list, map(dict.values, ledgers)))  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
     if any(U.ravel().tolist()):
@@ -241,7 +253,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
         effort = [0.0] * len(views)
     j_work = terms.index("action_work_positive")
-    work = [row[j_work] for row in sums]
+    work = list(map(itemgetter(j_work), sums))
     reward = np.array([
         fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(

@@ -285,7 +285,7 @@ class _RowRedo:
 
 
 def _held_rows(views, rows: list, pieces: list, sel: list, maps: list, X: np.ndarray,
-               Y: np.ndarray, cap: np.ndarray, Yn: np.ndarray) -> None:
+               Y: np.ndarray, cap: np.ndarray, Yn: np.ndarray, U=None) -> None:
     """The ledger of the rows ``sel`` (indices into ``rows``), each of which reached its
     period's end with the action on (its walker's
     :meth:`~walkerlab.gym.rigid_view.RigidView._held_work`, all at once): from ``Y`` to
@@ -299,9 +299,12 @@ def _held_rows(views, rows: list, pieces: list, sel: list, maps: list, X: np.nda
     The three sums of each row (the work and the power at both ends) are one reduction
     over a stacked (3, r, n) array: numpy's reduction along the last axis of each row,
     the same sums bit for bit as three of an (r, n) array (checked on 40,000 random
-    cases, n up to 23); the comparisons on Python floats are numpy's."""
+    cases, n up to 23); the comparisons on Python floats are numpy's.  ``U`` (r, k)
+    [N m]: the selected rows' held torques (``pieces[r][1].u``' numbers), when the caller
+    has them stacked."""
     n = X.shape[1] // 2
-    U = np.array([pieces[r][1].u for r in sel])  # (r, k) [N m]
+    if U is None:
+        U = np.array([pieces[r][1].u for r in sel])  # (r, k) [N m]
     if all(M is maps[0] for M in maps):  # one walker's map for all (its rows (k, n))
         W = U @ maps[0]  # (r, n)
     else:

@@ -33,7 +33,7 @@ torques' the action's.
 
 from __future__ import annotations
 
-from operator import attrgetter
+from operator import attrgetter, is_, itemgetter
 
 import numpy as np
 
@@ -135,6 +135,8 @@ def _lane_entry(v, lane, cache: dict):
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
                    "x", "ledger", "_log", "steps", "foot")
 _ENV = attrgetter("_elapsed", "dt", "_hip_x")
+_FIRST, _THIRD = itemgetter(0), itemgetter(2)
+_WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [J])
 
 
 def _common(envs, views, cache: dict):
@@ -207,7 +209,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     key, entries, read, caps, stops, t_ends, env_read = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
-    lanes = [en[0] for en in entries]
+    lanes = list(map(_FIRST, entries))
     for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
                                           env_read):
         e._elapsed = er[0] + 1  # (begin_periods, open_period, next_piece)
@@ -216,13 +218,13 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         r[10].append(per)
         lane[3].u = u
     (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
-    x_before = [er[2] for er in env_read]  # (the reward's origins, before the period)
-    w_before = [led["action_work_positive"] for led in ledgers]
-    on = [any(r) for r in U.tolist()]
-    batch = _batch(cache, key, entries, lanes, walkers)
+    x_before = list(map(_THIRD, env_read))  # (the reward's origins, before the period)
+    w_before = list(map(_WORK, ledgers))
+    on = list(map(any, U.tolist()))
+    batch = _batch(cache, key, entries, lanes, walkers, views)
     out = _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache)
     which, te, Yev, Y, cap, Yn, call = out
-    settled, slow = _settle_rows(views, lanes, on, which.tolist(), Yev, Y, cap, Yn)
+    settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
     X = list(Yev)
     if not slow:
         ended = []
@@ -272,28 +274,65 @@ def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
         advance_live(views, rows_u, t_ends, live, strikes)
     return strikes
 
-def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers) -> tuple:
+def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) -> tuple:
     """What a common period of these lanes reads every period, made once and kept by the
-    lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed)`` - the
-    walkers' data rows stacked (:func:`_flow_row`) and their step clocks, whether each row
-    takes its torques and clock as columns, the kernel's compiled functions and tolerances,
-    its guard tables, whether the walkers share one ``points`` function, and the
-    observations' stance-leg and phase columns (N, 2)."""
+    lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed, maps,
+    origins)`` - the walkers' data rows stacked (:func:`_flow_row`) and their step clocks,
+    whether each row takes its torques and clock as columns, the kernel's compiled
+    functions and tolerances, its guard tables, whether the walkers share one ``points``
+    function, the observations' stance-leg and phase columns (N, 2), each walker's joints'
+    map with whether every walker has one (:func:`~walkerlab.gym.rigid_rows._joint_map`:
+    kept in the walker, for the lane's actuators), and the flows' actuators
+    (:func:`_origins`).  Made of each walker's own part (:func:`_part`, kept by its lane
+    entry's id: the walkers falling out of step with each other make many sets of lanes,
+    each walker few lanes)."""
     fid = tuple(map(id, entries))
     out = cache.get(fid)
     if out is None:
         if len(cache) >= KEPT:
             cache.clear()
-        t_col = entries[0][4][2]
+        got = cache.get("parts")
+        if got is None or len(got) >= KEPT:
+            got = cache["parts"] = {}
+        parts = [got.get(i) or _part(got, en, v, lane)
+                 for i, en, v, lane in zip(fid, entries, views, lanes)]
+        rows, clocks, oks, points, fixed, maps, acts, _ = zip(*parts)
+        first = entries[0][4][1:3]
         out = cache[fid] = (
-            np.concatenate([en[4][0] for en in entries]),
-            [float(en[4][0][0, t_col]) for en in entries],
-            all(en[4][3] and en[4][1:3] == entries[0][4][1:3] for en in entries),
+            np.concatenate(rows), list(clocks),
+            all(ok and en[4][1:3] == first for ok, en in zip(oks, entries)),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
             _guard_tables([en[2] for en in entries]),
-            all(w.points is walkers[0].points for w in walkers),
-            np.array([(1.0 if lane[2] == "leg1" else 0.0, lane[1]) for lane in lanes]))
+            all(f is points[0] for f in points),
+            np.array(fixed),
+            (list(maps), all(M is not None for M in maps)),
+            _origins(list(acts)))
     return out
+
+
+def _part(parts: dict, en: tuple, v, lane: tuple) -> tuple:
+    """One walker's part of :func:`_batch` (its lane entry ``en``, view ``v``, lane
+    ``lane``): ``(data row (1, size), step clock [s], row takes its torques and clock as
+    columns, points function, (leg1's stance as 1.0, phase's index), joints' map or None,
+    its flow's actuators)``, kept in ``parts`` by the entry's id (the entry kept with it:
+    its id stays its own)."""
+    row = en[4][0]
+    out: tuple = (row, float(row[0, en[4][2]]), en[4][3], lane[0].points,
+           (1.0 if lane[2] == "leg1" else 0.0, lane[1]), _joint_map(v, lane[3]),
+           en[3].actuators)
+    out = parts[id(en)] = out + (en,)
+    return out
+
+
+#: a flow's actuators' step clock [s] (:func:`_integrate`)
+_T_ORIGIN = attrgetter("t_origin")
+
+
+def _origins(acts: list) -> tuple:
+    """``(None, acts)`` when some of the flows' actuators ``acts`` have no step clock
+    ``t_origin`` (read as 0.0 each period), else ``(True, acts)`` (each read with
+    :data:`_T_ORIGIN`)."""
+    return (True if all(hasattr(a, "t_origin") for a in acts) else None), acts
 
 
 def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache) -> tuple:
@@ -302,8 +341,10 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
     the data rows with this period's torques and clocks, the start states - the last
     common period's array when the walkers hold its rows -, the caps [s], the
     Gauss-Legendre nodes of the rows with the action on)."""
-    base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi), _, _ = batch
-    origins = [float(getattr(en[3].actuators, "t_origin", 0.0)) for en in entries]
+    base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi) = batch[:5]
+    acts = batch[8]
+    origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]] if acts[0] is None
+               else list(map(float, map(_T_ORIGIN, acts[1]))))
     if same:
         D = base.copy()
         D[:, entries[0][4][1]] = U
@@ -318,7 +359,7 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
     N, m = len(views), key[4]
     last = cache.get("X")  # (the last common period's states: the walkers' own rows)
     if (last is not None and len(last[1]) == N
-            and all(x is r for x, r in zip(xs, last[1]))):
+            and all(map(is_, xs, last[1]))):
         Y = last[0]
     else:
         Y = np.array(xs, dtype=float)
@@ -334,22 +375,28 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
     return which, te, Yev, Y, cap, Yn, call
 
 
-def _settle_rows(views, lanes, on, ends, Yev, Y, cap, Yn) -> tuple:
+def _settle_rows(views, on, ends, Yev, Y, cap, Yn, U, batch) -> tuple:
     """``(settled, slow)``: the rows that reached their piece's end, each to be settled
     there as :func:`~walkerlab.gym.rigid_rows._absorb_rows` settles it (the ledger of those
-    with the action on taken here at once: :func:`~walkerlab.gym.rigid_rows._held_rows`),
-    and the others (a guard crossing, a failed step, a state not finite, the ledger on the
-    dense output), to be absorbed by their walkers."""
+    with the action on taken here at once: :func:`~walkerlab.gym.rigid_rows._held_rows`,
+    with the held torques ``U`` (N, k) [N m] and the joints' maps kept in ``batch``:
+    :func:`_batch`), and the others (a guard crossing, a failed step, a state not finite,
+    the ledger on the dense output), to be absorbed by their walkers."""
     N = len(views)
     finite = ([True] * N if all_finite(Yev) else np.isfinite(Yev).all(axis=1).tolist())
-    if min(ends) == TIMEOUT == max(ends) and not any(on) and all(finite):
-        return range(N), []
+    maps_all, every_map = batch[7]
+    if min(ends) == TIMEOUT == max(ends) and all(finite):
+        if not any(on):
+            return range(N), []
+        if every_map and all(on):  # (every row's ledger at once: the same rows in order)
+            _held_rows(views, range(N), None, list(range(N)), maps_all, Yev, Y, cap, Yn, U)
+            return range(N), []
     settled, slow, held, maps = [], [], [], []
     for r in range(N):
         if ends[r] != TIMEOUT or not finite[r]:
             slow.append(r)
         elif on[r]:
-            M = _joint_map(views[r], lanes[r][3])
+            M = maps_all[r]
             if M is None:
                 slow.append(r)
             else:
@@ -359,6 +406,6 @@ def _settle_rows(views, lanes, on, ends, Yev, Y, cap, Yn) -> tuple:
         else:
             settled.append(r)
     if held:
-        _held_rows(views, list(range(N)), [(None, lane[3]) for lane in lanes], held, maps,
-                   Yev, Y, cap, Yn)
+        _held_rows(views, range(N), None, held, maps, Yev, Y, cap, Yn,
+                   U if len(held) == N else U[held])
     return settled, slow
