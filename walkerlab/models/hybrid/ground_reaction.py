@@ -30,6 +30,19 @@ with the hip's acceleration ``d^2/dt^2 hip(q(t))`` from the rigid model's own ``
 (central differences along ``q + h dq + h^2 qdd / 2``), and the impulses
 ``M_hip (v_hip+ - v_hip-)``.
 
+A walker in 3D (a straight-legged walker of :mod:`walkerlab.codegen.derive_3d`) has the
+floating view of its body tree set free at the stance foot
+(:func:`walkerlab.walker.tree.free_root`: three slides along the world's axes and a heading,
+a turn about the slope's normal, before the tree's own joints, which keep the rigid model's
+coordinates; :func:`walkerlab.codegen.floating_equations.derive_floating`).  Along the
+rigid flow the free coordinates rest, so the slides' rows of ``M qdd + h`` are the force
+(3,) and the heading's row the moment about the normal through the root's origin, moved to
+the contact point: the **twist** the rigid stance joint carries (it lets the foot roll and
+pitch, never turn), which a point foot on real ground cannot hold.  At a heel strike the
+post-impact rates are the rigid reset's, relabelled back by its permutation (the reset's
+configuration block).  A wheel in 3D turns on a spherical joint: no twist, and all its mass
+is its hub's (the force from the hub's acceleration, in 3D).
+
 Nothing here knows the number of states: the rigid state is read by role name
 (``walker.leg_angles`` or the roles) and mapped to the floating view's link coordinates by
 :func:`walkerlab.walker.layout.floating_links_from_rigid`.  Leg angles are affine in the
@@ -143,14 +156,14 @@ class TransitionImpulses:
 
     Attributes
     ----------
-    heel_strike : ndarray (2,)
-        Impulse on the leading foot [N s], world axes (x downhill, y up).
-    push_off : ndarray (2,)
+    heel_strike : ndarray (d,)
+        Impulse on the leading foot [N s], world axes (x downhill, y up; in 3D z lateral).
+    push_off : ndarray (d,)
         Impulse on the trailing foot [N s] (zeros without a push-off).
-    trailing_foot_velocity : ndarray (2,)
+    trailing_foot_velocity : ndarray (d,)
         The trailing foot's velocity just after the transition [m/s].
-    normal : ndarray (2,)
-        The ground's outward unit normal ``(sin phi, cos phi)``.
+    normal : ndarray (d,)
+        The ground's outward unit normal ``(sin phi, cos phi[, 0])``.
     """
 
     heel_strike: np.ndarray
