@@ -65,26 +65,9 @@ def _spoked_impact(W, hub, spin, par):
 
 
 def derive_spoked(structure) -> SimpleNamespace:
-    """Flow, impact, guards, energies and points of a spoked wheel in three dimensions
-    (module docstring).
-
-    Parameters
-    ----------
-    structure : walkerlab.walker.description.Structure
-        With ``spokes`` > 0 and ``in_3d`` (parameters
-        :data:`walkerlab.walker.description.SPOKED_3D_PARAMS`).
-
-    Returns
-    -------
-    SimpleNamespace
-        ``n = 3`` (heading, lean, stance); points (3, 1) in world axes; ``De``, ``E`` zeros
-        (no push-off: a wheel has no joint).
-
-    Raises
-    ------
-    ValueError
-        ``structure`` is not a 3D spoked wheel.
-    """
+    """The 3D spoked wheel's flow, impact, guards, energies and points (module docstring),
+    the fields of ``walkerlab.codegen.equations.Equations``, for a structure with ``spokes``
+    and ``in_3d``."""
     if not (structure.spokes and structure.in_3d):
         raise ValueError("derive_3d.derive_spoked: the structure is not a 3D spoked wheel")
     psi, phi, th = sp.symbols("q_heading q_lean q_stance", real=True)

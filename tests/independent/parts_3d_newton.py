@@ -105,6 +105,12 @@ class PartsReference:
     def impact(self, w, y):
         """The plastic impact, the impulse at the new foot an unknown: ``M_e (dq+ - dq-) =
         E^T F``, ``E dq+ = 0``; then the legs' roles swap."""
+        q, dqp = y[:3], self._impact_solution(w, y)[:3]
+        return np.array([q[0], q[2], q[1], dqp[0], dqp[2], dqp[1]])
+
+    def _impact_solution(self, w, y):
+        """``[dq+ (3), the old foot's velocity after (3), the impulse F (3)]`` of the
+        impact from ``y`` (:meth:`impact`)."""
         masses, foot = self.points(w)
         q, dq = y[:3], y[3:]
         Me = np.zeros((6, 6))
@@ -113,10 +119,8 @@ class PartsReference:
             Me += m * Je.T @ Je
         E = np.hstack([self.kin(foot, q, dq)[1], np.eye(3)])
         K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
-        sol = np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
-                                                  np.zeros(3)]))
-        dqp = sol[:3]
-        return np.array([q[0], q[2], q[1], dqp[0], dqp[2], dqp[1]])
+        return np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
+                                                   np.zeros(3)]))
 
     def ground_wrench(self, w, x):
         """The ground's force (3,) [N] and its moment about the stance foot (3,) [N m] at the
@@ -139,17 +143,7 @@ class PartsReference:
         """The ground's impulse (3,) [N s] at the new stance foot in the heel strike from the
         pre-impact state ``y`` (the Lagrange multiplier of :meth:`impact`; the old foot
         leaves with none), world axes."""
-        masses, foot = self.points(w)
-        q, dq = y[:3], y[3:]
-        Me = np.zeros((6, 6))
-        for m, terms in masses:
-            Je = np.hstack([self.kin(terms, q, dq)[1], np.eye(3)])
-            Me += m * Je.T @ Je
-        E = np.hstack([self.kin(foot, q, dq)[1], np.eye(3)])
-        K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
-        sol = np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
-                                                  np.zeros(3)]))
-        return sol[6:]
+        return self._impact_solution(w, y)[6:]
 
     def on_surface(self, w, z):
         """The state just after a heel strike of section coordinates ``z = [lean, stance,
