@@ -73,6 +73,8 @@ FREE_3D = ("leg2_foot_x", "leg2_foot_y", "leg2_foot_z", "heading")
 #: (:func:`walkerlab.codegen.derive_3d.derive_compass`'s: the lean is the stance leg's roll)
 ROLES_3D = {"lean": "leg2_roll", "swing": "leg1_angle", "stance": "leg2_angle",
             "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll"}
+#: why a wheel in 3D has no floating view (its ground reaction is its hub's)
+NO_WHEEL_3D = "walker.spokes: a wheel in 3D has no floating view of its tree yet"
 #: The floating view's coordinates of a spoked wheel (``model: rimless_wheel``): the hub's
 #: position [m] and the absolute angle of spoke 0 [rad] (from the downward vertical,
 #: positive when its tip is ahead of the hub).
@@ -82,6 +84,8 @@ WHEEL_COORDINATES = ("hip_x", "hip_y", "wheel_angle")
 def coordinate_names(structure: Structure) -> tuple[str, ...]:
     """Names of the floating view's generalised coordinates (module docstring)."""
     if structure.in_3d:
+        if structure.spokes:
+            raise ValueError(NO_WHEEL_3D)
         return FREE_3D + tuple(ROLES_3D[r] for r in structure.roles)
     if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
         return WHEEL_COORDINATES
@@ -461,13 +465,12 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
                              point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
 
 
-
-
 def _derive_3d(structure: Structure) -> FloatingEquations:
     """The floating view of a 3D straight-legged walker from its body tree
     (:func:`walkerlab.walker.trees.legs_3d_tree`, Kuo 1999), set free at leg2's foot
-    (:func:`walkerlab.walker.tree.free_root`: slides along ``s, n, z`` and a heading, then
-    the rigid tree's joints in its own coordinates renamed by :data:`ROLES_3D`): the mass
+    (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y, z`` and a
+    heading, then the rigid tree's joints in its own coordinates renamed by
+    :data:`ROLES_3D`): the mass
     matrix and potential of :func:`walkerlab.codegen.tree_derive.mass_and_potential`, the
     bias of :func:`walkerlab.codegen.lagrange.bias`, unsimplified (common subexpressions
     are the generated code's).  Positions in world axes (``x`` downhill, ``y`` up, ``z``
@@ -489,7 +492,7 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
     from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
 
     if structure.spokes:
-        raise ValueError("walker.spokes: a wheel in 3D has no floating view of its tree yet")
+        raise ValueError(NO_WHEEL_3D)
     rigid, coords = legs_3d_tree(structure)
     tree, fcoords = free_root(rigid, coords, FREE_3D)
     kin = kinematics(tree, fcoords)
