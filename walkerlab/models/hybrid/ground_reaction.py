@@ -264,41 +264,37 @@ class StanceReaction:
         stance foot's material point at rest (``swapped``: ``x`` is a post-impact state,
         roles swapped, and is expressed in the pre-impact labels: its stance leg in the
         swing leg's place).  The hip's position is 0 (nothing here depends on it)."""
-        if self._roles is not None:  # 3D: the view's coordinates are the roles'
-            return self._floating_3d(x, "swing" if swapped else "stance")
+        idx, z = self._links_of(x, swapped)
+        m = z.size // 2
+        q, dq = np.zeros(self.view.nq), np.zeros(self.view.nq)
+        q[idx], dq[idx] = z[:m], z[m:]
+        _, V, _ = self.view.contact_points(q, dq)
+        dq[self._hip] = -V[self._feet["swing" if swapped else "stance"]]
+        return q, dq
+
+    def _links_of(self, x, swapped: bool = False) -> tuple[list, np.ndarray]:
+        """The floating view's indices of the rigid state's coordinates and their values
+        then rates (2m,): a 3D walker's are its roles' (:data:`ROLES_3D`, ``x`` in this
+        step's labels); a planar walker's absolute link angles by role name
+        (:func:`walkerlab.walker.layout.floating_links_from_rigid`; ``swapped`` as in
+        :meth:`floating_state`)."""
+        if self._roles is not None:
+            return self._roles, np.asarray(x, float)
         vals = self._values(x)
         if swapped:
             flip = {"swing": "stance", "stance": "swing"}
             vals = {(flip[k.split("_", 1)[0]] + "_" + k.split("_", 1)[1]
                      if k.split("_", 1)[0] in flip else k): v for k, v in vals.items()}
-        z = floating_links_from_rigid(vals, self._layout)
-        m = z.size // 2
-        q, dq = np.zeros(self.view.nq), np.zeros(self.view.nq)
-        q[self._links], dq[self._links] = z[:m], z[m:]
-        _, V, _ = self.view.contact_points(q, dq)
-        dq[self._hip] = -V[self._feet["swing" if swapped else "stance"]]
-        return q, dq
+        return self._links, floating_links_from_rigid(vals, self._layout)
 
-    def _floating_3d(self, x, rest: str) -> tuple[np.ndarray, np.ndarray]:
-        """A 3D walker's :meth:`floating_state`: the rigid coordinates (``x`` (2n,) in the
-        labels of this step) by role, no heading, the free slides' rates those that hold
-        the foot of the role ``rest`` at rest."""
-        x = np.asarray(x, float)
-        n = x.size // 2
-        q, dq = np.zeros(self.view.nq), np.zeros(self.view.nq)
-        q[self._roles], dq[self._roles] = x[:n], x[n:]
-        _, V, _ = self.view.contact_points(q, dq)
-        dq[self._hip] = -V[self._feet[rest]]
-        return q, dq
-
-    def _link_acceleration(self, x, xdot) -> np.ndarray:
-        """The link angles' accelerations (floating order) from the rigid rates' derivatives
-        (the leg-angle map is affine: its rate part is linear)."""
-        w = self.walker
-        n = w.n_coordinates
+    def _link_acceleration(self, x, xdot) -> tuple[list, np.ndarray]:
+        """The floating view's indices of the rigid coordinates and their accelerations
+        from the rigid rates' derivatives (the leg-angle map is affine: its rate part is
+        linear)."""
+        n = self.walker.n_coordinates
         xa = np.concatenate([np.asarray(x, float)[:n], np.asarray(xdot, float)[n:]])
-        z = floating_links_from_rigid(self._values(xa), self._layout)
-        return z[z.size // 2:]
+        idx, z = self._links_of(xa)
+        return idx, z[z.size // 2:]
 
     # ------------------------------------------------------------------ a point hip
     def _point(self, name: str, q) -> np.ndarray:
@@ -346,10 +342,8 @@ class StanceReaction:
                     np.nan if self.tangent is not None else 0.0)
         q, dq = self.floating_state(x)
         qdd = np.zeros(self.view.nq)
-        if self._roles is not None:
-            qdd[self._roles] = xdot[xdot.size // 2:]
-        else:
-            qdd[self._links] = self._link_acceleration(x, xdot)
+        idx, acc = self._link_acceleration(x, xdot)
+        qdd[idx] = acc
         i = self._feet["stance"]
         P, _, J = self.view.contact_points(q, dq)
         dV = self.view.velocity_gradient(q, dq)
