@@ -31,6 +31,7 @@ from walkerlab.models.contact.assembly import (I_PHI, I_K, I_E, I_CMAX, I_DMAX, 
                                                D_N2, D_PC, D_P)
 from walkerlab.models.contact.assembly import chol as _chol, chol_solve as _chol_solve
 from walkerlab.models.contact.assembly import point as _point, knee_torque as _knee_torque
+from walkerlab.models.contact.assembly import point3 as _point3
 from walkerlab.models.contact.powered_kernels import A_HEAD
 from walkerlab.codegen.torque_law import HEAD
 
@@ -42,7 +43,7 @@ _FORCE = '''
 @njit(cache=True)
 def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
     """Q - h (NQ,) with the contact forces of the legs' points used and the knee stops;
-    fills M, the points' P, V, J, per-point ``info`` (NF, 12) and ``knees`` (2, 5)."""
+    fills M, the points' P, V, J, per-point ``info`` (NF, NINFO) and ``knees`` (2, 5)."""
     h = np.empty(NQ)
     dyn(x, p, M, h)
     feet(x, p, P, V, J)
@@ -53,16 +54,16 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
 @njit(cache=True)
 def jac(x, PC, p, c1, c2):
     """Analytic d rhs / dx (NX, NX); patch membership locally constant."""
-    M, P, V, J, info, knees = _asm.buffers(NQ, NF)
+    M, P, V, J, info, knees = _asm.buffers(NQ, NF, DIM)
     Q = _force(x, PC, p, c1, c2, True, True, M, P, V, J, info, knees)
     L = _chol(M)
     a = _chol_solve(L, Q.reshape((NQ, 1)))[:, 0]
     Dq = np.empty((NQ, NQ))
     Dv = np.empty((NQ, NQ))
     dyn_jac(x, a, p, Dq, Dv)
-    dV = np.empty((NF, 2, NQ))
+    dV = np.empty((NF, DIM, NQ))
     dJtF = np.empty((NQ, NQ))
-    feet_jac(x, _asm.world_forces(info), p, dV, dJtF)
+    feet_jac(x, _asm.world_forces(info, DIM), p, dV, dJtF)
     return _asm.jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, KNEE)
 '''
 
@@ -70,10 +71,10 @@ _PINNED = '''
 
 @njit(cache=True)
 def pinned_to_full(z, p, foot2):
-    """Full state (NX,) with leg2's (first) contact point PIN at ``foot2`` (2,) and at
-    rest; ``z = [link angles (NQ - 2), their rates]``."""
-    x = _asm.pinned_angles(z, NQ)
-    P, V, J = _asm.point_buffers(NQ, NF)
+    """Full state (NX,) with leg2's (first) contact point PIN at ``foot2`` (DIM,) and at
+    rest; ``z = [the coordinates after the base's DIM slides, their rates]``."""
+    x = _asm.pinned_angles(z, NQ, DIM)
+    P, V, J = _asm.point_buffers(NQ, NF, DIM)
     feet(x, p, P, V, J)  # hip at the origin, at rest: foot offset and velocity
     _asm.pin_at(x, P, V, PIN, foot2)
     return x
@@ -83,11 +84,11 @@ def pinned_to_full(z, p, foot2):
 def rhs_pinned(z, PC, p, c1, c2, foot2):
     """Reduced dynamics with leg2's foot pinned (leg1 keeps its contact)."""
     x = pinned_to_full(z, p, foot2)
-    M, P, V, J, info, knees = _asm.buffers(NQ, NF)
+    M, P, V, J, info, knees = _asm.buffers(NQ, NF, DIM)
     Q = _force(x, PC, p, c1, c2, True, False, M, P, V, J, info, knees)
-    dV = np.empty((NF, 2, NQ))
+    dV = np.empty((NF, DIM, NQ))
     dJtF = np.empty((NQ, NQ))
-    feet_jac(x, np.zeros((NF, 2)), p, dV, dJtF)
+    feet_jac(x, np.zeros((NF, DIM)), p, dV, dJtF)
     return _asm.pinned_dynamics(z, x, Q, M, J, dV, PIN)
 '''
 
@@ -95,11 +96,12 @@ _TABLES = '''
 
 @njit(cache=True)
 def contact_table(X, PC, p, c1, c2):
-    """(n, NF, 8): per contact point penetration [m], its rate [m/s], slip velocity [m/s],
-    s [m], Fn [N], Ff [N], power F . v [W], on_ground (1/0)."""
-    out = np.zeros((X.shape[0], NF, 8))
+    """(n, NF, 8) (3D: (n, NF, 10)): per contact point penetration [m], its rate [m/s],
+    slip velocity [m/s], s [m], Fn [N], Ff [N], power F . v [W], on_ground (1/0); in 3D
+    then the lateral slip velocity [m/s] and friction [N] (``assembly.contact_row``)."""
+    out = np.zeros((X.shape[0], NF, 8 if DIM == 2 else 10))
     sp, cp = _asm.slope(PC)
-    P, V, J = _asm.point_buffers(NQ, NF)
+    P, V, J = _asm.point_buffers(NQ, NF, DIM)
     for r in range(X.shape[0]):
         feet(X[r], p, P, V, J)
         _asm.contact_row(P, V, sp, cp, PC, c1, c2, POINT_LEG, out, r)
@@ -113,7 +115,7 @@ def knee_table(X, PC, p, c1, c2):
     out = np.zeros((X.shape[0], 2, 4))
     if KNEE:
         sp, cp = _asm.slope(PC)
-        P, V, J = _asm.point_buffers(NQ, NF)
+        P, V, J = _asm.point_buffers(NQ, NF, DIM)
         for r in range(X.shape[0]):
             feet(X[r], p, P, V, J)
             _asm.knee_row(X[r], NQ, P, V, sp, cp, PC, c1, c2, out, r)
@@ -146,7 +148,7 @@ _POWERED_RHS = '''
 def push_force(x, p, push_leg, force, hx, hy):
     """The generalised force (NQ,) of a force ``force`` [N] at contact point ``push_leg``
     along the line from it to the hip (coordinates ``hx``, ``hy``), and its power [W]."""
-    P, V, J = _asm.point_buffers(NQ, NF)
+    P, V, J = _asm.point_buffers(NQ, NF, DIM)
     feet(x, p, P, V, J)
     return _pk.push_along_leg(x, P, V, J, push_leg, force, hx, hy)
 
@@ -205,7 +207,7 @@ def _phase(x, A, p, st):
     c = int(A[4]) if st == 0 else int(A[31])
     if A[3] < 0.5:
         return x[c], x[NQ + c]
-    P, V, J = _asm.point_buffers(NQ, NF)
+    P, V, J = _asm.point_buffers(NQ, NF, DIM)
     feet(x, p, P, V, J)
     return _pk.virtual_leg_phase(x, A, P, V, c, NQ)
 

@@ -140,7 +140,7 @@ def derive_spoked(structure) -> Equations:
     )
 
 
-def _hip_roll_forces(q, dq, P) -> sp.Matrix:
+def hip_roll_forces(q, dq, P) -> sp.Matrix:
     """Generalised forces (n, 1) of the hip-roll law (:class:`walkerlab.config.walker.
     HipRollLaw`) in the coordinates ``(lean, swing, stance, pelvis_roll, swing_roll)``.
 
@@ -219,7 +219,7 @@ def derive_compass(structure) -> Equations:
     line (``T += I_pelvis dphi_p^2 / 2``; a rotation about ``s`` moves no foot, so the
     impact's extended mass gets it unchanged); the impact as above (the law's torques are
     finite: every joint is free through it); the law's generalised forces
-    (:func:`_hip_roll_forces`) are subtracted from ``G``.  The pelvis' pitch and yaw are
+    (:func:`hip_roll_forces`) are subtracted from ``G``.  The pelvis' pitch and yaw are
     held (the coordinates have none): its roll axis, on which the legs' roll joints lie,
     stays on the fall line.  Without hip-roll joints ``phi_p = phi_w = phi`` and the
     expressions are the three-coordinate walker's.
@@ -288,7 +288,7 @@ def derive_compass(structure) -> Equations:
     arc = structure.foot == "arc"
     R = P["R_foot"] if arc else 0
     e_s, e_n = sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0])
-    G = te.G - _hip_roll_forces(q, dq, P) if structure.hip_roll else te.G
+    G = te.G - hip_roll_forces(q, dq, P) if structure.hip_roll else te.G
     # the swing foot's contact point, and the rates that keep its material point at rest: a
     # point foot's, or the disc's lowest point's velocity plus R theta_sw' s (the material
     # point's, v_c + omega x (-R n_w) = d(contact)/dt + R theta_sw' s: the lean pivots the

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.models.contact.energy import side_entry
-from walkerlab.walker.layout import StateIndex
 
 from .ends import RunEnd
 
@@ -102,7 +101,7 @@ def hermite_state(walker, ta, tb, xa, xb, tc):
     return h00 * xa + h10 * h * fa + h01 * xb + h11 * h * fb
 
 
-def _hip_crossing(walker, idx, tt, X, hh, level, k0, down):
+def _hip_crossing(walker, tt, X, hh, level, k0, down):
     """First crossing of the hip height ``hh`` through ``level`` (downward if ``down``):
     (sample, time) on the Hermite interpolant, or None."""
     hit = np.flatnonzero(hh < level) if down else np.flatnonzero(hh > level)
@@ -111,8 +110,7 @@ def _hip_crossing(walker, idx, tt, X, hh, level, k0, down):
     k = int(hit[0])
     if k == 0:
         return k0 - 1, float(tt[0])
-    n = walker.normal
-    v = idx.hip_velocity(X[k0 - 1 + k - 1:k0 - 1 + k + 1]) @ n  # hip velocity . n
+    v = walker.hip_height_rate(X[k0 - 1 + k - 1:k0 - 1 + k + 1])  # hip velocity . n
     tc = hermite_root(tt[k - 1], tt[k], hh[k - 1] - level, hh[k] - level, float(v[0]),
                       float(v[1]), rising=not down)
     if tc is None:
@@ -135,14 +133,13 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
     """
     if len(t) <= k0:
         return None
-    idx = StateIndex(walker)
     sl = slice(k0 - 1, None)
     hh = walker.hip_height(X[sl])
     tt = t[sl]
     best = None
     for kind, level, down in ((RunEnd.FALL.value, limits.fall_hip_height_m, True),
                               (RunEnd.AIRBORNE.value, limits.airborne_hip_height_m, False)):
-        c = _hip_crossing(walker, idx, tt, X, hh, level, k0, down)
+        c = _hip_crossing(walker, tt, X, hh, level, k0, down)
         if c is not None and (best is None or c[1] < best[2]):
             best = (kind, c[0], c[1], "", np.nan)
     if walker.continuous:

@@ -285,7 +285,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{(f, "*"): ACTUATION_3D for f in ("hip_torque", "knee_torque",
                                             "ankle_torque", "torso_torque", "push_off",
                                             "ankle_push_off", "virtual_constraints")},
-        **_CELLS_3D,
+        # the compliant-contact model takes the straight legs in 3D (its vectors are
+        # d-dimensional: walkerlab.models.contact.assembly.point3)
+        **{cell: why for cell, why in _CELLS_3D.items() if cell != ("walk", "contact")},
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.legs_3d.

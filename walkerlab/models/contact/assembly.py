@@ -15,10 +15,14 @@ keys a function on its arguments' types); the generated module of each walker st
 (``dyn``, ``feet``, ``feet_jac``) and hands their arrays to these kernels
 (:mod:`walkerlab.codegen.contact_glue`).
 
-Shapes: ``nq`` generalised coordinates, ``nf`` contact points; ``P``, ``V`` (nf, 2) the
-points' positions [m] and material velocities [m/s], ``J`` (nf, 2, nq) their Jacobians,
-``point_leg`` (nf,) each point's leg (0: leg1, on lane ``c1``; 1: leg2, on ``c2``), ``info``
-(nf, 12) each point's :func:`point` result, ``knees`` (2, 5) each knee's :func:`knee` result.
+Shapes: ``nq`` generalised coordinates, ``nf`` contact points, ``d`` the world's dimension
+(2: a planar walker, world axes ``x`` downhill, ``y`` up; 3: a walker in 3D, ``z``
+lateral); ``P``, ``V`` (nf, d) the points' positions [m] and material velocities [m/s],
+``J`` (nf, d, nq) their Jacobians, ``point_leg`` (nf,) each point's leg (0: leg1, on lane
+``c1``; 1: leg2, on ``c2``), ``info`` (nf, :data:`NINFO`) each point's :func:`point`
+(planar) or :func:`point3` (3D) result, ``knees`` (2, 5) each knee's :func:`knee` result.
+The kernels read ``d`` from the arrays' shapes: one assembly, whose planar case is the
+walkers' before 3D contact, operation for operation.
 The contact parameter vector ``PC`` is read through the named indices ``I_*``
 (:mod:`walkerlab.models.contact.generated`'s table).
 """
@@ -44,6 +48,9 @@ I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
 I_KK, I_KE, I_KC, I_KD, I_KL, I_KF, I_KA = 11, 12, 13, 14, 15, 16, 17
 #: Number of contact parameters.
 NPC = 18
+#: Columns of a contact point's ``info`` row: :func:`point3`'s 15 (a planar point fills the
+#: first 12, :func:`point`'s).
+NINFO = 15
 #: The packed data vector's head: ``[n1, n2, PC (NPC), p, ...]``.
 D_N1, D_N2, D_PC = 0, 1, 2
 D_P = D_PC + NPC
@@ -122,6 +129,42 @@ def point(px, py, vx, vy, sp, cp, PC, cen):
 
 
 @njit(cache=True)
+def point3(px, py, pz, vx, vy, vz, sp, cp, PC, cen):
+    """Contact of a point at (px, py, pz) [m] whose material velocity is (vx, vy, vz) [m/s]
+    with the slope of a walker in 3D (the plane ``y = -x tan phi``, outward normal
+    ``n = (sin phi, cos phi, 0)``, its lines of greatest slope along ``t = (cos phi,
+    -sin phi, 0)``, level across them along ``z``), on the lane ``cen``: the penetration,
+    its rate, ``s`` and the patches are :func:`point`'s (the ground does not change across
+    the slope); the friction acts against the slip velocity ``v_t = (vt, vz)`` in the
+    tangent plane with the ADAMS Coulomb coefficient of the slip speed ``|v_t|``
+    (stiction and transition velocities on ``|v_t|``, MSC Adams/Solver's CONTACT
+    friction): ``F_t = mu(|v_t|) Fn v_t / |v_t|`` (``mu`` signed, < 0: against the slip;
+    ``mu(w) / w`` -> ``dmu(0)`` as ``w`` -> 0, so the force is smooth through rest).
+
+    Returns the 15 entries (delta, ddot, vt, s, Fn, Ft, dFn/ddelta, dFn/dddot, g, dmu/dw,
+    nx, ny, vz, Fz, w): :func:`point`'s first 12 with ``Ft`` the friction along ``t``
+    [N], ``g = mu(w) / w`` [s/m] (the friction per unit slip and normal force) and
+    ``dmu/dw`` at the slip speed ``w = |v_t|`` [m/s], then the lateral slip ``vz`` [m/s],
+    the lateral friction ``Fz`` [N] and ``w``.  Raises nothing: a polyline ground is
+    planar (a scene of one in 3D is refused before)."""
+    delta = -(px * sp + py * cp)
+    ddot = -(vx * sp + vy * cp)
+    vt = vx * cp - vy * sp
+    s = px * cp - py * sp
+    w = np.sqrt(vt * vt + vz * vz)
+    fn, dfd, dfdd, g, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
+    hp = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5) if delta + cen[-1] > 0.0 else np.nan
+    if hp == hp:
+        delta += hp
+    if delta > 0.0 and hp == hp:
+        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
+        if fn > 0.0:
+            mu, dmu = friction_mu(w, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
+            g = mu / w if w > 0.0 else dmu
+    return (delta, ddot, vt, s, fn, g * fn * vt, dfd, dfdd, g, dmu, sp, cp, vz, g * fn * vz, w)
+
+
+@njit(cache=True)
 def on_line(px, py, vx, vy, sp, cp, PC, line):
     """:func:`point` on the polyline ground ``line`` (stairs' treads and risers): the
     IMPACT and Coulomb laws on the penetration into the nearest segment, along its normal."""
@@ -187,7 +230,8 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
                    has_knees):
     """Q - h (nq,) from the bias ``h`` (nq,) with the contact forces of the points of the
     legs used (``use1``, ``use2``) and, ``has_knees``, the knee stops (knee k's foot: point
-    k); fills ``info`` and ``knees``."""
+    k); fills ``info`` and ``knees``.  Points in ``d = P.shape[1]`` dimensions
+    (:func:`point` in the plane, :func:`point3` in 3D)."""
     nq = h.shape[0]
     Q = -h
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
@@ -195,7 +239,17 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
         leg = point_leg[i]
         if not ((leg == 0 and use1) or (leg == 1 and use2)):
             continue
-        res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, c1 if leg == 0 else c2)
+        cen = c1 if leg == 0 else c2
+        if P.shape[1] == 3:
+            r3 = point3(P[i, 0], P[i, 1], P[i, 2], V[i, 0], V[i, 1], V[i, 2], sp, cp, PC, cen)
+            for k in range(15):
+                info[i, k] = r3[k]
+            if r3[4] > 0.0:
+                F = world_force(info[i])
+                for k in range(nq):
+                    Q[k] += J[i, 0, k] * F[0] + J[i, 1, k] * F[1] + J[i, 2, k] * F[2]
+            continue
+        res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
         for k in range(12):
             info[i, k] = res[k]
         fn, ff = res[4], res[5]
@@ -218,26 +272,37 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
 
 
 @njit(cache=True)
-def buffers(nq, nf):
+def world_force(row):
+    """A 3D point's contact force (3,) [N] in the world from its ``info`` row
+    (:func:`point3`): ``Fn n + Ft t + Fz e_z``."""
+    fn, ft, nx, ny = row[4], row[5], row[10], row[11]
+    return np.array((fn * nx + ft * ny, fn * ny - ft * nx, row[13]))
+
+
+@njit(cache=True)
+def buffers(nq, nf, d):
     """The arrays :func:`contact_forces` and the kinematics fill: M (nq, nq), the points'
-    P, V (nf, 2), J (nf, 2, nq), their info (nf, 12) and the knees' (2, 5)."""
-    return (np.empty((nq, nq)), np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, nq)),
-            np.zeros((nf, 12)), np.zeros((2, 5)))
+    P, V (nf, d), J (nf, d, nq), their info (nf, NINFO) and the knees' (2, 5)."""
+    return (np.empty((nq, nq)), np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, nq)),
+            np.zeros((nf, NINFO)), np.zeros((2, 5)))
 
 
 @njit(cache=True)
-def point_buffers(nq, nf):
-    """The points' P, V (nf, 2) and J (nf, 2, nq), to be filled by the kinematics."""
-    return np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, nq))
+def point_buffers(nq, nf, d):
+    """The points' P, V (nf, d) and J (nf, d, nq), to be filled by the kinematics."""
+    return np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, nq))
 
 
 @njit(cache=True)
-def world_forces(info):
-    """(nf, 2) each point's contact force [N] in the world from its ``info`` row."""
-    F = np.zeros((info.shape[0], 2))
+def world_forces(info, d):
+    """(nf, d) each point's contact force [N] in the world from its ``info`` row."""
+    F = np.zeros((info.shape[0], d))
     for i in range(info.shape[0]):
         fn, ff = info[i, 4], info[i, 5]
         if fn > 0.0:
+            if d == 3:
+                F[i] = world_force(info[i])
+                continue
             sp, cp = info[i, 10], info[i, 11]  # the ground's normal at the point
             F[i, 0] = fn * sp + ff * cp
             F[i, 1] = fn * cp - ff * sp
@@ -249,7 +314,8 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
     """d rhs / dx (2 nq, 2 nq) from the Cholesky factor ``L`` of M, the partials ``Dq``,
     ``Dv`` (nq, nq) of ``M a + h`` at the acceleration ``a``, ``dJtF`` (nq, nq) of ``J^T F``
     at the forces held, the points' Jacobians ``J`` and their rates' partials ``dV``
-    (nf, 2, nq); patch membership and each point's normal locally constant."""
+    (nf, d, nq); patch membership and each point's normal locally constant (3D points:
+    :func:`point3_partials`)."""
     nq = L.shape[0]
     B = np.empty((nq, 2 * nq))
     for r in range(nq):
@@ -259,6 +325,9 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
     for i in range(info.shape[0]):
         fn = info[i, 4]
         if fn <= 0.0:
+            continue
+        if J.shape[1] == 3:
+            point3_partials(B, J, dV, info[i], i)
             continue
         dfd, dfdd, mu, dmu = info[i, 6], info[i, 7], info[i, 8], info[i, 9]
         sp, cp = info[i, 10], info[i, 11]  # the normal, locally constant
@@ -301,41 +370,72 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
 
 
 @njit(cache=True)
-def pinned_angles(z, nq):
-    """The state (2 nq,) with the link angles and rates ``z`` (2 (nq - 2),), the hip at the
-    origin and at rest."""
+def point3_partials(B, J, dV, row, i):
+    """Add ``J_i^T dF_i/dx`` (nq, 2 nq) of the 3D point ``i`` (its :func:`point3` ``row``)
+    to ``B``: ``F = Fn n + g Fn (vt t + vz e_z)`` with ``g = mu(w) / w`` and
+    ``dg/dw = (dmu/dw - g) / w`` (0 at rest, where ``g`` is even in ``w``)."""
+    nq = J.shape[2]
+    fn, vt, dfd, dfdd, g, dmu = row[4], row[2], row[6], row[7], row[8], row[9]
+    sp, cp, vz, w = row[10], row[11], row[12], row[14]
+    dgdw = (dmu - g) / w if w > 0.0 else 0.0
+    dF = np.zeros((3, 2 * nq))
+    for k in range(2 * nq):
+        if k < nq:  # a coordinate: the point moves, its material velocity changes
+            dn, dndot = -(sp * J[i, 0, k] + cp * J[i, 1, k]), -(sp * dV[i, 0, k] + cp * dV[i, 1, k])
+            dvt, dvz = cp * dV[i, 0, k] - sp * dV[i, 1, k], dV[i, 2, k]
+        else:  # a rate: only the velocity changes
+            c = k - nq
+            dn, dndot = 0.0, -(sp * J[i, 0, c] + cp * J[i, 1, c])
+            dvt, dvz = cp * J[i, 0, c] - sp * J[i, 1, c], J[i, 2, c]
+        dfn = dfd * dn + dfdd * dndot
+        dg = dgdw * (vt * dvt + vz * dvz) / w if w > 0.0 else 0.0
+        dft = (dg * fn + g * dfn) * vt + g * fn * dvt
+        dF[0, k] = sp * dfn + cp * dft
+        dF[1, k] = cp * dfn - sp * dft
+        dF[2, k] = (dg * fn + g * dfn) * vz + g * fn * dvz
+    for r in range(nq):
+        for k in range(2 * nq):
+            B[r, k] += J[i, 0, r] * dF[0, k] + J[i, 1, r] * dF[1, k] + J[i, 2, r] * dF[2, k]
+
+
+@njit(cache=True)
+def pinned_angles(z, nq, d):
+    """The state (2 nq,) with the coordinates after the ``d`` slides of the floating base
+    and their rates ``z`` (2 (nq - d),), the base at the origin and at rest."""
     x = np.zeros(2 * nq)
-    for k in range(nq - 2):
-        x[2 + k] = z[k]
-        x[nq + 2 + k] = z[nq - 2 + k]
+    for k in range(nq - d):
+        x[d + k] = z[k]
+        x[nq + d + k] = z[nq - d + k]
     return x
 
 
 @njit(cache=True)
 def pin_at(x, P, V, pin, foot2):
     """Move the state ``x`` of :func:`pinned_angles` (its points at ``P``, ``V``) so that
-    its point ``pin`` is at ``foot2`` (2,) and at rest."""
+    its point ``pin`` is at ``foot2`` (d,) and at rest (the base's slides: the first ``d``
+    coordinates, translations along the world's axes)."""
     nq = x.shape[0] // 2
-    x[0] = foot2[0] - P[pin, 0]
-    x[1] = foot2[1] - P[pin, 1]
-    x[nq] = -V[pin, 0]
-    x[nq + 1] = -V[pin, 1]
+    for r in range(P.shape[1]):
+        x[r] = foot2[r] - P[pin, r]
+        x[nq + r] = -V[pin, r]
 
 
 @njit(cache=True)
 def pinned_dynamics(z, x, Q, M, J, dV, pin):
     """dz/dt of the reduced dynamics with point ``pin`` held: ``q = Phi(z)``,
     ``dq = Jp dz``, ``qdd = Jp zdd + gam``; ``Jp^T M Jp zdd = Jp^T (Q - h - M gam)``, from
-    the full state ``x``, its ``Q - h``, ``M`` and the points' ``J``, ``dV``."""
+    the full state ``x``, its ``Q - h``, ``M`` and the points' ``J``, ``dV`` (the base's
+    ``d = J.shape[1]`` slides eliminated)."""
     nq = M.shape[0]
-    m = nq - 2
+    d = J.shape[1]
+    m = nq - d
     Jp = np.zeros((nq, m))
     for k in range(m):
-        Jp[0, k] = -J[pin, 0, 2 + k]
-        Jp[1, k] = -J[pin, 1, 2 + k]
-        Jp[2 + k, k] = 1.0
+        for r in range(d):
+            Jp[r, k] = -J[pin, r, d + k]
+        Jp[d + k, k] = 1.0
     gam = np.zeros(nq)
-    for r in range(2):
+    for r in range(d):
         s = 0.0
         for k in range(nq):
             s += dV[pin, r, k] * x[nq + k]
@@ -366,18 +466,32 @@ def pinned_dynamics(z, x, Q, M, J, dV, pin):
 
 @njit(cache=True)
 def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r):
-    """Row ``r`` of the contact table ``out`` (n, nf, 8): per point penetration [m], its
-    rate [m/s], slip velocity [m/s], s [m], Fn [N], Ff [N], power F . v [W], on_ground."""
+    """Row ``r`` of the contact table ``out`` (n, nf, 8) (3D: (n, nf, 10)): per point
+    penetration [m], its rate [m/s], slip velocity along the slope's fall line [m/s], s
+    [m], Fn [N], Ff [N] (the friction along the fall line), power F . v [W], on_ground;
+    in 3D then the lateral slip velocity [m/s] and friction [N]."""
     for i in range(P.shape[0]):
         cen = c1 if point_leg[i] == 0 else c2
-        res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
-        fn, ff = res[4], res[5]
-        Fx = fn * res[10] + ff * res[11]
-        Fy = fn * res[11] - ff * res[10]
-        for k in range(6):
-            out[r, i, k] = res[k]
-        out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
-        hq = patch_height(res[3], cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
+        if P.shape[1] == 3:
+            r3 = point3(P[i, 0], P[i, 1], P[i, 2], V[i, 0], V[i, 1], V[i, 2], sp, cp, PC,
+                        cen)
+            for k in range(6):
+                out[r, i, k] = r3[k]
+            F = world_force(np.array(r3))
+            out[r, i, 6] = F[0] * V[i, 0] + F[1] * V[i, 1] + F[2] * V[i, 2]
+            out[r, i, 8] = r3[12]
+            out[r, i, 9] = r3[13]
+            s = r3[3]
+        else:
+            res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
+            fn, ff = res[4], res[5]
+            Fx = fn * res[10] + ff * res[11]
+            Fy = fn * res[11] - ff * res[10]
+            for k in range(6):
+                out[r, i, k] = res[k]
+            out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
+            s = res[3]
+        hq = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
         out[r, i, 7] = 1.0 if hq == hq else 0.0
 
 

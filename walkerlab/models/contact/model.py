@@ -318,14 +318,22 @@ class ContactWalker(ContactReadouts):
         return float(self.data.total_mass_kg)
 
     @property
+    def dim(self) -> int:
+        """The world's dimension ``d``: 2 for a planar walker, 3 for a walker in 3D (world
+        axes ``x`` downhill, ``y`` up, ``z`` lateral)."""
+        return int(self.kernels.DIM)
+
+    @property
     def normal(self) -> np.ndarray:
-        """Outward ground normal n = (sin phi, cos phi), shape (2,), unit vector [-]."""
-        return np.array([np.sin(self.phi), np.cos(self.phi)])
+        """Outward ground normal n = (sin phi, cos phi) (3D: (sin phi, cos phi, 0)), shape
+        (d,), unit vector [-]."""
+        return np.array([np.sin(self.phi), np.cos(self.phi), 0.0][:self.dim])
 
     @property
     def tangent(self) -> np.ndarray:
-        """Down-slope tangent t = (cos phi, -sin phi), shape (2,), unit vector [-]."""
-        return np.array([np.cos(self.phi), -np.sin(self.phi)])
+        """Down-slope tangent t = (cos phi, -sin phi) (3D: (cos phi, -sin phi, 0)), shape
+        (d,), unit vector [-]."""
+        return np.array([np.cos(self.phi), -np.sin(self.phi), 0.0][:self.dim])
 
     def static_penetration(self, load: float | None = None) -> float:
         """IMPACT static penetration (F / k)^(1/e) [m] under ``load`` [N] (default M g cos phi).
@@ -375,7 +383,7 @@ class ContactWalker(ContactReadouts):
 
     def state_units(self) -> tuple[str, ...]:
         """Units of :meth:`state_names`."""
-        u = ("m", "m") + ("rad",) * (self.nq - 2)
+        u = ("m",) * self.dim + ("rad",) * (self.nq - self.dim)
         return u + tuple(f"{s}/s" for s in u)
 
     def layout(self):
@@ -483,16 +491,16 @@ class ContactWalker(ContactReadouts):
 
         Returns
         -------
-        ndarray, shape (2 nq - 4,)
-            The link angles [rad] and their rates [rad/s] (the hip's position and velocity
-            dropped).
+        ndarray, shape (2 (nq - d),)
+            The link angles [rad] and their rates [rad/s] (the base's ``d`` slides and their
+            rates dropped: the hip's position and velocity; in 3D the stance foot's).
         """
         x = np.asarray(x, float)
-        n = self.nq
-        return np.concatenate([x[2:n], x[n + 2:]])
+        n, d = self.nq, self.dim
+        return np.concatenate([x[d:n], x[n + d:]])
 
     def rhs_pinned(self, t, z, foot2) -> np.ndarray:
-        """Reduced dynamics dz/dt with leg2's foot held at ``foot2`` (2,) [m] (point feet).
+        """Reduced dynamics dz/dt with leg2's foot held at ``foot2`` (d,) [m] (point feet).
 
         ``z = [link angles, their rates]`` (:meth:`pinned_state`); leg1's foot still feels
         its contact, the knees their stops.
@@ -501,14 +509,14 @@ class ContactWalker(ContactReadouts):
         ----------
         t : float
             Time [s] (ignored).
-        z : array_like, shape (2 nq - 4,)
+        z : array_like, shape (2 (nq - d),)
             Link angles [rad] and rates [rad/s].
-        foot2 : array_like, shape (2,)
+        foot2 : array_like, shape (d,)
             Position (x, y) [m] of leg2's pinned foot.
 
         Returns
         -------
-        ndarray, shape (2 nq - 4,)
+        ndarray, shape (2 (nq - d),)
             dz/dt [rad/s, rad/s^2].
 
         Raises
@@ -525,9 +533,9 @@ class ContactWalker(ContactReadouts):
 
         Parameters
         ----------
-        z : array_like, shape (2 nq - 4,)
+        z : array_like, shape (2 (nq - d),)
             Link angles [rad] and rates [rad/s] (:meth:`pinned_state`).
-        foot2 : array_like, shape (2,)
+        foot2 : array_like, shape (d,)
             Position (x, y) [m] of leg2's pinned foot.
 
         Returns
@@ -561,7 +569,7 @@ class ContactWalker(ContactReadouts):
 
         Returns
         -------
-        ndarray, shape (2 nq - 4,)
+        ndarray, shape (2 (nq - d),)
             The pinned state z (:meth:`pinned_state`), [rad] and [rad/s].
         """
         return contact_part(self.structure).link_state(self, np.asarray(x_ideal, float),

@@ -90,9 +90,10 @@ class ContactPart:
         """``(z, chord, x)``: the pinned start, the distance between the feet's reference
         points (along the slope: its component there) and the full state."""
         z = walker.link_state_from_ideal(x_ideal)
-        x = walker.pinned_to_full(z, np.zeros(2))
+        x = walker.pinned_to_full(z, np.zeros(walker.dim))
         feet = walker.foot_positions(x)
-        chord = float(np.hypot(*(feet[1] - feet[0])))
+        gap = feet[1] - feet[0]
+        chord = float(np.hypot(*gap)) if gap.size == 2 else float(np.linalg.norm(gap))
         if along_slope:
             chord = abs(float((feet[1] - feet[0]) @ walker.tangent))
         return z, chord, x
@@ -245,6 +246,49 @@ class RollingPolygonPart(ContactPart):
         return None
 
 
+class Legs3DPart(ContactPart):
+    """Straight legs in 3D (Kuo 1999): the floating base at leg2's foot (three slides along
+    the world's axes and the heading, :data:`walkerlab.codegen.floating_equations.FREE_3D`),
+    then the rigid roles' own coordinates (:data:`~walkerlab.codegen.floating_equations.
+    ROLES_3D`: the stance leg's roll and pitch, the swing leg's pitch, the pelvis' and the
+    swing leg's rolls), so the rigid state is the floating one with the base at rest."""
+
+    plain = False
+
+    def link_state(self, walker, x, rate_scale) -> np.ndarray:
+        """The floating state after the base's slides (``[heading, the rigid roles' angles,
+        their rates]``) of the rigid state ``x`` (role order), the heading 0 and at rest;
+        each leg's coordinates' rates scaled by its leg's factor (the pelvis' by none)."""
+        from walkerlab.codegen.floating_equations import ROLES_3D  # light
+
+        x = np.asarray(x, float)
+        roles = walker.structure.roles
+        n = len(roles)
+        coords = walker.coordinate_names()[walker.dim:]
+        at = {ROLES_3D[r]: k for k, r in enumerate(roles)}
+        angles = np.array([x[at[c]] if c in at else 0.0 for c in coords])
+        scale = [rate_scale[0] if c.startswith("leg1") else
+                 rate_scale[1] if c.startswith("leg2") else 1.0 for c in coords]
+        rates = np.array([x[n + at[c]] * f if c in at else 0.0
+                          for c, f in zip(coords, scale)])
+        return np.concatenate([angles, rates])
+
+    def step_length(self, walker, x_ideal, along_slope: bool) -> float:
+        """The feet's distance along the slope's fall line at the heel strike (the
+        patches are strips across the slope; the hip width lies across it)."""
+        return self._chord(walker, x_ideal, True)[1]
+
+    def check(self, scene, data, cs) -> str | None:
+        """No pinned start (its stance foot turns freely about the normal: a point foot
+        holds no twist) and no contact periodic gait yet (the step map's section is
+        planar)."""
+        if cs.start == "periodic_gait" or cs.periodic_gait:
+            return ("contact_sim.start / periodic_gait: the contact periodic gait of a "
+                    "walker in 3D is a later step: start from the rigid gait (start: "
+                    "ideal, periodic_gait: false)")
+        return None
+
+
 #: contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) -> the contact view's part
 PARTS: dict[str, ContactPart] = {
     "legs": ContactPart(),
@@ -253,6 +297,7 @@ PARTS: dict[str, ContactPart] = {
     "five_link": FreeJointsPart(),
     "three_link": HingedTorsoPart(),
     "wheel": RollingPolygonPart(),
+    "legs_3d": Legs3DPart(),
 }
 
 

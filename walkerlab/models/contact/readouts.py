@@ -53,20 +53,22 @@ class ContactReadouts:
 
     def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
         """Reference contact point of leg ``i`` (0/1) (its only point; a flat foot's heel)
-        and the velocity of the material point there: (px, py, vx, vy) [m, m/s]."""
-        n, nf = self.nq, len(self._contacts)
-        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
+        and the velocity of the material point there: (px, py, vx, vy) [m, m/s] (the
+        sagittal components of a walker in 3D)."""
+        n, nf, d = self.nq, len(self._contacts), self.dim
+        P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, n))
         self.kernels.feet(np.asarray(x, float), self.walker_params, P, V, J)
         i = self._point_legs.index(i)
         return float(P[i, 0]), float(P[i, 1]), float(V[i, 0]), float(V[i, 1])
 
     def foot_positions(self, X) -> np.ndarray:
-        """Reference contact point of each leg (n, 2, 2) [m] (leg, xy) for states X (n, 2 nq),
-        or (2, 2) for one: the foot point, an arc's lowest point, a flat foot's heel."""
+        """Reference contact point of each leg (n, 2, d) [m] (leg, xy (z)) for states X
+        (n, 2 nq), or (2, d) for one: the foot point, an arc's lowest point, a flat foot's
+        heel."""
         X = self._rows(X)
         pts = self.kernels.points(X.T, self.walker_params)
         key = contact_part(self.structure).foot_point(self.structure)
-        out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
+        out = np.stack([np.stack([pts[f"{leg}_{key}"][k] for k in range(self.dim)], axis=-1)
                         for leg in FOOT_NAMES], axis=1)
         return out if len(out) > 1 else out[0]
 
@@ -80,7 +82,23 @@ class ContactReadouts:
         a fresh user cache; the same operations as that kernel had)."""
         X = self._rows(X)
         phi = float(self.contact_params[self.kernels.I_PHI])
+        if self.dim == 3:  # the base is the stance foot: the hip from the kinematics
+            hip = np.atleast_2d(self.points(X)["hip"].T)
+            return hip[:, 0] * math.sin(phi) + hip[:, 1] * math.cos(phi)
         return X[:, 0] * math.sin(phi) + X[:, 1] * math.cos(phi)
+
+    def hip_height_rate(self, X) -> np.ndarray:
+        """Rate of :meth:`hip_height` [m/s] for X (n, 2 nq) -> (n,): the hip's velocity
+        along the slope's normal (a planar walker's hip rates; in 3D, where the base is
+        the stance foot, the central difference of the height along the flow,
+        ``(h(x + e f) - h(x - e f)) / 2 e`` with ``e`` 1e-6 s: exact to ~1e-12 m/s)."""
+        X = self._rows(X)
+        if self.dim == 2:
+            ix = [self.state_names().index(n) for n in ("vhip_x", "vhip_y")]
+            return X[:, ix] @ self.normal
+        e = 1e-6
+        F = np.array([self.rhs(0.0, x) for x in X])
+        return (self.hip_height(X + e * F) - self.hip_height(X - e * F)) / (2 * e)
 
     def fall_margin(self, x, threshold: float) -> float:
         """The one fall test: hip height of state ``x`` minus ``threshold`` [m]
@@ -106,11 +124,14 @@ class ContactReadouts:
             height above ground), ``penetration_rate`` [m/s], ``slip_velocity`` [m/s]
             (down-slope, of the material point), ``s`` [m] along-slope position,
             ``normal_force`` [N], ``friction_force`` [N] (along t), ``power`` [W] (F . v),
-            ``on_ground`` (1.0 where the point's lane has ground).
+            ``on_ground`` (1.0 where the point's lane has ground); a walker in 3D also
+            ``lateral_slip_velocity`` [m/s] and ``lateral_friction_force`` [N] (along the
+            slope's level direction ``z``).
         """
         tab = self.kernels.contact_table(self._rows(X), *self._args())
         names = ("penetration", "penetration_rate", "slip_velocity", "s", "normal_force",
-                 "friction_force", "power", "on_ground")
+                 "friction_force", "power", "on_ground", "lateral_slip_velocity",
+                 "lateral_friction_force")[:tab.shape[2]]
         return {foot: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
                 for i, foot in enumerate(self._contacts)}
 

@@ -33,23 +33,23 @@ def _cholesky_lines(nq: int, nz: set) -> list[str]:
     return lines
 
 
-def _force_lines(point_legs, Fs, forced: bool) -> list[str]:
-    """:func:`rhs_source`'s contact forces ``Fs`` (x, y per point) in the world from each
-    point's ``_point`` result ``_r<i>`` (normal and friction force along the ground's normal
-    and tangent); ``forced``: a ghost point's (of leg ``G[0]``, ``G[1]`` ahead of the other
-    leg's points) zero."""
+def _force_lines(point_legs, Fs, forced: bool, d: int = 2) -> list[str]:
+    """:func:`rhs_source`'s contact forces ``Fs`` (``d`` per point: x, y (, z)) in the world
+    from each point's ``_point`` (``_point3``) result ``_r<i>`` (normal and friction force
+    along the ground's normal and tangent; in 3D the lateral friction); ``forced``: a ghost
+    point's (of leg ``G[0]``, ``G[1]`` ahead of the other leg's points) zero."""
     lines = []
     for i, leg in enumerate(point_legs):
         # (Fn, Ff) in the world, along the ground's normal (the slope's: _sp, _cp)
-        fx = f"_r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]"
-        fy = f"_r{i}[4] * _r{i}[11] - _r{i}[5] * _r{i}[10]"
+        comps = [f"_r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]",
+                 f"_r{i}[4] * _r{i}[11] - _r{i}[5] * _r{i}[10]", f"_r{i}[13]"][:d]
         if forced:  # a ghost point: of leg G[0], ahead of the other leg's points by G[1]
             others = ", ".join(f"_r{j}[3]" for j, lg in enumerate(point_legs) if lg != leg)
             front = f"max({others}, -1e300)" if others.count(",") else f"{others}"
             lines.append(f"    _ghost{i} = S[NQ + 10] == {float(leg)} and "
                          f"_r{i}[3] - {front} >= S[NQ + 11]")
-            fx, fy = f"0.0 if _ghost{i} else {fx}", f"0.0 if _ghost{i} else {fy}"
-        lines += [f"    {Fs[2 * i]} = {fx}", f"    {Fs[2 * i + 1]} = {fy}"]
+            comps = [f"0.0 if _ghost{i} else {c}" for c in comps]
+        lines += [f"    {Fs[d * i + k]} = {c}" for k, c in enumerate(comps)]
     return lines
 
 
@@ -72,6 +72,27 @@ def _knee_lines(eq, red, pr, Q, power: list) -> list[str]:
         Q[t] += T
         Q[sh] -= T
         power.append(f"-{T} * ({eq.dq[sh]} - {eq.dq[t]})")
+    return lines
+
+
+def _stance_lines(eq, Q) -> list[str]:
+    """:func:`rhs_source`'s stance-dependent internal forces
+    (:attr:`walkerlab.codegen.floating.FloatingEquations.stance_forces`: a walker in 3D
+    with hip-roll joints, Kuo 1999's law) added into ``Q``: each leg's law weighted by its
+    foot's share of the normal load, ``_w<k> = Fn_k / (Fn_1 + Fn_2)`` (the point results
+    ``_r<i>``; the stance leg's law alone in single support, the two blended through the
+    double support, halves in flight)."""
+    import sympy as sp
+
+    if not eq.stance_forces:
+        return []
+    loads = [" + ".join(f"_r{i}[4]" for i, lg in enumerate(eq.point_legs) if lg == leg)
+             for leg in (0, 1)]
+    lines = [f"    _load0 = {loads[0]}", f"    _load1 = {loads[1]}",
+             "    _w1 = _load1 / (_load0 + _load1) if _load0 + _load1 > 0.0 else 0.5",
+             "    _w0 = 1.0 - _w1"]
+    for k, F in enumerate(eq.stance_forces):  # leg k + 1 in stance
+        Q += sp.Symbol(f"_w{k}", real=True) * F
     return lines
 
 
@@ -115,24 +136,29 @@ def rhs_source(eq, forced: bool = False) -> str:
     lines += [f"    {s} = x[{i}]" for i, s in enumerate(eq.q)]
     lines += [f"    {s} = x[{nq + i}]" for i, s in enumerate(eq.dq)]
     lines += ["    _sp = _sin(PC[I_PHI])", "    _cp = _cos(PC[I_PHI])"]
+    d = eq.feet[0][0].shape[0]  # the world's dimension: 2 (planar) or 3
     kin = []
     for pos, J in eq.feet:
         v = J * dqv
-        kin += [pos[0], pos[1], v[0], v[1]]
+        kin += [*pos[:d], *v[:d]]
     repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
     lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
-    Fs = sp.symbols(" ".join(f"_Fx{i} _Fy{i}" for i in range(len(eq.feet))), real=True)
+    axes = "xyz"[:d]
+    Fs = sp.symbols(" ".join(f"_F{a}{i}" for i in range(len(eq.feet)) for a in axes),
+                    real=True)
     power = []  # forced: each point's F . v
     for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
-        args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
-        power.append(f"{Fs[2 * i]} * ({pr.doprint(red[4 * i + 2])}) + "
-                     f"{Fs[2 * i + 1]} * ({pr.doprint(red[4 * i + 3])})")
-        lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
-    lines += _force_lines(eq.point_legs, Fs, forced)
+        args = ", ".join(pr.doprint(e) for e in red[2 * d * i:2 * d * (i + 1)])
+        power.append(" + ".join(f"{Fs[d * i + k]} * ({pr.doprint(red[2 * d * i + d + k])})"
+                                for k in range(d)))
+        fn = "_point" if d == 2 else "_point3"
+        lines += [f"    _r{i} = {fn}({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
+    lines += _force_lines(eq.point_legs, Fs, forced, d)
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
-        Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])
+        Q += J.T * sp.Matrix(Fs[d * i:d * (i + 1)])
     lines += _knee_lines(eq, red, pr, Q, power)
+    lines += _stance_lines(eq, Q)
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}
     mexprs = [eq.M[i, j] for i in range(nq) for j in range(i + 1) if (i, j) in nz]
     repl, red = sp.cse(mexprs + list(Q), symbols=sp.numbered_symbols("_m"), order="none")

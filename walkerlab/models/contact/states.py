@@ -10,10 +10,20 @@ __all__ = ["FOOT_NAMES", "STATE_OF_COORDINATE", "state_name"]
 FOOT_NAMES = ("leg1", "leg2")
 
 
+#: A walker in 3D: its floating base's coordinates (leg2's foot, the heading) and rolls ->
+#: their state names (their rates: ``v`` before a position, ``d`` before an angle).
+STATE_3D = {"leg2_foot_x": "foot2_x", "leg2_foot_y": "foot2_y", "leg2_foot_z": "foot2_z",
+            "heading": "heading", "leg1_roll": "phi1", "leg2_roll": "phi2",
+            "pelvis_roll": "phi_pelvis"}
+
+
 def state_name(coordinate: str, rate: bool = False) -> str:
     """State name of a floating coordinate (module docstring's table)."""
     if coordinate in ("hip_x", "hip_y"):
         return ("v" if rate else "") + coordinate
+    if coordinate in STATE_3D:
+        name = STATE_3D[coordinate]
+        return (("v" if name.startswith("foot") else "d") if rate else "") + name
     if coordinate == "torso_angle":  # a hinged torso (five-link biped)
         return ("d" if rate else "") + "theta_torso"
     if coordinate == "wheel_angle":  # a spoked wheel: spoke 0's angle
