@@ -27,11 +27,11 @@ from walkerlab.models.contact._kernels import (normal_force, friction_mu, patch_
                                                step, ground_line)
 from walkerlab.models.contact.assembly import (I_PHI, I_K, I_E, I_CMAX, I_DMAX, I_MUS,
                                                I_MUD, I_VS, I_VD, I_HW, I_CONT, I_KK, I_KE,
-                                               I_KC, I_KD, I_KL, I_KF, I_KA, NPC, D_N1,
-                                               D_N2, D_PC, D_P)
+                                               I_KC, I_KD, I_KL, I_KF, I_KA, I_TOR, I_WEPS, NPC,
+                                               D_N1, D_N2, D_PC, D_P)
 from walkerlab.models.contact.assembly import chol as _chol, chol_solve as _chol_solve
 from walkerlab.models.contact.assembly import point as _point, knee_torque as _knee_torque
-from walkerlab.models.contact.assembly import point3 as _point3
+from walkerlab.models.contact.assembly import point3 as _point3, twist as _twist
 from walkerlab.models.contact.powered_kernels import A_HEAD
 from walkerlab.codegen.torque_law import HEAD
 
@@ -47,8 +47,14 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
     h = np.empty(NQ)
     dyn(x, p, M, h)
     feet(x, p, P, V, J)
-    return _asm.contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees,
-                               POINT_LEG, KNEE)
+    Q = _asm.contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees,
+                            POINT_LEG, KNEE)
+    if DIM == 3:  # the contact patches' torsional friction (the analytic Jacobian holds
+        # it constant)
+        S, Jn = np.empty(NF), np.empty((NF, NQ))
+        spins(x, p, S, Jn)
+        _asm.add_twists(Q, info, S, Jn, PC)
+    return Q
 
 
 @njit(cache=True)
@@ -96,15 +102,19 @@ _TABLES = '''
 
 @njit(cache=True)
 def contact_table(X, PC, p, c1, c2):
-    """(n, NF, 8) (3D: (n, NF, 10)): per contact point penetration [m], its rate [m/s],
+    """(n, NF, 8) (3D: (n, NF, 12)): per contact point penetration [m], its rate [m/s],
     slip velocity [m/s], s [m], Fn [N], Ff [N], power F . v [W], on_ground (1/0); in 3D
-    then the lateral slip velocity [m/s] and friction [N] (``assembly.contact_row``)."""
-    out = np.zeros((X.shape[0], NF, 8 if DIM == 2 else 10))
+    then the lateral slip velocity [m/s] and friction [N], the spin about the normal
+    [rad/s] and the torsional friction moment [N m] (``assembly.contact_row``)."""
+    out = np.zeros((X.shape[0], NF, 8 if DIM == 2 else 12))
     sp, cp = _asm.slope(PC)
     P, V, J = _asm.point_buffers(NQ, NF, DIM)
+    S, Jn = np.empty(NF), np.empty((NF, NQ))
     for r in range(X.shape[0]):
         feet(X[r], p, P, V, J)
-        _asm.contact_row(P, V, sp, cp, PC, c1, c2, POINT_LEG, out, r)
+        if DIM == 3:
+            spins(X[r], p, S, Jn)
+        _asm.contact_row(P, V, sp, cp, PC, c1, c2, POINT_LEG, out, r, S)
     return out
 
 

@@ -15,6 +15,9 @@ Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
                                        ``V`` (nf, d) [m/s], Jacobians ``J`` (nf, d, nq)
 ``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (nf, d, nq) and
                                        ``dJtF = d(sum_i J_i^T F_i)/dq`` (nq, nq), ``F`` (nf, d)
+``spins(x, p, S, Jn)``                 each contact point's spin rate about the ground's
+                                       normal ``S`` (nf,) [rad/s] and its Jacobian ``Jn``
+                                       (nf, nq) (zeros for a planar walker)
 ``energies(X, p)``                     numpy: kinetic, potential [J] of states (2 nq, k)
 ``points(X, p)``                       numpy: named points (d, k) [m]
 =====================================  ========================================================
@@ -204,6 +207,13 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
     lines.insert(2, f"    {', '.join(str(f) for f in F)} = "
                  + ", ".join(f"F[{i}, {r}]" for i in range(nf) for r in range(d)))
     body += lines
+    # each point's spin about the ground's normal and its Jacobian (zeros in the plane)
+    outs = []
+    for i in range(nf):
+        Jn = eq.spins[i] if eq.spins else sp.zeros(1, nq)
+        outs += [(f"S[{i}]", (Jn * dqv)[0])]
+        outs += [(f"Jn[{i}, {k}]", Jn[0, k]) for k in range(nq)]
+    body += _fn("spins", "x, p, S, Jn", eq, outs, pr)
     body += _numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential})
     body += ["def energies(X, p):", "    d = _energies(X, p)",
              "    return d['kinetic'], d['potential']", ""]

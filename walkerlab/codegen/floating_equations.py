@@ -170,6 +170,10 @@ class FloatingEquations:
         pelvis level and the swing hip placing its leg); empty: none.  The contact model
         weights each by its foot's share of the normal load
         (:mod:`walkerlab.models.contact.rhs_lines`).
+    spins : tuple of Matrix (1, nq)
+        A walker in 3D: per contact point, the Jacobian of its body's angular velocity
+        about the slope's normal (the foot's spin rate ``omega . n = Jn dq``, where the
+        contact's torsional friction acts); empty for a planar walker.
     """
 
     q: tuple
@@ -185,6 +189,7 @@ class FloatingEquations:
     contacts: tuple = LEGS
     point_legs: tuple = (0, 1)
     stance_forces: tuple = ()
+    spins: tuple = ()
 
 @cache
 def derive_floating(structure: Structure) -> FloatingEquations:
@@ -528,6 +533,10 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
             pos = to_world * kin.contacts[contact].xreplace(rename)
             feet.append((pos, pos.jacobian(qv)))
             points[f"{leg}_foot"] = pos
+    # each foot's spin about the slope's normal (the slope frame's y): its leg's angular
+    # velocity there, omega = R_b omega_b
+    spins = tuple((kin.rotations[link] * kin.omegas[link]).jacobian(sp.Matrix(kin.dq))[1, :]
+                  .xreplace(rename) for link in ("swing_leg", "stance_leg"))
     points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
     for b in structure.bodies:
         for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
@@ -538,7 +547,8 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
                              params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
                              kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
                              points=points, contacts=LEGS, point_legs=(0, 1),
-                             stance_forces=_stance_forces(structure, q, dq, kin.params))
+                             stance_forces=_stance_forces(structure, q, dq, kin.params),
+                             spins=spins)
 
 
 def _stance_forces(structure: Structure, q, dq, params) -> tuple:

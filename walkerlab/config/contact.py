@@ -275,6 +275,16 @@ class ContactSettings(BaseModel):
         "walker.hub_inertia_kg_m2 is given.",
         json_schema_extra={"unit": "kg m^2"})
 
+    torsional_friction_m: float | None = Field(
+        None, ge=0, le=1, description="Walkers in 3D only: the largest moment about the "
+        "ground's normal a foot's contact holds per newton of normal force [m] (MuJoCo's "
+        "torsional friction coefficient; an evenly pressed round patch of radius r has "
+        "2 mu_static r / 3).  A point foot holds none, and a 3D walker on it spins about "
+        "its stance foot: the contact model gives each foot this torsional friction, the "
+        "ADAMS Coulomb law on the patch's slip speed (rho |omega_n|, rho = this / "
+        "mu_static).  Default (null) 0.05 leg lengths, the MJCF export's.",
+        json_schema_extra={"unit": "m"})
+
     push_off_duration_s: float | None = Field(
         None, ge=0, le=0.5, description="Powered walkers only: the duration [s] of the "
         "push-off pulse, a constant force P / duration along the trailing leg (from its foot "

@@ -32,7 +32,8 @@ Contact: the planar export's (:func:`walkerlab.export.scene.mujoco_contact`: the
 IMPACT law linearised at the walker's static penetration, a stiffer time constant and its
 timestep), with ``condim 4`` at the feet: sliding and torsional friction, as the rigid
 model's stance foot neither slips nor twists (it rolls and pitches freely: no rolling
-friction); the torsional coefficient is :data:`TORSION_FRACTION` of the leg length.  The
+friction); the torsional coefficient is the contact model's default,
+:data:`walkerlab.models.contact.laws.TORSION_FRACTION` of the leg length.  The
 friction cone is elliptic (MuJoCo's exact Coulomb cone): the default pyramidal cone sums
 its facets in an order that breaks the walker's mirror symmetry by roundoff (~1e-16 rad of
 lean at the first step of configs/paper_3d.yaml), which the unstable roll (x 11.2 a step)
@@ -74,18 +75,13 @@ from walkerlab.export.tree_bodies import (
     mjcf_body_lines,
     mjcf_coupling_lines,
 )
+from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_3d_tree
 
 __all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
            "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
 
-#: The feet's torsional friction coefficient [m] as a fraction of the leg length: the torque
-#: about the ground's normal a stance foot holds is this times its normal force (MuJoCo's
-#: ``condim 4``).  The rigid model's foot does not twist; the yaw moment of a swinging leg
-#: ``w`` off the stance foot's line is ~ ``m_leg a w`` (5 kg x 3 m/s^2 x 0.1 m = 1.5 N m on
-#: a 200 N load: 0.0075 m): 0.05 L holds it with room.
-TORSION_FRACTION = 0.05
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
 PATCH_ACROSS_L = 0.08

@@ -30,8 +30,8 @@ def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
     n = idx.coordinates.stop
     out = {}
     for i, coord in enumerate(walker.coordinate_names()):
-        if coord in ("hip_x", "hip_y"):
-            continue
+        if i < walker.dim:  # the floating base's slides (the hip's, or a 3D walker's
+            continue        # stance foot's position): points of their own
         leg = coord.split("_", 1)[0]
         new = coord if leg not in ("leg1", "leg2") else legs[int(leg[-1]) - 1] + coord[4:]
         out[idx.names[i]] = new
@@ -122,7 +122,8 @@ def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
     by_points = by_points or bool(res.steps) and res.steps[0].stance_leg not in legs
     X = res.x
     en = walker.energies(X)
-    pts = {k: np.asarray(v, float).reshape(2, -1) for k, v in walker.points(X).items()}
+    pts = {k: np.asarray(v, float).reshape(walker.dim, -1)
+           for k, v in walker.points(X).items()}
     names = trajectory_names(walker, legs)
     units = dict(zip(walker.state_names(), walker.state_units()))
     coords = {new: res.column(old) for old, new in names.items()}

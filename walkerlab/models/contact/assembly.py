@@ -46,8 +46,9 @@ from walkerlab.models.contact._kernels import (
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
 I_KK, I_KE, I_KC, I_KD, I_KL, I_KF, I_KA = 11, 12, 13, 14, 15, 16, 17
+I_TOR, I_WEPS = 18, 19
 #: Number of contact parameters.
-NPC = 18
+NPC = 20
 #: Columns of a contact point's ``info`` row: :func:`point3`'s 15 (a planar point fills the
 #: first 12, :func:`point`'s).
 NINFO = 15
@@ -272,6 +273,34 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
 
 
 @njit(cache=True)
+def twist(spin, fn, PC):
+    """The torsional friction moment [N m] about the ground's normal on a contact point
+    whose body spins at ``spin`` [rad/s] about it under the normal force ``fn`` [N]: the
+    contact patch's, ``M = mu(rho spin) fn rho`` with ``rho = tau / mu_s`` (``tau`` =
+    ``PC[I_TOR]`` [m], the largest moment per newton of normal force: MuJoCo's
+    torsional coefficient; an evenly pressed disc of radius ``r`` has ``tau = 2 mu_s r /
+    3``) and ``mu`` the ADAMS Coulomb coefficient of the patch's slip speed ``rho spin``
+    (:func:`walkerlab.models.contact._kernels.friction_mu`, signed: against the spin).
+    0 without a torsional coefficient or off the ground."""
+    tau = PC[I_TOR]
+    if fn <= 0.0 or tau <= 0.0:
+        return 0.0
+    rho = tau / PC[I_MUS]
+    return friction_mu(rho * spin, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])[0] * fn * rho
+
+
+@njit(cache=True)
+def add_twists(Q, info, S, Jn, PC):
+    """Add each 3D contact point's torsional friction ``Jn_i^T M_i`` (:func:`twist` of its
+    spin ``S`` (nf,) [rad/s] and its ``info`` row's normal force) to ``Q`` (nq,)."""
+    for i in range(S.shape[0]):
+        m = twist(S[i], info[i, 4], PC)
+        if m != 0.0:
+            for k in range(Q.shape[0]):
+                Q[k] += Jn[i, k] * m
+
+
+@njit(cache=True)
 def world_force(row):
     """A 3D point's contact force (3,) [N] in the world from its ``info`` row
     (:func:`point3`): ``Fn n + Ft t + Fz e_z``."""
@@ -465,11 +494,12 @@ def pinned_dynamics(z, x, Q, M, J, dV, pin):
 
 
 @njit(cache=True)
-def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r):
-    """Row ``r`` of the contact table ``out`` (n, nf, 8) (3D: (n, nf, 10)): per point
+def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r, S):
+    """Row ``r`` of the contact table ``out`` (n, nf, 8) (3D: (n, nf, 12)): per point
     penetration [m], its rate [m/s], slip velocity along the slope's fall line [m/s], s
-    [m], Fn [N], Ff [N] (the friction along the fall line), power F . v [W], on_ground;
-    in 3D then the lateral slip velocity [m/s] and friction [N]."""
+    [m], Fn [N], Ff [N] (the friction along the fall line), power F . v (+ M spin) [W],
+    on_ground; in 3D then the lateral slip velocity [m/s] and friction [N], the spin
+    about the normal ``S`` (nf,) [rad/s] and the torsional friction moment [N m]."""
     for i in range(P.shape[0]):
         cen = c1 if point_leg[i] == 0 else c2
         if P.shape[1] == 3:
@@ -478,9 +508,12 @@ def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r):
             for k in range(6):
                 out[r, i, k] = r3[k]
             F = world_force(np.array(r3))
-            out[r, i, 6] = F[0] * V[i, 0] + F[1] * V[i, 1] + F[2] * V[i, 2]
+            m = twist(S[i], r3[4], PC)
+            out[r, i, 6] = F[0] * V[i, 0] + F[1] * V[i, 1] + F[2] * V[i, 2] + m * S[i]
             out[r, i, 8] = r3[12]
             out[r, i, 9] = r3[13]
+            out[r, i, 10] = S[i]
+            out[r, i, 11] = m
             s = r3[3]
         else:
             res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)

@@ -38,6 +38,8 @@ I_KD      knee-stop penetration at max damping      rad
 I_KL      knee latch on (1/0)                       -
 I_KF      latch release height of the foot          m
 I_KA      latch capture angle                       rad
+I_TOR     torsional friction coefficient (3D)       m
+I_WEPS    load share's regularising force           N
 ========  ========================================  ==============
 
 Knee latch (``contact.knee_stop.latch``): while a leg's foot is on (or within the release
@@ -111,7 +113,9 @@ _SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
     constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``NF``,
-    ``POINT_LEG``, ``PIN``, ``CONTACTS``, then the glue of
+    ``POINT_LEG``, ``PIN``, ``CONTACTS``, ``STANCE_LAW`` (internal forces by stance: a
+    hip-roll law, :attr:`walkerlab.codegen.floating.FloatingEquations.stance_forces`), then
+    the glue of
     :func:`walkerlab.codegen.contact_glue.contact_glue` that hands the generated
     kinematics to :mod:`walkerlab.models.contact.assembly`, the straight-line ``rhs`` and
     ``rhs_q``, and the powered glue of
@@ -133,7 +137,8 @@ def contact_source(structure: Structure, key: str) -> str:
     legs = tuple(eq.point_legs)
     return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(eq.knees)}\n"
             f"NF = {len(eq.feet)}\nPOINT_LEG = {legs!r}\nPIN = {legs.index(1)}\n"
-            f"CONTACTS = {tuple(eq.contacts)!r}\n" + contact_glue() + "\n\n" + rhs_source(eq)
+            f"CONTACTS = {tuple(eq.contacts)!r}\nSTANCE_LAW = {bool(eq.stance_forces)}\n"
+            + contact_glue() + "\n\n" + rhs_source(eq)
             + "\n\n" + rhs_source(eq, forced=True) + "\n\n" + powered_source())
 
 

@@ -41,6 +41,27 @@ __all__ = [
 ]
 
 
+#: A contact point's torsional friction coefficient [m] as a fraction of the leg length,
+#: for a walker in 3D when the scene gives none (``contact.torsional_friction_m``): the
+#: largest moment about the ground's normal the foot's patch holds is this times its normal
+#: force (MuJoCo's ``condim 4`` coefficient; the MJCF export's).  The rigid model's foot
+#: does not twist; the yaw moment of a swinging leg ``w`` off the stance foot's line is
+#: ~ ``m_leg a w`` (5 kg x 3 m/s^2 x 0.1 m = 1.5 N m on a 200 N load: 0.0075 m): 0.05 L
+#: holds it with room.
+TORSION_FRACTION = 0.05
+
+
+def torsional_friction_m(settings, leg_length_m: float, in_3d: bool) -> float:
+    """The torsional friction coefficient [m] of the scene's contact law ``settings``
+    (:class:`walkerlab.config.contact.ContactSettings`): ``torsional_friction_m``, else
+    :data:`TORSION_FRACTION` of the leg length ``leg_length_m`` [m] for a walker in 3D and
+    0 in the plane (a planar contact has no normal to spin about)."""
+    given = getattr(settings, "torsional_friction_m", None)
+    if not in_3d:
+        return 0.0
+    return float(given) if given is not None else TORSION_FRACTION * float(leg_length_m)
+
+
 @dataclass(frozen=True)
 class ContactParamsSI:
     """Contact parameters in SI units (what the model kernels use).

@@ -128,6 +128,12 @@ class ContactWalker(ContactReadouts):
         the push-off pulse; a free-jointed (five-link) biped's joint torques
         (:mod:`walkerlab.models.contact.joint_torques`); a walker with them runs on
         :mod:`walkerlab.integrate.contact_powered` (its stance leg is a discrete state).
+    torsion : float
+        A walker in 3D: each contact's torsional friction coefficient [m] (the largest
+        moment about the ground's normal per newton of normal force,
+        :func:`walkerlab.models.contact.assembly.twist`; ``contact.torsional_friction_m``,
+        :func:`walkerlab.models.contact.laws.torsional_friction_m`); 0: none (a planar
+        walker's contact has no spin about the normal).
     rhs_ready : walkerlab.codegen.pending.CompiledElsewhere, optional
         A side process compiling the compiled solvers' right-hand side: the first compiled
         chunk waits for it and loads the kernel from the cache (the caller's hand-off,
@@ -161,6 +167,7 @@ class ContactWalker(ContactReadouts):
     rhs_ready: object = None
     hub_inertia: float | None = None
     ground_line: np.ndarray | None = None
+    torsion: float = 0.0
 
     def __post_init__(self):
         from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
@@ -194,6 +201,8 @@ class ContactWalker(ContactReadouts):
         PC[mod.I_KK], PC[mod.I_KE], PC[mod.I_KC], PC[mod.I_KD] = ks.k, ks.e, ks.cmax, ks.dmax
         PC[mod.I_KL], PC[mod.I_KF] = (1.0 if ks.latch else 0.0), ks.latch_height
         PC[mod.I_KA] = ks.latch_capture
+        PC[mod.I_TOR] = self.torsion
+        PC[mod.I_WEPS] = 1e-3 * d.total_mass_kg * d.gravity_m_per_s2  # load shares' floor
         set_(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
         set_(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
         for k in ("1", "2"):

@@ -79,20 +79,23 @@ def _stance_lines(eq, Q) -> list[str]:
     """:func:`rhs_source`'s stance-dependent internal forces
     (:attr:`walkerlab.codegen.floating.FloatingEquations.stance_forces`: a walker in 3D
     with hip-roll joints, Kuo 1999's law) added into ``Q``: each leg's law weighted by its
-    foot's share of the normal load, ``_w<k> = Fn_k / (Fn_1 + Fn_2)`` (the point results
-    ``_r<i>``; the stance leg's law alone in single support, the two blended through the
-    double support, halves in flight)."""
+    foot's share of the normal load, ``_w<k> = (Fn_k + e) / (Fn_1 + Fn_2 + 2 e)`` (the
+    point results ``_r<i>``; ``e`` = ``PC[I_WEPS]``, 1e-3 of the walker's weight: the
+    stance leg's law in single support to 0.1 %, the two blended through the double
+    support, halves in flight, and continuous through a bounce, where both loads
+    vanish)."""
     import sympy as sp
 
     if not eq.stance_forces:
         return []
     loads = [" + ".join(f"_r{i}[4]" for i, lg in enumerate(eq.point_legs) if lg == leg)
              for leg in (0, 1)]
-    lines = [f"    _load0 = {loads[0]}", f"    _load1 = {loads[1]}",
-             "    _w1 = _load1 / (_load0 + _load1) if _load0 + _load1 > 0.0 else 0.5",
-             "    _w0 = 1.0 - _w1"]
-    for k, F in enumerate(eq.stance_forces):  # leg k + 1 in stance
-        Q += sp.Symbol(f"_w{k}", real=True) * F
+    lines = [f"    _load0 = {loads[0]} + PC[I_WEPS]", f"    _load1 = {loads[1]} + PC[I_WEPS]",
+             "    _w1 = _load1 / (_load0 + _load1)", "    _w0 = 1.0 - _w1"]
+    for k, F in enumerate(eq.stance_forces):  # leg k + 1 in stance (Q in place)
+        w = sp.Symbol(f"_w{k}", real=True)
+        for i in range(len(Q)):
+            Q[i] += w * F[i]
     return lines
 
 
@@ -141,6 +144,7 @@ def rhs_source(eq, forced: bool = False) -> str:
     for pos, J in eq.feet:
         v = J * dqv
         kin += [*pos[:d], *v[:d]]
+    kin += [(Jn * dqv)[0] for Jn in eq.spins]  # each point's spin about the normal
     repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
     lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
     axes = "xyz"[:d]
@@ -157,6 +161,13 @@ def rhs_source(eq, forced: bool = False) -> str:
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
         Q += J.T * sp.Matrix(Fs[d * i:d * (i + 1)])
+    for i, Jn in enumerate(eq.spins):  # the patches' torsional friction (3D)
+        spin = pr.doprint(red[2 * d * len(eq.feet) + i])
+        tw = sp.Symbol(f"_tw{i}", real=True)
+        lines.append(f"    {tw} = _twist({spin}, _r{i}[4], PC)"
+                     + (f" if not _ghost{i} else 0.0" if forced else ""))
+        Q += Jn.T * tw
+        power[i] += f" + {tw} * ({spin})"
     lines += _knee_lines(eq, red, pr, Q, power)
     lines += _stance_lines(eq, Q)
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}

@@ -26,7 +26,7 @@ from walkerlab.walker.plant import Plant
 
 from .actuation import ContactActuators
 from .joint_torques import JointTorqueActuators
-from .laws import ContactParamsSI, KneeStopSI
+from .laws import ContactParamsSI, KneeStopSI, torsional_friction_m
 from .model import ContactWalker
 from .parts import contact_part
 from .rigid_limit import contact_si
@@ -147,9 +147,12 @@ class ContactSetup:
         -------
         ContactWalker
         """
+        st = self.walker.structure
         return ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
                              flat_foot=self.law.flat_foot(), actuators=self.actuators,
-                             rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2)
+                             rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2,
+                             torsion=torsional_friction_m(self.law, self.walker.leg_length_m,
+                                                          st.in_3d))
 
     def held_actuators(self):
         """Actuators with no law of the scene's (an empty actuation): what a run that holds a
