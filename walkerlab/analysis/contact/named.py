@@ -34,6 +34,8 @@ def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
             continue        # stance foot's position): points of their own
         leg = coord.split("_", 1)[0]
         new = coord if leg not in ("leg1", "leg2") else legs[int(leg[-1]) - 1] + coord[4:]
+        if not new.endswith("_angle"):  # a 3D walker's heading and rolls, as the rigid
+            new += "_angle"             # view names its angles (leg1_roll_angle, ...)
         out[idx.names[i]] = new
         out[idx.names[n + i]] = new.removesuffix("_angle") + "_rate"
     return out
