@@ -160,7 +160,8 @@ def _run_outcome(walker, run, ev, after, limits, slip_limit_mm, initial_stance):
     checkerboard's note (:meth:`walkerlab.analysis.contact.terrain_fit.PatchFit.note`)."""
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
-                   slip_limit_mm, limits.wall_time_limit_s, scuff_cause(walker))
+                   slip_limit_mm, limits.wall_time_limit_s, scuff_cause(walker),
+                   walker.fall_how(run.X[-1]) if run.termination == "fall" else "")
     if after is not None:
         out = _named_after(out, after, ev, hh)
     if out.after or out.kind in _OFF_THE_PATCHES:

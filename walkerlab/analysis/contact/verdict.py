@@ -242,7 +242,8 @@ _SCUFF_CAUSES = {"legs": _straight_leg_scuff, "kneed": _unlatched_knee}
 
 def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,
              message: str, limits, slip_limit_mm: float | None,
-             wall_time_limit_s: float | None, scuff_why: str = "") -> Outcome:
+             wall_time_limit_s: float | None, scuff_why: str = "", how: str = ""
+             ) -> Outcome:
     """The typed outcome of a contact run from how its integration stopped.
 
     Parameters
@@ -263,6 +264,10 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
     scuff_why : str
         The likely cause of swing-foot scuffs before a fall, and what helps
         (:func:`scuff_cause` of the run's walker; ``""``: none named).
+    how : str
+        How a fallen walker went down (a walker in 3D: capsized sideways or fell along the
+        slope, :meth:`walkerlab.models.contact.model.ContactWalker.fall_how`; ``""``: not
+        named).
     """
     n_hs = max(len(steps) - 1, 0)
     te = float(t[-1])
@@ -278,7 +283,7 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
             why = (f"; the swing foot scuffed the ground {scuffs} time(s) before"
                    + (f" {scuff_why}" if scuff_why else ""))
         return Outcome("fall", te, "", np.nan, hip_height_m,
-                       f"fall: hip {hip_height_m:.3f} m above ground "
+                       f"fall: {how + '; ' if how else ''}hip {hip_height_m:.3f} m above ground "
                        f"(< {limits.fall_hip_height_m:g} m) at t = {te:.4g} s after {n_hs} "
                        f"heel strikes{why}")
     if termination == "airborne":

@@ -100,6 +100,31 @@ class ContactReadouts:
         F = np.array([self.rhs(0.0, x) for x in X])
         return (self.hip_height(X + e * F) - self.hip_height(X - e * F)) / (2 * e)
 
+    def fall_how(self, x) -> str:
+        """How a walker in 3D went down, from its last state ``x`` (2 nq,): capsized
+        sideways (its hip farther from the stance foot across the slope than along it) or
+        fell along the slope, with the hip's offset [m] and its lean from the normal [deg];
+        the stance foot the one pressed deeper.  ``""`` for a planar walker (its falls have
+        one plane)."""
+        if self.dim == 2:
+            return ""
+        X = self._rows(x)[-1:]
+        hip = np.asarray(self.points(X)["hip"], float).reshape(3, -1)[:, -1]
+        feet = self.foot_positions(X)
+        pen = [float(self.contact_quantities(X)[c]["penetration"][0])
+               for c in self.contact_names()]
+        foot = feet[self._point_legs[int(np.argmax(pen))]]
+        rel = hip - foot
+        side, along = float(rel[2]), float(rel @ self.tangent)
+        lean = math.degrees(math.atan2(math.hypot(side, along), float(rel @ self.normal)))
+        if abs(side) > abs(along):
+            return (f"capsized sideways: the hip {abs(side):.3f} m to the "
+                    f"{'right' if side > 0 else 'left'} of the stance foot, {lean:.0f} deg "
+                    "from the slope's normal")
+        return (f"fell {'forward' if along > 0 else 'backward'}: the hip {abs(along):.3f} m "
+                f"{'ahead of' if along > 0 else 'behind'} the stance foot, {lean:.0f} deg "
+                "from the slope's normal")
+
     def fall_margin(self, x, threshold: float) -> float:
         """The one fall test: hip height of state ``x`` minus ``threshold`` [m]
         (negative = fallen).  Used as the fall event of every integration.
