@@ -159,12 +159,13 @@ def _run_outcome(walker, run, ev, after, limits, slip_limit_mm, initial_stance):
     strides asked for (``after``) and, when the footfalls left the patches, the
     checkerboard's note (:meth:`walkerlab.analysis.contact.terrain_fit.PatchFit.note`)."""
     hh = float(walker.hip_height(run.X[-1:])[0])
+    how = walker.fall_how(run.X[-1]) if run.termination == "fall" else ""
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
-                   slip_limit_mm, limits.wall_time_limit_s, scuff_cause(walker),
-                   walker.fall_how(run.X[-1]) if run.termination == "fall" else "")
+                   slip_limit_mm, limits.wall_time_limit_s, scuff_cause(walker), how)
     if after is not None:
         out = _named_after(out, after, ev, hh)
-    if out.after or out.kind in _OFF_THE_PATCHES:
+    # a walker in 3D that capsized sideways went down across its patches, not off them
+    if (out.after or out.kind in _OFF_THE_PATCHES) and not how.startswith("capsized"):
         fit = patch_fit(walker, run.t, ev["feet"], ev["hs_t"], ev["hs_leg"], initial_stance)
         note = fit.note() if fit is not None else ""
         if note:

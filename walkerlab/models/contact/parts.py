@@ -275,8 +275,15 @@ class Legs3DPart(ContactPart):
 
     def step_length(self, walker, x_ideal, along_slope: bool) -> float:
         """The feet's distance along the slope's fall line at the heel strike (the
-        patches are strips across the slope; the hip width lies across it)."""
-        return self._chord(walker, x_ideal, True)[1]
+        patches are strips across the slope; the hip width lies across it), plus round
+        feet's roll over the step, ``R (theta_stance - theta_swing)`` (the legs' pitches),
+        as a planar walker's arc feet."""
+        z, chord = self._chord(walker, x_ideal, True)[:2]
+        if walker.structure.foot != "arc":
+            return chord
+        R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
+        links = walker.coordinate_names()[walker.dim:]
+        return chord + R * (z[links.index("leg2_angle")] - z[links.index("leg1_angle")])
 
     def check(self, scene, data, cs) -> str | None:
         """No pinned start (its stance foot turns freely about the normal: a point foot
