@@ -145,9 +145,9 @@ def test_the_3d_contact_flow_matches_an_independent_newton_model(hip_width):
     rounding): truncation ~ 2e-13 m |dq|^3 and rounding ~ 1e-10 |dr/dt| m/s^2, at the
     rates here (<= 23 rad/s) ~ 1e-11 of the largest acceleration (measured <= 2.5e-11; the
     error falls as the step squared down to 1e-6: 2.5e-9 at 1e-5); 1e-8 keeps a margin of
-    400.  Flipping the lateral friction's sign or dropping the torsional moment in
-    walkerlab's assembly changes the flow by > 1e-3 relative at the slipping and spinning
-    states (checked by hand)."""
+    400.  Checked by hand against a sabotaged assembly (numba off, a private cache):
+    without the torsional moment the flow differs by 7e-3 (start) to 0.27 relative, with
+    the lateral friction's sign flipped by 1.1 to 1.7 at the four slipping states."""
     cw, x0, ref, perm = hip_width
     law = ref.law
     nq = len(perm)
@@ -201,10 +201,10 @@ def _lift(xp, names_p, names_3d, L):
 def test_a_3d_walker_without_hip_width_has_the_planar_contact_flow():
     """configs/paper_3d.yaml (hip width 0) in its sagittal plane is configs/paper.yaml's
     walker: at the planar contact start state and at a double-support state whose feet slip
-    (leg2 in the friction law's transition, leg1 below the stiction velocity), lifted to 3D
+    (leg2 in the friction law's transition, leg1 above the friction velocity), lifted to 3D
     with no lateral motion, the 3D contact model's hip and leg accelerations are the planar
     contact model's to 1e-9 relative (two generated codes of one law: rounding, measured
-    <= 2e-14) and its lateral, roll and heading accelerations vanish (< 1e-12 of the
+    <= 7e-13) and its lateral, roll and heading accelerations vanish (< 1e-12 of the
     largest; the torsional friction sees no spin)."""
     cp, xp, c3 = _planar_and_3d()
     names_p, names_3 = cp.coordinate_names(), c3.coordinate_names()

@@ -135,13 +135,15 @@ class Floating3DContact:
 
     def jacobian(self, name, q):
         """(3, 7) Jacobian of point ``name``."""
-        f = (lambda qq: self.positions(qq)[name])
+        def f(qq):
+            return self.positions(qq)[name]
         return np.column_stack([self._d_along(f, q, e) for e in np.eye(7)])
 
     def jdot_dq(self, name, q, dq):
         """(3,) ``Jdot dq`` of point ``name``: ``d^2/dt^2 r(q + t dq)`` at 0, the central
         difference (step :data:`EPS`) of the complex-step first derivative."""
-        f = (lambda qq: self.positions(qq)[name])
+        def f(qq):
+            return self.positions(qq)[name]
         q, dq = np.asarray(q, float), np.asarray(dq, float)
         return (self._d_along(f, q + EPS * dq, dq) - self._d_along(f, q - EPS * dq, dq)) / (
             2 * EPS)
@@ -186,6 +188,7 @@ class Floating3DContact:
 
     # -- dynamics ----------------------------------------------------------------------
     def masses(self):
+        """``(point name, mass [kg])`` of the three masses."""
         return (("hip_mass", self.M_hip), ("leg1_mass", self.m), ("leg2_mass", self.m))
 
     def mass_matrix(self, q):
