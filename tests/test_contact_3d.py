@@ -1,0 +1,249 @@
+"""The compliant-contact model of walkers in 3D against an independent Newton model and
+against the planar contact model it contains.
+
+* ``tests/independent/floating_3d_contact.py`` writes the 3D compass walker with hip width
+  (configs/hip_width.yaml) set free on the ground from its point masses, with the contact
+  law (IMPACT normal force, Adams Coulomb friction against the slip velocity in the
+  tangent plane, torsional friction about the normal) implemented again from the Adams
+  formulas: the contact flow ``cw.rhs`` must be its, at states where both feet are loaded
+  and slip and spin in each regime of the friction law.
+* A 3D walker of zero hip width (configs/paper_3d.yaml) moving in its sagittal plane is
+  the planar walker (configs/paper.yaml) under the same contact law: equal sagittal
+  accelerations, no lateral ones.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from tests.independent.floating_3d_contact import Floating3DContact
+from walkerlab.analysis.contact.start import initial_state_from_ideal
+from walkerlab.analysis.gait.scene import initial_guess
+from walkerlab.config import load_scene
+from walkerlab.models.contact import assembly as A
+from walkerlab.models.contact.scene import contact_setup
+from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
+
+#: walkerlab's floating coordinates of a 3D compass walker -> the reference's index
+#: (tests/independent/floating_3d_contact.COORDINATES)
+TO_REF = {"leg2_foot_x": 0, "leg2_foot_y": 1, "leg2_foot_z": 2, "heading": 3,
+          "leg2_roll": 4, "leg1_angle": 5, "leg2_angle": 6}
+
+
+def _continuous(scene):
+    """The scene on continuous ground (every foot below the slope plane in contact)."""
+    return scene.model_copy(update={"terrain": scene.terrain_or_default().model_copy(
+        update={"lanes": "continuous"})})
+
+
+def _contact_walker(scene):
+    """The scene's contact walker and its contact start state (the rigid initial guess's
+    stance foot at its static penetration, at rest)."""
+    plant = Plant.from_scene(scene)
+    xi = np.asarray(initial_guess(scene, build_walker(scene, plant)), float)
+    cw, _ = contact_setup(scene, plant=plant).build(xi, 10)
+    return cw, initial_state_from_ideal(cw, *xi)
+
+
+@pytest.fixture(scope="module")
+def hip_width():
+    """(contact walker, its start state, the reference, permutation walkerlab -> ref)."""
+    cw, x0 = _contact_walker(_continuous(load_scene("configs/hip_width.yaml")))
+    names = cw.coordinate_names()
+    assert set(names) == set(TO_REF)
+    P = dict(zip(cw.structure.param_names, cw.walker_params))
+    PC = cw.contact_params
+    law = {"k": PC[A.I_K], "e": PC[A.I_E], "cmax": PC[A.I_CMAX], "dmax": PC[A.I_DMAX],
+           "mus": PC[A.I_MUS], "mud": PC[A.I_MUD], "vs": PC[A.I_VS], "vd": PC[A.I_VD],
+           "tau": PC[A.I_TOR]}
+    assert law["tau"] > 0  # the default torsional coefficient: 0.05 leg lengths
+    ref = Floating3DContact(P["g"], P["L"], P["gamma"], P["M_hip"], P["m_leg"],
+                            P["a_leg"], P["w_hip"], law)
+    perm = np.array([TO_REF[n] for n in names])  # walkerlab's coordinate i is ref's perm[i]
+    return cw, x0, ref, perm
+
+
+def _to_ref(x, perm):
+    nq = len(perm)
+    out = np.empty(2 * nq)
+    out[perm], out[nq + perm] = x[:nq], x[nq:]
+    return out
+
+
+def _from_ref(xr, perm):
+    nq = len(perm)
+    return np.concatenate([xr[:nq][perm], xr[nq:][perm]])
+
+
+def _double_support(ref, heading, lean, pitch2, depth, rate, slip, lean_rate):
+    """A reference state (14,) with both feet in the ground: leg1's foot at penetration
+    ``depth[0]``, leg2's at ``depth[1]`` [m] (leg1's pitch found by Brent's method), their
+    penetration rates ``rate`` [m/s] and slip velocities ``slip`` ((2, 2): along the fall
+    line and across it, [m/s]), the lean's rate ``lean_rate`` [rad/s]; the heading's and the
+    legs' rates follow (a linear solve on the feet's Jacobians: the feet's lateral slips
+    differ by the heading's rate times the feet's distance along the fall line, so the
+    heading turns and the feet spin at about ``(slip1_z - slip2_z) / 0.36 m``)."""
+    n, s, z = ref.n, ref.s, ref.z
+
+    def rise(th1):  # leg1's foot above leg2's along n, less the depths' difference
+        r = ref.positions(np.array([0, 0, 0, heading, lean, th1, pitch2]))
+        return n @ (r["leg1_foot"] - r["leg2_foot"]) - (depth[1] - depth[0])
+    th1 = brentq(rise, -pitch2 - 0.3, -pitch2 + 0.05)  # the trailing leg
+    q = np.array([0, 0, 0, heading, lean, th1, pitch2], float)
+    q[:3] = -depth[1] * n
+    v = [-rate[k] * n + slip[k][0] * s + slip[k][1] * z for k in range(2)]
+    A_ = np.vstack([ref.jacobian("leg1_foot", q), ref.jacobian("leg2_foot", q),
+                    np.eye(7)[4]])
+    dq = np.linalg.solve(A_, np.concatenate([v[0], v[1], [lean_rate]]))
+    return np.concatenate([q, dq])
+
+
+def _regime(speed, law):
+    return ("rest" if speed == 0 else "stiction" if speed < law["vs"] else
+            "transition" if speed < law["vd"] else "sliding")
+
+
+#: name -> (heading, lean, pitch2, depths, penetration rates, slips (leg1, leg2) along and
+#: across the fall line, lean rate), and the regimes expected of (leg1's slip, leg2's
+#: slip, leg1's patch slip speed rho |spin|, leg2's); ADAMS default velocities: vs 0.1 m/s,
+#: vd 1 m/s, rho = 0.05 / 0.9 m
+STATES = {
+    "creep": ((0.1, 0.03, 0.15, (8e-5, 1.2e-4), (0.002, -0.003),
+               ((-0.02, 0.01), (0.03, 0.04)), 0.2),
+              ("stiction", "stiction", "stiction", "stiction")),
+    "lateral_skid": ((-0.2, -0.05, 0.18, (1.1e-4, 9e-5), (-0.004, 0.001),
+                      ((0.4, -0.3), (0.2, 1.5)), -0.3),
+                     ("transition", "sliding", "transition", "transition")),
+    "spin": ((0.3, 0.02, 0.12, (6e-5, 1.3e-4), (0.0, 0.0),
+              ((0.0, -3.5), (0.1, 3.5)), 0.1),
+             ("sliding", "sliding", "sliding", "sliding")),
+    "loaded_swing_foot": ((0.0, -0.01, 0.16, (1.5e-4, 3e-5), (0.01, 0.0),
+                           ((0.1, -1.2), (0.05, -0.02)), -0.5),
+                          ("sliding", "stiction", "transition", "transition")),
+}
+
+
+def _states(ref, x0, perm):
+    """The contact start state and the double-support :data:`STATES`, each with its
+    expected regimes (None: the start state, leg2 loaded at rest)."""
+    out = {"start": (_to_ref(x0, perm), None)}
+    for name, (args, regimes) in STATES.items():
+        out[name] = (_double_support(ref, *args), regimes)
+    return out
+
+
+def test_the_3d_contact_flow_matches_an_independent_newton_model(hip_width):
+    """``cw.rhs`` of configs/hip_width.yaml's contact walker (continuous ground) equals the
+    independent Newton model's flow at the contact start state and at four double-support
+    states whose feet slip (along and across the fall line) and spin in every regime of the
+    Adams Coulomb law (at rest, below the stiction velocity, in the transition, above the
+    friction velocity).  The reference's only approximation is its velocity-product term,
+    a central difference of step 1e-6 s (its Jacobians are complex-step, exact to
+    rounding): truncation ~ 2e-13 m |dq|^3 and rounding ~ 1e-10 |dr/dt| m/s^2, at the
+    rates here (<= 23 rad/s) ~ 1e-11 of the largest acceleration (measured <= 2.5e-11; the
+    error falls as the step squared down to 1e-6: 2.5e-9 at 1e-5); 1e-8 keeps a margin of
+    400.  Checked by hand against a sabotaged assembly (numba off, a private cache):
+    without the torsional moment the flow differs by 7e-3 (start) to 0.27 relative, with
+    the lateral friction's sign flipped by 1.1 to 1.7 at the four slipping states."""
+    cw, x0, ref, perm = hip_width
+    law = ref.law
+    nq = len(perm)
+    worst = 0.0
+    for name, (xr, regimes) in _states(ref, x0, perm).items():
+        c = [ref.foot_contact(xr[:7], xr[7:], leg) for leg in (1, 2)]
+        if regimes is None:
+            assert c[1]["fn"] > 0 and c[1]["slip"] == 0, name
+        else:  # both feet loaded, their slip and spin in the regimes the state is for
+            assert c[0]["fn"] > 0 and c[1]["fn"] > 0, name
+            rho = law["tau"] / law["mus"]
+            got = (_regime(c[0]["slip"], law), _regime(c[1]["slip"], law),
+                   _regime(rho * abs(c[0]["spin"]), law), _regime(rho * abs(c[1]["spin"]), law))
+            assert got == regimes, name
+            assert np.all(np.abs(xr[7:]) < 30), name
+        x = _from_ref(xr, perm)
+        want = _from_ref(ref.rhs(0.0, xr), perm)[nq:]
+        got_ = np.asarray(cw.rhs(0.0, x))[nq:]
+        err = np.max(np.abs(got_ - want)) / np.max(np.abs(want))
+        worst = max(worst, err)
+        assert err < 1e-8, (name, err, got_, want)
+    assert worst > 0  # two codes, not one
+
+
+def _planar_and_3d():
+    """configs/paper.yaml's and configs/paper_3d.yaml's contact walkers under paper.yaml's
+    contact law on continuous ground, and the planar contact start state."""
+    planar = _continuous(load_scene("configs/paper.yaml"))
+    spatial = load_scene("configs/paper_3d.yaml").model_copy(
+        update={"contact": planar.contact, "terrain": planar.terrain})
+    cp, xp = _contact_walker(planar)
+    c3, _ = _contact_walker(spatial)
+    return cp, xp, c3
+
+
+def _lift(xp, names_p, names_3d, L):
+    """The 3D state of a planar contact state (hip position, leg angles and rates), no
+    lateral motion: leg2's foot at ``hip + L (sin th2, -cos th2)``."""
+    q = dict(zip(names_p, xp[:4]))
+    dq = dict(zip(names_p, xp[4:]))
+    th2, w2 = q["leg2_angle"], dq["leg2_angle"]
+    foot = np.array([q["hip_x"] + L * np.sin(th2), q["hip_y"] - L * np.cos(th2)])
+    vfoot = np.array([dq["hip_x"] + L * w2 * np.cos(th2), dq["hip_y"] + L * w2 * np.sin(th2)])
+    q3 = {"leg2_foot_x": foot[0], "leg2_foot_y": foot[1], "leg1_angle": q["leg1_angle"],
+          "leg2_angle": th2}
+    dq3 = {"leg2_foot_x": vfoot[0], "leg2_foot_y": vfoot[1], "leg1_angle": dq["leg1_angle"],
+           "leg2_angle": w2}
+    return np.array([q3.get(n, 0.0) for n in names_3d] + [dq3.get(n, 0.0) for n in names_3d])
+
+
+def test_a_3d_walker_without_hip_width_has_the_planar_contact_flow():
+    """configs/paper_3d.yaml (hip width 0) in its sagittal plane is configs/paper.yaml's
+    walker: at the planar contact start state and at a double-support state whose feet slip
+    (leg2 in the friction law's transition, leg1 above the friction velocity), lifted to 3D
+    with no lateral motion, the 3D contact model's hip and leg accelerations are the planar
+    contact model's to 1e-9 relative (two generated codes of one law: rounding, measured
+    <= 7e-13) and its lateral, roll and heading accelerations vanish (< 1e-12 of the
+    largest; the torsional friction sees no spin)."""
+    cp, xp, c3 = _planar_and_3d()
+    names_p, names_3 = cp.coordinate_names(), c3.coordinate_names()
+    assert set(names_p) == {"hip_x", "hip_y", "leg1_angle", "leg2_angle"}
+    L = dict(zip(c3.structure.param_names, c3.walker_params))["L"]
+    # double support: the hip lowered so both feet are in; leg2's foot slipping at 0.05 m/s
+    # (vs 0.01, vd 0.1 m/s) and leg1's foot at the rate that keeps it pressed in
+    slipping = xp.copy()
+    i = {n: k for k, n in enumerate(names_p)}
+    slipping[i["hip_y"]] -= 6e-5
+    n = np.array([np.sin(0.0174), np.cos(0.0174)])
+    t = np.array([n[1], -n[0]])
+    th1, th2 = slipping[i["leg1_angle"]], slipping[i["leg2_angle"]]
+    w2 = slipping[4 + i["leg2_angle"]]
+    v_foot2 = 0.05 * t + 0.001 * (-n)
+    v_hip = v_foot2 - L * w2 * np.array([np.cos(th2), np.sin(th2)])
+    # leg1's foot: penetration rate 0.002 m/s
+    w1 = (-0.002 - n @ v_hip) / (L * n @ np.array([np.cos(th1), np.sin(th1)]))
+    slipping[4 + i["hip_x"]], slipping[4 + i["hip_y"]] = v_hip
+    slipping[4 + i["leg1_angle"]] = w1
+    for name, x in (("start", xp), ("slipping", slipping)):
+        table = cp.contact_quantities(x[None, :])
+        loaded = [float(table[leg]["normal_force"][0]) > 0 for leg in ("leg1", "leg2")]
+        assert loaded == ([False, True] if name == "start" else [True, True]), name
+        ap = np.asarray(cp.rhs(0.0, x))[4:]
+        x3 = _lift(x, names_p, names_3, L)
+        a3 = dict(zip(names_3, np.asarray(c3.rhs(0.0, x3))[len(names_3):]))
+        q3 = dict(zip(names_3, x3[:len(names_3)]))
+        dq3 = dict(zip(names_3, x3[len(names_3):]))
+        th2, w2, al2 = q3["leg2_angle"], dq3["leg2_angle"], a3["leg2_angle"]
+        # the hip's acceleration from leg2's foot's: hip = foot2 + L (-sin th2, cos th2)
+        hip = (np.array([a3["leg2_foot_x"], a3["leg2_foot_y"]])
+               + L * al2 * np.array([-np.cos(th2), -np.sin(th2)])
+               + L * w2 ** 2 * np.array([np.sin(th2), -np.cos(th2)]))
+        lifted = dict(zip(("hip_x", "hip_y"), hip), leg1_angle=a3["leg1_angle"],
+                      leg2_angle=al2)
+        want = dict(zip(names_p, ap))
+        scale = max(abs(v) for v in want.values())
+        err = max(abs(lifted[k] - want[k]) for k in want) / scale
+        assert err < 1e-9, (name, err, lifted, want)
+        for k in ("leg2_foot_z", "heading", "leg2_roll"):
+            assert abs(a3[k]) < 1e-12 * scale, (name, k, a3[k])
