@@ -42,7 +42,7 @@ ADM_SUBSET = {
     "PART": {"GROUND", "MASS", "CM", "IP", "QG", "REULER", "VX", "VY", "VZ", "WX", "WY",
              "WZ"},
     "MARKER": {"PART", "QP", "REULER", "FLOATING"},
-    "JOINT": {"REVOLUTE", "FIXED", "PLANAR", "I", "J"},
+    "JOINT": {"REVOLUTE", "FIXED", "PLANAR", "SPHERICAL", "I", "J"},
     "ACCGRAV": {"IGRAVITY", "JGRAVITY", "KGRAVITY"},
     "GRAPHICS": {"ELLIPSOID", "CM", "XSCALE", "YSCALE", "ZSCALE", "BOX", "CORNER", "X", "Y",
                  "Z"},
