@@ -5,9 +5,10 @@
 Statements are the planar dataset's (:mod:`walkerlab.export.adams`; Adams Solver statement
 reference): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP`` with products, ``QG``, ``REULER``,
 ``VX``, ``VY``, ``VZ``, ``WX``, ``WY``, ``WZ``), ``MARKER`` (``QP``, ``REULER``), ``JOINT``
-(``REVOLUTE``, ``FIXED``, ``SPHERICAL``), ``COUPLER``, ``ACCGRAV``, ``GRAPHICS``
-(``ELLIPSOID``, ``BOX``), ``CONTACT`` (:func:`walkerlab.export.adams_contact.
-contact_statement`), ``OUTPUT``, ``END``; the command file is the planar one
+(``REVOLUTE``, ``FIXED``, ``SPHERICAL``, ``UNIVERSAL``), ``JPRIM`` (``PARALLEL_AXES``),
+``COUPLER``, ``ACCGRAV``, ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT``
+(:func:`walkerlab.export.adams_contact.contact_statement`), ``VARIABLE``, ``GFORCE``,
+``OUTPUT``, ``END``; the command file is the planar one
 (:func:`walkerlab.export.adams.acf_text`).
 
 Axes: the exports' of walkers in 3D (:data:`walkerlab.export.axes_3d.TO_MUJOCO`, the
@@ -37,12 +38,24 @@ by a ``COUPLER`` of its and leg1's revolutes (both measured from the pelvis, fix
 ``SPHERICAL`` joint at leg2's foot) holds during the initial-conditions analysis and is
 deactivated by the .acf.
 
+Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates): the pelvis, of
+its roll inertia, on a ``JPRIM/PARALLEL_AXES`` to the ground (markers ``100 p + 2`` and
+``103``, z along the fall line: it translates and rolls, neither pitches nor yaws, as the
+MJCF's slides and roll hinge), each leg on a ``UNIVERSAL`` joint at its hip (J on the
+pelvis, z along the fall line: the roll; I on the leg, z along its pitch axis), and the law
+as a torque on each leg about the pelvis' roll axis (``GFORCE/31``, ``32``;
+:mod:`walkerlab.export.adams_hip_roll`).  A GFORCE, not an ``SFORCE/ROTATION`` (which
+takes its I and J z axes to stay parallel: a leg's pitch axis is not the roll axis) nor a
+``MOTION`` (which would prescribe the roll: the law is a spring and damper that lets the
+rolls move under the walk's forces, as in the rigid model and the MJCF's loop).
+
 Feet and ground: each foot a sphere of radius ``r = L / 1000`` (the planar dataset's bevel)
 whose centre is the rigid point foot (``L`` down the leg, marker ``100 p + 3``); the ground
 the MJCF's footfall patches (:func:`walkerlab.export.legs_3d_mjcf.legs3d_footfalls`: the
 rigid swing foot passes through the ground at mid-stance), boxes ``terrain.patch_width_m``
 along the slope and :data:`~walkerlab.export.legs_3d_mjcf.PATCH_ACROSS_L` leg lengths
-across, their tops ``r`` below the slope's plane through the footfalls (the sphere touches
+across (:data:`~walkerlab.export.legs_3d_mjcf.PATCH_ACROSS_PUSHED_L` with the hip-roll law,
+as the MJCF), their tops ``r`` below the slope's plane through the footfalls (the sphere touches
 where the point foot does); each foot has a ``CONTACT`` (the scene's IMPACT law and Coulomb
 friction, :func:`walkerlab.export.adams_contact.contact_mm`) with its own lane's patches only.
 
@@ -54,9 +67,8 @@ the tree; the pelvis turns with leg2 (its FIXED joint), its centre of mass on th
 moving as the rigid hip does.  No rate scale (``contact_sim.initial_rate_scale`` is the
 planar contact walker's).
 
-Not written: the hip-roll joints and their law (``walker.hip_roll``; the capability table's
-cell), round feet and leg inertia (``walker.foot_radius_m``, refused as the MJCF refuses
-them), requests of energies (the planar dataset's ``REQUEST/90``).
+Not written: round feet and leg inertia (``walker.foot_radius_m``, refused as the MJCF
+refuses them), requests of energies (the planar dataset's ``REQUEST/90``).
 """
 
 from __future__ import annotations
@@ -67,9 +79,11 @@ import numpy as np
 import sympy as sp
 
 from walkerlab.export.adams_contact import contact_mm, contact_statement
+from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
 from walkerlab.export.legs_3d_mjcf import (
     PATCH_ACROSS_L,
+    PATCH_ACROSS_PUSHED_L,
     _rotation,
     legs3d_footfalls,
     legs3d_keyframe,
@@ -131,12 +145,16 @@ class Adams3dStart:
         The rigid gait's step period [s].
     numbers : dict
         The walker's numbers by parameter name (:func:`walker_tree`).
+    law : dict or None
+        ``walker.hip_roll``'s numbers (the pelvis on its roll hinge, the legs on roll and
+        pitch); None: no hip-roll joints (the pelvis fixed to leg2).
     """
 
-    def __init__(self, bodies, couplings, pose, velocity, hinges, lanes, period_s, numbers):
+    def __init__(self, bodies, couplings, pose, velocity, hinges, lanes, period_s, numbers,
+                 law=None):
         self.bodies, self.couplings = bodies, couplings
         self.pose, self.velocity, self.hinges = pose, velocity, hinges
-        self.lanes, self.period_s, self.numbers = lanes, period_s, numbers
+        self.lanes, self.period_s, self.numbers, self.law = lanes, period_s, numbers, law
 
     def cm_velocity(self, name: str) -> np.ndarray:
         """The body's centre-of-mass velocity [m/s] (3,) in ground."""
@@ -152,10 +170,11 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     Parameters
     ----------
     data : WalkerData
-        The 3D straight-legged walker without hip-roll joints.
+        The 3D straight-legged walker (point feet, point-mass legs).
     ideal : gait
         ``x`` (6,) (roles ``lean``, ``swing``, ``stance`` and their rates, just after a
-        heel strike), ``period_s`` [s], ``step_lengths_m``.
+        heel strike) or, with hip-roll joints, (10,) (``pelvis_roll``, ``swing_roll`` too),
+        ``period_s`` [s], ``step_lengths_m``.
     strides : int
         Strides of the run: footfall patches for ``2 strides + 2`` steps.
 
@@ -166,7 +185,9 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     from walkerlab.codegen.cache import functions  # light: codegen when a gait is written
 
     tree, coords, p = walker_tree(data)
-    root, couplings = export_bodies(tree, coords, p, PelvisRoles())
+    rolled = bool(data.structure.hip_roll)
+    root, couplings = export_bodies(tree, coords, p, PelvisRoles(
+        pelvis_hinges=("stance_hip_roll",) if rolled else ()))
     f = functions(data)
     x = np.asarray(ideal.x, float)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], x, data.slope_rad, 0.0)
@@ -175,24 +196,35 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     s = dict(zip(state_names(data.structure.roles), x))
     angles = {c: s[f"{c}_angle"] for c in coords.names if f"{c}_angle" in s}
     rates = {c: s[f"{c}_rate"] for c in coords.names if f"{c}_rate" in s}
-    R0 = Rotation.from_quat([qpos[4], qpos[5], qpos[6], qpos[3]]).as_matrix()
-    pose = {root.name: (np.array(qpos[:3]), R0)}
-    velocity = {root.name: (np.array(qvel[:3]), R0 @ np.array(qvel[3:6]))}
     hinges = {}
+
+    def turn(joints, R, w):
+        """``R``, ``w`` turned by the hinges ``joints`` at the start's angles and rates."""
+        for j in joints:
+            if j.kind != "hinge":
+                continue
+            sym = {q: angles[q.name[2:]] for q in j.angle.free_symbols}
+            ang = float(j.angle.subs(sym))
+            rate = float(sum(sp.diff(j.angle, q) * rates[q.name[2:]]
+                             for q in j.angle.free_symbols))
+            hinges[j.name] = (np.asarray(j.axis, float), ang, rate)
+            w = w + rate * (R @ np.asarray(j.axis, float))
+            R = R @ _rotation(j.axis, ang)
+        return R, w
+
+    if rolled:  # the pelvis on slides and its roll hinge
+        R0, w0 = turn(root.joints, np.eye(3), np.zeros(3))
+    else:       # a free pelvis: the keyframe's quaternion and body-axis rates
+        R0 = Rotation.from_quat([qpos[4], qpos[5], qpos[6], qpos[3]]).as_matrix()
+        w0 = R0 @ np.array(qvel[3:6])
+    pose = {root.name: (np.array(qpos[:3]), R0)}
+    velocity = {root.name: (np.array(qvel[:3]), w0)}
 
     def down(b):
         o, R = pose[b.name]
         v, w = velocity[b.name]
         for c in b.children:
-            Rc, wc = R, w.copy()
-            for j in c.joints:
-                sym = {q: angles[q.name[2:]] for q in j.angle.free_symbols}
-                ang = float(j.angle.subs(sym))
-                rate = float(sum(sp.diff(j.angle, q) * rates[q.name[2:]]
-                                 for q in j.angle.free_symbols))
-                hinges[j.name] = (np.asarray(j.axis, float), ang, rate)
-                wc = wc + rate * (Rc @ np.asarray(j.axis, float))
-                Rc = Rc @ _rotation(j.axis, ang)
+            Rc, wc = turn(c.joints, R, w)
             r = R @ c.pos_m
             pose[c.name] = (o + r, Rc)
             velocity[c.name] = (v + np.cross(w, r), wc)
@@ -200,8 +232,9 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     down(root)
     lanes = legs3d_footfalls(f["points"], x, 2 * strides + 2)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
+    law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
     return Adams3dStart(list(root.walk()), couplings, pose, velocity, hinges, lanes,
-                        float(ideal.period_s) / steps, p)
+                        float(ideal.period_s) / steps, p, law)
 
 
 def part_ids_3d(start: Adams3dStart) -> dict[str, int]:
@@ -219,13 +252,15 @@ def _marker(mid: int, part: int, qp, angles=(0.0, 0.0, 0.0)) -> list[str]:
 def _parts(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
     """Each body's PART (the pelvis turning with ``stance``, its FIXED joint), its CM,
     joint and foot markers and the foot spheres."""
-    out = ["!", "! ---- parts: the pelvis (fixed to leg2), the legs, an upper body ----"]
+    out = ["!", "! ---- parts: the pelvis (fixed to leg2), the legs, an upper body ----"
+           if start.law is None else "! ---- parts: the pelvis (on its roll), the legs ----"]
     L, r = start.numbers["L"], WHEEL_TIP_FRACTION * start.numbers["L"]
     by_name = {b.name: b for b in start.bodies}
     for b in start.bodies:
         p = ids[b.name]
         o, R = start.pose[b.name]
-        w = start.velocity[stance if b is start.bodies[0] else b.name][1]
+        fixed = b is start.bodies[0] and start.law is None   # it turns with the stance leg
+        w = start.velocity[stance if fixed else b.name][1]
         vcm = start.cm_velocity(b.name)
         J = np.asarray(b.inertia_kg_m2, float) * MM * MM
         wb = R.T @ w  # along the CM marker's (the part's) axes
@@ -238,13 +273,17 @@ def _parts(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
                      *(f"V{k}={_f(v * MM)}" for k, v in zip("XYZ", vcm)),
                      *(f"W{k}={_f(v)}" for k, v in zip("XYZ", wb)))
         out += _marker(100 * p + 1, p, b.com_m)
-        for c in b.children:   # the child's hinge on this part, z along its axis
+        for c in b.children:   # the child's (first) hinge on this part, z along its axis
             c0 = by_name[c.name]
             ax = c0.joints[0].axis if c0.joints else (0.0, 0.0, 1.0)
             out += _marker(100 * p + 10 + ids[c.name], p, c.pos_m, _z_to(ax))
-        if b.joints and b.joints[0].kind == "hinge":
-            out += _marker(100 * p + 2, p, (0.0, 0.0, 0.0), _z_to(b.joints[0].axis))
-        if b.name == stance:   # the pelvis' FIXED joint's J: the pelvis' CM frame
+        hinged = [j for j in b.joints if j.kind == "hinge"]
+        if hinged:   # its own (last) hinge: z along its axis (a leg's pitch axis)
+            out += _marker(100 * p + 2, p, (0.0, 0.0, 0.0), _z_to(hinged[-1].axis))
+        if start.law is not None and b.name in ("pelvis", "leg1", "leg2"):
+            out += _marker(100 * p + 5, p, (0.0, -1.0, 0.0))   # 1 m along the pitch axis
+        if b.name == stance and start.law is None:   # the pelvis' FIXED joint's J marker:
+            # the pelvis' CM frame on the stance leg
             op, Rp = start.pose[start.bodies[0].name]
             out += _marker(100 * p + 10 + ids[start.bodies[0].name], p, R.T @ (op - o),
                            reuler_angles(R.T @ Rp))
@@ -262,17 +301,22 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
     hip's COUPLER and the temporary stance-foot pin."""
     pelvis = start.bodies[0]
     ps, pp = ids[stance], ids[pelvis.name]
-    out = ["!", "! ---- joints (I on the child, J on the parent; z along the hinge axis) ----",
-           f"! the pelvis fixed to {stance} (the planar dataset's hip on leg2)",
-           f"JOINT/{_PELVIS_FIXED}, FIXED, I={100 * pp + 1}, J={100 * ps + 10 + pp}"]
+    out = ["!", "! ---- joints (I on the child, J on the parent; z along the hinge axis) ----"]
+    if start.law is None:
+        out += [f"! the pelvis fixed to {stance} (the planar dataset's hip on leg2)",
+                f"JOINT/{_PELVIS_FIXED}, FIXED, I={100 * pp + 1}, J={100 * ps + 10 + pp}"]
+    else:
+        out += ["! the pelvis rolls about the fall line, neither pitches nor yaws",
+                f"JPRIM/{_PELVIS_FIXED}, PARALLEL_AXES, I={100 * pp + 2}, J=103"]
     jid = {}
     for b in start.bodies:
         for c in b.children:
-            if c.name == stance:
+            if c.name == stance and start.law is None:
                 continue
+            kind = "UNIVERSAL" if len(c.joints) == 2 else "REVOLUTE"  # roll, then pitch
             jid[c.joints[0].name] = 10 + ids[c.name]
-            out += [f"! {c.joints[0].name}",
-                    f"JOINT/{10 + ids[c.name]}, REVOLUTE, I={100 * ids[c.name] + 2}, "
+            out += [f"! {', '.join(j.name for j in c.joints)}",
+                    f"JOINT/{10 + ids[c.name]}, {kind}, I={100 * ids[c.name] + 2}, "
                     f"J={100 * ids[b.name] + 10 + ids[c.name]}"]
     stance_joint = next(c.joints[0].name for c in pelvis.children if c.name == stance)
     for cp in start.couplings:   # measured from the pelvis, which turns with the stance leg
@@ -290,8 +334,8 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
     return out
 
 
-def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float
-            ) -> tuple[list[str], list[list[int]]]:
+def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
+            rolled: bool = False) -> tuple[list[str], list[list[int]]]:
     """PART/1, its markers, ACCGRAV and each lane's patches (boxes whose top face lies
     ``r`` below the slope's plane through the footfalls); the patches' GRAPHICS ids by
     lane."""
@@ -299,13 +343,17 @@ def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float
     r = WHEEL_TIP_FRACTION * L
     t = np.array([math.cos(slope_rad), 0.0, -math.sin(slope_rad)])
     n = np.array([math.sin(slope_rad), 0.0, math.cos(slope_rad)])
-    across = PATCH_ACROSS_L * L
+    across = (PATCH_ACROSS_PUSHED_L if rolled else PATCH_ACROSS_L) * L
     depth = width_m / 10
     tilt = (math.pi / 2, slope_rad, -math.pi / 2)  # Rz(90) Rx(phi) Rz(-90) = Rot(y, phi)
     out = ["!", "! ---- ground, gravity (along -z) and the footfall patches of each lane ----",
            "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
            "MARKER/102, PART=1, QP=0.0, 0.0, 0.0",
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-g * MM)}"]
+    if rolled:  # the pelvis' roll axis; the frame its law reads rolls in (x s, y n, z z_w)
+        out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))
+        out += _marker(ROLL_FRAME, 1, (0.0, 0.0, 0.0), reuler_angles(
+            np.column_stack([t, n, np.cross(t, n)])))
     gid, ids = 1001, []
     for leg, falls in zip(("leg1", "leg2"), start.lanes):
         ids.append([])
@@ -329,7 +377,7 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     ----------
     scene : walkerlab.config.Scene
     data : WalkerData
-        Its 3D straight-legged walker (no hip-roll joints, point feet).
+        Its 3D straight-legged walker (point feet, point-mass legs).
     start : Adams3dStart
         :func:`adams3d_start`.
     name, version : str
@@ -356,15 +404,18 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
            "origin.", "! Not written: the energies' requests of the planar dataset.",
            "UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND"]
     ground, patches = _ground(start, data.slope_rad, p["g"], float(
-        scene.terrain_or_default().patch_width_m))
+        scene.terrain_or_default().patch_width_m), start.law is not None)
     out += ground
     out += _parts(start, ids, stance)
     out += _joints(start, ids, stance)
     out += ["!", "! ---- contact: IMPACT normal force + Coulomb friction, mm-kg-s ----"]
-    cid = 1
+    cid, contacts = 1, {}
     for leg, lane in zip(("leg1", "leg2"), patches):
         for gid in lane:
             out += contact_statement(cid, 100 * ids[leg] + 3, gid, law)
+            contacts.setdefault(leg, []).append(cid)
             cid += 1
+    if start.law is not None:
+        out += hip_roll_statements(start.law, ids, contacts)
     out += ["!", "OUTPUT/REQSAVE, GRSAVE"]
     return "\n".join([*out, "END", ""])

@@ -11,7 +11,7 @@ re-exports every public name here; the layers import them from there.
 from __future__ import annotations
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_ADAMS_3D", "HIP_ROLL_EXPORT_3D",
+           "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
@@ -101,10 +101,6 @@ _CELLS_3D = {
                           "step (walk it in the rigid model: fixedpoint, simulate)"),
     ("walk", "osim"): EXPORT_3D,
 }
-#: why the Adams dataset refuses the 3D walker's hip-roll joints
-HIP_ROLL_ADAMS_3D = ("the Adams dataset of a 3D walker carries legs rigid to the pelvis "
-                     "in roll so far: the hip-roll joints and their law (switched at each "
-                     "heel strike) are in the MJCF (--format mjcf) and the rigid model")
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -283,7 +279,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "straight_legs_3d": {
         ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
-        ("hip_roll", "adams"): HIP_ROLL_ADAMS_3D,
         **{("round_feet_3d", v): ROUND_FEET_EXPORT_3D for v in ("mjcf", "urdf", "adams")},
         **{(f, "*"): ACTUATION_3D for f in ("hip_torque", "knee_torque",
                                             "ankle_torque", "torso_torque", "push_off",
@@ -293,7 +288,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.legs_3d.
         # legs_3d_urdf_text); the Adams dataset: the pelvis fixed to leg2, the legs on
-        # revolutes (walkerlab.export.adams_3d.adm3d_text)
+        # revolutes, or with hip-roll joints the pelvis rolling, the legs on universal
+        # joints and the law as GFORCE torques (walkerlab.export.adams_3d.adm3d_text)
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
                           "is a later step"),
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
