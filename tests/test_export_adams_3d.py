@@ -146,9 +146,10 @@ def test_a_3d_datasets_hips_feet_and_joint_axes_are_the_rigid_walkers(case):
     model's: a REVOLUTE's both along the hip axis ``Rot(s, lean) z`` (lateral, pitch); a
     hip-roll walker's UNIVERSAL the leg's pitch axis ``Rot(s, roll) z`` on the leg and the
     fall line ``s`` on the pelvis (its roll axis, the JPRIM's); the pelvis' FIXED markers
-    coincide in pose; the stance foot (the pin's marker) at the origin, the trailing foot at
-    the rigid one; both foot spheres touch their lanes' patches (their centres r = L / 1000
-    above the top face)."""
+    coincide in pose and a JPRIM keeps leg2's hip axis perpendicular to the fall line (no
+    yaw, as the rigid walker); the stance foot (the pin's marker) at the origin, the trailing
+    foot at the rigid one; both foot spheres touch their lanes' patches (their centres
+    r = L / 1000 above the top face)."""
     scene, data, f, ideal, model, _adm, _acf = case
     x = np.asarray(ideal.x, float)
     s = dict(zip(state_names(data.structure.roles), x))
@@ -179,7 +180,12 @@ def test_a_3d_datasets_hips_feet_and_joint_axes_are_the_rigid_walkers(case):
         jp = model.get("JPRIM", 1)
         for m in (jp.integer("I"), jp.integer("J")):
             assert abs(abs(model.marker_pose(m)[1][:, 2] @ (C @ fall)) - 1) < TOL
-    else:
+    else:   # no yaw: leg2's hip axis perpendicular to the fall line
+        jp = model.get("JPRIM", 2)
+        assert "PERPENDICULAR" in jp.flags
+        zi, zj = (model.marker_pose(jp.integer(k))[1][:, 2] for k in "IJ")
+        assert abs(abs(zi @ pitch[402]) - 1) < TOL and abs(zj @ (C @ fall) - 1) < TOL
+        assert abs(zi @ zj) < TOL
         (_t, i, j), = [j for j in joints.values() if j[0] == "FIXED"]
         (pi, Ri), (pj, Rj) = model.marker_pose(i), model.marker_pose(j)
         np.testing.assert_allclose(pi, pj, atol=TOL)

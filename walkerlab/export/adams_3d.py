@@ -36,7 +36,11 @@ freedom (lean, two leg pitches) with the stance foot held; an upper body on a bi
 by a ``COUPLER`` of its and leg1's revolutes (both measured from the pelvis, fixed to leg2:
 ``torso - leg2 = (leg1 - leg2) / 2``).  The temporary stance-foot pin (``JOINT/99``, a
 ``SPHERICAL`` joint at leg2's foot) holds during the initial-conditions analysis and is
-deactivated by the .acf.
+deactivated by the .acf.  The rigid walker neither yaws nor twists on its stance foot (its
+legs are ``Rot(s, lean) Rot(z, theta)``): a ``JPRIM/PERPENDICULAR`` keeps leg2's hip axis
+perpendicular to the fall line (ground marker 103), as the planar dataset's ``PLANAR``
+joint keeps the paper's plane (a foot sphere's contact holds no twist: the MJCF's
+torsional friction does that there).
 
 Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates): the pelvis, of
 its roll inertia, on a ``JPRIM/PARALLEL_AXES`` to the ground (markers ``100 p + 2`` and
@@ -101,6 +105,9 @@ __all__ = ["PIN_JOINT_3D", "Adams3dStart", "adams3d_start", "adm3d_text", "reule
 PIN_JOINT_3D = 99
 #: The pelvis' FIXED joint to leg2.
 _PELVIS_FIXED = 1
+#: The JPRIM holding the walker without hip roll from yawing (its hip axis perpendicular
+#: to the fall line).
+_NO_YAW = 2
 #: The bisecting hip's COUPLER (:data:`walkerlab.export.adams.COUPLER_ID`).
 _COUPLER = 1
 
@@ -304,7 +311,10 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
     out = ["!", "! ---- joints (I on the child, J on the parent; z along the hinge axis) ----"]
     if start.law is None:
         out += [f"! the pelvis fixed to {stance} (the planar dataset's hip on leg2)",
-                f"JOINT/{_PELVIS_FIXED}, FIXED, I={100 * pp + 1}, J={100 * ps + 10 + pp}"]
+                f"JOINT/{_PELVIS_FIXED}, FIXED, I={100 * pp + 1}, J={100 * ps + 10 + pp}",
+                "! no yaw (the rigid walker's): the hip axis stays perpendicular to the fall",
+                "! line, as the planar dataset's PLANAR joint holds its plane",
+                f"JPRIM/{_NO_YAW}, PERPENDICULAR, I={100 * ps + 2}, J=103"]
     else:
         out += ["! the pelvis rolls about the fall line, neither pitches nor yaws",
                 f"JPRIM/{_PELVIS_FIXED}, PARALLEL_AXES, I={100 * pp + 2}, J=103"]
@@ -350,8 +360,8 @@ def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
            "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
            "MARKER/102, PART=1, QP=0.0, 0.0, 0.0",
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-g * MM)}"]
-    if rolled:  # the pelvis' roll axis; the frame its law reads rolls in (x s, y n, z z_w)
-        out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))
+    out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))   # z along the fall line
+    if rolled:  # the frame the law reads rolls in (x s, y n, z z_w)
         out += _marker(ROLL_FRAME, 1, (0.0, 0.0, 0.0), reuler_angles(
             np.column_stack([t, n, np.cross(t, n)])))
     gid, ids = 1001, []

@@ -43,7 +43,7 @@ ADM_SUBSET = {
              "WZ"},
     "MARKER": {"PART", "QP", "REULER", "FLOATING"},
     "JOINT": {"REVOLUTE", "FIXED", "PLANAR", "SPHERICAL", "UNIVERSAL", "I", "J"},
-    "JPRIM": {"PARALLEL_AXES", "I", "J"},
+    "JPRIM": {"PARALLEL_AXES", "PERPENDICULAR", "I", "J"},
     "ACCGRAV": {"IGRAVITY", "JGRAVITY", "KGRAVITY"},
     "GRAPHICS": {"ELLIPSOID", "CM", "XSCALE", "YSCALE", "ZSCALE", "BOX", "CORNER", "X", "Y",
                  "Z"},
