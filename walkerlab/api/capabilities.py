@@ -420,9 +420,12 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     path = export.write(scene, runs, "adm").path
     model = read_adm(Path(path).read_text())
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    mb = multibody(data)
     parts = [p for p in model.by_kind["PART"] if p != 1]
     total = sum(model.part_mass(p) for p in parts)
+    if data.structure.in_3d:  # the 3D walker's parts: its tree's bodies
+        return (abs(total / data.total_mass_kg - 1.0),
+                f"{len(parts)} parts, {total:.6g} kg against {data.total_mass_kg:.6g} kg")
+    mb = multibody(data)
     want = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
     if data.structure.kind.feet_have_modes and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's

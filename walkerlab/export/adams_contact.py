@@ -8,7 +8,7 @@ from walkerlab.config.contact import LENGTH_UNITS, ContactSettings
 from walkerlab.export.adams_feet import contact_pairs
 from walkerlab.export.adams_statements import MM, _f, _stmt
 
-__all__ = ["contact_mm", "contact_statements"]
+__all__ = ["contact_mm", "contact_statement", "contact_statements"]
 
 
 def contact_mm(settings: ContactSettings) -> dict[str, float]:
@@ -44,20 +44,26 @@ def contact_mm(settings: ContactSettings) -> dict[str, float]:
             "FRICTION_TRANSITION_VELOCITY": out["friction_velocity"]}
 
 
+def contact_statement(cid: int, igeom: int, jgeom: int, law: dict) -> list[str]:
+    """``CONTACT/cid`` of the GRAPHICS ``igeom`` (a foot sphere) and ``jgeom`` (a ground
+    patch): the IMPACT law ``law`` of :func:`contact_mm` with Coulomb friction."""
+    return _stmt(f"CONTACT/{cid}, IGEOM={igeom}, JGEOM={jgeom}",
+                 f"IMPACT, STIFFNESS={_f(law['STIFFNESS'])}, "
+                 f"EXPONENT={_f(law['EXPONENT'])}",
+                 f"DAMPING={_f(law['DAMPING'])}, DMAX={_f(law['DMAX'])}",
+                 f"COULOMB_FRICTION=ON, MU_STATIC={_f(law['MU_STATIC'])}, "
+                 f"MU_DYNAMIC={_f(law['MU_DYNAMIC'])}",
+                 "STICTION_TRANSITION_VELOCITY="
+                 f"{_f(law['STICTION_TRANSITION_VELOCITY'])}",
+                 "FRICTION_TRANSITION_VELOCITY="
+                 f"{_f(law['FRICTION_TRANSITION_VELOCITY'])}")
+
+
 def contact_statements(mb, ids: dict, lanes: bool, n_patches: tuple, law: dict) -> list[str]:
     """One CONTACT per foot sphere and patch of its lane
     (:func:`walkerlab.export.adams_feet.contact_pairs`), the IMPACT law ``law`` of
-    :func:`contact_mm` with Coulomb friction."""
+    :func:`contact_mm` with Coulomb friction (:func:`contact_statement`)."""
     out = ["!", "! ---- contact: IMPACT normal force + Coulomb friction, mm-kg-s ----"]
     for cid, _leg, _role, m, g in contact_pairs(mb, ids, lanes, n_patches):
-        out += _stmt(f"CONTACT/{cid}, IGEOM={m}, JGEOM={g}",
-                     f"IMPACT, STIFFNESS={_f(law['STIFFNESS'])}, "
-                     f"EXPONENT={_f(law['EXPONENT'])}",
-                     f"DAMPING={_f(law['DAMPING'])}, DMAX={_f(law['DMAX'])}",
-                     f"COULOMB_FRICTION=ON, MU_STATIC={_f(law['MU_STATIC'])}, "
-                     f"MU_DYNAMIC={_f(law['MU_DYNAMIC'])}",
-                     "STICTION_TRANSITION_VELOCITY="
-                     f"{_f(law['STICTION_TRANSITION_VELOCITY'])}",
-                     "FRICTION_TRANSITION_VELOCITY="
-                     f"{_f(law['FRICTION_TRANSITION_VELOCITY'])}")
+        out += contact_statement(cid, m, g, law)
     return out

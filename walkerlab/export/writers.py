@@ -314,6 +314,23 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     from walkerlab.export.legs_3d import legs_3d_urdf_text  # light: 3D only
     from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene
 
+    scene, data = job.scene, job.data
+    _check_legs_3d(job, w)
+    version = walkerlab.__version__
+    ideal = None
+    if w.name == "urdf":
+        text = legs_3d_urdf_text(data, job.name, version)
+    elif job.walker_only:
+        text = legs3d_mjcf_text(data, job.name, version)
+    else:
+        ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
+        text = legs3d_mjcf_text(data, job.name, version, extra)
+    return Written((_xml(job, w, text),), xml_lines((), scene), step_period(ideal))
+
+
+def _check_legs_3d(job: ExportJob, w: Writer) -> None:
+    """Refuse in one line what the 3D straight-legged walker's ``w`` does not carry (the
+    capability table's cells: round feet, hip-roll joints, actuators; numbers, ground)."""
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
     st = data.structure
@@ -329,16 +346,6 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
         from walkerlab.models.hybrid.actuated import refuse_actuators  # light: actuated only
 
         refuse_actuators(kind, scene.walker.actuation, w.view)
-    version = walkerlab.__version__
-    ideal = None
-    if w.name == "urdf":
-        text = legs_3d_urdf_text(data, job.name, version)
-    elif job.walker_only:
-        text = legs3d_mjcf_text(data, job.name, version)
-    else:
-        ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
-        text = legs3d_mjcf_text(data, job.name, version, extra)
-    return Written((_xml(job, w, text),), xml_lines((), scene), step_period(ideal))
 
 
 #: :attr:`walkerlab.walker.kinds.Kind.body` -> the URDF / MJCF writer of that multibody
@@ -361,7 +368,10 @@ def _by_body(job: ExportJob, w: Writer) -> Written:
 
 
 def _adams(job: ExportJob, w: Writer) -> Written:
-    """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
+    """``walker.adm`` and ``walker.acf`` (both built before either is written); a walker
+    in 3D by :func:`_adams_3d`."""
+    if job.kind.in_3d:
+        return _adams_3d(job, w)
     _tree_only(job, w)
     scene, data = job.scene, job.data
     mb = multibody(data)
@@ -375,6 +385,21 @@ def _adams(job: ExportJob, w: Writer) -> Written:
     acf = acf_text(scene, start)
     return Written(((w.file, adm), (ADAMS_FILES["acf"], acf)),
                    tuple(o.line for o in adams_omissions(scene, mb)))
+
+
+def _adams_3d(job: ExportJob, w: Writer) -> Written:
+    """The 3D straight-legged walker's ``walker.adm`` and ``walker.acf``
+    (:func:`walkerlab.export.adams_3d.adm3d_text`), refused before the gait search as its
+    MJCF is (:func:`_check_legs_3d`); a 3D wheel as the capability table has it."""
+    from walkerlab.export.adams_3d import adams3d_start, adm3d_text  # light: 3D only
+
+    _check_legs_3d(job, w)  # --walker-only: the gait still written, as the planar dataset's
+    scene = job.scene
+    strides = int(scene.contact_sim.n_strides) if scene.contact_sim else 5
+    ideal, start = job.gait(lambda ideal: adams3d_start(job.data, ideal, strides))
+    adm = adm3d_text(scene, job.data, start, job.name, walkerlab.__version__)
+    return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))), (),
+                   step_period(ideal))
 
 
 def _osim(job: ExportJob, w: Writer) -> Written:

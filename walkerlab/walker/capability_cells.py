@@ -11,9 +11,9 @@ re-exports every public name here; the layers import them from there.
 from __future__ import annotations
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D", "KNEE_LATCH_OSIM",
-           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE", "ROUND_FEET_EXPORT_3D",
-           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
+           "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D",
+           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
+           "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -90,16 +90,15 @@ ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass 
 HIP_ROLL_EXPORT_3D = ("the URDF carries legs rigid to the pelvis in roll so far: the "
                       "hip-roll joints and their law are in the MJCF (--format mjcf) "
                       "and the rigid model")
-#: why the exports refuse a 3D walker
+#: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
 #: what the views of both 3D kinds refuse: a ground other than a plane, the contact model,
-#: the Adams and OpenSim exports
+#: the OpenSim export
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
     ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a later "
                           "step (walk it in the rigid model: fixedpoint, simulate)"),
-    ("walk", "adams"): EXPORT_3D,
     ("walk", "osim"): EXPORT_3D,
 }
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
@@ -280,8 +279,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "straight_legs_3d": {
         ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
-        ("round_feet_3d", "mjcf"): ROUND_FEET_EXPORT_3D,
-        ("round_feet_3d", "urdf"): ROUND_FEET_EXPORT_3D,
+        **{("round_feet_3d", v): ROUND_FEET_EXPORT_3D for v in ("mjcf", "urdf", "adams")},
         **{(f, "*"): ACTUATION_3D for f in ("hip_torque", "knee_torque",
                                             "ankle_torque", "torso_torque", "push_off",
                                             "ankle_push_off", "virtual_constraints")},
@@ -291,7 +289,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.legs_3d.
-        # legs_3d_urdf_text)
+        # legs_3d_urdf_text); the Adams dataset: the pelvis fixed to leg2, the legs on
+        # revolutes, or with hip-roll joints the pelvis rolling, the legs on universal
+        # joints and the law as GFORCE torques (walkerlab.export.adams_3d.adm3d_text)
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
                           "is a later step"),
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
@@ -301,6 +301,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_PLANAR,
         **_WHEEL_JOINTS,
         **_CELLS_3D,
+        ("walk", "adams"): ("the Adams dataset writes legged walkers (planar, and the 3D "
+                            "straight legs); a 3D spoked wheel (one rigid body) is "
+                            "exported as urdf or mjcf"),
         # the MJCF and the URDF: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
         ("walk", "gym"): _WHEEL_GYM,
