@@ -168,6 +168,32 @@ def hip_roll_forces(q, dq, P) -> sp.Matrix:
     return tau_st * grad_st + tau_sw * grad_sw
 
 
+def stance_forces(structure, q, dq, params, roles_3d: dict) -> tuple:
+    """The hip-roll law's generalised forces (nq, 1) of a floating view (coordinates
+    ``q``, rates ``dq``, parameter symbols ``params``) with leg1, then leg2 in stance
+    (:attr:`walkerlab.codegen.floating_equations.FloatingEquations.stance_forces`; none
+    without the hip-roll joints' roles): the rigid model's law (:func:`hip_roll_forces`)
+    on the roles of the floating coordinates with that leg standing (``roles_3d``,
+    :data:`walkerlab.codegen.floating_equations.ROLES_3D`, with the legs swapped for
+    leg1), its forces added at those coordinates.  The law is odd in the rolls, so the
+    floating (unmirrored) coordinates take it as they are."""
+    if "pelvis_roll" not in structure.roles:  # no hip-roll joints
+        return ()
+    names = [str(c) for c in q]
+    P = dict(zip(structure.param_names, params))
+    out = []
+    for stance in ("leg1", "leg2"):
+        swing = "leg2" if stance == "leg1" else "leg1"
+        role = {r: n.replace("leg2", "@").replace("leg1", swing).replace("@", stance)
+                for r, n in roles_3d.items()}
+        idx = [names.index(role[r]) for r in structure.roles]
+        F = hip_roll_forces([q[i] for i in idx], [dq[i] for i in idx], P)
+        Q = sp.zeros(len(q), 1)
+        for k, i in enumerate(idx):
+            Q[i] += F[k]
+        out.append(Q)
+    return tuple(out)
+
 @cache
 @_seeded
 def derive_compass(structure) -> Equations:

@@ -166,7 +166,7 @@ class FloatingEquations:
     stance_forces : tuple of Matrix (nq, 1)
         Internal generalised forces that depend on which leg stands: with leg1, then with
         leg2 in stance (a walker in 3D with hip-roll joints: Kuo 1999's law,
-        :func:`walkerlab.codegen.derive_3d.hip_roll_forces`, the stance hip holding the
+        :func:`walkerlab.codegen.derive_3d.stance_forces`, the stance hip holding the
         pelvis level and the swing hip placing its leg); empty: none.  The contact model
         weights each by its foot's share of the normal load
         (:mod:`walkerlab.models.contact.rhs_lines`).
@@ -500,6 +500,7 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
     """
     import sympy as sp
 
+    from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
     from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
     from walkerlab.codegen.lagrange import bias  # light
     from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
@@ -547,37 +548,10 @@ def _derive_3d(structure: Structure) -> FloatingEquations:
                              params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
                              kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
                              points=points, contacts=LEGS, point_legs=(0, 1),
-                             stance_forces=_stance_forces(structure, q, dq, kin.params),
+                             stance_forces=stance_forces(structure, q, dq, kin.params,
+                                                         ROLES_3D),
                              spins=spins)
 
-
-def _stance_forces(structure: Structure, q, dq, params) -> tuple:
-    """The hip-roll law's generalised forces (nq, 1) with leg1, then leg2 in stance
-    (:attr:`FloatingEquations.stance_forces`; none without hip-roll joints): the rigid
-    model's law (:func:`walkerlab.codegen.derive_3d.hip_roll_forces`) on the roles of
-    the floating coordinates with that leg standing (:data:`ROLES_3D` with the legs
-    swapped for leg1), its forces added at those coordinates.  The law is odd in the
-    rolls, so the floating (unmirrored) coordinates take it as they are."""
-    import sympy as sp
-
-    from walkerlab.codegen.derive_3d import hip_roll_forces  # light: sympy on first use
-
-    if not structure.hip_roll:
-        return ()
-    names = [str(c) for c in q]
-    P = dict(zip(structure.param_names, params))
-    out = []
-    for stance in ("leg1", "leg2"):
-        swing = "leg2" if stance == "leg1" else "leg1"
-        role = {r: n.replace("leg2", "@").replace("leg1", swing).replace("@", stance)
-                for r, n in ROLES_3D.items()}
-        idx = [names.index(role[r]) for r in structure.roles]
-        F = hip_roll_forces([q[i] for i in idx], [dq[i] for i in idx], P)
-        Q = sp.zeros(len(q), 1)
-        for k, i in enumerate(idx):
-            Q[i] += F[k]
-        out.append(Q)
-    return tuple(out)
 
 
 def _disc_contact(kin, body: str, centre, radius):

@@ -129,11 +129,9 @@ class ContactWalker(ContactReadouts):
         (:mod:`walkerlab.models.contact.joint_torques`); a walker with them runs on
         :mod:`walkerlab.integrate.contact_powered` (its stance leg is a discrete state).
     torsion : float
-        A walker in 3D: each contact's torsional friction coefficient [m] (the largest
-        moment about the ground's normal per newton of normal force,
-        :func:`walkerlab.models.contact.assembly.twist`; ``contact.torsional_friction_m``,
-        :func:`walkerlab.models.contact.laws.torsional_friction_m`); 0: none (a planar
-        walker's contact has no spin about the normal).
+        A walker in 3D: each contact's torsional friction coefficient [m]
+        (:func:`walkerlab.models.contact.assembly.twist`; ``contact.torsional_friction_m``);
+        0: none (a planar walker's contact has no spin about the normal).
     rhs_ready : walkerlab.codegen.pending.CompiledElsewhere, optional
         A side process compiling the compiled solvers' right-hand side: the first compiled
         chunk waits for it and loads the kernel from the cache (the caller's hand-off,
@@ -328,8 +326,7 @@ class ContactWalker(ContactReadouts):
 
     @property
     def dim(self) -> int:
-        """The world's dimension ``d``: 2 for a planar walker, 3 for a walker in 3D (world
-        axes ``x`` downhill, ``y`` up, ``z`` lateral)."""
+        """The world's dimension ``d``: 2 (planar), 3 (in 3D, ``z`` lateral)."""
         return int(self.kernels.DIM)
 
     @property
