@@ -15,7 +15,7 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, write_rigid_limit
-from walkerlab.stages.common import StageOutcome, require, run_cached, with_defaults
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 #: Default stiffness factors [-]: the scene's contact and three decades stiffer.
@@ -34,6 +34,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     scene = with_defaults(scene, "contact", "rigid-limit")  # left out: the paper's contact law
     require(scene, "fixedpoint", "rigid-limit")
     kappas = tuple(float(k) for k in kappas)
+    _periodic_gait_taken(scene)
 
     def compute():
         from walkerlab.analysis.contact.periodic import ideal_gait  # light
@@ -59,6 +60,26 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     return run_cached("rigid-limit", scene, runs_root, SECTIONS, (), compute, force,
                       extra_key=repr(kappas))
+
+
+def _periodic_gait_taken(scene: Scene) -> None:
+    """Refuse, before anything runs, a walker whose contact periodic gait the kind's contact
+    part does not find (a walker in 3D: its step map is a later step), in one line.
+
+    Raises
+    ------
+    StageError
+    """
+    from walkerlab.config.contact_sim import ContactSimSettings
+    from walkerlab.models.contact.parts import contact_part
+    from walkerlab.walker.plant import Plant  # light
+
+    data = Plant.from_scene(scene).data
+    cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"periodic_gait": True})
+    why = contact_part(data.structure).check(scene, data, cs)
+    if why is not None:
+        raise StageError(f"compare --rigid-limit (the contact periodic gait at each "
+                         f"stiffness): scene '{scene.name}': {why}")
 
 
 def draw(scene: Scene, runs_root: Path | str, path: Path) -> list[Path]:

@@ -291,8 +291,9 @@ class Legs3DPart(ContactPart):
         planar)."""
         if cs.start == "periodic_gait" or cs.periodic_gait:
             return ("contact_sim.start / periodic_gait: the contact periodic gait of a "
-                    "walker in 3D is a later step: start from the rigid gait (start: "
-                    "ideal, periodic_gait: false)")
+                    "walker in 3D (its mirrored step map: also contact-sim --periodic and "
+                    "compare --rigid-limit) is a later step: its contact run starts from "
+                    "the rigid gait (start: ideal, periodic_gait: false)")
         return None
 
 
