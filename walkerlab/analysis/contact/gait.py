@@ -133,7 +133,8 @@ def _foot_traces(walker, t, X, points: bool = False) -> dict[str, FootTrace]:
         on = d["on_ground"] > 0.5
         td, lo = _crossings(t, d["penetration"], d["penetration_rate"], on)
         feet[name] = FootTrace(d["normal_force"], d["friction_force"], d["penetration"],
-                               d["slip_velocity"], d["s"], on, td, lo)
+                               d["slip_velocity"], d["s"], on, td, lo,
+                               d.get("lateral_slip_velocity"), d.get("spin_rate"))
     return feet
 
 
@@ -235,12 +236,17 @@ def _step_summary(t, feet, points, names, starts, loaded, ds, j, ta, leg, bounce
                          for f in pair)
     peak = max(float(np.max(feet[f].penetration[sel] * feet[f].on_ground[sel]))
                for f in names) if sel.any() else np.nan
+    lateral = turn = np.nan
+    if ft.spin_rate is not None and phases:  # a walker in 3D: across the slope, the turn
+        lateral = float(1e3 * phase_integral(t, ft.lateral_slip_velocity, held))
+        turn = float(1e3 * phase_integral(t, ft.spin_rate, held))
     return StepSummary(j, leg, float(ta), float(tb), float(tb - ta),
                        float(1e3 * slip), float(1e3 * creep), int(bounces),
                        int(scuffs), max(peak, 0.0),
                        float(lo_mine[-1]) if lo_mine.size else np.nan,
                        stance_slip_path_mm=float(1e3 * path) if phases else np.nan,
-                       friction_work_j=float(friction) if phases else np.nan)
+                       friction_work_j=float(friction) if phases else np.nan,
+                       stance_lateral_slip_mm=lateral, stance_turn_mrad=turn)
 
 
 def _annotate_foot_modes(t, points, steps) -> None:

@@ -73,7 +73,11 @@ def run_summary(res) -> dict:
     steps = res.steps
     slips = np.array([s.stance_slip_mm for s in steps])
     creep = np.array([s.double_support_creep_mm for s in steps])
-    return {
+    turns = np.array([s.stance_turn_mrad for s in steps])
+    # a walker in 3D: the stance foot's largest turn a step (its torsional friction's creep)
+    turn = ({"max_abs_stance_turn_mrad": float(np.nanmax(np.abs(turns)))}
+            if np.isfinite(turns).any() else {})
+    return {**turn,
         "termination": res.termination,
         "outcome": res.outcome.kind,
         "heel_strikes": int(res.walked_steps),

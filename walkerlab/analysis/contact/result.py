@@ -35,6 +35,9 @@ class FootTrace:
         Whether the foot's lane has ground under it.
     touchdown_times, liftoff_times : ndarray
         Event times [s], located on the Hermite interpolant of the samples.
+    lateral_slip_velocity, spin_rate : ndarray (n,) or None
+        A walker in 3D: the foot's slip across the slope [m/s] and its spin about the
+        slope's normal [rad/s]; None in the plane.
     """
 
     normal_force: np.ndarray
@@ -45,6 +48,8 @@ class FootTrace:
     on_ground: np.ndarray
     touchdown_times: np.ndarray
     liftoff_times: np.ndarray
+    lateral_slip_velocity: np.ndarray | None = None
+    spin_rate: np.ndarray | None = None
 
 
 @dataclass
@@ -92,6 +97,11 @@ class StepSummary:
         Work the friction forces of the stance foot's contact points take over the same
         phase(s) as ``stance_slip_path_mm``, ``-sum of the integrals of F_t v_t`` [J]
         (>= 0: dissipated).  NaN as ``stance_slip_mm``.
+    stance_lateral_slip_mm, stance_turn_mrad : float
+        A walker in 3D: the stance foot's slide across the slope [mm] and its turn about
+        the slope's normal [mrad] over the same phase(s) as ``stance_slip_path_mm`` (the
+        integrals of its lateral slip velocity and its spin: what the torsional friction
+        lets through).  NaN in the plane.
     """
 
     index: int
@@ -108,6 +118,8 @@ class StepSummary:
     foot_modes: str = ""
     stance_slip_path_mm: float = float("nan")
     friction_work_j: float = float("nan")
+    stance_lateral_slip_mm: float = float("nan")
+    stance_turn_mrad: float = float("nan")
 
 
 @dataclass

@@ -42,9 +42,16 @@ from walkerlab.units import Units, for_artifact
 STAGE = CONTACT_SIM.name
 #: unit of each ``summary/`` entry (others: "-")
 SUMMARY_UNITS = {"mean_abs_stance_slip_mm": "mm", "peak_penetration_mm": "mm",
+                 "max_abs_stance_turn_mrad": "mrad",
                  "max_abs_stance_slip_mm": "mm", "total_double_support_creep_mm": "mm",
                  "mean_stance_slip_path_mm": "mm", "mean_friction_work_j": "J",
                  "wall_time_s": "s"}
+#: a walker in 3D's per-step stance-foot quantities (``steps/``): field, unit, meaning
+STEP_3D_FIELDS = (
+    ("stance_lateral_slip_mm", "mm", "the stance foot's slide across the slope over its "
+     "stance (the integral of its lateral slip velocity)"),
+    ("stance_turn_mrad", "mrad", "the stance foot's turn about the slope's normal over its "
+     "stance (the integral of its spin: what the torsional friction lets through)"))
 #: the stance foot's slip path and friction work per step (``steps/``): name, unit, meaning
 STEP_SLIP_FIELDS = (
     ("stance_slip_path_mm", "mm", "path of the stance foot's slip over its stance phase(s), "
@@ -230,6 +237,10 @@ def _write_feet_events_steps(f, run: ContactSimRun) -> None:
     for fld, unit, what in STEP_SLIP_FIELDS:
         put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, what,
             dims=s_dim if steps else None)
+    if any(np.isfinite(s.stance_turn_mrad) for s in steps):  # a walker in 3D
+        for fld, unit, what in STEP_3D_FIELDS:
+            put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit,
+                what, dims=s_dim)
     put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "stance leg",
         dims=s_dim)
     if any(getattr(s, "foot_modes", "") for s in steps):  # flat feet

@@ -151,12 +151,13 @@ class ContactReadouts:
             ``normal_force`` [N], ``friction_force`` [N] (along t), ``power`` [W] (F . v),
             ``on_ground`` (1.0 where the point's lane has ground); a walker in 3D also
             ``lateral_slip_velocity`` [m/s] and ``lateral_friction_force`` [N] (along the
-            slope's level direction ``z``).
+            slope's level direction ``z``), ``spin_rate`` [rad/s] (its body's about the
+            slope's normal) and ``twist_moment`` [N m] (the torsional friction's).
         """
         tab = self.kernels.contact_table(self._rows(X), *self._args())
         names = ("penetration", "penetration_rate", "slip_velocity", "s", "normal_force",
                  "friction_force", "power", "on_ground", "lateral_slip_velocity",
-                 "lateral_friction_force")[:tab.shape[2]]
+                 "lateral_friction_force", "spin_rate", "twist_moment")[:tab.shape[2]]
         return {foot: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
                 for i, foot in enumerate(self._contacts)}
 
