@@ -102,6 +102,29 @@ def slope(PC):
 
 
 @njit(cache=True)
+def pressed(px, py, vx, vy, sp, cp, PC, cen):
+    """How a point at (px, py) [m] with material velocity (vx, vy) [m/s] (in 3D: their
+    sagittal parts; the slope does not change across it) presses the slope's lane ``cen``:
+    (delta, ddot, vt, s, Fn, dFn/ddelta, dFn/dddot), the penetration [m] below the top of
+    the patch under it (a gap: none), its rate [m/s], the slip along the fall line [m/s],
+    the along-slope position [m] and the IMPACT normal force [N] with its partials; the
+    slope's (sin, cos) = (sp, cp).  :func:`point`'s and :func:`point3`'s shared part."""
+    delta = -(px * sp + py * cp)
+    ddot = -(vx * sp + vy * cp)
+    vt = vx * cp - vy * sp
+    s = px * cp - py * sp
+    fn, dfd, dfdd = 0.0, 0.0, 0.0
+    # a patch at height hp: penetration below its top (cen[-1], the lane's highest patch,
+    # skips the lookup for a foot above every patch; all heights 0: the flat ground)
+    hp = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5) if delta + cen[-1] > 0.0 else np.nan
+    if hp == hp:
+        delta += hp
+    if delta > 0.0 and hp == hp:
+        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
+    return delta, ddot, vt, s, fn, dfd, dfdd
+
+
+@njit(cache=True)
 def point(px, py, vx, vy, sp, cp, PC, cen):
     """Contact of a point at (px, py) [m] whose material velocity is (vx, vy) [m/s] on the
     lane ``cen``, the slope's (sin, cos) = (sp, cp): (delta, ddot, vt, s, Fn, Ff, dFn/ddelta,
@@ -112,20 +135,10 @@ def point(px, py, vx, vy, sp, cp, PC, cen):
     normal are the nearest segment's."""
     if PC[I_CONT] > 1.5:
         return on_line(px, py, vx, vy, sp, cp, PC, cen)
-    delta = -(px * sp + py * cp)
-    ddot = -(vx * sp + vy * cp)
-    vt = vx * cp - vy * sp
-    s = px * cp - py * sp
-    fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
-    # a patch at height hp: penetration below its top (cen[-1], the lane's highest patch,
-    # skips the lookup for a foot above every patch; all heights 0: the flat ground)
-    hp = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5) if delta + cen[-1] > 0.0 else np.nan
-    if hp == hp:
-        delta += hp
-    if delta > 0.0 and hp == hp:
-        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
-        if fn > 0.0:
-            mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
+    delta, ddot, vt, s, fn, dfd, dfdd = pressed(px, py, vx, vy, sp, cp, PC, cen)
+    mu, dmu = 0.0, 0.0
+    if fn > 0.0:
+        mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
     return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, sp, cp
 
 
@@ -148,20 +161,12 @@ def point3(px, py, pz, vx, vy, vz, sp, cp, PC, cen):
     ``dmu/dw`` at the slip speed ``w = |v_t|`` [m/s], then the lateral slip ``vz`` [m/s],
     the lateral friction ``Fz`` [N] and ``w``.  Raises nothing: a polyline ground is
     planar (a scene of one in 3D is refused before)."""
-    delta = -(px * sp + py * cp)
-    ddot = -(vx * sp + vy * cp)
-    vt = vx * cp - vy * sp
-    s = px * cp - py * sp
+    delta, ddot, vt, s, fn, dfd, dfdd = pressed(px, py, vx, vy, sp, cp, PC, cen)
     w = np.sqrt(vt * vt + vz * vz)
-    fn, dfd, dfdd, g, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
-    hp = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5) if delta + cen[-1] > 0.0 else np.nan
-    if hp == hp:
-        delta += hp
-    if delta > 0.0 and hp == hp:
-        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
-        if fn > 0.0:
-            mu, dmu = friction_mu(w, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
-            g = mu / w if w > 0.0 else dmu
+    g, dmu = 0.0, 0.0
+    if fn > 0.0:
+        mu, dmu = friction_mu(w, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
+        g = mu / w if w > 0.0 else dmu
     return (delta, ddot, vt, s, fn, g * fn * vt, dfd, dfdd, g, dmu, sp, cp, vz, g * fn * vz, w)
 
 
