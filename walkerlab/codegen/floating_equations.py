@@ -45,6 +45,8 @@ point is
   parameter vector (:func:`param_names`).
 
 The contact points are named by :func:`contact_names` (``leg1``, ``leg2``; flat feet
+their heels and toes; a spoked wheel its spoke tips).  Walkers in 3D (straight legs, the
+spoked wheel) derive from their body trees: :mod:`walkerlab.codegen.floating_3d`.
 
 Massless bodies (the simplest walker's legs) have no floating model: :func:`check_masses`
 raises.
@@ -57,8 +59,6 @@ from functools import cache
 
 from walkerlab.walker.description import Structure
 from walkerlab.walker.multibody import check_floating_view
-from walkerlab.walker.tree import free_root
-from walkerlab.walker.trees import legs_3d_tree
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
@@ -73,8 +73,16 @@ FREE_3D = ("leg2_foot_x", "leg2_foot_y", "leg2_foot_z", "heading")
 #: (:func:`walkerlab.codegen.derive_3d.derive_compass`'s: the lean is the stance leg's roll)
 ROLES_3D = {"lean": "leg2_roll", "swing": "leg1_angle", "stance": "leg2_angle",
             "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll"}
-#: why a wheel in 3D has no floating view (its ground reaction is its hub's)
-NO_WHEEL_3D = "walker.spokes: a wheel in 3D has no floating view of its tree yet"
+#: A spoked wheel's free coordinates in 3D (:func:`walkerlab.walker.tree.free_root`'s slides
+#: only: its tree turns about every axis at spoke 0's tip already): spoke 0's tip in world
+#: axes [m]; the tree's heading, lean and spin follow (:data:`WHEEL_3D_COORDINATES`).
+FREE_WHEEL_3D = ("spoke0_foot_x", "spoke0_foot_y", "spoke0_foot_z")
+#: The floating view's coordinates of a spoked wheel in 3D (``model: rimless_wheel``,
+#: ``walker.space: 3d``): spoke 0's tip [m], then the rigid tree's heading (about the slope's
+#: normal), lean (about the fall line) and spoke 0's angle in the wheel's plane from the
+#: downward vertical (positive when its tip is ahead of the hub; the planar wheel's
+#: ``wheel_angle``) [rad] (:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`).
+WHEEL_3D_COORDINATES = FREE_WHEEL_3D + ("heading", "lean", "wheel_angle")
 #: The floating view's coordinates of a spoked wheel (``model: rimless_wheel``): the hub's
 #: position [m] and the absolute angle of spoke 0 [rad] (from the downward vertical,
 #: positive when its tip is ahead of the hub).
@@ -84,8 +92,8 @@ WHEEL_COORDINATES = ("hip_x", "hip_y", "wheel_angle")
 def coordinate_names(structure: Structure) -> tuple[str, ...]:
     """Names of the floating view's generalised coordinates (module docstring)."""
     if structure.in_3d:
-        if structure.spokes:
-            raise ValueError(NO_WHEEL_3D)
+        if structure.spokes:  # the slides, then the tree's heading, lean and spin
+            return WHEEL_3D_COORDINATES
         return FREE_3D + tuple(ROLES_3D[r] for r in structure.roles)
     if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
         return WHEEL_COORDINATES
@@ -211,8 +219,10 @@ def derive_floating(structure: Structure) -> FloatingEquations:
 
     check_floating_view(structure)
     check_masses(structure)
-    if structure.in_3d:
-        return _derive_3d(structure)
+    if structure.in_3d:  # from the body trees (walkerlab.codegen.floating_3d)
+        from walkerlab.codegen.floating_3d import derive_legs_3d, derive_wheel_3d  # circle
+
+        return derive_wheel_3d(structure) if structure.spokes else derive_legs_3d(structure)
     if structure.spokes:
         return _derive_spoked(structure)
     if structure.foot not in ("point", "arc", "flat"):
@@ -476,100 +486,3 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
                              feet=tuple(feet), kinetic=T, potential=V, points=points,
                              knees=(), contacts=contacts,
                              point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
-
-
-def _derive_3d(structure: Structure) -> FloatingEquations:
-    """The floating view of a 3D straight-legged walker from its body tree
-    (:func:`walkerlab.walker.trees.legs_3d_tree`, Kuo 1999), set free at leg2's foot
-    (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y, z`` and a
-    heading, then the rigid tree's joints in its own coordinates renamed by
-    :data:`ROLES_3D`): the mass
-    matrix and potential of :func:`walkerlab.codegen.tree_derive.mass_and_potential`, the
-    bias of :func:`walkerlab.codegen.lagrange.bias`, unsimplified (common subexpressions
-    are the generated code's).  Positions in world axes (``x`` downhill, ``y`` up, ``z``
-    lateral), as a planar walker's; the feet ``leg1`` (the rigid model's swing foot) and
-    ``leg2`` (its stance foot, the root's contact); round feet's the discs' lowest points
-    with their material points' Jacobians (:func:`_disc_contact`).
-    The hip-roll law's torques act between bodies (no force on the free coordinates): the
-    view leaves them out.
-
-    Raises
-    ------
-    ValueError
-        A spoked wheel (its floating view is not yet its tree's).
-    """
-    import sympy as sp
-
-    from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
-    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
-    from walkerlab.codegen.lagrange import bias  # light
-    from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
-
-    if structure.spokes:
-        raise ValueError(NO_WHEEL_3D)
-    rigid, coords = legs_3d_tree(structure)
-    tree, fcoords = free_root(rigid, coords, FREE_3D)
-    kin = kinematics(tree, fcoords)
-    names = coordinate_names(structure)
-    q = sp.symbols(names, real=True)
-    dq = sp.symbols([f"d_{n}" for n in names], real=True)
-    rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
-    M, _, _, V = mass_and_potential(kin)
-    M, V = M.xreplace(rename), V.xreplace(rename)
-    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
-    h = bias(M, V, q, dq)
-    to_world = slope_to_world(kin.gamma)
-    feet, points = [], {}
-    if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
-        radius = dict(zip(tree.params, kin.params))["R_foot"]
-        for leg, link, centre in (("leg1", "swing_leg", kin.contacts["swing_foot_centre"]),
-                                  ("leg2", "stance_leg", kin.origins["stance_leg"])):
-            low, J = _disc_contact(kin, link, centre, radius)
-            pos = to_world * low.xreplace(rename)
-            feet.append((pos, (to_world * J).xreplace(rename)))
-            points[f"{leg}_contact"] = pos
-            points[f"{leg}_foot_centre"] = to_world * centre.xreplace(rename)
-    else:
-        for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
-            pos = to_world * kin.contacts[contact].xreplace(rename)
-            feet.append((pos, pos.jacobian(qv)))
-            points[f"{leg}_foot"] = pos
-    # each foot's spin about the slope's normal (the slope frame's y): its leg's angular
-    # velocity there, omega = R_b omega_b
-    spins = tuple((kin.rotations[link] * kin.omegas[link]).jacobian(sp.Matrix(kin.dq))[1, :]
-                  .xreplace(rename) for link in ("swing_leg", "stance_leg"))
-    points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
-    for b in structure.bodies:
-        for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
-            points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)
-    for b in structure.torso:
-        points[f"torso_{b.name}"] = to_world * kin.coms[f"torso_{b.name}"].xreplace(rename)
-    return FloatingEquations(q=tuple(q), dq=tuple(dq),
-                             params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
-                             kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
-                             points=points, contacts=LEGS, point_legs=(0, 1),
-                             stance_forces=stance_forces(structure, q, dq, kin.params,
-                                                         ROLES_3D),
-                             spins=spins)
-
-
-
-def _disc_contact(kin, body: str, centre, radius):
-    """A round foot's contact on the slope: the lowest point of the disc of ``radius``
-    about ``centre`` (3, 1) in the plane normal to ``body``'s ``z`` axis (its leg's
-    sagittal plane; McGeer 1990), ``centre - R u / |u|`` with ``u = n - (n . a) a`` the
-    slope's normal ``n`` without its part along the disc's axis ``a``, and the Jacobian
-    (3, nq) of the disc's material point there, ``v = v_centre + omega x (low - centre)``
-    (``omega`` the body's angular velocity: a disc that rolls without slip has that point
-    at rest).  Slope frame, the tree's own coordinates (``kin``:
-    :class:`walkerlab.codegen.tree_derive.TreeKinematics`)."""
-    import sympy as sp
-
-    R_b = kin.rotations[body]
-    a = R_b * sp.Matrix([0, 0, 1])
-    u = sp.Matrix([0, 1, 0]) - a[1] * a
-    low = centre - radius * u / sp.sqrt(1 - a[1] ** 2)
-    r = low - centre
-    skew = sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
-    omega = R_b * kin.omegas[body].jacobian(sp.Matrix(kin.dq))
-    return low, centre.jacobian(sp.Matrix(kin.q)) - skew * omega
