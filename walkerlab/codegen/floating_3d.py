@@ -18,7 +18,7 @@ unsimplified (common subexpressions are the generated code's).
 
 from __future__ import annotations
 
-from walkerlab.codegen.floating_equations import (
+from walkerlab.codegen.floating_names import (
     FREE_3D,
     FREE_WHEEL_3D,
     LEGS,
