@@ -294,3 +294,122 @@ def test_the_passive_3d_walker_capsizes_in_contact_as_its_lateral_multiplier_say
     failure, _, strikes, _ = _contact_run("hip_width", tmp_path)
     assert failure and strikes <= 6
     assert "capsized sideways" in failure and "Floquet multiplier" in failure
+
+
+# ---------------------------------------------------------------- the spoked wheel in 3D
+def _wheel(scene):
+    """(contact walker of the 3D wheel ``scene`` with the ADAMS defaults and a torsional
+    coefficient 0.05 m, its start state, the Newton-Euler reference)."""
+    from tests.independent.wheel_3d_contact import Wheel3DContact
+
+    scene = scene.model_copy(update={"contact": ContactSettings(
+        torsional_friction_m=0.05)})
+    cw, x0 = _contact_walker(scene)
+    P = dict(zip(cw.structure.param_names, cw.walker_params))
+    PC = cw.contact_params
+    law = {"k": PC[A.I_K], "e": PC[A.I_E], "cmax": PC[A.I_CMAX], "dmax": PC[A.I_DMAX],
+           "mus": PC[A.I_MUS], "mud": PC[A.I_MUD], "vs": PC[A.I_VS], "vd": PC[A.I_VD],
+           "tau": PC[A.I_TOR]}
+    return cw, x0, Wheel3DContact(P["g"], P["L"], P["gamma"], P["M_hub"], P["I_hub"],
+                                  P["I_diam"], cw.structure.spokes, law)
+
+
+def _two_tips(ref, heading, lean, depth, slip, slip_dir, rates):
+    """A state with spokes 0 and n-1 level (the wheel's angle ``alpha - gamma``: their
+    tips are level at every heading and lean) ``depth`` [m] into the slope, every tip
+    sliding at ``slip`` [m/s] along ``slip_dir`` [rad] from the fall line (plus the
+    rotation's share) and spoke 0's tip penetrating at 1e-4 m/s; ``rates`` the heading's,
+    lean's and wheel's [rad/s]."""
+    alpha = np.pi / ref.spokes
+    q = np.r_[-depth * ref.n, heading, lean, alpha - ref.gamma]
+    dq = np.r_[np.zeros(3), rates]
+    J0 = ref.jacobian(lambda qq: ref.tip(qq, 0), q)
+    v0 = J0 @ dq
+    want = slip * (np.cos(slip_dir) * ref.s + np.sin(slip_dir) * ref.z) - 1e-4 * ref.n
+    dq[:3] = want - (v0 - (v0 @ ref.n) * ref.n) - (v0 @ ref.n) * ref.n
+    return np.r_[q, dq]
+
+
+def test_the_3d_wheel_contact_flow_matches_an_independent_newton_euler_model():
+    """``cw.rhs`` of the 3D disc wheel (configs/rimless_wheel_3d_disc.yaml; ADAMS View
+    friction 0.1 / 1 m/s, torsional coefficient 0.05 m) against the Newton-Euler model of
+    one rigid body (tests/independent/wheel_3d_contact.py) at the contact start and at
+    states with two spokes loaded, leaning and heading off the fall line, their tips
+    slipping in each regime of the friction law (0.01, 0.5, 2 m/s) and spinning about the
+    normal in each regime of the torsional law (rho |w| = 0.03, 0.28, 0.9 m/s).  The
+    reference's error (complex step exact; the central difference of its velocity-product
+    terms ~1e-12) bounds the agreement: measured <= 3e-11 relative."""
+    cw, x0, ref = _wheel(load_scene("configs/rimless_wheel_3d_disc.yaml"))
+    assert cw.coordinate_names() == ("spoke0_foot_x", "spoke0_foot_y", "spoke0_foot_z",
+                                     "heading", "lean", "wheel_angle")
+    states = [x0,
+              _two_tips(ref, 0.0, 0.0, 5e-5, 0.01, 0.0, (0.5, 1e-4, -2e-4)),
+              _two_tips(ref, 0.3, 0.1, 6e-5, 0.5, 0.8, (5.0, -2e-4, 1e-4)),
+              _two_tips(ref, -0.5, -0.2, 4e-5, 2.0, -1.9, (-16.0, 3e-4, 2e-4))]
+    for x in states:
+        loaded = [ref.tip_contact(x[:6], x[6:], k)["fn"] > 0 for k in range(ref.spokes)]
+        if x is not x0:
+            assert loaded[0] and loaded[-1]
+        a, b = cw.rhs(0.0, x), ref.rhs(0.0, x)
+        assert np.abs(a - b).max() <= 1e-8 * np.abs(b).max(), (a - b, b)
+
+
+def _contact_sim(scene_path, runs, *args):
+    """Run ``walkerlab contact-sim`` on ``scene_path`` into ``runs``; the artifacts' folder."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    subprocess.run([shutil.which("walkerlab"), "contact-sim", str(scene_path),
+                    "--runs-dir", str(runs), *args], check=True, capture_output=True)
+    return Path(runs) / Path(scene_path).stem
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("angle_rad", [0.2, 0.25])
+def test_the_3d_disc_wheel_rolls_in_contact_at_the_rigid_step_period(tmp_path, angle_rad):
+    """configs/rimless_wheel_3d_disc.yaml (stable above its critical slope, 0.18-0.2 rad)
+    and a variant on 0.25 rad: 5 strides of the contact run are >= 10 spoke touchdowns,
+    and the last four steps' mean period is the rigid gait's ``step_period`` within 1 %
+    (measured -0.028 % at 0.2 rad, -0.097 % at 0.25 rad)."""
+    import h5py
+
+    from pathlib import Path
+
+    text = Path("configs/rimless_wheel_3d_disc.yaml").read_text()
+    if angle_rad != 0.2:  # the rigid gait's guess follows the slope: alpha - slope
+        text = text.replace("  angle_rad: 0.2\n", f"  angle_rad: {angle_rad}\n").replace(
+            "stance_angle_rad: 0.1927", f"stance_angle_rad: {np.pi / 8 - angle_rad:.4f}")
+    scene = tmp_path / f"disc_{int(angle_rad * 100)}.yaml"
+    scene.write_text(text)
+    out = _contact_sim(scene, tmp_path / "runs", "--strides", "5")
+    with h5py.File(out / "fixedpoint.h5") as f:
+        period = float(f["step_period"][()])
+    with h5py.File(out / "contact_sim.h5") as f:
+        strikes = f["events/heel_strike_times"][()]
+    assert strikes.size >= 10
+    steps = np.diff(strikes)
+    assert abs(steps[-4:].mean() / period - 1.0) < 0.01, (steps, period)
+
+
+@pytest.mark.slow
+def test_the_unstable_3d_wheel_capsizes_sideways_in_contact():
+    """configs/rimless_wheel_3d.yaml (lateral Floquet multiplier 22.4): from its rigid gait
+    with a lean rate of 0.05 rad/s the contact run falls within its first steps (measured:
+    after 1 heel strike, t = 1.65 s) and names how: capsized sideways, the hub 60 deg from
+    the slope's normal beside its stance spoke's tip.  (Unperturbed the lean grows x23 a
+    step from 1e-26 rad, as the rigid gait's multiplier says.)"""
+
+    from walkerlab.analysis.contact.record import contact_walk
+    from walkerlab.models.contact.scene import contact_setup as setup_of
+
+    scene = load_scene("configs/rimless_wheel_3d.yaml")
+    plant = Plant.from_scene(scene)
+    x = np.asarray(initial_guess(scene, build_walker(scene, plant)), float)
+    names = build_walker(scene, plant).state_names()
+    x[list(names).index("lean_rate")] += 0.05
+    walker, res, *_ = contact_walk(setup_of(scene, plant=plant), x, 1.04)
+    assert res.termination == "fall"
+    assert len(res.heel_strike_times) <= 4
+    how = walker.fall_how(res.x[-1])
+    assert how.startswith("capsized sideways: the hub") and "stance spoke's tip" in how

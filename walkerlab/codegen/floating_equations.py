@@ -45,6 +45,8 @@ point is
   parameter vector (:func:`param_names`).
 
 The contact points are named by :func:`contact_names` (``leg1``, ``leg2``; flat feet
+their heels and toes; a spoked wheel its spoke tips).  Walkers in 3D (straight legs, the
+spoked wheel) derive from their body trees: :mod:`walkerlab.codegen.floating_3d`.
 
 Massless bodies (the simplest walker's legs) have no floating model: :func:`check_masses`
 raises.
@@ -55,141 +57,25 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cache
 
+from walkerlab.codegen.floating_3d import derive_legs_3d, derive_wheel_3d
+from walkerlab.codegen.floating_names import (  # noqa: F401 (re-exported)
+    FOOT_PARAMS,
+    FREE_3D,
+    FREE_WHEEL_3D,
+    LEGS,
+    MASSLESS_MESSAGE,
+    ROLES_3D,
+    WHEEL_3D_COORDINATES,
+    WHEEL_COORDINATES,
+    FloatingEquations,
+    check_masses,
+    contact_names,
+    coordinate_names,
+    param_names,
+)
 from walkerlab.walker.description import Structure
 from walkerlab.walker.multibody import check_floating_view
-from walkerlab.walker.tree import free_root
-from walkerlab.walker.trees import legs_3d_tree
 
-MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
-LEGS = ("leg1", "leg2")
-#: Floating-view parameters of a flat foot (not in the walker description, whose foot is
-#: massless): its mass at the ankle [kg] and its inertia about the ankle [kg m^2].
-FOOT_PARAMS = ("m_foot", "I_foot")
-#: A 3D walker's free coordinates (:func:`walkerlab.walker.tree.free_root`): leg2's foot in
-#: world axes (``x`` downhill, ``y`` up, ``z`` lateral) [m], and the heading, a turn about the
-#: slope's normal [rad]; the rigid roles' coordinates follow, renamed by :data:`ROLES_3D`.
-FREE_3D = ("leg2_foot_x", "leg2_foot_y", "leg2_foot_z", "heading")
-#: A 3D walker's rigid roles (leg1 swinging, leg2 standing) -> its floating coordinates
-#: (:func:`walkerlab.codegen.derive_3d.derive_compass`'s: the lean is the stance leg's roll)
-ROLES_3D = {"lean": "leg2_roll", "swing": "leg1_angle", "stance": "leg2_angle",
-            "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll"}
-#: why a wheel in 3D has no floating view (its ground reaction is its hub's)
-NO_WHEEL_3D = "walker.spokes: a wheel in 3D has no floating view of its tree yet"
-#: The floating view's coordinates of a spoked wheel (``model: rimless_wheel``): the hub's
-#: position [m] and the absolute angle of spoke 0 [rad] (from the downward vertical,
-#: positive when its tip is ahead of the hub).
-WHEEL_COORDINATES = ("hip_x", "hip_y", "wheel_angle")
-
-
-def coordinate_names(structure: Structure) -> tuple[str, ...]:
-    """Names of the floating view's generalised coordinates (module docstring)."""
-    if structure.in_3d:
-        if structure.spokes:
-            raise ValueError(NO_WHEEL_3D)
-        return FREE_3D + tuple(ROLES_3D[r] for r in structure.roles)
-    if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
-        return WHEEL_COORDINATES
-    if structure.knee:
-        ang = tuple(f"{leg}_{ln}_angle" for leg in LEGS for ln in ("thigh", "shank"))
-    else:
-        ang = tuple(f"{leg}_angle" for leg in LEGS)
-    if structure.foot == "flat":  # the feet's absolute angles after the legs'
-        ang += tuple(f"{leg}_foot_angle" for leg in LEGS)
-    if structure.hinged_torso:  # its own coordinate, last (a five-link biped)
-        ang += ("torso_angle",)
-    return ("hip_x", "hip_y") + ang
-
-
-def param_names(structure: Structure) -> tuple[str, ...]:
-    """Names of the floating view's parameter vector: ``structure.param_names``, then for
-    flat feet the contact model's regularising foot mass ``m_foot`` [kg] and inertia about
-    the ankle ``I_foot`` [kg m^2] (:data:`FOOT_PARAMS`; the rigid view's foot is
-    massless) unless the walker's feet carry them (``structure.foot_mass``)."""
-    # feet with mass (walker.leg.foot.mass_kg) carry m_foot, I_foot in the walker's own vector
-    extra = FOOT_PARAMS if structure.foot == "flat" and not structure.foot_mass else ()
-    return tuple(structure.param_names) + extra
-
-
-def contact_names(structure: Structure) -> tuple[str, ...]:
-    """Names of the contact points, in the order of the generated ``feet`` (one per leg,
-    ``leg1``, ``leg2``, for point and arc feet; ``leg1_heel``, ``leg1_toe``,
-    ``leg2_heel``, ``leg2_toe`` for flat feet; a spoked wheel's spoke tips ``spoke0``,
-    ``spoke1``, ... in the order they touch down rolling downhill)."""
-    if structure.spokes:
-        return tuple(f"spoke{k}" for k in range(structure.spokes))
-    if structure.foot == "flat":
-        return tuple(f"{leg}_{end}" for leg in LEGS for end in ("heel", "toe"))
-    return LEGS
-
-
-def check_masses(structure: Structure) -> None:
-    """Raise if a body has mass 0 (the massless limit has no floating model).
-
-    Raises
-    ------
-    ValueError
-        One line: :data:`MASSLESS_MESSAGE`.
-    """
-    light = [b.name for b in structure.bodies if b.massless]
-    if light:
-        raise ValueError(f"{MASSLESS_MESSAGE} (walker.leg.bodies: {', '.join(light)} has "
-                         "mass_kg 0)")
-
-
-@dataclass(frozen=True)
-class FloatingEquations:
-    """Symbolic floating view (all sympy; ``nq = len(q)``).
-
-    Attributes
-    ----------
-    q, dq : tuple of Symbol (nq,)
-    params : tuple of Symbol
-        :func:`param_names` order.
-    M : Matrix (nq, nq); h : Matrix (nq, 1)
-    feet : tuple of (Matrix (2, 1), Matrix (2, nq))
-        Per contact point (``contacts``): its position (an arc's lowest point) and the
-        Jacobian of the material point there.
-    kinetic, potential : Expr
-    points : dict[str, Matrix (2, 1)]
-        Named as the rigid model's: ``hip``, ``<leg>_<body>``, ``<leg>_foot`` (end of the
-        leg axis), arc feet ``<leg>_foot_centre`` and ``<leg>_contact`` (lowest point),
-        kneed ``<leg>_knee``, flat feet ``<leg>_ankle`` (= ``<leg>_foot``),
-        ``<leg>_heel``, ``<leg>_toe``.
-    knees : tuple of (int, int)
-        Per leg with a knee stop, the indices in ``q`` of its thigh and shank angles (by
-        their names); empty for straight legs and for free knees (``knee.lock: free``: no
-        stop, as in the rigid view, :mod:`walkerlab.codegen.free_joints`).
-    contacts : tuple of str
-        Names of the contact points, in the order of ``feet`` (:func:`contact_names`).
-    point_legs : tuple of int
-        Leg (0 = leg1, 1 = leg2) of each contact point.
-    stance_forces : tuple of Matrix (nq, 1)
-        Internal generalised forces that depend on which leg stands: with leg1, then with
-        leg2 in stance (a walker in 3D with hip-roll joints: Kuo 1999's law,
-        :func:`walkerlab.codegen.derive_3d.stance_forces`, the stance hip holding the
-        pelvis level and the swing hip placing its leg); empty: none.  The contact model
-        weights each by its foot's share of the normal load
-        (:mod:`walkerlab.models.contact.rhs_lines`).
-    spins : tuple of Matrix (1, nq)
-        A walker in 3D: per contact point, the Jacobian of its body's angular velocity
-        about the slope's normal (the foot's spin rate ``omega . n = Jn dq``, where the
-        contact's torsional friction acts); empty for a planar walker.
-    """
-
-    q: tuple
-    dq: tuple
-    params: tuple
-    M: object
-    h: object
-    feet: tuple
-    kinetic: object
-    potential: object
-    points: dict
-    knees: tuple = ()
-    contacts: tuple = LEGS
-    point_legs: tuple = (0, 1)
-    stance_forces: tuple = ()
-    spins: tuple = ()
 
 @cache
 def derive_floating(structure: Structure) -> FloatingEquations:
@@ -211,8 +97,8 @@ def derive_floating(structure: Structure) -> FloatingEquations:
 
     check_floating_view(structure)
     check_masses(structure)
-    if structure.in_3d:
-        return _derive_3d(structure)
+    if structure.in_3d:  # from the body trees (walkerlab.codegen.floating_3d)
+        return derive_wheel_3d(structure) if structure.spokes else derive_legs_3d(structure)
     if structure.spokes:
         return _derive_spoked(structure)
     if structure.foot not in ("point", "arc", "flat"):
@@ -476,100 +362,3 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
                              feet=tuple(feet), kinetic=T, potential=V, points=points,
                              knees=(), contacts=contacts,
                              point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
-
-
-def _derive_3d(structure: Structure) -> FloatingEquations:
-    """The floating view of a 3D straight-legged walker from its body tree
-    (:func:`walkerlab.walker.trees.legs_3d_tree`, Kuo 1999), set free at leg2's foot
-    (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y, z`` and a
-    heading, then the rigid tree's joints in its own coordinates renamed by
-    :data:`ROLES_3D`): the mass
-    matrix and potential of :func:`walkerlab.codegen.tree_derive.mass_and_potential`, the
-    bias of :func:`walkerlab.codegen.lagrange.bias`, unsimplified (common subexpressions
-    are the generated code's).  Positions in world axes (``x`` downhill, ``y`` up, ``z``
-    lateral), as a planar walker's; the feet ``leg1`` (the rigid model's swing foot) and
-    ``leg2`` (its stance foot, the root's contact); round feet's the discs' lowest points
-    with their material points' Jacobians (:func:`_disc_contact`).
-    The hip-roll law's torques act between bodies (no force on the free coordinates): the
-    view leaves them out.
-
-    Raises
-    ------
-    ValueError
-        A spoked wheel (its floating view is not yet its tree's).
-    """
-    import sympy as sp
-
-    from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
-    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
-    from walkerlab.codegen.lagrange import bias  # light
-    from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
-
-    if structure.spokes:
-        raise ValueError(NO_WHEEL_3D)
-    rigid, coords = legs_3d_tree(structure)
-    tree, fcoords = free_root(rigid, coords, FREE_3D)
-    kin = kinematics(tree, fcoords)
-    names = coordinate_names(structure)
-    q = sp.symbols(names, real=True)
-    dq = sp.symbols([f"d_{n}" for n in names], real=True)
-    rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
-    M, _, _, V = mass_and_potential(kin)
-    M, V = M.xreplace(rename), V.xreplace(rename)
-    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
-    h = bias(M, V, q, dq)
-    to_world = slope_to_world(kin.gamma)
-    feet, points = [], {}
-    if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
-        radius = dict(zip(tree.params, kin.params))["R_foot"]
-        for leg, link, centre in (("leg1", "swing_leg", kin.contacts["swing_foot_centre"]),
-                                  ("leg2", "stance_leg", kin.origins["stance_leg"])):
-            low, J = _disc_contact(kin, link, centre, radius)
-            pos = to_world * low.xreplace(rename)
-            feet.append((pos, (to_world * J).xreplace(rename)))
-            points[f"{leg}_contact"] = pos
-            points[f"{leg}_foot_centre"] = to_world * centre.xreplace(rename)
-    else:
-        for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
-            pos = to_world * kin.contacts[contact].xreplace(rename)
-            feet.append((pos, pos.jacobian(qv)))
-            points[f"{leg}_foot"] = pos
-    # each foot's spin about the slope's normal (the slope frame's y): its leg's angular
-    # velocity there, omega = R_b omega_b
-    spins = tuple((kin.rotations[link] * kin.omegas[link]).jacobian(sp.Matrix(kin.dq))[1, :]
-                  .xreplace(rename) for link in ("swing_leg", "stance_leg"))
-    points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
-    for b in structure.bodies:
-        for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
-            points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)
-    for b in structure.torso:
-        points[f"torso_{b.name}"] = to_world * kin.coms[f"torso_{b.name}"].xreplace(rename)
-    return FloatingEquations(q=tuple(q), dq=tuple(dq),
-                             params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
-                             kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
-                             points=points, contacts=LEGS, point_legs=(0, 1),
-                             stance_forces=stance_forces(structure, q, dq, kin.params,
-                                                         ROLES_3D),
-                             spins=spins)
-
-
-
-def _disc_contact(kin, body: str, centre, radius):
-    """A round foot's contact on the slope: the lowest point of the disc of ``radius``
-    about ``centre`` (3, 1) in the plane normal to ``body``'s ``z`` axis (its leg's
-    sagittal plane; McGeer 1990), ``centre - R u / |u|`` with ``u = n - (n . a) a`` the
-    slope's normal ``n`` without its part along the disc's axis ``a``, and the Jacobian
-    (3, nq) of the disc's material point there, ``v = v_centre + omega x (low - centre)``
-    (``omega`` the body's angular velocity: a disc that rolls without slip has that point
-    at rest).  Slope frame, the tree's own coordinates (``kin``:
-    :class:`walkerlab.codegen.tree_derive.TreeKinematics`)."""
-    import sympy as sp
-
-    R_b = kin.rotations[body]
-    a = R_b * sp.Matrix([0, 0, 1])
-    u = sp.Matrix([0, 1, 0]) - a[1] * a
-    low = centre - radius * u / sp.sqrt(1 - a[1] ** 2)
-    r = low - centre
-    skew = sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
-    omega = R_b * kin.omegas[body].jacobian(sp.Matrix(kin.dq))
-    return low, centre.jacobian(sp.Matrix(kin.q)) - skew * omega

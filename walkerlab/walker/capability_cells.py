@@ -93,12 +93,10 @@ HIP_ROLL_EXPORT_3D = ("the URDF carries legs rigid to the pelvis in roll so far:
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
-#: what the views of both 3D kinds refuse: a ground other than a plane, the contact model,
-#: the OpenSim export
+#: what the views of both 3D kinds refuse: a ground other than a plane, the OpenSim
+#: export
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
-    ("walk", "contact"): ("the compliant-contact model is planar: a 3D walker's is a later "
-                          "step (walk it in the rigid model: fixedpoint, simulate)"),
     ("walk", "osim"): EXPORT_3D,
 }
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
@@ -285,7 +283,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                             "ankle_push_off", "virtual_constraints")},
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)
-        **{cell: why for cell, why in _CELLS_3D.items() if cell != ("walk", "contact")},
+        **_CELLS_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.legs_3d.
@@ -300,6 +298,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "rolling_polygon_3d": {
         **_PLANAR,
         **_WHEEL_JOINTS,
+        # the compliant-contact model: a free body on its spoke tips
+        # (walkerlab.codegen.floating_3d.derive_wheel_3d)
         **_CELLS_3D,
         ("walk", "adams"): ("the Adams dataset writes legged walkers (planar, and the 3D "
                             "straight legs); a 3D spoked wheel (one rigid body) is "

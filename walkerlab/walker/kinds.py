@@ -40,8 +40,8 @@ walker's :class:`Kind`:
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
-    rigid model, the MJCF (a free body: it rolls in MuJoCo) and the URDF, so far; the
-    other views' cells say so.
+    rigid model, the compliant-contact model (a free body on its spoke tips), the MJCF (a
+    free body: it rolls in MuJoCo) and the URDF, so far; the other views' cells say so.
 
 The layers ask the kind (:func:`kind_of`, once), never the switches, and never its name:
 the kind carries its part of each layer as a word (:attr:`Kind.body`, :attr:`Kind.rigid`,
@@ -311,7 +311,7 @@ KINDS = {k.name: k for k in (
          contact="wheel", scene="configs/rimless_wheel.yaml"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
          "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d", rigid="wheel",
-         landing=None, scene="configs/rimless_wheel_3d.yaml"),
+         landing=None, contact="wheel_3d", scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", "legs_3d", landing=None, contact="legs_3d",
          scene="configs/hip_width.yaml"),

@@ -330,7 +330,7 @@ class CoordinateMap:
             _check_scalar(expr, f"coordinates.joint_angles[{c}]", known)
 
 
-def free_root(tree: BodyTree, coords: CoordinateMap, names: tuple[str, str, str, str]
+def free_root(tree: BodyTree, coords: CoordinateMap, names: tuple[str, ...]
               ) -> tuple[BodyTree, CoordinateMap]:
     """The floating view of a tree: its root's contact point set free, as Drake's
     ``MultibodyPlant`` floats a body the world does not weld (a free joint).
@@ -349,9 +349,11 @@ def free_root(tree: BodyTree, coords: CoordinateMap, names: tuple[str, str, str,
     tree : BodyTree
     coords : CoordinateMap
         The walker's coordinates of ``tree``.
-    names : tuple of 4 str
+    names : tuple of 3 or 4 str
         The free coordinates' names (slides along world ``x``, ``y``, ``z``, then the
-        heading).
+        heading); three: the slides only, for a tree whose root joint turns about the
+        slope's normal already (a spherical joint: the 3D spoked wheel's), which a heading
+        would duplicate.
 
     Returns
     -------
@@ -362,8 +364,12 @@ def free_root(tree: BodyTree, coords: CoordinateMap, names: tuple[str, str, str,
     Raises
     ------
     ValueError
-        A name already a body, coordinate or parameter of the tree (from the validation).
+        ``names`` not 3 or 4 names; a name already a body, coordinate or parameter of the
+        tree (from the validation).
     """
+    if len(names) not in (3, 4):
+        raise ValueError(f"free_root: names: the slides and optionally a heading (3 or 4 "
+                         f"names), got {len(names)}")
     gamma = tree.root.slope_rad      # world x and y in the slope's frame (s, n, z)
     c, s = (f"cos({gamma})", f"sin({gamma})") if isinstance(gamma, str) else (
         math.cos(gamma), math.sin(gamma))

@@ -72,16 +72,18 @@ def _legs_from_points(walker, res: ContactResult, stance, legs) -> tuple[dict, d
     """
     t, X = res.t, np.ascontiguousarray(np.atleast_2d(res.x), dtype=float)
     st_pt, sw_pt = _stance_points(walker, res, t)
-    nf, n = len(walker.contact_names()), walker.nq
-    P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
-    pos, vel = np.empty((t.size, nf, 2)), np.empty((t.size, nf, 2))
+    nf, n, d = len(walker.contact_names()), walker.nq, walker.dim
+    P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, n))
+    pos, vel = np.empty((t.size, nf, d)), np.empty((t.size, nf, d))
     for r in range(t.size):
         walker.kernels.feet(X[r], walker.walker_params, P, V, J)
         pos[r], vel[r] = P, V
     col = dict(zip(walker.state_names(), X.T))
+    rows = np.arange(t.size)
+    if d == 3:  # in 3D the spokes' angles in the wheel's plane, as the rigid view's
+        return _spoke_angles(col, pos, rows, stance, st_pt, sw_pt, legs)
     hip = np.vstack([col[state_name(c)] for c in ("hip_x", "hip_y")])
     hip_v = np.vstack([col[state_name(c, rate=True)] for c in ("hip_x", "hip_y")])
-    rows = np.arange(t.size)
     coords, feet = {}, {}
     for i, leg in enumerate(legs):
         pt = np.where(stance == i, st_pt, sw_pt)
@@ -90,6 +92,23 @@ def _legs_from_points(walker, res: ContactResult, stance, legs) -> tuple[dict, d
         coords[f"{leg}_angle"] = np.arctan2(dx, -dy)
         coords[f"{leg}_rate"] = (dx * dvy - dy * dvx) / (dx ** 2 + dy ** 2)
         feet[f"{leg}_foot"] = foot
+    return coords, feet
+
+
+def _spoke_angles(col, pos, rows, stance, st_pt, sw_pt, legs) -> tuple[dict, dict]:
+    """:func:`_legs_from_points` of a spoked wheel in 3D: each leg's angle that of its
+    spoke in the wheel's plane from the downward vertical (the rigid view's ``stance``,
+    ``swing``; :mod:`walkerlab.codegen.derive_3d`), spoke ``k``'s the wheel's angle (spoke
+    0's, ``wheel_angle``) plus ``2 pi k / n``, its rate the wheel's; ``pos`` the
+    spoke tips (n samples, nf, 3) [m], ``col`` the states by name."""
+    nf = pos.shape[1]
+    theta, rate = col[state_name("wheel_angle")], col[state_name("wheel_angle", rate=True)]
+    coords, feet = {}, {}
+    for i, leg in enumerate(legs):
+        pt = np.where(stance == i, st_pt, sw_pt)
+        coords[f"{leg}_angle"] = theta + 2.0 * np.pi * pt / nf
+        coords[f"{leg}_rate"] = rate.copy()
+        feet[f"{leg}_foot"] = pos[rows, pt].T
     return coords, feet
 
 

@@ -246,6 +246,45 @@ class RollingPolygonPart(ContactPart):
         return None
 
 
+class RollingPolygon3DPart(RollingPolygonPart):
+    """A rimless (spoked) wheel in 3D (Coleman, Chatterjee & Ruina 1997): one rigid body on
+    its spokes' tips, free at spoke 0's tip (three slides along the world's axes,
+    :data:`walkerlab.codegen.floating_equations.FREE_WHEEL_3D`), then the rigid tree's
+    heading, lean and spin (:data:`~walkerlab.codegen.floating_equations.
+    WHEEL_3D_COORDINATES`): the rigid state is the floating one with the slides at rest.
+    Its checks are the planar wheel's (a regularising hub inertia for a point-mass hub,
+    continuous ground, no contact periodic gait)."""
+
+    def link_state(self, walker, x, rate_scale) -> np.ndarray:
+        """``[heading, lean, wheel angle, their rates]`` of the rigid state ``x`` (``[heading,
+        lean, stance, their rates]``, the tree's own coordinates: spoke 0 the stance
+        spoke), every rate by the stance scale (one body: its rotation as a whole)."""
+        x = np.asarray(x, float)
+        n = len(walker.structure.roles)
+        return np.concatenate([x[:n], x[n:2 * n] * rate_scale[1]])
+
+    def step_length(self, walker, x_ideal, along_slope: bool) -> float:
+        """The chord between the stance spoke's tip and the trailing one's at the heel
+        strike (the rigid state ``x_ideal``, both on the ground), along the slope's fall
+        line (2 L sin(alpha) for the wheel rolling straight downhill)."""
+        x = self._chord_state(walker, x_ideal)
+        P = self._tips(walker, x)
+        return abs(float((P[0] - P[-1]) @ walker.tangent))
+
+    @staticmethod
+    def _chord_state(walker, x_ideal) -> np.ndarray:
+        z = walker.link_state_from_ideal(x_ideal)
+        return walker.pinned_to_full(z, np.zeros(walker.dim))
+
+    @staticmethod
+    def _tips(walker, x) -> np.ndarray:
+        """The spoke tips (nf, d) [m] of the state ``x``."""
+        nf, n, d = len(walker.contact_names()), walker.nq, walker.dim
+        P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, n))
+        walker.kernels.feet(np.asarray(x, float), walker.walker_params, P, V, J)
+        return P
+
+
 class Legs3DPart(ContactPart):
     """Straight legs in 3D (Kuo 1999): the floating base at leg2's foot (three slides along
     the world's axes and the heading, :data:`walkerlab.codegen.floating_equations.FREE_3D`),
@@ -306,6 +345,7 @@ PARTS: dict[str, ContactPart] = {
     "three_link": HingedTorsoPart(),
     "wheel": RollingPolygonPart(),
     "legs_3d": Legs3DPart(),
+    "wheel_3d": RollingPolygon3DPart(),
 }
 
 

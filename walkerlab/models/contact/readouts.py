@@ -103,27 +103,32 @@ class ContactReadouts:
     def fall_how(self, x) -> str:
         """How a walker in 3D went down, from its last state ``x`` (2 nq,): capsized
         sideways (its hip farther from the stance foot across the slope than along it) or
-        fell along the slope, with the hip's offset [m] and its lean from the normal [deg];
-        the stance foot the one pressed deeper.  ``""`` for a planar walker (its falls have
-        one plane)."""
+        fell along the slope, with the hip's (a wheel's hub's) offset [m] and its lean from
+        the normal [deg]; the stance foot the contact point pressed deepest (a leg's foot
+        point or its arc's lowest point, a wheel's spoke tip).  ``""`` for a planar walker
+        (its falls have one plane)."""
         if self.dim == 2:
             return ""
         X = self._rows(x)[-1:]
         hip = np.asarray(self.points(X)["hip"], float).reshape(3, -1)[:, -1]
-        feet = self.foot_positions(X)
+        nf, n = len(self._contacts), self.nq
+        P, V, J = np.empty((nf, 3)), np.empty((nf, 3)), np.empty((nf, 3, n))
+        self.kernels.feet(X[0], self.walker_params, P, V, J)
         pen = [float(self.contact_quantities(X)[c]["penetration"][0])
                for c in self.contact_names()]
-        foot = feet[self._point_legs[int(np.argmax(pen))]]
-        rel = hip - foot
+        rel = hip - P[int(np.argmax(pen))]
+        # a wheel's (its contact points are its feet) hip is its hub, its stance foot a tip
+        hub = contact_part(self.structure).per_point_feet
+        hip_word, foot_word = ("hub", "stance spoke's tip") if hub else ("hip", "stance foot")
         side, along = float(rel[2]), float(rel @ self.tangent)
         lean = math.degrees(math.atan2(math.hypot(side, along), float(rel @ self.normal)))
         if abs(side) > abs(along):
-            return (f"capsized sideways: the hip {abs(side):.3f} m to the "
-                    f"{'right' if side > 0 else 'left'} of the stance foot, {lean:.0f} deg "
+            return (f"capsized sideways: the {hip_word} {abs(side):.3f} m to the "
+                    f"{'right' if side > 0 else 'left'} of the {foot_word}, {lean:.0f} deg "
                     "from the slope's normal")
-        return (f"fell {'forward' if along > 0 else 'backward'}: the hip {abs(along):.3f} m "
-                f"{'ahead of' if along > 0 else 'behind'} the stance foot, {lean:.0f} deg "
-                "from the slope's normal")
+        return (f"fell {'forward' if along > 0 else 'backward'}: the {hip_word} "
+                f"{abs(along):.3f} m {'ahead of' if along > 0 else 'behind'} the {foot_word}, "
+                f"{lean:.0f} deg from the slope's normal")
 
     def fall_margin(self, x, threshold: float) -> float:
         """The one fall test: hip height of state ``x`` minus ``threshold`` [m]

@@ -10,11 +10,13 @@ __all__ = ["FOOT_NAMES", "STATE_OF_COORDINATE", "state_name"]
 FOOT_NAMES = ("leg1", "leg2")
 
 
-#: A walker in 3D: its floating base's coordinates (leg2's foot, the heading) and rolls ->
-#: their state names (their rates: ``v`` before a position, ``d`` before an angle).
+#: A walker in 3D: its floating base's coordinates (leg2's foot, the heading; a spoked
+#: wheel's spoke 0 tip) and rolls (a wheel's lean) -> their state names (their rates: ``v``
+#: before a position, ``d`` before an angle).
 STATE_3D = {"leg2_foot_x": "foot2_x", "leg2_foot_y": "foot2_y", "leg2_foot_z": "foot2_z",
             "heading": "heading", "leg1_roll": "phi1", "leg2_roll": "phi2",
-            "pelvis_roll": "phi_pelvis"}
+            "pelvis_roll": "phi_pelvis", "spoke0_foot_x": "spoke0_x",
+            "spoke0_foot_y": "spoke0_y", "spoke0_foot_z": "spoke0_z", "lean": "lean"}
 
 
 def state_name(coordinate: str, rate: bool = False) -> str:
@@ -23,7 +25,7 @@ def state_name(coordinate: str, rate: bool = False) -> str:
         return ("v" if rate else "") + coordinate
     if coordinate in STATE_3D:
         name = STATE_3D[coordinate]
-        return (("v" if name.startswith("foot") else "d") if rate else "") + name
+        return (("v" if name.endswith(("_x", "_y", "_z")) else "d") if rate else "") + name
     if coordinate == "torso_angle":  # a hinged torso (five-link biped)
         return ("d" if rate else "") + "theta_torso"
     if coordinate == "wheel_angle":  # a spoked wheel: spoke 0's angle

@@ -1,0 +1,195 @@
+"""The floating views of walkers in three dimensions, derived (sympy) from their body trees
+(:mod:`walkerlab.walker.trees`) set free on the ground by
+:func:`walkerlab.walker.tree.free_root`: the straight-legged walker (Kuo 1999;
+:func:`derive_legs_3d`) and the spoked wheel (Coleman, Chatterjee & Ruina 1997;
+:func:`derive_wheel_3d`).  Their
+:class:`~walkerlab.codegen.floating_equations.FloatingEquations` are a planar walker's with
+points of three components in world axes (``x`` downhill, ``y`` up, ``z`` lateral) and, per
+contact point, the Jacobian of its body's spin about the slope's normal (``spins``, where
+the contact's torsional friction acts); the generated contact module
+(:mod:`walkerlab.models.contact.generated`) reads the dimension from the points.
+
+Both share one derivation (:func:`_free_flow`): the tree with its free joints ahead of its
+own, its kinematics (:func:`walkerlab.codegen.tree_derive.kinematics`), the mass matrix and
+potential of :func:`walkerlab.codegen.tree_derive.mass_and_potential` and the bias
+``h = d(M dq)/dq dq - dT/dq + dV/dq`` of :func:`walkerlab.codegen.lagrange.bias`,
+unsimplified (common subexpressions are the generated code's).
+"""
+
+from __future__ import annotations
+
+from walkerlab.codegen.floating_names import (
+    FREE_3D,
+    FREE_WHEEL_3D,
+    LEGS,
+    ROLES_3D,
+    FloatingEquations,
+    contact_names,
+    coordinate_names,
+)
+from walkerlab.walker.description import Structure
+from walkerlab.walker.tree import free_root
+from walkerlab.walker.trees import legs_3d_tree, spoked_wheel_3d_tree
+
+__all__ = ["derive_legs_3d", "derive_wheel_3d", "wheel_tip_names"]
+
+
+def _free_flow(structure: Structure, rigid, coords, free: tuple):
+    """The floating tree of ``rigid`` (its map ``coords``) with the free joints ``free``
+    (:func:`walkerlab.walker.tree.free_root`), its kinematics and the flow in the floating
+    view's coordinates (:func:`walkerlab.codegen.floating_equations.coordinate_names`):
+    ``(tree, kin, q, dq, rename, M, V, h)``, ``rename`` the kinematics' symbols to ``q``,
+    ``dq``."""
+    import sympy as sp
+
+    from walkerlab.codegen.lagrange import bias  # light: sympy on first use
+    from walkerlab.codegen.tree_derive import kinematics, mass_and_potential  # light
+
+    tree, fcoords = free_root(rigid, coords, free)
+    kin = kinematics(tree, fcoords)
+    names = coordinate_names(structure)
+    q = sp.symbols(names, real=True)
+    dq = sp.symbols([f"d_{n}" for n in names], real=True)
+    rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
+    M, _, _, V = mass_and_potential(kin)
+    M, V = M.xreplace(rename), V.xreplace(rename)
+    return tree, kin, q, dq, rename, M, V, bias(M, V, q, dq)
+
+
+def _spin(kin, body: str, rename):
+    """The Jacobian (1, nq) of ``body``'s angular velocity about the slope's normal (the
+    slope frame's ``y``): ``omega = R_b omega_b``."""
+    import sympy as sp
+
+    return ((kin.rotations[body] * kin.omegas[body]).jacobian(sp.Matrix(kin.dq))[1, :]
+            .xreplace(rename))
+
+
+def derive_legs_3d(structure: Structure) -> FloatingEquations:
+    """The floating view of a 3D straight-legged walker from its body tree
+    (:func:`walkerlab.walker.trees.legs_3d_tree`, Kuo 1999), set free at leg2's foot
+    (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y, z`` and a
+    heading, :data:`~walkerlab.codegen.floating_equations.FREE_3D`, then the rigid tree's
+    joints in its own coordinates renamed by
+    :data:`~walkerlab.codegen.floating_equations.ROLES_3D`).  The feet ``leg1`` (the rigid
+    model's swing foot) and ``leg2`` (its stance foot, the root's contact); round feet's the
+    discs' lowest points with their material points' Jacobians (:func:`_disc_contact`).
+    The hip-roll law's torques act between bodies (no force on the free coordinates): the
+    view leaves them out of the flow (they are ``stance_forces``).
+    """
+    import sympy as sp
+
+    from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
+    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
+
+    rigid, coords = legs_3d_tree(structure)
+    tree, kin, q, dq, rename, M, V, h = _free_flow(structure, rigid, coords, FREE_3D)
+    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    to_world = slope_to_world(kin.gamma)
+    feet, points = [], {}
+    if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
+        radius = dict(zip(tree.params, kin.params))["R_foot"]
+        for leg, link, centre in (("leg1", "swing_leg", kin.contacts["swing_foot_centre"]),
+                                  ("leg2", "stance_leg", kin.origins["stance_leg"])):
+            low, J = _disc_contact(kin, link, centre, radius)
+            pos = to_world * low.xreplace(rename)
+            feet.append((pos, (to_world * J).xreplace(rename)))
+            points[f"{leg}_contact"] = pos
+            points[f"{leg}_foot_centre"] = to_world * centre.xreplace(rename)
+    else:
+        for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
+            pos = to_world * kin.contacts[contact].xreplace(rename)
+            feet.append((pos, pos.jacobian(qv)))
+            points[f"{leg}_foot"] = pos
+    # each foot's spin about the slope's normal: its leg's angular velocity there
+    spins = tuple(_spin(kin, link, rename) for link in ("swing_leg", "stance_leg"))
+    points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
+    for b in structure.bodies:
+        for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
+            points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)
+    for b in structure.torso:
+        points[f"torso_{b.name}"] = to_world * kin.coms[f"torso_{b.name}"].xreplace(rename)
+    return FloatingEquations(q=tuple(q), dq=tuple(dq),
+                             params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
+                             kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
+                             points=points, contacts=LEGS, point_legs=(0, 1),
+                             stance_forces=stance_forces(structure, q, dq, kin.params,
+                                                         ROLES_3D),
+                             spins=spins)
+
+
+def wheel_tip_names(spokes: int) -> tuple[str, ...]:
+    """The contact points of :func:`walkerlab.walker.trees.spoked_wheel_3d_tree` that are
+    spoke ``0, 1, ..., spokes - 1``'s tips (spoke ``k`` is ``k`` spokes ahead of spoke 0, the
+    tree's stance spoke): ``stance_foot``, ``next_foot``, ``spoke2_foot``, ...,
+    ``trailing_foot``."""
+    inner = tuple(f"spoke{k}_foot" for k in range(2, spokes - 1))
+    return ("stance_foot", "next_foot") + inner + ("trailing_foot",)
+
+
+def derive_wheel_3d(structure: Structure) -> FloatingEquations:
+    """The floating view of a spoked wheel in 3D from its body tree
+    (:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`; Coleman, Chatterjee & Ruina 1997):
+    one body, the hub (mass ``M_hub`` at its centre, inertia ``diag(I_diam, I_diam, I_hub)``
+    in the wheel's frame, ``z`` its axle) with ``n`` massless spokes of length ``L``, on a
+    spherical joint at spoke 0's tip (heading, lean, spin); set free there by three slides
+    along the world's axes (:func:`walkerlab.walker.tree.free_root` with
+    :data:`~walkerlab.codegen.floating_equations.FREE_WHEEL_3D`: no heading of its own, the
+    tree's joint turns about the slope's normal already).  ``q = [spoke0_foot_x,
+    spoke0_foot_y, spoke0_foot_z, heading, lean, wheel_angle]``
+    (:data:`~walkerlab.codegen.floating_equations.WHEEL_3D_COORDINATES`), the wheel's angle
+    spoke 0's from the downward vertical in its plane (the rigid tree's ``stance``).
+
+    Every spoke tip is a contact point, ``spoke<k>`` (:func:`contact_names`: spoke ``k``
+    ``k`` spokes ahead of spoke 0, so rolling downhill they touch down in the order 0, 1,
+    2, ..., as the planar wheel's, :func:`walkerlab.codegen.floating_equations.
+    _derive_spoked`), each a material point of the wheel (its Jacobian the position's),
+    each with the wheel's spin about the slope's normal (``spins``); the points ``hip`` (the
+    hub) and ``spoke<k>_foot``.  Upright (heading and lean 0) the sagittal rows are the
+    planar wheel's.  The contact points alternate between the legs' lanes as the planar
+    wheel's (spoke ``k`` on leg2's for even ``k``).
+    """
+    import sympy as sp
+
+    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
+
+    rigid, coords = spoked_wheel_3d_tree(structure.spokes)
+    _, kin, q, dq, rename, M, V, h = _free_flow(structure, rigid, coords, FREE_WHEEL_3D)
+    if tuple(str(p) for p in kin.params) != tuple(structure.param_names):
+        raise ValueError("floating_3d.derive_wheel_3d: the wheel tree's parameters are not "
+                         "the walker's, in order")  # floating_params' vector is the walker's
+    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    to_world = slope_to_world(kin.gamma)
+    feet, points = [], {"hip": to_world * kin.coms["wheel"].xreplace(rename)}
+    for k, tip in enumerate(wheel_tip_names(structure.spokes)):
+        pos = to_world * kin.contacts[tip].xreplace(rename)
+        feet.append((pos, pos.jacobian(qv)))
+        points[f"spoke{k}_foot"] = pos
+    contacts = contact_names(structure)
+    return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(kin.params), M=M, h=h,
+                             feet=tuple(feet),
+                             kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
+                             points=points, contacts=contacts,
+                             point_legs=tuple((k + 1) % 2 for k in range(len(contacts))),
+                             spins=(_spin(kin, "wheel", rename),) * len(contacts))
+
+
+def _disc_contact(kin, body: str, centre, radius):
+    """A round foot's contact on the slope: the lowest point of the disc of ``radius``
+    about ``centre`` (3, 1) in the plane normal to ``body``'s ``z`` axis (its leg's
+    sagittal plane; McGeer 1990), ``centre - R u / |u|`` with ``u = n - (n . a) a`` the
+    slope's normal ``n`` without its part along the disc's axis ``a``, and the Jacobian
+    (3, nq) of the disc's material point there, ``v = v_centre + omega x (low - centre)``
+    (``omega`` the body's angular velocity: a disc that rolls without slip has that point
+    at rest).  Slope frame, the tree's own coordinates (``kin``:
+    :class:`walkerlab.codegen.tree_derive.TreeKinematics`)."""
+    import sympy as sp
+
+    R_b = kin.rotations[body]
+    a = R_b * sp.Matrix([0, 0, 1])
+    u = sp.Matrix([0, 1, 0]) - a[1] * a
+    low = centre - radius * u / sp.sqrt(1 - a[1] ** 2)
+    r = low - centre
+    skew = sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+    omega = R_b * kin.omegas[body].jacobian(sp.Matrix(kin.dq))
+    return low, centre.jacobian(sp.Matrix(kin.q)) - skew * omega
