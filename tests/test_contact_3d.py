@@ -372,9 +372,9 @@ def test_the_3d_disc_wheel_rolls_in_contact_at_the_rigid_step_period(tmp_path, a
     and a variant on 0.25 rad: 5 strides of the contact run are >= 10 spoke touchdowns,
     and the last four steps' mean period is the rigid gait's ``step_period`` within 1 %
     (measured -0.028 % at 0.2 rad, -0.097 % at 0.25 rad)."""
-    import h5py
-
     from pathlib import Path
+
+    import h5py
 
     text = Path("configs/rimless_wheel_3d_disc.yaml").read_text()
     if angle_rad != 0.2:  # the rigid gait's guess follows the slope: alpha - slope
