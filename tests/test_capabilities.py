@@ -386,13 +386,13 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
 
 
 @pytest.mark.parametrize("name", ["paper_3d", "hip_width", "rimless_wheel_3d"])
-@pytest.mark.parametrize("stage", ["contact-sim", "compare", "optimize", "robustness"])
+@pytest.mark.parametrize("stage", ["optimize", "robustness"])
 def test_a_stage_a_3d_walker_does_not_take_is_refused_before_any_work(tmp_path, name, stage):
     """Every pipeline stage a 3D kind does not take - its view's cell
-    (:data:`walkerlab.walker.kinds.STAGE_VIEWS`: compare reads the contact walk) or its
-    study's (:data:`~walkerlab.walker.kinds.STAGE_CELLS`) - is refused in one line naming
-    walker.space before any upstream stage runs (compare ran the fixed point first), and
-    nothing is written."""
+    (:data:`walkerlab.walker.kinds.STAGE_VIEWS`) or its study's
+    (:data:`~walkerlab.walker.kinds.STAGE_CELLS`) - is refused in one line naming
+    walker.space before any upstream stage runs, and nothing is written.  (contact-sim and
+    compare take both 3D kinds: tests/test_contact_3d.py.)"""
     from walkerlab.config import load_scene
     from walkerlab.stages import pipeline
     from walkerlab.stages.common import StageError
@@ -403,11 +403,11 @@ def test_a_stage_a_3d_walker_does_not_take_is_refused_before_any_work(tmp_path, 
     assert not any(tmp_path.iterdir())
 
 
-def test_a_3d_walkers_contact_work_precision_is_refused_before_the_gait(tmp_path):
-    """``workprecision`` with its contact model on a 3D walker: refused by the stage's check
-    (the table's contact cell) in one line naming both fields, before the fixed point
-    upstream runs (it ran first, then failed); without a ``workprecision`` section the
-    same check says so at once."""
+def test_a_3d_walkers_work_precision_without_its_section_is_refused_at_once(tmp_path):
+    """``workprecision`` on a 3D walker without a ``workprecision`` section: the stage's
+    check says so in one line before the fixed point upstream runs (it ran first, then
+    failed), nothing written.  (Its contact model takes the 3D walkers since they have a
+    contact view.)"""
     import yaml
 
     from walkerlab.config import scene_from_dict
@@ -416,8 +416,5 @@ def test_a_3d_walkers_contact_work_precision_is_refused_before_the_gait(tmp_path
 
     raw = yaml.safe_load((ROOT / "configs" / "paper_3d.yaml").read_text())
     with pytest.raises(StageError, match="has no 'workprecision' section"):
-        pipeline.run("workprecision", scene_from_dict(raw), tmp_path)
-    raw.update(workprecision={"models": ["ideal", "contact"]}, contact={})
-    with pytest.raises(StageError, match=r"^workprecision\.models: contact: walker\.space: 3d"):
         pipeline.run("workprecision", scene_from_dict(raw), tmp_path)
     assert not any(tmp_path.iterdir())

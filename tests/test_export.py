@@ -505,15 +505,15 @@ def test_a_format_is_one_writer_in_the_registry(tmp_path, monkeypatch):
         return writers.Written(((w.file, f"{job.name} {job.kind.name}"),), ("a: b",), 1.5)
 
     monkeypatch.setitem(writers.WRITERS, "txt", writers.Writer("txt", "walker.txt",
-                                                               "adams", write))
+                                                               "osim", write))
     out = export_stage.write(load_scene(ROOT / "configs" / "paper.yaml"), tmp_path, "txt")
     assert out.path == tmp_path / "paper" / "walker.txt"
     assert out.path.read_text() == "paper straight_legs"
     assert (out.left_out, out.step_period_s) == (("a: b",), 1.5)
-    with pytest.raises(ValueError) as exc:  # the adams column refuses the 3D walker
+    with pytest.raises(ValueError) as exc:  # the osim column refuses the 3D walker
         export_stage.write(load_scene(ROOT / "configs" / "paper_3d.yaml"), tmp_path, "txt")
     assert str(exc.value) == ("walker.space: 3d: "
-                              + KINDS["straight_legs_3d"].cell("walk", "adams"))
+                              + KINDS["straight_legs_3d"].cell("walk", "osim"))
 
 
 def test_mjcf_options_are_refused_for_either_spoked_wheel_in_one_line(tmp_path):

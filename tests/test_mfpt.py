@@ -527,9 +527,10 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
 
 
 def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):
-    """``mfpt.model: contact`` walks the compliant-contact walker, which a 3D walker does not
-    have (the table's contact cell): refused in one line naming both fields before the gait
-    is searched, nothing written."""
+    """``mfpt.model: contact`` walks the compliant-contact walker from its own periodic
+    gait, which the contact view does not find for a 3D walker (its mirrored step map is a
+    later step): refused in one line naming both fields before the gait is searched,
+    nothing written."""
     from walkerlab.config import scene_from_dict
     from walkerlab.stages import pipeline
     from walkerlab.stages.common import StageError
@@ -537,6 +538,8 @@ def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):
     raw = yaml.safe_load((ROOT / "configs" / "paper_3d.yaml").read_text())
     raw["mfpt"] = {"model": "contact", "method": "montecarlo"}
 
-    with pytest.raises(StageError, match=r"^mfpt\.model: contact: walker\.space: 3d: "):
+    with pytest.raises(StageError, match=r"^mfpt\.model: contact: contact_sim\.start / "
+                                         r"periodic_gait: the contact periodic gait of a "
+                                         r"walker in 3D"):
         pipeline.run("mfpt", scene_from_dict(raw), tmp_path)
     assert not any(tmp_path.iterdir())

@@ -37,18 +37,25 @@ def check(scene: Scene, sigma_rad: list[float] | None = None, method: str | None
     """``(MfptSettings, workers)`` with the command-line overrides, checked before anything
     runs (:func:`walkerlab.config.options.mfpt_options`).  Raises StageError: no
     ``fixedpoint`` section, or ``mfpt.model: contact`` for a walker without a contact view
-    (a 3D walker); SceneError: an option out of bounds (one line)."""
+    or whose contact periodic gait the contact view does not find (a 3D walker, a rimless
+    wheel); SceneError: an option out of bounds (one line)."""
     require(scene, "fixedpoint", "mfpt")
     st, workers = mfpt_options(scene, sigma_rad, method, workers)
     if st.model == "contact":  # the contact walker's Monte Carlo: the table's contact cell
+        from walkerlab.models.contact.parts import periodic_gait_refusal  # light
         from walkerlab.walker.kinds import KindRefused  # light
         from walkerlab.walker.plant import Plant  # light
 
-        kind = Plant.from_scene(scene).kind
+        plant = Plant.from_scene(scene)
+        kind = plant.kind
         try:
             kind.require("walk", "contact", f"mfpt.model: contact: {kind.field}")
         except KindRefused as exc:
             raise StageError(str(exc)) from None
+        # its walks start on the contact model's own periodic gait
+        why = periodic_gait_refusal(scene, plant.data)
+        if why is not None:
+            raise StageError(f"mfpt.model: contact: {why}")
     return st, workers
 
 

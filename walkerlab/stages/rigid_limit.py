@@ -70,13 +70,10 @@ def _periodic_gait_taken(scene: Scene) -> None:
     ------
     StageError
     """
-    from walkerlab.config.contact_sim import ContactSimSettings
-    from walkerlab.models.contact.parts import contact_part
+    from walkerlab.models.contact.parts import periodic_gait_refusal  # light
     from walkerlab.walker.plant import Plant  # light
 
-    data = Plant.from_scene(scene).data
-    cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"periodic_gait": True})
-    why = contact_part(data.structure).check(scene, data, cs)
+    why = periodic_gait_refusal(scene, Plant.from_scene(scene).data)
     if why is not None:
         raise StageError(f"compare --rigid-limit (the contact periodic gait at each "
                          f"stiffness): scene '{scene.name}': {why}")

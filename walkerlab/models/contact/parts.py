@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PARTS", "ContactPart", "contact_part"]
+__all__ = ["PARTS", "ContactPart", "contact_part", "periodic_gait_refusal"]
 
 
 class ContactPart:
@@ -347,6 +347,18 @@ PARTS: dict[str, ContactPart] = {
     "legs_3d": Legs3DPart(),
     "wheel_3d": RollingPolygon3DPart(),
 }
+
+
+def periodic_gait_refusal(scene, data) -> str | None:
+    """Why the contact view does not find the contact periodic gait of ``scene``'s walker
+    (``data``: its WalkerData) - the mid-stance step map that ``contact-sim --periodic``,
+    ``compare --rigid-limit`` and ``mfpt.model: contact`` run on -, in one line without the
+    scene's name (the kind's part's :meth:`ContactPart.check` with the periodic gait asked
+    for: a walker in 3D, a rimless wheel), or None."""
+    from walkerlab.config.contact_sim import ContactSimSettings  # light
+
+    cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"periodic_gait": True})
+    return contact_part(data.structure).check(scene, data, cs)
 
 
 def contact_part(structure) -> ContactPart:
