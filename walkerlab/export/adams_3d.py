@@ -113,9 +113,10 @@ _COUPLER = 1
 
 
 def reuler_angles(R) -> tuple[float, float, float]:
-    """Body-fixed 3-1-3 angles ``(a, b, c)`` [rad] of the rotation ``R`` (3, 3):
-    ``R = Rz(a) Rx(b) Rz(c)`` (Adams ``REULER``; :func:`walkerlab.export.adams_reader.
-    reuler_matrix` is its inverse).  At ``b = 0`` (or pi) the turn is ``a`` alone."""
+    """Body-fixed 3-1-3 angles ``(a, b, c)`` [rad] of the rotation ``R`` (3, 3), with
+    ``R = Rz(a) Rx(b) Rz(c)`` (Adams ``REULER``; the reader's ``reuler_matrix``,
+    :mod:`walkerlab.export.adams_reader`, is its inverse).  At ``b = 0`` (or pi) the turn
+    is ``a`` alone."""
     R = np.asarray(R, float)
     b = math.acos(max(-1.0, min(1.0, R[2, 2])))
     if math.hypot(R[0, 2], R[1, 2]) < 1e-12:

@@ -250,8 +250,9 @@ class RollingPolygon3DPart(RollingPolygonPart):
     """A rimless (spoked) wheel in 3D (Coleman, Chatterjee & Ruina 1997): one rigid body on
     its spokes' tips, free at spoke 0's tip (three slides along the world's axes,
     :data:`walkerlab.codegen.floating_equations.FREE_WHEEL_3D`), then the rigid tree's
-    heading, lean and spin (:data:`~walkerlab.codegen.floating_equations.
-    WHEEL_3D_COORDINATES`): the rigid state is the floating one with the slides at rest.
+    heading, lean and spin
+    (:data:`~walkerlab.codegen.floating_equations.WHEEL_3D_COORDINATES`): the rigid state
+    is the floating one with the slides at rest.
     Its checks are the planar wheel's (a regularising hub inertia for a point-mass hub,
     continuous ground, no contact periodic gait)."""
 
@@ -288,9 +289,10 @@ class RollingPolygon3DPart(RollingPolygonPart):
 class Legs3DPart(ContactPart):
     """Straight legs in 3D (Kuo 1999): the floating base at leg2's foot (three slides along
     the world's axes and the heading, :data:`walkerlab.codegen.floating_equations.FREE_3D`),
-    then the rigid roles' own coordinates (:data:`~walkerlab.codegen.floating_equations.
-    ROLES_3D`: the stance leg's roll and pitch, the swing leg's pitch, the pelvis' and the
-    swing leg's rolls), so the rigid state is the floating one with the base at rest."""
+    then the rigid roles' own coordinates
+    (:data:`~walkerlab.codegen.floating_equations.ROLES_3D`: the stance leg's roll and
+    pitch, the swing leg's pitch, the pelvis' and the swing leg's rolls), so the rigid
+    state is the floating one with the base at rest."""
 
     plain = False
 
@@ -350,11 +352,12 @@ PARTS: dict[str, ContactPart] = {
 
 
 def periodic_gait_refusal(scene, data) -> str | None:
-    """Why the contact view does not find the contact periodic gait of ``scene``'s walker
-    (``data``: its WalkerData) - the mid-stance step map that ``contact-sim --periodic``,
-    ``compare --rigid-limit`` and ``mfpt.model: contact`` run on -, in one line without the
-    scene's name (the kind's part's :meth:`ContactPart.check` with the periodic gait asked
-    for: a walker in 3D, a rimless wheel), or None."""
+    """Why the contact view does not find the contact periodic gait of the scene's walker,
+    in one line without the scene's name, or None: the kind's part's
+    :meth:`ContactPart.check` with the periodic gait asked for (a walker in 3D, a rimless
+    wheel).  ``data`` is the walker's WalkerData; the gait is the mid-stance step map's
+    that ``contact-sim --periodic``, ``compare --rigid-limit`` and ``mfpt.model: contact``
+    run on."""
     from walkerlab.config.contact_sim import ContactSimSettings  # light
 
     cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"periodic_gait": True})
