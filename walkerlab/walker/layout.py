@@ -289,7 +289,3 @@ class StateIndex:
         """Column of the rate of coordinate state ``name``."""
         return self._col[self.layout.rate_of(name)]
 
-    def hip_velocity(self, X) -> np.ndarray:
-        """Hip velocity (n, 2) [m/s] of states X (n, N): the rates of ``hip_x``, ``hip_y``."""
-        X = np.atleast_2d(X)
-        return X[:, [self.rate_of("hip_x"), self.rate_of("hip_y")]]
