@@ -72,7 +72,9 @@ The module's functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.float
 ``rhs(x, PC, p, c1, c2)``                dx/dt (NX,) (``assembly.point``, ``knee_torque``)
 ``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX), patch membership locally
                                          constant (``assembly.contact_forces``,
-                                         ``jac_assembly``)
+                                         ``jac_assembly``); a walker in 3D: the
+                                         torsional friction held constant, a hip-roll
+                                         law left out (Newton directions only)
 ``rhs_pinned(z, PC, p, c1, c2, foot2)``  leg2's point PIN held at ``foot2``:
                                          ``z = [link angles, their rates]`` -> dz/dt
                                          (``assembly.pinned_dynamics``)
