@@ -413,3 +413,20 @@ def test_the_unstable_3d_wheel_capsizes_sideways_in_contact():
     assert len(res.heel_strike_times) <= 4
     how = walker.fall_how(res.x[-1])
     assert how.startswith("capsized sideways: the hub") and "stance spoke's tip" in how
+
+
+def test_a_3d_walkers_pinned_start_and_contact_periodic_gait_are_refused_in_one_line():
+    """The pinned start phase (planar walkers': it holds the stance foot's slides, not its
+    turn, and carries no hip-roll law) and the contact periodic gait (its mirrored step map
+    is a later step) are refused by the scene check, before any model is built."""
+    from walkerlab.config.contact_sim import ContactSimSettings
+    from walkerlab.models.contact.scene import ContactSceneError
+
+    scene = load_scene("configs/hip_width_stabilised.yaml")
+    plant = Plant.from_scene(scene)
+    for update, field in (({"pin_stance_until": "first_touchdown"}, "pin_stance_until"),
+                          ({"periodic_gait": True}, "periodic_gait")):
+        bad = scene.model_copy(update={"contact_sim": ContactSimSettings(**update)})
+        with pytest.raises(ContactSceneError, match=field) as exc:
+            contact_setup(bad, plant=plant)
+        assert "\n" not in str(exc.value)

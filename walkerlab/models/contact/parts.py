@@ -327,9 +327,12 @@ class Legs3DPart(ContactPart):
         return chord + R * (z[links.index("leg2_angle")] - z[links.index("leg1_angle")])
 
     def check(self, scene, data, cs) -> str | None:
-        """No pinned start (its stance foot turns freely about the normal: a point foot
-        holds no twist) and no contact periodic gait yet (the step map's section is
-        planar)."""
+        """No pinned start (its pinned dynamics hold the stance foot's slides, not its
+        turn, and carry no hip-roll law) and no contact periodic gait yet (the step map's
+        section is planar)."""
+        if cs.pin_stance_until != "none":
+            return ("contact_sim.pin_stance_until: a walker in 3D starts on its feet (the "
+                    "pinned start phase is planar walkers'): leave it 'none'")
         if cs.start == "periodic_gait" or cs.periodic_gait:
             return ("contact_sim.start / periodic_gait: the contact periodic gait of a "
                     "walker in 3D (its mirrored step map: also contact-sim --periodic and "
