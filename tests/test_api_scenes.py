@@ -129,7 +129,8 @@ def _same_contact_run(w: wl.Walker, cli: CliRuns, name: str) -> None:
     art = load_contact_sim(path)
     walk = w.contact().simulate()
     assert (walk.outcome, walk.termination) == (art.outcome, art.termination)
-    assert walk.heel_strikes.size == art.heel_strike_times.size > 0
+    assert walk.heel_strikes.size == art.heel_strike_times.size
+    assert art.samples.time.size > 1  # a run (round_feet_3d on the defaults trips unstruck)
     assert np.array_equal(walk.heel_strikes, art.heel_strike_times)
     assert np.array_equal(walk.t, art.samples.time)
     for k in CONTACT_STEPS:

@@ -203,8 +203,9 @@ def _initial_state_lines(c, arts, pub, table2: dict) -> list[str]:
         sym, pm, pa = table2.get(key, (key, np.nan, np.nan))
         oi = i0.get(key, np.nan)
         pd = f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%" if key in table2 else "—"
-        rows.append([sym, printed(pm), printed(pa), pd, oi, c0[key],
-                     f"{100 * (abs(c0[key]) - abs(oi)) / abs(oi):+.1f}%"])
+        od = (f"{100 * (abs(c0[key]) - abs(oi)) / abs(oi):+.1f}%" if abs(oi) > 0.0
+              else "—")  # an ideal state of 0 (a 3D wheel's upright lean): no relative change
+        rows.append([sym, printed(pm), printed(pa), pd, oi, c0[key], od])
     head = ["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
             "ours contact", "ours diff."]
     if not table2:
