@@ -99,6 +99,34 @@ def _stance_lines(eq, Q) -> list[str]:
     return lines
 
 
+def _point_lines(eq, pr, dqv, d: int, lines: list) -> tuple:
+    """:func:`rhs_source`'s contact points, appended to ``lines``: each point's position
+    and material velocity (``d`` components) and its spin about the normal (3D), common
+    subexpressions shared, and its ``_point`` (``_point3``) result ``_r<i>`` on its leg's
+    lane.  Returns the reduced kinematics, the force symbols (``d`` per point) and each
+    point's power ``F . v`` as text."""
+    import sympy as sp
+
+    kin = []
+    for pos, J in eq.feet:
+        v = J * dqv
+        kin += [*pos[:d], *v[:d]]
+    kin += [(Jn * dqv)[0] for Jn in eq.spins]  # each point's spin about the normal
+    repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
+    lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
+    axes = "xyz"[:d]
+    Fs = sp.symbols(" ".join(f"_F{a}{i}" for i in range(len(eq.feet)) for a in axes),
+                    real=True)
+    power = []  # forced: each point's F . v
+    for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
+        args = ", ".join(pr.doprint(e) for e in red[2 * d * i:2 * d * (i + 1)])
+        power.append(" + ".join(f"{Fs[d * i + k]} * ({pr.doprint(red[2 * d * i + d + k])})"
+                                for k in range(d)))
+        fn = "_point" if d == 2 else "_point3"
+        lines += [f"    _r{i} = {fn}({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
+    return red, Fs, power
+
+
 def rhs_source(eq, forced: bool = False) -> str:
     """Straight-line numba source of ``rhs(x, PC, p, c1, c2)`` for the floating equations
     ``eq`` (:class:`walkerlab.codegen.floating.FloatingEquations`): the feet's contact points
@@ -140,23 +168,7 @@ def rhs_source(eq, forced: bool = False) -> str:
     lines += [f"    {s} = x[{nq + i}]" for i, s in enumerate(eq.dq)]
     lines += ["    _sp = _sin(PC[I_PHI])", "    _cp = _cos(PC[I_PHI])"]
     d = eq.feet[0][0].shape[0]  # the world's dimension: 2 (planar) or 3
-    kin = []
-    for pos, J in eq.feet:
-        v = J * dqv
-        kin += [*pos[:d], *v[:d]]
-    kin += [(Jn * dqv)[0] for Jn in eq.spins]  # each point's spin about the normal
-    repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
-    lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
-    axes = "xyz"[:d]
-    Fs = sp.symbols(" ".join(f"_F{a}{i}" for i in range(len(eq.feet)) for a in axes),
-                    real=True)
-    power = []  # forced: each point's F . v
-    for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
-        args = ", ".join(pr.doprint(e) for e in red[2 * d * i:2 * d * (i + 1)])
-        power.append(" + ".join(f"{Fs[d * i + k]} * ({pr.doprint(red[2 * d * i + d + k])})"
-                                for k in range(d)))
-        fn = "_point" if d == 2 else "_point3"
-        lines += [f"    _r{i} = {fn}({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
+    red, Fs, power = _point_lines(eq, pr, dqv, d, lines)
     lines += _force_lines(eq.point_legs, Fs, forced, d)
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
