@@ -119,8 +119,9 @@ def _coordinate_styles(names, model_index: int = 0) -> dict[str, dict]:
         st = n.rsplit("_", 1)[0]
         owner = st.split("_", 1)[0]
         part = [x for x in stems if x.split("_", 1)[0] == owner].index(st)
-        shades = PART_COLORS[owners.index(owner) % len(PART_COLORS)]
-        out[n] = dict(color=shades[part % len(shades)],
+        k = owners.index(owner)  # past the palettes (a 3D walker's heading, lean, rolls):
+        shades = PART_COLORS[k % len(PART_COLORS)]  # the next shade of a palette reused
+        out[n] = dict(color=shades[(part + k // len(PART_COLORS)) % len(shades)],
                       ls=MODEL_STYLES[model_index % len(MODEL_STYLES)])
     return out
 
