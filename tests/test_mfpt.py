@@ -526,11 +526,13 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
     assert build_walker(sc, plant=Plant.from_scene(sc)).mirror is None
 
 
-def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):
+@pytest.mark.slow
+def test_a_3d_walker_without_a_contact_periodic_gait_ends_contact_mfpt_in_one_line(tmp_path):
     """``mfpt.model: contact`` walks the compliant-contact walker from its own periodic
-    gait, which the contact view does not find for a 3D walker (its mirrored step map is a
-    later step): refused in one line naming both fields before the gait is searched,
-    nothing written."""
+    gait; configs/paper_3d.yaml (zero hip width) has none the stride map reaches: its
+    inertia about the stance foot's normal vanishes as the legs pass each other, and its
+    contact run stalls at mid-stance. The study ends in one line naming the field before
+    any walk, no study artifact written (the rigid gait's, upstream, is)."""
     from walkerlab.config import scene_from_dict
     from walkerlab.stages import pipeline
     from walkerlab.stages.common import StageError
@@ -538,8 +540,7 @@ def test_a_3d_walkers_contact_mfpt_is_refused_before_any_work(tmp_path):
     raw = yaml.safe_load((ROOT / "configs" / "paper_3d.yaml").read_text())
     raw["mfpt"] = {"model": "contact", "method": "montecarlo"}
 
-    with pytest.raises(StageError, match=r"^mfpt\.model: contact: contact_sim\.start / "
-                                         r"periodic_gait: the contact periodic gait of a "
-                                         r"walker in 3D"):
+    with pytest.raises(StageError, match=r"^mfpt\.model: contact: ") as exc:
         pipeline.run("mfpt", scene_from_dict(raw), tmp_path)
-    assert not any(tmp_path.iterdir())
+    assert "\n" not in str(exc.value)
+    assert not list(tmp_path.rglob("mfpt*"))

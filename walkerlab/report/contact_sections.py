@@ -13,6 +13,7 @@ from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.published import for_scene
 from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
+from walkerlab.report.run_text import contact_multiplier_words
 from walkerlab.units import for_scene as units_for
 
 
@@ -77,7 +78,7 @@ def contact_section(scene, arts) -> list[str]:
         per_fail = (c.periodic.outcome, c.periodic.message)
     elif c.periodic is not None:
         g = c.periodic
-        per = (g.step_period_s, g.step_length_m, g.multipliers, g.stable)
+        per = (g.step_period_s, g.step_length_m, contact_multiplier_words(g, 4), g.stable)
     out = [
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)
@@ -121,9 +122,7 @@ def contact_section(scene, arts) -> list[str]:
         out += [f"**Periodic gait of the contact model** (fixed point of its step-to-step map, "
                 f"mid-stance section): step period {num(per[0], 6)} s, step length "
                 f"{num(per[1], 6)} m, "
-                f"{'stable' if per[3] else 'unstable'}; Floquet multipliers "
-                + ", ".join(f"{m:.4f}" for m in per[2][:3])
-                + " and three fast contact/creep modes ≈ 0.", ""]
+                f"{'stable' if per[3] else 'unstable'}; {per[2]}.", ""]
     return out
 
 

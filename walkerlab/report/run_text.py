@@ -14,6 +14,7 @@ import numpy as np
 
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.report.markdown import num
+from walkerlab.units import per_map
 
 if TYPE_CHECKING:  # the loaded artifacts these summaries print
     from walkerlab.io.schemas.compare import Comparison
@@ -121,14 +122,27 @@ def contact_text(c: ContactSimArtifact) -> str:
     if per is not None and not per.found:
         lines.append(f"periodic contact gait: not found ({per.outcome}: {per.message})")
     elif per is not None:
-        mult = per.multipliers
         lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} "
                      f"{c.units.time}, step length {num(per.step_length_m, 6)} "
                      f"{c.units.length}, "
                      f"{'stable' if per.stable else 'unstable'}")
-        lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
-                     + f" (+{len(mult) - 3} fast contact modes ~0)")
+        lines.append("  " + contact_multiplier_words(per, 5))
     return "\n".join(lines)
+
+
+def contact_multiplier_words(per, digits: int) -> str:
+    """``"Floquet multipliers per stride: 1.00180 (heading), 0.53995, ... (+10 fast contact
+    modes ~0)"``: the contact periodic gait's (``per``, a loaded
+    :class:`~walkerlab.io.schemas.contact_sim.PeriodicGait`) slow multipliers (modulus above
+    1e-3, at least three) to ``digits`` decimals, the largest's mode named when it is above
+    1 (a walker in 3D's heading), and how many fast contact modes there are."""
+    mult, modes = per.multipliers, per.multiplier_modes
+    n = min(len(mult), max(3, int(np.sum(np.abs(mult) > 1e-3))))
+    shown = [f"{m:.{digits}f}" for m in mult[:n]]
+    if modes and abs(mult[0]) > 1.0:
+        shown[0] += f" ({modes[0]})"
+    return (f"Floquet multipliers {per_map(per.steps_per_map)}: " + ", ".join(shown)
+            + f" (+{len(mult) - n} fast contact modes ~0)")
 
 
 def compare_text(c: Comparison) -> str:

@@ -64,7 +64,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
 def _periodic_gait_taken(scene: Scene) -> None:
     """Refuse, before anything runs, a walker whose contact periodic gait the kind's contact
-    part does not find (a walker in 3D: its step map is a later step), in one line.
+    part does not find (a rimless wheel: its spokes have no mid-stance), in one line.
 
     Raises
     ------

@@ -46,6 +46,7 @@ from walkerlab.integrate.contact_grid import GRID_METHODS
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.parts import contact_part
 from walkerlab.models.contact.powered_data import powered_data
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
@@ -79,9 +80,9 @@ class ContactPeriodicGait:
         The same, named.
     period_s : float
         Step period [s] (mid-stance to mid-stance; equals the heel-strike-to-heel-strike
-        period on a periodic orbit).
+        period on a periodic orbit; a stride map's mean step).
     step_length_m : float
-        Along-slope advance of the stance foot per step [m].
+        Along-slope advance of the stance foot per step [m] (a stride map's mean step).
     residual : float
         max ``|(P(z) - z) / scale|`` (scaled, see :data:`SCALES`) [-].
     residual_si : ndarray (n,)
@@ -89,7 +90,8 @@ class ContactPeriodicGait:
     jacobian : ndarray (n, n)
         dP/dz in SI (rows/cols in the section's order).
     multipliers : ndarray (n,) complex
-        Floquet multipliers, sorted by decreasing modulus.
+        Floquet multipliers of the map (:attr:`steps_per_map` steps), sorted by decreasing
+        modulus.
     multiplier_fd_spread : float
         max change of the slow (``|lambda|`` > 1e-3) sorted multipliers when the FD step is
         multiplied or divided by 3.
@@ -107,6 +109,12 @@ class ContactPeriodicGait:
     wall_time_s : float
     info : dict
         Extra diagnostics (warm-up history, solver settings).
+    steps_per_map : int
+        Steps of the map (:attr:`walkerlab.models.contact.model.ContactWalker.steps_per_map`:
+        1, a step with the legs' roles swapped; 2, a stride, in 3D).
+    multiplier_modes : tuple of str
+        For each multiplier, the section coordinate its eigenvector moves most (scaled by
+        :data:`SCALES`): ``"heading"`` for a walker in 3D's near-neutral heading mode.
     """
 
     z: np.ndarray
@@ -126,6 +134,8 @@ class ContactPeriodicGait:
     full_state: np.ndarray
     wall_time_s: float
     info: dict = field(default_factory=dict)
+    steps_per_map: int = 1
+    multiplier_modes: tuple = ()
 
     @property
     def max_multiplier(self) -> float:
@@ -302,7 +312,14 @@ def _map_solvers(walker: ContactWalker, solver, jacobian_solver, coarse_solver):
     replay's Python callables) has the whole map in Python, so the defaults become the
     looser :data:`POWERED_MAP_SOLVER` and :data:`POWERED_COARSE_SOLVER`; laws that are data
     run on the compiled map (:mod:`walkerlab.integrate.contact_powered_step`) at the passive
-    map's tolerances; a solver given stays."""
+    map's tolerances; a kind whose map has tolerances of its own
+    (:attr:`walkerlab.models.contact.parts.ContactPart.map_tolerances`: a walker in 3D) has
+    them in place of :data:`MAP_SOLVER`'s; a solver given stays."""
+    tol = contact_part(walker.structure).map_tolerances  # the kind's map (a walker in 3D)
+    if tol != (MAP_SOLVER.rtol, MAP_SOLVER.atol):
+        own = dataclasses.replace(MAP_SOLVER, rtol=tol[0], atol=tol[1])
+        solver = own if solver is MAP_SOLVER else solver
+        jacobian_solver = own if jacobian_solver is MAP_SOLVER else jacobian_solver
     acts = getattr(walker, "actuators", None)
     if acts is not None and acts.laws and powered_data(walker) is None:  # Python laws
         solver = POWERED_MAP_SOLVER if solver is MAP_SOLVER else solver
@@ -467,7 +484,35 @@ def _periodic_gait_result(walker: ContactWalker, P: StepMap, PC: StepMap, coarse
         converged=bool(resid < residual_tol), message=sol.message,
         nfev=P.nfev + (PJ.nfev if PJ is not P else 0) + (PC.nfev if coarse else 0),
         patch_margin_m=margin, full_state=P.to_state(zs),
-        wall_time_s=time.perf_counter() - wall, info=info)
+        wall_time_s=time.perf_counter() - wall, info=info, steps_per_map=P.steps,
+        multiplier_modes=multiplier_modes(J, ev, P.names[:len(P.names) - P.walker.dim - 1]))
+
+
+def multiplier_modes(J: np.ndarray, multipliers: np.ndarray, names) -> tuple:
+    """The link coordinate (angle [rad] or rate [rad/s]) each Floquet multiplier's
+    eigenvector moves most.
+
+    Parameters
+    ----------
+    J : ndarray (n, n)
+        The map's Jacobian in SI section coordinates (the link angles and rates first).
+    multipliers : ndarray (n,) complex
+        Its eigenvalues in the order wanted (sorted).
+    names : sequence of str (k,)
+        The names of the section's first k coordinates, the link angles and rates (the
+        stance foot's penetration and velocities after them are left out: their fast modes
+        are the contact's, and a slow mode moves them in other units).
+
+    Returns
+    -------
+    tuple of str (n,)
+    """
+    w, V = np.linalg.eig(J)
+    out = []
+    for lam in multipliers:
+        j = int(np.argmin(np.abs(w - lam)))
+        out.append(str(names[int(np.argmax(np.abs(V[:len(names), j])))]))
+    return tuple(out)
 
 def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None = None,
                                 solver=None):  # setup: ContactSetup, solver: SolverSettings

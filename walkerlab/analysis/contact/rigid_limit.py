@@ -82,7 +82,7 @@ def observed_order(kappa, gap) -> np.ndarray:
     return np.log(g[:-1] / g[1:]) / np.log(k[1:] / k[:-1])
 
 
-def match_multipliers(contact, rigid) -> np.ndarray:
+def match_multipliers(contact, rigid, free_modes: int = 0) -> np.ndarray:
     """The contact multipliers matched to their rigid partners.
 
     Parameters
@@ -90,17 +90,22 @@ def match_multipliers(contact, rigid) -> np.ndarray:
     contact : array_like (m,) complex
         All Floquet multipliers of the contact gait (its fast contact modes ~ 0 included).
     rigid : array_like (r,) complex
-        The rigid gait's nonzero multipliers (r <= m).
+        The rigid gait's nonzero multipliers (r + free_modes <= m).
+    free_modes : int
+        Slow contact multipliers with no rigid partner (a walker in 3D: the heading, which
+        the rigid stance foot holds; :attr:`walkerlab.models.contact.parts.ContactPart.
+        free_modes`), left unmatched.
 
     Returns
     -------
     ndarray (r,) complex
-        Entry j is the contact multiplier nearest ``rigid[j]`` among the r largest in modulus
-        (assignment minimising the summed distance, ``scipy.optimize.linear_sum_assignment``).
+        Entry j is the contact multiplier nearest ``rigid[j]`` among the ``r + free_modes``
+        largest in modulus (assignment minimising the summed distance,
+        ``scipy.optimize.linear_sum_assignment``).
     """
     c = np.asarray(contact, complex)
     r = np.asarray(rigid, complex)
-    slow = sort_multipliers(c)[:r.size]
+    slow = sort_multipliers(c)[:r.size + free_modes]
     rows, cols = linear_sum_assignment(np.abs(slow[:, None] - r[None, :]))
     out = np.empty(r.size, complex)
     out[cols] = slow[rows]
@@ -116,8 +121,11 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
     walker : ContactWalker
         The scene's contact walker (``kappa = 1``).
     ideal : fixed-point result of the rigid walker
-        With ``x`` (post-impact state, role order), ``period_s`` and
-        ``multipliers_variational`` (as :func:`walkerlab.analysis.gait.scene.solve_variant`).
+        With ``x`` (post-impact state, role order), ``period_s`` (its map's: a stride's
+        when ``step_periods_s`` has two steps) and ``multipliers_variational`` (as
+        :func:`walkerlab.analysis.gait.scene.solve_variant`); its multipliers are put on the
+        contact map's steps (``walker.steps_per_map``: squared for a stride of a step
+        map's) and its period on one step.
     kappas : array_like (n,)
         Increasing stiffness factors [-].
     min_multiplier : float
@@ -131,19 +139,25 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
     RigidLimitTable
     """
     from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
+    from walkerlab.models.contact.parts import contact_part
     from walkerlab.models.contact.scene import ideal_step_length
 
+    rigid_steps = max(1, len(getattr(ideal, "step_periods_s", ()) or ()))
     lam_r = np.asarray(ideal.multipliers_variational, complex)
     lam_r = lam_r[np.abs(lam_r) > min_multiplier]
+    if walker.steps_per_map % rigid_steps == 0:  # the rigid map's multipliers, on the
+        lam_r = lam_r ** (walker.steps_per_map // rigid_steps)  # contact map's steps
     lam_r = sort_multipliers(lam_r)
+    free = contact_part(walker.structure).free_modes
     search.setdefault("check_fd", False)
     rows, guess = [], ideal.x
     for kappa in kappas:
         g = find_contact_periodic_gait(scale_walker(walker, float(kappa)), guess, **search)
-        rows.append((g.period_s, g.step_length_m, match_multipliers(g.multipliers, lam_r),
-                     g.converged))
+        rows.append((g.period_s, g.step_length_m,
+                     match_multipliers(g.multipliers, lam_r, free), g.converged))
         guess = g.z if g.converged else guess
     period, step, lam, ok = zip(*rows)
     return RigidLimitTable(np.asarray(kappas, float), np.array(period), np.array(step),
-                           np.array(lam), float(ideal.period_s), ideal_step_length(walker, ideal.x),
+                           np.array(lam), float(ideal.period_s) / rigid_steps,
+                           ideal_step_length(walker, ideal.x),
                            lam_r, np.array(ok))

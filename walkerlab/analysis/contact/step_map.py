@@ -17,7 +17,13 @@ name, :func:`section_coordinates`); straight legs (6 = 8 - 2)::
          delta_stance, v_t_stance, ddelta_stance]
 
 kneed legs (10 = 12 - 2): ``theta_stance_thigh, theta_stance_shank, theta_swing_shank``, the
-four link rates (swing leg first), then the three stance-foot coordinates.
+four link rates (swing leg first), then the three stance-foot coordinates.  Straight legs
+in 3D (15 = 18 - 1 - 2, the translations along the slope and across it dropped)::
+
+    z = [theta_stance, heading, phi2, phi_pelvis, phi1,
+         dtheta_swing, dtheta_stance, dheading, dphi2, dphi_pelvis, dphi1,
+         delta_stance, v_t_stance, v_lat_stance, ddelta_stance]
+
 ``theta_swing = theta_stance`` on the section [rad]; rates [rad/s]; ``delta_stance`` is the
 stance foot's penetration [m] (along -n), ``v_t_stance`` its down-slope slip velocity [m/s],
 ``ddelta_stance`` its penetration rate [m/s].  The along-slope position of the stance foot is
@@ -28,7 +34,14 @@ Step map
 ``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
 leg1 = swing: the legs are identical, so one orientation suffices), integrate until the next
 upward zero of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), swap the leg
-roles and express the state relative to the new stance foot (leg1).  The search's map runs
+roles and express the state relative to the new stance foot (leg1).  A walker whose two
+steps are not the same state with the roles swapped maps a **stride**
+(:attr:`~walkerlab.models.contact.model.ContactWalker.steps_per_map` 2): a walker in 3D,
+whose steps mirror each other across the sagittal plane and whose floating base is leg2's
+foot, and legs that differ; the map then runs on through leg1's mid-stance to leg2's next
+(each footfall on a patch of its own, leg2's two a stride apart), its period and step
+length are the stride's means, and its Floquet multipliers are the stride's (a symmetric
+gait's reflected step map's squared, as the rigid view's).  The search's map runs
 on the compiled integrator (``"cyrk_bdf"``: CyRK's BDF over the generated right-hand side on
 a 2 ms grid, :func:`walkerlab.integrate.contact_grid.contact_grid`; no Python per RHS call),
 the crossing bracketed on the samples and located by brentq on short compiled runs from the
@@ -63,8 +76,9 @@ the centre): :func:`find_contact_periodic_gait` reports the worst margin to a pa
 (``patch_margin_m``), and the fixed point is then a true periodic gait of a checkerboard
 whose patches are spaced by the gait's own step length.  On stairs and footholds of one
 height (patches a riser apart, :func:`walkerlab.models.contact.terrain.terrain_ground`) the
-swing patch lies the step's rise (:func:`step_rise`) above the stance patch, and the new
-stance foot's penetration is measured from its own patch: each step on the same ground.
+swing patch lies the step's rise (:func:`~walkerlab.analysis.contact.section.step_rise`)
+above the stance patch, and the new stance foot's penetration is measured from its own
+patch: each step on the same ground.
 
 """
 
@@ -86,7 +100,14 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
 
-from .section import SCALES, SECTION_NAMES, SECTION_UNITS, section_coordinates
+from .section import (
+    SCALES,
+    SECTION_NAMES,
+    SECTION_UNITS,
+    other_coordinates,
+    section_coordinates,
+    step_rise,
+)
 
 brentq = import_on_fresh_stack("scipy.optimize").brentq  # see walkerlab.freshstack
 
@@ -119,39 +140,6 @@ FELL = f"step map: the walker fell (hip below L/2): {FELL_ADVICE}"
 
 #: the step map's default integrator (LSODA with the analytic Jacobian)
 DEFAULT_SOLVER = Solver("LSODA", 1e-11, 1e-13)
-
-
-def step_rise(walker: ContactWalker) -> float:
-    """Height [m] (along the slope's normal) of each footfall's patch above the last one's on
-    a ground whose every step is alike (stairs, footholds of one height, on checkerboard
-    lanes: :func:`walkerlab.models.contact.terrain.terrain_ground`); 0.0 without patch
-    heights.
-
-    Raises
-    ------
-    ValueError
-        A polyline ground (continuous stairs, a profile), or footfall heights whose steps
-        differ (rough ground): the step map's ground is the same at every step (one line,
-        naming ``contact_sim.start``).
-    """
-    if walker.ground_line is not None:
-        raise ValueError("contact_sim.start / periodic_gait: the contact periodic gait's "
-                         "step map lays a patch at each foot (checkerboard lanes); a polyline "
-                         "ground (stairs on continuous lanes, a profile) has none: use "
-                         "terrain.lanes: checkerboard, or start: ideal")
-    if walker.heights1 is None and walker.heights2 is None:
-        return 0.0
-    h2 = np.zeros(walker.lane2.size) if walker.heights2 is None else walker.heights2
-    h1 = np.zeros(walker.lane1.size) if walker.heights1 is None else walker.heights1
-    n = min(h1.size, h2.size)  # footfall order: leg2's 0, leg1's 1, leg2's 2, ...
-    h = np.ravel(np.column_stack([h2[:n], h1[:n]]))
-    rises = np.diff(h) if h.size > 1 else np.zeros(1)
-    # equal to rounding (the heights are -k * drop * cos(phi), k up to a few hundred)
-    if np.ptp(rises) > 1e-9 * max(1.0, float(np.max(np.abs(h)))):
-        raise ValueError("contact_sim.start / periodic_gait: the contact periodic gait needs "
-                         "a ground whose every step is alike (slope, stairs, footholds of one "
-                         "height); these footfall heights differ from step to step")
-    return float(rises[0])
 
 
 class StepMap:
@@ -202,11 +190,16 @@ class StepMap:
         o2 = footprint_offsets(walker.data)[1]
         #: height [m] of the swing lane's patch above the stance patch (stairs, footholds)
         self.rise = step_rise(walker)
+        #: steps per map (:attr:`ContactWalker.steps_per_map`): 2, a stride, for a walker
+        #: whose section is leg2's mid-stance only; each footfall of the map has a patch
+        self.steps = int(walker.steps_per_map)
+        k1 = np.arange(1, self.steps + 1, 2)  # leg1's footfalls (leg2's at 0, 2, ...)
+        k2 = np.arange(0, self.steps + 1, 2)
         heights = {} if walker.heights1 is None and walker.heights2 is None else {
-            "heights1": np.array([self.rise]), "heights2": np.array([0.0])}
-        self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing + o2]),
-                                          lane2=np.array([o2]), continuous=keep_ground,
-                                          **heights)
+            "heights1": self.rise * k1, "heights2": self.rise * k2}
+        self.walker = dataclasses.replace(walker, lane1=self.spacing * k1 + o2,
+                                          lane2=self.spacing * k2 + o2,
+                                          continuous=keep_ground, **heights)
         self.method, self.t_max = solver.method, t_max
         self.solver = solver  # the step map's integrator
         self.deadline = np.inf if deadline is None else deadline
@@ -225,13 +218,16 @@ class StepMap:
         self._links = [w.leg_angle_states("leg1"), w.leg_angle_states("leg2")]
         self._angle = [self.idx[a[0]] for a in self._links]
         self._rate = [self.idx.rate_of(a[0]) for a in self._links]
+        self._others = other_coordinates(w)  # in 3D the heading and the rolls
         self.names, self.units, self.scale = section_coordinates(w)
+        self._last_map = (None, None)  # _run_map's last (section state, answer)
 
     def _columns(self, stance: int) -> list[int]:
         """State columns of the link coordinates in section order, with foot ``stance``."""
         ix, st, sw = self.idx, self._links[stance], self._links[1 - stance]
-        return ([ix[a] for a in st] + [ix[a] for a in sw[1:]]
-                + [ix.rate_of(a) for a in sw] + [ix.rate_of(a) for a in st])
+        return ([ix[a] for a in st] + [ix[a] for a in sw[1:]] + [ix[a] for a in self._others]
+                + [ix.rate_of(a) for a in sw] + [ix.rate_of(a) for a in st]
+                + [ix.rate_of(a) for a in self._others])
 
     # ------------------------------------------------------------------ coordinates
     def to_state(self, z) -> np.ndarray:
@@ -242,36 +238,39 @@ class StepMap:
         follows ``walker.state_names()`` [m, rad, m/s, rad/s].
         """
         z = np.asarray(z, float)
-        nl = len(z) - 3
-        d, vt, dd = z[nl:]
+        dim = self.walker.dim
+        nl = len(z) - dim - 1
+        d, slips, dd = z[nl], z[nl + 1:-1], z[-1]
         p = -d * self.n
-        v = vt * self.t - dd * self.n
+        v = slips @ self.walker.tangents - dd * self.n
         # link state by name: the swing leg's proximal link aligned with the stance one's
         val = dict(zip(self._columns(1), z[:nl]))
         val[self._angle[0]] = val[self._angle[1]]
         ix = self.idx
-        cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
+        names = ix.names[ix.coordinates]
+        cols = [ix[c] for c in names[dim:]]  # after the base's slides
         zp = np.array([val[c] for c in cols] + [val[ix.rate_of(ix.names[c])] for c in cols])
         # stance foot at p and at rest, then the whole walker translated at v
         x = self.walker.pinned_to_full(zp, p)
-        x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
+        x[[ix.rate_of(c) for c in names[:dim]]] += v
         return x
 
-    def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
+    def to_section(self, x, stance: int, footfall: int | None = None
+                   ) -> tuple[np.ndarray, float]:
         """Section coordinates (:attr:`names`) and along-slope position s [m] of foot
-        ``stance`` (0/1).
+        ``stance`` (0/1), standing on the map's footfall ``footfall`` (0: leg2's at s = 0,
+        1: leg1's next, ...; default ``1 - stance``, the step's).
 
         ``x`` (2 nq,): full state (``walker.state_names()``); returns ``(z, s)`` with ``z``
         of shape (m,) (units :attr:`units`).
         """
         x = np.asarray(x, float)
-        px, py, vx, vy = self.walker.foot_state(x, stance)
-        p, v = np.array([px, py]), np.array([vx, vy])
-        # the penetration below the foot's own patch: leg1's (stance 0) lies ``rise`` above
-        # leg2's on stairs and footholds, the next step's ground as the last one
-        h = self.rise if stance == 0 else 0.0
-        z = np.concatenate([x[self._columns(stance)], [h - p @ self.n, v @ self.t,
-                                                        -v @ self.n]])
+        p, v = self.walker.foot_state(x, stance)
+        # the penetration below the foot's own patch: each footfall lies ``rise`` above the
+        # last on stairs and footholds, the next step's ground as the last one
+        h = self.rise * (1 - stance if footfall is None else footfall)
+        z = np.concatenate([x[self._columns(stance)], [h - p @ self.n],
+                            self.walker.tangents @ v, [-v @ self.n]])
         return z, float(p @ self.t)
 
     # ------------------------------------------------------------------ the map
@@ -454,7 +453,8 @@ class StepMap:
                                 f"within {self.t_max:g} s")
 
     def __call__(self, z):
-        """One step: returns (P(z) (n,), period [s], step length [m]).
+        """One map (:attr:`steps` steps): returns (P(z) (n,), the mean step period [s], the
+        mean step length [m]) over its steps.
 
         Raises
         ------
@@ -462,36 +462,58 @@ class StepMap:
             The walker fell, did not reach the next mid-stance within ``t_max``, the solver
             failed or the wall-time limit ran out.
         """
-        if self.method in GRID_METHODS or self.powered:
-            te, xe = self.next_section(self.to_state(z))
-            z1, s1 = self.to_section(xe, 0)
-            return z1, te, s1
-        run = self.integrate(self.to_state(z))
-        if run.event != "mid_stance":
-            if run.end is RunEnd.FALL:
-                raise PeriodicGaitError("fall", FELL)
-            if run.end is RunEnd.SOLVER_FAILURE:
-                raise PeriodicGaitError("solver_failure", f"step map: {solver_words(run.message)}")
-            raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
-                                    f"{self.t_max:g} s")
-        z1, s1 = self.to_section(run.y_event, 0)
-        return z1, run.t_event, s1
+        te, xe = self._run_map(z)
+        stance = (self.steps - 1) % 2  # the last step's new stance leg (0 = leg1)
+        z1, s1 = self.to_section(xe, stance, self.steps)
+        return z1, te / self.steps, s1 / self.steps
+
+    def _run_map(self, z) -> tuple[float, np.ndarray]:
+        """(t [s], x (2 nq,)): the time to and the full state at the map's section
+        (:attr:`steps` mid-stances on) from the section state ``z``; the last call's
+        answer is kept (:meth:`patch_margin` integrates over the map just taken)."""
+        key = np.asarray(z, float).tobytes()
+        if self._last_map[0] != key:
+            self._last_map = (key, self._map_steps(self.to_state(z)))
+        te, xe = self._last_map[1]
+        return te, xe.copy()
+
+    def _map_steps(self, x) -> tuple[float, np.ndarray]:
+        """:meth:`_run_map` without its memory: each step to the next mid-stance, the new
+        stance leg alternating (leg1 first)."""
+        t = 0.0
+        for k in range(self.steps):
+            if self.method in GRID_METHODS or self.powered:
+                te, x = self.next_section(x, stance_to_come=k % 2)
+            else:
+                run = self.integrate(x, stance_to_come=k % 2)
+                if run.event != "mid_stance":
+                    if run.end is RunEnd.FALL:
+                        raise PeriodicGaitError("fall", FELL)
+                    if run.end is RunEnd.SOLVER_FAILURE:
+                        raise PeriodicGaitError("solver_failure",
+                                                f"step map: {solver_words(run.message)}")
+                    raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance "
+                                            f"within {self.t_max:g} s")
+                te, x = run.t_event, run.y_event
+            t += te
+        return t, x
 
     def patch_margin(self, z) -> float:
         """Smallest distance [m] of a loaded foot to its patch edge over one step from the
         section coordinates ``z`` (m,) (:attr:`names`); inf on continuous ground."""
+        x0 = self.to_state(z)
         if self.powered:
-            x0 = self.to_state(z)
-            te = self.next_section(x0)[0]
+            te = self._run_map(z)[0]
             X = run_powered(self.walker, x0, 0.0, te, self.solver,
                             ContactLimits(sample_rate_hz=2000 / te), self.deadline, None)[1]
-        elif self.method in GRID_METHODS:
-            x0 = self.to_state(z)
-            te = self.next_section(x0)[0]
-            tt = np.linspace(0.0, te, 2001)
-            X = contact_grid(self.walker, x0, tt, self.solver, self._data)[0]
+        elif self.method in GRID_METHODS or self.steps > 1:
+            te = self._run_map(z)[0]
+            tt = np.linspace(0.0, te, 2000 * self.steps + 1)
+            solver = self.solver if self.method in GRID_METHODS else \
+                dataclasses.replace(self.solver, method=GRID_METHODS[0])
+            X = contact_grid(self.walker, x0, tt, solver, self._data)[0]
         else:
-            run = self.integrate(self.to_state(z), dense=True)
+            run = self.integrate(x0, dense=True)
             te = run.t_event if run.event == "mid_stance" else run.t[-1]
             tt = np.linspace(0.0, te, 2001)
             X = run.dense(tt).T
@@ -500,13 +522,13 @@ class StepMap:
         cq = self.walker.contact_quantities(X)
         hw = self.walker.patch_half_width
         margin = np.inf
-        for name, q in cq.items():  # every contact point on its leg's patch
-            c = float(self.walker.lane(name)[0])
-            loaded = q["penetration"] > 0
-            near = np.abs(q["s"] - c) <= 2 * hw  # in or next to this leg's patch
-            sel = loaded & near
-            if sel.any():
-                margin = min(margin, float(np.min(hw - np.abs(q["s"][sel] - c))))
+        for name, q in cq.items():  # every contact point on its leg's patches
+            for c in map(float, self.walker.lane(name)):
+                loaded = q["penetration"] > 0
+                near = np.abs(q["s"] - c) <= 2 * hw  # in or next to this patch
+                sel = loaded & near
+                if sel.any():
+                    margin = min(margin, float(np.min(hw - np.abs(q["s"][sel] - c))))
         return margin
 
 
@@ -553,11 +575,11 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
                                     "the ideal state does not reach mid-stance on the "
                                     "contact model" + (f" (it falls): {FELL_ADVICE}"
                                                        if e.kind == "fall" else "")) from None
-        return step_map.to_section(xe, 1)[0]
+        return step_map.to_section(xe, 1, 0)[0]
     run = step_map.integrate(x0, stance_to_come=1)
     if run.event != "mid_stance":
         fell = run.end is RunEnd.FALL
         raise PeriodicGaitError("fall" if fell else "no_mid_stance",
                                 "the ideal state does not reach mid-stance on the contact model"
                                 + (f" (it falls): {FELL_ADVICE}" if fell else ""))
-    return step_map.to_section(run.y_event, 1)[0]
+    return step_map.to_section(run.y_event, 1, 0)[0]

@@ -259,6 +259,8 @@ def _write_periodic_and_adjust(f, run: ContactSimRun) -> None:
         g = f.create_group("periodic_gait")
         g.attrs["section"] = "mid-stance (proximal links aligned), stance foot loaded only"
         g.attrs["outcome"] = "ok"
+        g.attrs["steps_per_map"] = int(gait.steps_per_map)  # the multipliers' map
+        g.attrs["multiplier_modes"] = list(gait.multiplier_modes)
         for k, v in gait.fixed_point.items():
             g.attrs[f"fixed_point_{k}"] = float(v)
         put(g, "step_period", gait.period_s, "s", "period of the contact gait")
@@ -366,8 +368,10 @@ class PeriodicGait:
     ``outcome`` and ``message``).  Period [s], step length [m], multipliers complex.
 
     ``multipliers`` is an ndarray of shape (m,) (the section's dimension: 6 for straight
-    legs, 10 kneed; shape (0,) when not found), Floquet multipliers [-] by decreasing
-    modulus.
+    legs, 10 kneed, 15 straight legs in 3D; shape (0,) when not found), Floquet
+    multipliers [-] by decreasing modulus, of the map of ``steps_per_map`` steps (2: a
+    stride); ``multiplier_modes`` names each one's most moved section coordinate (empty in
+    older artifacts).
     """
 
     found: bool
@@ -377,6 +381,8 @@ class PeriodicGait:
     step_length_m: float = np.nan
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
     stable: bool = False
+    steps_per_map: int = 1
+    multiplier_modes: tuple = ()
 
 
 @dataclass
@@ -428,7 +434,8 @@ def _periodic(f) -> PeriodicGait | None:
     return PeriodicGait(True, "ok", "", float(g["step_period"][()]),
                         float(g["step_length"][()]),
                         g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
-                        bool(g["stable"][()]))
+                        bool(g["stable"][()]), int(g.attrs.get("steps_per_map", 1)),
+                        tuple(str(m) for m in g.attrs.get("multiplier_modes", ())))
 
 
 @artifact_loader(STAGE)

@@ -329,18 +329,6 @@ class ContactWalker(ContactReadouts):
         """The world's dimension ``d``: 2 (planar), 3 (in 3D, ``z`` lateral)."""
         return int(self.kernels.DIM)
 
-    @property
-    def normal(self) -> np.ndarray:
-        """Outward ground normal n = (sin phi, cos phi) (3D: (sin phi, cos phi, 0)), shape
-        (d,), unit vector [-]."""
-        return np.array([np.sin(self.phi), np.cos(self.phi), 0.0][:self.dim])
-
-    @property
-    def tangent(self) -> np.ndarray:
-        """Down-slope tangent t = (cos phi, -sin phi) (3D: (cos phi, -sin phi, 0)), shape
-        (d,), unit vector [-]."""
-        return np.array([np.cos(self.phi), -np.sin(self.phi), 0.0][:self.dim])
-
     def static_penetration(self, load: float | None = None) -> float:
         """IMPACT static penetration (F / k)^(1/e) [m] under ``load`` [N] (default M g cos phi).
 

@@ -19,6 +19,38 @@ class ContactReadouts:
     (a mix-in: it reads the walker's compiled ``kernels``, ``walker_params``, its contact
     points ``_contacts`` and ``_point_legs``, and ``nq``)."""
 
+    @property
+    def normal(self) -> np.ndarray:
+        """Outward ground normal n = (sin phi, cos phi) (3D: (sin phi, cos phi, 0)), shape
+        (d,), unit vector [-]."""
+        return np.array([np.sin(self.phi), np.cos(self.phi), 0.0][:self.dim])
+
+    @property
+    def tangent(self) -> np.ndarray:
+        """Down-slope tangent t = (cos phi, -sin phi) (3D: (cos phi, -sin phi, 0)), shape
+        (d,), unit vector [-]."""
+        return np.array([np.cos(self.phi), -np.sin(self.phi), 0.0][:self.dim])
+
+    @property
+    def tangents(self) -> np.ndarray:
+        """The ground's tangent basis, shape (d - 1, d), unit rows [-]: the down-slope
+        :attr:`tangent`, then (in 3D) the lateral axis ``z`` (across the slope, to the
+        walker's left).  With :attr:`normal` it spans the world; a contact walker's dynamics
+        are invariant under translation along it (the patches are strips across the
+        slope)."""
+        return np.array([self.tangent] + [np.eye(self.dim)[k] for k in range(2, self.dim)])
+
+    @property
+    def steps_per_map(self) -> int:
+        """Steps in the contact periodic gait's Poincaré map
+        (:mod:`walkerlab.analysis.contact.step_map`): 1 where a step's end, the legs'
+        roles swapped, is the same state as its start (planar walkers), 2 where the two
+        steps of a stride mirror each other across the sagittal plane and the section is
+        leg2's mid-stance (a walker in 3D, whose floating base is leg2's foot:
+        :attr:`walkerlab.models.contact.parts.ContactPart.steps_per_map`) or differ (legs
+        that differ: the rigid view's map is a stride too)."""
+        return 2 if self.structure.asymmetric else contact_part(self.structure).steps_per_map
+
     def _rows(self, X) -> np.ndarray:
         return np.ascontiguousarray(np.atleast_2d(X), dtype=float)
 
@@ -51,15 +83,20 @@ class ContactReadouts:
         return self._kernel_lane1[self.lane1.size:2 * self.lane1.size] if leg == "leg1" \
             else self._kernel_lane2[self.lane2.size:2 * self.lane2.size]
 
-    def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
+    def foot_state(self, x, i: int) -> tuple[np.ndarray, np.ndarray]:
         """Reference contact point of leg ``i`` (0/1) (its only point; a flat foot's heel)
-        and the velocity of the material point there: (px, py, vx, vy) [m, m/s] (the
-        sagittal components of a walker in 3D)."""
+        and the velocity of the material point there, for the state ``x`` (2 nq,).
+
+        Returns
+        -------
+        p, v : ndarray, shape (d,)
+            Position [m] and velocity [m/s] in the world frame (x, y, and in 3D z).
+        """
         n, nf, d = self.nq, len(self._contacts), self.dim
         P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, n))
         self.kernels.feet(np.asarray(x, float), self.walker_params, P, V, J)
         i = self._point_legs.index(i)
-        return float(P[i, 0]), float(P[i, 1]), float(V[i, 0]), float(V[i, 1])
+        return P[i].copy(), V[i].copy()
 
     def foot_positions(self, X) -> np.ndarray:
         """Reference contact point of each leg (n, 2, d) [m] (leg, xy (z)) for states X
