@@ -504,3 +504,28 @@ def test_the_hip_roll_walkers_contact_periodic_gait_is_its_rigid_gait_within_a_p
     heading = [m for m, name in zip(g.multipliers, g.multiplier_modes) if name == "heading"]
     assert len(heading) >= 1 and abs(heading[0] - 1.0) < 0.01
     assert g.patch_margin_m > 0
+
+
+@pytest.mark.slow
+def test_the_hip_roll_walkers_contact_gait_tends_to_the_rigid_gait_as_the_contact_stiffens():
+    """The rigid-limit family (stiffness, damping and stiction velocity scaled together,
+    :mod:`walkerlab.models.contact.rigid_limit`) on configs/hip_width_stabilised.yaml at
+    1, 2 and 4 times the contact's stiffness: the contact periodic gait's step length and
+    step period close on the rigid gait's monotonically. The step length's gap falls at
+    the order of the family's stiction velocity, kappa^-1/2 (the stance foot's creep along,
+    across and about the normal; measured 0.51 on each octave to 8), the period's faster
+    than the impact's duration (1/(e+1) = 0.31; measured 0.74, 0.95, 1.56: a gap of two
+    parts of opposite sign)."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.rigid_limit import convergence, observed_order
+
+    P, _ = _stride_map()
+    scene = load_scene("configs/hip_width_stabilised.yaml")
+    rigid = ideal_gait(scene, Plant.from_scene(scene))
+    tab = convergence(P.walker, rigid, (1.0, 2.0, 4.0))
+    assert tab.converged.all()
+    assert tab.rigid_period_s == pytest.approx(np.mean(rigid.step_periods_s), rel=1e-12)
+    step, period = np.abs(tab.step_gap_m), np.abs(tab.period_gap_s)
+    assert np.all(np.diff(step) < 0) and np.all(np.diff(period) < 0)
+    assert np.all(np.abs(observed_order(tab.kappa, tab.step_gap_m) - 0.5) < 0.1)
+    assert np.all(observed_order(tab.kappa, tab.period_gap_s) > 0.5)

@@ -38,6 +38,8 @@ def rigid_limit_figure(d: dict, title: str):
             ax.axhline(abs(lam.imag), color=line.get_color(), lw=1, ls=":")
     ax.set_ylabel("Floquet multiplier [-] (rigid: lines)")
     for ax in axes:
+        ax.set_xticks(k, [f"{v:g}" for v in k])  # the factors computed, not the decades
+        ax.minorticks_off()
         ax.set_xlabel("stiffness factor kappa [-]")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best")

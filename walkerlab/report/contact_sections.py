@@ -15,6 +15,7 @@ from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
 from walkerlab.report.run_text import contact_multiplier_words
 from walkerlab.units import for_scene as units_for
+from walkerlab.units import map_name
 
 
 def _table2_note(pub) -> str:
@@ -78,7 +79,8 @@ def contact_section(scene, arts) -> list[str]:
         per_fail = (c.periodic.outcome, c.periodic.message)
     elif c.periodic is not None:
         g = c.periodic
-        per = (g.step_period_s, g.step_length_m, contact_multiplier_words(g, 4), g.stable)
+        per = (g.step_period_s, g.step_length_m, contact_multiplier_words(g, 4), g.stable,
+               map_name(g.steps_per_map))
     out = [
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)
@@ -119,8 +121,8 @@ def contact_section(scene, arts) -> list[str]:
         out += _drop_lines(scene, drop, c.stiffness_family)
     out += _map_lines(arts)
     if per is not None:
-        out += [f"**Periodic gait of the contact model** (fixed point of its step-to-step map, "
-                f"mid-stance section): step period {num(per[0], 6)} s, step length "
+        out += [f"**Periodic gait of the contact model** (fixed point of its Poincaré map at "
+                f"mid-stance, a {per[4]}'s): step period {num(per[0], 6)} s, step length "
                 f"{num(per[1], 6)} m, "
                 f"{'stable' if per[3] else 'unstable'}; {per[2]}.", ""]
     return out

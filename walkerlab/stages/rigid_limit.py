@@ -1,7 +1,9 @@
 """Stage ``rigid-limit``: the contact walker's periodic gait along the one rigid-limit family
 -> ``rigid_limit.h5`` (``walkerlab compare --rigid-limit``).
 
-For each stiffness factor ``kappa`` (default :data:`KAPPAS`) the scene's contact is scaled by
+For each stiffness factor ``kappa`` (default the walker kind's,
+:attr:`walkerlab.models.contact.parts.ContactPart.rigid_limit_kappas`: :data:`KAPPAS`, a
+walker in 3D one octave at a time to 8) the scene's contact is scaled by
 :mod:`walkerlab.models.contact.rigid_limit` and the contact walker's own periodic gait is found
 (:func:`walkerlab.analysis.contact.rigid_limit.convergence`); the artifact holds its step period,
 step length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
@@ -18,13 +20,15 @@ from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, wr
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
-#: Default stiffness factors [-]: the scene's contact and three decades stiffer.
+#: Default stiffness factors [-] of a planar walker: the scene's contact and three decades
+#: stiffer.
 KAPPAS = (1.0, 10.0, 100.0, 1000.0)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        kappas=KAPPAS) -> StageOutcome:
-    """Compute (or reuse) ``rigid_limit.h5``.
+        kappas=None) -> StageOutcome:
+    """Compute (or reuse) ``rigid_limit.h5`` at the stiffness factors ``kappas`` [-]
+    (default the walker kind's).
 
     Raises
     ------
@@ -33,8 +37,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     scene = with_defaults(scene, "contact", "rigid-limit")  # left out: the paper's contact law
     require(scene, "fixedpoint", "rigid-limit")
-    kappas = tuple(float(k) for k in kappas)
     _periodic_gait_taken(scene)
+    if kappas is None:
+        from walkerlab.models.contact.parts import contact_part  # light
+        from walkerlab.walker.plant import Plant  # light
+
+        kappas = contact_part(Plant.from_scene(scene).data.structure).rigid_limit_kappas
+    kappas = tuple(float(k) for k in kappas)
 
     def compute():
         from walkerlab.analysis.contact.periodic import ideal_gait  # light

@@ -45,6 +45,10 @@ class ContactPart:
     #: the contact gait's slow Floquet multipliers that have no partner in the rigid gait's
     #: (:func:`walkerlab.analysis.contact.rigid_limit.match_multipliers`)
     free_modes = 0
+    #: the stiffness factors [-] of ``walkerlab compare --rigid-limit``
+    #: (:mod:`walkerlab.models.contact.rigid_limit`): the scene's contact and three decades
+    #: stiffer
+    rigid_limit_kappas = (1.0, 10.0, 100.0, 1000.0)
     #: steps in the contact periodic gait's map
     #: (:attr:`walkerlab.models.contact.model.ContactWalker.steps_per_map`): a planar
     #: walker's step, its legs' roles swapped, starts the next one
@@ -315,6 +319,11 @@ class Legs3DPart(ContactPart):
     #: measured on ``configs/hip_width_stabilised.yaml``: CyRK's BDF takes 2 s a stride at
     #: rtol 1e-12 and 0.11 s at 1e-11, and the two maps agree to 2e-10 (scaled)
     map_tolerances = (1e-11, 1e-13)
+    #: one octave at a time to eight times the scene's stiffness: the stride map's cost
+    #: grows past it (measured on ``hip_width_stabilised``, CyRK's BDF at rtol 1e-11: 0.11
+    #: s a stride at 1, 0.6 s at 10, 35 s at 100, 440 s at 1000 times the stiffness; the
+    #: family's stiction velocity, which the twist's law shares, falls as kappa^-1/2)
+    rigid_limit_kappas = (1.0, 2.0, 4.0, 8.0)
     #: the heading: the rigid stance foot holds its yaw (the rigid state has no heading),
     #: the compliant one turns, with a multiplier near 1 (heading is nearly neutral)
     free_modes = 1
