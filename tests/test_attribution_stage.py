@@ -58,6 +58,28 @@ def test_report_runs_attribution_only_with_full():
     assert "attribution" not in report_plan(ideal_only, full=True)
 
 
+def test_a_walker_without_the_attributions_gaits_is_left_out_of_the_full_report(tmp_path):
+    """The attribution's seven periodic-gait searches need the contact periodic gait, and
+    two of them a contact 1000 times stiffer and one with the stiction velocity / 100: a
+    rimless wheel has no contact periodic gait, and for a walker in 3D those contacts are
+    beyond the stride map's integrator (440 s a stride at 1000 times the stiffness). The
+    full report leaves the stage out, and the stage asked for directly refuses in one
+    line naming the scene, before any work (nothing written)."""
+    from walkerlab.stages import attribution
+    from walkerlab.stages.common import StageError
+    from walkerlab.stages.pipeline import report_plan
+
+    for name, why in (("hip_width_stabilised", "beyond the stride map's integrator in 3D"),
+                      ("rimless_wheel", "a rimless wheel has not")):
+        scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+        plan = report_plan(scene, full=True)
+        assert "contact-sim" in plan and "attribution" not in plan
+        with pytest.raises(StageError, match=f"^attribution: scene '{name}': .*{why}") as e:
+            attribution.run(scene, tmp_path)
+        assert "\n" not in str(e.value)
+    assert not any(tmp_path.iterdir())
+
+
 def test_attribution_stage_writes_and_reuses(tmp_path, monkeypatch):
     """The stage runs the analysis once from fixedpoint.h5 and reuses its artifact (the
     analysis itself, ~17 s CPU on the paper scene, is replaced by its recorded numbers:

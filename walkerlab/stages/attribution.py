@@ -18,7 +18,8 @@ from walkerlab.config import Scene
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.attribution import AttributionRun, write_attribution
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import StageOutcome, run_cached, with_defaults
+from walkerlab.stages.common import StageError, StageOutcome, run_cached, with_defaults
+from walkerlab.stages.registry import attribution_refused
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "contact", "terrain", "contact_sim",
             "contact_solver")
@@ -31,11 +32,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     Raises
     ------
     StageError
-        No ``contact`` section (one line).
+        A walker whose attribution is not computed (no contact periodic gait, a walker in
+        3D: :func:`walkerlab.stages.registry.attribution_refused`; one line).
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
     scene = with_defaults(scene, "contact", "attribution")  # left out: the paper's contact law
+    why = attribution_refused(scene)
+    if why is not None:
+        raise StageError(f"attribution: scene '{scene.name}': {why}")
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
 
     def compute():
@@ -55,3 +60,4 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         return (lambda f: write_attribution(f, res)), summary
 
     return run_cached("attribution", scene, runs_root, SECTIONS, up, compute, force)
+

@@ -94,6 +94,16 @@ def contact_walks_ground(scene: Scene) -> bool:
     return kind.supports(ground, "contact")
 
 
+def attribution_refused(scene: Scene) -> str | None:
+    """Why the scene's walker gets no Section-5 attribution (no contact periodic gait, or a
+    walker in 3D: :func:`walkerlab.models.contact.parts.attribution_refusal`), one line
+    without the scene's name, or None."""
+    from walkerlab.models.contact.parts import attribution_refusal  # light
+    from walkerlab.walker.description import walker_data  # light: kinds on drawn grounds
+
+    return attribution_refusal(scene, walker_data(scene.walker, scene.slope.phi_rad))
+
+
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:
     """The stages ``stage`` reads the artifacts of, for ``scene`` (direct dependencies):
     ``simulate`` reads ``fixedpoint.h5`` only when ``simulate.initial_state`` is the fixed
@@ -176,7 +186,7 @@ STAGES: dict[str, Stage] = {s.name: s for s in (
           not_run="no 'contact' or 'fixedpoint' section",
           earlier="computed for other settings; `walkerlab report --full` computes it again",
           in_plan=lambda scene, full, plan: full and plan[art.CONTACT_SIM.name]
-          and scene.fixedpoint is not None),
+          and scene.fixedpoint is not None and attribution_refused(scene) is None),
     _stage(art.OPTIMIZE, "optimize", (art.FIXEDPOINT.name,), "own",
           "no 'optimize' section (or no 'fixedpoint')",
           in_plan=lambda scene, full, plan: getattr(scene, "optimize", None) is not None

@@ -24,6 +24,7 @@ from walkerlab.io.stage_files import ATTRIBUTION, BIFURCATION, CONTACT_SIM, SIMU
 from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.common import StageError
 from walkerlab.stages.pipeline import report_plan
+from walkerlab.stages.registry import attribution_refused
 from walkerlab.stages.report_dag import run_report
 from walkerlab.stages.report_inputs import animation_current, report_artifacts
 
@@ -81,7 +82,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
     if scene.contact is not None and scene.fixedpoint is not None \
             and ATTRIBUTION.name not in paths:
-        echo(f"{'attribution':>13s}: not computed (opt-in, ~17 s CPU on the paper scene: "
+        why = attribution_refused(scene)
+        echo(f"{'attribution':>13s}: not computed ({why})" if why is not None else
+             f"{'attribution':>13s}: not computed (opt-in, ~17 s CPU on the paper scene: "
              "`walkerlab report --full`)")
     if left_out:
         echo(left_out)

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PARTS", "ContactPart", "contact_part", "periodic_gait_refusal"]
+__all__ = ["PARTS", "ContactPart", "attribution_refusal", "contact_part",
+           "periodic_gait_refusal"]
 
 
 class ContactPart:
@@ -49,6 +50,9 @@ class ContactPart:
     #: (:mod:`walkerlab.models.contact.rigid_limit`): the scene's contact and three decades
     #: stiffer
     rigid_limit_kappas = (1.0, 10.0, 100.0, 1000.0)
+    #: why the Section-5 attribution (:mod:`walkerlab.analysis.contact.attribution`) is not
+    #: computed for this kind beyond what :func:`periodic_gait_refusal` says (None: it is)
+    attribution_refusal: str | None = None
     #: steps in the contact periodic gait's map
     #: (:attr:`walkerlab.models.contact.model.ContactWalker.steps_per_map`): a planar
     #: walker's step, its legs' roles swapped, starts the next one
@@ -324,6 +328,10 @@ class Legs3DPart(ContactPart):
     #: s a stride at 1, 0.6 s at 10, 35 s at 100, 440 s at 1000 times the stiffness; the
     #: family's stiction velocity, which the twist's law shares, falls as kappa^-1/2)
     rigid_limit_kappas = (1.0, 2.0, 4.0, 8.0)
+    attribution_refusal = (
+        "the attribution's creep-free (stiction velocity / 100) and 1000 times stiffer "
+        "contacts are beyond the stride map's integrator in 3D (440 s a stride at 1000 "
+        "times the stiffness): walkerlab compare --rigid-limit shows the gap's orders")
     #: the heading: the rigid stance foot holds its yaw (the rigid state has no heading),
     #: the compliant one turns, with a multiplier near 1 (heading is nearly neutral)
     free_modes = 1
@@ -391,6 +399,16 @@ def periodic_gait_refusal(scene, data) -> str | None:
 
     cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"periodic_gait": True})
     return contact_part(data.structure).check(scene, data, cs)
+
+
+def attribution_refusal(scene, data) -> str | None:
+    """Why the Section-5 attribution of the contact gap
+    (:mod:`walkerlab.analysis.contact.attribution`: seven periodic-gait searches) is not
+    computed for the scene's walker, in one line without the scene's name, or None: no
+    contact periodic gait (:func:`periodic_gait_refusal`), or the kind's
+    :attr:`ContactPart.attribution_refusal` (a walker in 3D).  ``data`` is the walker's
+    WalkerData."""
+    return periodic_gait_refusal(scene, data) or contact_part(data.structure).attribution_refusal
 
 
 def contact_part(structure) -> ContactPart:
