@@ -277,10 +277,8 @@ def actuated_module(structure, joints):
             from walkerlab.codegen.free_joints import derive_five_link  # light
 
             eq = derive_five_link(structure)
-        else:
-            from walkerlab.codegen import symbolic  # light
-
-            eq = symbolic.derive(structure)
+        else:  # a planar biped's (symbolic.derive) or a 3D walker's (derive_3d)
+            eq = cache.derive_equations(structure)
         return generate_actuated(eq, structure.param_names, tuple(joints), key)
 
     return cache.import_generated(f"{key}_act_{tag}_nb.py", f"walkerlab_actuated_{key}_{tag}",

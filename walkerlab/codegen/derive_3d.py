@@ -367,6 +367,9 @@ def derive_compass(structure) -> Equations:
     if structure.torso:   # the bisecting hip: the upper body's pitch from the upward vertical
         leg_angles["torso"] = (th_sw + th_st) / 2
     n = len(q)
+    De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)
+    if not arc:  # the extended impact system of a push-off (world axes; arcs: none yet)
+        De, E = push_off_system(te, F, to_world)
     return Equations(
         q=q, dq=dq, params=te.params, M=te.M, C=te.C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=te.kinetic,
@@ -375,5 +378,24 @@ def derive_compass(structure) -> Equations:
                 "hip_height": pelvis[1], "swing_clearance": height},
         points=points, leg_angles=leg_angles,
         section_drop=1, drop_solution=drop_solution,
-        De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
+        De=De, E=E, limit=False, section_tied=None,
     )
+
+
+def push_off_system(te, F: sp.Matrix, to_world: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
+    """The extended impact system of the 3D straight legs' push-off (the stance foot free,
+    :class:`walkerlab.models.hybrid.push_off.PushOffTransition`), in world axes.
+
+    Extended coordinates ``qe = (q, p)``, ``p`` (3,) the stance foot's position in the
+    world: ``De = [[M, A W^T], [W A^T, m I]]`` (n + 3, n + 3), the tree's extended mass
+    matrix (:mod:`walkerlab.codegen.tree_derive`: ``A`` in the slope's frame, turned to the
+    world's by ``W``, ``to_world``); ``E = [W F | I]`` (3, n + 3), the leading (swing)
+    foot's Jacobian (``F`` its Jacobian from the stance foot in the slope's frame).  With no
+    impulse, ``E dqe+ = 0`` and ``De dqe+ = De dqe- + E^T F`` give the passive heel strike
+    ``Mi dq+ = B dq-`` (:func:`walkerlab.codegen.tree_derive.plastic_impact`: ``J = [I;
+    -W F]`` spans ``E``'s null space).
+    """
+    Aw = (te.A * to_world.T).applyfunc(sp.expand)
+    De = te.M.row_join(Aw).col_join(Aw.T.row_join(te.total_mass * sp.eye(3)))
+    E = (to_world * F).applyfunc(sp.expand).row_join(sp.eye(3))
+    return De, E

@@ -156,9 +156,6 @@ class CompassGaitParams(_Actuated):
                                  "and leg inertia are the passive 3D walker's so far)")
         if self.foot_radius_m is not None and not self.foot_radius_m < self.leg_length_m:
             raise ValueError("walker.foot_radius_m must be smaller than walker.leg_length_m")
-        if self.hip_roll is not None and self.actuation is not None:
-            raise ValueError("walker.actuation: a 3D walker's actuators are its hip_roll "
-                             "law so far")
         return self
 
     @property

@@ -74,10 +74,17 @@ def require_kind(stage: str, scene: Scene) -> None:
     from walkerlab.walker.description import walker_data  # light
     from walkerlab.walker.kinds import KindRefused  # light
 
+    from walkerlab.walker.kinds import STAGE_VIEWS  # light
+
+    act = getattr(scene.walker, "actuation", None)
     try:
         kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
         for s in order(stage, scene):
             kind.require_stage(s)
+            if act is not None and s in STAGE_VIEWS:  # the view's actuators (the table's)
+                from walkerlab.models.hybrid.actuated import refuse_actuators  # light
+
+                refuse_actuators(kind, act, STAGE_VIEWS[s][1])
     except KindRefused as exc:
         raise StageError(str(exc)) from None
 

@@ -70,8 +70,12 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
 #: why a 3D walker refuses actuators
-ACTUATION_3D = ("a walker in 3D takes no walker.actuation so far (its lateral "
-                "foot-placement law is walker.hip_roll: hip-roll joints)")
+ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model so far "
+                "(fixedpoint, simulate, the rigid studies); its contact model and exports "
+                "are passive but for the hip-roll law (walker.hip_roll)")
+#: why a 3D walker refuses virtual constraints
+VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
+         "walker.actuation.torques (joint: hip)")
 #: why the kinds other than the 3D straight legs refuse hip-roll joints (the scene's check
 #: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
 NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
@@ -278,9 +282,14 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "straight_legs_3d": {
         ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
         **{("round_feet_3d", v): ROUND_FEET_EXPORT_3D for v in ("mjcf", "urdf", "adams")},
-        **{(f, "*"): ACTUATION_3D for f in ("hip_torque", "knee_torque",
-                                            "ankle_torque", "torso_torque", "push_off",
-                                            "ankle_push_off", "virtual_constraints")},
+        # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
+        # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints)
+        **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
+           for v in ("contact", "mjcf", "urdf", "adams")},
+        ("knee_torque", "*"): _NO_KNEE,
+        **_NO_ANKLES,
+        ("torso_torque", "*"): "the 3D straight legs carry no torso",
+        ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)
         **_CELLS_3D,

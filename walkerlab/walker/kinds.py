@@ -314,7 +314,7 @@ KINDS = {k.name: k for k in (
          landing=None, contact="wheel_3d", scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", "legs_3d", landing=None, contact="legs_3d",
-         scene="configs/hip_width.yaml"),
+         actuators="legs_3d", scene="configs/hip_width.yaml"),
 )}
 
 

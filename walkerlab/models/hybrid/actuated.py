@@ -343,6 +343,41 @@ class _FreeJoints(_Joints):
         return guard_outputs(phase, data)
 
 
+class _Legs3d(_Joints):
+    """Straight legs in 3D (:func:`walkerlab.codegen.derive_3d.derive_compass`): the hip
+    torque between the legs' pitch joints and the push-off along the trailing leg, by the
+    planar walkers' :class:`Actuators`.  Each leg's pitch ``theta`` is its rotation about
+    its own (rolled) hip axis, ``R_leg = Rot(s, phi_leg) Rot(z, theta)``, from the
+    pelvis, which neither pitches nor yaws: a torque ``+tau`` on the swing leg about its
+    pitch axis and ``-tau`` on the stance leg about its own does the virtual work ``tau
+    delta(theta_sw - theta_st)`` (the legs' rolls are not pitch: their angular rates
+    about the hip axis cancel in the difference), so ``B = d(delta)/dq`` of the generated
+    leg angles is the true generalised force, as the planar hip's.  The push-off's
+    extended system is the generated one in world axes (``impact_matrices``: ``(n + 3)``
+    extended coordinates), along the trailing leg from its foot to its own hip
+    (``stance_hip``).  The heel strike's role swap carries the rolls too: its rate map is
+    the generated reset's (:meth:`PushOffTransition.swap_from_reset`), not the legs'
+    pitches alone."""
+
+    hip_spring = False  # the 3D flow has no generated hip spring: the laws are compiled
+
+    def actuators(self, walker: HybridWalker, data, spec):
+        """``(acts, False)`` (legs with mass: the 3D walker has no massless limit); a
+        push-off on round feet refused (one line)."""
+        if spec.push_off is not None and data.structure.foot == "arc":
+            raise ValueError("walker.actuation.push_off: a 3D walker's push-off is a point "
+                             "foot's so far (the disc foot's rolling contact point is not "
+                             "in its extended impact system): drop walker.foot_radius_m")
+        acts, limit = super().actuators(walker, data, spec)
+        if limit:
+            raise ValueError("walker.actuation: a 3D walker's legs carry mass")
+        return acts, limit
+
+    def hold(self, acts, walker: HybridWalker) -> None:
+        """No constraint; the role swap's rate map from the generated reset (the rolls)."""
+        acts.push.swap_from_reset()
+
+
 class _FlatFeet:
     """Flat feet: their stance-foot modes' own mass matrices or an ankle push-off
     (:func:`walkerlab.models.hybrid.ankle_push_off.actuate_flat`)."""
@@ -395,4 +430,4 @@ class _RollingPolygon:
 #: actuators part (:attr:`walkerlab.walker.kinds.Kind.actuators`) -> how :func:`actuate`
 #: drives it (``none``: passive so far, the table refuses)
 _PARTS = {"hips": _Joints(), "latched_knees": _LockingKnees(), "joints": _FreeJoints(),
-          "ankles": _FlatFeet(), "none": _RollingPolygon()}
+          "ankles": _FlatFeet(), "legs_3d": _Legs3d(), "none": _RollingPolygon()}

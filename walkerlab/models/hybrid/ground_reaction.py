@@ -399,7 +399,12 @@ class StanceReaction:
                              "with the roles swapped")
         total = (self.view.dynamics(q0, v0)[0] @ (v1 - v0))[self._hip]
         P, _, _ = self.view.contact_points(q0)
-        push = self._push_off(x_minus, -P[self._feet["stance"]])  # the hip is at 0
+        if self._roles is None:  # the hip is at 0
+            push = self._push_off(x_minus, -P[self._feet["stance"]])
+        else:  # 3D: the root is the stance foot; the trailing leg ends at its own hip
+            pts = w.points(x_minus)
+            push = self._push_off(x_minus, np.asarray(pts["stance_hip"], float)
+                                  - np.asarray(pts["stance_foot"], float))
         _, V, _ = self.view.contact_points(q1, v1)
         return TransitionImpulses(total - push, push, V[self._feet["stance"]].copy(),
                                   self.normal.copy())
@@ -424,8 +429,8 @@ class StanceReaction:
         return np.concatenate([P.T @ x_plus[:n], P.T @ x_plus[n:]])
 
     def _push_off(self, x_minus, e) -> np.ndarray:
-        """The push-off's impulse (2,) [N s]: ``P`` (``walker.actuators.impulse``) along
-        ``e`` (from the trailing foot to the hip); zeros without a push-off."""
+        """The push-off's impulse (d,) [N s]: ``P`` (``walker.actuators.impulse``) along
+        ``e`` (d,) (from the trailing foot to its hip); zeros without a push-off."""
         acts = getattr(self.walker, "actuators", None)
         if acts is None or getattr(acts.spec, "push_off", None) is None:
             return np.zeros(self.normal.size)

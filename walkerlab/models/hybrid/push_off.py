@@ -182,7 +182,9 @@ class PushOffTransition(Transitions):
         """The push-off's unit direction (2,): from the trailing foot's contact point (an
         arc's ``stance_contact``, else the stance foot at the origin) to the hip."""
         pts = self.fns["points"](x)
-        r = np.asarray(pts["hip"])
+        # the trailing leg's hip: a walker in 3D with hip width names its own (its
+        # ``stance_hip``, w/2 from the pelvis' ``hip``); a planar walker's legs share one
+        r = np.asarray(pts["stance_hip"] if "stance_hip" in pts else pts["hip"])
         if "stance_contact" in pts:
             r = r - np.asarray(pts["stance_contact"])
         return r / np.sqrt(r @ r)
@@ -201,14 +203,15 @@ class PushOffTransition(Transitions):
         De, E = self.fns["impact_matrices"](q)
         De, E = np.asarray(De), np.asarray(E)
         e = self.direction(x)
-        dqe = np.concatenate([dq, np.zeros(2)])
-        Ef = np.zeros((2, n + 2))
-        Ef[:, n:] = np.eye(2)
+        k = len(De) - n  # the foot's translations: 2 (planar), 3 (a walker in 3D)
+        dqe = np.concatenate([dq, np.zeros(k)])
+        Ef = np.zeros((k, n + k))
+        Ef[:, n:] = np.eye(k)
         if self.lock is None:
             dqe_po = dqe + np.linalg.solve(De, Ef.T @ (P * e))
-            K = np.zeros((n + 4, n + 4), dtype=np.result_type(De, E))
-            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -E.T, E
-            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(2)]))
+            K = np.zeros((n + 2 * k, n + 2 * k), dtype=np.result_type(De, E))
+            K[:n + k, :n + k], K[:n + k, n + k:], K[n + k:, :n + k] = De, -E.T, E
+            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(k)]))
         else:  # the swing knee locked through both impulses (as the passive heel strike)
             a = np.concatenate([np.asarray(self.lock(x)), np.zeros(2)])[None, :]
             A = np.zeros((n + 3, n + 3), dtype=np.result_type(De, a))
@@ -222,8 +225,8 @@ class PushOffTransition(Transitions):
         dq_plus = sol[:n]
         qn, R = self.relabel(np.real(q))
         qn = qn + R @ (q - np.real(q))  # the swap is affine: exact for a complex step too
-        ke = (0.5 * dqe @ De @ dqe, 0.5 * dqe_po @ De @ dqe_po, 0.5 * sol[:n + 2] @ De
-              @ sol[:n + 2])
+        ke = (0.5 * dqe @ De @ dqe, 0.5 * dqe_po @ De @ dqe_po, 0.5 * sol[:n + k] @ De
+              @ sol[:n + k])
         return {"x_plus": np.concatenate([qn, R @ dq_plus]),
                 "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
 
