@@ -61,7 +61,7 @@ def test_the_3d_hip_torque_is_the_virtual_work_of_a_torque_pair_at_the_pitch_joi
     walker, passive, ref, _w = _walkers(acts)
     for w_act, w_pas in ((walker, passive), (walker.mirror, passive.mirror)):
         for x in _states(11, 4):
-            q, dq = x[:5], x[5:]
+            q = x[:5]
             tau = _law_torque(x)
             a_sw, a_st = ref._R(q[SWROLL]) @ ref.z, ref._R(q[LEAN]) @ ref.z
             Q = tau * (a_sw @ ref._omega_jacobian(SWROLL, SWING, q)

@@ -72,9 +72,7 @@ def require_kind(stage: str, scene: Scene) -> None:
     """
     from walkerlab.stages.common import StageError  # light
     from walkerlab.walker.description import walker_data  # light
-    from walkerlab.walker.kinds import KindRefused  # light
-
-    from walkerlab.walker.kinds import STAGE_VIEWS  # light
+    from walkerlab.walker.kinds import STAGE_VIEWS, KindRefused  # light
 
     act = getattr(scene.walker, "actuation", None)
     try:

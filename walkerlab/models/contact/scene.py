@@ -324,14 +324,16 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
-    if getattr(spec, "virtual_constraints", None) is not None:
-        from walkerlab.walker.kinds import KindRefused
+    from walkerlab.models.hybrid.actuated import refuse_actuators  # light
+    from walkerlab.walker.kinds import KindRefused
 
-        try:
+    try:  # the table's cells: the controller first, then each actuator (a walker in 3D's)
+        if getattr(spec, "virtual_constraints", None) is not None:
             st.kind.require("virtual_constraints", "contact",
                             "walker.actuation.virtual_constraints")
-        except KindRefused as err:
-            raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+        refuse_actuators(st.kind, spec, "contact")
+    except KindRefused as err:
+        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     part = contact_part(st)
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
