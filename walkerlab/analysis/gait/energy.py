@@ -165,13 +165,14 @@ def _signed_work(power, a: float, b: float, scale: float) -> tuple[float, float]
     ``quad_work(p)`` of the smooth integrand.  Kinked where ``p`` changes sign, the two can
     miss a steep stretch quad certifies wrongly (measured: 1.7e-5 J over a 3D walker's step
     whose hip-roll law delivers a 40 W transient after the heel strike); when their sum is
-    more than 1e-10 of ``scale`` from the net work, the interval is split at the sign
+    more than 1e-9 of ``scale`` from the net work (the ledger's aim: 1e-9 J a step), the
+    interval is split at the sign
     changes of ``p`` (bracketed on a 2000-point grid, located by brentq), each piece of one
     sign integrated whole."""
     pos = quad_work(lambda t: max(power(t), 0.0), a, b, scale)
     neg = quad_work(lambda t: min(power(t), 0.0), a, b, scale)
     net = quad_work(power, a, b, scale)
-    if abs(pos + neg - net) <= 1e-10 * scale:
+    if abs(pos + neg - net) <= 1e-9 * scale:
         return pos, neg
     from scipy.optimize import brentq
 
