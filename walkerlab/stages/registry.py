@@ -83,15 +83,27 @@ def _stage(artifact: StageArtifact, module: str, *args, **kwargs) -> Stage:
 
 
 def contact_walks_ground(scene: Scene) -> bool:
-    """Whether the walker's kind walks the scene's ground in the contact view (its cell of
-    :data:`walkerlab.walker.kinds.CAPABILITIES`; the slope always)."""
+    """Whether the walker's kind walks the scene's ground in the contact view, with the
+    scene's actuators (their cells of :data:`walkerlab.walker.kinds.CAPABILITIES`; the
+    slope always, a passive walker always: a 3D walker's actuators are the rigid model's
+    so far)."""
     ground = "slope" if scene.terrain is None else scene.terrain.kind
-    if ground not in ("stairs", "footholds", "profile"):
+    act = getattr(scene.walker, "actuation", None)
+    if ground not in ("stairs", "footholds", "profile") and act is None:
         return True
+    from walkerlab.models.hybrid.actuated import refuse_actuators  # light
     from walkerlab.walker.description import walker_data  # light: kinds on drawn grounds
+    from walkerlab.walker.kinds import KindRefused  # light
 
     kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
-    return kind.supports(ground, "contact")
+    if ground in ("stairs", "footholds", "profile") and not kind.supports(ground, "contact"):
+        return False
+    try:
+        if act is not None:
+            refuse_actuators(kind, act, "contact")
+    except KindRefused:
+        return False
+    return True
 
 
 def attribution_refused(scene: Scene) -> str | None:

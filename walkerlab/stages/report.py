@@ -81,7 +81,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if scene.workprecision is not None and WORKPRECISION.name not in paths:
         echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
     if scene.contact is not None and scene.fixedpoint is not None \
-            and ATTRIBUTION.name not in paths:
+            and CONTACT_SIM.name in stages and ATTRIBUTION.name not in paths:
         why = attribution_refused(scene)
         echo(f"{'attribution':>13s}: not computed ({why})" if why is not None else
              f"{'attribution':>13s}: not computed (opt-in, ~17 s CPU on the paper scene: "

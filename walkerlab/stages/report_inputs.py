@@ -40,6 +40,9 @@ def not_run(scene: Scene, stage: str) -> str:
             return "no 'contact' section"
         if not contact_walks_ground(scene):
             ground = scene.terrain.kind if scene.terrain is not None else "slope"
+            if scene.walker.actuation is not None and ground == "slope":
+                return ("a walker whose actuators the contact view does not take "
+                        "(`walkerlab capabilities`)")
             return (f"a walker the contact view does not walk on {ground} "
                     "(`walkerlab capabilities`)")
         return str(STAGES[CONTACT_SIM.name].not_run)
