@@ -240,9 +240,9 @@ class StepMap:
         z = np.asarray(z, float)
         dim = self.walker.dim
         nl = len(z) - dim - 1
-        d, slips, dd = z[nl], z[nl + 1:-1], z[-1]
+        d, *slips, dd = z[nl:]  # penetration, slip along each tangent, penetration rate
         p = -d * self.n
-        v = slips @ self.walker.tangents - dd * self.n
+        v = np.array(slips) @ self.walker.tangents - dd * self.n
         # link state by name: the swing leg's proximal link aligned with the stance one's
         val = dict(zip(self._columns(1), z[:nl]))
         val[self._angle[0]] = val[self._angle[1]]

@@ -134,6 +134,12 @@ class ContactPart:
     #: why the contact periodic gait refuses this kind's actuators (None: it carries them)
     periodic_actuators: str | None = None
 
+    def actuators_refusal(self, scene, data) -> str | None:
+        """Why the contact view does not take the scene's actuators (``walker.actuation``,
+        not None), one line without the scene's name, before they are built; None here
+        (each actuator's joint is checked as it is built)."""
+        return None
+
 
 class KneedPart(ContactPart):
     """Locking knees: the rigid state by name whatever the coordinates."""
@@ -372,6 +378,18 @@ class Legs3DPart(ContactPart):
         if cs.pin_stance_until != "none":
             return ("contact_sim.pin_stance_until: a walker in 3D starts on its feet (the "
                     "pinned start phase is planar walkers'): leave it 'none'")
+        return None
+
+    def actuators_refusal(self, scene, data) -> str | None:
+        """The table's refusal of the scene's actuators in the contact view (all of them so
+        far: a 3D walker's hip torque and push-off are the rigid model's)."""
+        from walkerlab.models.hybrid.actuated import refuse_actuators  # light
+        from walkerlab.walker.kinds import KindRefused  # light
+
+        try:
+            refuse_actuators(data.structure.kind, scene.walker.actuation, "contact")
+        except KindRefused as err:
+            return str(err)
         return None
 
 

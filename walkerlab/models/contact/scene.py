@@ -324,17 +324,18 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
-    from walkerlab.models.hybrid.actuated import refuse_actuators  # light
-    from walkerlab.walker.kinds import KindRefused
+    if getattr(spec, "virtual_constraints", None) is not None:
+        from walkerlab.walker.kinds import KindRefused
 
-    try:  # the table's cells: the controller first, then each actuator (a walker in 3D's)
-        if getattr(spec, "virtual_constraints", None) is not None:
+        try:
             st.kind.require("virtual_constraints", "contact",
                             "walker.actuation.virtual_constraints")
-        refuse_actuators(st.kind, spec, "contact")
-    except KindRefused as err:
-        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+        except KindRefused as err:
+            raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     part = contact_part(st)
+    why = part.actuators_refusal(scene, data)
+    if why is not None:
+        raise ContactSceneError(f"scene '{scene.name}': {why}")
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
