@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 import walkerlab as wl
-from tests.test_hip_roll_3d import LEAN, STANCE, SWING, SWROLL, Reference, _states
+from tests.test_hip_roll_3d import LEAN, STANCE, SWING, SWROLL, _states, reference_of
 from walkerlab.analysis.gait.energy import trajectory_ledger
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.rigid import simulate_steps
@@ -32,15 +32,9 @@ def _walkers(actuation):
     passive = Scene.model_validate(raw)
     raw["walker"]["actuation"] = actuation
     scene = Scene.model_validate(raw)
-    wc, h = scene.walker, scene.walker.hip_roll
-    gains = (h.pelvis_stiffness_n_m_per_rad, h.pelvis_damping_n_m_s_per_rad,
-             h.swing_stiffness_n_m_per_rad, h.swing_damping_n_m_s_per_rad, h.lean_gain,
-             h.lean_rate_gain_s)
-    ref = Reference(wc.gravity_m_per_s2, wc.leg_length_m, scene.slope.angle_rad,
-                    wc.hip_mass_kg, wc.leg_mass_kg, wc.leg_mass_from_foot_m,
-                    h.pelvis_roll_inertia_kg_m2, gains)
     return (build_walker(scene, plant=Plant.from_scene(scene)),
-            build_walker(passive, plant=Plant.from_scene(passive)), ref, wc.hip_width_m)
+            build_walker(passive, plant=Plant.from_scene(passive)), reference_of(scene),
+            scene.walker.hip_width_m)
 
 
 def _law_torque(x):

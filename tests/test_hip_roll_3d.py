@@ -194,15 +194,19 @@ class Reference:
 def _walker_and_reference(law=None):
     scene = Scene.model_validate(_raw(law))
     walker = build_walker(scene, plant=Plant.from_scene(scene))
-    wc = scene.walker
-    h = wc.hip_roll
+    return scene, walker, reference_of(scene), scene.walker.hip_width_m
+
+
+def reference_of(scene) -> Reference:
+    """The independent Newton model of a hip-roll scene's walker (its masses, slope and
+    law gains)."""
+    wc, h = scene.walker, scene.walker.hip_roll
     gains = (h.pelvis_stiffness_n_m_per_rad, h.pelvis_damping_n_m_s_per_rad,
              h.swing_stiffness_n_m_per_rad, h.swing_damping_n_m_s_per_rad, h.lean_gain,
              h.lean_rate_gain_s)
-    ref = Reference(wc.gravity_m_per_s2, wc.leg_length_m, scene.slope.angle_rad,
-                    wc.hip_mass_kg, wc.leg_mass_kg, wc.leg_mass_from_foot_m,
-                    h.pelvis_roll_inertia_kg_m2, gains)
-    return scene, walker, ref, wc.hip_width_m
+    return Reference(wc.gravity_m_per_s2, wc.leg_length_m, scene.slope.angle_rad,
+                     wc.hip_mass_kg, wc.leg_mass_kg, wc.leg_mass_from_foot_m,
+                     h.pelvis_roll_inertia_kg_m2, gains)
 
 
 @pytest.fixture(scope="module")
