@@ -193,9 +193,18 @@ def test_the_energy_ledger_closes_and_cost_of_transport(name):
         np.testing.assert_allclose(sinks.sum(), led["slope_energy"].sum(),
                                    rtol=1e-7 if w.model.steps_per_map == 1 else 1e-6)
         assert not np.any(led["push_off_work"]) and not np.any(led["actuator_work_positive"])
+    elif phi != 0.0:  # a powered walker on a slope (hip_width_powered: a 3D walker's
+        # push-off and hip spring): the ground releases m g h over each step's descent h
+        # (the landing swing foot's depth below the stance foot), on top of the actuators
+        m, g = w.model.total_mass_kg, w.model.params["gravity_m_per_s2"]
+        feet = [w.model.for_stance(s.stance_leg).points(s.x_end)["swing_foot"]
+                for s in simulate_steps(w.model, w.fixed_point().x, len(led["closure"]),
+                                        w.solver, max_step_time=w.max_step_time).segments]
+        h = np.array([-f[1] for f in feet])
+        assert np.all(h > 0) and np.all(led["push_off_work"] + led["actuator_work_positive"] > 0)
+        np.testing.assert_allclose(led["slope_energy"], m * g * h, rtol=1e-12)
     else:  # level ground: the actuators' share alone (footholds of alternating heights: a
         # step's gravity work m g dh, summing to 0 over the period of footholds)
-        assert phi == 0.0
         if "landing_drop_m" in w.model.params:
             assert abs(led["slope_energy"].sum()) < 1e-12 * np.abs(led["slope_energy"]).sum()
         else:
