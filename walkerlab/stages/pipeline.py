@@ -82,7 +82,10 @@ def require_kind(stage: str, scene: Scene) -> None:
             if act is not None and s in STAGE_VIEWS:  # the view's actuators (the table's)
                 from walkerlab.models.hybrid.actuated import refuse_actuators  # light
 
-                refuse_actuators(kind, act, STAGE_VIEWS[s][1])
+                try:
+                    refuse_actuators(kind, act, STAGE_VIEWS[s][1])
+                except KindRefused as exc:  # as the view itself says it (with the scene)
+                    raise StageError(f"scene '{scene.name}': {exc}") from None
     except KindRefused as exc:
         raise StageError(str(exc)) from None
 
