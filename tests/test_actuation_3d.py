@@ -72,20 +72,14 @@ def _push_off_reference(ref, w, x, P):
     coordinates ``[q, p]``, ``p`` the stance foot, free): ``M_e (dq_po - dq-) = [0; P e]``
     with ``e`` the unit vector from the stance foot to the stance hip, then ``M_e (dq+ -
     dq_po) = E^T F``, ``E dq+ = 0`` (the new foot at rest), the roles swapped."""
-    masses, foot, hip_st = ref.terms(w)
+    hip_st = ref.terms(w)[2]
     q, dq = x[:5], x[5:]
-    Me = np.zeros((8, 8))
-    for m, terms in masses:
-        Je = np.hstack([ref.kin(terms, q, dq)[1], np.eye(3)])
-        Me += m * Je.T @ Je
-    Me[3, 3] += ref.I_pelvis
+    Me = ref.extended_mass(w, q, dq)
     r = ref.kin(hip_st, q, dq)[0]
     e = r / np.linalg.norm(r)
     dqe = np.concatenate([dq, np.zeros(3)])
     dqe_po = dqe + np.linalg.solve(Me, np.concatenate([np.zeros(5), P * e]))
-    E = np.hstack([ref.kin(foot, q, dq)[1], np.eye(3)])
-    K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
-    sol = np.linalg.solve(K, np.concatenate([Me @ dqe_po, np.zeros(3)]))
+    sol = ref.plastic_impact(w, q, dq, dqe_po)
     order = [SWROLL, STANCE, SWING, 3, LEAN]
     return np.concatenate([q[order], sol[:5][order]]), dqe, dqe_po, Me
 

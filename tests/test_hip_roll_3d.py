@@ -160,18 +160,27 @@ class Reference:
         coordinates ``[q, p]`` (``p`` the old stance foot), ``M_e (dq+ - dq-) = E^T F``,
         ``E dq+ = 0`` (the new foot at rest; the hip-roll torques are finite: no
         impulse)."""
-        masses, foot, _ = self.terms(w)
         q, dq = y[:5], y[5:]
+        sol = self.plastic_impact(w, q, dq, np.concatenate([dq, np.zeros(3)]))
+        return sol[:5], sol[5:8]
+
+    def extended_mass(self, w, q, dq):
+        """The mass matrix (8, 8) of the extended coordinates ``[q, p]``, ``p`` the stance
+        foot's position (free)."""
         Me = np.zeros((8, 8))
-        for m, terms in masses:
+        for m, terms in self.terms(w)[0]:
             Je = np.hstack([self.kin(terms, q, dq)[1], np.eye(3)])
             Me += m * Je.T @ Je
         Me[PELVIS, PELVIS] += self.I_pelvis
-        E = np.hstack([self.kin(foot, q, dq)[1], np.eye(3)])
+        return Me
+
+    def plastic_impact(self, w, q, dq, dqe_minus):
+        """``[dq+ (5), dp+ (3), F (3)]`` of the plastic heel strike from the extended rates
+        ``dqe_minus`` (8,): ``M_e (dq+ - dq-) = E^T F``, ``E dq+ = 0``."""
+        Me = self.extended_mass(w, q, dq)
+        E = np.hstack([self.kin(self.terms(w)[1], q, dq)[1], np.eye(3)])
         K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
-        sol = np.linalg.solve(K, np.concatenate([Me @ np.concatenate([dq, np.zeros(3)]),
-                                                  np.zeros(3)]))
-        return sol[:5], sol[5:8]
+        return np.linalg.solve(K, np.concatenate([Me @ dqe_minus, np.zeros(3)]))
 
     def impact(self, w, y):
         """The heel strike: the impact, then the legs' roles swap (the swing leg's roll is
