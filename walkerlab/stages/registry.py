@@ -88,15 +88,16 @@ def contact_walks_ground(scene: Scene) -> bool:
     slope always, a passive walker always: a 3D walker's actuators are the rigid model's
     so far)."""
     ground = "slope" if scene.terrain is None else scene.terrain.kind
+    drawn = ground in ("stairs", "footholds", "profile")
     act = getattr(scene.walker, "actuation", None)
-    if ground not in ("stairs", "footholds", "profile") and act is None:
+    if not drawn and act is None:
         return True
     from walkerlab.models.hybrid.actuated import refuse_actuators  # light
     from walkerlab.walker.description import walker_data  # light: kinds on drawn grounds
     from walkerlab.walker.kinds import KindRefused  # light
 
     kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
-    if ground in ("stairs", "footholds", "profile") and not kind.supports(ground, "contact"):
+    if drawn and not kind.supports(ground, "contact"):
         return False
     try:
         if act is not None:

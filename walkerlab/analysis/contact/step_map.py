@@ -523,8 +523,8 @@ class StepMap:
         hw = self.walker.patch_half_width
         margin = np.inf
         for name, q in cq.items():  # every contact point on its leg's patches
+            loaded = q["penetration"] > 0
             for c in map(float, self.walker.lane(name)):
-                loaded = q["penetration"] > 0
                 near = np.abs(q["s"] - c) <= 2 * hw  # in or next to this patch
                 sel = loaded & near
                 if sel.any():
