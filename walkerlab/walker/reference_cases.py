@@ -179,6 +179,11 @@ SHIPPED = {
     ("straight_legs_3d", "hip_roll"): "hip_width_stabilised",
     # configs/round_feet.yaml's walker in 3D on disc feet, upright: the planar gait
     ("straight_legs_3d", "round_feet_3d"): "round_feet_3d",
+    # the stabilised walker with a push-off and a hip spring (a stable powered 3D gait:
+    # the generated cases on configs/hip_width.yaml's lateral multiplier of ~100 a stride
+    # fall in contact within a few steps)
+    ("straight_legs_3d", "hip_torque"): "hip_width_powered",
+    ("straight_legs_3d", "push_off"): "hip_width_powered",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the
