@@ -115,14 +115,16 @@ class Floating3DContact:
         return Rp, Rp @ _rot(self.z, q[5]), Rp @ _rot(self.z, q[6])
 
     def positions(self, q):
-        """Named points (3,) [m]: ``hip_mass``, ``leg1_mass``, ``leg2_mass``, ``leg1_foot``,
+        """Named points (3,) [m]: each leg's hip ``leg1_hip``, ``leg2_hip`` (the ends of the
+        hip axis), ``hip_mass``, ``leg1_mass``, ``leg2_mass``, ``leg1_foot``,
         ``leg2_foot``."""
         L, a, w = self.L, self.a, self.w
         Rp, R1, R2 = self.orientations(q)
         p = np.asarray(q[:3])
         hip2 = p + R2 @ np.array([0.0, L, 0.0])
         hip1 = hip2 + Rp @ np.array([0.0, 0.0, w])
-        return {"hip_mass": hip2 + Rp @ np.array([0.0, 0.0, w / 2]),
+        return {"leg1_hip": hip1, "leg2_hip": hip2,
+                "hip_mass": hip2 + Rp @ np.array([0.0, 0.0, w / 2]),
                 "leg1_mass": hip1 + R1 @ np.array([0.0, a - L, 0.0]),
                 "leg2_mass": p + R2 @ np.array([0.0, a, 0.0]),
                 "leg1_foot": hip1 + R1 @ np.array([0.0, -L, 0.0]),
@@ -157,6 +159,33 @@ class Floating3DContact:
             W = self._d_along(lambda qq: self.orientations(qq)[leg], q, e) @ R.T
             out[k] = self.n @ np.array([W[2, 1], W[0, 2], W[1, 0]])
         return out
+
+    def angular_velocity_jacobian(self, body, q):
+        """(3, 7) the Jacobian of body ``body``'s (0 the pelvis, 1 leg1, 2 leg2) angular
+        velocity in world axes: column ``k`` is ``vee(dR/dq_k R^T)``."""
+        R = self.orientations(q)[body]
+        out = np.empty((3, 7))
+        for k, e in enumerate(np.eye(7)):
+            W = self._d_along(lambda qq: self.orientations(qq)[body], q, e) @ R.T
+            out[:, k] = (W[2, 1], W[0, 2], W[1, 0])
+        return out
+
+    def hip_torque_force(self, q, tau, stance):
+        """The generalised force (7,) of a hip motor pair: a torque ``+tau`` about the
+        hip axis (the pelvis' lateral axis ``R_p z``) on the swing leg and ``-tau`` on the
+        stance leg ``stance`` (1 or 2), each against the pelvis: the virtual power
+        ``tau (w_swing - w_stance) . (R_p z)``."""
+        axis = self.orientations(q)[0] @ self.z
+        swing = 3 - stance
+        Jw = self.angular_velocity_jacobian(swing, q) - self.angular_velocity_jacobian(stance, q)
+        return tau * (axis @ Jw)
+
+    def push_force(self, q, force, leg):
+        """The generalised force (7,) of a force ``force`` [N] at leg ``leg``'s foot (1 or
+        2) along the line from it to that leg's own hip."""
+        r = self.positions(q)
+        e = r[f"leg{leg}_hip"] - r[f"leg{leg}_foot"]
+        return self.jacobian(f"leg{leg}_foot", q).T @ (force * e / np.linalg.norm(e))
 
     # -- contact -----------------------------------------------------------------------
     def foot_contact(self, q, dq, leg):

@@ -155,16 +155,19 @@ def rhs_packed(y, d, dy):
 _POWERED_RHS = '''
 
 @njit(cache=True, error_model='numpy')
-def push_force(x, p, push_leg, force, hx, hy):
+def push_force(x, p, push_leg, force):
     """The generalised force (NQ,) of a force ``force`` [N] at contact point ``push_leg``
-    along the line from it to the hip (coordinates ``hx``, ``hy``), and its power [W]."""
+    along the line from it to its leg's hip (``hips``), and its power [W]."""
     P, V, J = _asm.point_buffers(NQ, NF, DIM)
     feet(x, p, P, V, J)
-    return _pk.push_along_leg(x, P, V, J, push_leg, force, hx, hy)
+    H = np.empty((3, DIM))
+    HV = np.empty((3, DIM))
+    hips(x, p, H, HV)
+    return _pk.push_along_leg(P, V, J, push_leg, force, H[1 + POINT_LEG[push_leg]])
 
 
 @njit(cache=True, error_model='numpy')
-def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy, out):
+def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, out):
     """A powered walker's right-hand side with its ledger's powers, into ``out``
     (NX + 4,): ``[dx, hip torque's positive and negative power, push-off's, contact
     forces']`` (:func:`walkerlab.models.contact.actuation.powered_rhs`'s arithmetic)."""
@@ -173,7 +176,7 @@ def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy,
     Q = _pk.hip_torque_ledger(x, r, tab, has_tau, sw, st, tau, out)
     p_po = 0.0
     if push_leg >= 0:
-        Qp, p_po = push_force(x, p, push_leg, force, hx, hy)
+        Qp, p_po = push_force(x, p, push_leg, force)
         Q = Q + Qp
     out[NX + 2] = p_po
     if _pk.moves(Q):
@@ -225,7 +228,7 @@ def _phase(x, A, p, st):
 @njit(cache=True, error_model='numpy')
 def _pulse(x, A, p, S):
     """The push-off pulse's force into ``S[:NQ]`` and its power into ``S[NQ + 4]``."""
-    Qp, pp = push_force(x, p, int(A[5]), A[6], int(A[7]), int(A[8]))
+    Qp, pp = push_force(x, p, int(A[5]), A[6])
     if A[15] > 0.5:  # a flat foot's ankle holds through the pulse
         M = np.empty((NQ, NQ))
         h = np.empty(NQ)

@@ -18,6 +18,10 @@ Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
 ``spins(x, p, S, Jn)``                 each contact point's spin rate about the ground's
                                        normal ``S`` (nf,) [rad/s] and its Jacobian ``Jn``
                                        (nf, nq) (zeros for a planar walker)
+``hips(x, p, H, HV)``                  the hip ``H[0]`` (a planar walker's floating base,
+                                       a 3D walker's pelvis), leg1's and leg2's own hips
+                                       ``H[1]``, ``H[2]`` (the hip's where the legs share
+                                       it) (3, d) [m] and their velocities ``HV`` [m/s]
 ``energies(X, p)``                     numpy: kinetic, potential [J] of states (2 nq, k)
 ``points(X, p)``                       numpy: named points (d, k) [m]
 =====================================  ========================================================
@@ -214,6 +218,16 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
         outs += [(f"S[{i}]", (Jn * dqv)[0])]
         outs += [(f"Jn[{i}, {k}]", Jn[0, k]) for k in range(nq)]
     body += _fn("spins", "x, p, S, Jn", eq, outs, pr)
+    # the hip (the floating base of a planar walker; a 3D walker's pelvis) and each leg's
+    # own hip (a walker with hip width: its end of the hip axis), with their velocities
+    hip = eq.points.get("hip", sp.zeros(d, 1))
+    outs = []
+    for i, name in enumerate(("hip", "leg1_hip", "leg2_hip")):
+        pos = eq.points.get(name, hip)
+        v = pos.jacobian(qv) * dqv
+        outs += [(f"H[{i}, {r}]", pos[r]) for r in range(d)]
+        outs += [(f"HV[{i}, {r}]", v[r]) for r in range(d)]
+    body += _fn("hips", "x, p, H, HV", eq, outs, pr)
     body += _numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential})
     body += ["def energies(X, p):", "    d = _energies(X, p)",
              "    return d['kinetic'], d['potential']", ""]

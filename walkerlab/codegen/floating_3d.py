@@ -104,6 +104,10 @@ def derive_legs_3d(structure: Structure) -> FloatingEquations:
     # each foot's spin about the slope's normal: its leg's angular velocity there
     spins = tuple(_spin(kin, link, rename) for link in ("swing_leg", "stance_leg"))
     points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
+    # each leg's own hip, w/2 from the pelvis' (the push-off's line: the rigid model's
+    # stance_hip and swing_hip, walkerlab.codegen.derive_3d)
+    points["leg1_hip"] = to_world * kin.origins["swing_leg"].xreplace(rename)
+    points["leg2_hip"] = to_world * kin.origins["pelvis"].xreplace(rename)
     for b in structure.bodies:
         for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
             points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)

@@ -427,7 +427,7 @@ class ActuationHook:
             self._keep(sol, t)
             self.t, self.y = t, y
             self.pushed = True
-            P = acts.impulse(y[:n])
+            P = acts.impulse(self.walker, y[:n])
             if not P > 0.0:
                 return "go"
             tp, trailing = min(t + acts.pulse_s, t1), self.stance
@@ -457,7 +457,7 @@ class ActuationHook:
         trailing = self.stance
         before = (trailing, self.t_origin, self.ankle_on)
         self._strike(t)
-        P = acts.impulse(y[:n]) if not self.pushed else 0.0
+        P = acts.impulse(self.walker, y[:n]) if not self.pushed else 0.0
         self.pushed = False
         if self.segments is not None and not P > 0.0:  # the next segment: from before it
             self.resume = (*self._back(t), *before)

@@ -140,7 +140,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
             return t, y[:n], RunEnd.T_FINAL
         struck, trailing = True, run.stance
         run.stance, run.t_origin = 1 - trailing, t  # heel strike: the roles swap
-        P = 0.0 if pushed else acts.impulse(y[:n])
+        P = 0.0 if pushed else acts.impulse(run.walker, y[:n])
         got, end = _touchdown_push(run, y, t, trailing, P)
         if got is None:
             return end
@@ -186,7 +186,7 @@ def _lead_pulse(run, t, y):
     to its end.  Returns ``((t, y, struck), None)`` or ``(None, end)`` as
     :func:`_pulse_segment`."""
     acts = run.walker.actuators
-    P = acts.impulse(y[:2 * run.walker.nq])
+    P = acts.impulse(run.walker, y[:2 * run.walker.nq])
     if not P > 0.0:
         return (t, y, False), None
     tp, trailing = t + acts.pulse_s, run.stance
@@ -254,7 +254,7 @@ def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.in
 
     acts = walker.actuators
     x = np.asarray(x, float)
-    P = acts.impulse(x)
+    P = acts.impulse(walker, x)
     if P <= 0.0:
         return t, x, RunEnd.T_FINAL
     if acts.pulse_s == 0.0:

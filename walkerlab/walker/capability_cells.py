@@ -285,7 +285,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints)
         **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
-           for v in ("contact", "mjcf", "urdf", "adams")},
+           for v in ("mjcf", "urdf", "adams")},
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
         ("torso_torque", "*"): "the 3D straight legs carry no torso",

@@ -82,7 +82,10 @@ def contact_step_ledger(walker, t, X, work, heel_strike_times) -> dict[str, np.n
         cols = [work[:, names.index(k)] for k in keys if k in names]
         return sum(delta(c) for c in cols) if cols else np.zeros(b.size - 1)
 
-    hip = np.column_stack([np.interp(b, t, X[:, 0]), np.interp(b, t, X[:, 1])])
+    # the hip's position along the ground (a planar walker's floating base; a 3D
+    # walker's pelvis: its base is a foot)
+    hip = walker.hip_positions(X)
+    hip = np.column_stack([np.interp(b, t, hip[:, k]) for k in range(hip.shape[1])])
     d = np.diff(hip @ np.asarray(walker.tangent, float))
     m, g, phi = float(walker.total_mass), float(walker.g), float(walker.phi)
     slope = m * g * d * np.sin(phi)

@@ -153,23 +153,37 @@ class PushOffPulse:
                 for i in (1, 2))
         return self._push_rows[leg]
 
-    def impulse(self, x) -> float:
+    @staticmethod
+    def hips(walker, x) -> tuple[np.ndarray, np.ndarray]:
+        """``(H, HV)``: the hip, leg1's and leg2's own hips (3, d) [m] and their velocities
+        [m/s] at the state ``x`` (the generated ``hips``: a planar walker's legs share the
+        hip, its floating base; a 3D walker's hips are the ends of its hip axis, the pelvis
+        between them)."""
+        d = walker.dim
+        H, HV = np.empty((3, d)), np.empty((3, d))
+        walker.kernels.hips(np.ascontiguousarray(x, dtype=float), walker.walker_params, H, HV)
+        return H, HV
+
+    def impulse(self, walker, x) -> float:
         """Push-off impulse ``P`` [N s] for the state ``x`` where the pulse starts (its hip
-        speed)."""
-        n = self.nq
-        return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
+        speed: the pelvis' in 3D, as the rigid view's)."""
+        v = self.hips(walker, x)[1][0]
+        speed = v[0]
+        for c in v[1:]:  # np.hypot over the components (a planar walker's two: one call)
+            speed = np.hypot(speed, c)
+        return float(push_off_impulse(self.spec.push_off, speed))
 
     def push_direction(self, walker, x, trailing: int):
-        """``(e, J, v)``: the unit vector (2,) from leg ``trailing``'s push-off point
-        (:meth:`push_row`) towards the hip (the push-off's direction), that point's Jacobian
-        (2, nq) and velocity (2,) [m/s]."""
-        n = self.nq
+        """``(e, J, v)``: the unit vector (d,) from leg ``trailing``'s push-off point
+        (:meth:`push_row`) towards its leg's hip (the push-off's direction), that point's
+        Jacobian (d, nq) and velocity (d,) [m/s]."""
+        n, d = self.nq, walker.dim
         nf = len(walker.contact_names())
-        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
+        P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, n))
         x = np.asarray(x, float)
         walker.kernels.feet(x, walker.walker_params, P, V, J)
         k = self.push_row(walker, trailing)
-        r = x[list(self.hip)] - P[k]  # the hip is the floating base's point
+        r = self.hips(walker, x)[0][1 + trailing] - P[k]
         return r / np.sqrt(r @ r), J[k], V[k]
 
     def push_off_force(self, walker, x, trailing: int, force: float):
@@ -221,6 +235,9 @@ class ContactActuators(PushOffPulse, ContactRows):
     torso : bool
         The walker has a torso bisecting the legs (its angle the mean of the legs', of the
         thighs' on knees: the rigid view's).
+    flow_law : bool
+        The walker's generated flow carries a joint law that does work (a 3D walker's
+        hip-roll law, Kuo 1999): its power is a term of the ledger, ``hip_roll``.
 
     Raises
     ------
@@ -238,7 +255,8 @@ class ContactActuators(PushOffPulse, ContactRows):
     #: ones (:mod:`walkerlab.io.schemas.contact_sim`): none
     work_labels: dict = {}
 
-    def __init__(self, spec, coordinates, pulse_s: float, kind, torso: bool = False):
+    def __init__(self, spec, coordinates, pulse_s: float, kind, torso: bool = False,
+                 flow_law: bool = False):
         from walkerlab.walker.joints import joint_links
 
         names = tuple(coordinates)
@@ -260,6 +278,9 @@ class ContactActuators(PushOffPulse, ContactRows):
                                  "walkers whose legs are massless (the contact view has "
                                  "massive legs)")
         self.ankle = ankle
+        #: the walker's own joint law in its generated flow does work (a 3D walker's
+        #: hip-roll law): the ledger's ``hip_roll`` term
+        self.flow_law = bool(flow_law)
         self._dampers = None  # the walker's dampers, looked up on first use
         self.foot = ((names.index("leg1_foot_angle"), names.index("leg2_foot_angle"))
                      if flat else None)
@@ -271,8 +292,10 @@ class ContactActuators(PushOffPulse, ContactRows):
         #: the link an ankle joins to its foot (a kneed walker's shank)
         self.ankle_leg = ((names.index("leg1_shank_angle"), names.index("leg2_shank_angle"))
                           if self.knee else self.leg)
-        #: the hip's position columns (the floating base: the hip point itself)
-        self.hip = (names.index("hip_x"), names.index("hip_y"))
+        #: the hip's position columns where the floating base is the hip point (a walker
+        #: in 3D is set free at a foot: (-1, -1))
+        self.hip = ((names.index("hip_x"), names.index("hip_y")) if "hip_x" in names
+                    else (-1, -1))
         self.laws = TorqueLaws(spec.torques)
         #: every torque at the hip between the legs (the arithmetic of a single hip torque)
         self.hip_only = all(t.joint == "hip" for t in spec.torques)
@@ -358,7 +381,7 @@ class ContactActuators(PushOffPulse, ContactRows):
         the knee stops' last on knees."""
         knee = ("knee_stop",) if self.knee else ()
         if self.foot is None:
-            return WORK_NAMES + knee
+            return WORK_NAMES + knee + (("hip_roll",) if self.flow_law else ())
         names = ()
         if self.ankle is not None:
             names += ANKLE_WORK_NAMES[:2]
@@ -412,11 +435,10 @@ class ContactActuators(PushOffPulse, ContactRows):
         """
         kern = getattr(walker.kernels, "powered_rhs", None)
         if (kern is None or self.knee or self.foot is not None or self.ankle is not None
-                or not self.hip_only):
+                or not self.hip_only or self.flow_law):
             return None
         args = walker._args()
         nx = 2 * self.nq
-        hx, hy = self.hip
 
         def f(y, stance: int, push, t_step: float):
             x = np.ascontiguousarray(y[:nx], dtype=float)
@@ -428,7 +450,7 @@ class ContactActuators(PushOffPulse, ContactRows):
             out = np.empty(nx + 4)
             kern(x, *args, bool(laws), self.leg[1 - stance], self.leg[stance], tau,
                  -1 if push is None else self.push_row(walker, int(push[0])),
-                 0.0 if push is None else float(push[1]), hx, hy, out)
+                 0.0 if push is None else float(push[1]), out)
             return out
         return f
 
@@ -491,7 +513,23 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
     if acts.knee:
         return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
                              _knee_power(walker, x)])
+    if acts.flow_law:
+        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
+                             _flow_law_power(walker, x)])
     return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact])
+
+
+def _flow_law_power(walker, x) -> float:
+    """The power [W] of the joint law in the walker's generated flow (a 3D walker's
+    hip-roll law) at the state ``x``: the generated ``rhs_q``'s joint-law power
+    (:func:`walkerlab.models.contact.rhs_lines.rhs_source`, no force added, no ghost
+    foot)."""
+    n = walker.nq
+    S = np.zeros(n + 12)
+    S[n + 10] = -1.0
+    walker.kernels.rhs_q(np.ascontiguousarray(x, dtype=float), *walker._args(), S,
+                         np.empty(2 * n))
+    return float(S[n + 7])
 
 
 def _knee_power(walker, x) -> float:

@@ -380,9 +380,33 @@ class Legs3DPart(ContactPart):
                     "pinned start phase is planar walkers'): leave it 'none'")
         return None
 
+    def actuators(self, data, spec, coordinates, pulse_s: float):
+        """The planar walkers' actuators on the legs' pitch joints
+        (:class:`walkerlab.models.contact.actuation.ContactActuators`): the hip torque
+        pair ``tau (e_swing - e_stance)`` on the pitch coordinates (each leg's pitch is its
+        rotation about its own hip axis from the pelvis, which neither pitches nor yaws:
+        the rigid view's generalised force, :class:`walkerlab.models.hybrid.actuated.
+        _Legs3d`), the push-off pulse along the trailing leg from its foot to its own hip
+        (the generated ``hips``), and the hip-roll law's power in the ledger
+        (``hip_roll``).
+
+        Raises
+        ------
+        ValueError
+            A push-off on disc feet (the rigid view's refusal, one line).
+        """
+        from .actuation import ContactActuators  # light
+
+        st = data.structure
+        if spec.push_off is not None and st.foot == "arc":
+            raise ValueError("walker.actuation.push_off: a 3D walker's push-off is a point "
+                             "foot's so far (the rigid view's): drop walker.foot_radius_m")
+        return ContactActuators(spec, coordinates, pulse_s, st.kind,
+                                flow_law=bool(st.hip_roll))
+
     def actuators_refusal(self, scene, data) -> str | None:
-        """The table's refusal of the scene's actuators in the contact view (all of them so
-        far: a 3D walker's hip torque and push-off are the rigid model's)."""
+        """The table's refusal of the scene's actuators in the contact view (a torque at a
+        joint the straight legs do not have, virtual constraints), one line."""
         from walkerlab.models.hybrid.actuated import refuse_actuators  # light
         from walkerlab.walker.kinds import KindRefused  # light
 

@@ -25,13 +25,12 @@ A_HEAD = 36
 
 
 @njit(cache=True, error_model='numpy')
-def push_along_leg(x, P, V, J, push_leg, force, hx, hy):
+def push_along_leg(P, V, J, push_leg, force, hip):
     """The generalised force (nq,) of a force ``force`` [N] at contact point ``push_leg``
-    (its position ``P``, velocity ``V``, Jacobian ``J``) along the line from it to the hip
-    (coordinates ``hx``, ``hy``), and its power [W]."""
-    rr = np.empty(2)
-    rr[0] = x[hx] - P[push_leg, 0]
-    rr[1] = x[hy] - P[push_leg, 1]
+    (its position ``P``, velocity ``V``, Jacobian ``J``) along the line from it to its
+    leg's hip ``hip`` (d,) [m] (the hip point of a planar walker, the leg's own end of the
+    hip axis of one with hip width), and its power [W]."""
+    rr = hip - P[push_leg]
     e = rr / np.sqrt(np.dot(rr, rr))
     F = force * e
     Jt = np.ascontiguousarray(J[push_leg].T)

@@ -24,13 +24,13 @@ reference arithmetic; a test holds the two equal on every kind of walker):
   biped (Westervelt, Grizzle & Koditschek 2003); ``Q += B tau``, power ``tau . d delta/dt``;
 - a flat foot's ankle push-off ``tau_a = -K (a - a_0) - c`` on ``(foot, leg)`` while on;
 - the push-off pulse: a force ``F e`` at the trailing foot's push point along the line to
-  the hip, ``Q += J^T F e`` (on a flat foot with the ankle torque ``lam`` that holds the
+  its leg's hip (the generated ``hips``: a 3D walker's own end of the hip axis), ``Q += J^T F e`` (on a flat foot with the ankle torque ``lam`` that holds the
   ankle: ``a M^-1 (J^T F e + a lam) = 0``);
 - a generalised force held from outside (a Gymnasium action's torques, per stance leg),
   power ``E . dq``;
-- the ledger's powers: ``W = [tau+, tau-, ankle+, ankle-, push, damper, contact, knee,
-  action+, action-]``, of which the block's work map picks the run's work integrals in
-  order.
+- the ledger's powers: ``W = [tau+, tau-, ankle+, ankle-, push, damper, contact, joint
+  law (the knee stops'; a 3D walker's hip-roll law's), action+, action-]``, of which
+  the block's work map picks the run's work integrals in order.
 
 The actuation block ``A`` (after the passive data ``[n1, n2, PC, p, c1, c2]``; then the call
 counter):
@@ -82,7 +82,7 @@ __all__ = ["A_HEAD", "CYRK_POWERED_SOURCE", "W_INDEX", "powered_source"]
 #: Index in the powers ``W`` of each work integral's name.
 W_INDEX = {"hip_torque_positive": 0, "hip_torque_negative": 1, "ankle_torque_positive": 2,
            "ankle_torque_negative": 3, "push_off": 4, "damper": 5, "contact": 6,
-           "knee_stop": 7, "action_positive": 8, "action_negative": 9}
+           "knee_stop": 7, "hip_roll": 7, "action_positive": 8, "action_negative": 9}
 
 
 def powered_source() -> str:

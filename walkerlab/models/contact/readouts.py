@@ -113,6 +113,15 @@ class ContactReadouts:
         """Named points (2, n) [m]: hip, each body (``leg1_<body>``), feet, knees."""
         return self.kernels.points(self._rows(X).T, self.walker_params)
 
+    def hip_positions(self, X) -> np.ndarray:
+        """The hip's position (n, d) [m] in world axes for states X (n, 2 nq): a planar
+        walker's floating base (its first two coordinates), a 3D walker's pelvis (its
+        base is a foot: from the kinematics)."""
+        X = self._rows(X)
+        if self.dim == 2:
+            return X[:, :2].copy()
+        return np.atleast_2d(self.points(X)["hip"].T)
+
     def hip_height(self, X) -> np.ndarray:
         """Hip height above the ground line, hip . n [m], for X (n, 2 nq) -> (n,) (numpy: a
         dot product is not worth a compiled kernel per walker structure, compiled anew in

@@ -75,7 +75,7 @@ def _knee_lines(eq, red, pr, Q, power: list) -> list[str]:
     return lines
 
 
-def _stance_lines(eq, Q) -> list[str]:
+def _stance_lines(eq, Q, pr=None, power=None) -> list[str]:
     """:func:`rhs_source`'s stance-dependent internal forces
     (:attr:`walkerlab.codegen.floating.FloatingEquations.stance_forces`: a walker in 3D
     with hip-roll joints, Kuo 1999's law) added into ``Q``: each leg's law weighted by its
@@ -83,7 +83,9 @@ def _stance_lines(eq, Q) -> list[str]:
     point results ``_r<i>``; ``e`` = ``PC[I_WEPS]``, 1e-3 of the walker's weight: the
     stance leg's law in single support to 0.1 %, the two blended through the double
     support, halves in flight, and continuous through a bounce, where both loads
-    vanish)."""
+    vanish).  With ``power`` (a list: :func:`rhs_source`'s forced variant) the law's power
+    ``sum_k w_k F_k . dq`` [W] is appended to it as text (its terms computed here,
+    printed by ``pr``)."""
     import sympy as sp
 
     if not eq.stance_forces:
@@ -96,6 +98,13 @@ def _stance_lines(eq, Q) -> list[str]:
         w = sp.Symbol(f"_w{k}", real=True)
         for i in range(len(Q)):
             Q[i] += w * F[i]
+    if power is not None:  # each leg's law's power F_k . dq, weighted as its force
+        dqv = sp.Matrix(eq.dq)
+        pk = [(F.T * dqv)[0] for F in eq.stance_forces]
+        repl, red = sp.cse(pk, symbols=sp.numbered_symbols("_pl"), order="none")
+        lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
+        lines += [f"    _plaw{k} = {pr.doprint(r)}" for k, r in enumerate(red)]
+        power.append(" + ".join(f"_w{k} * _plaw{k}" for k in range(len(red))))
     return lines
 
 
@@ -145,8 +154,9 @@ def rhs_source(eq, forced: bool = False) -> str:
     :mod:`walkerlab.models.contact.powered_source`), the same arithmetic with the
     generalised force ``S[:nq]`` [N, N m] added to ``Q - h`` before the solve (an actuated
     walker's forces), and ``S[nq + 6]``, ``S[nq + 7]`` filled with the contact forces' power
-    ``sum F . v`` over the contact points (their material velocities) and the knee stops'
-    power ``-T d(ext)/dt`` [W]; ``S[nq + 10:nq + 12]`` = ``G``:
+    ``sum F . v`` over the contact points (their material velocities) and the joints' own
+    laws' power: the knee stops' ``-T d(ext)/dt``, a 3D walker's hip-roll law's
+    ``sum_k w_k F_k . dq`` [W]; ``S[nq + 10:nq + 12]`` = ``G``:
     the contact points of leg ``G[0]`` (0: leg1, 1: leg2; -1: none) at least ``G[1]`` [m]
     ahead (along the ground) of every point of the other leg carry no contact force (a
     *ghost* swing foot: up to its touchdown ahead the run is the same, and a compiled run
@@ -181,7 +191,7 @@ def rhs_source(eq, forced: bool = False) -> str:
         Q += Jn.T * tw
         power[i] += f" + {tw} * ({spin})"
     lines += _knee_lines(eq, red, pr, Q, power)
-    lines += _stance_lines(eq, Q)
+    lines += _stance_lines(eq, Q, pr, power if forced else None)
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}
     mexprs = [eq.M[i, j] for i in range(nq) for j in range(i + 1) if (i, j) in nz]
     repl, red = sp.cse(mexprs + list(Q), symbols=sp.numbered_symbols("_m"), order="none")
