@@ -24,8 +24,9 @@ reference arithmetic; a test holds the two equal on every kind of walker):
   biped (Westervelt, Grizzle & Koditschek 2003); ``Q += B tau``, power ``tau . d delta/dt``;
 - a flat foot's ankle push-off ``tau_a = -K (a - a_0) - c`` on ``(foot, leg)`` while on;
 - the push-off pulse: a force ``F e`` at the trailing foot's push point along the line to
-  its leg's hip (the generated ``hips``: a 3D walker's own end of the hip axis), ``Q += J^T F e`` (on a flat foot with the ankle torque ``lam`` that holds the
-  ankle: ``a M^-1 (J^T F e + a lam) = 0``);
+  its leg's hip (the generated ``hips``: a 3D walker's own end of the hip axis),
+  ``Q += J^T F e`` (on a flat foot with the ankle torque ``lam`` that holds the ankle:
+  ``a M^-1 (J^T F e + a lam) = 0``);
 - a generalised force held from outside (a Gymnasium action's torques, per stance leg),
   power ``E . dq``;
 - the ledger's powers: ``W = [tau+, tau-, ankle+, ankle-, push, damper, contact, joint
