@@ -65,10 +65,12 @@ def test_the_3d_hip_torque_and_push_off_move_the_walker_as_the_independent_model
     spinning in every regime of the friction law), with leg1 or leg2 in stance and with or
     without a 40 N push-off pulse at the trailing foot: the hip spring's torque is ``-5
     (theta_swing - theta_stance)`` N m from the reference's pitches, and the actuated
-    accelerations equal the reference's ``qdd + M^-1 (Q_hip + Q_push)`` (the reference's
+    accelerations equal the reference's ``qdd + M^-1 (Q_hip + Q_push)`` (``Q_push`` with the
+    moment about the normal that holds the trailing foot's spin, as the rigid foot's yaw
+    is held through the impulse: the reference's spin Jacobian; the reference's
     velocity-product term is a central difference: 1e-8 relative, as the passive flow's
     test, measured <= 3e-11); the torque's power is ``tau (dtheta_sw - dtheta_st)`` and the
-    pulse's ``F e . v_foot`` from the reference's kinematics (1e-9).  Both forces are
+    pulse's ``F e . v_foot + lam w_n`` from the reference's kinematics (1e-9).  Both forces are
     resolved: either left out moves the accelerations by over 100 times the tolerance."""
     cw, x0, ref, perm = powered_hip_width
     acts = cw.actuators
@@ -84,8 +86,15 @@ def test_the_3d_hip_torque_and_push_off_move_the_walker_as_the_independent_model
             tau = -5.0 * (q[4 + swing] - q[4 + stance])  # pitch1, pitch2 at 5, 6
             assert abs(acts.torques(x, stance - 1)[0] - tau) < 1e-12 * (1 + abs(tau))
             Q_hip = ref.hip_torque_force(q, tau, stance)
+            # the pulse with the moment about the normal that holds the trailing foot's
+            # spin through it (the rigid view's yaw-held foot): a M^-1 (Q_po + lam a) = 0
+            Q_po = ref.push_force(q, 40.0, stance)
+            a = ref.spin_jacobian(stance, q)
+            lam = -(a @ np.linalg.solve(M, Q_po)) / (a @ np.linalg.solve(M, a))
+            Q_po = Q_po + lam * a
+            assert abs(a @ np.linalg.solve(M, Q_po)) < 1e-9 * np.max(np.abs(Q_po))
             for push in (None, (stance - 1, 40.0)):
-                Q = Q_hip + (0.0 if push is None else ref.push_force(q, 40.0, stance))
+                Q = Q_hip + (0.0 if push is None else Q_po)
                 want = passive + np.linalg.solve(M, Q)
                 dx, pw = powered_rhs(cw, x, stance - 1, push)
                 got = _to_ref(dx, perm)[7:]
@@ -103,7 +112,7 @@ def test_the_3d_hip_torque_and_push_off_move_the_walker_as_the_independent_model
                     r = ref.positions(q)
                     e = r[f"leg{stance}_hip"] - r[f"leg{stance}_foot"]
                     v = ref.jacobian(f"leg{stance}_foot", q) @ dq
-                    p_po = 40.0 * (e / np.linalg.norm(e)) @ v
+                    p_po = 40.0 * (e / np.linalg.norm(e)) @ v + lam * (a @ dq)
                     assert abs(pw[2] - p_po) < 1e-9 * (1 + abs(p_po))
     assert worst > 0 and nq == 7
 

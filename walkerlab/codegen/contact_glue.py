@@ -229,7 +229,16 @@ def _phase(x, A, p, st):
 def _pulse(x, A, p, S):
     """The push-off pulse's force into ``S[:NQ]`` and its power into ``S[NQ + 4]``."""
     Qp, pp = push_force(x, p, int(A[5]), A[6])
-    if A[15] > 0.5:  # a flat foot's ankle holds through the pulse
+    if A[15] > 1.5:  # a 3D walker's trailing foot holds its spin through the pulse
+        M = np.empty((NQ, NQ))
+        h = np.empty(NQ)
+        dyn(_pk.at_rest(x, NQ), p, M, h)
+        Sn = np.empty(NF)
+        Jn = np.empty((NF, NQ))
+        spins(x, p, Sn, Jn)
+        k = int(A[5])
+        pp = _pk.hold_row(M, Qp, pp, Jn[k].copy(), Sn[k])
+    elif A[15] > 0.5:  # a flat foot's ankle holds through the pulse
         M = np.empty((NQ, NQ))
         h = np.empty(NQ)
         dyn(_pk.at_rest(x, NQ), p, M, h)

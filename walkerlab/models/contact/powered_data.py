@@ -130,6 +130,8 @@ class PoweredData:
             h[5], h[6] = self.push_rows[trailing], float(push[1])
             if self.foot is not None:
                 h[15:18] = (1.0, self.foot[trailing], acts.ankle_leg[trailing])
+            elif self.walker.dim == 3:  # the trailing foot holds its spin (3D)
+                h[15] = 2.0
         if ankle:
             h[9:12] = (1.0, self.foot[0], acts.ankle_leg[0])
             h[32:34] = (self.foot[1], acts.ankle_leg[1])

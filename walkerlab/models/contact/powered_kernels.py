@@ -181,6 +181,20 @@ def hold_ankle(x, A, M, Qp, pp):
 
 
 @njit(cache=True, error_model='numpy')
+def hold_row(M, Qp, pp, a, rate):
+    """The push-off pulse's force ``Qp`` (nq,) with the generalised force ``lam a`` that
+    holds the rate ``a . dq`` (its value ``rate``) through it, ``a M^-1 (Qp + a lam) = 0``,
+    added in place (a 3D walker's trailing foot holding its spin about the ground's
+    normal: ``a`` the spin's Jacobian); returns the pulse's power with ``lam rate``."""
+    n = Qp.shape[0]
+    Ma = np.linalg.solve(M, a)
+    lam = -np.dot(Ma, Qp) / np.dot(a, Ma)
+    for i in range(n):
+        Qp[i] += lam * a[i]
+    return pp + lam * rate
+
+
+@njit(cache=True, error_model='numpy')
 def add_pulse(S, Qp, pp):
     """The push-off pulse's force into ``S[:nq]`` and its power into ``S[nq + 4]``."""
     n = Qp.shape[0]

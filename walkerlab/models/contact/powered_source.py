@@ -50,7 +50,8 @@ counter):
 ``A[10:12]``   the stance ankle's foot and leg coordinates with leg1 in stance (``A[32:34]``
                with leg2)
 ``A[12:15]``   the ankle push-off's stiffness [N m/rad], rest angle [rad], constant [N m]
-``A[15]``      the pulse holds a flat foot's ankle (0/1), ``A[16:18]`` its foot and leg
+``A[15]``      the pulse holds a flat foot's ankle (1), ``A[16:18]`` its foot and leg; a
+               3D walker's trailing foot's spin about the normal (2); neither (0)
 ``A[18:20]``   the ankle dampers' and the leg springs' damping [N m s/rad]
 ``A[20:26]``   feet (2), ankle legs (2), legs (2) coordinates of the dampers' power
 ``A[26]``      the ledger has the dampers' term (0/1)
