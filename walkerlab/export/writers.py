@@ -44,6 +44,7 @@ from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
     comments_in_scene_units,
+    mjcf_actuation_omissions,
     mjcf_omissions,
     mjcf_text,
     wheel_mjcf_text,
@@ -317,7 +318,7 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     scene, data = job.scene, job.data
     _check_legs_3d(job, w)
     version = walkerlab.__version__
-    ideal = None
+    ideal, left_out = None, ()
     if w.name == "urdf":
         text = legs_3d_urdf_text(data, job.name, version)
     elif job.walker_only:
@@ -325,7 +326,8 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     else:
         ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
         text = legs3d_mjcf_text(data, job.name, version, extra)
-    return Written((_xml(job, w, text),), xml_lines((), scene), step_period(ideal))
+        left_out = mjcf_actuation_omissions(extra.actuation)  # the stepping loop's
+    return Written((_xml(job, w, text),), xml_lines(left_out, scene), step_period(ideal))
 
 
 def _check_legs_3d(job: ExportJob, w: Writer) -> None:

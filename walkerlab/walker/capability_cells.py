@@ -283,9 +283,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
         **{("round_feet_3d", v): ROUND_FEET_EXPORT_3D for v in ("mjcf", "urdf", "adams")},
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
-        # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints)
+        # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints) and
+        # the MJCF (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text,
+        # run by walkerlab.export.mujoco_walk.PoweredLoop)
         **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
-           for v in ("contact", "mjcf", "urdf", "adams")},
+           for v in ("contact", "urdf", "adams")},
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
         ("torso_torque", "*"): "the 3D straight legs carry no torso",
