@@ -231,9 +231,7 @@ class PoweredLoop:
         self.v_of = {j.name: int(j.dofadr[0]) for j in hinges}
         self.body = [int(model.body(g if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g)
                                     >= 0 else f"{g}_shank").id) for g in LEGS]
-        # a planar walker's hip on the slides hip_x, hip_z; a walker in 3D's pelvis (the
-        # body the legs' hips hang from) on a free joint or slides, its legs' pitches the
-        # hinges leg<i>_hip about their own hip axes (walkerlab.export.legs_3d_mjcf)
+        # a planar hip on the slides hip_x, hip_z; a 3D pelvis (the legs' parent) free
         self.planar = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x") >= 0
         self.leg_hip = [int(model.joint(f"{g}_hip").id) for g in LEGS]
         self.pelvis = int(model.body_parentid[model.jnt_bodyid[self.leg_hip[0]]])
@@ -274,9 +272,7 @@ class PoweredLoop:
         """The phase variable [rad] and its rate [rad/s]: the angle from the downward
         vertical of the line from the hip to the stance foot's site (the rigid view's,
         :func:`walkerlab.export.joint_torques.stance_phase`; MuJoCo's x-z plane); a walker
-        in 3D: its stance leg's pitch about its own hip axis and its rate (the rigid 3D
-        model's, :func:`walkerlab.codegen.derive_3d.derive_compass`'s ``stance`` leg
-        angle: the hinge ``leg<i>_hip``)."""
+        in 3D: its stance leg's pitch (the hinge ``leg<i>_hip``) and its rate."""
         import mujoco
 
         if not self.planar:
@@ -339,11 +335,9 @@ class PoweredLoop:
         self.push = ((1 - leg, data.time + self.pulse_s, P / self.pulse_s) if P > 0 else None)
 
     def hip_speed(self, data) -> float:
-        """The hip's speed [m/s]: a planar walker's from its slides ``hip_x``, ``hip_z``; a
-        walker in 3D's pelvis' (its origin, the rigid model's ``hip`` point)."""
+        """The hip's speed [m/s]: a planar walker's slides', a 3D walker's pelvis'."""
         if self.planar:
-            vx, vz = data.qvel[self.hip], data.qvel[self.hip + 1]
-            return float(np.hypot(vx, vz))
+            return float(np.hypot(data.qvel[self.hip], data.qvel[self.hip + 1]))
         import mujoco
 
         vel = np.zeros(6)
@@ -352,14 +346,9 @@ class PoweredLoop:
         return float(np.sqrt(vel[3:] @ vel[3:]))
 
     def hip_point(self, data, leg: int) -> np.ndarray:
-        """Where leg ``leg`` (0, 1) meets the pelvis (3,) [m]: a planar walker's hip body;
-        a walker in 3D with hip width, the leg's own hip (the anchor of its hinge
-        ``leg<i>_hip``, ``hip_width / 2`` from the pelvis: the rigid model's push-off
-        points at it, :meth:`walkerlab.models.hybrid.push_off.PushOffTransition.
-        direction`)."""
-        if self.planar:
-            return data.xpos[self._hip_body]
-        return data.xanchor[self.leg_hip[leg]]
+        """Leg ``leg``'s (0, 1) hip (3,) [m]: a planar walker's hip body; a 3D walker's own
+        hip, the anchor of its hinge ``leg<i>_hip`` (module docstring)."""
+        return data.xpos[self._hip_body] if self.planar else data.xanchor[self.leg_hip[leg]]
 
     def bind(self, model, site: list) -> None:
         """The foot sites and the hip body (ids)."""
