@@ -312,7 +312,7 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`; ``job.options``: the MJCF's
     :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
     table has them (refused before this is reached)."""
-    from walkerlab.export.legs_3d import legs_3d_urdf_text  # light: 3D only
+    from walkerlab.export.legs_3d import legs_3d_urdf_omissions, legs_3d_urdf_text
     from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene
 
     scene, data = job.scene, job.data
@@ -320,7 +320,8 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     version = walkerlab.__version__
     ideal, left_out = None, ()
     if w.name == "urdf":
-        text = legs_3d_urdf_text(data, job.name, version)
+        text = legs_3d_urdf_text(data, job.name, version, scene.walker.actuation)
+        left_out = legs_3d_urdf_omissions(data, scene.walker.actuation)
     elif job.walker_only:
         text = legs3d_mjcf_text(data, job.name, version)
     else:
