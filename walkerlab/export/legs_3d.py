@@ -28,7 +28,7 @@ from __future__ import annotations
 import json
 from xml.sax.saxutils import quoteattr
 
-from walkerlab.export.legs_3d_mjcf import legs_summary, walker_tree
+from walkerlab.export.legs_3d_mjcf import hip_roll_law, legs_summary, walker_tree
 from walkerlab.export.mjcf_scene import actuation_text
 from walkerlab.export.omitted import Omission, xml_comments
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
@@ -46,7 +46,7 @@ def legs_3d_urdf_omissions(data, actuation=None) -> tuple[Omission, ...]:
     from walkerlab.export.urdf import urdf_actuation_omissions  # light
 
     out = []
-    if data.structure.hip_roll:
+    if hip_roll_law(data) is not None:
         out += [Omission("the hip-roll law (walker.hip_roll)", "URDF has no law element: "
                          "its gains are in the comment walkerlab_hip_roll (the MJCF export "
                          "runs it)"),
@@ -84,7 +84,7 @@ def legs_3d_urdf_text(data, name: str, version: str = "", actuation=None) -> str
                    f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); the "
                    "pelvis is the free root link"),
            *xml_comments(legs_3d_urdf_omissions(data, actuation))]
-    law = getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
+    law = hip_roll_law(data)
     if law is not None:
         out.append(comment(f"walkerlab_hip_roll: {json.dumps(law)}"))
     if actuation is not None:

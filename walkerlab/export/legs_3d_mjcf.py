@@ -93,8 +93,8 @@ from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_3d_tree
 
-__all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
-           "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
+__all__ = ["TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "legs3d_footfalls",
+           "legs3d_keyframe", "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -396,6 +396,12 @@ def _world_head(p: dict, extra, phi: float, condim: int) -> list[str]:
             '</default>', "  <worldbody>", *_patches(p, extra, phi)]
 
 
+def hip_roll_law(data) -> dict | None:
+    """The walker's hip-roll law (``walker.hip_roll``'s gains by field name, as the custom
+    text ``walkerlab_hip_roll`` carries them), None without hip-roll joints."""
+    return getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
+
+
 def walker_tree(data) -> tuple:
     """The 3D straight-legged walker's body tree, its coordinate map and numbers
     (:func:`walkerlab.walker.trees.legs_3d_tree`; ``data``'s parameters by name,
@@ -484,7 +490,7 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
     """
     p = _numbers(data)
     w, r, phi = p["w_hip"], p["r"], data.slope_rad
-    law = getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
+    law = hip_roll_law(data)
     # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
     # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
     condim = 4 if law is None else 3
