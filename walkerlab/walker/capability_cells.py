@@ -70,9 +70,9 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
 #: why a 3D walker refuses actuators
-ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model so far "
-                "(fixedpoint, simulate, the rigid studies); its contact model and exports "
-                "are passive but for the hip-roll law (walker.hip_roll)")
+ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model, MJCF and "
+                "URDF so far; its contact model and Adams dataset are passive but for the "
+                "hip-roll law (walker.hip_roll)")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
          "walker.actuation.torques (joint: hip)")
