@@ -500,7 +500,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
         free = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "pelvis_x")
     hip = model.jnt_qposadr[slide if slide >= 0 else free]
     up = hip + (1 if slide >= 0 else 2)  # the hip's height (world z)
-    loops = []  # the stepping rules, in order (each sets only its own joints' forces)
+    loops = []  # in order: PoweredLoop sets every hinge's force, HipRollLoop the rolls'
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
         loops.append(powered_loop(model, feedback))
         loops[-1].bind(model, site)
