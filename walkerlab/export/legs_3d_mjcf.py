@@ -54,6 +54,17 @@ The feet are ``condim 3``: the joints hold them from twisting, and a torsional f
 top is a redundant constraint (with it the stance foot's contact chatters).  The law runs
 in :class:`walkerlab.export.mujoco_walk.HipRollLoop`, which reads its gains from the custom
 text ``walkerlab_hip_roll``.
+
+Actuators (``walker.actuation``: a hip torque, ``joint: hip``, and Kuo 2002's push-off, the
+rigid model's :class:`walkerlab.models.hybrid.actuated._Legs3d`): written as the planar
+MJCF writes them (:func:`walkerlab.export.motors.motors`): a motor ``hip`` on the fixed
+tendon ``hip_actuation = leg1_hip - leg2_hip`` for a controller of one's own, the laws in the
+custom text ``walkerlab_actuation`` and the push-off pulse's length (one timestep) in the
+numeric ``push_off_duration_s``, run by :class:`walkerlab.export.mujoco_walk.PoweredLoop`.
+Each leg's hinge ``leg<i>_hip`` is its pitch ``theta`` about its own (rolled) hip axis, so
+the torque pair ``+tau`` on ``leg<sw>_hip``, ``-tau`` on ``leg<st>_hip`` does the rigid
+model's virtual work ``tau delta(theta_sw - theta_st)``; the push-off acts along the
+trailing leg from its foot to its own hip (the anchor of its hinge ``leg<i>_hip``).
 """
 
 from __future__ import annotations
@@ -66,7 +77,10 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from walkerlab.export.axes_3d import TO_MUJOCO
-from walkerlab.export.mjcf_scene import LANE_BITS
+from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
+from walkerlab.export.motors import mjcf_actuator_lines, mjcf_motor_tendons, motors
+from walkerlab.export.multibody import mjcf_actuation_omissions
+from walkerlab.export.omitted import xml_comments
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import (
@@ -79,8 +93,8 @@ from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_3d_tree
 
-__all__ = ["TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls", "legs3d_keyframe",
-           "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
+__all__ = ["TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "legs3d_footfalls",
+           "legs3d_keyframe", "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -241,6 +255,13 @@ class Legs3dScene:
         The rigid gait's step period [s].
     notes : tuple of str
         Comments written into the file.
+    actuation : Actuation or None
+        The scene's ``walker.actuation`` (a powered walker: module docstring); None for a
+        passive one.
+    push_off_duration_s : float
+        The push-off pulse's length [s]: one timestep (the rigid model's impulse as MuJoCo
+        applies it, as the planar MJCF's :attr:`walkerlab.export.mjcf_scene.MjcfScene.
+        push_off_duration_s`).
     """
 
     qpos: tuple
@@ -254,6 +275,8 @@ class Legs3dScene:
     step_period_s: float
     notes: tuple = ()
     patch_across_m: float = 0.08  # PATCH_ACROSS_L of a 1 m leg
+    actuation: object = None
+    push_off_duration_s: float = 0.005
 
 
 def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
@@ -325,8 +348,14 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         "Feet: condim 3 (the hip-roll walker's joints hold its feet from twisting: its "
         "pelvis neither pitches nor yaws); the law of walker.hip_roll in the custom text "
         "walkerlab_hip_roll, run by walkerlab's walk loop (HipRollLoop).")
+    act = scene.walker.actuation
+    if act is not None:  # the planar walkers' note: one motor 'hip', the loop's laws
+        from walkerlab.export.parts import kind_part  # light
+
+        notes += (kind_part(data.structure.kind).mjcf_actuators,)
     return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
-                       tuple(solref), tuple(solimp), float(mu), period, notes, float(across))
+                       tuple(solref), tuple(solimp), float(mu), period, notes, float(across),
+                       act, float(dt))  # the push-off over one timestep
 
 
 def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
@@ -365,6 +394,12 @@ def _world_head(p: dict, extra, phi: float, condim: int) -> list[str]:
             f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
             f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="{condim}"/>'
             '</default>', "  <worldbody>", *_patches(p, extra, phi)]
+
+
+def hip_roll_law(data) -> dict | None:
+    """The walker's hip-roll law (``walker.hip_roll``'s gains by field name, as the custom
+    text ``walkerlab_hip_roll`` carries them), None without hip-roll joints."""
+    return getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
 
 
 def walker_tree(data) -> tuple:
@@ -420,6 +455,18 @@ def _pelvis_and_legs(data, law: dict | None) -> tuple[list[str], list[str]]:
     return (mjcf_body_lines(root, _geoms(p, roles)), mjcf_coupling_lines(couplings))
 
 
+def _with_motor_tendons(couplings: list[str], motor_list) -> list[str]:
+    """The couplings' lines (:func:`walkerlab.export.tree_bodies.mjcf_coupling_lines`) with
+    the motors' tendons (:func:`walkerlab.export.motors.mjcf_motor_tendons`) first in their
+    ``<tendon>`` block (one of its own without couplings)."""
+    driven = mjcf_motor_tendons(motor_list)
+    if not driven:
+        return couplings
+    if not couplings:
+        return ["  <tendon>", *driven, "  </tendon>"]
+    return [couplings[0], *driven, *couplings[1:]]  # couplings[0] is "  <tendon>"
+
+
 def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | None = None
                      ) -> str:
     """The 3D straight-legged walker as a MuJoCo model (MJCF; module docstring).
@@ -443,7 +490,7 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
     """
     p = _numbers(data)
     w, r, phi = p["w_hip"], p["r"], data.slope_rad
-    law = getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
+    law = hip_roll_law(data)
     # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
     # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
     condim = 4 if law is None else 3
@@ -455,13 +502,21 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
                    f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot)."),
            f"<mujoco model={quoteattr(name)}>",
            *(comment(note) for note in (extra.notes if extra else ())),
+           *xml_comments(mjcf_actuation_omissions(extra.actuation if extra else None)),
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
     out += _world_head(p, extra, phi, condim)
     bodies, couplings = _pelvis_and_legs(data, law)
+    act = extra.actuation if extra is not None else None
+    motor_list = motors(act)
     out += bodies
-    out += ["  </worldbody>", *couplings,
+    out += ["  </worldbody>", *_with_motor_tendons(couplings, motor_list),
+            *mjcf_actuator_lines(act, motor_list),
             "  <custom>", f'    <numeric name="slope_rad" data="{num(phi)}"/>',
             '    <numeric name="foot_height_offset_m" data="0.0"/>']
+    if act is not None:  # the laws and the push-off, run by mujoco_walk.PoweredLoop
+        out += [f'    <numeric name="push_off_duration_s" '
+                f'data="{num(extra.push_off_duration_s)}"/>',
+                f"    <text name=\"walkerlab_actuation\" data={quoteattr(actuation_text(act))}/>"]
     if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop
         out.append(f"    <text name=\"walkerlab_hip_roll\" data={quoteattr(json.dumps(law))}/>")
     out.append("  </custom>")

@@ -30,6 +30,15 @@ ankle's motor gives ``-stiffness (a - rest_angle_rad) - constant_n_m`` on its an
 (positive toe up), the swing ankle's 0; heel off is taken once the heel has been out
 of contact :data:`HEEL_OFF_STEPS` MuJoCo steps running (the soft contact flickers).
 
+The same loop drives a walker in 3D (:mod:`walkerlab.export.legs_3d_mjcf`, its pelvis on a
+free joint or slides): the laws act on the hinges ``leg<i>_hip`` (each leg's pitch about its
+own hip axis, the rigid 3D model's coordinates), the phase variable is the stance leg's
+pitch (the rigid 3D model's), the push-off's law reads the pelvis' speed and its force
+points from the trailing foot to that leg's own hip (the anchor of its ``leg<i>_hip``,
+``hip_width / 2`` from the pelvis, as :class:`walkerlab.models.hybrid.push_off.
+PushOffTransition` has it).  With hip-roll joints :class:`HipRollLoop` runs after it (it sets
+the roll joints' forces only).
+
 Virtual constraints (``walker.actuation.virtual_constraints``) are the rigid view's computed
 torque (:class:`walkerlab.models.virtual_constraints.VirtualConstraintController`:
 ``u = (L_g L_f h)^-1 (-L_f^2 h - kp y - kd y')`` on the rigid model's ``M, C, G``;
@@ -47,7 +56,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
+from walkerlab.export.joint_torques import law_generalized_forces, link_angle, stance_phase
 
 __all__ = ["HipRollLoop", "MujocoWalk", "PoweredLoop", "VirtualConstraintFeedback", "latch_rule",
            "powered_loop", "roll", "virtual_constraint_feedback", "walk"]
@@ -222,8 +231,15 @@ class PoweredLoop:
         self.v_of = {j.name: int(j.dofadr[0]) for j in hinges}
         self.body = [int(model.body(g if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g)
                                     >= 0 else f"{g}_shank").id) for g in LEGS]
-        self.hip = int(model.joint("hip_x").dofadr[0])
-        self.hip_q = int(model.joint("hip_x").qposadr[0])
+        # a planar hip on the slides hip_x, hip_z; a 3D pelvis (the legs' parent) free
+        self.planar = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x") >= 0
+        self.leg_hip = [int(model.joint(f"{g}_hip").id) for g in LEGS]
+        self.pelvis = int(model.body_parentid[model.jnt_bodyid[self.leg_hip[0]]])
+        if self.planar:
+            self.hip = int(model.joint("hip_x").dofadr[0])
+            self.hip_q = int(model.joint("hip_x").qposadr[0])
+        else:  # the rigid 3D model's phase: the stance leg's pitch (its hinge)
+            self.stance_link = [link_angle("stance", st, coords) for st in (0, 1)]
         self.dt = float(model.opt.timestep)
         self.stance, self.t_step, self.push = 1, 0.0, None  # leg2 stands at the keyframe
         self.ankle = self.spec.ankle_push_off
@@ -255,9 +271,14 @@ class PoweredLoop:
     def phase(self, data) -> tuple[float, float]:
         """The phase variable [rad] and its rate [rad/s]: the angle from the downward
         vertical of the line from the hip to the stance foot's site (the rigid view's,
-        :func:`walkerlab.export.joint_torques.stance_phase`; MuJoCo's x-z plane)."""
+        :func:`walkerlab.export.joint_torques.stance_phase`; MuJoCo's x-z plane); a walker
+        in 3D: its stance leg's pitch (the hinge ``leg<i>_hip``) and its rate."""
         import mujoco
 
+        if not self.planar:
+            g = self.stance_link[self.stance]
+            return (sum(k * float(data.qpos[self.q_of[c]]) for c, k in g.items()),
+                    sum(k * float(data.qvel[self.v_of[c]]) for c, k in g.items()))
         vel = np.zeros(6)
         mujoco.mj_objectVelocity(self._model, data, mujoco.mjtObj.mjOBJ_SITE,
                                  self._site[self.stance], vel, 0)
@@ -296,7 +317,7 @@ class PoweredLoop:
             share = min(1.0, (self.push[1] - data.time) / self.dt)
             leg, force = self.push[0], self.push[2] * share
             foot = data.site_xpos[self._site[leg]]
-            e = data.xpos[self._hip_body] - foot
+            e = self.hip_point(data, leg) - foot
             F = force * e / np.sqrt(e @ e)
             data.xfrc_applied[self.body[leg], :3] = F
             data.xfrc_applied[self.body[leg], 3:] = np.cross(foot - data.xipos[self.body[leg]], F)
@@ -310,15 +331,30 @@ class PoweredLoop:
         if self.spec.push_off is None:
             self.push = None
             return
-        vx, vz = data.qvel[self.hip], data.qvel[self.hip + 1]
-        P = float(push_off_impulse(self.spec.push_off, float(np.hypot(vx, vz))))
+        P = float(push_off_impulse(self.spec.push_off, self.hip_speed(data)))
         self.push = ((1 - leg, data.time + self.pulse_s, P / self.pulse_s) if P > 0 else None)
+
+    def hip_speed(self, data) -> float:
+        """The hip's speed [m/s]: a planar walker's slides', a 3D walker's pelvis'."""
+        if self.planar:
+            return float(np.hypot(data.qvel[self.hip], data.qvel[self.hip + 1]))
+        import mujoco
+
+        vel = np.zeros(6)
+        mujoco.mj_objectVelocity(self._model, data, mujoco.mjtObj.mjOBJ_BODY, self.pelvis,
+                                 vel, 0)
+        return float(np.sqrt(vel[3:] @ vel[3:]))
+
+    def hip_point(self, data, leg: int) -> np.ndarray:
+        """Leg ``leg``'s (0, 1) hip (3,) [m]: a planar walker's hip body; a 3D walker's own
+        hip, the anchor of its hinge ``leg<i>_hip`` (module docstring)."""
+        return data.xpos[self._hip_body] if self.planar else data.xanchor[self.leg_hip[leg]]
 
     def bind(self, model, site: list) -> None:
         """The foot sites and the hip body (ids)."""
         self._site = site
         self._model = model
-        self._hip_body = int(model.body("hip").id)
+        self._hip_body = int(model.body("hip").id) if self.planar else self.pelvis
 
 
 class HipRollLoop:
@@ -464,13 +500,13 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
         free = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "pelvis_x")
     hip = model.jnt_qposadr[slide if slide >= 0 else free]
     up = hip + (1 if slide >= 0 else 2)  # the hip's height (world z)
-    powered = None
+    loops = []  # in order: PoweredLoop sets every hinge's force, HipRollLoop the rolls'
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
-        powered = powered_loop(model, feedback)
-        powered.bind(model, site)
-    elif mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_hip_roll") >= 0:
-        powered = HipRollLoop(model)  # a 3D walker's hip-roll law
-    nstep = 1 if latched or powered else LOOK_EVERY
+        loops.append(powered_loop(model, feedback))
+        loops[-1].bind(model, site)
+    if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_hip_roll") >= 0:
+        loops.append(HipRollLoop(model))  # a 3D walker's hip-roll law
+    nstep = 1 if latched or loops else LOOK_EVERY
     mujoco.mj_forward(model, data)
     L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, up]])))
     last_contact = [data.time, data.time]  # both feet at the ground at the keyframe
@@ -481,8 +517,8 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
             for i in range(2):
                 data.eq_active[latch[i]] = latch_rule(float(data.site_xpos[site[i]] @ n) - off,
                                                       float(data.qpos[knee[i]]), h_rel, cap)
-        if powered is not None:
-            powered.control(data)
+        for loop in loops:
+            loop.control(data)
         mujoco.mj_step(model, data, nstep)
         if data.ncon:
             geoms = data.contact.geom[:data.ncon]
@@ -492,8 +528,8 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
                         times.append(data.time)
                         legs.append(LEGS[i])
                         pos.append(float(data.site_xpos[site[i]] @ t))
-                        if powered is not None:
-                            powered.heel_strike(data, i)
+                        for loop in loops:
+                            loop.heel_strike(data, i)
                     last_contact[i] = data.time
         if each is not None:
             each(model, data)

@@ -97,11 +97,12 @@ from walkerlab.export.mjcf_scene import (
     MJCF_MIN_MASS_KG,
     MjcfScene,
     actuation_text,
-    motor_limits,
     point_foot_radius,
 )
 from walkerlab.export.motors import (  # noqa: F401 (part of this API)
     HIP_ACTUATION_TENDON,
+    mjcf_actuator_lines,
+    mjcf_motor_tendons,
     motor_target,
     motors,
 )
@@ -114,7 +115,8 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.walker.multibody import Link, Multibody
 
 __all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION",
-           "comments_in_scene_units", "mjcf_omissions", "mjcf_text", "motor_target", "motors",
+           "comments_in_scene_units", "mjcf_actuation_omissions", "mjcf_omissions",
+           "mjcf_text", "motor_target", "motors",
            "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
@@ -139,6 +141,21 @@ def mjcf_omissions(mb: Multibody, extra: MjcfScene | None = None) -> tuple[Omiss
                             "lock: the equalities leg<i>_latch are switched by a stepping "
                             "loop (walkerlab.export.mujoco_walk.latch_rule)"))
     act = extra.actuation
+    out += mjcf_actuation_omissions(act)
+    if act is not None and act.ankle_push_off is not None:
+        out.append(Omission("the ankle push-off's heel-off latch "
+                            "(walker.actuation.ankle_push_off)", "MJCF has no contact-switched "
+                            "motor: a stepping loop sets the motors leg<i>_ankle_motor "
+                            "(walkerlab.export.mujoco_walk)"))
+    return tuple(out)
+
+
+def mjcf_actuation_omissions(act) -> list[Omission]:
+    """What an MJCF leaves of the actuation ``act`` (``walker.actuation``, or None) to a
+    stepping loop (:mod:`walkerlab.export.mujoco_walk`): the joint torque laws and the
+    push-off (the planar walkers' MJCF, :func:`mjcf_omissions`, and the 3D straight legs',
+    :mod:`walkerlab.export.legs_3d_mjcf`)."""
+    out = []
     if act is not None and act.torques:
         out.append(Omission("the joint torque laws (walker.actuation.torques)", "MJCF has no "
                             "state-dependent torque law: the laws are in the custom text "
@@ -148,12 +165,7 @@ def mjcf_omissions(mb: Multibody, extra: MjcfScene | None = None) -> tuple[Omiss
         out.append(Omission("the push-off (walker.actuation.push_off)", "MJCF has no "
                             "event-switched force: a stepping loop applies it from each heel "
                             "strike (walkerlab.export.mujoco_walk)"))
-    if act is not None and act.ankle_push_off is not None:
-        out.append(Omission("the ankle push-off's heel-off latch "
-                            "(walker.actuation.ankle_push_off)", "MJCF has no contact-switched "
-                            "motor: a stepping loop sets the motors leg<i>_ankle_motor "
-                            "(walkerlab.export.mujoco_walk)"))
-    return tuple(out)
+    return out
 
 
 def _joint_springs(mb: Multibody) -> dict:
@@ -172,12 +184,7 @@ def _tendons(mb: Multibody, motor_list=()) -> list[str]:
     driven = [m[2] for m in motor_list if m[1] == "tendon"]
     if not (springs or mb.couplings or driven):
         return []
-    out = ["  <tendon>"]
-    for name in driven:
-        second = "leg2_hip" if name == HIP_ACTUATION_TENDON else "torso_hip"
-        first = "leg1_hip" if name == HIP_ACTUATION_TENDON else name[:-len("_torso")]
-        out += [f'    <fixed name="{name}">', f'      <joint joint="{first}" coef="1.0"/>',
-                f'      <joint joint="{second}" coef="-1.0"/>', "    </fixed>"]
+    out = ["  <tendon>", *mjcf_motor_tendons(motor_list)]
     for sp in springs:
         # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
         # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
@@ -251,12 +258,8 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
         out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
     motor_list = motors(extra.actuation if extra is not None else None)
     out += ["    </body>", "  </worldbody>", *_tendons(mb, motor_list)]
-    if motor_list:  # the laws live in the custom text, a stepping loop sets the controls
-        lim = motor_limits(extra.actuation)  # the saturations: MuJoCo clamps ctrl
-        rng = {n: f' ctrllimited="true" ctrlrange="{nums(-u, u)}"' for n, u in lim.items()}
-        out += ["  <actuator>", *(f'    <motor name="{name}" {kind}="{target}" gear="1"'
-                                  f'{rng.get(name, "")}/>'
-                                  for name, kind, target in motor_list), "  </actuator>"]
+    # the laws live in the custom text, a stepping loop sets the controls
+    out += mjcf_actuator_lines(extra.actuation if extra is not None else None, motor_list)
     out += [*_mjcf_tail(mb, extra), ""]
     return "\n".join(out)
 

@@ -485,26 +485,27 @@ def urdf_link_lines(b: ExportBody, visuals=lambda b, pad: [], parent: str | None
                     ) -> list[str]:
     """URDF's ``link`` of ``b`` (its ``inertial`` and the lines ``visuals(b, pad)``
     returns), the joint from ``parent`` (``continuous`` on one hinge, ``fixed`` on none;
-    none for the root, a floating base), then its children's.
-
-    Raises
-    ------
-    ValueError
-        A body on more than one hinge (URDF's joints have one axis: one line naming it).
-    """
+    none for the root, a floating base), then its children's.  A body on several hinges
+    (a leg on its roll then its pitch: URDF's joints have one axis) hangs from a chain of
+    massless links ``<hinge>_link``, one after each hinge but its last, each at the body's
+    origin in the body's reference frame: URDF turns each child link about its joint's axis
+    in its parent's frame, as MuJoCo turns a body's joints in order
+    (:func:`mjcf_body_lines`)."""
     extra = visuals(b, "    ")
     out = [f'  <link name="{b.name}">{_urdf_inertial(b)}' + ("" if extra else "</link>"),
            *extra, *(["  </link>"] if extra else [])]
     if parent is not None:
-        if len(b.joints) > 1:
-            raise ValueError(f"{b.name}: {len(b.joints)} joints on one body (a URDF joint "
-                             "has one axis)")
-        head = (f'  <joint name="{b.joints[0].name}" type="continuous">' if b.joints else
-                f'  <joint name="{b.name}_weld" type="fixed">')
-        out.append(head + f'<parent link="{parent}"/><child link="{b.name}"/>'
-                   f'<origin xyz="{nums(*b.pos_m)}"/>'
-                   + (f'<axis xyz="{_axis_text(b.joints[0].axis)}"/>' if b.joints else "")
-                   + "</joint>")
+        links = [f"{j.name}_link" for j in b.joints[:-1]] + [b.name]
+        out += [f'  <link name="{name}"/>' for name in links[:-1]]
+        pos = nums(*b.pos_m)
+        for j, (up, child) in zip(b.joints, zip([parent, *links], links)):
+            out.append(f'  <joint name="{j.name}" type="continuous"><parent link="{up}"/>'
+                       f'<child link="{child}"/><origin xyz="{pos}"/>'
+                       f'<axis xyz="{_axis_text(j.axis)}"/></joint>')
+            pos = nums(0, 0, 0)
+        if not b.joints:
+            out.append(f'  <joint name="{b.name}_weld" type="fixed"><parent link="{parent}"/>'
+                       f'<child link="{b.name}"/><origin xyz="{pos}"/></joint>')
     for c in b.children:
         out += urdf_link_lines(c, visuals, b.name)
     return out

@@ -92,13 +92,23 @@ def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
         out.append(Omission("the knee latch (contact.knee_stop.latch)", "URDF has no "
                             "contact-switched lock (the joint limit at 0 is the straight-leg "
                             "stop)"))
-    out += [Omission(f"motor {name}", f"URDF has no actuator element for a torque u on "
-                     f"{motor_target(kind, target)}; its law is the scene's walker.actuation "
-                     "(in the keyframe sidecar)") for name, kind, target in motors(actuation)]
+    out += urdf_actuation_omissions(actuation)
+    return tuple(out)
+
+
+def urdf_actuation_omissions(actuation: Actuation | None,
+                             where: str = "in the keyframe sidecar") -> list[Omission]:
+    """What a URDF leaves of ``actuation`` (``walker.actuation``, or None): each motor of
+    :func:`motors` and the push-off (no actuator or force element; their laws ``where``
+    the file's reader finds them: the planar URDF's keyframe sidecar, the 3D walker's
+    comment :func:`walkerlab.export.legs_3d.legs_3d_urdf_text`)."""
+    out = [Omission(f"motor {name}", f"URDF has no actuator element for a torque u on "
+                    f"{motor_target(kind, target)}; its law is the scene's walker.actuation "
+                    f"({where})") for name, kind, target in motors(actuation)]
     if actuation is not None and actuation.push_off is not None:
         out.append(Omission("the push-off (walker.actuation.push_off)", "URDF has no force "
-                            "element; its law is in the keyframe sidecar"))
-    return tuple(out)
+                            f"element; its law is {where}"))
+    return out
 
 
 def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:

@@ -44,6 +44,7 @@ from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
     comments_in_scene_units,
+    mjcf_actuation_omissions,
     mjcf_omissions,
     mjcf_text,
     wheel_mjcf_text,
@@ -311,21 +312,23 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`; ``job.options``: the MJCF's
     :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
     table has them (refused before this is reached)."""
-    from walkerlab.export.legs_3d import legs_3d_urdf_text  # light: 3D only
+    from walkerlab.export.legs_3d import legs_3d_urdf_omissions, legs_3d_urdf_text
     from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene
 
     scene, data = job.scene, job.data
     _check_legs_3d(job, w)
     version = walkerlab.__version__
-    ideal = None
+    ideal, left_out = None, ()
     if w.name == "urdf":
-        text = legs_3d_urdf_text(data, job.name, version)
+        text = legs_3d_urdf_text(data, job.name, version, scene.walker.actuation)
+        left_out = legs_3d_urdf_omissions(data, scene.walker.actuation)
     elif job.walker_only:
         text = legs3d_mjcf_text(data, job.name, version)
     else:
         ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
         text = legs3d_mjcf_text(data, job.name, version, extra)
-    return Written((_xml(job, w, text),), xml_lines((), scene), step_period(ideal))
+        left_out = mjcf_actuation_omissions(extra.actuation)  # the stepping loop's
+    return Written((_xml(job, w, text),), xml_lines(left_out, scene), step_period(ideal))
 
 
 def _check_legs_3d(job: ExportJob, w: Writer) -> None:

@@ -11,7 +11,7 @@ re-exports every public name here; the layers import them from there.
 from __future__ import annotations
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D",
+           "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
@@ -70,9 +70,9 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
 #: why a 3D walker refuses actuators
-ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model so far "
-                "(fixedpoint, simulate, the rigid studies); its contact model and exports "
-                "are passive but for the hip-roll law (walker.hip_roll)")
+ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model, contact "
+                "model, MJCF and URDF so far; its Adams dataset is passive but for the "
+                "hip-roll law (walker.hip_roll)")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
          "walker.actuation.torques (joint: hip)")
@@ -90,10 +90,6 @@ NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a
 ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass legs "
                         "so far (its round feet and leg inertia run in the rigid model: "
                         "fixedpoint, simulate)")
-#: why the URDF refuses the 3D walker's hip-roll joints
-HIP_ROLL_EXPORT_3D = ("the URDF carries legs rigid to the pelvis in roll so far: the "
-                      "hip-roll joints and their law are in the MJCF (--format mjcf) "
-                      "and the rigid model")
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -280,12 +276,16 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
     "straight_legs_3d": {
-        ("hip_roll", "urdf"): HIP_ROLL_EXPORT_3D,
         **{("round_feet_3d", v): ROUND_FEET_EXPORT_3D for v in ("mjcf", "urdf", "adams")},
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
-        # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints)
+        # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
+        # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
+        # contact actuators, the pulse holding the trailing foot's spin) and the MJCF (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text,
+        # run by walkerlab.export.mujoco_walk.PoweredLoop) and the URDF (its hip joints,
+        # the motor and the push-off left out as the planar URDF's: walkerlab.export.
+        # legs_3d.legs_3d_urdf_text; with hip-roll joints each leg's roll then pitch)
         **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
-           for v in ("mjcf", "urdf", "adams")},
+           for v in ("adams",)},
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
         ("torso_torque", "*"): "the 3D straight legs carry no torso",

@@ -36,7 +36,8 @@ walker's :class:`Kind`:
     ``space: 3d``): the walker rolls about the fall line through its stance foot and its
     legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
     1999).  The rigid model, the MJCF (a free pelvis on footfall patches: it walks in
-    MuJoCo) and the URDF, passive, so far.
+    MuJoCo; its hip torque and push-off run by walkerlab's stepping loop) and the URDF (its
+    actuators left out, as the planar URDF's).
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
@@ -71,7 +72,6 @@ from walkerlab.walker.capability_cells import (  # the table's cells, re-exporte
     FOOTHOLD_SLOPES,
     FREE_JOINT_TORQUES,
     GROUND_3D,
-    HIP_ROLL_EXPORT_3D,
     KNEE_LATCH_OSIM,
     NO_HIP_ROLL,
     NO_ROUND_FEET_3D,
@@ -84,7 +84,7 @@ from walkerlab.walker.capability_cells import (  # the table's cells, re-exporte
 )
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURES",
-           "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES", "GROUND_3D", "HIP_ROLL_EXPORT_3D", "KINDS",
+           "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES", "GROUND_3D", "KINDS",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
            "URDF_GROUND", "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
