@@ -415,6 +415,39 @@ def test_the_unstable_3d_wheel_capsizes_sideways_in_contact():
     assert how.startswith("capsized sideways: the hub") and "stance spoke's tip" in how
 
 
+@pytest.mark.slow
+def test_the_shipped_unstable_3d_wheel_falls_in_contact_from_its_start_offset(tmp_path):
+    """``walkerlab contact-sim configs/rimless_wheel_3d.yaml``: its scene starts the contact
+    run with a lean rate of 0.05 rad/s (``contact_sim.start_offset``; exactly upright the
+    lean grows from round-off only), and the run ends in a fall within its first steps,
+    named (measured: capsized sideways after 1 heel strike, t = 1.65 s)."""
+    failure, _, strikes, _ = _contact_run("rimless_wheel_3d", tmp_path)
+    assert failure and strikes <= 4
+    assert "capsized sideways" in failure and "Floquet multiplier" in failure
+
+
+def test_a_start_offset_names_the_rigid_states_or_is_refused_in_one_line():
+    """``contact_sim.start_offset`` adds to the named rigid states only (0 elsewhere); a
+    name that is not one of the walker's states is refused naming the field and listing
+    the states, an unparseable one by the scene's check."""
+    from walkerlab.config.studies import StateOffset
+
+    names = ["heading_angle", "lean_angle", "stance_angle", "heading_rate", "lean_rate",
+             "stance_rate"]
+    off = StateOffset.model_validate({"lean_rate_rad_per_s": 0.05, "lean_angle_rad": -0.01})
+    np.testing.assert_array_equal(off.as_array(names), [0, -0.01, 0, 0, 0.05, 0])
+    with pytest.raises(ValueError, match="tilt_rate_rad_per_s: not a state of the walker "
+                                         r"\(its states: heading_angle_rad"):
+        StateOffset.model_validate({"tilt_rate_rad_per_s": 1.0}).as_array(names)
+    scene = load_scene("configs/rimless_wheel_3d.yaml")
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["contact_sim"]["start_offset"] = {"lean_rate": 0.05}
+    from walkerlab.config import Scene
+
+    with pytest.raises(ValueError, match="(?s)start_offset.*lean_rate: not a state name"):
+        Scene.model_validate(d)
+
+
 def test_a_3d_walkers_pinned_start_is_refused_in_one_line():
     """The pinned start phase (planar walkers': it holds the stance foot's slides, not its
     turn, and carries no hip-roll law) is refused by the scene check, before any model is

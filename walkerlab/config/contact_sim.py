@@ -17,6 +17,7 @@ from pydantic import (
 )
 
 from walkerlab.config.base import _list_to_tuple
+from walkerlab.config.studies import StateOffset
 
 # Longest contact run (D8): 100 strides is ~20x the paper's 5 and keeps the artifact < 100 MB.
 MAX_CONTACT_STRIDES = 100
@@ -78,6 +79,13 @@ class ContactSimSettings(BaseModel):
         "gait at its mid-stance, the legs parallel and the stance foot flat at its static "
         "deflection, rates times initial_rate_scale; no impact under way at the start).")
 
+    start_offset: StateOffset | None = Field(
+        None, description="A change added to the start state (the rigid gait's, or its "
+        "mid-stance's), by the rigid state's names with units, e.g. {lean_rate_rad_per_s: "
+        "0.05}; states not named are unchanged. For an unstable rigid gait whose unstable "
+        "mode the start does not excite (a 3D walker started exactly upright: its lean "
+        "grows from round-off only); the patches stay at the rigid gait's footfalls.")
+
     @model_serializer(mode="wrap")
     def _drop_default_start(self, handler):
         # a scene with the default start serialises as before (same content hashes)
@@ -86,4 +94,6 @@ class ContactSimSettings(BaseModel):
             d.pop("start", None)
         if isinstance(d, dict) and d.get("adjust_cpu_budget_s") == 300.0:
             d.pop("adjust_cpu_budget_s", None)  # likewise the default budget
+        if isinstance(d, dict) and d.get("start_offset", 0) is None:
+            d.pop("start_offset", None)  # and no start offset
         return d

@@ -133,6 +133,36 @@ class StateSpec(Strict):
         return np.array([float(given[k]) for k in keys])
 
 
+class StateOffset(StateSpec):
+    """A change to a walker state by state name with its unit (as :class:`StateSpec`'s
+    names: ``<role>_angle_rad``, ``<role>_rate_rad_per_s``); the states it does not name
+    are unchanged."""
+
+    def as_array(self, state_names: list[str] | None = None):
+        """The change (2n,) in the order of ``state_names`` (a walker's ``state_names()``),
+        0 where a state is not named.
+
+        Raises
+        ------
+        ValueError
+            A name that is not one of the walker's states (one line listing them), or a
+            state read from an artifact (an offset is given by name).
+        """
+        import numpy as np
+
+        if self.artifact is not None:
+            raise ValueError("give the change by state name (<role>_angle_rad, "
+                             "<role>_rate_rad_per_s), not from an artifact")
+        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
+        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
+        given = dict(self.model_extra or {})
+        extra = [k for k in given if k not in keys]
+        if extra:
+            raise ValueError(f"{extra[0]}: not a state of the walker (its states: "
+                             f"{', '.join(keys)})")
+        return np.array([float(given.get(k, 0.0)) for k in keys])
+
+
 class FixedPointSettings(Strict):
     """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
 

@@ -280,8 +280,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
-        # contact actuators, the pulse holding the trailing foot's spin) and the MJCF (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text,
-        # run by walkerlab.export.mujoco_walk.PoweredLoop) and the URDF (its hip joints,
+        # contact actuators, the pulse holding the trailing foot's spin), the MJCF
+        # (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text, run by
+        # walkerlab.export.mujoco_walk.PoweredLoop) and the URDF (its hip joints,
         # the motor and the push-off left out as the planar URDF's: walkerlab.export.
         # legs_3d.legs_3d_urdf_text; with hip-roll joints each leg's roll then pitch)
         **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")

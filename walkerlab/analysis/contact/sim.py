@@ -270,7 +270,7 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
         Ideal post-impact state (rigid walker's ``state_names()`` order) [rad, rad/s]; the
         patches are laid from it, and the run starts from it, or with ``contact_sim.start:
         mid_stance`` from the rigid gait's mid-stance that follows it
-        (:func:`rigid_mid_stance`).
+        (:func:`rigid_mid_stance`), plus ``contact_sim.start_offset``.
     n_strides : int
         Strides the run may take (patches are laid out for them).
     rate_scale : (float, float), optional
@@ -297,6 +297,15 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
     x_start = (rigid_mid_stance(setup.scene, x_ideal, setup.plant)
                if cs.start == "mid_stance" else x_ideal)
+    if cs.start_offset is not None:  # a change to the start (the patches stay)
+        from walkerlab.models.contact.scene import ContactSceneError  # light
+
+        try:
+            dx = cs.start_offset.as_array(list(walker.rigid_layout().names))
+        except ValueError as exc:
+            raise ContactSceneError(f"scene '{setup.scene.name}': contact_sim.start_offset."
+                                    f"{exc}") from None
+        x_start = np.asarray(x_start, float) + dx
     x0 = initial_state_from_ideal(walker, *np.asarray(x_start, float), rate_scale=tuple(scale))
     limits = ContactLimits(
         sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
