@@ -562,3 +562,20 @@ def test_the_hip_roll_walkers_contact_gait_tends_to_the_rigid_gait_as_the_contac
     assert np.all(np.diff(step) < 0) and np.all(np.diff(period) < 0)
     assert np.all(np.abs(observed_order(tab.kappa, tab.step_gap_m) - 0.5) < 0.1)
     assert np.all(observed_order(tab.kappa, tab.period_gap_s) > 0.5)
+
+
+def test_a_planar_walkers_torsional_friction_is_refused_in_one_line():
+    """``contact.torsional_friction_m`` acts about the ground's normal, which a planar
+    walker's feet never turn about: on configs/paper.yaml it is refused, naming the field;
+    on a 3D walker (configs/hip_width.yaml) it is taken."""
+    from walkerlab.config import Scene
+
+    for name, ok in (("paper", False), ("hip_width", True)):
+        d = load_scene(f"configs/{name}.yaml").model_dump(mode="json", exclude_none=True)
+        d["contact"]["torsional_friction_m"] = 0.03
+        if ok:
+            assert Scene.model_validate(d).contact.torsional_friction_m == 0.03
+        else:
+            with pytest.raises(ValueError, match="contact.torsional_friction_m: a planar "
+                                                 "walker's feet hold no moment"):
+                Scene.model_validate(d)

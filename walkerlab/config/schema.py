@@ -175,6 +175,18 @@ class Scene(Strict):
         return self
 
     @model_validator(mode="after")
+    def _twist_needs_3d(self) -> Scene:
+        # a number that cannot act is a mistake (as the knee latch above): a planar walker's
+        # feet turn in its plane only, and its contact carries no moment about the normal
+        c = self.contact
+        if (c is not None and c.torsional_friction_m is not None
+                and getattr(self.walker, "space", "2d") != "3d"):
+            raise ValueError("contact.torsional_friction_m: a planar walker's feet hold no "
+                             "moment about the ground's normal (they turn in its plane "
+                             "only): remove it, or give the walker walker.space: 3d")
+        return self
+
+    @model_validator(mode="after")
     def _one_foot_mass(self) -> Scene:
         # feet with mass (walker.leg.foot.mass_kg) are the same feet in every view: the
         # contact section's regularising foot mass would be a second, different foot
