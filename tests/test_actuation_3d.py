@@ -174,18 +174,14 @@ def test_a_zero_width_3d_powered_walker_is_the_planar_one(hip_law):
     assert abs(g3.step_period - g2.step_period) < 1e-9
 
 
-def test_the_powered_3d_scenes_report_leaves_out_the_contact_run_its_view_refuses():
-    """configs/hip_width_powered.yaml carries a contact section (the MJCF's law), but the
-    contact view does not take a 3D walker's actuators yet: the report's plan leaves out
-    contact-sim and compare (instead of stopping at the refusal) and says why, while the
-    passive hip_width_stabilised keeps them."""
+def test_the_powered_3d_scenes_report_plans_its_contact_run_and_comparison():
+    """configs/hip_width_powered.yaml's actuators (a hip spring and a push-off) are taken
+    by the contact view as by the rigid one, so its report plans contact-sim and compare
+    beside fixedpoint and simulate (before the contact view took them, the plan left the
+    two out and said why)."""
     from walkerlab.config import load_scene
     from walkerlab.stages.pipeline import report_plan
-    from walkerlab.stages.report_inputs import not_run
 
     powered = load_scene(ROOT / "configs" / "hip_width_powered.yaml")
     assert powered.contact is not None
-    assert report_plan(powered) == ["fixedpoint", "simulate"]
-    assert "actuators the contact view does not take" in not_run(powered, "contact-sim")
-    passive = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    assert "contact-sim" in report_plan(passive)
+    assert report_plan(powered) == ["fixedpoint", "simulate", "contact-sim", "compare"]

@@ -267,7 +267,7 @@ _POWERED_PACKED = '''
 @njit(cache=True, error_model='numpy')
 def powered_packed(t, y, d, dy):
     """dy/dt of a powered walker's state and work integrals from the data vector ``d``
-    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 12), calls]``); counts the call in
+    (``[n1, n2, PC, p, c1, c2, A, scratch (NQ + 14), calls]``); counts the call in
     ``d[-1]``."""
     a1 = D_P + NP
     a2 = a1 + int(d[D_N1])
@@ -276,13 +276,14 @@ def powered_packed(t, y, d, dy):
     A = d[a3:a3 + la]
     p = d[D_P:a1]
     # scratch in the data vector (no allocation per call): the force Q (NQ), the powers W
-    # (10), the ghost swing foot G (2)
-    S = d[a3 + la:a3 + la + NQ + 12]
+    # (10), the ghost swing foot G (2), the joint law's positive and negative power (2)
+    S = d[a3 + la:a3 + la + NQ + 14]
     for i in range(NQ + 10):
         S[i] = 0.0
     actuate(t, y, A, p, S)
     _pk.ghost_foot(t, A, S, NQ)
     rhs_q(y, d[D_PC:D_P], p, d[a1:a2], d[a2:a3], S, dy)
+    _pk.split_law_power(S, NQ)
     _pk.work_rates(A, S, dy, NQ)
     d[d.size - 1] += 1.0
 
@@ -291,7 +292,7 @@ def powered_packed(t, y, d, dy):
 def powered_size(d):
     """Length of a powered data vector (``d`` may be a raw pointer in a cfunc)."""
     a3 = D_P + NP + int(d[D_N1]) + int(d[D_N2])
-    return a3 + int(d[a3]) + NQ + 12 + 1
+    return a3 + int(d[a3]) + NQ + 14 + 1
 
 
 @njit(cache=True)

@@ -111,7 +111,8 @@ def contact_section(scene, arts) -> list[str]:
                 f"their dissipation and the energy their springs hold) "
                 f"{num(w['contact'][-1], 4)}"
                 + (f", knee stops {num(w['knee_stop'][-1], 4)}" if "knee_stop" in w else "")
-                + (f", the hip-roll law {num(w['hip_roll'][-1], 4)}" if "hip_roll" in w
+                + (f", the hip-roll law +{num(w['hip_roll_positive'][-1], 4)} / "
+                   f"{num(w['hip_roll_negative'][-1], 4)}" if "hip_roll_positive" in w
                    else "")
                 + "; closure (kinetic + potential energy change minus "
                 f"these) at most {num(float(abs(w['residual']).max()), 2)} J.", ""]

@@ -10,7 +10,8 @@ support, where interpolating the samples is accurate.  Per step:
 
 - ``push_off_work`` [J]: the push-off pulse's work (0 without one);
 - ``actuator_work_positive`` / ``actuator_work_negative`` [J]: the joint (or ankle) torques'
-  positive and negative work;
+  positive and negative work, with a 3D walker's hip-roll law's (as the rigid ledger counts
+  it);
 - ``contact_work`` [J]: the contact forces' (their dissipation, and the change of the
   energy their springs hold);
 - ``distance`` [m]: the hip's displacement along the slope over the step (on a periodic gait
@@ -41,8 +42,8 @@ STEP_LEDGER_DESCRIPTIONS = {
     "cost_of_transport": "(positive actuator work + push-off work + slope energy if > 0) "
                          "/ (M g d), d the hip's displacement along the ground",
 }
-_POSITIVE = ("hip_torque_positive", "ankle_torque_positive")
-_NEGATIVE = ("hip_torque_negative", "ankle_torque_negative")
+_POSITIVE = ("hip_torque_positive", "ankle_torque_positive", "hip_roll_positive")
+_NEGATIVE = ("hip_torque_negative", "ankle_torque_negative", "hip_roll_negative")
 
 
 def contact_step_ledger(walker, t, X, work, heel_strike_times) -> dict[str, np.ndarray]:

@@ -319,9 +319,10 @@ def _write_work(f, run: ContactSimRun) -> None:
                        "dissipation and the energy their springs hold",
             "knee_stop": "work of the knee stops (a kneed walker): their dissipation and "
                          "the energy their springs hold",
-            "hip_roll": "work of the hip-roll law (a 3D walker's hip-roll joints: the "
-                        "stance hip holding the pelvis level, the swing hip placing its leg; "
-                        "Kuo 1999)"}
+            "hip_roll_positive": "positive work of the hip-roll law (a 3D walker's "
+                                 "hip-roll joints: the stance hip holding the pelvis level, "
+                                 "the swing hip placing its leg; Kuo 1999)",
+            "hip_roll_negative": "negative work of the hip-roll law"}
     # the actuators' own words (a five-link biped's hip-torque terms carry every joint's)
     what.update(run.walker.actuators.work_labels)
     # the samples' times as the ledger's own coordinate (without it the dimension was a

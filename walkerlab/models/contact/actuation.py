@@ -86,7 +86,8 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
-__all__ = ["ANKLE_WORK_NAMES", "FLAT_HIP_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES",
+__all__ = ["ANKLE_WORK_NAMES", "FLAT_HIP_WORK_NAMES", "FLOW_LAW_WORK_NAMES", "KNEE_WORK_NAMES",
+           "WORK_NAMES",
            "ContactActuators", "ContactRows", "PushOffPulse", "powered_rhs"]
 
 
@@ -259,7 +260,8 @@ class ContactActuators(PushOffPulse, ContactRows):
         thighs' on knees: the rigid view's).
     flow_law : bool
         The walker's generated flow carries a joint law that does work (a 3D walker's
-        hip-roll law, Kuo 1999): its power is a term of the ledger, ``hip_roll``.
+        hip-roll law, Kuo 1999): its positive and negative work are terms of the ledger
+        (:data:`FLOW_LAW_WORK_NAMES`).
 
     Raises
     ------
@@ -301,7 +303,7 @@ class ContactActuators(PushOffPulse, ContactRows):
                                  "massive legs)")
         self.ankle = ankle
         #: the walker's own joint law in its generated flow does work (a 3D walker's
-        #: hip-roll law): the ledger's ``hip_roll`` term
+        #: hip-roll law): the ledger's :data:`FLOW_LAW_WORK_NAMES` terms
         self.flow_law = bool(flow_law)
         self._dampers = None  # the walker's dampers, looked up on first use
         self.foot = ((names.index("leg1_foot_angle"), names.index("leg2_foot_angle"))
@@ -403,7 +405,7 @@ class ContactActuators(PushOffPulse, ContactRows):
         the knee stops' last on knees."""
         knee = ("knee_stop",) if self.knee else ()
         if self.foot is None:
-            return WORK_NAMES + knee + (("hip_roll",) if self.flow_law else ())
+            return WORK_NAMES + knee + (FLOW_LAW_WORK_NAMES if self.flow_law else ())
         names = ()
         if self.ankle is not None:
             names += ANKLE_WORK_NAMES[:2]
@@ -485,6 +487,9 @@ ANKLE_WORK_NAMES = ("ankle_torque_positive", "ankle_torque_negative", "damper", 
 FLAT_HIP_WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "damper", "contact")
 #: ... and those of a kneed walker's (the knee stops' work last) [J].
 KNEE_WORK_NAMES = WORK_NAMES + ("knee_stop",)
+#: ... and those a joint law in the flow adds (a 3D walker's hip-roll law: its positive and
+#: negative work, as the rigid ledger counts it among the actuators') [J].
+FLOW_LAW_WORK_NAMES = ("hip_roll_positive", "hip_roll_negative")
 
 
 def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
@@ -535,9 +540,10 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
     if acts.knee:
         return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
                              _knee_power(walker, x)])
-    if acts.flow_law:
+    if getattr(acts, "flow_law", False):
+        p_law = _flow_law_power(walker, x)
         return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
-                             _flow_law_power(walker, x)])
+                             max(p_law, 0.0), min(p_law, 0.0)])
     return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact])
 
 

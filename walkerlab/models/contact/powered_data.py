@@ -107,7 +107,7 @@ class PoweredData:
         h[5], h[6] = -1.0, 0.0
         block = np.concatenate([h, self.B[0], self.B[1], *self.held, self.laws])
         block[0] = block.size
-        scratch = np.zeros(n + 12)  # the compiled call's force and powers
+        scratch = np.zeros(n + 14)  # the compiled call's force and powers
         self._template = np.concatenate([self.base, block, scratch, [0.0]]).astype(np.float64)
 
     def data(self, stance: int, t_origin: float, push: tuple[int, float] | None = None,

@@ -4,7 +4,8 @@ actuation block, numba, on arrays.
 Internal module.  Everything is SI.  The forces of
 :mod:`walkerlab.models.contact.powered_source` (the actuation block's layout ``A``, the
 scratch ``S`` of one call: the generalised force ``S[:nq]``, the powers
-``W = S[nq:nq + 10]``, the ghost swing foot ``S[nq + 10:nq + 12]``), taking arrays only; the
+``W = S[nq:nq + 10]``, the ghost swing foot ``S[nq + 10:nq + 12]``, the joint law's
+positive and negative power ``S[nq + 12:nq + 14]``), taking arrays only; the
 generated contact module of each walker structure calls its generated kinematics (``feet``,
 ``dyn``) and hands their arrays to these kernels, in the order of the actuators' sum
 (joint torques, the ankle push-off, the push-off pulse, the held force:
@@ -235,6 +236,16 @@ def ghost_foot(t, A, S, nq):
         st = 1 - st
     S[nq + 10] = float(1 - st) if A[35] >= 0.0 and (switched or A[29] == np.inf) else -1.0
     S[nq + 11] = A[35]
+
+
+@njit(cache=True, error_model='numpy')
+def split_law_power(S, nq):
+    """The joint laws' power of the flow (``S[nq + 7]``: a 3D walker's hip-roll law) split
+    into its positive and negative parts, ``S[nq + 12]``, ``S[nq + 13]`` (the ledger's
+    ``hip_roll_positive``, ``hip_roll_negative``: the rigid ledger's split)."""
+    p = S[nq + 7]
+    S[nq + 12] = p if p > 0.0 else 0.0
+    S[nq + 13] = p if p < 0.0 else 0.0
 
 
 @njit(cache=True, error_model='numpy')

@@ -70,8 +70,9 @@ then           ``B`` with leg1 in stance, then with leg2 (nq * k each, row-major
                (its ``b[2]``, the time the step began, written by each call)
 =============  =============================================================================
 
-After the block, ``nq + 12`` numbers of scratch (the force, the powers and the ghost
-swing foot of one call: the right-hand side allocates nothing), then the call counter.
+After the block, ``nq + 14`` numbers of scratch (the force, the powers, the ghost swing
+foot and the joint law's power split in its positive and negative parts of one call: the
+right-hand side allocates nothing), then the call counter.
 """
 
 from __future__ import annotations
@@ -84,7 +85,8 @@ __all__ = ["A_HEAD", "CYRK_POWERED_SOURCE", "W_INDEX", "powered_source"]
 #: Index in the powers ``W`` of each work integral's name.
 W_INDEX = {"hip_torque_positive": 0, "hip_torque_negative": 1, "ankle_torque_positive": 2,
            "ankle_torque_negative": 3, "push_off": 4, "damper": 5, "contact": 6,
-           "knee_stop": 7, "hip_roll": 7, "action_positive": 8, "action_negative": 9}
+           "knee_stop": 7, "action_positive": 8, "action_negative": 9,
+           "hip_roll_positive": 12, "hip_roll_negative": 13}
 
 
 def powered_source() -> str:
