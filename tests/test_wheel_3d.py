@@ -34,6 +34,8 @@ def _scene(**walker):
 
     raw = yaml.safe_load(SCENE.read_text())
     raw["walker"].update(walker)
+    if raw["walker"].get("space") == "2d":  # a planar scene takes no torsional friction
+        raw["contact"].pop("torsional_friction_m", None)
     return Scene.model_validate(raw)
 
 

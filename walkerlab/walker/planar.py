@@ -14,10 +14,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["PlanarTwin", "planar_twin"]
+__all__ = ["CONTACT_ONLY_IN_3D", "PlanarTwin", "planar_twin"]
 
 #: fields of a 3D walker section that only a 3D walker has, left out of its planar twin
 ONLY_IN_3D = ("space", "hip_width_m", "hip_roll", "diametral_inertia_kg_m2")
+#: fields of the contact section that only a 3D walker takes (a planar scene refuses them),
+#: left out of its planar twin's scene
+CONTACT_ONLY_IN_3D = ("torsional_friction_m",)
 #: fields a planar twin cannot carry (a 3D walker with one of them set has no planar twin
 #: here: a planar walker's round feet are ``model: biped``'s ``leg.foot``)
 NO_TWIN = ("foot_radius_m", "leg_inertia_kg_m2")

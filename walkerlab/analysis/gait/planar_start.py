@@ -43,7 +43,7 @@ from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.registry import build_walker
-from walkerlab.walker.planar import planar_twin
+from walkerlab.walker.planar import CONTACT_ONLY_IN_3D, planar_twin
 from walkerlab.walker.plant import Plant
 
 __all__ = ["PlanarStart", "planar_start", "planar_fallback", "embed", "carry_width",
@@ -76,10 +76,12 @@ class PlanarStart:
 
 
 def _twin_scene(scene: Scene, walker: dict) -> Scene:
-    """The scene with ``walker`` as its walker section and no initial guess (the twin's
-    gait is searched for from its own seeds)."""
+    """The scene with ``walker`` as its walker section, no initial guess (the twin's gait is
+    searched for from its own seeds) and no contact field only a 3D walker takes."""
     data = scene.model_dump(mode="json", by_alias=True)
     data["walker"] = walker
+    for k in CONTACT_ONLY_IN_3D:  # a 3D walker's contact fields (a planar scene refuses)
+        (data.get("contact") or {}).pop(k, None)
     fp = data.get("fixedpoint") or {}
     data["fixedpoint"] = {k: v for k, v in fp.items()
                           if k in ("tolerance", "fd_step", "max_step_time_s")}
