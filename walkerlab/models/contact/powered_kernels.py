@@ -184,7 +184,7 @@ def hold_ankle(x, A, M, Qp, pp):
 @njit(cache=True, error_model='numpy')
 def hold_row(M, Qp, pp, a, rate):
     """The push-off pulse's force ``Qp`` (nq,) with the generalised force ``lam a`` that
-    holds the rate ``a . dq`` (its value ``rate``) through it, ``a M^-1 (Qp + a lam) = 0``,
+    holds the rate ``a @ dq`` (its value ``rate``) through it, ``a M^-1 (Qp + a lam) = 0``,
     added in place (a 3D walker's trailing foot holding its spin about the ground's
     normal: ``a`` the spin's Jacobian); returns the pulse's power with ``lam rate``."""
     n = Qp.shape[0]
