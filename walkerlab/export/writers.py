@@ -346,7 +346,7 @@ def _check_legs_3d(job: ExportJob, w: Writer) -> None:
         kind.require("hip_roll", w.view, "walker.hip_roll")
     check_exportable(scene, kind, w.name, job.walker_only)  # numbers, ground
     if scene.walker.actuation is not None:  # passive so far: the table's reason
-        from walkerlab.models.hybrid.actuated import refuse_actuators  # light: actuated only
+        from walkerlab.models.actuation import refuse_actuators  # light: actuated only
 
         refuse_actuators(kind, scene.walker.actuation, w.view)
 

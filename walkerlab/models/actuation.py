@@ -20,7 +20,7 @@ import numpy as np
 from walkerlab.walker.joints import joint_angles, joint_columns, joint_links, link_angles
 
 __all__ = ["JointMap", "TorqueLaws", "TorqueOfTime", "phase_reference", "push_off_impulse",
-           "saturate", "shared_phase_table"]
+           "refuse_actuators", "saturate", "shared_phase_table", "torque_feature"]
 
 
 def phase_reference(table):
@@ -308,3 +308,28 @@ class JointMap:
         [rad] and rate [rad/s], the phase variable (the virtual stance leg's angle) [rad] and
         its rate [rad/s] (:func:`walkerlab.walker.joints.joint_angles`)."""
         return joint_angles(self._angles(x), self.links, "stance")
+
+
+def torque_feature(joint: str) -> str:
+    """The capability table's feature of a torque at ``joint`` (``hip``: the hip torque;
+    ``stance_hip``/``swing_hip``: between a torso and a leg; a knee's, an ankle's)."""
+    for part in ("knee", "ankle"):
+        if part in joint:
+            return f"{part}_torque"
+    return "hip_torque" if joint == "hip" else "torso_torque"
+
+
+def refuse_actuators(kind, spec, view: str) -> None:
+    """Refuse the first actuator ``spec`` (a ``walker.actuation`` section) asks for that
+    ``kind`` does not have in ``view``, in the table's one line naming its field (both
+    views' and the exports' check: it lies below them).
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+    """
+    for i, t in enumerate(spec.torques):
+        kind.require(torque_feature(t.joint), view, f"walker.actuation.torques.{i}.joint")
+    for name in ("push_off", "ankle_push_off", "virtual_constraints"):
+        if getattr(spec, name, None) is not None:
+            kind.require(name, view, f"walker.actuation.{name}")

@@ -80,7 +80,7 @@ def require_kind(stage: str, scene: Scene) -> None:
         for s in order(stage, scene):
             kind.require_stage(s)
             if act is not None and s in STAGE_VIEWS:  # the view's actuators (the table's)
-                from walkerlab.models.hybrid.actuated import refuse_actuators  # light
+                from walkerlab.models.actuation import refuse_actuators  # light
 
                 try:
                     refuse_actuators(kind, act, STAGE_VIEWS[s][1])

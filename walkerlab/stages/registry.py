@@ -92,7 +92,7 @@ def contact_walks_ground(scene: Scene) -> bool:
     act = getattr(scene.walker, "actuation", None)
     if not drawn and act is None:
         return True
-    from walkerlab.models.hybrid.actuated import refuse_actuators  # light
+    from walkerlab.models.actuation import refuse_actuators  # light
     from walkerlab.walker.description import walker_data  # light: kinds on drawn grounds
     from walkerlab.walker.kinds import KindRefused  # light
 

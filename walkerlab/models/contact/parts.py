@@ -407,7 +407,7 @@ class Legs3DPart(ContactPart):
     def actuators_refusal(self, scene, data) -> str | None:
         """The table's refusal of the scene's actuators in the contact view (a torque at a
         joint the straight legs do not have, virtual constraints), one line."""
-        from walkerlab.models.hybrid.actuated import refuse_actuators  # light
+        from walkerlab.models.actuation import refuse_actuators  # light
         from walkerlab.walker.kinds import KindRefused  # light
 
         try:

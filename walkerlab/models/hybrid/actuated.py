@@ -20,6 +20,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from walkerlab.models.actuation import refuse_actuators, torque_feature
 from walkerlab.models.hybrid.actuators import Actuators, torque_chain_jacobian
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian
@@ -389,30 +390,6 @@ class _FlatFeet:
         from walkerlab.models.hybrid.ankle_push_off import actuate_flat
 
         return actuate_flat(walker, data, spec)
-
-
-def torque_feature(joint: str) -> str:
-    """The capability table's feature of a torque at ``joint`` (``hip``: the hip torque;
-    ``stance_hip``/``swing_hip``: between a torso and a leg; a knee's, an ankle's)."""
-    for part in ("knee", "ankle"):
-        if part in joint:
-            return f"{part}_torque"
-    return "hip_torque" if joint == "hip" else "torso_torque"
-
-
-def refuse_actuators(kind, spec, view: str) -> None:
-    """Refuse the first actuator ``spec`` (a ``walker.actuation`` section) asks for that
-    ``kind`` does not have in ``view``, in the table's one line naming its field.
-
-    Raises
-    ------
-    walkerlab.walker.kinds.KindRefused
-    """
-    for i, t in enumerate(spec.torques):
-        kind.require(torque_feature(t.joint), view, f"walker.actuation.torques.{i}.joint")
-    for name in ("push_off", "ankle_push_off", "virtual_constraints"):
-        if getattr(spec, name, None) is not None:
-            kind.require(name, view, f"walker.actuation.{name}")
 
 
 class _RollingPolygon:
