@@ -143,6 +143,10 @@ class PushOffPulse:
     point to the hip."""
 
     _push_rows = None  # the contact-table row of each leg's push-off point, on first use
+    #: the walker's generated flow carries a joint law that does work (a 3D walker's
+    #: hip-roll law; set by :class:`ContactActuators`): the ledger's
+    #: :data:`FLOW_LAW_WORK_NAMES` terms
+    flow_law = False
 
     def push_row(self, walker, leg: int) -> int:
         """Row of ``walker.contact_names()`` where leg ``leg`` (0: leg1, 1: leg2) pushes off:
@@ -540,7 +544,7 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
     if acts.knee:
         return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
                              _knee_power(walker, x)])
-    if getattr(acts, "flow_law", False):
+    if acts.flow_law:
         p_law = _flow_law_power(walker, x)
         return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
                              max(p_law, 0.0), min(p_law, 0.0)])
