@@ -143,9 +143,8 @@ class PushOffPulse:
     point to the hip."""
 
     _push_rows = None  # the contact-table row of each leg's push-off point, on first use
-    #: the walker's generated flow carries a joint law that does work (a 3D walker's
-    #: hip-roll law; set by :class:`ContactActuators`): the ledger's
-    #: :data:`FLOW_LAW_WORK_NAMES` terms
+    #: the generated flow carries a joint law that does work (a 3D walker's hip-roll law,
+    #: set by :class:`ContactActuators`): the ledger's :data:`FLOW_LAW_WORK_NAMES` terms
     flow_law = False
 
     def push_row(self, walker, leg: int) -> int:
