@@ -30,7 +30,6 @@ from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root
 from walkerlab.walker.trees import (
     compass_3d_tree,
-    planar_compass_tree,
     spoked_wheel_3d_tree,
 )
 
@@ -202,19 +201,6 @@ def test_production_spoked_wheel_from_the_tree_equals_the_hand_derivation(spokes
                             *((k, e.points[k], ours.points[k]) for k in e.points
                               if k != "stance_foot")):
         _close(name, ref, cand, args, pts)
-
-
-@pytest.mark.parametrize("rod", [False, True], ids=["point_legs", "rod_legs"])
-def test_a_planar_tree_reproduces_the_compass_gait(rod):
-    """Every axis along ``z``, no hip width: the tree's mass matrix (and Coriolis, gravity,
-    impact) equal the planar compass gait's (``symbolic.derive``; Goswami, Thuilot & Espiau
-    1996), with a rod's inertia about its mass point or without."""
-    e = derive(Structure("absolute", (BodySpec("mass", "rod" if rod else "point_mass"),),
-                         hip_mass=True))
-    tree, coords = planar_compass_tree(leg_inertia=rod)
-    te = derive_tree(tree, coords, simplify=_same)
-    Mi, B = heel_strike(te, "swing_foot", simplify=_same)
-    _compare(e, te, Mi, B, np.random.default_rng(18 + rod))
 
 
 def test_the_3d_tree_upright_and_narrow_is_the_planar_compass_gait():

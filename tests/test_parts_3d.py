@@ -1,5 +1,5 @@
 """Walkers written from parts (``model: biped``) in three dimensions (``space: 3d``,
-``hip_width_m``; the body tree of :func:`walkerlab.walker.trees.straight_legs_3d_tree`)
+``hip_width_m``; the body tree of :func:`walkerlab.walker.trees.biped_tree`)
 against references that share no code with their generated equations: the planar walker of
 the same parts (the planar embedding), the ``compass_gait`` shorthand's walker (configs/
 hip_width.yaml), and a model written here from Newton's law for the point masses, the upper

@@ -57,14 +57,15 @@ def _generator_hash() -> str:
 @cache
 def _flat_generator_hash() -> str:
     """sha256 of the flat-foot generator's sources (once per process)."""
-    return _source_hash("foot_modes.py", "double_support.py", "push_off.py")
+    return _source_hash("codegen/foot_modes.py", "codegen/double_support.py",
+                        "codegen/push_off.py")
 
 
 def _source_hash(*names: str) -> str:
-    """sha256 of the sources ``names`` of this package, in order."""
+    """sha256 of the sources ``names`` (paths in ``walkerlab/``), in order."""
     h = hashlib.sha256()
     for name in names:
-        h.update((Path(__file__).parent / name).read_bytes())
+        h.update((Path(__file__).parents[1] / name).read_bytes())
     return h.hexdigest()
 
 
@@ -94,7 +95,9 @@ def cache_key(structure) -> str:
     :mod:`~walkerlab.codegen.double_support` and :mod:`~walkerlab.codegen.push_off`), a
     free-jointed one's (free knees or a hinged torso) :mod:`walkerlab.codegen.free_joints`,
     a spoked wheel's
-    :mod:`walkerlab.codegen.rolling_polygon`, which no other structure's key reads)."""
+    :mod:`walkerlab.codegen.rolling_polygon`, a 3D walker's its derivation from its body tree
+    (:mod:`walkerlab.codegen.derive_3d`, :mod:`~walkerlab.codegen.tree_derive`,
+    :mod:`walkerlab.walker.trees`), which no other structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())
     if structure.foot == "flat":
@@ -103,8 +106,10 @@ def cache_key(structure) -> str:
         h.update(_five_link_generator_hash().encode())
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
-    if getattr(structure, "in_3d", False):
-        h.update(_source_hash("derive_3d.py", "frames.py").encode())
+    if getattr(structure, "in_3d", False):  # derived from its body tree
+        h.update(_source_hash("codegen/derive_3d.py", "codegen/frames.py",
+                              "codegen/tree_derive.py", "walker/tree.py",
+                              "walker/trees.py").encode())
     return h.hexdigest()[:24]
 
 

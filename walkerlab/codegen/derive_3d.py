@@ -66,7 +66,7 @@ from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
 from walkerlab.codegen.seeded import seeded as _seeded
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike, plastic_impact
-from walkerlab.walker.trees import legs_3d_tree, spoked_wheel_3d_tree
+from walkerlab.walker.trees import legs_tree, spoked_wheel_3d_tree
 
 
 @cache
@@ -303,7 +303,7 @@ def derive_compass(structure) -> Equations:
     if not structure.in_3d or structure.spokes:
         raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
                          "walker")
-    tree, coords = legs_3d_tree(structure)
+    tree, coords = legs_tree(structure)
     te = derive_tree(tree, coords)
     kin, q, dq = te.kinematics, te.q, te.dq
     phi, th_sw, th_st = q[:3]

@@ -29,7 +29,7 @@ from walkerlab.codegen.floating_names import (
 )
 from walkerlab.walker.description import Structure
 from walkerlab.walker.tree import free_root
-from walkerlab.walker.trees import legs_3d_tree, spoked_wheel_3d_tree
+from walkerlab.walker.trees import legs_tree, spoked_wheel_3d_tree
 
 __all__ = ["derive_legs_3d", "derive_wheel_3d", "wheel_tip_names"]
 
@@ -67,7 +67,7 @@ def _spin(kin, body: str, rename):
 
 def derive_legs_3d(structure: Structure) -> FloatingEquations:
     """The floating view of a 3D straight-legged walker from its body tree
-    (:func:`walkerlab.walker.trees.legs_3d_tree`, Kuo 1999), set free at leg2's foot
+    (:func:`walkerlab.walker.trees.legs_tree`, Kuo 1999), set free at leg2's foot
     (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y, z`` and a
     heading, :data:`~walkerlab.codegen.floating_equations.FREE_3D`, then the rigid tree's
     joints in its own coordinates renamed by
@@ -82,7 +82,7 @@ def derive_legs_3d(structure: Structure) -> FloatingEquations:
     from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
     from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
 
-    rigid, coords = legs_3d_tree(structure)
+    rigid, coords = legs_tree(structure)
     tree, kin, q, dq, rename, M, V, h = _free_flow(structure, rigid, coords, FREE_3D)
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
     to_world = slope_to_world(kin.gamma)

@@ -258,7 +258,7 @@ class BipedParams(_Actuated):
 
     def _space_check(self, pair) -> None:
         """``space: 3d`` (the legs' parts in three dimensions,
-        :func:`walkerlab.walker.trees.straight_legs_3d_tree`): what it supports today, one
+        :func:`walkerlab.walker.trees.biped_tree`): what it supports today, one
         line otherwise."""
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
             raise ValueError(HIP_ROLL_NEEDS)

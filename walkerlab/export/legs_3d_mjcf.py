@@ -91,7 +91,7 @@ from walkerlab.export.tree_bodies import (
 )
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
-from walkerlab.walker.trees import legs_3d_tree
+from walkerlab.walker.trees import legs_tree
 
 __all__ = ["TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "legs3d_footfalls",
            "legs3d_keyframe", "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
@@ -404,9 +404,9 @@ def hip_roll_law(data) -> dict | None:
 
 def walker_tree(data) -> tuple:
     """The 3D straight-legged walker's body tree, its coordinate map and numbers
-    (:func:`walkerlab.walker.trees.legs_3d_tree`; ``data``'s parameters by name,
+    (:func:`walkerlab.walker.trees.legs_tree`; ``data``'s parameters by name,
     :func:`_numbers`)."""
-    return (*legs_3d_tree(data.structure), _numbers(data))
+    return (*legs_tree(data.structure), _numbers(data))
 
 
 def legs_summary(data, p: dict) -> str:

@@ -1,10 +1,11 @@
-"""The 3D walkers and the planar compass gait as body trees (:mod:`walkerlab.walker.tree`):
-the straight-legged walker in 3D from its parts (:func:`straight_legs_3d_tree`; Kuo 1999,
-"Stabilization of lateral motion in passive dynamic walking", IJRR 18(9)), which production
-derives (:func:`walkerlab.codegen.derive_3d.derive_compass`) for the ``compass_gait``
-shorthand and for a biped from parts alike (:func:`legs_3d_tree`), the planar compass gait
-as a planar tree (every axis along ``z``, no hip width; :func:`planar_compass_tree`, held to
-:func:`walkerlab.codegen.symbolic.derive` by the tests), and the 3D spoked wheel
+"""The walkers as body trees (:mod:`walkerlab.walker.tree`): a biped from its parts
+(:func:`biped_tree`, :func:`legs_tree`) in three dimensions (Kuo 1999, "Stabilization of
+lateral motion in passive dynamic walking", IJRR 18(9)), which production derives
+(:func:`walkerlab.codegen.derive_3d.derive_compass`) for the ``compass_gait`` shorthand and
+for a biped from parts alike, and in the plane, its special case (every joint a pitch about
+``z``: no ankle or hip roll, no hip width; with a knee on the swing leg, legs that differ,
+round feet, an upper body on the bisecting hip), held to the planar derivation
+(:func:`walkerlab.codegen.symbolic.derive`) by the tests; and the 3D spoked wheel
 (:func:`spoked_wheel_3d_tree`).
 
 The 3D tree, from the stance foot (the root, in the slope's frame):
@@ -33,6 +34,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from walkerlab.walker.description import ROLE_TAG
 from walkerlab.walker.tree import (
     ZERO_INERTIA,
     Body,
@@ -44,8 +46,7 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["Part", "compass_3d_tree", "legs_3d_tree", "planar_compass_tree", "spoked_wheel_3d_tree",
-           "straight_legs_3d_tree"]
+__all__ = ["Part", "biped_tree", "compass_3d_tree", "legs_tree", "spoked_wheel_3d_tree"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 #: the parameters the 3D compass's tree reads, before the hip-roll law's gains (the order
@@ -66,12 +67,15 @@ class Part:
     mass : str
         [kg].
     from_hip : str
-        Distance from the hip along the link [m]: down a leg, up the upper body.
+        Distance from the hip along the leg [m] (down a leg, a shank's body too; up the upper
+        body).
     inertia : str or None
         Inertia about the centre of mass about every axis normal to the link [kg m^2] (a
         slender rod's; none about the link's own axis), or None: a point mass.
     ahead : str or None
         Distance of the centre of mass ahead of the link's axis, in its sagittal plane [m].
+    link : {"leg", "thigh", "shank"}
+        The link a kneed leg carries it on (a straight leg's bodies: ``leg``).
     """
 
     name: str
@@ -79,6 +83,7 @@ class Part:
     from_hip: str
     inertia: str | None = None
     ahead: str | None = None
+    link: str = "leg"
 
     def com(self, along: str) -> tuple:
         return (self.ahead or 0, along, 0)
@@ -88,16 +93,22 @@ class Part:
                                                                   self.inertia)
 
 
-def straight_legs_3d_tree(params: tuple[str, ...], legs: tuple[Part, ...],
-                          torso: tuple[Part, ...] = (), *, hip_width: str | float = 0,
-                          hip_roll: bool = False, foot_radius: str | None = None
-                          ) -> tuple[BodyTree, CoordinateMap]:
-    """A straight-legged walker in three dimensions (Kuo 1999) as a tree (module docstring),
-    from its parts: each leg a frame carrying ``legs`` (welded), the pelvis with ``M_hip``
-    midway between the hips, and an upper body carrying ``torso`` held on the bisector of
-    the legs by a bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007, IEEE Trans.
-    Robotics 23(1)): its pitch from the upward vertical is the mean of the legs' pitches
-    (leaning back when the feet are ahead; no coordinate of its own), its roll the pelvis'.
+def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Part, ...] = (),
+               *, planar: bool = False, swing_legs: tuple[Part, ...] | None = None,
+               thigh: str | None = None, hip_mass: bool = True, hip_width: str | float = 0,
+               hip_roll: bool = False,
+               foot_radius: str | None = None,
+               coordinates: str = "absolute") -> tuple[BodyTree, CoordinateMap]:
+    """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
+    or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
+    pelvis with ``M_hip`` midway between the hips, and an upper body carrying ``torso`` held
+    on the bisector of the legs by a bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007,
+    IEEE Trans. Robotics 23(1)): its pitch from the upward vertical is the mean of the legs'
+    pitches (leaning back when the feet are ahead; no coordinate of its own), its roll the
+    pelvis'.  In the plane every joint turns about ``z`` (the pitch joints alone: no roll,
+    no hip width), as the planar derivation (:func:`walkerlab.codegen.symbolic.derive`) has
+    it; a knee (McGeer 1990, "Passive walking with knees") is a pitch joint on the swing
+    leg, the stance leg straight.
 
     Parameters
     ----------
@@ -105,26 +116,40 @@ def straight_legs_3d_tree(params: tuple[str, ...], legs: tuple[Part, ...],
         The parameter names (the generated code's vector, in order); they include ``g, L,
         gamma, M_hip`` and every name the parts use.
     legs, torso : tuple of Part
-        The bodies on each leg (both legs alike) and on the upper body.
+        The bodies on each leg (the stance leg's when ``swing_legs`` is given) and on the
+        upper body.
+    planar : bool
+        The walker in the plane: coordinates ``swing, stance`` (a knee: ``swing_thigh,
+        swing_shank, stance``), no lean.
+    swing_legs : tuple of Part, optional
+        The swing leg's bodies when the legs differ (default ``legs``).
+    thigh : str or None
+        A knee on the swing leg this far below the hip [m] (a parameter name): the swing
+        leg's ``shank`` parts hang from it; None: straight legs.
+    hip_mass : bool
+        The pelvis carries ``M_hip`` (else it is massless).
     hip_width : str or float
-        The distance between the hips along the hip axis [m] (a parameter name, or 0).
+        The distance between the hips along the hip axis [m] (a parameter name, or 0; 3D).
     hip_roll : bool
         The legs hang from the pelvis on roll joints (coordinates ``pelvis_roll,
-        swing_roll``; the pelvis' roll inertia ``I_pelvis``).
+        swing_roll``; the pelvis' roll inertia ``I_pelvis``; 3D).
     foot_radius : str or None
         Round feet: each foot a disc of this radius [m] in its leg's rolled sagittal plane
         rolling on the slope without slip (its centre ``L - R`` from the hip; the stance
         disc's centre ``-R (theta_st + gamma)`` along the fall line and ``R`` along the
         rolled normal from the step's reference point: a slide ``stance_travel``, then the
         roll, then the pitch about the centre); None: point feet.
+    coordinates : {"absolute", "slope_relative"}
+        A planar walker's coordinates: the legs' angles from the vertical, or Garcia et
+        al.'s (1998) ``stance`` from the slope's normal and ``hip`` between the legs.
 
     Returns
     -------
     BodyTree, CoordinateMap
-        Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (and ``torso``), each part
-        ``<link>_<part>``; contacts ``stance_foot`` and ``swing_foot`` (round feet:
-        ``swing_foot_centre``, the swing disc's centre); coordinates ``lean, swing, stance``
-        (and ``pelvis_roll, swing_roll``).
+        Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (``swing_shank``, ``torso``), each
+        part ``<link>_<part>``; contacts ``stance_foot`` and ``swing_foot`` (round feet:
+        ``swing_foot_centre``, the swing disc's centre); coordinates ``lean, swing,
+        stance`` (and ``pelvis_roll, swing_roll``), planar as ``planar`` says.
 
     Raises
     ------
@@ -133,58 +158,100 @@ def straight_legs_3d_tree(params: tuple[str, ...], legs: tuple[Part, ...],
     """
     R = foot_radius
     up_leg = "L" if R is None else f"L - {R}"     # from the frame's origin to the hip
-    bodies = _stance_foot(R)
+    pitch = (("stance_hip", "revolute", (Z,), ("stance_hip_pitch",)),
+             ("swing_hip", "revolute", (Z,), ("swing_hip_pitch",))) if planar else (
+        ("stance_hip", "universal", (Z, S), ("stance_hip_pitch", "stance_hip_roll")),
+        ("swing_hip", "universal", (S, Z), ("swing_hip_roll", "swing_hip_pitch")))
+    bodies = _stance_foot(R, planar)
     # each leg's parts hang from its hip (their frames there, the leg's axes)
     bodies += [Body(f"stance_leg_{p.name}", p.mass, p.inertia_tensor(),
                     p.com(f"-({p.from_hip})"),
                     Joint(f"stance_leg_{p.name}_weld", "fixed", "stance_leg", (0, up_leg, 0)))
                for p in legs]
     half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
-    bodies.append(Body("pelvis", "M_hip",
+    (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = pitch
+    bodies.append(Body("pelvis", "M_hip" if hip_mass else 0,
                        diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
                        (0, 0, half),
-                       Joint("stance_hip", "universal", "stance_leg", (0, up_leg, 0), (Z, S),
-                             ("stance_hip_pitch", "stance_hip_roll"))))
+                       Joint(hip, kind, "stance_leg", (0, up_leg, 0), axes, names)))
     bodies.append(Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
-                       Joint("swing_hip", "universal", "pelvis", (0, 0, hip_width), (S, Z),
-                             ("swing_hip_roll", "swing_hip_pitch"))))
+                       Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
+                             swing_names)))
+    swing = legs if swing_legs is None else swing_legs
     bodies += [Body(f"swing_leg_{p.name}", p.mass, p.inertia_tensor(),
                     p.com(f"-({p.from_hip})"),
-                    Joint(f"swing_leg_{p.name}_weld", "fixed", "swing_leg")) for p in legs]
+                    Joint(f"swing_leg_{p.name}_weld", "fixed", "swing_leg"))
+               for p in swing if thigh is None or p.link != "shank"]
+    foot_link, to_foot = "swing_leg", ("-L" if R is None else f"-({up_leg})")
+    if thigh is not None:  # the swing knee, ``thigh`` below the hip; the shank's parts on it
+        bodies.append(Body("swing_shank", 0, ZERO_INERTIA, (0, 0, 0),
+                           Joint("swing_knee", "revolute", "swing_leg", (0, f"-{thigh}", 0),
+                                 (Z,), ("swing_knee",))))
+        bodies += [Body(f"swing_shank_{p.name}", p.mass, p.inertia_tensor(),
+                        p.com(f"-({p.from_hip} - {thigh})"),
+                        Joint(f"swing_shank_{p.name}_weld", "fixed", "swing_shank"))
+                   for p in swing if p.link == "shank"]
+        foot_link = "swing_shank"
+        to_foot = f"-(L - {thigh})" if R is None else f"-({up_leg} - {thigh})"
     if torso:
         bodies.append(Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
                            Joint("torso_pitch", "revolute", "pelvis", (0, 0, half), (Z,),
                                  ("torso_pitch",))))
         bodies += [Body(f"torso_{p.name}", p.mass, p.inertia_tensor(), p.com(p.from_hip),
                         Joint(f"torso_{p.name}_weld", "fixed", "torso")) for p in torso]
-    swing_end = ((ContactPoint("swing_foot", "swing_leg", (0, "-L", 0)),) if R is None else
-                 (ContactPoint("swing_foot_centre", "swing_leg", (0, f"-({up_leg})", 0)),))
+    swing_end = ContactPoint("swing_foot" if R is None else "swing_foot_centre", foot_link,
+                             (0, to_foot, 0))
     tree = BodyTree(params, Root(), tuple(bodies),
                     (ContactPoint("stance_foot", "stance_leg" if R is None else
-                                  "stance_travel", (0, 0, 0)),) + swing_end)
-    names = ("lean", "swing", "stance") + (("pelvis_roll", "swing_roll") if hip_roll else ())
+                                  "stance_travel", (0, 0, 0)), swing_end))
+    return tree, _coordinates(planar, thigh is not None, hip_roll, R, bool(torso), coordinates)
+
+
+def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
+                 coordinates: str) -> CoordinateMap:
+    """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`)."""
+    if coordinates == "slope_relative":  # Garcia et al. (1998): theta, and phi between legs
+        names, swing, stance = ("stance", "hip"), "stance - hip - gamma", "stance - gamma"
+    elif knee:
+        names, swing, stance = ("swing_thigh", "swing_shank", "stance"), "swing_thigh", "stance"
+    else:
+        names, swing, stance = ("swing", "stance"), "swing", "stance"
+    if not planar:
+        names = ("lean",) + names + (("pelvis_roll", "swing_roll") if hip_roll else ())
     pelvis_roll, swing_roll = ("pelvis_roll", "swing_roll") if hip_roll else ("lean", "lean")
-    angles = ((("stance_travel", f"-{R} * (stance + gamma)"),) if R is not None else ()) + (
-        ("stance_ankle_roll", "lean"), ("stance_ankle_pitch", "stance + gamma"),
-        ("stance_hip_pitch", "-(stance + gamma)"),
-        ("stance_hip_roll", f"{pelvis_roll} - lean"),
-        ("swing_hip_roll", f"{swing_roll} - {pelvis_roll}"),
-        ("swing_hip_pitch", "swing + gamma")) + (
-        (("torso_pitch", "(swing + stance) / 2 + gamma"),) if torso else ())
-    return tree, CoordinateMap(names, angles)
+    rolls = () if planar else (("stance_ankle_roll", "lean"),)
+    angles = ((("stance_travel", f"-{R} * ({stance} + gamma)"),) if R is not None else ()) + (
+        rolls + (("stance_ankle_pitch", f"{stance} + gamma"),
+                 ("stance_hip_pitch", f"-({stance} + gamma)")))
+    if not planar:
+        angles += (("stance_hip_roll", f"{pelvis_roll} - lean"),
+                   ("swing_hip_roll", f"{swing_roll} - {pelvis_roll}"))
+    angles += (("swing_hip_pitch", f"{swing} + gamma"),)
+    if knee:
+        angles += (("swing_knee", "swing_shank - swing_thigh"),)
+    if torso:
+        angles += (("torso_pitch", f"({swing} + {stance}) / 2 + gamma"),)
+    return CoordinateMap(names, angles)
 
 
-def _stance_foot(R: str | None) -> list:
-    """The stance leg's frame on the slope: on a universal ankle (roll, then pitch) at a
-    point foot, or on the rolling disc of radius ``R`` (a slide along the fall line, the
-    roll, the pitch about the disc's centre)."""
+def _stance_foot(R: str | None, planar: bool = False) -> list:
+    """The stance leg's frame on the slope: on a universal ankle (roll, then pitch; in the
+    plane the pitch alone) at a point foot, or on the rolling disc of radius ``R`` (a slide
+    along the fall line, the roll, the pitch about the disc's centre)."""
     if R is None:
         return [Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                     Joint("stance_ankle", "revolute", "slope", (0, 0, 0), (Z,),
+                           ("stance_ankle_pitch",)) if planar else
                      Joint("stance_ankle", "universal", "slope", (0, 0, 0), (S, Z),
                            ("stance_ankle_roll", "stance_ankle_pitch")))]
-    return [Body("stance_travel", 0, ZERO_INERTIA, (0, 0, 0),
-                 Joint("stance_roll_travel", "prismatic", "slope", (0, 0, 0), (S,),
-                       ("stance_travel",))),
+    travel = Body("stance_travel", 0, ZERO_INERTIA, (0, 0, 0),
+                  Joint("stance_roll_travel", "prismatic", "slope", (0, 0, 0), (S,),
+                        ("stance_travel",)))
+    if planar:
+        return [travel, Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                             Joint("stance_ankle_pitch", "revolute", "stance_travel",
+                                   (0, R, 0), (Z,), ("stance_ankle_pitch",)))]
+    return [travel,
             Body("stance_roll", 0, ZERO_INERTIA, (0, 0, 0),
                  Joint("stance_ankle_roll", "revolute", "stance_travel", (0, 0, 0), (S,),
                        ("stance_ankle_roll",))),
@@ -196,7 +263,7 @@ def _stance_foot(R: str | None) -> list:
 def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
                     ) -> tuple[BodyTree, CoordinateMap]:
     """The 3D straight-legged walker with hip width ``w_hip`` as a tree
-    (:func:`straight_legs_3d_tree`: a point mass ``m_leg`` on each leg ``a_leg`` from its
+    (:func:`biped_tree`: a point mass ``m_leg`` on each leg ``a_leg`` from its
     foot), and the coordinates ``lean, swing, stance`` (and, with ``hip_roll``,
     ``pelvis_roll, swing_roll``) as its joint angles' map.
 
@@ -217,27 +284,49 @@ def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
     params = _BASE + ("w_hip",) + (("I_leg",) if leg_inertia else ()) + (
         _HIP_ROLL_LAW if hip_roll else ())
     leg = Part("mass", "m_leg", "L - a_leg", "I_leg" if leg_inertia else None)
-    return straight_legs_3d_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
+    return biped_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
 
 
-def legs_3d_tree(structure) -> tuple[BodyTree, CoordinateMap]:
-    """The tree of a 3D straight-legged walker's structure
-    (:class:`walkerlab.walker.description.Structure`, ``in_3d`` without spokes): the
-    ``model: compass_gait`` shorthand (one mass ``m_leg`` on each leg ``a_leg`` from its
-    foot, a rod's ``I_leg``, round feet ``R_foot``) or a biped from parts (``parts_3d``:
-    each leg body ``m_<name>, d_<name>[, I_<name>][, e_<name>]``, each upper-body body
-    ``m_torso_<name>, d_torso_<name>[, e_torso_<name>][, I_torso_<name>]``), with the hip
-    width ``w_hip`` and the hip-roll joints as the structure has them
-    (:func:`straight_legs_3d_tree`).
+def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
+    """The tree of a biped's structure (:class:`walkerlab.walker.description.Structure`,
+    legs without spokes), planar or in 3D (:func:`biped_tree`): a biped from parts (each leg
+    body ``m_<name>, d_<name>[, I_<name>][, e_<name>]`` (legs that differ: ``m_sw_<name>``,
+    ``m_st_<name>``, ...), each upper-body body ``m_torso_<name>, d_torso_<name>[,
+    e_torso_<name>][, I_torso_<name>]``, a knee ``L_thigh`` below the hip, round feet
+    ``R_foot``), or the 3D ``model: compass_gait`` shorthand (one mass ``m_leg`` on each leg
+    ``a_leg`` from its foot, a rod's ``I_leg``), with the hip width ``w_hip`` and the
+    hip-roll joints as the structure has them.
 
     Returns
     -------
     BodyTree, CoordinateMap
+
+    Raises
+    ------
+    ValueError
+        A part a tree does not carry yet, naming its field: a massless body (the mass -> 0
+        limit, Garcia et al. 1998), flat feet, free knees, a hinged torso, spokes.
     """
-    if structure.parts_3d:
-        legs = tuple(Part(b.name, f"m_{b.name}", f"d_{b.name}",
-                          f"I_{b.name}" if b.kind == "rod" else None,
-                          f"e_{b.name}" if b.off_axis else None) for b in structure.bodies)
+    planar = not structure.in_3d
+    if planar:
+        for flag, field in (("spokes", "walker.spokes"), ("free_knees", "walker.leg.knee"),
+                            ("hinged_torso", "walker.torso.joint")):
+            if getattr(structure, flag):
+                raise ValueError(f"{field}: a body tree of this walker is not built yet")
+        if structure.foot == "flat":
+            raise ValueError("walker.leg.foot.kind: flat: a body tree of flat feet is not "
+                             "built yet")
+        if any(b.massless for b in structure.bodies):
+            raise ValueError("walker.leg.bodies: a massless body is the mass -> 0 limit of "
+                             "the equations (Garcia et al. 1998), not a body of a tree")
+    if structure.parts_3d or planar:
+        def leg(role):
+            tag = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
+            return tuple(Part(b.name, f"m_{tag}{b.name}", f"d_{tag}{b.name}",
+                              f"I_{tag}{b.name}" if b.kind == "rod" else None,
+                              f"e_{tag}{b.name}" if b.off_axis else None, b.link)
+                         for b in structure.bodies)
+        legs, swing = leg("stance"), leg("swing") if structure.asymmetric else None
         torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
                            f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
                            f"e_torso_{b.name}" if b.off_axis else None)
@@ -245,40 +334,14 @@ def legs_3d_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     else:
         legs = (Part(structure.bodies[0].name, "m_leg", "L - a_leg",
                      "I_leg" if structure.bodies[0].kind == "rod" else None),)
-        torso = ()
-    return straight_legs_3d_tree(structure.param_names, legs, torso,
-                                 hip_width="w_hip" if structure.hip_width else 0,
-                                 hip_roll=structure.hip_roll,
-                                 foot_radius="R_foot" if structure.foot == "arc" else None)
-
-
-def planar_compass_tree(*, leg_inertia: bool = False) -> tuple[BodyTree, CoordinateMap]:
-    """The planar compass gait (a hip mass ``M_hip``, on each leg a mass ``m_mass`` at
-    ``d_mass`` from the hip; Goswami, Thuilot & Espiau 1996) as a tree whose axes all lie
-    along ``z``, in the absolute leg angles ``swing, stance`` of
-    :func:`walkerlab.codegen.symbolic.derive` (its parameters ``g, L, gamma, M_hip, m_mass,
-    d_mass[, I_mass]``).
-
-    Returns
-    -------
-    BodyTree, CoordinateMap
-    """
-    params = ("g", "L", "gamma", "M_hip", "m_mass", "d_mass") + (
-        ("I_mass",) if leg_inertia else ())
-    leg_i = diagonal(0, 0, "I_mass") if leg_inertia else ZERO_INERTIA
-    stance_leg = Body("stance_leg", "m_mass", leg_i, (0, "L - d_mass", 0),
-                      Joint("stance_ankle", "revolute", "slope", (0, 0, 0), (Z,),
-                            ("stance_ankle_pitch",)))
-    pelvis = Body("pelvis", "M_hip", ZERO_INERTIA, (0, 0, 0),
-                  Joint("hip_weld", "fixed", "stance_leg", (0, "L", 0)))
-    swing_leg = Body("swing_leg", "m_mass", leg_i, (0, "-d_mass", 0),
-                     Joint("hip", "revolute", "pelvis", (0, 0, 0), (Z,), ("hip_angle",)))
-    tree = BodyTree(params, Root(), (stance_leg, pelvis, swing_leg),
-                    (ContactPoint("stance_foot", "stance_leg", (0, 0, 0)),
-                     ContactPoint("swing_foot", "swing_leg", (0, "-L", 0))))
-    return tree, CoordinateMap(("swing", "stance"),
-                               (("stance_ankle_pitch", "stance + gamma"),
-                                ("hip_angle", "swing - stance")))
+        swing, torso = None, ()
+    return biped_tree(structure.param_names, legs, torso, planar=planar, swing_legs=swing,
+                      thigh="L_thigh" if structure.knee else None,
+                      hip_mass=structure.hip_mass,
+                      hip_width="w_hip" if structure.hip_width else 0,
+                      hip_roll=structure.hip_roll,
+                      foot_radius="R_foot" if structure.foot == "arc" else None,
+                      coordinates=structure.coordinates)
 
 
 def spoked_wheel_3d_tree(spokes: int | None = None) -> tuple[BodyTree, CoordinateMap]:

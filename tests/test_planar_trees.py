@@ -1,0 +1,143 @@
+"""The planar walkers as body trees, the special case of the 3D biped's
+(:func:`walkerlab.walker.trees.legs_tree`: every joint a pitch about ``z``): Lagrange's
+equations derived from the tree (:func:`walkerlab.codegen.tree_derive.derive_tree`) equal
+the planar derivation's (:func:`walkerlab.codegen.symbolic.derive`, link sums of leg
+vectors, which shares no kinematics with the tree) for the shipped planar walkers' structures:
+the mass matrix, the Coriolis and centrifugal terms, gravity, the potential, and the rates
+after the heel strike (Goswami, Thuilot & Espiau 1996; McGeer 1990 for the knee and the round
+feet; Wisse, Hobbelen & Schwab 2007 for the bisecting hip), numerically at random states and
+parameters.  The 3D trees the same builder makes are the production derivation's
+(``tests/test_body_tree.py``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from walkerlab.codegen.symbolic import derive
+from walkerlab.codegen.tree_derive import derive_tree, plastic_impact
+from walkerlab.config import load_scene
+from walkerlab.walker.description import BodySpec, Structure
+from walkerlab.walker.plant import Plant
+from walkerlab.walker.trees import legs_tree
+
+#: relative agreement of the two derivations' numbers (both exact: round-off of ~100 terms)
+RTOL = 1e-12
+
+
+def _params(names: list[str], rng) -> dict:
+    """Random physical parameters by name: a knee between the hip and the foot, each thigh
+    body above it and each shank body below it, springs off (the tree carries bodies and
+    joints, not the springs' potential)."""
+    L = rng.uniform(0.7, 1.3)
+    thigh = rng.uniform(0.35, 0.6) * L
+    out = {}
+    for n in names:
+        if n in ("L", "L_thigh"):
+            v = L if n == "L" else thigh
+        elif n == "g":
+            v = rng.uniform(9.0, 10.5)
+        elif n == "gamma":
+            v = rng.uniform(-0.1, 0.2)
+        elif n.startswith(("m_", "M_")):
+            v = rng.uniform(0.5, 8.0)
+        elif n.startswith("I_"):
+            v = rng.uniform(0.01, 0.5)
+        elif n.startswith("e_"):
+            v = rng.uniform(-0.1, 0.1)
+        elif n.startswith("d_torso"):
+            v = rng.uniform(0.1, 0.6)
+        elif n.startswith("d_"):
+            v = rng.uniform(thigh + 0.01, L) if "shank" in n else rng.uniform(0.05, thigh)
+        elif n == "R_foot":
+            v = rng.uniform(0.05, 0.3) * L
+        elif n.startswith(("k_", "c_", "r_")):
+            v = 0.0
+        else:
+            raise KeyError(n)
+        out[n] = v
+    return out
+
+
+def _swing_contact_jacobian(te, structure: Structure) -> sp.Matrix:
+    """The velocity Jacobian of the swing foot's material contact point: a point foot's, or
+    a round foot's lowest point plus ``R`` times its leg's pitch rate along the slope (the
+    disc's material point ``v_centre + omega x (-R n)``)."""
+    kin, q = te.kinematics, sp.Matrix(te.q)
+    if structure.foot != "arc":
+        return kin.contacts["swing_foot"].jacobian(q)
+    P = dict(zip(map(str, te.params), te.params))
+    swing = te.q[list(structure.roles).index("swing")]
+    lowest = kin.contacts["swing_foot_centre"] - P["R_foot"] * sp.Matrix([0, 1, 0])
+    return lowest.jacobian(q) + P["R_foot"] * sp.Matrix([1, 0, 0]) * sp.Matrix(
+        [[sp.diff(swing, k) for k in te.q]])
+
+
+def _scene_structure(name: str) -> Structure:
+    return Plant.from_scene(load_scene(f"configs/{name}.yaml")).data.structure
+
+
+def _agree(structure: Structure, seed: int) -> None:
+    e = derive(structure)
+    tree, coords = legs_tree(structure)
+    te = derive_tree(tree, coords)
+    assert tuple(map(str, te.q)) == tuple(map(str, e.q))
+    assert tuple(map(str, te.params)) == tuple(map(str, e.params))
+    dq = sp.Matrix(e.dq)
+    pairs = [("M", e.M, te.M), ("C dq", e.C * dq, te.C * dq), ("G", e.G, te.G),
+             ("V", sp.Matrix([e.potential]), sp.Matrix([te.potential]))]
+    if not structure.knee:   # the kneed heel strike holds the knee: the locked system
+        Mi, B = plastic_impact(te.M, te.A, te.total_mass,
+                               _swing_contact_jacobian(te, structure))
+        pairs.append(("rates after the heel strike", e.Mi.LUsolve(e.B * dq),
+                      Mi.LUsolve(B * dq)))
+    args = list(e.q) + list(e.dq) + list(e.params)
+    names = [str(p) for p in e.params]
+    rng = np.random.default_rng(seed)
+    points = []
+    for _ in range(4):
+        par = _params(names, rng)
+        points.append(np.concatenate([rng.uniform(-0.6, 0.6, len(e.q)),
+                                      rng.uniform(-2.0, 2.0, len(e.dq)),
+                                      [par[n] for n in names]]))
+    for what, reference, tree_value in pairs:
+        fa, fb = sp.lambdify(args, reference), sp.lambdify(args, tree_value)
+        for x in points:
+            a, b = np.array(fa(*x), float), np.array(fb(*x), float)
+            scale = np.max(np.abs(a))
+            assert scale > 0, what
+            assert np.max(np.abs(a - b)) <= RTOL * scale, (what, x, a, b)
+
+
+@pytest.mark.parametrize("scene", [
+    "paper",                 # the compass gait, point masses
+    "asymmetric_legs",       # legs that differ (per-role parameters)
+    "kneed",                 # a knee on the swing leg, thigh and shank masses
+    "round_feet",            # rolling arc feet, rod legs
+    pytest.param("paper_rods", marks=pytest.mark.slow),
+    pytest.param("hip_spring", marks=pytest.mark.slow),
+    pytest.param("torso_bhm", marks=pytest.mark.slow),   # an upper body on a bisecting hip
+])
+def test_a_shipped_planar_walker_derived_from_its_tree_equals_the_planar_derivation(scene):
+    _agree(_scene_structure(scene), seed=sum(map(ord, scene)))
+
+
+def test_garcias_coordinates_and_a_body_off_the_leg_axis_derive_alike():
+    """Garcia et al.'s (1998) slope-relative coordinates (``stance`` from the slope's normal,
+    ``hip`` between the legs) with a massive foot, and a body ahead of its leg's axis."""
+    _agree(Structure("slope_relative", (BodySpec("foot_mass", "point_mass"),), hip_mass=True),
+           seed=3)
+    _agree(Structure("absolute", (BodySpec("mass", "point_mass", off_axis=True),),
+                     hip_mass=True), seed=4)
+
+
+@pytest.mark.parametrize("structure, field", [
+    (Structure("slope_relative", (BodySpec("foot", "point_mass", massless=True),),
+               hip_mass=True), "walker.leg.bodies"),
+    (Structure("absolute", (BodySpec("mass", "point_mass"),), foot="flat"),
+     "walker.leg.foot.kind"),
+])
+def test_a_walker_the_tree_does_not_carry_yet_is_refused_naming_the_field(structure, field):
+    with pytest.raises(ValueError, match=rf"^{field}"):
+        legs_tree(structure)
