@@ -186,7 +186,7 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
         No gait at the scene's own value.
     """
     from walkerlab.analysis.continuation.branch import add_gait_measures
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
+    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point  # light
 
     unit = axis_unit(scene, ParamAxis(path, (), path))
     p0 = scene_value(scene, path)
@@ -309,7 +309,7 @@ def homotopy_gait(known: Scene, new: Scene):
     MapFailed
         No gait for the known scene.
     """
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
+    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point  # light
 
     make, fields = homotopy_family(known, new)
     try:
