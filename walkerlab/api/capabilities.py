@@ -430,7 +430,7 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     if data.structure.kind.feet_have_modes and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's
         # regularising mass (contact.flat_foot_mass_kg), as it documents
-        from walkerlab.export.scene import flat_foot_bodies
+        from walkerlab.export.scene_feet import flat_foot_bodies
 
         want += sum(f[5] for f in flat_foot_bodies(scene, data))
     dev = abs(total / want - 1.0)

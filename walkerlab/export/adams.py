@@ -295,7 +295,7 @@ def _stance_pin(mb, start: AdamsStart) -> tuple[float, float]:
 def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = None
            ) -> list[str]:
     """The PART and MARKER statements of the hip and the links, and the foot spheres (flat
-    feet, ``feet`` of :func:`walkerlab.export.scene.flat_foot_bodies`: their parts)."""
+    feet, ``feet`` of :func:`walkerlab.export.scene_feet.flat_foot_bodies`: their parts)."""
     out = ["!", "! ---- parts: the hip (fixed to leg2) and the links ----"]
     hip_x, hip_y = start.hip
     hip_cm = marker_id(2, "cm")
@@ -373,7 +373,7 @@ def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None,
             start: AdamsStart | None = None) -> list[str]:
     """Hip springs (SPRINGDAMPER), knee stops (SFORCE with IMPACT) and flat feet's ankle
     springs (SPRINGDAMPER between the foot and its leg: ``feet`` of
-    :func:`walkerlab.export.scene.flat_foot_bodies`)."""
+    :func:`walkerlab.export.scene_feet.flat_foot_bodies`)."""
     out = []
     link_of = {leg: hip_link(mb, leg) for leg in ("leg1", "leg2")}
     for i, sp in enumerate(mb.springs):

@@ -44,7 +44,8 @@ from walkerlab.studies.bifurcation_point import (
 )
 from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.params import ParamAxis
-from walkerlab.studies.runner import plan_chunks, sweep_executor
+from walkerlab.studies.runner import sweep_executor
+from walkerlab.studies.sweep_plan import plan_chunks
 from walkerlab.walker.plant import Plant
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
@@ -270,7 +271,7 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
                workers: int, scheduler, steps_per_map: int = 0) -> list[dict]:
     """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
     state; :func:`bifurcation_chunk`), in grid order: the grid of ``axis`` is cut into runs
-    (:func:`walkerlab.studies.runner.plan_chunks`) evaluated on
+    (:func:`walkerlab.studies.sweep_plan.plan_chunks`) evaluated on
     :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
     from walkerlab import progress
 

@@ -62,7 +62,7 @@ def scene_family(scene: Scene, path: str) -> WalkerFamily:
 
 def scene_value(scene: Scene, path: str) -> float:
     """The scene's own value of a numeric field (the slope in either unit)."""
-    from walkerlab.studies.runner import base_value  # light
+    from walkerlab.studies.sweep_plan import base_value  # light
 
     v = base_value(scene.model_dump(mode="json"), path)
     if v is None:  # a field the scene does not have (one line naming it), or one left unset

@@ -221,7 +221,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     return cw, res, 2 * setup.sim.n_strides
 
 
-#: contact outcome kind (walkerlab.analysis.contact.gait.CONTACT_OUTCOMES, the shared run
+#: contact outcome kind (walkerlab.analysis.contact.verdict.CONTACT_OUTCOMES, the shared run
 #: ends) -> sweep outcome: a run that walked is "ok", every other end keeps its name
 _CONTACT_OUTCOME = {k: ("ok" if k in ("heel_strike", "t_final") else k)
                     for k in RUN_END_NAMES}
@@ -242,7 +242,7 @@ def contact_point(scene: Scene, guess, options: dict):
         The outcomes above (each with the columns computed so far), or as
         :func:`ideal_fixed_point`.
     """
-    from walkerlab.analysis.contact.gait import classify_complete
+    from walkerlab.analysis.contact.verdict import classify_complete
     from walkerlab.config import FixedPointSettings
     from walkerlab.integrate.rigid import integrate_step
 

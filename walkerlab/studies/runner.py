@@ -74,11 +74,10 @@ from walkerlab.studies.outcomes import OUTCOMES, STAGES, STRING_COLUMNS, walker_
 from walkerlab.studies.params import ParamAxis, SweepError, grid_points
 from walkerlab.studies.point_gait import DEFAULT_OPTIONS
 from walkerlab.studies.points import Task, evaluate, warm_up
-from walkerlab.studies.sweep_plan import base_value, plan_chunks, sweep_input_hash
+from walkerlab.studies.sweep_plan import plan_chunks, sweep_input_hash
 
-__all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
-           "sweep_executor", "sweep_input_hash", "pool_pays", "MAX_GRID_POINTS", "PIECE_POINTS",
-           "FLUSH_EVERY_S", "POOL_START_S"]
+__all__ = ["run_sweep", "iter_piece_results", "run_piece", "sweep_executor", "pool_pays",
+           "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S", "POOL_START_S"]
 
 MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk

@@ -139,7 +139,7 @@ class Kind:
     feet : str
         ``leg_ends`` (point or arc feet at the legs' ends) or ``flat`` (a foot body on an
         ankle spring, with foot modes): the exports' feet
-        (:data:`walkerlab.export.scene.SCENE_FEET`, :data:`walkerlab.export.adams_feet.
+        (:data:`walkerlab.export.scene_feet.SCENE_FEET`, :data:`walkerlab.export.adams_feet.
         ADAMS_FEET`).
     landing : str or None
         How the rigid view lands on stairs and footholds
