@@ -169,7 +169,7 @@ def test_sweep_columns_and_bifurcation_arrays_follow_the_walker(walker, fixed_po
     from walkerlab.io.schemas.bifurcation import bifurcation_writer
     from walkerlab.studies.bifurcation import BifurcationResult
     from walkerlab.studies.outcomes import columns
-    from walkerlab.studies.points import _fp_columns, interleg_angle
+    from walkerlab.studies.point_columns import _fp_columns, interleg_angle
 
     cols = columns("fixedpoint", walker.state_names(), walker.state_units())
     assert "torso_angle_rad" in cols and "torso_rate_rad_per_s" in cols

@@ -30,7 +30,8 @@ import numpy as np
 import pytest
 
 from tests.scripts_loader import load_file
-from walkerlab.walker.kinds import CAPABILITIES, FEATURES, KINDS, VIEWS
+from walkerlab.walker.capability_cells import CAPABILITIES
+from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS
 from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -322,7 +323,7 @@ def test_the_urdf_refuses_a_ground_other_than_the_slope_with_its_cells_reason(
     changed reason is the export's), before any gait search."""
     from walkerlab.config import scene_from_dict
     from walkerlab.stages import export
-    from walkerlab.walker.kinds import URDF_GROUND
+    from walkerlab.walker.capability_cells import URDF_GROUND
 
     assert KINDS[kind].cell(ground, "urdf") == URDF_GROUND
     monkeypatch.setattr(export, "_gait", _no_gait_search)
@@ -358,8 +359,9 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     ``note`` and ``detail``, and on the docs' page; no other kind's cells do."""
 
     from walkerlab.export.parts import kind_part
+    from walkerlab.walker.capability_cells import KNEE_LATCH_OSIM
     from walkerlab.walker.capability_tables import kind_grid, text
-    from walkerlab.walker.kinds import KNEE_LATCH_OSIM, table_rows
+    from walkerlab.walker.kinds import table_rows
 
     latched = {k for k, kind in KINDS.items() if kind_part(kind).knee_stops}
     assert latched == {"locking_knees"}
@@ -389,8 +391,8 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
 @pytest.mark.parametrize("stage", ["optimize", "robustness"])
 def test_a_stage_a_3d_walker_does_not_take_is_refused_before_any_work(tmp_path, name, stage):
     """Every pipeline stage a 3D kind does not take - its view's cell
-    (:data:`walkerlab.walker.kinds.STAGE_VIEWS`) or its study's
-    (:data:`~walkerlab.walker.kinds.STAGE_CELLS`) - is refused in one line naming
+    (:data:`walkerlab.walker.capability_cells.STAGE_VIEWS`) or its study's
+    (:data:`~walkerlab.walker.capability_cells.STAGE_CELLS`) - is refused in one line naming
     walker.space before any upstream stage runs, and nothing is written.  (contact-sim and
     compare take both 3D kinds: tests/test_contact_3d.py.)"""
     from walkerlab.config import load_scene

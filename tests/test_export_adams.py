@@ -19,12 +19,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from walkerlab.config import load_scene
-from walkerlab.export.adams import (
-    LINE_WIDTH,
-    PIN_JOINT,
-    marker_id,
-    part_ids,
-)
+from walkerlab.export.adams import PIN_JOINT
+from walkerlab.export.adams_feet import part_ids
 from walkerlab.export.adams_reader import (
     AdmReadError,
     parse_acf,
@@ -32,6 +28,7 @@ from walkerlab.export.adams_reader import (
     read_adm,
     reuler_matrix,
 )
+from walkerlab.export.adams_statements import LINE_WIDTH, marker_id
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data

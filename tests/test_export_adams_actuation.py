@@ -25,20 +25,18 @@ from typer.testing import CliRunner
 
 from walkerlab.cli import app
 from walkerlab.config import load_scene, scene_from_dict
-from walkerlab.export.adams import (
+from walkerlab.export.adams import adams_start, adm_text
+from walkerlab.export.adams_actuation import (
     ACT_VARIABLES,
     HIP_SFORCE,
     HIP_TORQUE_SUM,
-    LINE_WIDTH,
     PUSH_GFORCE,
-    adams_start,
-    adm_text,
     check_adams_actuation,
     hip_torque_ids,
-    marker_id,
-    part_ids,
 )
+from walkerlab.export.adams_feet import part_ids
 from walkerlab.export.adams_reader import read_adm
+from walkerlab.export.adams_statements import LINE_WIDTH, marker_id
 from walkerlab.integrate.powered_events import pulse_lead
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.walker.description import walker_data
@@ -361,7 +359,8 @@ def test_five_link_joint_torques_equal_walkerlab_laws():
     give), the phase variable ``atan2(dx, -dy)`` of the hip -> stance foot line.  Was
     refused ("free knees ... need a user subroutine")."""
     from walkerlab.config.actuation import FIVE_LINK_JOINTS
-    from walkerlab.export.adams import JOINT_SFORCE, AdamsStart
+    from walkerlab.export.adams_actuation import JOINT_SFORCE
+    from walkerlab.export.adams_statements import AdamsStart
 
     scene = load_scene(ROOT / "configs" / "rabbit.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -440,7 +439,8 @@ def test_adm_export_of_a_powered_walker_on_level_ground_carries_its_push_off(tmp
 def test_adm_warning_is_empty_and_what_is_not_written_is_refused():
     """Push-off and hip torques are written (no warning line); a time reference is not
     (refused in one line naming the field)."""
-    from walkerlab.export.adams import actuation_warning, check_adams_actuation
+    from walkerlab.export.adams import actuation_warning
+    from walkerlab.export.adams_actuation import check_adams_actuation
 
     d = yaml.safe_load(POWERED.read_text())
     d["slope"] = {"angle_deg": 1.0}

@@ -21,20 +21,11 @@ import yaml
 
 from tests.test_export_adams_actuation import AdamsState, evaluate
 from walkerlab.config import load_scene
-from walkerlab.export.adams import (
-    ACT_VARIABLES,
-    ANKLE_JOINT,
-    ANKLE_SFORCE,
-    ANKLE_SPRING,
-    ANKLE_VARIABLES,
-    COUPLER_ID,
-    FOOT_FORCES,
-    LINE_WIDTH,
-    PIN_JOINT,
-    marker_id,
-    part_ids,
-)
+from walkerlab.export.adams import COUPLER_ID, PIN_JOINT
+from walkerlab.export.adams_actuation import ACT_VARIABLES, ANKLE_SFORCE, ANKLE_VARIABLES
+from walkerlab.export.adams_feet import ANKLE_JOINT, ANKLE_SPRING, FOOT_FORCES, part_ids
 from walkerlab.export.adams_reader import read_adm
+from walkerlab.export.adams_statements import LINE_WIDTH, marker_id
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.models.hybrid.ankle_push_off import AnklePushOffActuator
 from walkerlab.stages import export as export_stage
@@ -264,12 +255,8 @@ def test_ankle_and_hip_torques_on_flat_feet_equal_walkerlab_laws(flat, tmp_path_
     SFORCE/17, 18 on each ankle (I foot, J leg) evaluated at 24 states equal walkerlab's
     laws (:meth:`TorqueLaws.each` on the role ankles' angles, the roles from the feet's
     contact forces); the hip SFORCE/10 the hip law's."""
-    from walkerlab.export.adams import (
-        ANKLE_TORQUE_SFORCE,
-        HIP_SFORCE,
-        adams_start,
-        adm_text,
-    )
+    from walkerlab.export.adams import adams_start, adm_text
+    from walkerlab.export.adams_actuation import ANKLE_TORQUE_SFORCE, HIP_SFORCE
     from walkerlab.models.actuation import TorqueLaws
 
     scene0, mb, data0, _model, _adm = flat

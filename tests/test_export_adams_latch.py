@@ -20,7 +20,8 @@ import yaml
 
 from tests.test_export_adams_actuation import AdamsState, evaluate
 from walkerlab.config import scene_from_dict
-from walkerlab.export.adams import LATCH_SFORCE, adm_text
+from walkerlab.export.adams import adm_text
+from walkerlab.export.adams_latch import LATCH_SFORCE
 from walkerlab.export.adams_reader import read_adm
 from walkerlab.export.adams_statements import MM
 from walkerlab.walker.description import walker_data

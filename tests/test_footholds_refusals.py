@@ -17,11 +17,8 @@ import yaml
 from cli_run import ROOT, run_cli
 
 from walkerlab.config import scene_from_dict
-from walkerlab.walker.kinds import (
-    FOOTHOLD_SLOPES,
-    KINDS,
-    SEVERAL_FOOTHOLDS,
-)
+from walkerlab.walker.capability_cells import FOOTHOLD_SLOPES, SEVERAL_FOOTHOLDS
+from walkerlab.walker.kinds import KINDS
 from walkerlab.walker.plant import Plant
 
 #: configs/footholds_two.yaml: the paper walker on footholds of two heights (stable rigid

@@ -93,7 +93,7 @@ def test_footholds_clearance_is_the_mid_stance_foot_through_at_every_length(heig
 
 
 def test_ground_pieces_measure_along_their_own_normal():
-    from walkerlab.config.contact import TerrainSettings
+    from walkerlab.config.terrain import TerrainSettings
 
     # a slope: the line through the origin, as the report always measured
     g = scene_ground(None, 0.1)

@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from walkerlab.optimal.replay.virtual_constraints import PhaseLaw, phase_law
+from walkerlab.optimal.replay.phase import PhaseLaw
+from walkerlab.optimal.replay.virtual_constraints import phase_law
 
 
 def _table(m: int = 21, k: int = 2):
@@ -150,7 +151,7 @@ def test_the_feed_forward_is_the_transcriptions_control_at_the_time_the_step_pas
     control (each interval's quadratic, control_of_time against torques_of_time to
     round-off) at the time the step passes ``s``; exact at the points, and between them
     within the Hermite spline ``T``'s O(h^4) of a step at constant ``ds`` (T exact)."""
-    from walkerlab.optimal.replay.virtual_constraints import control_of_time
+    from walkerlab.optimal.replay.phase import control_of_time
     from walkerlab.optimal.transcription.free_joints import torques_of_time
 
     s, ds, delta, slope, _, _ = _table()
@@ -170,7 +171,8 @@ def test_the_phased_walker_runs_its_law_in_python_and_compiled():
     from pathlib import Path
 
     from walkerlab.config import load_scene
-    from walkerlab.optimal.replay.virtual_constraints import LIMIT_N_M, phased_walker
+    from walkerlab.optimal.replay.phase import LIMIT_N_M
+    from walkerlab.optimal.replay.virtual_constraints import phased_walker
     from walkerlab.walker.description import walker_data
 
     scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "rabbit_optimal.yaml")

@@ -15,7 +15,7 @@ from walkerlab.cli import app
 from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.driver import history_and_energies
+from walkerlab.optimal.outcome import history_and_energies
 from walkerlab.optimal.transcription.mode_sequence import collocate_step
 from walkerlab.optimal.transcription.step import CollocationSpec
 from walkerlab.walker.description import walker_data

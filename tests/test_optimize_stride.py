@@ -86,7 +86,7 @@ def test_the_least_effort_stride_is_the_passive_period_two_gait(asym):
     7.5e-8 on 40), the start
     within 1e-6, the replay over the stride closing to 1e-6 and the stride map's
     multipliers those of the fixed point (1e-6: the start's distance)."""
-    from walkerlab.optimal.driver import replay_multipliers
+    from walkerlab.optimal.outcome import replay_multipliers
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of

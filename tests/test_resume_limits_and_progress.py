@@ -236,7 +236,7 @@ def test_unreadable_checkpoints_restart_every_chain(tmp_path, fake_points):
 
 def test_finished_sweep_carries_a_content_hash(tmp_path, fake_points):
     out = _sweep(tmp_path, "fin")
-    from walkerlab.studies.runner import sweep_input_hash
+    from walkerlab.studies.sweep_plan import sweep_input_hash
 
     with h5py.File(out, "r") as f:
         key = str(f.attrs["input_hash"])

@@ -170,9 +170,9 @@ def test_stability_map_prints_the_path_of_the_figure_it_drew(tmp_path, monkeypat
 def test_robustness_refuses_a_3d_walker_before_any_work(tmp_path, name):
     """The robustness study is of planar walkers (its disturbances and state norms are
     sagittal): a 3D walker is refused in one line naming walker.space, from the table
-    (:data:`walkerlab.walker.kinds.STAGE_CELLS`), before the gait is searched or the walker
-    built (paper_3d took 106 s to 'use a smaller e', hip_width 78 s to 'legs that differ');
-    the study's own entry refuses it too, and nothing is written."""
+    (:data:`walkerlab.walker.capability_cells.STAGE_CELLS`), before the gait is searched or
+    the walker built (paper_3d took 106 s to 'use a smaller e', hip_width 78 s to 'legs that
+    differ'); the study's own entry refuses it too, and nothing is written."""
     import time
 
     from walkerlab.stages import pipeline

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import SceneError, load_scene, scene_from_dict
-from walkerlab.config.contact import TerrainSettings
+from walkerlab.config.terrain import TerrainSettings
 from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]

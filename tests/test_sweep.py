@@ -15,7 +15,7 @@ from walkerlab.studies import points as points_mod
 from walkerlab.studies.outcomes import COLUMNS, OUTCOMES
 from walkerlab.studies.params import SweepError, apply_point, parse_param
 from walkerlab.studies.points import evaluate
-from walkerlab.studies.runner import plan_chunks
+from walkerlab.studies.sweep_plan import plan_chunks
 from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]

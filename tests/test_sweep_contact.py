@@ -32,7 +32,7 @@ def test_contact_outcomes_map_onto_sweep_outcomes():
     """Every typed outcome of a contact run has a sweep outcome of its own (trip and fall
     apart, time limit apart from solver failure); the two ends of a run that walked
     (heel_strike: strides cap, t_final: end time) are both 'ok'."""
-    from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES
+    from walkerlab.analysis.contact.verdict import CONTACT_OUTCOMES
 
     assert set(_CONTACT_OUTCOME) == set(CONTACT_OUTCOMES)
     assert set(_CONTACT_OUTCOME.values()) <= set(OUTCOMES)

@@ -306,17 +306,11 @@ def test_the_adams_hip_torques_equal_walkerlab_laws():
     swing_hip = swing leg - torso), the phase variable the hip -> stance foot line's
     ``atan2(dx, -dy)`` (the stance leg's angle)."""
     from tests.test_export_adams_actuation import AdamsState, evaluate
-    from walkerlab.export.adams import (
-        ACT_VARIABLES,
-        JOINT_SFORCE,
-        LINE_WIDTH,
-        MM,
-        AdamsStart,
-        adm_text,
-        marker_id,
-        part_ids,
-    )
+    from walkerlab.export.adams import adm_text
+    from walkerlab.export.adams_actuation import ACT_VARIABLES, JOINT_SFORCE
+    from walkerlab.export.adams_feet import part_ids
     from walkerlab.export.adams_reader import AdmReadError, read_adm
+    from walkerlab.export.adams_statements import LINE_WIDTH, MM, AdamsStart, marker_id
     from walkerlab.models.actuation import TorqueLaws
     from walkerlab.walker.multibody import multibody
 

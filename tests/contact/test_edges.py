@@ -10,10 +10,10 @@ import pytest
 
 from tests.contact.conftest import FP, STEP_LENGTH
 from walkerlab.analysis.contact.drop import restitution_curve
-from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES as OUTCOME_KINDS
 from walkerlab.analysis.contact.gait import gait_events
 from walkerlab.analysis.contact.gait import phase_slip as _phase_slip
 from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.verdict import CONTACT_OUTCOMES as OUTCOME_KINDS
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.models.contact import ContactWalker

@@ -150,8 +150,8 @@ def test_a_contact_run_that_drifts_off_the_rigid_footfalls_walks_on_its_own(heig
     strides asked for (30 heel strikes; measured two heights +0.32 % and +1.32 % per step of
     the cycle), every heel strike near its patch's centre; footholds of one height
     (configs/footholds.yaml's) alike."""
-    from walkerlab.analysis.contact.gait import patch_fit
     from walkerlab.analysis.contact.sim import scene_start, simulate_from
+    from walkerlab.analysis.contact.terrain_fit import patch_fit
     from walkerlab.models.contact.scene import contact_setup
 
     sc = _scene(heights, contact=ADAMS_FRICTION, n_strides=15)

@@ -84,7 +84,7 @@ def test_wall_time_limit_holds_inside_a_chunk(method):
 
 def test_one_vocabulary():
     """Contact outcomes, rigid terminations and the walked set are names of one tuple."""
-    from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES
+    from walkerlab.analysis.contact.verdict import CONTACT_OUTCOMES
     from walkerlab.integrate.ends import RIGID_ENDS
     from walkerlab.studies.outcomes import OUTCOMES
 
@@ -180,7 +180,7 @@ def test_a_fall_after_scuffs_is_advised_for_the_walker_and_its_ground():
     for a kneed walker without it, knees or (a profile flat at the footfalls) the
     checkerboard on a profile, the checkerboard
     (``terrain.lanes``) for straight legs on continuous slope."""
-    from walkerlab.analysis.contact.gait import scuff_cause
+    from walkerlab.analysis.contact.verdict import scuff_cause
     from walkerlab.api.scenes import with_changes
     from walkerlab.config import load_scene
 

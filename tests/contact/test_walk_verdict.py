@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from tests.contact.conftest import FP, STEP_LENGTH
-from walkerlab.analysis.contact.gait import Outcome, PatchFit, step_trend, walk_verdict
 from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.terrain_fit import PatchFit
+from walkerlab.analysis.contact.verdict import Outcome, step_trend, walk_verdict
 from walkerlab.config import ContactSettings, TerrainSettings
 from walkerlab.models.contact import ContactWalker
 from walkerlab.walker.plant import Plant

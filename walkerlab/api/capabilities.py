@@ -27,8 +27,8 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     rigid gait: the mean step period against the rigid one (relative, 3 %).  The OpenSim
     model is walked by walkerlab's stepping loop (:mod:`walkerlab.export.opensim_walk`:
     the joint torques, the push-off and a kneed walker's knee latch switched between the
-    Manager's windows); a kneed walker's cells say so (:data:`walkerlab.walker.kinds.
-    KNEE_LATCH_OSIM`: the file alone falls).
+    Manager's windows); a kneed walker's cells say so
+    (:data:`walkerlab.walker.capability_cells.KNEE_LATCH_OSIM`: the file alone falls).
 ``urdf``
     ``walkerlab export --format urdf`` (its keyframe's rigid gait searched as the command
     does) loaded by Pinocchio (``pinocchio.buildModelFromUrdf``; Carpentier et al. 2019):
@@ -430,7 +430,7 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     if data.structure.kind.feet_have_modes and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's
         # regularising mass (contact.flat_foot_mass_kg), as it documents
-        from walkerlab.export.scene import flat_foot_bodies
+        from walkerlab.export.scene_feet import flat_foot_bodies
 
         want += sum(f[5] for f in flat_foot_bodies(scene, data))
     dev = abs(total / want - 1.0)

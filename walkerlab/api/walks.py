@@ -164,7 +164,8 @@ class ContactWalk:
     message : str
         The outcome in one line.
     walks : bool
-        The walker walked the run (:attr:`~walkerlab.analysis.contact.gait.ContactResult.verdict`).
+        The walker walked the run
+        (:attr:`~walkerlab.analysis.contact.result.ContactResult.verdict`).
     x0 : ndarray, shape (N,)
         The initial state [m, rad, m/s, rad/s].
     x_ideal : ndarray, shape (2n,)
@@ -181,7 +182,7 @@ class ContactWalk:
     step_ledger : dict[str, ndarray]
         A powered walker's energy ledger per step
         (:func:`walkerlab.analysis.contact.ledger.contact_step_ledger`); empty when passive.
-    result : walkerlab.analysis.contact.gait.ContactResult
+    result : walkerlab.analysis.contact.result.ContactResult
         The library's whole result (feet traces, touchdowns, counters).
     """
 
@@ -237,7 +238,7 @@ def recorded_contact_walk(walker, res, x_start, x_ideal, step_length: float, sca
     """The :class:`ContactWalk` of a contact run
     (:meth:`walkerlab.api.walker.ContactWalker.simulate`; the outputs of
     :func:`walkerlab.analysis.contact.record.contact_walk`): ``walker`` the run's contact
-    model, ``res`` its :class:`~walkerlab.analysis.contact.gait.ContactResult`, ``x_start``
+    model, ``res`` its :class:`~walkerlab.analysis.contact.result.ContactResult`, ``x_start``
     (N,) its initial state, ``x_ideal`` (2n,) the rigid state it started from,
     ``step_length`` [m] the patches' spacing, ``scale`` (2,) the rates' multipliers and
     ``gait`` the periodic gait it started from (or None); the step table by

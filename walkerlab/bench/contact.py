@@ -13,8 +13,9 @@ import time
 import numpy as np
 
 from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
-from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings
 from walkerlab.config.solver import SolverSettings
+from walkerlab.config.terrain import TerrainSettings
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.walker.layout import StateIndex
 from walkerlab.walker.plant import Plant

@@ -49,13 +49,8 @@ from walkerlab.config.biped_parts import (
     TorsoRigidBody,
     TorsoSpec,
 )
-from walkerlab.config.contact import (
-    MAX_CONTACT_STRIDES,
-    ContactSettings,
-    ContactSimSettings,
-    PerStepTerrain,
-    TerrainSettings,
-)
+from walkerlab.config.contact import ContactSettings
+from walkerlab.config.contact_sim import MAX_CONTACT_STRIDES, ContactSimSettings
 from walkerlab.config.errors import WALKER_VOCABULARY, SceneError
 from walkerlab.config.limits import (
     MAX_BASIN_CELLS_PER_AXIS,
@@ -98,6 +93,7 @@ from walkerlab.config.studies import (
     StateSpec,
     WorkPrecisionSettings,
 )
+from walkerlab.config.terrain import PerStepTerrain, TerrainSettings
 from walkerlab.config.walker import BipedParams, CompassGaitParams, WalkerParams
 from walkerlab.config.wheel import RimlessWheelParams
 

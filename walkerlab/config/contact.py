@@ -1,11 +1,11 @@
 """Validated settings of the compliant-contact model and its runs (pydantic v2).
 
-The scene sections ``contact`` and ``contact_sim`` (read through :mod:`walkerlab.config`;
-``contact_sim`` is :mod:`walkerlab.config.contact_sim`'s, importable from here;
-``contact_solver`` is a :class:`walkerlab.config.solver.SolverSettings` as ``solver`` is; the
-``terrain`` section lives in :mod:`walkerlab.config.terrain` and is importable from here).
-The contact model package imports its settings from here; this module imports no model
-(settings lie under the models, not beside them).
+The scene section ``contact`` (read through :mod:`walkerlab.config`; ``contact_sim`` is
+:mod:`walkerlab.config.contact_sim`'s, ``contact_solver`` a
+:class:`walkerlab.config.solver.SolverSettings` as ``solver`` is, the ``terrain`` section
+:mod:`walkerlab.config.terrain`'s).  The contact model package imports its settings from
+here and there; this module imports no model (settings lie under the models, not beside
+them).
 
 Every dimensional number of :class:`ContactSettings` carries its unit in its name, in
 ADAMS's default mm-kg-s units (``stiffness_n_per_mm_pow_e``) or in SI
@@ -27,18 +27,9 @@ from pydantic import (
 )
 
 from walkerlab.config.base import drop_unset
-from walkerlab.config.contact_sim import MAX_CONTACT_STRIDES, ContactSimSettings
-from walkerlab.config.terrain import (
-    GROUND_KINDS,
-    LANE_KINDS,
-    PerStepTerrain,
-    TerrainSettings,
-    check_profile,
-)
 
-__all__ = ["CONTACT_QUANTITIES", "LENGTH_UNITS", "MAX_CONTACT_STRIDES", "ContactSettings",
-           "ContactSimSettings", "GROUND_KINDS", "KneeStopSettings", "LANE_KINDS",
-           "PerStepTerrain", "TerrainSettings", "check_profile", "renamed_contact_field"]
+__all__ = ["CONTACT_QUANTITIES", "LENGTH_UNITS", "ContactSettings", "KneeStopSettings",
+           "renamed_contact_field"]
 
 
 # Numbers are strict and finite: no bool or string as a number, no inf/NaN;

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from walkerlab.config.contact import ContactSimSettings, TerrainSettings
+from walkerlab.config.contact_sim import ContactSimSettings
 from walkerlab.config.loader import validate_option
 from walkerlab.config.schema import (
     BasinSettings,
@@ -26,6 +26,7 @@ from walkerlab.config.schema import (
     SceneError,
     SimulateSettings,
 )
+from walkerlab.config.terrain import TerrainSettings
 
 
 def checked_workers(workers: int) -> int:

@@ -31,11 +31,8 @@ from pydantic import (
 )
 
 from walkerlab.config.base import Strict, drop_unset
-from walkerlab.config.contact import (
-    ContactSettings,
-    ContactSimSettings,
-    TerrainSettings,
-)
+from walkerlab.config.contact import ContactSettings
+from walkerlab.config.contact_sim import ContactSimSettings
 from walkerlab.config.errors import SceneError, format_error
 from walkerlab.config.limits import (
     MAX_BIFURCATION_KEEP,
@@ -60,6 +57,7 @@ from walkerlab.config.studies import (
     SimulateSettings,
     WorkPrecisionSettings,
 )
+from walkerlab.config.terrain import TerrainSettings
 from walkerlab.config.walker import WalkerParams
 
 #: The default ground's patch width for flat feet, in soles (heel to toe): see

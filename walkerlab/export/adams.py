@@ -145,39 +145,13 @@ import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
-from walkerlab.export.adams_actuation import (
-    ACT_BLOCK,
-    ACT_VARIABLES,
-    ANKLE_SFORCE,
-    ANKLE_TORQUE_SFORCE,
-    ANKLE_VARIABLES,
-    HIP_SFORCE,
-    HIP_TORQUE_SUM,
-    JOINT_SFORCE,
-    PUSH_FLOAT_MARKER,
-    PUSH_GFORCE,
-    PUSH_MIN_STEP_M,
-    actuation_statements,
-    check_adams_actuation,
-    hip_torque_ids,
-    table_terms,
-)
+from walkerlab.export.adams_actuation import actuation_statements, check_adams_actuation
 from walkerlab.export.adams_contact import contact_mm, contact_statements
-from walkerlab.export.adams_feet import (
-    ANKLE_JOINT,
-    ANKLE_SPRING,
-    FOOT_FORCES,
-    adams_feet,
-    contact_pairs,
-    hip_link,
-    leg_end,
-    part_ids,
-)
+from walkerlab.export.adams_feet import ANKLE_SPRING, adams_feet, hip_link, leg_end, part_ids
 from walkerlab.export.adams_ground import ground_patches, ground_statements
-from walkerlab.export.adams_latch import LATCH_SFORCE, LATCH_VARIABLES, TREAD_BLOCK, knee_latches
+from walkerlab.export.adams_latch import knee_latches
 from walkerlab.export.adams_statements import (
     LANE_Z,
-    LINE_WIDTH,
     MM,
     AdamsStart,
     _deg,
@@ -192,16 +166,10 @@ from walkerlab.export.omitted import Omission, adams_comments
 from walkerlab.export.parts import export_part
 from walkerlab.units import for_scene
 
-# the dataset's parts, contact and actuation live in sibling modules (statements, feet per
-# walker kind, actuation); their public names are this module's too
-__all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ADAMS_FILES", "ANKLE_JOINT", "ANKLE_SFORCE",
-           "ANKLE_SPRING", "ANKLE_TORQUE_SFORCE", "ANKLE_VARIABLES", "COUPLER_ID",
-           "LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK",
-           "FOOT_FORCES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE", "LINE_WIDTH",
-           "PIN_JOINT", "PUSH_FLOAT_MARKER", "PUSH_GFORCE", "PUSH_MIN_STEP_M", "AdamsStart",
-           "acf_text", "actuation_warning", "adams_omissions", "adams_start", "adm_text",
-           "check_adams_actuation", "check_adams_exportable", "contact_mm", "contact_pairs",
-           "hip_torque_ids", "marker_id", "part_ids", "table_terms"]
+# the dataset's statements, feet, contact, actuation and latches are written by the sibling
+# modules (walkerlab.export.adams_*); their names are imported from there
+__all__ = ["ADAMS_FILES", "COUPLER_ID", "PIN_JOINT", "acf_text", "actuation_warning",
+           "adams_omissions", "adams_start", "adm_text", "check_adams_exportable"]
 
 #: Files of ``--format adm`` in ``runs/<scene>/``.
 ADAMS_FILES = {"adm": "walker.adm", "acf": "walker.acf"}
@@ -327,7 +295,7 @@ def _stance_pin(mb, start: AdamsStart) -> tuple[float, float]:
 def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = None
            ) -> list[str]:
     """The PART and MARKER statements of the hip and the links, and the foot spheres (flat
-    feet, ``feet`` of :func:`walkerlab.export.scene.flat_foot_bodies`: their parts)."""
+    feet, ``feet`` of :func:`walkerlab.export.scene_feet.flat_foot_bodies`: their parts)."""
     out = ["!", "! ---- parts: the hip (fixed to leg2) and the links ----"]
     hip_x, hip_y = start.hip
     hip_cm = marker_id(2, "cm")
@@ -405,7 +373,7 @@ def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None,
             start: AdamsStart | None = None) -> list[str]:
     """Hip springs (SPRINGDAMPER), knee stops (SFORCE with IMPACT) and flat feet's ankle
     springs (SPRINGDAMPER between the foot and its leg: ``feet`` of
-    :func:`walkerlab.export.scene.flat_foot_bodies`)."""
+    :func:`walkerlab.export.scene_feet.flat_foot_bodies`)."""
     out = []
     link_of = {leg: hip_link(mb, leg) for leg in ("leg1", "leg2")}
     for i, sp in enumerate(mb.springs):

@@ -13,7 +13,8 @@ from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_feet import FOOT_FORCES, adams_feet, contact_pairs, hip_link, leg_end
 from walkerlab.export.adams_statements import MM, _chain_sum, _f, _plus, _var, marker_id
-from walkerlab.walker.kinds import FREE_JOINT_TORQUES, KINDS
+from walkerlab.walker.capability_cells import FREE_JOINT_TORQUES
+from walkerlab.walker.kinds import KINDS
 
 __all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ANKLE_SFORCE", "ANKLE_TORQUE_SFORCE",
            "ANKLE_VARIABLES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE",

@@ -142,8 +142,8 @@ class FlatFeet(LegEndFeet):
         return {"leg1_foot": first, "leg2_foot": first + 1}
 
     def scene_feet(self, scene: Scene, data):
-        """:func:`walkerlab.export.scene.flat_foot_bodies`."""
-        from walkerlab.export.scene import flat_foot_bodies
+        """:func:`walkerlab.export.scene_feet.flat_foot_bodies`."""
+        from walkerlab.export.scene_feet import flat_foot_bodies
 
         return flat_foot_bodies(scene, data)
 
@@ -241,7 +241,7 @@ def _flat_foot_parts(mb, start: AdamsStart, ids: dict, lanes: bool, frames: dict
     revolute's markers coincide), contact spheres at heel (``foot`` marker) and toe
     (``toe`` marker),
     radius :func:`walkerlab.export.mjcf_scene.point_foot_radius` as a point foot's.
-    ``feet``: :func:`walkerlab.export.scene.flat_foot_bodies`."""
+    ``feet``: :func:`walkerlab.export.scene_feet.flat_foot_bodies`."""
     out = ["!", "! ---- flat feet: parts on the ankles (the contact model's mass) ----"]
     for k, leg in enumerate(LEGS):
         heel, toe, _k, _c, _rest, mass, inertia = feet[k]

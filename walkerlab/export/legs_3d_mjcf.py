@@ -305,7 +305,8 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     """
     from walkerlab.codegen.cache import functions
     from walkerlab.config.contact import ContactSettings  # light
-    from walkerlab.export.scene import EXPORT_STEPS, mujoco_contact  # light
+    from walkerlab.export.scene import mujoco_contact  # light
+    from walkerlab.export.scene_ground import EXPORT_STEPS  # light
     from walkerlab.models.contact.rigid_limit import contact_si  # light
 
     terrain = scene.terrain_or_default()

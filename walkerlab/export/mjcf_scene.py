@@ -112,11 +112,11 @@ class MjcfScene:
         first vertex (:func:`walkerlab.models.contact.terrain.profile_line`), written as a
         MuJoCo height field sampled every :data:`PROFILE_DX_M`; None: no profile.
     flat_feet : tuple or None
-        Flat feet (:func:`walkerlab.export.scene.flat_foot_bodies`): per leg (leg1, leg2) ``(heel
-        [m], toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot
-        mass [kg], inertia about the ankle [kg m^2])``; the ``qpos``/``qvel`` then hold the
-        ankles in MuJoCo's tree order (``hip_x, hip_z, leg1_hip, leg1_ankle, leg2_hip,
-        leg2_ankle``).  None: no foot bodies.
+        Flat feet (:func:`walkerlab.export.scene_feet.flat_foot_bodies`): per leg (leg1,
+        leg2) ``(heel [m], toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest
+        angle [rad], foot mass [kg], inertia about the ankle [kg m^2])``; the
+        ``qpos``/``qvel`` then hold the ankles in MuJoCo's tree order (``hip_x, hip_z,
+        leg1_hip, leg1_ankle, leg2_hip, leg2_ankle``).  None: no foot bodies.
     notes : tuple of str
         Comments written into the file (how the numbers were derived).
     """

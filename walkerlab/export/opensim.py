@@ -18,7 +18,7 @@ Bodies and joints:
 - ``PinJoint`` ``leg<i>_hip`` (coordinate = the absolute link angle, the base does not
   rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``;
 - flat feet: a ``Body`` ``leg<i>_sole`` per leg (the MJCF's foot mass and inertia at the
-  ankle, :func:`walkerlab.export.scene.flat_foot_bodies`) on a ``PinJoint`` ``leg<i>_ankle`` at
+  ankle, :func:`walkerlab.export.scene_feet.flat_foot_bodies`) on a ``PinJoint`` ``leg<i>_ankle`` at
   the leg's end (the angle from the leg's perpendicular, positive toe up), its ankle spring
   a ``SpringGeneralizedForce``, contact spheres at its heel (``leg<i>_foot``) and toe
   (``leg<i>_toe``).
@@ -159,9 +159,9 @@ class OsimGait:
     flat_feet : tuple or None
         Flat feet, per leg (leg1, leg2) ``(heel [m], toe [m], ankle stiffness [N m/rad],
         damping [N m s/rad], rest angle [rad], foot mass [kg], inertia about the ankle
-        [kg m^2])`` (:func:`walkerlab.export.scene.flat_foot_bodies`, the MJCF's); then ``qpos`` and
-        ``qvel`` hold the ankles after their legs (:func:`osim_coordinates`).  None: no
-        foot bodies.
+        [kg m^2])`` (:func:`walkerlab.export.scene_feet.flat_foot_bodies`, the MJCF's); then
+        ``qpos`` and ``qvel`` hold the ankles after their legs (:func:`osim_coordinates`).
+        None: no foot bodies.
     """
 
     qpos: tuple
@@ -256,7 +256,8 @@ def osim_gait(scene: Scene, mb, plant, ideal=None) -> OsimGait:
         No rigid gait.
     """
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
-    from walkerlab.export.scene import SCENE_FEET, mjcf_scene
+    from walkerlab.export.scene import mjcf_scene
+    from walkerlab.export.scene_feet import SCENE_FEET
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.scene import ideal_step_length

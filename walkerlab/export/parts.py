@@ -4,7 +4,7 @@ differently for a kind, made from the kind's parts (:mod:`walkerlab.walker.kinds
 The writers never ask the description's switches (flat feet, free knees, spokes) which code
 runs: they ask the walker's kind for its part, :func:`export_part` (the Adams dataset's foot
 statements in :data:`walkerlab.export.adams_feet.ADAMS_FEET`, the MJCF scene's feet in
-:data:`walkerlab.export.scene.SCENE_FEET`, the export stage's writer per kind in
+:data:`walkerlab.export.scene_feet.SCENE_FEET`, the export stage's writer per kind in
 ``walkerlab.stages.export``).  Whether a kind is exported in a format at all is the
 capability table's (:meth:`walkerlab.walker.kinds.Kind.require`).
 """

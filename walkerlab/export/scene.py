@@ -34,7 +34,8 @@ from __future__ import annotations
 import math
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings
+from walkerlab.config.terrain import TerrainSettings
 from walkerlab.export.mjcf_scene import (
     MJCF_CONTACT_SHRINK,
     MJCF_MIN_LENGTH_M,
@@ -44,9 +45,8 @@ from walkerlab.export.mjcf_scene import (
     point_foot_radius,
 )
 from walkerlab.export.parts import export_part
-from walkerlab.export.scene_feet import SCENE_FEET, flat_foot_bodies, joint_state
+from walkerlab.export.scene_feet import SCENE_FEET
 from walkerlab.export.scene_ground import (
-    EXPORT_STEPS,
     checkerboard,
     footfalls_per_step,
     ground_notes,
@@ -56,8 +56,7 @@ from walkerlab.export.scene_ground import (
 from walkerlab.models.contact.laws import ContactParamsSI
 from walkerlab.walker.kinds import KINDS, Kind
 
-__all__ = ["EXPORT_STEPS", "FORMAT_VIEWS", "SCENE_FEET", "arc_roll_m", "check_exportable",
-           "flat_foot_bodies", "joint_state", "mjcf_scene", "mujoco_contact"]
+__all__ = ["FORMAT_VIEWS", "arc_roll_m", "check_exportable", "mjcf_scene", "mujoco_contact"]
 
 #: The capability table's view (:data:`walkerlab.walker.kinds.VIEWS`) of each export format
 FORMAT_VIEWS = {"urdf": "urdf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
@@ -176,8 +175,8 @@ def arc_roll_m(mb, qpos) -> float:
     """How far an arc foot rolls its contact point ahead of its footfall during a stance [m]:
     ``R (psi_start - psi_end)``, the stance shank's turn from heel strike to the next (rolling
     without slip on the slope), from the ``gait`` keyframe ``qpos`` (joint order of
-    :func:`joint_state`): the stance leg (leg2) starts at its own angle and ends at the swing
-    leg's (a symmetric gait); 0 for point feet."""
+    :func:`~walkerlab.export.scene_feet.joint_state`): the stance leg (leg2) starts at its
+    own angle and ends at the swing leg's (a symmetric gait); 0 for point feet."""
     if not (mb.foot == "arc" and mb.foot_radius_m > 0):
         return 0.0
     q = dict(zip(["hip_x", "hip_z", *(ln.joint for ln in mb.links)], qpos))

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import TerrainSettings
+from walkerlab.config.terrain import TerrainSettings
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40

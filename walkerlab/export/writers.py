@@ -34,9 +34,9 @@ from walkerlab.export.adams import (
     adams_omissions,
     adams_start,
     adm_text,
-    check_adams_actuation,
     check_adams_exportable,
 )
+from walkerlab.export.adams_actuation import check_adams_actuation
 from walkerlab.export.engine_walk import ENGINES, EngineWalk, not_walked, walk_export
 from walkerlab.export.mjcf_ground import wheel_ground
 from walkerlab.export.mjcf_scene import MjcfOptions

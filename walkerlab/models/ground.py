@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.walker.kinds import FOOTHOLD_SLOPES, SEVERAL_FOOTHOLDS
+from walkerlab.walker.capability_cells import FOOTHOLD_SLOPES, SEVERAL_FOOTHOLDS
 
 __all__ = ["Ground", "foothold_steps", "landing_drop", "landing_drops", "scene_ground",
            "stair_treads"]
@@ -40,7 +40,8 @@ def landing_drop(terrain) -> float:
         A ground whose steps differ (footholds of several heights or of their own slopes:
         :func:`foothold_steps` and :func:`walkerlab.models.hybrid.ground.on_footholds`
         walk them in the rigid model): one line naming the field and what to do
-        (:data:`walkerlab.walker.kinds.SEVERAL_FOOTHOLDS`, the capability table's reason).
+        (:data:`walkerlab.walker.capability_cells.SEVERAL_FOOTHOLDS`, the capability table's
+        reason).
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
@@ -70,7 +71,7 @@ def landing_drops(terrain) -> tuple[float, ...]:
     ------
     ValueError
         Footholds of their own slopes (``terrain.foothold_slopes_rad``; one line naming
-        the field, :data:`walkerlab.walker.kinds.FOOTHOLD_SLOPES`).
+        the field, :data:`walkerlab.walker.capability_cells.FOOTHOLD_SLOPES`).
     """
     if terrain is not None and terrain.kind == "footholds" \
             and terrain.foothold_slopes_rad is None \

@@ -47,7 +47,7 @@ import numpy as np
 
 from walkerlab.io.schemas.optimize import OptimizeData
 from walkerlab.optimal import outcome as reported
-from walkerlab.optimal.free_joints import optimize_five_link, stick_figures
+from walkerlab.optimal.free_joints import optimize_five_link
 from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
 from walkerlab.optimal.virtual_constraints import (
     check_design,
@@ -58,8 +58,7 @@ from walkerlab.walker.plant import Plant
 
 __all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
            "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
-           "not_a_gait_outcome", "optimize_scene", "replay_multipliers", "starting_phases",
-           "starting_stride", "history_and_energies", "stick_figures"]
+           "optimize_scene", "starting_phases", "starting_stride"]
 
 
 # -- the scene's set-up ------------------------------------------------------------------

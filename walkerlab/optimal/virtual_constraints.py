@@ -146,7 +146,8 @@ def contact_scene(scene):
     sections, or (none) :data:`CONTROLLER_CONTACT` and the run's defaults; ``terrain`` and
     ``contact_solver`` as they are (their defaults when absent: a checkerboard of the
     footfalls, over whose gaps the straight swing foot passes at mid-stance)."""
-    from walkerlab.config.contact import ContactSettings, ContactSimSettings  # light
+    from walkerlab.config.contact import ContactSettings  # light
+    from walkerlab.config.contact_sim import ContactSimSettings  # light
 
     update = {}
     if scene.contact is None:

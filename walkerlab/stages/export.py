@@ -116,7 +116,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         Unknown format, a walker with a massless link (a multibody model needs positive
         masses), feet the formats cannot carry, a ground other than the slope (stairs ...)
         in the URDF unless ``walker_only`` (the capability table's cell of that ground,
-        :data:`walkerlab.walker.kinds.URDF_GROUND`), or no rigid gait to start from; a
+        :data:`walkerlab.walker.capability_cells.URDF_GROUND`), or no rigid gait to start from; a
         spoked wheel to a format other than urdf or mjcf (naming walker.model); footholds
         of several heights where the capability table refuses them (the Adams dataset,
         the OpenSim model: naming terrain.foothold_heights_m); MJCF options for a format

@@ -242,7 +242,7 @@ def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True,
     sticks = None
     # a five-link biped's open-loop step: its stop action
     if d.torque_names != ("hip",) and not d.controllers:
-        from walkerlab.optimal.driver import stick_figures
+        from walkerlab.optimal.free_joints import stick_figures
 
         sticks = stick_figures(Plant.from_scene(scene).data, d)
     return save_optimize_figure(d, scene.name, folder, sticks, svg, key)

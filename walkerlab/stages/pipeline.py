@@ -71,8 +71,9 @@ def require_kind(stage: str, scene: Scene) -> None:
         One line naming the scene field (``walker.space: 3d``, ``walker``).
     """
     from walkerlab.stages.common import StageError  # light
+    from walkerlab.walker.capability_cells import STAGE_VIEWS  # light
     from walkerlab.walker.description import walker_data  # light
-    from walkerlab.walker.kinds import STAGE_VIEWS, KindRefused  # light
+    from walkerlab.walker.kinds import KindRefused  # light
 
     act = getattr(scene.walker, "actuation", None)
     try:

@@ -44,7 +44,8 @@ from walkerlab.studies.bifurcation_point import (
 )
 from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.params import ParamAxis
-from walkerlab.studies.runner import plan_chunks, sweep_executor
+from walkerlab.studies.runner import sweep_executor
+from walkerlab.studies.sweep_plan import plan_chunks
 from walkerlab.walker.plant import Plant
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
@@ -53,7 +54,7 @@ __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
 
 def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH,
        steps_per_map: int = 0) -> tuple[float, np.ndarray]:
-    from walkerlab.studies.points import ideal_fixed_point, on_study_map
+    from walkerlab.studies.point_gait import ideal_fixed_point, on_study_map
 
     scene = scene_at(scene_base, value, path)
     w, res, _s = ideal_fixed_point(scene, guess)
@@ -142,7 +143,7 @@ class BifurcationResult:
         Period-1 fixed point just after heel strike (NaN if none).
     fixed_point_interleg_deg : ndarray (n,)
         Inter-leg angle of the fixed point [deg] (see
-        :func:`walkerlab.studies.points.interleg_angle`).
+        :func:`walkerlab.studies.point_columns.interleg_angle`).
     multipliers : ndarray (n, 2m) complex
         Floquet multipliers (variational), sorted by modulus.
     step_period_s : ndarray (n,)
@@ -270,7 +271,7 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
                workers: int, scheduler, steps_per_map: int = 0) -> list[dict]:
     """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
     state; :func:`bifurcation_chunk`), in grid order: the grid of ``axis`` is cut into runs
-    (:func:`walkerlab.studies.runner.plan_chunks`) evaluated on
+    (:func:`walkerlab.studies.sweep_plan.plan_chunks`) evaluated on
     :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
     from walkerlab import progress
 
@@ -297,7 +298,7 @@ def _diagram_result(scene: Scene, slopes: np.ndarray, rows: list[dict], x: np.nd
     degrees and the attractor period (distinct inter-leg angles among them), the grid
     ``slopes`` of ``param`` [``unit``] and the period-doubling ``onset``."""
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import interleg_angle
+    from walkerlab.studies.point_columns import interleg_angle
 
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
     walker = build_walker(scene, plant=Plant.from_scene(scene))

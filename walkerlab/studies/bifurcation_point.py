@@ -72,7 +72,8 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
     import warnings
 
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point, on_study_map, warm_up
+    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point, on_study_map
+    from walkerlab.studies.points import warm_up
 
     warm_up()
     from walkerlab.studies.continuation import scene_family
@@ -137,7 +138,7 @@ def _steady_state(task: BifurcationTask, scene, walker, row: dict, x_att):
     """
     from walkerlab.integrate.rigid import simulate_steps  # light: worker side
     from walkerlab.integrate.solver import Solver  # light: worker side
-    from walkerlab.studies.points import interleg_angle  # light: worker side
+    from walkerlab.studies.point_columns import interleg_angle  # light: worker side
 
     if x_att is not None:
         x0 = walker.from_section(walker.section(x_att))

@@ -62,7 +62,7 @@ def scene_family(scene: Scene, path: str) -> WalkerFamily:
 
 def scene_value(scene: Scene, path: str) -> float:
     """The scene's own value of a numeric field (the slope in either unit)."""
-    from walkerlab.studies.runner import base_value  # light
+    from walkerlab.studies.sweep_plan import base_value  # light
 
     v = base_value(scene.model_dump(mode="json"), path)
     if v is None:  # a field the scene does not have (one line naming it), or one left unset
@@ -186,7 +186,7 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
         No gait at the scene's own value.
     """
     from walkerlab.analysis.continuation.branch import add_gait_measures
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
+    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point  # light
 
     unit = axis_unit(scene, ParamAxis(path, (), path))
     p0 = scene_value(scene, path)
@@ -309,7 +309,7 @@ def homotopy_gait(known: Scene, new: Scene):
     MapFailed
         No gait for the known scene.
     """
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
+    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point  # light
 
     make, fields = homotopy_family(known, new)
     try:

@@ -1,15 +1,16 @@
 """Evaluate sweep points: one function per swept stage, and the chunk runner workers call.
 
 Each point function takes a validated :class:`~walkerlab.config.Scene`, the fixed points of
-the previous points of the same chunk (a :class:`Continuation`, or ``None``) and the sweep
-options, and returns ``(columns, fixed point result or None)``.  :func:`run_chunk` wraps
-them so that every point ends in a typed outcome (:mod:`walkerlab.studies.outcomes`),
-whatever happens.
+the previous points of the same chunk (a :class:`~walkerlab.studies.guess.Continuation`, or
+``None``) and the sweep options, and returns ``(columns, fixed point result or None)``.
+:func:`run_chunk` wraps them so that every point ends in a typed outcome
+(:mod:`walkerlab.studies.outcomes`), whatever happens.
 
 The contact-sim point goes through :func:`contact_adapter`, the only place that knows the
 calling convention of :func:`walkerlab.analysis.contact.sim.simulate_from` (adjust the
 adapter, nothing else, when its interface changes).  A point's rigid gait, the options'
-defaults and :class:`PointOutcome` are :mod:`walkerlab.studies.point_gait`'s (re-exported).
+defaults and :class:`PointOutcome` are :mod:`walkerlab.studies.point_gait`'s, a point's columns
+:mod:`walkerlab.studies.point_columns`', the guesses' JSON :mod:`walkerlab.studies.guess`'s.
 """
 
 from __future__ import annotations
@@ -31,28 +32,25 @@ from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.io.stage_files import CONTACT_SIM
-from walkerlab.studies.guess import Continuation, guess_from_json, guess_to_json
 from walkerlab.studies.outcomes import empty_row
 from walkerlab.studies.params import apply_point
-from walkerlab.studies.point_columns import (  # noqa: F401  (re-exported)
+from walkerlab.studies.point_columns import (
     _fp_columns,
     _ground_columns,
     _state_columns,
     interleg_angle,
 )
-from walkerlab.studies.point_gait import (  # noqa: F401 (part of this API)
+from walkerlab.studies.point_gait import (
     DEFAULT_OPTIONS,
     PointOutcome,
-    ideal_fixed_point,
     on_study_map,
     scene_gait,
     scene_solver,
 )
 from walkerlab.walker.plant import Plant
 
-__all__ = ["Task", "Continuation", "guess_from_json", "guess_to_json", "run_chunk",
-           "fixedpoint_point", "simulate_point", "contact_point", "contact_adapter",
-           "ideal_fixed_point", "DEFAULT_OPTIONS", "POINT_FUNCTIONS"]
+__all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
+           "contact_adapter", "POINT_FUNCTIONS"]
 
 
 @dataclass(frozen=True)
@@ -223,7 +221,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     return cw, res, 2 * setup.sim.n_strides
 
 
-#: contact outcome kind (walkerlab.analysis.contact.gait.CONTACT_OUTCOMES, the shared run
+#: contact outcome kind (walkerlab.analysis.contact.verdict.CONTACT_OUTCOMES, the shared run
 #: ends) -> sweep outcome: a run that walked is "ok", every other end keeps its name
 _CONTACT_OUTCOME = {k: ("ok" if k in ("heel_strike", "t_final") else k)
                     for k in RUN_END_NAMES}
@@ -244,7 +242,7 @@ def contact_point(scene: Scene, guess, options: dict):
         The outcomes above (each with the columns computed so far), or as
         :func:`ideal_fixed_point`.
     """
-    from walkerlab.analysis.contact.gait import classify_complete
+    from walkerlab.analysis.contact.verdict import classify_complete
     from walkerlab.config import FixedPointSettings
     from walkerlab.integrate.rigid import integrate_step
 

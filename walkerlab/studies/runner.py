@@ -1,6 +1,6 @@
 """Run a sweep: plan chunks, evaluate them locally or on Dask, append rows as they finish.
 
-Every point is a function of itself alone (:func:`walkerlab.studies.points.scene_gait`:
+Every point is a function of itself alone (:func:`walkerlab.studies.point_gait.scene_gait`:
 the gait ``walkerlab fixedpoint`` finds and chooses for the point's scene; no neighbour's
 gait is carried along): a sweep's rows are the same, bit for bit, whatever the chunking,
 the worker count or the executor.  (A branch beyond the reach of the scene's guess and
@@ -68,22 +68,16 @@ from walkerlab.io.sweep_store import (
     complete_sweep,
     partial_path,
 )
+from walkerlab.studies.guess import guess_from_json, guess_to_json
 from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.outcomes import OUTCOMES, STAGES, STRING_COLUMNS, walker_columns
 from walkerlab.studies.params import ParamAxis, SweepError, grid_points
-from walkerlab.studies.points import (
-    DEFAULT_OPTIONS,
-    Task,
-    evaluate,
-    guess_from_json,
-    guess_to_json,
-    warm_up,
-)
-from walkerlab.studies.sweep_plan import base_value, plan_chunks, sweep_input_hash
+from walkerlab.studies.point_gait import DEFAULT_OPTIONS
+from walkerlab.studies.points import Task, evaluate, warm_up
+from walkerlab.studies.sweep_plan import plan_chunks, sweep_input_hash
 
-__all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
-           "sweep_executor", "sweep_input_hash", "pool_pays", "MAX_GRID_POINTS", "PIECE_POINTS",
-           "FLUSH_EVERY_S", "POOL_START_S"]
+__all__ = ["run_sweep", "iter_piece_results", "run_piece", "sweep_executor", "pool_pays",
+           "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S", "POOL_START_S"]
 
 MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
@@ -222,7 +216,7 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     resume : bool
         Continue an interrupted sweep from its partial file (finished rows are kept).
     options : dict, optional
-        Point options (:data:`walkerlab.studies.points.DEFAULT_OPTIONS`).
+        Point options (:data:`walkerlab.studies.point_gait.DEFAULT_OPTIONS`).
     chunk_size : int, optional
         Longest chunk (continuation restarts from the scene's guess at each chunk start).
     progress : bool

@@ -160,7 +160,7 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
     from walkerlab.analysis.contact.step_map import PeriodicGaitError
     from walkerlab.config import SceneError
     from walkerlab.models.contact.scene import build
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
+    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point  # light
 
     y = spec.y_values[iy]
     row, z_prev, x_ideal_prev = [], None, None

@@ -4,8 +4,8 @@
 (:data:`CELL_NOTES`).
 
 The kinds and their questions (:meth:`walkerlab.walker.kinds.Kind.cell`,
-:meth:`~walkerlab.walker.kinds.Kind.require`) are in :mod:`walkerlab.walker.kinds`, which
-re-exports every public name here; the layers import them from there.
+:meth:`~walkerlab.walker.kinds.Kind.require`) are in :mod:`walkerlab.walker.kinds`; a layer
+that names a cell's reason itself (a refusal of its own, a test) imports it from here.
 """
 
 from __future__ import annotations

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from walkerlab.walker.capability_cells import STAGE_CELLS
 from walkerlab.walker.capability_evidence import (
     CHECK_KINDS,
     UNVERIFIED,
@@ -21,7 +22,7 @@ from walkerlab.walker.capability_evidence import (
     unverified_reason,
     verified,
 )
-from walkerlab.walker.kinds import FEATURES, KINDS, STAGE_CELLS, VIEWS, Kind
+from walkerlab.walker.kinds import FEATURES, KINDS, VIEWS, Kind
 
 __all__ = ["SUPPORTED", "KindGrid", "grids", "kind_grid", "markdown", "text"]
 

@@ -51,7 +51,8 @@ the kind carries its part of each layer as a word (:attr:`Kind.body`, :attr:`Kin
 keyed by its own part words (the rigid model's builders, the contact model's geometry, the
 export's writers, the transcriptions) or asks the kind a question (:attr:`Kind.spoked`,
 :attr:`Kind.in_3d`, :attr:`Kind.joints_free`, :attr:`Kind.feet_have_modes`).
-Whether a kind supports a feature in a view is read from :data:`CAPABILITIES`; a refusal is
+Whether a kind supports a feature in a view is read from
+:data:`~walkerlab.walker.capability_cells.CAPABILITIES`; a refusal is
 :meth:`Kind.require`'s one line, naming the scene field and the physical or modelling
 reason, so ``walkerlab capabilities``, the documentation and the refusals say the same.
 
@@ -64,30 +65,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from walkerlab.walker.capability_cells import (  # the table's cells, re-exported
-    ACTUATION_3D,
-    CAPABILITIES,
-    CELL_NOTES,
-    EXPORT_3D,
-    FOOTHOLD_SLOPES,
-    FREE_JOINT_TORQUES,
-    GROUND_3D,
-    KNEE_LATCH_OSIM,
-    NO_HIP_ROLL,
-    NO_ROUND_FEET_3D,
-    PROFILE_PASSIVE,
-    ROUND_FEET_EXPORT_3D,
-    SEVERAL_FOOTHOLDS,
-    STAGE_CELLS,
-    STAGE_VIEWS,
-    URDF_GROUND,
-)
+from walkerlab.walker.capability_cells import CAPABILITIES, CELL_NOTES, STAGE_CELLS, STAGE_VIEWS
 
-__all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURES",
-           "FOOTHOLD_SLOPES", "FREE_JOINT_TORQUES", "GROUND_3D", "KINDS",
-           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
-           "URDF_GROUND", "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
+__all__ = ["FEATURES", "KINDS", "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
 
 #: the views of one walker description: name -> what it is
 VIEWS = {
@@ -159,7 +139,7 @@ class Kind:
     feet : str
         ``leg_ends`` (point or arc feet at the legs' ends) or ``flat`` (a foot body on an
         ankle spring, with foot modes): the exports' feet
-        (:data:`walkerlab.export.scene.SCENE_FEET`, :data:`walkerlab.export.adams_feet.
+        (:data:`walkerlab.export.scene_feet.SCENE_FEET`, :data:`walkerlab.export.adams_feet.
         ADAMS_FEET`).
     landing : str or None
         How the rigid view lands on stairs and footholds

@@ -96,7 +96,7 @@ def own_footfall_lanes(walker, result, period: int, initial_stance: str = "leg2"
     ----------
     walker : ContactWalker
         On checkerboard lanes (leg2's patches footfalls 0, 2, ..., leg1's 1, 3, ...).
-    result : walkerlab.analysis.contact.gait.ContactResult
+    result : walkerlab.analysis.contact.result.ContactResult
         A run of ``walker`` (its ``feet[leg].s``, heel-strike times and legs).
     period : int
         Steps of the ground's cycle (``len(terrain.foothold_heights_m)``).

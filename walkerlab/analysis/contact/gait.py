@@ -4,10 +4,11 @@ Input: the samples of :func:`walkerlab.integrate.contact.integrate_contact` (tim
 named by ``walker.state_names()``) and the model's per-foot contact quantities
 (``walker.foot_quantities``: per leg; a flat foot's heel and toe combined, and
 ``walker.contact_quantities`` per contact point).  Output: per-foot traces with touchdown /
-lift-off times,
-the heel strikes, one :class:`StepSummary` per step (slip, creep, bounces, scuffs, peak
-penetration) and the run's typed :class:`Outcome`, whose ``kind`` is one of the shared run
-ends (:mod:`walkerlab.integrate.ends`).  Nothing here integrates or reads a state by row.
+lift-off times, the heel strikes and one :class:`StepSummary` per step (slip, creep,
+bounces, scuffs, peak penetration), from which the run's typed
+:class:`~walkerlab.analysis.contact.verdict.Outcome` is read (its ``kind`` one of the shared
+run ends, :mod:`walkerlab.integrate.ends`).  Nothing here integrates or reads a state by
+row.
 
 Touchdown and lift-off are the zero crossings of the penetration, located on the cubic
 Hermite interpolant of the samples and their rates; a heel strike is a touchdown of the
@@ -16,32 +17,19 @@ touchdowns of that foot are scuffs, of the stance foot bounces.
 
 The run's outcome and verdict are :mod:`walkerlab.analysis.contact.verdict`'s, the
 footfalls against a checkerboard :mod:`walkerlab.analysis.contact.terrain_fit`'s, the
-records (:class:`ContactResult`, :class:`StepSummary`, :class:`FootTrace`)
-:mod:`walkerlab.analysis.contact.result`'s (all importable from here).
+records (:class:`~walkerlab.analysis.contact.result.ContactResult`, :class:`StepSummary`,
+:class:`FootTrace`) :mod:`walkerlab.analysis.contact.result`'s.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.contact.result import ContactResult, FootTrace, StepSummary
-from walkerlab.analysis.contact.terrain_fit import PatchFit, patch_fit
-from walkerlab.analysis.contact.verdict import (
-    CONTACT_OUTCOMES,
-    Outcome,
-    classify,
-    classify_complete,
-    scuff_cause,
-    step_trend,
-    walk_verdict,
-)
+from walkerlab.analysis.contact.result import FootTrace, StepSummary
 from walkerlab.integrate.contact import hermite_root
 from walkerlab.models.contact.parts import contact_part
 
-__all__ = ["CONTACT_OUTCOMES", "FOOT_MODES", "ContactResult", "FootTrace", "Outcome",
-           "PatchFit", "StepSummary", "classify", "classify_complete", "foot_modes",
-           "gait_events", "heel_strike_count", "patch_fit", "phase_slip", "scuff_cause",
-           "step_trend", "walk_verdict"]
+__all__ = ["FOOT_MODES", "foot_modes", "gait_events", "heel_strike_count", "phase_slip"]
 
 
 def _crossings(t, pen, rate, on):

@@ -12,9 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.contact.gait import (
-    ContactResult,
-)
+from walkerlab.analysis.contact.result import ContactResult
 from walkerlab.models.contact.model import state_name
 from walkerlab.walker.layout import StateIndex
 

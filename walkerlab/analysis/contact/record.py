@@ -125,7 +125,7 @@ def contact_walk(setup: ContactSetup, x_ideal: np.ndarray, period: float,
     -------
     walker : walkerlab.models.contact.model.ContactWalker
         The contact model on the run's terrain.
-    result : walkerlab.analysis.contact.gait.ContactResult
+    result : walkerlab.analysis.contact.result.ContactResult
     x0 : ndarray, shape (N,)
         The contact walker's initial state [m, rad, m/s, rad/s].
     step_length : float

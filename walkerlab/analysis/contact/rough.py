@@ -106,7 +106,7 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     -------
     (heel_strikes, fell, outcome) : int, bool, str
         ``fell`` False: the walk reached ``max_steps`` (censored); ``outcome`` the run's
-        end (:data:`walkerlab.analysis.contact.gait.CONTACT_OUTCOMES`).
+        end (:data:`walkerlab.analysis.contact.verdict.CONTACT_OUTCOMES`).
     """
     from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
     from walkerlab.config import scene_from_dict  # light

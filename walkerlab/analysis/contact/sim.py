@@ -18,16 +18,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.analysis.contact.gait import (
-    ContactResult,
-    classify,
-    gait_events,
-    heel_strike_count,
-    patch_fit,
-    scuff_cause,
-)
+from walkerlab.analysis.contact.gait import gait_events, heel_strike_count
 from walkerlab.analysis.contact.named import named_trajectory, trajectory_names
+from walkerlab.analysis.contact.result import ContactResult
 from walkerlab.analysis.contact.start import initial_state_from_ideal, rigid_mid_stance
+from walkerlab.analysis.contact.terrain_fit import patch_fit
+from walkerlab.analysis.contact.verdict import classify, scuff_cause
 from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
@@ -70,10 +66,10 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         in which this many heel strikes have happened.  A run that ends in a trip, fall,
         flight, solver failure or the wall-time limit after ``max_heel_strikes - 1`` heel
         strikes (the strides asked for) ends by the cap too, its end named in the message
-        and in :attr:`~walkerlab.analysis.contact.gait.Outcome.after` (a trip, fall or
-        flight there makes :func:`~walkerlab.analysis.contact.gait.walk_verdict` say the run
+        and in :attr:`~walkerlab.analysis.contact.verdict.Outcome.after` (a trip, fall or
+        flight there makes :func:`~walkerlab.analysis.contact.verdict.walk_verdict` say the run
         does not walk).  A trip, fall or scuff on a checkerboard whose patches the footfalls
-        drifted off adds :meth:`~walkerlab.analysis.contact.gait.PatchFit.note` to the
+        drifted off adds :meth:`~walkerlab.analysis.contact.terrain_fit.PatchFit.note` to the
         message.
     slip_limit_mm : float, optional
         A stance phase sliding farther than this [mm] makes the outcome ``slip``.

@@ -252,7 +252,7 @@ def profile_ground(scene, plant):
     """
     from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points  # light
     from walkerlab.models.registry import passive_walker_at
-    from walkerlab.walker.kinds import PROFILE_PASSIVE
+    from walkerlab.walker.capability_cells import PROFILE_PASSIVE
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")

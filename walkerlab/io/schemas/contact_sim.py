@@ -3,7 +3,7 @@
 Layout: the named ``samples/`` of :mod:`walkerlab.io.trajectory` (as ``simulate.h5``);
 root attributes ``model``, ``legs``, ``termination``, ``method``, ``outcome``,
 ``outcome_message``, ``stiffness_family`` (``fall_time_s`` when it fell), ``walks`` (1/0:
-the one verdict from the steps, :func:`walkerlab.analysis.contact.gait.walk_verdict`) and
+the one verdict from the steps, :func:`walkerlab.analysis.contact.verdict.walk_verdict`) and
 ``walks_reason`` (why not; "" when it walks); ``outcome/`` (event time [s], patch edge
 [m], hip height [m]; attributes ``after``, the end that followed the heel strikes asked
 for, "" when none, and ``after_time`` [s]); ``drop_test/`` (restitution, largest

@@ -46,7 +46,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings, KneeStopSettings
+from walkerlab.config.terrain import TerrainSettings
 
 from .lanes import checkerboard_lanes, flat_foot_numbers, footprint_offsets
 from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si

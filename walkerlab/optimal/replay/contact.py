@@ -77,7 +77,7 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     ----------
     scene : Scene
         The optimised scene.
-    law : walkerlab.optimal.replay.virtual_constraints.PhaseLaw
+    law : walkerlab.optimal.replay.phase.PhaseLaw
     x0 : ndarray (2n,)
         The rigid start (post-impact, ``state_names()`` order) [rad, rad/s].
     step_period_s : float

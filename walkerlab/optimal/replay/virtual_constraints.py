@@ -42,15 +42,13 @@ from walkerlab.optimal.replay.phase import (
     LIMIT_N_M,
     PhaseLaw,
     PhaseReplay,
-    control_of_time,
     driven_by,
     law_of_rows,
     replay_law,
 )
 
-__all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "control_of_time", "phase_law",
-           "phase_replays", "phased_walker", "replay_phase_law", "replay_solver",
-           "rigid_actuators"]
+__all__ = ["RABBIT_GAINS", "phase_law", "phase_replays", "phased_walker", "replay_phase_law",
+           "replay_solver", "rigid_actuators"]
 
 #: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint
 #: (:data:`walkerlab.optimal.transcription.free_joint_functions.
