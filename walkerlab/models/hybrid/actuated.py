@@ -10,8 +10,9 @@ five-link biped) add one spline for laws sharing a table
 own mass matrices (:mod:`walkerlab.models.hybrid.mode_torques`) or an ankle push-off
 (:mod:`walkerlab.models.hybrid.ankle_push_off`).  Each kind's way is its part, reached
 through the walker's kind (``_PARTS``); what a kind cannot carry is refused by its row of
-:data:`walkerlab.walker.kinds.CAPABILITIES`.  Those modules import the shared
-actuators from :mod:`walkerlab.models.hybrid.actuators`, never this one.
+:data:`walkerlab.walker.kinds.CAPABILITIES`, what the legs' masses cannot carry by
+:mod:`walkerlab.models.hybrid.leg_masses`.  Those modules import the shared actuators from
+:mod:`walkerlab.models.hybrid.actuators`, never this one.
 """
 
 from __future__ import annotations
