@@ -114,7 +114,8 @@ def test_the_monte_carlo_benchmarks_yardstick_caches_its_numba_code_in_the_user_
     the user cache's numba folder does (the copy's entries)."""
     import shutil
 
-    from walkerlab.bench.main_job import MC_CHILD, TREE, child
+    from walkerlab.bench.main_job import MC_CHILD, child
+    from walkerlab.bench.process_env import TREE
     from walkerlab.usercache import private_dir
 
     src = tmp_path / "yardstick"

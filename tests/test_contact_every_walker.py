@@ -116,7 +116,7 @@ def test_stability_map_figure_names_scene_units_and_unsupported_cells():
     its patch-width map's axis read 'patch width [m]'; a kneed cell whose periodic-gait
     search has no section read '?'."""
     from walkerlab.io.schemas.stability_map import StabilityMap
-    from walkerlab.plotting.sweep_figures import gait_map_figure, plt
+    from walkerlab.plotting.gait_map_figure import gait_map_figure, plt
     from walkerlab.studies.stability import MAP_KINDS, REASONS, MapSpec
 
     assert "unsupported" in REASONS

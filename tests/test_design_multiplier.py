@@ -34,7 +34,7 @@ def test_largest_multiplier_gradient_equals_central_differences_of_the_resolved_
     the left/right eigenvectors equals the central difference (h = 1e-3 kg, truncation
     ~h² |λ'''| ≈ 1e-9 relative here) of |λ|max at re-solved fixed points to 1e-6 relative
     (measured 2.5e-8 at 10 kg and 3.3e-9 at 15 kg)."""
-    from walkerlab.optimal.design.search import _Gaits, multiplier_gradient
+    from walkerlab.optimal.design.gradients import _Gaits, multiplier_gradient
 
     scene, x = paper
     gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75])
@@ -51,7 +51,7 @@ def test_design_solves_follow_the_scenes_gait_not_a_neighbouring_one(paper):
     unstable gait of the same walker (|λ|max 2.48); walked in sub-steps of 0.75 kg it stays on
     the scene's own stable gait (|λ|max 0.5754, as the SLSQP path through 12.7 and 15.0 kg
     finds it)."""
-    from walkerlab.optimal.design.search import _Gaits
+    from walkerlab.optimal.design.gradients import _Gaits
 
     scene, x = paper
     gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75])

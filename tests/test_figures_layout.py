@@ -130,7 +130,7 @@ def test_stability_map_marks_the_scenes_point_with_three_cells_a_side():
     the scene's k = 1e5 N/mm^2.2, φ = 0.997°: the star sits between cells, at
     log10 interpolation: y index (5 - 3) / 3 = 0.667, x index (0.997 - 0.5) / 1.75."""
     from walkerlab.io.schemas.stability_map import StabilityMap
-    from walkerlab.plotting.sweep_figures import gait_map_figure
+    from walkerlab.plotting.gait_map_figure import gait_map_figure
 
     n = 3
     data = StabilityMap(

@@ -434,7 +434,7 @@ def test_bifurcation_figure_marks_falls_and_keeps_labels_inside():
 
 def test_stability_map_figure_whole_words_one_panel():
     from walkerlab.io.schemas.stability_map import StabilityMap
-    from walkerlab.plotting.sweep_figures import gait_map_figure, plt
+    from walkerlab.plotting.gait_map_figure import gait_map_figure, plt
 
     reason = np.array([["", "solver_failure"], ["not_converged", ""]], dtype=object)
     d = StabilityMap(

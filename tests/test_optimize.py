@@ -110,7 +110,7 @@ def test_design_gradient_through_the_fixed_point_equals_central_differences():
     """d(step period)/d(hip mass) and d(speed)/d(leg mass) of the paper walker's gait by the
     implicit function theorem on the Poincaré map, against central differences of the
     re-solved fixed point (h = 1e-3 kg: truncation ~1e-9 relative): <= 1e-6 relative."""
-    from walkerlab.optimal.design.search import _Gaits, measure_gradient
+    from walkerlab.optimal.design.gradients import _Gaits, measure_gradient
 
     scene = load_scene(CONFIGS / "paper.yaml")
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -132,7 +132,7 @@ def test_design_gradient_of_step_length_and_cost_of_transport():
     differences of the re-solved fixed point (h = 1e-3): <= 1e-6 relative - the paper
     walker's step length in its hip mass (1e-7 seen), and powered_compass.yaml's cost of
     transport in its push-off impulse (a passive walker's is 0; 9e-9 seen)."""
-    from walkerlab.optimal.design.search import _Gaits, measure_gradient
+    from walkerlab.optimal.design.gradients import _Gaits, measure_gradient
 
     for name, scene_name, field, p in (
             ("step_length", "paper", "walker.hip_mass_kg", 10.0),
@@ -213,7 +213,8 @@ def test_design_from_a_zero_stiffness_bound_stays_inside_the_bounds():
     central difference at 0 built a spring of -1e-6 N m/rad and the run stopped), and the
     gradient there is the one-sided difference of the re-solved speed (h = 1e-3 N m/rad:
     truncation ~1e-7 relative)."""
-    from walkerlab.optimal.design.search import _Gaits, design_optimize, measure_gradient
+    from walkerlab.optimal.design.gradients import _Gaits, measure_gradient
+    from walkerlab.optimal.design.search import design_optimize
 
     scene = load_scene(CONFIGS / "hip_spring.yaml")
     field = "walker.springs.0.stiffness_n_m_per_rad"
@@ -261,7 +262,7 @@ def test_gait_sensitivity_norm_gradient_converges(robust_paper):
     """The GSN's differenced gradient (step 1e-4 of the field) and one with a ten times
     larger step agree to O(h^2) (<= 1e-4 relative): the measure is smooth and its
     differences are not noise (its own B, C, D are differences at 1e-6 of the state)."""
-    from walkerlab.optimal.design.search import _Gaits
+    from walkerlab.optimal.design.gradients import _Gaits
 
     scene, x = robust_paper
     gaits = _Gaits(scene, ["walker.hip_mass_kg"], x)

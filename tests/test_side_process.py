@@ -248,7 +248,7 @@ print(r.ru_utime + r.ru_stime + there)
 def test_the_main_job_benchmark_counts_the_side_process_cpu():
     """A command's side process ends after the command's own process has been waited for:
     the benchmark still counts its CPU (an accounting identity, not a timing)."""
-    from walkerlab.bench.main_job import _env, _run
+    from walkerlab.bench.process_env import code_env, timed_run
 
-    _, cpu, out = _run([sys.executable, "-c", SIDE_CPU_CHILD], _env(ROOT), ROOT)
+    _, cpu, out = timed_run([sys.executable, "-c", SIDE_CPU_CHILD], code_env(ROOT), ROOT)
     assert cpu >= 0.95 * float(out.strip().splitlines()[-1])

@@ -42,7 +42,7 @@ measurement            what is timed                                            
 
 CPU times of a command are those of its whole process tree: the worker processes that end
 after it (multiprocessing's forkserver, the report's side process, pool workers) are reaped
-here and counted (:func:`_count_orphans`).
+here and counted (:func:`walkerlab.bench.process_env.count_orphans`).
 Medians over ``repeats`` (the mesh and the robustness study once per tree unless asked);
 with a second tree also the median over the repeats of each repeat's ratio of the two trees
 (``pair_ratios_this_over_vs``: the two runs of a pair are minutes apart at most, so a
@@ -52,23 +52,18 @@ change of the machine's load moves both).
 from __future__ import annotations
 
 import json
-import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
-from walkerlab.bench.process_env import installed_env
+from walkerlab.bench.process_env import TREE, cli_command, code_env, timed_run
 from walkerlab.io.stage_files import CONTACT_SIM
 
 __all__ = ["run_main_job", "MC_CHILD", "MESH_CHILD"]
 
 HERE = Path(__file__).resolve()
-TREE = HERE.parents[2]
 #: the plain-library yardstick of a warm contact run (no walkerlab import)
 BARE = HERE.with_name("bare_fixedpoint.py")
 
@@ -142,71 +137,17 @@ print(json.dumps({"wall_s": time.perf_counter() - t, "cpu_s": cpu() - c,
 """
 
 
-def _env(code: Path, cache: str | None = None) -> dict:
-    env = installed_env(PYTHONPATH=str(code))  # with its bytecode (:mod:`.process_env`)
-    env.pop("NUMBA_CACHE_DIR", None)  # walkerlab sets it from its user cache
-    if cache is not None:
-        env["WALKERLAB_CACHE_DIR"] = cache
-    return env
-
-
-def _count_orphans() -> None:
-    """Become the reaper of this process's orphaned descendants (Linux
-    ``PR_SET_CHILD_SUBREAPER``): the worker processes a command leaves to end after it
-    (multiprocessing's forkserver and the workers it forked, which the command never waits
-    for) are then reaped here (:func:`_reap`) and their CPU counted in ``RUSAGE_CHILDREN``
-    (without it, a command's side process or pool workers would not count)."""
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        try:
-            ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER
-        except (OSError, AttributeError):  # pragma: no cover - no prctl
-            pass
-
-
-def _reap(limit_s: float = 10.0) -> None:
-    """Wait (at most ``limit_s`` [s]) for the remaining child processes and reap them."""
-    end = time.monotonic() + limit_s
-    while time.monotonic() < end:
-        try:
-            pid, _ = os.waitpid(-1, os.WNOHANG)
-        except ChildProcessError:
-            return
-        if pid == 0:
-            time.sleep(0.01)
-
-
-def _run(cmd: list[str], env: dict, cwd: Path) -> tuple[float, float, str]:
-    """Wall [s], CPU of the process tree [s] (its orphans included: :func:`_count_orphans`)
-    and stdout of one command."""
-    _count_orphans()
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, env=env, cwd=cwd, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    _reap()
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode:
-        raise RuntimeError(f"{' '.join(cmd[:5])}: exit {p.returncode}: {p.stderr[-400:]}")
-    return wall, (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime), p.stdout
-
-
-def _cli(*args: str) -> list[str]:
-    return [sys.executable, "-m", "walkerlab.cli", "-q", *args]
-
-
 def contact_sim(code: Path, scene: str) -> dict:
     """Cold, warm and warm again ``contact-sim --force`` in a fresh user cache:
     ``{cold: (wall, cpu), warm: (wall, cpu), warm_again: (wall, cpu)}`` [s]."""
     with tempfile.TemporaryDirectory() as d:
-        env = _env(code, str(Path(d) / "cache"))
+        env = code_env(code, str(Path(d) / "cache"))
         runs = str(Path(d) / "runs")
-        _run(_cli("fixedpoint", scene, "--runs-dir", runs), env, code)
-        cmd = _cli(CONTACT_SIM.name, scene, "--force", "--runs-dir", runs)
-        cold = _run(cmd, env, code)[:2]
-        warm = _run(cmd, env, code)[:2]
-        again = _run(cmd, env, code)[:2]
+        timed_run(cli_command("fixedpoint", scene, "--runs-dir", runs), env, code)
+        cmd = cli_command(CONTACT_SIM.name, scene, "--force", "--runs-dir", runs)
+        cold = timed_run(cmd, env, code)[:2]
+        warm = timed_run(cmd, env, code)[:2]
+        again = timed_run(cmd, env, code)[:2]
     return {"cold": cold, "warm": warm, "warm_again": again}
 
 
@@ -215,38 +156,39 @@ def warm_vs_bare(code: Path, scene: str, pairs: int = 5) -> dict:
     times alternating, in one fresh user cache (fixed point and a first contact run done
     before): ``{"warm": [(wall, cpu), ...], "bare": [(wall, cpu), ...]}`` [s]."""
     with tempfile.TemporaryDirectory() as d:
-        env = _env(code, str(Path(d) / "cache"))
+        env = code_env(code, str(Path(d) / "cache"))
         runs = str(Path(d) / "runs")
-        _run(_cli("fixedpoint", scene, "--runs-dir", runs), env, code)
-        warm = _cli(CONTACT_SIM.name, scene, "--force", "--runs-dir", runs)
-        _run(warm, env, code)
-        _run(warm, env, code)  # the steady state (see contact_sim_warm_again)
+        timed_run(cli_command("fixedpoint", scene, "--runs-dir", runs), env, code)
+        warm = cli_command(CONTACT_SIM.name, scene, "--force", "--runs-dir", runs)
+        timed_run(warm, env, code)
+        timed_run(warm, env, code)  # the steady state (see contact_sim_warm_again)
         out: dict = {"warm": [], "bare": []}
         for i in range(pairs):
             for k in (("warm", "bare") if i % 2 == 0 else ("bare", "warm")):
                 cmd = warm if k == "warm" else [sys.executable, str(BARE)]
-                out[k].append(_run(cmd, env, code)[:2])
+                out[k].append(timed_run(cmd, env, code)[:2])
     return out
 
 
 def report_cold(code: Path, scene: str) -> tuple[float, float]:
     """The first ``walkerlab report`` of a fresh runs folder and user cache: (wall, cpu)."""
     with tempfile.TemporaryDirectory() as d:
-        env = _env(code, str(Path(d) / "cache"))
-        return _run(_cli("report", scene, "--runs-dir", str(Path(d) / "runs")), env, code)[:2]
+        env = code_env(code, str(Path(d) / "cache"))
+        cmd = cli_command("report", scene, "--runs-dir", str(Path(d) / "runs"))
+        return timed_run(cmd, env, code)[:2]
 
 
 def robustness(code: Path, scene: str, runs: str) -> tuple[float, float]:
     """``walkerlab robustness --force`` with the fixed point done: (wall, cpu) [s]."""
-    env = _env(code)
-    _run(_cli("fixedpoint", scene, "--runs-dir", runs), env, code)
-    return _run(_cli("robustness", scene, "--force", "--runs-dir", runs), env, code)[:2]
+    env = code_env(code)
+    timed_run(cli_command("fixedpoint", scene, "--runs-dir", runs), env, code)
+    return timed_run(cli_command("robustness", scene, "--force", "--runs-dir", runs), env, code)[:2]
 
 
 def child(code: Path, src: str, *args) -> dict:
     """Run ``src`` (:data:`MC_CHILD` or :data:`MESH_CHILD`) in a fresh process; its JSON,
     with ``process_cpu_s``: the CPU [s] of the whole process tree (its workers included)."""
-    _, cpu, out = _run([sys.executable, "-c", src, *map(str, args)], _env(code), code)
+    _, cpu, out = timed_run([sys.executable, "-c", src, *map(str, args)], code_env(code), code)
     return {**json.loads(out.strip().splitlines()[-1]), "process_cpu_s": cpu}
 
 

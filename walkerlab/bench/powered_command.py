@@ -20,7 +20,7 @@ all three alike), with a fresh private user cache and runs folder.  A first run 
 warms the cache (generated code, numba's machine code, the rigid fixed point) and is not
 counted; then ``repeats`` rounds run the three in turn (a shared machine's load falls on all
 alike).  Measured: each process's CPU (user + system of the process tree, its orphans
-reaped and counted: :func:`walkerlab.bench.main_job._run`) and wall time; per case the
+reaped and counted: :func:`walkerlab.bench.process_env.timed_run`) and wall time; per case the
 median over the rounds and the median over the rounds of the ratio to the same round's
 passive run.
 """
@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from walkerlab.bench.main_job import TREE, _cli, _env, _run
+from walkerlab.bench.process_env import TREE, cli_command, code_env, timed_run
 from walkerlab.io.stage_files import CONTACT_SIM
 
 __all__ = ["CASES", "bench_powered_command", "lines"]
@@ -88,17 +88,17 @@ def bench_powered_command(repeats: int = 5, code: Path = TREE) -> dict:
     """
     with tempfile.TemporaryDirectory() as d:
         folder = Path(d)
-        env = _env(code, str(folder / "cache"))
+        env = code_env(code, str(folder / "cache"))
         runs = str(folder / "runs")
         scenes = _scene_files(folder)
-        cmds = {k: _cli(CONTACT_SIM.name, str(p), "--force", "--runs-dir", runs)
+        cmds = {k: cli_command(CONTACT_SIM.name, str(p), "--force", "--runs-dir", runs)
                 for k, p in scenes.items()}
         for cmd in cmds.values():  # warm: generated code, machine code, rigid gait
-            _run(cmd, env, folder)
+            timed_run(cmd, env, folder)
         got = {k: [] for k in cmds}
         for _ in range(repeats):
             for k, cmd in cmds.items():
-                got[k].append(_run(cmd, env, folder)[:2])
+                got[k].append(timed_run(cmd, env, folder)[:2])
     base = np.array([c for _, c in got["paper passive"]])
     out = {"repeats": repeats, "target_ratio": TARGET_RATIO, "cases": {}}
     for k, runs_k in got.items():

@@ -31,7 +31,7 @@ from walkerlab.export.adams_statements import (
     marker_id,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
-from walkerlab.export.opensim_xml import latch_foot_offset
+from walkerlab.export.opensim_contact import latch_foot_offset
 
 __all__ = ["LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK", "knee_latches"]
 
@@ -56,7 +56,7 @@ def knee_latches(mb, ids: dict, ks, start: AdamsStart | None = None) -> list[str
     """The contact model's knee latch (:func:`walkerlab.models.contact.generated._knee`) as
     statements: per leg the contact point's height above the ground [mm]
     (:data:`LATCH_VARIABLES`: the foot sphere's centre above the slope line less
-    :func:`walkerlab.export.opensim_xml.latch_foot_offset`; the lower of a foot's spheres),
+    :func:`walkerlab.export.opensim_contact.latch_foot_offset`; the lower of a foot's spheres),
     the engagement ``w = STEP(h, 0, 1, h_release, 0) STEP(ext, -capture, 0, -capture/2, 1)``
     (the contact model's ``STEP(delta, -h_release, 0, 0, 1)`` in the height ``h = -delta``)
     and an SFORCE (:data:`LATCH_SFORCE`) ``w IMPACT(ext, d ext/dt, 0, k, e, cmax, dmax)`` on

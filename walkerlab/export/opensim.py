@@ -87,6 +87,7 @@ from walkerlab.config.contact import ContactSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.omitted import Omission, xml_comments
+from walkerlab.export.opensim_comments import header_comments
 from walkerlab.export.opensim_contact import (
     hunt_crossley,
     knee_stop_expression,
@@ -99,7 +100,6 @@ from walkerlab.export.opensim_xml import (
     contact_forces,
     contact_geometry_set,
     couplers,
-    header_comments,
     joint_set,
     knee_stop_forces,
     motor_forces,

@@ -4,7 +4,9 @@ re-exports these names): the scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cm
 static penetration), the knee stop's IMPACT law as an ``ExpressionBasedCoordinateForce``'s
 expression clamped to push only (:func:`knee_stop_expression`), and the radius of a
 checkerboard patch's ``ContactSphere`` (:func:`patch_radius`; on stairs and footholds
-:func:`terrain_patch_radius`).  Lengths [m], forces [N].
+:func:`terrain_patch_radius`), and how far a foot sphere's centre stands above the ground
+it touches (:func:`latch_foot_offset`, the knee latch's foot height).  Lengths [m],
+forces [N].
 """
 
 from __future__ import annotations
@@ -131,3 +133,15 @@ def terrain_patch_radius(gait, foot_sphere_m: float) -> float:
     rise = max((abs(a[1] - b[1]) for a, b in zip(falls, falls[1:])), default=0.0)
     d = max(gait.patch_width_m / 2, gait.step_length_m / 3)
     return min(rg, d ** 2 / (2 * (rise + 2 * foot_sphere_m)))
+
+
+def latch_foot_offset(r_foot: float, ground_offset_m: float) -> float:
+    """How far a foot sphere's centre stands above the ground when the sphere touches it
+    [m]: its radius ``r_foot`` less the ground's offset below the slope line
+    ``ground_offset_m`` (a point foot's sphere of radius ``L/1000`` on a ground lowered by
+    that radius: 0, its centre is the model's foot point; an arc foot's sphere of radius
+    ``R`` on the slope line: ``R``, its contact point is the lowest point).  The knee latch's
+    foot height is the centre's height above the slope line less this offset: the contact
+    point's, whose penetration the contact model's latch reads
+    (:func:`walkerlab.models.contact.generated._latch_weight`)."""
+    return float(r_foot) - float(ground_offset_m)

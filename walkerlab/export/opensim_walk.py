@@ -29,7 +29,7 @@ from it; OpenSim has no contact-switched force):
   ground as the contact model reads it (:func:`contact_height`: above the tread of the
   lane's patch under it, or above the slope line; the contact point the sphere's centre
   less the file's offset, an arc foot's radius,
-  :func:`walkerlab.export.opensim_xml.latch_foot_offset`)
+  :func:`walkerlab.export.opensim_contact.latch_foot_offset`)
   (:func:`walkerlab.export.mujoco_walk.latch_rule`, the MJCF's rule);
 - the **push-off** of a powered export (``leg<i>_push_off``, the force ``F = P0 / T`` along
   the leg from foot to hip, ``P0`` the law's ``impulse_n_s``, ``T`` the scene's
@@ -115,7 +115,7 @@ def contact_height(centre, r_foot: float, offset: float, patches, half_width: fl
     where the point is above the lane's highest patch top (the contact model skips the
     patches' lookup there: a foot above every patch touches none).  The contact point lies
     ``offset`` below the foot sphere's centre (the file's latch offset,
-    :func:`walkerlab.export.opensim_xml.latch_foot_offset`: an arc's radius, a point foot's
+    :func:`walkerlab.export.opensim_contact.latch_foot_offset`: an arc's radius, a point foot's
     0), a patch's tread ``r_foot - offset`` above its sphere's top (the ground's offset below
     the treads).
 

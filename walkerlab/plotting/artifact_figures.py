@@ -77,8 +77,8 @@ def save_bifurcation_figure(data: dict, walker_model: str, scene_name: str,
 
 
 def save_gait_map_figure(data, folder: Path | str, stem: str) -> list[Path]:
-    """Stability map of the contact gait (:func:`walkerlab.plotting.sweep_figures.gait_map_figure`)
-    as ``<stem>.png/.svg``.
+    """Stability map of the contact gait
+    (:func:`walkerlab.plotting.gait_map_figure.gait_map_figure`) as ``<stem>.png/.svg``.
 
     Parameters
     ----------
@@ -86,6 +86,6 @@ def save_gait_map_figure(data, folder: Path | str, stem: str) -> list[Path]:
         A loaded ``stability_map_<kind>.h5``.
     """
     from walkerlab.plotting.figures import save  # light
-    from walkerlab.plotting.sweep_figures import gait_map_figure  # light
+    from walkerlab.plotting.gait_map_figure import gait_map_figure  # light
 
     return save(gait_map_figure(data), Path(folder), stem)

@@ -16,11 +16,10 @@ from types import ModuleType
 import numpy as np
 
 from walkerlab.io.stage_files import CONTACT_SIM, SIMULATE
+from walkerlab.report.ground_text import ground_contact_text, twist_text
 from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import (
-    ground_contact_text,
     neutral_multipliers_text,
-    twist_text,
     zero_dynamics_text,
     zero_multipliers_text,
 )

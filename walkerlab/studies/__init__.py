@@ -1,6 +1,7 @@
 """Parameter sweeps over any dotted scene field, bifurcation diagrams, contact stability maps.
 
 - :mod:`walkerlab.studies.params`     ``--param`` parsing, grid, per-point scene validation
+- :mod:`walkerlab.studies.scene_paths` dotted fields of a scene mapping: read, set, removed
 - :mod:`walkerlab.studies.outcomes`   typed outcomes and result columns per stage
 - :mod:`walkerlab.studies.points`     point functions (fixedpoint, simulate, contact-sim)
 - :mod:`walkerlab.studies.runner`     chunk planning (continuation), local / Dask executors

@@ -26,9 +26,10 @@ from typing import Any
 from walkerlab.config import MAX_SWEEP_POINTS, Scene, SceneError, scene_from_dict
 from walkerlab.config.contact import CONTACT_QUANTITIES, renamed_contact_field
 from walkerlab.io.stage_files import CONTACT_SIM
+from walkerlab.studies.scene_paths import list_item, pop_dotted, set_dotted
 
 __all__ = ["SweepError", "ParamAxis", "parse_param", "grid_points", "apply_point",
-           "check_axes", "axis_unit", "list_item", "params_hash", "EXCLUSIVE_FIELDS"]
+           "check_axes", "axis_unit", "params_hash", "EXCLUSIVE_FIELDS"]
 
 
 class SweepError(ValueError):
@@ -172,66 +173,6 @@ def grid_points(axes: list[ParamAxis]) -> list[tuple]:
     list of tuple, length ``prod(len(axis))``
     """
     return list(itertools.product(*(a.values for a in axes)))
-
-
-def list_item(items: list, key: str, path: str):
-    """The item of a scene list (e.g. ``walker.leg.bodies``) named ``key`` (its ``name``
-    field) or at index ``key``.
-
-    Raises
-    ------
-    SceneError
-        No such item (the message lists the names and the index range).
-    """
-    names = [it.get("name") for it in items if isinstance(it, dict)]
-    named = ", ".join(str(n) for n in names if n is not None)
-    if key.isdigit():
-        if int(key) < len(items):
-            return items[int(key)]
-        raise SceneError(f"{path}: index {key} is out of range (the list has {len(items)} "
-                         + (f"items, indices 0-{len(items) - 1}" if items else "items")
-                         + (f": {named})" if named else ")"))
-    hits = [it for it in items if isinstance(it, dict) and it.get("name") == key]
-    if len(hits) == 1:
-        return hits[0]
-    close = difflib.get_close_matches(key, [str(n) for n in names], 1)
-    raise SceneError(f"{path}: no item named {key!r}"
-                     + (f" (did you mean {close[0]!r}?)" if close else "")
-                     + f"; items: {named or 'none named'} "
-                     f"(or by index 0-{max(len(items) - 1, 0)})")
-
-
-def _set_dotted(d: dict, path: str, value) -> None:
-    keys = path.split(".")
-    node = d
-    for k in keys[:-1]:
-        if isinstance(node, list):
-            node = list_item(node, k, path)
-            continue
-        nxt = node.get(k)
-        if nxt is None:
-            nxt = node[k] = {}
-        elif not isinstance(nxt, (dict, list)):
-            raise SceneError(f"{path}: '{k}' is not a section (it is {nxt!r})")
-        node = nxt
-    if isinstance(node, list) and keys[-1].isdigit() and int(keys[-1]) < len(node) \
-            and not isinstance(node[int(keys[-1])], dict):  # one number of a list of them
-        node[int(keys[-1])] = value
-        return
-    if isinstance(node, list):
-        raise SceneError(f"{path}: '{keys[-1]}' is a list item, not a field: name the item's "
-                         f"field ({path}.mass_kg, ...)")
-    node[keys[-1]] = value
-
-
-def _pop_dotted(d: dict, path: str) -> None:
-    keys = path.split(".")
-    node = d
-    for k in keys[:-1]:
-        node = node.get(k)
-        if not isinstance(node, dict):
-            return
-    node.pop(keys[-1], None)
 
 
 def _models_in(annotation) -> list:
@@ -394,8 +335,8 @@ def apply_point(base: dict, paths: list[str], values: tuple, origin: str = "<swe
     for p, v in zip(paths, values):
         other = EXCLUSIVE_FIELDS.get(p)
         if other is not None:
-            _pop_dotted(d, other)
-        _set_dotted(d, p, v)
+            pop_dotted(d, other)
+        set_dotted(d, p, v)
     label = ", ".join(f"{p}={v!r}" for p, v in zip(paths, values))
     return scene_from_dict(d, f"{origin} [{label}]")
 

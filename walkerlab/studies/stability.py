@@ -16,7 +16,7 @@ exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``time_limit``,
 the periodic-gait search has no section for this walker), ``wall_time_s``.
 
 The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
-:func:`walkerlab.plotting.sweep_figures.gait_map_figure`.
+:func:`walkerlab.plotting.gait_map_figure.gait_map_figure`.
 """
 
 from __future__ import annotations

@@ -18,7 +18,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from typing import Any
 
 import numpy as np
 
@@ -26,37 +25,18 @@ import walkerlab
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import code_hash
 from walkerlab.studies.params import ParamAxis, grid_points
-
-
-def _dotted_get(d: dict, path: str):
-    """Value at a dotted path of a scene mapping (list items by name or index); None if
-    absent."""
-    from walkerlab.config import SceneError
-    from walkerlab.studies.params import list_item
-
-    node: Any = d
-    for k in path.split("."):
-        if isinstance(node, list):
-            try:
-                node = list_item(node, k, path)
-            except SceneError:
-                return None
-            continue
-        if not isinstance(node, dict) or k not in node:
-            return None
-        node = node[k]
-    return node
+from walkerlab.studies.scene_paths import get_dotted
 
 
 def base_value(base: dict, path: str):
     """The value of a dotted field in a scene dump ``base`` (the slope in either unit:
     ``slope.angle_deg`` of a scene given in radians, and the other way round); None if
     absent."""
-    v = _dotted_get(base, path)
-    if v is None and path == "slope.angle_deg" and _dotted_get(base, "slope.angle_rad") is not None:
-        v = math.degrees(_dotted_get(base, "slope.angle_rad"))
-    if v is None and path == "slope.angle_rad" and _dotted_get(base, "slope.angle_deg") is not None:
-        v = math.radians(_dotted_get(base, "slope.angle_deg"))
+    v = get_dotted(base, path)
+    if v is None and path == "slope.angle_deg" and get_dotted(base, "slope.angle_rad") is not None:
+        v = math.degrees(get_dotted(base, "slope.angle_rad"))
+    if v is None and path == "slope.angle_rad" and get_dotted(base, "slope.angle_deg") is not None:
+        v = math.radians(get_dotted(base, "slope.angle_deg"))
     return v
 
 

@@ -10,8 +10,9 @@ five-link biped) add one spline for laws sharing a table
 own mass matrices (:mod:`walkerlab.models.hybrid.mode_torques`) or an ankle push-off
 (:mod:`walkerlab.models.hybrid.ankle_push_off`).  Each kind's way is its part, reached
 through the walker's kind (``_PARTS``); what a kind cannot carry is refused by its row of
-:data:`walkerlab.walker.kinds.CAPABILITIES`.  Those modules import the shared
-actuators from :mod:`walkerlab.models.hybrid.actuators`, never this one.
+:data:`walkerlab.walker.kinds.CAPABILITIES`, what the legs' masses cannot carry by
+:mod:`walkerlab.models.hybrid.leg_masses`.  Those modules import the shared actuators from
+:mod:`walkerlab.models.hybrid.actuators`, never this one.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 from walkerlab.models.actuation import refuse_actuators, torque_feature
 from walkerlab.models.hybrid.actuators import Actuators, torque_chain_jacobian
 from walkerlab.models.hybrid.base import HybridWalker, Phase
+from walkerlab.models.hybrid.leg_masses import check_impact_masses, massless_limit
 from walkerlab.numerics import complex_step_jacobian
 
 __all__ = ["compiled_with", "Actuators", "actuate", "refuse_actuators",
@@ -39,57 +41,6 @@ def spec_of(acts):
     """The actuation section ``acts`` drives (a virtual-constraint controller's: the scene's
     ``walker.actuation``)."""
     return getattr(acts, "vc_spec", acts.spec)
-
-
-def _structure_check(data, spec) -> bool:
-    """Refuse what is physically impossible (one line); True for massless legs.  A joint
-    the walker does not have is refused by :func:`walkerlab.models.hybrid.actuators.
-    joint_links` (naming the joints it has), an ankle push-off by the kind
-    (:meth:`_Joints.actuate`)."""
-    st = data.structure
-    massless = [b.massless for b in st.bodies]
-    # Kuo's limit: massless legs on a point hip mass.  Legs with some massless bodies, or
-    # massless legs under a torso (which the legs' angles move): the force in the massless
-    # limit's rows (Actuators.link_rows, which refuses a torque across a link whose
-    # bodies are all massless)
-    limit = bool(massless) and all(massless) and not st.torso
-    if limit and not st.hip_mass:
-        raise ValueError("walker.actuation: massless legs without a hip mass or a torso "
-                         "have no mass at all (no equations of motion to drive): give "
-                         "walker.hip_mass_kg > 0")
-    if limit and st.foot != "point" and spec.push_off is not None:
-        raise ValueError("walker.actuation.push_off: on massless legs the push-off's limit "
-                         "m -> 0 is Kuo's point foot; an arc's depends on where its mass "
-                         "sits: give the legs mass")
-    for i, t in enumerate(spec.torques):
-        if limit and t.scaled_by != "foot_mass":
-            raise ValueError(f"walker.actuation.torques.{i}.scaled_by: the legs are massless "
-                             "(a torque on them needs infinite acceleration): give the torque "
-                             "per foot mass, scaled_by: foot_mass (Kuo 2002)")
-        if limit and t.joint != "hip":
-            raise ValueError(f"walker.actuation.torques.{i}.joint: the legs are massless: a "
-                             "torque per foot mass acts at the hip only (joint: hip)")
-        if not limit and t.scaled_by != "none":
-            raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
-                             "massless legs on a hip mass (Kuo 2002; no torso), where the "
-                             "legs' rows are divided by the vanishing mass")
-    return limit
-
-
-def _massive_impact_check(acts) -> None:
-    """Legs with some massless bodies and a push-off: the extended impact needs every
-    link to carry mass (``De`` regular).  A leg link that moves no mass (its bodies
-    massless or at the hip; massless legs under a torso) takes any velocity at no cost:
-    the impulses leave it undetermined, and only a limiting rule fixes it (Kuo 2002's
-    point hip: the trailing foot keeps no velocity across its leg) (one line)."""
-    q = np.linspace(0.1, 0.3, acts.n)
-    w = np.linalg.eigvalsh(np.real(np.asarray(acts.fns["impact_matrices"](q)[0], float)))
-    if w[0] <= 1e-10 * w[-1]:
-        raise ValueError("walker.actuation.push_off: a leg link moves no mass (its bodies "
-                         "are massless or at the hip), so the impulses leave its velocity "
-                         "undetermined; give the leg mass, or describe the walker as "
-                         "massless legs on a hip mass without a torso (Kuo's point-hip "
-                         "push-off)")
 
 
 def spring_equivalent(data, spec):
@@ -290,16 +241,16 @@ class _Joints:
 
     def actuators(self, walker: HybridWalker, data, spec):
         """``(acts, limit)``: the actuators and whether the legs are massless (Kuo's
-        limit, :func:`_structure_check`)."""
+        limit, :func:`walkerlab.models.hybrid.leg_masses.massless_limit`)."""
         from walkerlab.codegen.cache import functions
 
-        limit = _structure_check(data, spec)
+        limit = massless_limit(data, spec)
         acts = Actuators(spec, functions(data), len(walker.roles), limit,
                          float(walker.total_mass_kg),
                          some_massless=any(b.massless for b in data.structure.bodies))
         self.hold(acts, walker)
         if spec.push_off is not None and acts.rows is not None:
-            _massive_impact_check(acts)
+            check_impact_masses(acts)
         return acts, limit
 
     def hold(self, acts, walker: HybridWalker) -> None:

@@ -62,7 +62,7 @@ def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkAc
     """
     from walkerlab.codegen.cache import functions
 
-    if spec.ankle_push_off is not None:  # point feet (as actuated._structure_check says)
+    if spec.ankle_push_off is not None:  # point feet (as leg_masses.massless_limit says)
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
     if spec.push_off is not None and not push_off:

@@ -56,14 +56,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.codegen.floating import (
-    FREE_3D,
-    ROLES_3D,
-    contact_names,
-    coordinate_names,
-    floating_params,
-    floating_plain,
-)
+from walkerlab.codegen.floating import FREE_3D, ROLES_3D, floating_plain
+from walkerlab.models.hybrid.floating_view import FloatingView
 from walkerlab.walker.layout import StateLayout, floating_links_from_rigid
 
 __all__ = ["StanceReaction", "TransitionImpulses"]
@@ -109,45 +103,6 @@ def _part(kind) -> _Part:
     """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): its
     rigid model's, planar or 3D."""
     return _PARTS[kind.rigid]
-
-
-class _View:
-    """The generated floating module's kernels (:mod:`walkerlab.codegen.floating`: ``dyn``,
-    ``feet``, ``feet_jac``) run as the plain Python they are generated from
-    (:func:`~walkerlab.codegen.floating.floating_plain`): a check of a few hundred states
-    loads no numba and compiles nothing."""
-
-    def __init__(self, data):
-        mod = floating_plain(data.structure)  # raises for a massless body
-        self.params = np.asarray(floating_params(data), float)
-        self.nq, self.dim = int(mod["NQ"]), int(mod["DIM"])
-        self.names = contact_names(data.structure)
-        self.coordinates = coordinate_names(data.structure)
-        self._dyn, self._feet, self._feet_jac = mod["dyn"], mod["feet"], mod["feet_jac"]
-
-    def _x(self, q, dq=None) -> np.ndarray:
-        return np.concatenate([q, np.zeros(self.nq) if dq is None else dq])
-
-    def dynamics(self, q, dq) -> tuple[np.ndarray, np.ndarray]:
-        """``M(q)`` (nq, nq) and ``h(q, dq)`` (nq,)."""
-        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
-        self._dyn(self._x(q, dq), self.params, M, h)
-        return M, h
-
-    def contact_points(self, q, dq=None):
-        """Contact points (nf, d) [m], material velocities (nf, d) [m/s], Jacobians
-        (nf, d, nq) (``d`` 2 in the plane, 3 in 3D: world axes)."""
-        nf, d = len(self.names), self.dim
-        P, V, J = np.empty((nf, d)), np.empty((nf, d)), np.empty((nf, d, self.nq))
-        self._feet(self._x(q, dq), self.params, P, V, J)
-        return P, V, J
-
-    def velocity_gradient(self, q, dq) -> np.ndarray:
-        """``d V_i / dq`` (nf, d, nq) at fixed rates: ``(dV/dq) dq = Jdot dq``."""
-        nf, d = len(self.names), self.dim
-        dV, dJtF = np.empty((nf, d, self.nq)), np.empty((self.nq, self.nq))
-        self._feet_jac(self._x(q, dq), np.zeros((nf, d)), self.params, dV, dJtF)
-        return dV
 
 
 @dataclass(frozen=True)
@@ -230,7 +185,7 @@ class StanceReaction:
                 self.normal, self.tangent = np.append(self.normal, 0.0), None
                 self._up_g = np.array([0.0, self.g, 0.0])
             return
-        self.view = _View(data)
+        self.view = FloatingView(data)
         coords = tuple(self.view.coordinates)
         self._feet = {r: self.view.names.index(f) for r, f in _FOOT_OF_ROLE.items()}
         if self.view.dim == 3:  # free at the stance foot: its slides, its heading, the roles
