@@ -134,8 +134,8 @@ def _lane_entry(v, lane, cache: dict):
 #: what a common period reads of each walker (its view, its environment), in C
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
                    "x", "ledger", "_log", "steps", "foot")
-_ENV = attrgetter("_elapsed", "dt", "_hip_x")
-_FIRST, _THIRD = itemgetter(0), itemgetter(2)
+_ENV = attrgetter("_elapsed", "dt", "_hip_x", "terrain_seed")
+_FIRST, _THIRD, _FOURTH = itemgetter(0), itemgetter(2), itemgetter(3)
 _WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [J])
 
 
@@ -210,9 +210,11 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
     lanes = list(map(_FIRST, entries))
+    elapsed = []
     for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
                                           env_read):
-        e._elapsed = er[0] + 1  # (begin_periods, open_period, next_piece)
+        e._elapsed = k = er[0] + 1  # (begin_periods, open_period, next_piece)
+        elapsed.append(k)
         per = (u, t_end)  # (u a float64 row, t_end a float)
         v._period = per
         r[10].append(per)
@@ -224,6 +226,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     batch = _batch(cache, key, entries, lanes, walkers, views)
     out = _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache)
     which, te, Yev, Y, cap, Yn, call = out
+    env_cols = (elapsed, list(map(_FOURTH, env_read)))  # (counts and terrain seeds)
     settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
     X = list(Yev)
     if not slow:
@@ -243,10 +246,13 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
                 else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
                            Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
-                           batch[6])
+                           batch[6], env_cols)
+    # (the data rows as they are now: the batch's own array is written again next period,
+    # a guard crossing's dense output may read them later)
+    out = (*out[:6], (*call[:3], call[3].copy(), *call[4:]))
     strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
     cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
-    return end_periods(envs, U, strikes, x_before, w_before, p, views)
+    return end_periods(envs, U, strikes, x_before, w_before, p, views, env_cols=env_cols)
 
 
 def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out) -> list:
@@ -277,13 +283,14 @@ def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
 def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) -> tuple:
     """What a common period of these lanes reads every period, made once and kept by the
     lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed, maps,
-    origins)`` - the walkers' data rows stacked (:func:`_flow_row`) and their step clocks,
+    origins, held)`` - the walkers' data rows stacked (:func:`_flow_row`) and their step clocks,
     whether each row takes its torques and clock as columns, the kernel's compiled
     functions and tolerances, its guard tables, whether the walkers share one ``points``
     function, the observations' stance-leg and phase columns (N, 2), each walker's joints'
     map with whether every walker has one (:func:`~walkerlab.gym.rigid_rows._joint_map`:
     kept in the walker, for the lane's actuators), and the flows' actuators
-    (:func:`_origins`).  Made of each walker's own part (:func:`_part`, kept by its lane
+    (:func:`_origins`), and the kernel's data rows of these walkers as last written
+    (:func:`_integrate`: ``[D, step clocks written]``, empty until then).  Made of each walker's own part (:func:`_part`, kept by its lane
     entry's id: the walkers falling out of step with each other make many sets of lanes,
     each walker few lanes)."""
     fid = tuple(map(id, entries))
@@ -306,7 +313,7 @@ def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) 
             all(f is points[0] for f in points),
             np.array(fixed),
             (list(maps), all(M is not None for M in maps)),
-            _origins(list(acts)))
+            _origins(list(acts)), [])
     return out
 
 
@@ -345,11 +352,15 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
     acts = batch[8]
     origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]] if acts[0] is None
                else list(map(float, map(_T_ORIGIN, acts[1]))))
-    if same:
-        D = base.copy()
+    if same:  # (the batch's data rows: this period's torques and clocks written in)
+        held = batch[9]
+        if not held:
+            held += [base.copy(), clocks]
+        D = held[0]
         D[:, entries[0][4][1]] = U
-        if origins != clocks:
+        if origins != held[1]:
             D[:, entries[0][4][2]] = origins
+            held[1] = origins
     else:  # (the law blocks written, as next_piece writes them, and read back)
         for v, lane, u in zip(views, lanes, rows_u):
             _hold(v, lane[6], u)

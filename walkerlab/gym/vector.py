@@ -170,6 +170,9 @@ class WalkerVectorEnv(VectorEnv):
         self._rewards = np.zeros(n, dtype=np.float64)
         self._terminations = np.zeros(n, dtype=np.bool_)
         self._truncations = np.zeros(n, dtype=np.bool_)
+        #: the four arrays above were returned by the last ``step`` (the caller's now):
+        #: copied before this class writes into them (:meth:`_own`)
+        self._lent = False
         self._autoreset_envs = np.zeros(n, dtype=np.bool_)
         self._every = np.ones(n, dtype=np.bool_)  # (every walker stepped; read only)
         self._every.flags.writeable = False
@@ -179,6 +182,9 @@ class WalkerVectorEnv(VectorEnv):
         self._most = 0
         #: every row and sub-environment (a step of all of them)
         self._all = (np.arange(n), list(self.envs))
+        #: every sub-environment's walker (``env.sim``), kept until :meth:`set_attr` or
+        #: :meth:`call` may have changed them (None: read again)
+        self._views: list | None = None
         self._has_reset = False
         self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
@@ -189,10 +195,22 @@ class WalkerVectorEnv(VectorEnv):
 
     def __getstate__(self) -> dict:
         """Its attributes for a copy or a pickle, without what its common periods keep of
-        its walkers (by their objects' ids: the copy's walkers are its own)."""
+        its walkers (by their objects' ids: the copy's walkers are its own) nor its list
+        of them (read again)."""
         state = self.__dict__.copy()
         state["_common"] = {}
+        state["_views"] = None
         return state
+
+    def _own(self) -> None:
+        """The observations, rewards and flags this class writes into its own again: the
+        arrays the last :meth:`step` returned (the caller's, not written after) copied."""
+        if self._lent:
+            self._lent = False
+            self._observations = self._observations.copy()
+            self._rewards = self._rewards.copy()
+            self._terminations = self._terminations.copy()
+            self._truncations = self._truncations.copy()
 
     # ------------------------------------------------------------------ the physics
     def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
@@ -233,6 +251,7 @@ class WalkerVectorEnv(VectorEnv):
             idx = np.flatnonzero(mask)
             envs = [self.envs[i] for i in idx]
         if not self.batched or self.envs[0].view != "rigid":
+            self._own()
             dicts = []
             for i, env in zip(idx, envs):
                 (self._observations[i], self._rewards[i], self._terminations[i],
@@ -248,6 +267,7 @@ class WalkerVectorEnv(VectorEnv):
             advance_rows = compile_notice(advance_rows)
         p = self._batch_parameters()
         if p is None:  # each walker's own begin and end of its period
+            self._own()
             begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
             strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
                                    [env.period_end_s for env in envs])
@@ -258,7 +278,12 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         whole = idx.size == self.num_envs
-        views = [env.sim for env in envs]
+        if whole:  # (every walker's view, kept)
+            views = self._views
+            if views is None:
+                views = self._views = [env.sim for env in envs]
+        else:
+            views = [env.sim for env in envs]
         if not whole:  # (the stepped walkers' parameters, kept per set of rows)
             some = p.setdefault("some", {})
             rows = idx.tobytes()
@@ -282,7 +307,9 @@ class WalkerVectorEnv(VectorEnv):
         if whole:  # (new arrays of this step's: kept as they are)
             self._observations, self._rewards = obs, reward
             self._terminations, self._truncations = term, trunc
+            self._lent = False
         else:
+            self._own()
             self._observations[idx] = obs
             self._rewards[idx] = reward
             self._terminations[idx] = term
@@ -308,6 +335,7 @@ class WalkerVectorEnv(VectorEnv):
         """Reset sub-environment ``i`` (its row of the observations, its time limit's
         count; not its reward and flags); returns its info."""
         obs, info = self.envs[i].reset(seed=seed, options=options)
+        self._own()
         self._observations[i] = obs
         self._elapsed[i] = 0
         return info
@@ -396,6 +424,7 @@ class WalkerVectorEnv(VectorEnv):
         infos: dict = {}
         for i in np.flatnonzero(mask):
             infos = self._add_info(infos, self._reset_one(int(i), seeds[i], options), int(i))
+        self._own()
         self._terminations[mask] = self._truncations[mask] = False
         self._autoreset_envs[mask] = False
         self._has_reset = True
@@ -434,6 +463,7 @@ class WalkerVectorEnv(VectorEnv):
         stepped = (self._step_all(a, stepping, not some_reset)
                    if not some_reset or stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
+        self._own()  # (no copy after a step of every walker: its arrays are new)
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
             self._most += 1  # (a bound on the counts: none can be at the limit below it)
             if some_reset:
@@ -464,8 +494,11 @@ class WalkerVectorEnv(VectorEnv):
         else:
             infos = LazyInfos(lambda: self._batched_infos(stepped, resets))
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
-        return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
-                self._truncations.copy(), infos)
+        # the arrays themselves, lent: the caller's from now on (:meth:`_own` copies them
+        # before this class writes into them again; a step of every walker makes new ones)
+        self._lent = True
+        return (self._observations, self._rewards, self._terminations, self._truncations,
+                infos)
 
     def _info_dicts(self, stepped: dict, resets: dict) -> list[dict]:
         """Every sub-environment's info as a dict (N): the stepped ones' (:meth:`_step_all`'s
@@ -530,6 +563,7 @@ class WalkerVectorEnv(VectorEnv):
         """``getattr(env, name)(*args, **kwargs)`` on each walker (the attribute itself
         when not callable), as a tuple of N."""
         self._params = False  # (a method may change what the batched step reads)
+        self._views = None
         out = []
         for env in self.envs:
             f = getattr(env, name)
@@ -554,6 +588,7 @@ class WalkerVectorEnv(VectorEnv):
         if len(values) != self.num_envs:
             raise ValueError(f"set_attr: {len(values)} values for num_envs={self.num_envs}")
         self._params = False  # read again by the next batched step
+        self._views = None
         for env, v in zip(self.envs, values, strict=True):
             setattr(env, name, v)
 
