@@ -237,7 +237,9 @@ class RigidView:
 
     def _start_step(self) -> None:
         self._step_start = (self.t, self.x.copy(), dict(self.ledger))
-        self._log = [self._period]  # the control periods of this step
+        # the control periods of this step (on a height profile, whose step may be walked
+        # again: :meth:`_again`; else the first alone)
+        self._log = [self._period]
         self._pieces: list = []  # on a profile: the step's dense output, piece by piece
         self._enter()
 
@@ -375,9 +377,11 @@ class RigidView:
 
     def open_period(self, u: np.ndarray, t_end: float) -> None:
         """A control period to ``t_end`` [s] with the torques ``u`` (k,) [N m] begins: kept
-        with the step's periods (a profile's step walked again replays them)."""
+        with the step's periods on a height profile (whose step walked again replays
+        them: :meth:`_again`)."""
         self._period = (np.asarray(u, dtype=float), float(t_end))
-        self._log.append(self._period)
+        if self.ground is not None:  # (read only where the step is walked again)
+            self._log.append(self._period)
 
     def _again(self, j: int) -> list[float]:
         """Walk the present step again from its start on a profile's segment ``j`` (the

@@ -133,7 +133,7 @@ def _lane_entry(v, lane, cache: dict):
 
 #: what a common period reads of each walker (its view, its environment), in C
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
-                   "x", "ledger", "_log", "steps", "foot")
+                   "x", "ledger", "steps", "foot")
 _ENV = attrgetter("_elapsed", "dt", "_hip_x", "terrain_seed")
 _FIRST, _THIRD, _FOURTH = itemgetter(0), itemgetter(2), itemgetter(3)
 _WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [J])
@@ -141,13 +141,16 @@ _WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [
 
 def _common(envs, views, cache: dict):
     """What a common period reads of the walkers, in one pass, before anything changes:
-    ``(key, entries, read, caps, stops, t_ends, env_read)`` (the flow key they share; each
-    walker's lane entry (:func:`_lane_entry`), what is read of its view (:data:`_VIEW`),
-    its piece's span [s] and end [s], its period's end [s]
+    ``(key, entries, read, caps, stops, t_ends, env_read, stall)`` (the flow key they
+    share; each walker's lane entry (:func:`_lane_entry`), what is read of its view
+    (:data:`_VIEW`), its piece's span [s] and end [s], its period's end [s]
     (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of its
-    environment (:data:`_ENV`)); None when the period is not common."""
+    environment (:data:`_ENV`); whether some walker's piece ends at its step's time limit
+    (``t_step + max_step_time <= t_end``: settled there, it stalls)); None when the period
+    is not common."""
     lanes_kept = cache.get("lanes") or {}
     key = None
+    stall = False
     entries, caps, stops, t_ends = [], [], [], []
     read = list(map(_VIEW, views))
     env_read = list(map(_ENV, envs))
@@ -165,13 +168,15 @@ def _common(envs, views, cache: dict):
         elif key is None:  # (the first walker's lane: one the common period cannot run)
             return None
         t_stop = got[6] + got[7]  # (next_piece's end of the piece: t_step + max_step_time)
+        if t_stop <= t_end:  # (RigidView.settle's stall: t_stop >= t_step + max_step_time)
+            stall = True
         if not t_stop < t_end:
             t_stop = t_end
         entries.append(en)
         caps.append(t_stop - t)
         stops.append(t_stop)
         t_ends.append(t_end)
-    return key, entries, read, caps, stops, t_ends, env_read
+    return key, entries, read, caps, stops, t_ends, env_read, stall
 
 
 def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
@@ -206,20 +211,18 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     got = _common(envs, views, cache)
     if got is None:
         return None
-    key, entries, read, caps, stops, t_ends, env_read = got
+    key, entries, read, caps, stops, t_ends, env_read, stall = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
     lanes = list(map(_FIRST, entries))
     elapsed = []
-    for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
-                                          env_read):
+    for e, v, lane, u, t_end, er in zip(envs, views, lanes, rows_u, t_ends, env_read):
         e._elapsed = k = er[0] + 1  # (begin_periods, open_period, next_piece)
         elapsed.append(k)
         per = (u, t_end)  # (u a float64 row, t_end a float)
-        v._period = per
-        r[10].append(per)
+        v._period = per  # (its step's log: a profile's alone, never common)
         lane[3].u = u
-    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
+    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, steps, feet) = zip(*read)
     x_before = list(map(_THIRD, env_read))  # (the reward's origins, before the period)
     w_before = list(map(_WORK, ledgers))
     on = list(map(any, U.tolist()))
@@ -229,7 +232,12 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     env_cols = (elapsed, list(map(_FOURTH, env_read)))  # (counts and terrain seeds)
     settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
     X = list(Yev)
-    if not slow:
+    if not slow and not stall:  # (RigidView.settle: no walker at its step's time limit)
+        for v, x, t_stop in zip(views, X, stops):
+            v.t = t_stop
+            v.x = x
+        ended = [""] * len(views)
+    elif not slow:
         ended = []
         for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
             v.t, v.x = t_stop, x  # (RigidView.settle)
@@ -238,6 +246,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
                 ended.append("stall")
             else:
                 ended.append("")
+    if not slow:
         cache["X"] = (Yev, X)
         # the hips' x: one call of the walkers' one points function on the states as
         # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
