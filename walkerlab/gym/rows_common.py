@@ -7,9 +7,10 @@ asking each walker for its piece (:meth:`~walkerlab.gym.rigid_view.RigidView.nex
 grouping the pieces by flow, writing each walker's held torques into its law block and
 reading the law blocks back into the kernel's data rows, around
 :func:`~walkerlab.gym.batch.begin_periods` and :func:`~walkerlab.gym.batch.end_periods`, which
-read the walkers again.  In a common period every walker is where its last period left it -
-the same step walker, phase and stance leg, its compiled phase and flow key known (kept in
-the walker: ``RigidView._lane``, ``row_keys``), all of one flow - so that work is the same
+read the walkers again.  In a common period every walker is in a compiled phase whose flow
+key is known (kept in the walker: ``RigidView._lane``, ``row_keys``; a walker whose step
+walker, phase or stance leg is not its lane's - a reset walker - has its lane made first, as
+``next_piece`` makes it as a period begins), all of one flow - so that work is the same
 every period.  Here the walkers are read once (``operator.attrgetter``, one C call per
 walker), the kernel's data rows are each walker's flow's row made once
 (:func:`_flow_row`, checked against ``data_rows``) stacked per set of lanes with this
@@ -25,9 +26,9 @@ crossing, a failed step) absorbed by their walkers as
 rows, states, data and caps, and the same element-wise operations, so the same numbers bit
 for bit as each walker's own period (``gym.make``'s environment is
 :func:`~walkerlab.gym.rigid_rows.advance_rows` on one walker).  A period that is not common
-(a walker in a new step or phase, one whose episode ended, a height profile, a fall guard
-checked at a phase's entry, walkers of several flows) is left to the general step, nothing
-changed.  Nothing here knows a walker's size: the states' width is the flow key's, the
+(a walker whose episode ended, a phase whose flow key is not made yet, a height profile, a
+fall guard checked at a phase's entry, walkers of several flows) is left to the general
+step, nothing changed but the walkers' lanes made current.  Nothing here knows a walker's size: the states' width is the flow key's, the
 torques' the action's.
 """
 
@@ -157,9 +158,13 @@ def _common(envs, views, cache: dict):
     for r, (got, er) in enumerate(zip(read, env_read)):
         lane, t = got[0], got[5]
         t_end = (er[0] + 1) * er[1]
-        if (lane is None or lane[0] is not got[1] or lane[1] != got[2]
-                or lane[2] != got[3] or got[4] or not t < t_end):
+        if got[4] or not t < t_end:
             return None
+        if lane is None or lane[0] is not got[1] or lane[1] != got[2] or lane[2] != got[3]:
+            # a walker in another step or phase than its lane's (a reset walker, most
+            # often): its lane made as next_piece makes it as the period begins
+            v = views[r]
+            lane = v._lane = v._lane_of(got[1])
         en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
         if en[1] is not key:
             if key is not None or en[1] is None:  # (walkers of several flows; a lane the
