@@ -28,8 +28,8 @@ for bit as each walker's own period (``gym.make``'s environment is
 :func:`~walkerlab.gym.rigid_rows.advance_rows` on one walker).  A period that is not common
 (a walker whose episode ended, a phase whose flow key is not made yet, a height profile, a
 fall guard checked at a phase's entry, walkers of several flows) is left to the general
-step, nothing changed but the walkers' lanes made current.  Nothing here knows a walker's size: the states' width is the flow key's, the
-torques' the action's.
+step, nothing changed but the walkers' lanes made current.  Nothing here knows a walker's
+size: the states' width is the flow key's, the torques' the action's.
 """
 
 from __future__ import annotations
@@ -103,6 +103,9 @@ def _flow_row(flow, acts) -> tuple:
 #: most entries of a vector env's caches (:func:`step_common`'s ``cache``; cleared when
 #: full)
 KEPT = 256
+#: most sets of lanes whose batch (:func:`_batch`) a vector env keeps (cleared when full:
+#: 8 walkers each on either stance leg make 256 sets)
+BATCHES_KEPT = 4096
 
 
 def _lane_entry(v, lane, cache: dict):
@@ -164,7 +167,7 @@ def _common(envs, views, cache: dict):
             # a walker in another step or phase than its lane's (a reset walker, most
             # often): its lane made as next_piece makes it as the period begins
             v = views[r]
-            lane = v._lane = v._lane_of(got[1])
+            lane = v._lane = v.lane_at(got[1])
         en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
         if en[1] is not key:
             if key is not None or en[1] is None:  # (walkers of several flows; a lane the
@@ -297,21 +300,26 @@ def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
 def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) -> tuple:
     """What a common period of these lanes reads every period, made once and kept by the
     lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed, maps,
-    origins, held)`` - the walkers' data rows stacked (:func:`_flow_row`) and their step clocks,
-    whether each row takes its torques and clock as columns, the kernel's compiled
-    functions and tolerances, its guard tables, whether the walkers share one ``points``
-    function, the observations' stance-leg and phase columns (N, 2), each walker's joints'
-    map with whether every walker has one (:func:`~walkerlab.gym.rigid_rows._joint_map`:
-    kept in the walker, for the lane's actuators), and the flows' actuators
-    (:func:`_origins`), and the kernel's data rows of these walkers as last written
-    (:func:`_integrate`: ``[D, step clocks written]``, empty until then).  Made of each walker's own part (:func:`_part`, kept by its lane
-    entry's id: the walkers falling out of step with each other make many sets of lanes,
-    each walker few lanes)."""
+    origins, held, entries)`` - the walkers' data rows stacked (:func:`_flow_row`) and
+    their step clocks, whether each row takes its torques and clock as columns, the
+    kernel's compiled functions and tolerances, its guard tables, whether the walkers share
+    one ``points`` function, the observations' stance-leg and phase columns (N, 2), each
+    walker's joints' map with whether every walker has one
+    (:func:`~walkerlab.gym.rigid_rows._joint_map`: kept in the walker, for the lane's
+    actuators), the flows' actuators (:func:`_origins`), the kernel's data rows of these
+    walkers as last written (:func:`_integrate`: ``[D, step clocks written]``, empty until
+    then), and the lane entries themselves (their ids, the key, stay theirs while it
+    lives).  Made of each walker's own part (:func:`_part`, kept by its lane entry's id:
+    the walkers falling out of step with each other make many sets of lanes, each walker
+    few lanes: up to :data:`BATCHES_KEPT` sets kept)."""
     fid = tuple(map(id, entries))
-    out = cache.get(fid)
+    batches = cache.get("batches")
+    if batches is None:
+        batches = cache["batches"] = {}
+    out = batches.get(fid)
     if out is None:
-        if len(cache) >= KEPT:
-            cache.clear()
+        if len(batches) >= BATCHES_KEPT:
+            batches.clear()
         got = cache.get("parts")
         if got is None or len(got) >= KEPT:
             got = cache["parts"] = {}
@@ -319,7 +327,7 @@ def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) 
                  for i, en, v, lane in zip(fid, entries, views, lanes)]
         rows, clocks, oks, points, fixed, maps, acts, _ = zip(*parts)
         first = entries[0][4][1:3]
-        out = cache[fid] = (
+        out = batches[fid] = (
             np.concatenate(rows), list(clocks),
             all(ok and en[4][1:3] == first for ok, en in zip(oks, entries)),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
@@ -327,7 +335,7 @@ def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) 
             all(f is points[0] for f in points),
             np.array(fixed),
             (list(maps), all(M is not None for M in maps)),
-            _origins(list(acts)), [])
+            _origins(list(acts)), [], tuple(entries))
     return out
 
 
