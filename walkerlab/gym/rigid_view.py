@@ -155,9 +155,7 @@ class RigidView:
         self._compiled: dict = {}
         #: :meth:`next_piece`'s memo of the present walker, phase and leg (:meth:`_lane_of`)
         self._lane: tuple | None = None
-        #: every lane made, by its walker's id, phase and leg (:meth:`lane_at`: the same
-        #: lane again when a walker comes back to them, as each step's walker does)
-        self._lanes: dict = {}
+        self._lanes: dict = {}  # every lane made, by walker, phase and leg (lane_at)
         #: ``(compiled phase, torques' bytes)``: what its law block holds, as last written
         self._held: tuple = (None, b"")
         #: what a compiled phase shares with other walkers' in a batched step
@@ -243,9 +241,7 @@ class RigidView:
 
     def _start_step(self) -> None:
         self._step_start = (self.t, self.x.copy(), dict(self.ledger))
-        # the control periods of this step (on a height profile, whose step may be walked
-        # again: :meth:`_again`; else the first alone)
-        self._log = [self._period]
+        self._log = [self._period]  # this step's periods (kept on a profile: _again)
         self._pieces: list = []  # on a profile: the step's dense output, piece by piece
         self._enter()
 
@@ -383,8 +379,7 @@ class RigidView:
 
     def open_period(self, u: np.ndarray, t_end: float) -> None:
         """A control period to ``t_end`` [s] with the torques ``u`` (k,) [N m] begins: kept
-        with the step's periods on a height profile (whose step walked again replays
-        them: :meth:`_again`)."""
+        with the step's periods on a height profile (replayed by :meth:`_again`)."""
         self._period = (np.asarray(u, dtype=float), float(t_end))
         if self.ground is not None:  # (read only where the step is walked again)
             self._log.append(self._period)
