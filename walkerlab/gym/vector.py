@@ -170,21 +170,19 @@ class WalkerVectorEnv(VectorEnv):
         self._rewards = np.zeros(n, dtype=np.float64)
         self._terminations = np.zeros(n, dtype=np.bool_)
         self._truncations = np.zeros(n, dtype=np.bool_)
-        #: the four arrays above were returned by the last ``step`` (the caller's now):
-        #: copied before this class writes into them (:meth:`_own`)
-        self._lent = False
+        self._lent = False  # (the four above: the last step's, lent to the caller: _own)
         self._autoreset_envs = np.zeros(n, dtype=np.bool_)
         self._every = np.ones(n, dtype=np.bool_)  # (every walker stepped; read only)
         self._every.flags.writeable = False
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
-        #: at least the largest of ``_elapsed`` (a reset only lowers a count)
+        #: steps of every walker not yet added to ``_elapsed`` (:meth:`_counts`)
+        self._pending = 0
+        #: at least the largest of the counts (a reset only lowers a count)
         self._most = 0
         #: every row and sub-environment (a step of all of them)
         self._all = (np.arange(n), list(self.envs))
-        #: every sub-environment's walker (``env.sim``), kept until :meth:`set_attr` or
-        #: :meth:`call` may have changed them (None: read again)
-        self._views: list | None = None
+        self._views: list | None = None  # (each env.sim; None after set_attr or call)
         self._has_reset = False
         self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
@@ -194,9 +192,8 @@ class WalkerVectorEnv(VectorEnv):
         self._common: dict = {}
 
     def __getstate__(self) -> dict:
-        """Its attributes for a copy or a pickle, without what its common periods keep of
-        its walkers (by their objects' ids: the copy's walkers are its own) nor its list
-        of them (read again)."""
+        """Its attributes for a copy or a pickle, without what it keeps of its walkers (by
+        their objects' ids, or a list of them: the copy's walkers are its own)."""
         state = self.__dict__.copy()
         state["_common"] = {}
         state["_views"] = None
@@ -207,8 +204,7 @@ class WalkerVectorEnv(VectorEnv):
         arrays the last :meth:`step` returned (the caller's, not written after) copied."""
         if self._lent:
             self._lent = False
-            self._observations = self._observations.copy()
-            self._rewards = self._rewards.copy()
+            self._observations, self._rewards = self._observations.copy(), self._rewards.copy()
             self._terminations = self._terminations.copy()
             self._truncations = self._truncations.copy()
 
@@ -278,12 +274,10 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         whole = idx.size == self.num_envs
+        views = (self._views if whole and self._views is not None
+                 else [env.sim for env in envs])
         if whole:  # (every walker's view, kept)
-            views = self._views
-            if views is None:
-                views = self._views = [env.sim for env in envs]
-        else:
-            views = [env.sim for env in envs]
+            self._views = views
         if not whole:  # (the stepped walkers' parameters, kept per set of rows)
             some = p.setdefault("some", {})
             rows = idx.tobytes()
@@ -337,8 +331,15 @@ class WalkerVectorEnv(VectorEnv):
         obs, info = self.envs[i].reset(seed=seed, options=options)
         self._own()
         self._observations[i] = obs
-        self._elapsed[i] = 0
+        self._counts()[i] = 0
         return info
+
+    def _counts(self) -> np.ndarray:
+        """The control periods since each sub-environment's reset (N,), all counted."""
+        if self._pending:
+            self._elapsed += self._pending
+            self._pending = 0
+        return self._elapsed
 
     # ------------------------------------------------------------------ checks
     def _actions(self, actions) -> np.ndarray:
@@ -434,7 +435,7 @@ class WalkerVectorEnv(VectorEnv):
         """Hold ``actions[i]`` (k,) on walker ``i`` for one control period (a walker whose
         episode ended is reset instead, as ``autoreset_mode`` says); returns
         ``(observations (N, m), rewards (N,), terminations (N,), truncations (N,),
-        infos)``.
+        infos)``, arrays the environment does not write into again (the caller's).
 
         Raises
         ------
@@ -467,13 +468,15 @@ class WalkerVectorEnv(VectorEnv):
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
             self._most += 1  # (a bound on the counts: none can be at the limit below it)
             if some_reset:
-                self._elapsed[stepping] += 1
-                self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
-            else:  # (every walker stepped)
-                self._elapsed += 1
+                elapsed = self._counts()
+                elapsed[stepping] += 1
+                self._truncations |= stepping & (elapsed >= self.max_episode_steps)
+            else:  # (every walker stepped: counted at once when read)
+                self._pending += 1
                 if self._most >= self.max_episode_steps:
-                    self._truncations |= self._elapsed >= self.max_episode_steps
-                    self._most = int(self._elapsed.max())
+                    elapsed = self._counts()
+                    self._truncations |= elapsed >= self.max_episode_steps
+                    self._most = int(elapsed.max())
         resets: dict = {}
         for i in np.flatnonzero(resetting).tolist() if some_reset else ():  # NEXT_STEP: the
             resets[i] = self._reset_one(i, None, None)  # reset is the outcome
@@ -494,9 +497,7 @@ class WalkerVectorEnv(VectorEnv):
         else:
             infos = LazyInfos(lambda: self._batched_infos(stepped, resets))
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
-        # the arrays themselves, lent: the caller's from now on (:meth:`_own` copies them
-        # before this class writes into them again; a step of every walker makes new ones)
-        self._lent = True
+        self._lent = True  # (the arrays themselves: the caller's; _own copies them first)
         return (self._observations, self._rewards, self._terminations, self._truncations,
                 infos)
 
