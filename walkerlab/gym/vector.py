@@ -170,7 +170,6 @@ class WalkerVectorEnv(VectorEnv):
         self._rewards = np.zeros(n, dtype=np.float64)
         self._terminations = np.zeros(n, dtype=np.bool_)
         self._truncations = np.zeros(n, dtype=np.bool_)
-        self._lent = False  # (the four above: the last step's, lent to the caller: _own)
         self._autoreset_envs = np.zeros(n, dtype=np.bool_)
         self._every = np.ones(n, dtype=np.bool_)  # (every walker stepped; read only)
         self._every.flags.writeable = False
@@ -198,15 +197,6 @@ class WalkerVectorEnv(VectorEnv):
         state["_common"] = {}
         state["_views"] = None
         return state
-
-    def _own(self) -> None:
-        """The observations, rewards and flags this class writes into its own again: the
-        arrays the last :meth:`step` returned (the caller's, not written after) copied."""
-        if self._lent:
-            self._lent = False
-            self._observations, self._rewards = self._observations.copy(), self._rewards.copy()
-            self._terminations = self._terminations.copy()
-            self._truncations = self._truncations.copy()
 
     # ------------------------------------------------------------------ the physics
     def _step_all(self, actions: np.ndarray, mask: np.ndarray, every: bool = False) -> dict:
@@ -247,7 +237,6 @@ class WalkerVectorEnv(VectorEnv):
             idx = np.flatnonzero(mask)
             envs = [self.envs[i] for i in idx]
         if not self.batched or self.envs[0].view != "rigid":
-            self._own()
             dicts = []
             for i, env in zip(idx, envs):
                 (self._observations[i], self._rewards[i], self._terminations[i],
@@ -263,7 +252,6 @@ class WalkerVectorEnv(VectorEnv):
             advance_rows = compile_notice(advance_rows)
         p = self._batch_parameters()
         if p is None:  # each walker's own begin and end of its period
-            self._own()
             begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
             strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
                                    [env.period_end_s for env in envs])
@@ -301,9 +289,7 @@ class WalkerVectorEnv(VectorEnv):
         if whole:  # (new arrays of this step's: kept as they are)
             self._observations, self._rewards = obs, reward
             self._terminations, self._truncations = term, trunc
-            self._lent = False
         else:
-            self._own()
             self._observations[idx] = obs
             self._rewards[idx] = reward
             self._terminations[idx] = term
@@ -329,7 +315,6 @@ class WalkerVectorEnv(VectorEnv):
         """Reset sub-environment ``i`` (its row of the observations, its time limit's
         count; not its reward and flags); returns its info."""
         obs, info = self.envs[i].reset(seed=seed, options=options)
-        self._own()
         self._observations[i] = obs
         self._counts()[i] = 0
         return info
@@ -425,7 +410,6 @@ class WalkerVectorEnv(VectorEnv):
         infos: dict = {}
         for i in np.flatnonzero(mask):
             infos = self._add_info(infos, self._reset_one(int(i), seeds[i], options), int(i))
-        self._own()
         self._terminations[mask] = self._truncations[mask] = False
         self._autoreset_envs[mask] = False
         self._has_reset = True
@@ -435,7 +419,8 @@ class WalkerVectorEnv(VectorEnv):
         """Hold ``actions[i]`` (k,) on walker ``i`` for one control period (a walker whose
         episode ended is reset instead, as ``autoreset_mode`` says); returns
         ``(observations (N, m), rewards (N,), terminations (N,), truncations (N,),
-        infos)``, arrays the environment does not write into again (the caller's).
+        infos)``, copies (the caller's to keep or change, as gymnasium's vector
+        environments return them by default).
 
         Raises
         ------
@@ -464,7 +449,6 @@ class WalkerVectorEnv(VectorEnv):
         stepped = (self._step_all(a, stepping, not some_reset)
                    if not some_reset or stepping.any()
                    else {"rows": np.zeros(0, np.int64), "dicts": []})
-        self._own()  # (no copy after a step of every walker: its arrays are new)
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
             self._most += 1  # (a bound on the counts: none can be at the limit below it)
             if some_reset:
@@ -497,9 +481,8 @@ class WalkerVectorEnv(VectorEnv):
         else:
             infos = LazyInfos(lambda: self._batched_infos(stepped, resets))
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
-        self._lent = True  # (the arrays themselves: the caller's; _own copies them first)
-        return (self._observations, self._rewards, self._terminations, self._truncations,
-                infos)
+        return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
+                self._truncations.copy(), infos)
 
     def _info_dicts(self, stepped: dict, resets: dict) -> list[dict]:
         """Every sub-environment's info as a dict (N): the stepped ones' (:meth:`_step_all`'s
