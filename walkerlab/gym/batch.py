@@ -174,7 +174,7 @@ _ENV_READ = attrgetter("_elapsed", "terrain_seed")
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
                 p: dict, views=None, X: np.ndarray | None = None,
                 cols: tuple | None = None, hips: list | None = None,
-                fixed: np.ndarray | None = None) -> tuple:
+                fixed: np.ndarray | None = None, env_cols: tuple | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -203,6 +203,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     fixed : ndarray (N, 2), optional
         The observations' stance-leg and phase columns (leg1's stance as 1.0, the phase's
         index), when the caller has them.
+    env_cols : tuple, optional
+        ``(elapsed, seeds)``: each environment's period count (``_elapsed``, this period
+        counted) and ``terrain_seed``, sequences of N, when the caller has read them.
 
     Returns
     -------
@@ -235,14 +238,16 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         hip = None  # (made of hips when the infos are)
     for e, h in zip(envs, hips):
         e._hip_x = h  # the next period's start (its reward's origin)
-    elapsed, seeds = zip(*map(_ENV_READ, envs))  # (each environment's count and seed)
+    # (each environment's count and seed)
+    elapsed, seeds = zip(*map(_ENV_READ, envs)) if env_cols is None else env_cols
     terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
     fws, healthy, cws, wws, dts, limits = _lists(p)
     if _no_limit(p, limits):  # (no environment's own limit: a vector env's walkers)
-        truncated = [False] * len(terminated)
+        truncated = np.zeros(len(terminated), dtype=np.bool_)
     else:
-        truncated = [not te and lim >= 0 and el >= lim
-                     for te, lim, el in zip(terminated, limits, elapsed)]
+        truncated = np.array([not te and lim >= 0 and el >= lim
+                              for te, lim, el in zip(terminated, limits, elapsed)],
+                             dtype=np.bool_)
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
     sums = list(map(list, map(dict.values, ledgers)))  # (the ledgers' values now)
     # the reward of each walker as its own end_period computes it, on Python floats (the
@@ -279,9 +284,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         out.update({f"ledger_{k}": L[j] for j, k in enumerate(terms)})
         return out
 
-    terminated = np.array(terminated, dtype=np.bool_)
-    truncated = np.array(truncated, dtype=np.bool_)
-    return obs, reward, terminated, truncated, columns
+    return obs, reward, np.array(terminated, dtype=np.bool_), truncated, columns
 
 
 _CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``

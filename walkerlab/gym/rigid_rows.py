@@ -170,35 +170,39 @@ def _kernel_args(key: tuple, fphase) -> tuple:
 #: most entries of :data:`_GUARD_ROWS` (rows' guard numbers in order; cleared when full)
 GUARD_ROWS_KEPT = 4096
 _GUARD_ROWS: dict = {}  # rows' guard numbers (tuple) -> _guard_tables' answer
+#: ``(number of guard sets, tables)``: :func:`_guard_sets`' tables of every set numbered
+#: in :data:`_GUARDS` so far
+_ALL_SETS: list = [0, None]
 
 
 def _guard_tables(guards: list) -> tuple:
     """:func:`walkerlab.integrate.rows_dop853.period_rows`' guard arguments for rows whose
-    phases have the guards numbered ``guards`` (:data:`_GUARDS`): the distinct sets as
-    tables (S, g) (padded), their sizes (S,) and each row's set (N,), kept per rows'
-    numbers (:data:`_GUARD_ROWS`: the kernel only reads them)."""
+    phases have the guards numbered ``guards`` (:data:`_GUARDS`): every set numbered so
+    far as tables (S, g) (padded), their sizes (S,) (:func:`_guard_sets`) and each row's
+    set (N,) (its number), kept per rows' numbers (:data:`_GUARD_ROWS`: the kernel only
+    reads them; rows of any sets in any order share the tables)."""
     key = tuple(guards)
     out = _GUARD_ROWS.get(key)
     if out is None:
         if len(_GUARD_ROWS) >= GUARD_ROWS_KEPT:
             _GUARD_ROWS.clear()
-        out = _GUARD_ROWS[key] = _guard_sets(guards)
+        if _ALL_SETS[0] != len(_GUARDS):  # (sets numbered since: the tables made again)
+            _ALL_SETS[:] = [len(_GUARDS), _guard_sets()]
+        out = _GUARD_ROWS[key] = (*_ALL_SETS[1], np.array(key, np.int64))
     return out
 
 
-def _guard_sets(guards: list) -> tuple:
-    """:func:`_guard_tables`' answer, made."""
-    sets: dict = {}
-    gi = np.array([sets.setdefault(g, len(sets)) for g in guards], np.int64)
-    numbered = {j: g for g, j in _GUARDS.items()}
-    chosen = [numbered[j] for j in sets]
+def _guard_sets() -> tuple:
+    """The guard sets of :data:`_GUARDS` as tables, row ``j`` set number ``j``: its
+    columns, offsets and directions (S, g) (padded with zeros) and sizes (S,)."""
+    chosen = sorted(_GUARDS, key=_GUARDS.__getitem__)
     g = max(len(c) for c, _, _ in chosen)
-    tables = (np.zeros((len(sets), g), np.int64), np.zeros((len(sets), g)),
-              np.zeros((len(sets), g)))
+    tables = (np.zeros((len(chosen), g), np.int64), np.zeros((len(chosen), g)),
+              np.zeros((len(chosen), g)))
     for s, entry in enumerate(chosen):
         for table, values in zip(tables, entry):
             table[s, :len(values)] = values
-    return (*tables, np.array([len(c) for c, _, _ in chosen], np.int64), gi)
+    return (*tables, np.array([len(c) for c, _, _ in chosen], np.int64))
 
 
 #: (rows, states) -> period_rows' node arguments for no nodes (zero-size: never written)

@@ -79,6 +79,9 @@ __all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
 #: kinds' flows gain the generic ``M^-1 B u``
 MODE_TWINS = {"flat": flat_action_walker}
 
+#: most lanes a view keeps (:meth:`RigidView.lane_at`)
+LANES_KEPT = 64
+
 #: the ledger's terms (:mod:`walkerlab.gym.rigid_view` docstring) [J]
 LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_work",
                 "push_off_work", "heel_strike_loss")
@@ -152,6 +155,7 @@ class RigidView:
         self._compiled: dict = {}
         #: :meth:`next_piece`'s memo of the present walker, phase and leg (:meth:`_lane_of`)
         self._lane: tuple | None = None
+        self._lanes: dict = {}  # every lane made, by walker, phase and leg (lane_at)
         #: ``(compiled phase, torques' bytes)``: what its law block holds, as last written
         self._held: tuple = (None, b"")
         #: what a compiled phase shares with other walkers' in a batched step
@@ -237,7 +241,7 @@ class RigidView:
 
     def _start_step(self) -> None:
         self._step_start = (self.t, self.x.copy(), dict(self.ledger))
-        self._log = [self._period]  # the control periods of this step
+        self._log = [self._period]  # this step's periods (kept on a profile: _again)
         self._pieces: list = []  # on a profile: the step's dense output, piece by piece
         self._enter()
 
@@ -375,9 +379,10 @@ class RigidView:
 
     def open_period(self, u: np.ndarray, t_end: float) -> None:
         """A control period to ``t_end`` [s] with the torques ``u`` (k,) [N m] begins: kept
-        with the step's periods (a profile's step walked again replays them)."""
+        with the step's periods on a height profile (replayed by :meth:`_again`)."""
         self._period = (np.asarray(u, dtype=float), float(t_end))
-        self._log.append(self._period)
+        if self.ground is not None:  # (read only where the step is walked again)
+            self._log.append(self._period)
 
     def _again(self, j: int) -> list[float]:
         """Walk the present step again from its start on a profile's segment ``j`` (the
@@ -424,7 +429,7 @@ class RigidView:
         w = self.walker
         lane = self._lane
         if lane is None or lane[0] is not w or lane[1] != self.k or lane[2] != self.leg:
-            lane = self._lane = self._lane_of(w)
+            lane = self._lane = self.lane_at(w)
         _, _, _, acts, phase, falls, fast = lane
         u = acts.u = np.asarray(u, dtype=float)
         act_on = any(u.tolist())
@@ -444,6 +449,18 @@ class RigidView:
                 fast[1][_CONSTANT_0:_CONSTANT_0 + HEAD * u.size:HEAD] = u
                 self._held = (fast, bits)
         return w, acts, act_on, phase, t_stop, fast
+
+    def lane_at(self, w) -> tuple:
+        """:meth:`_lane_of` the step walker ``w`` at the present phase and stance leg, made
+        once (kept by the walker's id, phase and leg, the walker with it: its id stays its
+        own; at most :data:`LANES_KEPT`, cleared when full: a profile's walkers are many)."""
+        key = (id(w), self.k, self.leg)
+        lane = self._lanes.get(key)
+        if lane is None:
+            if len(self._lanes) >= LANES_KEPT:
+                self._lanes.clear()
+            lane = self._lanes[key] = self._lane_of(w)
+        return lane
 
     def _lane_of(self, w) -> tuple:
         """What :meth:`next_piece` reads of the present step walker ``w``, phase and

@@ -7,9 +7,10 @@ asking each walker for its piece (:meth:`~walkerlab.gym.rigid_view.RigidView.nex
 grouping the pieces by flow, writing each walker's held torques into its law block and
 reading the law blocks back into the kernel's data rows, around
 :func:`~walkerlab.gym.batch.begin_periods` and :func:`~walkerlab.gym.batch.end_periods`, which
-read the walkers again.  In a common period every walker is where its last period left it -
-the same step walker, phase and stance leg, its compiled phase and flow key known (kept in
-the walker: ``RigidView._lane``, ``row_keys``), all of one flow - so that work is the same
+read the walkers again.  In a common period every walker is in a compiled phase whose flow
+key is known (kept in the walker: ``RigidView._lane``, ``row_keys``; a walker whose step
+walker, phase or stance leg is not its lane's - a reset walker - has its lane made first, as
+``next_piece`` makes it as a period begins), all of one flow - so that work is the same
 every period.  Here the walkers are read once (``operator.attrgetter``, one C call per
 walker), the kernel's data rows are each walker's flow's row made once
 (:func:`_flow_row`, checked against ``data_rows``) stacked per set of lanes with this
@@ -25,10 +26,10 @@ crossing, a failed step) absorbed by their walkers as
 rows, states, data and caps, and the same element-wise operations, so the same numbers bit
 for bit as each walker's own period (``gym.make``'s environment is
 :func:`~walkerlab.gym.rigid_rows.advance_rows` on one walker).  A period that is not common
-(a walker in a new step or phase, one whose episode ended, a height profile, a fall guard
-checked at a phase's entry, walkers of several flows) is left to the general step, nothing
-changed.  Nothing here knows a walker's size: the states' width is the flow key's, the
-torques' the action's.
+(a walker whose episode ended, a phase whose flow key is not made yet, a height profile, a
+fall guard checked at a phase's entry, walkers of several flows) is left to the general
+step, nothing changed but the walkers' lanes made current.  Nothing here knows a walker's
+size: the states' width is the flow key's, the torques' the action's.
 """
 
 from __future__ import annotations
@@ -102,6 +103,9 @@ def _flow_row(flow, acts) -> tuple:
 #: most entries of a vector env's caches (:func:`step_common`'s ``cache``; cleared when
 #: full)
 KEPT = 256
+#: most sets of lanes whose batch (:func:`_batch`) a vector env keeps (cleared when full:
+#: 8 walkers out of step under random actions meet about 800 sets in 3,000 steps)
+BATCHES_KEPT = 1024
 
 
 def _lane_entry(v, lane, cache: dict):
@@ -133,30 +137,37 @@ def _lane_entry(v, lane, cache: dict):
 
 #: what a common period reads of each walker (its view, its environment), in C
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
-                   "x", "ledger", "_log", "steps", "foot")
-_ENV = attrgetter("_elapsed", "dt", "_hip_x")
-_FIRST, _THIRD = itemgetter(0), itemgetter(2)
+                   "x", "ledger", "steps", "foot")
+_ENV = attrgetter("_elapsed", "dt", "_hip_x", "terrain_seed")
+_FIRST, _THIRD, _FOURTH = itemgetter(0), itemgetter(2), itemgetter(3)
 _WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [J])
 
 
 def _common(envs, views, cache: dict):
     """What a common period reads of the walkers, in one pass, before anything changes:
-    ``(key, entries, read, caps, stops, t_ends, env_read)`` (the flow key they share; each
-    walker's lane entry (:func:`_lane_entry`), what is read of its view (:data:`_VIEW`),
-    its piece's span [s] and end [s], its period's end [s]
+    ``(key, entries, read, caps, stops, t_ends, env_read, stall)`` (the flow key they
+    share; each walker's lane entry (:func:`_lane_entry`), what is read of its view
+    (:data:`_VIEW`), its piece's span [s] and end [s], its period's end [s]
     (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of its
-    environment (:data:`_ENV`)); None when the period is not common."""
+    environment (:data:`_ENV`); whether some walker's piece ends at its step's time limit
+    (``t_step + max_step_time <= t_end``: settled there, it stalls)); None when the period
+    is not common."""
     lanes_kept = cache.get("lanes") or {}
     key = None
+    stall = False
     entries, caps, stops, t_ends = [], [], [], []
     read = list(map(_VIEW, views))
     env_read = list(map(_ENV, envs))
     for r, (got, er) in enumerate(zip(read, env_read)):
         lane, t = got[0], got[5]
         t_end = (er[0] + 1) * er[1]
-        if (lane is None or lane[0] is not got[1] or lane[1] != got[2]
-                or lane[2] != got[3] or got[4] or not t < t_end):
+        if got[4] or not t < t_end:
             return None
+        if lane is None or lane[0] is not got[1] or lane[1] != got[2] or lane[2] != got[3]:
+            # a walker in another step or phase than its lane's (a reset walker, most
+            # often): its lane made as next_piece makes it as the period begins
+            v = views[r]
+            lane = v._lane = v.lane_at(got[1])
         en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
         if en[1] is not key:
             if key is not None or en[1] is None:  # (walkers of several flows; a lane the
@@ -165,13 +176,15 @@ def _common(envs, views, cache: dict):
         elif key is None:  # (the first walker's lane: one the common period cannot run)
             return None
         t_stop = got[6] + got[7]  # (next_piece's end of the piece: t_step + max_step_time)
+        if t_stop <= t_end:  # (RigidView.settle's stall: t_stop >= t_step + max_step_time)
+            stall = True
         if not t_stop < t_end:
             t_stop = t_end
         entries.append(en)
         caps.append(t_stop - t)
         stops.append(t_stop)
         t_ends.append(t_end)
-    return key, entries, read, caps, stops, t_ends, env_read
+    return key, entries, read, caps, stops, t_ends, env_read, stall
 
 
 def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
@@ -206,27 +219,33 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     got = _common(envs, views, cache)
     if got is None:
         return None
-    key, entries, read, caps, stops, t_ends, env_read = got
+    key, entries, read, caps, stops, t_ends, env_read, stall = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
     lanes = list(map(_FIRST, entries))
-    for e, v, lane, u, t_end, r, er in zip(envs, views, lanes, rows_u, t_ends, read,
-                                          env_read):
-        e._elapsed = er[0] + 1  # (begin_periods, open_period, next_piece)
+    elapsed = []
+    for e, v, lane, u, t_end, er in zip(envs, views, lanes, rows_u, t_ends, env_read):
+        e._elapsed = k = er[0] + 1  # (begin_periods, open_period, next_piece)
+        elapsed.append(k)
         per = (u, t_end)  # (u a float64 row, t_end a float)
-        v._period = per
-        r[10].append(per)
+        v._period = per  # (its step's log: a profile's alone, never common)
         lane[3].u = u
-    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, _, steps, feet) = zip(*read)
+    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, steps, feet) = zip(*read)
     x_before = list(map(_THIRD, env_read))  # (the reward's origins, before the period)
     w_before = list(map(_WORK, ledgers))
     on = list(map(any, U.tolist()))
     batch = _batch(cache, key, entries, lanes, walkers, views)
     out = _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache)
     which, te, Yev, Y, cap, Yn, call = out
+    env_cols = (elapsed, list(map(_FOURTH, env_read)))  # (counts and terrain seeds)
     settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
     X = list(Yev)
-    if not slow:
+    if not slow and not stall:  # (RigidView.settle: no walker at its step's time limit)
+        for v, x, t_stop in zip(views, X, stops):
+            v.t = t_stop
+            v.x = x
+        ended = [""] * len(views)
+    elif not slow:
         ended = []
         for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
             v.t, v.x = t_stop, x  # (RigidView.settle)
@@ -235,6 +254,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
                 ended.append("stall")
             else:
                 ended.append("")
+    if not slow:
         cache["X"] = (Yev, X)
         # the hips' x: one call of the walkers' one points function on the states as
         # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
@@ -243,10 +263,13 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
                 else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
                            Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
-                           batch[6])
+                           batch[6], env_cols)
+    # (the data rows as they are now: the batch's own array is written again next period,
+    # a guard crossing's dense output may read them later)
+    out = (*out[:6], (*call[:3], call[3].copy(), *call[4:]))
     strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
     cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
-    return end_periods(envs, U, strikes, x_before, w_before, p, views)
+    return end_periods(envs, U, strikes, x_before, w_before, p, views, env_cols=env_cols)
 
 
 def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out) -> list:
@@ -277,20 +300,26 @@ def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
 def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) -> tuple:
     """What a common period of these lanes reads every period, made once and kept by the
     lanes' ids: ``(base, clocks, same, kernel, guard_tables, one_points, fixed, maps,
-    origins)`` - the walkers' data rows stacked (:func:`_flow_row`) and their step clocks,
-    whether each row takes its torques and clock as columns, the kernel's compiled
-    functions and tolerances, its guard tables, whether the walkers share one ``points``
-    function, the observations' stance-leg and phase columns (N, 2), each walker's joints'
-    map with whether every walker has one (:func:`~walkerlab.gym.rigid_rows._joint_map`:
-    kept in the walker, for the lane's actuators), and the flows' actuators
-    (:func:`_origins`).  Made of each walker's own part (:func:`_part`, kept by its lane
-    entry's id: the walkers falling out of step with each other make many sets of lanes,
-    each walker few lanes)."""
+    origins, held, entries)`` - the walkers' data rows stacked (:func:`_flow_row`) and
+    their step clocks, whether each row takes its torques and clock as columns, the
+    kernel's compiled functions and tolerances, its guard tables, whether the walkers share
+    one ``points`` function, the observations' stance-leg and phase columns (N, 2), each
+    walker's joints' map with whether every walker has one
+    (:func:`~walkerlab.gym.rigid_rows._joint_map`: kept in the walker, for the lane's
+    actuators), the flows' actuators (:func:`_origins`), the kernel's data rows of these
+    walkers as last written (:func:`_integrate`: ``[D, step clocks written]``, empty until
+    then), and the lane entries themselves (their ids, the key, stay theirs while it
+    lives).  Made of each walker's own part (:func:`_part`, kept by its lane entry's id:
+    the walkers falling out of step with each other make many sets of lanes, each walker
+    few lanes: up to :data:`BATCHES_KEPT` sets kept)."""
     fid = tuple(map(id, entries))
-    out = cache.get(fid)
+    batches = cache.get("batches")
+    if batches is None:
+        batches = cache["batches"] = {}
+    out = batches.get(fid)
     if out is None:
-        if len(cache) >= KEPT:
-            cache.clear()
+        if len(batches) >= BATCHES_KEPT:
+            batches.clear()
         got = cache.get("parts")
         if got is None or len(got) >= KEPT:
             got = cache["parts"] = {}
@@ -298,7 +327,7 @@ def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) 
                  for i, en, v, lane in zip(fid, entries, views, lanes)]
         rows, clocks, oks, points, fixed, maps, acts, _ = zip(*parts)
         first = entries[0][4][1:3]
-        out = cache[fid] = (
+        out = batches[fid] = (
             np.concatenate(rows), list(clocks),
             all(ok and en[4][1:3] == first for ok, en in zip(oks, entries)),
             _CFUNCS.get(key) or _kernel_args(key, lanes[0][6][0]),
@@ -306,7 +335,7 @@ def _batch(cache: dict, key: tuple, entries: list, lanes: list, walkers, views) 
             all(f is points[0] for f in points),
             np.array(fixed),
             (list(maps), all(M is not None for M in maps)),
-            _origins(list(acts)))
+            _origins(list(acts)), [], tuple(entries))
     return out
 
 
@@ -345,11 +374,15 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
     acts = batch[8]
     origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]] if acts[0] is None
                else list(map(float, map(_T_ORIGIN, acts[1]))))
-    if same:
-        D = base.copy()
+    if same:  # (the batch's data rows: this period's torques and clocks written in)
+        held = batch[9]
+        if not held:
+            held += [base.copy(), clocks]
+        D = held[0]
         D[:, entries[0][4][1]] = U
-        if origins != clocks:
+        if origins != held[1]:
             D[:, entries[0][4][2]] = origins
+            held[1] = origins
     else:  # (the law blocks written, as next_piece writes them, and read back)
         for v, lane, u in zip(views, lanes, rows_u):
             _hold(v, lane[6], u)

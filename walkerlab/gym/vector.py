@@ -175,10 +175,13 @@ class WalkerVectorEnv(VectorEnv):
         self._every.flags.writeable = False
         #: control periods since each sub-environment's reset (its time limit's count)
         self._elapsed = np.zeros(n, dtype=np.int64)
-        #: at least the largest of ``_elapsed`` (a reset only lowers a count)
+        #: steps of every walker not yet added to ``_elapsed`` (:meth:`_counts`)
+        self._pending = 0
+        #: at least the largest of the counts (a reset only lowers a count)
         self._most = 0
         #: every row and sub-environment (a step of all of them)
         self._all = (np.arange(n), list(self.envs))
+        self._views: list | None = None  # (each env.sim; None after set_attr or call)
         self._has_reset = False
         self._batched_before = False  # a batched step made (the first: compile_notice)
         #: :func:`walkerlab.gym.batch.batch_parameters` of the walkers (False: not yet read)
@@ -188,10 +191,11 @@ class WalkerVectorEnv(VectorEnv):
         self._common: dict = {}
 
     def __getstate__(self) -> dict:
-        """Its attributes for a copy or a pickle, without what its common periods keep of
-        its walkers (by their objects' ids: the copy's walkers are its own)."""
+        """Its attributes for a copy or a pickle, without what it keeps of its walkers (by
+        their objects' ids, or a list of them: the copy's walkers are its own)."""
         state = self.__dict__.copy()
         state["_common"] = {}
+        state["_views"] = None
         return state
 
     # ------------------------------------------------------------------ the physics
@@ -258,7 +262,10 @@ class WalkerVectorEnv(VectorEnv):
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
         whole = idx.size == self.num_envs
-        views = [env.sim for env in envs]
+        views = (self._views if whole and self._views is not None
+                 else [env.sim for env in envs])
+        if whole:  # (every walker's view, kept)
+            self._views = views
         if not whole:  # (the stepped walkers' parameters, kept per set of rows)
             some = p.setdefault("some", {})
             rows = idx.tobytes()
@@ -309,8 +316,15 @@ class WalkerVectorEnv(VectorEnv):
         count; not its reward and flags); returns its info."""
         obs, info = self.envs[i].reset(seed=seed, options=options)
         self._observations[i] = obs
-        self._elapsed[i] = 0
+        self._counts()[i] = 0
         return info
+
+    def _counts(self) -> np.ndarray:
+        """The control periods since each sub-environment's reset (N,), all counted."""
+        if self._pending:
+            self._elapsed += self._pending
+            self._pending = 0
+        return self._elapsed
 
     # ------------------------------------------------------------------ checks
     def _actions(self, actions) -> np.ndarray:
@@ -405,7 +419,8 @@ class WalkerVectorEnv(VectorEnv):
         """Hold ``actions[i]`` (k,) on walker ``i`` for one control period (a walker whose
         episode ended is reset instead, as ``autoreset_mode`` says); returns
         ``(observations (N, m), rewards (N,), terminations (N,), truncations (N,),
-        infos)``.
+        infos)``, copies (the caller's to keep or change, as gymnasium's vector
+        environments return them by default).
 
         Raises
         ------
@@ -437,13 +452,15 @@ class WalkerVectorEnv(VectorEnv):
         if self.max_episode_steps is not None:  # gymnasium's TimeLimit, per walker
             self._most += 1  # (a bound on the counts: none can be at the limit below it)
             if some_reset:
-                self._elapsed[stepping] += 1
-                self._truncations |= stepping & (self._elapsed >= self.max_episode_steps)
-            else:  # (every walker stepped)
-                self._elapsed += 1
+                elapsed = self._counts()
+                elapsed[stepping] += 1
+                self._truncations |= stepping & (elapsed >= self.max_episode_steps)
+            else:  # (every walker stepped: counted at once when read)
+                self._pending += 1
                 if self._most >= self.max_episode_steps:
-                    self._truncations |= self._elapsed >= self.max_episode_steps
-                    self._most = int(self._elapsed.max())
+                    elapsed = self._counts()
+                    self._truncations |= elapsed >= self.max_episode_steps
+                    self._most = int(elapsed.max())
         resets: dict = {}
         for i in np.flatnonzero(resetting).tolist() if some_reset else ():  # NEXT_STEP: the
             resets[i] = self._reset_one(i, None, None)  # reset is the outcome
@@ -530,6 +547,7 @@ class WalkerVectorEnv(VectorEnv):
         """``getattr(env, name)(*args, **kwargs)`` on each walker (the attribute itself
         when not callable), as a tuple of N."""
         self._params = False  # (a method may change what the batched step reads)
+        self._views = None
         out = []
         for env in self.envs:
             f = getattr(env, name)
@@ -554,6 +572,7 @@ class WalkerVectorEnv(VectorEnv):
         if len(values) != self.num_envs:
             raise ValueError(f"set_attr: {len(values)} values for num_envs={self.num_envs}")
         self._params = False  # read again by the next batched step
+        self._views = None
         for env, v in zip(self.envs, values, strict=True):
             setattr(env, name, v)
 
