@@ -794,3 +794,23 @@ def test_native_vector_env_of_8_walkers_is_8_single_envs_bit_for_bit(policy, act
     native.close()
     for env in singles:
         env.close()
+
+
+@pytest.mark.parametrize("batched", [True, False], ids=["batched", "per_walker"])
+def test_a_callers_change_to_a_steps_arrays_does_not_come_back_from_a_partial_reset(batched):
+    """The step's arrays are the caller's (copies): changed in place (an observation
+    normalised in place, say), the walker a reset of the others leaves keeps its row as the
+    environment has it."""
+    env = _native(2, autoreset_mode="Disabled", batched=batched)
+    env.reset(seed=0)
+    zero = np.zeros(env.action_space.shape, np.float32)
+    obs, reward, term, trunc, _ = env.step(zero)
+    kept = obs[1].copy()
+    obs += 1000.0
+    reward += 1000.0
+    again, _ = env.reset(options={"reset_mask": np.array([True, False])})
+    np.testing.assert_array_equal(again[1], kept)
+    assert not np.shares_memory(again, obs)
+    obs2, reward2, *_ = env.step(zero)
+    assert np.all(np.abs(obs2) < 1000.0) and np.all(np.abs(reward2) < 1000.0)
+    env.close()
