@@ -96,8 +96,7 @@ class Part:
 def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Part, ...] = (),
                *, planar: bool = False, swing_legs: tuple[Part, ...] | None = None,
                thigh: str | None = None, hip_mass: bool = True, hip_width: str | float = 0,
-               hip_roll: bool = False,
-               foot_radius: str | None = None,
+               hip_roll: bool = False, foot_radius: str | None = None,
                coordinates: str = "absolute") -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
     or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
@@ -105,40 +104,33 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     on the bisector of the legs by a bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007,
     IEEE Trans. Robotics 23(1)): its pitch from the upward vertical is the mean of the legs'
     pitches (leaning back when the feet are ahead; no coordinate of its own), its roll the
-    pelvis'.  In the plane every joint turns about ``z`` (the pitch joints alone: no roll,
-    no hip width), as the planar derivation (:func:`walkerlab.codegen.symbolic.derive`) has
-    it; a knee (McGeer 1990, "Passive walking with knees") is a pitch joint on the swing
-    leg, the stance leg straight.
+    pelvis'.  In the plane every joint is a pitch about ``z``; a knee (McGeer 1990) is a
+    pitch joint on the swing leg, the stance leg straight.
 
     Parameters
     ----------
     params : tuple of str
-        The parameter names (the generated code's vector, in order); they include ``g, L,
-        gamma, M_hip`` and every name the parts use.
+        The parameter names (the generated code's vector, in order): ``g, L, gamma``,
+        ``M_hip`` and every name the parts use.
     legs, torso : tuple of Part
-        The bodies on each leg (the stance leg's when ``swing_legs`` is given) and on the
-        upper body.
+        Each leg's bodies (the stance leg's, given ``swing_legs``); the upper body's.
     planar : bool
         The walker in the plane: coordinates ``swing, stance`` (a knee: ``swing_thigh,
         swing_shank, stance``), no lean.
     swing_legs : tuple of Part, optional
         The swing leg's bodies when the legs differ (default ``legs``).
     thigh : str or None
-        A knee on the swing leg this far below the hip [m] (a parameter name): the swing
-        leg's ``shank`` parts hang from it; None: straight legs.
+        A knee this far below the swing hip [m] (a name), the ``shank`` parts on it.
     hip_mass : bool
         The pelvis carries ``M_hip`` (else it is massless).
     hip_width : str or float
-        The distance between the hips along the hip axis [m] (a parameter name, or 0; 3D).
+        The hips' distance along the hip axis [m] (a name, or 0; 3D).
     hip_roll : bool
-        The legs hang from the pelvis on roll joints (coordinates ``pelvis_roll,
-        swing_roll``; the pelvis' roll inertia ``I_pelvis``; 3D).
+        The legs on roll joints (3D; ``pelvis_roll, swing_roll``; inertia ``I_pelvis``).
     foot_radius : str or None
-        Round feet: each foot a disc of this radius [m] in its leg's rolled sagittal plane
-        rolling on the slope without slip (its centre ``L - R`` from the hip; the stance
-        disc's centre ``-R (theta_st + gamma)`` along the fall line and ``R`` along the
-        rolled normal from the step's reference point: a slide ``stance_travel``, then the
-        roll, then the pitch about the centre); None: point feet.
+        Round feet: each foot a disc of this radius [m] in its leg's (rolled) sagittal
+        plane rolling without slip, its centre ``L - R`` from the hip (module docstring);
+        None: point feet.
     coordinates : {"absolute", "slope_relative"}
         A planar walker's coordinates: the legs' angles from the vertical, or Garcia et
         al.'s (1998) ``stance`` from the slope's normal and ``hip`` between the legs.
@@ -147,9 +139,9 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     -------
     BodyTree, CoordinateMap
         Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (``swing_shank``, ``torso``), each
-        part ``<link>_<part>``; contacts ``stance_foot`` and ``swing_foot`` (round feet:
-        ``swing_foot_centre``, the swing disc's centre); coordinates ``lean, swing,
-        stance`` (and ``pelvis_roll, swing_roll``), planar as ``planar`` says.
+        part ``<link>_<part>``; contacts ``stance_foot``, ``swing_foot`` (round feet: the
+        disc's centre ``swing_foot_centre``); coordinates as ``planar`` says, 3D ``lean,
+        swing, stance`` (and ``pelvis_roll, swing_roll``).
 
     Raises
     ------
@@ -158,18 +150,11 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     """
     R = foot_radius
     up_leg = "L" if R is None else f"L - {R}"     # from the frame's origin to the hip
-    pitch = (("stance_hip", "revolute", (Z,), ("stance_hip_pitch",)),
-             ("swing_hip", "revolute", (Z,), ("swing_hip_pitch",))) if planar else (
-        ("stance_hip", "universal", (Z, S), ("stance_hip_pitch", "stance_hip_roll")),
-        ("swing_hip", "universal", (S, Z), ("swing_hip_roll", "swing_hip_pitch")))
-    bodies = _stance_foot(R, planar)
-    # each leg's parts hang from its hip (their frames there, the leg's axes)
-    bodies += [Body(f"stance_leg_{p.name}", p.mass, p.inertia_tensor(),
-                    p.com(f"-({p.from_hip})"),
-                    Joint(f"stance_leg_{p.name}_weld", "fixed", "stance_leg", (0, up_leg, 0)))
-               for p in legs]
+    (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = (
+        _PLANAR_HIPS if planar else _HIPS_3D)
     half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
-    (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = pitch
+    # each leg's parts hang from its hip (their frames there, the leg's axes)
+    bodies = _stance_foot(R, planar) + _welded("stance_leg", legs, (0, up_leg, 0))
     bodies.append(Body("pelvis", "M_hip" if hip_mass else 0,
                        diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
                        (0, 0, half),
@@ -177,34 +162,60 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     bodies.append(Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
                        Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
                              swing_names)))
-    swing = legs if swing_legs is None else swing_legs
-    bodies += [Body(f"swing_leg_{p.name}", p.mass, p.inertia_tensor(),
-                    p.com(f"-({p.from_hip})"),
-                    Joint(f"swing_leg_{p.name}_weld", "fixed", "swing_leg"))
-               for p in swing if thigh is None or p.link != "shank"]
-    foot_link, to_foot = "swing_leg", ("-L" if R is None else f"-({up_leg})")
-    if thigh is not None:  # the swing knee, ``thigh`` below the hip; the shank's parts on it
-        bodies.append(Body("swing_shank", 0, ZERO_INERTIA, (0, 0, 0),
-                           Joint("swing_knee", "revolute", "swing_leg", (0, f"-{thigh}", 0),
-                                 (Z,), ("swing_knee",))))
-        bodies += [Body(f"swing_shank_{p.name}", p.mass, p.inertia_tensor(),
-                        p.com(f"-({p.from_hip} - {thigh})"),
-                        Joint(f"swing_shank_{p.name}_weld", "fixed", "swing_shank"))
-                   for p in swing if p.link == "shank"]
-        foot_link = "swing_shank"
-        to_foot = f"-(L - {thigh})" if R is None else f"-({up_leg} - {thigh})"
+    swing_bodies, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh,
+                                         up_leg, R)
+    bodies += swing_bodies
     if torso:
         bodies.append(Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
                            Joint("torso_pitch", "revolute", "pelvis", (0, 0, half), (Z,),
                                  ("torso_pitch",))))
-        bodies += [Body(f"torso_{p.name}", p.mass, p.inertia_tensor(), p.com(p.from_hip),
-                        Joint(f"torso_{p.name}_weld", "fixed", "torso")) for p in torso]
-    swing_end = ContactPoint("swing_foot" if R is None else "swing_foot_centre", foot_link,
-                             (0, to_foot, 0))
+        bodies += _welded("torso", torso, up=True)
     tree = BodyTree(params, Root(), tuple(bodies),
                     (ContactPoint("stance_foot", "stance_leg" if R is None else
                                   "stance_travel", (0, 0, 0)), swing_end))
     return tree, _coordinates(planar, thigh is not None, hip_roll, R, bool(torso), coordinates)
+
+
+#: the hips' joints (name, kind, axes, coordinates), stance then swing: in the plane the
+#: pitch alone, in 3D the pitch and the roll
+_PLANAR_HIPS = (("stance_hip", "revolute", (Z,), ("stance_hip_pitch",)),
+                ("swing_hip", "revolute", (Z,), ("swing_hip_pitch",)))
+_HIPS_3D = (("stance_hip", "universal", (Z, S), ("stance_hip_pitch", "stance_hip_roll")),
+            ("swing_hip", "universal", (S, Z), ("swing_hip_roll", "swing_hip_pitch")))
+
+
+def _welded(link: str, parts: tuple[Part, ...], origin: tuple = (0, 0, 0), *,
+            up: bool = False, below: str | None = None) -> list:
+    """The bodies ``<link>_<part>`` welded to ``link`` at ``origin`` (its frame's hip):
+    each part ``from_hip`` down the link (``up``: up it; ``below``: measured from the hip,
+    on a link whose frame is that far below it)."""
+    def along(p):
+        if up:
+            return p.from_hip
+        return f"-({p.from_hip})" if below is None else f"-({p.from_hip} - {below})"
+    return [Body(f"{link}_{p.name}", p.mass, p.inertia_tensor(), p.com(along(p)),
+                 Joint(f"{link}_{p.name}_weld", "fixed", link,
+                       *((origin,) if origin != (0, 0, 0) else ())))
+            for p in parts]
+
+
+def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str | None
+               ) -> tuple[list, ContactPoint]:
+    """The swing leg's parts (on a knee ``thigh`` below the hip: the thigh's on the leg, the
+    shank's on the shank) and its foot's contact point (a round foot's centre)."""
+    to_foot = "-L" if R is None else f"-({up_leg})"
+    on_thigh = [p for p in swing if thigh is None or p.link != "shank"]
+    bodies, foot_link = _welded("swing_leg", tuple(on_thigh)), "swing_leg"
+    if thigh is not None:  # the swing knee, ``thigh`` below the hip; the shank's parts on it
+        bodies.append(Body("swing_shank", 0, ZERO_INERTIA, (0, 0, 0),
+                           Joint("swing_knee", "revolute", "swing_leg", (0, f"-{thigh}", 0),
+                                 (Z,), ("swing_knee",))))
+        bodies += _welded("swing_shank", tuple(p for p in swing if p.link == "shank"),
+                          below=thigh)
+        foot_link = "swing_shank"
+        to_foot = f"-(L - {thigh})" if R is None else f"-({up_leg} - {thigh})"
+    name = "swing_foot" if R is None else "swing_foot_centre"
+    return bodies, ContactPoint(name, foot_link, (0, to_foot, 0))
 
 
 def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
