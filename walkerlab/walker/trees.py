@@ -153,8 +153,7 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = (
         _PLANAR_HIPS if planar else _HIPS_3D)
     half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
-    # each leg's parts hang from its hip (their frames there, the leg's axes)
-    bodies = _stance_foot(R, planar) + _welded("stance_leg", legs, (0, up_leg, 0))
+    bodies = _stance_foot(R, planar) + _welded("stance_leg", legs, (0, up_leg, 0))  # at its hip
     bodies.append(Body("pelvis", "M_hip" if hip_mass else 0,
                        diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
                        (0, 0, half),
