@@ -18,6 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from walkerlab.analysis.contact.footfalls import MAX_RELAYS, own_footfall_lanes, rigid_step_lengths
 from walkerlab.analysis.contact.gait import (
     ContactResult,
     classify,
@@ -33,6 +34,7 @@ from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ContactSetup
+from walkerlab.models.contact.terrain import ground_drops
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
            "rigid_mid_stance", "scene_start", "simulate_contact", "simulate_from",
@@ -290,7 +292,6 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     cs = setup.sim
     lengths = None
     if step_length_m is None and setup.steps_differ:  # the rigid period-n gait's footfalls
-        from walkerlab.analysis.contact.footfalls import rigid_step_lengths
 
         lengths = rigid_step_lengths(setup.scene, setup.model(), x_ideal, setup.plant)
     walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m, lengths)
@@ -368,9 +369,6 @@ def _at_own_footfalls(setup: ContactSetup, walker, res, run):
     (:func:`walkerlab.analysis.contact.footfalls.own_footfall_lanes`), up to
     :data:`~walkerlab.analysis.contact.footfalls.MAX_RELAYS` times while each walks further
     (more heel strikes); the last that did is kept."""
-    from walkerlab.analysis.contact.footfalls import MAX_RELAYS, own_footfall_lanes
-    from walkerlab.models.contact.terrain import ground_drops
-
     period = len(ground_drops(setup.terrain))
     for _ in range(MAX_RELAYS):
         if res.outcome.kind not in _OFF_THE_PATCHES:

@@ -7,12 +7,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.gait.metrics import sample_trajectory, step_table
-from walkerlab.config import Scene
+from walkerlab.analysis.gait.energy import trajectory_ledger
+from walkerlab.analysis.gait.metrics import sample_trajectory, step_table, total_mass_kg
+from walkerlab.analysis.robustness.mfpt import height_rows
+from walkerlab.analysis.robustness.slope_stream import slope_rows
+from walkerlab.config import MAX_SIMULATE_SAMPLES, Scene
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
+from walkerlab.io.schemas.simulate import SimulateRun
 from walkerlab.io.trajectory import NamedTrajectory
+from walkerlab.models.registry import build_walker_on_steps, passive_walker_at
+from walkerlab.walker.kinds import PROFILE_PASSIVE
 
 
 @dataclass
@@ -142,9 +148,6 @@ def simulate_run(scene: Scene, fixed_point, plant):
         integrating when the period is known); an initial state that does not fit the
         walker (one line naming the field).
     """
-    from walkerlab.analysis.gait.metrics import total_mass_kg
-    from walkerlab.config import MAX_SIMULATE_SAMPLES
-    from walkerlab.io.schemas.simulate import SimulateRun
     from walkerlab.models.registry import build_walker
     sim = scene.simulate
     walker = build_walker(scene, plant)
@@ -166,7 +169,6 @@ def simulate_run(scene: Scene, fixed_point, plant):
     if sim.terrain_seed is not None:
         walker = rough_ground_walker(scene, 2 * sim.strides, plant)
     r = simulate_scene(scene, walker, x0, plant)
-    from walkerlab.analysis.gait.energy import trajectory_ledger
 
     return SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
                        total_mass_kg(walker), r.summary, trajectory_ledger(r.trajectory))
@@ -184,9 +186,6 @@ def rough_ground_steps(scene, n_steps: int) -> list[tuple[float, float]]:
     ValueError
         No ``terrain.per_step`` section (one line).
     """
-    from walkerlab.analysis.robustness.mfpt import height_rows
-    from walkerlab.analysis.robustness.slope_stream import slope_rows
-
     per = scene.terrain.per_step if scene.terrain is not None else None
     if per is None:
         raise ValueError("simulate.terrain_seed: the scene has no terrain.per_step (the "
@@ -209,8 +208,6 @@ def rough_ground_walker(scene, n_steps: int, plant):
         As :func:`rough_ground_steps` and
         :func:`walkerlab.models.registry.build_walker_on_steps` (one line).
     """
-    from walkerlab.models.registry import build_walker_on_steps
-
     return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps), plant)
 
 
@@ -251,8 +248,6 @@ def profile_ground(scene, plant):
         line).
     """
     from walkerlab.analysis.gait.profile_walk import ProfileGround, profile_points  # light
-    from walkerlab.models.registry import passive_walker_at
-    from walkerlab.walker.kinds import PROFILE_PASSIVE
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
