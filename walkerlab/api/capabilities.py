@@ -67,7 +67,10 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import scene_from_dict
+from walkerlab.export.adams_reader import read_adm
+from walkerlab.export.scene import flat_foot_bodies
 from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.multibody import multibody
 from walkerlab.walker.reference_cases import reference_scene
 
 __all__ = ["CHECKS", "CONE", "QUANTITIES", "Measurement", "measure"]
@@ -198,7 +201,7 @@ def _rigid(scene, d, runs: Path) -> tuple[float, str, dict]:
     """simulate's steps against the fixed point's, and the fixed point's friction verdict
     where it made one: with the cell's quantity as measured (``quantity``: the friction cone
     named only when its verdict exists; ``not_checked``: why not) and its ``check``."""
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     fp = pipeline.run("fixedpoint", scene, runs).path
     sim = pipeline.run("simulate", scene, runs).path
@@ -306,7 +309,7 @@ def _same_ground(cs_path, slope_scene, runs: Path) -> tuple[float, str, object]:
     their heel-strike times over the walk, relative to the slope walk's mean step period;
     with the slope walk's artifact path."""
     from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     ref = pipeline.run(CONTACT_SIM.name, slope_scene, runs).path
     with _h5(cs_path) as f, _h5(ref) as g:
@@ -330,9 +333,8 @@ def _contact(scene, d, runs: Path) -> tuple[float, str]:
     contact walk on that slope, heel strike by heel strike (:func:`_same_ground`), and the
     rigid walk is the slope's where the rigid view does not walk the profile (flat feet, a
     walker driven by torques: the same ground)."""
-    from walkerlab.config import scene_from_dict
     from walkerlab.io.stage_files import CONTACT_SIM  # light: as the pipeline below
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
     from walkerlab.stages.common import StageError  # light
 
     cs = pipeline.run(CONTACT_SIM.name, scene, runs).path
@@ -412,10 +414,8 @@ def _engine(fmt):
 
 
 def _adams(scene, d, runs: Path) -> tuple[float, str]:
-    from walkerlab.export.adams_reader import read_adm
     from walkerlab.stages import export  # light
     from walkerlab.walker.description import walker_data
-    from walkerlab.walker.multibody import multibody
 
     path = export.write(scene, runs, "adm").path
     model = read_adm(Path(path).read_text())
@@ -430,8 +430,6 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     if data.structure.kind.feet_have_modes and not data.structure.foot_mass:
         # massless flat feet: the dataset's foot PARTs carry the contact model's
         # regularising mass (contact.flat_foot_mass_kg), as it documents
-        from walkerlab.export.scene import flat_foot_bodies
-
         want += sum(f[5] for f in flat_foot_bodies(scene, data))
     dev = abs(total / want - 1.0)
     return dev, f"{len(parts)} parts, {total:.6g} kg against {want:.6g} kg"
@@ -462,7 +460,7 @@ def _urdf(scene, d, runs: Path) -> tuple[float, str]:
 
 def _gym(scene, d, runs: Path) -> tuple[float, str]:
     from walkerlab.gym.env import WalkerEnv  # light
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     sim = pipeline.run("simulate", scene, runs).path
     with _h5(sim) as s:
@@ -493,7 +491,7 @@ def _gym(scene, d, runs: Path) -> tuple[float, str]:
 
 
 def _optimize(scene, d, runs: Path) -> tuple[float, str]:
-    from walkerlab.stages import pipeline
+    from walkerlab.stages import pipeline  # light
 
     path = pipeline.run("optimize", scene, runs).path
     with _h5(path) as f:
