@@ -12,9 +12,10 @@ import time
 
 import numpy as np
 
-from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.sim import initial_state_from_ideal, scene_start, simulate_contact
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.config.solver import SolverSettings
+from walkerlab.integrate import numbalsoda_backend as lsoda
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.walker.layout import StateIndex
 from walkerlab.walker.plant import Plant
@@ -52,8 +53,6 @@ def rhs_cost(walker: ContactWalker, x: np.ndarray, n: int = 2000) -> dict:
 def _default_methods() -> tuple:
     """odeint, cyrk_bdf, LSODA, BDF, Radau, and numbalsoda when the optional extra is
     installed."""
-    from walkerlab.integrate import numbalsoda_backend as lsoda
-
     return ("odeint", "cyrk_bdf") + (("numbalsoda",) if lsoda.available() else ()) + \
         ("LSODA", "BDF", "Radau")
 
@@ -259,7 +258,6 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
         The scene has no ``contact`` section or a massless body.
     """
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
-    from walkerlab.analysis.contact.sim import scene_start
     from walkerlab.models.contact.scene import contact_setup
 
     plant = Plant.from_scene(scene)  # the bench's scene, described once
