@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.config import Scene
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_statements import (
     LANE_Z,
     MM,
@@ -24,6 +25,9 @@ from walkerlab.export.adams_statements import (
     part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.export.scene import flat_foot_bodies
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.walker.kinds import KINDS
 
 __all__ = ["ADAMS_FEET", "ANKLE_JOINT", "ANKLE_SPRING", "FOOT_FORCES", "FlatFeet",
@@ -79,10 +83,6 @@ class LegEndFeet:
     def start(self, scene: Scene, mb, data, ideal, extra, lanes, heights) -> AdamsStart:
         """The rigid gait's post-impact state as the contact view has it (rates times
         ``contact_sim.initial_rate_scale``); a bisecting torso at the legs' mean angle."""
-        from walkerlab.config.contact import ContactSettings
-        from walkerlab.models.contact.model import ContactWalker
-        from walkerlab.models.contact.rigid_limit import contact_si
-
         c, knee = contact_si(scene.contact or ContactSettings())
         scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
         walker = ContactWalker(contact=c, data=data, knee_stop=knee)
@@ -143,8 +143,6 @@ class FlatFeet(LegEndFeet):
 
     def scene_feet(self, scene: Scene, data):
         """:func:`walkerlab.export.scene.flat_foot_bodies`."""
-        from walkerlab.export.scene import flat_foot_bodies
-
         return flat_foot_bodies(scene, data)
 
     def start(self, scene: Scene, mb, data, ideal, extra, lanes, heights) -> AdamsStart:

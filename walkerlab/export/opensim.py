@@ -108,8 +108,12 @@ from walkerlab.export.opensim_xml import (
     torque_joints,
 )
 from walkerlab.export.parts import export_part
+from walkerlab.export.scene import SCENE_FEET, mjcf_scene
 from walkerlab.export.text import nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.rigid_limit import contact_si
+from walkerlab.models.contact.scene import ideal_step_length
 from walkerlab.walker.kinds import KINDS
 
 if TYPE_CHECKING:
@@ -256,10 +260,6 @@ def osim_gait(scene: Scene, mb, plant, ideal=None) -> OsimGait:
         No rigid gait.
     """
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
-    from walkerlab.export.scene import SCENE_FEET, mjcf_scene
-    from walkerlab.models.contact.model import ContactWalker
-    from walkerlab.models.contact.rigid_limit import contact_si
-    from walkerlab.models.contact.scene import ideal_step_length
 
     data = plant.data
     settings = scene.contact or ContactSettings()

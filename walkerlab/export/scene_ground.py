@@ -12,8 +12,18 @@ import math
 
 import numpy as np
 
+from walkerlab.analysis.contact.footfalls import rigid_step_lengths
 from walkerlab.config import Scene
 from walkerlab.config.contact import TerrainSettings
+from walkerlab.models.contact.scene import ideal_step_length
+from walkerlab.models.contact.terrain import (
+    check_ground,
+    footfall_heights,
+    footfall_positions,
+    ground_drops,
+    profile_patch_heights,
+    stairs_line,
+)
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -23,8 +33,6 @@ def checkerboard(walker, ideal, terrain: TerrainSettings) -> tuple:
     """The checkerboard's footfalls ``(leg1's, leg2's)`` along the ground [m], before the
     feet's :meth:`footprints`: the keyframe's feet are one step apart, leg2's step (the last
     of the gait's map; stairs, footholds: the footholds' spacing, along the slope)."""
-    from walkerlab.models.contact.scene import ideal_step_length
-
     ell2 = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
@@ -46,13 +54,6 @@ def footfalls_per_step(scene: Scene, walker, x_ideal, terrain: TerrainSettings,
     footfall -1, the last step of the rigid map (``l_{m-1}`` behind, ``d_{m-1} cos(phi)``
     above); leg2's lane holds footfalls 0, 2, ..., leg1's -1, 1, 3, ....  ``plant``: the
     scene's :class:`~walkerlab.walker.plant.Plant` (the stage's)."""
-    from walkerlab.analysis.contact.footfalls import rigid_step_lengths
-    from walkerlab.models.contact.terrain import (
-        footfall_heights,
-        footfall_positions,
-        ground_drops,
-    )
-
     ells = rigid_step_lengths(scene, walker, x_ideal, plant=plant)
     drops = ground_drops(terrain)
     n = EXPORT_STEPS + 1  # footfalls 0 .. EXPORT_STEPS
@@ -78,8 +79,6 @@ def profile_patches(terrain: TerrainSettings, lanes: tuple, ahead_m: float,
     ValueError
         A profile not flat across a patch (one line naming ``terrain.lanes``).
     """
-    from walkerlab.models.contact.terrain import profile_patch_heights
-
     hw = 0.5 * (terrain.patch_width_m + ahead_m)
     return tuple(tuple(float(h) for h in profile_patch_heights(
         terrain, np.asarray(lane, float) + 0.5 * ahead_m, hw, phi)) for lane in lanes)
@@ -129,8 +128,6 @@ def ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
         A ground the contact model does not build (one line,
         :func:`walkerlab.models.contact.terrain.check_ground`).
     """
-    from walkerlab.models.contact.terrain import check_ground, stairs_line
-
     drop = check_ground(terrain) * math.cos(float(walker.phi))
     if terrain.lanes == "checkerboard":
         k = np.arange(EXPORT_STEPS // 2 + 1)
