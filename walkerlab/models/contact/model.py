@@ -46,13 +46,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
 from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainSettings
+from walkerlab.walker.description import WalkerData, compass_gait_structure
+from walkerlab.walker.layout import StateLayout
 
 from .lanes import checkerboard_lanes, flat_foot_numbers, footprint_offsets
 from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
 from .parts import contact_part
 from .readouts import ContactReadouts
+from .rigid_limit import contact_si
 from .states import FOOT_NAMES, STATE_OF_COORDINATE, state_name
+from .terrain import footfall_positions, ground_drops, terrain_ground
 
 __all__ = ["FOOT_NAMES", "FOOT_RATE_ATOL_FACTOR", "ContactWalker", "STATE_OF_COORDINATE",
            "checkerboard_lanes", "compass_gait_data", "flat_foot_numbers", "footprint_offsets",
@@ -72,8 +77,6 @@ FOOT_RATE_ATOL_FACTOR = 100.0
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
     """:class:`~walkerlab.walker.description.WalkerData` of the paper's compass gait (Table 1):
     leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
-    from walkerlab.walker.description import WalkerData, compass_gait_structure
-
     st = compass_gait_structure()
     vals = {"g": g, "L": L, "gamma": phi, "M_hip": MH, "m_mass": m, "d_mass": L - a}
     return WalkerData(st, tuple(float(vals[n]) for n in st.param_names), MH + 2 * m, L, g, phi,
@@ -168,9 +171,7 @@ class ContactWalker(ContactReadouts):
     torsion: float = 0.0
 
     def __post_init__(self):
-        from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
-
-        from .generated import NPC, contact_module
+        from .generated import NPC, contact_module  # light
 
         set_ = object.__setattr__
         if self.data is None:
@@ -240,8 +241,6 @@ class ContactWalker(ContactReadouts):
         """Build from validated settings; ``step_length`` [m] is the ideal gait's step length
         (patch spacing; each lane shifted by the leg's :func:`footprint_offsets`).  ``data``
         (a WalkerData) replaces the compass-gait shorthand."""
-        from .rigid_limit import contact_si
-
         si, knee = contact_si(contact)  # the scene's stiffness family applied
         walker = cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=si, data=data, knee_stop=knee,
                      flat_foot=contact.flat_foot())
@@ -283,8 +282,6 @@ class ContactWalker(ContactReadouts):
             already on a terrain is laid out afresh (its patch heights and polyline are
             replaced, never carried to lanes they do not fit).
         """
-        from .terrain import footfall_positions, ground_drops
-
         if step_lengths is None:
             if not terrain.is_slope and len(ground_drops(terrain)) > 1:
                 raise ValueError("terrain.foothold_heights_m: footholds of several heights "
@@ -305,7 +302,6 @@ class ContactWalker(ContactReadouts):
                                      heights1=None, heights2=None, ground_line=None)
         if terrain.is_slope:
             return walker
-        from .terrain import terrain_ground
 
         return terrain_ground(walker, terrain, n_steps)
 
@@ -382,14 +378,10 @@ class ContactWalker(ContactReadouts):
 
     def layout(self):
         """The floating state layout (:class:`walkerlab.walker.layout.StateLayout`)."""
-        from walkerlab.walker.layout import StateLayout
-
         return StateLayout.floating(self._coords, self.state_names(), self.state_units())
 
     def rigid_layout(self):
         """The layout of the rigid hybrid view of the same walker (its ideal states)."""
-        from walkerlab.walker.layout import StateLayout
-
         return StateLayout.rigid(self.structure.roles)
 
     def leg_angle_states(self, leg: str) -> tuple[str, ...]:

@@ -23,6 +23,7 @@ Jacobian is taken by the complex step as on the straight-legged walkers.
 
 from __future__ import annotations
 
+from walkerlab.codegen.cache import functions
 from walkerlab.models.actuation import shared_phase_table as _shared_phase_table
 from walkerlab.models.hybrid.actuators import Actuators
 
@@ -60,8 +61,6 @@ def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkAc
         A joint the walker does not have (naming the joints it has), a torque per foot mass,
         a push-off the caller does not carry (one line, naming the field).
     """
-    from walkerlab.codegen.cache import functions
-
     if spec.ankle_push_off is not None:  # point feet (as actuated._structure_check says)
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
