@@ -14,10 +14,26 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from walkerlab import progress
+from walkerlab.analysis.gait.poincare import FixedPointNotFound
 from walkerlab.config import Scene
-from walkerlab.io.runpaths import design_stem, stage_artifact
+from walkerlab.io.runpaths import design_stem, figures_dir, stage_artifact
 from walkerlab.io.schemas import optimize as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.optimal.design.search import design_optimize
+from walkerlab.optimal.driver import (
+    check_scene,
+    check_targets,
+    guess_from_targets,
+    no_gait_of_its_own,
+    optimize_scene,
+    stick_figures,
+)
+from walkerlab.optimal.guess import has_target, stairs_targets, target_numbers
+from walkerlab.optimal.virtual_constraints import controller_scene_text, designs_controller
+from walkerlab.plotting.design_figure import save_design_figure
+from walkerlab.plotting.figure_cache import drawn_from, figure_key
+from walkerlab.plotting.optimize_figure import save_optimize_figure
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
@@ -25,6 +41,7 @@ from walkerlab.stages.common import (
     run_cached,
     with_defaults,
 )
+from walkerlab.units import for_scene
 from walkerlab.walker.plant import Plant
 
 #: the sections optimize.h5 depends on (the contact ones: its contact replay)
@@ -45,7 +62,6 @@ def check(scene: Scene, **options) -> None:
         straight legs: :func:`walkerlab.optimal.driver.check_scene`; one line).
     """
     from walkerlab.extras import require
-    from walkerlab.optimal.driver import check_scene
 
     require("casadi", "optimize", "walkerlab optimize")
     check_scene(scene, Plant.from_scene(scene).data)
@@ -64,9 +80,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         defaults (said in one note), a missing ``fixedpoint`` section with its.  A walker
         kind the collocation does not take (the capability table's line).
     """
-    from walkerlab.optimal.driver import check_targets, guess_from_targets, no_gait_of_its_own
-    from walkerlab.optimal.virtual_constraints import designs_controller
-
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
     plant = Plant.from_scene(scene)  # the walker described once, handed down
@@ -90,8 +103,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                               if missing else "optimize: ") + str(exc)) from exc
         return _run_optimum(scene, runs_root, force, None, (), plant)
     if missing:
-        from walkerlab import progress
-
         progress.note(f"optimize: scene '{scene.name}' has no 'optimize' section: its "
                       "defaults (least effort int u^2 dt over 40 intervals, the scene's "
                       "push-off fixed, no targets or limits)")
@@ -109,9 +120,6 @@ def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream,
     optimize_scene` of ``plant``, started from the gait of the artifact ``gait``, or from
     the targets when None), its records built here (:func:`walkerlab.io.schemas.optimize.
     optimize_record`, the energies in the scene's unit)."""
-    from walkerlab.optimal.driver import optimize_scene
-    from walkerlab.units import for_scene
-
     def compute():
         start = (None, None)
         if gait is not None:
@@ -139,7 +147,6 @@ def write_controller_scenes(scene: Scene, artifact: Path) -> list[Path]:
     import os
     import re
 
-    from walkerlab.optimal.virtual_constraints import controller_scene_text
     from walkerlab.safefs import atomic_replace, refuse_link
 
     folder = Path(artifact).parent
@@ -167,8 +174,6 @@ def _run_from_targets(scene: Scene, runs_root, force: bool, plant: Plant) -> Sta
     ground: :func:`walkerlab.optimal.driver.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
     refused at once without them."""
-    from walkerlab.optimal.guess import has_target, stairs_targets, target_numbers
-
     o = stairs_targets(scene)  # on stairs the step is the tread
     try:
         if not has_target(o):
@@ -197,9 +202,6 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
     StageError
         An unknown objective or field, or no gait along the way (one line).
     """
-    from walkerlab.analysis.gait.poincare import FixedPointNotFound
-    from walkerlab.optimal.design.search import design_optimize
-
     require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
 
@@ -227,23 +229,17 @@ def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True,
     drawn from the artifact's result as it is now (the same result, code and matplotlib)
     instead of drawing it again: the figure it would draw (``walkerlab optimize`` rerun on
     a fresh artifact, or recomputed to the same result)."""
-    from walkerlab.io.runpaths import figures_dir
-    from walkerlab.plotting.figure_cache import drawn_from, figure_key
-
     art = stage_artifact(scene, runs_root, "optimize")
     folder = figures_dir(scene, runs_root)
     key = figure_key(art, "optimize")  # stored in the PNG drawn
     if keep_current and not svg and drawn_from(folder / "optimize.png", key):
         (folder / "optimize.svg").unlink(missing_ok=True)  # as a PNG-only draw does
         return [folder / "optimize.png"]
-    from walkerlab.plotting.optimize_figure import save_optimize_figure
 
     d = schema.load(art)
     sticks = None
     # a five-link biped's open-loop step: its stop action
     if d.torque_names != ("hip",) and not d.controllers:
-        from walkerlab.optimal.driver import stick_figures
-
         sticks = stick_figures(Plant.from_scene(scene).data, d)
     return save_optimize_figure(d, scene.name, folder, sticks, svg, key)
 
@@ -253,9 +249,6 @@ def draw_design(scene: Scene, runs_root: Path | str, fields: list[str], objectiv
     """Draw the design optimisation's figure ``<stem>.png`` (PNG + SVG) from its artifact
     ``<stem>.h5`` (``stem``: :func:`walkerlab.io.runpaths.design_stem` of ``fields``,
     ``objective`` and ``maximize``)."""
-    from walkerlab.io.runpaths import figures_dir
-    from walkerlab.plotting.design_figure import save_design_figure
-
     stem = design_stem(list(fields), objective, maximize)
     d = schema.load_design(stage_artifact(scene, runs_root, stem))
     return save_design_figure(d, scene.name, figures_dir(scene, runs_root), stem)
