@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab import progress
 from walkerlab.config import Scene
 from walkerlab.execution.executor import run_each
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH, onset_name, parameter_dim
@@ -43,7 +44,8 @@ from walkerlab.studies.bifurcation_point import (
     scene_at,
 )
 from walkerlab.studies.map_length import study_steps_per_map
-from walkerlab.studies.params import ParamAxis
+from walkerlab.studies.params import ParamAxis, axis_unit, check_axes
+from walkerlab.studies.points import ideal_fixed_point, interleg_angle, on_study_map
 from walkerlab.studies.runner import plan_chunks, sweep_executor
 from walkerlab.walker.plant import Plant
 
@@ -53,8 +55,6 @@ __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
 
 def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH,
        steps_per_map: int = 0) -> tuple[float, np.ndarray]:
-    from walkerlab.studies.points import ideal_fixed_point, on_study_map
-
     scene = scene_at(scene_base, value, path)
     w, res, _s = ideal_fixed_point(scene, guess)
     _w, res = on_study_map(scene, w, res, steps_per_map)  # the study's one map
@@ -243,8 +243,6 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     walkerlab.studies.params.SweepError
         ``param`` names no field of the scene, or a grid value does not validate.
     """
-    from walkerlab.studies.params import axis_unit, check_axes
-
     slopes = np.asarray(slopes_deg, float)
     axis = ParamAxis(param, tuple(float(s) for s in slopes), f"{param}=<bifurcation grid>")
     if param != SLOPE_PATH:
@@ -272,8 +270,6 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
     state; :func:`bifurcation_chunk`), in grid order: the grid of ``axis`` is cut into runs
     (:func:`walkerlab.studies.runner.plan_chunks`) evaluated on
     :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
-    from walkerlab import progress
-
     param, n = axis.path, len(axis.values)
     chunks = plan_chunks([axis], base, workers=max(1, workers))
     tasks = [BifurcationTask(base, tuple(c), n_transient, n_keep, steady_state, param,
@@ -297,7 +293,6 @@ def _diagram_result(scene: Scene, slopes: np.ndarray, rows: list[dict], x: np.nd
     degrees and the attractor period (distinct inter-leg angles among them), the grid
     ``slopes`` of ``param`` [``unit``] and the period-doubling ``onset``."""
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import interleg_angle
 
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
     walker = build_walker(scene, plant=Plant.from_scene(scene))
@@ -366,8 +361,6 @@ def grid_key(scene: Scene, values: list[float], n_transient: int, n_keep: int,
         ``param`` names no field of the scene or a grid value does not validate (one line).
     """
     import json
-
-    from walkerlab.studies.params import axis_unit, check_axes
 
     if param == SLOPE_PATH:
         key = json.dumps({"slopes_deg": values, "n_transient": n_transient, "n_keep": n_keep,

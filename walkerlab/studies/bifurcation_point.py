@@ -18,8 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.analysis.continuation.branch import continue_branch, first_point
+from walkerlab.analysis.continuation.gait_map import MapFailed
 from walkerlab.config import Scene
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
+from walkerlab.studies.continuation import scene_family
+from walkerlab.studies.params import apply_point
 from walkerlab.walker.plant import Plant
 
 
@@ -40,8 +44,6 @@ class BifurcationTask:
 
 def scene_at(base: dict, value: float, path: str = SLOPE_PATH) -> Scene:
     """The base scene with the field at ``path`` set to ``value`` (in the field's unit)."""
-    from walkerlab.studies.params import apply_point
-
     return apply_point(base, [path], (value,), "<bifurcation>")
 
 
@@ -72,10 +74,14 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
     import warnings
 
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.points import PointOutcome, ideal_fixed_point, on_study_map, warm_up
+    from walkerlab.studies.points import (  # light
+        PointOutcome,
+        ideal_fixed_point,
+        on_study_map,
+        warm_up,
+    )
 
     warm_up()
-    from walkerlab.studies.continuation import scene_family
 
     out = []
     guess = prev = fam = None
@@ -178,9 +184,6 @@ def _arclength_step(fam, prev, value: float):
     at 3 kg).  None when there is no previous point or the branch does not reach
     ``value`` (a fold in between): the caller falls back to the root finder.
     """
-    from walkerlab.analysis.continuation.branch import continue_branch, first_point
-    from walkerlab.analysis.continuation.gait_map import MapFailed
-
     if prev is None:
         return None
     v0, q0 = prev

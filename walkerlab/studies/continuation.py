@@ -16,13 +16,25 @@ import math
 
 import numpy as np
 
-from walkerlab.analysis.continuation.branch import ContinuationResult, continuation
+from walkerlab.analysis.continuation.branch import (
+    ContinuationResult,
+    add_gait_measures,
+    continuation,
+)
 from walkerlab.analysis.continuation.gait_map import MapFailed, WalkerFamily
 from walkerlab.analysis.continuation.homotopy import homotopy
 from walkerlab.analysis.continuation.two_parameter import two_parameter
-from walkerlab.config import Scene, SceneError
+from walkerlab.config import Scene, SceneError, load_scene
 from walkerlab.integrate.solver import Solver
-from walkerlab.studies.params import ParamAxis, apply_point, axis_unit, check_axes
+from walkerlab.studies.params import (
+    EXCLUSIVE_FIELDS,
+    ParamAxis,
+    SweepError,
+    apply_point,
+    axis_unit,
+    check_axes,
+    takes_whole_numbers,
+)
 from walkerlab.walker.plant import Plant
 
 __all__ = ["scene_family", "scene_value", "check_continuation", "run_continuation",
@@ -85,8 +97,6 @@ def _finite(value, what: str) -> float:
 
 def _field_range(scene: Scene, opt: str, path, start, stop) -> tuple[float, float]:
     """One field and its range checked (as :func:`check_continuation`)."""
-    from walkerlab.studies.params import SweepError, takes_whole_numbers
-
     if not isinstance(path, str) or not path:
         raise SceneError(f"{opt}: give a dotted numeric scene field (e.g. slope.angle_deg), "
                          f"got {path!r}")
@@ -143,7 +153,6 @@ def check_continuation(scene: Scene, path, start, stop, path2=None, range2=None
     if isinstance(range2, (str, bytes)) or not hasattr(range2, "__len__") or len(range2) != 2:
         raise SceneError(f"--param2 {path2}: range2 must be two numbers (start, stop), "
                          f"got {range2!r}")
-    from walkerlab.studies.params import EXCLUSIVE_FIELDS
 
     if path2 in (path, EXCLUSIVE_FIELDS.get(path)):
         raise SceneError(f"--param2 {path2}: the same field as --param {path}; the "
@@ -185,7 +194,6 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     MapFailed
         No gait at the scene's own value.
     """
-    from walkerlab.analysis.continuation.branch import add_gait_measures
     from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
 
     unit = axis_unit(scene, ParamAxis(path, (), path))
@@ -335,8 +343,6 @@ def known_scene(scene: Scene, known=None) -> Scene | None:
         The file does not load (one line).
     """
     from pathlib import Path
-
-    from walkerlab.config import load_scene
 
     fp = scene.fixedpoint
     if known is None and (fp is None or fp.from_ is None):

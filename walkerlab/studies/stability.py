@@ -27,7 +27,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab import progress as _progress
+from walkerlab.config.contact import CONTACT_QUANTITIES
+from walkerlab.config.options import map_axis_value
+from walkerlab.execution.executor import make_executor, run_each
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.scene import build
+from walkerlab.studies.params import apply_point
 from walkerlab.walker.plant import Plant
 
 __all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
@@ -89,8 +95,6 @@ class MapSpec:
     def y_label(self) -> str:
         """Axis label of the y parameter, with its unit."""
         if self.kind == "stiffness" and self.y_field:
-            from walkerlab.config.contact import CONTACT_QUANTITIES
-
             unit = dict(CONTACT_QUANTITIES["stiffness"].values())[self.y_field]
             return f"contact stiffness k [{unit}]"
         return MAP_KINDS[self.kind][1]
@@ -135,8 +139,6 @@ def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
 
 
 def _cell_scene(base: dict, spec: MapSpec, y: float, slope_deg: float):
-    from walkerlab.studies.params import apply_point
-
     paths, values = ["slope.angle_deg", spec.y_path], [slope_deg, y]
     if spec.kind == "friction":  # keep the paper's ratio mu_d / mu_s = 0.7 / 0.9
         paths.append("contact.mu_dynamic")
@@ -157,9 +159,8 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
     process pool.
     """
     from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
     from walkerlab.config import SceneError
-    from walkerlab.models.contact.scene import build
     from walkerlab.studies.points import PointOutcome, ideal_fixed_point  # light
 
     y = spec.y_values[iy]
@@ -241,7 +242,6 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
     base = scene.model_dump(mode="json")
     ny, nx = len(spec.y_values), len(spec.slopes_deg)
     rows: list = [None] * ny
-    from walkerlab.execution.executor import make_executor, run_each
 
     # pool workers end with this process (SIGKILL, SIGTERM included) and do not inherit its
     # open files (the artifact lock): walkerlab.execution.workers
@@ -285,8 +285,6 @@ def stability_map_run(scene, spec: MapSpec, workers: int = 2,
     """
     import math
 
-    from walkerlab import progress as _progress
-    from walkerlab.config.options import map_axis_value
     from walkerlab.io.schemas.stability_map import StabilityMapRun  # light
 
     ny = len(spec.y_values)

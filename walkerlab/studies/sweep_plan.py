@@ -25,14 +25,13 @@ import numpy as np
 import walkerlab
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import code_hash
-from walkerlab.studies.params import ParamAxis, grid_points
+from walkerlab.studies.params import ParamAxis, grid_points, list_item
 
 
 def _dotted_get(d: dict, path: str):
     """Value at a dotted path of a scene mapping (list items by name or index); None if
     absent."""
     from walkerlab.config import SceneError
-    from walkerlab.studies.params import list_item
 
     node: Any = d
     for k in path.split("."):
