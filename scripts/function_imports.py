@@ -279,7 +279,8 @@ SKIP = {
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--light", type=Path, required=True,
-                    help="JSON list of light paths, each the list of modules it loads")
+                    help="JSON list of light paths, each the list of walkerlab modules it "
+                         "loads (measured and written there when the file is absent)")
     ap.add_argument("--write", action="store_true")
     ap.add_argument("--only", default="", help="top-level package to edit (default: all)")
     ap.add_argument("--log", type=Path, help="write every decision here (JSON)")
@@ -287,6 +288,8 @@ def main() -> int:
                     help="JSON {module: the modules importing it loads}, of the tree before "
                          "the moves (measured and written there when the file is absent)")
     args = ap.parse_args()
+    if not args.light.exists():
+        args.light.write_text(json.dumps(measure_light_paths()))
     paths = [set(p) for p in json.loads(args.light.read_text())]
     ix = Index()
     floor = {name: i for i, names in enumerate(LAYERS) for name in names}
@@ -485,6 +488,38 @@ def _kept_lazy(ix, mod, tree, par, said, src_lines) -> set[str]:
                         if (r := ix.resolve(t)) is not None:
                             out.add(r)
     return out - {mod}
+
+
+#: the light paths: the CLI's start, its help and each command's, and loading every scene
+LIGHT_PATHS = [
+    "import walkerlab.cli",
+    *[f"import sys, walkerlab.cli\nsys.argv = ['walkerlab', *{args!r}, '--help']\n"
+      "try:\n    walkerlab.cli.app()\nexcept SystemExit:\n    pass"
+      for args in ([], ["fixedpoint"], ["simulate"], ["contact-sim"], ["compare"],
+                   ["workprecision"], ["plot"], ["report"], ["sweep"], ["bifurcation"],
+                   ["continuation"], ["target"], ["optimize"], ["basin"], ["mfpt"],
+                   ["robustness"], ["stability-map"], ["animate"], ["export"], ["bench"],
+                   ["capabilities"])],
+    "from walkerlab.config.loader import load_scene\n"
+    f"for p in sorted(__import__('pathlib').Path({str(ROOT / 'configs')!r}).glob('*.yaml')):\n"
+    "    load_scene(p)",
+]
+
+
+def measure_light_paths() -> list[list[str]]:
+    """The walkerlab modules each of :data:`LIGHT_PATHS` loads, each run in a fresh
+    interpreter."""
+    import subprocess
+
+    out = []
+    for code in LIGHT_PATHS:
+        probe = (f"import atexit, json, sys\natexit.register(lambda: print(json.dumps(sorted("
+                 f"m for m in sys.modules if m.startswith('walkerlab'))), file=sys.stderr))\n"
+                 f"{code}\n")
+        run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                             cwd=ROOT, check=True)
+        out.append(json.loads(run.stderr.strip().splitlines()[-1]))
+    return out
 
 
 def measure_loads(mods: list[str]) -> dict[str, list[str]]:
