@@ -685,7 +685,7 @@ def _unexplained_function_imports(path: Path) -> list[int]:
 
 #: function-level imports of walkerlab without a comment, today: the count may only fall
 #: (a new one says why in a word, or moves to the top)
-UNEXPLAINED_FUNCTION_IMPORTS = 715
+UNEXPLAINED_FUNCTION_IMPORTS = 360
 
 
 def test_a_function_level_import_of_walkerlab_says_why(tmp_path):

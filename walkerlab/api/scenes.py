@@ -7,6 +7,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from walkerlab.rigid_walker import scene_of
+from walkerlab.safefs import RunPathError
+
 if TYPE_CHECKING:  # pragma: no cover
     import xarray
 
@@ -43,7 +46,6 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
         a safe folder name (empty, path separators).
     """
     from walkerlab.config import SceneError  # light
-    from walkerlab.rigid_walker import scene_of
 
     sc = scene_of(path_or_dict)
     if name is not None:
@@ -126,8 +128,6 @@ def runs_folder(runs_dir) -> Path:
     """``runs_dir`` as a path; an empty name (which would be the current folder) or a value
     that is not a path is refused in one line, as ``--runs-dir ''`` is."""
     import os
-
-    from walkerlab.safefs import RunPathError
 
     if not isinstance(runs_dir, (str, os.PathLike)) or isinstance(runs_dir, bytes):
         raise RunPathError(f"runs_dir={runs_dir!r}: give a folder name, e.g. runs_dir='runs'")

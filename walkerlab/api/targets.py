@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from walkerlab.api.walker import Walker
 from walkerlab.api.walks import Gait
+from walkerlab.units import field_unit
 
 if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
@@ -82,7 +83,6 @@ def target(scene: Scene | str | Path | dict[str, Any], vary: str, *,
     >>> t.value, t.gait.step_period, t.gait.cost_of_transport                      # doctest: +SKIP
     """
     from walkerlab.studies.continuation import scene_value  # light
-    from walkerlab.units import field_unit
 
     given = {k: v for k, v in (("speed_m_per_s", speed_m_per_s),
                                ("step_length_m", step_length_m),

@@ -48,6 +48,7 @@ from walkerlab.api.checks import (
 )
 from walkerlab.api.scenes import as_scene, with_changes
 from walkerlab.api.walks import ContactWalk, Gait, Step, Walk, recorded_contact_walk, sampled_walk
+from walkerlab.integrate.solver import Solver
 from walkerlab.rigid_walker import SceneWalker
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -373,7 +374,6 @@ class ContactWalker:
     def __init__(self, scene: Scene, rigid: Walker | None = None,
                  step_time_limit_s: float = STEP_TIME_LIMIT_S):
         from walkerlab.config.sections import with_default_section  # light
-        from walkerlab.integrate.solver import Solver
         from walkerlab.models.contact.scene import contact_setup  # light
         from walkerlab.walker.plant import Plant  # light
 
@@ -568,7 +568,10 @@ class ContactWalker:
             ``not_converged``, :func:`~walkerlab.analysis.contact.periodic.converged_gait`;
             one line), as the stage reports it.
         """
-        from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
+        from walkerlab.analysis.contact.periodic import (  # light
+            converged_gait,
+            find_contact_periodic_gait,
+        )
         from walkerlab.analysis.contact.sim import scene_start  # light
 
         self._check_periodic()

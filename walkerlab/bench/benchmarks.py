@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.bench.process_env import installed_env
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.walker.plant import Plant
 
@@ -48,8 +51,6 @@ def paper_scene():
 def bench_ideal(repeats: int = 7) -> dict:
     """5 ideal strides at rtol 1e-10 per integrator backend, and the fixed-point search."""
     from walkerlab.analysis.gait.poincare import find_fixed_point  # light
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     scene = paper_scene()
@@ -191,7 +192,6 @@ def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
         cmd = _cli("basin", "--grid", grid, "--workers", str(workers), "--force",
                    "--runs-dir", d)
         res = _time_process(cmd, 1)
-        from walkerlab.io.runpaths import stage_artifact
         from walkerlab.io.schemas.basin import load_basin
 
         b = load_basin(stage_artifact(paper_scene(), d, "basin"))

@@ -32,6 +32,11 @@ from typing import NamedTuple
 import numpy as np
 
 from walkerlab.execution.lanes import Lanes, pinned_worker, run_on_lanes
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver, available_backends
+from walkerlab.safefs import read_regular
+from walkerlab.usercache import use_for_numba
+from walkerlab.walker.layout import StateIndex
 from walkerlab.walker.plant import Plant
 
 CYRK_PREFIX = "CyRK "
@@ -46,8 +51,6 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
     (shape (2n + 1,)), None if the run did not end in a heel strike; the CPU time is the
     thread's around :func:`walkerlab.integrate.rigid.simulate_steps` alone.
     """
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     walker = build_walker(scene, plant=Plant.from_scene(scene))
@@ -108,7 +111,6 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     from walkerlab.bench.contact import leg_angle_columns  # light
     from walkerlab.config import SolverSettings  # light
     from walkerlab.models.contact.scene import contact_setup  # light
-    from walkerlab.walker.layout import StateIndex
 
     setup = contact_setup(scene, plant=Plant.from_scene(scene))
     cs = setup.sim
@@ -205,11 +207,7 @@ def load_libraries() -> None:
     import scipy.integrate  # noqa: F401
     import scipy.optimize  # noqa: F401
 
-    from walkerlab.integrate.solver import available_backends
-
     if "cyrk" in available_backends():
-        from walkerlab.usercache import use_for_numba
-
         use_for_numba()  # numba's cache in the user cache (before numba loads)
         import CyRK  # noqa: F401  (and numba)
 
@@ -240,8 +238,6 @@ def read_cached_case(path: Path) -> dict | None:
     """A cached case result (:func:`time_case`) if the file holds a complete one, else None
     (missing, unreadable, not JSON, or lacking/mistyping a field: the case is measured
     again)."""
-    from walkerlab.safefs import read_regular
-
     try:
         res = json.loads(read_regular(path, 1 << 20, "cache entry"))
     except (OSError, ValueError):  # missing, not a bounded regular file, not JSON

@@ -10,9 +10,12 @@ import hashlib
 import json
 from pathlib import Path
 
+import walkerlab
+from walkerlab import progress
 from walkerlab.bench.workprecision import CYRK_PREFIX, Case, run_cases
 from walkerlab.bench.workprecision_results import rows_from_cases, summarize
 from walkerlab.config import Scene
+from walkerlab.integrate.solver import CYRK_METHODS, available_backends
 
 #: the sources a case's result depends on (a change elsewhere - report text, plots, other
 #: stages - keeps the measured cases)
@@ -24,8 +27,6 @@ CASE_SOURCES = {
 
 def sources_hash(parts: tuple[str, ...]) -> str:
     """SHA-256 over the walkerlab sources under ``parts`` (files or subpackages)."""
-    import walkerlab
-
     root = Path(walkerlab.__file__).parent
     h = hashlib.sha256(walkerlab.__version__.encode())
     for part in parts:
@@ -54,8 +55,6 @@ def reference_method() -> str:
     """The ideal model's reference integrator: CyRK's DOP853 when installed (the same steps
     as scipy's DOP853, measured: the two reference vectors at rtol 1e-13 differ by 1.0e-13,
     the accuracy both reach, at 0.06 s instead of 0.7 s CPU), else scipy's."""
-    from walkerlab.integrate.solver import available_backends
-
     return CYRK_PREFIX + "DOP853" if "cyrk" in available_backends() else "DOP853"
 
 
@@ -73,8 +72,6 @@ def plan(scene: Scene) -> dict:
         raise ValueError(f"scene '{scene.name}' has no 'workprecision' section")
     out = {}
     if "ideal" in wp.models:
-        from walkerlab.integrate.solver import CYRK_METHODS, available_backends
-
         extra = ([CYRK_PREFIX + m for m in wp.methods if m in CYRK_METHODS]
                  if "cyrk" in available_backends() else [])
         out["ideal"] = (list(wp.methods) + extra, list(wp.rtols), wp.atol_factor,
@@ -117,8 +114,6 @@ def run_study(scene: Scene, wp, x0, step_period_s: float, cache: Path, workers: 
         ``{model: (rows, summary, reference)}``, the cases found in the cache, all cases.
     """
     import numpy as np
-
-    from walkerlab import progress
 
     x0t = tuple(float(v) for v in x0)
     sj = json.dumps(scene.model_dump(mode="json"), sort_keys=True)

@@ -60,7 +60,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=version_call
     to report."""
     single_threaded_blas()
     process_settings()
-    from walkerlab import progress
+    from walkerlab import progress  # light
 
     progress.install(progress.sink_for_terminal(quiet))
 

@@ -77,6 +77,7 @@ import numpy as np
 
 from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
+from walkerlab.io.sweep_store import load_sweep
 
 #: benchmark -> ``module:function`` that runs it with no arguments (imported when it runs:
 #: CasADi, MuJoCo, Gymnasium, ...)
@@ -106,7 +107,6 @@ def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True
     variational, from the artifact) and, with ``cpu``, the CPU time per point of the same
     sweep run in this process (one worker).
     """
-    from walkerlab.io.sweep_store import load_sweep
     from walkerlab.stages.sweep import draw, run  # light
 
     scene = B.paper_scene()

@@ -79,7 +79,7 @@ def export(scene: Path | None = SceneArg,
     --walk walks the MJCF in MuJoCo and the OpenSim model in OpenSim (where importable) for 10
     heel strikes and prints the step period against the rigid gait's (exit code 0 either way;
     a walk that falls or misses 1 % adds a warning on stderr)."""
-    from walkerlab.export.mjcf_scene import MjcfOptions
+    from walkerlab.export.mjcf_scene import MjcfOptions  # light
     from walkerlab.stages import export as stage  # light
 
     sc = load(scene)

@@ -20,10 +20,10 @@ def capabilities(as_json: bool = typer.Option(False, "--json", help="print every
     if as_json:
         import json
 
-        from walkerlab.walker.kinds import table_rows
+        from walkerlab.walker.kinds import table_rows  # light
 
         typer.echo(json.dumps(table_rows(), indent=1, ensure_ascii=False))
         return
-    from walkerlab.walker.capability_tables import text
+    from walkerlab.walker.capability_tables import text  # light
 
     typer.echo(text(), nl=False)

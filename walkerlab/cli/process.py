@@ -6,13 +6,13 @@ import os
 
 import typer
 
+import walkerlab
+
 
 def versions() -> str:
     """walkerlab, Python and the numeric libraries' versions (for bug reports)."""
     import platform
     from importlib import metadata
-
-    import walkerlab
 
     parts = [f"walkerlab {walkerlab.__version__}", f"python {platform.python_version()}"]
     for dist in ("numpy", "scipy", "numba", "h5py", "pydantic", "matplotlib"):
@@ -72,7 +72,7 @@ def process_settings() -> None:
     import gc
     import signal
 
-    from walkerlab.usercache import use_for_numba
+    from walkerlab.usercache import use_for_numba  # light
 
     use_for_numba()
     if hasattr(signal, "SIGXFSZ"):
@@ -86,7 +86,7 @@ def process_settings() -> None:
 
 
 def _interrupt(signum, frame) -> None:
-    from walkerlab.safefs import note_interrupt
+    from walkerlab.safefs import note_interrupt  # light
 
     note_interrupt()  # kept even if the exception below is swallowed on its way
     raise KeyboardInterrupt
@@ -99,7 +99,7 @@ def _unraisable(hook):
     instead of printed as a traceback; anything else goes to ``hook``."""
     def unraisable(args) -> None:
         if isinstance(args.exc_value, KeyboardInterrupt):
-            from walkerlab.safefs import note_interrupt
+            from walkerlab.safefs import note_interrupt  # light
 
             note_interrupt()
             return

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.robustness.basin_area import basin_area
 from walkerlab.io.stage_files import CONTACT_SIM
+from walkerlab.published import for_scene
 
 
 def report_numbers(scene, arts: dict) -> dict:
@@ -40,8 +42,6 @@ def report_numbers(scene, arts: dict) -> dict:
     ValueError
         The scene's ``published`` key names no module.
     """
-    from walkerlab.published import for_scene
-
     out: dict = {}
     sim, contact = arts.get("simulate"), arts.get(CONTACT_SIM.name)
     if sim is not None:
@@ -72,8 +72,6 @@ def report_numbers(scene, arts: dict) -> dict:
     if contact is not None:
         out["mean_stance_slip_mm"] = mean_stance_slip(contact)
     if arts.get("basin") is not None:
-        from walkerlab.analysis.robustness.basin_area import basin_area
-
         out["basin_area"] = basin_area(arts["basin"])
     return out
 

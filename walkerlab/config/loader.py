@@ -16,9 +16,11 @@ from typing import Annotated, Any
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
+import walkerlab
 from walkerlab.config.errors import PLAIN_NUMBER, SceneError, format_error
 from walkerlab.config.limits import MAX_SCENE_BYTES, MAX_YAML_DEPTH, SMALL_SLOPE_DEG
 from walkerlab.config.schema import SCENE_NAME_RE, Scene
+from walkerlab.safefs import NotARegularFile, read_regular
 
 
 def default_scene_path() -> Path:
@@ -27,7 +29,6 @@ def default_scene_path() -> Path:
     here = Path("configs/paper.yaml")
     if here.is_file():
         return here
-    import walkerlab
 
     return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
 
@@ -36,8 +37,6 @@ def shipped_scene_path(name: str | Path) -> Path | None:
     """A shipped scene by name (``paper``, ``kneed``, ``rabbit.yaml``) or by its path in the
     repository (``configs/paper.yaml``): the file in the ``configs`` folder next to the
     package (an editable install), or None when there is none."""
-    import walkerlab
-
     configs = Path(walkerlab.__file__).resolve().parent.parent / "configs"
     p = Path(name)
     if len(p.parts) == 2 and p.parts[0] == "configs":
@@ -127,8 +126,6 @@ def _read_scene_text(path: Path) -> str:
     SceneError
         Not a regular file, not UTF-8 text, or unreadable (one line naming the file).
     """
-    from walkerlab.safefs import NotARegularFile, read_regular
-
     try:
         text = read_regular(path, MAX_SCENE_BYTES, "scene file").decode("utf-8")
     except NotARegularFile as exc:
@@ -220,7 +217,7 @@ def load_scene(path: str | Path) -> Scene:
     scene = scene_from_dict(data, path)
     scene._origin = path.resolve()
     if unit_warnings(scene):
-        from walkerlab import progress
+        from walkerlab import progress  # light
 
         for line in unit_warnings(scene):
             progress.note(f"warning: {path}: {line}")
@@ -241,8 +238,6 @@ def _profile_from_csv(terrain: dict, scene_path: Path) -> dict:
     """
     import csv
     import io
-
-    from walkerlab.safefs import NotARegularFile, read_regular
 
     name = terrain["profile_csv"]
     where = f"{scene_path}: terrain.profile_csv: {name}"

@@ -59,6 +59,7 @@ from walkerlab.config.studies import (
 )
 from walkerlab.config.terrain import TerrainSettings
 from walkerlab.config.walker import WalkerParams
+from walkerlab.published import available
 
 #: The default ground's patch width for flat feet, in soles (heel to toe): see
 #: :meth:`Scene.terrain_or_default`.
@@ -245,8 +246,6 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _published_exists(self) -> Scene:
         if self.published is not None:
-            from walkerlab.published import available
-
             if self.published not in available():
                 raise ValueError(f"published: no module walkerlab.published.{self.published} "
                                  f"(available: {', '.join(available())})")

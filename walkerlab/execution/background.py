@@ -12,6 +12,8 @@ import os
 import threading
 from collections.abc import Callable
 
+from walkerlab.execution.lanes import Lanes
+
 
 class BackgroundStudy:
     """A timed study in a thread, overlapping the untimed work of this process.
@@ -44,8 +46,6 @@ class BackgroundStudy:
 
     def __init__(self, run: Callable, start_worker: Callable, first_run: bool,
                  pending: tuple[str, ...] = (), workers: int = 2):
-        from walkerlab.execution.lanes import Lanes
-
         self._run_study = run
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
         self.lanes = None

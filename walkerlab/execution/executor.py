@@ -25,6 +25,10 @@ from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol
 
+from walkerlab.execution.dask import completed, connect, quiet_distributed, result
+from walkerlab.execution.workers import process_pool
+from walkerlab.extras import require
+
 __all__ = ["DaskExecutor", "Executor", "InlineExecutor", "PoolExecutor", "make_executor",
            "run_chains", "run_each"]
 
@@ -113,8 +117,6 @@ class PoolExecutor(_Context):
 
     def __init__(self, workers: int, context=None, initializer: Callable | None = None,
                  initargs: tuple = ()):
-        from walkerlab.execution.workers import process_pool
-
         self._ex = process_pool(workers, context, initializer, initargs)
         self._pending: set = set()
         self._done: deque = deque()
@@ -163,10 +165,7 @@ class DaskExecutor(_Context):
     slots = None
 
     def __init__(self, scheduler):
-        from walkerlab.extras import require
-
         require("distributed", "dask", "--scheduler")
-        from walkerlab.execution.dask import connect, quiet_distributed
 
         self._own = isinstance(scheduler, str)
         self._quiet = quiet_distributed()
@@ -180,8 +179,6 @@ class DaskExecutor(_Context):
         self._ac = None
 
     def submit(self, fn: Callable, *args):
-        from walkerlab.execution.dask import completed
-
         fut = self.client.submit(fn, *args, pure=False)
         self._futures.append(fut)
         if self._ac is None:
@@ -191,8 +188,6 @@ class DaskExecutor(_Context):
         return fut.key
 
     def next_done(self) -> tuple[Any, Any]:
-        from walkerlab.execution.dask import result
-
         fut = next(self._ac)
         return fut.key, result(self.client, fut)
 

@@ -19,6 +19,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from walkerlab.execution.workers import mp_context, process_pool
+
 __all__ = ["Lanes", "THREAD_VARS", "pinned_worker", "run_on_lanes"]
 
 #: Thread-count variables set to 1 in the environment a pinned worker starts with.
@@ -55,8 +57,6 @@ def pinned_worker(core: int, warm: Callable | None = None, context=None):
     -------
     concurrent.futures.ProcessPoolExecutor
     """
-    from walkerlab.execution.workers import mp_context, process_pool
-
     ex = process_pool(1, context or mp_context("spawn"), _pin, (core, warm))
     with _ENV_LOCK:
         old = {v: os.environ.get(v) for v in THREAD_VARS}

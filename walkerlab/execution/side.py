@@ -27,6 +27,8 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from concurrent.futures.process import BrokenProcessPool
 
+from walkerlab.execution.workers import process_pool
+
 __all__ = ["SideWorker", "side_signals", "spare_core"]
 
 
@@ -114,8 +116,6 @@ class SideWorker:
             return None
         try:
             if self._pool is None:
-                from walkerlab.execution.workers import process_pool
-
                 self._pool = process_pool(1, initializer=side_signals)
             return self._pool.submit(fn, *args)
         except (BrokenProcessPool, OSError, RuntimeError):

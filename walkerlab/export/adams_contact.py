@@ -7,6 +7,7 @@ from __future__ import annotations
 from walkerlab.config.contact import LENGTH_UNITS, ContactSettings
 from walkerlab.export.adams_feet import contact_pairs
 from walkerlab.export.adams_statements import MM, _f, _stmt
+from walkerlab.models.contact.rigid_limit import contact_si
 
 __all__ = ["contact_mm", "contact_statement", "contact_statements"]
 
@@ -25,8 +26,6 @@ def contact_mm(settings: ContactSettings) -> dict[str, float]:
         ``MU_STATIC``, ``MU_DYNAMIC``, ``STICTION_TRANSITION_VELOCITY``,
         ``FRICTION_TRANSITION_VELOCITY`` [mm/s].
     """
-    from walkerlab.models.contact.rigid_limit import contact_si
-
     c, _ = contact_si(settings)
     si = {"stiffness": c.k / MM ** c.e, "max_damping": c.cmax / MM,
           "penetration_at_max_damping": c.dmax * MM, "stiction_velocity": c.v_s * MM,

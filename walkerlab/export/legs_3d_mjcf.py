@@ -76,6 +76,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
 from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
 from walkerlab.export.motors import mjcf_actuator_lines, mjcf_motor_tendons, motors
@@ -303,7 +304,6 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         A ground other than the slope laid as a checkerboard (one line naming
         ``terrain.lanes``).
     """
-    from walkerlab.codegen.cache import functions
     from walkerlab.config.contact import ContactSettings  # light
     from walkerlab.export.scene import mujoco_contact  # light
     from walkerlab.export.scene_ground import EXPORT_STEPS  # light

@@ -8,8 +8,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from walkerlab.export.mjcf_scene import LANE_BITS, MjcfScene
+from walkerlab.export.mjcf_scene import LANE_BITS, PROFILE_DX_M, MjcfScene
 from walkerlab.export.text import nums
+from walkerlab.models.contact.terrain import profile_line
+from walkerlab.models.ground import landing_drops, stair_treads
 
 if TYPE_CHECKING:
     from walkerlab.walker.multibody import Multibody
@@ -72,8 +74,6 @@ def _profile_grid(mb: Multibody, extra: MjcfScene) -> tuple:
     (:attr:`MjcfScene.profile`, lowered by the ground offset) sampled every
     :data:`PROFILE_DX_M` over the leg-length-padded span of its vertices; a flat profile
     gets a 1 mm elevation range (MuJoCo needs one)."""
-    from walkerlab.export.mjcf_scene import PROFILE_DX_M
-
     line = np.asarray(extra.profile, dtype=float)
     pad = 2 * mb.leg_length_m
     inner = line[1:-1] if len(line) > 3 else line
@@ -162,15 +162,11 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
 
     mb = SimpleNamespace(leg_length_m=float(spoke_length_m))
     if terrain.kind == "stairs":
-        from walkerlab.models.ground import stair_treads
-
         extra = SimpleNamespace(treads=stair_treads(terrain, 0.0, n_treads),
                                 ground_offset_m=0.0)
         return [], [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
                     for g in _tread_boxes(mb, extra)]
     if terrain.kind == "profile":
-        from walkerlab.models.contact.terrain import profile_line
-
         extra = SimpleNamespace(profile=profile_line(terrain, 0.0, 0.0), ground_offset_m=0.0)
         geoms = [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
                  for g in _profile_geom(mb, extra)]
@@ -185,8 +181,6 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
 def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int) -> list[str]:
     """:func:`wheel_ground`'s footholds: a box per footfall, footfall -1 (behind the first
     stance tip) to ``n`` (a finite list, ``periodic: false``: its own footfalls)."""
-    from walkerlab.models.ground import landing_drops
-
     h = [-d for d in landing_drops(terrain)]  # each step's landing above the stance tip
     t = np.array([math.cos(phi), -math.sin(phi)])
     nrm = np.array([math.sin(phi), math.cos(phi)])

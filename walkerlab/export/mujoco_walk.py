@@ -56,7 +56,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.export.joint_torques import law_generalized_forces, link_angle, stance_phase
+from walkerlab.codegen.cache import functions
+from walkerlab.export.joint_torques import (
+    law_generalized_forces,
+    link_angle,
+    stance_phase,
+    torque_generalized_forces,
+)
+from walkerlab.extras import require
+from walkerlab.models.virtual_constraints import VirtualConstraintController
 
 __all__ = ["HipRollLoop", "MujocoWalk", "PoweredLoop", "VirtualConstraintFeedback", "latch_rule",
            "powered_loop", "roll", "virtual_constraint_feedback", "walk"]
@@ -151,8 +159,6 @@ class VirtualConstraintFeedback:
     def role_state(self, q, v, stance: int) -> np.ndarray:
         """The rigid role state (2 n,) [rad, rad/s] of the export's coordinates ``q``, ``v``
         (name -> value) with leg ``stance`` (0: leg1) in stance."""
-        from walkerlab.export.joint_torques import link_angle
-
         combos = [link_angle(r, stance, q.keys()) for r in self.roles]
         return np.array([sum(k * q[c] for c, k in g.items()) for g in combos]
                         + [sum(k * v[c] for c, k in g.items()) for g in combos])
@@ -176,8 +182,6 @@ def virtual_constraint_feedback(scene, data) -> VirtualConstraintFeedback | None
     act = scene.walker.actuation
     if act is None or act.virtual_constraints is None:
         return None
-    from walkerlab.codegen.cache import functions
-    from walkerlab.models.virtual_constraints import VirtualConstraintController
 
     ctrl = VirtualConstraintController(act.virtual_constraints, functions(data),
                                        data.structure, data.params)
@@ -206,7 +210,6 @@ class PoweredLoop:
         import mujoco
 
         from walkerlab.config.actuation import Actuation  # light
-        from walkerlab.export.joint_torques import torque_generalized_forces
         from walkerlab.models.actuation import TorqueLaws  # light
 
         i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
@@ -448,8 +451,6 @@ def _at_gait_keyframe(xml_path, doing: str):
     """``(mujoco, model, data)``: the MJCF at ``xml_path`` loaded and reset to its ``gait``
     keyframe (:func:`walk` and :func:`roll`; their ``ValueError`` without one, their
     ``MissingExtra`` without MuJoCo, ``doing`` naming the use in its line)."""
-    from walkerlab.extras import require
-
     mujoco = require("mujoco", "engines", doing)
     model = mujoco.MjModel.from_xml_path(str(xml_path))
     data = mujoco.MjData(model)

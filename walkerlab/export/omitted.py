@@ -19,6 +19,8 @@ from __future__ import annotations
 import textwrap
 from dataclasses import dataclass
 
+from walkerlab.export.text import comment
+
 __all__ = ["ADAMS_CONTINUATION", "PREFIX", "URDF_GROUND", "Omission", "adams_comments",
            "lines", "xml_comments"]
 
@@ -68,8 +70,6 @@ def lines(items) -> tuple[str, ...]:
 
 def xml_comments(items) -> list[str]:
     """One XML comment per item (:func:`walkerlab.export.text.comment`)."""
-    from walkerlab.export.text import comment
-
     return [comment(text) for text in lines(items)]
 
 

@@ -53,8 +53,14 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
-from walkerlab.export.mujoco_walk import MujocoWalk
+import walkerlab
+from walkerlab.export.joint_torques import (
+    law_generalized_forces,
+    stance_phase,
+    torque_generalized_forces,
+)
+from walkerlab.export.mujoco_walk import MujocoWalk, latch_rule
+from walkerlab.extras import MissingExtra, require, require_installed
 
 __all__ = ["OpensimWalk", "contact_height", "walk", "walk_here"]
 
@@ -155,7 +161,6 @@ class _Drive:
     def __init__(self, model, spec, coords, bodies, foot_loc):
         import opensim as osim
 
-        from walkerlab.export.joint_torques import torque_generalized_forces
         from walkerlab.models.actuation import TorqueLaws  # light
 
         self.laws = TorqueLaws(spec.torques)
@@ -224,9 +229,6 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
     import subprocess
     import tempfile
 
-    import walkerlab
-    from walkerlab.extras import MissingExtra, require_installed
-
     require_installed("opensim", "osim", "walking an OpenSim export")
     env = dict(os.environ)  # this walkerlab, whatever put it on sys.path here
     here = str(Path(walkerlab.__file__).resolve().parents[1])
@@ -261,8 +263,6 @@ _MISSING_EXIT = 3
 def _main(argv: list[str]) -> int:
     """The child process of :func:`walk`: ``argv[0]`` the JSON of its arguments and the
     output file; writes the walk's numbers there as JSON (floats exactly: ``repr``)."""
-    from walkerlab.extras import MissingExtra
-
     a = json.loads(argv[0])
     try:
         w = walk_here(a["path"], a["duration_s"], a["window_s"], a["min_air_s"],
@@ -286,9 +286,6 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         As :func:`walk`, which also gives what it returns (:class:`OpensimWalk`) and raises
         (:class:`walkerlab.extras.MissingExtra` without OpenSim).
     """
-    from walkerlab.export.mujoco_walk import latch_rule
-    from walkerlab.extras import require
-
     osim = require("opensim", "osim", "walking an OpenSim export")
     osim.Logger.removeFileSink()  # OpenSim logs to ./opensim.log: nothing outside runs/
     osim.Logger.setLevelString("warn")  # not a report per window

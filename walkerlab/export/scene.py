@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 
+from walkerlab import progress
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.config.terrain import TerrainSettings
@@ -54,6 +55,9 @@ from walkerlab.export.scene_ground import (
     profile_patches,
 )
 from walkerlab.models.contact.laws import ContactParamsSI
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.rigid_limit import contact_si
+from walkerlab.models.contact.terrain import check_ground, ground_drops, profile_line
 from walkerlab.walker.kinds import KINDS, Kind
 
 __all__ = ["FORMAT_VIEWS", "arc_roll_m", "check_exportable", "mjcf_scene", "mujoco_contact"]
@@ -193,7 +197,6 @@ def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[f
     half = terrain.patch_width_m / 2
     if terrain.lanes != "checkerboard" or roll <= half:
         return 0.0, ()
-    from walkerlab import progress
 
     ahead = roll  # the patch's downhill edge from footfall + w/2 to the roll's end + w/2
     line = (f"terrain.patch_width_m = {terrain.patch_width_m:g} m: the arc feet roll their "
@@ -233,9 +236,6 @@ def mjcf_scene(scene: Scene, mb, plant, ideal=None, options: MjcfOptions | None 
         No ``fixedpoint`` section (one line).
     """
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
-    from walkerlab.models.contact.model import ContactWalker
-    from walkerlab.models.contact.rigid_limit import contact_si
-    from walkerlab.models.contact.terrain import ground_drops
 
     data = plant.data
     settings = scene.contact or ContactSettings()
@@ -250,8 +250,6 @@ def mjcf_scene(scene: Scene, mb, plant, ideal=None, options: MjcfOptions | None 
                                                    options)
     lanes = lane_heights = treads = profile = None
     if terrain.kind == "profile":
-        from walkerlab.models.contact.terrain import check_ground, profile_line
-
         check_ground(terrain)  # an inline profile: one line otherwise
         if terrain.lanes == "continuous":
             profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin

@@ -10,8 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
+from walkerlab.models.contact.model import footprint_offsets
+from walkerlab.models.ground import landing_drops
+from walkerlab.models.hybrid.ground import on_landing
+from walkerlab.models.hybrid.rigid import make_rigid_walker
 
 
 def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
@@ -73,11 +78,6 @@ def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
     the slope, or on stairs and footholds on the tread it stood on: the landing of the step
     before the keyframe, the last of the ground's period, above the new stance heel's line)
     or, where the gait has none, the trailing foot at its rest angle."""
-    from walkerlab.codegen.cache import functions
-    from walkerlab.models.ground import landing_drops
-    from walkerlab.models.hybrid.ground import on_landing
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-
     feet = flat_foot_bodies(scene, data)
     drop = landing_drops(scene.terrain)[-1]  # the step that ended at the keyframe [m]
     rigid = on_landing(make_rigid_walker(data), data, drop)
@@ -167,8 +167,6 @@ class _FlatFeet(_LinkFeet):
 
     def footprints(self, lanes: tuple, data) -> tuple:
         """A flat foot's patch centred on its sole, not on its heel's touchdown."""
-        from walkerlab.models.contact.model import footprint_offsets
-
         return tuple(tuple(s + off for s in lane)
                      for lane, off in zip(lanes, footprint_offsets(data)))
 

@@ -10,6 +10,8 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.scene import FORMAT_VIEWS
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.walker.kinds import Kind
 
 __all__ = ["WHEEL_FORMATS", "WheelKeyframe", "check_wheel_exportable", "wheel_keyframe",
@@ -88,8 +90,6 @@ def wheel_keyframe(scene: Scene, plant, ideal=None) -> WheelKeyframe:
         :data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`: the file's hub needs it too).
     """
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
-    from walkerlab.models.contact.model import ContactWalker
-    from walkerlab.models.contact.rigid_limit import contact_si
 
     data = plant.data
     settings = scene.contact or ContactSettings()

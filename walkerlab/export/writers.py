@@ -58,7 +58,14 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.scene import FORMAT_VIEWS, check_exportable, mjcf_scene
-from walkerlab.export.spoked import WHEEL_URDF_OMISSIONS, wheel_chord_m
+from walkerlab.export.spoked import (
+    WHEEL_TIP_FRACTION,
+    WHEEL_URDF_OMISSIONS,
+    wheel3d_keyframe,
+    wheel3d_mjcf_text,
+    wheel3d_urdf_text,
+    wheel_chord_m,
+)
 from walkerlab.export.text import comment
 from walkerlab.export.urdf import keyframe_json, urdf_omissions, urdf_text
 from walkerlab.export.wheel_scene import (
@@ -277,12 +284,6 @@ def _wheel_3d(job: ExportJob, w: Writer) -> Written:
     keyframe (:func:`~walkerlab.export.spoked.wheel3d_keyframe`), the scene's static friction
     coefficient on the spoke tips; the other formats as the capability table has them."""
     from walkerlab.codegen.cache import functions  # light: the writers load without codegen
-    from walkerlab.export.spoked import (
-        WHEEL_TIP_FRACTION,
-        wheel3d_keyframe,
-        wheel3d_mjcf_text,
-        wheel3d_urdf_text,
-    )
 
     data = job.data
     job.kind.require("walk", w.view, "walker.space: 3d")
@@ -312,8 +313,8 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`; ``job.options``: the MJCF's
     :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
     table has them (refused before this is reached)."""
-    from walkerlab.export.legs_3d import legs_3d_urdf_omissions, legs_3d_urdf_text
-    from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene
+    from walkerlab.export.legs_3d import legs_3d_urdf_omissions, legs_3d_urdf_text  # light
+    from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene  # light
 
     scene, data = job.scene, job.data
     _check_legs_3d(job, w)

@@ -55,6 +55,8 @@ from walkerlab.io.atomic_files import (  # noqa: F401  (re-exported: imported fr
     disk_full_error,
     is_disk_full,
 )
+from walkerlab.units import for_scene, relabel_artifact
+from walkerlab.usercache import private_dir, read_private, write_private
 
 #: what h5py raises reading a file that opens but is damaged inside (HDF5's error stack
 #: surfaces as OSError, RuntimeError such as "Iteration operator failed", KeyError or
@@ -224,8 +226,6 @@ def _disk_memo(key: tuple, value: str | None = None) -> str | None:
     remembered, another stamp, no usable cache); with ``value``: remember it (if the cache
     can be written) and return it."""
     import json
-
-    from walkerlab.usercache import private_dir, read_private, write_private
 
     d = private_dir("hashes", writable=value is not None)
     if d is None:
@@ -430,7 +430,6 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
         for k, v in (extra_attrs or {}).items():
             f.attrs[k] = v
         writer(f)
-        from walkerlab.units import for_scene, relabel_artifact
 
         relabel_artifact(f, for_scene(scene))  # unit labels follow the scene's system
         netcdf.finish(f)

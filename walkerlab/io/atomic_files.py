@@ -12,6 +12,8 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
+from walkerlab.safefs import atomic_replace_all, refuse_link
+
 __all__ = ["DISK_FULL_ERRNOS", "FILE_MODE", "ArtifactError", "atomic_write",
            "atomic_write_all", "disk_full_error", "is_disk_full"]
 
@@ -108,8 +110,6 @@ def atomic_write_all(items) -> list[Path]:
     walkerlab.io.runpaths.RunPathError
         A path is a symbolic link.
     """
-    from walkerlab.safefs import atomic_replace_all, refuse_link
-
     paths = [refuse_link(Path(p)) for p, _ in items]
     for path in paths:
         try:

@@ -16,6 +16,7 @@ import h5py
 import numpy as np
 
 from walkerlab.io.artifacts import READ_ERRORS
+from walkerlab.io.h5image import H5Image
 
 __all__ = ["read_basin_partial", "basin_partial_writer"]
 
@@ -75,8 +76,6 @@ def basin_partial_writer(part: Path, key: str, arrays: dict[str, np.ndarray],
     walkerlab.io.artifacts.ArtifactError
         The disk is full ("disk full", one line).
     """
-    from walkerlab.io.h5image import H5Image
-
     if part.exists() or part.is_symlink():
         raise FileExistsError(part)
     img = H5Image(part)

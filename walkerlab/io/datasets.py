@@ -37,6 +37,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from walkerlab.extras import require
 from walkerlab.io.artifacts import READ_ERRORS, ArtifactError
 from walkerlab.io.stage_files import CONTACT_SIM
 
@@ -60,8 +61,6 @@ def xarray():
         xarray or h5netcdf is not installed (an ImportError; one line naming the missing one
         and the ``api`` extra).
     """
-    from walkerlab.extras import require
-
     require("h5netcdf", "api", "walkerlab's Python API")
     return require("xarray", "api", "walkerlab's Python API")
 

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import h5py
 
+from walkerlab.io.artifacts import disk_full_error, is_disk_full
+
 __all__ = ["H5Image"]
 
 
@@ -64,7 +66,6 @@ class H5Image:
         OSError
             Another write error (nothing is left behind).
         """
-        from walkerlab.io.artifacts import disk_full_error, is_disk_full
         from walkerlab.safefs import atomic_replace
 
         self.f.flush()

@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from walkerlab.safefs import RunPathError, refuse_link
+from walkerlab.safefs import RunPathError, process_alive, refuse_link
 
 try:  # POSIX; elsewhere runs are not locked
     import fcntl
@@ -97,8 +97,6 @@ def _take_over(fd: int, lock: Path) -> bool:
     """Remove a lock file whose recorded holder process is dead, though its lock is held
     (by a descendant that inherited it).  True when the name was removed (the caller then
     starts over on a new file)."""
-    from walkerlab.safefs import process_alive
-
     with _folder_locked(lock.parent):
         pid = _holder(fd, local_only=True)
         if pid is None or pid == os.getpid() or process_alive(pid) or not _same_file(fd, lock):

@@ -23,6 +23,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from walkerlab.io.h5image import H5Image
+from walkerlab.safefs import refuse_link
+
 __all__ = ["MfptPartial", "piece_digest"]
 
 
@@ -101,9 +104,6 @@ class MfptPartial:
     """
 
     def __init__(self, path: Path | str, key: str, resume: bool = True):
-        from walkerlab.io.h5image import H5Image
-        from walkerlab.safefs import refuse_link
-
         self.path = refuse_link(Path(path))
         self.key = key
         self.dropped = 0
@@ -122,8 +122,6 @@ class MfptPartial:
             raise
 
     def _read(self) -> tuple[dict, int]:
-        from walkerlab.io.h5image import H5Image
-
         try:
             img = H5Image.load(self.path)
         except (OSError, RuntimeError):  # not an HDF5 file, truncated, ...

@@ -33,9 +33,16 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from walkerlab.io.artifacts import atomic_write_all
 from walkerlab.io.locks import ArtifactBusy, artifact_lock  # noqa: F401 (part of this API)
 from walkerlab.io.stage_files import ARTIFACTS
-from walkerlab.safefs import RunPathError, refuse_link  # noqa: F401 (part of this API)
+from walkerlab.safefs import (  # noqa: F401 (part of this API)
+    NotARegularFile,
+    RunPathError,
+    read_regular,
+    refuse_link,
+    remove_stale_temps,
+)
 
 __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_artifact",
            "named_artifact", "scene_file", "report_dir", "figures_dir", "run_cache_dir",
@@ -134,8 +141,6 @@ TEMP_SUFFIXES = (".tmp", ".gif", ".mp4")
 
 def _owner(marker: Path) -> Path | None:
     """The scene file a run folder's marker names (None: no readable marker)."""
-    from walkerlab.safefs import NotARegularFile, read_regular
-
     try:  # a bounded regular file: a FIFO or /dev/zero in its place must not hang or fill RAM
         return Path(read_regular(marker, MAX_MARKER_BYTES, "run-folder marker")
                     .decode().strip())
@@ -162,8 +167,6 @@ def claimed(scene, runs_root: Path | str) -> bool:
 
 def _mkdir(d: Path) -> None:
     """Create a run folder and remove the temporary files a killed run left in it."""
-    from walkerlab.safefs import remove_stale_temps
-
     try:
         d.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -315,6 +318,4 @@ def atomic_text(path: Path, text: str) -> Path:
 def atomic_texts(items) -> list[Path]:
     """Write text files together, all or none (:func:`walkerlab.io.artifacts.
     atomic_write_all`): ``items`` is a sequence of ``(path, text)``."""
-    from walkerlab.io.artifacts import atomic_write_all
-
     return atomic_write_all([(p, lambda fh, t=t: fh.write(t.encode())) for p, t in items])

@@ -143,7 +143,7 @@ class TorqueLaws:
         (:func:`walkerlab.codegen.torque_law.pack_laws`): the same tables (the not-a-knot
         :class:`scipy.interpolate.CubicSpline`'s coefficients, or the piecewise-linear
         slopes), gains and saturations as :meth:`each` evaluates."""
-        from walkerlab.codegen.torque_law import PHASE, PLAIN, TIME, pack_laws
+        from walkerlab.codegen.torque_law import PHASE, PLAIN, TIME, pack_laws  # light
 
         rows = []
         for act in self.torques:
@@ -241,7 +241,7 @@ class TorqueOfTime:
     def packed(self) -> np.ndarray | None:
         """The law block (:func:`walkerlab.codegen.torque_law.pack_laws`) of this torque
         (None without its pieces)."""
-        from walkerlab.codegen.torque_law import TIME_FEEDFORWARD, pack_laws
+        from walkerlab.codegen.torque_law import TIME_FEEDFORWARD, pack_laws  # light
 
         if self.knots is None:
             return None

@@ -5,6 +5,10 @@ from __future__ import annotations
 from dataclasses import replace
 
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.ground import foothold_steps, landing_drop, on_footholds, on_landing
+from walkerlab.models.hybrid.printed_equations import make_compass_gait
+from walkerlab.models.hybrid.rigid import make_rigid_walker
+from walkerlab.walker.description import state_names, state_units
 from walkerlab.walker.plant import Plant
 
 
@@ -20,8 +24,6 @@ def state_layout(scene, plant: Plant) -> tuple[list[str], list[str]]:
     -------
     names, units : list of str, length 2n
     """
-    from walkerlab.walker.description import state_names, state_units
-
     roles = plant.structure.roles
     return state_names(roles), state_units(roles)
 
@@ -63,13 +65,6 @@ def build_walker(scene, plant: Plant) -> HybridWalker:
 def _on_ground(scene, plant: Plant, walker: HybridWalker) -> HybridWalker:
     """The walker on the scene's ``terrain`` (stairs: the heel strike at the next tread,
     :func:`walkerlab.models.hybrid.ground.on_landing`); a slope: ``walker`` itself."""
-    from walkerlab.models.hybrid.ground import (
-        foothold_steps,
-        landing_drop,
-        on_footholds,
-        on_landing,
-    )
-
     steps = foothold_steps(scene.terrain, scene.slope.phi_rad)
     if steps is not None:  # footholds that differ from step to step
         return _on_footholds(scene, plant, walker, steps, on_footholds)
@@ -121,8 +116,6 @@ def build_walker_on_steps(scene, steps, plant: Plant) -> HybridWalker:
     ValueError
         A ground other than the slope under it, or a walker that cannot walk it (one line).
     """
-    from walkerlab.models.hybrid.ground import on_footholds
-
     if scene.terrain is not None and not scene.terrain.is_slope:
         raise ValueError(f"terrain.kind: {scene.terrain.kind}: per-step draws are of a slope "
                          "(terrain.per_step on kind: slope)")
@@ -167,16 +160,12 @@ def _passive(scene, plant: Plant, slope_rad: float | None = None) -> HybridWalke
     ``slope_rad`` [rad] (described by ``plant``)."""
     w = scene.walker
     if w.model == "compass_gait" and w.space == "2d":
-        from walkerlab.models.hybrid.printed_equations import make_compass_gait
-
         return make_compass_gait(
             w.leg_length_m, w.leg_mass_kg, w.hip_mass_kg, w.gravity_m_per_s2,
             w.leg_mass_from_foot_m, scene.slope.phi_rad, scene.ideal.variant,
         )
     # any other walker is described as data: its kind builds it
     # (walkerlab.models.hybrid.rigid.BUILDERS; a rimless wheel: the rolling polygon)
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-
     if scene.ideal.variant != "derived":
         raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
                          "model: compass_gait (the paper's printed equations)")

@@ -9,7 +9,13 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.io.schemas.optimize import OptimizeData
+from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.optimal.outcome import history_and_energies, named_states, not_a_gait_outcome
+from walkerlab.optimal.replay.shooting import close_step
+from walkerlab.optimal.replay.virtual_constraints import phase_replays
+from walkerlab.optimal.transcription.free_joint_functions import JOINTS, five_link_functions
+from walkerlab.optimal.transcription.free_joints import collocate_five_link, replay_five_link
+from walkerlab.optimal.transcription.step import CollocationSpec
 
 __all__ = ["CONTACT_STRIDES", "STICK", "five_link_replays", "optimize_five_link",
            "stick_figures"]
@@ -36,18 +42,6 @@ def optimize_five_link(scene, plant, x_gait=None, period_s=None) -> OptimizeData
     ValueError
         A walker the five-link generator does not handle (one line).
     """
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.shooting import close_step
-    from walkerlab.optimal.transcription.free_joint_functions import (
-        JOINTS,
-        five_link_functions,
-    )
-    from walkerlab.optimal.transcription.free_joints import (
-        collocate_five_link,
-        replay_five_link,
-    )
-    from walkerlab.optimal.transcription.step import CollocationSpec
-
     data = plant.data  # the scene's walker, described once (walkerlab.walker.plant.Plant)
     o = scene.optimize
     fns = five_link_functions(data.structure)
@@ -83,7 +77,6 @@ def five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple
     start; an optimum that is not a gait is not replayed there (``not_gait``: why, the
     contact outcome)."""
     from walkerlab.optimal.replay.contact import contact_replay_five_link  # light
-    from walkerlab.optimal.replay.virtual_constraints import phase_replays
 
     if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
         return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "
@@ -112,8 +105,6 @@ def stick_figures(data, d, frames: int = 8) -> list:
     from the caller's :class:`~walkerlab.walker.plant.Plant`) at ``frames`` instants of the
     stored step ``d`` (a loaded ``optimize.h5``): polylines (7, 2) [m] through :data:`STICK`
     (the torso's top: its centre of mass, the generated ``torso_*`` point)."""
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-
     w = make_rigid_walker(data, "biped", "derived")
     names = w.state_names()
     out = []

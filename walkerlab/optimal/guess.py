@@ -10,6 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
+
 __all__ = ["has_target", "read_guess", "simulated_step", "starting_segment", "starting_step",
            "stairs_targets", "target_numbers", "target_step"]
 
@@ -142,8 +145,6 @@ def starting_segment(walker, x0, period_s: float, solver):
     ValueError
         The step does not end in a heel strike (one line).
     """
-    from walkerlab.integrate.rigid import simulate_steps
-
     seg = simulate_steps(walker, np.asarray(x0, float), 1, solver,
                          max_step_time=3.0 * period_s).segments[0]
     if seg.termination != "heel_strike":
@@ -196,8 +197,6 @@ def starting_step(scene, walker, x_gait, period_s: float):
         The artifact is missing, damaged, of another stage or walker, or ``at`` is off its
         branch (one line naming the field).
     """
-    from walkerlab.integrate.solver import Solver
-
     solver = Solver.from_settings(scene.solver)
     if x_gait is None:  # no gait of its own: a step from the targets
         return target_step(scene, walker)

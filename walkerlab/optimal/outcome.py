@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.integrate.solver import Solver
+from walkerlab.optimal.replay.hip_phase import hip_phase_replays
+from walkerlab.optimal.transcription.step import OBJECTIVES
+
 __all__ = ["hip_phase_replays_of", "history_and_energies", "massless_legs", "named_states",
            "not_a_gait_outcome", "optimum_outcome", "replay_multipliers", "unit_of_objective"]
 
@@ -27,8 +31,6 @@ def optimum_outcome(scene, res, err: float, contact) -> tuple[bool, float, str]:
 def unit_of_objective(o, data=None) -> str:
     """The objective's unit (a weighted sum's: ``-``; the torque per foot mass on massless
     legs: N m/kg in place of N m)."""
-    from walkerlab.optimal.transcription.step import OBJECTIVES
-
     unit = OBJECTIVES.get(o.objective, "-")
     if data is not None and massless_legs(data):
         unit = {"N^2 m^2 s": "N^2 m^2 s / kg^2", "N m": "N m/kg"}.get(unit, unit)
@@ -53,9 +55,6 @@ def hip_phase_replays_of(scene, data, res, tau) -> tuple[dict, str]:
     :func:`walkerlab.optimal.replay.hip_phase.hip_phase_replays`, the scene's solver), and
     why there are none (``({}, "")`` unless ``optimize.phase_replay`` is on: off by default
     here; nor on stairs or footholds: the replays walk the slope)."""
-    from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.replay.hip_phase import hip_phase_replays
-
     if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
         return {}, ""
     t = scene.terrain
@@ -120,7 +119,6 @@ def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
         The multipliers, NaN when the replay or the map failed (a report, not a gate).
     """
     from walkerlab.analysis.gait.poincare import poincare_map  # light
-    from walkerlab.integrate.solver import Solver
 
     mu = np.full(res.x.shape[1], np.nan, complex)
     if not np.isfinite(err):

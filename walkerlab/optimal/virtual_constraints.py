@@ -23,7 +23,15 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from walkerlab import progress
-from walkerlab.io.schemas.optimize import ControllerData
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.integrate.solver import Solver
+from walkerlab.io.schemas.optimize import ControllerData, OptimizeData
+from walkerlab.optimal import outcome as reported
+from walkerlab.optimal.transcription.virtual_constraints import (
+    collocate_virtual_constraints,
+    hzd_functions,
+    mid_stance_window,
+)
 from walkerlab.walker.plant import Plant
 
 __all__ = ["CHECK_MIN_S", "CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
@@ -259,7 +267,6 @@ def controller_step(walker, solver, points: int):
         strike (one line naming the key).
     """
     from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
-    from walkerlab.integrate.rigid import integrate_step
 
     ctrl = walker.actuators.controller
     zd = zero_dynamics(ctrl)
@@ -298,7 +305,6 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
     from walkerlab.analysis.gait.budget import search_budget  # light
     from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
-    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     sc = controller_scene(scene, res.alpha)
@@ -407,13 +413,7 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     """
     import time
 
-    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.transcription.virtual_constraints import (
-        collocate_virtual_constraints,
-        hzd_functions,
-        mid_stance_window,
-    )
 
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
@@ -516,9 +516,7 @@ def optimize_virtual_constraints(scene, plant, spec):
     ValueError
         As :func:`design_controllers`.
     """
-    from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal import outcome as reported
 
     data = plant.data
     walker = build_walker(scene, plant)  # one build for the design and the record

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import matplotlib
 
+from walkerlab.plotting.figures import draw_patches
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
@@ -253,7 +255,6 @@ def _draw_ground(ax, gx: np.ndarray, slope_rad: float, L: float, ground: dict | 
         ax.fill_between(sx, sy, sy.min() - 3 * L, color="0.85", lw=0)
         ax.plot(sx, sy, color="k", lw=1)
     elif ground is not None and not ground["continuous"]:  # patches over gaps
-        from walkerlab.plotting.figures import draw_patches
 
         draw_patches(ax, ground, slope_rad, 0.12 * L)
         ax.plot(gx, gy, color="0.6", lw=0.8, ls=":")

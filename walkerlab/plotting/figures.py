@@ -15,6 +15,8 @@ from pathlib import Path
 
 import matplotlib
 
+from walkerlab.plotting.figure_cache import KEY_CHUNK
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
@@ -55,7 +57,6 @@ def save(fig, folder: Path, stem: str, svg: bool = True, key: str | None = None
         The folder cannot be written (one line).
     """
     from walkerlab.io.artifacts import atomic_write
-    from walkerlab.plotting.figure_cache import KEY_CHUNK
 
     folder = Path(folder)
     out = []

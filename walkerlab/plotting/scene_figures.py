@@ -11,10 +11,12 @@ from collections.abc import Callable, Collection
 from functools import partial
 from pathlib import Path
 
+from walkerlab.io.schemas.workprecision import pareto
 from walkerlab.io.trajectory import NamedTrajectory
-from walkerlab.plotting import IDEAL_LABEL
+from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
 from walkerlab.plotting import figures as F
-from walkerlab.units import Units
+from walkerlab.plotting.figure_3d import top_and_front
+from walkerlab.units import Units, for_scene
 
 #: stems of the trajectory figures drawn from the rigid run (``simulate.h5``) alone: the same
 #: figure whether or not the scene also has a contact run
@@ -46,8 +48,6 @@ def trajectory_plan(trajs: dict[str, NamedTrajectory], title: str, slope_rad: fl
         plan.append((stem, partial(F.stick_diagram, tr, label, slope_rad=slope_rad,
                                    units=units, terrain=ground)))
     if any(len(p) > 2 for tr in trajs.values() for p in tr.points.values()):
-        from walkerlab.plotting.figure_3d import top_and_front
-
         plan.append(("gait_3d_top_front", partial(top_and_front, trajs, title,
                                                   units=units)))
     plan += [("fig7_angles_rates", partial(F.fig7_angles_rates, trajs, title, units=units)),
@@ -82,9 +82,6 @@ def scene_figure_plan(scene, sim, contact, terrain, compare) -> list[tuple[str, 
     compare : CompareArtifact, optional
         Loaded ``compare.h5``.
     """
-    from walkerlab.plotting import CONTACT_LABEL
-    from walkerlab.units import for_scene
-
     trajs = {label: a.samples for label, a in ((IDEAL_LABEL, sim), (CONTACT_LABEL, contact))
              if a is not None}
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
@@ -112,8 +109,6 @@ def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Pat
 def workprecision_figures(wp, out_dir: Path, units: Units) -> list[Path]:
     """One work-precision diagram per model of a loaded ``workprecision.h5`` (``wp``), with
     its Pareto front; returns the written files."""
-    from walkerlab.io.schemas.workprecision import pareto
-
     written: list[Path] = []
     for model, m in wp.models.items():
         rows = {meth: {k: v for k, v in cols.items() if k != "repeats"}

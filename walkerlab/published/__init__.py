@@ -19,9 +19,7 @@ from types import ModuleType
 
 def available() -> list[str]:
     """Names of the published-number modules shipped (``paper``, ...)."""
-    import walkerlab.published as pkg
-
-    return sorted(m.name for m in pkgutil.iter_modules(pkg.__path__))
+    return sorted(m.name for m in pkgutil.iter_modules(__path__))
 
 
 def for_scene(scene) -> ModuleType | None:

@@ -20,6 +20,7 @@ import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections, study_sections
+from walkerlab.report.attribution_section import attribution_section
 from walkerlab.report.figures_section import figures_section, ledger_section
 from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.report.robustness_section import mfpt_section, robustness_section
@@ -132,7 +133,6 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     pub = for_scene(scene)
-    from walkerlab.report.attribution_section import attribution_section
 
     md = _header(scene)
     arts = inputs.artifacts

@@ -15,6 +15,7 @@ from types import ModuleType
 
 import numpy as np
 
+from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.stage_files import CONTACT_SIM, SIMULATE
 from walkerlab.report.ground_text import ground_contact_text, twist_text
 from walkerlab.report.markdown import num, printed, sig_digits, table
@@ -88,8 +89,6 @@ def _fixedpoint_summary(fp, pub, u, bullets: list, rows: list) -> None:
 def _contact_verdict(c) -> str:
     """The contact walker's verdict (:func:`summary_section`): whether it walks, from the
     steps stored with the run (an older artifact: its outcome), and its own periodic gait."""
-    from walkerlab.integrate.ends import CONTACT_WALKED
-
     walks = c.walks if c.walks is not None else c.outcome in CONTACT_WALKED
     extra = ""
     if c.periodic is not None and c.periodic.found:

@@ -7,7 +7,7 @@ import numpy as np
 
 from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.report.markdown import num
-from walkerlab.units import Units, per_map
+from walkerlab.units import Units, field_unit, per_map
 
 #: the main results of each swept stage (columns of ``points``), in the order printed
 MAIN_COLUMNS = {
@@ -41,8 +41,6 @@ def sweep_text(data: dict) -> str:
     """``5 points: ok 5``, then for each main result its range over the points that walk
     (``step_period_s 0.7036 .. 0.7343 s over slope.angle_deg 1 .. 3 deg``), of a loaded
     sweep (:func:`walkerlab.io.sweep_store.load_sweep`)."""
-    from walkerlab.units import field_unit
-
     units = Units(str(data["attrs"].get("scene_units", "SI")))
     outcome = np.asarray(data["points"]["outcome"]).astype(str)
     kinds, counts = np.unique(outcome, return_counts=True)

@@ -18,6 +18,7 @@ from walkerlab.config import Scene
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.attribution import AttributionRun, write_attribution
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.models.contact.scene import build
 from walkerlab.stages.common import StageError, StageOutcome, run_cached, with_defaults
 from walkerlab.stages.registry import attribution_refused
 
@@ -45,7 +46,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     def compute():
         from walkerlab.analysis.contact.attribution import adjustment_effect, attribute
-        from walkerlab.models.contact.scene import build
         from walkerlab.walker.plant import Plant  # light
 
         fp = load_fixedpoint(up[0])

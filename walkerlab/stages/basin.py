@@ -17,6 +17,7 @@ from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.plotting.artifact_figures import save_basin_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.studies.basin import BasinError, basin_run
 
 SECTIONS = ("walker", "slope", "ideal", "basin")
 
@@ -56,8 +57,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     with ``workers`` local processes or a Dask ``scheduler``; ``resume`` continues an
     interrupted run.  Raises StageError: no ``fixedpoint`` section, bad basin settings."""
     check_periodic_ground(scene.terrain, "the basin of attraction")
-
-    from walkerlab.studies.basin import BasinError, basin_run
 
     grid, workers = check(scene, grid, workers)
     up, name = stage_artifact(scene, runs_root, "fixedpoint"), stem(scene, grid)

@@ -15,8 +15,11 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.config.options import bifurcation_options
 from walkerlab.io.runpaths import bifurcation_stem, figures_dir
+from walkerlab.io.schemas.bifurcation import bifurcation_writer, load_bifurcation
 from walkerlab.models.hybrid.ground import check_periodic_ground
+from walkerlab.plotting.artifact_figures import save_bifurcation_figure
 from walkerlab.stages.common import StageOutcome, run_cached, with_defaults
+from walkerlab.studies.bifurcation import bifurcation_diagram, diagram_summary, grid_key
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 
@@ -40,10 +43,6 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
         before anything runs; :func:`walkerlab.studies.bifurcation.grid_key`).
     """
     check_periodic_ground(scene.terrain, "the bifurcation diagram")
-
-    from walkerlab.io.schemas.bifurcation import bifurcation_writer, load_bifurcation
-    from walkerlab.plotting.artifact_figures import save_bifurcation_figure
-    from walkerlab.studies.bifurcation import bifurcation_diagram, diagram_summary, grid_key
 
     scene = with_defaults(scene, "fixedpoint", "bifurcation")
     n_transient, n_keep, workers = bifurcation_options(n_transient, n_keep, workers)

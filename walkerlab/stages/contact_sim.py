@@ -17,8 +17,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from walkerlab.analysis.contact.record import contact_sim_run
+from walkerlab.analysis.contact.warm import compile_rhs_kernels, compile_run_kernels
+from walkerlab.codegen.pending import CompiledElsewhere
 from walkerlab.config import Scene, SceneError
 from walkerlab.config.options import with_contact_strides
+from walkerlab.integrate.contact_grid import COMPILED_METHODS
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.artifacts import ArtifactError
 from walkerlab.io.runpaths import stage_artifact
@@ -32,6 +35,7 @@ from walkerlab.stages.common import (
     run_cached,
     with_defaults,
 )
+from walkerlab.usercache import use_for_numba
 from walkerlab.walker.plant import Plant
 
 if TYPE_CHECKING:
@@ -45,7 +49,7 @@ SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_sol
 
 
 def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool):
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         run = contact_sim_run(setup, load_fixedpoint(fixedpoint), adjust, periodic)
@@ -68,8 +72,7 @@ def rhs_beside(setup: ContactSetup, side: Callable[[], SideWorker]
     future, else None: a warm run, no user cache to share the kernel through, a walk on
     scipy's solvers, or no side process (disabled, or it broke).  The numbers are the same
     either way."""
-    from walkerlab.codegen.pending import CompiledElsewhere
-    from walkerlab.models.contact.generated import contact_module_state
+    from walkerlab.models.contact.generated import contact_module_state  # light
 
     name, cached = contact_module_state(setup.walker.structure)
     if cached is not False or not _compiled_walk(setup):
@@ -217,17 +220,12 @@ def warm_up(scene: Scene) -> bool:
     walkerlab.models.contact.scene.ContactSceneError
         As :func:`run` (no ``contact`` section, a walker that cannot stand on contacts).
     """
-    from walkerlab.analysis.contact.warm import compile_run_kernels
-    from walkerlab.usercache import use_for_numba
-
     use_for_numba()  # the same cache folder as the run's (set before numba is imported)
     return compile_run_kernels(contact_setup(scene, plant=Plant.from_scene(scene)))
 
 
 def _compiled_walk(setup: ContactSetup) -> bool:
     """Whether the run integrates on the compiled right-hand side (CyRK's methods)."""
-    from walkerlab.integrate.contact_grid import COMPILED_METHODS
-
     return setup.solver.method in COMPILED_METHODS
 
 
@@ -236,8 +234,5 @@ def warm_rhs(setup: ContactSetup) -> bool:
     cache (:func:`walkerlab.analysis.contact.warm.compile_rhs_kernels`; the side process of
     a cold :func:`run`).  Returns False when nothing was compiled (numba is not installed).
     """
-    from walkerlab.analysis.contact.warm import compile_rhs_kernels
-    from walkerlab.usercache import use_for_numba
-
     use_for_numba()  # the same cache folder as the run's (set before numba is imported)
     return compile_rhs_kernels(setup)

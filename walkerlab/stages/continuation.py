@@ -10,10 +10,14 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from walkerlab.analysis.continuation.gait_map import MapFailed
 from walkerlab.config import Scene
-from walkerlab.io.runpaths import figures_dir
+from walkerlab.io.runpaths import bifurcation_artifacts, continuation_stem, figures_dir
+from walkerlab.io.schemas.bifurcation import load_bifurcation
+from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
 from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.studies.continuation import check_continuation, run_continuation
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 
@@ -36,17 +40,12 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     """
     check_periodic_ground(scene.terrain, "continuation")
 
-    from walkerlab.analysis.continuation.gait_map import MapFailed
-    from walkerlab.io.runpaths import bifurcation_artifacts, continuation_stem
-    from walkerlab.io.schemas.bifurcation import load_bifurcation
-    from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
     from walkerlab.plotting.continuation_figures import (  # light
         continuation_figure,
         cost_of_transport_figure,
         two_parameter_figure,
     )
     from walkerlab.plotting.figures import save  # light
-    from walkerlab.studies.continuation import check_continuation, run_continuation
 
     require(scene, "fixedpoint", "continuation")
     if switch not in (0, 1, 2):

@@ -26,7 +26,13 @@ from walkerlab.export.mjcf_scene import MjcfOptions
 from walkerlab.export.multibody import SIDECAR  # noqa: F401 (part of this API)
 from walkerlab.export.writers import WRITERS, Exported, ExportJob, walk_file
 from walkerlab.io import runpaths
+from walkerlab.io.artifacts import ArtifactError, code_hash, root_attrs, verified_hash
+from walkerlab.io.freshness import changed_fields
+from walkerlab.io.schemas.contact_sim import load_step_periods
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.stage_files import CONTACT_SIM
+from walkerlab.models.contact.terrain import ground_drops
+from walkerlab.stages.pipeline import fresh_fixedpoint, stage_module
 from walkerlab.walker.plant import Plant
 
 
@@ -51,10 +57,6 @@ def stored_gait(scene: Scene, runs_root: Path | str):
     gait, :class:`walkerlab.io.schemas.fixedpoint.GaitResult`), or None: missing, stale, or
     of another equation variant (then the export searches, as ``walkerlab fixedpoint``
     would)."""
-    from walkerlab.io.artifacts import ArtifactError
-    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-    from walkerlab.stages.pipeline import fresh_fixedpoint
-
     path = fresh_fixedpoint(scene, runs_root)
     if path is None:
         return None
@@ -69,8 +71,8 @@ def _gait(scene: Scene, runs_root, build, plant):
     """``(ideal, build(ideal))``: the rigid gait (:func:`stored_gait`, else searched as the
     writers search it) and what ``build`` makes of it; no rigid gait: one line."""
     # light: the gait search's modules, only when a writer asks for the gait
-    from walkerlab.analysis.contact.periodic import ideal_gait
-    from walkerlab.analysis.gait.poincare import FixedPointNotFound
+    from walkerlab.analysis.contact.periodic import ideal_gait  # light
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound  # light
 
     try:
         ideal = stored_gait(scene, runs_root)
@@ -136,7 +138,6 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         if not writer.ground:  # its cell of that ground (the URDF's refuses every one)
             plant.kind.require(
                 scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")
-        from walkerlab.models.contact.terrain import ground_drops
 
         drops = ground_drops(scene.terrain)  # a profile: one line
     if walk and walker_only:
@@ -179,11 +180,6 @@ def contact_period(scene: Scene, runs_root) -> float:
     of ``contact_sim.h5`` when it is up to date for ``scene`` (its sections and walkerlab's
     code unchanged), else NaN (nothing is computed: run ``walkerlab contact-sim`` first)."""
     import numpy as np
-
-    from walkerlab.io.artifacts import ArtifactError, code_hash, root_attrs, verified_hash
-    from walkerlab.io.freshness import changed_fields
-    from walkerlab.io.schemas.contact_sim import load_step_periods
-    from walkerlab.stages.pipeline import stage_module
 
     try:
         path = runpaths.stage_artifact(scene, runs_root, CONTACT_SIM.name)

@@ -9,8 +9,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from walkerlab.config import Scene, SceneError
-from walkerlab.io.schemas.fixedpoint import write_fixedpoint
+from walkerlab.config import Scene, SceneError, load_scene
+from walkerlab.config.loader import default_scene_path
+from walkerlab.io.artifacts import root_attrs, verified_hash
+from walkerlab.io.freshness import input_hash
+from walkerlab.io.runpaths import RunPathError, stage_artifact
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint, write_fixedpoint
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
@@ -48,9 +52,6 @@ FROM_ATTR = "homotopy_from"
 def _stored_from(scene: Scene, runs_root) -> str:
     """The :func:`_from_key` the scene's ``fixedpoint.h5`` was found with ("": none, or no
     artifact)."""
-    from walkerlab.io.artifacts import root_attrs
-    from walkerlab.io.runpaths import stage_artifact
-
     key = root_attrs(stage_artifact(scene, runs_root, "fixedpoint"), FROM_ATTR)
     return str(key.get(FROM_ATTR, ""))
 
@@ -72,10 +73,6 @@ def fresh_artifact(scene: Scene, runs_root: Path | str = "runs") -> Path | None:
 
     Read-only: nothing is computed or written, no lock is taken.
     """
-    from walkerlab.io.artifacts import verified_hash
-    from walkerlab.io.freshness import input_hash
-    from walkerlab.io.runpaths import RunPathError, stage_artifact
-
     try:
         path = stage_artifact(scene, runs_root, "fixedpoint")
         from_key = _from_key(_known(scene, None))
@@ -98,8 +95,6 @@ def stored_gaits(scene: Scene, runs_root: Path | str) -> list:
     scene's own stale one too) whose walker model is the scene's, as
     :class:`walkerlab.studies.warm_start.StoredGait` (the fixed point read only when one is
     chosen); unreadable ones are passed over."""
-    from walkerlab.io.artifacts import root_attrs
-    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.studies.warm_start import StoredGait  # only when the guess failed
 
     root = Path(runs_root)
@@ -135,8 +130,6 @@ def guess_owners(scene: Scene) -> list:
     -------
     list of StoredGait
     """
-    from walkerlab.config import load_scene
-    from walkerlab.config.loader import default_scene_path
     from walkerlab.studies.warm_start import StoredGait  # only when the guess failed
     if not _may_have_guess_owner(scene):
         return []
@@ -176,8 +169,8 @@ def _may_have_guess_owner(scene: Scene) -> bool:
 def _own_gait(scene: Scene):
     """The gait ``scene``'s own initial guess converges to (no fallback starts: a guess
     that fails there says so); ValueError when it does not."""
-    from walkerlab.analysis.gait.scene import initial_guess, solve_scene
-    from walkerlab.analysis.gait.search import GaitNotFound
+    from walkerlab.analysis.gait.scene import initial_guess, solve_scene  # light
+    from walkerlab.analysis.gait.search import GaitNotFound  # light
     from walkerlab.models.registry import build_walker
     from walkerlab.walker.plant import Plant  # light
 
@@ -196,7 +189,7 @@ def _nearby(scene: Scene, runs_root):
     (:func:`guess_owners`), as a fallback start of the gait search (carried here), or
     None; the scene files are read only when the start is tried."""
     from walkerlab.analysis.gait.starts import FallbackStart  # only for a compute
-    from walkerlab.studies.warm_start import stored_gait_start
+    from walkerlab.studies.warm_start import stored_gait_start  # light
 
     stored = stored_gaits(scene, runs_root)
     if not _may_have_guess_owner(scene):
@@ -236,15 +229,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     def compute():
         # the rigid analysis only when the gait is computed: a run that reuses fixedpoint.h5
         # (every downstream stage's upstream check) imports none of it
-        from walkerlab.analysis.gait.scene import fixed_point_run
-        from walkerlab.analysis.gait.search import GaitNotFound
+        from walkerlab.analysis.gait.scene import fixed_point_run  # light
+        from walkerlab.analysis.gait.search import GaitNotFound  # light
         from walkerlab.walker.plant import Plant  # light
 
         plant = Plant.from_scene(scene)  # the walker described once, handed down
         guess = note = nearby = None
         try:
             if src is not None:  # the known gait carried here
-                from walkerlab.studies.continuation import homotopy_start
+                from walkerlab.studies.continuation import homotopy_start  # light
 
                 guess, note = homotopy_start(scene, src)
             else:  # a gait stored nearby: a start should the scene's own guess fail

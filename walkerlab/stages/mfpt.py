@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from walkerlab import progress
 from walkerlab.config import Scene
 from walkerlab.config.options import mfpt_options
 from walkerlab.io.freshness import input_hash
@@ -17,6 +18,7 @@ from walkerlab.io.schemas import mfpt as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.plotting.artifact_figures import save_mfpt_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.studies.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt")
 
@@ -66,13 +68,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     montecarlo or both) on ``workers`` local processes or a Dask ``scheduler``, and draw it.
     Raises StageError (one line): no ``fixedpoint`` section, or a walker the study cannot
     carry (:class:`walkerlab.studies.mfpt.MfptStudyError`)."""
-    from walkerlab.studies.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
-
     st, workers = check(scene, sigma_rad, method, workers)
     per = scene.terrain.per_step if scene.terrain is not None else None
     if per is not None and per.slope_sd_rad > 0 and getattr(st, "sigma_m", None) is None:
-        from walkerlab import progress
-
         progress.note(f"mfpt: terrain.per_step.slope_sd_rad ({per.slope_sd_rad:g} rad) is not "
                       "used: the study sweeps mfpt.sigma_rad (--sigma-rad) "
                       f"{', '.join(f'{v:g}' for v in st.sigma_rad)} rad")

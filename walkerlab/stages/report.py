@@ -18,8 +18,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from walkerlab import progress
+from walkerlab.comparison.report_numbers import report_numbers
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir, report_dir
+from walkerlab.io.schemas.loaders import load_artifact
 from walkerlab.io.stage_files import ATTRIBUTION, BIFURCATION, CONTACT_SIM, SIMULATE, WORKPRECISION
 from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.common import StageError
@@ -27,6 +30,7 @@ from walkerlab.stages.pipeline import report_plan
 from walkerlab.stages.registry import attribution_refused
 from walkerlab.stages.report_dag import run_report
 from walkerlab.stages.report_inputs import animation_current, report_artifacts
+from walkerlab.studies.bifurcation import fall_onset, onset_value
 
 
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
@@ -34,10 +38,6 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     whose figure is in ``figures``) through :mod:`walkerlab.io.schemas`, with the numbers
     computed from them (:func:`walkerlab.comparison.report_numbers.report_numbers`; the
     bifurcation diagrams' onsets: :mod:`walkerlab.studies.bifurcation`)."""
-    from walkerlab.comparison.report_numbers import report_numbers
-    from walkerlab.io.schemas.loaders import load_artifact
-    from walkerlab.studies.bifurcation import fall_onset, onset_value
-
     if CONTACT_SIM.name in paths:
         maps = (paths[CONTACT_SIM.name].parent / f"stability_map_{k}.h5"
                 for k in ("stiffness", "friction", "patch_width"))
@@ -56,8 +56,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
     ``full``: also the work-precision study and the attribution
     (:func:`walkerlab.stages.pipeline.report_plan`).  Returns the HTML report."""
-    from walkerlab import progress
-
     stages = report_plan(scene, full)
     if not stages:
         raise StageError(f"scene '{scene.name}' gives the report nothing to run: add a "

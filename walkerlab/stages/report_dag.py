@@ -17,6 +17,7 @@ from __future__ import annotations
 import importlib
 
 from walkerlab.config import Scene
+from walkerlab.execution.background import BackgroundStudy
 from walkerlab.execution.side import SideWorker
 from walkerlab.io.stage_files import SIMULATE, WORKPRECISION
 from walkerlab.stages.pipeline import report_plan, stage_module
@@ -53,7 +54,6 @@ def _study(scene: Scene, runs_root, force: bool):
     (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
     the contact model's kernels are compiled."""
     from walkerlab.bench.workprecision import start_worker  # light
-    from walkerlab.execution.background import BackgroundStudy
     from walkerlab.io.runpaths import stage_artifact  # light
 
     wp = stage_module(WORKPRECISION.name)

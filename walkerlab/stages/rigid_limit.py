@@ -16,7 +16,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.config import Scene
+from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, write_rigid_limit
+from walkerlab.models.contact.rigid_limit import expected_order
+from walkerlab.models.contact.scene import build
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
@@ -48,8 +51,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     def compute():
         from walkerlab.analysis.contact.periodic import ideal_gait  # light
         from walkerlab.analysis.contact.rigid_limit import convergence, observed_order  # light
-        from walkerlab.models.contact.rigid_limit import expected_order
-        from walkerlab.models.contact.scene import build
         from walkerlab.walker.plant import Plant  # light
 
         plant = Plant.from_scene(scene)  # the walker described once, handed down
@@ -90,7 +91,6 @@ def _periodic_gait_taken(scene: Scene) -> None:
 
 def draw(scene: Scene, runs_root: Path | str, path: Path) -> list[Path]:
     """Draw ``rigid_limit.png/svg`` into the scene's figures folder from the artifact."""
-    from walkerlab.io.runpaths import figures_dir
     from walkerlab.plotting.figures import save  # light
     from walkerlab.plotting.rigid_limit_figure import rigid_limit_figure  # light
 

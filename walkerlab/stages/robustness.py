@@ -17,6 +17,7 @@ from walkerlab.io.schemas import robustness as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.studies.robustness_study import scene_robustness
 from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
@@ -46,8 +47,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
         Missing sections, or a walker the batched step map cannot carry (one line).
     """
     check_periodic_ground(scene.terrain, "the robustness study")
-
-    from walkerlab.studies.robustness_study import scene_robustness
 
     workers = check(scene, workers)
     up = stage_artifact(scene, runs_root, "fixedpoint")

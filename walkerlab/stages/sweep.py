@@ -14,6 +14,7 @@ from pathlib import Path
 from walkerlab.config import CommandOptions, Scene, load_scene, validate_option
 from walkerlab.io.runpaths import figures_dir, named_artifact
 from walkerlab.io.stage_files import CONTACT_SIM
+from walkerlab.io.sweep_store import load_sweep
 from walkerlab.studies.params import ParamAxis, SweepError, params_hash, parse_param, sweep_axes
 from walkerlab.studies.runner import run_sweep
 
@@ -76,7 +77,6 @@ def figure_path(scene: Scene, path: Path, runs_root: str | Path = "runs") -> Pat
 def draw(scene: Scene, path: Path, runs_root: str | Path = "runs") -> list[Path]:
     """Draw the sweep's main results against its first swept field (PNG + SVG) from the
     artifact ``path`` (:func:`walkerlab.plotting.sweep_figures.sweep_figure`)."""
-    from walkerlab.io.sweep_store import load_sweep
     from walkerlab.plotting.sweep_figures import save, sweep_figure  # light
 
     fig = sweep_figure(load_sweep(path), f"scene '{scene.name}'")

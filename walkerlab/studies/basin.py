@@ -41,6 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab import progress
+from walkerlab.execution.executor import run_each
 from walkerlab.studies.basin_cell import (  # noqa: F401 (part of this API)
     CODE,
     OUTCOMES,
@@ -105,8 +107,6 @@ def _resumed_cells(part: Path, key: str, nx: int, ny: int):
         arrays["steps"][j] = 0
         arrays["period"][j] = 0
     if bad:
-        from walkerlab import progress
-
         progress.note(f"{part}: {bad} grid row(s) failed their integrity check; "
                       "computing them again")
     return arrays, row_hash
@@ -220,8 +220,6 @@ def _run_basin_tasks(tasks: list[BasinTask], part: Path, key: str, arrays: dict,
     :func:`walkerlab.studies.runner.sweep_executor`, storing each chunk's cells in
     ``arrays`` (and the hash of every grid row it completes in ``row_hash``), writing the
     partial file ``part`` and reporting progress after each; returns the cells computed."""
-    from walkerlab import progress
-    from walkerlab.execution.executor import run_each
     from walkerlab.io.basin_partial import basin_partial_writer  # light
     from walkerlab.studies.runner import sweep_executor  # light
 

@@ -37,6 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.config import BasinSettings, scene_from_dict
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.integrate.solver import Solver
 from walkerlab.studies.basin_slice import (
     BasinError,
     heel_strike_slice,
@@ -68,8 +71,6 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
         Period of the attractor reached, in Poincare maps (strides when the legs differ;
         1 for the fixed point, 0 if none).
     """
-    from walkerlab.integrate.rigid import integrate_step
-
     x = np.asarray(x0, dtype=float)
     hist = [x]
     per_map = walker.steps_per_map  # legs that differ: the section is reached every stride
@@ -124,7 +125,7 @@ def family_member(walker, x: np.ndarray, solver, max_step_time: float = 5.0
         The member's post-impact state [rad, rad/s]; None where the root finder finds none.
     """
     # light: only a walker with neutral coordinates needs the root finder
-    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point  # light
 
     try:
         res = find_fixed_point(walker, x, solver, fd_check=False, max_step_time=max_step_time)
@@ -161,7 +162,6 @@ def walker_and_settings(base: dict):
     """``(walker, basin settings, max step time [s])`` of a scene mapping, built once per
     process (the last scene's kept); the settings' axes are the walker's
     (:func:`default_axes`) when the scene names none."""
-    from walkerlab.config import BasinSettings, scene_from_dict
     from walkerlab.models.registry import build_walker
 
     key = json.dumps(base, sort_keys=True)
@@ -197,8 +197,6 @@ def default_axes(walker, axes: tuple[str, str]) -> tuple[str, str]:
 
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
-    from walkerlab.integrate.solver import Solver
-
     walker, st, max_step_time = walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
     x_star = np.asarray(task.x_star, dtype=float)
@@ -226,9 +224,6 @@ def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: 
     BasinError
         The step from ``x_star`` does not end in a heel strike.
     """
-    from walkerlab.integrate.rigid import integrate_step
-    from walkerlab.integrate.solver import Solver
-
     solver = Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend)
     x = np.asarray(x_star, dtype=float)
     for k in range(walker.steps_per_map):  # legs that differ: the stride's closing step

@@ -16,7 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.analysis.contact import rough as C
+from walkerlab.analysis.robustness.measures import bracket_flip
 from walkerlab.analysis.robustness.mfpt import MonteCarloResult
+from walkerlab.execution.executor import run_each
 from walkerlab.models.contact import terrain as T
 
 __all__ = ["ContactWalkTask", "contact_monte_carlo", "contact_largest_step", "run_contact_walk"]
@@ -39,7 +41,6 @@ def run_contact_walk(task: ContactWalkTask):
 
 
 def _walk_all(tasks, workers, scheduler, done=None):
-    from walkerlab.execution.executor import run_each
     from walkerlab.studies.runner import sweep_executor  # light
 
     out = {}
@@ -115,8 +116,6 @@ def contact_largest_step(start: C.ContactStart, sign: float, max_value_m: float,
     strikes (:func:`walkerlab.analysis.robustness.measures.bracket_flip`; the ``sections - 1``
     walks of a round run as tasks at once).  ``(nan, 0.0)``: the walker does not make
     ``steps`` heel strikes even without a step (its gait does not fit the lanes)."""
-    from walkerlab.analysis.robustness.measures import bracket_flip
-
     n = steps + 6
 
     def survive(values):

@@ -16,8 +16,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab import progress as _progress
+from walkerlab.analysis.contact.rough import contact_start
 from walkerlab.analysis.robustness import mfpt as M
+from walkerlab.config import MfptSettings, scene_from_dict
+from walkerlab.execution.dask import DaskLost
+from walkerlab.execution.executor import run_each
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.integrate.python_step import make_step_map
+from walkerlab.models.contact.scene import ContactSceneError
+from walkerlab.models.hybrid.ground import with_clearance_guard
+from walkerlab.studies.contact_rough import contact_monte_carlo
 
 #: walks per Monte Carlo task, rows per mesh task
 WALKS_PER_TASK = 500
@@ -51,8 +59,6 @@ def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
         ``heights`` for a walker without compiled flows or on a ground other than a slope
         (one line).
     """
-    from walkerlab.config import MfptSettings, scene_from_dict
-    from walkerlab.integrate.python_step import make_step_map
     from walkerlab.models.registry import build_walker
     from walkerlab.walker.plant import Plant  # light
 
@@ -64,7 +70,6 @@ def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
         walker = build_walker(scene, plant)
         if heights:
             from walkerlab.integrate.python_step import needs_python_path
-            from walkerlab.models.hybrid.ground import with_clearance_guard
 
             if needs_python_path(walker) or walker.variant != "derived":
                 raise ValueError("mfpt.sigma_m: per-step heights need the compiled, generated "
@@ -170,7 +175,6 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     censored geometric estimate of Byl & Tedrake (2009) is
     :attr:`~walkerlab.analysis.robustness.mfpt.MonteCarloResult.mfpt` [steps].
     """
-    from walkerlab.execution.executor import run_each
     from walkerlab.studies.runner import sweep_executor  # light
 
     base = scene.model_dump(mode="json")
@@ -214,8 +218,6 @@ def image_evaluator(scene, ex):
     :func:`M.mesh_mfpt`; one worker pool serves every mesh of a refinement): ``X`` (k, 2n)
     post-impact states [rad, rad/s], ``gamma`` (k,) slopes [rad] -> ``x_next`` (k, 2n),
     ``ok`` (k,) bool (heel strike)."""
-    from walkerlab.execution.executor import run_each
-
     base = scene.model_dump(mode="json")
 
     def evaluate(X, gamma):
@@ -379,8 +381,6 @@ def _one_sigma(scene, x_star, st, i, sd, vals, hist, contact, start, seed, dist,
     import time
 
     if contact:
-        from walkerlab.studies.contact_rough import contact_monte_carlo
-
         t = time.perf_counter()
         mc, _ = contact_monte_carlo(start, sd, st.walks, st.max_steps, seed, dist,
                                     workers, scheduler, partial)
@@ -442,9 +442,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
 
 def _contact_start(scene, x_star: np.ndarray, st, plant):
     """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
-    from walkerlab.analysis.contact.rough import contact_start
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
-    from walkerlab.models.contact.scene import ContactSceneError
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     if st.method != "montecarlo":
         raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
@@ -506,7 +504,6 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
         The Dask cluster was lost (one line advising :data:`RERUN`; the partial file is
         kept).
     """
-    from walkerlab.execution.dask import DaskLost
     from walkerlab.io.mfpt_partial import MfptPartial  # light
 
     partial = MfptPartial(partial_path, key, resume=resume)

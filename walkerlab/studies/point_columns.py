@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
 from walkerlab.studies.outcomes import state_column
 
 __all__ = ["interleg_angle"]
@@ -52,7 +53,6 @@ def _fp_columns(walker, res) -> dict:
                 variational_maps=float(res.variational_maps), nfev=float(res.nfev))
     ctrl = getattr(getattr(walker, "actuators", None), "controller", None)
     if ctrl is not None:  # virtual constraints: the restricted map beside the full one
-        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
 
         z = zero_dynamics(ctrl)
         cols.update(delta2=z.delta2, v_minus=z.v_minus, v_max=z.v_max,

@@ -13,7 +13,11 @@ from typing import Any
 
 import numpy as np
 
-from walkerlab.config import Scene
+from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
+from walkerlab.analysis.gait.scene import hzd_start, solve_scene
+from walkerlab.analysis.gait.search import GaitNotFound
+from walkerlab.config import FixedPointSettings, Scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.studies.guess import Continuation
 from walkerlab.studies.point_columns import interleg_angle
@@ -37,8 +41,6 @@ class PointOutcome(Exception):
 
 def scene_solver(scene: Scene):
     """The scene's ``solver`` section as a :class:`walkerlab.integrate.solver.Solver`."""
-    from walkerlab.integrate.solver import Solver
-
     return Solver.from_settings(scene.solver)
 
 
@@ -76,11 +78,9 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     PointOutcome
         ``no_fixed_point`` (with the best residual) or ``invalid_config`` (no section).
     """
-    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
     from walkerlab.models.registry import build_walker
 
     opts = {**DEFAULT_OPTIONS, **(options or {})}
-    from walkerlab.config import FixedPointSettings
 
     fp = scene.fixedpoint or FixedPointSettings()  # every field optional: the defaults
     walker = build_walker(scene, plant=Plant.from_scene(scene))
@@ -95,8 +95,6 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     if fp.initial_guess is not None:
         tries.append(("scene", initial_state(fp.initial_guess, walker.state_names()), None))
     else:
-        from walkerlab.analysis.gait.scene import hzd_start
-
         x_hzd = hzd_start(walker)  # virtual constraints: the zero dynamics' orbit
         if x_hzd is not None:
             tries.append(("zero_dynamics", x_hzd, None))
@@ -156,9 +154,6 @@ def scene_gait(scene: Scene, options: dict | None = None):
         gait whose inter-leg angle is below ``options["min_interleg_angle_rad"]``) or
         ``invalid_config`` (a malformed initial guess or gait choice).
     """
-    from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.analysis.gait.search import GaitNotFound
-
     opts = {**DEFAULT_OPTIONS, **(options or {})}
     try:
         fp = scene.fixedpoint
@@ -217,8 +212,6 @@ def on_study_map(scene: Scene, walker, res, steps_per_map: int | None):
     """
     if not steps_per_map or int(steps_per_map) == walker.steps_per_map:
         return walker, res
-    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
-    from walkerlab.config import FixedPointSettings
 
     fp = scene.fixedpoint or FixedPointSettings()
     try:

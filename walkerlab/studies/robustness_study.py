@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from walkerlab.analysis.contact.rough import contact_start
 from walkerlab.analysis.robustness.measures import (
     UNITS,
     gsn_nonlinear,
@@ -18,6 +19,12 @@ from walkerlab.analysis.robustness.measures import (
     relative_coordinates,
     state_gsn,
 )
+from walkerlab.config import RobustnessSettings
+from walkerlab.integrate.python_step import make_step_map
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.scene import ContactSceneError
+from walkerlab.studies import mfpt as work
+from walkerlab.studies.contact_rough import contact_largest_step
 
 
 def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None,
@@ -44,12 +51,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
         side: slower).
     """
     from walkerlab.analysis.gait.poincare import poincare_map  # light
-    from walkerlab.config import RobustnessSettings
-    from walkerlab.integrate.python_step import make_step_map
-    from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies import mfpt as work
 
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
     plant.kind.require_stage("robustness")
@@ -111,10 +114,7 @@ def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
             "contact_step_up_m/hi")
     if not getattr(st, "contact", False):
         return dict.fromkeys(keys, math.nan)
-    from walkerlab.analysis.contact.rough import contact_start
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
-    from walkerlab.models.contact.scene import ContactSceneError
-    from walkerlab.studies.contact_rough import contact_largest_step
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         start = contact_start(scene, x_star, plant=plant)

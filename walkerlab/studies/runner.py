@@ -61,6 +61,7 @@ from walkerlab import progress as _progress
 from walkerlab.config import MAX_SWEEP_POINTS, Scene
 from walkerlab.execution.executor import make_executor, run_chains
 from walkerlab.execution.workers import mp_context
+from walkerlab.io.runpaths import artifact_lock, refuse_link
 from walkerlab.io.sweep_store import (
     SweepColumns,
     SweepFileError,
@@ -256,7 +257,6 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
                          f"({' x '.join(str(len(a)) for a in axes)}); at most "
                          f"{MAX_GRID_POINTS:,} are allowed")
     opts = {**DEFAULT_OPTIONS, **(options or {})}
-    from walkerlab.io.runpaths import artifact_lock, refuse_link
 
     out_path = refuse_link(Path(out_path))  # the artifact is never written through a link
 

@@ -17,6 +17,7 @@ from walkerlab.walker.capability_evidence import (
     UNVERIFIED,
     cell_evidence,
     check_of,
+    evidence,
     not_checked,
     number,
     unverified_reason,
@@ -96,8 +97,6 @@ def _legend() -> list[str]:
 
 
 def _tolerances() -> str:
-    from walkerlab.walker.capability_evidence import evidence
-
     tol = evidence().get("tolerances", {})
     return "tolerances: " + "; ".join(f"{v}: {t}" for v, t in tol.items()) if tol else ""
 

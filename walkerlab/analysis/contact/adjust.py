@@ -22,6 +22,8 @@ import time
 import numpy as np
 from scipy.optimize import brute, minimize
 
+from walkerlab import progress
+
 #: Nelder-Mead's most contact runs after the grid
 NELDER_MEAD_RUNS = 60
 
@@ -101,8 +103,6 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
         :func:`~walkerlab.analysis.contact.sim.simulate_from` results of the scene's start
         (``"scene"``) and of the best start (``"best"``), so that neither is run again.
     """
-    from walkerlab import progress
-
     cs = setup.sim
     budget = getattr(cs, "adjust_cpu_budget_s", None) if cpu_budget_s is None else cpu_budget_s
     scene_scale = np.asarray(cs.initial_rate_scale, float)

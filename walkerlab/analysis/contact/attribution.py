@@ -30,6 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
+
 __all__ = ["COMPLIANCE_OFF", "CREEP_OFF", "Attribution", "adjustment_effect", "attribute",
            "energy_by_sink"]
 
@@ -179,8 +182,6 @@ def adjustment_effect(scene, ideal, strides: int = 5, *, plant) -> dict:
         ``rigid_heel_strikes``.
     """
     from walkerlab.analysis.contact.sim import simulate_from  # light
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.integrate.solver import Solver
     from walkerlab.models.contact.scene import contact_setup  # light
     from walkerlab.models.registry import build_walker
 

@@ -38,10 +38,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import root
 
+from walkerlab.analysis.contact.sim import scene_start, simulate_contact
 from walkerlab.analysis.contact.step_map import (
+    PeriodicGaitError,
     StepMap,
     section_guess_from_ideal,
 )
+from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+from walkerlab.config import FixedPointSettings
 from walkerlab.integrate.contact_grid import GRID_METHODS
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
@@ -159,7 +163,6 @@ def converged_gait(gait: ContactPeriodicGait) -> ContactPeriodicGait:
     """
     if gait.converged:
         return gait
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
 
     tol = gait.info.get("residual_tol", float("nan"))
     # the root finder's message, to its first clause ("The iteration is not making good
@@ -187,7 +190,6 @@ def ideal_gait(scene, plant):
     from walkerlab.models.registry import build_walker
 
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
-    from walkerlab.config import FixedPointSettings
 
     fp = sc.fixedpoint or FixedPointSettings()  # every field optional: the defaults
     iw = build_walker(sc, plant)  # the variant changes the equations, not the description
@@ -198,8 +200,6 @@ def ideal_gait(scene, plant):
     if ctrl is not None:  # virtual constraints: from their zero dynamics' orbit, as
         # walkerlab fixedpoint starts (seeds off the constraint surface can leave the
         # controller's domain: a math domain error in its flow)
-        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
-
         zd = zero_dynamics(ctrl)
         guess = zd.x_plus if zd.exists else None
     return find_gaits(iw, Solver.from_settings(sc.solver), guess,
@@ -542,8 +542,6 @@ def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None 
         The periodic gait was not found (fell, no mid-stance, solver failure, time limit,
         not converged: :func:`converged_gait`).
     """
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact
-
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
     probe, _, limits, _ = scene_start(setup, x_ideal, n_strides)

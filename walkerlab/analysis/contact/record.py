@@ -9,13 +9,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.contact import sim as contact_run
+from walkerlab.analysis.contact.drop import restitution_curve
 from walkerlab.analysis.contact.ledger import (
     STEP_LEDGER_DESCRIPTIONS,
     STEP_LEDGER_UNITS,
     contact_step_ledger,
 )
 from walkerlab.config import ContactSettings
-from walkerlab.models.contact.scene import ContactSetup
+from walkerlab.config.contact import CONTACT_QUANTITIES
+from walkerlab.models.contact.scene import (
+    SEVERAL_STEPS_OUTCOME,
+    SEVERAL_STEPS_PERIODIC,
+    ContactSetup,
+)
 
 #: stiffness values of the drop test stored with every contact run, relative to the scene's
 #: own stiffness (the paper's k = 1e5 N/mm^2.2: 1e4 ... 1e9 N/mm^2.2)
@@ -39,9 +46,6 @@ def drop_test(law: ContactSettings, mass_kg: float) -> dict:
     reference stiffness defaults to the paper's 1e5 N/mm^2.2, far from e.g.
     round_feet.yaml's 4e9 N/m^2.2).
     """
-    from walkerlab.analysis.contact.drop import restitution_curve
-    from walkerlab.config.contact import CONTACT_QUANTITIES
-
     k, unit, _ = law.written("stiffness")
     if law.stiffness_family == "paper":
         law = law.with_written("reference_stiffness", k, unit)
@@ -142,8 +146,6 @@ def contact_walk(setup: ContactSetup, x_ideal: np.ndarray, period: float,
     walkerlab.analysis.contact.step_map.PeriodicGaitError
         ``start: periodic_gait`` and the gait was not found (one line naming the field).
     """
-    from walkerlab.analysis.contact import sim as contact_run
-
     cs = setup.sim
     adj = scale = gait = None
     tried = {}  # the --adjust search's runs of the scene's start and the best start
@@ -178,7 +180,7 @@ def _periodic_start(setup: ContactSetup, x_ideal, solver):
     :func:`~walkerlab.analysis.contact.periodic.simulate_from_periodic_gait`; its
     ``PeriodicGaitError`` again with the scene and the field named."""
     from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait  # light
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         return simulate_from_periodic_gait(setup, x_ideal, solver=solver)
@@ -206,7 +208,6 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     walkerlab.analysis.contact.step_map.PeriodicGaitError
         ``start: periodic_gait`` and the gait was not found (one line naming the field).
     """
-    from walkerlab.analysis.contact import sim as contact_run
     from walkerlab.io.schemas.contact_sim import ContactSimRun  # light
 
     cs = setup.sim
@@ -214,8 +215,7 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     walker, res, x0, step_length, scale, gait, adj = contact_walk(
         setup, fp.x, fp.step_period_s, adjust)
     if periodic and gait is None and setup.steps_differ:
-        from walkerlab.analysis.contact.step_map import PeriodicGaitError
-        from walkerlab.models.contact.scene import SEVERAL_STEPS_OUTCOME, SEVERAL_STEPS_PERIODIC
+        from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
         # the step map is one step's; this ground's gait is of several (not searched)
         gait_error = PeriodicGaitError(SEVERAL_STEPS_OUTCOME, SEVERAL_STEPS_PERIODIC)
@@ -224,7 +224,7 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
             converged_gait,
             find_contact_periodic_gait,
         )
-        from walkerlab.analysis.contact.step_map import PeriodicGaitError
+        from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
         try:  # an unconverged search is a gait not found (its outcome and message)
             gait = converged_gait(find_contact_periodic_gait(

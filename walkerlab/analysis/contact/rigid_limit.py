@@ -17,7 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from walkerlab.models.contact.parts import contact_part
 from walkerlab.models.contact.rigid_limit import scale_walker
+from walkerlab.models.contact.scene import ideal_step_length
 from walkerlab.numerics import sort_multipliers
 
 __all__ = ["RigidLimitTable", "convergence", "match_multipliers", "observed_order"]
@@ -139,8 +141,6 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
     RigidLimitTable
     """
     from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
-    from walkerlab.models.contact.parts import contact_part
-    from walkerlab.models.contact.scene import ideal_step_length
 
     rigid_steps = max(1, len(getattr(ideal, "step_periods_s", ()) or ()))
     lam_r = np.asarray(ideal.multipliers_variational, complex)

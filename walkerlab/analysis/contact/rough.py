@@ -14,6 +14,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from walkerlab.analysis.robustness.mfpt import draw_slopes
+from walkerlab.integrate.rigid import Solver, integrate_step
 from walkerlab.models.contact.terrain import footfall_lanes, slope_heights
 from walkerlab.walker.plant import Plant
 
@@ -66,7 +68,10 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
     walkerlab.models.contact.scene.ContactSceneError
         No ``contact`` section.
     """
-    from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
+    from walkerlab.analysis.contact.periodic import (  # light
+        converged_gait,
+        find_contact_periodic_gait,
+    )
     from walkerlab.analysis.contact.sim import scene_start  # light
     from walkerlab.models.contact.scene import contact_setup  # light
 
@@ -74,7 +79,6 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
     cs = setup.sim
     probe, x0, _, step_length = scene_start(setup, x_ideal, 2)
     if not periodic:
-        from walkerlab.integrate.rigid import Solver, integrate_step
         from walkerlab.models.registry import build_walker
 
         period = integrate_step(build_walker(scene, setup.plant), np.asarray(x_ideal, float),
@@ -150,7 +154,5 @@ def walk_heights(start: ContactStart, seed: int, walk: int, max_steps: int, sd: 
     ndarray, shape (max_steps + 3,)
         Footfall heights [m], footfall 0 at 0.
     """
-    from walkerlab.analysis.robustness.mfpt import draw_slopes
-
     g = draw_slopes(seed, walk, max_steps + 2, start.slope_rad, sd, distribution)
     return slope_heights(g, start.slope_rad, start.step_length_m)

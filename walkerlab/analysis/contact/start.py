@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.integrate.brentq import brentq
 from walkerlab.integrate.ends import RunEnd
+from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ContactSceneError
 
@@ -80,8 +82,6 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray, plant) -> np.ndarray:
         The step does not reach mid-stance (it falls first), or reaches it with the stance
         foot not flat (one line naming ``contact_sim.start``).
     """
-    from walkerlab.integrate.brentq import brentq
-    from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.models.registry import build_walker
 
     walker = build_walker(scene, plant)

@@ -89,6 +89,7 @@ import time
 
 import numpy as np
 
+from walkerlab.analysis.contact.sim import initial_state_from_ideal
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.contact import ContactLimits, run_powered
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
@@ -560,8 +561,6 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
         ``fall`` or ``no_mid_stance``: the placed state does not reach mid-stance;
         ``time_limit`` when the step map's wall-time deadline passes.
     """
-    from walkerlab.analysis.contact.sim import initial_state_from_ideal
-
     w = step_map.walker
     x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
     if step_map.method in GRID_METHODS or step_map.powered:

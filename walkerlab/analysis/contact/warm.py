@@ -17,7 +17,10 @@ import importlib.util
 
 import numpy as np
 
+from walkerlab.analysis.contact.sim import scene_start, simulate_contact
+from walkerlab.integrate.contact_grid import compile_rhs
 from walkerlab.models.contact.scene import ContactSetup
+from walkerlab.walker.layout import StateLayout
 
 __all__ = ["WARM_UP_TIME_S", "WARM_UP_STEP_M", "compile_rhs_kernels", "compile_run_kernels"]
 
@@ -48,8 +51,6 @@ def compile_run_kernels(setup: ContactSetup) -> bool:
     """
     if importlib.util.find_spec("numba") is None:
         return False
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact
-    from walkerlab.walker.layout import StateLayout
 
     x = np.zeros(len(StateLayout.rigid(setup.walker.structure.roles).names))
     walker, x0, limits, _ = scene_start(setup, x, setup.sim.n_strides,
@@ -69,8 +70,7 @@ def compile_rhs_kernels(setup: ContactSetup) -> bool:
     """
     if importlib.util.find_spec("numba") is None:
         return False
-    from walkerlab.integrate.contact_grid import compile_rhs
-    from walkerlab.models.contact.generated import contact_module
+    from walkerlab.models.contact.generated import contact_module  # light
 
     compile_rhs(contact_module(setup.walker.structure))
     return True

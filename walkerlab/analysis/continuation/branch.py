@@ -79,6 +79,7 @@ from walkerlab.analysis.continuation.points import (
     switch_period_doubling,
 )
 from walkerlab.analysis.continuation.validity import VALIDITY
+from walkerlab.numerics import sort_multipliers
 
 __all__ = ["Branch", "ContinuationResult", "SPECIAL_KINDS", "continue_branch", "continuation",
            "first_point", "fixed_point_at"]
@@ -430,8 +431,6 @@ def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple
 
 def _doubled(q: BranchPoint) -> BranchPoint:
     """A period-k point seen as a period-2k orbit: the orbit twice, multipliers squared."""
-    from walkerlab.numerics import sort_multipliers
-
     return dataclasses.replace(q, period_s=2 * q.period_s,
                                multipliers=sort_multipliers(q.multipliers ** 2),
                                orbit=np.concatenate([q.orbit, q.orbit]))

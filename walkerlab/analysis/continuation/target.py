@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.analysis.continuation.gait_map import MapFailed, WalkerFamily
+from walkerlab.analysis.gait.metrics import step_length
 from walkerlab.analysis.gait.poincare import StepFailed
 
 __all__ = ["MEASURES", "TargetNotReached", "TargetResult", "solve_target"]
@@ -66,7 +67,6 @@ class TargetResult:
 
 def _measures(walker, x, solver, max_step_time):
     """``(P(x), {speed [m/s], step_length [m], step_period [s]})`` of one map from ``x``."""
-    from walkerlab.analysis.gait.metrics import step_length
     from walkerlab.analysis.gait.poincare import poincare_map
 
     steps: list = []

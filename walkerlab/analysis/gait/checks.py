@@ -8,7 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.analysis.gait.friction import flat_foot_friction, stance_friction
+from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.io.trajectory import NamedTrajectory
+from walkerlab.models.ground import foothold_steps, scene_ground
+from walkerlab.models.hybrid.ground_reaction import StanceReaction
 
 
 def energy_drift_in_swing(tr: NamedTrajectory) -> tuple[float, float]:
@@ -71,8 +75,6 @@ def swing_foot_clearance(tr: NamedTrajectory, ground, margin: float = 0.1) -> fl
         Fraction of each step left out at either end [-].
     """
     if not hasattr(ground, "clearance"):
-        from walkerlab.models.ground import scene_ground
-
         ground = scene_ground(None, float(ground))
     lowest = np.inf
     for k in np.unique(tr.step_index):
@@ -100,8 +102,6 @@ def run_ground(scene, tr: NamedTrajectory):
     ValueError
         Footholds under a run without two legs' feet (one line).
     """
-    from walkerlab.models.ground import foothold_steps, scene_ground
-
     terrain, phi = scene.terrain, float(scene.slope.phi_rad)
     sim = scene.simulate
     slopes = None
@@ -220,9 +220,6 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
         ``not_checked`` set for a walker without a floating view (massless legs, flat
         feet) or a map that does not end in heel strikes.
     """
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.models.hybrid.ground_reaction import StanceReaction
-
     try:
         reaction = {id(walker): StanceReaction(walker, data)}
         if walker.mirror is not None:
@@ -230,8 +227,6 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
     except ValueError as exc:
         friction = None
         if mu is not None and data.structure.kind.feet_have_modes:
-            from walkerlab.analysis.gait.friction import flat_foot_friction
-
             friction = flat_foot_friction(walker, data, x, solver, mu, mu_source, samples)
         return GroundContact(not_checked=str(exc), friction=friction)
     traj = simulate_steps(walker, np.asarray(x, float), walker.steps_per_map, solver)
@@ -264,8 +259,6 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
         vt = min(vt, imp.trailing_foot_normal_velocity)
     friction = None
     if mu is not None:
-        from walkerlab.analysis.gait.friction import stance_friction
-
         friction = stance_friction(forces, mu, mu_source,
                                    float(data.total_mass_kg) * float(data.gravity_m_per_s2))
     return GroundContact(float(n_min), t_min, float(ratio), float(hs), float(po), float(vt),

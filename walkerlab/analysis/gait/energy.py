@@ -35,8 +35,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.gait.energy_modes import flat_trajectory_ledger
 from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work, released_energy
 from walkerlab.analysis.gait.metrics import step_length
+from walkerlab.integrate.rigid import other_leg, simulate_steps
 
 __all__ = ["gait_ledger", "gait_measures", "step_ledger", "trajectory_ledger"]
 
@@ -217,12 +219,8 @@ def trajectory_ledger(traj) -> dict[str, np.ndarray]:
     (no generated flow matrices: their modes pin the heel or the toe) by
     :func:`walkerlab.analysis.gait.energy_modes.flat_trajectory_ledger`, empty for flat
     feet on legs that differ."""
-    from walkerlab.integrate.rigid import other_leg
-
     w = traj.walker
     if w.matrices is None:
-        from walkerlab.analysis.gait.energy_modes import flat_trajectory_ledger
-
         return {} if w.mirror is not None else flat_trajectory_ledger(traj)
     rows = {k: [] for k in LEDGER_NAMES}
     for seg in traj.segments:
@@ -278,8 +276,6 @@ def gait_ledger(walker, x, steps: int, solver, max_step_time: float = 5.0
         -]; empty when a step does not end by a heel strike, or for flat feet on legs that
         differ (no ledger).
     """
-    from walkerlab.integrate.rigid import simulate_steps
-
     traj = simulate_steps(walker, np.asarray(x, float), int(steps), solver,
                           max_step_time=max_step_time)
     segs = traj.segments

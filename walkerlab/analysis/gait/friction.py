@@ -30,7 +30,9 @@ import math
 
 import numpy as np
 
+from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.io.friction import FrictionVerdict
+from walkerlab.models.hybrid.rigid_foot_modes import mode_of
 
 __all__ = ["FrictionVerdict", "scene_friction", "flat_foot_friction", "stance_friction",
            "UNLOADED"]
@@ -157,9 +159,6 @@ def flat_foot_friction(walker, data, x, solver, mu: float, mu_source: str,
         ``not_checked`` set when the walker's masses cannot be read or the map does not end
         in heel strikes.
     """
-    from walkerlab.integrate.rigid import simulate_steps
-    from walkerlab.models.hybrid.rigid_foot_modes import mode_of
-
     masses = _point_masses(walker, data)
     if isinstance(masses, str):
         return FrictionVerdict(mu=mu, mu_source=mu_source, not_checked=masses)

@@ -39,6 +39,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from walkerlab.integrate.rigid import HybridTrajectory, integrate_step, other_leg
+from walkerlab.models.hybrid.ground import on_landing
 
 __all__ = ["CLEARANCE_TOL_M", "Clearance", "ProfileGround", "profile_points",
            "simulate_on_profile", "swing_clearance"]
@@ -118,8 +119,6 @@ class ProfileGround:
     def walker(self, j: int, foot: np.ndarray):
         """The walker of a step from the stance foot ``foot`` (2,) [m] landing on segment
         ``j`` (:func:`walkerlab.models.hybrid.ground.on_landing`, built once per landing)."""
-        from walkerlab.models.hybrid.ground import on_landing
-
         P = self.P
         g, dydx = _line(P, j)
         drop = float(foot[1] - (P[j, 1] + (foot[0] - P[j, 0]) * dydx))

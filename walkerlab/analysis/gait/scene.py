@@ -7,23 +7,27 @@ from __future__ import annotations
 
 import math
 
+from walkerlab.analysis.gait.checks import ground_contact
 from walkerlab.analysis.gait.failure_text import no_energy_reason
+from walkerlab.analysis.gait.friction import scene_friction
 from walkerlab.analysis.gait.planar_start import planar_fallback
 from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.analysis.gait.search import GaitNotFound, find_gaits
-from walkerlab.config import Scene
+from walkerlab.analysis.gait.zero_dynamics import compare_full_order, zero_dynamics
+from walkerlab.config import FixedPointSettings, Scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
+from walkerlab.io.schemas.fixedpoint import FixedPointRun
+from walkerlab.models.hybrid.printed_equations import VARIANTS
 from walkerlab.models.hybrid.rolling_polygon import cannot_roll
 from walkerlab.models.registry import build_walker
+from walkerlab.units import for_scene
 from walkerlab.walker.plant import Plant
 
 
 def _settings(scene: Scene):
     """The scene's ``fixedpoint`` section; left out, its defaults (every field is optional:
     the gait is then found from scale-free seeds)."""
-    from walkerlab.config import FixedPointSettings
-
     return scene.fixedpoint if scene.fixedpoint is not None else FixedPointSettings()
 
 
@@ -36,8 +40,6 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     if scene.terrain is not None and not scene.terrain.is_slope:  # ... and on the slope
         return own
     if compare and scene.walker.model == "compass_gait" and scene.published is not None:
-        from walkerlab.models.hybrid.printed_equations import VARIANTS
-
         return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
     return own
 
@@ -80,8 +82,6 @@ def check_walking_state(x, walker, scene: Scene) -> None:
     ValueError
         One line naming the field, its value and the bound.
     """
-    from walkerlab.units import for_scene
-
     g = walker.params.get("gravity_m_per_s2")
     length = walker.params.get("leg_length_m")
     if not g or not length:
@@ -191,7 +191,6 @@ def hzd_start(walker):
     ctrl = controller(walker)
     if ctrl is None:
         return None
-    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
 
     zd = zero_dynamics(ctrl)
     return zd.x_plus.copy() if zd.exists else None
@@ -253,8 +252,6 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     ValueError
         A malformed initial guess or gait choice (one line).
     """
-    from walkerlab.io.schemas.fixedpoint import FixedPointRun
-
     walker, search = solve_scene(scene, guess=guess, ground=True, nearby=nearby, plant=plant)
     if note:
         search.notes.append(note)
@@ -275,7 +272,6 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         treads = tread_landing(walker, main.x, scene.terrain, Solver.from_settings(scene.solver))
     hzd = None
     if controller(walker) is not None:  # virtual constraints: the restricted map too
-        from walkerlab.analysis.gait.zero_dynamics import compare_full_order, zero_dynamics
 
         hzd = zero_dynamics(controller(walker))
         compare_full_order(hzd, controller(walker), walker, main,
@@ -299,9 +295,6 @@ def gait_ground_contact(scene: Scene, walker, x, plant: Plant):
     -------
     walkerlab.analysis.gait.checks.GroundContact
     """
-    from walkerlab.analysis.gait.checks import ground_contact
-    from walkerlab.analysis.gait.friction import scene_friction
-
     mu, mu_source = scene_friction(scene)
     return ground_contact(walker, plant.data, x,
                           Solver.from_settings(scene.solver), mu=mu, mu_source=mu_source)

@@ -56,7 +56,11 @@ from walkerlab.analysis.gait.starts import (
     screen_seeds,
     walked_start,
 )
-from walkerlab.analysis.gait.zero_dynamics import gaits_on_zero_dynamics, no_orbit_reason
+from walkerlab.analysis.gait.zero_dynamics import (
+    gaits_on_zero_dynamics,
+    no_orbit_reason,
+    zero_dynamics,
+)
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import without_neutral
@@ -398,8 +402,6 @@ class _RootStarts:
         """Root from the zero dynamics' periodic orbit (a walker whose gaits lie on it:
         :func:`~walkerlab.analysis.gait.zero_dynamics.gaits_on_zero_dynamics`), unless that
         was the ``guess`` already tried."""
-        from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
-
         zd = zero_dynamics(self.walker.actuators.controller)
         if not zd.exists:  # an unstable orbit (delta^2 > 1): no start on it here
             self.last_msg = self.last_msg or "no stable orbit of the zero dynamics to start on"

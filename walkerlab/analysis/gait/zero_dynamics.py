@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.integrate.rigid import integrate_step
 from walkerlab.models.hybrid.virtual_constraints import annihilator, bezier
 
 __all__ = ["ZeroDynamics", "compare_full_order", "gaits_on_zero_dynamics", "impact_multiplier",
@@ -273,8 +274,6 @@ def compare_full_order(zd: ZeroDynamics, ctrl, walker, result, solver) -> dict:
     result : walkerlab.analysis.gait.poincare.FixedPointResult
     solver : walkerlab.integrate.solver.Solver
     """
-    from walkerlab.integrate.rigid import integrate_step
-
     n = ctrl.n  # the map's first step (walkerlab.analysis.gait.poincare.poincare_map's)
     x_minus = np.asarray(integrate_step(walker.for_step(0), result.x, solver,
                                         stance_leg=walker.legs[1]).x_end, float)

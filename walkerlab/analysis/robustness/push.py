@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.integrate.batch_step import FALL, HEEL_STRIKE, BatchStep
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.integrate.solver import Solver
 from walkerlab.numerics import fd_jacobian
 
 __all__ = ["apply_push", "entry_lock", "hip_jacobian", "mass_matrix", "pushed_step",
@@ -144,9 +146,6 @@ def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
         The gait's stance leg never passes the vertical in the step.
     """
     from scipy.optimize import brentq
-
-    from walkerlab.integrate.rigid import integrate_step
-    from walkerlab.integrate.solver import Solver
 
     solver = solver or Solver("DOP853", 1e-12, 1e-12, None, "scipy")
     seg = integrate_step(walker, np.asarray(x0, float), solver, max_step_time=max_step_time)

@@ -85,6 +85,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
+from walkerlab.walker.joints import joint_links
 
 __all__ = ["ANKLE_WORK_NAMES", "FLAT_HIP_WORK_NAMES", "FLOW_LAW_WORK_NAMES", "KNEE_WORK_NAMES",
            "WORK_NAMES",
@@ -284,8 +285,6 @@ class ContactActuators(PushOffPulse, ContactRows):
 
     def __init__(self, spec, coordinates, pulse_s: float, kind, torso: bool = False,
                  flow_law: bool = False):
-        from walkerlab.walker.joints import joint_links
-
         names = tuple(coordinates)
         #: a kneed walker: the hip torque acts on the thighs (module docstring)
         self.knee = "leg1_thigh_angle" in names

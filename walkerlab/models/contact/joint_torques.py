@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
 from walkerlab.models.actuation import JointMap
 from walkerlab.models.contact.actuation import WORK_NAMES, ContactRows, PushOffPulse
 
@@ -90,8 +91,6 @@ class JointTorqueActuators(PushOffPulse, ContactRows):
                    "hip_torque_negative": "negative work of the joint torques (hips and knees)"}
 
     def __init__(self, data, spec, coordinates, pulse_s: float = 0.0):
-        from walkerlab.codegen.cache import functions
-
         self.spec = spec
         roles = tuple(data.structure.roles)
         #: the joints, their ``B`` and laws in the rigid view's role order (what the rigid

@@ -14,6 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
+from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, HUB_INERTIA_MESSAGE
+from walkerlab.walker.layout import floating_links_from_rigid
+
 __all__ = ["PARTS", "ContactPart", "attribution_refusal", "contact_part",
            "periodic_gait_refusal"]
 
@@ -78,14 +82,11 @@ class ContactPart:
         layout's names; otherwise through the generated leg angles)."""
         if walker.structure.coordinates == "absolute":
             return walker.rigid_layout().named(x)
-        from walkerlab.codegen.cache import functions
 
         return functions(walker.data)["leg_angles"](x)
 
     def link_state(self, walker, x, rate_scale) -> np.ndarray:
         """:meth:`walkerlab.models.contact.model.ContactWalker.link_state_from_ideal`."""
-        from walkerlab.walker.layout import floating_links_from_rigid
-
         return floating_links_from_rigid(self.rigid_values(walker, x), walker.layout(),
                                          rate_scale)
 
@@ -196,8 +197,6 @@ class FlatFeetPart(ContactPart):
         return heel2 - (s_toe - f1["heel"] - f1["toe"])
 
     def check(self, scene, data, cs) -> str | None:
-        from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE
-
         missing = scene.contact.flat_foot() is None and not data.structure.foot_mass
         return FLAT_FOOT_MESSAGE if missing else None
 
@@ -253,8 +252,6 @@ class RollingPolygonPart(ContactPart):
         (:data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`), continuous ground (its
         spokes are not a pair of legs with a lane each) and no contact periodic gait (the
         step map's mid-stance section is a biped's)."""
-        from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
-
         if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
                 and scene.contact.hub_inertia_kg_m2 is None:
             return HUB_INERTIA_MESSAGE

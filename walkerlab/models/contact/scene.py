@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from walkerlab.codegen.floating import check_masses, coordinate_names
 from walkerlab.config import (
     ContactSettings,
     ContactSimSettings,
@@ -21,7 +22,9 @@ from walkerlab.config import (
     SolverSettings,
     TerrainSettings,
 )
+from walkerlab.config.actuation import Actuation
 from walkerlab.config.sections import with_default_section
+from walkerlab.walker.kinds import KindRefused
 from walkerlab.walker.plant import Plant
 
 from .actuation import ContactActuators
@@ -163,9 +166,6 @@ class ContactSetup:
         -------
         ContactActuators or JointTorqueActuators
         """
-        from walkerlab.codegen.floating import coordinate_names
-        from walkerlab.config.actuation import Actuation
-
         st = self.walker.structure
         empty = Actuation.model_construct(torques=[], push_off=None, ankle_push_off=None)
         return contact_part(st).actuators(self.walker, empty, coordinate_names(st), 0.0)
@@ -245,8 +245,6 @@ def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetu
         (:data:`SEVERAL_STEPS_PERIODIC`; ``periodic_gait: true`` there records the gait as
         not found, with that reason) (one line).
     """
-    from walkerlab.codegen.floating import check_masses
-
     scene = with_default_section(scene, "contact")  # left out: its defaults (contact: {})
     if scene.contact is None:  # a section with a required field has no defaults
         raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
@@ -262,7 +260,6 @@ def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetu
     data = plant.data
     ground = "slope" if scene.terrain is None else scene.terrain.kind
     if ground in ("stairs", "footholds", "profile"):  # the kind's cell of that ground
-        from walkerlab.walker.kinds import KindRefused
 
         try:
             data.structure.kind.require(ground, "contact", f"terrain.kind: {ground}")
@@ -321,12 +318,9 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     spec = scene.walker.actuation
     if spec is None:
         return None
-    from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
     if getattr(spec, "virtual_constraints", None) is not None:
-        from walkerlab.walker.kinds import KindRefused
-
         try:
             st.kind.require("virtual_constraints", "contact",
                             "walker.actuation.virtual_constraints")

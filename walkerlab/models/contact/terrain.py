@@ -51,6 +51,8 @@ import numpy as np
 
 from walkerlab.models.ground import landing_drops, stair_treads
 
+from .lanes import footprint_offsets
+
 __all__ = ["PROFILE_PATCH_TOL_M", "check_ground", "footfall_heights", "footfall_lanes",
            "footfall_positions", "ground_drops", "profile_line", "profile_patch_heights",
            "slope_heights", "stairs_line", "step_heights", "terrain_ground"]
@@ -309,8 +311,6 @@ def terrain_ground(walker, terrain, n_steps: int):
     drops = ground_drops(terrain)
     if terrain.kind == "profile" and terrain.lanes == "checkerboard":  # flat patches on it,
         # the profile's first point at the first stance foot's footfall (leg2's patch 0)
-        from .lanes import footprint_offsets
-
         first = float(walker.lane2[0]) - footprint_offsets(walker.data)[1]
         hw, phi = float(walker.patch_half_width), float(walker.phi)
         return replace(walker,

@@ -20,7 +20,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
+from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
 __all__ = ["AnklePushOffActuator", "actuate_flat", "ankle_push_off_work", "heel_off_data"]
 
@@ -99,8 +102,6 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
         A joint the walker does not have, a torque per foot mass, an ankle push-off's
         constant torque without an ankle spring (one line, naming the field).
     """
-    from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
-
     if spec.torques and spec.push_off is None and spec.ankle_push_off is None:
         return actuate_flat_hips(walker, data, spec)
     if data.mirror is None:
@@ -114,9 +115,6 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
 def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
     """One step's flat-footed walker (``data`` without ``mirror_params``, or legs alike)
     with the push-off impulse and/or the ankle push-off, and joint torques if any."""
-    from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
-    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
     from walkerlab.models.hybrid.toe_push_off import FlatPushOff, push_off_flat  # light
 
     walker = replace(walker, mirror=None)  # one step's (legs that differ: set by the caller)

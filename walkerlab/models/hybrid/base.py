@@ -53,6 +53,9 @@ from typing import Literal
 
 import numpy as np
 
+from walkerlab.walker.description import state_names, state_units
+from walkerlab.walker.layout import StateLayout
+
 Flow = Callable[[float, np.ndarray], np.ndarray]
 GuardOutcome = Literal["next_phase", "heel_strike", "fall"]
 
@@ -395,8 +398,6 @@ class HybridWalker:
     def layout(self):
         """The state layout (:class:`walkerlab.walker.layout.StateLayout`): names, units,
         q / qd slices and legs of the role-ordered state (2n,)."""
-        from walkerlab.walker.layout import StateLayout
-
         return StateLayout.rigid(self.roles)
 
     def section_names(self) -> list[str]:
@@ -416,14 +417,10 @@ class HybridWalker:
 
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
-        from walkerlab.walker.description import state_names
-
         return state_names(self.roles)
 
     def state_units(self) -> list[str]:
         """Units of :meth:`state_names` (every coordinate is an angle)."""
-        from walkerlab.walker.description import state_units
-
         return state_units(self.roles)
 
     @property

@@ -34,6 +34,7 @@ import numpy as np
 from walkerlab.codegen.cache import functions
 from walkerlab.models.ground import foothold_steps, landing_drop
 from walkerlab.models.hybrid.base import HybridWalker, OffSection, Phase
+from walkerlab.models.hybrid.rigid_foot_modes import on_landing_flat
 
 __all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
            "with_clearance_guard"]
@@ -247,8 +248,6 @@ def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
 def _on_flat_feet(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     """Flat feet: every stance mode's heel-strike guard and the double support's trailing
     toe (:func:`walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat`)."""
-    from walkerlab.models.hybrid.rigid_foot_modes import on_landing_flat
-
     return on_landing_flat(walker, data, drop_m)
 
 

@@ -27,7 +27,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 from walkerlab.numerics import complex_step_jacobian
 
 __all__ = ["actuate_flat_hips", "mode_mass_matrix"]
@@ -79,9 +81,7 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None,
         A joint the walker does not have (naming the joints it has), a torque per foot
         mass (flat feet carry massive legs) (one line).
     """
-    from walkerlab.codegen.cache import functions
     from walkerlab.models.hybrid.actuators import Actuators  # light
-    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
     for i, t in enumerate(spec.torques):
         if t.scaled_by != "none":

@@ -39,7 +39,9 @@ from functools import cache, partial
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.numerics import complex_step_jacobian
 from walkerlab.walker.description import compass_gait_structure  # noqa: F401
 from walkerlab.walker.plant import compass_gait_data
@@ -185,8 +187,6 @@ def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
 @cache
 def _generated(p: tuple) -> dict:
     """Generated functions for ``p = (m, M_H, L, a, g)`` (slope 0: flow, impact, energies)."""
-    from walkerlab.codegen.cache import functions
-
     m, mh, L, a, g = p
     return functions(compass_gait_data(L, m, mh, g, a, 0.0))
 
@@ -206,8 +206,6 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
     ValueError
         Unknown ``variant``.
     """
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
-
     if variant not in VARIANTS:
         raise ValueError(f"ideal.variant: unknown variant {variant!r}; choose from {VARIANTS}")
     data = compass_gait_data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2,

@@ -49,6 +49,8 @@ from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
+from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
+from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
 from walkerlab.walker.description import WalkerData
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
@@ -260,8 +262,6 @@ def _make_free(data: WalkerData, name: str, variant: str, printed: dict,
                double_support: bool) -> HybridWalker:
     """Every joint free (five-link bipeds): one flow
     (:func:`walkerlab.models.hybrid.rigid_free_joints.make_five_link_walker`)."""
-    from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
-
     _only_generated(data, printed)
     return make_five_link_walker(data, name, variant)
 
@@ -270,8 +270,6 @@ def _make_polygon(data: WalkerData, name: str, variant: str, printed: dict,
                   double_support: bool) -> HybridWalker:
     """A rimless (spoked) wheel rolling on its spokes
     (:func:`walkerlab.models.hybrid.rolling_polygon.make_spoked_walker`)."""
-    from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
-
     _only_generated(data, printed)
     return make_spoked_walker(data, name, variant)
 

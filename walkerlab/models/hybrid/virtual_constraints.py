@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.models.hybrid.actuators import Actuators
+from walkerlab.models.hybrid.base import Guard
 from walkerlab.models.virtual_constraints import (
     KEY,
     MAX_CONDITION,
@@ -18,6 +19,7 @@ from walkerlab.models.virtual_constraints import (
     bezier,
     default_joints,
 )
+from walkerlab.walker.joints import joint_links
 
 #: the normalised phase's range of a step (:meth:`VirtualConstraintActuators.phase_guards`):
 #: a quarter of a step beyond either end of the Bezier polynomials' [0, 1]
@@ -45,7 +47,6 @@ class VirtualConstraintActuators(Actuators):
         super().__init__(shim, fns, n, False, total_mass)
         self.controller = VirtualConstraintController(vc, fns, structure, params)
         names = self.link_angles(np.zeros(2 * n))
-        from walkerlab.walker.joints import joint_links
 
         self.links = [joint_links(names, j, f"{KEY}.joints") for j in self.controller.joints]
         self.B = self.controller.B
@@ -60,8 +61,6 @@ class VirtualConstraintActuators(Actuators):
         end with the swing foot off the ground), where the computed torque, extrapolating
         them, drives the walker to rates the integrator crawls through; it ends there as a
         fall instead (Westervelt et al. 2003 define the controller on one step's phase)."""
-        from walkerlab.models.hybrid.base import Guard
-
         d = self.controller.design
         th_p, dth = d.theta_plus, d.theta_minus - d.theta_plus
         pieces = self.controller.pieces

@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.analysis.robustness.measures import linearise
+from walkerlab.integrate.python_step import make_step_map
 from walkerlab.walker.plant import Plant
 
 __all__ = ["ROBUSTNESS_MEASURES", "robustness_measure"]
@@ -40,8 +42,6 @@ def robustness_measure(name: str, scene, walker, x_star, A) -> float:
     """
     x_star = np.asarray(x_star, float)
     if name == "gait_sensitivity_norm":
-        from walkerlab.analysis.robustness.measures import linearise
-        from walkerlab.integrate.python_step import make_step_map
         from walkerlab.studies.mfpt import scene_walker_at  # light
 
         dist = scene.robustness.disturbances[0] if scene.robustness is not None else "slope"

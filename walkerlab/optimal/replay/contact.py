@@ -11,7 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab import progress
+from walkerlab.analysis.contact.verdict import step_trend, walk_verdict
+from walkerlab.config import SolverSettings
 from walkerlab.models.actuation import TorqueOfTime
+from walkerlab.optimal.transcription.free_joint_functions import JOINTS
+from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
+from walkerlab.optimal.transcription.stride import step_of
+from walkerlab.safefs import raise_if_interrupted
 from walkerlab.walker.plant import Plant
 
 __all__ = ["REPLAY_WALL_TIME_LIMIT_S", "SETTLED_STEPS", "contact_replay",
@@ -43,7 +50,6 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
         How the run ended, or why there is no replay (massless legs: the contact view
         needs leg masses).
     """
-    from walkerlab.config import SolverSettings
     from walkerlab.optimal.transcription.step import torque_of_time
 
     w = scene.walker.model_dump()
@@ -91,9 +97,6 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
         The mean period [s] of the run's steps after the first touchdown and how the run
         ended, or why there is no replay (one line), as :func:`contact_replay`.
     """
-    from walkerlab.config import SolverSettings
-    from walkerlab.optimal.transcription.free_joint_functions import JOINTS
-
     setup, why = _powered_setup(scene, {"torques": [{"joint": j, "law": {}} for j in JOINTS]},
                                 {"n_strides": strides, "sample_rate_hz": 500}, terrain=True)
     if setup is None:
@@ -134,8 +137,6 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
         section's flat-foot regularisation or a walker the contact view carries no hip
         torque on (one line).
     """
-    from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
-
     # a powered run is on a Python RHS (slow on a flat-footed walker's stride), so the
     # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
     setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
@@ -172,10 +173,6 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     (step_period_s, outcome) : (float, str)
         As :func:`contact_replay` (``outcome`` one line).
     """
-    from walkerlab.config import SolverSettings
-    from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
-    from walkerlab.optimal.transcription.stride import step_of
-
     setup, why = _powered_setup(scene, _hip_actuation(res),
                                 {"n_strides": strides, "sample_rate_hz": 500})
     if setup is None:
@@ -248,9 +245,7 @@ def _run(setup, x0, step_period_s: float, strides: int, solver=None,
     """The powered contact run from ``x0``: the mean period of its steps after the first
     touchdown [s] (NaN if fewer than two) and how it ended (``fixed``: ``solver`` is the
     replay's own, not the scene's ``contact_solver``; :func:`replay_failure`)."""
-    from walkerlab import progress
     from walkerlab.analysis.contact.sim import simulate_from
-    from walkerlab.safefs import raise_if_interrupted
 
     kw = {} if solver is None else {"solver": solver}
     with progress.task(f"optimize: the contact replay ({strides} strides)"):
@@ -338,9 +333,7 @@ def contact_replay_controller(scene, x_star, period_s: float, step_length_m: flo
         comparison, or why there is no replay).
     """
     from walkerlab.analysis.contact.sim import simulate_from
-    from walkerlab.analysis.contact.verdict import step_trend, walk_verdict
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup
-    from walkerlab.safefs import raise_if_interrupted
 
     nan = float("nan")
     out = {"periods": np.zeros(0), "step_period_s": nan, "speed_m_per_s": nan,

@@ -29,6 +29,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from walkerlab import progress
+from walkerlab.integrate.solver import CYRK_METHODS, available_backends
+from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.optimal.replay.phase import (
     LIMIT_N_M,
     PhaseLaw,
@@ -85,7 +88,7 @@ class PiecewisePhaseLaw:
         -------
         ndarray (L,)
         """
-        from walkerlab.codegen.torque_law import PIECEWISE, pack_laws
+        from walkerlab.codegen.torque_law import PIECEWISE, pack_laws  # light
 
         rows = []
         for k in range(len(self.K)):
@@ -114,7 +117,6 @@ def hip_walker(data, law, push_off_n_s: float = 0.0):
     the same splines); without a law (None) no compiled flow."""
     from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.models.hybrid.actuated import actuate  # light
-    from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     st = data.structure
     massless = bool(st.bodies) and all(b.massless for b in st.bodies)
@@ -131,8 +133,6 @@ def replay_solver(walker, solver):
     """The solver of the replays: ``solver`` on CyRK's compiled flows (``cyrk_compiled``)
     when every phase of ``walker`` has one and CyRK integrates ``solver``'s method, else
     ``solver`` itself (the law then a Python callback)."""
-    from walkerlab.integrate.solver import CYRK_METHODS, available_backends
-
     if (all(ph.compiled is not None for ph in walker.phases) and solver.method in CYRK_METHODS
             and "cyrk" in available_backends()):
         return replace(solver, backend="cyrk_compiled")
@@ -233,8 +233,6 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
     ValueError
         The phase variable is not monotonic over the step or a phase of it (one line).
     """
-    from walkerlab import progress
-
     names = tuple(getattr(res, "phase_names", ()) or ())
     start = getattr(res, "phase_start", None)
     push = float(getattr(res, "push_off_n_s", 0.0))

@@ -30,7 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.numerics import sort_multipliers
+from walkerlab.codegen.actuated import ActuatedFlow
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.numerics import fd_jacobian, sort_multipliers
 
 __all__ = ["LIMIT_N_M", "PhaseLaw", "PhaseReplay", "control_of_time", "driven_by",
            "law_of_rows", "replay_law", "torque_error"]
@@ -126,7 +128,7 @@ class PhaseLaw:
         -------
         ndarray (L,)
         """
-        from walkerlab.codegen.torque_law import FEEDFORWARD, pack_laws
+        from walkerlab.codegen.torque_law import FEEDFORWARD, pack_laws  # light
 
         n = len(self.h.x)
         return pack_laws([(FEEDFORWARD, 0.0, float(self.K[k]), float(self.D[k]), 0.0, limit,
@@ -178,8 +180,6 @@ def driven_by(walker, law, limit: float):
     block (``law.packed(limit)``, the same splines, saturated at ``limit`` [N m]) and every
     other compiled flow dropped (it would run without the law); ``law`` None: none kept."""
     from dataclasses import replace
-
-    from walkerlab.codegen.actuated import ActuatedFlow
 
     walker.actuators.laws = law
     block = None if law is None else law.packed(limit)
@@ -327,9 +327,6 @@ def replay_law(walker, solver, t, x, tau, close: bool = True, tol: float = 1e-10
         ``return_error`` inf, NaN multipliers when a step does not end in a heel strike
         (or crosses other phases).
     """
-    from walkerlab.integrate.rigid import integrate_step
-    from walkerlab.numerics import fd_jacobian
-
     x_col = np.asarray(x, float)[0]
     horizon = 3.0 * float(t[-1])
 

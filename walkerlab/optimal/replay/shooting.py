@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.optimal.transcription.free_joints import torques_of_time
+
 __all__ = ["ClosedStep", "close_step", "open_loop_error"]
 
 
@@ -149,8 +151,6 @@ def _multipliers(fns, params, G, z, zs, t, u) -> np.ndarray:
     """Eigenvalues of ``DP = DR (Phi_x - f (grad c . Phi_x) / (grad c . f))`` at the closed
     step (module docstring)."""
     import casadi as ca
-
-    from walkerlab.optimal.transcription.free_joints import torques_of_time
 
     n2 = 2 * fns["n"]
     xT_sym = G(z)[1]
