@@ -15,15 +15,13 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
 from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, plastic_impact
 from walkerlab.config import load_scene
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.plant import Plant
 from walkerlab.walker.trees import legs_tree
-
-#: relative agreement of the two derivations' numbers (both exact: round-off of ~100 terms)
-RTOL = 1e-12
 
 
 def _params(names: list[str], rng) -> dict:
@@ -102,12 +100,7 @@ def _agree(structure: Structure, seed: int) -> None:
                                       rng.uniform(-2.0, 2.0, len(e.dq)),
                                       [par[n] for n in names]]))
     for what, reference, tree_value in pairs:
-        fa, fb = sp.lambdify(args, reference), sp.lambdify(args, tree_value)
-        for x in points:
-            a, b = np.array(fa(*x), float), np.array(fb(*x), float)
-            scale = np.max(np.abs(a))
-            assert scale > 0, what
-            assert np.max(np.abs(a - b)) <= RTOL * scale, (what, x, a, b)
+        _close(what, reference, tree_value, args, points)
 
 
 @pytest.mark.parametrize("scene", [
