@@ -2,15 +2,19 @@
 apart from run-dependent records (wall and CPU times, content hashes, walkerlab's source
 hash, timestamps).  For restructurings that must keep every number bit-identical.
 
-    python scripts/compare_artifacts.py runs_before runs_after
+    python scripts/compare_artifacts.py runs_before runs_after [--rtol 1e-12] [--present]
 
-Prints one line per artifact (identical / which datasets or attributes differ; datasets
+Prints one line per artifact (identical / which datasets or attributes differ, with the
+largest relative difference of a floating dataset, ``max |a - b| / max |a|``; datasets
 only the second has are listed apart, as additions) and exits 1 when anything that both
-have differs or the first has something the second lacks.
+have differs or the first has something the second lacks.  ``--rtol``: a round-off change
+(a floating dataset of the same shape within ``rtol`` relative) is reported, not failed;
+``--present``: only the artifacts the second folder has (a subset of the scenes rerun).
 """
 
 from __future__ import annotations
 
+import argparse
 import re
 import sys
 from pathlib import Path
@@ -56,41 +60,78 @@ def _same(a, b) -> bool:
     return a == b
 
 
-def compare(a: Path, b: Path) -> list[str]:
-    """Differences between the artifacts ``a`` and ``b`` (empty: identical)."""
+def relative(a, b) -> float | None:
+    """``max |a - b| / max |a|`` of two floating arrays of one shape (0 where ``a`` is all
+    zero and ``b`` equals it; NaNs where both have them agree); None for anything else."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape or a.dtype.kind not in "fc" or b.dtype.kind not in "fc":
+        return None
+    if not np.array_equal(np.isnan(a), np.isnan(b)):
+        return np.inf
+    ok = ~np.isnan(a)
+    d, scale = np.max(np.abs(a - b)[ok], initial=0.0), np.max(np.abs(a)[ok], initial=0.0)
+    return 0.0 if d == 0 else (d / scale if scale > 0 else np.inf)
+
+
+def compare(a: Path, b: Path) -> tuple[list[str], dict]:
+    """Differences between the artifacts ``a`` and ``b`` (empty: identical) and the relative
+    size of each differing floating dataset's (:func:`relative`; ``{name: size}``)."""
     with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
         ia, ib = _items(fa), _items(fb)
     diffs = [f"only before: {k}" for k in sorted(set(ia) - set(ib))]
     diffs += [f"only after: {k}" for k in sorted(set(ib) - set(ia))]
-    diffs += [f"differs: {k}" for k in sorted(set(ia) & set(ib)) if not _same(ia[k], ib[k])]
-    return diffs
+    differ = [k for k in sorted(set(ia) & set(ib)) if not _same(ia[k], ib[k])]
+    diffs += [f"differs: {k}" for k in differ]
+    return diffs, {k: relative(ia[k], ib[k]) for k in differ}
 
 
-def main(before: str, after: str) -> int:
-    A, B = Path(before), Path(after)
-    bad = n = added = 0
+def main(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("before")
+    ap.add_argument("after")
+    ap.add_argument("--rtol", type=float, default=None,
+                    help="report, not fail, floating datasets within this relative size")
+    ap.add_argument("--present", action="store_true",
+                    help="only the artifacts the second folder has")
+    args = ap.parse_args(argv)
+    A, B = Path(args.before), Path(args.after)
+    bad = n = added = within = 0
     for a in sorted(A.rglob("*.h5")):
         b = B / a.relative_to(A)
+        if not b.exists() and args.present:
+            continue
         n += 1
         if not b.exists():
             print(f"{a.relative_to(A)}: missing after")
             bad += 1
             continue
-        d = compare(a, b)
+        d, sizes = compare(a, b)
         new = [x for x in d if x.startswith("only after: ")]
         d = [x for x in d if not x.startswith("only after: ")]
         groups = sorted({x.removeprefix("only after: ").split("/")[0].split("@")[0]
                          for x in new})
-        print(f"{a.relative_to(A)}: " + ("identical" if not d else f"{len(d)} differ: "
-                                           + "; ".join(d[:6]))
+        worst = max(sizes.items(), key=lambda kv: -1.0 if kv[1] is None else kv[1],
+                    default=None)
+        small = (args.rtol is not None and len(sizes) == len(d)
+                 and all(v is not None and v <= args.rtol for v in sizes.values()))
+        size = "" if worst is None or worst[1] is None else \
+            f" (largest relative {worst[1]:.1e}: {worst[0]})"
+        if not d:
+            state = "identical"
+        elif small:
+            state = f"{len(d)} within rtol{size}"
+        else:
+            state = f"{len(d)} differ{size}: " + "; ".join(d[:6])
+        print(f"{a.relative_to(A)}: {state}"
               + (f" (+ {len(new)} new datasets/attributes in {', '.join(groups)})"
                  if new else ""))
-        bad += bool(d)
+        bad += bool(d) and not small
+        within += bool(d) and small
         added += bool(new)
-    print(f"{n} artifacts, {n - bad} identical in everything they had before ({added} with "
-          f"new datasets), {bad} differ")
+    print(f"{n} artifacts, {n - bad - within} identical in everything they had before "
+          f"({added} with new datasets), {within} within rtol {args.rtol}, {bad} differ")
     return 1 if bad else 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(*sys.argv[1:3]))
+    sys.exit(main(sys.argv[1:]))

@@ -17,7 +17,7 @@ import sympy as sp
 
 from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
 from walkerlab.codegen.symbolic import derive
-from walkerlab.codegen.tree_derive import derive_tree, plastic_impact
+from walkerlab.codegen.tree_derive import derive_tree, kinematics, plastic_impact, simplifier
 from walkerlab.config import load_scene
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.plant import Plant
@@ -87,7 +87,8 @@ def _agree(structure: Structure, seed: int) -> None:
              ("V", sp.Matrix([e.potential]), sp.Matrix([te.potential]))]
     if not structure.knee:   # the kneed heel strike holds the knee: the locked system
         Mi, B = plastic_impact(te.M, te.A, te.total_mass,
-                               _swing_contact_jacobian(te, structure))
+                               _swing_contact_jacobian(te, structure),
+                               simplifier(te.kinematics))
         pairs.append(("rates after the heel strike", e.Mi.LUsolve(e.B * dq),
                       Mi.LUsolve(B * dq)))
     args = list(e.q) + list(e.dq) + list(e.params)
@@ -114,6 +115,22 @@ def _agree(structure: Structure, seed: int) -> None:
 ])
 def test_a_shipped_planar_walker_derived_from_its_tree_equals_the_planar_derivation(scene):
     _agree(_scene_structure(scene), seed=sum(map(ord, scene)))
+
+
+def test_a_planar_trees_mass_matrix_is_in_relative_angles_and_a_3d_trees_keeps_trigsimp():
+    """The planar trees' entries come out in the planar closed form (``product_to_sum``:
+    ``cos(q_i - q_j)``, no product of two turns' sines or cosines left), the 3D trees' by
+    ``trigsimp`` (:func:`walkerlab.codegen.tree_derive.simplifier`, the shipped 3D walkers'
+    equations unchanged)."""
+    te = derive_tree(*legs_tree(_scene_structure("paper")))
+    stance, swing = te.q
+    assert simplifier(te.kinematics).__name__ == "product_to_sum"
+    products = [f for f in sp.preorder_traversal(te.M) if isinstance(f, sp.Mul)
+                and sum(isinstance(a, sp.cos | sp.sin) for a in f.args) > 1]
+    assert not products, products
+    assert te.M[0, 1].has(sp.cos(stance - swing)) or te.M[0, 1].has(sp.cos(swing - stance))
+    kin3d = kinematics(*legs_tree(_scene_structure("hip_width")))
+    assert simplifier(kin3d).__name__ == "trig_simplify"
 
 
 def test_garcias_coordinates_and_a_body_off_the_leg_axis_derive_alike():
