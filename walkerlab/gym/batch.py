@@ -174,7 +174,8 @@ _ENV_READ = attrgetter("_elapsed", "terrain_seed")
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
                 p: dict, views=None, X: np.ndarray | None = None,
                 cols: tuple | None = None, hips: list | None = None,
-                fixed: np.ndarray | None = None, env_cols: tuple | None = None) -> tuple:
+                fixed: np.ndarray | None = None, env_cols: tuple | None = None,
+                written: bool = False) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -206,6 +207,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     env_cols : tuple, optional
         ``(elapsed, seeds)``: each environment's period count (``_elapsed``, this period
         counted) and ``terrain_seed``, sequences of N, when the caller has read them.
+    written : bool
+        The caller has written ``hips`` into each environment (its next period's reward's
+        origin).
 
     Returns
     -------
@@ -236,8 +240,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         hips = hip.tolist()
     else:
         hip = None  # (made of hips when the infos are)
-    for e, h in zip(envs, hips):
-        e._hip_x = h  # the next period's start (its reward's origin)
+    if not written:
+        for e, h in zip(envs, hips):
+            e._hip_x = h  # the next period's start (its reward's origin)
     # (each environment's count and seed)
     elapsed, seeds = zip(*map(_ENV_READ, envs)) if env_cols is None else env_cols
     terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
