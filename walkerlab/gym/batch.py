@@ -8,7 +8,7 @@ of them at once: :func:`hip_xs`) - the same element-wise operations as each
 
 from __future__ import annotations
 
-from operator import attrgetter, itemgetter
+from operator import attrgetter, itemgetter, methodcaller
 
 import numpy as np
 
@@ -120,7 +120,7 @@ def held_torques(envs, actions: np.ndarray, p: dict) -> np.ndarray:
     half: scaled, the scene policy's added at the walkers' present states, clipped; a new
     array)."""
     norm = p["normalize"]
-    every, some, policy = _flags(p)
+    every, some, policy = p.get("flags") or _flags(p)
     tau = p["tau"]
     if every:  # (the actions read as float64, then scaled: numpy's casting of any real
         a = np.multiply(actions, tau, dtype=np.float64)  # dtype, in one operation)
@@ -270,7 +270,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
             fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
             w_before)], dtype=np.float64)
     # (a view's own words, when it has them: the rigid view's are its instance's)
-    messages = ([v.__dict__.get("failure", "") for v in views]
+    messages = (list(map(_FAILURE, map(_DICT, views)))
                 if not any(map(_class_failure, set(map(type, views))))
                 else [getattr(v, "failure", "") for v in views])
 
@@ -293,6 +293,8 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
 
 
 _CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
+#: an instance's own attributes; a dict's ``failure`` (text, "" when none)
+_DICT, _FAILURE = attrgetter("__dict__"), methodcaller("get", "failure", "")
 
 
 def _class_failure(cls) -> bool:
