@@ -34,7 +34,6 @@ size: the states' width is the flow key's, the torques' the action's.
 
 from __future__ import annotations
 
-from itertools import repeat
 from operator import attrgetter, is_, itemgetter
 
 import numpy as np
@@ -140,73 +139,35 @@ def _lane_entry(v, lane, cache: dict):
 _VIEW = attrgetter("_lane", "walker", "k", "leg", "ended", "t", "t_step", "max_step_time",
                    "x", "ledger", "steps", "foot")
 _ENV = attrgetter("_elapsed", "dt", "_hip_x", "terrain_seed")
-_FIRST, _SECOND, _THIRD, _FOURTH = itemgetter(0), itemgetter(1), itemgetter(2), itemgetter(3)
-_HEAD = itemgetter(0, 1, 2)  # (a lane's step walker, phase and stance leg)
+_FIRST, _THIRD, _FOURTH = itemgetter(0), itemgetter(2), itemgetter(3)
 _WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [J])
 
 
 def _common(envs, views, cache: dict):
-    """What a common period reads of the walkers, before anything changes: ``(key,
-    entries, cols, caps, stops, t_ends, env_read, stall, elapsed)`` (the flow key they
-    share; each walker's lane entry (:func:`_lane_entry`), what is read of the views
-    (:data:`_VIEW`) as columns (N each), each piece's span [s] and end [s], each period's
-    end [s] (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of each
+    """What a common period reads of the walkers, in one pass, before anything changes:
+    ``(key, entries, read, caps, stops, t_ends, env_read, stall, elapsed)`` (the flow key they
+    share; each walker's lane entry (:func:`_lane_entry`), what is read of its view
+    (:data:`_VIEW`), its piece's span [s] and end [s], its period's end [s]
+    (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of its
     environment (:data:`_ENV`); whether some walker's piece ends at its step's time limit
     (``t_step + max_step_time <= t_end``: settled there, it stalls); each environment's
     count of periods with this one (``_elapsed + 1``)); None when the period is not
-    common.  The walkers' lanes and their entries are checked on the columns at once
-    (every walker in its lane's step walker, phase and stance leg, its entry kept, one
-    flow key), else walker by walker (:func:`_lanes`: the lanes made current)."""
-    read = list(map(_VIEW, views))
-    env_read = list(map(_ENV, envs))
-    cols = tuple(zip(*read))
-    lanes = cols[0]
-    entries = None
-    if None not in lanes and not any(cols[4]):
-        lws, lks, llegs = zip(*map(_HEAD, lanes))
-        if all(map(is_, lws, cols[1])) and lks == cols[2] and llegs == cols[3]:
-            entries = list(map((cache.get("lanes") or {}).get, map(id, lanes)))
-            key = entries[0] and entries[0][1]
-            if (key is None or None in entries
-                    or not all(map(is_, map(_SECOND, entries), repeat(key)))):
-                entries = None
-    if entries is None:
-        got = _lanes(views, read, cache)
-        if got is None:
-            return None
-        key, entries = got
-    stall = False
-    caps, stops, t_ends, elapsed = [], [], [], []
-    for t, t_step, mst, er in zip(cols[5], cols[6], cols[7], env_read):
-        k = er[0] + 1
-        t_end = k * er[1]
-        if not t < t_end:
-            return None
-        t_stop = t_step + mst  # (next_piece's end of the piece: t_step + max_step_time)
-        if t_stop <= t_end:  # (RigidView.settle's stall: t_stop >= t_step + max_step_time)
-            stall = True
-        if not t_stop < t_end:
-            t_stop = t_end
-        caps.append(t_stop - t)
-        stops.append(t_stop)
-        t_ends.append(t_end)
-        elapsed.append(k)
-    return key, entries, cols, caps, stops, t_ends, env_read, stall, elapsed
-
-
-def _lanes(views, read: list, cache: dict):
-    """``(key, entries)`` of :func:`_common`, walker by walker: a walker in another step
-    walker, phase or stance leg than its lane's (a reset walker, most often) has its lane
-    made as ``next_piece`` makes it as the period begins; None when the period is not
-    common (an ended walker, a lane the common period cannot run, several flows)."""
+    common."""
     lanes_kept = cache.get("lanes") or {}
     key = None
-    entries = []
-    for r, got in enumerate(read):
-        lane = got[0]
-        if got[4]:
+    stall = False
+    entries, caps, stops, t_ends, elapsed = [], [], [], [], []
+    read = list(map(_VIEW, views))
+    env_read = list(map(_ENV, envs))
+    for r, (got, er) in enumerate(zip(read, env_read)):
+        lane, t = got[0], got[5]
+        k = er[0] + 1
+        t_end = k * er[1]
+        if got[4] or not t < t_end:
             return None
         if lane is None or lane[0] is not got[1] or lane[1] != got[2] or lane[2] != got[3]:
+            # a walker in another step or phase than its lane's (a reset walker, most
+            # often): its lane made as next_piece makes it as the period begins
             v = views[r]
             lane = v._lane = v.lane_at(got[1])
         en = lanes_kept.get(id(lane)) or _lane_entry(views[r], lane, cache)
@@ -216,8 +177,17 @@ def _lanes(views, read: list, cache: dict):
             key = en[1]
         elif key is None:  # (the first walker's lane: one the common period cannot run)
             return None
+        t_stop = got[6] + got[7]  # (next_piece's end of the piece: t_step + max_step_time)
+        if t_stop <= t_end:  # (RigidView.settle's stall: t_stop >= t_step + max_step_time)
+            stall = True
+        if not t_stop < t_end:
+            t_stop = t_end
         entries.append(en)
-    return key, entries
+        caps.append(t_stop - t)
+        stops.append(t_stop)
+        t_ends.append(t_end)
+        elapsed.append(k)
+    return key, entries, read, caps, stops, t_ends, env_read, stall, elapsed
 
 
 def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
@@ -252,11 +222,11 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     got = _common(envs, views, cache)
     if got is None:
         return None
-    key, entries, cols, caps, stops, t_ends, env_read, stall, elapsed = got
+    key, entries, read, caps, stops, t_ends, env_read, stall, elapsed = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
     lanes = list(map(_FIRST, entries))
-    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, steps, feet) = cols
+    (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, steps, feet) = zip(*read)
     x_before = list(map(_THIRD, env_read))  # (the reward's origins, before the period)
     w_before = list(map(_WORK, ledgers))
     on = list(map(any, U.tolist()))
