@@ -8,7 +8,7 @@ of them at once: :func:`hip_xs`) - the same element-wise operations as each
 
 from __future__ import annotations
 
-from operator import attrgetter, itemgetter, methodcaller
+from operator import attrgetter, itemgetter
 
 import numpy as np
 
@@ -167,6 +167,8 @@ def _observations(X: np.ndarray, ts, legs, ks, t_steps, p: dict, fixed=None) -> 
     return _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
 
 
+#: a ledger's positive action work [J]
+_WORK = itemgetter("action_work_positive")
 #: what :func:`end_periods` reads of each environment
 _ENV_READ = attrgetter("_elapsed", "terrain_seed")
 
@@ -254,7 +256,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                               for te, lim, el in zip(terminated, limits, elapsed)],
                              dtype=np.bool_)
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
-    sums = list(map(list, map(dict.values, ledgers)))  # (the ledgers' values now)
+    sums = list(map(dict.copy, ledgers))  # (the ledgers now: copies, read as lists below)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
     if any(U.ravel().tolist()):
@@ -262,20 +264,19 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2)
     else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
         effort = [0.0] * len(views)
-    j_work = terms.index("action_work_positive")
-    work = list(map(itemgetter(j_work), sums))
+    work = list(map(_WORK, sums))
     reward = np.array([
         fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
             fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
             w_before)], dtype=np.float64)
     # (a view's own words, when it has them: the rigid view's are its instance's)
-    messages = (list(map(_FAILURE, map(_DICT, views)))
+    messages = ([v.__dict__.get("failure", "") for v in views]
                 if not any(map(_class_failure, set(map(type, views))))
                 else [getattr(v, "failure", "") for v in views])
 
     def columns() -> dict:  # (of the values read above, whenever called)
-        L = np.array(sums, dtype=np.float64).T.copy()
+        L = np.array(list(map(list, map(dict.values, sums))), dtype=np.float64).T.copy()
         out = {"time_s": np.array(ts, dtype=np.float64),
                "heel_strike": [bool(s) for s in strikes],
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],
@@ -293,8 +294,6 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
 
 
 _CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
-#: an instance's own attributes; a dict's ``failure`` (text, "" when none)
-_DICT, _FAILURE = attrgetter("__dict__"), methodcaller("get", "failure", "")
 
 
 def _class_failure(cls) -> bool:
