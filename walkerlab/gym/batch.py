@@ -120,7 +120,7 @@ def held_torques(envs, actions: np.ndarray, p: dict) -> np.ndarray:
     half: scaled, the scene policy's added at the walkers' present states, clipped; a new
     array)."""
     norm = p["normalize"]
-    every, some, policy = _flags(p)
+    every, some, policy = p.get("flags") or _flags(p)
     tau = p["tau"]
     if every:  # (the actions read as float64, then scaled: numpy's casting of any real
         a = np.multiply(actions, tau, dtype=np.float64)  # dtype, in one operation)
@@ -167,6 +167,8 @@ def _observations(X: np.ndarray, ts, legs, ks, t_steps, p: dict, fixed=None) -> 
     return _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
 
 
+#: a ledger's positive action work [J]
+_WORK = itemgetter("action_work_positive")
 #: what :func:`end_periods` reads of each environment
 _ENV_READ = attrgetter("_elapsed", "terrain_seed")
 
@@ -174,7 +176,8 @@ _ENV_READ = attrgetter("_elapsed", "terrain_seed")
 def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: list,
                 p: dict, views=None, X: np.ndarray | None = None,
                 cols: tuple | None = None, hips: list | None = None,
-                fixed: np.ndarray | None = None, env_cols: tuple | None = None) -> tuple:
+                fixed: np.ndarray | None = None, env_cols: tuple | None = None,
+                written: bool = False) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -206,6 +209,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     env_cols : tuple, optional
         ``(elapsed, seeds)``: each environment's period count (``_elapsed``, this period
         counted) and ``terrain_seed``, sequences of N, when the caller has read them.
+    written : bool
+        The caller has written ``hips`` into each environment (its next period's reward's
+        origin).
 
     Returns
     -------
@@ -236,8 +242,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         hips = hip.tolist()
     else:
         hip = None  # (made of hips when the infos are)
-    for e, h in zip(envs, hips):
-        e._hip_x = h  # the next period's start (its reward's origin)
+    if not written:
+        for e, h in zip(envs, hips):
+            e._hip_x = h  # the next period's start (its reward's origin)
     # (each environment's count and seed)
     elapsed, seeds = zip(*map(_ENV_READ, envs)) if env_cols is None else env_cols
     terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
@@ -249,7 +256,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                               for te, lim, el in zip(terminated, limits, elapsed)],
                              dtype=np.bool_)
     terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
-    sums = list(map(list, map(dict.values, ledgers)))  # (the ledgers' values now)
+    sums = list(map(dict.copy, ledgers))  # (the ledgers now: copies, read as lists below)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
     if any(U.ravel().tolist()):
@@ -257,8 +264,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2)
     else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
         effort = [0.0] * len(views)
-    j_work = terms.index("action_work_positive")
-    work = list(map(itemgetter(j_work), sums))
+    work = list(map(_WORK, sums))
     reward = np.array([
         fw * (h - xb) / dt + (0.0 if te else hl) - cw * c - ww * (wa - wb) / dt
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
@@ -270,7 +276,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                 else [getattr(v, "failure", "") for v in views])
 
     def columns() -> dict:  # (of the values read above, whenever called)
-        L = np.array(sums, dtype=np.float64).T.copy()
+        L = np.array(list(map(list, map(dict.values, sums))), dtype=np.float64).T.copy()
         out = {"time_s": np.array(ts, dtype=np.float64),
                "heel_strike": [bool(s) for s in strikes],
                "heel_strike_time_s": [float(s[-1]) if s else None for s in strikes],

@@ -145,22 +145,24 @@ _WORK = itemgetter("action_work_positive")  # (a ledger's positive action work [
 
 def _common(envs, views, cache: dict):
     """What a common period reads of the walkers, in one pass, before anything changes:
-    ``(key, entries, read, caps, stops, t_ends, env_read, stall)`` (the flow key they
+    ``(key, entries, read, caps, stops, t_ends, env_read, stall, elapsed)`` (the flow key they
     share; each walker's lane entry (:func:`_lane_entry`), what is read of its view
     (:data:`_VIEW`), its piece's span [s] and end [s], its period's end [s]
     (:func:`~walkerlab.gym.batch.begin_periods`' ``k dt``), what is read of its
     environment (:data:`_ENV`); whether some walker's piece ends at its step's time limit
-    (``t_step + max_step_time <= t_end``: settled there, it stalls)); None when the period
-    is not common."""
+    (``t_step + max_step_time <= t_end``: settled there, it stalls); each environment's
+    count of periods with this one (``_elapsed + 1``)); None when the period is not
+    common."""
     lanes_kept = cache.get("lanes") or {}
     key = None
     stall = False
-    entries, caps, stops, t_ends = [], [], [], []
+    entries, caps, stops, t_ends, elapsed = [], [], [], [], []
     read = list(map(_VIEW, views))
     env_read = list(map(_ENV, envs))
     for r, (got, er) in enumerate(zip(read, env_read)):
         lane, t = got[0], got[5]
-        t_end = (er[0] + 1) * er[1]
+        k = er[0] + 1
+        t_end = k * er[1]
         if got[4] or not t < t_end:
             return None
         if lane is None or lane[0] is not got[1] or lane[1] != got[2] or lane[2] != got[3]:
@@ -184,7 +186,8 @@ def _common(envs, views, cache: dict):
         caps.append(t_stop - t)
         stops.append(t_stop)
         t_ends.append(t_end)
-    return key, entries, read, caps, stops, t_ends, env_read, stall
+        elapsed.append(k)
+    return key, entries, read, caps, stops, t_ends, env_read, stall, elapsed
 
 
 def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
@@ -219,17 +222,10 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     got = _common(envs, views, cache)
     if got is None:
         return None
-    key, entries, read, caps, stops, t_ends, env_read, stall = got
+    key, entries, read, caps, stops, t_ends, env_read, stall, elapsed = got
     U = held_torques(envs, actions, p)  # (the policy's at the present states)
     rows_u = list(U)
     lanes = list(map(_FIRST, entries))
-    elapsed = []
-    for e, v, lane, u, t_end, er in zip(envs, views, lanes, rows_u, t_ends, env_read):
-        e._elapsed = k = er[0] + 1  # (begin_periods, open_period, next_piece)
-        elapsed.append(k)
-        per = (u, t_end)  # (u a float64 row, t_end a float)
-        v._period = per  # (its step's log: a profile's alone, never common)
-        lane[3].u = u
     (_, walkers, ks, legs, _, _, t_steps, msts, xs, ledgers, steps, feet) = zip(*read)
     x_before = list(map(_THIRD, env_read))  # (the reward's origins, before the period)
     w_before = list(map(_WORK, ledgers))
@@ -240,20 +236,6 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     env_cols = (elapsed, list(map(_FOURTH, env_read)))  # (counts and terrain seeds)
     settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
     X = list(Yev)
-    if not slow and not stall:  # (RigidView.settle: no walker at its step's time limit)
-        for v, x, t_stop in zip(views, X, stops):
-            v.t = t_stop
-            v.x = x
-        ended = [""] * len(views)
-    elif not slow:
-        ended = []
-        for v, x, t_stop, t_step, mst in zip(views, X, stops, t_steps, msts):
-            v.t, v.x = t_stop, x  # (RigidView.settle)
-            if t_stop >= t_step + mst:
-                v.ended = "stall"
-                ended.append("stall")
-            else:
-                ended.append("")
     if not slow:
         cache["X"] = (Yev, X)
         # the hips' x: one call of the walkers' one points function on the states as
@@ -261,9 +243,28 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         hx = _hips(walkers[0], Yev) if batch[5] else None
         hips = (None if hx is None
                 else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
+        # each walker's period opened and settled (RigidView.settle) in one pass
+        for e, v, lane, u, t_end, k, x, t_stop, h in zip(
+                envs, views, lanes, rows_u, t_ends, elapsed, X, stops,
+                hips if hips is not None else [None] * len(views)):
+            e._elapsed = k  # (begin_periods, open_period, next_piece)
+            v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
+            lane[3].u = u
+            v.t = t_stop
+            v.x = x
+            e._hip_x = h  # (the next period's reward's origin; None: end_periods' to write)
+        ended = [""] * len(views)
+        if stall:  # (RigidView.settle: a walker at its step's time limit)
+            for r, (t_stop, t_step, mst) in enumerate(zip(stops, t_steps, msts)):
+                if t_stop >= t_step + mst:
+                    views[r].ended = ended[r] = "stall"
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
                            Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
-                           batch[6], env_cols)
+                           batch[6], env_cols, hips is not None)
+    for e, v, lane, u, t_end, k in zip(envs, views, lanes, rows_u, t_ends, elapsed):
+        e._elapsed = k  # (begin_periods, open_period, next_piece)
+        v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
+        lane[3].u = u
     # (the data rows as they are now: the batch's own array is written again next period,
     # a guard crossing's dense output may read them later)
     out = (*out[:6], (*call[:3], call[3].copy(), *call[4:]))

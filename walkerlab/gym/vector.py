@@ -243,15 +243,12 @@ class WalkerVectorEnv(VectorEnv):
                  self._truncations[i], info) = env.step(actions[i])
                 dicts.append(info)
             return {"rows": idx, "dicts": dicts}
-        advance_rows = _advance_rows()
         first = not self._batched_before
-        if first:  # its kernels compiled or loaded: a long wait said
-            self._batched_before = True
-            from .rigid_rows import compile_notice  # (advance_rows' module: imported)
-
-            advance_rows = compile_notice(advance_rows)
-        p = self._batch_parameters()
+        p = self._params
+        if p is False:
+            p = self._batch_parameters()
         if p is None:  # each walker's own begin and end of its period
+            advance_rows = self._advancer(first)
             begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
             strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
                                    [env.period_end_s for env in envs])
@@ -280,6 +277,7 @@ class WalkerVectorEnv(VectorEnv):
                else _step_common()(envs, views, actions if whole else actions[idx], p,
                                    self._common))
         if out is None:
+            advance_rows = self._advancer(first)
             # (begin_periods reads the actions into an array of its own: every row as given)
             U, x_before, w_before, t_ends = begin_periods(
                 envs, actions if whole else actions[idx], p)
@@ -295,6 +293,18 @@ class WalkerVectorEnv(VectorEnv):
             self._terminations[idx] = term
             self._truncations[idx] = trunc
         return {"rows": idx, "make_columns": columns}
+
+    def _advancer(self, first: bool):
+        """:func:`walkerlab.gym.rigid_rows.advance_rows`; on the first batched step
+        (``first``: its kernels compiled or loaded, a long wait said) through
+        :func:`~walkerlab.gym.rigid_rows.compile_notice`."""
+        advance_rows = _advance_rows()
+        if first:
+            self._batched_before = True
+            from .rigid_rows import compile_notice  # (advance_rows' module: imported)
+
+            advance_rows = compile_notice(advance_rows)
+        return advance_rows
 
     @staticmethod
     def _columns(stepped: dict) -> dict:
