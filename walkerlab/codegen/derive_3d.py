@@ -64,6 +64,7 @@ import sympy as sp
 
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
+from walkerlab.codegen.lagrange import knee_lock
 from walkerlab.codegen.seeded import seeded as _seeded
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike, plastic_impact
 from walkerlab.walker.trees import legs_tree, spoked_wheel_3d_tree
@@ -306,7 +307,11 @@ def derive_compass(structure) -> Equations:
     tree, coords = legs_tree(structure)
     te = derive_tree(tree, coords)
     kin, q, dq = te.kinematics, te.q, te.dq
-    phi, th_sw, th_st = q[:3]
+    knee = structure.knee
+    if knee:  # lean, swing thigh, swing shank, stance (KNEED_3D_ROLES)
+        phi, th_sw, th_sh, th_st = q
+    else:
+        (phi, th_sw, th_st), th_sh = q[:3], q[1]
     phi_p, phi_w = q[3:] if structure.hip_roll else (phi, phi)
     P = dict(zip(structure.param_names, te.params))
     L, gamma = P["L"], P["gamma"]
@@ -333,6 +338,8 @@ def derive_compass(structure) -> Equations:
     pelvis = kin.coms["pelvis"]
     height = swing_contact[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
+    if knee:  # the new swing knee starts straight (the knee locked at heel strike)
+        relabel_q = sp.Matrix([phi, th_st, th_st, th_sw])
     if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
         relabel_q = sp.Matrix([phi_w, th_st, th_sw, phi_p, phi])   # the new swing roll
     relabel_rate = relabel_q.jacobian(sp.Matrix(q))
@@ -351,8 +358,12 @@ def derive_compass(structure) -> Equations:
     named = [("hip", pelvis), ("stance_hip", kin.origins["pelvis"]),
              ("swing_hip", kin.origins["swing_leg"]), ("stance_foot", sp.zeros(3, 1)),
              ("swing_foot", swing_foot)]
-    named += [(f"{role}_{b.name}", kin.coms[f"{role}_leg_{b.name}"])
+    named += [(f"{role}_{b.name}", kin.coms[f"{role}_{_link(b, role, knee)}_{b.name}"])
               for b in structure.bodies for role in ("stance", "swing")]
+    if knee:  # the swing knee (the shank's origin), the straight stance leg's
+        up = kin.origins["pelvis"]
+        named += [("swing_knee", kin.origins["swing_shank"]),
+                  ("stance_knee", up * (1 - P["L_thigh"] / L))]
     named += [(f"torso_{b.name}", kin.coms[f"torso_{b.name}"]) for b in structure.torso]
     if arc:
         centre_st = kin.origins["stance_leg"]
@@ -364,9 +375,20 @@ def derive_compass(structure) -> Equations:
                   # each leg's roll by leg (the lean is the stance leg's)
                   **({"pelvis_roll": phi_p, "stance_roll": phi, "swing_roll": phi_w}
                      if structure.hip_roll else {})}
+    guards = {"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
+              "hip_height": pelvis[1], "swing_clearance": height}
+    n = len(q)
+    kneed = {"section_tied": None}
+    if knee:  # the planar kneed walker's names, the lean besides; the knee lock
+        leg_angles = {"stance_thigh": th_st, "stance_shank": th_st, "swing_thigh": th_sw,
+                      "swing_shank": th_sh, "lean": phi}
+        guards["knee_extension"] = th_sh - th_sw   # zero straight, > 0 hyperextended
+        lock = knee_lock(te.M, te.C, G, Mi, B, thigh=1, shank=2)
+        Mi, B = lock.heel_strike
+        kneed = {"section_tied": {2: 1, n + 2: n + 1}, "locked": lock.locked,
+                 "knee_impact": lock.knee_impact}
     if structure.torso:   # the bisecting hip: the upper body's pitch from the upward vertical
         leg_angles["torso"] = (th_sw + th_st) / 2
-    n = len(q)
     De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)
     if not arc:  # the extended impact system of a push-off (world axes; arcs: none yet)
         De, E = push_off_system(te, F, to_world)
@@ -374,12 +396,16 @@ def derive_compass(structure) -> Equations:
         q=q, dq=dq, params=te.params, M=te.M, C=te.C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=te.kinetic,
         potential=te.potential,
-        guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
-                "hip_height": pelvis[1], "swing_clearance": height},
-        points=points, leg_angles=leg_angles,
-        section_drop=1, drop_solution=drop_solution,
-        De=De, E=E, limit=False, section_tied=None,
+        guards=guards, points=points, leg_angles=leg_angles,
+        section_drop=1, drop_solution=drop_solution, De=De, E=E, limit=False, **kneed,
     )
+
+
+def _link(body, role: str, knee: bool) -> str:
+    """The link of the tree (:func:`walkerlab.walker.trees.biped_tree`) a leg body is welded
+    to in ``role``: the swing shank's parts on ``shank``, every other on ``leg`` (the
+    stance leg is straight)."""
+    return "shank" if knee and role == "swing" and body.link == "shank" else "leg"
 
 
 def push_off_system(te, F: sp.Matrix, to_world: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:

@@ -93,7 +93,14 @@ ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass 
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
-#: what the views of both 3D kinds refuse: a ground other than a plane, the OpenSim
+#: why a kneed walker in 3D refuses a view (its rigid model is its only one so far)
+_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model only so far (walkerlab "
+                  "fixedpoint, simulate): its floating (contact) view and its exports are a "
+                  "later step")
+#: why a kneed walker in 3D refuses every actuator
+_KNEED_3D_PASSIVE = ("a kneed walker in 3D is passive so far (walker.actuation): its rigid "
+                     "model has no torque law or push-off")
+#: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -305,6 +312,24 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
     },
+    "locking_knees_3d": {
+        **{(f, "*"): _KNEED_3D_PASSIVE for f in ("hip_torque", "knee_torque", "push_off",
+                                                 "virtual_constraints")},
+        ("torso_torque", "*"): ("a kneed walker in 3D carries no torso so far "
+                                "(walker.torso)"),
+        **_NO_ANKLES,
+        ("hip_roll", "*"): ("hip-roll joints are the 3D straight legs' so far: a kneed "
+                            "walker in 3D has universal hips (walker.hip_roll)"),
+        ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
+                                 "(walker.foot_radius_m)"),
+        **_CELLS_3D,
+        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "mjcf", "urdf", "adams",
+                                                 "osim")},
+        ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
+                          "is a later step"),
+        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
+                               "is a later step"),
+    },
     "rolling_polygon_3d": {
         **_PLANAR,
         **_WHEEL_JOINTS,
@@ -351,4 +376,4 @@ ROBUSTNESS_3D = ("the robustness study (gait sensitivity norms, largest step-dow
 #: it refuses may still design virtual constraints, so only the 3D kinds' is here)
 STAGE_CELLS: dict[str, dict[str, str]] = {
     k: {"robustness": ROBUSTNESS_3D, "optimize": CAPABILITIES[k][("walk", "optimize")]}
-    for k in ("straight_legs_3d", "rolling_polygon_3d")}
+    for k in ("straight_legs_3d", "locking_knees_3d", "rolling_polygon_3d")}
