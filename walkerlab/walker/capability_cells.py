@@ -10,6 +10,8 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
+from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
+
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
@@ -97,9 +99,6 @@ EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written 
 _KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model only so far (walkerlab "
                   "fixedpoint, simulate): its floating (contact) view and its exports are a "
                   "later step")
-#: why a kneed walker in 3D refuses every actuator
-_KNEED_3D_PASSIVE = ("a kneed walker in 3D is passive so far (walker.actuation): its rigid "
-                     "model has no torque law or push-off")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -313,13 +312,12 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                "is a later step"),
     },
     "locking_knees_3d": {
-        **{(f, "*"): _KNEED_3D_PASSIVE for f in ("hip_torque", "knee_torque", "push_off",
-                                                 "virtual_constraints")},
-        ("torso_torque", "*"): ("a kneed walker in 3D carries no torso so far "
-                                "(walker.torso)"),
-        **_NO_ANKLES,
-        ("hip_roll", "*"): ("hip-roll joints are the 3D straight legs' so far: a kneed "
-                            "walker in 3D has universal hips (walker.hip_roll)"),
+        # the scene's own check says the same (walkerlab.config.walker.BipedParams)
+        **{(f, "*"): KNEED_3D_PASSIVE for f in ("hip_torque", "knee_torque", "push_off",
+                                                "virtual_constraints", "ankle_torque",
+                                                "ankle_push_off")},
+        ("torso_torque", "*"): KNEED_3D_TORSO,
+        ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
