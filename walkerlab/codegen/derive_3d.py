@@ -198,9 +198,10 @@ def stance_forces(structure, q, dq, params, roles_3d: dict) -> tuple:
 @cache
 @_seeded
 def derive_compass(structure) -> Equations:
-    """Flow, impact, guards, energies and points of a straight-legged walker with hip width in
-    three dimensions (``model: compass_gait`` with ``space: 3d``; Kuo 1999, "Stabilization of
-    lateral motion in passive dynamic walking", IJRR 18(9)).
+    """Flow, impact, guards, energies and points of a legged walker (straight legs, or
+    locking knees) with hip width in three dimensions (``model: compass_gait`` or a biped
+    from parts with ``space: 3d``; Kuo 1999, "Stabilization of lateral motion in passive
+    dynamic walking", IJRR 18(9)).
 
     The walker: a hip (pelvis) point mass ``M_hip`` midway between two hips ``w`` apart
     along the hip axis, and on each straight leg of length ``L`` a point mass ``m`` at
@@ -283,23 +284,37 @@ def derive_compass(structure) -> Equations:
     round_feet_3d.yaml``, ``tests/test_round_feet_3d.py``).  Neither goes with
     hip-roll joints yet (the scene refuses the combination).
 
+    Locking knees (``structure.knee``, a biped from parts; McGeer 1990, "Passive walking
+    with knees", ICRA): the tree's swing leg is a thigh and a shank on a pitch joint
+    ``L_thigh`` below the hip, about the leg's own pitch axis (in its rolled sagittal
+    plane); the stance leg straight.  Coordinates ``lean, swing_thigh, swing_shank,
+    stance`` (absolute pitches as above).  The knee lock ``J_k = d(shank - thigh)/dq``
+    closes the square systems of the locked flow, the plastic knee strike and the heel
+    strike with the knee locked (:func:`walkerlab.codegen.lagrange.knee_lock`, the planar
+    kneed walker's too; ``locked``, ``knee_impact``, ``Mi``, ``B``); the guard
+    ``knee_extension`` ``shank - thigh``; after heel strike the new swing knee is straight
+    (``relabel_q``: both new swing pitches the old stance leg's) and the section ties the
+    shank's angle and rate to the thigh's.  The heel-strike guard, section and impact are
+    the straight legs' with the shank's foot; point feet, no torso, no hip-roll joints
+    (the scene refuses them).
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
         ``in_3d`` and not ``spokes`` (parameters
         :data:`walkerlab.walker.description.COMPASS_3D_PARAMS`; ``hip_width``: whether
         ``w`` is a parameter, else 0; ``foot`` ``point`` or ``arc``; ``bodies[0].kind``
-        ``point_mass`` or ``rod``).
+        ``point_mass`` or ``rod``; ``knee``: locking knees, parameter ``L_thigh``).
 
     Returns
     -------
     Equations
-        ``n = 3`` (5 with ``hip_roll``); points (3, 1) in world axes.
+        ``n = 3`` (5 with ``hip_roll``, 4 with ``knee``); points (3, 1) in world axes.
 
     Raises
     ------
     ValueError
-        ``structure`` is not a 3D straight-legged walker.
+        ``structure`` is not a 3D legged walker.
     """
     if not structure.in_3d or structure.spokes:
         raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
