@@ -43,7 +43,9 @@ def _scene(name):
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
            "simplest": "walker.leg.bodies",
            # the 3D walker's round feet (discs) are the rigid model's so far
-           "round_feet_3d": "walker.foot_radius_m"}
+           "round_feet_3d": "walker.foot_radius_m",
+           # the kneed walker in 3D runs in its rigid model only so far
+           "kneed_3d": "walker.space: 3d"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.

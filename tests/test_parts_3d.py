@@ -222,7 +222,8 @@ def test_the_shipped_3d_torso_gait_and_multipliers_match_an_independent_model(to
 
 
 @pytest.mark.parametrize("change, field", [
-    ({"leg": {"length_m": 1.0, "knee": {"thigh_length_m": 0.5}, "bodies": [
+    # free knees (locking ones walk in 3D: tests/test_kneed_3d.py)
+    ({"leg": {"length_m": 1.0, "knee": {"thigh_length_m": 0.5, "lock": "free"}, "bodies": [
         {"kind": "point_mass", "name": "thigh", "link": "thigh", "mass_kg": 5.0,
          "from_hip_m": 0.25},
         {"kind": "point_mass", "name": "shank", "link": "shank", "mass_kg": 1.0,

@@ -64,6 +64,7 @@ import sympy as sp
 
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
+from walkerlab.codegen.lagrange import knee_lock
 from walkerlab.codegen.seeded import seeded as _seeded
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike, plastic_impact
 from walkerlab.walker.trees import legs_tree, spoked_wheel_3d_tree
@@ -197,9 +198,10 @@ def stance_forces(structure, q, dq, params, roles_3d: dict) -> tuple:
 @cache
 @_seeded
 def derive_compass(structure) -> Equations:
-    """Flow, impact, guards, energies and points of a straight-legged walker with hip width in
-    three dimensions (``model: compass_gait`` with ``space: 3d``; Kuo 1999, "Stabilization of
-    lateral motion in passive dynamic walking", IJRR 18(9)).
+    """Flow, impact, guards, energies and points of a legged walker (straight legs, or
+    locking knees) with hip width in three dimensions (``model: compass_gait`` or a biped
+    from parts with ``space: 3d``; Kuo 1999, "Stabilization of lateral motion in passive
+    dynamic walking", IJRR 18(9)).
 
     The walker: a hip (pelvis) point mass ``M_hip`` midway between two hips ``w`` apart
     along the hip axis, and on each straight leg of length ``L`` a point mass ``m`` at
@@ -282,23 +284,37 @@ def derive_compass(structure) -> Equations:
     round_feet_3d.yaml``, ``tests/test_round_feet_3d.py``).  Neither goes with
     hip-roll joints yet (the scene refuses the combination).
 
+    Locking knees (``structure.knee``, a biped from parts; McGeer 1990, "Passive walking
+    with knees", ICRA): the tree's swing leg is a thigh and a shank on a pitch joint
+    ``L_thigh`` below the hip, about the leg's own pitch axis (in its rolled sagittal
+    plane); the stance leg straight.  Coordinates ``lean, swing_thigh, swing_shank,
+    stance`` (absolute pitches as above).  The knee lock ``J_k = d(shank - thigh)/dq``
+    closes the square systems of the locked flow, the plastic knee strike and the heel
+    strike with the knee locked (:func:`walkerlab.codegen.lagrange.knee_lock`, the planar
+    kneed walker's too; ``locked``, ``knee_impact``, ``Mi``, ``B``); the guard
+    ``knee_extension`` ``shank - thigh``; after heel strike the new swing knee is straight
+    (``relabel_q``: both new swing pitches the old stance leg's) and the section ties the
+    shank's angle and rate to the thigh's.  The heel-strike guard, section and impact are
+    the straight legs' with the shank's foot; point feet, no torso, no hip-roll joints
+    (the scene refuses them).
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
         ``in_3d`` and not ``spokes`` (parameters
         :data:`walkerlab.walker.description.COMPASS_3D_PARAMS`; ``hip_width``: whether
         ``w`` is a parameter, else 0; ``foot`` ``point`` or ``arc``; ``bodies[0].kind``
-        ``point_mass`` or ``rod``).
+        ``point_mass`` or ``rod``; ``knee``: locking knees, parameter ``L_thigh``).
 
     Returns
     -------
     Equations
-        ``n = 3`` (5 with ``hip_roll``); points (3, 1) in world axes.
+        ``n = 3`` (5 with ``hip_roll``, 4 with ``knee``); points (3, 1) in world axes.
 
     Raises
     ------
     ValueError
-        ``structure`` is not a 3D straight-legged walker.
+        ``structure`` is not a 3D legged walker.
     """
     if not structure.in_3d or structure.spokes:
         raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
@@ -306,7 +322,11 @@ def derive_compass(structure) -> Equations:
     tree, coords = legs_tree(structure)
     te = derive_tree(tree, coords)
     kin, q, dq = te.kinematics, te.q, te.dq
-    phi, th_sw, th_st = q[:3]
+    knee = structure.knee
+    if knee:  # lean, swing thigh, swing shank, stance (KNEED_3D_ROLES)
+        phi, th_sw, th_sh, th_st = q
+    else:
+        (phi, th_sw, th_st), th_sh = q[:3], q[1]
     phi_p, phi_w = q[3:] if structure.hip_roll else (phi, phi)
     P = dict(zip(structure.param_names, te.params))
     L, gamma = P["L"], P["gamma"]
@@ -333,6 +353,8 @@ def derive_compass(structure) -> Equations:
     pelvis = kin.coms["pelvis"]
     height = swing_contact[1]
     relabel_q = sp.Matrix([phi, th_st, th_sw])        # lean kept, the legs' roles swap
+    if knee:  # the new swing knee starts straight (the knee locked at heel strike)
+        relabel_q = sp.Matrix([phi, th_st, th_st, th_sw])
     if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
         relabel_q = sp.Matrix([phi_w, th_st, th_sw, phi_p, phi])   # the new swing roll
     relabel_rate = relabel_q.jacobian(sp.Matrix(q))
@@ -351,8 +373,12 @@ def derive_compass(structure) -> Equations:
     named = [("hip", pelvis), ("stance_hip", kin.origins["pelvis"]),
              ("swing_hip", kin.origins["swing_leg"]), ("stance_foot", sp.zeros(3, 1)),
              ("swing_foot", swing_foot)]
-    named += [(f"{role}_{b.name}", kin.coms[f"{role}_leg_{b.name}"])
+    named += [(f"{role}_{b.name}", kin.coms[f"{role}_{_link(b, role, knee)}_{b.name}"])
               for b in structure.bodies for role in ("stance", "swing")]
+    if knee:  # the swing knee (the shank's origin), the straight stance leg's
+        up = kin.origins["pelvis"]
+        named += [("swing_knee", kin.origins["swing_shank"]),
+                  ("stance_knee", up * (1 - P["L_thigh"] / L))]
     named += [(f"torso_{b.name}", kin.coms[f"torso_{b.name}"]) for b in structure.torso]
     if arc:
         centre_st = kin.origins["stance_leg"]
@@ -364,9 +390,20 @@ def derive_compass(structure) -> Equations:
                   # each leg's roll by leg (the lean is the stance leg's)
                   **({"pelvis_roll": phi_p, "stance_roll": phi, "swing_roll": phi_w}
                      if structure.hip_roll else {})}
+    guards = {"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
+              "hip_height": pelvis[1], "swing_clearance": height}
+    n = len(q)
+    kneed = {"section_tied": None}
+    if knee:  # the planar kneed walker's names, the lean besides; the knee lock
+        leg_angles = {"stance_thigh": th_st, "stance_shank": th_st, "swing_thigh": th_sw,
+                      "swing_shank": th_sh, "lean": phi}
+        guards["knee_extension"] = th_sh - th_sw   # zero straight, > 0 hyperextended
+        lock = knee_lock(te.M, te.C, G, Mi, B, thigh=1, shank=2)
+        Mi, B = lock.heel_strike
+        kneed = {"section_tied": {2: 1, n + 2: n + 1}, "locked": lock.locked,
+                 "knee_impact": lock.knee_impact}
     if structure.torso:   # the bisecting hip: the upper body's pitch from the upward vertical
         leg_angles["torso"] = (th_sw + th_st) / 2
-    n = len(q)
     De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)
     if not arc:  # the extended impact system of a push-off (world axes; arcs: none yet)
         De, E = push_off_system(te, F, to_world)
@@ -374,12 +411,16 @@ def derive_compass(structure) -> Equations:
         q=q, dq=dq, params=te.params, M=te.M, C=te.C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=te.kinetic,
         potential=te.potential,
-        guards={"heel_strike": heel, "swing_foot_ahead": th_sw - th_st,
-                "hip_height": pelvis[1], "swing_clearance": height},
-        points=points, leg_angles=leg_angles,
-        section_drop=1, drop_solution=drop_solution,
-        De=De, E=E, limit=False, section_tied=None,
+        guards=guards, points=points, leg_angles=leg_angles,
+        section_drop=1, drop_solution=drop_solution, De=De, E=E, limit=False, **kneed,
     )
+
+
+def _link(body, role: str, knee: bool) -> str:
+    """The link of the tree (:func:`walkerlab.walker.trees.biped_tree`) a leg body is welded
+    to in ``role``: the swing shank's parts on ``shank``, every other on ``leg`` (the
+    stance leg is straight)."""
+    return "shank" if knee and role == "swing" and body.link == "shank" else "leg"
 
 
 def push_off_system(te, F: sp.Matrix, to_world: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:

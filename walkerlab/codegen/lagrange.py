@@ -6,14 +6,17 @@ Lagrange's equations of a walker with coordinates ``q`` (n,), kinetic energy
 ``G = dV/dq`` and ``C`` from the Christoffel symbols of the first kind of ``M`` (Murray, Li &
 Sastry 1994, *A Mathematical Introduction to Robotic Manipulation*, Eq. 4.23; Spong,
 Hutchinson & Vidyasagar 2006, Eq. 7.54).  Planar and 3D walkers, their foot modes and free
-joints, all read it from here.
+joints, all read it from here; the walkers with locking knees (planar and 3D) their knee lock
+(:func:`knee_lock`).
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import sympy as sp
 
-__all__ = ["bias", "christoffel"]
+__all__ = ["KneeLock", "bias", "christoffel", "knee_lock"]
 
 
 def christoffel(M: sp.Matrix, q, dq) -> sp.Matrix:
@@ -67,3 +70,61 @@ def bias(M: sp.Matrix, V, q, dq) -> sp.Matrix:
     T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
     return ((M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, v) for v in q])
             + sp.Matrix([sp.diff(V, v) for v in q]))
+
+
+class KneeLock(NamedTuple):
+    """A locking knee's square systems (:func:`knee_lock`), each a pair or triple of sympy
+    Matrices with ``n`` rows: ``locked`` ``(Ml, Cl, Gl)`` the flow with the knee locked,
+    ``knee_impact`` ``(Mk, Bk)`` the plastic knee strike, ``heel_strike`` ``(Mh, Bh)`` the
+    heel strike with the knee locked."""
+
+    locked: tuple
+    knee_impact: tuple
+    heel_strike: tuple
+
+
+def knee_lock(M: sp.Matrix, C: sp.Matrix, G: sp.Matrix, Mi: sp.Matrix, B: sp.Matrix,
+              thigh: int, shank: int) -> KneeLock:
+    """The flow, knee strike and heel strike of a walker whose swing knee locks (McGeer 1990,
+    "Passive walking with knees", ICRA; the planar and the 3D kneed walkers alike).
+
+    The locked knee is the constraint ``J_k dq = 0``, ``J_k = d(q_shank - q_thigh)/dq`` (the
+    shank's absolute pitch the thigh's); ``S`` (n, n - 1) spans its null space: the shank
+    moving with the thigh, every other coordinate alone.  Projecting Lagrange's equations on
+    ``S`` removes the lock's constraint force, and ``J_k`` closes each system:
+
+    - locked flow ``[S^T M; J_k] qdd = [S^T (-C dq - G); 0]``, given as
+      ``([S^T M; J_k], [S^T C; 0], [S^T G; 0])`` (the printers' ``M qdd + C dq + G = 0``);
+    - plastic knee strike ``[S^T M; J_k] dq+ = [S^T M; 0] dq-``: the momenta along ``S``
+      (the whole walker's angular momentum about the stance foot, the swing leg's about the
+      hip) are conserved, the knee's relative rate stopped;
+    - heel strike with the knee locked ``[S^T Mi; J_k] dq+ = [S^T B; 0] dq-`` from the
+      unlocked impact ``Mi dq+ = B dq-``.
+
+    Parameters
+    ----------
+    M, C : sympy Matrix (n, n)
+        Mass and Coriolis matrices of the unlocked walker (coordinates ``q``, absolute
+        pitches of thigh and shank among them).
+    G : sympy Matrix (n, 1)
+    Mi, B : sympy Matrix (n, n)
+        The heel strike's (knee free) impact matrices.
+    thigh, shank : int
+        Indices of the swing thigh's and shank's coordinates in ``q``.
+
+    Returns
+    -------
+    KneeLock
+    """
+    n = M.rows
+    Jk = sp.zeros(1, n)
+    Jk[thigh], Jk[shank] = -1, 1
+    S = sp.zeros(n, n - 1)
+    for k, i in enumerate(i for i in range(n) if i != shank):
+        S[i, k] = 1
+        if i == thigh:
+            S[shank, k] = 1
+    z = sp.zeros(1, n)
+    locked = (S.T * M).col_join(Jk), (S.T * C).col_join(z), (S.T * G).col_join(sp.zeros(1, 1))
+    knee_impact = (S.T * M).col_join(Jk), (S.T * M).col_join(z)
+    return KneeLock(locked, knee_impact, ((S.T * Mi).col_join(Jk), (S.T * B).col_join(z)))

@@ -422,7 +422,9 @@ def generate(eq: Equations, param_names, key: str) -> str:
             *reset_lines(eq, False), *reset_lines(eq, True), *_guards(eq)]
     if eq.locked is not None:  # kneed walker: knee-locked flow and the knee strike
         lk = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
-        q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, len(eq.q)))])
+        # the knee strike's coordinates: the shank's angle the thigh's (its section tie)
+        tied = eq.section_tied or {}
+        q_lock = sp.Matrix([eq.q[tied.get(i, i)] for i in range(len(eq.q))])
         kn = replace(eq, Mi=eq.knee_impact[0], B=eq.knee_impact[1], relabel_q=q_lock,
                      relabel_rate=sp.eye(len(eq.q)))
         fast += [*flow_lines(lk, False, "flow_locked"),

@@ -49,7 +49,7 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.lagrange import christoffel
+from walkerlab.codegen.lagrange import christoffel, knee_lock
 from walkerlab.codegen.link_sums import (
     add_length,
     add_mass_terms,
@@ -377,13 +377,8 @@ def _lagrange(s: _Symbols, Mp, Mi, Bm, V, D) -> _Dynamics:
         Mi, Bm = imp[:, :n], imp[:, n:]
         T, V = T.subs(beta, 0), V.subs(beta, 0)
     locked = knee_impact = None
-    if s.knee:
-        Jk = sp.Matrix([[-1, 1, 0]])
-        S = sp.Matrix([[1, 0], [1, 0], [0, 1]])
-        z = sp.zeros(1, n)
-        locked = (S.T * M).col_join(Jk), (S.T * C).col_join(z), (S.T * G).col_join(sp.zeros(1, 1))
-        knee_impact = (S.T * M).col_join(Jk), (S.T * M).col_join(z)
-        Mi, Bm = (S.T * Mi).col_join(Jk), (S.T * Bm).col_join(z)
+    if s.knee:  # the swing thigh and shank are link angles 0 and 1
+        locked, knee_impact, (Mi, Bm) = knee_lock(M, C, G, Mi, Bm, thigh=0, shank=1)
     return _Dynamics(M, C, G, Mi, Bm, T, V, lim, locked, knee_impact)
 
 

@@ -87,6 +87,15 @@ class HipRollLaw(Strict):
 #: the one line refusing hip-roll joints elsewhere (the capability table's reason)
 HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged walker's with "
                   "hip width (walker.space: 3d, hip_width_m > 0)")
+#: what a walker with locking knees in 3D does not carry yet (``walker.space: 3d`` with a
+#: ``leg.knee``), each the reason after its field in the scene's one line and in the
+#: capability table (:data:`walkerlab.walker.capability_cells.CAPABILITIES`,
+#: ``locking_knees_3d``)
+KNEED_3D_PASSIVE = ("a kneed walker in 3D is passive so far: its rigid model has no torque "
+                    "law or push-off")
+KNEED_3D_TORSO = "a kneed walker in 3D carries no upper body so far"
+KNEED_3D_HIP_ROLL = ("hip-roll joints are the 3D straight legs' so far: a kneed walker in 3D "
+                     "has universal hips")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "
@@ -268,11 +277,23 @@ class BipedParams(_Actuated):
                                  "walker's hips are one point)")
             return
         leg = pair[0]
+        if leg.knee is not None:  # what the kneed walker in 3D does not carry yet
+            for field, bad, why in (("walker.torso", self.torso is not None, KNEED_3D_TORSO),
+                                    ("walker.hip_roll", self.hip_roll is not None,
+                                     KNEED_3D_HIP_ROLL),
+                                    ("walker.actuation", self.actuation is not None,
+                                     KNEED_3D_PASSIVE)):
+                if bad:
+                    raise ValueError(f"{field}: {why}")
         for field, bad, what in (
                 ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
                 ("walker.legs", self.legs is not None and pair[0] != pair[1],
                  "both legs identical (give 'leg')"),
-                ("walker.leg.knee", leg.knee is not None, "straight legs (no knee)"),
+                ("walker.leg.knee", leg.knee is not None and (
+                    leg.knee.lock != "plastic" or leg.knee.spring is not None),
+                 "straight legs or locking knees (knee.lock: plastic, no knee.spring)"),
+                ("walker.leg.foot.kind", leg.knee is not None and leg.foot.kind != "point",
+                 "point feet on locking knees"),
                 ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc"),
                  "point or arc feet"),
                 ("walker.leg.bodies", any(b.mass_kg == 0 for b in leg.bodies),

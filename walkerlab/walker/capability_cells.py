@@ -10,6 +10,8 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
+from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
+
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
@@ -93,7 +95,11 @@ ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass 
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
-#: what the views of both 3D kinds refuse: a ground other than a plane, the OpenSim
+#: why a kneed walker in 3D refuses a view (its rigid model is its only one so far)
+_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model only so far (walkerlab "
+                  "fixedpoint, simulate): its floating (contact) view and its exports are a "
+                  "later step")
+#: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -305,6 +311,23 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
     },
+    "locking_knees_3d": {
+        # the scene's own check says the same (walkerlab.config.walker.BipedParams)
+        **{(f, "*"): KNEED_3D_PASSIVE for f in ("hip_torque", "knee_torque", "push_off",
+                                                "virtual_constraints", "ankle_torque",
+                                                "ankle_push_off")},
+        ("torso_torque", "*"): KNEED_3D_TORSO,
+        ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
+        ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
+                                 "(walker.foot_radius_m)"),
+        **_CELLS_3D,
+        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "mjcf", "urdf", "adams",
+                                                 "osim")},
+        ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
+                          "is a later step"),
+        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
+                               "is a later step"),
+    },
     "rolling_polygon_3d": {
         **_PLANAR,
         **_WHEEL_JOINTS,
@@ -351,4 +374,4 @@ ROBUSTNESS_3D = ("the robustness study (gait sensitivity norms, largest step-dow
 #: it refuses may still design virtual constraints, so only the 3D kinds' is here)
 STAGE_CELLS: dict[str, dict[str, str]] = {
     k: {"robustness": ROBUSTNESS_3D, "optimize": CAPABILITIES[k][("walk", "optimize")]}
-    for k in ("straight_legs_3d", "rolling_polygon_3d")}
+    for k in ("straight_legs_3d", "locking_knees_3d", "rolling_polygon_3d")}

@@ -44,6 +44,9 @@ SPOKED_3D_PARAMS = SPOKED_PARAMS + ("I_diam",)
 #: Roles of a straight-legged walker in 3D (``space: 3d``; :mod:`walkerlab.codegen.derive_3d`):
 #: the roll about the fall line, then the legs' pitch angles as the planar walkers'.
 COMPASS_3D_ROLES = ("lean", "swing", "stance")
+#: Roles of a walker with locking knees in 3D: the lean, then the planar kneed walker's
+#: (:data:`KNEED_ROLES`: the swing thigh's and shank's pitch, the straight stance leg's).
+KNEED_3D_ROLES = ("lean",) + KNEED_ROLES
 #: Parameters of the ``compass_gait`` shorthand in 3D: gravity, leg length, slope, hip mass,
 #: leg mass and its distance from the foot [SI], then the hip width ``w_hip`` [m], a rod's
 #: ``I_leg`` [kg m^2] normal to the leg, round feet's ``R_foot`` [m] (each if any).
@@ -143,8 +146,8 @@ class Structure:
         The walker moves in three dimensions (``walker.space: 3d``;
         :mod:`walkerlab.codegen.derive_3d`): a spoked wheel free about every axis of its
         stance foot (roles :data:`SPOKED_3D_ROLES`), or straight legs on point feet
-        that roll and pitch (roles :data:`COMPASS_3D_ROLES`).  False: in the sagittal
-        plane.
+        that roll and pitch (roles :data:`COMPASS_3D_ROLES`; with ``knee``, locking knees:
+        :data:`KNEED_3D_ROLES`).  False: in the sagittal plane.
     hip_width : bool
         A 3D straight-legged walker's hips are apart (parameter ``w_hip``; the steps
         alternate sides: a stride is the Poincaré map); False: zero hip width.
@@ -186,7 +189,8 @@ class Structure:
         if self.spokes:
             return SPOKED_3D_ROLES if self.in_3d else SPOKED_ROLES
         if self.in_3d:
-            return COMPASS_3D_ROLES + (HIP_ROLL_ROLES if self.hip_roll else ())
+            return (KNEED_3D_ROLES if self.knee else
+                    COMPASS_3D_ROLES + (HIP_ROLL_ROLES if self.hip_roll else ()))
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.hinged_torso:

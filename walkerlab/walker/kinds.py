@@ -38,6 +38,11 @@ walker's :class:`Kind`:
     1999).  The rigid model, the MJCF (a free pelvis on footfall patches: it walks in
     MuJoCo; its hip torque and push-off run by walkerlab's stepping loop) and the URDF (its
     actuators left out, as the planar URDF's).
+``locking_knees_3d``
+    Locking knees (McGeer 1990, "Passive walking with knees") in three dimensions
+    (``model: biped`` with ``space: 3d`` and a knee): the kneed walker's two phases and
+    resets, its swing knee a pitch joint in the swing leg's rolled sagittal plane, the
+    walker rolling about the fall line as the 3D straight legs.  The rigid model so far.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
@@ -295,6 +300,9 @@ KINDS = {k.name: k for k in (
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", "legs_3d", landing=None, contact="legs_3d",
          actuators="legs_3d", scene="configs/hip_width.yaml"),
+    Kind("locking_knees_3d", "knees that lock at the knee strike, in 3D with hip width",
+         "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",
+         "legs_3d", knees="locking", landing=None, scene="configs/kneed_3d.yaml"),
 )}
 
 
@@ -314,7 +322,7 @@ def kind_of(structure) -> Kind:
     if structure.spokes:
         return KINDS["rolling_polygon_3d" if structure.in_3d else "rolling_polygon"]
     if structure.in_3d:
-        return KINDS["straight_legs_3d"]
+        return KINDS["locking_knees_3d" if structure.knee else "straight_legs_3d"]
     if structure.free_knees:
         return KINDS["free_joints"]
     if structure.hinged_torso:

@@ -184,6 +184,8 @@ SHIPPED = {
     # fall in contact within a few steps)
     ("straight_legs_3d", "hip_torque"): "hip_width_powered",
     ("straight_legs_3d", "push_off"): "hip_width_powered",
+    # configs/kneed.yaml's walker with 10 cm hip width (its rigid model, the one view so far)
+    ("locking_knees_3d", "walk"): "kneed_3d",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the

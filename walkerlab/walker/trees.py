@@ -25,6 +25,10 @@ The 3D tree, from the stance foot (the root, in the slope's frame):
 - an upper body ``torso`` on a pitch joint at the hips' midpoint, its angle the legs' mean
   (a bisecting hip), its bodies welded to it at ``(e, d, 0)``.
 
+A knee (locking knees, McGeer 1990) cuts the swing leg at ``L_thigh`` below its hip: the
+``swing_shank`` on a pitch joint about the leg's own ``z`` (its rolled sagittal plane), its
+angle ``swing_shank - swing_thigh``; the stance leg stays straight.
+
 Without hip-roll joints the rolls are held (``phi_p = phi_w = phi``: the joints' roll
 coordinates map to 0).  Round feet put the stance leg on a slide along the fall line (the
 disc's roll), then the roll, then the pitch about the disc's centre.

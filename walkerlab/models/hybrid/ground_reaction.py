@@ -101,7 +101,11 @@ _PARTS = {
 
 def _part(kind) -> _Part:
     """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): its
-    rigid model's, planar or 3D."""
+    rigid model's, planar or 3D; a refusal for a kind without a floating view (the view
+    this reads the reaction from: a kind whose contact view is None has none)."""
+    if kind.contact is None:
+        return _Part(refusal=f"{kind.title}: no floating view yet (the contact view's), so "
+                             "the stance foot's reaction is not computed")
     return _PARTS[kind.rigid]
 
 
