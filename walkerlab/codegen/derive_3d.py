@@ -317,8 +317,7 @@ def derive_compass(structure) -> Equations:
         ``structure`` is not a 3D legged walker.
     """
     if not structure.in_3d or structure.spokes:
-        raise ValueError("derive_3d.derive_compass: the structure is not a 3D straight-legged "
-                         "walker")
+        raise ValueError("derive_3d.derive_compass: the structure is not a 3D legged walker")
     tree, coords = legs_tree(structure)
     te = derive_tree(tree, coords)
     kin, q, dq = te.kinematics, te.q, te.dq
