@@ -95,7 +95,8 @@ class Part:
 
 def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Part, ...] = (),
                *, planar: bool = False, swing_legs: tuple[Part, ...] | None = None,
-               thigh: str | None = None, hip_mass: bool = True, hip_width: str | float = 0,
+               thigh: str | None = None, knee_stop: bool = False, hip_mass: bool = True,
+               hip_width: str | float = 0,
                hip_roll: bool = False, foot_radius: str | None = None,
                coordinates: str = "absolute") -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
@@ -121,6 +122,9 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         The swing leg's bodies when the legs differ (default ``legs``).
     thigh : str or None
         A knee this far below the swing hip [m] (a name), the ``shank`` parts on it.
+    knee_stop : bool
+        The knee has the straight-leg stop (McGeer 1990's locking knee: its angle
+        ``shank - thigh`` in ``[-pi, 0]``, :attr:`~walkerlab.walker.tree.Joint.stops`).
     hip_mass : bool
         The pelvis carries ``M_hip`` (else it is massless).
     hip_width : str or float
@@ -162,7 +166,7 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
                        Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
                              swing_names)))
     swing_bodies, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh,
-                                         up_leg, R)
+                                         up_leg, R, knee_stop)
     bodies += swing_bodies
     if torso:
         bodies.append(Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
@@ -198,17 +202,19 @@ def _welded(link: str, parts: tuple[Part, ...], origin: tuple = (0, 0, 0), *,
             for p in parts]
 
 
-def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str | None
-               ) -> tuple[list, ContactPoint]:
+def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str | None,
+               knee_stop: bool = False) -> tuple[list, ContactPoint]:
     """The swing leg's parts (on a knee ``thigh`` below the hip: the thigh's on the leg, the
-    shank's on the shank) and its foot's contact point (a round foot's centre)."""
+    shank's on the shank; ``knee_stop``: the knee's straight-leg stop) and its foot's
+    contact point (a round foot's centre)."""
     to_foot = "-L" if R is None else f"-({up_leg})"
     on_thigh = [p for p in swing if thigh is None or p.link != "shank"]
     bodies, foot_link = _welded("swing_leg", tuple(on_thigh)), "swing_leg"
     if thigh is not None:  # the swing knee, ``thigh`` below the hip; the shank's parts on it
         bodies.append(Body("swing_shank", 0, ZERO_INERTIA, (0, 0, 0),
                            Joint("swing_knee", "revolute", "swing_leg", (0, f"-{thigh}", 0),
-                                 (Z,), ("swing_knee",))))
+                                 (Z,), ("swing_knee",),
+                                 (("-pi", 0),) if knee_stop else ())))
         bodies += _welded("swing_shank", tuple(p for p in swing if p.link == "shank"),
                           below=thigh)
         foot_link = "swing_shank"
@@ -347,6 +353,7 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
         swing, torso = None, ()
     return biped_tree(structure.param_names, legs, torso, planar=planar, swing_legs=swing,
                       thigh="L_thigh" if structure.knee else None,
+                      knee_stop=structure.knee and not structure.free_knees,
                       hip_mass=structure.hip_mass,
                       hip_width="w_hip" if structure.hip_width else 0,
                       hip_roll=structure.hip_roll,
