@@ -210,8 +210,8 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     Parameters
     ----------
     mb, name, version
-        The walker, model name (the scene's name) and walkerlab version, as for
-        :func:`urdf_text`.
+        The walker (:func:`walkerlab.walker.multibody.multibody`), model name (the scene's
+        name) and walkerlab version.
     extra : MjcfScene, optional
         The gait keyframe, terrain, contact setting and knee latch of the scene; without it
         a plane through the feet and MuJoCo's default contact.

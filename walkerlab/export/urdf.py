@@ -16,11 +16,11 @@ dimension; :func:`legs_urdf_text` is the legged walkers' file:
   carriage ``hip_slider``) and ``hip_z``, the legs' joints ``leg<i>_hip`` (``leg<i>_knee``:
   ``revolute`` in ``[-pi, 0]`` with the straight-leg stop), ``torso_hip``, each foot a
   massless link ``leg<i>_foot`` on a fixed joint of that name at the foot point or the arc's
-  centre; the inertias as the tree has them (a point mass none).  A walker on free joints
-  (free knees or a hinged torso: the five-link and three-link bipeds), which the tree does
-  not describe yet, comes from its links (:func:`walkerlab.walker.multibody.multibody`) in
-  the same bodies.  The frame, joint names, feet and what the springs, couplings and motors
-  become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states them;
+  centre; the inertias as the tree has them (a point mass none); the walkers whose joints
+  are all free (the five-link and three-link bipeds) alike, their knees free and the torso
+  on its own hinge.  The frame, joint names, feet and what the springs, couplings and
+  motors become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states
+  them (the links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
 - 3D (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`): the pelvis is the root link, free
   in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
   body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
@@ -40,8 +40,6 @@ import json
 import math
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
-
-import numpy as np
 
 from walkerlab.export.mjcf_scene import (
     MjcfScene,
@@ -199,7 +197,7 @@ def legs_urdf_text(data, name: str, version: str = "",
     if data.structure.in_3d:
         return _legs_3d_text(data, name, version, actuation)
     mb = multibody(data)
-    root, couplings = planar_bodies(data, mb)
+    root, couplings = planar_bodies(data)
     comments = [*header(mb, name, "URDF", version),
                 *xml_comments(urdf_omissions(mb, actuation))]
     return urdf_robot_text(name, comments, root, couplings, _planar_visuals(mb), world=True)
@@ -229,14 +227,18 @@ def planar_roles(structure):
     """The planar walker's :class:`~walkerlab.export.tree_bodies.PelvisRoles`: the hip
     ``hip`` on :data:`PLANAR_SLIDES`, the joints ``leg<i>_hip``, ``leg<i>_knee``,
     ``torso_hip``, a kneed leg's bodies ``leg<i>_thigh``, ``leg<i>_shank``, each foot at the
-    swing leg's contact point (a round foot's centre), leg2's numbers the stance role's."""
+    swing leg's contact point (a round foot's centre), leg2's numbers the stance role's, its
+    joints' angles the stance leg's (a locking knee's stance shank, which the tree's straight
+    stance leg has not, a coordinate of its own)."""
     from walkerlab.export.tree_bodies import PelvisRoles  # light: sympy with the bodies
 
     sw, st = (f"_{ROLE_TAG[r]}_" for r in ("swing", "stance"))
-    knee = structure.kind.knees != "none"   # the kind's knees (walkerlab.walker.kinds)
+    kind = structure.kind           # its knees and joints (walkerlab.walker.kinds)
+    knee = kind.knees != "none"      # on the swing leg, or free on both (every joint free)
+    thigh = "stance_thigh" if kind.joints_free else "stance"
     return PelvisRoles(
         name="hip", slides=PLANAR_SLIDES,
-        stance_roles=((("swing_thigh", "stance"), ("swing_shank", "stance_shank")) if knee
+        stance_roles=((("swing_thigh", thigh), ("swing_shank", "stance_shank")) if knee
                       else (("swing", "stance"),)),
         joint_names=(("swing_hip_pitch", "{leg}_hip"), ("swing_knee", "{leg}_knee"),
                      ("torso_pitch", "torso_hip")),
@@ -246,46 +248,17 @@ def planar_roles(structure):
         stance_params=tuple((n, n.replace(sw, st)) for n in structure.param_names if sw in n))
 
 
-def planar_bodies(data, mb: Multibody | None = None) -> tuple:
+def planar_bodies(data) -> tuple:
     """The planar walker's export bodies and couplings
-    (:func:`walkerlab.export.tree_bodies.export_bodies` of its tree with
-    :func:`planar_roles`, the inertias as they are); a walker on free joints (free knees, a
-    hinged torso), which :func:`walkerlab.walker.trees.legs_tree` refuses, from its links
-    ``mb`` (:func:`walkerlab.walker.multibody.multibody` of ``data``)."""
+    (:func:`walkerlab.export.tree_bodies.export_bodies` of its tree,
+    :func:`walkerlab.walker.trees.legs_tree`, with :func:`planar_roles`, the inertias as
+    they are)."""
     from walkerlab.export.tree_bodies import export_bodies  # light: sympy with the bodies
 
     s = data.structure
-    if s.kind.joints_free:  # the five-link biped, the three-link walker
-        return _link_bodies(mb or multibody(data)), ()
     tree, coords = legs_tree(s)
     return export_bodies(tree, coords, dict(zip(s.param_names, data.params)),
                          planar_roles(s), inertia_floor=0.0)
-
-
-def _link_bodies(mb: Multibody):
-    """The links of ``mb`` as export bodies: each link on its hinge about ``0 -1 0`` (a
-    knee with a stop in ``[-pi, 0]``), its inertia about the pitch axis (and about x: a
-    line along the link), its foot a massless body on a fixed joint."""
-    from walkerlab.export.tree_bodies import ExportBody, ExportJoint  # light: as above
-
-    stops = export_part(mb).knee_stops
-
-    def body(ln):
-        kids = [body(k) for k in mb.links if k.parent == ln.name]
-        if ln.foot_m is not None:
-            foot = ln.name.split("_")[0] + "_foot"
-            kids.append(ExportBody(foot, foot, np.array([0.0, 0.0, -ln.foot_m]),
-                                   (ExportJoint(foot, "fixed"),), 0.0, np.zeros(3),
-                                   np.zeros((3, 3))))
-        limit = (-math.pi, 0.0) if stops and ln.joint.endswith("_knee") else None
-        return ExportBody(ln.name, ln.name, np.array([0.0, 0.0, -ln.joint_from_parent_m]),
-                          (ExportJoint(ln.joint, "hinge", (0.0, -1.0, 0.0), limit=limit),),
-                          ln.mass_kg, np.array([ln.com_off_axis_m, 0.0, -ln.com_m]),
-                          np.diag([ln.inertia_kg_m2, ln.inertia_kg_m2, 0.0]), tuple(kids))
-    slides = tuple(ExportJoint(j, "slide", axis, link=link) for j, axis, link in PLANAR_SLIDES)
-    return ExportBody("hip", "pelvis", np.zeros(3), slides, mb.hip_mass_kg, np.zeros(3),
-                      np.zeros((3, 3)), tuple(body(ln) for ln in mb.links
-                                              if ln.parent == "hip"))
 
 
 def _planar_visuals(mb: Multibody):

@@ -10,7 +10,8 @@ The URDF and MJCF writers write the walker's multibody as its kind has it
 (:attr:`walkerlab.walker.kinds.Kind.body`, :data:`BODIES`): a tree of leg links
 (:mod:`walkerlab.export.multibody`), a spoked wheel (planar, or in 3D:
 :mod:`walkerlab.export.spoked`), or the 3D straight-legged walker's free pelvis
-(:mod:`walkerlab.export.legs_3d`, :mod:`walkerlab.export.legs_3d_mjcf`).  The
+(:mod:`walkerlab.export.legs_3d_mjcf`); the URDF of a legged walker, planar or in 3D, is
+one writer's (:func:`walkerlab.export.urdf.legs_urdf_text`).  The
 Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
 (:mod:`walkerlab.export.opensim`) write a tree of leg links.
 
