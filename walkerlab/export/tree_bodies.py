@@ -1,15 +1,15 @@
 """A walker's bodies for its exports, read from its body tree (:mod:`walkerlab.walker.tree`):
 the floating pelvis with a leg on each hip and any upper body on its own joint, every body's
 mass, centre of mass, inertia and joint axes evaluated from the tree's expressions, in the
-exports' axes.  The MJCF writer of walkers in 3D
-(:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`) and the URDF writer of legged
-walkers, planar and 3D (:func:`walkerlab.export.urdf.legs_urdf_text`), write these bodies;
-:func:`mjcf_body_lines` and :func:`mjcf_coupling_lines` are the MJCF's text of them,
-:func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's tree (every
-joint a pitch) gives the same bodies in the plane ``x``-``z``: its roles
-(:class:`PelvisRoles`) carry the pelvis on two slides, name its bodies and joints as the
-planar exports do, hang a foot body where each leg's contact is and read the stance leg's
-numbers for legs that differ.
+exports' axes.  The MJCF and URDF writers of legged walkers, planar and 3D
+(:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`,
+:func:`walkerlab.export.multibody.mjcf_text`, :func:`walkerlab.export.urdf.legs_urdf_text`),
+write these bodies; :func:`mjcf_body_lines` and :func:`mjcf_coupling_lines` are the MJCF's
+text of them, :func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's
+tree (every joint a pitch) gives the same bodies in the plane ``x``-``z``
+(:mod:`walkerlab.export.planar_bodies`): its roles (:class:`PelvisRoles`) carry the pelvis
+on two slides, name its bodies and joints as the planar exports do, hang a foot body where
+each leg's contact is and read the stance leg's numbers for legs that differ.
 
 Axes
 ----
@@ -488,12 +488,12 @@ def _couplings(ev: _Evaluator, root: ExportBody) -> tuple[Coupling, ...]:
     return tuple(out)
 
 
-def _inertial(b: ExportBody, root: bool) -> str:
+def _inertial(b: ExportBody) -> str:
     """MJCF's ``inertial`` of ``b``: ``diaginertia`` when its inertia is diagonal, else
-    ``fullinertia`` (MuJoCo's order ``ixx iyy izz ixy ixz iyz``); the root's centre of mass
-    at its origin ``0 0 0``."""
+    ``fullinertia`` (MuJoCo's order ``ixx iyy izz ixy ixz iyz``); a centre of mass at the
+    body's origin ``0 0 0``."""
     J = b.inertia_kg_m2
-    pos = "0 0 0" if root and not b.com_m.any() else nums(*b.com_m)
+    pos = "0 0 0" if not b.com_m.any() else nums(*b.com_m)
     if np.count_nonzero(J - np.diag(np.diag(J))) == 0:
         inertia = f'diaginertia="{nums(*np.diag(J))}"'
     else:
@@ -510,9 +510,12 @@ def axis_text(axis) -> str:
 
 
 def mjcf_body_lines(b: ExportBody, geoms=lambda b, pad: [], indent: int = 4,
-                    root: bool = True) -> list[str]:
-    """The MJCF ``body`` element of ``b`` and its children: joints, ``inertial``, the
-    geoms ``geoms(b, pad)`` returns (lines at the indent ``pad``), then the children."""
+                    root: bool = True, joint_attrs=lambda j: "") -> list[str]:
+    """The MJCF ``body`` element of ``b`` and its children: joints (a hinge's limit its
+    ``range``, then the attributes ``joint_attrs(joint)`` returns: a spring's), ``inertial``,
+    the geoms ``geoms(b, pad)`` returns (lines at the indent ``pad``), then each child: a
+    massless child on a fixed joint (a foot: a named point) as the lines ``geoms(child,
+    pad)`` returns in ``b``, first, then the other children's bodies."""
     pad = " " * indent
     inner = pad + "  "
     pos = "0 0 0" if root else nums(*b.pos_m)
@@ -521,13 +524,24 @@ def mjcf_body_lines(b: ExportBody, geoms=lambda b, pad: [], indent: int = 4,
         if j.kind == "free":
             out.append(f'{inner}<freejoint name="{j.name}"/>')
         else:
+            rng = "" if j.limit is None else f' range="{nums(*j.limit)}"'
             out.append(f'{inner}<joint name="{j.name}" type="{j.kind}" '
-                       f'axis="{axis_text(j.axis)}"/>')
-    out.append(inner + _inertial(b, root))
+                       f'axis="{axis_text(j.axis)}"{rng}{joint_attrs(j)}/>')
+    out.append(inner + _inertial(b))
     out += geoms(b, inner)
     for c in b.children:
-        out += mjcf_body_lines(c, geoms, indent + 2, root=False)
+        if _is_point(c):
+            out += geoms(c, inner)
+    for c in b.children:
+        if not _is_point(c):
+            out += mjcf_body_lines(c, geoms, indent + 2, False, joint_attrs)
     return out + [f"{pad}</body>"]
+
+
+def _is_point(b: ExportBody) -> bool:
+    """A massless body welded to its parent without children (a foot's point)."""
+    return (b.mass_kg == 0 and not b.inertia_kg_m2.any() and not b.children
+            and all(j.kind == "fixed" for j in b.joints))
 
 
 def mjcf_coupling_lines(couplings) -> list[str]:

@@ -11,7 +11,8 @@ inertias, axes), its couplings as comments (``mimic`` follows one joint only) an
 comments it is given (the springs, motors and what else the file leaves out), whatever the
 dimension; :func:`legs_urdf_text` is the legged walkers' file:
 
-- planar (:func:`planar_bodies`): the tree of :func:`walkerlab.walker.trees.legs_tree`,
+- planar (:func:`walkerlab.export.planar_bodies.planar_bodies`): the tree of
+  :func:`walkerlab.walker.trees.legs_tree`,
   the hip carried by the fixed link ``world`` on the slides ``hip_x`` (through the massless
   carriage ``hip_slider``) and ``hip_z``, the legs' joints ``leg<i>_hip`` (``leg<i>_knee``:
   ``revolute`` in ``[-pi, 0]`` with the straight-leg stop), ``torso_hip``, each foot a
@@ -50,22 +51,18 @@ from walkerlab.export.mjcf_scene import (
 from walkerlab.export.motors import motor_target, motors
 from walkerlab.export.omitted import URDF_GROUND, Omission, xml_comments
 from walkerlab.export.parts import export_part
+from walkerlab.export.planar_bodies import planar_bodies
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import arc_feet, comment, header, num, nums
-from walkerlab.walker.description import ROLE_TAG
 from walkerlab.walker.multibody import multibody
-from walkerlab.walker.trees import legs_tree
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.config.actuation import Actuation
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["PLANAR_SLIDES", "keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
-           "planar_bodies", "planar_roles", "urdf_actuation_omissions", "urdf_link_lines",
-           "urdf_omissions", "urdf_robot_text"]
+__all__ = ["keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
+           "urdf_actuation_omissions", "urdf_link_lines", "urdf_omissions", "urdf_robot_text"]
 
-#: the planar hip's slides: (joint, axis, the massless link it carries when not the last)
-PLANAR_SLIDES = (("hip_x", (1.0, 0.0, 0.0), "hip_slider"), ("hip_z", (0.0, 0.0, 1.0), ""))
 #: a slide's ``limit`` (URDF requires one on a prismatic joint): none that binds
 _FREE_SLIDE = '<limit lower="-1e9" upper="1e9" effort="0" velocity="1e9"/>'
 
@@ -221,44 +218,6 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
                          "about the fall line")]
     return tuple(out + urdf_actuation_omissions(actuation,
                                                 "in the comment walkerlab_actuation"))
-
-
-def planar_roles(structure):
-    """The planar walker's :class:`~walkerlab.export.tree_bodies.PelvisRoles`: the hip
-    ``hip`` on :data:`PLANAR_SLIDES`, the joints ``leg<i>_hip``, ``leg<i>_knee``,
-    ``torso_hip``, a kneed leg's bodies ``leg<i>_thigh``, ``leg<i>_shank``, each foot at the
-    swing leg's contact point (a round foot's centre), leg2's numbers the stance role's, its
-    joints' angles the stance leg's (a locking knee's stance shank, which the tree's straight
-    stance leg has not, a coordinate of its own)."""
-    from walkerlab.export.tree_bodies import PelvisRoles  # light: sympy with the bodies
-
-    sw, st = (f"_{ROLE_TAG[r]}_" for r in ("swing", "stance"))
-    kind = structure.kind           # its knees and joints (walkerlab.walker.kinds)
-    knee = kind.knees != "none"      # on the swing leg, or free on both (every joint free)
-    thigh = "stance_thigh" if kind.joints_free else "stance"
-    return PelvisRoles(
-        name="hip", slides=PLANAR_SLIDES,
-        stance_roles=((("swing_thigh", thigh), ("swing_shank", "stance_shank")) if knee
-                      else (("swing", "stance"),)),
-        joint_names=(("swing_hip_pitch", "{leg}_hip"), ("swing_knee", "{leg}_knee"),
-                     ("torso_pitch", "torso_hip")),
-        body_names=((("swing_leg", "{leg}_thigh"), ("swing_shank", "{leg}_shank")) if knee
-                    else ()),
-        foot="swing_foot_centre" if structure.foot == "arc" else "swing_foot",
-        stance_params=tuple((n, n.replace(sw, st)) for n in structure.param_names if sw in n))
-
-
-def planar_bodies(data) -> tuple:
-    """The planar walker's export bodies and couplings
-    (:func:`walkerlab.export.tree_bodies.export_bodies` of its tree,
-    :func:`walkerlab.walker.trees.legs_tree`, with :func:`planar_roles`, the inertias as
-    they are)."""
-    from walkerlab.export.tree_bodies import export_bodies  # light: sympy with the bodies
-
-    s = data.structure
-    tree, coords = legs_tree(s)
-    return export_bodies(tree, coords, dict(zip(s.param_names, data.params)),
-                         planar_roles(s), inertia_floor=0.0)
 
 
 def _planar_visuals(mb: Multibody):

@@ -243,7 +243,7 @@ def _links(job: ExportJob, w: Writer) -> Written:
         text = legs_urdf_text(job.data, job.name, version, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)
     else:
-        text = mjcf_text(mb, job.name, version, extra)
+        text = mjcf_text(job.data, mb, job.name, version, extra)
         left_out = mjcf_omissions(mb, extra)
     files = [_xml(job, w, text)]
     if w.name == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
