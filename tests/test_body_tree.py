@@ -290,6 +290,12 @@ def _tree(*bodies, params=("m", "a", "g", "gamma"), contacts=None):
     (dict(mass_kg=-1.0), "tree.bodies[0].mass_kg"),
     (dict(com_m=(0, "b", 0)), "tree.bodies[0].com_m[1]"),
     (dict(com_m=(0, 1)), "tree.bodies[0].com_m"),
+    (dict(joint=Joint("ankle", "revolute", "slope", (0, 0, 0), ((0, 0, 1),), ("q",),
+                      ((0, -1.0),))), "tree.bodies[0].joint.stops[0]"),
+    (dict(joint=Joint("ankle", "revolute", "slope", (0, 0, 0), ((0, 0, 1),), ("q",),
+                      (None, None))), "tree.bodies[0].joint.stops"),
+    (dict(joint=Joint("ankle", "revolute", "slope", (0, 0, 0), ((0, 0, 1),), ("q",),
+                      ((0, "b"),))), "tree.bodies[0].joint.stops[0]"),
 ])
 def test_a_bad_tree_is_refused_naming_the_field(change, field):
     """A malformed body or joint is refused in one line that names the field."""

@@ -1,5 +1,5 @@
 """The 3D straight-legged walker's URDF with hip-roll joints and actuators
-(:func:`walkerlab.export.legs_3d.legs_3d_urdf_text`; ``configs/hip_width_powered.yaml``):
+(:func:`walkerlab.export.urdf.legs_urdf_text`; ``configs/hip_width_powered.yaml``):
 loaded by Pinocchio (Carpentier et al. 2019, an engine of its own), its joints, masses and
 kinematics against the MJCF's in MuJoCo, and what it leaves out."""
 

@@ -255,11 +255,11 @@ def test_a_3d_torso_walkers_urdf_names_the_bisecting_hip_it_cannot_hold(torso_3d
     - leg2_hip = 0``); its masses add up to the walker's."""
     import xml.etree.ElementTree as ET
 
-    from walkerlab.export.legs_3d import legs_3d_urdf_text
+    from walkerlab.export.urdf import legs_urdf_text
 
     _walker_, scene = torso_3d
     data = Plant.from_scene(scene).data
-    text = legs_3d_urdf_text(data, "torso_bhm_3d")
+    text = legs_urdf_text(data, "torso_bhm_3d")
     assert "2 * torso_pitch + -1 * leg1_hip + -1 * leg2_hip = 0" in text
     masses = [float(m.get("value")) for m in ET.fromstring(text.split("\n", 1)[1]).iter("mass")]
     assert sum(masses) == pytest.approx(data.total_mass_kg, abs=1e-9)

@@ -6,7 +6,10 @@ vectors, which shares no kinematics with the tree) for the shipped planar walker
 the mass matrix, the Coriolis and centrifugal terms, gravity, the potential, and the rates
 after the heel strike (Goswami, Thuilot & Espiau 1996; McGeer 1990 for the knee and the round
 feet; Wisse, Hobbelen & Schwab 2007 for the bisecting hip), numerically at random states and
-parameters.  The 3D trees the same builder makes are the production derivation's
+parameters; the walkers whose joints are all free (the five-link biped, Westervelt, Grizzle &
+Koditschek 2003, free knees on both legs; the three-link walker, Grizzle, Abba & Plestan
+2001; each with a hinged torso) equal :func:`walkerlab.codegen.free_joints.
+derive_five_link`'s.  The 3D trees the same builder makes are the production derivation's
 (``tests/test_body_tree.py``)."""
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import pytest
 import sympy as sp
 
 from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
+from walkerlab.codegen.free_joints import derive_five_link
 from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, kinematics, plastic_impact, simplifier
 from walkerlab.config import load_scene
@@ -77,7 +81,8 @@ def _scene_structure(name: str) -> Structure:
 
 
 def _agree(structure: Structure, seed: int) -> None:
-    e = derive(structure)
+    free = structure.free_knees or structure.hinged_torso   # every joint free
+    e = derive_five_link(structure) if free else derive(structure)
     tree, coords = legs_tree(structure)
     te = derive_tree(tree, coords)
     assert tuple(map(str, te.q)) == tuple(map(str, e.q))
@@ -85,7 +90,7 @@ def _agree(structure: Structure, seed: int) -> None:
     dq = sp.Matrix(e.dq)
     pairs = [("M", e.M, te.M), ("C dq", e.C * dq, te.C * dq), ("G", e.G, te.G),
              ("V", sp.Matrix([e.potential]), sp.Matrix([te.potential]))]
-    if not structure.knee:   # the kneed heel strike holds the knee: the locked system
+    if free or not structure.knee:   # the kneed heel strike holds the knee: the locked system
         Mi, B = plastic_impact(te.M, te.A, te.total_mass,
                                _swing_contact_jacobian(te, structure),
                                simplifier(te.kinematics))
@@ -112,6 +117,8 @@ def _agree(structure: Structure, seed: int) -> None:
     pytest.param("paper_rods", marks=pytest.mark.slow),
     pytest.param("hip_spring", marks=pytest.mark.slow),
     pytest.param("torso_bhm", marks=pytest.mark.slow),   # an upper body on a bisecting hip
+    pytest.param("threelink", marks=pytest.mark.slow),   # a hinged torso on straight legs
+    pytest.param("rabbit", marks=pytest.mark.slow),      # free knees on both legs, hinged torso
 ])
 def test_a_shipped_planar_walker_derived_from_its_tree_equals_the_planar_derivation(scene):
     _agree(_scene_structure(scene), seed=sum(map(ord, scene)))

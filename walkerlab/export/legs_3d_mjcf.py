@@ -2,7 +2,7 @@
 :func:`walkerlab.codegen.derive_3d.derive_compass`) as a MuJoCo model (MJCF) that walks from
 the rigid gait.
 
-The walker is the URDF's (:func:`walkerlab.export.legs_3d.legs_3d_urdf_text`): a
+The walker is the URDF's (:func:`walkerlab.export.urdf.legs_urdf_text`): a
 pelvis body carrying the hip mass on a free joint ``free`` (no plane constraint), and a leg
 on each side of it, ``hip_width / 2`` along the hip axis (MuJoCo's body y), on a hinge
 ``leg<i>_hip`` about that axis (``0 -1 0``: a positive angle moves the foot ahead, the rigid

@@ -84,8 +84,8 @@ Formats:
 
 from __future__ import annotations
 
-import math
 import re
+from dataclasses import replace
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
@@ -107,12 +107,12 @@ from walkerlab.export.motors import (  # noqa: F401 (part of this API)
     motors,
 )
 from walkerlab.export.omitted import Omission, xml_comments
-from walkerlab.export.parts import export_part
+from walkerlab.export.planar_bodies import planar_bodies
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_mjcf_text, wheel_urdf_text
-from walkerlab.export.text import AXIS, arc_feet, comment, header, num, nums
+from walkerlab.export.text import arc_feet, comment, header, num, nums
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
-    from walkerlab.walker.multibody import Link, Multibody
+    from walkerlab.walker.multibody import Multibody
 
 __all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION",
            "comments_in_scene_units", "mjcf_actuation_omissions", "mjcf_omissions",
@@ -202,16 +202,20 @@ def _tendons(mb: Multibody, motor_list=()) -> list[str]:
     return out + ["  </tendon>"]
 
 
-def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | None = None
-              ) -> str:
+def mjcf_text(data, mb: Multibody, name: str, version: str = "",
+              extra: MjcfScene | None = None) -> str:
     """The walker as a MuJoCo model (MJCF; MuJoCo XML Reference,
-    https://mujoco.readthedocs.io/en/stable/XMLreference.html).
+    https://mujoco.readthedocs.io/en/stable/XMLreference.html): its bodies
+    (:func:`walkerlab.export.planar_bodies.planar_bodies`) written as the 3D walkers' are
+    (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`).
 
     Parameters
     ----------
+    data : WalkerData
+        The walker (:func:`walkerlab.walker.description.walker_data`).
     mb, name, version
-        The walker, model name (the scene's name) and walkerlab version, as for
-        :func:`urdf_text`.
+        Its links (:func:`walkerlab.walker.multibody.multibody`: the header, tendons and
+        drawing), model name (the scene's name) and walkerlab version.
     extra : MjcfScene, optional
         The gait keyframe, terrain, contact setting and knee latch of the scene; without it
         a plane through the feet and MuJoCo's default contact.
@@ -225,7 +229,6 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
         ``extra``, a keyframe ``gait`` and the knee latches as joint equality constraints
         named ``leg<i>_latch``.
     """
-    width = mb.leg_length_m / 50
     lo = MJCF_MIN_INERTIA_KG_M2
     hip_mass = mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG
     out = [*header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
@@ -244,51 +247,39 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
                    f'friction="{nums(extra.friction, 0, 0)}" condim="3"/></default>')
     if extra is not None and extra.profile is not None:
         out += profile_asset(mb, extra)
+    # the bodies as the 3D walkers' are written (walkerlab.export.tree_bodies)
+    from walkerlab.export.tree_bodies import mjcf_body_lines  # light: sympy with the bodies
+
+    root, _ = planar_bodies(data, mb, lo, extra.flat_feet if extra is not None else None)
+    root = replace(root, mass_kg=hip_mass)
     out += ["  <worldbody>", *ground_geoms(mb, extra),
-            '    <body name="hip" pos="0 0 0">',
-            '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
-            '      <joint name="hip_z" type="slide" axis="0 0 1"/>',
-            f'      <inertial pos="0 0 0" mass="{num(hip_mass)}" '
-            f'diaginertia="{nums(lo, lo, lo)}"/>',
-            f'      <geom type="sphere" size="{num(2 * width)}"/>']
-    children: dict[str, list[Link]] = {}
-    for ln in mb.links:
-        children.setdefault(ln.parent, []).append(ln)
-    for ln in children["hip"]:
-        out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
+            *mjcf_body_lines(root, _geoms(mb, extra), 4, True, _joint_attrs(mb, extra))]
     motor_list = motors(extra.actuation if extra is not None else None)
-    out += ["    </body>", "  </worldbody>", *_tendons(mb, motor_list)]
+    out += ["  </worldbody>", *_tendons(mb, motor_list)]
     # the laws live in the custom text, a stepping loop sets the controls
     out += mjcf_actuator_lines(extra.actuation if extra is not None else None, motor_list)
     out += [*_mjcf_tail(mb, extra), ""]
     return "\n".join(out)
 
 
-def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
-               children: dict, joint_springs: dict) -> list[str]:
-    """The MJCF body of link ``ln`` with its hinge, inertia, capsule, foot (a site and a
-    contact geom) and its child links' bodies nested inside."""
-    lo = MJCF_MIN_INERTIA_KG_M2
+def _geoms(mb: Multibody, extra: MjcfScene | None):
+    """The geoms (no mass: ``inertiafromgeom`` is off) of each export body
+    (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`): the hip's sphere, each link's
+    capsule (up the torso), each foot's site and contact sphere (a flat foot: its site; its
+    sole's capsule and heel and toe spheres)."""
     width = mb.leg_length_m / 50
-    inertia = max(ln.inertia_kg_m2, lo)
-    stop = ln.joint.endswith("_knee") and export_part(mb).knee_stops
-    rng = f' range="{nums(-math.pi, 0)}"' if stop else ""
-    if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
-        sp = joint_springs[ln.joint]
-        rng += (f' stiffness="{num(sp.stiffness_n_m_per_rad)}" '
-                f'springref="{num(sp.rest_angle_rad)}" '
-                f'damping="{num(sp.damping_n_m_s_per_rad)}"')
-    reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
-    lines = [f'{indent}<body name="{ln.name}" pos="{nums(0, 0, -ln.joint_from_parent_m)}">',
-             f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
-             f'{indent}  <inertial pos="{nums(ln.com_off_axis_m, 0, -ln.com_m)}" '
-             f'mass="{num(ln.mass_kg)}" diaginertia="{nums(inertia, inertia, lo)}"/>',
-             f'{indent}  <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -reach)}" '
-             f'size="{num(width / 2)}"/>']
-    if ln.foot_m is not None:
-        leg = ln.name.split("_")[0]
-        foot = leg + "_foot"
-        z = -ln.foot_m
+    links = {ln.name: ln for ln in mb.links}
+    feet = extra.flat_feet if extra is not None else None
+
+    def geoms(b, pad: str) -> list[str]:
+        if b.name == "hip":
+            return [f'{pad}<geom type="sphere" size="{num(2 * width)}"/>']
+        if b.name in links:
+            ln = links[b.name]
+            reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
+            return [f'{pad}<geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -reach)}" '
+                    f'size="{num(width / 2)}"/>']
+        leg = b.name.split("_")[0]
         y = 0.0 if extra is None or extra.lanes is None else (
             0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
         # an arc foot is a sphere of radius R too: MuJoCo's cylinder-box collision is its
@@ -296,42 +287,38 @@ def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
         # (round_feet's steps came out 11 % short); sphere-box and sphere-plane are analytic,
         # and in the x-z plane the sphere's section through its centre is the arc
         r = mb.foot_radius_m if arc_feet(mb) else point_foot_radius(mb)
-        geom = f'type="sphere" pos="{nums(0, y, z)}" size="{num(r)}"'
-        if extra is not None and extra.flat_feet is not None:
-            lines += _flat_foot_body(leg, indent + "  ", z, y, r, extra.flat_feet,
-                                     LANE_BITS.get(leg, 6), width)
-        else:
-            lines += [f'{indent}  <site name="{foot}" pos="{nums(0, 0, z)}"/>',
-                      f'{indent}  <geom name="{foot}" {geom} contype="0" '
-                      f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
-    for child in children.get(ln.name, []):
-        lines += _mjcf_body(child, indent + "  ", mb, extra, children, joint_springs)
-    return lines + [f"{indent}</body>"]
+        sphere = (f'type="sphere" size="{num(r)}" contype="0" '
+                  f'conaffinity="{LANE_BITS.get(leg, 6)}"')
+        if b.name.endswith("_sole"):   # a flat foot's sole (its ankle's site: the foot's)
+            heel, toe = feet[0 if leg == "leg1" else 1][:2]
+            return [f'{pad}<geom type="capsule" fromto="{nums(-heel, 0, 0, toe, 0, 0)}" '
+                    f'size="{num(width / 4)}"/>',
+                    f'{pad}<geom name="{leg}_foot" pos="{nums(-heel, y, 0)}" {sphere}/>',
+                    f'{pad}<geom name="{leg}_toe" pos="{nums(toe, y, 0)}" {sphere}/>']
+        z = b.pos_m[2]
+        site = f'{pad}<site name="{b.name}" pos="{nums(0, 0, z)}"/>'
+        if feet is not None:
+            return [site]
+        return [site, f'{pad}<geom name="{b.name}" type="sphere" pos="{nums(0, y, z)}" '
+                f'size="{num(r)}" contype="0" conaffinity="{LANE_BITS.get(leg, 6)}"/>']
+    return geoms
 
 
-def _flat_foot_body(leg: str, indent: str, z: float, y: float, r: float, feet: tuple,
-                    bits: int, width: float) -> list[str]:
-    """A flat foot (:attr:`MjcfScene.flat_feet`): the site ``leg<i>_foot`` at the ankle and
-    the body ``leg<i>_sole`` on the hinge ``leg<i>_ankle`` (the legs' axis: positive toe up;
-    MuJoCo's joint spring ``stiffness``/``springref`` and ``damping`` are the ankle's), its
-    mass at the ankle, its sole perpendicular to the leg at the rest angle 0; contact
-    spheres of radius ``r`` at the heel (geom ``leg<i>_foot``: a stepping loop's heel
-    strike) and the toe (``leg<i>_toe``)."""
-    heel, toe, k, c, rest, mass, inertia = feet[0 if leg == "leg1" else 1]
-    lo = MJCF_MIN_INERTIA_KG_M2
-    i = max(inertia, lo)
-    sphere = f'type="sphere" size="{num(r)}" contype="0" conaffinity="{bits}"'
-    return [f'{indent}<site name="{leg}_foot" pos="{nums(0, 0, z)}"/>',
-            f'{indent}<body name="{leg}_sole" pos="{nums(0, 0, z)}">',
-            f'{indent}  <joint name="{leg}_ankle" type="hinge" axis="{AXIS}" '
-            f'stiffness="{num(k)}" springref="{num(rest)}" damping="{num(c)}"/>',
-            f'{indent}  <inertial pos="0 0 0" mass="{num(mass)}" '
-            f'diaginertia="{nums(i, i, lo)}"/>',
-            f'{indent}  <geom type="capsule" fromto="{nums(-heel, 0, 0, toe, 0, 0)}" '
-            f'size="{num(width / 4)}"/>',
-            f'{indent}  <geom name="{leg}_foot" pos="{nums(-heel, y, 0)}" {sphere}/>',
-            f'{indent}  <geom name="{leg}_toe" pos="{nums(toe, y, 0)}" {sphere}/>',
-            f"{indent}</body>"]
+def _joint_attrs(mb: Multibody, extra: MjcfScene | None):
+    """A joint's spring-damper as MuJoCo's joint attributes (``stiffness``, ``springref``,
+    ``damping``): a knee spring's (:func:`_joint_springs`), a flat foot's ankle's."""
+    springs = {j: (sp.stiffness_n_m_per_rad, sp.rest_angle_rad, sp.damping_n_m_s_per_rad)
+               for j, sp in _joint_springs(mb).items()}
+    if extra is not None and extra.flat_feet is not None:
+        for leg, (_, _, k, c, rest, _, _) in zip(("leg1", "leg2"), extra.flat_feet):
+            springs[f"{leg}_ankle"] = (k, rest, c)
+
+    def attrs(j) -> str:
+        if j.name not in springs:
+            return ""
+        k, rest, c = springs[j.name]
+        return f' stiffness="{num(k)}" springref="{num(rest)}" damping="{num(c)}"'
+    return attrs
 
 
 def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:

@@ -1,9 +1,15 @@
 """A walker's bodies for its exports, read from its body tree (:mod:`walkerlab.walker.tree`):
 the floating pelvis with a leg on each hip and any upper body on its own joint, every body's
 mass, centre of mass, inertia and joint axes evaluated from the tree's expressions, in the
-exports' axes.  The MJCF and URDF writers of walkers in 3D write these bodies
-(:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`); :func:`mjcf_body_lines` and
-:func:`mjcf_coupling_lines` are the MJCF's text of them.
+exports' axes.  The MJCF and URDF writers of legged walkers, planar and 3D
+(:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`,
+:func:`walkerlab.export.multibody.mjcf_text`, :func:`walkerlab.export.urdf.legs_urdf_text`),
+write these bodies; :func:`mjcf_body_lines` and :func:`mjcf_coupling_lines` are the MJCF's
+text of them, :func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's
+tree (every joint a pitch) gives the same bodies in the plane ``x``-``z``
+(:mod:`walkerlab.export.planar_bodies`): its roles (:class:`PelvisRoles`) carry the pelvis
+on two slides, name its bodies and joints as the planar exports do, hang a foot body where
+each leg's contact is and read the stance leg's numbers for legs that differ.
 
 Axes
 ----
@@ -57,6 +63,7 @@ nothing).
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
@@ -72,7 +79,7 @@ from walkerlab.export.text import num, nums
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
 __all__ = ["Coupling", "ExportBody", "ExportJoint", "PelvisRoles", "export_bodies",
-           "mjcf_body_lines", "mjcf_coupling_lines", "tree_mjcf_text", "urdf_link_lines"]
+           "axis_text", "mjcf_body_lines", "mjcf_coupling_lines", "tree_mjcf_text"]
 
 
 @dataclass(frozen=True)
@@ -94,9 +101,26 @@ class PelvisRoles:
         The walker coordinates ``legs[1]``'s joints read in place of ``legs[0]``'s
         (``swing -> stance``): the stance leg's angles are the swing leg's with the roles
         swapped.
+        A name not a walker coordinate stands for a coordinate of its own (a planar
+        stance leg's knee, which the tree's straight stance leg does not have).
     joint_names : tuple of (str, str)
         Export joint names by tree coordinate (``{leg}`` the export leg's name); other
         coordinates keep their names.
+    name : str
+        The export pelvis' name (empty: ``pelvis``'s).
+    slides : tuple of (str, (3,), str)
+        The slides that carry the pelvis ``(joint name, axis, the massless carriage link it
+        carries when not the last)``, then its hinges ``pelvis_hinges``; empty: a free joint,
+        or with ``pelvis_hinges`` three slides ``<pelvis>_x``, ``_y``, ``_z``.
+    body_names : tuple of (str, str)
+        Export names of the swing leg's subtree's bodies by tree body (``{leg}`` the export
+        leg's name); default ``{leg}`` for ``leg``, ``{leg}_<body>`` for the others.
+    foot : str
+        The swing leg's contact point each export leg carries as a massless body
+        ``<leg>_foot`` on a fixed joint of that name; empty: none.
+    stance_params : tuple of (str, str)
+        Legs that differ: the parameter ``legs[1]`` reads in place of each of the swing
+        leg's (``swing -> stance``).
     """
 
     pelvis: str = "pelvis"
@@ -107,18 +131,29 @@ class PelvisRoles:
     joint_names: tuple[tuple[str, str], ...] = (
         ("swing_hip_roll", "{leg}_roll"), ("swing_hip_pitch", "{leg}_hip"),
         ("stance_hip_roll", "pelvis_roll"))
+    name: str = ""
+    slides: tuple = ()
+    body_names: tuple[tuple[str, str], ...] = ()
+    foot: str = ""
+    stance_params: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
 class ExportJoint:
-    """A joint of an export body: ``kind`` "free", "slide" or "hinge", its ``axis`` (3,) in
-    the body's frame (none for "free") and ``angle``, its angle (or the slide's travel) in
-    the walker's coordinates (a sympy expression; None for the pelvis' own)."""
+    """A joint of an export body: ``kind`` "free", "slide", "hinge" or "fixed", its
+    ``axis`` (3,) in the body's frame (none for "free" and "fixed") and ``angle``, its angle
+    (or the slide's travel) in the walker's coordinates (a sympy expression; None for the
+    pelvis' own); ``limit`` a hinge's stops ``(lower, upper)`` [rad] (the tree joint's
+    :attr:`~walkerlab.walker.tree.Joint.stops` less its reference angle) or None; ``link``
+    the massless link a joint that is not its body's last carries (empty:
+    ``<name>_link``)."""
 
     name: str
     kind: str
     axis: tuple = ()
     angle: sp.Expr | None = None
+    limit: tuple[float, float] | None = None
+    link: str = ""
 
 
 @dataclass(frozen=True)
@@ -186,12 +221,21 @@ class _Evaluator:
         self.angle = {c: self.sym(e) for c, e in coords.joint_angles}
         self.C = sp.Matrix(TO_MUJOCO).applyfunc(lambda v: sp.Integer(int(v)))
         self.W = slope_to_world(self.kin.gamma)
+        self.floor = MJCF_MIN_INERTIA_KG_M2
 
     def frame(self, body: str) -> sp.Matrix:
         """``Q_b`` (module docstring): the body's tree frame in the exports' axes at the
         reference pose."""
         R = self.kin.rotations[body].subs(self.zero)
         return (self.C * self.W * R).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+
+    def swapped(self, pairs) -> _Evaluator:
+        """This evaluator with each parameter ``a`` of ``pairs`` ``(a, b)`` at ``b``'s
+        value (a leg's numbers read in the other role's)."""
+        out = copy.copy(self)
+        at = dict(zip(map(str, self.params), self.values))
+        out.values = tuple(at[dict(pairs).get(str(p), str(p))] for p in self.params)
+        return out
 
     def number(self, e) -> float:
         e = sp.trigsimp(sp.expand(sp.sympify(e)))
@@ -248,9 +292,9 @@ def _absolute_angle(ev: _Evaluator, tree: BodyTree, body: str, coordinate: str):
 
 
 def _inertia(ev: _Evaluator, body: str, Q: sp.Matrix, about=None) -> np.ndarray:
-    """The body's inertia in its export frame with the floor (module docstring); ``about``:
-    the one axis a root turns about."""
-    floor = MJCF_MIN_INERTIA_KG_M2
+    """The body's inertia in its export frame with the floor ``ev.floor`` (module
+    docstring); ``about``: the one axis a root turns about."""
+    floor = ev.floor
     I_b = ev.kin.inertias[body]
     if about is not None:
         moment = ev.number((about.T * Q * I_b * Q.T * about)[0, 0])
@@ -264,23 +308,37 @@ def _inertia(ev: _Evaluator, body: str, Q: sp.Matrix, about=None) -> np.ndarray:
     return V @ np.diag(np.maximum(w, floor)) @ V.T if w[0] < floor else J
 
 
-def _subtree(ev, tree, roles, body, name, pos, rename, swap) -> ExportBody:
+def _subtree(ev, tree, roles, body, name, pos, rename, swap, foot=None, leg=None
+             ) -> ExportBody:
     """``body`` and the bodies hung below it, ``body`` named ``name`` at ``pos`` (its
     parent's export frame); ``rename`` a body name's export name, ``swap`` the walker
-    coordinates read in place of others (the stance leg's)."""
+    coordinates read in place of others (the stance leg's); ``foot`` (contact point, export
+    name) the massless foot body hung on a fixed joint where the contact is; ``leg`` the
+    export leg's name its joints' names read (default ``name``)."""
     b = tree.body(body)
     Q = ev.frame(body)
     joints = []
+    stops = dict(zip(b.joint.coordinates, b.joint.stops))
     for c, axis, angle, held in _joint_axes(ev, tree, body):
         if held:
             continue
         template = dict(roles.joint_names).get(c, c)
-        joints.append(ExportJoint(template.format(leg=name), "hinge",
-                                  tuple(ev.vector(axis)), angle.subs(swap, simultaneous=True)))
+        ref = ev.angle[c].subs(ev.zero)
+        limit = None if stops.get(c) is None else tuple(
+            ev.number(ev.sym(v) - ref) for v in stops[c])
+        joints.append(ExportJoint(template.format(leg=leg or name), "hinge",
+                                  tuple(ev.vector(axis)), angle.subs(swap, simultaneous=True),
+                                  limit))
     children = tuple(
         _subtree(ev, tree, roles, k.name, rename(k.name),
-                 ev.vector(Q * sp.Matrix([ev.sym(v) for v in k.joint.origin_m])), rename, swap)
+                 ev.vector(Q * sp.Matrix([ev.sym(v) for v in k.joint.origin_m])), rename, swap,
+                 foot, leg or name)
         for k in tree.bodies if k.joint.parent == body)
+    if foot is not None and tree.contact(foot[0]).body == body:
+        point = Q * sp.Matrix([ev.sym(v) for v in tree.contact(foot[0]).point_m])
+        children += (ExportBody(foot[1], foot[0], ev.vector(point),
+                                (ExportJoint(foot[1], "fixed"),), 0.0, np.zeros(3),
+                                np.zeros((3, 3))),)
     welded = {k.name for k in tree.bodies if k.joint.parent == body and k.joint.kind == "fixed"}
     return _folded(ExportBody(name, body, np.asarray(pos, float), tuple(joints),
                               ev.number(ev.kin.masses[body]),
@@ -314,7 +372,8 @@ def _folded(b: ExportBody, welded: set) -> ExportBody:
 
 
 def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
-                  roles: PelvisRoles = PelvisRoles()) -> tuple[ExportBody, tuple[Coupling, ...]]:
+                  roles: PelvisRoles = PelvisRoles(), inertia_floor: float =
+                  MJCF_MIN_INERTIA_KG_M2) -> tuple[ExportBody, tuple[Coupling, ...]]:
     """The walker's export bodies (module docstring) and its hinges' couplings.
 
     Parameters
@@ -324,6 +383,9 @@ def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
     values : dict[str, float]
         A number for every one of ``tree.params`` (SI).
     roles : PelvisRoles
+    inertia_floor : float
+        The smallest principal moment a body carries [kg m^2] (module docstring; 0: the
+        tree's inertias as they are).
 
     Returns
     -------
@@ -343,6 +405,7 @@ def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
     if tree.body(roles.leg).joint.parent != roles.pelvis:
         raise ValueError(f"roles.leg: {roles.leg!r} does not hang from {roles.pelvis!r}")
     ev = _Evaluator(tree, coords, values)
+    ev.floor = inertia_floor
     pelvis = tree.body(roles.pelvis)
     Q = ev.frame(roles.pelvis)
     hip = sp.Matrix([ev.sym(v) for v in tree.body(roles.leg).joint.origin_m]) / 2
@@ -352,33 +415,43 @@ def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
         raise ValueError(f"roles.pelvis_hinges: {', '.join(unknown)} not a coordinate of "
                          f"{roles.pelvis!r}'s joint")
     names_of = dict(roles.joint_names)
-    if roles.pelvis_hinges:
-        joints = [ExportJoint(f"{roles.pelvis}_{c}", "slide", ax) for c, ax in
-                  (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0)))]
+    slides = roles.slides or tuple(
+        (f"{roles.pelvis}_{c}", ax, "") for c, ax in
+        (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0))))
+    about = None
+    if roles.pelvis_hinges or roles.slides:
+        joints = [ExportJoint(n, "slide", ax, link=link) for n, ax, link in slides]
         joints += [ExportJoint(names_of.get(c, c), "hinge", tuple(ev.vector(axes[c][0])),
                                _absolute_angle(ev, tree, roles.pelvis, c))
                    for c in roles.pelvis_hinges]
-        hinge, *more = roles.pelvis_hinges          # a root turning about one axis only
-        about = None if more else axes[hinge][0]
+        if roles.pelvis_hinges:
+            hinge, *more = roles.pelvis_hinges      # a root turning about one axis only
+            about = None if more else axes[hinge][0]
     else:
-        joints, about = [ExportJoint("free", "free")], None
-    swap = {ev.names[a]: ev.names[b] for a, b in roles.stance_roles if a in ev.names}
+        joints = [ExportJoint("free", "free")]
+    swap = {ev.names[a]: ev.names.get(b, sp.Symbol(b)) for a, b in roles.stance_roles
+            if a in ev.names}
+    body_names = dict(roles.body_names)
     children = []
     for k in tree.bodies:
         if k.joint.parent != roles.pelvis:
             continue
         at = Q * (sp.Matrix([ev.sym(v) for v in k.joint.origin_m]) - hip)
         if k.name == roles.leg:
-            leg1, leg2 = roles.legs
-            ren1 = lambda n, leg=leg1: leg if n == roles.leg else f"{leg}_{n}"  # noqa: E731
-            ren2 = lambda n, leg=leg2: leg if n == roles.leg else f"{leg}_{n}"  # noqa: E731
-            children.append(_subtree(ev, tree, roles, k.name, leg1, ev.vector(at), ren1, {}))
-            children.append(_subtree(ev, tree, roles, k.name, leg2, ev.vector(Q * -hip), ren2,
-                                     swap))
+            for leg, pos, sw, e in ((roles.legs[0], at, {}, ev),
+                                    (roles.legs[1], Q * -hip, swap,
+                                     ev.swapped(roles.stance_params))):
+                def rename(n, leg=leg):
+                    default = "{leg}" if n == roles.leg else "{leg}_" + n
+                    return body_names.get(n, default).format(leg=leg)
+                children.append(_subtree(e, tree, roles, k.name, rename(k.name),
+                                         e.vector(pos), rename, sw,
+                                         (roles.foot, f"{leg}_foot") if roles.foot else None,
+                                         leg))
         else:
             children.append(_subtree(ev, tree, roles, k.name, k.name, ev.vector(at),
                                      lambda n: n, {}))
-    root = ExportBody(roles.pelvis, roles.pelvis, np.zeros(3), tuple(joints),
+    root = ExportBody(roles.name or roles.pelvis, roles.pelvis, np.zeros(3), tuple(joints),
                       ev.number(ev.kin.masses[roles.pelvis]),
                       ev.vector(Q * (sp.Matrix([ev.sym(v) for v in pelvis.com_m]) - hip)),
                       _inertia(ev, roles.pelvis, Q, about), tuple(children))
@@ -389,7 +462,9 @@ def _couplings(ev: _Evaluator, root: ExportBody) -> tuple[Coupling, ...]:
     """Each hinge whose angle is a rational sum of the earlier hinges' (module docstring)."""
     hinges = [j for b in root.walk() for j in b.joints
               if j.kind == "hinge" and j.angle is not None]
-    q = list(ev.kin.q)
+    q = list(ev.kin.q)      # and the coordinates of a role's own (PelvisRoles.stance_roles)
+    q += sorted({s for j in hinges for s in j.angle.free_symbols} - set(q) - set(ev.params),
+                key=str)
 
     def row(e):
         return [sp.nsimplify(sp.diff(e, qi)) for qi in q]
@@ -413,12 +488,12 @@ def _couplings(ev: _Evaluator, root: ExportBody) -> tuple[Coupling, ...]:
     return tuple(out)
 
 
-def _inertial(b: ExportBody, root: bool) -> str:
+def _inertial(b: ExportBody) -> str:
     """MJCF's ``inertial`` of ``b``: ``diaginertia`` when its inertia is diagonal, else
-    ``fullinertia`` (MuJoCo's order ``ixx iyy izz ixy ixz iyz``); the root's centre of mass
-    at its origin ``0 0 0``."""
+    ``fullinertia`` (MuJoCo's order ``ixx iyy izz ixy ixz iyz``); a centre of mass at the
+    body's origin ``0 0 0``."""
     J = b.inertia_kg_m2
-    pos = "0 0 0" if root and not b.com_m.any() else nums(*b.com_m)
+    pos = "0 0 0" if not b.com_m.any() else nums(*b.com_m)
     if np.count_nonzero(J - np.diag(np.diag(J))) == 0:
         inertia = f'diaginertia="{nums(*np.diag(J))}"'
     else:
@@ -426,7 +501,7 @@ def _inertial(b: ExportBody, root: bool) -> str:
     return f'<inertial pos="{pos}" mass="{num(b.mass_kg)}" {inertia}/>'
 
 
-def _axis_text(axis) -> str:
+def axis_text(axis) -> str:
     """An axis whose components are whole numbers as integers (``0 -1 0``), else each as
     :func:`~walkerlab.export.text.num` writes it."""
     if all(float(v).is_integer() for v in axis):
@@ -435,9 +510,12 @@ def _axis_text(axis) -> str:
 
 
 def mjcf_body_lines(b: ExportBody, geoms=lambda b, pad: [], indent: int = 4,
-                    root: bool = True) -> list[str]:
-    """The MJCF ``body`` element of ``b`` and its children: joints, ``inertial``, the
-    geoms ``geoms(b, pad)`` returns (lines at the indent ``pad``), then the children."""
+                    root: bool = True, joint_attrs=lambda j: "") -> list[str]:
+    """The MJCF ``body`` element of ``b`` and its children: joints (a hinge's limit its
+    ``range``, then the attributes ``joint_attrs(joint)`` returns: a spring's), ``inertial``,
+    the geoms ``geoms(b, pad)`` returns (lines at the indent ``pad``), then each child: a
+    massless child on a fixed joint (a foot: a named point) as the lines ``geoms(child,
+    pad)`` returns in ``b``, first, then the other children's bodies."""
     pad = " " * indent
     inner = pad + "  "
     pos = "0 0 0" if root else nums(*b.pos_m)
@@ -446,13 +524,24 @@ def mjcf_body_lines(b: ExportBody, geoms=lambda b, pad: [], indent: int = 4,
         if j.kind == "free":
             out.append(f'{inner}<freejoint name="{j.name}"/>')
         else:
+            rng = "" if j.limit is None else f' range="{nums(*j.limit)}"'
             out.append(f'{inner}<joint name="{j.name}" type="{j.kind}" '
-                       f'axis="{_axis_text(j.axis)}"/>')
-    out.append(inner + _inertial(b, root))
+                       f'axis="{axis_text(j.axis)}"{rng}{joint_attrs(j)}/>')
+    out.append(inner + _inertial(b))
     out += geoms(b, inner)
     for c in b.children:
-        out += mjcf_body_lines(c, geoms, indent + 2, root=False)
+        if _is_point(c):
+            out += geoms(c, inner)
+    for c in b.children:
+        if not _is_point(c):
+            out += mjcf_body_lines(c, geoms, indent + 2, False, joint_attrs)
     return out + [f"{pad}</body>"]
+
+
+def _is_point(b: ExportBody) -> bool:
+    """A massless body welded to its parent without children (a foot's point)."""
+    return (b.mass_kg == 0 and not b.inertia_kg_m2.any() and not b.children
+            and all(j.kind == "fixed" for j in b.joints))
 
 
 def mjcf_coupling_lines(couplings) -> list[str]:
@@ -468,47 +557,6 @@ def mjcf_coupling_lines(couplings) -> list[str]:
     out += ["  </tendon>", "  <equality>"]
     out += [f'    <tendon name="{c.name}" tendon1="{c.name}"/>' for c in couplings]
     return out + ["  </equality>"]
-
-
-def _urdf_inertial(b: ExportBody) -> str:
-    """URDF's ``inertial`` of ``b`` (zero products of inertia written ``0``)."""
-    J = b.inertia_kg_m2
-
-    def v(x: float) -> str:
-        return "0" if x == 0 else num(x)
-    return (f'<inertial><origin xyz="{nums(*b.com_m)}"/><mass value="{num(b.mass_kg)}"/>'
-            f'<inertia ixx="{num(J[0, 0])}" ixy="{v(J[0, 1])}" ixz="{v(J[0, 2])}" '
-            f'iyy="{num(J[1, 1])}" iyz="{v(J[1, 2])}" izz="{num(J[2, 2])}"/></inertial>')
-
-
-def urdf_link_lines(b: ExportBody, visuals=lambda b, pad: [], parent: str | None = None
-                    ) -> list[str]:
-    """URDF's ``link`` of ``b`` (its ``inertial`` and the lines ``visuals(b, pad)``
-    returns), the joint from ``parent`` (``continuous`` on one hinge, ``fixed`` on none;
-    none for the root, a floating base), then its children's.  A body on several hinges
-    (a leg on its roll then its pitch: URDF's joints have one axis) hangs from a chain of
-    massless links ``<hinge>_link``, one after each hinge but its last, each at the body's
-    origin in the body's reference frame: URDF turns each child link about its joint's axis
-    in its parent's frame, as MuJoCo turns a body's joints in order
-    (:func:`mjcf_body_lines`)."""
-    extra = visuals(b, "    ")
-    out = [f'  <link name="{b.name}">{_urdf_inertial(b)}' + ("" if extra else "</link>"),
-           *extra, *(["  </link>"] if extra else [])]
-    if parent is not None:
-        links = [f"{j.name}_link" for j in b.joints[:-1]] + [b.name]
-        out += [f'  <link name="{name}"/>' for name in links[:-1]]
-        pos = nums(*b.pos_m)
-        for j, (up, child) in zip(b.joints, zip([parent, *links], links)):
-            out.append(f'  <joint name="{j.name}" type="continuous"><parent link="{up}"/>'
-                       f'<child link="{child}"/><origin xyz="{pos}"/>'
-                       f'<axis xyz="{_axis_text(j.axis)}"/></joint>')
-            pos = nums(0, 0, 0)
-        if not b.joints:
-            out.append(f'  <joint name="{b.name}_weld" type="fixed"><parent link="{parent}"/>'
-                       f'<child link="{b.name}"/><origin xyz="{pos}"/></joint>')
-    for c in b.children:
-        out += urdf_link_lines(c, visuals, b.name)
-    return out
 
 
 def tree_mjcf_text(tree: BodyTree, coords: CoordinateMap, values: dict,

@@ -1,13 +1,38 @@
-"""The walker as a URDF robot and its keyframe sidecar (``walker.urdf``, ``walker.gait.json``).
+"""Legged walkers, planar and 3D, as URDF robots (``walker.urdf``) and the planar walkers'
+keyframe sidecar (``walker.gait.json``).
 
 URDF: ROS "URDF XML specification", http://wiki.ros.org/urdf/XML (``robot``, ``link``,
 ``inertial``, ``joint`` of type ``prismatic``/``continuous``/``revolute``/``fixed``).  Links
-without ``inertial`` are massless (Pinocchio and Drake accept them).  The frame, joint names,
-feet and what the springs, couplings and motors become are those of
-:mod:`walkerlab.export.multibody` (which writes the MJCF of the same tree); what URDF cannot
-hold (ground, springs, couplings, the knee latch, motors, push-off) is listed by
-:func:`urdf_omissions` and stated in the header, the laws in the sidecar
-(:func:`keyframe_json`).
+without ``inertial`` are massless (Pinocchio and Drake accept them).
+
+One writer, :func:`urdf_robot_text`, writes the bodies of a walker's body tree
+(:func:`walkerlab.export.tree_bodies.export_bodies`: joints, masses, centres of mass,
+inertias, axes), its couplings as comments (``mimic`` follows one joint only) and the
+comments it is given (the springs, motors and what else the file leaves out), whatever the
+dimension; :func:`legs_urdf_text` is the legged walkers' file:
+
+- planar (:func:`walkerlab.export.planar_bodies.planar_bodies`): the tree of
+  :func:`walkerlab.walker.trees.legs_tree`,
+  the hip carried by the fixed link ``world`` on the slides ``hip_x`` (through the massless
+  carriage ``hip_slider``) and ``hip_z``, the legs' joints ``leg<i>_hip`` (``leg<i>_knee``:
+  ``revolute`` in ``[-pi, 0]`` with the straight-leg stop), ``torso_hip``, each foot a
+  massless link ``leg<i>_foot`` on a fixed joint of that name at the foot point or the arc's
+  centre; the inertias as the tree has them (a point mass none); the walkers whose joints
+  are all free (the five-link and three-link bipeds) alike, their knees free and the torso
+  on its own hinge.  The frame, joint names, feet and what the springs, couplings and
+  motors become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states
+  them (the links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
+- 3D (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`): the pelvis is the root link, free
+  in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
+  body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
+  ``leg<i>_roll`` then ``leg<i>_hip`` through the massless ``leg<i>_roll_link``), its foot a
+  sphere (collision); point masses carry the export's smallest inertia
+  (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the MJCF's; the hip-roll
+  law and the actuation in the comments ``walkerlab_hip_roll``, ``walkerlab_actuation``.
+
+What URDF cannot hold (ground, springs, couplings, the knee latch, motors, push-off) is
+listed by :func:`legs_urdf_omissions` and stated in the header, the planar laws in the
+sidecar (:func:`keyframe_json`).
 """
 
 from __future__ import annotations
@@ -20,65 +45,251 @@ from xml.sax.saxutils import quoteattr
 from walkerlab.export.mjcf_scene import (
     MjcfScene,
     actuation_dict,
+    actuation_text,
     point_foot_radius,
 )
 from walkerlab.export.motors import motor_target, motors
 from walkerlab.export.omitted import URDF_GROUND, Omission, xml_comments
 from walkerlab.export.parts import export_part
-from walkerlab.export.text import AXIS, arc_feet, header, num, nums
+from walkerlab.export.planar_bodies import planar_bodies
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION
+from walkerlab.export.text import arc_feet, comment, header, num, nums
+from walkerlab.walker.multibody import multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.config.actuation import Actuation
-    from walkerlab.walker.multibody import Link, Multibody
+    from walkerlab.walker.multibody import Multibody
+
+__all__ = ["keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
+           "urdf_actuation_omissions", "urdf_link_lines", "urdf_omissions", "urdf_robot_text"]
+
+#: a slide's ``limit`` (URDF requires one on a prismatic joint): none that binds
+_FREE_SLIDE = '<limit lower="-1e9" upper="1e9" effort="0" velocity="1e9"/>'
 
 
-def urdf_text(mb: Multibody, name: str, version: str = "",
-              actuation: Actuation | None = None) -> str:
-    """The walker as a URDF robot (ROS URDF XML specification, http://wiki.ros.org/urdf/XML).
+def urdf_robot_text(name: str, comments: list[str], root, couplings=(),
+                    visuals=lambda b, pad: [], world: bool = False) -> str:
+    """A walker's export bodies as a URDF robot: the one writer of the legged walkers.
 
     Parameters
     ----------
-    mb : Multibody
-        From :func:`walkerlab.walker.multibody.multibody`.
+    name : str
+        The robot's name (the scene's).
+    comments : list of str
+        Lines before ``<robot>`` (the header: axes, springs, what is left out).
+    root : walkerlab.export.tree_bodies.ExportBody
+        The root body, every other below it (:func:`walkerlab.export.tree_bodies.
+        export_bodies`).
+    couplings : tuple of walkerlab.export.tree_bodies.Coupling
+        Each stated in a comment (URDF holds no joint at a sum of others: the simulator that
+        loads the file adds it; the MJCF holds it as an equality on a fixed tendon).
+    visuals : callable
+        ``visuals(body, pad) -> list of str``: a link's ``visual`` and ``collision`` lines.
+    world : bool
+        The root hangs from the fixed link ``world`` on its joints (the planar hip's
+        slides); else the root is the loader's floating base and its own joints are not
+        written (a 3D pelvis: free; on hip-roll joints, free about the axes it holds).
+
+    Returns
+    -------
+    str
+        URDF XML.
+    """
+    out = ['<?xml version="1.0"?>', *comments, f"<robot name={quoteattr(name)}>"]
+    out += [comment("coupling " + c.name + " left out (URDF cannot hold it): "
+                    + " + ".join(f"{k} * {j}" for j, k in c.terms) + " = 0")
+            for c in couplings]
+    if world:
+        out.append('  <link name="world"/>')
+    out += urdf_link_lines(root, visuals, "world" if world else None)
+    return "\n".join(out + ["</robot>", ""])
+
+
+def _urdf_inertial(b) -> str:
+    """URDF's ``inertial`` of ``b`` (zero products of inertia written ``0``); none for a
+    massless body without inertia."""
+    J = b.inertia_kg_m2
+    if b.mass_kg == 0 and not J.any():
+        return ""
+
+    def v(x: float) -> str:
+        return "0" if x == 0 else num(x)
+    return (f'<inertial><origin xyz="{nums(*b.com_m)}"/><mass value="{num(b.mass_kg)}"/>'
+            f'<inertia ixx="{num(J[0, 0])}" ixy="{v(J[0, 1])}" ixz="{v(J[0, 2])}" '
+            f'iyy="{num(J[1, 1])}" iyz="{v(J[1, 2])}" izz="{num(J[2, 2])}"/></inertial>')
+
+
+def urdf_link_lines(b, visuals=lambda b, pad: [], parent: str | None = None) -> list[str]:
+    """URDF's ``link`` of ``b`` (its ``inertial`` and the lines ``visuals(b, pad)``
+    returns), the joints from ``parent`` (none for a floating root), then its children's.
+
+    A hinge is ``continuous``, ``revolute`` with its stops as the ``limit``; a slide
+    ``prismatic`` (its ``limit`` none that binds); a body without joints is welded
+    (``fixed``: its own fixed joint's name, else ``<body>_weld``).  A body on several joints
+    (a leg on its roll then its pitch, the planar hip on its two slides: URDF's joints have
+    one axis) hangs from a chain of massless links (:attr:`~walkerlab.export.tree_bodies.
+    ExportJoint.link`, default ``<joint>_link``), one after each joint but its last, each at
+    the body's origin in the body's reference frame: URDF turns each child link about its
+    joint's axis in its parent's frame, as MuJoCo turns a body's joints in order
+    (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`)."""
+    from walkerlab.export.tree_bodies import axis_text  # light: sympy with the bodies
+
+    inertial, extra = _urdf_inertial(b), visuals(b, "    ")
+    if extra:
+        out = [f'  <link name="{b.name}">{inertial}', *extra, "  </link>"]
+    else:
+        out = [f'  <link name="{b.name}">{inertial}</link>' if inertial else
+               f'  <link name="{b.name}"/>']
+    if parent is not None:
+        moving = [j for j in b.joints if j.kind != "fixed"]
+        links = [j.link or f"{j.name}_link" for j in moving[:-1]] + [b.name]
+        out += [f'  <link name="{name}"/>' for name in links[:-1]]
+        pos = nums(*b.pos_m)
+        for j, (up, child) in zip(moving, zip([parent, *links], links)):
+            kind = ("prismatic" if j.kind == "slide" else "revolute" if j.limit else
+                    "continuous")
+            stop = (f'<limit lower="{num(j.limit[0])}" upper="{num(j.limit[1])}" effort="0" '
+                    'velocity="1e9"/>' if j.limit else _FREE_SLIDE if j.kind == "slide" else "")
+            out.append(f'  <joint name="{j.name}" type="{kind}"><parent link="{up}"/>'
+                       f'<child link="{child}"/><origin xyz="{pos}"/>'
+                       f'<axis xyz="{axis_text(j.axis)}"/>{stop}</joint>')
+            pos = nums(0, 0, 0)
+        if not moving:
+            weld = b.joints[0].name if b.joints else f"{b.name}_weld"
+            out.append(f'  <joint name="{weld}" type="fixed"><parent link="{parent}"/>'
+                       f'<child link="{b.name}"/><origin xyz="{pos}"/></joint>')
+    for c in b.children:
+        out += urdf_link_lines(c, visuals, b.name)
+    return out
+
+
+def legs_urdf_text(data, name: str, version: str = "",
+                   actuation: Actuation | None = None) -> str:
+    """A legged walker, planar or in 3D, as URDF (module docstring).
+
+    Parameters
+    ----------
+    data : WalkerData
+        From :func:`walkerlab.walker.description.walker_data` (legs without spokes).
     name : str
         Robot name (the scene's name).
     version : str
         walkerlab version, for the header comment.
     actuation : Actuation, optional
-        The scene's ``walker.actuation``: its motors (:func:`motors`) are stated in
-        comments (URDF has no element for them).
+        The scene's ``walker.actuation``: its motors (:func:`motors`) and push-off are
+        stated in comments (URDF has no element for them; the 3D walker's laws in the
+        comment ``walkerlab_actuation``).
 
     Returns
     -------
     str
-        URDF XML; the base is ``world -> hip_x (prismatic x) -> hip_z (prismatic z) -> hip``
-        through a massless ``hip_slider`` link; hip joints are ``continuous``.
+        URDF XML (:func:`urdf_robot_text`).
+
+    Raises
+    ------
+    ValueError
+        A walker the export does not carry (massless legs, :func:`walkerlab.walker.
+        multibody.multibody`).
     """
+    if data.structure.in_3d:
+        return _legs_3d_text(data, name, version, actuation)
+    mb = multibody(data)
+    root, couplings = planar_bodies(data, mb)
+    comments = [*header(mb, name, "URDF", version),
+                *xml_comments(urdf_omissions(mb, actuation))]
+    return urdf_robot_text(name, comments, root, couplings, _planar_visuals(mb), world=True)
+
+
+def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omission, ...]:
+    """What :func:`legs_urdf_text` leaves out (:mod:`walkerlab.export.omitted`): a planar
+    walker's :func:`urdf_omissions`; a 3D walker's hip-roll law and the pelvis' held pitch
+    and yaw (with hip-roll joints), its motors and push-off."""
+    if not data.structure.in_3d:
+        return urdf_omissions(multibody(data), actuation)
+    from walkerlab.export.legs_3d_mjcf import hip_roll_law  # light: 3D only
+
+    out = []
+    if hip_roll_law(data) is not None:
+        out += [Omission("the hip-roll law (walker.hip_roll)", "URDF has no law element: "
+                         "its gains are in the comment walkerlab_hip_roll (the MJCF export "
+                         "runs it)"),
+                Omission("the pelvis' held pitch and yaw", "URDF's root is a loader's "
+                         "floating base, free about every axis; the rigid pelvis only rolls "
+                         "about the fall line")]
+    return tuple(out + urdf_actuation_omissions(actuation,
+                                                "in the comment walkerlab_actuation"))
+
+
+def _planar_visuals(mb: Multibody):
+    """The planar walker's drawing: the hip a sphere, each link a cylinder along it (up the
+    torso), each foot a sphere of :func:`point_foot_radius` or the arc's cylinder."""
     width = mb.leg_length_m / 50  # visual thickness of the links
-    out = ['<?xml version="1.0"?>', *header(mb, name, "URDF", version),
-           *xml_comments(urdf_omissions(mb, actuation)),
-           f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
-           '  <link name="hip_slider"/>']
-    for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
-                                       ("hip_z", "hip_slider", "hip", "0 0 1")):
-        out += [f'  <joint name="{joint}" type="prismatic">', f'    <parent link="{parent}"/>',
-                f'    <child link="{child}"/>', '    <origin xyz="0 0 0" rpy="0 0 0"/>',
-                f'    <axis xyz="{axis}"/>',
-                '    <limit lower="-1e9" upper="1e9" effort="0" velocity="1e9"/>', "  </joint>"]
-    out.append('  <link name="hip">')
-    if mb.hip_mass_kg > 0:
-        out += _urdf_inertial(mb.hip_mass_kg, 0.0, 0.0)
-    out += ['    <visual><geometry><sphere radius="' + num(2 * width) + '"/></geometry></visual>',
-            "  </link>"]
-    for ln in mb.links:
-        out += _urdf_link(ln, mb, width)
-    out += ["</robot>", ""]
-    return "\n".join(out)
+    links = {ln.name: ln for ln in mb.links}
+
+    def visuals(b, pad: str) -> list[str]:
+        if b.tree_body == "pelvis":
+            return [f'{pad}<visual><geometry><sphere radius="{num(2 * width)}"/></geometry>'
+                    "</visual>"]
+        if b.name in links:
+            ln = links[b.name]
+            reach = -ln.length_m if ln.up else ln.length_m
+            return [f'{pad}<visual><origin xyz="{nums(0, 0, -reach / 2)}"/><geometry>'
+                    f'<cylinder radius="{num(width / 2)}" length="{num(ln.length_m)}"/>'
+                    "</geometry></visual>"]
+        if not (b.joints and b.joints[0].kind == "fixed"):   # not a foot
+            return []
+        if arc_feet(mb):  # cylinder axis (z) turned onto y
+            geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
+                    f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
+                    "</geometry>")
+        else:
+            geom = f'<geometry><sphere radius="{num(point_foot_radius(mb))}"/></geometry>'
+        return [f"{pad}<collision>{geom}</collision>"]
+    return visuals
+
+
+def _legs_3d_text(data, name: str, version: str, actuation) -> str:
+    """The 3D legged walker's URDF (module docstring): the bodies of its tree
+    (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`), each leg's rod and foot sphere."""
+    from walkerlab.export.legs_3d_mjcf import (  # light: 3D only
+        hip_roll_law,
+        legs_summary,
+        walker_tree,
+    )
+    from walkerlab.export.tree_bodies import PelvisRoles, export_bodies  # light
+
+    p = dict(zip(data.structure.param_names, data.params))
+    L, w = p["L"], p.get("w_hip", 0.0)
+    r = WHEEL_TIP_FRACTION * L
+    comments = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): "
+                        f"straight {legs_summary(data, p)}, hips {num(w)} m apart; slope "
+                        f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); "
+                        "the pelvis is the free root link"),
+                *xml_comments(legs_urdf_omissions(data, actuation))]
+    law = hip_roll_law(data)
+    if law is not None:
+        comments.append(comment(f"walkerlab_hip_roll: {json.dumps(law)}"))
+    if actuation is not None:
+        comments.append(comment(f"walkerlab_actuation: {actuation_text(actuation)}"))
+    tree, coords, p = walker_tree(data)
+    # with hip-roll joints the pelvis' roll and each leg's roll then pitch (the MJCF's)
+    roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
+    root, couplings = export_bodies(tree, coords, p, roles)
+
+    def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere
+        if b.tree_body != roles.leg:
+            return []
+        return [f'{pad}<visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
+                f'radius="{num(L / 100)}" length="{num(L)}"/></geometry></visual>',
+                f'{pad}<collision name="{b.name}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+    return urdf_robot_text(name, comments, root, couplings, visuals)
 
 
 def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
                    ) -> tuple[Omission, ...]:
-    """What :func:`urdf_text` leaves out (:mod:`walkerlab.export.omitted`): the ground and
+    """What a planar walker's :func:`legs_urdf_text` leaves out
+    (:mod:`walkerlab.export.omitted`): the ground and
     contact, each spring (URDF has no spring element), each coupling (``mimic`` follows one
     joint only), the knee latch, each motor of :func:`motors` and the push-off (no actuator
     or force element: the laws are in the keyframe sidecar)."""
@@ -101,51 +312,13 @@ def urdf_actuation_omissions(actuation: Actuation | None,
     """What a URDF leaves of ``actuation`` (``walker.actuation``, or None): each motor of
     :func:`motors` and the push-off (no actuator or force element; their laws ``where``
     the file's reader finds them: the planar URDF's keyframe sidecar, the 3D walker's
-    comment :func:`walkerlab.export.legs_3d.legs_3d_urdf_text`)."""
+    comment ``walkerlab_actuation``, :func:`legs_urdf_text`)."""
     out = [Omission(f"motor {name}", f"URDF has no actuator element for a torque u on "
                     f"{motor_target(kind, target)}; its law is the scene's walker.actuation "
                     f"({where})") for name, kind, target in motors(actuation)]
     if actuation is not None and actuation.push_off is not None:
         out.append(Omission("the push-off (walker.actuation.push_off)", "URDF has no force "
                             f"element; its law is {where}"))
-    return out
-
-
-def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:
-    # a line along the link's z axis: inertia about x and y, none about z
-    return ["    <inertial>", f'      <origin xyz="{nums(off, 0, -com)}" rpy="0 0 0"/>',
-            f'      <mass value="{num(mass)}"/>',
-            f'      <inertia ixx="{num(inertia)}" ixy="0" ixz="0" iyy="{num(inertia)}" iyz="0" '
-            'izz="0"/>', "    </inertial>"]
-
-
-def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
-    knee = ln.joint.endswith("_knee") and export_part(mb).knee_stops  # free knees: no stop
-    jtype = "revolute" if knee else "continuous"
-    reach = -ln.length_m if ln.up else ln.length_m  # the visual runs up the torso
-    out = [f'  <joint name="{ln.joint}" type="{jtype}">', f'    <parent link="{ln.parent}"/>',
-           f'    <child link="{ln.name}"/>',
-           f'    <origin xyz="{nums(0, 0, -ln.joint_from_parent_m)}" rpy="0 0 0"/>',
-           f'    <axis xyz="{AXIS}"/>']
-    if knee:  # straight-leg stop at 0, flexion down to -pi
-        out.append(f'    <limit lower="{num(-math.pi)}" upper="0" effort="0" velocity="1e9"/>')
-    out += ["  </joint>", f'  <link name="{ln.name}">',
-            *_urdf_inertial(ln.mass_kg, ln.com_m, ln.inertia_kg_m2, ln.com_off_axis_m),
-            f'    <visual><origin xyz="{nums(0, 0, -reach / 2)}" rpy="0 0 0"/>'
-            f'<geometry><cylinder radius="{num(width / 2)}" length="{num(ln.length_m)}"/>'
-            "</geometry></visual>", "  </link>"]
-    if ln.foot_m is not None:
-        foot = ln.name.split("_")[0] + "_foot"
-        if arc_feet(mb):  # cylinder axis (z) turned onto y
-            geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
-                    f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
-                    "</geometry>")
-        else:
-            geom = f'<geometry><sphere radius="{num(point_foot_radius(mb))}"/></geometry>'
-        out += [f'  <joint name="{foot}" type="fixed">', f'    <parent link="{ln.name}"/>',
-                f'    <child link="{foot}"/>',
-                f'    <origin xyz="{nums(0, 0, -ln.foot_m)}" rpy="0 0 0"/>', "  </joint>",
-                f'  <link name="{foot}">', f"    <collision>{geom}</collision>", "  </link>"]
     return out
 
 

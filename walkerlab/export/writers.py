@@ -10,7 +10,8 @@ The URDF and MJCF writers write the walker's multibody as its kind has it
 (:attr:`walkerlab.walker.kinds.Kind.body`, :data:`BODIES`): a tree of leg links
 (:mod:`walkerlab.export.multibody`), a spoked wheel (planar, or in 3D:
 :mod:`walkerlab.export.spoked`), or the 3D straight-legged walker's free pelvis
-(:mod:`walkerlab.export.legs_3d`, :mod:`walkerlab.export.legs_3d_mjcf`).  The
+(:mod:`walkerlab.export.legs_3d_mjcf`); the URDF of a legged walker, planar or in 3D, is
+one writer's (:func:`walkerlab.export.urdf.legs_urdf_text`).  The
 Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
 (:mod:`walkerlab.export.opensim`) write a tree of leg links.
 
@@ -67,7 +68,12 @@ from walkerlab.export.spoked import (
     wheel_chord_m,
 )
 from walkerlab.export.text import comment
-from walkerlab.export.urdf import keyframe_json, urdf_omissions, urdf_text
+from walkerlab.export.urdf import (
+    keyframe_json,
+    legs_urdf_omissions,
+    legs_urdf_text,
+    urdf_omissions,
+)
 from walkerlab.export.wheel_scene import (
     check_wheel_exportable,
     wheel_keyframe,
@@ -233,11 +239,11 @@ def _links(job: ExportJob, w: Writer) -> Written:
     ideal, extra = (None, None) if job.walker_only else job.gait(
         lambda ideal: mjcf_scene(scene, mb, job.plant, ideal, job.options))
     version = walkerlab.__version__
-    if w.name == "urdf":
-        text = urdf_text(mb, job.name, version, scene.walker.actuation)
+    if w.name == "urdf":  # the legged walkers' one URDF writer, planar and 3D
+        text = legs_urdf_text(job.data, job.name, version, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)
     else:
-        text = mjcf_text(mb, job.name, version, extra)
+        text = mjcf_text(job.data, mb, job.name, version, extra)
         left_out = mjcf_omissions(mb, extra)
     files = [_xml(job, w, text)]
     if w.name == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
@@ -307,13 +313,13 @@ def _wheel_3d(job: ExportJob, w: Writer) -> Written:
 
 def _legs_3d(job: ExportJob, w: Writer) -> Written:
     """The 3D straight-legged walker (``walker.space: 3d``): its URDF, a free pelvis and two
-    legs on hip joints (:func:`walkerlab.export.legs_3d.legs_3d_urdf_text`), or its
+    legs on hip joints (:func:`walkerlab.export.urdf.legs_urdf_text`, the planar walkers'
+    writer), or its
     MJCF, the same walker on a free joint with the rigid gait as its ``gait`` keyframe, the
     footfall patches of its lanes and the scene's contact
     (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`; ``job.options``: the MJCF's
     :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
     table has them (refused before this is reached)."""
-    from walkerlab.export.legs_3d import legs_3d_urdf_omissions, legs_3d_urdf_text  # light
     from walkerlab.export.legs_3d_mjcf import legs3d_mjcf_text, legs3d_scene  # light
 
     scene, data = job.scene, job.data
@@ -321,8 +327,8 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     version = walkerlab.__version__
     ideal, left_out = None, ()
     if w.name == "urdf":
-        text = legs_3d_urdf_text(data, job.name, version, scene.walker.actuation)
-        left_out = legs_3d_urdf_omissions(data, scene.walker.actuation)
+        text = legs_urdf_text(data, job.name, version, scene.walker.actuation)
+        left_out = legs_urdf_omissions(data, scene.walker.actuation)
     elif job.walker_only:
         text = legs3d_mjcf_text(data, job.name, version)
     else:

@@ -290,7 +290,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text, run by
         # walkerlab.export.mujoco_walk.PoweredLoop) and the URDF (its hip joints,
         # the motor and the push-off left out as the planar URDF's: walkerlab.export.
-        # legs_3d.legs_3d_urdf_text; with hip-roll joints each leg's roll then pitch)
+        # urdf.legs_urdf_text; with hip-roll joints each leg's roll then pitch)
         **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
            for v in ("adams",)},
         ("knee_torque", "*"): _NO_KNEE,
@@ -302,8 +302,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_CELLS_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
-        # the straight legs' mid-stance foot-through; walkerlab.export.legs_3d.
-        # legs_3d_urdf_text); the Adams dataset: the pelvis fixed to leg2, the legs on
+        # the straight legs' mid-stance foot-through; walkerlab.export.urdf.
+        # legs_urdf_text); the Adams dataset: the pelvis fixed to leg2, the legs on
         # revolutes, or with hip-roll joints the pelvis rolling, the legs on universal
         # joints and the law as GFORCE torques (walkerlab.export.adams_3d.adm3d_text)
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import ast
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 __all__ = ["Body", "BodyTree", "ContactPoint", "CoordinateMap", "Joint", "Root", "JOINT_AXES",
            "free_root",
@@ -63,6 +63,11 @@ class Joint:
     coordinates : tuple of str
         The joint's angles [rad] (a prismatic joint's travel [m]), one per axis, named
         uniquely in the tree.
+    stops : tuple of (Scalar, Scalar) or None
+        Empty (no stops), or one per coordinate: the range ``(lower, upper)`` its stops
+        hold it in [rad] (a locking knee's straight-leg stop: ``("-pi", 0)``), or None.
+        A description for the exports (a joint limit); the derivation does not read it
+        (a stop is an impact of the hybrid model).
     """
 
     name: str
@@ -71,6 +76,7 @@ class Joint:
     origin_m: Vector = (0.0, 0.0, 0.0)
     axes: tuple[Vector, ...] = ()
     coordinates: tuple[str, ...] = ()
+    stops: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -224,6 +230,16 @@ def _check_joint(j: Joint, where: str, params: frozenset, known: set, coords: se
         vals = _check_vector(axis, f"{where}.axes[{i}]", params)
         if None not in vals and abs(math.fsum(v * v for v in vals) - 1.0) > 1e-12:
             raise ValueError(f"{where}.axes[{i}]: {axis!r} is not a unit vector")
+    if j.stops and len(j.stops) != k:
+        raise ValueError(f"{where}.stops: one range (or None) per coordinate, got "
+                         f"{len(j.stops)} for {k}")
+    for i, stop in enumerate(j.stops):
+        if stop is not None:
+            if not isinstance(stop, tuple | list) or len(stop) != 2:
+                raise ValueError(f"{where}.stops[{i}]: {stop!r} is not (lower, upper)")
+            lo, hi = (_check_scalar(v, f"{where}.stops[{i}]", params) for v in stop)
+            if lo is not None and hi is not None and not lo < hi:
+                raise ValueError(f"{where}.stops[{i}]: {stop!r} is not a range lower < upper")
     for c in j.coordinates:
         if not isinstance(c, str) or not c.isidentifier():
             raise ValueError(f"{where}.coordinates: {c!r} is not a name")
@@ -383,8 +399,7 @@ def free_root(tree: BodyTree, coords: CoordinateMap, names: tuple[str, ...]
         parent = name
     bodies = tuple(b if b.joint.parent != tree.root.name else
                    Body(b.name, b.mass_kg, b.inertia_kg_m2, b.com_m,
-                        Joint(b.joint.name, b.joint.kind, parent, b.joint.origin_m,
-                              b.joint.axes, b.joint.coordinates)) for b in tree.bodies)
+                        replace(b.joint, parent=parent)) for b in tree.bodies)
     floating = BodyTree(tree.params, tree.root, tuple(free) + bodies, tree.contacts)
     return floating, CoordinateMap(tuple(names) + coords.names,
                                    tuple((n, n) for n in names) + coords.joint_angles)

@@ -99,9 +99,11 @@ class Part:
 
 def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Part, ...] = (),
                *, planar: bool = False, swing_legs: tuple[Part, ...] | None = None,
-               thigh: str | None = None, hip_mass: bool = True, hip_width: str | float = 0,
+               thigh: str | None = None, knee_stop: bool = False, hip_mass: bool = True,
+               hip_width: str | float = 0,
                hip_roll: bool = False, foot_radius: str | None = None,
-               coordinates: str = "absolute") -> tuple[BodyTree, CoordinateMap]:
+               coordinates: str = "absolute", free_joints: bool = False
+               ) -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
     or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
     pelvis with ``M_hip`` midway between the hips, and an upper body carrying ``torso`` held
@@ -109,7 +111,10 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     IEEE Trans. Robotics 23(1)): its pitch from the upward vertical is the mean of the legs'
     pitches (leaning back when the feet are ahead; no coordinate of its own), its roll the
     pelvis'.  In the plane every joint is a pitch about ``z``; a knee (McGeer 1990) is a
-    pitch joint on the swing leg, the stance leg straight.
+    pitch joint on the swing leg, the stance leg straight; a planar biped whose joints are
+    all free (``free_joints``: the five-link biped of Westervelt, Grizzle & Koditschek 2003
+    and the three-link walker of Grizzle, Abba & Plestan 2001) has its knee on both legs and
+    its upper body on a hinge of its own.
 
     Parameters
     ----------
@@ -125,6 +130,9 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         The swing leg's bodies when the legs differ (default ``legs``).
     thigh : str or None
         A knee this far below the swing hip [m] (a name), the ``shank`` parts on it.
+    knee_stop : bool
+        The knee has the straight-leg stop (McGeer 1990's locking knee: its angle
+        ``shank - thigh`` in ``[-pi, 0]``, :attr:`~walkerlab.walker.tree.Joint.stops`).
     hip_mass : bool
         The pelvis carries ``M_hip`` (else it is massless).
     hip_width : str or float
@@ -138,6 +146,13 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     coordinates : {"absolute", "slope_relative"}
         A planar walker's coordinates: the legs' angles from the vertical, or Garcia et
         al.'s (1998) ``stance`` from the slope's normal and ``hip`` between the legs.
+    free_joints : bool
+        Planar, every joint free (:mod:`walkerlab.codegen.free_joints`' coordinates: every
+        link's absolute angle, ``stance_shank, stance_thigh, swing_thigh, swing_shank``
+        with a knee, else ``stance, swing``, then ``torso``): with ``thigh`` the stance leg
+        a shank ``stance_shank`` at the foot and a thigh ``stance_leg`` on the knee
+        ``stance_knee``; the upper body's pitch the coordinate ``torso`` (from the upward
+        vertical, leaning back) in place of the legs' mean.
 
     Returns
     -------
@@ -157,16 +172,29 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = (
         _PLANAR_HIPS if planar else _HIPS_3D)
     half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
-    bodies = _stance_foot(R, planar) + _welded("stance_leg", legs, (0, up_leg, 0))  # at its hip
+    stance_knee = free_joints and thigh is not None
+    foot_body = "stance_shank" if stance_knee else "stance_leg"
+    bodies = _stance_foot(R, planar, foot_body)
+    if stance_knee:   # the shank's parts on the shank, the thigh's on the thigh, at its hip
+        bodies += _welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
+                          (0, up_leg, 0))
+        bodies.append(Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                           Joint("stance_knee", "revolute", "stance_shank",
+                                 (0, f"{up_leg} - {thigh}", 0), (Z,), ("stance_knee",))))
+        bodies += _welded("stance_leg", tuple(p for p in legs if p.link != "shank"),
+                          (0, thigh, 0))
+    else:
+        bodies += _welded("stance_leg", legs, (0, up_leg, 0))  # at its hip
     bodies.append(Body("pelvis", "M_hip" if hip_mass else 0,
                        diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
                        (0, 0, half),
-                       Joint(hip, kind, "stance_leg", (0, up_leg, 0), axes, names)))
+                       Joint(hip, kind, "stance_leg", (0, thigh if stance_knee else up_leg, 0),
+                             axes, names)))
     bodies.append(Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
                        Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
                              swing_names)))
     swing_bodies, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh,
-                                         up_leg, R)
+                                         up_leg, R, knee_stop)
     bodies += swing_bodies
     if torso:
         bodies.append(Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
@@ -174,9 +202,10 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
                                  ("torso_pitch",))))
         bodies += _welded("torso", torso, up=True)
     tree = BodyTree(params, Root(), tuple(bodies),
-                    (ContactPoint("stance_foot", "stance_leg" if R is None else
+                    (ContactPoint("stance_foot", foot_body if R is None else
                                   "stance_travel", (0, 0, 0)), swing_end))
-    return tree, _coordinates(planar, thigh is not None, hip_roll, R, bool(torso), coordinates)
+    return tree, _coordinates(planar, thigh is not None, hip_roll, R, bool(torso), coordinates,
+                              free_joints)
 
 
 #: the hips' joints (name, kind, axes, coordinates), stance then swing: in the plane the
@@ -202,17 +231,19 @@ def _welded(link: str, parts: tuple[Part, ...], origin: tuple = (0, 0, 0), *,
             for p in parts]
 
 
-def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str | None
-               ) -> tuple[list, ContactPoint]:
+def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str | None,
+               knee_stop: bool = False) -> tuple[list, ContactPoint]:
     """The swing leg's parts (on a knee ``thigh`` below the hip: the thigh's on the leg, the
-    shank's on the shank) and its foot's contact point (a round foot's centre)."""
+    shank's on the shank; ``knee_stop``: the knee's straight-leg stop) and its foot's
+    contact point (a round foot's centre)."""
     to_foot = "-L" if R is None else f"-({up_leg})"
     on_thigh = [p for p in swing if thigh is None or p.link != "shank"]
     bodies, foot_link = _welded("swing_leg", tuple(on_thigh)), "swing_leg"
     if thigh is not None:  # the swing knee, ``thigh`` below the hip; the shank's parts on it
         bodies.append(Body("swing_shank", 0, ZERO_INERTIA, (0, 0, 0),
                            Joint("swing_knee", "revolute", "swing_leg", (0, f"-{thigh}", 0),
-                                 (Z,), ("swing_knee",))))
+                                 (Z,), ("swing_knee",),
+                                 (("-pi", 0),) if knee_stop else ())))
         bodies += _welded("swing_shank", tuple(p for p in swing if p.link == "shank"),
                           below=thigh)
         foot_link = "swing_shank"
@@ -222,9 +253,16 @@ def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str |
 
 
 def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
-                 coordinates: str) -> CoordinateMap:
-    """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`)."""
-    if coordinates == "slope_relative":  # Garcia et al. (1998): theta, and phi between legs
+                 coordinates: str, free: bool = False) -> CoordinateMap:
+    """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`;
+    ``free``: every joint free, :mod:`walkerlab.codegen.free_joints`' coordinates)."""
+    ankle = None          # the stance shank's angle, on a stance knee
+    if free:
+        names = (("stance_shank", "stance_thigh", "swing_thigh", "swing_shank") if knee
+                 else ("stance", "swing")) + (("torso",) if torso else ())
+        swing, stance = ("swing_thigh", "stance_thigh") if knee else ("swing", "stance")
+        ankle = "stance_shank" if knee else None
+    elif coordinates == "slope_relative":  # Garcia et al. (1998): theta, and phi between legs
         names, swing, stance = ("stance", "hip"), "stance - hip - gamma", "stance - gamma"
     elif knee:
         names, swing, stance = ("swing_thigh", "swing_shank", "stance"), "swing_thigh", "stance"
@@ -235,25 +273,29 @@ def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso:
     pelvis_roll, swing_roll = ("pelvis_roll", "swing_roll") if hip_roll else ("lean", "lean")
     rolls = () if planar else (("stance_ankle_roll", "lean"),)
     angles = ((("stance_travel", f"-{R} * ({stance} + gamma)"),) if R is not None else ()) + (
-        rolls + (("stance_ankle_pitch", f"{stance} + gamma"),
+        rolls + (("stance_ankle_pitch", f"{ankle or stance} + gamma"),
                  ("stance_hip_pitch", f"-({stance} + gamma)")))
+    if ankle:   # the stance thigh turned from the shank
+        angles += (("stance_knee", f"{stance} - {ankle}"),)
     if not planar:
         angles += (("stance_hip_roll", f"{pelvis_roll} - lean"),
                    ("swing_hip_roll", f"{swing_roll} - {pelvis_roll}"))
     angles += (("swing_hip_pitch", f"{swing} + gamma"),)
     if knee:
         angles += (("swing_knee", "swing_shank - swing_thigh"),)
-    if torso:
-        angles += (("torso_pitch", f"({swing} + {stance}) / 2 + gamma"),)
+    if torso:   # hinged, or the bisecting hip: the legs' mean
+        angles += (("torso_pitch", "torso + gamma" if free else
+                    f"({swing} + {stance}) / 2 + gamma"),)
     return CoordinateMap(names, angles)
 
 
-def _stance_foot(R: str | None, planar: bool = False) -> list:
-    """The stance leg's frame on the slope: on a universal ankle (roll, then pitch; in the
-    plane the pitch alone) at a point foot, or on the rolling disc of radius ``R`` (a slide
-    along the fall line, the roll, the pitch about the disc's centre)."""
+def _stance_foot(R: str | None, planar: bool = False, leg: str = "stance_leg") -> list:
+    """The stance leg's frame ``leg`` (its shank's, on a stance knee) on the slope: on a
+    universal ankle (roll, then pitch; in the plane the pitch alone) at a point foot, or on
+    the rolling disc of radius ``R`` (a slide along the fall line, the roll, the pitch about
+    the disc's centre)."""
     if R is None:
-        return [Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+        return [Body(leg, 0, ZERO_INERTIA, (0, 0, 0),
                      Joint("stance_ankle", "revolute", "slope", (0, 0, 0), (Z,),
                            ("stance_ankle_pitch",)) if planar else
                      Joint("stance_ankle", "universal", "slope", (0, 0, 0), (S, Z),
@@ -262,14 +304,14 @@ def _stance_foot(R: str | None, planar: bool = False) -> list:
                   Joint("stance_roll_travel", "prismatic", "slope", (0, 0, 0), (S,),
                         ("stance_travel",)))
     if planar:
-        return [travel, Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+        return [travel, Body(leg, 0, ZERO_INERTIA, (0, 0, 0),
                              Joint("stance_ankle_pitch", "revolute", "stance_travel",
                                    (0, R, 0), (Z,), ("stance_ankle_pitch",)))]
     return [travel,
             Body("stance_roll", 0, ZERO_INERTIA, (0, 0, 0),
                  Joint("stance_ankle_roll", "revolute", "stance_travel", (0, 0, 0), (S,),
                        ("stance_ankle_roll",))),
-            Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+            Body(leg, 0, ZERO_INERTIA, (0, 0, 0),
                  Joint("stance_ankle_pitch", "revolute", "stance_roll", (0, R, 0), (Z,),
                        ("stance_ankle_pitch",)))]
 
@@ -309,7 +351,9 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     e_torso_<name>][, I_torso_<name>]``, a knee ``L_thigh`` below the hip, round feet
     ``R_foot``), or the 3D ``model: compass_gait`` shorthand (one mass ``m_leg`` on each leg
     ``a_leg`` from its foot, a rod's ``I_leg``), with the hip width ``w_hip`` and the
-    hip-roll joints as the structure has them.
+    hip-roll joints as the structure has them; a planar biped whose joints are all free
+    (free knees, a hinged torso: ``free_joints``) with its stance knee and its torso's
+    coordinate.
 
     Returns
     -------
@@ -319,14 +363,12 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     ------
     ValueError
         A part a tree does not carry yet, naming its field: a massless body (the mass -> 0
-        limit, Garcia et al. 1998), flat feet, free knees, a hinged torso, spokes.
+        limit, Garcia et al. 1998), flat feet, spokes.
     """
     planar = not structure.in_3d
     if planar:
-        for flag, field in (("spokes", "walker.spokes"), ("free_knees", "walker.leg.knee"),
-                            ("hinged_torso", "walker.torso.joint")):
-            if getattr(structure, flag):
-                raise ValueError(f"{field}: a body tree of this walker is not built yet")
+        if structure.spokes:
+            raise ValueError("walker.spokes: a body tree of this walker is not built yet")
         if structure.foot == "flat":
             raise ValueError("walker.leg.foot.kind: flat: a body tree of flat feet is not "
                              "built yet")
@@ -351,11 +393,13 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
         swing, torso = None, ()
     return biped_tree(structure.param_names, legs, torso, planar=planar, swing_legs=swing,
                       thigh="L_thigh" if structure.knee else None,
+                      knee_stop=structure.knee and not structure.free_knees,
                       hip_mass=structure.hip_mass,
                       hip_width="w_hip" if structure.hip_width else 0,
                       hip_roll=structure.hip_roll,
                       foot_radius="R_foot" if structure.foot == "arc" else None,
-                      coordinates=structure.coordinates)
+                      coordinates=structure.coordinates,
+                      free_joints=planar and (structure.free_knees or structure.hinged_torso))
 
 
 def spoked_wheel_3d_tree(spokes: int | None = None) -> tuple[BodyTree, CoordinateMap]:
