@@ -409,26 +409,7 @@ def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
     pelvis = tree.body(roles.pelvis)
     Q = ev.frame(roles.pelvis)
     hip = sp.Matrix([ev.sym(v) for v in tree.body(roles.leg).joint.origin_m]) / 2
-    axes = {c: (axis, angle) for c, axis, angle, _ in _joint_axes(ev, tree, roles.pelvis)}
-    unknown = sorted(set(roles.pelvis_hinges) - set(axes))
-    if unknown:
-        raise ValueError(f"roles.pelvis_hinges: {', '.join(unknown)} not a coordinate of "
-                         f"{roles.pelvis!r}'s joint")
-    names_of = dict(roles.joint_names)
-    slides = roles.slides or tuple(
-        (f"{roles.pelvis}_{c}", ax, "") for c, ax in
-        (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0))))
-    about = None
-    if roles.pelvis_hinges or roles.slides:
-        joints = [ExportJoint(n, "slide", ax, link=link) for n, ax, link in slides]
-        joints += [ExportJoint(names_of.get(c, c), "hinge", tuple(ev.vector(axes[c][0])),
-                               _absolute_angle(ev, tree, roles.pelvis, c))
-                   for c in roles.pelvis_hinges]
-        if roles.pelvis_hinges:
-            hinge, *more = roles.pelvis_hinges      # a root turning about one axis only
-            about = None if more else axes[hinge][0]
-    else:
-        joints = [ExportJoint("free", "free")]
+    joints, about = _root_joints(ev, tree, roles)
     swap = {ev.names[a]: ev.names.get(b, sp.Symbol(b)) for a, b in roles.stance_roles
             if a in ev.names}
     body_names = dict(roles.body_names)
@@ -456,6 +437,38 @@ def export_bodies(tree: BodyTree, coords: CoordinateMap, values: dict,
                       ev.vector(Q * (sp.Matrix([ev.sym(v) for v in pelvis.com_m]) - hip)),
                       _inertia(ev, roles.pelvis, Q, about), tuple(children))
     return root, _couplings(ev, root)
+
+
+def _root_joints(ev: _Evaluator, tree: BodyTree, roles: PelvisRoles) -> tuple[list, object]:
+    """The export root's joints (:func:`export_bodies`): a free joint, or slides
+    (``roles.slides``, default along x, y, z) and the hinges ``roles.pelvis_hinges`` on the
+    pelvis' own joint coordinates; and the one axis the root turns about (its moment about
+    it carried about every axis), None when it is free or turns about several.
+
+    Raises
+    ------
+    ValueError
+        A pelvis hinge not a coordinate of the pelvis' joint.
+    """
+    axes = {c: (axis, angle) for c, axis, angle, _ in _joint_axes(ev, tree, roles.pelvis)}
+    unknown = sorted(set(roles.pelvis_hinges) - set(axes))
+    if unknown:
+        raise ValueError(f"roles.pelvis_hinges: {', '.join(unknown)} not a coordinate of "
+                         f"{roles.pelvis!r}'s joint")
+    if not (roles.pelvis_hinges or roles.slides):
+        return [ExportJoint("free", "free")], None
+    names_of = dict(roles.joint_names)
+    slides = roles.slides or tuple(
+        (f"{roles.pelvis}_{c}", ax, "") for c, ax in
+        (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0))))
+    joints = [ExportJoint(n, "slide", ax, link=link) for n, ax, link in slides]
+    joints += [ExportJoint(names_of.get(c, c), "hinge", tuple(ev.vector(axes[c][0])),
+                           _absolute_angle(ev, tree, roles.pelvis, c))
+               for c in roles.pelvis_hinges]
+    if not roles.pelvis_hinges:
+        return joints, None
+    hinge, *more = roles.pelvis_hinges      # a root turning about one axis only
+    return joints, None if more else axes[hinge][0]
 
 
 def _couplings(ev: _Evaluator, root: ExportBody) -> tuple[Coupling, ...]:

@@ -169,30 +169,11 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     """
     R = foot_radius
     up_leg = "L" if R is None else f"L - {R}"     # from the frame's origin to the hip
-    (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = (
-        _PLANAR_HIPS if planar else _HIPS_3D)
     half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
     stance_knee = free_joints and thigh is not None
-    foot_body = "stance_shank" if stance_knee else "stance_leg"
-    bodies = _stance_foot(R, planar, foot_body)
-    if stance_knee:   # the shank's parts on the shank, the thigh's on the thigh, at its hip
-        bodies += _welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
-                          (0, up_leg, 0))
-        bodies.append(Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
-                           Joint("stance_knee", "revolute", "stance_shank",
-                                 (0, f"{up_leg} - {thigh}", 0), (Z,), ("stance_knee",))))
-        bodies += _welded("stance_leg", tuple(p for p in legs if p.link != "shank"),
-                          (0, thigh, 0))
-    else:
-        bodies += _welded("stance_leg", legs, (0, up_leg, 0))  # at its hip
-    bodies.append(Body("pelvis", "M_hip" if hip_mass else 0,
-                       diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA,
-                       (0, 0, half),
-                       Joint(hip, kind, "stance_leg", (0, thigh if stance_knee else up_leg, 0),
-                             axes, names)))
-    bodies.append(Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
-                       Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
-                             swing_names)))
+    bodies, foot_body = _stance_side(legs, R, planar, up_leg, thigh if stance_knee else None)
+    bodies += _hips(_PLANAR_HIPS if planar else _HIPS_3D, thigh if stance_knee else up_leg,
+                    hip_mass, hip_roll, half, hip_width)
     swing_bodies, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh,
                                          up_leg, R, knee_stop)
     bodies += swing_bodies
@@ -206,6 +187,40 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
                                   "stance_travel", (0, 0, 0)), swing_end))
     return tree, _coordinates(planar, thigh is not None, hip_roll, R, bool(torso), coordinates,
                               free_joints)
+
+
+def _stance_side(legs: tuple[Part, ...], R: str | None, planar: bool, up_leg: str,
+                 knee: str | None) -> tuple[list, str]:
+    """The stance foot's bodies and the stance leg's (:func:`biped_tree`), and the body the
+    stance foot is on: a straight leg's parts welded at its hip, or, with a stance knee
+    ``knee`` below the hip (every joint free), the shank's parts on the shank at the foot and
+    the thigh's on the thigh ``stance_leg`` on the knee ``stance_knee``."""
+    foot_body = "stance_shank" if knee is not None else "stance_leg"
+    bodies = _stance_foot(R, planar, foot_body)
+    if knee is None:
+        return bodies + _welded("stance_leg", legs, (0, up_leg, 0)), foot_body
+    bodies += _welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
+                      (0, up_leg, 0))
+    bodies.append(Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                       Joint("stance_knee", "revolute", "stance_shank",
+                             (0, f"{up_leg} - {knee}", 0), (Z,), ("stance_knee",))))
+    return bodies + _welded("stance_leg", tuple(p for p in legs if p.link != "shank"),
+                            (0, knee, 0)), foot_body
+
+
+def _hips(joints: tuple, hip_at: str, hip_mass: bool, hip_roll: bool, half,
+          hip_width) -> list:
+    """The pelvis on the stance hip, ``hip_at`` up the stance leg's frame (``M_hip`` midway
+    between the hips; ``I_pelvis`` about the fall line with hip-roll joints), and the swing
+    leg's frame on the swing hip, ``hip_width`` along the hip axis (:func:`biped_tree`;
+    ``joints``: :data:`_PLANAR_HIPS` or :data:`_HIPS_3D`)."""
+    (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = joints
+    return [Body("pelvis", "M_hip" if hip_mass else 0,
+                 diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA, (0, 0, half),
+                 Joint(hip, kind, "stance_leg", (0, hip_at, 0), axes, names)),
+            Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
+                       swing_names))]
 
 
 #: the hips' joints (name, kind, axes, coordinates), stance then swing: in the plane the
