@@ -100,21 +100,17 @@ class Part:
 def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Part, ...] = (),
                *, planar: bool = False, swing_legs: tuple[Part, ...] | None = None,
                thigh: str | None = None, knee_stop: bool = False, hip_mass: bool = True,
-               hip_width: str | float = 0,
-               hip_roll: bool = False, foot_radius: str | None = None,
-               coordinates: str = "absolute", free_joints: bool = False
+               hip_width: str | float = 0, hip_roll: bool = False, foot_radius: str | None =
+               None, coordinates: str = "absolute", free_joints: bool = False
                ) -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
     or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
     pelvis with ``M_hip`` midway between the hips, and an upper body carrying ``torso`` held
     on the bisector of the legs by a bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007,
-    IEEE Trans. Robotics 23(1)): its pitch from the upward vertical is the mean of the legs'
-    pitches (leaning back when the feet are ahead; no coordinate of its own), its roll the
-    pelvis'.  In the plane every joint is a pitch about ``z``; a knee (McGeer 1990) is a
-    pitch joint on the swing leg, the stance leg straight; a planar biped whose joints are
-    all free (``free_joints``: the five-link biped of Westervelt, Grizzle & Koditschek 2003
-    and the three-link walker of Grizzle, Abba & Plestan 2001) has its knee on both legs and
-    its upper body on a hinge of its own.
+    IEEE Trans. Robotics 23(1)): its pitch from the upward vertical the mean of the legs'
+    (no coordinate of its own), its roll the pelvis'.  In the plane every joint is a pitch
+    about ``z``; a knee (McGeer 1990) is a pitch joint on the swing leg, the stance leg
+    straight (``free_joints``: on both).
 
     Parameters
     ----------
@@ -147,46 +143,40 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         A planar walker's coordinates: the legs' angles from the vertical, or Garcia et
         al.'s (1998) ``stance`` from the slope's normal and ``hip`` between the legs.
     free_joints : bool
-        Planar, every joint free (:mod:`walkerlab.codegen.free_joints`' coordinates: every
-        link's absolute angle, ``stance_shank, stance_thigh, swing_thigh, swing_shank``
-        with a knee, else ``stance, swing``, then ``torso``): with ``thigh`` the stance leg
-        a shank ``stance_shank`` at the foot and a thigh ``stance_leg`` on the knee
-        ``stance_knee``; the upper body's pitch the coordinate ``torso`` (from the upward
-        vertical, leaning back) in place of the legs' mean.
+        Planar, every joint free (the five-link biped of Westervelt, Grizzle & Koditschek
+        2003, the three-link walker of Grizzle, Abba & Plestan 2001; the coordinates of
+        :mod:`walkerlab.codegen.free_joints`: every link's absolute angle, ``stance_shank,
+        stance_thigh, swing_thigh, swing_shank`` with a knee, else ``stance, swing``, then
+        ``torso``): with ``thigh`` the stance leg a shank ``stance_shank`` at the foot and a
+        thigh ``stance_leg`` on the knee ``stance_knee``; the upper body's pitch the
+        coordinate ``torso`` (from the upward vertical, leaning back) in place of the legs'.
 
     Returns
     -------
     BodyTree, CoordinateMap
-        Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (``swing_shank``, ``torso``), each
-        part ``<link>_<part>``; contacts ``stance_foot``, ``swing_foot`` (round feet: the
-        disc's centre ``swing_foot_centre``); coordinates as ``planar`` says, 3D ``lean,
-        swing, stance`` (and ``pelvis_roll, swing_roll``).
+        Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (``swing_shank``, ``torso``), each part
+        ``<link>_<part>``; contacts ``stance_foot``, ``swing_foot`` (round feet: the disc's
+        centre ``swing_foot_centre``); coordinates as ``planar`` says, 3D ``lean, swing,
+        stance`` (and ``pelvis_roll, swing_roll``).
 
     Raises
     ------
     ValueError
         The tree does not validate (:class:`~walkerlab.walker.tree.BodyTree`).
     """
-    R = foot_radius
-    up_leg = "L" if R is None else f"L - {R}"     # from the frame's origin to the hip
-    half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
-    stance_knee = free_joints and thigh is not None
-    bodies, foot_body = _stance_side(legs, R, planar, up_leg, thigh if stance_knee else None)
-    bodies += _hips(_PLANAR_HIPS if planar else _HIPS_3D, thigh if stance_knee else up_leg,
-                    hip_mass, hip_roll, half, hip_width)
-    swing_bodies, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh,
-                                         up_leg, R, knee_stop)
-    bodies += swing_bodies
-    if torso:
-        bodies.append(Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
-                           Joint("torso_pitch", "revolute", "pelvis", (0, 0, half), (Z,),
-                                 ("torso_pitch",))))
-        bodies += _welded("torso", torso, up=True)
+    up_leg = "L" if foot_radius is None else f"L - {foot_radius}"   # the frame's origin to hip
+    knee = thigh if free_joints else None               # a stance knee this far below the hip
+    bodies, foot_body = _stance_side(legs, foot_radius, planar, up_leg, knee)
+    bodies += _hips(_PLANAR_HIPS if planar else _HIPS_3D, knee or up_leg, hip_mass, hip_roll,
+                    hip_width)
+    swing, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh, up_leg,
+                                  foot_radius, knee_stop)
+    bodies += swing + _torso(torso, hip_width)
     tree = BodyTree(params, Root(), tuple(bodies),
-                    (ContactPoint("stance_foot", foot_body if R is None else
+                    (ContactPoint("stance_foot", foot_body if foot_radius is None else
                                   "stance_travel", (0, 0, 0)), swing_end))
-    return tree, _coordinates(planar, thigh is not None, hip_roll, R, bool(torso), coordinates,
-                              free_joints)
+    return tree, _coordinates(planar, thigh is not None, hip_roll, foot_radius, bool(torso),
+                              coordinates, free_joints)
 
 
 def _stance_side(legs: tuple[Part, ...], R: str | None, planar: bool, up_leg: str,
@@ -208,19 +198,31 @@ def _stance_side(legs: tuple[Part, ...], R: str | None, planar: bool, up_leg: st
                             (0, knee, 0)), foot_body
 
 
-def _hips(joints: tuple, hip_at: str, hip_mass: bool, hip_roll: bool, half,
-          hip_width) -> list:
+def _hips(joints: tuple, hip_at: str, hip_mass: bool, hip_roll: bool, hip_width) -> list:
     """The pelvis on the stance hip, ``hip_at`` up the stance leg's frame (``M_hip`` midway
-    between the hips; ``I_pelvis`` about the fall line with hip-roll joints), and the swing
+    between the hips; ``I_pelvis`` about the fall line with hip-roll joints), the swing
     leg's frame on the swing hip, ``hip_width`` along the hip axis (:func:`biped_tree`;
     ``joints``: :data:`_PLANAR_HIPS` or :data:`_HIPS_3D`)."""
     (hip, kind, axes, names), (swing_hip, swing_kind, swing_axes, swing_names) = joints
-    return [Body("pelvis", "M_hip" if hip_mass else 0,
-                 diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA, (0, 0, half),
-                 Joint(hip, kind, "stance_leg", (0, hip_at, 0), axes, names)),
-            Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
-                 Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
-                       swing_names))]
+    half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
+    out = [Body("pelvis", "M_hip" if hip_mass else 0,
+                diagonal("I_pelvis", 0, 0) if hip_roll else ZERO_INERTIA, (0, 0, half),
+                Joint(hip, kind, "stance_leg", (0, hip_at, 0), axes, names)),
+           Body("swing_leg", 0, ZERO_INERTIA, (0, 0, 0),
+                Joint(swing_hip, swing_kind, "pelvis", (0, 0, hip_width), swing_axes,
+                      swing_names))]
+    return out
+
+
+def _torso(torso: tuple[Part, ...], hip_width) -> list:
+    """An upper body carrying ``torso`` on its pitch joint midway between the hips
+    (:func:`biped_tree`; none without parts)."""
+    if not torso:
+        return []
+    half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
+    return [Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint("torso_pitch", "revolute", "pelvis", (0, 0, half), (Z,),
+                       ("torso_pitch",))), *_welded("torso", torso, up=True)]
 
 
 #: the hips' joints (name, kind, axes, coordinates), stance then swing: in the plane the
