@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.test_parts_3d import _guess, _walker  # the same walker and guess readers
 from walkerlab.config import scene_from_dict
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -49,19 +50,6 @@ def _kneed_in_3d(width: float) -> dict:
         raw.pop(key, None)
     raw["walker"] = {**raw["walker"], "space": "3d", "hip_width_m": width}
     return raw
-
-
-def _walker(scene: Scene):
-    from walkerlab.models.registry import build_walker
-    from walkerlab.walker.plant import Plant
-
-    return build_walker(scene, plant=Plant.from_scene(scene))
-
-
-def _guess(scene: Scene, names) -> np.ndarray:
-    g = scene.fixedpoint.initial_guess.model_extra
-    return np.array([g.get(n + ("_rad" if n.endswith("_angle") else "_rad_per_s"), 0.0)
-                     for n in names])
 
 
 # --- the scene's check and the kind (quick) -------------------------------------------------
