@@ -26,7 +26,11 @@ import numpy as np
 import pytest
 import yaml
 
-from tests.test_parts_3d import _guess, _walker  # the same walker and guess readers
+from tests.test_parts_3d import (  # the same walker, guess and planar-embedding checks
+    _guess,
+    _planar_embedding,
+    _walker,
+)
 from walkerlab.config import scene_from_dict
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -145,19 +149,8 @@ def test_the_kneed_walker_in_3d_with_zero_hip_width_walks_the_planar_kneed_gait(
     flat = _walker(flat_scene)
     f = find_fixed_point(flat, _guess(flat_scene, flat.state_names()), SOLVER,
                          fd_check=False)
-    w3 = _walker(Scene.model_validate(_kneed_in_3d(0.0)))
-    names = w3.state_names()
-    planar = dict(zip(flat.state_names(), f.x))
-    s = find_fixed_point(w3, np.array([planar.get(n, 0.0) for n in names]), SOLVER,
-                         fd_check=False)
-    x3 = dict(zip(names, s.x))
-    for name, value in planar.items():
-        assert abs(x3[name] - value) <= 1e-9 * abs(value), name
-    assert abs(x3["lean_angle"]) < 1e-12 and abs(x3["lean_rate"]) < 1e-12
-    assert abs(s.period_s - f.period_s) <= 1e-9 * f.period_s
-    for m in f.multipliers_variational:
-        if abs(m) > 1e-6:
-            assert np.min(np.abs(s.multipliers_variational - m)) < 1e-7, m
+    s = _planar_embedding(flat, f, _walker(Scene.model_validate(_kneed_in_3d(0.0))),
+                          tiny=1e-6)
     print(f"planar step period {f.period_s:.12f} s, 3D {s.period_s:.12f} s; multipliers "
           f"3D {np.round(np.abs(s.multipliers_variational), 6)}")
 
