@@ -157,43 +157,35 @@ class Scene(Strict):
             raise ValueError(why)
         return self
 
+    def _legs(self) -> tuple:
+        """The walker's two legs (a biped's ``leg_pair``: its ``legs``, or ``leg`` twice), or
+        ``()`` for a walker without legs (the rimless wheels)."""
+        pair = getattr(self.walker, "leg_pair", None)
+        return pair() if pair is not None else ()
+
     @model_validator(mode="after")
-    def _knee_stop_needs_a_knee(self) -> Scene:
-        # a latch that cannot act is a mistake, as an unknown key is: an error,
-        # not a warning, so a latch the user counts on is never silently absent (the stop's
+    def _contact_fits_the_walker(self) -> Scene:
+        # a contact number that cannot act is a mistake, as an unknown key is: an error, not
+        # a warning, so a number the user counts on is never silently absent (the stop's
         # other numbers have defaults and are dumped with every scene: not checked)
         c = self.contact
-        if c is None or not c.knee_stop.latch:
+        if c is None:
             return self
-        pair = getattr(self.walker, "leg_pair", None)  # a biped's legs (or its leg, twice)
-        leg = pair()[0] if pair is not None else None
-        if leg is None or leg.knee is None:
+        legs = self._legs()
+        if c.knee_stop.latch and (not legs or legs[0].knee is None):
             raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
                              "walker.leg.knee), so there is no knee to latch: remove it or "
                              "give the leg a knee")
-        return self
-
-    @model_validator(mode="after")
-    def _twist_needs_3d(self) -> Scene:
-        # a number that cannot act is a mistake (as the knee latch above): a planar walker's
-        # feet turn in its plane only, and its contact carries no moment about the normal
-        c = self.contact
-        if (c is not None and c.torsional_friction_m is not None
-                and getattr(self.walker, "space", "2d") != "3d"):
+        # a planar walker's feet turn in its plane only, and its contact carries no moment
+        # about the normal
+        if c.torsional_friction_m is not None and getattr(self.walker, "space", "2d") != "3d":
             raise ValueError("contact.torsional_friction_m: a planar walker's feet hold no "
                              "moment about the ground's normal (they turn in its plane "
                              "only): remove it, or give the walker walker.space: 3d")
-        return self
-
-    @model_validator(mode="after")
-    def _one_foot_mass(self) -> Scene:
         # feet with mass (walker.leg.foot.mass_kg) are the same feet in every view: the
         # contact section's regularising foot mass would be a second, different foot
-        c = self.contact
-        foot = getattr(getattr(self.walker, "leg", None), "foot", None)
-        if foot is None and getattr(self.walker, "legs", None):
-            foot = self.walker.legs[0].foot
-        if (c is not None and getattr(foot, "kind", "") == "flat" and foot.mass() is not None
+        foot = legs[0].foot if legs else None
+        if (getattr(foot, "kind", "") == "flat" and foot.mass() is not None
                 and (c.flat_foot_mass_kg is not None or c.flat_foot_inertia_kg_m2 is not None)):
             raise ValueError("contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the "
                              "walker's feet carry their own mass (walker.leg.foot.mass_kg, "
@@ -221,8 +213,7 @@ class Scene(Strict):
         """
         if self.terrain is not None:
             return self.terrain
-        pair = getattr(self.walker, "leg_pair", None)
-        feet = [getattr(leg, "foot", None) for leg in pair()] if pair is not None else []
+        feet = [getattr(leg, "foot", None) for leg in self._legs()]
         soles = [f.heel_m + f.toe_m for f in feet if getattr(f, "kind", "") == "flat"]
         if soles:
             return TerrainSettings(patch_width_m=FLAT_FOOT_PATCH_SOLES * max(soles))
