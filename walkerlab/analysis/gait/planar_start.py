@@ -43,7 +43,7 @@ from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.registry import build_walker
-from walkerlab.walker.planar import CONTACT_ONLY_IN_3D, planar_twin
+from walkerlab.walker.planar import CONTACT_ONLY_IN_3D, PlanarTwin, planar_twin
 from walkerlab.walker.plant import Plant
 
 __all__ = ["PlanarStart", "planar_start", "planar_fallback", "embed", "carry_width",
@@ -196,15 +196,17 @@ def carry_width(make, x0: np.ndarray, w0: float, w1: float, solver: Solver,
     return res.x, points
 
 
-def planar_start(scene: Scene, walker: HybridWalker, solver: Solver) -> PlanarStart | None:
+def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: Solver
+                 ) -> PlanarStart | None:
     """A start for the 3D scene's root finder from its planar twin's gait (module
-    docstring), or None (a planar walker, a 3D one without a twin, a twin without a gait,
-    or a width continuation that stalled).
+    docstring), or None (a twin without a gait, or a width continuation that stalled).
 
     Parameters
     ----------
     scene : Scene
         A 3D walker's scene (``walker.space: 3d``).
+    twin : walkerlab.walker.planar.PlanarTwin
+        Its walker's planar twin (:func:`walkerlab.walker.planar.planar_twin`).
     walker, solver
         The scene's rigid walker and integrator.
 
@@ -212,9 +214,6 @@ def planar_start(scene: Scene, walker: HybridWalker, solver: Solver) -> PlanarSt
     -------
     PlanarStart or None
     """
-    twin = planar_twin(scene.walker)
-    if twin is None:
-        return None
     try:
         twin_scene = _twin_scene(scene, twin.walker)
     except (SceneError, ValueError):
@@ -257,9 +256,8 @@ def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver
 
     Parameters
     ----------
-    scene : Scene
-    walker, solver
-        The scene's rigid walker and integrator.
+    scene, walker, solver
+        As :func:`planar_start`'s (a walker of either space).
 
     Returns
     -------
@@ -273,7 +271,7 @@ def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver
     fb = FallbackStart(label, "planar_twin", None)
 
     def find():
-        start = planar_start(scene, walker, solver)
+        start = planar_start(scene, twin, walker, solver)
         if start is None:
             return None
         fb.unique = start.unique
