@@ -16,7 +16,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_serializer, model_validator
 
-from walkerlab.config.base import Strict, drop_unset
+from walkerlab.config.base import Strict, check_one_of, drop_unset, one_of
 
 #: a reference table's angle [rad]: within two turns of zero (a joint or stance-leg angle
 #: beyond that is no posture, and an unbounded one overflows the spline)
@@ -53,8 +53,8 @@ class _JointTable(Strict):
         # one of the value fields, as long as the abscissa (``phase_rad``: the table's
         # abscissa, whichever field holds it), which increases
         name, abscissa = self._ABSCISSA, self.phase_rad
-        if (self.hip_angle_rad is None) == (self.angle_rad is None):
-            raise ValueError("give hip_angle_rad or angle_rad (one of them)")
+        check_one_of(self, "hip_angle_rad", "angle_rad",
+                     "give hip_angle_rad or angle_rad (one of them)")
         if len(abscissa) != len(self.values_rad):
             field = "hip_angle_rad" if self.hip_angle_rad is not None else "angle_rad"
             raise ValueError(f"{name} and {field} need the same length")
@@ -295,11 +295,7 @@ class BezierOutput(Strict):
     bezier_rad: list[TableAngle] = Field(min_length=4, max_length=21, description="Bezier "
                                          "coefficients c_0..c_M (M >= 3) [rad]")
 
-    @model_validator(mode="after")
-    def _one(self) -> BezierOutput:
-        if (self.link is None) == (self.joint is None):
-            raise ValueError("give link or joint (one of them)")
-        return self
+    _one = one_of("link", "joint", "give link or joint (one of them)")
 
     @property
     def name(self) -> str:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict
+from pydantic import BaseModel, BeforeValidator, ConfigDict, model_validator
 
 
 class Strict(BaseModel):
@@ -50,3 +50,53 @@ def drop_unset(d, keys):
             if d.get(k, 0) is None:
                 d.pop(k)
     return d
+
+
+def check_one_of(model, first: str, second: str, message: str):
+    """``model``, of whose fields ``first`` and ``second`` exactly one is given (not None).
+
+    The rule of a section that takes one quantity in either of two fields (a slope in
+    radians or in degrees, an output on a link or on a joint, a leg given once or a pair).
+
+    Parameters
+    ----------
+    model : pydantic.BaseModel
+        A validated section.
+    first, second : str
+        Its two fields' names.
+    message : str
+        The error's one line (naming the fields).
+
+    Returns
+    -------
+    pydantic.BaseModel
+        ``model`` itself.
+
+    Raises
+    ------
+    ValueError
+        Both fields given, or neither: ``message``.
+    """
+    if (getattr(model, first) is None) == (getattr(model, second) is None):
+        raise ValueError(message)
+    return model
+
+
+def one_of(first: str, second: str, message: str):
+    """:func:`check_one_of` as a section's after-validator, assigned in its class body
+    (``_one = one_of("link", "joint", "give link or joint (one of them)")``).
+
+    Parameters
+    ----------
+    first, second, message : str
+        As :func:`check_one_of`'s.
+
+    Returns
+    -------
+    object
+        The validator (pydantic's decorator proxy), collected by the class.
+    """
+    def check(self):
+        return check_one_of(self, first, second, message)
+
+    return model_validator(mode="after")(check)

@@ -30,7 +30,7 @@ from pydantic import (
     model_validator,
 )
 
-from walkerlab.config.base import Strict, drop_unset
+from walkerlab.config.base import Strict, drop_unset, one_of
 from walkerlab.config.contact import ContactSettings
 from walkerlab.config.contact_sim import ContactSimSettings
 from walkerlab.config.errors import SceneError, format_error
@@ -73,11 +73,8 @@ class SlopeSettings(Strict):
                                     description="slope [rad]")
     angle_deg: float | None = Field(None, gt=-90, lt=90, description="slope [deg]")
 
-    @model_validator(mode="after")
-    def _exactly_one(self) -> SlopeSettings:
-        if (self.angle_rad is None) == (self.angle_deg is None):
-            raise ValueError("slope: give exactly one of angle_rad or angle_deg")
-        return self
+    _exactly_one = one_of("angle_rad", "angle_deg",
+                          "slope: give exactly one of angle_rad or angle_deg")
 
     @property
     def phi_rad(self) -> float:

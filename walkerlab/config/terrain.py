@@ -13,7 +13,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, Field, model_serializer, model_validator
 
-from walkerlab.config.base import _list_to_tuple, drop_unset
+from walkerlab.config.base import _list_to_tuple, check_one_of, drop_unset
 
 __all__ = ["GROUND_KINDS", "LANE_KINDS", "PerStepTerrain", "TerrainSettings", "check_profile"]
 
@@ -192,9 +192,8 @@ class TerrainSettings(BaseModel):
                 raise ValueError("terrain.foothold_*: finite heights [m] and slopes within "
                                  "(-pi/2, pi/2) [rad]")
         if self.kind == "profile":
-            if (self.profile_m is None) == (self.profile_csv is None):
-                raise ValueError("terrain.profile_m: kind: profile needs profile_m or "
-                                 "profile_csv (one of them)")
+            check_one_of(self, "profile_m", "profile_csv", "terrain.profile_m: kind: profile "
+                         "needs profile_m or profile_csv (one of them)")
             if self.profile_m is not None:
                 check_profile(self.profile_m, "terrain.profile_m")
         return self

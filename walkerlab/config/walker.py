@@ -15,7 +15,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Discriminator, Field, Tag, model_serializer, model_validator
 
 from walkerlab.config.actuation import Actuation
-from walkerlab.config.base import Strict, drop_unset
+from walkerlab.config.base import Strict, check_one_of, drop_unset
 from walkerlab.config.biped_parts import LegSpec, SpringSpec, TorsoSpec
 from walkerlab.config.wheel import RimlessWheelParams
 
@@ -222,8 +222,8 @@ class BipedParams(_Actuated):
 
     @model_validator(mode="after")
     def _has_mass(self) -> BipedParams:
-        if (self.leg is None) == (self.legs is None):
-            raise ValueError("give either 'leg' (both legs identical) or 'legs' (a pair)")
+        check_one_of(self, "leg", "legs",
+                     "give either 'leg' (both legs identical) or 'legs' (a pair)")
         pair = self.leg_pair()
         if self.legs is not None:
             a, b = pair
