@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.bench.optimize import paired_text
 from walkerlab.walker.plant import Plant
 
 __all__ = ["bench_design", "bench_design_process", "bench_hzd", "lines"]
@@ -305,22 +306,26 @@ def _design_lines(res: dict) -> list[str]:
 def _process_lines(p: dict | None) -> list[str]:
     if not p:
         return []
-    ok = "met" if p["wall_ratio"]["median"] <= p["target_ratio"] else "NOT MET"
-    w, s = p["walkerlab"], p["script"]
     return [f"hzd: three-link design as a whole process (walkerlab optimize --force, warm) "
-            f"{p['wall_s']['median']:.2f} s wall, {p['cpu_s']['median']:.2f} s CPU against "
-            f"the minimal script from the same start {p['script_wall_s']['median']:.2f} s, "
-            f"{p['script_cpu_s']['median']:.2f} s: {p['wall_ratio']['median']:.2f}x wall "
-            f"[{p['wall_ratio']['min']:.2f}, {p['wall_ratio']['max']:.2f}], "
-            f"{p['cpu_ratio']['median']:.2f}x CPU (medians of {p['pairs']} pairs in turn; "
-            f"target <= {p['target_ratio']:.0f}x: {ok}); optima: walkerlab {w['status']} "
-            f"{w['objective']:.10g} in {w['iterations']}, script {s['status']} "
-            f"{s['objective']:.10g} in {s['iterations']}"]
+            f"against the minimal script from the same start, {p['pairs']} pairs in turn: "
+            f"{paired_text(p)}",
+            f"hzd: whole process: {_optima(p['walkerlab'], p['script'])}"]
+
+
+def _optima(w: dict, s: dict) -> str:
+    """Both sides' optima as text: IPOPT's status and iterations, the objective [N^2 m s],
+    ``delta^2`` (where measured) and the step period [s] of walkerlab's (``w``) and the
+    script's (``s``)."""
+    def side(o):
+        d2 = f", delta^2 {o['delta2']:.10g}" if "delta2" in o else ""
+        return (f"{o['status']} in {o['iterations']} iterations, objective "
+                f"{o['objective']:.10g} N^2 m s{d2}, period {o['period_s']:.10g} s")
+
+    return f"optima: walkerlab {side(w)}; script {side(s)}"
 
 
 def _build_solve_lines(d: dict) -> list[str]:
     ok = "met" if d["ratio"] <= d["target_ratio"] else "NOT MET"
-    w, s = d["walkerlab"], d["script"]
     return [f"hzd: three-link design (0.8 m/s, delta^2 <= 0.6): walkerlab "
             f"{d['walkerlab_s']:.2f} s, minimal CasADi script {d['script_s']:.2f} s (build + "
             f"solve, medians of {d['repeats']}; walkerlab's after its first, from the disk "
@@ -328,7 +333,4 @@ def _build_solve_lines(d: dict) -> list[str]:
             f"{d['ratio']:.2f}x (target <= "
             f"{d['target_ratio']:.0f}x: {ok}); the first run (sympy on an empty cache) "
             f"{d['walkerlab_cold_s']:.2f} s; the whole optimize computation {d['stage_s']:.1f} s",
-            f"hzd: optima: walkerlab {w['status']} in {w['iterations']} iterations, objective "
-            f"{w['objective']:.10g} N^2 m s, delta^2 {w['delta2']:.10g}, period "
-            f"{w['period_s']:.10g} s; script {s['status']} in {s['iterations']}, "
-            f"{s['objective']:.10g}, {s['delta2']:.10g}, {s['period_s']:.10g} s"]
+            f"hzd: {_optima(d['walkerlab'], d['script'])}"]

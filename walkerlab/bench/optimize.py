@@ -164,6 +164,34 @@ def paired(this: list[tuple[float, float]], script: list[tuple[float, float]]) -
             "cpu_ratio": stats([a[1] / b[1] for a, b in zip(this, script)])}
 
 
+def _cell(d: dict | None) -> str:
+    """A median and its spread, ``median [min, max]`` (``-`` for None)."""
+    return "-" if d is None else f"{d['median']:.2f} [{d['min']:.2f}, {d['max']:.2f}]"
+
+
+def paired_text(p: dict) -> str:
+    """:func:`paired`'s numbers as text, with the verdict of the wall ratio's median
+    against the goal.
+
+    Parameters
+    ----------
+    p : dict
+        :func:`in_turn`'s result (medians [min, max] [s] and ratios) and ``target_ratio``,
+        the goal on the wall ratio's median.
+
+    Returns
+    -------
+    str
+        ``wall A s against B s, ratio R (target <= T: met); cpu A s against B s, ratio R``
+        (``NOT MET`` past the goal).
+    """
+    ok = "met" if p["wall_ratio"]["median"] <= p["target_ratio"] else "NOT MET"
+    return (f"wall {_cell(p['wall_s'])} s against {_cell(p['script_wall_s'])} s, ratio "
+            f"{_cell(p['wall_ratio'])} (target <= {p['target_ratio']:g}: {ok}); cpu "
+            f"{_cell(p['cpu_s'])} s against {_cell(p['script_cpu_s'])} s, ratio "
+            f"{_cell(p['cpu_ratio'])}")
+
+
 def in_turn(cmd: list[str], env: dict, cwd, script: list[str], pairs: int) -> dict:
     """``pairs`` pairs of the command ``cmd`` (in ``env``, ``cwd``) and the yardstick
     ``script`` (from ``/``), which runs first alternating pair by pair: :func:`paired`'s
@@ -217,29 +245,22 @@ def bench_optimize(scenes=SCENES, repeats: int = 3, vs: Path | None = None,
 
 def lines(result: dict) -> list[str]:
     """The benchmark as a table, one line a scene and mode."""
-    def cell(d):
-        return "-" if d is None else f"{d['median']:.2f} [{d['min']:.2f}, {d['max']:.2f}]"
-
     out = ["optimize: scene | mode | wall s | cpu s | compute s | ipopt s | iterations | goal s"]
     for s in result["scenes"]:
         for mode in ("cold", "warm"):
             m = s[mode]
-            out.append(f"  {s['scene']} | {mode} | {cell(m['wall_s'])} | {cell(m['cpu_s'])} | "
-                       f"{cell(m['compute_s'])} | {cell(m['ipopt_wall_s'])} | "
-                       f"{cell(m['ipopt_iterations'])} | {s['goal_s']}")
+            out.append(f"  {s['scene']} | {mode} | {_cell(m['wall_s'])} | {_cell(m['cpu_s'])} | "
+                       f"{_cell(m['compute_s'])} | {_cell(m['ipopt_wall_s'])} | "
+                       f"{_cell(m['ipopt_iterations'])} | {s['goal_s']}")
         out.append(f"  {s['scene']}: IPOPT {', '.join(s['status'])}; a gait: {s['gait']}"
                    + (f"; FAILED: {s['failure']}" if "failure" in s else ""))
         for mode, r in s.get("ratio_this_over_vs", {}).items():
             v = s["vs"][mode]
             out.append(f"  {s['scene']} | {mode} | vs {s['vs']['tree']}: wall "
-                       f"{cell(v['wall_s'])}, cpu {cell(v['cpu_s'])}; this / vs paired: "
-                       f"wall {cell(r['wall_s'])}, cpu {cell(r['cpu_s'])}")
+                       f"{_cell(v['wall_s'])}, cpu {_cell(v['cpu_s'])}; this / vs paired: "
+                       f"wall {_cell(r['wall_s'])}, cpu {_cell(r['cpu_s'])}")
     y = result.get("vs_script")
     if y:
-        ok = "met" if y["wall_ratio"]["median"] <= y["target_ratio"] else "NOT MET"
         out.append(f"  {y['scene']} | warm | vs the minimal CasADi script (whole process, "
-                   f"{y['pairs']} pairs in turn): wall {cell(y['wall_s'])} s against "
-                   f"{cell(y['script_wall_s'])} s, ratio {cell(y['wall_ratio'])} (target <= "
-                   f"{y['target_ratio']:g}: {ok}); cpu {cell(y['cpu_s'])} s against "
-                   f"{cell(y['script_cpu_s'])} s, ratio {cell(y['cpu_ratio'])}")
+                   f"{y['pairs']} pairs in turn): {paired_text(y)}")
     return out
