@@ -381,7 +381,7 @@ class HipRollLoop:
     ----------
     model : mujoco.MjModel
         With the custom text ``walkerlab_hip_roll`` and bodies ``pelvis``, ``leg1``,
-        ``leg2`` (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`).
+        ``leg2`` (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`).
     """
 
     def __init__(self, model):
