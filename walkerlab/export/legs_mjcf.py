@@ -31,7 +31,8 @@ from walkerlab.export.text import comment, num, nums
 if TYPE_CHECKING:  # the bodies' module loads sympy: read lazily (the writers load light)
     from walkerlab.export.tree_bodies import ExportBody
 
-__all__ = ["LegsMjcf", "MjcfContact", "legs_mjcf_text", "tree_mjcf_text"]
+__all__ = ["COMPILER", "GEOM_DEFAULTS", "LegsMjcf", "MjcfContact", "legs_mjcf_text",
+           "tree_mjcf_text"]
 
 #: ``compiler`` of every legged walker's MJCF: radians, inertias as written, limits from ranges
 COMPILER = '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>'
@@ -41,7 +42,8 @@ GEOM_DEFAULTS = 'contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"'
 
 @dataclass(frozen=True)
 class MjcfContact:
-    """A scene's contact and integration in the MJCF's ``option`` and geom ``default``.
+    """A scene's contact and integration as the MJCF's ``option`` and the geoms' ``default``
+    carry them (:func:`legs_mjcf_text`).
 
     Attributes
     ----------
@@ -69,7 +71,8 @@ class MjcfContact:
 
 @dataclass(frozen=True)
 class LegsMjcf:
-    """What a legged walker's MJCF carries beyond the skeleton (:func:`legs_mjcf_text`).
+    """What a legged walker's MJCF carries beyond the skeleton :func:`legs_mjcf_text`
+    writes: its bodies, and what differs from one walker to another.
 
     Attributes
     ----------

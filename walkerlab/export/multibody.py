@@ -231,13 +231,15 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
     contact = None if extra is None else MjcfContact(
         extra.timestep_s, extra.solref, extra.solimp, (extra.friction, 0, 0))
     numerics, texts = _custom(mb, extra)
+    profile = extra is not None and extra.profile is not None
     return LegsMjcf(
-        name, root, mb.gravity_m_per_s2, tuple(header(mb, name, "MJCF", version)),
-        extra.notes if extra else (), mjcf_omissions(mb, extra), contact,
-        _geoms(mb, extra), _joint_attrs(mb, extra),
-        tuple(profile_asset(mb, extra)) if extra is not None and extra.profile is not None
-        else (), tuple(ground_geoms(mb, extra)), extra.actuation if extra else None,
-        tuple(_tendons(mb)), tuple(_equality(mb, extra)), numerics, texts, _keys(mb, extra))
+        name, root, mb.gravity_m_per_s2, header=tuple(header(mb, name, "MJCF", version)),
+        notes=extra.notes if extra else (), left_out=mjcf_omissions(mb, extra),
+        contact=contact, geoms=_geoms(mb, extra), joint_attrs=_joint_attrs(mb, extra),
+        asset=tuple(profile_asset(mb, extra)) if profile else (),
+        ground=tuple(ground_geoms(mb, extra)), actuation=extra.actuation if extra else None,
+        tendons=tuple(_tendons(mb)), equality=tuple(_equality(mb, extra)),
+        numerics=numerics, texts=texts, keyframes=_keys(mb, extra))
 
 
 def _geoms(mb: Multibody, extra: MjcfScene | None):
