@@ -77,7 +77,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.export.axes_3d import TO_MUJOCO
+from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
 from walkerlab.export.multibody import mjcf_actuation_omissions
@@ -357,7 +357,7 @@ def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
     """Each lane's patches: boxes ``patch_width_m`` along the slope, ``patch_across_m``
     across (:data:`PATCH_ACROSS_L`, :data:`PATCH_ACROSS_PUSHED_L`), their tops on the
     slope through the footfalls."""
-    n = np.array([math.sin(phi), 0.0, math.cos(phi)])       # MuJoCo axes
+    _, n = slope_axes(phi)
     w = extra.patch_width_m
     depth = w / 10
     size = nums(w / 2, extra.patch_across_m / 2, depth)
@@ -514,5 +514,5 @@ def pelvis_lean_rad(model, data, slope_rad: float) -> float:
     float
     """
     R = np.asarray(data.xmat[model.body("pelvis").id], float).reshape(3, 3)
-    n = np.array([math.sin(slope_rad), 0.0, math.cos(slope_rad)])
+    _, n = slope_axes(slope_rad)
     return float(math.asin(max(-1.0, min(1.0, R[:, 1] @ n))))
