@@ -14,7 +14,10 @@ and ``keyframe``; an empty section is not written.
 
 The record is made by the code that knows the walker: a planar walker's by
 :func:`walkerlab.export.multibody.planar_legs_mjcf`, a 3D walker's by
-:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`.
+:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`, a spoked wheel's (its spokes the legs,
+the hub one body on slides and a hinge or, in 3D, a free joint) by
+:func:`walkerlab.export.spoked.wheel_mjcf_text` and
+:func:`~walkerlab.export.spoked.wheel3d_mjcf_text`.
 """
 
 from __future__ import annotations
@@ -51,8 +54,9 @@ class MjcfContact:
         ``option timestep`` [s] (the integrator ``implicitfast``).
     solref : (float, float)
         Contact time constant [s] and damping ratio [-].
-    solimp : tuple of float
-        ``solimp`` (d0, dwidth, width [m], midpoint, power).
+    solimp : tuple of float or None
+        ``solimp`` (d0, dwidth, width [m], midpoint, power); None: MuJoCo's default (a
+        spoked wheel's tips).
     friction : (float, float, float)
         Sliding [-], torsional [m] and rolling [m] friction.
     condim : int
@@ -142,10 +146,11 @@ def _option_and_default(g: float, c: MjcfContact | None) -> list[str]:
         return [f'  <option gravity="{nums(0, 0, -g)}"/>',
                 f"  <default><geom {GEOM_DEFAULTS}/></default>"]
     cone = f' cone="{c.cone}"' if c.cone else ""
+    solimp = "" if c.solimp is None else f' solimp="{nums(*c.solimp)}"'
     return [f'  <option gravity="{nums(0, 0, -g)}" timestep="{num(c.timestep_s)}" '
             f'integrator="implicitfast"{cone}/>',
-            f'  <default><geom {GEOM_DEFAULTS} solref="{nums(*c.solref)}" '
-            f'solimp="{nums(*c.solimp)}" friction="{nums(*c.friction)}" '
+            f'  <default><geom {GEOM_DEFAULTS} solref="{nums(*c.solref)}"{solimp} '
+            f'friction="{nums(*c.friction)}" '
             f'condim="{c.condim}"/></default>']
 
 

@@ -257,7 +257,8 @@ def _links(job: ExportJob, w: Writer) -> Written:
 
 def _wheel(job: ExportJob, w: Writer) -> Written:
     """A spoked wheel (one rigid body on its spokes, no tree of leg links) by its own
-    writers (:func:`walkerlab.export.multibody.wheel_urdf_text`, ``wheel_mjcf_text``): the
+    writers (:func:`walkerlab.export.multibody.wheel_urdf_text`, ``wheel_mjcf_text``, whose
+    MJCF the legged walkers' one writer writes): the
     rigid gait as the MJCF's ``gait`` keyframe (the URDF's sidecar), the scene's static
     friction coefficient on the spoke tips, a ground other than the slope as
     :func:`walkerlab.export.mjcf_ground.wheel_ground` lays it; other formats refused in one
