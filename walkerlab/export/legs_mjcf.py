@@ -150,8 +150,7 @@ def _option_and_default(g: float, c: MjcfContact | None) -> list[str]:
     return [f'  <option gravity="{nums(0, 0, -g)}" timestep="{num(c.timestep_s)}" '
             f'integrator="implicitfast"{cone}/>',
             f'  <default><geom {GEOM_DEFAULTS} solref="{nums(*c.solref)}"{solimp} '
-            f'friction="{nums(*c.friction)}" '
-            f'condim="{c.condim}"/></default>']
+            f'friction="{nums(*c.friction)}" condim="{c.condim}"/></default>']
 
 
 def _block(tag: str, lines) -> list[str]:
@@ -160,14 +159,16 @@ def _block(tag: str, lines) -> list[str]:
 
 
 def legs_mjcf_text(m: LegsMjcf) -> str:
-    """A legged walker, planar or 3D, as a MuJoCo model (MJCF; module docstring).
+    """A legged walker, planar or 3D (a spoked wheel too), as a MuJoCo model (MJCF; module
+    docstring).
 
     Parameters
     ----------
     m : LegsMjcf
         The walker's bodies and what its MJCF carries beyond the skeleton
         (:func:`walkerlab.export.multibody.planar_legs_mjcf`,
-        :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`).
+        :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`, ``walkerlab.export.spoked``'s
+        ``_wheel_mjcf``).
 
     Returns
     -------
