@@ -85,6 +85,7 @@ import sympy as sp
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
+from walkerlab.export.axes_3d import slope_axes
 from walkerlab.export.legs_3d_mjcf import (
     PATCH_ACROSS_L,
     PATCH_ACROSS_PUSHED_L,
@@ -352,8 +353,7 @@ def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
     lane."""
     L = start.numbers["L"]
     r = WHEEL_TIP_FRACTION * L
-    t = np.array([math.cos(slope_rad), 0.0, -math.sin(slope_rad)])
-    n = np.array([math.sin(slope_rad), 0.0, math.cos(slope_rad)])
+    t, n = slope_axes(slope_rad)
     across = (PATCH_ACROSS_PUSHED_L if rolled else PATCH_ACROSS_L) * L
     depth = width_m / 10
     tilt = (math.pi / 2, slope_rad, -math.pi / 2)  # Rz(90) Rx(phi) Rz(-90) = Rot(y, phi)

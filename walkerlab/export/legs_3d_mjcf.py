@@ -15,7 +15,8 @@ site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest iner
 (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).  The bodies, their masses,
 inertias and joint axes are read from the walker's body tree (:func:`walker_tree`;
 :mod:`walkerlab.export.tree_bodies`, where walkerlab's axes meet MuJoCo's); this module adds
-the geoms, the ground, the contact and the keyframe.
+the geoms, the ground, the contact and the keyframe (:func:`legs3d_mjcf`, the record the
+legged walkers' one MJCF writer, :func:`walkerlab.export.legs_mjcf.legs_mjcf_text`, writes).
 
 The ground is the planar straight-legged walker's checkerboard
 (:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
@@ -72,30 +73,23 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.export.axes_3d import TO_MUJOCO
+from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
+from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
-from walkerlab.export.motors import mjcf_actuator_lines, mjcf_motor_tendons, motors
 from walkerlab.export.multibody import mjcf_actuation_omissions
-from walkerlab.export.omitted import xml_comments
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
-from walkerlab.export.tree_bodies import (
-    PelvisRoles,
-    export_bodies,
-    mjcf_body_lines,
-    mjcf_coupling_lines,
-)
+from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_tree
 
 __all__ = ["TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "legs3d_footfalls",
-           "legs3d_keyframe", "legs3d_mjcf_text", "legs3d_scene", "pelvis_lean_rad"]
+           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -363,7 +357,7 @@ def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
     """Each lane's patches: boxes ``patch_width_m`` along the slope, ``patch_across_m``
     across (:data:`PATCH_ACROSS_L`, :data:`PATCH_ACROSS_PUSHED_L`), their tops on the
     slope through the footfalls."""
-    n = np.array([math.sin(phi), 0.0, math.cos(phi)])       # MuJoCo axes
+    _, n = slope_axes(phi)
     w = extra.patch_width_m
     depth = w / 10
     size = nums(w / 2, extra.patch_across_m / 2, depth)
@@ -377,24 +371,14 @@ def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
     return out
 
 
-def _world_head(p: dict, extra, phi: float, condim: int) -> list[str]:
-    """The MJCF's option and default lines and the world body's ground: the slope's plane
-    with MuJoCo's default contact when ``extra`` is None, else the footfall patches under
-    the scene's contact (timestep, solref, solimp, friction; ``condim``); ``p`` the walker's
-    numbers (:func:`_numbers`), ``phi`` the slope [rad]."""
-    L = p["L"]
+def _ground(p: dict, extra, phi: float) -> tuple[str, ...]:
+    """The world body's ground: the slope's plane (every foot touches it) when ``extra`` is
+    None, else the footfall patches (:func:`_patches`); ``p`` the walker's numbers
+    (:func:`_numbers`), ``phi`` the slope [rad]."""
     if extra is None:
-        return [f'  <option gravity="{nums(0, 0, -p["g"])}"/>',
-                '  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
-                '</default>', "  <worldbody>",
-                f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
-                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
-    return [f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(extra.timestep_s)}"'
-            ' integrator="implicitfast" cone="elliptic"/>',
-            f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-            f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
-            f'friction="{nums(extra.friction, TORSION_FRACTION * L, 0)}" condim="{condim}"/>'
-            '</default>', "  <worldbody>", *_patches(p, extra, phi)]
+        return (f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
+                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>',)
+    return tuple(_patches(p, extra, phi))
 
 
 def hip_roll_law(data) -> dict | None:
@@ -445,32 +429,23 @@ def _geoms(p: dict, roles: PelvisRoles):
     return geoms
 
 
-def _pelvis_and_legs(data, law: dict | None) -> tuple[list[str], list[str]]:
+def _bodies(data, law: dict | None) -> tuple:
     """The pelvis body (a free joint, or with the hip-roll ``law`` three slides and a roll
     about the fall line) with the legs' bodies and any upper body in it, read from the
-    walker's tree (:func:`walkerlab.export.tree_bodies.export_bodies`), and the MJCF lines
-    of its couplings (none without an upper body)."""
+    walker's tree (:func:`walkerlab.export.tree_bodies.export_bodies`), its geoms
+    (:func:`_geoms`) and the MJCF lines of its couplings' tendons and equalities (none
+    without an upper body)."""
     tree, coords, p = walker_tree(data)
     roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
     root, couplings = export_bodies(tree, coords, p, roles)
-    return (mjcf_body_lines(root, _geoms(p, roles)), mjcf_coupling_lines(couplings))
+    return (root, _geoms(p, roles), *mjcf_coupling_lines(couplings))
 
 
-def _with_motor_tendons(couplings: list[str], motor_list) -> list[str]:
-    """The couplings' lines (:func:`walkerlab.export.tree_bodies.mjcf_coupling_lines`) with
-    the motors' tendons (:func:`walkerlab.export.motors.mjcf_motor_tendons`) first in their
-    ``<tendon>`` block (one of its own without couplings)."""
-    driven = mjcf_motor_tendons(motor_list)
-    if not driven:
-        return couplings
-    if not couplings:
-        return ["  <tendon>", *driven, "  </tendon>"]
-    return [couplings[0], *driven, *couplings[1:]]  # couplings[0] is "  <tendon>"
-
-
-def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | None = None
-                     ) -> str:
-    """The 3D straight-legged walker as a MuJoCo model (MJCF; module docstring).
+def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = None
+                ) -> LegsMjcf:
+    """The 3D straight-legged walker's MJCF (module docstring) as the legged walkers' one
+    writer writes it (:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`): its bodies and
+    what its file carries beyond them.
 
     Parameters
     ----------
@@ -486,46 +461,40 @@ def legs3d_mjcf_text(data, name: str, version: str = "", extra: Legs3dScene | No
 
     Returns
     -------
-    str
-        MJCF XML (MuJoCo XML Reference): total mass ``M_hip + 2 m_leg``.
+    LegsMjcf
+        Total mass ``M_hip + 2 m_leg``; the custom numerics ``slope_rad`` and
+        ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg),
+        the texts ``walkerlab_actuation`` (a powered walker) and ``walkerlab_hip_roll``
+        (hip-roll joints).
     """
     p = _numbers(data)
     w, r, phi = p["w_hip"], p["r"], data.slope_rad
     law = hip_roll_law(data)
-    # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
-    # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
-    condim = 4 if law is None else 3
-    out = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
+    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
                    f"{legs_summary(data, p)}, hips {num(w)} m apart; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
                    "x downhill, z up, leg1 on the side of -y; a foot sphere of radius "
-                   f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot)."),
-           f"<mujoco model={quoteattr(name)}>",
-           *(comment(note) for note in (extra.notes if extra else ())),
-           *xml_comments(mjcf_actuation_omissions(extra.actuation if extra else None)),
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
-    out += _world_head(p, extra, phi, condim)
-    bodies, couplings = _pelvis_and_legs(data, law)
+                   f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot).")
+    # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
+    # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
+    contact = None if extra is None else MjcfContact(
+        extra.timestep_s, extra.solref, extra.solimp,
+        (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic")
     act = extra.actuation if extra is not None else None
-    motor_list = motors(act)
-    out += bodies
-    out += ["  </worldbody>", *_with_motor_tendons(couplings, motor_list),
-            *mjcf_actuator_lines(act, motor_list),
-            "  <custom>", f'    <numeric name="slope_rad" data="{num(phi)}"/>',
-            '    <numeric name="foot_height_offset_m" data="0.0"/>']
+    root, geoms, tendons, equality = _bodies(data, law)
+    numerics = (("slope_rad", phi), ("foot_height_offset_m", 0.0))
+    texts = ()
     if act is not None:  # the laws and the push-off, run by mujoco_walk.PoweredLoop
-        out += [f'    <numeric name="push_off_duration_s" '
-                f'data="{num(extra.push_off_duration_s)}"/>',
-                f"    <text name=\"walkerlab_actuation\" data={quoteattr(actuation_text(act))}/>"]
+        numerics += (("push_off_duration_s", extra.push_off_duration_s),)
+        texts += (("walkerlab_actuation", actuation_text(act)),)
     if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop
-        out.append(f"    <text name=\"walkerlab_hip_roll\" data={quoteattr(json.dumps(law))}/>")
-    out.append("  </custom>")
-    if extra is not None:
-        out += ["  <keyframe>",
-                f'    <key name="gait" qpos="{nums(*extra.qpos)}" qvel="{nums(*extra.qvel)}"/>',
-                "  </keyframe>"]
-    return "\n".join(out + ["</mujoco>", ""])
+        texts += (("walkerlab_hip_roll", json.dumps(law)),)
+    return LegsMjcf(name, root, p["g"], (head,), extra.notes if extra else (),
+                    tuple(mjcf_actuation_omissions(act)), contact, geoms,
+                    ground=_ground(p, extra, phi), actuation=act, tendons=tuple(tendons),
+                    equality=tuple(equality), numerics=numerics, texts=texts,
+                    keyframes=(("gait", extra.qpos, extra.qvel),) if extra else ())
 
 
 def pelvis_lean_rad(model, data, slope_rad: float) -> float:
@@ -536,7 +505,7 @@ def pelvis_lean_rad(model, data, slope_rad: float) -> float:
     Parameters
     ----------
     model, data : mujoco.MjModel, mujoco.MjData
-        The walker of :func:`legs3d_mjcf_text` (body ``pelvis``), after ``mj_forward`` or a
+        The walker of :func:`legs3d_mjcf` (body ``pelvis``), after ``mj_forward`` or a
         step.
     slope_rad : float
 
@@ -545,5 +514,5 @@ def pelvis_lean_rad(model, data, slope_rad: float) -> float:
     float
     """
     R = np.asarray(data.xmat[model.body("pelvis").id], float).reshape(3, 3)
-    n = np.array([math.sin(slope_rad), 0.0, math.cos(slope_rad)])
+    _, n = slope_axes(slope_rad)
     return float(math.asin(max(-1.0, min(1.0, R[:, 1] @ n))))

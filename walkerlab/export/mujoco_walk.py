@@ -57,6 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.codegen.cache import functions
+from walkerlab.export.axes_3d import slope_axes
 from walkerlab.export.joint_torques import (
     law_generalized_forces,
     link_angle,
@@ -381,7 +382,7 @@ class HipRollLoop:
     ----------
     model : mujoco.MjModel
         With the custom text ``walkerlab_hip_roll`` and bodies ``pelvis``, ``leg1``,
-        ``leg2`` (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`).
+        ``leg2`` (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`).
     """
 
     def __init__(self, model):
@@ -398,8 +399,7 @@ class HipRollLoop:
         self.c_s = law["swing_damping_n_m_s_per_rad"]
         self.g_l, self.g_r = law["lean_gain"], law["lean_rate_gain_s"]
         phi = _numeric(model, "slope_rad", 0.0)
-        self.n = np.array([math.sin(phi), 0.0, math.cos(phi)])    # MuJoCo axes
-        self.s = np.array([math.cos(phi), 0.0, -math.sin(phi)])
+        self.s, self.n = slope_axes(phi)    # MuJoCo axes
         self.zw = np.array([0.0, -1.0, 0.0])
         self.bodies = [int(model.body(b).id) for b in ("pelvis", *LEGS)]
         self.dof = [int(model.joint(f"{g}_roll").dofadr[0]) for g in LEGS]
@@ -486,8 +486,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
     off = _numeric(model, "foot_height_offset_m", 0.0)
     h_rel = _numeric(model, "latch_release_height_m")
     cap = _numeric(model, "latch_capture_rad")
-    n = np.array([math.sin(phi), 0.0, math.cos(phi)])  # slope normal and tangent, (x, y, z)
-    t = np.array([math.cos(phi), 0.0, -math.sin(phi)])
+    t, n = slope_axes(phi)  # slope tangent and normal, (x, y, z)
     foot_geom = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{g}_foot") for g in LEGS]
     site = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{g}_foot") for g in LEGS]
     latch = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, f"{g}_latch") for g in LEGS]
@@ -570,8 +569,7 @@ def roll(xml_path, t_final_s: float) -> MujocoWalk:
     ground = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "ground")
     qw, _, qy, _ = model.geom_quat[ground] if ground >= 0 else (1.0, 0.0, 0.0, 0.0)
     phi = 2.0 * math.atan2(float(qy), float(qw))  # the plane turned about y by phi
-    nrm = np.array([math.sin(phi), 0.0, math.cos(phi)])
-    tan = np.array([math.cos(phi), 0.0, -math.sin(phi)])
+    tan, nrm = slope_axes(phi)
     slide = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")
     free = slide < 0  # a wheel in 3D: a free joint, its position the first three of qpos
     hub = int(model.jnt_qposadr[slide if not free else mujoco.mj_name2id(

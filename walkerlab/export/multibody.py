@@ -72,6 +72,8 @@ Formats:
 - URDF: ROS "URDF XML specification" (:mod:`walkerlab.export.urdf` writes it, with its
   keyframe sidecar).
 - MJCF: MuJoCo "XML Reference", https://mujoco.readthedocs.io/en/stable/XMLreference.html
+  (:func:`walkerlab.export.legs_mjcf.legs_mjcf_text` writes it, planar and 3D, from the
+  record :func:`planar_legs_mjcf` makes)
   (``compiler``, ``option``, ``worldbody``, ``body``, ``joint`` of type ``slide``/``hinge``,
   ``inertial``, ``geom``, ``site``, ``keyframe``).  MuJoCo refuses moving bodies without
   mass or with a zero principal inertia, so: both slide joints sit in the hip body (no
@@ -87,8 +89,8 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 from typing import TYPE_CHECKING
-from xml.sax.saxutils import quoteattr
 
+from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact
 from walkerlab.export.mjcf_ground import ground_geoms, profile_asset
 from walkerlab.export.mjcf_scene import (
     LANE_BITS,
@@ -101,22 +103,20 @@ from walkerlab.export.mjcf_scene import (
 )
 from walkerlab.export.motors import (  # noqa: F401 (part of this API)
     HIP_ACTUATION_TENDON,
-    mjcf_actuator_lines,
-    mjcf_motor_tendons,
     motor_target,
     motors,
 )
-from walkerlab.export.omitted import Omission, xml_comments
+from walkerlab.export.omitted import Omission
 from walkerlab.export.planar_bodies import planar_bodies
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_mjcf_text, wheel_urdf_text
-from walkerlab.export.text import arc_feet, comment, header, num, nums
+from walkerlab.export.text import arc_feet, header, num, nums
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.walker.multibody import Multibody
 
 __all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION",
            "comments_in_scene_units", "mjcf_actuation_omissions", "mjcf_omissions",
-           "mjcf_text", "motor_target", "motors",
+           "motor_target", "motors", "planar_legs_mjcf",
            "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
@@ -128,7 +128,7 @@ COUPLING_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 
 
 def mjcf_omissions(mb: Multibody, extra: MjcfScene | None = None) -> tuple[Omission, ...]:
-    """What :func:`mjcf_text` leaves to a stepping loop outside the file
+    """What :func:`planar_legs_mjcf`'s MJCF leaves to a stepping loop outside the file
     (:mod:`walkerlab.export.omitted`; :mod:`walkerlab.export.mujoco_walk` is walkerlab's):
     the knee latch's switching, the joint torque laws, the push-off and the ankle push-off's
     heel-off latch.  The walker alone (no ``extra``) has no gait, latch or actuation."""
@@ -175,17 +175,13 @@ def _joint_springs(mb: Multibody) -> dict:
             if len(sp.terms) == 1 and sp.terms[0][1] == 1.0}
 
 
-def _tendons(mb: Multibody, motor_list=()) -> list[str]:
-    """Fixed tendons: each spring on its ``delta``, each coupling on its residual; a powered
-    walker's actuated joint combinations (:data:`HIP_ACTUATION_TENDON`, a five-link biped's
-    ``leg<i>_hip_torso``; :func:`motors`)."""
+def _tendons(mb: Multibody) -> list[str]:
+    """The fixed tendons of the springs between links (on their ``delta``) and of the
+    couplings (on their residual), after the motors' (:func:`walkerlab.export.motors.
+    mjcf_motor_tendons`, :data:`HIP_ACTUATION_TENDON`)."""
     on_joint = _joint_springs(mb).values()
-    springs = [sp for sp in mb.springs if sp not in on_joint]
-    driven = [m[2] for m in motor_list if m[1] == "tendon"]
-    if not (springs or mb.couplings or driven):
-        return []
-    out = ["  <tendon>", *mjcf_motor_tendons(motor_list)]
-    for sp in springs:
+    out = []
+    for sp in (sp for sp in mb.springs if sp not in on_joint):
         # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
         # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
         sign = -1.0 if sp.rest_angle_rad < 0 else 1.0
@@ -199,15 +195,15 @@ def _tendons(mb: Multibody, motor_list=()) -> list[str]:
         out.append(f'      <joint joint="{cp.joint}" coef="1.0"/>')
         out += [f'      <joint joint="{j}" coef="{num(-c)}"/>' for j, c in cp.terms]
         out.append("    </fixed>")
-    return out + ["  </tendon>"]
+    return out
 
 
-def mjcf_text(data, mb: Multibody, name: str, version: str = "",
-              extra: MjcfScene | None = None) -> str:
-    """The walker as a MuJoCo model (MJCF; MuJoCo XML Reference,
-    https://mujoco.readthedocs.io/en/stable/XMLreference.html): its bodies
-    (:func:`walkerlab.export.planar_bodies.planar_bodies`) written as the 3D walkers' are
-    (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`).
+def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
+                     extra: MjcfScene | None = None) -> LegsMjcf:
+    """A planar walker's MJCF as the legged walkers' one writer writes it
+    (:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`): its bodies
+    (:func:`walkerlab.export.planar_bodies.planar_bodies`) and what its file carries beyond
+    them.
 
     Parameters
     ----------
@@ -222,44 +218,28 @@ def mjcf_text(data, mb: Multibody, name: str, version: str = "",
 
     Returns
     -------
-    str
-        MJCF XML: the ground, the hip body with both slide joints, the links as nested
-        bodies with hinges, feet as contact geoms (only feet touch the ground), a keyframe
-        ``standing`` (legs vertical, the feet at the ground line at x = 0) and, with
-        ``extra``, a keyframe ``gait`` and the knee latches as joint equality constraints
-        named ``leg<i>_latch``.
+    LegsMjcf
+        The ground, the hip body with both slide joints, the links as nested bodies with
+        hinges, feet as contact geoms (only feet touch the ground), a keyframe ``standing``
+        (legs vertical, the feet at the ground line at x = 0) and, with ``extra``, a
+        keyframe ``gait`` and the knee latches as joint equality constraints named
+        ``leg<i>_latch``.
     """
-    lo = MJCF_MIN_INERTIA_KG_M2
-    hip_mass = mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG
-    out = [*header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
-           *(comment(note) for note in (extra.notes if extra else ())),
-           *xml_comments(mjcf_omissions(mb, extra)),
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
-    if extra is None:
-        out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}"/>')
-        out.append('  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
-                   '</default>')
-    else:
-        out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}" '
-                   f'timestep="{num(extra.timestep_s)}" integrator="implicitfast"/>')
-        out.append(f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-                   f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
-                   f'friction="{nums(extra.friction, 0, 0)}" condim="3"/></default>')
-    if extra is not None and extra.profile is not None:
-        out += profile_asset(mb, extra)
-    # the bodies as the 3D walkers' are written (walkerlab.export.tree_bodies)
-    from walkerlab.export.tree_bodies import mjcf_body_lines  # light: sympy with the bodies
-
-    root, _ = planar_bodies(data, mb, lo, extra.flat_feet if extra is not None else None)
-    root = replace(root, mass_kg=hip_mass)
-    out += ["  <worldbody>", *ground_geoms(mb, extra),
-            *mjcf_body_lines(root, _geoms(mb, extra), 4, True, _joint_attrs(mb, extra))]
-    motor_list = motors(extra.actuation if extra is not None else None)
-    out += ["  </worldbody>", *_tendons(mb, motor_list)]
-    # the laws live in the custom text, a stepping loop sets the controls
-    out += mjcf_actuator_lines(extra.actuation if extra is not None else None, motor_list)
-    out += [*_mjcf_tail(mb, extra), ""]
-    return "\n".join(out)
+    root, _ = planar_bodies(data, mb, MJCF_MIN_INERTIA_KG_M2,
+                            extra.flat_feet if extra is not None else None)
+    root = replace(root, mass_kg=mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG)
+    contact = None if extra is None else MjcfContact(
+        extra.timestep_s, extra.solref, extra.solimp, (extra.friction, 0, 0))
+    numerics, texts = _custom(mb, extra)
+    profile = extra is not None and extra.profile is not None
+    return LegsMjcf(
+        name, root, mb.gravity_m_per_s2, header=tuple(header(mb, name, "MJCF", version)),
+        notes=extra.notes if extra else (), left_out=mjcf_omissions(mb, extra),
+        contact=contact, geoms=_geoms(mb, extra), joint_attrs=_joint_attrs(mb, extra),
+        asset=tuple(profile_asset(mb, extra)) if profile else (),
+        ground=tuple(ground_geoms(mb, extra)), actuation=extra.actuation if extra else None,
+        tendons=tuple(_tendons(mb)), equality=tuple(_equality(mb, extra)),
+        numerics=numerics, texts=texts, keyframes=_keys(mb, extra))
 
 
 def _geoms(mb: Multibody, extra: MjcfScene | None):
@@ -321,38 +301,44 @@ def _joint_attrs(mb: Multibody, extra: MjcfScene | None):
     return attrs
 
 
-def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
-    """After the world: the equality constraints (couplings, knee latches), the numbers a
-    stepping loop reads (``custom``) and the keyframes (``standing``; ``gait`` with
-    ``extra``), through ``</mujoco>``."""
+def _equality(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    """The equality constraints: each coupling's tendon held at 0 (as stiff as MuJoCo
+    allows, :data:`COUPLING_SOLIMP`, a time constant of two timesteps); with ``extra``, each
+    knee latch (leg2's active: the gait keyframe starts with leg2 in stance)."""
+    dt = extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S
+    out = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" solref="{nums(2 * dt, 1)}" '
+           f'solimp="{nums(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
+    knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
+    if extra is not None and knees and extra.latch is not None:
+        out += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
+                f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>' for k in knees]
+    return out
+
+
+def _custom(mb: Multibody, extra: MjcfScene | None) -> tuple[tuple, tuple]:
+    """What a stepping loop reads (:mod:`walkerlab.export.mujoco_walk`), with ``extra``: the
+    numerics (the slope, an arc foot's radius, the knee latch's thresholds, the push-off's
+    duration) and the actuation's laws as the text ``walkerlab_actuation``."""
+    if extra is None:
+        return (), ()
+    custom = {"slope_rad": mb.slope_rad,
+              "foot_height_offset_m": mb.foot_radius_m if arc_feet(mb) else 0.0}
+    if extra.latch is not None:
+        custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
+    if extra.actuation is None:
+        return tuple(custom.items()), ()
+    custom["push_off_duration_s"] = extra.push_off_duration_s
+    return (tuple(custom.items()),
+            (("walkerlab_actuation", actuation_text(extra.actuation)),))
+
+
+def _keys(mb: Multibody, extra: MjcfScene | None) -> tuple:
+    """The keyframes: ``standing`` (legs vertical, the hip at ``L``), with ``extra`` the
+    rigid gait's ``gait``."""
     ankles = 2 if extra is not None and extra.flat_feet is not None else 0
     standing = [0.0, mb.leg_length_m] + [0.0] * (len(mb.links) + ankles)
-    keys = [f'    <key name="standing" qpos="{nums(*standing)}"/>']
-    equality = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" '
-                f'solref="{nums(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '
-                f'solimp="{nums(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
-    if extra is not None:
-        keys.append(f'    <key name="gait" qpos="{nums(*extra.qpos)}" qvel="{nums(*extra.qvel)}"/>')
-        knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
-        if knees and extra.latch is not None:
-            # the gait keyframe starts with leg2 in stance: its latch holds, leg1's is free
-            equality += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
-                         f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>'
-                         for k in knees]
-    out = ["  <equality>", *equality, "  </equality>"] if equality else []
-    if extra is not None:  # what a stepping loop needs (walkerlab.export.mujoco_walk)
-        arc = mb.foot_radius_m if arc_feet(mb) else 0.0
-        custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
-        if extra.latch is not None:
-            custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
-        if extra.actuation is not None:
-            custom["push_off_duration_s"] = extra.push_off_duration_s
-        texts = ([f'    <text name="walkerlab_actuation" '
-                  f'data={quoteattr(actuation_text(extra.actuation))}/>']
-                 if extra.actuation is not None else [])
-        out += ["  <custom>", *(f'    <numeric name="{k}" data="{num(v)}"/>'
-                                for k, v in custom.items()), *texts, "  </custom>"]
-    return out + ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>"]
+    gait = (("gait", extra.qpos, extra.qvel),) if extra is not None else ()
+    return (("standing", standing, None), *gait)
 
 
 def comments_in_scene_units(text: str, units) -> str:

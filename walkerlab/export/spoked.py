@@ -3,7 +3,9 @@ multibody libraries, URDF and MJCF, in the x-z plane and with the joint names of
 :mod:`walkerlab.export.multibody` (x downhill, z up, hinge axis world -y): a hub on two slide
 joints and a hinge ``wheel``, massless spokes with a contact sphere at each tip (McGeer 1990,
 "Passive dynamic walking"; Coleman, Chatterjee & Ruina 1997, "Motions of a rimless spoked
-wheel").  Its kind has no tree of leg links, so it has its own writers.
+wheel").  Its kind has no tree of leg links, so it has its own URDF writers; its MJCF, planar
+or 3D, is written by the legged walkers' one MJCF writer
+(:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`: the hub one body, its spokes its geoms).
 """
 
 from __future__ import annotations
@@ -11,10 +13,13 @@ from __future__ import annotations
 import math
 from xml.sax.saxutils import quoteattr
 
+import numpy as np
+
 from walkerlab.export.axes_3d import TO_MUJOCO  # the axes' one place (re-exported)
+from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact, legs_mjcf_text
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
-from walkerlab.export.text import AXIS, comment, num, nums
+from walkerlab.export.text import comment, num, nums
 
 __all__ = ["TO_MUJOCO", "WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe",
            "wheel3d_mjcf_text", "wheel3d_urdf_text", "wheel_chord_m", "wheel_mjcf_text",
@@ -68,37 +73,39 @@ def _urdf_spokes(p: dict) -> list[str]:
     return out
 
 
-def _mjcf_head(p: dict, timestep_s: float, solref, friction: float) -> list[str]:
-    """The MJCF's compiler, gravity and integrator, and the spokes' contact defaults."""
-    return ['  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-            f'  <option gravity="{nums(0, 0, -p["g"])}" timestep="{num(timestep_s)}" '
-            'integrator="implicitfast"/>',
-            f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-            f'solref="{nums(*solref)}" friction="{nums(friction, 0, 0)}" condim="3"/>'
-            '</default>']
+def _wheel_mjcf(p: dict, name: str, joints, inertia, timestep_s: float, solref,
+                friction: float, qpos, qvel) -> dict:
+    """What a wheel's MJCF carries beyond the skeleton of the legged walkers' one writer
+    (:class:`walkerlab.export.legs_mjcf.LegsMjcf`, by field name; a header and a ground to
+    add): the hub body on ``joints`` (:class:`~walkerlab.export.tree_bodies.ExportJoint`)
+    with the principal moments ``inertia`` (3,) [kg m^2] about x, y, z, its geoms and
+    spokes, the spokes' contact (sliding friction ``friction``, ``condim 3``, no ``solimp``)
+    and the ``gait`` keyframe (none without ``qpos``; ``qvel`` None: at rest)."""
+    from walkerlab.export.tree_bodies import ExportBody  # light: sympy with the bodies
+
+    hub = ExportBody("hub", "hub", np.zeros(3), tuple(joints), p["M_hub"], np.zeros(3),
+                     np.diag(inertia))
+    qv = None if qpos is None else (0.0,) * len(qpos) if qvel is None else qvel
+    return dict(name=name, bodies=hub, gravity_m_per_s2=p["g"],
+                contact=MjcfContact(timestep_s, solref, None, (friction, 0, 0)),
+                geoms=lambda b, pad: [f'{pad}<geom name="hub" type="sphere" '
+                                      f'size="{num(p["L"] / 25)}"/>', *_mjcf_spokes(p, pad)],
+                keyframes=() if qpos is None else (("gait", qpos, qv),))
 
 
-def _mjcf_spokes(p: dict) -> list[str]:
+def _mjcf_spokes(p: dict, pad: str) -> list[str]:
     """Each spoke as an MJCF capsule (no contact) and its tip's sphere ``spoke<k>_tip`` (the
-    only geoms that touch the ground), in the hub body's frame."""
+    only geoms that touch the ground), in the hub body's frame (lines at the indent
+    ``pad``)."""
     L, r = p["L"], p["r"]
     out = []
     for k in range(p["n"]):
         tx, tz = _spoke_tip(p, k, L - r)
-        out += [f'      <geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
+        out += [f'{pad}<geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
                 f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
-                f'      <geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
+                f'{pad}<geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
                 f'pos="{nums(tx, 0, tz)}" contype="1" conaffinity="1"/>']
     return out
-
-
-def _mjcf_keyframe(qpos, qvel) -> list[str]:
-    """The ``gait`` keyframe (none without ``qpos``; ``qvel`` None: at rest)."""
-    if qpos is None:
-        return []
-    qv = (0.0,) * len(qpos) if qvel is None else qvel
-    return ["  <keyframe>", f'    <key name="gait" qpos="{nums(*qpos)}" qvel="{nums(*qv)}"/>',
-            "  </keyframe>"]
 
 
 def _wheel_header(name: str, fmt: str, version: str, p: dict, slope: float) -> list[str]:
@@ -192,24 +199,21 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
     str
         MJCF XML (MuJoCo XML Reference).
     """
+    from walkerlab.export.tree_bodies import ExportJoint  # light: sympy with the bodies
+
     p = _wheel_numbers(data, hub_inertia_kg_m2)
-    L, phi = p["L"], data.slope_rad
-    out = [*_wheel_header(name, "MJCF", version, p, phi), f"<mujoco model={quoteattr(name)}>",
-           *_mjcf_head(p, timestep_s, solref, friction),
-           *(ground[0] if ground is not None else ()),
-           "  <worldbody>",
-           *([f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
-              'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>'] if ground is None
-             else ground[1]),
-           '    <body name="hub" pos="0 0 0">',
-           '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
-           '      <joint name="hip_z" type="slide" axis="0 0 1"/>',
-           f'      <joint name="wheel" type="hinge" axis="{AXIS}"/>',
-           f'      <inertial pos="0 0 0" mass="{num(p["M_hub"])}" '
-           f'diaginertia="{nums(p["I_hub"], p["I_hub"], p["I_hub"])}"/>',
-           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>', *_mjcf_spokes(p),
-           "    </body>", "  </worldbody>", *_mjcf_keyframe(qpos, qvel)]
-    return "\n".join(out + ["</mujoco>", ""])
+    phi = data.slope_rad
+    joints = [ExportJoint("hip_x", "slide", (1.0, 0.0, 0.0)),
+              ExportJoint("hip_z", "slide", (0.0, 0.0, 1.0)),
+              ExportJoint("wheel", "hinge", (0.0, -1.0, 0.0))]
+    plane = (f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
+             'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',)
+    return legs_mjcf_text(LegsMjcf(
+        **_wheel_mjcf(p, name, joints, (p["I_hub"],) * 3, timestep_s, solref, friction,
+                      qpos, qvel),
+        header=tuple(_wheel_header(name, "MJCF", version, p, phi)),
+        asset=tuple(ground[0]) if ground is not None else (),
+        ground=plane if ground is None else tuple(ground[1])))
 
 
 
@@ -297,23 +301,22 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
     str
         MJCF XML (MuJoCo XML Reference).
     """
+    from walkerlab.export.tree_bodies import ExportJoint  # light: sympy with the bodies
+
     p = _wheel_numbers(data, None)
     n, L, phi, I_axle = p["n"], p["L"], data.slope_rad, p["I_hub"]
-    out = [comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (MJCF): "
+    head = comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (MJCF): "
                    f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
                    f"{num(I_axle)} kg m^2 about the axle and {num(p['I_diam'])} kg m^2 about "
-                   f"a diameter; slope {num(phi)} rad; a free body, no plane constraint"),
-           f"<mujoco model={quoteattr(name)}>", *_mjcf_head(p, timestep_s, solref, friction),
-           "  <worldbody>",
-           f'    <geom name="ground" type="plane" size="400 400 0.1" euler="0 {num(phi)} 0" '
-           'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
-           '    <body name="hub" pos="0 0 0">',
-           '      <freejoint name="free"/>',
-           f'      <inertial pos="0 0 0" mass="{num(p["M_hub"])}" '
-           f'diaginertia="{nums(p["I_diam"], I_axle, p["I_diam"])}"/>',
-           f'      <geom name="hub" type="sphere" size="{num(L / 25)}"/>', *_mjcf_spokes(p),
-           "    </body>", "  </worldbody>", *_mjcf_keyframe(qpos, qvel)]
-    return "\n".join(out + ["</mujoco>", ""])
+                   f"a diameter; slope {num(phi)} rad; a free body, no plane constraint")
+    return legs_mjcf_text(LegsMjcf(
+        **_wheel_mjcf(p, name, [ExportJoint("free", "free")],
+                      (p["I_diam"], I_axle, p["I_diam"]), timestep_s, solref, friction,
+                      qpos, qvel),
+        header=(head,),
+        ground=(f'    <geom name="ground" type="plane" size="400 400 0.1" '
+                f'euler="0 {num(phi)} 0" contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
+                )))
 
 
 def wheel3d_urdf_text(data, name: str, version: str = "") -> str:

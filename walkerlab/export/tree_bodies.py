@@ -2,8 +2,7 @@
 the floating pelvis with a leg on each hip and any upper body on its own joint, every body's
 mass, centre of mass, inertia and joint axes evaluated from the tree's expressions, in the
 exports' axes.  The MJCF and URDF writers of legged walkers, planar and 3D
-(:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text`,
-:func:`walkerlab.export.multibody.mjcf_text`, :func:`walkerlab.export.urdf.legs_urdf_text`),
+(:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`, :func:`walkerlab.export.urdf.legs_urdf_text`),
 write these bodies; :func:`mjcf_body_lines` and :func:`mjcf_coupling_lines` are the MJCF's
 text of them, :func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's
 tree (every joint a pitch) gives the same bodies in the plane ``x``-``z``
@@ -79,7 +78,7 @@ from walkerlab.export.text import num, nums
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
 __all__ = ["Coupling", "ExportBody", "ExportJoint", "PelvisRoles", "export_bodies",
-           "axis_text", "mjcf_body_lines", "mjcf_coupling_lines", "tree_mjcf_text"]
+           "axis_text", "mjcf_body_lines", "mjcf_coupling_lines"]
 
 
 @dataclass(frozen=True)
@@ -557,37 +556,14 @@ def _is_point(b: ExportBody) -> bool:
             and all(j.kind == "fixed" for j in b.joints))
 
 
-def mjcf_coupling_lines(couplings) -> list[str]:
+def mjcf_coupling_lines(couplings) -> tuple[list[str], list[str]]:
     """Each coupling as a fixed tendon held at zero length by an equality (MuJoCo XML
-    Reference: ``tendon/fixed``, ``equality/tendon``)."""
-    if not couplings:
-        return []
-    out = ["  <tendon>"]
+    Reference: ``tendon/fixed``, ``equality/tendon``): the ``fixed`` elements' lines and the
+    equalities' (the MJCF writer puts them in their sections,
+    :func:`walkerlab.export.legs_mjcf.legs_mjcf_text`)."""
+    tendons = []
     for c in couplings:
-        out.append(f'    <fixed name="{c.name}">')
-        out += [f'      <joint joint="{j}" coef="{k}"/>' for j, k in c.terms]
-        out.append("    </fixed>")
-    out += ["  </tendon>", "  <equality>"]
-    out += [f'    <tendon name="{c.name}" tendon1="{c.name}"/>' for c in couplings]
-    return out + ["  </equality>"]
-
-
-def tree_mjcf_text(tree: BodyTree, coords: CoordinateMap, values: dict,
-                   roles: PelvisRoles = PelvisRoles(), name: str = "walker") -> str:
-    """The walker's bodies alone as MJCF (no ground, contact or keyframe; gravity ``g``
-    along -z): the bodies of :func:`export_bodies` and their couplings.
-
-    Returns
-    -------
-    str
-        MJCF XML.
-    """
-    root, couplings = export_bodies(tree, coords, values, roles)
-    g = float(values[tree.root.gravity_m_per_s2]) if isinstance(
-        tree.root.gravity_m_per_s2, str) else float(tree.root.gravity_m_per_s2)
-    out = [f'<mujoco model="{name}">',
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-           f'  <option gravity="{nums(0, 0, -g)}"/>', "  <worldbody>",
-           *mjcf_body_lines(root), "  </worldbody>", *mjcf_coupling_lines(couplings)]
-    return "\n".join(out + ["</mujoco>", ""])
-
+        tendons.append(f'    <fixed name="{c.name}">')
+        tendons += [f'      <joint joint="{j}" coef="{k}"/>' for j, k in c.terms]
+        tendons.append("    </fixed>")
+    return tendons, [f'    <tendon name="{c.name}" tendon1="{c.name}"/>' for c in couplings]

@@ -301,7 +301,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # d-dimensional: walkerlab.models.contact.assembly.point3)
         **_CELLS_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
-        # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf_text: on footfall patches, past
+        # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.urdf.
         # legs_urdf_text); the Adams dataset: the pelvis fixed to leg2, the legs on
         # revolutes, or with hip-roll joints the pelvis rolling, the legs on universal
