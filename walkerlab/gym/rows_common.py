@@ -219,6 +219,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         columns)``; None when the period is not common (nothing changed: the caller steps
         the walkers its own way).
     """
+    cache["steady"] = None  # (what a steady period reuses: this one's, when it is one)
     got = _common(envs, views, cache)
     if got is None:
         return None
@@ -243,21 +244,16 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         hx = _hips(walkers[0], Yev) if batch[5] else None
         hips = (None if hx is None
                 else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
-        # each walker's period opened and settled (RigidView.settle) in one pass
-        for e, v, lane, u, t_end, k, x, t_stop, h in zip(
-                envs, views, lanes, rows_u, t_ends, elapsed, X, stops,
-                hips if hips is not None else [None] * len(views)):
-            e._elapsed = k  # (begin_periods, open_period, next_piece)
-            v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
-            lane[3].u = u
-            v.t = t_stop
-            v.x = x
-            e._hip_x = h  # (the next period's reward's origin; None: end_periods' to write)
+        settle_all(envs, views, lanes, rows_u, t_ends, elapsed, X, stops,
+                   hips if hips is not None else [None] * len(views))
         ended = [""] * len(views)
         if stall:  # (RigidView.settle: a walker at its step's time limit)
             for r, (t_stop, t_step, mst) in enumerate(zip(stops, t_steps, msts)):
                 if t_stop >= t_step + mst:
                     views[r].ended = ended[r] = "stall"
+        elif hips is not None:  # (a steady period next: walkerlab.gym.rows_steady)
+            cache["steady"] = (envs, views, p, key, entries, lanes, batch, read, env_read,
+                               Yev, X, stops, elapsed, hips)
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
                            Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
                            batch[6], env_cols, hips is not None)
@@ -271,6 +267,23 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
     cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
     return end_periods(envs, U, strikes, x_before, w_before, p, views, env_cols=env_cols)
+
+
+def settle_all(envs, views, lanes, rows_u, t_ends, elapsed, X, stops, hips) -> None:
+    """Each walker's period opened (:func:`~walkerlab.gym.batch.begin_periods`' count,
+    :meth:`~walkerlab.gym.rigid_view.RigidView.open_period`, ``next_piece``'s torques
+    ``rows_u``) and settled at its piece's end ``stops`` [s] in the state ``X[r]``
+    (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, no stall), in one pass; ``hips``
+    [m]: each environment's next reward's origin (None: :func:`~walkerlab.gym.batch.
+    end_periods`' to write)."""
+    for e, v, lane, u, t_end, k, x, t_stop, h in zip(
+            envs, views, lanes, rows_u, t_ends, elapsed, X, stops, hips):
+        e._elapsed = k  # (begin_periods, open_period, next_piece)
+        v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
+        lane[3].u = u
+        v.t = t_stop
+        v.x = x
+        e._hip_x = h  # (the next period's reward's origin; None: end_periods' to write)
 
 
 def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out) -> list:

@@ -76,7 +76,7 @@ def _step_common():
     :func:`_advance_rows`), kept."""
     global _STEP_COMMON
     if _STEP_COMMON is None:
-        from .rows_common import step_common as _STEP_COMMON  # light
+        from .rows_steady import step as _STEP_COMMON  # light
     return _STEP_COMMON
 
 

@@ -1,0 +1,74 @@
+"""The native vector environment's steady control period (:mod:`walkerlab.gym.rows_steady`):
+a common period after one whose every walker settled at its piece's end reuses what that
+period wrote instead of reading the walkers again; it must give ``gymnasium.make_vec(...,
+"sync")``'s numbers bit for bit, and fall back on the common period whenever a walker may
+have changed (a heel strike, a fall, a reset, ``set_attr``).
+
+Compared exactly (no tolerance): ``gym.make``'s environment advances its walker with the
+same kernel as a batch of one (tests/test_gym_vector.py), so sync's numbers are the native
+form's bit for bit.
+"""
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium")
+
+from tests.test_gym_vector import _native, _run, _same, _vec  # noqa: E402
+
+
+def _count_steady(monkeypatch) -> dict:
+    """Count the steady periods run (``ran``) and those that fell back (``back``)."""
+    from walkerlab.gym import rows_steady
+
+    counts = {"ran": 0, "back": 0}
+    period = rows_steady._Steady.period
+
+    def counted(self, *args):
+        out = period(self, *args)
+        counts["ran" if out is not None else "back"] += 1
+        return out
+
+    monkeypatch.setattr(rows_steady._Steady, "period", counted)
+    return counts
+
+
+@pytest.mark.parametrize("policy, scale", [("scene", 0.3), (None, 0.0)],
+                         ids=["controller_random_actions", "zero_actions"])
+def test_steady_periods_equal_sync_through_heel_strikes_falls_and_resets(
+        monkeypatch, policy, scale):
+    """8 three-link walkers: the scene's controller under random actions (torques on in
+    every row; one row held at zero for a stretch: on in the others only), or no
+    controller and zero actions (no torque: the benchmark's case), walker 0 pushed for 10
+    periods twice (without the controller it falls: autoresets of one walker), the time
+    limit 70 (truncations, resets of every walker at once).  Over 260 periods a third or more
+    steady, every output (observations, rewards, flags, infos) is sync's exactly, heel
+    strikes, truncations (and falls) met; a ``set_attr`` half-way is read by the next
+    period (the steady one falls back)."""
+    counts = _count_steady(monkeypatch)
+    n, steps = 8, 260
+    kw = dict(start_noise=0.05, max_episode_steps=70, policy=policy)
+    sync = _vec("sync", n, "threelink_hzd", **kw)
+    native = _native(n, "threelink_hzd", **kw)
+    rng = np.random.default_rng(21)
+    actions = (scale * rng.uniform(-1.0, 1.0, (steps, n, 2))).astype(np.float32)
+    actions[40:60, 3] = 0.0  # (with random actions: torques on in the other rows only)
+    actions[100:110, 0] = actions[200:210, 0] = 1.0  # (walker 0 pushed)
+    half = steps // 2
+    a = _run(sync, actions[:half], 5)
+    b = _run(native, actions[:half], 5)
+    for env in (sync, native):
+        env.set_attr("weights", [(1.0, 0.5, 1e-3, 0.0)] * n)
+    a += [sync.step(act) for act in actions[half:]]
+    b += [native.step(act) for act in actions[half:]]
+    assert len(a) == len(b)
+    for k, (x, y) in enumerate(zip(a, b, strict=True)):
+        for j, (u, v) in enumerate(zip(x, y, strict=True)):
+            _same(u, v, f"output {k}, item {j}")
+    outs = b[1:]
+    terms = np.array([o[2] for o in outs])
+    assert np.array([o[3] for o in outs]).any() and (terms.any() or policy == "scene")
+    assert sum(int(o[4]["heel_strike"].sum()) for o in outs) > n
+    assert counts["ran"] > steps // 3 and counts["back"] > 0
+    sync.close()
+    native.close()
