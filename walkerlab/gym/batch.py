@@ -177,7 +177,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                 p: dict, views=None, X: np.ndarray | None = None,
                 cols: tuple | None = None, hips: list | None = None,
                 fixed: np.ndarray | None = None, env_cols: tuple | None = None,
-                written: bool = False) -> tuple:
+                written: bool = False, known: tuple | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -212,6 +212,11 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     written : bool
         The caller has written ``hips`` into each environment (its next period's reward's
         origin).
+    known : tuple, optional
+        ``(terminated, messages, terms, some)``, when the caller knows them: each
+        episode's end as a bool (list of N; ``cols``' ends), each view's solver words
+        (:func:`view_messages`), the ledgers' terms in order, whether some torque in ``U``
+        is not zero.
 
     Returns
     -------
@@ -247,7 +252,13 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
             e._hip_x = h  # the next period's start (its reward's origin)
     # (each environment's count and seed)
     elapsed, seeds = zip(*map(_ENV_READ, envs)) if env_cols is None else env_cols
-    terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
+    if known is None:
+        terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
+        messages = view_messages(views)
+        terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
+        some = any(U.ravel().tolist())
+    else:
+        terminated, messages, terms, some = known
     fws, healthy, cws, wws, dts, limits = _lists(p)
     if _no_limit(p, limits):  # (no environment's own limit: a vector env's walkers)
         truncated = np.zeros(len(terminated), dtype=np.bool_)
@@ -255,11 +266,10 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         truncated = np.array([not te and lim >= 0 and el >= lim
                               for te, lim, el in zip(terminated, limits, elapsed)],
                              dtype=np.bool_)
-    terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
     sums = list(map(dict.copy, ledgers))  # (the ledgers now: copies, read as lists below)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
-    if any(U.ravel().tolist()):
+    if some:
         effort = U / p["tau"]
         effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2)
     else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
@@ -270,10 +280,6 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
             fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
             w_before)], dtype=np.float64)
-    # (a view's own words, when it has them: the rigid view's are its instance's)
-    messages = ([v.__dict__.get("failure", "") for v in views]
-                if not any(map(_class_failure, set(map(type, views))))
-                else [getattr(v, "failure", "") for v in views])
 
     def columns() -> dict:  # (of the values read above, whenever called)
         L = np.array(list(map(list, map(dict.values, sums))), dtype=np.float64).T.copy()
@@ -291,6 +297,14 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         return out
 
     return obs, reward, np.array(terminated, dtype=np.bool_), truncated, columns
+
+
+def view_messages(views) -> list:
+    """Each view's solver words (its ``failure``, "" without one: the rigid view's are its
+    instance's, when it has them), as :func:`end_periods`' infos read them."""
+    if not any(map(_class_failure, set(map(type, views)))):
+        return [v.__dict__.get("failure", "") for v in views]
+    return [getattr(v, "failure", "") for v in views]
 
 
 _CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``

@@ -378,12 +378,13 @@ def _origins(acts: list) -> tuple:
     return (True if all(hasattr(a, "t_origin") for a in acts) else None), acts
 
 
-def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache) -> tuple:
+def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache,
+               Y=None) -> tuple:
     """The kernel on every walker's piece: ``(which, te, Yev, Y, cap, Yn, call)`` as
     :func:`walkerlab.gym.rigid_rows._integrate_rows` gives them (its arguments the same:
-    the data rows with this period's torques and clocks, the start states - the last
-    common period's array when the walkers hold its rows -, the caps [s], the
-    Gauss-Legendre nodes of the rows with the action on)."""
+    the data rows with this period's torques and clocks, the start states - ``Y`` when
+    given (N, m), else the last common period's array when the walkers hold its rows -,
+    the caps [s], the Gauss-Legendre nodes of the rows with the action on)."""
     base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi) = batch[:5]
     acts = batch[8]
     origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]] if acts[0] is None
@@ -405,7 +406,9 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
     f, fs, fg, sel, rtol, atol, n_out = kernel
     N, m = len(views), key[4]
     last = cache.get("X")  # (the last common period's states: the walkers' own rows)
-    if (last is not None and len(last[1]) == N
+    if Y is not None:
+        pass
+    elif (last is not None and len(last[1]) == N
             and all(map(is_, xs, last[1]))):
         Y = last[0]
     else:

@@ -24,7 +24,7 @@ from operator import attrgetter, is_, itemgetter, le, sub
 
 from walkerlab.integrate.rows_dop853 import TIMEOUT
 
-from .batch import _hips, end_periods, held_torques
+from .batch import _hips, end_periods, held_torques, view_messages
 from .rows_common import _integrate, _settle_rows, settle_all, step_common
 from .small_arrays import all_finite
 
@@ -56,8 +56,8 @@ class _Steady:
     from each steady period after it."""
 
     __slots__ = ("envs", "views", "p", "key", "entries", "lanes", "batch", "walker", "lim",
-                 "dts", "seeds", "foot", "cols", "ended", "strikes", "Yev", "X", "T", "K",
-                 "hips")
+                 "lo", "dts", "seeds", "foot", "cols", "off", "known", "strikes", "Yev", "X",
+                 "T", "K", "hips")
 
     def __init__(self, envs, views, p, key, entries, lanes, batch, read, env_read, Yev, X,
                  stops, elapsed, hips):
@@ -67,11 +67,19 @@ class _Steady:
         self.walker = walkers[0]
         #: each piece's end at its step's time limit [s] (next_piece's t_step + max_step_time)
         self.lim = [a + b for a, b in zip(t_steps, msts)]
+        #: the earliest of them (below every period's end: no stall, each piece to its
+        #: period's end; -inf when one is NaN: each compared)
+        self.lo = min(self.lim) if self.lim == self.lim else -float("inf")
         self.dts = [er[1] for er in env_read]
         self.seeds = [er[3] for er in env_read]
         self.foot = [f.item(0) for f in feet]
         self.cols = (legs, ks, t_steps, steps, ledgers)
-        self.ended = [""] * len(views)
+        n = len(views)
+        self.off = [False] * n  # (no row's torques on)
+        #: end_periods' known columns: no episode ended, each view's own words (a failure's
+        #: only on a piece not settled at its end), the ledger's terms
+        self.known = ([""] * n, [False] * n,
+                      view_messages(views), list(ledgers[0]))
         self.strikes = [[] for _ in views]  # (none: read, never written)
         self.Yev, self.X, self.T, self.K, self.hips = Yev, X, stops, elapsed, hips
 
@@ -84,19 +92,22 @@ class _Steady:
             return None
         ks = [k + 1 for k in self.K]
         t_ends = [k * dt for k, dt in zip(ks, self.dts)]  # (begin_periods' k dt)
-        if any(map(le, self.lim, t_ends)):  # (a stall: the common period's)
+        if max(t_ends) < self.lo:  # (every piece to its period's end)
+            stops = t_ends
+        elif any(map(le, self.lim, t_ends)):  # (a stall: the common period's)
             return None
-        stops = [t if t < te else te for t, te in zip(self.lim, t_ends)]
+        else:  # (next_piece's min(t_end, t_step + max_step_time))
+            stops = [t if t < te else te for t, te in zip(self.lim, t_ends)]
         U = held_torques(envs, actions, p)
-        on = list(map(any, U.tolist()))
-        some = any(on)
+        some = any(U.ravel().tolist())
+        on = list(map(any, U.tolist())) if some else self.off
         batch = self.batch
         if some and not batch[7][1]:  # (a ledger not taken at once)
             return None
         rows_u = list(U)
         w_before = list(map(_WORK, self.cols[4]))
         out = _integrate(views, self.entries, self.lanes, rows_u, U, on, self.key, batch,
-                         self.X, list(map(sub, stops, self.T)), cache)
+                         self.X, list(map(sub, stops, self.T)), cache, self.Yev)
         which, _, Yev, Y, cap, Yn, _ = out
         ends = which.tolist()
         if not (min(ends) == TIMEOUT == max(ends) and all_finite(Yev)):
@@ -113,6 +124,7 @@ class _Steady:
         x_before = self.hips
         self.Yev, self.X, self.T, self.K, self.hips = Yev, X, stops, ks, hips
         legs, kk, t_steps, steps, ledgers = self.cols
+        known = self.known
         return end_periods(envs, U, self.strikes, x_before, w_before, p, views, Yev,
-                           (X, stops, legs, kk, t_steps, self.ended, steps, ledgers), hips,
-                           batch[6], (ks, self.seeds), True)
+                           (X, stops, legs, kk, t_steps, known[0], steps, ledgers), hips,
+                           batch[6], (ks, self.seeds), True, (*known[1:], some))
