@@ -22,6 +22,8 @@ from __future__ import annotations
 
 from operator import attrgetter, is_, itemgetter, le, sub
 
+import numpy as np
+
 from walkerlab.integrate.rows_dop853 import TIMEOUT
 
 from .batch import _hips, end_periods, held_torques, view_messages
@@ -56,8 +58,8 @@ class _Steady:
     from each steady period after it."""
 
     __slots__ = ("envs", "views", "p", "key", "entries", "lanes", "batch", "walker", "lim",
-                 "lo", "dts", "seeds", "foot", "cols", "off", "known", "strikes", "Yev", "X",
-                 "T", "K", "hips")
+                 "lo", "dts", "seeds", "foot", "cols", "off", "known", "strikes", "obs",
+                 "sums", "Yev", "X", "T", "K", "hips")
 
     def __init__(self, envs, views, p, key, entries, lanes, batch, read, env_read, Yev, X,
                  stops, elapsed, hips):
@@ -81,6 +83,10 @@ class _Steady:
         self.known = ([""] * n, [False] * n,
                       view_messages(views), list(ledgers[0]))
         self.strikes = [[] for _ in views]  # (none: read, never written)
+        m = Yev.shape[1]  # (the observations' buffer: its stance-leg and phase columns)
+        self.obs = np.empty((n, m + 3))
+        self.obs[:, m:m + 2] = batch[6]
+        self.sums = None  # (the ledgers' copies as the last period ended)
         self.Yev, self.X, self.T, self.K, self.hips = Yev, X, stops, elapsed, hips
 
     def period(self, envs, views, actions, p: dict, cache: dict):
@@ -124,7 +130,10 @@ class _Steady:
         x_before = self.hips
         self.Yev, self.X, self.T, self.K, self.hips = Yev, X, stops, ks, hips
         legs, kk, t_steps, steps, ledgers = self.cols
+        sums = self.sums
+        if some or sums is None:  # (no torque: the ledgers as the last period left them)
+            sums = self.sums = list(map(dict.copy, ledgers))
         known = self.known
         return end_periods(envs, U, self.strikes, x_before, w_before, p, views, Yev,
                            (X, stops, legs, kk, t_steps, known[0], steps, ledgers), hips,
-                           batch[6], (ks, self.seeds), True, (*known[1:], some))
+                           self.obs, (ks, self.seeds), True, (*known[1:], some, sums))
