@@ -2,7 +2,8 @@
 a common period after one whose every walker settled at its piece's end reuses what that
 period wrote instead of reading the walkers again; it must give ``gymnasium.make_vec(...,
 "sync")``'s numbers bit for bit, and fall back on the common period whenever a walker may
-have changed (a heel strike, a fall, a reset, ``set_attr``).
+have changed (a heel strike, a fall, a reset, ``set_attr``); and the rewards and flags it
+returns uncopied stay the caller's.
 
 Compared exactly (no tolerance): ``gym.make``'s environment advances its walker with the
 same kernel as a batch of one (tests/test_gym_vector.py), so sync's numbers are the native
@@ -72,3 +73,27 @@ def test_steady_periods_equal_sync_through_heel_strikes_falls_and_resets(
     assert counts["ran"] > steps // 3 and counts["back"] > 0
     sync.close()
     native.close()
+
+
+def test_a_steps_arrays_stay_as_returned_through_later_steps_and_resets():
+    """The rewards and flags a step returns are the caller's (not copied again: the vector
+    env copies them before it writes, ``_own``): through later steps, a walker's fall and
+    its reset on the next step (rows written in place), the time limit and a partial
+    ``reset``, every array returned stays as it was returned."""
+    env = _native(3, "threelink_hzd", max_episode_steps=40, policy=None)
+    env.reset(seed=2)
+    actions = np.zeros((90, 3, 2), np.float32)
+    actions[:, 0] = 1.0  # (walker 0 pushed over: it falls, the others walk on)
+    kept = []
+    for t, a in enumerate(actions):
+        out = env.step(a)
+        kept.append((out[:4], [x.copy() for x in out[:4]]))
+        if t == 60:
+            env.reset(options={"reset_mask": np.array([False, True, False])})
+        for got, copy in kept:
+            for x, y in zip(got, copy, strict=True):
+                np.testing.assert_array_equal(x, y)
+    steps = [o for o, _ in kept]
+    terms = np.array([o[2] for o in steps])
+    assert terms[:, 0].any() and not terms[:, 1:].any() and np.array([o[3] for o in steps]).any()
+    env.close()
