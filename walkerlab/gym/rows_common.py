@@ -382,22 +382,25 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
                Y=None) -> tuple:
     """The kernel on every walker's piece: ``(which, te, Yev, Y, cap, Yn, call)`` as
     :func:`walkerlab.gym.rigid_rows._integrate_rows` gives them (its arguments the same:
-    the data rows with this period's torques and clocks, the start states - ``Y`` when
-    given (N, m), else the last common period's array when the walkers hold its rows -,
-    the caps [s], the Gauss-Legendre nodes of the rows with the action on)."""
+    the data rows with this period's torques and clocks, the start states - the last
+    common period's array when the walkers hold its rows -, the caps [s], the
+    Gauss-Legendre nodes of the rows with the action on).  ``Y`` (N, m): the start states
+    of a steady period (:mod:`walkerlab.gym.rows_steady`: the walkers untouched since the
+    last period, their step clocks those it wrote into the data rows)."""
     base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi) = batch[:5]
-    acts = batch[8]
-    origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]] if acts[0] is None
-               else list(map(float, map(_T_ORIGIN, acts[1]))))
     if same:  # (the batch's data rows: this period's torques and clocks written in)
         held = batch[9]
         if not held:
             held += [base.copy(), clocks]
         D = held[0]
         D[:, entries[0][4][1]] = U
-        if origins != held[1]:
-            D[:, entries[0][4][2]] = origins
-            held[1] = origins
+        if Y is None:  # (the flows' step clocks, written where they moved)
+            acts = batch[8]
+            origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]]
+                       if acts[0] is None else list(map(float, map(_T_ORIGIN, acts[1]))))
+            if origins != held[1]:
+                D[:, entries[0][4][2]] = origins
+                held[1] = origins
     else:  # (the law blocks written, as next_piece writes them, and read back)
         for v, lane, u in zip(views, lanes, rows_u):
             _hold(v, lane[6], u)

@@ -59,7 +59,7 @@ class _Steady:
 
     __slots__ = ("envs", "views", "p", "key", "entries", "lanes", "batch", "walker", "lim",
                  "lo", "dts", "seeds", "foot", "cols", "off", "known", "strikes", "obs",
-                 "sums", "Yev", "X", "T", "K", "hips")
+                 "sums", "held", "Yev", "X", "T", "K", "hips")
 
     def __init__(self, envs, views, p, key, entries, lanes, batch, read, env_read, Yev, X,
                  stops, elapsed, hips):
@@ -87,6 +87,8 @@ class _Steady:
         self.obs = np.empty((n, m + 3))
         self.obs[:, m:m + 2] = batch[6]
         self.sums = None  # (the ledgers' copies as the last period ended)
+        #: the last torques' bytes, their rows, whether some and which rows are on
+        self.held: tuple = (None, None)
         self.Yev, self.X, self.T, self.K, self.hips = Yev, X, stops, elapsed, hips
 
     def period(self, envs, views, actions, p: dict, cache: dict):
@@ -105,12 +107,17 @@ class _Steady:
         else:  # (next_piece's min(t_end, t_step + max_step_time))
             stops = [t if t < te else te for t, te in zip(self.lim, t_ends)]
         U = held_torques(envs, actions, p)
-        some = any(U.ravel().tolist())
-        on = list(map(any, U.tolist())) if some else self.off
+        bits = U.tobytes()
+        if bits == self.held[0]:  # (the last period's torques: its rows, which hold them)
+            rows_u, some, on = self.held[1]
+        else:
+            some = any(U.ravel().tolist())
+            rows_u = list(U)
+            on = list(map(any, U.tolist())) if some else self.off
+            self.held = (bits, (rows_u, some, on))
         batch = self.batch
         if some and not batch[7][1]:  # (a ledger not taken at once)
             return None
-        rows_u = list(U)
         w_before = list(map(_WORK, self.cols[4]))
         out = _integrate(views, self.entries, self.lanes, rows_u, U, on, self.key, batch,
                          self.X, list(map(sub, stops, self.T)), cache, self.Yev)
