@@ -12,6 +12,8 @@ from operator import attrgetter, itemgetter
 
 import numpy as np
 
+from .infos import view_messages
+
 __all__ = ["batch_parameters", "begin_periods", "end_periods", "held_torques", "hip_xs"]
 
 
@@ -225,9 +227,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
     known : tuple, optional
         ``(terminated, messages, terms, some, sums)``, when the caller knows them: each
         episode's end as a bool (list of N; ``cols``' ends), each view's solver words
-        (:func:`view_messages`), the ledgers' terms in order, whether some torque in ``U``
-        is not zero, the ledgers' copies (list of N dicts, never written: ``ledgers``'
-        numbers now).
+        (:func:`~walkerlab.gym.infos.view_messages`), the ledgers' terms in order,
+        whether some torque in ``U`` is not zero, the ledgers' copies (list of N dicts,
+        never written: ``ledgers``' numbers now).
 
     Returns
     -------
@@ -308,25 +310,6 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         return out
 
     return obs, reward, np.array(terminated, dtype=np.bool_), truncated, columns
-
-
-def view_messages(views) -> list:
-    """Each view's solver words (its ``failure``, "" without one: the rigid view's are its
-    instance's, when it has them), as :func:`end_periods`' infos read them."""
-    if not any(map(_class_failure, set(map(type, views)))):
-        return [v.__dict__.get("failure", "") for v in views]
-    return [getattr(v, "failure", "") for v in views]
-
-
-_CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
-
-
-def _class_failure(cls) -> bool:
-    """Whether the class ``cls`` has an attribute ``failure`` (kept per class)."""
-    out = _CLASS_FAILURE.get(cls)
-    if out is None:
-        out = _CLASS_FAILURE[cls] = hasattr(cls, "failure")
-    return out
 
 
 #: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``

@@ -26,7 +26,8 @@ import numpy as np
 
 from walkerlab.integrate.rows_dop853 import TIMEOUT
 
-from .batch import _hips, end_periods, held_torques, view_messages
+from .batch import _hips, end_periods, held_torques
+from .infos import view_messages
 from .rows_common import _integrate, _settle_rows, settle_all, step_common
 from .small_arrays import all_finite
 
