@@ -22,8 +22,8 @@ and a mask ``_key`` per key, as ``VectorEnv._add_info`` batches N dicts, without
 them); the same element-wise operations as each walker's own ``step``, so that these
 numbers are those of each walker ending its own period on the same physics, bit for bit.
 A common period (every stepped walker where its last period left it, in a compiled phase of
-one flow: most periods) runs all of this in one pass over the walkers
-(:func:`walkerlab.gym.rows_common.step_common`).
+one flow: most periods) runs all of this in one pass over the walkers (``step_common``; after
+one that settled them all, without reading them: :mod:`walkerlab.gym.rows_steady`).
 A ``reward_fn`` (it is given each walker's info dict) has each walker begin and end its
 own period around the batched physics; the contact view, or ``batched=False``, steps them
 one after another.  The time limit, the autoreset and the batching of the infos are this
