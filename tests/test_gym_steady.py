@@ -19,18 +19,25 @@ from tests.test_gym_vector import _native, _run, _same, _vec  # noqa: E402
 
 
 def _count_steady(monkeypatch) -> dict:
-    """Count the steady periods run (``ran``) and those that fell back (``back``)."""
+    """Count the steady periods run (``ran``), those that fell back (``back``) and those
+    whose rows did not all settle (``slow``: a guard crossing taken from the steady
+    period)."""
     from walkerlab.gym import rows_steady
 
-    counts = {"ran": 0, "back": 0}
-    period = rows_steady._Steady.period
+    counts = {"ran": 0, "back": 0, "slow": 0}
+    period, slow_period = rows_steady._Steady.period, rows_steady.slow_period
 
     def counted(self, *args):
         out = period(self, *args)
         counts["ran" if out is not None else "back"] += 1
         return out
 
+    def slow(*args):
+        counts["slow"] += 1
+        return slow_period(*args)
+
     monkeypatch.setattr(rows_steady._Steady, "period", counted)
+    monkeypatch.setattr(rows_steady, "slow_period", slow)
     return counts
 
 
@@ -43,9 +50,10 @@ def test_steady_periods_equal_sync_through_heel_strikes_falls_and_resets(
     controller and zero actions (no torque: the benchmark's case), walker 0 pushed for 10
     periods twice (without the controller it falls: autoresets of one walker), the time
     limit 70 (truncations, resets of every walker at once).  Over 260 periods a third or more
-    steady, every output (observations, rewards, flags, infos) is sync's exactly, heel
-    strikes, truncations (and falls) met; a ``set_attr`` half-way is read by the next
-    period (the steady one falls back)."""
+    steady (guard crossings among them: their rows taken as the common period takes them),
+    every output (observations, rewards, flags, infos) is sync's exactly, heel strikes,
+    truncations (and falls) met; a ``set_attr`` half-way is read by the next period (the
+    steady one falls back)."""
     counts = _count_steady(monkeypatch)
     n, steps = 8, 260
     kw = dict(start_noise=0.05, max_episode_steps=70, policy=policy)
@@ -70,7 +78,7 @@ def test_steady_periods_equal_sync_through_heel_strikes_falls_and_resets(
     terms = np.array([o[2] for o in outs])
     assert np.array([o[3] for o in outs]).any() and (terms.any() or policy == "scene")
     assert sum(int(o[4]["heel_strike"].sum()) for o in outs) > n
-    assert counts["ran"] > steps // 3 and counts["back"] > 0
+    assert counts["ran"] > steps // 3 and counts["back"] > 0 and counts["slow"] > 0
     sync.close()
     native.close()
 

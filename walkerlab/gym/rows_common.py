@@ -236,8 +236,8 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     which, te, Yev, Y, cap, Yn, call = out
     env_cols = (elapsed, list(map(_FOURTH, env_read)))  # (counts and terrain seeds)
     settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
-    X = list(Yev)
     if not slow:
+        X = list(Yev)
         cache["X"] = (Yev, X)
         # the hips' x: one call of the walkers' one points function on the states as
         # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
@@ -257,12 +257,29 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
                            Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
                            batch[6], env_cols, hips is not None)
+    return slow_period(envs, views, lanes, rows_u, on, stops, t_ends, settled, slow, out, U,
+                       x_before, w_before, p, env_cols, cache)
+
+
+def slow_period(envs, views, lanes, rows_u, on, stops, t_ends, settled, slow, out, U,
+                x_before, w_before, p, env_cols, cache) -> tuple:
+    """A common period whose rows ``slow`` did not settle at their pieces' ends (a guard
+    crossing, a failed step, a state not finite), its kernel's ``out`` run
+    (:func:`_integrate`; the ledgers of the rows ``settled`` taken: :func:`_settle_rows`):
+    each walker's period opened (:func:`settle_all`'s count, period and torques
+    ``rows_u``), the rows settled or absorbed and their periods gone on
+    (:func:`_absorb_slow`), and :func:`~walkerlab.gym.batch.end_periods`' outputs
+    (``x_before``, ``w_before``: the reward's origins; ``env_cols``: the counts and terrain
+    seeds) of the walkers read again."""
+    elapsed = env_cols[0]
     for e, v, lane, u, t_end, k in zip(envs, views, lanes, rows_u, t_ends, elapsed):
         e._elapsed = k  # (begin_periods, open_period, next_piece)
         v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
         lane[3].u = u
     # (the data rows as they are now: the batch's own array is written again next period,
     # a guard crossing's dense output may read them later)
+    Yev, call = out[2], out[6]
+    X = list(Yev)
     out = (*out[:6], (*call[:3], call[3].copy(), *call[4:]))
     strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
     cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)

@@ -10,12 +10,12 @@ is still that very array (a reset, a heel strike, any absorbed piece gives a wal
 one; :meth:`~walkerlab.gym.vector.WalkerVectorEnv.set_attr` and ``call`` give the vector env
 new parameters and views); the period then skips reading and checking every walker
 (:func:`walkerlab.gym.rows_common._common`) and runs the kernel on the kept batch.  It falls
-back on the common period, before any walker is changed, whenever it may not be steady: a
-walker's step at its time limit (a stall), some walker's piece ending otherwise than at its
-end (a guard crossing, a failed step, a state not finite: the common period integrates the
-same rows again, the same numbers), torques held by walkers whose ledger is not taken at
-once.  The same operations on the same numbers as the common period, so the same numbers
-bit for bit.
+back on the common period, before any walker is changed, whenever it may not be steady (a
+walker's step at its time limit: a stall; torques held by walkers whose ledger is not taken
+at once); the rows whose pieces ended otherwise than at their ends (a guard crossing, a
+failed step, a state not finite) are taken as the common period takes them
+(:func:`walkerlab.gym.rows_common.slow_period`).  The same operations on the same numbers as
+the common period, so the same numbers bit for bit.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from walkerlab.integrate.rows_dop853 import TIMEOUT
 
 from .batch import _hips, end_periods, held_torques
 from .infos import view_messages
-from .rows_common import _integrate, _settle_rows, settle_all, step_common
+from .rows_common import _integrate, _settle_rows, settle_all, slow_period, step_common
 from .small_arrays import all_finite
 
 __all__ = ["step"]
@@ -125,7 +125,11 @@ class _Steady:
         which, _, Yev, Y, cap, Yn, _ = out
         ends = which.tolist()
         if not (min(ends) == TIMEOUT == max(ends) and all_finite(Yev)):
-            return None  # (the common period integrates them again)
+            # (rows not at their pieces' ends: the common period's slow rows, from here)
+            cache["steady"] = None
+            settled, slow = _settle_rows(views, on, ends, Yev, Y, cap, Yn, U, batch)
+            return slow_period(envs, views, self.lanes, rows_u, on, stops, t_ends, settled,
+                               slow, out, U, self.hips, w_before, p, (ks, self.seeds), cache)
         hx = _hips(self.walker, Yev)
         if hx is None:  # pragma: no cover - the common period's hips were made so
             return None
