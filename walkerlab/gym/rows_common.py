@@ -291,8 +291,8 @@ def settle_all(envs, views, lanes, rows_u, t_ends, elapsed, X, stops, hips) -> N
     :meth:`~walkerlab.gym.rigid_view.RigidView.open_period`, ``next_piece``'s torques
     ``rows_u``) and settled at its piece's end ``stops`` [s] in the state ``X[r]``
     (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, no stall), in one pass; ``hips``
-    [m]: each environment's next reward's origin (None: :func:`~walkerlab.gym.batch.
-    end_periods`' to write)."""
+    [m]: each environment's next reward's origin (None:
+    :func:`~walkerlab.gym.batch.end_periods`' to write)."""
     for e, v, lane, u, t_end, k, x, t_stop, h in zip(
             envs, views, lanes, rows_u, t_ends, elapsed, X, stops, hips):
         e._elapsed = k  # (begin_periods, open_period, next_piece)
@@ -425,14 +425,12 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
         entries[0][3].data_rows([en[3] for en in entries], D)
     f, fs, fg, sel, rtol, atol, n_out = kernel
     N, m = len(views), key[4]
-    last = cache.get("X")  # (the last common period's states: the walkers' own rows)
-    if Y is not None:
-        pass
-    elif (last is not None and len(last[1]) == N
-            and all(map(is_, xs, last[1]))):
-        Y = last[0]
-    else:
-        Y = np.array(xs, dtype=float)
+    if Y is None:
+        last = cache.get("X")  # (the last common period's states: the walkers' own rows)
+        if last is not None and len(last[1]) == N and all(map(is_, xs, last[1])):
+            Y = last[0]
+        else:
+            Y = np.array(xs, dtype=float)
     cap, which, te, Yev, Tn, Yn = period_buffers(caps, on, N, m)
     args = (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol, n_out, which,
             te, Yev, np.zeros(N), Tn, Yn)

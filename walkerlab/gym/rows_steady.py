@@ -20,6 +20,7 @@ the common period, so the same numbers bit for bit.
 
 from __future__ import annotations
 
+import math
 from operator import attrgetter, is_, itemgetter, le, sub
 
 import numpy as np
@@ -72,7 +73,7 @@ class _Steady:
         self.lim = [a + b for a, b in zip(t_steps, msts)]
         #: the earliest of them (below every period's end: no stall, each piece to its
         #: period's end; -inf when one is NaN: each compared)
-        self.lo = min(self.lim) if self.lim == self.lim else -float("inf")
+        self.lo = -math.inf if any(map(math.isnan, self.lim)) else min(self.lim)
         self.dts = [er[1] for er in env_read]
         self.seeds = [er[3] for er in env_read]
         self.foot = [f.item(0) for f in feet]
