@@ -12,7 +12,7 @@ import gymnasium as gym
 import numpy as np
 
 __all__ = ["MAX_START_NOISE", "InvalidAction", "check_arguments", "checked_action", "plant_scene",
-           "rigid_ground"]
+           "rigid_ground", "whole_number"]
 
 #: the largest ``start_noise``: the start's rates times ``1 + U(-1, 1)`` (from rest to twice
 #: the gait's rates; beyond, rates change sign)
@@ -83,6 +83,23 @@ def check_arguments(view, control_period_s, max_episode_steps, render_mode, star
     if start_noise > MAX_START_NOISE:
         raise ValueError(f"start_noise={start_noise!r}: give a relative noise in [0, "
                          f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
+
+
+def whole_number(value, name: str, low: int, allow_none: bool = False) -> int | None:
+    """``value`` as a whole number >= ``low`` (or None when ``allow_none``).
+
+    Raises
+    ------
+    ValueError
+        Not a whole number >= ``low`` (a bool, a float, text) or None where not allowed
+        (one line naming ``name``).
+    """
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise ValueError(f"{name}={value!r}: give a whole number >= {low}"
+                         + (" or None" if allow_none else ""))
+    return int(value)
 
 
 class InvalidAction(ValueError, gym.error.InvalidAction):

@@ -12,6 +12,8 @@ from operator import attrgetter, itemgetter
 
 import numpy as np
 
+from .infos import view_messages
+
 __all__ = ["batch_parameters", "begin_periods", "end_periods", "held_torques", "hip_xs"]
 
 
@@ -123,7 +125,9 @@ def held_torques(envs, actions: np.ndarray, p: dict) -> np.ndarray:
     every, some, policy = p.get("flags") or _flags(p)
     tau = p["tau"]
     if every:  # (the actions read as float64, then scaled: numpy's casting of any real
-        a = np.multiply(actions, tau, dtype=np.float64)  # dtype, in one operation)
+        # dtype, in one operation; float32 or float64 ones are cast so by the product)
+        a = (np.multiply(actions, tau) if actions.dtype in _PROMOTED
+             else np.multiply(actions, tau, dtype=np.float64))
     else:
         a = np.asarray(actions).astype(np.float64)
     if not every and some:
@@ -137,6 +141,8 @@ def held_torques(envs, actions: np.ndarray, p: dict) -> np.ndarray:
     return _CLIP(a, _neg_tau(p), tau, out=a)
 
 
+#: actions' dtypes whose product with float64 torques is float64 (numpy's promotion)
+_PROMOTED = frozenset({np.dtype(np.float32), np.dtype(np.float64)})
 #: the ufunc ``ndarray.clip(lo, hi)`` calls (numpy's ``_methods._clip``: ``umath.clip``),
 #: without its Python layer (numpy's own function where its module is not there)
 _CLIP = getattr(getattr(getattr(np, "_core", None), "umath", None), "clip", np.clip)
@@ -153,18 +159,23 @@ def _neg_tau(p: dict) -> np.ndarray:
 def _observations(X: np.ndarray, ts, legs, ks, t_steps, p: dict, fixed=None) -> np.ndarray:
     """The observations (N, m + 3) of the states ``X`` (N, m): each state, then leg1's
     stance as 1.0, the phase's index as a float and the time in the step [s] (``ts``
-    minus ``t_steps``; the float64 of each; the first two ``fixed`` (N, 2) when given),
-    clipped to :func:`batch_parameters`' bounds."""
+    minus ``t_steps``; the float64 of each; the first two ``fixed`` (N, 2) when given, or
+    a buffer ``fixed`` (N, m + 3) holding them in its columns ``m, m + 1``, the others
+    written here), clipped to :func:`batch_parameters`' bounds (a new array)."""
     m = X.shape[1]
-    obs = np.empty((X.shape[0], m + 3))
-    obs[:, :m] = X
-    if fixed is None:
-        obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0 in
-                      zip(legs, ks, ts, t_steps)]
+    if fixed is not None and fixed.shape[1] == m + 3:
+        obs = fixed
     else:
+        obs = np.empty((X.shape[0], m + 3))
+        if fixed is None:
+            obs[:, :m] = X
+            obs[:, m:] = [(1.0 if leg == "leg1" else 0.0, k, tv - ts0) for leg, k, tv, ts0
+                          in zip(legs, ks, ts, t_steps)]
+            return _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc)
         obs[:, m:m + 2] = fixed
-        obs[:, m + 2] = [tv - ts0 for tv, ts0 in zip(ts, t_steps)]
-    return _CLIP(obs, p["low"], p["high"], out=obs)  # (ndarray.clip's ufunc: its numbers)
+    obs[:, :m] = X
+    obs[:, m + 2] = [tv - ts0 for tv, ts0 in zip(ts, t_steps)]
+    return _CLIP(obs, p["low"], p["high"], out=None if obs is fixed else obs)
 
 
 #: a ledger's positive action work [J]
@@ -177,7 +188,7 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
                 p: dict, views=None, X: np.ndarray | None = None,
                 cols: tuple | None = None, hips: list | None = None,
                 fixed: np.ndarray | None = None, env_cols: tuple | None = None,
-                written: bool = False) -> tuple:
+                written: bool = False, known: tuple | None = None) -> tuple:
     """:meth:`~walkerlab.gym.env.WalkerEnv.end_period` of N rigid-view environments at
     once, their walkers advanced (:func:`walkerlab.gym.rigid_rows.advance_rows`):
     observations, rewards, flags and the infos as columns.
@@ -203,15 +214,22 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         starts, ends, steps, ledgers, each a sequence of N), when the caller has read it.
     hips : list of float, optional
         The hips' world x [m] (:func:`hip_xs`' numbers), when the caller has them.
-    fixed : ndarray (N, 2), optional
+    fixed : ndarray (N, 2) or (N, m + 3), optional
         The observations' stance-leg and phase columns (leg1's stance as 1.0, the phase's
-        index), when the caller has them.
+        index), when the caller has them; or a buffer holding them in its columns ``m, m +
+        1`` (its other columns written here: the caller's, kept from call to call).
     env_cols : tuple, optional
         ``(elapsed, seeds)``: each environment's period count (``_elapsed``, this period
         counted) and ``terrain_seed``, sequences of N, when the caller has read them.
     written : bool
         The caller has written ``hips`` into each environment (its next period's reward's
         origin).
+    known : tuple, optional
+        ``(terminated, messages, terms, some, sums)``, when the caller knows them: each
+        episode's end as a bool (list of N; ``cols``' ends), each view's solver words
+        (:func:`~walkerlab.gym.infos.view_messages`), the ledgers' terms in order,
+        whether some torque in ``U`` is not zero, the ledgers' copies (list of N dicts,
+        never written: ``ledgers``' numbers now).
 
     Returns
     -------
@@ -247,7 +265,14 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
             e._hip_x = h  # the next period's start (its reward's origin)
     # (each environment's count and seed)
     elapsed, seeds = zip(*map(_ENV_READ, envs)) if env_cols is None else env_cols
-    terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
+    if known is None:
+        terminated = list(map(bool, ended))  # (an end's text: "" while the episode goes on)
+        messages = view_messages(views)
+        terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
+        some = any(U.ravel().tolist())
+        sums = list(map(dict.copy, ledgers))  # (the ledgers now: copies, read as lists)
+    else:
+        terminated, messages, terms, some, sums = known
     fws, healthy, cws, wws, dts, limits = _lists(p)
     if _no_limit(p, limits):  # (no environment's own limit: a vector env's walkers)
         truncated = np.zeros(len(terminated), dtype=np.bool_)
@@ -255,11 +280,9 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         truncated = np.array([not te and lim >= 0 and el >= lim
                               for te, lim, el in zip(terminated, limits, elapsed)],
                              dtype=np.bool_)
-    terms = list(ledgers[0])  # (every walker's ledger holds LEDGER_TERMS in order)
-    sums = list(map(dict.copy, ledgers))  # (the ledgers now: copies, read as lists below)
     # the reward of each walker as its own end_period computes it, on Python floats (the
     # same IEEE operations in the same order as there)
-    if any(U.ravel().tolist()):
+    if some:
         effort = U / p["tau"]
         effort = np.add.reduce(np.square(effort, out=effort), axis=1).tolist()  # (** 2)
     else:  # (no torque: each walker's sum of (0 / tau)^2 is 0.0)
@@ -270,10 +293,6 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         for fw, h, xb, dt, te, hl, cw, c, ww, wa, wb in zip(
             fws, hips, x_before, dts, terminated, healthy, cws, effort, wws, work,
             w_before)], dtype=np.float64)
-    # (a view's own words, when it has them: the rigid view's are its instance's)
-    messages = ([v.__dict__.get("failure", "") for v in views]
-                if not any(map(_class_failure, set(map(type, views))))
-                else [getattr(v, "failure", "") for v in views])
 
     def columns() -> dict:  # (of the values read above, whenever called)
         L = np.array(list(map(list, map(dict.values, sums))), dtype=np.float64).T.copy()
@@ -291,17 +310,6 @@ def end_periods(envs, U: np.ndarray, strikes: list, x_before: list, w_before: li
         return out
 
     return obs, reward, np.array(terminated, dtype=np.bool_), truncated, columns
-
-
-_CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
-
-
-def _class_failure(cls) -> bool:
-    """Whether the class ``cls`` has an attribute ``failure`` (kept per class)."""
-    out = _CLASS_FAILURE.get(cls)
-    if out is None:
-        out = _CLASS_FAILURE[cls] = hasattr(cls, "failure")
-    return out
 
 
 #: per ``points`` function (by id): ``(points, the hips' x of states as columns or None)``

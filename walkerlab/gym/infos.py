@@ -1,13 +1,14 @@
 """The native vector environment's infos (:class:`walkerlab.gym.vector.WalkerVectorEnv`):
 the sub-environments' info dicts, or their columns, batched as
 :meth:`gymnasium.vector.VectorEnv._add_info` batches them one by one (:func:`batch_infos`,
-:func:`batch_columns`), and a step's infos batched on first use (:class:`LazyInfos`)."""
+:func:`batch_columns`), a step's infos batched on first use (:class:`LazyInfos`), and the
+views' solver words they hold (:func:`view_messages`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LazyInfos", "batch_columns", "batch_infos"]
+__all__ = ["LazyInfos", "batch_columns", "batch_infos", "view_messages"]
 
 
 def batch_infos(each: list[dict]) -> dict | None:
@@ -110,3 +111,23 @@ for _name in ("__getitem__", "__iter__", "__len__", "__contains__", "__eq__", "_
               "get", "pop", "popitem", "setdefault", "update", "copy", "clear"):
     setattr(LazyInfos, _name, _filling(_name))
 del _name
+
+
+def view_messages(views) -> list:
+    """Each view's solver words (its ``failure``, "" without one: the rigid view's are its
+    instance's, when it has them), as :func:`walkerlab.gym.batch.end_periods`' infos read
+    them (``solver_message``)."""
+    if not any(map(_class_failure, set(map(type, views)))):
+        return [v.__dict__.get("failure", "") for v in views]
+    return [getattr(v, "failure", "") for v in views]
+
+
+_CLASS_FAILURE: dict = {}  # a view's class -> whether it has an attribute ``failure``
+
+
+def _class_failure(cls) -> bool:
+    """Whether the class ``cls`` has an attribute ``failure`` (kept per class)."""
+    out = _CLASS_FAILURE.get(cls)
+    if out is None:
+        out = _CLASS_FAILURE[cls] = hasattr(cls, "failure")
+    return out

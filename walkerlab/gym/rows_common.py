@@ -219,6 +219,7 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
         columns)``; None when the period is not common (nothing changed: the caller steps
         the walkers its own way).
     """
+    cache["steady"] = None  # (what a steady period reuses: this one's, when it is one)
     got = _common(envs, views, cache)
     if got is None:
         return None
@@ -235,42 +236,71 @@ def step_common(envs, views, actions: np.ndarray, p: dict, cache: dict):
     which, te, Yev, Y, cap, Yn, call = out
     env_cols = (elapsed, list(map(_FOURTH, env_read)))  # (counts and terrain seeds)
     settled, slow = _settle_rows(views, on, which.tolist(), Yev, Y, cap, Yn, U, batch)
-    X = list(Yev)
     if not slow:
+        X = list(Yev)
         cache["X"] = (Yev, X)
         # the hips' x: one call of the walkers' one points function on the states as
         # columns (hip_xs' numbers: the foot's x plus the hip's from the foot)
         hx = _hips(walkers[0], Yev) if batch[5] else None
         hips = (None if hx is None
                 else [foot.item(0) + h for foot, h in zip(feet, hx.tolist())])
-        # each walker's period opened and settled (RigidView.settle) in one pass
-        for e, v, lane, u, t_end, k, x, t_stop, h in zip(
-                envs, views, lanes, rows_u, t_ends, elapsed, X, stops,
-                hips if hips is not None else [None] * len(views)):
-            e._elapsed = k  # (begin_periods, open_period, next_piece)
-            v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
-            lane[3].u = u
-            v.t = t_stop
-            v.x = x
-            e._hip_x = h  # (the next period's reward's origin; None: end_periods' to write)
+        settle_all(envs, views, lanes, rows_u, t_ends, elapsed, X, stops,
+                   hips if hips is not None else [None] * len(views))
         ended = [""] * len(views)
         if stall:  # (RigidView.settle: a walker at its step's time limit)
             for r, (t_stop, t_step, mst) in enumerate(zip(stops, t_steps, msts)):
                 if t_stop >= t_step + mst:
                     views[r].ended = ended[r] = "stall"
+        elif hips is not None:  # (a steady period next: walkerlab.gym.rows_steady)
+            cache["steady"] = (envs, views, p, key, entries, lanes, batch, read, env_read,
+                               Yev, X, stops, elapsed, hips)
         return end_periods(envs, U, [[] for _ in views], x_before, w_before, p, views,
                            Yev, (X, stops, legs, ks, t_steps, ended, steps, ledgers), hips,
                            batch[6], env_cols, hips is not None)
+    return slow_period(envs, views, lanes, rows_u, on, stops, t_ends, settled, slow, out, U,
+                       x_before, w_before, p, env_cols, cache)
+
+
+def slow_period(envs, views, lanes, rows_u, on, stops, t_ends, settled, slow, out, U,
+                x_before, w_before, p, env_cols, cache) -> tuple:
+    """A common period whose rows ``slow`` did not settle at their pieces' ends (a guard
+    crossing, a failed step, a state not finite), its kernel's ``out`` run
+    (:func:`_integrate`; the ledgers of the rows ``settled`` taken: :func:`_settle_rows`):
+    each walker's period opened (:func:`settle_all`'s count, period and torques
+    ``rows_u``), the rows settled or absorbed and their periods gone on
+    (:func:`_absorb_slow`), and :func:`~walkerlab.gym.batch.end_periods`' outputs
+    (``x_before``, ``w_before``: the reward's origins; ``env_cols``: the counts and terrain
+    seeds) of the walkers read again."""
+    elapsed = env_cols[0]
     for e, v, lane, u, t_end, k in zip(envs, views, lanes, rows_u, t_ends, elapsed):
         e._elapsed = k  # (begin_periods, open_period, next_piece)
         v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
         lane[3].u = u
     # (the data rows as they are now: the batch's own array is written again next period,
     # a guard crossing's dense output may read them later)
+    Yev, call = out[2], out[6]
+    X = list(Yev)
     out = (*out[:6], (*call[:3], call[3].copy(), *call[4:]))
     strikes = _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out)
     cache["X"] = (Yev, X)  # (the settled walkers' rows; the others' own: not reused)
     return end_periods(envs, U, strikes, x_before, w_before, p, views, env_cols=env_cols)
+
+
+def settle_all(envs, views, lanes, rows_u, t_ends, elapsed, X, stops, hips) -> None:
+    """Each walker's period opened (:func:`~walkerlab.gym.batch.begin_periods`' count,
+    :meth:`~walkerlab.gym.rigid_view.RigidView.open_period`, ``next_piece``'s torques
+    ``rows_u``) and settled at its piece's end ``stops`` [s] in the state ``X[r]``
+    (:meth:`~walkerlab.gym.rigid_view.RigidView.settle`, no stall), in one pass; ``hips``
+    [m]: each environment's next reward's origin (None:
+    :func:`~walkerlab.gym.batch.end_periods`' to write)."""
+    for e, v, lane, u, t_end, k, x, t_stop, h in zip(
+            envs, views, lanes, rows_u, t_ends, elapsed, X, stops, hips):
+        e._elapsed = k  # (begin_periods, open_period, next_piece)
+        v._period = (u, t_end)  # (its step's log: a profile's alone, never common)
+        lane[3].u = u
+        v.t = t_stop
+        v.x = x
+        e._hip_x = h  # (the next period's reward's origin; None: end_periods' to write)
 
 
 def _absorb_slow(views, lanes, rows_u, on, stops, t_ends, settled, slow, X, out) -> list:
@@ -365,25 +395,29 @@ def _origins(acts: list) -> tuple:
     return (True if all(hasattr(a, "t_origin") for a in acts) else None), acts
 
 
-def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache) -> tuple:
+def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache,
+               Y=None) -> tuple:
     """The kernel on every walker's piece: ``(which, te, Yev, Y, cap, Yn, call)`` as
     :func:`walkerlab.gym.rigid_rows._integrate_rows` gives them (its arguments the same:
     the data rows with this period's torques and clocks, the start states - the last
     common period's array when the walkers hold its rows -, the caps [s], the
-    Gauss-Legendre nodes of the rows with the action on)."""
+    Gauss-Legendre nodes of the rows with the action on).  ``Y`` (N, m): the start states
+    of a steady period (:mod:`walkerlab.gym.rows_steady`: the walkers untouched since the
+    last period, their step clocks those it wrote into the data rows)."""
     base, clocks, same, kernel, (gcols, goffs, dirs, ng, gi) = batch[:5]
-    acts = batch[8]
-    origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]] if acts[0] is None
-               else list(map(float, map(_T_ORIGIN, acts[1]))))
     if same:  # (the batch's data rows: this period's torques and clocks written in)
         held = batch[9]
         if not held:
             held += [base.copy(), clocks]
         D = held[0]
         D[:, entries[0][4][1]] = U
-        if origins != held[1]:
-            D[:, entries[0][4][2]] = origins
-            held[1] = origins
+        if Y is None:  # (the flows' step clocks, written where they moved)
+            acts = batch[8]
+            origins = ([float(getattr(a, "t_origin", 0.0)) for a in acts[1]]
+                       if acts[0] is None else list(map(float, map(_T_ORIGIN, acts[1]))))
+            if origins != held[1]:
+                D[:, entries[0][4][2]] = origins
+                held[1] = origins
     else:  # (the law blocks written, as next_piece writes them, and read back)
         for v, lane, u in zip(views, lanes, rows_u):
             _hold(v, lane[6], u)
@@ -391,12 +425,12 @@ def _integrate(views, entries, lanes, rows_u, U, on, key, batch, xs, caps, cache
         entries[0][3].data_rows([en[3] for en in entries], D)
     f, fs, fg, sel, rtol, atol, n_out = kernel
     N, m = len(views), key[4]
-    last = cache.get("X")  # (the last common period's states: the walkers' own rows)
-    if (last is not None and len(last[1]) == N
-            and all(map(is_, xs, last[1]))):
-        Y = last[0]
-    else:
-        Y = np.array(xs, dtype=float)
+    if Y is None:
+        last = cache.get("X")  # (the last common period's states: the walkers' own rows)
+        if last is not None and len(last[1]) == N and all(map(is_, xs, last[1])):
+            Y = last[0]
+        else:
+            Y = np.array(xs, dtype=float)
     cap, which, te, Yev, Tn, Yn = period_buffers(caps, on, N, m)
     args = (f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, ng, gi, rtol, atol, n_out, which,
             te, Yev, np.zeros(N), Tn, Yn)

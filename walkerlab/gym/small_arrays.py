@@ -53,6 +53,7 @@ def all_finite(a: np.ndarray) -> bool:
     """
     if a.dtype.kind != "f":
         return a.dtype.kind in "iub" or bool(np.isfinite(a).all())
-    if a.size <= SMALL:
-        return all(map(math.isfinite, a.ravel().tolist()))
+    if a.size <= SMALL:  # (a finite sum of the values: each is finite, NaN and inf
+        vals = a.ravel().tolist()  # propagating; else, an overflow maybe: each tested)
+        return math.isfinite(sum(vals)) or all(map(math.isfinite, vals))
     return bool(np.isfinite(a).all())

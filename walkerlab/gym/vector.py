@@ -22,8 +22,8 @@ and a mask ``_key`` per key, as ``VectorEnv._add_info`` batches N dicts, without
 them); the same element-wise operations as each walker's own ``step``, so that these
 numbers are those of each walker ending its own period on the same physics, bit for bit.
 A common period (every stepped walker where its last period left it, in a compiled phase of
-one flow: most periods) runs all of this in one pass over the walkers
-(:func:`walkerlab.gym.rows_common.step_common`).
+one flow: most periods) runs all of this in one pass over the walkers (``step_common``; after
+one that settled them all, without reading them: :mod:`walkerlab.gym.rows_steady`).
 A ``reward_fn`` (it is given each walker's info dict) has each walker begin and end its
 own period around the batched physics; the contact view, or ``batched=False``, steps them
 one after another.  The time limit, the autoreset and the batching of the infos are this
@@ -40,23 +40,13 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, create_empty_array
 
+from .arguments import whole_number
 from .batch import batch_parameters, begin_periods, end_periods
 from .env import DEFAULT_EPISODE_STEPS, InvalidAction, WalkerEnv, registered_env
 from .infos import LazyInfos, batch_columns, batch_infos
 from .small_arrays import all_finite, any_true
 
 __all__ = ["WalkerVectorEnv"]
-
-
-def _whole(value, name: str, low: int, allow_none: bool = False) -> int | None:
-    """``value`` as a whole number >= ``low`` (or None when allowed); else a one-line
-    ``ValueError`` naming ``name``."""
-    if value is None and allow_none:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
-        raise ValueError(f"{name}={value!r}: give a whole number >= {low}"
-                         + (" or None" if allow_none else ""))
-    return int(value)
 
 
 def _advance_rows():
@@ -76,7 +66,7 @@ def _step_common():
     :func:`_advance_rows`), kept."""
     global _STEP_COMMON
     if _STEP_COMMON is None:
-        from .rows_common import step_common as _STEP_COMMON  # light
+        from .rows_steady import step as _STEP_COMMON  # light
     return _STEP_COMMON
 
 
@@ -147,8 +137,8 @@ class WalkerVectorEnv(VectorEnv):
         #: advance_rows`: their compiled pieces in one compiled call per flow); False: one
         #: after another, each as ``gym.make``'s environment steps (sync's numbers bit for bit)
         self.batched = bool(batched)
-        n = _whole(num_envs, "num_envs", 1)
-        self.max_episode_steps = _whole(max_episode_steps, "max_episode_steps", 1,
+        n = whole_number(num_envs, "num_envs", 1)
+        self.max_episode_steps = whole_number(max_episode_steps, "max_episode_steps", 1,
                                         allow_none=True)
         try:
             self.autoreset_mode = AutoresetMode(autoreset_mode)
@@ -171,6 +161,7 @@ class WalkerVectorEnv(VectorEnv):
         self._terminations = np.zeros(n, dtype=np.bool_)
         self._truncations = np.zeros(n, dtype=np.bool_)
         self._autoreset_envs = np.zeros(n, dtype=np.bool_)
+        self._lent = False  # (the last step's flags the caller's: copied to write, _own)
         self._every = np.ones(n, dtype=np.bool_)  # (every walker stepped; read only)
         self._every.flags.writeable = False
         #: control periods since each sub-environment's reset (its time limit's count)
@@ -237,6 +228,7 @@ class WalkerVectorEnv(VectorEnv):
             idx = np.flatnonzero(mask)
             envs = [self.envs[i] for i in idx]
         if not self.batched or self.envs[0].view != "rigid":
+            self._own()
             dicts = []
             for i, env in zip(idx, envs):
                 (self._observations[i], self._rewards[i], self._terminations[i],
@@ -248,6 +240,7 @@ class WalkerVectorEnv(VectorEnv):
         if p is False:
             p = self._batch_parameters()
         if p is None:  # each walker's own begin and end of its period
+            self._own()
             advance_rows = self._advancer(first)
             begun = [env.begin_period(actions[i]) for i, env in zip(idx, envs)]
             strikes = advance_rows([env.sim for env in envs], [u for u, _ in begun],
@@ -287,7 +280,9 @@ class WalkerVectorEnv(VectorEnv):
         if whole:  # (new arrays of this step's: kept as they are)
             self._observations, self._rewards = obs, reward
             self._terminations, self._truncations = term, trunc
+            self._lent = False
         else:
+            self._own()
             self._observations[idx] = obs
             self._rewards[idx] = reward
             self._terminations[idx] = term
@@ -328,6 +323,15 @@ class WalkerVectorEnv(VectorEnv):
         self._observations[i] = obs
         self._counts()[i] = 0
         return info
+
+    def _own(self) -> None:
+        """The rewards and flags copied, before a write, when the last step returned them
+        as they are (``_lent``; the caller may change them: each step writes all their
+        rows before reading one; the observations, read by a partial reset, are copies)."""
+        if self._lent:
+            self._rewards, self._terminations, self._truncations = (
+                self._rewards.copy(), self._terminations.copy(), self._truncations.copy())
+            self._lent = False
 
     def _counts(self) -> np.ndarray:
         """The control periods since each sub-environment's reset (N,), all counted."""
@@ -404,6 +408,7 @@ class WalkerVectorEnv(VectorEnv):
             own refusals (``WalkerEnv.reset``).
         """
         seeds = self._seeds(seed)
+        self._own()
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"reset: options must be a dict or None, got a "
                              f"{type(options).__name__}")
@@ -429,8 +434,8 @@ class WalkerVectorEnv(VectorEnv):
         """Hold ``actions[i]`` (k,) on walker ``i`` for one control period (a walker whose
         episode ended is reset instead, as ``autoreset_mode`` says); returns
         ``(observations (N, m), rewards (N,), terminations (N,), truncations (N,),
-        infos)``, copies (the caller's to keep or change, as gymnasium's vector
-        environments return them by default).
+        infos)``, the caller's to keep or change (as gymnasium's vector environments
+        return them by default: copies, or copied by this class to write, :meth:`_own`).
 
         Raises
         ------
@@ -455,6 +460,8 @@ class WalkerVectorEnv(VectorEnv):
                     f"{np.flatnonzero(self._autoreset_envs).tolist()} ended; reset them with "
                     "reset(options={'reset_mask': mask}) before stepping")
         some_reset = any_true(resetting)
+        if some_reset:  # (rows written below)
+            self._own()
         stepping = ~resetting if some_reset else self._every  # (every walker: not read)
         stepped = (self._step_all(a, stepping, not some_reset)
                    if not some_reset or stepping.any()
@@ -491,8 +498,9 @@ class WalkerVectorEnv(VectorEnv):
         else:
             infos = LazyInfos(lambda: self._batched_infos(stepped, resets))
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
-        return (self._observations.copy(), self._rewards.copy(), self._terminations.copy(),
-                self._truncations.copy(), infos)
+        self._lent = True  # (the caller's: copied before this class writes into them)
+        return (self._observations.copy(), self._rewards, self._terminations,
+                self._truncations, infos)
 
     def _info_dicts(self, stepped: dict, resets: dict) -> list[dict]:
         """Every sub-environment's info as a dict (N): the stepped ones' (:meth:`_step_all`'s
