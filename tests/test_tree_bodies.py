@@ -27,7 +27,7 @@ import sympy as sp
 from walkerlab.codegen.frames import slope_to_world
 from walkerlab.codegen.tree_derive import kinematics
 from walkerlab.export.axes_3d import TO_MUJOCO
-from walkerlab.export.legs_mjcf import tree_mjcf_text
+from walkerlab.export.mjcf_document import tree_mjcf_text
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
 from walkerlab.walker.tree import ZERO_INERTIA, Body, BodyTree, CoordinateMap, Joint, diagonal
 from walkerlab.walker.trees import compass_3d_tree

@@ -16,7 +16,7 @@ site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest iner
 inertias and joint axes are read from the walker's body tree (:func:`walker_tree`;
 :mod:`walkerlab.export.tree_bodies`, where walkerlab's axes meet MuJoCo's); this module adds
 the geoms, the ground, the contact and the keyframe (:func:`legs3d_mjcf`, the record the
-legged walkers' one MJCF writer, :func:`walkerlab.export.legs_mjcf.legs_mjcf_text`, writes).
+legged walkers' one MJCF writer, :func:`walkerlab.export.mjcf_document.walker_mjcf_text`, writes).
 
 The ground is the planar straight-legged walker's checkerboard
 (:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
@@ -78,7 +78,7 @@ import numpy as np
 
 from walkerlab.codegen.cache import functions
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
-from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact
+from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
 from walkerlab.export.multibody import mjcf_actuation_omissions
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
@@ -442,9 +442,9 @@ def _bodies(data, law: dict | None) -> tuple:
 
 
 def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = None
-                ) -> LegsMjcf:
+                ) -> WalkerMjcf:
     """The 3D straight-legged walker's MJCF (module docstring) as the legged walkers' one
-    writer writes it (:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`): its bodies and
+    writer writes it (:func:`walkerlab.export.mjcf_document.walker_mjcf_text`): its bodies and
     what its file carries beyond them.
 
     Parameters
@@ -461,7 +461,7 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
 
     Returns
     -------
-    LegsMjcf
+    WalkerMjcf
         Total mass ``M_hip + 2 m_leg``; the custom numerics ``slope_rad`` and
         ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg),
         the texts ``walkerlab_actuation`` (a powered walker) and ``walkerlab_hip_roll``
@@ -490,7 +490,7 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
         texts += (("walkerlab_actuation", actuation_text(act)),)
     if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop
         texts += (("walkerlab_hip_roll", json.dumps(law)),)
-    return LegsMjcf(name, root, p["g"], (head,), extra.notes if extra else (),
+    return WalkerMjcf(name, root, p["g"], (head,), extra.notes if extra else (),
                     tuple(mjcf_actuation_omissions(act)), contact, geoms,
                     ground=_ground(p, extra, phi), actuation=act, tendons=tuple(tendons),
                     equality=tuple(equality), numerics=numerics, texts=texts,

@@ -1,6 +1,7 @@
 """What an MJCF export of a scene carries beyond the walker (:class:`MjcfScene`: the gait
 keyframe, the terrain, the contact, the knee latch; computed by
-:mod:`walkerlab.export.scene`, written by :func:`walkerlab.export.legs_mjcf.legs_mjcf_text` from
+:mod:`walkerlab.export.scene`, written by
+:func:`walkerlab.export.mjcf_document.walker_mjcf_text` from
 :func:`walkerlab.export.multibody.planar_legs_mjcf`), and
 the limits MuJoCo sets on it (its floors of mass, inertia and length, its default timestep,
 the contact bits of the checkerboard lanes, the point foot's sphere).

@@ -72,7 +72,7 @@ Formats:
 - URDF: ROS "URDF XML specification" (:mod:`walkerlab.export.urdf` writes it, with its
   keyframe sidecar).
 - MJCF: MuJoCo "XML Reference", https://mujoco.readthedocs.io/en/stable/XMLreference.html
-  (:func:`walkerlab.export.legs_mjcf.legs_mjcf_text` writes it, planar and 3D, from the
+  (:func:`walkerlab.export.mjcf_document.walker_mjcf_text` writes it, planar and 3D, from the
   record :func:`planar_legs_mjcf` makes)
   (``compiler``, ``option``, ``worldbody``, ``body``, ``joint`` of type ``slide``/``hinge``,
   ``inertial``, ``geom``, ``site``, ``keyframe``).  MuJoCo refuses moving bodies without
@@ -90,7 +90,7 @@ import re
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact
+from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_ground import ground_geoms, profile_asset
 from walkerlab.export.mjcf_scene import (
     LANE_BITS,
@@ -199,9 +199,9 @@ def _tendons(mb: Multibody) -> list[str]:
 
 
 def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
-                     extra: MjcfScene | None = None) -> LegsMjcf:
+                     extra: MjcfScene | None = None) -> WalkerMjcf:
     """A planar walker's MJCF as the legged walkers' one writer writes it
-    (:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`): its bodies
+    (:func:`walkerlab.export.mjcf_document.walker_mjcf_text`): its bodies
     (:func:`walkerlab.export.planar_bodies.planar_bodies`) and what its file carries beyond
     them.
 
@@ -218,7 +218,7 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
 
     Returns
     -------
-    LegsMjcf
+    WalkerMjcf
         The ground, the hip body with both slide joints, the links as nested bodies with
         hinges, feet as contact geoms (only feet touch the ground), a keyframe ``standing``
         (legs vertical, the feet at the ground line at x = 0) and, with ``extra``, a
@@ -232,7 +232,7 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
         extra.timestep_s, extra.solref, extra.solimp, (extra.friction, 0, 0))
     numerics, texts = _custom(mb, extra)
     profile = extra is not None and extra.profile is not None
-    return LegsMjcf(
+    return WalkerMjcf(
         name, root, mb.gravity_m_per_s2, header=tuple(header(mb, name, "MJCF", version)),
         notes=extra.notes if extra else (), left_out=mjcf_omissions(mb, extra),
         contact=contact, geoms=_geoms(mb, extra), joint_attrs=_joint_attrs(mb, extra),

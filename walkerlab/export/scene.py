@@ -3,7 +3,7 @@
 :func:`mjcf_scene` turns a validated scene (its feet by :mod:`walkerlab.export.scene_feet`,
 its ground by :mod:`walkerlab.export.scene_ground`) into
 :class:`walkerlab.export.mjcf_scene.MjcfScene` (written by
-:func:`walkerlab.export.legs_mjcf.legs_mjcf_text` from
+:func:`walkerlab.export.mjcf_document.walker_mjcf_text` from
 :func:`walkerlab.export.multibody.planar_legs_mjcf`):
 
 - **gait keyframe**: the rigid walker's fixed point (just after heel strike, leg2 in stance,

@@ -5,7 +5,7 @@ joints and a hinge ``wheel``, massless spokes with a contact sphere at each tip 
 "Passive dynamic walking"; Coleman, Chatterjee & Ruina 1997, "Motions of a rimless spoked
 wheel").  Its kind has no tree of leg links, so it has its own URDF writers; its MJCF, planar
 or 3D, is written by the legged walkers' one MJCF writer
-(:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`: the hub one body, its spokes its geoms).
+(:func:`walkerlab.export.mjcf_document.walker_mjcf_text`: the hub one body, its spokes its geoms).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from walkerlab.export.axes_3d import TO_MUJOCO  # the axes' one place (re-exported)
-from walkerlab.export.legs_mjcf import LegsMjcf, MjcfContact, legs_mjcf_text
+from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf, walker_mjcf_text
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import comment, num, nums
@@ -76,7 +76,7 @@ def _urdf_spokes(p: dict) -> list[str]:
 def _wheel_mjcf(p: dict, name: str, joints, inertia, timestep_s: float, solref,
                 friction: float, qpos, qvel) -> dict:
     """What a wheel's MJCF carries beyond the skeleton of the legged walkers' one writer
-    (:class:`walkerlab.export.legs_mjcf.LegsMjcf`, by field name; a header and a ground to
+    (:class:`walkerlab.export.mjcf_document.WalkerMjcf`, by field name; a header and a ground to
     add): the hub body on ``joints`` (:class:`~walkerlab.export.tree_bodies.ExportJoint`)
     with the principal moments ``inertia`` (3,) [kg m^2] about x, y, z, its geoms and
     spokes, the spokes' contact (sliding friction ``friction``, ``condim 3``, no ``solimp``)
@@ -208,7 +208,7 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
               ExportJoint("wheel", "hinge", (0.0, -1.0, 0.0))]
     plane = (f'    <geom name="ground" type="plane" size="200 2 0.1" euler="0 {num(phi)} 0" '
              'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',)
-    return legs_mjcf_text(LegsMjcf(
+    return walker_mjcf_text(WalkerMjcf(
         **_wheel_mjcf(p, name, joints, (p["I_hub"],) * 3, timestep_s, solref, friction,
                       qpos, qvel),
         header=tuple(_wheel_header(name, "MJCF", version, p, phi)),
@@ -309,7 +309,7 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
                    f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
                    f"{num(I_axle)} kg m^2 about the axle and {num(p['I_diam'])} kg m^2 about "
                    f"a diameter; slope {num(phi)} rad; a free body, no plane constraint")
-    return legs_mjcf_text(LegsMjcf(
+    return walker_mjcf_text(WalkerMjcf(
         **_wheel_mjcf(p, name, [ExportJoint("free", "free")],
                       (p["I_diam"], I_axle, p["I_diam"]), timestep_s, solref, friction,
                       qpos, qvel),

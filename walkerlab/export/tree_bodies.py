@@ -2,10 +2,10 @@
 the floating pelvis with a leg on each hip and any upper body on its own joint, every body's
 mass, centre of mass, inertia and joint axes evaluated from the tree's expressions, in the
 exports' axes.  The MJCF and URDF writers of legged walkers, planar and 3D
-(:func:`walkerlab.export.legs_mjcf.legs_mjcf_text`, :func:`walkerlab.export.urdf.legs_urdf_text`),
-write these bodies; :func:`mjcf_body_lines` and :func:`mjcf_coupling_lines` are the MJCF's
-text of them, :func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's
-tree (every joint a pitch) gives the same bodies in the plane ``x``-``z``
+(:func:`walkerlab.export.mjcf_document.walker_mjcf_text`,
+:func:`walkerlab.export.urdf.legs_urdf_text`), write these bodies; :func:`mjcf_body_lines`
+and :func:`mjcf_coupling_lines` are the MJCF's text of them,
+:func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's tree (every joint a pitch) gives the same bodies in the plane ``x``-``z``
 (:mod:`walkerlab.export.planar_bodies`): its roles (:class:`PelvisRoles`) carry the pelvis
 on two slides, name its bodies and joints as the planar exports do, hang a foot body where
 each leg's contact is and read the stance leg's numbers for legs that differ.
@@ -560,7 +560,7 @@ def mjcf_coupling_lines(couplings) -> tuple[list[str], list[str]]:
     """Each coupling as a fixed tendon held at zero length by an equality (MuJoCo XML
     Reference: ``tendon/fixed``, ``equality/tendon``): the ``fixed`` elements' lines and the
     equalities' (the MJCF writer puts them in their sections,
-    :func:`walkerlab.export.legs_mjcf.legs_mjcf_text`)."""
+    :func:`walkerlab.export.mjcf_document.walker_mjcf_text`)."""
     tendons = []
     for c in couplings:
         tendons.append(f'    <fixed name="{c.name}">')

@@ -12,7 +12,7 @@ The URDF and MJCF writers write the walker's multibody as its kind has it
 :mod:`walkerlab.export.spoked`), or the 3D straight-legged walker's free pelvis
 (:mod:`walkerlab.export.legs_3d_mjcf`); a legged walker, planar or in 3D, has one writer
 per format: the URDF's :func:`walkerlab.export.urdf.legs_urdf_text`, the MJCF's
-:func:`walkerlab.export.legs_mjcf.legs_mjcf_text` (of the record
+:func:`walkerlab.export.mjcf_document.walker_mjcf_text` (of the record
 :func:`walkerlab.export.multibody.planar_legs_mjcf` or
 :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf` makes).  The
 Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
@@ -42,7 +42,7 @@ from walkerlab.export.adams import (
 )
 from walkerlab.export.adams_actuation import check_adams_actuation
 from walkerlab.export.engine_walk import ENGINES, EngineWalk, not_walked, walk_export
-from walkerlab.export.legs_mjcf import legs_mjcf_text
+from walkerlab.export.mjcf_document import walker_mjcf_text
 from walkerlab.export.mjcf_ground import wheel_ground
 from walkerlab.export.mjcf_scene import MjcfOptions
 from walkerlab.export.multibody import (
@@ -247,7 +247,7 @@ def _links(job: ExportJob, w: Writer) -> Written:
         text = legs_urdf_text(job.data, job.name, version, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)
     else:  # the legged walkers' one MJCF writer, planar and 3D
-        text = legs_mjcf_text(planar_legs_mjcf(job.data, mb, job.name, version, extra))
+        text = walker_mjcf_text(planar_legs_mjcf(job.data, mb, job.name, version, extra))
         left_out = mjcf_omissions(mb, extra)
     files = [_xml(job, w, text)]
     if w.name == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
@@ -322,9 +322,9 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
     writer), or its
     MJCF, the same walker on a free joint with the rigid gait as its ``gait`` keyframe, the
     footfall patches of its lanes and the scene's contact
-    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`, written by the legged walkers' one
-    MJCF writer, :func:`walkerlab.export.legs_mjcf.legs_mjcf_text`; ``job.options``: the MJCF's
-    :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
+    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`, written by the walkers' one MJCF
+    writer, :func:`walkerlab.export.mjcf_document.walker_mjcf_text`; ``job.options``: the
+    MJCF's :class:`~walkerlab.export.mjcf_scene.MjcfOptions`); the other formats as the capability
     table has them (refused before this is reached)."""
     from walkerlab.export.legs_3d_mjcf import legs3d_mjcf, legs3d_scene  # light
 
@@ -336,10 +336,10 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
         text = legs_urdf_text(data, job.name, version, scene.walker.actuation)
         left_out = legs_urdf_omissions(data, scene.walker.actuation)
     elif job.walker_only:
-        text = legs_mjcf_text(legs3d_mjcf(data, job.name, version))
+        text = walker_mjcf_text(legs3d_mjcf(data, job.name, version))
     else:
         ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
-        text = legs_mjcf_text(legs3d_mjcf(data, job.name, version, extra))
+        text = walker_mjcf_text(legs3d_mjcf(data, job.name, version, extra))
         left_out = mjcf_actuation_omissions(extra.actuation)  # the stepping loop's
     return Written((_xml(job, w, text),), xml_lines(left_out, scene), step_period(ideal))
 

@@ -1,6 +1,7 @@
-"""The legged walkers' one MJCF writer, planar and 3D: the document's skeleton written from
-the walker's export bodies (:class:`walkerlab.export.tree_bodies.ExportBody`) and a record
-of what differs per walker (:class:`LegsMjcf`).
+"""The walkers' one MJCF writer (the legged walkers, planar and 3D, and the spoked wheels):
+the document's skeleton written from the walker's export bodies
+(:class:`walkerlab.export.tree_bodies.ExportBody`) and a record of what differs per walker
+(:class:`WalkerMjcf`).
 
 The skeleton (MuJoCo XML Reference, https://mujoco.readthedocs.io/en/stable/XMLreference.html),
 in this order: the header comments, ``mujoco``, the scene's notes and what the file leaves
@@ -34,10 +35,10 @@ from walkerlab.export.text import comment, num, nums
 if TYPE_CHECKING:  # the bodies' module loads sympy: read lazily (the writers load light)
     from walkerlab.export.tree_bodies import ExportBody
 
-__all__ = ["COMPILER", "GEOM_DEFAULTS", "LegsMjcf", "MjcfContact", "legs_mjcf_text",
+__all__ = ["COMPILER", "GEOM_DEFAULTS", "WalkerMjcf", "MjcfContact", "walker_mjcf_text",
            "tree_mjcf_text"]
 
-#: ``compiler`` of every legged walker's MJCF: radians, inertias as written, limits from ranges
+#: ``compiler`` of every walker's MJCF: radians, inertias as written, limits from ranges
 COMPILER = '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>'
 #: the geoms' defaults before a scene's contact: no collisions but the ground's and the feet's
 GEOM_DEFAULTS = 'contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"'
@@ -46,7 +47,7 @@ GEOM_DEFAULTS = 'contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"'
 @dataclass(frozen=True)
 class MjcfContact:
     """A scene's contact and integration as the MJCF's ``option`` and the geoms' ``default``
-    carry them (:func:`legs_mjcf_text`).
+    carry them (:func:`walker_mjcf_text`).
 
     Attributes
     ----------
@@ -74,8 +75,8 @@ class MjcfContact:
 
 
 @dataclass(frozen=True)
-class LegsMjcf:
-    """What a legged walker's MJCF carries beyond the skeleton :func:`legs_mjcf_text`
+class WalkerMjcf:
+    """What a walker's MJCF carries beyond the skeleton :func:`walker_mjcf_text`
     writes: its bodies, and what differs from one walker to another.
 
     Attributes
@@ -158,13 +159,13 @@ def _block(tag: str, lines) -> list[str]:
     return [f"  <{tag}>", *lines, f"  </{tag}>"] if lines else []
 
 
-def legs_mjcf_text(m: LegsMjcf) -> str:
+def walker_mjcf_text(m: WalkerMjcf) -> str:
     """A legged walker, planar or 3D (a spoked wheel too), as a MuJoCo model (MJCF; module
     docstring).
 
     Parameters
     ----------
-    m : LegsMjcf
+    m : WalkerMjcf
         The walker's bodies and what its MJCF carries beyond the skeleton
         (:func:`walkerlab.export.multibody.planar_legs_mjcf`,
         :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`, ``walkerlab.export.spoked``'s
@@ -196,7 +197,7 @@ def legs_mjcf_text(m: LegsMjcf) -> str:
 
 
 def tree_mjcf_text(tree, coords, values: dict, roles=None, name: str = "walker") -> str:
-    """A body tree's walker alone as MJCF (:func:`legs_mjcf_text`: no ground, contact or
+    """A body tree's walker alone as MJCF (:func:`walker_mjcf_text`: no ground, contact or
     keyframe; gravity ``g`` along -z): the bodies of
     :func:`walkerlab.export.tree_bodies.export_bodies` and their couplings.
 
@@ -224,5 +225,5 @@ def tree_mjcf_text(tree, coords, values: dict, roles=None, name: str = "walker")
     root, couplings = export_bodies(tree, coords, values, roles or PelvisRoles())
     g = tree.root.gravity_m_per_s2
     tendons, equality = mjcf_coupling_lines(couplings)
-    return legs_mjcf_text(LegsMjcf(name, root, float(values[g] if isinstance(g, str) else g),
+    return walker_mjcf_text(WalkerMjcf(name, root, float(values[g] if isinstance(g, str) else g),
                                    tendons=tendons, equality=equality))
