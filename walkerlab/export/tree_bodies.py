@@ -5,7 +5,8 @@ exports' axes.  The MJCF and URDF writers of legged walkers, planar and 3D
 (:func:`walkerlab.export.mjcf_document.walker_mjcf_text`,
 :func:`walkerlab.export.urdf.legs_urdf_text`), write these bodies; :func:`mjcf_body_lines`
 and :func:`mjcf_coupling_lines` are the MJCF's text of them,
-:func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's tree (every joint a pitch) gives the same bodies in the plane ``x``-``z``
+:func:`walkerlab.export.urdf.urdf_robot_text` the URDF's.  A planar walker's tree (every
+joint a pitch) gives the same bodies in the plane ``x``-``z``
 (:mod:`walkerlab.export.planar_bodies`): its roles (:class:`PelvisRoles`) carry the pelvis
 on two slides, name its bodies and joints as the planar exports do, hang a foot body where
 each leg's contact is and read the stance leg's numbers for legs that differ.
