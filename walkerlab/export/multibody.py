@@ -225,7 +225,7 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
         keyframe ``gait`` and the knee latches as joint equality constraints named
         ``leg<i>_latch``.
     """
-    root, _ = planar_bodies(data, mb, MJCF_MIN_INERTIA_KG_M2,
+    root, _ = planar_bodies(data, MJCF_MIN_INERTIA_KG_M2,
                             extra.flat_feet if extra is not None else None)
     root = replace(root, mass_kg=mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG)
     contact = None if extra is None else MjcfContact(

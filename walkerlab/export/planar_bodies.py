@@ -8,19 +8,20 @@ hip ``hip`` on the slides ``hip_x`` (carrying the massless ``hip_slider`` where 
 needs one link per joint) and ``hip_z``, each leg ``leg<i>`` (kneed: ``leg<i>_thigh`` on
 ``leg<i>_hip``, ``leg<i>_shank`` on ``leg<i>_knee``, the locking knee's stop its limit
 ``[-pi, 0]``), the torso on ``torso_hip``, each foot a massless body ``leg<i>_foot`` on a
-fixed joint at the foot point or the arc's centre (a site).  Flat feet, which the tree does
-not describe yet, come from the walker's links (:func:`walkerlab.walker.multibody.multibody`)
-in the same bodies, each foot a sole ``leg<i>_sole`` on an ankle hinge ``leg<i>_ankle``
+fixed joint at the foot point or the arc's centre (a site).  Flat feet: each leg's sole
+``leg<i>_sole`` on its ankle hinge ``leg<i>_ankle`` at the leg's end (the site
+``leg<i>_foot``), its angle the swing foot's ``swing_ankle`` (leg2: the stance foot's
+``stance_ankle``), the foot's mass at the ankle; a massless foot (mass 0 in the tree)
+carries the contact model's regularising mass and inertia
 (:attr:`walkerlab.export.mjcf_scene.MjcfScene.flat_feet`).
 """
 
 from __future__ import annotations
 
-import math
+from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.export.parts import export_part
 from walkerlab.walker.description import ROLE_TAG
 from walkerlab.walker.trees import legs_tree
 
@@ -28,8 +29,6 @@ __all__ = ["PLANAR_SLIDES", "planar_bodies", "planar_roles"]
 
 #: the planar hip's slides: (joint, axis, the massless link it carries when not the last)
 PLANAR_SLIDES = (("hip_x", (1.0, 0.0, 0.0), "hip_slider"), ("hip_z", (0.0, 0.0, 1.0), ""))
-#: the planar hinges' axis (world -y: a positive angle moves the foot ahead)
-_PITCH = (0.0, -1.0, 0.0)
 
 
 def planar_roles(structure):
@@ -38,40 +37,42 @@ def planar_roles(structure):
     ``torso_hip``, a kneed leg's bodies ``leg<i>_thigh``, ``leg<i>_shank``, each foot at the
     swing leg's contact point (a round foot's centre), leg2's numbers the stance role's, its
     joints' angles the stance leg's (a locking knee's stance shank, which the tree's straight
-    stance leg has not, a coordinate of its own)."""
+    stance leg has not, a coordinate of its own); flat feet: each leg's sole
+    ``leg<i>_sole`` on ``leg<i>_ankle``, the foot ``leg<i>_foot`` at the ankle."""
     from walkerlab.export.tree_bodies import PelvisRoles  # light: sympy with the bodies
 
     sw, st = (f"_{ROLE_TAG[r]}_" for r in ("swing", "stance"))
     kind = structure.kind           # its knees and joints (walkerlab.walker.kinds)
     knee = kind.knees != "none"      # on the swing leg, or free on both (every joint free)
     thigh = "stance_thigh" if kind.joints_free else "stance"
+    flat = structure.foot == "flat"
     return PelvisRoles(
         name="hip", slides=PLANAR_SLIDES,
         stance_roles=((("swing_thigh", thigh), ("swing_shank", "stance_shank")) if knee
-                      else (("swing", "stance"),)),
+                      else (("swing", "stance"),)) + (
+                          (("swing_ankle", "stance_ankle"),) if flat else ()),
         joint_names=(("swing_hip_pitch", "{leg}_hip"), ("swing_knee", "{leg}_knee"),
-                     ("torso_pitch", "torso_hip")),
+                     ("torso_pitch", "torso_hip"), ("swing_ankle_pitch", "{leg}_ankle")),
         body_names=((("swing_leg", "{leg}_thigh"), ("swing_shank", "{leg}_shank")) if knee
-                    else ()),
-        foot="swing_foot_centre" if structure.foot == "arc" else "swing_foot",
+                    else ()) + ((("swing_sole", "{leg}_sole"),) if flat else ()),
+        foot={"arc": "swing_foot_centre", "flat": "swing_ankle"}.get(structure.foot,
+                                                                      "swing_foot"),
         stance_params=tuple((n, n.replace(sw, st)) for n in structure.param_names if sw in n))
 
 
-def planar_bodies(data, mb=None, inertia_floor: float = 0.0, flat_feet=None) -> tuple:
+def planar_bodies(data, inertia_floor: float = 0.0, flat_feet=None) -> tuple:
     """The planar walker's export bodies and couplings (module docstring).
 
     Parameters
     ----------
     data : WalkerData
         From :func:`walkerlab.walker.description.walker_data` (planar legs).
-    mb : Multibody, optional
-        The walker's links (:func:`walkerlab.walker.multibody.multibody`): flat feet's
-        bodies.
     inertia_floor : float
         The smallest principal moment a body carries [kg m^2] (0: the inertias as they
         are; the MJCF's :data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).
     flat_feet : tuple, optional
-        :attr:`walkerlab.export.mjcf_scene.MjcfScene.flat_feet`: the soles.
+        :attr:`walkerlab.export.mjcf_scene.MjcfScene.flat_feet`: the mass and inertia
+        about the ankle [kg, kg m^2] of a massless flat foot's sole (leg1's, leg2's).
 
     Returns
     -------
@@ -82,49 +83,27 @@ def planar_bodies(data, mb=None, inertia_floor: float = 0.0, flat_feet=None) -> 
     Raises
     ------
     ValueError
-        A walker the tree does not describe, but flat feet (naming the field).
+        A walker the tree does not describe (naming the field).
     """
     from walkerlab.export.tree_bodies import export_bodies  # light: sympy with the bodies
 
     s = data.structure
-    if s.kind.feet_have_modes:   # flat feet: from the links
-        return _link_bodies(mb, inertia_floor, flat_feet), ()
     tree, coords = legs_tree(s)
-    return export_bodies(tree, coords, dict(zip(s.param_names, data.params)),
-                         planar_roles(s), inertia_floor=inertia_floor)
+    roles = planar_roles(s)
+    root, couplings = export_bodies(tree, coords, dict(zip(s.param_names, data.params)),
+                                    roles, inertia_floor=inertia_floor)
+    if flat_feet is None:
+        return root, couplings
+    return _weighted_soles(root, dict(zip(roles.legs, flat_feet)), inertia_floor), couplings
 
 
-def _link_bodies(mb, floor: float, flat_feet):
-    """The links of ``mb`` as export bodies: each link on its hinge about ``0 -1 0`` (a
-    knee with a stop in ``[-pi, 0]``), its moment about the pitch axis (and about x: a line
-    along the link) floored at ``floor``, its foot a massless body on a fixed joint, a flat
-    foot's sole (``flat_feet``) on its ankle hinge with its mass at the ankle."""
-    from walkerlab.export.tree_bodies import ExportBody, ExportJoint  # light: as above
-
-    stops = export_part(mb).knee_stops
-
-    def inertia(moment):
-        return np.diag([max(moment, floor), max(moment, floor), floor])
-
-    def body(ln):
-        kids = [body(k) for k in mb.links if k.parent == ln.name]
-        if ln.foot_m is not None:
-            leg = ln.name.split("_")[0]
-            at = np.array([0.0, 0.0, -ln.foot_m])
-            kids.append(ExportBody(f"{leg}_foot", "foot", at,
-                                   (ExportJoint(f"{leg}_foot", "fixed"),), 0.0, np.zeros(3),
-                                   np.zeros((3, 3))))
-            if flat_feet is not None:
-                *_, mass, moment = flat_feet[0 if leg == "leg1" else 1]
-                kids.append(ExportBody(f"{leg}_sole", "sole", at,
-                                       (ExportJoint(f"{leg}_ankle", "hinge", _PITCH),), mass,
-                                       np.zeros(3), inertia(moment)))
-        limit = (-math.pi, 0.0) if stops and ln.joint.endswith("_knee") else None
-        return ExportBody(ln.name, ln.name, np.array([0.0, 0.0, -ln.joint_from_parent_m]),
-                          (ExportJoint(ln.joint, "hinge", _PITCH, limit=limit),),
-                          ln.mass_kg, np.array([ln.com_off_axis_m, 0.0, -ln.com_m]),
-                          inertia(ln.inertia_kg_m2), tuple(kids))
-    slides = tuple(ExportJoint(j, "slide", axis, link=link) for j, axis, link in PLANAR_SLIDES)
-    return ExportBody("hip", "pelvis", np.zeros(3), slides, mb.hip_mass_kg, np.zeros(3),
-                      np.eye(3) * floor, tuple(body(ln) for ln in mb.links
-                                               if ln.parent == "hip"))
+def _weighted_soles(b, feet: dict, floor: float):
+    """``b`` with each massless sole (tree body ``swing_sole``) of leg ``leg`` carrying
+    ``feet[leg]``'s mass at its ankle and moment about it (about the pitch axis and along
+    the sole, as the tree's rod normal to the leg; its moment about the leg the floor)."""
+    kids = tuple(_weighted_soles(c, feet, floor) for c in b.children)
+    if b.tree_body != "swing_sole" or b.mass_kg != 0:
+        return replace(b, children=kids)
+    *_, mass, moment = feet[b.name.removesuffix("_sole")]
+    inertia = np.diag([max(moment, floor), max(moment, floor), floor])
+    return replace(b, mass_kg=mass, inertia_kg_m2=inertia, children=kids)

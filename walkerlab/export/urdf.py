@@ -194,7 +194,7 @@ def legs_urdf_text(data, name: str, version: str = "",
     if data.structure.in_3d:
         return _legs_3d_text(data, name, version, actuation)
     mb = multibody(data)
-    root, couplings = planar_bodies(data, mb)
+    root, couplings = planar_bodies(data)
     comments = [*header(mb, name, "URDF", version),
                 *xml_comments(urdf_omissions(mb, actuation))]
     return urdf_robot_text(name, comments, root, couplings, _planar_visuals(mb), world=True)

@@ -32,6 +32,28 @@ angle ``swing_shank - swing_thigh``; the stance leg stays straight.
 Without hip-roll joints the rolls are held (``phi_p = phi_w = phi``: the joints' roll
 coordinates map to 0).  Round feet put the stance leg on a slide along the fall line (the
 disc's roll), then the roll, then the pitch about the disc's centre.
+
+Flat feet (planar; Wisse et al. 2006, "Ankle springs instead of arc-shaped feet for passive
+dynamic walkers", IEEE-RAS Humanoids; the equations :mod:`walkerlab.codegen.foot_modes`)
+put a sole under each leg, the ankle on the sole line ``heel`` ahead of the heel and
+``toe`` behind the toe, the foot's mass ``m_foot`` at the ankle and ``I_foot`` about it (a
+rod's, normal to the leg; massless feet: mass 0):
+
+- the root is the stance heel (the contact ``stance_heel``, the heel-contact mode's pinned
+  point ``O``): the ``stance_sole`` on the pitch joint ``stance_sole`` there, its angle
+  from the slope ``stance + stance_ankle + gamma`` (toe up positive; 0: the foot flat on
+  the slope, the foot-flat mode's lock), the toe ``stance_toe`` ``heel + toe`` ahead;
+- the stance leg on the pitch joint ``stance_ankle`` at the ankle, its angle from the sole
+  ``-stance_ankle`` (``stance_ankle`` the walker's coordinate: the sole's angle from the
+  leg's perpendicular, toe up positive);
+- the ``swing_sole`` on the pitch joint ``swing_ankle`` at the swing leg's end (the contact
+  ``swing_ankle``), its angle the coordinate ``swing_ankle`` (as the stance ankle's), its
+  heel ``swing_heel`` and toe ``swing_toe`` on the sole line.
+
+The walker's coordinates are ``swing, stance, stance_ankle``; the map's fourth,
+``swing_ankle``, is the swing foot's own (the rigid view holds it at its spring's rest
+angle ``r_ankle``, :mod:`walkerlab.codegen.foot_modes`; the exports turn it on its hinge).
+The ankle springs are the exports' (:class:`~walkerlab.walker.tree.Joint` carries none).
 """
 
 from __future__ import annotations
@@ -50,7 +72,7 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["Part", "biped_tree", "compass_3d_tree", "legs_tree", "spoked_wheel_3d_tree"]
+__all__ = ["Part", "Soles", "biped_tree", "compass_3d_tree", "legs_tree", "spoked_wheel_3d_tree"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 #: the parameters the 3D compass's tree reads, before the hip-roll law's gains (the order
@@ -97,12 +119,38 @@ class Part:
                                                                   self.inertia)
 
 
+@dataclass(frozen=True)
+class Soles:
+    """Flat feet (module docstring), by the names of their numbers in the tree's parameters.
+
+    Attributes
+    ----------
+    heel, toe : (str, str)
+        The heel's distance behind and the toe's ahead of the ankle along the sole [m], of
+        the swing foot and of the stance foot.
+    mass : str or float
+        Each foot's mass at its ankle [kg] (0: massless feet).
+    inertia : str or None
+        Each foot's inertia about its ankle, about every axis normal to the leg [kg m^2]
+        (None: none).
+    """
+
+    heel: tuple[str, str]
+    toe: tuple[str, str]
+    mass: str | float = 0
+    inertia: str | None = None
+
+    def inertia_tensor(self):
+        return ZERO_INERTIA if self.inertia is None else diagonal(self.inertia, 0,
+                                                                  self.inertia)
+
+
 def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Part, ...] = (),
                *, planar: bool = False, swing_legs: tuple[Part, ...] | None = None,
                thigh: str | None = None, knee_stop: bool = False, hip_mass: bool = True,
                hip_width: str | float = 0, hip_roll: bool = False, foot_radius: str | None =
-               None, coordinates: str = "absolute", free_joints: bool = False
-               ) -> tuple[BodyTree, CoordinateMap]:
+               None, coordinates: str = "absolute", free_joints: bool = False,
+               soles: Soles | None = None) -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
     or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
     pelvis with ``M_hip`` midway between the hips, and an upper body carrying ``torso`` held
@@ -150,43 +198,55 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         ``torso``): with ``thigh`` the stance leg a shank ``stance_shank`` at the foot and a
         thigh ``stance_leg`` on the knee ``stance_knee``; the upper body's pitch the
         coordinate ``torso`` (from the upward vertical, leaning back) in place of the legs'.
+    soles : Soles, optional
+        Planar flat feet (module docstring): the stance sole at the root, each leg on its
+        ankle; coordinates ``stance_ankle, swing_ankle`` after the legs'.
 
     Returns
     -------
     BodyTree, CoordinateMap
         Bodies ``stance_leg``, ``pelvis``, ``swing_leg`` (``swing_shank``, ``torso``), each part
         ``<link>_<part>``; contacts ``stance_foot``, ``swing_foot`` (round feet: the disc's
-        centre ``swing_foot_centre``); coordinates as ``planar`` says, 3D ``lean, swing,
-        stance`` (and ``pelvis_roll, swing_roll``).
+        centre ``swing_foot_centre``; flat feet: ``stance_heel``, ``stance_toe``,
+        ``swing_ankle``, ``swing_heel``, ``swing_toe``); coordinates as ``planar`` says, 3D
+        ``lean, swing, stance`` (and ``pelvis_roll, swing_roll``).
 
     Raises
     ------
     ValueError
-        The tree does not validate (:class:`~walkerlab.walker.tree.BodyTree`).
+        The tree does not validate (:class:`~walkerlab.walker.tree.BodyTree`); flat feet
+        not planar (naming ``soles``).
     """
+    if soles is not None and not planar:
+        raise ValueError("soles: flat feet are planar (a 3D tree of flat feet is not built)")
     up_leg = "L" if foot_radius is None else f"L - {foot_radius}"   # the frame's origin to hip
     knee = thigh if free_joints else None               # a stance knee this far below the hip
-    bodies, foot_body = _stance_side(legs, foot_radius, planar, up_leg, knee)
+    bodies, foot_body = _stance_side(legs, foot_radius, planar, up_leg, knee, soles)
     bodies += _hips(_PLANAR_HIPS if planar else _HIPS_3D, knee or up_leg, hip_mass, hip_roll,
                     hip_width)
     swing, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh, up_leg,
                                   foot_radius, knee_stop)
+    contacts = (ContactPoint("stance_foot", foot_body if foot_radius is None else
+                             "stance_travel", (0, 0, 0)), swing_end)
+    if soles is not None:
+        sole, contacts = _swing_sole(soles, swing_end)
+        swing.append(sole)
     bodies += swing + _torso(torso, hip_width)
-    tree = BodyTree(params, Root(), tuple(bodies),
-                    (ContactPoint("stance_foot", foot_body if foot_radius is None else
-                                  "stance_travel", (0, 0, 0)), swing_end))
+    tree = BodyTree(params, Root(stance_contact=contacts[0].name), tuple(bodies), contacts)
     return tree, _coordinates(planar, thigh is not None, hip_roll, foot_radius, bool(torso),
-                              coordinates, free_joints)
+                              coordinates, free_joints, soles is not None)
 
 
 def _stance_side(legs: tuple[Part, ...], R: str | None, planar: bool, up_leg: str,
-                 knee: str | None) -> tuple[list, str]:
+                 knee: str | None, soles: Soles | None = None) -> tuple[list, str]:
     """The stance foot's bodies and the stance leg's (:func:`biped_tree`), and the body the
     stance foot is on: a straight leg's parts welded at its hip, or, with a stance knee
     ``knee`` below the hip (every joint free), the shank's parts on the shank at the foot and
-    the thigh's on the thigh ``stance_leg`` on the knee ``stance_knee``."""
+    the thigh's on the thigh ``stance_leg`` on the knee ``stance_knee``; with ``soles`` the
+    leg on its ankle on the stance sole."""
     foot_body = "stance_shank" if knee is not None else "stance_leg"
-    bodies = _stance_foot(R, planar, foot_body)
+    bodies = _stance_foot(R, planar, foot_body) if soles is None else _stance_sole(
+        soles, foot_body)
     if knee is None:
         return bodies + _welded("stance_leg", legs, (0, up_leg, 0)), foot_body
     bodies += _welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
@@ -270,9 +330,10 @@ def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str |
 
 
 def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
-                 coordinates: str, free: bool = False) -> CoordinateMap:
+                 coordinates: str, free: bool = False, flat: bool = False) -> CoordinateMap:
     """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`;
-    ``free``: every joint free, :mod:`walkerlab.codegen.free_joints`' coordinates)."""
+    ``free``: every joint free, :mod:`walkerlab.codegen.free_joints`' coordinates;
+    ``flat``: flat feet, the ankles' after the legs')."""
     ankle = None          # the stance shank's angle, on a stance knee
     if free:
         names = (("stance_shank", "stance_thigh", "swing_thigh", "swing_shank") if knee
@@ -289,15 +350,19 @@ def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso:
         names = ("lean",) + names + (("pelvis_roll", "swing_roll") if hip_roll else ())
     pelvis_roll, swing_roll = ("pelvis_roll", "swing_roll") if hip_roll else ("lean", "lean")
     rolls = () if planar else (("stance_ankle_roll", "lean"),)
+    foot = ((("stance_sole_pitch", f"{ankle or stance} + stance_ankle + gamma"),
+             ("stance_ankle_pitch", "-stance_ankle")) if flat else
+            (("stance_ankle_pitch", f"{ankle or stance} + gamma"),))
+    names += ("stance_ankle", "swing_ankle") if flat else ()
     angles = ((("stance_travel", f"-{R} * ({stance} + gamma)"),) if R is not None else ()) + (
-        rolls + (("stance_ankle_pitch", f"{ankle or stance} + gamma"),
-                 ("stance_hip_pitch", f"-({stance} + gamma)")))
+        rolls + foot + (("stance_hip_pitch", f"-({stance} + gamma)"),))
     if ankle:   # the stance thigh turned from the shank
         angles += (("stance_knee", f"{stance} - {ankle}"),)
     if not planar:
         angles += (("stance_hip_roll", f"{pelvis_roll} - lean"),
                    ("swing_hip_roll", f"{swing_roll} - {pelvis_roll}"))
     angles += (("swing_hip_pitch", f"{swing} + gamma"),)
+    angles += (("swing_ankle_pitch", "swing_ankle"),) if flat else ()
     if knee:
         angles += (("swing_knee", "swing_shank - swing_thigh"),)
     if torso:   # hinged, or the bisecting hip: the legs' mean
@@ -333,6 +398,32 @@ def _stance_foot(R: str | None, planar: bool = False, leg: str = "stance_leg") -
                        ("stance_ankle_pitch",)))]
 
 
+def _stance_sole(soles: Soles, leg: str) -> list:
+    """The stance sole on its pitch joint at the root (the heel) and the stance leg's frame
+    ``leg`` on the ankle ``heel`` ahead of it along the sole (module docstring)."""
+    heel = soles.heel[1]
+    return [Body("stance_sole", soles.mass, soles.inertia_tensor(), (heel, 0, 0),
+                 Joint("stance_sole", "revolute", "slope", (0, 0, 0), (Z,),
+                       ("stance_sole_pitch",))),
+            Body(leg, 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint("stance_ankle", "revolute", "stance_sole", (heel, 0, 0), (Z,),
+                       ("stance_ankle_pitch",)))]
+
+
+def _swing_sole(soles: Soles, end: ContactPoint) -> tuple[Body, tuple]:
+    """The swing sole on its ankle at the swing leg's end ``end`` and the flat feet's
+    contacts, the stance heel (the root) first (module docstring)."""
+    (heel, heel_st), (toe, toe_st) = soles.heel, soles.toe
+    sole = Body("swing_sole", soles.mass, soles.inertia_tensor(), (0, 0, 0),
+                Joint("swing_ankle", "revolute", end.body, end.point_m, (Z,),
+                      ("swing_ankle_pitch",)))
+    return sole, (ContactPoint("stance_heel", "stance_sole", (0, 0, 0)),
+                  ContactPoint("stance_toe", "stance_sole", (f"{heel_st} + {toe_st}", 0, 0)),
+                  ContactPoint("swing_ankle", end.body, end.point_m),
+                  ContactPoint("swing_heel", "swing_sole", (f"-{heel}", 0, 0)),
+                  ContactPoint("swing_toe", "swing_sole", (toe, 0, 0)))
+
+
 def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
                     ) -> tuple[BodyTree, CoordinateMap]:
     """The 3D straight-legged walker with hip width ``w_hip`` as a tree
@@ -366,7 +457,8 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     body ``m_<name>, d_<name>[, I_<name>][, e_<name>]`` (legs that differ: ``m_sw_<name>``,
     ``m_st_<name>``, ...), each upper-body body ``m_torso_<name>, d_torso_<name>[,
     e_torso_<name>][, I_torso_<name>]``, a knee ``L_thigh`` below the hip, round feet
-    ``R_foot``), or the 3D ``model: compass_gait`` shorthand (one mass ``m_leg`` on each leg
+    ``R_foot``, flat feet ``heel_m, toe_m[, m_foot, I_foot]`` (per role ``heel_sw_m``, ...;
+    :class:`Soles`)), or the 3D ``model: compass_gait`` shorthand (one mass ``m_leg`` on each leg
     ``a_leg`` from its foot, a rod's ``I_leg``), with the hip width ``w_hip`` and the
     hip-roll joints as the structure has them; a planar biped whose joints are all free
     (free knees, a hinged torso: ``free_joints``) with its stance knee and its torso's
@@ -380,15 +472,12 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     ------
     ValueError
         A part a tree does not carry yet, naming its field: a massless body (the mass -> 0
-        limit, Garcia et al. 1998), flat feet, spokes.
+        limit, Garcia et al. 1998), spokes.
     """
     planar = not structure.in_3d
     if planar:
         if structure.spokes:
             raise ValueError("walker.spokes: a body tree of this walker is not built yet")
-        if structure.foot == "flat":
-            raise ValueError("walker.leg.foot.kind: flat: a body tree of flat feet is not "
-                             "built yet")
         if any(b.massless for b in structure.bodies):
             raise ValueError("walker.leg.bodies: a massless body is the mass -> 0 limit of "
                              "the equations (Garcia et al. 1998), not a body of a tree")
@@ -416,7 +505,16 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
                       hip_roll=structure.hip_roll,
                       foot_radius="R_foot" if structure.foot == "arc" else None,
                       coordinates=structure.coordinates,
-                      free_joints=planar and (structure.free_knees or structure.hinged_torso))
+                      free_joints=planar and (structure.free_knees or structure.hinged_torso),
+                      soles=_soles(structure) if structure.foot == "flat" else None)
+
+
+def _soles(structure) -> Soles:
+    """A flat-footed structure's :class:`Soles` by its parameters' names (per role when the
+    legs differ; ``m_foot``, ``I_foot`` with ``structure.foot_mass``)."""
+    sw, st = (f"{ROLE_TAG[r]}_" if structure.asymmetric else "" for r in ("swing", "stance"))
+    mass = ("m_foot", "I_foot") if structure.foot_mass else (0, None)
+    return Soles((f"heel_{sw}m", f"heel_{st}m"), (f"toe_{sw}m", f"toe_{st}m"), *mass)
 
 
 def spoked_wheel_3d_tree(spokes: int | None = None) -> tuple[BodyTree, CoordinateMap]:
