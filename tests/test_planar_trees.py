@@ -9,8 +9,10 @@ feet; Wisse, Hobbelen & Schwab 2007 for the bisecting hip), numerically at rando
 parameters; the walkers whose joints are all free (the five-link biped, Westervelt, Grizzle &
 Koditschek 2003, free knees on both legs; the three-link walker, Grizzle, Abba & Plestan
 2001; each with a hinged torso) equal :func:`walkerlab.codegen.free_joints.
-derive_five_link`'s.  The 3D trees the same builder makes are the production derivation's
-(``tests/test_body_tree.py``)."""
+derive_five_link`'s; flat feet (Wisse et al. 2006) with foot mass, in heel contact and foot
+flat, equal :func:`walkerlab.codegen.foot_modes.derive_flat`'s modes (its link sums from the
+pinned heel) with the ankle spring and damper added.  The 3D trees the same builder makes
+are the production derivation's (``tests/test_body_tree.py``)."""
 
 from __future__ import annotations
 
@@ -19,12 +21,14 @@ import pytest
 import sympy as sp
 
 from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
+from walkerlab.codegen.foot_modes import derive_flat
 from walkerlab.codegen.free_joints import derive_five_link
 from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, kinematics, plastic_impact, simplifier
 from walkerlab.config import load_scene
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.plant import Plant
+from walkerlab.walker.tree import CoordinateMap
 from walkerlab.walker.trees import legs_tree
 
 
@@ -152,9 +156,67 @@ def test_garcias_coordinates_and_a_body_off_the_leg_axis_derive_alike():
 @pytest.mark.parametrize("structure, field", [
     (Structure("slope_relative", (BodySpec("foot", "point_mass", massless=True),),
                hip_mass=True), "walker.leg.bodies"),
-    (Structure("absolute", (BodySpec("mass", "point_mass"),), foot="flat"),
-     "walker.leg.foot.kind"),
 ])
 def test_a_walker_the_tree_does_not_carry_yet_is_refused_naming_the_field(structure, field):
     with pytest.raises(ValueError, match=rf"^{field}"):
         legs_tree(structure)
+
+
+def _flat_coordinates(coords: CoordinateMap, foot_flat: bool) -> CoordinateMap:
+    """The flat-footed tree's map with the swing ankle at its spring's rest angle
+    (:mod:`walkerlab.codegen.foot_modes`: no coordinate) and, ``foot_flat``, the stance sole
+    locked flat on the slope (``stance_ankle = -(stance + gamma)``; coordinates ``swing,
+    stance``)."""
+    held = {"swing_ankle_pitch": "r_ankle"}
+    if foot_flat:
+        held.update(stance_sole_pitch="0", stance_ankle_pitch="stance + gamma")
+    names = ("swing", "stance") if foot_flat else ("swing", "stance", "stance_ankle")
+    return CoordinateMap(names, tuple((c, held.get(c, e)) for c, e in coords.joint_angles))
+
+
+def test_a_flat_footed_trees_heel_contact_and_foot_flat_equal_the_foot_modes():
+    """configs/flat_feet_foot_mass.yaml's structure (a foot of mass ``m_foot`` and inertia
+    ``I_foot`` at each ankle): the tree's Lagrange equations with the swing foot at its rest
+    angle equal :func:`~walkerlab.codegen.foot_modes.derive_flat`'s ``heel_contact`` flow
+    (``M``; ``C dq`` and ``G`` less the ankle's damper ``c dq_a`` and spring ``k (a - r)``,
+    which the tree leaves to the exports), and with the sole locked flat its ``foot_flat``
+    flow's (``S^T M S``, ``S^T (C S dq + G)`` at ``a = -(stance + gamma)``, ``S`` the lock's
+    null space; the ankle's spring and damper added to the tree's), at random states and
+    parameters (1e-12 relative)."""
+    structure = _scene_structure("flat_feet_foot_mass")
+    assert structure.foot_mass
+    e = derive_flat(structure)
+    hc = e.flows["heel_contact"]
+    tree, coords = legs_tree(structure)
+    P = dict(zip(map(str, e.params), e.params))
+    k, r, c = P["k_ankle"], P["r_ankle"], P["c_ankle"]
+    a, da = e.q[2], e.dq[2]
+    dq = sp.Matrix(e.dq)
+    th = derive_tree(tree, _flat_coordinates(coords, foot_flat=False))
+    assert tuple(map(str, th.q)) == tuple(map(str, e.q))
+    ankle = sp.Matrix([0, 0, 1])
+    pairs = [("heel contact M", hc.M, th.M),
+             ("heel contact C dq", hc.C * dq, th.C * dq + c * da * ankle),
+             ("heel contact G", hc.G, th.G + k * (a - r) * ankle)]
+    tf = derive_tree(tree, _flat_coordinates(coords, foot_flat=True))
+    S = sp.Matrix([[1, 0], [0, 1], [0, -1]])
+    flat = {a: -(e.q[1] + P["gamma"]), da: -e.dq[1]}
+    dq2 = sp.Matrix(tf.dq).subs({t: f for t, f in zip(tf.dq, e.dq)})
+    to_e = {t: f for t, f in zip(tf.q + tf.dq, e.q[:2] + e.dq[:2])}
+    ankle_torque = (k * (a - r) * ankle + c * da * ankle).subs(flat)   # spring, damper
+    pairs += [("foot flat M", S.T * hc.M.subs(flat) * S, tf.M.subs(to_e)),
+              ("foot flat C dq + G", S.T * (hc.C * S * dq2 + hc.G).subs(flat),
+               (tf.C * sp.Matrix(tf.dq) + tf.G).subs(to_e) + S.T * ankle_torque)]
+    names = [str(p) for p in e.params]
+    rng = np.random.default_rng(81)
+    points = []
+    for _ in range(4):
+        par = _params([n for n in names if not n.startswith(("heel_", "toe_"))], rng)
+        par.update(heel_m=rng.uniform(0.02, 0.1), toe_m=rng.uniform(0.05, 0.2),
+                   k_ankle=rng.uniform(50, 200), r_ankle=rng.uniform(-0.2, 0.2),
+                   c_ankle=rng.uniform(0.5, 5))
+        points.append(np.concatenate([rng.uniform(-0.6, 0.6, 3), rng.uniform(-2.0, 2.0, 3),
+                                      [par[n] for n in names]]))
+    args = list(e.q) + list(e.dq) + list(e.params)
+    for what, reference, tree_value in pairs:
+        _close(what, reference, tree_value, args, points)
