@@ -45,7 +45,7 @@ def planar_roles(structure):
     kind = structure.kind           # its knees and joints (walkerlab.walker.kinds)
     knee = kind.knees != "none"      # on the swing leg, or free on both (every joint free)
     thigh = "stance_thigh" if kind.joints_free else "stance"
-    flat = structure.foot == "flat"
+    flat = kind.feet_have_modes       # flat feet: a sole on each ankle
     return PelvisRoles(
         name="hip", slides=PLANAR_SLIDES,
         stance_roles=((("swing_thigh", thigh), ("swing_shank", "stance_shank")) if knee
@@ -55,8 +55,8 @@ def planar_roles(structure):
                      ("torso_pitch", "torso_hip"), ("swing_ankle_pitch", "{leg}_ankle")),
         body_names=((("swing_leg", "{leg}_thigh"), ("swing_shank", "{leg}_shank")) if knee
                     else ()) + ((("swing_sole", "{leg}_sole"),) if flat else ()),
-        foot={"arc": "swing_foot_centre", "flat": "swing_ankle"}.get(structure.foot,
-                                                                      "swing_foot"),
+        foot="swing_ankle" if flat else ("swing_foot_centre" if structure.foot == "arc"
+                                         else "swing_foot"),
         stance_params=tuple((n, n.replace(sw, st)) for n in structure.param_names if sw in n))
 
 
