@@ -16,6 +16,8 @@ are the production derivation's (``tests/test_body_tree.py``)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -162,43 +164,46 @@ def test_a_walker_the_tree_does_not_carry_yet_is_refused_naming_the_field(struct
         legs_tree(structure)
 
 
-def _flat_coordinates(coords: CoordinateMap, foot_flat: bool) -> CoordinateMap:
-    """The flat-footed tree's map with the swing ankle at its spring's rest angle
+def _flat_coordinates(coords: CoordinateMap, foot_flat: bool, rest: str) -> CoordinateMap:
+    """The flat-footed tree's map with the swing ankle at its spring's rest angle ``rest``
     (:mod:`walkerlab.codegen.foot_modes`: no coordinate) and, ``foot_flat``, the stance sole
     locked flat on the slope (``stance_ankle = -(stance + gamma)``; coordinates ``swing,
     stance``)."""
-    held = {"swing_ankle_pitch": "r_ankle"}
+    held = {"swing_ankle_pitch": rest}
     if foot_flat:
         held.update(stance_sole_pitch="0", stance_ankle_pitch="stance + gamma")
     names = ("swing", "stance") if foot_flat else ("swing", "stance", "stance_ankle")
     return CoordinateMap(names, tuple((c, held.get(c, e)) for c, e in coords.joint_angles))
 
 
-def test_a_flat_footed_trees_heel_contact_and_foot_flat_equal_the_foot_modes():
+@pytest.mark.parametrize("asymmetric", [False, True])
+def test_a_flat_footed_trees_heel_contact_and_foot_flat_equal_the_foot_modes(asymmetric):
     """configs/flat_feet_foot_mass.yaml's structure (a foot of mass ``m_foot`` and inertia
-    ``I_foot`` at each ankle): the tree's Lagrange equations with the swing foot at its rest
+    ``I_foot`` at each ankle; ``asymmetric``: its legs' and feet's numbers per role): the
+    tree's Lagrange equations with the swing foot at its rest
     angle equal :func:`~walkerlab.codegen.foot_modes.derive_flat`'s ``heel_contact`` flow
     (``M``; ``C dq`` and ``G`` less the ankle's damper ``c dq_a`` and spring ``k (a - r)``,
     which the tree leaves to the exports), and with the sole locked flat its ``foot_flat``
     flow's (``S^T M S``, ``S^T (C S dq + G)`` at ``a = -(stance + gamma)``, ``S`` the lock's
     null space; the ankle's spring and damper added to the tree's), at random states and
     parameters (1e-12 relative)."""
-    structure = _scene_structure("flat_feet_foot_mass")
+    structure = replace(_scene_structure("flat_feet_foot_mass"), asymmetric=asymmetric)
     assert structure.foot_mass
     e = derive_flat(structure)
     hc = e.flows["heel_contact"]
     tree, coords = legs_tree(structure)
     P = dict(zip(map(str, e.params), e.params))
-    k, r, c = P["k_ankle"], P["r_ankle"], P["c_ankle"]
+    sw, st = ("sw_", "st_") if asymmetric else ("", "")
+    k, r, c = P[f"k_{st}ankle"], P[f"r_{st}ankle"], P[f"c_{st}ankle"]
     a, da = e.q[2], e.dq[2]
     dq = sp.Matrix(e.dq)
-    th = derive_tree(tree, _flat_coordinates(coords, foot_flat=False))
+    th = derive_tree(tree, _flat_coordinates(coords, False, f"r_{sw}ankle"))
     assert tuple(map(str, th.q)) == tuple(map(str, e.q))
     ankle = sp.Matrix([0, 0, 1])
     pairs = [("heel contact M", hc.M, th.M),
              ("heel contact C dq", hc.C * dq, th.C * dq + c * da * ankle),
              ("heel contact G", hc.G, th.G + k * (a - r) * ankle)]
-    tf = derive_tree(tree, _flat_coordinates(coords, foot_flat=True))
+    tf = derive_tree(tree, _flat_coordinates(coords, True, f"r_{sw}ankle"))
     S = sp.Matrix([[1, 0], [0, 1], [0, -1]])
     flat = {a: -(e.q[1] + P["gamma"]), da: -e.dq[1]}
     dq2 = sp.Matrix(tf.dq).subs({t: f for t, f in zip(tf.dq, e.dq)})
@@ -212,9 +217,10 @@ def test_a_flat_footed_trees_heel_contact_and_foot_flat_equal_the_foot_modes():
     points = []
     for _ in range(4):
         par = _params([n for n in names if not n.startswith(("heel_", "toe_"))], rng)
-        par.update(heel_m=rng.uniform(0.02, 0.1), toe_m=rng.uniform(0.05, 0.2),
-                   k_ankle=rng.uniform(50, 200), r_ankle=rng.uniform(-0.2, 0.2),
-                   c_ankle=rng.uniform(0.5, 5))
+        for t in (sw, st):
+            par.update({f"heel_{t}m": rng.uniform(0.02, 0.1), f"toe_{t}m": rng.uniform(0.05, 0.2),
+                        f"k_{t}ankle": rng.uniform(50, 200), f"r_{t}ankle": rng.uniform(-0.2, 0.2),
+                        f"c_{t}ankle": rng.uniform(0.5, 5)})
         points.append(np.concatenate([rng.uniform(-0.6, 0.6, 3), rng.uniform(-2.0, 2.0, 3),
                                       [par[n] for n in names]]))
     args = list(e.q) + list(e.dq) + list(e.params)
