@@ -225,5 +225,6 @@ def tree_mjcf_text(tree, coords, values: dict, roles=None, name: str = "walker")
     root, couplings = export_bodies(tree, coords, values, roles or PelvisRoles())
     g = tree.root.gravity_m_per_s2
     tendons, equality = mjcf_coupling_lines(couplings)
-    return walker_mjcf_text(WalkerMjcf(name, root, float(values[g] if isinstance(g, str) else g),
-                                   tendons=tendons, equality=equality))
+    gravity = float(values[g] if isinstance(g, str) else g)
+    return walker_mjcf_text(WalkerMjcf(name, root, gravity, tendons=tendons,
+                                       equality=equality))
