@@ -30,7 +30,7 @@ ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
                     "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
                     "codegen/equations.py", "codegen/lagrange.py",
-                    "codegen/compiled_source.py")
+                    "codegen/compiled_source.py", "codegen/frames.py")
 _memo: dict[str, dict] = {}
 
 

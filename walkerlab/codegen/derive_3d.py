@@ -115,7 +115,7 @@ def derive_spoked(structure) -> Equations:
     # the impact's entries expanded, not trigsimp'd: trigsimp takes ~35 s here (the hand
     # derivation's 25-30 s) for matrices evaluated once a heel strike
     Mi, B = heel_strike(te, "next_foot", simplify=sp.expand)
-    nrm = sp.Matrix([sp.sin(gamma), sp.cos(gamma), 0])   # the slope's normal (world)
+    nrm = slope_to_world(gamma)[:, 1]   # the slope's normal (world)
     pts = te.points
     nxt, hub = pts["next_foot"], pts["wheel_com"]
     axle = slope_to_world(gamma) * te.kinematics.rotations["wheel"] * sp.Matrix([0, 0, 1])

@@ -172,12 +172,12 @@ def _legs(s: _Symbols) -> tuple[list, list, dict]:
     without a trigonometric simplifier."""
     import sympy as sp
 
+    from walkerlab.codegen.frames import planar_slope_axes  # light
     from walkerlab.codegen.link_sums import e  # light
 
     structure, q, P, tags = s.structure, s.q, s.P, s.tags
     L, gamma, lt, R, knee = P["L"], P["gamma"], s.lt, s.R, s.knee
-    n_vec = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
-    t_vec = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
+    n_vec, t_vec = planar_slope_axes(gamma)
     nq = len(q)
     hip = sp.Matrix([q[0], q[1]])
     bodies = []
@@ -339,6 +339,8 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
     is the first stance, the pinned point of a pinned start)."""
     import sympy as sp
 
+    from walkerlab.codegen.link_sums import e  # light
+
     names = coordinate_names(structure)
     q = sp.symbols(names, real=True)
     dq = sp.symbols([f"d_{n}" for n in names], real=True)
@@ -349,7 +351,7 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
     feet, points = [], {"hip": hub}
     for k in range(structure.spokes):
         psi = q[2] + 2 * k * alpha
-        tip = hub + L * sp.Matrix([sp.sin(psi), -sp.cos(psi)])
+        tip = hub + L * e(psi)
         feet.append((tip, tip.jacobian(sp.Matrix(q))))
         points[f"spoke{k}_foot"] = tip
     M = sp.diag(m, m, inertia)

@@ -70,6 +70,7 @@ from walkerlab.codegen.double_support import (
     derive_double_support,
     double_support_lines,
 )
+from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.link_sums import add_length, dot_terms, position_of, velocity_terms
 from walkerlab.codegen.push_off import push_off_systems
@@ -248,8 +249,7 @@ def derive_flat(structure: Structure) -> FlatEquations:
     hs, ts = fp("heel", "stance"), fp("toe", "stance")
     rw = fp("r", "swing")
     half = sp.pi / 2
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
-    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])  # along the slope, downhill
+    normal, tangent = planar_slope_axes(gamma)
     theta_f = ps_st + a
     # positions = sum of {angle: length} e(angle) + a constant offset (e(angle + pi/2) is
     # the unit vector at ``angle`` from the x axis)

@@ -1,5 +1,7 @@
-"""Rotations and the slope's frame, written once for every symbolic derivation in three
-dimensions (:mod:`walkerlab.codegen.derive_3d`, :mod:`walkerlab.codegen.tree_derive`).
+"""Rotations and the slope's frame, written once for every symbolic derivation: in three
+dimensions (:mod:`walkerlab.codegen.derive_3d`, :mod:`walkerlab.codegen.tree_derive`) and in
+the plane (the planar walkers' generators take the slope's normal and fall line from
+:func:`planar_slope_axes`).
 
 Frames
 ------
@@ -7,14 +9,16 @@ World axes as the planar walkers': ``x`` horizontal downhill, ``y`` up, ``z = x 
 slope's frame has the fall line ``s = (cos gamma, -sin gamma, 0)``, the slope's unit normal
 ``n = (sin gamma, cos gamma, 0)`` and ``z`` as its axes; a vector with components ``r`` in
 it has the world components ``slope_to_world(gamma) @ r`` and the height
-``slope_up(gamma) . r`` above the horizontal through the slope frame's origin.
+``slope_up(gamma) . r`` above the horizontal through the slope frame's origin.  A planar
+walker's world is the ``x, y`` plane: its slope's normal and fall line are ``n`` and ``s``
+without their ``z`` components.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["rotation", "skew", "slope_to_world", "slope_up"]
+__all__ = ["planar_slope_axes", "rotation", "skew", "slope_to_world", "slope_up"]
 
 
 def skew(v) -> sp.Matrix:
@@ -42,3 +46,11 @@ def slope_to_world(gamma) -> sp.Matrix:
     ``n`` and ``z`` in world axes."""
     return sp.Matrix([[sp.cos(gamma), sp.sin(gamma), 0],
                       [-sp.sin(gamma), sp.cos(gamma), 0], [0, 0, 1]])
+
+
+def planar_slope_axes(gamma) -> tuple[sp.Matrix, sp.Matrix]:
+    """The slope's unit normal ``n = (sin gamma, cos gamma)`` and its fall line (the
+    tangent along the slope, downhill) ``s = (cos gamma, -sin gamma)``, each (2, 1), in a
+    planar walker's world axes (``x`` horizontal downhill, ``y`` up; module docstring)."""
+    return (sp.Matrix([sp.sin(gamma), sp.cos(gamma)]),
+            sp.Matrix([sp.cos(gamma), -sp.sin(gamma)]))

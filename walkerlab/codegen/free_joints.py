@@ -52,8 +52,9 @@ from __future__ import annotations
 
 import sympy as sp
 
+from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
-from walkerlab.codegen.link_sums import add_mass_terms, position_of
+from walkerlab.codegen.link_sums import add_mass_terms, extended_impact, position_of
 from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
 
@@ -138,19 +139,6 @@ def _matrices(q, bodies: list, foot_lin: dict, g):
     return [X.applyfunc(sp.factor_terms) for X in (M, Mi, B)] + [V]
 
 
-def _extended(q, dq, bodies: list, foot):
-    """``De`` (Hessian of the kinetic energy in the rates of ``[q, x_f, y_f]``, the stance
-    foot free) and ``E`` (Jacobian of the swing foot's position) of the extended impact."""
-    xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
-    qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
-    Te = sp.Integer(0)
-    for mass, lin, inertia, a in bodies:
-        v = (position_of(lin) + sp.Matrix([xf, yf])).jacobian(qe) * dqe
-        w = sp.Matrix([[sp.diff(a, k) for k in qe]])
-        Te += sp.Rational(1, 2) * (mass * (v.T * v)[0] + inertia * (w * dqe)[0] ** 2)
-    return sp.hessian(Te, dqe), (foot + sp.Matrix([xf, yf])).jacobian(qe)
-
-
 def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, tangent):
     """Straight legs on arc feet (radius ``R``, centre on the leg's axis at ``L - R`` from
     the hip; McGeer 1990): every position gains the stance arc's rolling offset ``-R (q_st +
@@ -168,7 +156,8 @@ def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, t
         ``stance_foot_centre``, ``swing_contact``, ``swing_foot_centre``, ``swing_foot``
         the next step's reference point).
     De, E : Matrix
-        The extended impact (:func:`_extended`'s, with the offset and the arc's spin).
+        The extended impact (:func:`~walkerlab.codegen.link_sums.extended_impact`'s,
+        with the offset and the arc's spin).
     """
     R, gamma, g = P["R_foot"], P["gamma"], P["g"]
     st, ws = psi["stance"], psi["swing"]
@@ -194,17 +183,10 @@ def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, t
     points.update(stance_foot=sp.zeros(2, 1), stance_foot_centre=offset,
                   stance_contact=offset - R * normal, swing_foot_centre=centre,
                   swing_contact=contact, swing_foot=contact + R * (ws + gamma) * tangent)
-    xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
-    qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
-    Te = sp.Integer(0)
-    for mass, lin, inertia, a in bodies:
-        v = (position_of(lin) + offset + sp.Matrix([xf, yf])).jacobian(qe) * dqe
-        w = sp.Matrix([[sp.diff(a, k) for k in qe]])
-        Te += sp.Rational(1, 2) * (mass * (v.T * v)[0] + inertia * (w * dqe)[0] ** 2)
-    E = (centre + sp.Matrix([xf, yf])).jacobian(qe) \
-        + R * tangent * sp.Matrix([[sp.diff(ws, k) for k in qe]])
-    return ([X.applyfunc(sp.factor_terms) for X in (M, Mi, B)] + [V, points,
-            sp.hessian(Te, dqe), E])
+    De, E = extended_impact(q, dq, [(m, position_of(lin) + offset, i, a)
+                                    for m, lin, i, a in bodies],
+                            centre, arc=(R, tangent, ws))
+    return [X.applyfunc(sp.factor_terms) for X in (M, Mi, B)] + [V, points, De, E]
 
 
 def _guards(structure: Structure, points: dict, psi: dict, gamma, normal, tangent) -> dict:
@@ -275,8 +257,7 @@ def derive_five_link(structure: Structure) -> Equations:
         lin = {"stance_foot": {}, "hip": {st: -reach}}
         lin["swing_foot"] = _plus(lin["hip"], ws, reach)
     bodies, point_lin = _bodies(structure, P, psi, lin)
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
-    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
+    normal, tangent = planar_slope_axes(gamma)
     arc = structure.foot == "arc"
     if arc:
         M, Mi, B, V, points, De, E = _rolling(q, dq, bodies, point_lin, P, psi, normal,
@@ -299,7 +280,8 @@ def derive_five_link(structure: Structure) -> Equations:
         drop, drop_solution = STRAIGHT_SECTION_DROP, -st - 2 * gamma
     leg_angles = _leg_angles(hip, foot, psi)
     if not arc:
-        De, E = _extended(q, dq, bodies, foot)
+        De, E = extended_impact(q, dq, [(m, position_of(lin), i, a)
+                                        for m, lin, i, a in bodies], foot)
     return Equations(
         q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
         relabel_q=relabel_q, relabel_rate=relabel_q.jacobian(qv),

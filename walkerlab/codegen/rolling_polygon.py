@@ -39,13 +39,10 @@ from functools import cache
 
 import sympy as sp
 
+from walkerlab.codegen.frames import planar_slope_axes
+from walkerlab.codegen.link_sums import e
 from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
-
-
-def _e(psi):
-    """Unit vector from the hub towards the foot of a spoke at angle ``psi``."""
-    return sp.Matrix([sp.sin(psi), -sp.cos(psi)])
 
 
 @cache
@@ -72,13 +69,13 @@ def derive(structure: Structure) -> Equations:
     q, dq = sp.symbols("q_stance dq_stance", real=True)
     par = sp.symbols(structure.param_names, real=True)
     g, L, gamma, m, inertia, alpha = par
-    hub = -L * _e(q)                       # from the stance foot
+    hub = -L * e(q)                       # from the stance foot
     ahead = q + 2 * alpha                  # the next spoke (the vocabulary's swing leg)
-    swing_foot = hub + L * _e(ahead)
+    swing_foot = hub + L * e(ahead)
     about_foot = m * L ** 2 + inertia      # inertia about the stance foot
     kinetic = sp.Rational(1, 2) * about_foot * dq ** 2
     potential = m * g * hub[1]
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    normal, _ = planar_slope_axes(gamma)
     return Equations(
         q=(q,), dq=(dq,), params=tuple(par),
         M=sp.Matrix([[about_foot]]), C=sp.zeros(1, 1),
@@ -91,8 +88,8 @@ def derive(structure: Structure) -> Equations:
                 "hip_height": (hub.T * normal)[0],
                 "swing_clearance": (swing_foot.T * normal)[0]},
         points={"hip": hub, "stance_foot": sp.zeros(2, 1), "swing_foot": swing_foot,
-                "trailing_foot": hub + L * _e(q - 2 * alpha),
-                **{f"spoke{k}_foot": hub + L * _e(q + 2 * k * alpha)
+                "trailing_foot": hub + L * e(q - 2 * alpha),
+                **{f"spoke{k}_foot": hub + L * e(q + 2 * k * alpha)
                    for k in range(2, structure.spokes - 1)}},
         leg_angles={"stance": q, "swing": ahead},
         section_drop=0, drop_solution=alpha - gamma,

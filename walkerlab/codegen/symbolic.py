@@ -49,10 +49,12 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen.equations import Equations
+from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel, knee_lock
 from walkerlab.codegen.link_sums import (
     add_length,
     add_mass_terms,
+    extended_impact,
     position_of,
 )
 from walkerlab.walker.description import ROLE_TAG, Structure
@@ -190,13 +192,13 @@ def _symbols(structure: Structure) -> _Symbols:
         dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_stance", real=True))
         psv = sp.Matrix([ps_sw, ps_st])
         ps_shank = ps_sw
+    normal, tangent = planar_slope_axes(gamma)
     return _Symbols(
         structure=structure, knee=knee, arc=arc, n=len(structure.roles), q=q, dq=dq, par=par,
         P=P, beta=sp.Symbol("beta", positive=True), qv=sp.Matrix(q), dqv=sp.Matrix(dq),
         psi_sw=psi_sw, psi_st=psi_st, psi_q=psi_q, ps_sw=ps_sw, ps_shank=ps_shank, ps_st=ps_st,
         psi_t=(ps_sw + ps_st) / 2, psv=psv, dps=dps,
-        normal=sp.Matrix([sp.sin(gamma), sp.cos(gamma)]),
-        tangent=sp.Matrix([sp.cos(gamma), -sp.sin(gamma)]),  # along the slope, downhill
+        normal=normal, tangent=tangent,
         lt=P["L_thigh"] if knee else 0, R=P["R_foot"] if arc else 0,
     )
 
@@ -457,38 +459,6 @@ def _swap_and_guards(s: _Symbols, points: dict, swing_contact, sub: dict) -> dic
             "section_tied": tied}
 
 
-def _extended(s: _Symbols, bodies: list, foot, lim: bool, spin=None):
-    """Extended impact matrices: with the stance foot free at ``(x_f, y_f)`` (the whole
-    walker translated by them), ``De`` is the Hessian of the kinetic energy in the rates of
-    ``[q, x_f, y_f]`` (massless bodies carry none) and ``E`` the Jacobian of the swing foot's
-    material contact point (paper Eq. 6-7, A.7-A.24).  A point foot's is its position's;
-    an arc foot's (``spin``, the swing arc's angle, given) moves at ``v_centre + w x (-R n)``
-    with ``foot`` its centre (McGeer 1990).  The stance arc's material contact point moves
-    at ``(dx_f, dy_f)`` here: the rolling offset's rate ``-R dpsi t`` cancels the arc's spin
-    about its centre ``R dpsi t``, so an impulse there (a push-off) has the generalised
-    force ``[0, ..., 0, F]`` for a point foot and an arc alike.
-
-    Returns
-    -------
-    De : Matrix (n + 2, n + 2)
-    E : Matrix (2, n + 2)
-    """
-    xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
-    qe, dqe = sp.Matrix([*s.q, xf, yf]), sp.Matrix([*s.dq, dxf, dyf])
-    Te = sp.Integer(0)
-    for mass, pos, inertia, psi in bodies:
-        ve = (pos + sp.Matrix([xf, yf])).jacobian(qe) * dqe
-        a = sp.Matrix([[sp.diff(psi, qi) for qi in qe]])
-        Te += (sp.Rational(1, 2) * mass * (ve.T * ve)[0]
-               + sp.Rational(1, 2) * inertia * (a * dqe)[0] ** 2)
-    Te = Te.subs(s.beta, 0) if lim else Te
-    De = sp.hessian(Te, dqe)
-    E = (foot + sp.Matrix([xf, yf])).jacobian(qe)
-    if spin is not None:  # the arc's material point: w x (-R n) = R w t
-        E += s.R * s.tangent * sp.Matrix([[sp.diff(spin, qi) for qi in qe]])
-    return De, E
-
-
 @cache
 def derive(structure: Structure) -> Equations:
     """Derive flow, impact, guards, energies and points of ``structure`` (memoised per process).
@@ -517,10 +487,15 @@ def derive(structure: Structure) -> Equations:
         s, _lagrange(s, Mp, Mi, Bm, V, D), geo, points, bodies)
     swap = _swap_and_guards(s, points, swing_contact, sub)
     # the extended impact system (a push-off at the stance foot's contact point): the swing
-    # foot's material contact point, an arc's from its centre and its spin
-    De, E = (_extended(s, bodies, points["swing_foot_centre"], dyn.lim,
-                       spin=s.ps_shank.subs(sub)) if s.arc
-             else _extended(s, bodies, points["swing_foot"], dyn.lim))
+    # foot's material contact point, an arc's from its centre and its spin.  The stance
+    # arc's material contact point moves at (dx_f, dy_f) there: the rolling offset's rate
+    # -R dpsi t cancels the arc's spin about its centre R dpsi t, so an impulse there (a
+    # push-off) has the generalised force [0, ..., 0, F] for a point foot and an arc alike
+    massless = s.beta if dyn.lim else None
+    De, E = (extended_impact(s.q, s.dq, bodies, points["swing_foot_centre"],
+                             massless=massless, arc=(s.R, s.tangent, s.ps_shank.subs(sub)))
+             if s.arc else
+             extended_impact(s.q, s.dq, bodies, points["swing_foot"], massless=massless))
     extra = ({"locked": dyn.locked, "knee_impact": dyn.knee_impact} if s.arc or s.knee
              else {"section_tied": None})
     return Equations(
