@@ -22,6 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.walker.description import ROLE_TAG
 from walkerlab.walker.trees import legs_tree
 
@@ -92,8 +93,6 @@ def sole_points(data) -> dict:
     (:data:`walkerlab.export.axes_3d.TO_MUJOCO`); the heel lies ``heel`` behind the ankle
     (-x), the toe ``toe`` ahead (+x)."""
     import sympy as sp  # light: the tree's expressions
-
-    from walkerlab.export.axes_3d import TO_MUJOCO
 
     s = data.structure
     tree, _ = legs_tree(s)

@@ -222,6 +222,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
         ("profile", "optimize"): _OPTIMIZE_PROFILE,
+        **_URDF_GROUNDS,
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
         # steps that walker (its contact view asks the contact cells)
