@@ -12,16 +12,20 @@ comments it is given (the springs, motors and what else the file leaves out), wh
 dimension; :func:`legs_urdf_text` is the legged walkers' file:
 
 - planar (:func:`walkerlab.export.planar_bodies.planar_bodies`): the tree of
-  :func:`walkerlab.walker.trees.legs_tree`,
-  the hip carried by the fixed link ``world`` on the slides ``hip_x`` (through the massless
-  carriage ``hip_slider``) and ``hip_z``, the legs' joints ``leg<i>_hip`` (``leg<i>_knee``:
-  ``revolute`` in ``[-pi, 0]`` with the straight-leg stop), ``torso_hip``, each foot a
-  massless link ``leg<i>_foot`` on a fixed joint of that name at the foot point or the arc's
-  centre; the inertias as the tree has them (a point mass none); the walkers whose joints
+  :func:`walkerlab.walker.trees.legs_tree`, the hip carried by the fixed link ``world`` on
+  the slides ``hip_x`` (through the massless carriage ``hip_slider``) and ``hip_z``, the
+  legs' joints ``leg<i>_hip`` (``leg<i>_knee``: ``revolute`` in ``[-pi, 0]`` with the
+  straight-leg stop), ``torso_hip``, each foot a massless link ``leg<i>_foot`` on a fixed
+  joint of that name at the foot point or the arc's centre; flat feet: each sole
+  ``leg<i>_sole`` on its ankle hinge ``leg<i>_ankle`` (the foot link at the ankle), as the
+  rigid model has it (massless: no ``inertial``; or ``walker.leg.foot.mass_kg``), collision
+  spheres ``leg<i>_heel``, ``leg<i>_toe`` at the tree's heel and toe
+  (:func:`walkerlab.export.planar_bodies.sole_points`), the ankle springs' law in the
+  header; the inertias as the tree has them (a point mass none); the walkers whose joints
   are all free (the five-link and three-link bipeds) alike, their knees free and the torso
-  on its own hinge.  The frame, joint names, feet and what the springs, couplings and
-  motors become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states
-  them (the links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
+  on its own hinge. The frame, joint names, feet and what the springs, couplings and motors
+  become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states them (the
+  links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
 - 3D (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`): the pelvis is the root link, free
   in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
   body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
@@ -30,7 +34,8 @@ dimension; :func:`legs_urdf_text` is the legged walkers' file:
   (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the MJCF's; the hip-roll
   law and the actuation in the comments ``walkerlab_hip_roll``, ``walkerlab_actuation``.
 
-What URDF cannot hold (ground, springs, couplings, the knee latch, motors, push-off) is
+What URDF cannot hold (ground, springs, ankle springs, couplings, the knee latch, motors,
+push-off) is
 listed by :func:`legs_urdf_omissions` and stated in the header, the planar laws in the
 sidecar (:func:`keyframe_json`).
 """
@@ -340,7 +345,8 @@ def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
                    ) -> tuple[Omission, ...]:
     """What a planar walker's :func:`legs_urdf_text` leaves out
     (:mod:`walkerlab.export.omitted`): the ground and
-    contact, each spring (URDF has no spring element), each coupling (``mimic`` follows one
+    contact, each spring and flat foot's ankle spring (URDF has no spring element), each
+    coupling (``mimic`` follows one
     joint only), the knee latch, each motor of :func:`motors` and the push-off (no actuator
     or force element: the laws are in the keyframe sidecar)."""
     out = [URDF_GROUND]
