@@ -181,3 +181,24 @@ def test_flat_feet_urdf_and_walker_only_mjcf_written_by_the_cli(tmp_path):
         app, ["export", cfg, "--format", "urdf", "--runs-dir", str(runs)]).output
     for f in ("walker.urdf", export_stage.SIDECAR, "walker.xml"):
         assert (runs / "flat_feet" / f).is_file()
+
+
+def test_flat_feet_push_off_urdf_states_its_ankle_motors_and_their_laws(tmp_path):
+    """configs/flat_feet_push_off.yaml to URDF: the hip and both ankle motors among what the
+    file leaves out, each ankle motor's sense the ankle's (+u turns the sole toe up, the
+    hinge's positive angle; before: "+u extends the knee", a knee motor's words), the
+    actuation's laws in the keyframe sidecar."""
+    from walkerlab.export.urdf import urdf_omissions
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    scene = _scene("flat_feet_push_off")
+    lines = [o.line for o in urdf_omissions(multibody(walker_data(scene.walker,
+                                                                  scene.slope.phi_rad)),
+                                             scene.walker.actuation)]
+    for leg in ("leg1", "leg2"):
+        assert any(f"motor {leg}_ankle_motor" in ln and f"the joint {leg}_ankle (+u turns "
+                   "the sole toe up)" in ln for ln in lines), lines
+    path = export_stage.run(scene, tmp_path, "urdf")
+    key = json.loads((path.parent / export_stage.SIDECAR).read_text())
+    assert "actuation" in key and len(key["joints"]) == len(key["qpos"]) == 6
