@@ -338,14 +338,14 @@ def test_the_urdf_refuses_a_ground_other_than_the_slope_with_its_cells_reason(
 
 
 def test_the_urdf_column_supports_what_the_urdf_writer_takes():
-    """The URDF's column: the walker of every kind the URDF writer takes (not flat feet,
-    which have no foot link there), and no ground but the slope."""
+    """The URDF's column: the walker of every kind the URDF writer takes (flat feet too:
+    soles on ankle hinges, tests/test_flat_feet_urdf.py), and no ground but the slope."""
     from walkerlab.walker.kinds import VIEWS
 
     assert "urdf" in VIEWS
     took = {k for k in KINDS if KINDS[k].supports("walk", "urdf")}
-    # flat feet have no foot link there; the kneed walker in 3D runs in its rigid model only
-    assert took == set(KINDS) - {"flat_feet", "locking_knees_3d"}
+    # the kneed walker in 3D runs in its rigid model only
+    assert took == set(KINDS) - {"locking_knees_3d"}
     for k in KINDS.values():
         assert not any(k.supports(g, "urdf") for g in ("stairs", "footholds", "profile"))
 

@@ -308,24 +308,28 @@ def test_scene_without_fixedpoint_section_exports_its_gait(tmp_path):
     assert alone.nkey == 1
 
 
-def test_flat_feet_without_fixedpoint_refused_in_one_line(tmp_path):
-    """Flat feet to a URDF (no foot link: it would hold point feet): refused in one line
-    naming the foot, with or without a ``fixedpoint`` section (before: the shipped scene
-    asked for contact fields it sets; without the section a point-footed walker was written,
-    exit 0); the MJCF carries them (tests/test_export_flat_feet.py)."""
+def test_flat_feet_without_fixedpoint_written_alone_or_refused_in_one_line(tmp_path):
+    """Flat feet without a ``fixedpoint`` section (before: the shipped scene asked for
+    contact fields it sets; without the section a point-footed walker was written, exit 0):
+    the walker alone goes to a URDF and an MJCF (its soles on ankle hinges,
+    tests/test_flat_feet_urdf.py); OpenSim's model without its scene is refused in one line
+    (its default state is the rigid gait)."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
 
     _without_fixedpoint(tmp_path, "flat_feet", "flat_bare")
-    for path in (tmp_path / "flat_bare.yaml", ROOT / "configs" / "flat_feet.yaml"):
-        for fmt in ("urdf",):
-            r = CliRunner().invoke(app, ["export", str(path), "--format", fmt,
-                                         "--runs-dir", str(tmp_path / "runs")])
-            assert r.exit_code == 1, r.output
-            assert r.output.strip().count("\n") == 0, r.output
-            assert "walker.leg.foot.kind: flat feet" in r.output
-    assert not list((tmp_path / "runs").rglob("walker.*"))
+    runs = tmp_path / "runs"
+    for fmt in ("urdf", "mjcf"):
+        r = CliRunner().invoke(app, ["export", str(tmp_path / "flat_bare.yaml"), "--format",
+                                     fmt, "--walker-only", "--runs-dir", str(runs)])
+        assert r.exit_code == 0, r.output
+    assert {p.name for p in (runs / "flat_bare").glob("walker.*")} == {"walker.urdf",
+                                                                      "walker.xml"}
+    r = CliRunner().invoke(app, ["export", str(tmp_path / "flat_bare.yaml"), "--format",
+                                 "osim", "--walker-only", "--runs-dir", str(runs)])
+    assert r.exit_code == 1 and r.output.strip().count("\n") == 0, r.output
+    assert "--walker-only" in r.output
 
 
 def test_arc_feet_get_ground_for_their_roll_with_a_warning(tmp_path, capsys):

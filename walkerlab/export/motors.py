@@ -51,8 +51,9 @@ def motors(act: Actuation | None) -> list[tuple[str, str, str]]:
 
 def motor_target(kind: str, target: str) -> str:
     """What a motor of :func:`motors` turns, in words."""
-    if kind == "joint":
-        return f"the joint {target} (+u extends the knee)"
+    if kind == "joint":  # a knee, or a flat foot's ankle (its angle toe up positive)
+        turn = "turns the sole toe up" if target.endswith("_ankle") else "extends the knee"
+        return f"the joint {target} (+u {turn})"
     if target == HIP_ACTUATION_TENDON:
         return "leg1_hip - leg2_hip (+u on leg1_hip, -u on leg2_hip)"
     return f"{target[:-len('_torso')]} - torso_hip (+u on the thigh's joint, -u on torso_hip)"

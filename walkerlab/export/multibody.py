@@ -199,7 +199,8 @@ def _tendons(mb: Multibody) -> list[str]:
 
 
 def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
-                     extra: MjcfScene | None = None) -> WalkerMjcf:
+                     extra: MjcfScene | None = None, alone: tuple = (None, ())
+                     ) -> WalkerMjcf:
     """A planar walker's MJCF as the legged walkers' one writer writes it
     (:func:`walkerlab.export.mjcf_document.walker_mjcf_text`): its bodies
     (:func:`walkerlab.export.planar_bodies.planar_bodies`) and what its file carries beyond
@@ -215,6 +216,12 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
     extra : MjcfScene, optional
         The gait keyframe, terrain, contact setting and knee latch of the scene; without it
         a plane through the feet and MuJoCo's default contact.
+    alone : (tuple or None, tuple of str)
+        Without ``extra`` (the walker alone): its flat feet and their notes
+        (:meth:`walkerlab.export.scene_feet._FlatFeet.alone`; none for other feet).  The
+        flat feet (:func:`walkerlab.export.scene_feet.flat_foot_bodies`, per leg heel, toe,
+        ankle spring and the sole's mass and inertia) are ``extra.flat_feet`` with
+        ``extra``: the bodies, geoms, ankle springs and keyframes read them from here.
 
     Returns
     -------
@@ -225,8 +232,8 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
         keyframe ``gait`` and the knee latches as joint equality constraints named
         ``leg<i>_latch``.
     """
-    root, _ = planar_bodies(data, MJCF_MIN_INERTIA_KG_M2,
-                            extra.flat_feet if extra is not None else None)
+    feet = extra.flat_feet if extra is not None else alone[0]  # the flat feet, once
+    root, _ = planar_bodies(data, MJCF_MIN_INERTIA_KG_M2, feet)
     root = replace(root, mass_kg=mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG)
     contact = None if extra is None else MjcfContact(
         extra.timestep_s, extra.solref, extra.solimp, (extra.friction, 0, 0))
@@ -234,22 +241,21 @@ def planar_legs_mjcf(data, mb: Multibody, name: str, version: str = "",
     profile = extra is not None and extra.profile is not None
     return WalkerMjcf(
         name, root, mb.gravity_m_per_s2, header=tuple(header(mb, name, "MJCF", version)),
-        notes=extra.notes if extra else (), left_out=mjcf_omissions(mb, extra),
-        contact=contact, geoms=_geoms(mb, extra), joint_attrs=_joint_attrs(mb, extra),
+        notes=extra.notes if extra else alone[1], left_out=mjcf_omissions(mb, extra),
+        contact=contact, geoms=_geoms(mb, extra, feet), joint_attrs=_joint_attrs(mb, feet),
         asset=tuple(profile_asset(mb, extra)) if profile else (),
         ground=tuple(ground_geoms(mb, extra)), actuation=extra.actuation if extra else None,
         tendons=tuple(_tendons(mb)), equality=tuple(_equality(mb, extra)),
-        numerics=numerics, texts=texts, keyframes=_keys(mb, extra))
+        numerics=numerics, texts=texts, keyframes=_keys(mb, extra, feet))
 
 
-def _geoms(mb: Multibody, extra: MjcfScene | None):
+def _geoms(mb: Multibody, extra: MjcfScene | None, feet: tuple | None):
     """The geoms (no mass: ``inertiafromgeom`` is off) of each export body
     (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`): the hip's sphere, each link's
-    capsule (up the torso), each foot's site and contact sphere (a flat foot: its site; its
-    sole's capsule and heel and toe spheres)."""
+    capsule (up the torso), each foot's site and contact sphere (flat feet ``feet``, per
+    leg heel and toe first: its site; its sole's capsule and heel and toe spheres)."""
     width = mb.leg_length_m / 50
     links = {ln.name: ln for ln in mb.links}
-    feet = extra.flat_feet if extra is not None else None
 
     def geoms(b, pad: str) -> list[str]:
         if b.name == "hip":
@@ -284,13 +290,14 @@ def _geoms(mb: Multibody, extra: MjcfScene | None):
     return geoms
 
 
-def _joint_attrs(mb: Multibody, extra: MjcfScene | None):
+def _joint_attrs(mb: Multibody, feet: tuple | None):
     """A joint's spring-damper as MuJoCo's joint attributes (``stiffness``, ``springref``,
-    ``damping``): a knee spring's (:func:`_joint_springs`), a flat foot's ankle's."""
+    ``damping``): a knee spring's (:func:`_joint_springs`), a flat foot's ankle's (``feet``:
+    per leg heel, toe, stiffness, damping, rest angle, ...)."""
     springs = {j: (sp.stiffness_n_m_per_rad, sp.rest_angle_rad, sp.damping_n_m_s_per_rad)
                for j, sp in _joint_springs(mb).items()}
-    if extra is not None and extra.flat_feet is not None:
-        for leg, (_, _, k, c, rest, _, _) in zip(("leg1", "leg2"), extra.flat_feet):
+    if feet is not None:
+        for leg, (_, _, k, c, rest, _, _) in zip(("leg1", "leg2"), feet):
             springs[f"{leg}_ankle"] = (k, rest, c)
 
     def attrs(j) -> str:
@@ -332,10 +339,10 @@ def _custom(mb: Multibody, extra: MjcfScene | None) -> tuple[tuple, tuple]:
             (("walkerlab_actuation", actuation_text(extra.actuation)),))
 
 
-def _keys(mb: Multibody, extra: MjcfScene | None) -> tuple:
-    """The keyframes: ``standing`` (legs vertical, the hip at ``L``), with ``extra`` the
-    rigid gait's ``gait``."""
-    ankles = 2 if extra is not None and extra.flat_feet is not None else 0
+def _keys(mb: Multibody, extra: MjcfScene | None, feet: tuple | None) -> tuple:
+    """The keyframes: ``standing`` (legs vertical, the hip at ``L``, flat ``feet`` at
+    their ankles' 0), with ``extra`` the rigid gait's ``gait``."""
+    ankles = 2 if feet is not None else 0
     standing = [0.0, mb.leg_length_m] + [0.0] * (len(mb.links) + ankles)
     gait = (("gait", extra.qpos, extra.qvel),) if extra is not None else ()
     return (("standing", standing, None), *gait)

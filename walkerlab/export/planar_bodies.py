@@ -22,10 +22,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.walker.description import ROLE_TAG
 from walkerlab.walker.trees import legs_tree
 
-__all__ = ["PLANAR_SLIDES", "planar_bodies", "planar_roles"]
+__all__ = ["PLANAR_SLIDES", "ankle_springs", "planar_bodies", "planar_roles", "sole_points"]
 
 #: the planar hip's slides: (joint, axis, the massless link it carries when not the last)
 PLANAR_SLIDES = (("hip_x", (1.0, 0.0, 0.0), "hip_slider"), ("hip_z", (0.0, 0.0, 1.0), ""))
@@ -58,6 +59,52 @@ def planar_roles(structure):
         foot="swing_ankle" if flat else ("swing_foot_centre" if structure.foot == "arc"
                                          else "swing_foot"),
         stance_params=tuple((n, n.replace(sw, st)) for n in structure.param_names if sw in n))
+
+
+def ankle_springs(data) -> tuple:
+    """Per leg (leg1, leg2: leg1 the swing role's numbers when the legs differ, leg2 the
+    stance role's, as :func:`planar_roles` reads them) ``(heel, toe [m], ankle stiffness
+    [N m/rad], damping [N m s/rad], rest angle [rad])`` of a flat-footed walker
+    (``walker.leg.foot``: ``heel_m``, ``toe_m``, ``ankle``); the ankle's law is
+    ``-k (a - rest) - c da/dt`` on the sole, ``a`` its hinge's angle (toe up positive).
+
+    Parameters
+    ----------
+    data : WalkerData
+        A flat-footed planar walker (:func:`walkerlab.walker.description.walker_data`).
+
+    Returns
+    -------
+    tuple of two tuples of five floats
+    """
+    st = data.structure
+    P = dict(zip(st.param_names, data.params))
+    tags = ("sw_", "st_") if st.asymmetric else ("", "")
+    return tuple((P[f"heel_{t}m"], P[f"toe_{t}m"], P[f"k_{t}ankle"], P[f"c_{t}ankle"],
+                  P[f"r_{t}ankle"]) for t in tags)
+
+
+def sole_points(data) -> dict:
+    """Each sole's heel and toe (the tree's contact points ``swing_heel``, ``swing_toe``,
+    :func:`walkerlab.walker.trees.legs_tree`) in its export body's frame [m]: ``{"leg1":
+    (heel (3,), toe (3,)), "leg2": ...}``, leg2's of the stance role's numbers.  At the
+    export's reference pose (legs vertical, ankles at 0) a sole is level, so its frame's
+    axes are the world's and a tree vector ``v`` reads ``TO_MUJOCO @ v``
+    (:data:`walkerlab.export.axes_3d.TO_MUJOCO`); the heel lies ``heel`` behind the ankle
+    (-x), the toe ``toe`` ahead (+x)."""
+    import sympy as sp  # light: the tree's expressions
+
+    s = data.structure
+    tree, _ = legs_tree(s)
+    values = dict(zip(s.param_names, data.params))
+    stance = dict(values, **{sw: values[st] for sw, st in planar_roles(s).stance_params})
+    Q = np.array(TO_MUJOCO)
+
+    def at(name: str, vals: dict) -> np.ndarray:
+        v = [float(sp.sympify(c).subs(vals)) for c in tree.contact(name).point_m]
+        return Q @ np.array(v)
+    return {leg: (at("swing_heel", vals), at("swing_toe", vals))
+            for leg, vals in (("leg1", values), ("leg2", stance))}
 
 
 def planar_bodies(data, inertia_floor: float = 0.0, flat_feet=None) -> tuple:

@@ -73,8 +73,8 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
 
     ``kind`` is the walker's (:attr:`walkerlab.walker.description.Structure.kind`); ``fmt``
     (``"mjcf"``, ``"urdf"``; None: any) and ``walker_only`` (no gait, contact or terrain)
-    are the export's: flat feet are written to an MJCF with its scene only
-    (:meth:`_LinkFeet.check_format`).
+    are the export's: flat feet are written to a URDF, an MJCF (the walker alone too) and
+    an OpenSim model with its scene (:meth:`_LinkFeet.check_format`).
 
     Raises
     ------
@@ -82,8 +82,8 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
         One line naming the field: a mass below :data:`MJCF_MIN_MASS_KG` (but > 0; 0 is
         refused by the multibody model) or a length / foot radius below
         :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); flat feet
-        other than to an MJCF with its scene (the URDF has no foot link: it would hold point
-        feet; the MJCF's foot bodies take their mass from the scene's contact section).  An
+        other than to a URDF, an MJCF or an OpenSim model with its scene (the MJCF's
+        massless foot bodies take their mass from the scene's contact section).  An
         ankle push-off (flat feet) is exported: motors ``leg<i>_ankle_motor`` that
         :mod:`walkerlab.export.mujoco_walk` drives.
     """

@@ -13,6 +13,7 @@ import numpy as np
 from walkerlab.codegen.cache import functions
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
+from walkerlab.export.planar_bodies import ankle_springs
 from walkerlab.models.contact.model import footprint_offsets
 from walkerlab.models.ground import landing_drops
 from walkerlab.models.hybrid.ground import on_landing
@@ -49,7 +50,10 @@ def flat_foot_bodies(scene: Scene, data) -> tuple:
     [kg], inertia about the ankle [kg m^2])`` of a flat-footed walker; mass and inertia the
     walker's (``walker.leg.foot.mass_kg``, ``inertia_about_ankle_kg_m2``) or, for massless
     feet, the contact model's (``contact.flat_foot_mass_kg``,
-    ``contact.flat_foot_inertia_kg_m2``).
+    ``contact.flat_foot_inertia_kg_m2``): the ankle's numbers of
+    :func:`walkerlab.export.planar_bodies.ankle_springs` and the mass.  The MJCF's one
+    source of its flat feet, with its scene (:attr:`walkerlab.export.mjcf_scene.MjcfScene.
+    flat_feet`) and alone (:meth:`_FlatFeet.alone`).
 
     Raises
     ------
@@ -65,9 +69,7 @@ def flat_foot_bodies(scene: Scene, data) -> tuple:
         raise ValueError("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: an "
                          "MJCF's flat feet need their mass and inertia (the rigid view's "
                          "feet are massless)")
-    tags = ("sw_", "st_") if st.asymmetric else ("", "")
-    return tuple((P[f"heel_{t}m"], P[f"toe_{t}m"], P[f"k_{t}ankle"], P[f"c_{t}ankle"],
-                  P[f"r_{t}ankle"], *mi) for t in tags)
+    return tuple((*leg, *mi) for leg in ankle_springs(data))
 
 
 def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
@@ -113,6 +115,11 @@ class _LinkFeet:
         """The contact walker's regularising foot mass and inertia: none."""
         return None
 
+    def alone(self, scene: Scene, data) -> tuple:
+        """The walker alone's (``--walker-only``) foot bodies and notes for its MJCF
+        (:func:`walkerlab.export.multibody.planar_legs_mjcf`): none."""
+        return None, ()
+
     def keyframe(self, scene: Scene, mb, data, walker, x_ideal):
         """``qpos``, ``qvel`` (:func:`joint_state`) and no foot bodies."""
         z = walker.link_state_from_ideal(x_ideal)
@@ -129,32 +136,44 @@ class _FlatFeet(_LinkFeet):
     regularising mass (:func:`flat_foot_bodies`), the rigid heel strike's double support as the
     keyframe (:func:`_flat_keyframe`), patches centred on the soles."""
 
-    notes = ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
-             "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
-             "the contact model's regularising foot mass and inertia at the ankle "
-             "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
-             "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
-             "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
-             "gait's double support as it begins).",)
+    #: the foot bodies' note (a walker alone's, :meth:`alone`), then the keyframe's
+    body_note = ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
+                 "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
+                 "the contact model's regularising foot mass and inertia at the ankle "
+                 "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+                 "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
+                 "toe (leg<i>_toe)")
+    notes = (body_note + "; the keyframe has the trailing foot on its toe (the rigid gait's "
+             "double support as it begins).",)
 
     def notes_for(self, data) -> tuple:
         """:attr:`notes`; feet with mass (``walker.leg.foot.mass_kg``): the walker's own."""
+        return (self._own_mass(data, self.notes[0]),)
+
+    @staticmethod
+    def _own_mass(data, note: str) -> str:
+        """``note`` with feet with mass (``walker.leg.foot.mass_kg``): the walker's own."""
         if not data.structure.foot_mass:
-            return self.notes
-        return (self.notes[0].replace(
+            return note
+        return note.replace(
             "the contact model's regularising foot mass and inertia at the ankle "
             "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
             "view's feet are massless)", "the walker's foot mass and inertia at the ankle "
-            "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)"),)
+            "(walker.leg.foot.mass_kg, inertia_about_ankle_kg_m2: every view's)")
 
     def check_format(self, fmt: str | None, walker_only: bool) -> None:
-        """Flat feet go to an MJCF or an OpenSim model with its scene only (one line
-        naming the field)."""
-        if fmt not in ("mjcf", "osim") or walker_only:
-            raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF and "
-                             "OpenSim with the scene only (a URDF would hold point feet: "
-                             "no foot link, ankle spring or heel and toe contacts); "
-                             "--walker-only has no foot mass")
+        """Flat feet go to a URDF, an MJCF (the walker alone too: its foot bodies carry
+        the scene's contact section's regularising mass, :meth:`alone`) or an OpenSim
+        model with its scene (one line naming the field)."""
+        if fmt not in ("urdf", "mjcf", "osim") or (fmt == "osim" and walker_only):
+            raise ValueError("walker.leg.foot.kind: flat feet are exported to URDF, MJCF "
+                             "and OpenSim (OpenSim with the scene only)")
+
+    def alone(self, scene: Scene, data) -> tuple:
+        """The walker alone's foot bodies (:func:`flat_foot_bodies`: MuJoCo needs mass on
+        a moving body, so massless feet carry the contact section's regularising mass and
+        inertia, or its defaults) and their note (:attr:`body_note`, no keyframe's)."""
+        return flat_foot_bodies(scene, data), (self._own_mass(data, self.body_note + "."),)
 
     def foot_mass(self, settings: ContactSettings):
         """``contact.flat_foot_mass_kg`` and ``contact.flat_foot_inertia_kg_m2`` (the

@@ -12,16 +12,20 @@ comments it is given (the springs, motors and what else the file leaves out), wh
 dimension; :func:`legs_urdf_text` is the legged walkers' file:
 
 - planar (:func:`walkerlab.export.planar_bodies.planar_bodies`): the tree of
-  :func:`walkerlab.walker.trees.legs_tree`,
-  the hip carried by the fixed link ``world`` on the slides ``hip_x`` (through the massless
-  carriage ``hip_slider``) and ``hip_z``, the legs' joints ``leg<i>_hip`` (``leg<i>_knee``:
-  ``revolute`` in ``[-pi, 0]`` with the straight-leg stop), ``torso_hip``, each foot a
-  massless link ``leg<i>_foot`` on a fixed joint of that name at the foot point or the arc's
-  centre; the inertias as the tree has them (a point mass none); the walkers whose joints
+  :func:`walkerlab.walker.trees.legs_tree`, the hip carried by the fixed link ``world`` on
+  the slides ``hip_x`` (through the massless carriage ``hip_slider``) and ``hip_z``, the
+  legs' joints ``leg<i>_hip`` (``leg<i>_knee``: ``revolute`` in ``[-pi, 0]`` with the
+  straight-leg stop), ``torso_hip``, each foot a massless link ``leg<i>_foot`` on a fixed
+  joint of that name at the foot point or the arc's centre; flat feet: each sole
+  ``leg<i>_sole`` on its ankle hinge ``leg<i>_ankle`` (the foot link at the ankle), as the
+  rigid model has it (massless: no ``inertial``; or ``walker.leg.foot.mass_kg``), collision
+  spheres ``leg<i>_heel``, ``leg<i>_toe`` at the tree's heel and toe
+  (:func:`walkerlab.export.planar_bodies.sole_points`), the ankle springs' law in the
+  header; the inertias as the tree has them (a point mass none); the walkers whose joints
   are all free (the five-link and three-link bipeds) alike, their knees free and the torso
-  on its own hinge.  The frame, joint names, feet and what the springs, couplings and
-  motors become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states
-  them (the links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
+  on its own hinge. The frame, joint names, feet and what the springs, couplings and motors
+  become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states them (the
+  links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
 - 3D (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`): the pelvis is the root link, free
   in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
   body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
@@ -30,7 +34,8 @@ dimension; :func:`legs_urdf_text` is the legged walkers' file:
   (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the MJCF's; the hip-roll
   law and the actuation in the comments ``walkerlab_hip_roll``, ``walkerlab_actuation``.
 
-What URDF cannot hold (ground, springs, couplings, the knee latch, motors, push-off) is
+What URDF cannot hold (ground, springs, ankle springs, couplings, the knee latch, motors,
+push-off) is
 listed by :func:`legs_urdf_omissions` and stated in the header, the planar laws in the
 sidecar (:func:`keyframe_json`).
 """
@@ -51,9 +56,10 @@ from walkerlab.export.mjcf_scene import (
 from walkerlab.export.motors import motor_target, motors
 from walkerlab.export.omitted import URDF_GROUND, Omission, xml_comments
 from walkerlab.export.parts import export_part
-from walkerlab.export.planar_bodies import planar_bodies
+from walkerlab.export.planar_bodies import ankle_springs, planar_bodies, sole_points
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import arc_feet, comment, header, num, nums
+from walkerlab.walker.kinds import KINDS
 from walkerlab.walker.multibody import multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
@@ -194,10 +200,41 @@ def legs_urdf_text(data, name: str, version: str = "",
     if data.structure.in_3d:
         return _legs_3d_text(data, name, version, actuation)
     mb = multibody(data)
-    root, couplings = planar_bodies(data)
-    comments = [*header(mb, name, "URDF", version),
+    root, couplings = planar_bodies(data)  # flat feet: the soles as the rigid model has them
+    soles = sole_points(data) if data.structure.kind.feet_have_modes else None
+    comments = [*header(mb, name, "URDF", version), *_flat_feet_comments(data, mb),
                 *xml_comments(urdf_omissions(mb, actuation))]
-    return urdf_robot_text(name, comments, root, couplings, _planar_visuals(mb), world=True)
+    return urdf_robot_text(name, comments, root, couplings, _planar_visuals(mb, soles),
+                           world=True)
+
+
+def _flat_feet_comments(data, mb: Multibody) -> list[str]:
+    """The planar URDF's comments on flat feet (none for other feet): the soles as the
+    rigid model has them (massless, or the walker's foot mass), their heel and toe
+    collision spheres and each ankle spring's law (URDF has no spring element)."""
+    st = data.structure
+    if not st.kind.feet_have_modes:
+        return []
+    if st.foot_mass:
+        P = dict(zip(st.param_names, data.params))
+        mass = (f"each carrying the walker's foot mass {num(P['m_foot'])} kg at the ankle and "
+                f"{num(P['I_foot'])} kg m^2 about it (walker.leg.foot.mass_kg, "
+                "inertia_about_ankle_kg_m2)")
+    else:
+        mass = ("massless (no inertial) as the rigid model's feet are (the contact model's, "
+                "the MJCF's and OpenSim's regularising contact.flat_foot_mass_kg is not in "
+                "this file)")
+    out = [comment("Flat feet (the rigid model, which a URDF describes): links leg<i>_sole "
+                   "on the ankle hinges leg<i>_ankle at the leg's end (the link leg<i>_foot), "
+                   f"{mass}; collision spheres of radius {num(point_foot_radius(mb))} m at "
+                   "the heel (leg<i>_heel) and the toe (leg<i>_toe).")]
+    for leg, (heel, toe, k, c, rest) in zip(("leg1", "leg2"), ankle_springs(data)):
+        out.append(comment(
+            f"Ankle spring {leg}_ankle (heel {num(heel)} m behind, toe {num(toe)} m ahead of "
+            "the ankle along the sole): a = the hinge's angle (the sole from the leg's "
+            "perpendicular, toe up positive) [rad], torque on the sole -k (a - rest) - c "
+            f"da/dt with k = {num(k)} N m/rad, rest = {num(rest)} rad, c = {num(c)} N m s/rad."))
+    return out
 
 
 def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omission, ...]:
@@ -220,11 +257,27 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
                                                 "in the comment walkerlab_actuation"))
 
 
-def _planar_visuals(mb: Multibody):
+def _planar_visuals(mb: Multibody, soles: dict | None = None):
     """The planar walker's drawing: the hip a sphere, each link a cylinder along it (up the
-    torso), each foot a sphere of :func:`point_foot_radius` or the arc's cylinder."""
+    torso), each foot a sphere of :func:`point_foot_radius` or the arc's cylinder; flat
+    feet (``soles``: :func:`walkerlab.export.planar_bodies.sole_points`) each sole a
+    cylinder from heel to toe with collision spheres of :func:`point_foot_radius` at its
+    heel (``leg<i>_heel``) and toe (``leg<i>_toe``), the foot link at the ankle none."""
     width = mb.leg_length_m / 50  # visual thickness of the links
     links = {ln.name: ln for ln in mb.links}
+    r = point_foot_radius(mb)
+
+    def sole(b, pad: str) -> list[str]:
+        leg = b.name.removesuffix("_sole")
+        heel, toe = soles[leg]
+        ball = f'<geometry><sphere radius="{num(r)}"/></geometry>'
+        return [f'{pad}<visual><origin xyz="{nums(*(heel + toe) / 2)}" '
+                f'rpy="{nums(0, math.pi / 2, 0)}"/><geometry><cylinder radius="{num(width / 4)}" '
+                f'length="{num(float(toe[0] - heel[0]))}"/></geometry></visual>',
+                f'{pad}<collision name="{leg}_heel"><origin xyz="{nums(*heel)}"/>{ball}'
+                "</collision>",
+                f'{pad}<collision name="{leg}_toe"><origin xyz="{nums(*toe)}"/>{ball}'
+                "</collision>"]
 
     def visuals(b, pad: str) -> list[str]:
         if b.tree_body == "pelvis":
@@ -236,14 +289,16 @@ def _planar_visuals(mb: Multibody):
             return [f'{pad}<visual><origin xyz="{nums(0, 0, -reach / 2)}"/><geometry>'
                     f'<cylinder radius="{num(width / 2)}" length="{num(ln.length_m)}"/>'
                     "</geometry></visual>"]
-        if not (b.joints and b.joints[0].kind == "fixed"):   # not a foot
-            return []
+        if soles is not None and b.tree_body == "swing_sole":
+            return sole(b, pad)
+        if not (b.joints and b.joints[0].kind == "fixed") or soles is not None:
+            return []   # not a foot (flat feet: the sole's heel and toe are)
         if arc_feet(mb):  # cylinder axis (z) turned onto y
             geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
                     f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
                     "</geometry>")
         else:
-            geom = f'<geometry><sphere radius="{num(point_foot_radius(mb))}"/></geometry>'
+            geom = f'<geometry><sphere radius="{num(r)}"/></geometry>'
         return [f"{pad}<collision>{geom}</collision>"]
     return visuals
 
@@ -290,12 +345,16 @@ def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
                    ) -> tuple[Omission, ...]:
     """What a planar walker's :func:`legs_urdf_text` leaves out
     (:mod:`walkerlab.export.omitted`): the ground and
-    contact, each spring (URDF has no spring element), each coupling (``mimic`` follows one
+    contact, each spring and flat foot's ankle spring (URDF has no spring element), each
+    coupling (``mimic`` follows one
     joint only), the knee latch, each motor of :func:`motors` and the push-off (no actuator
     or force element: the laws are in the keyframe sidecar)."""
     out = [URDF_GROUND]
     out += [Omission(f"spring {sp.name}", "URDF has no spring element (its law is in the "
                      "header)") for sp in mb.springs]
+    if KINDS[mb.kind].feet_have_modes:  # flat feet: the ankle spring-dampers
+        out += [Omission(f"ankle spring {leg}_ankle", "URDF has no spring element (its law "
+                         "is in the header)") for leg in ("leg1", "leg2")]
     out += [Omission(f"coupling {cp.name}", f"URDF's mimic follows one joint only, so a URDF "
                      f"library sees a free {cp.joint} (the relation is in the header)")
             for cp in mb.couplings]
@@ -325,10 +384,16 @@ def urdf_actuation_omissions(actuation: Actuation | None,
 def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
     """The ``gait`` keyframe as JSON: ``{"joints": [...], "qpos": [...], "qvel": [...],
     "units": [...]}`` in the URDF's joint names and order (the sidecar of ``walker.urdf``)."""
-    joints = ["hip_x", "hip_z", *(ln.joint for ln in mb.links)]
-    units = ["m", "m", *("rad" for _ in mb.links)]
+    # flat feet: each leg's ankle after its hip (MuJoCo's tree order, the MJCF's keyframe)
+    ankle = {f"{leg}_hip": [f"{leg}_ankle"] for leg in ("leg1", "leg2")
+             if extra.flat_feet is not None}
+    joints = ["hip_x", "hip_z", *(j for ln in mb.links for j in [ln.joint,
+                                                                  *ankle.get(ln.joint, [])])]
+    units = ["m", "m", *("rad" for _ in joints[2:])]
+    flat = (" (flat feet: the rigid heel strike's double support as it begins, the "
+            "trailing foot on its toe, leg2's heel at the origin)" if ankle else "")
     out = {"keyframe": "gait", "description": "rigid fixed point just after heel strike, "
-           "leg2 in stance, its foot at the origin on the ground line",
+           "leg2 in stance, its foot at the origin on the ground line" + flat,
            "joints": joints, "units": units, "qpos": list(extra.qpos),
            "qvel": list(extra.qvel)}
     if extra.actuation is not None:  # a powered walker: its actuators, as the scene

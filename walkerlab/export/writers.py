@@ -63,6 +63,7 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.scene import FORMAT_VIEWS, check_exportable, mjcf_scene
+from walkerlab.export.scene_feet import SCENE_FEET
 from walkerlab.export.spoked import (
     WHEEL_TIP_FRACTION,
     WHEEL_URDF_OMISSIONS,
@@ -247,7 +248,10 @@ def _links(job: ExportJob, w: Writer) -> Written:
         text = legs_urdf_text(job.data, job.name, version, scene.walker.actuation)
         left_out = urdf_omissions(mb, scene.walker.actuation)
     else:  # the legged walkers' one MJCF writer, planar and 3D
-        text = walker_mjcf_text(planar_legs_mjcf(job.data, mb, job.name, version, extra))
+        alone = SCENE_FEET[job.kind.feet].alone(scene, job.data) if extra is None else (
+            None, ())  # the walker alone's flat feet (with its scene: extra's)
+        text = walker_mjcf_text(planar_legs_mjcf(job.data, mb, job.name, version, extra,
+                                                 alone))
         left_out = mjcf_omissions(mb, extra)
     files = [_xml(job, w, text)]
     if w.name == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it

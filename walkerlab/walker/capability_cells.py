@@ -222,9 +222,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                      "ankle motors yet (--format mjcf, contact-sim)"),
         ("profile", "osim"): _OSIM_PROFILE,
         ("profile", "optimize"): _OPTIMIZE_PROFILE,
-        ("walk", "urdf"): ("flat feet are exported to MJCF and OpenSim with the scene only "
-                           "(a URDF would hold point feet: no foot link, ankle spring or heel "
-                           "and toe contacts)"),
+        **_URDF_GROUNDS,
         # the rigid view lands its heel strike on stairs and footholds of several heights
         # (walkerlab.models.hybrid.rigid_foot_modes.on_landing_flat); the gym's rigid view
         # steps that walker (its contact view asks the contact cells)
