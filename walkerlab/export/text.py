@@ -1,6 +1,6 @@
 """The text both export formats (:mod:`walkerlab.export.multibody`) are written with: floats that
 read back exactly, XML comments, the header comments stating the conventions, and the feet
-the header and both writers describe (arc feet or point feet)."""
+the header and both writers describe (arc feet, flat feet or point feet)."""
 
 from __future__ import annotations
 
@@ -39,7 +39,8 @@ def header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
         knee += ("; torso_hip = the torso's absolute angle from the upward vertical, positive "
                  "leaning back (a free hinge)")
     foot = (f"arc feet, radius R = {num(mb.foot_radius_m)} m, centre at L - R from the hip"
-            if arc_feet(mb) else "point feet")
+            if arc_feet(mb) else "flat feet, each a sole leg<i>_sole on its ankle hinge "
+            "leg<i>_ankle at the leg's end" if export_part(mb).ankles else "point feet")
     parts = [comment(f"walker {name!s} exported by walkerlab {version} ({fmt})."),
             comment("Floating planar walker in the x-z plane: x downhill (horizontal), z up; "
                      "joint axes along -y (positive angle = foot ahead)."),
