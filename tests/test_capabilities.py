@@ -344,8 +344,8 @@ def test_the_urdf_column_supports_what_the_urdf_writer_takes():
 
     assert "urdf" in VIEWS
     took = {k for k in KINDS if KINDS[k].supports("walk", "urdf")}
-    # flat feet have no foot link there; the kneed walker in 3D runs in its rigid model only
-    assert took == set(KINDS) - {"flat_feet", "locking_knees_3d"}
+    # flat feet have no foot link there
+    assert took == set(KINDS) - {"flat_feet"}
     for k in KINDS.values():
         assert not any(k.supports(g, "urdf") for g in ("stairs", "footholds", "profile"))
 
