@@ -344,8 +344,9 @@ def test_the_urdf_column_supports_what_the_urdf_writer_takes():
 
     assert "urdf" in VIEWS
     took = {k for k in KINDS if KINDS[k].supports("walk", "urdf")}
-    # the kneed walker in 3D runs in its rigid model only
-    assert took == set(KINDS) - {"locking_knees_3d"}
+    # every legged kind and the wheels (flat feet: soles on ankle hinges; the kneed
+    # walker in 3D: knees with their straight-leg stop)
+    assert took == set(KINDS)
     for k in KINDS.values():
         assert not any(k.supports(g, "urdf") for g in ("stairs", "footholds", "profile"))
 

@@ -43,6 +43,11 @@ upright (< 1e-23 rad over 11 heel strikes).
 
 Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
 
+Knees (``locking_knees_3d``, :func:`legs3d_roles`): each thigh ``leg<i>`` carries its shank
+``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about its pitch axis, its range
+the tree's straight-leg stop ``[-pi, 0]``; with the gait the planar kneed MJCF's latch
+(:func:`walkerlab.export.multibody.latch_equality_lines`), listed as left out.
+
 Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates,
 :func:`walkerlab.codegen.derive_3d.derive_compass`): each leg hangs on a hinge
 ``leg<i>_roll`` about the fall line (the pelvis' frame: ``cos phi, 0, -sin phi``) before its
@@ -80,7 +85,8 @@ from walkerlab.codegen.cache import functions
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
-from walkerlab.export.multibody import mjcf_actuation_omissions
+from walkerlab.export.multibody import latch_equality_lines, mjcf_actuation_omissions
+from walkerlab.export.omitted import MJCF_KNEE_LATCH
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
@@ -88,8 +94,9 @@ from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_tree
 
-__all__ = ["TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "legs3d_footfalls",
-           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad"]
+__all__ = ["SHANK", "TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "kneed", "leg_links",
+           "legs3d_footfalls", "legs3d_keyframe", "legs3d_mjcf", "legs3d_roles", "legs3d_scene",
+           "legs_words", "pelvis_lean_rad"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -146,8 +153,10 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
         The rigid walker's generated ``points`` and ``point_velocities``
         (:func:`walkerlab.codegen.cache.functions`; world axes of walkerlab, the stance foot
         at the origin): ``hip`` (the pelvis), ``stance_hip``.
-    x : ndarray (6,) or (10,)
-        ``[lean, swing, stance]`` [rad] and their rates [rad/s]; with hip-roll joints
+    x : ndarray (6,), (8,) or (10,)
+        ``[lean, swing, stance]`` [rad] and their rates [rad/s]; knees: ``[lean,
+        swing_thigh, swing_shank, stance]``, each leg's hip then knee ``swing_thigh,
+        swing_shank - swing_thigh, stance, 0`` and their rates; with hip-roll joints
         ``[lean, swing, stance, pelvis_roll, swing_roll]`` and their rates: then ``qpos``
         (8,) = the pelvis' slides, its roll, ``leg1_roll`` = ``swing_roll - pelvis_roll``,
         ``leg1_hip``, ``leg2_roll`` = ``lean - pelvis_roll``, ``leg2_hip``, ``qvel`` (8,)
@@ -159,14 +168,18 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
 
     Returns
     -------
-    (qpos (9,), qvel (8,)) or, with hip-roll joints, (qpos (8,), qvel (8,)) : tuple of float
+    (qpos (9,), qvel (8,)); knees (11,), (10,); hip-roll joints (8,), (8,) : tuple of float
     """
     from scipy.spatial.transform import Rotation
 
     x = np.asarray(x, float)
     rolled = x.size == 10  # hip-roll joints: the pelvis' and the swing leg's own rolls
+    kneed = x.size == 8    # a knee on the swing leg: its shank's own angle
     if rolled:
         lean, sw, st, pelvis_roll, swing_roll, dlean, dsw, dst, dpelvis, dswing = x
+    elif kneed:
+        lean, sw, shank, st, dlean, dsw, dshank, dst = x
+        pelvis_roll, swing_roll, dpelvis, dswing = lean, lean, dlean, dlean
     else:
         lean, sw, st, dlean, dsw, dst = x
         pelvis_roll, swing_roll, dpelvis, dswing = lean, lean, dlean, dlean
@@ -189,6 +202,9 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
     if rolled:  # the pelvis on slides, yaw (0) and roll; each leg's roll, then its hinge
         qpos = (*qpos[:3], pelvis_roll, swing_roll - pelvis_roll, sw, lean - pelvis_roll, st)
         qvel = (*qvel[:3], dpelvis, dswing - dpelvis, dsw, dlean - dpelvis, dst)
+    if kneed:   # each leg's hip, then its knee (the stance knee straight)
+        qpos = (*qpos[:7], sw, shank - sw, st, 0.0)
+        qvel = (*qvel[:6], dsw, dshank - dsw, dst, 0.0)
     return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
 
 
@@ -206,7 +222,7 @@ def legs3d_footfalls(points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
     points : callable ``x -> dict[str, ndarray (3,)]``
         The rigid walker's generated ``points``: ``swing_foot`` (the trailing foot just
         after the heel strike).
-    x : ndarray (6,)
+    x : ndarray (6,) or (8,)
     steps : int
         Footfalls ahead of the keyframe (both legs'), ``EXPORT_STEPS``.
 
@@ -257,6 +273,8 @@ class Legs3dScene:
         The push-off pulse's length [s]: one timestep (the rigid model's impulse as MuJoCo
         applies it, as the planar MJCF's :attr:`walkerlab.export.mjcf_scene.MjcfScene.
         push_off_duration_s`).
+    latch : (float, float) or None
+        Knees: the planar MJCF's :attr:`walkerlab.export.mjcf_scene.MjcfScene.latch`.
     """
 
     qpos: tuple
@@ -272,6 +290,7 @@ class Legs3dScene:
     patch_across_m: float = 0.08  # PATCH_ACROSS_L of a 1 m leg
     actuation: object = None
     push_off_duration_s: float = 0.005
+    latch: tuple | None = None
 
 
 def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
@@ -284,7 +303,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     data : WalkerData
         The 3D walker (:func:`walkerlab.walker.description.walker_data`).
     ideal : gait
-        ``x`` (6,) or (10,), ``period_s`` [s], ``step_lengths_m`` (one per step of its period).
+        ``x`` (6,), (8,) or (10,), ``period_s`` [s], ``step_lengths_m`` (one per step).
     options : walkerlab.export.mjcf_scene.MjcfOptions, optional
         The contact's time constant and the timestep.
 
@@ -318,7 +337,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         qpos += ((s["swing_angle"] + s["stance_angle"]) / 2,)
         qvel += ((s["swing_rate"] + s["stance_rate"]) / 2,)
     lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
-    c, _knee = contact_si(scene.contact or ContactSettings())
+    c, knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
                                                    data.slope_rad, options)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
@@ -343,6 +362,12 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         "Feet: condim 3 (the hip-roll walker's joints hold its feet from twisting: its "
         "pelvis neither pitches nor yaws); the law of walker.hip_roll in the custom text "
         "walkerlab_hip_roll, run by walkerlab's walk loop (HipRollLoop).")
+    latch = None
+    if kneed(data):  # the planar kneed MJCF's latch and its note
+        from walkerlab.export.scene import latch_note  # light
+
+        latch = (knee.latch_height, knee.latch_capture)
+        notes += (latch_note(knee),)
     act = scene.walker.actuation
     if act is not None:  # the planar walkers' note: one motor 'hip', the loop's laws
         from walkerlab.export.parts import kind_part  # light
@@ -350,7 +375,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         notes += (kind_part(data.structure.kind).mjcf_actuators,)
     return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
                        tuple(solref), tuple(solimp), float(mu), period, notes, float(across),
-                       act, float(dt))  # the push-off over one timestep
+                       act, float(dt), latch)  # the push-off over one timestep
 
 
 def _patches(p: dict, extra: Legs3dScene, phi: float) -> list[str]:
@@ -405,45 +430,95 @@ def legs_summary(data, p: dict) -> str:
             f"{num(p['M_hip'])} kg{', an upper body' if data.structure.torso else ''})")
 
 
+#: the 3D kneed walker's shank in its body tree (:func:`walkerlab.walker.trees.legs_tree`)
+SHANK = "swing_shank"
+
+
+def kneed(data) -> bool:
+    """Whether the 3D walker has knees (:attr:`walkerlab.walker.kinds.Kind.knees`)."""
+    return data.structure.kind.knees != "none"
+
+
+def legs3d_roles(data) -> PelvisRoles:
+    """The 3D legs' export roles, the MJCF's and the URDF's: the pelvis free, or on its roll
+    (hip-roll joints); knees ``leg<i>_knee`` on shanks ``leg<i>_shank``, leg2's knee a
+    coordinate of its own (the planar kneed walker's, :func:`walkerlab.export.
+    planar_bodies.planar_roles`)."""
+    hinges = ("stance_hip_roll",) if hip_roll_law(data) is not None else ()
+    if not kneed(data):
+        return PelvisRoles(pelvis_hinges=hinges)
+    return PelvisRoles(pelvis_hinges=hinges,
+                       stance_roles=(("swing_thigh", "stance"), ("swing_shank", "stance_shank"),
+                                     ("swing_roll", "lean")),
+                       joint_names=PelvisRoles().joint_names + (("swing_knee", "{leg}_knee"),),
+                       body_names=((SHANK, "{leg}_shank"),))
+
+
+def leg_links(p: dict, roles: PelvisRoles) -> dict:
+    """Each leg link by tree body: ``(length, foot sphere's centre down it or None)`` [m]:
+    ``(L, L - r)``; knees: ``(L_thigh, None)``, the shank ``(L - L_thigh, L - L_thigh - r)``
+    (``p``: :func:`_numbers`)."""
+    L, r, thigh = p["L"], p["r"], p.get("L_thigh")
+    if thigh is None:
+        return {roles.leg: (L, L - r)}
+    return {roles.leg: (thigh, None), SHANK: (L - thigh, L - thigh - r)}
+
+
+def legs_words(data, p: dict) -> tuple[str, str]:
+    """The legs' word for the files' header (``straight``, ``kneed``) and a clause on the
+    knees (empty without)."""
+    if not kneed(data):
+        return "straight", ""
+    return "kneed", (f"; knees {num(p['L_thigh'])} m below the hips on hinges leg<i>_knee "
+                     "about the leg's own pitch axis (shank - thigh angle, limit [-pi, 0], "
+                     "0 = straight-leg stop)")
+
+
 def _geoms(p: dict, roles: PelvisRoles):
     """The geoms (no mass: ``inertiafromgeom`` is off) of each export body
     (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`): the pelvis' sphere and hip
-    axis, each leg's capsule, foot site and foot sphere (its contact bits its lane's), a
-    sphere at each other massive body's centre of mass."""
+    axis, each leg link's capsule (:func:`leg_links`), the foot's site and sphere (its
+    contact bits its lane's), a sphere at each other massive body's centre of mass."""
     L, w, r = p["L"], p["w_hip"], p["r"]
+    links = leg_links(p, roles)
 
     def geoms(b, pad: str) -> list[str]:
         if b.tree_body == roles.pelvis:
             return [f'{pad}<geom name="{b.name}" type="sphere" size="{num(L / 25)}"/>'] + (
                 [f'{pad}<geom name="hip_axis" type="capsule" size="{num(L / 100)}" '
                  f'fromto="{nums(0, -w / 2, 0, 0, w / 2, 0)}"/>'] if w > 0 else [])
-        if b.tree_body == roles.leg:
-            return [f'{pad}<geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
-                    f'size="{num(L / 100)}"/>',
-                    f'{pad}<site name="{b.name}_foot" pos="{nums(0, 0, -(L - r))}"/>',
-                    f'{pad}<geom name="{b.name}_foot" type="sphere" '
-                    f'pos="{nums(0, 0, -(L - r))}" size="{num(r)}" contype="0" '
-                    f'conaffinity="{LANE_BITS[b.name]}"/>']
+        if b.tree_body in links:
+            length, foot = links[b.tree_body]
+            reach = length if foot is None else foot
+            out = [f'{pad}<geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -reach)}" '
+                   f'size="{num(L / 100)}"/>']
+            if foot is None:
+                return out
+            leg = b.name.split("_")[0]
+            return out + [f'{pad}<site name="{leg}_foot" pos="{nums(0, 0, -foot)}"/>',
+                          f'{pad}<geom name="{leg}_foot" type="sphere" '
+                          f'pos="{nums(0, 0, -foot)}" size="{num(r)}" contype="0" '
+                          f'conaffinity="{LANE_BITS[leg]}"/>']
         return ([f'{pad}<geom name="{b.name}" type="sphere" pos="{nums(*b.com_m)}" '
                  f'size="{num(L / 25)}"/>'] if b.mass_kg > 0 else [])
     return geoms
 
 
-def _bodies(data, law: dict | None) -> tuple:
-    """The pelvis body (a free joint, or with the hip-roll ``law`` three slides and a roll
+def _bodies(data) -> tuple:
+    """The pelvis body (a free joint, or with the hip-roll law three slides and a roll
     about the fall line) with the legs' bodies and any upper body in it, read from the
     walker's tree (:func:`walkerlab.export.tree_bodies.export_bodies`), its geoms
     (:func:`_geoms`) and the MJCF lines of its couplings' tendons and equalities (none
     without an upper body)."""
     tree, coords, p = walker_tree(data)
-    roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
+    roles = legs3d_roles(data)
     root, couplings = export_bodies(tree, coords, p, roles)
     return (root, _geoms(p, roles), *mjcf_coupling_lines(couplings))
 
 
 def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = None
                 ) -> WalkerMjcf:
-    """The 3D straight-legged walker's MJCF (module docstring) as the legged walkers' one
+    """The 3D legged walker's MJCF (module docstring) as the legged walkers' one
     writer writes it (:func:`walkerlab.export.mjcf_document.walker_mjcf_text`): its bodies and
     what its file carries beyond them.
 
@@ -465,13 +540,14 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
         Total mass ``M_hip + 2 m_leg``; the custom numerics ``slope_rad`` and
         ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg),
         the texts ``walkerlab_actuation`` (a powered walker) and ``walkerlab_hip_roll``
-        (hip-roll joints).
+        (hip-roll joints); knees: ``latch_release_height_m``, ``latch_capture_rad``.
     """
     p = _numbers(data)
     w, r, phi = p["w_hip"], p["r"], data.slope_rad
     law = hip_roll_law(data)
-    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
-                   f"{legs_summary(data, p)}, hips {num(w)} m apart; slope {num(phi)} "
+    word, knees = legs_words(data, p)
+    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): {word} "
+                   f"{legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
                    "x downhill, z up, leg1 on the side of -y; a foot sphere of radius "
@@ -482,16 +558,22 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
         extra.timestep_s, extra.solref, extra.solimp,
         (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic")
     act = extra.actuation if extra is not None else None
-    root, geoms, tendons, equality = _bodies(data, law)
+    root, geoms, tendons, equality = _bodies(data)
     numerics = (("slope_rad", phi), ("foot_height_offset_m", 0.0))
-    texts = ()
+    texts, left_out = (), tuple(mjcf_actuation_omissions(act))
+    if extra is not None and extra.latch is not None:  # the planar kneed MJCF's latch
+        equality += latch_equality_lines([j.name for b in root.walk() for j in b.joints
+                                          if j.name.endswith("_knee")])
+        numerics += (("latch_release_height_m", extra.latch[0]),
+                     ("latch_capture_rad", extra.latch[1]))
+        left_out = (MJCF_KNEE_LATCH,) + left_out
     if act is not None:  # the laws and the push-off, run by mujoco_walk.PoweredLoop
         numerics += (("push_off_duration_s", extra.push_off_duration_s),)
         texts += (("walkerlab_actuation", actuation_text(act)),)
     if law is not None:  # the hip-roll law, run by walkerlab.export.mujoco_walk.HipRollLoop
         texts += (("walkerlab_hip_roll", json.dumps(law)),)
     return WalkerMjcf(name, root, p["g"], (head,), extra.notes if extra else (),
-                    tuple(mjcf_actuation_omissions(act)), contact, geoms,
+                    left_out, contact, geoms,
                     ground=_ground(p, extra, phi), actuation=act, tendons=tuple(tendons),
                     equality=tuple(equality), numerics=numerics, texts=texts,
                     keyframes=(("gait", extra.qpos, extra.qvel),) if extra else ())

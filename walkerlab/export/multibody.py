@@ -106,7 +106,7 @@ from walkerlab.export.motors import (  # noqa: F401 (part of this API)
     motor_target,
     motors,
 )
-from walkerlab.export.omitted import Omission
+from walkerlab.export.omitted import MJCF_KNEE_LATCH, Omission
 from walkerlab.export.planar_bodies import planar_bodies
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_mjcf_text, wheel_urdf_text
 from walkerlab.export.text import arc_feet, header, num, nums
@@ -115,7 +115,8 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.walker.multibody import Multibody
 
 __all__ = ["FORMATS", "SIDECAR", "WHEEL_TIP_FRACTION",
-           "comments_in_scene_units", "mjcf_actuation_omissions", "mjcf_omissions",
+           "comments_in_scene_units", "latch_equality_lines", "mjcf_actuation_omissions",
+           "mjcf_omissions",
            "motor_target", "motors", "planar_legs_mjcf",
            "wheel_mjcf_text", "wheel_urdf_text"]
 
@@ -137,9 +138,7 @@ def mjcf_omissions(mb: Multibody, extra: MjcfScene | None = None) -> tuple[Omiss
     out = []
     knees = any(ln.joint.endswith("_knee") for ln in mb.links)
     if knees and extra.latch is not None:
-        out.append(Omission("the knee latch's switching", "MuJoCo has no contact-switched "
-                            "lock: the equalities leg<i>_latch are switched by a stepping "
-                            "loop (walkerlab.export.mujoco_walk.latch_rule)"))
+        out.append(MJCF_KNEE_LATCH)
     act = extra.actuation
     out += mjcf_actuation_omissions(act)
     if act is not None and act.ankle_push_off is not None:
@@ -317,9 +316,18 @@ def _equality(mb: Multibody, extra: MjcfScene | None) -> list[str]:
            f'solimp="{nums(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
     knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
     if extra is not None and knees and extra.latch is not None:
-        out += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
-                f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>' for k in knees]
+        out += latch_equality_lines(knees)
     return out
+
+
+def latch_equality_lines(knees) -> list[str]:
+    """The knee latches as MJCF joint equalities ``leg<i>_latch`` holding each knee of
+    ``knees`` (joint names ``leg<i>_knee``) at 0, leg2's active (the gait keyframe starts
+    with leg2 in stance), switched by a stepping loop
+    (:func:`walkerlab.export.mujoco_walk.latch_rule`); the planar and the 3D kneed walkers'
+    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`)."""
+    return [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
+            f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>' for k in knees]
 
 
 def _custom(mb: Multibody, extra: MjcfScene | None) -> tuple[tuple, tuple]:

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 from walkerlab.export.text import comment
 
-__all__ = ["ADAMS_CONTINUATION", "PREFIX", "URDF_GROUND", "Omission", "adams_comments",
-           "lines", "xml_comments"]
+__all__ = ["ADAMS_CONTINUATION", "MJCF_KNEE_LATCH", "PREFIX", "URDF_GROUND", "URDF_KNEE_LATCH",
+           "Omission", "adams_comments", "lines", "xml_comments"]
 
 #: The text every omission comment starts with (after an XML comment's opening or an Adams
 #: comment's exclamation mark and a space).
@@ -60,6 +60,17 @@ URDF_GROUND = Omission(
     "the ground (slope, terrain and contact law)",
     "URDF has no world or contact element; the slope is stated in the header, the rigid "
     "gait in the keyframe sidecar (the MJCF export carries ground and contact)")
+#: A kneed walker's MJCF with its gait (planar, :func:`walkerlab.export.multibody.
+#: mjcf_omissions`; in 3D, :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`): the knee
+#: latch's equalities are switched outside the file.
+MJCF_KNEE_LATCH = Omission(
+    "the knee latch's switching", "MuJoCo has no contact-switched lock: the equalities "
+    "leg<i>_latch are switched by a stepping loop (walkerlab.export.mujoco_walk.latch_rule)")
+#: A kneed walker's URDF (planar, :func:`walkerlab.export.urdf.urdf_omissions`; in 3D,
+#: :func:`walkerlab.export.urdf.legs_urdf_omissions`): no latch, the stop its joint limit.
+URDF_KNEE_LATCH = Omission(
+    "the knee latch (contact.knee_stop.latch)", "URDF has no contact-switched lock (the "
+    "joint limit at 0 is the straight-leg stop)")
 
 
 def lines(items) -> tuple[str, ...]:

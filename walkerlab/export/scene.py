@@ -61,7 +61,8 @@ from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.models.contact.terrain import check_ground, ground_drops, profile_line
 from walkerlab.walker.kinds import KINDS, Kind
 
-__all__ = ["FORMAT_VIEWS", "arc_roll_m", "check_exportable", "mjcf_scene", "mujoco_contact"]
+__all__ = ["FORMAT_VIEWS", "arc_roll_m", "check_exportable", "latch_note", "mjcf_scene",
+           "mujoco_contact"]
 
 #: The capability table's view (:data:`walkerlab.walker.kinds.VIEWS`) of each export format
 FORMAT_VIEWS = {"urdf": "urdf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
@@ -278,6 +279,17 @@ def mjcf_scene(scene: Scene, mb, plant, ideal=None, options: MjcfOptions | None 
                      feet, lane_heights, treads, profile)
 
 
+def latch_note(knee) -> str:
+    """The MJCF's comment on its knee latch (``knee``: the contact model's knee stop, its
+    ``latch_height`` [m] and ``latch_capture`` [rad]); the planar and the 3D kneed walkers'
+    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_scene`)."""
+    return (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
+            f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
+            f"{knee.latch_height:.4g} m above the ground and its knee within "
+            f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
+            "(data.eq_active), MuJoCo has no contact-switched lock.")
+
+
 def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) -> tuple:
     """The MJCF's comments on its keyframe, knee latch and actuators (``part``: the kind's
     :class:`walkerlab.export.parts.ExportPart`), then ``contact_notes``."""
@@ -285,11 +297,7 @@ def _walker_notes(scene: Scene, part, ideal, latch, knee, contact_notes: tuple) 
              f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
              "origin.",) + contact_notes
     if latch:
-        notes += (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
-                  f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
-                  f"{knee.latch_height:.4g} m above the ground and its knee within "
-                  f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
-                  "(data.eq_active), MuJoCo has no contact-switched lock.",)
+        notes += (latch_note(knee),)
     actuation = scene.walker.actuation
     if actuation is not None:
         notes += (part.mjcf_actuators,)

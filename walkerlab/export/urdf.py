@@ -30,7 +30,9 @@ dimension; :func:`legs_urdf_text` is the legged walkers' file:
   in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
   body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
   ``leg<i>_roll`` then ``leg<i>_hip`` through the massless ``leg<i>_roll_link``), its foot a
-  sphere (collision); point masses carry the export's smallest inertia
+  sphere (collision); knees (the kneed walker in 3D) ``leg<i>_knee``, ``revolute`` in
+  ``[-pi, 0]`` (the straight-leg stop) on the shanks ``leg<i>_shank``, the latch left out as
+  the planar URDF's; point masses carry the export's smallest inertia
   (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the MJCF's; the hip-roll
   law and the actuation in the comments ``walkerlab_hip_roll``, ``walkerlab_actuation``.
 
@@ -54,7 +56,7 @@ from walkerlab.export.mjcf_scene import (
     point_foot_radius,
 )
 from walkerlab.export.motors import motor_target, motors
-from walkerlab.export.omitted import URDF_GROUND, Omission, xml_comments
+from walkerlab.export.omitted import URDF_GROUND, URDF_KNEE_LATCH, Omission, xml_comments
 from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import ankle_springs, planar_bodies, sole_points
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
@@ -240,10 +242,11 @@ def _flat_feet_comments(data, mb: Multibody) -> list[str]:
 def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omission, ...]:
     """What :func:`legs_urdf_text` leaves out (:mod:`walkerlab.export.omitted`): a planar
     walker's :func:`urdf_omissions`; a 3D walker's hip-roll law and the pelvis' held pitch
-    and yaw (with hip-roll joints), its motors and push-off."""
+    and yaw (with hip-roll joints), its knee latch (knees: the planar URDF's item), its
+    motors and push-off."""
     if not data.structure.in_3d:
         return urdf_omissions(multibody(data), actuation)
-    from walkerlab.export.legs_3d_mjcf import hip_roll_law  # light: 3D only
+    from walkerlab.export.legs_3d_mjcf import hip_roll_law, kneed  # light: 3D only
 
     out = []
     if hip_roll_law(data) is not None:
@@ -253,6 +256,8 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
                 Omission("the pelvis' held pitch and yaw", "URDF's root is a loader's "
                          "floating base, free about every axis; the rigid pelvis only rolls "
                          "about the fall line")]
+    if kneed(data):
+        out.append(URDF_KNEE_LATCH)
     return tuple(out + urdf_actuation_omissions(actuation,
                                                 "in the comment walkerlab_actuation"))
 
@@ -308,16 +313,20 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`), each leg's rod and foot sphere."""
     from walkerlab.export.legs_3d_mjcf import (  # light: 3D only
         hip_roll_law,
+        leg_links,
+        legs3d_roles,
         legs_summary,
+        legs_words,
         walker_tree,
     )
-    from walkerlab.export.tree_bodies import PelvisRoles, export_bodies  # light
+    from walkerlab.export.tree_bodies import export_bodies  # light
 
     p = dict(zip(data.structure.param_names, data.params))
     L, w = p["L"], p.get("w_hip", 0.0)
     r = WHEEL_TIP_FRACTION * L
+    word, knees = legs_words(data, p)
     comments = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): "
-                        f"straight {legs_summary(data, p)}, hips {num(w)} m apart; slope "
+                        f"{word} {legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope "
                         f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); "
                         "the pelvis is the free root link"),
                 *xml_comments(legs_urdf_omissions(data, actuation))]
@@ -327,17 +336,22 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     if actuation is not None:
         comments.append(comment(f"walkerlab_actuation: {actuation_text(actuation)}"))
     tree, coords, p = walker_tree(data)
-    # with hip-roll joints the pelvis' roll and each leg's roll then pitch (the MJCF's)
-    roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
+    # with hip-roll joints the pelvis' roll and each leg's roll then pitch; knees (the MJCF's)
+    roles = legs3d_roles(data)
     root, couplings = export_bodies(tree, coords, p, roles)
+    links = leg_links(p, roles)
 
-    def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere
-        if b.tree_body != roles.leg:
+    def visuals(b, pad: str) -> list[str]:   # each leg link's rod, the foot's sphere
+        if b.tree_body not in links:
             return []
-        return [f'{pad}<visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
-                f'radius="{num(L / 100)}" length="{num(L)}"/></geometry></visual>',
-                f'{pad}<collision name="{b.name}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+        length, foot = links[b.tree_body]
+        rod = [f'{pad}<visual><origin xyz="{nums(0, 0, -length / 2)}"/><geometry><cylinder '
+               f'radius="{num(L / 100)}" length="{num(length)}"/></geometry></visual>']
+        if foot is None:
+            return rod
+        return rod + [f'{pad}<collision name="{b.name.split("_")[0]}_foot"><origin '
+                      f'xyz="{nums(0, 0, -foot)}"/><geometry><sphere radius="{num(r)}"/>'
+                      '</geometry></collision>']
     return urdf_robot_text(name, comments, root, couplings, visuals)
 
 
@@ -359,9 +373,7 @@ def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
                      f"library sees a free {cp.joint} (the relation is in the header)")
             for cp in mb.couplings]
     if export_part(mb).knee_stops:
-        out.append(Omission("the knee latch (contact.knee_stop.latch)", "URDF has no "
-                            "contact-switched lock (the joint limit at 0 is the straight-leg "
-                            "stop)"))
+        out.append(URDF_KNEE_LATCH)
     out += urdf_actuation_omissions(actuation)
     return tuple(out)
 

@@ -49,7 +49,6 @@ from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
     comments_in_scene_units,
-    mjcf_actuation_omissions,
     mjcf_omissions,
     planar_legs_mjcf,
     wheel_mjcf_text,
@@ -321,7 +320,8 @@ def _wheel_3d(job: ExportJob, w: Writer) -> Written:
 
 
 def _legs_3d(job: ExportJob, w: Writer) -> Written:
-    """The 3D straight-legged walker (``walker.space: 3d``): its URDF, a free pelvis and two
+    """The 3D legged walker (``walker.space: 3d``; straight, or kneed: knees on the legs'
+    own pitch axes with the straight-leg stop): its URDF, a free pelvis and two
     legs on hip joints (:func:`walkerlab.export.urdf.legs_urdf_text`, the planar walkers'
     writer), or its
     MJCF, the same walker on a free joint with the rigid gait as its ``gait`` keyframe, the
@@ -343,8 +343,8 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
         text = walker_mjcf_text(legs3d_mjcf(data, job.name, version))
     else:
         ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
-        text = walker_mjcf_text(legs3d_mjcf(data, job.name, version, extra))
-        left_out = mjcf_actuation_omissions(extra.actuation)  # the stepping loop's
+        m = legs3d_mjcf(data, job.name, version, extra)
+        text, left_out = walker_mjcf_text(m), m.left_out  # the stepping loop's
     return Written((_xml(job, w, text),), xml_lines(left_out, scene), step_period(ideal))
 
 

@@ -95,10 +95,12 @@ ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass 
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
-#: why a kneed walker in 3D refuses a view (its rigid model is its only one so far)
-_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model only so far (walkerlab "
-                  "fixedpoint, simulate): its floating (contact) view and its exports are a "
-                  "later step")
+#: why a kneed walker in 3D refuses a view (its rigid model, its MJCF and its URDF are its
+#: only ones so far)
+_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model (walkerlab fixedpoint, "
+                  "simulate) and is exported as MJCF and URDF (export --format mjcf, urdf) "
+                  "so far: its floating (contact) view and its Adams and OpenSim exports are "
+                  "a later step")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -319,8 +321,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
-        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "mjcf", "urdf", "adams",
-                                                 "osim")},
+        # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
+        # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
+        # straight-leg stop, the MJCF's latch the planar kneed walker's
+        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "adams", "osim")},
         ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
                           "is a later step"),
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
