@@ -66,6 +66,18 @@ Each leg's hinge ``leg<i>_hip`` is its pitch ``theta`` about its own (rolled) hi
 the torque pair ``+tau`` on ``leg<sw>_hip``, ``-tau`` on ``leg<st>_hip`` does the rigid
 model's virtual work ``tau delta(theta_sw - theta_st)``; the push-off acts along the
 trailing leg from its foot to its own hip (the anchor of its hinge ``leg<i>_hip``).
+
+Round feet (``walker.foot_radius_m``: :func:`walkerlab.codegen.derive_3d.derive_compass`'s
+disc in each leg's rolled sagittal plane, its centre on the leg ``L - R`` from the hip,
+rolling without slip): each leg's foot geom ``leg<i>_foot`` is that disc, a MuJoCo
+``cylinder`` of radius ``R`` and half-height :data:`DISC_HALF_THICKNESS_L` ``L`` whose axis
+is the leg's hinge axis, centred ``L - R`` down the leg (the site ``leg<i>_foot`` at its
+centre, the numeric ``foot_height_offset_m`` = ``R``: the centre's height over the ground
+at contact), and the keyframe is the rigid state as it is (the rigid discs are MuJoCo's:
+no shift).  The footfall patches are centred on the rigid gait's reference points (the
+contact with the leg normal to the slope), the contact rolling ``-R (theta + gamma)``
+along the fall line from them.  A leg's rod inertia (``walker.leg_inertia_kg_m2``) is the
+tree's, as every body's.
 """
 
 from __future__ import annotations
@@ -88,8 +100,9 @@ from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_tree
 
-__all__ = ["TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "legs3d_footfalls",
-           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad"]
+__all__ = ["DISC_CCD_TOLERANCE_L", "DISC_HALF_THICKNESS_L", "TORSION_FRACTION", "Legs3dScene",
+           "hip_roll_law", "legs3d_footfalls", "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene",
+           "pelvis_lean_rad", "round_feet"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -101,14 +114,32 @@ PATCH_ACROSS_L = 0.08
 #: across: the larger excursion with 5.7 cm to spare each side
 #: (tests/test_walker_3d_mjcf.py)
 PATCH_ACROSS_PUSHED_L = 0.30
+#: a round foot's disc: its half-thickness along the hip axis, as a fraction of the leg
+#: length (the leg capsule's radius: thin against the disc's radius, the rigid model's disc
+#: having none)
+DISC_HALF_THICKNESS_L = 0.01
+#: ... and MuJoCo's convex collider's tolerance for the disc on a patch (a cylinder on a
+#: box has no analytic collision), as a fraction of the leg length: MuJoCo's default
+#: (1e-6) is a tenth of the walker's static penetration (7e-6 L in configs/
+#: round_feet_3d.yaml), and the contact point it finds wanders by as much: the disc lands
+#: 11 % late and the walker falls at its second step; at 1e-10 L it walks 24 heel strikes
+#: (60 s) at the rigid step period to 0.01 % (measured in MuJoCo)
+DISC_CCD_TOLERANCE_L = 1e-10
+
+
+def round_feet(data) -> bool:
+    """The 3D walker has round feet (a disc of radius ``R_foot`` in each leg's plane)."""
+    return data.structure.foot == "arc"
 
 
 def _numbers(data) -> dict:
     """The walker's numbers by parameter name (the ``compass_gait`` shorthand's or the
-    parts'), ``w_hip`` 0 without hip width, and the foot sphere's radius ``r`` [m]."""
+    parts'), ``w_hip`` 0 without hip width, and the foot geom's radius ``r`` [m]: the point
+    foot's sphere's, or a round foot's disc's ``R_foot`` (its centre ``L - r`` down the leg
+    either way)."""
     p = dict(zip(data.structure.param_names, data.params))
     p.setdefault("w_hip", 0.0)
-    p["r"] = WHEEL_TIP_FRACTION * p["L"]
+    p["r"] = p["R_foot"] if round_feet(data) else WHEEL_TIP_FRACTION * p["L"]
     return p
 
 
@@ -155,7 +186,8 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
         ``Rot(s, lean) z``).
     slope_rad : float
     foot_radius_m : float
-        The foot sphere's radius ``r`` [m].
+        The foot sphere's radius ``r`` [m]; 0 for round feet (the rigid model's discs are
+        the file's: its state needs no shift).
 
     Returns
     -------
@@ -311,7 +343,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     p = _numbers(data)
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
-                                 data.slope_rad, p["r"])
+                                 data.slope_rad, 0.0 if round_feet(data) else p["r"])
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order):
         # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma)
         s = dict(zip(state_names(data.structure.roles), np.asarray(ideal.x, float)))
@@ -332,9 +364,11 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         across = PATCH_ACROSS_L * p["L"]
         why = (f"{across:g} m across (a passive walker in 3D: its lateral mode falls under "
                "any push)")
+    on = ("its foot disc rolling on the slope as the rigid model's (the origin its "
+          "reference point)" if round_feet(data) else
+          "its foot sphere on the slope at the origin")
     notes = (f"Keyframe 'gait': the rigid walker's gait just after a heel strike (step "
-             f"period {period:.6g} s), leg2 in stance, its foot sphere on the slope at the "
-             "origin.",) + notes + (
+             f"period {period:.6g} s), leg2 in stance, {on}.",) + notes + (
         f"Terrain: footfall patches {terrain.patch_width_m:g} m long and {why}, centred "
         "on the rigid gait's footfalls, leg<i>_patch<k> touched by leg<i>'s foot only (the "
         "rigid swing foot passes through the ground at mid-stance).",
@@ -405,12 +439,16 @@ def legs_summary(data, p: dict) -> str:
             f"{num(p['M_hip'])} kg{', an upper body' if data.structure.torso else ''})")
 
 
-def _geoms(p: dict, roles: PelvisRoles):
+def _geoms(p: dict, roles: PelvisRoles, disc: bool = False):
     """The geoms (no mass: ``inertiafromgeom`` is off) of each export body
     (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`): the pelvis' sphere and hip
-    axis, each leg's capsule, foot site and foot sphere (its contact bits its lane's), a
-    sphere at each other massive body's centre of mass."""
+    axis, each leg's capsule, foot site and foot sphere (``disc``: round feet, the disc's
+    cylinder about the hip axis; its contact bits its lane's), a sphere at each other
+    massive body's centre of mass."""
     L, w, r = p["L"], p["w_hip"], p["r"]
+    foot = (f'type="cylinder" size="{nums(r, DISC_HALF_THICKNESS_L * L)}" zaxis="0 1 0" '
+            if disc else 'type="sphere" ')
+    size = "" if disc else f' size="{num(r)}"'
 
     def geoms(b, pad: str) -> list[str]:
         if b.tree_body == roles.pelvis:
@@ -421,8 +459,8 @@ def _geoms(p: dict, roles: PelvisRoles):
             return [f'{pad}<geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -(L - r))}" '
                     f'size="{num(L / 100)}"/>',
                     f'{pad}<site name="{b.name}_foot" pos="{nums(0, 0, -(L - r))}"/>',
-                    f'{pad}<geom name="{b.name}_foot" type="sphere" '
-                    f'pos="{nums(0, 0, -(L - r))}" size="{num(r)}" contype="0" '
+                    f'{pad}<geom name="{b.name}_foot" {foot}'
+                    f'pos="{nums(0, 0, -(L - r))}"{size} contype="0" '
                     f'conaffinity="{LANE_BITS[b.name]}"/>']
         return ([f'{pad}<geom name="{b.name}" type="sphere" pos="{nums(*b.com_m)}" '
                  f'size="{num(L / 25)}"/>'] if b.mass_kg > 0 else [])
@@ -438,7 +476,7 @@ def _bodies(data, law: dict | None) -> tuple:
     tree, coords, p = walker_tree(data)
     roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
     root, couplings = export_bodies(tree, coords, p, roles)
-    return (root, _geoms(p, roles), *mjcf_coupling_lines(couplings))
+    return (root, _geoms(p, roles, round_feet(data)), *mjcf_coupling_lines(couplings))
 
 
 def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = None
@@ -463,27 +501,31 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     -------
     WalkerMjcf
         Total mass ``M_hip + 2 m_leg``; the custom numerics ``slope_rad`` and
-        ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg),
+        ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg; a
+        round foot's ``R``: its disc's centre is ``R`` above the ground at contact),
         the texts ``walkerlab_actuation`` (a powered walker) and ``walkerlab_hip_roll``
         (hip-roll joints).
     """
     p = _numbers(data)
     w, r, phi = p["w_hip"], p["r"], data.slope_rad
+    disc = round_feet(data)
     law = hip_roll_law(data)
     head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): straight "
                    f"{legs_summary(data, p)}, hips {num(w)} m apart; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
-                   "x downhill, z up, leg1 on the side of -y; a foot sphere of radius "
+                   "x downhill, z up, leg1 on the side of -y; a foot "
+                   f"{'disc (a cylinder about the hip axis)' if disc else 'sphere'} of radius "
                    f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot).")
     # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
     # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
     contact = None if extra is None else MjcfContact(
         extra.timestep_s, extra.solref, extra.solimp,
-        (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic")
+        (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic",
+        DISC_CCD_TOLERANCE_L * p["L"] if disc else None)
     act = extra.actuation if extra is not None else None
     root, geoms, tendons, equality = _bodies(data, law)
-    numerics = (("slope_rad", phi), ("foot_height_offset_m", 0.0))
+    numerics = (("slope_rad", phi), ("foot_height_offset_m", r if disc else 0.0))
     texts = ()
     if act is not None:  # the laws and the push-off, run by mujoco_walk.PoweredLoop
         numerics += (("push_off_duration_s", extra.push_off_duration_s),)

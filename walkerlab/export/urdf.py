@@ -26,9 +26,12 @@ dimension; :func:`legs_urdf_text` is the legged walkers' file:
   in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
   body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
   ``leg<i>_roll`` then ``leg<i>_hip`` through the massless ``leg<i>_roll_link``), its foot a
-  sphere (collision); point masses carry the export's smallest inertia
-  (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the MJCF's; the hip-roll
-  law and the actuation in the comments ``walkerlab_hip_roll``, ``walkerlab_actuation``.
+  sphere (collision), or with round feet the disc (a cylinder of the MJCF's radius and
+  thickness about the hip axis, centred ``L - R`` down the leg, :func:`arc_cylinder`, the
+  planar arc feet's); a leg's rod inertia the tree's; point masses carry the export's
+  smallest inertia (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the
+  MJCF's; the hip-roll law and the actuation in the comments ``walkerlab_hip_roll``,
+  ``walkerlab_actuation``.
 
 What URDF cannot hold (ground, springs, couplings, the knee latch, motors, push-off) is
 listed by :func:`legs_urdf_omissions` and stated in the header, the planar laws in the
@@ -60,7 +63,7 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.config.actuation import Actuation
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
+__all__ = ["arc_cylinder", "keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
            "urdf_actuation_omissions", "urdf_link_lines", "urdf_omissions", "urdf_robot_text"]
 
 #: a slide's ``limit`` (URDF requires one on a prismatic joint): none that binds
@@ -238,29 +241,39 @@ def _planar_visuals(mb: Multibody):
                     "</geometry></visual>"]
         if not (b.joints and b.joints[0].kind == "fixed"):   # not a foot
             return []
-        if arc_feet(mb):  # cylinder axis (z) turned onto y
-            geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
-                    f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
-                    "</geometry>")
+        if arc_feet(mb):
+            geom = arc_cylinder((0, 0, 0), mb.foot_radius_m, 2 * width)
         else:
             geom = f'<geometry><sphere radius="{num(point_foot_radius(mb))}"/></geometry>'
         return [f"{pad}<collision>{geom}</collision>"]
     return visuals
 
 
+def arc_cylinder(centre, radius: float, length: float) -> str:
+    """A round foot as URDF's ``origin`` and ``geometry`` (in a ``collision``): a cylinder
+    of ``radius`` [m] and ``length`` [m] whose axis (URDF's cylinder's ``z``, turned by
+    ``rpy = pi/2 0 0``) is the exports' ``y``, the legs' pitch axis, centred at ``centre``
+    (3,) [m] in the link's frame: the planar arc foot's section, the 3D walker's disc."""
+    return (f'<origin xyz="{nums(*centre)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
+            f'<cylinder radius="{num(radius)}" length="{num(length)}"/></geometry>')
+
+
 def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     """The 3D legged walker's URDF (module docstring): the bodies of its tree
-    (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`), each leg's rod and foot sphere."""
+    (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`), each leg's rod and foot sphere
+    (round feet: its disc)."""
     from walkerlab.export.legs_3d_mjcf import (  # light: 3D only
+        DISC_HALF_THICKNESS_L,
         hip_roll_law,
         legs_summary,
+        round_feet,
         walker_tree,
     )
     from walkerlab.export.tree_bodies import PelvisRoles, export_bodies  # light
 
     p = dict(zip(data.structure.param_names, data.params))
     L, w = p["L"], p.get("w_hip", 0.0)
-    r = WHEEL_TIP_FRACTION * L
+    r = p["R_foot"] if round_feet(data) else WHEEL_TIP_FRACTION * L
     comments = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): "
                         f"straight {legs_summary(data, p)}, hips {num(w)} m apart; slope "
                         f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); "
@@ -276,13 +289,15 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     roles = PelvisRoles(pelvis_hinges=("stance_hip_roll",) if law is not None else ())
     root, couplings = export_bodies(tree, coords, p, roles)
 
-    def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere
+    def visuals(b, pad: str) -> list[str]:   # each leg's rod and foot sphere (or disc)
         if b.tree_body != roles.leg:
             return []
+        foot = (arc_cylinder((0, 0, -(L - r)), r, 2 * DISC_HALF_THICKNESS_L * L)
+                if round_feet(data) else f'<origin xyz="{nums(0, 0, -(L - r))}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry>')
         return [f'{pad}<visual><origin xyz="{nums(0, 0, -L / 2)}"/><geometry><cylinder '
                 f'radius="{num(L / 100)}" length="{num(L)}"/></geometry></visual>',
-                f'{pad}<collision name="{b.name}_foot"><origin xyz="{nums(0, 0, -(L - r))}"/>'
-                f'<geometry><sphere radius="{num(r)}"/></geometry></collision>']
+                f'{pad}<collision name="{b.name}_foot">{foot}</collision>']
     return urdf_robot_text(name, comments, root, couplings, visuals)
 
 
