@@ -41,9 +41,7 @@ def _scene(name):
 #: have no multibody form (flat feet and their ankle push-off are exported:
 #: tests/test_export_flat_feet.py).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies",
-           # the 3D walker's round feet (discs) are the rigid model's so far
-           "round_feet_3d": "walker.foot_radius_m"}
+           "simplest": "walker.leg.bodies"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.
@@ -97,8 +95,8 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
     each a riser lower), footholds +0.17 %, footholds_two +0.09 %, threelink +0.14 %,
     threelink_footholds +0.16 %, threelink_hzd +0.21 %, rabbit +0.05 %, rabbit_footholds
     +0.20 %, rabbit_hzd and rabbit_hzd_optimal +0.20 %, paper_3d (the free pelvis in 3D)
-    -0.005 %; hip_width falls after 3 heel strikes (:data:`FALLS`).  About 5-40 s each
-    under load."""
+    -0.005 %, round_feet_3d (its disc feet: MuJoCo cylinders) +0.01 %; hip_width falls
+    after 3 heel strikes (:data:`FALLS`).  About 5-40 s each under load."""
     scene = _scene(name)
     if name in REFUSED or name in NO_GAIT:
         with pytest.raises(ValueError) as err:

@@ -591,6 +591,8 @@ def test_every_package_stands_on_a_floor_and_no_import_climbs():
 SWITCH_3D_READERS = {
     "codegen/derive_3d.py": "derives the 3D walker's equations: hip roll adds coordinates",
     "export/legs_3d_mjcf.py": "writes one MJCF joint per hip roll",
+    "export/legs_3d_parts.py": "the 3D legs' export roles: the pelvis on its roll with "
+                               "hip-roll joints (the MJCF's, URDF's and Adams')",
     "export/adams_3d.py": "writes the Adams dataset's hip-roll joints and their law",
     "models/registry.py": "builds a 3D compass gait from its 2D scene's kind",
     "export/writers.py": "refuses a hip-roll walker per format (the capability table's cell)",

@@ -18,7 +18,7 @@ the slope angle about ``y`` (as the planar dataset tilts the ground, not gravity
 the planar dataset's mm-kg-s.
 
 Parts: the bodies of the walker's tree as the MJCF has them (:func:`walkerlab.export.
-tree_bodies.export_bodies`, :func:`walkerlab.export.legs_3d_mjcf.walker_tree`): PART/2 the
+tree_bodies.export_bodies`, :func:`walkerlab.export.legs_3d_parts.walker_tree`): PART/2 the
 pelvis (the hip mass at the hips' midpoint), PART/3 ``leg1`` (the swing leg at the start,
 on walkerlab's ``+z`` side: the file's ``-y``), PART/4 ``leg2`` (the stance leg), PART/5 an
 upper body.  A part's frame is its body's (the world's at the tree's reference pose, turned
@@ -92,9 +92,8 @@ from walkerlab.export.legs_3d_mjcf import (
     _rotation,
     legs3d_footfalls,
     legs3d_keyframe,
-    legs_summary,
-    walker_tree,
 )
+from walkerlab.export.legs_3d_parts import legs_summary, walker_tree
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
 from walkerlab.walker.description import state_names

@@ -71,6 +71,18 @@ Each leg's hinge ``leg<i>_hip`` is its pitch ``theta`` about its own (rolled) hi
 the torque pair ``+tau`` on ``leg<sw>_hip``, ``-tau`` on ``leg<st>_hip`` does the rigid
 model's virtual work ``tau delta(theta_sw - theta_st)``; the push-off acts along the
 trailing leg from its foot to its own hip (the anchor of its hinge ``leg<i>_hip``).
+
+Round feet (``walker.foot_radius_m``: :func:`walkerlab.codegen.derive_3d.derive_compass`'s
+disc in each leg's rolled sagittal plane, its centre on the leg ``L - R`` from the hip,
+rolling without slip): each leg's foot geom ``leg<i>_foot`` is that disc, a MuJoCo
+``cylinder`` of radius ``R`` and half-height :data:`DISC_HALF_THICKNESS_L` ``L`` whose axis
+is the leg's hinge axis, centred ``L - R`` down the leg (the site ``leg<i>_foot`` at its
+centre, the numeric ``foot_height_offset_m`` = ``R``: the centre's height over the ground
+at contact), and the keyframe is the rigid state as it is (the rigid discs are MuJoCo's:
+no shift).  The footfall patches are centred on the rigid gait's reference points (the
+contact with the leg normal to the slope), the contact rolling ``-R (theta + gamma)``
+along the fall line from them.  A leg's rod inertia (``walker.leg_inertia_kg_m2``) is the
+tree's, as every body's.
 """
 
 from __future__ import annotations
@@ -83,20 +95,29 @@ import numpy as np
 
 from walkerlab.codegen.cache import functions
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
+from walkerlab.export.legs_3d_parts import (
+    DISC_HALF_THICKNESS_L,
+    hip_roll_law,
+    kneed,
+    leg_links,
+    legs3d_numbers,
+    legs3d_roles,
+    legs_summary,
+    legs_words,
+    round_feet,
+    walker_tree,
+)
 from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
 from walkerlab.export.multibody import latch_equality_lines, mjcf_actuation_omissions
 from walkerlab.export.omitted import MJCF_KNEE_LATCH
-from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
-from walkerlab.walker.trees import legs_tree
 
-__all__ = ["SHANK", "TORSION_FRACTION", "Legs3dScene", "hip_roll_law", "kneed", "leg_links",
-           "legs3d_footfalls", "legs3d_keyframe", "legs3d_mjcf", "legs3d_roles", "legs3d_scene",
-           "legs_words", "pelvis_lean_rad"]
+__all__ = ["DISC_CCD_TOLERANCE_L", "TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls",
+           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -108,15 +129,13 @@ PATCH_ACROSS_L = 0.08
 #: across: the larger excursion with 5.7 cm to spare each side
 #: (tests/test_walker_3d_mjcf.py)
 PATCH_ACROSS_PUSHED_L = 0.30
-
-
-def _numbers(data) -> dict:
-    """The walker's numbers by parameter name (the ``compass_gait`` shorthand's or the
-    parts'), ``w_hip`` 0 without hip width, and the foot sphere's radius ``r`` [m]."""
-    p = dict(zip(data.structure.param_names, data.params))
-    p.setdefault("w_hip", 0.0)
-    p["r"] = WHEEL_TIP_FRACTION * p["L"]
-    return p
+#: ... and MuJoCo's convex collider's tolerance for the disc on a patch (a cylinder on a
+#: box has no analytic collision), as a fraction of the leg length: MuJoCo's default
+#: (1e-6) is a tenth of the walker's static penetration (7e-6 L in configs/
+#: round_feet_3d.yaml), and the contact point it finds wanders by as much: the disc lands
+#: 11 % late and the walker falls at its second step; at 1e-10 L it walks 24 heel strikes
+#: (60 s) at the rigid step period to 0.01 % (measured in MuJoCo)
+DISC_CCD_TOLERANCE_L = 1e-10
 
 
 def _rotation(axis, angle: float) -> np.ndarray:
@@ -164,7 +183,8 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
         ``Rot(s, lean) z``).
     slope_rad : float
     foot_radius_m : float
-        The foot sphere's radius ``r`` [m].
+        The foot sphere's radius ``r`` [m]; 0 for round feet (the rigid model's discs are
+        the file's: its state needs no shift).
 
     Returns
     -------
@@ -327,10 +347,10 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         raise ValueError("terrain.lanes: the 3D walker's MJCF lays footfall patches "
                          "(checkerboard): its swing foot passes through the ground at "
                          "mid-stance, as the rigid model's does")
-    p = _numbers(data)
+    p = legs3d_numbers(data)
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
-                                 data.slope_rad, p["r"])
+                                 data.slope_rad, 0.0 if round_feet(data) else p["r"])
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order):
         # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma)
         s = dict(zip(state_names(data.structure.roles), np.asarray(ideal.x, float)))
@@ -351,9 +371,11 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         across = PATCH_ACROSS_L * p["L"]
         why = (f"{across:g} m across (a passive walker in 3D: its lateral mode falls under "
                "any push)")
+    on = ("its foot disc rolling on the slope as the rigid model's (the origin its "
+          "reference point)" if round_feet(data) else
+          "its foot sphere on the slope at the origin")
     notes = (f"Keyframe 'gait': the rigid walker's gait just after a heel strike (step "
-             f"period {period:.6g} s), leg2 in stance, its foot sphere on the slope at the "
-             "origin.",) + notes + (
+             f"period {period:.6g} s), leg2 in stance, {on}.",) + notes + (
         f"Terrain: footfall patches {terrain.patch_width_m:g} m long and {why}, centred "
         "on the rigid gait's footfalls, leg<i>_patch<k> touched by leg<i>'s foot only (the "
         "rigid swing foot passes through the ground at mid-stance).",
@@ -406,81 +428,17 @@ def _ground(p: dict, extra, phi: float) -> tuple[str, ...]:
     return tuple(_patches(p, extra, phi))
 
 
-def hip_roll_law(data) -> dict | None:
-    """The walker's hip-roll law (``walker.hip_roll``'s gains by field name, as the custom
-    text ``walkerlab_hip_roll`` carries them), None without hip-roll joints."""
-    return getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
-
-
-def walker_tree(data) -> tuple:
-    """The 3D straight-legged walker's body tree, its coordinate map and numbers
-    (:func:`walkerlab.walker.trees.legs_tree`; ``data``'s parameters by name,
-    :func:`_numbers`)."""
-    return (*legs_tree(data.structure), _numbers(data))
-
-
-def legs_summary(data, p: dict) -> str:
-    """The walker's numbers in a line for the files' header comment: the ``compass_gait``
-    shorthand's (each leg's mass and its distance from the foot), or a walker from parts'
-    (its total mass)."""
-    if "m_leg" in p:
-        return (f"legs of {num(p['L'])} m, {num(p['m_leg'])} kg at {num(p['a_leg'])} m from "
-                f"each foot, hip mass {num(p['M_hip'])} kg")
-    return (f"legs of {num(p['L'])} m, {num(data.total_mass_kg)} kg in all (hip mass "
-            f"{num(p['M_hip'])} kg{', an upper body' if data.structure.torso else ''})")
-
-
-#: the 3D kneed walker's shank in its body tree (:func:`walkerlab.walker.trees.legs_tree`)
-SHANK = "swing_shank"
-
-
-def kneed(data) -> bool:
-    """Whether the 3D walker has knees (:attr:`walkerlab.walker.kinds.Kind.knees`)."""
-    return data.structure.kind.knees != "none"
-
-
-def legs3d_roles(data) -> PelvisRoles:
-    """The 3D legs' export roles, the MJCF's and the URDF's: the pelvis free, or on its roll
-    (hip-roll joints); knees ``leg<i>_knee`` on shanks ``leg<i>_shank``, leg2's knee a
-    coordinate of its own (the planar kneed walker's, :func:`walkerlab.export.
-    planar_bodies.planar_roles`)."""
-    hinges = ("stance_hip_roll",) if hip_roll_law(data) is not None else ()
-    if not kneed(data):
-        return PelvisRoles(pelvis_hinges=hinges)
-    return PelvisRoles(pelvis_hinges=hinges,
-                       stance_roles=(("swing_thigh", "stance"), ("swing_shank", "stance_shank"),
-                                     ("swing_roll", "lean")),
-                       joint_names=PelvisRoles().joint_names + (("swing_knee", "{leg}_knee"),),
-                       body_names=((SHANK, "{leg}_shank"),))
-
-
-def leg_links(p: dict, roles: PelvisRoles) -> dict:
-    """Each leg link by tree body: ``(length, foot sphere's centre down it or None)`` [m]:
-    ``(L, L - r)``; knees: ``(L_thigh, None)``, the shank ``(L - L_thigh, L - L_thigh - r)``
-    (``p``: :func:`_numbers`)."""
-    L, r, thigh = p["L"], p["r"], p.get("L_thigh")
-    if thigh is None:
-        return {roles.leg: (L, L - r)}
-    return {roles.leg: (thigh, None), SHANK: (L - thigh, L - thigh - r)}
-
-
-def legs_words(data, p: dict) -> tuple[str, str]:
-    """The legs' word for the files' header (``straight``, ``kneed``) and a clause on the
-    knees (empty without)."""
-    if not kneed(data):
-        return "straight", ""
-    return "kneed", (f"; knees {num(p['L_thigh'])} m below the hips on hinges leg<i>_knee "
-                     "about the leg's own pitch axis (shank - thigh angle, limit [-pi, 0], "
-                     "0 = straight-leg stop)")
-
-
-def _geoms(p: dict, roles: PelvisRoles):
+def _geoms(p: dict, roles: PelvisRoles, disc: bool = False):
     """The geoms (no mass: ``inertiafromgeom`` is off) of each export body
     (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`): the pelvis' sphere and hip
-    axis, each leg link's capsule (:func:`leg_links`), the foot's site and sphere (its
-    contact bits its lane's), a sphere at each other massive body's centre of mass."""
+    axis, each leg link's capsule (:func:`leg_links`), the foot's site and sphere
+    (``disc``: round feet, the disc's cylinder about the hip axis; its contact bits its
+    lane's), a sphere at each other massive body's centre of mass."""
     L, w, r = p["L"], p["w_hip"], p["r"]
     links = leg_links(p, roles)
+    foot_geom = (f'type="cylinder" size="{nums(r, DISC_HALF_THICKNESS_L * L)}" zaxis="0 1 0" '
+                 if disc else 'type="sphere" ')
+    size = "" if disc else f' size="{num(r)}"'
 
     def geoms(b, pad: str) -> list[str]:
         if b.tree_body == roles.pelvis:
@@ -496,8 +454,8 @@ def _geoms(p: dict, roles: PelvisRoles):
                 return out
             leg = b.name.split("_")[0]
             return out + [f'{pad}<site name="{leg}_foot" pos="{nums(0, 0, -foot)}"/>',
-                          f'{pad}<geom name="{leg}_foot" type="sphere" '
-                          f'pos="{nums(0, 0, -foot)}" size="{num(r)}" contype="0" '
+                          f'{pad}<geom name="{leg}_foot" {foot_geom}'
+                          f'pos="{nums(0, 0, -foot)}"{size} contype="0" '
                           f'conaffinity="{LANE_BITS[leg]}"/>']
         return ([f'{pad}<geom name="{b.name}" type="sphere" pos="{nums(*b.com_m)}" '
                  f'size="{num(L / 25)}"/>'] if b.mass_kg > 0 else [])
@@ -513,7 +471,7 @@ def _bodies(data) -> tuple:
     tree, coords, p = walker_tree(data)
     roles = legs3d_roles(data)
     root, couplings = export_bodies(tree, coords, p, roles)
-    return (root, _geoms(p, roles), *mjcf_coupling_lines(couplings))
+    return (root, _geoms(p, roles, round_feet(data)), *mjcf_coupling_lines(couplings))
 
 
 def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = None
@@ -538,28 +496,32 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     -------
     WalkerMjcf
         Total mass ``M_hip + 2 m_leg``; the custom numerics ``slope_rad`` and
-        ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg),
+        ``foot_height_offset_m`` (0: the foot sphere's centre is ``L - r`` down the leg; a
+        round foot's ``R``: its disc's centre is ``R`` above the ground at contact),
         the texts ``walkerlab_actuation`` (a powered walker) and ``walkerlab_hip_roll``
         (hip-roll joints); knees: ``latch_release_height_m``, ``latch_capture_rad``.
     """
-    p = _numbers(data)
+    p = legs3d_numbers(data)
     w, r, phi = p["w_hip"], p["r"], data.slope_rad
+    disc = round_feet(data)
     law = hip_roll_law(data)
     word, knees = legs_words(data, p)
     head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): {word} "
                    f"{legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
-                   "x downhill, z up, leg1 on the side of -y; a foot sphere of radius "
+                   "x downhill, z up, leg1 on the side of -y; a foot "
+                   f"{'disc (a cylinder about the hip axis)' if disc else 'sphere'} of radius "
                    f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot).")
     # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
     # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
     contact = None if extra is None else MjcfContact(
         extra.timestep_s, extra.solref, extra.solimp,
-        (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic")
+        (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic",
+        DISC_CCD_TOLERANCE_L * p["L"] if disc else None)
     act = extra.actuation if extra is not None else None
     root, geoms, tendons, equality = _bodies(data)
-    numerics = (("slope_rad", phi), ("foot_height_offset_m", 0.0))
+    numerics = (("slope_rad", phi), ("foot_height_offset_m", r if disc else 0.0))
     texts, left_out = (), tuple(mjcf_actuation_omissions(act))
     if extra is not None and extra.latch is not None:  # the planar kneed MJCF's latch
         equality += latch_equality_lines([j.name for b in root.walk() for j in b.joints

@@ -64,6 +64,9 @@ class MjcfContact:
         Contact dimensionality (3: sliding friction; 4: and torsional).
     cone : str
         ``option cone`` (``elliptic``); empty: MuJoCo's default (pyramidal).
+    ccd_tolerance_m : float or None
+        ``option ccd_tolerance`` [m]: the convex collider's (a cylinder on a box: the 3D
+        walker's round feet); None: MuJoCo's default (1e-6).
     """
 
     timestep_s: float
@@ -72,6 +75,7 @@ class MjcfContact:
     friction: tuple
     condim: int = 3
     cone: str = ""
+    ccd_tolerance_m: float | None = None
 
 
 @dataclass(frozen=True)
@@ -141,12 +145,14 @@ class WalkerMjcf:
 
 
 def _option_and_default(g: float, c: MjcfContact | None) -> list[str]:
-    """``option`` (gravity; a scene's timestep, integrator and cone) and the geoms'
-    ``default`` (a scene's contact)."""
+    """``option`` (gravity; a scene's timestep, integrator, cone and convex collider's
+    tolerance) and the geoms' ``default`` (a scene's contact)."""
     if c is None:
         return [f'  <option gravity="{nums(0, 0, -g)}"/>',
                 f"  <default><geom {GEOM_DEFAULTS}/></default>"]
     cone = f' cone="{c.cone}"' if c.cone else ""
+    if c.ccd_tolerance_m is not None:
+        cone += f' ccd_tolerance="{num(c.ccd_tolerance_m)}"'
     solimp = "" if c.solimp is None else f' solimp="{nums(*c.solimp)}"'
     return [f'  <option gravity="{nums(0, 0, -g)}" timestep="{num(c.timestep_s)}" '
             f'integrator="implicitfast"{cone}/>',

@@ -26,15 +26,18 @@ dimension; :func:`legs_urdf_text` is the legged walkers' file:
   on its own hinge. The frame, joint names, feet and what the springs, couplings and motors
   become are those of :mod:`walkerlab.export.multibody`'s MJCF; the header states them (the
   links of :func:`walkerlab.walker.multibody.multibody` give its drawing);
-- 3D (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`): the pelvis is the root link, free
+- 3D (:func:`walkerlab.export.legs_3d_parts.walker_tree`): the pelvis is the root link, free
   in space (a loader's floating base: Pinocchio's ``JointModelFreeFlyer``, Drake's free
   body), each leg ``hip_width / 2`` along the hip axis on ``leg<i>_hip`` (hip-roll joints:
   ``leg<i>_roll`` then ``leg<i>_hip`` through the massless ``leg<i>_roll_link``), its foot a
-  sphere (collision); knees (the kneed walker in 3D) ``leg<i>_knee``, ``revolute`` in
-  ``[-pi, 0]`` (the straight-leg stop) on the shanks ``leg<i>_shank``, the latch left out as
-  the planar URDF's; point masses carry the export's smallest inertia
-  (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`), as the MJCF's; the hip-roll
-  law and the actuation in the comments ``walkerlab_hip_roll``, ``walkerlab_actuation``.
+  sphere (collision), or with round feet the disc (a cylinder of the MJCF's radius and
+  thickness about the hip axis, centred ``L - R`` down the leg, :func:`arc_cylinder`, the
+  planar arc feet's); a leg's rod inertia the tree's; knees (the kneed walker in 3D)
+  ``leg<i>_knee``, ``revolute`` in ``[-pi, 0]`` (the straight-leg stop) on the shanks
+  ``leg<i>_shank``, the latch left out as the planar URDF's; point masses carry the
+  export's smallest inertia (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`),
+  as the MJCF's; the hip-roll law and the actuation in the comments ``walkerlab_hip_roll``,
+  ``walkerlab_actuation``.
 
 What URDF cannot hold (ground, springs, ankle springs, couplings, the knee latch, motors,
 push-off) is
@@ -68,7 +71,7 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.config.actuation import Actuation
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
+__all__ = ["arc_cylinder", "keyframe_json", "legs_urdf_omissions", "legs_urdf_text",
            "urdf_actuation_omissions", "urdf_link_lines", "urdf_omissions", "urdf_robot_text"]
 
 #: a slide's ``limit`` (URDF requires one on a prismatic joint): none that binds
@@ -246,7 +249,7 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
     motors and push-off."""
     if not data.structure.in_3d:
         return urdf_omissions(multibody(data), actuation)
-    from walkerlab.export.legs_3d_mjcf import hip_roll_law, kneed  # light: 3D only
+    from walkerlab.export.legs_3d_parts import hip_roll_law, kneed  # light: 3D only
 
     out = []
     if hip_roll_law(data) is not None:
@@ -299,31 +302,41 @@ def _planar_visuals(mb: Multibody, soles: dict | None = None):
         if not (b.joints and b.joints[0].kind == "fixed") or soles is not None:
             return []   # not a foot (flat feet: the sole's heel and toe are)
         if arc_feet(mb):  # cylinder axis (z) turned onto y
-            geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
-                    f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
-                    "</geometry>")
+            geom = arc_cylinder((0, 0, 0), mb.foot_radius_m, 2 * width)
         else:
             geom = f'<geometry><sphere radius="{num(r)}"/></geometry>'
         return [f"{pad}<collision>{geom}</collision>"]
     return visuals
 
 
+def arc_cylinder(centre, radius: float, length: float) -> str:
+    """A round foot as URDF's ``origin`` and ``geometry`` (in a ``collision``): a cylinder
+    of ``radius`` [m] and ``length`` [m] whose axis (URDF's cylinder's ``z``, turned by
+    ``rpy = pi/2 0 0``) is the exports' ``y``, the legs' pitch axis, centred at ``centre``
+    (3,) [m] in the link's frame: the planar arc foot's section, the 3D walker's disc."""
+    return (f'<origin xyz="{nums(*centre)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
+            f'<cylinder radius="{num(radius)}" length="{num(length)}"/></geometry>')
+
+
 def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     """The 3D legged walker's URDF (module docstring): the bodies of its tree
-    (:func:`walkerlab.export.legs_3d_mjcf.walker_tree`), each leg's rod and foot sphere."""
-    from walkerlab.export.legs_3d_mjcf import (  # light: 3D only
+    (:func:`walkerlab.export.legs_3d_parts.walker_tree`), each leg's rod and foot sphere
+    (round feet: its disc)."""
+    from walkerlab.export.legs_3d_parts import (  # light: 3D only
+        DISC_HALF_THICKNESS_L,
         hip_roll_law,
         leg_links,
         legs3d_roles,
         legs_summary,
         legs_words,
+        round_feet,
         walker_tree,
     )
     from walkerlab.export.tree_bodies import export_bodies  # light
 
     p = dict(zip(data.structure.param_names, data.params))
     L, w = p["L"], p.get("w_hip", 0.0)
-    r = WHEEL_TIP_FRACTION * L
+    r = p["R_foot"] if round_feet(data) else WHEEL_TIP_FRACTION * L
     word, knees = legs_words(data, p)
     comments = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): "
                         f"{word} {legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope "
@@ -341,7 +354,7 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     root, couplings = export_bodies(tree, coords, p, roles)
     links = leg_links(p, roles)
 
-    def visuals(b, pad: str) -> list[str]:   # each leg link's rod, the foot's sphere
+    def visuals(b, pad: str) -> list[str]:   # each leg link's rod, the foot's sphere (disc)
         if b.tree_body not in links:
             return []
         length, foot = links[b.tree_body]
@@ -349,9 +362,11 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
                f'radius="{num(L / 100)}" length="{num(length)}"/></geometry></visual>']
         if foot is None:
             return rod
-        return rod + [f'{pad}<collision name="{b.name.split("_")[0]}_foot"><origin '
-                      f'xyz="{nums(0, 0, -foot)}"/><geometry><sphere radius="{num(r)}"/>'
-                      '</geometry></collision>']
+        geom = (arc_cylinder((0, 0, -foot), r, 2 * DISC_HALF_THICKNESS_L * L)
+                if round_feet(data) else f'<origin xyz="{nums(0, 0, -foot)}"/>'
+                f'<geometry><sphere radius="{num(r)}"/></geometry>')
+        return rod + [f'{pad}<collision name="{b.name.split("_")[0]}_foot">{geom}'
+                      '</collision>']
     return urdf_robot_text(name, comments, root, couplings, visuals)
 
 

@@ -350,7 +350,9 @@ def _legs_3d(job: ExportJob, w: Writer) -> Written:
 
 def _check_legs_3d(job: ExportJob, w: Writer) -> None:
     """Refuse in one line what the 3D straight-legged walker's ``w`` does not carry (the
-    capability table's cells: round feet, hip-roll joints, actuators; numbers, ground)."""
+    capability table's cells: round feet and leg inertia in the Adams dataset, hip-roll
+    joints, actuators; numbers, ground).  The URDF and MJCF carry round feet (each foot's
+    disc) and the legs' inertia (the tree's)."""
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
     st = data.structure
@@ -358,7 +360,9 @@ def _check_legs_3d(job: ExportJob, w: Writer) -> None:
         fields = ("walker.leg.foot, walker.leg.bodies" if st.parts_3d   # the parts' fields
                   else "walker.foot_radius_m, walker.leg_inertia_kg_m2")
         kind.require("round_feet_3d", w.view, fields)
-        raise ValueError(f"{fields}: this export carries point feet and point-mass legs")
+        if w.view == "adams":  # the table's cell, if it ran
+            raise ValueError(f"{fields}: the Adams dataset carries point feet and point-mass "
+                             "legs")
     if data.structure.hip_roll:
         kind.require("hip_roll", w.view, "walker.hip_roll")
     check_exportable(scene, kind, w.name, job.walker_only)  # numbers, ground

@@ -88,10 +88,10 @@ NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width
 NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
                     "straight-legged walker's (walker.space: 3d); a planar walker's round "
                     "feet are walker.leg.foot.kind: arc")
-#: why the 3D walker's exports refuse its round feet
-ROUND_FEET_EXPORT_3D = ("a 3D walker's export carries point feet and point-mass legs "
-                        "so far (its round feet and leg inertia run in the rigid model: "
-                        "fixedpoint, simulate)")
+#: why the 3D walker's Adams dataset refuses its round feet (and leg inertia)
+ROUND_FEET_EXPORT_3D = ("a 3D walker's Adams dataset carries point feet and point-mass legs "
+                        "so far (its round feet and leg inertia run in the rigid model and "
+                        "the URDF and MJCF exports)")
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -282,7 +282,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
     "straight_legs_3d": {
-        **{("round_feet_3d", v): ROUND_FEET_EXPORT_3D for v in ("mjcf", "urdf", "adams")},
+        # round feet and leg inertia: the MJCF's disc (cylinder) feet, the URDF's
+        # cylinder collisions and both files' leg inertia (walkerlab.export.legs_3d_mjcf)
+        ("round_feet_3d", "adams"): ROUND_FEET_EXPORT_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar

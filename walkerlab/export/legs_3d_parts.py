@@ -1,0 +1,105 @@
+"""The 3D legged walkers' parts as their exports (MJCF, URDF, Adams) read them: the
+walker's numbers by name, its body tree, the export roles of its bodies and joints (pelvis,
+legs, knees), each leg link's length and foot, the round feet's disc, the words of the
+files' headers.  Shared by :mod:`walkerlab.export.legs_3d_mjcf`,
+:mod:`walkerlab.export.urdf` and :mod:`walkerlab.export.adams_3d`.
+"""
+
+from __future__ import annotations
+
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION
+from walkerlab.export.text import num
+from walkerlab.export.tree_bodies import PelvisRoles
+from walkerlab.walker.trees import legs_tree
+
+__all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "hip_roll_law", "kneed", "leg_links",
+           "legs3d_numbers", "legs3d_roles", "legs_summary", "legs_words", "round_feet",
+           "walker_tree"]
+
+#: a round foot's disc: its half-thickness along the hip axis, as a fraction of the leg
+#: length (the leg capsule's radius: thin against the disc's radius, the rigid model's disc
+#: having none)
+DISC_HALF_THICKNESS_L = 0.01
+
+def round_feet(data) -> bool:
+    """The 3D walker has round feet (a disc of radius ``R_foot`` in each leg's plane)."""
+    return data.structure.foot == "arc"
+
+
+def legs3d_numbers(data) -> dict:
+    """The walker's numbers by parameter name (the ``compass_gait`` shorthand's or the
+    parts'), ``w_hip`` 0 without hip width, and the foot geom's radius ``r`` [m]: the point
+    foot's sphere's, or a round foot's disc's ``R_foot`` (its centre ``L - r`` down the leg
+    either way)."""
+    p = dict(zip(data.structure.param_names, data.params))
+    p.setdefault("w_hip", 0.0)
+    p["r"] = p["R_foot"] if round_feet(data) else WHEEL_TIP_FRACTION * p["L"]
+    return p
+
+
+def hip_roll_law(data) -> dict | None:
+    """The walker's hip-roll law (``walker.hip_roll``'s gains by field name, as the custom
+    text ``walkerlab_hip_roll`` carries them), None without hip-roll joints."""
+    return getattr(data, "extra", {}).get("hip_roll") if data.structure.hip_roll else None
+
+
+def walker_tree(data) -> tuple:
+    """The 3D straight-legged walker's body tree, its coordinate map and numbers
+    (:func:`walkerlab.walker.trees.legs_tree`; ``data``'s parameters by name,
+    :func:`legs3d_numbers`)."""
+    return (*legs_tree(data.structure), legs3d_numbers(data))
+
+
+def legs_summary(data, p: dict) -> str:
+    """The walker's numbers in a line for the files' header comment: the ``compass_gait``
+    shorthand's (each leg's mass and its distance from the foot), or a walker from parts'
+    (its total mass)."""
+    if "m_leg" in p:
+        return (f"legs of {num(p['L'])} m, {num(p['m_leg'])} kg at {num(p['a_leg'])} m from "
+                f"each foot, hip mass {num(p['M_hip'])} kg")
+    return (f"legs of {num(p['L'])} m, {num(data.total_mass_kg)} kg in all (hip mass "
+            f"{num(p['M_hip'])} kg{', an upper body' if data.structure.torso else ''})")
+
+
+#: the 3D kneed walker's shank in its body tree (:func:`walkerlab.walker.trees.legs_tree`)
+SHANK = "swing_shank"
+
+
+def kneed(data) -> bool:
+    """Whether the 3D walker has knees (:attr:`walkerlab.walker.kinds.Kind.knees`)."""
+    return data.structure.kind.knees != "none"
+
+
+def legs3d_roles(data) -> PelvisRoles:
+    """The 3D legs' export roles, the MJCF's and the URDF's: the pelvis free, or on its roll
+    (hip-roll joints); knees ``leg<i>_knee`` on shanks ``leg<i>_shank``, leg2's knee a
+    coordinate of its own (the planar kneed walker's, :func:`walkerlab.export.
+    planar_bodies.planar_roles`)."""
+    hinges = ("stance_hip_roll",) if hip_roll_law(data) is not None else ()
+    if not kneed(data):
+        return PelvisRoles(pelvis_hinges=hinges)
+    return PelvisRoles(pelvis_hinges=hinges,
+                       stance_roles=(("swing_thigh", "stance"), ("swing_shank", "stance_shank"),
+                                     ("swing_roll", "lean")),
+                       joint_names=PelvisRoles().joint_names + (("swing_knee", "{leg}_knee"),),
+                       body_names=((SHANK, "{leg}_shank"),))
+
+
+def leg_links(p: dict, roles: PelvisRoles) -> dict:
+    """Each leg link by tree body: ``(length, foot sphere's centre down it or None)`` [m]:
+    ``(L, L - r)``; knees: ``(L_thigh, None)``, the shank ``(L - L_thigh, L - L_thigh - r)``
+    (``p``: :func:`legs3d_numbers`)."""
+    L, r, thigh = p["L"], p["r"], p.get("L_thigh")
+    if thigh is None:
+        return {roles.leg: (L, L - r)}
+    return {roles.leg: (thigh, None), SHANK: (L - thigh, L - thigh - r)}
+
+
+def legs_words(data, p: dict) -> tuple[str, str]:
+    """The legs' word for the files' header (``straight``, ``kneed``) and a clause on the
+    knees (empty without)."""
+    if not kneed(data):
+        return "straight", ""
+    return "kneed", (f"; knees {num(p['L_thigh'])} m below the hips on hinges leg<i>_knee "
+                     "about the leg's own pitch axis (shank - thigh angle, limit [-pi, 0], "
+                     "0 = straight-leg stop)")
