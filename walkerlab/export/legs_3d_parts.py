@@ -73,8 +73,8 @@ def kneed(data) -> bool:
 def legs3d_roles(data) -> PelvisRoles:
     """The 3D legs' export roles, the MJCF's and the URDF's: the pelvis free, or on its roll
     (hip-roll joints); knees ``leg<i>_knee`` on shanks ``leg<i>_shank``, leg2's knee a
-    coordinate of its own (the planar kneed walker's, :func:`walkerlab.export.
-    planar_bodies.planar_roles`)."""
+    coordinate of its own (the planar kneed walker's,
+    :func:`walkerlab.export.planar_bodies.planar_roles`)."""
     hinges = ("stance_hip_roll",) if hip_roll_law(data) is not None else ()
     if not kneed(data):
         return PelvisRoles(pelvis_hinges=hinges)
