@@ -188,7 +188,7 @@ def test_flat_feet_push_off_urdf_states_its_ankle_motors_and_their_laws(tmp_path
     file leaves out, each ankle motor's sense the ankle's (+u turns the sole toe up, the
     hinge's positive angle; before: "+u extends the knee", a knee motor's words), the
     actuation's laws in the keyframe sidecar."""
-    from walkerlab.export.urdf import urdf_omissions
+    from walkerlab.export.urdf_omitted import urdf_omissions
     from walkerlab.walker.description import walker_data
     from walkerlab.walker.multibody import multibody
 

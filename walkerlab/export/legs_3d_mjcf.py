@@ -147,9 +147,8 @@ def _rotation(axis, angle: float) -> np.ndarray:
 
 def legs3d_keyframe(points, velocities, x, slope_rad: float,
                     foot_radius_m: float) -> tuple[tuple, tuple]:
-    """The ``gait`` keyframe of the 3D straight-legged walker at the rigid state ``x`` (just
-    after a heel strike, roles ``lean``, ``swing``, ``stance``; leg2 in stance, leg1 the
-    trailing leg): MuJoCo's ``qpos`` (9,) and ``qvel`` (8,) in its axes (:data:`TO_MUJOCO`).
+    """The ``gait`` keyframe of the 3D legged walker at the rigid state ``x`` after a heel
+    strike (leg2 in stance): MuJoCo's ``qpos`` (9,) and ``qvel`` (8,) (:data:`TO_MUJOCO`).
 
     ``qpos`` = the pelvis' position [m], its orientation as the unit quaternion ``w, x, y,
     z`` (the rigid model's roll ``lean`` about the fall line ``s``: ``C Rot(s, lean) C^T``,
@@ -197,15 +196,15 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
     kneed = x.size == 8    # a knee on the swing leg: its shank's own angle
     if rolled:
         lean, sw, st, pelvis_roll, swing_roll, dlean, dsw, dst, dpelvis, dswing = x
-    elif kneed:
-        lean, sw, shank, st, dlean, dsw, dshank, dst = x
-        pelvis_roll, swing_roll, dpelvis, dswing = lean, lean, dlean, dlean
-    else:
-        lean, sw, st, dlean, dsw, dst = x
+    else:   # the pelvis and the swing leg roll with the stance leg's lean
+        if kneed:
+            lean, sw, shank, st, dlean, dsw, dshank, dst = x
+        else:
+            lean, sw, st, dlean, dsw, dst = x
         pelvis_roll, swing_roll, dpelvis, dswing = lean, lean, dlean, dlean
     C = np.array(TO_MUJOCO)
-    fall = np.array([math.cos(slope_rad), -math.sin(slope_rad), 0.0])
-    nrm = np.array([math.sin(slope_rad), math.cos(slope_rad), 0.0])
+    fall, nrm = np.array([[math.cos(slope_rad), -math.sin(slope_rad), 0.0],   # walkerlab's
+                          [math.sin(slope_rad), math.cos(slope_rad), 0.0]])    # world axes
     R = _rotation(fall, pelvis_roll)                        # pelvis -> world (walkerlab)
     axis = _rotation(fall, lean) @ np.array([0.0, 0.0, 1.0])   # the stance leg's pitch axis
     pts = {k: np.ravel(np.asarray(v, float)) for k, v in points(x).items()}
@@ -313,6 +312,20 @@ class Legs3dScene:
     latch: tuple | None = None
 
 
+def _patches_across(data, L: float) -> tuple[float, str]:
+    """The footfall patches' width across the slope [m] (:data:`PATCH_ACROSS_L`, with the
+    hip-roll law :data:`PATCH_ACROSS_PUSHED_L`, of the leg length ``L``) and why, for the
+    file's note."""
+    if data.structure.hip_roll:
+        across = PATCH_ACROSS_PUSHED_L * L
+        return across, (f"{across:g} m across: the stabilised gait pushed by +-5 % of its "
+                        "lateral velocity settles 6.9-9.3 cm sideways of these footfalls "
+                        "(measured in MuJoCo; on 8 cm patches it falls)")
+    across = PATCH_ACROSS_L * L
+    return across, (f"{across:g} m across (a passive walker in 3D: its lateral mode falls "
+                    "under any push)")
+
+
 def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     """The keyframe, footfall lanes and contact of ``scene``'s 3D walker at the rigid gait
     ``ideal`` (``x``, ``period_s``; legs that alternate sides: a stride of two steps).
@@ -362,15 +375,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
                                                    data.slope_rad, options)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     period = float(ideal.period_s) / steps
-    if data.structure.hip_roll:
-        across = PATCH_ACROSS_PUSHED_L * p["L"]
-        why = (f"{across:g} m across: the stabilised gait pushed by +-5 % of its lateral "
-               "velocity settles 6.9-9.3 cm sideways of these footfalls (measured in "
-               "MuJoCo; on 8 cm patches it falls)")
-    else:
-        across = PATCH_ACROSS_L * p["L"]
-        why = (f"{across:g} m across (a passive walker in 3D: its lateral mode falls under "
-               "any push)")
+    across, why = _patches_across(data, p["L"])
     on = ("its foot disc rolling on the slope as the rigid model's (the origin its "
           "reference point)" if round_feet(data) else
           "its foot sphere on the slope at the origin")

@@ -66,8 +66,8 @@ URDF_GROUND = Omission(
 MJCF_KNEE_LATCH = Omission(
     "the knee latch's switching", "MuJoCo has no contact-switched lock: the equalities "
     "leg<i>_latch are switched by a stepping loop (walkerlab.export.mujoco_walk.latch_rule)")
-#: A kneed walker's URDF (planar, :func:`walkerlab.export.urdf.urdf_omissions`; in 3D,
-#: :func:`walkerlab.export.urdf.legs_urdf_omissions`): no latch, the stop its joint limit.
+#: A kneed walker's URDF (planar, :func:`walkerlab.export.urdf_omitted.urdf_omissions`; in 3D,
+#: :func:`walkerlab.export.urdf_omitted.legs_urdf_omissions`): no latch, the stop its joint limit.
 URDF_KNEE_LATCH = Omission(
     "the knee latch (contact.knee_stop.latch)", "URDF has no contact-switched lock (the "
     "joint limit at 0 is the straight-leg stop)")

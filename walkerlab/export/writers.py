@@ -72,12 +72,8 @@ from walkerlab.export.spoked import (
     wheel_chord_m,
 )
 from walkerlab.export.text import comment
-from walkerlab.export.urdf import (
-    keyframe_json,
-    legs_urdf_omissions,
-    legs_urdf_text,
-    urdf_omissions,
-)
+from walkerlab.export.urdf import keyframe_json, legs_urdf_text
+from walkerlab.export.urdf_omitted import legs_urdf_omissions, urdf_omissions
 from walkerlab.export.wheel_scene import (
     check_wheel_exportable,
     wheel_keyframe,
