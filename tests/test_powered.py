@@ -335,7 +335,8 @@ def test_target_command_prints_the_value_or_one_line():
 def test_the_export_carries_an_ankle_push_off(tmp_path):
     """Not silently passive: the MJCF of a flat-footed walker with an ankle push-off has a
     motor on each ankle hinge and the law in its custom text (it walks:
-    tests/test_export_flat_feet.py); the URDF refuses flat feet in one line."""
+    tests/test_export_flat_feet.py); the URDF (soles on ankle hinges, no actuator element)
+    names each ankle motor it leaves out, its law in the keyframe sidecar."""
     import yaml
     from typer.testing import CliRunner
 
@@ -355,8 +356,13 @@ def test_the_export_carries_an_ankle_push_off(tmp_path):
     assert '"constant_n_m": 5.0' in text
     r = CliRunner().invoke(app, ["export", "--format", "urdf", str(scene), "--runs-dir",
                                  str(tmp_path / "urdf")])
-    assert r.exit_code == 1 and "Traceback" not in r.output and r.output.count("error:") == 1
-    assert "walker.leg.foot.kind" in r.output
+    assert r.exit_code == 0 and "Traceback" not in r.output, r.output
+    assert (tmp_path / "urdf" / "ankle_flat" / "walker.urdf").is_file()
+    for leg in ("leg1", "leg2"):
+        assert (f"left out of walker.urdf: motor {leg}_ankle_motor: URDF has no actuator "
+                f"element for a torque u on the joint {leg}_ankle") in r.output
+    assert '"constant_n_m": 5.0' in (tmp_path / "urdf" / "ankle_flat" /
+                                     "walker.gait.json").read_text()
 
 
 @pytest.mark.parametrize("name", ["powered_compass", "kuo2002"])
