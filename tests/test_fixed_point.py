@@ -189,61 +189,106 @@ def test_require_stable_names_a_stable_gait_the_policy_passed_over():
 # -------------------- a bounded gait search
 # ------------------------------------------------------------------ 8: a bounded gait search
 @pytest.mark.parametrize("search", ["find_fixed_point", "find_gaits"])
-def test_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
+def test_gait_search_gives_up_when_its_work_budget_is_spent_and_says_why(
         paper_walker, monkeypatch, search):
-    """A spring and damper at their caps (1e6) make one step map take ~40 s, and the search
-    went on for 12+ maps (459 s, silent) before "no gait found".  Here every step is made
-    0.25 s slower and the budget is 0.6 s: the search stops after a few maps (MINPACK alone
-    needs ~20), says why, and a slow map is said in one notice."""
-    import time as _time
-
+    """A spring and damper at their caps (1e6) make one step map crawl, and the search
+    went on for 12+ maps (459 s, silent) before "no gait found".  Here every step costs
+    250,000 more right-hand-side evaluations and the budget is 1,000,000: the search stops
+    after exactly 4 maps (MINPACK alone needs ~20) whatever the machine, says why from the
+    counts (each map a quarter of the budget: a crawl), and a costly map is said in one
+    notice."""
     from walkerlab import progress
     from walkerlab.analysis.gait import budget, poincare
     from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.integrate import work_limit
     from walkerlab.integrate.solver import Solver
     from walkerlab.published import paper
 
-    monkeypatch.setattr(budget, "ROOT_BUDGET_S", 0.6, raising=False)
-    monkeypatch.setattr(budget, "SLOW_MAP_S", 0.2, raising=False)
+    monkeypatch.setattr(budget, "ROOT_BUDGET_EVALUATIONS", 1_000_000, raising=False)
+    monkeypatch.setattr(budget, "SLOW_MAP_EVALUATIONS", 100_000, raising=False)
     steps, notes = [], []
     real = poincare.integrate_step
 
-    def slow_step(*a, **k):
+    def costly_step(*a, **k):
         steps.append(1)
-        t = _time.thread_time()  # the budget counts this thread's CPU time, so burn it
-        while _time.thread_time() - t < 0.25:
-            pass
-        return real(*a, **k)
+        out = real(*a, **k)
+        work_limit.count(250_000)  # the budget counts evaluations: spend them
+        return out
 
-    monkeypatch.setattr(poincare, "integrate_step", slow_step)
+    monkeypatch.setattr(poincare, "integrate_step", costly_step)
     monkeypatch.setattr(progress, "note", notes.append)
     solver, guess = Solver("DOP853", 1e-12, 1e-12), np.array(paper.EQ11_STATE)
-    with pytest.raises(poincare.FixedPointNotFound, match="gave up after [1-4] step map"):
+    with pytest.raises(poincare.FixedPointNotFound, match="gave up after 4 step map") as e:
         if search == "find_fixed_point":
             poincare.find_fixed_point(paper_walker, guess, solver)
         else:
             gait_search.find_gaits(paper_walker, solver, guess)
-    assert 1 <= len(steps) <= 4, len(steps)
-    assert len(notes) == 1 and "step map took" in notes[0], notes
+    assert len(steps) == 4, len(steps)
+    assert "1,000,000 right-hand-side evaluations" in str(e.value)
+    assert "the step's rates grow" in str(e.value) and "root finder" not in str(e.value)
+    assert len(notes) == 1 and "step map took 250,4" in notes[0], notes
+
+
+def test_a_search_of_ordinary_maps_that_spends_its_budget_says_the_root_finder_went_on(
+        paper_walker, monkeypatch):
+    """A budget spent by many maps of ordinary cost is no crawl: the line says the root
+    finder did not converge, and blames no spring or rate."""
+    from walkerlab.analysis.gait import budget, poincare
+    from walkerlab.integrate.solver import Solver
+
+    monkeypatch.setattr(budget, "ROOT_BUDGET_EVALUATIONS", 3000, raising=False)
+    with pytest.raises(poincare.FixedPointNotFound) as e:
+        find_fixed_point(paper_walker, np.array(paper.EQ11_STATE) * 1.3,
+                         Solver("DOP853", 1e-12, 1e-12))
+    text = str(e.value)
+    assert "gave up after" in text and "3,000 right-hand-side evaluations" in text
+    assert "root finder did not converge" in text and "integrator crawls" not in text
+    assert "spring" not in text
+
+
+def test_the_search_outcome_does_not_depend_on_cpu_time(paper_walker, monkeypatch):
+    """The same search on a machine where every step map is 0.05 s of CPU slower (a busy
+    machine, a first run compiling): the same fixed point, bit for bit, the same number of
+    maps; the budget counts right-hand-side evaluations, not seconds."""
+    import time as _time
+
+    from walkerlab.analysis.gait import budget, poincare
+    from walkerlab.integrate.solver import Solver
+
+    solver, guess = Solver("DOP853", 1e-12, 1e-12), np.array(paper.EQ11_STATE)
+    monkeypatch.setattr(budget, "ROOT_BUDGET_EVALUATIONS", 40_000, raising=False)
+    quick = find_fixed_point(paper_walker, guess, solver, fd_check=False)
+    real = poincare.integrate_step
+
+    def slow_step(*a, **k):
+        t = _time.thread_time()
+        while _time.thread_time() - t < 0.05:
+            pass
+        return real(*a, **k)
+
+    monkeypatch.setattr(poincare, "integrate_step", slow_step)
+    slow = find_fixed_point(paper_walker, guess, solver, fd_check=False)
+    assert np.array_equal(quick.x, slow.x) and quick.period_s == slow.period_s
+    assert quick.nfev == slow.nfev and quick.iterations == slow.iterations
 
 
 def test_a_step_map_under_way_is_stopped_at_the_search_budget(paper_walker, monkeypatch):
     """One step map with no end (a controller or spring driving the rates to 1e9 rad/s, the
     integrator crawling) used to run past the budget, which was looked at between maps
-    only: its integration now looks at the clock too (every 64 right-hand sides, as
-    ``solve_on`` wraps them) and the search ends inside the map, in one line saying where
-    the map was and why it crawls - for a walker with no spring, not a spring."""
+    only: its integration counts its evaluations (``solve_on`` wraps the right-hand side)
+    and the search ends inside the map, in one line saying where the map was and why it
+    crawls - for a walker with no spring, not a spring."""
     from walkerlab import progress
     from walkerlab.analysis.gait import budget, poincare
     from walkerlab.integrate.solver import Solver
-    from walkerlab.integrate.time_limit import limited
+    from walkerlab.integrate.work_limit import counted
 
-    monkeypatch.setattr(budget, "ROOT_BUDGET_S", 0.3, raising=False)
+    monkeypatch.setattr(budget, "ROOT_BUDGET_EVALUATIONS", 1000, raising=False)
     notes = []
     monkeypatch.setattr(progress, "note", notes.append)
 
     def crawling_step(walker, x, *a, **k):  # the flow, wrapped as the integrator wraps it
-        rhs, y = limited(lambda t, y: y), np.full(np.size(x), 1e9)
+        rhs, y = counted(lambda t, y: y), np.full(np.size(x), 1e9)
         while True:
             rhs(0.25, y)
     monkeypatch.setattr(poincare, "integrate_step", crawling_step)
@@ -252,8 +297,9 @@ def test_a_step_map_under_way_is_stopped_at_the_search_budget(paper_walker, monk
                                                                            1e-12))
     text = str(e.value)
     assert len(text.splitlines()) == 1 and "gave up after 1 step map" in text
-    assert "t = 0.25 s, rates 1e+09 rad/s" in text
+    assert "stopped after 1,001 evaluations at t = 0.25 s, rates 1e+09 rad/s" in text
     assert "spring" not in text and "the step's rates grow" in text
+    assert "nan" not in text
     assert not notes  # the line says it all: no notice beside it
 
 
@@ -282,12 +328,12 @@ def test_search_budgets_nest_and_end_with_their_search():
 
     from walkerlab.analysis.gait import budget as B
 
-    with B.search_budget(1000.0):
+    with B.search_budget(1000):
         outer = B.deadline()
-        with B.search_budget(2000.0):
+        with B.search_budget(2000):
             assert B.deadline() == outer
             B.map_started()
-        with B.search_budget(0.0):
+        with B.search_budget(0):
             with pytest.raises(B.SearchGaveUp, match="gave up after 1 step map"):
                 B.map_started()
         assert B.deadline() == outer

@@ -490,15 +490,25 @@ def test_bench_out_naming_a_file_says_what_to_do(tmp_path):
 
 
 # -------------------- one-line advice kept whole; SIGTERM as Ctrl-C; a full disk
-def test_advice_longer_than_the_limit_is_kept_whole_only_the_detail_is_cut():
+def test_a_long_error_is_never_cut_its_detail_takes_a_second_line():
+    """A message longer than the limit loses nothing ("rerun with WALKERLAB_DEBUG=1" is
+    never needed to read it): the advice stays whole on the first line, the search's
+    ``[detail]`` goes on a second; a long message without one breaks at a clause."""
     from walkerlab.cli.errors import MAX_ERROR_CHARS, one_line
 
     advice = "no gait; " + "advice " * 60  # longer than the limit on its own
     assert len(advice) > MAX_ERROR_CHARS
-    line = one_line(advice + "[tried a; last: " + "word " * 60 + "]")
-    assert line.startswith(advice + "[tried a ... rerun with WALKERLAB_DEBUG=1")
-    short = advice + "[tried a and b]"
-    assert one_line(short) == short  # nothing cut: nothing to rerun for
+    detail = "[tried a; last: " + "word " * 60 + "]"
+    lines = one_line(advice + detail).splitlines()
+    assert lines == [advice.rstrip(), "  " + detail.replace("  ", " ").rstrip()] or \
+        (len(lines) == 2 and lines[0] == advice.rstrip() and lines[1].strip() ==
+         detail.strip())
+    short = "no gait; advice [tried a and b]"
+    assert one_line(short) == short  # short: one line as it is
+    long = "first clause; " + "word " * 80
+    two = one_line(long).splitlines()
+    assert len(two) == 2 and " ".join(t.strip() for t in two) == long.strip()
+    assert "WALKERLAB_DEBUG" not in one_line(long)
 
 
 # ------------------------------------------------------------- 15: SIGTERM as Ctrl-C

@@ -6,7 +6,6 @@ speed, energy ledger and cost of transport of the ``simulate`` stage's own funct
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -48,9 +47,13 @@ def test_a_state_of_the_wrong_shape_or_value_is_one_scene_error(paper, method, c
     assert "(swing_angle, stance_angle, swing_rate, stance_rate)" in msg or "=" in msg
 
 
-def test_an_absurd_state_fails_at_once_and_a_step_has_a_cpu_limit(paper):
+def test_an_absurd_state_fails_at_once_and_a_step_has_a_work_limit(paper):
     w, gait = paper
-    t = time.perf_counter()
+    from walkerlab.integrate import work_limit
+
+    bound = work_limit.work_bound(1e18)  # every evaluation counted, none stopped
+    bound.__enter__()
+    n0 = work_limit.done()
     for fn in (w.step, w.jacobian, lambda x: w.simulate(x, 1)):
         with pytest.raises(SceneError, match="more than half a turn"):
             fn(gait.x * 1e10)  # was 332 s of integration before failing
@@ -58,10 +61,13 @@ def test_an_absurd_state_fails_at_once_and_a_step_has_a_cpu_limit(paper):
     x[2] = 100.0  # 100 rad/s: above 20 sqrt(g/l) = 62.6 rad/s, no walking state
     with pytest.raises(SceneError, match=r"x\[2\] \(swing_rate\) = 100 rad/s is not a walking"):
         w.step(x)
-    assert time.perf_counter() - t < 1.0  # refused before any integration
-    # the per-step CPU bound: a limit far below one step's cost stops the map in one line
-    tight = wl.Walker(w.scene, step_time_limit_s=1e-6)
-    with pytest.raises(StepFailed, match=r"^step: a walking step used up its 1e-06 s of CPU"):
+    assert work_limit.done() == n0  # refused before any integration
+    bound.__exit__(None, None, None)
+    # the per-step work bound: a limit far below one step's cost stops the map in one line,
+    # the same on any machine (evaluations, not seconds)
+    tight = wl.Walker(w.scene, step_evaluations=10)
+    with pytest.raises(StepFailed, match=r"^step: a walking step used up its 10 "
+                                         r"right-hand-side evaluations"):
         tight.step(gait.x)
     with pytest.raises(StepFailed, match="used up"):
         tight.simulate(gait.x, 1)
@@ -69,8 +75,9 @@ def test_an_absurd_state_fails_at_once_and_a_step_has_a_cpu_limit(paper):
     x1, period, _ = poincare_map(w.model, gait.x, w.solver, w.max_step_time)
     step = w.step(gait.x)
     assert np.array_equal(step.x_next, x1) and step.period == period
-    with pytest.raises(SceneError, match="step_time_limit_s"):
-        wl.Walker(w.scene, step_time_limit_s=0)
+    with pytest.raises(SceneError, match="step_evaluations=0: give a positive number of "
+                                         "right-hand-side evaluations"):
+        wl.Walker(w.scene, step_evaluations=0)
 
 
 def test_a_step_from_a_falling_state_says_the_walker_fell(paper):
@@ -90,10 +97,13 @@ def test_a_step_from_a_falling_state_says_the_walker_fell(paper):
     ("2", "whole number"), (0, "greater than or equal to 1"), (2.0, "whole number")])
 def test_simulate_takes_whole_strides_within_the_cap(paper, strides, says):
     w, gait = paper
-    t = time.perf_counter()
-    with pytest.raises(SceneError, match=f"simulate: strides={strides!r}: .*{says}"):
-        w.simulate(gait.x, strides)
-    assert time.perf_counter() - t < 0.5  # refused at once (10**9 ran 280 s and on)
+    from walkerlab.integrate import work_limit
+
+    with work_limit.work_bound(1e18):  # every evaluation counted
+        n0 = work_limit.done()
+        with pytest.raises(SceneError, match=f"simulate: strides={strides!r}: .*{says}"):
+            w.simulate(gait.x, strides)
+        assert work_limit.done() == n0  # refused at once (10**9 ran 280 s and on)
 
 
 def test_simulate_refuses_more_samples_than_the_stage_keeps(paper):

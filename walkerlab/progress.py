@@ -13,18 +13,28 @@ happens with those calls is decided by the installed *sink* (:func:`use`):
   finished unit of a task of few units - a sigma, a controller, a stage - and per tenth of a
   longer one, and the notices), and ``QuietSink(silent=True)`` under ``--quiet`` (nothing).
 
+No silence over :data:`HEARTBEAT_S`: the CLI's sinks keep a heartbeat (:class:`Heartbeat`)
+that, when nothing was shown for that long, prints one line naming the innermost task under
+way (or the command, where none is open) and how long the command has run: a derivation, a
+compilation or an integration that reports no units is still seen to be working.
+
 A sink is any object with the :class:`Sink` methods; a test can install a recorder.
 """
 
 from __future__ import annotations
 
 import sys
+import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Protocol
 
-__all__ = ["Sink", "Task", "task", "note", "use", "current", "install", "sink_for_terminal",
-           "QuietSink", "RichSink", "LineSink"]
+__all__ = ["HEARTBEAT_S", "Heartbeat", "Sink", "Task", "task", "note", "use", "current",
+           "install", "sink_for_terminal", "QuietSink", "RichSink", "LineSink"]
+
+#: longest silence of a command [s]: past it the heartbeat prints a line (:class:`Heartbeat`)
+HEARTBEAT_S = 8.0
 
 
 class Sink(Protocol):
@@ -63,6 +73,48 @@ class QuietSink:
             print(message, file=sys.stderr, flush=True)
 
 
+def _clock_text(seconds: float) -> str:
+    s = int(seconds)
+    return f"{s // 60}:{s % 60:02d}"
+
+
+class Heartbeat:
+    """A daemon thread that prints ``<what>: working (m:ss)`` through ``say`` whenever
+    nothing was said for :data:`HEARTBEAT_S` (``beat()`` marks a line said; ``what()``
+    names the work under way: the innermost open task, or the command's ``label``).
+
+    The thread holds no lock the work needs and reads only the sink's own fields; a
+    compiled call that holds the interpreter for longer delays its line until it returns.
+    """
+
+    def __init__(self, say, what, every_s: float | None = None):
+        self._say, self._what = say, what
+        self._every = HEARTBEAT_S if every_s is None else float(every_s)
+        self.t0 = self.last = time.monotonic()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="walkerlab-heartbeat",
+                                        daemon=True)
+        self._thread.start()
+
+    def beat(self) -> None:
+        """A line was shown now."""
+        self.last = time.monotonic()
+
+    def stop(self) -> None:
+        """No more lines (the command ended)."""
+        self._stop.set()
+
+    def _run(self) -> None:
+        while not self._stop.wait(min(1.0, self._every / 4)):
+            now = time.monotonic()
+            if now - self.last >= self._every:
+                self.last = now
+                try:
+                    self._say(f"{self._what()}: working ({_clock_text(now - self.t0)})")
+                except Exception:  # noqa: BLE001 - a closed stream at exit: no more lines
+                    return
+
+
 class LineSink:
     """Plain lines on ``stream`` (stderr) for a log without a terminal: a line per finished
     unit (``<task>: <done>/<total> <info> (<elapsed m:ss>)``) of a task of at most
@@ -72,24 +124,29 @@ class LineSink:
     #: tasks of at most this many units get a line per unit (sigmas, controllers, stages)
     EVERY_UNIT = 50
 
-    def __init__(self, stream=None):
+    def __init__(self, stream=None, label: str | None = None):
         self._stream = stream
         #: key -> (description, start [monotonic s], units shown, total)
         self._tasks: dict[int, tuple[str, float, int, int | None]] = {}
+        self._label = label
+        #: with a label (the CLI's command), a line at least every HEARTBEAT_S
+        self.heartbeat = Heartbeat(self._print, self._under_way) if label else None
+
+    def _under_way(self) -> str:
+        """The innermost task open, or the command."""
+        tasks = list(self._tasks.values())
+        return tasks[-1][0] if tasks else str(self._label)
 
     def _print(self, line: str) -> None:
         print(line, file=sys.stderr if self._stream is None else self._stream, flush=True)
+        if getattr(self, "heartbeat", None) is not None:
+            self.heartbeat.beat()
 
     @staticmethod
     def _elapsed(t0: float) -> str:
-        import time
-
-        s = int(time.monotonic() - t0)
-        return f"{s // 60}:{s % 60:02d}"
+        return _clock_text(time.monotonic() - t0)
 
     def start(self, key, description, total, completed):
-        import time
-
         self._tasks[key] = (description, time.monotonic(), int(completed), total)
 
     def update(self, key, completed, total, info):
@@ -116,9 +173,17 @@ class LineSink:
 class RichSink:
     """``rich.progress`` on stderr (imported when the first task starts)."""
 
-    def __init__(self):
+    def __init__(self, label: str | None = None):
         self._progress = None
         self._ids: dict[int, int] = {}
+        self._label = label
+        # with a label: a line when no task is open and nothing was shown for HEARTBEAT_S
+        # (an open task's line is redrawn with its elapsed time by rich itself)
+        self.heartbeat = Heartbeat(self._idle_line, lambda: str(label)) if label else None
+
+    def _idle_line(self, line: str) -> None:
+        if self._progress is None:
+            print(line, file=sys.stderr, flush=True)
 
     def _ensure(self):
         if self._progress is None:
@@ -172,6 +237,8 @@ class RichSink:
             self._progress.console.print(message, markup=False, highlight=False)
         else:
             print(message, file=sys.stderr, flush=True)
+        if self.heartbeat is not None:
+            self.heartbeat.beat()
 
 
 _SINK: Sink = QuietSink()
@@ -189,14 +256,16 @@ def install(sink: Sink) -> None:
     _SINK = sink
 
 
-def sink_for_terminal(quiet: bool, stream=None) -> Sink:
+def sink_for_terminal(quiet: bool, stream=None, label: str | None = None) -> Sink:
     """The CLI's sink: nothing under ``--quiet``, rich progress when ``stream`` (stderr) is a
-    terminal, plain lines otherwise (:class:`LineSink`)."""
+    terminal, plain lines otherwise (:class:`LineSink`); with ``label`` (the command, e.g.
+    ``"walkerlab fixedpoint"``) a :class:`Heartbeat`: never silent for more than
+    :data:`HEARTBEAT_S`."""
     stream = sys.stderr if stream is None else stream
     if quiet:
         return QuietSink(silent=True)
     isatty = getattr(stream, "isatty", None)
-    return RichSink() if isatty is not None and isatty() else LineSink()
+    return RichSink(label) if isatty is not None and isatty() else LineSink(label=label)
 
 
 @contextmanager

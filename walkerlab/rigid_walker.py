@@ -19,12 +19,14 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "Gait", "SceneWalker", "positive", "scene_of", "short"]
+__all__ = ["STEP_EVALUATIONS", "Gait", "SceneWalker", "positive", "scene_of", "short"]
 
-#: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
-#: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
-#: search's budget (:data:`walkerlab.analysis.gait.budget.ROOT_BUDGET_S`)
-STEP_TIME_LIMIT_S = 60.0
+#: right-hand-side evaluations one walking step of the in-memory walker may take (a map is
+#: one step, or a stride of two; :func:`walkerlab.integrate.work_limit.step_work_limit`), as
+#: the gait search's budget
+#: (:data:`walkerlab.analysis.gait.budget.ROOT_BUDGET_EVALUATIONS`): work, not time, so that
+#: a step ends the same way on any machine
+STEP_EVALUATIONS = 2_000_000
 
 
 def short(value) -> str:
@@ -53,8 +55,9 @@ def scene_of(scene) -> Scene:
     return load_scene(scene)
 
 
-def positive(value, name: str) -> float:
-    """``value`` as a positive finite float, else one line naming ``name``."""
+def positive(value, name: str, unit: str = "right-hand-side evaluations") -> float:
+    """``value`` as a positive finite float, else one line naming ``name`` (and ``unit``,
+    what the number counts)."""
     import math
     import numbers
 
@@ -62,7 +65,7 @@ def positive(value, name: str) -> float:
 
     if (isinstance(value, bool) or not isinstance(value, numbers.Real)
             or not math.isfinite(value) or value <= 0):
-        raise SceneError(f"{name}={short(value)}: give a positive number of seconds")
+        raise SceneError(f"{name}={short(value)}: give a positive number of {unit}")
     return float(value)
 
 
@@ -158,8 +161,9 @@ class SceneWalker:
     ----------
     scene : walkerlab.config.Scene
         A validated scene.
-    step_time_limit_s : float
-        CPU time each walking step may take [s] (:data:`STEP_TIME_LIMIT_S`).
+    step_evaluations : int
+        Right-hand-side evaluations each walking step may take [-]
+        (:data:`STEP_EVALUATIONS`; work, not time: the same on any machine).
     plant : walkerlab.walker.plant.Plant, optional
         The scene's walker described, when the caller holds it (the API's contact view);
         default: described here.
@@ -167,23 +171,23 @@ class SceneWalker:
     Raises
     ------
     walkerlab.config.SceneError
-        ``step_time_limit_s`` not a positive number.
+        ``step_evaluations`` not a positive number.
     ValueError
         A walker or ground the rigid model does not carry (one line naming the key).
     """
 
     def __reduce__(self):
-        """Pickled as its scene and step time limit (the model is built again: a compiled
+        """Pickled as its scene and step work limit (the model is built again: a compiled
         flow does not pickle; a process pool or a vector env's subprocess gets the same
         walker)."""
-        return (type(self), (self.scene, self.step_time_limit_s))
+        return (type(self), (self.scene, self.step_evaluations))
 
-    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S,
+    def __init__(self, scene: Scene, step_evaluations: int = STEP_EVALUATIONS,
                  plant=None):
         from walkerlab.models.registry import build_walker  # light
         from walkerlab.walker.plant import Plant  # light
 
-        self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")
+        self.step_evaluations = positive(step_evaluations, "step_evaluations")
         self.scene = scene
         # described once, handed to every analysis
         self.plant = Plant.from_scene(scene) if plant is None else plant

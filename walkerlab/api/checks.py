@@ -7,12 +7,12 @@ from __future__ import annotations
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
-from walkerlab.rigid_walker import STEP_TIME_LIMIT_S, positive, short
+from walkerlab.rigid_walker import STEP_EVALUATIONS, positive, short
 
 if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "bounded_steps", "check_target", "clear_step_failure",
+__all__ = ["STEP_EVALUATIONS", "bounded_steps", "check_target", "clear_step_failure",
            "positive", "short", "simulate_options"]
 
 def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
@@ -131,29 +131,27 @@ def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
 
 
 @contextmanager
-def bounded_steps(step_time_limit_s: float, max_step_time: float):
-    """Each walking step inside bounded to ``step_time_limit_s`` of CPU time [s]; a failed
-    step said in one line (how and when it ended, what to do: :func:`clear_step_failure`).
+def bounded_steps(step_evaluations: int, max_step_time: float):
+    """Each walking step inside bounded to ``step_evaluations`` right-hand-side evaluations
+    (work, not time: the same step ends the same way on any machine); a failed step said in
+    one line (how and when it ended, what to do: :func:`clear_step_failure`).
 
     Raises
     ------
     walkerlab.analysis.gait.poincare.StepFailed
-        A step used up its CPU time (``time_limit``), or ended otherwise than at a heel
+        A step used up its evaluations (``work_limit``), or ended otherwise than at a heel
         strike (its one line).
     """
     from walkerlab.analysis.gait.poincare import StepFailed  # light
-    from walkerlab.integrate.time_limit import (  # light
-        IntegrationTimeLimit,
-        integration_time_limit,
-    )
+    from walkerlab.integrate.work_limit import StepWorkLimit, step_work_limit  # light
 
     try:
-        with integration_time_limit(step_time_limit_s):
+        with step_work_limit(step_evaluations):
             yield
-    except IntegrationTimeLimit:
-        out = StepFailed("time_limit", float("nan"), None)
-        out.args = (f"step: a walking step used up its {step_time_limit_s:g} s of "
-                    "CPU time (Walker(..., step_time_limit_s=...)): a state far from any "
+    except StepWorkLimit:
+        out = StepFailed("work_limit", float("nan"), None)
+        out.args = (f"step: a walking step used up its {step_evaluations:.3g} right-hand-side "
+                    "evaluations (Walker(..., step_evaluations=...)): a state far from any "
                     "gait, or a very stiff spring, makes the integrator crawl",)
         raise out from None
     except StepFailed as exc:

@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from walkerlab.api.checks import (
-    STEP_TIME_LIMIT_S,
+    STEP_EVALUATIONS,
     bounded_steps,
     check_target,
     short,
@@ -56,7 +56,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Step", "Walk", "Walker",
+__all__ = ["STEP_EVALUATIONS", "ContactWalk", "ContactWalker", "Step", "Walk", "Walker",
            "check_target"]
 
 
@@ -74,11 +74,11 @@ class Walker(SceneWalker):
         A validated scene (its ``walker``, ``slope``, ``ideal``, ``terrain``, ``solver``,
         ``fixedpoint`` and ``simulate`` sections are used, as the ``fixedpoint`` and
         ``simulate`` stages use them).
-    step_time_limit_s : float
-        CPU time each walking step of :meth:`step`, :meth:`jacobian`, :meth:`floquet` and
-        :meth:`simulate` may take [s] (this thread's CPU time, so a busy machine does not
-        trip it); past it the map stops with one line
-        (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``time_limit``).  The
+    step_evaluations : int
+        Right-hand-side evaluations each walking step of :meth:`step`, :meth:`jacobian`,
+        :meth:`floquet` and :meth:`simulate` may take [-] (work, not time: the same step
+        ends the same way on any machine, busy or not); past it the map stops with one line
+        (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``work_limit``).  The
         simulated time of a step is bounded apart, by ``fixedpoint.max_step_time_s``.
 
     Attributes
@@ -98,7 +98,7 @@ class Walker(SceneWalker):
     Raises
     ------
     walkerlab.config.SceneError
-        ``step_time_limit_s`` not a positive number.
+        ``step_evaluations`` not a positive number.
     ValueError
         A walker or ground the rigid model does not carry (one line naming the key, as
         :func:`walkerlab.models.registry.build_walker`: footholds of several heights for
@@ -107,17 +107,17 @@ class Walker(SceneWalker):
 
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
-                   step_time_limit_s: float = STEP_TIME_LIMIT_S) -> Walker:
+                   step_evaluations: int = STEP_EVALUATIONS) -> Walker:
         """The walker of a scene: a YAML path, a mapping with the scene's sections, or a
-        loaded scene (``step_time_limit_s`` as in :class:`Walker`).
+        loaded scene (``step_evaluations`` as in :class:`Walker`).
 
         Raises
         ------
         walkerlab.config.SceneError
             The file is missing or the scene does not validate (one line per field), or a
-            bad ``step_time_limit_s``.
+            bad ``step_evaluations``.
         """
-        return cls(as_scene(scene), step_time_limit_s)
+        return cls(as_scene(scene), step_evaluations)
 
     def with_changes(self, changes: dict[str, Any]) -> Walker:
         """A new walker with scene fields set by dotted path
@@ -128,7 +128,7 @@ class Walker(SceneWalker):
         walkerlab.config.SceneError
             An unknown field (with the closest name) or a value the field does not accept.
         """
-        return Walker(with_changes(self.scene, changes), self.step_time_limit_s)
+        return Walker(with_changes(self.scene, changes), self.step_evaluations)
 
     def contact(self) -> ContactWalker:
         """The contact (compliant-foot) view of this walker: a :class:`ContactWalker` on the
@@ -145,7 +145,7 @@ class Walker(SceneWalker):
         from walkerlab.analysis.gait.poincare import poincare_map  # light
 
         x = self.check_state(x)
-        with bounded_steps(self.step_time_limit_s, self.max_step_time):
+        with bounded_steps(self.step_evaluations, self.max_step_time):
             return poincare_map(self.model, x, self.solver, self.max_step_time,
                                 jacobian=jacobian, steps=steps)
 
@@ -170,7 +170,7 @@ class Walker(SceneWalker):
             (:meth:`check_state`; one line).
         walkerlab.analysis.gait.poincare.StepFailed
             The step fell, the solver failed, the step ran past ``max_step_time_s`` or the
-            step past ``step_time_limit_s`` of CPU time (one line: how and when).
+            step past ``step_evaluations`` right-hand-side evaluations (one line: how and when).
         """
         segs: list = []
         x_next, period, _ = self._map(x, steps=segs)
@@ -299,7 +299,7 @@ class Walker(SceneWalker):
             printed equations: ``terrain.kind: profile: ...``) (one line each, naming the
             key).
         walkerlab.analysis.gait.poincare.StepFailed
-            A step used up ``step_time_limit_s`` of CPU time (a fall is recorded in
+            A step used up its ``step_evaluations`` (a fall is recorded in
             ``termination``, not raised).
         """
         from walkerlab.analysis.gait.rigid_run import rough_ground_walker, walk_scene  # light
@@ -317,7 +317,7 @@ class Walker(SceneWalker):
         try:
             if scene.simulate is not None and scene.simulate.terrain_seed is not None:
                 walker = rough_ground_walker(scene, 2 * strides, self.plant)
-            with bounded_steps(self.step_time_limit_s, self.max_step_time):
+            with bounded_steps(self.step_evaluations, self.max_step_time):
                 traj = walk_scene(scene, walker, x0, 2 * strides, self.solver,
                                   self.walk_step_time, self.plant)
         except SceneError:
@@ -351,7 +351,7 @@ class ContactWalker:
         the paper's contact law, and :attr:`scene` has it written out).
     rigid : Walker, optional
         The scene's rigid walker (default: built here).
-    step_time_limit_s : float
+    step_evaluations : int
         As :class:`~walkerlab.api.walker.Walker` (the rigid view's steps).
 
     Attributes
@@ -368,11 +368,11 @@ class ContactWalker:
         A walker the contact view does not carry (one line:
         :func:`~walkerlab.models.contact.scene.contact_setup`).
     walkerlab.config.SceneError
-        A bad ``step_time_limit_s``.
+        A bad ``step_evaluations``.
     """
 
     def __init__(self, scene: Scene, rigid: Walker | None = None,
-                 step_time_limit_s: float = STEP_TIME_LIMIT_S):
+                 step_evaluations: int = STEP_EVALUATIONS):
         from walkerlab.config.sections import with_default_section  # light
         from walkerlab.models.contact.scene import contact_setup  # light
         from walkerlab.walker.plant import Plant  # light
@@ -380,7 +380,7 @@ class ContactWalker:
         self.scene = with_default_section(scene, "contact")  # left out: its defaults
         plant = Plant.from_scene(scene) if rigid is None else rigid.plant  # described once
         self.setup = contact_setup(self.scene, plant=plant)
-        self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s, plant)
+        self.rigid = rigid if rigid is not None else Walker(scene, step_evaluations, plant)
         self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
         self.solver = Solver.from_settings(self.setup.solver)
         self._gait = None  # the rigid gait, found on first use
@@ -388,7 +388,7 @@ class ContactWalker:
 
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
-                   step_time_limit_s: float = STEP_TIME_LIMIT_S) -> ContactWalker:
+                   step_evaluations: int = STEP_EVALUATIONS) -> ContactWalker:
         """The contact walker of a scene: a YAML path, a mapping with the scene's sections,
         or a loaded scene.
 
@@ -399,7 +399,7 @@ class ContactWalker:
         walkerlab.models.contact.scene.ContactSceneError
             As :class:`ContactWalker`.
         """
-        return cls(as_scene(scene), step_time_limit_s=step_time_limit_s)
+        return cls(as_scene(scene), step_evaluations=step_evaluations)
 
     def with_changes(self, changes: dict[str, Any]) -> ContactWalker:
         """A new contact walker (and rigid walker) with scene fields set by dotted path

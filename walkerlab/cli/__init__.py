@@ -47,7 +47,8 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
 
 
 @app.callback()
-def _main(version: bool = typer.Option(False, "--version", callback=version_callback,
+def _main(ctx: typer.Context,
+          version: bool = typer.Option(False, "--version", callback=version_callback,
                                        is_eager=True,
                                        help="print walkerlab, Python, numpy, scipy, numba "
                                        "and h5py versions and exit"),
@@ -62,7 +63,11 @@ def _main(version: bool = typer.Option(False, "--version", callback=version_call
     process_settings()
     from walkerlab import progress  # light
 
-    progress.install(progress.sink_for_terminal(quiet))
+    sink = progress.sink_for_terminal(quiet, label=f"walkerlab {ctx.invoked_subcommand}")
+    progress.install(sink)
+    beat = getattr(sink, "heartbeat", None)
+    if beat is not None:  # no silence past progress.HEARTBEAT_S, and none after the command
+        ctx.call_on_close(beat.stop)
 
 
 #: every command in the order ``--help`` lists them: (command name, function)

@@ -4,7 +4,8 @@
   <message>``, unknown keys first (with the closest field name), exit code 1;
 - bad input (scene, names, paths, artifacts, a busy artifact, a read-only runs folder) and
   a walker that falls (``simulate``, ``contact-sim``: the stage's ``StageOutcome.failure``):
-  one line ``error: ...`` on stderr, exit code 1;
+  one line ``error: ...`` on stderr (a reason longer than :data:`MAX_ERROR_CHARS` takes a
+  second line: never cut), exit code 1;
 - an unexpected exception: one line ``error: internal error (<type>): <message>`` and a hint
   to rerun with ``WALKERLAB_DEBUG=1``, which shows the traceback instead; exit code 1;
 - Ctrl-C or SIGTERM: ``interrupted``, exit code 130, also when a library swallowed the
@@ -30,7 +31,7 @@ DEBUG_ENV = "WALKERLAB_DEBUG"
 #: values of ``WALKERLAB_DEBUG`` that show tracebacks (case-insensitive); anything else
 #: (``0``, ``false``, ``no``, empty) keeps errors to one line
 DEBUG_ON = ("1", "true", "yes")
-#: longest error line; a longer message is cut at a sentence or field boundary
+#: longest error line; a longer message takes a second line (never cut)
 MAX_ERROR_CHARS = 300
 
 
@@ -38,52 +39,25 @@ def _debug() -> bool:
     return os.environ.get(DEBUG_ENV, "").strip().lower() in DEBUG_ON
 
 
-def _word_end(text: str) -> int:
-    """Where to cut ``text`` at a space outside parentheses (-1: nowhere)."""
-    depth, cut = 0, -1
-    for i, c in enumerate(text):
-        depth += (c == "(") - (c == ")")
-        if c == " " and depth <= 0:
-            cut = i
-    return cut
-
-
 def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
-    """A message as one line: its lines joined (a sentence wrapped over two lines stays
-    whole); longer than ``limit``, it is cut after the last sentence or field boundary
-    (``.``, ``;``, ``:``, ``,`` followed by a space) and says how to see the rest.  A
-    message ending in a ``[detail]`` (what a search tried) loses that detail first and keeps
-    the advice before it whole, however long."""
+    """A message as one line (its lines joined: a sentence wrapped over two lines stays
+    whole), never cut: longer than ``limit``, it takes a second line, broken after the last
+    sentence or field boundary (``.``, ``;``, ``:``, ``,`` followed by a space) within the
+    limit.  A message ending in a ``[detail]`` (what a search tried) keeps its advice on the
+    first line, however long, and the detail on the second."""
     line = " ".join(ln.strip() for ln in str(text).strip().splitlines() if ln.strip())
     if len(line) <= limit:
         return line
-    # a trailing "[detail]" (a solver's report) is cut first: the advice before it stays
-    # whole, even when the advice alone is longer than the limit
     start = line.rfind(" [")
-    if line.endswith("]") and start > 0:
-        budget = max(limit, start)
-        more = f" ... rerun with {DEBUG_ENV}=1 for the rest]"
-        detail = line[start:-1]
-        # the detail's first clause (what was tried) whole, unless longer than a line of
-        # its own; further clauses ("; ") while they fit 80 characters past the budget:
-        # never cut inside a clause, a parenthesis or a sentence
-        clauses = detail.split("; ")
-        keep = clauses[0] if len(clauses[0]) <= 160 else ""
-        for c in clauses[1:] if keep else ():
-            if start + len(keep) + 2 + len(c) + len(more) > budget + 80:
-                break
-            keep += "; " + c
-        if keep == detail:  # nothing cut: the advice, longer than the limit, and the detail
-            return line
-        if not keep:  # one long clause: at a space outside parentheses
-            cut = _word_end(detail[:max(budget + 80 - start - len(more), 2)])
-            keep = detail[:cut].rstrip(",;:( ") if cut > 2 else " ["
-        return line[:start] + keep + more
+    if line.endswith("]") and start > 0:  # the advice, then what was tried
+        return f"{line[:start]}\n  {line[start + 1:]}"
     head = line[:limit]
     cut = max(head.rfind(sep) for sep in (". ", "; ", ": ", ", "))
-    head = head[:cut + 1] if cut > limit // 3 else head[:head.rfind(" ")].rstrip()
-    return (f"{head} ... [{len(line) - len(head)} more characters: rerun with "
-            f"{DEBUG_ENV}=1 for the full message]")
+    if cut <= limit // 3:
+        cut = head.rfind(" ")
+    if cut <= 0:
+        return line
+    return f"{line[:cut + 1].rstrip()}\n  {line[cut + 1:].lstrip()}"
 
 
 def _disk_full_line(exc: BaseException) -> str:

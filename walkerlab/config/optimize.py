@@ -111,7 +111,7 @@ class OptimizeSettings(Strict):
     cpu_budget_s: float | None = Field(
         None, gt=0, le=86400, description="design: virtual_constraints: the CPU time of "
         "each controller [s]: IPOPT stops at it (status Maximum_CpuTime_Exceeded) and the "
-        "closed loop's gait search gets what IPOPT left, at least 10 s (default 60)")
+        "closed loop's gait search has the gait search's work budget (default 60)")
 
     @model_serializer(mode="wrap")
     def _as_given(self, handler):

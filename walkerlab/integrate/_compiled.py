@@ -26,6 +26,8 @@ import ctypes
 
 import numpy as np
 
+from .work_limit import count
+
 EPS = np.finfo(float).eps
 _NS: list = []  # CyRK's numba bridge, once imported
 
@@ -424,11 +426,15 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     while True:
         _res, T, Y, ok, msg, nf = plan.run(data, ta, t1, ya, K, h0, False)
         nfev += nf
+        # the work bound (walkerlab.integrate.work_limit): no Python in the flow, so the
+        # chunk's evaluations are counted after it, where it ended
+        count(nf, float(T[-1]) if T.size else ta, Y[-1, :m] if T.size else ya)
         G = values(T, Y) if T.size > 1 else None
         k, active = (None, None) if G is None else _first_crossing(G, dirs)
         if k is not None:
             te, ye, failed, msg1, i, nf1 = _crossing(plan, data, T, Y, k, active, fns, n, m,
                                                      dense, h0)
+            count(nf1, te, ye)
             return te, ye, failed, msg1 or msg, i, dense, nfev + nf1
         if T.size > 1:
             dense.pieces.append(plan.piece(data, T[0], T[-1], Y[0, :m], h0))

@@ -25,7 +25,7 @@ from walkerlab.models.hybrid.base import HybridWalker, Phase
 from .ends import RunEnd
 from .rigid_phase import integrate_phase, numeric_jacobian, phase_rhs
 from .solver import Solver
-from .time_limit import start_step_clock
+from .work_limit import start_step
 
 #: A heel strike this soon after the step began [s] is no step: the state sat on the
 #: heel-strike surface and never moved (slope 0, all-zero state; a passive step lasts
@@ -321,7 +321,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     """
     backend = solver.resolved_backend()
     n = x0.size
-    start_step_clock()  # inside an integration_time_limit only: this step's CPU time
+    start_step()  # inside a step_work_limit only: this step's evaluations
     if walker.actuators is not None:  # a time-based torque law counts from the step's start
         walker.actuators.begin_step(t0)
     t_stop = t0 + max_step_time

@@ -30,7 +30,7 @@ from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
 from .solver import Solver
-from .time_limit import check_time_limit, limited
+from . import work_limit
 
 __all__ = ["IMPLICIT_METHODS", "PhaseRun", "integrate_phase", "numeric_jacobian", "phase_rhs"]
 
@@ -151,7 +151,7 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
         if backend != "scipy" or solver.method not in _SCALAR_RTOL:
             rtol = np.full(len(y0), rtol)
             rtol[n:] = np.maximum(rtol[n:], rows_rtol)
-    rhs = limited(rhs)  # inside an integration_time_limit only: the clock checked
+    rhs = work_limit.counted(rhs)  # inside a work bound only: each evaluation counted
     if backend == "cyrk":
         from walkerlab.integrate.cyrk_loader import pysolve_ivp as cyrk_solver
 
@@ -243,7 +243,7 @@ def integrate_phase(phase: Phase, t0: float, x: np.ndarray, Phi: np.ndarray, t_s
     y0 = np.concatenate([x, Phi.ravel()]) if variational else x
     if backend == "cyrk_compiled" and phase.compiled is not None:
         solve_phase = _SOLVE_PHASE[0] if _SOLVE_PHASE else _compiled_solve_phase()
-        check_time_limit(t0, x)  # no Python in the compiled flow: checked at each phase start
+        work_limit.count(0, t0, x)  # no Python in the compiled flow: it counts after each chunk
 
         return PhaseRun(*solve_phase(phase.compiled, variational, t0, t_stop, y0,
                                      phase.guards, n, solver))

@@ -34,7 +34,7 @@ from walkerlab.optimal.transcription.virtual_constraints import (
 )
 from walkerlab.walker.plant import Plant
 
-__all__ = ["CHECK_MIN_S", "CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
+__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
            "REPLAY_STRIDES", "ControllerDesign", "check_design", "clearance_report",
            "contact_scene", "controller_scene", "controller_scene_text", "controller_step",
            "design_controllers", "design_failures", "design_spec", "designs_controller",
@@ -289,16 +289,13 @@ def controller_step(walker, solver, points: int):
 #: (IPOPT's ``max_cpu_time``: a bound, not a measure; configs/rabbit_hzd_optimal.yaml, whose
 #: 0.8 m/s controller takes 435 IPOPT iterations, gives its own)
 DESIGN_BUDGET_S = 60.0
-#: the least CPU time the closed loop's gait search of a controller gets, whatever IPOPT
-#: left of the budget [s]
-CHECK_MIN_S = 10.0
 
 
-def _evaluate(scene, res, target, name: str, clearance: dict,
-              budget_s: float = CHECK_MIN_S) -> ControllerDesign:
+def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesign:
     """The written controller of the optimum ``res`` on the rigid model: its coefficients
     in force, its restricted map and its full-order fixed point (from the zero dynamics'
-    orbit; the gait search bounded to ``budget_s`` of CPU time [s]); ``clearance``: the
+    orbit; the gait search's work budget,
+    :data:`walkerlab.analysis.gait.budget.ROOT_BUDGET_EVALUATIONS`); ``clearance``: the
     swing foot's (:func:`clearance_report`).  IPOPT's last
     iterate whose coefficients make no controller (a failed design) is recorded as it is,
     with the reason in ``note``."""
@@ -337,7 +334,7 @@ def _evaluate(scene, res, target, name: str, clearance: dict,
     near, shift, note, x_star = complex(np.nan), np.inf, "", None
     if zd.exists:
         try:
-            with search_budget(budget_s):
+            with search_budget():
                 fp = solve_scene(sc, False, guess=zd.x_plus, walker=walker,
                                  solver=Solver.from_settings(sc.solver), plant=plant)[1].gait.result
             period = float(fp.period_s)
@@ -402,8 +399,8 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     -------
     list of ControllerDesign
         One per speed, converged or not (IPOPT's status; each controller's IPOPT solve
-        stops at ``optimize.cpu_budget_s``, default :data:`DESIGN_BUDGET_S`, of CPU time and
-        its closed loop's gait search gets what is left, at least :data:`CHECK_MIN_S`).
+        stops at ``optimize.cpu_budget_s``, default :data:`DESIGN_BUDGET_S`, of CPU time;
+        its closed loop's gait search has the gait search's work budget).
 
     Raises
     ------
@@ -437,11 +434,9 @@ def design_controllers(scene, data, spec, print_level: int = 0,
                 (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level,
                 mid_stance_window_m=window, cpu_budget_s=budget)
             res.build_time_s += build
-            left = max(budget - res.cpu_time_s, CHECK_MIN_S)  # the closed loop's search
             out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml",
                                  {**clearance_report(fns, res.x, window),
-                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)},
-                                 left))
+                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)}))
             speed = "no target speed" if v is None else f"{v:g} m/s"
             bar.advance(info=f"controller {i + 1} ({speed}): {res.status}")
             if res.status == "Solve_Succeeded":  # the next speed starts here

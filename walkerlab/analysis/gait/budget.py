@@ -1,78 +1,102 @@
-"""The CPU-time budget of a gait search: every step map of a search counted and bounded
-(:func:`search_budget`), a slow map said once, a spent budget raised as
-:class:`SearchGaveUp` with why this walker's maps can crawl."""
+"""The work budget of a gait search: every step map of a search counted, and the
+right-hand-side evaluations of their integrations bounded (:func:`search_budget`); a map
+far costlier than the search's others said once; a spent budget raised as
+:class:`SearchGaveUp`, saying from the counts whether one map crawled or the root finder
+wandered.
+
+The budget counts work, never seconds (:mod:`walkerlab.integrate.work_limit`): the same scene
+gives the same search, and the same outcome, on a quiet machine, a busy one, and on its first
+run while the walker's code is being generated and compiled.
+"""
 
 from __future__ import annotations
 
 import math
 import re
 import threading
-import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+import numpy as np
+
 from walkerlab import progress
+from walkerlab.integrate import work_limit
 from walkerlab.models.hybrid.base import HybridWalker
 
-__all__ = ["ROOT_BUDGET_S", "SLOW_MAP_S", "SearchGaveUp", "clock", "deadline", "gave_up",
-           "map_ended", "map_started", "search_budget", "slow_step_reason"]
+__all__ = ["CRAWL_SHARE", "ROOT_BUDGET_EVALUATIONS", "SLOW_MAP_EVALUATIONS", "SearchGaveUp",
+           "deadline", "evaluations", "gave_up", "map_ended", "map_started", "search_budget",
+           "slow_step_reason"]
 
-#: longest CPU time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
-#: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes
-#: need a small part of it; a spring or damper at its cap (1e6), or a virtual-constraint
-#: controller started far from its designed step, makes the integrator crawl (stiff), and the
-#: search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it busy, silent, for
-#: many minutes before it says "no gait found"
-ROOT_BUDGET_S = 60.0
-#: the budget's clock: this thread's CPU time, so that a loaded machine (other processes on
-#: the same cores) does not make a search give up that would finish on a quiet one
-_clock = time.thread_time
-#: a step map slower than this [s] is said in one notice (the search is not silent)
-SLOW_MAP_S = 5.0
+#: most right-hand-side evaluations of one search for a gait (:func:`search_budget`; a fixed
+#: point, or every start of :func:`walkerlab.analysis.gait.search.find_gaits`).  The shipped
+#: scenes' searches use at most about 260,000 (``hip_width_powered``, 3D: 61 maps of at most
+#: 4,664 each; a planar scene at most 116,000, ``flat_feet_footholds``); a spring or damper
+#: at its cap (1e6), or a virtual-constraint controller started far from its designed step,
+#: makes the integrator crawl (stiff), and the search's starts and MINPACK's own cap of
+#: 200 (n + 1) maps would keep it busy for many minutes before it says "no gait found".  At
+#: about 30 us an evaluation (a planar walker's Python flow) the budget is a minute, at
+#: 300 us (a 3D walker's) ten; the compiled flow takes the same steps, hence the same count
+ROOT_BUDGET_EVALUATIONS = 2_000_000
+#: a step map of more evaluations than this is said in one notice (the search is not silent;
+#: a shipped gait's map takes at most about 5,300)
+SLOW_MAP_EVALUATIONS = 100_000
+#: a search whose costliest map used this share of its budget or more gave up because that
+#: map crawled (else: the root finder wandered over many maps of ordinary cost)
+CRAWL_SHARE = 0.25
+
 
 class _Budget(threading.local):
-    """The CPU-time budget of the search under way in this thread (:func:`search_budget`;
+    """The work budget of the search under way in this thread (:func:`search_budget`;
     per thread: the report runs the work-precision study in a thread of its own)."""
 
-    deadline = math.inf  # _clock() after which no step map starts
+    deadline = math.inf  # work_limit.done() after which no step map starts
     maps = 0  # step maps started under the budget
-    slowest = 0.0  # slowest of them [s]
-    started = 0.0
+    costliest = 0  # evaluations of the costliest of them
+    started = 0  # work_limit.done() when the outermost budget began
+    size = 0.0  # evaluations the outermost budget allows
 
 
 _BUDGET = _Budget()
 
 
 class SearchGaveUp(Exception):
-    """A search for a gait spent its CPU-time budget (:func:`search_budget`); raised
-    before a step map would start, or from the step map under way (its integration checks
-    the clock).  The message says after how many maps, how slow, and why a map of this
-    walker can crawl (:func:`slow_step_reason`)."""
+    """A search for a gait spent its work budget (:func:`search_budget`); raised before a
+    step map would start, or from the step map under way (its integration counts its
+    right-hand-side evaluations).  The message says after how many maps and evaluations,
+    and, from those counts, whether one map crawled (:func:`slow_step_reason`) or the root
+    finder went on over many maps."""
 
 
 @contextmanager
-def search_budget(seconds: float | None = None, fresh: bool = False) -> Iterator[None]:
-    """Bound every step map started inside to ``seconds`` of this thread's CPU time from now
-    (default :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline, unless
-    ``fresh``: a start tried after the search's own ones failed, with a budget of its own
-    and the outer deadline back after it): past it,
-    :func:`walkerlab.analysis.gait.poincare.poincare_map` raises :class:`SearchGaveUp`
-    instead of starting a map, and stops
-    the map under way (:func:`walkerlab.integrate.time_limit.integration_deadline`: its
-    right-hand side looks at the clock every 64 evaluations; the compiled CyRK flow at each
-    phase's start), so that a search ends within its budget and a few evaluations.  A map
-    slower than :data:`SLOW_MAP_S` is said once in a notice
-    (:func:`walkerlab.progress.note`)."""
-    outer = _BUDGET.deadline
-    now = _clock()
-    if not math.isfinite(outer) or fresh:  # the outermost budget counts the maps inside
-        _BUDGET.maps, _BUDGET.slowest, _BUDGET.started = 0, 0.0, now
-    own = now + (ROOT_BUDGET_S if seconds is None else seconds)
-    _BUDGET.deadline = own if fresh else min(outer, own)
+def search_budget(evaluations: float | None = None, fresh: bool = False) -> Iterator[None]:
+    """Bound every step map started inside to ``evaluations`` right-hand-side evaluations
+    of this thread's integrations from now (default :data:`ROOT_BUDGET_EVALUATIONS`; nested
+    budgets keep the earlier end, unless ``fresh``: a start tried after the search's own
+    ones failed, with a budget of its own and the outer one back after it).
+
+    Past it, :func:`walkerlab.analysis.gait.poincare.poincare_map` raises
+    :class:`SearchGaveUp` instead of starting a map, and stops the map under way
+    (:func:`walkerlab.integrate.work_limit.work_bound`: the right-hand side counts each of
+    its evaluations; the compiled CyRK flow after each integration chunk), so that a search
+    ends within its budget and one chunk.  A map of more than :data:`SLOW_MAP_EVALUATIONS`
+    is said once in a notice (:func:`walkerlab.progress.note`).  Code generation and
+    compilation do no counted work: a walker's first run on a machine ends as its tenth.
+    """
+    outer = (_BUDGET.deadline, _BUDGET.maps, _BUDGET.costliest, _BUDGET.started, _BUDGET.size)
+    now = work_limit.done()
+    size = float(ROOT_BUDGET_EVALUATIONS if evaluations is None else evaluations)
+    if not math.isfinite(outer[0]) or fresh:  # the outermost budget counts the maps inside
+        _BUDGET.maps, _BUDGET.costliest, _BUDGET.started, _BUDGET.size = 0, 0, now, size
+    own = now + size
+    _BUDGET.deadline = own if fresh else min(outer[0], own)
     try:
         yield
     finally:
-        _BUDGET.deadline = outer
+        if fresh:
+            (_BUDGET.deadline, _BUDGET.maps, _BUDGET.costliest, _BUDGET.started,
+             _BUDGET.size) = outer
+        else:
+            _BUDGET.deadline = outer[0]
 
 
 def slow_step_reason(walker: HybridWalker) -> str:
@@ -100,48 +124,74 @@ def slow_step_reason(walker: HybridWalker) -> str:
     return "the step's rates grow so large that the integrator crawls"
 
 
-def gave_up(walker: HybridWalker | None, where: str = "") -> SearchGaveUp:
+def _count(n: float) -> str:
+    """``n`` evaluations, digits grouped (1234567 -> '1,234,567')."""
+    return f"{n:,.0f}"
+
+
+def gave_up(walker: HybridWalker | None, where: str = "",
+            costliest: float | None = None) -> SearchGaveUp:
     """The :class:`SearchGaveUp` of a search whose budget is spent (``where``: how the map
-    under way was stopped, if one was)."""
-    where = where or f"the slowest map {_BUDGET.slowest:.1f} s"
+    under way was stopped, if one was; ``costliest``: the evaluations of the costliest map,
+    the one under way included)."""
+    worst = float(_BUDGET.costliest if costliest is None else max(costliest, _BUDGET.costliest))
+    where = where or f"the costliest map {_count(worst)}"
+    if worst >= CRAWL_SHARE * _BUDGET.size:
+        why = f"{slow_step_reason(walker)}; start nearer the gait"
+    else:  # many maps of ordinary cost: the root finder went on without converging
+        why = ("the root finder did not converge from the starts tried (no single map "
+               "crawled); start nearer the gait or check that the walker has one")
     return SearchGaveUp(
-        f"the search gave up after {_BUDGET.maps} step map(s), its "
-        f"{_BUDGET.deadline - _BUDGET.started:.0f} s CPU budget spent ({where}): "
-        f"{slow_step_reason(walker)}; start nearer the gait")
+        f"the search gave up after {_BUDGET.maps} step map(s), its budget of "
+        f"{_count(_BUDGET.size)} right-hand-side evaluations spent ({where}): {why}")
 
 
-def map_started(walker: HybridWalker | None = None) -> float:
-    """Count a step map starting now; its start on this thread's CPU clock [s].
+def map_started(walker: HybridWalker | None = None) -> int:
+    """Count a step map starting now; its start on this thread's work count
+    (:func:`walkerlab.integrate.work_limit.done`).
 
     Raises
     ------
     SearchGaveUp
         The search's budget is spent: no map starts.
     """
-    t = _clock()
-    if t > _BUDGET.deadline:
+    n = work_limit.done()
+    if n >= _BUDGET.deadline:  # spent (a budget of 0 starts no map)
         raise gave_up(walker)
     _BUDGET.maps += 1
-    return t
+    return n
 
 
-def map_ended(walker: HybridWalker, t: float) -> None:
-    """Record a step map started at ``t`` (:func:`map_started`) as ended; the first map
-    slower than :data:`SLOW_MAP_S` is said in a notice."""
-    dt = _clock() - t
-    if dt > SLOW_MAP_S and _BUDGET.slowest <= SLOW_MAP_S and math.isfinite(_BUDGET.deadline):
-        progress.note(f"gait search: one step map took {dt:.0f} s ({slow_step_reason(walker)});"
-                      f" the search gives up once it has spent "
-                      f"{_BUDGET.deadline - _BUDGET.started:.0f} s of CPU time (a step under "
-                      "way included: on a busy machine the wall time is longer)")
-    _BUDGET.slowest = max(_BUDGET.slowest, dt)
+def map_ended(walker: HybridWalker, n: int, x_end=None) -> None:
+    """Record a step map started at count ``n`` (:func:`map_started`) as ended (``x_end``:
+    its end state, if it has one); the first map of more than :data:`SLOW_MAP_EVALUATIONS`
+    is said in a notice, with the rates it reached."""
+    cost = work_limit.done() - n
+    if (cost > SLOW_MAP_EVALUATIONS and _BUDGET.costliest <= SLOW_MAP_EVALUATIONS
+            and math.isfinite(_BUDGET.deadline)):
+        progress.note(f"gait search: one step map took {_count(cost)} right-hand-side "
+                      f"evaluations{_rates(x_end)} ({slow_step_reason(walker)}); the search "
+                      f"gives up once it has spent {_count(_BUDGET.size)}")
+    _BUDGET.costliest = max(_BUDGET.costliest, cost)
 
 
-def clock() -> float:
-    """This thread's CPU time [s]: the budget's clock."""
-    return _clock()
+def _rates(x) -> str:
+    """', its rates reaching R rad/s' for a finite state ``x`` [rad, rad/s] (its second
+    half), else ''."""
+    if x is None:
+        return ""
+    x = np.asarray(x, float).ravel()
+    rates = x[x.size // 2:]
+    if not rates.size or not np.all(np.isfinite(rates)):
+        return ""
+    return f", its rates reaching {float(np.max(np.abs(rates))):.2g} rad/s"
+
+
+def evaluations() -> int:
+    """This thread's right-hand-side evaluations counted so far (the budget's measure)."""
+    return work_limit.done()
 
 
 def deadline() -> float:
-    """The CPU time [s] (:func:`clock`) after which no step map starts (inf: no budget)."""
+    """The count (:func:`evaluations`) after which no step map starts (inf: no budget)."""
     return _BUDGET.deadline

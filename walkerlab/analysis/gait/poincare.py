@@ -25,7 +25,7 @@ from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
-from walkerlab.integrate.time_limit import IntegrationDeadline, integration_deadline
+from walkerlab.integrate.work_limit import WorkBoundReached, work_bound
 from walkerlab.models.hybrid.base import HybridWalker, OffSection
 from walkerlab.numerics import sort_multipliers
 
@@ -52,12 +52,14 @@ class FixedPointNotFound(RuntimeError):
     """The root finder stopped without a fixed point; ``residual`` is the best reached."""
 
     def __init__(self, message: str, residual: float):
-        super().__init__(f"no fixed point found: {message} (residual {residual:.3g})")
+        # a residual never reached (NaN: no map ended) is not said
+        super().__init__(f"no fixed point found: {message}" + (
+            f" (residual {residual:.3g})" if math.isfinite(residual) else ""))
         self.residual = residual
 
 
 class FixedPointGaveUp(FixedPointNotFound):
-    """:func:`find_fixed_point` spent its (or its search's) time budget."""
+    """:func:`find_fixed_point` spent its (or its search's) work budget."""
 
 
 class MultipliersDisagree(RuntimeError):
@@ -120,24 +122,28 @@ def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
     StepFailed
         A step ended in a fall, a solver failure or ran past ``max_step_time``.
     SearchGaveUp
-        Inside a :func:`search_budget` whose time is spent: no map is started, and a map
-        under way is stopped (its integration checks the clock).
+        Inside a :func:`search_budget` whose work is spent: no map is started, and a map
+        under way is stopped (its integration counts its right-hand-side evaluations).
     """
-    t = budget.map_started(walker)
-    try:  # a step under way is stopped at the budget's end too (nothing checked outside one)
-        with integration_deadline(budget.deadline()):
+    n0 = budget.map_started(walker)
+    try:  # a step under way is stopped at the budget's end too (nothing counted outside one)
+        with work_bound(budget.deadline()):
             out = _step_map(walker, x, solver, max_step_time, jacobian, steps)
-    except IntegrationDeadline as exc:
-        where = f"the last one stopped after {budget.clock() - t:.1f} s"
+    except WorkBoundReached as exc:
+        where = f"the last one stopped after {budget.evaluations() - n0:,} evaluations"
         if exc.x is not None:
             n = np.size(x) // 2
-            where += (f" at t = {exc.t:.3g} s, rates "
-                      f"{float(np.max(np.abs(np.asarray(exc.x)[n:2 * n]))):.2g} rad/s")
-        raise budget.gave_up(walker, where) from None
+            rates = np.asarray(exc.x, float)[n:2 * n]
+            where += f" at t = {exc.t:.3g} s"
+            if rates.size and np.all(np.isfinite(rates)):
+                where += f", rates {float(np.max(np.abs(rates))):.2g} rad/s"
+            elif rates.size:
+                where += ", its state no longer finite"
+        raise budget.gave_up(walker, where, budget.evaluations() - n0) from None
     except BaseException:
-        budget.map_ended(walker, t)
+        budget.map_ended(walker, n0)
         raise
-    budget.map_ended(walker, t)
+    budget.map_ended(walker, n0, out[0])
     return out
 
 
@@ -266,7 +272,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
                      fd_check: bool = True,
                      jacobian_guess: np.ndarray | None = None,
                      deflate: tuple | list = (),
-                     budget_s: float | None = None) -> FixedPointResult:
+                     budget_evaluations: float | None = None) -> FixedPointResult:
     """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
 
     The root finder is MINPACK (``scipy.optimize.root``, method ``hybr``) on the map reduced
@@ -296,11 +302,12 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         J. Sci. Comput. 37(4)), whose roots are the roots of ``F`` other than the ``z_k``:
         from a start near a known gait it converges to another one.  Not with
         ``jacobian_guess``.
-    budget_s : float, optional
-        Longest CPU time of the search in this thread [s] (default
-        :data:`~walkerlab.analysis.gait.budget.ROOT_BUDGET_S`;
-        an enclosing :func:`search_budget` keeps its earlier deadline), checked before each
-        step map and inside it: once spent, the search gives up and says why.
+    budget_evaluations : float, optional
+        Most right-hand-side evaluations of the search's integrations [-] (default
+        :data:`~walkerlab.analysis.gait.budget.ROOT_BUDGET_EVALUATIONS`; an enclosing
+        :func:`search_budget` keeps its earlier end), counted before each step map and
+        inside it: once spent, the search gives up and says why.  Work, not time: the same
+        search ends the same way on any machine.
 
     Returns
     -------
@@ -325,7 +332,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     on_orbit = gaits_on_zero_dynamics(walker)
     t0 = time.perf_counter()
     F, sol = _root_on_section(walker, guess, solver, max_step_time, xtol, jacobian_guess,
-                              deflate, budget_s, on_orbit)
+                              deflate, budget_evaluations, on_orbit)
     x, xn, period, DP, segs = F.variational_at(F.full(sol.x), sol.message)
     res = float(np.max(np.abs(xn - x)))
     _check_walking(walker, x, sol, res, xtol)
@@ -351,10 +358,10 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
 
 
 def _root_on_section(walker: HybridWalker, guess, solver: Solver, max_step_time: float,
-                     xtol: float, jacobian_guess, deflate, budget_s: float | None,
+                     xtol: float, jacobian_guess, deflate, budget_evaluations: float | None,
                      on_orbit: bool):
     """:func:`find_fixed_point`'s root finder: MINPACK hybr on the reduced map (deflated by
-    ``deflate``; hybrj from ``jacobian_guess``) within the time budget ``budget_s`` [s];
+    ``deflate``; hybrj from ``jacobian_guess``) within the work budget ``budget_evaluations``;
     returns the reduced map (its counters and the variational map) and scipy's result.
 
     Raises
@@ -376,7 +383,7 @@ def _root_on_section(walker: HybridWalker, guess, solver: Solver, max_step_time:
     z0 = walker.section(np.asarray(guess, float))
     F.hold(z0)
     try:
-        with search_budget(budget_s):
+        with search_budget(budget_evaluations):
             if on_orbit and F.fails_at(z0):  # its gait is an orbit of the zero dynamics:
                 raise FixedPointNotFound(  # a start that does not step is not near it
                     f"the closed loop does not step from the start: {F.failure}", math.nan)

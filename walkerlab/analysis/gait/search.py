@@ -265,7 +265,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
                                max_step_time, fd_check, time_unit, seeds, ground_check,
                                partner_off_ground, partner_if_needed, fallbacks)
     except (SearchGaveUp, FixedPointGaveUp) as exc:
-        why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
+        why = str(exc).removeprefix("no fixed point found: ")
         raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
 
 
