@@ -108,20 +108,27 @@ class OptimizeSettings(Strict):
     target_speeds_m_per_s: list[Annotated[float, Field(gt=0, le=20)]] | None = Field(
         None, min_length=1, max_length=8, description="design: virtual_constraints: one "
         "controller per speed (step length / step period) [m/s]")
+    max_iterations: int | None = Field(
+        None, ge=1, le=100_000, description="design: virtual_constraints: IPOPT's "
+        "iterations per controller at most (default 1000; status "
+        "Maximum_Iterations_Exceeded): a bound on work, the same on any machine")
     cpu_budget_s: float | None = Field(
-        None, gt=0, le=86400, description="design: virtual_constraints: the CPU time of "
-        "each controller [s]: IPOPT stops at it (status Maximum_CpuTime_Exceeded) and the "
-        "closed loop's gait search has the gait search's work budget (default 60)")
+        None, gt=0, le=86400, description="design: virtual_constraints: a CPU-time limit "
+        "per controller a user may ask for [s] (default none: IPOPT is bounded by "
+        "optimize.max_iterations); a design it stops (Maximum_CpuTime_Exceeded) depends on "
+        "the machine: it is said so and never reused, a rerun designs again")
 
     @model_serializer(mode="wrap")
     def _as_given(self, handler):
         return drop_unset(handler(self), ("design", "max_multiplier",
-                                          "target_speeds_m_per_s", "cpu_budget_s"))
+                                          "target_speeds_m_per_s", "max_iterations",
+                                          "cpu_budget_s"))
 
     @model_validator(mode="after")
     def _design(self) -> OptimizeSettings:
         if self.design is None:
-            for k in ("max_multiplier", "target_speeds_m_per_s", "cpu_budget_s"):
+            for k in ("max_multiplier", "target_speeds_m_per_s", "max_iterations",
+                      "cpu_budget_s"):
                 if getattr(self, k) is not None:
                     raise ValueError(f"optimize.{k}: give it with design: "
                                      "virtual_constraints (and only then)")

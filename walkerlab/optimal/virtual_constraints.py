@@ -34,7 +34,7 @@ from walkerlab.optimal.transcription.virtual_constraints import (
 )
 from walkerlab.walker.plant import Plant
 
-__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_BUDGET_S",
+__all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_ITERATIONS",
            "REPLAY_STRIDES", "ControllerDesign", "check_design", "clearance_report",
            "contact_scene", "controller_scene", "controller_scene_text", "controller_step",
            "design_controllers", "design_failures", "design_spec", "designs_controller",
@@ -285,10 +285,10 @@ def controller_step(walker, solver, points: int):
     return t, x, u, ctrl.design.alpha.copy(), zd
 
 
-#: the CPU time of each designed controller when ``optimize.cpu_budget_s`` is not given [s]
-#: (IPOPT's ``max_cpu_time``: a bound, not a measure; configs/rabbit_hzd_optimal.yaml, whose
-#: 0.8 m/s controller takes 435 IPOPT iterations, gives its own)
-DESIGN_BUDGET_S = 60.0
+#: IPOPT's iterations of each designed controller when ``optimize.max_iterations`` is not
+#: given (``max_iter``: a bound on work, the same on any machine; RABBIT's 0.8 m/s
+#: controller, configs/rabbit_hzd_optimal.yaml, takes 435)
+DESIGN_ITERATIONS = 1000
 
 
 def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesign:
@@ -399,7 +399,8 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     -------
     list of ControllerDesign
         One per speed, converged or not (IPOPT's status; each controller's IPOPT solve
-        stops at ``optimize.cpu_budget_s``, default :data:`DESIGN_BUDGET_S`, of CPU time;
+        stops after ``optimize.max_iterations``, default :data:`DESIGN_ITERATIONS`,
+        iterations, or at ``optimize.cpu_budget_s`` of CPU time where a user asked for one;
         its closed loop's gait search has the gait search's work budget).
 
     Raises
@@ -425,14 +426,15 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     window = None
     if not fns.clearance_guard and spec.min_clearance_m is not None:
         window = mid_stance_window(spec.min_clearance_m, _leg_length_m(scene))
-    budget = float(o.cpu_budget_s or DESIGN_BUDGET_S)
+    budget = None if o.cpu_budget_s is None else float(o.cpu_budget_s)
+    iterations = int(o.max_iterations or DESIGN_ITERATIONS)
     out = []
     with progress.task(f"optimize: {len(speeds)} controller(s)", len(speeds)) as bar:
         for i, v in enumerate(speeds):
             res = collocate_virtual_constraints(
                 fns, replace(spec, target_speed_m_per_s=v), t, x, u, alpha, o.max_multiplier,
                 (vc.feedback.kp_per_s2, vc.feedback.kd_per_s), print_level,
-                mid_stance_window_m=window, cpu_budget_s=budget)
+                mid_stance_window_m=window, cpu_budget_s=budget, max_iterations=iterations)
             res.build_time_s += build
             out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml",
                                  {**clearance_report(fns, res.x, window),

@@ -358,7 +358,8 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
                                   guess_alpha, max_multiplier: float | None,
                                   gains: tuple[float, float], print_level: int = 0,
                                   mid_stance_window_m: float | None = None,
-                                  cpu_budget_s: float | None = None) -> HzdDesign:
+                                  cpu_budget_s: float | None = None,
+                                  max_iterations: int = 1000) -> HzdDesign:
     """Optimise one step and its virtual constraints (module docstring).
 
     Parameters
@@ -385,7 +386,10 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
         ``W`` [m] of the mid-stance pass exempted from ``spec.min_clearance_m``
         (:func:`clearance_bound`; :func:`mid_stance_window`); None: no clearance bound.
     cpu_budget_s : float, optional
-        IPOPT's ``max_cpu_time`` [s] (it then ends with ``Maximum_CpuTime_Exceeded``).
+        IPOPT's ``max_cpu_time`` [s] (it then ends with ``Maximum_CpuTime_Exceeded``): a
+        limit a user asked for; None (default): none, the solve is bounded by its work.
+    max_iterations : int
+        IPOPT's ``max_iter`` (it then ends with ``Maximum_Iterations_Exceeded``).
 
     Returns
     -------
@@ -483,7 +487,7 @@ def collocate_virtual_constraints(fns: HzdFunctions, spec, guess_t, guess_x, gue
     opti.set_initial(A, guess_alpha)
     opti.solver("ipopt", {"expand": True, "print_time": False},
                 {"print_level": print_level, "tol": 1e-10, "constr_viol_tol": 1e-11,
-                 "max_iter": 1000, "sb": "yes",
+                 "max_iter": int(max_iterations), "sb": "yes",
                  **({} if cpu_budget_s is None else {"max_cpu_time": float(cpu_budget_s)})})
     build = time.perf_counter() - t_build
     status, get, wall, cpu = solve(opti)
