@@ -269,8 +269,9 @@ def test_the_design_says_its_collocated_and_its_closed_loop_speed(designed):
 
 @pytest.mark.slow
 def test_an_impossible_design_is_recorded_as_failed_not_blamed_on_the_scene(tmp_path):
-    """delta^2 <= 0.01 at 5 m/s with 1 N m and mu 0.01 cannot hold: IPOPT stops (here at a
-    5 s CPU budget: optimize.cpu_budget_s) and optimize.h5 records it; its last iterate's
+    """delta^2 <= 0.01 at 5 m/s with 1 N m and mu 0.01 cannot hold: IPOPT stops (here after
+    60 iterations, optimize.max_iterations: the same on any machine) and optimize.h5
+    records it; its last iterate's
     coefficients make no controller, which is said as the design's failure (not as an
     error naming the scene's outputs); the written scene's first line says it failed;
     the reason names the optimize fields to relax."""
@@ -280,7 +281,7 @@ def test_an_impossible_design_is_recorded_as_failed_not_blamed_on_the_scene(tmp_
 
     sc = scene_from_dict(_scene(THREELINK, {
         "design": "virtual_constraints", "max_multiplier": 0.01, "target_speed_m_per_s": 5.0,
-        "max_torque_n_m": 1.0, "friction_coefficient": 0.01, "cpu_budget_s": 5.0}, "imp"))
+        "max_torque_n_m": 1.0, "friction_coefficient": 0.01, "max_iterations": 60}, "imp"))
     out = pipeline.run("optimize", sc, tmp_path, False)
     d = load(out.path)
     c = d.controllers[0]
@@ -577,3 +578,25 @@ def test_a_failed_designs_scene_says_it_failed_in_its_first_line():
     assert first.startswith("# FAILED: IPOPT Restoration_Failed, not a designed controller")
     assert "the friction cone 0.3" in text.splitlines()[1]
     assert yaml.safe_load(text)["source"].startswith("FAILED: IPOPT Restoration_Failed")
+
+
+@pytest.mark.parametrize("change, says", [
+    ({"max_iterations": 0}, "optimize.max_iterations"),
+    ({"max_iterations": 2.5}, "optimize.max_iterations"),
+])
+def test_a_design_is_bounded_by_iterations_given_as_a_whole_number(change, says):
+    """IPOPT's bound is its iterations (work, the same on any machine): a positive whole
+    number, refused in one line otherwise; given, it reaches IPOPT's ``max_iter``."""
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(_scene(THREELINK, {**DESIGN, **change}))
+    assert says in one_line(e)
+    sc = scene_from_dict(_scene(THREELINK, {**DESIGN, "max_iterations": 7}))
+    assert sc.optimize.max_iterations == 7 and sc.optimize.cpu_budget_s is None
+
+
+def test_iterations_without_design_refused():
+    opt = {**{k: v for k, v in DESIGN.items() if k not in ("design", "max_multiplier")},
+           "max_iterations": 10}
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(_scene(THREELINK, opt))
+    assert "optimize.max_iterations" in one_line(e)
