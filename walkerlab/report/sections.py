@@ -19,6 +19,7 @@ from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.stage_files import CONTACT_SIM, SIMULATE
 from walkerlab.report.ground_text import ground_contact_text, twist_text
 from walkerlab.report.markdown import num, printed, sig_digits, table
+from walkerlab.report.run_text import periodic_not_found
 from walkerlab.report.text import (
     neutral_multipliers_text,
     zero_dynamics_text,
@@ -95,7 +96,8 @@ def _contact_verdict(c) -> str:
         extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
                                                   else "unstable"))
     elif c.periodic is not None:
-        extra = f"; its own periodic gait was not found ({c.periodic.outcome})"
+        extra = ("; its own periodic gait was not found "
+                 f"({periodic_not_found(c.periodic.outcome)})")
     why = f": {c.walks_reason}" if not walks and c.walks_reason else ""
     return (f"- **Contact walker walks**: {'yes' if walks else 'no'} "
             f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}"
@@ -289,13 +291,18 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                        if s in arts)
            + ").", "", table(header, rows)]
     if "ours, contact" in cols:
-        out += ["", "*ours, contact* averages every complete step of the contact run, which "
-                "starts from the rigid gait, so its start-up steps are included"
-                + ("; *ours, contact periodic gait* is the contact model's own periodic gait "
+        per = getattr(arts.get(CONTACT_SIM.name), "periodic", None)
+        if "ours, contact periodic gait" in cols:
+            own = ("; *ours, contact periodic gait* is the contact model's own periodic gait "
                    "(the fixed point of its step-to-step map: no start-up, energies not "
-                   "defined)." if "ours, contact periodic gait" in cols else
-                   " (the scene computes no contact periodic gait: contact_sim.periodic_gait)."
-                   )]
+                   "defined).")
+        elif per is not None:  # searched, not found: say why, as the summary does
+            own = (" (the contact model's own periodic gait was not found: "
+                   f"{periodic_not_found(per.outcome)}).")
+        else:
+            own = " (the scene computes no contact periodic gait: contact_sim.periodic_gait)."
+        out += ["", "*ours, contact* averages every complete step of the contact run, which "
+                "starts from the rigid gait, so its start-up steps are included" + own]
     ideal = cols.get("ours, ideal")
     eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:
