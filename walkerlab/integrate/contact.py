@@ -436,7 +436,7 @@ def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: fl
     last = Xn[bad - 1] if bad else xa
     trip = side_entry(walker, last, 2.0 / rate)
     msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
-           f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
+           f"t = {tn[bad]:.6g} s ({energy_source_words(walker)}): the run ends "
            "at the last trustworthy sample")
     term = RunEnd.SOLVER_FAILURE
     if trip is not None:  # the cause: a foot in a gap entered a patch's side
@@ -447,6 +447,17 @@ def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: fl
         msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
                f"entered a patch from its side; {msg}")
     return event, term, msg
+
+
+def energy_source_words(walker) -> str:
+    """Why the energy guard's rise is not physics, from what the walker has: a passive
+    walker cannot gain energy; one whose joints carry a law that does work (a hip-roll law,
+    ``kernels.STANCE_LAW``) gains some from it, but not this much (the guard's bound allows
+    for it: :func:`walkerlab.models.contact.energy.energy_rise_bound`)."""
+    if getattr(getattr(walker, "kernels", None), "STANCE_LAW", False):
+        return ("more than this walker's joint law can put in: a blow-up, not the law's "
+                "work")
+    return "a passive contact walker cannot gain energy"
 
 
 def _cut_at_event(walker, t_all: np.ndarray, X_all: np.ndarray, event: tuple, term: RunEnd):
