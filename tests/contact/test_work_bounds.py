@@ -129,3 +129,17 @@ def test_a_wall_limited_run_is_stored_but_never_reused(tmp_path):
         assert "not_final" not in f.attrs
     r4 = CliRunner().invoke(app, ["contact-sim", str(p), "--runs-dir", str(runs)])
     assert "(inputs unchanged)" in r4.stdout + r4.stderr
+
+
+@pytest.mark.slow  # two rigid gait searches and a kernel compile: ~100 s on a loaded machine
+def test_a_stability_map_cell_without_work_left_says_work_limit_twice_alike():
+    """A map cell whose searches may make 3 step-map integrations each (the default 2,000):
+    its reason is work_limit, the same in a second computation; no clock decides it."""
+    from walkerlab.studies.stability import REASONS, MapSpec, gait_row
+
+    base = load_scene(ROOT / "configs" / "paper.yaml").model_dump(mode="json")
+    spec = MapSpec("friction", (0.9,), (3.0,), max_step_maps=3)
+    rows = [gait_row(base, spec, 0) for _ in range(2)]
+    assert [c["reason"] for c in rows[0]] == [c["reason"] for c in rows[1]] == ["work_limit"]
+    assert "work_limit" in REASONS
+    assert MapSpec("friction", (0.9,), (3.0,)).key() != spec.key()
