@@ -274,7 +274,7 @@ class ActuationHook:
         ``limits.max_rhs_evaluations``, is asked before each segment)."""
         most = getattr(self.limits, "max_rhs_evaluations", None)
         if most is not None and self.nfev >= most:
-            from .contact_events import work_limit_message
+            from .contact_events import work_limit_message  # light (as trip_or_failure below)
 
             self.term, self.msg = RunEnd.WORK_LIMIT, work_limit_message(self.limits)
             return None
