@@ -30,7 +30,6 @@ from walkerlab.io.artifacts import (
 from walkerlab.io.runpaths import artifact_lock, claimed, stage_artifact
 from walkerlab.safefs import NotARegularFile, read_regular, refuse_link
 
-
 #: Root attribute of an artifact whose result depends on the machine it ran on (a run that a
 #: user's wall-clock limit cut short: ``time_limit``), its value one line saying what was
 #: cut: such an artifact is written and read like any other but never reused as up to date,
@@ -177,8 +176,8 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
     -------
     CachedArtifact
         Reused (``wall_time_s`` 0, empty summary) or written (an artifact whose writer set
-        :data:`NOT_FINAL_ATTR`, a run a wall-clock limit cut short, is never reused); an existing artifact that is
-        recomputed is never replaced silently: one line through ``tell`` says which and
+        :data:`NOT_FINAL_ATTR`, a run a wall-clock limit cut short, is never reused); an
+        existing artifact that is recomputed is never replaced silently: one line through ``tell`` says which and
         why (the scene fields that changed, ``--force``, ...), also kept in ``note``.
 
     Raises

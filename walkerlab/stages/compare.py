@@ -16,9 +16,9 @@ from walkerlab.comparison.errors import (
 )
 from walkerlab.comparison.tables import gait_metrics
 from walkerlab.config import Scene
+from walkerlab.io.freshness import NOT_FINAL_ATTR, not_final
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import METRIC_UNITS, Comparison, write_compare
-from walkerlab.io.freshness import NOT_FINAL_ATTR, not_final
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.stage_files import CONTACT_SIM

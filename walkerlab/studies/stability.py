@@ -13,8 +13,9 @@ patch), ``stable`` (all ``|multipliers|`` < 1), ``max_abs_multiplier``, ``step_p
 ``patch_margin_m``, ``source`` ("neighbour" / "ideal"), ``reason`` ("" when the gait
 exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``work_limit`` (the cell's
 search spent its step-map integrations, :attr:`MapSpec.max_step_maps`: the same on any
-machine), ``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``, ``unsupported``:
-the periodic-gait search has no section for this walker), ``wall_time_s`` (a record only: no cell's answer depends on the clock).
+machine), ``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``,
+``unsupported``: the periodic-gait search has no section for this walker), ``wall_time_s``
+(a record only: no cell's answer depends on the clock).
 
 The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
 :func:`walkerlab.plotting.gait_map_figure.gait_map_figure`.
@@ -32,7 +33,8 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.walker.plant import Plant
 
 __all__ = ["MAP_KINDS", "MAP_MAX_STEP_MAPS", "CELL_FIELDS", "REASONS", "MapSpec",
-           "default_spec", "gait_row", "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS", "stability_map_run"]
+           "default_spec", "gait_row", "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS",
+           "stability_map_run"]
 
 #: map kind -> (dotted scene path of the y axis, label); the stiffness map varies the field
 #: the scene writes its stiffness in (:attr:`MapSpec.y_field`; this one by default)
