@@ -5,7 +5,8 @@ The rigid side's segment terminations (:mod:`walkerlab.integrate.rigid`: a step 
 contact model can do (trip, scuff, slip, fly away) and with the verdicts a whole run needs
 (no heel strike at all, the wall-time limit, the work bound).  Every producer and reader
 uses these names: the contact integration (:mod:`walkerlab.integrate.contact`:
-``termination``), the contact gait analysis (:class:`walkerlab.analysis.contact.verdict.Outcome`: ``kind``), the stages'
+``termination``), the contact gait analysis
+(:class:`walkerlab.analysis.contact.verdict.Outcome`: ``kind``), the stages'
 artifacts (attribute ``termination`` / ``outcome``), the report, the CLI's exit code and the
 sweeps (:mod:`walkerlab.studies.outcomes`, which add their own verdicts such as
 ``no_fixed_point``).

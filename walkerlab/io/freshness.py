@@ -178,7 +178,8 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
         Reused (``wall_time_s`` 0, empty summary) or written (an artifact whose writer set
         :data:`NOT_FINAL_ATTR`, a run a wall-clock limit cut short, is never reused); an
         existing artifact that is recomputed is never replaced silently: one line through
-        ``tell`` says which and why (the scene fields that changed, ``--force``, ...), also kept in ``note``.
+        ``tell`` says which and why (the scene fields that changed, ``--force``, ...), also
+        kept in ``note``.
 
     Raises
     ------

@@ -544,7 +544,8 @@ def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None 
     (:func:`walkerlab.analysis.contact.periodic.find_contact_periodic_gait`, within
     ``contact_sim.periodic_max_step_maps``, :func:`search_bounds`); the run starts at its
     mid-stance section (leg2 stance, stance foot at s = 0) on patches spaced by the gait's
-    step length, so every footfall lands where the gait's does, and runs ``(2 strides + 1)`` gait periods.
+    step length, so every footfall lands where the gait's does, and runs
+    ``(2 strides + 1)`` gait periods.
 
     ``x_ideal`` (2n,): the rigid walker's post-impact fixed point (its ``state_names()``,
     [rad, rad/s]); the returned ``x0`` is the contact walker's full state (2 nq,)
