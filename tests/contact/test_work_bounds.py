@@ -60,10 +60,12 @@ def test_default_work_bound_leaves_a_walk_unchanged():
 
 
 def test_scene_defaults_have_no_wall_clock_limit_and_keep_their_serialisation():
-    """No wall-clock limit by default; the work bounds at their defaults are left out of the
-    scene's serialisation (its content hash), a bound set is kept."""
+    """No wall-clock limit by default (nor numbalsoda, whose chunks are sized in wall time,
+    as the default method); the work bounds at their defaults are left out of the scene's
+    serialisation (its content hash), a bound set is kept."""
     cs = ContactSimSettings()
     assert cs.wall_time_limit_s is None and cs.periodic_time_limit_s is None
+    assert SolverSettings.for_contact().method != "numbalsoda"
     d = cs.model_dump()
     assert not {"max_rhs_evaluations", "periodic_max_step_maps",
                 "adjust_max_contact_runs"} & set(d)

@@ -298,7 +298,8 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
         return Outcome("time_limit", te, "", np.nan, hip_height_m,
                        f"time limit: {wall_time_limit_s:g} s of wall time used by t = "
                        f"{te:.4g} s ({n_hs} heel strikes); cut short by the machine's speed "
-                       "(contact_sim.wall_time_limit_s), not stored as the scene's result")
+                       "(contact_sim.wall_time_limit_s): never kept as the scene's result, "
+                       "the next run recomputes it")
     if termination == "work_limit":
         return Outcome("work_limit", te, "", np.nan, hip_height_m,
                        f"work limit: {limits.max_rhs_evaluations:,} right-hand-side "
