@@ -299,7 +299,7 @@ class _Backend:
         return sol.t[1:], sol.y.T[1:], sol.status == 0, sol.message, sol.nfev, sol.njev
 
 
-def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
+def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None, spent=0):
     """Integrate the free walker until t1, an event, the deadline or ``stop``: the one
     contact integrator loop, passive or powered.
 
@@ -307,7 +307,9 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
     (:class:`walkerlab.integrate.contact_powered.ActuationHook`): it integrates each chunk
     (its discrete state, events and transitions), the loop asks ``stop`` after each of its
     heel strikes; None: the passive walker on the solver's backend, ``stop`` asked after each
-    chunk, the energy guard and the events checked on each chunk's samples.
+    chunk, the energy guard and the events checked on each chunk's samples.  ``spent``:
+    right-hand-side evaluations the run made before (its pinned phase), charged to the work
+    bound.
 
     Returns (t, X, nfev, njev, termination, message, event, work), ``work`` None for a
     passive run (:class:`ContactIntegration`)."""
@@ -330,7 +332,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
         tb = min(ta + span, t1)
         tg = sample_grid(ta, tb, rate)
         w0 = time.perf_counter()
-        be.bound(_work_left(limits, nfev))
+        be.bound(_work_left(limits, spent + nfev))
         try:
             tn, Xn, ok, m, nf, nj = be.chunk(xa, tg)
         except _TimeLimit:
@@ -368,7 +370,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
                                                len(t_all) - 1, 2.0 / rate)
             guarded = True  # the last sample is the run's end (no event state to interpolate)
             break
-        if _work_left(limits, nfev) == 0 and t_all[-1] < t1 - 1e-12:
+        if _work_left(limits, spent + nfev) == 0 and t_all[-1] < t1 - 1e-12:
             term, msg = RunEnd.WORK_LIMIT, work_limit_message(limits)
             break
         if time.perf_counter() > deadline and t_all[-1] < t1 - 1e-12:
@@ -576,7 +578,8 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
             hook = ActuationHook(walker, solver, limits, deadline,
                                  sample_grid(t_pin, t_final, limits.sample_rate_hz))
         tf, Xf, nf, nj, term, msg, event, work = _run_free(walker, x0, t_pin, t_final, solver,
-                                                           limits, deadline, stop, hook)
+                                                           limits, deadline, stop, hook,
+                                                           spent=nfev)
         if ts:
             tf, Xf = tf[1:], Xf[1:]
         ts.append(tf)
