@@ -107,6 +107,8 @@ def _scene(tmp_path, **sim) -> Path:
     return p
 
 
+@pytest.mark.slow  # four contact-sim commands (~16 s); tests/test_not_final_artifacts.py
+# checks the cache's rule quickly
 def test_a_wall_limited_run_is_stored_but_never_reused(tmp_path):
     """A run a wall-clock limit ends (a limit already spent: time_limit at its first
     sample) is written, marked not_final, and the next run recomputes it instead of saying
