@@ -24,14 +24,14 @@ from walkerlab.config.studies import StateOffset
 MAX_CONTACT_STRIDES = 100
 
 #: Default work bound of one contact run (contact_sim.max_rhs_evaluations): right-hand-side
-#: evaluations.  The paper's 5 strides take ~28,000 (a 100-stride run well under a million):
-#: the bound ends only a run that grinds (a contact chattering), about a minute of a compiled
-#: right-hand side's work.
+#: evaluations.  The paper's 5 strides take ~28,000 (about 4 us each on the compiled CyRK
+#: right-hand side): the bound ends only a run that grinds (a contact chattering), about a
+#: minute of a compiled right-hand side's work.
 MAX_RHS_EVALUATIONS = 20_000_000
 
 #: Default work bound of the periodic-gait search (contact_sim.periodic_max_step_maps):
 #: step-map integrations (the warm-up, the root solves' and the Floquet Jacobians'
-#: evaluations; a shipped scene's search makes a few hundred).
+#: evaluations; the paper's search makes 60).
 PERIODIC_MAX_STEP_MAPS = 5_000
 
 
@@ -71,8 +71,8 @@ class ContactSimSettings(BaseModel):
         json_schema_extra={"unit": "s"})
     max_rhs_evaluations: int | None = Field(
         MAX_RHS_EVALUATIONS, ge=1, description="Work bound of one contact run: the most "
-        "right-hand-side evaluations it may make [-] (a shipped scene's run makes well under "
-        "a million); past it the run ends with outcome 'work_limit', the same on any "
+        "right-hand-side evaluations it may make [-] (the paper's 5 strides make about "
+        "28,000); past it the run ends with outcome 'work_limit', the same on any "
         "machine (null = none).")
     stop_after_strides: bool = Field(
         True, description="Strides cap: stop once 2 * n_strides + 1 heel strikes have "
@@ -86,8 +86,8 @@ class ContactSimSettings(BaseModel):
         json_schema_extra={"unit": "s"})
     periodic_max_step_maps: int | None = Field(
         PERIODIC_MAX_STEP_MAPS, ge=1, description="Work bound of the periodic-gait search: "
-        "the most step-map integrations it may make [-] (a shipped scene's search makes a "
-        "few hundred); past it the gait is reported as 'work_limit' (null = none).")
+        "the most step-map integrations it may make [-] (the paper's search makes 60); "
+        "past it the gait is reported as 'work_limit' (null = none).")
     adjust_max_contact_runs: int | None = Field(
         None, ge=1, description="Work bound of the `contact-sim --adjust` search: the most "
         "contact runs it may make [-] (null, the default: the search's own, 1 + 8^2 grid "
