@@ -9,7 +9,7 @@ floor height step and mid-stance push, and the largest tolerable single step-dow
 
 ``--contact``: the contact model's largest single step-down and step-up instead (patches at
 the step's height, from the contact model's periodic gait - or from the contact run's own
-start when none is found within contact_sim.periodic_time_limit_s - surviving 10 heel strikes;
+start when none is found within contact_sim.periodic_max_step_maps - surviving 10 heel strikes;
 bisection brackets to 1 mm, walks on 2 local worker processes).
 """
 

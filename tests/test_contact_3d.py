@@ -437,7 +437,9 @@ def test_a_start_offset_names_the_rigid_states_or_is_refused_in_one_line():
     off = StateOffset.model_validate({"lean_rate_rad_per_s": 0.05, "lean_angle_rad": -0.01})
     np.testing.assert_array_equal(off.as_array(names), [0, -0.01, 0, 0, 0.05, 0])
     with pytest.raises(ValueError, match="tilt_rate_rad_per_s: not a state of the walker "
-                                         r"\(its states: heading_angle_rad"):
+                                         r"\(its states: <role>_angle_rad and "
+                                         r"<role>_rate_rad_per_s of the roles heading, "
+                                         r"lean, stance\)$"):
         StateOffset.model_validate({"tilt_rate_rad_per_s": 1.0}).as_array(names)
     scene = load_scene("configs/rimless_wheel_3d.yaml")
     d = scene.model_dump(mode="json", exclude_none=True)

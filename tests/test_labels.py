@@ -476,7 +476,8 @@ def test_help_texts_show_their_units():
         assert r.exit_code == 0
         return " ".join(r.output.split())
     assert "slope grid in degrees" in helptext("bifurcation")
-    assert "wall-time limit per cell, in seconds" in helptext("stability-map")
+    assert "work bound of each search of a cell: its step-map integrations" in helptext(
+        "stability-map")
     sim = helptext("simulate")
     assert "simulate.initial_state" in sim and "a given state" not in sim
 

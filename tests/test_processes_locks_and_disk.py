@@ -103,7 +103,7 @@ def test_stability_map_workers_end_with_their_parent_and_free_the_lock(tmp_path)
         from walkerlab.stages import stability_map
         sc = load_scene({str(ROOT / 'configs' / 'paper.yaml')!r})
         stability_map.run(sc, {str(tmp_path)!r}, kind="friction", n=3, workers=2,
-                          time_limit_s=30)
+                          max_step_maps=300)
         """)
     main = subprocess.Popen([sys.executable, "-c", script], env=ENV)
     artifact = tmp_path / "paper" / "stability_map_friction.h5"

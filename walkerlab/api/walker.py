@@ -540,7 +540,7 @@ class ContactWalker:
         and its Floquet multipliers, as ``walkerlab contact-sim`` with
         ``contact_sim.periodic_gait: true`` finds it
         (:func:`walkerlab.analysis.contact.periodic.find_contact_periodic_gait`, from the
-        rigid state ``x0``, within ``contact_sim.periodic_time_limit_s``).
+        rigid state ``x0``, within ``contact_sim.periodic_max_step_maps``).
 
         Parameters
         ----------
@@ -571,6 +571,7 @@ class ContactWalker:
         from walkerlab.analysis.contact.periodic import (  # light
             converged_gait,
             find_contact_periodic_gait,
+            search_bounds,
         )
         from walkerlab.analysis.contact.sim import scene_start  # light
 
@@ -578,7 +579,7 @@ class ContactWalker:
         x = self.rigid_gait().x if x0 is None else self.rigid.check_state(x0, "x0")
         walker = scene_start(self.setup, x, self.setup.sim.n_strides)[0]  # the stage's ground
         return converged_gait(find_contact_periodic_gait(
-            walker, x, time_limit_s=self.setup.sim.periodic_time_limit_s))
+            walker, x, **search_bounds(self.setup.sim)))
 
     def _check_periodic(self) -> None:
         """Refuse a walker whose periodic gait the contact view does not find (the scene's

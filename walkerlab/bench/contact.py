@@ -158,10 +158,12 @@ class _Case:
 
     def run(self, method: str, rtol: float, atol: float, unlimited: bool = False):
         """One contact run (:func:`~walkerlab.analysis.contact.sim.simulate_contact`);
-        ``unlimited``: without the limits' wall-time limit (a reference must be complete)."""
+        ``unlimited``: without the limits' wall-time limit and work bound (a reference must
+        be complete)."""
         limits = self.limits
         if unlimited and limits is not None:
-            limits = dataclasses.replace(limits, wall_time_limit_s=None)
+            limits = dataclasses.replace(limits, wall_time_limit_s=None,
+                                         max_rhs_evaluations=None)
         return simulate_contact(self.walker, self.x0, self.t_final, SolverSettings.for_contact(
             method=method, rtol=rtol, atol=atol), limits)
 

@@ -118,8 +118,9 @@ def stability_map(scene: Path | None = SceneArg,
                   kind: str = typer.Option("all", "--kind", help="stiffness | friction | "
                                            "patch_width | all (each against the slope)"),
                   n: int = typer.Option(8, "--n", min=2, help="grid size n x n"),
-                  time_limit: float = typer.Option(60.0, "--time-limit", min=1.0,
-                                                   help="wall-time limit per cell, in seconds"),
+                  max_step_maps: int = typer.Option(
+                      2_000, "--max-step-maps", min=1, help="work bound of each search of a "
+                      "cell: its step-map integrations (the same answer on any machine)"),
                   workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
                   runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Stability maps of the contact gait: does a periodic gait exist, is it stable, max
@@ -137,7 +138,7 @@ def stability_map(scene: Path | None = SceneArg,
             typer.echo(f"{k}: skipped ({map_not_applicable(sc, k).split(': ', 1)[1]})")
             continue
         out = stage.run(sc, runs_dir, force, kind=k, n=n, workers=workers,
-                        time_limit_s=time_limit)
+                        max_step_maps=max_step_maps)
         s = out.summary
         typer.echo(f"{k}: " + (", ".join(f"{a}: {b:.3g}" if isinstance(b, float) else
                                          f"{a}: {b}" for a, b in s.items()) or "cached"))

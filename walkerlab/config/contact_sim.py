@@ -1,7 +1,8 @@
 """Validated run settings of a compliant-contact simulation: the scene's ``contact_sim``
-section (:class:`ContactSimSettings`: strides, time, start, sample rate, wall-time limits,
-the periodic-gait search), read through :mod:`walkerlab.config`.  The contact law itself is
-the ``contact`` section (:mod:`walkerlab.config.contact`, which re-exports these names).
+section (:class:`ContactSimSettings`: strides, time, start, sample rate, the work bounds of
+a run, of the periodic-gait search and of the adjust search, the optional wall-clock
+limits), read through :mod:`walkerlab.config`.  The contact law itself is the ``contact``
+section (:mod:`walkerlab.config.contact`, which re-exports these names).
 """
 
 from __future__ import annotations
@@ -21,6 +22,17 @@ from walkerlab.config.studies import StateOffset
 
 # Longest contact run (D8): 100 strides is ~20x the paper's 5 and keeps the artifact < 100 MB.
 MAX_CONTACT_STRIDES = 100
+
+#: Default work bound of one contact run (contact_sim.max_rhs_evaluations): right-hand-side
+#: evaluations.  The paper's 5 strides take ~28,000 (about 4 us each on the compiled CyRK
+#: right-hand side): the bound ends only a run that grinds (a contact chattering), about a
+#: minute of a compiled right-hand side's work.
+MAX_RHS_EVALUATIONS = 20_000_000
+
+#: Default work bound of the periodic-gait search (contact_sim.periodic_max_step_maps):
+#: step-map integrations (the warm-up, the root solves' and the Floquet Jacobians'
+#: evaluations; the paper's search makes 60).
+PERIODIC_MAX_STEP_MAPS = 5_000
 
 
 class ContactSimSettings(BaseModel):
@@ -52,23 +64,35 @@ class ContactSimSettings(BaseModel):
         (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
     )
     wall_time_limit_s: float | None = Field(
-        120.0, gt=0, description="Wall-time limit of one contact run [s]; when it runs out "
-        "the run ends with outcome 'time_limit' (null = none).",
+        None, gt=0, description="Wall-clock limit of one contact run [s] (null, the default: "
+        "none; the run is bounded by max_rhs_evaluations). A run it ends has outcome "
+        "'time_limit', depends on the machine's speed and is never kept as the scene's "
+        "result: the next run recomputes it.",
         json_schema_extra={"unit": "s"})
+    max_rhs_evaluations: int | None = Field(
+        MAX_RHS_EVALUATIONS, ge=1, description="Work bound of one contact run: the most "
+        "right-hand-side evaluations it may make [-] (the paper's 5 strides make about "
+        "28,000); past it the run ends with outcome 'work_limit', the same on any "
+        "machine (null = none).")
     stop_after_strides: bool = Field(
         True, description="Strides cap: stop once 2 * n_strides + 1 heel strikes have "
         "happened, even if t_final_s is longer (a passive run at the end of that integration "
         "chunk; a powered run, which asks after each heel strike on the samples before it, "
         "at the heel strike after: 2 * n_strides + 2, its last step complete).")
     periodic_time_limit_s: float | None = Field(
-        120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
-        "runs out the gait is reported as 'time_limit' (null = none).",
+        None, gt=0, description="Wall-clock limit of the periodic-gait search [s] (null, the "
+        "default: none; the search is bounded by periodic_max_step_maps). A search it ends "
+        "is reported as 'time_limit' and never kept as the scene's result.",
         json_schema_extra={"unit": "s"})
-    adjust_cpu_budget_s: float | None = Field(
-        300.0, gt=0, description="CPU-time budget of the `contact-sim --adjust` search [s], "
-        "checked between its contact runs (a run under way is finished); when it is spent "
-        "the search keeps the best start found so far and says so (null = none).",
-        json_schema_extra={"unit": "s"})
+    periodic_max_step_maps: int | None = Field(
+        PERIODIC_MAX_STEP_MAPS, ge=1, description="Work bound of the periodic-gait search: "
+        "the most step-map integrations it may make [-] (the paper's search makes 60); "
+        "past it the gait is reported as 'work_limit' (null = none).")
+    adjust_max_contact_runs: int | None = Field(
+        None, ge=1, description="Work bound of the `contact-sim --adjust` search: the most "
+        "contact runs it may make [-] (null, the default: the search's own, 1 + 8^2 grid "
+        "starts + 60 Nelder-Mead runs = 125); when they are spent the search keeps the best start "
+        "found so far and says so.")
     start: Literal["ideal", "adjusted", "periodic_gait", "mid_stance"] = Field(
         "ideal", description="Initial state of the run: 'ideal' (the rigid fixed point, rates "
         "times initial_rate_scale; the default, for a passive flat-footed walker on its "
@@ -88,12 +112,20 @@ class ContactSimSettings(BaseModel):
 
     @model_serializer(mode="wrap")
     def _drop_default_start(self, handler):
-        # a scene with the default start serialises as before (same content hashes)
+        # a scene with the default start, bounds and no start offset serialises as before
+        # (same content hashes)
         d = handler(self)
-        if isinstance(d, dict) and d.get("start") == "ideal":
-            d.pop("start", None)
-        if isinstance(d, dict) and d.get("adjust_cpu_budget_s") == 300.0:
-            d.pop("adjust_cpu_budget_s", None)  # likewise the default budget
-        if isinstance(d, dict) and d.get("start_offset", 0) is None:
-            d.pop("start_offset", None)  # and no start offset
+        if not isinstance(d, dict):
+            return d
+        for name, default in _DROPPED_DEFAULTS.items():
+            if name in d and d[name] == default:
+                d.pop(name)
         return d
+
+
+#: fields left out of a scene's serialisation (its content hash) at these values: the
+#: defaults of fields added after scenes were hashed
+_DROPPED_DEFAULTS = {"start": "ideal", "start_offset": None,
+                     "max_rhs_evaluations": MAX_RHS_EVALUATIONS,
+                     "periodic_max_step_maps": PERIODIC_MAX_STEP_MAPS,
+                     "adjust_max_contact_runs": None}

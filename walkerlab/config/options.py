@@ -100,10 +100,10 @@ def basin_options(scene: Scene, grid: tuple[int, int] | None = None, workers: in
     return tuple(grid or st.grid), workers
 
 
-def stability_map_options(n: int, workers: int, time_limit_s: float
-                          ) -> tuple[int, int, float]:
-    """``--n`` (cells per axis), ``--workers`` and ``--time-limit`` [s] of a stability map,
-    within their :class:`CommandOptions` bounds.
+def stability_map_options(n: int, workers: int, max_step_maps: int
+                          ) -> tuple[int, int, int]:
+    """``--n`` (cells per axis), ``--workers`` and ``--max-step-maps`` (the work bound of a
+    cell's search) of a stability map, within their :class:`CommandOptions` bounds.
 
     Raises
     ------
@@ -112,9 +112,9 @@ def stability_map_options(n: int, workers: int, time_limit_s: float
     """
     n = validate_option(CommandOptions, "stability_map_n", n, "--n")
     workers = checked_workers(workers)
-    time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
-                                   float(time_limit_s), "--time-limit")
-    return n, workers, time_limit_s
+    max_step_maps = validate_option(CommandOptions, "stability_map_max_step_maps",
+                                    int(max_step_maps), "--max-step-maps")
+    return n, workers, max_step_maps
 
 
 def bifurcation_options(n_transient: int, n_keep: int, workers: int) -> tuple[int, int, int]:

@@ -314,8 +314,9 @@ class CommandOptions(Strict):
                          description=f"local worker processes (at most {MAX_WORKERS}: 4 per core)")
     stability_map_n: int = Field(8, ge=2, le=MAX_STABILITY_MAP_N,
                                  description="stability-map grid size n x n")
-    stability_map_time_limit_s: float = Field(60.0, ge=1.0, le=3600.0,
-                                              description="wall-time limit per map cell [s]")
+    stability_map_max_step_maps: int = Field(
+        2_000, ge=1, le=1_000_000, description="work bound of each periodic-gait search of "
+        "a map cell: its step-map integrations [-]")
     bifurcation_transient: int = Field(100, ge=1, le=MAX_BIFURCATION_TRANSIENT,
                                        description="steps discarded before sampling")
     bifurcation_keep: int = Field(30, ge=1, le=MAX_BIFURCATION_KEEP,

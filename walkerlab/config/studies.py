@@ -159,8 +159,19 @@ class StateOffset(StateSpec):
         extra = [k for k in given if k not in keys]
         if extra:
             raise ValueError(f"{extra[0]}: not a state of the walker (its states: "
-                             f"{', '.join(keys)})")
+                             f"{_state_list(names, keys)})")
         return np.array([float(given.get(k, 0.0)) for k in keys])
+
+
+def _state_list(names: list[str], keys: list[str]) -> str:
+    """Every valid state name of :meth:`StateOffset.as_array`, short enough for one line:
+    by role (``<role>_angle_rad`` and ``<role>_rate_rad_per_s``) when the states are each
+    role's angle and rate, else the names themselves."""
+    roles = [n.removesuffix("_angle") for n in names if n.endswith("_angle")]
+    if sorted(names) == sorted([f"{r}_angle" for r in roles] + [f"{r}_rate" for r in roles]):
+        return ("<role>_angle_rad and <role>_rate_rad_per_s of the roles "
+                + ", ".join(roles))
+    return ", ".join(keys)
 
 
 class FixedPointSettings(Strict):

@@ -85,7 +85,7 @@ _PERIODIC: dict = {}
 def _periodic_gait(setup, probe, x_gait):
     """The contact walker's own periodic gait (:func:`walkerlab.analysis.contact.periodic.
     find_contact_periodic_gait` from the rigid gait ``x_gait``, within ``contact_sim.
-    periodic_time_limit_s``), as ``contact-sim`` starts from it
+    periodic_max_step_maps``), as ``contact-sim`` starts from it
     (:func:`walkerlab.analysis.contact.periodic.simulate_from_periodic_gait`): the run
     starts at its mid-stance section, on patches spaced by its step length.
 
@@ -94,12 +94,16 @@ def _periodic_gait(setup, probe, x_gait):
     walkerlab.analysis.contact.periodic.PeriodicGaitError
         No periodic gait found (one line).
     """
-    from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
+    from walkerlab.analysis.contact.periodic import (
+        converged_gait,
+        find_contact_periodic_gait,
+        search_bounds,
+    )
 
     key = setup.scene.model_dump_json() if setup.scene is not None else None
     if key is None or key not in _PERIODIC:
         gait = converged_gait(find_contact_periodic_gait(
-            probe, x_gait, time_limit_s=setup.sim.periodic_time_limit_s))
+            probe, x_gait, **search_bounds(setup.sim)))
         if key is None:
             return gait
         _PERIODIC[key] = gait

@@ -13,15 +13,22 @@ compiled RHS, no Python per evaluation; :mod:`walkerlab.integrate._cyrk`), ``"nu
 (numbalsoda's LSODA from compiled code; optional extra,
 :mod:`walkerlab.integrate.numbalsoda_backend`)
 or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``, ...), these given the
-model's analytic Jacobian.  All run in chunks so a fall, a trip, a flight, the wall-time
-limit or the strides cap stops the run.
+model's analytic Jacobian.  All run in chunks so a fall, a trip, a flight, the work bound,
+the wall-time limit or the strides cap stops the run.
 
-Wall-time limit: the Python right-hand sides (odeint, solve_ivp, the pinned phase) check the
-deadline at every call.  The compiled backends check no clock: a CyRK call stops after
-:data:`CYRK_STEPS_PER_CALL` steps (well above what a chunk of a walking run takes, so its
-samples do not change) and the chunk goes on in odeint, whose RHS checks the deadline;
-numbalsoda's chunks are sized in wall time (each aims at :data:`CHUNK_WALL_S` seconds from
-the cost of the chunk before, the first is short).
+Work bound (``ContactLimits.max_rhs_evaluations``, the scene's
+``contact_sim.max_rhs_evaluations``): a run ends with ``work_limit`` once it has evaluated its
+right-hand side that many times, the same end on any machine.  The Python right-hand sides
+(odeint, solve_ivp, the pinned phase) count every call; the compiled backends are asked
+between chunks (a CyRK call stops after :data:`CYRK_STEPS_PER_CALL` steps, well above what a
+chunk of a walking run takes, so its samples do not change, and the chunk goes on in odeint,
+whose RHS counts); a powered run's hook between its segments.
+
+Wall-time limit (``ContactLimits.wall_time_limit_s``, none by default): checked where the
+work bound is, on ``time.perf_counter``; a run it ends (``time_limit``) depends on the
+machine's speed, and the stages never keep it as a scene's result.  numbalsoda's chunks are
+sized in wall time (each aims at :data:`CHUNK_WALL_S` seconds from the cost of the chunk
+before, the first is short): numbalsoda is an optional extra, never the default method.
 
 One loop (:func:`integrate_contact`'s free run) serves every walker: a powered one (with
 ``actuators``) brings its actuation hook (:class:`walkerlab.integrate.contact_powered.
@@ -70,13 +77,15 @@ from .contact_events import (
     run_atol,
     sample_grid,
     trip_or_failure,
+    work_limit_message,
 )
 from .ends import RunEnd, solver_words
 from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
            "ContactLimits", "first_event", "hermite_root", "hermite_state",
-           "integrate_contact", "run_atol", "run_powered", "sample_grid", "trip_or_failure"]
+           "integrate_contact", "run_atol", "run_powered", "sample_grid", "trip_or_failure",
+           "work_limit_message"]
 
 #: Solver methods this module runs.
 METHODS = ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
@@ -101,7 +110,7 @@ class ContactIntegration:
         states there, columns named by ``walker.state_names()``.
     termination : str
         ``t_final``, ``heel_strike`` (the ``stop`` predicate held: strides cap), ``fall``,
-        ``trip``, ``airborne``, ``solver_failure`` or ``time_limit``
+        ``trip``, ``airborne``, ``solver_failure``, ``work_limit`` or ``time_limit``
         (:mod:`walkerlab.integrate.ends`).
     message : str
     event : tuple or None
@@ -132,19 +141,34 @@ class _TimeLimit(Exception):
     """Internal: the wall-time limit ran out inside a right-hand side."""
 
 
-def _guarded(f, deadline, calls=None):
+class _WorkLimit(Exception):
+    """Internal: the work bound (right-hand-side evaluations) ran out inside a right-hand
+    side."""
+
+
+def _guarded(f, deadline, calls=None, most=None):
     """``f`` that raises :class:`_TimeLimit` once ``time.perf_counter()`` passes ``deadline``
-    (and counts its calls in ``calls[0]``, if given: the count of a cut chunk)."""
-    if not np.isfinite(deadline):
+    and :class:`_WorkLimit` on its call past ``most`` calls (None: no bound), counting its
+    calls in ``calls[0]``, if given (the count of a cut chunk)."""
+    if not np.isfinite(deadline) and most is None and calls is None:
         return f
+    calls = [0] if calls is None else calls
+    timed = np.isfinite(deadline)
 
     def g(t, x, *a):
-        if calls is not None:
-            calls[0] += 1
-        if time.perf_counter() > deadline:
+        calls[0] += 1
+        if most is not None and calls[0] > most:
+            raise _WorkLimit
+        if timed and time.perf_counter() > deadline:
             raise _TimeLimit
         return f(t, x, *a)
     return g
+
+
+def _work_left(limits, nfev: int):
+    """Right-hand-side evaluations the run may still make (None: no bound)."""
+    most = getattr(limits, "max_rhs_evaluations", None)
+    return None if most is None else max(int(most) - int(nfev), 0)
 
 
 def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline):
@@ -172,7 +196,8 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
     from scipy.integrate import solve_ivp  # here: the compiled backends need no scipy.integrate
 
     try:
-        sol = solve_ivp(_guarded(f, deadline), (t0, t_end), z0, method="LSODA",
+        sol = solve_ivp(_guarded(f, deadline, most=_work_left(limits, 0)), (t0, t_end), z0,
+                        method="LSODA",
                         rtol=solver.rtol, atol=solver.atol,
                         max_step=solver.max_step_s or np.inf,
                         t_eval=sample_grid(t0, t_end, limits.sample_rate_hz), events=events,
@@ -180,6 +205,9 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
     except _TimeLimit:
         return (np.array([t0]), x0[None], 0, 0, RunEnd.TIME_LIMIT,
                 "wall-time limit reached in the pinned phase")
+    except _WorkLimit:
+        return (np.array([t0]), x0[None], int(limits.max_rhs_evaluations), 0,
+                RunEnd.WORK_LIMIT, work_limit_message(limits) + " in the pinned phase")
     t, Z = sol.t, sol.y.T
     if sol.status == 1:  # stopped on an event: append the event point
         te = (sol.t_events[1][0] if (until_touchdown and sol.t_events[1].size)
@@ -202,6 +230,7 @@ class _Backend:
         self.walker, self.solver, self.method = walker, solver, solver.method
         self.max_step = solver.max_step_s if solver.max_step_s else np.inf
         self.calls = [0]  # RHS calls of the current chunk (Python backends)
+        self.deadline = deadline
         self.frhs = _guarded(walker.rhs, deadline, self.calls)
         self.fjac = walker.jac if use_jac else None
         self.compiled = self.method == "numbalsoda" or self.method in _cyrk.CYRK_METHODS
@@ -210,6 +239,12 @@ class _Backend:
             raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
         self.data = walker.pack() if self.compiled else None
         self.atol = run_atol(walker, solver.atol, self.method)
+
+    def bound(self, most):
+        """Count this chunk's Python RHS calls from 0 and allow ``most`` of them (None: no
+        bound)."""
+        self.calls[0] = 0
+        self.frhs = _guarded(self.walker.rhs, self.deadline, self.calls, most)
 
     def odeint_chunk(self, xs, tg):
         from scipy.integrate import ODEintWarning, odeint
@@ -264,7 +299,7 @@ class _Backend:
         return sol.t[1:], sol.y.T[1:], sol.status == 0, sol.message, sol.nfev, sol.njev
 
 
-def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
+def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None, spent=0):
     """Integrate the free walker until t1, an event, the deadline or ``stop``: the one
     contact integrator loop, passive or powered.
 
@@ -272,7 +307,9 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
     (:class:`walkerlab.integrate.contact_powered.ActuationHook`): it integrates each chunk
     (its discrete state, events and transitions), the loop asks ``stop`` after each of its
     heel strikes; None: the passive walker on the solver's backend, ``stop`` asked after each
-    chunk, the energy guard and the events checked on each chunk's samples.
+    chunk, the energy guard and the events checked on each chunk's samples.  ``spent``:
+    right-hand-side evaluations the run made before (its pinned phase), charged to the work
+    bound.
 
     Returns (t, X, nfev, njev, termination, message, event, work), ``work`` None for a
     passive run (:class:`ContactIntegration`)."""
@@ -295,12 +332,16 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
         tb = min(ta + span, t1)
         tg = sample_grid(ta, tb, rate)
         w0 = time.perf_counter()
-        be.calls[0] = 0
+        be.bound(_work_left(limits, spent + nfev))
         try:
             tn, Xn, ok, m, nf, nj = be.chunk(xa, tg)
         except _TimeLimit:
             nfev += be.calls[0]
             term, msg = RunEnd.TIME_LIMIT, "wall-time limit reached inside a chunk"
+            break
+        except _WorkLimit:
+            nfev += be.calls[0] - 1  # the call that went past the bound was not made
+            term, msg = RunEnd.WORK_LIMIT, work_limit_message(limits)
             break
         nfev += nf
         njev += nj
@@ -328,6 +369,9 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
             term, msg, event = trip_or_failure(walker, float(t_all[-1]), X_all[-1], str(m),
                                                len(t_all) - 1, 2.0 / rate)
             guarded = True  # the last sample is the run's end (no event state to interpolate)
+            break
+        if _work_left(limits, spent + nfev) == 0 and t_all[-1] < t1 - 1e-12:
+            term, msg = RunEnd.WORK_LIMIT, work_limit_message(limits)
             break
         if time.perf_counter() > deadline and t_all[-1] < t1 - 1e-12:
             term, msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
@@ -394,7 +438,7 @@ def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: fl
     last = Xn[bad - 1] if bad else xa
     trip = side_entry(walker, last, 2.0 / rate)
     msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
-           f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
+           f"t = {tn[bad]:.6g} s ({energy_source_words(walker)}): the run ends "
            "at the last trustworthy sample")
     term = RunEnd.SOLVER_FAILURE
     if trip is not None:  # the cause: a foot in a gap entered a patch's side
@@ -405,6 +449,17 @@ def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: fl
         msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
                f"entered a patch from its side; {msg}")
     return event, term, msg
+
+
+def energy_source_words(walker) -> str:
+    """Why the energy guard's rise is not physics, from what the walker has: a passive
+    walker cannot gain energy; one whose joints carry a law that does work (a hip-roll law,
+    ``kernels.STANCE_LAW``) gains some from it, but not this much (the guard's bound allows
+    for it: :func:`walkerlab.models.contact.energy.energy_rise_bound`)."""
+    if getattr(getattr(walker, "kernels", None), "STANCE_LAW", False):
+        return ("more than this walker's joint law can put in: a blow-up, not the law's "
+                "work")
+    return "a passive contact walker cannot gain energy"
 
 
 def _cut_at_event(walker, t_all: np.ndarray, X_all: np.ndarray, event: tuple, term: RunEnd):
@@ -523,7 +578,8 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
             hook = ActuationHook(walker, solver, limits, deadline,
                                  sample_grid(t_pin, t_final, limits.sample_rate_hz))
         tf, Xf, nf, nj, term, msg, event, work = _run_free(walker, x0, t_pin, t_final, solver,
-                                                           limits, deadline, stop, hook)
+                                                           limits, deadline, stop, hook,
+                                                           spent=nfev)
         if ts:
             tf, Xf = tf[1:], Xf[1:]
         ts.append(tf)

@@ -16,7 +16,7 @@ from walkerlab.models.contact.energy import side_entry
 from .ends import RunEnd
 
 __all__ = ["ContactLimits", "first_event", "hermite_root", "hermite_state", "run_atol",
-           "sample_grid", "trip_or_failure"]
+           "sample_grid", "trip_or_failure", "work_limit_message"]
 
 
 @dataclass(frozen=True)
@@ -37,10 +37,16 @@ class ContactLimits:
     airborne_hip_height_m : float
         The walker flew off when its hip rises above this [m] (inf: never).
     wall_time_limit_s : float or None
-        Stop with ``time_limit`` once this much wall time is used [s].
+        Stop with ``time_limit`` once this much wall time is used [s] (None: no clock; a
+        run it ends depends on the machine's speed).
+    max_rhs_evaluations : int or None
+        Stop with ``work_limit`` once the run has evaluated its right-hand side this many
+        times (checked at each evaluation of a Python right-hand side, between chunks of a
+        compiled one and between segments of a powered run): the same end on any machine
+        (None: no bound).
     chunk_s : float
-        Longest chunk of simulated time [s]; trips, falls, flights, the wall-time limit and
-        the ``stop`` predicate are checked between chunks.
+        Longest chunk of simulated time [s]; trips, falls, flights, the wall-time limit, the work
+        bound and the ``stop`` predicate are checked between chunks.
     use_jacobian : bool
         Pass the analytic Jacobian to odeint / solve_ivp (the compiled backends take none).
     """
@@ -51,8 +57,16 @@ class ContactLimits:
     fall_hip_height_m: float = 0.5
     airborne_hip_height_m: float = np.inf
     wall_time_limit_s: float | None = None
+    max_rhs_evaluations: int | None = None
     chunk_s: float = 1.0
     use_jacobian: bool = True
+
+
+def work_limit_message(limits: ContactLimits) -> str:
+    """The message of a run the work bound ended (``limits.max_rhs_evaluations``): the
+    bound and the scene field that raises it."""
+    return (f"work bound reached: {limits.max_rhs_evaluations:,} right-hand-side "
+            "evaluations (raise contact_sim.max_rhs_evaluations for a longer run)")
 
 
 def sample_grid(t0: float, t1: float, rate: float) -> np.ndarray:

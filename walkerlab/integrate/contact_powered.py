@@ -270,7 +270,14 @@ class ActuationHook:
 
     def _run(self, y, t, tb, push, events):
         """One segment (compiled where :attr:`segments` is set, else on ``solve_ivp``);
-        returns the solution, or None when the run ends here."""
+        returns the solution, or None when the run ends here (the work bound,
+        ``limits.max_rhs_evaluations``, is asked before each segment)."""
+        most = getattr(self.limits, "max_rhs_evaluations", None)
+        if most is not None and self.nfev >= most:
+            from .contact_events import work_limit_message  # light (as trip_or_failure below)
+
+            self.term, self.msg = RunEnd.WORK_LIMIT, work_limit_message(self.limits)
+            return None
         try:
             if self.segments is not None:
                 if time.perf_counter() > self.deadline:

@@ -3,9 +3,10 @@
 The rigid side's segment terminations (:mod:`walkerlab.integrate.rigid`: a step ends in
 ``heel_strike``, ``fall``, ``t_final`` or ``solver_failure``) extended with what only the
 contact model can do (trip, scuff, slip, fly away) and with the verdicts a whole run needs
-(no heel strike at all, the wall-time limit).  Every producer and reader uses these names:
-the contact integration (:mod:`walkerlab.integrate.contact`: ``termination``), the contact
-gait analysis (:class:`walkerlab.analysis.contact.verdict.Outcome`: ``kind``), the stages'
+(no heel strike at all, the wall-time limit, the work bound).  Every producer and reader
+uses these names: the contact integration (:mod:`walkerlab.integrate.contact`:
+``termination``), the contact gait analysis
+(:class:`walkerlab.analysis.contact.verdict.Outcome`: ``kind``), the stages'
 artifacts (attribute ``termination`` / ``outcome``), the report, the CLI's exit code and the
 sweeps (:mod:`walkerlab.studies.outcomes`, which add their own verdicts such as
 ``no_fixed_point``).
@@ -25,7 +26,10 @@ sweeps (:mod:`walkerlab.studies.outcomes`, which add their own verdicts such as
                    heel strike; a rigid step that ended where it began (a walker that
                    never moves)
 ``solver_failure`` the integrator stopped
-``time_limit``     the wall-time limit ran out first
+``time_limit``     the wall-time limit a user set ran out first (a result of the machine's
+                   speed: never stored as the scene's result)
+``work_limit``     the work bound ran out first (right-hand-side evaluations of a run:
+                   ``contact_sim.max_rhs_evaluations``): the same end on any machine
 =================  ==========================================================================
 
 :class:`RunEnd` is the vocabulary: a ``str``-valued enum, so ``RunEnd.FALL == "fall"``.  The
@@ -55,6 +59,7 @@ class RunEnd(StrEnum):
     NO_HEEL_STRIKE = "no_heel_strike"
     SOLVER_FAILURE = "solver_failure"
     TIME_LIMIT = "time_limit"
+    WORK_LIMIT = "work_limit"
 
 
 #: run end -> one line (the table above).
@@ -72,6 +77,7 @@ RUN_ENDS: dict[RunEnd, str] = {
                            "where it began)",
     RunEnd.SOLVER_FAILURE: "the integrator stopped",
     RunEnd.TIME_LIMIT: "the wall-time limit ran out first",
+    RunEnd.WORK_LIMIT: "the work bound (right-hand-side evaluations) ran out first",
 }
 
 #: The names (plain strings), in the order of :class:`RunEnd`.

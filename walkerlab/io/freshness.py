@@ -30,6 +30,18 @@ from walkerlab.io.artifacts import (
 from walkerlab.io.runpaths import artifact_lock, claimed, stage_artifact
 from walkerlab.safefs import NotARegularFile, read_regular, refuse_link
 
+#: Root attribute of an artifact whose result depends on the machine it ran on (a run that a
+#: user's wall-clock limit cut short: ``time_limit``), its value one line saying what was
+#: cut: such an artifact is written and read like any other but never reused as up to date,
+#: so the next run recomputes it (a run bounded by work ends the same everywhere and is kept).
+NOT_FINAL_ATTR = "not_final"
+
+
+def not_final(path: Path) -> str:
+    """What cut the artifact ``path`` short (its :data:`NOT_FINAL_ATTR`), "" for a result
+    that may be reused (or an absent or unreadable file)."""
+    return str(root_attrs(path, NOT_FINAL_ATTR).get(NOT_FINAL_ATTR, ""))
+
 
 def input_hash(stage: str, scene, sections: tuple[str, ...],
                upstream: tuple[Path, ...] = (), extra: str = "") -> str:
@@ -163,9 +175,11 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
     Returns
     -------
     CachedArtifact
-        Reused (``wall_time_s`` 0, empty summary) or written; an existing artifact that is
-        recomputed is never replaced silently: one line through ``tell`` says which and
-        why (the scene fields that changed, ``--force``, ...), also kept in ``note``.
+        Reused (``wall_time_s`` 0, empty summary) or written (an artifact whose writer set
+        :data:`NOT_FINAL_ATTR`, a run a wall-clock limit cut short, is never reused); an
+        existing artifact that is recomputed is never replaced silently: one line through
+        ``tell`` says which and why (the scene fields that changed, ``--force``, ...), also
+        kept in ``note``.
 
     Raises
     ------
@@ -183,7 +197,7 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
         # writing anything (the lock, the folder's claim): a read-only runs folder serves it;
         # artifacts are replaced atomically, so reading one without the lock sees a whole file
         path = refuse_link(stage_artifact(scene, runs_root, artifact or stage))
-        if path.is_file() and up_to_date(verified_hash(path)):
+        if path.is_file() and up_to_date(verified_hash(path)) and not not_final(path):
             return CachedArtifact(path, True, 0.0, {})
     # a link in place of the artifact is refused now, not after the computation
     path = refuse_link(stage_artifact(scene, runs_root, artifact or stage, claim=True))
@@ -195,10 +209,13 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
             note = "--force"  # recomputed whatever it holds: its content is not hashed
         elif path.is_file():
             have = verified_hash(path)
-            if up_to_date(have):
+            cut = not_final(path)
+            if up_to_date(have) and not cut:
                 return CachedArtifact(path, True, 0.0, {})
             # never replace a result silently: say what is recomputed and why (one line)
-            note = recompute_reason(path, scene, sections, have)
+            note = (f"its run was cut short by a wall-clock limit ({cut}), which is never "
+                    "kept as a result" if cut and up_to_date(have)
+                    else recompute_reason(path, scene, sections, have))
             tell(f"{stage}: recomputing {path} ({note})")
         t0 = time.perf_counter()
         writer, summary = compute()

@@ -18,14 +18,15 @@ from walkerlab.units import Units
 __all__ = ["GAIT_CLASSES", "GAIT_COLORS", "gait_map_figure"]
 
 #: the map's cell classes, in the colour map's order (:data:`GAIT_COLORS`)
-GAIT_CLASSES = ("stable gait", "unstable gait", "off patch", "falls", "time limit",
+GAIT_CLASSES = ("stable gait", "unstable gait", "off patch", "falls", "work limit",
                 "no convergence", "other failure")
 GAIT_COLORS = ("#2ca02c", "#ff7f0e", "#9467bd", "#d62728", "#17becf", "#7f7f7f", "#000000")
 _REASON_CLASS = {"off_patch": 2, "fall": 3, "no_mid_stance": 3, "time_limit": 4,
-                 "not_converged": 5}
+                 "work_limit": 4, "not_converged": 5}
 #: cell text of a cell without a gait (whole words, wrapped to fit a cell)
 _REASON_TEXT = {"off_patch": "off\npatch", "fall": "falls", "no_mid_stance": "no mid-\nstance",
-                "time_limit": "time\nlimit", "not_converged": "no con-\nvergence",
+                "time_limit": "time\nlimit", "work_limit": "work\nlimit",
+                "not_converged": "no con-\nvergence",
                 "solver_failure": "solver\nfailure", "no_ideal_gait": "no ideal\ngait",
                 "invalid_config": "invalid\nconfig", "error": "error",
                 "unsupported": "not sup-\nported"}

@@ -13,7 +13,7 @@ from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.published import for_scene
 from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
-from walkerlab.report.run_text import contact_multiplier_words
+from walkerlab.report.run_text import contact_multiplier_words, periodic_not_found
 from walkerlab.units import for_scene as units_for
 from walkerlab.units import map_name
 
@@ -76,7 +76,7 @@ def contact_section(scene, arts) -> list[str]:
     periods = c.steps["period"]
     per = per_fail = None
     if c.periodic is not None and not c.periodic.found:
-        per_fail = (c.periodic.outcome, c.periodic.message)
+        per_fail = (periodic_not_found(c.periodic.outcome), c.periodic.message)
     elif c.periodic is not None:
         g = c.periodic
         per = (g.step_period_s, g.step_length_m, contact_multiplier_words(g, 4), g.stable,

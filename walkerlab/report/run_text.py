@@ -120,7 +120,8 @@ def contact_text(c: ContactSimArtifact) -> str:
                      f"took {num(c.stage_wall_time_s, 3)} s)")
     per = c.periodic
     if per is not None and not per.found:
-        lines.append(f"periodic contact gait: not found ({per.outcome}: {per.message})")
+        lines.append(f"periodic contact gait: not found ({periodic_not_found(per.outcome)}: "
+                     f"{per.message})")
     elif per is not None:
         lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} "
                      f"{c.units.time}, step length {num(per.step_length_m, 6)} "
@@ -145,11 +146,43 @@ def contact_multiplier_words(per, digits: int) -> str:
             + f" (+{len(mult) - n} fast contact modes ~0)")
 
 
+def _e_avg_span(metrics: dict) -> str:
+    """The steps compare's E_avg is a time average over, as each run's metrics say
+    (``E_avg_steps``; an older artifact without it: the first 5): "the first 2 steps of each
+    run", or each run's own count where they differ (a contact run of more steps than the
+    rigid one)."""
+    def steps(model):
+        n = metrics.get(model, {}).get("E_avg_steps")
+        return int(n) if n is not None and np.isfinite(n) else 5
+    ni, nc = steps("ideal"), steps("contact")
+    if ni == nc:
+        return f"the first {ni} steps of each run"
+    return f"the first {ni} steps of the ideal run and the first {nc} of the contact run"
+
+
+def periodic_not_found(outcome: str) -> str:
+    """Why a contact run's own periodic gait was not found, by the search's ``outcome`` (a
+    :class:`walkerlab.analysis.contact.step_map.PeriodicGaitError` kind), in the words the
+    summary, the gait table and the contact section share: a search a wall-clock limit cut
+    short is named so (not a property of the scene), as is one its work bound ended."""
+    if outcome == "time_limit":
+        return ("time_limit: the search was cut short by a wall-clock limit, "
+                "contact_sim.periodic_time_limit_s, not a property of the scene")
+    if outcome == "work_limit":
+        return ("work_limit: the search spent its work bound, "
+                "contact_sim.periodic_max_step_maps")
+    return outcome
+
+
 def compare_text(c: Comparison) -> str:
     """Key errors of a compare artifact: largest angle and rate error contact − ideal per
     coordinate, the limit cycles' mean distance, and the gait metrics side by side."""
     u = c.units
-    lines = [f"errors contact - ideal over the common span 0-{num(c.time[-1], 4)} {u.time}:",
+    cut = getattr(c, "contact_cut_short", "")
+    lines = ([f"the contact run was cut short by a wall-clock limit ({cut}): compared over "
+              "what it ran before the limit (time_limit; not kept, the next run recomputes "
+              "it)"] if cut else [])
+    lines += [f"errors contact - ideal over the common span 0-{num(c.time[-1], 4)} {u.time}:",
              f"  max |angle error| {num(c.max_abs_angle_rad, 3)} rad, "
              f"max |rate error| {num(c.max_abs_rate_rad_per_s, 3)} {u.rate}"]
     for n, e in c.errors.items():
@@ -168,10 +201,7 @@ def compare_text(c: Comparison) -> str:
                              f"{num(m['contact'][k]):>11s}"
                              + (f" {unit}" if unit not in ("", "-") else ""))
         if "E_avg_J" in m["ideal"]:
-            steps = m["ideal"].get("E_avg_steps")
-            over = (f"the first {int(steps)} steps" if steps is not None and np.isfinite(steps)
-                    else "the first 5 steps")
-            lines.append(f"  (E_avg: time averages over {over} of each run (E_avg_steps); "
+            lines.append(f"  (E_avg: time averages over {_e_avg_span(m)} (E_avg_steps); "
                          "simulate's 'mean total energy' is the mean of its samples over all "
                          "its steps)")
     return "\n".join(lines)

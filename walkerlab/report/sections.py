@@ -19,6 +19,7 @@ from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.stage_files import CONTACT_SIM, SIMULATE
 from walkerlab.report.ground_text import ground_contact_text, twist_text
 from walkerlab.report.markdown import num, printed, sig_digits, table
+from walkerlab.report.run_text import periodic_not_found
 from walkerlab.report.text import (
     neutral_multipliers_text,
     zero_dynamics_text,
@@ -95,7 +96,8 @@ def _contact_verdict(c) -> str:
         extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
                                                   else "unstable"))
     elif c.periodic is not None:
-        extra = f"; its own periodic gait was not found ({c.periodic.outcome})"
+        extra = ("; its own periodic gait was not found "
+                 f"({periodic_not_found(c.periodic.outcome)})")
     why = f": {c.walks_reason}" if not walks and c.walks_reason else ""
     return (f"- **Contact walker walks**: {'yes' if walks else 'no'} "
             f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}"
@@ -255,6 +257,28 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
     return out
 
 
+def gait_note(inputs) -> list[str]:
+    """The gait table's note on its contact columns (none without a contact run): what
+    *ours, contact* averages and the contact model's own periodic gait: its column, why it
+    was not found (a search cut short named so, as the summary says it:
+    :func:`walkerlab.report.run_text.periodic_not_found`), or that the scene asks for none."""
+    cols, arts = inputs.gait_columns, inputs.artifacts
+    if "ours, contact" not in cols:
+        return []
+    per = getattr(arts.get(CONTACT_SIM.name), "periodic", None)
+    if "ours, contact periodic gait" in cols:
+        own = ("; *ours, contact periodic gait* is the contact model's own periodic gait "
+               "(the fixed point of its step-to-step map: no start-up, energies not "
+               "defined).")
+    elif per is not None:  # searched, not found: say why, as the summary does
+        own = (" (the contact model's own periodic gait was not found: "
+               f"{periodic_not_found(per.outcome)}).")
+    else:
+        own = " (the scene computes no contact periodic gait: contact_sim.periodic_gait)."
+    return ["", "*ours, contact* averages every complete step of the contact run, which "
+            "starts from the rigid gait, so its start-up steps are included" + own]
+
+
 # --------------------------------------------------------------------------- gait table
 def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     """Gait characteristics (paper Table 3 rows), ours beside the published ones."""
@@ -288,14 +312,7 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
            + ", ".join(f"`{arts[s].path.name}`" for s in (SIMULATE.name, CONTACT_SIM.name)
                        if s in arts)
            + ").", "", table(header, rows)]
-    if "ours, contact" in cols:
-        out += ["", "*ours, contact* averages every complete step of the contact run, which "
-                "starts from the rigid gait, so its start-up steps are included"
-                + ("; *ours, contact periodic gait* is the contact model's own periodic gait "
-                   "(the fixed point of its step-to-step map: no start-up, energies not "
-                   "defined)." if "ours, contact periodic gait" in cols else
-                   " (the scene computes no contact periodic gait: contact_sim.periodic_gait)."
-                   )]
+    out += gait_note(inputs)
     ideal = cols.get("ours, ideal")
     eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:

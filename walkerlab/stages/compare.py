@@ -16,6 +16,7 @@ from walkerlab.comparison.errors import (
 )
 from walkerlab.comparison.tables import gait_metrics
 from walkerlab.config import Scene
+from walkerlab.io.freshness import NOT_FINAL_ATTR, not_final
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import METRIC_UNITS, Comparison, write_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
@@ -59,6 +60,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     def compute():
         c = compare_files(*up)
+        # a contact run a wall-clock limit cut short: the comparison is not kept either
+        c.contact_cut_short = not_final(up[1])
         summary = {"max_angle_error_rad": c.max_abs_angle_rad,
                    "max_rate_error_rad_per_s": c.max_abs_rate_rad_per_s,
                    "max_phase_aligned_angle_error_rad": float(max(
@@ -66,6 +69,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                         if c.error_units[n] == "rad" and e.size), default=np.nan)),
                    "compared_until_s": float(c.time[-1]), "metrics": c.metrics,
                    "limit_cycle_distance": c.limit_cycle_distance}
-        return (lambda f: write_compare(f, c)), summary
+        def writer(f):
+            write_compare(f, c)
+            if c.contact_cut_short:
+                f.attrs[NOT_FINAL_ATTR] = c.contact_cut_short
+        return writer, summary
 
     return run_cached("compare", scene, runs_root, ("walker",), up, compute, force)

@@ -24,6 +24,7 @@ from walkerlab.config.options import with_contact_strides
 from walkerlab.integrate.contact_grid import COMPILED_METHODS
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.artifacts import ArtifactError
+from walkerlab.io.freshness import NOT_FINAL_ATTR
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
@@ -54,8 +55,33 @@ def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool
     try:
         run = contact_sim_run(setup, load_fixedpoint(fixedpoint), adjust, periodic)
     except PeriodicGaitError as exc:  # the start asked for a gait that was not found
+        if exc.kind == "time_limit":  # the machine's speed, not the scene's answer
+            raise StageError(f"{exc} (contact_sim.periodic_time_limit_s: a wall-clock limit; "
+                             "nothing was stored)") from None
         raise StageError(str(exc)) from None
-    return (lambda f: write_contact_sim(f, run)), run.summary
+    cut = cut_short(run)
+
+    def writer(f):
+        write_contact_sim(f, run)
+        if cut:  # stored to be read and shown, never reused as the scene's result
+            f.attrs[NOT_FINAL_ATTR] = cut
+    return writer, run.summary
+
+
+def cut_short(run) -> str:
+    """What a wall-clock limit cut short in a contact run (a
+    :class:`walkerlab.io.schemas.contact_sim.ContactSimRun`): the walking run, its periodic
+    gait's search, runs of its adjust search; "" when nothing (the work bounds end a run the
+    same way on any machine: such a run is a result)."""
+    cut = []
+    if run.result.termination == "time_limit":
+        cut.append("the contact run: contact_sim.wall_time_limit_s")
+    if getattr(run.gait_error, "kind", "") == "time_limit":
+        cut.append("the periodic-gait search: contact_sim.periodic_time_limit_s")
+    if run.adjust and run.adjust.get("time_limited_runs"):
+        cut.append(f"{run.adjust['time_limited_runs']} run(s) of the adjust search: "
+                   "contact_sim.wall_time_limit_s")
+    return "; ".join(cut)
 
 
 def rhs_beside(setup: ContactSetup, side: Callable[[], SideWorker]

@@ -17,7 +17,12 @@ from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.stability_map import load_stability_map, write_stability_map
 from walkerlab.plotting.artifact_figures import save_gait_map_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
-from walkerlab.studies.stability import MapSpec, default_spec, stability_map_run
+from walkerlab.studies.stability import (
+    MAP_MAX_STEP_MAPS,
+    MapSpec,
+    default_spec,
+    stability_map_run,
+)
 from walkerlab.walker.description import walker_data
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
@@ -28,7 +33,8 @@ def stage_name(kind: str) -> str:
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        kind: str = "stiffness", n: int = 8, workers: int = 2, time_limit_s: float = 60.0,
+        kind: str = "stiffness", n: int = 8, workers: int = 2,
+        max_step_maps: int = MAP_MAX_STEP_MAPS,
         spec: MapSpec | None = None, progress=None) -> StageOutcome:
     """Compute (or reuse) one stability map and draw its figure.
 
@@ -47,10 +53,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     why = map_not_applicable(scene, kind)
     if why:
         raise StageError(why)
-    n, workers, time_limit_s = stability_map_options(n, workers, time_limit_s)
+    n, workers, max_step_maps = stability_map_options(n, workers, max_step_maps)
     terrain = scene.terrain
     k, _, k_field = scene.contact.written("stiffness")
-    spec = spec or default_spec(kind, n, time_limit_s, stiffness=k, stiffness_field=k_field,
+    spec = spec or default_spec(kind, n, max_step_maps, stiffness=k, stiffness_field=k_field,
                                 patch_width_m=terrain.patch_width_m if terrain is not None
                                 else 0.10)
 

@@ -2,7 +2,8 @@
 
 Every point of a sweep ends in exactly one outcome (never an unhandled exception).  How a
 run ended uses the shared run-end names (:mod:`walkerlab.integrate.ends`: ``fall``, ``trip``,
-``scuff``, ``slip``, ``airborne``, ``no_heel_strike``, ``solver_failure``, ``time_limit``);
+``scuff``, ``slip``, ``airborne``, ``no_heel_strike``, ``solver_failure``, ``time_limit``,
+``work_limit``);
 a run that walked is ``ok``; the others are a sweep's own verdicts:
 
 ==================  =======================================================================
@@ -22,7 +23,9 @@ a run that walked is ``ok``; the others are a sweep's own verdicts:
 ``solver_failure``  the integrator stopped (``message`` = scipy's message)
 ``max_steps``       a budget ran out before a verdict: a step lasted longer than
                     ``max_step_time_s`` (rigid), or the contact walker stalled (too few steps)
-``time_limit``      contact model: the run's wall-time limit ran out first
+``time_limit``      contact model: the run's wall-time limit (set by the user) ran out first
+``work_limit``      contact model: the run's work bound (``contact_sim.max_rhs_evaluations``)
+                    ran out first
 ``invalid_config``  the point's scene does not validate (``message`` = pydantic's, one line)
 ``error``           any other exception (type and message recorded; should not happen)
 ==================  =======================================================================

@@ -11,9 +11,11 @@ fixed point at that slope (placed on the contact model and iterated a few steps)
 Cell results (:data:`CELL_FIELDS`): ``exists`` (converged and every loaded foot stays on its
 patch), ``stable`` (all ``|multipliers|`` < 1), ``max_abs_multiplier``, ``step_period_s``,
 ``patch_margin_m``, ``source`` ("neighbour" / "ideal"), ``reason`` ("" when the gait
-exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``time_limit``,
-``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``, ``unsupported``:
-the periodic-gait search has no section for this walker), ``wall_time_s``.
+exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``work_limit`` (the cell's
+search spent its step-map integrations, :attr:`MapSpec.max_step_maps`: the same on any
+machine), ``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``,
+``unsupported``: the periodic-gait search has no section for this walker), ``wall_time_s``
+(a record only: no cell's answer depends on the clock).
 
 The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
 :func:`walkerlab.plotting.gait_map_figure.gait_map_figure`.
@@ -30,8 +32,9 @@ import numpy as np
 from walkerlab.integrate.solver import Solver
 from walkerlab.walker.plant import Plant
 
-__all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
-           "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS", "stability_map_run"]
+__all__ = ["MAP_KINDS", "MAP_MAX_STEP_MAPS", "CELL_FIELDS", "REASONS", "MapSpec",
+           "default_spec", "gait_row", "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS",
+           "stability_map_run"]
 
 #: map kind -> (dotted scene path of the y axis, label); the stiffness map varies the field
 #: the scene writes its stiffness in (:attr:`MapSpec.y_field`; this one by default)
@@ -42,7 +45,13 @@ MAP_KINDS = {
 }
 
 REASONS = ("", "fall", "no_mid_stance", "solver_failure", "time_limit", "not_converged",
-           "off_patch", "no_ideal_gait", "invalid_config", "unsupported", "error")
+           "off_patch", "no_ideal_gait", "invalid_config", "unsupported", "error",
+           "work_limit")
+
+#: Default work bound of each periodic-gait search of a map cell [step-map integrations]
+#: (:attr:`MapSpec.max_step_maps`; a cell's search on the paper's walker makes a few
+#: hundred; it replaced a 60 s wall-clock limit per cell)
+MAP_MAX_STEP_MAPS = 2_000
 
 CELL_FIELDS = ("exists", "stable", "max_abs_multiplier", "step_period_s", "patch_margin_m",
                "residual", "source", "reason", "wall_time_s")
@@ -67,8 +76,10 @@ class MapSpec:
         Values of the y parameter (scene units).
     slopes_deg : tuple of float
         Slopes [deg] (x axis).
-    time_limit_s : float
-        Wall-time limit per cell [s].
+    max_step_maps : int
+        Work bound of each search of a cell (from the neighbour's gait, then from the
+        ideal one): its step-map integrations [-]
+        (:class:`walkerlab.analysis.contact.step_map.SearchBudget`).
     y_field : str, optional
         Contact field of a stiffness map (``stiffness_n_per_mm_pow_e`` or
         ``stiffness_n_per_m_pow_e``: the one the scene writes; None: the first).
@@ -77,7 +88,7 @@ class MapSpec:
     kind: str
     y_values: tuple
     slopes_deg: tuple
-    time_limit_s: float = 60.0
+    max_step_maps: int = MAP_MAX_STEP_MAPS
     y_field: str | None = None
 
     @property
@@ -98,11 +109,11 @@ class MapSpec:
     def key(self) -> str:
         """Text that identifies the spec (part of the stage's input hash)."""
         return (f"{self.kind}|{','.join(f'{v:.6g}' for v in self.y_values)}|"
-                f"{','.join(f'{v:.6g}' for v in self.slopes_deg)}|{self.time_limit_s:g}|"
+                f"{','.join(f'{v:.6g}' for v in self.slopes_deg)}|{self.max_step_maps}maps|"
                 + ",".join(f"{k}={v}" for k, v in sorted(MAP_GAIT_OPTIONS.items())))
 
 
-def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
+def default_spec(kind: str, n: int = 8, max_step_maps: int = MAP_MAX_STEP_MAPS,
                  stiffness: float = 1e5, patch_width_m: float = 0.10,
                  stiffness_field: str | None = None) -> MapSpec:
     """The default ``n x n`` grid of a map kind (slopes 0.5-4 deg), its y axis around the
@@ -130,7 +141,7 @@ def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
     lk = np.log10(stiffness)
     ys = {"stiffness": np.logspace(lk - 2, lk + 4, n), "friction": np.linspace(0.1, 0.9, n),
           "patch_width": np.linspace(0.2 * patch_width_m, 2.0 * patch_width_m, n)}[kind]
-    return MapSpec(kind, tuple(float(v) for v in np.round(ys, 6)), slopes, time_limit_s,
+    return MapSpec(kind, tuple(float(v) for v in np.round(ys, 6)), slopes, max_step_maps,
                    stiffness_field if kind == "stiffness" else None)
 
 
@@ -166,8 +177,7 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
     row, z_prev, x_ideal_prev = [], None, None
     for slope in spec.slopes_deg:
         cell = _empty_cell()
-        t0 = time.perf_counter()
-        deadline = t0 + spec.time_limit_s
+        t0 = time.perf_counter()  # a record only (wall_time_s)
         try:
             scene = _cell_scene(base, spec, y, slope)
             _w, fp, _src = ideal_fixed_point(scene, x_ideal_prev)
@@ -177,17 +187,12 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
                 + [("ideal", fp.x, 6)]
             gait, why = None, ""
             for source, guess, warm in tries:
-                left = deadline - time.perf_counter()
-                if left <= 0:
-                    why = "time_limit"
-                    break
                 try:
                     g = find_contact_periodic_gait(walker, guess, warmup_steps=warm,
-                                                   time_limit_s=left, **MAP_GAIT_OPTIONS)
+                                                   max_step_maps=spec.max_step_maps,
+                                                   **MAP_GAIT_OPTIONS)
                 except PeriodicGaitError as exc:
                     why = exc.kind
-                    if exc.kind == "time_limit":
-                        break
                     continue
                 if not g.converged:
                     why = "not_converged"

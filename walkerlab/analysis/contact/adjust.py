@@ -10,9 +10,10 @@ with ``T*``, ``l*`` the ideal step period and step length; a run that does not c
 heel strikes gets ``J = 1 + (missing steps)``.  The scene's own start is run first, then a
 coarse grid (``scipy.optimize.brute``), refined by Nelder-Mead (``scipy.optimize.minimize``)
 only when some grid start walked all its heel strikes (``J`` < 1: below that ``J`` is a step
-function of the heel strikes made, on which Nelder-Mead only spends runs).  The search has a
-CPU-time budget (``contact_sim.adjust_cpu_budget_s``), checked between contact runs: when it
-is spent the search stops and keeps the best start found so far.
+function of the heel strikes made, on which Nelder-Mead only spends runs).  The search is
+bounded by work: at most ``1 + n^2 +`` :data:`NELDER_MEAD_RUNS` contact runs, or fewer
+(``contact_sim.adjust_max_contact_runs``); when they are spent the search stops and keeps the
+best start found so far.  The same runs on any machine, so the same answer.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ NELDER_MEAD_RUNS = 60
 
 
 class _BudgetSpent(Exception):
-    """The search's CPU-time budget ran out (raised between contact runs)."""
+    """The search's contact runs are spent (raised before the run past the bound)."""
 
 
 def start_mismatch(walker, res, period: float, step_length: float, n_strides: int) -> float:
@@ -71,7 +72,7 @@ def start_mismatch(walker, res, period: float, step_length: float, n_strides: in
 
 
 def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
-                 cpu_budget_s: float | None = None) -> dict:
+                 max_contact_runs: int | None = None) -> dict:
     """Find initial-rate scale factors that make the contact gait match the ideal one.
 
     Parameters
@@ -84,11 +85,10 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
         Ideal step period [s].
     grid : (float, float, int)
         Lower and upper scale and points per axis of the coarse grid.
-    cpu_budget_s : float, optional
-        CPU time [s] of this process the search may spend, checked before each contact
-        run after the first (a run under way is finished: the search can overrun by one
-        run, at most ``contact_sim.wall_time_limit_s``); default
-        ``contact_sim.adjust_cpu_budget_s`` (None there: no budget).
+    max_contact_runs : int, optional
+        The most contact runs the search may make (the scene's own start counts; it is
+        always run); default ``contact_sim.adjust_max_contact_runs`` (None there: the
+        search's own bound, ``1 + n^2 + NELDER_MEAD_RUNS``).
 
     Returns
     -------
@@ -97,14 +97,17 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
         ``objective`` (its ``J``), ``scene_objective`` (``J`` of the scene's
         ``initial_rate_scale``), ``evaluations`` (contact runs), ``grid_best`` (2,),
         ``cpu_s`` (CPU time spent [s]), ``gave_up`` (one line when the budget ran out,
-        else ""), ``note`` (one line on a skipped refinement or on trial runs that ended in
+        else ""), ``time_limited_runs`` (runs a wall-clock limit,
+        ``contact_sim.wall_time_limit_s``, cut short: a result of the machine's speed),
+        ``note`` (one line on a skipped refinement or on trial runs that ended in
         an error, ``ValueError``/``RuntimeError``/``ArithmeticError``, counted as failed
         starts; else "") and ``runs``: the
         :func:`~walkerlab.analysis.contact.sim.simulate_from` results of the scene's start
         (``"scene"``) and of the best start (``"best"``), so that neither is run again.
     """
     cs = setup.sim
-    budget = getattr(cs, "adjust_cpu_budget_s", None) if cpu_budget_s is None else cpu_budget_s
+    budget = (getattr(cs, "adjust_max_contact_runs", None) if max_contact_runs is None
+              else max_contact_runs)
     scene_scale = np.asarray(cs.initial_rate_scale, float)
     lo, hi, n = grid
     most = 1 + n * n + NELDER_MEAD_RUNS
@@ -125,16 +128,15 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
                 minimize(lambda s: trials(s, bar), x0, method="Nelder-Mead",
                          options={"xatol": 1e-3, "fatol": 1e-8, "maxfev": NELDER_MEAD_RUNS})
         except _BudgetSpent:
-            gave_up = (f"the search gave up after {time.process_time() - trials.cpu0:.3g} s "
-                       f"of CPU time (contact_sim.adjust_cpu_budget_s: {budget:g} s, checked "
-                       f"between runs) and {trials.count} of at most {most} contact runs; "
-                       "kept the best start found so far")
+            gave_up = (f"the search gave up after {trials.count} of at most {most} contact "
+                       f"runs (contact_sim.adjust_max_contact_runs: {budget}); kept the best "
+                       "start found so far")
     note = _errors_note(note, trials.errors)
     return {"scale": np.asarray(best["scale"], float), "objective": float(best["J"]),
             "scene_objective": float(scene_J), "evaluations": trials.count,
             "grid_best": np.asarray(x0, float),
             "cpu_s": float(time.process_time() - trials.cpu0),
-            "gave_up": gave_up, "note": note,
+            "gave_up": gave_up, "note": note, "time_limited_runs": trials.time_limited,
             "runs": {"scene": trials.runs.get("scene"), "best": best["run"]}}
 
 
@@ -143,7 +145,8 @@ class _Trials:
     run from the ideal fixed point, its ``J`` (:func:`start_mismatch`); keeps the count of
     runs, the best start, the scene's own run (the first) and the trial runs that ended in
     an error (``ValueError``/``RuntimeError``/``ArithmeticError``: a failed start, ``J = 2 +
-    2 n_strides``); raises :class:`_BudgetSpent` before a run past the CPU budget [s]."""
+    2 n_strides``); raises :class:`_BudgetSpent` before a run past the bound ``budget`` (the
+    most contact runs; None: none)."""
 
     def __init__(self, setup, x_fp, period, budget, scene_scale):
         self.setup, self.x_fp, self.period, self.budget = setup, x_fp, period, budget
@@ -153,13 +156,13 @@ class _Trials:
         self.best = {"J": np.inf, "scale": scene_scale, "run": None}
         self.runs = {}
         self.errors = []  # (scale, exception) of trial runs that ended in an error
+        self.time_limited = 0  # runs a wall-clock limit (wall_time_limit_s) cut short
 
     def __call__(self, s, bar):
         from walkerlab.analysis.contact.sim import simulate_from  # light
 
         best, runs, budget = self.best, self.runs, self.budget
-        spent = time.process_time() - self.cpu0
-        if self.count and budget is not None and spent > budget:
+        if self.count and budget is not None and self.count >= budget:
             raise _BudgetSpent
         self.count += 1
         s = np.clip(np.asarray(s, float), 0.2, 5.0)
@@ -175,15 +178,15 @@ class _Trials:
             bar.update(self.count, info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: run failed")
             return v
         walker, res, _, l_star = run
+        if res.termination == "time_limit":  # a wall-clock limit: the machine's speed
+            self.time_limited += 1
         v = start_mismatch(walker, res, self.period, l_star, self.n_strides)
         if "scene" not in runs:
             runs["scene"] = run
         if v < best["J"]:
             best.update(J=v, scale=s, run=run)
-        spent = time.process_time() - self.cpu0
         bar.update(self.count, info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: J {v:.3g}; best "
-                   f"{best['J']:.3g}; CPU {spent:.0f} s"
-                   + (f" of {budget:.0f} s" if budget is not None else ""))
+                   f"{best['J']:.3g}")
         return v
 
 

@@ -41,6 +41,7 @@ from scipy.optimize import root
 from walkerlab.analysis.contact.sim import scene_start, simulate_contact
 from walkerlab.analysis.contact.step_map import (
     PeriodicGaitError,
+    SearchBudget,
     StepMap,
     section_guess_from_ideal,
 )
@@ -68,7 +69,7 @@ POWERED_COARSE_SOLVER = Solver("LSODA", 1e-8, 1e-10)
 
 __all__ = ["COARSE_SOLVER", "MAP_SOLVER", "POWERED_COARSE_SOLVER", "POWERED_MAP_SOLVER",
            "ContactPeriodicGait", "converged_gait", "find_contact_periodic_gait",
-           "ideal_gait", "simulate_from_periodic_gait"]
+           "ideal_gait", "search_bounds", "simulate_from_periodic_gait"]
 
 
 @dataclass
@@ -223,6 +224,16 @@ def _last_call_memo(f):
     return g
 
 
+def search_bounds(sim) -> dict:
+    """The bounds a scene's ``contact_sim`` section (``sim``,
+    :class:`walkerlab.config.contact_sim.ContactSimSettings`) sets on its periodic-gait
+    search, as :func:`find_contact_periodic_gait`'s keywords: ``max_step_maps``
+    (``periodic_max_step_maps``, work) and ``time_limit_s`` (``periodic_time_limit_s``, an
+    optional wall-clock limit)."""
+    return {"max_step_maps": getattr(sim, "periodic_max_step_maps", None),
+            "time_limit_s": getattr(sim, "periodic_time_limit_s", None)}
+
+
 def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0, 1.0),
                                warmup_steps: int = 8, xtol: float = 1e-8,
                                residual_tol: float = 1e-8, fd_step: float = 1e-4,
@@ -231,7 +242,8 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
                                coarse_solver: Solver | None = COARSE_SOLVER,
                                coarse_xtol: float = 1e-6,
                                patch_spacing: float | None = None,
-                               time_limit_s: float | None = None) -> ContactPeriodicGait:
+                               time_limit_s: float | None = None,
+                               max_step_maps: int | None = None) -> ContactPeriodicGait:
     """Periodic gait of the compliant-contact walker and its Floquet multipliers.
 
     Parameters
@@ -279,7 +291,11 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     patch_spacing : float, optional
         Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
     time_limit_s : float, optional
-        Wall-time limit of the whole search [s].
+        Wall-clock limit of the whole search [s] (a search it ends depends on the machine's
+        speed: kind ``time_limit``).
+    max_step_maps : int, optional
+        Work bound of the whole search: the most step-map integrations
+        (:class:`~walkerlab.analysis.contact.step_map.SearchBudget`; kind ``work_limit``).
 
     Returns
     -------
@@ -288,21 +304,21 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     Raises
     ------
     PeriodicGaitError
-        A step of the map fell, found no mid-stance, the solver failed, or the wall-time
-        limit ran out (``kind`` says which).
+        A step of the map fell, found no mid-stance, the solver failed, the work bound or
+        the wall-clock limit ran out (``kind`` says which).
     """
     wall = time.perf_counter()
-    deadline = None if time_limit_s is None else wall + time_limit_s
+    budget = SearchBudget(max_step_maps, np.inf if time_limit_s is None else wall + time_limit_s)
     solver, jacobian_solver, coarse_solver = _map_solvers(walker, solver, jacobian_solver,
                                                           coarse_solver)
-    P, PC, coarse = _step_maps(walker, patch_spacing, solver, coarse_solver, deadline)
+    P, PC, coarse = _step_maps(walker, patch_spacing, solver, coarse_solver, budget)
     z, hist = _warm_up_guess(walker, P, PC, guess, rate_scale, warmup_steps)
     sol, root_nfev = _solve_fixed_point(P, PC, coarse, z, solver.method, fd_step, xtol,
                                         coarse_xtol, residual_tol)
     return _periodic_gait_result(
         walker, P, PC, coarse, sol, root_nfev, hist, solver=solver,
         coarse_solver=coarse_solver, jacobian_solver=jacobian_solver,
-        patch_spacing=patch_spacing, deadline=deadline, fd_step=fd_step, check_fd=check_fd,
+        patch_spacing=patch_spacing, budget=budget, fd_step=fd_step, check_fd=check_fd,
         residual_tol=residual_tol, wall=wall)
 
 
@@ -329,15 +345,17 @@ def _map_solvers(walker: ContactWalker, solver, jacobian_solver, coarse_solver):
     return solver, jacobian_solver, coarse_solver
 
 
-def _step_maps(walker: ContactWalker, patch_spacing, solver, coarse_solver, deadline):
+def _step_maps(walker: ContactWalker, patch_spacing, solver, coarse_solver,
+               budget: SearchBudget):
     """The step map on ``solver`` and the cheap one on ``coarse_solver`` (the same method) when
-    its ``rtol`` is looser (else the map itself): ``(P, PC, coarse)``."""
+    its ``rtol`` is looser (else the map itself): ``(P, PC, coarse)``, both charged to the
+    search's ``budget``."""
     method = solver.method
-    P = StepMap(walker, patch_spacing, solver, deadline=deadline)
+    P = StepMap(walker, patch_spacing, solver, budget=budget)
     coarse = coarse_solver is not None and coarse_solver.rtol > solver.rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, dataclasses.replace(coarse_solver, method=method),
-                 deadline=deadline) if coarse else P
+                 budget=budget) if coarse else P
     return P, PC, coarse
 
 
@@ -428,7 +446,8 @@ def _solve_fixed_point(P: StepMap, PC: StepMap, coarse: bool, z: np.ndarray, met
 
 
 def _floquet_multipliers(walker: ContactWalker, P: StepMap, zs: np.ndarray, solver: Solver,
-                         jacobian_solver: Solver, patch_spacing, deadline, fd_step: float,
+                         jacobian_solver: Solver, patch_spacing, budget: SearchBudget,
+                         fd_step: float,
                          check_fd: bool):
     """The final Jacobian of :func:`find_contact_periodic_gait` at the fixed point ``zs``:
     central differences of step ``fd_step * scale`` on the map at ``jacobian_solver``'s
@@ -439,7 +458,7 @@ def _floquet_multipliers(walker: ContactWalker, P: StepMap, zs: np.ndarray, solv
     scale = P.scale
     jac_solver = dataclasses.replace(jacobian_solver, method=solver.method)
     PJ = P if (jac_solver.rtol, jac_solver.atol) == (solver.rtol, solver.atol) else \
-        StepMap(walker, patch_spacing, jac_solver, deadline=deadline)
+        StepMap(walker, patch_spacing, jac_solver, budget=budget)
     FJ = lambda v: PJ(v)[0]  # noqa: E731
     J = fd_jacobian(FJ, zs, fd_step * scale)
     ev = sort_multipliers(np.linalg.eigvals(J))
@@ -457,7 +476,8 @@ def _floquet_multipliers(walker: ContactWalker, P: StepMap, zs: np.ndarray, solv
 def _periodic_gait_result(walker: ContactWalker, P: StepMap, PC: StepMap, coarse: bool, sol,
                           root_nfev: int, hist: list[float], *, solver: Solver,
                           coarse_solver: Solver | None, jacobian_solver: Solver,
-                          patch_spacing, deadline, fd_step: float, check_fd: bool,
+                          patch_spacing, budget: SearchBudget, fd_step: float,
+                          check_fd: bool,
                           residual_tol: float, wall: float) -> ContactPeriodicGait:
     """The result of :func:`find_contact_periodic_gait` from its root solve ``sol``: one step
     of the tight map from the fixed point (period, step length, residual), the Floquet
@@ -470,7 +490,7 @@ def _periodic_gait_result(walker: ContactWalker, P: StepMap, PC: StepMap, coarse
     res_si = z1 - zs
     margin = P.patch_margin(zs)  # from the step just taken (the map keeps its last one)
     PJ, J, ev, spread = _floquet_multipliers(walker, P, zs, solver, jacobian_solver,
-                                             patch_spacing, deadline, fd_step, check_fd)
+                                             patch_spacing, budget, fd_step, check_fd)
     info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": root_nfev,
             "fd_step": fd_step, "scales": scale, "method": method, "rtol": solver.rtol,
             "atol": solver.atol, "coarse_rtol": coarse_solver.rtol if coarse else None,
@@ -522,9 +542,10 @@ def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None 
 
     The gait is found from the ideal fixed point ``x_ideal``
     (:func:`walkerlab.analysis.contact.periodic.find_contact_periodic_gait`, within
-    ``contact_sim.periodic_time_limit_s``); the run starts at its mid-stance section (leg2
-    stance, stance foot at s = 0) on patches spaced by the gait's step length, so every
-    footfall lands where the gait's does, and runs ``(2 strides + 1)`` gait periods.
+    ``contact_sim.periodic_max_step_maps``, :func:`search_bounds`); the run starts at its
+    mid-stance section (leg2 stance, stance foot at s = 0) on patches spaced by the gait's
+    step length, so every footfall lands where the gait's does, and runs
+    ``(2 strides + 1)`` gait periods.
 
     ``x_ideal`` (2n,): the rigid walker's post-impact fixed point (its ``state_names()``,
     [rad, rad/s]); the returned ``x0`` is the contact walker's full state (2 nq,)
@@ -539,14 +560,13 @@ def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None 
     Raises
     ------
     walkerlab.analysis.contact.periodic.PeriodicGaitError
-        The periodic gait was not found (fell, no mid-stance, solver failure, time limit,
-        not converged: :func:`converged_gait`).
+        The periodic gait was not found (fell, no mid-stance, solver failure, work bound,
+        time limit, not converged: :func:`converged_gait`).
     """
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
     probe, _, limits, _ = scene_start(setup, x_ideal, n_strides)
-    gait = converged_gait(find_contact_periodic_gait(probe, x_ideal,
-                                                     time_limit_s=cs.periodic_time_limit_s))
+    gait = converged_gait(find_contact_periodic_gait(probe, x_ideal, **search_bounds(cs)))
     walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
     x0 = np.asarray(gait.full_state, float)
     t_final = cs.t_final_s or (2 * n_strides + 1) * gait.period_s

@@ -223,12 +223,13 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
         from walkerlab.analysis.contact.periodic import (  # light
             converged_gait,
             find_contact_periodic_gait,
+            search_bounds,
         )
         from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
         try:  # an unconverged search is a gait not found (its outcome and message)
-            gait = converged_gait(find_contact_periodic_gait(
-                walker, fp.x, time_limit_s=cs.periodic_time_limit_s))
+            gait = converged_gait(find_contact_periodic_gait(walker, fp.x,
+                                                             **search_bounds(cs)))
         except PeriodicGaitError as exc:
             gait_error = exc
     return ContactSimRun(

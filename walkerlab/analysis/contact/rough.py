@@ -53,7 +53,7 @@ class ContactStart:
 def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
                   *, plant) -> ContactStart:
     """The contact periodic gait of ``scene`` found from the rigid gait ``x_ideal``
-    (within ``contact_sim.periodic_time_limit_s``); ``periodic=False``: the contact run's
+    (within ``contact_sim.periodic_max_step_maps``); ``periodic=False``: the contact run's
     own start instead (:func:`walkerlab.analysis.contact.sim.scene_start`: the rigid gait
     with ``contact_sim.initial_rate_scale``, the ideal step length, the rigid gait's step
     period; no periodic-gait search, so walks start with a transient).
@@ -71,6 +71,7 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
     from walkerlab.analysis.contact.periodic import (  # light
         converged_gait,
         find_contact_periodic_gait,
+        search_bounds,
     )
     from walkerlab.analysis.contact.sim import scene_start  # light
     from walkerlab.models.contact.scene import contact_setup  # light
@@ -86,25 +87,27 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
         return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                             tuple(map(float, x0)), float(step_length), float(period),
                             float(scene.slope.phi_rad))
-    gait = converged_gait(find_contact_periodic_gait(probe, x_ideal,
-                                                     time_limit_s=cs.periodic_time_limit_s))
+    gait = converged_gait(find_contact_periodic_gait(probe, x_ideal, **search_bounds(cs)))
     return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                         tuple(map(float, gait.full_state)), float(gait.step_length_m),
                         float(gait.period_s), float(scene.slope.phi_rad))
 
 
-#: wall-time limit of one walk [s]: WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S per step (a
-#: foot caught below a patch's top at its edge makes the stiff solver grind until the
-#: limit: that walk has tripped; a walking step takes a small fraction of the limit)
-WALK_TIME_LIMIT_S = 10.0
-WALK_TIME_PER_STEP_S = 2.0
+#: work bound of one walk [right-hand-side evaluations]: WALK_RHS_EVALUATIONS +
+#: WALK_RHS_EVALUATIONS_PER_STEP per step (a foot caught below a patch's top at its edge
+#: makes the stiff solver grind until the bound: that walk has tripped; a walking step of the
+#: paper's walker takes ~3,000, a small fraction of the bound); the same walks end the same
+#: way on any machine
+WALK_RHS_EVALUATIONS = 2_000_000
+WALK_RHS_EVALUATIONS_PER_STEP = 200_000
 
 
 def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
                  ) -> tuple[int, bool, str]:
     """Walk the contact walker from ``start`` on footfalls at ``heights_m`` [m] until it
-    makes ``max_steps`` heel strikes or stops otherwise (wall-time limit
-    ``WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S max_steps``, or the scene's if smaller).
+    makes ``max_steps`` heel strikes or stops otherwise (work bound
+    ``WALK_RHS_EVALUATIONS + WALK_RHS_EVALUATIONS_PER_STEP max_steps`` right-hand-side
+    evaluations, or the scene's ``contact_sim.max_rhs_evaluations`` if smaller).
 
     Returns
     -------
@@ -121,8 +124,8 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     sv = setup.solver
     x_ideal = np.asarray(start.x_ideal, float)
     _, _, limits, _ = scene_start(setup, x_ideal, 2)
-    cap = WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S * max_steps
-    limits = replace(limits, wall_time_limit_s=min(limits.wall_time_limit_s or cap, cap))
+    cap = WALK_RHS_EVALUATIONS + WALK_RHS_EVALUATIONS_PER_STEP * max_steps
+    limits = replace(limits, max_rhs_evaluations=min(limits.max_rhs_evaluations or cap, cap))
     walker, _ = setup.build(x_ideal, max_steps + 2, step_length_m=start.step_length_m)
     walker = footfall_lanes(walker, heights_m)
     res = simulate_contact(walker, np.asarray(start.x0, float),

@@ -170,12 +170,14 @@ def _run_outcome(walker, run, ev, after, limits, slip_limit_mm, initial_stance):
 
 
 #: the ends without an event that a run met after its strides asked for still ends by the cap
-_EVENTLESS_ENDS = (RunEnd.SOLVER_FAILURE.value, RunEnd.TIME_LIMIT.value)
+_EVENTLESS_ENDS = (RunEnd.SOLVER_FAILURE.value, RunEnd.TIME_LIMIT.value,
+                   RunEnd.WORK_LIMIT.value)
 #: outcomes a checkerboard laid out for another step can cause (its fit is then named)
 _OFF_THE_PATCHES = ("trip", "fall", "scuff")
 #: how the end that followed the strides asked for reads after "then"
 _AFTER_WORDS = {"trip": "tripped", "fall": "fell", "airborne": "left the ground",
-                "solver_failure": "the solver failed", "time_limit": "the wall time ran out"}
+                "solver_failure": "the solver failed", "time_limit": "the wall time ran out",
+                "work_limit": "the work bound ran out"}
 #: a foot this far [m] below the ground line over a gap at the run's end fell into it
 _IN_A_GAP_M = 0.01
 
@@ -307,7 +309,7 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
         sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
         pin_time_s=cs.pin_time_s,
         fall_hip_height_m=cs.fall_hip_height_m or ContactLimits().fall_hip_height_m,
-        wall_time_limit_s=cs.wall_time_limit_s)
+        wall_time_limit_s=cs.wall_time_limit_s, max_rhs_evaluations=cs.max_rhs_evaluations)
     return walker, x0, limits, step_length
 
 

@@ -101,6 +101,7 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
 
+from .search_budget import PeriodicGaitError, SearchBudget
 from .section import (
     SCALES,
     SECTION_NAMES,
@@ -112,19 +113,9 @@ from .section import (
 
 brentq = import_on_fresh_stack("scipy.optimize").brentq  # see walkerlab.freshstack
 
-__all__ = ["SCALES", "SECTION_NAMES", "SECTION_UNITS", "PeriodicGaitError", "StepMap",
+__all__ = ["SCALES", "SECTION_NAMES", "SECTION_UNITS", "PeriodicGaitError", "SearchBudget",
+           "StepMap",
            "section_coordinates", "section_guess_from_ideal"]
-
-
-class PeriodicGaitError(RuntimeError):
-    """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
-    "time_limit", "solver_failure", "not_converged" (the search ended away from a fixed
-    point: :func:`walkerlab.analysis.contact.periodic.converged_gait`), "several_steps" (a
-    ground whose steps differ: the one-step map does not apply, not searched)."""
-
-    def __init__(self, kind: str, message: str):
-        super().__init__(message)
-        self.kind = kind
 
 
 #: what to try when a step of the map falls: the search starts from the rigid gait's state
@@ -165,11 +156,17 @@ class StepMap:
         (:mod:`walkerlab.integrate.contact_powered_step`).
     t_max : float
         Give up a step after this time [s].
+    deadline : float, optional
+        ``time.perf_counter()`` value past which a map evaluation raises ``time_limit``
+        (None: none); ignored when ``budget`` is given (its own deadline).
+    budget : SearchBudget, optional
+        The search's bounds, shared with its other maps (each integration is charged to
+        it); default a budget of this map's own with no work bound.
     """
 
     def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
                  solver: Solver = DEFAULT_SOLVER, t_max: float = 3.0,
-                 deadline: float | None = None):
+                 deadline: float | None = None, budget: SearchBudget | None = None):
         acts = getattr(walker, "actuators", None)
         if acts is not None and any(r is not None for r in acts.laws.time_refs):
             raise ValueError("walker.actuation: a torque law on time since the heel strike "
@@ -203,7 +200,10 @@ class StepMap:
                                           continuous=keep_ground, **heights)
         self.method, self.t_max = solver.method, t_max
         self.solver = solver  # the step map's integrator
-        self.deadline = np.inf if deadline is None else deadline
+        #: the search's shared bounds (its work, its wall-clock deadline)
+        self.budget = SearchBudget(deadline=np.inf if deadline is None else deadline) \
+            if budget is None else budget
+        self.deadline = self.budget.deadline
         self.nfev = 0
         self._last_section = (None, None)  # next_section's last (arguments, answer)
         w = self.walker
@@ -302,10 +302,15 @@ class StepMap:
         events = [Event("mid_stance", lambda t, x: x[isw] - x[ist], 1.0),
                   Event("fall", lambda t, x: self.walker.fall_margin(x, hth), -1.0,
                         RunEnd.FALL)]
-        run = run_to_event(self._rhs, x0, self.t_max, self.solver, events, jac=self._jac,
-                           dense=dense)
+        self._spend()
+        return run_to_event(self._rhs, x0, self.t_max, self.solver, events, jac=self._jac,
+                            dense=dense)
+
+    def _spend(self) -> None:
+        """Count one integration of the map (:attr:`nfev`) and charge it to the search's
+        :class:`SearchBudget` (raises its ``work_limit``)."""
+        self.budget.spend()
         self.nfev += 1
-        return run
 
     def next_section(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
                      chunk_s: float = 0.25, passive: bool = False):
@@ -360,7 +365,7 @@ class StepMap:
             return X
 
         ta, xa = t0, np.asarray(x0, float)
-        self.nfev += 1
+        self._spend()
         while ta < self.t_max:
             if time.perf_counter() > self.deadline:
                 raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
@@ -404,7 +409,7 @@ class StepMap:
         acts = self.walker.actuators
         if not acts.laws:
             return self._push_off_section(x0, stance_to_come, ist, isw, hth)
-        self.nfev += 1
+        self._spend()
         te, xe, end = powered_to_section(self.walker, np.asarray(x0, float),
                                          1 - stance_to_come,
                                          lambda x: x[..., isw] - x[..., ist],
@@ -568,7 +573,7 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
             # from the post-impact state to the first mid-stance: no heel strike between
             xe = step_map.next_section(x0, stance_to_come=1, passive=True)[1]
         except PeriodicGaitError as e:
-            if e.kind == "time_limit":
+            if e.kind in ("time_limit", "work_limit"):
                 raise
             raise PeriodicGaitError("fall" if e.kind == "fall" else "no_mid_stance",
                                     "the ideal state does not reach mid-stance on the "

@@ -297,5 +297,12 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
     if termination == "time_limit":
         return Outcome("time_limit", te, "", np.nan, hip_height_m,
                        f"time limit: {wall_time_limit_s:g} s of wall time used by t = "
-                       f"{te:.4g} s ({n_hs} heel strikes)")
+                       f"{te:.4g} s ({n_hs} heel strikes); cut short by the machine's speed "
+                       "(contact_sim.wall_time_limit_s): never kept as the scene's result, "
+                       "the next run recomputes it")
+    if termination == "work_limit":
+        return Outcome("work_limit", te, "", np.nan, hip_height_m,
+                       f"work limit: {limits.max_rhs_evaluations:,} right-hand-side "
+                       f"evaluations used by t = {te:.4g} s ({n_hs} heel strikes); raise "
+                       "contact_sim.max_rhs_evaluations for a longer run")
     return classify_complete(steps, slip_limit_mm, hip_height_m, end=termination)

@@ -248,8 +248,9 @@ def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_P
                 if not np.isnan(moment):  # a walker in 3D: the twist its stance foot needs
                     if np.isnan(twist) or abs(moment) > twist:
                         twist, t_twist = abs(moment), float(t)
-                    if mu is not None and fn > 0:
-                        radius = np.nanmax([radius, 1.5 * abs(moment) / (mu * fn)])
+                    if mu is not None and fn > 0:  # no friction (mu 0): no foot holds it
+                        radius = np.nanmax([radius, 1.5 * abs(moment) / (mu * fn)
+                                            if mu > 0 else np.inf])
                 if fn < n_min:
                     n_min, t_min = fn, float(t)
                 if fn > 0:

@@ -51,6 +51,10 @@ class Comparison:
         Step number + fraction of the step [-] of the phase-aligned errors.
     phase_errors : dict[str, ndarray (m,)] or None
         Error contact - ideal at the same fraction of the same step, per named coordinate.
+    contact_cut_short : str
+        What a wall-clock limit cut short in the contact run compared (its
+        ``contact_sim.h5``'s ``not_final``; "" when nothing): such a comparison is over what
+        the run did before the limit, and is never kept as a result either.
     """
 
     legs: list
@@ -66,6 +70,7 @@ class Comparison:
     phase_errors: dict | None = None
     path: Path | None = None
     units: Units | None = None
+    contact_cut_short: str = ""
 
 
 def write_compare(f, c: Comparison) -> None:
@@ -126,4 +131,5 @@ def load_compare(f, path: Path) -> Comparison:
                               if "limit_cycle_distance" in g else {}),
         max_abs_angle_rad=float(g["max_abs_angle"][()]),
         max_abs_rate_rad_per_s=float(g["max_abs_rate"][()]),
-        metrics=metrics, metric_units=munits, path=Path(path), units=for_artifact(f))
+        metrics=metrics, metric_units=munits, path=Path(path), units=for_artifact(f),
+        contact_cut_short=str(f.attrs.get("not_final", "")))

@@ -2,7 +2,7 @@
 contact parameter × the slope (writer and loader side by side).
 
 Layout: root attributes ``kind``, ``y_path`` (the scene field varied), ``y_label``,
-``stiffness_family``, ``time_limit_s``, ``method``; ``y_values`` (ny,)
+``stiffness_family``, ``max_step_maps``, ``method``; ``y_values`` (ny,)
 and ``slopes_deg`` (nx,) [deg]; one (ny, nx) array per cell field
 (:data:`walkerlab.studies.stability.CELL_FIELDS`: ``exists``, ``stable``,
 ``max_abs_multiplier``, ``step_period_s`` [s], ``patch_margin_m`` [m], ``residual``,
@@ -60,7 +60,7 @@ def write_stability_map(f, run: StabilityMapRun) -> None:
     f.attrs["y_path"] = run.spec.y_path
     f.attrs["y_label"] = run.y_label
     f.attrs["stiffness_family"] = run.stiffness_family
-    f.attrs["time_limit_s"] = run.spec.time_limit_s
+    f.attrs["max_step_maps"] = int(run.spec.max_step_maps)
     if run.scene_point is not None:  # marked on the map wherever the grid lies
         f.attrs["scene_slope_deg"], f.attrs["scene_y"] = (float(v) for v in run.scene_point)
     f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "

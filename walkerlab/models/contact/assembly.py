@@ -286,9 +286,10 @@ def twist(spin, fn, PC):
     torsional coefficient; an evenly pressed disc of radius ``r`` has ``tau = 2 mu_s r /
     3``) and ``mu`` the ADAMS Coulomb coefficient of the patch's slip speed ``rho spin``
     (:func:`walkerlab.models.contact._kernels.friction_mu`, signed: against the spin).
-    0 without a torsional coefficient or off the ground."""
+    0 without a torsional coefficient, without friction (``mu_s`` 0: no moment, and no
+    ``rho``) or off the ground."""
     tau = PC[I_TOR]
-    if fn <= 0.0 or tau <= 0.0:
+    if fn <= 0.0 or tau <= 0.0 or PC[I_MUS] <= 0.0:
         return 0.0
     rho = tau / PC[I_MUS]
     return friction_mu(rho * spin, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])[0] * fn * rho

@@ -282,10 +282,32 @@ def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetu
     if cs.start == "periodic_gait" and len(ground_drops(scene.terrain)) > 1:
         # the run cannot start there (periodic_gait: true records the gait as not found)
         raise ContactSceneError(f"scene '{scene.name}': {SEVERAL_STEPS_PERIODIC}")
+    _check_start_offset(scene, data.structure, cs)
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain_or_default(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators,
                         scene=scene, plant=plant)
+
+
+def _check_start_offset(scene: Scene, structure, cs: ContactSimSettings) -> None:
+    """Refuse, before any search, a ``contact_sim.start_offset`` naming a state the walker
+    does not have (its rigid states, :meth:`walkerlab.walker.layout.StateLayout.rigid` of
+    the structure's roles: what the run adds the offset to), in one line listing every
+    valid name.
+
+    Raises
+    ------
+    ContactSceneError
+    """
+    if cs.start_offset is None:
+        return
+    from walkerlab.walker.layout import StateLayout  # light
+
+    try:
+        cs.start_offset.as_array(list(StateLayout.rigid(structure.roles).names))
+    except ValueError as exc:
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start_offset.{exc}"
+                                ) from None
 
 
 def _start_of(scene: Scene, part, cs: ContactSimSettings) -> ContactSimSettings:

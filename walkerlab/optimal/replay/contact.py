@@ -21,13 +21,9 @@ from walkerlab.optimal.transcription.stride import step_of
 from walkerlab.safefs import raise_if_interrupted
 from walkerlab.walker.plant import Plant
 
-__all__ = ["REPLAY_WALL_TIME_LIMIT_S", "SETTLED_STEPS", "contact_replay",
+__all__ = ["SETTLED_STEPS", "contact_replay",
            "contact_replay_controller", "contact_replay_five_link",
            "contact_replay_phased", "contact_replay_stride", "replay_failure"]
-
-#: Wall-time limit [s] of a phased walker's contact replay (its powered run).
-REPLAY_WALL_TIME_LIMIT_S = 1800.0
-
 
 def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     """Run the contact model with the optimised torques.
@@ -137,11 +133,10 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
         section's flat-foot regularisation or a walker the contact view carries no hip
         torque on (one line).
     """
-    # a powered run is on a Python RHS (slow on a flat-footed walker's stride), so the
-    # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
+    # a powered run is on a Python RHS (slow on a flat-footed walker's stride): bounded by
+    # its work (contact_sim.max_rhs_evaluations' default), the same on any machine
     setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
-                                {"n_strides": strides, "sample_rate_hz": 500,
-                                 "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S})
+                                {"n_strides": strides, "sample_rate_hz": 500})
     if setup is None:
         return float("nan"), why
     setup.actuators.laws = TorqueOfTime(phase_torque_of_time(res),
