@@ -600,3 +600,17 @@ def test_iterations_without_design_refused():
     with pytest.raises(SceneError) as e:
         scene_from_dict(_scene(THREELINK, opt))
     assert "optimize.max_iterations" in one_line(e)
+
+
+def test_a_design_a_cpu_limit_stopped_is_marked_never_reused():
+    """A controller IPOPT stopped at the user's CPU-time limit depends on the machine:
+    optimize.h5 is marked not_final (never reused); one stopped by its iterations is a
+    result."""
+    from types import SimpleNamespace as NS
+
+    from walkerlab.stages.optimize import cpu_limited
+
+    data = NS(controllers=[NS(status="Solve_Succeeded"), NS(status="Maximum_CpuTime_Exceeded")])
+    assert cpu_limited(data) == "controller(s) 2: optimize.cpu_budget_s, a CPU-time limit"
+    assert cpu_limited(NS(controllers=[NS(status="Maximum_Iterations_Exceeded")])) == ""
+    assert cpu_limited(NS(controllers=None)) == ""

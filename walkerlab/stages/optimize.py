@@ -15,6 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.config import Scene
+from walkerlab.io.freshness import NOT_FINAL_ATTR
 from walkerlab.io.runpaths import design_stem, stage_artifact
 from walkerlab.io.schemas import optimize as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
@@ -122,9 +123,26 @@ def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream,
         except ValueError as exc:
             raise StageError(str(exc)) from exc
         data = schema.optimize_record(optimum, for_scene(scene).energy)
-        return (lambda f: schema.write(f, data)), {"data": data}
+        cut = cpu_limited(data)
+
+        def writer(f):
+            schema.write(f, data)
+            if cut:  # a user's CPU-time limit decided it: shown, never reused
+                f.attrs[NOT_FINAL_ATTR] = cut
+        return writer, {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, upstream, compute, force)
+
+
+def cpu_limited(data) -> str:
+    """What a user's CPU-time limit (``optimize.cpu_budget_s``) cut short in the optimum's
+    records ``data``: the controllers IPOPT stopped at it (``Maximum_CpuTime_Exceeded``),
+    "" when none (IPOPT's iterations, ``optimize.max_iterations``, end the same way on any
+    machine: such a design is a result)."""
+    cut = [str(i + 1) for i, c in enumerate(getattr(data, "controllers", None) or ())
+           if getattr(c, "status", "") == "Maximum_CpuTime_Exceeded"]
+    return (f"controller(s) {', '.join(cut)}: optimize.cpu_budget_s, a CPU-time limit"
+            if cut else "")
 
 
 def write_controller_scenes(scene: Scene, artifact: Path) -> list[Path]:
