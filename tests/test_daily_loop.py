@@ -105,11 +105,13 @@ def test_contact_sim_without_a_contact_section_runs_on_the_defaults(tmp_path):
 
 # --------------------------------------------------------------- 2: no-gait advice whole
 def test_no_gait_error_keeps_its_advice_whole(tmp_path):
-    """An uphill slope has no passive gait: the one error line ends the advice with what
-    to give (fixedpoint.initial_guess); only the solver's detail is shortened."""
+    """An uphill slope has no passive gait: the error's first line ends the advice with what
+    to give (fixedpoint.initial_guess); the solver's detail, whole, takes a second."""
     d = {**BARE, "slope": {"angle_deg": -1.0}, "fixedpoint": {}}
     rc, err, _ = _cli("fixedpoint", _scene(tmp_path, d), "--runs-dir", tmp_path / "runs")
-    assert rc == 1 and len(err.splitlines()) == 1
+    lines = err.splitlines()
+    assert rc == 1 and len(lines) == 2 and lines[1].startswith("  [tried "), err
+    assert "give fixedpoint.initial_guess" in lines[0]
     assert "downhill slope" in err and "give fixedpoint.initial_guess" in err
     assert "try a continuation from a walker whose gait is known" in err
     assert "more characters" not in err.split("give fixedpoint.initial_guess")[0]
