@@ -110,7 +110,7 @@ def contact_text(c: ContactSimArtifact) -> str:
             lines.append("--adjust: kept the adjusted initial rate scale: "
                          + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
                          + (f" ({why})" if why else ""))
-        for k in ("gave_up", "note"):  # a search that ran out of CPU time, or cut short
+        for k in ("gave_up", "note"):  # a search that spent its runs, or cut short
             if str(c.adjust.get(k, "")):
                 lines.append(f"--adjust: {c.adjust[k]}")
     for k, (v, unit) in c.summary.items():
