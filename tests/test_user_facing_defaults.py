@@ -63,7 +63,7 @@ def test_quiet_after_the_command_is_accepted_as_before_it(tmp_path):
 
 # ------------------------------------------------------------------ 4: 3D walker's figures
 def test_out_of_plane_coordinates_are_told_by_their_names():
-    from walkerlab.walker.description import out_of_plane
+    from walkerlab.walker.planes import out_of_plane
 
     for name in ("lean_angle", "lean_rate", "leg1_roll_angle", "pelvis_roll_rate",
                  "heading_angle"):

@@ -132,10 +132,10 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
     """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model
     (``units``: the scene's unit labels).  The coordinates that turn out of the sagittal
     plane (a walker in 3D: its lean and rolls, a wheel's heading;
-    :func:`walkerlab.walker.description.out_of_plane`, by name) get panels of their own
+    :func:`walkerlab.walker.planes.out_of_plane`, by name) get panels of their own
     beside them, (c) and (d): their few hundredths of a radian would be flat lines on the
     pitches' axes.  A planar walker's figure has the two panels alone."""
-    from walkerlab.walker.description import out_of_plane  # light
+    from walkerlab.walker.planes import out_of_plane  # light
 
     every = [n for tr in trajs.values() for n in tr.coordinates]  # one colour per link
     lateral = any(out_of_plane(n) for n in every)

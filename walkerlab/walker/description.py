@@ -54,11 +54,6 @@ COMPASS_3D_PARAMS = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
 #: Roles added by hip-roll joints (``hip_roll``): the pelvis' and the swing leg's roll
 #: about the fall line (the ``lean`` is then the stance leg's).
 HIP_ROLL_ROLES = ("pelvis_roll", "swing_roll")
-#: The last word of a coordinate that turns out of the sagittal plane (a walker in 3D: the
-#: lean and the rolls about the fall line, a wheel's heading about the slope's normal), in a
-#: role's name (:data:`COMPASS_3D_ROLES`, :data:`HIP_ROLL_ROLES`, :data:`SPOKED_3D_ROLES`) or
-#: a leg's (``leg1_roll_angle``); every other coordinate is a pitch in that plane.
-OUT_OF_PLANE_WORDS = ("lean", "roll", "heading")
 #: Parameters of the hip-roll joints and law (:class:`walkerlab.config.walker.HipRollLaw`,
 #: SI): the pelvis' roll inertia, the stance hip's stiffness and damping on the pelvis roll,
 #: the swing hip's on the swing leg's, the foot-placement gains on the lean and its rate.
@@ -298,25 +293,6 @@ class Structure:
             d["space"] = "3d"
         d.update({k: True for k in ("hip_width", "hip_roll", "parts_3d") if getattr(self, k)})
         return json.dumps(d)
-
-
-def out_of_plane(name: str) -> bool:
-    """Whether the coordinate ``name`` (a role's or a physical one, with its ``_angle`` or
-    ``_rate``: ``lean_angle``, ``leg1_roll_rate``, ``heading_angle``) turns out of the
-    sagittal plane (:data:`OUT_OF_PLANE_WORDS`): a 3D walker's lateral motion, which the
-    figures draw on axes of their own (a roll of a few hundredths of a radian beside
-    pitches of tenths).
-
-    Parameters
-    ----------
-    name : str
-
-    Returns
-    -------
-    bool
-    """
-    stem = name.removesuffix("_angle").removesuffix("_rate")
-    return stem.rsplit("_", 1)[-1] in OUT_OF_PLANE_WORDS
 
 
 def state_names(roles) -> list[str]:
