@@ -175,3 +175,43 @@ def test_a_pool_worker_ends_silently_with_130_on_sigint(capfd):
             job.result()
     err = capfd.readouterr().err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
+
+
+_CTRL_C = '''
+import os, signal, sys, time
+
+
+def main():
+    signal.signal(signal.SIGINT, lambda *a: None)  # the command's handler: records, prints nothing
+    from walkerlab.execution.workers import process_pool
+    with open(sys.argv[1], "w") as ready:
+        ex = process_pool(2)
+        ready.write(str(ex.submit(os.getpid).result()))  # a worker started and now idle
+    os.killpg(os.getpgid(0), signal.SIGINT)  # Ctrl-C reaches the terminal's whole group
+    for _ in range(200):  # until the workers are gone (each ends on its own)
+        if not any(p.is_alive() for p in list(ex._processes.values())):
+            break
+        time.sleep(0.05)
+    ex.shutdown(wait=False)
+
+
+if __name__ == "__main__":
+    main()
+'''
+
+
+def test_ctrl_c_to_a_commands_process_group_prints_no_workers_traceback(tmp_path):
+    """Issue 96 item 6: Ctrl-C reaches the pool's workers as well as the command; an idle
+    worker printed ``Process ForkServerProcess-1: Traceback ... KeyboardInterrupt`` (one
+    compiling numba, an llvmlite traceback) under the command's own ``interrupted``."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "ctrl_c.py"
+    script.write_text(_CTRL_C)
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    r = subprocess.run([sys.executable, str(script), str(tmp_path / "ready")],
+                       capture_output=True, text=True, start_new_session=True, env=env,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "Traceback" not in r.stderr and "KeyboardInterrupt" not in r.stderr, r.stderr
