@@ -61,17 +61,19 @@ def test_the_hip_roll_urdf_is_the_mjcfs_walker_in_pinocchio(tmp_path):
 def test_the_powered_3d_urdf_lists_its_actuators_and_hip_roll_law_as_left_out(tmp_path):
     """The URDF has no actuator, force or law element: the motor ``hip`` (on ``leg1_hip -
     leg2_hip``), the push-off, the hip-roll law and the pelvis' held pitch and yaw are
-    listed as left out (file comments and the export's lines alike), the scene's actuation
-    and law in comments; the passive walker without hip roll lists nothing."""
+    listed as left out after the ground (file comments and the export's lines alike), the
+    scene's actuation and law in comments; the passive walker without hip roll lists the
+    ground alone (issue 96: it printed nothing)."""
     scene = load(str(ROOT / "configs" / "hip_width_powered.yaml"))
     out = export.write(scene, tmp_path / "u", "urdf", walker_only=True)
     text = Path(out.path).read_text()
     assert [ln.split(":")[0] for ln in out.left_out] == [
-        "the hip-roll law (walker.hip_roll)", "the pelvis' held pitch and yaw", "motor hip",
+        "the ground (slope, terrain and contact law)", "the hip-roll law (walker.hip_roll)", "the pelvis' held pitch and yaw", "motor hip",
         "the push-off (walker.actuation.push_off)"]
     assert all(f"<!-- Left out: {ln} -->" in text for ln in out.left_out)
-    assert "leg1_hip - leg2_hip" in out.left_out[2]
+    assert "leg1_hip - leg2_hip" in out.left_out[3]
     assert "<!-- walkerlab_actuation: {" in text and "<!-- walkerlab_hip_roll: {" in text
     passive = export.write(load(str(ROOT / "configs" / "paper_3d.yaml")), tmp_path / "p",
                            "urdf", walker_only=True)
-    assert passive.left_out == ()
+    assert [ln.split(":")[0] for ln in passive.left_out] == [
+        "the ground (slope, terrain and contact law)"]

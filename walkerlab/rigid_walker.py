@@ -96,7 +96,12 @@ class Gait:
         Mean step length [m]: stance foot to swing foot at heel strike
         (:func:`walkerlab.analysis.gait.metrics.step_length`).
     speed : float
-        Distance along the ground over the map's period [m/s].
+        Distance along the ground over the map's period [m/s]: the step length (along the
+        slope) over the step period.  Not :attr:`walkerlab.api.walks.Walk.speed` (the
+        ``simulate`` stage's ``hip_speed``), the hip's *horizontal* displacement over the
+        step's period: on a slope of angle phi that is ``cos(phi)`` times this, at the
+        fixed point exactly (the paper's scene, phi = 0.0174 rad: 0.527902 against 0.527822
+        m/s, 1.5e-4 lower; the same gait, two definitions).
     cost_of_transport : float
         Mean over the map's steps of (positive actuator work + push-off work + slope
         energy if > 0) / (M g d) [-] (Kuo 2002; Collins et al. 2005); a passive gait's is

@@ -81,7 +81,10 @@ class Walk:
 
     @property
     def speed(self) -> np.ndarray:
-        """Hip speed of each step [m/s] (``steps["hip_speed"]``)."""
+        """Hip speed of each step [m/s] (``steps["hip_speed"]``): the hip's horizontal
+        displacement over the step's period.  :attr:`Gait.speed` is the distance along the
+        slope over the period: on a slope of angle phi a walk on the fixed point has
+        ``cos(phi)`` times the gait's speed (the paper's scene: 1.5e-4 lower)."""
         return self.steps["hip_speed"]
 
     @property

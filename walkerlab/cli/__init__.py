@@ -10,7 +10,8 @@ module                    what
 ``commands_families``     sweep, bifurcation, continuation
 ``commands_robustness``   basin, mfpt, robustness, stability-map
 ``commands_reference``    capabilities (the walker kinds' capability table)
-``options``               the shared arguments, loading the scene, the status line
+``options``               the shared arguments, loading the scene, the status line,
+                          ``--quiet``/``-q`` on every command (``with_quiet``)
 ``errors``                the exit policy (:func:`walkerlab.cli.errors.guard`)
 ``process``               process settings (OpenBLAS threads, numba cache) and --version
 ``typer_flags``           typer's usage errors as one line ``error: ...``
@@ -36,6 +37,7 @@ from walkerlab.cli import (
     commands_robustness,
     commands_runs,
 )
+from walkerlab.cli.options import QUIET_HELP, with_quiet
 from walkerlab.cli.process import process_settings, single_threaded_blas, version_callback
 from walkerlab.cli.typer_flags import usage_errors_in_one_spelling
 
@@ -52,10 +54,7 @@ def _main(ctx: typer.Context,
                                        is_eager=True,
                                        help="print walkerlab, Python, numpy, scipy, numba "
                                        "and h5py versions and exit"),
-          quiet: bool = typer.Option(False, "--quiet", "-q",
-                                     help="no progress display and no notices on stderr "
-                                     "(errors are still shown); when stderr is not a "
-                                     "terminal, progress is a plain line per finished unit")
+          quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP)
           ) -> None:
     """walkerlab: biped walkers (planar; in 3D: space: 3d), passive and powered, from fixed point
     to report."""
@@ -109,5 +108,5 @@ SHORT_HELP = {
     "bench": "Benchmark wall time and right-hand-side evaluations.",
     "capabilities": "Show what each walker kind supports in each view.",
 }
-for _name, _command in COMMANDS:
-    app.command(_name, short_help=SHORT_HELP[_name])(_command)
+for _name, _command in COMMANDS:  # each with --quiet/-q of its own (options.with_quiet)
+    app.command(_name, short_help=SHORT_HELP[_name])(with_quiet(_command))

@@ -43,3 +43,49 @@ def status(o) -> str:
     """The line saying what a stage did: ``wrote <path> (compute ...)`` or ``reused ...``."""
     return (f"reused {o.path} ({o.note or 'inputs unchanged'})" if o.reused
             else f"wrote {o.path} (compute {o.wall_time_s:.3f} s)")
+
+
+#: ``--quiet`` / ``-q``: accepted before the command (``walkerlab -q report``) and after it
+#: (``walkerlab report -q``), so every command's ``--help`` lists it
+QUIET_HELP = ("no progress display and no notices on stderr (errors are still shown); when "
+              "stderr is not a terminal, progress is a plain line per finished unit")
+
+
+def with_quiet(command):
+    """``command`` with a ``--quiet``/``-q`` option of its own: the one of ``walkerlab
+    --quiet``, listed by the command's ``--help`` (typer lists a group's options only in
+    the group's help).  Given, it installs the silent progress sink before the command runs
+    (:func:`walkerlab.progress.sink_for_terminal`).
+
+    Parameters
+    ----------
+    command : callable
+        A command function (already wrapped by :func:`walkerlab.cli.errors.guard`).
+
+    Returns
+    -------
+    callable
+        The function typer registers: ``command``'s parameters and ``quiet``.
+    """
+    import functools
+    import inspect
+
+    sig = inspect.signature(command, eval_str=True)
+    if "quiet" in sig.parameters:
+        raise TypeError(f"{command.__name__}: has a 'quiet' parameter of its own")
+    option = typer.Option(False, "--quiet", "-q", help=QUIET_HELP)
+
+    @functools.wraps(command)
+    def quieted(*args, quiet: bool = False, **kwargs):
+        if quiet:
+            from walkerlab import progress  # light
+
+            progress.install(progress.sink_for_terminal(True))
+        return command(*args, **kwargs)
+
+    quieted.__signature__ = sig.replace(parameters=[
+        *sig.parameters.values(),
+        inspect.Parameter("quiet", inspect.Parameter.KEYWORD_ONLY, default=option,
+                          annotation=bool)])
+    quieted.__annotations__ = {**getattr(command, "__annotations__", {}), "quiet": bool}
+    return quieted

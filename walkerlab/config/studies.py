@@ -237,7 +237,16 @@ class SimulateSettings(Strict):
 
 
 class WorkPrecisionSettings(Strict):
-    """Error against run time for every scipy method over a range of tolerances."""
+    """Error against run time for every scipy method over a range of tolerances.
+
+    ``walkerlab report`` measures it with ``--full``, or without it when
+    ``in_default_report`` is true (the paper's scene: its error against run time is the
+    first thing the project adds to the paper).
+    """
+
+    in_default_report: bool = Field(
+        False, description="also measured by `walkerlab report` without `--full` (default: "
+        "opt-in, `--full` only; the study times every setting: keep it light where true)")
 
     methods: list[Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"]] = Field(
         ["RK45", "DOP853", "Radau", "BDF", "LSODA"], description="scipy solve_ivp methods")

@@ -94,11 +94,20 @@ from walkerlab.export.legs_3d_mjcf import (
     legs3d_keyframe,
 )
 from walkerlab.export.legs_3d_parts import legs_summary, walker_tree
+from walkerlab.export.omitted import Omission
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
 from walkerlab.walker.description import state_names
 
-__all__ = ["PIN_JOINT_3D", "Adams3dStart", "adams3d_start", "adm3d_text", "reuler_angles"]
+#: What the 3D dataset leaves out of the planar dataset's statements (its header's "Not
+#: written" line; ``walkerlab export`` prints it)
+ADAMS_3D_OMISSIONS = (Omission(
+    "the energies' requests (the planar dataset's REQUEST/90)",
+    "the 3D dataset writes no energy requests; walkerlab's simulate.h5 and contact_sim.h5 "
+    "hold the energies"),)
+
+__all__ = ["ADAMS_3D_OMISSIONS", "PIN_JOINT_3D", "Adams3dStart", "adams3d_start", "adm3d_text",
+           "reuler_angles"]
 
 #: The temporary stance-foot pin (a SPHERICAL joint), deactivated by the .acf (the planar
 #: dataset's id: :data:`walkerlab.export.adams.PIN_JOINT`).

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 from walkerlab.export.text import comment
 
-__all__ = ["ADAMS_CONTINUATION", "MJCF_KNEE_LATCH", "PREFIX", "URDF_GROUND", "URDF_KNEE_LATCH",
+__all__ = ["ADAMS_CONTINUATION", "MJCF_KNEE_LATCH", "PREFIX", "URDF_GROUND", "URDF_GROUND_3D",
+           "URDF_KNEE_LATCH",
            "Omission", "adams_comments", "lines", "xml_comments"]
 
 #: The text every omission comment starts with (after an XML comment's opening or an Adams
@@ -60,6 +61,11 @@ URDF_GROUND = Omission(
     "the ground (slope, terrain and contact law)",
     "URDF has no world or contact element; the slope is stated in the header, the rigid "
     "gait in the keyframe sidecar (the MJCF export carries ground and contact)")
+#: The ground a 3D walker's URDF leaves out (no keyframe sidecar: the MJCF carries the gait).
+URDF_GROUND_3D = Omission(
+    "the ground (slope, terrain and contact law)",
+    "URDF has no world or contact element; the slope is stated in the header (the MJCF "
+    "export carries ground, contact and the rigid gait)")
 #: A kneed walker's MJCF with its gait (planar, :func:`walkerlab.export.multibody.
 #: mjcf_omissions`; in 3D, :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`): the knee
 #: latch's equalities are switched outside the file.

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.motors import motor_target, motors
-from walkerlab.export.omitted import URDF_GROUND, URDF_KNEE_LATCH, Omission
+from walkerlab.export.omitted import URDF_GROUND, URDF_GROUND_3D, URDF_KNEE_LATCH, Omission
 from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import ankle_springs
 from walkerlab.export.text import comment, num
@@ -58,13 +58,20 @@ def flat_feet_comments(data, mb: Multibody) -> list[str]:
 def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omission, ...]:
     """What :func:`walkerlab.export.urdf.legs_urdf_text` leaves out
     (:mod:`walkerlab.export.omitted`): a planar walker's :func:`urdf_omissions`; a 3D
-    walker's hip-roll law and the pelvis' held pitch and yaw (with hip-roll joints), its knee
-    latch (knees: the planar URDF's item), its motors and push-off."""
+    walker's ground, hip-roll law and the pelvis' held pitch and yaw (with hip-roll joints),
+    each coupling (a bisecting hip: ``mimic`` follows one joint only), its knee latch
+    (knees: the planar URDF's item), its motors and push-off."""
     if not data.structure.in_3d:
         return urdf_omissions(multibody(data), actuation)
-    from walkerlab.export.legs_3d_parts import hip_roll_law, kneed  # light: 3D only
+    from walkerlab.export.legs_3d_parts import (  # light: 3D only
+        hip_roll_law,
+        kneed,
+        legs3d_roles,
+        walker_tree,
+    )
+    from walkerlab.export.tree_bodies import export_bodies  # light
 
-    out = []
+    out = [URDF_GROUND_3D]
     if hip_roll_law(data) is not None:
         out += [Omission("the hip-roll law (walker.hip_roll)", "URDF has no law element: "
                          "its gains are in the comment walkerlab_hip_roll (the MJCF export "
@@ -72,6 +79,11 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
                 Omission("the pelvis' held pitch and yaw", "URDF's root is a loader's "
                          "floating base, free about every axis; the rigid pelvis only rolls "
                          "about the fall line")]
+    tree, coords, p = walker_tree(data)
+    _root, couplings = export_bodies(tree, coords, p, legs3d_roles(data))
+    out += [Omission(f"coupling {cp.name}", "URDF's mimic follows one joint only, so a URDF "
+                     f"library sees a free {cp.terms[0][0]} (the relation is in a comment)")
+            for cp in couplings]
     if kneed(data):
         out.append(URDF_KNEE_LATCH)
     return tuple(out + urdf_actuation_omissions(actuation,

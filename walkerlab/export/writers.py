@@ -411,15 +411,19 @@ def _adams_3d(job: ExportJob, w: Writer) -> Written:
     """The 3D straight-legged walker's ``walker.adm`` and ``walker.acf``
     (:func:`walkerlab.export.adams_3d.adm3d_text`), refused before the gait search as its
     MJCF is (:func:`_check_legs_3d`); a 3D wheel as the capability table has it."""
-    from walkerlab.export.adams_3d import adams3d_start, adm3d_text  # light: 3D only
+    from walkerlab.export.adams_3d import (  # light: 3D only
+        ADAMS_3D_OMISSIONS,
+        adams3d_start,
+        adm3d_text,
+    )
 
     _check_legs_3d(job, w)  # --walker-only: the gait still written, as the planar dataset's
     scene = job.scene
     strides = int(scene.contact_sim.n_strides) if scene.contact_sim else 5
     ideal, start = job.gait(lambda ideal: adams3d_start(job.data, ideal, strides))
     adm = adm3d_text(scene, job.data, start, job.name, walkerlab.__version__)
-    return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))), (),
-                   step_period(ideal))
+    return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))),
+                   tuple(o.line for o in ADAMS_3D_OMISSIONS), step_period(ideal))
 
 
 def _osim(job: ExportJob, w: Writer) -> Written:

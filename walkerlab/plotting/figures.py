@@ -130,28 +130,49 @@ def _coordinate_styles(names, model_index: int = 0) -> dict[str, dict]:
 def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
                       units: Units = SI_UNITS):
     """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model
-    (``units``: the scene's unit labels)."""
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.4), sharex=True, layout="constrained")
+    (``units``: the scene's unit labels).  The coordinates that turn out of the sagittal
+    plane (a walker in 3D: its lean and rolls, a wheel's heading;
+    :func:`walkerlab.walker.planes.out_of_plane`, by name) get panels of their own
+    beside them, (c) and (d): their few hundredths of a radian would be flat lines on the
+    pitches' axes.  A planar walker's figure has the two panels alone."""
+    from walkerlab.walker.planes import out_of_plane  # light
+
     every = [n for tr in trajs.values() for n in tr.coordinates]  # one colour per link
+    lateral = any(out_of_plane(n) for n in every)
+    ncol = 2 if lateral else 1
+    fig, axes = plt.subplots(2, ncol, figsize=(8 * ncol, 6.4), sharex=True,
+                             layout="constrained", squeeze=False)
     for mi, (label, tr) in enumerate(trajs.items()):
         sty = {n: s for n, s in _coordinate_styles(every, mi).items() if n in tr.coordinates}
-        for ax, names in zip(axes, (tr.angle_names(), tr.rate_names())):
+        for row, names in enumerate((tr.angle_names(), tr.rate_names())):
             for n in sorted(names, key=lambda n: n.split("_", 1)[0]):  # legend: leg by leg
+                ax = axes[row, 1 if lateral and out_of_plane(n) else 0]
                 ax.plot(tr.time, tr.coordinates[n], lw=1.2,
                         label=f"{n.rsplit('_', 1)[0]} - {label}", **sty[n])
-    axes[0].set_ylabel("angle from vertical [rad]", fontsize=10)
-    axes[1].set_ylabel(f"angular rate [{units.rate}]", fontsize=10)
-    axes[1].set_xlabel(f"time [{units.time}]", fontsize=10)
-    axes[0].set_title("(a) angles", fontsize=10)
-    axes[1].set_title("(b) angular rates", fontsize=10)
-    for ax in axes:
+    plane = " in the sagittal plane (pitches)" if lateral else ""
+    axes[0, 0].set_ylabel("angle from vertical [rad]", fontsize=10)
+    axes[1, 0].set_ylabel(f"angular rate [{units.rate}]", fontsize=10)
+    axes[0, 0].set_title(f"(a) angles{plane}", fontsize=10)
+    axes[1, 0].set_title(f"(b) angular rates{plane}", fontsize=10)
+    if lateral:
+        axes[0, 1].set_ylabel("angle [rad]", fontsize=10)
+        axes[1, 1].set_ylabel(f"angular rate [{units.rate}]", fontsize=10)
+        axes[0, 1].set_title("(c) angles out of the sagittal plane (lean, rolls, heading)",
+                             fontsize=10)
+        axes[1, 1].set_title("(d) their rates", fontsize=10)
+    for ax in axes[1]:
+        ax.set_xlabel(f"time [{units.time}]", fontsize=10)
+    for ax in axes.flat:
         ax.grid(alpha=0.3)
         ax.tick_params(labelsize=9)
-    h, lab = axes[0].get_legend_handles_labels()
+    h, lab = [], []
+    for ax in axes[0]:
+        hh, ll = ax.get_legend_handles_labels()
+        h, lab = h + hh, lab + ll
     # below the panels, inside the figure with its margin (constrained layout makes room)
     # two columns (a model's legs side by side): no wider than the panels, so the report's
     # scaled image keeps its text size
-    fig.legend(h, lab, loc="outside lower center", ncol=min(2, len(h)), fontsize=9)
+    fig.legend(h, lab, loc="outside lower center", ncol=min(2 * ncol, len(h)), fontsize=9)
     fig.suptitle(f"Fig. 7 - {title}, angles and rates", fontsize=11)
     return fig
 

@@ -85,6 +85,9 @@ def scene_figure_plan(scene, sim, contact, terrain, compare) -> list[tuple[str, 
     trajs = {label: a.samples for label, a in ((IDEAL_LABEL, sim), (CONTACT_LABEL, contact))
              if a is not None}
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
+    if any(len(p) > 2 for a in (sim, contact) if a is not None
+           for p in a.samples.points.values()):  # world points in 3D: a walker in 3D
+        title = title.replace(" walking", " in 3D walking")
     has_drop = contact is not None and scene.contact is not None and contact.drop is not None
     ledger = [] if sim is None or not sim.ledger else [
         ("energy_ledger", partial(energy_ledger, sim, for_scene(scene)))]

@@ -181,7 +181,8 @@ STAGES: dict[str, Stage] = {s.name: s for s in (
     _stage(art.WORKPRECISION, "workprecision", (art.FIXEDPOINT.name,), "workprecision",
           "no 'workprecision' section", phase="study",
           earlier="measured for other settings; `walkerlab report --full` measures it again",
-          in_plan=lambda scene, full, plan: full and scene.workprecision is not None),
+          in_plan=lambda scene, full, plan: scene.workprecision is not None
+          and (full or scene.workprecision.in_default_report)),
     _stage(art.BIFURCATION, "bifurcation",
           earlier="computed for another walker, slope or solver"),
     _stage(art.BASIN, "basin", (art.FIXEDPOINT.name,),
@@ -213,8 +214,9 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
     each only when the scene has its sections (``fixedpoint``, with the section's defaults,
     also when ``simulate`` starts from the gait or the scene asks for a contact run:
     ``contact`` and ``contact_sim``); the work-precision study (it times every solver
-    setting: most of a cold report) and the Section-5 attribution (seven periodic-gait
-    searches) only with ``full``."""
+    setting: most of a cold report) only with ``full`` or where the scene's
+    ``workprecision.in_default_report`` asks for it (the paper's scene), and the Section-5
+    attribution (seven periodic-gait searches) only with ``full``."""
     plan: dict[str, bool] = {}
     for s in STAGES.values():
         plan[s.name] = s.in_plan is not None and bool(s.in_plan(scene, full, plan))

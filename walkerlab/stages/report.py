@@ -54,7 +54,8 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo: Callable[[str], None] = print, full: bool = False) -> Path:
     """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
-    ``full``: also the work-precision study and the attribution
+    ``full``: also the work-precision study (without it too where the scene's
+    ``workprecision.in_default_report`` is true: the paper's scene) and the attribution
     (:func:`walkerlab.stages.pipeline.report_plan`).  Returns the HTML report."""
     stages = report_plan(scene, full)
     if not stages:
@@ -77,7 +78,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo(line)
     paths, left_out = report_artifacts(scene, runs_root, done, full)
     if scene.workprecision is not None and WORKPRECISION.name not in paths:
-        echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
+        echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`, or "
+             "`workprecision.in_default_report: true` in the scene)")
     if scene.contact is not None and scene.fixedpoint is not None \
             and CONTACT_SIM.name in stages and ATTRIBUTION.name not in paths:
         why = attribution_refused(scene)

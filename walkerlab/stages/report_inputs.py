@@ -103,8 +103,10 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
     """'' when the artifact ``p`` the report did not produce is shown all the same."""
     kind = BIFURCATION.name if stage.startswith(BIFURCATION.name) else stage
-    if kind not in EARLIER or (kind == WORKPRECISION.name and (scene.workprecision is None or full)
-                               ) or (kind == ATTRIBUTION.name and (scene.contact is None or full)):
+    wp = scene.workprecision
+    if kind not in EARLIER or (kind == WORKPRECISION.name and (
+            wp is None or full or wp.in_default_report)) or (
+            kind == ATTRIBUTION.name and (scene.contact is None or full)):
         return f"an earlier standalone run: the scene has {not_run(scene, stage)}"
     if kind == BIFURCATION.name and not stored_content_hash_matches(p):  # edited by hand (26)
         return "changed after it was written: rerun 'walkerlab bifurcation'"

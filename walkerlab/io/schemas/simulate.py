@@ -39,6 +39,9 @@ STEP_UNITS = {"t_start": "s", "t_end": "s", "period": "s", "step_length": "m",
               "midstance_time": "s"}
 #: what each ``steps/`` column is, where its name does not say it all (others: the name)
 STEP_DESCRIPTIONS = {
+    "hip_speed": "the hip's horizontal displacement over the step divided by its period (on "
+                 "a slope phi: cos(phi) times step length / period, the gait's speed along "
+                 "the slope)",
     "impact_energy_loss": "kinetic energy lost in the heel-strike collision (after the "
                           "push-off, if any, minus after the heel strike)",
     "transition_energy_change": "net change of the kinetic energy across the step-to-step "
