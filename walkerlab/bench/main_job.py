@@ -22,8 +22,10 @@ measurement            what is timed                                            
                        (:mod:`walkerlab.bench.bare_fixedpoint`), whole process against
                        whole process, ``pairs`` pairs alternating which goes first
                        (CPU of each; the median of the pairs' ratios)
-``report_cold``        the first ``walkerlab report SCENE`` of a fresh runs folder and   10 s
-                       a fresh user cache, whole process
+``report_cold``        the first ``walkerlab report SCENE`` of a fresh runs folder and   90 s
+                       a fresh user cache, whole process (the paper's report times its
+                       work-precision study, ``workprecision.in_default_report``: about
+                       a minute of repeats, which the 10 s of the report alone exclude)
 ``montecarlo``         CPU per heel strike of the MFPT Monte Carlo walks (one chunk    1.2 x
                        of ``walks`` walks of at most ``steps`` steps at ``sigma_mc``,
                        in process, :func:`walkerlab.studies.mfpt.run_walks`) against
