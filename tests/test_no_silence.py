@@ -31,7 +31,7 @@ def _wait_for(pred, limit_s: float = 20.0) -> bool:
 def test_a_quiet_task_gets_a_heartbeat_line_naming_it_and_none_after_the_command():
     out = io.StringIO()
     sink = progress.LineSink(stream=out, label="walkerlab fixedpoint")
-    sink.heartbeat.stop()  # replaced by one with a short period
+    assert sink.heartbeat is None  # the suite's WALKERLAB_HEARTBEAT_S=0 (conftest)
     sink.heartbeat = progress.Heartbeat(sink._print, sink._under_way, every_s=0.2)
     with progress.use(sink):
         with progress.task("deriving the equations of this walker structure"):
@@ -50,7 +50,6 @@ def test_a_quiet_task_gets_a_heartbeat_line_naming_it_and_none_after_the_command
 def test_a_line_shown_resets_the_heartbeat():
     out = io.StringIO()
     sink = progress.LineSink(stream=out, label="walkerlab sweep")
-    sink.heartbeat.stop()
     sink.heartbeat = progress.Heartbeat(sink._print, sink._under_way, every_s=5.0)
     with progress.use(sink):
         for _ in range(4):  # a notice every 0.1 s: never 5 s of silence
@@ -60,11 +59,16 @@ def test_a_line_shown_resets_the_heartbeat():
     assert "working" not in out.getvalue()
 
 
-def test_the_cli_sink_has_a_heartbeat_unless_quiet():
+def test_the_cli_sink_has_a_heartbeat_unless_quiet(monkeypatch):
     class Tty(io.StringIO):
         def isatty(self):
             return False
 
+    monkeypatch.delenv(progress.HEARTBEAT_ENV, raising=False)  # the default: 8 s
+    assert progress.heartbeat_s() == progress.HEARTBEAT_S <= 10
+    monkeypatch.setenv(progress.HEARTBEAT_ENV, "0")  # off
+    assert progress.sink_for_terminal(False, Tty(), label="walkerlab report").heartbeat is None
+    monkeypatch.delenv(progress.HEARTBEAT_ENV)
     loud = progress.sink_for_terminal(False, Tty(), label="walkerlab report")
     quiet = progress.sink_for_terminal(True, Tty(), label="walkerlab report")
     try:
@@ -78,10 +82,10 @@ def test_the_cli_sink_has_a_heartbeat_unless_quiet():
 def test_a_new_structure_says_its_code_generation_before_it_starts(tmp_path):
     """An empty code cache: the first run of the paper walker says, on stderr, that it
     derives this structure's equations for the first time on this machine (and where the
-    cost is documented); the second run, from the cache, says nothing of it and finds the
+    cost is documented), and the heartbeat names the derivation while it runs; the second run, from the cache, says nothing of it and finds the
     same gait."""
     env = {**os.environ, "WALKERLAB_CACHE_DIR": str(tmp_path / "cache"),
-           "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+           "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "WALKERLAB_HEARTBEAT_S": "1"}
     cmd = [sys.executable, "-m", "walkerlab.cli", "fixedpoint", str(ROOT / "configs/paper.yaml"),
            "--runs-dir", str(tmp_path / "runs")]
     first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=1200)
@@ -89,6 +93,8 @@ def test_a_new_structure_says_its_code_generation_before_it_starts(tmp_path):
     assert "deriving the equations of this walker structure: first time on this machine" \
         in first.stderr
     assert "docs/user_guide/first_run.md" in first.stderr
+    # never silent: the derivation (seconds) is seen working, a line a second here
+    assert "deriving the equations of this walker structure: working (" in first.stderr
     (tmp_path / "runs" / "paper" / "fixedpoint.h5").unlink()
     second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=1200)
     assert second.returncode == 0, second.stderr

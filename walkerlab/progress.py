@@ -30,11 +30,24 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Protocol
 
-__all__ = ["HEARTBEAT_S", "Heartbeat", "Sink", "Task", "task", "note", "use", "current",
+__all__ = ["HEARTBEAT_ENV", "HEARTBEAT_S", "Heartbeat", "heartbeat_s", "Sink", "Task", "task", "note", "use", "current",
            "install", "sink_for_terminal", "QuietSink", "RichSink", "LineSink"]
 
-#: longest silence of a command [s]: past it the heartbeat prints a line (:class:`Heartbeat`)
+#: longest silence of a command [s]: past it the heartbeat prints a line (:class:`Heartbeat`);
+#: ``$WALKERLAB_HEARTBEAT_S`` sets another (0: none, as a test suite that reads stderr does)
 HEARTBEAT_S = 8.0
+HEARTBEAT_ENV = "WALKERLAB_HEARTBEAT_S"
+
+
+def heartbeat_s() -> float:
+    """The heartbeat's period [s]: ``$WALKERLAB_HEARTBEAT_S`` when it is a number, else
+    :data:`HEARTBEAT_S`; 0 or less: no heartbeat."""
+    import os
+
+    try:
+        return float(os.environ.get(HEARTBEAT_ENV, HEARTBEAT_S))
+    except ValueError:
+        return HEARTBEAT_S
 
 
 class Sink(Protocol):
@@ -130,7 +143,9 @@ class LineSink:
         self._tasks: dict[int, tuple[str, float, int, int | None]] = {}
         self._label = label
         #: with a label (the CLI's command), a line at least every HEARTBEAT_S
-        self.heartbeat = Heartbeat(self._print, self._under_way) if label else None
+        period = heartbeat_s()
+        self.heartbeat = (Heartbeat(self._print, self._under_way, period)
+                          if label and period > 0 else None)
 
     def _under_way(self) -> str:
         """The innermost task open, or the command."""
@@ -179,7 +194,9 @@ class RichSink:
         self._label = label
         # with a label: a line when no task is open and nothing was shown for HEARTBEAT_S
         # (an open task's line is redrawn with its elapsed time by rich itself)
-        self.heartbeat = Heartbeat(self._idle_line, lambda: str(label)) if label else None
+        period = heartbeat_s()
+        self.heartbeat = (Heartbeat(self._idle_line, lambda: str(label), period)
+                          if label and period > 0 else None)
 
     def _idle_line(self, line: str) -> None:
         if self._progress is None:
