@@ -32,16 +32,25 @@ _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
                     "codegen/equations.py", "codegen/lagrange.py",
                     "codegen/compiled_source.py", "codegen/frames.py")
 _memo: dict[str, dict] = {}
-#: what each generated module of the cache folder is, by the tag its file name ends in
-_WHAT = {"nb": "the compiled flow", "floating": "the floating-base (contact) view"}
+#: what each generated module of the cache folder is, by a part of its file name (the first
+#: part that names one, from the end: ``<key>_act_<tag>_nb.py`` is an actuated flow)
+_WHAT = {"rows": "the batched step kernels", "act": "the actuated compiled flow",
+         "vcnb": "the compiled virtual-constraint controller",
+         "vc": "the virtual-constraint outputs", "vcflow": "the virtual-constraint flow",
+         "vcrhs": "the contact model's virtual-constraint controller",
+         "contact": "the contact model's kernels",
+         "floating": "the floating-base (contact) view", "nb": "the compiled flow"}
 #: the documentation page that says what a first run of a new structure costs
 FIRST_RUN_DOC = "docs/user_guide/first_run.md"
 
 
 def _what(filename: str) -> str:
     """What the generated module ``filename`` is, in words (:data:`_WHAT`)."""
-    tag = filename.rsplit(".", 1)[0].rsplit("_", 1)[-1]
-    return _WHAT.get(tag, f"the generated {tag} module")
+    parts = filename.rsplit(".", 1)[0].split("_")[1:]
+    for part in ("rows", "act", "vcnb", "vcflow", "vcrhs", "vc", "contact", "floating", "nb"):
+        if part in parts:
+            return _WHAT[part]
+    return "a generated module"
 
 
 def _first_time(what: str) -> None:
