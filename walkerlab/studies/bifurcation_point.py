@@ -1,7 +1,9 @@
 """One chunk of a bifurcation diagram's grid (:mod:`walkerlab.studies.bifurcation`), the
 worker's side: for each value ``p`` along the chunk's run, the scene at ``p``
 (:func:`scene_at`), the period-1 fixed point and its Floquet multipliers (continued from the
-neighbouring value's, by arclength steps where the branch turns) and the steady state
+neighbouring value's, by arclength steps where the branch turns; where that finds none, the
+gait ``walkerlab fixedpoint`` finds for the value's scene, so that a value is
+``no_fixed_point`` only when a fresh start finds no gait either) and the steady state
 (``n_transient`` steps simulated, the inter-leg angle at the last ``n_keep`` heel strikes
 kept; started from the previous value's final state projected on this value's heel-strike
 surface, or from the fixed point slightly perturbed): :func:`bifurcation_chunk`, one row per
@@ -142,7 +144,11 @@ def _value_gait(scene, guess):
     PointOutcome
         ``no_fixed_point`` (the fresh start's message) or ``invalid_config``.
     """
-    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point, scene_gait
+    from walkerlab.studies.point_gait import (  # light: worker side
+        PointOutcome,
+        ideal_fixed_point,
+        scene_gait,
+    )
 
     try:
         walker, res, _src = ideal_fixed_point(scene, guess)
