@@ -152,22 +152,37 @@ def test_a_planar_basin_artifact_is_the_same_on_one_and_two_workers(tmp_path):
     assert_same_datasets(one, two)
 
 
-def test_a_3d_basins_corner_cell_off_the_heel_strike_surface_is_unreachable_on_any_workers(
-        tmp_path):
-    """The stabilised 3D walker's default axes (stance angle x stance rate) on a 4 x 4 grid:
-    the corner cells at the smallest stance angle have no state on the heel-strike surface
-    (OffSection, once an internal error); they are ``unreachable``, the map is drawn, and
-    it is the same on two workers."""
-    from walkerlab.io.schemas.basin import load_basin
-    from walkerlab.studies.basin import CODE
-
-    scene = _scene(tmp_path, "hip_width_stabilised", basin={"grid": [4, 4], "max_steps": 3})
+def test_a_3d_basin_artifact_is_the_same_on_one_and_two_workers(tmp_path):
+    """The 3D walker with hip width, its default axes on a 4 x 4 grid, three strides a cell."""
+    scene = _scene(tmp_path, "hip_width", ("contact", "simulate"),
+                   basin={"grid": [4, 4], "max_steps": 3})
     one, two = _basin_on_one_and_two(scene, tmp_path)
     assert_same_datasets(one, two)
-    b = load_basin(two)
-    outcome = np.asarray(b["outcome"])
-    assert outcome[0, 0] == CODE["unreachable"] and outcome[-1, 0] == CODE["unreachable"]
-    assert np.sum(outcome != CODE["unreachable"]) >= 8  # the rest were walked
+
+
+def test_a_3d_basin_cell_off_the_heel_strike_surface_is_unreachable():
+    """The stabilised 3D walker's default axes (stance angle x stance rate) on a 4 x 4 grid:
+    the cells at the smallest stance angle have no state on the heel-strike surface
+    (OffSection: ``walkerlab basin`` ended in an internal error).  Such a cell is
+    ``unreachable``, and the axes are checked at the first cell on the surface."""
+    from walkerlab.models.registry import build_walker
+    from walkerlab.studies.basin import CODE, BasinTask, _start_pre_impact, axis_values
+    from walkerlab.studies.basin_cell import run_basin_chunk, walker_and_settings
+    from walkerlab.walker.plant import Plant
+
+    scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
+    names = build_walker(scene, plant=Plant.from_scene(scene)).state_names()
+    g = scene.fixedpoint.initial_guess.model_extra  # the gait to 6 decimals
+    x_star = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                       for n in names])
+    base = scene.model_dump(mode="json")
+    base["basin"] = {"grid": [4, 4]}
+    walker, st, mst = walker_and_settings(base)
+    xs, ys = axis_values(st, walker, x_star, (4, 4))
+    assert _start_pre_impact(walker, x_star, st, mst, xs, ys) == ()  # no error
+    cells = ((0, float(xs[0]), float(ys[0])), (12, float(xs[0]), float(ys[-1])))
+    rows = run_basin_chunk(BasinTask(base, tuple(x_star), cells, ()))
+    assert rows == [(0, CODE["unreachable"], 0, 0), (12, CODE["unreachable"], 0, 0)]
 
 
 # ----------------------------------------------------------------------------- mfpt
