@@ -103,7 +103,7 @@ def test_a_planar_bifurcation_artifact_is_the_same_on_one_and_two_workers(tmp_pa
     assert_same_datasets(one, two)
 
 
-@pytest.mark.slow  # five 3D values (one from the fixedpoint stage's search), twice: ~40 s
+@pytest.mark.slow  # five 3D values (0.06 m from a fresh search), twice: ~10 s
 def test_a_3d_bifurcation_over_the_hip_width_finds_every_gait_on_two_workers(tmp_path):
     """The hostile probe of issue 96: over the hip width 0.06 ... 0.1 m two workers recorded
     ``no_fixed_point`` at 0.06 and 0.08 m (their chain started at 0.08 m from the scene's
@@ -186,7 +186,7 @@ def test_a_3d_basin_cell_off_the_heel_strike_surface_is_unreachable():
 
 
 # ----------------------------------------------------------------------------- mfpt
-@pytest.mark.slow  # the step map compiled in this process and in the pool: ~2 min
+@pytest.mark.slow  # ~7 s, ~2 min on a cold numba cache (the step map compiled)
 def test_a_planar_mfpt_artifact_is_the_same_on_one_and_two_workers(tmp_path):
     """Monte Carlo walks in two chunks (500 walks a task)."""
     from walkerlab.stages import pipeline
