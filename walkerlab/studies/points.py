@@ -50,7 +50,7 @@ from walkerlab.studies.point_gait import (
 from walkerlab.walker.plant import Plant
 
 __all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
-           "contact_adapter", "POINT_FUNCTIONS"]
+           "contact_adapter", "step_period", "POINT_FUNCTIONS"]
 
 
 @dataclass(frozen=True)
