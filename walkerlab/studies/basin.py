@@ -43,6 +43,7 @@ import numpy as np
 
 from walkerlab import progress
 from walkerlab.execution.executor import run_each
+from walkerlab.models.hybrid.base import OffSection
 from walkerlab.studies.basin_cell import (  # noqa: F401 (part of this API)
     CODE,
     OUTCOMES,
@@ -182,16 +183,27 @@ def _start_pre_impact(walker, x_star: np.ndarray, st, mst: float, xs: np.ndarray
     heel_strike`` the fixed point's pre-impact state (:func:`pre_impact_fixed_point`, ``mst``
     [s] capping the step) as a tuple of floats, once :func:`heel_strike_slice` has accepted
     the axes; with ``fixed_point`` an empty tuple, once :func:`slice_state` has accepted the
-    axes at the first cell ``(xs[0], ys[0])``.  Raises :class:`BasinError` for bad axes or a
-    step from the fixed point that ends in no heel strike."""
+    axes at the first cell on the heel-strike surface (``(xs[0], ys[0])`` unless that has
+    no state there: such a cell is ``unreachable``).  Raises :class:`BasinError` for bad
+    axes, a box with no cell on the surface or a step from the fixed point that ends in
+    no heel strike."""
     x_pre: tuple = ()
     if st.start == "heel_strike":  # validates the axes too
         pre = pre_impact_fixed_point(walker, x_star, st, mst)
         heel_strike_slice(walker, pre, (st.x_axis, st.y_axis))
         x_pre = tuple(float(v) for v in pre)
-    else:
-        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]),
-                    st.start != "phase_plane")  # validate axes
+    else:  # validate the axes at the first cell on the heel-strike surface
+        for vx, vy in ((vx, vy) for vy in ys for vx in xs):
+            try:
+                slice_state(walker, x_star, (st.x_axis, st.y_axis), (vx, vy),
+                            st.start != "phase_plane")
+            except OffSection:  # this cell is unreachable (run_basin_chunk): the next
+                continue
+            break
+        else:
+            raise BasinError(f"basin: no cell of basin.x_range x basin.y_range "
+                             f"({st.x_axis} x {st.y_axis}) has a state on the heel-strike "
+                             "surface; choose ranges nearer the fixed point")
     return x_pre
 
 

@@ -24,7 +24,9 @@ Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
     a step longer than ``max_step_time_s``, or a solver failure
 ``unreachable``
     (``start: heel_strike``) no pre-impact state on the guard has a heel
-    strike that lands on the cell
+    strike that lands on the cell; (``start: fixed_point``) no state on the heel-strike
+    surface has the cell's coordinates (a 3D walker's corner cell: the projection of
+    :func:`slice_state` raises :class:`~walkerlab.models.hybrid.base.OffSection`)
 
 The grid, its chunks, the partial file and resuming are :mod:`walkerlab.studies.basin`'s
 (which re-exports these names).
@@ -40,6 +42,7 @@ import numpy as np
 from walkerlab.config import BasinSettings, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.hybrid.base import OffSection
 from walkerlab.studies.basin_slice import (
     BasinError,
     heel_strike_slice,
@@ -196,7 +199,8 @@ def default_axes(walker, axes: tuple[str, str]) -> tuple[str, str]:
 
 
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
-    """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
+    """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]`` (a
+    cell with no state on the heel-strike surface: ``unreachable``)."""
     walker, st, max_step_time = walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
     x_star = np.asarray(task.x_star, dtype=float)
@@ -204,8 +208,11 @@ def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     hs = heel_strike_slice(walker, np.asarray(task.x_pre), axes) if task.x_pre else None
     out = []
     for idx, vx, vy in task.cells:
-        x0 = (slice_state(walker, x_star, axes, (vx, vy), st.start != "phase_plane")
-              if hs is None else hs.state(walker, (vx, vy)))
+        try:
+            x0 = (slice_state(walker, x_star, axes, (vx, vy), st.start != "phase_plane")
+                  if hs is None else hs.state(walker, (vx, vy)))
+        except OffSection:  # no state on the heel-strike surface has these coordinates
+            x0 = None
         if x0 is None:
             out.append((int(idx), CODE["unreachable"], 0, 0))
             continue

@@ -20,8 +20,10 @@ the field's dotted path with the field's unit (from its name or metadata,
 :func:`walkerlab.studies.params.axis_unit`) otherwise (``bifurcation_<field>.h5``); either way
 it carries the field in its ``path`` attribute.
 
-Grid chunks (the runs up and down from the scene's slope) are evaluated with the sweep
-executors (:func:`walkerlab.studies.runner.sweep_executor`), locally or on Dask.  Arrays
+Grid chunks (the runs up and down from the scene's slope, planned alike for any worker
+count or executor, so the artifact is the same on each but for its wall times) are
+evaluated with the sweep executors (:func:`walkerlab.studies.runner.sweep_executor`),
+locally or on Dask.  Arrays
 are sized by the walker (``walker.state_names()``); the cached stage that writes the
 artifact is :mod:`walkerlab.stages.bifurcation`.
 """
@@ -271,12 +273,15 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
                workers: int, scheduler, steps_per_map: int = 0) -> list[dict]:
     """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
     state; :func:`bifurcation_chunk`), in grid order: the grid of ``axis`` is cut into runs
-    (:func:`walkerlab.studies.sweep_plan.plan_chunks`) evaluated on
-    :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
+    (:func:`walkerlab.studies.sweep_plan.plan_chunks`, the same runs for any ``workers``
+    and ``scheduler``: the rows are the same, bit for bit, but for their wall times)
+    evaluated on :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
     from walkerlab import progress
 
     param, n = axis.path, len(axis.values)
-    chunks = plan_chunks([axis], base, workers=max(1, workers))
+    # the runs up and down from the scene's value, whatever the workers: a value's
+    # continuation start (hence its row) is its run's previous value on any executor
+    chunks = plan_chunks([axis], base)
     tasks = [BifurcationTask(base, tuple(c), n_transient, n_keep, steady_state, param,
                              steps_per_map) for c in chunks]
     rows = []

@@ -1,7 +1,9 @@
 """One chunk of a bifurcation diagram's grid (:mod:`walkerlab.studies.bifurcation`), the
 worker's side: for each value ``p`` along the chunk's run, the scene at ``p``
 (:func:`scene_at`), the period-1 fixed point and its Floquet multipliers (continued from the
-neighbouring value's, by arclength steps where the branch turns) and the steady state
+neighbouring value's, by arclength steps where the branch turns; where that finds none, the
+gait ``walkerlab fixedpoint`` finds for the value's scene, so that a value is
+``no_fixed_point`` only when a fresh start finds no gait either) and the steady state
 (``n_transient`` steps simulated, the inter-leg angle at the last ``n_keep`` heel strikes
 kept; started from the previous value's final state projected on this value's heel-strike
 surface, or from the fixed point slightly perturbed): :func:`bifurcation_chunk`, one row per
@@ -72,7 +74,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
     import warnings
 
     from walkerlab.models.registry import build_walker
-    from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point, on_study_map
+    from walkerlab.studies.point_gait import PointOutcome, on_study_map
     from walkerlab.studies.points import warm_up
 
     warm_up()
@@ -105,7 +107,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
                     row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
                                period_s=q.period_s / fam.steps(walker))  # per step
                 else:
-                    walker, res, _src = ideal_fixed_point(scene, guess)
+                    walker, res = _value_gait(scene, guess)
                     on_map, res = on_study_map(scene, walker, res, task.steps_per_map)
                     row.update(x=res.x, period_s=res.period_s / on_map.steps_per_map,
                                multipliers=np.asarray(res.multipliers_variational, complex))
@@ -122,6 +124,40 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
         row["wall_time_s"] = time.perf_counter() - t0
         out.append(row)
     return out
+
+
+def _value_gait(scene, guess):
+    """The period-1 gait of one value's ``scene`` (:func:`bifurcation_chunk`, where the
+    neighbour's branch does not reach it): from the neighbour's fixed point ``guess`` (or
+    the scene's own start, :func:`~walkerlab.studies.point_gait.ideal_fixed_point`), and
+    when that finds none, the gait ``walkerlab fixedpoint`` finds for the scene
+    (:func:`~walkerlab.studies.point_gait.scene_gait`: its guess, then the seeds): a value
+    is recorded ``no_fixed_point`` only when a fresh start finds no gait either.
+
+    Returns
+    -------
+    walker : HybridWalker
+    result : FixedPointResult
+
+    Raises
+    ------
+    PointOutcome
+        ``no_fixed_point`` (the fresh start's message) or ``invalid_config``.
+    """
+    from walkerlab.studies.point_gait import (  # light: worker side
+        PointOutcome,
+        ideal_fixed_point,
+        scene_gait,
+    )
+
+    try:
+        walker, res, _src = ideal_fixed_point(scene, guess)
+    except PointOutcome as exc:
+        if exc.outcome != "no_fixed_point":
+            raise
+        walker, search, _src = scene_gait(scene)
+        res = search.result
+    return walker, res
 
 
 def _steady_state(task: BifurcationTask, scene, walker, row: dict, x_att):

@@ -50,7 +50,7 @@ from walkerlab.studies.point_gait import (
 from walkerlab.walker.plant import Plant
 
 __all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
-           "contact_adapter", "POINT_FUNCTIONS"]
+           "contact_adapter", "step_period", "POINT_FUNCTIONS"]
 
 
 @dataclass(frozen=True)
@@ -227,11 +227,21 @@ _CONTACT_OUTCOME = {k: ("ok" if k in ("heel_strike", "t_final") else k)
                     for k in RUN_END_NAMES}
 
 
+def step_period(fp) -> float:
+    """The mean step period [s] of a gait (a FixedPointResult): its map's period over the
+    map's steps (a 3D walker's or a walker with differing legs' map is a stride of two
+    steps, ``fp.step_periods_s``), the number ``fixedpoint.h5`` stores as
+    ``step_period`` and the ``contact-sim`` stage starts its run from."""
+    steps = len(getattr(fp, "step_periods_s", ()) or ())
+    return float(fp.period_s / steps if steps > 1 else fp.period_s)
+
+
 def contact_point(scene: Scene, guess, options: dict):
     """Compliant-contact simulation started from the ideal gait at this point (``contact-sim``).
 
-    The ideal fixed point (continuation from ``guess``) gives the initial state, the step
-    period and the checkerboard spacing; see :func:`contact_adapter`.  The point's outcome
+    The ideal fixed point gives the initial state, the step period (the map's period over
+    its steps, :func:`step_period`, as the ``contact-sim`` stage takes it: a 3D walker's
+    map is a stride) and the checkerboard spacing; see :func:`contact_adapter`.  The point's outcome
     is the contact run's typed outcome (trip, fall, scuff, slip beyond
     ``options["slip_limit_mm"]``, solver failure, time limit), then ``bounce`` (a stance
     foot left the ground and came back) and ``max_steps`` (stalled).
@@ -253,9 +263,10 @@ def contact_point(scene: Scene, guess, options: dict):
                          max_step_time=(scene.fixedpoint
                                         or FixedPointSettings()).max_step_time_s)
     step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"][:2]))
+    period = step_period(fp)
     cols = {"guess_source": source, "ideal_step_length_m": step_length,
-            "ideal_step_period_s": float(fp.period_s)}
-    _cw, res, n_steps = contact_adapter(scene, fp.x, fp.period_s, step_length)
+            "ideal_step_period_s": period}
+    _cw, res, n_steps = contact_adapter(scene, fp.x, period, step_length)
     out = res.outcome
     if out.ok:
         out = classify_complete(res.steps, opts["slip_limit_mm"], out.hip_height_m, out.kind)

@@ -28,7 +28,7 @@ import numpy as np
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker, OffSection
 from walkerlab.numerics import without_neutral
 
 __all__ = ["RESIDUAL_TOL", "BranchSystem", "MapFailed", "WalkerFamily", "critical_vector",
@@ -199,12 +199,13 @@ def state_from_section(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
     Raises
     ------
     MapFailed
-        ``z`` leaves the section's domain (or gives a non-finite state).
+        ``z`` leaves the section's domain (no state on the heel-strike surface there,
+        :class:`~walkerlab.models.hybrid.base.OffSection`, or a non-finite state).
     """
     with np.errstate(all="ignore"):
         try:
             x = np.asarray(walker.from_section(np.asarray(z, float)), float)
-        except (ValueError, ArithmeticError) as exc:
+        except (ValueError, ArithmeticError, OffSection) as exc:
             raise MapFailed("section coordinates leave their domain", str(exc)) from None
     if not np.all(np.isfinite(x)):
         raise MapFailed("section coordinates leave their domain", "non-finite state")
@@ -308,7 +309,10 @@ class BranchSystem:
                                   steps_per_map=self.family.steps(w),
                                   max_step_time=self.family.max_step_time, segments=True)
         self.n_variational += self.k
-        D_from = numeric_jacobian(w.from_section, np.asarray(z, float))
+        try:  # its difference steps may leave the surface next to the branch's end
+            D_from = numeric_jacobian(w.from_section, np.asarray(z, float))
+        except (ValueError, ArithmeticError, OffSection) as exc:
+            raise MapFailed("section coordinates leave their domain", str(exc)) from None
         D_sec = numeric_jacobian(w.section, np.asarray(xk, float))
         M = D_sec @ J @ D_from
         Fz = M - np.eye(z.size)
