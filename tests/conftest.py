@@ -7,7 +7,8 @@ import tempfile
 # (keyed by content, so safe), not the user's own
 os.environ.setdefault("WALKERLAB_CACHE_DIR",
                       os.path.join(tempfile.gettempdir(), "walkerlab-test-models"))
-# no heartbeat lines ("...: working (m:ss)", walkerlab.progress.Heartbeat) in the stderr the
+# no heartbeat lines ("...: working (m:ss)", walkerlab.progress.Heartbeat) nor first-run
+# code-generation notices (walkerlab.progress.machine_note) in the stderr the
 # tests read: how many a command prints depends on the machine's speed; the heartbeat's own
 # tests (tests/test_no_silence.py) set it
 os.environ.setdefault("WALKERLAB_HEARTBEAT_S", "0")

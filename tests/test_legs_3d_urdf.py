@@ -68,8 +68,8 @@ def test_the_powered_3d_urdf_lists_its_actuators_and_hip_roll_law_as_left_out(tm
     out = export.write(scene, tmp_path / "u", "urdf", walker_only=True)
     text = Path(out.path).read_text()
     assert [ln.split(":")[0] for ln in out.left_out] == [
-        "the ground (slope, terrain and contact law)", "the hip-roll law (walker.hip_roll)", "the pelvis' held pitch and yaw", "motor hip",
-        "the push-off (walker.actuation.push_off)"]
+        "the ground (slope, terrain and contact law)", "the hip-roll law (walker.hip_roll)",
+        "the pelvis' held pitch and yaw", "motor hip", "the push-off (walker.actuation.push_off)"]
     assert all(f"<!-- Left out: {ln} -->" in text for ln in out.left_out)
     assert "leg1_hip - leg2_hip" in out.left_out[3]
     assert "<!-- walkerlab_actuation: {" in text and "<!-- walkerlab_hip_roll: {" in text

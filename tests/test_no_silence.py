@@ -82,7 +82,8 @@ def test_the_cli_sink_has_a_heartbeat_unless_quiet(monkeypatch):
 def test_a_new_structure_says_its_code_generation_before_it_starts(tmp_path):
     """An empty code cache: the first run of the paper walker says, on stderr, that it
     derives this structure's equations for the first time on this machine (and where the
-    cost is documented), and the heartbeat names the derivation while it runs; the second run, from the cache, says nothing of it and finds the
+    cost is documented), and the heartbeat names the derivation while it runs; the second
+    run, from the cache, says nothing of it and finds the
     same gait."""
     env = {**os.environ, "WALKERLAB_CACHE_DIR": str(tmp_path / "cache"),
            "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "WALKERLAB_HEARTBEAT_S": "1"}

@@ -437,13 +437,15 @@ def test_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch, da
 
 
 # ------------------------------------------------------------------ 14: messages
-def test_one_line_keeps_a_wrapped_sentence_and_cuts_at_a_boundary():
+def test_one_line_keeps_a_wrapped_sentence_and_breaks_a_long_one_at_a_boundary():
     short = _one_line("the error is larger than allowed, as measured by the\nreference run.")
     assert short == "the error is larger than allowed, as measured by the reference run."
-    long = _one_line("first field: bad value. " + "second sentence goes on " * 30 + "end.")
-    assert long.startswith("first field: bad value.") and "WALKERLAB_DEBUG=1" in long
-    assert "\n" not in long and len(long) < 400
-    assert "more lines" not in long
+    text = "first field: bad value. " + "second sentence goes on " * 30 + "end."
+    first, second = _one_line(text).splitlines()  # never cut: a second line
+    assert first.startswith("first field: bad value.") and len(first) <= 300  # at a word
+    assert second.startswith("  ") and second.rstrip().endswith("end.")
+    assert f"{first} {second.strip()}" == text.strip()
+    assert "WALKERLAB_DEBUG=1" not in second and "more lines" not in second
 
 
 @pytest.mark.parametrize("value,traceback", [("false", False), ("0", False), ("no", False),

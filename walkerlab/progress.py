@@ -30,11 +30,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Protocol
 
-__all__ = ["HEARTBEAT_ENV", "HEARTBEAT_S", "Heartbeat", "heartbeat_s", "Sink", "Task", "task", "note", "use", "current",
-           "install", "sink_for_terminal", "QuietSink", "RichSink", "LineSink"]
+__all__ = ["HEARTBEAT_ENV", "HEARTBEAT_S", "Heartbeat", "heartbeat_s", "machine_note", "Sink",
+           "Task", "task", "note", "use", "current", "install", "sink_for_terminal",
+           "QuietSink", "RichSink", "LineSink"]
 
 #: longest silence of a command [s]: past it the heartbeat prints a line (:class:`Heartbeat`);
-#: ``$WALKERLAB_HEARTBEAT_S`` sets another (0: none, as a test suite that reads stderr does)
+#: ``$WALKERLAB_HEARTBEAT_S`` sets another (0: none, and no :func:`machine_note` either, as a
+#: test suite that reads stderr sets it)
 HEARTBEAT_S = 8.0
 HEARTBEAT_ENV = "WALKERLAB_HEARTBEAT_S"
 
@@ -340,3 +342,12 @@ def task(description: str, total: int | None = None, completed: int = 0) -> Iter
 def note(message: str) -> None:
     """Send a one-line notice to the installed sink."""
     _SINK.note(message)
+
+
+def machine_note(message: str) -> None:
+    """A notice of what this machine is doing once (a walker structure's first code
+    generation: it depends on the user cache, not on the scene), sent as :func:`note`
+    unless the heartbeat is off (``$WALKERLAB_HEARTBEAT_S`` = 0, as a test suite that reads
+    stderr sets it: the lines that depend on the machine and its cache are left out)."""
+    if heartbeat_s() > 0:
+        _SINK.note(message)

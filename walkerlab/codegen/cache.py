@@ -56,9 +56,9 @@ def _what(filename: str) -> str:
 def _first_time(what: str) -> None:
     """Say, in one notice, that ``what`` of this walker structure is being made: the first
     time on this machine (or after an upgrade), kept in the user cache after."""
-    progress.note(f"{what} of this walker structure: first time on this machine (or since "
-                  "an upgrade), seconds to a few minutes; kept in the user cache for later "
-                  f"runs ({FIRST_RUN_DOC})")
+    progress.machine_note(f"{what} of this walker structure: first time on this machine (or "
+                          "since an upgrade), seconds to a few minutes; kept in the user "
+                          f"cache for later runs ({FIRST_RUN_DOC})")
 
 
 def cache_dir() -> Path | None:

@@ -29,8 +29,8 @@ import numpy as np
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
-from .solver import Solver
 from . import work_limit
+from .solver import Solver
 
 __all__ = ["IMPLICIT_METHODS", "PhaseRun", "integrate_phase", "numeric_jacobian", "phase_rhs"]
 
