@@ -51,18 +51,17 @@ def test_an_absurd_state_fails_at_once_and_a_step_has_a_work_limit(paper):
     w, gait = paper
     from walkerlab.integrate import work_limit
 
-    bound = work_limit.work_bound(1e18)  # every evaluation counted, none stopped
-    bound.__enter__()
-    n0 = work_limit.done()
-    for fn in (w.step, w.jacobian, lambda x: w.simulate(x, 1)):
-        with pytest.raises(SceneError, match="more than half a turn"):
-            fn(gait.x * 1e10)  # was 332 s of integration before failing
-    x = gait.x.copy()
-    x[2] = 100.0  # 100 rad/s: above 20 sqrt(g/l) = 62.6 rad/s, no walking state
-    with pytest.raises(SceneError, match=r"x\[2\] \(swing_rate\) = 100 rad/s is not a walking"):
-        w.step(x)
-    assert work_limit.done() == n0  # refused before any integration
-    bound.__exit__(None, None, None)
+    with work_limit.work_bound(1e18):  # every evaluation counted, none stopped
+        n0 = work_limit.done()
+        for fn in (w.step, w.jacobian, lambda x: w.simulate(x, 1)):
+            with pytest.raises(SceneError, match="more than half a turn"):
+                fn(gait.x * 1e10)  # was 332 s of integration before failing
+        x = gait.x.copy()
+        x[2] = 100.0  # 100 rad/s: above 20 sqrt(g/l) = 62.6 rad/s, no walking state
+        with pytest.raises(SceneError,
+                           match=r"x\[2\] \(swing_rate\) = 100 rad/s is not a walking"):
+            w.step(x)
+        assert work_limit.done() == n0  # refused before any integration
     # the per-step work bound: a limit far below one step's cost stops the map in one line,
     # the same on any machine (evaluations, not seconds)
     tight = wl.Walker(w.scene, step_evaluations=10)

@@ -111,6 +111,13 @@ class Heartbeat:
                                         daemon=True)
         self._thread.start()
 
+    @classmethod
+    def for_command(cls, label: str | None, say, what) -> Heartbeat | None:
+        """The heartbeat of the command ``label`` (None: not a command's sink), at
+        :func:`heartbeat_s`; None where there is none (no label, or the period is 0)."""
+        period = heartbeat_s()
+        return cls(say, what, period) if label and period > 0 else None
+
     def beat(self) -> None:
         """A line was shown now."""
         self.last = time.monotonic()
@@ -145,9 +152,7 @@ class LineSink:
         self._tasks: dict[int, tuple[str, float, int, int | None]] = {}
         self._label = label
         #: with a label (the CLI's command), a line at least every HEARTBEAT_S
-        period = heartbeat_s()
-        self.heartbeat = (Heartbeat(self._print, self._under_way, period)
-                          if label and period > 0 else None)
+        self.heartbeat = Heartbeat.for_command(label, self._print, self._under_way)
 
     def _under_way(self) -> str:
         """The innermost task open, or the command."""
@@ -196,9 +201,7 @@ class RichSink:
         self._label = label
         # with a label: a line when no task is open and nothing was shown for HEARTBEAT_S
         # (an open task's line is redrawn with its elapsed time by rich itself)
-        period = heartbeat_s()
-        self.heartbeat = (Heartbeat(self._idle_line, lambda: str(label), period)
-                          if label and period > 0 else None)
+        self.heartbeat = Heartbeat.for_command(label, self._idle_line, lambda: str(label))
 
     def _idle_line(self, line: str) -> None:
         if self._progress is None:

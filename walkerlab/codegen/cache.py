@@ -33,7 +33,7 @@ _GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
                     "codegen/compiled_source.py", "codegen/frames.py")
 _memo: dict[str, dict] = {}
 #: what each generated module of the cache folder is, by a part of its file name (the first
-#: part that names one, from the end: ``<key>_act_<tag>_nb.py`` is an actuated flow)
+#: key here that is a part of it: ``<key>_act_<tag>_nb.py`` is an actuated flow, not ``nb``)
 _WHAT = {"rows": "the batched step kernels", "act": "the actuated compiled flow",
          "vcnb": "the compiled virtual-constraint controller",
          "vc": "the virtual-constraint outputs", "vcflow": "the virtual-constraint flow",
@@ -47,10 +47,8 @@ FIRST_RUN_DOC = "docs/user_guide/first_run.md"
 def _what(filename: str) -> str:
     """What the generated module ``filename`` is, in words (:data:`_WHAT`)."""
     parts = filename.rsplit(".", 1)[0].split("_")[1:]
-    for part in ("rows", "act", "vcnb", "vcflow", "vcrhs", "vc", "contact", "floating", "nb"):
-        if part in parts:
-            return _WHAT[part]
-    return "a generated module"
+    return next((words for part, words in _WHAT.items() if part in parts),
+                "a generated module")
 
 
 def _first_time(what: str) -> None:

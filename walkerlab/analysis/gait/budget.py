@@ -24,8 +24,8 @@ from walkerlab.integrate import work_limit
 from walkerlab.models.hybrid.base import HybridWalker
 
 __all__ = ["CRAWL_SHARE", "ROOT_BUDGET_EVALUATIONS", "SLOW_MAP_EVALUATIONS", "SearchGaveUp",
-           "deadline", "evaluations", "gave_up", "map_ended", "map_started", "search_budget",
-           "slow_step_reason"]
+           "deadline", "evaluations", "gave_up", "map_ended", "map_started", "rates_words",
+           "search_budget", "slow_step_reason"]
 
 #: most right-hand-side evaluations of one search for a gait (:func:`search_budget`; a fixed
 #: point, or every start of :func:`walkerlab.analysis.gait.search.find_gaits`).  The shipped
@@ -170,21 +170,24 @@ def map_ended(walker: HybridWalker, n: int, x_end=None) -> None:
     if (cost > SLOW_MAP_EVALUATIONS and _BUDGET.costliest <= SLOW_MAP_EVALUATIONS
             and math.isfinite(_BUDGET.deadline)):
         progress.note(f"gait search: one step map took {_count(cost)} right-hand-side "
-                      f"evaluations{_rates(x_end)} ({slow_step_reason(walker)}); the search "
+                      f"evaluations{rates_words(x_end, np.size(x_end) // 2)} "
+                      f"({slow_step_reason(walker)}); the search "
                       f"gives up once it has spent {_count(_BUDGET.size)}")
     _BUDGET.costliest = max(_BUDGET.costliest, cost)
 
 
-def _rates(x) -> str:
-    """', its rates reaching R rad/s' for a finite state ``x`` [rad, rad/s] (its second
-    half), else ''."""
-    if x is None:
+def rates_words(y, n: int) -> str:
+    """Where a map's integration was, in words: ``', rates R rad/s'`` (the largest of the
+    rates ``y[n:2n]``, [rad/s]; ``y`` may carry variational rows after them), ``', its state
+    no longer finite'``, or ``''`` without a state (never "nan")."""
+    if y is None:
         return ""
-    x = np.asarray(x, float).ravel()
-    rates = x[x.size // 2:]
-    if not rates.size or not np.all(np.isfinite(rates)):
+    rates = np.asarray(y, float).ravel()[n:2 * n]
+    if not rates.size:
         return ""
-    return f", its rates reaching {float(np.max(np.abs(rates))):.2g} rad/s"
+    if not np.all(np.isfinite(rates)):
+        return ", its state no longer finite"
+    return f", rates {float(np.max(np.abs(rates))):.2g} rad/s"
 
 
 def evaluations() -> int:

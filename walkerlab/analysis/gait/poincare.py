@@ -132,13 +132,7 @@ def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
     except WorkBoundReached as exc:
         where = f"the last one stopped after {budget.evaluations() - n0:,} evaluations"
         if exc.x is not None:
-            n = np.size(x) // 2
-            rates = np.asarray(exc.x, float)[n:2 * n]
-            where += f" at t = {exc.t:.3g} s"
-            if rates.size and np.all(np.isfinite(rates)):
-                where += f", rates {float(np.max(np.abs(rates))):.2g} rad/s"
-            elif rates.size:
-                where += ", its state no longer finite"
+            where += f" at t = {exc.t:.3g} s{budget.rates_words(exc.x, np.size(x) // 2)}"
         raise budget.gave_up(walker, where, budget.evaluations() - n0) from None
     except BaseException:
         budget.map_ended(walker, n0)
