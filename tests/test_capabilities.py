@@ -257,25 +257,80 @@ def test_the_command_and_the_docs_show_the_table():
     assert "capability-table" in (ROOT / "docs" / "reference" / "capabilities.rst").read_text()
 
 
-def test_every_part_table_has_the_part_of_every_kind_it_takes():
-    """Each layer's table of parts, keyed by the kind's part word for that layer, has the
-    part of every kind (the three-link walker's ``export --walk`` failed with KeyError
-    'hinged_torso' in the export stage's table, when the tables were keyed by kind name)."""
-    from walkerlab.export.writers import BODIES
-    from walkerlab.models.contact.parts import PARTS as CONTACT
-    from walkerlab.models.hybrid.actuated import _PARTS as ACTUATORS
-    from walkerlab.models.hybrid.ground import LANDINGS
-    from walkerlab.models.hybrid.rigid import BUILDERS
+#: the layers that give the kinds' parts their behaviour (imported: each provides its own)
+_PART_LAYERS = ("walkerlab.models.hybrid.rigid", "walkerlab.models.hybrid.ground",
+                "walkerlab.models.hybrid.actuated", "walkerlab.models.hybrid.ground_reaction",
+                "walkerlab.models.contact.parts", "walkerlab.analysis.contact.verdict",
+                "walkerlab.optimal.driver", "walkerlab.optimal.transcription.phases")
 
-    kinds = KINDS.values()
-    assert {kind.body for kind in kinds} <= set(BODIES)  # the export's writers
-    assert {kind.rigid for kind in kinds} == set(BUILDERS)
-    assert {kind.actuators for kind in kinds} == set(ACTUATORS)
-    assert {kind.landing for kind in kinds} - {None} == set(LANDINGS)
-    assert {kind.contact for kind in kinds} - {None} == set(CONTACT)
-    for kind in kinds:  # a view without a part for the kind refuses the walker itself
+#: the part slots each supported cell needs: (feature, view) -> slots
+_CELL_PARTS = {("walk", "rigid"): ("rigid", "reaction", "actuators"),
+               ("stairs", "rigid"): ("landing",), ("footholds", "rigid"): ("landing",),
+               ("walk", "contact"): ("contact", "scuff"),
+               ("walk", "optimize"): ("collocation",)}
+
+
+def _missing_parts(kinds) -> list[str]:
+    """``kind: slot`` of every supported cell's part that is absent or has no behaviour."""
+    import importlib
+
+    for m in _PART_LAYERS:
+        importlib.import_module(m)
+    out = []
+    for kind in kinds:
+        for (feature, view), slots in _CELL_PARTS.items():
+            if not kind.supports(feature, view):
+                continue
+            for slot in slots:
+                part = getattr(kind, slot)
+                if part is None or not part.provided:
+                    out.append(f"{kind.name}: {slot} ({feature} in {view})")
+        c = kind.collocation  # a transcription of phases needs their symbolic pieces
+        phased = c is not None and not c.one_step and not c.from_targets
+        if kind.supports("walk", "optimize") and phased \
+                and (kind.phases is None or not kind.phases.provided):
+            out.append(f"{kind.name}: phases (walk in optimize)")
+    return out
+
+
+def test_every_kind_has_the_parts_of_every_cell_its_row_supports():
+    """Each supported cell's parts (the rigid maker, reaction and actuators of the rigid
+    view, the landing on stairs and footholds, the contact part and its scuff cause, the
+    collocation and its phases) are objects on the kind whose layer gave them their
+    behaviour; a view without a part for the kind refuses the walker (or the ground)
+    itself.  Every part object of a kind is given its behaviour by its layer."""
+    assert _missing_parts(KINDS.values()) == []
+    for kind in KINDS.values():
         assert (kind.landing is None) == (kind.cell("stairs", "rigid") is not None), kind
         assert (kind.contact is None) == (kind.cell("walk", "contact") is not None), kind
+        assert (kind.collocation is None) == (kind.cell("walk", "optimize") is not None), kind
+        for slot, part in kind.parts().items():
+            assert part is None or part.provided, f"{kind.name}: {slot} {part}"
+
+
+def test_a_kind_missing_a_part_its_row_claims_is_named():
+    """A kind whose supported cell has no part (or a part without behaviour) is named with
+    the part's slot: the check above can fail."""
+    from dataclasses import replace
+
+    from walkerlab.walker.parts import Part, PartMissing
+
+    bare = replace(KINDS["straight_legs"], contact=Part("contact", "unprovided: a test part"))
+    assert _missing_parts([bare]) == ["straight_legs: contact (walk in contact)"]
+    with pytest.raises(PartMissing, match="contact part 'unprovided: a test"):
+        _ = bare.contact.step_length
+
+
+def test_parts_pickle_as_the_same_objects():
+    """A kind's parts reach a worker process as the same objects (found by slot and name),
+    their behaviour with them."""
+    import pickle
+
+    from walkerlab.models.hybrid import rigid  # noqa: F401  (gives the rigid parts theirs)
+
+    kind = KINDS["locking_knees"]
+    assert pickle.loads(pickle.dumps(kind.rigid)) is kind.rigid
+    assert pickle.loads(pickle.dumps(kind)).rigid is kind.rigid
 
 
 # ------------------------------------------- a refusal the table decides comes first (64, 6)

@@ -8,7 +8,7 @@ the stage fills in the scene's energy unit and the replays' records:
 :func:`walkerlab.io.schemas.optimize.optimize_record`).
 
 The transcription follows the walker's kind (:class:`walkerlab.walker.kinds.Kind`), reached
-through the kind's part (:data:`PARTS`: a :class:`Collocation` holding the kind's
+through the kind's part (its collocation part's behaviour, a :class:`Collocation` holding the kind's
 transcription, guess and replays; Hermite-Simpson collocation, CasADi + IPOPT); a kind the
 collocation does not take, and a feature the kind lacks here, are refused from the
 capability table (:func:`check_kind`):
@@ -54,9 +54,10 @@ from walkerlab.optimal.virtual_constraints import (
     designs_controller,
     optimize_virtual_constraints,
 )
+from walkerlab.walker import parts as P
 from walkerlab.walker.plant import Plant
 
-__all__ = ["PARTS", "Collocation", "check_kind", "check_scene", "check_targets",
+__all__ = ["Collocation", "check_kind", "check_scene", "check_targets",
            "collocation_spec", "guess_from_targets", "needs_gait", "no_gait_of_its_own",
            "optimize_scene", "starting_phases", "starting_stride"]
 
@@ -90,7 +91,8 @@ def collocation_spec(scene):
 
 
 def _part(structure) -> Collocation:
-    """The collocation's part for the walker kind of ``structure`` (:data:`PARTS`).
+    """The collocation's part for the walker kind of ``structure`` (its
+    :attr:`~walkerlab.walker.kinds.Kind.collocation`'s behaviour).
 
     Raises
     ------
@@ -98,7 +100,7 @@ def _part(structure) -> Collocation:
         A kind the collocation does not take (the capability table's line, ``walker: ...``).
     """
     structure.kind.require("walk", "optimize", "walker")
-    return PARTS[structure.kind.collocation]
+    return structure.kind.collocation.behaviour
 
 
 def needs_gait(scene, plant: Plant) -> bool:
@@ -111,7 +113,8 @@ def needs_gait(scene, plant: Plant) -> bool:
     :class:`~walkerlab.walker.plant.Plant`."""
     if designs_controller(scene):  # starts from the scene's own controller
         return False
-    part = PARTS.get(plant.kind.collocation)
+    c = plant.kind.collocation
+    part = c.behaviour if c is not None else None
     return part is not None and not part.from_targets and not no_gait_of_its_own(scene)
 
 
@@ -177,7 +180,7 @@ def check_targets(o) -> None:
 def optimize_scene(scene, x_gait: np.ndarray | None = None,
                    period_s: float | None = None, *, plant: Plant) -> OptimizeData:
     """Optimise the scene's gait (the ``optimize`` section) by its walker kind's part
-    (:data:`PARTS`): a step, a step of phases, a stride of two steps (legs that differ) or
+    (its collocation part): a step, a step of phases, a stride of two steps (legs that differ) or
     a five-link biped's step (module docstring).
 
     Parameters
@@ -300,7 +303,7 @@ def check_scene(scene, data) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
-    if data.structure.kind.collocation == "legs":  # the ground it lands on, refused early
+    if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
         from walkerlab.optimal.transcription.landing import step_ground
 
         step_ground(scene)
@@ -659,7 +662,7 @@ def _guide(walker, data, spec):
 class Collocation:
     """How ``walkerlab optimize`` finds and replays the optimal gait of one walker kind
     (:class:`walkerlab.walker.kinds.Kind`): its transcription, starting guess and replay
-    laws, reached through :data:`PARTS` by the kind's collocation part.
+    laws, reached through the kind's collocation part.
 
     Attributes
     ----------
@@ -684,11 +687,10 @@ class Collocation:
     legs_cross_level: bool = False
 
 
-#: the collocation's part of each kind it takes, by :attr:`Kind.collocation` (the spoked
-#: wheel has none: refused from the capability table, :func:`_part`)
-PARTS = {
-    "legs": Collocation(_straight_legs, target_step=True, legs_cross_level=True),
-    "kneed": Collocation(_phased),
-    "flat": Collocation(partial(_phased, resolve_gait=True)),
-    "five_link": Collocation(optimize_five_link, from_targets=True),
-}
+# each kind's collocation part (:attr:`walkerlab.walker.kinds.Kind.collocation`) given its
+# transcription (the spoked wheel has none: refused from the capability table, :func:`_part`)
+P.COLLOCATION_STRAIGHT_LEGS.provide(Collocation(_straight_legs, target_step=True,
+                                                legs_cross_level=True))
+P.COLLOCATION_LOCKING_KNEES.provide(Collocation(_phased))
+P.COLLOCATION_FLAT_FEET.provide(Collocation(partial(_phased, resolve_gait=True)))
+P.COLLOCATION_FIVE_LINK.provide(Collocation(optimize_five_link, from_targets=True))

@@ -50,29 +50,39 @@ walker's :class:`Kind`:
     free body: it rolls in MuJoCo) and the URDF, so far; the other views' cells say so.
 
 The layers ask the kind (:func:`kind_of`, once), never the switches, and never its name:
-the kind carries its part of each layer as a word (:attr:`Kind.body`, :attr:`Kind.rigid`,
-:attr:`Kind.landing`, :attr:`Kind.contact`, :attr:`Kind.actuators`, :attr:`Kind.feet`,
-:attr:`Kind.collocation`; kinds that share a part share its word), and a layer keeps a table
-keyed by its own part words (the rigid model's builders, the contact model's geometry, the
-export's writers, the transcriptions) or asks the kind a question (:attr:`Kind.spoked`,
-:attr:`Kind.in_3d`, :attr:`Kind.joints_free`, :attr:`Kind.feet_have_modes`).
+the kind holds its parts as objects (:mod:`walkerlab.walker.parts`: :attr:`Kind.rigid`,
+:attr:`Kind.landing`, :attr:`Kind.actuators`, :attr:`Kind.reaction`, :attr:`Kind.contact`,
+:attr:`Kind.scuff`, :attr:`Kind.collocation`, :attr:`Kind.phases`; kinds that share a
+part share its object), each given its behaviour by its layer, and a layer calls the part
+it is given
+(``kind.rigid.build(...)``) or asks the kind a question (:attr:`Kind.spoked`,
+:attr:`Kind.in_3d`, :attr:`Kind.joints_free`, :attr:`Kind.feet_have_modes`,
+:attr:`Kind.has_knees`, :attr:`Kind.knees_lock`).
 Whether a kind supports a feature in a view is read from
 :data:`~walkerlab.walker.capability_cells.CAPABILITIES`; a refusal is
 :meth:`Kind.require`'s one line, naming the scene field and the physical or modelling
 reason, so ``walkerlab capabilities``, the documentation and the refusals say the same.
 
-Adding a kind is one :class:`Kind` here (its parts' words; a new word where its part is new)
-and its row of :data:`CAPABILITIES` (:mod:`walkerlab.walker.capability_cells`); each layer
-then gets its part for a new word.
+Adding a kind is one :class:`Kind` here (its parts: existing objects, or new ones declared
+in :mod:`walkerlab.walker.parts` and given their behaviour by their layers) and its row of
+:data:`CAPABILITIES` (:mod:`walkerlab.walker.capability_cells`); a supported cell whose
+part has no behaviour fails ``tests/test_capabilities.py``, naming the kind and the part.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from walkerlab.walker import parts as P
 from walkerlab.walker.capability_cells import CAPABILITIES, CELL_NOTES, STAGE_CELLS, STAGE_VIEWS
+from walkerlab.walker.parts import Part
 
-__all__ = ["FEATURES", "KINDS", "VIEWS", "Kind", "KindRefused", "kind_of", "table_rows"]
+__all__ = ["FEATURES", "KINDS", "PART_SLOTS", "VIEWS", "Kind", "KindRefused", "kind_of",
+           "table_rows"]
+
+#: the slots of a kind that hold its parts (:mod:`walkerlab.walker.parts`)
+PART_SLOTS = ("rigid", "landing", "actuators", "reaction", "contact", "scuff", "collocation",
+              "phases")
 
 #: the views of one walker description: name -> what it is
 VIEWS = {
@@ -129,39 +139,40 @@ class Kind:
         The scene field a refusal of the walker itself names first (``walker``; the 3D
         kinds': ``walker.space: 3d``).
     body : str
-        The multibody its exports write (:data:`walkerlab.export.writers.BODIES`):
-        ``links``, a tree of leg links (:func:`walkerlab.walker.multibody.multibody`);
-        ``wheel`` and ``wheel_3d``, one rigid body on its spokes; ``legs_3d``, a free
-        pelvis and two legs on hip joints.
-    rigid : str
-        The rigid model's maker (:data:`walkerlab.models.hybrid.rigid.BUILDERS`): ``legs``,
-        a generated flow and the heel-strike reset of straight or locking-knee legs;
-        ``flat``, the flat feet's foot-mode phase graph; ``free``, every joint free (one
-        flow per step); ``wheel``, a spoked wheel.
+        The multibody its exports write: ``links``, a tree of leg links
+        (:func:`walkerlab.walker.multibody.multibody`); ``wheel`` and ``wheel_3d``, one
+        rigid body on its spokes; ``legs_3d``, a free pelvis and two legs on hip joints.
     knees : str
         ``none`` (straight legs), ``locking`` (free in early swing, locked at the knee
-        strike) or ``free`` (a free joint all along, driven by torques).
+        strike) or ``free`` (a free joint all along, driven by torques): read through
+        :attr:`has_knees` and :attr:`knees_lock`.
     feet : str
         ``leg_ends`` (point or arc feet at the legs' ends) or ``flat`` (a foot body on an
-        ankle spring, with foot modes): the exports' feet
-        (:data:`walkerlab.export.scene_feet.SCENE_FEET`, :data:`walkerlab.export.adams_feet.
-        ADAMS_FEET`).
-    landing : str or None
+        ankle spring, with foot modes): read through :attr:`feet_have_modes`.
+    rigid : Part
+        The rigid model's maker (:mod:`walkerlab.models.hybrid.rigid`): straight legs
+        (planar or 3D) or locking knees on one generated flow, flat feet's foot modes,
+        every joint free, a spoked wheel.
+    landing : Part or None
         How the rigid view lands on stairs and footholds
-        (:data:`walkerlab.models.hybrid.ground.LANDINGS`): ``clearance``, the generated
-        swing clearance; ``flat``, a guard per stance mode; None, not at all (the
-        capability table refuses it first).
-    contact : str or None
-        The contact view's part (:data:`walkerlab.models.contact.parts.PARTS`), None for a
+        (:mod:`walkerlab.models.hybrid.ground`); None, not at all (the capability table
+        refuses it first).
+    actuators : Part
+        How the rigid model drives it (:mod:`walkerlab.models.hybrid.actuated`).
+    reaction : Part
+        The stance foot's reaction (:mod:`walkerlab.models.hybrid.ground_reaction`).
+    contact : Part or None
+        The contact view's part (:mod:`walkerlab.models.contact.parts`), None for a
         walker the contact view refuses.
-    actuators : str
-        How the rigid model drives it (:mod:`walkerlab.models.hybrid.actuated`): ``hips``,
-        ``latched_knees``, ``joints`` (every joint free), ``ankles`` (flat feet) or
-        ``none`` (passive: the capability table refuses every actuator).
-    collocation : str or None
-        Its transcription in the direct collocation (:data:`walkerlab.optimal.driver.PARTS`):
-        ``legs`` (one step, straight legs), ``kneed`` and ``flat`` (phased), ``five_link``
-        (the five-link biped's own); None, not transcribed.
+    scuff : Part
+        What a contact run names as the cause of the swing foot's scuffs
+        (:mod:`walkerlab.analysis.contact.verdict`).
+    collocation : Part or None
+        Its transcription in the direct collocation (:mod:`walkerlab.optimal.driver`);
+        None, not transcribed.
+    phases : Part or None
+        The symbolic pieces of its phases in the phased transcription
+        (:mod:`walkerlab.optimal.transcription.phases`); None, none.
     scene : str
         Its shipped reference scene (:data:`walkerlab.walker.reference_cases.SCENES`).
     """
@@ -171,13 +182,16 @@ class Kind:
     reference: str
     field: str = "walker"
     body: str = "links"
-    rigid: str = "legs"
     knees: str = "none"
     feet: str = "leg_ends"
-    landing: str | None = "clearance"
-    contact: str | None = None
-    actuators: str = "none"
-    collocation: str | None = None
+    rigid: Part = P.RIGID_STRAIGHT_LEGS
+    landing: Part | None = P.LANDING_CLEARANCE
+    actuators: Part = P.ACTUATORS_NONE
+    reaction: Part = P.REACTION_LEG_END
+    contact: Part | None = None
+    scuff: Part = P.SCUFF_NONE
+    collocation: Part | None = None
+    phases: Part | None = None
     scene: str = ""
 
     @property
@@ -189,13 +203,27 @@ class Kind:
     def joints_free(self) -> bool:
         """Whether every joint is free, driven by torques (the five-link biped, the
         three-link walker): their models are derived alike."""
-        return self.rigid == "free"
+        return self.rigid is P.RIGID_FREE_JOINTS
 
     @property
     def feet_have_modes(self) -> bool:
         """Whether the stance foot goes through foot modes (flat feet: heel contact, foot
         flat, heel off)."""
         return self.feet == "flat"
+
+    @property
+    def has_knees(self) -> bool:
+        """Whether the legs have knees (locking, or free all along)."""
+        return self.knees != "none"
+
+    @property
+    def knees_lock(self) -> bool:
+        """Whether the knees lock at the knee strike (free in early swing)."""
+        return self.knees == "locking"
+
+    def parts(self) -> dict[str, Part]:
+        """The kind's parts by slot (None where the kind has none)."""
+        return {slot: getattr(self, slot) for slot in PART_SLOTS}
 
     @property
     def spoked(self) -> bool:
@@ -273,36 +301,46 @@ class Kind:
 KINDS = {k.name: k for k in (
     Kind("straight_legs", "straight legs (point or arc feet)",
          "Goswami, Thuilot & Espiau 1996; Garcia et al. 1998; Kuo 2002",
-         contact="legs", actuators="hips", collocation="legs",
-         scene="configs/paper_rods.yaml"),
+         contact=P.CONTACT_STRAIGHT_LEGS, actuators=P.ACTUATORS_HIPS,
+         scuff=P.SCUFF_STRAIGHT_LEG, collocation=P.COLLOCATION_STRAIGHT_LEGS,
+         phases=P.PHASES_STRAIGHT_LEGS, scene="configs/paper_rods.yaml"),
     Kind("locking_knees", "knees that lock at the knee strike",
          "McGeer 1990 (passive walking with knees); Hsu Chen 2007", knees="locking",
-         contact="kneed", actuators="latched_knees", collocation="kneed",
+         rigid=P.RIGID_LOCKING_KNEES, contact=P.CONTACT_LOCKING_KNEES,
+         actuators=P.ACTUATORS_LATCHED_KNEES, scuff=P.SCUFF_UNLATCHED_KNEE,
+         collocation=P.COLLOCATION_LOCKING_KNEES, phases=P.PHASES_LOCKING_KNEES,
          scene="configs/kneed.yaml"),
     Kind("flat_feet", "flat feet on ankle springs (foot modes)",
-         "McGeer 1990; Collins, Wisse & Ruina 2001", rigid="flat", feet="flat",
-         landing="flat", contact="flat", actuators="ankles", collocation="flat",
+         "McGeer 1990; Collins, Wisse & Ruina 2001", feet="flat", rigid=P.RIGID_FLAT_FEET,
+         landing=P.LANDING_FLAT_FEET, reaction=P.REACTION_FLAT_FEET,
+         contact=P.CONTACT_FLAT_FEET, actuators=P.ACTUATORS_ANKLES,
+         collocation=P.COLLOCATION_FLAT_FEET, phases=P.PHASES_FLAT_FEET,
          scene="configs/flat_feet.yaml"),
     Kind("free_joints", "free hips and knees, hinged torso (five-link biped)",
-         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)", rigid="free", knees="free",
-         contact="five_link", actuators="joints", collocation="five_link",
+         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)", knees="free",
+         rigid=P.RIGID_FREE_JOINTS, contact=P.CONTACT_FIVE_LINK,
+         actuators=P.ACTUATORS_JOINTS, collocation=P.COLLOCATION_FIVE_LINK,
          scene="configs/rabbit.yaml"),
     Kind("hinged_torso", "a torso hinged on straight legs (three-link walker)",
          "Grizzle, Abba & Plestan 2001; Westervelt, Grizzle, Chevallereau, Choi & Morris "
-         "2007", rigid="free", contact="three_link", actuators="joints",
-         scene="configs/threelink.yaml"),
+         "2007", rigid=P.RIGID_FREE_JOINTS, contact=P.CONTACT_THREE_LINK,
+         actuators=P.ACTUATORS_JOINTS, scene="configs/threelink.yaml"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
-         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", body="wheel", rigid="wheel",
-         contact="wheel", scene="configs/rimless_wheel.yaml"),
+         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", body="wheel",
+         rigid=P.RIGID_SPOKES, reaction=P.REACTION_HUB, contact=P.CONTACT_WHEEL,
+         scene="configs/rimless_wheel.yaml"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
-         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d", rigid="wheel",
-         landing=None, contact="wheel_3d", scene="configs/rimless_wheel_3d.yaml"),
+         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d",
+         rigid=P.RIGID_SPOKES, landing=None, reaction=P.REACTION_HUB,
+         contact=P.CONTACT_WHEEL_3D, scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
-         "Kuo 1999", "walker.space: 3d", "legs_3d", landing=None, contact="legs_3d",
-         actuators="legs_3d", scene="configs/hip_width.yaml"),
+         "Kuo 1999", "walker.space: 3d", "legs_3d", rigid=P.RIGID_STRAIGHT_LEGS_3D,
+         landing=None, contact=P.CONTACT_LEGS_3D, actuators=P.ACTUATORS_LEGS_3D,
+         scene="configs/hip_width.yaml"),
     Kind("locking_knees_3d", "knees that lock at the knee strike, in 3D with hip width",
          "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",
-         "legs_3d", knees="locking", landing=None, scene="configs/kneed_3d.yaml"),
+         "legs_3d", knees="locking", rigid=P.RIGID_LOCKING_KNEES, landing=None,
+         reaction=P.REACTION_NONE, scene="configs/kneed_3d.yaml"),
 )}
 
 

@@ -183,7 +183,7 @@ class StepMap:
         # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
         # a kneed swing leg (knees that lock or free knees) is flexed there, so its
         # continuous ground is kept
-        keep_ground = walker.continuous and walker.structure.kind.knees != "none"
+        keep_ground = walker.continuous and walker.structure.kind.has_knees
         # each patch centred on its foot's footprint (a flat foot's lies ahead of its heel)
         o2 = footprint_offsets(walker.data)[1]
         #: height [m] of the swing lane's patch above the stance patch (stairs, footholds)

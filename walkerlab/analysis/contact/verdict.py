@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
+from walkerlab.walker import parts as P
 
 __all__ = ["CONTACT_OUTCOMES", "Outcome", "classify", "classify_complete", "scuff_cause",
            "step_trend", "walk_verdict"]
@@ -206,7 +207,7 @@ def scuff_cause(walker) -> str:
     -------
     str
     """
-    return _SCUFF_CAUSES.get(walker.data.structure.kind.contact, _no_cause)(walker)
+    return walker.data.structure.kind.scuff(walker)
 
 
 def _no_cause(walker) -> str:
@@ -235,9 +236,11 @@ def _straight_leg_scuff(walker) -> str:
     return f"({straight})"
 
 
-#: contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) -> the likely cause of its
-#: swing foot's scuffs (:func:`scuff_cause`; a part not listed has none to name)
-_SCUFF_CAUSES = {"legs": _straight_leg_scuff, "kneed": _unlatched_knee}
+# each kind's scuff part (:attr:`walkerlab.walker.kinds.Kind.scuff`) given the likely cause
+# of its swing foot's scuffs (:func:`scuff_cause`)
+P.SCUFF_STRAIGHT_LEG.provide(_straight_leg_scuff)
+P.SCUFF_UNLATCHED_KNEE.provide(_unlatched_knee)
+P.SCUFF_NONE.provide(_no_cause)
 
 
 def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,

@@ -16,9 +16,10 @@ import numpy as np
 
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, HUB_INERTIA_MESSAGE
+from walkerlab.walker import parts as P
 from walkerlab.walker.layout import floating_links_from_rigid
 
-__all__ = ["PARTS", "ContactPart", "attribution_refusal", "contact_part",
+__all__ = ["ContactPart", "attribution_refusal", "contact_part",
            "periodic_gait_refusal"]
 
 
@@ -414,17 +415,16 @@ class Legs3DPart(ContactPart):
         return None
 
 
-#: contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) -> the contact view's part
-PARTS: dict[str, ContactPart] = {
-    "legs": ContactPart(),
-    "kneed": KneedPart(),
-    "flat": FlatFeetPart(),
-    "five_link": FreeJointsPart(),
-    "three_link": HingedTorsoPart(),
-    "wheel": RollingPolygonPart(),
-    "legs_3d": Legs3DPart(),
-    "wheel_3d": RollingPolygon3DPart(),
-}
+# each kind's contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) given the
+# contact view's behaviour
+P.CONTACT_STRAIGHT_LEGS.provide(ContactPart())
+P.CONTACT_LOCKING_KNEES.provide(KneedPart())
+P.CONTACT_FLAT_FEET.provide(FlatFeetPart())
+P.CONTACT_FIVE_LINK.provide(FreeJointsPart())
+P.CONTACT_THREE_LINK.provide(HingedTorsoPart())
+P.CONTACT_WHEEL.provide(RollingPolygonPart())
+P.CONTACT_LEGS_3D.provide(Legs3DPart())
+P.CONTACT_WHEEL_3D.provide(RollingPolygon3DPart())
 
 
 def periodic_gait_refusal(scene, data) -> str | None:
@@ -460,4 +460,4 @@ def contact_part(structure) -> ContactPart:
         The kind has no contact view (its ``walk`` cell there, one line).
     """
     structure.kind.require("walk", "contact", structure.kind.field)
-    return PARTS[structure.kind.contact]
+    return structure.kind.contact.behaviour

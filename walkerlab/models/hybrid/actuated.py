@@ -8,8 +8,9 @@ the generated link angles; the push-off of Kuo (2002) in its transition.  Free k
 five-link biped) add one spline for laws sharing a table
 (:mod:`walkerlab.models.hybrid.free_joint_actuators`); flat feet run their stance-foot modes'
 own mass matrices (:mod:`walkerlab.models.hybrid.mode_torques`) or an ankle push-off
-(:mod:`walkerlab.models.hybrid.ankle_push_off`).  Each kind's way is its part, reached
-through the walker's kind (``_PARTS``); what a kind cannot carry is refused by its row of
+(:mod:`walkerlab.models.hybrid.ankle_push_off`).  Each kind's way is its actuators part
+(:attr:`walkerlab.walker.kinds.Kind.actuators`), given its behaviour here; what a kind
+cannot carry is refused by its row of
 :data:`walkerlab.walker.kinds.CAPABILITIES`, what the legs' masses cannot carry by
 :mod:`walkerlab.models.hybrid.leg_masses`.  Those modules import the shared actuators from
 :mod:`walkerlab.models.hybrid.actuators`, never this one.
@@ -26,6 +27,7 @@ from walkerlab.models.hybrid.actuators import Actuators, torque_chain_jacobian
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.models.hybrid.leg_masses import check_impact_masses, massless_limit
 from walkerlab.numerics import complex_step_jacobian
+from walkerlab.walker import parts as P
 
 __all__ = ["compiled_with", "Actuators", "actuate", "refuse_actuators",
            "torque_chain_jacobian", "torque_feature"]
@@ -56,7 +58,7 @@ def spring_equivalent(data, spec):
 
     st = data.structure
     laws = [t for t in spec.torques]
-    if not laws or not _PARTS[st.kind.actuators].hip_spring or st.knee_spring or st.torso \
+    if not laws or not st.kind.actuators.hip_spring or st.knee_spring or st.torso \
             or any(b.massless for b in st.bodies) or any(
             t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
             or t.law.reference is not None or t.law.time_reference is not None for t in laws):
@@ -96,7 +98,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
         return VirtualConstraintFlow.of(acts.controller, data.structure, data.params)
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None:  # a passive flow run in Python: the guards' outputs from the kind
-        guards = _PARTS[data.structure.kind.actuators].guard_outputs(phase, data)
+        guards = data.structure.kind.actuators.guard_outputs(phase, data)
     if guards is None:
         return None
     links = acts.links  # each actuator's (first, second) link: keys of ``leg_angles``
@@ -146,7 +148,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     if getattr(spec, "virtual_constraints", None) is not None:  # the kind's table
         data.structure.kind.require("virtual_constraints", "rigid",
                                     "walker.actuation.virtual_constraints")
-    return _PARTS[data.structure.kind.actuators].actuate(walker, data, spec)
+    return data.structure.kind.actuators.actuate(walker, data, spec)
 
 
 def _actuate_joints(part, walker: HybridWalker, data, spec) -> HybridWalker:
@@ -355,7 +357,11 @@ class _RollingPolygon:
         return walker
 
 
-#: actuators part (:attr:`walkerlab.walker.kinds.Kind.actuators`) -> how :func:`actuate`
-#: drives it (``none``: passive so far, the table refuses)
-_PARTS = {"hips": _Joints(), "latched_knees": _LockingKnees(), "joints": _FreeJoints(),
-          "ankles": _FlatFeet(), "legs_3d": _Legs3d(), "none": _RollingPolygon()}
+# each kind's actuators part (:attr:`walkerlab.walker.kinds.Kind.actuators`) given how
+# :func:`actuate` drives it (none: passive so far, the capability table refuses)
+P.ACTUATORS_HIPS.provide(_Joints())
+P.ACTUATORS_LATCHED_KNEES.provide(_LockingKnees())
+P.ACTUATORS_JOINTS.provide(_FreeJoints())
+P.ACTUATORS_ANKLES.provide(_FlatFeet())
+P.ACTUATORS_LEGS_3D.provide(_Legs3d())
+P.ACTUATORS_NONE.provide(_RollingPolygon())

@@ -35,6 +35,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.models.ground import foothold_steps, landing_drop
 from walkerlab.models.hybrid.base import HybridWalker, OffSection, Phase
 from walkerlab.models.hybrid.rigid_foot_modes import on_landing_flat
+from walkerlab.walker import parts as P
 
 __all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
            "with_clearance_guard"]
@@ -200,9 +201,9 @@ def with_clearance_guard(walker: HybridWalker, data) -> HybridWalker:
 
 def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     """:func:`on_landing`'s walker for any ``drop_m`` (0 included): the kind's part of
-    :data:`LANDINGS`."""
+    its landing part (:attr:`walkerlab.walker.kinds.Kind.landing`)."""
     data.structure.kind.require("stairs", "rigid", "terrain.kind")
-    return LANDINGS[data.structure.kind.landing](walker, data, drop_m)
+    return data.structure.kind.landing(walker, data, drop_m)
 
 
 def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
@@ -251,11 +252,12 @@ def _on_flat_feet(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     return on_landing_flat(walker, data, drop_m)
 
 
-#: landing part (:attr:`walkerlab.walker.kinds.Kind.landing`) -> ``(walker, data, drop_m) ->
-#: HybridWalker``: the kinds whose rigid view lands on stairs and footholds (the rimless
-#: wheel's rolling polygon and the legged kinds with the generated swing clearance; flat
-#: feet, a guard per stance mode)
-LANDINGS = {"clearance": _on_clearance, "flat": _on_flat_feet}
+# each kind's landing part (:attr:`walkerlab.walker.kinds.Kind.landing`) given its
+# ``(walker, data, drop_m) -> HybridWalker``: the kinds whose rigid view lands on stairs and
+# footholds (the rimless wheel's rolling polygon and the legged kinds with the generated
+# swing clearance; flat feet, a guard per stance mode)
+P.LANDING_CLEARANCE.provide(_on_clearance)
+P.LANDING_FLAT_FEET.provide(_on_flat_feet)
 
 
 def on_footholds(walker_at, data_at, steps, periodic: bool = True,

@@ -58,6 +58,7 @@ import numpy as np
 
 from walkerlab.codegen.floating import FREE_3D, ROLES_3D, floating_plain
 from walkerlab.models.hybrid.floating_view import FloatingView
+from walkerlab.walker import parts as P
 from walkerlab.walker.layout import StateLayout, floating_links_from_rigid
 
 __all__ = ["StanceReaction", "TransitionImpulses"]
@@ -88,25 +89,14 @@ class _Part:
     refusal: str | None = None
 
 
-#: rigid model part (:attr:`walkerlab.walker.kinds.Kind.rigid`) -> its part of the stance
-#: reaction, in the plane (:func:`_part`)
-_PARTS = {
-    "legs": _Part(),
-    "free": _Part(),
-    "flat": _Part(refusal="flat feet: the rigid model's own guards check the heel's "
-                          "and toe's normal forces"),
-    "wheel": _Part(hub=True, trailing_point="trailing_foot"),
-}
-
-
-def _part(kind) -> _Part:
-    """The stance reaction's part of a kind (:class:`walkerlab.walker.kinds.Kind`): its
-    rigid model's, planar or 3D; a refusal for a kind without a floating view (the view
-    this reads the reaction from: a kind whose contact view is None has none)."""
-    if kind.contact is None:
-        return _Part(refusal=f"{kind.title}: no floating view yet (the contact view's), so "
-                             "the stance foot's reaction is not computed")
-    return _PARTS[kind.rigid]
+# each kind's reaction part (:attr:`walkerlab.walker.kinds.Kind.reaction`) given what the
+# stance reaction needs of it, planar or 3D ("{title}": the kind's title)
+P.REACTION_LEG_END.provide(_Part())
+P.REACTION_FLAT_FEET.provide(_Part(refusal="flat feet: the rigid model's own guards check "
+                                           "the heel's and toe's normal forces"))
+P.REACTION_HUB.provide(_Part(hub=True, trailing_point="trailing_foot"))
+P.REACTION_NONE.provide(_Part(refusal="{title}: no floating view (the contact view's), so "
+                                      "the stance foot's reaction is not computed"))
 
 
 @dataclass(frozen=True)
@@ -170,9 +160,9 @@ class StanceReaction:
 
     def __init__(self, walker, data):
         st = data.structure
-        self.part = _part(st.kind)
+        self.part = st.kind.reaction.behaviour
         if self.part.refusal is not None:
-            raise ValueError(self.part.refusal)
+            raise ValueError(self.part.refusal.format(title=st.kind.title))
         self.walker = walker
         phi = float(walker.slope_rad)
         self.normal = np.array([np.sin(phi), np.cos(phi)])

@@ -18,7 +18,7 @@ Flat feet on ankle springs have their own phase graph
 (:mod:`walkerlab.models.hybrid.rigid_foot_modes`), free joints theirs
 (:mod:`walkerlab.models.hybrid.rigid_free_joints`), a rimless wheel its one phase
 (:mod:`walkerlab.models.hybrid.rolling_polygon`): :func:`make_rigid_walker` reaches each
-through the walker's kind (:data:`BUILDERS`).
+through the walker's kind, whose rigid part each gives its behaviour (:class:`RigidMaker`).
 
 Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
 
@@ -51,6 +51,7 @@ from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
 from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
+from walkerlab.walker import parts as P
 from walkerlab.walker.description import WalkerData
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
@@ -127,8 +128,9 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     """A hybrid walker from generated code; ``flow``/``reset`` may override the generated ones
     (the paper's printed Appendix A variants).
 
-    The walker's kind (:attr:`walkerlab.walker.description.Structure.kind`) picks its
-    builder in :data:`BUILDERS`.
+    The walker's kind (:attr:`walkerlab.walker.description.Structure.kind`) holds its
+    rigid model's maker (:attr:`walkerlab.walker.kinds.Kind.rigid`), given its behaviour
+    here.
 
     Parameters
     ----------
@@ -154,7 +156,7 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     """
     printed = {"flow": flow, "flow_jacobian": flow_jacobian, "reset": reset,
                "reset_jacobian": reset_jacobian}
-    return BUILDERS[data.structure.kind.rigid](data, name, variant, printed, double_support)
+    return data.structure.kind.rigid.build(data, name, variant, printed, double_support)
 
 
 @dataclass(frozen=True)
@@ -178,27 +180,17 @@ def _never(structure) -> bool:
     return False
 
 
-#: the legged kinds' parts (:func:`_make_legged`, :func:`_legs`): straight legs, knees that
-#: lock, straight legs in 3D (the state has the lean besides the legs' angles: the map names
-#: them)
+#: the legged kinds' parts (:func:`_make_legged`): straight legs, knees that lock, straight
+#: legs in 3D (the state has the lean besides the legs' angles: the map names them)
 _STRAIGHT = _Legs(_straight_leg_phases, _absolute_legs_only)
 _LOCKING = _Legs(_kneed_phases, _never)
 _STRAIGHT_3D = _Legs(_straight_leg_phases, _never)
 
 
-def _legs(kind) -> _Legs:
-    """The legged part of a kind (:class:`walkerlab.walker.kinds.Kind`) whose rigid model
-    is ``legs``."""
-    if kind.knees == "locking":
-        return _LOCKING
-    return _STRAIGHT_3D if kind.in_3d else _STRAIGHT
-
-
-def _make_legged(data: WalkerData, name: str, variant: str, printed: dict,
+def _make_legged(legs: _Legs, data: WalkerData, name: str, variant: str, printed: dict,
                  double_support: bool) -> HybridWalker:
-    """Straight legs or locking knees (:func:`_legs`): one generated flow, its phases, the
-    heel-strike reset (``printed``: the printed equations' replacements)."""
-    legs = _legs(data.structure.kind)
+    """Straight legs or locking knees (``legs``: their phases): one generated flow, its
+    phases, the heel-strike reset (``printed``: the printed equations' replacements)."""
     flow, flow_jacobian = printed["flow"], printed["flow_jacobian"]
     reset, reset_jacobian = printed["reset"], printed["reset_jacobian"]
     f = functions(data)
@@ -274,11 +266,23 @@ def _make_polygon(data: WalkerData, name: str, variant: str, printed: dict,
     return make_spoked_walker(data, name, variant)
 
 
-#: rigid model part (:attr:`walkerlab.walker.kinds.Kind.rigid`) -> its builder ``(data,
-#: name, variant, printed, double_support) -> HybridWalker``
-BUILDERS: dict[str, Callable] = {
-    "legs": _make_legged,
-    "flat": _make_flat,
-    "free": _make_free,
-    "wheel": _make_polygon,
-}
+@dataclass(frozen=True)
+class RigidMaker:
+    """A rigid model's maker, the behaviour of a kind's rigid part
+    (:attr:`walkerlab.walker.kinds.Kind.rigid`): ``make(data, name, variant, printed,
+    double_support) -> HybridWalker``."""
+
+    make: Callable
+
+    def build(self, data: WalkerData, name: str, variant: str, printed: dict,
+              double_support: bool) -> HybridWalker:
+        """The kind's rigid hybrid walker (see :func:`make_rigid_walker`)."""
+        return self.make(data, name, variant, printed, double_support)
+
+
+P.RIGID_STRAIGHT_LEGS.provide(RigidMaker(partial(_make_legged, _STRAIGHT)))
+P.RIGID_LOCKING_KNEES.provide(RigidMaker(partial(_make_legged, _LOCKING)))
+P.RIGID_STRAIGHT_LEGS_3D.provide(RigidMaker(partial(_make_legged, _STRAIGHT_3D)))
+P.RIGID_FLAT_FEET.provide(RigidMaker(_make_flat))
+P.RIGID_FREE_JOINTS.provide(RigidMaker(_make_free))
+P.RIGID_SPOKES.provide(RigidMaker(_make_polygon))

@@ -113,7 +113,7 @@ def five_link_functions(structure) -> dict:
     from walkerlab.codegen.cache import cache_key
     from walkerlab.codegen.casadi_functions import cached_functions
 
-    if structure.kind.collocation != "five_link" or not structure.hinged_torso:
+    if not (structure.kind.joints_free and structure.kind.has_knees) or not structure.hinged_torso:
         raise ValueError("optimize: the five-link collocation drives the hips between a hinged "
                          "torso and the thighs and the free knees (walker.torso.coupling: "
                          "hinged, walker.leg.knee.lock: free)")

@@ -59,6 +59,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.walker import parts as P
+
 __all__ = ["ModePhase", "mode_functions", "phase_order"]
 
 @dataclass(frozen=True)
@@ -177,7 +179,7 @@ def mode_functions(data, walker, order=None) -> dict:
     import casadi as ca
 
     st = data.structure
-    modes = _MODES.get(st.kind.collocation)
+    modes = st.kind.phases.behaviour if st.kind.phases is not None else None
     if modes is None or st.torso or st.foot == "arc" or any(b.massless for b in st.bodies):
         raise ValueError("optimize: the phased transcription takes massive legs with point "
                          "or flat feet and no torso today")
@@ -434,7 +436,9 @@ class _Impact:
     relabel_rate: object
 
 
-#: the phases' symbolic pieces of each walker kind the phased transcription takes, by
-#: :attr:`walkerlab.walker.kinds.Kind.name` (a five-link biped has its own transcription,
-#: :mod:`walkerlab.optimal.transcription.free_joints`; a spoked wheel none)
-_MODES = {"legs": _StraightModes, "kneed": _KneedModes, "flat": _FlatModes}
+# each kind's phases part (:attr:`walkerlab.walker.kinds.Kind.phases`) given the symbolic
+# pieces of its phases (a five-link biped has its own transcription,
+# :mod:`walkerlab.optimal.transcription.free_joints`; a spoked wheel none)
+P.PHASES_STRAIGHT_LEGS.provide(_StraightModes)
+P.PHASES_LOCKING_KNEES.provide(_KneedModes)
+P.PHASES_FLAT_FEET.provide(_FlatModes)

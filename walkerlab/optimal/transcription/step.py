@@ -54,7 +54,7 @@ import numpy as np
 from walkerlab.codegen.casadi_functions import casadi_function
 from walkerlab.optimal.transcription.ipopt import CollocatedStep
 
-__all__ = ["OBJECTIVES", "ONE_STEP_COLLOCATIONS", "CollocationResult", "CollocationSpec",
+__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec",
            "check_objective", "ipopt_options", "number", "positive_power", "replay",
            "replay_actuation", "step_functions", "target_constraints", "torque_of_time"]
 
@@ -125,12 +125,6 @@ class CollocationSpec:
     touchdown_rate_rad_per_s: float = 0.05
     warm_start: bool = False
 
-
-#: the walker kinds (:attr:`walkerlab.walker.kinds.Kind.name`) one step of one phase
-#: transcribes: straight legs (a kneed or flat-footed step is a sequence of phases,
-#: :mod:`walkerlab.optimal.transcription.phases`)
-ONE_STEP_COLLOCATIONS = ("legs",)
-
 #: Objectives of one step, with their units (``u`` per foot mass on massless legs).
 OBJECTIVES = {"effort": "N^2 m^2 s", "push_off_work": "J", "cost_of_transport": "-",
               "peak_torque": "N m"}
@@ -193,7 +187,7 @@ def step_functions(data, eq):
     st = data.structure
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
-    if st.kind.collocation not in ONE_STEP_COLLOCATIONS:
+    if not (st.kind.collocation is not None and st.kind.collocation.one_step):
         raise ValueError("optimize: knees and flat feet take a step of phases "
                          "(walkerlab.optimal.transcription.phases.mode_functions)")
     if any(massless) and not limit:

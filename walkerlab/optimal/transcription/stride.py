@@ -71,14 +71,14 @@ def stride_functions(data) -> dict:
         Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
         legs (one line).
     """
-    from walkerlab.optimal.transcription.step import ONE_STEP_COLLOCATIONS
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
     st = data.structure
     if data.mirror is None:
         raise ValueError("optimize: a stride is for legs that differ (mirror-image legs take "
                          "one step)")
-    if (st.kind.collocation not in ONE_STEP_COLLOCATIONS or st.foot == "arc" or st.torso
+    one_step = st.kind.collocation is not None and st.kind.collocation.one_step
+    if (not one_step or st.foot == "arc" or st.torso
             or any(b.massless for b in st.bodies)):
         raise ValueError("optimize: a stride of legs that differ takes straight massive legs "
                          "with point feet today (knees, flat or arc feet, a torso: not yet)")
