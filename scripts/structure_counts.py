@@ -59,6 +59,54 @@ def _kinds(root: Path) -> tuple[str, ...]:
     return tuple(out.stdout.split())
 
 
+#: the words a layer's table of a kind's parts was keyed by (the kinds' part words before
+#: the parts were objects: the rigid makers, landings, actuators, contact parts, exports'
+#: bodies and feet, collocations): a dict keyed by two of them, or by two kind names, outside
+#: ``walker/`` is a table of parts kept in a layer
+PART_WORDS = frozenset({
+    "legs", "kneed", "flat", "free", "wheel", "wheel_3d", "legs_3d", "five_link",
+    "three_link", "hips", "latched_knees", "joints", "ankles", "clearance", "leg_ends",
+    "links", "locking"})
+
+#: attributes of a kind (:class:`walkerlab.walker.kinds.Kind`) a switch compares with a word
+KIND_WORD_ATTRS = frozenset({"name", "body", "rigid", "knees", "feet", "landing", "contact",
+                             "actuators", "collocation", "reaction", "scuff", "phases"})
+
+
+def _is_kind_word(n) -> bool:
+    """``kind.<attr>`` or ``<...>.kind.<attr>`` for a word attribute of the kind."""
+    if not (isinstance(n, ast.Attribute) and n.attr in KIND_WORD_ATTRS):
+        return False
+    owner = n.value
+    return (isinstance(owner, ast.Name) and owner.id == "kind") or (
+        isinstance(owner, ast.Attribute) and owner.attr == "kind")
+
+
+def _kind_word_lookup(n) -> bool:
+    """``TABLE[kind.<attr>]`` or ``TABLE.get(kind.<attr>, ...)``: a table of parts looked up
+    by a kind's word."""
+    if isinstance(n, ast.Subscript):
+        return _is_kind_word(n.slice)
+    return (isinstance(n, ast.Call) and _call_name(n) == "get" and bool(n.args)
+            and _is_kind_word(n.args[0]))
+
+
+def _kind_word_switch(n) -> bool:
+    """``<...>.kind.<attr> == "word"`` (or ``!=``, ``in``/``not in`` a tuple of words), or
+    ``kind.<attr>`` so compared: a switch on a kind's word."""
+    if not isinstance(n, ast.Compare):
+        return False
+    if not _is_kind_word(n.left):
+        return False
+    for c in n.comparators:
+        if isinstance(c, ast.Constant) and isinstance(c.value, str):
+            return True
+        if isinstance(c, (ast.Tuple, ast.List, ast.Set)) and any(
+                isinstance(e, ast.Constant) and isinstance(e.value, str) for e in c.elts):
+            return True
+    return False
+
+
 def _docstrings(tree: ast.Module) -> set[int]:
     """``id`` of every docstring node (module, class, function)."""
     out = set()
@@ -127,6 +175,7 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
         return p.relative_to(pkg).as_posix()
 
     tables, kind_files, cs_files, wd_calls, christoffel = [], set(), set(), {}, []
+    part_tables, kind_switches = [], []
     plant_builds = {}  # module -> ["line (plant=None default)" or "line"]
     plant_fallbacks = {}  # module -> ["function:line"]: a plant parameter defaulting to None
     long_strings, gym_parse, gym_hook = [], [], []
@@ -139,6 +188,14 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
                 keys = {k.value for k in n.keys if isinstance(k, ast.Constant)} & kinds
                 if len(keys) >= 2:
                     tables.append(f"{r}:{n.lineno}")
+            if top != "walker" and isinstance(n, ast.Dict):
+                keys = {k.value for k in n.keys if isinstance(k, ast.Constant)}
+                if len(keys & (kinds | PART_WORDS)) >= 2:
+                    part_tables.append(f"{r}:{n.lineno}")
+            if top != "walker" and _kind_word_lookup(n):
+                part_tables.append(f"{r}:{n.lineno} (lookup)")
+            if top != "walker" and _kind_word_switch(n):
+                kind_switches.append(f"{r}:{n.lineno}")
             if top != "walker" and isinstance(n, ast.Call) and _call_name(n) == "dict":
                 if len({k.arg for k in n.keywords} & kinds) >= 2:
                     tables.append(f"{r}:{n.lineno}")
@@ -183,9 +240,6 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
             christoffel.append(r)
 
     sizes = {rel(p): len(texts[p].splitlines()) for p in files}
-    funcs = [f"{rel(p)}:{n.name} ({n.end_lineno - n.lineno + 1})" for p in files
-             for n in ast.walk(trees[p]) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))
-             and n.end_lineno - n.lineno + 1 > 80]
     wd_out = {r: v for r, v in wd_calls.items()
               if r.split("/")[0] not in ("walker", "stages", "api")}
     # the front: the stages, the API (and its rigid walker, rigid_walker.SceneWalker), the CLI
@@ -217,6 +271,10 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
     rows = [
         ("per-kind tables outside walker/ (dicts keyed by >= 2 kind names)", len(tables), 1,
          tables),
+        ("tables keyed by part or kind words outside walker/ (dicts, lookups by kind.<part>)",
+         len(part_tables), 1, part_tables),
+        ("switches on a kind's word outside walker/ (kind.<part> == 'word')",
+         len(kind_switches), 2, kind_switches),
         ("files naming a walker kind as a string outside walker/, config/", len(kind_files), 3,
          sorted(kind_files)),
         ('files with the literal "contact-sim"', len(cs_files), 6, sorted(cs_files)),
@@ -234,8 +292,6 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
          sorted(k for k, v in sizes.items() if v > 800)),
         ("modules > 600 lines", sum(v > 600 for v in sizes.values()), 3,
          sorted(k for k, v in sizes.items() if v > 600)),
-        ("modules > 400 lines", sum(v > 400 for v in sizes.values()), 55, []),
-        ("functions > 80 lines", len(funcs), 10, funcs),
         ("duplicate pairs in walkerlab/ (duplicates)", dup, 45, []),
         ("arrows back up (imports from a lower floor to a higher one)", len(arrows), 1,
          {"arrows": arrows, "packages in no floor": unplaced}),
