@@ -78,6 +78,8 @@ def _is_kind_word(n) -> bool:
     if not (isinstance(n, ast.Attribute) and n.attr in KIND_WORD_ATTRS):
         return False
     owner = n.value
+    if n.attr != "name" and isinstance(owner, ast.Name) and len(owner.id) == 1:
+        return True  # a loop over the kinds: k.<part>
     return (isinstance(owner, ast.Name) and owner.id == "kind") or (
         isinstance(owner, ast.Attribute) and owner.attr == "kind")
 

@@ -193,7 +193,8 @@ def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
 #: why a walker with phases is not optimised with a push-off (one line: the capability
 #: table's, :data:`walkerlab.walker.kinds.CAPABILITIES`)
 PHASED_PUSH_OFF = "optimize.push_off: " + next(
-    k for k in KINDS.values() if k.collocation == "kneed").cell("push_off", "optimize")
+    k for k in KINDS.values() if k.phases is not None and k.collocation is not None
+    and not k.collocation.one_step).cell("push_off", "optimize")
 
 
 def _check(spec, phases) -> None:
