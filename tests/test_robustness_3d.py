@@ -136,3 +136,24 @@ def test_the_passive_hip_width_walker_survives_no_sideways_push_the_stabilised_o
     assert not R.stable(A) and R.linearise(p_sm, p_x, A, "lateral_push").gsn() == np.inf
     lo, hi = R.largest_by_bisection(p_sm, p_x, "lateral_push", 1.0, 0.02, 20)
     assert lo == 0.0 and hi <= 0.02
+
+
+def test_each_3d_kind_either_refuses_robustness_or_has_its_verified_measurement():
+    """The capability table's robustness study on the 3D kinds: refused in one line
+    (:data:`walkerlab.walker.capability_cells.STAGE_CELLS`) or measured and verified
+    (:func:`walkerlab.walker.capability_evidence.stage_evidence`: the 3D straight legs),
+    never both; ``walkerlab capabilities`` prints the measurement with its ✓."""
+    from walkerlab.walker.capability_cells import STAGE_CELLS
+    from walkerlab.walker.capability_evidence import stage_evidence, stage_verified
+    from walkerlab.walker.capability_tables import text
+    from walkerlab.walker.kinds import KINDS
+
+    in_3d = [k for k, kind in KINDS.items() if kind.in_3d]
+    assert in_3d
+    for kind in in_3d:
+        refused = "robustness" in STAGE_CELLS.get(kind, {})
+        assert refused != (stage_evidence(kind, "robustness") is not None), kind
+        assert refused or stage_verified(kind, "robustness"), kind
+    e = stage_evidence("straight_legs_3d", "robustness")
+    assert e["case"] == "configs/hip_width_stabilised.yaml" and e["check"] == "self"
+    assert "walkerlab robustness: ✓ 1.2e-06 self: configs/hip_width_stabilised.yaml" in text()
