@@ -370,9 +370,10 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
 STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
                "stability-map": ("walk", "contact")}
 #: why the robustness study refuses a 3D kneed walker (:mod:`walkerlab.studies.robustness_study`)
-ROBUSTNESS_KNEED_3D = ("the robustness study of a walker in 3D is measured on the straight "
-                       "legs (configs/hip_width_stabilised.yaml); a kneed walker in 3D is not "
-                       "measured yet: its metastability is walkerlab mfpt's")
+ROBUSTNESS_KNEED_3D = ("a kneed walker in 3D is passive and laterally unstable (a stride "
+                       "multiplier of about 40, configs/kneed_3d.yaml) and takes no hip-roll "
+                       "law to steady it: its sensitivity norms are infinite and it survives "
+                       "no disturbance; its metastability is walkerlab mfpt's")
 #: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
 #: robustness_study`)
 ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance leg's "
