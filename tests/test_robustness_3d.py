@@ -157,3 +157,31 @@ def test_each_3d_kind_either_refuses_robustness_or_has_its_verified_measurement(
     e = stage_evidence("straight_legs_3d", "robustness")
     assert e["case"] == "configs/hip_width_stabilised.yaml" and e["check"] == "self"
     assert "walkerlab robustness: ✓ 1.2e-06 self: configs/hip_width_stabilised.yaml" in text()
+
+
+def test_the_report_shows_the_sideways_push_with_its_units_and_a_planar_walker_none():
+    """The report's robustness section of a walker in 3D: the sideways push's norm row in
+    s/m, its largest pushes in m/s and N·s (the bracket times the impulse per m/s) and step
+    width among the indicators; a planar artifact (no ``push_lateral_*``) shows none of it,
+    and an unstable gait's infinite norms are said so."""
+    from walkerlab.io.schemas.robustness import LATERAL_SCALARS, SCALARS, RobustnessData
+    from walkerlab.report.robustness_section import robustness_section
+
+    dists = ["slope", "push", "lateral_push"]
+    units = {"slope": "rad", "push": "m/s", "lateral_push": "m/s"}
+    sc = {**dict.fromkeys(SCALARS, 0.1), **dict.fromkeys(LATERAL_SCALARS, 0.1),
+          "push_lateral_kg": 11.0, "push_lateral_out_m_per_s/lo": 0.06}
+    norms = {d: 2.0 for d in dists}
+    d3 = RobustnessData(dists, units, {"absolute": 0.7, "relative": 0.7}, norms, norms,
+                        {"absolute": norms, "relative": norms}, sc, [])
+    text = "\n".join(robustness_section({"robustness": d3}))
+    assert "| sideways push at heel strike [s/m] |" in text
+    assert "toward the swing leg's side 0.06" in text and "(0.660 N·s)" in text
+    assert "step width" in text and "unstable" not in text
+    planar = RobustnessData(dists[:2], units, d3.max_abs_multiplier,
+                            {"slope": np.inf, "push": np.inf}, {"slope": np.nan,
+                                                                 "push": np.nan},
+                            d3.state_norm, dict.fromkeys(SCALARS, 0.0), [])
+    text = "\n".join(robustness_section({"robustness": planar}))
+    assert "sideways" not in text and "step width" not in text
+    assert "the gait is unstable" in text and "unstable gait: no finite norm" in text

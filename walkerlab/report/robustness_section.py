@@ -29,6 +29,15 @@ def _contact_steps(r) -> list[str]:
             f"{_mm(r['contact_step_up_m/lo'], r['contact_step_up_m/hi'])} mm."]
 
 
+def _unstable(r) -> list[str]:
+    """A line for an unstable gait (a multiplier outside the unit circle: infinite norms)."""
+    if all(math.isfinite(r.gsn[d]) for d in r.disturbances):
+        return []
+    return ["- the gait is unstable (a multiplier outside the unit circle): the undisturbed "
+            "walker leaves it within the survival steps, so its sensitivity norms are "
+            "infinite and no disturbance is survived (each bracket's 0 falls too)."]
+
+
 def _lateral_pushes(r) -> list[str]:
     """The largest sideways pushes (a walker in 3D: ``push_lateral_*`` in the artifact),
     as the hip's lateral velocity change [m/s] and the impulse [N·s]."""
@@ -86,7 +95,7 @@ def robustness_section(arts: dict, basin_area=None) -> list[str]:
             f"{num(r['montecarlo_walks'])} walks, {num(r['montecarlo_falls'])} fell): {mfpt}.",
             f"- largest single step-down survived: {_mm(r['step_down_m/lo'], r['step_down_m/hi'])}"
             f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).",
-            *_contact_steps(r),
+            *_contact_steps(r), *_unstable(r),
             "- largest mid-stance push survived (an impulsive horizontal push at the hip when "
             "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
             f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
