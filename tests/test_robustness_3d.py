@@ -68,7 +68,7 @@ def test_a_planar_walker_takes_no_sideways_push(paper_walker):
     assert R.indicators_of(paper_walker) == R.INDICATORS
 
 
-@pytest.mark.slow  # the hip-roll walker's gait search and batched map (~1 min warm)
+@pytest.mark.slow  # the hip-roll walker's gait search and batched map (minutes)
 def test_a_sideways_push_changes_the_hips_lateral_velocity_by_its_size(stabilised):
     """The push along the hip axis at the section: the hip's lateral velocity (central
     differences of its position along the rates, independent of the push's Jacobian)
@@ -91,7 +91,7 @@ def test_a_sideways_push_changes_the_hips_lateral_velocity_by_its_size(stabilise
     assert np.array_equal(lay.q(xp), lay.q(x))  # an impulse moves no coordinate
 
 
-@pytest.mark.slow  # the hip-roll walker's gait search and batched map (~1 min warm)
+@pytest.mark.slow  # the hip-roll walker's gait search and batched map (minutes)
 def test_3d_gait_sensitivity_norms_equal_the_nonlinear_response_and_stride_multipliers(
         stabilised):
     """The reflected step map ``Q = S P`` of the stabilised walker: its Jacobian ``S A_step``
@@ -118,7 +118,7 @@ def test_3d_gait_sensitivity_norms_equal_the_nonlinear_response_and_stride_multi
         assert abs(g - R.gsn_nonlinear(sm, x, d, 1e-5, steps=60)) / g < 1e-5, d
 
 
-@pytest.mark.slow  # two gait searches and bisections of 20-step walks (~2 min warm)
+@pytest.mark.slow  # two gait searches and bisections of 20-step walks (minutes)
 def test_the_passive_hip_width_walker_survives_no_sideways_push_the_stabilised_one_does(
         stabilised):
     """Kuo 1999: the passive walker with hip width has an unstable lateral mode (a stride
