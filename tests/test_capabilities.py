@@ -446,8 +446,9 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     assert "knee latch" in page
 
 
-@pytest.mark.parametrize("name", ["paper_3d", "hip_width", "rimless_wheel_3d"])
-@pytest.mark.parametrize("stage", ["optimize", "robustness"])
+@pytest.mark.parametrize("name, stage", [
+    *((n, "optimize") for n in ("paper_3d", "hip_width", "rimless_wheel_3d")),
+    ("rimless_wheel_3d", "robustness"), ("kneed_3d", "robustness")])
 def test_a_stage_a_3d_walker_does_not_take_is_refused_before_any_work(tmp_path, name, stage):
     """Every pipeline stage a 3D kind does not take - its view's cell
     (:data:`walkerlab.walker.capability_cells.STAGE_VIEWS`) or its study's

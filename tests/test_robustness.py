@@ -166,13 +166,14 @@ def test_stability_map_prints_the_path_of_the_figure_it_drew(tmp_path, monkeypat
         in out
 
 
-@pytest.mark.parametrize("name", ["paper_3d", "hip_width", "rimless_wheel_3d"])
-def test_robustness_refuses_a_3d_walker_before_any_work(tmp_path, name):
-    """The robustness study is of planar walkers (its disturbances and state norms are
-    sagittal): a 3D walker is refused in one line naming walker.space, from the table
+@pytest.mark.parametrize("name, why", [("rimless_wheel_3d", "a spoked wheel"),
+                                       ("kneed_3d", "a kneed walker in 3D is passive")])
+def test_robustness_refuses_the_3d_kinds_it_does_not_take_before_any_work(tmp_path, name, why):
+    """The robustness study takes the 3D straight legs (tests/test_robustness_3d.py); the 3D
+    spoked wheel (no hip to push, no legs to read) and the kneed walker in 3D (passive,
+    laterally unstable) are refused in one line naming walker.space, from the table
     (:data:`walkerlab.walker.capability_cells.STAGE_CELLS`), before the gait is searched or
-    the walker built (paper_3d took 106 s to 'use a smaller e', hip_width 78 s to 'legs that
-    differ'); the study's own entry refuses it too, and nothing is written."""
+    the walker built; the study's own entry refuses them too, and nothing is written."""
     import time
 
     from walkerlab.stages import pipeline
@@ -182,8 +183,9 @@ def test_robustness_refuses_a_3d_walker_before_any_work(tmp_path, name):
 
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
     t0 = time.perf_counter()
-    with pytest.raises(StageError, match=r"^walker\.space: 3d: the robustness study"):
+    pattern = rf"^walker\.space: 3d: .*{why}"
+    with pytest.raises(StageError, match=pattern):
         pipeline.run("robustness", scene, tmp_path)
-    with pytest.raises(KindRefused, match=r"^walker\.space: 3d: the robustness study"):
+    with pytest.raises(KindRefused, match=pattern):
         scene_robustness(scene, np.zeros(6), plant=Plant.from_scene(scene))
     assert time.perf_counter() - t0 < 2.0 and not any(tmp_path.iterdir())

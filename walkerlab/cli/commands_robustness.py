@@ -110,6 +110,13 @@ def robustness(scene: Path | None = SceneArg,
                    f"± {d['mfpt_steps_stderr']:.2g} steps at sigma {d['sigma_rad']:g} rad")
         typer.echo(f"largest mid-stance push {d['push_forward_m_per_s/lo']:.3f} m/s forward, "
                    f"{d['push_backward_m_per_s/lo']:.3f} m/s backward (hip velocity change)")
+        if "push_lateral_kg" in d.scalars:  # a walker with a lateral axis (3D)
+            kg, swing, stance = (d["push_lateral_kg"], d["push_lateral_out_m_per_s/lo"],
+                                 d["push_lateral_in_m_per_s/lo"])
+            typer.echo(f"largest sideways push at heel strike {swing:.3f} m/s "
+                       f"({kg * swing:.3f} N s) toward the swing leg, {stance:.3f} m/s "
+                       f"({kg * stance:.3f} N s) toward the stance leg (hip lateral velocity "
+                       "change)")
     typer.echo(status(out))
 
 

@@ -10,7 +10,7 @@ from walkerlab.io.schemas.robustness import per_unit
 from walkerlab.report.markdown import num, table
 
 _LABEL = {"slope": "slope change", "floor_height": "floor height step",
-          "push": "mid-stance push"}
+          "push": "mid-stance push", "lateral_push": "sideways push at heel strike"}
 
 
 def _mm(lo: float, hi: float, scale: float = 1000) -> str:
@@ -27,6 +27,31 @@ def _contact_steps(r) -> list[str]:
             "periodic gait): step-down "
             f"{_mm(r['contact_step_down_m/lo'], r['contact_step_down_m/hi'])} mm; step-up "
             f"{_mm(r['contact_step_up_m/lo'], r['contact_step_up_m/hi'])} mm."]
+
+
+def _unstable(r) -> list[str]:
+    """A line for an unstable gait (a multiplier outside the unit circle: infinite norms)."""
+    if all(math.isfinite(r.gsn[d]) for d in r.disturbances):
+        return []
+    return ["- the gait is unstable (a multiplier outside the unit circle): the undisturbed "
+            "walker leaves it within the survival steps, so its sensitivity norms are "
+            "infinite and no disturbance is survived (each bracket's 0 falls too)."]
+
+
+def _lateral_pushes(r) -> list[str]:
+    """The largest sideways pushes (a walker in 3D: ``push_lateral_*`` in the artifact),
+    as the hip's lateral velocity change [m/s] and the impulse [N·s]."""
+    if "push_lateral_kg" not in r.scalars:
+        return []
+    kg = r["push_lateral_kg"]
+
+    def side(name: str) -> str:
+        lo, hi = r[f"push_lateral_{name}_m_per_s/lo"], r[f"push_lateral_{name}_m_per_s/hi"]
+        return f"{_mm(lo, hi, 1)} m/s ({num(kg * lo, 3)} N·s)"
+    return ["- largest sideways push survived (an impulsive push at the hip along the hip "
+            "axis just after heel strike, the stance foot pinned; as the hip's lateral "
+            f"velocity change, and its impulse at {num(kg, 3)} N·s per m/s): toward the "
+            f"swing leg's side {side('out')}, toward the stance leg's side {side('in')}."]
 
 
 def _basin_line(a) -> list[str]:
@@ -56,7 +81,8 @@ def robustness_section(arts: dict, basin_area=None) -> list[str]:
         return []
     lam = r.max_abs_multiplier
     rows = [[f"{_LABEL.get(d, d)} [{per_unit(r.units[d])}]", r.gsn[d],
-             f"{abs(r.gsn[d] - r.gsn_nonlinear[d]) / r.gsn[d]:.0e}",
+             f"{abs(r.gsn[d] - r.gsn_nonlinear[d]) / r.gsn[d]:.0e}" if math.isfinite(r.gsn[d])
+             else "unstable gait: no finite norm",
              r.state_norm["absolute"][d], r.state_norm["relative"][d]] for d in r.disturbances]
     m, se = r["mfpt_steps"], r["mfpt_steps_stderr"]
     mfpt = (f"≥ {num(r['montecarlo_walks'])} walks reached the step cap (no fall)"
@@ -69,14 +95,15 @@ def robustness_section(arts: dict, basin_area=None) -> list[str]:
             f"{num(r['montecarlo_walks'])} walks, {num(r['montecarlo_falls'])} fell): {mfpt}.",
             f"- largest single step-down survived: {_mm(r['step_down_m/lo'], r['step_down_m/hi'])}"
             f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).",
-            *_contact_steps(r),
+            *_contact_steps(r), *_unstable(r),
             "- largest mid-stance push survived (an impulsive horizontal push at the hip when "
             "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
             f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
             f"m/s, backward {_mm(r['push_backward_m_per_s/lo'], r['push_backward_m_per_s/hi'], 1)}"
-            " m/s.", *_basin_line(basin_area), "",
+            " m/s.", *_lateral_pushes(r), *_basin_line(basin_area), "",
             "Gait sensitivity norm (Hobbelen & Wisse 2007; indicators step time, step length, "
-            "stance angle at heel strike), with the relative difference to the nonlinear "
+            f"stance angle{', step width' if 'push_lateral_kg' in r.scalars else ''} at heel "
+            "strike), with the relative difference to the nonlinear "
             "response to a small impulse, and the norm with the post-impact state as "
             "indicator in two state coordinates.  Jin et al. (2021, R. Soc. Open Sci. 8: "
             "201122) caution that local measures like this can rank walkers differently in "

@@ -12,15 +12,20 @@ import numpy as np
 
 from walkerlab.analysis.contact.rough import contact_start
 from walkerlab.analysis.robustness.measures import (
+    LATERAL_DISTURBANCES,
     UNITS,
+    disturbances_of,
     gsn_nonlinear,
     largest_by_bisection,
     linearise,
     relative_coordinates,
+    stable,
     state_gsn,
+    step_walker,
 )
+from walkerlab.analysis.robustness.push import LATERAL_AXIS, apply_push
 from walkerlab.config import RobustnessSettings
-from walkerlab.integrate.python_step import make_step_map
+from walkerlab.integrate.python_step import ReflectedStepMap, make_step_map
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ContactSceneError
 from walkerlab.studies import mfpt as work
@@ -37,6 +42,17 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     and
     the Monte Carlo MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.studies.mfpt.monte_carlo`).
     ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (the stage's).
+
+    A walker whose points have a lateral axis (a walker in 3D) also takes the sideways push
+    at the section (:data:`~walkerlab.analysis.robustness.measures.LATERAL_DISTURBANCES`,
+    beside the scene's ``robustness.disturbances``) and its largest sideways pushes toward
+    the swing leg's side (``out``) and the stance leg's (``in``), with the impulse per unit
+    hip velocity change at the gait's section (:func:`lateral_scalars`).  A walker whose
+    steps alternate sides (hip width) is stepped by its reflected step map
+    (:class:`~walkerlab.integrate.python_step.ReflectedStepMap`): every number is per step,
+    the map's Jacobian ``S A_step`` (``S`` the reflection).  An unstable gait (a multiplier
+    on or outside the unit circle) has infinite sensitivity norms, its nonlinear check NaN
+    (the undisturbed gait falls).
 
     Returns
     -------
@@ -58,19 +74,28 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     plant.kind.require_stage("robustness")
     st = scene.robustness or RobustnessSettings()
     walker = build_walker(scene, plant)
-    if walker.steps_per_map != 1:
+    if walker.steps_per_map != 1 and (walker.mirror_reflection is None
+                                      or walker.cycle is not None):
         raise ValueError("robustness: legs that differ (a stride map) are not supported")
     sm = make_step_map(walker, work.scene_walker_at(scene, plant), 1e-12, 1e-12)
-    A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
-                     jacobian=True)[2]
+    solver = Solver("DOP853", 1e-12, 1e-12, None, "scipy")
+    if isinstance(sm, ReflectedStepMap):  # one step, reflected: Q(y) = S P(y)
+        n2 = x_star.size
+        A = walker.reflect(np.eye(n2)) @ poincare_map(step_walker(sm), x_star, solver,
+                                                      jacobian=True)[2]
+    else:
+        A = poincare_map(walker, x_star, solver, jacobian=True)[2]
     names = walker.state_names()
     T = relative_coordinates(names)
     lam = {"absolute": float(np.max(np.abs(np.linalg.eigvals(A)))),
            "relative": float(np.max(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T)))))}
+    lateral = tuple(d for d in disturbances_of(step_walker(sm)) if d in LATERAL_DISTURBANCES)
+    dists = [*st.disturbances, *lateral]
     gsn, gnl, norm = {}, {}, {"absolute": {}, "relative": {}}
-    for d in st.disturbances:
+    for d in dists:
         lin = linearise(sm, x_star, A, d)
-        gsn[d], gnl[d] = lin.gsn(), gsn_nonlinear(sm, x_star, d, 1e-5, steps=60)
+        gsn[d] = lin.gsn()
+        gnl[d] = gsn_nonlinear(sm, x_star, d, 1e-5, steps=60) if stable(A) else math.nan
         norm["absolute"][d], norm["relative"][d] = state_gsn(lin), state_gsn(lin, T)
     cap = 0.25 * float(walker.params.get("leg_length_m", 1.0))
     down = largest_by_bisection(sm, x_star, "floor_height", cap, st.resolution_m,
@@ -91,8 +116,40 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
           "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
           "montecarlo_falls": int(mc.fell.sum())}
     sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler, plant=plant))
-    return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
-                          gsn, gnl, norm, sc, names)
+    if lateral:
+        sc.update(lateral_scalars(sm, x_star, st))
+    return RobustnessData(dists, {d: UNITS[d] for d in dists}, lam, gsn, gnl, norm, sc, names)
+
+
+def lateral_scalars(sm, x_star: np.ndarray, st) -> dict:
+    """The largest sideways pushes at the section (the disturbance ``lateral_push``) a
+    walker with a lateral axis survives: bisection brackets [m/s] of the hip's lateral
+    velocity change toward the swing leg's side (``push_lateral_out``) and the stance leg's
+    (``push_lateral_in``), search cap ``robustness.push_cap_m_per_s``, bracket
+    ``robustness.push_resolution_m_per_s``, survival ``robustness.survival_steps`` steps
+    (:func:`~walkerlab.analysis.robustness.measures.largest_by_bisection`: a count of
+    rounds and steps); and ``push_lateral_kg``, the impulse per unit of that velocity change
+    at the gait's section [N s per m/s = kg] (the pushes in N s are the brackets times it).
+
+    Parameters
+    ----------
+    sm : step map
+        The walker's step map (``make_step_map``; a reflected one for hip width).
+    x_star : ndarray, shape (2n,)
+        The gait's post-impact fixed point [rad, rad/s].
+    st : walkerlab.config.RobustnessSettings
+
+    Returns
+    -------
+    dict
+        ``push_lateral_{out,in}_m_per_s/{lo,hi}`` [m/s] and ``push_lateral_kg`` [kg].
+    """
+    out = {"push_lateral_kg": apply_push(step_walker(sm), x_star, 1.0, axis=LATERAL_AXIS)[1]}
+    for sign, side in ((1.0, "out"), (-1.0, "in")):
+        lo, hi = largest_by_bisection(sm, x_star, "lateral_push", st.push_cap_m_per_s,
+                                      st.push_resolution_m_per_s, st.survival_steps, sign)
+        out[f"push_lateral_{side}_m_per_s/lo"], out[f"push_lateral_{side}_m_per_s/hi"] = lo, hi
+    return out
 
 
 def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,

@@ -369,13 +369,26 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
 #: reads the contact walk)
 STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
                "stability-map": ("walk", "contact")}
-#: why the robustness study refuses a 3D walker (:mod:`walkerlab.studies.robustness_study`)
-ROBUSTNESS_3D = ("the robustness study (gait sensitivity norms, largest step-down/up "
-                 "and push) is of planar walkers so far: its disturbances and state "
-                 "norms are sagittal; a 3D walker's metastability is walkerlab mfpt's")
+#: why the robustness study refuses a 3D kneed walker (:mod:`walkerlab.studies.robustness_study`)
+ROBUSTNESS_KNEED_3D = ("a kneed walker in 3D is passive and laterally unstable (a stride "
+                       "multiplier of about 40, configs/kneed_3d.yaml) and takes no hip-roll "
+                       "law to steady it: its sensitivity norms are infinite and it survives "
+                       "no disturbance; its metastability is walkerlab mfpt's")
+#: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
+#: robustness_study`)
+ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance leg's "
+                       "angle and the feet's placement: a spoked wheel, one rigid body, has "
+                       "no hip or legs (its metastability is walkerlab mfpt's)")
 #: kind -> {stage: reason}: the studies (stages of :mod:`walkerlab.stages.pipeline`) a kind
 #: does not take at all; a stage not listed takes it (``optimize`` of a kind whose ``walk``
-#: it refuses may still design virtual constraints, so only the 3D kinds' is here)
+#: it refuses may still design virtual constraints, so only the 3D kinds' is here).  The
+#: 3D straight legs take ``robustness``: its evidence is :data:`walkerlab.walker.
+#: capability_evidence.stage_evidence`'s.
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    k: {"robustness": ROBUSTNESS_3D, "optimize": CAPABILITIES[k][("walk", "optimize")]}
-    for k in ("straight_legs_3d", "locking_knees_3d", "rolling_polygon_3d")}
+    "straight_legs_3d": {"optimize": CAPABILITIES["straight_legs_3d"][("walk", "optimize")]},
+    "locking_knees_3d": {"robustness": ROBUSTNESS_KNEED_3D,
+                         "optimize": CAPABILITIES["locking_knees_3d"][("walk", "optimize")]},
+    "rolling_polygon_3d": {"robustness": ROBUSTNESS_WHEEL_3D,
+                           "optimize": CAPABILITIES["rolling_polygon_3d"][("walk",
+                                                                          "optimize")]},
+}

@@ -26,7 +26,8 @@ from functools import lru_cache
 from pathlib import Path
 
 __all__ = ["CHECK_KINDS", "EVIDENCE_FILE", "UNVERIFIED", "cell_evidence", "check_of",
-           "commit_words", "evidence", "not_checked", "number", "verified"]
+           "commit_words", "evidence", "not_checked", "number", "stage_evidence",
+           "stage_verified", "verified"]
 
 #: the data file
 EVIDENCE_FILE = Path(__file__).with_name("capability_evidence.json")
@@ -56,6 +57,21 @@ def cell_evidence(kind: str, feature: str, view: str) -> dict | None:
     """The cell's measurement (``case``, ``quantity``, ``value``, ``tolerance``, ``unit``,
     ``ok``, ``detail``, ``commit``), or None when it was never measured."""
     return evidence()["cells"].get(f"{kind}/{feature}/{view}")
+
+
+def stage_evidence(kind: str, stage: str) -> dict | None:
+    """The measurement of a study (a pipeline stage beyond the grid's cells, e.g.
+    ``robustness``) on a kind that takes it (the file's ``stages``, keyed ``kind/stage``;
+    the same fields as a cell's), or None when it was never measured."""
+    return evidence().get("stages", {}).get(f"{kind}/{stage}")
+
+
+def stage_verified(kind: str, stage: str) -> bool:
+    """Whether the study's measurement on the kind is within its tolerance
+    (:func:`stage_evidence`)."""
+    e = stage_evidence(kind, stage)
+    return bool(e and e["ok"] and e["value"] is not None
+                and abs(e["value"]) <= e["tolerance"])
 
 
 def verified(kind: str, feature: str, view: str) -> bool:

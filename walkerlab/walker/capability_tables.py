@@ -20,6 +20,8 @@ from walkerlab.walker.capability_evidence import (
     evidence,
     not_checked,
     number,
+    stage_evidence,
+    stage_verified,
     unverified_reason,
     verified,
 )
@@ -29,6 +31,9 @@ __all__ = ["SUPPORTED", "KindGrid", "grids", "kind_grid", "markdown", "text"]
 
 #: the mark of a supported cell
 SUPPORTED = "✓"
+#: the studies (pipeline stages beyond the grid's cells) whose measurement on a kind the
+#: evidence file may hold (:func:`walkerlab.walker.capability_evidence.stage_evidence`)
+STAGE_STUDIES = ("robustness",)
 
 
 @dataclass(frozen=True)
@@ -101,6 +106,21 @@ def _tolerances() -> str:
     return "tolerances: " + "; ".join(f"{v}: {t}" for v, t in tol.items()) if tol else ""
 
 
+def _stage_lines(kind: str) -> list[str]:
+    """The studies measured on a kind beyond its grid (:func:`stage_evidence`): ``✓`` with
+    the number and its check when verified, else ``~``, with the case and what was
+    measured."""
+    out = []
+    for stage in STAGE_STUDIES:
+        e = stage_evidence(kind, stage)
+        if e is None:
+            continue
+        mark = (f"{SUPPORTED} {number(e)} {check_of(e)}".rstrip()
+                if stage_verified(kind, stage) else f"{UNVERIFIED} {number(e)}")
+        out.append(f"  walkerlab {stage}: {mark}: {e['case']}: {e['detail']}")
+    return out
+
+
 def text() -> str:
     """The table as plain text (``walkerlab capabilities``): per kind its title, the grid
     (columns padded) and its numbered reasons; the views and features explained first."""
@@ -118,6 +138,7 @@ def text() -> str:
         out += [f"  {i}. {why}" for i, why in enumerate(g.reasons, 1)]
         out += [f"  walkerlab {stage}: refused: {why}"
                 for stage, why in STAGE_CELLS.get(g.kind.name, {}).items()]
+        out += _stage_lines(g.kind.name)
         out.append("")
     return "\n".join(out).rstrip() + "\n"
 

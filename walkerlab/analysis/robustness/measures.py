@@ -23,10 +23,20 @@ Disturbances (scalar, one step): ``slope`` (that step's slope changes by ``e`` [
 ``push`` (an impulsive horizontal push at the hip at mid-stance changing the hip's forward
 velocity by ``e`` [m/s], :func:`walkerlab.analysis.robustness.push.apply_push`; those rows are
 integrated one by one by scipy's DOP853 at 1e-12,
-:func:`walkerlab.analysis.robustness.push.pushed_step`).
+:func:`walkerlab.analysis.robustness.push.pushed_step`), and for a walker whose points have a
+lateral axis (a walker in 3D) ``lateral_push`` (an impulsive sideways push at the hip just
+after heel strike, at the section, changing the hip's lateral velocity by ``e`` [m/s] toward
+the swing leg's side, :func:`walkerlab.analysis.robustness.push.push_rows`).
 Indicators: ``step_time_s``, ``step_length_m`` (distance from stance foot to swing foot at
-heel strike), ``stance_angle_rad`` (the stance leg's absolute angle from the vertical at
-heel strike).
+heel strike, in the sagittal plane), ``stance_angle_rad`` (the stance leg's absolute angle
+from the vertical at heel strike), and where the walker has a lateral axis
+``step_width_m`` (the swing foot's lateral offset from the stance foot at heel strike).
+
+A walker whose steps alternate sides (a 3D walker with hip width) is stepped by its
+reflected step map (:class:`walkerlab.integrate.python_step.ReflectedStepMap`,
+``Q(y) = S P(y)``): its symmetric gait is a fixed point of ``Q``, so each quantity here is
+per step as for a planar walker, and a disturbance of one sign is of one side relative to
+the stance foot on every step.
 
 Jin et al. (2021, R. Soc. Open Sci. 8: 201122) show that local measures can rank walkers
 differently in different state coordinates.  The multipliers do not change (the Jacobians in
@@ -41,19 +51,45 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.robustness.push import pushed_step
+from walkerlab.analysis.robustness.push import lateral_axis, push_rows, pushed_step
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.integrate.python_step import ReflectedStepMap
+from walkerlab.walker.planes import out_of_plane
 
 DISTURBANCES = ("slope", "floor_height", "push")
+#: the disturbances of a walker whose points have a lateral axis (:func:`disturbances_of`)
+LATERAL_DISTURBANCES = ("lateral_push",)
 INDICATORS = ("step_time_s", "step_length_m", "stance_angle_rad")
+#: the indicator of a walker whose points have a lateral axis (:func:`indicators_of`)
+LATERAL_INDICATORS = ("step_width_m",)
 #: disturbance units
-UNITS = {"slope": "rad", "floor_height": "m", "push": "m/s"}
+UNITS = {"slope": "rad", "floor_height": "m", "push": "m/s", "lateral_push": "m/s"}
+
+
+def step_walker(sm):
+    """The walker of one step of the map ``sm`` (a reflected map's first step's walker)."""
+    return sm.inner.walker if isinstance(sm, ReflectedStepMap) else sm.walker
+
+
+def disturbances_of(walker) -> tuple[str, ...]:
+    """The disturbances a walker takes: :data:`DISTURBANCES`, and
+    :data:`LATERAL_DISTURBANCES` where its points have a lateral axis
+    (:func:`walkerlab.analysis.robustness.push.lateral_axis`)."""
+    return DISTURBANCES + (LATERAL_DISTURBANCES if lateral_axis(walker) is not None else ())
+
+
+def indicators_of(walker) -> tuple[str, ...]:
+    """The gait indicators of a walker: :data:`INDICATORS`, and :data:`LATERAL_INDICATORS`
+    where its points have a lateral axis."""
+    return INDICATORS + (LATERAL_INDICATORS if lateral_axis(walker) is not None else ())
 
 
 def _indicators(sm: BatchStepMap, res) -> np.ndarray:
-    """Indicators (N, 3) of a batch step (NaN where no heel strike)."""
-    w = sm.walker
-    out = np.full((res.outcome.size, len(INDICATORS)), np.nan)
+    """Indicators (N, k) of a batch step (NaN where no heel strike): :func:`indicators_of`
+    the step's walker."""
+    w = step_walker(sm)
+    side = lateral_axis(w)
+    out = np.full((res.outcome.size, len(INDICATORS) + (side is not None)), np.nan)
     ok = res.outcome == HEEL_STRIKE
     if ok.any():
         Xp = res.x_pre[ok].T
@@ -63,37 +99,45 @@ def _indicators(sm: BatchStepMap, res) -> np.ndarray:
         # the stance leg is straight: its angle, or (kneed walker) its thigh's
         key = f"{stance}_angle" if f"{stance}_angle" in coords else f"{stance}_thigh_angle"
         ang = np.asarray(coords[key])
-        out[ok] = np.column_stack([res.step_time_s[ok], np.hypot(foot[0], foot[1]), ang])
+        cols = [res.step_time_s[ok], np.hypot(foot[0], foot[1]), ang]
+        out[ok] = np.column_stack(cols if side is None else [*cols, foot[side]])
     return out
 
 
 def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
     """One step of rows ``X`` (N, 2n) with disturbance values ``e`` (N,).
 
-    Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``.  ``X``: post-impact states
+    Returns ``(x_next (N, 2n), indicators (N, k), ok (N,))``.  ``X``: post-impact states
     (``state_names()``, [rad, rad/s]); ``e`` in :data:`UNITS` ([rad], [m] or [m/s]);
-    indicators :data:`INDICATORS` ([s], [m], [rad]; NaN where not ``ok``).
+    indicators :func:`indicators_of` the walker ([s], [m], [rad], [m]; NaN where not
+    ``ok``).
 
     Raises
     ------
     ValueError
-        ``disturbance`` is not one of :data:`DISTURBANCES`.
+        ``disturbance`` is not one of :data:`DISTURBANCES` or the walker's
+        :data:`LATERAL_DISTURBANCES`.
     """
     e = np.asarray(e, dtype=float)
     if disturbance == "push":  # pushed rows one by one (scipy), the others batched
         e = np.broadcast_to(e, (X.shape[0],))
         r = sm.step(X, None)
+        w = step_walker(sm)
         for i in np.flatnonzero(e != 0):
-            p = pushed_step(sm.walker, X[i], e[i:i + 1])
+            p = pushed_step(w, X[i], e[i:i + 1])
+            if isinstance(sm, ReflectedStepMap):  # the next step's state, reflected
+                p.x_next = sm.walker.reflect(p.x_next)
             for name in ("outcome", "x_pre", "x_next", "step_time_s"):
                 getattr(r, name)[i] = getattr(p, name)[0]
+    elif disturbance == "lateral_push" and lateral_axis(step_walker(sm)) is not None:
+        r = sm.step(push_rows(step_walker(sm), X, e)[0], None)
     elif disturbance == "slope":
         r = sm.step(X, sm.slope_rad + e)
     elif disturbance == "floor_height":
         r = sm.step(X, None, drop_m=e)
     else:
-        raise ValueError(f"disturbance: unknown {disturbance!r}; choose from "
-                         f"{', '.join(DISTURBANCES)}")
+        raise ValueError(f"disturbance: unknown {disturbance!r} for this walker; choose "
+                         f"from {', '.join(disturbances_of(step_walker(sm)))}")
     return r.x_next, _indicators(sm, r), r.outcome == HEEL_STRIKE
 
 
@@ -103,7 +147,8 @@ class Linearisation:
     (Hobbelen & Wisse 2007, Eq. 5-8).
 
     Shapes: ``A`` (2n, 2n) the Poincaré-map Jacobian; ``B`` (2n,) per unit of disturbance
-    (:data:`UNITS`); ``C`` (3, 2n) and ``D`` (3,) of the :data:`INDICATORS` ([s], [m], [rad]).
+    (:data:`UNITS`); ``C`` (k, 2n) and ``D`` (k,) of the walker's indicators
+    (:func:`indicators_of`: ``k`` = 3, [s], [m], [rad]; a walker in 3D also [m]).
     """
 
     A: np.ndarray
@@ -112,9 +157,13 @@ class Linearisation:
     D: np.ndarray
 
     def gsn(self) -> float:
-        """H2 norm from the disturbance to the indicators (Hobbelen & Wisse 2007)."""
+        """H2 norm from the disturbance to the indicators (Hobbelen & Wisse 2007); ``inf``
+        for a gait whose map has a multiplier on or outside the unit circle (its response
+        does not decay: the sum diverges)."""
         from scipy.linalg import solve_discrete_lyapunov
 
+        if not stable(self.A):
+            return float("inf")
         W = solve_discrete_lyapunov(self.A, np.outer(self.B, self.B))
         return float(np.sqrt(self.D @ self.D + np.trace(self.C @ W @ self.C.T)))
 
@@ -183,10 +232,18 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
     return float(np.sqrt(acc)) / abs(e)
 
 
+def stable(A: np.ndarray) -> bool:
+    """Whether every eigenvalue of the map's Jacobian ``A`` (m, m) lies inside the unit
+    circle (the H2 norms here are finite only then)."""
+    return bool(np.max(np.abs(np.linalg.eigvals(A))) < 1.0)
+
+
 def relative_coordinates(names: list[str]) -> np.ndarray:
     """``T`` (2n, 2n): absolute angles -> angles relative to the stance leg (each other
     coordinate minus ``stance_angle``, its rate minus ``stance_rate``; the stance leg's
-    own stay absolute), by state name.  ``T`` is dimensionless ([-]: entries 0, 1, -1), so
+    own stay absolute), by state name; coordinates out of the sagittal plane (a 3D walker's
+    lean and rolls, :func:`walkerlab.walker.planes.out_of_plane`) stay absolute too, being
+    no pitch.  ``T`` is dimensionless ([-]: entries 0, 1, -1), so
     ``z = T x`` keeps the units of ``x`` ([rad], [rad/s]).
 
     Raises
@@ -199,6 +256,8 @@ def relative_coordinates(names: list[str]) -> np.ndarray:
     T = np.eye(len(names))
     ia, ir = names.index("stance_angle"), names.index("stance_rate")
     for i, nm in enumerate(names):
+        if out_of_plane(nm):  # a lean or roll (3D) is not a pitch: kept absolute
+            continue
         if nm.endswith("_angle") and i != ia:
             T[i, ia] = -1.0
         elif nm.endswith("_rate") and i != ir:
@@ -211,10 +270,13 @@ def state_gsn(lin: Linearisation, T: np.ndarray | None = None) -> float:
     ``z = T x`` (Jin et al. 2021: such a norm depends on the coordinates):
     ``sqrt(trace(T W T^T))`` with ``W`` as in :meth:`Linearisation.gsn`, including the
     first step's ``B``.  ``T`` (2n, 2n): :func:`relative_coordinates` or None (identity);
-    the norm is in state units ([rad], [rad/s]) per disturbance unit (:data:`UNITS`).
+    the norm is in state units ([rad], [rad/s]) per disturbance unit (:data:`UNITS`);
+    ``inf`` for an unstable gait (:func:`stable`).
     """
     from scipy.linalg import solve_discrete_lyapunov
 
+    if not stable(lin.A):
+        return float("inf")
     T = np.eye(lin.A.shape[0]) if T is None else T
     W = solve_discrete_lyapunov(lin.A, np.outer(lin.B, lin.B))
     return float(np.sqrt(np.trace(T @ W @ T.T)))

@@ -4,6 +4,12 @@ impulse-momentum balance with the stance foot pinned (:func:`apply_push`; the ma
 from the walker's kinetic energy, :func:`mass_matrix`, the hip's Jacobian,
 :func:`hip_jacobian`), and the pushed step, integrated by scipy's DOP853 at 1e-12 from the
 mid-stance state through the walker's phase graph (:func:`pushed_step`).
+
+A sideways push (the disturbance ``lateral_push``) is the same impulse along the world's
+lateral axis, where the walker's points have one (:func:`lateral_axis`: the models' world
+axes are x downhill, y up and, in 3D, z lateral along the hip axis), applied at the section
+(just after heel strike, :func:`push_rows`): it changes the hip's lateral velocity and with
+it the lean rate.
 """
 
 from __future__ import annotations
@@ -15,8 +21,13 @@ from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver
 from walkerlab.numerics import fd_jacobian
 
-__all__ = ["apply_push", "entry_lock", "hip_jacobian", "mass_matrix", "pushed_step",
-           "starting_at"]
+__all__ = ["LATERAL_AXIS", "apply_push", "entry_lock", "hip_jacobian", "lateral_axis",
+           "mass_matrix", "push_rows", "pushed_step", "starting_at"]
+
+#: the world axis of a walker's points that is lateral, where they have one (the models'
+#: world axes: x downhill, y up, and in 3D z along the hip axis,
+#: :mod:`walkerlab.codegen.derive_3d`)
+LATERAL_AXIS = 2
 
 
 def mass_matrix(walker, x: np.ndarray) -> np.ndarray:
@@ -52,8 +63,9 @@ def hip_jacobian(walker, x: np.ndarray, h: float = 1e-6) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (2, n)
-        d(hip position: world x forward, y up) / dq [m/rad].
+    ndarray, shape (d, n)
+        d(hip position: world x forward, y up; a walker in 3D also z lateral) / dq [m/rad]
+        (``d`` the walker's own point size).
     """
     lay = walker.layout()
     x = np.asarray(x, float)
@@ -62,15 +74,26 @@ def hip_jacobian(walker, x: np.ndarray, h: float = 1e-6) -> np.ndarray:
                        x[lay.q_slice], h)
 
 
-def apply_push(walker, x: np.ndarray, dv_mps: float, lock=None) -> tuple[np.ndarray, float]:
-    """An impulsive horizontal push at the hip that changes the hip's horizontal velocity by
-    ``dv_mps`` [m/s] (positive forward), the stance foot pinned; ``lock`` (optional): the
+def lateral_axis(walker) -> int | None:
+    """:data:`LATERAL_AXIS` when the walker's hip point has it (a walker in 3D), else None
+    (a planar walker: no sideways push)."""
+    lay = walker.layout()
+    hip = np.asarray(walker.points(lay.zeros())["hip"])
+    return LATERAL_AXIS if hip.shape[0] > LATERAL_AXIS else None
+
+
+def apply_push(walker, x: np.ndarray, dv_mps: float, lock=None,
+               axis: int = 0) -> tuple[np.ndarray, float]:
+    """An impulsive horizontal push at the hip that changes the hip's velocity along the world
+    axis ``axis`` (0: forward, the default; :data:`LATERAL_AXIS`: sideways, toward +z) by
+    ``dv_mps`` [m/s], the stance foot pinned; ``lock`` (optional): the
     plastic projection onto a locked mode's rates (a flat foot's foot slap, ``[S^T M; J]
     dqd+ = [S^T M; 0] dqd-``), applied when the push comes while that mode holds a
     coordinate locked: the lock's impulse (the ground's on the flat foot) keeps it locked.
 
-    The push is a physical impulse ``P`` [N s] along world x at the hip: the generalised
-    impulse is ``J_x^T P`` (``J_x`` the hip's horizontal Jacobian row), so the rates jump by
+    The push is a physical impulse ``P`` [N s] along world ``axis`` at the hip: the
+    generalised impulse is ``J_x^T P`` (``J_x`` the hip's Jacobian row of that axis), so the
+    rates jump by
     ``dqd = M^-1 J_x^T P`` (the impulse-momentum balance ``M dqd = J^T P``; the ground's
     impulse at the pinned stance foot does no virtual work in these coordinates).  ``P`` is
     chosen so that ``J_x dqd = dv``: ``P = dv / (J_x M^-1 J_x^T)``.  The hip's vertical
@@ -80,9 +103,14 @@ def apply_push(walker, x: np.ndarray, dv_mps: float, lock=None) -> tuple[np.ndar
     -------
     x_plus : ndarray (2n,)
     impulse_Ns : float
+
+    Raises
+    ------
+    IndexError
+        ``axis`` is not one of the walker's point axes.
     """
     M = mass_matrix(walker, x)
-    jx = hip_jacobian(walker, x)[0]
+    jx = hip_jacobian(walker, x)[axis]
     w = np.linalg.solve(M, jx)
     if lock is not None:  # linear in the rates: the locked rate change per unit impulse
         lay = walker.layout()
@@ -91,6 +119,25 @@ def apply_push(walker, x: np.ndarray, dv_mps: float, lock=None) -> tuple[np.ndar
     xp = np.array(x, float)
     xp[walker.layout().qd_slice] += P * w
     return xp, P
+
+
+def push_rows(walker, X: np.ndarray, dv_mps: np.ndarray,
+              axis: int = LATERAL_AXIS) -> tuple[np.ndarray, np.ndarray]:
+    """Each row of ``X`` (N, 2n) pushed at the hip along ``axis`` by ``dv_mps`` (N,) [m/s]
+    (:func:`apply_push`; rows of zero push are kept as they are, bit for bit).
+
+    Returns
+    -------
+    X_plus : ndarray, shape (N, 2n)
+    impulse_Ns : ndarray, shape (N,)
+        The impulse of each push [N s] (0 where none).
+    """
+    X = np.array(X, dtype=float)
+    dv = np.broadcast_to(np.asarray(dv_mps, float), (X.shape[0],))
+    P = np.zeros(X.shape[0])
+    for i in np.flatnonzero(dv != 0):
+        X[i], P[i] = apply_push(walker, X[i], float(dv[i]), axis=axis)
+    return X, P
 
 
 def _stance_angle(walker, X: np.ndarray) -> np.ndarray:

@@ -13,6 +13,10 @@ Layout (every value a scalar dataset with its unit)::
     sigma_rad                                         rad    per-step slope sigma of the MFPT
     mfpt_steps, mfpt_steps_stderr                     steps  Monte Carlo MFPT (censored MLE)
     montecarlo_walks, montecarlo_falls                -
+    push_lateral_{out,in}_m_per_s/{lo,hi}             m/s    sideways push at the section
+                                                             (a walker in 3D only)
+    push_lateral_kg                                   kg     its impulse per unit hip
+                                                             velocity change [N s/(m/s)]
 
 attributes: ``disturbances`` (names), ``units`` (unit of each disturbance), ``state_names``.
 """
@@ -63,6 +67,20 @@ SCALARS = {
 }
 
 
+#: the scalars of a walker with a lateral axis (a walker in 3D), written only when the study
+#: computed them (a planar walker's artifact has none of them)
+LATERAL_SCALARS = {
+    **_bracket("push_lateral_out_m_per_s", "m/s", "largest sideways push at the section "
+               "survived, toward the swing leg's side (hip lateral velocity change; lower "
+               "end)", "smallest sideways push toward the swing leg's side that falls"),
+    **_bracket("push_lateral_in_m_per_s", "m/s", "largest sideways push at the section "
+               "survived, toward the stance leg's side (lower end)",
+               "smallest sideways push toward the stance leg's side that falls"),
+    "push_lateral_kg": ("kg", "impulse of a sideways push at the hip per unit of the hip's "
+                        "lateral velocity change, at the gait's section [N s per m/s]"),
+}
+
+
 @dataclass
 class RobustnessData:
     """The contents of ``robustness.h5``.
@@ -79,7 +97,7 @@ class RobustnessData:
     state_norm : dict[str, dict[str, float]]
         By coordinate choice, then disturbance.
     scalars : dict[str, float]
-        Every name of :data:`SCALARS`.
+        Every name of :data:`SCALARS`; a walker in 3D also :data:`LATERAL_SCALARS`.
     state_names : list of str
     """
 
@@ -113,6 +131,9 @@ def write(f, d: RobustnessData) -> None:
                 f"sensitivity norm with the post-impact state as indicator, {c} angles")
     for name, (unit, desc) in SCALARS.items():
         put(f, name, float(d.scalars[name]), unit, desc)
+    for name, (unit, desc) in LATERAL_SCALARS.items():
+        if name in d.scalars:
+            put(f, name, float(d.scalars[name]), unit, desc)
     f.attrs["disturbances"] = list(d.disturbances)
     f.attrs["disturbance_units"] = [d.units[k] for k in d.disturbances]
     f.attrs["state_names"] = list(d.state_names)
@@ -129,5 +150,6 @@ def load(f, path: Path) -> RobustnessData:
         {k: float(f[f"gsn/{k}"][()]) for k in dists},
         {k: float(f[f"gsn_nonlinear/{k}"][()]) for k in dists},
         {c: {k: float(f[f"state_norm/{c}/{k}"][()]) for k in dists} for c in COORDINATES},
-        {k: float(f[k][()]) if k in f else float("nan") for k in SCALARS},
+        {**{k: float(f[k][()]) if k in f else float("nan") for k in SCALARS},
+         **{k: float(f[k][()]) for k in LATERAL_SCALARS if k in f}},
         [str(s) for s in f.attrs["state_names"]])
