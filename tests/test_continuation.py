@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _walker(scene, path, p):
     sc = apply_point(scene.model_dump(mode="json"), [path], (p,))
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 def _kmap(walker, x, solver, k, tmax):
@@ -327,7 +327,7 @@ def test_stance_foot_normal_force_from_the_equations_of_motion():
     from walkerlab.analysis.continuation.validity import normal_force_ratio
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     s = Solver.from_settings(scene.solver)
     x0 = np.array([-0.3234, 0.2187, -0.3801, -1.0932])  # near the gait: any step will do
     segs = step_map(w, w.from_section(w.section(x0)), s, 1, segments=True)[3]
@@ -554,7 +554,7 @@ def test_the_disc_wheels_critical_slope_is_a_branch_point_the_family_passes_thro
     side = []
     for a in (0.18, 0.19):
         sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_rad"], (a,))
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         r = find_fixed_point(w, bp.x, s, fd_check=False)
         m = np.sort(np.abs(r.multipliers_variational))[::-1]
         side.append(m[0] if m[0] > 1 + 1e-6 else m[1])  # the largest besides the neutral 1

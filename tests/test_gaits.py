@@ -57,7 +57,7 @@ def _without_guess(name: str):
 
 
 def _solve(scene):
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     fp = scene.fixedpoint
     guess = None if fp.initial_guess is None else fp.initial_guess.as_array(walker.state_names())
     return find_gaits(walker, Solver.from_settings(scene.solver), guess, policy=fp.gait,
@@ -84,7 +84,7 @@ def test_seed_states_put_both_feet_on_the_slope():
     """A seed is a state on the heel-strike surface, by leg angle whatever the coordinates:
     the slope-relative simplest walker's seed has its legs at the asked absolute angles."""
     sc = load_scene(ROOT / "configs" / "simplest.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     g = sc.slope.phi_rad
     x = state_from_legs(w, 0.2 - g, -0.2 - g, -0.2, -0.05)
     legs = w.leg_coordinates(x, w.legs[-1])
@@ -330,7 +330,7 @@ def test_a_failed_search_names_the_fallback_starts_it_tried_and_says_each_in_a_n
     d["slope"] = {"angle_rad": 0.0}
     del d["fixedpoint"]["initial_guess"]
     scene = scene_from_dict(d)
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     label = "the planar twin's gait carried in walker.hip_width_m"
     with progress.use(Notes()) as sink, pytest.raises(GaitNotFound) as exc:
         find_gaits(walker, Solver.from_settings(scene.solver), None, fd_check=False,

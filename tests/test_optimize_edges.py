@@ -277,7 +277,7 @@ def test_a_level_ground_optimal_gait_starts_from_its_targets():
     scene = _level_compass(push_off="free", target_speed_m_per_s=0.6,
                            target_step_length_m=0.5)
     assert pipeline.order("optimize", scene) == ["optimize"]  # no gait to find first
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     t, x, u, p = starting_step(scene, walker, None, None)
     assert u is None and p > 0 and t[-1] == pytest.approx(0.5 / 0.6, rel=1e-12)
     data = walker_data(scene.walker, 0.0)

@@ -131,7 +131,7 @@ def test_a_mode_graph_without_a_fixed_sequence_is_refused_in_one_line():
 
     with pytest.raises(ValueError, match="no fixed phase sequence"):
         sc = load_scene(CONFIGS / "flat_feet.yaml")
-        phase_order(build_walker(sc, plant=Plant.from_scene(sc)))
+        phase_order(build_walker(Plant.from_scene(sc)))
 
 
 #: the flat-footed passive gait's phases (configs/flat_feet.yaml's note): the sequence

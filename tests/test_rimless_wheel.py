@@ -135,7 +135,7 @@ def test_rimless_wheel_mfpt_matches_independent_monte_carlo():
 
     scene = load_scene(SCENE)
     x0 = _walker().fixed_point().x
-    sm = make_step_map(build_walker(scene, plant=Plant.from_scene(scene)), scene_walker_at(scene,
+    sm = make_step_map(build_walker(Plant.from_scene(scene)), scene_walker_at(scene,
             plant=Plant.from_scene(scene)), 1e-9, 1e-9, 5.0)
     for sd in (0.008, 0.012):
         ours = monte_carlo(sm, x0, sd, range(1500), 4000, seed=3).mfpt

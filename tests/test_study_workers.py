@@ -171,7 +171,7 @@ def test_a_3d_basin_cell_off_the_heel_strike_surface_is_unreachable():
     from walkerlab.walker.plant import Plant
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    names = build_walker(scene, plant=Plant.from_scene(scene)).state_names()
+    names = build_walker(Plant.from_scene(scene)).state_names()
     g = scene.fixedpoint.initial_guess.model_extra  # the gait to 6 decimals
     x_star = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
                        for n in names])

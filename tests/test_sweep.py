@@ -106,7 +106,7 @@ def test_a_sweeps_rows_are_the_fixed_points_from_the_scenes_guess_bit_for_bit(sc
                                                                    < 0.35))
     for k, v in enumerate(slopes):
         sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_deg"], (float(v),))
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         ref = find_fixed_point(w, sc.fixedpoint.initial_guess.as_array(w.state_names()),
                                Solver.from_settings(sc.solver), xtol=sc.fixedpoint.tolerance,
                                fd_check=False)

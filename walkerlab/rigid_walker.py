@@ -164,14 +164,13 @@ class SceneWalker:
 
     Parameters
     ----------
-    scene : walkerlab.config.Scene
-        A validated scene.
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once, by the front that builds this walker (the API's
+        :class:`walkerlab.api.walker.Walker`, the gym's environment): its ``scene`` is the
+        walker's (:attr:`scene`).
     step_evaluations : int
         Right-hand-side evaluations each walking step may take [-]
         (:data:`STEP_EVALUATIONS`; work, not time: the same on any machine).
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described, when the caller holds it (the API's contact view);
-        default: described here.
 
     Raises
     ------
@@ -182,21 +181,18 @@ class SceneWalker:
     """
 
     def __reduce__(self):
-        """Pickled as its scene and step work limit (the model is built again: a compiled
+        """Pickled as its plant and step work limit (the model is built again: a compiled
         flow does not pickle; a process pool or a vector env's subprocess gets the same
         walker)."""
-        return (type(self), (self.scene, self.step_evaluations))
+        return (type(self), (self.plant, self.step_evaluations))
 
-    def __init__(self, scene: Scene, step_evaluations: int = STEP_EVALUATIONS,
-                 plant=None):
+    def __init__(self, plant, step_evaluations: int = STEP_EVALUATIONS):
         from walkerlab.models.registry import build_walker  # light
-        from walkerlab.walker.plant import Plant  # light
 
         self.step_evaluations = positive(step_evaluations, "step_evaluations")
-        self.scene = scene
-        # described once, handed to every analysis
-        self.plant = Plant.from_scene(scene) if plant is None else plant
-        self.model = build_walker(scene, self.plant)
+        self.plant = plant  # described once by the front, handed to every analysis
+        self.scene: Scene = plant.scene
+        self.model = build_walker(plant)
         self.solver = Solver.from_settings(scene.solver)
         fp = scene.fixedpoint
         self.max_step_time = 5.0 if fp is None else fp.max_step_time_s

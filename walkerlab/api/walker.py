@@ -80,6 +80,10 @@ class Walker(SceneWalker):
         ends the same way on any machine, busy or not); past it the map stops with one line
         (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``work_limit``).  The
         simulated time of a step is bounded apart, by ``fixedpoint.max_step_time_s``.
+    plant : walkerlab.walker.plant.Plant, optional
+        A plant the caller holds (the contact view's, this walker's before a change): the
+        scene's is :meth:`~walkerlab.walker.plant.Plant.with_` of it; default: the scene's
+        walker described here (the API is a front door).
 
     Attributes
     ----------
@@ -105,6 +109,18 @@ class Walker(SceneWalker):
         an actuated walker, printed equations on stairs, ...).
     """
 
+    def __init__(self, scene: Scene, step_evaluations: int = STEP_EVALUATIONS, plant=None):
+        from walkerlab.walker.plant import Plant  # light
+
+        # the front: the scene's walker described here, once (or handed in by the caller
+        # that holds it: the contact view, a changed walker's neighbour)
+        super().__init__(Plant.from_scene(scene) if plant is None else plant.with_(scene),
+                         step_evaluations)
+
+    def __reduce__(self):
+        """Pickled as its scene, step work limit and plant (the model is built again)."""
+        return (type(self), (self.scene, self.step_evaluations, self.plant))
+
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
                    step_evaluations: int = STEP_EVALUATIONS) -> Walker:
@@ -128,7 +144,8 @@ class Walker(SceneWalker):
         walkerlab.config.SceneError
             An unknown field (with the closest name) or a value the field does not accept.
         """
-        return Walker(with_changes(self.scene, changes), self.step_evaluations)
+        return Walker(with_changes(self.scene, changes), self.step_evaluations,
+                      self.plant)  # the same walker section keeps its description
 
     def contact(self) -> ContactWalker:
         """The contact (compliant-foot) view of this walker: a :class:`ContactWalker` on the

@@ -362,7 +362,7 @@ def _step(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     ground = step_ground(scene)
     if ground is not None and len(ground.drops_m) > 1:  # footholds that differ: a period
         return _footholds(scene, plant, spec, x_gait, period_s, ground)
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)
@@ -408,7 +408,7 @@ def _footholds(scene, plant, spec, x_gait, period_s, ground) -> OptimizeData:
     if o.initial_guess is not None or x_gait is None:
         raise ValueError("optimize.initial_guess: footholds of several heights start from "
                          "the scene's own period gait (walkerlab fixedpoint); leave it out")
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     guess = footholds_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
                             spec.intervals)
     fns = cached_step_functions(data)

@@ -316,7 +316,7 @@ def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesig
         violations=getattr(res, "violations", ""), **clearance)
     plant = Plant.from_scene(sc)  # the designed controller's walker, described once
     try:
-        walker = build_walker(sc, plant)
+        walker = build_walker(plant)
     except ValueError as exc:  # a failed design's last iterate: no controller to check
         if res.status == "Solve_Succeeded":
             raise
@@ -416,7 +416,7 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
     spec = design_spec(scene, spec)
-    walker = build_walker(scene, plant=Plant.from_scene(scene)) if walker is None else walker
+    walker = build_walker(Plant.from_scene(scene)) if walker is None else walker
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
     t0 = time.perf_counter()
@@ -516,7 +516,7 @@ def optimize_virtual_constraints(scene, plant, spec):
     from walkerlab.models.registry import build_walker
 
     data = plant.data
-    walker = build_walker(scene, plant)  # one build for the design and the record
+    walker = build_walker(plant.with_(scene))  # one build for the design and the record
     cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec,
                                                                    walker=walker)]
     c = cs[0]

@@ -175,7 +175,7 @@ def _own_gait(scene: Scene):
     from walkerlab.walker.plant import Plant  # light
 
     plant = Plant.from_scene(scene)  # the walker described once, handed down
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant)
     try:
         _, search = solve_scene(scene, fd_check=False, guess=initial_guess(scene, walker),
                                 walker=walker, other_gait=False, plant=plant)

@@ -174,7 +174,7 @@ def walker_and_settings(base: dict):
         st = scene.basin or BasinSettings()
         mst = st.max_step_time_s or (scene.fixedpoint.max_step_time_s if scene.fixedpoint
                                      else 5.0)
-        walker = build_walker(scene, plant=Plant.from_scene(scene))
+        walker = build_walker(Plant.from_scene(scene))
         if not {"x_axis", "y_axis"} & st.model_fields_set:  # the default axes: this walker's
             st = st.model_copy(update=dict(zip(("x_axis", "y_axis"),
                                                default_axes(walker, (st.x_axis, st.y_axis)))))

@@ -306,7 +306,7 @@ def _diagram_result(scene: Scene, slopes: np.ndarray, rows: list[dict], x: np.nd
     from walkerlab.studies.point_columns import interleg_angle
 
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     fp_il = np.degrees([interleg_angle(walker, xi) if np.all(np.isfinite(xi)) else math.nan
                         for xi in x])
     return BifurcationResult(

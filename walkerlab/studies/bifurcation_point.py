@@ -86,7 +86,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
     for index, (value,) in task.points:
         t0 = time.perf_counter()
         sc = scene_at(task.base, value, task.path)
-        n = len(build_walker(sc, Plant.from_scene(sc)).state_names())
+        n = len(build_walker(Plant.from_scene(sc)).state_names())
         row = {"index": index, "value": value, "x": np.full(n, np.nan),
                "multipliers": np.full(n, np.nan, complex), "period_s": math.nan,
                "fp_outcome": "ok", "message": "", "hs_interleg": np.full(task.n_keep, np.nan),
@@ -103,7 +103,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
                                                   _cache={})
                 q = _arclength_step(fam, prev, value)
                 if q is not None:  # the neighbour's branch followed to this value
-                    walker = build_walker(scene, plant=plant)
+                    walker = build_walker(plant)
                     row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
                                period_s=q.period_s / fam.steps(walker))  # per step
                 else:
@@ -115,10 +115,10 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
                 prev = (value, q if q is not None else row["x"])
             except PointOutcome as exc:
                 row.update(fp_outcome=exc.outcome, message=exc.message)
-                walker = build_walker(scene, plant=plant)
+                walker = build_walker(plant)
             except Exception as exc:  # noqa: BLE001
                 row.update(fp_outcome="error", message=f"{type(exc).__name__}: {exc}")
-                walker = build_walker(scene, plant=plant)
+                walker = build_walker(plant)
             if task.steady_state:
                 x_att = _steady_state(task, scene, walker, row, x_att)
         row["wall_time_s"] = time.perf_counter() - t0

@@ -54,7 +54,7 @@ def scene_family(scene: Scene, path: str) -> WalkerFamily:
         except SceneError as exc:
             raise MapFailed("parameter leaves the scene's domain",
                             str(exc).split("]: ", 1)[-1]) from None
-        return build_walker(sc, plant=Plant.from_scene(sc))
+        return build_walker(Plant.from_scene(sc))
 
     return WalkerFamily(make, path, Solver.from_settings(scene.solver),
                         fp.max_step_time_s if fp is not None else 5.0)
@@ -288,7 +288,7 @@ def homotopy_family(known: Scene, new: Scene):
         except SceneError as exc:
             raise MapFailed("parameter leaves the scene's domain",
                             str(exc).split("]: ", 1)[-1]) from None
-        return build_walker(sc, plant=Plant.from_scene(sc))
+        return build_walker(Plant.from_scene(sc))
 
     return make, fields
 

@@ -68,7 +68,7 @@ def study_steps_per_map(base: dict, paths: list[str], points, origin: str = "<st
         at = tuple(values[i] if i in model else first[i] for i in range(len(values)))
         try:
             sc = apply_point(base, list(paths), at, origin)
-            own = build_walker(sc, Plant.from_scene(sc)).steps_per_map
+            own = build_walker(Plant.from_scene(sc)).steps_per_map
         except (SceneError, ValueError):
             continue
         steps = math.lcm(steps, own)

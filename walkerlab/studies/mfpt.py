@@ -42,7 +42,7 @@ def scene_walker_at(scene, plant):
 
     def at(gamma: float):
         on = plant.on_slope(gamma)
-        return build_walker(on.scene, on)
+        return build_walker(on)
     return at
 
 
@@ -67,7 +67,7 @@ def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
         scene = scene_from_dict(base)  # the worker's scene: its plant is built here, once
         plant = Plant.from_scene(scene)
         st = scene.mfpt or MfptSettings()
-        walker = build_walker(scene, plant)
+        walker = build_walker(plant.with_(scene))
         if heights:
             from walkerlab.integrate.python_step import needs_python_path
 
@@ -342,7 +342,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     if getattr(st, "sigma_m", None) is not None:
         return _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial,
                              plant)
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     contact = getattr(st, "model", "rigid") == "contact"
     start = None
     if contact:
@@ -423,7 +423,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     step_map_for(scene.model_dump(mode="json"), True)  # validates the walker here
     hdist = per.heights[0] if per is not None else "normal"
     slope_sd = float(per.slope_sd_rad) if per is not None else 0.0

@@ -167,7 +167,7 @@ def walker_columns(stage: str, scene) -> dict[str, tuple]:
         return dict(COLUMNS[stage])
     from walkerlab.models.registry import state_layout  # light
 
-    out = columns(stage, *state_layout(scene, plant=Plant.from_scene(scene)))
+    out = columns(stage, *state_layout(Plant.from_scene(scene)))
     act = scene.walker.actuation if hasattr(scene.walker, "actuation") else None
     if stage == "fixedpoint" and act is not None and act.virtual_constraints is not None:
         out.update(ZERO_DYNAMICS_COLUMNS)  # a scene under virtual constraints: its HZD too

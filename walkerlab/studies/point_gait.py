@@ -83,7 +83,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     opts = {**DEFAULT_OPTIONS, **(options or {})}
 
     fp = scene.fixedpoint or FixedPointSettings()  # every field optional: the defaults
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     solver = scene_solver(scene)
     tries = []
     if isinstance(guess, Continuation) and guess.states:

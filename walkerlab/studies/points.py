@@ -152,7 +152,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         x0, next_guess = res.x, res
         cols["guess_source"] = source
     else:
-        walker = build_walker(scene, plant=Plant.from_scene(scene))
+        walker = build_walker(Plant.from_scene(scene))
         x0 = initial_state(sim.initial_state, walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, scene_solver(scene),

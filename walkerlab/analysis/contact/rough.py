@@ -82,7 +82,7 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
     if not periodic:
         from walkerlab.models.registry import build_walker
 
-        period = integrate_step(build_walker(scene, setup.plant), np.asarray(x_ideal, float),
+        period = integrate_step(build_walker(setup.plant.with_(scene)), np.asarray(x_ideal, float),
                                 Solver("DOP853", 1e-10, 1e-10)).period
         return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                             tuple(map(float, x0)), float(step_length), float(period),

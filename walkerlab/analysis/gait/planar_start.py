@@ -116,7 +116,7 @@ def embed(planar: HybridWalker, x_planar: np.ndarray, walker: HybridWalker
 
 def _planar_gait(twin: Scene) -> tuple[np.ndarray, str, bool] | None:
     """The planar twin's gait and how it was found, or None."""
-    w = build_walker(twin, plant=Plant.from_scene(twin))
+    w = build_walker(Plant.from_scene(twin))
     closed = w.closed_form_gait() if w.closed_form_gait is not None else None
     if closed is not None:
         return np.asarray(closed, float), "its gait in closed form", True
@@ -222,7 +222,7 @@ def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: S
     if found is None:
         return None
     x_planar, how, unique = found
-    planar = build_walker(twin_scene, plant=Plant.from_scene(twin_scene))
+    planar = build_walker(Plant.from_scene(twin_scene))
     x = embed(planar, x_planar, walker)
     if x is None:
         return None
@@ -236,7 +236,7 @@ def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: S
     def make(width: float) -> HybridWalker:
         data["walker"][field] = float(width)
         sc = Scene.model_validate(data)
-        return build_walker(sc, Plant.from_scene(sc))
+        return build_walker(Plant.from_scene(sc))
 
     fp = scene.fixedpoint
     max_step = fp.max_step_time_s if fp is not None else 5.0

@@ -73,7 +73,7 @@ class _Gaits:
         from walkerlab.models.registry import build_walker
 
         sc = self.scene_at(p)  # the design point's walker, described here
-        return build_walker(sc, Plant.from_scene(sc))
+        return build_walker(Plant.from_scene(sc))
 
     def value(self, p, name: str) -> float:
         """A measure that is not one map's (``max_abs_multiplier`` and
