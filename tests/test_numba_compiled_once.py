@@ -53,7 +53,7 @@ simulate_contact(w, x, 0.05)
 rw = build_walker(Plant.from_scene(sc))
 xs = sc.fixedpoint.initial_guess.as_array(rw.state_names())
 poincare_map(rw, xs, Solver("DOP853", 1e-10, 1e-10, None, "cyrk_compiled"), jacobian=True)
-sm = step_map_for(sc.model_dump(mode="json"))
+sm = step_map_for(sc.model_dump(mode="json"), plant=Plant.from_scene(sc))
 sm.step(np.tile(xs, (3, 1)), np.array([0.017, 0.0174, 0.018]))
 sm.walk(np.tile(xs, (2, 1)), np.full((2, 3), 0.0174))
 multi = sorted(f"{v.py_func.__module__}.{v.py_func.__name__}"

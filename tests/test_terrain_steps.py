@@ -205,7 +205,7 @@ def test_mfpt_on_per_step_heights_matches_an_independent_monte_carlo(paper_scene
 
     sd, walks = 0.002, 300
     mc = monte_carlo(paper_scene, paper_fixed_point.x, 0.0, walks, 2000, 3,
-                     heights=("normal", sd))
+                     heights=("normal", sd), plant=Plant.from_scene(paper_scene))
     m, se = mc.mfpt
     assert mc.fell.all()
     ref = _independent().StairsCompass(0.0)
