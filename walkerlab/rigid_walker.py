@@ -324,4 +324,4 @@ class SceneWalker:
             src = known_scene(self.scene)
         except SceneError as exc:
             raise SceneError(f"fixedpoint.from: {exc}") from None
-        return homotopy_start(self.scene, src)[0]
+        return homotopy_start(self.scene, src, plant=self.plant)[0]

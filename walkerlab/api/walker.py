@@ -255,7 +255,7 @@ class Walker(SceneWalker):
         from walkerlab.studies.continuation import scene_family, scene_value  # light
 
         name, value = check_target(self.scene, vary, target)
-        fam = scene_family(self.scene, vary)
+        fam = scene_family(self.scene, vary, plant=self.plant)
         res = solve_target(fam, scene_value(self.scene, vary), self.fixed_point().x,
                            MEASURES[name][0], value)
         found = self.with_changes({vary: res.p})
