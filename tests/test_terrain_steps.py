@@ -71,7 +71,8 @@ def test_a_finite_foothold_list_ends_the_walk(paper_scene, paper_fixed_point):
                        foothold_slopes_rad=[phi] * 3)
     w = build_walker(Plant.from_scene(sc))
     tr = simulate_steps(w, paper_fixed_point.x, 10, solver)
-    ref = simulate_steps(build_walker(Plant.from_scene(paper_scene)), paper_fixed_point.x, 3, solver)
+    ref = simulate_steps(build_walker(Plant.from_scene(paper_scene)), paper_fixed_point.x, 3,
+                         solver)
     assert len(tr.segments) == 3 and tr.termination == "heel_strike"
     for a, b in zip(tr.segments, ref.segments):
         np.testing.assert_array_equal(a.x_next, b.x_next)
@@ -289,7 +290,8 @@ def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fix
     sc = scene_from_dict(d)
     x0 = paper_fixed_point.x
     tr = profile_walk(sc, x0, 8, plant=Plant.from_scene(sc))
-    ref = simulate_steps(build_walker(Plant.from_scene(paper_scene)), x0, 8, Solver.from_settings(sc.solver))
+    ref = simulate_steps(build_walker(Plant.from_scene(paper_scene)), x0, 8,
+                         Solver.from_settings(sc.solver))
     assert len(tr.segments) == 8 and tr.termination == "heel_strike"
     for a, b in zip(tr.segments, ref.segments):
         assert np.max(np.abs(a.x_next - b.x_next)) < 1e-9

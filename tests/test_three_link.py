@@ -168,7 +168,8 @@ def test_the_shipped_gait_is_a_stable_fixed_point():
 
 def _x_gait():
     scene = load_scene(SCENE)
-    return scene, scene.fixedpoint.initial_guess.as_array(build_walker(Plant.from_scene(scene)).state_names())
+    names = build_walker(Plant.from_scene(scene)).state_names()
+    return scene, scene.fixedpoint.initial_guess.as_array(names)
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget

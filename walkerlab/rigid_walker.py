@@ -191,7 +191,7 @@ class SceneWalker:
 
         self.step_evaluations = positive(step_evaluations, "step_evaluations")
         self.plant = plant  # described once by the front, handed to every analysis
-        self.scene: Scene = plant.scene
+        self.scene = scene = plant.scene
         self.model = build_walker(plant)
         self.solver = Solver.from_settings(scene.solver)
         fp = scene.fixedpoint

@@ -140,7 +140,6 @@ def test_a_stability_map_cell_without_work_left_says_work_limit_twice_alike():
     """A map cell whose searches may make 3 step-map integrations each (the default 2,000):
     its reason is work_limit, the same in a second computation; no clock decides it."""
     from walkerlab.studies.stability import REASONS, MapSpec, gait_row
-
     from walkerlab.walker.plant import Plant
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")

@@ -134,8 +134,9 @@ def bench_design_process(pairs: int = 3) -> dict:
         scene = load_scene(path)
         vc = scene.walker.actuation.virtual_constraints
         spec = design_spec(scene, collocation_spec(scene))
-        t, x, u, alpha, _zd = controller_step(build_walker(Plant.from_scene(scene)), Solver.from_settings(
-            scene.solver), 2 * DESIGN["intervals"] + 1)
+        t, x, u, alpha, _zd = controller_step(build_walker(Plant.from_scene(scene)),
+                                              Solver.from_settings(scene.solver),
+                                              2 * DESIGN["intervals"] + 1)
         npz = Path(d) / "start.npz"
         _write_start(npz, (t, x, u, alpha), vc, spec.max_torque_n_m, spec.friction_coefficient)
         script.append(str(npz))

@@ -341,8 +341,8 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
                                      else max(2, workers), steps, plant)
     offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
     done = {i for c, chain in enumerate(plan) for i in chain[:offset[c]]}
-    chains = _piece_tasks(Task(stage, base, tuple(paths), (), opts, origin, plant=plant), plan, offset,
-                          values_of)
+    chains = _piece_tasks(Task(stage, base, tuple(paths), (), opts, origin, plant=plant), plan,
+                          offset, values_of)
     guesses = [start.get(c, (0, None))[1] for c in range(len(plan))]
     t0 = time.perf_counter()
     counts = {o: 0 for o in OUTCOMES}
