@@ -172,7 +172,8 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     if guess is None and not no_energy_reason(walker):  # (none where no gait can be)
         if nearby is not None:  # a gait stored nearby, carried here
             fallbacks.append(nearby)
-        planar = planar_fallback(scene, walker, solver)  # a 3D walker: from its planar twin
+        planar = planar_fallback(scene, walker, solver,
+                                 plant=plant)  # a 3D walker: from its planar twin
         if planar is not None:
             fallbacks.append(planar)
     return walker, search_from(start, fallbacks)
