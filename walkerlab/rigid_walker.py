@@ -155,6 +155,20 @@ class Gait:
         return self.max_abs_multiplier < 1.0
 
 
+def rebuilt(cls, plant, step_evaluations: int):
+    """A :class:`SceneWalker` of class ``cls`` (or a subclass whose constructor only hands
+    its plant up, :class:`walkerlab.api.walker.Walker`) built again from its plant and step
+    work limit: what unpickling a walker calls.
+
+    Returns
+    -------
+    SceneWalker
+    """
+    walker = cls.__new__(cls)
+    SceneWalker.__init__(walker, plant, step_evaluations)
+    return walker
+
+
 class SceneWalker:
     """The rigid hybrid walker of a scene: the validated scene, its walker described
     (:attr:`plant`, a :class:`~walkerlab.walker.plant.Plant`), the generated model
@@ -183,8 +197,8 @@ class SceneWalker:
     def __reduce__(self):
         """Pickled as its plant and step work limit (the model is built again: a compiled
         flow does not pickle; a process pool or a vector env's subprocess gets the same
-        walker)."""
-        return (type(self), (self.plant, self.step_evaluations))
+        walker, of the same class: :func:`rebuilt`)."""
+        return (rebuilt, (type(self), self.plant, self.step_evaluations))
 
     def __init__(self, plant, step_evaluations: int = STEP_EVALUATIONS):
         from walkerlab.models.registry import build_walker  # light

@@ -46,7 +46,7 @@ from walkerlab.api.checks import (
     short,
     simulate_options,
 )
-from walkerlab.api.scenes import as_scene, with_changes
+from walkerlab.api.scenes import as_scene, scene_plant, with_changes
 from walkerlab.api.walks import ContactWalk, Gait, Step, Walk, recorded_contact_walk, sampled_walk
 from walkerlab.integrate.solver import Solver
 from walkerlab.rigid_walker import SceneWalker
@@ -81,9 +81,7 @@ class Walker(SceneWalker):
         (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``work_limit``).  The
         simulated time of a step is bounded apart, by ``fixedpoint.max_step_time_s``.
     plant : walkerlab.walker.plant.Plant, optional
-        A plant the caller holds (the contact view's, this walker's before a change): the
-        scene's is :meth:`~walkerlab.walker.plant.Plant.with_` of it; default: the scene's
-        walker described here (the API is a front door).
+        A plant the caller holds (:func:`~walkerlab.api.scenes.scene_plant`).
 
     Attributes
     ----------
@@ -110,16 +108,7 @@ class Walker(SceneWalker):
     """
 
     def __init__(self, scene: Scene, step_evaluations: int = STEP_EVALUATIONS, plant=None):
-        from walkerlab.walker.plant import Plant  # light
-
-        # the front: the scene's walker described here, once (or handed in by the caller
-        # that holds it: the contact view, a changed walker's neighbour)
-        super().__init__(Plant.from_scene(scene) if plant is None else plant.with_(scene),
-                         step_evaluations)
-
-    def __reduce__(self):
-        """Pickled as its scene, step work limit and plant (the model is built again)."""
-        return (type(self), (self.scene, self.step_evaluations, self.plant))
+        super().__init__(scene_plant(scene, plant), step_evaluations)  # the front describes
 
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
@@ -144,8 +133,7 @@ class Walker(SceneWalker):
         walkerlab.config.SceneError
             An unknown field (with the closest name) or a value the field does not accept.
         """
-        return Walker(with_changes(self.scene, changes), self.step_evaluations,
-                      self.plant)  # the same walker section keeps its description
+        return Walker(with_changes(self.scene, changes), self.step_evaluations, self.plant)
 
     def contact(self) -> ContactWalker:
         """The contact (compliant-foot) view of this walker: a :class:`ContactWalker` on the
@@ -392,12 +380,10 @@ class ContactWalker:
                  step_evaluations: int = STEP_EVALUATIONS):
         from walkerlab.config.sections import with_default_section  # light
         from walkerlab.models.contact.scene import contact_setup  # light
-        from walkerlab.walker.plant import Plant  # light
 
         self.scene = with_default_section(scene, "contact")  # left out: its defaults
-        plant = Plant.from_scene(scene) if rigid is None else rigid.plant  # described once
-        self.setup = contact_setup(self.scene, plant=plant)
-        self.rigid = rigid if rigid is not None else Walker(scene, step_evaluations, plant)
+        self.setup = contact_setup(self.scene, plant=scene_plant(scene, rigid and rigid.plant))
+        self.rigid = rigid or Walker(scene, step_evaluations, self.setup.plant)  # described once
         self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
         self.solver = Solver.from_settings(self.setup.solver)
         self._gait = None  # the rigid gait, found on first use
@@ -430,8 +416,7 @@ class ContactWalker:
         walkerlab.models.contact.scene.ContactSceneError
             The changed scene's walker is one the contact view does not carry.
         """
-        rigid = self.rigid.with_changes(changes)
-        return ContactWalker(rigid.scene, rigid)
+        return ContactWalker((rigid := self.rigid.with_changes(changes)).scene, rigid)
 
     def state_names(self) -> list[str]:
         """Names of the floating walker's state (N,): the hip position, the link angles,

@@ -525,8 +525,7 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
     err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
     gait, contact_period, contact_outcome = reported.optimum_outcome(
-        scene, res, err, lambda: contact_replay_phased(scene, res, strides=2,
-                                                              plant=plant))
+        scene, res, err, lambda: contact_replay_phased(scene, res, strides=2, plant=plant))
     phases, phase_note = reported.hip_phase_replays_of(scene, data, res, phase_torque_of_time(res))
     states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
@@ -623,8 +622,7 @@ def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
-        scene, res, err, lambda: contact_replay_stride(scene, res, strides=2,
-                                                              plant=plant))
+        scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
     record = history_and_energies(scene, walker, res)
