@@ -53,7 +53,7 @@ def main() -> None:
         times, cpu = [], []
         for _ in range(args.repeats):
             t0, c0 = time.perf_counter(), time.process_time()
-            res, _c = run_continuation(scene, path, a, b, switch)
+            res, _c = run_continuation(scene, path, a, b, switch, plant=Plant.from_scene(scene))
             times.append(time.perf_counter() - t0)
             cpu.append(time.process_time() - c0)
         med = statistics.median(times)

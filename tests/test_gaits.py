@@ -49,6 +49,11 @@ HEAVY_HIP = {
 }
 
 
+def _plant(base: dict) -> Plant:
+    """The plant of a scene mapping (the study's, as its stage builds it)."""
+    return Plant.from_scene(scene_from_dict(base))
+
+
 def _without_guess(name: str):
     d = yaml.safe_load((ROOT / "configs" / f"{name}.yaml").read_text())
     d["name"] = name
@@ -121,13 +126,14 @@ def test_sweep_point_chooses_the_gait_as_the_stage_does():
     """A sweep's first point (no neighbour yet) follows fixedpoint.gait like the stage: the
     heavy-hip walker's stable long-period gait, not the unstable one its guess reaches."""
     base = scene_from_dict(HEAVY_HIP).model_dump(mode="json")
-    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {})
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {},
+                      plant=_plant(base))
     # the stable gait is the partner of the one the guess reaches (deflation): "search"
     assert row["outcome"] == "ok" and row["guess_source"] == "search"
     assert row["stable"] == 1.0 and 0.93 < row["step_period_s"] < 0.95
-    row, _ = evaluate("fixedpoint", dict(base, fixedpoint={**base["fixedpoint"],
-                                                          "gait": "nearest_guess"}),
-                      ["slope.angle_deg"], (2.0,), 0, None, {})
+    nearest = dict(base, fixedpoint={**base["fixedpoint"], "gait": "nearest_guess"})
+    row, _ = evaluate("fixedpoint", nearest, ["slope.angle_deg"], (2.0,), 0, None, {},
+                      plant=_plant(nearest))
     assert row["stable"] == 0.0 and abs(row["max_abs_multiplier"] - 4.08) < 0.01
 
 
@@ -250,11 +256,13 @@ def test_sweep_over_a_body_mass_by_name(tmp_path):
     T = np.asarray(rows["step_period_s"])
     assert np.all(np.diff(T) > 1e-3), T
     row, _ = evaluate("fixedpoint", scene.model_dump(mode="json"),
-                      ["walker.leg.bodies.1.mass_kg"], (0.07,), 0, None, {})
+                      ["walker.leg.bodies.1.mass_kg"], (0.07,), 0, None, {},
+                      plant=Plant.from_scene(scene))
     assert row["outcome"] == "ok" and abs(row["step_period_s"] - T[-1]) < 1e-9
     # position along the leg, by name: the thigh mass lower -> longer swing, longer step
     lo, _ = evaluate("fixedpoint", scene.model_dump(mode="json"),
-                     ["walker.leg.bodies.thigh_mass.from_hip_m"], (0.35,), 0, None, {})
+                     ["walker.leg.bodies.thigh_mass.from_hip_m"], (0.35,), 0, None, {},
+                     plant=Plant.from_scene(scene))
     assert lo["outcome"] == "ok" and lo["step_period_s"] > T[1] + 1e-3
 
 

@@ -160,7 +160,7 @@ def test_rimless_wheel_basin_on_the_phase_plane():
     # (w-^2 = 0.25^2 + 2 g/L (cos 0.1 - cos 0.4727) gives w+^2 = 1.06 > the 0.95 needed)
     cells = ((0, psi, -1.05 * slow), (1, psi, -0.95 * slow), (2, -0.1, 0.25))
     out = {i: code for i, code, _, _ in run_basin_chunk(BasinTask(
-        scene.model_dump(mode="json"), tuple(x_star), cells))}
+        scene.model_dump(mode="json"), tuple(x_star), cells, plant=Plant.from_scene(scene)))}
     assert out == {0: CODE["converged"], 1: CODE["fell_backward"], 2: CODE["converged"]}
 
 

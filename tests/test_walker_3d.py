@@ -322,7 +322,8 @@ def test_a_changed_gain_falls_back_to_the_stored_gait_and_finds_the_gait(tmp_pat
     scene = load_scene(path)
     known = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
     guess = initial_guess(known, build_walker(Plant.from_scene(known)))
-    nearby = stored_gait_start(scene, [StoredGait(known, lambda: guess, "known")])
+    nearby = stored_gait_start(scene, [StoredGait(known, lambda: guess, "known")],
+                               plant=Plant.from_scene(scene))
     walker, search = solve_scene(scene, fd_check=False, nearby=nearby,
                                  plant=Plant.from_scene(scene))
     assert any("initial guess did not converge" in n for n in search.notes)
