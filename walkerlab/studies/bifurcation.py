@@ -73,8 +73,7 @@ def _onset_dict(onset: float, bracket, mult_at: float, n: int, path: str) -> dic
 
 def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
                            x: np.ndarray, xtol_deg: float = 1e-4,
-                           path: str = SLOPE_PATH, steps_per_map: int = 0, *,
-                           plant) -> dict:
+                           path: str = SLOPE_PATH, steps_per_map: int = 0, *, plant) -> dict:
     """Parameter value where the most negative real multiplier crosses -1.
 
     The first grid interval where ``g = 1 + min real multiplier`` goes from > 0 to <= 0
@@ -98,8 +97,7 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
     steps_per_map : int
         The study's one Poincaré map (``mult``'s; 0: each walker's own).
     plant : walkerlab.walker.plant.Plant
-        The study's plant (the base scene's, from the stage): each value's walker is
-        :meth:`~walkerlab.walker.plant.Plant.with_` of it.
+        The study's, from the stage (each value's is its ``with_``).
 
     Returns
     -------
@@ -240,8 +238,7 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     unit : str, optional
         Its SI unit (default: :func:`walkerlab.studies.params.axis_unit`).
     plant : walkerlab.walker.plant.Plant
-        The scene's plant, built by the stage and handed down (the tasks carry it; each
-        value's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of it).
+        The scene's, built by the stage (the tasks carry it; each value's is its ``with_``).
 
     Returns
     -------
@@ -307,10 +304,9 @@ def _diagram_result(plant, slopes: np.ndarray, rows: list[dict], x: np.ndarray,
                     unit: str) -> BifurcationResult:
     """:func:`bifurcation_diagram`'s rows packed as a :class:`BifurcationResult`: the fixed
     points ``x`` and multipliers ``mult`` with the fixed points' inter-leg angles (from the
-    scene's walker, that of ``plant``; NaN where no fixed point was found), the steady
-    state's heel strikes in degrees and the attractor period (distinct inter-leg angles
-    among them), the grid ``slopes`` of ``param`` [``unit``] and the period-doubling
-    ``onset``."""
+    walker of ``plant``; NaN where no fixed point was found), the steady state's heel strikes
+    in degrees and the attractor period (distinct inter-leg angles among them), the grid
+    ``slopes`` of ``param`` [``unit``] and the period-doubling ``onset``."""
     from walkerlab.models.registry import build_walker
     from walkerlab.studies.point_columns import interleg_angle
 

@@ -36,9 +36,8 @@ NOT_WALKER = ("name", "source", "published", "fixedpoint", "simulate", "contact"
 def scene_family(scene: Scene, path: str, *, plant) -> WalkerFamily:
     """The scene's walker as a function of the field ``path`` (and any fields held fixed).
 
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, handed down by the front;
-    each value's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of it (a slope, the
-    solver: the same description).
+    ``plant``: the scene's, handed down; each value's is :meth:`~walkerlab.walker.plant.
+    Plant.with_` of it.
 
     Raises
     ------
@@ -156,8 +155,8 @@ def check_continuation(scene: Scene, path, start, stop, path2=None, range2=None
 
 def run_continuation(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
                      path2: str | None = None, range2: tuple | None = None,
-                     n2: int = 25, ds_max: float = 0.1, *,
-                     plant) -> tuple[ContinuationResult, list]:
+                     n2: int = 25, ds_max: float = 0.1, *, plant
+                     ) -> tuple[ContinuationResult, list]:
     """Continue the scene's gait over ``path`` in ``[start, stop]``.
 
     Parameters
@@ -177,8 +176,7 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     ds_max : float
         Largest arclength step (scaled: the range's span is 1).
     plant : walkerlab.walker.plant.Plant
-        The scene's plant, built by the stage: each step's walker is
-        :meth:`~walkerlab.walker.plant.Plant.with_` of it.
+        The scene's, built by the stage (each step's is its ``with_``).
 
     Returns
     -------
@@ -275,8 +273,7 @@ def _slope_rad(s: dict) -> float:
 def homotopy_family(known: Scene, new: Scene, *, plant):
     """``(make, fields)``: ``make({"lambda": v})`` builds the walker whose numeric fields are
     ``(1 - v) known + v new``; ``fields`` maps each differing path to ``(known, new)``.
-    ``plant``: the new scene's :class:`~walkerlab.walker.plant.Plant`, handed down (each
-    walker on the way is :meth:`~walkerlab.walker.plant.Plant.with_` of it).
+    ``plant``: the new scene's, handed down (each walker on the way is its ``with_``).
 
     Raises
     ------
