@@ -387,7 +387,7 @@ def test_a_homotopy_from_a_scene_with_the_same_numbers_says_so_without_an_empty_
     sc = load_scene(Path(__file__).resolve().parents[1] / "configs" / "paper.yaml")
     same = SimpleNamespace(reached=True, fields={}, specials=[], x=np.zeros(4),
                            branch=SimpleNamespace(points=[None] * 8))
-    monkeypatch.setattr(C, "homotopy_gait", lambda known, new: same)
+    monkeypatch.setattr(C, "homotopy_gait", lambda known, new, plant: same)
     _, note = C.homotopy_start(sc, sc, plant=Plant.from_scene(sc))
     assert "over  (" not in note and "by homotopy over" not in note
     assert note == ("initial guess: the gait of scene paper, whose walker and slope have this "
@@ -513,7 +513,7 @@ def test_a_homotopy_turned_back_by_a_fold_says_how_far_it_got_not_only_where_it_
     fold = SimpleNamespace(kind="fold", p=0.2343, cause="")
     res = SimpleNamespace(reached=False, fields={"slope.angle_rad": 1}, specials=[fold],
                           x=np.zeros(4), branch=SimpleNamespace(points=pts))
-    monkeypatch.setattr(C, "homotopy_gait", lambda known, new: res)
+    monkeypatch.setattr(C, "homotopy_gait", lambda known, new, plant: res)
     with pytest.raises(ValueError) as exc:
         C.homotopy_start(sc, sc, plant=Plant.from_scene(sc))
     msg = str(exc.value)
