@@ -87,3 +87,22 @@ def test_a_plant_pickles_with_its_scene_and_description():
         back = loads(dumps(plant))
         assert back.scene == plant.scene and back.data.params == plant.data.params
         assert back.kind == plant.kind and back.data.structure == plant.data.structure
+
+
+def test_a_plant_crosses_the_worker_pool_and_a_walker_pickles_as_its_plant():
+    """A study's task carries the plant to a pool worker (walkerlab.execution) and back; the
+    API's walker pickles as its plant and step work limit and is rebuilt of its class."""
+    import pickle
+
+    from walkerlab.execution.executor import make_executor, run_each
+    from walkerlab.models.registry import state_layout
+
+    plant = Plant.from_scene(load_scene(CONFIGS / "kneed.yaml"))
+    with make_executor(2, pool=True) as ex:
+        (_, got), = list(run_each(ex, state_layout, [(plant,)]))
+    assert got == state_layout(plant)
+    w = Walker(load_scene(CONFIGS / "paper.yaml"), step_evaluations=1234)
+    back = pickle.loads(pickle.dumps(w))
+    assert type(back) is Walker and back.step_evaluations == 1234
+    assert back.scene == w.scene and back.plant.data.params == w.plant.data.params
+    assert back.state_names() == w.state_names()
