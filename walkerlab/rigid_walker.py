@@ -173,8 +173,8 @@ class SceneWalker:
     """The rigid hybrid walker of a scene: the validated scene, its walker described
     (:attr:`plant`, a :class:`~walkerlab.walker.plant.Plant`), the generated model
     (:func:`walkerlab.models.registry.build_walker`) and the scene's integrator, built once
-    (the parameters, attributes and errors of :class:`walkerlab.api.walker.Walker`, which
-    extends it).
+    (the attributes and errors of :class:`walkerlab.api.walker.Walker`, which extends it and
+    builds the plant from its scene).
 
     Parameters
     ----------
