@@ -27,7 +27,7 @@ from walkerlab.models.registry import build_walker
 from walkerlab.integrate.solver import Solver
 from walkerlab.analysis.gait.poincare import poincare_map
 from walkerlab.walker.plant import Plant
-sc = load_scene({path!r}); w = build_walker(sc, Plant.from_scene(sc))
+sc = load_scene({path!r}); w = build_walker(Plant.from_scene(sc))
 x = sc.fixedpoint.initial_guess.as_array(w.state_names())
 poincare_map(w, x, Solver('DOP853', sc.solver.rtol, sc.solver.atol, None, {backend!r}))
 print(time.perf_counter() - t0)
@@ -41,7 +41,7 @@ def main(path: str = "configs/paper.yaml", repeats: int = 30) -> None:
     from walkerlab.models.registry import build_walker
 
     sc = load_scene(path)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     x = sc.fixedpoint.initial_guess.as_array(w.state_names())
     sv = {b: Solver("DOP853", sc.solver.rtol, sc.solver.atol, None, b)
           for b in ("cyrk", "cyrk_compiled")}

@@ -49,12 +49,11 @@ def main() -> None:
     out = {"load_average": os.getloadavg(), "cpus": os.cpu_count(), "cases": {}}
     for name, (cfg, path, a, b, switch, goal) in CASES.items():
         scene = load_scene(ROOT / "configs" / cfg)
-        build_walker(scene,
-                     plant=Plant.from_scene(scene))  # generated code built / loaded once, not timed
+        build_walker(Plant.from_scene(scene))  # generated code built / loaded once, not timed
         times, cpu = [], []
         for _ in range(args.repeats):
             t0, c0 = time.perf_counter(), time.process_time()
-            res, _c = run_continuation(scene, path, a, b, switch)
+            res, _c = run_continuation(scene, path, a, b, switch, plant=Plant.from_scene(scene))
             times.append(time.perf_counter() - t0)
             cpu.append(time.process_time() - c0)
         med = statistics.median(times)

@@ -44,7 +44,7 @@ def _cases():
     out = {}
     for name in ("kneed", "flat_feet"):
         sc = load_scene(CONFIGS / f"{name}.yaml")
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         guess = sc.fixedpoint.initial_guess.as_array(w.state_names())
         for b in BACKENDS:
             sv = Solver(sc.solver.method, sc.solver.rtol, sc.solver.atol, None, b)

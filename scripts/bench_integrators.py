@@ -55,7 +55,7 @@ def main() -> None:
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(default_scene())
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     names = w.state_names()
     try:
         guess = scene.fixedpoint.initial_guess.as_array(names)

@@ -178,14 +178,15 @@ def measure(scene_path: str, walks: int = 500, steps: int = 100, sigma: float = 
     from walkerlab.studies import mfpt as work
 
     scene = load_scene(scene_path)
-    _, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, fd_check=False, plant=plant)
     x = np.asarray(search.gait.result.x, float)
     st = scene.mfpt or MfptSettings()
     W, S = walks, steps
     base = scene.model_dump(mode="json")
     task = work.WalkTask(base, tuple(map(float, x)), sigma, tuple(range(W)), S, st.seed,
-                         "normal", 0)
-    sm = work.step_map_for(base)
+                         "normal", 0, plant=plant)
+    sm = work.step_map_for(base, plant=plant)
     slopes = np.stack([draw_slopes(st.seed, w, S, sm.slope_rad, sigma) for w in range(W)])
     p = mc.params(scene.walker)
     cy_walks = _cyrk_walks(mc)

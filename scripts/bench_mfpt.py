@@ -45,11 +45,13 @@ def main() -> None:
     from walkerlab.studies import mfpt as work
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    _, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, fd_check=False, plant=plant)
     x = search.gait.result.x
     out = {}
     t, c = time.perf_counter(), cpu_s()
-    mc = work.monte_carlo(scene, x, a.sigma_mc, a.walks, a.steps, seed=0, workers=a.workers)
+    mc = work.monte_carlo(scene, x, a.sigma_mc, a.walks, a.steps, seed=0, workers=a.workers,
+                          plant=plant)
     wall, cpu = time.perf_counter() - t, cpu_s() - c
     n = int(mc.steps.sum() + mc.fell.sum())
     out["montecarlo"] = {"sigma_rad": a.sigma_mc, "steps": n, "wall_s": wall, "cpu_s": cpu,
@@ -60,7 +62,7 @@ def main() -> None:
     if not a.skip_mesh:
         st = MfptSettings()
         t, c = time.perf_counter(), cpu_s()
-        last, meshes = work.mesh(scene, x, a.sigma_mesh, st, a.workers)
+        last, meshes = work.mesh(scene, x, a.sigma_mesh, st, a.workers, plant=plant)
         wall, cpu = time.perf_counter() - t, cpu_s() - c
         out["mesh"] = {"sigma_rad": a.sigma_mesh, "wall_s": wall, "cpu_s": cpu,
                        "meshes": [{"cells": r.cells, "h": r.h, "mfpt_steps": r.mfpt_steps}

@@ -33,11 +33,12 @@ def main() -> None:
     from walkerlab.studies.mfpt import step_map_for
 
     sc = load_scene(ROOT / "configs" / "paper.yaml")
-    _, search = solve_scene(sc, plant=Plant.from_scene(sc))
+    plant = Plant.from_scene(sc)
+    _, search = solve_scene(sc, plant=plant)
     x = search.result.x
     base = sc.model_dump(mode="json")
-    cases = {"slopes": (step_map_for(base), 0.004, None),
-             "heights": (step_map_for(base, True), 0.0, ("normal", 0.0016))}
+    cases = {"slopes": (step_map_for(base, plant=plant), 0.004, None),
+             "heights": (step_map_for(base, True, plant=plant), 0.0, ("normal", 0.0016))}
     out = {}
     for name, (sm, sd, heights) in cases.items():
         M.monte_carlo(sm, x, sd, range(20), 200, 1, heights=heights)  # compile / load

@@ -24,7 +24,7 @@ def per_call_us(fn, number: int) -> float:
 def main(paths: list[str]) -> None:
     for p in paths or ["configs/paper.yaml", "configs/paper_rods.yaml", "configs/simplest.yaml"]:
         sc = load_scene(p)
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         names = w.state_names()
         try:
             x = sc.fixedpoint.initial_guess.as_array(names)

@@ -61,7 +61,7 @@ def rigid_gait(scene, double_support: bool = True):
     """The rigid view's fixed point (role order) and step period [s]; ``double_support``
     False: the rigid view without its double support (the trailing foot released at heel
     strike, walkerlab before issue 48)."""
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     if not double_support:
         walker = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad),
                                    double_support=False)

@@ -51,7 +51,7 @@ def rigid(scene) -> dict:
     from walkerlab.models.registry import build_walker
     from walkerlab.walker.description import walker_data
 
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     ctrl = walker.actuators.controller
     zd = zero_dynamics(ctrl)
     seg = integrate_step(walker, zd.x_plus, Solver.from_settings(scene.solver),
@@ -190,7 +190,7 @@ def mujoco(scene, outdir: Path, subs, period: float, steps: float = 21.5) -> Non
         a = x[np.searchsorted(tt, t0 + 0.03)]
         slip.append((a - x[0], x[-1] - a))
     slip = 1e3 * np.array(slip[1:])
-    walker, solver = build_walker(scene, plant=plant), Solver.from_settings(scene.solver)
+    walker, solver = build_walker(plant), Solver.from_settings(scene.solver)
 
     def rigid_after(xr):  # the rigid closed loop 3 ms after its impact
         seg = integrate_step(walker, xr, solver, max_step_time=0.003)

@@ -40,7 +40,7 @@ def row(name: str) -> str:
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
     plant = Plant.from_scene(sc)
     try:
-        sm = BatchStepMap(build_walker(sc, plant=plant), scene_walker_at(sc, plant=plant),
+        sm = BatchStepMap(build_walker(plant), scene_walker_at(sc, plant=plant),
                           1e-12, 1e-12)
     except ValueError as exc:
         return f"| {name} | not supported: {exc} |"

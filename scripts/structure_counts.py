@@ -1,7 +1,9 @@
 """The package's structure in numbers: each row of the structure table (per-kind tables, walker
-kinds named as strings, ``"contact-sim"`` literals, ``walker_data`` callers, the functions
-below the front doors that describe the walker themselves when handed no plant (a
-``plant=None`` fallback to ``Plant.from_scene``), the places that
+kinds named as strings, ``"contact-sim"`` literals, ``walker_data`` callers, the modules below
+the front that build a description of the walker (``Plant.from_scene`` or ``walker_data``:
+the front, :data:`FRONT`, builds the plant once and hands it down), the functions below the
+front that describe the walker themselves when handed no plant (a ``plant=None`` fallback
+to ``Plant.from_scene``), the places that
 write the Christoffel symbols, code kept as text, module and function sizes, duplicates, arrows
 back up and import circles, the gym's run-time parsing and hook swapping), with its goal and
 pass/fail.
@@ -35,6 +37,15 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
+
+#: the front: the top-level packages (and modules) below ``walkerlab/`` that build the plant
+#: (:meth:`walkerlab.walker.plant.Plant.from_scene`) and hand it down - the walker's own
+#: package, the stages, the API, the CLI, the benches - and the gym's constructor
+#: (:data:`FRONT_FUNCTIONS`); everything else is below the front
+FRONT = ("walker", "stages", "api", "cli", "bench")
+#: functions of a package below the front that are front doors themselves: the gym's
+#: constructor (``gym/``'s ``__init__``)
+FRONT_FUNCTIONS = {"gym": ("__init__",)}
 
 
 def _layers_module():
@@ -152,6 +163,25 @@ def _call_name(n: ast.Call) -> str:
     return getattr(n.func, "attr", None) or getattr(n.func, "id", None) or ""
 
 
+def _describes(n) -> bool:
+    """``n`` builds a description of the walker: a call ``Plant.from_scene(...)`` or
+    ``walker_data(...)``."""
+    if not isinstance(n, ast.Call):
+        return False
+    name = _call_name(n)
+    return name == "walker_data" or (name == "from_scene" and isinstance(n.func, ast.Attribute)
+                                     and getattr(n.func.value, "id", "") == "Plant")
+
+
+def _front_calls(tree: ast.Module, top: str) -> set[int]:
+    """``id`` of the calls of ``tree`` (a module of package ``top``) made inside one of its
+    front functions (:data:`FRONT_FUNCTIONS`)."""
+    names = FRONT_FUNCTIONS.get(top, ())
+    return {id(c) for f in ast.walk(tree)
+            if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)) and f.name in names
+            for c in ast.walk(f) if isinstance(c, ast.Call)}
+
+
 def _floor(rel: str, layers) -> int | None:
     """The floor of the module at ``rel`` (a path below ``walkerlab/``)."""
     top = rel.split("/")[0].removesuffix(".py")
@@ -180,10 +210,13 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
     part_tables, kind_switches = [], []
     plant_builds = {}  # module -> ["line (plant=None default)" or "line"]
     plant_fallbacks = {}  # module -> ["function:line"]: a plant parameter defaulting to None
+    described = {}  # module below the front -> lines of its Plant.from_scene / walker_data
     long_strings, gym_parse, gym_hook = [], [], []
     for p in files:
         r, tree = rel(p), trees[p]
         top = r.split("/")[0]
+        below = r.removesuffix(".py").split("/")[0] not in FRONT
+        front_calls = _front_calls(tree, top) if below else set()
         strings = _strings(tree)
         for n in ast.walk(tree):
             if top != "walker" and isinstance(n, ast.Dict):
@@ -203,6 +236,8 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
                     tables.append(f"{r}:{n.lineno}")
             if isinstance(n, ast.Call) and _call_name(n) == "walker_data":
                 wd_calls.setdefault(r, []).append(n.lineno)
+            if below and _describes(n) and id(n) not in front_calls:
+                described.setdefault(r, []).append(n.lineno)
             if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 a = n.args
                 pos = a.posonlyargs + a.args
@@ -242,14 +277,12 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
             christoffel.append(r)
 
     sizes = {rel(p): len(texts[p].splitlines()) for p in files}
-    wd_out = {r: v for r, v in wd_calls.items()
-              if r.split("/")[0] not in ("walker", "stages", "api")}
-    # the front: the stages, the API (and its rigid walker, rigid_walker.SceneWalker), the CLI
-    front = ("walker", "stages", "api", "cli", "rigid_walker")
-    plant_out = {r: v for r, v in plant_builds.items()
-                 if r.removesuffix(".py").split("/")[0] not in front}
-    fallback_out = {r: v for r, v in plant_fallbacks.items()
-                    if r.removesuffix(".py").split("/")[0] not in front}
+    def below_front(r):
+        return r.removesuffix(".py").split("/")[0] not in FRONT
+
+    wd_out = {r: v for r, v in wd_calls.items() if below_front(r)}
+    plant_out = {r: v for r, v in plant_builds.items() if below_front(r)}
+    fallback_out = {r: v for r, v in plant_fallbacks.items() if below_front(r)}
 
     # arrows back up, by the floors of tests/test_layers.py's LAYERS
     layers = tl.LAYERS
@@ -280,14 +313,19 @@ def measure(root: Path, duplicates: bool = True) -> list[dict]:
         ("files naming a walker kind as a string outside walker/, config/", len(kind_files), 3,
          sorted(kind_files)),
         ('files with the literal "contact-sim"', len(cs_files), 6, sorted(cs_files)),
-        ("modules calling walker_data(...) outside walker/, stages/, api/", len(wd_out), 0,
+        ("modules calling walker_data(...) outside walker/, stages/, api/, cli/, bench/",
+         len(wd_out), 0,
          {"modules": sorted(wd_out), "calls in all": sum(map(len, wd_calls.values())),
           "files in all": len(wd_calls)}),
+        ("modules below the front building a description (Plant.from_scene / walker_data "
+         "outside walker/, stages/, api/, cli/, bench/, the gym's constructor)",
+         len(described), 4,
+         {"modules": {r: v for r, v in sorted(described.items())},
+          "Plant.from_scene below the front (all, the gym's constructor too)":
+          {r: v for r, v in sorted(plant_out.items())}}),
         ("functions below the front describing the walker when handed no plant",
          sum(map(len, fallback_out.values())), 0,
-         {"fallbacks (plant=None)": {r: v for r, v in sorted(fallback_out.items())},
-          "modules describing a scene they made (Plant.from_scene: a study's point, a "
-          "search's planar twin, a bench)": sorted(plant_out)}),
+         {"fallbacks (plant=None)": {r: v for r, v in sorted(fallback_out.items())}}),
         ("modules writing the Christoffel symbols", len(christoffel), 1, christoffel),
         ("strings of >= 60 lines outside codegen/", len(long_strings), 0, long_strings),
         ("modules > 800 lines", sum(v > 800 for v in sizes.values()), 0,

@@ -36,7 +36,7 @@ def paper_scene():
 
 @pytest.fixture(scope="session")
 def paper_walker(paper_scene):
-    return build_walker(paper_scene, plant=Plant.from_scene(paper_scene))
+    return build_walker(Plant.from_scene(paper_scene))
 
 
 @pytest.fixture(scope="session")

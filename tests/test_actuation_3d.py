@@ -32,8 +32,8 @@ def _walkers(actuation):
     passive = Scene.model_validate(raw)
     raw["walker"]["actuation"] = actuation
     scene = Scene.model_validate(raw)
-    return (build_walker(scene, plant=Plant.from_scene(scene)),
-            build_walker(passive, plant=Plant.from_scene(passive)), reference_of(scene),
+    return (build_walker(Plant.from_scene(scene)),
+            build_walker(Plant.from_scene(passive)), reference_of(scene),
             scene.walker.hip_width_m)
 
 

@@ -31,7 +31,7 @@ def _flat_push_off() -> dict:
 
 def _step(d: dict, n: int = 1, x0=None):
     scene = scene_from_dict(d)
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     if x0 is None:
         x0 = scene.fixedpoint.initial_guess.as_array(w.state_names())
     traj = simulate_steps(w, x0, n, Solver.from_settings(scene.solver), max_step_time=3.0)
@@ -136,14 +136,14 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
                                                 "damping_n_m_s_per_rad": 0.5}}],
            "push_off": {"impulse_n_s": 1.0}}
     s0, s1 = _partly_massless(act), _partly_massless(act, 1e-10)
-    w0, w1 = (build_walker(s, plant=Plant.from_scene(s)) for s in (s0, s1))
+    w0, w1 = (build_walker(Plant.from_scene(s)) for s in (s0, s1))
     rng = np.random.default_rng(7)
     for _ in range(3):
         x = np.array([0.2, 0.4, -0.9, 0.3]) + rng.normal(0.0, 0.05, 4)
         f0, f1 = w0.phases[0].flow(0.0, x), w1.phases[0].flow(0.0, x)
         np.testing.assert_allclose(f0, f1, rtol=0, atol=1e-8)
         sc = _partly_massless(None)
-        assert np.max(np.abs(f0[2:] - build_walker(sc, plant=Plant.from_scene(sc)).phases[0].flow(
+        assert np.max(np.abs(f0[2:] - build_walker(Plant.from_scene(sc)).phases[0].flow(
             0.0, x)[2:])) > 0.1  # the torque acts
         np.testing.assert_allclose(w0.reset(x), w1.reset(x), rtol=0, atol=1e-8)
         # the energy's rate along the flow is the torque's power (central differences of
@@ -158,7 +158,7 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
     light = copy.deepcopy(torso)
     torso["walker"]["leg"]["bodies"][0]["mass_kg"] = 0.0
     light["walker"]["leg"]["bodies"][0]["mass_kg"] = 1e-10
-    t0, t1 = (build_walker(sc, plant=Plant.from_scene(sc))
+    t0, t1 = (build_walker(Plant.from_scene(sc))
               for sc in (scene_from_dict(c) for c in (torso, light)))
     x = np.array([-0.2, 0.2, -1.0, -0.9])
     np.testing.assert_allclose(t0.phases[0].flow(0.0, x), t1.phases[0].flow(0.0, x),
@@ -166,15 +166,15 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
     torso["walker"]["actuation"]["push_off"] = act["push_off"]
     with pytest.raises(ValueError, match=r"actuation\.push_off") as e:
         sc = scene_from_dict(torso)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     assert "\n" not in str(e.value)
     with pytest.raises(ValueError, match=r"torques\.0\.joint") as e:
         sc = _partly_massless({"torques": act["torques"]}, from_hip_a=0.0)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     assert "\n" not in str(e.value)
     with pytest.raises(ValueError, match=r"actuation\.push_off") as e:
         sc = _partly_massless({"push_off": act["push_off"]}, from_hip_a=0.0)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     assert "\n" not in str(e.value)
 
 
@@ -187,6 +187,6 @@ def test_the_contact_view_carries_a_five_link_push_off():
     d = load_scene(CONFIGS / "rabbit.yaml").model_dump(exclude_none=True)
     d["walker"]["actuation"]["push_off"] = {"impulse_n_s": 1.0}
     scene = scene_from_dict(d)
-    build_walker(scene, plant=Plant.from_scene(scene))  # the rigid view takes it
+    build_walker(Plant.from_scene(scene))  # the rigid view takes it
     acts = contact_setup(scene, plant=Plant.from_scene(scene)).actuators
     assert acts is not None and acts.spec.push_off.impulse_n_s == 1.0

@@ -93,7 +93,7 @@ def scene():
 def walker(scene):
     from walkerlab.models.registry import build_walker
 
-    return torso_walker(build_walker(scene, plant=Plant.from_scene(scene)))
+    return torso_walker(build_walker(Plant.from_scene(scene)))
 
 
 @pytest.fixture(scope="module")

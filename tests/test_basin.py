@@ -109,7 +109,7 @@ def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
     from walkerlab.studies.basin import heel_strike_slice, pre_impact_fixed_point
 
     sc = _simplest(tmp_path)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     names = w.state_names()
     th, ph, thd, phd = (names.index(n) for n in ("stance_angle", "hip_angle", "stance_rate",
                                                    "hip_rate"))
@@ -178,7 +178,7 @@ def test_a_3d_wheel_that_settles_rolling_at_another_heading_has_converged():
     from walkerlab.models.registry import build_walker
 
     sc = load_scene(DISC)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     st = BasinSettings(max_steps=10)
     sv = Solver("DOP853", st.rtol, st.atol)
     guess = np.array([0.0, 0.0, np.pi / 8 - 0.2, 0.0, 0.0, -1.9])

@@ -29,7 +29,7 @@ def _one_guard_set(sm, rows: int) -> tuple:
 
 @pytest.fixture(scope="module")
 def paper_map(paper_scene):
-    return BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+    return BatchStepMap(build_walker(plant := Plant.from_scene(paper_scene)),
                         scene_walker_at(paper_scene, plant), 1e-9, 1e-9)
 
 
@@ -56,7 +56,7 @@ def test_compiled_reset_is_the_walkers_reset(scene):
     Python ``reset``), applied row by row by ``rows_dop853.reset_rows``, gives the walker's
     heel-strike reset bit for bit, on two slopes."""
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     cf = w.phases[-1].compiled
     mod = compiled_module(cf.structure)
     n = w.layout().size
@@ -100,7 +100,7 @@ def test_kneed_walker_keeps_the_step_by_step_walks():
     """A kneed walker (two flows, the knee strike's reset between phases) is not walked in
     one compiled call: ``can_walk`` is False and ``walk`` says why in one line."""
     sc = load_scene(ROOT / "configs" / "kneed.yaml")
-    sm = BatchStepMap(build_walker(sc, plant=Plant.from_scene(sc)), scene_walker_at(sc,
+    sm = BatchStepMap(build_walker(Plant.from_scene(sc)), scene_walker_at(sc,
             plant=Plant.from_scene(sc)), 1e-9, 1e-9)
     assert not sm.can_walk
     with pytest.raises(ValueError, match="compiled walks need"):
@@ -120,7 +120,7 @@ def test_stage_and_guard_cfuncs_are_the_flows_values(scene):
         return v.ctypes.data_as(POINTER(c_double))
 
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     cf = w.phases[0].compiled
     mod = compiled_module(cf.structure)
     n, ng = w.layout().size, len(mod.GUARDS)
@@ -303,7 +303,7 @@ def test_loops_specialised_to_the_flow_give_the_cfunc_loops_numbers(scene):
     from walkerlab.walker.description import walker_data
 
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     w_hts = with_clearance_guard(w, walker_data(sc.walker, sc.slope.phi_rad))
     maps = [[BatchStepMap(wk, scene_walker_at(sc,
             plant=Plant.from_scene(sc)), 1e-9, 1e-9, specialised=s)

@@ -57,7 +57,7 @@ def test_the_law_block_evaluates_the_laws_as_torque_laws(name):
     """Plain Python (no numba): ``law_torque`` on the packed block against
     ``TorqueLaws.each``, its partial derivatives against the complex step through it."""
     sc = scene_from_dict(_scene(CASES[name]))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     laws = w.actuators.laws
     b = laws.packed()
     rng = np.random.default_rng(5)
@@ -93,7 +93,7 @@ def test_the_actuated_cfuncs_are_the_python_flow_and_jacobian(name):
     Jacobian; the guards' outputs are the Python guards'."""
     pytest.importorskip("numba")
     sc = scene_from_dict(_scene(CASES[name]))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     w.actuators.begin_step(0.1)
     for ph in w.phases:
         cf = ph.compiled
@@ -122,7 +122,7 @@ def test_steps_on_compiled_laws_agree_with_the_python_path(name):
     paths take different steps and locate the guards on different dense outputs)."""
     pytest.importorskip("numba")
     sc = scene_from_dict(_scene(CASES[name]))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert needs_python_path(w)  # the batched map would run the passive cfuncs
     runs = [simulate_steps(w, X0, 2, Solver("DOP853", 1e-11, 1e-11, None, b))
             for b in ("cyrk", "cyrk_compiled")]
@@ -142,7 +142,7 @@ def test_rabbit_runs_its_virtual_constraints_on_compiled_flows():
     from walkerlab.config import load_scene
 
     sc = load_scene("configs/rabbit.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     x0 = sc.fixedpoint.initial_guess.as_array(w.state_names())
     cf = w.phases[0].compiled
     mod = cf.module()

@@ -43,7 +43,7 @@ def _contact_walker(scene):
     """The scene's contact walker and its contact start state (the rigid initial guess's
     stance foot at its static penetration, at rest)."""
     plant = Plant.from_scene(scene)
-    xi = np.asarray(initial_guess(scene, build_walker(scene, plant)), float)
+    xi = np.asarray(initial_guess(scene, build_walker(plant)), float)
     cw, _ = contact_setup(scene, plant=plant).build(xi, 10)
     return cw, initial_state_from_ideal(cw, *xi)
 
@@ -405,8 +405,8 @@ def test_the_unstable_3d_wheel_capsizes_sideways_in_contact():
 
     scene = load_scene("configs/rimless_wheel_3d.yaml")
     plant = Plant.from_scene(scene)
-    x = np.asarray(initial_guess(scene, build_walker(scene, plant)), float)
-    names = build_walker(scene, plant).state_names()
+    x = np.asarray(initial_guess(scene, build_walker(plant)), float)
+    names = build_walker(plant).state_names()
     x[list(names).index("lean_rate")] += 0.05
     walker, res, *_ = contact_walk(setup_of(scene, plant=plant), x, 1.04)
     assert res.termination == "fall"
@@ -475,7 +475,7 @@ def _stride_map():
 
     scene = load_scene("configs/hip_width_stabilised.yaml")
     plant = Plant.from_scene(scene)
-    xi = np.asarray(initial_guess(scene, build_walker(scene, plant)), float)
+    xi = np.asarray(initial_guess(scene, build_walker(plant)), float)
     cw, _ = contact_setup(scene, plant=plant).build(xi, 10)
     return StepMap(cw, solver=COARSE_SOLVER), xi
 

@@ -245,7 +245,7 @@ def test_work_precision_contact_runner_reads_a_kneed_walkers_legs_by_name():
     from walkerlab.models.registry import build_walker
 
     scene = load_scene("configs/kneed.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     g = scene.fixedpoint.initial_guess.model_dump()
     guess = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
                       for n in walker.state_names()])

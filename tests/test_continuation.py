@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _walker(scene, path, p):
     sc = apply_point(scene.model_dump(mode="json"), [path], (p,))
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 def _kmap(walker, x, solver, k, tmax):
@@ -84,14 +84,16 @@ def _special(res, kind, period):
 @pytest.fixture(scope="module")
 def paper():
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    res, _ = run_continuation(scene, "slope.angle_deg", 3.8, 4.97, switch=1)
+    res, _ = run_continuation(scene, "slope.angle_deg", 3.8, 4.97, switch=1,
+                              plant=Plant.from_scene(scene))
     return scene, res
 
 
 @pytest.fixture(scope="module")
 def simplest():
     scene = load_scene(ROOT / "configs" / "simplest.yaml")
-    res, _ = run_continuation(scene, "slope.angle_rad", 0.012, 0.0179, switch=1)
+    res, _ = run_continuation(scene, "slope.angle_rad", 0.012, 0.0179, switch=1,
+                              plant=Plant.from_scene(scene))
     return scene, res
 
 
@@ -132,7 +134,8 @@ def test_branches_agree_with_independent_fixed_points():
     state equals an independent fixed-point solve (k-step map) at the same parameter to
     1e-9 (both solved to ~1e-12)."""
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    res, _ = run_continuation(scene, "slope.angle_deg", 4.0, 4.8, switch=1, ds_max=0.04)
+    res, _ = run_continuation(scene, "slope.angle_deg", 4.0, 4.8, switch=1, ds_max=0.04,
+                              plant=Plant.from_scene(scene))
     assert [b.period for b in res.branches] == [1, 2]
     for br in res.branches:
         # the period doubling a switched branch starts at is not an isolated fixed point of
@@ -157,7 +160,7 @@ def test_kneed_gait_ends_in_a_fold_where_a_scan_loses_it():
 
     scene = load_scene(ROOT / "configs" / "kneed.yaml")
     path = "walker.leg.bodies.thigh_mass.from_hip_m"
-    res, _ = run_continuation(scene, path, 0.255, 0.31)
+    res, _ = run_continuation(scene, path, 0.255, 0.31, plant=Plant.from_scene(scene))
     folds = _special(res, "fold", 1)
     assert len(folds) == 1
     f = folds[0]
@@ -181,7 +184,7 @@ def test_paper_rods_bifurcation_chain_keeps_the_stable_long_gait():
 
     scene = load_scene(ROOT / "configs" / "paper_rods.yaml")
     r = bifurcation_diagram(scene, np.arange(3.0, 7.01, 0.5), steady_state=False, workers=1,
-                            param="walker.leg.bodies.rod.mass_kg")
+                            param="walker.leg.bodies.rod.mass_kg", plant=Plant.from_scene(scene))
     assert abs(r.step_period_s[0] - 1.0223) < 1e-4
     assert abs(np.max(np.abs(r.multipliers[0])) - 0.778) < 1e-3
     assert np.all(np.max(np.abs(r.multipliers), axis=1) < 1)
@@ -223,7 +226,8 @@ def test_two_parameter_period_doubling_curve_matches_independent_onsets():
     (Goswami, Thuilot & Espiau 1998, Fig. 10: the period-doubling slope decreases with mu)."""
     scene = load_scene(ROOT / "configs" / "paper.yaml")
     _res, curves = run_continuation(scene, "slope.angle_deg", 4.2, 4.6, 0,
-                                    "walker.hip_mass_kg", (10.0, 20.0), n2=3)
+                                    "walker.hip_mass_kg", (10.0, 20.0), n2=3,
+                                    plant=Plant.from_scene(scene))
     (c,) = curves
     assert c.kind == "period_doubling" and list(c.p2) == [10.0, 15.0, 20.0]
     assert np.all(np.diff(c.p) < 0)
@@ -327,7 +331,7 @@ def test_stance_foot_normal_force_from_the_equations_of_motion():
     from walkerlab.analysis.continuation.validity import normal_force_ratio
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     s = Solver.from_settings(scene.solver)
     x0 = np.array([-0.3234, 0.2187, -0.3801, -1.0932])  # near the gait: any step will do
     segs = step_map(w, w.from_section(w.section(x0)), s, 1, segments=True)[3]
@@ -383,8 +387,8 @@ def test_a_homotopy_from_a_scene_with_the_same_numbers_says_so_without_an_empty_
     sc = load_scene(Path(__file__).resolve().parents[1] / "configs" / "paper.yaml")
     same = SimpleNamespace(reached=True, fields={}, specials=[], x=np.zeros(4),
                            branch=SimpleNamespace(points=[None] * 8))
-    monkeypatch.setattr(C, "homotopy_gait", lambda known, new: same)
-    _, note = C.homotopy_start(sc, sc)
+    monkeypatch.setattr(C, "homotopy_gait", lambda known, new, plant: same)
+    _, note = C.homotopy_start(sc, sc, plant=Plant.from_scene(sc))
     assert "over  (" not in note and "by homotopy over" not in note
     assert note == ("initial guess: the gait of scene paper, whose walker and slope have this "
                     "scene's numbers (nothing to carry by homotopy)")
@@ -509,9 +513,9 @@ def test_a_homotopy_turned_back_by_a_fold_says_how_far_it_got_not_only_where_it_
     fold = SimpleNamespace(kind="fold", p=0.2343, cause="")
     res = SimpleNamespace(reached=False, fields={"slope.angle_rad": 1}, specials=[fold],
                           x=np.zeros(4), branch=SimpleNamespace(points=pts))
-    monkeypatch.setattr(C, "homotopy_gait", lambda known, new: res)
+    monkeypatch.setattr(C, "homotopy_gait", lambda known, new, plant: res)
     with pytest.raises(ValueError) as exc:
-        C.homotopy_start(sc, sc)
+        C.homotopy_start(sc, sc, plant=Plant.from_scene(sc))
     msg = str(exc.value)
     assert "stopped at lambda = 0" not in msg
     assert "got as far as lambda = 0.2343, then turned back and ended at lambda = 0" in msg
@@ -534,7 +538,7 @@ def test_the_disc_wheels_critical_slope_is_a_branch_point_the_family_passes_thro
     (transcritical or pitchfork), no fold.  The kneed walker's fold, where the branch does
     turn back, stays a fold (test_kneed_gait_ends_in_a_fold_where_a_scan_loses_it)."""
     scene = load_scene(ROOT / "configs" / "rimless_wheel_3d_disc.yaml")
-    res, _ = run_continuation(scene, "slope.angle_rad", 0.18, 0.19)
+    res, _ = run_continuation(scene, "slope.angle_rad", 0.18, 0.19, plant=Plant.from_scene(scene))
     assert res.steps_per_map == 1  # the wheel's map is one step: multipliers per step
     assert [s.kind for s in res.specials] == ["branch_point"]
     bp = res.specials[0]
@@ -554,7 +558,7 @@ def test_the_disc_wheels_critical_slope_is_a_branch_point_the_family_passes_thro
     side = []
     for a in (0.18, 0.19):
         sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_rad"], (a,))
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         r = find_fixed_point(w, bp.x, s, fd_check=False)
         m = np.sort(np.abs(r.multipliers_variational))[::-1]
         side.append(m[0] if m[0] > 1 + 1e-6 else m[1])  # the largest besides the neutral 1

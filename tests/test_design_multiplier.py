@@ -9,6 +9,7 @@ import pytest
 
 import walkerlab as wl
 from walkerlab.config.loader import load_scene
+from walkerlab.walker.plant import Plant
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -37,7 +38,7 @@ def test_largest_multiplier_gradient_equals_central_differences_of_the_resolved_
     from walkerlab.optimal.design.gradients import _Gaits, multiplier_gradient
 
     scene, x = paper
-    gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75])
+    gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75], plant=Plant.from_scene(scene))
     value, grad = multiplier_gradient(gaits, [mass])
     assert value == pytest.approx(np.max(np.abs(np.linalg.eigvals(
         np.asarray(gaits.gait([mass])[1].jacobian_variational)))), rel=1e-12)
@@ -54,7 +55,7 @@ def test_design_solves_follow_the_scenes_gait_not_a_neighbouring_one(paper):
     from walkerlab.optimal.design.gradients import _Gaits
 
     scene, x = paper
-    gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75])
+    gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75], plant=Plant.from_scene(scene))
     assert gaits.value([15.0], "max_abs_multiplier") == pytest.approx(0.57545, abs=1e-4)
     assert gaits.count == 7  # ceil(5 / 0.75) sub-steps, each one fixed point
 
@@ -66,7 +67,8 @@ def test_hip_mass_minimising_the_largest_multiplier_is_interior_with_zero_gradie
     from walkerlab.optimal.design.search import design_optimize
 
     scene, x = paper
-    res = design_optimize(scene, {"walker.hip_mass_kg": (5.0, 40.0)}, "max_abs_multiplier", x)
+    res = design_optimize(scene, {"walker.hip_mass_kg": (5.0, 40.0)}, "max_abs_multiplier", x,
+                          plant=Plant.from_scene(scene))
     assert res.success, res.message
     assert res.values[0] == pytest.approx(20.64, abs=0.05)
     assert res.value == pytest.approx(0.57365, abs=2e-5) and res.value < 0.5858

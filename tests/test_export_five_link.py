@@ -216,8 +216,7 @@ def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / "rabbit.yaml")
-    x = scene.fixedpoint.initial_guess.as_array(build_walker(scene,
-            plant=Plant.from_scene(scene)).state_names())
+    x = scene.fixedpoint.initial_guess.as_array(build_walker(Plant.from_scene(scene)).state_names())
     monkeypatch.setattr("walkerlab.analysis.contact.periodic.ideal_gait",
                         _known_gait(x, 0.37093))
     path = export_stage.run(scene, tmp_path, "mjcf")

@@ -59,7 +59,7 @@ def from_ref(r):
 @pytest.fixture(scope="module")
 def walker():
     sc = scene_from_dict(SCENE)
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 def states(k=4, seed=3):
@@ -190,7 +190,7 @@ def test_the_five_link_step_map_on_lsoda_calls_no_python_flow_and_agrees_with_it
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / "rabbit.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     calls = []
 
     def counted(f):

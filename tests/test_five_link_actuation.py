@@ -37,7 +37,7 @@ def scene_with(torques, push_off=None):
 def constant_walker():
     sc = scene_with([{"joint": j, "law": {"constant_n_m": CONSTANT[j]}}
                                     for j in JOINTS])
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 def test_constant_torques_match_generalised_forces_of_joint_coordinates(constant_walker):
@@ -73,7 +73,7 @@ def test_pd_law_reads_the_joint_angle_and_the_virtual_stance_leg():
         "stiffness_n_m_per_rad": K, "damping_n_m_s_per_rad": D,
         "reference": {"phase_rad": phase, "angle_rad": [a + b * s for s in phase],
                       "interpolation": "linear"}}}])
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     for x in states():
         hip = w.points(x)["hip"]
         s = np.arctan(-hip[0] / hip[1])
@@ -95,7 +95,7 @@ def test_shared_spline_equals_each_laws_own():
         "reference": {"phase_rad": phase, "angle_rad": [np.sin(3 * s + i) for s in phase]}}}
         for i, j in enumerate(JOINTS)]
     sc = scene_with(torques)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     acts = w.actuators
     own = TorqueLaws(acts.spec.torques)
     for x in states():
@@ -115,7 +115,7 @@ def test_refusals_name_the_field(edit, message):
     edit(cfg["walker"])
     with pytest.raises(ValueError) as e:
         sc = scene_from_dict(cfg)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     assert message in str(e.value) and "\n" not in str(e.value)
 
 
@@ -126,7 +126,7 @@ def test_five_link_joint_on_a_straight_legged_walker_is_refused():
            "slope": {"angle_rad": 0.0}}
     with pytest.raises(ValueError, match=r"torques\.0\.joint: swing_knee"):
         sc = scene_from_dict(cfg)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
 
 
 def test_reference_tables_take_angle_rad_or_hip_angle_rad_once():
@@ -149,11 +149,11 @@ def test_push_off_matches_an_independent_impulse_and_is_the_heel_strike_at_zero(
     heel strike; the plastic heel strike after it loses kinetic energy."""
     impulse = 4.0
     sc = scene_with([], push_off={"impulse_n_s": impulse})
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     sc1 = scene_with([], push_off={"impulse_n_s": 0.0})
-    w0 = build_walker(sc1, plant=Plant.from_scene(sc1))
+    w0 = build_walker(Plant.from_scene(sc1))
     sc2 = scene_from_dict(SCENE)
-    passive = build_walker(sc2, plant=Plant.from_scene(sc2))
+    passive = build_walker(Plant.from_scene(sc2))
     for x in states():
         r, dr = to_ref(x)
         r_new, dr_new = ref.push_off_heel_strike(r, dr, P, impulse)

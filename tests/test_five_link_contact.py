@@ -237,8 +237,7 @@ def test_rabbit_walks_on_contact_at_its_rigid_step_period():
     from walkerlab.models.registry import build_walker
 
     sc = load_scene(ROOT / "configs" / "rabbit.yaml")
-    x = sc.fixedpoint.initial_guess.as_array(build_walker(sc,
-                                                          plant=Plant.from_scene(sc)).state_names())
+    x = sc.fixedpoint.initial_guess.as_array(build_walker(Plant.from_scene(sc)).state_names())
     walker, res, _x0, _sl = simulate_from(contact_setup(sc,
             plant=Plant.from_scene(sc)), x, RIGID_PERIOD_S, strides=5)
     assert res.outcome.kind == "heel_strike", res.message

@@ -316,11 +316,11 @@ def test_the_slow_map_reason_names_what_the_walker_has():
 
     root = Path(__file__).resolve().parents[1] / "configs"
     sc = load_scene(root / "hip_spring.yaml")
-    sprung = slow_step_reason(build_walker(sc, plant=Plant.from_scene(sc)))
+    sprung = slow_step_reason(build_walker(Plant.from_scene(sc)))
     sc1 = load_scene(root / "threelink_hzd.yaml")
-    hzd = slow_step_reason(build_walker(sc1, plant=Plant.from_scene(sc1)))
+    hzd = slow_step_reason(build_walker(Plant.from_scene(sc1)))
     sc2 = load_scene(root / "paper.yaml")
-    bare = slow_step_reason(build_walker(sc2, plant=Plant.from_scene(sc2)))
+    bare = slow_step_reason(build_walker(Plant.from_scene(sc2)))
     assert "spring" in sprung and "walker.springs" in sprung
     assert "virtual-constraint controller" in hzd and "spring" not in hzd
     assert "spring" not in bare and "controller" not in bare

@@ -39,7 +39,7 @@ def _scene(damping=None):
 @pytest.fixture(scope="module")
 def flat():
     sc = _scene()
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     traj = simulate_steps(w, X_STAR, 1, Solver.from_settings(sc.solver))
     return sc, w, functions(walker_data(sc.walker, sc.slope.angle_rad)), traj.segments[0], traj
 
@@ -183,7 +183,7 @@ def _actuated(torques, ankle_push_off=None):
     d["walker"]["actuation"] = {k: v for k, v in (("torques", torques),
                                                   ("ankle_push_off", ankle_push_off)) if v}
     sc = scene_from_dict(d, "flat_feet.yaml")
-    return build_walker(sc, plant=Plant.from_scene(sc)), Solver.from_settings(sc.solver)
+    return build_walker(Plant.from_scene(sc)), Solver.from_settings(sc.solver)
 
 
 @pytest.mark.parametrize("joint", ["hip", "stance_ankle"])

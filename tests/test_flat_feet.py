@@ -117,7 +117,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def walker(scene):
-    return build_walker(scene, plant=Plant.from_scene(scene))
+    return build_walker(Plant.from_scene(scene))
 
 
 @pytest.fixture(scope="module")
@@ -372,7 +372,7 @@ def test_a_heel_strike_before_heel_off_is_a_step_from_foot_flat(scene):
     heel-strike map (heel pinned), and the next step is the same."""
     data = _variant(scene, stiffness_n_m_per_rad=80.0)
     sc = scene_from_dict(data, "soft.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     guess = np.array([-0.213, 0.19, 0.0, -0.933, -0.849, -6.31])  # near its gait
     x = find_fixed_point(w, guess, FINE, xtol=1e-10, fd_check=False).x
     traj = simulate_steps(w, x, 2, FINE)
@@ -390,7 +390,7 @@ def test_a_contact_that_pulls_as_its_mode_begins_is_a_fall(scene, gait):
     (negative) normal force - no zero crossing to find - and the step is reported as
     ``stance_foot_lifts`` at its start, not walked through."""
     sc = scene_from_dict(_variant(scene, damping_n_m_s_per_rad=0.0), "c0.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     seg = integrate_step(w, gait.x, FINE)
     lifts = next(g for g in w.phases[0].guards if g.name == "stance_foot_lifts")
     assert lifts.function(0.0, gait.x) < 0
@@ -450,7 +450,7 @@ def test_legs_with_different_feet_walk_a_stride(scene):
     other["foot"]["toe_m"] = 0.11
     data["walker"]["leg"], data["walker"]["legs"] = None, [leg, other]
     sc = scene_from_dict(data, "legs.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert w.steps_per_map == 2
     assert (w.params["k_sw_ankle"], w.params["k_st_ankle"]) == (120.0, 130.0)
     assert (w.mirror.params["k_sw_ankle"], w.mirror.params["toe_st_m"]) == (130.0, 0.10)

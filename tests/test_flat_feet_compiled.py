@@ -30,7 +30,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def walker(scene):
-    return build_walker(scene, plant=Plant.from_scene(scene))
+    return build_walker(Plant.from_scene(scene))
 
 
 def _call(cfunc, x: np.ndarray, data: np.ndarray, m: int) -> np.ndarray:

@@ -128,7 +128,7 @@ def test_the_flat_footed_contact_run_starts_at_the_rigid_mid_stance():
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / "flat_feet.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     guess = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     fp = find_fixed_point(walker, guess, Solver.from_settings(scene.solver), fd_check=False)
     x = rigid_mid_stance(scene, fp.x, plant=Plant.from_scene(scene))

@@ -26,7 +26,7 @@ SOLVER = Solver("DOP853", 1e-12, 1e-12, None, "scipy")
 @pytest.fixture(scope="module")
 def flat():
     scene = load_scene("configs/flat_feet.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     return walker, make_step_map(walker, scene_walker_at(scene,
             plant=Plant.from_scene(scene)), 1e-10, 1e-10)
 

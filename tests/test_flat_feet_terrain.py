@@ -55,7 +55,7 @@ def _swing_heel_by_hand(x, pin: str, foot, gamma: float, length: float = 1.0):
 
 def _run(name: str, steps: int):
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     traj = simulate_steps(walker, x0, steps, Solver.from_settings(scene.solver))
     assert len(traj.segments) == steps
@@ -188,10 +188,10 @@ def test_an_actuated_flat_walker_keeps_its_landing_on_stairs():
     d = load_scene(ROOT / "configs" / "flat_feet_push_off.yaml").model_dump(
         mode="json", exclude_none=True)
     sc = scene_from_dict(d)
-    level = build_walker(sc, plant=Plant.from_scene(sc))
+    level = build_walker(Plant.from_scene(sc))
     d["terrain"] = {"kind": "stairs", "riser_m": 0.0075, "tread_m": 0.405}
     sc1 = scene_from_dict(d)
-    stairs = build_walker(sc1, plant=Plant.from_scene(sc1))
+    stairs = build_walker(Plant.from_scene(sc1))
     assert stairs.actuators is not None and stairs.params["landing_drop_m"] == 0.0075
     x = np.array([-0.2, 0.2, 0.0, -0.7, -0.7, -3.0])
 

@@ -50,7 +50,7 @@ def test_a_pushed_off_compass_walker_lands_each_step_at_its_footholds_height():
     from walkerlab.models.registry import build_walker
 
     scene = _powered_compass_on_footholds()
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     assert walker.cycle is not None and len(walker.cycle) == 2
     assert all(w.actuators is not None for w in walker.cycle)
     g = scene.fixedpoint.initial_guess

@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _search(name: str):
     scene = load_scene(ROOT / "configs" / name)
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     fp = scene.fixedpoint
     guess = fp.initial_guess.as_array(walker.state_names())
     return walker, find_gaits(walker, Solver.from_settings(scene.solver), guess,

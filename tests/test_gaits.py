@@ -49,6 +49,11 @@ HEAVY_HIP = {
 }
 
 
+def _plant(base: dict) -> Plant:
+    """The plant of a scene mapping (the study's, as its stage builds it)."""
+    return Plant.from_scene(scene_from_dict(base))
+
+
 def _without_guess(name: str):
     d = yaml.safe_load((ROOT / "configs" / f"{name}.yaml").read_text())
     d["name"] = name
@@ -57,7 +62,7 @@ def _without_guess(name: str):
 
 
 def _solve(scene):
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     fp = scene.fixedpoint
     guess = None if fp.initial_guess is None else fp.initial_guess.as_array(walker.state_names())
     return find_gaits(walker, Solver.from_settings(scene.solver), guess, policy=fp.gait,
@@ -84,7 +89,7 @@ def test_seed_states_put_both_feet_on_the_slope():
     """A seed is a state on the heel-strike surface, by leg angle whatever the coordinates:
     the slope-relative simplest walker's seed has its legs at the asked absolute angles."""
     sc = load_scene(ROOT / "configs" / "simplest.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     g = sc.slope.phi_rad
     x = state_from_legs(w, 0.2 - g, -0.2 - g, -0.2, -0.05)
     legs = w.leg_coordinates(x, w.legs[-1])
@@ -121,13 +126,14 @@ def test_sweep_point_chooses_the_gait_as_the_stage_does():
     """A sweep's first point (no neighbour yet) follows fixedpoint.gait like the stage: the
     heavy-hip walker's stable long-period gait, not the unstable one its guess reaches."""
     base = scene_from_dict(HEAVY_HIP).model_dump(mode="json")
-    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {})
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {},
+                      plant=_plant(base))
     # the stable gait is the partner of the one the guess reaches (deflation): "search"
     assert row["outcome"] == "ok" and row["guess_source"] == "search"
     assert row["stable"] == 1.0 and 0.93 < row["step_period_s"] < 0.95
-    row, _ = evaluate("fixedpoint", dict(base, fixedpoint={**base["fixedpoint"],
-                                                          "gait": "nearest_guess"}),
-                      ["slope.angle_deg"], (2.0,), 0, None, {})
+    nearest = dict(base, fixedpoint={**base["fixedpoint"], "gait": "nearest_guess"})
+    row, _ = evaluate("fixedpoint", nearest, ["slope.angle_deg"], (2.0,), 0, None, {},
+                      plant=_plant(nearest))
     assert row["stable"] == 0.0 and abs(row["max_abs_multiplier"] - 4.08) < 0.01
 
 
@@ -250,11 +256,13 @@ def test_sweep_over_a_body_mass_by_name(tmp_path):
     T = np.asarray(rows["step_period_s"])
     assert np.all(np.diff(T) > 1e-3), T
     row, _ = evaluate("fixedpoint", scene.model_dump(mode="json"),
-                      ["walker.leg.bodies.1.mass_kg"], (0.07,), 0, None, {})
+                      ["walker.leg.bodies.1.mass_kg"], (0.07,), 0, None, {},
+                      plant=Plant.from_scene(scene))
     assert row["outcome"] == "ok" and abs(row["step_period_s"] - T[-1]) < 1e-9
     # position along the leg, by name: the thigh mass lower -> longer swing, longer step
     lo, _ = evaluate("fixedpoint", scene.model_dump(mode="json"),
-                     ["walker.leg.bodies.thigh_mass.from_hip_m"], (0.35,), 0, None, {})
+                     ["walker.leg.bodies.thigh_mass.from_hip_m"], (0.35,), 0, None, {},
+                     plant=Plant.from_scene(scene))
     assert lo["outcome"] == "ok" and lo["step_period_s"] > T[1] + 1e-3
 
 
@@ -330,7 +338,7 @@ def test_a_failed_search_names_the_fallback_starts_it_tried_and_says_each_in_a_n
     d["slope"] = {"angle_rad": 0.0}
     del d["fixedpoint"]["initial_guess"]
     scene = scene_from_dict(d)
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     label = "the planar twin's gait carried in walker.hip_width_m"
     with progress.use(Notes()) as sink, pytest.raises(GaitNotFound) as exc:
         find_gaits(walker, Solver.from_settings(scene.solver), None, fd_check=False,

@@ -31,7 +31,7 @@ def _compass(push_off_n_s: float, slope: float = 0.0) -> dict:
 
 def _reaction(push_off_n_s: float, slope: float = 0.0):
     scene = scene_from_dict(_compass(push_off_n_s, slope))
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     return w, StanceReaction(w, walker_data(scene.walker, scene.slope.phi_rad))
 
 
@@ -285,7 +285,7 @@ def test_the_flat_foots_trailing_toe_leaves_the_cone_only_as_it_unloads():
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     guess = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     fp = find_fixed_point(walker, guess, Solver.from_settings(scene.solver), fd_check=False)
     seg = simulate_steps(walker, fp.x, 1, Solver.from_settings(scene.solver)).segments[0]
@@ -319,7 +319,7 @@ def _walker_3d(name: str):
 
     scene = load(f"configs/{name}.yaml")
     plant = Plant.from_scene(scene)
-    return build_walker(scene, plant=plant), plant.data, scene.walker.hip_width_m
+    return build_walker(plant), plant.data, scene.walker.hip_width_m
 
 
 @pytest.mark.parametrize("name", sorted(REFS_3D))
@@ -389,7 +389,7 @@ def test_a_3d_gaits_ground_impulse_over_its_period_is_its_weight_times_the_perio
 
     scene = load(f"configs/{name}.yaml")
     plant = Plant.from_scene(scene)
-    walker = build_walker(scene, plant=plant)
+    walker = build_walker(plant)
     res = find_fixed_point(walker, _guess(scene, walker.state_names()), SOLVER, fd_check=False)
     traj = simulate_steps(walker, res.x, walker.steps_per_map, SOLVER)
     reaction = {id(walker): StanceReaction(walker, plant.data)}
@@ -421,7 +421,7 @@ def test_a_round_footed_3d_walker_upright_has_the_planar_walkers_ground_reaction
 
     flat, solid = (load(f"configs/{n}.yaml") for n in ("round_feet", "round_feet_3d"))
     p_flat, p_solid = Plant.from_scene(flat), Plant.from_scene(solid)
-    w2, w3 = build_walker(flat, plant=p_flat), build_walker(solid, plant=p_solid)
+    w2, w3 = build_walker(p_flat), build_walker(p_solid)
     r2, r3 = StanceReaction(w2, p_flat.data), StanceReaction(w3, p_solid.data)
     rng = np.random.default_rng(11)
     for _ in range(4):

@@ -202,7 +202,7 @@ class Reference:
 
 def _walker_and_reference(law=None):
     scene = Scene.model_validate(_raw(law))
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     return scene, walker, reference_of(scene), scene.walker.hip_width_m
 
 

@@ -329,8 +329,8 @@ def test_every_shipped_initial_guess_is_within_the_walking_bound():
     for path in sorted((ROOT / "configs").glob("*.yaml")):
         scene = load_scene(path)
         if scene.fixedpoint is not None and scene.fixedpoint.initial_guess is not None:
-            assert initial_guess(scene, build_walker(scene,
-                    plant=Plant.from_scene(scene))) is not None, path.name
+            walker = build_walker(Plant.from_scene(scene))
+            assert initial_guess(scene, walker) is not None, path.name
             n += 1
     assert n >= 3
 

@@ -120,7 +120,7 @@ def test_hip_torque_on_arc_feet():
     read off the hip and the foot arcs' centres, its ledger closed over a step."""
     w = wl.Walker.from_scene(scene_from_dict(_scene("round_feet", ARC_TORQUE)))
     sc = load_scene(CONFIGS / "round_feet.yaml")
-    passive = build_walker(sc, plant=Plant.from_scene(sc))
+    passive = build_walker(Plant.from_scene(sc))
     gait = w.fixed_point()
     assert 0.5 < gait.step_period < 5.0
     np.testing.assert_allclose(w.model.reset(simulate_steps(
@@ -139,7 +139,7 @@ def test_stance_hip_pd_on_the_torso_walker():
     w = wl.Walker.from_scene(scene_from_dict(_scene(
         "torso_bhm", [{"joint": "stance_hip", "law": law}])))
     sc = load_scene(CONFIGS / "torso_bhm.yaml")
-    passive = build_walker(sc, plant=Plant.from_scene(sc))
+    passive = build_walker(Plant.from_scene(sc))
     assert w.model.actuators.links == [("torso", "stance")]
     np.testing.assert_array_equal(w.model.actuators.B[:, 0], [-0.5, 0.5])  # (swing, stance)
     gait = w.fixed_point()
@@ -158,7 +158,7 @@ def test_knee_torque_on_the_kneed_walker():
     w = wl.Walker.from_scene(scene_from_dict(_scene(
         "kneed", [{"joint": "swing_knee", "law": law}])))
     sc = load_scene(CONFIGS / "kneed.yaml")
-    passive = build_walker(sc, plant=Plant.from_scene(sc))
+    passive = build_walker(Plant.from_scene(sc))
     x = np.array([-0.2, -0.5, 0.2, -1.0, 0.5, -1.1])  # (swing thigh, swing shank, stance)
     Q = _check_force(w.model, passive, x)
     np.testing.assert_allclose(Q, [-w.model.actuators.torques(0, x)[0],
@@ -178,7 +178,7 @@ def test_stance_knee_torque_is_taken_by_the_lock():
     force and does no work (a zero row of ``B``)."""
     sc = scene_from_dict(_scene("kneed", [{"joint": "stance_knee",
                                           "law": {"constant_n_m": 1.0}}]))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert not w.actuators.B.any()
     x = np.array([-0.2, -0.5, 0.2, -1.0, 0.5, -1.1])
     assert w.actuators.power(0.0, x) == 0.0
@@ -191,7 +191,7 @@ def test_a_joint_the_walker_lacks_is_one_line():
                              ("torso_bhm", "swing_ankle", "hip, stance_hip, swing_hip")):
         with pytest.raises(ValueError) as e:
             sc = scene_from_dict(_scene(name, [{"joint": joint, "law": {}}]))
-            build_walker(sc, plant=Plant.from_scene(sc))
+            build_walker(Plant.from_scene(sc))
         assert str(e.value) == (f"walker.actuation.torques.0.joint: {joint} is not a joint "
                                 f"of this walker (its joints: {has})")
 
@@ -221,7 +221,7 @@ def test_hip_torque_on_flat_feet_with_legs_that_differ():
     d = _flat_unequal([])
     del d["walker"]["actuation"]
     sc = scene_from_dict(d)
-    passive = build_walker(sc, plant=Plant.from_scene(sc))
+    passive = build_walker(Plant.from_scene(sc))
     m = w.model
     assert m.mirror is not None and m.mirror.actuators is not m.actuators
     x = np.array([-0.2, 0.15, 0.05, -1.0, -0.9, 0.3])
@@ -243,9 +243,9 @@ def test_ankle_torque_on_flat_feet():
     torques = [{"joint": "stance_ankle", "law": {"constant_n_m": -2.0,
                                                  "stiffness_n_m_per_rad": 5.0}}]
     sc = scene_from_dict(_scene("flat_feet", torques))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     sc1 = load_scene(CONFIGS / "flat_feet.yaml")
-    passive = build_walker(sc1, plant=Plant.from_scene(sc1))
+    passive = build_walker(Plant.from_scene(sc1))
     x = np.array([-0.2, 0.15, 0.05, -1.0, -0.9, 0.3])
     M = mode_mass_matrix(w.actuators.fns["energies_heel"], x)
     Q = _check_force(w, passive, x, FLAT, mass_matrix=M)

@@ -123,7 +123,7 @@ def gaits():
     out = {}
     for name, x0 in guess.items():
         sc = _scene(name)
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         out[name] = (w, find_fixed_point(w, np.array(x0), SOLVER, fd_check=False))
     return out
 
@@ -154,7 +154,7 @@ def test_flows_and_impacts_match_the_kneed_prototype(variant):
     """Knee free, knee locked, knee strike, heel strike: ours = the prototype's at random
     states, for both steps of a stride (``walker.for_stance``)."""
     sc = _scene(variant)
-    w0 = build_walker(sc, plant=Plant.from_scene(sc))
+    w0 = build_walker(Plant.from_scene(sc))
     rng = np.random.default_rng(7)
     gamma = w0.slope_rad
     for stance in ("leg2", "leg1"):

@@ -68,9 +68,9 @@ def _to_ours(xr):
 
 def test_a_push_off_of_zero_is_the_passive_heel_strike():
     sc = scene_from_dict(_scene(None))
-    w0 = build_walker(sc, plant=Plant.from_scene(sc))
+    w0 = build_walker(Plant.from_scene(sc))
     sc1 = scene_from_dict(_scene({"impulse_n_s": 0.0}))
-    w = build_walker(sc1, plant=Plant.from_scene(sc1))
+    w = build_walker(Plant.from_scene(sc1))
     rng = np.random.default_rng(2)
     for _ in range(5):
         q = np.array([0.2, 0.2, -0.25]) + rng.normal(0, 0.02, 3)
@@ -83,7 +83,7 @@ def test_a_push_off_of_zero_is_the_passive_heel_strike():
 
 def test_the_pushed_heel_strike_is_the_independent_one():
     sc = scene_from_dict(_scene({"impulse_n_s": P}))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     ref = _PushedKneed(P=P)
     ref.p["gamma"] = GAMMA
     rng = np.random.default_rng(3)

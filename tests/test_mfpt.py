@@ -26,7 +26,7 @@ TIGHT = Solver("DOP853", 1e-12, 1e-12)
 
 @pytest.fixture(scope="module")
 def paper_map(paper_scene):
-    return BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+    return BatchStepMap(build_walker(plant := Plant.from_scene(paper_scene)),
                         scene_walker_at(paper_scene, plant), 1e-10, 1e-10)
 
 
@@ -71,7 +71,7 @@ def test_kneed_walker_two_phases_and_knee_strike(paper_scene):
     """The kneed walker (unlocked swing, knee strike reset, locked swing) through the batched
     map equals integrate_step on two slopes."""
     sc = load_scene(ROOT / "configs" / "kneed.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     from walkerlab.analysis.gait.poincare import find_fixed_point
 
     g = sc.fixedpoint.initial_guess.as_array(w.state_names())
@@ -328,7 +328,7 @@ def test_gait_sensitivity_norm_linear_equals_nonlinear(paper_scene, paper_fixed_
     (measured ~1e-6: central differences with steps 1e-6, impulse response O(e^2))."""
     from walkerlab.analysis.robustness import measures as R
 
-    sm = BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+    sm = BatchStepMap(build_walker(plant := Plant.from_scene(paper_scene)),
                         scene_walker_at(paper_scene, plant), 1e-12, 1e-12)
     lin = R.linearise(sm, paper_fixed_point.x, paper_fixed_point.jacobian_variational,
                       disturbance)
@@ -344,7 +344,7 @@ def test_state_norm_depends_on_coordinates_multipliers_do_not(paper_fixed_point,
     from walkerlab.analysis.robustness import measures as R
 
     A = paper_fixed_point.jacobian_variational
-    names = build_walker(paper_scene, plant=Plant.from_scene(paper_scene)).state_names()
+    names = build_walker(Plant.from_scene(paper_scene)).state_names()
     T = R.relative_coordinates(names)
     ev = np.sort(np.abs(np.linalg.eigvals(A)))
     evT = np.sort(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T))))
@@ -461,7 +461,7 @@ def hip_roll_walk():
     from walkerlab.integrate.python_step import make_step_map
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     g = scene.fixedpoint.initial_guess.model_extra
     x0 = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
                    for n in walker.state_names()])
@@ -513,7 +513,7 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
     """The 3D walker with hip width: its mirror is the reflection across the sagittal plane
     (lean and hip rolls negated, pitches kept); planar legs that differ have none."""
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     names = walker.state_names()
     assert set(walker.mirror_reflection) == {f"{r}_{k}" for r in ("lean", "pelvis_roll",
                                                                   "swing_roll")
@@ -523,7 +523,7 @@ def test_the_mirror_of_a_3d_step_is_its_reflection():
     for i, n in enumerate(names):
         assert s[i] == (-x[i] if ("lean" in n or "roll" in n) else x[i])
     sc = load_scene(ROOT / "configs" / "paper_3d.yaml")
-    assert build_walker(sc, plant=Plant.from_scene(sc)).mirror is None
+    assert build_walker(Plant.from_scene(sc)).mirror is None
 
 
 @pytest.mark.slow

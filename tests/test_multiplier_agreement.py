@@ -99,7 +99,7 @@ def test_target_and_fixedpoint_give_one_verdict():
 def test_a_disagreement_is_an_error():
     """A wrong reset Jacobian (as the massless-leg one was) stops the run with one line."""
     scene = load_scene(CONFIGS / "paper.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     right = w.reset_jacobian
     wrong = replace(w, reset_jacobian=lambda x: right(x) + 0.05)
     from walkerlab.integrate.solver import Solver
@@ -115,7 +115,7 @@ def test_convergence_is_judged_by_the_residual():
     """MINPACK's "not making good progress" at a residual 18x below the tolerance is a gait;
     a residual above it is not."""
     sc = load_scene(CONFIGS / "paper.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     x = np.array([-0.3238, 0.2187, -0.3777, -1.0924])
     stalled = SimpleNamespace(success=False, message="The iteration is not making good "
                                                      "progress")

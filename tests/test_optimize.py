@@ -16,6 +16,7 @@ from walkerlab.config import load_scene
 from walkerlab.optimal.transcription.mode_sequence import collocate_step
 from walkerlab.optimal.transcription.step import CollocationSpec, replay
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 pytest.importorskip("casadi")
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
@@ -115,7 +116,7 @@ def test_design_gradient_through_the_fixed_point_equals_central_differences():
     scene = load_scene(CONFIGS / "paper.yaml")
     g = wl.Walker.from_scene(scene).fixed_point()
     fields = ["walker.hip_mass_kg", "walker.leg_mass_kg"]
-    gaits = _Gaits(scene, fields, g.x)
+    gaits = _Gaits(scene, fields, g.x, plant=Plant.from_scene(scene))
     p = np.array([10.0, 5.0])
     for name in ("step_period", "speed"):
         _, grad = measure_gradient(gaits, p, name)
@@ -139,7 +140,8 @@ def test_design_gradient_of_step_length_and_cost_of_transport():
             ("cost_of_transport", "powered_compass", "walker.actuation.push_off.impulse_n_s",
              3.0)):
         scene = load_scene(CONFIGS / f"{scene_name}.yaml")
-        gaits = _Gaits(scene, [field], wl.Walker.from_scene(scene).fixed_point().x)
+        gaits = _Gaits(scene, [field], wl.Walker.from_scene(scene).fixed_point().x,
+                       plant=Plant.from_scene(scene))
         _, grad = measure_gradient(gaits, [p], name)
         fd = (measure_gradient(gaits, [p + 1e-3], name)[0]
               - measure_gradient(gaits, [p - 1e-3], name)[0]) / 2e-3
@@ -156,7 +158,7 @@ def test_design_optimisation_follows_the_gait_to_a_bounded_optimum():
     scene = load_scene(CONFIGS / "paper.yaml")
     g = wl.Walker.from_scene(scene).fixed_point()
     res = design_optimize(scene, {"walker.hip_mass_kg": (5.0, 20.0)}, "speed", g.x,
-                          maximize=True, max_evaluations=20)
+                          maximize=True, max_evaluations=20, plant=Plant.from_scene(scene))
     start = [v for p, v in res.history if abs(p[0] - 10.0) < 1e-12][0]
     assert res.value >= start - 1e-12
     m = res.values[0]
@@ -219,10 +221,11 @@ def test_design_from_a_zero_stiffness_bound_stays_inside_the_bounds():
     scene = load_scene(CONFIGS / "hip_spring.yaml")
     field = "walker.springs.0.stiffness_n_m_per_rad"
     x = wl.Walker.from_scene(scene).fixed_point().x
-    res = design_optimize(scene, {field: (0.0, 30.0)}, "speed", x, max_evaluations=10)
+    res = design_optimize(scene, {field: (0.0, 30.0)}, "speed", x, max_evaluations=10,
+                          plant=Plant.from_scene(scene))
     assert all(p[0] >= 0.0 for p, _ in res.history)
     assert res.values[0] == pytest.approx(0.0, abs=1e-9) and res.gradient[0] > 0
-    gaits = _Gaits(scene, [field], x, bounds=([0.0], [30.0]))
+    gaits = _Gaits(scene, [field], x, bounds=([0.0], [30.0]), plant=Plant.from_scene(scene))
     v0, g0 = measure_gradient(gaits, [0.0], "speed")
     fd = (measure_gradient(gaits, [1e-3], "speed")[0] - v0) / 1e-3
     assert g0[0] == pytest.approx(fd, rel=1e-3)
@@ -251,7 +254,7 @@ def test_design_on_robustness_measures(robust_paper, objective, maximize):
 
     scene, x = robust_paper
     res = design_optimize(scene, {"walker.hip_mass_kg": (8.0, 12.0)}, objective, x,
-                          maximize=maximize, max_evaluations=4)
+                          maximize=maximize, max_evaluations=4, plant=Plant.from_scene(scene))
     start = [v for p, v in res.history if abs(p[0] - 10.0) < 1e-12][0]
     assert (res.value >= start - 1e-12) if maximize else (res.value <= start + 1e-12)
     assert np.isfinite(res.gradient[0]) == (objective == "gait_sensitivity_norm")
@@ -265,7 +268,7 @@ def test_gait_sensitivity_norm_gradient_converges(robust_paper):
     from walkerlab.optimal.design.gradients import _Gaits
 
     scene, x = robust_paper
-    gaits = _Gaits(scene, ["walker.hip_mass_kg"], x)
+    gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, plant=Plant.from_scene(scene))
     v1, g1 = gaits.differenced([10.0], "gait_sensitivity_norm", h_rel=1e-4)
     v2, g2 = gaits.differenced([10.0], "gait_sensitivity_norm", h_rel=1e-3)
     assert v1 == pytest.approx(v2, rel=1e-9)

@@ -44,9 +44,8 @@ def test_least_effort_gait_is_drakes_compass_gait_limit_cycle():
     w = wl.Walker.from_scene(scene)
     g = w.fixed_point()
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    t, x = simulated_step(build_walker(scene,
-            plant=Plant.from_scene(scene)), g.x, g.step_period, Solver("DOP853", 1e-12,
-                                                                          1e-12))
+    t, x = simulated_step(build_walker(Plant.from_scene(scene)), g.x, g.step_period,
+                          Solver("DOP853", 1e-12, 1e-12))
     res = collocate_step(data, symbolic.derive(data.structure), CollocationSpec(intervals=60),
                          t, x)
     assert res.status == "Solve_Succeeded" and res.objective <= 1e-10

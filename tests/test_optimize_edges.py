@@ -91,7 +91,7 @@ def test_the_contact_replay_runs_the_scenes_contact_solver_it_advises_changing(m
     d["contact_solver"] = {"method": "Radau", "rtol": 1e-7, "atol": 1e-9}
     scene = type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
     res = SimpleNamespace(push_off_n_s=0.0, x=np.zeros((1, 4)), step_period_s=0.7)
-    period, outcome = contact_replay.contact_replay(scene, res)
+    period, outcome = contact_replay.contact_replay(scene, res, plant=Plant.from_scene(scene))
     assert np.isnan(period) and used[-1].method == "Radau" and used[-1].rtol == 1e-7
     assert "solver (Radau, rtol 1e-07) failed" in outcome
     assert outcome.endswith("set another contact_solver (method, rtol) in the scene: the "
@@ -277,7 +277,7 @@ def test_a_level_ground_optimal_gait_starts_from_its_targets():
     scene = _level_compass(push_off="free", target_speed_m_per_s=0.6,
                            target_step_length_m=0.5)
     assert pipeline.order("optimize", scene) == ["optimize"]  # no gait to find first
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     t, x, u, p = starting_step(scene, walker, None, None)
     assert u is None and p > 0 and t[-1] == pytest.approx(0.5 / 0.6, rel=1e-12)
     data = walker_data(scene.walker, 0.0)

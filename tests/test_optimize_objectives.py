@@ -40,7 +40,7 @@ class _Case:
         from walkerlab.io.schemas.continuation import initial_state
 
         self.scene = load_scene(CONFIGS / f"{name}.yaml")
-        walker = build_walker(self.scene, plant=Plant.from_scene(self.scene))
+        walker = build_walker(Plant.from_scene(self.scene))
         guess = self.scene.fixedpoint.initial_guess
         self.x0 = (initial_state(guess, walker.state_names()) if guess is not None
                    else wl.Walker.from_scene(self.scene).fixed_point().x)
@@ -159,8 +159,7 @@ def test_cost_of_transport_alone_on_a_slope_is_a_passive_gait(compass):
     assert res.status == "Solve_Succeeded" and res.iterations < 100
     assert 0.0 <= res.terms["cost_of_transport"] <= 1e-10 and res.objective <= 1e-10
     assert np.max(np.abs(res.u)) < 1e-2
-    passive = find_fixed_point(build_walker(case.scene,
-                                            plant=Plant.from_scene(case.scene)), res.x[0],
+    passive = find_fixed_point(build_walker(Plant.from_scene(case.scene)), res.x[0],
                                Solver("DOP853", 1e-12, 1e-12))
     assert res.step_period_s == pytest.approx(passive.period_s, abs=1e-3)
 
@@ -232,7 +231,7 @@ def test_a_guess_from_another_optimisation(kuo, tmp_path):
     from walkerlab.optimal.guess import starting_step
 
     case, res = kuo
-    names = list(build_walker(case.scene, plant=Plant.from_scene(case.scene)).state_names())
+    names = list(build_walker(Plant.from_scene(case.scene)).state_names())
     d = schema.OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
                             res.step_period_s, res.step_length_m, res.push_off_n_s,
                             res.objective, 0.0, np.zeros(4, complex), True, res.status,
@@ -242,8 +241,7 @@ def test_a_guess_from_another_optimisation(kuo, tmp_path):
     dd = case.scene.model_dump(mode="json", exclude_none=True)
     dd["optimize"]["initial_guess"] = {"from": str(path)}
     scene = load_scene(CONFIGS / "kuo2002.yaml").model_validate(dd)
-    t, x, u, p = starting_step(scene, build_walker(scene,
-            plant=Plant.from_scene(scene)), case.x0, case.period)
+    t, x, u, p = starting_step(scene, build_walker(Plant.from_scene(scene)), case.x0, case.period)
     np.testing.assert_array_equal(x, res.x)
     again = collocate_step(case.data, case.eq, replace(collocation_spec(scene),
                                                        push_off_n_s=p), t, x, u, case.fns)
@@ -278,7 +276,7 @@ def test_bad_optimize_sections_say_which_field(tmp_path):
         d = {**base, "optimize": {**base["optimize"], "initial_guess": {"from": str(path)}}}
         sc = type(scene).model_validate(d)
         with pytest.raises(ValueError, match="optimize.initial_guess: .*" + msg):
-            starting_step(sc, build_walker(sc, plant=Plant.from_scene(sc)), np.zeros(4), 0.7)
+            starting_step(sc, build_walker(Plant.from_scene(sc)), np.zeros(4), 0.7)
 
 
 def test_a_guess_from_a_continuation_branch(compass, tmp_path):
@@ -292,7 +290,7 @@ def test_a_guess_from_a_continuation_branch(compass, tmp_path):
     from walkerlab.optimal.guess import starting_step
 
     case, passive = compass
-    names = list(build_walker(case.scene, plant=Plant.from_scene(case.scene)).state_names())
+    names = list(build_walker(Plant.from_scene(case.scene)).state_names())
     slopes = [0.05, 0.055]
     gaits = [wl.Walker.from_scene(case.scene).with_changes({"slope.angle_rad": s}
                                                            ).fixed_point() for s in slopes]
@@ -326,8 +324,7 @@ def test_a_guess_from_a_continuation_branch(compass, tmp_path):
     d = case.scene.model_dump(mode="json", exclude_none=True)
     d["optimize"]["initial_guess"] = {"from": str(path), "at": 0.0525}
     scene = type(case.scene).model_validate(d)
-    t, x, u, p = starting_step(scene, build_walker(scene,
-            plant=Plant.from_scene(scene)), np.zeros(4), 0.73)
+    t, x, u, p = starting_step(scene, build_walker(Plant.from_scene(scene)), np.zeros(4), 0.73)
     np.testing.assert_allclose(x[0], X.mean(axis=0), rtol=0, atol=1e-14)
     assert u is None and p is None
     res = collocate_step(case.data, case.eq, CollocationSpec(intervals=40), t, x, fns=case.fns)

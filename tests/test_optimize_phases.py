@@ -131,7 +131,7 @@ def test_a_mode_graph_without_a_fixed_sequence_is_refused_in_one_line():
 
     with pytest.raises(ValueError, match="no fixed phase sequence"):
         sc = load_scene(CONFIGS / "flat_feet.yaml")
-        phase_order(build_walker(sc, plant=Plant.from_scene(sc)))
+        phase_order(build_walker(Plant.from_scene(sc)))
 
 
 #: the flat-footed passive gait's phases (configs/flat_feet.yaml's note): the sequence
@@ -386,7 +386,8 @@ def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
     assert res.step_length_m / res.step_period_s == pytest.approx(0.8, rel=1e-9)
     assert 0.1 < np.max(np.abs(res.u)) < 10.0
     assert err <= 1e-6
-    period, outcome = contact_replay_phased(flat[0], res, strides=1)
+    period, outcome = contact_replay_phased(flat[0], res, strides=1,
+                                            plant=Plant.from_scene(flat[0]))
     assert outcome == "heel_strike"
     g = start[0]
     rigid_change = res.step_period_s / g.step_period - 1.0

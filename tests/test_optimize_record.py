@@ -51,9 +51,9 @@ def test_energy_change_over_the_step_equals_the_hip_torques_work(powered):
     O(h^4)): equal to 1e-6 of the work (measured 2.6e-7 at 40 intervals), and the work (0.209
     J) is not small."""
     scene, res = powered
-    rec = history_and_energies(scene, build_walker(scene, plant=Plant.from_scene(scene)), res)
+    rec = history_and_energies(scene, build_walker(Plant.from_scene(scene)), res)
     e = rec["energy"]["kinetic"] + rec["energy"]["potential"]
-    names = build_walker(scene, plant=Plant.from_scene(scene)).state_names()
+    names = build_walker(Plant.from_scene(scene)).state_names()
     rate = {n: res.x[:, k] for k, n in enumerate(names)}
     power = res.u * (rate["swing_rate"] - rate["stance_rate"])
     h = res.t[2] - res.t[0]
@@ -70,7 +70,7 @@ def test_ipopt_history_is_recorded_and_the_artifact_reads_it_back(powered, tmp_p
     from walkerlab.io.schemas import optimize as schema
 
     scene, res = powered
-    rec = history_and_energies(scene, build_walker(scene, plant=Plant.from_scene(scene)), res)
+    rec = history_and_energies(scene, build_walker(Plant.from_scene(scene)), res)
     h = rec["ipopt_history"]
     assert len(h["objective"]) == res.iterations + 1
     assert h["primal_infeasibility"][-1] <= 1e-10 < h["dual_infeasibility"].max()

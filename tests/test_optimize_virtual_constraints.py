@@ -49,7 +49,7 @@ def test_collocation_delta2_is_the_restricted_maps(cfg):
     from walkerlab.walker.description import walker_data
 
     sc = scene_from_dict(copy.deepcopy(cfg))
-    ctrl = build_walker(sc, plant=Plant.from_scene(sc)).actuators.controller
+    ctrl = build_walker(Plant.from_scene(sc)).actuators.controller
     fns = hzd_functions(walker_data(sc.walker, sc.slope.phi_rad),
                         sc.walker.actuation.virtual_constraints)
     d = ctrl.design
@@ -197,7 +197,7 @@ def test_collocated_delta2_is_the_written_controllers_restricted_map(designed):
 
     c = d.controllers[0]
     sc = load_scene(folder / c.scene_file)
-    zd = zero_dynamics(build_walker(sc, plant=Plant.from_scene(sc)).actuators.controller)
+    zd = zero_dynamics(build_walker(Plant.from_scene(sc)).actuators.controller)
     assert abs(zd.delta2 - c.delta2) < 1e-8
     assert zd.exists
     np.testing.assert_allclose(
@@ -240,13 +240,13 @@ def test_written_scene_holds_the_coefficients_in_force(designed):
     c = d.controllers[0]
     sc = load_scene(folder / c.scene_file)
     written = np.array([o.bezier_rad for o in sc.walker.actuation.virtual_constraints.outputs])
-    ctrl = build_walker(sc, plant=Plant.from_scene(sc)).actuators.controller
+    ctrl = build_walker(Plant.from_scene(sc)).actuators.controller
     assert np.array_equal(ctrl.design.alpha, written)
     assert np.array_equal(np.asarray(c.bezier_rad), written)
     cfg = yaml.safe_load((folder / c.scene_file).read_text())
     cfg["walker"]["actuation"]["virtual_constraints"]["invariant"] = False
     sc1 = scene_from_dict(cfg)
-    as_written = build_walker(sc1, plant=Plant.from_scene(sc1)).actuators.controller
+    as_written = build_walker(Plant.from_scene(sc1)).actuators.controller
     assert as_written.design.residual_position < 1e-12
     assert as_written.design.residual_rate < 1e-9
     assert abs(zero_dynamics(as_written).step_period_s

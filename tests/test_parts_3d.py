@@ -49,7 +49,7 @@ def _in_3d(raw: dict, width: float) -> Scene:
 
 
 def _walker(scene: Scene):
-    return build_walker(scene, plant=Plant.from_scene(scene))
+    return build_walker(Plant.from_scene(scene))
 
 
 def _guess(scene: Scene, names) -> np.ndarray:

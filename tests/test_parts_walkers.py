@@ -36,7 +36,7 @@ SHIPPED = {"asymmetric_legs": (1.3928103873, 0.3531098),  # a stride: 0.67839 + 
 
 def _walker(name):
     sc = load_scene(f"configs/{name}.yaml")
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 def _with(walker_extra: dict, base="torso_bhm"):
@@ -84,7 +84,7 @@ def test_off_axis_rigid_upper_body_matches_the_reference():
                                 "off_axis_m": 0.03}]}
     sc = _with({"leg": None, "legs": [leg, heavy],
                             "torso": {"bodies": [body]}})
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     ref = PartsReference(Parts(legs={"A": (5.0, 0.5), "B": (6.0, 0.4, 0.03)},
                                torso=(4.0, 0.3, 0.05, 0.2)))
     rng = np.random.default_rng(3)
@@ -123,10 +123,10 @@ def test_legs_that_differ_make_a_stride_map_and_others_one_step():
     # a rest angle breaks the mirror symmetry of equal legs; a torso-to-leg spring too
     spring = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 5.0, "rest_angle_rad": 0.1}
     sc = _with({"springs": [spring]})
-    assert build_walker(sc, plant=Plant.from_scene(sc)).steps_per_map == 2
+    assert build_walker(Plant.from_scene(sc)).steps_per_map == 2
     spring = {"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 5.0}
     sc1 = _with({"springs": [spring]})
-    assert build_walker(sc1, plant=Plant.from_scene(sc1)).steps_per_map == 2
+    assert build_walker(Plant.from_scene(sc1)).steps_per_map == 2
 
 
 def test_leg_shorthand_expands_to_the_same_walker_as_an_equal_pair():
@@ -186,7 +186,7 @@ def test_damper_dissipates_exactly_c_times_relative_rate_squared():
     spring = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 20.0,
               "damping_n_m_s_per_rad": 0.5}
     sc = _with({"springs": [spring]}, base="hip_spring")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     x0 = np.array([-0.18, 0.15, -0.7, -0.9])
     seg = integrate_step(w, x0, SOLVER)
     t = np.linspace(seg.t_start, seg.t_end, 4001)

@@ -48,7 +48,7 @@ LAW = {"constant_n_m": 1.5, "stiffness_n_m_per_rad": 20.0, "damping_n_m_s_per_ra
 def test_actuated_flow_equals_the_independent_derivation(slope):
     sc = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": LAW,
                                                 "max_torque_n_m": 2.0}]}, slope))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     law = ref.spring_torque(1.5, 20.0, 0.5, 0.1, tau_max=2.0)
     rng = np.random.default_rng(1)
     for _ in range(20):
@@ -67,7 +67,7 @@ def test_actuated_flow_equals_the_independent_derivation(slope):
 @pytest.mark.parametrize("P", [0.0, 1.0, 3.0])
 def test_push_off_and_heel_strike_equal_the_independent_derivation(P):
     sc = scene_from_dict(_compass({"push_off": {"impulse_n_s": P}}))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     for xm in ([-0.17, 0.17, -0.77, -0.87], [-0.2, 0.2, -0.5, -0.9], [-0.1, 0.1, -0.9, -0.6]):
         xm = np.array(xm)
         want, info = ref.push_off_heel_strike(xm, ref.PAPER, 0.0, P)
@@ -79,7 +79,7 @@ def test_push_off_and_heel_strike_equal_the_independent_derivation(P):
                                                                  abs=1e-12)
     if P == 0.0:  # the push-off form with P = 0 is the generated passive impact
         sc = load_scene(CONFIGS / "paper.yaml")
-        passive = build_walker(sc, plant=Plant.from_scene(sc))
+        passive = build_walker(Plant.from_scene(sc))
         xm = np.array([-0.2, 0.1652, -0.6, -0.85])
         np.testing.assert_allclose(w.reset(xm), passive.reset(xm), rtol=0, atol=1e-13)
 
@@ -141,7 +141,7 @@ def test_kuo_hip_torque_is_the_swing_equation_term(kuo):
     (Kuo 2002: phi'' = ... - k phi), nothing to the stance leg's (the hip mass's)."""
     sc = load_scene(CONFIGS / "simplest.yaml").model_copy(
         update={"slope": load_scene(CONFIGS / "kuo2002.yaml").slope})
-    passive = build_walker(sc, plant=Plant.from_scene(sc))
+    passive = build_walker(Plant.from_scene(sc))
     x = np.array([0.1, 0.3, -0.2, 0.05])
     d = kuo.model.phases[0].flow(0, x) - passive.phases[0].flow(0, x)
     # coordinates (theta, phi = theta - psi_sw): theta'' unchanged, phi'' gains -k phi
@@ -250,7 +250,7 @@ def test_a_passive_scene_is_serialised_as_before():
     for name in PASSIVE:
         assert '"actuation"' not in load_scene(CONFIGS / f"{name}.yaml").model_dump_json()
         sc = load_scene(CONFIGS / f"{name}.yaml")
-        assert build_walker(sc, plant=Plant.from_scene(sc)).actuators is None
+        assert build_walker(Plant.from_scene(sc)).actuators is None
 
 
 @pytest.mark.parametrize("bad, msg", [
@@ -270,12 +270,12 @@ def test_actuators_the_walker_cannot_carry_are_refused():
     kneed["walker"]["actuation"] = {"push_off": {"impulse_n_s": 1.0}}
     # a kneed walker takes a push-off now (tests/test_kneed_push_off.py)
     sc1 = scene_from_dict(kneed)
-    assert build_walker(sc1, plant=Plant.from_scene(sc1)).actuators is not None
+    assert build_walker(Plant.from_scene(sc1)).actuators is not None
     simplest = load_scene(CONFIGS / "simplest.yaml").model_dump(mode="json", exclude_none=True)
     simplest["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
     with pytest.raises(ValueError, match="scaled_by: foot_mass"):
         sc = scene_from_dict(simplest)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
 
 
 def test_the_ledger_names_the_dampers_work():
@@ -385,7 +385,7 @@ def test_a_push_off_law_of_the_pre_impact_speed():
     hip speed from the compass gait's own kinematics, hip = foot + L (-sin th2, cos th2)."""
     law = {"impulse_n_s": 3.0, "speed_gain_n_s2_per_m": 10.0, "reference_speed_m_per_s": 0.5}
     sc1 = scene_from_dict(_compass({"push_off": law}))
-    w = build_walker(sc1, plant=Plant.from_scene(sc1))
+    w = build_walker(Plant.from_scene(sc1))
     for xm in ([-0.17, 0.17, -0.77, -0.87], [-0.2, 0.2, -0.5, -0.6], [-0.1, 0.1, -2.0, -2.0]):
         xm = np.array(xm)
         v = abs(xm[3]) * 1.0  # |d hip / dt| = L |dtheta2|
@@ -421,7 +421,7 @@ def test_pd_tracking_of_a_phase_reference(interpolation):
            "reference": {"phase_rad": phase, "hip_angle_rad": hip,
                          "interpolation": interpolation}}
     sc = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": law}]}))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     if interpolation == "linear":
         def h(s):
             return np.interp(s, phase, hip)
@@ -463,7 +463,7 @@ def test_pd_tracking_of_a_time_table_counts_from_each_step(interpolation):
     sc = _compass({"push_off": {"impulse_n_s": 3.0},
                    "torques": [{"joint": "hip", "law": law}]})
     sc1 = scene_from_dict(sc)
-    w = build_walker(sc1, plant=Plant.from_scene(sc1))
+    w = build_walker(Plant.from_scene(sc1))
     if interpolation == "linear":
         slopes = np.diff(hip) / np.diff(times)
 
@@ -505,12 +505,12 @@ def test_ankle_push_off_on_flat_feet_is_the_released_spring_in_heel_off():
 
     d = load_scene(CONFIGS / "flat_feet.yaml").model_dump(mode="json", exclude_none=True)
     sc = scene_from_dict(d)
-    passive = build_walker(sc, plant=Plant.from_scene(sc))
+    passive = build_walker(Plant.from_scene(sc))
     d["walker"]["actuation"] = {"ankle_push_off": {"stiffness_n_m_per_rad": 40.0,
                                                    "rest_angle_rad": -0.2,
                                                    "constant_n_m": 7.0}}
     sc1 = scene_from_dict(d)
-    powered = build_walker(sc1, plant=Plant.from_scene(sc1))
+    powered = build_walker(Plant.from_scene(sc1))
     x = np.array([-0.3, 0.2, 0.05, -1.2, -1.1, -3.0])
     a = x[2]
     for ph0, ph1 in zip(passive.phases, powered.phases):
@@ -524,7 +524,7 @@ def test_ankle_push_off_on_flat_feet_is_the_released_spring_in_heel_off():
         d2 = dict(d, walker=dict(d["walker"], actuation={"ankle_push_off": {
             "constant_n_m": -1.0}}))
         sc = scene_from_dict(d2)
-        unit = np.asarray(build_walker(sc, plant=Plant.from_scene(sc)).phases[
+        unit = np.asarray(build_walker(Plant.from_scene(sc)).phases[
             [p.name for p in powered.phases].index(ph1.name)].flow(0.0, x)) - f0
         np.testing.assert_allclose(f1 - f0, tau * unit, rtol=1e-10, atol=1e-10)
     w = wl.Walker.from_scene(CONFIGS / "flat_feet_push_off.yaml")
@@ -547,13 +547,13 @@ def test_linear_hip_torques_run_on_the_compiled_flows():
     from walkerlab.models.hybrid.actuated import Actuators
 
     sc = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": LAW}]}))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert all(ph.compiled is not None for ph in w.phases)
     acts = w.actuators
     assert isinstance(acts, Actuators)
     rng = np.random.default_rng(7)
     sc1 = scene_from_dict(_compass({"push_off": {"impulse_n_s": 0.0}}))
-    passive = build_walker(sc1, plant=Plant.from_scene(sc1))
+    passive = build_walker(Plant.from_scene(sc1))
     for _ in range(5):
         x = rng.normal(0, 0.3, 4)
         expect = np.asarray(passive.phases[0].flow(0.0, x), float)
@@ -565,7 +565,7 @@ def test_linear_hip_torques_run_on_the_compiled_flows():
     # a phase-reference law: the Python flow, and compiled flows that evaluate the law
     # (tests/test_compiled_laws.py)
     assert all(ph.compiled is not None and not ph.compiled.batchable
-               for ph in build_walker(sc2, plant=Plant.from_scene(sc2)).phases)
+               for ph in build_walker(Plant.from_scene(sc2)).phases)
 
 
 def test_the_flat_footed_ankle_push_off_walks_on_level_ground():

@@ -33,6 +33,7 @@ from walkerlab.io import runpaths
 from walkerlab.io.artifacts import ArtifactError, atomic_write, write_artifact
 from walkerlab.io.runpaths import RunPathError, artifact_lock
 from walkerlab.stages import common
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
@@ -329,7 +330,7 @@ def test_writers_refuse_a_symlink_in_place(tmp_path, name):
 
             monkey_fp = np.zeros(4)
             basin.compute_basin(sc, monkey_fp, "k", link.with_name("basin.h5"), grid=(2, 2),
-                                workers=1)
+                                workers=1, plant=Plant.from_scene(sc))
         elif name.endswith(".h5"):
             write_artifact(link, "fixedpoint", sc, "k", lambda f: None, 0.0)
         else:

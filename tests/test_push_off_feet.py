@@ -50,10 +50,10 @@ def test_a_push_off_of_zero_is_the_generated_heel_strike(scene):
     contact point pinned) is the generated passive heel strike, to round-off."""
     d = _kneed_arc() if scene == "kneed_arc" else _scene(scene, None)
     sc = scene_from_dict(d)
-    w0 = build_walker(sc, plant=Plant.from_scene(sc))
+    w0 = build_walker(Plant.from_scene(sc))
     d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.0}}
     sc1 = scene_from_dict(d)
-    w = build_walker(sc1, plant=Plant.from_scene(sc1))
+    w = build_walker(Plant.from_scene(sc1))
     n = len(w.roles)
     rng = np.random.default_rng(4)
     for _ in range(4):
@@ -67,7 +67,7 @@ def test_the_arc_foot_push_off_is_the_independent_one():
     """The pushed transition (impulse at the rolling contact, towards the hip) equals the
     prototype's, and its complex-step Jacobian the central differences."""
     sc = scene_from_dict(_scene("round_feet", {"impulse_n_s": P}, GAMMA))
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     ref = PushedRoundFeet(P=P)
     ref.p["gamma"] = GAMMA
     rng = np.random.default_rng(5)
@@ -123,10 +123,10 @@ def test_a_toe_push_off_of_zero_is_the_generated_heel_strike():
     heel strike (heel- or toe-pinned kinematics) to round-off."""
     d = _scene("flat_feet", None)
     sc = scene_from_dict(d)
-    w0 = build_walker(sc, plant=Plant.from_scene(sc))
+    w0 = build_walker(Plant.from_scene(sc))
     d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.0}}
     sc1 = scene_from_dict(d)
-    w = build_walker(sc1, plant=Plant.from_scene(sc1))
+    w = build_walker(Plant.from_scene(sc1))
     rng = np.random.default_rng(6)
     gamma = float(w.slope_rad)
     for ph0, ph in zip(w0.phases, w.phases):
@@ -154,7 +154,7 @@ def test_the_toe_push_off_is_the_independent_one_and_balances_momentum():
     Pf = 3.0  # N s: the walker weighs ~ 8 kg
     d = _scene("flat_feet", {"impulse_n_s": Pf})
     scene = scene_from_dict(d)
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     wk, leg = scene.walker, scene.walker.leg
     ankle = leg.foot.ankle
     ref = FlatFeetReference(dict(
@@ -227,5 +227,5 @@ def test_a_push_off_on_massless_arc_legs_is_refused_in_one_line():
     d["walker"]["leg"]["foot"] = {"kind": "arc", "radius_m": 0.1}
     with pytest.raises(ValueError, match="give the legs mass") as e:
         sc = scene_from_dict(d)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     assert "\n" not in str(e.value) and "walker.actuation.push_off" in str(e.value)

@@ -34,7 +34,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def step(scene):
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     x0 = scene.fixedpoint.initial_guess.as_array(w.state_names())
     traj = simulate_steps(w, x0, 1, Solver.from_settings(scene.solver), max_step_time=2.0)
     return w, x0, traj.segments[0]

@@ -101,7 +101,7 @@ def _fake_basin_chunk(calls):
 def _basin(tmp_path, on_chunk=None):
     sc = scene_from_dict({**IDEAL, "name": "paper", "basin": {"grid": [4, 5]}})
     return basin_mod.compute_basin(sc, X_GUESS, "key", tmp_path / "basin.h5", workers=1,
-                                   on_chunk=on_chunk)
+                                   on_chunk=on_chunk, plant=Plant.from_scene(sc))
 
 
 def _interrupt_after(n):
@@ -145,7 +145,7 @@ def test_intact_basin_partial_rows_are_kept(tmp_path, monkeypatch):
 
 
 # ------------------------------------------------------------------ items 4, 13: sweeps
-def _fake_evaluate(stage, base, paths, values, index, guess, options, origin):
+def _fake_evaluate(stage, base, paths, values, index, guess, options, origin, *, plant):
     """A continuation-dependent fake point: each row depends on the guess it started from,
     as a real point's fixed point does (to round-off) on its predictor."""
     g = 0.0 if guess is None else float(np.asarray(guess).ravel()[0])
@@ -425,7 +425,7 @@ def test_progress_bifurcation_counts_are_monotone_and_end_at_the_total(tmp_path)
     rec = Recorder()
     with progress.use(rec):
         bifurcation_diagram(sc, [1.0, 1.5, 2.0], n_transient=2, n_keep=1, workers=1,
-                            steady_state=False)
+                            steady_state=False, plant=Plant.from_scene(sc))
     t = rec.one("bifurcation")
     assert t["total"] == 3
     _assert_monotone_to_total(t)
@@ -513,10 +513,10 @@ def test_the_mfpt_study_reports_each_sigma_it_finishes(monkeypatch):
 
     from walkerlab.studies import mfpt as study
 
-    monkeypatch.setattr(study, "build_walker", lambda scene, plant=None: SimpleNamespace(
+    monkeypatch.setattr(study, "build_walker", lambda plant: SimpleNamespace(
         state_names=lambda: ["a"]), raising=False)
     monkeypatch.setattr("walkerlab.models.registry.build_walker",
-                        lambda scene, plant=None: SimpleNamespace(state_names=lambda: ["a"]))
+                        lambda plant: SimpleNamespace(state_names=lambda: ["a"]))
     monkeypatch.setattr("walkerlab.integrate.python_step.needs_python_path", lambda w: False)
     monkeypatch.setattr(study, "step_map_for", lambda *a, **k: None)
 
@@ -532,7 +532,8 @@ def test_the_mfpt_study_reports_each_sigma_it_finishes(monkeypatch):
         def update(self, key, completed, total, info):
             got.append((completed, total, info))
     with progress.use(Rec()):
-        study.mfpt_study(scene, np.zeros(2), st, plant=None)  # build_walker stood in
+        # build_walker stood in: the plant only hands itself on
+        study.mfpt_study(scene, np.zeros(2), st, plant=SimpleNamespace(with_=lambda sc: None))
     assert got == [(1, 2, "sigma 0.01 rad: Monte Carlo MFPT 100 steps"),
                    (2, 2, "sigma 0.02 rad: Monte Carlo MFPT 200 steps")]
 

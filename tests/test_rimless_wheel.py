@@ -135,7 +135,7 @@ def test_rimless_wheel_mfpt_matches_independent_monte_carlo():
 
     scene = load_scene(SCENE)
     x0 = _walker().fixed_point().x
-    sm = make_step_map(build_walker(scene, plant=Plant.from_scene(scene)), scene_walker_at(scene,
+    sm = make_step_map(build_walker(Plant.from_scene(scene)), scene_walker_at(scene,
             plant=Plant.from_scene(scene)), 1e-9, 1e-9, 5.0)
     for sd in (0.008, 0.012):
         ours = monte_carlo(sm, x0, sd, range(1500), 4000, seed=3).mfpt
@@ -160,7 +160,7 @@ def test_rimless_wheel_basin_on_the_phase_plane():
     # (w-^2 = 0.25^2 + 2 g/L (cos 0.1 - cos 0.4727) gives w+^2 = 1.06 > the 0.95 needed)
     cells = ((0, psi, -1.05 * slow), (1, psi, -0.95 * slow), (2, -0.1, 0.25))
     out = {i: code for i, code, _, _ in run_basin_chunk(BasinTask(
-        scene.model_dump(mode="json"), tuple(x_star), cells))}
+        scene.model_dump(mode="json"), tuple(x_star), cells, plant=Plant.from_scene(scene)))}
     assert out == {0: CODE["converged"], 1: CODE["fell_backward"], 2: CODE["converged"]}
 
 

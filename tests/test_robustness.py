@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def tight_map(paper_scene):
-    return BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+    return BatchStepMap(build_walker(plant := Plant.from_scene(paper_scene)),
                         scene_walker_at(paper_scene, plant), 1e-12, 1e-12)
 
 
@@ -80,7 +80,7 @@ def test_bisection_bracket_flips_survival(paper_scene, paper_fixed_point):
     """The largest single step-down by bracketing bisection: bracket <= 1 mm, the lower end
     survives 40 steps and the upper end falls; it lies within 1 mm of the 1 mm grid scan
     (R.largest_tolerable), an independent search."""
-    sm = BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+    sm = BatchStepMap(build_walker(plant := Plant.from_scene(paper_scene)),
                         scene_walker_at(paper_scene, plant), 1e-10, 1e-10)
     x = paper_fixed_point.x
     lo, hi = R.largest_by_bisection(sm, x, "floor_height", 0.05, 0.001)

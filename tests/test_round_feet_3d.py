@@ -215,8 +215,8 @@ def walkers():
     """The walker of configs/round_feet_3d.yaml, upright, and with a hip width of 0.1 l."""
     sc = _scene("round_feet_3d.yaml")
     sc1 = _scene("round_feet_3d.yaml", hip_width_m=WIDTH)
-    return (build_walker(sc, plant=Plant.from_scene(sc)),
-            build_walker(sc1, plant=Plant.from_scene(sc1)))
+    return (build_walker(Plant.from_scene(sc)),
+            build_walker(Plant.from_scene(sc1)))
 
 
 # ---- the planar embedding ---------------------------------------------------------------
@@ -229,7 +229,7 @@ def test_round_feet_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one(wal
     tolerance 1e-12), its planar multipliers among the 3D ones to 1e-7 (the variational
     equations' accuracy)."""
     flat_scene = _scene("round_feet.yaml")
-    flat = build_walker(flat_scene, plant=Plant.from_scene(flat_scene))
+    flat = build_walker(Plant.from_scene(flat_scene))
     f = find_fixed_point(flat, _guess(flat_scene, flat.state_names()), SOLVER, fd_check=False)
     sp_scene = _scene("round_feet_3d.yaml")
     w3 = walkers[0]

@@ -42,6 +42,7 @@ from walkerlab.stages import common
 from walkerlab.studies import runner
 from walkerlab.studies.outcomes import empty_row
 from walkerlab.studies.params import SweepError, parse_param
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -387,7 +388,7 @@ def fake_points(monkeypatch):
     monkeypatch.setattr(runner, "warm_up", lambda: None)
 
 
-def _fake_evaluate(stage, base, paths, values, index, guess, options, origin):
+def _fake_evaluate(stage, base, paths, values, index, guess, options, origin, *, plant):
     row = empty_row(stage, index)
     row.update(outcome="ok", wall_time_s=0.0, residual=float(values[0]))
     return row, np.array([values[0]])
@@ -465,7 +466,8 @@ def test_grid_cap_is_on_the_product_of_the_axes():
     axes = [parse_param("slope.angle_deg=0:99999:1"), parse_param("walker.hip_mass_kg=0:99:1")]
     assert math.prod(len(a) for a in axes) > runner.MAX_GRID_POINTS
     with pytest.raises(SweepError, match="at most 1,000,000"):
-        runner.run_sweep(sc, axes, "fixedpoint", Path("/nonexistent/x.h5"), workers=1)
+        runner.run_sweep(sc, axes, "fixedpoint", Path("/nonexistent/x.h5"), workers=1,
+                         plant=Plant.from_scene(sc))
 
 
 # ------------------------------------------------------------------ D7: orphans

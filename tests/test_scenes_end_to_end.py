@@ -197,8 +197,7 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     # also in a nondimensional scene whose artifacts label rates rad/√(l/g)
     from walkerlab.models.registry import build_walker
 
-    for n, u in zip(art.state_names, build_walker(scene,
-                                                  plant=Plant.from_scene(scene)).state_units()):
+    for n, u in zip(art.state_names, build_walker(Plant.from_scene(scene)).state_units()):
         col = f"{n}_{u.replace('/', '_per_')}"
         assert col in data  # one column per state, named by the walker
     mid = data["outcome"] == "ok"

@@ -67,7 +67,7 @@ def test_bad_seed_or_walk_is_one_clear_error():
 def test_monte_carlo_walks_equal_walks_on_draw_slopes(paper_scene, paper_fixed_point):
     """The compiled walks of ``monte_carlo`` equal the same walks on ``draw_slopes``' slopes
     (walk numbers not from 0), with falls (sigma 0.004 rad, MFPT ~ 32 steps) and censored walks."""
-    sm = BatchStepMap(build_walker(paper_scene, plant := Plant.from_scene(paper_scene)),
+    sm = BatchStepMap(build_walker(plant := Plant.from_scene(paper_scene)),
                         scene_walker_at(paper_scene, plant), 1e-9, 1e-9)
     assert sm.can_walk
     x0 = np.asarray(paper_fixed_point.x, float)

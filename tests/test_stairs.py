@@ -191,7 +191,7 @@ def test_stairs_refused_where_not_modelled(paper_scene):
     d["ideal"] = {"variant": "appendix_a"}
     with pytest.raises(ValueError, match="ideal.variant: derived"):
         sc = scene_from_dict(d)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
 
 
 def test_stairs_drawn_as_a_polyline_under_the_walker():
@@ -208,10 +208,10 @@ def test_footholds_of_one_height_are_a_landing_and_others_are_refused(paper_scen
     from walkerlab.models.registry import build_walker
 
     sc = load_scene(ROOT / "configs" / "footholds.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert w.params["landing_drop_m"] == 0.005  # 5 mm below: the guard's offset
     x = np.array([0.25, -0.2, -0.6, -0.9])
-    slope = build_walker(paper_scene, plant=Plant.from_scene(paper_scene))
+    slope = build_walker(Plant.from_scene(paper_scene))
     # the heel strike: the swing foot 5 mm below the slope line (along its normal)
     assert w.heel_strike_guard(0.0, x) == pytest.approx(
         _clearance(slope, x) + 0.005 * np.cos(paper_scene.slope.phi_rad), abs=1e-15)
@@ -222,11 +222,11 @@ def test_footholds_of_one_height_are_a_landing_and_others_are_refused(paper_scen
                             ({"kind": "footholds", "foothold_slopes_rad": [0.01]}, 1)):
         d["terrain"] = terrain
         sc = scene_from_dict(d)
-        assert build_walker(sc, plant=Plant.from_scene(sc)).steps_per_map == period
+        assert build_walker(Plant.from_scene(sc)).steps_per_map == period
     d["ideal"] = {"variant": "appendix_a"}
     with pytest.raises(ValueError, match="footholds need ideal.variant: derived"):
         sc = scene_from_dict(d)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
 
 
 def _clearance(walker, x):
@@ -284,7 +284,7 @@ def test_a_landing_out_of_the_legs_reach_is_off_the_section(paper_scene):
     from walkerlab.models.registry import build_walker
 
     sc = _on_stairs(paper_scene, 0.01, direction="up")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     with pytest.raises(OffSection, match="no post-impact state"):
         w.from_section(np.array([0.05, -0.6, -0.84]))
     x = w.from_section(np.array([0.1674, -0.6, -0.84]))  # reachable: on the surface

@@ -18,10 +18,16 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.config import load_scene
+from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 HIP_WIDTH = "walker.hip_width_m"
+
+
+def _plant(base: dict) -> Plant:
+    """The plant of a scene mapping (the study's, as its stage builds it)."""
+    return Plant.from_scene(scene_from_dict(base))
 
 
 def _datasets(path: Path) -> dict:
@@ -127,7 +133,7 @@ def test_a_bifurcation_value_the_scenes_guess_misses_is_found_by_a_fresh_search(
 
     base = load_scene(ROOT / "configs" / "hip_width.yaml").model_dump(mode="json")
     (row,) = bifurcation_chunk(BifurcationTask(base, ((0, (0.06,)),), 4, 2, False,
-                                               HIP_WIDTH, 2))
+                                               HIP_WIDTH, 2, plant=_plant(base)))
     assert row["fp_outcome"] == "ok", row["message"]
     assert abs(row["period_s"] - 0.7036) < 1e-3  # per step: the stride's half
 
@@ -168,20 +174,19 @@ def test_a_3d_basin_cell_off_the_heel_strike_surface_is_unreachable():
     from walkerlab.models.registry import build_walker
     from walkerlab.studies.basin import CODE, BasinTask, _start_pre_impact, axis_values
     from walkerlab.studies.basin_cell import run_basin_chunk, walker_and_settings
-    from walkerlab.walker.plant import Plant
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    names = build_walker(scene, plant=Plant.from_scene(scene)).state_names()
+    names = build_walker(Plant.from_scene(scene)).state_names()
     g = scene.fixedpoint.initial_guess.model_extra  # the gait to 6 decimals
     x_star = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
                        for n in names])
     base = scene.model_dump(mode="json")
     base["basin"] = {"grid": [4, 4]}
-    walker, st, mst = walker_and_settings(base)
+    walker, st, mst = walker_and_settings(base, _plant(base))
     xs, ys = axis_values(st, walker, x_star, (4, 4))
     assert _start_pre_impact(walker, x_star, st, mst, xs, ys) == ()  # no error
     cells = ((0, float(xs[0]), float(ys[0])), (12, float(xs[0]), float(ys[-1])))
-    rows = run_basin_chunk(BasinTask(base, tuple(x_star), cells, ()))
+    rows = run_basin_chunk(BasinTask(base, tuple(x_star), cells, (), plant=_plant(base)))
     assert rows == [(0, CODE["unreachable"], 0, 0), (12, CODE["unreachable"], 0, 0)]
 
 
@@ -220,13 +225,13 @@ def test_a_3d_contact_sweep_point_starts_from_the_step_period_as_the_contact_sim
     class Stop(Exception):
         pass
 
-    def adapter(sc, x, period, length):
+    def adapter(sc, x, period, length, plant):
         seen.append((np.asarray(x, float), period))
         raise Stop
 
     monkeypatch.setattr(points_mod, "contact_adapter", adapter)
     with pytest.raises(Stop):
-        points_mod.contact_point(scene, None, {})
+        points_mod.contact_point(scene, None, {}, Plant.from_scene(scene))
     fp = load_fixedpoint(fixedpoint_stage.run(scene, runs_root=tmp_path).path)
     (x, period), = seen
     assert period == fp.step_period_s

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.config import load_scene
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import sweep as sweep_stage
 from walkerlab.studies import points as points_mod
@@ -22,6 +22,11 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "goswami1996.yaml"
 FAR_STATE = {"swing_angle_rad": -0.33, "stance_angle_rad": 0.22,
              "swing_rate_rad_per_s": -0.38, "stance_rate_rad_per_s": -0.3}
+
+
+def _plant(base: dict) -> Plant:
+    """The plant of a scene mapping (the study's, as its stage builds it)."""
+    return Plant.from_scene(scene_from_dict(base))
 
 
 @pytest.fixture(scope="module")
@@ -106,7 +111,7 @@ def test_a_sweeps_rows_are_the_fixed_points_from_the_scenes_guess_bit_for_bit(sc
                                                                    < 0.35))
     for k, v in enumerate(slopes):
         sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_deg"], (float(v),))
-        w = build_walker(sc, plant=Plant.from_scene(sc))
+        w = build_walker(Plant.from_scene(sc))
         ref = find_fixed_point(w, sc.fixedpoint.initial_guess.as_array(w.state_names()),
                                Solver.from_settings(sc.solver), xtol=sc.fixedpoint.tolerance,
                                fd_check=False)
@@ -119,9 +124,10 @@ def test_a_sweeps_rows_are_the_fixed_points_from_the_scenes_guess_bit_for_bit(sc
 def test_a_point_ignores_any_neighbours_gait(base):
     """A point's row is a function of the point alone: a (wrong) guess handed to it changes
     nothing (what keeps a sweep's rows independent of how its points are dealt out)."""
-    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.1,), 0, None, {})
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.1,), 0, None, {},
+                      plant=_plant(base))
     far, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.1,), 0,
-                      np.array([-0.33, 0.22, -0.38, -0.3]), {})
+                      np.array([-0.33, 0.22, -0.38, -0.3]), {}, plant=_plant(base))
     assert row["outcome"] == far["outcome"] == "ok"
     for k in row:
         if k != "wall_time_s":
@@ -147,35 +153,38 @@ def test_bad_value_is_an_invalid_config_row(scene, tmp_path):
 
 
 def test_slope_zero_no_fixed_point_and_past_period_doubling(base):
-    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (0.0,), 0, None, {})
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (0.0,), 0, None, {},
+                      plant=_plant(base))
     assert row["outcome"] == "no_fixed_point" and np.isfinite(row["residual"])
     assert row["residual"] > 1e-6
-    row, x = evaluate("fixedpoint", base, ["slope.angle_deg"], (5.0,), 1, None, {})
+    row, x = evaluate("fixedpoint", base, ["slope.angle_deg"], (5.0,), 1, None, {},
+                      plant=_plant(base))
     assert row["outcome"] == "ok" and row["stable"] == 0.0
     assert row["multiplier_0_re"] < -1.0 and abs(row["multiplier_0_im"]) < 1e-12
 
 
 def test_far_initial_state_falls(base):
     b = dict(base, simulate={**base["simulate"], "initial_state": FAR_STATE})
-    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {})
+    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {}, plant=_plant(b))
     assert row["outcome"] == "fall"
     assert row["fall_leg"] in ("leg1", "leg2") and 0 < row["fall_time_s"] < 5
     assert row["steps_completed"] == 0
 
 
 def test_max_steps_scuffing_solver_failure_error(base, monkeypatch):
-    row, _ = evaluate("simulate", base, ["simulate.max_step_time_s"], (0.05,), 0, None, {})
+    row, _ = evaluate("simulate", base, ["simulate.max_step_time_s"], (0.05,), 0, None, {},
+                      plant=_plant(base))
     assert row["outcome"] == "max_steps"
     b = dict(base, simulate={**base["simulate"], "strides": 1})
     row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None,
-                      {"scuff_limit_m": 1e-4})
+                      {"scuff_limit_m": 1e-4}, plant=_plant(b))
     assert row["outcome"] == "scuff" and row["scuff_depth_m"] > 1e-3  # ideal gait dips ~3.6 mm
-    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {})
+    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {}, plant=_plant(b))
     assert row["outcome"] == "ok" and row["steps_completed"] == 2
     bad = dict(base, simulate={**base["simulate"],
                                "initial_state": {**FAR_STATE,
                                                  "swing_rate_rad_per_s": float("nan")}})
-    row, _ = evaluate("simulate", bad, ["slope.angle_deg"], (3.0,), 0, None, {})
+    row, _ = evaluate("simulate", bad, ["slope.angle_deg"], (3.0,), 0, None, {}, plant=_plant(b))
     # a NaN initial state is refused by the scene's validation, naming the field
     assert row["outcome"] == "invalid_config" and "initial_state" in row["message"]
 
@@ -183,7 +192,8 @@ def test_max_steps_scuffing_solver_failure_error(base, monkeypatch):
         raise RuntimeError("kaboom")
 
     monkeypatch.setitem(points_mod.POINT_FUNCTIONS, "fixedpoint", boom)
-    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.0,), 0, None, {})
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.0,), 0, None, {},
+                      plant=_plant(base))
     assert row["outcome"] == "error" and "kaboom" in row["message"]
 
 
@@ -191,7 +201,7 @@ def test_tolerances_from_1e_3_to_1e_12(base):
     xs = {}
     for tol in (1e-3, 1e-6, 1e-9, 1e-12):
         row, _ = evaluate("fixedpoint", base, ["solver.rtol", "solver.atol"], (tol, tol), 0,
-                          None, {})
+                          None, {}, plant=_plant(base))
         assert row["outcome"] in ("ok", "no_fixed_point"), row["message"]
         names = [k for k in row if k.endswith(("_angle_rad", "_rate_rad_per_s"))]
         xs[tol] = np.array([row[k] for k in names]) if row["outcome"] == "ok" else None
@@ -326,7 +336,7 @@ def test_bifurcation_onset_where_multiplier_crosses_minus_one(scene):
     from walkerlab.studies.bifurcation import bifurcation_diagram, min_real_multiplier
 
     res = bifurcation_diagram(scene, [3.5, 4.0, 4.5, 5.0], workers=1, steady_state=False,
-                              xtol_deg=1e-3)
+                              xtol_deg=1e-3, plant=Plant.from_scene(scene))
     m = np.array([min_real_multiplier(z) for z in res.multipliers])
     lo, hi = res.onset["bracket_deg"]
     k = int(np.flatnonzero(res.slopes_deg == lo)[0])
@@ -477,13 +487,14 @@ def test_a_studys_map_is_a_stride_when_any_point_needs_one():
 
     hip = load_scene(ROOT / "configs" / "hip_width.yaml").model_dump(mode="json")
     path = ["walker.hip_width_m"]
-    assert study_steps_per_map(hip, path, [(0.0,), (0.1,)]) == 2
-    assert study_steps_per_map(hip, path, [(0.1,), (0.0,)]) == 2
-    assert study_steps_per_map(hip, path, [(0.0,)]) == 1
+    assert study_steps_per_map(hip, path, [(0.0,), (0.1,)], plant=_plant(hip)) == 2
+    assert study_steps_per_map(hip, path, [(0.1,), (0.0,)], plant=_plant(hip)) == 2
+    assert study_steps_per_map(hip, path, [(0.0,)], plant=_plant(hip)) == 1
     goswami = load_scene(SCENE).model_dump(mode="json")
-    assert study_steps_per_map(goswami, ["slope.angle_deg"], [(1.0,), (3.0,)]) == 1
+    assert study_steps_per_map(goswami, ["slope.angle_deg"], [(1.0,), (3.0,)],
+                               plant=_plant(goswami)) == 1
     # a point whose scene does not validate is left out (its row says why)
-    assert study_steps_per_map(hip, path, [(-1.0,), (0.0,)]) == 1
+    assert study_steps_per_map(hip, path, [(-1.0,), (0.0,)], plant=_plant(hip)) == 1
 
 
 def test_a_3d_sweep_reports_every_point_per_stride(tmp_path):

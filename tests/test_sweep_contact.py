@@ -6,17 +6,23 @@ from pathlib import Path
 
 import pytest
 
-from walkerlab.config import load_scene
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.studies.outcomes import OUTCOMES
 from walkerlab.studies.points import _CONTACT_OUTCOME, evaluate
+from walkerlab.walker.plant import Plant
 
 SCENE = Path(__file__).resolve().parents[1] / "configs" / "goswami1996.yaml"
+
+
+def _plant(base: dict) -> Plant:
+    """The plant of a scene mapping (the study's, as its stage builds it)."""
+    return Plant.from_scene(scene_from_dict(base))
 
 
 def test_contact_point_gives_a_typed_outcome():
     base = load_scene(SCENE).model_dump(mode="json")
     row, x = evaluate("contact-sim", base, ["slope.angle_deg", "contact.stiffness_n_per_mm_pow_e"],
-                      (1.0, 1e5), 0, None, {})
+                      (1.0, 1e5), 0, None, {}, plant=_plant(base))
     assert row["outcome"] in OUTCOMES and row["outcome"] not in ("error", "invalid_config"), \
         row["message"]
     assert row["steps_expected"] == 10 and row["heel_strikes"] >= 0
@@ -24,7 +30,7 @@ def test_contact_point_gives_a_typed_outcome():
     if row["outcome"] in ("fall", "trip"):
         assert row["fall_leg"] in ("leg1", "leg2") and row["fall_time_s"] > 0
     row, _ = evaluate("contact-sim", base, ["contact.mu_static", "contact.mu_dynamic"],
-                      (0.1, 0.7), 1, None, {})
+                      (0.1, 0.7), 1, None, {}, plant=_plant(base))
     assert row["outcome"] == "invalid_config" and "mu_dynamic" in row["message"]
 
 

@@ -69,10 +69,10 @@ def test_a_finite_foothold_list_ends_the_walk(paper_scene, paper_fixed_point):
     solver = Solver.from_settings(paper_scene.solver)
     sc = _on_footholds(paper_scene, [0.0, 0.0, 0.0], phi, periodic=False,
                        foothold_slopes_rad=[phi] * 3)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     tr = simulate_steps(w, paper_fixed_point.x, 10, solver)
-    ref = simulate_steps(build_walker(paper_scene,
-            plant=Plant.from_scene(paper_scene)), paper_fixed_point.x, 3, solver)
+    ref = simulate_steps(build_walker(Plant.from_scene(paper_scene)), paper_fixed_point.x, 3,
+                         solver)
     assert len(tr.segments) == 3 and tr.termination == "heel_strike"
     for a, b in zip(tr.segments, ref.segments):
         np.testing.assert_array_equal(a.x_next, b.x_next)
@@ -138,7 +138,7 @@ def test_a_finite_foothold_list_of_one_height_ends_the_walk(tmp_path):
     assert out.splitlines()[0] == ("the ground ends after its 3 footholds (terrain.periodic: "
                                    "false): 3 heel strikes of the 10 asked (5 strides)")
     sc = load_scene(f)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert w.steps_per_map == 1 and w.ground_steps == 3
     (tmp_path / "endless").mkdir()
     endless = _footholds_file(tmp_path / "endless", [-0.005])  # periodic: true
@@ -206,7 +206,7 @@ def test_mfpt_on_per_step_heights_matches_an_independent_monte_carlo(paper_scene
 
     sd, walks = 0.002, 300
     mc = monte_carlo(paper_scene, paper_fixed_point.x, 0.0, walks, 2000, 3,
-                     heights=("normal", sd))
+                     heights=("normal", sd), plant=Plant.from_scene(paper_scene))
     m, se = mc.mfpt
     assert mc.fell.all()
     ref = _independent().StairsCompass(0.0)
@@ -290,8 +290,8 @@ def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fix
     sc = scene_from_dict(d)
     x0 = paper_fixed_point.x
     tr = profile_walk(sc, x0, 8, plant=Plant.from_scene(sc))
-    ref = simulate_steps(build_walker(paper_scene,
-            plant=Plant.from_scene(paper_scene)), x0, 8, Solver.from_settings(sc.solver))
+    ref = simulate_steps(build_walker(Plant.from_scene(paper_scene)), x0, 8,
+                         Solver.from_settings(sc.solver))
     assert len(tr.segments) == 8 and tr.termination == "heel_strike"
     for a, b in zip(tr.segments, ref.segments):
         assert np.max(np.abs(a.x_next - b.x_next)) < 1e-9

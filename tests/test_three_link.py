@@ -122,7 +122,7 @@ def test_torque_columns_and_the_closed_loop_flow_are_the_books(p, slope):
     states inside the tables, to 1e-9 of the accelerations."""
     d = _scene(p, slope)
     sc = scene_from_dict(d)
-    walker = build_walker(sc, plant=Plant.from_scene(sc))
+    walker = build_walker(Plant.from_scene(sc))
     np.testing.assert_array_equal(walker.actuators.B, ref.B)
     law = _law(d)
     rng = np.random.default_rng(5)
@@ -168,8 +168,8 @@ def test_the_shipped_gait_is_a_stable_fixed_point():
 
 def _x_gait():
     scene = load_scene(SCENE)
-    return scene, scene.fixedpoint.initial_guess.as_array(build_walker(scene,
-            plant=Plant.from_scene(scene)).state_names())
+    names = build_walker(Plant.from_scene(scene)).state_names()
+    return scene, scene.fixedpoint.initial_guess.as_array(names)
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
@@ -259,7 +259,7 @@ def _refusal(change) -> str:
     change(d["walker"])
     with pytest.raises((SceneError, ValueError)) as exc:
         sc = scene_from_dict(d)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     line = str(exc.value)
     assert "\n" not in line
     return line

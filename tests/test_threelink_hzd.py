@@ -44,7 +44,7 @@ b = np.ones(3)
 @pytest.fixture(scope="module")
 def walker():
     sc = scene_from_dict(copy.deepcopy(SCENE))
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 @pytest.fixture(scope="module")
@@ -345,7 +345,7 @@ def test_a_hip_position_phase_puts_the_step_ends_within_half_a_turn():
     at -+0.181051 rad, to the Newton solve's 1e-11), so c_0 is the swing leg's post-impact
     angle, -0.181051 rad."""
     sc = scene_with_c4(0.181051, point="hip")
-    d = build_walker(sc, plant=Plant.from_scene(sc)).actuators.controller.design
+    d = build_walker(Plant.from_scene(sc)).actuators.controller.design
     np.testing.assert_allclose(d.q_minus, [-0.181051, 0.181051, -0.106052], atol=1e-9)
     np.testing.assert_allclose(d.q_plus, [0.181051, -0.181051, -0.106052], atol=1e-9)
     assert abs(d.alpha[0, 0] + 0.181051) < 1e-9

@@ -30,8 +30,8 @@ COMPASS = {"name": "t", "walker": {"model": "compass_gait", "leg_length_m": 1.0,
 def _walkers():
     sc = scene_from_dict(COMPASS)
     sc1 = load_scene(CONFIGS / "kuo2002.yaml")
-    return {"compass": build_walker(sc, plant=Plant.from_scene(sc)),  # massive legs
-            "kuo2002": build_walker(sc1, plant=Plant.from_scene(sc1))}  # massless legs
+    return {"compass": build_walker(Plant.from_scene(sc)),  # massive legs
+            "kuo2002": build_walker(Plant.from_scene(sc1))}  # massless legs
 
 
 @pytest.fixture(scope="module")

@@ -32,7 +32,7 @@ def walker_and_scene(request):
     from walkerlab.models.registry import build_walker
 
     scene = load_scene(ROOT / "configs" / f"{request.param}.yaml")
-    return build_walker(scene, plant=Plant.from_scene(scene)), scene
+    return build_walker(Plant.from_scene(scene)), scene
 
 
 def test_compiled_closed_loop_is_the_python_flow_and_jacobian(walker_and_scene):

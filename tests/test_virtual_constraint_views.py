@@ -53,7 +53,7 @@ def test_contact_view_torque_is_the_rigid_closed_loops(scene):
     from walkerlab.models.contact.scene import contact_setup
     from walkerlab.models.registry import build_walker
 
-    rigid = build_walker(scene, plant=Plant.from_scene(scene)).actuators
+    rigid = build_walker(Plant.from_scene(scene)).actuators
     acts = contact_setup(scene, plant=Plant.from_scene(scene)).actuators
     assert type(acts).__name__ == "VirtualConstraintJointTorques"
     rng = np.random.default_rng(59)
@@ -126,7 +126,7 @@ def rigid_gait(scene, tmp_path_factory):
     runs = tmp_path_factory.mktemp("runs")
     out = fixedpoint.run(scene, runs, compare_variants=False)
     period = float(load_fixedpoint(out.path).step_period_s)
-    ctrl = build_walker(scene, plant=Plant.from_scene(scene)).actuators.controller
+    ctrl = build_walker(Plant.from_scene(scene)).actuators.controller
     step = float(ctrl.pieces.foot(ctrl.design.q_minus)[1])
     return runs, period, step / period
 
@@ -177,7 +177,7 @@ def test_mujoco_export_walks_at_the_rigid_closed_loops_speed(scene, rigid_gait):
     q = {nm: float(key.qpos[model.joint(nm).qposadr[0]]) for nm in names}
     v = {nm: float(key.qvel[model.joint(nm).dofadr[0]]) for nm in names}
     xr = fb.role_state(q, v, 1)  # leg2 stands at the keyframe
-    rigid = build_walker(scene, plant=Plant.from_scene(scene)).actuators
+    rigid = build_walker(Plant.from_scene(scene)).actuators
     np.testing.assert_allclose(fb.torques(q, v, 1), rigid.torques(0.0, xr), rtol=0, atol=1e-10)
     y, dy = rigid.controller.outputs(xr)
     assert np.max(np.abs(y)) < 1e-6 and np.max(np.abs(dy)) < 1e-5  # on the surface

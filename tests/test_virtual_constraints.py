@@ -41,7 +41,7 @@ def scene_with(**vc):
 @pytest.fixture(scope="module")
 def walker():
     sc = scene_from_dict(copy.deepcopy(SCENE))
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 @pytest.fixture(scope="module")
@@ -130,7 +130,7 @@ def test_non_invariant_coefficients_report_their_residual():
     """invariant: false keeps the given c_0, c_1: the outputs jump at the heel strike by
     the reported residual."""
     sc = scene_with(invariant=False)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     d = w.actuators.controller.design
     np.testing.assert_array_equal(d.alpha, d.given)
     dth = d.theta_minus - d.theta_plus
@@ -150,7 +150,7 @@ def hip_phase_walker():
     """The outputs on the hip's horizontal position: a phase variable nonlinear in the
     angles (its second derivative enters L_f^2 h)."""
     sc = scene_with(phase={"point": "hip"})
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 @pytest.mark.parametrize("which", ["stance_leg", "hip"])
@@ -235,7 +235,7 @@ def one_line(exc) -> str:
 def test_too_few_actuators_refused():
     with pytest.raises(ValueError) as e:
         sc = scene_with(joints=["stance_hip", "swing_hip"])
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     msg = one_line(e)
     assert "virtual_constraints.outputs" in msg and "2 actuators" in msg
 
@@ -244,7 +244,7 @@ def test_phase_not_monotone_refused():
     """The torso's angle keeps its value across the heel strike: theta+ = theta-."""
     with pytest.raises(ValueError) as e:
         sc = scene_with(phase={"link": "torso"})
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     msg = one_line(e)
     assert "virtual_constraints.phase" in msg and "not monotone" in msg
 
@@ -254,7 +254,7 @@ def test_singular_decoupling_matrix_refused_naming_outputs():
     four outputs: the decoupling matrix is singular."""
     with pytest.raises(ValueError) as e:
         sc = scene_with(joints=["stance_hip", "swing_hip", "stance_knee", "hip"])
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     msg = one_line(e)
     assert "virtual_constraints.outputs" in msg and "decoupling matrix" in msg
     assert "joint:" in msg
@@ -279,7 +279,7 @@ def test_unknown_link_refused():
     cfg["walker"]["actuation"]["virtual_constraints"]["phase"] = {"coordinates": {"foo": 1.0}}
     with pytest.raises(ValueError) as e:
         sc = scene_from_dict(cfg)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     assert "phase.coordinates.foo" in one_line(e)
 
 
@@ -392,7 +392,7 @@ def test_compass_gait_under_one_virtual_constraint():
         "feedback": {"kind": "input_output_linearization", "kp_per_s2": 2500,
                      "kd_per_s": 100}}}
     scene = scene_from_dict(cfg)
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     ctrl = w.actuators.controller
     assert ctrl.joints == ["hip"]
     z = zero_dynamics(ctrl)
@@ -419,7 +419,7 @@ def test_walkers_the_quadrature_does_not_hold_for_refused(name, words):
                      "kd_per_s": 40}}}
     with pytest.raises(ValueError) as e:
         sc = scene_from_dict(cfg)
-        build_walker(sc, plant=Plant.from_scene(sc))
+        build_walker(Plant.from_scene(sc))
     msg = one_line(e)
     assert msg.startswith("walker.actuation.virtual_constraints: ") and words in msg
 

@@ -45,10 +45,10 @@ def test_the_paper_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one():
     """Started upright, the 3D walker of zero hip width is the planar walker (configs/
     paper.yaml): the same fixed point and period, to 1e-9."""
     flat_scene = _scene("paper.yaml")
-    flat = build_walker(flat_scene, plant=Plant.from_scene(flat_scene))
+    flat = build_walker(Plant.from_scene(flat_scene))
     f = find_fixed_point(flat, _guess(flat_scene, flat.state_names()), SOLVER, fd_check=False)
     sp_scene = _scene("paper_3d.yaml")
-    w3 = build_walker(sp_scene, plant=Plant.from_scene(sp_scene))
+    w3 = build_walker(Plant.from_scene(sp_scene))
     s = find_fixed_point(w3, _guess(sp_scene, w3.state_names()), SOLVER, fd_check=False)
     x3 = dict(zip(w3.state_names(), s.x))
     for name, value in zip(flat.state_names(), f.x):
@@ -77,7 +77,7 @@ HIP = dict(g=9.81, L=1.0, gamma=0.0174, M=10.0, m=5.0, a=0.5)
 @pytest.fixture(scope="module")
 def hip_width_gait():
     scene = _scene("hip_width.yaml")
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     res = find_fixed_point(walker, _guess(scene, walker.state_names()), SOLVER, fd_check=False)
     return walker, res, scene.walker.hip_width_m
 
@@ -205,7 +205,7 @@ def test_a_stride_map_of_the_zero_width_walker_squares_its_step_multipliers():
     period, every Floquet multiplier squared - each found by its own root finder and
     variational equations, not one computed from the other."""
     scene = _scene("paper_3d.yaml")
-    step = build_walker(scene, plant=Plant.from_scene(scene))
+    step = build_walker(Plant.from_scene(scene))
     assert step.steps_per_map == 1
     stride = step.with_steps_per_map(2)
     assert stride.steps_per_map == 2 and step.with_steps_per_map(1) is step
@@ -218,7 +218,7 @@ def test_a_stride_map_of_the_zero_width_walker_squares_its_step_multipliers():
         np.sort(np.abs(a.multipliers_variational) ** 2), rel=1e-7, abs=1e-9)
     with pytest.raises(ValueError, match="not made of this walker's maps"):
         sc = _scene("hip_width.yaml")
-        build_walker(sc, plant=Plant.from_scene(sc)).with_steps_per_map(3)
+        build_walker(Plant.from_scene(sc)).with_steps_per_map(3)
 
 
 def test_other_gait_false_stops_the_second_gait_search_of_a_3d_walker(tmp_path):
@@ -321,8 +321,9 @@ def test_a_changed_gain_falls_back_to_the_stored_gait_and_finds_the_gait(tmp_pat
     path.write_text(yaml.safe_dump(data))
     scene = load_scene(path)
     known = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    guess = initial_guess(known, build_walker(known, plant=Plant.from_scene(known)))
-    nearby = stored_gait_start(scene, [StoredGait(known, lambda: guess, "known")])
+    guess = initial_guess(known, build_walker(Plant.from_scene(known)))
+    nearby = stored_gait_start(scene, [StoredGait(known, lambda: guess, "known")],
+                               plant=Plant.from_scene(scene))
     walker, search = solve_scene(scene, fd_check=False, nearby=nearby,
                                  plant=Plant.from_scene(scene))
     assert any("initial guess did not converge" in n for n in search.notes)

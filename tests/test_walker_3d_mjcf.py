@@ -318,7 +318,7 @@ def test_the_3d_stance_foots_force_and_twist_are_mujocos_contact_force_and_torsi
     seen = {k: rows[np.abs(rows[:, 0] - t) < WINDOW_S / 2, 1:].mean(axis=0)
             for k, t in enumerate(times)}
     plant = Plant.from_scene(scene)
-    walker = build_walker(scene, plant=plant)
+    walker = build_walker(plant)
     reaction = StanceReaction(walker, plant.data)
     x0 = ideal_gait(scene, plant=plant).x
     seg = simulate_steps(walker, x0, 1, Solver(method="DOP853", rtol=1e-12, atol=1e-12)

@@ -36,7 +36,7 @@ def powered(tmp_path_factory):
     scene = load(str(ROOT / "configs" / "hip_width_powered.yaml"))
     out = export.write(scene, tmp_path_factory.mktemp("powered_3d"), "mjcf")
     plant = Plant.from_scene(scene)
-    walker = build_walker(scene, plant=plant)
+    walker = build_walker(plant)
     x = np.asarray(ideal_gait(scene, plant=plant).x, float)
     return scene, out.path, out, walker, x
 

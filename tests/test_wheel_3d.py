@@ -42,7 +42,7 @@ def _scene(**walker):
 @pytest.fixture(scope="module")
 def wheel():
     sc = _scene()
-    return build_walker(sc, plant=Plant.from_scene(sc))
+    return build_walker(Plant.from_scene(sc))
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +134,7 @@ def test_upright_3d_wheel_rolls_downhill_as_the_planar_wheel(gait):
                                    "lean_rate")) < 1e-12
     # the planar wheel's step period: the pendulum from alpha - gamma to -alpha - gamma
     sc = _scene(space="2d", diametral_inertia_kg_m2=None)
-    planar = build_walker(sc, plant=Plant.from_scene(sc))
+    planar = build_walker(Plant.from_scene(sc))
     solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     flat = find_fixed_point(planar, np.array([ALPHA - SLOPE, -1.0]), solver, fd_check=False)
     assert abs(gait.period_s - flat.period_s) < 1e-10
@@ -164,7 +164,7 @@ def test_the_disc_wheel_rolls_stably_above_its_critical_slope_as_the_reference_s
     from walkerlab.cli.options import load
 
     scene = load(str(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     res = find_fixed_point(walker, np.array([0, 0, ALPHA - 0.2, 0, 0, -1.9]), solver,
                            fd_check=False)
@@ -246,7 +246,7 @@ def test_the_3d_wheels_mjcf_walks_in_mujoco_as_the_rigid_model_predicts(tmp_path
     from walkerlab.walker.description import walker_data
 
     scene = load(str(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     gait = find_fixed_point(walker, np.array([0, 0, ALPHA - 0.2, 0, 0, -1.9]), solver,
                             fd_check=False)
@@ -388,13 +388,13 @@ def test_the_planar_wheel_closed_form_gait_is_a_fixed_point():
     from walkerlab.config import load_scene
 
     scene = load_scene(ROOT / "configs" / "rimless_wheel.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     x = w.closed_form_gait()
     assert x[1] == pytest.approx(-W_PLUS, rel=1e-14)
     for inertia in (0.0, 0.5):
         sc = scene.model_copy(update={"walker": scene.walker.model_copy(
             update={"hub_inertia_kg_m2": inertia})})
-        wi = build_walker(sc, plant=Plant.from_scene(sc))
+        wi = build_walker(Plant.from_scene(sc))
         xi = wi.closed_form_gait()
         xn, _, _ = poincare_map(wi, xi, Solver(method="DOP853", rtol=1e-12, atol=1e-12))
         np.testing.assert_allclose(xn, xi, atol=1e-10)

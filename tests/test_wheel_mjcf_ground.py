@@ -119,7 +119,7 @@ def test_the_wheels_post_impact_section_on_stairs_stands_the_spoke_behind_a_rise
 
     scene = _wheel({"kind": "stairs", "riser_m": RISER, "tread_m": TREAD,
                     "direction": "down", "lanes": "continuous"}, slope=0.0)
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     alpha, L = math.pi / scene.walker.spokes, scene.walker.spoke_length_m
     want = alpha - math.asin(RISER / (2 * L * math.sin(alpha)))
     x0 = walker.from_section(np.array([-1.0953]))
@@ -149,7 +149,7 @@ def test_the_wheels_footholds_lie_a_chord_apart_at_their_heights_on_the_slope():
     def after(k):  # the stance angle just after landing k (height h[k mod 2])
         return alpha + math.asin(h[k % 2] * math.cos(phi) / c) - phi
 
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     x0 = walker.from_section(np.array([-1.09]))
     assert x0[0] == pytest.approx(after(1), abs=1e-12)  # the map's section: step 1's
     segs = simulate_steps(walker, x0, 4, Solver.from_settings(scene.solver)).segments

@@ -155,23 +155,36 @@ class Gait:
         return self.max_abs_multiplier < 1.0
 
 
+def rebuilt(cls, plant, step_evaluations: int):
+    """A :class:`SceneWalker` of class ``cls`` (or a subclass whose constructor only hands
+    its plant up, :class:`walkerlab.api.walker.Walker`) built again from its plant and step
+    work limit: what unpickling a walker calls.
+
+    Returns
+    -------
+    SceneWalker
+    """
+    walker = cls.__new__(cls)
+    SceneWalker.__init__(walker, plant, step_evaluations)
+    return walker
+
+
 class SceneWalker:
     """The rigid hybrid walker of a scene: the validated scene, its walker described
     (:attr:`plant`, a :class:`~walkerlab.walker.plant.Plant`), the generated model
     (:func:`walkerlab.models.registry.build_walker`) and the scene's integrator, built once
-    (the parameters, attributes and errors of :class:`walkerlab.api.walker.Walker`, which
-    extends it).
+    (the attributes and errors of :class:`walkerlab.api.walker.Walker`, which extends it and
+    builds the plant from its scene).
 
     Parameters
     ----------
-    scene : walkerlab.config.Scene
-        A validated scene.
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once, by the front that builds this walker (the API's
+        :class:`walkerlab.api.walker.Walker`, the gym's environment): its ``scene`` is the
+        walker's (:attr:`scene`).
     step_evaluations : int
         Right-hand-side evaluations each walking step may take [-]
         (:data:`STEP_EVALUATIONS`; work, not time: the same on any machine).
-    plant : walkerlab.walker.plant.Plant, optional
-        The scene's walker described, when the caller holds it (the API's contact view);
-        default: described here.
 
     Raises
     ------
@@ -182,21 +195,18 @@ class SceneWalker:
     """
 
     def __reduce__(self):
-        """Pickled as its scene and step work limit (the model is built again: a compiled
+        """Pickled as its plant and step work limit (the model is built again: a compiled
         flow does not pickle; a process pool or a vector env's subprocess gets the same
-        walker)."""
-        return (type(self), (self.scene, self.step_evaluations))
+        walker, of the same class: :func:`rebuilt`)."""
+        return (rebuilt, (type(self), self.plant, self.step_evaluations))
 
-    def __init__(self, scene: Scene, step_evaluations: int = STEP_EVALUATIONS,
-                 plant=None):
+    def __init__(self, plant, step_evaluations: int = STEP_EVALUATIONS):
         from walkerlab.models.registry import build_walker  # light
-        from walkerlab.walker.plant import Plant  # light
 
         self.step_evaluations = positive(step_evaluations, "step_evaluations")
-        self.scene = scene
-        # described once, handed to every analysis
-        self.plant = Plant.from_scene(scene) if plant is None else plant
-        self.model = build_walker(scene, self.plant)
+        self.plant = plant  # described once by the front, handed to every analysis
+        self.scene = scene = plant.scene
+        self.model = build_walker(plant)
         self.solver = Solver.from_settings(scene.solver)
         fp = scene.fixedpoint
         self.max_step_time = 5.0 if fp is None else fp.max_step_time_s
@@ -328,4 +338,4 @@ class SceneWalker:
             src = known_scene(self.scene)
         except SceneError as exc:
             raise SceneError(f"fixedpoint.from: {exc}") from None
-        return homotopy_start(self.scene, src)[0]
+        return homotopy_start(self.scene, src, plant=self.plant)[0]

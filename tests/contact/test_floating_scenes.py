@@ -28,7 +28,7 @@ def _scene(name):
 @pytest.mark.parametrize("name", ["paper", "paper_rods", "kneed", "round_feet", "goswami1996"])
 def test_build_any_walker(name):
     sc = _scene(name)
-    rigid = build_walker(sc, plant=Plant.from_scene(sc))
+    rigid = build_walker(Plant.from_scene(sc))
     x = sc.fixedpoint.initial_guess.as_array(rigid.state_names())
     w, step = build(sc, x, 4, plant=Plant.from_scene(sc))
     n = 6 if name == "kneed" else 4

@@ -86,7 +86,7 @@ def test_the_patches_lie_at_the_rigid_gaits_footfalls_at_their_heights(heights):
     x, _ = _rigid(sc)
     walker, _, _, _ = scene_start(contact_setup(sc, plant=Plant.from_scene(sc)), x, 3)
     # the reference: the rigid model's own footfalls (its swing foot at each heel strike)
-    rigid = build_walker(sc, plant=Plant.from_scene(sc))
+    rigid = build_walker(Plant.from_scene(sc))
     n = 2 * walker.lane1.size
     traj = simulate_steps(rigid, x, n - 1, Solver.from_settings(
         SolverSettings(method="DOP853", rtol=1e-12, atol=1e-12)))

@@ -257,8 +257,9 @@ def test_the_flat_feet_optimums_contact_replay():
     res = SimpleNamespace(t=np.array([0.0, T / 2, T]), u=np.zeros(3), x=x[None],
                           phase_start=np.array([0]), phase_duration_s=np.array([T]),
                           step_period_s=T)
-    period, outcome = contact_replay_phased(load_scene(CONFIGS / "flat_feet_optimal.yaml"),
-                                            res, strides=1)
+    optimal = load_scene(CONFIGS / "flat_feet_optimal.yaml")
+    period, outcome = contact_replay_phased(optimal, res, strides=1,
+                                            plant=Plant.from_scene(optimal))
     assert outcome == "heel_strike"
     assert period == pytest.approx(passive_contact_period(x, T, 1), rel=1e-4)
     assert 0.06 < period / T - 1.0 < 0.08

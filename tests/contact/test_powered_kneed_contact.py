@@ -103,7 +103,8 @@ def test_the_kneed_optimums_contact_replay_keeps_its_period(gait):
     res = SimpleNamespace(t=np.array([0.0, T / 2, T]), u=np.zeros(3), x=gait.x[None],
                           phase_start=np.array([0]), phase_duration_s=np.array([T]),
                           step_period_s=T)
-    period, outcome = contact_replay_phased(load_scene(CONFIGS / "kneed_optimal.yaml"), res)
+    optimal = load_scene(CONFIGS / "kneed_optimal.yaml")
+    period, outcome = contact_replay_phased(optimal, res, plant=Plant.from_scene(optimal))
     assert outcome == "heel_strike"
     assert abs(period / T - 1.0) < 0.03, period
 

@@ -140,10 +140,12 @@ def test_a_stability_map_cell_without_work_left_says_work_limit_twice_alike():
     """A map cell whose searches may make 3 step-map integrations each (the default 2,000):
     its reason is work_limit, the same in a second computation; no clock decides it."""
     from walkerlab.studies.stability import REASONS, MapSpec, gait_row
+    from walkerlab.walker.plant import Plant
 
-    base = load_scene(ROOT / "configs" / "paper.yaml").model_dump(mode="json")
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    base, plant = scene.model_dump(mode="json"), Plant.from_scene(scene)
     spec = MapSpec("friction", (0.9,), (3.0,), max_step_maps=3)
-    rows = [gait_row(base, spec, 0) for _ in range(2)]
+    rows = [gait_row(base, spec, 0, plant) for _ in range(2)]
     assert [c["reason"] for c in rows[0]] == [c["reason"] for c in rows[1]] == ["work_limit"]
     assert "work_limit" in REASONS
     assert MapSpec("friction", (0.9,), (3.0,)).key() != spec.key()

@@ -55,7 +55,7 @@ def test_compiled_flow_and_guards_match_python(scene):
     """Each phase's cfunc equals its Python flow, and its guard columns the phase's guards
     (which generated guard, which offset: the mapping written in the model layer)."""
     sc = load_scene(ROOT / "configs" / scene)
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     rng = np.random.default_rng(1)
     for phase in w.phases:
         for _ in range(3):
@@ -69,7 +69,7 @@ def test_compiled_flow_and_guards_match_python(scene):
 def test_kneed_steps_agree():
     """Knee strike (an intra-step reset) and heel strike: same events, same states."""
     sc = load_scene(ROOT / "configs" / "kneed.yaml")
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     x0 = sc.fixedpoint.initial_guess.as_array(w.state_names())
     ta = simulate_steps(w, x0, 2, A)
     tb = simulate_steps(w, x0, 2, B)

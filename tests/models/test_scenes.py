@@ -20,7 +20,7 @@ def _fixed_point(name, slope_rad=None, guess=None):
     sc = load_scene(CONFIGS / f"{name}.yaml")
     if slope_rad is not None:
         sc = sc.model_copy(update={"slope": sc.slope.model_copy(update={"angle_rad": slope_rad})})
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     fp = sc.fixedpoint
     if guess is None:
         guess = fp.initial_guess.as_array(w.state_names())

@@ -16,6 +16,5 @@ CONFIGS = sorted((Path(__file__).resolve().parents[2] / "configs").glob("*.yaml"
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_state_layout_is_the_built_walkers(path):
     scene = load_scene(path)
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
-    assert state_layout(scene,
-            plant=Plant.from_scene(scene)) == (walker.state_names(), walker.state_units())
+    walker = build_walker(Plant.from_scene(scene))
+    assert state_layout(Plant.from_scene(scene)) == (walker.state_names(), walker.state_units())

@@ -36,7 +36,7 @@ def test_state_by_name_must_match_the_walker():
     from walkerlab.models.registry import build_walker
 
     sc = scene_from_dict(_simplest())
-    w = build_walker(sc, plant=Plant.from_scene(sc))
+    w = build_walker(Plant.from_scene(sc))
     assert sc.fixedpoint.initial_guess.as_array(w.state_names()).shape == (4,)
     with pytest.raises(ValueError, match="swing_angle_rad"):
         sc.fixedpoint.initial_guess.as_array()  # the compass gait's names: not this walker's

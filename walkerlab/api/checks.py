@@ -101,8 +101,8 @@ def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
 
     from walkerlab.analysis.continuation.target import MEASURES  # light
     from walkerlab.config import SceneError  # light
-    from walkerlab.studies.continuation import scene_family, scene_value  # light
-    from walkerlab.studies.params import ParamAxis, takes_whole_numbers  # light
+    from walkerlab.studies.continuation import scene_value  # light
+    from walkerlab.studies.params import ParamAxis, check_axes, takes_whole_numbers  # light
 
     if len(target) != 1 or next(iter(target)) not in MEASURES:
         raise SceneError(f"target: give exactly one of {', '.join(MEASURES)} (got "
@@ -120,7 +120,8 @@ def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
     from walkerlab.studies.params import SweepError  # light
 
     try:
-        scene_family(scene, vary)  # an unknown field: SweepError with the closest name
+        # an unknown field: SweepError with the closest name
+        check_axes(scene, [ParamAxis(vary, (), vary)], values=False)
     except SweepError as exc:
         raise SweepError(str(exc).replace("--param ", "target --vary ", 1)) from None
     if takes_whole_numbers(scene, ParamAxis(vary, (), vary)):

@@ -16,7 +16,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
 __all__ = ["DEFAULT_RUNS", "as_scene", "load_scene", "read_dataset", "runs_folder",
-           "with_changes"]
+           "scene_plant", "with_changes"]
 
 DEFAULT_RUNS = Path("runs")
 
@@ -122,6 +122,21 @@ def as_scene(scene) -> Scene:
     from walkerlab.config import Scene  # light
 
     return scene if isinstance(scene, Scene) else load_scene(scene)
+
+
+def scene_plant(scene: Scene, plant=None):
+    """The plant of ``scene``, built at this front door: its walker described
+    (:meth:`~walkerlab.walker.plant.Plant.from_scene`), or, given the ``plant`` a caller
+    holds (the contact view's, a walker's before a change), :meth:`~walkerlab.walker.plant.
+    Plant.with_` of it (the same walker section keeps its description).
+
+    Returns
+    -------
+    walkerlab.walker.plant.Plant
+    """
+    from walkerlab.walker.plant import Plant  # light
+
+    return Plant.from_scene(scene) if plant is None else plant.with_(scene)
 
 
 def runs_folder(runs_dir) -> Path:

@@ -46,7 +46,7 @@ from walkerlab.api.checks import (
     short,
     simulate_options,
 )
-from walkerlab.api.scenes import as_scene, with_changes
+from walkerlab.api.scenes import as_scene, scene_plant, with_changes
 from walkerlab.api.walks import ContactWalk, Gait, Step, Walk, recorded_contact_walk, sampled_walk
 from walkerlab.integrate.solver import Solver
 from walkerlab.rigid_walker import SceneWalker
@@ -80,6 +80,8 @@ class Walker(SceneWalker):
         ends the same way on any machine, busy or not); past it the map stops with one line
         (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``work_limit``).  The
         simulated time of a step is bounded apart, by ``fixedpoint.max_step_time_s``.
+    plant : walkerlab.walker.plant.Plant, optional
+        A plant the caller holds (:func:`~walkerlab.api.scenes.scene_plant`).
 
     Attributes
     ----------
@@ -105,6 +107,9 @@ class Walker(SceneWalker):
         an actuated walker, printed equations on stairs, ...).
     """
 
+    def __init__(self, scene: Scene, step_evaluations: int = STEP_EVALUATIONS, plant=None):
+        super().__init__(scene_plant(scene, plant), step_evaluations)  # the front describes
+
     @classmethod
     def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
                    step_evaluations: int = STEP_EVALUATIONS) -> Walker:
@@ -128,7 +133,7 @@ class Walker(SceneWalker):
         walkerlab.config.SceneError
             An unknown field (with the closest name) or a value the field does not accept.
         """
-        return Walker(with_changes(self.scene, changes), self.step_evaluations)
+        return Walker(with_changes(self.scene, changes), self.step_evaluations, self.plant)
 
     def contact(self) -> ContactWalker:
         """The contact (compliant-foot) view of this walker: a :class:`ContactWalker` on the
@@ -238,7 +243,7 @@ class Walker(SceneWalker):
         from walkerlab.studies.continuation import scene_family, scene_value  # light
 
         name, value = check_target(self.scene, vary, target)
-        fam = scene_family(self.scene, vary)
+        fam = scene_family(self.scene, vary, plant=self.plant)
         res = solve_target(fam, scene_value(self.scene, vary), self.fixed_point().x,
                            MEASURES[name][0], value)
         found = self.with_changes({vary: res.p})
@@ -375,12 +380,10 @@ class ContactWalker:
                  step_evaluations: int = STEP_EVALUATIONS):
         from walkerlab.config.sections import with_default_section  # light
         from walkerlab.models.contact.scene import contact_setup  # light
-        from walkerlab.walker.plant import Plant  # light
 
         self.scene = with_default_section(scene, "contact")  # left out: its defaults
-        plant = Plant.from_scene(scene) if rigid is None else rigid.plant  # described once
-        self.setup = contact_setup(self.scene, plant=plant)
-        self.rigid = rigid if rigid is not None else Walker(scene, step_evaluations, plant)
+        self.setup = contact_setup(self.scene, plant=scene_plant(scene, rigid and rigid.plant))
+        self.rigid = rigid or Walker(scene, step_evaluations, self.setup.plant)  # described once
         self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
         self.solver = Solver.from_settings(self.setup.solver)
         self._gait = None  # the rigid gait, found on first use
@@ -413,8 +416,7 @@ class ContactWalker:
         walkerlab.models.contact.scene.ContactSceneError
             The changed scene's walker is one the contact view does not carry.
         """
-        rigid = self.rigid.with_changes(changes)
-        return ContactWalker(rigid.scene, rigid)
+        return ContactWalker((rigid := self.rigid.with_changes(changes)).scene, rigid)
 
     def state_names(self) -> list[str]:
         """Names of the floating walker's state (N,): the hip position, the link angles,

@@ -55,7 +55,7 @@ def bench_ideal(repeats: int = 7) -> dict:
 
     scene = paper_scene()
     t0 = time.perf_counter()
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     build_s = time.perf_counter() - t0
     guess = np.asarray(initial_state(scene.fixedpoint.initial_guess, w.state_names()))
     sv = Solver.from_settings(scene.solver)

@@ -63,7 +63,7 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
     path = scene_path or Path(__file__).resolve().parents[2] / "configs" / "rabbit_hzd.yaml"
     scene = load_scene(path)
     t = time.perf_counter()
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
     build = time.perf_counter() - t
     ctrl = walker.actuators.controller
     d2_times, zd_times = [], []
@@ -134,9 +134,9 @@ def bench_design_process(pairs: int = 3) -> dict:
         scene = load_scene(path)
         vc = scene.walker.actuation.virtual_constraints
         spec = design_spec(scene, collocation_spec(scene))
-        t, x, u, alpha, _zd = controller_step(build_walker(scene,
-                plant=Plant.from_scene(scene)), Solver.from_settings(
-            scene.solver), 2 * DESIGN["intervals"] + 1)
+        t, x, u, alpha, _zd = controller_step(build_walker(Plant.from_scene(scene)),
+                                              Solver.from_settings(scene.solver),
+                                              2 * DESIGN["intervals"] + 1)
         npz = Path(d) / "start.npz"
         _write_start(npz, (t, x, u, alpha), vc, spec.max_torque_n_m, spec.friction_coefficient)
         script.append(str(npz))
@@ -192,7 +192,7 @@ def bench_design(repeats: int = 3) -> dict:
     vc = scene.walker.actuation.virtual_constraints
     plant = Plant.from_scene(scene)  # the bench's scene, described once
     K = 2 * DESIGN["intervals"] + 1
-    start = controller_step(build_walker(scene, plant), Solver.from_settings(scene.solver),
+    start = controller_step(build_walker(plant), Solver.from_settings(scene.solver),
                             K)[:4]
     ours, res = _time_collocation(scene, plant.data, start, repeats)
     theirs, words = _time_script(root / "walkerlab" / "bench" / "minimal_casadi_hzd.py",

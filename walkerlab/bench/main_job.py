@@ -85,12 +85,14 @@ from walkerlab.config import MfptSettings, load_scene
 from walkerlab.walker.plant import Plant
 from walkerlab.studies import mfpt as work
 scene = load_scene(scene_path)
-_, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
+plant = Plant.from_scene(scene)
+_, search = solve_scene(scene, fd_check=False, plant=plant)
 x = np.asarray(search.gait.result.x, float)
 st = scene.mfpt or MfptSettings()
 base = scene.model_dump(mode="json")
-task = work.WalkTask(base, tuple(map(float, x)), sd, tuple(range(W)), S, st.seed, "normal", 0)
-sm = work.step_map_for(base)
+task = work.WalkTask(base, tuple(map(float, x)), sd, tuple(range(W)), S, st.seed, "normal", 0,
+                     plant=plant)
+sm = work.step_map_for(base, plant=plant)
 slopes = np.stack([draw_slopes(st.seed, w, S, sm.slope_rad, sd) for w in range(W)])
 p = mc.params(scene.walker)
 bs, bf = np.zeros(W, np.int64), np.zeros(W, bool)
@@ -124,14 +126,15 @@ from walkerlab.config import MfptSettings, load_scene
 from walkerlab.walker.plant import Plant
 from walkerlab.studies import mfpt as work
 scene = load_scene(sys.argv[1]); sd = float(sys.argv[2]); workers = int(sys.argv[3])
-_, search = solve_scene(scene, fd_check=False, plant=Plant.from_scene(scene))
+plant = Plant.from_scene(scene)
+_, search = solve_scene(scene, fd_check=False, plant=plant)
 x = np.asarray(search.gait.result.x, float)
 import resource
 def cpu():
     r = [resource.getrusage(k) for k in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
     return sum(u.ru_utime + u.ru_stime for u in r)
 t, c = time.perf_counter(), cpu()
-last, meshes = work.mesh(scene, x, sd, scene.mfpt or MfptSettings(), workers)
+last, meshes = work.mesh(scene, x, sd, scene.mfpt or MfptSettings(), workers, plant=plant)
 print(json.dumps({"wall_s": time.perf_counter() - t, "cpu_s": cpu() - c,
     "mfpt_steps": last.mfpt_steps,
     "cells": last.cells, "meshes": len(meshes), "converged": bool(last.converged),

@@ -53,7 +53,7 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
     """
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(Plant.from_scene(scene))
 
     def run(method, rtol, atol):
         backend = "scipy"

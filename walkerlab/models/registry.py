@@ -12,13 +12,15 @@ from walkerlab.walker.description import state_names, state_units
 from walkerlab.walker.plant import Plant
 
 
-def state_layout(scene, plant: Plant) -> tuple[list[str], list[str]]:
-    """State names and units of the rigid walker of ``scene``, from its description alone
-    (no equations derived, no code loaded): what :func:`build_walker` ``(scene)``'s
+def state_layout(plant: Plant) -> tuple[list[str], list[str]]:
+    """State names and units of the rigid walker of the plant's scene, from its description
+    alone (no equations derived, no code loaded): what :func:`build_walker` ``(plant)``'s
     ``state_names()`` and ``state_units()`` return.
 
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once,
-    by the caller).
+    Parameters
+    ----------
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker, described once by the caller.
 
     Returns
     -------
@@ -28,8 +30,9 @@ def state_layout(scene, plant: Plant) -> tuple[list[str], list[str]]:
     return state_names(roles), state_units(roles)
 
 
-def build_walker(scene, plant: Plant) -> HybridWalker:
-    """Build the rigid hybrid walker of a :class:`~walkerlab.config.Scene`.
+def build_walker(plant: Plant) -> HybridWalker:
+    """Build the rigid hybrid walker of a plant's scene (:attr:`~walkerlab.walker.plant.
+    Plant.scene`, a :class:`~walkerlab.config.Scene`).
 
     ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
     (``ideal.variant``); ``model: biped`` is any walker described as data, derived
@@ -40,9 +43,17 @@ def build_walker(scene, plant: Plant) -> HybridWalker:
     A ``walker.actuation`` section adds its actuators (:func:`walkerlab.models.hybrid.
     actuated.actuate`).
 
-    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant` (its walker described once:
-    by a stage, the API, or the caller that has just made ``scene``, a sweep's point, with
-    :meth:`~walkerlab.walker.plant.Plant.from_scene`).
+    Parameters
+    ----------
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once: by a stage or the API
+        (:meth:`~walkerlab.walker.plant.Plant.from_scene`), or for a neighbouring scene (a
+        sweep's point) from the plant handed down (:meth:`~walkerlab.walker.plant.Plant.
+        with_`).  Its ``scene`` decides the slope, the ground, the variant and the actuators.
+
+    Returns
+    -------
+    HybridWalker
 
     Raises
     ------
@@ -50,6 +61,7 @@ def build_walker(scene, plant: Plant) -> HybridWalker:
         The scene names a walker model or variant that has no rigid hybrid implementation,
         or actuators the walker cannot carry (one line).
     """
+    scene = plant.scene
     act = scene.walker.actuation
     walker = _on_ground(scene, plant, _passive(scene, plant))
     if act is None or walker.cycle is not None:  # footholds: each step's walker actuated
@@ -82,10 +94,11 @@ def _on_ground(scene, plant: Plant, walker: HybridWalker) -> HybridWalker:
     return walker
 
 
-def passive_walker_at(scene, plant: Plant):
-    """``(walker_at, data_at)``: ``slope [rad] -> HybridWalker`` (the scene's passive rigid
-    walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``
-    (:meth:`walkerlab.walker.plant.Plant.data_at` of ``plant``, the scene's plant)."""
+def passive_walker_at(plant: Plant):
+    """``(walker_at, data_at)``: ``slope [rad] -> HybridWalker`` (the plant's scene's passive
+    rigid walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``
+    (:meth:`walkerlab.walker.plant.Plant.data_at` of ``plant``)."""
+    scene = plant.scene
     own = {}
 
     def at(g: float) -> HybridWalker:
@@ -104,11 +117,11 @@ def _passive_on(scene, plant: Plant, g: float) -> HybridWalker:
         update={"angle_rad": float(g), "angle_deg": None})}), plant, float(g))
 
 
-def build_walker_on_steps(scene, steps, plant: Plant) -> HybridWalker:
-    """The scene's rigid walker on a finite list of per-step grounds (a drawn rough ground,
-    ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the stance
-    foot's level on ground of slope ``steps[k][1]`` [rad]; the walk ends after the list
-    (:func:`walkerlab.models.hybrid.ground.on_footholds`).  ``plant``: the scene's
+def build_walker_on_steps(plant: Plant, steps) -> HybridWalker:
+    """The plant's scene's rigid walker on a finite list of per-step grounds (a drawn rough
+    ground, ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the
+    stance foot's level on ground of slope ``steps[k][1]`` [rad]; the walk ends after the
+    list (:func:`walkerlab.models.hybrid.ground.on_footholds`).  ``plant``: the scene's
     :class:`~walkerlab.walker.plant.Plant`.
 
     Raises
@@ -116,6 +129,7 @@ def build_walker_on_steps(scene, steps, plant: Plant) -> HybridWalker:
     ValueError
         A ground other than the slope under it, or a walker that cannot walk it (one line).
     """
+    scene = plant.scene
     if scene.terrain is not None and not scene.terrain.is_slope:
         raise ValueError(f"terrain.kind: {scene.terrain.kind}: per-step draws are of a slope "
                          "(terrain.per_step on kind: slope)")

@@ -344,7 +344,7 @@ def _straight_legs(scene, plant, x_gait, period_s) -> OptimizeData:
                          "of two steps, whose landing is not transcribed yet; optimise legs "
                          "of one build, or on the slope")
     return (_step(scene, plant, spec, x_gait, period_s) if data.mirror is None
-            else _stride(scene, data, spec, x_gait, period_s))
+            else _stride(scene, plant, spec, x_gait, period_s))
 
 
 def _step(scene, plant, spec, x_gait, period_s) -> OptimizeData:
@@ -362,7 +362,7 @@ def _step(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     ground = step_ground(scene)
     if ground is not None and len(ground.drops_m) > 1:  # footholds that differ: a period
         return _footholds(scene, plant, spec, x_gait, period_s, ground)
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)
@@ -373,7 +373,7 @@ def _step(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     err, replayed = replay(data, res, drop_m=0.0 if ground is None else ground.drops_m[0])
     mu = replay_multipliers(replayed, res, scene, err)
     gait, contact_period, contact_outcome = reported.optimum_outcome(
-        scene, res, err, lambda: contact_replay(scene, res))
+        scene, res, err, lambda: contact_replay(scene, res, plant=plant))
     phases, phase_note = reported.hip_phase_replays_of(scene, data, res, torque_of_time(res))
     states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m,
@@ -408,7 +408,7 @@ def _footholds(scene, plant, spec, x_gait, period_s, ground) -> OptimizeData:
     if o.initial_guess is not None or x_gait is None:
         raise ValueError("optimize.initial_guess: footholds of several heights start from "
                          "the scene's own period gait (walkerlab fixedpoint); leave it out")
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     guess = footholds_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
                             spec.intervals)
     fns = cached_step_functions(data)
@@ -525,7 +525,7 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
     err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
     gait, contact_period, contact_outcome = reported.optimum_outcome(
-        scene, res, err, lambda: contact_replay_phased(scene, res, strides=2))
+        scene, res, err, lambda: contact_replay_phased(scene, res, strides=2, plant=plant))
     phases, phase_note = reported.hip_phase_replays_of(scene, data, res, phase_torque_of_time(res))
     states, units = reported.named_states(walker, res)
     return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
@@ -596,7 +596,7 @@ def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
                         intervals), None
 
 
-def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
+def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     """One stride of a walker whose legs differ (the step sequence of the walker and its
     mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
@@ -609,7 +609,7 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
 
-    o = scene.optimize
+    o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
     walker = make_rigid_walker(data)
     guess, guess_u = starting_stride(scene, _guide(walker, data, spec), x_gait, period_s,
@@ -622,7 +622,7 @@ def _stride(scene, data, spec, x_gait, period_s) -> OptimizeData:
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
-        scene, res, err, lambda: contact_replay_stride(scene, res, strides=2))
+        scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
     record = history_and_energies(scene, walker, res)

@@ -59,7 +59,7 @@ def optimize_five_link(scene, plant, x_gait=None, period_s=None) -> OptimizeData
                 and err <= o.replay_tolerance)
     why = "" if gait else (not_a_gait_outcome(err, res.status) if closed.converged else
                            "not replayed: not a gait (the shooting did not close the step)")
-    phases, contact = five_link_replays(scene, data, res, why)
+    phases, contact = five_link_replays(scene, plant, res, why)
     states, units = named_states(rigid, res)
     return OptimizeData(
         res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0, res.objective, err,
@@ -70,13 +70,16 @@ def optimize_five_link(scene, plant, x_gait=None, period_s=None) -> OptimizeData
         **history_and_energies(scene, rigid, res))
 
 
-def five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple]:
+def five_link_replays(scene, plant, res, not_gait: str = "") -> tuple[dict, tuple]:
     """The phase-variable replays
     (:func:`walkerlab.optimal.replay.virtual_constraints.phase_replays`) and the contact
     model's ``(step period [s], outcome)`` under the feed-forward + PD law from its closed
     start; an optimum that is not a gait is not replayed there (``not_gait``: why, the
-    contact outcome)."""
+    contact outcome); ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from
+    the stage."""
     from walkerlab.optimal.replay.contact import contact_replay_five_link  # light
+
+    data = plant.data
 
     if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
         return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "
@@ -92,7 +95,7 @@ def five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple
         return replays, (float("nan"), "not replayed: the feed-forward + PD law did not "
                          "close on the rigid model")
     contact = contact_replay_five_link(scene, laws["feedback"], fb.x0, fb.step_period_s,
-                                       strides=CONTACT_STRIDES)
+                                       strides=CONTACT_STRIDES, plant=plant)
     return replays, contact
 
 

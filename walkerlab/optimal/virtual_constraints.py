@@ -32,7 +32,6 @@ from walkerlab.optimal.transcription.virtual_constraints import (
     hzd_functions,
     mid_stance_window,
 )
-from walkerlab.walker.plant import Plant
 
 __all__ = ["CONTACT_CONE_FRACTION", "CONTROLLER_CONTACT", "DESIGN_ITERATIONS",
            "REPLAY_STRIDES", "ControllerDesign", "check_design", "clearance_report",
@@ -291,14 +290,15 @@ def controller_step(walker, solver, points: int):
 DESIGN_ITERATIONS = 1000
 
 
-def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesign:
+def _evaluate(scene, res, target, name: str, clearance: dict, plant) -> ControllerDesign:
     """The written controller of the optimum ``res`` on the rigid model: its coefficients
     in force, its restricted map and its full-order fixed point (from the zero dynamics'
     orbit; the gait search's work budget,
     :data:`walkerlab.analysis.gait.budget.ROOT_BUDGET_EVALUATIONS`); ``clearance``: the
     swing foot's (:func:`clearance_report`).  IPOPT's last
     iterate whose coefficients make no controller (a failed design) is recorded as it is,
-    with the reason in ``note``."""
+    with the reason in ``note``.  ``plant``: the scene's (the controller's scene is
+    :meth:`~walkerlab.walker.plant.Plant.with_` of it)."""
     from walkerlab.analysis.gait.budget import search_budget  # light
     from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
@@ -314,9 +314,9 @@ def _evaluate(scene, res, target, name: str, clearance: dict) -> ControllerDesig
         wall_time_s=res.wall_time_s, build_time_s=res.build_time_s, scene_file=name,
         t=res.t, x=res.x, u=res.u, history=res.history,
         violations=getattr(res, "violations", ""), **clearance)
-    plant = Plant.from_scene(sc)  # the designed controller's walker, described once
+    plant = plant.with_(sc)  # the designed controller's walker, described once
     try:
-        walker = build_walker(sc, plant)
+        walker = build_walker(plant)
     except ValueError as exc:  # a failed design's last iterate: no controller to check
         if res.status == "Solve_Succeeded":
             raise
@@ -372,7 +372,7 @@ def design_spec(scene, spec):
     return spec
 
 
-def design_controllers(scene, data, spec, print_level: int = 0,
+def design_controllers(scene, plant, spec, print_level: int = 0,
                        walker=None) -> list[ControllerDesign]:
     """Optimise one controller per target speed of ``scene`` (module docstring).
 
@@ -381,7 +381,8 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     scene : Scene
         With ``optimize.design: virtual_constraints`` and ``walker.actuation.
         virtual_constraints``.
-    data : WalkerData
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (by the stage).
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         The ``optimize`` section's (:func:`walkerlab.optimal.driver.collocation_spec`; its
         speed replaced by each of ``target_speeds_m_per_s``; its friction coefficient, when
@@ -416,7 +417,8 @@ def design_controllers(scene, data, spec, print_level: int = 0,
     o = scene.optimize
     vc = scene.walker.actuation.virtual_constraints
     spec = design_spec(scene, spec)
-    walker = build_walker(scene, plant=Plant.from_scene(scene)) if walker is None else walker
+    data = plant.data
+    walker = build_walker(plant.with_(scene)) if walker is None else walker
     K = 2 * int(o.intervals) + 1
     t, x, u, alpha, _zd = controller_step(walker, Solver.from_settings(scene.solver), K)
     t0 = time.perf_counter()
@@ -438,7 +440,8 @@ def design_controllers(scene, data, spec, print_level: int = 0,
             res.build_time_s += build
             out.append(_evaluate(scene, res, v, f"{scene.name}_controller_{i + 1}.yaml",
                                  {**clearance_report(fns, res.x, window),
-                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)}))
+                                  "friction_ratio": _friction_ratio(fns, res.x, res.u)},
+                                 plant))
             speed = "no target speed" if v is None else f"{v:g} m/s"
             bar.advance(info=f"controller {i + 1} ({speed}): {res.status}")
             if res.status == "Solve_Succeeded":  # the next speed starts here
@@ -475,10 +478,11 @@ def _friction_ratio(fns, x, u) -> float:
     return float(np.max(np.abs(f[:, 1]) / np.maximum(f[:, 0], 1e-12)))
 
 
-def replay_in_contact(scene, c: ControllerDesign) -> ControllerDesign:
+def replay_in_contact(scene, c: ControllerDesign, plant) -> ControllerDesign:
     """``c`` with its contact replay (:func:`walkerlab.optimal.replay.contact.
     contact_replay_controller` of :func:`controller_scene`, :data:`REPLAY_STRIDES`
-    strides from the rigid fixed point); not replayed without one."""
+    strides from the rigid fixed point); not replayed without one.  ``plant``: the
+    scene's, from the stage."""
     from walkerlab.optimal.replay.contact import contact_replay_controller  # light
 
     if c.x_star is None or not np.isfinite(c.full_order_step_period_s):
@@ -486,7 +490,7 @@ def replay_in_contact(scene, c: ControllerDesign) -> ControllerDesign:
                        "fixed point")
     r = contact_replay_controller(controller_scene(scene, c.bezier_rad), c.x_star,
                                   c.full_order_step_period_s, c.step_length_m,
-                                  strides=REPLAY_STRIDES)
+                                  strides=REPLAY_STRIDES, plant=plant)
     steady = float("nan") if r["outcome"].startswith("not replayed") else \
         float(r["walks"] and not r["trend"])
     return replace(c, contact_step_period_s=r["step_period_s"],
@@ -515,10 +519,9 @@ def optimize_virtual_constraints(scene, plant, spec):
     """
     from walkerlab.models.registry import build_walker
 
-    data = plant.data
-    walker = build_walker(scene, plant)  # one build for the design and the record
-    cs = [replay_in_contact(scene, c) for c in design_controllers(scene, data, spec,
-                                                                   walker=walker)]
+    walker = build_walker(plant.with_(scene))  # one build for the design and the record
+    cs = [replay_in_contact(scene, c, plant) for c in design_controllers(scene, plant, spec,
+                                                                          walker=walker)]
     c = cs[0]
     res = _AsResult(c)
     states, units = reported.named_states(walker, res)

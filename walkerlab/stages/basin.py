@@ -18,6 +18,7 @@ from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.plotting.artifact_figures import save_basin_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.studies.basin import BasinError, basin_run
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "basin")
 
@@ -67,7 +68,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         key = input_hash("basin", scene, SECTIONS, (up,), extra)  # run_cached's own key
         try:
             basin, part = basin_run(scene, x_star, key, stage_artifact(scene, runs_root, name),
-                                    grid, workers, scheduler, resume and not force, on_chunk)
+                                    grid, workers, scheduler, resume and not force, on_chunk,
+                                    plant=Plant.from_scene(scene))  # described once
         except BasinError as exc:
             raise StageError(str(exc)) from None
         partial.append(part)

@@ -20,6 +20,7 @@ from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.plotting.artifact_figures import save_bifurcation_figure
 from walkerlab.stages.common import StageOutcome, run_cached, with_defaults
 from walkerlab.studies.bifurcation import bifurcation_diagram, diagram_summary, grid_key
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 
@@ -52,7 +53,8 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
 
     def compute():
         res = bifurcation_diagram(scene, slopes, n_transient, n_keep, workers, scheduler,
-                                  steady_state=steady_state, param=param, unit=unit)
+                                  steady_state=steady_state, param=param, unit=unit,
+                                  plant=Plant.from_scene(scene))  # described once, handed down
         return bifurcation_writer(res), {"onset": res.onset["onset"]}
 
     out = run_cached("bifurcation", scene, runs_root, SECTIONS, (), compute, force,

@@ -18,6 +18,7 @@ from walkerlab.io.schemas.continuation import continuation_writer, load_continua
 from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.studies.continuation import check_continuation, run_continuation
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 
@@ -57,7 +58,8 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
 
     def compute():
         try:
-            res, curves = run_continuation(scene, path, start, stop, switch, path2, range2)
+            res, curves = run_continuation(scene, path, start, stop, switch, path2, range2,
+                                           plant=Plant.from_scene(scene))  # handed down
         except MapFailed as exc:
             raise StageError(f"continuation of {path}: {exc}") from None
         summary = {"special_points": [(s.kind, s.p, s.period, s.cause) for s in res.specials]}

@@ -175,7 +175,7 @@ def _own_gait(scene: Scene):
     from walkerlab.walker.plant import Plant  # light
 
     plant = Plant.from_scene(scene)  # the walker described once, handed down
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant)
     try:
         _, search = solve_scene(scene, fd_check=False, guess=initial_guess(scene, walker),
                                 walker=walker, other_gait=False, plant=plant)
@@ -184,7 +184,7 @@ def _own_gait(scene: Scene):
     return search.result.x
 
 
-def _nearby(scene: Scene, runs_root):
+def _nearby(scene: Scene, runs_root, plant):
     """The nearest stored gait, or the gait of the scene the initial guess was written for
     (:func:`guess_owners`), as a fallback start of the gait search (carried here), or
     None; the scene files are read only when the start is tried."""
@@ -193,10 +193,10 @@ def _nearby(scene: Scene, runs_root):
 
     stored = stored_gaits(scene, runs_root)
     if not _may_have_guess_owner(scene):
-        return stored_gait_start(scene, stored) if stored else None
+        return stored_gait_start(scene, stored, plant=plant) if stored else None
 
     def find():  # the scene files are read only when the guess has failed
-        start = stored_gait_start(scene, stored + guess_owners(scene))
+        start = stored_gait_start(scene, stored + guess_owners(scene), plant=plant)
         return None if start is None else start.find()
 
     return FallbackStart("the nearest stored gait, or the gait of the scene the initial "
@@ -239,9 +239,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             if src is not None:  # the known gait carried here
                 from walkerlab.studies.continuation import homotopy_start  # light
 
-                guess, note = homotopy_start(scene, src)
+                guess, note = homotopy_start(scene, src, plant=plant)
             else:  # a gait stored nearby: a start should the scene's own guess fail
-                nearby = _nearby(scene, runs_root)
+                nearby = _nearby(scene, runs_root, plant)
             run, summary = fixed_point_run(scene, compare_variants, guess, note, nearby,
                                            plant=plant)
         except GaitNotFound as exc:

@@ -223,7 +223,8 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
 
     def compute():
         try:
-            r = design_optimize(scene, bounds, objective, load_fixedpoint(up).x, maximize)
+            r = design_optimize(scene, bounds, objective, load_fixedpoint(up).x, maximize,
+                                plant=Plant.from_scene(scene))  # described once, handed down
         except (ValueError, FixedPointNotFound) as exc:
             msg = str(exc)
             raise StageError(msg if msg.startswith("optimize --design")

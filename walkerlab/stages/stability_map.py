@@ -23,7 +23,7 @@ from walkerlab.studies.stability import (
     default_spec,
     stability_map_run,
 )
-from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 
@@ -48,7 +48,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     scene = with_defaults(scene, "contact", "stability-map")  # left out: the paper's contact law
     require(scene, "fixedpoint", "stability-map")
-    walker_kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
+    plant = Plant.from_scene(scene)  # the walker described once, handed down
+    walker_kind = plant.kind
     walker_kind.require("walk", "contact", walker_kind.field)  # a map of the contact gait
     why = map_not_applicable(scene, kind)
     if why:
@@ -61,7 +62,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                 else 0.10)
 
     def compute():
-        run, summary = stability_map_run(scene, spec, workers, progress)
+        run, summary = stability_map_run(scene, spec, workers, progress, plant=plant)
         return (lambda f: write_stability_map(f, run)), summary
 
     out = run_cached(stage_name(spec.kind), scene, runs_root, SECTIONS, (), compute, force,

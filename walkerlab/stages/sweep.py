@@ -17,6 +17,7 @@ from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.io.sweep_store import load_sweep
 from walkerlab.studies.params import ParamAxis, SweepError, params_hash, parse_param, sweep_axes
 from walkerlab.studies.runner import run_sweep
+from walkerlab.walker.plant import Plant
 
 __all__ = ["run", "parse_param", "sweep_path", "SweepError", "STAGE_NAMES"]
 
@@ -63,7 +64,8 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
     path = run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
-                     on_chunk=on_chunk, pool=pool)
+                     on_chunk=on_chunk, pool=pool,
+                     plant=Plant.from_scene(scene))  # described once, handed down
     if figure:
         draw(scene, path, runs_root)
     return path

@@ -115,8 +115,8 @@ def _resumed_cells(part: Path, key: str, nx: int, ny: int):
 
 def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                   grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
-                  resume: bool = True, on_chunk: Callable[[int, int], None] | None = None
-                  ) -> dict:
+                  resume: bool = True, on_chunk: Callable[[int, int], None] | None = None,
+                  *, plant) -> dict:
     """Classify every cell of the basin grid; resumable through ``<out_path>.partial``.
 
     Parameters
@@ -137,6 +137,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         Keep the cells of a matching partial file.
     on_chunk : callable(done, total), optional
         Called after each chunk is stored.
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, built by the stage (the tasks carry it).
 
     Returns
     -------
@@ -155,7 +157,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         # no axes named: left unset for the workers too (the dump would set the defaults),
         # so each takes this walker's (:func:`default_axes`)
         base["basin"] = scene.basin.model_dump(mode="json", exclude_unset=True)
-    walker, st, mst = walker_and_settings(base)
+    walker, st, mst = walker_and_settings(base, plant)
     xs, ys = axis_values(st, walker, x_star, grid)
     x_pre = _start_pre_impact(walker, x_star, st, mst, xs, ys)
     nx, ny = xs.size, ys.size
@@ -168,7 +170,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
                   "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
         row_hash = np.array([""] * ny, dtype=object)
-    tasks = _basin_tasks(base, walker, st, x_star, xs, ys, arrays, x_pre)
+    tasks = _basin_tasks(base, walker, st, x_star, xs, ys, arrays, x_pre, plant)
     t0 = time.perf_counter()
     part.unlink(missing_ok=True)
     computed = _run_basin_tasks(tasks, part, key, arrays, row_hash, nx, ny, workers, scheduler,
@@ -208,7 +210,7 @@ def _start_pre_impact(walker, x_star: np.ndarray, st, mst: float, xs: np.ndarray
 
 
 def _basin_tasks(base: dict, walker, st, x_star: np.ndarray, xs: np.ndarray, ys: np.ndarray,
-                 arrays: dict, x_pre: tuple) -> list[BasinTask]:
+                 arrays: dict, x_pre: tuple, plant) -> list[BasinTask]:
     """The chunks of :func:`compute_basin`: one :class:`BasinTask` per grid row with cells
     still not done in ``arrays`` (those cells only), the rows nearest the fixed point's
     ``y`` value first (they converge slowly: started first for load balance)."""
@@ -218,7 +220,8 @@ def _basin_tasks(base: dict, walker, st, x_star: np.ndarray, xs: np.ndarray, ys:
         cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)
                       if arrays["outcome"][j, i] == NOT_DONE)
         if cells:
-            tasks.append(BasinTask(base, tuple(float(v) for v in x_star), cells, x_pre))
+            tasks.append(BasinTask(base, tuple(float(v) for v in x_star), cells, x_pre,
+                                   plant=plant))
     # rows through the fixed point converge slowly: start them first for load balance
     jc = int(np.argmin(np.abs(ys - x_star[walker.state_names().index(st.y_axis)])))
     tasks.sort(key=lambda t: abs(t.cells[0][0] // nx - jc))
@@ -259,9 +262,10 @@ def _run_basin_tasks(tasks: list[BasinTask], part: Path, key: str, arrays: dict,
 
 def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
               grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
-              resume: bool = True, on_chunk: Callable[[int, int], None] | None = None):
-    """:func:`compute_basin` (same arguments; ``x_star`` of shape (2n,) [rad, rad/s]) packed
-    for the basin artifact.
+              resume: bool = True, on_chunk: Callable[[int, int], None] | None = None, *,
+              plant):
+    """:func:`compute_basin` (same arguments; ``x_star`` of shape (2n,) [rad, rad/s];
+    ``plant``: the scene's, from the stage) packed for the basin artifact.
 
     Returns
     -------
@@ -279,7 +283,7 @@ def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
     from walkerlab.io.schemas.basin import BasinRun  # light
 
     res = compute_basin(scene, x_star, key, out_path, grid, workers, scheduler, resume=resume,
-                        on_chunk=on_chunk)
+                        on_chunk=on_chunk, plant=plant)
     counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
     # the settings the cells were computed with: the axes this walker's default ones
     # (:func:`default_axes`: a 3D wheel's lean and lean rate) where the scene names none

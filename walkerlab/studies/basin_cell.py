@@ -35,7 +35,8 @@ The grid, its chunks, the partial file and resuming are :mod:`walkerlab.studies.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -48,7 +49,6 @@ from walkerlab.studies.basin_slice import (
     heel_strike_slice,
     slice_state,
 )
-from walkerlab.walker.plant import Plant
 
 OUTCOMES = ("converged", "other_attractor", "fell_forward", "fell_backward", "max_steps",
             "stalled", "unreachable")
@@ -149,6 +149,8 @@ class BasinTask:
         Fixed point (role-ordered).
     cells : tuple of (int, float, float)
         ``(flat index, x value, y value)``.
+    plant : walkerlab.walker.plant.Plant
+        The study's plant, built by the stage (it pickles with the task).
     """
 
     base: dict
@@ -156,15 +158,18 @@ class BasinTask:
     cells: tuple
     #: the fixed point's pre-impact state (``basin.start: heel_strike``), else empty
     x_pre: tuple = ()
+    plant: Any = field(kw_only=True)
 
 
 _WALKERS: dict[str, object] = {}
 
 
-def walker_and_settings(base: dict):
+def walker_and_settings(base: dict, plant):
     """``(walker, basin settings, max step time [s])`` of a scene mapping, built once per
     process (the last scene's kept); the settings' axes are the walker's
-    (:func:`default_axes`) when the scene names none."""
+    (:func:`default_axes`) when the scene names none.  ``plant``: the study's
+    :class:`~walkerlab.walker.plant.Plant`, handed down (the walker of ``base`` is
+    :meth:`~walkerlab.walker.plant.Plant.with_` of it)."""
     from walkerlab.models.registry import build_walker
 
     key = json.dumps(base, sort_keys=True)
@@ -174,7 +179,7 @@ def walker_and_settings(base: dict):
         st = scene.basin or BasinSettings()
         mst = st.max_step_time_s or (scene.fixedpoint.max_step_time_s if scene.fixedpoint
                                      else 5.0)
-        walker = build_walker(scene, plant=Plant.from_scene(scene))
+        walker = build_walker(plant.with_(scene))
         if not {"x_axis", "y_axis"} & st.model_fields_set:  # the default axes: this walker's
             st = st.model_copy(update=dict(zip(("x_axis", "y_axis"),
                                                default_axes(walker, (st.x_axis, st.y_axis)))))
@@ -201,7 +206,7 @@ def default_axes(walker, axes: tuple[str, str]) -> tuple[str, str]:
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]`` (a
     cell with no state on the heel-strike surface: ``unreachable``)."""
-    walker, st, max_step_time = walker_and_settings(task.base)
+    walker, st, max_step_time = walker_and_settings(task.base, task.plant)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
     x_star = np.asarray(task.x_star, dtype=float)
     axes = (st.x_axis, st.y_axis)

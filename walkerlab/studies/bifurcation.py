@@ -48,18 +48,17 @@ from walkerlab.studies.map_length import study_steps_per_map
 from walkerlab.studies.params import ParamAxis
 from walkerlab.studies.runner import sweep_executor
 from walkerlab.studies.sweep_plan import plan_chunks
-from walkerlab.walker.plant import Plant
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
            "min_real_multiplier", "parameter_values", "onset_value", "fall_onset", "grid_key",
            "diagram_summary"]
 
 def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH,
-       steps_per_map: int = 0) -> tuple[float, np.ndarray]:
+       steps_per_map: int = 0, *, plant) -> tuple[float, np.ndarray]:
     from walkerlab.studies.point_gait import ideal_fixed_point, on_study_map
 
     scene = scene_at(scene_base, value, path)
-    w, res, _s = ideal_fixed_point(scene, guess)
+    w, res, _s = ideal_fixed_point(scene, guess, plant=plant)
     _w, res = on_study_map(scene, w, res, steps_per_map)  # the study's one map
     return 1.0 + min_real_multiplier(res.multipliers_variational), res.x
 
@@ -74,7 +73,7 @@ def _onset_dict(onset: float, bracket, mult_at: float, n: int, path: str) -> dic
 
 def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
                            x: np.ndarray, xtol_deg: float = 1e-4,
-                           path: str = SLOPE_PATH, steps_per_map: int = 0) -> dict:
+                           path: str = SLOPE_PATH, steps_per_map: int = 0, *, plant) -> dict:
     """Parameter value where the most negative real multiplier crosses -1.
 
     The first grid interval where ``g = 1 + min real multiplier`` goes from > 0 to <= 0
@@ -97,6 +96,8 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
         The dotted scene field of the grid (default :data:`SLOPE_PATH`).
     steps_per_map : int
         The study's one Poincaré map (``mult``'s; 0: each walker's own).
+    plant : walkerlab.walker.plant.Plant
+        The study's, from the stage (each value's is its ``with_``).
 
     Returns
     -------
@@ -116,7 +117,7 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
         state = {"guess": x[k] if rising else x[k + 1], "n": 0}
 
         def f(s, state=state):
-            val, xs = _g(base, s, state["guess"], path, steps_per_map)
+            val, xs = _g(base, s, state["guess"], path, steps_per_map, plant=plant)
             state["n"] += 1
             state["guess"] = xs
             return val
@@ -210,7 +211,7 @@ def _distinct(v: np.ndarray, tol: float = 1e-4) -> int:
 def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep: int = 30,
                         workers: int = 2, scheduler=None, steady_state: bool = True,
                         xtol_deg: float | None = None, param: str = SLOPE_PATH,
-                        unit: str | None = None) -> BifurcationResult:
+                        unit: str | None = None, *, plant) -> BifurcationResult:
     """Compute the bifurcation diagram of the scene's rigid walker over the slope or over any
     numeric scene field.
 
@@ -236,6 +237,8 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         Dotted scene field (lists by item name or index, as ``walkerlab sweep``).
     unit : str, optional
         Its SI unit (default: :func:`walkerlab.studies.params.axis_unit`).
+    plant : walkerlab.walker.plant.Plant
+        The scene's, built by the stage (the tasks carry it; each value's is its ``with_``).
 
     Returns
     -------
@@ -258,19 +261,21 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         xtol_deg = 1e-4 if param == SLOPE_PATH else 1e-5 * (span or 1.0)
     base = scene.model_dump(mode="json")
     # one map for every value (a stride where any value's walker needs one)
-    steps = study_steps_per_map(base, [param], [(float(s),) for s in slopes], "<bifurcation>")
-    rows = _grid_rows(base, axis, n_transient, n_keep, steady_state, workers, scheduler, steps)
+    steps = study_steps_per_map(base, [param], [(float(s),) for s in slopes], "<bifurcation>",
+                                plant=plant)
+    rows = _grid_rows(base, axis, n_transient, n_keep, steady_state, workers, scheduler, steps,
+                      plant)
     x = np.array([r["x"] for r in rows])
     mult = np.array([r["multipliers"] for r in rows])
-    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param, steps)
-    res = _diagram_result(scene, slopes, rows, x, mult, onset, n_transient, n_keep, param,
-                          unit)
+    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param, steps, plant=plant)
+    res = _diagram_result(plant.with_(scene), slopes, rows, x, mult, onset, n_transient,
+                          n_keep, param, unit)
     res.steps_per_map = steps
     return res
 
 
 def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, steady_state: bool,
-               workers: int, scheduler, steps_per_map: int = 0) -> list[dict]:
+               workers: int, scheduler, steps_per_map: int, plant) -> list[dict]:
     """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
     state; :func:`bifurcation_chunk`), in grid order: the grid of ``axis`` is cut into runs
     (:func:`walkerlab.studies.sweep_plan.plan_chunks`, the same runs for any ``workers``
@@ -283,7 +288,7 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
     # continuation start (hence its row) is its run's previous value on any executor
     chunks = plan_chunks([axis], base)
     tasks = [BifurcationTask(base, tuple(c), n_transient, n_keep, steady_state, param,
-                             steps_per_map) for c in chunks]
+                             steps_per_map, plant=plant) for c in chunks]
     rows = []
     with progress.task(f"bifurcation: {n} values of {param}", n) as bar:
         with sweep_executor(workers, scheduler) as ex:
@@ -294,19 +299,19 @@ def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, stead
     return rows
 
 
-def _diagram_result(scene: Scene, slopes: np.ndarray, rows: list[dict], x: np.ndarray,
+def _diagram_result(plant, slopes: np.ndarray, rows: list[dict], x: np.ndarray,
                     mult: np.ndarray, onset: dict, n_transient: int, n_keep: int, param: str,
                     unit: str) -> BifurcationResult:
     """:func:`bifurcation_diagram`'s rows packed as a :class:`BifurcationResult`: the fixed
     points ``x`` and multipliers ``mult`` with the fixed points' inter-leg angles (from the
-    scene's walker; NaN where no fixed point was found), the steady state's heel strikes in
-    degrees and the attractor period (distinct inter-leg angles among them), the grid
+    walker of ``plant``; NaN where no fixed point was found), the steady state's heel strikes
+    in degrees and the attractor period (distinct inter-leg angles among them), the grid
     ``slopes`` of ``param`` [``unit``] and the period-doubling ``onset``."""
     from walkerlab.models.registry import build_walker
     from walkerlab.studies.point_columns import interleg_angle
 
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(plant)
     fp_il = np.degrees([interleg_angle(walker, xi) if np.all(np.isfinite(xi)) else math.nan
                         for xi in x])
     return BifurcationResult(

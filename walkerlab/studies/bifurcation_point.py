@@ -16,20 +16,22 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
-from walkerlab.walker.plant import Plant
 
 
 @dataclass(frozen=True)
 class BifurcationTask:
     """A run of grid values evaluated in order by one worker (picklable): the base scene
     (``Scene.model_dump(mode="json")``), ``points`` ``((index, (value,)), ...)``, the steady
-    state's settings and the swept field's dotted ``path``."""
+    state's settings, the swept field's dotted ``path`` and the study's ``plant`` (the base
+    scene's :class:`~walkerlab.walker.plant.Plant`, built by the stage; each value's is
+    :meth:`~walkerlab.walker.plant.Plant.with_` of it)."""
 
     base: dict
     points: tuple            # ((index, (value,)), ...)
@@ -38,6 +40,7 @@ class BifurcationTask:
     steady_state: bool
     path: str = SLOPE_PATH
     steps_per_map: int = 0   # the study's one map (0: each walker's own)
+    plant: Any = field(kw_only=True)
 
 
 def scene_at(base: dict, value: float, path: str = SLOPE_PATH) -> Scene:
@@ -86,7 +89,7 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
     for index, (value,) in task.points:
         t0 = time.perf_counter()
         sc = scene_at(task.base, value, task.path)
-        n = len(build_walker(sc, Plant.from_scene(sc)).state_names())
+        n = len(build_walker(task.plant.with_(sc)).state_names())
         row = {"index": index, "value": value, "x": np.full(n, np.nan),
                "multipliers": np.full(n, np.nan, complex), "period_s": math.nan,
                "fp_outcome": "ok", "message": "", "hs_interleg": np.full(task.n_keep, np.nan),
@@ -94,20 +97,20 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
             scene = scene_at(task.base, value, task.path)
-            plant = Plant.from_scene(scene)  # this value's walker, described once
+            plant = task.plant.with_(scene)  # this value's walker, from the study's plant
             try:
                 if fam is None:  # the walker over the grid's field, built once a chunk
-                    fam = scene_family(scene, task.path)
+                    fam = scene_family(scene, task.path, plant=plant)
                     if task.steps_per_map:  # the study's one map at every value
                         fam = dataclasses.replace(fam, steps_per_map=task.steps_per_map,
                                                   _cache={})
                 q = _arclength_step(fam, prev, value)
                 if q is not None:  # the neighbour's branch followed to this value
-                    walker = build_walker(scene, plant=plant)
+                    walker = build_walker(plant)
                     row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
                                period_s=q.period_s / fam.steps(walker))  # per step
                 else:
-                    walker, res = _value_gait(scene, guess)
+                    walker, res = _value_gait(scene, guess, plant)
                     on_map, res = on_study_map(scene, walker, res, task.steps_per_map)
                     row.update(x=res.x, period_s=res.period_s / on_map.steps_per_map,
                                multipliers=np.asarray(res.multipliers_variational, complex))
@@ -115,10 +118,10 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
                 prev = (value, q if q is not None else row["x"])
             except PointOutcome as exc:
                 row.update(fp_outcome=exc.outcome, message=exc.message)
-                walker = build_walker(scene, plant=plant)
+                walker = build_walker(plant)
             except Exception as exc:  # noqa: BLE001
                 row.update(fp_outcome="error", message=f"{type(exc).__name__}: {exc}")
-                walker = build_walker(scene, plant=plant)
+                walker = build_walker(plant)
             if task.steady_state:
                 x_att = _steady_state(task, scene, walker, row, x_att)
         row["wall_time_s"] = time.perf_counter() - t0
@@ -126,13 +129,14 @@ def bifurcation_chunk(task: BifurcationTask) -> list[dict]:
     return out
 
 
-def _value_gait(scene, guess):
+def _value_gait(scene, guess, plant):
     """The period-1 gait of one value's ``scene`` (:func:`bifurcation_chunk`, where the
     neighbour's branch does not reach it): from the neighbour's fixed point ``guess`` (or
     the scene's own start, :func:`~walkerlab.studies.point_gait.ideal_fixed_point`), and
     when that finds none, the gait ``walkerlab fixedpoint`` finds for the scene
     (:func:`~walkerlab.studies.point_gait.scene_gait`: its guess, then the seeds): a value
-    is recorded ``no_fixed_point`` only when a fresh start finds no gait either.
+    is recorded ``no_fixed_point`` only when a fresh start finds no gait either.  ``plant``:
+    the value's plant (:meth:`~walkerlab.walker.plant.Plant.with_` of the study's).
 
     Returns
     -------
@@ -151,11 +155,11 @@ def _value_gait(scene, guess):
     )
 
     try:
-        walker, res, _src = ideal_fixed_point(scene, guess)
+        walker, res, _src = ideal_fixed_point(scene, guess, plant=plant)
     except PointOutcome as exc:
         if exc.outcome != "no_fixed_point":
             raise
-        walker, search, _src = scene_gait(scene)
+        walker, search, _src = scene_gait(scene, plant=plant)
         res = search.result
     return walker, res
 

@@ -23,7 +23,6 @@ from walkerlab.analysis.continuation.two_parameter import two_parameter
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.studies.params import ParamAxis, apply_point, axis_unit, check_axes
-from walkerlab.walker.plant import Plant
 
 __all__ = ["scene_family", "scene_value", "check_continuation", "run_continuation",
            "numeric_fields", "homotopy_family", "homotopy_gait", "known_scene",
@@ -34,8 +33,11 @@ NOT_WALKER = ("name", "source", "published", "fixedpoint", "simulate", "contact"
               "contact_sim", "contact_solver", "terrain", "workprecision", "solver", "ideal")
 
 
-def scene_family(scene: Scene, path: str) -> WalkerFamily:
+def scene_family(scene: Scene, path: str, *, plant) -> WalkerFamily:
     """The scene's walker as a function of the field ``path`` (and any fields held fixed).
+
+    ``plant``: the scene's, handed down; each value's is :meth:`~walkerlab.walker.plant.
+    Plant.with_` of it.
 
     Raises
     ------
@@ -54,7 +56,7 @@ def scene_family(scene: Scene, path: str) -> WalkerFamily:
         except SceneError as exc:
             raise MapFailed("parameter leaves the scene's domain",
                             str(exc).split("]: ", 1)[-1]) from None
-        return build_walker(sc, plant=Plant.from_scene(sc))
+        return build_walker(plant.with_(sc))
 
     return WalkerFamily(make, path, Solver.from_settings(scene.solver),
                         fp.max_step_time_s if fp is not None else 5.0)
@@ -95,7 +97,7 @@ def _field_range(scene: Scene, opt: str, path, start, stop) -> tuple[float, floa
         raise SceneError(f"{opt} {path}: start and stop are both {a:g}; a continuation "
                          "needs a range: FIELD=START:STOP with two different numbers")
     try:
-        scene_family(scene, path)  # an unknown field: one line before anything runs
+        check_axes(scene, [ParamAxis(path, (), path)], values=False)  # an unknown field
         whole = takes_whole_numbers(scene, ParamAxis(path, (), path))
     except SweepError as exc:
         raise SweepError(str(exc).replace("--param ", f"{opt} ", 1)) from None
@@ -153,7 +155,8 @@ def check_continuation(scene: Scene, path, start, stop, path2=None, range2=None
 
 def run_continuation(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
                      path2: str | None = None, range2: tuple | None = None,
-                     n2: int = 25, ds_max: float = 0.1) -> tuple[ContinuationResult, list]:
+                     n2: int = 25, ds_max: float = 0.1, *, plant
+                     ) -> tuple[ContinuationResult, list]:
     """Continue the scene's gait over ``path`` in ``[start, stop]``.
 
     Parameters
@@ -172,6 +175,8 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
         period-1 branch is continued in the plane (``path``, ``path2``).
     ds_max : float
         Largest arclength step (scaled: the range's span is 1).
+    plant : walkerlab.walker.plant.Plant
+        The scene's, built by the stage (each step's is its ``with_``).
 
     Returns
     -------
@@ -192,11 +197,11 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     p0 = scene_value(scene, path)
     lo, hi = min(start, stop), max(start, stop)
     # one map (step or stride) along the whole branch, even where the legs become equal
-    fam = scene_family(scene, path).sharing_map((lo, hi, min(max(p0, lo), hi)))
+    fam = scene_family(scene, path, plant=plant).sharing_map((lo, hi, min(max(p0, lo), hi)))
     at = scene if lo <= p0 <= hi else apply_point(scene.model_dump(mode="json"), [path],
                                                   (min(max(p0, lo), hi),), "<continuation>")
     try:
-        _w, gait, _src = ideal_fixed_point(at, None)
+        _w, gait, _src = ideal_fixed_point(at, None, plant=plant)
     except PointOutcome as exc:
         raise MapFailed("no gait at the scene's own value", exc.message) from None
     res = continuation(fam, min(max(p0, lo), hi), gait.x, (lo, hi), unit, switch=switch,
@@ -265,9 +270,10 @@ def _slope_rad(s: dict) -> float:
     return math.radians(float(s["angle_deg"]))
 
 
-def homotopy_family(known: Scene, new: Scene):
+def homotopy_family(known: Scene, new: Scene, *, plant):
     """``(make, fields)``: ``make({"lambda": v})`` builds the walker whose numeric fields are
     ``(1 - v) known + v new``; ``fields`` maps each differing path to ``(known, new)``.
+    ``plant``: the new scene's, handed down (each walker on the way is its ``with_``).
 
     Raises
     ------
@@ -288,14 +294,15 @@ def homotopy_family(known: Scene, new: Scene):
         except SceneError as exc:
             raise MapFailed("parameter leaves the scene's domain",
                             str(exc).split("]: ", 1)[-1]) from None
-        return build_walker(sc, plant=Plant.from_scene(sc))
+        return build_walker(plant.with_(sc))
 
     return make, fields
 
 
-def homotopy_gait(known: Scene, new: Scene):
+def homotopy_gait(known: Scene, new: Scene, *, plant):
     """The known scene's gait carried to the new scene's walker (see
-    :func:`walkerlab.analysis.continuation.homotopy.homotopy`).
+    :func:`walkerlab.analysis.continuation.homotopy.homotopy`); ``plant``: the new scene's
+    :class:`~walkerlab.walker.plant.Plant`, handed down.
 
     Returns
     -------
@@ -311,9 +318,9 @@ def homotopy_gait(known: Scene, new: Scene):
     """
     from walkerlab.studies.point_gait import PointOutcome, ideal_fixed_point  # light
 
-    make, fields = homotopy_family(known, new)
+    make, fields = homotopy_family(known, new, plant=plant)
     try:
-        _w, gait, _src = ideal_fixed_point(known, None)
+        _w, gait, _src = ideal_fixed_point(known, None, plant=plant)
     except PointOutcome as exc:
         raise MapFailed("no gait for the known scene", exc.message) from None
     fp = new.fixedpoint or known.fixedpoint
@@ -349,9 +356,10 @@ def known_scene(scene: Scene, known=None) -> Scene | None:
     return load_scene(path)
 
 
-def homotopy_start(scene: Scene, known: Scene):
+def homotopy_start(scene: Scene, known: Scene, *, plant):
     """The known scene's gait carried to this walker (a start for the root finder) and a
-    note on the way it went.
+    note on the way it went; ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`,
+    handed down by the front.
 
     Returns
     -------
@@ -366,7 +374,7 @@ def homotopy_start(scene: Scene, known: Scene):
         named) - one line.
     """
     try:
-        res = homotopy_gait(known, scene)
+        res = homotopy_gait(known, scene, plant=plant)
     except (ValueError, MapFailed) as exc:
         raise ValueError(f"fixedpoint.from {known.name}: {exc}") from None
     if not res.reached:

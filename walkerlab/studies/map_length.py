@@ -19,7 +19,6 @@ import math
 from walkerlab.config import SceneError
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.params import apply_point
-from walkerlab.walker.plant import Plant
 
 __all__ = ["MODEL_SECTIONS", "study_steps_per_map"]
 
@@ -28,7 +27,8 @@ __all__ = ["MODEL_SECTIONS", "study_steps_per_map"]
 MODEL_SECTIONS = ("walker.", "terrain.", "ideal.")
 
 
-def study_steps_per_map(base: dict, paths: list[str], points, origin: str = "<study>") -> int:
+def study_steps_per_map(base: dict, paths: list[str], points, origin: str = "<study>", *,
+                        plant) -> int:
     """Steps of the one Poincaré map of a study over ``points``: the least common multiple
     of the maps of the rigid walkers at the points (1: a step, 2: a stride).
 
@@ -47,6 +47,9 @@ def study_steps_per_map(base: dict, paths: list[str], points, origin: str = "<st
         Values of ``paths`` at each point, in their fields' units.
     origin : str
         Scene origin for messages.
+    plant : walkerlab.walker.plant.Plant
+        The study's plant (its base scene's, handed down): each point's walker is
+        :meth:`~walkerlab.walker.plant.Plant.with_` of it.
 
     Returns
     -------
@@ -68,7 +71,7 @@ def study_steps_per_map(base: dict, paths: list[str], points, origin: str = "<st
         at = tuple(values[i] if i in model else first[i] for i in range(len(values)))
         try:
             sc = apply_point(base, list(paths), at, origin)
-            own = build_walker(sc, Plant.from_scene(sc)).steps_per_map
+            own = build_walker(plant.with_(sc)).steps_per_map
         except (SceneError, ValueError):
             continue
         steps = math.lcm(steps, own)

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -42,16 +43,18 @@ def scene_walker_at(scene, plant):
 
     def at(gamma: float):
         on = plant.on_slope(gamma)
-        return build_walker(on.scene, on)
+        return build_walker(on)
     return at
 
 
-def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
+def step_map_for(base: dict, heights: bool = False, *, plant) -> BatchStepMap:
     """The batched step map of a scene mapping (built once per process; a walker without
     compiled flows, e.g. flat feet, gets the row-by-row
     :class:`~walkerlab.integrate.python_step.PythonStepMap`); ``heights``: its heel strike
     written as the swing foot's clearance, for per-step landing heights
-    (:func:`walkerlab.models.hybrid.ground.with_clearance_guard`).
+    (:func:`walkerlab.models.hybrid.ground.with_clearance_guard`).  ``plant``: the study's
+    plant, handed down (the walker of ``base`` is :meth:`~walkerlab.walker.plant.Plant.with_`
+    of it: a worker describes nothing again).
 
     Raises
     ------
@@ -60,14 +63,13 @@ def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
         (one line).
     """
     from walkerlab.models.registry import build_walker
-    from walkerlab.walker.plant import Plant  # light
 
     key = json.dumps(base, sort_keys=True) + ("/heights" if heights else "")
     if key not in _MAPS:
-        scene = scene_from_dict(base)  # the worker's scene: its plant is built here, once
-        plant = Plant.from_scene(scene)
+        scene = scene_from_dict(base)  # the worker's scene: the plant handed down, with_ it
+        plant = plant.with_(scene)
         st = scene.mfpt or MfptSettings()
-        walker = build_walker(scene, plant)
+        walker = build_walker(plant)
         if heights:
             from walkerlab.integrate.python_step import needs_python_path
 
@@ -90,9 +92,12 @@ class StepMapTask:
     ----------
     base : dict
         What :func:`step_map_for` rebuilds the batched step map from.
+    plant : walkerlab.walker.plant.Plant
+        The study's plant (it pickles with the task), handed to :func:`step_map_for`.
     """
 
     base: dict
+    plant: Any = field(kw_only=True)
 
 
 @dataclass(frozen=True)
@@ -146,7 +151,7 @@ class ImageTask(StepMapTask):
 
 def run_walks(task: WalkTask):
     """``(index, steps, fell)`` of a chunk of walks."""
-    sm = step_map_for(task.base, task.heights is not None)
+    sm = step_map_for(task.base, task.heights is not None, plant=task.plant)
     res = M.monte_carlo(sm, np.asarray(task.x0), task.sd, task.walks, task.max_steps,
                         task.seed, distribution=task.distribution, heights=task.heights)
     return task.index, res.steps, res.fell
@@ -154,14 +159,14 @@ def run_walks(task: WalkTask):
 
 def run_images(task: ImageTask):
     """``(start, x_next, ok)`` of a chunk of mesh rows."""
-    sm = step_map_for(task.base)
+    sm = step_map_for(task.base, plant=task.plant)
     r = sm.step(task.X, task.gamma)
     return task.start, r.x_next, r.outcome == HEEL_STRIKE
 
 
 def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, seed: int,
                 distribution: str = "normal", workers: int = 1, scheduler=None,
-                partial=None, heights: tuple | None = None) -> M.MonteCarloResult:
+                partial=None, heights: tuple | None = None, *, plant) -> M.MonteCarloResult:
     """Monte Carlo MFPT walks of a scene at one sigma [rad] (see
     :func:`walkerlab.analysis.robustness.mfpt.monte_carlo`), chunked over the executor.
 
@@ -174,6 +179,7 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     (:func:`walkerlab.analysis.robustness.mfpt.height_rows`).  The
     censored geometric estimate of Byl & Tedrake (2009) is
     :attr:`~walkerlab.analysis.robustness.mfpt.MonteCarloResult.mfpt` [steps].
+    ``plant``: the study's plant, handed down (the tasks carry it).
     """
     from walkerlab.studies.runner import sweep_executor  # light
 
@@ -181,7 +187,7 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     tasks = [WalkTask(base, tuple(float(v) for v in x0), float(sd),
                       tuple(range(a, min(a + WALKS_PER_TASK, walks))), max_steps, seed,
                       distribution, i, None if heights is None else
-                      (str(heights[0]), float(heights[1])))
+                      (str(heights[0]), float(heights[1])), plant=plant)
              for i, a in enumerate(range(0, walks, WALKS_PER_TASK))]
     steps = np.zeros(walks, dtype=np.int64)
     fell = np.zeros(walks, dtype=bool)
@@ -213,16 +219,17 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     return M.MonteCarloResult(steps, fell)
 
 
-def image_evaluator(scene, ex):
+def image_evaluator(scene, ex, *, plant):
     """``(X, gamma) -> (x_next, ok)`` on the open executor ``ex`` (for
     :func:`M.mesh_mfpt`; one worker pool serves every mesh of a refinement): ``X`` (k, 2n)
     post-impact states [rad, rad/s], ``gamma`` (k,) slopes [rad] -> ``x_next`` (k, 2n),
-    ``ok`` (k,) bool (heel strike)."""
+    ``ok`` (k,) bool (heel strike); ``plant``: the study's plant (the tasks carry it)."""
     base = scene.model_dump(mode="json")
 
     def evaluate(X, gamma):
         n = X.shape[0]
-        tasks = [ImageTask(base, X[a:a + ROWS_PER_TASK], gamma[a:a + ROWS_PER_TASK], a)
+        tasks = [ImageTask(base, X[a:a + ROWS_PER_TASK], gamma[a:a + ROWS_PER_TASK], a,
+                           plant=plant)
                  for a in range(0, n, ROWS_PER_TASK)]
         xn = np.full_like(X, np.nan)
         ok = np.zeros(n, dtype=bool)
@@ -233,7 +240,7 @@ def image_evaluator(scene, ex):
 
 
 def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None,
-         distribution: str = "normal", partial=None):
+         distribution: str = "normal", partial=None, *, plant):
     """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``.
 
     The nodes are the post-impact states visited by noisy walks from the gait at ``sd`` and
@@ -253,6 +260,8 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
     sd : float
         Slope standard deviation [rad].
     settings : MfptSettings
+    plant : walkerlab.walker.plant.Plant
+        The study's plant, handed down (the image tasks carry it).
 
     Returns
     -------
@@ -268,7 +277,7 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
     import hashlib
 
     base = scene.model_dump(mode="json")
-    sm = step_map_for(base)
+    sm = step_map_for(base, plant=plant)
     n = settings.mesh_max_cells
     walks = 100
     steps = max(20, math.ceil(n / walks) + 2)  # a pool of ~2 max_cells
@@ -303,7 +312,7 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
         return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
                                      refine=settings.mesh_refine,
                                      rel_change=settings.mesh_rel_change, max_cells=n,
-                                     quadrature=q, evaluate=image_evaluator(scene, ex),
+                                     quadrature=q, evaluate=image_evaluator(scene, ex, plant=plant),
                                      distribution=distribution, cache=cache, on_mesh=store)
 
 
@@ -342,7 +351,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     if getattr(st, "sigma_m", None) is not None:
         return _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial,
                              plant)
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     contact = getattr(st, "model", "rigid") == "contact"
     start = None
     if contact:
@@ -354,14 +363,14 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
             raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "
                              "~10^6 step images); this walker has no compiled flows (flat "
                              "feet): use --method montecarlo")
-        step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
+        step_map_for(scene.model_dump(mode="json"), plant=plant)  # validates the walker here
     sig = np.asarray(st.sigma_rad, float)
     vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
     hist = []
     with _progress.task(f"mfpt: {sig.size} sigma value(s)", sig.size) as bar:
         for i, sd in enumerate(sig):
             _one_sigma(scene, x_star, st, i, sd, vals, hist, contact, start, seed, dist,
-                       workers, scheduler, partial)
+                       workers, scheduler, partial, plant)
             bar.advance(info=_sigma_line(vals, i, sd, "rad"))
     return MfptData(sig, vals, st.method, walker.state_names(), hist)
 
@@ -375,7 +384,7 @@ def _sigma_line(vals: dict, i: int, sd: float, unit: str) -> str:
 
 
 def _one_sigma(scene, x_star, st, i, sd, vals, hist, contact, start, seed, dist, workers,
-               scheduler, partial) -> None:
+               scheduler, partial, plant) -> None:
     """The Monte Carlo walks and / or the mesh of :func:`mfpt_study` at sigma ``sd``
     [rad] (row ``i`` of ``vals``; the mesh's refinements appended to ``hist``)."""
     import time
@@ -387,12 +396,13 @@ def _one_sigma(scene, x_star, st, i, sd, vals, hist, contact, start, seed, dist,
     elif st.method in ("montecarlo", "both"):
         t = time.perf_counter()
         mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
-                         scheduler, partial)
+                         scheduler, partial, plant=plant)
     if contact or st.method in ("montecarlo", "both"):
         _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
     if st.method in ("mesh", "both"):
         t = time.perf_counter()
-        last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial)
+        last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial,
+                                plant=plant)
         vals["mfpt_steps_mesh"][i] = last.mfpt_steps
         vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
         vals["mesh_cells"][i] = last.cells
@@ -423,8 +433,8 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene, plant)
-    step_map_for(scene.model_dump(mode="json"), True)  # validates the walker here
+    walker = build_walker(plant.with_(scene))
+    step_map_for(scene.model_dump(mode="json"), True, plant=plant)  # validates the walker
     hdist = per.heights[0] if per is not None else "normal"
     slope_sd = float(per.slope_sd_rad) if per is not None else 0.0
     sig_m = np.asarray(st.sigma_m, float)
@@ -433,7 +443,8 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
         for i, sd_m in enumerate(sig_m):
             t = time.perf_counter()
             mc = monte_carlo(scene, x_star, slope_sd, st.walks, st.max_steps, seed, dist,
-                             workers, scheduler, partial, heights=(hdist, float(sd_m)))
+                             workers, scheduler, partial, heights=(hdist, float(sd_m)),
+                             plant=plant)
             _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
             bar.advance(info=_sigma_line(vals, i, sd_m, "m"))
     return MfptData(np.full(sig_m.size, slope_sd), vals, st.method, walker.state_names(), [],

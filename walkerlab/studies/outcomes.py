@@ -35,7 +35,6 @@ from __future__ import annotations
 
 from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.io.stage_files import CONTACT_SIM
-from walkerlab.walker.plant import Plant
 
 #: Run ends that are a verdict of their own (the others, heel_strike / t_final, are ``ok``).
 RUN_END_OUTCOMES = tuple(k for k in RUN_END_NAMES if k not in ("heel_strike", "t_final"))
@@ -160,14 +159,28 @@ def columns(stage: str, state_names: list[str], state_units: list[str]) -> dict[
     return out
 
 
-def walker_columns(stage: str, scene) -> dict[str, tuple]:
-    """:func:`columns` for the rigid walker of ``scene`` (its state names from the walker's
-    description: :func:`walkerlab.models.registry.state_layout`, no walker built)."""
+def walker_columns(stage: str, plant) -> dict[str, tuple]:
+    """:func:`columns` for the rigid walker of the plant's scene (its state names from the
+    walker's description: :func:`walkerlab.models.registry.state_layout`, no walker built).
+
+    Parameters
+    ----------
+    stage : str
+        The swept stage.
+    plant : walkerlab.walker.plant.Plant
+        The sweep's plant, handed down by the stage.
+
+    Returns
+    -------
+    dict
+        Column name -> ``(unit, description)``.
+    """
     if stage not in ("fixedpoint", "simulate"):
         return dict(COLUMNS[stage])
     from walkerlab.models.registry import state_layout  # light
 
-    out = columns(stage, *state_layout(scene, plant=Plant.from_scene(scene)))
+    scene = plant.scene
+    out = columns(stage, *state_layout(plant))
     act = scene.walker.actuation if hasattr(scene.walker, "actuation") else None
     if stage == "fixedpoint" and act is not None and act.virtual_constraints is not None:
         out.update(ZERO_DYNAMICS_COLUMNS)  # a scene under virtual constraints: its HZD too

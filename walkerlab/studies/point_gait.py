@@ -21,7 +21,6 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.studies.guess import Continuation
 from walkerlab.studies.point_columns import interleg_angle
-from walkerlab.walker.plant import Plant
 
 #: the sweep options' defaults (every point function reads them)
 DEFAULT_OPTIONS: dict[str, Any] = {
@@ -47,7 +46,7 @@ def scene_solver(scene: Scene):
 _FP_CACHE: dict[tuple, Any] = {}
 
 
-def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
+def ideal_fixed_point(scene: Scene, guess, options: dict | None = None, *, plant):
     """Period-1 fixed point of the scene's rigid walker, trying the continuation guess first.
 
     Tries, in order: the continuation's predicted fixed point and Jacobian (MINPACK hybrj
@@ -64,6 +63,11 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
         The chunk's previous fixed points (aimed at this point, see
         :meth:`Continuation.aimed`), or a neighbour's fixed point (role-ordered state just
         after heel strike, ``state_names()``; [rad, rad/s]).
+    options : dict, optional
+        Point options (:data:`DEFAULT_OPTIONS`).
+    plant : walkerlab.walker.plant.Plant
+        The study's plant, handed down by its front (the base scene's, or this scene's):
+        this scene's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of it.
 
     Returns
     -------
@@ -83,7 +87,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     opts = {**DEFAULT_OPTIONS, **(options or {})}
 
     fp = scene.fixedpoint or FixedPointSettings()  # every field optional: the defaults
-    walker = build_walker(scene, plant=Plant.from_scene(scene))
+    walker = build_walker(plant.with_(scene))
     solver = scene_solver(scene)
     tries = []
     if isinstance(guess, Continuation) and guess.states:
@@ -124,7 +128,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     raise PointOutcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
 
 
-def scene_gait(scene: Scene, options: dict | None = None):
+def scene_gait(scene: Scene, options: dict | None = None, *, plant):
     """The scene's period-1 gait found and chosen exactly as ``walkerlab fixedpoint`` does
     (:func:`walkerlab.analysis.gait.scene.solve_scene`: the scene's initial guess or the
     zero dynamics' orbit, then the scale-free seeds; the choice by ``fixedpoint.gait``,
@@ -135,7 +139,8 @@ def scene_gait(scene: Scene, options: dict | None = None):
     ``fixedpoint.other_gait``, off the ground's verdict): the choice is the stage's unless
     both gaits of a pair are stable, on real ground and inside the friction cone.  A
     function of the point alone: no neighbour's gait enters, so a sweep's rows do not
-    depend on how its points are dealt out to workers.
+    depend on how its points are dealt out to workers.  ``plant``: the study's plant,
+    handed down (this scene's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Returns
     -------
@@ -159,7 +164,7 @@ def scene_gait(scene: Scene, options: dict | None = None):
         fp = scene.fixedpoint
         walker, search = solve_scene(scene, fd_check=False, ground=True, other_gait=False,
                                      partner_off_ground=fp is None or fp.other_gait,
-                                     plant=Plant.from_scene(scene))
+                                     plant=plant.with_(scene))
     except GaitNotFound as exc:
         r = exc.residual
         raise PointOutcome("no_fixed_point", str(exc),

@@ -2,7 +2,9 @@
 
 Each point function takes a validated :class:`~walkerlab.config.Scene`, the fixed points of
 the previous points of the same chunk (a :class:`~walkerlab.studies.guess.Continuation`, or
-``None``) and the sweep options, and returns ``(columns, fixed point result or None)``.
+``None``), the sweep options and the sweep's plant (the base scene's, built by the stage and
+carried by the task: the point's is :meth:`~walkerlab.walker.plant.Plant.with_` of it), and
+returns ``(columns, fixed point result or None)``.
 :func:`run_chunk` wraps them so that every point ends in a typed outcome
 (:mod:`walkerlab.studies.outcomes`), whatever happens.
 
@@ -47,7 +49,6 @@ from walkerlab.studies.point_gait import (
     scene_gait,
     scene_solver,
 )
-from walkerlab.walker.plant import Plant
 
 __all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
            "contact_adapter", "step_period", "POINT_FUNCTIONS"]
@@ -72,6 +73,9 @@ class Task:
         Sweep options (see :data:`DEFAULT_OPTIONS`).
     origin : str
         Scene origin for error messages.
+    plant : walkerlab.walker.plant.Plant
+        The base scene's plant, built by the stage and handed down (it pickles with the
+        task): each point's is :meth:`~walkerlab.walker.plant.Plant.with_` of it.
     """
 
     stage: str
@@ -80,9 +84,10 @@ class Task:
     points: tuple
     options: dict = field(default_factory=dict)
     origin: str = "<sweep>"
+    plant: Any = field(kw_only=True)
 
 
-def fixedpoint_point(scene: Scene, guess, options: dict):
+def fixedpoint_point(scene: Scene, guess, options: dict, plant):
     """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``): the gait
     ``walkerlab fixedpoint`` finds and chooses for the point's scene (:func:`scene_gait`;
     ``guess`` is not used: a point's row is a function of the point alone), on the study's
@@ -96,7 +101,7 @@ def fixedpoint_point(scene: Scene, guess, options: dict):
     fixed_point : FixedPointResult
         The chosen gait's.
     """
-    walker, search, source = scene_gait(scene, options)
+    walker, search, source = scene_gait(scene, options, plant=plant)
     walker, res = on_study_map(scene, walker, search.result, (options or {}).get("steps_per_map"))
     cols = _fp_columns(walker, res)
     cols.update(_ground_columns(search.gait.ground))
@@ -117,7 +122,7 @@ def _scuff_depth(walker, seg, n: int = 64) -> float:
     return float(max(0.0, -np.min(h)))
 
 
-def simulate_point(scene: Scene, guess, options: dict):
+def simulate_point(scene: Scene, guess, options: dict, plant):
     """Forward simulation of ``2 * simulate.strides`` steps (stage ``simulate``).
 
     The initial state is the scene's explicit state, or (``initial_state: fixed_point``)
@@ -147,12 +152,12 @@ def simulate_point(scene: Scene, guess, options: dict):
     cols: dict = {}
     next_guess = None
     if sim.initial_state == "fixed_point":
-        walker, search, source = scene_gait(scene, options)
+        walker, search, source = scene_gait(scene, options, plant=plant)
         res = search.result
         x0, next_guess = res.x, res
         cols["guess_source"] = source
     else:
-        walker = build_walker(scene, plant=Plant.from_scene(scene))
+        walker = build_walker(plant.with_(scene))
         x0 = initial_state(sim.initial_state, walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, scene_solver(scene),
@@ -188,7 +193,7 @@ def simulate_point(scene: Scene, guess, options: dict):
 
 
 def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
-                    step_length_m: float):
+                    step_length_m: float, plant):
     """Run the compliant-contact simulation of ``scene`` from an ideal-model state.
 
     The only place that calls :mod:`walkerlab.models.contact`; keep it in step with that module.
@@ -204,6 +209,8 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
         Step period of the ideal gait [s] (sets the default simulated time).
     step_length_m : float
         Step length of the ideal gait [m] (checkerboard patch spacing).
+    plant : walkerlab.walker.plant.Plant
+        The sweep's plant (the point's is :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Returns
     -------
@@ -216,7 +223,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     from walkerlab.models.contact.scene import contact_setup
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
-    setup = contact_setup(scene, plant=Plant.from_scene(scene))
+    setup = contact_setup(scene, plant=plant.with_(scene))
     cw, res, _, _ = simulate_from(setup, np.asarray(x_ideal, float), ideal_period_s)
     return cw, res, 2 * setup.sim.n_strides
 
@@ -236,7 +243,7 @@ def step_period(fp) -> float:
     return float(fp.period_s / steps if steps > 1 else fp.period_s)
 
 
-def contact_point(scene: Scene, guess, options: dict):
+def contact_point(scene: Scene, guess, options: dict, plant):
     """Compliant-contact simulation started from the ideal gait at this point (``contact-sim``).
 
     The ideal fixed point gives the initial state, the step period (the map's period over
@@ -257,7 +264,7 @@ def contact_point(scene: Scene, guess, options: dict):
     from walkerlab.integrate.rigid import integrate_step
 
     opts = {**DEFAULT_OPTIONS, **options}
-    walker, search, source = scene_gait(scene, options)
+    walker, search, source = scene_gait(scene, options, plant=plant)
     fp = search.result
     seg = integrate_step(walker, fp.x, scene_solver(scene),
                          max_step_time=(scene.fixedpoint
@@ -266,7 +273,7 @@ def contact_point(scene: Scene, guess, options: dict):
     period = step_period(fp)
     cols = {"guess_source": source, "ideal_step_length_m": step_length,
             "ideal_step_period_s": period}
-    _cw, res, n_steps = contact_adapter(scene, fp.x, period, step_length)
+    _cw, res, n_steps = contact_adapter(scene, fp.x, period, step_length, plant)
     out = res.outcome
     if out.ok:
         out = classify_complete(res.steps, opts["slip_limit_mm"], out.hip_height_m, out.kind)
@@ -307,8 +314,11 @@ POINT_FUNCTIONS: dict[str, Callable] = {
 
 # ----------------------------------------------------------------------------- chunk runner
 def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: dict,
-             origin: str = "<sweep>") -> tuple[dict, Any]:
+             origin: str = "<sweep>", *, plant) -> tuple[dict, Any]:
     """Evaluate one point; never raises (except KeyboardInterrupt / SystemExit).
+
+    ``plant``: the sweep's plant (the base scene's, :attr:`Task.plant`); the point's walker
+    is :meth:`~walkerlab.walker.plant.Plant.with_` of it.
 
     Returns
     -------
@@ -335,7 +345,7 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
             scene = apply_point(base, list(paths), tuple(values), origin)
             # a point's row is a function of the point alone (no neighbour's gait): the rows
             # do not depend on the chunking, the worker count or the executor
-            cols, _fp = POINT_FUNCTIONS[stage](scene, None, options)
+            cols, _fp = POINT_FUNCTIONS[stage](scene, None, options, plant)
             row.update(cols)
         except SceneError as exc:
             row.update(outcome="invalid_config", message=str(exc))
@@ -375,7 +385,7 @@ def run_chunk(task: Task) -> list[dict]:
     rows, guess = [], None
     for index, values in task.points:
         row, nxt = evaluate(task.stage, task.base, task.paths, values, index, guess,
-                            task.options, task.origin)
+                            task.options, task.origin, plant=task.plant)
         rows.append(row)
         guess = nxt if nxt is not None else guess
     return rows

@@ -103,7 +103,7 @@ def run_piece(task: Task, guess: Any = None) -> tuple[list[dict], Any]:
     rows = []
     for index, values in task.points:
         row, nxt = evaluate(task.stage, task.base, task.paths, values, index, guess,
-                            task.options, task.origin)
+                            task.options, task.origin, plant=task.plant)
         rows.append(row)
         guess = nxt if nxt is not None else guess
     return rows, guess
@@ -198,7 +198,7 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
               options: dict | None = None, chunk_size: int | None = None,
               progress: bool = True,
               on_chunk: Callable[[int, int], None] | None = None,
-              pool: bool | None = None) -> Path:
+              pool: bool | None = None, *, plant) -> Path:
     """Run a sweep and write its artifact (see :mod:`walkerlab.io.sweep_store`).
 
     Parameters
@@ -228,6 +228,9 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     pool : bool, optional
         Force a process pool even for one worker (True) or run in this process (False);
         default: a pool when ``workers > 1``.
+    plant : walkerlab.walker.plant.Plant
+        The base scene's plant, built by the stage: the tasks carry it, each point's is
+        :meth:`~walkerlab.walker.plant.Plant.with_` of it.
 
     Returns
     -------
@@ -262,11 +265,11 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
 
     with artifact_lock(out_path, wait=False):
         return _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts,
-                           chunk_size, progress, on_chunk, pool, n_total)
+                           chunk_size, progress, on_chunk, pool, n_total, plant)
 
 
 def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_chains,
-                steps_per_map=None):
+                steps_per_map, plant):
     """The sweep's partial file: resumed (its plan and each chain's checkpoint) or created
     with a new plan of ``n_chains`` chains.
 
@@ -275,7 +278,7 @@ def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_c
     SweepError
         A partial file that cannot be resumed (one line).
     """
-    columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, scene), OUTCOMES)
+    columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, plant.with_(scene)), OUTCOMES)
     if resume and partial_path(out_path).is_file():
         # the chunk plan of the interrupted run (not re-planned from what is left: a point's
         # continuation guess, hence its row, depends on the chain it is in)
@@ -319,7 +322,7 @@ def _keep_on_interrupt(store, write, t0: float) -> None:
 
 
 def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
-                progress, on_chunk, pool, n_total) -> Path:
+                progress, on_chunk, pool, n_total, plant) -> Path:
     paths = [a.path for a in axes]
     key = sweep_input_hash(scene, stage, axes, opts)
     base = scene.model_dump(mode="json")
@@ -331,15 +334,15 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     origin = scene.name or "<scene>"
     steps = None
     if stage == "fixedpoint":  # one map for every point's multipliers, decided before any
-        steps = study_steps_per_map(base, paths, values_of.values(), origin)
+        steps = study_steps_per_map(base, paths, values_of.values(), origin, plant=plant)
         opts = {**opts, "steps_per_map": steps}  # not in the input hash: the scene decides it
     store, plan, start = _open_store(scene, axes, stage, out_path, resume, opts, key,
                                      chunk_size, 1 if scheduler is None and workers <= 1
-                                     else max(2, workers), steps)
+                                     else max(2, workers), steps, plant)
     offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
     done = {i for c, chain in enumerate(plan) for i in chain[:offset[c]]}
-    chains = _piece_tasks(Task(stage, base, tuple(paths), (), opts, origin), plan, offset,
-                          values_of)
+    chains = _piece_tasks(Task(stage, base, tuple(paths), (), opts, origin, plant=plant), plan,
+                          offset, values_of)
     guesses = [start.get(c, (0, None))[1] for c in range(len(plan))]
     t0 = time.perf_counter()
     counts = {o: 0 for o in OUTCOMES}

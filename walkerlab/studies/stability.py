@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.integrate.solver import Solver
-from walkerlab.walker.plant import Plant
 
 __all__ = ["MAP_KINDS", "MAP_MAX_STEP_MAPS", "CELL_FIELDS", "REASONS", "MapSpec",
            "default_spec", "gait_row", "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS",
@@ -161,11 +160,12 @@ def _empty_cell() -> dict:
             "source": "", "reason": "", "wall_time_s": np.nan}
 
 
-def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
+def gait_row(base: dict, spec: MapSpec, iy: int, plant) -> list[dict]:
     """Cells of row ``iy`` (one y value), slopes ascending, with continuation.
 
     Never raises (every failure becomes a ``reason``).  Top-level so it pickles for a
-    process pool.
+    process pool (``plant``, the map's :class:`~walkerlab.walker.plant.Plant`, pickles with
+    it; each cell's is :meth:`~walkerlab.walker.plant.Plant.with_` of it).
     """
     from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
     from walkerlab.analysis.contact.step_map import PeriodicGaitError
@@ -180,9 +180,10 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
         t0 = time.perf_counter()  # a record only (wall_time_s)
         try:
             scene = _cell_scene(base, spec, y, slope)
-            _w, fp, _src = ideal_fixed_point(scene, x_ideal_prev)
+            cell_plant = plant.with_(scene)  # the cell's slope and contact: the same walker
+            _w, fp, _src = ideal_fixed_point(scene, x_ideal_prev, plant=cell_plant)
             x_ideal_prev = fp.x
-            walker, _ = build(scene, fp.x, 2, plant=Plant.from_scene(scene))
+            walker, _ = build(scene, fp.x, 2, plant=cell_plant)
             tries = ([("neighbour", z_prev, 0)] if z_prev is not None else []) \
                 + [("ideal", fp.x, 6)]
             gait, why = None, ""
@@ -222,7 +223,7 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
 
 
 def gait_map(scene, spec: MapSpec, workers: int = 2,
-             progress: Callable[[int, int], None] | None = None) -> dict:
+             progress: Callable[[int, int], None] | None = None, *, plant) -> dict:
     """All cells of a map; rows in parallel on ``workers`` processes.
 
     Parameters
@@ -236,6 +237,8 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
         this process dies).
     progress : callable, optional
         ``progress(rows_done, rows_total)``.
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, built by the stage and handed to each row.
 
     Returns
     -------
@@ -252,7 +255,8 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
     # open files (the artifact lock): walkerlab.execution.workers
     with make_executor(workers) as ex:
         for done, (iy, row) in enumerate(run_each(ex, gait_row,
-                                                  [(base, spec, iy) for iy in range(ny)]), 1):
+                                                  [(base, spec, iy, plant)
+                                                   for iy in range(ny)]), 1):
             rows[iy] = row
             if progress:
                 progress(done, ny)
@@ -274,11 +278,11 @@ def stable_fraction(cells: dict) -> dict:
 
 
 def stability_map_run(scene, spec: MapSpec, workers: int = 2,
-                      progress: Callable[[int, int], None] | None = None):
+                      progress: Callable[[int, int], None] | None = None, *, plant):
     """:func:`gait_map` with a progress bar, packed for the stability-map artifact.
 
     The parameters are :func:`gait_map`'s (``progress`` is called beside the terminal's
-    progress bar).
+    progress bar; ``plant``: the scene's, from the stage).
 
     Returns
     -------
@@ -302,7 +306,7 @@ def stability_map_run(scene, spec: MapSpec, workers: int = 2,
             if progress is not None:
                 progress(done, total)
 
-        cells = gait_map(scene, spec, workers=workers, progress=tick)
+        cells = gait_map(scene, spec, workers=workers, progress=tick, plant=plant)
     frac = stable_fraction(cells)
     reasons = [str(r) for r in cells["reason"].ravel() if r]
     summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}

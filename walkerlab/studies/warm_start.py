@@ -80,7 +80,7 @@ def nearest_stored(scene: Scene, stored: Sequence[StoredGait]
 
 
 def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
-                      solver: Solver | None = None) -> FallbackStart | None:
+                      solver: Solver | None = None, *, plant) -> FallbackStart | None:
     """The nearest stored gait carried to ``scene``'s walker (module docstring) as a start
     of its gait search (:class:`~walkerlab.analysis.gait.starts.FallbackStart`, carried only
     when tried), or None when no stored gait is of the same structure.
@@ -91,6 +91,9 @@ def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
     stored : sequence of StoredGait
     solver : Solver, optional
         The scene's (default ``Solver.from_settings(scene.solver)``).
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, handed down by the stage (the walkers on the way from a stored
+        gait are :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Returns
     -------
@@ -114,7 +117,7 @@ def stored_gait_start(scene: Scene, stored: Sequence[StoredGait],
             return None
         if not fields:  # the same walker: its gait is this one's
             return x0, f"initial guess: {known.what} (same walker)"
-        make, _ = homotopy_family(known.scene, scene)
+        make, _ = homotopy_family(known.scene, scene, plant=plant)
         try:
             x, points = carry_width(lambda lam: make({"lambda": lam}), x0, 0.0, 1.0, solver,
                                     max_step, fd_step, "lambda",

@@ -6,8 +6,10 @@ algorithm; the models, the analyses, the studies, the optimisers, the exports an
 take it (or its :attr:`Plant.data`, its :attr:`Plant.kind`) from their caller instead of
 describing the walker again from the scene (:func:`walkerlab.walker.description.walker_data`).
 
-A scene that differs (a sweep's point, a continuation's step) is another walker: its own
-plant is built from that scene where the scene is made.
+A scene that differs (a sweep's point, a continuation's step, a design point, a planar
+twin) is reached from the plant the caller handed down (:meth:`Plant.with_`): the same
+walker section keeps its descriptions (only the slope's is looked up), another walker is
+described anew.
 """
 
 from __future__ import annotations
@@ -100,6 +102,35 @@ class Plant:
         if key not in self._slopes:
             self._slopes[key] = walker_data(self.scene.walker, slope_rad)
         return self._slopes[key]
+
+    def with_(self, scene) -> Plant:
+        """The plant of a neighbouring scene (a study's point, a continuation's step, a
+        design point, a planar twin, a replay's scene).
+
+        A scene whose ``walker`` section equals this plant's scene's (pydantic equality:
+        a sweep over the slope, the solver, the contact or the noise settings) is the same
+        walker: its description is this plant's on the new scene's slope (:meth:`data_at`),
+        and the new plant shares this one's descriptions of other slopes, so the walker is
+        never described again.  A scene with another walker section is described anew
+        (:meth:`from_scene`).
+
+        Parameters
+        ----------
+        scene : walkerlab.config.Scene
+            A validated scene.
+
+        Returns
+        -------
+        Plant
+            ``self`` when ``scene`` is this plant's scene (the same object).
+        """
+        if scene is self.scene:
+            return self
+        if scene.walker != self.scene.walker:
+            return Plant.from_scene(scene)
+        own = self.data.slope_rad
+        self._slopes.setdefault((own, math.copysign(1.0, own)), self.data)
+        return Plant(scene, self.data_at(scene.slope.phi_rad), self._slopes)
 
     def on_slope(self, slope_rad: float) -> Plant:
         """The plant of the scene on a slope of ``slope_rad`` [rad] (its ``slope`` section

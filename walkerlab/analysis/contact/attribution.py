@@ -195,7 +195,7 @@ def adjustment_effect(scene, ideal, strides: int = 5, *, plant) -> dict:
         out[key] = float(np.mean(T)) if T.size and r.termination in ("t_final",
                                                                      "heel_strike") \
             else float("nan")
-    iw = build_walker(scene, setup.plant)  # the set-up's plant: the walker described once
+    iw = build_walker(setup.plant.with_(scene))  # the set-up's plant: the walker described once
     # leg1 swings first (paper Eq. 11): its rates take scale[0], the stance leg's scale[1]
     x = iw.layout().scale_rates(ideal.x, {"swing": scale[0], "stance": scale[1]})
     run = simulate_steps(iw, x, 2 * strides, Solver.from_settings(scene.solver))

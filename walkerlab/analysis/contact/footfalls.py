@@ -65,7 +65,7 @@ def rigid_step_lengths(scene, walker, x_ideal, plant) -> tuple[float, ...] | Non
 
     if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:
         return None
-    rigid = build_walker(scene, plant)
+    rigid = build_walker(plant.with_(scene))
     m = len(rigid.cycle) if rigid.cycle is not None else 1
     traj = simulate_steps(rigid, np.asarray(x_ideal, float), m,
                           Solver.from_settings(scene.solver))

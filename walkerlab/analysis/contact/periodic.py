@@ -193,7 +193,7 @@ def ideal_gait(scene, plant):
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
 
     fp = sc.fixedpoint or FixedPointSettings()  # every field optional: the defaults
-    iw = build_walker(sc, plant)  # the variant changes the equations, not the description
+    iw = build_walker(plant.with_(sc))  # the variant changes the equations, not the description
     guess = None if fp.initial_guess is None else initial_state(fp.initial_guess,
                                                                 iw.state_names())
     ctrl = getattr(getattr(iw, "actuators", None), "controller", None) if guess is None \

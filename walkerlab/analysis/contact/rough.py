@@ -10,14 +10,14 @@ that makes ``max_steps`` is censored.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
 from walkerlab.analysis.robustness.mfpt import draw_slopes
 from walkerlab.integrate.rigid import Solver, integrate_step
 from walkerlab.models.contact.terrain import footfall_lanes, slope_heights
-from walkerlab.walker.plant import Plant
 
 __all__ = ["ContactStart", "contact_start", "contact_walk"]
 
@@ -40,6 +40,9 @@ class ContactStart:
         Of the contact periodic gait (the patch spacing [m]; the time per step [s]).
     slope_rad : float
         The scene's slope [rad] (the mean of per-step slopes).
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant (from the caller; it pickles with the start): a worker's walk
+        describes nothing again.
     """
 
     scene: dict
@@ -48,6 +51,7 @@ class ContactStart:
     step_length_m: float
     period_s: float
     slope_rad: float
+    plant: Any = field(kw_only=True)
 
 
 def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
@@ -82,15 +86,16 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
     if not periodic:
         from walkerlab.models.registry import build_walker
 
-        period = integrate_step(build_walker(scene, setup.plant), np.asarray(x_ideal, float),
+        period = integrate_step(build_walker(setup.plant.with_(scene)),
+                                np.asarray(x_ideal, float),
                                 Solver("DOP853", 1e-10, 1e-10)).period
         return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                             tuple(map(float, x0)), float(step_length), float(period),
-                            float(scene.slope.phi_rad))
+                            float(scene.slope.phi_rad), plant=setup.plant)
     gait = converged_gait(find_contact_periodic_gait(probe, x_ideal, **search_bounds(cs)))
     return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                         tuple(map(float, gait.full_state)), float(gait.step_length_m),
-                        float(gait.period_s), float(scene.slope.phi_rad))
+                        float(gait.period_s), float(scene.slope.phi_rad), plant=setup.plant)
 
 
 #: work bound of one walk [right-hand-side evaluations]: WALK_RHS_EVALUATIONS +
@@ -119,8 +124,8 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     from walkerlab.config import scene_from_dict  # light
     from walkerlab.models.contact.scene import contact_setup  # light
 
-    scene = scene_from_dict(start.scene)  # the worker's scene, described here
-    setup = contact_setup(scene, plant=Plant.from_scene(scene))
+    scene = scene_from_dict(start.scene)  # the worker's scene: the start's plant, with_ it
+    setup = contact_setup(scene, plant=start.plant.with_(scene))
     sv = setup.solver
     x_ideal = np.asarray(start.x_ideal, float)
     _, _, limits, _ = scene_start(setup, x_ideal, 2)

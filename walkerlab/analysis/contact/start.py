@@ -84,7 +84,7 @@ def rigid_mid_stance(scene, x_ideal: np.ndarray, plant) -> np.ndarray:
     """
     from walkerlab.models.registry import build_walker
 
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     seg = simulate_steps(walker, np.asarray(x_ideal, float), 1,
                          Solver.from_settings(scene.solver)).segments[0]
     if seg.termination != RunEnd.HEEL_STRIKE.value:

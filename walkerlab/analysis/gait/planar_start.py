@@ -44,7 +44,6 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.planar import CONTACT_ONLY_IN_3D, PlanarTwin, planar_twin
-from walkerlab.walker.plant import Plant
 
 __all__ = ["PlanarStart", "planar_start", "planar_fallback", "embed", "carry_width",
            "FIRST_WIDTH"]
@@ -114,9 +113,9 @@ def embed(planar: HybridWalker, x_planar: np.ndarray, walker: HybridWalker
     return x
 
 
-def _planar_gait(twin: Scene) -> tuple[np.ndarray, str, bool] | None:
-    """The planar twin's gait and how it was found, or None."""
-    w = build_walker(twin, plant=Plant.from_scene(twin))
+def _planar_gait(twin: Scene, plant) -> tuple[np.ndarray, str, bool] | None:
+    """The planar twin's gait and how it was found, or None (``plant``: the twin's)."""
+    w = build_walker(plant)
     closed = w.closed_form_gait() if w.closed_form_gait is not None else None
     if closed is not None:
         return np.asarray(closed, float), "its gait in closed form", True
@@ -196,8 +195,8 @@ def carry_width(make, x0: np.ndarray, w0: float, w1: float, solver: Solver,
     return res.x, points
 
 
-def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: Solver
-                 ) -> PlanarStart | None:
+def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: Solver,
+                 *, plant) -> PlanarStart | None:
     """A start for the 3D scene's root finder from its planar twin's gait (module
     docstring), or None (a twin without a gait, or a width continuation that stalled).
 
@@ -209,6 +208,9 @@ def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: S
         Its walker's planar twin (:func:`walkerlab.walker.planar.planar_twin`).
     walker, solver
         The scene's rigid walker and integrator.
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, handed down (the twin's and each width's walker are
+        :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Returns
     -------
@@ -218,11 +220,12 @@ def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: S
         twin_scene = _twin_scene(scene, twin.walker)
     except (SceneError, ValueError):
         return None
-    found = _planar_gait(twin_scene)
+    twin_plant = plant.with_(twin_scene)  # the twin's walker: another description
+    found = _planar_gait(twin_scene, twin_plant)
     if found is None:
         return None
     x_planar, how, unique = found
-    planar = build_walker(twin_scene, plant=Plant.from_scene(twin_scene))
+    planar = build_walker(twin_plant)
     x = embed(planar, x_planar, walker)
     if x is None:
         return None
@@ -236,7 +239,7 @@ def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: S
     def make(width: float) -> HybridWalker:
         data["walker"][field] = float(width)
         sc = Scene.model_validate(data)
-        return build_walker(sc, Plant.from_scene(sc))
+        return build_walker(plant.with_(sc))
 
     fp = scene.fixedpoint
     max_step = fp.max_step_time_s if fp is not None else 5.0
@@ -248,7 +251,7 @@ def planar_start(scene: Scene, twin: PlanarTwin, walker: HybridWalker, solver: S
                            f"{points} continuation points", unique)
 
 
-def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver
+def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver, *, plant
                     ) -> FallbackStart | None:
     """The planar-twin start (:func:`planar_start`) as a fallback of the gait search
     (:class:`~walkerlab.analysis.gait.starts.FallbackStart`: found only when tried), or None
@@ -256,7 +259,7 @@ def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver
 
     Parameters
     ----------
-    scene, walker, solver
+    scene, walker, solver, plant
         As :func:`planar_start`'s (a walker of either space).
 
     Returns
@@ -271,7 +274,7 @@ def planar_fallback(scene: Scene, walker: HybridWalker, solver: Solver
     fb = FallbackStart(label, "planar_twin", None)
 
     def find():
-        start = planar_start(scene, twin, walker, solver)
+        start = planar_start(scene, twin, walker, solver, plant=plant)
         if start is None:
             return None
         fb.unique = start.unique

@@ -147,7 +147,7 @@ def simulate_run(scene: Scene, fixed_point, plant):
     from walkerlab.io.schemas.simulate import SimulateRun
     from walkerlab.models.registry import build_walker
     sim = scene.simulate
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     if sim.initial_state == "fixed_point":
         x0, period = fixed_point.x, fixed_point.step_period_s
         # refuse before integrating what could not be sampled (sample_trajectory checks
@@ -211,7 +211,7 @@ def rough_ground_walker(scene, n_steps: int, plant):
     """
     from walkerlab.models.registry import build_walker_on_steps
 
-    return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps), plant)
+    return build_walker_on_steps(plant.with_(scene), rough_ground_steps(scene, n_steps))
 
 
 def profile_walk(scene, x0: np.ndarray, n_steps: int, solver: Solver | None = None,
@@ -259,5 +259,5 @@ def profile_ground(scene, plant):
     if scene.walker.model != "compass_gait":  # a described walker: its kind's cell
         plant.kind.require("profile", "rigid", "terrain.kind: profile")
     P = profile_points(scene.terrain)
-    at, data_at = passive_walker_at(scene, plant)
+    at, data_at = passive_walker_at(plant.with_(scene))
     return ProfileGround(at, data_at, P)

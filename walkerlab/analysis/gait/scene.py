@@ -153,7 +153,7 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
         why = cannot_roll(plant.data)
         if why is not None:
             raise GaitNotFound(why, math.nan)
-    walker = build_walker(scene, plant) if walker is None else walker
+    walker = build_walker(plant.with_(scene)) if walker is None else walker
     solver = Solver.from_settings(scene.solver) if solver is None else solver
     start = initial_guess(scene, walker) if guess is None else guess
     if start is None:  # virtual constraints: the zero dynamics' periodic orbit, if any
@@ -172,7 +172,8 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     if guess is None and not no_energy_reason(walker):  # (none where no gait can be)
         if nearby is not None:  # a gait stored nearby, carried here
             fallbacks.append(nearby)
-        planar = planar_fallback(scene, walker, solver)  # a 3D walker: from its planar twin
+        planar = planar_fallback(scene, walker, solver,
+                                 plant=plant)  # a 3D walker: from its planar twin
         if planar is not None:
             fallbacks.append(planar)
     return walker, search_from(start, fallbacks)
@@ -207,7 +208,7 @@ def solve_variant(scene: Scene, variant: str, guess=None, *, plant: Plant):
         No fixed point from the guess (or no guess).
     """
     sc = with_variant(scene, variant)
-    walker = build_walker(sc, plant)
+    walker = build_walker(plant.with_(sc))
     fp = _settings(scene)
     g = initial_guess(scene, walker) if guess is None else guess
     if g is None:

@@ -23,19 +23,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.walker.plant import Plant
-
 __all__ = ["measure_gradient", "multiplier_gradient"]
 
 
 class _Gaits:
-    """Walkers and their gaits over the design, each solve started at the last gait."""
+    """Walkers and their gaits over the design, each solve started at the last gait;
+    ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, handed down by the stage
+    (each design point's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of it)."""
 
-    def __init__(self, scene, fields, x0, max_step=None, bounds=None):
+    def __init__(self, scene, fields, x0, max_step=None, bounds=None, *, plant):
         from walkerlab.integrate.solver import Solver
         from walkerlab.studies.continuation import scene_value  # light
 
-        self.scene, self.fields = scene, list(fields)
+        self.scene, self.fields, self.plant = scene, list(fields), plant
         self.solver = Solver.from_settings(scene.solver)
         # the last gait and its design point: every solve is continued from there
         self.last = np.asarray(x0, float)
@@ -72,8 +72,8 @@ class _Gaits:
     def walker(self, p):
         from walkerlab.models.registry import build_walker
 
-        sc = self.scene_at(p)  # the design point's walker, described here
-        return build_walker(sc, Plant.from_scene(sc))
+        sc = self.scene_at(p)  # the design point's walker: a neighbour of the scene's
+        return build_walker(self.plant.with_(sc))
 
     def value(self, p, name: str) -> float:
         """A measure that is not one map's (``max_abs_multiplier`` and
@@ -83,7 +83,8 @@ class _Gaits:
         w, fp = self.gait(p)
         if name == "max_abs_multiplier":
             return float(np.max(np.abs(fp.multipliers_variational)))
-        return robustness_measure(name, self.scene_at(p), w, fp.x, fp.jacobian_variational)
+        return robustness_measure(name, self.scene_at(p), w, fp.x, fp.jacobian_variational,
+                                  plant=self.plant)
 
     def differenced(self, p, name: str, h_rel: float = 1e-4):
         """``(value, gradient (k,))``: central differences of the re-solved measure."""

@@ -23,7 +23,6 @@ import numpy as np
 
 from walkerlab.analysis.robustness.measures import linearise
 from walkerlab.integrate.python_step import make_step_map
-from walkerlab.walker.plant import Plant
 
 __all__ = ["ROBUSTNESS_MEASURES", "robustness_measure"]
 
@@ -31,9 +30,11 @@ __all__ = ["ROBUSTNESS_MEASURES", "robustness_measure"]
 ROBUSTNESS_MEASURES = {"gait_sensitivity_norm": "-", "basin_share": "-", "mfpt": "steps"}
 
 
-def robustness_measure(name: str, scene, walker, x_star, A) -> float:
+def robustness_measure(name: str, scene, walker, x_star, A, *, plant) -> float:
     """The measure ``name`` (module docstring) of ``scene``'s gait ``x_star`` (2n,) with
-    the Poincaré map's Jacobian ``A`` (2n, 2n) there.
+    the Poincaré map's Jacobian ``A`` (2n, 2n) there; ``plant``: the design's
+    :class:`~walkerlab.walker.plant.Plant`, handed down (``scene``'s is
+    :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Raises
     ------
@@ -41,19 +42,19 @@ def robustness_measure(name: str, scene, walker, x_star, A) -> float:
         An unknown measure, or a walker its study cannot carry (one line).
     """
     x_star = np.asarray(x_star, float)
+    plant = plant.with_(scene)
     if name == "gait_sensitivity_norm":
         from walkerlab.studies.mfpt import scene_walker_at  # light
 
         dist = scene.robustness.disturbances[0] if scene.robustness is not None else "slope"
-        sm = make_step_map(walker, scene_walker_at(scene,
-                                                   plant=Plant.from_scene(scene)), 1e-12, 1e-12)
+        sm = make_step_map(walker, scene_walker_at(scene, plant=plant), 1e-12, 1e-12)
         return linearise(sm, x_star, np.asarray(A, float), dist).gsn()
     if name == "basin_share":
         from walkerlab.studies.basin import CODE, compute_basin  # light
 
         with tempfile.TemporaryDirectory() as tmp:
             cells = compute_basin(scene, x_star, "design", Path(tmp) / "basin.h5",
-                                  workers=1, resume=False)
+                                  workers=1, resume=False, plant=plant)
         return float(np.mean(np.asarray(cells["outcome"]) == CODE["converged"]))
     if name == "mfpt":
         from walkerlab.config.studies import MfptSettings  # light
@@ -61,5 +62,5 @@ def robustness_measure(name: str, scene, walker, x_star, A) -> float:
 
         st = scene.mfpt or MfptSettings()
         return float(monte_carlo(scene, x_star, st.sigma_rad[0], st.walks, st.max_steps,
-                                 st.seed).mfpt[0])
+                                 st.seed, plant=plant).mfpt[0])
     raise ValueError(f"unknown robustness measure {name!r}")

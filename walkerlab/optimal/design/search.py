@@ -139,7 +139,7 @@ def design_bounds(scene, items: list[str]) -> dict:
 
 
 def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool = False,
-                    max_evaluations: int = 60) -> DesignResult:
+                    max_evaluations: int = 60, *, plant) -> DesignResult:
     """Optimise the scene's fields within ``bounds`` for the gait measure ``objective``.
 
     Parameters
@@ -155,6 +155,9 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
     maximize : bool
     max_evaluations : int
         Cap on the optimiser's iterations.
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, built by the stage (each design point's walker is
+        :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Returns
     -------
@@ -175,7 +178,7 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
     hi = np.array([bounds[f][1] for f in fields], float)
     p0 = np.clip([float(scene_value(scene, f)) for f in fields], lo, hi)
     gaits = _Gaits(scene, fields, x_gait, max_step=MAX_STEP_SHARE * (hi - lo),
-                   bounds=(lo, hi))
+                   bounds=(lo, hi), plant=plant)
     sign = -1.0 if maximize else 1.0
     history: list = []
     box = (p0, lo, hi, sign)

@@ -19,13 +19,12 @@ from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
 from walkerlab.optimal.transcription.stride import step_of
 from walkerlab.safefs import raise_if_interrupted
-from walkerlab.walker.plant import Plant
 
 __all__ = ["SETTLED_STEPS", "contact_replay",
            "contact_replay_controller", "contact_replay_five_link",
            "contact_replay_phased", "contact_replay_stride", "replay_failure"]
 
-def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
+def contact_replay(scene, res, strides: int = 1, *, plant) -> tuple[float, str]:
     """Run the contact model with the optimised torques.
 
     Parameters
@@ -36,6 +35,10 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     res : walkerlab.optimal.transcription.step.CollocationResult
     strides : int
         Strides to run (2 steps each).
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, handed down by the stage (the replay's scene, the optimised
+        torques in place of the walker's actuation, is :meth:`~walkerlab.walker.plant.
+        Plant.with_` of it).
 
     Returns
     -------
@@ -54,7 +57,7 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     if bodies and all(b.get("mass_kg", 1.0) == 0.0 for b in bodies):
         return float("nan"), "not replayed: massless legs (the contact view needs masses)"
     setup, why = _powered_setup(scene, _hip_actuation(res),
-                                {"n_strides": strides, "sample_rate_hz": 500})
+                                {"n_strides": strides, "sample_rate_hz": 500}, plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.laws = TorqueOfTime(torque_of_time(res), _nodes(res))
@@ -63,7 +66,7 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
 
 
 def contact_replay_five_link(scene, law, x0, step_period_s: float,
-                             strides: int = 1) -> tuple[float, str]:
+                             strides: int = 1, *, plant) -> tuple[float, str]:
     """Run the contact model of a five-link biped under a phase-variable law.
 
     The scene's walker gets torques on
@@ -86,6 +89,9 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
         The rigid step period [s] (sets the run's length).
     strides : int
         Strides to run (2 steps each).
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, handed down (the replay's scene is its
+        :meth:`~walkerlab.walker.plant.Plant.with_`).
 
     Returns
     -------
@@ -94,7 +100,8 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
         ended, or why there is no replay (one line), as :func:`contact_replay`.
     """
     setup, why = _powered_setup(scene, {"torques": [{"joint": j, "law": {}} for j in JOINTS]},
-                                {"n_strides": strides, "sample_rate_hz": 500}, terrain=True)
+                                {"n_strides": strides, "sample_rate_hz": 500}, terrain=True,
+                                plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.rigid.laws = law
@@ -102,7 +109,7 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     return _run(setup, x0, step_period_s, strides, solver)
 
 
-def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
+def contact_replay_phased(scene, res, strides: int = 1, *, plant) -> tuple[float, str]:
     """Run the contact model of a walker with phases (a kneed or flat-footed walker) with its
     optimised hip torque.
 
@@ -125,6 +132,9 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     res : walkerlab.optimal.transcription.mode_sequence.PhasedResult
     strides : int
         As :func:`contact_replay`.
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, handed down (the replay's scene is its
+        :meth:`~walkerlab.walker.plant.Plant.with_`).
 
     Returns
     -------
@@ -136,7 +146,7 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     # a powered run is on a Python RHS (slow on a flat-footed walker's stride): bounded by
     # its work (contact_sim.max_rhs_evaluations' default), the same on any machine
     setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
-                                {"n_strides": strides, "sample_rate_hz": 500})
+                                {"n_strides": strides, "sample_rate_hz": 500}, plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.laws = TorqueOfTime(phase_torque_of_time(res),
@@ -144,7 +154,7 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     return _run(setup, res.x[0], res.step_period_s, strides)
 
 
-def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
+def contact_replay_stride(scene, res, strides: int = 2, *, plant) -> tuple[float, str]:
     """Run the contact model of a walker whose legs differ with its optimised stride's hip
     torques: leg A's step's (:func:`walkerlab.optimal.transcription.stride.step_of` 0) while
     ``leg2`` is
@@ -162,6 +172,9 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
         The optimised stride (its ``step_period_s`` the stride's).
     strides : int
         As :func:`contact_replay`.
+    plant : walkerlab.walker.plant.Plant
+        The scene's plant, handed down (the replay's scene is its
+        :meth:`~walkerlab.walker.plant.Plant.with_`).
 
     Returns
     -------
@@ -169,7 +182,7 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
         As :func:`contact_replay` (``outcome`` one line).
     """
     setup, why = _powered_setup(scene, _hip_actuation(res),
-                                {"n_strides": strides, "sample_rate_hz": 500})
+                                {"n_strides": strides, "sample_rate_hz": 500}, plant=plant)
     if setup is None:
         return float("nan"), why
     acts = setup.actuators
@@ -216,10 +229,13 @@ def _law_of_time(tau):
     return lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
 
 
-def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = False):
+def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = False, *,
+                   plant):
     """The contact set-up of ``scene`` with ``actuation`` in place of its walker's and
     ``contact_sim`` as its run section (its ``contact`` law, the paper's default one if none;
-    ``terrain``: continuous level ground if none), or ``(None, why)`` in one line."""
+    ``terrain``: continuous level ground if none), or ``(None, why)`` in one line; the
+    replay's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of ``plant`` (the
+    scene's, handed down)."""
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup
 
     d = scene.model_dump(mode="json", exclude_none=True)
@@ -229,8 +245,8 @@ def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = Fa
         d.setdefault("terrain", {})
     d["contact_sim"] = contact_sim
     try:
-        sc = type(scene).model_validate(d)  # the replay's scene, described here
-        return contact_setup(sc, plant=Plant.from_scene(sc)), ""
+        sc = type(scene).model_validate(d)  # the replay's scene: a neighbour of the plant's
+        return contact_setup(sc, plant=plant.with_(sc)), ""
     except (ContactSceneError, ValueError) as exc:
         return None, f"not replayed: {exc}"
 
@@ -300,7 +316,7 @@ SETTLED_STEPS = 4
 
 
 def contact_replay_controller(scene, x_star, period_s: float, step_length_m: float,
-                              strides: int | None = None) -> dict:
+                              strides: int | None = None, *, plant) -> dict:
     """Run the contact model of a designed controller's scene (its walker under virtual
     constraints, with its ``contact``, ``terrain``, ``contact_sim`` and ``contact_solver``)
     from the rigid closed loop's fixed point and compare its steps with the rigid gait's.
@@ -316,6 +332,9 @@ def contact_replay_controller(scene, x_star, period_s: float, step_length_m: flo
         The rigid gait's step period [s] and length [m].
     strides : int, optional
         Strides to run (default the scene's ``contact_sim.n_strides``).
+    plant : walkerlab.walker.plant.Plant
+        The optimised scene's plant, handed down (the controller's scene is
+        :meth:`~walkerlab.walker.plant.Plant.with_` of it).
 
     Returns
     -------
@@ -334,7 +353,7 @@ def contact_replay_controller(scene, x_star, period_s: float, step_length_m: flo
     out = {"periods": np.zeros(0), "step_period_s": nan, "speed_m_per_s": nan,
            "heel_strikes": 0, "trend": "", "walks": False}
     try:
-        setup = contact_setup(scene, plant=Plant.from_scene(scene))
+        setup = contact_setup(scene, plant=plant.with_(scene))
         walker, run, _, _ = simulate_from(setup, np.asarray(x_star, float), period_s,
                                           strides=strides)
     except (ContactSceneError, ValueError, ArithmeticError, RuntimeError) as exc:
