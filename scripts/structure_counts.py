@@ -84,13 +84,14 @@ KIND_WORD_ATTRS = frozenset({"name", "body", "rigid", "knees", "feet", "landing"
                              "actuators", "collocation", "reaction", "scuff", "phases"})
 
 
-def _is_kind_word(n) -> bool:
-    """``kind.<attr>`` or ``<...>.kind.<attr>`` for a word attribute of the kind."""
+def _is_kind_word(n, loops: bool = False) -> bool:
+    """``kind.<attr>`` or ``<...>.kind.<attr>`` for a word attribute of the kind (with
+    ``loops``, also ``k.<attr>``: a loop over the kinds)."""
     if not (isinstance(n, ast.Attribute) and n.attr in KIND_WORD_ATTRS):
         return False
     owner = n.value
-    if n.attr != "name" and isinstance(owner, ast.Name) and len(owner.id) == 1:
-        return True  # a loop over the kinds: k.<part>
+    if loops and n.attr != "name" and isinstance(owner, ast.Name) and len(owner.id) == 1:
+        return True
     return (isinstance(owner, ast.Name) and owner.id == "kind") or (
         isinstance(owner, ast.Attribute) and owner.attr == "kind")
 
@@ -109,7 +110,7 @@ def _kind_word_switch(n) -> bool:
     ``kind.<attr>`` so compared: a switch on a kind's word."""
     if not isinstance(n, ast.Compare):
         return False
-    if not _is_kind_word(n.left):
+    if not _is_kind_word(n.left, loops=True):
         return False
     for c in n.comparators:
         if isinstance(c, ast.Constant) and isinstance(c.value, str):

@@ -73,7 +73,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
     plant.kind.require_stage("robustness")
     st = scene.robustness or RobustnessSettings()
-    walker = build_walker(scene, plant)
+    walker = build_walker(plant.with_(scene))
     if walker.steps_per_map != 1 and (walker.mirror_reflection is None
                                       or walker.cycle is not None):
         raise ValueError("robustness: legs that differ (a stride map) are not supported")
@@ -107,7 +107,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     back = largest_by_bisection(sm, x_star, "push", st.push_cap_m_per_s,
                                 st.push_resolution_m_per_s, st.survival_steps, sign=-1.0)
     mc = work.monte_carlo(scene, x_star, st.sigma_rad, st.montecarlo_walks,
-                          st.montecarlo_max_steps, st.seed, "normal", workers, scheduler)
+                          st.montecarlo_max_steps, st.seed, "normal", workers, scheduler,
+                          plant=plant)
     m, se = mc.mfpt
     sc = {"step_down_m/lo": down[0], "step_down_m/hi": down[1], "step_up_m/lo": up[0],
           "step_up_m/hi": up[1], "push_forward_m_per_s/lo": fwd[0],
