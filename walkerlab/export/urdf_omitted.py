@@ -15,7 +15,6 @@ from walkerlab.export.omitted import URDF_GROUND, URDF_GROUND_3D, URDF_KNEE_LATC
 from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import ankle_springs
 from walkerlab.export.text import comment, num
-from walkerlab.walker.kinds import KINDS
 from walkerlab.walker.multibody import multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
@@ -100,7 +99,7 @@ def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
     out = [URDF_GROUND]
     out += [Omission(f"spring {sp.name}", "URDF has no spring element (its law is in the "
                      "header)") for sp in mb.springs]
-    if KINDS[mb.kind].feet_have_modes:  # flat feet: the ankle spring-dampers
+    if export_part(mb).ankles:  # flat feet (the tree's soles): the ankle spring-dampers
         out += [Omission(f"ankle spring {leg}_ankle", "URDF has no spring element (its law "
                          "is in the header)") for leg in ("leg1", "leg2")]
     out += [Omission(f"coupling {cp.name}", f"URDF's mimic follows one joint only, so a URDF "
