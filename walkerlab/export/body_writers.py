@@ -39,6 +39,7 @@ from walkerlab.export.spoked import (
     wheel3d_urdf_text,
     wheel_chord_m,
 )
+from walkerlab.export.tree_links import tree_multibody
 from walkerlab.export.urdf import keyframe_json, legs_urdf_text
 from walkerlab.export.urdf_omitted import legs_urdf_omissions, urdf_omissions
 from walkerlab.export.wheel_scene import (
@@ -46,7 +47,6 @@ from walkerlab.export.wheel_scene import (
     wheel_keyframe,
     wheel_keyframe_json,
 )
-from walkerlab.walker.multibody import multibody
 
 __all__ = ["MJCF", "URDF", "MjcfWriter", "TreeWriter", "UrdfWriter", "check_legs_3d",
            "planar_legs_only"]
@@ -107,7 +107,7 @@ class TreeWriter:
         check_exportable`), and ``(ideal, extra)``: the rigid gait and its MJCF scene
         (:func:`walkerlab.export.scene.mjcf_scene`: keyframe, terrain, contact), or
         ``(None, None)`` for the walker alone."""
-        scene, mb = job.scene, multibody(job.data)
+        scene, mb = job.scene, tree_multibody(job.data)
         check_exportable(scene, job.kind, w.name, job.walker_only, job.tree)
         ideal, extra = (None, None) if job.walker_only else job.gait(
             lambda ideal: mjcf_scene(scene, mb, job.plant, ideal, job.options))

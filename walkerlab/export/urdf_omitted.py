@@ -15,7 +15,7 @@ from walkerlab.export.omitted import URDF_GROUND, URDF_GROUND_3D, URDF_KNEE_LATC
 from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import ankle_springs
 from walkerlab.export.text import comment, num
-from walkerlab.walker.multibody import multibody
+from walkerlab.export.tree_links import tree_multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.config.actuation import Actuation
@@ -61,7 +61,7 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
     each coupling (a bisecting hip: ``mimic`` follows one joint only), its knee latch
     (knees: the planar URDF's item), its motors and push-off."""
     if not data.structure.in_3d:
-        return urdf_omissions(multibody(data), actuation)
+        return urdf_omissions(tree_multibody(data), actuation)
     from walkerlab.export.legs_3d_parts import (  # light: 3D only
         hip_roll_law,
         kneed,

@@ -66,7 +66,7 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.scene import FORMAT_VIEWS, check_exportable
-from walkerlab.walker.multibody import multibody
+from walkerlab.export.tree_links import tree_multibody
 
 
 def _adams(job: ExportJob, w: Writer) -> Written:
@@ -76,7 +76,7 @@ def _adams(job: ExportJob, w: Writer) -> Written:
         return _adams_3d(job, w)
     planar_legs_only(job, w)
     scene, data = job.scene, job.data
-    mb = multibody(data)
+    mb = tree_multibody(data)  # its links: the body tree's
     act = scene.walker.actuation
     if act is not None and act.virtual_constraints is not None:  # the table's cell
         job.kind.require("virtual_constraints", w.view, "walker.actuation.virtual_constraints")
@@ -120,7 +120,7 @@ def _osim(job: ExportJob, w: Writer) -> Written:
     """``walker.osim``: the walker, its gait as the default state, its ground and contact."""
     planar_legs_only(job, w)
     scene, data = job.scene, job.data
-    mb = multibody(data)
+    mb = tree_multibody(data)  # its links: the body tree's
     if job.walker_only:
         raise ValueError("--walker-only: the OpenSim export carries the gait, ground and "
                          "contact (its default state is the rigid gait); drop --walker-only")
