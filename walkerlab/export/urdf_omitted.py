@@ -30,7 +30,7 @@ def flat_feet_comments(data, mb: Multibody) -> list[str]:
     rigid model has them (massless, or the walker's foot mass), their heel and toe
     collision spheres and each ankle spring's law (URDF has no spring element)."""
     st = data.structure
-    if not st.kind.feet_have_modes:
+    if not mb.tree.soles:  # the body tree's soles: flat feet
         return []
     if st.foot_mass:
         P = dict(zip(st.param_names, data.params))

@@ -141,11 +141,12 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
 )}
 
 
-def walk_file(out: Exported, fmt: str, kind, steps: int, scene: Scene,
+def walk_file(out: Exported, fmt: str, tree, steps: int, scene: Scene,
               data=None) -> EngineWalk:
     """The written file walked in its engine
-    (:func:`walkerlab.export.engine_walk.walk_export`; a spoked wheel rolls on its spokes,
-    :attr:`walkerlab.walker.kinds.Kind.spoked`; virtual constraints by their computed torque,
+    (:func:`walkerlab.export.engine_walk.walk_export`; a spoked wheel, one body on its
+    spokes in its body tree ``tree``, :attr:`walkerlab.walker.tree.BodyTree.one_body`, rolls
+    on its spokes; virtual constraints by their computed torque,
     :func:`walkerlab.export.mujoco_walk.virtual_constraint_feedback` of ``data``, the scene's
     walker description from the stage's :class:`~walkerlab.walker.plant.Plant`), or why
     not."""
@@ -157,4 +158,4 @@ def walk_file(out: Exported, fmt: str, kind, steps: int, scene: Scene,
 
         feedback = virtual_constraint_feedback(scene, data)
     return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,
-                       spokes=kind.spoked, feedback=feedback)
+                       spokes=tree.one_body, feedback=feedback)

@@ -167,7 +167,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     out = Exported(files[0][0], built.left_out, built.step_period_s)
     if not walk:
         return out
-    walked = walk_file(out, fmt, kind, walk_steps, scene, data)
+    walked = walk_file(out, fmt, job.tree, walk_steps, scene, data)
     return replace(out, walk=replace(walked, contact_period_s=contact_period(scene,
                                                                              runs_root)))
 
