@@ -414,15 +414,23 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     own parts table) carries the note: in the grid (a numbered note), in the JSON's
     ``note`` and ``detail``, and on the docs' page; no other kind's cells do."""
 
-    from walkerlab.export.parts import kind_part
+    from walkerlab.config import load_scene
+    from walkerlab.export.parts import tree_part
     from walkerlab.walker.capability_cells import KNEE_LATCH_OSIM
     from walkerlab.walker.capability_tables import kind_grid, text
     from walkerlab.walker.kinds import table_rows
+    from walkerlab.walker.plant import Plant
 
     # the kinds whose OpenSim model is written with knee stops (the kneed walker in 3D has
     # them as a part, but its export is refused)
-    latched = {k for k, kind in KINDS.items() if kind_part(kind).knee_stops
-               and kind.supports("walk", "osim")}
+    def knee_stops(kind):  # the export's part, read from the kind's walker's body tree
+        from walkerlab.walker.walker_trees import walker_tree
+
+        structure = Plant.from_scene(load_scene(kind.scene)).structure
+        return tree_part(walker_tree(structure)[0]).knee_stops
+
+    latched = {k for k, kind in KINDS.items() if kind.supports("walk", "osim")
+               and knee_stops(kind)}
     assert latched == {"locking_knees"}
     for row in table_rows():
         if row["supported"] and row["view"] == "osim":

@@ -67,11 +67,21 @@ def test_a_pushed_off_compass_walker_lands_each_step_at_its_footholds_height():
 
 def test_the_exports_walk_check_knows_every_kind():
     """``export --walk`` picks heel strikes or spoke strikes by the walker's kind (its
-    ``spoked``), and every kind's multibody has a writer (the three-link walker's entry was
-    missing from a table keyed by kind name: a KeyError on its walk)."""
-    from walkerlab.export.writers import BODIES
+    ``spoked``), and every kind's body tree has a URDF and an MJCF writer of its form (the
+    three-link walker's entry was missing from a table keyed by kind name: a KeyError on
+    its walk; the writers now ask the tree)."""
+    from walkerlab.config import load_scene
+    from walkerlab.export.body_writers import MJCF, URDF, TreeWriter
+    from walkerlab.walker.plant import Plant
+    from walkerlab.walker.walker_trees import walker_tree
 
-    assert {k.body for k in KINDS.values()} <= set(BODIES)
+    for kind in KINDS.values():
+        tree, _ = walker_tree(Plant.from_scene(load_scene(kind.scene)).structure)
+        form = ("wheel" if tree.in_plane else "wheel_3d") if tree.one_body else (
+            "legs" if tree.in_plane else "legs_3d")
+        for writer in (URDF, MJCF):
+            assert getattr(type(writer), form) is not getattr(TreeWriter, form), (kind, form)
+        assert tree.one_body == kind.spoked, kind.name
     assert [k.name for k in KINDS.values() if k.spoked] == ["rolling_polygon",
                                                             "rolling_polygon_3d"]
 

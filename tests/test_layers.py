@@ -595,7 +595,8 @@ SWITCH_3D_READERS = {
                                "hip-roll joints (the MJCF's, URDF's and Adams')",
     "export/adams_3d.py": "writes the Adams dataset's hip-roll joints and their law",
     "models/registry.py": "builds a 3D compass gait from its 2D scene's kind",
-    "export/writers.py": "refuses a hip-roll walker per format (the capability table's cell)",
+    "export/body_writers.py": "refuses a hip-roll walker per format (the capability table's "
+                              "cell)",
     "models/contact/parts.py": "the 3D straight legs' contact part: a hip-roll law's power "
                                "is a term of the powered contact run's ledger",
 }

@@ -1,8 +1,8 @@
-"""The feet of the Adams Solver dataset (:mod:`walkerlab.export.adams`) per walker kind: a
-point or arc foot is a contact sphere on its leg's end (:class:`LegEndFeet`), a flat foot a
-PART on an ankle REVOLUTE with heel and toe spheres (:class:`FlatFeet`); the writer reaches
-them through the walker's kind (:data:`ADAMS_FEET`, :func:`adams_feet`), never through the
-description's switches.
+"""The feet of the Adams Solver dataset (:mod:`walkerlab.export.adams`), as the walker's body
+tree has them: a point or arc foot is a contact sphere on its leg's end (:class:`LegEndFeet`),
+a flat foot (a sole of the tree, :attr:`walkerlab.walker.tree.BodyTree.soles`) a PART on an
+ankle REVOLUTE with heel and toe spheres (:class:`FlatFeet`); the writer reaches them through
+the tree (:func:`adams_feet`), never through the walker's kind or the description's switches.
 """
 
 from __future__ import annotations
@@ -24,9 +24,8 @@ from walkerlab.export.adams_statements import (
     part_statement,
 )
 from walkerlab.export.mjcf_scene import point_foot_radius
-from walkerlab.walker.kinds import KINDS
 
-__all__ = ["ADAMS_FEET", "ANKLE_JOINT", "ANKLE_SPRING", "FOOT_FORCES", "FlatFeet",
+__all__ = ["ANKLE_JOINT", "ANKLE_SPRING", "FOOT_FORCES", "FlatFeet",
            "LegEndFeet", "adams_feet", "contact_pairs", "hip_link", "leg_end", "part_ids"]
 
 #: Flat feet: the ankle revolutes of leg1 and leg2 (``ANKLE_JOINT``, ``+ 1``).
@@ -196,14 +195,13 @@ class FlatFeet(LegEndFeet):
                 {g: marker_id(ids[f"{g}_foot"], "foot") for g in LEGS})
 
 
-#: feet (:attr:`walkerlab.walker.kinds.Kind.feet`) -> the dataset's feet of that kind (the
-#: rolling polygon has no Adams dataset: :data:`walkerlab.walker.kinds.CAPABILITIES`)
-ADAMS_FEET = {"leg_ends": LegEndFeet(), "flat": FlatFeet()}
-
-
 def adams_feet(mb) -> LegEndFeet:
-    """The feet of the multibody walker's kind (``mb.kind``)."""
-    return ADAMS_FEET[KINDS[mb.kind].feet]
+    """The dataset's feet of the multibody walker ``mb``
+    (:class:`walkerlab.walker.multibody.Multibody`) as its body tree has them: flat feet
+    where the tree has soles (:attr:`walkerlab.walker.tree.BodyTree.soles`), else the legs'
+    ends (the rolling polygon has no Adams dataset:
+    :data:`walkerlab.walker.kinds.CAPABILITIES`)."""
+    return FlatFeet() if mb.tree.soles else LegEndFeet()
 
 
 def part_ids(mb) -> dict[str, int]:

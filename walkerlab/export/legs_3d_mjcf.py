@@ -115,6 +115,7 @@ from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.walker.description import state_names
+from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_CCD_TOLERANCE_L", "TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls",
            "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad"]
@@ -397,9 +398,10 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         notes += (latch_note(knee),)
     act = scene.walker.actuation
     if act is not None:  # the planar walkers' note: one motor 'hip', the loop's laws
-        from walkerlab.export.parts import kind_part  # light
+        from walkerlab.export.parts import tree_part  # light
 
-        notes += (kind_part(data.structure.kind).mjcf_actuators,)
+        notes += (tree_part(body_tree(data.structure)[0],
+                            data.structure.kind.joints_free).mjcf_actuators,)
     return Legs3dScene(qpos, qvel, lanes, float(terrain.patch_width_m), float(dt),
                        tuple(solref), tuple(solimp), float(mu), period, notes, float(across),
                        act, float(dt), latch)  # the push-off over one timestep

@@ -11,6 +11,7 @@ from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import num
 from walkerlab.export.tree_bodies import PelvisRoles
 from walkerlab.walker.trees import legs_tree
+from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "hip_roll_law", "kneed", "leg_links",
            "legs3d_numbers", "legs3d_roles", "legs_summary", "legs_words", "round_feet",
@@ -66,8 +67,9 @@ SHANK = "swing_shank"
 
 
 def kneed(data) -> bool:
-    """Whether the 3D walker has knees (:attr:`walkerlab.walker.kinds.Kind.knees`)."""
-    return data.structure.kind.knees != "none"
+    """Whether the 3D walker has knees: its body tree a knee (the joint ``swing_knee``,
+    :func:`walkerlab.walker.walker_trees.walker_tree`)."""
+    return body_tree(data.structure)[0].has_joint("swing_knee")
 
 
 def legs3d_roles(data) -> PelvisRoles:

@@ -257,7 +257,7 @@ def osim_gait(scene: Scene, mb, plant, ideal=None) -> OsimGait:
     """
     from walkerlab.analysis.contact.periodic import ideal_gait  # light
     from walkerlab.export.scene import mjcf_scene
-    from walkerlab.export.scene_feet import SCENE_FEET
+    from walkerlab.export.scene_feet import scene_feet
     from walkerlab.models.contact.model import ContactWalker
     from walkerlab.models.contact.rigid_limit import contact_si
     from walkerlab.models.contact.scene import ideal_step_length
@@ -276,7 +276,7 @@ def osim_gait(scene: Scene, mb, plant, ideal=None) -> OsimGait:
                          "patches on the treads")
     ms = mjcf_scene(scene, mb, plant, ideal)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
-                           flat_foot=SCENE_FEET[KINDS[mb.kind].feet].foot_mass(settings))
+                           flat_foot=scene_feet(mb.tree).foot_mass(settings))
     ell = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:

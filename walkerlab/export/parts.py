@@ -1,21 +1,23 @@
-"""The export's part of each walker kind: what the writers (URDF, MJCF, Adams, OpenSim) do
-differently for a kind, made from the kind's parts (:mod:`walkerlab.walker.kinds`).
+"""The export's part of a walker: what the writers (URDF, MJCF, Adams, OpenSim) do
+differently for it, read from its body tree (:mod:`walkerlab.walker.tree`: its knee, its
+joints' stops, its soles).
 
-The writers never ask the description's switches (flat feet, free knees, spokes) which code
-runs: they ask the walker's kind for its part, :func:`export_part` (the Adams dataset's foot
-statements in :data:`walkerlab.export.adams_feet.ADAMS_FEET`, the MJCF scene's feet in
-:data:`walkerlab.export.scene_feet.SCENE_FEET`, the export stage's writer per kind in
-``walkerlab.stages.export``).  Whether a kind is exported in a format at all is the
-capability table's (:meth:`walkerlab.walker.kinds.Kind.require`).
+The writers never ask the description's switches (flat feet, free knees, spokes) or the
+kind's words which code runs: they ask the walker's tree, :func:`export_part` (the Adams
+dataset's foot statements, :func:`walkerlab.export.adams_feet.adams_feet`, the MJCF scene's
+feet, :func:`walkerlab.export.scene_feet.scene_feet`, the export stage's writer of the
+tree's form, :mod:`walkerlab.export.writers`).  Whether a kind is exported in a format at
+all is the capability table's (:meth:`walkerlab.walker.kinds.Kind.require`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from walkerlab.walker.kinds import KINDS, Kind
+from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.tree import BodyTree
 
-__all__ = ["ExportPart", "export_part", "kind_part"]
+__all__ = ["ExportPart", "export_part", "tree_part"]
 
 _HIP_SIDECAR = ("hip torques act +tau on the swing leg's hip joint and -tau on the stance "
                 "leg's; the push-off is an impulse along the trailing leg at its foot at each "
@@ -91,17 +93,21 @@ _STRAIGHT_LEGS = {
         "is the stance leg's angle from the downward vertical")}
 
 
-def kind_part(kind: Kind) -> ExportPart:
-    """The export part of a walker kind (:class:`walkerlab.walker.kinds.Kind`): knee stops
-    for knees that lock, ankles for flat feet, a free-jointed walker's actuator notes."""
+def tree_part(tree: BodyTree, joints_free: bool = False) -> ExportPart:
+    """The export part of the walker whose body tree is ``tree``
+    (:class:`walkerlab.walker.tree.BodyTree`): knee stops where a joint has a stop
+    (:attr:`~walkerlab.walker.tree.BodyTree.stopped_joints`: a locking knee's), ankles where
+    it has soles (:attr:`~walkerlab.walker.tree.BodyTree.soles`: flat feet); a free-jointed
+    walker's (``joints_free``, :attr:`walkerlab.walker.kinds.Kind.joints_free`) actuator
+    notes, of knees where the tree has a knee (a joint ``swing_knee``), else of straight
+    legs."""
     notes = {}
-    if kind.joints_free:
-        notes = _FREE_KNEES if kind.knees == "free" else _STRAIGHT_LEGS
-    return ExportPart(knee_stops=kind.knees == "locking", ankles=kind.feet_have_modes,
-                      **notes)
+    if joints_free:
+        notes = _FREE_KNEES if tree.has_joint("swing_knee") else _STRAIGHT_LEGS
+    return ExportPart(knee_stops=bool(tree.stopped_joints), ankles=bool(tree.soles), **notes)
 
 
 def export_part(mb) -> ExportPart:
-    """The export part of a multibody walker's kind (``mb.kind``,
-    :class:`walkerlab.walker.multibody.Multibody`): :func:`kind_part`."""
-    return kind_part(KINDS[mb.kind])
+    """The export part of a multibody walker (:class:`walkerlab.walker.multibody.Multibody`):
+    :func:`tree_part` of its body tree (``mb.tree``)."""
+    return tree_part(mb.tree, KINDS[mb.kind].joints_free)

@@ -43,10 +43,10 @@ def planar_roles(structure):
     from walkerlab.export.tree_bodies import PelvisRoles  # light: sympy with the bodies
 
     sw, st = (f"_{ROLE_TAG[r]}_" for r in ("swing", "stance"))
-    kind = structure.kind           # its knees and joints (walkerlab.walker.kinds)
-    knee = kind.knees != "none"      # on the swing leg, or free on both (every joint free)
-    thigh = "stance_thigh" if kind.joints_free else "stance"
-    flat = kind.feet_have_modes       # flat feet: a sole on each ankle
+    tree, _ = legs_tree(structure)   # its knees and soles, as its tree has them
+    knee = tree.has_joint("swing_knee")  # on the swing leg, or free on both (every joint free)
+    thigh = "stance_thigh" if tree.has_joint("stance_knee") else "stance"
+    flat = bool(tree.soles)           # flat feet: a sole on each ankle
     return PelvisRoles(
         name="hip", slides=PLANAR_SLIDES,
         stance_roles=((("swing_thigh", thigh), ("swing_shank", "stance_shank")) if knee

@@ -47,7 +47,7 @@ from walkerlab.export.mjcf_scene import (
     point_foot_radius,
 )
 from walkerlab.export.parts import export_part
-from walkerlab.export.scene_feet import SCENE_FEET
+from walkerlab.export.scene_feet import scene_feet
 from walkerlab.export.scene_ground import (
     checkerboard,
     footfalls_per_step,
@@ -59,7 +59,10 @@ from walkerlab.models.contact.laws import ContactParamsSI
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.models.contact.terrain import check_ground, ground_drops, profile_line
-from walkerlab.walker.kinds import KINDS, Kind
+from walkerlab.walker.kinds import Kind
+from walkerlab.walker.plant import Plant
+from walkerlab.walker.tree import BodyTree
+from walkerlab.walker.walker_trees import walker_tree
 
 __all__ = ["FORMAT_VIEWS", "arc_roll_m", "check_exportable", "latch_note", "mjcf_scene",
            "mujoco_contact"]
@@ -69,13 +72,15 @@ FORMAT_VIEWS = {"urdf": "urdf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
 
 
 def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
-                     walker_only: bool = False) -> None:
+                     walker_only: bool = False, tree: BodyTree | None = None) -> None:
     """Refuse walkers whose numbers MuJoCo cannot represent.
 
     ``kind`` is the walker's (:attr:`walkerlab.walker.description.Structure.kind`); ``fmt``
     (``"mjcf"``, ``"urdf"``; None: any) and ``walker_only`` (no gait, contact or terrain)
     are the export's: flat feet are written to a URDF, an MJCF (the walker alone too) and
-    an OpenSim model with its scene (:meth:`_LinkFeet.check_format`).
+    an OpenSim model with its scene (:meth:`_LinkFeet.check_format` of the feet ``tree``
+    has, :func:`walkerlab.export.scene_feet.scene_feet`; default: the scene's walker's body
+    tree, :func:`walkerlab.walker.walker_trees.walker_tree`).
 
     Raises
     ------
@@ -88,7 +93,9 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
         ankle push-off (flat feet) is exported: motors ``leg<i>_ankle_motor`` that
         :mod:`walkerlab.export.mujoco_walk` drives.
     """
-    SCENE_FEET[kind.feet].check_format(fmt, walker_only)
+    if tree is None:
+        tree = walker_tree(Plant.from_scene(scene).structure)[0]
+    scene_feet(tree).check_format(fmt, walker_only)
     act = scene.walker.actuation
     if not walker_only and act is not None and act.virtual_constraints is not None:
         kind.require("virtual_constraints", FORMAT_VIEWS.get(fmt or "mjcf", "mjcf"),
@@ -243,7 +250,7 @@ def mjcf_scene(scene: Scene, mb, plant, ideal=None, options: MjcfOptions | None 
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain_or_default()
     c, knee = contact_si(settings)
-    feet_part, part = SCENE_FEET[KINDS[mb.kind].feet], export_part(mb)
+    feet_part, part = scene_feet(mb.tree), export_part(mb)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee,
                            flat_foot=feet_part.foot_mass(settings))
     ideal = ideal_gait(scene, plant=plant) if ideal is None else ideal

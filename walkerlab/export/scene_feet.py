@@ -1,4 +1,5 @@
-"""The exported MuJoCo scene's feet, per kind of feet (:data:`SCENE_FEET`): the ``gait``
+"""The exported MuJoCo scene's feet, as the walker's body tree has them (:func:`scene_feet`:
+its soles, :attr:`walkerlab.walker.tree.BodyTree.soles`, or its legs' ends): the ``gait``
 keyframe in the export's joint coordinates (:func:`joint_state`) and, for flat feet, the foot
 bodies on their ankle hinges (:func:`flat_foot_bodies`) with the rigid heel strike's double
 support as the keyframe, and the checkerboard's patches centred on the soles.
@@ -190,7 +191,10 @@ class _FlatFeet(_LinkFeet):
                      for lane, off in zip(lanes, footprint_offsets(data)))
 
 
-#: feet (:attr:`walkerlab.walker.kinds.Kind.feet`) -> the MJCF scene's feet of that kind (a
-#: spoked wheel's keyframe is :func:`walkerlab.export.wheel_scene.wheel_keyframe`'s; its
-#: entry only passes :func:`check_exportable`)
-SCENE_FEET = {"leg_ends": _LinkFeet(), "flat": _FlatFeet()}
+def scene_feet(tree) -> _LinkFeet:
+    """The MJCF scene's feet of the walker whose body tree is ``tree``
+    (:class:`walkerlab.walker.tree.BodyTree`): flat feet where it has soles
+    (:attr:`~walkerlab.walker.tree.BodyTree.soles`), else the legs' ends (a spoked wheel's
+    keyframe is :func:`walkerlab.export.wheel_scene.wheel_keyframe`'s; its feet only pass
+    :func:`walkerlab.export.scene.check_exportable`)."""
+    return _FlatFeet() if tree.soles else _LinkFeet()

@@ -63,12 +63,12 @@ from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import planar_bodies, sole_points
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import arc_feet, comment, header, num, nums
+from walkerlab.export.tree_links import tree_multibody
 from walkerlab.export.urdf_omitted import (
     flat_feet_comments,
     legs_urdf_omissions,
     urdf_omissions,
 )
-from walkerlab.walker.multibody import multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.config.actuation import Actuation
@@ -207,9 +207,9 @@ def legs_urdf_text(data, name: str, version: str = "",
     """
     if data.structure.in_3d:
         return _legs_3d_text(data, name, version, actuation)
-    mb = multibody(data)
+    mb = tree_multibody(data)
     root, couplings = planar_bodies(data)  # flat feet: the soles as the rigid model has them
-    soles = sole_points(data) if data.structure.kind.feet_have_modes else None
+    soles = sole_points(data) if mb.tree.soles else None
     comments = [*header(mb, name, "URDF", version), *flat_feet_comments(data, mb),
                 *xml_comments(urdf_omissions(mb, actuation))]
     return urdf_robot_text(name, comments, root, couplings, _planar_visuals(mb, soles),

@@ -15,8 +15,7 @@ from walkerlab.export.omitted import URDF_GROUND, URDF_GROUND_3D, URDF_KNEE_LATC
 from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import ankle_springs
 from walkerlab.export.text import comment, num
-from walkerlab.walker.kinds import KINDS
-from walkerlab.walker.multibody import multibody
+from walkerlab.export.tree_links import tree_multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.config.actuation import Actuation
@@ -31,7 +30,7 @@ def flat_feet_comments(data, mb: Multibody) -> list[str]:
     rigid model has them (massless, or the walker's foot mass), their heel and toe
     collision spheres and each ankle spring's law (URDF has no spring element)."""
     st = data.structure
-    if not st.kind.feet_have_modes:
+    if not mb.tree.soles:  # the body tree's soles: flat feet
         return []
     if st.foot_mass:
         P = dict(zip(st.param_names, data.params))
@@ -62,7 +61,7 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
     each coupling (a bisecting hip: ``mimic`` follows one joint only), its knee latch
     (knees: the planar URDF's item), its motors and push-off."""
     if not data.structure.in_3d:
-        return urdf_omissions(multibody(data), actuation)
+        return urdf_omissions(tree_multibody(data), actuation)
     from walkerlab.export.legs_3d_parts import (  # light: 3D only
         hip_roll_law,
         kneed,
@@ -100,7 +99,7 @@ def urdf_omissions(mb: Multibody, actuation: Actuation | None = None
     out = [URDF_GROUND]
     out += [Omission(f"spring {sp.name}", "URDF has no spring element (its law is in the "
                      "header)") for sp in mb.springs]
-    if KINDS[mb.kind].feet_have_modes:  # flat feet: the ankle spring-dampers
+    if export_part(mb).ankles:  # flat feet (the tree's soles): the ankle spring-dampers
         out += [Omission(f"ankle spring {leg}_ankle", "URDF has no spring element (its law "
                          "is in the header)") for leg in ("leg1", "leg2")]
     out += [Omission(f"coupling {cp.name}", f"URDF's mimic follows one joint only, so a URDF "

@@ -108,7 +108,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     ``fixedpoint`` section or, without one, from its defaults (an automatic search).
     ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
     default contact, no sidecar).  A spoked wheel, a straight-legged walker in 3D (a free
-    pelvis): their own URDF / MJCF (:data:`walkerlab.export.writers.BODIES`).
+    pelvis): their own URDF / MJCF (the writer of their body tree's form,
+    :mod:`walkerlab.export.body_writers`).
     ``mjcf``: the MJCF's contact time constant and timestep
     (:class:`walkerlab.export.mjcf_scene.MjcfOptions`; default: the scene's contact law's).
 
@@ -145,20 +146,20 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
                          "drop one of them")
     data = plant.data
     kind = plant.kind
-    if kind.field != "walker":  # a kind whose walker the writers do not refuse themselves
+    job = ExportJob(scene, plant, scene.name or "walker", walker_only,
+                    lambda build: _gait(scene, runs_root, build, plant),
+                    lambda: stored_gait(scene, runs_root),
+                    mjcf if mjcf is not None and mjcf != MjcfOptions() else None)
+    if not job.tree.in_plane:  # a walker in 3D, which the writers do not refuse themselves
         kind.require("walk", writer.view, kind.field)
     if ground and len(drops) > 1:  # footholds of several heights: the table's cell
         kind.require("footholds", writer.view, "terrain.foothold_heights_m")
     if ground and scene.terrain.kind in ("stairs", "profile"):  # the kind's cell of it
         kind.require(scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")
-    if mjcf is not None and mjcf != MjcfOptions() and (fmt != "mjcf" or kind.spoked):
+    if mjcf is not None and mjcf != MjcfOptions() and (fmt != "mjcf" or job.tree.one_body):
         raise ValueError("--mjcf-contact-time-constant-s, --mjcf-timestep-s: options of "
                          "a legged walker's MJCF (--format mjcf); the spoked wheel's MJCF "
                          "has its own contact")
-    job = ExportJob(scene, plant, scene.name or "walker", walker_only,
-                    lambda build: _gait(scene, runs_root, build, plant),
-                    lambda: stored_gait(scene, runs_root),
-                    mjcf if mjcf is not None and mjcf != MjcfOptions() else None)
     built = writer.write(job, writer)
     files = [(runpaths.scene_file(scene, runs_root, name, claim=True), text)
              for name, text in built.files]
@@ -166,7 +167,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     out = Exported(files[0][0], built.left_out, built.step_period_s)
     if not walk:
         return out
-    walked = walk_file(out, fmt, kind, walk_steps, scene, data)
+    walked = walk_file(out, fmt, job.tree, walk_steps, scene, data)
     return replace(out, walk=replace(walked, contact_period_s=contact_period(scene,
                                                                              runs_root)))
 

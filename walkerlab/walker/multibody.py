@@ -41,6 +41,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from walkerlab.walker.description import WalkerData
+from walkerlab.walker.tree import BodyTree
+from walkerlab.walker.walker_trees import walker_tree
 
 __all__ = ["Coupling", "Link", "Multibody", "Spring", "multibody"]
 
@@ -173,7 +175,10 @@ class Multibody:
         for free knees (``knee.lock: free``, the five-link biped: no stop in any view).
     kind : str
         The walker's structural kind (:attr:`walkerlab.walker.description.Structure.kind`'s
-        name): the key of the exports' tables of parts.
+        name): its cells of the capability table.
+    tree : BodyTree or None
+        The walker's body tree (:func:`walkerlab.walker.walker_trees.walker_tree`): what the
+        exports ask of its form (its soles, knees and their stops).
     """
 
     hip_mass_kg: float
@@ -188,6 +193,7 @@ class Multibody:
     couplings: tuple[Coupling, ...] = ()
     knee_stop: bool = True
     kind: str = "straight_legs"
+    tree: BodyTree | None = None
 
 
 def _combine(name: str, parts: list[tuple[float, float, float, str, float]]
@@ -245,7 +251,7 @@ def multibody(data: WalkerData) -> Multibody:
     springs = _springs(s, p)
     return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
                      data.slope_rad, tuple(springs), couplings, not s.free_knees,
-                     s.kind.name)
+                     s.kind.name, walker_tree(s)[0])
 
 
 def _leg_links(s, p: dict, L: float, lt: float, R: float) -> list[Link]:

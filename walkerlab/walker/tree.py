@@ -183,6 +183,52 @@ class BodyTree:
                 return c
         raise KeyError(name)
 
+    @property
+    def joints(self) -> tuple[Joint, ...]:
+        """Every body's joint, in body order."""
+        return tuple(b.joint for b in self.bodies)
+
+    def has_joint(self, name: str) -> bool:
+        """Whether a joint is called ``name`` (a knee ``swing_knee``, say)."""
+        return any(j.name == name for j in self.joints)
+
+    @property
+    def stopped_joints(self) -> tuple[Joint, ...]:
+        """The joints with a stop on a coordinate (:attr:`Joint.stops`: a locking knee's
+        straight-leg stop), in body order."""
+        return tuple(j for j in self.joints if any(s is not None for s in j.stops))
+
+    @property
+    def in_plane(self) -> bool:
+        """Whether every joint keeps the bodies in the slope's plane ``s``-``n``: each turn
+        about ``z``, each slide normal to it (a planar walker's tree; an expression axis
+        counts as out of the plane)."""
+        for j in self.joints:
+            for axis in j.axes:
+                if any(isinstance(v, str) for v in axis):
+                    return False
+                turn = j.kind != "prismatic"
+                if (turn and tuple(float(v) for v in axis) != (0.0, 0.0, 1.0)) or (
+                        not turn and float(axis[2]) != 0.0):
+                    return False
+        return True
+
+    @property
+    def one_body(self) -> bool:
+        """Whether the walker is one rigid body on its contact points (a spoked wheel on its
+        spokes' feet): a single body, no legs."""
+        return len(self.bodies) == 1
+
+    @property
+    def soles(self) -> tuple[str, ...]:
+        """The bodies that are soles: each carries a heel and a toe contact point (``<side>
+        _heel``, ``<side>_toe``; flat feet, :func:`walkerlab.walker.trees.biped_tree`), in
+        body order; empty for point, round or spoke feet."""
+        on = {c.name: c.body for c in self.contacts}
+        return tuple(b.name for b in self.bodies
+                     if any(on.get(f"{side}_heel") == b.name and on.get(f"{side}_toe") == b.name
+                            for side in ("stance", "swing")))
+
 
 def _check_scalar(value, where: str, params: frozenset) -> float | None:
     """``value``'s float if it is a number, None if an expression in ``params``; else
