@@ -70,7 +70,7 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     scene = scene_from_dict(_kneed_in_3d(0.1))
     data = walker_data(scene.walker, scene.slope.angle_rad)
     kind = kind_of(data.structure)
-    assert kind is KINDS["locking_knees_3d"] and kind.knees == "locking" and kind.in_3d
+    assert kind is KINDS["locking_knees_3d"] and kind.knees_lock and kind.in_3d
     assert data.structure.roles == ("lean", "swing_thigh", "swing_shank", "stance")
     assert data.structure.mirror_odd_roles == ("lean",)   # steps on alternate sides
     assert all(kind.supports("walk", v) for v in ("rigid", "mjcf", "urdf"))

@@ -138,17 +138,18 @@ class Kind:
     field : str
         The scene field a refusal of the walker itself names first (``walker``; the 3D
         kinds': ``walker.space: 3d``).
-    body : str
-        The multibody its exports write: ``links``, a tree of leg links
-        (:func:`walkerlab.walker.multibody.multibody`); ``wheel`` and ``wheel_3d``, one
-        rigid body on its spokes; ``legs_3d``, a free pelvis and two legs on hip joints.
-    knees : str
-        ``none`` (straight legs), ``locking`` (free in early swing, locked at the knee
-        strike) or ``free`` (a free joint all along, driven by torques): read through
-        :attr:`has_knees` and :attr:`knees_lock`.
-    feet : str
-        ``leg_ends`` (point or arc feet at the legs' ends) or ``flat`` (a foot body on an
-        ankle spring, with foot modes): read through :attr:`feet_have_modes`.
+    in_3d : bool
+        The walker moves in three dimensions (``walker.space: 3d``).
+    spoked : bool
+        The walker rolls on its spokes (its steps are spoke strikes, not two legs' heel
+        strikes): one rigid body, no legs.
+    has_knees : bool
+        The legs have knees (locking, or free all along).
+    knees_lock : bool
+        The knees lock at the knee strike (free in early swing).
+    feet_have_modes : bool
+        The stance foot goes through foot modes (flat feet: heel contact, foot flat, heel
+        off).
     rigid : Part
         The rigid model's maker (:mod:`walkerlab.models.hybrid.rigid`): straight legs
         (planar or 3D) or locking knees on one generated flow, flat feet's foot modes,
@@ -181,9 +182,11 @@ class Kind:
     title: str
     reference: str
     field: str = "walker"
-    body: str = "links"
-    knees: str = "none"
-    feet: str = "leg_ends"
+    in_3d: bool = False
+    spoked: bool = False
+    has_knees: bool = False
+    knees_lock: bool = False
+    feet_have_modes: bool = False
     rigid: Part = P.RIGID_STRAIGHT_LEGS
     landing: Part | None = P.LANDING_CLEARANCE
     actuators: Part = P.ACTUATORS_NONE
@@ -195,41 +198,14 @@ class Kind:
     scene: str = ""
 
     @property
-    def in_3d(self) -> bool:
-        """Whether the walker moves in three dimensions (``walker.space: 3d``)."""
-        return self.body in ("wheel_3d", "legs_3d")
-
-    @property
     def joints_free(self) -> bool:
         """Whether every joint is free, driven by torques (the five-link biped, the
         three-link walker): their models are derived alike."""
         return self.rigid is P.RIGID_FREE_JOINTS
 
-    @property
-    def feet_have_modes(self) -> bool:
-        """Whether the stance foot goes through foot modes (flat feet: heel contact, foot
-        flat, heel off)."""
-        return self.feet == "flat"
-
-    @property
-    def has_knees(self) -> bool:
-        """Whether the legs have knees (locking, or free all along)."""
-        return self.knees != "none"
-
-    @property
-    def knees_lock(self) -> bool:
-        """Whether the knees lock at the knee strike (free in early swing)."""
-        return self.knees == "locking"
-
     def parts(self) -> dict[str, Part]:
         """The kind's parts by slot (None where the kind has none)."""
         return {slot: getattr(self, slot) for slot in PART_SLOTS}
-
-    @property
-    def spoked(self) -> bool:
-        """Whether the walker rolls on its spokes (its steps are spoke strikes, not two
-        legs' heel strikes): one rigid body, no legs."""
-        return self.body in ("wheel", "wheel_3d")
 
     def cell(self, feature: str, view: str) -> str | None:
         """None when the kind supports ``feature`` in ``view``, else the one-line reason
@@ -305,19 +281,20 @@ KINDS = {k.name: k for k in (
          scuff=P.SCUFF_STRAIGHT_LEG, collocation=P.COLLOCATION_STRAIGHT_LEGS,
          phases=P.PHASES_STRAIGHT_LEGS, scene="configs/paper_rods.yaml"),
     Kind("locking_knees", "knees that lock at the knee strike",
-         "McGeer 1990 (passive walking with knees); Hsu Chen 2007", knees="locking",
-         rigid=P.RIGID_LOCKING_KNEES, contact=P.CONTACT_LOCKING_KNEES,
+         "McGeer 1990 (passive walking with knees); Hsu Chen 2007", has_knees=True,
+         knees_lock=True, rigid=P.RIGID_LOCKING_KNEES, contact=P.CONTACT_LOCKING_KNEES,
          actuators=P.ACTUATORS_LATCHED_KNEES, scuff=P.SCUFF_UNLATCHED_KNEE,
          collocation=P.COLLOCATION_LOCKING_KNEES, phases=P.PHASES_LOCKING_KNEES,
          scene="configs/kneed.yaml"),
     Kind("flat_feet", "flat feet on ankle springs (foot modes)",
-         "McGeer 1990; Collins, Wisse & Ruina 2001", feet="flat", rigid=P.RIGID_FLAT_FEET,
+         "McGeer 1990; Collins, Wisse & Ruina 2001", feet_have_modes=True,
+         rigid=P.RIGID_FLAT_FEET,
          landing=P.LANDING_FLAT_FEET, reaction=P.REACTION_FLAT_FEET,
          contact=P.CONTACT_FLAT_FEET, actuators=P.ACTUATORS_ANKLES,
          collocation=P.COLLOCATION_FLAT_FEET, phases=P.PHASES_FLAT_FEET,
          scene="configs/flat_feet.yaml"),
     Kind("free_joints", "free hips and knees, hinged torso (five-link biped)",
-         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)", knees="free",
+         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)", has_knees=True,
          rigid=P.RIGID_FREE_JOINTS, contact=P.CONTACT_FIVE_LINK,
          actuators=P.ACTUATORS_JOINTS, collocation=P.COLLOCATION_FIVE_LINK,
          scene="configs/rabbit.yaml"),
@@ -326,20 +303,20 @@ KINDS = {k.name: k for k in (
          "2007", rigid=P.RIGID_FREE_JOINTS, contact=P.CONTACT_THREE_LINK,
          actuators=P.ACTUATORS_JOINTS, scene="configs/threelink.yaml"),
     Kind("rolling_polygon", "rimless (spoked) wheel",
-         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", body="wheel",
+         "McGeer 1990; Coleman, Chatterjee & Ruina 1997", spoked=True,
          rigid=P.RIGID_SPOKES, reaction=P.REACTION_HUB, contact=P.CONTACT_WHEEL,
          scene="configs/rimless_wheel.yaml"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
-         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", "wheel_3d",
+         "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", in_3d=True, spoked=True,
          rigid=P.RIGID_SPOKES, landing=None, reaction=P.REACTION_HUB,
          contact=P.CONTACT_WHEEL_3D, scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
-         "Kuo 1999", "walker.space: 3d", "legs_3d", rigid=P.RIGID_STRAIGHT_LEGS_3D,
+         "Kuo 1999", "walker.space: 3d", in_3d=True, rigid=P.RIGID_STRAIGHT_LEGS_3D,
          landing=None, contact=P.CONTACT_LEGS_3D, actuators=P.ACTUATORS_LEGS_3D,
          scene="configs/hip_width.yaml"),
     Kind("locking_knees_3d", "knees that lock at the knee strike, in 3D with hip width",
          "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",
-         "legs_3d", knees="locking", rigid=P.RIGID_LOCKING_KNEES, landing=None,
+         in_3d=True, has_knees=True, knees_lock=True, rigid=P.RIGID_LOCKING_KNEES, landing=None,
          reaction=P.REACTION_NONE, scene="configs/kneed_3d.yaml"),
 )}
 
