@@ -262,7 +262,7 @@ class WalkerEnv(gym.Env):
                  policy: str | None = None, compiled_step: bool = True):
         #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
-        from .action import action_joints, action_limits, action_torques
+        from .action import action_joints, action_limits, action_torques, walker_links
         from .rigid_view import RigidView
 
         check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
@@ -309,7 +309,8 @@ class WalkerEnv(gym.Env):
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
         plant = self.rigid if vc is None else SceneWalker(plant_scene(sc))
         model = plant.model
-        self.joints = action_joints(sc, self.controller)
+        self.joints = action_joints(sc, self.controller, () if vc is not None else
+                                    walker_links(data, model.n_coordinates))
         if view == "rigid":
             self.sim = RigidView(model, plant.solver, data, self.joints,
                                  plant.max_step_time, ground, plant.scene.walker.actuation,
