@@ -173,7 +173,6 @@ class RigidView:
             self.acts[model.legs[0]] = action_torques(data.mirror, n, joints)
         self.max_step_time = float(max_step_time)
         self.state_names = list(model.state_names())
-        self._dims: int | None = None  # the points' axes (:meth:`_point_size`)
         # a kind whose phases have their own mass matrices: each step's walker's twin with
         # the action in its modes (MODE_TWINS), built on first use
         self._twin_of = MODE_TWINS.get(data.structure.kind.feet)
@@ -215,8 +214,8 @@ class RigidView:
         self.t_step = 0.0
         self.leg = self.model.legs[-1]
         self.x = np.array(x0, dtype=float)
-        self.foot = (np.zeros(self._point_size()) if self.ground is None
-                     else self.ground.start.copy())
+        self.foot = (np.zeros(np.size(self.model.points(self.x)["stance_foot"]))  # its
+                     if self.ground is None else self.ground.start.copy())  # world's axes
         self.advance_x = 0.0  # the last step's advance along x [m] (a profile's segment)
         self.ended = ""
         #: ``(t [s], x [m], y [m])`` where the swing foot met a profile (a ``trip``), or None
@@ -261,13 +260,6 @@ class RigidView:
             self.x = np.asarray(x_new, float)
             self.k = 0 if name is None else [p.name for p in w.phases].index(name)
 
-    def _point_size(self) -> int:
-        """How many world axes the walker's points have (the generated ``points``' stance
-        foot's: the world's dimension, read once, not assumed)."""
-        if self._dims is None:
-            self._dims = int(np.size(self.model.points(self.x)["stance_foot"]))
-        return self._dims
-
     def hip_x(self) -> float:
         """World position of the hip along x (horizontal, downhill) [m]."""
         w = self.walker
@@ -276,8 +268,7 @@ class RigidView:
         return float(self.foot[0] + w.hip_x(self.x))
 
     def points(self) -> dict:
-        """World positions [m] of the walker's named points, by role (each of the
-        generated ``points``' axes: x downhill, y up, in 3D z lateral)."""
+        """World positions [m] of the walker's named points, by role (x, y; 3D: z)."""
         return {k: self.foot + np.asarray(v, float)
                 for k, v in self.walker.points(self.x).items()}
 
