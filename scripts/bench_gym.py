@@ -10,6 +10,7 @@ Needs ``gymnasium[mujoco]`` for Walker2d (skipped with a note without it).
 Usage::
 
     python scripts/bench_gym.py [--periods 2000] [--scenes paper powered_compass kneed]
+    python scripts/bench_gym.py --scenes paper hip_width_stabilised kneed_3d   # 3D walkers
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 as the planar walkers'): the scene's own walk under a zero action (the fixed point's period),
 the checker's contract, an action from the walker's joints (the hip's pitch torque, and its
 hip-roll joints where it has them), the sideways fall as a termination, seeded episodes and
-the native vector env bit for bit, and the contact view's refusal in one line."""
+the native vector env bit for bit, and the contact view's walk near the rigid period."""
 
 import warnings
 from pathlib import Path
@@ -143,3 +143,18 @@ def test_the_same_seed_gives_the_same_3d_episode_and_the_native_vector_env_is_sy
     assert any(o[3].any() for o in got[1:])  # the time limit met (resets on the way)
     sync.close()
     native.close()
+
+
+@pytest.mark.slow
+def test_the_contact_view_walks_the_stabilised_3d_walker_near_the_rigid_step_period():
+    """The contact view of configs/hip_width_stabilised.yaml (its floating walker from the
+    contact model's own periodic gait; the action's torques on the floating legs' pitch and
+    roll coordinates) under a zero action: its heel strikes come at the rigid step period
+    within 3 % (the planar contact view's tolerance: the compliant feet; measured 0.3 %),
+    mean of the steps after the first, and it does not fall."""
+    env = _env("hip_width_stabilised", view="contact", max_episode_steps=400)
+    assert env.joints == ["hip", "stance_hip_roll", "swing_hip_roll"]
+    strikes, _, info = _walk(env, 400)
+    assert len(strikes) >= 4 and not info["termination"], info
+    mean = np.mean(np.diff(strikes))
+    assert abs(mean / STABILISED_PERIOD_S - 1.0) < 0.03, (strikes, mean)
