@@ -39,11 +39,26 @@ def _defined(lines: list[str]) -> set[str]:
     return {ln.split("=", 1)[0].strip() for ln in lines if "=" in ln}
 
 
-#: A kneed walker's locked knee (:mod:`walkerlab.codegen.symbolic`): ``S`` spans the
-#: null space of the lock ``J_k = [-1, 1, 0]`` in ``(swing thigh, swing shank, stance)``
+#: The planar kneed walker's locked knee (:mod:`walkerlab.codegen.symbolic`): ``S`` spans
+#: the null space of the lock ``J_k = [-1, 1, 0]`` in ``(swing thigh, swing shank, stance)``
 #: (thigh and shank together); the locked flow's rows are ``[S^T M; J_k]``, its forces
-#: ``[S^T (B tau - C dq - G); 0]``.
+#: ``[S^T (B tau - C dq - G); 0]``.  Any kneed walker's (the 3D one's too) is read from its
+#: lock's row: :func:`lock_basis`.
 KNEE_LOCK_BASIS = ((1, 0), (1, 0), (0, 1))
+
+
+def lock_basis(eq) -> tuple:
+    """``S`` (n, n - 1) of a kneed walker's locked knee, as
+    :func:`walkerlab.codegen.lagrange.knee_lock` builds it, read from the lock's row ``J_k``
+    (the locked rows' last: -1 at the swing thigh, +1 at its shank): the shank moving with
+    the thigh, every other coordinate alone (:data:`KNEE_LOCK_BASIS` for the planar
+    walker's three coordinates, its lean besides for the 3D walker's)."""
+    n = len(eq.q)
+    jk = [eq.locked[0][n - 1, i] for i in range(n)]
+    thigh, shank = jk.index(-1), jk.index(1)
+    cols = [i for i in range(n) if i != shank]
+    return tuple(tuple(int(i == c or (i == shank and c == thigh)) for c in cols)
+                 for i in range(n))
 
 
 def _joint_exprs(eq, joints):
@@ -63,12 +78,11 @@ def _joint_exprs(eq, joints):
     return out, (s, rate(s))
 
 
-def _locked(acts):
+def _locked(acts, S):
     """The actuators' generalised-force directions in the locked flow's rows: ``[S^T B;
-    0]`` (:data:`KNEE_LOCK_BASIS`)."""
-    S = KNEE_LOCK_BASIS
-    return [(d, dd, [sum(S[i][r] * B[i] for i in range(len(B))) for r in range(2)] + [0])
-            for d, dd, B in acts]
+    0]`` (``S``: :func:`lock_basis`)."""
+    return [(d, dd, [sum(S[i][r] * B[i] for i in range(len(B))) for r in range(len(S[0]))]
+             + [0]) for d, dd, B in acts]
 
 
 def _law_lines(eq, joints, printer, cse_lines):
@@ -94,7 +108,7 @@ def _body(eq, joints, variational, guards, printer, locked: bool = False) -> lis
     """The lines of one cfunc after its constants' unpacking (see the module docstring);
     ``NCONST`` is the module's constant count (a compile-time global for numba).
     ``locked``: a kneed walker's flow with its swing knee locked (``eq.locked``'s rows,
-    :data:`KNEE_LOCK_BASIS`)."""
+    :func:`lock_basis`)."""
     import sympy as sp
 
     from walkerlab.codegen.source import cse_lines, flow_lines  # light
@@ -103,7 +117,7 @@ def _body(eq, joints, variational, guards, printer, locked: bool = False) -> lis
     m = 2 * n
     law_lines, acts, grads = _law_lines(eq, joints, printer, cse_lines)
     if locked:
-        acts = _locked(acts)
+        acts = _locked(acts, lock_basis(eq))
         eq = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
     taus = [sp.Symbol(f"_tau{k}", real=True) for k in range(len(acts))]
     G = eq.G - sum((sp.Matrix(B) * tau for (_d, _dd, B), tau in zip(acts, taus)),

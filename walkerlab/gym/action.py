@@ -6,7 +6,12 @@ Which joints
 The joints of the scene's ``walker.actuation.torques`` (in their order, each joint once); a
 scene without torques (passive, or powered by a push-off alone) gets one torque at the
 ``hip`` between the legs (:data:`walkerlab.config.actuation.JOINTS`: ``+tau`` on the swing
-leg, ``-tau`` on the stance leg).
+leg, ``-tau`` on the stance leg; in 3D about the legs' pitch axes).  A walker with hip-roll
+joints (a 3D walker's ``walker.hip_roll``) adds a torque at each of them, after those
+(:data:`walkerlab.walker.joints.ROLL_JOINTS`: ``stance_hip_roll``, ``swing_hip_roll``,
+``+tau`` on the leg about its roll joint, ``-tau`` on the pelvis), beside the scene's own
+hip-roll law: the joints are read from the walker's links (its generated ``leg_angles``),
+not from its dimension.
 
 Bounds
 ------
@@ -31,9 +36,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.models.hybrid.actuators import Actuators
+from walkerlab.walker.joints import ROLL_JOINTS, link_angles, roll_joints
 
 __all__ = ["DEFAULT_TORQUE_FRACTION", "GL_W", "GL_X", "ActionTorques", "action_joints",
-           "action_limits", "action_torques"]
+           "action_limits", "action_torques", "walker_links"]
 
 #: the 4-point Gauss-Legendre rule on [-1, 1] (nodes, weights) of the action's work over an
 #: integrated piece (the rigid view's ledger: :mod:`walkerlab.gym.rigid_view`, and the
@@ -45,10 +51,12 @@ GL_X, GL_W = np.polynomial.legendre.leggauss(4)
 DEFAULT_TORQUE_FRACTION = 0.1
 
 
-def action_joints(scene, controller=None) -> list[str]:
+def action_joints(scene, controller=None, links=()) -> list[str]:
     """The joints the action drives: a feedback controller's (``controller.joints``, of
     ``walker.actuation.virtual_constraints``), else those of ``walker.actuation.torques``
-    (each once, in order), else ``["hip"]``."""
+    (each once, in order), else ``["hip"]``; then the hip-roll joints among the walker's
+    ``links`` (keys of :func:`walkerlab.walker.joints.link_angles`: :func:`walker_links`),
+    if it has them."""
     if controller is not None:
         return list(controller.joints)
     act = scene.walker.actuation
@@ -56,7 +64,29 @@ def action_joints(scene, controller=None) -> list[str]:
     for t in (act.torques if act is not None else ()):
         if t.joint not in joints:
             joints.append(t.joint)
-    return joints or ["hip"]
+    return (joints or ["hip"]) + [j for j in roll_joints(links) if j not in joints]
+
+
+def walker_links(data, n: int) -> list[str]:
+    """The links of the walker ``data`` (``n`` generalised coordinates): the keys of
+    :func:`walkerlab.walker.joints.link_angles` of its generated ``leg_angles`` (none for a
+    walker without them: a spoked wheel)."""
+    from walkerlab.codegen.cache import functions  # light
+
+    angles = functions(data).get("leg_angles")
+    return [] if angles is None else list(link_angles(angles(np.zeros(2 * n))))
+
+
+def _joint_torque(joint: str):
+    """A constant-torque actuator at ``joint`` (its law the action's); a hip-roll joint
+    (:data:`walkerlab.walker.joints.ROLL_JOINTS`), not a scene's torque joint, is built
+    without the scene's joint check (the walker's links are checked when the actuators
+    are made: :func:`walkerlab.walker.joints.joint_links`)."""
+    from walkerlab.config.actuation import JointTorque, TorqueLaw  # light
+
+    if joint in ROLL_JOINTS:
+        return JointTorque.model_construct(joint=joint, law=TorqueLaw())
+    return JointTorque(joint=joint, law=TorqueLaw())
 
 
 def action_limits(scene, joints: list[str], total_mass_kg: float, gravity: float,
@@ -231,13 +261,13 @@ def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
         their modes'; the rigid view drives them through :func:`flat_action_walker`.)
     """
     from walkerlab.codegen.cache import functions
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    from walkerlab.config.actuation import Actuation
 
     st = data.structure
     st.kind.require("walk", "gym", "walkerlab.gym")  # a wheel: the table's
     if st.bodies and all(b.massless for b in st.bodies):
         raise ValueError("walkerlab.gym: the legs are massless (Kuo's simplest walker): a "
                          "joint torque has no inertia to act on; give the legs mass")
-    spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw()) for j in joints])
+    spec = Actuation(torques=[_joint_torque(j) for j in joints])
     return ActionTorques(spec, functions(data), n, False, float(data.total_mass_kg),
                          some_massless=any(b.massless for b in st.bodies))

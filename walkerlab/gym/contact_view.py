@@ -111,17 +111,20 @@ def _periodic_gait(setup, probe, x_gait):
 
 
 def _link_coordinate(link: str, leg: dict, names: tuple) -> int:
-    """Index of a rigid role link (``stance``, ``swing_thigh``, ``torso``, ...) among the
-    floating coordinates ``names`` with ``leg`` = ``{"stance": legX, "swing": legY}``."""
+    """Index of a rigid role link (``stance``, ``swing_thigh``, ``torso``, a 3D walker's
+    ``stance_roll``, ``pelvis_roll``, ...) among the floating coordinates ``names`` with
+    ``leg`` = ``{"stance": legX, "swing": legY}``: the link's ``<name>_angle``, else (a 3D
+    walker's rolls: ``legX_roll``, ``pelvis_roll``) ``<name>``."""
     role, _, part = link.partition("_")
     if role in leg:
-        name = f"{leg[role]}_{part}_angle" if part else f"{leg[role]}_angle"
+        name = f"{leg[role]}_{part}" if part else leg[role]
     else:
-        name = f"{link}_angle"
-    if name not in names:
-        raise ValueError(f"walkerlab.gym: the contact view has no coordinate {name} for the "
-                         f"action's link {link} (its coordinates: {', '.join(names)})")
-    return names.index(name)
+        name = link
+    for n in (f"{name}_angle", name):
+        if n in names:
+            return names.index(n)
+    raise ValueError(f"walkerlab.gym: the contact view has no coordinate {name}_angle for "
+                     f"the action's link {link} (its coordinates: {', '.join(names)})")
 
 
 class ContactView:

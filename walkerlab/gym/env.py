@@ -3,6 +3,9 @@
 
 Spaces
 ------
+Planar and 3D walkers alike: the spaces are read from the walker's own named state and
+joints (a 3D walker's hip-roll joints among them), never from its dimension.
+
 Action: one torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.action`),
 added to the scene's own actuation and held over the control period: ``Box(-1, 1, (k,),
 float32)``, the torque as a fraction of its bound ``tau = a * tau_max``
@@ -40,8 +43,9 @@ cached; :meth:`walkerlab.rigid_walker.SceneWalker.fixed_point`), leg1 swinging, 
 ``reset(options={"state": x})`` gives the state (the rigid walker's post-impact state (2n,),
 or in the contact view its floating state (N,)); ``start_noise`` (at most 1) multiplies the
 start's rates by ``1 + U(-s, s)`` drawn by the reset's seed, before the start is checked.
-Terminated on a fall (a fall guard of the rigid model; in the contact view the hip below
-``contact_sim.fall_hip_height_m``), a stall (no heel strike within
+Terminated on a fall (a fall guard of the rigid model - a 3D walker's sideways fall too, its
+hip's height guard; in the contact view the hip below ``contact_sim.fall_hip_height_m``), a
+stall (no heel strike within
 ``fixedpoint.max_step_time_s``), a launch (contact view: the hip thrown above
 :data:`walkerlab.gym.contact_view.LAUNCH_HIP_FACTOR` leg lengths, a foot having met a raised
 patch's side), a trip (contact view: a foot found at a patch's side where the solver stopped),
@@ -262,7 +266,7 @@ class WalkerEnv(gym.Env):
                  policy: str | None = None, compiled_step: bool = True):
         #: the arguments it was built from (pickling rebuilds it from them: __reduce__)
         self._init_args = {k: v for k, v in locals().items() if k not in ("self", "__class__")}
-        from .action import action_joints, action_limits, action_torques
+        from .action import action_joints, action_limits, action_torques, walker_links
         from .rigid_view import RigidView
 
         check_arguments(view, control_period_s, max_episode_steps, render_mode, start_noise,
@@ -309,7 +313,8 @@ class WalkerEnv(gym.Env):
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
         plant = self.rigid if vc is None else SceneWalker(plant_scene(sc))
         model = plant.model
-        self.joints = action_joints(sc, self.controller)
+        self.joints = action_joints(sc, self.controller, () if vc is not None else
+                                    walker_links(data, model.n_coordinates))
         if view == "rigid":
             self.sim = RigidView(model, plant.solver, data, self.joints,
                                  plant.max_step_time, ground, plant.scene.walker.actuation,

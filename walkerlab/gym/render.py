@@ -30,8 +30,9 @@ def draw(points: dict, slope_rad: float, leg_length_m: float, t: float) -> np.nd
 
     Parameters
     ----------
-    points : dict[str, ndarray (2,)]
-        World positions [m] (x horizontal downhill, y up) of the walker's named points.
+    points : dict[str, ndarray]
+        World positions [m] (x horizontal downhill, y up; a 3D walker's lateral z is not
+        drawn: its sagittal view) of the walker's named points.
     slope_rad : float
         The ground's slope [rad] (the ground line through the origin, falling with x).
     leg_length_m : float

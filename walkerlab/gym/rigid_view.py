@@ -214,7 +214,8 @@ class RigidView:
         self.t_step = 0.0
         self.leg = self.model.legs[-1]
         self.x = np.array(x0, dtype=float)
-        self.foot = np.zeros(2) if self.ground is None else self.ground.start.copy()
+        self.foot = (np.zeros(np.size(self.model.points(self.x)["stance_foot"]))  # its
+                     if self.ground is None else self.ground.start.copy())  # world's axes
         self.advance_x = 0.0  # the last step's advance along x [m] (a profile's segment)
         self.ended = ""
         #: ``(t [s], x [m], y [m])`` where the swing foot met a profile (a ``trip``), or None
@@ -267,7 +268,7 @@ class RigidView:
         return float(self.foot[0] + w.hip_x(self.x))
 
     def points(self) -> dict:
-        """World positions (2,) [m] of the walker's named points, by role."""
+        """World positions [m] of the walker's named points, by role (x, y; 3D: z)."""
         return {k: self.foot + np.asarray(v, float)
                 for k, v in self.walker.points(self.x).items()}
 

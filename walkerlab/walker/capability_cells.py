@@ -308,8 +308,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # legs_urdf_text); the Adams dataset: the pelvis fixed to leg2, the legs on
         # revolutes, or with hip-roll joints the pelvis rolling, the legs on universal
         # joints and the law as GFORCE torques (walkerlab.export.adams_3d.adm3d_text)
-        ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
-                          "is a later step"),
+        # the Gymnasium environment: its rigid view steps the 3D walker as the planar
+        # ones (the action the hip's pitch torque and, with hip-roll joints, each roll
+        # joint's: walkerlab.walker.joints.ROLL_JOINTS), its contact view the floating
+        # walker (the torques on its legX_angle, legX_roll and pelvis_roll coordinates)
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
     },
@@ -327,8 +329,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's
         **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "adams", "osim")},
-        ("walk", "gym"): ("the Gymnasium environment steps planar walkers; a 3D walker's "
-                          "is a later step"),
+        # the Gymnasium environment's rigid view (its contact view: the contact cell's)
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
     },

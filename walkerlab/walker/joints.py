@@ -18,7 +18,17 @@ import numpy as np
 
 from walkerlab.config.actuation import JOINTS
 
-__all__ = ["joint_angles", "joint_columns", "joint_links", "link_angles"]
+__all__ = ["ROLL_JOINTS", "joint_angles", "joint_columns", "joint_links", "link_angles",
+           "roll_joints"]
+
+#: The hip-roll joints of a 3D walker with them (``walker.hip_roll``): each leg hangs from
+#: the pelvis on a roll joint, its angle the leg's roll minus the pelvis' (the generated
+#: ``leg_angles``' ``pelvis_roll``, ``stance_roll``, ``swing_roll``; the hip-roll law's
+#: ``d_st``, ``d_sw``: :func:`walkerlab.codegen.derive_3d.hip_roll_forces`), ``+tau`` on the
+#: leg and ``-tau`` on the pelvis.  Not a scene's torque joints (the scene's law at them is
+#: ``walker.hip_roll``): the Gymnasium environment's action drives them besides the hip.
+ROLL_JOINTS = {"stance_hip_roll": ("pelvis_roll", "stance_roll"),
+               "swing_hip_roll": ("pelvis_roll", "swing_roll")}
 
 
 def link_angles(la: dict) -> dict:
@@ -41,7 +51,7 @@ def link_angles(la: dict) -> dict:
 def joint_links(links, joint: str, where: str = "joint") -> tuple[str, str]:
     """``(first, second)``: the links (keys of :func:`link_angles`) a joint joins
     (:data:`walkerlab.config.actuation.JOINTS`; a leg's link at the hip is its thigh on a
-    kneed walker).
+    kneed walker; a hip-roll joint's, :data:`ROLL_JOINTS`, on a walker with them).
 
     Raises
     ------
@@ -49,6 +59,8 @@ def joint_links(links, joint: str, where: str = "joint") -> tuple[str, str]:
         The walker has no such joint: one line naming ``where`` and the joints it has.
     """
     links = set(links)
+    if joint in ROLL_JOINTS and set(ROLL_JOINTS[joint]) <= links:
+        return ROLL_JOINTS[joint]
     thigh = "_thigh" if "stance_thigh" in links else ""
 
     def resolve(name):
@@ -59,6 +71,13 @@ def joint_links(links, joint: str, where: str = "joint") -> tuple[str, str]:
         raise ValueError(f"{where}: {joint} is not a joint of this walker (its joints: "
                          f"{', '.join(have)})")
     return resolve(joint)
+
+
+def roll_joints(links) -> list[str]:
+    """The hip-roll joints (:data:`ROLL_JOINTS`, in its order) whose links are all among
+    ``links`` (keys of :func:`link_angles`): none on a walker without hip-roll joints."""
+    links = set(links)
+    return [j for j, pair in ROLL_JOINTS.items() if set(pair) <= links]
 
 
 def joint_columns(angles_at, n: int, links) -> np.ndarray:
