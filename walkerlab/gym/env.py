@@ -110,6 +110,7 @@ import numpy as np
 from gymnasium import spaces
 
 from walkerlab.rigid_walker import SceneWalker, scene_of
+from walkerlab.walker.plant import Plant
 
 from .arguments import (
     InvalidAction,
@@ -274,7 +275,8 @@ class WalkerEnv(gym.Env):
         if policy not in (None, "scene"):
             raise ValueError(f"policy={policy!r}: give None or 'scene' (the scene's feedback "
                              "controller acting with the action)")
-        self.rigid = SceneWalker(scene_of(scene if not isinstance(scene, Path) else str(scene)))
+        self.rigid = SceneWalker(Plant.from_scene(  # the gym's front door: described once
+            scene_of(scene if not isinstance(scene, Path) else str(scene))))
         sc = self.rigid.scene
         data = self.rigid.plant.data  # the scene's walker, described once (SceneWalker)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
@@ -311,7 +313,8 @@ class WalkerEnv(gym.Env):
         #: the scene's feedback controller (virtual constraints; None: the scene has none):
         #: out of the walker's flow, the policy (:meth:`scene_policy`)
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
-        plant = self.rigid if vc is None else SceneWalker(plant_scene(sc))
+        plant = self.rigid if vc is None else SceneWalker(
+            self.rigid.plant.with_(plant_scene(sc)))
         model = plant.model
         self.joints = action_joints(sc, self.controller, () if vc is not None else
                                     walker_links(data, model.n_coordinates))

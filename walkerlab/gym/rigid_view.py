@@ -69,15 +69,7 @@ from walkerlab.integrate.solver import Solver, available_backends
 
 from .action import GL_W, GL_X, action_torques, flat_action_walker
 
-__all__ = ["LEDGER_TERMS", "MODE_TWINS", "RigidView"]
-
-#: the feet (:attr:`walkerlab.walker.kinds.Kind.feet`) whose phases each have a mass
-#: matrix of their own (a flat foot's stance modes: heel or toe pinned, the foot locked
-#: flat): the action acts through a twin of each step's walker, built by the feet's entry
-#: ``(walker, data, joints, actuation) -> (walker, ActionTorques)``, whose phases are the
-#: walker's with ``M_mode^-1 B u`` in each flow and in its guards' ground forces; the other
-#: kinds' flows gain the generic ``M^-1 B u``
-MODE_TWINS = {"flat": flat_action_walker}
+__all__ = ["LEDGER_TERMS", "RigidView"]
 
 #: most lanes a view keeps (:meth:`RigidView.lane_at`)
 LANES_KEPT = 64
@@ -173,9 +165,12 @@ class RigidView:
             self.acts[model.legs[0]] = action_torques(data.mirror, n, joints)
         self.max_step_time = float(max_step_time)
         self.state_names = list(model.state_names())
-        # a kind whose phases have their own mass matrices: each step's walker's twin with
-        # the action in its modes (MODE_TWINS), built on first use
-        self._twin_of = MODE_TWINS.get(data.structure.kind.feet)
+        # feet whose stance modes each have a mass matrix of their own (a flat foot's: heel
+        # or toe pinned, the foot locked flat): the action acts through a twin of each
+        # step's walker whose phases have M_mode^-1 B u in each flow and in its guards'
+        # ground forces (flat_action_walker), built on first use; the other kinds' flows
+        # gain the generic M^-1 B u
+        self._twin_of = flat_action_walker if data.structure.kind.feet_have_modes else None
         self._twins: dict = {}
         self._data, self._joints, self._actuation = data, list(joints), actuation
         if self._twin_of is not None:
@@ -197,7 +192,8 @@ class RigidView:
 
     def _twin(self, w):
         """``(walker, actuators)``: the twin of the step's walker ``w`` with the action in
-        its modes (:data:`MODE_TWINS`), its actuators' clock at the step's start."""
+        its modes (:func:`walkerlab.gym.action.flat_action_walker`), its actuators' clock
+        at the step's start."""
         key = id(w)
         if key not in self._twins:
             d = self._step_data(w)
