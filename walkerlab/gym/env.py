@@ -4,9 +4,7 @@
 Spaces
 ------
 Planar and 3D walkers alike: the spaces are read from the walker's own named state and
-joints (a 3D walker's hip-roll joints among them), never from its dimension.
-
-Action: one torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.action`),
+joints (a 3D walker's hip-roll joints among them), never from its dimension.  Action: one torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.action`),
 added to the scene's own actuation and held over the control period: ``Box(-1, 1, (k,),
 float32)``, the torque as a fraction of its bound ``tau = a * tau_max``
 (:attr:`WalkerEnv.tau_max` [N m]; Walker2d's actions are normalised alike, by their motors'
@@ -313,8 +311,7 @@ class WalkerEnv(gym.Env):
         #: the scene's feedback controller (virtual constraints; None: the scene has none):
         #: out of the walker's flow, the policy (:meth:`scene_policy`)
         self.controller = self.rigid.model.actuators.controller if vc is not None else None
-        plant = self.rigid if vc is None else SceneWalker(
-            self.rigid.plant.with_(plant_scene(sc)))
+        plant = self.rigid if vc is None else SceneWalker(self.rigid.plant.with_(plant_scene(sc)))
         model = plant.model
         self.joints = action_joints(sc, self.controller, () if vc is not None else
                                     walker_links(data, model.n_coordinates))
