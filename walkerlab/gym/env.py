@@ -4,12 +4,12 @@
 Spaces
 ------
 Planar and 3D walkers alike: the spaces are read from the walker's own named state and
-joints (a 3D walker's hip-roll joints among them), never from its dimension.  Action: one torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.action`),
-added to the scene's own actuation and held over the control period: ``Box(-1, 1, (k,),
-float32)``, the torque as a fraction of its bound ``tau = a * tau_max``
-(:attr:`WalkerEnv.tau_max` [N m]; Walker2d's actions are normalised alike, by their motors'
-gears), or with ``normalize_action=False`` ``Box(-tau_max, tau_max)`` in N m.  An all-zero
-action is the scene as written (passive, or its own torque laws and push-off).
+joints (a 3D walker's hip-roll joints among them), never from its dimension.  Action: one
+torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.action`), added to the
+scene's own actuation and held over the control period: ``Box(-1, 1, (k,), float32)``, the
+torque as a fraction of its bound ``tau = a * tau_max`` (:attr:`WalkerEnv.tau_max` [N m];
+as Walker2d's by its motors' gears), or with ``normalize_action=False`` ``Box(-tau_max,
+tau_max)`` in N m.  An all-zero action is the scene as written (passive, or its laws).
 
 A scene whose actuation is a feedback controller (``walker.actuation.virtual_constraints``)
 is stepped without it: the action drives the controller's joints (bounded by its
@@ -273,8 +273,8 @@ class WalkerEnv(gym.Env):
         if policy not in (None, "scene"):
             raise ValueError(f"policy={policy!r}: give None or 'scene' (the scene's feedback "
                              "controller acting with the action)")
-        self.rigid = SceneWalker(Plant.from_scene(  # the gym's front door: described once
-            scene_of(scene if not isinstance(scene, Path) else str(scene))))
+        self.rigid = SceneWalker(Plant.from_scene(scene_of(str(scene) if isinstance(
+            scene, Path) else scene)))  # the gym's front door: the walker described once
         sc = self.rigid.scene
         data = self.rigid.plant.data  # the scene's walker, described once (SceneWalker)
         data.structure.kind.require("walk", "gym", "walkerlab.gym")  # the table's refusals
