@@ -29,7 +29,9 @@ also those inside functions), never by running it: dependencies point down.
   ``walker/`` (today's other comparers listed, the list only shrinks);
 - modules hold at most 600 lines (today's bigger ones at their sizes as ceilings);
 - a function-level import of walkerlab says why in a comment (``# light``, ``# circle``):
-  the unexplained ones are counted down;
+  the unexplained ones are counted down; a ``# light`` one keeps a heavy package (or a heavy
+  floor of the project) off its module, measured from the module-level imports, or it
+  belongs at module level;
 - package docstrings tell what the code does, not its issue history (no "issue N"), and
   cite papers, equations and the project's own files, never a path outside the project
   (a notes file, ``../shared``, a machine's absolute path).
@@ -698,3 +700,121 @@ def test_a_function_level_import_of_walkerlab_says_why(tmp_path):
     assert _unexplained_function_imports(probe) == [2]
     n = sum(len(_unexplained_function_imports(p)) for p in _modules())
     assert n <= UNEXPLAINED_FUNCTION_IMPORTS, n
+
+
+#: the packages a ``# light`` import keeps off its module's import (third-party ones that
+#: take tens of milliseconds or more to import, and the project's own heavy floors that the
+#: command layer's start-up keeps out, tests/test_startup_imports.py)
+HEAVY_PACKAGES = frozenset({
+    "numpy", "scipy", "sympy", "casadi", "matplotlib", "numba", "CyRK", "h5py", "h5netcdf",
+    "mujoco", "pinocchio", "pydrake", "dask", "distributed", "xarray", "gymnasium", "pandas",
+    "opensim", "numbalsoda", "typer", "pydantic", "yaml"})
+HEAVY_FLOORS = ("walkerlab.plotting", "walkerlab.studies", "walkerlab.optimal",
+                "walkerlab.analysis.gait.poincare")
+
+
+def _module_level_imports(path: Path) -> list[str]:
+    """The modules ``path`` imports at module level (its top-level statements; a
+    ``TYPE_CHECKING`` block is not run)."""
+    tree = _tree(path)
+    try:
+        pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
+        if path.name == "__init__.py":
+            pkg = ".".join(path.relative_to(PKG.parent).parts[:-1])
+    except ValueError:
+        pkg = ""
+    out = []
+    for node in tree.body:
+        if isinstance(node, ast.Import):
+            out += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = pkg.split(".")[:len(pkg.split(".")) - node.level + 1]
+                base = ".".join(parts + ([base] if base else []))
+            out += [base] + [f"{base}.{a.name}" for a in node.names]
+    return out
+
+
+def _heavy_loaded(paths: dict[str, Path]):
+    """``module -> the heavy packages importing it loads`` (through module-level imports,
+    transitively; a package's ``__init__`` counted where its module is imported)."""
+    tops = {m: _module_level_imports(p) for m, p in paths.items()}
+    memo = {}
+
+    def chain(name):
+        parts = name.split(".")
+        return [".".join(parts[:i]) for i in range(1, len(parts) + 1)]
+
+    def heavy(m):
+        if m not in memo:
+            seen, todo, out = {m}, [m], set()
+            while todo:
+                x = todo.pop()
+                if x.startswith(HEAVY_FLOORS):
+                    out.add(x)
+                for t in tops.get(x, []):
+                    if t.split(".")[0] in HEAVY_PACKAGES:
+                        out.add(t.split(".")[0])
+                    for q in chain(t):
+                        if q in paths and q not in seen:
+                            seen.add(q)
+                            todo.append(q)
+            memo[m] = out
+        return memo[m]
+    return heavy, chain
+
+
+def _light_claims_without_a_heavy_package(paths: dict[str, Path]) -> list[str]:
+    """``module:line`` of each import of walkerlab inside a function whose comment says
+    ``light`` but whose module loads no heavy package (:data:`HEAVY_PACKAGES`,
+    :data:`HEAVY_FLOORS`) that the importing module does not load already: the comment
+    claims a saving there is none of (the import belongs at module level)."""
+    import io
+    import tokenize
+
+    heavy, chain = _heavy_loaded(paths)
+    out = []
+    for m, path in sorted(paths.items()):
+        src = path.read_text()
+        comments = {t.start[0]: t.string
+                    for t in tokenize.generate_tokens(io.StringIO(src).readline)
+                    if t.type == tokenize.COMMENT}
+        pkg = m if path.name == "__init__.py" else m.rpartition(".")[0]
+        for f in ast.walk(_tree(path)):
+            if not isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            for n in ast.walk(f):
+                if not isinstance(n, (ast.Import, ast.ImportFrom)):
+                    continue
+                said = " ".join(comments.get(k, "") for k in range(n.lineno, n.end_lineno + 1))
+                if "light" not in said:
+                    continue
+                if isinstance(n, ast.Import):
+                    names = [a.name for a in n.names]
+                else:
+                    base = n.module or ""
+                    if n.level:
+                        parts = pkg.split(".")[:len(pkg.split(".")) - n.level + 1]
+                        base = ".".join(parts + ([base] if base else []))
+                    names = [base] + [f"{base}.{a.name}" for a in n.names]
+                names = [x for x in names if x.startswith("walkerlab")]
+                if not names:
+                    continue
+                saved = set().union(*(heavy(q) for x in names for q in chain(x) if q in paths))
+                if not saved - heavy(m):
+                    out.append(f"{m}:{n.lineno}")
+    return sorted(set(out))
+
+
+def test_a_light_import_keeps_a_heavy_package_off_its_module():
+    """A ``# light`` import inside a function is one whose module loads a heavy package
+    (or one of the project's heavy floors) that its importer does not load already: the
+    comment is measured, not taken on trust."""
+    paths = {}
+    for p in _modules():
+        parts = p.relative_to(PKG.parent).with_suffix("").parts
+        paths[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = p
+    heavy, _ = _heavy_loaded(paths)
+    assert "numpy" in heavy("walkerlab.numerics") and "sympy" in heavy("walkerlab.codegen.lagrange")
+    assert _light_claims_without_a_heavy_package(paths) == []

@@ -44,6 +44,8 @@ import stat
 import sys
 from pathlib import Path
 
+from walkerlab.safefs import NotARegularFile, atomic_replace, process_alive, read_regular
+
 __all__ = ["ENV", "root", "private_dir", "is_private", "read_private", "write_private",
            "use_for_numba", "private_tmp", "guard_numba_cache", "MAX_CACHE_FILE_BYTES"]
 
@@ -120,8 +122,6 @@ def _remove_stale_tmp(base: Path) -> None:
     """Remove ``walkerlab_gen_<pid>_*`` folders of this user whose process is gone."""
     import shutil
 
-    from walkerlab.safefs import process_alive  # light
-
     try:
         entries = list(os.scandir(base))
     except OSError:
@@ -172,7 +172,6 @@ def read_private(path: Path) -> str | None:
     :data:`MAX_CACHE_FILE_BYTES`, no link); the checks are made on the open file, so the
     file read is the file checked.  A FIFO or device in its place is a miss, never a hang.
     """
-    from walkerlab.safefs import NotARegularFile, read_regular  # light
 
     if not is_private(path.parent):
         return None
@@ -187,7 +186,6 @@ def write_private(path: Path, text: str, errors: list | None = None) -> bool:
     """Write ``path`` atomically with mode 0600; False (and nothing left behind) when the
     folder cannot be written (read-only, disk full, ...), the OSError appended to
     ``errors`` when given."""
-    from walkerlab.safefs import atomic_replace  # light
 
     def fill(fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
@@ -248,8 +246,6 @@ def _load_index(self):
     import io
     import pickle
 
-    from walkerlab.safefs import NotARegularFile, read_regular  # light
-
     try:
         raw = read_regular(self._index_path, MAX_CACHE_FILE_BYTES, "numba cache index",
                            follow_links=False)
@@ -276,8 +272,6 @@ def _load_data(self, name):
     """``IndexDataCacheFile._load_data``, bounded; a damaged entry is discarded and read as
     an OSError (numba recompiles)."""
     import pickle
-
-    from walkerlab.safefs import read_regular  # light
 
     path = self._data_path(name)
     try:

@@ -7,6 +7,7 @@ from __future__ import annotations
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
+from walkerlab.integrate.work_limit import StepWorkLimit, step_work_limit
 from walkerlab.rigid_walker import STEP_EVALUATIONS, positive, short
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -144,7 +145,6 @@ def bounded_steps(step_evaluations: int, max_step_time: float):
         strike (its one line).
     """
     from walkerlab.analysis.gait.poincare import StepFailed  # light
-    from walkerlab.integrate.work_limit import StepWorkLimit, step_work_limit  # light
 
     try:
         with step_work_limit(step_evaluations):

@@ -18,7 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.bench.contact import run_scene_benchmark
 from walkerlab.bench.process_env import installed_env
+from walkerlab.config import default_scene_path as default_scene
+from walkerlab.config import load_scene
+from walkerlab.config.loader import shipped_scene_path
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.runpaths import stage_artifact
@@ -42,8 +46,6 @@ def paper_scene():
     SceneError
         The scene file is missing or does not validate (:func:`load_scene`).
     """
-    from walkerlab.config import default_scene_path as default_scene  # light
-    from walkerlab.config import load_scene  # light
 
     return load_scene(default_scene())
 
@@ -140,7 +142,6 @@ def bench_fixedpoint_3d(runs: int = 5) -> dict:
     """``walkerlab fixedpoint --force`` of the 3D walkers (the hip-width walker, its stride
     map with multipliers, and the 3D rimless wheel at Drake's defaults), whole process, warm
     (the generated code cached by a first run), medians of ``runs``; target 5 s each."""
-    from walkerlab.config.loader import shipped_scene_path  # light
 
     out: dict = {"target_s": 5.0, "scenes": {}}
     with tempfile.TemporaryDirectory() as d:
@@ -227,8 +228,6 @@ def bench_contact_scenes(scenes) -> dict:
     ConfigError
         A scene file is missing or invalid (one line, from :func:`load_scene`).
     """
-    from walkerlab.bench.contact import run_scene_benchmark  # light
-    from walkerlab.config import load_scene  # light
 
     loaded = [load_scene(p) for p in scenes]  # every file checked before the first run
     return {"scenes": [run_scene_benchmark(sc) for sc in loaded]}

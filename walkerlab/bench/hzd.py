@@ -25,7 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.analysis.gait.zero_dynamics import impact_multiplier, zero_dynamics
 from walkerlab.bench.optimize import paired_text
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.walker.plant import Plant
 
 __all__ = ["bench_design", "bench_design_process", "bench_hzd", "lines"]
@@ -55,8 +57,6 @@ def bench_hzd(scene_path: Path | str | None = None, repeats: int = 50,
         (by quadrature) [s].
     """
     from walkerlab.analysis.gait.poincare import poincare_map  # light
-    from walkerlab.analysis.gait.zero_dynamics import impact_multiplier, zero_dynamics  # light
-    from walkerlab.config import load_scene  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
@@ -117,7 +117,6 @@ def bench_design_process(pairs: int = 3) -> dict:
 
     from walkerlab.bench.optimize import in_turn, process_times
     from walkerlab.bench.process_env import installed_env
-    from walkerlab.config import load_scene  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import load  # light
     from walkerlab.models.registry import build_walker
@@ -179,7 +178,6 @@ def bench_design(repeats: int = 3) -> dict:
     """
     import yaml
 
-    from walkerlab.config import scene_from_dict  # light
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.driver import optimize_scene  # light

@@ -24,6 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.analysis.contact.sim import scene_start, simulate_contact
+from walkerlab.config import Scene, load_scene
+from walkerlab.models.contact.scene import contact_setup
 from walkerlab.walker.plant import Plant
 
 __all__ = ["bench_powered_contact", "lines"]
@@ -35,7 +38,6 @@ PUSH_OFF = {"push_off": {"impulse_n_s": 0.5}}
 
 
 def _scene(name: str, actuation):
-    from walkerlab.config import Scene, load_scene  # light
 
     d = load_scene(CONFIGS / name).model_dump(mode="json", exclude_none=True)
     d["walker"].pop("actuation", None)
@@ -47,8 +49,6 @@ def _scene(name: str, actuation):
 def _timed(scene, x_ideal, steps_s: float, repeats: int, method: str | None = None):
     """Median CPU time [s] of the scene's contact run from ``x_ideal`` over ``steps_s``,
     its simulated time [s] and heel strikes."""
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
-    from walkerlab.models.contact.scene import contact_setup  # light
 
     setup = contact_setup(scene, plant=Plant.from_scene(scene))
     walker, x0, limits, _ = scene_start(setup, x_ideal, 3)
@@ -101,8 +101,6 @@ def bench_powered_contact(repeats: int = 7) -> dict:
 
 
 def _rabbit_actuation():
-    from walkerlab.config import load_scene  # light
-
     return load_scene(CONFIGS / "rabbit.yaml").walker.actuation.model_dump(
         mode="json", exclude_none=True)
 

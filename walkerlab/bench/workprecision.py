@@ -31,9 +31,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+from walkerlab.analysis.contact.sim import scene_start, simulate_contact
+from walkerlab.bench.contact import leg_angle_columns
+from walkerlab.config import SolverSettings, scene_from_dict
 from walkerlab.execution.lanes import Lanes, pinned_worker, run_on_lanes
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver, available_backends
+from walkerlab.models.contact.scene import contact_setup
 from walkerlab.safefs import read_regular
 from walkerlab.usercache import use_for_numba
 from walkerlab.walker.layout import StateIndex
@@ -107,11 +111,6 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     (:func:`walkerlab.analysis.contact.sim.scene_start`); the CPU time is the thread's
     around :func:`walkerlab.analysis.contact.sim.simulate_contact` alone.
     """
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
-    from walkerlab.bench.contact import leg_angle_columns  # light
-    from walkerlab.config import SolverSettings  # light
-    from walkerlab.models.contact.scene import contact_setup  # light
-
     setup = contact_setup(scene, plant=Plant.from_scene(scene))
     cs = setup.sim
     walker, z0, limits, _ = scene_start(setup, x0, strides)
@@ -164,7 +163,6 @@ _RUNNERS: dict = {}
 
 
 def _build_runner(model: str, scene_json: str, step_period: float, x0: tuple, strides: int):
-    from walkerlab.config import scene_from_dict  # light
 
     scene = scene_from_dict(json.loads(scene_json))
     if model == "ideal":

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import typer
 
+from walkerlab import progress
 from walkerlab.cli import (
     commands_families,
     commands_output,
@@ -60,7 +61,6 @@ def _main(ctx: typer.Context,
     to report."""
     single_threaded_blas()
     process_settings()
-    from walkerlab import progress  # light
 
     sink = progress.sink_for_terminal(quiet, label=f"walkerlab {ctx.invoked_subcommand}")
     progress.install(sink)

@@ -9,6 +9,7 @@ import typer
 
 from walkerlab.cli.errors import guard
 from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load
+from walkerlab.export.mjcf_scene import MjcfOptions
 
 
 @guard
@@ -79,7 +80,6 @@ def export(scene: Path | None = SceneArg,
     --walk walks the MJCF in MuJoCo and the OpenSim model in OpenSim (where importable) for 10
     heel strikes and prints the step period against the rigid gait's (exit code 0 either way;
     a walk that falls or misses 1 % adds a warning on stderr)."""
-    from walkerlab.export.mjcf_scene import MjcfOptions  # light
     from walkerlab.stages import export as stage  # light
 
     sc = load(scene)

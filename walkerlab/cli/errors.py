@@ -20,6 +20,9 @@ import sys
 
 import typer
 
+from walkerlab import progress
+from walkerlab.safefs import interrupted, raise_if_interrupted, watching_interrupts
+
 
 def fail(exc: Exception) -> None:
     """Print ``error: <exc>`` on stderr and exit with code 1."""
@@ -85,11 +88,9 @@ def guard(fn):
 
     @functools.wraps(fn)
     def wrapper(*a, **k):
-        from walkerlab import progress  # light
         from walkerlab.config import SceneError  # light
         from walkerlab.io.artifacts import ArtifactError, is_disk_full  # light
         from walkerlab.io.runpaths import ArtifactBusy  # light
-        from walkerlab.safefs import interrupted, raise_if_interrupted, watching_interrupts  # light
         from walkerlab.stages.common import StageError  # light
 
         debug = _debug()

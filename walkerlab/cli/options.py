@@ -6,6 +6,8 @@ from pathlib import Path
 
 import typer
 
+from walkerlab import progress
+
 SceneArg = typer.Argument(None, help="scene YAML file, or a shipped scene's name (paper, "
                           "kneed, rabbit, ...) (default: configs/paper.yaml, the paper's walker)",
                           show_default=False)
@@ -78,7 +80,6 @@ def with_quiet(command):
     @functools.wraps(command)
     def quieted(*args, quiet: bool = False, **kwargs):
         if quiet:
-            from walkerlab import progress  # light
 
             progress.install(progress.sink_for_terminal(True))
         return command(*args, **kwargs)

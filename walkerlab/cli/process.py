@@ -7,6 +7,8 @@ import os
 import typer
 
 import walkerlab
+from walkerlab.safefs import note_interrupt
+from walkerlab.usercache import use_for_numba
 
 
 def versions() -> str:
@@ -72,8 +74,6 @@ def process_settings() -> None:
     import gc
     import signal
 
-    from walkerlab.usercache import use_for_numba  # light
-
     use_for_numba()
     if hasattr(signal, "SIGXFSZ"):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
@@ -86,7 +86,6 @@ def process_settings() -> None:
 
 
 def _interrupt(signum, frame) -> None:
-    from walkerlab.safefs import note_interrupt  # light
 
     note_interrupt()  # kept even if the exception below is swallowed on its way
     raise KeyboardInterrupt
@@ -99,7 +98,6 @@ def _unraisable(hook):
     instead of printed as a traceback; anything else goes to ``hook``."""
     def unraisable(args) -> None:
         if isinstance(args.exc_value, KeyboardInterrupt):
-            from walkerlab.safefs import note_interrupt  # light
 
             note_interrupt()
             return

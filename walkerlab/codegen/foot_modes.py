@@ -65,6 +65,7 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen import source as codegen
+from walkerlab.codegen.compiled_source import cfunc_lines
 from walkerlab.codegen.double_support import (
     DOUBLE_SUPPORT_LEADS,
     derive_double_support,
@@ -570,7 +571,6 @@ def generate_flat_compiled(structure: Structure, key: str) -> str:
     each writing ``GUARDS`` after its outputs (the state guards, then :data:`FORCES`);
     ``constants(p)`` (the data vector: parameters, parameter-only subexpressions, a zeroed
     call counter) and ``NCONST``, as :func:`walkerlab.codegen.compiled_source.generate_compiled`."""
-    from walkerlab.codegen.compiled_source import cfunc_lines  # light
 
     eq = derive_flat(structure)
     hoisted = start_module(eq.params)  # filled as the lines below are generated

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.analysis.robustness.basin_area import basin_area
+from walkerlab.comparison.tables import table3
 from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.published import for_scene
 
@@ -50,7 +51,6 @@ def report_numbers(scene, arts: dict) -> dict:
             run_ground,
             swing_foot_clearance,
         )
-        from walkerlab.comparison.tables import table3  # light
 
         out["energy_drift"] = energy_drift_in_swing(sim.samples)
         ground = run_ground(scene, sim.samples)

@@ -17,6 +17,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 import walkerlab
+from walkerlab import progress
 from walkerlab.config.errors import PLAIN_NUMBER, SceneError, format_error
 from walkerlab.config.limits import MAX_SCENE_BYTES, MAX_YAML_DEPTH, SMALL_SLOPE_DEG
 from walkerlab.config.schema import SCENE_NAME_RE, Scene
@@ -217,7 +218,6 @@ def load_scene(path: str | Path) -> Scene:
     scene = scene_from_dict(data, path)
     scene._origin = path.resolve()
     if unit_warnings(scene):
-        from walkerlab import progress  # light
 
         for line in unit_warnings(scene):
             progress.note(f"warning: {path}: {line}")

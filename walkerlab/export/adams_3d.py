@@ -82,6 +82,8 @@ import math
 import numpy as np
 import sympy as sp
 
+from walkerlab.codegen.cache import functions
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
@@ -199,7 +201,6 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     -------
     Adams3dStart
     """
-    from walkerlab.codegen.cache import functions  # light: codegen when a gait is written
 
     tree, coords, p = walker_tree(data)
     rolled = bool(data.structure.hip_roll)
@@ -407,7 +408,6 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     str
         The .adm text: a title line, then statements, ``END``.
     """
-    from walkerlab.config.contact import ContactSettings  # light
 
     p = start.numbers
     law = contact_mm(scene.contact or ContactSettings())

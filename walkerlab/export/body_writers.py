@@ -18,8 +18,10 @@ sidecar; :class:`MjcfWriter`: the text with its keyframe, terrain and contact).
 from __future__ import annotations
 
 import walkerlab
+from walkerlab.codegen.cache import functions
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.jobs import ExportJob, Writer, Written, step_period, xml_file, xml_lines
+from walkerlab.export.legs_3d_mjcf import legs3d_mjcf, legs3d_scene
 from walkerlab.export.mjcf_document import walker_mjcf_text
 from walkerlab.export.mjcf_ground import wheel_ground
 from walkerlab.export.multibody import (
@@ -47,6 +49,7 @@ from walkerlab.export.wheel_scene import (
     wheel_keyframe,
     wheel_keyframe_json,
 )
+from walkerlab.models.actuation import refuse_actuators
 
 __all__ = ["MJCF", "URDF", "MjcfWriter", "TreeWriter", "UrdfWriter", "check_legs_3d",
            "planar_legs_only"]
@@ -78,7 +81,6 @@ def check_legs_3d(job: ExportJob, w: Writer) -> None:
         kind.require("hip_roll", w.view, "walker.hip_roll")
     check_exportable(scene, kind, w.name, job.walker_only, job.tree)  # numbers, ground
     if scene.walker.actuation is not None:  # passive so far: the table's reason
-        from walkerlab.models.actuation import refuse_actuators  # light: actuated only
 
         refuse_actuators(kind, scene.walker.actuation, w.view)
 
@@ -211,7 +213,6 @@ class MjcfWriter(TreeWriter):
         footfall patches of its lanes and the scene's contact
         (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`; ``job.options``: the MJCF's
         :class:`~walkerlab.export.mjcf_scene.MjcfOptions`)."""
-        from walkerlab.export.legs_3d_mjcf import legs3d_mjcf, legs3d_scene  # light
 
         scene, data = job.scene, job.data
         check_legs_3d(job, w)
@@ -247,7 +248,6 @@ class MjcfWriter(TreeWriter):
         """The 3D wheel's free body (:func:`walkerlab.export.spoked.wheel3d_mjcf_text`),
         the rigid gait as its ``gait`` keyframe (:func:`~walkerlab.export.spoked.
         wheel3d_keyframe`), the scene's static friction coefficient on the spoke tips."""
-        from walkerlab.codegen.cache import functions  # light: the writers load without codegen
 
         data = job.data
         job.kind.require("walk", w.view, "walker.space: 3d")

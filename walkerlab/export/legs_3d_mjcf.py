@@ -94,6 +94,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.codegen.cache import functions
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
@@ -111,9 +112,13 @@ from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
 from walkerlab.export.multibody import latch_equality_lines, mjcf_actuation_omissions
 from walkerlab.export.omitted import MJCF_KNEE_LATCH
+from walkerlab.export.parts import tree_part
+from walkerlab.export.scene import latch_note, mujoco_contact
+from walkerlab.export.scene_ground import EXPORT_STEPS
 from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
+from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.walker.description import state_names
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
@@ -351,11 +356,6 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         A ground other than the slope laid as a checkerboard (one line naming
         ``terrain.lanes``).
     """
-    from walkerlab.config.contact import ContactSettings  # light
-    from walkerlab.export.scene import mujoco_contact  # light
-    from walkerlab.export.scene_ground import EXPORT_STEPS  # light
-    from walkerlab.models.contact.rigid_limit import contact_si  # light
-
     terrain = scene.terrain_or_default()
     if terrain.lanes != "checkerboard":
         raise ValueError("terrain.lanes: the 3D walker's MJCF lays footfall patches "
@@ -392,13 +392,11 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         "walkerlab_hip_roll, run by walkerlab's walk loop (HipRollLoop).")
     latch = None
     if kneed(data):  # the planar kneed MJCF's latch and its note
-        from walkerlab.export.scene import latch_note  # light
 
         latch = (knee.latch_height, knee.latch_capture)
         notes += (latch_note(knee),)
     act = scene.walker.actuation
     if act is not None:  # the planar walkers' note: one motor 'hip', the loop's laws
-        from walkerlab.export.parts import tree_part  # light
 
         notes += (tree_part(body_tree(data.structure)[0],
                             data.structure.kind.joints_free).mjcf_actuators,)

@@ -57,6 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.codegen.cache import functions
+from walkerlab.config.actuation import Actuation
 from walkerlab.export.axes_3d import slope_axes
 from walkerlab.export.joint_torques import (
     law_generalized_forces,
@@ -65,6 +66,7 @@ from walkerlab.export.joint_torques import (
     torque_generalized_forces,
 )
 from walkerlab.extras import require
+from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.models.virtual_constraints import VirtualConstraintController
 
 __all__ = ["HipRollLoop", "MujocoWalk", "PoweredLoop", "VirtualConstraintFeedback", "latch_rule",
@@ -210,8 +212,6 @@ class PoweredLoop:
 
         import mujoco
 
-        from walkerlab.config.actuation import Actuation  # light
-        from walkerlab.models.actuation import TorqueLaws  # light
 
         i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
         adr, size = int(model.text_adr[i]), int(model.text_size[i])
@@ -328,7 +328,6 @@ class PoweredLoop:
 
     def heel_strike(self, data, leg: int) -> None:
         """Leg ``leg`` (0, 1) struck: roles swap, the push-off starts at the other foot."""
-        from walkerlab.models.actuation import push_off_impulse  # light
 
         self.stance, self.t_step, self.heel_off, self.off_steps = leg, float(data.time), \
             False, 0

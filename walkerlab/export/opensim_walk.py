@@ -54,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 import walkerlab
+from walkerlab.config.actuation import Actuation
 from walkerlab.export.joint_torques import (
     law_generalized_forces,
     stance_phase,
@@ -61,6 +62,7 @@ from walkerlab.export.joint_torques import (
 )
 from walkerlab.export.mujoco_walk import MujocoWalk, latch_rule
 from walkerlab.extras import MissingExtra, require, require_installed
+from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
 __all__ = ["OpensimWalk", "contact_height", "walk", "walk_here"]
 
@@ -160,8 +162,6 @@ class _Drive:
 
     def __init__(self, model, spec, coords, bodies, foot_loc):
         import opensim as osim
-
-        from walkerlab.models.actuation import TorqueLaws  # light
 
         self.laws = TorqueLaws(spec.torques)
         self.gf = [[torque_generalized_forces(t.joint, st, coords) for t in spec.torques]
@@ -314,8 +314,6 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     push_law = None
     spec = None
     if "actuation" in info:
-        from walkerlab.config.actuation import Actuation  # light
-        from walkerlab.models.actuation import push_off_impulse  # light
 
         spec = Actuation.model_validate(info["actuation"])
         push_law = spec.push_off

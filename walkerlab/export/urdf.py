@@ -52,6 +52,16 @@ import math
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
+from walkerlab.export.legs_3d_parts import (
+    DISC_HALF_THICKNESS_L,
+    hip_roll_law,
+    leg_links,
+    legs3d_roles,
+    legs_summary,
+    legs_words,
+    round_feet,
+    walker_tree,
+)
 from walkerlab.export.mjcf_scene import (
     MjcfScene,
     actuation_dict,
@@ -63,6 +73,7 @@ from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import planar_bodies, sole_points
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import arc_feet, comment, header, num, nums
+from walkerlab.export.tree_bodies import axis_text, export_bodies
 from walkerlab.export.tree_links import tree_multibody
 from walkerlab.export.urdf_omitted import (
     flat_feet_comments,
@@ -146,7 +157,6 @@ def urdf_link_lines(b, visuals=lambda b, pad: [], parent: str | None = None) -> 
     the body's origin in the body's reference frame: URDF turns each child link about its
     joint's axis in its parent's frame, as MuJoCo turns a body's joints in order
     (:func:`walkerlab.export.tree_bodies.mjcf_body_lines`)."""
-    from walkerlab.export.tree_bodies import axis_text  # light: sympy with the bodies
 
     inertial, extra = _urdf_inertial(b), visuals(b, "    ")
     if extra:
@@ -273,18 +283,6 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     """The 3D legged walker's URDF (module docstring): the bodies of its tree
     (:func:`walkerlab.export.legs_3d_parts.walker_tree`), each leg's rod and foot sphere
     (round feet: its disc)."""
-    from walkerlab.export.legs_3d_parts import (  # light: 3D only
-        DISC_HALF_THICKNESS_L,
-        hip_roll_law,
-        leg_links,
-        legs3d_roles,
-        legs_summary,
-        legs_words,
-        round_feet,
-        walker_tree,
-    )
-    from walkerlab.export.tree_bodies import export_bodies  # light
-
     p = dict(zip(data.structure.param_names, data.params))
     L, w = p["L"], p.get("w_hip", 0.0)
     r = p["R_foot"] if round_feet(data) else WHEEL_TIP_FRACTION * L

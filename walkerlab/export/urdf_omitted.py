@@ -9,12 +9,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from walkerlab.export.legs_3d_parts import hip_roll_law, kneed, legs3d_roles, walker_tree
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.motors import motor_target, motors
 from walkerlab.export.omitted import URDF_GROUND, URDF_GROUND_3D, URDF_KNEE_LATCH, Omission
 from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import ankle_springs
 from walkerlab.export.text import comment, num
+from walkerlab.export.tree_bodies import export_bodies
 from walkerlab.export.tree_links import tree_multibody
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
@@ -62,14 +64,6 @@ def legs_urdf_omissions(data, actuation: Actuation | None = None) -> tuple[Omiss
     (knees: the planar URDF's item), its motors and push-off."""
     if not data.structure.in_3d:
         return urdf_omissions(tree_multibody(data), actuation)
-    from walkerlab.export.legs_3d_parts import (  # light: 3D only
-        hip_roll_law,
-        kneed,
-        legs3d_roles,
-        walker_tree,
-    )
-    from walkerlab.export.tree_bodies import export_bodies  # light
-
     out = [URDF_GROUND_3D]
     if hip_roll_law(data) is not None:
         out += [Omission("the hip-roll law (walker.hip_roll)", "URDF has no law element: "

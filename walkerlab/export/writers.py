@@ -39,6 +39,7 @@ from walkerlab.export.adams import (
     adm_text,
     check_adams_exportable,
 )
+from walkerlab.export.adams_3d import ADAMS_3D_OMISSIONS, adams3d_start, adm3d_text
 from walkerlab.export.adams_actuation import check_adams_actuation
 from walkerlab.export.body_writers import (
     MJCF,
@@ -57,6 +58,7 @@ from walkerlab.export.jobs import (  # noqa: F401 (part of this API)
     xml_file,
     xml_lines,
 )
+from walkerlab.export.mujoco_walk import virtual_constraint_feedback
 from walkerlab.export.multibody import FORMATS
 from walkerlab.export.opensim import (
     OSIM_FILE,
@@ -94,11 +96,6 @@ def _adams_3d(job: ExportJob, w: Writer) -> Written:
     (:func:`walkerlab.export.adams_3d.adm3d_text`), refused before the gait search as its
     MJCF is (:func:`walkerlab.export.body_writers.check_legs_3d`; round feet and leg
     inertia refused here); a 3D wheel as the capability table has it."""
-    from walkerlab.export.adams_3d import (  # light: 3D only
-        ADAMS_3D_OMISSIONS,
-        adams3d_start,
-        adm3d_text,
-    )
 
     job.kind.require("walk", w.view, "walker.space: 3d")
     st = job.data.structure
@@ -154,7 +151,6 @@ def walk_file(out: Exported, fmt: str, tree, steps: int, scene: Scene,
         return not_walked("the file has no gait to start from")
     feedback = None
     if fmt == "mjcf":
-        from walkerlab.export.mujoco_walk import virtual_constraint_feedback  # light: mjcf
 
         feedback = virtual_constraint_feedback(scene, data)
     return walk_export(out.path, fmt, out.step_period_s or math.nan, steps,

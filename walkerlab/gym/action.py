@@ -35,6 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.codegen.cache import functions
+from walkerlab.config.actuation import JointTorque, TorqueLaw
 from walkerlab.models.hybrid.actuators import Actuators
 from walkerlab.walker.joints import ROLL_JOINTS, link_angles, roll_joints
 
@@ -71,7 +73,6 @@ def walker_links(data, n: int) -> list[str]:
     """The links of the walker ``data`` (``n`` generalised coordinates): the keys of
     :func:`walkerlab.walker.joints.link_angles` of its generated ``leg_angles`` (none for a
     walker without them: a spoked wheel)."""
-    from walkerlab.codegen.cache import functions  # light
 
     angles = functions(data).get("leg_angles")
     return [] if angles is None else list(link_angles(angles(np.zeros(2 * n))))
@@ -82,7 +83,6 @@ def _joint_torque(joint: str):
     (:data:`walkerlab.walker.joints.ROLL_JOINTS`), not a scene's torque joint, is built
     without the scene's joint check (the walker's links are checked when the actuators
     are made: :func:`walkerlab.walker.joints.joint_links`)."""
-    from walkerlab.config.actuation import JointTorque, TorqueLaw  # light
 
     if joint in ROLL_JOINTS:
         return JointTorque.model_construct(joint=joint, law=TorqueLaw())

@@ -79,6 +79,7 @@ from .contact_events import (
     trip_or_failure,
     work_limit_message,
 )
+from .contact_powered import ActuationHook
 from .ends import RunEnd, solver_words
 from .solver import Solver
 
@@ -507,7 +508,6 @@ def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
         (n, len(work_names)) [J] the integrals of ``walker.actuators.work_names`` at the
         samples.
     """
-    from .contact_powered import ActuationHook  # light
 
     hook = ActuationHook(walker, solver, limits, deadline,
                          sample_grid(t0, t1, limits.sample_rate_hz))
@@ -573,7 +573,6 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
     if term is RunEnd.T_FINAL and t_pin < t_final - 1e-12:
         hook = None
         if getattr(walker, "actuators", None) is not None:  # (never pinned: the scene refuses)
-            from .contact_powered import ActuationHook  # light
 
             hook = ActuationHook(walker, solver, limits, deadline,
                                  sample_grid(t_pin, t_final, limits.sample_rate_hz))

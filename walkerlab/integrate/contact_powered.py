@@ -69,6 +69,7 @@ import numpy as np
 from walkerlab.models.contact.actuation import powered_rhs
 
 from .compiled_segments import Stalled, grid_inside
+from .contact_events import work_limit_message
 from .ends import RunEnd
 from .powered_events import (
     fall_event,
@@ -274,7 +275,6 @@ class ActuationHook:
         ``limits.max_rhs_evaluations``, is asked before each segment)."""
         most = getattr(self.limits, "max_rhs_evaluations", None)
         if most is not None and self.nfev >= most:
-            from .contact_events import work_limit_message  # light (as trip_or_failure below)
 
             self.term, self.msg = RunEnd.WORK_LIMIT, work_limit_message(self.limits)
             return None

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.hybrid.ground import foothold_steps, landing_drop, on_footholds, on_landing
 from walkerlab.models.hybrid.printed_equations import make_compass_gait
@@ -66,7 +67,6 @@ def build_walker(plant: Plant) -> HybridWalker:
     walker = _on_ground(scene, plant, _passive(scene, plant))
     if act is None or walker.cycle is not None:  # footholds: each step's walker actuated
         return walker
-    from walkerlab.models.hybrid.actuated import actuate  # light
 
     if scene.ideal.variant != "derived":
         raise ValueError("walker.actuation: only with ideal.variant: derived (the printed "
@@ -153,7 +153,6 @@ def _on_footholds(scene, plant: Plant, walker: HybridWalker, steps, on_footholds
         if scene.ideal.variant != "derived":
             raise ValueError("walker.actuation: only with ideal.variant: derived (the "
                              "printed Appendix A equations are passive)")
-        from walkerlab.models.hybrid.actuated import actuate  # light
 
         def finish(w, d):
             return actuate(w, d, act)

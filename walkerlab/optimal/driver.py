@@ -45,10 +45,17 @@ from functools import partial
 
 import numpy as np
 
+from walkerlab.config.actuation import Actuation, PushOff
 from walkerlab.io.schemas.optimize import OptimizeData
+from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.optimal import outcome as reported
 from walkerlab.optimal.free_joints import optimize_five_link
 from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
+from walkerlab.optimal.replay.contact import (
+    contact_replay,
+    contact_replay_phased,
+    contact_replay_stride,
+)
 from walkerlab.optimal.virtual_constraints import (
     check_design,
     designs_controller,
@@ -352,7 +359,6 @@ def _step(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     mass): :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`."""
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.guess import starting_step
-    from walkerlab.optimal.replay.contact import contact_replay  # light
     from walkerlab.optimal.transcription.landing import step_ground
     from walkerlab.optimal.transcription.mode_sequence import collocate_step
     from walkerlab.optimal.transcription.step import replay, torque_of_time
@@ -501,7 +507,6 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
 
     from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.contact import contact_replay_phased  # light
     from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
         phase_torque_of_time,
@@ -605,7 +610,6 @@ def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.contact import contact_replay_stride  # light
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
 
@@ -650,8 +654,6 @@ def _guide(walker, data, spec):
     ``fixedpoint``, is the pushed walker's)."""
     if not spec.push_off_n_s:
         return walker
-    from walkerlab.config.actuation import Actuation, PushOff  # light
-    from walkerlab.models.hybrid.actuated import actuate  # light
 
     return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=spec.push_off_n_s)))
 

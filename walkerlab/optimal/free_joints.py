@@ -11,6 +11,7 @@ import numpy as np
 from walkerlab.io.schemas.optimize import OptimizeData
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.optimal.outcome import history_and_energies, named_states, not_a_gait_outcome
+from walkerlab.optimal.replay.contact import contact_replay_five_link
 from walkerlab.optimal.replay.shooting import close_step
 from walkerlab.optimal.replay.virtual_constraints import phase_replays
 from walkerlab.optimal.transcription.free_joint_functions import JOINTS, five_link_functions
@@ -77,7 +78,6 @@ def five_link_replays(scene, plant, res, not_gait: str = "") -> tuple[dict, tupl
     start; an optimum that is not a gait is not replayed there (``not_gait``: why, the
     contact outcome); ``plant``: the scene's :class:`~walkerlab.walker.plant.Plant`, from
     the stage."""
-    from walkerlab.optimal.replay.contact import contact_replay_five_link  # light
 
     data = plant.data
 

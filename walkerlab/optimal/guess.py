@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.config.studies import GuessFromArtifact
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
 
@@ -247,7 +248,6 @@ def read_guess(scene, names: list):
             return "optimize", d
         if kind != "continuation" or g.at is None:
             raise ValueError("give an optimize.h5, or a continuation artifact with 'at'")
-        from walkerlab.config.studies import GuessFromArtifact  # light
         from walkerlab.io.schemas.continuation import load_continuation  # light
 
         return "continuation", GuessFromArtifact(from_=g.from_, at=g.at, branch=g.branch).pick(

@@ -23,10 +23,15 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from walkerlab import progress
+from walkerlab.analysis.gait.budget import search_budget
+from walkerlab.analysis.gait.zero_dynamics import zero_dynamics
+from walkerlab.config.contact import ContactSettings
+from walkerlab.config.contact_sim import ContactSimSettings
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.optimize import ControllerData, OptimizeData
 from walkerlab.optimal import outcome as reported
+from walkerlab.optimal.replay.contact import contact_replay_controller
 from walkerlab.optimal.transcription.virtual_constraints import (
     collocate_virtual_constraints,
     hzd_functions,
@@ -153,8 +158,6 @@ def contact_scene(scene):
     sections, or (none) :data:`CONTROLLER_CONTACT` and the run's defaults; ``terrain`` and
     ``contact_solver`` as they are (their defaults when absent: a checkerboard of the
     footfalls, over whose gaps the straight swing foot passes at mid-stance)."""
-    from walkerlab.config.contact import ContactSettings  # light
-    from walkerlab.config.contact_sim import ContactSimSettings  # light
 
     update = {}
     if scene.contact is None:
@@ -265,7 +268,6 @@ def controller_step(walker, solver, points: int):
         The scene's controller has no periodic orbit or its step does not end in a heel
         strike (one line naming the key).
     """
-    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
 
     ctrl = walker.actuators.controller
     zd = zero_dynamics(ctrl)
@@ -299,9 +301,7 @@ def _evaluate(scene, res, target, name: str, clearance: dict, plant) -> Controll
     iterate whose coefficients make no controller (a failed design) is recorded as it is,
     with the reason in ``note``.  ``plant``: the scene's (the controller's scene is
     :meth:`~walkerlab.walker.plant.Plant.with_` of it)."""
-    from walkerlab.analysis.gait.budget import search_budget  # light
     from walkerlab.analysis.gait.scene import solve_scene  # light
-    from walkerlab.analysis.gait.zero_dynamics import zero_dynamics  # light
     from walkerlab.models.registry import build_walker
 
     sc = controller_scene(scene, res.alpha)
@@ -483,7 +483,6 @@ def replay_in_contact(scene, c: ControllerDesign, plant) -> ControllerDesign:
     contact_replay_controller` of :func:`controller_scene`, :data:`REPLAY_STRIDES`
     strides from the rigid fixed point); not replayed without one.  ``plant``: the
     scene's, from the stage."""
-    from walkerlab.optimal.replay.contact import contact_replay_controller  # light
 
     if c.x_star is None or not np.isfinite(c.full_order_step_period_s):
         return replace(c, contact_outcome="not replayed: the rigid closed loop has no "

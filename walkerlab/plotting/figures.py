@@ -16,6 +16,7 @@ from pathlib import Path
 import matplotlib
 
 from walkerlab.plotting.figure_cache import KEY_CHUNK
+from walkerlab.walker.planes import out_of_plane
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -135,7 +136,6 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
     :func:`walkerlab.walker.planes.out_of_plane`, by name) get panels of their own
     beside them, (c) and (d): their few hundredths of a radian would be flat lines on the
     pitches' axes.  A planar walker's figure has the two panels alone."""
-    from walkerlab.walker.planes import out_of_plane  # light
 
     every = [n for tr in trajs.values() for n in tr.coordinates]  # one colour per link
     lateral = any(out_of_plane(n) for n in every)

@@ -21,6 +21,7 @@ from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.contact.scene import build
 from walkerlab.stages.common import StageError, StageOutcome, run_cached, with_defaults
 from walkerlab.stages.registry import attribution_refused
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "contact", "terrain", "contact_sim",
             "contact_solver")
@@ -46,7 +47,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     def compute():
         from walkerlab.analysis.contact.attribution import adjustment_effect, attribute
-        from walkerlab.walker.plant import Plant  # light
 
         fp = load_fixedpoint(up[0])
         ideal = SimpleNamespace(x=fp.x, period_s=float(fp.step_period_s))

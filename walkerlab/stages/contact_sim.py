@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from walkerlab.analysis.contact.record import contact_sim_run
+from walkerlab.analysis.contact.step_map import PeriodicGaitError
 from walkerlab.analysis.contact.warm import compile_rhs_kernels, compile_run_kernels
 from walkerlab.codegen.pending import CompiledElsewhere
 from walkerlab.config import Scene, SceneError
@@ -50,7 +51,6 @@ SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_sol
 
 
 def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool):
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         run = contact_sim_run(setup, load_fixedpoint(fixedpoint), adjust, periodic)

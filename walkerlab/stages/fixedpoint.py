@@ -16,6 +16,8 @@ from walkerlab.io.freshness import input_hash
 from walkerlab.io.runpaths import RunPathError, stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint, write_fixedpoint
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
@@ -159,7 +161,6 @@ def guess_owners(scene: Scene) -> list:
 def _may_have_guess_owner(scene: Scene) -> bool:
     """A 3D walker with an initial guess (a planar walker's search has its scale-free
     seeds): :func:`guess_owners` may find the scene its guess was written for."""
-    from walkerlab.walker.description import walker_data  # light
 
     fp = scene.fixedpoint
     return (fp is not None and fp.initial_guess is not None
@@ -172,7 +173,6 @@ def _own_gait(scene: Scene):
     from walkerlab.analysis.gait.scene import initial_guess, solve_scene  # light
     from walkerlab.analysis.gait.search import GaitNotFound  # light
     from walkerlab.models.registry import build_walker
-    from walkerlab.walker.plant import Plant  # light
 
     plant = Plant.from_scene(scene)  # the walker described once, handed down
     walker = build_walker(plant)
@@ -231,7 +231,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         # (every downstream stage's upstream check) imports none of it
         from walkerlab.analysis.gait.scene import fixed_point_run  # light
         from walkerlab.analysis.gait.search import GaitNotFound  # light
-        from walkerlab.walker.plant import Plant  # light
 
         plant = Plant.from_scene(scene)  # the walker described once, handed down
         guess = note = nearby = None

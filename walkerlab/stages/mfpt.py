@@ -16,9 +16,12 @@ from walkerlab.io.freshness import input_hash
 from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas import mfpt as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.models.contact.parts import periodic_gait_refusal
 from walkerlab.plotting.artifact_figures import save_mfpt_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.studies.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
+from walkerlab.walker.kinds import KindRefused
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt")
 
@@ -44,10 +47,6 @@ def check(scene: Scene, sigma_rad: list[float] | None = None, method: str | None
     require(scene, "fixedpoint", "mfpt")
     st, workers = mfpt_options(scene, sigma_rad, method, workers)
     if st.model == "contact":  # the contact walker's Monte Carlo: the table's contact cell
-        from walkerlab.models.contact.parts import periodic_gait_refusal  # light
-        from walkerlab.walker.kinds import KindRefused  # light
-        from walkerlab.walker.plant import Plant  # light
-
         plant = Plant.from_scene(scene)
         kind = plant.kind
         try:
@@ -78,7 +77,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     done = []  # the resume file, removed once the artifact is written
 
     def work():
-        from walkerlab.walker.plant import Plant  # light
 
         x_star = load_fixedpoint(up).x
         try:

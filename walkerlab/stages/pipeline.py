@@ -14,12 +14,17 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.stage_files import FIXEDPOINT
+from walkerlab.models.actuation import refuse_actuators
+from walkerlab.stages.common import StageError
 from walkerlab.stages.registry import (  # noqa: F401 (part of this API)
     STAGES,
     contact_walks_ground,
     needs,
     report_plan,
 )
+from walkerlab.walker.capability_cells import STAGE_VIEWS
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.kinds import KindRefused
 
 
 def order(stage: str, scene: Scene) -> list[str]:
@@ -70,18 +75,12 @@ def require_kind(stage: str, scene: Scene) -> None:
     StageError
         One line naming the scene field (``walker.space: 3d``, ``walker``).
     """
-    from walkerlab.stages.common import StageError  # light
-    from walkerlab.walker.capability_cells import STAGE_VIEWS  # light
-    from walkerlab.walker.description import walker_data  # light
-    from walkerlab.walker.kinds import KindRefused  # light
-
     act = getattr(scene.walker, "actuation", None)
     try:
         kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
         for s in order(stage, scene):
             kind.require_stage(s)
             if act is not None and s in STAGE_VIEWS:  # the view's actuators (the table's)
-                from walkerlab.models.actuation import refuse_actuators  # light
 
                 try:
                     refuse_actuators(kind, act, STAGE_VIEWS[s][1])

@@ -22,6 +22,11 @@ from dataclasses import dataclass
 from walkerlab.config import Scene
 from walkerlab.io import stage_files as art
 from walkerlab.io.stage_files import StageArtifact
+from walkerlab.models.actuation import refuse_actuators
+from walkerlab.models.contact.parts import attribution_refusal
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.kinds import KindRefused
+from walkerlab.walker.plant import Plant
 
 #: when the report runs a stage (:func:`walkerlab.stages.report_dag.run_report`): the gait
 #: first, then the trajectories (the contact walker after its kernels' warm-up), the
@@ -92,10 +97,6 @@ def contact_walks_ground(scene: Scene) -> bool:
     act = getattr(scene.walker, "actuation", None)
     if not drawn and act is None:
         return True
-    from walkerlab.models.actuation import refuse_actuators  # light
-    from walkerlab.walker.description import walker_data  # light: kinds on drawn grounds
-    from walkerlab.walker.kinds import KindRefused  # light
-
     kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
     if drawn and not kind.supports(ground, "contact"):
         return False
@@ -111,8 +112,6 @@ def attribution_refused(scene: Scene) -> str | None:
     """Why the scene's walker gets no Section-5 attribution (no contact periodic gait, or a
     walker in 3D: :func:`walkerlab.models.contact.parts.attribution_refusal`), one line
     without the scene's name, or None."""
-    from walkerlab.models.contact.parts import attribution_refusal  # light
-    from walkerlab.walker.description import walker_data  # light: kinds on drawn grounds
 
     return attribution_refusal(scene, walker_data(scene.walker, scene.slope.phi_rad))
 
@@ -126,7 +125,6 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
         return ()
     if stage == art.OPTIMIZE.name:
         from walkerlab.optimal.driver import needs_gait  # light: the optimal layer
-        from walkerlab.walker.plant import Plant  # light
 
         # a five-link biped: its guess is built from the targets
         if not needs_gait(scene, Plant.from_scene(scene)):

@@ -16,12 +16,19 @@ from __future__ import annotations
 
 import importlib
 
+from walkerlab.bench.workprecision import start_worker
 from walkerlab.config import Scene
 from walkerlab.execution.background import BackgroundStudy
 from walkerlab.execution.side import SideWorker
+from walkerlab.io.artifacts import ArtifactError
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.stage_files import SIMULATE, WORKPRECISION
+from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+from walkerlab.stages.common import StageError
 from walkerlab.stages.pipeline import report_plan, stage_module
+from walkerlab.stages.plot import draw_ideal_ahead, draw_if_changed
 from walkerlab.stages.registry import STAGES, in_phase
+from walkerlab.walker.plant import Plant
 
 
 def _named(stage: str, run, *args, **kwargs):
@@ -37,8 +44,6 @@ def _named(stage: str, run, *args, **kwargs):
         anything else pass unchanged.
     """
     from walkerlab.config import SceneError
-    from walkerlab.io.artifacts import ArtifactError  # light
-    from walkerlab.stages.common import StageError  # light
 
     try:
         return run(*args, **kwargs)
@@ -53,8 +58,6 @@ def _study(scene: Scene, runs_root, force: bool):
     """The work-precision stage in a thread of the report, overlapping the untimed stages
     (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
     the contact model's kernels are compiled."""
-    from walkerlab.bench.workprecision import start_worker  # light
-    from walkerlab.io.runpaths import stage_artifact  # light
 
     wp = stage_module(WORKPRECISION.name)
     first_run = not stage_artifact(scene, runs_root, WORKPRECISION.name).is_file()
@@ -84,14 +87,11 @@ def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
     (``ready`` None) the side process compiles, or loads, all of them
     (:func:`walkerlab.stages.contact_sim.warm_up`) and the run here waits for it first.
     """
-    from walkerlab.io.runpaths import stage_artifact  # light
 
     warmed = _warmed(plan)
     if warmed is None or not (
             force or not stage_artifact(scene, runs_root, warmed).is_file()):
         return None
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup  # light
-    from walkerlab.walker.plant import Plant  # light
 
     cs = stage_module(warmed)
     try:
@@ -116,7 +116,6 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     (list of StageOutcome, list of str)
         What each stage did, in order, and one line per figure group drawn or reused.
     """
-    from walkerlab.stages.plot import draw_ideal_ahead, draw_if_changed  # light
 
     plan = report_plan(scene, full)
     for name in plan:  # what the scene alone refuses (the capability table's cells, bad

@@ -18,9 +18,11 @@ from pathlib import Path
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, write_rigid_limit
+from walkerlab.models.contact.parts import contact_part, periodic_gait_refusal
 from walkerlab.models.contact.rigid_limit import expected_order
 from walkerlab.models.contact.scene import build
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
+from walkerlab.walker.plant import Plant
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 #: Default stiffness factors [-] of a planar walker: the scene's contact and three decades
@@ -42,8 +44,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     require(scene, "fixedpoint", "rigid-limit")
     _periodic_gait_taken(scene)
     if kappas is None:
-        from walkerlab.models.contact.parts import contact_part  # light
-        from walkerlab.walker.plant import Plant  # light
 
         kappas = contact_part(Plant.from_scene(scene).data.structure).rigid_limit_kappas
     kappas = tuple(float(k) for k in kappas)
@@ -51,7 +51,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     def compute():
         from walkerlab.analysis.contact.periodic import ideal_gait  # light
         from walkerlab.analysis.contact.rigid_limit import convergence, observed_order  # light
-        from walkerlab.walker.plant import Plant  # light
 
         plant = Plant.from_scene(scene)  # the walker described once, handed down
         ideal = ideal_gait(scene, plant)
@@ -80,8 +79,6 @@ def _periodic_gait_taken(scene: Scene) -> None:
     ------
     StageError
     """
-    from walkerlab.models.contact.parts import periodic_gait_refusal  # light
-    from walkerlab.walker.plant import Plant  # light
 
     why = periodic_gait_refusal(scene, Plant.from_scene(scene).data)
     if why is not None:

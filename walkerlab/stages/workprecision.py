@@ -36,6 +36,8 @@ from walkerlab.io.runpaths import run_cache_dir, stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.workprecision import WorkPrecisionRun, write_workprecision
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.kinds import KindRefused
 
 SECTIONS = ("walker", "slope", "ideal", "fixedpoint", "workprecision", "contact", "terrain",
             "contact_sim")
@@ -56,8 +58,6 @@ def check(scene: Scene, **_options) -> None:
     except ValueError as exc:  # no workprecision section (one line)
         raise StageError(str(exc)) from None
     if "contact" in models:
-        from walkerlab.walker.description import walker_data  # light
-        from walkerlab.walker.kinds import KindRefused  # light
 
         kind = walker_data(scene.walker, scene.slope.phi_rad).structure.kind
         try:

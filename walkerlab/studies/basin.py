@@ -43,6 +43,9 @@ import numpy as np
 
 from walkerlab import progress
 from walkerlab.execution.executor import run_each
+from walkerlab.io.basin_partial import basin_partial_writer, read_basin_partial
+from walkerlab.io.runpaths import refuse_link
+from walkerlab.io.schemas.basin import BasinRun
 from walkerlab.models.hybrid.base import OffSection
 from walkerlab.studies.basin_cell import (  # noqa: F401 (part of this API)
     CODE,
@@ -90,7 +93,6 @@ def _resumed_cells(part: Path, key: str, nx: int, ny: int):
     """``(arrays, row_hash)`` of a partial basin file of input hash ``key`` and grid
     ``(ny, nx)``, keeping only grid rows whose cells still match the hash written with them
     (the others are set back to not done); ``(None, None)`` without a usable file."""
-    from walkerlab.io.basin_partial import read_basin_partial  # light
 
     arrays, stored = read_basin_partial(part, key, (ny, nx))
     if arrays is None:
@@ -161,7 +163,6 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     xs, ys = axis_values(st, walker, x_star, grid)
     x_pre = _start_pre_impact(walker, x_star, st, mst, xs, ys)
     nx, ny = xs.size, ys.size
-    from walkerlab.io.runpaths import refuse_link  # light
 
     part = refuse_link(_partial(Path(out_path)))  # never written through a link
     part.parent.mkdir(parents=True, exist_ok=True)
@@ -235,7 +236,6 @@ def _run_basin_tasks(tasks: list[BasinTask], part: Path, key: str, arrays: dict,
     :func:`walkerlab.studies.runner.sweep_executor`, storing each chunk's cells in
     ``arrays`` (and the hash of every grid row it completes in ``row_hash``), writing the
     partial file ``part`` and reporting progress after each; returns the cells computed."""
-    from walkerlab.io.basin_partial import basin_partial_writer  # light
     from walkerlab.studies.runner import sweep_executor  # light
 
     total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
@@ -280,7 +280,6 @@ def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
     BasinError
         Bad axes or ranges (one line).
     """
-    from walkerlab.io.schemas.basin import BasinRun  # light
 
     res = compute_basin(scene, x_star, key, out_path, grid, workers, scheduler, resume=resume,
                         on_chunk=on_chunk, plant=plant)

@@ -22,7 +22,10 @@ from typing import Any
 import numpy as np
 
 from walkerlab.config import Scene
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
+from walkerlab.studies.point_columns import interleg_angle
 
 
 @dataclass(frozen=True)
@@ -176,10 +179,6 @@ def _steady_state(task: BifurcationTask, scene, walker, row: dict, x_att):
         The attractor's last post-impact state (the next value's start), None when the walk
         did not last (or did not start).
     """
-    from walkerlab.integrate.rigid import simulate_steps  # light: worker side
-    from walkerlab.integrate.solver import Solver  # light: worker side
-    from walkerlab.studies.point_columns import interleg_angle  # light: worker side
-
     if x_att is not None:
         x0 = walker.from_section(walker.section(x_att))
     elif row["fp_outcome"] == "ok":

@@ -23,6 +23,7 @@ from walkerlab.analysis.continuation.two_parameter import two_parameter
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.studies.params import ParamAxis, apply_point, axis_unit, check_axes
+from walkerlab.studies.sweep_plan import base_value
 
 __all__ = ["scene_family", "scene_value", "check_continuation", "run_continuation",
            "numeric_fields", "homotopy_family", "homotopy_gait", "known_scene",
@@ -64,7 +65,6 @@ def scene_family(scene: Scene, path: str, *, plant) -> WalkerFamily:
 
 def scene_value(scene: Scene, path: str) -> float:
     """The scene's own value of a numeric field (the slope in either unit)."""
-    from walkerlab.studies.sweep_plan import base_value  # light
 
     v = base_value(scene.model_dump(mode="json"), path)
     if v is None:  # a field the scene does not have (one line naming it), or one left unset

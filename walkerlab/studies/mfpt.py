@@ -18,12 +18,15 @@ import numpy as np
 
 from walkerlab import progress as _progress
 from walkerlab.analysis.contact.rough import contact_start
+from walkerlab.analysis.contact.step_map import PeriodicGaitError
 from walkerlab.analysis.robustness import mfpt as M
 from walkerlab.config import MfptSettings, scene_from_dict
 from walkerlab.execution.dask import DaskLost
 from walkerlab.execution.executor import run_each
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.integrate.python_step import make_step_map
+from walkerlab.io.mfpt_partial import MfptPartial
+from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
 from walkerlab.models.contact.scene import ContactSceneError
 from walkerlab.models.hybrid.ground import with_clearance_guard
 from walkerlab.studies.contact_rough import contact_monte_carlo
@@ -339,7 +342,6 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
         without patches or without a periodic gait (one line).
     """
 
-    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
     if scene.terrain is not None and not scene.terrain.is_slope:
@@ -430,7 +432,6 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
     slope drawn with ``terrain.per_step.slope_sd_rad``): Monte Carlo at each level."""
     import time
 
-    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData  # light
     from walkerlab.models.registry import build_walker
 
     walker = build_walker(plant.with_(scene))
@@ -453,7 +454,6 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
 
 def _contact_start(scene, x_star: np.ndarray, st, plant):
     """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     if st.method != "montecarlo":
         raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
@@ -515,7 +515,6 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
         The Dask cluster was lost (one line advising :data:`RERUN`; the partial file is
         kept).
     """
-    from walkerlab.io.mfpt_partial import MfptPartial  # light
 
     partial = MfptPartial(partial_path, key, resume=resume)
     try:

@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from walkerlab.analysis.contact.rough import contact_start
+from walkerlab.analysis.contact.step_map import PeriodicGaitError
 from walkerlab.analysis.robustness.measures import (
     LATERAL_DISTURBANCES,
     UNITS,
@@ -27,6 +28,7 @@ from walkerlab.analysis.robustness.push import LATERAL_AXIS, apply_push
 from walkerlab.config import RobustnessSettings
 from walkerlab.integrate.python_step import ReflectedStepMap, make_step_map
 from walkerlab.integrate.solver import Solver
+from walkerlab.io.schemas.robustness import RobustnessData
 from walkerlab.models.contact.scene import ContactSceneError
 from walkerlab.studies import mfpt as work
 from walkerlab.studies.contact_rough import contact_largest_step
@@ -67,7 +69,6 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
         side: slower).
     """
     from walkerlab.analysis.gait.poincare import poincare_map  # light
-    from walkerlab.io.schemas.robustness import RobustnessData  # light
     from walkerlab.models.registry import build_walker
 
     # the kind's refusal (a 3D walker: walker.space) before the walker is built
@@ -172,7 +173,6 @@ def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
             "contact_step_up_m/hi")
     if not getattr(st, "contact", False):
         return dict.fromkeys(keys, math.nan)
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         start = contact_start(scene, x_star, plant=plant)

@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from walkerlab.config import CompassGaitParams
 from walkerlab.walker.description import Structure, WalkerData, walker_data
 from walkerlab.walker.kinds import Kind
 
@@ -164,7 +165,6 @@ def compass_gait_data(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
     -------
     WalkerData
     """
-    from walkerlab.config import CompassGaitParams  # light: the schema, for its defaults
 
     w = CompassGaitParams(leg_length_m=leg_length_m, leg_mass_kg=leg_mass_kg,
                           hip_mass_kg=hip_mass_kg, gravity_m_per_s2=gravity_m_per_s2,

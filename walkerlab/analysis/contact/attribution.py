@@ -30,8 +30,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.analysis.contact.sim import simulate_from
+from walkerlab.analysis.contact.step_map import PeriodicGaitError, StepMap
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.rigid_limit import scale_walker
+from walkerlab.models.contact.scene import contact_setup, ideal_step_length
 
 __all__ = ["COMPLIANCE_OFF", "CREEP_OFF", "Attribution", "adjustment_effect", "attribute",
            "energy_by_sink"]
@@ -80,7 +84,6 @@ def _no_creep(walker, factor: float = CREEP_OFF):
 
 def _gap_or_nan(find, T0, L0):
     """(period gap, step gap, z) of a periodic-gait search; NaN gaps if it fails."""
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         g = find()
@@ -102,7 +105,6 @@ def energy_by_sink(walker, z, n_samples: int = 20000) -> dict[str, float]:
     n_samples : int
         Samples of the step's dense output for the trapezoidal integrals.
     """
-    from walkerlab.analysis.contact.step_map import StepMap  # light
 
     sm = StepMap(walker)
     run = sm.integrate(sm.to_state(z), stance_to_come=0, dense=True)
@@ -144,8 +146,6 @@ def attribute(walker, ideal, **search) -> Attribution:
         Passed to :func:`~walkerlab.analysis.contact.periodic.find_contact_periodic_gait`.
     """
     from walkerlab.analysis.contact.periodic import find_contact_periodic_gait  # light
-    from walkerlab.models.contact.rigid_limit import scale_walker  # light
-    from walkerlab.models.contact.scene import ideal_step_length  # light
 
     search.setdefault("check_fd", False)
     T0, L0 = float(ideal.period_s), ideal_step_length(walker, ideal.x)
@@ -181,8 +181,6 @@ def adjustment_effect(scene, ideal, strides: int = 5, *, plant) -> dict:
         ``rigid_from_adjusted`` (the rigid run's termination after ``2 strides`` steps),
         ``rigid_heel_strikes``.
     """
-    from walkerlab.analysis.contact.sim import simulate_from  # light
-    from walkerlab.models.contact.scene import contact_setup  # light
     from walkerlab.models.registry import build_walker
 
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)

@@ -24,6 +24,7 @@ import numpy as np
 
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.scene import ideal_step_length
 from walkerlab.models.contact.terrain import ground_drops
 
 __all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_step_lengths"]
@@ -60,7 +61,6 @@ def rigid_step_lengths(scene, walker, x_ideal, plant) -> tuple[float, ...] | Non
     ValueError
         The rigid gait does not make its steps from ``x_ideal`` (a fall: one line).
     """
-    from walkerlab.models.contact.scene import ideal_step_length  # light
     from walkerlab.models.registry import build_walker
 
     if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:

@@ -16,6 +16,7 @@ from walkerlab.analysis.contact.ledger import (
     STEP_LEDGER_UNITS,
     contact_step_ledger,
 )
+from walkerlab.analysis.contact.step_map import PeriodicGaitError
 from walkerlab.config import ContactSettings
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.models.contact.scene import (
@@ -180,7 +181,6 @@ def _periodic_start(setup: ContactSetup, x_ideal, solver):
     :func:`~walkerlab.analysis.contact.periodic.simulate_from_periodic_gait`; its
     ``PeriodicGaitError`` again with the scene and the field named."""
     from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait  # light
-    from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
     try:
         return simulate_from_periodic_gait(setup, x_ideal, solver=solver)
@@ -215,7 +215,6 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     walker, res, x0, step_length, scale, gait, adj = contact_walk(
         setup, fp.x, fp.step_period_s, adjust)
     if periodic and gait is None and setup.steps_differ:
-        from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
         # the step map is one step's; this ground's gait is of several (not searched)
         gait_error = PeriodicGaitError(SEVERAL_STEPS_OUTCOME, SEVERAL_STEPS_PERIODIC)
@@ -225,7 +224,6 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
             find_contact_periodic_gait,
             search_bounds,
         )
-        from walkerlab.analysis.contact.step_map import PeriodicGaitError  # light
 
         try:  # an unconverged search is a gait not found (its outcome and message)
             gait = converged_gait(find_contact_periodic_gait(walker, fp.x,

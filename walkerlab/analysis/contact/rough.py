@@ -15,8 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from walkerlab.analysis.contact.sim import scene_start, simulate_contact
 from walkerlab.analysis.robustness.mfpt import draw_slopes
+from walkerlab.config import scene_from_dict
 from walkerlab.integrate.rigid import Solver, integrate_step
+from walkerlab.models.contact.scene import contact_setup
 from walkerlab.models.contact.terrain import footfall_lanes, slope_heights
 
 __all__ = ["ContactStart", "contact_start", "contact_walk"]
@@ -77,8 +80,6 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True,
         find_contact_periodic_gait,
         search_bounds,
     )
-    from walkerlab.analysis.contact.sim import scene_start  # light
-    from walkerlab.models.contact.scene import contact_setup  # light
 
     setup = contact_setup(scene, plant=plant)  # plant: the caller's
     cs = setup.sim
@@ -120,10 +121,6 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
         ``fell`` False: the walk reached ``max_steps`` (censored); ``outcome`` the run's
         end (:data:`walkerlab.analysis.contact.verdict.CONTACT_OUTCOMES`).
     """
-    from walkerlab.analysis.contact.sim import scene_start, simulate_contact  # light
-    from walkerlab.config import scene_from_dict  # light
-    from walkerlab.models.contact.scene import contact_setup  # light
-
     scene = scene_from_dict(start.scene)  # the worker's scene: the start's plant, with_ it
     setup = contact_setup(scene, plant=start.plant.with_(scene))
     sv = setup.solver

@@ -28,7 +28,7 @@ from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.contact.scene import ContactSetup
+from walkerlab.models.contact.scene import ContactSceneError, ContactSetup
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
            "rigid_mid_stance", "scene_start", "simulate_contact", "simulate_from",
@@ -296,7 +296,6 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
     x_start = (rigid_mid_stance(setup.scene, x_ideal, setup.plant)
                if cs.start == "mid_stance" else x_ideal)
     if cs.start_offset is not None:  # a change to the start (the patches stay)
-        from walkerlab.models.contact.scene import ContactSceneError  # light
 
         try:
             dx = cs.start_offset.as_array(list(walker.rigid_layout().names))

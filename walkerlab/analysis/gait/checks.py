@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.analysis.gait.friction import flat_foot_friction, stance_friction
+from walkerlab.analysis.gait.rigid_run import rough_ground_steps
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.io.trajectory import NamedTrajectory
 from walkerlab.models.ground import foothold_steps, scene_ground
@@ -110,7 +111,6 @@ def run_ground(scene, tr: NamedTrajectory):
         slopes = [g for _d, g in steps] if steps is not None else [phi]
     elif sim is not None and sim.terrain_seed is not None and terrain is not None \
             and terrain.per_step is not None:
-        from walkerlab.analysis.gait.rigid_run import rough_ground_steps  # light
 
         n = int(np.unique(tr.step_index).size)
         slopes = [g for _d, g in rough_ground_steps(scene, n)]

@@ -30,6 +30,7 @@ import math
 
 import numpy as np
 
+from walkerlab.config import ContactSettings
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.io.friction import FrictionVerdict
 from walkerlab.models.hybrid.rigid_foot_modes import mode_of
@@ -74,7 +75,6 @@ def scene_friction(scene) -> tuple[float, str]:
     from (the contact section's ``mu_static``, or the contact model's default)."""
     if getattr(scene, "contact", None) is not None:
         return float(scene.contact.mu_static), "contact.mu_static"
-    from walkerlab.config import ContactSettings  # light
 
     return float(ContactSettings.model_fields["mu_static"].default), \
         "the contact model's default"

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from walkerlab.config import MAX_SIMULATE_SAMPLES
 from walkerlab.integrate.rigid import HybridTrajectory
 from walkerlab.io.trajectory import NamedTrajectory
 
@@ -59,7 +60,6 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         More than :data:`walkerlab.config.MAX_SIMULATE_SAMPLES` samples (checked before any
         is taken; the message names ``simulate.sample_rate_hz``).
     """
-    from walkerlab.config import MAX_SIMULATE_SAMPLES  # light
 
     n = sum(math.ceil(max(s.t_end - s.t_start, 0.0) * rate_hz) + 1 for s in traj.segments)
     if n > MAX_SIMULATE_SAMPLES:

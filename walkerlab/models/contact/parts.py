@@ -16,8 +16,15 @@ import numpy as np
 
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, HUB_INERTIA_MESSAGE
+from walkerlab.codegen.floating_equations import ROLES_3D
+from walkerlab.config.contact_sim import ContactSimSettings
+from walkerlab.models.actuation import refuse_actuators
 from walkerlab.walker import parts as P
+from walkerlab.walker.kinds import KindRefused
 from walkerlab.walker.layout import floating_links_from_rigid
+
+from .actuation import ContactActuators
+from .joint_torques import JointTorqueActuators
 
 __all__ = ["ContactPart", "attribution_refusal", "contact_part",
            "periodic_gait_refusal"]
@@ -127,7 +134,6 @@ class ContactPart:
         """The contact view's actuators: joint torques at the links' joints, a push-off
         pulse, an ankle push-off (:class:`walkerlab.models.contact.actuation.
         ContactActuators`)."""
-        from .actuation import ContactActuators  # light
 
         st = data.structure
         return ContactActuators(spec, coordinates, pulse_s, st.kind,
@@ -219,7 +225,6 @@ class FreeJointsPart(KneedPart):
             from .virtual_constraints import VirtualConstraintJointTorques  # light
 
             return VirtualConstraintJointTorques(data, spec, coordinates, pulse_s)
-        from .joint_torques import JointTorqueActuators  # light
 
         return JointTorqueActuators(data, spec, coordinates, pulse_s)
 
@@ -344,7 +349,6 @@ class Legs3DPart(ContactPart):
         """The floating state after the base's slides (``[heading, the rigid roles' angles,
         their rates]``) of the rigid state ``x`` (role order), the heading 0 and at rest;
         each leg's coordinates' rates scaled by its leg's factor (the pelvis' by none)."""
-        from walkerlab.codegen.floating_equations import ROLES_3D  # light
 
         x = np.asarray(x, float)
         roles = walker.structure.roles
@@ -393,7 +397,6 @@ class Legs3DPart(ContactPart):
         ValueError
             A push-off on disc feet (the rigid view's refusal, one line).
         """
-        from .actuation import ContactActuators  # light
 
         st = data.structure
         if spec.push_off is not None and st.foot == "arc":
@@ -405,8 +408,6 @@ class Legs3DPart(ContactPart):
     def actuators_refusal(self, scene, data) -> str | None:
         """The table's refusal of the scene's actuators in the contact view (a torque at a
         joint the straight legs do not have, virtual constraints), one line."""
-        from walkerlab.models.actuation import refuse_actuators  # light
-        from walkerlab.walker.kinds import KindRefused  # light
 
         try:
             refuse_actuators(data.structure.kind, scene.walker.actuation, "contact")
@@ -434,7 +435,6 @@ def periodic_gait_refusal(scene, data) -> str | None:
     wheel).  ``data`` is the walker's WalkerData; the gait is the mid-stance step map's
     that ``contact-sim --periodic``, ``compare --rigid-limit`` and ``mfpt.model: contact``
     run on."""
-    from walkerlab.config.contact_sim import ContactSimSettings  # light
 
     cs = (scene.contact_sim or ContactSimSettings()).model_copy(update={"periodic_gait": True})
     return contact_part(data.structure).check(scene, data, cs)

@@ -25,6 +25,7 @@ from walkerlab.config import (
 from walkerlab.config.actuation import Actuation
 from walkerlab.config.sections import with_default_section
 from walkerlab.walker.kinds import KindRefused
+from walkerlab.walker.layout import StateLayout
 from walkerlab.walker.plant import Plant
 
 from .actuation import ContactActuators
@@ -301,7 +302,6 @@ def _check_start_offset(scene: Scene, structure, cs: ContactSimSettings) -> None
     """
     if cs.start_offset is None:
         return
-    from walkerlab.walker.layout import StateLayout  # light
 
     try:
         cs.start_offset.as_array(list(StateLayout.rigid(structure.roles).names))

@@ -24,6 +24,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
+from walkerlab.models.hybrid.toe_push_off import FlatPushOff, push_off_flat
 
 __all__ = ["AnklePushOffActuator", "actuate_flat", "ankle_push_off_work", "heel_off_data"]
 
@@ -115,7 +116,6 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
 def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
     """One step's flat-footed walker (``data`` without ``mirror_params``, or legs alike)
     with the push-off impulse and/or the ankle push-off, and joint torques if any."""
-    from walkerlab.models.hybrid.toe_push_off import FlatPushOff, push_off_flat  # light
 
     walker = replace(walker, mirror=None)  # one step's (legs that differ: set by the caller)
     off = None if spec.ankle_push_off is None else heel_off_data(data, spec)

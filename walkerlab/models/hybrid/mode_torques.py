@@ -28,6 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from walkerlab.codegen.cache import functions
+from walkerlab.models.hybrid.actuators import Actuators
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 from walkerlab.numerics import complex_step_jacobian
@@ -81,7 +82,6 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None,
         A joint the walker does not have (naming the joints it has), a torque per foot
         mass (flat feet carry massive legs) (one line).
     """
-    from walkerlab.models.hybrid.actuators import Actuators  # light
 
     for i, t in enumerate(spec.torques):
         if t.scaled_by != "none":

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.analysis.robustness.measures import linearise
+from walkerlab.config.studies import MfptSettings
 from walkerlab.integrate.python_step import make_step_map
 
 __all__ = ["ROBUSTNESS_MEASURES", "robustness_measure"]
@@ -57,7 +58,6 @@ def robustness_measure(name: str, scene, walker, x_star, A, *, plant) -> float:
                                   workers=1, resume=False, plant=plant)
         return float(np.mean(np.asarray(cells["outcome"]) == CODE["converged"]))
     if name == "mfpt":
-        from walkerlab.config.studies import MfptSettings  # light
         from walkerlab.studies.mfpt import monte_carlo  # light
 
         st = scene.mfpt or MfptSettings()

@@ -30,7 +30,9 @@ from dataclasses import replace
 import numpy as np
 
 from walkerlab import progress
+from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
 from walkerlab.integrate.solver import CYRK_METHODS, available_backends
+from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.optimal.replay.phase import (
     LIMIT_N_M,
@@ -115,8 +117,6 @@ def hip_walker(data, law, push_off_n_s: float = 0.0):
     in Python (``law`` called) and, where the walker has compiled actuated flows (massive
     legs: straight or kneed, point feet), compiled with the law's block (``law.packed``,
     the same splines); without a law (None) no compiled flow."""
-    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
-    from walkerlab.models.hybrid.actuated import actuate  # light
 
     st = data.structure
     massless = bool(st.bodies) and all(b.massless for b in st.bodies)

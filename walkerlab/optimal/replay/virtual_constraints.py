@@ -38,6 +38,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+from walkerlab.models.hybrid.actuated import actuate
+from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
 from walkerlab.optimal.replay.phase import (
     LIMIT_N_M,
     PhaseLaw,
@@ -94,8 +97,6 @@ def phased_walker(data, law: PhaseLaw):
     (``law`` called) and
     compiled (its flows' law block :meth:`PhaseLaw.packed`, the same splines: the
     ``cyrk_compiled`` backend of :func:`replay_solver` runs it without a Python callback)."""
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw  # light
-    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
@@ -109,8 +110,6 @@ def rigid_actuators(data):
     """The rigid walker's actuators on
     :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (for
     :func:`phase_law`)."""
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw  # light
-    from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators  # light
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw()) for j in JOINTS])

@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.optimal.transcription.ipopt import (
     CollocatedStep,
     iteration_history,
@@ -347,10 +349,8 @@ def replay_phases(data, res: PhasedResult, solver=None):
     walker : HybridWalker
         The replayed walker.
     """
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw  # light
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
