@@ -548,6 +548,7 @@ def test_sigterm_during_a_write_leaves_no_lock_nor_temporary_file(tmp_path):
 # ------------------------------------------ 15: a full disk while the model is written
 def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(monkeypatch):
     import walkerlab.safefs as safefs
+    import walkerlab.usercache as usercache
     from walkerlab.cli.errors import _disk_full_line
     from walkerlab.codegen import cache
     from walkerlab.io.artifacts import is_disk_full
@@ -556,6 +557,7 @@ def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(
         raise OSError(errno.EFBIG, "File too large", str(path))
 
     monkeypatch.setattr(safefs, "atomic_replace", full)
+    monkeypatch.setattr(usercache, "atomic_replace", full)  # the name the cache writes by
     with pytest.raises(OSError) as exc:
         cache.import_generated("zz_never_written_nb.py", "walkerlab_zz_never", lambda: "X = 1")
     assert is_disk_full(exc.value) and "cannot write the generated module" in str(exc.value)

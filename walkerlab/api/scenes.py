@@ -127,8 +127,9 @@ def as_scene(scene) -> Scene:
 def scene_plant(scene: Scene, plant=None):
     """The plant of ``scene``, built at this front door: its walker described
     (:meth:`~walkerlab.walker.plant.Plant.from_scene`), or, given the ``plant`` a caller
-    holds (the contact view's, a walker's before a change), :meth:`~walkerlab.walker.plant.
-    Plant.with_` of it (the same walker section keeps its description).
+    holds (the contact view's, a walker's before a change), that plant's
+    :meth:`~walkerlab.walker.plant.Plant.with_` (the same walker section keeps its
+    description).
 
     Returns
     -------

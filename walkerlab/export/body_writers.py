@@ -1,7 +1,7 @@
 """The URDF and the MJCF writers over the walker's body tree: one writer object per format
 (:data:`URDF`, :data:`MJCF`), each with one method per form of tree, which
-:meth:`TreeWriter.write` picks by asking the tree (:func:`walkerlab.walker.walker_trees.
-walker_tree`) what is there, never the walker's kind:
+:meth:`TreeWriter.write` picks by asking the tree
+(:func:`walkerlab.walker.walker_trees.walker_tree`) what is there, never the walker's kind:
 
 - legs in the plane (:meth:`TreeWriter.legs`): a tree of leg links
   (:mod:`walkerlab.export.multibody`; its bodies :mod:`walkerlab.export.planar_bodies`);

@@ -32,8 +32,8 @@ def state_layout(plant: Plant) -> tuple[list[str], list[str]]:
 
 
 def build_walker(plant: Plant) -> HybridWalker:
-    """Build the rigid hybrid walker of a plant's scene (:attr:`~walkerlab.walker.plant.
-    Plant.scene`, a :class:`~walkerlab.config.Scene`).
+    """Build the rigid hybrid walker of a plant's scene (its
+    :attr:`~walkerlab.walker.plant.Plant.scene`, a :class:`~walkerlab.config.Scene`).
 
     ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
     (``ideal.variant``); ``model: biped`` is any walker described as data, derived
