@@ -301,13 +301,15 @@ def test_views_without_the_controller_refuse_it(tmp_path):
     from walkerlab.export.scene import check_exportable
     from walkerlab.models.contact.scene import contact_setup
     from walkerlab.walker.kinds import KINDS, KindRefused
+    from walkerlab.walker.walker_trees import walker_tree
 
     scene = scene_from_dict(copy.deepcopy(SCENE))
     assert contact_setup(scene, plant=Plant.from_scene(scene)).actuators.controller is not None
-    check_exportable(scene, KINDS["free_joints"], "mjcf")
+    tree = walker_tree(Plant.from_scene(scene).structure)[0]
+    check_exportable(scene, KINDS["free_joints"], "mjcf", tree=tree)
     for fmt in ("adm", "osim"):
         with pytest.raises(KindRefused) as e:
-            check_exportable(scene, KINDS["free_joints"], fmt)
+            check_exportable(scene, KINDS["free_joints"], fmt, tree=tree)
         assert one_line(e).startswith("walker.actuation.virtual_constraints: ")
     from walkerlab.stages import export
 

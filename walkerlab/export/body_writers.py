@@ -79,7 +79,7 @@ def check_legs_3d(job: ExportJob, w: Writer) -> None:
         kind.require("round_feet_3d", w.view, round_feet_3d_fields(job))
     if data.structure.hip_roll:
         kind.require("hip_roll", w.view, "walker.hip_roll")
-    check_exportable(scene, kind, w.name, job.walker_only, job.tree)  # numbers, ground
+    check_exportable(scene, kind, w.name, job.walker_only, tree=job.tree)  # numbers, ground
     if scene.walker.actuation is not None:  # passive so far: the table's reason
 
         refuse_actuators(kind, scene.walker.actuation, w.view)
@@ -110,7 +110,7 @@ class TreeWriter:
         (:func:`walkerlab.export.scene.mjcf_scene`: keyframe, terrain, contact), or
         ``(None, None)`` for the walker alone."""
         scene, mb = job.scene, tree_multibody(job.data)
-        check_exportable(scene, job.kind, w.name, job.walker_only, job.tree)
+        check_exportable(scene, job.kind, w.name, job.walker_only, tree=job.tree)
         ideal, extra = (None, None) if job.walker_only else job.gait(
             lambda ideal: mjcf_scene(scene, mb, job.plant, ideal, job.options))
         return mb, ideal, extra
@@ -122,7 +122,7 @@ class TreeWriter:
         ``(None, None)`` for the wheel alone."""
         scene = job.scene
         check_wheel_exportable(scene, job.kind, w.name, job.walker_only)
-        check_exportable(scene, job.kind, w.name, job.walker_only, job.tree)
+        check_exportable(scene, job.kind, w.name, job.walker_only, tree=job.tree)
         hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
         ideal, key = (None, None) if job.walker_only else job.gait(
             lambda ideal: wheel_keyframe(scene, job.plant, ideal))

@@ -60,9 +60,7 @@ from walkerlab.models.contact.model import ContactWalker
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.models.contact.terrain import check_ground, ground_drops, profile_line
 from walkerlab.walker.kinds import Kind
-from walkerlab.walker.plant import Plant
 from walkerlab.walker.tree import BodyTree
-from walkerlab.walker.walker_trees import walker_tree
 
 __all__ = ["FORMAT_VIEWS", "arc_roll_m", "check_exportable", "latch_note", "mjcf_scene",
            "mujoco_contact"]
@@ -72,15 +70,15 @@ FORMAT_VIEWS = {"urdf": "urdf", "mjcf": "mjcf", "adm": "adams", "osim": "osim"}
 
 
 def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
-                     walker_only: bool = False, tree: BodyTree | None = None) -> None:
+                     walker_only: bool = False, *, tree: BodyTree) -> None:
     """Refuse walkers whose numbers MuJoCo cannot represent.
 
     ``kind`` is the walker's (:attr:`walkerlab.walker.description.Structure.kind`); ``fmt``
     (``"mjcf"``, ``"urdf"``; None: any) and ``walker_only`` (no gait, contact or terrain)
     are the export's: flat feet are written to a URDF, an MJCF (the walker alone too) and
     an OpenSim model with its scene (:meth:`_LinkFeet.check_format` of the feet ``tree``
-    has, :func:`walkerlab.export.scene_feet.scene_feet`; default: the scene's walker's body
-    tree, :func:`walkerlab.walker.walker_trees.walker_tree`).
+    has, :func:`walkerlab.export.scene_feet.scene_feet`: the scene's walker's body tree,
+    :func:`walkerlab.walker.walker_trees.walker_tree`, handed down by the export's job).
 
     Raises
     ------
@@ -93,8 +91,6 @@ def check_exportable(scene: Scene, kind: Kind, fmt: str | None = None,
         ankle push-off (flat feet) is exported: motors ``leg<i>_ankle_motor`` that
         :mod:`walkerlab.export.mujoco_walk` drives.
     """
-    if tree is None:
-        tree = walker_tree(Plant.from_scene(scene).structure)[0]
     scene_feet(tree).check_format(fmt, walker_only)
     act = scene.walker.actuation
     if not walker_only and act is not None and act.virtual_constraints is not None:
