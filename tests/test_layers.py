@@ -81,24 +81,36 @@ def _tree(path: Path) -> ast.Module:
     return ast.parse(path.read_text(), filename=str(path))
 
 
-def _imports(path: Path) -> list[str]:
-    """Every module ``path`` imports, absolute (``from . import x`` resolved)."""
-    tree = _tree(path)
+def _package(path: Path) -> str:
+    """The package ``path`` lies in, dotted (``""`` for a file outside the package: the
+    rules' self-tests): what a relative import of ``path`` starts from."""
     try:
-        pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
-    except ValueError:  # a file outside the package: the rules' self-tests
-        pkg = ""
-    out = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            out += [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = pkg.split(".")[:len(pkg.split(".")) - node.level + 1]
-                base = ".".join(parts + ([base] if base else []))
-            out += [base] + [f"{base}.{a.name}" for a in node.names]
-    return out
+        return ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
+    except ValueError:
+        return ""
+
+
+def _node_imports(node, pkg: str) -> list[str]:
+    """The modules one import statement names, absolute (``from . import x`` resolved
+    from ``pkg``); [] for any other node."""
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names]
+    if not isinstance(node, ast.ImportFrom):
+        return []
+    base = node.module or ""
+    if node.level:
+        parts = pkg.split(".")[:len(pkg.split(".")) - node.level + 1]
+        base = ".".join(parts + ([base] if base else []))
+    return [base] + [f"{base}.{a.name}" for a in node.names]
+
+
+def _imports(path: Path, module_level: bool = False) -> list[str]:
+    """Every module ``path`` imports, absolute (``from . import x`` resolved); with
+    ``module_level``, only its top-level statements' (a ``TYPE_CHECKING`` block is not
+    run)."""
+    tree, pkg = _tree(path), _package(path)
+    nodes = tree.body if module_level else ast.walk(tree)
+    return [m for node in nodes for m in _node_imports(node, pkg)]
 
 
 def _modules() -> list[Path]:
@@ -713,33 +725,10 @@ HEAVY_FLOORS = ("walkerlab.plotting", "walkerlab.studies", "walkerlab.optimal",
                 "walkerlab.analysis.gait.poincare")
 
 
-def _module_level_imports(path: Path) -> list[str]:
-    """The modules ``path`` imports at module level (its top-level statements; a
-    ``TYPE_CHECKING`` block is not run)."""
-    tree = _tree(path)
-    try:
-        pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
-        if path.name == "__init__.py":
-            pkg = ".".join(path.relative_to(PKG.parent).parts[:-1])
-    except ValueError:
-        pkg = ""
-    out = []
-    for node in tree.body:
-        if isinstance(node, ast.Import):
-            out += [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = pkg.split(".")[:len(pkg.split(".")) - node.level + 1]
-                base = ".".join(parts + ([base] if base else []))
-            out += [base] + [f"{base}.{a.name}" for a in node.names]
-    return out
-
-
 def _heavy_loaded(paths: dict[str, Path]):
     """``module -> the heavy packages importing it loads`` (through module-level imports,
     transitively; a package's ``__init__`` counted where its module is imported)."""
-    tops = {m: _module_level_imports(p) for m, p in paths.items()}
+    tops = {m: _imports(p, module_level=True) for m, p in paths.items()}
     memo = {}
 
     def chain(name):
@@ -780,7 +769,7 @@ def _light_claims_without_a_heavy_package(paths: dict[str, Path]) -> list[str]:
         comments = {t.start[0]: t.string
                     for t in tokenize.generate_tokens(io.StringIO(src).readline)
                     if t.type == tokenize.COMMENT}
-        pkg = m if path.name == "__init__.py" else m.rpartition(".")[0]
+        pkg = _package(path)
         for f in ast.walk(_tree(path)):
             if not isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 continue
@@ -790,15 +779,7 @@ def _light_claims_without_a_heavy_package(paths: dict[str, Path]) -> list[str]:
                 said = " ".join(comments.get(k, "") for k in range(n.lineno, n.end_lineno + 1))
                 if "light" not in said:
                     continue
-                if isinstance(n, ast.Import):
-                    names = [a.name for a in n.names]
-                else:
-                    base = n.module or ""
-                    if n.level:
-                        parts = pkg.split(".")[:len(pkg.split(".")) - n.level + 1]
-                        base = ".".join(parts + ([base] if base else []))
-                    names = [base] + [f"{base}.{a.name}" for a in n.names]
-                names = [x for x in names if x.startswith("walkerlab")]
+                names = [x for x in _node_imports(n, pkg) if x.startswith("walkerlab")]
                 if not names:
                     continue
                 saved = set().union(*(heavy(q) for x in names for q in chain(x) if q in paths))

@@ -212,7 +212,6 @@ class PoweredLoop:
 
         import mujoco
 
-
         i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
         adr, size = int(model.text_adr[i]), int(model.text_size[i])
         self.spec = Actuation.model_validate(json.loads(
