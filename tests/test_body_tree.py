@@ -3,7 +3,8 @@
 3D compass with hip width, with and without hip-roll joints, with rod legs and round feet
 (``tests/independent/hand_3d_compass.py``: point masses summed, written out as walkerlab
 derived it before the tree), the 3D spoked wheel (``tests/independent/hand_3d_wheel.py``) and
-the planar compass gait (``symbolic.derive``), numerically at random states and parameters.
+the planar compass gait (``tests/independent/planar_link_sums.py``), numerically at random
+states and parameters.
 
 Tolerance: 1e-12 relative to the largest entry of the compared matrix - the two derivations
 are the same mechanics in different expression trees, so they differ by round-off only
@@ -22,9 +23,9 @@ import sympy as sp
 
 from tests.independent.hand_3d_compass import derive_compass
 from tests.independent.hand_3d_wheel import derive_spoked as hand_spoked
+from tests.independent.planar_link_sums import derive
 from walkerlab.codegen import derive_3d
 from walkerlab.codegen.derive_3d import derive_spoked
-from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike, kinematics
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from walkerlab.codegen.symbolic import derive
+from walkerlab.codegen.legged import derive_legged as derive
 from walkerlab.models.hybrid.printed_equations import (
     energies,
     flow,

@@ -1,11 +1,12 @@
 """A walker with locking knees in three dimensions (``model: biped``, ``space: 3d``, a knee
 with ``lock: plastic``; McGeer 1990, "Passive walking with knees"; Kuo 1999's hip width),
 derived from its body tree (:func:`walkerlab.walker.trees.legs_tree`) by
-:func:`walkerlab.codegen.derive_3d.derive_compass`, against references that share no
+:func:`walkerlab.codegen.legged.derive_legged`, against references that share no
 kinematics with that tree:
 
-- the planar kneed walker (configs/kneed.yaml, :func:`walkerlab.codegen.symbolic.derive`,
-  leg-vector sums): with zero hip width and started upright the 3D walker walks its gait;
+- the planar kneed walker (configs/kneed.yaml: the planar tree, whose equations equal the
+  leg-vector sums of ``tests/independent/planar_link_sums.py``): with zero hip width and
+  started upright the 3D walker walks its gait;
 - Pinocchio's recursive Newton-Euler algorithm on a model built here by hand (the pelvis
   welded to the stance leg, each joint's angle relative to its parent: another
   parametrisation than the tree's absolute pitches) for the flow ``M qdd + C dq + G``;

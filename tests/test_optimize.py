@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import walkerlab as wl
-from walkerlab.codegen import symbolic
+from walkerlab.codegen import legged
 from walkerlab.config import load_scene
 from walkerlab.optimal.transcription.mode_sequence import collocate_step
 from walkerlab.optimal.transcription.step import CollocationSpec, replay
@@ -42,7 +42,7 @@ def test_the_least_effort_gait_on_a_slope_is_the_passive_gait(slope):
     g, t, x = _start(scene)
     data = walker_data(scene.walker, scene.slope.phi_rad)
     # a guess off the gait: the optimiser must find its way back
-    res = collocate_step(data, symbolic.derive(data.structure), CollocationSpec(intervals=40),
+    res = collocate_step(data, legged.derive_legged(data.structure), CollocationSpec(intervals=40),
                          t, x * 1.05, np.full(t.size, 0.5))
     assert res.status == "Solve_Succeeded"
     assert res.objective <= 1e-10 and np.max(np.abs(res.u)) < 1e-5
@@ -60,7 +60,7 @@ def test_a_powered_gait_at_a_target_speed_replays_on_the_rigid_model():
     scene = load_scene(CONFIGS / "powered_compass.yaml")
     g, t, x = _start(scene)
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    res = collocate_step(data, symbolic.derive(data.structure),
+    res = collocate_step(data, legged.derive_legged(data.structure),
                          CollocationSpec(intervals=40, push_off_n_s=3.0,
                                          target_speed_m_per_s=0.55), t, x)
     assert res.status == "Solve_Succeeded"

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import walkerlab as wl
-from walkerlab.codegen import symbolic
+from walkerlab.codegen import legged
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
@@ -46,7 +46,7 @@ def test_least_effort_gait_is_drakes_compass_gait_limit_cycle():
     data = walker_data(scene.walker, scene.slope.phi_rad)
     t, x = simulated_step(build_walker(Plant.from_scene(scene)), g.x, g.step_period,
                           Solver("DOP853", 1e-12, 1e-12))
-    res = collocate_step(data, symbolic.derive(data.structure), CollocationSpec(intervals=60),
+    res = collocate_step(data, legged.derive_legged(data.structure), CollocationSpec(intervals=60),
                          t, x)
     assert res.status == "Solve_Succeeded" and res.objective <= 1e-10
     names = list(w.model.state_names())

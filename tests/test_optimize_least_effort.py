@@ -84,12 +84,12 @@ def test_arc_feet_and_a_torso_are_optimised():
     extended heel strike); a push-off on arc feet is transcribed too
     (tests/test_optimize_arc_push_off.py)."""
     pytest.importorskip("casadi")
-    from walkerlab.codegen import symbolic
+    from walkerlab.codegen import legged
     from walkerlab.optimal.transcription.step import step_functions
     from walkerlab.walker.description import walker_data
 
     for name in ("round_feet", "torso_bhm"):
         scene = load_scene(CONFIGS / f"{name}.yaml")
         data = walker_data(scene.walker, scene.slope.phi_rad)
-        fns = step_functions(data, symbolic.derive(data.structure))
+        fns = step_functions(data, legged.derive_legged(data.structure))
         assert {"flow", "reset", "guard"} <= set(fns)

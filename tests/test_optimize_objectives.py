@@ -14,7 +14,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from walkerlab.codegen import symbolic
+from walkerlab.codegen import legged
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
@@ -46,7 +46,7 @@ class _Case:
                    else wl.Walker.from_scene(self.scene).fixed_point().x)
         self.period = period_s
         self.data = walker_data(self.scene.walker, self.scene.slope.phi_rad)
-        self.eq = symbolic.derive(self.data.structure)
+        self.eq = legged.derive_legged(self.data.structure)
         self.fns = step_functions(self.data, self.eq)
         self.t, self.x = simulated_step(walker, self.x0, period_s, Solver("DOP853", 1e-12,
                                                                            1e-12))
@@ -200,7 +200,7 @@ def test_ground_reaction_balances_the_weight_at_rest():
     d["slope"] = {"angle_rad": 0.0}
     scene = wl.Walker.from_scene(d).scene
     data = walker_data(scene.walker, 0.0)
-    fns = step_functions(data, symbolic.derive(data.structure))
+    fns = step_functions(data, legged.derive_legged(data.structure))
     F = np.asarray(fns["grf"](np.zeros(4), 0.0)).ravel()
     np.testing.assert_allclose(F, [20.0 * 9.81, 0.0], atol=1e-12)
 

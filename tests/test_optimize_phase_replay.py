@@ -264,7 +264,7 @@ def test_a_powered_optimum_closes_under_the_phase_law():
     0.82 against 0.74 at the default speed).  ~2 min of CPU."""
     pytest.importorskip("casadi")
     import walkerlab as wl
-    from walkerlab.codegen import symbolic
+    from walkerlab.codegen import legged
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.replay.hip_phase import hip_phase_replays
     from walkerlab.optimal.transcription.mode_sequence import collocate_step
@@ -276,7 +276,7 @@ def test_a_powered_optimum_closes_under_the_phase_law():
     walk = w.simulate(g.x, strides=1, sample_rate_hz=2000.0)
     first = walk.stance_leg == walk.stance_leg[0]
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    res = collocate_step(data, symbolic.derive(data.structure),
+    res = collocate_step(data, legged.derive_legged(data.structure),
                          CollocationSpec(intervals=40, push_off_n_s=3.0,
                                          target_speed_m_per_s=0.55), walk.t[first],
                          walk.x[first])

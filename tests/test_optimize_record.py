@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 import walkerlab as wl
 from walkerlab.cli import app
-from walkerlab.codegen import symbolic
+from walkerlab.codegen import legged
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
 from walkerlab.optimal.outcome import history_and_energies
@@ -35,7 +35,7 @@ def powered():
     walk = w.simulate(g.x, strides=1, sample_rate_hz=2000.0)
     first = walk.stance_leg == walk.stance_leg[0]
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    res = collocate_step(data, symbolic.derive(data.structure),
+    res = collocate_step(data, legged.derive_legged(data.structure),
                          CollocationSpec(intervals=40, push_off_n_s=3.0,
                                          target_speed_m_per_s=0.55),
                          walk.t[first], walk.x[first])
@@ -92,7 +92,7 @@ def test_legs_that_differ_are_refused_in_one_line_not_optimised_as_one_step():
     mirror-image legs: with legs that differ it closed on itself with the wrong leg in
     stance every other step (and then the contact replay crashed on the scene's ``legs``).
     It is refused in one line naming the reason."""
-    from walkerlab.codegen import symbolic
+    from walkerlab.codegen import legged
 
     scene = load_scene(CONFIGS / "asymmetric_legs.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -100,7 +100,7 @@ def test_legs_that_differ_are_refused_in_one_line_not_optimised_as_one_step():
     from walkerlab.optimal.transcription.step import step_functions
 
     with pytest.raises(ValueError, match="legs that differ") as info:
-        step_functions(data, symbolic.derive(data.structure))
+        step_functions(data, legged.derive_legged(data.structure))
     assert "\n" not in str(info.value)
 
 

@@ -1,8 +1,8 @@
 """The planar walkers as body trees, the special case of the 3D biped's
 (:func:`walkerlab.walker.trees.legs_tree`: every joint a pitch about ``z``): Lagrange's
 equations derived from the tree (:func:`walkerlab.codegen.tree_derive.derive_tree`) equal
-the planar derivation's (:func:`walkerlab.codegen.symbolic.derive`, link sums of leg
-vectors, which shares no kinematics with the tree) for the shipped planar walkers' structures:
+the planar derivation by sums of leg vectors (``tests/independent/planar_link_sums.py``,
+which shares no kinematics with the tree) for the shipped planar walkers' structures:
 the mass matrix, the Coriolis and centrifugal terms, gravity, the potential, and the rates
 after the heel strike (Goswami, Thuilot & Espiau 1996; McGeer 1990 for the knee and the round
 feet; Wisse, Hobbelen & Schwab 2007 for the bisecting hip), numerically at random states and
@@ -22,10 +22,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from tests.independent.planar_link_sums import derive
 from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
 from walkerlab.codegen.foot_modes import derive_flat
 from walkerlab.codegen.free_joints import derive_five_link
-from walkerlab.codegen.symbolic import derive
 from walkerlab.codegen.tree_derive import derive_tree, kinematics, plastic_impact, simplifier
 from walkerlab.config import load_scene
 from walkerlab.walker.description import BodySpec, Structure
@@ -226,3 +226,75 @@ def test_a_flat_footed_trees_heel_contact_and_foot_flat_equal_the_foot_modes(asy
     args = list(e.q) + list(e.dq) + list(e.params)
     for what, reference, tree_value in pairs:
         _close(what, reference, tree_value, args, points)
+
+
+def _scene_numbers(name: str) -> tuple[Structure, dict]:
+    plant = Plant.from_scene(load_scene(f"configs/{name}.yaml"))
+    return plant.data.structure, dict(zip(plant.data.structure.param_names, plant.data.params))
+
+
+def _printed_pairs(e, f, dq) -> list:
+    """What the printers read of two derivations' equations, as pairs of sympy matrices
+    that must agree: the accelerations ``M^-1 (-C dq - G)`` (the rows of the massless limit
+    and of the knee lock are a convention: the solutions are the physics), the rates after
+    the heel strike, the role swap, the section, the energies, the guards, the named
+    points and leg angles, and the push-off's extended system ``De``, ``E``."""
+    def one(v):
+        return sp.Matrix([v])
+    pairs = [("accelerations", e.M.LUsolve(-(e.C * dq + e.G)), f.M.LUsolve(-(f.C * dq + f.G))),
+             ("rates after the heel strike", e.Mi.LUsolve(e.B * dq), f.Mi.LUsolve(f.B * dq)),
+             ("coordinates after the swap", e.relabel_q, f.relabel_q),
+             ("rates' swap", e.relabel_rate, f.relabel_rate),
+             ("the section's coordinate", one(e.drop_solution), one(f.drop_solution)),
+             ("kinetic energy", one(e.kinetic), one(f.kinetic)),
+             ("potential energy", one(e.potential), one(f.potential)),
+             ("De", e.De, f.De), ("E", e.E, f.E)]
+    assert set(e.guards) == set(f.guards) and set(e.points) == set(f.points)
+    assert set(e.leg_angles) == set(f.leg_angles)
+    pairs += [(f"guard {k}", one(e.guards[k]), one(f.guards[k])) for k in e.guards]
+    pairs += [(f"point {k}", e.points[k], f.points[k]) for k in e.points]
+    pairs += [(f"leg angle {k}", one(e.leg_angles[k]), one(f.leg_angles[k]))
+              for k in e.leg_angles]
+    if e.locked is not None:
+        pairs += [("locked accelerations",
+                   e.locked[0].LUsolve(-(e.locked[1] * dq + e.locked[2])),
+                   f.locked[0].LUsolve(-(f.locked[1] * dq + f.locked[2]))),
+                  ("rates after the knee strike", e.knee_impact[0].LUsolve(e.knee_impact[1] * dq),
+                   f.knee_impact[0].LUsolve(f.knee_impact[1] * dq))]
+    return pairs
+
+
+@pytest.mark.parametrize("scene", [
+    "paper",                 # the compass gait with the printed A.5's sign (appendix_a)
+    "kneed",                 # a locking knee: the locked flow and the knee strike
+    "simplest",              # Garcia et al.'s coordinates and massless legs (the limit)
+    "hip_spring",            # a torsional spring-damper between the legs
+    pytest.param("round_feet", marks=pytest.mark.slow),   # arc feet, rod legs
+    pytest.param("torso_bhm", marks=pytest.mark.slow),    # an upper body, bisecting hip
+    pytest.param("asymmetric_legs", marks=pytest.mark.slow),
+    pytest.param("paper_rods", marks=pytest.mark.slow),
+])
+def test_a_planar_walkers_printed_equations_from_its_tree_equal_the_leg_vector_sums(scene):
+    """Every field the printers read of :func:`walkerlab.codegen.legged.derive_legged` (the
+    tree's equations with the heel strike, the role swap, the section, the springs, the
+    massless limit, the knee lock and the push-off's extended system added) equals the
+    leg-vector sums' derivation (``tests/independent/planar_link_sums.py``) at random
+    states and the scene's parameters (1e-12 relative: both are exact, so they differ by
+    round-off on terms of order 1-10)."""
+    from walkerlab.codegen.legged import derive_legged
+
+    structure, numbers = _scene_numbers(scene)
+    e, f = derive(structure), derive_legged(structure)
+    assert tuple(map(str, f.q)) == tuple(map(str, e.q))
+    assert tuple(map(str, f.params)) == tuple(map(str, e.params))
+    assert (f.limit, f.section_drop, bool(f.section_tied)) == (
+        e.limit, e.section_drop, bool(e.section_tied))
+    args = list(e.q) + list(e.dq) + list(e.params)
+    rng = np.random.default_rng(sum(map(ord, scene)))
+    points = [np.concatenate([rng.uniform(-0.5, 0.5, len(e.q)), rng.uniform(-2, 2, len(e.dq)),
+                              [numbers[str(p)] for p in e.params]]) for _ in range(3)]
+    for what, reference, tree_value in _printed_pairs(e, f, sp.Matrix(e.dq)):
+        fa, fb = sp.lambdify(args, reference), sp.lambdify(args, tree_value)
+        for x in points:   # a point at the stance foot is 0: there, to 1e-12 absolute
+            a, b = np.array(fa(*x), float), np.array(fb(*x), float)
+            assert np.max(np.abs(a - b)) <= 1e-12 * max(np.max(np.abs(a)), 1.0), (what, a, b)

@@ -3,7 +3,8 @@
 against references that share no code with its generated equations:
 
 - the planar round-feet walker of ``configs/round_feet.yaml`` (``model: biped``, its own
-  generator, :mod:`walkerlab.codegen.symbolic`): the planar embedding;
+  generator, the planar tree, checked against the leg-vector sums of
+  ``tests/independent/planar_link_sums.py``): the planar embedding;
 - a model written here from Newton-Euler's laws: each leg a rigid body (its point mass and a
   slender rod's inertia), the pelvis a point mass, the velocities and accelerations
   propagated from the stance disc's centre, which moves by the no-slip condition
@@ -223,8 +224,8 @@ def walkers():
 
 @pytest.mark.slow  # ~3 s: two fixed points and their variational equations
 def test_round_feet_walker_in_3d_with_zero_hip_width_walks_as_the_planar_one(walkers):
-    """Started upright, configs/round_feet_3d.yaml is configs/round_feet.yaml (another
-    generator: the planar arc feet of walkerlab.codegen.symbolic, a rod's inertia): the same
+    """Started upright, configs/round_feet_3d.yaml is configs/round_feet.yaml (the
+    planar tree's arc feet, a rod's inertia): the same
     fixed point and step period to 1e-9 (measured 1.0e-12 and 6.5e-12: the fixed points'
     tolerance 1e-12), its planar multipliers among the 3D ones to 1e-7 (the variational
     equations' accuracy)."""

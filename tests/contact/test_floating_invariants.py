@@ -1,7 +1,7 @@
 """The rigid hybrid view and the floating (contact) view of every shipped walker with masses
 are one walker (issue 17, part 6): both are generated from the same description, by two
 different derivations (the rigid one with the stance foot pinned from the start,
-:mod:`walkerlab.codegen.symbolic`; the floating one with hip coordinates,
+:mod:`walkerlab.codegen.legged`; the floating one with hip coordinates,
 :mod:`walkerlab.codegen.floating`).
 
 Tolerances: the exact identities (pinned mass matrix, impact projections) compare the same

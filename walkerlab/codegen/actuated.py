@@ -39,7 +39,7 @@ def _defined(lines: list[str]) -> set[str]:
     return {ln.split("=", 1)[0].strip() for ln in lines if "=" in ln}
 
 
-#: The planar kneed walker's locked knee (:mod:`walkerlab.codegen.symbolic`): ``S`` spans
+#: The planar kneed walker's locked knee (:mod:`walkerlab.codegen.legged`): ``S`` spans
 #: the null space of the lock ``J_k = [-1, 1, 0]`` in ``(swing thigh, swing shank, stance)``
 #: (thigh and shank together); the locked flow's rows are ``[S^T M; J_k]``, its forces
 #: ``[S^T (B tau - C dq - G); 0]``.  Any kneed walker's (the 3D one's too) is read from its
@@ -214,7 +214,7 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
 
     Parameters
     ----------
-    eq : walkerlab.codegen.symbolic.Equations
+    eq : walkerlab.codegen.equations.Equations
     param_names : sequence of str
     joints : tuple of (str, str)
         Each actuator's (first, second) key of ``eq.leg_angles``.
@@ -291,7 +291,7 @@ def actuated_module(structure, joints):
             from walkerlab.codegen.free_joints import derive_five_link  # light
 
             eq = derive_five_link(structure)
-        else:  # a planar biped's (symbolic.derive) or a 3D walker's (derive_3d)
+        else:  # a biped's, planar or 3D (legged.derive_legged)
             eq = cache.derive_equations(structure)
         return generate_actuated(eq, structure.param_names, tuple(joints), key)
 

@@ -8,7 +8,7 @@ belongs to the current user and is not writable by group or others (else it is r
 without a private folder the code stays in memory.
 
 Key: sha256 of the walker :class:`~walkerlab.walker.description.Structure` (no numbers: a
-sweep over masses shares one file) and of the generator's own source files (``symbolic.py``,
+sweep over masses shares one file) and of the generator's own source files (``legged.py``,
 ``source.py``, ``walker/description.py``, ``cache.py``, ``link_sums.py``, ``equations.py``)
 and the sympy version, so editing the generator regenerates.  Files are written atomically
 (temporary name, then ``os.replace``; a failed write - disk full, read-only - leaves nothing
@@ -27,7 +27,8 @@ from pathlib import Path
 from walkerlab import progress, usercache
 
 ENV = usercache.ENV
-_GENERATOR_FILES = ("codegen/symbolic.py", "codegen/source.py",
+_GENERATOR_FILES = ("codegen/legged.py", "codegen/tree_derive.py", "walker/tree.py",
+                    "walker/trees.py", "codegen/seeded.py", "codegen/source.py",
                     "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
                     "codegen/equations.py", "codegen/lagrange.py",
                     "codegen/compiled_source.py", "codegen/frames.py")
@@ -132,9 +133,7 @@ def cache_key(structure) -> str:
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
     if getattr(structure, "in_3d", False):  # derived from its body tree
-        h.update(_source_hash("codegen/derive_3d.py", "codegen/frames.py",
-                              "codegen/tree_derive.py", "walker/tree.py",
-                              "walker/trees.py").encode())
+        h.update(_source_hash("codegen/derive_3d.py").encode())
     return h.hexdigest()[:24]
 
 
@@ -226,22 +225,21 @@ def _derive_module(structure, key: str, path: Path | None) -> dict:
 
 
 def derive_equations(structure):
-    """The symbolic :class:`~walkerlab.codegen.symbolic.Equations` of ``structure`` that the
+    """The symbolic :class:`~walkerlab.codegen.equations.Equations` of ``structure`` that the
     printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's
     (:mod:`walkerlab.codegen.rolling_polygon`) or a biped's
-    (:func:`walkerlab.codegen.symbolic.derive`)."""
-    if structure.in_3d:
+    (:func:`walkerlab.codegen.legged.derive_legged`)."""
+    if structure.in_3d and structure.spokes:
         from walkerlab.codegen import derive_3d  # light
 
-        return (derive_3d.derive_spoked(structure) if structure.spokes
-                else derive_3d.derive_compass(structure))
+        return derive_3d.derive_spoked(structure)
     if structure.spokes:
         from walkerlab.codegen import rolling_polygon  # light
 
         return rolling_polygon.derive(structure)
-    from walkerlab.codegen import symbolic  # light
+    from walkerlab.codegen import legged  # light
 
-    return symbolic.derive(structure)
+    return legged.derive_legged(structure)
 
 
 _imported: dict[str, object] = {}

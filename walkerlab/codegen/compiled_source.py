@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
+from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.source import (
     IND,
     PRINTER,
@@ -19,7 +20,6 @@ from walkerlab.codegen.source import (
     reset_lines,
     start_module,
 )
-from walkerlab.codegen.symbolic import Equations
 
 __all__ = ["cfunc_lines", "generate_compiled"]
 

@@ -1,6 +1,6 @@
 """The symbolic equations of a walker's rigid hybrid view (flow, impact, guards, energies,
 points, the extended impact system) as the printers of :mod:`walkerlab.codegen.source` read
-them; derived by :func:`walkerlab.codegen.symbolic.derive` (and, for a spoked wheel,
+them; derived by :func:`walkerlab.codegen.legged.derive_legged` (and, for a spoked wheel,
 :func:`walkerlab.codegen.rolling_polygon.derive`).
 """
 
@@ -34,7 +34,7 @@ class Flow:
 
 @dataclass(frozen=True)
 class Equations(Flow):
-    """Symbolic results of :func:`walkerlab.codegen.symbolic.derive` (all sympy): the
+    """Symbolic results of :func:`walkerlab.codegen.legged.derive_legged` (all sympy): the
     :class:`Flow` and
 
     Attributes

@@ -1,5 +1,5 @@
 """The floating view of a walker: the same bodies, links and feet as the rigid hybrid model
-(:mod:`walkerlab.codegen.symbolic`), with no foot pinned (what the compliant-contact model
+(:mod:`walkerlab.codegen.legged`), with no foot pinned (what the compliant-contact model
 integrates): its coordinates, contact points and symbolic equations are derived in
 :mod:`walkerlab.codegen.floating_equations` (conventions and equations there); here they
 are emitted as numba-compiled code, cached on disk through :mod:`walkerlab.codegen.cache`,

@@ -21,7 +21,7 @@ FOOT_PARAMS = ("m_foot", "I_foot")
 #: slope's normal [rad]; the rigid roles' coordinates follow, renamed by :data:`ROLES_3D`.
 FREE_3D = ("leg2_foot_x", "leg2_foot_y", "leg2_foot_z", "heading")
 #: A 3D walker's rigid roles (leg1 swinging, leg2 standing) -> its floating coordinates
-#: (:func:`walkerlab.codegen.derive_3d.derive_compass`'s: the lean is the stance leg's roll)
+#: (:func:`walkerlab.codegen.legged.derive_legged`'s: the lean is the stance leg's roll)
 ROLES_3D = {"lean": "leg2_roll", "swing": "leg1_angle", "stance": "leg2_angle",
             "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll"}
 #: A spoked wheel's free coordinates in 3D (:func:`walkerlab.walker.tree.free_root`'s slides

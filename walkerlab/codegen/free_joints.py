@@ -22,7 +22,7 @@ a)`` (world axes: x downhill, y up) and the stance foot at the origin::
 
 (``l_t`` the thigh, ``l_s = L - l_t`` the shank); straight legs (``q = (q_st, q_sw,
 q_t)``): ``hip = -L e(q_st)``, ``swing foot = hip + L e(q_sw)``.  Then, as in
-:mod:`walkerlab.codegen.symbolic` (whose helpers for sums of link vectors this module
+:mod:`walkerlab.codegen.legged` (whose helpers for sums of link vectors this module
 uses):
 
 - flow: Lagrange's equations ``M qdd + C dq + G = 0``, ``C`` from Christoffel symbols;
@@ -34,7 +34,7 @@ uses):
   (the torso keeps its angle);
 - guards: ``heel_strike`` = ``swing_clearance`` = the swing foot's height above the slope
   (straight legs: ``heel_strike = q_st + q_sw + 2 gamma``, the legs symmetric about the
-  slope's normal, as :mod:`walkerlab.codegen.symbolic`'s; their swing foot passes through
+  slope's normal, as :mod:`walkerlab.codegen.legged`'s; their swing foot passes through
   the ground at mid-stance, which the ideal model ignores), ``swing_foot_ahead`` = its
   distance ahead of the stance foot along the slope, ``hip_height``;
 - arc feet (straight legs only): the stance arc rolls (:func:`_rolling`), the impact is
@@ -52,10 +52,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.link_sums import add_mass_terms, extended_impact, position_of
-from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
 
 __all__ = ["derive_five_link", "generate_five_link"]
@@ -145,7 +145,7 @@ def _rolling(q, dq, bodies: list, point_lin: dict, P: dict, psi: dict, normal, t
     gamma) t + R n`` (its contact point rolls along the slope from the step's reference
     point), so ``M`` and the impact matrices come from plain Jacobians; the impact is about
     the swing arc's material contact point, moving at ``v_centre + R w t`` (``w`` the swing
-    leg's rate), as :mod:`walkerlab.codegen.symbolic`'s arc feet.
+    leg's rate), as :mod:`walkerlab.codegen.legged`'s arc feet.
 
     Returns
     -------

@@ -1,7 +1,7 @@
 """Points of a walker as sums of link vectors: a point is ``sum(length * e(angle))`` over
 ``{angle: length}`` (an angle a coordinate or a linear expression of them), so that velocities
 and the mass matrix come out in ``cos(a - b)`` form without a trigonometric simplifier (shared
-by the derivations of :mod:`walkerlab.codegen.symbolic`, :mod:`walkerlab.codegen.foot_modes`
+by the derivations of :mod:`walkerlab.codegen.legged`, :mod:`walkerlab.codegen.foot_modes`
 and :mod:`walkerlab.codegen.free_joints`), and the heel strike's impact in extended
 coordinates of those bodies (:func:`extended_impact`, written once for the planar
 derivations).

@@ -1,5 +1,5 @@
 """Symbolic equations of a spoked wheel rolling on its spokes' feet (``model: rimless_wheel``),
-as the :class:`~walkerlab.codegen.symbolic.Equations` every generated walker has: the
+as the :class:`~walkerlab.codegen.equations.Equations` every generated walker has: the
 printers of :mod:`walkerlab.codegen.source` turn them into the Python module and the
 compiled (numba) module like any biped's, so fixed points, simulation, basins and MFPT run
 on the wheel unchanged.
@@ -39,9 +39,9 @@ from functools import cache
 
 import sympy as sp
 
+from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.link_sums import e
-from walkerlab.codegen.symbolic import Equations
 from walkerlab.walker.description import Structure
 
 

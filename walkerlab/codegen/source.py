@@ -1,5 +1,5 @@
 """Python source of a walker's equations, generated from
-:class:`~walkerlab.codegen.symbolic.Equations`.
+:class:`~walkerlab.codegen.equations.Equations`.
 
 The generated module defines one function, ``make(p) -> dict[str, callable]``, that binds the
 parameter vector ``p`` (``Structure.param_names`` order) in closures.  The hot functions
@@ -38,7 +38,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from walkerlab.codegen.symbolic import Equations
+from walkerlab.codegen.equations import Equations
 
 PRINTER = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
 _NP = NumPyPrinter({"fully_qualified_modules": True})

@@ -33,8 +33,8 @@ no work on them, so ``J^T M_e J dq+ = J^T M_e [I; 0] dq-``:
 
     Mi = M - A F - F^T A^T + m F^T F,        B = M - F^T A^T.
 
-The planar generators' ``Mi, B`` (:mod:`walkerlab.codegen.symbolic`, ``add_mass_terms``) and
-the 3D compass's (:func:`walkerlab.codegen.derive_3d.derive_compass`) are this formula on
+The planar generators' ``Mi, B`` (:mod:`walkerlab.codegen.legged`, ``add_mass_terms``) and
+the 3D compass's (:func:`walkerlab.codegen.legged.derive_legged`) are this formula on
 their own bodies.
 """
 

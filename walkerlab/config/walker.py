@@ -47,7 +47,7 @@ class HipRollLaw(Strict):
     torque law, a lateral foot-placement controller (Kuo 1999, "Stabilization of lateral
     motion in passive dynamic walking", IJRR 18(9)): each leg hangs from the pelvis on a
     roll joint (about the fall line) below its pitch hinge, so the pelvis and each leg roll
-    on their own (:func:`walkerlab.codegen.derive_3d.derive_compass`).
+    on their own (:func:`walkerlab.codegen.legged.derive_legged`).
 
     With ``phi`` the stance leg's roll (the lean), ``phi_p`` the pelvis', ``phi_w`` the
     swing leg's (rad, about the fall line):
@@ -60,7 +60,7 @@ class HipRollLaw(Strict):
 
     The law is odd in the rolls, so the mirror step (the swing hip on the other side) runs
     the same law.  ``pelvis_roll_inertia_kg_m2`` is the pelvis' own inertia in roll (its
-    pitch and yaw are held: :func:`walkerlab.codegen.derive_3d.derive_compass`): without one
+    pitch and yaw are held: :func:`walkerlab.codegen.legged.derive_legged`): without one
     the impact sets the light pelvis rolling so fast that the old stance foot is driven into
     the ground (``configs/hip_width_stabilised.yaml``'s gait at 0 kg m^2: -0.10 m/s).
     """
@@ -148,7 +148,7 @@ class CompassGaitParams(_Actuated):
             # leaning its centre of mass over the stance foot, tan(lean) ~ w / (2 L) (the
             # pelvis midway between the hips), lifts the swing foot w tan(lean) = w^2 / (2 L)
             # off the slope, and legs of length L reach down at most 2 L (the heel-strike
-            # surface, walkerlab.codegen.derive_3d.derive_compass): w < 2 L
+            # surface, walkerlab.codegen.legged.derive_legged): w < 2 L
             raise ValueError(f"walker.hip_width_m: {self.hip_width_m:g} m on legs of "
                              f"{self.leg_length_m:g} m: hips twice the leg length apart or "
                              "more cannot stand on one leg and reach the slope with the "
@@ -185,7 +185,7 @@ class CompassGaitParams(_Actuated):
                else {"actuation": self.actuation.model_dump(mode="json")})})
 class BipedParams(_Actuated):
     """A planar passive biped described as data (``model: biped``); its equations of motion,
-    guards and impact are derived symbolically (:mod:`walkerlab.codegen.symbolic`).
+    guards and impact are derived symbolically (:mod:`walkerlab.codegen.legged`).
 
     Give ``leg`` (both legs identical, the shorthand) or ``legs`` (a pair: ``leg1``, which
     starts as the swing leg, then ``leg2``; same length, foot and body names, the numbers

@@ -1,5 +1,5 @@
 """A straight-legged walker in three dimensions (``walker.space: 3d``;
-:func:`walkerlab.codegen.derive_3d.derive_compass`) as an MSC Adams Solver dataset
+:func:`walkerlab.codegen.legged.derive_legged`) as an MSC Adams Solver dataset
 (``walker.adm``) and command file (``walker.acf``), started from the rigid gait.
 
 Statements are the planar dataset's (:mod:`walkerlab.export.adams`; Adams Solver statement

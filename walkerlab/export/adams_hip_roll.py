@@ -1,6 +1,6 @@
 """The hip-roll law of a 3D walker's Adams dataset (``walker.hip_roll``;
 :mod:`walkerlab.export.adams_3d`): the rigid model's law
-(:func:`walkerlab.codegen.derive_3d.derive_compass`), as the MJCF's stepping loop runs it
+(:func:`walkerlab.codegen.legged.derive_legged`), as the MJCF's stepping loop runs it
 (:class:`walkerlab.export.mujoco_walk.HipRollLoop`), written as ``VARIABLE`` expressions of
 Adams runtime functions and one ``GFORCE`` per leg.
 

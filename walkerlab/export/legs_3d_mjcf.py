@@ -1,5 +1,5 @@
 """A straight-legged walker in three dimensions (``model: compass_gait`` with ``space: 3d``;
-:func:`walkerlab.codegen.derive_3d.derive_compass`) as a MuJoCo model (MJCF) that walks from
+:func:`walkerlab.codegen.legged.derive_legged`) as a MuJoCo model (MJCF) that walks from
 the rigid gait.
 
 The walker is the URDF's (:func:`walkerlab.export.urdf.legs_urdf_text`): a
@@ -49,7 +49,7 @@ the tree's straight-leg stop ``[-pi, 0]``; with the gait the planar kneed MJCF's
 (:func:`walkerlab.export.multibody.latch_equality_lines`), listed as left out.
 
 Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates,
-:func:`walkerlab.codegen.derive_3d.derive_compass`): each leg hangs on a hinge
+:func:`walkerlab.codegen.legged.derive_legged`): each leg hangs on a hinge
 ``leg<i>_roll`` about the fall line (the pelvis' frame: ``cos phi, 0, -sin phi``) before its
 ``leg<i>_hip`` (MuJoCo composes a body's joints in order: ``pelvis Rot(s, d) Rot(z, theta)``,
 the rigid leg's ``Rot(s, phi_leg) Rot(z, theta)`` with ``d = phi_leg - phi_p``).  The rigid
@@ -72,7 +72,7 @@ the torque pair ``+tau`` on ``leg<sw>_hip``, ``-tau`` on ``leg<st>_hip`` does th
 model's virtual work ``tau delta(theta_sw - theta_st)``; the push-off acts along the
 trailing leg from its foot to its own hip (the anchor of its hinge ``leg<i>_hip``).
 
-Round feet (``walker.foot_radius_m``: :func:`walkerlab.codegen.derive_3d.derive_compass`'s
+Round feet (``walker.foot_radius_m``: :func:`walkerlab.codegen.legged.derive_legged`'s
 disc in each leg's rolled sagittal plane, its centre on the leg ``L - R`` from the hip,
 rolling without slip): each leg's foot geom ``leg<i>_foot`` is that disc, a MuJoCo
 ``cylinder`` of radius ``R`` and half-height :data:`DISC_HALF_THICKNESS_L` ``L`` whose axis

@@ -362,7 +362,7 @@ class PoweredLoop:
 class HipRollLoop:
     """The hip-roll law of a 3D walker's MJCF (custom text ``walkerlab_hip_roll``: the
     scene's :class:`walkerlab.config.walker.HipRollLaw`), the rigid model's
-    (:func:`walkerlab.codegen.derive_3d.derive_compass`) on MuJoCo's state: before every
+    (:func:`walkerlab.codegen.legged.derive_legged`) on MuJoCo's state: before every
     MuJoCo step each body's roll about the fall line ``s`` is read from its pitch axis
     ``a`` (the body's ``0 -1 0``, walkerlab's ``Rot(s, phi) z``):
     ``phi = atan2(-a . n, a . z_w)`` (``n`` the slope's normal, ``z_w`` walkerlab's z), its

@@ -24,7 +24,7 @@ __all__ = ["ROLL_JOINTS", "joint_angles", "joint_columns", "joint_links", "link_
 #: The hip-roll joints of a 3D walker with them (``walker.hip_roll``): each leg hangs from
 #: the pelvis on a roll joint, its angle the leg's roll minus the pelvis' (the generated
 #: ``leg_angles``' ``pelvis_roll``, ``stance_roll``, ``swing_roll``; the hip-roll law's
-#: ``d_st``, ``d_sw``: :func:`walkerlab.codegen.derive_3d.hip_roll_forces`), ``+tau`` on the
+#: ``d_st``, ``d_sw``: :func:`walkerlab.codegen.legged.hip_roll_forces`), ``+tau`` on the
 #: leg and ``-tau`` on the pelvis.  Not a scene's torque joints (the scene's law at them is
 #: ``walker.hip_roll``): the Gymnasium environment's action drives them besides the hip.
 ROLL_JOINTS = {"stance_hip_roll": ("pelvis_roll", "stance_roll"),

@@ -1,11 +1,11 @@
 """The walkers as body trees (:mod:`walkerlab.walker.tree`): a biped from its parts
 (:func:`biped_tree`, :func:`legs_tree`) in three dimensions (Kuo 1999, "Stabilization of
 lateral motion in passive dynamic walking", IJRR 18(9)), which production derives
-(:func:`walkerlab.codegen.derive_3d.derive_compass`) for the ``compass_gait`` shorthand and
+(:func:`walkerlab.codegen.legged.derive_legged`) for the ``compass_gait`` shorthand and
 for a biped from parts alike, and in the plane, its special case (every joint a pitch about
 ``z``: no ankle or hip roll, no hip width; with a knee on the swing leg, legs that differ,
 round feet, an upper body on the bisecting hip), held to the planar derivation
-(:func:`walkerlab.codegen.symbolic.derive`) by the tests; and the 3D spoked wheel
+(:func:`walkerlab.codegen.legged.derive_legged`) by the tests; and the 3D spoked wheel
 (:func:`spoked_wheel_3d_tree`).
 
 The 3D tree, from the stance foot (the root, in the slope's frame):
@@ -451,7 +451,7 @@ def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
     return biped_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
 
 
-def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
+def legs_tree(structure, massless_mass: str | None = None) -> tuple[BodyTree, CoordinateMap]:
     """The tree of a biped's structure (:class:`walkerlab.walker.description.Structure`,
     legs without spokes), planar or in 3D (:func:`biped_tree`): a biped from parts (each leg
     body ``m_<name>, d_<name>[, I_<name>][, e_<name>]`` (legs that differ: ``m_sw_<name>``,
@@ -464,6 +464,14 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     (free knees, a hinged torso: ``free_joints``) with its stance knee and its torso's
     coordinate.
 
+    Parameters
+    ----------
+    structure : walkerlab.walker.description.Structure
+    massless_mass : str or None
+        The name of a symbolic mass every massless body carries, appended to the tree's
+        parameters: the derivation's massless limit (Garcia et al. 1998,
+        :mod:`walkerlab.codegen.legged`) takes it to 0.  None: a massless body is refused.
+
     Returns
     -------
     BodyTree, CoordinateMap
@@ -471,20 +479,22 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
     Raises
     ------
     ValueError
-        A part a tree does not carry yet, naming its field: a massless body (the mass -> 0
-        limit, Garcia et al. 1998), spokes.
+        A part a tree does not carry yet, naming its field: a massless body without
+        ``massless_mass`` (the mass -> 0 limit, Garcia et al. 1998), spokes.
     """
     planar = not structure.in_3d
+    some_massless = any(b.massless for b in structure.bodies)
     if planar:
         if structure.spokes:
             raise ValueError("walker.spokes: a body tree of this walker is not built yet")
-        if any(b.massless for b in structure.bodies):
+        if some_massless and massless_mass is None:
             raise ValueError("walker.leg.bodies: a massless body is the mass -> 0 limit of "
                              "the equations (Garcia et al. 1998), not a body of a tree")
     if structure.parts_3d or planar:
         def leg(role):
             tag = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
-            return tuple(Part(b.name, f"m_{tag}{b.name}", f"d_{tag}{b.name}",
+            return tuple(Part(b.name, massless_mass if b.massless else f"m_{tag}{b.name}",
+                              f"d_{tag}{b.name}",
                               f"I_{tag}{b.name}" if b.kind == "rod" else None,
                               f"e_{tag}{b.name}" if b.off_axis else None, b.link)
                          for b in structure.bodies)
@@ -497,7 +507,8 @@ def legs_tree(structure) -> tuple[BodyTree, CoordinateMap]:
         legs = (Part(structure.bodies[0].name, "m_leg", "L - a_leg",
                      "I_leg" if structure.bodies[0].kind == "rod" else None),)
         swing, torso = None, ()
-    return biped_tree(structure.param_names, legs, torso, planar=planar, swing_legs=swing,
+    params = structure.param_names + ((massless_mass,) if some_massless else ())
+    return biped_tree(params, legs, torso, planar=planar, swing_legs=swing,
                       thigh="L_thigh" if structure.knee else None,
                       knee_stop=structure.knee and not structure.free_knees,
                       hip_mass=structure.hip_mass,

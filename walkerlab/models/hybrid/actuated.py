@@ -298,7 +298,7 @@ class _FreeJoints(_Joints):
 
 
 class _Legs3d(_Joints):
-    """Straight legs in 3D (:func:`walkerlab.codegen.derive_3d.derive_compass`): the hip
+    """Straight legs in 3D (:func:`walkerlab.codegen.legged.derive_legged`): the hip
     torque between the legs' pitch joints and the push-off along the trailing leg, by the
     planar walkers' :class:`Actuators`.  Each leg's pitch ``theta`` is its rotation about
     its own (rolled) hip axis, ``R_leg = Rot(s, phi_leg) Rot(z, theta)``, from the

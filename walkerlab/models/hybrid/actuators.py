@@ -90,7 +90,7 @@ class Actuators:
     torso_mean: bool = False
 
     #: legs with some massless bodies: the generated equations' rows are link-angle rows
-    #: (:mod:`walkerlab.codegen.symbolic`'s massless limit), the force mapped into them
+    #: (:mod:`walkerlab.codegen.legged`'s massless limit), the force mapped into them
     #: (:meth:`link_rows`)
     some_massless: bool = False
 
@@ -122,7 +122,7 @@ class Actuators:
         """The map ``L`` (n, n) of a generalised force ``F`` in ``q``'s rows into the
         generated equations' rows on legs with some massless bodies, ``M_gen qdd + ... =
         L F``.  The generated rows are link-angle rows, each at its massless limit
-        (:mod:`walkerlab.codegen.symbolic`, Garcia et al. 1998): a link that moves massive
+        (:mod:`walkerlab.codegen.legged`, Garcia et al. 1998): a link that moves massive
         bodies keeps its row's value at ``m = 0``, ``(A^-T F)_k`` (``A = dpsi/dq``); a link
         that moves only massless bodies has its row divided by the vanishing mass, where a
         finite torque would give an infinite angular acceleration.  With ``M_q`` the
@@ -274,7 +274,7 @@ class Actuators:
         ``a = constraint(x)`` (n,) (a locked knee), the constrained system's
         ``M^-1 (B tau + a lam)`` with ``a . qdd = 0`` (the lock's share: ``lam = -a M^-1
         B tau / (a M^-1 a)``; the same as ``[S^T M; a] qdd = [S^T B tau; 0]``, ``S`` a
-        basis of the constraint's null space, :mod:`walkerlab.codegen.symbolic`).  ``M``
+        basis of the constraint's null space, :mod:`walkerlab.codegen.legged`).  ``M``
         (n, n): the mass matrix of the phase (default: the generated ``matrices``')."""
         M = self.fns["matrices"](x)[0] if M is None else M
         acc = np.linalg.solve(M, self.generalised_force(t, x))

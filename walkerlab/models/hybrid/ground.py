@@ -3,7 +3,7 @@ above) the stance foot's level (stairs, footholds).
 
 The generated model of every point- or arc-footed biped has the swing foot's clearance above
 the slope line through the stance foot (``guard_swing_clearance``: its lowest point's
-distance along the slope's normal, :mod:`walkerlab.codegen.symbolic`; the free-jointed
+distance along the slope's normal, :mod:`walkerlab.codegen.legged`; the free-jointed
 biped's and the spoked wheel's generated models have it too).  A landing ``drop_m`` [m]
 below that line (a stair ``riser_m`` down; negative: up) is the same guard plus a constant,
 

@@ -16,7 +16,7 @@ Three pure pieces (as in Drake's ``examples/compass_gait``):
 
 The ``derived`` equations are not written here: the compass gait is the generic biped of
 :mod:`walkerlab.walker.description` (hip point mass, one point mass per leg) and its code is
-generated and cached (:mod:`walkerlab.codegen.symbolic`, :mod:`walkerlab.codegen.source`).
+generated and cached (:mod:`walkerlab.codegen.legged`, :mod:`walkerlab.codegen.source`).
 This module keeps the paper's *printed* equations (Appendix A) for comparison.
 
 Equation variants

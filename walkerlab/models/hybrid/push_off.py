@@ -12,7 +12,7 @@ heel strike pins the leading foot.  The contact point is
   (:class:`walkerlab.models.hybrid.toe_push_off.FlatPushOff`).
 
 Point and arc feet share one form.  In the extended coordinates ``qe = (q, x_f, y_f)`` (the
-stance foot free, :func:`walkerlab.codegen.symbolic.derive`'s ``De, E``: ``De`` the mass
+stance foot free, :func:`walkerlab.codegen.legged.derive_legged`'s ``De, E``: ``De`` the mass
 matrix, ``E`` the leading foot's material contact point's Jacobian) the trailing contact's
 material point moves at ``(dx_f, dy_f)`` (for an arc the rolling offset's rate cancels its
 spin about its centre), so ``E_f = [0 | I]`` and::

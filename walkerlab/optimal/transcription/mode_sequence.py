@@ -401,7 +401,7 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
     ----------
     data : WalkerData
     eq : Equations or None
-        ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
+        ``walkerlab.codegen.legged.derive_legged(data.structure)`` (unused when ``fns`` is
         given, e.g. by :func:`walkerlab.optimal.transcription.step_cache.
         cached_step_functions`).
     spec : walkerlab.optimal.transcription.step.CollocationSpec

@@ -18,7 +18,7 @@ passive gait of configs/flat_feet.yaml): ``heel_contact:early_swing`` until ``fo
 ``heel_off:late_swing`` until ``heel_strike`` (the toe-pinned map).
 
 Each phase's flow, guard and reset in CasADi come from the walker's symbolic equations
-(:func:`walkerlab.codegen.symbolic.derive`, :func:`walkerlab.codegen.foot_modes.derive_flat`:
+(:func:`walkerlab.codegen.legged.derive_legged`, :func:`walkerlab.codegen.foot_modes.derive_flat`:
 the ones its generated code is printed from): a free flow ``M qdd = B u - C dq - G``; a
 locked one (knee, flat foot) as the square system ``[S^T M; J] qdd = [S^T (-C dq - G); 0]``
 with the hip torque's acceleration projected on the lock (``M^-1 (B u + a lam)``,
@@ -285,9 +285,9 @@ class _KneedModes(_Modes):
     (the plain impact: the rigid kneed model's push-off is not transcribed)."""
 
     def __init__(self, data):
-        from walkerlab.codegen import symbolic  # light
+        from walkerlab.codegen import legged  # light
 
-        eq = symbolic.derive(data.structure)
+        eq = legged.derive_legged(data.structure)
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
         self.eq, self.guards = eq, eq.guards
 

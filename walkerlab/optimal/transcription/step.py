@@ -10,7 +10,7 @@ direct collocation", SIAM Review 59(4):849-904, Sec. 4, separated Hermite-Simpso
     x_m = (x_i + x_j) / 2 + h (f_i - f_j) / 8,      x_j = x_i + h (f_i + 4 f_m + f_j) / 6
 
 with ``f = [dq, M(q)^-1 (B u - C(q, dq) dq - G(q))]`` from the walker's generated symbolic
-equations (:func:`walkerlab.codegen.symbolic.derive`, paper Eq. 3 with ``B u``; ``B`` the
+equations (:func:`walkerlab.codegen.legged.derive_legged`, paper Eq. 3 with ``B u``; ``B`` the
 hip angle's gradient, so ``+u`` acts on the swing leg and ``-u`` on the stance leg as in
 :mod:`walkerlab.models.actuation`).  The end is a heel strike (the generated guard = 0, the
 swing foot ahead); the step's start is the end mapped by push-off + heel strike + role swap
@@ -171,7 +171,7 @@ def step_functions(data, eq):
     ``power(x, u)`` (the hip torque's power [W]) and ``grf(x, u)`` (the stance foot's
     ground reaction along the slope's normal and tangent, forward positive [N]).
 
-    On massless legs (the limit ``m_foot -> 0``, :mod:`walkerlab.codegen.symbolic`) ``u``
+    On massless legs (the limit ``m_foot -> 0``, :mod:`walkerlab.codegen.legged`) ``u``
     is the torque per foot mass acting on the swing leg's row only and doing no work, and
     the transition is the point hip's (Kuo 2002, as :mod:`walkerlab.models.hybrid.actuated`).
 

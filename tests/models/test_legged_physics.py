@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 
 from walkerlab.codegen.cache import functions
-from walkerlab.codegen.symbolic import derive
+from walkerlab.codegen.legged import derive_legged as derive
 from walkerlab.walker.description import BodySpec, Structure, WalkerData
 
 COMPASS = Structure("absolute", (BodySpec("mass", "point_mass"),))

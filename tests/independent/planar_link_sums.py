@@ -1,4 +1,7 @@
-"""Generic symbolic derivation of a planar biped from its :class:`Structure` (sympy).
+"""An independent reference for the planar bipeds' equations: their derivation by sums of
+leg vectors (``e(psi) = (sin psi, -cos psi)``, no body tree, no frames), which printed the
+planar walkers before :mod:`walkerlab.codegen.legged` derived them from the tree; the tests
+compare the two (``tests/test_planar_trees.py``).
 
 Nothing here is specific to one walker: positions of all bodies follow from the leg angles,
 then
