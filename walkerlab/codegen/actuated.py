@@ -287,12 +287,7 @@ def actuated_module(structure, joints):
     tag = hashlib.sha256(f"{joints!r}{_source_hash()}".encode()).hexdigest()[:12]
 
     def build() -> str:
-        if structure.kind.joints_free:
-            from walkerlab.codegen.free_joints import derive_five_link  # light
-
-            eq = derive_five_link(structure)
-        else:  # a biped's, planar or 3D (legged.derive_legged)
-            eq = cache.derive_equations(structure)
+        eq = cache.derive_equations(structure)   # a biped's, planar or 3D
         return generate_actuated(eq, structure.param_names, tuple(joints), key)
 
     return cache.import_generated(f"{key}_act_{tag}_nb.py", f"walkerlab_actuated_{key}_{tag}",

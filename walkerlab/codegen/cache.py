@@ -102,25 +102,11 @@ def _spoked_generator_hash() -> str:
                           ).hexdigest()
 
 
-@cache
-def _five_link_generator_hash() -> str:
-    """sha256 of the free-jointed (five-link) generator's source (once per process)."""
-    return hashlib.sha256((Path(__file__).parent / "free_joints.py").read_bytes()).hexdigest()
-
-
-def _free_jointed(structure) -> bool:
-    """Whether :mod:`walkerlab.codegen.free_joints` derives the walker (the free-jointed
-    kinds, :attr:`walkerlab.walker.kinds.Kind.joints_free`: free knees, and a hinged torso
-    on straight legs)."""
-    return structure.kind.joints_free
-
-
 def cache_key(structure) -> str:
     """Cache key (hex, 24 characters) of a structure for the current generator (a
     flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes` (with
     :mod:`~walkerlab.codegen.double_support` and :mod:`~walkerlab.codegen.push_off`), a
-    free-jointed one's (free knees or a hinged torso) :mod:`walkerlab.codegen.free_joints`,
-    a spoked wheel's
+    spoked wheel's
     :mod:`walkerlab.codegen.rolling_polygon`, a 3D walker's its derivation from its body tree
     (:mod:`walkerlab.codegen.derive_3d`, :mod:`~walkerlab.codegen.tree_derive`,
     :mod:`walkerlab.walker.trees`), which no other structure's key reads)."""
@@ -128,8 +114,6 @@ def cache_key(structure) -> str:
     h.update(_generator_hash().encode())
     if structure.foot == "flat":
         h.update(_flat_generator_hash().encode())
-    if _free_jointed(structure):
-        h.update(_five_link_generator_hash().encode())
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
     if getattr(structure, "in_3d", False):  # derived from its body tree
@@ -203,13 +187,6 @@ def _derive_module(structure, key: str, path: Path | None) -> dict:
         from walkerlab.codegen import foot_modes as flatfoot  # light
 
         body = flatfoot.generate_flat(structure, key)
-        ns = _exec(body, str(path or f"<walkerlab model {key}>"))
-        if path is not None:
-            write_source(path, body)
-    if ns is None and _free_jointed(structure):
-        from walkerlab.codegen import free_joints as five_link  # light
-
-        body = five_link.generate_five_link(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)

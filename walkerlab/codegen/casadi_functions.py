@@ -2,7 +2,7 @@
 
 One printer (:func:`casadi_matrix`, :func:`casadi_function`) turns the sympy expressions
 of :mod:`walkerlab.codegen.legged`, :mod:`walkerlab.codegen.foot_modes` and
-:mod:`walkerlab.codegen.free_joints` (the derivation the generated numeric code is printed
+:mod:`walkerlab.codegen.legged` (the derivation the generated numeric code is printed
 from) into CasADi SX expressions, for every transcription of ``walkerlab optimize``.  One
 cache (:func:`cached_functions`) stores the CasADi functions built from them as
 ``<user cache>/models/<key>.casadi`` through :mod:`walkerlab.codegen.cache` (its private

@@ -14,7 +14,7 @@ vertical, positive when the foot is ahead of the hip.  A torso hinged at the hip
 five-link biped of Westervelt, Grizzle & Koditschek 2003: free knees, ``torso.coupling:
 hinged``) adds its own coordinate ``torso_angle`` last (from the upward vertical, positive
 leaning back, as the rigid view's); its free knees have no stop (as in the rigid view,
-:mod:`walkerlab.codegen.free_joints`); a bisecting torso is eliminated (its angle the mean of
+:mod:`walkerlab.codegen.legged`); a bisecting torso is eliminated (its angle the mean of
 the legs').  A point at distance ``d`` along a link
 at angle ``psi`` from the link's proximal joint is at ``joint + d (sin psi, -cos psi)``.
 

@@ -117,7 +117,7 @@ class FloatingEquations:
     knees : tuple of (int, int)
         Per leg with a knee stop, the indices in ``q`` of its thigh and shank angles (by
         their names); empty for straight legs and for free knees (``knee.lock: free``: no
-        stop, as in the rigid view, :mod:`walkerlab.codegen.free_joints`).
+        stop, as in the rigid view, :mod:`walkerlab.codegen.legged`).
     contacts : tuple of str
         Names of the contact points, in the order of ``feet`` (:func:`contact_names`).
     point_legs : tuple of int

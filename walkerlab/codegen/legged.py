@@ -24,6 +24,8 @@ What a tree does not carry, added here on top of Lagrange's equations:
   ``A = d psi / dq`` constant) each row either keeps its value at ``beta = 0`` or, where it
   vanishes there (a link that moves massless bodies only), is replaced by its coefficient of
   ``beta``: the exact limit ``beta -> 0`` (Garcia et al.'s Eq. 2-4), swing row first;
+- **the heel strike of a free-jointed biped** (free knees, a hinged torso; Westervelt,
+  Grizzle & Koditschek 2003): its guards, section and virtual legs (:func:`derive_legged`);
 - **the locking knee** (McGeer 1990, "Passive walking with knees", ICRA): the square systems
   of :func:`walkerlab.codegen.lagrange.knee_lock`;
 - **the extended impact system** of a push-off (the stance foot free: paper Eq. 6-7;
@@ -52,7 +54,12 @@ from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
 from walkerlab.codegen.lagrange import knee_lock
 from walkerlab.codegen.seeded import seeded
-from walkerlab.codegen.tree_derive import derive_tree, plastic_impact, simplifier
+from walkerlab.codegen.tree_derive import (
+    derive_tree,
+    impact_of_bodies,
+    plastic_impact,
+    simplifier,
+)
 from walkerlab.walker.trees import legs_tree
 
 __all__ = ["BETA", "SECTION_DROP", "derive_legged", "extended_impact", "hip_roll_forces"]
@@ -150,6 +157,8 @@ def _pitches(structure, q, gamma) -> tuple:
     roles = structure.roles
     at = {r: q[i] for i, r in enumerate(roles)}
     lean = at.get("lean", 0)
+    if structure.kind.joints_free and structure.knee:   # the stance leg's thigh
+        return at["swing_thigh"], at["swing_shank"], at["stance_thigh"], lean
     if structure.coordinates == "slope_relative":   # Garcia et al.: theta, phi between legs
         theta, phi = at["stance"], at["hip"]
         return theta - phi - gamma, theta - phi - gamma, theta - gamma, lean
@@ -177,11 +186,67 @@ def _springs(structure, q, P, pitches) -> tuple[sp.Expr, sp.Matrix]:
     return V, D
 
 
-def _link(body, role: str, knee: bool) -> str:
+def _link(body, role: str, knee: bool, free: bool) -> str:
     """The link of the tree (:func:`walkerlab.walker.trees.biped_tree`) a leg body is welded
-    to in ``role``: the swing shank's parts on ``shank``, every other on ``leg`` (the
-    stance leg is straight)."""
-    return "shank" if knee and role == "swing" and body.link == "shank" else "leg"
+    to in ``role``: a shank's parts on ``shank`` (the stance shank's only on free knees),
+    every other on ``leg`` (a locking knee's stance leg is straight)."""
+    return ("shank" if knee and body.link == "shank" and (role == "swing" or free)
+            else "leg")
+
+
+def _check_free(structure) -> None:
+    """A free-jointed biped (free knees, or straight legs under a hinged torso; Westervelt,
+    Grizzle & Koditschek 2003; Grizzle, Abba & Plestan 2001) as the tree's free joints
+    carry it (one line otherwise)."""
+    straight = structure.hinged_torso and not structure.knee
+    arc_ok = straight and structure.foot == "arc"
+    if ((structure.foot != "point" and not arc_ok) or structure.asymmetric or structure.springs
+            or structure.knee_spring or any(b.off_axis or b.massless for b in structure.bodies)
+            or any(b.off_axis for b in structure.torso)
+            or (structure.torso and not structure.hinged_torso)):
+        raise ValueError("walker.leg.knee.lock: free knees need identical legs with point "
+                         "feet, massive bodies on the link axes, no springs and a hinged "
+                         "torso (if any) today")
+
+
+def _free_step(structure, q, P, points: dict, gamma) -> dict:
+    """A free-jointed biped's heel strike (:func:`derive_legged`): the legs swap, the torso
+    keeps its angle; the guards (the swing foot's height, its distance ahead along the
+    slope; straight legs strike when they are symmetric about the slope's normal, their
+    swing foot passing through the ground at mid-stance as the compass gait's, Goswami et
+    al. 1996); the section (the new swing foot behind on the ground: free knees solve the
+    swing shank's angle, ``-acos(..) - gamma``); and the leg angles (every link's, and the
+    virtual legs' from the hip to each foot, written with ``atan``: complex-safe for the
+    torque laws' complex steps, exact while the hip is above the feet).  ``points`` are in
+    the slope's frame."""
+    psi = dict(zip(structure.roles, q))
+    arc = structure.foot == "arc"
+    foot, hip = points["swing_foot"], points["hip"]
+    clearance = (points["swing_contact"] if arc else foot)[1]
+    if structure.knee:
+        ss, st, wt, ws = (psi[r] for r in structure.roles[:4])
+        lt, ls = P["L_thigh"], P["L"] - P["L_thigh"]
+        relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])   # the torso keeps its angle
+        reach = (ls * sp.cos(ss + gamma) + lt * sp.cos(st + gamma)
+                 - lt * sp.cos(wt + gamma)) / ls
+        drop, drop_solution, strike = 3, -sp.acos(reach) - gamma, clearance
+    else:
+        st, ws = psi["stance"], psi["swing"]
+        relabel_q = sp.Matrix([ws, st, q[2]])
+        drop, drop_solution, strike = 1, -st - 2 * gamma, st + ws + 2 * gamma
+    ahead = (points["swing_contact"] - points["stance_contact"]) if arc else foot
+    return {"relabel_q": relabel_q, "section_drop": drop, "drop_solution": drop_solution,
+            "guards": {"heel_strike": strike, "swing_foot_ahead": ahead[0],
+                       "hip_height": hip[1], "swing_clearance": clearance}}
+
+
+def _virtual_legs(hip, foot, q, roles) -> dict:
+    """A free-jointed biped's ``leg_angles``: the stance leg's (stance foot to ``hip``) and
+    the swing leg's (``hip`` to swing ``foot``) angle from the world's vertical [rad] (world
+    points (2, 1)), and every coordinate by its role."""
+    return {"stance": sp.atan(-hip[0] / hip[1]),
+            "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
+            **dict(zip(roles, q))}
 
 
 def _planar_swap(structure, q, pitches, gamma) -> tuple[sp.Matrix, sp.Expr]:
@@ -242,11 +307,21 @@ def derive_legged(structure) -> Equations:
     thigh``; after heel strike the new swing knee is straight and the section ties the
     shank's angle and rate to the thigh's.
 
+    Free joints (``structure.kind.joints_free``, planar): free knees on both legs (the
+    five-link biped of Westervelt, Grizzle & Koditschek 2003, "Hybrid zero dynamics of
+    planar biped walkers", IEEE TAC 48(1); RABBIT) and a torso hinged at the hip with its
+    own coordinate, or two straight legs under a hinged torso (the three-link walker of
+    Grizzle, Abba & Plestan 2001, IEEE TAC 46(1)); every coordinate a link's absolute angle
+    (``stance_shank, stance_thigh, swing_thigh, swing_shank[, torso]`` or ``stance, swing,
+    torso``).  The heel strike: the swing foot's height through 0 (straight legs: the legs
+    symmetric about the slope's normal); the section solves the swing shank's angle
+    (``-acos(..) - gamma``); the leg angles add the virtual legs from the hip to each foot.
+
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
-        A biped (no spokes, no flat feet; a planar one not free-jointed: those are
-        :mod:`walkerlab.codegen.foot_modes`' and :mod:`walkerlab.codegen.free_joints`').
+        A biped (no spokes; no flat feet: :mod:`walkerlab.codegen.foot_modes`'), its joints
+        locking or free (``structure.kind.joints_free``: free knees, a hinged torso).
 
     Returns
     -------
@@ -264,6 +339,9 @@ def derive_legged(structure) -> Equations:
     if structure.spokes or structure.foot not in ("point", "arc"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     knee, arc = structure.knee, structure.foot == "arc"
+    free = planar and structure.kind.joints_free
+    if free:
+        _check_free(structure)
     if (knee or arc) and structure.coordinates != "absolute":
         raise ValueError("walker.coordinates: a knee or arc feet need 'absolute'")
     massless = any(b.massless for b in structure.bodies)
@@ -307,7 +385,8 @@ def derive_legged(structure) -> Equations:
     else:
         swing_contact = kin.contacts["swing_foot"]
         F = swing_contact.jacobian(qv)
-    Mi, B = plastic_impact(M, te.A, te.total_mass, F, simplify)
+    Mi, B = (impact_of_bodies(kin, F, simplify) if planar else   # (the same matrices)
+             plastic_impact(M, te.A, te.total_mass, F, simplify))
     kinetic, total, A = te.kinetic, te.total_mass, te.A
     if massless:   # the exact limit, in the link angles' rows (module docstring)
         beta = P[BETA]
@@ -329,7 +408,9 @@ def derive_legged(structure) -> Equations:
     height = swing_contact[1]
     sigma = th_sw + th_st + 2 * gamma
     n = len(q)
-    if planar:
+    if free:   # _free_step below
+        relabel_q, drop_solution, heel, drop = sp.zeros(n, 1), 0, 0, 0
+    elif planar:
         relabel_q, drop_solution = _planar_swap(structure, q, pitches, gamma)
         heel, drop = sp.expand(sigma), SECTION_DROP[structure.coordinates]
     else:
@@ -356,18 +437,25 @@ def derive_legged(structure) -> Equations:
     if not planar:
         named += [("stance_hip", kin.origins["pelvis"]), ("swing_hip", kin.origins["swing_leg"])]
     named += [("stance_foot", sp.zeros(3, 1)), ("swing_foot", swing_foot)]
-    named += [(f"{role}_{b.name}", kin.coms[f"{role}_{_link(b, role, knee)}_{b.name}"])
+    named += [(f"{role}_{b.name}",
+               kin.coms[f"{role}_{_link(b, role, knee, free)}_{b.name}"])
               for b in structure.bodies for role in ("stance", "swing")]
-    if knee:  # the swing knee (the shank's origin), the straight stance leg's
+    if knee:  # the swing knee (the shank's origin), the stance leg's (a straight one's)
         up = kin.origins["pelvis"]
         named += [("swing_knee", kin.origins["swing_shank"]),
-                  ("stance_knee", up * (1 - P["L_thigh"] / L))]
+                  ("stance_knee", kin.origins["stance_leg"] if free
+                   else up * (1 - P["L_thigh"] / L))]
     named += [(f"torso_{b.name}", kin.coms[f"torso_{b.name}"]) for b in structure.torso]
     if arc:
         centre_st = kin.origins["stance_leg"]
         named += [("stance_contact", centre_st - R * rotation(e_s, phi) * e_n),
                   ("stance_foot_centre", centre_st), ("swing_contact", swing_contact),
                   ("swing_foot_centre", centre_sw)]
+    if free:
+        step = _free_step(structure, q, P, dict(named), gamma)
+        relabel_q, drop, drop_solution = (step[k] for k in ("relabel_q", "section_drop",
+                                                             "drop_solution"))
+        relabel_rate = relabel_q.jacobian(qv)
     points = {k: to_world * v[:d, :] for k, v in named}
     if planar:   # the world's closed forms (the slope's angle gone from a leg's sines)
         points = {k: v.applyfunc(simplify) for k, v in points.items()}
@@ -379,7 +467,11 @@ def derive_legged(structure) -> Equations:
     guards = {"heel_strike": heel, "swing_foot_ahead": sp.expand(th_sw - th_st),
               "hip_height": pelvis[1], "swing_clearance": height}
     kneed = {"section_tied": None}
-    if knee:  # the planar kneed walker's names (the lean besides, in 3D); the knee lock
+    if free:
+        guards = step["guards"]
+        leg_angles = _virtual_legs(points["hip"], points["swing_foot"], q, structure.roles)
+        kneed = {"section_tied": {}}
+    elif knee:  # the planar kneed walker's names (the lean besides, in 3D); the knee lock
         leg_angles = {"stance_thigh": th_st, "stance_shank": th_st, "swing_thigh": th_sw,
                       "swing_shank": th_sh, **({} if planar else {"lean": phi})}
         guards["knee_extension"] = th_sh - th_sw   # zero straight, > 0 hyperextended
@@ -388,9 +480,9 @@ def derive_legged(structure) -> Equations:
         Mi, B = lock.heel_strike
         kneed = {"section_tied": {thigh + 1: thigh, n + thigh + 1: n + thigh},
                  "locked": lock.locked, "knee_impact": lock.knee_impact}
-    elif arc and planar:
+    if arc and planar and not knee:
         kneed = {"section_tied": None, "locked": None, "knee_impact": None}
-    if structure.torso:   # the bisecting hip: the upper body's pitch from the upward vertical
+    if structure.torso and not free:   # the bisecting hip: the upper body's pitch
         leg_angles["torso"] = (th_sw + th_st) / 2
     De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)   # none: the printers' empty system
     if planar or not arc:  # the push-off's extended impact (a 3D walker's round feet: none)

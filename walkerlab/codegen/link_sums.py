@@ -2,7 +2,7 @@
 ``{angle: length}`` (an angle a coordinate or a linear expression of them), so that velocities
 and the mass matrix come out in ``cos(a - b)`` form without a trigonometric simplifier (shared
 by the derivations of :mod:`walkerlab.codegen.legged`, :mod:`walkerlab.codegen.foot_modes`
-and :mod:`walkerlab.codegen.free_joints`), and the heel strike's impact in extended
+and :mod:`walkerlab.codegen.legged`), and the heel strike's impact in extended
 coordinates of those bodies (:func:`extended_impact`, written once for the planar
 derivations).
 """

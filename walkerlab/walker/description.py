@@ -125,12 +125,12 @@ class Structure:
     free_knees : bool
         Both knees free, never locking (``knee.lock: free``; needs ``knee``): every link
         angle is a coordinate (roles :data:`FREE_KNEE_ROLES`), derived by
-        :mod:`walkerlab.codegen.free_joints`.
+        :mod:`walkerlab.codegen.legged`.
     hinged_torso : bool
         The torso (``torso`` bodies) is jointed at the hip with its own coordinate, role
         ``torso`` (its angle from the upward vertical, positive leaning back), on free knees
         or on straight legs (roles :data:`HINGED_ROLES`: the three-link walker); derived by
-        :mod:`walkerlab.codegen.free_joints`.
+        :mod:`walkerlab.codegen.legged`.
     foot_mass : bool
         Flat feet with mass (``walker.leg.foot.mass_kg``): each foot a body with mass
         ``m_foot`` [kg] at its ankle and inertia ``I_foot`` [kg m^2] about it (the same on

@@ -329,7 +329,7 @@ def check_floating_view(structure) -> None:
     (``structure``: :class:`walkerlab.walker.description.Structure`): free
     knees (the five-link biped) on legs that differ, on feet other than points, or with
     springs, a hinged torso on straight legs that differ, on flat feet or with springs (what
-    their rigid view, :mod:`walkerlab.codegen.free_joints`, refuses too).
+    their rigid view, :mod:`walkerlab.codegen.legged`, refuses too).
 
     A spoked wheel (``model: rimless_wheel``) has one: the hub's position and the wheel's
     angle with one contact point per spoke (:mod:`walkerlab.codegen.floating`).

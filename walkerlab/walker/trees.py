@@ -193,7 +193,7 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     free_joints : bool
         Planar, every joint free (the five-link biped of Westervelt, Grizzle & Koditschek
         2003, the three-link walker of Grizzle, Abba & Plestan 2001; the coordinates of
-        :mod:`walkerlab.codegen.free_joints`: every link's absolute angle, ``stance_shank,
+        :mod:`walkerlab.codegen.legged`: every link's absolute angle, ``stance_shank,
         stance_thigh, swing_thigh, swing_shank`` with a knee, else ``stance, swing``, then
         ``torso``): with ``thigh`` the stance leg a shank ``stance_shank`` at the foot and a
         thigh ``stance_leg`` on the knee ``stance_knee``; the upper body's pitch the
@@ -332,7 +332,7 @@ def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str |
 def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
                  coordinates: str, free: bool = False, flat: bool = False) -> CoordinateMap:
     """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`;
-    ``free``: every joint free, :mod:`walkerlab.codegen.free_joints`' coordinates;
+    ``free``: every joint free, :mod:`walkerlab.codegen.legged`' coordinates;
     ``flat``: flat feet, the ankles' after the legs')."""
     ankle = None          # the stance shank's angle, on a stance knee
     if free:

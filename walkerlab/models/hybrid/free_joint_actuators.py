@@ -3,7 +3,7 @@ five-link biped of Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56):
 and knees driven by torque laws, e.g. PD tracking of references of the phase variable
 (virtual constraints).
 
-Every coordinate is a link's absolute angle (:mod:`walkerlab.codegen.free_joints`), so a
+Every coordinate is a link's absolute angle (:mod:`walkerlab.codegen.legged`), so a
 joint's angle ``delta = q[second] - q[first]`` (:data:`walkerlab.config.actuation.
 FIVE_LINK_JOINTS`) and its torque's generalised force is ``tau`` on the second link's row and
 ``-tau`` on the first's: ``B`` has one column ``e_second - e_first`` per actuator, and the flow

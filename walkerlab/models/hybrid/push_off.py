@@ -24,7 +24,7 @@ spin about its centre), so ``E_f = [0 | I]`` and::
 With ``P = 0`` this is the generated passive heel strike (tests show both to round-off).
 A kneed walker holds its swing knee through both impulses (the constraint's gradient,
 :meth:`PushOffTransition.hold_lock`); a free-jointed walker (the five-link biped) holds
-nothing: its generated ``De, E`` (:func:`walkerlab.codegen.free_joints.derive_five_link`)
+nothing: its generated ``De, E`` (:func:`walkerlab.codegen.legged.derive_legged`)
 carry every link, the push-off along the virtual trailing leg (stance foot to hip).  A
 walker with massless legs (only the hip carries mass) has a singular ``De``: its
 transition is written for the hip mass directly (Kuo 2002, Eq. 2 and its appendix).

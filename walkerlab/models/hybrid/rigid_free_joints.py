@@ -2,7 +2,7 @@
 (``knee.lock: free``; with a hinged torso the five-link biped of Westervelt, Grizzle &
 Koditschek 2003, IEEE TAC 48(1):42-56; a hinged torso on straight legs, the three-link
 walker of Grizzle, Abba & Plestan 2001, IEEE TAC 46(1):51-64), from the code
-:mod:`walkerlab.codegen.free_joints` generates.
+:mod:`walkerlab.codegen.legged` generates.
 
 One flow for the whole step (every link free, no knee lock), in two phases so that the
 heel strike is looked for only once the swing foot is ahead:
@@ -19,7 +19,7 @@ heel strike is looked for only once the swing foot is ahead:
   the swing foot falling back behind the stance foot, the hip reaching the slope.
 
 The heel strike is plastic, the old stance foot leaves the ground without impulse, the legs
-swap roles (:mod:`walkerlab.codegen.free_joints`).  The passive walker has no compiled flow
+swap roles (:mod:`walkerlab.codegen.legged`).  The passive walker has no compiled flow
 (``cyrk_compiled`` runs it on CyRK with the Python flow); one driven by joint torques does
 (:mod:`walkerlab.codegen.actuated`, its guards' outputs from :func:`guard_outputs`).
 """

@@ -1,5 +1,5 @@
 """CasADi functions of a free-jointed (five-link) biped's step, from its own symbolic model
-(:func:`walkerlab.codegen.free_joints.derive_five_link`), built once per walker structure and
+(:func:`walkerlab.codegen.legged.derive_legged`), built once per walker structure and
 cached on disk like the generated flows (:mod:`walkerlab.codegen.cache`).
 
 Every function takes the walker's parameter vector ``p`` (``structure.param_names`` order,
@@ -44,10 +44,10 @@ def _build(structure) -> dict:
     import numpy as np
 
     from walkerlab.codegen.casadi_functions import casadi_matrix
-    from walkerlab.codegen.free_joints import derive_five_link  # light
+    from walkerlab.codegen.legged import derive_legged  # light
     from walkerlab.config.actuation import FIVE_LINK_JOINTS  # light
 
-    eq = derive_five_link(structure)
+    eq = derive_legged(structure)
     n, roles = len(eq.q), list(structure.roles)
     syms = [*eq.q, *eq.dq, *eq.params]
     x, u, p = ca.SX.sym("x", 2 * n), ca.SX.sym("u", len(JOINTS)), ca.SX.sym("p", len(eq.params))
