@@ -84,6 +84,7 @@ import sympy as sp
 
 from walkerlab.codegen.cache import functions
 from walkerlab.config.contact import ContactSettings
+from walkerlab.export.adams_3d_actuation import actuation_3d_statements
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
@@ -356,10 +357,11 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
 
 
 def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
-            rolled: bool = False) -> tuple[list[str], list[list[int]]]:
+            rolled: bool = False, frame: bool = False) -> tuple[list[str], list[list[int]]]:
     """PART/1, its markers, ACCGRAV and each lane's patches (boxes whose top face lies
     ``r`` below the slope's plane through the footfalls); the patches' GRAPHICS ids by
-    lane."""
+    lane.  ``rolled``: the hip-roll law's wider patches; ``rolled`` or ``frame``: the ground
+    frame :data:`~walkerlab.export.adams_hip_roll.ROLL_FRAME` the laws read angles in."""
     L = start.numbers["L"]
     r = WHEEL_TIP_FRACTION * L
     t, n = slope_axes(slope_rad)
@@ -371,7 +373,7 @@ def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
            "MARKER/102, PART=1, QP=0.0, 0.0, 0.0",
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-g * MM)}"]
     out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))   # z along the fall line
-    if rolled:  # the frame the law reads rolls in (x s, y n, z z_w)
+    if rolled or frame:  # the frame the law reads rolls in (x s, y n, z z_w)
         out += _marker(ROLL_FRAME, 1, (0.0, 0.0, 0.0), reuler_angles(
             np.column_stack([t, n, np.cross(t, n)])))
     gid, ids = 1001, []
@@ -422,8 +424,12 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
            "strike, leg2", "! in stance, its foot point (the foot sphere's centre) at the "
            "origin.", "! Not written: the energies' requests of the planar dataset.",
            "UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND"]
+    act = scene.walker.actuation
+    if act is not None:
+        out += ["! walker.actuation: its hip torque (SFORCE or GFORCE) and push-off (GFORCE",
+                "! pulses) are written below, after the contacts"]
     ground, patches = _ground(start, data.slope_rad, p["g"], float(
-        scene.terrain_or_default().patch_width_m), start.law is not None)
+        scene.terrain_or_default().patch_width_m), start.law is not None, act is not None)
     out += ground
     out += _parts(start, ids, stance)
     out += _joints(start, ids, stance)
@@ -436,5 +442,6 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
             cid += 1
     if start.law is not None:
         out += hip_roll_statements(start.law, ids, contacts)
+    out += actuation_3d_statements(scene, ids, contacts, data.slope_rad, start.law is not None)
     out += ["!", "OUTPUT/REQSAVE, GRSAVE"]
     return "\n".join([*out, "END", ""])

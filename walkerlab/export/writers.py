@@ -106,6 +106,7 @@ def _adams_3d(job: ExportJob, w: Writer) -> Written:
                          "legs")  # the table's cell, if it ran
     check_legs_3d(job, w)  # --walker-only: the gait still written, as the planar dataset's
     scene = job.scene
+    check_adams_actuation(scene)  # before the gait search
     strides = int(scene.contact_sim.n_strides) if scene.contact_sim else 5
     ideal, start = job.gait(lambda ideal: adams3d_start(job.data, ideal, strides))
     adm = adm3d_text(scene, job.data, start, job.name, walkerlab.__version__)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
-__all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
+__all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
@@ -71,10 +71,6 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 #: why a 3D walker's views refuse a ground other than a plane
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
-#: why a 3D walker refuses actuators
-ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model, contact "
-                "model, MJCF and URDF so far; its Adams dataset is passive but for the "
-                "hip-roll law (walker.hip_roll)")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
          "walker.actuation.torques (joint: hip)")
@@ -292,9 +288,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text, run by
         # walkerlab.export.mujoco_walk.PoweredLoop) and the URDF (its hip joints,
         # the motor and the push-off left out as the planar URDF's: walkerlab.export.
-        # urdf.legs_urdf_text; with hip-roll joints each leg's roll then pitch)
-        **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
-           for v in ("adams",)},
+        # urdf.legs_urdf_text; with hip-roll joints each leg's roll then pitch) and the
+        # Adams dataset (walkerlab.export.adams_3d_actuation: the planar dataset's laws on
+        # each leg's pitch, an SFORCE or a GFORCE per leg, the push-off GFORCE pulse)
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
         ("torso_torque", "*"): "the 3D straight legs carry no torso",
