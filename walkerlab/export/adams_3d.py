@@ -71,8 +71,20 @@ the tree; the pelvis turns with leg2 (its FIXED joint), its centre of mass on th
 moving as the rigid hip does.  No rate scale (``contact_sim.initial_rate_scale`` is the
 planar contact walker's).
 
-Not written: round feet and leg inertia (``walker.foot_radius_m``, refused as the MJCF
-refuses them), requests of energies (the planar dataset's ``REQUEST/90``).
+Round feet (``walker.foot_radius_m``; :func:`walkerlab.codegen.derive_3d.derive_compass`'s
+disc in each leg's rolled sagittal plane, its centre ``L - R`` down the leg): each foot a
+``GRAPHICS/CYLINDER`` of radius ``R`` and length ``2`` :data:`~walkerlab.export.
+legs_3d_parts.DISC_HALF_THICKNESS_L` ``L`` about the leg's pitch axis (its base marker
+``100 p + 4``, z along the axis), the MJCF's disc, its ``CONTACT`` with its lane's patches,
+whose tops lie on the slope's plane through the footfalls (the disc touches the plane); the
+foot marker ``100 p + 3`` its centre, where the stance-foot pin holds it (ground marker 102
+there).  The legs' inertia (``walker.leg_inertia_kg_m2``, a rod's) is the tree's, as every
+body's.
+
+Actuation (``walker.actuation``: a hip torque, ``joint: hip``, and the push-off): the planar
+dataset's statements on each leg's pitch (:mod:`walkerlab.export.adams_3d_actuation`).
+
+Not written: requests of energies (the planar dataset's ``REQUEST/90``).
 """
 
 from __future__ import annotations
@@ -96,7 +108,12 @@ from walkerlab.export.legs_3d_mjcf import (
     legs3d_footfalls,
     legs3d_keyframe,
 )
-from walkerlab.export.legs_3d_parts import legs_summary, walker_tree
+from walkerlab.export.legs_3d_parts import (
+    DISC_HALF_THICKNESS_L,
+    legs_summary,
+    round_feet,
+    walker_tree,
+)
 from walkerlab.export.omitted import Omission
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
@@ -168,13 +185,29 @@ class Adams3dStart:
     law : dict or None
         ``walker.hip_roll``'s numbers (the pelvis on its roll hinge, the legs on roll and
         pitch); None: no hip-roll joints (the pelvis fixed to leg2).
+    feet : dict
+        ``body name -> (down [m], disc radius [m])``: the bodies that carry a foot, its
+        centre down the body's axis (a point foot's ``L``, a round foot's disc ``L - R``)
+        and a round foot's radius ``R`` (0: a point foot's sphere of radius ``L / 1000``).
     """
 
     def __init__(self, bodies, couplings, pose, velocity, hinges, lanes, period_s, numbers,
-                 law=None):
+                 law=None, feet=None):
         self.bodies, self.couplings = bodies, couplings
         self.pose, self.velocity, self.hinges = pose, velocity, hinges
         self.lanes, self.period_s, self.numbers, self.law = lanes, period_s, numbers, law
+        L = numbers["L"]
+        self.feet = feet if feet is not None else {"leg1": (L, 0.0), "leg2": (L, 0.0)}
+
+    @property
+    def disc_m(self) -> float:
+        """The round feet's radius [m] (0: point feet)."""
+        return max(d for _down, d in self.feet.values())
+
+    def foot_centre(self, name: str) -> np.ndarray:
+        """Where the foot of body ``name`` has its centre at the start [m] (3,)."""
+        o, R = self.pose[name]
+        return o + R @ np.array([0.0, 0.0, -self.feet[name][0]])
 
     def cm_velocity(self, name: str) -> np.ndarray:
         """The body's centre-of-mass velocity [m/s] (3,) in ground."""
@@ -252,8 +285,10 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     lanes = legs3d_footfalls(f["points"], x, 2 * strides + 2)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
+    disc = float(p["R_foot"]) if round_feet(data) else 0.0
+    feet = {leg: (p["L"] - disc, disc) for leg in ("leg1", "leg2")}
     return Adams3dStart(list(root.walk()), couplings, pose, velocity, hinges, lanes,
-                        float(ideal.period_s) / steps, p, law)
+                        float(ideal.period_s) / steps, p, law, feet)
 
 
 def part_ids_3d(start: Adams3dStart) -> dict[str, int]:
@@ -306,9 +341,17 @@ def _parts(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
             op, Rp = start.pose[start.bodies[0].name]
             out += _marker(100 * p + 10 + ids[start.bodies[0].name], p, R.T @ (op - o),
                            reuler_angles(R.T @ Rp))
-        if b.name in ("leg1", "leg2"):
-            m = 100 * p + 3
-            out += _marker(m, p, (0.0, 0.0, -L))
+        if b.name in start.feet:
+            m, (down, disc) = 100 * p + 3, start.feet[b.name]
+            out += _marker(m, p, (0.0, 0.0, -down))
+            if disc:   # the disc about the leg's pitch axis, from its base marker
+                half = DISC_HALF_THICKNESS_L * L
+                ax = np.asarray(hinged[-1].axis, float)
+                out += _marker(100 * p + 4, p, np.array([0.0, 0.0, -down]) - half * ax,
+                               _z_to(ax))
+                out += _stmt(f"GRAPHICS/{m}, CYLINDER, CM={100 * p + 4}",
+                             f"LENGTH={_f(2 * half * MM)}, RADIUS={_f(disc * MM)}")
+                continue
             out += _stmt(f"GRAPHICS/{m}, ELLIPSOID, CM={m}",
                          f"XSCALE={_f(2 * r * MM)}, YSCALE={_f(2 * r * MM)}, "
                          f"ZSCALE={_f(2 * r * MM)}")
@@ -359,18 +402,21 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
 def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
             rolled: bool = False, frame: bool = False) -> tuple[list[str], list[list[int]]]:
     """PART/1, its markers, ACCGRAV and each lane's patches (boxes whose top face lies
-    ``r`` below the slope's plane through the footfalls); the patches' GRAPHICS ids by
-    lane.  ``rolled``: the hip-roll law's wider patches; ``rolled`` or ``frame``: the ground
-    frame :data:`~walkerlab.export.adams_hip_roll.ROLL_FRAME` the laws read angles in."""
+    ``r`` below the slope's plane through the footfalls; round feet: on it); the patches'
+    GRAPHICS ids by lane.  ``rolled``: the hip-roll law's wider patches; ``rolled`` or
+    ``frame``: the ground frame :data:`~walkerlab.export.adams_hip_roll.ROLL_FRAME` the laws
+    read angles in.  The pin's ground marker 102 at leg2's foot centre (the origin, a round
+    foot's disc centre above it)."""
     L = start.numbers["L"]
-    r = WHEEL_TIP_FRACTION * L
+    r = 0.0 if start.disc_m else WHEEL_TIP_FRACTION * L
     t, n = slope_axes(slope_rad)
     across = (PATCH_ACROSS_PUSHED_L if rolled else PATCH_ACROSS_L) * L
     depth = width_m / 10
     tilt = (math.pi / 2, slope_rad, -math.pi / 2)  # Rz(90) Rx(phi) Rz(-90) = Rot(y, phi)
     out = ["!", "! ---- ground, gravity (along -z) and the footfall patches of each lane ----",
            "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
-           "MARKER/102, PART=1, QP=0.0, 0.0, 0.0",
+           *(_marker(102, 1, start.foot_centre("leg2")) if start.disc_m else
+             ["MARKER/102, PART=1, QP=0.0, 0.0, 0.0"]),
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-g * MM)}"]
     out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))   # z along the fall line
     if rolled or frame:  # the frame the law reads rolls in (x s, y n, z z_w)
@@ -421,8 +467,12 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
            "! Axes: x downhill, z up, y = walkerlab's -z (leg1 on the side of -y);",
            "! the ground's patches are tilted about y, gravity is along -z.",
            f"! Start: the rigid gait (step period {start.period_s:.6g} s) just after a heel "
-           "strike, leg2", "! in stance, its foot point (the foot sphere's centre) at the "
-           "origin.", "! Not written: the energies' requests of the planar dataset.",
+           "strike, leg2", *(["! in stance, its foot point (the foot sphere's centre) at the "
+                              "origin."] if not start.disc_m else
+                             ["! in stance, its foot disc on the slope (its reference point "
+                              "at the origin),", f"! each foot a disc of radius "
+                              f"{start.disc_m:g} m about the leg's pitch axis."]),
+           "! Not written: the energies' requests of the planar dataset.",
            "UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND"]
     act = scene.walker.actuation
     if act is not None:

@@ -41,13 +41,7 @@ from walkerlab.export.adams import (
 )
 from walkerlab.export.adams_3d import ADAMS_3D_OMISSIONS, adams3d_start, adm3d_text
 from walkerlab.export.adams_actuation import check_adams_actuation
-from walkerlab.export.body_writers import (
-    MJCF,
-    URDF,
-    check_legs_3d,
-    planar_legs_only,
-    round_feet_3d_fields,
-)
+from walkerlab.export.body_writers import MJCF, URDF, check_legs_3d, planar_legs_only
 from walkerlab.export.engine_walk import ENGINES, EngineWalk, not_walked, walk_export
 from walkerlab.export.jobs import (  # noqa: F401 (part of this API)
     Exported,
@@ -93,17 +87,12 @@ def _adams(job: ExportJob, w: Writer) -> Written:
 
 def _adams_3d(job: ExportJob, w: Writer) -> Written:
     """The 3D straight-legged walker's ``walker.adm`` and ``walker.acf``
-    (:func:`walkerlab.export.adams_3d.adm3d_text`), refused before the gait search as its
-    MJCF is (:func:`walkerlab.export.body_writers.check_legs_3d`; round feet and leg
-    inertia refused here); a 3D wheel as the capability table has it."""
+    (:func:`walkerlab.export.adams_3d.adm3d_text`: round feet, leg inertia, hip-roll joints,
+    the hip torque and the push-off), refused before the gait search as its MJCF is
+    (:func:`walkerlab.export.body_writers.check_legs_3d`); a 3D wheel as the capability
+    table has it."""
 
     job.kind.require("walk", w.view, "walker.space: 3d")
-    st = job.data.structure
-    if st.foot == "arc" or any(b.kind == "rod" for b in st.bodies):
-        fields = round_feet_3d_fields(job)
-        job.kind.require("round_feet_3d", w.view, fields)
-        raise ValueError(f"{fields}: the Adams dataset carries point feet and point-mass "
-                         "legs")  # the table's cell, if it ran
     check_legs_3d(job, w)  # --walker-only: the gait still written, as the planar dataset's
     scene = job.scene
     check_adams_actuation(scene)  # before the gait search

@@ -15,7 +15,7 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
+           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -84,10 +84,6 @@ NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width
 NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
                     "straight-legged walker's (walker.space: 3d); a planar walker's round "
                     "feet are walker.leg.foot.kind: arc")
-#: why the 3D walker's Adams dataset refuses its round feet (and leg inertia)
-ROUND_FEET_EXPORT_3D = ("a 3D walker's Adams dataset carries point feet and point-mass legs "
-                        "so far (its round feet and leg inertia run in the rigid model and "
-                        "the URDF and MJCF exports)")
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -279,8 +275,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "straight_legs_3d": {
         # round feet and leg inertia: the MJCF's disc (cylinder) feet, the URDF's
-        # cylinder collisions and both files' leg inertia (walkerlab.export.legs_3d_mjcf)
-        ("round_feet_3d", "adams"): ROUND_FEET_EXPORT_3D,
+        # cylinder collisions, the Adams dataset's GRAPHICS/CYLINDER contact and the
+        # files' leg inertia (walkerlab.export.legs_3d_mjcf, walkerlab.export.adams_3d)
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
