@@ -41,6 +41,7 @@ from walkerlab.export.adams import (
 )
 from walkerlab.export.adams_3d import ADAMS_3D_OMISSIONS, adams3d_start, adm3d_text
 from walkerlab.export.adams_actuation import check_adams_actuation
+from walkerlab.export.adams_wheel import ADAMS_WHEEL_OMISSIONS, adm_wheel_text, wheel_start
 from walkerlab.export.body_writers import MJCF, URDF, check_legs_3d, planar_legs_only
 from walkerlab.export.engine_walk import ENGINES, EngineWalk, not_walked, walk_export
 from walkerlab.export.jobs import (  # noqa: F401 (part of this API)
@@ -63,11 +64,15 @@ from walkerlab.export.opensim import (
 )
 from walkerlab.export.scene import FORMAT_VIEWS, check_exportable
 from walkerlab.export.tree_links import tree_multibody
+from walkerlab.export.wheel_scene import check_wheel_exportable
 
 
 def _adams(job: ExportJob, w: Writer) -> Written:
     """``walker.adm`` and ``walker.acf`` (both built before either is written); a walker
-    whose tree is not in the plane by :func:`_adams_3d`."""
+    whose tree is one body (a spoked wheel) by :func:`_adams_wheel`, one not in the plane by
+    :func:`_adams_3d`."""
+    if job.tree.one_body:
+        return _adams_wheel(job, w)
     if not job.tree.in_plane:
         return _adams_3d(job, w)
     planar_legs_only(job, w)
@@ -101,6 +106,22 @@ def _adams_3d(job: ExportJob, w: Writer) -> Written:
     adm = adm3d_text(scene, job.data, start, job.name, walkerlab.__version__)
     return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))),
                    tuple(o.line for o in ADAMS_3D_OMISSIONS), step_period(ideal))
+
+
+def _adams_wheel(job: ExportJob, w: Writer) -> Written:
+    """A spoked wheel's ``walker.adm`` and ``walker.acf``, planar or 3D
+    (:func:`walkerlab.export.adams_wheel.adm_wheel_text`: its tree's one body on its contact
+    points), checked as its URDF and MJCF are (its cells, its numbers) before the gait
+    search; the gait written with ``--walker-only`` too, as the legged datasets'."""
+    scene = job.scene
+    check_wheel_exportable(scene, job.kind, w.name)
+    check_exportable(scene, job.kind, w.name, True, tree=job.tree)
+    hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
+    strides = int(scene.contact_sim.n_strides) if scene.contact_sim else 5
+    ideal, start = job.gait(lambda ideal: wheel_start(job.data, ideal, strides, hub))
+    adm = adm_wheel_text(scene, job.data, start, job.name, walkerlab.__version__)
+    return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))),
+                   tuple(o.line for o in ADAMS_WHEEL_OMISSIONS), step_period(ideal))
 
 
 def _osim(job: ExportJob, w: Writer) -> Written:

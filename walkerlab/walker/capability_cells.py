@@ -126,6 +126,11 @@ _WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ank
                                               "torso_torque", "push_off", "ankle_push_off",
                                               "virtual_constraints")}
 _WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
+#: why the planar wheel's Adams dataset refuses a ground other than the slope
+WHEEL_ADAMS_GROUND = ("the wheel's Adams dataset lays the slope as one box under its spoke "
+                      "tips (their spheres touch it wherever they land); the treads, "
+                      "footholds and profiles a tip lands on are laid by its MJCF "
+                      "(--format mjcf)")
 _WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
                    "one, walkerlab fixedpoint)")
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
@@ -262,8 +267,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "rolling_polygon": {
         **_PLANAR,
         **_WHEEL_JOINTS,
-        ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
-                            "(one rigid body) is exported as urdf or mjcf"),
+        # the Adams dataset: the tree's one body on its spoke tips, on the slope
+        # (walkerlab.export.adams_wheel.adm_wheel_text)
+        **{(g, "adams"): WHEEL_ADAMS_GROUND for g in ("stairs", "footholds", "profile")},
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): _WHEEL_GYM,
@@ -331,11 +337,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the compliant-contact model: a free body on its spoke tips
         # (walkerlab.codegen.floating_3d.derive_wheel_3d)
         **_CELLS_3D,
-        ("walk", "adams"): ("the Adams dataset writes legged walkers (planar, and the 3D "
-                            "straight legs); a 3D spoked wheel (one rigid body) is "
-                            "exported as urdf or mjcf"),
-        # the MJCF and the URDF: a free body on its spoke tips
-        # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
+        # the MJCF, the URDF and the Adams dataset: a free body on its spoke tips
+        # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text,
+        # walkerlab.export.adams_wheel.adm_wheel_text)
         ("walk", "gym"): _WHEEL_GYM,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
