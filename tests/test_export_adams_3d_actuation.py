@@ -16,13 +16,14 @@ degrees, so an angle comes back within ~1e-14 rad and a length within ~1e-12 m.
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from tests.adams_eval import evaluate as _evaluate
+from tests.adams_eval import evaluate_expr as _evaluate_expr
 from walkerlab.codegen.cache import functions
 from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
@@ -63,48 +64,6 @@ def case(request):
     start = adams3d_start(data, ideal, 2)
     text = adm3d_text(scene, data, start, "walker")
     return scene, data, x, read_adm(text), text
-
-
-def _evaluate(model, ids, extra: dict | None = None) -> dict:
-    """The dataset's VARIABLEs ``ids`` at its start (Adams Solver function semantics:
-    ``DX(i, j, k)`` the displacement of marker i from j along k's x (k default ground),
-    ``DM`` its length, ``VX(i)`` i's velocity along ground x, ``WZ(i, j, k)`` i's angular
-    velocity relative to ground marker j along k's z, ``IF(e: a, b, c)`` a, b, c for
-    e <, =, > 0; ``CONTACT`` 0: the start's feet touch without penetrating)."""
-    fns = {**model.functions("VARIABLE"), **(extra or {})}
-    cache: dict = {}
-
-    def varval(n):
-        if n not in cache:
-            e = re.sub(r"IF\(([^:]*):", r"_if(\1,", fns[int(n)])
-            cache[n] = eval(e, {"__builtins__": {}}, env)  # noqa: S307 (the test's own file)
-        return cache[n]
-
-    def pose(m):
-        return model.marker_pose(m)
-
-    def disp(i, j=None, k=None):
-        d = pose(i)[0] - (pose(j)[0] if j is not None else 0.0)
-        R = pose(k)[1] if k is not None else np.eye(3)
-        return R.T @ d / model.length
-
-    def vel(i):
-        part = model.get("MARKER", i).integer("PART")
-        v, w = model.part_velocity(part)
-        cm = pose(model.get("PART", part).integer("CM"))[0]
-        return (v + np.cross(w, pose(i)[0] - cm)) / model.length
-
-    def wz(i, _j, k):
-        part = model.get("MARKER", i).integer("PART")
-        return (pose(k)[1].T @ model.part_velocity(part)[1])[2]
-
-    env = {"VARVAL": varval, "ATAN2": math.atan2, "SQRT": math.sqrt,
-           "CONTACT": lambda *a: 0.0, "MIN": min, "MAX": max,
-           "DX": lambda *a: disp(*a)[0], "DY": lambda *a: disp(*a)[1],
-           "DZ": lambda *a: disp(*a)[2], "DM": lambda i, j: float(np.linalg.norm(disp(i, j))),
-           "VX": lambda i: vel(i)[0], "VY": lambda i: vel(i)[1], "VZ": lambda i: vel(i)[2],
-           "WZ": wz, "_if": lambda e, a, b, c: a if e < 0 else (b if e == 0 else c)}
-    return {n: varval(n) for n in ids}
 
 
 def test_a_3d_datasets_leg_pitches_and_hip_torque_are_the_rigid_models(case):
@@ -189,8 +148,3 @@ def test_a_3d_datasets_push_off_reads_the_rigid_feet(case):
         e = g[k].replace("VARVAL(662)*", "")
         got.append(_evaluate_expr(model, e))
     np.testing.assert_allclose(got, want, atol=TOL)
-
-
-def _evaluate_expr(model, expr: str) -> float:
-    """One expression, as :func:`_evaluate` reads it."""
-    return _evaluate(model, (-1,), {-1: expr})[-1]

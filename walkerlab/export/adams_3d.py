@@ -97,6 +97,7 @@ import sympy as sp
 from walkerlab.codegen.cache import functions
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_3d_actuation import actuation_3d_statements
+from walkerlab.export.adams_3d_knees import knee_3d_statements
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
@@ -110,6 +111,8 @@ from walkerlab.export.legs_3d_mjcf import (
 )
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
+    kneed,
+    legs3d_roles,
     legs_summary,
     round_feet,
     walker_tree,
@@ -199,15 +202,19 @@ class Adams3dStart:
         L = numbers["L"]
         self.feet = feet if feet is not None else {"leg1": (L, 0.0), "leg2": (L, 0.0)}
 
+    def foot_body(self, leg: str) -> str:
+        """The body that carries ``leg``'s foot (``leg``, or its shank)."""
+        return next(b for b in self.feet if b.split("_")[0] == leg)
+
     @property
     def disc_m(self) -> float:
         """The round feet's radius [m] (0: point feet)."""
         return max(d for _down, d in self.feet.values())
 
-    def foot_centre(self, name: str) -> np.ndarray:
-        """Where the foot of body ``name`` has its centre at the start [m] (3,)."""
-        o, R = self.pose[name]
-        return o + R @ np.array([0.0, 0.0, -self.feet[name][0]])
+    def foot_centre(self, leg: str) -> np.ndarray:
+        """Where ``leg``'s foot has its centre at the start [m] (3,)."""
+        o, R = self.pose[self.foot_body(leg)]
+        return o + R @ np.array([0.0, 0.0, -self.feet[self.foot_body(leg)][0]])
 
     def cm_velocity(self, name: str) -> np.ndarray:
         """The body's centre-of-mass velocity [m/s] (3,) in ground."""
@@ -238,8 +245,10 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
 
     tree, coords, p = walker_tree(data)
     rolled = bool(data.structure.hip_roll)
-    root, couplings = export_bodies(tree, coords, p, PelvisRoles(
-        pelvis_hinges=("stance_hip_roll",) if rolled else ()))
+    knees = kneed(data)
+    root, couplings = export_bodies(tree, coords, p, legs3d_roles(data) if knees else
+                                    PelvisRoles(pelvis_hinges=("stance_hip_roll",) if rolled
+                                                else ()))
     f = functions(data)
     x = np.asarray(ideal.x, float)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], x, data.slope_rad, 0.0)
@@ -250,14 +259,20 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     rates = {c: s[f"{c}_rate"] for c in coords.names if f"{c}_rate" in s}
     hinges = {}
 
+    def coord(q) -> str:
+        """The state's coordinate of a joint angle's symbol (the stance leg's own shank
+        angle: the stance angle, its knee straight at the start)."""
+        name = q.name[2:] if q.name.startswith("q_") else q.name
+        return {"stance_shank": "stance"}.get(name, name)
+
     def turn(joints, R, w):
         """``R``, ``w`` turned by the hinges ``joints`` at the start's angles and rates."""
         for j in joints:
             if j.kind != "hinge":
                 continue
-            sym = {q: angles[q.name[2:]] for q in j.angle.free_symbols}
+            sym = {q: angles[coord(q)] for q in j.angle.free_symbols}
             ang = float(j.angle.subs(sym))
-            rate = float(sum(sp.diff(j.angle, q) * rates[q.name[2:]]
+            rate = float(sum(sp.diff(j.angle, q) * rates[coord(q)]
                              for q in j.angle.free_symbols))
             hinges[j.name] = (np.asarray(j.axis, float), ang, rate)
             w = w + rate * (R @ np.asarray(j.axis, float))
@@ -286,7 +301,8 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
     disc = float(p["R_foot"]) if round_feet(data) else 0.0
-    feet = {leg: (p["L"] - disc, disc) for leg in ("leg1", "leg2")}
+    feet = ({f"{leg}_shank": (p["L"] - p["L_thigh"], 0.0) for leg in ("leg1", "leg2")}
+            if knees else {leg: (p["L"] - disc, disc) for leg in ("leg1", "leg2")})
     return Adams3dStart(list(root.walk()), couplings, pose, velocity, hinges, lanes,
                         float(ideal.period_s) / steps, p, law, feet)
 
@@ -395,7 +411,8 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
                 _stmt(f"COUPLER/{_COUPLER}, JOINTS={terms[0][0]}, {terms[1][0]}, TYPE=R:R",
                       f"SCALES={_fs(*(float(c) for _j, c in terms))}")[0]]
     out += ["! temporary stance-foot pin: deactivated by walker.acf",
-            f"JOINT/{PIN_JOINT_3D}, SPHERICAL, I={100 * ps + 3}, J=102"]
+            f"JOINT/{PIN_JOINT_3D}, SPHERICAL, I={100 * ids[start.foot_body(stance)] + 3}, "
+            "J=102"]
     return out
 
 
@@ -462,7 +479,9 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     ids = part_ids_3d(start)
     stance = "leg2"
     out = [f"walker {name} exported by walkerlab {version} (Adams Solver dataset, 3D)",
-           "! A straight-legged walker in 3D:", f"! {legs_summary(data, p)},",
+           "! A straight-legged walker in 3D:" if not kneed(data) else
+           "! A kneed walker in 3D (knees on the legs' pitch axes, stops below):",
+           f"! {legs_summary(data, p)},",
            f"! hips {p['w_hip']:g} m apart, slope {data.slope_rad:g} rad.",
            "! Axes: x downhill, z up, y = walkerlab's -z (leg1 on the side of -y);",
            "! the ground's patches are tilted about y, gravity is along -z.",
@@ -487,11 +506,13 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     cid, contacts = 1, {}
     for leg, lane in zip(("leg1", "leg2"), patches):
         for gid in lane:
-            out += contact_statement(cid, 100 * ids[leg] + 3, gid, law)
+            out += contact_statement(cid, 100 * ids[start.foot_body(leg)] + 3, gid, law)
             contacts.setdefault(leg, []).append(cid)
             cid += 1
     if start.law is not None:
         out += hip_roll_statements(start.law, ids, contacts)
     out += actuation_3d_statements(scene, ids, contacts, data.slope_rad, start.law is not None)
+    if any(b.endswith("_shank") for b in start.feet):
+        out += knee_3d_statements(scene, ids, data.slope_rad)
     out += ["!", "OUTPUT/REQSAVE, GRSAVE"]
     return "\n".join([*out, "END", ""])

@@ -91,8 +91,8 @@ EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written 
 #: only ones so far)
 _KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model (walkerlab fixedpoint, "
                   "simulate) and is exported as MJCF and URDF (export --format mjcf, urdf) "
-                  "so far: its floating (contact) view and its Adams and OpenSim exports are "
-                  "a later step")
+                  "so far: its floating (contact) view and its OpenSim export are a later "
+                  "step")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -326,7 +326,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's
-        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "adams", "osim")},
+        # the Adams dataset: the 3D straight legs' with a knee revolute on each leg, its
+        # stop and latch the planar kneed dataset's (walkerlab.export.adams_3d_knees)
+        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "osim")},
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
