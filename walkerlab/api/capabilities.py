@@ -422,7 +422,7 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     data = walker_data(scene.walker, scene.slope.phi_rad)
     parts = [p for p in model.by_kind["PART"] if p != 1]
     total = sum(model.part_mass(p) for p in parts)
-    if data.structure.in_3d:  # the 3D walker's parts: its tree's bodies
+    if data.structure.in_3d or data.structure.spokes:  # its tree's bodies (a wheel: one)
         return (abs(total / data.total_mass_kg - 1.0),
                 f"{len(parts)} parts, {total:.6g} kg against {data.total_mass_kg:.6g} kg")
     mb = multibody(data)
