@@ -20,9 +20,11 @@ there.  Units mm-kg-s.
 The part: the tree body's frame (origin at the stance spoke's tip, ``y`` to the hub, ``z``
 along the axle, in walkerlab's axes; each vector ``v`` of the tree is ``C v`` in the part's
 frame, ``C`` = ``TO_MUJOCO``), its mass and its inertia about the hub (the tree's; a
-point-mass hub's moment about the axle ``contact.hub_inertia_kg_m2``, as the MJCF has it,
-moments the tree leaves 0 the MJCF's floor :data:`walkerlab.export.mjcf_scene.
-MJCF_MIN_INERTIA_KG_M2`).  Each contact point of the tree (``stance_foot``, ``next_foot``,
+point-mass hub's moment about the axle ``contact.hub_inertia_kg_m2``, the contact view's
+regularisation, as the planar MJCF has it, else the MJCF's floor :data:`walkerlab.export.
+mjcf_scene.MJCF_MIN_INERTIA_KG_M2`; a planar wheel's moments about its diameters, which its
+PLANAR joint holds, the axle's, a 3D wheel's the floor where the tree leaves them 0).
+Each contact point of the tree (``stance_foot``, ``next_foot``,
 ..., the spoke tips) a marker ``210 + k`` on it and a sphere of radius ``r = L / 1000``
 (:data:`walkerlab.export.spoked.WHEEL_TIP_FRACTION`: the legged dataset's point foot) centred
 on it, its ``CONTACT`` (the scene's IMPACT law and Coulomb friction,
@@ -54,6 +56,7 @@ from walkerlab.export.adams_3d import reuler_angles
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
+from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import Omission
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, _wheel_numbers
 from walkerlab.walker.walker_trees import walker_tree
@@ -163,10 +166,9 @@ def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = Non
     rhs = np.concatenate([vel[b] - vel[a] for a, b in spans])
     omega = np.linalg.lstsq(A, rhs, rcond=None)[0]
     inertia = np.array([[_value(v, values) for v in row] for row in body.inertia_kg_m2])
-    inertia[2, 2] = inertia[2, 2] or p["I_hub"]   # a point-mass hub's: the MJCF's
-    if planar:
-        inertia[0, 0] = inertia[0, 0] or p["I_hub"]
-        inertia[1, 1] = inertia[1, 1] or p["I_hub"]
+    inertia[2, 2] = inertia[2, 2] or p["I_hub"]   # a point-mass hub's about the axle
+    for k in (0, 1):   # a diameter's: the axle's in the plane (the PLANAR joint holds it)
+        inertia[k, k] = inertia[k, k] or (p["I_hub"] if planar else MJCF_MIN_INERTIA_KG_M2)
     tips = tuple((c.name, C @ np.array([_value(v, values) for v in c.point_m]))
                  for c in tree.contacts)
     return WheelStart(C @ pts["stance_foot"], C @ Rb @ C.T, C @ vel["hip"], C @ omega,
