@@ -242,11 +242,11 @@ def test_a_3d_acf_runs_the_requested_strides(case):
     assert max(len(s) for s in adm.splitlines()[1:]) <= 80
 
 
-def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_a_wheel_on_stairs(
+def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_a_wheel_on_footholds(
         tmp_path):
     """``walkerlab export configs/hip_width_stabilised.yaml --format adm`` writes both files;
-    a spoked wheel on stairs (its dataset lays the slope) is refused in one line naming the
-    field, nothing written."""
+    a spoked wheel on footholds (its dataset lays continuous ground) is refused in one line
+    naming the field, nothing written."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
@@ -259,14 +259,14 @@ def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_a_wheel_on_stai
     folder = tmp_path / "hip_width_stabilised"
     assert set(read_adm((folder / "walker.adm").read_text()).by_kind["GFORCE"]) == {31, 32}
     assert parse_acf((folder / "walker.acf").read_text())
-    _case, d = reference_scene("rolling_polygon", "stairs", "adams")
-    d["name"] = "wheel_stairs"
-    cfg = tmp_path / "wheel_stairs.yaml"
+    _case, d = reference_scene("rolling_polygon", "footholds", "adams")
+    d["name"] = "wheel_footholds"
+    cfg = tmp_path / "wheel_footholds.yaml"
     cfg.write_text(yaml.safe_dump(d))
     r = run(app, ["export", str(cfg), "--format", "adm", "--runs-dir", str(tmp_path)])
     assert r.exit_code != 0 and r.output.strip().count("\n") == 0, r.output
-    assert "terrain.kind: stairs" in r.output and "Traceback" not in r.output
-    assert not (tmp_path / "wheel_stairs" / "walker.adm").exists()
+    assert "terrain.kind: footholds" in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "wheel_footholds" / "walker.adm").exists()
 
 
 def _evaluate(model, ids=(331, 332, 333, 334, 341, 343, 351, 352)) -> dict:

@@ -147,3 +147,59 @@ def test_a_wheels_inertia_and_kinetic_energy_are_the_rigid_models(wheel):
     assert kind == "PLANAR"
     for m in (i, j):
         assert abs(model.marker_pose(m)[1][:, 2] @ np.array([0.0, 1.0, 0.0]) - 1) < TOL
+
+
+def _ground_case(feature):
+    """The planar wheel's reference case on ``feature``'s ground (its scene, the dataset at
+    the shipped wheel's state read back, the rigid points)."""
+    from walkerlab.config import scene_from_dict
+    from walkerlab.walker.reference_cases import reference_scene
+
+    _case, d = reference_scene("rolling_polygon", feature, "adams")
+    scene = scene_from_dict(d)
+    data = Plant.from_scene(scene).data
+    x = np.asarray(STATES["rimless_wheel"], float)
+    start = wheel_start(data, SimpleNamespace(x=x, period_s=1.0), 2,
+                        scene.contact.hub_inertia_kg_m2, scene.terrain)
+    model = read_adm(adm_wheel_text(scene, data, start, "wheel"))
+    pts = {k: _pad(v) for k, v in functions(data)["points"](x).items()}
+    return scene, data, model, pts
+
+
+def _under(model, p):
+    """The ground box under the point ``p`` (3,) [m]: ``p``'s height above its top [m]."""
+    for g in model.by_kind["GRAPHICS"].values():
+        if "BOX" not in g.flags:
+            continue
+        o, R = model.marker_pose(g.integer("CORNER"))
+        size = np.array([g.number(k) for k in "XYZ"]) * model.length
+        local = R.T @ (p - o)
+        if 0 <= local[0] <= size[0] and 0 <= local[1] <= size[1] and local[2] > 0:
+            return local[2] - size[2]
+    raise AssertionError(f"no box under {p}")
+
+
+def test_a_wheel_on_stairs_stands_its_stance_tip_on_tread_0():
+    """Stairs (the generated case): a box per tread, tread 0 (``tread_m`` deep, its middle
+    at the stance tip) its top r below height 0, the next one ``riser_m`` lower; the stance
+    tip's sphere touches it (its centre r above the top), every CONTACT of a tip on a box."""
+    scene, _data, model, pts = _ground_case("stairs")
+    t = scene.terrain
+    r = scene.walker.spoke_length_m / 1000
+    assert _under(model, pts["stance_foot"]) == pytest.approx(r, abs=TOL)
+    ahead = np.array([0.5 * t.tread_m + 1e-3, 0.0, -t.riser_m + 1e-3])  # on tread 1
+    assert _under(model, ahead) == pytest.approx(r + 1e-3, abs=TOL)
+    boxes = [g for g, s in model.by_kind["GRAPHICS"].items() if "BOX" in s.flags]
+    assert len(model.by_kind["CONTACT"]) == len(boxes) * scene.walker.spokes
+
+
+def test_a_wheel_on_its_slope_as_a_profile_has_the_slopes_ground():
+    """A profile (the generated case: the slope itself as a profile): a box per segment,
+    each tip's sphere centre r plus its rigid height above the slope over the box under
+    it, as on the slope."""
+    scene, data, model, pts = _ground_case("profile")
+    r = scene.walker.spoke_length_m / 1000
+    phi = data.slope_rad
+    normal = np.array([math.sin(phi), 0.0, math.cos(phi)])
+    for name in ("stance_foot", "swing_foot", "trailing_foot", "spoke2_foot"):
+        assert _under(model, pts[name]) == pytest.approx(r + normal @ pts[name], abs=TOL)

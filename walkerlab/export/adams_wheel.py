@@ -59,6 +59,8 @@ from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import Omission
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, _wheel_numbers
+from walkerlab.models.contact.terrain import profile_line
+from walkerlab.models.ground import stair_treads
 from walkerlab.walker.walker_trees import walker_tree
 
 __all__ = ["ADAMS_WHEEL_OMISSIONS", "TIP_MARKER", "WheelStart", "adm_wheel_text",
@@ -98,6 +100,12 @@ class WheelStart:
         A planar wheel (the PLANAR joint).
     steps : int
         Steps of the run (the ground's length).
+    treads : tuple of (float, float, float) or None
+        A planar wheel's stairs: each tread's ``(x_start, x_end, height)`` [m] in walkerlab's
+        world (:func:`walkerlab.models.ground.stair_treads`); None: not stairs.
+    profile : ndarray (m, 2) or None
+        A planar wheel's height profile's vertices [m] (walkerlab's world, x ahead, y up:
+        :func:`walkerlab.models.contact.terrain.profile_line`); None: not a profile.
     """
 
     origin: np.ndarray
@@ -113,14 +121,16 @@ class WheelStart:
     slope_rad: float
     planar: bool
     steps: int
+    treads: tuple | None = None
+    profile: np.ndarray | None = None
 
 
 def _value(expr, values: dict) -> float:
     return float(sp.sympify(expr).subs(values))
 
 
-def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = None
-                ) -> WheelStart:
+def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = None,
+                terrain=None) -> WheelStart:
     """The start of :func:`adm_wheel_text` at the rigid gait ``ideal`` (module docstring).
 
     Parameters
@@ -133,6 +143,10 @@ def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = Non
         Strides of the run (the ground's length: ``2 strides + 2`` steps).
     hub_inertia_kg_m2 : float, optional
         A point-mass hub's moment about the axle (``contact.hub_inertia_kg_m2``).
+    terrain : walkerlab.config.TerrainSettings, optional
+        A planar wheel's stairs or height profile, laid as its MJCF lays them
+        (:func:`walkerlab.export.mjcf_ground.wheel_ground`: the first stance tip at the
+        origin); None or a slope: the slope.
 
     Returns
     -------
@@ -171,10 +185,49 @@ def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = Non
         inertia[k, k] = inertia[k, k] or (p["I_hub"] if planar else MJCF_MIN_INERTIA_KG_M2)
     tips = tuple((c.name, C @ np.array([_value(v, values) for v in c.point_m]))
                  for c in tree.contacts)
+    kind = getattr(terrain, "kind", "slope")
+    treads = (tuple(stair_treads(terrain, 0.0, 2 * strides + 6)) if kind == "stairs"
+              else None)
+    profile = profile_line(terrain, 0.0, 0.0) if kind == "profile" else None
     return WheelStart(C @ pts["stance_foot"], C @ Rb @ C.T, C @ vel["hip"], C @ omega,
                       C @ np.array([_value(v, values) for v in body.com_m]),
                       C @ inertia @ C.T, _value(body.mass_kg, values), tips, p["L"],
-                      float(ideal.period_s), data.slope_rad, planar, 2 * strides + 2)
+                      float(ideal.period_s), data.slope_rad, planar, 2 * strides + 2,
+                      treads, profile)
+
+
+def _boxes(start: WheelStart) -> list[tuple[str, np.ndarray, np.ndarray, tuple]]:
+    """The ground's boxes: ``(comment, corner [m] (3,), 3-1-3 angles [rad], (X, Y, Z) [m])``
+    each, their top faces ``r`` below the ground (a tip's sphere touches where the rigid
+    tip does): the slope one box from two spokes behind the origin past the run's steps;
+    stairs a box per tread reaching a spoke below the lowest (its riser a face a tip can
+    hit, as the MJCF's); a profile a box per segment, its top along it."""
+    L, r = start.length_m, WHEEL_TIP_FRACTION * start.length_m
+    across, depth = 4 * L, L / 10
+    side = across / 2 * np.array([0.0, 1.0, 0.0])
+    if start.treads is not None:
+        floor = min(h for _a, _b, h in start.treads) - r - L
+        return [(f"tread at {h:g} m from {a:g} to {b:g} m", np.array([a, 0.0, floor]) - side,
+                 (0.0, 0.0, 0.0), (b - a, across, h - r - floor))
+                for a, b, h in start.treads]
+    if start.profile is not None:
+        out = []
+        for (x0, y0), (x1, y1) in zip(start.profile[:-1], start.profile[1:]):
+            d = np.array([x1 - x0, 0.0, y1 - y0])
+            length = float(np.linalg.norm(d))
+            t = d / length
+            n = np.array([-t[2], 0.0, t[0]])   # the segment's normal, out of the ground
+            tilt = math.atan2(-t[2], t[0])     # turned about y: x along the segment
+            corner = np.array([x0, 0.0, y0]) - (r + depth) * n - side
+            out.append((f"segment ({x0:g}, {y0:g}) to ({x1:g}, {y1:g}) m", corner,
+                        (math.pi / 2, tilt, -math.pi / 2), (length, across, depth)))
+        return out
+    t, n = slope_axes(start.slope_rad)
+    chord = 2 * L * math.sin(math.pi / len(start.tips))
+    length = (start.steps + 4) * chord + 4 * L
+    return [(f"the slope: {length:g} m along it, its top {r:g} m below the plane",
+             -2 * L * t - (r + depth) * n - side,
+             (math.pi / 2, start.slope_rad, -math.pi / 2), (length, across, depth))]
 
 
 def _marker(mid: int, part: int, qp, angles=(0.0, 0.0, 0.0)) -> list[str]:
@@ -203,13 +256,11 @@ def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "")
         The .adm text: a title line, then statements, ``END``.
     """
     L, r = start.length_m, WHEEL_TIP_FRACTION * start.length_m
-    t, n = slope_axes(start.slope_rad)
     J = start.inertia * MM * MM
     R = start.rotation
     wb = R.T @ start.omega
-    chord = 2 * L * math.sin(math.pi / len(start.tips))
-    length = (start.steps + 4) * chord + 4 * L
-    across, depth = 4 * L, L / 10
+    ground = ("stairs" if start.treads is not None else
+              "a height profile" if start.profile is not None else "the slope")
     out = [f"walker {name} exported by walkerlab {version} (Adams Solver dataset, "
            f"{'planar' if start.planar else '3D'} spoked wheel)",
            f"! A rimless wheel of {len(start.tips)} spokes of {L:g} m, hub {start.mass_kg:g} "
@@ -227,11 +278,13 @@ def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "")
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-data.gravity_m_per_s2 * MM)}"]
     if start.planar:   # z along the file's y: the plane of motion is x-z
         out += _marker(103, 1, (0.0, 0.0, 0.0), (0.0, -math.pi / 2, 0.0))
-    corner = -2 * L * t - (r + depth) * n - across / 2 * np.array([0.0, 1.0, 0.0])
-    out += [f"! the slope: a box {length:g} m along it, its top {r:g} m below the plane"]
-    out += _marker(_BOX, 1, corner, (math.pi / 2, start.slope_rad, -math.pi / 2))
-    out += _stmt(f"GRAPHICS/{_BOX}, BOX, CORNER={_BOX}",
-                 f"X={_f(length * MM)}, Y={_f(across * MM)}, Z={_f(depth * MM)}")
+    boxes = _boxes(start)
+    out += [f"! the ground: {ground}, {len(boxes)} box(es), their tops r below it"]
+    for k, (what, corner, angles, size) in enumerate(boxes):
+        out += [f"! {what}"]
+        out += _marker(_BOX + k, 1, corner, angles)
+        out += _stmt(f"GRAPHICS/{_BOX + k}, BOX, CORNER={_BOX + k}",
+                     *(f"{a}={_f(v * MM)}" for a, v in zip("XYZ", size)))
     vcm = start.velocity
     out += ["!", "! ---- the wheel: one part on its spoke tips ----",
             f"! wheel: {start.mass_kg:g} kg, its frame at the stance tip, y to the hub, z "
@@ -255,7 +308,8 @@ def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "")
         out += _stmt(f"GRAPHICS/{m}, ELLIPSOID, CM={m}",
                      f"XSCALE={_f(2 * r * MM)}, YSCALE={_f(2 * r * MM)}, "
                      f"ZSCALE={_f(2 * r * MM)}")
-        contacts += contact_statement(k + 1, m, _BOX, law)
+        for j in range(len(boxes)):
+            contacts += contact_statement(len(boxes) * k + j + 1, m, _BOX + j, law)
     out += ["!", "! ---- joints ----"]
     if start.planar:
         out += ["! the plane of motion: the hub's x-z plane on the ground's",

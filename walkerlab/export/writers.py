@@ -118,7 +118,8 @@ def _adams_wheel(job: ExportJob, w: Writer) -> Written:
     check_exportable(scene, job.kind, w.name, True, tree=job.tree)
     hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
     strides = int(scene.contact_sim.n_strides) if scene.contact_sim else 5
-    ideal, start = job.gait(lambda ideal: wheel_start(job.data, ideal, strides, hub))
+    ideal, start = job.gait(lambda ideal: wheel_start(job.data, ideal, strides, hub,
+                                                      scene.terrain))
     adm = adm_wheel_text(scene, job.data, start, job.name, walkerlab.__version__)
     return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))),
                    tuple(o.line for o in ADAMS_WHEEL_OMISSIONS), step_period(ideal))

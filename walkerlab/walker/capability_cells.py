@@ -126,11 +126,11 @@ _WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ank
                                               "torso_torque", "push_off", "ankle_push_off",
                                               "virtual_constraints")}
 _WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
-#: why the planar wheel's Adams dataset refuses a ground other than the slope
-WHEEL_ADAMS_GROUND = ("the wheel's Adams dataset lays the slope as one box under its spoke "
-                      "tips (their spheres touch it wherever they land); the treads, "
-                      "footholds and profiles a tip lands on are laid by its MJCF "
-                      "(--format mjcf)")
+#: why the planar wheel's Adams dataset refuses footholds
+WHEEL_ADAMS_FOOTHOLDS = ("footholds are patches at the rigid wheel's own landings (a chord "
+                         "apart, each step's height along the normal), which its MJCF lays "
+                         "(--format mjcf); its Adams dataset lays continuous ground under "
+                         "the spoke tips: the slope, stairs, a profile")
 _WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
                    "one, walkerlab fixedpoint)")
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
@@ -267,9 +267,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "rolling_polygon": {
         **_PLANAR,
         **_WHEEL_JOINTS,
-        # the Adams dataset: the tree's one body on its spoke tips, on the slope
+        # the Adams dataset: the tree's one body on its spoke tips, on the slope, stairs
+        # (a box per tread) or a profile (a box per segment)
         # (walkerlab.export.adams_wheel.adm_wheel_text)
-        **{(g, "adams"): WHEEL_ADAMS_GROUND for g in ("stairs", "footholds", "profile")},
+        ("footholds", "adams"): WHEEL_ADAMS_FOOTHOLDS,
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): _WHEEL_GYM,
