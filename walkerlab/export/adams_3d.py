@@ -1,12 +1,12 @@
-"""A straight-legged walker in three dimensions (``walker.space: 3d``;
-:func:`walkerlab.codegen.derive_3d.derive_compass`) as an MSC Adams Solver dataset
-(``walker.adm``) and command file (``walker.acf``), started from the rigid gait.
+"""A legged walker in three dimensions (``walker.space: 3d``: straight legs,
+:func:`walkerlab.codegen.derive_3d.derive_compass`, or kneed legs) as an MSC Adams Solver
+dataset (``walker.adm``) and command file (``walker.acf``), started from the rigid gait.
 
 Statements are the planar dataset's (:mod:`walkerlab.export.adams`; Adams Solver statement
 reference): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP`` with products, ``QG``, ``REULER``,
 ``VX``, ``VY``, ``VZ``, ``WX``, ``WY``, ``WZ``), ``MARKER`` (``QP``, ``REULER``), ``JOINT``
 (``REVOLUTE``, ``FIXED``, ``SPHERICAL``, ``UNIVERSAL``), ``JPRIM`` (``PARALLEL_AXES``),
-``COUPLER``, ``ACCGRAV``, ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT``
+``COUPLER``, ``ACCGRAV``, ``GRAPHICS`` (``ELLIPSOID``, ``CYLINDER``, ``BOX``), ``CONTACT``
 (:func:`walkerlab.export.adams_contact.contact_statement`), ``VARIABLE``, ``GFORCE``,
 ``OUTPUT``, ``END``; the command file is the planar one
 (:func:`walkerlab.export.adams.acf_text`).
@@ -83,6 +83,12 @@ body's.
 
 Actuation (``walker.actuation``: a hip torque, ``joint: hip``, and the push-off): the planar
 dataset's statements on each leg's pitch (:mod:`walkerlab.export.adams_3d_actuation`).
+
+Knees (``locking_knees_3d``): the tree's export bodies with the MJCF's roles
+(:func:`walkerlab.export.legs_3d_parts.legs3d_roles`): each thigh ``leg<i>`` carries its
+shank ``leg<i>_shank`` on a ``REVOLUTE`` about the leg's pitch axis, the foot on the
+shank, the stance knee straight at the start; the planar kneed dataset's knee stop and latch
+(:mod:`walkerlab.export.adams_3d_knees`).
 
 Not written: requests of energies (the planar dataset's ``REQUEST/90``).
 """
@@ -230,10 +236,12 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     Parameters
     ----------
     data : WalkerData
-        The 3D straight-legged walker (point feet, point-mass legs).
+        The 3D legged walker (straight or kneed legs, point or round feet).
     ideal : gait
         ``x`` (6,) (roles ``lean``, ``swing``, ``stance`` and their rates, just after a
-        heel strike) or, with hip-roll joints, (10,) (``pelvis_roll``, ``swing_roll`` too),
+        heel strike), knees (8,) (``lean``, ``swing_thigh``, ``swing_shank``, ``stance``;
+        the stance knee straight) or, with hip-roll joints, (10,) (``pelvis_roll``,
+        ``swing_roll`` too),
         ``period_s`` [s], ``step_lengths_m``.
     strides : int
         Strides of the run: footfall patches for ``2 strides + 2`` steps.
@@ -462,7 +470,7 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     ----------
     scene : walkerlab.config.Scene
     data : WalkerData
-        Its 3D straight-legged walker (point feet, point-mass legs).
+        Its 3D legged walker (straight or kneed legs, point or round feet).
     start : Adams3dStart
         :func:`adams3d_start`.
     name, version : str

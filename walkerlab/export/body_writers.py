@@ -57,8 +57,8 @@ __all__ = ["MJCF", "URDF", "MjcfWriter", "TreeWriter", "UrdfWriter", "check_legs
 
 def planar_legs_only(job: ExportJob, w: Writer) -> None:
     """Refuse a walker whose tree is not of legs in the plane (one body: a spoked wheel;
-    legs in 3D), as the capability table has it (naming ``walker.model``): the Adams and
-    OpenSim writers' tree of leg links."""
+    legs in 3D), as the capability table has it (naming ``walker.model``): the planar Adams
+    and the OpenSim writers' tree of leg links."""
     tree = job.tree
     if tree.one_body or not tree.in_plane:
         check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)

@@ -17,8 +17,10 @@ per format: the URDF's :func:`walkerlab.export.urdf.legs_urdf_text`, the MJCF's
 :func:`walkerlab.export.multibody.planar_legs_mjcf` or
 :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf` makes).  The
 Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
-(:mod:`walkerlab.export.opensim`) write a tree of leg links in the plane (the Adams dataset
-also the 3D legs, :mod:`walkerlab.export.adams_3d`).
+(:mod:`walkerlab.export.opensim`) write a tree of leg links in the plane; the Adams dataset
+also the 3D legs from their export bodies (:mod:`walkerlab.export.adams_3d`: straight or
+kneed, round feet, hip-roll joints, the hip torque and push-off) and a spoked wheel, planar
+or 3D, from its tree's one body and contact points (:mod:`walkerlab.export.adams_wheel`).
 
 A new format: a write function (or a :class:`~walkerlab.export.body_writers.TreeWriter`'s
 ``write``) and one :class:`Writer` in :data:`WRITERS` (its view a column of
