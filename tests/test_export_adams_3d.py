@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from walkerlab.config import load_scene
 from walkerlab.export.adams_reader import parse_acf, read_adm
@@ -241,14 +242,16 @@ def test_a_3d_acf_runs_the_requested_strides(case):
     assert max(len(s) for s in adm.splitlines()[1:]) <= 80
 
 
-def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_round_feet_and_the_wheel(
+def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_a_wheel_on_footholds(
         tmp_path):
     """``walkerlab export configs/hip_width_stabilised.yaml --format adm`` writes both files;
-    the 3D round feet and the 3D wheel are refused in one line naming the field, nothing
-    written."""
+    a spoked wheel on footholds (its dataset lays continuous ground) is refused in one line
+    naming the field, nothing written."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
+    from walkerlab.walker.capability_cells import WHEEL_ADAMS_FOOTHOLDS
+    from walkerlab.walker.reference_cases import reference_scene
 
     run = CliRunner().invoke
     r = run(app, ["export", str(ROOT / "configs" / "hip_width_stabilised.yaml"), "--format",
@@ -257,13 +260,15 @@ def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_round_feet_and_
     folder = tmp_path / "hip_width_stabilised"
     assert set(read_adm((folder / "walker.adm").read_text()).by_kind["GFORCE"]) == {31, 32}
     assert parse_acf((folder / "walker.acf").read_text())
-    for cfg, field in (("round_feet_3d", "walker.foot_radius_m"),
-                       ("rimless_wheel_3d", "walker.space: 3d")):
-        r = run(app, ["export", str(ROOT / "configs" / f"{cfg}.yaml"), "--format", "adm",
-                      "--runs-dir", str(tmp_path)])
-        assert r.exit_code != 0 and r.output.strip().count("\n") == 0, r.output
-        assert field in r.output and "Traceback" not in r.output
-        assert not (tmp_path / cfg / "walker.adm").exists()
+    _case, d = reference_scene("rolling_polygon", "footholds", "adams")
+    d["name"] = "wheel_footholds"
+    cfg = tmp_path / "wheel_footholds.yaml"
+    cfg.write_text(yaml.safe_dump(d))
+    r = run(app, ["export", str(cfg), "--format", "adm", "--runs-dir", str(tmp_path)])
+    assert r.exit_code != 0 and r.output.strip().count("\n") == 0, r.output
+    assert WHEEL_ADAMS_FOOTHOLDS in " ".join(r.output.split()) and "terrain." in r.output
+    assert "Traceback" not in r.output
+    assert not (tmp_path / "wheel_footholds" / "walker.adm").exists()
 
 
 def _evaluate(model, ids=(331, 332, 333, 334, 341, 343, 351, 352)) -> dict:

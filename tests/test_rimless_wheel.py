@@ -402,10 +402,11 @@ def test_rimless_wheel_contact_trajectory_alternates_its_legs(wheel_runs):
         assert np.max(np.abs(n @ foot[:, on])) < 1e-4
 
 
-@pytest.mark.parametrize("fmt", ["adm", "osim"])
+@pytest.mark.parametrize("fmt", ["osim"])
 def test_rimless_wheel_export_refuses_leg_formats_in_one_line(fmt, tmp_path):
-    """``walkerlab export --format adm|osim``: the Adams and OpenSim writers build a tree of
-    leg links; the wheel is refused in one line naming walker.model, nothing written."""
+    """``walkerlab export --format osim``: the OpenSim writer builds a tree of leg links;
+    the wheel is refused in one line naming walker.model, nothing written (its Adams
+    dataset: tests/test_export_adams_wheel.py)."""
     from walkerlab.stages import export as export_stage
 
     with pytest.raises(ValueError) as exc:

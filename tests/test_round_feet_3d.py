@@ -378,18 +378,3 @@ def test_round_feet_bad_input_is_refused_naming_its_field(name, walker, says):
 
     with pytest.raises(ValidationError, match=says):
         _scene(name, **walker)
-
-
-def test_round_feet_3d_adams_export_refuses_in_one_line_naming_the_fields(tmp_path):
-    """The Adams dataset carries point feet and point-mass legs: refused in one line naming
-    the fields, before any file is written (the MJCF and URDF carry them:
-    ``tests/test_round_feet_3d_export.py``)."""
-    from walkerlab.cli.options import load
-    from walkerlab.stages import export
-
-    scene = load(str(ROOT / "configs" / "round_feet_3d.yaml"))
-    with pytest.raises(ValueError, match="^walker.foot_radius_m, walker.leg_inertia_kg_m2: "
-                                         "a 3D walker's Adams dataset") as e:
-        export.write(scene, tmp_path, "adm")
-    assert "\n" not in str(e.value)
-    assert not list(tmp_path.rglob("walker.*"))

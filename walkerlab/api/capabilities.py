@@ -416,13 +416,15 @@ def _adams(scene, d, runs: Path) -> tuple[float, str]:
     from walkerlab.stages import export  # light
     from walkerlab.walker.description import walker_data
     from walkerlab.walker.multibody import multibody
+    from walkerlab.walker.walker_trees import walker_tree
 
     path = export.write(scene, runs, "adm").path
     model = read_adm(Path(path).read_text())
     data = walker_data(scene.walker, scene.slope.phi_rad)
     parts = [p for p in model.by_kind["PART"] if p != 1]
     total = sum(model.part_mass(p) for p in parts)
-    if data.structure.in_3d:  # the 3D walker's parts: its tree's bodies
+    tree = walker_tree(data.structure)[0]
+    if tree.one_body or not tree.in_plane:  # its tree's bodies (a wheel's one)
         return (abs(total / data.total_mass_kg - 1.0),
                 f"{len(parts)} parts, {total:.6g} kg against {data.total_mass_kg:.6g} kg")
     mb = multibody(data)

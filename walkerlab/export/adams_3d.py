@@ -1,12 +1,12 @@
-"""A straight-legged walker in three dimensions (``walker.space: 3d``;
-:func:`walkerlab.codegen.legged.derive_legged`) as an MSC Adams Solver dataset
-(``walker.adm``) and command file (``walker.acf``), started from the rigid gait.
+"""A legged walker in three dimensions (``walker.space: 3d``: straight legs,
+:func:`walkerlab.codegen.legged.derive_legged`, or kneed legs) as an MSC Adams Solver
+dataset (``walker.adm``) and command file (``walker.acf``), started from the rigid gait.
 
 Statements are the planar dataset's (:mod:`walkerlab.export.adams`; Adams Solver statement
 reference): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP`` with products, ``QG``, ``REULER``,
 ``VX``, ``VY``, ``VZ``, ``WX``, ``WY``, ``WZ``), ``MARKER`` (``QP``, ``REULER``), ``JOINT``
 (``REVOLUTE``, ``FIXED``, ``SPHERICAL``, ``UNIVERSAL``), ``JPRIM`` (``PARALLEL_AXES``),
-``COUPLER``, ``ACCGRAV``, ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT``
+``COUPLER``, ``ACCGRAV``, ``GRAPHICS`` (``ELLIPSOID``, ``CYLINDER``, ``BOX``), ``CONTACT``
 (:func:`walkerlab.export.adams_contact.contact_statement`), ``VARIABLE``, ``GFORCE``,
 ``OUTPUT``, ``END``; the command file is the planar one
 (:func:`walkerlab.export.adams.acf_text`).
@@ -71,8 +71,26 @@ the tree; the pelvis turns with leg2 (its FIXED joint), its centre of mass on th
 moving as the rigid hip does.  No rate scale (``contact_sim.initial_rate_scale`` is the
 planar contact walker's).
 
-Not written: round feet and leg inertia (``walker.foot_radius_m``, refused as the MJCF
-refuses them), requests of energies (the planar dataset's ``REQUEST/90``).
+Round feet (``walker.foot_radius_m``; :func:`walkerlab.codegen.derive_3d.derive_compass`'s
+disc in each leg's rolled sagittal plane, its centre ``L - R`` down the leg): each foot a
+``GRAPHICS/CYLINDER`` of radius ``R`` and length ``2`` :data:`~walkerlab.export.
+legs_3d_parts.DISC_HALF_THICKNESS_L` ``L`` about the leg's pitch axis (its base marker
+``100 p + 4``, z along the axis), the MJCF's disc, its ``CONTACT`` with its lane's patches,
+whose tops lie on the slope's plane through the footfalls (the disc touches the plane); the
+foot marker ``100 p + 3`` its centre, where the stance-foot pin holds it (ground marker 102
+there).  The legs' inertia (``walker.leg_inertia_kg_m2``, a rod's) is the tree's, as every
+body's.
+
+Actuation (``walker.actuation``: a hip torque, ``joint: hip``, and the push-off): the planar
+dataset's statements on each leg's pitch (:mod:`walkerlab.export.adams_3d_actuation`).
+
+Knees (``locking_knees_3d``): the tree's export bodies with the MJCF's roles
+(:func:`walkerlab.export.legs_3d_parts.legs3d_roles`): each thigh ``leg<i>`` carries its
+shank ``leg<i>_shank`` on a ``REVOLUTE`` about the leg's pitch axis, the foot on the
+shank, the stance knee straight at the start; the planar kneed dataset's knee stop and latch
+(:mod:`walkerlab.export.adams_3d_knees`).
+
+Not written: requests of energies (the planar dataset's ``REQUEST/90``).
 """
 
 from __future__ import annotations
@@ -84,6 +102,8 @@ import sympy as sp
 
 from walkerlab.codegen.cache import functions
 from walkerlab.config.contact import ContactSettings
+from walkerlab.export.adams_3d_actuation import actuation_3d_statements
+from walkerlab.export.adams_3d_knees import knee_3d_statements
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
@@ -95,7 +115,14 @@ from walkerlab.export.legs_3d_mjcf import (
     legs3d_footfalls,
     legs3d_keyframe,
 )
-from walkerlab.export.legs_3d_parts import legs_summary, walker_tree
+from walkerlab.export.legs_3d_parts import (
+    DISC_HALF_THICKNESS_L,
+    kneed,
+    legs3d_roles,
+    legs_summary,
+    round_feet,
+    walker_tree,
+)
 from walkerlab.export.omitted import Omission
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
@@ -167,13 +194,33 @@ class Adams3dStart:
     law : dict or None
         ``walker.hip_roll``'s numbers (the pelvis on its roll hinge, the legs on roll and
         pitch); None: no hip-roll joints (the pelvis fixed to leg2).
+    feet : dict
+        ``body name -> (down [m], disc radius [m])``: the bodies that carry a foot, its
+        centre down the body's axis (a point foot's ``L``, a round foot's disc ``L - R``)
+        and a round foot's radius ``R`` (0: a point foot's sphere of radius ``L / 1000``).
     """
 
     def __init__(self, bodies, couplings, pose, velocity, hinges, lanes, period_s, numbers,
-                 law=None):
+                 law=None, feet=None):
         self.bodies, self.couplings = bodies, couplings
         self.pose, self.velocity, self.hinges = pose, velocity, hinges
         self.lanes, self.period_s, self.numbers, self.law = lanes, period_s, numbers, law
+        L = numbers["L"]
+        self.feet = feet if feet is not None else {"leg1": (L, 0.0), "leg2": (L, 0.0)}
+
+    def foot_body(self, leg: str) -> str:
+        """The body that carries ``leg``'s foot (``leg``, or its shank)."""
+        return next(b for b in self.feet if b.split("_")[0] == leg)
+
+    @property
+    def disc_m(self) -> float:
+        """The round feet's radius [m] (0: point feet)."""
+        return max(d for _down, d in self.feet.values())
+
+    def foot_centre(self, leg: str) -> np.ndarray:
+        """Where ``leg``'s foot has its centre at the start [m] (3,)."""
+        o, R = self.pose[self.foot_body(leg)]
+        return o + R @ np.array([0.0, 0.0, -self.feet[self.foot_body(leg)][0]])
 
     def cm_velocity(self, name: str) -> np.ndarray:
         """The body's centre-of-mass velocity [m/s] (3,) in ground."""
@@ -189,10 +236,12 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     Parameters
     ----------
     data : WalkerData
-        The 3D straight-legged walker (point feet, point-mass legs).
+        The 3D legged walker (straight or kneed legs, point or round feet).
     ideal : gait
         ``x`` (6,) (roles ``lean``, ``swing``, ``stance`` and their rates, just after a
-        heel strike) or, with hip-roll joints, (10,) (``pelvis_roll``, ``swing_roll`` too),
+        heel strike), knees (8,) (``lean``, ``swing_thigh``, ``swing_shank``, ``stance``;
+        the stance knee straight) or, with hip-roll joints, (10,) (``pelvis_roll``,
+        ``swing_roll`` too),
         ``period_s`` [s], ``step_lengths_m``.
     strides : int
         Strides of the run: footfall patches for ``2 strides + 2`` steps.
@@ -204,8 +253,10 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
 
     tree, coords, p = walker_tree(data)
     rolled = bool(data.structure.hip_roll)
-    root, couplings = export_bodies(tree, coords, p, PelvisRoles(
-        pelvis_hinges=("stance_hip_roll",) if rolled else ()))
+    knees = kneed(data)
+    root, couplings = export_bodies(tree, coords, p, legs3d_roles(data) if knees else
+                                    PelvisRoles(pelvis_hinges=("stance_hip_roll",) if rolled
+                                                else ()))
     f = functions(data)
     x = np.asarray(ideal.x, float)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], x, data.slope_rad, 0.0)
@@ -216,14 +267,20 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     rates = {c: s[f"{c}_rate"] for c in coords.names if f"{c}_rate" in s}
     hinges = {}
 
+    def coord(q) -> str:
+        """The state's coordinate of a joint angle's symbol (the stance leg's own shank
+        angle: the stance angle, its knee straight at the start)."""
+        name = q.name[2:] if q.name.startswith("q_") else q.name
+        return {"stance_shank": "stance"}.get(name, name)
+
     def turn(joints, R, w):
         """``R``, ``w`` turned by the hinges ``joints`` at the start's angles and rates."""
         for j in joints:
             if j.kind != "hinge":
                 continue
-            sym = {q: angles[q.name[2:]] for q in j.angle.free_symbols}
+            sym = {q: angles[coord(q)] for q in j.angle.free_symbols}
             ang = float(j.angle.subs(sym))
-            rate = float(sum(sp.diff(j.angle, q) * rates[q.name[2:]]
+            rate = float(sum(sp.diff(j.angle, q) * rates[coord(q)]
                              for q in j.angle.free_symbols))
             hinges[j.name] = (np.asarray(j.axis, float), ang, rate)
             w = w + rate * (R @ np.asarray(j.axis, float))
@@ -251,8 +308,11 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     lanes = legs3d_footfalls(f["points"], x, 2 * strides + 2)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
+    disc = float(p["R_foot"]) if round_feet(data) else 0.0
+    feet = ({f"{leg}_shank": (p["L"] - p["L_thigh"], 0.0) for leg in ("leg1", "leg2")}
+            if knees else {leg: (p["L"] - disc, disc) for leg in ("leg1", "leg2")})
     return Adams3dStart(list(root.walk()), couplings, pose, velocity, hinges, lanes,
-                        float(ideal.period_s) / steps, p, law)
+                        float(ideal.period_s) / steps, p, law, feet)
 
 
 def part_ids_3d(start: Adams3dStart) -> dict[str, int]:
@@ -305,9 +365,17 @@ def _parts(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
             op, Rp = start.pose[start.bodies[0].name]
             out += _marker(100 * p + 10 + ids[start.bodies[0].name], p, R.T @ (op - o),
                            reuler_angles(R.T @ Rp))
-        if b.name in ("leg1", "leg2"):
-            m = 100 * p + 3
-            out += _marker(m, p, (0.0, 0.0, -L))
+        if b.name in start.feet:
+            m, (down, disc) = 100 * p + 3, start.feet[b.name]
+            out += _marker(m, p, (0.0, 0.0, -down))
+            if disc:   # the disc about the leg's pitch axis, from its base marker
+                half = DISC_HALF_THICKNESS_L * L
+                ax = np.asarray(hinged[-1].axis, float)
+                out += _marker(100 * p + 4, p, np.array([0.0, 0.0, -down]) - half * ax,
+                               _z_to(ax))
+                out += _stmt(f"GRAPHICS/{m}, CYLINDER, CM={100 * p + 4}",
+                             f"LENGTH={_f(2 * half * MM)}, RADIUS={_f(disc * MM)}")
+                continue
             out += _stmt(f"GRAPHICS/{m}, ELLIPSOID, CM={m}",
                          f"XSCALE={_f(2 * r * MM)}, YSCALE={_f(2 * r * MM)}, "
                          f"ZSCALE={_f(2 * r * MM)}")
@@ -351,27 +419,32 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
                 _stmt(f"COUPLER/{_COUPLER}, JOINTS={terms[0][0]}, {terms[1][0]}, TYPE=R:R",
                       f"SCALES={_fs(*(float(c) for _j, c in terms))}")[0]]
     out += ["! temporary stance-foot pin: deactivated by walker.acf",
-            f"JOINT/{PIN_JOINT_3D}, SPHERICAL, I={100 * ps + 3}, J=102"]
+            f"JOINT/{PIN_JOINT_3D}, SPHERICAL, I={100 * ids[start.foot_body(stance)] + 3}, "
+            "J=102"]
     return out
 
 
 def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
-            rolled: bool = False) -> tuple[list[str], list[list[int]]]:
+            rolled: bool = False, frame: bool = False) -> tuple[list[str], list[list[int]]]:
     """PART/1, its markers, ACCGRAV and each lane's patches (boxes whose top face lies
-    ``r`` below the slope's plane through the footfalls); the patches' GRAPHICS ids by
-    lane."""
+    ``r`` below the slope's plane through the footfalls; round feet: on it); the patches'
+    GRAPHICS ids by lane.  ``rolled``: the hip-roll law's wider patches; ``rolled`` or
+    ``frame``: the ground frame :data:`~walkerlab.export.adams_hip_roll.ROLL_FRAME` the laws
+    read angles in.  The pin's ground marker 102 at leg2's foot centre (the origin, a round
+    foot's disc centre above it)."""
     L = start.numbers["L"]
-    r = WHEEL_TIP_FRACTION * L
+    r = 0.0 if start.disc_m else WHEEL_TIP_FRACTION * L
     t, n = slope_axes(slope_rad)
     across = (PATCH_ACROSS_PUSHED_L if rolled else PATCH_ACROSS_L) * L
     depth = width_m / 10
     tilt = (math.pi / 2, slope_rad, -math.pi / 2)  # Rz(90) Rx(phi) Rz(-90) = Rot(y, phi)
     out = ["!", "! ---- ground, gravity (along -z) and the footfall patches of each lane ----",
            "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
-           "MARKER/102, PART=1, QP=0.0, 0.0, 0.0",
+           *(_marker(102, 1, start.foot_centre("leg2")) if start.disc_m else
+             ["MARKER/102, PART=1, QP=0.0, 0.0, 0.0"]),
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-g * MM)}"]
     out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))   # z along the fall line
-    if rolled:  # the frame the law reads rolls in (x s, y n, z z_w)
+    if rolled or frame:  # the frame the law reads rolls in (x s, y n, z z_w)
         out += _marker(ROLL_FRAME, 1, (0.0, 0.0, 0.0), reuler_angles(
             np.column_stack([t, n, np.cross(t, n)])))
     gid, ids = 1001, []
@@ -397,7 +470,7 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     ----------
     scene : walkerlab.config.Scene
     data : WalkerData
-        Its 3D straight-legged walker (point feet, point-mass legs).
+        Its 3D legged walker (straight or kneed legs, point or round feet).
     start : Adams3dStart
         :func:`adams3d_start`.
     name, version : str
@@ -414,16 +487,26 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     ids = part_ids_3d(start)
     stance = "leg2"
     out = [f"walker {name} exported by walkerlab {version} (Adams Solver dataset, 3D)",
-           "! A straight-legged walker in 3D:", f"! {legs_summary(data, p)},",
+           "! A straight-legged walker in 3D:" if not kneed(data) else
+           "! A kneed walker in 3D (knees on the legs' pitch axes, stops below):",
+           f"! {legs_summary(data, p)},",
            f"! hips {p['w_hip']:g} m apart, slope {data.slope_rad:g} rad.",
            "! Axes: x downhill, z up, y = walkerlab's -z (leg1 on the side of -y);",
            "! the ground's patches are tilted about y, gravity is along -z.",
            f"! Start: the rigid gait (step period {start.period_s:.6g} s) just after a heel "
-           "strike, leg2", "! in stance, its foot point (the foot sphere's centre) at the "
-           "origin.", "! Not written: the energies' requests of the planar dataset.",
+           "strike, leg2", *(["! in stance, its foot point (the foot sphere's centre) at the "
+                              "origin."] if not start.disc_m else
+                             ["! in stance, its foot disc on the slope (its reference point "
+                              "at the origin),", f"! each foot a disc of radius "
+                              f"{start.disc_m:g} m about the leg's pitch axis."]),
+           "! Not written: the energies' requests of the planar dataset.",
            "UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND"]
+    act = scene.walker.actuation
+    if act is not None:
+        out += ["! walker.actuation: its hip torque (SFORCE or GFORCE) and push-off (GFORCE",
+                "! pulses) are written below, after the contacts"]
     ground, patches = _ground(start, data.slope_rad, p["g"], float(
-        scene.terrain_or_default().patch_width_m), start.law is not None)
+        scene.terrain_or_default().patch_width_m), start.law is not None, act is not None)
     out += ground
     out += _parts(start, ids, stance)
     out += _joints(start, ids, stance)
@@ -431,10 +514,13 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     cid, contacts = 1, {}
     for leg, lane in zip(("leg1", "leg2"), patches):
         for gid in lane:
-            out += contact_statement(cid, 100 * ids[leg] + 3, gid, law)
+            out += contact_statement(cid, 100 * ids[start.foot_body(leg)] + 3, gid, law)
             contacts.setdefault(leg, []).append(cid)
             cid += 1
     if start.law is not None:
         out += hip_roll_statements(start.law, ids, contacts)
+    out += actuation_3d_statements(scene, ids, contacts, data.slope_rad, start.law is not None)
+    if any(b.endswith("_shank") for b in start.feet):
+        out += knee_3d_statements(scene, ids, data.slope_rad)
     out += ["!", "OUTPUT/REQSAVE, GRSAVE"]
     return "\n".join([*out, "END", ""])

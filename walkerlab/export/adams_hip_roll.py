@@ -25,7 +25,8 @@ from __future__ import annotations
 
 from walkerlab.export.adams_statements import MM, _chain_sum, _f, _var
 
-__all__ = ["HIP_ROLL_GFORCE", "ROLL_FRAME", "ROLL_VARIABLES", "hip_roll_statements"]
+__all__ = ["HIP_ROLL_GFORCE", "ROLL_FRAME", "ROLL_VARIABLES", "hip_roll_statements",
+           "role_statements"]
 
 #: The ground marker whose axes are the fall line, the slope's normal and walkerlab's z.
 ROLL_FRAME = 104
@@ -46,6 +47,30 @@ def _by_role(sign: int, leg1: int, leg2: int, stance: bool) -> str:
     st, sw = f"VARVAL({leg2})", f"VARVAL({leg1})"
     a, b = (sw, st) if stance else (st, sw)  # sign < 0: leg1 stands
     return f"IF(VARVAL({sign}):{a},{b},{b})"
+
+
+def role_statements(contacts: dict) -> list[str]:
+    """The roles' force test: each foot's normal contact force [N] (the sum over its
+    CONTACTs, VARIABLE/301, 302) and the role sign (VARIABLE/303: +1 while leg2 stands, -1
+    while leg1 stands, a tie leg2's), the planar dataset's
+    (:func:`walkerlab.export.adams_actuation.actuation_statements`).
+
+    Parameters
+    ----------
+    contacts : dict
+        CONTACT ids by leg (``leg1``, ``leg2``).
+
+    Returns
+    -------
+    list of str
+    """
+    V = ROLL_VARIABLES
+    out = []
+    for g, base in (("leg1", 410), ("leg2", 460)):
+        out += _chain_sum(base, V[f"force_{g}"],
+                          [f"CONTACT({c},0,1,0)" for c in contacts[g]])
+    return out + [_var(V["sign"], f"IF(VARVAL({V['force_leg1']})-VARVAL({V['force_leg2']}):"
+                       "1,1,-1)")]
 
 
 def hip_roll_statements(law: dict, parts: dict, contacts: dict) -> list[str]:
@@ -76,11 +101,7 @@ def hip_roll_statements(law: dict, parts: dict, contacts: dict) -> list[str]:
            "! (VARIABLE/301, 302 [N]); VARIABLE/303: +1 while leg2 stands, -1 while leg1",
            "! stands. Rolls about the fall line from each body's pitch axis (marker",
            f"! 100 p + 5), in the ground frame MARKER/{ROLL_FRAME} (x fall line, y normal)."]
-    for g, base in (("leg1", 410), ("leg2", 460)):
-        out += _chain_sum(base, V[f"force_{g}"],
-                          [f"CONTACT({c},0,1,0)" for c in contacts[g]])
-    out.append(_var(V["sign"], f"IF(VARVAL({V['force_leg1']})-VARVAL({V['force_leg2']}):"
-                    "1,1,-1)"))
+    out += role_statements(contacts)
     for k, body in enumerate(("pelvis", "leg1", "leg2")):
         p = parts[body]
         o, a = 100 * p + 2, 100 * p + 5

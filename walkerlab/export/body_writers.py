@@ -57,8 +57,8 @@ __all__ = ["MJCF", "URDF", "MjcfWriter", "TreeWriter", "UrdfWriter", "check_legs
 
 def planar_legs_only(job: ExportJob, w: Writer) -> None:
     """Refuse a walker whose tree is not of legs in the plane (one body: a spoked wheel;
-    legs in 3D), as the capability table has it (naming ``walker.model``): the Adams and
-    OpenSim writers' tree of leg links."""
+    legs in 3D), as the capability table has it (naming ``walker.model``): the planar Adams
+    and the OpenSim writers' tree of leg links."""
     tree = job.tree
     if tree.one_body or not tree.in_plane:
         check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
@@ -69,9 +69,8 @@ def planar_legs_only(job: ExportJob, w: Writer) -> None:
 def check_legs_3d(job: ExportJob, w: Writer) -> None:
     """Refuse in one line what the 3D legged walker's ``w`` does not carry (the capability
     table's cells: round feet and leg inertia, hip-roll joints, actuators; numbers,
-    ground).  The URDF and MJCF carry round feet (each foot's disc) and the legs' inertia
-    (the tree's); the Adams dataset refuses them itself (its writer,
-    :mod:`walkerlab.export.writers`)."""
+    ground).  The URDF, MJCF and Adams dataset carry round feet (each foot's disc) and the
+    legs' inertia (the tree's)."""
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
     st = data.structure

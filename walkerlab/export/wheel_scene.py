@@ -18,9 +18,10 @@ __all__ = ["WHEEL_FORMATS", "WheelKeyframe", "check_wheel_exportable", "wheel_ke
            "wheel_keyframe_json"]
 
 #: The formats whose writers take a walker that is one rigid body on its spokes (a
-#: spoked wheel: :func:`walkerlab.export.spoked.wheel_urdf_text`, ``wheel_mjcf_text``);
-#: the Adams and OpenSim writers build a tree of leg links.
-WHEEL_FORMATS = ("urdf", "mjcf")
+#: spoked wheel: :func:`walkerlab.export.spoked.wheel_urdf_text`, ``wheel_mjcf_text``,
+#: :func:`walkerlab.export.adams_wheel.adm_wheel_text`); the OpenSim writer builds a tree of
+#: leg links.
+WHEEL_FORMATS = ("urdf", "mjcf", "adm")
 
 
 def check_wheel_exportable(scene: Scene, kind: Kind, fmt: str,
@@ -32,7 +33,7 @@ def check_wheel_exportable(scene: Scene, kind: Kind, fmt: str,
     ------
     walkerlab.walker.kinds.KindRefused
         One line naming the field: ``walker.model`` for a format other than
-        :data:`WHEEL_FORMATS` (the Adams and OpenSim writers build leg links);
+        :data:`WHEEL_FORMATS` (the OpenSim writer builds leg links);
         ``terrain.kind`` for a ground other than the slope where the format's cell of that
         ground refuses it, unless ``walker_only``.
     """

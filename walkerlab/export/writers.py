@@ -6,8 +6,9 @@ them (:class:`Written`); it writes nothing.  The stage (:func:`walkerlab.stages.
 checks the scene against the capability table's cells, searches the rigid gait when the
 writer asks for it, and writes the files atomically (all or none).
 
-The URDF and MJCF writers are format objects over the walker's body tree
-(:data:`walkerlab.export.body_writers.URDF`, :data:`~walkerlab.export.body_writers.MJCF`):
+The URDF, MJCF and Adams writers are format objects over the walker's body tree
+(:data:`walkerlab.export.body_writers.URDF`, :data:`~walkerlab.export.body_writers.MJCF`,
+:data:`walkerlab.export.adams_writer.ADAMS`):
 each asks the tree its form (legs or one body, in the plane or in 3D) and writes it, a
 tree of leg links (:mod:`walkerlab.export.multibody`), a spoked wheel (planar, or in 3D:
 :mod:`walkerlab.export.spoked`), or the 3D legged walker's free pelvis
@@ -17,8 +18,10 @@ per format: the URDF's :func:`walkerlab.export.urdf.legs_urdf_text`, the MJCF's
 :func:`walkerlab.export.multibody.planar_legs_mjcf` or
 :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf` makes).  The
 Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
-(:mod:`walkerlab.export.opensim`) write a tree of leg links in the plane (the Adams dataset
-also the 3D legs, :mod:`walkerlab.export.adams_3d`).
+(:mod:`walkerlab.export.opensim`) write a tree of leg links in the plane; the Adams dataset
+also the 3D legs from their export bodies (:mod:`walkerlab.export.adams_3d`: straight or
+kneed, round feet, hip-roll joints, the hip torque and push-off) and a spoked wheel, planar
+or 3D, from its tree's one body and contact points (:mod:`walkerlab.export.adams_wheel`).
 
 A new format: a write function (or a :class:`~walkerlab.export.body_writers.TreeWriter`'s
 ``write``) and one :class:`Writer` in :data:`WRITERS` (its view a column of
@@ -31,23 +34,9 @@ import math
 
 import walkerlab
 from walkerlab.config import Scene
-from walkerlab.export.adams import (
-    ADAMS_FILES,
-    acf_text,
-    adams_omissions,
-    adams_start,
-    adm_text,
-    check_adams_exportable,
-)
-from walkerlab.export.adams_3d import ADAMS_3D_OMISSIONS, adams3d_start, adm3d_text
-from walkerlab.export.adams_actuation import check_adams_actuation
-from walkerlab.export.body_writers import (
-    MJCF,
-    URDF,
-    check_legs_3d,
-    planar_legs_only,
-    round_feet_3d_fields,
-)
+from walkerlab.export.adams import ADAMS_FILES
+from walkerlab.export.adams_writer import ADAMS
+from walkerlab.export.body_writers import MJCF, URDF, planar_legs_only
 from walkerlab.export.engine_walk import ENGINES, EngineWalk, not_walked, walk_export
 from walkerlab.export.jobs import (  # noqa: F401 (part of this API)
     Exported,
@@ -71,48 +60,6 @@ from walkerlab.export.scene import FORMAT_VIEWS, check_exportable
 from walkerlab.export.tree_links import tree_multibody
 
 
-def _adams(job: ExportJob, w: Writer) -> Written:
-    """``walker.adm`` and ``walker.acf`` (both built before either is written); a walker
-    whose tree is not in the plane by :func:`_adams_3d`."""
-    if not job.tree.in_plane:
-        return _adams_3d(job, w)
-    planar_legs_only(job, w)
-    scene, data = job.scene, job.data
-    mb = tree_multibody(data)  # its links: the body tree's
-    act = scene.walker.actuation
-    if act is not None and act.virtual_constraints is not None:  # the table's cell
-        job.kind.require("virtual_constraints", w.view, "walker.actuation.virtual_constraints")
-    check_adams_exportable(mb)  # before the gait search
-    check_adams_actuation(scene)
-    start = adams_start(scene, mb, job.plant, job.stored())
-    adm = adm_text(scene, mb, job.plant, job.name, walkerlab.__version__, start)
-    acf = acf_text(scene, start)
-    return Written(((w.file, adm), (ADAMS_FILES["acf"], acf)),
-                   tuple(o.line for o in adams_omissions(scene, mb)))
-
-
-def _adams_3d(job: ExportJob, w: Writer) -> Written:
-    """The 3D straight-legged walker's ``walker.adm`` and ``walker.acf``
-    (:func:`walkerlab.export.adams_3d.adm3d_text`), refused before the gait search as its
-    MJCF is (:func:`walkerlab.export.body_writers.check_legs_3d`; round feet and leg
-    inertia refused here); a 3D wheel as the capability table has it."""
-
-    job.kind.require("walk", w.view, "walker.space: 3d")
-    st = job.data.structure
-    if st.foot == "arc" or any(b.kind == "rod" for b in st.bodies):
-        fields = round_feet_3d_fields(job)
-        job.kind.require("round_feet_3d", w.view, fields)
-        raise ValueError(f"{fields}: the Adams dataset carries point feet and point-mass "
-                         "legs")  # the table's cell, if it ran
-    check_legs_3d(job, w)  # --walker-only: the gait still written, as the planar dataset's
-    scene = job.scene
-    strides = int(scene.contact_sim.n_strides) if scene.contact_sim else 5
-    ideal, start = job.gait(lambda ideal: adams3d_start(job.data, ideal, strides))
-    adm = adm3d_text(scene, job.data, start, job.name, walkerlab.__version__)
-    return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))),
-                   tuple(o.line for o in ADAMS_3D_OMISSIONS), step_period(ideal))
-
-
 def _osim(job: ExportJob, w: Writer) -> Written:
     """``walker.osim``: the walker, its gait as the default state, its ground and contact."""
     planar_legs_only(job, w)
@@ -133,7 +80,7 @@ def _osim(job: ExportJob, w: Writer) -> Written:
 WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("urdf", FORMATS["urdf"], FORMAT_VIEWS["urdf"], URDF.write, ground=False),
     Writer("mjcf", FORMATS["mjcf"], FORMAT_VIEWS["mjcf"], MJCF.write),
-    Writer("adm", ADAMS_FILES["adm"], FORMAT_VIEWS["adm"], _adams),
+    Writer("adm", ADAMS_FILES["adm"], FORMAT_VIEWS["adm"], ADAMS.write),
     Writer("osim", OSIM_FILE, FORMAT_VIEWS["osim"], _osim),
 )}
 

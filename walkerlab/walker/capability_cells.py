@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
-__all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
+__all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
+           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -71,10 +71,6 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 #: why a 3D walker's views refuse a ground other than a plane
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
-#: why a 3D walker refuses actuators
-ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model, contact "
-                "model, MJCF and URDF so far; its Adams dataset is passive but for the "
-                "hip-roll law (walker.hip_roll)")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
          "walker.actuation.torques (joint: hip)")
@@ -88,10 +84,6 @@ NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width
 NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
                     "straight-legged walker's (walker.space: 3d); a planar walker's round "
                     "feet are walker.leg.foot.kind: arc")
-#: why the 3D walker's Adams dataset refuses its round feet (and leg inertia)
-ROUND_FEET_EXPORT_3D = ("a 3D walker's Adams dataset carries point feet and point-mass legs "
-                        "so far (its round feet and leg inertia run in the rigid model and "
-                        "the URDF and MJCF exports)")
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -99,8 +91,8 @@ EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written 
 #: only ones so far)
 _KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model (walkerlab fixedpoint, "
                   "simulate) and is exported as MJCF and URDF (export --format mjcf, urdf) "
-                  "so far: its floating (contact) view and its Adams and OpenSim exports are "
-                  "a later step")
+                  "so far: its floating (contact) view and its OpenSim export are a later "
+                  "step")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -134,6 +126,11 @@ _WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ank
                                               "torso_torque", "push_off", "ankle_push_off",
                                               "virtual_constraints")}
 _WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
+#: why the planar wheel's Adams dataset refuses footholds
+WHEEL_ADAMS_FOOTHOLDS = ("footholds are patches at the rigid wheel's own landings (a chord "
+                         "apart, each step's height along the normal), which its MJCF lays "
+                         "(--format mjcf); its Adams dataset lays continuous ground under "
+                         "the spoke tips: the slope, stairs, a profile")
 _WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
                    "one, walkerlab fixedpoint)")
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
@@ -270,8 +267,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "rolling_polygon": {
         **_PLANAR,
         **_WHEEL_JOINTS,
-        ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
-                            "(one rigid body) is exported as urdf or mjcf"),
+        # the Adams dataset: the tree's one body on its spoke tips, on the slope, stairs
+        # (a box per tread) or a profile (a box per segment)
+        # (walkerlab.export.adams_wheel.adm_wheel_text)
+        ("footholds", "adams"): WHEEL_ADAMS_FOOTHOLDS,
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): _WHEEL_GYM,
@@ -283,8 +282,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "straight_legs_3d": {
         # round feet and leg inertia: the MJCF's disc (cylinder) feet, the URDF's
-        # cylinder collisions and both files' leg inertia (walkerlab.export.legs_3d_mjcf)
-        ("round_feet_3d", "adams"): ROUND_FEET_EXPORT_3D,
+        # cylinder collisions, the Adams dataset's GRAPHICS/CYLINDER contact and the
+        # files' leg inertia (walkerlab.export.legs_3d_mjcf, walkerlab.export.adams_3d)
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
@@ -292,9 +291,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (walkerlab.export.legs_3d_mjcf: the planar MJCF's motor and custom text, run by
         # walkerlab.export.mujoco_walk.PoweredLoop) and the URDF (its hip joints,
         # the motor and the push-off left out as the planar URDF's: walkerlab.export.
-        # urdf.legs_urdf_text; with hip-roll joints each leg's roll then pitch)
-        **{(f, v): ACTUATION_3D for f in ("hip_torque", "push_off")
-           for v in ("adams",)},
+        # urdf.legs_urdf_text; with hip-roll joints each leg's roll then pitch) and the
+        # Adams dataset (walkerlab.export.adams_3d_actuation: the planar dataset's laws on
+        # each leg's pitch, an SFORCE or a GFORCE per leg, the push-off GFORCE pulse)
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
         ("torso_torque", "*"): "the 3D straight legs carry no torso",
@@ -328,7 +327,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's
-        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "adams", "osim")},
+        # the Adams dataset: the 3D straight legs' with a knee revolute on each leg, its
+        # stop and latch the planar kneed dataset's (walkerlab.export.adams_3d_knees)
+        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "osim")},
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
@@ -339,11 +340,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the compliant-contact model: a free body on its spoke tips
         # (walkerlab.codegen.floating_3d.derive_wheel_3d)
         **_CELLS_3D,
-        ("walk", "adams"): ("the Adams dataset writes legged walkers (planar, and the 3D "
-                            "straight legs); a 3D spoked wheel (one rigid body) is "
-                            "exported as urdf or mjcf"),
-        # the MJCF and the URDF: a free body on its spoke tips
-        # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text)
+        # the MJCF, the URDF and the Adams dataset: a free body on its spoke tips
+        # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text,
+        # walkerlab.export.adams_wheel.adm_wheel_text)
         ("walk", "gym"): _WHEEL_GYM,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },

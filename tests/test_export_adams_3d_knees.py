@@ -1,0 +1,124 @@
+"""The kneed walker in 3D (``locking_knees_3d``, configs/kneed_3d.yaml) in its Adams dataset
+(:mod:`walkerlab.export.adams_3d`, :mod:`walkerlab.export.adams_3d_knees`), read back by
+walkerlab's reader and set against the rigid model at a state.
+
+References the writer does not compute: the masses are the scene's numbers; the parts'
+centres of mass, the knees and the feet are the rigid model's generated ``points`` (in the
+exports' axes, z up: ``X = x, Y = -z, Z = y``, written out here); the kinetic energy is the
+rigid model's ``0.5 dq^T M(q) dq``; the knee angles the state's (``swing_shank -
+swing_thigh``; the stance knee straight); the stop's and latch's numbers the contact
+model's (:func:`walkerlab.models.contact.rigid_limit.contact_si`).  The state is not a gait
+(the file's statements are functions of the state): no gait search.  Tolerance 1e-9.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from tests.adams_eval import evaluate
+from walkerlab.codegen.cache import functions
+from walkerlab.config import load_scene
+from walkerlab.config.contact import ContactSettings
+from walkerlab.export.adams_3d import adams3d_start, adm3d_text
+from walkerlab.export.adams_reader import read_adm
+from walkerlab.models.contact.rigid_limit import contact_si
+from walkerlab.walker.plant import Plant
+
+ROOT = Path(__file__).resolve().parents[1]
+TOL = 1e-9
+C = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+#: lean, swing thigh, swing shank, stance and their rates (the swing knee bent 0.085 rad)
+X = [-0.006, -0.285, -0.37, 0.1868, -0.125, -0.118, -0.5, -0.9]
+#: PART id -> (its body, the rigid point of its centre of mass, its mass [kg])
+PARTS = {2: ("pelvis", "hip", 0.5), 3: ("leg1", "swing_thigh_mass", 0.5),
+         4: ("leg1_shank", "swing_shank_mass", 0.05), 5: ("leg2", "stance_thigh_mass", 0.5),
+         6: ("leg2_shank", "stance_shank_mass", 0.05)}
+
+
+@pytest.fixture(scope="module", params=[False, True], ids=["stop", "latch"])
+def kneed(request):
+    scene = load_scene(ROOT / "configs" / "kneed_3d.yaml")
+    if request.param:   # the contact model's knee latch on
+        raw = scene.model_dump(exclude_none=True)
+        raw["contact"] = {"knee_stop": {"latch": True}}
+        scene = type(scene).model_validate(raw)
+    data = Plant.from_scene(scene).data
+    x = np.asarray(X, float)
+    start = adams3d_start(data, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.3,)), 2)
+    return scene, data, x, read_adm(adm3d_text(scene, data, start, "walker"))
+
+
+def test_a_kneed_3d_datasets_parts_are_the_rigid_walkers(kneed):
+    """Five parts (the pelvis, each thigh and shank) of the scene's masses, each centre of
+    mass at the rigid one, the kinetic energy the rigid model's (relative 1e-9)."""
+    scene, data, x, model = kneed
+    pts = {k: C @ np.ravel(v) for k, v in functions(data)["points"](x).items()}
+    assert sorted(p for p in model.by_kind["PART"] if p != 1) == sorted(PARTS)
+    for pid, (_body, point, mass) in PARTS.items():
+        assert model.part_mass(pid) == pytest.approx(mass, rel=1e-15)
+        cm, _ = model.marker_pose(model.get("PART", pid).integer("CM"))
+        np.testing.assert_allclose(cm, pts[point], atol=TOL)
+    n = x.size // 2
+    M = np.asarray(functions(data)["matrices"](x)[0], float).reshape(n, n)
+    got = 0.0
+    for pid in PARTS:
+        v, w = model.part_velocity(pid)
+        got += 0.5 * model.part_mass(pid) * v @ v + 0.5 * w @ model.part_inertia(pid) @ w
+    assert got == pytest.approx(0.5 * x[n:] @ M @ x[n:], rel=TOL)
+    assert sum(model.part_mass(p) for p in PARTS) == pytest.approx(data.total_mass_kg,
+                                                                   rel=1e-15)
+
+
+def test_a_kneed_3d_datasets_knees_are_revolutes_at_the_rigid_knees(kneed):
+    """Each knee a REVOLUTE (I on the shank, J on the thigh) at the rigid knee point, both
+    markers' z along the leg's pitch axis; its AZ the knee angle (swing: shank - thigh;
+    stance: 0, straight); the feet (each CONTACT's sphere, the pin's marker on leg2's shank)
+    at the rigid feet."""
+    scene, data, x, model = kneed
+    pts = {k: C @ np.ravel(v) for k, v in functions(data)["points"](x).items()}
+    joints = model.joints()
+    knees = {402: ("swing_knee", x[2] - x[1]), 602: ("stance_knee", 0.0)}
+    for i, (point, angle) in knees.items():
+        (kind, j), = [(t, jj) for t, ii, jj in joints.values() if ii == i]
+        assert kind == "REVOLUTE"
+        (pi, Ri), (pj, Rj) = model.marker_pose(i), model.marker_pose(j)
+        np.testing.assert_allclose(pi, pts[point], atol=TOL)
+        np.testing.assert_allclose(pj, pts[point], atol=TOL)
+        assert Ri[:, 2] @ Rj[:, 2] > 1 - TOL
+        got = evaluate(model, (-1,), {-1: f"AZ({i},{j})"})[-1]
+        assert got == pytest.approx(angle, abs=TOL)
+    feet = {c.integer("IGEOM") for c in model.by_kind["CONTACT"].values()}
+    assert feet == {403, 603}
+    np.testing.assert_allclose(model.marker_pose(403)[0], pts["swing_foot"], atol=TOL)
+    np.testing.assert_allclose(model.marker_pose(603)[0], pts["stance_foot"], atol=TOL)
+    assert joints[99][1] == 603
+
+
+def test_a_kneed_3d_datasets_knee_stop_and_latch_are_the_contact_models(kneed):
+    """SFORCE/1, 2: -IMPACT of the hyperextension on each knee with the contact model's
+    stop numbers; with contact.knee_stop.latch, SFORCE/3, 4 weighted by the foot's height
+    above the slope (the rigid feet's: the stance foot 0, the swing foot its own) and the
+    knee's flexion, the swing knee (bent past the capture) not latched at the state."""
+    scene, data, x, model = kneed
+    _, ks = contact_si(scene.contact or ContactSettings())
+    law = f"{ks.k * 1000!r},{ks.e!r},{ks.cmax * 1000!r},{ks.dmax!r}".replace("e-05", "E-05")
+    for sid, (i, j) in ((1, (402, 314)), (2, (602, 516))):
+        sf = model.get("SFORCE", sid)
+        assert (sf.integer("I"), sf.integer("J")) == (i, j)
+        assert sf.args["FUNCTION"] == (f"-IMPACT(-AZ({i},{j}),-WZ({i},{j},{j}),0.0,{law})",)
+    if not ks.latch:
+        assert sorted(model.by_kind["SFORCE"]) == [1, 2]
+        return
+    assert sorted(model.by_kind["SFORCE"]) == [1, 2, 3, 4]
+    pts = {k: C @ np.ravel(v) for k, v in functions(data)["points"](x).items()}
+    phi = data.slope_rad
+    n = np.array([np.sin(phi), 0.0, np.cos(phi)])
+    v = evaluate(model, (371, 372, 373, 374))
+    assert v[371] / 1000 == pytest.approx(n @ pts["swing_foot"], rel=TOL)
+    assert v[372] == pytest.approx(0.0, abs=1e-9)
+    assert v[373] == 0.0   # the swing knee bent 0.085 rad, past the 0.01 rad capture
+    assert v[374] == 1.0   # the stance foot on the ground, its knee straight

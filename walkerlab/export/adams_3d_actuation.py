@@ -1,0 +1,227 @@
+"""The actuation of a 3D walker's Adams dataset (``walker.actuation``;
+:mod:`walkerlab.export.adams_3d`): the hip torque law (``joint: hip``) and the push-off pulse,
+the planar dataset's statements (:mod:`walkerlab.export.adams_actuation`: the same laws as
+``VARIABLE`` expressions, an ``SFORCE`` or ``GFORCE`` per torque, a ``GFORCE`` pulse at the
+trailing foot) on the 3D walker's parts, as the rigid model has them
+(:class:`walkerlab.models.hybrid.actuated._Legs3d`; Kuo 2002, "Energetics of actively powered
+locomotion using the simplest walking model", J. Biomech. Eng. 124(1)).
+
+Each leg's pitch ``theta`` is its rotation about its own (rolled) hip axis, the rigid leg
+being ``Rot(s, phi_leg) Rot(z, theta)`` in the slope's frame (``s`` the fall line): with
+``d`` the leg's axis from its hip marker (``100 p + 2``) to its foot marker (``100 p + 3``) in
+the ground frame :data:`~walkerlab.export.adams_hip_roll.ROLL_FRAME` (x the fall line, y the
+slope's normal, z walkerlab's z), ``d = |d| (sin theta_s s - cos theta_s n')`` with ``n'``
+the rolled normal, so ``theta = ATAN2(d_x, SQRT(d_y^2 + d_z^2)) - gamma`` (``theta_s`` from
+the slope's normal, ``gamma`` the slope: the rigid model's pitch from the vertical, as the
+export's hinge reads it), and its rate ``WZ`` of the hip marker (z along the pitch axis; the
+roll's rate is along ``s``, normal to it).  The law's angle ``delta = theta_sw - theta_st``
+(the role sign: the planar dataset's force test, VARIABLE/303), the phase variable the
+stance leg's pitch.
+
+The torque ``+tau`` on the swing leg about its pitch axis, ``-tau`` on the stance leg about
+its own (the rigid model's virtual work ``tau delta(theta_sw - theta_st)``): without
+hip-roll joints the pelvis is fixed to leg2 and both legs pitch about one axis, so one
+``SFORCE/ROTATION`` on leg1's revolute (I on leg1, J on the pelvis) carries it, as the
+planar dataset's between the legs; with hip-roll joints the pitch axes differ, so each leg
+has a ``GFORCE`` torque about its own pitch axis (``RM`` its hip marker), the reaction on
+the pelvis (an ``SFORCE/ROTATION`` needs its I and J z axes parallel).
+
+The push-off: the planar dataset's pulse ``P / T`` at the stance foot along the line to its
+own hip (a ``GFORCE``, the reaction on a floating ground marker), on while that leg stands,
+the other foot's touchdown extrapolated ``T`` ahead at its rate is reached and that foot is
+at least :data:`~walkerlab.export.adams_actuation.PUSH_MIN_STEP_M` ahead along the fall
+line; a foot's penetration is minus its sphere centre's height above the slope's plane
+through the origin (the patches' tops lie the sphere's radius below it).  The speed gain's
+speed is the pelvis' (the hips' midpoint).
+"""
+
+from __future__ import annotations
+
+from walkerlab.config.contact import ContactSettings
+from walkerlab.export.adams_actuation import (
+    ACT_VARIABLES,
+    HIP_SFORCE,
+    HIP_TORQUE_SUM,
+    PUSH_MIN_STEP_M,
+    _law,
+    hip_torque_ids,
+)
+from walkerlab.export.adams_hip_roll import ROLL_FRAME, role_statements
+from walkerlab.export.adams_statements import MM, _chain_sum, _f, _plus, _var
+from walkerlab.export.axes_3d import slope_axes
+
+__all__ = ["ACT_3D_VARIABLES", "HIP_TORQUE_GFORCE", "PUSH_3D_FLOAT_MARKER",
+           "PUSH_3D_GFORCE", "actuation_3d_statements"]
+
+#: VARIABLE ids of the 3D actuation: each leg's pitch [rad] and rate [rad/s] (its axis'
+#: components along the fall line and across it [mm]), the push-off's
+#: constants (the slope normal's x and z, the fall line's, the pulse's length [s], the
+#: impulse [N s]), each foot's penetration [mm], its rate [mm/s] and extrapolation, the
+#: swing foot's lead along the fall line [mm], each leg's push [N]; the law's angle, rate
+#: and phase are the planar dataset's (:data:`walkerlab.export.adams_actuation.
+#: ACT_VARIABLES`: 304-307), its torques' sum :data:`~walkerlab.export.adams_actuation.
+#: HIP_TORQUE_SUM`.
+ACT_3D_VARIABLES = {"pitch_leg1": 611, "pitch_leg2": 612, "rate_leg1": 613, "rate_leg2": 614,
+                    "along_leg1": 615, "across_leg1": 616, "along_leg2": 617,
+                    "across_leg2": 618,
+                    "nx": 630, "nz": 631, "pulse_s": 632, "impulse": 633, "tx": 638,
+                    "tz": 639, "pen_leg1": 641, "pen_leg2": 642, "dpen_leg1": 643,
+                    "dpen_leg2": 644, "lead_leg1": 645, "lead_leg2": 646, "ahead": 647,
+                    "push_leg1": 661, "push_leg2": 662}
+#: GFORCE ids of the push-off at leg1's and leg2's foot (the hip-roll law's are 31, 32).
+PUSH_3D_GFORCE = {"leg1": 1, "leg2": 2}
+#: GFORCE ids of each leg's hip torque with hip-roll joints.
+HIP_TORQUE_GFORCE = {"leg1": 41, "leg2": 42}
+#: The floating ground marker that takes the push-off's reaction (the ground's 104 is
+#: :data:`~walkerlab.export.adams_hip_roll.ROLL_FRAME`).
+PUSH_3D_FLOAT_MARKER = 105
+
+
+def _pitches(parts: dict, slope_rad: float) -> list[str]:
+    """Each leg's pitch and rate (module docstring)."""
+    V = ACT_3D_VARIABLES
+    out = []
+    for g in ("leg1", "leg2"):
+        h, f = 100 * parts[g] + 2, 100 * parts[g] + 3
+        d = [f"D{a}({f},{h},{ROLL_FRAME})" for a in "XYZ"]
+        a, b = V[f"along_{g}"], V[f"across_{g}"]
+        out += [_var(a, d[0]), _var(b, f"SQRT({d[1]}**2+{d[2]}**2)"),
+                _var(V[f"pitch_{g}"], f"ATAN2(VARVAL({a}),VARVAL({b})){_plus(-slope_rad)}"),
+                _var(V[f"rate_{g}"], f"WZ({h},101,{h})")]
+    return out
+
+
+def _hip_torque(act, parts: dict, rolled: bool) -> list[str]:
+    """The hip torques' laws and their force (module docstring)."""
+    V, W = ACT_VARIABLES, ACT_3D_VARIABLES
+    sgn = f"VARVAL({V['sign']})"
+    out = ["! hip torques (walker.actuation.torques) [N mm]: +tau on the swing leg about",
+           "! its pitch axis, -tau on the stance leg about its own; delta = swing - stance",
+           "! pitch (times the role sign), the phase variable the stance leg's pitch",
+           _var(V["delta"], f"{sgn}*(VARVAL({W['pitch_leg1']})-VARVAL({W['pitch_leg2']}))"),
+           _var(V["ddelta"], f"{sgn}*(VARVAL({W['rate_leg1']})-VARVAL({W['rate_leg2']}))"),
+           _var(V["phase"], f"IF({sgn}:VARVAL({W['pitch_leg1']}),0,"
+                f"VARVAL({W['pitch_leg2']}))"),
+           _var(V["dphase"], f"IF({sgn}:VARVAL({W['rate_leg1']}),0,"
+                f"VARVAL({W['rate_leg2']}))")]
+    ks = range(len(act.torques))
+    for k in ks:
+        out += _law(k, act.torques[k], V["delta"], V["ddelta"])
+    out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
+                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks])
+    p1, pp = parts["leg1"], parts["pelvis"]
+    if not rolled:
+        return out + [
+            "! their sum on leg1 (I) about its revolute's axis, the reaction on the pelvis",
+            "! (fixed to leg2; both legs pitch about one axis): sign * tau",
+            f"SFORCE/{HIP_SFORCE}, ROTATION, I={100 * p1 + 2}, J={100 * pp + 10 + p1}",
+            f", FUNCTION={sgn}*VARVAL({HIP_TORQUE_SUM})"]
+    out += ["! each leg's torque about its own pitch axis (RM its hip marker), the reaction",
+            "! on the pelvis: sign * tau on leg1, -sign * tau on leg2"]
+    for j, g in enumerate(("leg1", "leg2")):
+        m = 100 * parts[g] + 2
+        out += [f"MARKER/{100 * pp + 8 + j}, PART={pp}, FLOATING",
+                f"GFORCE/{HIP_TORQUE_GFORCE[g]}, I={m}, JFLOAT={100 * pp + 8 + j}, RM={m}",
+                ", FX=0.0\\FY=0.0\\FZ=0.0\\TX=0.0\\TY=0.0\\",
+                f", TZ={'' if g == 'leg1' else '-'}{sgn}*VARVAL({HIP_TORQUE_SUM})"]
+    return out
+
+
+def _push_off(po, T: float, parts: dict, slope_rad: float) -> list[str]:
+    """The push-off pulse (module docstring)."""
+    V, W = ACT_VARIABLES, ACT_3D_VARIABLES
+    t, n = slope_axes(slope_rad)
+    foot = {g: 100 * parts[g] + 3 for g in ("leg1", "leg2")}
+    hip = {g: 100 * parts[g] + 2 for g in ("leg1", "leg2")}
+    min_step = PUSH_MIN_STEP_M * MM
+    out = [f"! push-off (walker.actuation.push_off): a force P / T for T = {T:g} s",
+           "! (contact.push_off_duration_s) at the stance (trailing) foot, from the foot",
+           "! towards its own hip, on from when the swing foot's penetration extrapolated T",
+           "! ahead at its rate crosses 0 (the touchdown T ahead: the contact view's start)",
+           f"! at least {min_step:g} mm ahead of the stance foot along the fall line, until",
+           "! that touchdown; the reaction on the ground (a floating marker).  Penetration",
+           "! [mm]: minus the foot sphere centre's height above the slope's plane.",
+           f"MARKER/{PUSH_3D_FLOAT_MARKER}, PART=1, FLOATING",
+           _var(W["nx"], _f(float(n[0]))), _var(W["nz"], _f(float(n[2]))),
+           _var(W["tx"], _f(float(t[0]))), _var(W["tz"], _f(float(t[2]))),
+           _var(W["pulse_s"], _f(T))]
+    if po.speed_gain_n_s2_per_m:
+        cm = 100 * parts["pelvis"] + 1
+        out += [_var(634, _f(po.impulse_n_s)), _var(635, _f(po.speed_gain_n_s2_per_m)),
+                _var(636, _f(po.reference_speed_m_per_s)),
+                _var(637, f"VARVAL(636)-VM({cm})/{_f(MM)}"),
+                _var(W["impulse"], "MAX(0.0,VARVAL(634)+VARVAL(635)*VARVAL(637))")]
+    else:
+        out.append(_var(W["impulse"], _f(po.impulse_n_s)))
+    nx, nz = f"VARVAL({W['nx']})", f"VARVAL({W['nz']})"
+    for g in ("leg1", "leg2"):
+        f = foot[g]
+        out += [_var(W[f"pen_{g}"], f"-({nx}*DX({f},101)+{nz}*DZ({f},101))"),
+                _var(W[f"dpen_{g}"], f"-({nx}*VX({f})+{nz}*VZ({f}))"),
+                _var(W[f"lead_{g}"], f"VARVAL({W[f'pen_{g}']})+VARVAL({W['pulse_s']})*"
+                     f"VARVAL({W[f'dpen_{g}']})")]
+    f1, f2 = foot["leg1"], foot["leg2"]
+    out.append(_var(W["ahead"], f"VARVAL({W['tx']})*DX({f2},{f1})+VARVAL({W['tz']})*"
+                    f"DZ({f2},{f1})"))
+    for i, (g, o) in enumerate((("leg1", "leg2"), ("leg2", "leg1"))):
+        on = 650 + 2 * i
+        stands = "1,0,0" if g == "leg1" else "0,0,1"  # sign < 0: leg1 stands
+        ahead = f"VARVAL({W['ahead']})" if g == "leg1" else f"-VARVAL({W['ahead']})"
+        h, f = hip[g], foot[g]
+        push = W[f"push_{g}"]
+        out += [f"! {g} stands, {o}'s touchdown is predicted within T, {o} is ahead",
+                _var(on, f"IF(VARVAL({V['sign']}):{stands})*IF(VARVAL({W[f'lead_{o}']}):0,0,1)"),
+                _var(on + 1, f"VARVAL({on})*IF(VARVAL({W[f'pen_{o}']}):1,0,0)"),
+                _var(on + 5, f"VARVAL({on + 1})*IF({ahead}-{_f(min_step)}:0,0,1)"),
+                _var(push, f"VARVAL({on + 5})*VARVAL({W['impulse']})/VARVAL({W['pulse_s']})"),
+                f"GFORCE/{PUSH_3D_GFORCE[g]}, I={f}, JFLOAT={PUSH_3D_FLOAT_MARKER}, RM=101",
+                f", FX=VARVAL({push})*DX({h},{f})/DM({h},{f})\\",
+                f", FY=VARVAL({push})*DY({h},{f})/DM({h},{f})\\",
+                f", FZ=VARVAL({push})*DZ({h},{f})/DM({h},{f})\\",
+                ", TX=0.0\\TY=0.0\\TZ=0.0"]
+    return out
+
+
+def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float,
+                            rolled: bool) -> list[str]:
+    """The 3D walker's actuation statements (none for a passive walker; module docstring).
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        Its ``walker.actuation`` (hip torques ``joint: hip``, a push-off) and
+        ``contact.push_off_duration_s``.
+    parts : dict
+        PART id by body: ``pelvis``, ``leg1``, ``leg2`` (markers ``100 p + 2`` at each hip,
+        z along the leg's pitch axis, ``100 p + 3`` its foot; the pelvis' ``100 p + 10 + q``
+        the J marker of leg ``q``'s revolute).
+    contacts : dict
+        CONTACT ids by leg (the roles' force test).
+    slope_rad : float
+        The slope [rad].
+    rolled : bool
+        Hip-roll joints: the roles are the hip-roll law's (written before), the torque a
+        GFORCE on each leg.
+
+    Returns
+    -------
+    list of str
+    """
+    act = scene.walker.actuation
+    if act is None:
+        return []
+    out = ["!", "! ---- actuation (walker.actuation), mm-kg-s: torques N mm, forces N ----"]
+    if not rolled:  # the hip-roll law's block writes the roles where it is
+        out += ["! the roles: the stance leg's foot carries the larger normal contact force",
+                "! (VARIABLE/301, 302 [N]); VARIABLE/303: +1 while leg2 stands, -1 while "
+                "leg1", "! stands."]
+        out += role_statements(contacts)
+    out += ["! each leg's pitch [rad] about its own hip axis from the vertical, and its "
+            "rate", f"! (the ground frame MARKER/{ROLL_FRAME}: x the fall line, y the normal)"]
+    out += _pitches(parts, slope_rad)
+    if act.torques:
+        out += _hip_torque(act, parts, rolled)
+    if act.push_off is not None:
+        T = (scene.contact or ContactSettings()).push_off_pulse_s()
+        out += _push_off(act.push_off, T, parts, slope_rad)
+    return out

@@ -1,0 +1,96 @@
+"""The knees of a kneed walker in 3D (``locking_knees_3d``) in its Adams dataset
+(:mod:`walkerlab.export.adams_3d`): the knee stop and the knee latch, the planar kneed
+dataset's statements (:mod:`walkerlab.export.adams`, :mod:`walkerlab.export.adams_latch`) on
+the 3D walker's knee revolutes.
+
+Each knee is a ``REVOLUTE`` between the shank (I: marker ``100 s + 2``, z along its hinge
+axis, the leg's own pitch axis) and the thigh (J: marker ``100 t + 10 + s`` at the knee, z
+along the same axis), so ``AZ(I, J)`` is the knee angle ``shank - thigh`` (the tree's knee
+hinge, limit ``[-pi, 0]``: 0 the straight-leg stop, ``> 0`` past straight), as the planar
+dataset's.
+
+Knee stop (``contact.knee_stop``): ``SFORCE/1``, ``2`` ``ROTATION`` with
+``FUNCTION = -IMPACT(-AZ, -WZ, 0, k, e, cmax, dmax)``: the stop's law on the
+hyperextension, pushing the shank back (Adams Solver function reference: IMPACT).
+
+Knee latch (``contact.knee_stop.latch``): the contact model's smooth weight times the stop's
+law mirrored on the flexion, ``SFORCE/3``, ``4`` (:func:`walkerlab.export.adams_latch.
+knee_latches`' expression): ``w = STEP(h, 0, 1, h_release, 0) STEP(knee, -capture, 0,
+-capture/2, 1)``, ``h`` the foot sphere's centre above the slope's plane through the origin
+[mm] (a point foot's sphere centre is the rigid foot point, the patches' tops the sphere's
+radius below the plane: its contact point's height), times ``IMPACT(knee, d knee/dt, 0, k,
+e, cmax, dmax)``.
+"""
+
+from __future__ import annotations
+
+from walkerlab.config.contact import ContactSettings
+from walkerlab.export.adams_latch import LATCH_SFORCE
+from walkerlab.export.adams_statements import MM, _f, _stmt, _var
+from walkerlab.export.axes_3d import slope_axes
+from walkerlab.models.contact.rigid_limit import contact_si
+
+__all__ = ["KNEE_3D_VARIABLES", "KNEE_STOP_SFORCE", "knee_3d_statements"]
+
+#: SFORCE ids of leg1's and leg2's knee stop (the latches': :data:`walkerlab.export.
+#: adams_latch.LATCH_SFORCE`).
+KNEE_STOP_SFORCE = {"leg1": 1, "leg2": 2}
+#: VARIABLE ids of the latch: the slope normal's x and z, each foot's height [mm], its
+#: latch's two factors (foot, knee) and their product.
+KNEE_3D_VARIABLES = {"nx": 370, "nz": 375, "height_leg1": 371, "height_leg2": 372,
+                     "weight_leg1": 373, "weight_leg2": 374, "foot_leg1": 376,
+                     "foot_leg2": 377, "knee_leg1": 378, "knee_leg2": 379}
+
+
+def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
+    """The knee stops and, with ``contact.knee_stop.latch``, the latches (module
+    docstring).
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        Its ``contact.knee_stop`` (default :class:`~walkerlab.config.contact.
+        ContactSettings`'s).
+    parts : dict
+        PART id by body: ``leg<i>`` (the thigh) and ``leg<i>_shank`` (its foot marker
+        ``100 s + 3``).
+    slope_rad : float
+
+    Returns
+    -------
+    list of str
+    """
+    _, ks = contact_si(scene.contact or ContactSettings())
+    law = f"{_f(ks.k * MM)},{_f(ks.e)},{_f(ks.cmax * MM)},{_f(ks.dmax)}"
+    knees = {}
+    out = ["!", "! ---- knees: the stop's IMPACT on the hyperextension shank - thigh (> 0 past",
+           "! straight) ----"]
+    for leg in ("leg1", "leg2"):
+        s, t = parts[f"{leg}_shank"], parts[leg]
+        i_m, j_m = 100 * s + 2, 100 * t + 10 + s
+        knees[leg] = (i_m, j_m, 100 * s + 3)
+        out += _stmt(f"SFORCE/{KNEE_STOP_SFORCE[leg]}, ROTATION, I={i_m}, J={j_m}",
+                     f"FUNCTION=-IMPACT(-AZ({i_m},{j_m}),-WZ({i_m},{j_m},{j_m}),0.0,{law})")
+    if not ks.latch:
+        return out
+    V = KNEE_3D_VARIABLES
+    _t, n = slope_axes(slope_rad)
+    h_rel, cap = ks.latch_height * MM, ks.latch_capture
+    out += ["! knee latch (contact.knee_stop.latch): the stop's IMPACT law on the flexion,",
+            f"! weighted by STEP(h, 0, 1, {_f(h_rel)}, 0) of the foot's contact height h [mm]",
+            f"! and STEP(knee, {_f(-cap)}, 0, {_f(-cap / 2)}, 1) of the knee angle [rad]: the "
+            "contact", "! model's latch (a smooth weight of the present state, no event)",
+            _var(V["nx"], _f(float(n[0]))), _var(V["nz"], _f(float(n[2])))]
+    for leg, (i_m, j_m, foot) in knees.items():
+        out += [_var(V[f"height_{leg}"], f"VARVAL({V['nx']})*DX({foot},101)+"
+                     f"VARVAL({V['nz']})*DZ({foot},101)"),
+                _var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
+                     f"{_f(h_rel)},0.0)"),
+                _var(V[f"knee_{leg}"], f"STEP(AZ({i_m},{j_m}),{_f(-cap)},0.0,{_f(-cap / 2)},"
+                     "1.0)"),
+                _var(V[f"weight_{leg}"], f"VARVAL({V[f'foot_{leg}']})*"
+                     f"VARVAL({V[f'knee_{leg}']})"),
+                *_stmt(f"SFORCE/{LATCH_SFORCE[leg]}, ROTATION, I={i_m}, J={j_m}",
+                       f"FUNCTION=VARVAL({V[f'weight_{leg}']})*IMPACT(AZ({i_m},{j_m}),"
+                       f"WZ({i_m},{j_m},{j_m}),0.0,{law})")]
+    return out
