@@ -328,7 +328,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's
-        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "adams", "osim")},
+        # the compliant-contact model: the floating tree with both knees
+        # (walkerlab.codegen.floating_3d.derive_legs_3d), the planar kneed walker's knee
+        # stop and latch
+        **{("walk", v): _KNEED_3D_VIEW for v in ("adams", "osim")},
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),

@@ -159,6 +159,7 @@ CONTACT_THREE_LINK = Part("contact", "three-link walker")
 CONTACT_WHEEL = Part("contact", "spoked wheel")
 CONTACT_WHEEL_3D = Part("contact", "spoked wheel in 3D")
 CONTACT_LEGS_3D = Part("contact", "straight legs in 3D")
+CONTACT_KNEES_3D = Part("contact", "locking knees in 3D")
 
 # what a contact run names as the cause of a swing foot's scuffs
 # (walkerlab.analysis.contact.verdict)
