@@ -13,7 +13,7 @@ from __future__ import annotations
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D",
+           "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
@@ -95,12 +95,18 @@ ROUND_FEET_EXPORT_3D = ("a 3D walker's Adams dataset carries point feet and poin
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
-#: why a kneed walker in 3D refuses a view (its rigid model, its MJCF and its URDF are its
-#: only ones so far)
-_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model (walkerlab fixedpoint, "
-                  "simulate) and is exported as MJCF and URDF (export --format mjcf, urdf) "
-                  "so far: its floating (contact) view and its Adams and OpenSim exports are "
-                  "a later step")
+#: why a kneed walker in 3D refuses a view (its rigid and contact models, its MJCF and its
+#: URDF are its only ones so far)
+_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid and contact models (walkerlab "
+                  "fixedpoint, simulate, contact-sim) and is exported as MJCF and URDF "
+                  "(export --format mjcf, urdf) so far: its Adams and OpenSim exports are a "
+                  "later step")
+#: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
+#: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
+KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
+                         "gait is laterally unstable (x40 a stride) and no hip-roll law "
+                         "steadies a kneed walker in 3D, so a walk started a little off it "
+                         "capsizes within a few steps, as the rigid walk would")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -366,7 +372,9 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
 #: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
-CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
+CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
+              ("locking_knees_3d", "contact"): KNEED_3D_FIRST_STRIDE,
+              ("locking_knees_3d", "mjcf"): KNEED_3D_FIRST_STRIDE}
 
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``
