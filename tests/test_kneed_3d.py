@@ -62,9 +62,9 @@ def _kneed_in_3d(width: float) -> dict:
 def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and_exports():
     """``space: 3d`` with a plastic knee validates and is the kind ``locking_knees_3d``
     (knees ``locking``, the 3D legs' body); its roles are the planar kneed walker's with
-    the lean first; the rigid view, the MJCF, the URDF and the gym take it
-    (tests/test_kneed_3d_export.py), every other view refuses it in one line naming the
-    field."""
+    the lean first; the rigid view, the contact model (tests/test_kneed_3d_contact.py), the
+    MJCF, the URDF and the gym take it (tests/test_kneed_3d_export.py), every other view
+    refuses it in one line naming the field."""
     from walkerlab.walker.description import walker_data
 
     scene = scene_from_dict(_kneed_in_3d(0.1))
@@ -73,8 +73,8 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     assert kind is KINDS["locking_knees_3d"] and kind.knees_lock and kind.in_3d
     assert data.structure.roles == ("lean", "swing_thigh", "swing_shank", "stance")
     assert data.structure.mirror_odd_roles == ("lean",)   # steps on alternate sides
-    assert all(kind.supports("walk", v) for v in ("rigid", "mjcf", "urdf", "gym"))
-    for view in ("contact", "adams", "osim", "optimize"):
+    assert all(kind.supports("walk", v) for v in ("rigid", "contact", "mjcf", "urdf", "gym"))
+    for view in ("adams", "osim", "optimize"):
         with pytest.raises(KindRefused) as err:
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
