@@ -148,7 +148,7 @@ ACTUATORS_NONE = Part("actuators", "none: a passive walker")
 REACTION_LEG_END = Part("reaction", "at the stance leg's end")
 REACTION_FLAT_FEET = Part("reaction", "flat feet: the heel's and toe's")
 REACTION_HUB = Part("reaction", "at the stance spoke's tip, the hub's")
-REACTION_NONE = Part("reaction", "none: no floating view")
+REACTION_NONE = Part("reaction", "none: the rigid state not mapped to the floating view")
 
 # the contact view's parts (walkerlab.models.contact.parts)
 CONTACT_STRAIGHT_LEGS = Part("contact", "straight legs")
