@@ -63,8 +63,9 @@ def _kneed_in_3d(width: float) -> dict:
 def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and_exports():
     """``space: 3d`` with a plastic knee validates and is the kind ``locking_knees_3d``
     (knees ``locking``, the 3D legs' body); its roles are the planar kneed walker's with
-    the lean first; the rigid view, the MJCF, the URDF, the gym (tests/test_kneed_3d_export.py)
-    and the Adams dataset (tests/test_export_adams_3d_knees.py) take it, every other view
+    the lean first; the rigid view, the contact model (tests/test_kneed_3d_contact.py), the
+    MJCF, the URDF, the gym (tests/test_kneed_3d_export.py) and the Adams dataset
+    (tests/test_export_adams_3d_knees.py) take it, every other view
     refuses it in one line naming the field."""
     from walkerlab.walker.description import walker_data
 
@@ -74,8 +75,9 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     assert kind is KINDS["locking_knees_3d"] and kind.knees_lock and kind.in_3d
     assert data.structure.roles == ("lean", "swing_thigh", "swing_shank", "stance")
     assert data.structure.mirror_odd_roles == ("lean",)   # steps on alternate sides
-    assert all(kind.supports("walk", v) for v in ("rigid", "mjcf", "urdf", "gym", "adams"))
-    for view in ("contact", "osim", "optimize"):
+    assert all(kind.supports("walk", v)
+               for v in ("rigid", "contact", "mjcf", "urdf", "gym", "adams"))
+    for view in ("osim", "optimize"):
         with pytest.raises(KindRefused) as err:
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)

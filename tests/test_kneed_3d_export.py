@@ -5,12 +5,15 @@ legs' writers (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`,
 - the MJCF in MuJoCo: each body's mass, centre of mass and inertia the scene's numbers,
   computed here from the scene's YAML (hip mass on the pelvis, each thigh's and shank's point
   mass ``from_hip_m`` down its leg, the knee ``thigh_length_m`` below the hip, the hips
-  ``hip_width_m`` apart; a point mass's inertia the export's floor, 1e-12 kg m^2); each knee a
-  hinge about the pitch axis with the straight-leg stop ``[-pi, 0]`` as its range; with the
-  gait, the planar kneed MJCF's latch equalities and thresholds;
+  ``hip_width_m`` apart; a point mass's inertia the export's floor, 1e-12 kg m^2, but the
+  pelvis': the hip mass as a rod between the hips, ``M_hip w^2 / 12`` about the roll and
+  yaw axes); each knee a hinge about the pitch axis with the straight-leg stop ``[-pi, 0]``
+  as its range; with the gait, the planar kneed MJCF's latch equalities and thresholds;
 - MuJoCo's joint-space mass matrix (``mj_fullM``) pulled back to the rigid model's
   coordinates (``lean, swing_thigh, swing_shank, stance``; the stance foot pinned) is the
-  rigid model's ``M``;
+  rigid model's ``M`` with the pelvis rod's roll inertia on the lean;
+- walked in MuJoCo, the latch holds the stance knee through the first step and the first
+  stride's mean step period is the rigid gait's within 3 %;
 - the URDF in Pinocchio: its total mass and its knees' limits;
 - ``walkerlab export`` of the scene as mjcf and urdf writes the files without a traceback.
 
@@ -67,11 +70,19 @@ def kneed_3d(tmp_path_factory):
     return scene, out
 
 
+def _pelvis_rod() -> float:
+    """The pelvis rod's inertia about the roll and yaw axes from the YAML: the hip mass over
+    the hip width, ``M w^2 / 12`` [kg m^2]."""
+    w = yaml.safe_load(SCENE.read_text())["walker"]
+    return w["hip_mass_kg"] * w["hip_width_m"] ** 2 / 12
+
+
 def test_the_kneed_3d_mjcf_has_the_scenes_masses_centres_of_mass_and_inertias(kneed_3d):
     """Each MuJoCo body's mass, position, centre of mass and inertia are the scene's (the
     hand computation of :func:`_by_hand`; 1e-15 m: the file's shank centre 0.15 m is
-    0.65 - 0.5 in floating point), the total 1.6 kg; a free pelvis (7 + 4 hinges of
-    coordinates, 6 + 4 of velocities)."""
+    0.65 - 0.5 in floating point), the pelvis' inertia the rod's (:func:`_pelvis_rod`,
+    4.2e-4 kg m^2 about x and z, the floor about the hip axis), the total 1.6 kg; a free
+    pelvis (7 + 4 hinges of coordinates, 6 + 4 of velocities)."""
     _scene, out = kneed_3d
     model = mujoco.MjModel.from_xml_path(str(out.path))
     assert (model.nq, model.nv) == (11, 10)
@@ -84,7 +95,9 @@ def test_the_kneed_3d_mjcf_has_the_scenes_masses_centres_of_mass_and_inertias(kn
         assert float(model.body_mass[b.id]) == mass, name
         assert np.max(np.abs(b.pos - pos)) < 1e-15, name
         assert np.max(np.abs(b.ipos - com)) < 1e-15, name
-        assert np.all(b.inertia == FLOOR), name
+        want_i = ([_pelvis_rod(), FLOOR, _pelvis_rod()] if name == "pelvis"
+                  else [FLOOR] * 3)
+        assert np.allclose(b.inertia, want_i, rtol=1e-15, atol=0), name
         assert np.max(np.abs(b.iquat - [1, 0, 0, 0])) == 0.0, name
     assert float(model.body_mass.sum()) == pytest.approx(1.6, abs=1e-15)
 
@@ -133,8 +146,10 @@ def _full_m(model, data) -> np.ndarray:
 def test_mujocos_mass_matrix_is_the_rigid_kneed_walkers_in_its_coordinates(kneed_3d):
     """At a configuration with lean, a bent swing knee and legs apart (every entry of the
     4 x 4 ``M`` non-zero), ``J^T M_mj J`` (module docstring) equals the rigid model's
-    ``M`` to 1e-10 of its largest entry; the check sees a mistaken map (the swing knee's
-    column read as its relative rate) far beyond it."""
+    ``M`` with the pelvis rod's inertia about the fall line on the lean's entry (the pelvis
+    rolls with the lean, about its x and z axes alike: ``I (cos^2 + sin^2)``) to 1e-10 of
+    its largest entry; the check sees a mistaken map (the swing knee's column read as its
+    relative rate) far beyond it."""
     from walkerlab.codegen.cache import functions
     from walkerlab.export.legs_3d_mjcf import legs3d_keyframe
     from walkerlab.walker.description import walker_data
@@ -157,11 +172,38 @@ def test_mujocos_mass_matrix_is_the_rigid_kneed_walkers_in_its_coordinates(kneed
     mujoco.mj_forward(model, data)
     M_mj = _full_m(model, data)
     M = J.T @ M_mj @ J
+    M_rigid = M_rigid + np.diag([_pelvis_rod(), 0.0, 0.0, 0.0])   # the rod rolls with lean
     scale = np.abs(M_rigid).max()
     assert np.abs(M - M_rigid).max() <= 1e-10 * scale, np.abs(M - M_rigid).max()
     wrong = J.copy()
     wrong[:, 2] = J[:, 2] - J[:, 1]   # a relative knee rate where the absolute one belongs
     assert np.abs(wrong.T @ M_mj @ wrong - M_rigid).max() > 1e-3 * scale
+
+
+def test_mujoco_walks_the_kneed_3d_mjcfs_first_stride_with_the_stance_knee_latched(
+        kneed_3d):
+    """From the keyframe (the rigid gait's heel strike, t = 0) MuJoCo's stepping loop
+    (:func:`walkerlab.export.mujoco_walk.walk`, the latch switched by its rule) holds the
+    stance knee (leg2's) within the latch's capture angle (0.01 rad) until the first heel
+    strike (measured 1e-5 rad; before the pelvis rod the latch slipped and the walker fell
+    at 0.448 s), and the first stride's two step periods average the rigid gait's within
+    3 % (measured +0.30 %); the lateral mode (x6 a step) leaves the gait after it, so only
+    the first stride is held (walkerlab.walker.reference_cases.FIRST_STEPS)."""
+    from walkerlab.export.mujoco_walk import walk
+
+    _scene, out = kneed_3d
+    period = float(out.step_period_s)
+    knee = []
+
+    def each(model, data):
+        knee.append((data.time, float(data.qpos[model.jnt_qposadr[
+            model.joint("leg2_knee").id]])))
+
+    run = walk(out.path, 2.3 * period, each=each)
+    assert run.legs[:2] == ["leg1", "leg2"]
+    t, k = np.array(knee).T
+    assert np.max(np.abs(k[t < run.times_s[0]])) < 0.01
+    assert abs(run.times_s[1] / 2 / period - 1.0) < 0.03
 
 
 def test_the_kneed_3d_urdf_in_pinocchio_has_the_scenes_mass_and_knee_stops(tmp_path):

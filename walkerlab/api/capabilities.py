@@ -22,6 +22,9 @@ By view (the quantity, its reference and tolerance: :data:`QUANTITIES`):
     profile that is the scene's slope (the profile cells' generated cases) also the contact
     walk on that slope, heel strike by heel strike (the same ground: integration
     tolerance), and the rigid walk the slope's where the rigid view refuses the profile.
+    A reference case whose passive gait is unstable with no stabilised counterpart
+    (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`: the 3D kneed walker) holds its
+    first steps instead, here and in the ``mjcf`` cell (:mod:`walkerlab.api.capability_early`).
 ``mjcf``, ``osim``
     The exported file walked in its engine (MuJoCo, OpenSim) for 10 heel strikes from the
     rigid gait: the mean step period against the rigid one (relative, 3 %).  The OpenSim
@@ -66,9 +69,10 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.api.capability_early import first_steps
 from walkerlab.config import scene_from_dict
 from walkerlab.walker.kinds import KINDS
-from walkerlab.walker.reference_cases import reference_scene
+from walkerlab.walker.reference_cases import FIRST_STEPS, reference_scene
 
 __all__ = ["CHECKS", "CONE", "QUANTITIES", "Measurement", "measure"]
 
@@ -544,7 +548,10 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
         scene = scene_from_dict(d)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            value, detail, *extra = _VIEWS[view](scene, d, Path(runs_root))
+            early = FIRST_STEPS.get((kind, feature))  # an unstable gait's first steps
+            run = (first_steps(view, early) if early and view in ("contact", "mjcf")
+                   else _VIEWS[view])
+            value, detail, *extra = run(scene, d, Path(runs_root))
     except Exception as exc:  # noqa: BLE001 - a cell that fails is evidence, not a crash
         value, detail, extra = (math.nan, f"{type(exc).__name__}: "
                                 f"{' '.join(str(exc).split())}"[:300], [])

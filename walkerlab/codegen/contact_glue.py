@@ -9,7 +9,8 @@ The glue is text because numba needs the generated functions as globals of the f
 that call them (a compiled function passed as an argument defeats numba's disk cache); it
 holds no arithmetic of its own beyond indexing.  :func:`contact_glue` is appended to the
 floating module by :func:`walkerlab.models.contact.generated.contact_source`, which also
-defines the constants it reads (``NQ``, ``NP``, ``NF``, ``KNEE``, ``POINT_LEG``, ``PIN``).
+defines the constants it reads (``NQ``, ``NP``, ``NF``, ``KNEE``, ``KNEES``, ``POINT_LEG``,
+``PIN``).
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
     dyn(x, p, M, h)
     feet(x, p, P, V, J)
     Q = _asm.contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees,
-                            POINT_LEG, KNEE)
+                            POINT_LEG, KNEE, KNEES)
     if DIM == 3:  # the contact patches' torsional friction (the analytic Jacobian holds
         # it constant)
         S, Jn = np.empty(NF), np.empty((NF, NQ))
@@ -70,7 +71,7 @@ def jac(x, PC, p, c1, c2):
     dV = np.empty((NF, DIM, NQ))
     dJtF = np.empty((NQ, NQ))
     feet_jac(x, _asm.world_forces(info, DIM), p, dV, dJtF)
-    return _asm.jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, KNEE)
+    return _asm.jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, KNEE, KNEES)
 '''
 
 _PINNED = '''
@@ -128,7 +129,7 @@ def knee_table(X, PC, p, c1, c2):
         P, V, J = _asm.point_buffers(NQ, NF, DIM)
         for r in range(X.shape[0]):
             feet(X[r], p, P, V, J)
-            _asm.knee_row(X[r], NQ, P, V, sp, cp, PC, c1, c2, out, r)
+            _asm.knee_row(X[r], NQ, P, V, sp, cp, PC, c1, c2, out, r, KNEES)
     return out
 '''
 

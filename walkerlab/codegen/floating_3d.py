@@ -66,26 +66,35 @@ def _spin(kin, body: str, rename):
 
 
 def derive_legs_3d(structure: Structure) -> FloatingEquations:
-    """The floating view of a 3D straight-legged walker from its body tree
-    (:func:`walkerlab.walker.trees.legs_tree`, Kuo 1999), set free at leg2's foot
-    (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y, z`` and a
-    heading, :data:`~walkerlab.codegen.floating_equations.FREE_3D`, then the rigid tree's
-    joints in its own coordinates renamed by
+    """The floating view of a 3D legged walker from its body tree
+    (:func:`walkerlab.walker.trees.legs_tree` with ``floating``, Kuo 1999), set free at
+    leg2's foot (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y,
+    z`` and a heading, :data:`~walkerlab.codegen.floating_equations.FREE_3D`, then the
+    tree's joints in its own coordinates renamed by
     :data:`~walkerlab.codegen.floating_equations.ROLES_3D`).  The feet ``leg1`` (the rigid
     model's swing foot) and ``leg2`` (its stance foot, the root's contact); round feet's the
     discs' lowest points with their material points' Jacobians (:func:`_disc_contact`).
     The hip-roll law's torques act between bodies (no force on the free coordinates): the
     view leaves them out of the flow (they are ``stance_forces``).
+
+    Locking knees (McGeer 1990): both legs carry their knee (the floating tree's stance
+    knee), each link's pitch a coordinate (``leg<i>_thigh_angle``, ``leg<i>_shank_angle``
+    in the leg's rolled sagittal plane, the knee's angle their difference), ``knees`` their
+    indices (the contact model's knee stop and latch act there, as on the planar kneed
+    walker's), the points ``leg<i>_knee``.
     """
     import sympy as sp
 
     from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
     from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
 
-    rigid, coords = legs_tree(structure)
+    rigid, coords = legs_tree(structure, floating=True)
     tree, kin, q, dq, rename, M, V, h = _free_flow(structure, rigid, coords, FREE_3D)
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
     to_world = slope_to_world(kin.gamma)
+    # each leg's links by role: the foot's (the shank with a knee) and the thigh's
+    knee = structure.knee
+    feet_links = ("swing_shank", "stance_shank") if knee else ("swing_leg", "stance_leg")
     feet, points = [], {}
     if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
         radius = dict(zip(tree.params, kin.params))["R_foot"]
@@ -101,22 +110,30 @@ def derive_legs_3d(structure: Structure) -> FloatingEquations:
             pos = to_world * kin.contacts[contact].xreplace(rename)
             feet.append((pos, pos.jacobian(qv)))
             points[f"{leg}_foot"] = pos
-    # each foot's spin about the slope's normal: its leg's angular velocity there
-    spins = tuple(_spin(kin, link, rename) for link in ("swing_leg", "stance_leg"))
+    # each foot's spin about the slope's normal: its link's angular velocity there
+    spins = tuple(_spin(kin, link, rename) for link in feet_links)
     points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
     # each leg's own hip, w/2 from the pelvis' (the push-off's line: the rigid model's
     # stance_hip and swing_hip, walkerlab.codegen.derive_3d)
     points["leg1_hip"] = to_world * kin.origins["swing_leg"].xreplace(rename)
     points["leg2_hip"] = to_world * kin.origins["pelvis"].xreplace(rename)
     for b in structure.bodies:
-        for leg, link in (("leg1", "swing_leg"), ("leg2", "stance_leg")):
+        for leg, role in (("leg1", "swing"), ("leg2", "stance")):
+            link = f"{role}_shank" if knee and b.link == "shank" else f"{role}_leg"
             points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)
     for b in structure.torso:
         points[f"torso_{b.name}"] = to_world * kin.coms[f"torso_{b.name}"].xreplace(rename)
+    knees = ()
+    if knee:  # the knees at the shank's (swing) and the thigh's (stance) frame origin
+        points["leg1_knee"] = to_world * kin.origins["swing_shank"].xreplace(rename)
+        points["leg2_knee"] = to_world * kin.origins["stance_leg"].xreplace(rename)
+        names = [str(c) for c in q]
+        knees = tuple((names.index(f"{leg}_thigh_angle"), names.index(f"{leg}_shank_angle"))
+                      for leg in LEGS)
     return FloatingEquations(q=tuple(q), dq=tuple(dq),
                              params=tuple(kin.params), M=M, h=h, feet=tuple(feet),
                              kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V,
-                             points=points, contacts=LEGS, point_legs=(0, 1),
+                             points=points, knees=knees, contacts=LEGS, point_legs=(0, 1),
                              stance_forces=stance_forces(structure, q, dq, kin.params,
                                                          ROLES_3D),
                              spins=spins)

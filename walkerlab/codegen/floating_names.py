@@ -8,8 +8,10 @@ module docstring of :mod:`walkerlab.codegen.floating_equations`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 from walkerlab.walker.description import Structure
+from walkerlab.walker.trees import legs_tree
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
@@ -23,7 +25,11 @@ FREE_3D = ("leg2_foot_x", "leg2_foot_y", "leg2_foot_z", "heading")
 #: A 3D walker's rigid roles (leg1 swinging, leg2 standing) -> its floating coordinates
 #: (:func:`walkerlab.codegen.legged.derive_legged`'s: the lean is the stance leg's roll)
 ROLES_3D = {"lean": "leg2_roll", "swing": "leg1_angle", "stance": "leg2_angle",
-            "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll"}
+            "pelvis_roll": "pelvis_roll", "swing_roll": "leg1_roll",
+            # locking knees: each link's pitch in its leg's rolled sagittal plane (the
+            # floating tree's stance knee, walkerlab.walker.trees.legs_tree(floating=True))
+            "swing_thigh": "leg1_thigh_angle", "swing_shank": "leg1_shank_angle",
+            "stance_thigh": "leg2_thigh_angle", "stance_shank": "leg2_shank_angle"}
 #: A spoked wheel's free coordinates in 3D (:func:`walkerlab.walker.tree.free_root`'s slides
 #: only: its tree turns about every axis at spoke 0's tip already): spoke 0's tip in world
 #: axes [m]; the tree's heading, lean and spin follow (:data:`WHEEL_3D_COORDINATES`).
@@ -45,7 +51,7 @@ def coordinate_names(structure: Structure) -> tuple[str, ...]:
     if structure.in_3d:
         if structure.spokes:  # the slides, then the tree's heading, lean and spin
             return WHEEL_3D_COORDINATES
-        return FREE_3D + tuple(ROLES_3D[r] for r in structure.roles)
+        return FREE_3D + tuple(ROLES_3D[r] for r in floating_roles_3d(structure))
     if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
         return WHEEL_COORDINATES
     if structure.knee:
@@ -57,6 +63,15 @@ def coordinate_names(structure: Structure) -> tuple[str, ...]:
     if structure.hinged_torso:  # its own coordinate, last (a five-link biped)
         ang += ("torso_angle",)
     return ("hip_x", "hip_y") + ang
+
+
+@cache
+def floating_roles_3d(structure: Structure) -> tuple[str, ...]:
+    """A legged walker in 3D: its floating tree's own coordinates
+    (:func:`walkerlab.walker.trees.legs_tree` with ``floating``), in the tree's order: the
+    rigid roles, but for locking knees, where the stance leg has its knee too (``lean,
+    stance_shank, stance_thigh, swing_thigh, swing_shank``)."""
+    return tuple(legs_tree(structure, floating=True)[1].names)
 
 
 def param_names(structure: Structure) -> tuple[str, ...]:

@@ -46,7 +46,16 @@ Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyfra
 Knees (``locking_knees_3d``, :func:`legs3d_roles`): each thigh ``leg<i>`` carries its shank
 ``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about its pitch axis, its range
 the tree's straight-leg stop ``[-pi, 0]``; with the gait the planar kneed MJCF's latch
-(:func:`walkerlab.export.multibody.latch_equality_lines`), listed as left out.
+(:func:`walkerlab.export.multibody.latch_equality_lines`), listed as left out.  The pelvis
+carries the hip mass as a slender rod between the hips (``M_hip w^2 / 12`` about the roll
+and yaw axes, :func:`pelvis_rod_inertia`) where the rigid model has a point: a pelvis of a
+point mass on a free joint leaves a mechanism (its yaw with the hips' and knees' pitches)
+that moves no mass to first order at MuJoCo's reference pose, so the stance knee's inverse
+inertia there (``dof_invweight0``, 3e10) scales the latch equality's regulariser to 3e9,
+which holds 1.6e-4 N m at 0.012 rad of flexion: the latch slips, the knee buckles and the
+walker falls in its first step (0.448 s).  The rod brings it to 3e3 and the latch holds;
+it adds 4e-4 kg m^2 to the walker's roll inertia about the stance foot (about 1 kg m^2) and
+acts on no pitch (the hips' hinges carry no pitch torque to the pelvis).
 
 Hip-roll joints (``walker.hip_roll``; the rigid model's five coordinates,
 :func:`walkerlab.codegen.legged.derive_legged`): each leg hangs on a hinge
@@ -89,7 +98,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -109,7 +118,7 @@ from walkerlab.export.legs_3d_parts import (
     walker_tree,
 )
 from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
-from walkerlab.export.mjcf_scene import LANE_BITS, actuation_text
+from walkerlab.export.mjcf_scene import LANE_BITS, MJCF_MIN_INERTIA_KG_M2, actuation_text
 from walkerlab.export.multibody import latch_equality_lines, mjcf_actuation_omissions
 from walkerlab.export.omitted import MJCF_KNEE_LATCH
 from walkerlab.export.parts import tree_part
@@ -123,7 +132,8 @@ from walkerlab.walker.description import state_names
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_CCD_TOLERANCE_L", "TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls",
-           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad"]
+           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad",
+           "pelvis_rod_inertia"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
 #: (its lateral mode falls under any push: the patches only carry the exact gait)
@@ -476,7 +486,20 @@ def _bodies(data) -> tuple:
     tree, coords, p = walker_tree(data)
     roles = legs3d_roles(data)
     root, couplings = export_bodies(tree, coords, p, roles)
+    if kneed(data):  # the pelvis a rod between the hips (module docstring)
+        root = replace(root, inertia_kg_m2=pelvis_rod_inertia(p))
     return (root, _geoms(p, roles, round_feet(data)), *mjcf_coupling_lines(couplings))
+
+
+def pelvis_rod_inertia(p: dict) -> np.ndarray:
+    """The kneed walker's pelvis in the MJCF (module docstring): the hip mass ``M_hip`` [kg]
+    as a slender rod of the hip width ``w_hip`` [m] along the hip axis (MuJoCo's ``y``),
+    ``M_hip w^2 / 12`` about ``x`` and ``z``, the export's floor
+    (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`) about its own axis
+    (3, 3) [kg m^2]; ``p`` the walker's numbers by name (:func:`legs3d_numbers`)."""
+    rod = p.get("M_hip", 0.0) * p["w_hip"] ** 2 / 12.0
+    return np.diag([max(rod, MJCF_MIN_INERTIA_KG_M2), MJCF_MIN_INERTIA_KG_M2,
+                    max(rod, MJCF_MIN_INERTIA_KG_M2)])
 
 
 def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = None

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
-__all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D",
+__all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
+           "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
            "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
@@ -87,12 +87,17 @@ NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
-#: why a kneed walker in 3D refuses a view (its rigid model, its MJCF and its URDF are its
-#: only ones so far)
-_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid model (walkerlab fixedpoint, "
-                  "simulate) and is exported as MJCF and URDF (export --format mjcf, urdf) "
-                  "so far: its floating (contact) view and its OpenSim export are a later "
-                  "step")
+#: why a kneed walker in 3D refuses the OpenSim export
+_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid and contact models (walkerlab "
+                  "fixedpoint, simulate, contact-sim) and is exported as MJCF, URDF and an "
+                  "Adams dataset (export --format mjcf, urdf, adams); the OpenSim export "
+                  "writes planar walkers only")
+#: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
+#: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
+KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
+                         "gait is laterally unstable (x40 a stride) and no hip-roll law "
+                         "steadies a kneed walker in 3D, so a walk started a little off it "
+                         "capsizes within a few steps, as the rigid walk would")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -327,9 +332,12 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's
-        # the Adams dataset: the 3D straight legs' with a knee revolute on each leg, its
-        # stop and latch the planar kneed dataset's (walkerlab.export.adams_3d_knees)
-        **{("walk", v): _KNEED_3D_VIEW for v in ("contact", "osim")},
+        # the compliant-contact model: the floating tree with both knees
+        # (walkerlab.codegen.floating_3d.derive_legs_3d), the planar kneed walker's knee
+        # stop and latch; the Adams dataset: the 3D straight legs' with a knee revolute on
+        # each leg, its stop and latch the planar kneed dataset's
+        # (walkerlab.export.adams_3d_knees)
+        ("walk", "osim"): _KNEED_3D_VIEW,
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
         ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
                                "is a later step"),
@@ -362,7 +370,9 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
 #: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
-CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM}
+CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
+              ("locking_knees_3d", "contact"): KNEED_3D_FIRST_STRIDE,
+              ("locking_knees_3d", "mjcf"): KNEED_3D_FIRST_STRIDE}
 
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``

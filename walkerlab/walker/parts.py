@@ -148,7 +148,7 @@ ACTUATORS_NONE = Part("actuators", "none: a passive walker")
 REACTION_LEG_END = Part("reaction", "at the stance leg's end")
 REACTION_FLAT_FEET = Part("reaction", "flat feet: the heel's and toe's")
 REACTION_HUB = Part("reaction", "at the stance spoke's tip, the hub's")
-REACTION_NONE = Part("reaction", "none: no floating view")
+REACTION_NONE = Part("reaction", "none: the rigid state not mapped to the floating view")
 
 # the contact view's parts (walkerlab.models.contact.parts)
 CONTACT_STRAIGHT_LEGS = Part("contact", "straight legs")
@@ -159,6 +159,7 @@ CONTACT_THREE_LINK = Part("contact", "three-link walker")
 CONTACT_WHEEL = Part("contact", "spoked wheel")
 CONTACT_WHEEL_3D = Part("contact", "spoked wheel in 3D")
 CONTACT_LEGS_3D = Part("contact", "straight legs in 3D")
+CONTACT_KNEES_3D = Part("contact", "locking knees in 3D")
 
 # what a contact run names as the cause of a swing foot's scuffs
 # (walkerlab.analysis.contact.verdict)

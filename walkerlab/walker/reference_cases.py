@@ -20,7 +20,7 @@ import yaml
 from walkerlab.config.loader import shipped_scene_path
 from walkerlab.walker.kinds import KINDS
 
-__all__ = ["JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "WALKING",
+__all__ = ["FIRST_STEPS", "JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "WALKING",
            "reference_scene", "scene_for"]
 
 
@@ -184,9 +184,23 @@ SHIPPED = {
     # fall in contact within a few steps)
     ("straight_legs_3d", "hip_torque"): "hip_width_powered",
     ("straight_legs_3d", "push_off"): "hip_width_powered",
-    # configs/kneed.yaml's walker with 10 cm hip width (its rigid model, the one view so far)
+    # configs/kneed.yaml's walker with 10 cm hip width: laterally unstable (a stride
+    # multiplier of 39.9), its contact and MJCF cells held over its first stride
+    # (:data:`FIRST_STEPS`)
     ("locking_knees_3d", "walk"): "kneed_3d",
 }
+
+#: (kind, feature) -> steps: a reference case whose passive gait is unstable and has no
+#: stabilised counterpart, so that a walk started a little off it (the compliant contact,
+#: MuJoCo) leaves it within a few steps: its contact and engine (MJCF) cells hold its first
+#: ``steps`` steps from the rigid gait's heel strike to the rigid gait's, not 10 heel
+#: strikes (:func:`walkerlab.api.capability_early.first_steps`).  The 3D kneed walker: its
+#: lateral mode grows x6.3 a step (39.9 a stride); the rigid model has no hip-roll joints
+#: with knees, so no foot-placement law stabilises it.  Measured on configs/kneed_3d.yaml:
+#: the contact walk's roll at its heel strikes is 0.003, 0.017, 0.09 rad off the rigid
+#: gait's (whose roll is +-0.006 rad), MuJoCo's 0.002, 0.011, 0.06 rad: over the first
+#: stride the lateral deviation stays within twice the gait's own roll.
+FIRST_STEPS = {("locking_knees_3d", "walk"): 2}
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the
 #: ``optimize`` cell

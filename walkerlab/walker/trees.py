@@ -451,7 +451,8 @@ def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
     return biped_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
 
 
-def legs_tree(structure, massless_mass: str | None = None) -> tuple[BodyTree, CoordinateMap]:
+def legs_tree(structure, floating: bool = False, massless_mass: str | None = None
+              ) -> tuple[BodyTree, CoordinateMap]:
     """The tree of a biped's structure (:class:`walkerlab.walker.description.Structure`,
     legs without spokes), planar or in 3D (:func:`biped_tree`): a biped from parts (each leg
     body ``m_<name>, d_<name>[, I_<name>][, e_<name>]`` (legs that differ: ``m_sw_<name>``,
@@ -467,6 +468,13 @@ def legs_tree(structure, massless_mass: str | None = None) -> tuple[BodyTree, Co
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
+    floating : bool
+        The tree of the floating (contact) view, whose legs swap roles on the ground: a 3D
+        kneed walker's stance leg then has its knee too (the swing knee's stop, the stance
+        knee free: the contact model's knee stop and latch hold it), the stance leg a shank
+        ``stance_shank`` at the foot and a thigh on the knee ``stance_knee`` as a
+        free-jointed planar walker's (coordinates ``lean, stance_shank, stance_thigh,
+        swing_thigh, swing_shank``); the rigid tree otherwise.
     massless_mass : str or None
         The name of a symbolic mass every massless body carries, appended to the tree's
         parameters: the derivation's massless limit (Garcia et al. 1998,
@@ -516,7 +524,8 @@ def legs_tree(structure, massless_mass: str | None = None) -> tuple[BodyTree, Co
                       hip_roll=structure.hip_roll,
                       foot_radius="R_foot" if structure.foot == "arc" else None,
                       coordinates=structure.coordinates,
-                      free_joints=planar and (structure.free_knees or structure.hinged_torso),
+                      free_joints=(planar and (structure.free_knees or structure.hinged_torso))
+                      or (floating and not planar and structure.knee),
                       soles=_soles(structure) if structure.foot == "flat" else None)
 
 

@@ -197,11 +197,10 @@ def latch_weight(delta, ext, PC):
 
 
 @njit(cache=True)
-def knee(x, k, PC, delta, nq):
-    """Knee stop (and latch, its foot at penetration delta [m]) of knee k of the state
-    ``x`` (``nq`` coordinates, then their rates): (extension, rate, torque, dT/dext,
-    dT/drate)."""
-    t, s = 2 + 2 * k, 3 + 2 * k
+def knee(x, t, s, PC, delta, nq):
+    """Knee stop (and latch, its foot at penetration delta [m]) of the knee between the
+    thigh angle ``x[t]`` and the shank angle ``x[s]`` of the state ``x`` (``nq``
+    coordinates, then their rates): (extension, rate, torque, dT/dext, dT/drate)."""
     ext = x[s] - x[t]
     rate = x[nq + s] - x[nq + t]
     if ext < 0.0:
@@ -233,10 +232,11 @@ def knee_torque(ext, rate, PC, delta):
 
 @njit(cache=True)
 def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg,
-                   has_knees):
+                   has_knees, knee_idx):
     """Q - h (nq,) from the bias ``h`` (nq,) with the contact forces of the points of the
     legs used (``use1``, ``use2``) and, ``has_knees``, the knee stops (knee k's foot: point
-    k); fills ``info`` and ``knees``.  Points in ``d = P.shape[1]`` dimensions
+    k; its thigh's and shank's coordinates ``knee_idx[k]``, (2, 2)); fills ``info`` and
+    ``knees``.  Points in ``d = P.shape[1]`` dimensions
     (:func:`point` in the plane, :func:`point3` in 3D)."""
     nq = h.shape[0]
     Q = -h
@@ -268,12 +268,13 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
     if has_knees:
         for k in range(2):
             used = (k == 0 and use1) or (k == 1 and use2)
-            res = knee(x, k, PC, info[k, 0] if used else np.inf, nq)  # pinned: on the ground
+            t, s = knee_idx[k, 0], knee_idx[k, 1]
+            res = knee(x, t, s, PC, info[k, 0] if used else np.inf, nq)  # pinned: on ground
             for j in range(5):
                 knees[k, j] = res[j]
             T = res[2]
-            Q[2 + 2 * k] += T
-            Q[3 + 2 * k] -= T
+            Q[t] += T
+            Q[s] -= T
     return Q
 
 
@@ -345,7 +346,7 @@ def world_forces(info, d):
 
 
 @njit(cache=True)
-def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
+def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees, knee_idx):
     """d rhs / dx (2 nq, 2 nq) from the Cholesky factor ``L`` of M, the partials ``Dq``,
     ``Dv`` (nq, nq) of ``M a + h`` at the acceleration ``a``, ``dJtF`` (nq, nq) of ``J^T F``
     at the forces held, the points' Jacobians ``J`` and their rates' partials ``dV``
@@ -386,7 +387,7 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees):
                 B[r, k] += J[i, 0, r] * dFx[k] + J[i, 1, r] * dFy[k]
     if has_knees:
         for kk in range(2):
-            t, s = 2 + 2 * kk, 3 + 2 * kk
+            t, s = knee_idx[kk, 0], knee_idx[kk, 1]
             dd, dr = knees[kk, 3], knees[kk, 4]
             # Q[t] += T, Q[s] -= T with T(ext = q_s - q_t, rate = dq_s - dq_t)
             for off, d in ((0, dd), (nq, dr)):
@@ -535,13 +536,19 @@ def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r, S):
 
 
 @njit(cache=True)
-def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out, r):
+def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out, r, knee_idx):
     """Row ``r`` of the knee table ``out`` (n, 2, 4): per knee extension [rad], its rate
-    [rad/s], stop torque [N m] and the stop's power [W] (knee k's foot: point k) of the
-    state ``x`` (``nq`` coordinates, then their rates)."""
+    [rad/s], stop torque [N m] and the stop's power [W] (knee k's foot: point k; its
+    thigh's and shank's coordinates ``knee_idx[k]``) of the state ``x`` (``nq``
+    coordinates, then their rates)."""
     for k in range(2):
-        delta = point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC, c1 if k == 0 else c2)[0]
-        ext, rate, T, _, _ = knee(x, k, PC, delta, nq)
+        cen = c1 if k == 0 else c2
+        if P.shape[1] == 3:
+            delta = point3(P[k, 0], P[k, 1], P[k, 2], V[k, 0], V[k, 1], V[k, 2], sp, cp, PC,
+                           cen)[0]
+        else:
+            delta = point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC, cen)[0]
+        ext, rate, T, _, _ = knee(x, knee_idx[k, 0], knee_idx[k, 1], PC, delta, nq)
         out[r, k, 0] = ext
         out[r, k, 1] = rate
         out[r, k, 2] = T

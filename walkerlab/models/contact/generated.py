@@ -114,7 +114,8 @@ _SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
-    constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``NF``,
+    constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``KNEES``
+    (2, 2) (each knee's thigh and shank coordinates in ``q``), ``NF``,
     ``POINT_LEG``, ``PIN``, ``CONTACTS``, ``STANCE_LAW`` (internal forces by stance: a
     hip-roll law, :attr:`walkerlab.codegen.floating.FloatingEquations.stance_forces`), then
     the glue of
@@ -137,7 +138,10 @@ def contact_source(structure: Structure, key: str) -> str:
         raise ValueError("a kneed walker's contact model needs one contact point per leg")
     fl = floating.floating_source(structure, key)
     legs = tuple(eq.point_legs)
+    # each knee's thigh and shank coordinates (a placeholder without knee stops: unread)
+    knees = tuple(tuple(k) for k in eq.knees) or ((0, 0), (0, 0))
     return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(eq.knees)}\n"
+            f"KNEES = np.array({knees!r}, dtype=np.int64)\n"
             f"NF = {len(eq.feet)}\nPOINT_LEG = {legs!r}\nPIN = {legs.index(1)}\n"
             f"CONTACTS = {tuple(eq.contacts)!r}\nSTANCE_LAW = {bool(eq.stance_forces)}\n"
             + contact_glue() + "\n\n" + rhs_source(eq)

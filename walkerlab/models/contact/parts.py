@@ -344,6 +344,9 @@ class Legs3DPart(ContactPart):
     #: the heading: the rigid stance foot holds its yaw (the rigid state has no heading),
     #: the compliant one turns, with a multiplier near 1 (heading is nearly neutral)
     free_modes = 1
+    #: floating coordinates the rigid state has no role of its own for -> the rigid role
+    #: whose angle and rate they take (locking knees: the straight stance leg's links)
+    same_as: dict = {}
 
     def link_state(self, walker, x, rate_scale) -> np.ndarray:
         """The floating state after the base's slides (``[heading, the rigid roles' angles,
@@ -355,6 +358,7 @@ class Legs3DPart(ContactPart):
         n = len(roles)
         coords = walker.coordinate_names()[walker.dim:]
         at = {ROLES_3D[r]: k for k, r in enumerate(roles)}
+        at.update({c: at[ROLES_3D[r]] for c, r in self.same_as.items()})
         angles = np.array([x[at[c]] if c in at else 0.0 for c in coords])
         scale = [rate_scale[0] if c.startswith("leg1") else
                  rate_scale[1] if c.startswith("leg2") else 1.0 for c in coords]
@@ -416,6 +420,16 @@ class Legs3DPart(ContactPart):
         return None
 
 
+class Kneed3DPart(Legs3DPart):
+    """Locking knees in 3D (McGeer 1990; Kuo 1999): the straight legs' floating base and
+    rolls, each leg's thigh and shank pitched in its rolled sagittal plane (both legs'
+    knees: the floating tree's stance knee, held by the contact model's knee stop and latch
+    as the planar kneed walker's); the rigid stance leg is straight, so its thigh and shank
+    both take its pitch."""
+
+    same_as = {"leg2_thigh_angle": "stance", "leg2_shank_angle": "stance"}
+
+
 # each kind's contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) given the
 # contact view's behaviour
 P.CONTACT_STRAIGHT_LEGS.provide(ContactPart())
@@ -426,6 +440,7 @@ P.CONTACT_THREE_LINK.provide(HingedTorsoPart())
 P.CONTACT_WHEEL.provide(RollingPolygonPart())
 P.CONTACT_LEGS_3D.provide(Legs3DPart())
 P.CONTACT_WHEEL_3D.provide(RollingPolygon3DPart())
+P.CONTACT_KNEES_3D.provide(Kneed3DPart())
 
 
 def periodic_gait_refusal(scene, data) -> str | None:

@@ -53,11 +53,11 @@ def _force_lines(point_legs, Fs, forced: bool, d: int = 2) -> list[str]:
     return lines
 
 
-def _knee_lines(eq, red, pr, Q, power: list) -> list[str]:
+def _knee_lines(eq, red, pr, Q, power: list, d: int = 2) -> list[str]:
     """:func:`rhs_source`'s knee-stop torques ``_T<k>`` of each leg's knee (none without
     knees), from its extension and rate and its foot's penetration (``red``: the feet's
-    reduced kinematics, printed by ``pr``); each added into ``Q`` (+ on the thigh, - on the
-    shank) and its power ``-T d(ext)/dt`` appended to ``power``."""
+    reduced kinematics, ``2 d`` per point, printed by ``pr``); each added into ``Q`` (+ on
+    the thigh, - on the shank) and its power ``-T d(ext)/dt`` appended to ``power``."""
     import sympy as sp
 
     lines = []
@@ -66,7 +66,8 @@ def _knee_lines(eq, red, pr, Q, power: list) -> list[str]:
         # penetration of leg k's foot, -(p . n)
         # (a polyline ground: the penetration into it, _point's)
         dl = (f"(_r{k}[0] if PC[I_CONT] > 1.5 else "
-              f"-(({pr.doprint(red[4 * k])}) * _sp + ({pr.doprint(red[4 * k + 1])}) * _cp))")
+              f"-(({pr.doprint(red[2 * d * k])}) * _sp + "
+              f"({pr.doprint(red[2 * d * k + 1])}) * _cp))")
         lines.append(f"    {T} = _knee_torque({eq.q[sh]} - {eq.q[t]}, "
                      f"{eq.dq[sh]} - {eq.dq[t]}, PC, {dl})")
         Q[t] += T
@@ -190,7 +191,7 @@ def rhs_source(eq, forced: bool = False) -> str:
                      + (f" if not _ghost{i} else 0.0" if forced else ""))
         Q += Jn.T * tw
         power[i] += f" + {tw} * ({spin})"
-    lines += _knee_lines(eq, red, pr, Q, power)
+    lines += _knee_lines(eq, red, pr, Q, power, d)
     lines += _stance_lines(eq, Q, pr, power if forced else None)
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}
     mexprs = [eq.M[i, j] for i in range(nq) for j in range(i + 1) if (i, j) in nz]

@@ -95,8 +95,10 @@ P.REACTION_LEG_END.provide(_Part())
 P.REACTION_FLAT_FEET.provide(_Part(refusal="flat feet: the rigid model's own guards check "
                                            "the heel's and toe's normal forces"))
 P.REACTION_HUB.provide(_Part(hub=True, trailing_point="trailing_foot"))
-P.REACTION_NONE.provide(_Part(refusal="{title}: no floating view (the contact view's), so "
-                                      "the stance foot's reaction is not computed"))
+P.REACTION_NONE.provide(_Part(refusal="{title}: its floating view has a stance knee the "
+                                      "rigid state leaves straight and a heel strike whose "
+                                      "reset is no relabelling, which this reaction does not "
+                                      "map, so the stance foot's reaction is not computed"))
 
 
 @dataclass(frozen=True)
