@@ -306,3 +306,29 @@ def test_a_planar_walkers_printed_equations_from_its_tree_equal_the_leg_vector_s
             scale = max(np.nanmax(np.abs(a)), 1.0) if np.isfinite(a).any() else 1.0
             np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * scale, equal_nan=True,
                                        err_msg=what)
+
+
+def test_the_planar_spoked_wheel_from_its_tree_equals_the_spoke_vector_sums():
+    """The rimless wheel (configs/rimless_wheel.yaml; McGeer 1990) derived from its tree
+    (:func:`walkerlab.codegen.derive_3d.derive_spoked`) equals the spoke-vector sums
+    (``tests/independent/planar_wheel.py``): flow, impact ``B = m L^2 cos 2 alpha + I``,
+    energies, guards and every spoke's foot, at a state and the scene's numbers (1e-12)."""
+    from tests.independent.planar_wheel import derive as spoke_sums
+    from walkerlab.codegen.derive_3d import derive_spoked
+
+    structure, numbers = _scene_numbers("rimless_wheel")
+    e, f = spoke_sums(structure), derive_spoked(structure)
+    assert set(e.points) == set(f.points) and set(e.guards) == set(f.guards)
+    args = list(e.q) + list(e.dq) + list(e.params)
+    x = [0.1, -0.7] + [numbers[str(p)] for p in e.params]
+    dq = sp.Matrix(e.dq)
+    pairs = [(e.M.LUsolve(-(e.C * dq + e.G)), f.M.LUsolve(-(f.C * dq + f.G))),
+             (e.Mi.LUsolve(e.B * dq), f.Mi.LUsolve(f.B * dq)),
+             (sp.Matrix([e.kinetic, e.potential]), sp.Matrix([f.kinetic, f.potential])),
+             (e.relabel_q, f.relabel_q),
+             (sp.Matrix([e.drop_solution]), sp.Matrix([f.drop_solution]))]
+    pairs += [(sp.Matrix([e.guards[k]]), sp.Matrix([f.guards[k]])) for k in e.guards]
+    pairs += [(e.points[k], f.points[k]) for k in e.points]
+    for a, b in pairs:
+        va, vb = (np.array(sp.lambdify(args, m)(*x), float) for m in (a, b))
+        assert np.max(np.abs(va - vb)) <= 1e-12 * max(np.max(np.abs(va)), 1.0)

@@ -98,26 +98,22 @@ def _source_hash(*names: str) -> str:
 @cache
 def _spoked_generator_hash() -> str:
     """sha256 of the spoked wheel's derivation (once per process)."""
-    return hashlib.sha256((Path(__file__).parent / "rolling_polygon.py").read_bytes()
-                          ).hexdigest()
+    return _source_hash("codegen/derive_3d.py", "walker/walker_trees.py")
 
 
 def cache_key(structure) -> str:
-    """Cache key (hex, 24 characters) of a structure for the current generator (a
-    flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes` (with
+    """Cache key (hex, 24 characters) of a structure for the current generator (every
+    biped's derivation from its body tree, :mod:`walkerlab.codegen.legged`; a flat-footed
+    walker's also covers :mod:`walkerlab.codegen.foot_modes` (with
     :mod:`~walkerlab.codegen.double_support` and :mod:`~walkerlab.codegen.push_off`), a
-    spoked wheel's
-    :mod:`walkerlab.codegen.rolling_polygon`, a 3D walker's its derivation from its body tree
-    (:mod:`walkerlab.codegen.derive_3d`, :mod:`~walkerlab.codegen.tree_derive`,
-    :mod:`walkerlab.walker.trees`), which no other structure's key reads)."""
+    spoked wheel's :mod:`walkerlab.codegen.derive_3d` and its planar tree, which no other
+    structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())
     if structure.foot == "flat":
         h.update(_flat_generator_hash().encode())
     if structure.spokes:
         h.update(_spoked_generator_hash().encode())
-    if getattr(structure, "in_3d", False):  # derived from its body tree
-        h.update(_source_hash("codegen/derive_3d.py").encode())
     return h.hexdigest()[:24]
 
 
@@ -203,17 +199,13 @@ def _derive_module(structure, key: str, path: Path | None) -> dict:
 
 def derive_equations(structure):
     """The symbolic :class:`~walkerlab.codegen.equations.Equations` of ``structure`` that the
-    printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's
-    (:mod:`walkerlab.codegen.rolling_polygon`) or a biped's
+    printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's, planar or 3D
+    (:func:`walkerlab.codegen.derive_3d.derive_spoked`) or a biped's
     (:func:`walkerlab.codegen.legged.derive_legged`)."""
-    if structure.in_3d and structure.spokes:
+    if structure.spokes:
         from walkerlab.codegen import derive_3d  # light
 
         return derive_3d.derive_spoked(structure)
-    if structure.spokes:
-        from walkerlab.codegen import rolling_polygon  # light
-
-        return rolling_polygon.derive(structure)
     from walkerlab.codegen import legged  # light
 
     return legged.derive_legged(structure)

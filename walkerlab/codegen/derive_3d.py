@@ -24,7 +24,7 @@ Sec. 2).  Its orientation is ``R = Rot(n, psi) Rot(s, phi) Rot(z, theta)``:
 - ``stance`` ``theta``: the spin about the axle, the stance spoke's angle from the
   downward vertical in the wheel's plane, positive when its foot is ahead of the hub -
   with ``psi = phi = 0`` the planar wheel's coordinate
-  (:mod:`walkerlab.codegen.rolling_polygon`), so that the upright wheel's equations are
+  (:func:`derive_spoked`, from the planar tree), so that the upright wheel's equations are
   the planar ones.
 
 The wheel is one body of its tree (:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`:
@@ -66,8 +66,49 @@ from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import slope_to_world
 from walkerlab.codegen.legged import hip_roll_forces
 from walkerlab.codegen.seeded import seeded as _seeded
-from walkerlab.codegen.tree_derive import derive_tree, heel_strike
+from walkerlab.codegen.tree_derive import (
+    derive_tree,
+    heel_strike,
+    impact_of_bodies,
+    simplifier,
+)
 from walkerlab.walker.trees import spoked_wheel_3d_tree
+from walkerlab.walker.walker_trees import spoked_wheel_tree
+
+
+def _planar_spoked(structure) -> Equations:
+    """The planar spoked wheel (McGeer 1990, "Passive dynamic walking", IJRR 9(2), the
+    rimless wheel) from its tree (:func:`walkerlab.walker.walker_trees.spoked_wheel_tree`):
+    one coordinate, the stance spoke's angle ``q`` from the vertical; the heel strike
+    ``2 q + 2 alpha + 2 gamma`` (the spokes symmetric about the slope's normal), the impact
+    about the next spoke's foot (:func:`~walkerlab.codegen.tree_derive.impact_of_bodies`:
+    ``B = m L^2 cos 2 alpha + I``), the new stance spoke the next (``q + 2 alpha``); the
+    section just after a heel strike, ``q = alpha - gamma``."""
+    tree, coords = spoked_wheel_tree(structure.spokes)
+    te = derive_tree(tree, coords)
+    kin, (q,), (dq,) = te.kinematics, te.q, te.dq
+    P = dict(zip(tree.params, te.params))
+    alpha, gamma = P["alpha"], P["gamma"]
+    simplify = simplifier(kin)
+    V = simplify(te.potential)
+    Mi, B = impact_of_bodies(kin, kin.contacts["next_foot"].jacobian(sp.Matrix([q])),
+                             simplify)
+    to_world = slope_to_world(gamma)[:2, :2]
+    hub, nxt = kin.coms["wheel"], kin.contacts["next_foot"]
+    named = {"hip": hub, "stance_foot": sp.zeros(3, 1), "swing_foot": nxt,
+             **{k: kin.contacts[k] for k in ["trailing_foot"] + [
+                 f"spoke{i}_foot" for i in range(2, structure.spokes - 1)]}}
+    points = {k: (to_world * v[:2, :]).applyfunc(simplify) for k, v in named.items()}
+    return Equations(
+        q=(q,), dq=(dq,), params=te.params, M=te.M, C=te.C,
+        G=sp.Matrix([sp.expand(sp.diff(V, q))]), Mi=Mi, B=B,
+        relabel_q=sp.Matrix([q + 2 * alpha]), relabel_rate=sp.eye(1),
+        kinetic=te.kinetic, potential=V,
+        guards={"heel_strike": 2 * q + 2 * alpha + 2 * gamma, "rolls_back": dq,
+                "hip_height": hub[1], "swing_clearance": nxt[1]},
+        points=points, leg_angles={"stance": q, "swing": q + 2 * alpha},
+        section_drop=0, drop_solution=alpha - gamma,
+        De=sp.zeros(3, 3), E=sp.zeros(2, 3), limit=False, section_tied=None)
 
 
 @cache
@@ -105,8 +146,10 @@ def derive_spoked(structure) -> Equations:
     ValueError
         ``structure`` is not a 3D spoked wheel.
     """
-    if not (structure.spokes and structure.in_3d):
-        raise ValueError("derive_3d.derive_spoked: the structure is not a 3D spoked wheel")
+    if not structure.spokes:
+        raise ValueError("derive_3d.derive_spoked: the structure is not a spoked wheel")
+    if not structure.in_3d:
+        return _planar_spoked(structure)
     tree, coords = spoked_wheel_3d_tree(structure.spokes)
     te = derive_tree(tree, coords)
     psi, phi, th = te.q

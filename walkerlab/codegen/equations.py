@@ -1,7 +1,7 @@
 """The symbolic equations of a walker's rigid hybrid view (flow, impact, guards, energies,
 points, the extended impact system) as the printers of :mod:`walkerlab.codegen.source` read
 them; derived by :func:`walkerlab.codegen.legged.derive_legged` (and, for a spoked wheel,
-:func:`walkerlab.codegen.rolling_polygon.derive`).
+:func:`walkerlab.codegen.derive_3d.derive_spoked`, planar or 3D).
 """
 
 from __future__ import annotations

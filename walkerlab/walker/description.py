@@ -140,7 +140,7 @@ class Structure:
         0, or the number of spokes of a spoked wheel (``model: rimless_wheel``): one rigid
         body, a hub with ``spokes`` massless spokes ``2 alpha = 2 pi / spokes`` apart,
         rolling about the stance spoke's foot (role ``stance``, parameters
-        :data:`SPOKED_PARAMS`; :mod:`walkerlab.codegen.rolling_polygon`; its floating view
+        :data:`SPOKED_PARAMS`; :func:`walkerlab.codegen.derive_3d.derive_spoked`; its floating view
         has one contact point per spoke).  The other fields are then unused.
     in_3d : bool
         The walker moves in three dimensions (``walker.space: 3d``;

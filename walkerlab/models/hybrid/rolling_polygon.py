@@ -1,7 +1,7 @@
 """A spoked wheel rolling on its spokes' feet (``model: rimless_wheel``) as a
 :class:`~walkerlab.models.hybrid.base.HybridWalker`, from its generated code.
 
-The equations are :mod:`walkerlab.codegen.rolling_polygon`'s (McGeer 1990; Coleman,
+The equations are :func:`walkerlab.codegen.derive_3d.derive_spoked`'s (McGeer 1990; Coleman,
 Chatterjee & Ruina 1997), printed and cached as every walker's
 (:mod:`walkerlab.codegen.source`, :mod:`walkerlab.codegen.cache`), with a compiled flow for
 the C++/numba integrators and the per-step-terrain batch map.  A step is one phase,

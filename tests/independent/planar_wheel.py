@@ -1,4 +1,8 @@
-"""Symbolic equations of a spoked wheel rolling on its spokes' feet (``model: rimless_wheel``),
+"""An independent reference for the planar spoked wheel's equations (sums of spoke vectors, no
+body tree), which printed it before :func:`walkerlab.codegen.derive_3d.derive_spoked` derived
+it from its tree; ``tests/test_planar_trees.py`` compares the two.
+
+The original generator's description follows: the planar spoked wheel's equations (McGeer 1990)
 as the :class:`~walkerlab.codegen.equations.Equations` every generated walker has: the
 printers of :mod:`walkerlab.codegen.source` turn them into the Python module and the
 compiled (numba) module like any biped's, so fixed points, simulation, basins and MFPT run
