@@ -603,7 +603,8 @@ def test_every_package_stands_on_a_floor_and_no_import_climbs():
 #: outside, each with its reason (a new one fails: ask the kind, its parts or the capability
 #: table instead)
 SWITCH_3D_READERS = {
-    "codegen/derive_3d.py": "derives the 3D walker's equations: hip roll adds coordinates",
+    "codegen/legged.py": "derives the legged walkers' equations: hip roll adds coordinates, a "
+                         "hip width the heel strike's height guard",
     "export/legs_3d_mjcf.py": "writes one MJCF joint per hip roll",
     "export/legs_3d_parts.py": "the 3D legs' export roles: the pelvis on its roll with "
                                "hip-roll joints (the MJCF's, URDF's and Adams')",
