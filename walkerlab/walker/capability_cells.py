@@ -302,6 +302,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)
         **_CELLS_3D,
+        # stairs and footholds: the ground a height along the walking direction, level
+        # across it; the rigid model lands on them as the planar walkers do (the generated
+        # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground)
+        **{(g, "rigid"): None for g in ("stairs", "footholds")},
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.urdf.

@@ -98,6 +98,19 @@ class _Mirrored:
         return _flip(np.asarray(out), self.n) if self.gradient else out
 
 
+def _probe(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
+    """``walker.from_section`` at the first of ``z, -z, z / 10, -z / 10`` the post-impact
+    surface has a state at (the 3D walker's surface needs the stance pitch to outweigh its
+    rolls against the hip width: ``z``'s alternating signs can put it off the surface)."""
+    for p in (z, -z, 0.1 * z, -0.1 * z):
+        try:
+            return np.asarray(walker.from_section(p), dtype=float)
+        except OffSection:
+            continue
+    raise OffSection("no state on the walker's own post-impact surface at the probes of "
+                     "its section's coordinates")
+
+
 class _LandingSection:
     """``from_section`` of the post-impact surface ``swing_clearance(x) = level`` (see the
     module docstring): the walker's own ``from_section`` (its slope's surface) as the start,
@@ -110,7 +123,7 @@ class _LandingSection:
         keep = np.asarray(walker.section(np.arange(m, dtype=float)), dtype=float)
         keep = [int(round(k)) for k in keep]
         z = np.linspace(0.137, 0.419, len(keep)) * (-1.0) ** np.arange(len(keep))
-        x = np.asarray(walker.from_section(z), dtype=float)
+        x = _probe(walker, z)
         dropped = [i for i in range(m) if i not in keep]
         # a dropped coordinate equal to a kept one is tied to it (e.g. the shank's rate to
         # the thigh's); the others are the solved group (one value)
