@@ -305,7 +305,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stairs and footholds: the ground a height along the walking direction, level
         # across it; the rigid model lands on them as the planar walkers do (the generated
         # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground)
-        **{(g, "rigid"): None for g in ("stairs", "footholds")},
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "contact")},
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.urdf.

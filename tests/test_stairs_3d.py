@@ -1,0 +1,166 @@
+"""The 3D straight-legged walker (``walker.space: 3d``, Kuo 1999) on stairs and footholds:
+the ground a height along the walking direction, level across it, so the landing is the
+generated swing clearance (the swing foot's height above the stance foot's plane) reaching
+the landing's depth, whatever the hip width or the lean
+(:mod:`walkerlab.models.hybrid.ground`).
+
+Physics checks: a zero riser (the clearance guard and the landing section at depth 0) gives
+the plane's map and gait; the stairs gait's footfalls land on the treads, each at the height
+of the tread under it (from its horizontal place alone); the stairs gait matches a model
+written without the generated equations (``tests/test_hip_roll_3d.py``'s Newton model with
+the heel strike at the tread below and the trailing foot on the tread above).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from tests.independent.mirror_stride import stride_against, to_heel_strike
+from tests.test_hip_roll_3d import STANCE, SWING, Reference, reference_of
+from walkerlab.analysis.gait.poincare import find_fixed_point, poincare_map
+from walkerlab.config import load_scene
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.hybrid.ground import with_clearance_guard
+from walkerlab.models.registry import build_walker
+from walkerlab.walker.capability_cells import CAPABILITIES
+from walkerlab.walker.kinds import KINDS
+from walkerlab.walker.plant import Plant
+
+ROOT = Path(__file__).resolve().parents[1]
+SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+#: the heel strike is located on the guard to the integrator's tolerance (1e-12): a
+#: footfall's height to 1e-10 m
+HEIGHT_TOL = 1e-10
+
+
+def _guess(scene, walker) -> np.ndarray:
+    g = scene.fixedpoint.initial_guess.model_extra
+    return np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                     for n in walker.state_names()])
+
+
+def _built(name: str):
+    scene = load_scene(ROOT / "configs" / name)
+    plant = Plant.from_scene(scene)
+    walker = build_walker(plant)
+    return scene, plant, walker, _guess(scene, walker)
+
+
+@pytest.fixture(scope="module")
+def stairs():
+    return _built("hip_width_stairs.yaml")
+
+
+@pytest.fixture(scope="module")
+def plane():
+    """The stabilised walker on its plane slope and the same walker whose heel strike is
+    the landing's clearance guard at depth 0 (a zero riser: the landing section solved by
+    Newton's method on the generated clearance)."""
+    scene, plant, walker, x0 = _built("hip_width_stabilised.yaml")
+    return scene, walker, with_clearance_guard(walker, plant.data), x0
+
+
+def test_3d_straight_legs_take_stairs_and_footholds_in_the_rigid_view():
+    """The table's cells: the rigid view walks them; the kneed walker in 3D still refuses,
+    in one line naming the field."""
+    kind = KINDS["straight_legs_3d"]
+    for ground in ("stairs", "footholds"):
+        assert kind.supports(ground, "rigid")
+    with pytest.raises(ValueError, match=r"^terrain\.kind: ") as err:
+        KINDS["locking_knees_3d"].require("stairs", "rigid", "terrain.kind")
+    assert "\n" not in str(err.value)
+    assert CAPABILITIES["locking_knees_3d"][("stairs", "*")]
+
+
+def test_a_zero_riser_gives_the_planes_map(plane):
+    """The landing at depth 0 (the clearance guard, the section solved on the post-impact
+    surface by Newton) is the plane's own heel strike and section: from the same section
+    coordinates the same state, and one stride of each map from it the same state and
+    period, to 1e-11 (both located to the integrator's 1e-12)."""
+    _scene, walker, zero, x0 = plane
+    z = walker.section(x0)
+    xa, xb = walker.from_section(z), zero.from_section(z)
+    assert np.max(np.abs(xa - xb)) < 1e-12
+    pa, ta = poincare_map(walker, xa, SOLVER)[:2]
+    pb, tb = poincare_map(zero, xb, SOLVER)[:2]
+    assert np.max(np.abs(pa - pb)) < 1e-11
+    assert abs(ta - tb) < 1e-11
+
+
+@pytest.mark.slow  # ~2 min: two fixed points of the 3D walker
+def test_a_zero_riser_gives_the_planes_gait(plane):
+    """The gait of the zero-riser landing is the plane's: fixed point and stride period to
+    1e-9 (both searched to the scene's 1e-12)."""
+    _scene, walker, zero, x0 = plane
+    a = find_fixed_point(walker, x0, SOLVER, fd_check=False)
+    b = find_fixed_point(zero, x0, SOLVER, fd_check=False)
+    assert np.max(np.abs(np.asarray(a.x) - np.asarray(b.x))) < 1e-9
+    assert abs(a.period_s - b.period_s) < 1e-9
+
+
+def test_stairs_footfalls_land_on_the_treads(stairs):
+    """Six steps from the shipped gait: heel strike ``k`` puts the new stance foot on tread
+    ``k`` (the tread under its horizontal place ``x``, ``floor((x + D/2) / D)``, the first
+    foot mid-tread) at that tread's height ``-k H``, to 1e-10 m; the feet alternate sides
+    by the step's lateral offset (the hip width and the lean) and return to the same side
+    every stride."""
+    scene, _plant, walker, x0 = stairs
+    H, D = scene.terrain.riser_m, scene.terrain.tread_m
+    traj = simulate_steps(walker, x0, 6, SOLVER)
+    feet = np.array([s.stance_foot_world for s in traj.segments])
+    assert [s.termination for s in traj.segments] == ["heel_strike"] * 6
+    for k, (x, y, _z) in enumerate(feet):
+        tread = math.floor((x + D / 2) / D)
+        assert tread == k
+        assert abs(y - (-tread * H)) < HEIGHT_TOL
+    lateral = np.diff(feet[:, 2])
+    assert np.all(np.abs(lateral) > 0.1)  # 0.146 m measured
+    assert np.all(lateral[:-1] * lateral[1:] < 0)
+    assert abs(feet[2, 2] - feet[0, 2]) < 1e-5 and abs(feet[3, 2] - feet[1, 2]) < 1e-5
+
+
+class _OnStairs(Reference):
+    """:class:`tests.test_hip_roll_3d.Reference` on level treads ``drop`` [m] apart: the heel
+    strike when the swing foot reaches the tread below (its height above the stance foot's
+    ``-drop``), and just after it the trailing foot on the tread above (``+drop``)."""
+
+    def __init__(self, drop: float, *args):
+        super().__init__(*args)
+        self.drop = drop
+
+    def step(self, w, x):
+        y, t2 = to_heel_strike(self.rhs(w), x, SWING, STANCE,
+                               lambda y: self.foot_height(w, y) + self.drop, 5.0)
+        return self.impact(w, y), t2
+
+    def on_surface(self, w, z):
+        def h(th_sw):
+            return self.foot_height(w, np.array([z[0], th_sw, *z[1:4], *np.zeros(5)])) \
+                - self.drop
+        g = 2 * self.gamma
+        th_sw = brentq(h, -z[1] - g - 0.3, -z[1] - g + 0.05)
+        return np.array([z[0], th_sw, *z[1:]])
+
+
+@pytest.mark.slow  # ~2 min: the generated gait, the reference's and its central differences
+def test_stairs_gait_matches_an_independent_model(stairs):
+    """The stairs gait's fixed point and stride period to 1e-8 and its multipliers to 1e-6
+    against the Newton model's on the same treads (hybr on its stride, central differences
+    h = 1e-6), and it is stable (largest multiplier 0.519 measured)."""
+    scene, _plant, walker, x0 = stairs
+    res = find_fixed_point(walker, x0, SOLVER, fd_check=False)
+    ref = reference_of(scene)
+    ref = _OnStairs(scene.terrain.riser_m, ref.g, ref.L, ref.gamma, ref.M, ref.m, ref.a,
+                    ref.I_pelvis, ref.law)
+    dx, dt, dmu = stride_against(ref, scene.walker.hip_width_m, res,
+                                 [0, 2, 3, 4, 5, 6, 7, 8, 9])
+    assert dx < 1e-8
+    assert dt < 1e-8
+    assert dmu < 1e-6
+    assert np.max(np.abs(res.multipliers_variational)) < 0.95
