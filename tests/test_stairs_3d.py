@@ -164,3 +164,43 @@ def test_stairs_gait_matches_an_independent_model(stairs):
     assert dt < 1e-8
     assert dmu < 1e-6
     assert np.max(np.abs(res.multipliers_variational)) < 0.95
+
+
+@pytest.mark.slow  # minutes: the rigid gait and five strides of the floating walker
+def test_stairs_contact_walk_is_within_3_percent_of_the_rigid_step_period(tmp_path):
+    """``walkerlab contact-sim`` down the stairs (patches at the rigid footfalls, each at
+    its tread's height): every heel strike of five strides, and the last four steps' mean
+    period within 3 % of the rigid gait's (the capability table's contact tolerance)."""
+    import h5py
+
+    from walkerlab.stages import pipeline
+
+    scene = load_scene(ROOT / "configs" / "hip_width_stairs.yaml")
+    out = pipeline.run("contact-sim", scene, tmp_path, strides=5)
+    with h5py.File(out.path) as f:
+        periods = np.asarray(f["steps/period"][()], float)
+        strikes = int(f["summary/heel_strikes"][()])
+    with h5py.File(tmp_path / scene.name / "fixedpoint.h5") as f:
+        rigid = float(f["step_period"][()])
+    periods = periods[np.isfinite(periods)]
+    assert not out.failure
+    assert strikes >= 10
+    assert abs(periods[-4:].mean() / rigid - 1.0) < 0.03
+
+
+@pytest.mark.slow  # ~1 min: the rigid gait and 8 s of MuJoCo stepped one timestep at a time
+def test_stairs_mjcf_walks_in_mujoco_within_3_percent_of_the_rigid_step_period(tmp_path):
+    """The exported MJCF (patches at the rigid footfalls, their tops at the treads'
+    heights) walked by MuJoCo with the hip-roll law in the walk loop: >= 10 alternating
+    heel strikes without falling, every step period within 3 % of the rigid one."""
+    pytest.importorskip("mujoco")
+    from walkerlab.export.mujoco_walk import walk
+    from walkerlab.stages import export
+
+    scene = load_scene(ROOT / "configs" / "hip_width_stairs.yaml")
+    out = export.write(scene, tmp_path, "mjcf", walk=True)
+    w = out.walk
+    assert not w.fell and w.alternating and w.strikes >= 10, w.line
+    run = walk(out.path, 11.3 * out.step_period_s)
+    assert len(run.times_s) >= 10
+    assert np.max(np.abs(run.step_periods_s / out.step_period_s - 1.0)) < 0.03

@@ -14,7 +14,7 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
-           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
+           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -71,6 +71,11 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 #: why a 3D walker's views refuse a ground other than a plane
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
+#: why the 3D straight legs refuse a height profile
+PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall line (the "
+              "pelvis' roll axis held on it): a profile's slope changes from step to step, "
+              "turning that axis between steps, which the rigid state does not carry; "
+              "stairs and footholds of several heights keep one fall line")
 #: why a 3D walker refuses actuators
 ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model, contact "
                 "model, MJCF and URDF so far; its Adams dataset is passive but for the "
@@ -304,8 +309,14 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_CELLS_3D,
         # stairs and footholds: the ground a height along the walking direction, level
         # across it; the rigid model lands on them as the planar walkers do (the generated
-        # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground)
-        **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "contact")},
+        # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground), the
+        # contact model, the MJCF and the Adams dataset lay their footfall patches at the
+        # rigid gait's footfalls (walkerlab.export.legs_3d_mjcf.legs3d_footfalls: the
+        # trailing foot's height included), the gym's rigid view steps them as simulate
+        **{(g, v): None for g in ("stairs", "footholds")
+           for v in ("rigid", "contact", "mjcf", "adams", "gym")},
+        **_URDF_GROUNDS,
+        ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.urdf.

@@ -184,6 +184,11 @@ SHIPPED = {
     # fall in contact within a few steps)
     ("straight_legs_3d", "hip_torque"): "hip_width_powered",
     ("straight_legs_3d", "push_off"): "hip_width_powered",
+    # the stabilised walker down stairs of its slope step and on footholds of two heights
+    # (the passive hip-width walker's lateral multiplier of ~100 a stride leaves a walk
+    # from its gait within a few steps)
+    ("straight_legs_3d", "stairs"): "hip_width_stairs",
+    ("straight_legs_3d", "footholds"): "hip_width_footholds",
     # configs/kneed.yaml's walker with 10 cm hip width (its rigid model, the one view so far)
     ("locking_knees_3d", "walk"): "kneed_3d",
 }

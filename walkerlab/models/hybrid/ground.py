@@ -36,6 +36,7 @@ from walkerlab.models.ground import foothold_steps, landing_drop
 from walkerlab.models.hybrid.base import HybridWalker, OffSection, Phase
 from walkerlab.models.hybrid.rigid_foot_modes import on_landing_flat
 from walkerlab.walker import parts as P
+from walkerlab.walker.capability_cells import PROFILE_3D
 
 __all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
            "with_clearance_guard"]
@@ -314,6 +315,8 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True,
     steps = tuple((float(d), float(g)) for d, g in steps)
     base = {g: walker_at(g) for g in sorted({g for _, g in steps})}
     data = {g: data_at(g) for g in base}
+    if len(base) > 1 and any(d.structure.in_3d for d in data.values()):
+        raise ValueError(f"terrain.foothold_slopes_rad: {PROFILE_3D}")
     if len(base) > 1 and any(d.structure.coordinates != "absolute" for d in data.values()):
         raise ValueError("terrain.foothold_slopes_rad: the walker's coordinates are measured "
                          "from the slope (walker.coordinates); footholds of several slopes "
