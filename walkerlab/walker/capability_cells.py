@@ -13,8 +13,9 @@ from __future__ import annotations
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D",
-           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_PASSIVE",
+           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D",
+           "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
+           "PROFILE_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -76,6 +77,16 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
               "turning that axis between steps, which the rigid state does not carry; "
               "stairs and footholds of several heights keep one fall line")
+#: why the 3D straight legs' MJCF and Adams dataset refuse footholds of several heights
+#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_footfalls`)
+FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF and Adams dataset lay its footfall patches a "
+                       "stride apart from the keyframe's trailing foot (its two steps mirror "
+                       "each other about the fall line); footholds of several heights make "
+                       "the steps differ: give footholds of one height for this view")
+#: why the kneed walker in 3D's MJCF refuses stairs and footholds
+KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D falls in MuJoCo within its first step on "
+                        "its slope (its walk cell): its MJCF lays no stairs or footholds "
+                        "a walk could be measured on")
 #: why a 3D walker refuses actuators
 ACTUATION_3D = ("a 3D walker's hip torque and push-off run in its rigid model, contact "
                 "model, MJCF and URDF so far; its Adams dataset is passive but for the "
@@ -315,6 +326,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # trailing foot's height included), the gym's rigid view steps them as simulate
         **{(g, v): None for g in ("stairs", "footholds")
            for v in ("rigid", "contact", "mjcf", "adams", "gym")},
+        **{("footholds", v): FOOTHOLDS_EXPORT_3D for v in ("mjcf", "adams")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
@@ -340,6 +352,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
+        # stairs and footholds in the rigid model and the gym's rigid view: the straight
+        # legs' landing (the generated swing clearance with the knee locked plus the
+        # landing's depth: walkerlab.models.hybrid.ground)
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},
+        **{(g, "mjcf"): KNEED_3D_GROUND_MJCF for g in ("stairs", "footholds")},
+        **_URDF_GROUNDS,
+        ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's

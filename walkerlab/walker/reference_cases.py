@@ -191,6 +191,8 @@ SHIPPED = {
     ("straight_legs_3d", "footholds"): "hip_width_footholds",
     # configs/kneed.yaml's walker with 10 cm hip width (its rigid model, the one view so far)
     ("locking_knees_3d", "walk"): "kneed_3d",
+    # ... down stairs of its slope step
+    ("locking_knees_3d", "stairs"): "kneed_3d_stairs",
 }
 
 #: (kind, feature) -> the shipped scene with an optimize section: the reference case of the

@@ -15,6 +15,20 @@ family.  The impact map is the walker's own (plastic, paper Eq. 5-8).  On level 
 (``gamma = 0``) of stairs going down ``H``, the heel strike is the swing foot reaching
 ``-H`` relative to the stance foot.
 
+A walker in 3D (the straight legs with hip width, Kuo 1999: :mod:`walkerlab.codegen.
+derive_3d`) walks the same grounds: a height along the walking direction (the fall line,
+the world's downhill ``x``), level across it (``z``), so a stair's tread or a foothold is the
+plane of the slope through the stance foot shifted along the vertical, whatever the feet's
+lateral places (the hip width, the lean).  Its generated ``swing_clearance`` is the swing
+foot's height along the slope's normal above the plane through the stance foot, so the
+landing is the planar one: the clearance reaching ``-drop_m cos(gamma)``.  The stance foot's
+axes are the slope's frame (``s`` the fall line, ``n`` the normal, ``z`` across; the lean and
+the pelvis' roll about ``s``, the legs' pitches about their rolled ``z``); on stairs the
+treads are level (``gamma = 0``), so that frame is the tread's: ``s`` the horizontal walking
+direction, ``n`` up.  The walker's rolls are about that fall line, so a ground whose slope
+changes from step to step (footholds of their own slopes, a profile) is refused
+(:data:`walkerlab.walker.capability_cells.PROFILE_3D`).
+
 Poincaré section: the state just after heel strike, where the new swing foot (the old stance
 foot) lies ``drop_m`` above the new stance foot's line: ``swing_clearance(x+) = drop_m
 cos(gamma)`` (both feet on their treads: for point feet exactly, for arc feet their lowest
