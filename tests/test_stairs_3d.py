@@ -125,6 +125,45 @@ def test_stairs_footfalls_land_on_the_treads(stairs):
     assert abs(feet[2, 2] - feet[0, 2]) < 1e-5 and abs(feet[3, 2] - feet[1, 2]) < 1e-5
 
 
+def test_kneed_3d_stairs_footfalls_land_on_the_treads():
+    """configs/kneed_3d_stairs.yaml (locking knees in 3D, its two phases): four steps from
+    the shipped gait, heel strike ``k`` on tread ``k`` at its height ``-k H`` to 1e-10 m
+    (the lateral mode is unstable, ~40 a stride: four steps stay on the gait)."""
+    scene, _plant, walker, x0 = _built("kneed_3d_stairs.yaml")
+    H, D = scene.terrain.riser_m, scene.terrain.tread_m
+    traj = simulate_steps(walker, x0, 4, SOLVER)
+    assert [s.termination for s in traj.segments] == ["heel_strike"] * 4
+    for k, s in enumerate(traj.segments):
+        x, y, _z = s.stance_foot_world
+        assert math.floor((x + D / 2) / D) == k
+        assert abs(y + k * H) < HEIGHT_TOL
+
+
+@pytest.mark.parametrize("terrain, field", [
+    ({"kind": "profile", "profile_m": [[-1.0, 0.02], [0.0, 0.0], [1.0, -0.03]]},
+     "terrain.kind: profile"),
+    ({"kind": "footholds", "foothold_heights_m": [0.0, 0.0],
+      "foothold_slopes_rad": [0.0174, 0.02]}, "terrain.foothold_slopes_rad"),
+])
+def test_a_ground_whose_slope_changes_is_refused_for_a_3d_walker_in_one_line(terrain, field):
+    """A profile and footholds of their own slopes turn the fall line the walker's rolls are
+    about from step to step: one line naming the field and the physics."""
+    from walkerlab.analysis.gait.rigid_run import profile_ground
+    from walkerlab.config import scene_from_dict
+
+    d = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml").model_dump(mode="json")
+    d["terrain"] = terrain
+    scene = scene_from_dict(d)
+    plant = Plant.from_scene(scene)
+    with pytest.raises(ValueError) as err:
+        if terrain["kind"] == "profile":
+            profile_ground(scene, plant)
+        else:
+            build_walker(plant)
+    line = str(err.value)
+    assert line.startswith(field) and "fall line" in line and "\n" not in line
+
+
 class _OnStairs(Reference):
     """:class:`tests.test_hip_roll_3d.Reference` on level treads ``drop`` [m] apart: the heel
     strike when the swing foot reaches the tread below (its height above the stance foot's
