@@ -125,6 +125,22 @@ def test_stairs_footfalls_land_on_the_treads(stairs):
     assert abs(feet[2, 2] - feet[0, 2]) < 1e-5 and abs(feet[3, 2] - feet[1, 2]) < 1e-5
 
 
+def test_footholds_footfalls_land_at_their_heights():
+    """configs/hip_width_footholds.yaml (footholds 2 mm above and below the slope line in
+    turn): four steps from the stabilised slope gait's start, heel strike ``k`` lands
+    ``h[k mod 2]`` above the slope line through the last stance foot, along the vertical
+    (``y_{k+1} = y_k - (x_{k+1} - x_k) tan(gamma) + h_k``), to 1e-10 m."""
+    scene, _plant, walker, x0 = _built("hip_width_footholds.yaml")
+    h = scene.terrain.foothold_heights_m
+    slope = math.tan(scene.slope.angle_rad)
+    traj = simulate_steps(walker, x0, 5, SOLVER)
+    assert [s.termination for s in traj.segments] == ["heel_strike"] * 5
+    feet = np.array([s.stance_foot_world for s in traj.segments])
+    for k in range(len(feet) - 1):
+        (xa, ya, _), (xb, yb, _) = feet[k], feet[k + 1]
+        assert abs(yb - (ya - (xb - xa) * slope + h[k % 2])) < HEIGHT_TOL
+
+
 def test_kneed_3d_stairs_footfalls_land_on_the_treads():
     """configs/kneed_3d_stairs.yaml (locking knees in 3D, its two phases): four steps from
     the shipped gait, heel strike ``k`` on tread ``k`` at its height ``-k H`` to 1e-10 m
