@@ -348,6 +348,10 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True,
         step = on_landing(replace(w, mirror=None), d, drop)
         cycle.append(step if finish is None else finish(step, d))
     last = cycle[-1]
+    if legs_differ and data[steps[0][1]].structure.in_3d:  # the map's section is step 0's
+        # walker's post-impact surface (its swing clearance: the hip offset of its side,
+        # which the last step's mirrored walker has negated) at the last step's landing
+        last = on_landing(replace(first, mirror=None), data[steps[0][1]], steps[(n - 1) % p][0])
     return replace(cycle[0], cycle=tuple(cycle), ground_steps=None if periodic else p,
                    mirror=cycle[1] if legs_differ else None,
                    section=last.section, from_section=last.from_section,
