@@ -141,6 +141,17 @@ def test_footholds_footfalls_land_at_their_heights():
         assert abs(yb - (ya - (xb - xa) * slope + h[k % 2])) < HEIGHT_TOL
 
 
+def test_footholds_map_section_is_the_state_a_cycle_ends_in():
+    """The footholds' period-2 map (one walker per step, the second the other side's): the
+    state just after the cycle's last heel strike is on the map's section surface - its
+    section coordinates give it back, to 1e-12 (the trailing foot on the last foothold,
+    seen from step 0's walker: its swing clearance at the first walker's hip offset)."""
+    scene, _plant, walker, x0 = _built("hip_width_footholds.yaml")
+    traj = simulate_steps(walker, x0, 2, SOLVER)
+    x = np.asarray(traj.segments[-1].x_next, float)
+    assert np.max(np.abs(walker.from_section(walker.section(x)) - x)) < 1e-12
+
+
 def test_kneed_3d_stairs_footfalls_land_on_the_treads():
     """configs/kneed_3d_stairs.yaml (locking knees in 3D, its two phases): four steps from
     the shipped gait, heel strike ``k`` on tread ``k`` at its height ``-k H`` to 1e-10 m
