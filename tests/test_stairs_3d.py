@@ -66,16 +66,17 @@ def plane():
     return scene, walker, with_clearance_guard(walker, plant.data), x0
 
 
-def test_3d_straight_legs_take_stairs_and_footholds_in_the_rigid_view():
-    """The table's cells: the rigid view walks them; the kneed walker in 3D still refuses,
-    in one line naming the field."""
-    kind = KINDS["straight_legs_3d"]
-    for ground in ("stairs", "footholds"):
-        assert kind.supports(ground, "rigid")
-    with pytest.raises(ValueError, match=r"^terrain\.kind: ") as err:
-        KINDS["locking_knees_3d"].require("stairs", "rigid", "terrain.kind")
-    assert "\n" not in str(err.value)
-    assert CAPABILITIES["locking_knees_3d"][("stairs", "*")]
+def test_3d_legged_kinds_take_stairs_and_footholds_in_the_rigid_view():
+    """The table's cells: the rigid view of both legged kinds in 3D walks them; a profile is
+    refused in one line naming the field and the physics (the fall line turns)."""
+    for name in ("straight_legs_3d", "locking_knees_3d"):
+        kind = KINDS[name]
+        for ground in ("stairs", "footholds"):
+            assert kind.supports(ground, "rigid")
+        with pytest.raises(ValueError, match=r"^terrain\.kind: profile: ") as err:
+            kind.require("profile", "rigid", "terrain.kind: profile")
+        assert "\n" not in str(err.value) and "fall line" in str(err.value)
+    assert CAPABILITIES["rolling_polygon_3d"][("stairs", "*")]
 
 
 def test_a_zero_riser_gives_the_planes_map(plane):
