@@ -37,12 +37,15 @@ walker's :class:`Kind`:
     legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
     1999).  The rigid model, the MJCF (a free pelvis on footfall patches: it walks in
     MuJoCo; its hip torque and push-off run by walkerlab's stepping loop) and the URDF (its
-    actuators left out, as the planar URDF's).
+    actuators left out, as the planar URDF's).  Stairs and footholds (a height along the
+    walking direction, level across it) land as the planar walkers' do
+    (:mod:`walkerlab.models.hybrid.ground`).
 ``locking_knees_3d``
     Locking knees (McGeer 1990, "Passive walking with knees") in three dimensions
     (``model: biped`` with ``space: 3d`` and a knee): the kneed walker's two phases and
     resets, its swing knee a pitch joint in the swing leg's rolled sagittal plane, the
-    walker rolling about the fall line as the 3D straight legs.  The rigid model so far.
+    walker rolling about the fall line as the 3D straight legs.  The rigid model (on the
+    slope, stairs and footholds) and its gym view.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
