@@ -45,7 +45,7 @@ walker's :class:`Kind`:
     (``model: biped`` with ``space: 3d`` and a knee): the kneed walker's two phases and
     resets, its swing knee a pitch joint in the swing leg's rolled sagittal plane, the
     walker rolling about the fall line as the 3D straight legs.  The rigid model (on the
-    slope, stairs and footholds) and its gym view.
+    slope, stairs and footholds), the gym's rigid view, and the MJCF and URDF on its slope.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
