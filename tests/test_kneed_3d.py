@@ -82,8 +82,10 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
     for feature in ("hip_torque", "knee_torque", "push_off", "hip_roll", "round_feet_3d",
-                    "stairs", "torso_torque"):
+                    "profile", "torso_torque"):
         assert not kind.supports(feature, "rigid"), feature
+    # stairs and footholds: the straight legs' landing (tests/test_stairs_3d.py)
+    assert kind.supports("stairs", "rigid") and kind.supports("footholds", "rigid")
 
 
 @pytest.mark.parametrize(("change", "field"), [

@@ -13,9 +13,10 @@ from __future__ import annotations
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
+           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
+           "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
+           "PROFILE_3D", "PROFILE_PASSIVE", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
+           "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -71,6 +72,21 @@ _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "prof
 #: why a 3D walker's views refuse a ground other than a plane
 GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
              "stairs, footholds and profiles are planar walkers' grounds")
+#: why the 3D straight legs refuse a height profile
+PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall line (the "
+              "pelvis' roll axis held on it): a profile's slope changes from step to step, "
+              "turning that axis between steps, which the rigid state does not carry; "
+              "stairs and footholds of several heights keep one fall line")
+#: why the 3D straight legs' MJCF and Adams dataset refuse footholds of several heights
+#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_footfalls`)
+FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF and Adams dataset lay its footfall patches a "
+                       "stride apart from the keyframe's trailing foot (its two steps mirror "
+                       "each other about the fall line); footholds of several heights make "
+                       "the steps differ: give footholds of one height for this view")
+#: why the kneed walker in 3D's MJCF refuses stairs and footholds
+KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D falls in MuJoCo within its first step on "
+                        "its slope (its walk cell): its MJCF lays no stairs or footholds "
+                        "a walk could be measured on")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
          "walker.actuation.torques (joint: hip)")
@@ -306,6 +322,17 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)
         **_CELLS_3D,
+        # stairs and footholds: the ground a height along the walking direction, level
+        # across it; the rigid model lands on them as the planar walkers do (the generated
+        # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground), the
+        # contact model, the MJCF and the Adams dataset lay their footfall patches at the
+        # rigid gait's footfalls (walkerlab.export.legs_3d_mjcf.legs3d_footfalls: the
+        # trailing foot's height included), the gym's rigid view steps them as simulate
+        **{(g, v): None for g in ("stairs", "footholds")
+           for v in ("rigid", "contact", "mjcf", "adams", "gym")},
+        **{("footholds", v): FOOTHOLDS_EXPORT_3D for v in ("mjcf", "adams")},
+        **_URDF_GROUNDS,
+        ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
         # (walkerlab.export.legs_3d_mjcf.legs3d_mjcf: on footfall patches, past
         # the straight legs' mid-stance foot-through; walkerlab.export.urdf.
@@ -329,6 +356,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
+        # stairs and footholds in the rigid model and the gym's rigid view: the straight
+        # legs' landing (the generated swing clearance with the knee locked plus the
+        # landing's depth: walkerlab.models.hybrid.ground)
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},
+        **{(g, "mjcf"): KNEED_3D_GROUND_MJCF for g in ("stairs", "footholds")},
+        **_URDF_GROUNDS,
+        ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's

@@ -37,12 +37,15 @@ walker's :class:`Kind`:
     legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
     1999).  The rigid model, the MJCF (a free pelvis on footfall patches: it walks in
     MuJoCo; its hip torque and push-off run by walkerlab's stepping loop) and the URDF (its
-    actuators left out, as the planar URDF's).
+    actuators left out, as the planar URDF's).  Stairs and footholds (a height along the
+    walking direction, level across it) land as the planar walkers' do
+    (:mod:`walkerlab.models.hybrid.ground`).
 ``locking_knees_3d``
     Locking knees (McGeer 1990, "Passive walking with knees") in three dimensions
     (``model: biped`` with ``space: 3d`` and a knee): the kneed walker's two phases and
     resets, its swing knee a pitch joint in the swing leg's rolled sagittal plane, the
-    walker rolling about the fall line as the 3D straight legs.  The rigid model so far.
+    walker rolling about the fall line as the 3D straight legs.  The rigid model (on the
+    slope, stairs and footholds), the gym's rigid view, and the MJCF and URDF on its slope.
 ``rolling_polygon_3d``
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
@@ -312,11 +315,11 @@ KINDS = {k.name: k for k in (
          contact=P.CONTACT_WHEEL_3D, scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", in_3d=True, rigid=P.RIGID_STRAIGHT_LEGS_3D,
-         landing=None, contact=P.CONTACT_LEGS_3D, actuators=P.ACTUATORS_LEGS_3D,
+         contact=P.CONTACT_LEGS_3D, actuators=P.ACTUATORS_LEGS_3D,
          scene="configs/hip_width.yaml"),
     Kind("locking_knees_3d", "knees that lock at the knee strike, in 3D with hip width",
          "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",
-         in_3d=True, has_knees=True, knees_lock=True, rigid=P.RIGID_LOCKING_KNEES, landing=None,
+         in_3d=True, has_knees=True, knees_lock=True, rigid=P.RIGID_LOCKING_KNEES,
          reaction=P.REACTION_NONE, contact=P.CONTACT_KNEES_3D, scene="configs/kneed_3d.yaml"),
 )}
 

@@ -184,10 +184,17 @@ SHIPPED = {
     # fall in contact within a few steps)
     ("straight_legs_3d", "hip_torque"): "hip_width_powered",
     ("straight_legs_3d", "push_off"): "hip_width_powered",
+    # the stabilised walker down stairs of its slope step and on footholds of two heights
+    # (the passive hip-width walker's lateral multiplier of ~100 a stride leaves a walk
+    # from its gait within a few steps)
+    ("straight_legs_3d", "stairs"): "hip_width_stairs",
+    ("straight_legs_3d", "footholds"): "hip_width_footholds",
     # configs/kneed.yaml's walker with 10 cm hip width: laterally unstable (a stride
     # multiplier of 39.9), its contact and MJCF cells held over its first stride
     # (:data:`FIRST_STEPS`)
     ("locking_knees_3d", "walk"): "kneed_3d",
+    # ... down stairs of its slope step
+    ("locking_knees_3d", "stairs"): "kneed_3d_stairs",
 }
 
 #: (kind, feature) -> steps: a reference case whose passive gait is unstable and has no

@@ -256,7 +256,8 @@ def profile_ground(scene, plant):
 
     if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError(f"terrain.kind: profile: {PROFILE_PASSIVE}")
-    if scene.walker.model != "compass_gait":  # a described walker: its kind's cell
+    if scene.walker.model != "compass_gait" or plant.kind.in_3d:  # a described walker, a
+        # walker in 3D: its kind's cell
         plant.kind.require("profile", "rigid", "terrain.kind: profile")
     P = profile_points(scene.terrain)
     at, data_at = passive_walker_at(plant.with_(scene))

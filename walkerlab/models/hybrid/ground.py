@@ -15,6 +15,20 @@ family.  The impact map is the walker's own (plastic, paper Eq. 5-8).  On level 
 (``gamma = 0``) of stairs going down ``H``, the heel strike is the swing foot reaching
 ``-H`` relative to the stance foot.
 
+A walker in 3D (the straight legs with hip width, Kuo 1999: :mod:`walkerlab.codegen.
+derive_3d`) walks the same grounds: a height along the walking direction (the fall line,
+the world's downhill ``x``), level across it (``z``), so a stair's tread or a foothold is the
+plane of the slope through the stance foot shifted along the vertical, whatever the feet's
+lateral places (the hip width, the lean).  Its generated ``swing_clearance`` is the swing
+foot's height along the slope's normal above the plane through the stance foot, so the
+landing is the planar one: the clearance reaching ``-drop_m cos(gamma)``.  The stance foot's
+axes are the slope's frame (``s`` the fall line, ``n`` the normal, ``z`` across; the lean and
+the pelvis' roll about ``s``, the legs' pitches about their rolled ``z``); on stairs the
+treads are level (``gamma = 0``), so that frame is the tread's: ``s`` the horizontal walking
+direction, ``n`` up.  The walker's rolls are about that fall line, so a ground whose slope
+changes from step to step (footholds of their own slopes, a profile) is refused
+(:data:`walkerlab.walker.capability_cells.PROFILE_3D`).
+
 Poincaré section: the state just after heel strike, where the new swing foot (the old stance
 foot) lies ``drop_m`` above the new stance foot's line: ``swing_clearance(x+) = drop_m
 cos(gamma)`` (both feet on their treads: for point feet exactly, for arc feet their lowest
@@ -36,6 +50,7 @@ from walkerlab.models.ground import foothold_steps, landing_drop
 from walkerlab.models.hybrid.base import HybridWalker, OffSection, Phase
 from walkerlab.models.hybrid.rigid_foot_modes import on_landing_flat
 from walkerlab.walker import parts as P
+from walkerlab.walker.capability_cells import PROFILE_3D
 
 __all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
            "with_clearance_guard"]
@@ -98,6 +113,19 @@ class _Mirrored:
         return _flip(np.asarray(out), self.n) if self.gradient else out
 
 
+def _probe(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
+    """``walker.from_section`` at the first of ``z, -z, z / 10, -z / 10`` the post-impact
+    surface has a state at (the 3D walker's surface needs the stance pitch to outweigh its
+    rolls against the hip width: ``z``'s alternating signs can put it off the surface)."""
+    for p in (z, -z, 0.1 * z, -0.1 * z):
+        try:
+            return np.asarray(walker.from_section(p), dtype=float)
+        except OffSection:
+            continue
+    raise OffSection("no state on the walker's own post-impact surface at the probes of "
+                     "its section's coordinates")
+
+
 class _LandingSection:
     """``from_section`` of the post-impact surface ``swing_clearance(x) = level`` (see the
     module docstring): the walker's own ``from_section`` (its slope's surface) as the start,
@@ -110,7 +138,7 @@ class _LandingSection:
         keep = np.asarray(walker.section(np.arange(m, dtype=float)), dtype=float)
         keep = [int(round(k)) for k in keep]
         z = np.linspace(0.137, 0.419, len(keep)) * (-1.0) ** np.arange(len(keep))
-        x = np.asarray(walker.from_section(z), dtype=float)
+        x = _probe(walker, z)
         dropped = [i for i in range(m) if i not in keep]
         # a dropped coordinate equal to a kept one is tied to it (e.g. the shank's rate to
         # the thigh's); the others are the solved group (one value)
@@ -301,6 +329,8 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True,
     steps = tuple((float(d), float(g)) for d, g in steps)
     base = {g: walker_at(g) for g in sorted({g for _, g in steps})}
     data = {g: data_at(g) for g in base}
+    if len(base) > 1 and any(d.structure.in_3d for d in data.values()):
+        raise ValueError(f"terrain.foothold_slopes_rad: {PROFILE_3D}")
     if len(base) > 1 and any(d.structure.coordinates != "absolute" for d in data.values()):
         raise ValueError("terrain.foothold_slopes_rad: the walker's coordinates are measured "
                          "from the slope (walker.coordinates); footholds of several slopes "
@@ -318,6 +348,10 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True,
         step = on_landing(replace(w, mirror=None), d, drop)
         cycle.append(step if finish is None else finish(step, d))
     last = cycle[-1]
+    if legs_differ and data[steps[0][1]].structure.in_3d:  # the map's section is step 0's
+        # walker's post-impact surface (its swing clearance: the hip offset of its side,
+        # which the last step's mirrored walker has negated) at the last step's landing
+        last = on_landing(replace(first, mirror=None), data[steps[0][1]], steps[(n - 1) % p][0])
     return replace(cycle[0], cycle=tuple(cycle), ground_steps=None if periodic else p,
                    mirror=cycle[1] if legs_differ else None,
                    section=last.section, from_section=last.from_section,
