@@ -312,8 +312,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # ones (the action the hip's pitch torque and, with hip-roll joints, each roll
         # joint's: walkerlab.walker.joints.ROLL_JOINTS), its contact view the floating
         # walker (the torques on its legX_angle, legX_roll and pelvis_roll coordinates)
-        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
-                               "is a later step"),
     },
     "locking_knees_3d": {
         # the scene's own check says the same (walkerlab.config.walker.BipedParams)
@@ -386,7 +384,6 @@ ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance
 #: 3D straight legs take ``robustness``: its evidence is :data:`walkerlab.walker.
 #: capability_evidence.stage_evidence`'s.
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    "straight_legs_3d": {"optimize": CAPABILITIES["straight_legs_3d"][("walk", "optimize")]},
     "locking_knees_3d": {"robustness": ROBUSTNESS_KNEED_3D,
                          "optimize": CAPABILITIES["locking_knees_3d"][("walk", "optimize")]},
     "rolling_polygon_3d": {"robustness": ROBUSTNESS_WHEEL_3D,

@@ -274,8 +274,9 @@ class _Modes:
 
         from walkerlab.optimal.transcription.step import _ground_reaction
 
-        return _ground_reaction(self.data, SimpleNamespace(q=self.q, points=points),
-                                self.xs, self.vals, x, f[self.n:])
+        eq = SimpleNamespace(q=self.q, dq=self.xs[self.n:], points=points,
+                             De=getattr(getattr(self, "eq", None), "De", None))
+        return _ground_reaction(self.data, eq, self.xs, self.vals, x, f[self.n:])
 
 
 class _KneedModes(_Modes):
@@ -285,9 +286,9 @@ class _KneedModes(_Modes):
     (the plain impact: the rigid kneed model's push-off is not transcribed)."""
 
     def __init__(self, data):
-        from walkerlab.codegen import symbolic  # light
+        from walkerlab.codegen.cache import derive_equations  # light
 
-        eq = symbolic.derive(data.structure)
+        eq = derive_equations(data.structure)  # a planar walker's or a 3D one's
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
         self.eq, self.guards = eq, eq.guards
 

@@ -131,7 +131,7 @@ def cached_step_functions(data) -> dict:
     from walkerlab.optimal.transcription import step as collocation  # light
 
     def build():
-        from walkerlab.codegen import symbolic  # sympy: only on a miss (a slow import)
+        from walkerlab.codegen.cache import derive_equations  # sympy: only on a miss
 
-        return collocation.step_functions(data, symbolic.derive(data.structure))
+        return collocation.step_functions(data, derive_equations(data.structure))
     return _cached(_key(data), build)
