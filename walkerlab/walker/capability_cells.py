@@ -15,7 +15,8 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3
 __all__ = ["ACTUATION_3D", "CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEE_LATCH_OSIM", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_EXPORT_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
+           "ROUND_FEET_EXPORT_3D", "ROUND_FEET_OPTIMIZE_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
+           "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -92,6 +93,11 @@ NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a
 ROUND_FEET_EXPORT_3D = ("a 3D walker's Adams dataset carries point feet and point-mass legs "
                         "so far (its round feet and leg inertia run in the rigid model and "
                         "the URDF and MJCF exports)")
+#: why the collocation refuses a 3D walker's disc feet
+ROUND_FEET_OPTIMIZE_3D = ("the collocation's heel strike, push-off and ground reaction are "
+                          "the stance foot's extended impact system, which a 3D walker's "
+                          "disc foot (its rolling contact) does not have in its equations: "
+                          "optimise point feet (drop walker.foot_radius_m)")
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -285,6 +291,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # round feet and leg inertia: the MJCF's disc (cylinder) feet, the URDF's
         # cylinder collisions and both files' leg inertia (walkerlab.export.legs_3d_mjcf)
         ("round_feet_3d", "adams"): ROUND_FEET_EXPORT_3D,
+        # the collocation (walkerlab.optimal.transcription.step, .stride) writes the heel
+        # strike, the push-off and the stance foot's reaction on the walker's extended
+        # impact system (walkerlab.codegen.derive_3d.push_off_system), which the derivation
+        # gives point feet only
+        ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
