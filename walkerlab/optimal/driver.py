@@ -285,10 +285,8 @@ def check_kind(scene, kind) -> None:
 def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
     kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
-    flat-footed or five-link walker; a 3D walker's disc feet) and a clearance that cannot
-    hold
-    (``optimize.min_clearance_m > 0`` for straight legs of one length and foot:
-    :func:`_feet_level_when_legs_cross`).
+    flat-footed or five-link walker, 3D disc feet) and a clearance that cannot hold
+    (``optimize.min_clearance_m > 0``: :func:`_feet_level_when_legs_cross`).
 
     Parameters
     ----------

@@ -162,7 +162,9 @@ def contact_replay_stride(scene, res, strides: int = 2, *, plant) -> tuple[float
     touchdown (:func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time`), from the
     collocated start ``res.x[0]`` (leg2 in stance, as the rigid model's); the scene's
     ``contact`` law (the paper's default one if none), ``terrain``; LSODA at rtol 1e-6,
-    atol 1e-8 (a powered contact run uses scipy's event location).
+    atol 1e-8 (a powered contact run uses scipy's event location); a 3D walker (the
+    steps on alternate sides, its hip-roll law stiff) the scene's ``contact_solver`` (the
+    contact default at rtol 1e-8, atol 1e-10 if none).
 
     Parameters
     ----------
@@ -193,6 +195,9 @@ def contact_replay_stride(scene, res, strides: int = 2, *, plant) -> tuple[float
         acts.laws = laws[0] if stance == 1 else laws[1]
         return own(x, stance, t_step)
     acts.hip_torque = hip_torque
+    if plant.kind.in_3d:  # a 3D walker's stiff hip-roll law and contact: the scene's solver
+        solver = scene.contact_solver or SolverSettings.for_contact(rtol=1e-8, atol=1e-10)
+        return _run(setup, res.x[0], res.step_period_s / 2, strides, solver)
     # a fixed solver, whatever the scene's contact_solver (configs/asymmetric_optimal.yaml's
     # replay is kept as it was): the outcome of a failure says so
     solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)

@@ -59,6 +59,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.codegen.cache import derive_equations
 from walkerlab.walker import parts as P
 
 __all__ = ["ModePhase", "mode_functions", "phase_order"]
@@ -292,8 +293,6 @@ class _KneedModes(_Modes):
     (the plain impact: the rigid kneed model's push-off is not transcribed)."""
 
     def __init__(self, data):
-        from walkerlab.codegen.cache import derive_equations  # light
-
         eq = derive_equations(data.structure)  # a planar walker's or a 3D one's
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
         self.eq, self.guards = eq, eq.guards
