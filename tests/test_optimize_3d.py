@@ -106,7 +106,8 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     (with hip-roll joints: the gait under the foot-placement law, part of the walker's
     equations): IPOPT converged, objective <= 1e-10 N^2 m^2 s, the start within 1e-6 of
     the fixed point ``walkerlab fixedpoint`` finds by shooting (Hermite-Simpson's O(h^4):
-    seen 2.3e-8 (paper_3d) and 9.1e-7 (hip width) on 40 intervals a step), each step's
+    seen 2.3e-8 (paper_3d) and 9.1e-7 (hip width) on 40 intervals a step, 1.8e-7 (hip
+    width) on 60), each step's
     period within 1e-7 relative and the replay on the rigid model closing to 1e-6."""
     pytest.importorskip("casadi")
     from walkerlab.analysis.gait.scene import solve_scene
