@@ -7,7 +7,7 @@ not share it:
   :mod:`walkerlab.codegen.floating_equations`: leg-vector sums written by hand): upright
   (no roll, heading or lateral motion) the 3D walker's sagittal motion has its kinetic and
   potential energy (the hips' lateral offset moves no mass in a sagittal motion);
-- the rigid 3D kneed model (:func:`walkerlab.codegen.derive_3d.derive_compass`, itself held
+- the rigid 3D kneed model (:func:`walkerlab.codegen.legged.derive_legged`, itself held
   to Pinocchio in tests/test_kneed_3d.py): with the stance foot held and the stance knee
   straight the floating mass matrix and gravity pulled back to the rigid coordinates are
   the rigid model's;

@@ -71,7 +71,7 @@ the tree; the pelvis turns with leg2 (its FIXED joint), its centre of mass on th
 moving as the rigid hip does.  No rate scale (``contact_sim.initial_rate_scale`` is the
 planar contact walker's).
 
-Round feet (``walker.foot_radius_m``; :func:`walkerlab.codegen.derive_3d.derive_compass`'s
+Round feet (``walker.foot_radius_m``; :func:`walkerlab.codegen.legged.derive_legged`'s
 disc in each leg's rolled sagittal plane, its centre ``L - R`` down the leg): each foot a
 ``GRAPHICS/CYLINDER`` of radius ``R`` and length ``2`` :data:`~walkerlab.export.
 legs_3d_parts.DISC_HALF_THICKNESS_L` ``L`` about the leg's pitch axis (its base marker

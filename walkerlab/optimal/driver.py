@@ -285,9 +285,8 @@ def check_kind(scene, kind) -> None:
 def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
     kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
-    flat-footed or five-link walker) and a clearance that cannot hold
-    (``optimize.min_clearance_m > 0`` for straight legs of one length and foot:
-    :func:`_feet_level_when_legs_cross`).
+    flat-footed or five-link walker, 3D disc feet) and a clearance that cannot hold
+    (``optimize.min_clearance_m > 0``: :func:`_feet_level_when_legs_cross`).
 
     Parameters
     ----------
@@ -310,6 +309,8 @@ def check_scene(scene, data) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
+    if data.structure.in_3d and data.structure.foot == "arc":  # a 3D walker's disc feet
+        data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
     if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
         from walkerlab.optimal.transcription.landing import step_ground
 

@@ -15,8 +15,8 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
-           "PROFILE_3D", "PROFILE_PASSIVE", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
-           "URDF_GROUND"]
+           "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "SEVERAL_FOOTHOLDS",
+           "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -100,6 +100,11 @@ NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width
 NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
                     "straight-legged walker's (walker.space: 3d); a planar walker's round "
                     "feet are walker.leg.foot.kind: arc")
+#: why the collocation refuses a 3D walker's disc feet
+ROUND_FEET_OPTIMIZE_3D = ("the collocation's heel strike, push-off and ground reaction are "
+                          "the stance foot's extended impact system, which a 3D walker's "
+                          "disc foot (its rolling contact) does not have in its equations: "
+                          "optimise point feet (drop walker.foot_radius_m)")
 #: why the OpenSim export refuses a 3D walker
 EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
              "URDF (--format urdf) or MJCF (--format mjcf)")
@@ -305,6 +310,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # round feet and leg inertia: the MJCF's disc (cylinder) feet, the URDF's
         # cylinder collisions, the Adams dataset's GRAPHICS/CYLINDER contact and the
         # files' leg inertia (walkerlab.export.legs_3d_mjcf, walkerlab.export.adams_3d)
+        # the collocation (walkerlab.optimal.transcription.step, .stride) writes the heel
+        # strike, the push-off and the stance foot's reaction on the walker's extended
+        # impact system (walkerlab.codegen.legged.extended_impact), which the derivation
+        # gives point feet only
+        ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
@@ -343,8 +353,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # ones (the action the hip's pitch torque and, with hip-roll joints, each roll
         # joint's: walkerlab.walker.joints.ROLL_JOINTS), its contact view the floating
         # walker (the torques on its legX_angle, legX_roll and pelvis_roll coordinates)
-        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
-                               "is a later step"),
     },
     "locking_knees_3d": {
         # the scene's own check says the same (walkerlab.config.walker.BipedParams)
@@ -429,7 +437,6 @@ ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance
 #: 3D straight legs take ``robustness``: its evidence is :data:`walkerlab.walker.
 #: capability_evidence.stage_evidence`'s.
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    "straight_legs_3d": {"optimize": CAPABILITIES["straight_legs_3d"][("walk", "optimize")]},
     "locking_knees_3d": {"robustness": ROBUSTNESS_KNEED_3D,
                          "optimize": CAPABILITIES["locking_knees_3d"][("walk", "optimize")]},
     "rolling_polygon_3d": {"robustness": ROBUSTNESS_WHEEL_3D,

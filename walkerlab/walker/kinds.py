@@ -316,6 +316,7 @@ KINDS = {k.name: k for k in (
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", in_3d=True, rigid=P.RIGID_STRAIGHT_LEGS_3D,
          contact=P.CONTACT_LEGS_3D, actuators=P.ACTUATORS_LEGS_3D,
+         collocation=P.COLLOCATION_STRAIGHT_LEGS, phases=P.PHASES_STRAIGHT_LEGS,
          scene="configs/hip_width.yaml"),
     Kind("locking_knees_3d", "knees that lock at the knee strike, in 3D with hip width",
          "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",

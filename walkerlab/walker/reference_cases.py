@@ -216,6 +216,7 @@ SHIPPED_OPTIMIZE = {
     ("locking_knees", "walk"): "kneed_optimal",
     ("flat_feet", "walk"): "flat_feet_optimal",
     ("free_joints", "walk"): "rabbit_optimal",
+    ("straight_legs_3d", "walk"): "hip_width_optimal",
 }
 
 

@@ -64,7 +64,10 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
         for k in range(K):
             F = mp.grf(X[:, k], at(k))
             opti.subject_to(F[0] >= 0)
-            opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
+            if F.shape[0] == 2:  # a planar walker's tangent
+                opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
+            else:  # in 3D, the tangential force along the fall line and across it
+                opti.subject_to(F[1] ** 2 + F[2] ** 2 <= (mu * F[0]) ** 2)
     return _simpson(T, tau, ca.sum1(U ** 2) if several else U ** 2)
 
 

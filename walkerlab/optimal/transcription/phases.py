@@ -59,6 +59,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.codegen.cache import derive_equations
 from walkerlab.walker import parts as P
 
 __all__ = ["ModePhase", "mode_functions", "phase_order"]
@@ -200,7 +201,8 @@ def mode_functions(data, walker, order=None) -> dict:
             clearance=ca.Function("clearance", [x], [kind.clearance(name, x)]),
             step=ca.Function("step", [x], [kind.step(name, x)]),
             grf=ca.Function(f"grf_{len(phases)}", [x, u], [kind.grf(name, x, f)]),
-            push_off=kind.push_off(gname, x, P, len(phases))))
+            push_off=kind.push_off(gname, x, P, len(phases)),
+            inside=kind.inside(gname)))
     hip = kind.cas([kind.hip], x)
     return {"phases": phases, "n": n,
             "ahead": ca.Function("ahead", [x], [kind.cas([kind.guards["swing_foot_ahead"]],
@@ -262,6 +264,11 @@ class _Modes:
     def keep(self, name, x, f, u):
         return None
 
+    def inside(self, gname) -> bool:
+        """Whether the guard ``gname``'s sign is kept inside its phase
+        (:attr:`ModePhase.inside`): yes."""
+        return True
+
     def push_off(self, gname, x, P, k):
         """The phase's heel strike with a push-off (:class:`ModePhase` ``push_off``), or
         None."""
@@ -274,8 +281,9 @@ class _Modes:
 
         from walkerlab.optimal.transcription.step import _ground_reaction
 
-        return _ground_reaction(self.data, SimpleNamespace(q=self.q, points=points),
-                                self.xs, self.vals, x, f[self.n:])
+        eq = SimpleNamespace(q=self.q, dq=self.xs[self.n:], points=points,
+                             De=getattr(getattr(self, "eq", None), "De", None))
+        return _ground_reaction(self.data, eq, self.xs, self.vals, x, f[self.n:])
 
 
 class _KneedModes(_Modes):
@@ -285,9 +293,7 @@ class _KneedModes(_Modes):
     (the plain impact: the rigid kneed model's push-off is not transcribed)."""
 
     def __init__(self, data):
-        from walkerlab.codegen import legged  # light
-
-        eq = legged.derive_legged(data.structure)
+        eq = derive_equations(data.structure)  # a planar walker's or a 3D one's
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
         self.eq, self.guards = eq, eq.guards
 
@@ -335,6 +341,25 @@ class _KneedModes(_Modes):
 class _StraightModes(_KneedModes):
     """Straight legs (``early_swing``, ``late_swing``): the kneed walker's free flow and
     guards, and a heel strike that may follow a push-off."""
+
+    def inside(self, gname) -> bool:
+        """The heel strike's sign is kept inside late swing when the swing foot is level with
+        the stance foot as the legs cross (its clearance zero at ``swing = stance``: planar
+        legs, a 3D walker of zero hip width), so that late swing starts on the slope.  A 3D
+        walker with hip width has its swing foot ``w sin(roll)`` off the slope there (Kuo
+        1999): it dips through the slope early in late swing, which the rigid model ignores
+        as it ignores the planar legs' mid-stance scuff (its heel strike is the downward
+        crossing); the transcription then bounds the clearance instead, as one step's
+        (``optimize.min_clearance_m``)."""
+        import sympy as sp
+
+        if gname != "heel_strike":
+            return True
+        sw, st = self.eq.leg_angles["swing"], self.eq.leg_angles["stance"]
+        q = next(c for c in self.q if c in sw.free_symbols)  # the swing leg's coordinate
+        crossed = {q: sp.solve(sp.Eq(sw, st), q)[0]}
+        h = self.eq.guards["swing_clearance"].subs(crossed).subs(self.vals)
+        return sp.simplify(h) == 0
 
     def push_off(self, gname, x, P, k):
         """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step

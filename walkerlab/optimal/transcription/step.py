@@ -252,27 +252,34 @@ def _relabel(eq, xs, vals, x, dq_plus):
 
 
 def _reset_extended(eq, xs, vals, x, P, _mass):
-    """Push-off + heel strike in extended coordinates ``[q, x_f, y_f]``
-    (:mod:`walkerlab.models.hybrid.push_off`: the impulse at the trailing foot's material
-    contact point - a point foot, an arc's rolling contact ``stance_contact`` - from it to
-    the hip; the generated ``De, E``, an arc's ``E`` at the leading arc's material contact
+    """Push-off + heel strike in extended coordinates ``[q, p]``, ``p`` the stance foot's
+    ``k`` translations (``E``'s rows: 2 for a planar walker, ``(x_f, y_f)``; 3 for a walker
+    in 3D, :func:`walkerlab.codegen.legged.extended_impact`) as the rigid view's
+    :class:`walkerlab.models.hybrid.push_off.PushOffTransition`: the impulse at the
+    trailing foot's material contact point - a point foot, an arc's rolling contact
+    ``stance_contact`` - to the trailing leg's hip (a 3D walker's ``stance_hip``, else the
+    ``hip``); the generated ``De, E``, an arc's ``E`` at the leading arc's material contact
     point), and the push-off's work [J]."""
     import casadi as ca
     import sympy as sp
 
-    n = len(eq.q)
+    n, k = len(eq.q), eq.E.shape[0]
     fs = {sp.Symbol("x_f"): 0, sp.Symbol("y_f"): 0}
     De = casadi_function(eq.De.subs(fs), xs, vals)(x)
     E = casadi_function(eq.E.subs(fs), xs, vals)(x)
-    hip = casadi_function(eq.points["hip"], xs, vals)(x)
+    hip = casadi_function(eq.points["stance_hip" if "stance_hip" in eq.points else "hip"],
+                          xs, vals)(x)
     if "stance_contact" in eq.points:  # an arc foot: from its rolling contact point
         hip = hip - casadi_function(eq.points["stance_contact"], xs, vals)(x)
-    e = hip / ca.sqrt(hip[0] ** 2 + hip[1] ** 2)
-    dqe = ca.vertcat(x[n:], 0, 0)
-    Ef = ca.horzcat(ca.SX.zeros(2, n), ca.SX.eye(2))
+    r2 = hip[0] ** 2
+    for i in range(1, k):
+        r2 = r2 + hip[i] ** 2
+    e = hip / ca.sqrt(r2)
+    dqe = ca.vertcat(x[n:], *[0] * k)
+    Ef = ca.horzcat(ca.SX.zeros(k, n), ca.SX.eye(k))
     dqe_po = dqe + ca.solve(De, Ef.T @ (P * e))
-    K = ca.vertcat(ca.horzcat(De, -E.T), ca.horzcat(E, ca.SX.zeros(2, 2)))
-    sol = ca.solve(K, ca.vertcat(De @ dqe_po, 0, 0))
+    K = ca.vertcat(ca.horzcat(De, -E.T), ca.horzcat(E, ca.SX.zeros(k, k)))
+    sol = ca.solve(K, ca.vertcat(De @ dqe_po, *[0] * k))
     work = 0.5 * (dqe_po.T @ De @ dqe_po - dqe.T @ De @ dqe)
     return _relabel(eq, xs, vals, x, sol[:n]), work
 
@@ -306,13 +313,33 @@ def _reset_point_hip(eq, xs, vals, x, P, mass):
 
 def _ground_reaction(data, eq, xs, vals, x, qdd):
     """The stance foot's ground reaction ``m_total (a_com + g y)`` [N] along the slope's
-    normal and tangent (forward positive), from the bodies' named points and masses."""
+    normal and tangent (forward positive), from the bodies' named points and masses.
+
+    A walker in 3D (points (3,), the third row lateral: :mod:`walkerlab.codegen.derive_3d`)
+    has its linear momentum in the rows of the stance foot's translations of its extended
+    mass matrix, ``p = De[n:, :n] dq`` (world axes, the foot at rest:
+    :func:`walkerlab.codegen.legged.extended_impact`), so the force is ``dp/dt + m_total
+    g y`` (Newton), every body's inertia and the pelvis' included; its (3,): normal, along
+    the fall line, lateral."""
     import casadi as ca
 
     from walkerlab.walker.description import ROLE_TAG
 
     st = data.structure
     n = len(eq.q)
+    if eq.points["hip"].shape[0] == 3:  # in 3D: the momentum rows of the extended system
+        import sympy as sp
+
+        if not any(eq.De[n:, :n]):
+            raise ValueError("optimize.friction_coefficient: a 3D walker's ground reaction "
+                             "is read from its extended impact system, which round feet "
+                             "lack (walker.foot_radius_m)")
+        mom = casadi_function(eq.De[n:, :n] * sp.Matrix(eq.dq), xs, vals)(x)
+        F = ca.jacobian(mom, x) @ ca.vertcat(x[n:], qdd) + ca.vertcat(
+            0, data.total_mass_kg * data.gravity_m_per_s2, 0)
+        gam = data.slope_rad
+        return ca.vertcat(ca.sin(gam) * F[0] + ca.cos(gam) * F[1],
+                          ca.cos(gam) * F[0] - ca.sin(gam) * F[1], F[2])
     names = list(st.param_names)
     pts = [(float(data.params[names.index("M_hip")]), "hip")] if st.hip_mass else []
     for b in st.bodies:

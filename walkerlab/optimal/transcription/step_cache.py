@@ -61,6 +61,7 @@ def _encode(fns: dict) -> str:
     """``fns`` (numbers, CasADi functions, a list of :class:`ModePhase`) as JSON."""
     def phase(p):
         return {"name": p.name, "guard_name": p.guard_name, "direction": p.direction,
+                "inside": p.inside,
                 **{f: (None if getattr(p, f) is None else getattr(p, f).serialize())
                    for f in _PHASE_FNS}}
     return json.dumps({k: (v if k in _NUMBERS else [phase(p) for p in v] if k == "phases"
@@ -75,6 +76,7 @@ def _decode(text: str) -> dict:
 
     def phase(p):
         return ModePhase(p["name"], p["guard_name"], int(p["direction"]),
+                         inside=bool(p.get("inside", True)),
                          **{f: (None if p[f] is None else ca.Function.deserialize(p[f]))
                             for f in _PHASE_FNS})
     return {k: (v if k in _NUMBERS else [phase(p) for p in v] if k == "phases"
@@ -131,7 +133,7 @@ def cached_step_functions(data) -> dict:
     from walkerlab.optimal.transcription import step as collocation  # light
 
     def build():
-        from walkerlab.codegen import legged  # sympy: only on a miss (a slow import)
+        from walkerlab.codegen.cache import derive_equations  # sympy: only on a miss
 
-        return collocation.step_functions(data, legged.derive_legged(data.structure))
+        return collocation.step_functions(data, derive_equations(data.structure))
     return _cached(_key(data), build)
