@@ -177,10 +177,10 @@ def test_hip_width_steps_release_the_slopes_energy_along_the_fall_line(hip_width
 
 
 def test_a_3d_derivation_draws_from_a_seeded_generator_and_restores_its_state():
-    """The walkers' derivations from their trees (``derive_legged``, ``derive_spoked``) run with sympy's
-    random number generator seeded (``trigsimp``'s factorisation draws from it: its time,
-    not its factors, depends on the draws), so every derivation draws the same numbers,
-    and the caller's generator state is as it was."""
+    """The walkers' derivations from their trees (``derive_legged``, ``derive_spoked``) run
+    with sympy's random number generator seeded (``trigsimp``'s factorisation draws from
+    it: its time, not its factors, depends on the draws), so every derivation draws the
+    same numbers, and the caller's generator state is as it was."""
     import sympy.core.random as srand
 
     from walkerlab.codegen.derive_3d import _seeded, derive_spoked
