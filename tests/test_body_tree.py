@@ -24,8 +24,8 @@ import sympy as sp
 from tests.independent.hand_3d_compass import derive_compass
 from tests.independent.hand_3d_wheel import derive_spoked as hand_spoked
 from tests.independent.planar_link_sums import derive
-from walkerlab.codegen import derive_3d
 from walkerlab.codegen.derive_3d import derive_spoked
+from walkerlab.codegen.legged import derive_legged
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike, kinematics
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root
@@ -147,14 +147,14 @@ def test_the_hip_roll_walker_tree_reproduces_derive_compass():
                          ids=["round_feet_rod_legs", "round_feet_hip_width"])
 def test_production_3d_equations_from_the_tree_equal_the_hand_derivation(width, rod):
     """The equations production generates for the 3D straight-legged walker
-    (``derive_3d.derive_compass``, now derived from its tree) equal the hand derivation's
+    (``legged.derive_legged``, derived from its tree) equal the hand derivation's
     with round feet (McGeer 1990's discs rolling in each leg's rolled sagittal plane: the
     tree's slide along the fall line, the impact about the disc's material point), at random
     states: flow, impact, potential, the heel-strike surface, the section's solved swing
     angle and the named points (70 s each: the arc's simplification)."""
     st = Structure("absolute", (BodySpec("mass", "rod" if rod else "point_mass"),),
                    foot="arc", in_3d=True, hip_width=width)
-    e, ours = derive_compass(st), derive_3d.derive_compass(st)
+    e, ours = derive_compass(st), derive_legged(st)
     rng = np.random.default_rng(83)
     args = e.q + e.dq + e.params
     pts = _states(e, rng)
