@@ -70,8 +70,8 @@ URDF_GROUND = ("the URDF carries the walker on a slope only (URDF has no ground 
                "--walker-only writes the walker alone")
 _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "profile")}
 #: why a 3D walker's views refuse a ground other than a plane
-GROUND_3D = ("a walker in 3D walks a plane slope only so far (terrain.kind: slope); "
-             "stairs, footholds and profiles are planar walkers' grounds")
+GROUND_3D = ("this view lays a plane slope only for this walker in 3D (terrain.kind: slope); "
+             "the views its row marks take stairs and footholds")
 #: why the 3D straight legs refuse a height profile
 PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall line (the "
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
@@ -381,8 +381,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (walkerlab.export.adams_3d_knees)
         ("walk", "osim"): _KNEED_3D_VIEW,
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
-        ("walk", "optimize"): ("the collocation transcribes planar walkers; a 3D walker's "
-                               "is a later step"),
+        ("walk", "optimize"): ("a locking knee makes the collocation phased (knee free, "
+                               "knee locked), and the 3D transcription takes straight legs "
+                               "only (straight_legs_3d): optimise the walker without knees"),
     },
     "rolling_polygon_3d": {
         **_PLANAR,
