@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from walkerlab.codegen import cache, symbolic
+from walkerlab.codegen import cache, legged
 from walkerlab.walker.description import BodySpec, Structure
 
 S = Structure("absolute", (BodySpec("mass", "point_mass"),))
@@ -22,7 +22,7 @@ def fresh(tmp_path, monkeypatch):
 def _forbid_derivation(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("sympy derivation called on a cache hit")
-    monkeypatch.setattr(symbolic, "derive", boom)
+    monkeypatch.setattr(legged, "derive_legged", boom)
 
 
 def test_second_build_reads_the_cache_without_deriving(fresh, monkeypatch):
