@@ -25,7 +25,7 @@ e, cmax, dmax)``.
 from __future__ import annotations
 
 from walkerlab.config.contact import ContactSettings
-from walkerlab.export.adams_latch import LATCH_SFORCE
+from walkerlab.export.adams_latch import latch_law, latch_sforce
 from walkerlab.export.adams_statements import MM, _f, _stmt, _var
 from walkerlab.export.axes_3d import slope_axes
 from walkerlab.models.contact.rigid_limit import contact_si
@@ -61,7 +61,7 @@ def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
     list of str
     """
     _, ks = contact_si(scene.contact or ContactSettings())
-    law = f"{_f(ks.k * MM)},{_f(ks.e)},{_f(ks.cmax * MM)},{_f(ks.dmax)}"
+    law = latch_law(ks)
     knees = {}
     out = ["!", "! ---- knees: the stop's IMPACT on the hyperextension shank - thigh (> 0 past",
            "! straight) ----"]
@@ -84,13 +84,5 @@ def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
     for leg, (i_m, j_m, foot) in knees.items():
         out += [_var(V[f"height_{leg}"], f"VARVAL({V['nx']})*DX({foot},101)+"
                      f"VARVAL({V['nz']})*DZ({foot},101)"),
-                _var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
-                     f"{_f(h_rel)},0.0)"),
-                _var(V[f"knee_{leg}"], f"STEP(AZ({i_m},{j_m}),{_f(-cap)},0.0,{_f(-cap / 2)},"
-                     "1.0)"),
-                _var(V[f"weight_{leg}"], f"VARVAL({V[f'foot_{leg}']})*"
-                     f"VARVAL({V[f'knee_{leg}']})"),
-                *_stmt(f"SFORCE/{LATCH_SFORCE[leg]}, ROTATION, I={i_m}, J={j_m}",
-                       f"FUNCTION=VARVAL({V[f'weight_{leg}']})*IMPACT(AZ({i_m},{j_m}),"
-                       f"WZ({i_m},{j_m},{j_m}),0.0,{law})")]
+                *latch_sforce(V, leg, i_m, j_m, h_rel, cap, law)]
     return out

@@ -33,7 +33,8 @@ from walkerlab.export.adams_statements import (
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.opensim_contact import latch_foot_offset
 
-__all__ = ["LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK", "knee_latches"]
+__all__ = ["LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK", "knee_latches", "latch_law",
+           "latch_sforce"]
 
 #: VARIABLE ids of the knee latch (:func:`knee_latches`): the slope's sine and cosine, each
 #: leg's contact height [mm], the latch's engagement and its two factors (foot, knee); on
@@ -106,17 +107,31 @@ def knee_latches(mb, ids: dict, ks, start: AdamsStart | None = None) -> list[str
             out += [_var(V[f"line_{leg}"], h), *treads]
         else:
             out.append(_var(V[f"height_{leg}"], h))
-        out += [_var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
-                     f"{_f(h_rel)},0.0)"),
-                _var(V[f"knee_{leg}"], f"STEP(AZ({i_m},{j_m}),{_f(-cap)},0.0,{_f(-cap / 2)},"
-                     "1.0)"),
-                _var(V[f"weight_{leg}"], f"VARVAL({V[f'foot_{leg}']})*"
-                     f"VARVAL({V[f'knee_{leg}']})"),
-                *_stmt(f"SFORCE/{LATCH_SFORCE[leg]}, ROTATION, I={i_m}, J={j_m}",
-                       f"FUNCTION=VARVAL({V[f'weight_{leg}']})*IMPACT(AZ({i_m},{j_m}),"
-                       f"WZ({i_m},{j_m},{j_m}),0.0,{_f(ks.k * MM)},{_f(ks.e)},"
-                       f"{_f(ks.cmax * MM)},{_f(ks.dmax)})")]
+        out += latch_sforce(V, leg, i_m, j_m, h_rel, cap, latch_law(ks))
     return out
+
+
+def latch_law(ks) -> str:
+    """The latch's ``IMPACT`` law arguments ``k, e, cmax, dmax`` in the dataset's units
+    (N/mm-scaled stiffness and damping) of the contact model's knee stop ``ks``."""
+    return f"{_f(ks.k * MM)},{_f(ks.e)},{_f(ks.cmax * MM)},{_f(ks.dmax)}"
+
+
+def latch_sforce(V: dict, leg: str, i_m: int, j_m: int, h_rel: float, cap: float,
+                 law: str) -> list[str]:
+    """One knee's latch (the planar and the 3D datasets'): its weight, ``STEP`` of the
+    foot's contact height ``VARVAL(V['height_<leg>'])`` [mm] up to ``h_rel`` times ``STEP``
+    of the knee angle ``AZ(i_m, j_m)`` [rad] within ``cap`` of straight, on the
+    ``SFORCE/ROTATION`` ``IMPACT`` torque of ``law`` (:func:`latch_law`)."""
+    return [_var(V[f"foot_{leg}"], f"STEP(VARVAL({V[f'height_{leg}']}),0.0,1.0,"
+                 f"{_f(h_rel)},0.0)"),
+            _var(V[f"knee_{leg}"], f"STEP(AZ({i_m},{j_m}),{_f(-cap)},0.0,{_f(-cap / 2)},"
+                 "1.0)"),
+            _var(V[f"weight_{leg}"], f"VARVAL({V[f'foot_{leg}']})*"
+                 f"VARVAL({V[f'knee_{leg}']})"),
+            *_stmt(f"SFORCE/{LATCH_SFORCE[leg]}, ROTATION, I={i_m}, J={j_m}",
+                   f"FUNCTION=VARVAL({V[f'weight_{leg}']})*IMPACT(AZ({i_m},{j_m}),"
+                   f"WZ({i_m},{j_m},{j_m}),0.0,{law})")]
 
 
 def _tread_under(leg: str, marker: int, start: AdamsStart | None, out_id: int) -> list[str]:
