@@ -10,8 +10,8 @@ parameters; the walkers whose joints are all free (the five-link biped, Westerve
 Koditschek 2003, free knees on both legs; the three-link walker, Grizzle, Abba & Plestan
 2001; each with a hinged torso) equal :func:`walkerlab.codegen.free_joints.
 derive_five_link`'s; flat feet (Wisse et al. 2006) with foot mass, in heel contact and foot
-flat, equal :func:`walkerlab.codegen.foot_modes.derive_flat`'s modes (its link sums from the
-pinned heel) with the ankle spring and damper added.  The 3D trees the same builder makes
+flat, equal the leg-vector sums' modes (``tests/independent/flat_feet_link_sums.py``, from
+the pinned heel) with the ankle spring and damper added.  The 3D trees the same builder makes
 are the production derivation's (``tests/test_body_tree.py``)."""
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from tests.independent.flat_feet_link_sums import derive_flat
 from tests.independent.free_joints_link_sums import derive_five_link
 from tests.independent.planar_link_sums import derive
 from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
-from walkerlab.codegen.foot_modes import derive_flat
 from walkerlab.codegen.tree_derive import derive_tree, kinematics, plastic_impact, simplifier
 from walkerlab.config import load_scene
 from walkerlab.walker.description import BodySpec, Structure
@@ -181,7 +181,7 @@ def test_a_flat_footed_trees_heel_contact_and_foot_flat_equal_the_foot_modes(asy
     """configs/flat_feet_foot_mass.yaml's structure (a foot of mass ``m_foot`` and inertia
     ``I_foot`` at each ankle; ``asymmetric``: its legs' and feet's numbers per role): the
     tree's Lagrange equations with the swing foot at its rest
-    angle equal :func:`~walkerlab.codegen.foot_modes.derive_flat`'s ``heel_contact`` flow
+    angle equal the leg-vector sums' ``heel_contact`` flow
     (``M``; ``C dq`` and ``G`` less the ankle's damper ``c dq_a`` and spring ``k (a - r)``,
     which the tree leaves to the exports), and with the sole locked flat its ``foot_flat``
     flow's (``S^T M S``, ``S^T (C S dq + G)`` at ``a = -(stance + gamma)``, ``S`` the lock's

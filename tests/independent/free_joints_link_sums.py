@@ -52,10 +52,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from tests.independent.link_sums import add_mass_terms, extended_impact, position_of
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
-from walkerlab.codegen.link_sums import add_mass_terms, extended_impact, position_of
 from walkerlab.walker.description import Structure
 
 __all__ = ["derive_five_link", "generate_five_link"]

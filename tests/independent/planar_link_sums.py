@@ -51,15 +51,15 @@ from functools import cache
 
 import sympy as sp
 
-from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.frames import planar_slope_axes
-from walkerlab.codegen.lagrange import christoffel, knee_lock
-from walkerlab.codegen.link_sums import (
+from tests.independent.link_sums import (
     add_length,
     add_mass_terms,
     extended_impact,
     position_of,
 )
+from walkerlab.codegen.equations import Equations
+from walkerlab.codegen.frames import planar_slope_axes
+from walkerlab.codegen.lagrange import christoffel, knee_lock
 from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: coordinate of ``q`` eliminated on the heel-strike surface (the rest parametrise the section)

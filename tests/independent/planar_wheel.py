@@ -43,9 +43,9 @@ from functools import cache
 
 import sympy as sp
 
+from tests.independent.link_sums import e
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import planar_slope_axes
-from walkerlab.codegen.link_sums import e
 from walkerlab.walker.description import Structure
 
 

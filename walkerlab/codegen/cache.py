@@ -9,7 +9,7 @@ without a private folder the code stays in memory.
 
 Key: sha256 of the walker :class:`~walkerlab.walker.description.Structure` (no numbers: a
 sweep over masses shares one file) and of the generator's own source files (``legged.py``,
-``source.py``, ``walker/description.py``, ``cache.py``, ``link_sums.py``, ``equations.py``)
+``source.py``, ``walker/description.py``, ``cache.py``, ``equations.py``, the tree's modules)
 and the sympy version, so editing the generator regenerates.  Files are written atomically
 (temporary name, then ``os.replace``; a failed write - disk full, read-only - leaves nothing
 behind); each starts with a sha256 of its body: a truncated or damaged file is regenerated,
@@ -29,9 +29,8 @@ from walkerlab import progress, usercache
 ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/legged.py", "codegen/tree_derive.py", "walker/tree.py",
                     "walker/trees.py", "codegen/seeded.py", "codegen/source.py",
-                    "walker/description.py", "codegen/cache.py", "codegen/link_sums.py",
-                    "codegen/equations.py", "codegen/lagrange.py",
-                    "codegen/compiled_source.py", "codegen/frames.py")
+                    "walker/description.py", "codegen/cache.py", "codegen/equations.py",
+                    "codegen/lagrange.py", "codegen/compiled_source.py", "codegen/frames.py")
 _memo: dict[str, dict] = {}
 #: what each generated module of the cache folder is, by a part of its file name (the first
 #: key here that is a part of it: ``<key>_act_<tag>_nb.py`` is an actuated flow, not ``nb``)
@@ -83,8 +82,7 @@ def _generator_hash() -> str:
 @cache
 def _flat_generator_hash() -> str:
     """sha256 of the flat-foot generator's sources (once per process)."""
-    return _source_hash("codegen/foot_modes.py", "codegen/double_support.py",
-                        "codegen/push_off.py")
+    return _source_hash("codegen/foot_modes.py", "codegen/double_support.py")
 
 
 def _source_hash(*names: str) -> str:

@@ -172,8 +172,8 @@ def _legs(s: _Symbols) -> tuple[list, list, dict]:
     without a trigonometric simplifier."""
     import sympy as sp
 
+    from walkerlab.codegen.frames import leg_unit as e  # light
     from walkerlab.codegen.frames import planar_slope_axes  # light
-    from walkerlab.codegen.link_sums import e  # light
 
     structure, q, P, tags = s.structure, s.q, s.P, s.tags
     L, gamma, lt, R, knee = P["L"], P["gamma"], s.lt, s.R, s.knee
@@ -240,7 +240,7 @@ def _torso(s: _Symbols, bodies: list, points: dict):
     ``torso_angle``; a point ``d`` up its axis is at ``hip - d e(t)``."""
     import sympy as sp
 
-    from walkerlab.codegen.link_sums import e  # light
+    from walkerlab.codegen.frames import leg_unit as e  # light
 
     structure, q, P, hip_links = s.structure, s.q, s.P, s.hip_links
     hip = points["hip"]
@@ -339,7 +339,7 @@ def _derive_spoked(structure: Structure) -> FloatingEquations:
     is the first stance, the pinned point of a pinned start)."""
     import sympy as sp
 
-    from walkerlab.codegen.link_sums import e  # light
+    from walkerlab.codegen.frames import leg_unit as e  # light
 
     names = coordinate_names(structure)
     q = sp.symbols(names, real=True)

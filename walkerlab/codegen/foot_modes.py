@@ -1,7 +1,9 @@
-"""Flat feet on ankle springs: the rigid hybrid view's modes, derived with sympy from a
-:class:`~walkerlab.walker.description.Structure` (``foot == "flat"``) and written as Python
-source (the same ``make(p)`` module form as :mod:`walkerlab.codegen.source`, through its
-printers and solvers).
+"""Flat feet on ankle springs: the rigid hybrid view's modes, derived with sympy from the
+walker's body tree (:func:`walkerlab.walker.trees.legs_tree` with its soles: the stance heel
+the root, each leg on its ankle; :func:`walkerlab.codegen.tree_derive.kinematics` in world
+axes, as every other legged walker's equations come from its tree in
+:mod:`walkerlab.codegen.legged`) and written as Python source (the same ``make(p)`` module
+form as :mod:`walkerlab.codegen.source`, through its printers and solvers).
 
 Coordinates ``q = (swing, stance, stance_ankle)``: the absolute leg angles (from the
 vertical, positive foot ahead of the hip) and the stance ankle's angle ``a``: the sole's
@@ -16,7 +18,7 @@ ankle and inertia ``I_foot`` about it; the ankle lies on the sole line, ``heel``
 ankle: its spring-damper's time constant ``c / k`` is 25 ms on configs/flat_feet.yaml, its
 inertial torque ``I_foot`` times the leg's angular acceleration ~5e-3 N m).
 
-A *mode* is a pinned contact point plus locked coordinates; each is derived from the same
+A *mode* is a pinned contact point plus locked coordinates; each is derived from the tree's
 bodies with Lagrange's equations ``M qdd + C dq + G = 0`` (``C`` in Christoffel form plus
 the ankle damper, ``G`` from gravity and the ankle spring ``k (a - r)^2 / 2``):
 
@@ -73,8 +75,7 @@ from walkerlab.codegen.double_support import (
 )
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
-from walkerlab.codegen.link_sums import add_length, dot_terms, position_of, velocity_terms
-from walkerlab.codegen.push_off import push_off_systems
+from walkerlab.codegen.legged import link_springs
 from walkerlab.codegen.source import (
     IND,
     PRINTER,
@@ -84,7 +85,10 @@ from walkerlab.codegen.source import (
     reset_lines,
     start_module,
 )
+from walkerlab.codegen.tree_derive import kinematics, product_to_sum
 from walkerlab.walker.description import ROLE_TAG, Structure
+from walkerlab.walker.tree import CoordinateMap
+from walkerlab.walker.trees import legs_tree
 
 #: Index of the stance ankle's angle in ``q``.
 ANKLE = 2
@@ -149,80 +153,38 @@ class FlatEquations:
     double_support: dict | None = None
 
 
-@dataclass(frozen=True)
-class _Walker:
-    """The symbols and numbers every section of :func:`derive_flat` reads: ``q``, ``dq``,
-    ``qdd``, the parameters (``P`` by name) and the bodies of a pinned ankle
-    (:meth:`bodies_from`)."""
+def _foot_numbers(structure: Structure, P: dict):
+    """A foot's number by kind (``heel``, ``toe``, ``k``, ``r``, ``c``) and role (per role
+    when the legs differ)."""
+    def fp(kind: str, role: str):
+        t = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
+        return P[{"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle",
+                  "r": f"r_{t}ankle", "c": f"c_{t}ankle"}[kind]]
+    return fp
 
-    structure: Structure
-    q: tuple
-    dq: tuple
-    qdd: tuple
-    par: tuple
-    P: dict
 
-    def fp(self, kind: str, role: str):
-        """A foot's number (per role when the legs differ)."""
-        t = f"{ROLE_TAG[role]}_" if self.structure.asymmetric else ""
-        return self.P[{"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle",
-                       "r": f"r_{t}ankle", "c": f"c_{t}ankle"}[kind]]
+def _held(coords: CoordinateMap, rest: str) -> CoordinateMap:
+    """The rigid view's coordinates of a flat-footed tree: the swing foot held at its
+    spring's rest angle ``rest`` (a parameter's name) from its leg, no coordinate of its own
+    (module docstring)."""
+    return CoordinateMap(tuple(n for n in coords.names if n != "swing_ankle"),
+                         tuple((c, rest if c == "swing_ankle_pitch" else e)
+                               for c, e in coords.joint_angles))
 
-    def bp(self, kind: str, name: str, role: str):
-        """A leg body's number (per role when the legs differ)."""
-        return self.P[f"{kind}_{ROLE_TAG[role]}_{name}" if self.structure.asymmetric
-                      else f"{kind}_{name}"]
 
-    def bodies_from(self, ankle_lin: dict, pinned: str = "stance", foot_angle=None):
-        """(mass, lin, inertia, link angle, name) of every body, the hip's lin and the
-        other leg's ankle's lin, for the ``pinned`` leg's ankle at ``ankle_lin``; names
-        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike).
-
-        Feet with mass (``structure.foot_mass``): each foot a body ``<role>_foot_body`` at
-        its ankle, mass ``m_foot``, inertia ``I_foot`` about it; the pinned leg's foot at
-        the sole angle ``foot_angle`` (default the stance sole's ``stance + a``), the other
-        leg's foot at its spring's rest angle from that leg (its angle no coordinate)."""
-        structure, P, bp = self.structure, self.P, self.bp
-        ps_sw, ps_st, _a = self.q
-        L, half = P["L"], sp.pi / 2
-        other = {"stance": "swing", "swing": "stance"}[pinned]
-        leg_psi = {"stance": ps_st, "swing": ps_sw}
-        hip = add_length(ankle_lin, leg_psi[pinned], -L)
-        out = []
-        if structure.hip_mass:
-            out.append((P["M_hip"], hip, 0, leg_psi[pinned], "hip"))
-        for b in structure.bodies:
-            for role in (pinned, other):
-                psi = leg_psi[role]
-                lin = add_length(hip, psi, bp("d", b.name, role))
-                if b.off_axis:
-                    lin = add_length(lin, psi + half, bp("e", b.name, role))
-                inertia = bp("I", b.name, role) if b.kind == "rod" else 0
-                out.append((bp("m", b.name, role), lin, inertia, psi, f"{role}_{b.name}"))
-        psi_t = (ps_sw + ps_st) / 2
-        for b in structure.torso:
-            lin = add_length(hip, psi_t, -P[f"d_torso_{b.name}"])
-            if b.off_axis:
-                lin = add_length(lin, psi_t + half, P[f"e_torso_{b.name}"])
-            inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
-            out.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t, f"torso_{b.name}"))
-        other_ankle = add_length(hip, leg_psi[other], L)
-        if structure.foot_mass:
-            if foot_angle is None:
-                foot_angle = ps_st + _a
-            out.append((P["m_foot"], ankle_lin, P["I_foot"], foot_angle, f"{pinned}_foot_body"))
-            out.append((P["m_foot"], other_ankle, P["I_foot"],
-                        leg_psi[other] + self.fp("r", other), f"{other}_foot_body"))
-        return out, hip, other_ankle
+def _other_role(name: str) -> str:
+    """A body's name with the legs' roles swapped (``stance_sole`` -> ``swing_sole``)."""
+    return name.replace("stance", "\0").replace("swing", "stance").replace("\0", "swing")
 
 
 @cache
 def derive_flat(structure: Structure) -> FlatEquations:
-    """Derive the modes, resets, guards, ground reactions and points of a flat-footed biped:
-    the pinned modes (:func:`_pinned_modes`), foot flat and the resets
-    (:func:`_locked_and_resets`), the push-off systems
-    (:func:`walkerlab.codegen.push_off.push_off_systems`) and the
-    double support (:func:`walkerlab.codegen.double_support.derive_double_support`).
+    """Derive the modes, resets, guards, ground reactions and points of a flat-footed biped
+    from its body tree (:func:`walkerlab.walker.trees.legs_tree`, the stance heel its root;
+    Lagrange's equations by :func:`walkerlab.codegen.tree_derive.derive_tree`): the pinned
+    modes (:func:`_pinned_modes`), foot flat and the resets (:func:`_locked_and_resets`),
+    the push-off systems (:func:`_push_off_systems`) and the double support
+    (:func:`walkerlab.codegen.double_support.derive_double_support`).
 
     Returns
     -------
@@ -238,157 +200,157 @@ def derive_flat(structure: Structure) -> FlatEquations:
                          "flat feet and absolute coordinates")
     if any(b.massless for b in structure.bodies):
         raise ValueError("walker.leg.bodies: flat feet need massive bodies (mass_kg > 0)")
-    q = sp.symbols("q_swing q_stance q_stance_ankle", real=True)
-    dq = sp.symbols("dq_swing dq_stance dq_stance_ankle", real=True)
+    tree, coords = legs_tree(structure)
+    rest = {role: f"r_{ROLE_TAG[role]}_ankle" if structure.asymmetric else "r_ankle"
+            for role in ("swing", "stance")}
+    kin = kinematics(tree, _held(coords, rest["swing"]), world=True)
+    q, dq = kin.q, kin.dq
     qdd = sp.symbols("ddq_swing ddq_stance ddq_stance_ankle", real=True)
-    par = sp.symbols(structure.param_names, real=True)
-    P = dict(zip(structure.param_names, par))
-    w = _Walker(structure, q, dq, qdd, par, P)
+    P = dict(zip(tree.params, kin.params))
+    fp = _foot_numbers(structure, P)
     gamma = P["gamma"]
     ps_sw, ps_st, a = q
-    fp = w.fp
     hs, ts = fp("heel", "stance"), fp("toe", "stance")
-    rw = fp("r", "swing")
-    half = sp.pi / 2
     normal, tangent = planar_slope_axes(gamma)
-    theta_f = ps_st + a
-    # positions = sum of {angle: length} e(angle) + a constant offset (e(angle + pi/2) is
-    # the unit vector at ``angle`` from the x axis)
-    anchors = {"heel": ({theta_f + half: hs}, sp.zeros(2, 1)),
-               "toe": ({theta_f + half: -ts}, (hs + ts) * tangent)}
-    flows, kin, ground, guards, lead_force, trailing_ankle = _pinned_modes(
-        w, anchors, normal)
+    flows, kin_pins, ground, guards, lead_force, trailing_ankle, pre = _pinned_modes(
+        structure, kin, P, fp, qdd)
     guards["swing_foot_ahead"] = ps_sw - ps_st
     guards["foot_angle"] = ps_st + a + gamma
     Jl = sp.Matrix([[0, 1, 1]])
-    resets, post_q, post = _locked_and_resets(w, anchors, flows, Jl)
-    push_off = push_off_systems(q, anchors, w.bodies_from, kin, flows, resets, post_q, post)
+    post = kin   # the tree after the heel strike: the same, unless the legs differ
+    if structure.asymmetric:
+        swapped, swapped_coords = legs_tree(structure, swap_roles=True)
+        post = kinematics(swapped, _held(swapped_coords, rest["stance"]), world=True)
+    resets, trans = _locked_and_resets(kin, post, pre, flows, Jl, fp("r", "swing"))
+    push_off = _push_off_systems(q, kin_pins, pre, flows, resets, trans)
     leg_angles = {"swing_angle": ps_sw, "stance_angle": ps_st, "stance_ankle_angle": a,
-                  "swing_ankle_angle": rw + 0 * ps_sw,
+                  "swing_ankle_angle": fp("r", "swing") + 0 * ps_sw,
                   "swing_rate": dq[0], "stance_rate": dq[1], "stance_ankle_rate": dq[2],
                   "swing_ankle_rate": 0 * dq[0]}
     double = derive_double_support(q, dq, qdd, flows, trailing_ankle, lead_force["heel"],
                                    (fp("toe", "swing"), fp("k", "swing"), fp("r", "swing"),
                                     fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl,
                                    P["I_foot"] if structure.foot_mass else 0)
-    return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
-                         guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles,
-                         push_off=push_off, double_support=double)
+    return FlatEquations(q=q, dq=dq, qdd=qdd, params=kin.params, flows=flows, resets=resets,
+                         guards=guards, ground=ground, kinematics=kin_pins,
+                         leg_angles=leg_angles, push_off=push_off, double_support=double)
 
 
-def _pinned_modes(w: _Walker, anchors: dict, normal):
-    """Per pinned point (``heel``, ``toe``): the flow ``heel_contact`` / ``heel_off``
-    (:func:`_pinned_dynamics`), the kinematics (points, energies), the ground reaction
-    (Newton's total and, heel pinned, the toe's share from the moment balance about the
-    heel: module docstring) and the guards on the swing heel's and the hip's heights.
+def _world(kin, structure: Structure | None = None) -> dict:
+    """Every massive body's centre of mass and (given ``structure``) every named point of a
+    tree's kinematics in world axes (``kinematics(..., world=True)``: sums of lengths times
+    sines and cosines of the links' absolute angles) (2, 1), the root (the stance heel) at
+    the origin, and each massive body's mass, inertia about ``z`` and angular rate's row
+    ``d omega / d dq`` (1, n)."""
+    dqv = sp.Matrix(kin.dq)
+
+    def world(v):
+        return v[:2, :].applyfunc(sp.expand)
+
+    bodies = {name: (kin.masses[name], kin.inertias[name][2, 2], world(r),
+                     kin.omegas[name][2:, :].jacobian(dqv))
+              for name, r in kin.coms.items()
+              if kin.masses[name] != 0 or kin.inertias[name] != sp.zeros(3, 3)}
+    if structure is None:
+        return {"bodies": bodies}
+    named = {"stance_heel": kin.contacts["stance_heel"], "stance_toe": kin.contacts["stance_toe"],
+             "stance_ankle": kin.origins["stance_leg"], "hip": kin.origins["pelvis"],
+             "swing_ankle": kin.contacts["swing_ankle"],
+             "swing_heel": kin.contacts["swing_heel"], "swing_toe": kin.contacts["swing_toe"]}
+    # the contract's names: the stance foot is the stance leg's end, the swing foot the
+    # next step's reference point (the swing heel)
+    named["stance_foot"], named["swing_foot"] = named["stance_ankle"], named["swing_heel"]
+    for b in structure.bodies:
+        for role in ("stance", "swing"):
+            named[f"{role}_{b.name}"] = kin.coms[f"{role}_leg_{b.name}"]
+    for b in structure.torso:
+        named[f"torso_{b.name}"] = kin.coms[f"torso_{b.name}"]
+    return {"bodies": bodies, "points": {k: world(v) for k, v in named.items()}}
+
+
+def _pinned_modes(structure: Structure, kin, P: dict, fp, qdd):
+    """Per pinned point (``heel``, ``toe``): the flow ``heel_contact`` / ``heel_off``, the
+    kinematics (points, energies), the ground reaction (Newton's total and, heel pinned, the
+    toe's share from the moment balance about the heel: module docstring) and the guards on
+    the swing heel's and the hip's heights.
+
+    Lagrange's equations of the tree's bodies (``T = sum [m |r_c'|^2 + I omega^2] / 2``,
+    ``V`` gravity plus the ankle's and the links' springs; Murray, Li & Sastry 1994,
+    Sec. 4.3), with every point in world axes.  The tree's root is the stance heel; with the
+    toe pinned at ``O + (heel + toe) s`` every point moves by ``(heel + toe) s - toe(q)``.
 
     Returns
     -------
     flows, kinematics, ground, guards : dict
     lead_force : dict
-        Per pin, Newton's total force and moment ``(F, mom)``.
+        Per pin, Newton's total force (world axes) and moment about the origin ``(F, mom)``.
     trailing_ankle : Matrix (2, 1)
-        The swing ankle's position, heel pinned.
+        The swing ankle's position, heel pinned (world axes).
+    pre : dict
+        Per pin, each massive body's ``(mass, inertia, J_c, J_w)`` (world axes).
     """
-    q, fp = w.q, w.fp
-    ps_sw, ps_st, a = q
-    half = sp.pi / 2
+    q, dq = kin.q, kin.dq
+    qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(qdd)
+    gamma, g = P["gamma"], P["g"]
+    normal, tangent = planar_slope_axes(gamma)
     hs, ts = fp("heel", "stance"), fp("toe", "stance")
-    hw, tw, rw = fp("heel", "swing"), fp("toe", "swing"), fp("r", "swing")
-    theta_f = ps_st + a
-    dqv = sp.Matrix(w.dq)
-    link_angle = {"swing": ps_sw, "stance": ps_st, "torso": (ps_sw + ps_st) / 2}
-    flows, kin, ground, guards = {}, {}, {}, {}
-    lead_force = {}
-    for pin, (ankle_lin, off) in anchors.items():
-        bodies, hip, sw_ankle = w.bodies_from(ankle_lin)
-        if pin == "heel":
-            trailing_ankle = position_of(sw_ankle)
-
-        def at(lin, _off=off):
-            return position_of(lin) + _off
-        M, C, G, V, F, mom = _pinned_dynamics(w, bodies, at, link_angle)
-        mode = "heel_contact" if pin == "heel" else "heel_off"
-        flows[mode] = _System(q, w.dq, M=M, C=C, G=G)
-        N = (F.T * normal)[0]
+    a = q[ANKLE]
+    k_a, r_a, c_a = fp("k", "stance"), fp("r", "stance"), fp("c", "stance")
+    sw, st = q[0], q[1]
+    Vs, D = link_springs(structure, q, P, (sw, sw, st, 0))
+    spring = k_a * (a - r_a) ** 2 / 2 + Vs
+    world = _world(kin, structure)
+    toe = world["points"]["stance_toe"]
+    flows, kin_pins, ground, guards, lead_force, pre = {}, {}, {}, {}, {}, {}
+    for pin in ("heel", "toe"):
+        shift = sp.zeros(2, 1) if pin == "heel" else (hs + ts) * tangent - toe
+        M, V = sp.zeros(3, 3), spring
+        bodies, F, mom = [], sp.zeros(2, 1), sp.Integer(0)
+        for m, inertia, r, Jw in world["bodies"].values():
+            pos = (r + shift).applyfunc(sp.expand)
+            Jc = pos.jacobian(qv)
+            M += m * Jc.T * Jc + inertia * Jw.T * Jw
+            V += m * g * pos[1]
+            bodies.append((m, inertia, Jc, Jw))
+            vel = Jc * dqv
+            acc = vel.jacobian(qv) * dqv + Jc * ddv
+            f = m * (acc + sp.Matrix([0, g]))
+            F += f
+            mom += pos[0] * f[1] - pos[1] * f[0] + inertia * (Jw * ddv)[0]
+        M = M.applyfunc(product_to_sum)
+        V = product_to_sum(V)
+        C = christoffel(M, q, dq) + D
+        C[ANKLE, ANKLE] += c_a  # the ankle damper: torque -c da/dt on the ankle coordinate
+        G = sp.Matrix([sp.expand(sp.diff(V, k)) for k in q])
+        flows["heel_contact" if pin == "heel" else "heel_off"] = _System(q, dq, M=M, C=C, G=G)
+        pre[pin] = bodies
         lead_force[pin] = (F, mom)
         # moment balance about the pinned heel: the toe's normal force (see module docstring)
+        N = (F.T * normal)[0]
         ground[pin] = [N, mom / (hs + ts)] if pin == "heel" else [N]
-        heel_sw = at(add_length(sw_ankle, ps_sw + rw + half, -hw))
-        toe_sw = at(add_length(sw_ankle, ps_sw + rw + half, tw))
-        points = {"stance_heel": at(add_length(ankle_lin, theta_f + half, -hs)),
-                  "stance_toe": at(add_length(ankle_lin, theta_f + half, ts)),
-                  "stance_ankle": at(ankle_lin), "hip": at(hip),
-                  "swing_ankle": at(sw_ankle), "swing_heel": heel_sw, "swing_toe": toe_sw}
-        # the contract's names: the stance foot is the stance leg's end, the swing foot the
-        # next step's reference point (the swing heel)
-        points["stance_foot"] = points["stance_ankle"]
-        points["swing_foot"] = heel_sw
-        for _m, lin, _i, _p, name in bodies:
-            if name != "hip" and not name.endswith("_foot_body"):  # feet: at the ankles
-                points[name] = at(lin)
-        T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
-        kin[pin] = {"points": points, "kinetic": T, "potential": V}
-        guards[f"swing_heel_height_{pin}"] = (heel_sw.T * normal)[0]
-        guards[f"hip_height_{pin}"] = (at(hip).T * normal)[0]
-    return flows, kin, ground, guards, lead_force, trailing_ankle
+        points = {k: (v + shift).applyfunc(sp.expand) for k, v in world["points"].items()}
+        if pin == "heel":
+            trailing_ankle = points["swing_ankle"]
+        kin_pins[pin] = {"points": points, "kinetic": sp.Rational(1, 2) * (dqv.T * M * dqv)[0],
+                         "potential": V}
+        guards[f"swing_heel_height_{pin}"] = sp.expand((points["swing_heel"].T * normal)[0])
+        guards[f"hip_height_{pin}"] = sp.expand((points["hip"].T * normal)[0])
+    return flows, kin_pins, ground, guards, lead_force, trailing_ankle, pre
 
 
-def _pinned_dynamics(w: _Walker, bodies: list, at, link_angle: dict):
-    """Lagrange's equations of one pinned mode: ``M``, ``C`` (Christoffel form plus the
-    ankle's and the springs' dampers), ``G`` and the potential ``V`` (gravity, the ankle
-    spring, the springs between links), and Newton's total force ``F`` and moment ``mom``
-    about the origin of the bodies (positions ``at(lin)``)."""
-    q, dq, P, structure = w.q, w.dq, w.P, w.structure
-    _ps_sw, _ps_st, a = q
-    g = P["g"]
-    k_a, r_a, c_a = w.fp("k", "stance"), w.fp("r", "stance"), w.fp("c", "stance")
-    qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(w.qdd)
-    M = sp.zeros(3, 3)
-    V = k_a * (a - r_a) ** 2 / 2
-    F = sp.zeros(2, 1)
-    mom = sp.Integer(0)
-    for mass, lin, inertia, psi, _name in bodies:
-        d = velocity_terms(lin, q)
-        wr = sp.Matrix([[sp.diff(psi, s) for s in q]])
-        for i in range(3):
-            for j in range(3):
-                M[i, j] += mass * dot_terms(d[i], d[j])
-        M += inertia * wr.T * wr
-        pos = at(lin)
-        V += mass * g * pos[1]
-        vel = pos.jacobian(qv) * dqv
-        acc = vel.jacobian(qv) * dqv + vel.jacobian(dqv) * ddv
-        f = mass * (acc + sp.Matrix([0, g]))
-        F += f
-        mom += pos[0] * f[1] - pos[1] * f[0] + inertia * (wr * ddv)[0]
-    for i, (first, second) in enumerate(structure.springs):  # springs between links
-        delta = link_angle[second] - link_angle[first]
-        V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
-    M = M.applyfunc(sp.factor_terms)
-    G = sp.Matrix([sp.diff(V, s) for s in q])
-    C = christoffel(M, q, dq)
-    C[ANKLE, ANKLE] += c_a  # the ankle damper: torque -c da/dt on the ankle coordinate
-    for i, (first, second) in enumerate(structure.springs):
-        delta = link_angle[second] - link_angle[first]
-        Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
-        C += P[f"c_s{i}"] * Jd.T * Jd
-    return M, C, G, V, F, mom
-
-
-def _locked_and_resets(w: _Walker, anchors: dict, flows: dict, Jl):
+def _locked_and_resets(kin, post, pre: dict, flows: dict, Jl, rest):
     """Add the ``foot_flat`` flow (the heel-contact flow with the foot's angle locked,
     ``Jl = d phi / dq``) to ``flows``; return the resets (``foot_slap``, ``heel_strike_heel``,
-    ``heel_strike_toe``), the post-impact coordinates and the post-impact bodies by name.
+    ``heel_strike_toe``) and the heel strike's translation rows (for the push-off).
 
-    Heel strike: post-impact coordinates ``(swing, stance, b)`` with the swing heel pinned
-    and the swing foot at angle ``swing + b`` (``b`` its rest angle at impact), in the
-    pre-impact labelling; then the roles swap (new swing = old stance, new stance = old
-    swing)."""
-    q, dq = w.q, w.dq
+    Heel strike: the post-impact bodies are the tree with the legs' roles swapped
+    (``post``, :func:`walkerlab.walker.trees.legs_tree`'s ``swap_roles``; its root the
+    swing heel, the new stance ankle ``b`` its coordinate, at the swing foot's rest angle
+    ``rest`` at impact), in the pre-impact labelling ``(swing, stance, b)``: ``Mi = sum
+    J+^T m J+``, ``B = sum J+^T m J-`` over the bodies (plus their rotations), then the roles
+    swap (new swing = old stance, new stance = old swing)."""
+    q, dq = kin.q, kin.dq
     ps_sw, ps_st, _a = q
-    half = sp.pi / 2
-    hw, rw = w.fp("heel", "swing"), w.fp("r", "swing")
     b_new = sp.Symbol("b_new_ankle", real=True)  # the swing ankle, once it is the stance one
     qv = sp.Matrix(q)
     S = sp.Matrix([[1, 0], [0, 1], [0, -1]])
@@ -399,32 +361,64 @@ def _locked_and_resets(w: _Walker, anchors: dict, flows: dict, Jl):
     resets = {"foot_slap": _System(q, dq, Mi=(S.T * hc.M).col_join(Jl),
                                    B=(S.T * hc.M).col_join(sp.zeros(1, 3)),
                                    relabel_q=qv, relabel_rate=sp.eye(3))}
-    post_q = (ps_sw, ps_st, b_new)
-    post_bodies, _h, _a = w.bodies_from({ps_sw + b_new + half: hw}, "swing", ps_sw + b_new)
-    post = {b[4]: b for b in post_bodies}
+    # the post-impact tree's coordinates (swing, stance, stance_ankle) in the pre-impact
+    # labelling: its swing leg the old stance one, its stance leg the old swing one
+    post_q = sp.Matrix([ps_sw, ps_st, b_new])
+    to_pre = dict(zip(post.q, (ps_st, ps_sw, b_new)))
+    order = [1, 0, 2]   # the post tree's rates in (swing, stance, b) order
+    after, trans = {}, sp.zeros(3, 2)
+    for name, (m, _i, r, Jw) in _world(post)["bodies"].items():
+        Jn = r.xreplace(to_pre).jacobian(post_q)
+        after[_other_role(name)] = (Jn, Jw[:, order])
+        trans += m * Jn.T
+    rw = rest
     relabel_q = sp.Matrix([ps_st, ps_sw, rw])
     relabel_rate = sp.Matrix([[0, 1, 0], [1, 0, 0], [0, 0, 1]])
-    for pin, (ankle_lin, _off) in anchors.items():
-        pre_bodies, _h, _a = w.bodies_from(ankle_lin)
-        Mi, Bm = sp.zeros(3, 3), sp.zeros(3, 3)
-        for mass, lin, inertia, psi, name in pre_bodies:
-            pmass, plin, pinertia, ppsi, _n = post[name]
-            dn, dl = velocity_terms(plin, post_q), velocity_terms(lin, q)
-            wn = sp.Matrix([[sp.diff(ppsi, s) for s in post_q]])
-            wl = sp.Matrix([[sp.diff(psi, s) for s in q]])
-            for i in range(3):
-                for j in range(3):
-                    Mi[i, j] += mass * dot_terms(dn[i], dn[j])
-                    Bm[i, j] += mass * dot_terms(dn[i], dl[j])
-            Mi += inertia * wn.T * wn
-            Bm += inertia * wn.T * wl
-        Mi, Bm = (X.subs(b_new, rw).applyfunc(sp.factor_terms) for X in (Mi, Bm))
-        resets[f"heel_strike_{pin}"] = _System(q, dq, Mi=Mi, B=Bm, relabel_q=relabel_q,
-                                               relabel_rate=relabel_rate)
-    return resets, post_q, post
+    Mi = sum((post.masses[_other_role(n)] * Jn.T * Jn
+              + post.inertias[_other_role(n)][2, 2] * Jwn.T * Jwn
+              for n, (Jn, Jwn) in after.items()), sp.zeros(3, 3))
+    Mi = Mi.subs(b_new, rw).applyfunc(product_to_sum)   # the same after either pin
+    names = [n for n in kin.coms
+             if kin.masses[n] != 0 or kin.inertias[n] != sp.zeros(3, 3)]
+    for pin in ("heel", "toe"):
+        Bm = sp.zeros(3, 3)
+        for name, (m, inertia, Jc, Jw) in zip(names, pre[pin]):
+            Jn, Jwn = after[name]
+            Bm += m * Jn.T * Jc + inertia * Jwn.T * Jw
+        resets[f"heel_strike_{pin}"] = _System(
+            q, dq, Mi=Mi, B=Bm.subs(b_new, rw).applyfunc(product_to_sum), relabel_q=relabel_q,
+            relabel_rate=relabel_rate)
+    return resets, trans.subs(b_new, rw).applyfunc(product_to_sum)
 
 
+def _push_off_systems(q, kin_pins, pre, flows, resets, trans) -> dict:
+    """The extended impact system of each pinned point (``heel``, ``toe``): the push-off at
+    the stance toe and the heel strike after it (Wisse et al. 2006).
 
+    Extended coordinates ``qe = (q, x_f, y_f)``: the walker translated by ``(x_f, y_f)``
+    with its pinned point.  Per pin: ``De`` (5, 5), the Hessian of the kinetic energy in
+    ``dqe`` (``[M, Mt; Mt^T, m I]``, ``Mt = sum m dr/dq`` in world axes; singular along the
+    massless foot's turn about the ankle, which the push-off holds); ``Jt`` (2, 5), the
+    stance toe's Jacobian; ``Jh`` (2, 3), the hip's (its speed for a push-off law); ``Mi``
+    (3, 3) and ``Be`` (3, 5), the heel strike's ``Mi dq+ = Be dqe-`` (momenta of the
+    pre-impact velocities, the trailing foot free and moving, projected on the post-impact
+    coordinates with the swing heel pinned: ``Be = [B | sum J+^T m]``, ``B`` the passive
+    heel strike's, so ``Be [dq; 0] = B dq`` to round-off); ``push`` (2,) the vector toe ->
+    hip; ``relabel_q`` (3,) and ``relabel_rate`` (3, 3) the role swap."""
+    qv = sp.Matrix(q)
+    out = {}
+    for pin, mode in (("heel", "heel_contact"), ("toe", "heel_off")):
+        Mt = sum((m * Jc.T for m, _i, Jc, _w in pre[pin]), sp.zeros(3, 2))
+        mass = sum((m for m, *_ in pre[pin]), sp.Integer(0))
+        hs = resets[f"heel_strike_{pin}"]
+        De = flows[mode].M.row_join(Mt).col_join(Mt.T.row_join(mass * sp.eye(2)))
+        pts = kin_pins[pin]["points"]
+        toe = pts["stance_toe"]
+        out[pin] = {"De": De, "Jt": toe.jacobian(qv).row_join(sp.eye(2)),
+                    "Jh": pts["hip"].jacobian(qv), "Mi": hs.Mi, "Be": hs.B.row_join(trans),
+                    "push": pts["hip"] - toe, "relabel_q": hs.relabel_q,
+                    "relabel_rate": hs.relabel_rate}
+    return out
 
 
 def _scalar_fn(name: str, eq: FlatEquations, exprs: list, with_acc: bool) -> list[str]:

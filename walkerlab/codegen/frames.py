@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["planar_slope_axes", "rotation", "skew", "slope_to_world", "slope_up"]
+__all__ = ["leg_unit", "planar_slope_axes", "rotation", "skew", "slope_to_world", "slope_up"]
 
 
 def skew(v) -> sp.Matrix:
@@ -54,3 +54,9 @@ def planar_slope_axes(gamma) -> tuple[sp.Matrix, sp.Matrix]:
     planar walker's world axes (``x`` horizontal downhill, ``y`` up; module docstring)."""
     return (sp.Matrix([sp.sin(gamma), sp.cos(gamma)]),
             sp.Matrix([sp.cos(gamma), -sp.sin(gamma)]))
+
+
+def leg_unit(psi) -> sp.Matrix:
+    """The unit vector (2, 1) from the hip towards the foot of a planar leg at ``psi`` [rad]
+    from the vertical (foot ahead positive), in world axes: ``(sin psi, -cos psi)``."""
+    return sp.Matrix([sp.sin(psi), -sp.cos(psi)])

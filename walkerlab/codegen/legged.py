@@ -62,7 +62,8 @@ from walkerlab.codegen.tree_derive import (
 )
 from walkerlab.walker.trees import legs_tree
 
-__all__ = ["BETA", "SECTION_DROP", "derive_legged", "extended_impact", "hip_roll_forces"]
+__all__ = ["BETA", "SECTION_DROP", "derive_legged", "extended_impact", "hip_roll_forces",
+           "link_springs"]
 
 #: the massless limit's symbolic mass (Garcia et al. 1998), a parameter of the tree only
 BETA = "beta"
@@ -167,7 +168,7 @@ def _pitches(structure, q, gamma) -> tuple:
     return at["swing"], at["swing"], at["stance"], lean
 
 
-def _springs(structure, q, P, pitches) -> tuple[sp.Expr, sp.Matrix]:
+def link_springs(structure, q, P, pitches) -> tuple[sp.Expr, sp.Matrix]:
     """The springs' potential ``sum k (delta - r)^2 / 2`` [J] and their dampers' matrix
     ``sum c J^T J`` (n, n) (module docstring).  The swing knee's spring acts on ``shank -
     thigh``; the stance knee is straight and locked, so its spring holds a constant energy
@@ -365,7 +366,7 @@ def derive_legged(structure) -> Equations:
     if structure.hip_roll:
         G = G - hip_roll_forces(q, dq, P)
     if structure.springs or structure.knee_spring:
-        Vs, D = _springs(structure, q, P, pitches)
+        Vs, D = link_springs(structure, q, P, pitches)
         V, C = V + Vs, C + D
         G = G + sp.Matrix([sp.expand(sp.diff(Vs, k)) for k in q])
     if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped

@@ -110,7 +110,8 @@ def _tr8(product: sp.Expr) -> sp.Expr:
 
 @dataclass(frozen=True)
 class TreeKinematics:
-    """Forward kinematics of a tree in a walker's coordinates (sympy; frames in the slope's).
+    """Forward kinematics of a tree in a walker's coordinates (sympy; frames in the slope's,
+    or in world axes: :func:`kinematics`' ``world``).
 
     Attributes
     ----------
@@ -190,7 +191,8 @@ def _product(chain: list) -> sp.Matrix:
     return R
 
 
-def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinematics:
+def kinematics(tree: BodyTree, coords: CoordinateMap | None = None,
+               world: bool = False) -> TreeKinematics:
     """Forward kinematics of ``tree`` (module docstring) in the coordinates ``coords``.
 
     Parameters
@@ -198,6 +200,12 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
     tree : walkerlab.walker.tree.BodyTree
     coords : walkerlab.walker.tree.CoordinateMap, optional
         The walker's coordinates and the joints' angles in them; default the joints' own.
+    world : bool
+        Frames, origins, centres of mass and contacts in world axes (``x`` horizontal
+        downhill, ``y`` up): the slope's frame turned by ``-gamma`` about ``z``
+        (:func:`~walkerlab.codegen.frames.slope_to_world`) at the root of every chain, so
+        that it merges with the joints' pitches (a planar link's absolute angle from the
+        vertical comes out with no ``gamma`` in it).
 
     Returns
     -------
@@ -227,7 +235,9 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
     angle = {c: num(e) for c, e in coords.joint_angles}
     chains, R, origin, com, omega, mass, inertia = {}, {}, {}, {}, {}, {}, {}
     root = tree.root.name
-    chains[root], R[root], origin[root] = [], sp.eye(3), sp.zeros(3, 1)
+    gamma = num(tree.root.slope_rad)
+    chains[root] = [((0, 0, 1), -gamma)] if world else []
+    R[root], origin[root] = _product(chains[root]), sp.zeros(3, 1)
     for b in tree.bodies:
         j = b.joint
         slide = j.kind == "prismatic"   # the origin moves along the axis, nothing turns
@@ -251,7 +261,7 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None) -> TreeKinem
     return TreeKinematics(q=q, dq=dq, params=par, rotations={k: R[k] for k in com},
                           origins={k: origin[k] for k in com}, coms=com, omegas=omega,
                           contacts=contacts, masses=mass, inertias=inertia,
-                          gamma=num(tree.root.slope_rad), g=num(tree.root.gravity_m_per_s2))
+                          gamma=gamma, g=num(tree.root.gravity_m_per_s2))
 
 
 def simplifier(kin: TreeKinematics) -> Callable[[sp.Expr], sp.Expr]:

@@ -451,8 +451,8 @@ def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
     return biped_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
 
 
-def legs_tree(structure, floating: bool = False, massless_mass: str | None = None
-              ) -> tuple[BodyTree, CoordinateMap]:
+def legs_tree(structure, floating: bool = False, massless_mass: str | None = None,
+              swap_roles: bool = False) -> tuple[BodyTree, CoordinateMap]:
     """The tree of a biped's structure (:class:`walkerlab.walker.description.Structure`,
     legs without spokes), planar or in 3D (:func:`biped_tree`): a biped from parts (each leg
     body ``m_<name>, d_<name>[, I_<name>][, e_<name>]`` (legs that differ: ``m_sw_<name>``,
@@ -479,6 +479,10 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
         The name of a symbolic mass every massless body carries, appended to the tree's
         parameters: the derivation's massless limit (Garcia et al. 1998,
         :mod:`walkerlab.codegen.legged`) takes it to 0.  None: a massless body is refused.
+    swap_roles : bool
+        The legs' numbers (and flat feet's) by the other role: the tree just after a heel
+        strike, its stance leg the old swing leg, in the names of the pre-impact roles (legs
+        that differ; the same tree otherwise).
 
     Returns
     -------
@@ -506,7 +510,8 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                               f"I_{tag}{b.name}" if b.kind == "rod" else None,
                               f"e_{tag}{b.name}" if b.off_axis else None, b.link)
                          for b in structure.bodies)
-        legs, swing = leg("stance"), leg("swing") if structure.asymmetric else None
+        roles = ("swing", "stance") if swap_roles else ("stance", "swing")
+        legs, swing = leg(roles[0]), leg(roles[1]) if structure.asymmetric else None
         torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
                            f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
                            f"e_torso_{b.name}" if b.off_axis else None)
@@ -526,13 +531,15 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                       coordinates=structure.coordinates,
                       free_joints=(planar and (structure.free_knees or structure.hinged_torso))
                       or (floating and not planar and structure.knee),
-                      soles=_soles(structure) if structure.foot == "flat" else None)
+                      soles=_soles(structure, swap_roles) if structure.foot == "flat" else None)
 
 
-def _soles(structure) -> Soles:
+def _soles(structure, swap_roles: bool = False) -> Soles:
     """A flat-footed structure's :class:`Soles` by its parameters' names (per role when the
-    legs differ; ``m_foot``, ``I_foot`` with ``structure.foot_mass``)."""
-    sw, st = (f"{ROLE_TAG[r]}_" if structure.asymmetric else "" for r in ("swing", "stance"))
+    legs differ, by the other role with ``swap_roles``; ``m_foot``, ``I_foot`` with
+    ``structure.foot_mass``)."""
+    roles = ("stance", "swing") if swap_roles else ("swing", "stance")
+    sw, st = (f"{ROLE_TAG[r]}_" if structure.asymmetric else "" for r in roles)
     mass = ("m_foot", "I_foot") if structure.foot_mass else (0, None)
     return Soles((f"heel_{sw}m", f"heel_{st}m"), (f"toe_{sw}m", f"toe_{st}m"), *mass)
 
