@@ -88,8 +88,11 @@ KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D falls in MuJoCo within its first
                         "its slope (its walk cell): its MJCF lays no stairs or footholds "
                         "a walk could be measured on")
 #: why a 3D walker refuses virtual constraints
-VC_3D = ("virtual constraints are planar walkers' so far; a 3D walker's hip torque laws are "
-         "walker.actuation.torques (joint: hip)")
+VC_3D = ("the hybrid zero dynamics of Bezier outputs (Westervelt, Grizzle & Koditschek 2003) "
+         "take one unactuated degree of freedom, the stance foot's pitch: a 3D walker's lean "
+         "is a second one, its zero dynamics two-dimensional, and outputs of one phase "
+         "variable leave its lateral mode free; steady it with the hip-roll law "
+         "(walker.hip_roll) and drive the hips with walker.actuation.torques (joint: hip)")
 #: why the kinds other than the 3D straight legs refuse hip-roll joints (the scene's check
 #: on a planar compass gait says it too: :class:`walkerlab.config.walker.CompassGaitParams`)
 NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width "
