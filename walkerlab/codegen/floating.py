@@ -55,6 +55,7 @@ from walkerlab.codegen.floating_equations import (
     derive_floating,
     param_names,
 )
+from walkerlab.walker import floating_tree
 from walkerlab.walker.description import Structure, WalkerData
 
 __all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "FREE_3D", "HUB_INERTIA_MESSAGE",
@@ -256,14 +257,16 @@ def _source_hash(paths: tuple) -> str:
 def module_key(structure: Structure, tag: str, sources=()) -> str:
     """Cache key: the rigid generator's key of ``structure`` (structure + generator + sympy),
     this file, the derivations' (:mod:`walkerlab.codegen.floating_equations`,
-    :mod:`walkerlab.codegen.floating_3d`, :mod:`walkerlab.codegen.floating_names`) and
-    ``sources`` (files whose text is part of the module), and ``tag``."""
+    :mod:`walkerlab.codegen.floating_3d`, :mod:`walkerlab.codegen.floating_names`, the
+    planar floating tree :mod:`walkerlab.walker.floating_tree`) and ``sources`` (files whose
+    text is part of the module), and ``tag``."""
     from walkerlab.codegen import cache, floating_3d, floating_equations, floating_names
 
     h = hashlib.sha256(cache.cache_key(structure).encode())
     h.update(tag.encode())
     h.update(_source_hash((__file__, floating_equations.__file__, floating_3d.__file__,
-                           floating_names.__file__, *sources)).encode())
+                           floating_names.__file__, floating_tree.__file__,
+                           *sources)).encode())
     return h.hexdigest()[:24]
 
 

@@ -54,7 +54,6 @@ raises.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cache
 
 from walkerlab.codegen.floating_3d import derive_legs_3d, derive_wheel_3d
@@ -74,15 +73,19 @@ from walkerlab.codegen.floating_names import (  # noqa: F401 (re-exported)
     param_names,
 )
 from walkerlab.walker.description import Structure
+from walkerlab.walker.floating_tree import floating_planar_tree
 from walkerlab.walker.multibody import check_floating_view
 
 
 @cache
 def derive_floating(structure: Structure) -> FloatingEquations:
-    """Derive the floating view of ``structure`` (memoised per process): the legs' bodies
-    and feet (:func:`_legs`), the torso's (:func:`_torso`), the mass matrix and potential
-    of the bodies (:func:`_mass_and_potential`), the spring-dampers (:func:`_springs`),
-    then the bias ``h`` (module docstring).
+    """Derive the floating view of ``structure`` (memoised per process): a planar legged
+    walker's from its floating tree (:func:`walkerlab.walker.floating_tree.
+    floating_planar_tree`; every body and foot where the tree's kinematics puts it, read as
+    a sum of link vectors, :func:`_link_sums`), the mass matrix and potential of its bodies
+    (:func:`_mass_and_potential`), its feet (:func:`_feet`), the spring-dampers
+    (:func:`_springs`), then the bias ``h`` (module docstring); a 3D walker's and a spoked
+    wheel's from theirs.
 
     Raises
     ------
@@ -94,6 +97,7 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     import sympy as sp
 
     from walkerlab.codegen.lagrange import bias  # light: sympy on first derivation only
+    from walkerlab.codegen.tree_derive import kinematics  # light
 
     check_floating_view(structure)
     check_masses(structure)
@@ -103,171 +107,91 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         return _derive_spoked(structure)
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
-    s = _symbols(structure)
-    q, dq, names = s.q, s.dq, s.names
-    bodies, feet, points = _legs(s)
-    psi_t = _torso(s, bodies, points)
-    M, V = _mass_and_potential(s, bodies)
+    tree, coords = floating_planar_tree(structure, param_names(structure))
+    kin = kinematics(tree, coords)   # the root is the world: world axes
+    q = sp.symbols(coords.names, real=True)
+    dq = sp.symbols([f"d_{n}" for n in coords.names], real=True)
+    rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
+    P = dict(zip(tree.params, kin.params))
+    hip = sp.Matrix(q[:2])
+    bodies = [(kin.masses[b], _link_sums(kin.coms[b].xreplace(rename), hip),
+               kin.inertias[b][2, 2], kin.omegas[b][2].xreplace(rename))
+              for b in kin.coms if kin.masses[b] != 0]
+    M, V = _mass_and_potential(q, dq, P["g"], bodies)
     dqv = sp.Matrix(dq)
     T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
-    V, damping = _springs(s, V, psi_t)
+    names = list(coords.names)
+    hips = [q[names.index(f"{leg}_thigh_angle" if structure.knee else f"{leg}_angle")]
+            for leg in LEGS]
+    psi_t = None
+    if structure.torso:
+        psi_t = (q[names.index("torso_angle")] if structure.hinged_torso
+                 else (hips[0] + hips[1]) / 2)
+    Vs, damping = _springs(structure, q, P, hips, psi_t)
+    V = V + Vs
     h = (bias(M, V, q, dq) + damping * dqv).applyfunc(sp.expand)
-    return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(s.par), M=M, h=h,
+    feet, points = _feet(structure, kin, rename, q, P)
+    return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(kin.params), M=M, h=h,
                              feet=tuple(feet), kinetic=T, potential=V, points=points,
                              knees=tuple((names.index(f"{leg}_thigh_angle"),
                                           names.index(f"{leg}_shank_angle"))
                                          for leg in LEGS
-                                         if s.knee and not structure.free_knees),
+                                         if structure.knee and not structure.free_knees),
                              contacts=contact_names(structure),
                              point_legs=tuple(int(c[3]) - 1 for c in contact_names(structure)))
 
 
-@dataclass(frozen=True)
-class _Symbols:
-    """What every section of :func:`derive_floating` reads: the coordinates, rates and
-    parameters (by name ``P``), the foot's kind, the thigh length ``lt`` and arc radius
-    ``R`` (0 when absent), the tags of leg1's and leg2's numbers and the hip's links."""
+def _link_sums(point, hip) -> dict:
+    """A planar point of the floating tree (3, 1; world axes) as ``hip + sum(length *
+    e(angle))`` (``e(a) = (sin a, -cos a)``, :func:`walkerlab.codegen.frames.leg_unit`):
+    ``{angle: length}``, each angle a link's absolute angle (a linear expression of the
+    coordinates: the bisecting torso's mean; ``+ pi/2`` for a length ahead of the link's
+    axis), so that velocities and the mass matrix come out in ``cos(a - b)`` form without a
+    trigonometric simplifier.
 
-    structure: Structure
-    names: tuple
-    q: tuple
-    dq: tuple
-    par: tuple
-    P: dict
-    knee: bool
-    arc: bool
-    flat: bool
-    lt: object
-    R: object
-    tags: tuple
-    hip_links: tuple
-
-
-def _symbols(structure: Structure) -> _Symbols:
-    """The symbols of :func:`derive_floating` (:class:`_Symbols`)."""
+    Raises
+    ------
+    ValueError
+        The point is not such a sum (its height does not match its run).
+    """
     import sympy as sp
 
-    names = coordinate_names(structure)
-    q = sp.symbols(names, real=True)
-    dq = sp.symbols([f"d_{n}" for n in names], real=True)
-    pnames = param_names(structure)
-    par = sp.symbols(pnames, real=True)
-    P = dict(zip(pnames, par))
-    knee, arc, flat = structure.knee, structure.foot == "arc", structure.foot == "flat"
-    # the parameter vector is the rigid view's first step (leg1 swinging, paper Eq. 11): with
-    # legs that differ, leg1's numbers are the swing role's (``sw``), leg2's the stance's
-    tags = ("sw_", "st_") if structure.asymmetric else ("", "")
-    hip_links = (q[2], q[4]) if knee else (q[2], q[3])  # leg1's and leg2's links at the hip
-    return _Symbols(structure, names, q, dq, par, P, knee, arc, flat,
-                    P["L_thigh"] if knee else 0, P["R_foot"] if arc else 0, tags, hip_links)
+    from walkerlab.codegen.frames import leg_unit  # light
+
+    lin: dict = {}
+    for term in sp.Add.make_args(sp.expand(point[0] - hip[0])):
+        if term == 0:   # the hip itself
+            continue
+        (trig,) = [f for f in sp.Mul.make_args(term) if isinstance(f, sp.sin | sp.cos)]
+        angle = trig.args[0]
+        key = angle if isinstance(trig, sp.sin) else angle + sp.pi / 2
+        lin[key] = lin.get(key, 0) + term / trig
+    rebuilt = hip + sum((v * leg_unit(a) for a, v in lin.items()), sp.zeros(2, 1))
+    if sp.expand(rebuilt[1] - point[1]) != 0:
+        raise ValueError("floating tree: a point is not a sum of link vectors from the hip")
+    return lin
 
 
-def _legs(s: _Symbols) -> tuple[list, list, dict]:
-    """The legs' bodies ``(mass, {angle: length}, inertia, link angle or None)`` (the hip's
-    point mass first), their contact points ``(position, Jacobian)`` and named points.
-
-    Every point is ``hip + sum(length * e(angle))``, kept as ``{angle: length}`` (an angle
-    is a coordinate, or a linear expression of them: an off-axis body's ``psi + pi/2``, the
-    torso's eliminated angle) so that the mass matrix comes out in ``cos(a - b)`` form
-    without a trigonometric simplifier."""
+def _at(lin: dict, hip):
+    """``hip + sum(length * e(angle))`` of a ``{angle: length}`` sum (:func:`_link_sums`)."""
     import sympy as sp
 
-    from walkerlab.codegen.frames import leg_unit as e  # light
-    from walkerlab.codegen.frames import planar_slope_axes  # light
+    from walkerlab.codegen.frames import leg_unit  # light
 
-    structure, q, P, tags = s.structure, s.q, s.P, s.tags
-    L, gamma, lt, R, knee = P["L"], P["gamma"], s.lt, s.R, s.knee
-    n_vec, t_vec = planar_slope_axes(gamma)
-    nq = len(q)
-    hip = sp.Matrix([q[0], q[1]])
-    bodies = []
-    feet, points = [], {"hip": hip}
-    if structure.hip_mass:
-        bodies.append((P["M_hip"], {}, 0, None))
-    arc, flat, names = s.arc, s.flat, s.names
-    for i, leg in enumerate(LEGS):
-        ks = (2 + 2 * i, 3 + 2 * i) if knee else (2 + i,)
-        upper, lower = ks[0], ks[-1]
-        for b in structure.bodies:
-            d = P[f"d_{tags[i]}{b.name}"]
-            lin = ({q[upper]: lt, q[lower]: d - lt} if b.link == "shank" else {q[upper]: d})
-            link = q[lower] if b.link == "shank" else q[upper]
-            if b.off_axis:  # ahead of the link's axis
-                lin[link + sp.pi / 2] = P[f"e_{tags[i]}{b.name}"]
-            inertia = P[f"I_{tags[i]}{b.name}"] if b.kind == "rod" else 0
-            bodies.append((P[f"m_{tags[i]}{b.name}"], lin, inertia, link))
-            points[f"{leg}_{b.name}"] = hip + sum((v * e(a) for a, v in lin.items()),
-                                                 sp.zeros(2, 1))
-        foot_lin = {upper: lt, lower: L - lt - R} if knee else {upper: L - R}
-        centre = hip + sum((v * e(q[k]) for k, v in foot_lin.items()), sp.zeros(2, 1))
-        Jc = centre.jacobian(sp.Matrix(q))
-        if arc:
-            sel = sp.Matrix([[1 if k == lower else 0 for k in range(nq)]])
-            feet.append((centre - R * n_vec, Jc + R * t_vec * sel))
-            # named as the rigid model's points: the arc's lowest point (contact) and the
-            # end of the leg axis (foot)
-            points[f"{leg}_foot_centre"] = centre
-            points[f"{leg}_contact"] = centre - R * n_vec
-            points[f"{leg}_foot"] = centre + R * e(q[lower])
-        elif flat:
-            # the foot link on a revolute ankle at the leg's end (the ankle on the sole
-            # line): sole direction u = (cos psi_f, sin psi_f) = e(psi_f + pi/2), psi_f the
-            # foot's absolute angle (= the leg's at the spring's rest with r = 0); heel and
-            # toe are material points of the foot; the foot's mass sits at the ankle
-            psi_f = q[names.index(f"{leg}_foot_angle")]
-            u = e(psi_f + sp.pi / 2)
-            for end, d in (("heel", -P[f"heel_{tags[i]}m"]), ("toe", P[f"toe_{tags[i]}m"])):
-                pos = centre + d * u
-                feet.append((pos, pos.jacobian(sp.Matrix(q))))
-                points[f"{leg}_{end}"] = pos
-            points[f"{leg}_foot"] = centre
-            points[f"{leg}_ankle"] = centre
-            bodies.append((P["m_foot"], {q[upper]: L}, P["I_foot"], psi_f))
-        else:
-            feet.append((centre, Jc))
-            points[f"{leg}_foot"] = centre
-        if knee:
-            points[f"{leg}_knee"] = hip + lt * e(q[upper])
-    return bodies, feet, points
+    return hip + sum((v * leg_unit(a) for a, v in lin.items()), sp.zeros(2, 1))
 
 
-def _torso(s: _Symbols, bodies: list, points: dict):
-    """Append the torso's bodies and points; return the torso's angle (None without one).
-
-    The upper body on the bisecting hip mechanism is eliminated as in the rigid view (its
-    angle from the upward vertical is the mean of the leg angles; both legs are free here,
-    the mechanism couples them); a hinged torso (five-link biped) has its own coordinate
-    ``torso_angle``; a point ``d`` up its axis is at ``hip - d e(t)``."""
-    import sympy as sp
-
-    from walkerlab.codegen.frames import leg_unit as e  # light
-
-    structure, q, P, hip_links = s.structure, s.q, s.P, s.hip_links
-    hip = points["hip"]
-    psi_t = (hip_links[0] + hip_links[1]) / 2 if structure.torso else None
-    if structure.hinged_torso:
-        psi_t = q[s.names.index("torso_angle")]
-    for b in structure.torso:
-        lin = {psi_t: -P[f"d_torso_{b.name}"]}
-        if b.off_axis:
-            lin[psi_t + sp.pi / 2] = P[f"e_torso_{b.name}"]
-        inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
-        bodies.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t))
-        points[f"torso_{b.name}"] = hip + sum((v * e(a) for a, v in lin.items()),
-                                              sp.zeros(2, 1))
-    return psi_t
-
-
-def _mass_and_potential(s: _Symbols, bodies: list):
+def _mass_and_potential(q, dq, g, bodies: list):
     """The mass matrix ``M`` (nq, nq) (``factor_terms`` applied) and the gravitational
-    potential ``V`` of ``bodies`` (:func:`_legs`)."""
+    potential ``V`` of ``bodies`` ``(mass, {angle: length}, inertia about z, spin)`` (the
+    spin ``omega_z``, linear in ``dq``): ``T = sum m |v|^2 / 2 + I omega_z^2 / 2``, each
+    velocity ``(dhip_x, dhip_y) + sum length a' (cos a, sin a)``."""
     import sympy as sp
 
-    q, g = s.q, s.P["g"]
     nq = len(q)
     M = sp.zeros(nq, nq)
     V = sp.Integer(0)
-    for mass, lin, inertia, link in bodies:
+    for mass, lin, inertia, spin in bodies:
         M[0, 0] += mass
         M[1, 1] += mass
         # d position / d q_k = sum over angles a of length * da/dq_k * (cos a, sin a)
@@ -281,48 +205,90 @@ def _mass_and_potential(s: _Symbols, bodies: list):
                 for a, ca in terms[k]:
                     for b_, cb in terms[j]:
                         M[k, j] += mass * ca * cb * sp.cos(a - b_)
-        if link is not None and inertia != 0:
-            w = sp.Matrix([[sp.diff(link, v) for v in q]])
+        if inertia != 0:
+            w = sp.Matrix([[sp.diff(spin, v) for v in dq]])
             M += inertia * w.T * w
         y = q[1] - sum((lk * sp.cos(a) for a, lk in lin.items()), sp.Integer(0))
         V += mass * g * y
     for k in range(2, nq):
         M[k, 0], M[k, 1] = M[0, k], M[1, k]
-    M = M.applyfunc(sp.factor_terms)
-    return M, V
+    return M.applyfunc(sp.factor_terms), V
 
 
-def _springs(s: _Symbols, V, psi_t):
-    """Add the torsional spring-dampers to ``V``; return it and the damping matrix (the
-    damper's ``-c J^T J dq`` joins the bias).
-
-    Roles of the rigid view's first step (swing = leg1, stance = leg2; a kneed leg's spring
-    acts on its thigh): ``V_s = k (delta - r)^2 / 2``; a knee spring on ``shank - thigh``;
-    flat feet's ankle springs on ``delta = foot angle - leg angle`` (toe up > 0)."""
+def _feet(structure: Structure, kin, rename: dict, q, P: dict) -> tuple[list, dict]:
+    """The contact points ``(position (2, 1), Jacobian (2, nq))`` of the feet and the named
+    points, in world axes, of a planar floating tree's kinematics (module docstring: an
+    arc's lowest point with its material point's Jacobian, a flat foot's heel and toe)."""
     import sympy as sp
 
-    structure, q, P, names, tags = s.structure, s.q, s.P, s.names, s.tags
-    hip_links, flat = s.hip_links, s.flat
-    nq = len(q)
-    angle = {"swing": hip_links[0], "stance": hip_links[1], "torso": psi_t}
-    damping = sp.zeros(nq, nq)
-    for i, (first, second) in enumerate(structure.springs):
-        delta = angle[second] - angle[first]
-        V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
-        Jd = sp.Matrix([[sp.diff(delta, v) for v in q]])
-        damping += P[f"c_s{i}"] * Jd.T * Jd
+    from walkerlab.codegen.frames import leg_unit, planar_slope_axes  # light
+
+    qv = sp.Matrix(q)
+    hip = sp.Matrix(q[:2])
+
+    def at(v):
+        return _at(_link_sums(v.xreplace(rename), hip), hip)
+
+    n_vec, t_vec = planar_slope_axes(P["gamma"])
+    R = P["R_foot"] if structure.foot == "arc" else 0
+    names = [str(c) for c in q]
+    feet, points = [], {"hip": hip}
+    for leg in LEGS:
+        lower = q[names.index(f"{leg}_shank_angle" if structure.knee else f"{leg}_angle")]
+        upper = f"{leg}_thigh" if structure.knee else leg
+        for b in structure.bodies:
+            link = f"{leg}_shank" if structure.knee and b.link == "shank" else upper
+            points[f"{leg}_{b.name}"] = at(kin.coms[f"{link}_{b.name}"])
+        end = at(kin.contacts[f"{leg}_foot"])   # a round foot's centre, a flat foot's ankle
+        if structure.foot == "arc":
+            sel = sp.Matrix([[1 if k == lower else 0 for k in q]])
+            feet.append((end - R * n_vec, end.jacobian(qv) + R * t_vec * sel))
+            # named as the rigid model's points: the arc's lowest point (contact) and the
+            # end of the leg axis (foot)
+            points[f"{leg}_foot_centre"] = end
+            points[f"{leg}_contact"] = end - R * n_vec
+            points[f"{leg}_foot"] = end + R * leg_unit(lower)
+        elif structure.foot == "flat":
+            for tip in ("heel", "toe"):
+                pos = at(kin.contacts[f"{leg}_{tip}"])
+                feet.append((pos, pos.jacobian(qv)))
+                points[f"{leg}_{tip}"] = pos
+            points[f"{leg}_foot"] = points[f"{leg}_ankle"] = end
+        else:
+            feet.append((end, end.jacobian(qv)))
+            points[f"{leg}_foot"] = end
+        if structure.knee:
+            points[f"{leg}_knee"] = at(kin.contacts[f"{leg}_knee"])
+    for b in structure.torso:
+        points[f"torso_{b.name}"] = at(kin.coms[f"torso_{b.name}"])
+    return feet, points
+
+
+def _springs(structure: Structure, q, P: dict, hips: list, psi_t):
+    """The torsional spring-dampers' potential ``sum k (delta - r)^2 / 2`` [J] (added to
+    gravity's) and damping matrix (the damper's ``-c J^T J dq`` joins the bias).
+
+    Roles of the rigid view's first step (swing = leg1, stance = leg2; a kneed leg's spring
+    acts on its thigh, ``hips``); a knee spring on ``shank - thigh``; flat feet's ankle
+    springs on ``delta = foot angle - leg angle`` (toe up > 0)."""
+    import sympy as sp
+
+    names = [str(c) for c in q]
+    tags = ("sw_", "st_") if structure.asymmetric else ("", "")
+    angle = {"swing": hips[0], "stance": hips[1], "torso": psi_t}
+    joints = [(angle[second] - angle[first], f"s{i}")
+              for i, (first, second) in enumerate(structure.springs)]
     if structure.knee_spring:  # a spring-damper at each knee on shank - thigh
-        for leg in LEGS:
-            knee_angle = q[names.index(f"{leg}_shank_angle")] - q[names.index(f"{leg}_thigh_angle")]
-            V += P["k_knee"] * (knee_angle - P["r_knee"]) ** 2 / 2
-            Jd = sp.Matrix([[sp.diff(knee_angle, v) for v in q]])
-            damping += P["c_knee"] * Jd.T * Jd
-    if flat:  # ankle spring-dampers, delta = foot angle - leg angle (toe up > 0)
-        for i, leg in enumerate(LEGS):
-            delta = q[names.index(f"{leg}_foot_angle")] - hip_links[i]
-            V += P[f"k_{tags[i]}ankle"] * (delta - P[f"r_{tags[i]}ankle"]) ** 2 / 2
-            Jd = sp.Matrix([[sp.diff(delta, v) for v in q]])
-            damping += P[f"c_{tags[i]}ankle"] * Jd.T * Jd
+        joints += [(q[names.index(f"{leg}_shank_angle")] - q[names.index(f"{leg}_thigh_angle")],
+                    "knee") for leg in LEGS]
+    if structure.foot == "flat":  # ankle spring-dampers, delta = foot - leg angle (toe up > 0)
+        joints += [(q[names.index(f"{leg}_foot_angle")] - hips[i], f"{tags[i]}ankle")
+                   for i, leg in enumerate(LEGS)]
+    V, damping = sp.Integer(0), sp.zeros(len(q), len(q))
+    for delta, tag in joints:
+        V += P[f"k_{tag}"] * (delta - P[f"r_{tag}"]) ** 2 / 2
+        Jd = sp.Matrix([[sp.diff(delta, v) for v in q]])
+        damping += P[f"c_{tag}"] * Jd.T * Jd
     return V, damping
 
 

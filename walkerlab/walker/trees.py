@@ -72,7 +72,8 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["Part", "Soles", "biped_tree", "compass_3d_tree", "legs_tree", "spoked_wheel_3d_tree"]
+__all__ = ["Part", "Soles", "biped_tree", "compass_3d_tree", "legs_tree", "spoked_wheel_3d_tree",
+           "welded"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 #: the parameters the 3D compass's tree reads, before the hip-roll law's gains (the order
@@ -248,13 +249,13 @@ def _stance_side(legs: tuple[Part, ...], R: str | None, planar: bool, up_leg: st
     bodies = _stance_foot(R, planar, foot_body) if soles is None else _stance_sole(
         soles, foot_body)
     if knee is None:
-        return bodies + _welded("stance_leg", legs, (0, up_leg, 0)), foot_body
-    bodies += _welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
+        return bodies + welded("stance_leg", legs, (0, up_leg, 0)), foot_body
+    bodies += welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
                       (0, up_leg, 0))
     bodies.append(Body("stance_leg", 0, ZERO_INERTIA, (0, 0, 0),
                        Joint("stance_knee", "revolute", "stance_shank",
                              (0, f"{up_leg} - {knee}", 0), (Z,), ("stance_knee",))))
-    return bodies + _welded("stance_leg", tuple(p for p in legs if p.link != "shank"),
+    return bodies + welded("stance_leg", tuple(p for p in legs if p.link != "shank"),
                             (0, knee, 0)), foot_body
 
 
@@ -282,7 +283,7 @@ def _torso(torso: tuple[Part, ...], hip_width) -> list:
     half = f"({hip_width}) / 2" if isinstance(hip_width, str) else hip_width / 2
     return [Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
                  Joint("torso_pitch", "revolute", "pelvis", (0, 0, half), (Z,),
-                       ("torso_pitch",))), *_welded("torso", torso, up=True)]
+                       ("torso_pitch",))), *welded("torso", torso, up=True)]
 
 
 #: the hips' joints (name, kind, axes, coordinates), stance then swing: in the plane the
@@ -293,7 +294,7 @@ _HIPS_3D = (("stance_hip", "universal", (Z, S), ("stance_hip_pitch", "stance_hip
             ("swing_hip", "universal", (S, Z), ("swing_hip_roll", "swing_hip_pitch")))
 
 
-def _welded(link: str, parts: tuple[Part, ...], origin: tuple = (0, 0, 0), *,
+def welded(link: str, parts: tuple[Part, ...], origin: tuple = (0, 0, 0), *,
             up: bool = False, below: str | None = None) -> list:
     """The bodies ``<link>_<part>`` welded to ``link`` at ``origin`` (its frame's hip):
     each part ``from_hip`` down the link (``up``: up it; ``below``: measured from the hip,
@@ -315,13 +316,13 @@ def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str |
     contact point (a round foot's centre)."""
     to_foot = "-L" if R is None else f"-({up_leg})"
     on_thigh = [p for p in swing if thigh is None or p.link != "shank"]
-    bodies, foot_link = _welded("swing_leg", tuple(on_thigh)), "swing_leg"
+    bodies, foot_link = welded("swing_leg", tuple(on_thigh)), "swing_leg"
     if thigh is not None:  # the swing knee, ``thigh`` below the hip; the shank's parts on it
         bodies.append(Body("swing_shank", 0, ZERO_INERTIA, (0, 0, 0),
                            Joint("swing_knee", "revolute", "swing_leg", (0, f"-{thigh}", 0),
                                  (Z,), ("swing_knee",),
                                  (("-pi", 0),) if knee_stop else ())))
-        bodies += _welded("swing_shank", tuple(p for p in swing if p.link == "shank"),
+        bodies += welded("swing_shank", tuple(p for p in swing if p.link == "shank"),
                           below=thigh)
         foot_link = "swing_shank"
         to_foot = f"-(L - {thigh})" if R is None else f"-({up_leg} - {thigh})"
@@ -584,3 +585,4 @@ def spoked_wheel_3d_tree(spokes: int | None = None) -> tuple[BodyTree, Coordinat
     return tree, CoordinateMap(("heading", "lean", "stance"),
                                (("wheel_heading", "heading"), ("wheel_lean", "lean"),
                                 ("wheel_spin", "stance + gamma")))
+

@@ -1,0 +1,119 @@
+"""A planar legged walker's floating (contact) view as a body tree
+(:func:`floating_planar_tree`): the pelvis free on the world's axes, the legs hanging from it,
+which :mod:`walkerlab.codegen.floating_equations` derives as the 3D walkers' floating trees
+(:func:`walkerlab.walker.tree.free_root` on :func:`walkerlab.walker.trees.legs_tree`) are.
+"""
+
+from __future__ import annotations
+
+from walkerlab.walker.description import ROLE_TAG
+from walkerlab.walker.tree import (
+    ZERO_INERTIA,
+    Body,
+    BodyTree,
+    ContactPoint,
+    CoordinateMap,
+    Joint,
+    Root,
+    diagonal,
+)
+from walkerlab.walker.trees import Part, S, Z, welded
+
+__all__ = ["floating_planar_tree"]
+
+
+def floating_planar_tree(structure, params: tuple[str, ...]
+                         ) -> tuple[BodyTree, CoordinateMap]:
+    """A planar legged walker's floating (contact) view as a tree: the pelvis on two slides
+    along the world's ``x`` (downhill) and ``y`` (up), each leg on its hip, ``leg1`` with the
+    rigid model's swing leg's numbers and ``leg2`` with its stance leg's (the first step's
+    roles), both with a knee on free knees or locking knees alike (a thigh and a shank, the
+    shank's parts on it), a flat foot on its ankle at the leg's end (its sole along the foot
+    frame's ``x``: the heel ``heel`` behind the ankle, the toe ``toe`` ahead; the foot's
+    mass ``m_foot`` at the ankle, ``I_foot`` about it), the upper body on the bisecting hip
+    (its pitch the mean of the legs') or hinged (its own coordinate).  The root is the world
+    (slope 0: the ground's slope is the contact model's), so each link's joint angle from
+    the pelvis is its absolute angle from the vertical.
+
+    Parameters
+    ----------
+    structure : walkerlab.walker.description.Structure
+        Planar, legged (no spokes).
+    params : tuple of str
+        The floating view's parameter names (the walker's, then a flat foot's ``m_foot,
+        I_foot`` when the walker's feet are massless).
+
+    Returns
+    -------
+    BodyTree, CoordinateMap
+        Bodies ``hip_x``, ``pelvis``, ``leg<i>`` (or ``leg<i>_thigh``, ``leg<i>_shank``),
+        ``leg<i>_foot`` (flat feet), ``torso``, each part ``<link>_<part>``; contacts
+        ``leg<i>_foot`` (the leg's end: a round foot's centre, a flat foot's ankle), flat
+        feet's ``leg<i>_heel``, ``leg<i>_toe``, a knee's ``leg<i>_knee``; coordinates
+        ``hip_x, hip_y``, every link's absolute angle (``leg<i>_angle`` or
+        ``leg<i>_thigh_angle, leg<i>_shank_angle``), the feet's ``leg<i>_foot_angle``, a
+        hinged torso's ``torso_angle``.
+    """
+    knee, flat, arc = structure.knee, structure.foot == "flat", structure.foot == "arc"
+    up_foot = "L - R_foot" if arc else "L"
+    bodies = [Body("hip_x", 0, ZERO_INERTIA, (0, 0, 0),
+                   Joint("hip_x", "prismatic", "world", (0, 0, 0), (S,), ("hip_x",))),
+              Body("pelvis", "M_hip" if structure.hip_mass else 0, ZERO_INERTIA, (0, 0, 0),
+                   Joint("hip_y", "prismatic", "hip_x", (0, 0, 0), ((0, 1, 0),), ("hip_y",)))]
+    contacts, angles, hips = [], [("hip_x", "hip_x"), ("hip_y", "hip_y")], []
+    feet_angles = []
+    for i, leg in enumerate(("leg1", "leg2")):
+        tag = (f"{ROLE_TAG['swing']}_", f"{ROLE_TAG['stance']}_")[i] if structure.asymmetric \
+            else ""
+        parts = [Part(b.name, f"m_{tag}{b.name}", f"d_{tag}{b.name}",
+                      f"I_{tag}{b.name}" if b.kind == "rod" else None,
+                      f"e_{tag}{b.name}" if b.off_axis else None, b.link)
+                 for b in structure.bodies]
+        upper = f"{leg}_thigh" if knee else leg
+        hips.append(f"{upper}_angle")
+        bodies.append(Body(upper, 0, ZERO_INERTIA, (0, 0, 0),
+                           Joint(f"{leg}_hip", "revolute", "pelvis", (0, 0, 0), (Z,),
+                                 (f"{leg}_hip",))))
+        angles.append((f"{leg}_hip", f"{upper}_angle"))
+        bodies += welded(upper, tuple(p for p in parts if not knee or p.link != "shank"))
+        end, to_end = upper, f"-({up_foot})"
+        if knee:
+            end, to_end = f"{leg}_shank", f"-({up_foot} - L_thigh)"
+            bodies.append(Body(end, 0, ZERO_INERTIA, (0, 0, 0),
+                               Joint(f"{leg}_knee", "revolute", upper, (0, "-L_thigh", 0),
+                                     (Z,), (f"{leg}_knee",))))
+            angles.append((f"{leg}_knee", f"{leg}_shank_angle - {leg}_thigh_angle"))
+            bodies += welded(end, tuple(p for p in parts if p.link == "shank"),
+                              below="L_thigh")
+            contacts.append(ContactPoint(f"{leg}_knee", end, (0, 0, 0)))
+        contacts.append(ContactPoint(f"{leg}_foot", end, (0, to_end, 0)))
+        if flat:
+            foot = f"{leg}_foot"
+            bodies.append(Body(foot, "m_foot", diagonal("I_foot", 0, "I_foot"), (0, 0, 0),
+                               Joint(f"{leg}_ankle", "revolute", end, (0, to_end, 0), (Z,),
+                                     (f"{leg}_ankle",))))
+            feet_angles.append((f"{leg}_ankle", f"{leg}_foot_angle - {hips[-1]}"))
+            contacts += [ContactPoint(f"{leg}_heel", foot, (f"-heel_{tag}m", 0, 0)),
+                         ContactPoint(f"{leg}_toe", foot, (f"toe_{tag}m", 0, 0))]
+    names = ("hip_x", "hip_y") + tuple(
+        (f"{leg}_thigh_angle", f"{leg}_shank_angle") if knee else (f"{leg}_angle",)
+        for leg in ("leg1", "leg2"))
+    names = ("hip_x", "hip_y") + tuple(n for grp in names[2:] for n in grp)
+    if flat:
+        names += ("leg1_foot_angle", "leg2_foot_angle")
+    angles += feet_angles
+    if structure.torso:
+        torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
+                           f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
+                           f"e_torso_{b.name}" if b.off_axis else None)
+                      for b in structure.torso)
+        bodies += [Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
+                        Joint("torso_pitch", "revolute", "pelvis", (0, 0, 0), (Z,),
+                              ("torso_pitch",))), *welded("torso", torso, up=True)]
+        pitch = "torso_angle" if structure.hinged_torso else f"({hips[0]} + {hips[1]}) / 2"
+        angles.append(("torso_pitch", pitch))
+        if structure.hinged_torso:
+            names += ("torso_angle",)
+    tree = BodyTree(params, Root("world", 0, "g", contacts[0].name), tuple(bodies),
+                    tuple(contacts))
+    return tree, CoordinateMap(names, tuple(angles))
