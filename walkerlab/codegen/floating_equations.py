@@ -271,7 +271,7 @@ def _springs(structure: Structure, q, P: dict, hips: list, psi_t):
     Roles of the rigid view's first step (swing = leg1, stance = leg2; a kneed leg's spring
     acts on its thigh, ``hips``); a knee spring on ``shank - thigh``; flat feet's ankle
     springs on ``delta = foot angle - leg angle`` (toe up > 0)."""
-    import sympy as sp
+    from walkerlab.codegen.lagrange import spring_dampers  # light: sympy on first use
 
     names = [str(c) for c in q]
     tags = ("sw_", "st_") if structure.asymmetric else ("", "")
@@ -284,12 +284,7 @@ def _springs(structure: Structure, q, P: dict, hips: list, psi_t):
     if structure.foot == "flat":  # ankle spring-dampers, delta = foot - leg angle (toe up > 0)
         joints += [(q[names.index(f"{leg}_foot_angle")] - hips[i], f"{tags[i]}ankle")
                    for i, leg in enumerate(LEGS)]
-    V, damping = sp.Integer(0), sp.zeros(len(q), len(q))
-    for delta, tag in joints:
-        V += P[f"k_{tag}"] * (delta - P[f"r_{tag}"]) ** 2 / 2
-        Jd = sp.Matrix([[sp.diff(delta, v) for v in q]])
-        damping += P[f"c_{tag}"] * Jd.T * Jd
-    return V, damping
+    return spring_dampers(joints, P, q)
 
 
 def _derive_spoked(structure: Structure) -> FloatingEquations:

@@ -83,6 +83,28 @@ class KneeLock(NamedTuple):
     heel_strike: tuple
 
 
+def spring_dampers(joints, P: dict, q) -> tuple[sp.Expr, sp.Matrix]:
+    """Torsional spring-dampers on joint angles: their potential ``sum k (delta - r)^2 / 2``
+    [J] and their dampers' matrix ``sum c J^T J`` (n, n) (``J = d delta / dq``; the damper's
+    generalised force ``-c J^T J dq``).
+
+    Parameters
+    ----------
+    joints : iterable of (Expr, str)
+        Each spring's angle ``delta`` (an expression of ``q``) [rad] and the tag of its
+        parameters ``k_<tag>`` [N m/rad], ``r_<tag>`` [rad], ``c_<tag>`` [N m s/rad].
+    P : dict
+        The parameters' symbols by name.
+    q : sequence of Symbol (n,)
+    """
+    V, D = sp.Integer(0), sp.zeros(len(q), len(q))
+    for delta, tag in joints:
+        V += P[f"k_{tag}"] * (delta - P[f"r_{tag}"]) ** 2 / 2
+        Jd = sp.Matrix([[sp.diff(delta, k) for k in q]])
+        D += P[f"c_{tag}"] * Jd.T * Jd
+    return V, D
+
+
 def knee_lock(M: sp.Matrix, C: sp.Matrix, G: sp.Matrix, Mi: sp.Matrix, B: sp.Matrix,
               thigh: int, shank: int) -> KneeLock:
     """The flow, knee strike and heel strike of a walker whose swing knee locks (McGeer 1990,

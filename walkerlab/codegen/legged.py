@@ -52,7 +52,7 @@ import sympy as sp
 
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
-from walkerlab.codegen.lagrange import knee_lock
+from walkerlab.codegen.lagrange import knee_lock, spring_dampers
 from walkerlab.codegen.seeded import seeded
 from walkerlab.codegen.tree_derive import (
     derive_tree,
@@ -169,22 +169,17 @@ def _pitches(structure, q, gamma) -> tuple:
 
 
 def link_springs(structure, q, P, pitches) -> tuple[sp.Expr, sp.Matrix]:
-    """The springs' potential ``sum k (delta - r)^2 / 2`` [J] and their dampers' matrix
-    ``sum c J^T J`` (n, n) (module docstring).  The swing knee's spring acts on ``shank -
-    thigh``; the stance knee is straight and locked, so its spring holds a constant energy
-    and no torque the lock does not take, and is left out."""
+    """The springs' potential and their dampers' matrix (:func:`walkerlab.codegen.lagrange.
+    spring_dampers`; module docstring).  The swing knee's spring acts on ``shank - thigh``;
+    the stance knee is straight and locked, so its spring holds a constant energy and no
+    torque the lock does not take, and is left out."""
     sw, sh, st, _ = pitches
     link_angle = {"swing": sw, "stance": st, "torso": (sw + st) / 2}
     joints = [(link_angle[b] - link_angle[a], f"s{i}")
               for i, (a, b) in enumerate(structure.springs)]
     if structure.knee_spring:
         joints.append((sh - sw, "knee"))
-    V, D = sp.Integer(0), sp.zeros(len(q), len(q))
-    for delta, tag in joints:
-        V += P[f"k_{tag}"] * (delta - P[f"r_{tag}"]) ** 2 / 2
-        Jd = sp.Matrix([[sp.diff(delta, k) for k in q]])
-        D += P[f"c_{tag}"] * Jd.T * Jd
-    return V, D
+    return spring_dampers(joints, P, q)
 
 
 def _link(body, role: str, knee: bool, free: bool) -> str:
