@@ -357,10 +357,10 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     state = model.initSystem()
     fs = model.getForceSet()
     contact = {g: fs.get(f"{g}_contact") for g in LEGS}
-    bodies = {g: model.getBodySet().get(g if model.getBodySet().contains(g) else f"{g}_shank")
-              for g in LEGS}
     feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
             for g in LEGS}
+    # the body that carries the foot sphere (a leg, a shank; a 3D kneed leg's leg<i>_shank)
+    bodies = {g: model.getBodySet().get(feet[g].getFrame().getName()) for g in LEGS}
     foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in LEGS}
     for g in LEGS:  # a flat foot: the foot point is the ankle, its sole's frame origin
         if model.getBodySet().contains(f"{g}_sole"):
