@@ -19,6 +19,7 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -34,15 +35,21 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def stabilised(tmp_path_factory):
-    """configs/hip_width_stabilised.yaml exported as OpenSim: (scene, Exported, the rigid
-    gait's state x (10,))."""
-    from walkerlab.analysis.contact.periodic import ideal_gait
-    from walkerlab.walker.plant import Plant
+    """configs/hip_width_stabilised.yaml's OpenSim model at the state of its scene's initial
+    guess (its fixed point to 1e-6: no gait search, the checks are of the file's
+    kinematics, not of the gait): (scene, the file's path, that state x (10,))."""
+    from walkerlab.export.opensim_3d import osim3d_gait, osim3d_text
+    from walkerlab.walker.description import state_names, walker_data
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    out = export_stage.write(scene, tmp_path_factory.mktemp("osim3d"), "osim")
-    x = np.asarray(ideal_gait(scene, plant=Plant.from_scene(scene)).x, float)
-    return scene, out, x
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    g = scene.fixedpoint.initial_guess
+    x = np.array([getattr(g, f"{n}_rad" if n.endswith("_angle") else f"{n}_rad_per_s")
+                  for n in state_names(data.structure.roles)], float)
+    ideal = SimpleNamespace(x=x, period_s=0.703242, step_lengths_m=())
+    path = tmp_path_factory.mktemp("osim3d") / "walker.osim"
+    path.write_text(osim3d_text(data, osim3d_gait(scene, data, ideal), "stabilised"))
+    return scene, path, x
 
 
 def _bodies(path) -> dict:
@@ -63,9 +70,9 @@ def test_the_3d_osim_carries_the_walkers_masses_and_hips(stabilised):
     all (the walker description's total)."""
     from walkerlab.walker.description import walker_data
 
-    scene, out, _ = stabilised
+    scene, path, _ = stabilised
     w = scene.walker
-    bodies = _bodies(out.path)
+    bodies = _bodies(path)
     assert set(bodies) == {"pelvis", "leg1", "leg2"}
     total = sum(m for m, _, _ in bodies.values())
     assert total == pytest.approx(walker_data(w, scene.slope.phi_rad).total_mass_kg, rel=1e-12)
@@ -77,7 +84,7 @@ def test_the_3d_osim_carries_the_walkers_masses_and_hips(stabilised):
         assert m == w.leg_mass_kg
         assert com == pytest.approx([0.0, -(w.leg_length_m - w.leg_mass_from_foot_m), 0.0],
                                     abs=1e-12)
-    root = ET.fromstring(Path(out.path).read_text().replace("::", "__"))
+    root = ET.fromstring(Path(path).read_text().replace("::", "__"))
     hips = {f.get("name"): np.array(f.findtext("translation").split(), float)
             for f in root.iter("PhysicalOffsetFrame") if "_parent_at_" in f.get("name")}
     assert hips["leg1_parent_at_leg1_joint"] == pytest.approx([0, 0, w.hip_width_m / 2])
@@ -125,10 +132,10 @@ def test_opensim_loads_the_3d_osim_with_the_trees_bodies_at_the_rigid_gait(stabi
     from walkerlab.export.opensim_tree import osim_axis, osim_inertia
     from walkerlab.walker.description import walker_data
 
-    scene, out, x = stabilised
+    scene, path, x = stabilised
     data = walker_data(scene.walker, scene.slope.phi_rad)
     L, r = scene.walker.leg_length_m, scene.walker.leg_length_m / 1000
-    got = _opensim(out.path, [["hip", "pelvis", 0.0], ["leg1_foot", "leg1", -L],
+    got = _opensim(path, [["hip", "pelvis", 0.0], ["leg1_foot", "leg1", -L],
                               ["leg2_foot", "leg2", -L]])
     assert got["total"] == pytest.approx(data.total_mass_kg, rel=1e-12)
     root, _ = osim3d_bodies(data)

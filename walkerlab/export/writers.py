@@ -17,8 +17,10 @@ per format: the URDF's :func:`walkerlab.export.urdf.legs_urdf_text`, the MJCF's
 :func:`walkerlab.export.mjcf_document.walker_mjcf_text` (of the record
 :func:`walkerlab.export.multibody.planar_legs_mjcf` or
 :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf` makes).  The
-Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
-(:mod:`walkerlab.export.opensim`) write a tree of leg links in the plane; the Adams dataset
+OpenSim writer is one object over the tree too (:data:`walkerlab.export.opensim_writer.OSIM`):
+a tree of leg links in the plane (:mod:`walkerlab.export.opensim`) or the 3D legs from their
+export bodies (:mod:`walkerlab.export.opensim_3d`).  The Adams dataset
+(:mod:`walkerlab.export.adams`) writes a tree of leg links in the plane and
 also the 3D legs from their export bodies (:mod:`walkerlab.export.adams_3d`: straight or
 kneed, round feet, hip-roll joints, the hip torque and push-off) and a spoked wheel, planar
 or 3D, from its tree's one body and contact points (:mod:`walkerlab.export.adams_wheel`).
