@@ -242,13 +242,18 @@ class _HipRoll:
                          for b in self.bodies])
         return phi, dphi
 
-    def control(self, state, stance: int) -> None:
-        """Set the roll motors' override actuation for the coming window [N m]."""
+    def torques(self, state, stance: int) -> dict:
+        """The law's torques on the legs' rolls (0: leg1) [N m] in ``state`` (realised to
+        its velocities)."""
         st, sw = stance, 1 - stance
         phi, dphi = self.rolls(state)
         ref = self.g_l * phi[1 + st] + self.g_r * dphi[1 + st]
-        tau = {st: self.k_p * phi[0] + self.c_p * dphi[0],
-               sw: -self.k_s * (phi[1 + sw] - ref) - self.c_s * (dphi[1 + sw] - dphi[0])}
+        return {st: self.k_p * phi[0] + self.c_p * dphi[0],
+                sw: -self.k_s * (phi[1 + sw] - ref) - self.c_s * (dphi[1 + sw] - dphi[0])}
+
+    def control(self, state, tau: dict) -> None:
+        """Set the roll motors' override actuation ``tau`` (:meth:`torques`) for the coming
+        window [N m] (an override drops the state's stage: read it first)."""
         for i, m in enumerate(self.motor):
             m.setOverrideActuation(state, float(tau[i]))
             m.overrideActuation(state, True)
@@ -441,10 +446,12 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
             pushing, changed = None, True
         if drive is not None or roll is not None:  # the laws' torques, held over the window
             model.realizeVelocity(state)
+            # read before any override is set (an override drops the state's stage)
+            tau = None if roll is None else roll.torques(state, LEGS.index(stance))
         if drive is not None:
             drive.control(state, LEGS.index(stance), t - t_step)
         if roll is not None:  # after the drive: the roll motors are the law's
-            roll.control(state, LEGS.index(stance))
+            roll.control(state, tau)
         if changed or restart or drive is not None or roll is not None:
             manager = osim.Manager(model)
             manager.setIntegratorAccuracy(accuracy)
