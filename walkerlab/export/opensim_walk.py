@@ -172,8 +172,10 @@ class _Drive:
         cs = model.getCoordinateSet()
         self.coord = {c: cs.get(c) for c in coords}
         fs = model.getForceSet()
+        used = {c for per_stance in self.gf for g in per_stance for c in g}
+        # the laws' motors only (a 3D walker's roll motors are the hip-roll law's)
         self.motor = {c: osim.CoordinateActuator.safeDownCast(fs.get(f"{c}_motor"))
-                      for c in coords if fs.contains(f"{c}_motor")}
+                      for c in coords if fs.contains(f"{c}_motor") and c in used}
         self.bodies, self.foot_loc = bodies, foot_loc
         self.hip = (cs.get(hip[0]), cs.get(hip[1]))
         # a walker in 3D (its pelvis on pelvis_x, ...): the rigid 3D model's phase, the
