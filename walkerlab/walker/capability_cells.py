@@ -15,7 +15,8 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
-           "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "SEVERAL_FOOTHOLDS",
+           "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D",
+           "SEVERAL_FOOTHOLDS",
            "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -106,6 +107,12 @@ ROUND_FEET_OPTIMIZE_3D = ("the collocation's heel strike, push-off and ground re
                           "the stance foot's extended impact system, which a 3D walker's "
                           "disc foot (its rolling contact) does not have in its equations: "
                           "optimise point feet (drop walker.foot_radius_m)")
+#: why the OpenSim export refuses a 3D walker's disc feet
+ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) have no disc: "
+                      "a disc foot written as a sphere of its radius R touches the ground "
+                      "R sin(lean) across the disc's rim point once the leg's plane leans, so "
+                      "it rolls sideways where the rigid disc cannot; export the disc feet "
+                      "as MJCF (--format mjcf) or an Adams dataset")
 #: why the OpenSim export refuses the 3D spoked wheel
 EXPORT_3D = ("the OpenSim export writes legs (a tree of leg links, or the 3D legs' "
              "pelvis and legs); a spoked wheel (one rigid body) is exported as urdf or mjcf")
@@ -309,6 +316,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # impact system (walkerlab.codegen.legged.extended_impact), which the derivation
         # gives point feet only
         ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
+        ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
@@ -408,6 +416,7 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
 CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
+              ("locking_knees_3d", "osim"): KNEE_LATCH_OSIM,
               ("locking_knees_3d", "contact"): KNEED_3D_FIRST_STRIDE,
               ("locking_knees_3d", "mjcf"): KNEED_3D_FIRST_STRIDE}
 
