@@ -37,13 +37,15 @@ surface one point-foot radius below the top at the patch's edge; on stairs no la
 leg's foot only (one ``HuntCrossleyForce`` per leg, the scene's IMPACT law through
 :func:`~walkerlab.export.opensim_contact.hunt_crossley`).  A foot is a ``ContactSphere``
 ``leg<i>_foot`` of radius ``r = L / 1000`` whose centre is ``L - r`` down the leg (the
-MJCF's).  Round feet: the disc of radius ``R`` in the leg's rolled sagittal plane is a
-sphere of radius ``R`` at the disc's centre.  The two touch the ground at the same point
-while the leg's plane is upright; with a lean ``phi`` the disc's rim point lies in its
-plane and the sphere's lowest point ``R sin(phi)`` across it (and ``R (1 - cos phi)``
-lower): OpenSim's contact geometries (sphere, half-space, mesh) have no disc, so the file
-holds the rigid disc exactly only on an upright gait (configs/round_feet_3d.yaml, zero
-hip width).
+MJCF's).  Round feet are refused (the capability table's cell,
+:data:`walkerlab.walker.capability_cells.ROUND_FEET_OSIM_3D`): OpenSim's contact geometries
+(sphere, half-space, mesh) have no disc, and the disc of radius ``R`` in the leg's rolled
+sagittal plane written as a sphere of radius ``R`` at its centre touches the ground where
+the disc does only while the leg's plane is upright; with a lean ``phi`` the sphere's lowest
+point lies ``R sin(phi)`` across the disc's rim point (and ``R (1 - cos phi)`` lower), a
+lateral rolling the rigid disc does not have.  The writer below still writes a round foot
+as that sphere (what ``legs3d_numbers`` gives, ``r = R``), for a user who lifts the
+refusal on an upright gait.
 
 Stepping rules (OpenSim has no contact- or event-switched force; walkerlab's loop,
 :mod:`walkerlab.export.opensim_walk`, runs them between Manager windows): the hip-roll law
