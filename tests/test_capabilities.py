@@ -421,8 +421,8 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
     from walkerlab.walker.kinds import table_rows
     from walkerlab.walker.plant import Plant
 
-    # the kinds whose OpenSim model is written with knee stops (the kneed walker in 3D has
-    # them as a part, but its export is refused)
+    # the kinds whose OpenSim model is written with knee stops (the planar kneed walker's
+    # and, from its body tree, the kneed walker in 3D's)
     def knee_stops(kind):  # the export's part, read from the kind's walker's body tree
         from walkerlab.walker.walker_trees import walker_tree
 
@@ -431,7 +431,7 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
 
     latched = {k for k, kind in KINDS.items() if kind.supports("walk", "osim")
                and knee_stops(kind)}
-    assert latched == {"locking_knees"}
+    assert latched == {"locking_knees", "locking_knees_3d"}
     for row in table_rows():
         if row["supported"] and row["view"] == "osim":
             has = row["kind"] in latched

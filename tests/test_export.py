@@ -496,7 +496,7 @@ def test_export_reads_the_gait_of_an_up_to_date_fixedpoint_artifact(tmp_path, mo
 def test_a_format_is_one_writer_in_the_registry(tmp_path, monkeypatch):
     """A writer added to :data:`walkerlab.export.writers.WRITERS` alone is a format of
     ``export``: its file written where the registry says, in its capability table's column
-    (a 3D walker refused in that column's words), with what the writer says it leaves
+    (a 3D spoked wheel refused in that column's words), with what the writer says it leaves
     out."""
     from walkerlab.export import writers
     from walkerlab.walker.kinds import KINDS
@@ -510,10 +510,11 @@ def test_a_format_is_one_writer_in_the_registry(tmp_path, monkeypatch):
     assert out.path == tmp_path / "paper" / "walker.txt"
     assert out.path.read_text() == "paper straight_legs"
     assert (out.left_out, out.step_period_s) == (("a: b",), 1.5)
-    with pytest.raises(ValueError) as exc:  # the osim column refuses the 3D walker
-        export_stage.write(load_scene(ROOT / "configs" / "paper_3d.yaml"), tmp_path, "txt")
-    assert str(exc.value) == ("walker.space: 3d: "
-                              + KINDS["straight_legs_3d"].cell("walk", "osim"))
+    with pytest.raises(ValueError) as exc:  # the osim column refuses the 3D wheel
+        export_stage.write(load_scene(ROOT / "configs" / "rimless_wheel_3d.yaml"), tmp_path,
+                           "txt")
+    kind = KINDS["rolling_polygon_3d"]
+    assert str(exc.value) == f"{kind.field}: " + kind.cell("walk", "osim")
 
 
 def test_mjcf_options_are_refused_for_either_spoked_wheel_in_one_line(tmp_path):

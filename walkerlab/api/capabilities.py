@@ -549,7 +549,7 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             early = FIRST_STEPS.get((kind, feature))  # an unstable gait's first steps
-            run = (first_steps(view, early) if early and view in ("contact", "mjcf")
+            run = (first_steps(view, early) if early and view in ("contact", "mjcf", "osim")
                    else _VIEWS[view])
             value, detail, *extra = run(scene, d, Path(runs_root))
     except Exception as exc:  # noqa: BLE001 - a cell that fails is evidence, not a crash

@@ -1,13 +1,14 @@
-"""The contact and MJCF cells of a reference case whose passive gait is unstable
+"""The contact, MJCF and OpenSim cells of a reference case whose passive gait is unstable
 (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`: the 3D kneed walker, whose lateral
 mode grows x40 a stride and which no foot-placement law stabilises in its rigid model): a
 walk started a little off the rigid gait leaves it within a few steps, as the rigid walker
 itself would, so the cell holds the walk's first steps, from the rigid gait's heel strike
 (the contact run's and the MJCF keyframe's start, ``t = 0``), to the rigid gait's: the mean
 of their step periods against the rigid gait's step period (relative; the cell's tolerance,
-3 %), each step's deviation listed.  The walks are ``walkerlab contact-sim`` and the
-exported MJCF walked in MuJoCo (:func:`walkerlab.export.mujoco_walk.walk`), each for as long
-as it walks.
+3 %), each step's deviation listed.  The walks are ``walkerlab contact-sim``, the
+exported MJCF walked in MuJoCo (:func:`walkerlab.export.mujoco_walk.walk`) and the OpenSim
+model walked by OpenSim (:func:`walkerlab.export.opensim_walk.walk`), each for as long as
+it walks.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ __all__ = ["first_steps", "quantity"]
 
 def quantity(view: str, steps: int) -> str:
     """The cell's quantity in words for ``view`` ("contact" or "mjcf") over ``steps``."""
-    walk = ("contact-sim" if view == "contact" else "the MJCF walked in MuJoCo")
+    walk = {"contact": "contact-sim", "mjcf": "the MJCF walked in MuJoCo",
+            "osim": "the OpenSim model walked by OpenSim"}[view]
     return (f"{walk}: the mean step period of its first {steps} steps from the rigid gait's "
             "heel strike against the rigid gait's (its passive gait is laterally unstable, "
             "x40 a stride: the walk leaves it within a few steps, as the rigid walk does)")
@@ -44,7 +46,7 @@ def _verdict(times, period: float, steps: int, what: str, end: str) -> tuple[flo
 
 
 def first_steps(view: str, steps: int):
-    """The measuring function of ``view`` ("contact", "mjcf") over the first ``steps`` steps
+    """The measuring function of ``view`` ("contact", "mjcf", "osim") over the first ``steps`` steps
     (module docstring), called as the views' of :mod:`walkerlab.api.capabilities`:
     ``(scene, d, runs) -> (value, detail, extra)`` (``extra``: the quantity)."""
     def contact(scene, d, runs: Path):
@@ -75,4 +77,17 @@ def first_steps(view: str, steps: int):
         return (*_verdict(run.times_s, period, steps, "walked in MuJoCo", end),
                 {"quantity": quantity(view, steps)})
 
-    return {"contact": contact, "mjcf": mjcf}[view]
+    def osim(scene, d, runs: Path):
+        from walkerlab.export.opensim_walk import walk  # light: opensim, in its process
+        from walkerlab.stages import export  # light
+
+        out = export.write(scene, runs, "osim")
+        period = float(out.step_period_s)
+        run = walk(out.path, (steps + 1.3) * period)
+        end = (f" (then fell at {run.t_end_s:.3f} s)" if run.fell else "")
+        if not run.alternating:
+            return math.nan, f"OpenSim's heel strikes do not alternate: {run.legs}", {}
+        return (*_verdict(run.times_s, period, steps, "walked in OpenSim", end),
+                {"quantity": quantity(view, steps)})
+
+    return {"contact": contact, "mjcf": mjcf, "osim": osim}[view]

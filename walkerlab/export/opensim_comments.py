@@ -11,7 +11,7 @@ from walkerlab.export.mjcf_scene import actuation_text
 from walkerlab.export.opensim_contact import latch_foot_offset
 from walkerlab.export.text import comment, num
 
-__all__ = ["header_comments"]
+__all__ = ["header_comments", "knee_comment"]
 
 
 def header_comments(mb, gait, name: str, version: str, total: float, contact_note: str,
@@ -70,7 +70,7 @@ def header_comments(mb, gait, name: str, version: str, total: float, contact_not
     if gait.actuation is not None:
         out.append(comment(f"walkerlab_actuation: {actuation_text(gait.actuation)}"))
     if knee_stops:
-        out.append(_knee_comment(gait, r_foot))
+        out.append(knee_comment(gait, r_foot))
     return out
 
 
@@ -93,8 +93,10 @@ def _flat_feet_comment(feet) -> str:
         "its toe (the rigid gait's double support as it begins).")
 
 
-def _knee_comment(gait, r_foot: float) -> str:
-    """The knee stop's and latch's comment (``gait.knee``; foot sphere ``r_foot`` [m])."""
+def knee_comment(gait, r_foot: float) -> str:
+    """The knee stop's and latch's comment (``gait.knee``, ``gait.ground_offset_m``; foot
+    sphere ``r_foot`` [m]): the planar and the 3D models' (:mod:`walkerlab.export.
+    opensim_3d`)."""
     return comment(
         "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
         f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "

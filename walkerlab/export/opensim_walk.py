@@ -57,6 +57,7 @@ import walkerlab
 from walkerlab.config.actuation import Actuation
 from walkerlab.export.joint_torques import (
     law_generalized_forces,
+    link_angle,
     stance_phase,
     torque_generalized_forces,
 )
@@ -111,6 +112,8 @@ def _header(text: str) -> dict:
         out["pulse"] = float(m.group(1))
     if m := re.search(r"walkerlab_actuation: (\{.*\}) -->", text):
         out["actuation"] = json.loads(m.group(1))
+    if m := re.search(r"walkerlab_hip_roll: (\{.*\}) -->", text):
+        out["hip_roll"] = json.loads(m.group(1))
     return out
 
 
@@ -160,7 +163,7 @@ class _Drive:
     forces they make (:func:`walkerlab.export.joint_torques.torque_generalized_forces`) as the
     actuators' override actuation."""
 
-    def __init__(self, model, spec, coords, bodies, foot_loc):
+    def __init__(self, model, spec, coords, bodies, foot_loc, hip=("hip_x", "hip_y")):
         import opensim as osim
 
         self.laws = TorqueLaws(spec.torques)
@@ -169,13 +172,24 @@ class _Drive:
         cs = model.getCoordinateSet()
         self.coord = {c: cs.get(c) for c in coords}
         fs = model.getForceSet()
+        used = {c for per_stance in self.gf for g in per_stance for c in g}
+        # the laws' motors only (a 3D walker's roll motors are the hip-roll law's)
         self.motor = {c: osim.CoordinateActuator.safeDownCast(fs.get(f"{c}_motor"))
-                      for c in coords if fs.contains(f"{c}_motor")}
+                      for c in coords if fs.contains(f"{c}_motor") and c in used}
         self.bodies, self.foot_loc = bodies, foot_loc
-        self.hip = (cs.get("hip_x"), cs.get("hip_y"))
+        self.hip = (cs.get(hip[0]), cs.get(hip[1]))
+        # a walker in 3D (its pelvis on pelvis_x, ...): the rigid 3D model's phase, the
+        # stance leg's pitch (the MJCF's loop, walkerlab.export.mujoco_walk.PoweredLoop)
+        self.pitch = (None if hip[0] == "hip_x" else
+                      [link_angle("stance", st, coords) for st in (0, 1)])
 
     def phase(self, state, stance: int) -> tuple[float, float]:
-        """The phase variable [rad] and its rate [rad/s] (class docstring)."""
+        """The phase variable [rad] and its rate [rad/s] (class docstring; a walker in 3D:
+        its stance leg's pitch)."""
+        if self.pitch is not None:
+            g = self.pitch[stance]
+            return (sum(k * self.coord[c].getValue(state) for c, k in g.items()),
+                    sum(k * self.coord[c].getSpeedValue(state) for c, k in g.items()))
         g = LEGS[stance]
         b, loc = self.bodies[g], self.foot_loc[g]
         return stance_phase([c.getValue(state) for c in self.hip],
@@ -192,6 +206,58 @@ class _Drive:
                                      self.phase(state, stance), since_s)
         for c, m in self.motor.items():
             m.setOverrideActuation(state, out.get(c, 0.0))
+            m.overrideActuation(state, True)
+
+
+class _HipRoll:
+    """The hip-roll law of a 3D export (comment ``walkerlab_hip_roll``: the scene's
+    :class:`walkerlab.config.walker.HipRollLaw`) on its ``leg<i>_roll_motor`` actuators, the
+    MJCF loop's law (:class:`walkerlab.export.mujoco_walk.HipRollLoop`) on OpenSim's state:
+    each body's (``pelvis``, ``leg1``, ``leg2``) roll about the fall line ``s`` read from its
+    pitch axis ``a`` (the body's ``z``): ``phi = atan2(-a . n, a . z)`` (``n`` the slope's
+    normal), its rate ``omega . s``; ``tau_st = k_p phi_p + c_p dphi_p`` on the stance
+    leg's roll, ``tau_sw = -k_s (phi_w - g_l phi - g_r dphi) - c_s (dphi_w - dphi_p)`` on
+    the swing leg's, held over the window."""
+
+    def __init__(self, model, law: dict, phi: float):
+        import opensim as osim
+
+        self.osim = osim
+        self.k_p = law["pelvis_stiffness_n_m_per_rad"]
+        self.c_p = law["pelvis_damping_n_m_s_per_rad"]
+        self.k_s = law["swing_stiffness_n_m_per_rad"]
+        self.c_s = law["swing_damping_n_m_s_per_rad"]
+        self.g_l, self.g_r = law["lean_gain"], law["lean_rate_gain_s"]
+        self.s = np.array([math.cos(phi), -math.sin(phi), 0.0])
+        self.n = np.array([math.sin(phi), math.cos(phi), 0.0])
+        fs, bs = model.getForceSet(), model.getBodySet()
+        self.motor = [osim.CoordinateActuator.safeDownCast(fs.get(f"{g}_roll_motor"))
+                      for g in LEGS]
+        self.bodies = [bs.get(b) for b in ("pelvis", *LEGS)]
+
+    def rolls(self, state) -> tuple[np.ndarray, np.ndarray]:
+        """Rolls [rad] and their rates [rad/s] of the pelvis, leg1 and leg2 (3,), (3,)."""
+        z = self.osim.Vec3(0.0, 0.0, 1.0)
+        a = [b.expressVectorInGround(state, z).to_numpy() for b in self.bodies]
+        phi = np.array([math.atan2(-(v @ self.n), v[2]) for v in a])
+        dphi = np.array([b.getAngularVelocityInGround(state).to_numpy() @ self.s
+                         for b in self.bodies])
+        return phi, dphi
+
+    def torques(self, state, stance: int) -> dict:
+        """The law's torques on the legs' rolls (0: leg1) [N m] in ``state`` (realised to
+        its velocities)."""
+        st, sw = stance, 1 - stance
+        phi, dphi = self.rolls(state)
+        ref = self.g_l * phi[1 + st] + self.g_r * dphi[1 + st]
+        return {st: self.k_p * phi[0] + self.c_p * dphi[0],
+                sw: -self.k_s * (phi[1 + sw] - ref) - self.c_s * (dphi[1 + sw] - dphi[0])}
+
+    def control(self, state, tau: dict) -> None:
+        """Set the roll motors' override actuation ``tau`` (:meth:`torques`) for the coming
+        window [N m] (an override drops the state's stage: read it first)."""
+        for i, m in enumerate(self.motor):
+            m.setOverrideActuation(state, float(tau[i]))
             m.overrideActuation(state, True)
 
 def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
@@ -298,10 +364,10 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     state = model.initSystem()
     fs = model.getForceSet()
     contact = {g: fs.get(f"{g}_contact") for g in LEGS}
-    bodies = {g: model.getBodySet().get(g if model.getBodySet().contains(g) else f"{g}_shank")
-              for g in LEGS}
     feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
             for g in LEGS}
+    # the body that carries the foot sphere (a leg, a shank; a 3D kneed leg's leg<i>_shank)
+    bodies = {g: model.getBodySet().get(feet[g].getFrame().getName()) for g in LEGS}
     foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in LEGS}
     for g in LEGS:  # a flat foot: the foot point is the ankle, its sole's frame origin
         if model.getBodySet().contains(f"{g}_sole"):
@@ -319,9 +385,13 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         push_law = spec.push_off
     coords = [model.getCoordinateSet().get(i).getName()
               for i in range(model.getCoordinateSet().getSize())]
-    drive = _Drive(model, spec, coords, bodies, foot_loc) if spec and spec.torques else None
-    hip_x = model.getCoordinateSet().get("hip_x")
-    hip_y = model.getCoordinateSet().get("hip_y")
+    # the hip: a planar walker's hip_x, hip_y; a 3D walker's pelvis (y up, as the plane's)
+    hip = ("hip_x", "hip_y") if "hip_x" in coords else ("pelvis_x", "pelvis_y")
+    drive = (_Drive(model, spec, coords, bodies, foot_loc, hip) if spec and spec.torques
+             else None)
+    roll = _HipRoll(model, info["hip_roll"], phi) if "hip_roll" in info else None
+    hip_x = model.getCoordinateSet().get(hip[0])
+    hip_y = model.getCoordinateSet().get(hip[1])
     mass = model.getTotalMass(state)
 
     def along(g, s):  # the foot point's position along the slope [m]
@@ -376,10 +446,15 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         if pushing is not None and t >= pulse_until - 1e-12:
             push[pushing].setAppliesForce(state, False)
             pushing, changed = None, True
-        if drive is not None:  # the laws' torques, held over the window
+        if drive is not None or roll is not None:  # the laws' torques, held over the window
             model.realizeVelocity(state)
+            # read before any override is set (an override drops the state's stage)
+            tau = None if roll is None else roll.torques(state, LEGS.index(stance))
+        if drive is not None:
             drive.control(state, LEGS.index(stance), t - t_step)
-        if changed or restart or drive is not None:
+        if roll is not None:  # after the drive: the roll motors are the law's
+            roll.control(state, tau)
+        if changed or restart or drive is not None or roll is not None:
             manager = osim.Manager(model)
             manager.setIntegratorAccuracy(accuracy)
             manager.initialize(state)

@@ -17,8 +17,10 @@ per format: the URDF's :func:`walkerlab.export.urdf.legs_urdf_text`, the MJCF's
 :func:`walkerlab.export.mjcf_document.walker_mjcf_text` (of the record
 :func:`walkerlab.export.multibody.planar_legs_mjcf` or
 :func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf` makes).  The
-Adams dataset (:mod:`walkerlab.export.adams`) and the OpenSim model
-(:mod:`walkerlab.export.opensim`) write a tree of leg links in the plane; the Adams dataset
+OpenSim writer is one object over the tree too (:data:`walkerlab.export.opensim_writer.OSIM`):
+a tree of leg links in the plane (:mod:`walkerlab.export.opensim`) or the 3D legs from their
+export bodies (:mod:`walkerlab.export.opensim_3d`).  The Adams dataset
+(:mod:`walkerlab.export.adams`) writes a tree of leg links in the plane and
 also the 3D legs from their export bodies (:mod:`walkerlab.export.adams_3d`: straight or
 kneed, round feet, hip-roll joints, the hip torque and push-off) and a spoked wheel, planar
 or 3D, from its tree's one body and contact points (:mod:`walkerlab.export.adams_wheel`).
@@ -32,11 +34,10 @@ from __future__ import annotations
 
 import math
 
-import walkerlab
 from walkerlab.config import Scene
 from walkerlab.export.adams import ADAMS_FILES
 from walkerlab.export.adams_writer import ADAMS
-from walkerlab.export.body_writers import MJCF, URDF, planar_legs_only
+from walkerlab.export.body_writers import MJCF, URDF
 from walkerlab.export.engine_walk import ENGINES, EngineWalk, not_walked, walk_export
 from walkerlab.export.jobs import (  # noqa: F401 (part of this API)
     Exported,
@@ -49,39 +50,16 @@ from walkerlab.export.jobs import (  # noqa: F401 (part of this API)
 )
 from walkerlab.export.mujoco_walk import virtual_constraint_feedback
 from walkerlab.export.multibody import FORMATS
-from walkerlab.export.opensim import (
-    OSIM_FILE,
-    check_osim_exportable,
-    osim_gait,
-    osim_omissions,
-    osim_text,
-)
-from walkerlab.export.scene import FORMAT_VIEWS, check_exportable
-from walkerlab.export.tree_links import tree_multibody
-
-
-def _osim(job: ExportJob, w: Writer) -> Written:
-    """``walker.osim``: the walker, its gait as the default state, its ground and contact."""
-    planar_legs_only(job, w)
-    scene, data = job.scene, job.data
-    mb = tree_multibody(data)  # its links: the body tree's
-    if job.walker_only:
-        raise ValueError("--walker-only: the OpenSim export carries the gait, ground and "
-                         "contact (its default state is the rigid gait); drop --walker-only")
-    check_osim_exportable(scene, mb)  # before the gait search
-    check_exportable(scene, job.kind, w.name, tree=job.tree)
-    ideal, gait = job.gait(lambda ideal: osim_gait(scene, mb, job.plant, ideal))
-    text = osim_text(mb, gait, job.name, walkerlab.__version__)
-    return Written((xml_file(job, w, text),), xml_lines(osim_omissions(mb, gait), scene),
-                   step_period(ideal))
-
+from walkerlab.export.opensim import OSIM_FILE
+from walkerlab.export.opensim_writer import OSIM
+from walkerlab.export.scene import FORMAT_VIEWS
 
 #: ``--format`` name -> its writer
 WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("urdf", FORMATS["urdf"], FORMAT_VIEWS["urdf"], URDF.write, ground=False),
     Writer("mjcf", FORMATS["mjcf"], FORMAT_VIEWS["mjcf"], MJCF.write),
     Writer("adm", ADAMS_FILES["adm"], FORMAT_VIEWS["adm"], ADAMS.write),
-    Writer("osim", OSIM_FILE, FORMAT_VIEWS["osim"], _osim),
+    Writer("osim", OSIM_FILE, FORMAT_VIEWS["osim"], OSIM.write),
 )}
 
 

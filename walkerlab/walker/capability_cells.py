@@ -15,7 +15,8 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
-           "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "SEVERAL_FOOTHOLDS",
+           "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D",
+           "SEVERAL_FOOTHOLDS",
            "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -79,7 +80,8 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "stairs and footholds of several heights keep one fall line")
 #: why the 3D straight legs' MJCF and Adams dataset refuse footholds of several heights
 #: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_footfalls`)
-FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF and Adams dataset lay its footfall patches a "
+FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model lay its "
+                       "footfall patches a "
                        "stride apart from the keyframe's trailing foot (its two steps mirror "
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
@@ -108,25 +110,24 @@ ROUND_FEET_OPTIMIZE_3D = ("the collocation's heel strike, push-off and ground re
                           "the stance foot's extended impact system, which a 3D walker's "
                           "disc foot (its rolling contact) does not have in its equations: "
                           "optimise point feet (drop walker.foot_radius_m)")
-#: why the OpenSim export refuses a 3D walker
-EXPORT_3D = ("this format carries planar walkers so far: a 3D walker is written as "
-             "URDF (--format urdf) or MJCF (--format mjcf)")
-#: why a kneed walker in 3D refuses the OpenSim export
-_KNEED_3D_VIEW = ("a kneed walker in 3D runs in the rigid and contact models (walkerlab "
-                  "fixedpoint, simulate, contact-sim) and is exported as MJCF, URDF and an "
-                  "Adams dataset (export --format mjcf, urdf, adams); the OpenSim export "
-                  "writes planar walkers only")
+#: why the OpenSim export refuses a 3D walker's disc feet
+ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) have no disc: "
+                      "a disc foot written as a sphere of its radius R touches the ground "
+                      "R sin(lean) across the disc's rim point once the leg's plane leans, so "
+                      "it rolls sideways where the rigid disc cannot; export the disc feet "
+                      "as MJCF (--format mjcf) or an Adams dataset")
+#: why the OpenSim export refuses the 3D spoked wheel
+EXPORT_3D = ("the OpenSim export writes legs (a tree of leg links, or the 3D legs' "
+             "pelvis and legs); a spoked wheel (one rigid body) is exported as urdf or mjcf")
 #: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
 #: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
 KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
                          "gait is laterally unstable (x40 a stride) and no hip-roll law "
                          "steadies a kneed walker in 3D, so a walk started a little off it "
                          "capsizes within a few steps, as the rigid walk would")
-#: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
-#: export
+#: what the views of the 3D kinds refuse: a ground other than a plane
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
-    ("walk", "osim"): EXPORT_3D,
 }
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
@@ -318,6 +319,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # impact system (walkerlab.codegen.legged.extended_impact), which the derivation
         # gives point feet only
         ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
+        ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
@@ -342,8 +344,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # rigid gait's footfalls (walkerlab.export.legs_3d_mjcf.legs3d_footfalls: the
         # trailing foot's height included), the gym's rigid view steps them as simulate
         **{(g, v): None for g in ("stairs", "footholds")
-           for v in ("rigid", "contact", "mjcf", "adams", "gym")},
-        **{("footholds", v): FOOTHOLDS_EXPORT_3D for v in ("mjcf", "adams")},
+           for v in ("rigid", "contact", "mjcf", "adams", "gym", "osim")},
+        **{("footholds", v): FOOTHOLDS_EXPORT_3D for v in ("mjcf", "adams", "osim")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
@@ -382,7 +384,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stop and latch; the Adams dataset: the 3D straight legs' with a knee revolute on
         # each leg, its stop and latch the planar kneed dataset's
         # (walkerlab.export.adams_3d_knees)
-        ("walk", "osim"): _KNEED_3D_VIEW,
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
         ("walk", "optimize"): ("a locking knee makes the collocation phased (knee free, "
                                "knee locked), and the 3D transcription takes straight legs "
@@ -399,6 +400,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # walkerlab.export.adams_wheel.adm_wheel_text)
         ("walk", "gym"): _WHEEL_GYM,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
+        ("walk", "osim"): EXPORT_3D,
     },
 }
 
@@ -417,6 +419,7 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
 CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
+              ("locking_knees_3d", "osim"): KNEE_LATCH_OSIM,
               ("locking_knees_3d", "contact"): KNEED_3D_FIRST_STRIDE,
               ("locking_knees_3d", "mjcf"): KNEED_3D_FIRST_STRIDE}
 
