@@ -415,7 +415,8 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
 ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk stays in its "
                          "sagittal plane: zero hip width and an upright start keep it "
                          "mirror-symmetric, its roll seeded at round-off and growing x11 a step "
-                         "(the rigid gait's lateral multiplier), 5e-4 rad by heel strike 10; "
+                         "(the rigid gait's lateral multiplier): by heel strike 10 5e-4 rad "
+                         "(configs/paper_3d.yaml), 2.5e-2 rad (configs/round_feet_3d.yaml); "
                          "started 1 mrad/s off upright (contact_sim.start_offset: "
                          "lean_rate_rad_per_s: 0.001) configs/paper_3d.yaml capsizes after 3 "
                          "heel strikes, as the rigid walk would")
