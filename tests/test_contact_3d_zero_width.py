@@ -58,6 +58,7 @@ def test_the_zero_width_walkers_contact_mass_matrix_is_regular_where_the_legs_pa
     assert ev[0] == pytest.approx(axial, rel=1e-9)
     view = object()  # a walker with hip width: its view returned untouched, not derived
     assert legs_axial_inertia(_data("hip_width").structure, view) is view
+    assert legs_axial_inertia(_data("paper").structure, view) is view  # planar
 
 
 def test_the_axial_inertia_leaves_an_upright_sagittal_motion_alone():

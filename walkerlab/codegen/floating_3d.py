@@ -186,9 +186,12 @@ def legs_axial_inertia(structure: Structure, eq: FloatingEquations) -> FloatingE
     from walkerlab.codegen.lagrange import bias  # light: sympy on first use
     from walkerlab.codegen.tree_derive import kinematics  # light: sympy on first use
 
-    if not structure.in_3d or structure.spokes or structure.hip_width:
+    if not structure.in_3d or structure.spokes:
         return eq
     rigid, coords = legs_tree(structure, floating=True)
+    swing_hip = next(b.joint for b in rigid.bodies if b.name == "swing_leg")
+    if any(c != 0 for c in swing_hip.origin_m):  # the hips apart (a hip width): no line
+        return eq
     tree, fcoords = free_root(rigid, coords, FREE_3D)
     kin = kinematics(tree, fcoords)
     rename = {**dict(zip(kin.q, eq.q)), **dict(zip(kin.dq, eq.dq))}

@@ -111,7 +111,8 @@ _HERE = Path(__file__).parent
 _SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
             _HERE / "assembly.py", _HERE / "powered_kernels.py", _HERE / "_kernels.py",
             _HERE.parent.parent / "codegen" / "torque_law.py",
-            _HERE.parent.parent / "codegen" / "contact_glue.py")
+            _HERE.parent.parent / "codegen" / "contact_glue.py",
+            _HERE.parent.parent / "codegen" / "floating_3d.py")  # legs_axial_inertia
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
