@@ -416,7 +416,7 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
 
     from walkerlab.config import load_scene
     from walkerlab.export.parts import tree_part
-    from walkerlab.walker.capability_cells import CELL_NOTES, KNEE_LATCH_OSIM
+    from walkerlab.walker.capability_cells import CELL_NOTES, FEATURE_NOTES, KNEE_LATCH_OSIM
     from walkerlab.walker.capability_tables import kind_grid, text
     from walkerlab.walker.kinds import table_rows
     from walkerlab.walker.plant import Plant
@@ -437,8 +437,10 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
             has = row["kind"] in latched
             assert (row["note"] == KNEE_LATCH_OSIM) == has, row
             assert (KNEE_LATCH_OSIM in row["detail"]) == has, row
-        elif row["supported"]:  # another note of the table's own (CELL_NOTES), or none
-            assert row["note"] == CELL_NOTES.get((row["kind"], row["view"]), ""), row
+        elif row["supported"]:  # another note of the table's own (a cell's, the kind's
+            # in the view: FEATURE_NOTES, CELL_NOTES), or none
+            assert row["note"] == (FEATURE_NOTES.get((row["kind"], row["feature"], row["view"]))
+                                   or CELL_NOTES.get((row["kind"], row["view"]), "")), row
     for kind in KINDS.values():
         g = kind_grid(kind)
         notes = [i + 1 for i, r in enumerate(g.reasons) if r == f"note: {KNEE_LATCH_OSIM}"]

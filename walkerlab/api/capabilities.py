@@ -557,7 +557,7 @@ def measure(kind: str, feature: str, view: str, runs_root: Path | str) -> Measur
                                 f"{' '.join(str(exc).split())}"[:300], [])
     extra = extra[0] if extra else {}  # what the view says it measured, where it varies
     ok = bool(math.isfinite(value) and abs(value) <= tol)
-    note = KINDS[kind].note(view)
+    note = KINDS[kind].note(view, feature)
     if note:  # what the cell rests on beyond the number (a kneed walker's OpenSim loop)
         detail = f"{detail}; {note}"
     return Measurement(kind, feature, view, case, extra.get("quantity", quantity),

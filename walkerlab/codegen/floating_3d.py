@@ -31,7 +31,13 @@ from walkerlab.walker.description import Structure
 from walkerlab.walker.tree import free_root
 from walkerlab.walker.trees import legs_tree, spoked_wheel_3d_tree
 
-__all__ = ["derive_legs_3d", "derive_wheel_3d", "wheel_tip_names"]
+__all__ = ["AXIAL_RADIUS_L", "derive_legs_3d", "derive_wheel_3d", "legs_axial_inertia",
+           "wheel_tip_names"]
+
+#: the radius of the solid rod, as a fraction of the leg length, whose axial moment of
+#: inertia each leg of a 3D walker of zero hip width carries in the contact view
+#: (:func:`legs_axial_inertia`): ``m (0.01 L)^2 / 2`` for a leg of mass ``m``
+AXIAL_RADIUS_L = 0.01
 
 
 def _free_flow(structure: Structure, rigid, coords, free: tuple):
@@ -137,6 +143,73 @@ def derive_legs_3d(structure: Structure) -> FloatingEquations:
                              stance_forces=stance_forces(structure, q, dq, kin.params,
                                                          ROLES_3D),
                              spins=spins)
+
+
+def legs_axial_inertia(structure: Structure, eq: FloatingEquations) -> FloatingEquations:
+    """The floating view ``eq`` of a 3D legged walker of zero hip width with each leg's
+    axial moment of inertia added, as the contact view integrates it: every leg link a solid
+    rod of radius :data:`AXIAL_RADIUS_L` ``L`` about its own axis (its frame's ``y``),
+    ``I_a = m r^2 / 2`` with ``m`` the mass welded to the link; any other walker's ``eq``
+    as it is.
+
+    Why: the rigid view's legs are slender (no inertia about their axes) and its stance foot
+    does not twist, so it has no heading; the contact view's floating base turns about the
+    slope's normal.  With zero hip width every mass lies on the legs' axes, and when the legs
+    pass each other (equal pitches) they lie on one line: the walker has no inertia about it,
+    the mass matrix is singular (its smallest eigenvalue goes as the square of the pitches'
+    difference: 1e-6 at 4 mrad for configs/round_feet_3d.yaml) and the twist's friction
+    drives a mode that no step size resolves: the integrator stalls at a leg crossing
+    (measured on configs/paper_3d.yaml and configs/round_feet_3d.yaml).  The added inertia
+    acts only through a leg's spin about its axis, which a walk upright in its sagittal
+    plane (no heading, no roll: the rigid gait's) never excites, so that walk and its
+    comparison with the rigid gait do not depend on it; it adds ``I_a sin^2(theta)``
+    (under 1e-5 of the walker's) to the roll inertia about the stance foot.
+
+    Parameters
+    ----------
+    structure : Structure
+        The walker (:func:`derive_legs_3d`'s).
+    eq : FloatingEquations
+        Its floating view (:func:`derive_legs_3d`).
+
+    Returns
+    -------
+    FloatingEquations
+        ``M + sum_i I_a J_i^T J_i`` with ``J_i`` (1, nq) the Jacobian of leg link ``i``'s
+        spin about its axis, the bias of that kinetic energy added to ``h``
+        (:func:`walkerlab.codegen.lagrange.bias`) and to ``kinetic``.
+    """
+    import dataclasses
+
+    import sympy as sp
+
+    from walkerlab.codegen.lagrange import bias  # light: sympy on first use
+    from walkerlab.codegen.tree_derive import kinematics  # light: sympy on first use
+
+    if not structure.in_3d or structure.spokes:
+        return eq
+    rigid, coords = legs_tree(structure, floating=True)
+    swing_hip = next(b.joint for b in rigid.bodies if b.name == "swing_leg")
+    if any(c != 0 for c in swing_hip.origin_m):  # the hips apart (a hip width): no line
+        return eq
+    tree, fcoords = free_root(rigid, coords, FREE_3D)
+    kin = kinematics(tree, fcoords)
+    rename = {**dict(zip(kin.q, eq.q)), **dict(zip(kin.dq, eq.dq))}
+    par = {str(p): p for p in kin.params}
+    links = ("swing_leg", "stance_leg") + (("swing_shank", "stance_shank")
+                                            if structure.knee else ())
+    dM = sp.zeros(len(eq.q), len(eq.q))
+    for link in links:
+        mass = sum((sp.sympify(b.mass_kg, locals=par) for b in tree.bodies
+                    if b.joint.parent == link and b.joint.kind == "fixed"), sp.Integer(0))
+        if mass == 0:
+            continue
+        J = kin.omegas[link][1, :].jacobian(sp.Matrix(kin.dq)).xreplace(rename)
+        axial = mass * (sp.Float(AXIAL_RADIUS_L) * par["L"]) ** 2 / 2
+        dM += axial * (J.T * J)
+    dqv = sp.Matrix(eq.dq)
+    return dataclasses.replace(eq, M=eq.M + dM, h=eq.h + bias(dM, 0, eq.q, eq.dq),
+                               kinetic=eq.kinetic + sp.Rational(1, 2) * (dqv.T * dM * dqv)[0])
 
 
 def wheel_tip_names(spokes: int) -> tuple[str, ...]:

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
 
-__all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
+__all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
            "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D",
-           "SEVERAL_FOOTHOLDS",
-           "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
+           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND",
+           "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -415,6 +415,17 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
                    "file alone under OpenSim's Manager does not hold the stance knee "
                    "straight (the kneed walker falls at 0.34 s, in its first step)")
 
+#: what the contact cells of the 3D straight legs of zero hip width rest on (configs/paper_3d.yaml,
+#: configs/round_feet_3d.yaml): their ten steps are the sagittal gait's
+ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk stays in its "
+                         "sagittal plane: zero hip width and an upright start keep it "
+                         "mirror-symmetric, its roll seeded at round-off and growing x11 a step "
+                         "(the rigid gait's lateral multiplier): by heel strike 10 5e-4 rad "
+                         "(configs/paper_3d.yaml), 2.5e-2 rad (configs/round_feet_3d.yaml); "
+                         "started 1 mrad/s off upright (contact_sim.start_offset: "
+                         "lean_rate_rad_per_s: 0.001) configs/paper_3d.yaml capsizes after 3 "
+                         "heel strikes, as the rigid walk would")
+
 #: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
@@ -422,6 +433,10 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
               ("locking_knees_3d", "osim"): KNEE_LATCH_OSIM,
               ("locking_knees_3d", "contact"): KNEED_3D_FIRST_STRIDE,
               ("locking_knees_3d", "mjcf"): KNEED_3D_FIRST_STRIDE}
+#: (kind, feature, view) -> what one supported cell rests on beyond its measurement, where
+#: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
+FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
+                 ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT}
 
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``

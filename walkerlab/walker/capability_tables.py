@@ -71,7 +71,7 @@ def kind_grid(kind: Kind) -> KindGrid:
         row = []
         for view in VIEWS:
             why = kind.cell(feature, view)
-            note = kind.note(view) if why is None else None
+            note = kind.note(view, feature) if why is None else None
             mark = "✗"
             if why is None and verified(kind.name, feature, view):
                 e = cell_evidence(kind.name, feature, view)

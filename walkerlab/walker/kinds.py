@@ -77,7 +77,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from walkerlab.walker import parts as P
-from walkerlab.walker.capability_cells import CAPABILITIES, CELL_NOTES, STAGE_CELLS, STAGE_VIEWS
+from walkerlab.walker.capability_cells import (
+    CAPABILITIES,
+    CELL_NOTES,
+    FEATURE_NOTES,
+    STAGE_CELLS,
+    STAGE_VIEWS,
+)
 from walkerlab.walker.parts import Part
 
 __all__ = ["FEATURES", "KINDS", "PART_SLOTS", "VIEWS", "Kind", "KindRefused", "kind_of",
@@ -231,10 +237,11 @@ class Kind:
             return row[("walk", view)]  # but one listed as None (its own transcription)
         return row.get((feature, view), row.get((feature, "*")))
 
-    def note(self, view: str) -> str | None:
-        """What every supported cell of the kind in ``view`` rests on beyond its measured
-        agreement (:data:`CELL_NOTES`), or None."""
-        return CELL_NOTES.get((self.name, view))
+    def note(self, view: str, feature: str | None = None) -> str | None:
+        """What the supported cell ``feature`` of the kind in ``view`` rests on beyond its
+        measured agreement (:data:`FEATURE_NOTES`), else what every supported cell of the
+        kind in ``view`` rests on (:data:`CELL_NOTES`), or None."""
+        return FEATURE_NOTES.get((self.name, feature, view)) or CELL_NOTES.get((self.name, view))
 
     def supports(self, feature: str, view: str) -> bool:
         """Whether the kind has ``feature`` in ``view``."""
@@ -374,7 +381,7 @@ def table_rows() -> list[dict]:
                        "supported": why is None, "reason": why or ""}
                 if why is None:
                     e = cell_evidence(kind.name, feature, view) or {}
-                    note = kind.note(view) or ""
+                    note = kind.note(view, feature) or ""
                     detail = e.get("detail", "")
                     if note and note not in detail:
                         detail = f"{detail}; {note}" if detail else note

@@ -98,6 +98,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.codegen.contact_glue import contact_glue
+from walkerlab.codegen.floating_3d import legs_axial_inertia
 from walkerlab.models.contact.assembly import NPC
 from walkerlab.models.contact.rhs_lines import rhs_source
 from walkerlab.walker.description import Structure
@@ -110,7 +111,8 @@ _HERE = Path(__file__).parent
 _SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
             _HERE / "assembly.py", _HERE / "powered_kernels.py", _HERE / "_kernels.py",
             _HERE.parent.parent / "codegen" / "torque_law.py",
-            _HERE.parent.parent / "codegen" / "contact_glue.py")
+            _HERE.parent.parent / "codegen" / "contact_glue.py",
+            _HERE.parent.parent / "codegen" / "floating_3d.py")  # legs_axial_inertia
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
@@ -133,10 +135,11 @@ def contact_source(structure: Structure, key: str) -> str:
 
     from .powered_source import powered_source
 
-    eq = floating.derive_floating(structure)
+    # a 3D walker of zero hip width: its legs' axial inertia (legs_axial_inertia)
+    eq = legs_axial_inertia(structure, floating.derive_floating(structure))
     if structure.knee and len(eq.feet) != 2:
         raise ValueError("a kneed walker's contact model needs one contact point per leg")
-    fl = floating.floating_source(structure, key)
+    fl = floating.generate_floating(eq, key)
     legs = tuple(eq.point_legs)
     # each knee's thigh and shank coordinates (a placeholder without knee stops: unread)
     knees = tuple(tuple(k) for k in eq.knees) or ((0, 0), (0, 0))

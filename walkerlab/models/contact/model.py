@@ -249,7 +249,8 @@ class ContactWalker(ContactReadouts):
         return walker.on_terrain(terrain, step_length=step_length, n_steps=n_steps)
 
     def on_terrain(self, terrain: TerrainSettings, *, step_length: float,
-                   n_steps: int, step_lengths: tuple | None = None) -> ContactWalker:
+                   n_steps: int, step_lengths: tuple | None = None,
+                   shift: float = 0.0) -> ContactWalker:
         """The same walker and contact law on ``terrain``: checkerboard patches spaced by
         ``step_length`` [m] (or by ``step_lengths`` in turn) for ``n_steps`` steps (each
         lane shifted by its leg's :func:`footprint_offsets`), or continuous ground; stairs
@@ -268,6 +269,9 @@ class ContactWalker(ContactReadouts):
             footholds of several heights, the rigid period-n gait's steps); replaces
             ``step_length``; footfall ``k`` at
             :func:`walkerlab.models.contact.terrain.footfall_positions`.
+        shift : float
+            Every patch this far [m] downhill of its footfall (a disc foot's roll,
+            :meth:`walkerlab.models.contact.parts.ContactPart.patch_shift`).
 
         Returns
         -------
@@ -300,7 +304,7 @@ class ContactWalker(ContactReadouts):
         o1, o2 = footprint_offsets(self.data)
         # the ground laid afresh: a previous terrain's patch heights or polyline go with it
         # (heights of other lanes would not fit these)
-        walker = dataclasses.replace(self, lane1=c1 + o1, lane2=c2 + o2,
+        walker = dataclasses.replace(self, lane1=c1 + o1 + shift, lane2=c2 + o2 + shift,
                                      patch_half_width=0.5 * terrain.patch_width_m,
                                      continuous=terrain.lanes == "continuous",
                                      heights1=None, heights2=None, ground_line=None)

@@ -112,6 +112,12 @@ class ContactPart:
                 for leg in ("leg1", "leg2")}
         return chord + R * (z[last["leg2"]] - z[last["leg1"]])
 
+    def patch_shift(self, walker, x_ideal) -> float:
+        """How far [m] along the slope the checkerboard's patches lie ahead of the footfalls
+        (the contact points at touchdown) of the gait started at ``x_ideal``: 0, the patch
+        centred on its footfall (a 3D walker's disc feet: :meth:`Legs3DPart.patch_shift`)."""
+        return 0.0
+
     @staticmethod
     def _chord(walker, x_ideal, along_slope: bool):
         """``(z, chord, x)``: the pinned start, the distance between the feet's reference
@@ -377,6 +383,21 @@ class Legs3DPart(ContactPart):
         R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
         links = walker.coordinate_names()[walker.dim:]
         return chord + R * (z[links.index("leg2_angle")] - z[links.index("leg1_angle")])
+
+    def patch_shift(self, walker, x_ideal) -> float:
+        """A disc foot rolls on its patch: from its touchdown point its contact (the disc's
+        lowest point) travels ``R (theta_td - theta_lo)`` downhill over the stance, so the
+        patch is centred on the middle of that path, the disc's reference point (its contact
+        with the leg normal to the slope, where the floating base stands; the MJCF and Adams
+        exports' patch centres): ``R (theta + gamma)`` ahead of the footfall at the start's
+        stance pitch ``theta``, half the roll of a period-1 gait (0.038 l of
+        configs/round_feet_3d.yaml's 0.076 l roll, where its patch is 0.1 l long); point
+        feet: 0."""
+        if walker.structure.foot != "arc":
+            return 0.0
+        x = self._chord(walker, x_ideal, True)[2]
+        root = np.asarray(x[:walker.dim], float)
+        return float((root - walker.foot_positions(x)[1]) @ walker.tangent)
 
     def check(self, scene, data, cs) -> str | None:
         """No pinned start (its pinned dynamics hold the stance foot's slides, not its

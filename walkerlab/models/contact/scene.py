@@ -203,13 +203,15 @@ class ContactSetup:
             Footholds of several heights without ``step_lengths_m`` (one line).
         """
         probe = self.model()
+        shift = contact_part(probe.structure).patch_shift(probe, x_ideal)  # a disc's roll
         if step_lengths_m is not None:
             return (probe.on_terrain(self.terrain, step_length=float(np.mean(step_lengths_m)),
-                                     n_steps=n_steps + 4, step_lengths=tuple(step_lengths_m)),
+                                     n_steps=n_steps + 4, step_lengths=tuple(step_lengths_m),
+                                     shift=shift),
                     float(np.mean(step_lengths_m)))
         step_length = ideal_step_length(probe, x_ideal, along_slope=not self.terrain.is_slope)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
-                                n_steps=n_steps + 4), step_length
+                                n_steps=n_steps + 4, shift=shift), step_length
 
 
 def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetup:
