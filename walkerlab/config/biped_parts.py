@@ -79,6 +79,29 @@ class ArcFoot(Strict):
     radius_m: float = Field(ge=0, le=100, description="arc radius R [m]")
 
 
+class ToroidalFoot(Strict):
+    """A foot curved in both directions (3D walkers): a torus patch whose sagittal section
+    is an arc of radius ``radius_m`` centred on the leg ``l - R`` from the hip (as an arc
+    foot's) and whose lateral section is an arc of radius ``lateral_radius_m`` (the tube
+    of a torus of major radius ``R - R_l`` about the leg's pitch axis).  The stance foot
+    rolls without slip or twist; the lateral curvature moves its contact sideways as the
+    walker leans (Coleman & Ruina 1998, "An uncontrolled walking toy that cannot stand
+    still", PRL 80(16); Collins, Wisse & Ruina 2001, IJRR 20(7)).  ``lateral_radius_m: 0``
+    is the arc foot (a disc in the leg's plane)."""
+
+    kind: Literal["toroidal"] = Field(description="foot shape")
+    radius_m: float = Field(gt=0, le=100, description="fore-aft (sagittal) radius R [m]")
+    lateral_radius_m: float = Field(ge=0, le=100, description="lateral (frontal) radius R_l "
+                                    "[m], at most radius_m")
+
+    @model_validator(mode="after")
+    def _lateral_within(self) -> ToroidalFoot:
+        if self.lateral_radius_m > self.radius_m:
+            raise ValueError("lateral_radius_m: at most radius_m (the torus' major radius "
+                             "R - R_l must not be negative)")
+        return self
+
+
 class TorsionalSpring(Strict):
     """A linear torsional spring and viscous damper: stiffness, rest angle, damping (each
     joint below says what its angle is and narrows the rest angle's range)."""
@@ -153,7 +176,7 @@ class FlatFoot(Strict):
         return float(self.mass_kg), float(self.inertia_about_ankle_kg_m2)
 
 
-Foot = Annotated[PointFoot | ArcFoot | FlatFoot, Field(discriminator="kind")]
+Foot = Annotated[PointFoot | ArcFoot | ToroidalFoot | FlatFoot, Field(discriminator="kind")]
 
 
 class KneeSpringSpec(TorsionalSpring):
@@ -249,7 +272,7 @@ class LegSpec(Strict):
                         f"{MIN_SOLE_FRACTION:g} of the leg ({shortest:g} m): the foot rolls "
                         "about its heel and its toe, which must lie apart from the ankle "
                         "(a foot without a sole is kind: point)")
-        if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
+        if self.foot.kind in ("arc", "toroidal") and self.foot.radius_m > self.length_m - (
                 self.knee.thigh_length_m if self.knee else 0.0):
             raise ValueError("foot.radius_m: the arc's centre must lie on the "
                              + ("shank" if self.knee else "leg"))

@@ -272,6 +272,9 @@ class BipedParams(_Actuated):
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
             raise ValueError(HIP_ROLL_NEEDS)
         if self.space == "2d":
+            if pair[0].foot.kind == "toroidal":
+                raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D walker's "
+                                 "(space: 3d; a planar walker's round feet are kind: arc)")
             if self.hip_width_m:
                 raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                                  "walker's hips are one point)")
@@ -294,8 +297,8 @@ class BipedParams(_Actuated):
                  "straight legs or locking knees (knee.lock: plastic, no knee.spring)"),
                 ("walker.leg.foot.kind", leg.knee is not None and leg.foot.kind != "point",
                  "point feet on locking knees"),
-                ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc"),
-                 "point or arc feet"),
+                ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc", "toroidal"),
+                 "point, arc or toroidal feet"),
                 ("walker.leg.bodies", any(b.mass_kg == 0 for b in leg.bodies),
                  "massive leg bodies (mass_kg > 0)"),
                 ("walker.springs", bool(self.springs), "no springs"),

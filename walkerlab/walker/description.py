@@ -99,7 +99,8 @@ class Structure:
     bodies : tuple of BodySpec
         Bodies on each leg (both legs identical), in YAML order.  ``hip_mass``: a hip mass.
     foot : str
-        ``"point"``, ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip) or
+        ``"point"``, ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip),
+        ``"toroidal"`` (3D: curved fore-aft ``R_foot`` and laterally ``R_lat``) or
         ``"flat"`` (a massless flat foot on an ankle spring: heel ``heel_m`` behind and toe
         ``toe_m`` ahead of the ankle along the sole, ankle spring ``k_ankle`` [N m/rad],
         rest angle ``r_ankle`` [rad], damper ``c_ankle`` [N m s/rad]; per role
@@ -248,6 +249,8 @@ class Structure:
             names.append("L_thigh")
         if self.foot == "arc":
             names.append("R_foot")
+        if self.foot == "toroidal":   # fore-aft and lateral radii
+            names += ["R_foot", "R_lat"]
         if self.foot == "flat":
             for t in tags:
                 names += [f"heel_{t}m", f"toe_{t}m", f"k_{t}ankle", f"r_{t}ankle",
@@ -476,6 +479,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
         tail.append(leg.knee.thigh_length_m)
     if leg.foot.kind == "arc":
         tail.append(leg.foot.radius_m)
+    if leg.foot.kind == "toroidal":
+        tail += [leg.foot.radius_m, leg.foot.lateral_radius_m]
     flat = leg.foot.kind == "flat"
     f1 = _flat_foot_values(leg1.foot) if flat else []
     f2 = _flat_foot_values(leg2.foot) if flat else []
