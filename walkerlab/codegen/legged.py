@@ -306,6 +306,13 @@ def derive_legged(structure) -> Equations:
     the slope), ``swing_contact``, ``swing_foot_centre``, ``stance_contact`` and
     ``stance_foot_centre`` the feet's.
 
+    Feet curved in both directions (``structure.foot == "toroidal"``, ``R_foot`` fore-aft
+    and ``R_lat`` across; Coleman & Ruina 1998, PRL 80(16)): the stance foot's travel along
+    the fall line is not holonomic, so the tree carries it as a coordinate and the flow is
+    its Chaplygin reduction (:mod:`walkerlab.codegen.rolling_feet`), the impact
+    :func:`~walkerlab.codegen.rolling_feet.rolling_impact`; the points are measured from
+    the reference point ``R beta`` up the fall line and ``R_l phi`` across from the contact.
+
     Locking knees (``structure.knee``): the swing leg a thigh and a shank on a pitch joint
     ``L_thigh`` below the hip, the stance leg straight; the knee lock's square systems
     (:func:`walkerlab.codegen.lagrange.knee_lock`: ``locked``, ``knee_impact``, the heel

@@ -80,26 +80,20 @@ class ArcFoot(Strict):
 
 
 class ToroidalFoot(Strict):
-    """A foot curved in both directions (3D walkers): a torus patch whose sagittal section
-    is an arc of radius ``radius_m`` centred on the leg ``l - R`` from the hip (as an arc
-    foot's) and whose lateral section is an arc of radius ``lateral_radius_m`` (the tube
-    of a torus of major radius ``R - R_l`` about the leg's pitch axis).  The stance foot
-    rolls without slip or twist; the lateral curvature moves its contact sideways as the
-    walker leans (Coleman & Ruina 1998, "An uncontrolled walking toy that cannot stand
-    still", PRL 80(16); Collins, Wisse & Ruina 2001, IJRR 20(7)).  ``lateral_radius_m: 0``
-    is the arc foot (a disc in the leg's plane)."""
+    """A foot curved in both directions (3D walkers): its sagittal section an arc of radius
+    ``radius_m`` about the leg's pitch axis ``l - R`` from the hip (as an arc foot's), its
+    lateral section an arc of radius ``lateral_radius_m``: a torus patch about the leg's
+    pitch axis (major radius ``R - R_l``; with ``R_l > R`` the spindle torus' inner, lemon,
+    surface: the lateral centre of curvature above the axis).  The stance foot rolls without
+    slip or twist; the lateral curvature moves its contact sideways as the walker leans
+    (Coleman & Ruina 1998, "An uncontrolled walking toy that cannot stand still", PRL
+    80(16); Collins, Wisse & Ruina 2001, IJRR 20(7)).  ``lateral_radius_m: 0`` is the arc
+    foot (a disc in the leg's plane)."""
 
     kind: Literal["toroidal"] = Field(description="foot shape")
     radius_m: float = Field(gt=0, le=100, description="fore-aft (sagittal) radius R [m]")
     lateral_radius_m: float = Field(ge=0, le=100, description="lateral (frontal) radius R_l "
-                                    "[m], at most radius_m")
-
-    @model_validator(mode="after")
-    def _lateral_within(self) -> ToroidalFoot:
-        if self.lateral_radius_m > self.radius_m:
-            raise ValueError("lateral_radius_m: at most radius_m (the torus' major radius "
-                             "R - R_l must not be negative)")
-        return self
+                                    "[m]")
 
 
 class TorsionalSpring(Strict):
