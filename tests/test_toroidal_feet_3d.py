@@ -147,9 +147,9 @@ def test_lateral_radius_lowers_the_lateral_multiplier():
     """The stride's largest multiplier (the lateral mode) against the lateral radius (the
     table of configs/toroidal_feet_3d.yaml), the gait continued from the disc's (R_l = 0:
     99.39, configs/round_feet_3d.yaml's walker with 0.1 l hip width): 56.2 at R_l = R =
-    0.2, 19.3 at 0.5, 1.112 (a complex pair) at 0.84, growing again beyond (1.27 at 1.2): the lateral curvature moves the multiplier
-    by two orders but not inside the unit circle on this walker (to 1e-3 relative: the
-    variational equations' accuracy is far finer)."""
+    0.2, 19.3 at 0.5, 1.112 (a complex pair) at 0.84, growing again beyond (1.27 at 1.2):
+    the lateral curvature moves the multiplier by two orders but not inside the unit
+    circle on this walker (to 1e-3 relative; the variational equations are far finer)."""
     table = {0.0: 99.39, 0.2: 56.22, 0.5: 19.31, LEAST: 1.1122, 1.2: 1.2684}
     x = DISC_GUESS
     for lateral, largest in table.items():
