@@ -31,10 +31,13 @@ class TorusReference:
     """Newton-Euler's walker (module docstring); state ``[lean, swing, stance, rates]`` as
     walkerlab's, ``w`` the swing hip's offset along the hip axis (its sign: the side)."""
 
-    def __init__(self, g, L, gamma, M, m, a, I_leg, R, R_l=0.0):
+    def __init__(self, g, L, gamma, M, m, a, I_leg, R, R_l=0.0, arms=None):
         self.g, self.L, self.gamma, self.M, self.m, self.a, self.I, self.R = (
             g, L, gamma, M, m, a, I_leg, R)
         self.R_l = R_l
+        #: arms coupled to the opposite legs: dict(h, r, m, d, I) (shoulders h above the
+        #: hips, r hip widths apart; each arm's mass m at d down it, I normal to it)
+        self.arms = arms
         self.s = np.array([math.cos(gamma), -math.sin(gamma), 0.0])   # the fall line
         self.n = np.array([math.sin(gamma), math.cos(gamma), 0.0])    # the slope's normal
         self.z = np.array([0.0, 0.0, 1.0])
@@ -84,11 +87,20 @@ class TorusReference:
         rigid("swing_centre", "swing_hip", -(L - R) * u_sw, w_sw, al_sw)
         rigid("swing_contact", "swing_centre", -rho * e2 - R_l * self.n, w_sw,
               al_sw)   # its material point
-        legs = [(w_st, al_st, u_st), (w_sw, al_sw, u_sw)]
+        legs = [(w_st, al_st, u_st, self.I), (w_sw, al_sw, u_sw, self.I)]
+        if self.arms:   # each arm parallel to the opposite leg, on the pelvis' shoulder
+            A = self.arms
+            for side, k, w_arm, al_arm, u in (("stance", -1, w_sw, al_sw, u_sw),
+                                              ("swing", 1, w_st, al_st, u_st)):
+                rigid(f"{side}_shoulder", "hip", A["h"] * e2 + w * (1 + k * A["r"]) / 2 * e3,
+                      w_p, al_p)
+                rigid(f"{side}_arm", f"{side}_shoulder", -A["d"] * u, w_arm, al_arm)
+                legs.append((w_arm, al_arm, u, A["I"]))
         return pos, vel, acc, legs
 
     def bodies(self):
-        return [("pelvis", self.M), ("stance_mass", self.m), ("swing_mass", self.m)]
+        arms = [(f"{s}_arm", self.arms["m"]) for s in ("stance", "swing")] if self.arms else []
+        return [("pelvis", self.M), ("stance_mass", self.m), ("swing_mass", self.m)] + arms
 
     def _partials(self, w, q, v_centre=False):
         """Partial velocities (3, k) of the points and angular velocities of the legs, with
@@ -101,11 +113,11 @@ class TorusReference:
             cols.append(self.kinematics(w, q, e[:3], np.zeros(3),
                                         e[3:] if v_centre else None))
         vel = {p: np.column_stack([c[1][p] for c in cols]) for p in cols[0][1]}
-        om = [np.column_stack([c[3][i][0] for c in cols]) for i in range(2)]
+        om = [np.column_stack([c[3][i][0] for c in cols]) for i in range(len(cols[0][3]))]
         return vel, om
 
-    def _inertia(self, u):
-        return self.I * (np.eye(3) - np.outer(u, u))
+    def _inertia(self, u, inertia):
+        return inertia * (np.eye(3) - np.outer(u, u))
 
     def rhs(self, w):
         grav = np.array([0.0, -self.g, 0.0])
@@ -118,8 +130,8 @@ class TorusReference:
             for p, m in self.bodies():
                 Mq += m * vel[p].T @ vel[p]
                 rhs += vel[p].T @ (m * (grav - acc[p]))
-            for W, (omega, alpha, u) in zip(om, legs):
-                Ib = self._inertia(u)
+            for W, (omega, alpha, u, inertia) in zip(om, legs):
+                Ib = self._inertia(u, inertia)
                 Mq += W.T @ Ib @ W
                 rhs -= W.T @ (Ib @ alpha + np.cross(omega, Ib @ omega))
             return np.concatenate([dq, np.linalg.solve(Mq, rhs)])
@@ -131,8 +143,8 @@ class TorusReference:
         e = 0.0
         for p, m in self.bodies():
             e += 0.5 * m * vel[p] @ vel[p] + m * self.g * pos[p][1]
-        for omega, _, u in legs:
-            e += 0.5 * omega @ self._inertia(u) @ omega
+        for omega, _, u, inertia in legs:
+            e += 0.5 * omega @ self._inertia(u, inertia) @ omega
         return e
 
     def foot_height(self, w, x):
@@ -148,8 +160,8 @@ class TorusReference:
         Me = np.zeros((6, 6))
         for p, m in self.bodies():
             Me += m * vel[p].T @ vel[p]
-        for W, (_, _, u) in zip(om, legs):
-            Me += W.T @ self._inertia(u) @ W
+        for W, (_, _, u, inertia) in zip(om, legs):
+            Me += W.T @ self._inertia(u, inertia) @ W
         E = vel["swing_contact"]
         v_minus = np.concatenate([dq, self.kinematics(w, q, dq, np.zeros(3))[1]["centre"]])
         K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
@@ -167,8 +179,8 @@ class TorusReference:
         h = np.zeros(3)
         for p, m in self.bodies():
             h += m * np.cross(pos[p] - point, vel[p])
-        for omega, _, u in legs:
-            h += self._inertia(u) @ omega
+        for omega, _, u, inertia in legs:
+            h += self._inertia(u, inertia) @ omega
         return h
 
     def step(self, w, x):

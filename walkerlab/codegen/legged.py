@@ -478,6 +478,8 @@ def derive_legged(structure) -> Equations:
                   ("stance_knee", kin.origins["stance_leg"] if free
                    else up * (1 - P["L_thigh"] / L))]
     named += [(f"torso_{b.name}", kin.coms[f"torso_{b.name}"]) for b in structure.torso]
+    named += [(f"{role}_arm_{b.name}", kin.coms[f"{role}_arm_{b.name}"])  # walker.arms
+              for b in structure.arms for role in ("stance", "swing")]
     if arc:
         centre_st = kin.origins["stance_leg"]
         named += [("stance_contact", contact_point(centre_st, phi, R, P["R_lat"]) if torus

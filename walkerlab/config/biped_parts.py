@@ -352,3 +352,29 @@ class SpringSpec(TorsionalSpring):
         if self.between[0] == self.between[1]:
             raise ValueError("between: a spring joins two different links")
         return self
+
+
+class ArmsSpec(Strict):
+    """Two arms, each on a shoulder above the hips, its pitch coupled to the opposite leg's
+    (Collins, Wisse & Ruina 2001, "A three-dimensional passive-dynamic walking robot with
+    two legs and knees", IJRR 20(7): each arm linked to the opposite leg, swinging with
+    it): a holonomic coupling, as the bisecting hip's, so the arms add bodies, not
+    coordinates.  Each arm pitches about the pelvis' (rolled) hip axis parallel to the
+    opposite leg (its bodies hang ``from_hip_m`` down it from the shoulder when that leg
+    is vertical); the shoulders ``shoulder_height_m`` above the hips' line,
+    ``shoulder_width_m`` apart across it, centred between the hips."""
+
+    coupling: Literal["opposite_leg"] = Field("opposite_leg", description="each arm's pitch "
+                                              "is the opposite leg's")
+    shoulder_height_m: float = Field(ge=0, le=100, description="shoulders above the hips [m]")
+    shoulder_width_m: float = Field(ge=0, le=100, description="between the shoulders [m]")
+    bodies: list[TorsoBody] = Field(min_length=1, description="bodies on each arm, "
+                                    "from_hip_m (com_from_hip_m) down it from the shoulder")
+
+    @model_validator(mode="after")
+    def _names(self) -> ArmsSpec:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"bodies: duplicate body names {names}")
+        return self
+

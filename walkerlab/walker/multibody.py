@@ -338,6 +338,10 @@ def check_floating_view(structure) -> None:
     ------
     ValueError
     """
+    if structure.arms:
+        raise ValueError("walker.arms: arms coupled to the opposite legs walk in the rigid "
+                         "model only (walkerlab fixedpoint, simulate): the floating view "
+                         "has no coupling between its links")
     if structure.foot == "toroidal":
         raise ValueError("walker.leg.foot.kind: toroidal feet walk in the rigid model only "
                          "(walkerlab fixedpoint, simulate): their rolling radius changes "

@@ -60,6 +60,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from walkerlab.walker.arm_trees import with_arms
 from walkerlab.walker.description import ROLE_TAG
 from walkerlab.walker.foot_trees import stance_torus as _stance_torus
 from walkerlab.walker.tree import (
@@ -532,7 +533,7 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                      "I_leg" if structure.bodies[0].kind == "rod" else None),)
         swing, torso = None, ()
     params = structure.param_names + ((massless_mass,) if some_massless else ())
-    return biped_tree(params, legs, torso, planar=planar, swing_legs=swing,
+    tree = biped_tree(params, legs, torso, planar=planar, swing_legs=swing,
                       thigh="L_thigh" if structure.knee else None,
                       knee_stop=structure.knee and not structure.free_knees,
                       hip_mass=structure.hip_mass,
@@ -544,6 +545,7 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                       or (floating and not planar and structure.knee),
                       soles=_soles(structure) if structure.foot == "flat" else None,
                       lateral_radius="R_lat" if structure.foot == "toroidal" else None)
+    return with_arms(*tree, structure.arms, structure.knee) if structure.arms else tree
 
 
 def _soles(structure) -> Soles:
