@@ -75,3 +75,25 @@ def test_collins_walker_walks_faster_than_the_robot_and_is_laterally_unstable(ga
     assert abs(mu - 1.473069) < 1e-5 * mu
     lead = res.multipliers_variational[np.argmax(np.abs(res.multipliers_variational))]
     assert abs(lead.imag) > 0.5                        # a complex pair: the rocking
+
+
+@pytest.mark.slow
+def test_arms_lower_the_collins_lateral_multiplier(gait):
+    """The arms' share: their mass scaled down (0.3 kg each to 0.03, the rest moved to the
+    pelvis: 4.8 kg throughout), the gait continued: the lateral pair's modulus 1.473 a
+    stride with the robot's arms, 1.638 at 0.6 of their mass, 1.902 at 0.1 (the lateral
+    radius moves it far more: 37.7 at R_l = 0.154 m, configs/collins2001.yaml).  To 1e-4
+    relative (the fixed points' tolerance 1e-12)."""
+    raw = yaml.safe_load((ROOT / "configs" / "collins2001.yaml").read_text())
+    x = gait[1].x
+    measured = {0.6: 1.637583, 0.1: 1.901853}
+    for f in (0.8, 0.6, 0.4, 0.2, 0.1):
+        arm = raw["walker"]["arms"]["bodies"][0]
+        arm["mass_kg"], arm["inertia_about_com_kg_m2"] = 0.3 * f, 0.004 * f
+        raw["walker"]["hip_mass_kg"] = 1.2 + 0.6 * (1 - f)
+        walker = build_walker(Plant.from_scene(Scene.model_validate(raw)))
+        res = find_fixed_point(walker, x, SOLVER, fd_check=False)
+        x = res.x
+        if f in measured:
+            mu = np.max(np.abs(res.multipliers_variational))
+            assert abs(mu - measured[f]) < 1e-4 * mu, (f, mu)
