@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from tests.compass_3d_tree import compass_3d_tree
 from tests.independent.hand_3d_compass import derive_compass
 from tests.independent.hand_3d_wheel import derive_spoked as hand_spoked
 from tests.independent.planar_link_sums import derive
@@ -29,10 +30,7 @@ from walkerlab.codegen.legged import derive_legged
 from walkerlab.codegen.tree_derive import derive_tree, heel_strike, kinematics
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.tree import Body, BodyTree, ContactPoint, CoordinateMap, Joint, Root
-from walkerlab.walker.trees import (
-    compass_3d_tree,
-    spoked_wheel_3d_tree,
-)
+from walkerlab.walker.trees import spoked_wheel_3d_tree
 
 RTOL = 1e-12
 

@@ -24,13 +24,13 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from tests.compass_3d_tree import compass_3d_tree
 from walkerlab.codegen.frames import slope_to_world
 from walkerlab.codegen.tree_derive import kinematics
 from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.export.mjcf_document import tree_mjcf_text
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
 from walkerlab.walker.tree import ZERO_INERTIA, Body, BodyTree, CoordinateMap, Joint, diagonal
-from walkerlab.walker.trees import compass_3d_tree
 
 mujoco = pytest.importorskip("mujoco")
 

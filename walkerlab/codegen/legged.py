@@ -53,6 +53,12 @@ import sympy as sp
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import rotation, slope_to_world
 from walkerlab.codegen.lagrange import knee_lock, spring_dampers
+from walkerlab.codegen.rolling_feet import (
+    contact_point,
+    material_jacobian,
+    reduce_rolling,
+    rolling_impact,
+)
 from walkerlab.codegen.seeded import seeded
 from walkerlab.codegen.tree_derive import (
     derive_tree,
@@ -296,6 +302,13 @@ def derive_legged(structure) -> Equations:
     the slope), ``swing_contact``, ``swing_foot_centre``, ``stance_contact`` and
     ``stance_foot_centre`` the feet's.
 
+    Feet curved in both directions (``structure.foot == "toroidal"``, ``R_foot`` fore-aft
+    and ``R_lat`` across; Coleman & Ruina 1998, PRL 80(16)): the stance foot's travel along
+    the fall line is not holonomic, so the tree carries it as a coordinate and the flow is
+    its Chaplygin reduction (:mod:`walkerlab.codegen.rolling_feet`), the impact
+    :func:`~walkerlab.codegen.rolling_feet.rolling_impact`; the points are measured from
+    the reference point ``R beta`` up the fall line and ``R_l phi`` across from the contact.
+
     Locking knees (``structure.knee``): the swing leg a thigh and a shank on a pitch joint
     ``L_thigh`` below the hip, the stance leg straight; the knee lock's square systems
     (:func:`walkerlab.codegen.lagrange.knee_lock`: ``locked``, ``knee_impact``, the heel
@@ -332,9 +345,13 @@ def derive_legged(structure) -> Equations:
         printed A.5 on another walker than the compass gait.
     """
     planar = not structure.in_3d
-    if structure.spokes or structure.foot not in ("point", "arc"):
+    if structure.spokes or structure.foot not in ("point", "arc", "toroidal"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
-    knee, arc = structure.knee, structure.foot == "arc"
+    knee, arc = structure.knee, structure.foot in ("arc", "toroidal")
+    torus = structure.foot == "toroidal"   # curved both ways (walkerlab.codegen.rolling_feet)
+    if torus and (planar or knee or structure.hip_roll):
+        raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D straight-legged "
+                         "walker's (no knee, no hip-roll joints)")
     free = planar and structure.kind.joints_free
     if free:
         _check_free(structure)
@@ -344,8 +361,12 @@ def derive_legged(structure) -> Equations:
     tree, coords = legs_tree(structure, massless_mass=BETA if massless else None)
     te = derive_tree(tree, coords)
     kin, q, dq = te.kinematics, te.q, te.dq
-    qv = sp.Matrix(q)
     P = dict(zip(tree.params, te.params))
+    rolling = None
+    if torus:   # the Chaplygin reduction: the stance foot's travel is not a coordinate
+        rolling = reduce_rolling(te, P, q[0], q[structure.roles.index("stance")] + P["gamma"])
+        kin, q, dq = rolling.kinematics, rolling.q, rolling.dq
+    qv = sp.Matrix(q)
     L, gamma = P["L"], P["gamma"]
     pitches = _pitches(structure, q, gamma)
     th_sw, th_sh, th_st, phi = pitches
@@ -355,6 +376,8 @@ def derive_legged(structure) -> Equations:
     simplify = simplifier(kin)
     e_s, e_n = sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0])
     M, C, G, V = te.M, te.C, te.G, te.potential
+    if torus:
+        M, C, G, V = rolling.M, rolling.C, rolling.G, rolling.potential
     if planar:   # the potential in the world's closed form (heights as cosines of the legs)
         V = simplify(V)
         G = sp.Matrix([sp.expand(sp.diff(V, k)) for k in q])
@@ -373,7 +396,13 @@ def derive_legged(structure) -> Equations:
     # point foot's, or the disc's lowest point's velocity plus R theta_sw' s (the material
     # point's, v_c + omega x (-R n_w) = d(contact)/dt + R theta_sw' s: the lean pivots the
     # disc about it)
-    if arc:
+    if torus:   # the tree's contact (the travel held): the material point's Jacobian
+        centre_sw = kin.contacts["swing_foot_centre"]
+        swing_contact = contact_point(centre_sw, phi_w, R, P["R_lat"])
+        F = material_jacobian(contact_point(te.kinematics.contacts["swing_foot_centre"],
+                                            phi_w, R, P["R_lat"]), q, phi_w, th_sh + gamma,
+                              R, P["R_lat"])
+    elif arc:
         centre_sw = kin.contacts["swing_foot_centre"]
         swing_contact = centre_sw - R * rotation(e_s, phi_w) * e_n
         F = swing_contact.jacobian(qv) + R * e_s * sp.Matrix(
@@ -382,8 +411,9 @@ def derive_legged(structure) -> Equations:
         swing_contact = kin.contacts["swing_foot"]
         F = swing_contact.jacobian(qv)
     Mi, B = (impact_of_bodies(kin, F, simplify) if planar else   # (the same matrices)
+             rolling_impact(te, rolling, F, simplify) if torus else
              plastic_impact(M, te.A, te.total_mass, F, simplify))
-    kinetic, total, A = te.kinetic, te.total_mass, te.A
+    kinetic, total, A = rolling.kinetic if torus else te.kinetic, te.total_mass, te.A
     if massless:   # the exact limit, in the link angles' rows (module docstring)
         beta = P[BETA]
         psi = sp.Matrix([th_sw, th_sh, th_st] if knee else [th_sw, th_st])
@@ -400,6 +430,8 @@ def derive_legged(structure) -> Equations:
         M0 = M
     # the next step's reference point (where its contact is with its leg normal to the slope)
     swing_foot = swing_contact + R * (th_sh + gamma) * e_s
+    if torus:   # and its contact's sideways travel R_l phi
+        swing_foot -= P["R_lat"] * phi_w * sp.Matrix([0, 0, 1])
     pelvis = kin.coms["pelvis"]
     height = swing_contact[1]
     sigma = th_sw + th_st + 2 * gamma
@@ -442,9 +474,12 @@ def derive_legged(structure) -> Equations:
                   ("stance_knee", kin.origins["stance_leg"] if free
                    else up * (1 - P["L_thigh"] / L))]
     named += [(f"torso_{b.name}", kin.coms[f"torso_{b.name}"]) for b in structure.torso]
+    named += [(f"{role}_arm_{b.name}", kin.coms[f"{role}_arm_{b.name}"])  # walker.arms
+              for b in structure.arms for role in ("stance", "swing")]
     if arc:
         centre_st = kin.origins["stance_leg"]
-        named += [("stance_contact", centre_st - R * rotation(e_s, phi) * e_n),
+        named += [("stance_contact", contact_point(centre_st, phi, R, P["R_lat"]) if torus
+                   else centre_st - R * rotation(e_s, phi) * e_n),
                   ("stance_foot_centre", centre_st), ("swing_contact", swing_contact),
                   ("swing_foot_centre", centre_sw)]
     if free:

@@ -79,6 +79,23 @@ class ArcFoot(Strict):
     radius_m: float = Field(ge=0, le=100, description="arc radius R [m]")
 
 
+class ToroidalFoot(Strict):
+    """A foot curved in both directions (3D walkers): its sagittal section an arc of radius
+    ``radius_m`` about the leg's pitch axis ``l - R`` from the hip (as an arc foot's), its
+    lateral section an arc of radius ``lateral_radius_m``: a torus patch about the leg's
+    pitch axis (major radius ``R - R_l``; with ``R_l > R`` the spindle torus' inner, lemon,
+    surface: the lateral centre of curvature above the axis).  The stance foot rolls without
+    slip or twist; the lateral curvature moves its contact sideways as the walker leans
+    (Coleman & Ruina 1998, "An uncontrolled walking toy that cannot stand still", PRL
+    80(16); Collins, Wisse & Ruina 2001, IJRR 20(7)).  ``lateral_radius_m: 0`` is the arc
+    foot (a disc in the leg's plane)."""
+
+    kind: Literal["toroidal"] = Field(description="foot shape")
+    radius_m: float = Field(gt=0, le=100, description="fore-aft (sagittal) radius R [m]")
+    lateral_radius_m: float = Field(ge=0, le=100, description="lateral (frontal) radius R_l "
+                                    "[m]")
+
+
 class TorsionalSpring(Strict):
     """A linear torsional spring and viscous damper: stiffness, rest angle, damping (each
     joint below says what its angle is and narrows the rest angle's range)."""
@@ -153,7 +170,7 @@ class FlatFoot(Strict):
         return float(self.mass_kg), float(self.inertia_about_ankle_kg_m2)
 
 
-Foot = Annotated[PointFoot | ArcFoot | FlatFoot, Field(discriminator="kind")]
+Foot = Annotated[PointFoot | ArcFoot | ToroidalFoot | FlatFoot, Field(discriminator="kind")]
 
 
 class KneeSpringSpec(TorsionalSpring):
@@ -249,7 +266,7 @@ class LegSpec(Strict):
                         f"{MIN_SOLE_FRACTION:g} of the leg ({shortest:g} m): the foot rolls "
                         "about its heel and its toe, which must lie apart from the ankle "
                         "(a foot without a sole is kind: point)")
-        if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
+        if self.foot.kind in ("arc", "toroidal") and self.foot.radius_m > self.length_m - (
                 self.knee.thigh_length_m if self.knee else 0.0):
             raise ValueError("foot.radius_m: the arc's centre must lie on the "
                              + ("shank" if self.knee else "leg"))
@@ -335,3 +352,29 @@ class SpringSpec(TorsionalSpring):
         if self.between[0] == self.between[1]:
             raise ValueError("between: a spring joins two different links")
         return self
+
+
+class ArmsSpec(Strict):
+    """Two arms, each on a shoulder above the hips, its pitch coupled to the opposite leg's
+    (Collins, Wisse & Ruina 2001, "A three-dimensional passive-dynamic walking robot with
+    two legs and knees", IJRR 20(7): each arm linked to the opposite leg, swinging with
+    it): a holonomic coupling, as the bisecting hip's, so the arms add bodies, not
+    coordinates.  Each arm pitches about the pelvis' (rolled) hip axis parallel to the
+    opposite leg (its bodies hang ``from_hip_m`` down it from the shoulder when that leg
+    is vertical); the shoulders ``shoulder_height_m`` above the hips' line,
+    ``shoulder_width_m`` apart across it, centred between the hips."""
+
+    coupling: Literal["opposite_leg"] = Field("opposite_leg", description="each arm's pitch "
+                                              "is the opposite leg's")
+    shoulder_height_m: float = Field(ge=0, le=100, description="shoulders above the hips [m]")
+    shoulder_width_m: float = Field(ge=0, le=100, description="between the shoulders [m]")
+    bodies: list[TorsoBody] = Field(min_length=1, description="bodies on each arm, "
+                                    "from_hip_m (com_from_hip_m) down it from the shoulder")
+
+    @model_validator(mode="after")
+    def _names(self) -> ArmsSpec:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"bodies: duplicate body names {names}")
+        return self
+

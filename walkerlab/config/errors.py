@@ -20,7 +20,8 @@ class SceneError(ValueError):
 
 
 # discriminator tags of walker models and bodies: not part of a field's path
-_TAGS = {"compass_gait", "biped", "rimless_wheel", "point_mass", "rod", "point", "arc", "flat"}
+_TAGS = {"compass_gait", "biped", "rimless_wheel", "point_mass", "rod", "point", "arc", "flat",
+         "toroidal"}
 
 
 def _loc_part(p) -> bool:

@@ -16,7 +16,7 @@ from pydantic import Discriminator, Field, Tag, model_serializer, model_validato
 
 from walkerlab.config.actuation import Actuation
 from walkerlab.config.base import Strict, check_one_of, drop_unset
-from walkerlab.config.biped_parts import LegSpec, SpringSpec, TorsoSpec
+from walkerlab.config.biped_parts import ArmsSpec, LegSpec, SpringSpec, TorsoSpec
 from walkerlab.config.wheel import RimlessWheelParams
 
 #: ``walker.space`` of the straight-legged walkers (the shorthand's and the parts')
@@ -206,6 +206,8 @@ class BipedParams(_Actuated):
     torso: TorsoSpec | None = Field(None, description="upper body on the hip (null: none)")
     springs: list[SpringSpec] = Field(default_factory=list, description="torsional springs "
                                       "and dampers between links at the hip")
+    arms: ArmsSpec | None = Field(None, description="arms coupled to the opposite legs (3D; "
+                                  "Collins et al. 2001; null: none)")
     space: _Space = "2d"
     hip_width_m: _HipWidth = 0.0
     hip_roll: _HipRoll = None
@@ -214,7 +216,7 @@ class BipedParams(_Actuated):
     def _passive_as_before(self, handler):
         """A planar walker serialises as before ``space`` existed (the same scene JSON and
         input hashes): ``space: 2d`` and a zero hip width are left out."""
-        d = drop_unset(handler(self), ("actuation", "hip_roll"))
+        d = drop_unset(handler(self), ("actuation", "hip_roll", "arms"))
         if isinstance(d, dict) and self.space == "2d" and not self.hip_width_m:
             d.pop("space", None)
             d.pop("hip_width_m", None)
@@ -271,7 +273,14 @@ class BipedParams(_Actuated):
         line otherwise."""
         if self.hip_roll is not None and not (self.space == "3d" and self.hip_width_m):
             raise ValueError(HIP_ROLL_NEEDS)
+        if self.arms is not None and (self.space != "3d" or self.hip_roll is not None
+                                      or (self.arms.shoulder_width_m and not self.hip_width_m)):
+            raise ValueError("walker.arms: arms need space: 3d, a hip width (their shoulders "
+                             "scale with it across the mirror steps) and no hip_roll")
         if self.space == "2d":
+            if pair[0].foot.kind == "toroidal":
+                raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D walker's "
+                                 "(space: 3d; a planar walker's round feet are kind: arc)")
             if self.hip_width_m:
                 raise ValueError("walker.hip_width_m: a hip width needs space: 3d (a planar "
                                  "walker's hips are one point)")
@@ -294,8 +303,8 @@ class BipedParams(_Actuated):
                  "straight legs or locking knees (knee.lock: plastic, no knee.spring)"),
                 ("walker.leg.foot.kind", leg.knee is not None and leg.foot.kind != "point",
                  "point feet on locking knees"),
-                ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc"),
-                 "point or arc feet"),
+                ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc", "toroidal"),
+                 "point, arc or toroidal feet"),
                 ("walker.leg.bodies", any(b.mass_kg == 0 for b in leg.bodies),
                  "massive leg bodies (mass_kg > 0)"),
                 ("walker.springs", bool(self.springs), "no springs"),

@@ -50,6 +50,7 @@ from walkerlab.export.wheel_scene import (
     wheel_keyframe_json,
 )
 from walkerlab.models.actuation import refuse_actuators
+from walkerlab.walker.multibody import check_floating_view
 
 __all__ = ["MJCF", "URDF", "MjcfWriter", "TreeWriter", "UrdfWriter", "check_legs_3d",
            "planar_legs_only"]
@@ -74,6 +75,8 @@ def check_legs_3d(job: ExportJob, w: Writer) -> None:
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
     st = data.structure
+    if st.foot == "toroidal":   # the floating view's refusal (its rolling radius, the lean)
+        check_floating_view(st)
     if st.foot == "arc" or any(b.kind == "rod" for b in st.bodies):
         kind.require("round_feet_3d", w.view, round_feet_3d_fields(job))
     if data.structure.hip_roll:

@@ -309,7 +309,7 @@ def check_scene(scene, data) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
-    if data.structure.in_3d and data.structure.foot == "arc":  # a 3D walker's disc feet
+    if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
     if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
         from walkerlab.optimal.transcription.landing import step_ground

@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, replace
 
+from walkerlab.walker.arm_trees import arm_names, arm_numbers
 from walkerlab.walker.kinds import Kind, kind_of
 
 #: Roles of the generalised coordinates for each coordinate scheme (see HybridWalker.roles).
@@ -99,7 +100,8 @@ class Structure:
     bodies : tuple of BodySpec
         Bodies on each leg (both legs identical), in YAML order.  ``hip_mass``: a hip mass.
     foot : str
-        ``"point"``, ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip) or
+        ``"point"``, ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip),
+        ``"toroidal"`` (3D: curved fore-aft ``R_foot`` and laterally ``R_lat``) or
         ``"flat"`` (a massless flat foot on an ankle spring: heel ``heel_m`` behind and toe
         ``toe_m`` ahead of the ankle along the sole, ankle spring ``k_ankle`` [N m/rad],
         rest angle ``r_ankle`` [rad], damper ``c_ankle`` [N m s/rad]; per role
@@ -167,6 +169,7 @@ class Structure:
     knee: bool = False
     asymmetric: bool = False
     torso: tuple[BodySpec, ...] = ()
+    arms: tuple[BodySpec, ...] = ()   # coupled to the opposite legs (walker.arms; 3D)
     springs: tuple[tuple[str, str], ...] = ()
     knee_spring: bool = False
     free_knees: bool = False
@@ -248,6 +251,8 @@ class Structure:
             names.append("L_thigh")
         if self.foot == "arc":
             names.append("R_foot")
+        if self.foot == "toroidal":   # fore-aft and lateral radii
+            names += ["R_foot", "R_lat"]
         if self.foot == "flat":
             for t in tags:
                 names += [f"heel_{t}m", f"toe_{t}m", f"k_{t}ankle", f"r_{t}ankle",
@@ -260,6 +265,7 @@ class Structure:
                 names.append(f"e_torso_{b.name}")
             if b.kind == "rigid_body":
                 names.append(f"I_torso_{b.name}")
+        names += arm_names(self.arms) if self.arms else []
         for i in range(len(self.springs)):
             names += [f"k_s{i}", f"r_s{i}", f"c_s{i}"]
         if self.knee_spring:
@@ -277,6 +283,8 @@ class Structure:
             d["asymmetric"] = True
         if self.torso:
             d["torso"] = [b.key() for b in self.torso]
+        if self.arms:
+            d["arms"] = [b.key() for b in self.arms]
         if self.springs:
             d["springs"] = [list(s) for s in self.springs]
         if self.knee_spring:
@@ -476,6 +484,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
         tail.append(leg.knee.thigh_length_m)
     if leg.foot.kind == "arc":
         tail.append(leg.foot.radius_m)
+    if leg.foot.kind == "toroidal":
+        tail += [leg.foot.radius_m, leg.foot.lateral_radius_m]
     flat = leg.foot.kind == "flat"
     f1 = _flat_foot_values(leg1.foot) if flat else []
     f2 = _flat_foot_values(leg2.foot) if flat else []
@@ -483,7 +493,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     n_foot_tail = len(tail)  # the flat foot's numbers (per role) go here, before the torso's
     foot_mass = leg1.foot.mass() if flat else None  # the same on both legs (config checks)
     torso, torso_tail = _torso_section(walker_cfg.torso)
-    tail += torso_tail
+    arms, arms_tail = arm_numbers(getattr(walker_cfg, "arms", None), walker_cfg.hip_width_m)
+    tail += torso_tail + arms_tail
     pairs, steps = _spring_steps(walker_cfg.springs)
     hip = walker_cfg.hip_mass_kg > 0
     head = [walker_cfg.gravity_m_per_s2, leg.length_m, slope_rad]
@@ -496,7 +507,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
                           free_knees=leg.knee is not None and leg.knee.lock == "free",
                           hinged_torso=(walker_cfg.torso is not None
                                         and walker_cfg.torso.coupling == "hinged"),
-                          foot_mass=foot_mass is not None)
+                          foot_mass=foot_mass is not None,
+                          arms=tuple(BodySpec(n, k, False, "arm", o) for n, k, o in arms))
 
     def params(swing_vals, stance_vals, feet, springs) -> tuple[float, ...]:
         return _param_vector(head, _leg_block(bodies, asym, swing_vals, stance_vals),
@@ -507,7 +519,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     p2 = params(v2, v1, (f2, f1), steps[1])
     total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
              + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ()))
-             + (2 * foot_mass[0] if foot_mass is not None else 0.0))
+             + (2 * foot_mass[0] if foot_mass is not None else 0.0)
+             + 2 * sum(b.mass_kg for b in (walker_cfg.arms.bodies if arms else ())))
     if walker_cfg.space == "3d":
         structure, p1, p2 = _parts_in_3d(walker_cfg, structure, p1, extra)
     return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,

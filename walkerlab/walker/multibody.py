@@ -338,6 +338,15 @@ def check_floating_view(structure) -> None:
     ------
     ValueError
     """
+    if structure.arms:
+        raise ValueError("walker.arms: arms coupled to the opposite legs walk in the rigid "
+                         "model only (walkerlab fixedpoint, simulate): the floating view "
+                         "has no coupling between its links")
+    if structure.foot == "toroidal":
+        raise ValueError("walker.leg.foot.kind: toroidal feet walk in the rigid model only "
+                         "(walkerlab fixedpoint, simulate): their rolling radius changes "
+                         "with the lean, which the contact model's and the exports' disc "
+                         "and point feet do not carry")
     if structure.free_knees and (structure.foot != "point" or structure.asymmetric
                                  or structure.springs or structure.knee_spring):
         raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "

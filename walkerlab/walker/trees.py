@@ -60,7 +60,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from walkerlab.walker.arm_trees import with_arms
 from walkerlab.walker.description import ROLE_TAG
+from walkerlab.walker.foot_trees import stance_torus as _stance_torus
 from walkerlab.walker.tree import (
     ZERO_INERTIA,
     Body,
@@ -72,16 +74,10 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["Part", "Soles", "biped_tree", "compass_3d_tree", "legs_tree", "spoked_wheel_3d_tree",
+__all__ = ["Part", "Soles", "biped_tree", "legs_tree", "spoked_wheel_3d_tree",
            "welded"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
-#: the parameters the 3D compass's tree reads, before the hip-roll law's gains (the order
-#: of :data:`walkerlab.walker.description.COMPASS_3D_PARAMS` and its tails)
-_BASE = ("g", "L", "gamma", "M_hip", "m_leg", "a_leg")
-_HIP_ROLL_LAW = ("I_pelvis", "kp_pelvis", "kd_pelvis", "kp_swing", "kd_swing", "g_lean",
-                 "g_lean_rate")
-
 
 @dataclass(frozen=True)
 class Part:
@@ -151,7 +147,8 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
                thigh: str | None = None, knee_stop: bool = False, hip_mass: bool = True,
                hip_width: str | float = 0, hip_roll: bool = False, foot_radius: str | None =
                None, coordinates: str = "absolute", free_joints: bool = False,
-               soles: Soles | None = None) -> tuple[BodyTree, CoordinateMap]:
+               soles: Soles | None = None, lateral_radius: str | None = None
+               ) -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
     or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
     pelvis with ``M_hip`` midway between the hips, and an upper body carrying ``torso`` held
@@ -202,6 +199,11 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
     soles : Soles, optional
         Planar flat feet (module docstring): the stance sole at the root, each leg on its
         ankle; coordinates ``stance_ankle, swing_ankle`` after the legs'.
+    lateral_radius : str or None
+        3D feet curved in both directions (with ``foot_radius`` the fore-aft radius ``R``):
+        each foot a torus patch whose lateral section has this radius ``R_l`` (module
+        docstring); the stance foot's travel along the fall line is then the coordinate
+        ``travel`` (its rolling is not holonomic: :mod:`walkerlab.codegen.rolling_feet`).
 
     Returns
     -------
@@ -222,32 +224,36 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         raise ValueError("soles: flat feet are planar (a 3D tree of flat feet is not built)")
     up_leg = "L" if foot_radius is None else f"L - {foot_radius}"   # the frame's origin to hip
     knee = thigh if free_joints else None               # a stance knee this far below the hip
-    bodies, foot_body = _stance_side(legs, foot_radius, planar, up_leg, knee, soles)
+    bodies, foot_body = _stance_side(legs, foot_radius, planar, up_leg, knee, soles,
+                                     lateral_radius)
     bodies += _hips(_PLANAR_HIPS if planar else _HIPS_3D, knee or up_leg, hip_mass, hip_roll,
                     hip_width)
     swing, swing_end = _swing_leg(legs if swing_legs is None else swing_legs, thigh, up_leg,
                                   foot_radius, knee_stop)
     contacts = (ContactPoint("stance_foot", foot_body if foot_radius is None else
-                             "stance_travel", (0, 0, 0)), swing_end)
+                             "stance_travel" if lateral_radius is None else "stance_side",
+                             (0, 0, 0)), swing_end)
     if soles is not None:
         sole, contacts = _swing_sole(soles, swing_end)
         swing.append(sole)
     bodies += swing + _torso(torso, hip_width)
     tree = BodyTree(params, Root(stance_contact=contacts[0].name), tuple(bodies), contacts)
     return tree, _coordinates(planar, thigh is not None, hip_roll, foot_radius, bool(torso),
-                              coordinates, free_joints, soles is not None)
+                              coordinates, free_joints, soles is not None, lateral_radius)
 
 
 def _stance_side(legs: tuple[Part, ...], R: str | None, planar: bool, up_leg: str,
-                 knee: str | None, soles: Soles | None = None) -> tuple[list, str]:
+                 knee: str | None, soles: Soles | None = None, lateral: str | None = None
+                 ) -> tuple[list, str]:
     """The stance foot's bodies and the stance leg's (:func:`biped_tree`), and the body the
     stance foot is on: a straight leg's parts welded at its hip, or, with a stance knee
     ``knee`` below the hip (every joint free), the shank's parts on the shank at the foot and
     the thigh's on the thigh ``stance_leg`` on the knee ``stance_knee``; with ``soles`` the
     leg on its ankle on the stance sole."""
     foot_body = "stance_shank" if knee is not None else "stance_leg"
-    bodies = _stance_foot(R, planar, foot_body) if soles is None else _stance_sole(
-        soles, foot_body)
+    bodies = (_stance_sole(soles, foot_body) if soles is not None else
+              _stance_foot(R, planar, foot_body) if lateral is None else
+              _stance_torus(R, lateral, foot_body))
     if knee is None:
         return bodies + welded("stance_leg", legs, (0, up_leg, 0)), foot_body
     bodies += welded("stance_shank", tuple(p for p in legs if p.link == "shank"),
@@ -331,10 +337,12 @@ def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str |
 
 
 def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
-                 coordinates: str, free: bool = False, flat: bool = False) -> CoordinateMap:
+                 coordinates: str, free: bool = False, flat: bool = False,
+                 lateral: str | None = None) -> CoordinateMap:
     """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`;
     ``free``: every joint free, :mod:`walkerlab.codegen.legged`' coordinates;
-    ``flat``: flat feet, the ankles' after the legs')."""
+    ``flat``: flat feet, the ankles' after the legs'; ``lateral``: toroidal feet, the
+    stance foot's travel ``travel`` last and its sideways travel ``R_l lean``)."""
     ankle = None          # the stance shank's angle, on a stance knee
     if free:
         names = (("stance_shank", "stance_thigh", "swing_thigh", "swing_shank") if knee
@@ -355,8 +363,11 @@ def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso:
              ("stance_ankle_pitch", "-stance_ankle")) if flat else
             (("stance_ankle_pitch", f"{ankle or stance} + gamma"),))
     names += ("stance_ankle", "swing_ankle") if flat else ()
-    angles = ((("stance_travel", f"-{R} * ({stance} + gamma)"),) if R is not None else ()) + (
+    travel = ((("stance_travel", f"-{R} * ({stance} + gamma)"),) if lateral is None else
+              (("stance_travel", "travel"), ("stance_lateral_travel", f"{lateral} * lean")))
+    angles = (travel if R is not None else ()) + (
         rolls + foot + (("stance_hip_pitch", f"-({stance} + gamma)"),))
+    names += ("travel",) if lateral is not None else ()
     if ankle:   # the stance thigh turned from the shank
         angles += (("stance_knee", f"{stance} - {ankle}"),)
     if not planar:
@@ -423,33 +434,6 @@ def _swing_sole(soles: Soles, end: ContactPoint) -> tuple[Body, tuple]:
                   ContactPoint("swing_ankle", end.body, end.point_m),
                   ContactPoint("swing_heel", "swing_sole", (f"-{heel}", 0, 0)),
                   ContactPoint("swing_toe", "swing_sole", (toe, 0, 0)))
-
-
-def compass_3d_tree(*, hip_roll: bool = False, leg_inertia: bool = False
-                    ) -> tuple[BodyTree, CoordinateMap]:
-    """The 3D straight-legged walker with hip width ``w_hip`` as a tree
-    (:func:`biped_tree`: a point mass ``m_leg`` on each leg ``a_leg`` from its
-    foot), and the coordinates ``lean, swing, stance`` (and, with ``hip_roll``,
-    ``pelvis_roll, swing_roll``) as its joint angles' map.
-
-    Parameters
-    ----------
-    hip_roll : bool
-        The legs hang from the pelvis on roll joints (the pelvis' inertia ``I_pelvis`` about
-        the fall line; the law's gains are parameters the tree does not read).
-    leg_inertia : bool
-        Each leg a slender rod with ``I_leg`` [kg m^2] about its mass point normal to it.
-
-    Returns
-    -------
-    BodyTree, CoordinateMap
-        Parameters ``g, L, gamma, M_hip, m_leg, a_leg, w_hip[, I_leg][, I_pelvis, kp_pelvis,
-        ...]`` (:data:`walkerlab.walker.description.COMPASS_3D_PARAMS` and its tails).
-    """
-    params = _BASE + ("w_hip",) + (("I_leg",) if leg_inertia else ()) + (
-        _HIP_ROLL_LAW if hip_roll else ())
-    leg = Part("mass", "m_leg", "L - a_leg", "I_leg" if leg_inertia else None)
-    return biped_tree(params, (leg,), hip_width="w_hip", hip_roll=hip_roll)
 
 
 def legs_tree(structure, floating: bool = False, massless_mass: str | None = None,
@@ -522,17 +506,19 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                      "I_leg" if structure.bodies[0].kind == "rod" else None),)
         swing, torso = None, ()
     params = structure.param_names + ((massless_mass,) if some_massless else ())
-    return biped_tree(params, legs, torso, planar=planar, swing_legs=swing,
+    tree = biped_tree(params, legs, torso, planar=planar, swing_legs=swing,
                       thigh="L_thigh" if structure.knee else None,
                       knee_stop=structure.knee and not structure.free_knees,
                       hip_mass=structure.hip_mass,
                       hip_width="w_hip" if structure.hip_width else 0,
                       hip_roll=structure.hip_roll,
-                      foot_radius="R_foot" if structure.foot == "arc" else None,
+                      foot_radius="R_foot" if structure.foot in ("arc", "toroidal") else None,
                       coordinates=structure.coordinates,
                       free_joints=(planar and (structure.free_knees or structure.hinged_torso))
                       or (floating and not planar and structure.knee),
-                      soles=_soles(structure, swap_roles) if structure.foot == "flat" else None)
+                      soles=_soles(structure, swap_roles) if structure.foot == "flat" else None,
+                      lateral_radius="R_lat" if structure.foot == "toroidal" else None)
+    return with_arms(*tree, structure.arms, structure.knee) if structure.arms else tree
 
 
 def _soles(structure, swap_roles: bool = False) -> Soles:
