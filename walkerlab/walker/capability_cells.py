@@ -10,10 +10,10 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
+from walkerlab.config.walker import KNEED_3D_TORSO
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
-           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
+           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_POWERED",
            "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
            "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "SEVERAL_FOOTHOLDS",
            "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
@@ -119,6 +119,13 @@ KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the
                          "gait is laterally unstable (x40 a stride) and no hip-roll law "
                          "steadies a kneed walker in 3D, so a walk started a little off it "
                          "capsizes within a few steps, as the rigid walk would")
+#: why the kneed walker in 3D's views other than the rigid one refuse its joint torques and
+#: push-off: the powered gait (configs/kneed_3d_powered.yaml's) keeps the passive one's
+#: lateral instability, and it has no hip roll to steady it
+KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keeps the "
+                    "passive one's unstable lateral mode (a stride multiplier of about 40): "
+                    "a walk in this view started off the rigid gait capsizes within a few "
+                    "steps, so its torques and push-off are measured in the rigid model")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -356,11 +363,15 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "locking_knees_3d": {
         # the scene's own check says the same (walkerlab.config.walker.BipedParams)
-        **{(f, "*"): KNEED_3D_PASSIVE for f in ("hip_torque", "knee_torque", "push_off",
-                                                "virtual_constraints", "ankle_torque",
-                                                "ankle_push_off")},
+        # the hip and knee torques and the push-off in the rigid model (walkerlab.models.
+        # hybrid.actuated._KneedLegs3d: the 3D straight legs' actuators with the planar
+        # kneed walker's knee held through the push-off and the heel strike)
+        **{(f, "*"): KNEED_3D_POWERED for f in ("hip_torque", "knee_torque", "push_off")},
+        **{(f, "rigid"): None for f in ("hip_torque", "knee_torque", "push_off")},
+        ("virtual_constraints", "*"): VC_3D,
+        **_NO_ANKLES,
         ("torso_torque", "*"): KNEED_3D_TORSO,
-        ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
+        ("hip_roll", "*"): KNEED_3D_POWERED,
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
