@@ -118,3 +118,46 @@ def test_the_kneed_walker_in_3d_of_zero_width_is_driven_as_the_planar_kneed_walk
         t2, t3 = flat.actuators.transition(xl[sagittal]), w3.actuators.transition(xl)
         for k in ("ke_minus", "ke_push_off", "ke_plus"):
             assert abs(t2[k] - t3[k]) < 1e-12, k
+
+
+# --- hip-roll joints with knees (configs/kneed_3d_stabilised.yaml) --------------------------
+
+
+def _straight_twin(raw: dict) -> dict:
+    """The same walker on straight legs: each leg's thigh and shank masses on one rigid leg
+    at the same distances from the hip (the kneed leg with its knee locked)."""
+    out = {k: v for k, v in raw.items() if k in ("source", "walker", "slope", "solver")}
+    leg = dict(raw["walker"]["leg"])
+    leg.pop("knee")
+    leg["bodies"] = [{k: v for k, v in b.items() if k != "link"} for b in leg["bodies"]]
+    out["walker"] = {**raw["walker"], "leg": leg}
+    return out
+
+
+@pytest.mark.slow   # minutes cold: two 3D derivations with hip-roll joints
+def test_the_locked_kneed_walker_with_hip_roll_is_the_straight_legged_one_with_the_same_masses():
+    """configs/kneed_3d_stabilised.yaml's walker with its swing knee locked against the 3D
+    straight-legged walker with hip-roll joints carrying the same point masses on rigid
+    legs (derived without a knee or its lock: no code of the knee's projection shared):
+    the locked phase's flow, the heel-strike guard and the heel strike (the new swing knee
+    straight) are the straight walker's, the hip-roll law's forces included (lean, pitches
+    and both rolls), both hip sides, to 1e-11 (round-off of two derivations)."""
+    raw = _raw("kneed_3d_stabilised.yaml")
+    kneed, straight = _walker(raw), _walker(_straight_twin(raw))
+    assert kneed.roles == ("lean", "swing_thigh", "swing_shank", "stance", "pelvis_roll",
+                           "swing_roll")
+    ours = [0, 1, 3, 4, 5, 6, 7, 9, 10, 11]    # the kneed state without the shank's
+    rng = np.random.default_rng(11)
+    for wk, ws in ((kneed, straight), (kneed.mirror, straight.mirror)):
+        for _ in range(4):
+            q = np.array([0.01, -0.25, 0.2, -0.01, 0.02]) + 0.05 * rng.standard_normal(5)
+            dq = rng.standard_normal(5)
+            xs = np.concatenate([q, dq])
+            xk = np.concatenate([q[:2], q[1:2], q[2:], dq[:2], dq[1:2], dq[2:]])
+            fk = wk.phases[-1].flow(0.0, xk)
+            assert abs(fk[2 + 6] - fk[1 + 6]) < 1e-11      # the knee stays locked
+            assert np.max(np.abs(fk[ours] - ws.phases[-1].flow(0.0, xs))) < 1e-11
+            assert abs(wk.heel_strike_guard(0.0, xk) - ws.heel_strike_guard(0.0, xs)) < 1e-12
+            rk, rs = wk.reset(xk), ws.reset(xs)
+            assert abs(rk[2] - rk[1]) < 1e-12 and abs(rk[8] - rk[7]) < 1e-11
+            assert np.max(np.abs(rk[ours] - rs)) < 1e-11
