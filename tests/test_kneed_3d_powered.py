@@ -120,6 +120,28 @@ def test_the_kneed_walker_in_3d_of_zero_width_is_driven_as_the_planar_kneed_walk
             assert abs(t2[k] - t3[k]) < 1e-12, k
 
 
+@pytest.mark.slow   # ~1.5 min: the powered gait and a stride of it
+def test_the_powered_kneed_walker_in_3d_walks_and_its_work_equals_its_losses():
+    """configs/kneed_3d_powered.yaml: a period-1 (stride) gait whose steps mirror each
+    other; over each step the energy change is the torques' and the push-off's work plus
+    the slope's less the knee and heel strikes' losses, to 1e-9 J (measured ~1e-14 J); the
+    push-off's impulse is the scene's and does positive work; the lateral mode is the
+    passive gait's (unstable: no hip-roll joints)."""
+    import walkerlab as wl
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.integrate.rigid import simulate_steps
+
+    w = wl.Walker.from_scene(Scene.model_validate(_raw("kneed_3d_powered.yaml")))
+    g = w.fixed_point()
+    assert 30.0 < g.max_abs_multiplier < 50.0          # measured 39.17 (passive 39.86)
+    led = trajectory_ledger(simulate_steps(w.model, np.asarray(g.x), 2, w.solver))
+    assert np.max(np.abs(led["closure"])) < 1e-9
+    assert np.all(led["push_off_impulse"] == 0.02)
+    assert np.all(led["push_off_work"] > 0.0)          # measured 1.5e-4 J
+    assert np.all(led["internal_collision_loss"] > 0.0)  # the knee strike: 0.023 J
+    assert abs(led["heel_strike_loss"][0] - led["heel_strike_loss"][1]) < 1e-9
+
+
 # --- hip-roll joints with knees (configs/kneed_3d_stabilised.yaml) --------------------------
 
 
