@@ -120,8 +120,8 @@ KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the
                          "gait is laterally unstable (x40 a stride) and no hip-roll law "
                          "steadies a kneed walker in 3D, so a walk started a little off it "
                          "capsizes within a few steps, as the rigid walk would")
-#: why the kneed walker in 3D's views other than the rigid one refuse its joint torques and
-#: push-off: the powered gait (configs/kneed_3d_powered.yaml's) keeps the passive one's
+#: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
+#: rigid view) refuse its joint torques and push-off: the powered gait (configs/kneed_3d_powered.yaml's) keeps the passive one's
 #: lateral instability, and it has no hip roll to steady it
 KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keeps the "
                     "passive one's unstable lateral mode (a stride multiplier of about 40): "
@@ -131,7 +131,8 @@ KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keep
 KNEED_3D_HIP_ROLL = ("the floating (contact) tree and the exports of a kneed walker in 3D "
                      "hang each leg on a pitch hip from a pelvis that rolls with the stance "
                      "leg: they have no roll joint for walker.hip_roll's law to act at; its "
-                     "hip-roll joints are the rigid model's (walkerlab fixedpoint, simulate)")
+                     "hip-roll joints are the rigid model's (walkerlab fixedpoint, simulate, "
+                     "the gym's rigid view)")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -373,7 +374,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # hybrid.actuated._KneedLegs3d: the 3D straight legs' actuators with the planar
         # kneed walker's knee held through the push-off and the heel strike)
         **{(f, "*"): KNEED_3D_POWERED for f in ("hip_torque", "knee_torque", "push_off")},
-        **{(f, "rigid"): None for f in ("hip_torque", "knee_torque", "push_off")},
+        # and the Gymnasium environment's rigid view (it steps the rigid model)
+        **{(f, v): None for f in ("hip_torque", "knee_torque", "push_off")
+           for v in ("rigid", "gym")},
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
         ("torso_torque", "*"): KNEED_3D_TORSO,
@@ -382,6 +385,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # straight at the heel strike)
         ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
         ("hip_roll", "rigid"): None,
+        ("hip_roll", "gym"): None,
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
