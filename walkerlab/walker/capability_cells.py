@@ -121,8 +121,9 @@ KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the
                          "steadies a kneed walker in 3D, so a walk started a little off it "
                          "capsizes within a few steps, as the rigid walk would")
 #: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
-XX
-#: lateral instability, and it has no hip roll to steady it
+#: rigid view) refuse its joint torques and push-off: the powered gait
+#: (configs/kneed_3d_powered.yaml's) keeps the passive one's lateral instability, and it
+#: has no hip roll to steady it
 KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keeps the "
                     "passive one's unstable lateral mode (a stride multiplier of about 40): "
                     "a walk in this view started off the rigid gait capsizes within a few "
