@@ -92,6 +92,10 @@ HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged wal
 #: capability table (:data:`walkerlab.walker.capability_cells.CAPABILITIES`,
 #: ``locking_knees_3d``)
 KNEED_3D_TORSO = "a kneed walker in 3D carries no upper body so far"
+KNEED_3D_HIP_ROLL = ("hip-roll joints on a kneed walker in 3D: its equations derive "
+                     "(walkerlab.codegen.legged: lean, thigh, shank, stance, then the rolls) "
+                     "but no gait of them is measured, so no view takes them; "
+                     "configs/hip_width_stabilised.yaml steadies the straight legs")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "
@@ -276,6 +280,8 @@ class BipedParams(_Actuated):
         if leg.knee is not None:  # what the kneed walker in 3D does not carry yet
             if self.torso is not None:
                 raise ValueError(f"walker.torso: {KNEED_3D_TORSO}")
+            if self.hip_roll is not None:
+                raise ValueError(f"walker.hip_roll: {KNEED_3D_HIP_ROLL}")
         for field, bad, what in (
                 ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
                 ("walker.legs", self.legs is not None and pair[0] != pair[1],

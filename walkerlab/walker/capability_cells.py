@@ -10,11 +10,11 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-from walkerlab.config.walker import KNEED_3D_TORSO
+from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_TORSO
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEED_3D_HIP_ROLL", "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF",
+           "KNEED_3D_POWERED", "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF",
            "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
            "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "SEVERAL_FOOTHOLDS",
            "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND"]
@@ -128,12 +128,6 @@ KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keep
                     "passive one's unstable lateral mode (a stride multiplier of about 40): "
                     "a walk in this view started off the rigid gait capsizes within a few "
                     "steps, so its torques and push-off are measured in the rigid model")
-#: why the kneed walker in 3D's views other than the rigid one refuse hip-roll joints
-KNEED_3D_HIP_ROLL = ("the floating (contact) tree and the exports of a kneed walker in 3D "
-                     "hang each leg on a pitch hip from a pelvis that rolls with the stance "
-                     "leg: they have no roll joint for walker.hip_roll's law to act at; its "
-                     "hip-roll joints are the rigid model's (walkerlab fixedpoint, simulate, "
-                     "the gym's rigid view)")
 #: what the views of the 3D kinds refuse: a ground other than a plane, the OpenSim
 #: export
 _CELLS_3D = {
@@ -381,12 +375,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
         ("torso_torque", "*"): KNEED_3D_TORSO,
-        # hip-roll joints in the rigid model: the 3D straight legs' law on the kneed tree
+        # hip-roll joints: the 3D straight legs' law on the kneed tree derives
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
-        # straight at the heel strike)
+        # straight at the heel strike); the scene refuses them (no measured gait)
         ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
-        ("hip_roll", "rigid"): None,
-        ("hip_roll", "gym"): None,
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
