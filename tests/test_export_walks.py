@@ -45,7 +45,10 @@ REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodie
            # the 3D walkers' cells: patches a stride apart (footholds of two heights), the
            # kneed walker in 3D falls in MuJoCo on its slope (stairs)
            "hip_width_footholds": "terrain.foothold_heights_m",
-           "kneed_3d_stairs": "terrain.kind: stairs"}
+           "kneed_3d_stairs": "terrain.kind: stairs",
+           # the powered kneed walker in 3D: its torques and push-off run in the rigid
+           # model only (its lateral mode, x39 a stride, as the passive gait's)
+           "kneed_3d_powered": "walker.actuation.torques.0.joint"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.

@@ -81,9 +81,11 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
         with pytest.raises(KindRefused) as err:
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
-    for feature in ("hip_torque", "knee_torque", "push_off", "hip_roll", "round_feet_3d",
-                    "profile", "torso_torque"):
+    for feature in ("round_feet_3d", "profile", "torso_torque", "hip_roll"):
         assert not kind.supports(feature, "rigid"), feature
+    # the planar kneed walker's torques and push-off (tests/test_kneed_3d_powered.py)
+    for feature in ("hip_torque", "knee_torque", "push_off"):
+        assert kind.supports(feature, "rigid"), feature
     # stairs and footholds: the straight legs' landing (tests/test_stairs_3d.py)
     assert kind.supports("stairs", "rigid") and kind.supports("footholds", "rigid")
 

@@ -202,7 +202,9 @@ def stance_forces(structure, q, dq, params, roles_3d: dict) -> tuple:
         swing = "leg2" if stance == "leg1" else "leg1"
         role = {r: n.replace("leg2", "@").replace("leg1", swing).replace("@", stance)
                 for r, n in roles_3d.items()}
-        idx = [names.index(role[r]) for r in structure.roles]
+        # the law's roles (the lean first, the rolls last; a kneed walker's rigid stance
+        # pitch is the floating tree's stance thigh and shank, where the law has no term)
+        idx = [names.index(role[r]) for r in structure.roles if role[r] in names]
         F = hip_roll_forces([q[i] for i in idx], [dq[i] for i in idx], P)
         Q = sp.zeros(len(q), 1)
         for k, i in enumerate(idx):

@@ -94,15 +94,20 @@ def hip_roll_forces(q, dq, P) -> sp.Matrix:
     (Kuo 1999's lateral foot placement, realised continuously by the swing hip: the target
     roll of the swing leg a linear feedback of the lean and its rate).  Odd in the rolls:
     the mirror step (``w_hip -> -w_hip``, the rolls negated) runs the same law.
+
+    The coordinates are the lean first and the two rolls last, the pitches between them
+    (any number: a kneed walker's ``swing_thigh, swing_shank, stance``; the law has no
+    pitch term), so ``q``, ``dq`` of length ``n >= 3`` give forces (n, 1).
     """
-    phi, _sw, _st, phi_p, phi_w = q
-    dphi, _dsw, _dst, dphi_p, dphi_w = dq
+    n = len(q)
+    phi, phi_p, phi_w = q[0], q[-2], q[-1]
+    dphi, dphi_p, dphi_w = dq[0], dq[-2], dq[-1]
     k_p, c_p, k_s, c_s, g_l, g_r = (P[k] for k in ("kp_pelvis", "kd_pelvis", "kp_swing",
                                                     "kd_swing", "g_lean", "g_lean_rate"))
     tau_st = k_p * phi_p + c_p * dphi_p
     tau_sw = -k_s * (phi_w - (g_l * phi + g_r * dphi)) - c_s * (dphi_w - dphi_p)
-    grad_st = sp.Matrix([1, 0, 0, -1, 0])
-    grad_sw = sp.Matrix([0, 0, 0, -1, 1])
+    grad_st = sp.Matrix([1] + [0] * (n - 3) + [-1, 0])
+    grad_sw = sp.Matrix([0] * (n - 2) + [-1, 1])
     return tau_st * grad_st + tau_sw * grad_sw
 
 
@@ -370,7 +375,7 @@ def derive_legged(structure) -> Equations:
     L, gamma = P["L"], P["gamma"]
     pitches = _pitches(structure, q, gamma)
     th_sw, th_sh, th_st, phi = pitches
-    phi_p, phi_w = q[3:] if structure.hip_roll else (phi, phi)
+    phi_p, phi_w = q[-2:] if structure.hip_roll else (phi, phi)   # the rolls come last
     w = P.get("w_hip", 0)
     R = P["R_foot"] if arc else 0
     simplify = simplifier(kin)
@@ -447,6 +452,8 @@ def derive_legged(structure) -> Equations:
             relabel_q = sp.Matrix([phi, th_st, th_st, th_sw])
         if structure.hip_roll:  # the swing leg's roll is the new lean, the old stance leg's
             relabel_q = sp.Matrix([phi_w, th_st, th_sw, phi_p, phi])   # the new swing roll
+            if knee:  # ... and the new swing knee straight
+                relabel_q = sp.Matrix([phi_w, th_st, th_st, th_sw, phi_p, phi])
         drop = 1
         if structure.hip_width:
             heel = height
@@ -505,6 +512,8 @@ def derive_legged(structure) -> Equations:
     elif knee:  # the planar kneed walker's names (the lean besides, in 3D); the knee lock
         leg_angles = {"stance_thigh": th_st, "stance_shank": th_st, "swing_thigh": th_sw,
                       "swing_shank": th_sh, **({} if planar else {"lean": phi})}
+        if structure.hip_roll:   # each leg's roll, as the straight legs' above
+            leg_angles.update(pelvis_roll=phi_p, stance_roll=phi, swing_roll=phi_w)
         guards["knee_extension"] = th_sh - th_sw   # zero straight, > 0 hyperextended
         thigh = q.index(th_sw)
         lock = knee_lock(M, C, G, Mi, B, thigh=thigh, shank=thigh + 1)

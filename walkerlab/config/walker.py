@@ -91,11 +91,11 @@ HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged wal
 #: ``leg.knee``), each the reason after its field in the scene's one line and in the
 #: capability table (:data:`walkerlab.walker.capability_cells.CAPABILITIES`,
 #: ``locking_knees_3d``)
-KNEED_3D_PASSIVE = ("a kneed walker in 3D is passive so far: its rigid model has no torque "
-                    "law or push-off")
 KNEED_3D_TORSO = "a kneed walker in 3D carries no upper body so far"
-KNEED_3D_HIP_ROLL = ("hip-roll joints are the 3D straight legs' so far: a kneed walker in 3D "
-                     "has universal hips")
+KNEED_3D_HIP_ROLL = ("hip-roll joints on a kneed walker in 3D: its equations derive "
+                     "(walkerlab.codegen.legged: lean, thigh, shank, stance, then the rolls) "
+                     "but no gait of them is measured, so no view takes them; "
+                     "configs/hip_width_stabilised.yaml steadies the straight legs")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "
@@ -287,13 +287,10 @@ class BipedParams(_Actuated):
             return
         leg = pair[0]
         if leg.knee is not None:  # what the kneed walker in 3D does not carry yet
-            for field, bad, why in (("walker.torso", self.torso is not None, KNEED_3D_TORSO),
-                                    ("walker.hip_roll", self.hip_roll is not None,
-                                     KNEED_3D_HIP_ROLL),
-                                    ("walker.actuation", self.actuation is not None,
-                                     KNEED_3D_PASSIVE)):
-                if bad:
-                    raise ValueError(f"{field}: {why}")
+            if self.torso is not None:
+                raise ValueError(f"walker.torso: {KNEED_3D_TORSO}")
+            if self.hip_roll is not None:
+                raise ValueError(f"walker.hip_roll: {KNEED_3D_HIP_ROLL}")
         for field, bad, what in (
                 ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
                 ("walker.legs", self.legs is not None and pair[0] != pair[1],
@@ -310,7 +307,8 @@ class BipedParams(_Actuated):
                 ("walker.springs", bool(self.springs), "no springs"),
                 ("walker.torso.coupling", self.torso is not None
                  and self.torso.coupling != "bisecting_hip", "a bisecting_hip torso"),
-                ("walker.actuation", self.actuation is not None, "a passive walker"),
+                ("walker.actuation", self.actuation is not None and leg.knee is None,
+                 "a passive walker (or locking knees: hip and knee torques, push-off)"),
                 ("walker.hip_roll", self.hip_roll is not None and (
                     leg.foot.kind != "point" or any(b.kind != "point_mass"
                                                     for b in leg.bodies)),

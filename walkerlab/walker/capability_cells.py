@@ -10,14 +10,14 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_PASSIVE, KNEED_3D_TORSO
+from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_TORSO
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D",
-           "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D",
-           "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS", "URDF_GROUND",
-           "ZERO_WIDTH_3D_UPRIGHT"]
+           "KNEED_3D_POWERED", "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL",
+           "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D",
+           "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
+           "URDF_GROUND", "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -125,6 +125,14 @@ KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the
                          "gait is laterally unstable (x40 a stride) and no hip-roll law "
                          "steadies a kneed walker in 3D, so a walk started a little off it "
                          "capsizes within a few steps, as the rigid walk would")
+#: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
+#: rigid view) refuse its joint torques and push-off: the powered gait
+#: (configs/kneed_3d_powered.yaml's) keeps the passive one's lateral instability, and it
+#: has no hip roll to steady it
+KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keeps the "
+                    "passive one's unstable lateral mode (a stride multiplier of about 40): "
+                    "a walk in this view started off the rigid gait capsizes within a few "
+                    "steps, so its torques and push-off are measured in the rigid model")
 #: what the views of the 3D kinds refuse: a ground other than a plane
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -361,10 +369,19 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "locking_knees_3d": {
         # the scene's own check says the same (walkerlab.config.walker.BipedParams)
-        **{(f, "*"): KNEED_3D_PASSIVE for f in ("hip_torque", "knee_torque", "push_off",
-                                                "virtual_constraints", "ankle_torque",
-                                                "ankle_push_off")},
+        # the hip and knee torques and the push-off in the rigid model (walkerlab.models.
+        # hybrid.actuated._KneedLegs3d: the 3D straight legs' actuators with the planar
+        # kneed walker's knee held through the push-off and the heel strike)
+        **{(f, "*"): KNEED_3D_POWERED for f in ("hip_torque", "knee_torque", "push_off")},
+        # and the Gymnasium environment's rigid view (it steps the rigid model)
+        **{(f, v): None for f in ("hip_torque", "knee_torque", "push_off")
+           for v in ("rigid", "gym")},
+        ("virtual_constraints", "*"): VC_3D,
+        **_NO_ANKLES,
         ("torso_torque", "*"): KNEED_3D_TORSO,
+        # hip-roll joints: the 3D straight legs' law on the kneed tree derives
+        # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
+        # straight at the heel strike); the scene refuses them (no measured gait)
         ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),

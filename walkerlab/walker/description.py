@@ -192,8 +192,8 @@ class Structure:
         if self.spokes:
             return SPOKED_3D_ROLES if self.in_3d else SPOKED_ROLES
         if self.in_3d:
-            return (KNEED_3D_ROLES if self.knee else
-                    COMPASS_3D_ROLES + (HIP_ROLL_ROLES if self.hip_roll else ()))
+            return ((KNEED_3D_ROLES if self.knee else COMPASS_3D_ROLES)
+                    + (HIP_ROLL_ROLES if self.hip_roll else ()))
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.hinged_torso:

@@ -328,7 +328,8 @@ KINDS = {k.name: k for k in (
     Kind("locking_knees_3d", "knees that lock at the knee strike, in 3D with hip width",
          "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",
          in_3d=True, has_knees=True, knees_lock=True, rigid=P.RIGID_LOCKING_KNEES,
-         reaction=P.REACTION_NONE, contact=P.CONTACT_KNEES_3D, scene="configs/kneed_3d.yaml"),
+         actuators=P.ACTUATORS_KNEES_3D, reaction=P.REACTION_NONE,
+         contact=P.CONTACT_KNEES_3D, scene="configs/kneed_3d.yaml"),
 )}
 
 

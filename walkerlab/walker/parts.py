@@ -142,6 +142,8 @@ ACTUATORS_LATCHED_KNEES = Part("actuators", "hip and knee torques of latching kn
 ACTUATORS_JOINTS = Part("actuators", "a torque at every free joint")
 ACTUATORS_ANKLES = Part("actuators", "hip and ankle torques of flat feet")
 ACTUATORS_LEGS_3D = Part("actuators", "hip pitch torques, push-off and hip roll in 3D")
+ACTUATORS_KNEES_3D = Part("actuators", "hip and knee pitch torques and push-off of "
+                          "locking knees in 3D")
 ACTUATORS_NONE = Part("actuators", "none: a passive walker")
 
 # the stance foot's reaction (walkerlab.models.hybrid.ground_reaction)

@@ -195,6 +195,10 @@ SHIPPED = {
     ("locking_knees_3d", "walk"): "kneed_3d",
     # ... down stairs of its slope step
     ("locking_knees_3d", "stairs"): "kneed_3d_stairs",
+    # ... with a push-off, a hip and a knee spring-damper (laterally unstable as the
+    # passive gait: x39 a stride)
+    **{("locking_knees_3d", f): "kneed_3d_powered"
+       for f in ("hip_torque", "knee_torque", "push_off")},
 }
 
 #: (kind, feature) -> steps: a reference case whose passive gait is unstable and has no

@@ -405,6 +405,9 @@ class Legs3DPart(ContactPart):
         if cs.pin_stance_until != "none":
             return ("contact_sim.pin_stance_until: a walker in 3D starts on its feet (the "
                     "pinned start phase is planar walkers'): leave it 'none'")
+        why = data.structure.kind.cell("hip_roll", "contact")
+        if data.structure.hip_roll and why is not None:  # the table's (the kneed walker's)
+            return f"walker.hip_roll: {why}"
         return None
 
     def actuators(self, data, spec, coordinates, pulse_s: float):

@@ -332,6 +332,23 @@ class _Legs3d(_Joints):
         acts.push.swap_from_reset()
 
 
+class _KneedLegs3d(_Legs3d):
+    """Locking knees in 3D (:func:`walkerlab.codegen.legged.derive_legged`: the 3D straight
+    legs' tree with a pitch knee on the swing leg): the 3D straight legs' hip torque and
+    push-off (:class:`_Legs3d`) with the planar kneed walker's knee (:class:`_LockingKnees`).
+    The knee's pitch ``theta_sh - theta_sw`` is a rotation about the swing thigh's own
+    (rolled) ``z`` axis, the hip's ``theta_sw - theta_st`` one about the hip axis, so each
+    torque's generalised force is ``tau d(delta)/dq`` of the generated leg angles as in the
+    plane; the push-off and the heel strike hold the locked swing knee (the last phase's
+    constraint) in the generated 3D extended impact system, and the role swap's rate map is
+    the generated reset's (the lean, the rolls and the new swing knee's shank)."""
+
+    def hold(self, acts, walker: HybridWalker) -> None:
+        """The locked knee of the last phase (``locked_swing``), with the generated reset's
+        role swap."""
+        acts.hold_lock(walker.phases[-1].constraint)
+
+
 class _FlatFeet:
     """Flat feet: their stance-foot modes' own mass matrices or an ankle push-off
     (:func:`walkerlab.models.hybrid.ankle_push_off.actuate_flat`)."""
@@ -364,4 +381,5 @@ P.ACTUATORS_LATCHED_KNEES.provide(_LockingKnees())
 P.ACTUATORS_JOINTS.provide(_FreeJoints())
 P.ACTUATORS_ANKLES.provide(_FlatFeet())
 P.ACTUATORS_LEGS_3D.provide(_Legs3d())
+P.ACTUATORS_KNEES_3D.provide(_KneedLegs3d())
 P.ACTUATORS_NONE.provide(_RollingPolygon())

@@ -213,15 +213,15 @@ class PushOffTransition(Transitions):
             K[:n + k, :n + k], K[:n + k, n + k:], K[n + k:, :n + k] = De, -E.T, E
             sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(k)]))
         else:  # the swing knee locked through both impulses (as the passive heel strike)
-            a = np.concatenate([np.asarray(self.lock(x)), np.zeros(2)])[None, :]
-            A = np.zeros((n + 3, n + 3), dtype=np.result_type(De, a))
-            A[:n + 2, :n + 2], A[:n + 2, n + 2:], A[n + 2:, :n + 2] = De, -a.T, a
+            a = np.concatenate([np.asarray(self.lock(x)), np.zeros(k)])[None, :]
+            A = np.zeros((n + k + 1, n + k + 1), dtype=np.result_type(De, a))
+            A[:n + k, :n + k], A[:n + k, n + k:], A[n + k:, :n + k] = De, -a.T, a
             dqe_po = np.linalg.solve(A, np.concatenate([De @ dqe + Ef.T @ (P * e),
-                                                        np.zeros(1)]))[:n + 2]
+                                                        np.zeros(1)]))[:n + k]
             C = np.vstack([E, a])
-            K = np.zeros((n + 5, n + 5), dtype=np.result_type(De, C))
-            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -C.T, C
-            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(3)]))
+            K = np.zeros((n + 2 * k + 1, n + 2 * k + 1), dtype=np.result_type(De, C))
+            K[:n + k, :n + k], K[:n + k, n + k:], K[n + k:, :n + k] = De, -C.T, C
+            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(k + 1)]))
         dq_plus = sol[:n]
         qn, R = self.relabel(np.real(q))
         qn = qn + R @ (q - np.real(q))  # the swap is affine: exact for a complex step too
