@@ -156,11 +156,13 @@ class PushOffTransition(Transitions):
                              for e in np.eye(n)], axis=1)
 
         try:
-            self.R = swap(z, 1.0)
+            R = swap(z, 1.0)
         except ZeroDivisionError:  # the reset's impact singular at a unit step from q = 0
-            # (both legs vertical under an upper body on the bisecting hip): the positions
-            # are affine in q, so a generic nearby point gives the same map
-            self.R = swap(0.05 * (1.0 + np.arange(n)) / n, 0.1)
+            R = None  # (both legs vertical under an upper body on the bisecting hip)
+        if R is None or not np.all(np.isfinite(R)):
+            # the positions are affine in q: a generic nearby point gives the same map
+            R = swap(0.05 * (1.0 + np.arange(n)) / n, 0.1)
+        self.R = R
         self._memo.clear()
 
     def hip_velocity(self, x) -> np.ndarray:
