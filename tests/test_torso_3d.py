@@ -1,8 +1,8 @@
 """An upper body in 3D with a torso torque and hip-roll joints
 (``configs/torso_bhm_3d_stabilised.yaml``, ``configs/torso_powered_3d.yaml``): the upper body
 on the bisecting hip (Wisse, Hobbelen & Schwab 2007, IEEE Trans. Robotics 23(1)) of the 3D
-straight legs with Kuo's (1999) lateral foot placement at the hips, driven by a torque between the upper body and the stance leg
-(``joint: stance_hip``).
+straight legs with Kuo's (1999) lateral foot placement at the hips, driven by a torque
+between the upper body and the stance leg (``joint: stance_hip``).
 
 The references: the bisecting hip's kinematics (the torso's pitch is the legs' mean, so a
 torque ``tau`` between torso and stance leg is the hip torque ``-tau / 2``), the planar torso
@@ -19,7 +19,9 @@ import pytest
 import yaml
 
 import walkerlab as wl
+from walkerlab.analysis.gait.energy import trajectory_ledger
 from walkerlab.config.schema import Scene
+from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.plant import Plant
 
@@ -116,3 +118,73 @@ def test_a_zero_width_3d_torso_torque_walker_is_the_planar_torso_powered_walker(
     assert abs(x3["lean_angle"]) < 1e-12 and abs(x3["lean_rate"]) < 1e-12
     assert abs(g3.step_period - g2.step_period) < 1e-9
     assert abs(g2.step_period - 0.838507) < 1e-6
+
+
+def _contact_run(name: str, tmp_path, strides: int):
+    """``walkerlab contact-sim configs/<name>.yaml --strides <strides>``: (its failure or
+    None, the step periods [s], the heel strikes, the rigid step period [s])."""
+    import h5py
+
+    from walkerlab.config import load_scene
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("contact-sim", load_scene(ROOT / "configs" / f"{name}.yaml"),
+                       tmp_path, strides=strides)
+    with h5py.File(out.path) as f:
+        periods = np.asarray(f["steps/period"][()], float)
+        strikes = int(f["summary/heel_strikes"][()])
+    with h5py.File(tmp_path / name / "fixedpoint.h5") as f:
+        rigid = float(f["step_period"][()])
+    return out.failure, periods[np.isfinite(periods)], strikes, rigid
+
+
+@pytest.mark.slow  # ~10 min on a fresh cache (the floating tree's derivation and kernels)
+@pytest.mark.parametrize("name", ["torso_bhm_3d_stabilised", "torso_powered_3d"])
+def test_the_stabilised_3d_upper_body_walker_walks_in_contact_at_its_rigid_period(
+        name, tmp_path):
+    """The stabilised upper-body walker (passive, and driven by its torso torque and
+    push-off) in the compliant-contact model (the paper's contact law): six strides, >= 10
+    heel strikes, the last four steps' mean period within 1 % of the rigid gait's and every
+    step within 1 % (measured on torso_bhm_3d_stabilised: 12 heel strikes, every step
+    within 0.49 %, the last four -0.05 %)."""
+    failure, periods, strikes, rigid = _contact_run(name, tmp_path, 6)
+    assert not failure
+    assert strikes >= 10
+    assert abs(periods[-4:].mean() / rigid - 1.0) < 0.01
+    assert np.max(np.abs(periods / rigid - 1.0)) < 0.01
+
+
+@pytest.mark.slow  # ~3 min: the rigid gait and about 10 s of MuJoCo
+@pytest.mark.parametrize("name", ["torso_bhm_3d_stabilised", "torso_powered_3d"])
+def test_the_stabilised_3d_upper_body_walkers_mjcf_walks_at_its_rigid_period(name, tmp_path):
+    """The upper-body walker's MJCF (the torso on its hinge held to the legs' mean by an
+    equality, the hip-roll law and the torso torque run by walkerlab's walk loop) walked in
+    MuJoCo: >= 10 alternating heel strikes without a fall, the mean step period within 1 %
+    of the rigid one."""
+    pytest.importorskip("mujoco")
+    from walkerlab.cli.options import load
+    from walkerlab.stages import export
+
+    scene = load(str(ROOT / "configs" / f"{name}.yaml"))
+    out = export.write(scene, tmp_path, "mjcf", walk=True)
+    w = out.walk
+    assert not w.fell and w.alternating and w.strikes >= 10, w.line
+    assert abs(w.period_s / w.rigid_period_s - 1.0) < 0.01, w.line
+
+
+@pytest.mark.slow  # ~5 min on a fresh cache: the gait and a stride of it
+def test_the_3d_torso_torque_walkers_ledger_closes_over_a_stride():
+    """configs/torso_powered_3d.yaml: a stable stride gait; over each step of a stride the
+    energy change is the torso torque's work (its power ``tau alpha'`` on the stance hip's
+    angle, integrated along the flow) plus the hip-roll law's, minus the heel strike's
+    loss, to 1e-9 J of the step's (the flow's generalised force ``tau d(alpha)/dq``
+    against the law's own power: a force on the wrong coordinates leaves ~tau x rate x
+    period, ~0.1 J); the torque does work both ways."""
+    w = wl.Walker.from_scene(Scene.model_validate(_raw("torso_powered_3d")))
+    g = w.fixed_point()
+    assert g.max_abs_multiplier < 1.0
+    led = trajectory_ledger(simulate_steps(w.model, np.asarray(g.x), 2, w.solver))
+    assert len(led["closure"]) == 2
+    assert np.max(np.abs(led["closure"])) < 1e-9
+    assert np.all(np.asarray(led["actuator_work_positive"]) > 1e-4)
+    assert np.all(np.asarray(led["heel_strike_loss"]) > 0.0)

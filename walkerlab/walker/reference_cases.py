@@ -183,6 +183,11 @@ SHIPPED = {
     # the generated cases on configs/hip_width.yaml's lateral multiplier of ~100 a stride
     # fall in contact within a few steps)
     ("straight_legs_3d", "hip_torque"): "hip_width_powered",
+    # the upper body on the bisecting hip with hip-roll joints and Kuo's foot placement
+    # (configs/torso_bhm_3d_stabilised.yaml) driven by a torque between the upper body and
+    # the stance leg: a stable stride gait (the passive torso walker's lateral multiplier of
+    # ~206 a stride leaves a walk from its gait within a few steps)
+    ("straight_legs_3d", "torso_torque"): "torso_powered_3d",
     ("straight_legs_3d", "push_off"): "hip_width_powered",
     # the stabilised walker down stairs of its slope step and on footholds of two heights
     # (the passive hip-width walker's lateral multiplier of ~100 a stride leaves a walk
