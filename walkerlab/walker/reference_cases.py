@@ -84,6 +84,10 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         A scene mapping (``name``: ``<kind>-<feature>-<view>``).
     """
     d = _shipped(SCENES[kind])
+    if feature == "torso_torque" and "leg" not in d["walker"] and (kind, feature) in SHIPPED:
+        # a shorthand walker (model: compass_gait) has no parts to carry an upper body: the
+        # kind's shipped upper-body walker
+        d = _shipped(SHIPPED[(kind, feature)])
     d["name"] = f"{kind}-{feature}-{view}"
     w = d["walker"]
     shipped = copy.deepcopy(w.get("actuation")) or {}
