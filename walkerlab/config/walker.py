@@ -307,8 +307,6 @@ class BipedParams(_Actuated):
                 ("walker.springs", bool(self.springs), "no springs"),
                 ("walker.torso.coupling", self.torso is not None
                  and self.torso.coupling != "bisecting_hip", "a bisecting_hip torso"),
-                ("walker.actuation", self.actuation is not None and leg.knee is None,
-                 "a passive walker (or locking knees: hip and knee torques, push-off)"),
                 ("walker.hip_roll", self.hip_roll is not None and (
                     leg.foot.kind != "point" or any(b.kind != "point_mass"
                                                     for b in leg.bodies)),

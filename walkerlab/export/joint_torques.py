@@ -53,6 +53,8 @@ def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
     """
     if link == "torso" and "torso_hip" in coordinates:
         return {"torso_hip": 1.0}
+    if link == "torso" and "torso_pitch" in coordinates:  # a 3D walker's (the pelvis'
+        return {"torso_pitch": 1.0}                      # pitch axis: no pitch of its own)
     role, _, part = link.partition("_")
     part = part or "leg"  # a straight leg's role is its leg's angle (``stance``, ``swing``)
     leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"

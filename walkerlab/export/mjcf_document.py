@@ -185,6 +185,10 @@ def walker_mjcf_text(m: WalkerMjcf) -> str:
     from walkerlab.export.tree_bodies import mjcf_body_lines  # light: sympy with the bodies
 
     motor_list = motors(m.actuation)
+    bodies = mjcf_body_lines(m.bodies, m.geoms, joint_attrs=m.joint_attrs)
+    # the upper body's hinge: a planar walker's torso_hip, a 3D walker's torso_pitch
+    torso = "torso_pitch" if any('joint name="torso_pitch"' in b for b in bodies) \
+        else "torso_hip"
     custom = [*(f'    <numeric name="{k}" data="{num(v)}"/>' for k, v in m.numerics),
               *(f"    <text name=\"{k}\" data={quoteattr(v)}/>" for k, v in m.texts)]
     keys = [f'    <key name="{k}" qpos="{nums(*qpos)}"'
@@ -193,9 +197,8 @@ def walker_mjcf_text(m: WalkerMjcf) -> str:
     out = [*m.header, f"<mujoco model={quoteattr(m.name)}>", *map(comment, m.notes),
            *xml_comments(m.left_out), COMPILER,
            *_option_and_default(m.gravity_m_per_s2, m.contact), *m.asset,
-           "  <worldbody>", *m.ground,
-           *mjcf_body_lines(m.bodies, m.geoms, joint_attrs=m.joint_attrs), "  </worldbody>",
-           *_block("tendon", [*mjcf_motor_tendons(motor_list), *m.tendons]),
+           "  <worldbody>", *m.ground, *bodies, "  </worldbody>",
+           *_block("tendon", [*mjcf_motor_tendons(motor_list, torso), *m.tendons]),
            *mjcf_actuator_lines(m.actuation, motor_list),
            *_block("equality", m.equality), *_block("custom", custom),
            *_block("keyframe", keys), "</mujoco>", ""]

@@ -59,14 +59,15 @@ def motor_target(kind: str, target: str) -> str:
     return f"{target[:-len('_torso')]} - torso_hip (+u on the thigh's joint, -u on torso_hip)"
 
 
-def mjcf_motor_tendons(motor_list) -> list[str]:
+def mjcf_motor_tendons(motor_list, torso: str = "torso_hip") -> list[str]:
     """The MJCF fixed tendons (``<fixed>`` elements, without the enclosing ``<tendon>``) a
     powered export's motors drive (``motor_list``: :func:`motors`): :data:`HIP_ACTUATION_TENDON`
     ``= leg1_hip - leg2_hip``, a five-link biped's ``leg<i>_hip_torso = leg<i>_hip -
-    torso_hip`` (MuJoCo XML Reference: ``tendon/fixed``)."""
+    torso_hip`` (MuJoCo XML Reference: ``tendon/fixed``); ``torso`` the upper body's hinge
+    (a 3D walker's ``torso_pitch``)."""
     out = []
     for name in (m[2] for m in motor_list if m[1] == "tendon"):
-        second = "leg2_hip" if name == HIP_ACTUATION_TENDON else "torso_hip"
+        second = "leg2_hip" if name == HIP_ACTUATION_TENDON else torso
         first = "leg1_hip" if name == HIP_ACTUATION_TENDON else name[:-len("_torso")]
         out += [f'    <fixed name="{name}">', f'      <joint joint="{first}" coef="1.0"/>',
                 f'      <joint joint="{second}" coef="-1.0"/>', "    </fixed>"]

@@ -17,7 +17,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD
            "KNEED_3D_POWERED", "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D",
            "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
-           "URDF_GROUND", "ZERO_WIDTH_3D_UPRIGHT"]
+           "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND", "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -89,6 +89,17 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
 KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D falls in MuJoCo within its first step on "
                         "its slope (its walk cell): its MJCF lays no stairs or footholds "
                         "a walk could be measured on")
+#: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
+#: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
+TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
+                  "alone: on the bisecting hip the torso's pitch is the legs' mean, so a "
+                  "torque tau between torso and stance leg is the hip torque -tau/2 (give "
+                  "it as joint: hip)")
+#: why the collocation refuses a 3D walker's upper body (:func:`walkerlab.optimal.
+#: transcription.stride.stride_functions`)
+TORSO_OPTIMIZE_3D = ("a 3D walker's collocation is a stride of two mirrored steps (its hip "
+                     "width puts them on either side), whose transcription carries straight "
+                     "legs without an upper body: optimise the walker without walker.torso")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("the hybrid zero dynamics of Bezier outputs (Westervelt, Grizzle & Koditschek 2003) "
          "take one unactuated degree of freedom, the stance foot's pitch: a 3D walker's lean "
@@ -340,7 +351,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # each leg's pitch, an SFORCE or a GFORCE per leg, the push-off GFORCE pulse)
         ("knee_torque", "*"): _NO_KNEE,
         **_NO_ANKLES,
-        ("torso_torque", "*"): "the 3D straight legs carry no torso",
+        # a torque between the upper body on the bisecting hip and a leg (stance_hip,
+        # swing_hip): the torso's pitch is the legs' mean (Wisse, Hobbelen & Schwab 2007),
+        # so its generalised force is the planar walkers' (walkerlab.models.hybrid.
+        # actuated._Legs3d, walkerlab.models.contact.parts.Legs3DPart.actuators, the MJCF's
+        # torso_hip hinge held to the legs' mean by its equality)
+        ("torso_torque", "adams"): TORSO_ADAMS_3D,
+        ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)

@@ -35,8 +35,10 @@ walker's :class:`Kind`:
     Straight legs on point feet in three dimensions (``model: compass_gait`` with
     ``space: 3d``): the walker rolls about the fall line through its stance foot and its
     legs pitch; the hips may be apart (``hip_width_m``: the steps alternate sides, Kuo
-    1999).  The rigid model, the MJCF (a free pelvis on footfall patches: it walks in
-    MuJoCo; its hip torque and push-off run by walkerlab's stepping loop) and the URDF (its
+    1999); an upper body on the bisecting hip (Wisse, Hobbelen & Schwab 2007) rolls with
+    the pelvis, a torque between it and a leg acting on the legs' pitches.  The rigid
+    model, the MJCF (a free pelvis on footfall patches: it walks in MuJoCo; its hip and
+    torso torques and push-off run by walkerlab's stepping loop) and the URDF (its
     actuators left out, as the planar URDF's).  Stairs and footholds (a height along the
     walking direction, level across it) land as the planar walkers' do
     (:mod:`walkerlab.models.hybrid.ground`).

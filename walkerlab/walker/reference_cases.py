@@ -84,6 +84,10 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         A scene mapping (``name``: ``<kind>-<feature>-<view>``).
     """
     d = _shipped(SCENES[kind])
+    if feature == "torso_torque" and "leg" not in d["walker"] and (kind, feature) in SHIPPED:
+        # a shorthand walker (model: compass_gait) has no parts to carry an upper body: the
+        # kind's shipped upper-body walker
+        d = _shipped(SHIPPED[(kind, feature)])
     d["name"] = f"{kind}-{feature}-{view}"
     w = d["walker"]
     shipped = copy.deepcopy(w.get("actuation")) or {}
@@ -183,6 +187,11 @@ SHIPPED = {
     # the generated cases on configs/hip_width.yaml's lateral multiplier of ~100 a stride
     # fall in contact within a few steps)
     ("straight_legs_3d", "hip_torque"): "hip_width_powered",
+    # the upper body on the bisecting hip with hip-roll joints and Kuo's foot placement
+    # (configs/torso_bhm_3d_stabilised.yaml) driven by a torque between the upper body and
+    # the stance leg: a stable stride gait (the passive torso walker's lateral multiplier of
+    # ~206 a stride leaves a walk from its gait within a few steps)
+    ("straight_legs_3d", "torso_torque"): "torso_powered_3d",
     ("straight_legs_3d", "push_off"): "hip_width_powered",
     # the stabilised walker down stairs of its slope step and on footholds of two heights
     # (the passive hip-width walker's lateral multiplier of ~100 a stride leaves a walk

@@ -418,7 +418,10 @@ class Legs3DPart(ContactPart):
         the rigid view's generalised force, :class:`walkerlab.models.hybrid.actuated.
         _Legs3d`), the push-off pulse along the trailing leg from its foot to its own hip
         (the generated ``hips``), and the hip-roll law's power in the ledger
-        (``hip_roll``).
+        (``hip_roll``).  A torque between the upper body on the bisecting hip and a
+        leg (``stance_hip``, ``swing_hip``) acts on the torso's pitch, the legs' mean
+        (Wisse, Hobbelen & Schwab 2007): half on each leg's pitch coordinate, as the
+        planar walkers'.
 
         Raises
         ------
@@ -430,7 +433,7 @@ class Legs3DPart(ContactPart):
         if spec.push_off is not None and st.foot == "arc":
             raise ValueError("walker.actuation.push_off: a 3D walker's push-off is a point "
                              "foot's so far (the rigid view's): drop walker.foot_radius_m")
-        return ContactActuators(spec, coordinates, pulse_s, st.kind,
+        return ContactActuators(spec, coordinates, pulse_s, st.kind, torso=bool(st.torso),
                                 flow_law=bool(st.hip_roll))
 
     def actuators_refusal(self, scene, data) -> str | None:

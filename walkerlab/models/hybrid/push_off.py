@@ -149,9 +149,20 @@ class PushOffTransition(Transitions):
         2003, Sec. III-B)."""
         n, z = self.n, np.zeros(self.n)
         pos = self.fns["reset"]
-        self.R = np.stack([(np.real(pos(np.concatenate([e, z])))[:n]
-                            - np.real(pos(np.concatenate([-e, z])))[:n]) / 2.0
-                           for e in np.eye(n)], axis=1)
+
+        def swap(q0, h):
+            return np.stack([(np.real(pos(np.concatenate([q0 + h * e, z])))[:n]
+                              - np.real(pos(np.concatenate([q0 - h * e, z])))[:n]) / (2 * h)
+                             for e in np.eye(n)], axis=1)
+
+        try:
+            R = swap(z, 1.0)
+        except ZeroDivisionError:  # the reset's impact singular at a unit step from q = 0
+            R = None  # (both legs vertical under an upper body on the bisecting hip)
+        if R is None or not np.all(np.isfinite(R)):
+            # the positions are affine in q: a generic nearby point gives the same map
+            R = swap(0.05 * (1.0 + np.arange(n)) / n, 0.1)
+        self.R = R
         self._memo.clear()
 
     def hip_velocity(self, x) -> np.ndarray:
