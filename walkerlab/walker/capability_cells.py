@@ -86,9 +86,10 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
 #: why the kneed walker in 3D's MJCF refuses stairs and footholds
-KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D falls in MuJoCo within its first step on "
-                        "its slope (its walk cell): its MJCF lays no stairs or footholds "
-                        "a walk could be measured on")
+KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D is laterally unstable (x40 a stride) and no "
+                        "hip-roll law steadies it: its MuJoCo walk holds the rigid gait over "
+                        "its first stride on the slope (its walk cell), and its MJCF lays no "
+                        "stairs or footholds")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
