@@ -82,6 +82,22 @@ def _timed(measure, kind, feature, view, tmp, limit_s: int) -> dict | None:
         signal.signal(signal.SIGALRM, old)
 
 
+def _unmeasured(cell: str, limit_s: int, commit: str) -> dict:
+    """The record of a supported cell never measured: its case, quantity and tolerance, no
+    value and no verdict (its run did not end within the wall-clock guard)."""
+    from walkerlab.api.capabilities import CHECKS, QUANTITIES
+    from walkerlab.walker.reference_cases import reference_scene
+
+    kind, feature, view = cell.split("/")
+    q, tol, unit = QUANTITIES[view]
+    return {"case": reference_scene(kind, feature, view)[0], "quantity": q, "value": None,
+            "tolerance": tol, "unit": unit, "ok": False, "check": CHECKS[view],
+            "not_checked": "", "commit": commit,
+            "detail": (f"not measured: its run did not end within the measuring machine's "
+                       f"wall-clock guard ({limit_s} s); no verdict "
+                       "(scripts/measure_capabilities.py --limit-s on a quieter machine)")}
+
+
 def _group(cells: list[str], limit_s: int = CELL_LIMIT_S) -> list[dict]:
     """One feature's cells (``kind/feature/view``), in :data:`ORDER`, in one runs folder;
     when the rigid gait is not found, the views that start from it say so without
@@ -162,8 +178,10 @@ def main(argv=None) -> int:
                 if "unmeasured" in d:
                     done += 1
                     print(f"[{done}/{len(cells)}] {c}: not measured within {d['unmeasured']} s "
-                          "of wall time (this machine's speed): nothing written, its last "
+                          "of wall time (this machine's speed): no verdict written, its last "
                           "entry kept (--limit-s)", flush=True)
+                    if c not in data["cells"]:   # a supported cell keeps a record: unmeasured
+                        data["cells"][c] = _unmeasured(c, d["unmeasured"], commit)
                     continue
                 d["commit"] = commit
                 for k in ("kind", "feature", "view"):
