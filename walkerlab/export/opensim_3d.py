@@ -182,10 +182,11 @@ def osim3d_bodies(data):
 
 
 def osim3d_state(root, qpos, qvel, slope_rad: float) -> tuple[dict, dict]:
-    """The MJCF keyframe's ``qpos``, ``qvel`` (:func:`walkerlab.export.legs_3d_mjcf.
-    legs3d_keyframe`: a free pelvis' position and quaternion, or its slides and roll, then
-    the hinges in body order) as the OpenSim model's coordinates and speeds by name
-    [m, rad; m/s, rad/s]: the pelvis' position in OpenSim's axes, its roll about the fall
+    """The MJCF keyframe's ``qpos``, ``qvel`` as the OpenSim model's coordinates and speeds.
+
+    The keyframe (:func:`walkerlab.export.legs_3d_mjcf.legs3d_keyframe`): a free pelvis'
+    position and quaternion, or its slides and roll, then the hinges in body order; the
+    coordinates and speeds by name [m, rad; m/s, rad/s]: the pelvis' position in OpenSim's axes, its roll about the fall
     line (a quaternion's rotation vector along it; the body's angular velocity along it),
     the hinges as they are."""
     from scipy.spatial.transform import Rotation  # light

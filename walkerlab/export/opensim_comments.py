@@ -94,9 +94,10 @@ def _flat_feet_comment(feet) -> str:
 
 
 def knee_comment(gait, r_foot: float) -> str:
-    """The knee stop's and latch's comment (``gait.knee``, ``gait.ground_offset_m``; foot
-    sphere ``r_foot`` [m]): the planar and the 3D models' (:mod:`walkerlab.export.
-    opensim_3d`)."""
+    """The knee stop's and latch's comment, of the planar and the 3D models.
+
+    From ``gait.knee``, ``gait.ground_offset_m`` and the foot sphere's radius ``r_foot`` [m]
+    (the 3D model: :mod:`walkerlab.export.opensim_3d`)."""
     return comment(
         "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
         f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "
