@@ -49,6 +49,7 @@ def _states(seed, k=4):
             for _ in range(k)]
 
 
+@pytest.mark.slow  # the toroidal walker's cold derivation: minutes on a loaded 2-core machine
 @pytest.mark.parametrize("lateral", [0.0, 0.1, 0.84])
 def test_toroidal_flow_and_impact_match_newton_euler(lateral):
     """The generated (Chaplygin-reduced) flow and heel-strike map against the reference's at
@@ -62,6 +63,7 @@ def test_toroidal_flow_and_impact_match_newton_euler(lateral):
         assert np.max(np.abs(walker.reset(x) - ref.impact(WIDTH, x))) < 1e-11
 
 
+@pytest.mark.slow  # the same derivation (a minute or more cold), then 1.5 time units
 def test_toroidal_contact_moves_sideways_and_conserves_energy():
     """Over 1.5 time units of the generated flow (rolled, hip width 0.1 l, R_l = 0.5): the
     reference's energy, its potential from the contact's true height (the contact's
