@@ -72,6 +72,7 @@ import sympy as sp
 
 from tests.independent.link_sums import add_length, dot_terms, position_of, velocity_terms
 from walkerlab.codegen.double_support import derive_double_support
+from walkerlab.codegen.foot_modes import FlatEquations, _System  # the containers only
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.walker.description import ROLE_TAG, Structure
@@ -86,57 +87,6 @@ ANKLE = 2
 #: threshold (``|phi_dd|`` < 100 rad/s^2), so the kinetic energy read there is off by < 1e-4 J
 #: for a microsecond.
 HEEL_OFF_PHI_RAD = 1e-12
-
-
-@dataclass(frozen=True)
-class _System:
-    """What :func:`~walkerlab.codegen.source.flow_lines` and
-    :func:`~walkerlab.codegen.source.reset_lines` read (duck-typed Equations)."""
-
-    q: tuple
-    dq: tuple
-    M: sp.Matrix = None
-    C: sp.Matrix = None
-    G: sp.Matrix = None
-    Mi: sp.Matrix = None
-    B: sp.Matrix = None
-    relabel_q: sp.Matrix = None
-    relabel_rate: sp.Matrix = None
-
-
-@dataclass(frozen=True)
-class FlatEquations:
-    """Symbolic results of :func:`derive_flat` (``n = 3``).
-
-    Attributes
-    ----------
-    q, dq, qdd, params : tuple of Symbol
-    flows : dict[str, _System]
-        ``heel_contact``, ``foot_flat``, ``heel_off``: ``M, C, G`` (3 x 3, 3 x 3, 3 x 1).
-    resets : dict[str, _System]
-        ``foot_slap``, ``heel_strike_heel`` (from heel contact or foot flat: heel-pinned
-        kinematics), ``heel_strike_toe`` (from heel off): ``Mi, B, relabel_q, relabel_rate``.
-    guards : dict[str, Expr]
-        Scalar functions of the state.
-    ground : dict[str, list of Expr]
-        ``heel``: ``[N, N_toe]``, ``toe``: ``[N]`` [N], functions of ``q, dq, qdd``.
-    kinematics : dict[str, dict]
-        Per pinned point (``heel``, ``toe``): ``points``, ``kinetic``, ``potential``.
-    leg_angles : dict[str, Expr]
-    """
-
-    q: tuple
-    dq: tuple
-    qdd: tuple
-    params: tuple
-    flows: dict
-    resets: dict
-    guards: dict
-    ground: dict
-    kinematics: dict
-    leg_angles: dict
-    push_off: dict | None = None
-    double_support: dict | None = None
 
 
 @dataclass(frozen=True)

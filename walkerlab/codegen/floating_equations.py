@@ -156,7 +156,6 @@ def _link_sums(point, hip) -> dict:
     """
     import sympy as sp
 
-    from walkerlab.codegen.frames import leg_unit  # light
 
     lin: dict = {}
     for term in sp.Add.make_args(sp.expand(point[0] - hip[0])):
@@ -166,8 +165,7 @@ def _link_sums(point, hip) -> dict:
         angle = trig.args[0]
         key = angle if isinstance(trig, sp.sin) else angle + sp.pi / 2
         lin[key] = lin.get(key, 0) + term / trig
-    rebuilt = hip + sum((v * leg_unit(a) for a, v in lin.items()), sp.zeros(2, 1))
-    if sp.expand(rebuilt[1] - point[1]) != 0:
+    if sp.expand(_at(lin, hip)[1] - point[1]) != 0:
         raise ValueError("floating tree: a point is not a sum of link vectors from the hip")
     return lin
 

@@ -153,14 +153,12 @@ class FlatEquations:
     double_support: dict | None = None
 
 
-def _foot_numbers(structure: Structure, P: dict):
-    """A foot's number by kind (``heel``, ``toe``, ``k``, ``r``, ``c``) and role (per role
-    when the legs differ)."""
-    def fp(kind: str, role: str):
-        t = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
-        return P[{"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle",
-                  "r": f"r_{t}ankle", "c": f"c_{t}ankle"}[kind]]
-    return fp
+def _foot_name(structure: Structure, kind: str, role: str) -> str:
+    """A foot's parameter name by kind (``heel``, ``toe``, ``k``, ``r``, ``c``) and role (per
+    role when the legs differ)."""
+    t = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
+    return {"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle", "r": f"r_{t}ankle",
+            "c": f"c_{t}ankle"}[kind]
 
 
 def _held(coords: CoordinateMap, rest: str) -> CoordinateMap:
@@ -201,13 +199,13 @@ def derive_flat(structure: Structure) -> FlatEquations:
     if any(b.massless for b in structure.bodies):
         raise ValueError("walker.leg.bodies: flat feet need massive bodies (mass_kg > 0)")
     tree, coords = legs_tree(structure)
-    rest = {role: f"r_{ROLE_TAG[role]}_ankle" if structure.asymmetric else "r_ankle"
-            for role in ("swing", "stance")}
+    rest = {role: _foot_name(structure, "r", role) for role in ("swing", "stance")}
     kin = kinematics(tree, _held(coords, rest["swing"]), world=True)
     q, dq = kin.q, kin.dq
     qdd = sp.symbols("ddq_swing ddq_stance ddq_stance_ankle", real=True)
     P = dict(zip(tree.params, kin.params))
-    fp = _foot_numbers(structure, P)
+    def fp(kind: str, role: str):
+        return P[_foot_name(structure, kind, role)]
     gamma = P["gamma"]
     ps_sw, ps_st, a = q
     hs, ts = fp("heel", "stance"), fp("toe", "stance")
@@ -367,23 +365,22 @@ def _locked_and_resets(kin, post, pre: dict, flows: dict, Jl, rest):
     to_pre = dict(zip(post.q, (ps_st, ps_sw, b_new)))
     order = [1, 0, 2]   # the post tree's rates in (swing, stance, b) order
     after, trans = {}, sp.zeros(3, 2)
-    for name, (m, _i, r, Jw) in _world(post)["bodies"].items():
+    for name, (m, inertia, r, Jw) in _world(post)["bodies"].items():
         Jn = r.xreplace(to_pre).jacobian(post_q)
-        after[_other_role(name)] = (Jn, Jw[:, order])
+        after[_other_role(name)] = (m, inertia, Jn, Jw[:, order])
         trans += m * Jn.T
     rw = rest
     relabel_q = sp.Matrix([ps_st, ps_sw, rw])
     relabel_rate = sp.Matrix([[0, 1, 0], [1, 0, 0], [0, 0, 1]])
-    Mi = sum((post.masses[_other_role(n)] * Jn.T * Jn
-              + post.inertias[_other_role(n)][2, 2] * Jwn.T * Jwn
-              for n, (Jn, Jwn) in after.items()), sp.zeros(3, 3))
+    Mi = sum((m * Jn.T * Jn + inertia * Jwn.T * Jwn for m, inertia, Jn, Jwn in after.values()),
+             sp.zeros(3, 3))
     Mi = Mi.subs(b_new, rw).applyfunc(product_to_sum)   # the same after either pin
     names = [n for n in kin.coms
              if kin.masses[n] != 0 or kin.inertias[n] != sp.zeros(3, 3)]
     for pin in ("heel", "toe"):
         Bm = sp.zeros(3, 3)
         for name, (m, inertia, Jc, Jw) in zip(names, pre[pin]):
-            Jn, Jwn = after[name]
+            _m, _i, Jn, Jwn = after[name]
             Bm += m * Jn.T * Jc + inertia * Jwn.T * Jw
         resets[f"heel_strike_{pin}"] = _System(
             q, dq, Mi=Mi, B=Bm.subs(b_new, rw).applyfunc(product_to_sum), relabel_q=relabel_q,

@@ -186,9 +186,9 @@ def osim3d_state(root, qpos, qvel, slope_rad: float) -> tuple[dict, dict]:
 
     The keyframe (:func:`walkerlab.export.legs_3d_mjcf.legs3d_keyframe`): a free pelvis'
     position and quaternion, or its slides and roll, then the hinges in body order; the
-    coordinates and speeds by name [m, rad; m/s, rad/s]: the pelvis' position in OpenSim's axes, its roll about the fall
-    line (a quaternion's rotation vector along it; the body's angular velocity along it),
-    the hinges as they are."""
+    coordinates and speeds by name [m, rad; m/s, rad/s]: the pelvis' position in OpenSim's
+    axes, its roll about the fall line (a quaternion's rotation vector along it; the body's
+    angular velocity along it), the hinges as they are."""
     from scipy.spatial.transform import Rotation  # light
 
     fall, _ = slope_axes(slope_rad)

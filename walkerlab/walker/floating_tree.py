@@ -61,7 +61,7 @@ def floating_planar_tree(structure, params: tuple[str, ...]
               Body("pelvis", "M_hip" if structure.hip_mass else 0, ZERO_INERTIA, (0, 0, 0),
                    Joint("hip_y", "prismatic", "hip_x", (0, 0, 0), ((0, 1, 0),), ("hip_y",)))]
     contacts, angles, hips = [], [("hip_x", "hip_x"), ("hip_y", "hip_y")], []
-    feet_angles = []
+    feet_angles, names = [], ["hip_x", "hip_y"]
     for i, leg in enumerate(("leg1", "leg2")):
         tag = (f"{ROLE_TAG['swing']}_", f"{ROLE_TAG['stance']}_")[i] if structure.asymmetric \
             else ""
@@ -71,6 +71,7 @@ def floating_planar_tree(structure, params: tuple[str, ...]
                  for b in structure.bodies]
         upper = f"{leg}_thigh" if knee else leg
         hips.append(f"{upper}_angle")
+        names += [f"{leg}_thigh_angle", f"{leg}_shank_angle"] if knee else [f"{leg}_angle"]
         bodies.append(Body(upper, 0, ZERO_INERTIA, (0, 0, 0),
                            Joint(f"{leg}_hip", "revolute", "pelvis", (0, 0, 0), (Z,),
                                  (f"{leg}_hip",))))
@@ -95,12 +96,8 @@ def floating_planar_tree(structure, params: tuple[str, ...]
             feet_angles.append((f"{leg}_ankle", f"{leg}_foot_angle - {hips[-1]}"))
             contacts += [ContactPoint(f"{leg}_heel", foot, (f"-heel_{tag}m", 0, 0)),
                          ContactPoint(f"{leg}_toe", foot, (f"toe_{tag}m", 0, 0))]
-    names = ("hip_x", "hip_y") + tuple(
-        (f"{leg}_thigh_angle", f"{leg}_shank_angle") if knee else (f"{leg}_angle",)
-        for leg in ("leg1", "leg2"))
-    names = ("hip_x", "hip_y") + tuple(n for grp in names[2:] for n in grp)
     if flat:
-        names += ("leg1_foot_angle", "leg2_foot_angle")
+        names += ["leg1_foot_angle", "leg2_foot_angle"]
     angles += feet_angles
     if structure.torso:
         torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
@@ -113,7 +110,7 @@ def floating_planar_tree(structure, params: tuple[str, ...]
         pitch = "torso_angle" if structure.hinged_torso else f"({hips[0]} + {hips[1]}) / 2"
         angles.append(("torso_pitch", pitch))
         if structure.hinged_torso:
-            names += ("torso_angle",)
+            names.append("torso_angle")
     tree = BodyTree(params, Root("world", 0, "g", contacts[0].name), tuple(bodies),
                     tuple(contacts))
-    return tree, CoordinateMap(names, tuple(angles))
+    return tree, CoordinateMap(tuple(names), tuple(angles))
