@@ -1,6 +1,7 @@
 """The OpenSim writer over the walker's body tree (``--format osim``): one writer object
-(:data:`OSIM`) whose method per form of tree :meth:`~walkerlab.export.body_writers.
-TreeWriter.write` picks by asking the tree, as the URDF's and the MJCF's:
+(:data:`OSIM`) whose method per form of tree
+:meth:`~walkerlab.export.body_writers.TreeWriter.write` picks by asking the tree, as the
+URDF's and the MJCF's:
 
 - legs in the plane (:meth:`OsimWriter.legs`): the tree of leg links
   (:func:`walkerlab.export.opensim.osim_text`);

@@ -1,7 +1,8 @@
-"""The events of a powered contact run (:class:`walkerlab.integrate.contact_powered.
-ActuationHook`), each a function of one state for :func:`scipy.integrate.solve_ivp` (terminal,
-direction -1) and, as its ``values``, of many states at once (the compiled segments'
-samples and their contact table: :mod:`walkerlab.integrate.compiled_segments`):
+"""The events of a powered contact run
+(:class:`walkerlab.integrate.contact_powered.ActuationHook`), each a function of one state
+for :func:`scipy.integrate.solve_ivp` (terminal, direction -1) and, as its ``values``, of
+many states at once (the compiled segments' samples and their contact table:
+:mod:`walkerlab.integrate.compiled_segments`):
 
 - the heel strike: the swing foot's penetration crosses 0 on ground, ``min_step_m`` ahead
   of the stance foot (:func:`touchdown_event`);
