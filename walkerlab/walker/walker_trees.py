@@ -1,7 +1,7 @@
 """Every walker's body tree (:mod:`walkerlab.walker.tree`), for the questions the exports ask
 of its form: :func:`walker_tree` (the legs' :func:`walkerlab.walker.trees.legs_tree`, the
-spoked wheels' :func:`spoked_wheel_tree` and :func:`walkerlab.walker.trees.
-spoked_wheel_3d_tree`).
+spoked wheels' :func:`spoked_wheel_tree` and
+:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`).
 
 The exports write a walker as its tree has it: a tree of one body rolling on its contact
 points (:attr:`~walkerlab.walker.tree.BodyTree.one_body`: a spoked wheel), planar or not

@@ -1,11 +1,11 @@
 """The optimised step replayed in the compliant-contact model: the optimised hip torque (as a
-function of the time since each touchdown, :func:`walkerlab.optimal.transcription.step.
-torque_of_time`) and push-off drive the scene's contact walker (its ``contact`` law, or the
-paper's default one) from the optimised start; the mean period of its steps is compared with
-the optimum's (the issue's check: within 3 %).  A walker with phases
-(:func:`contact_replay_phased`) gets its optimised hip torque between the thighs (kneed) or
-the legs (flat feet); a walker whose legs differ (:func:`contact_replay_stride`) each step's
-own torque."""
+function of the time since each touchdown,
+:func:`walkerlab.optimal.transcription.step.torque_of_time`) and push-off drive the scene's
+contact walker (its ``contact`` law, or the paper's default one) from the optimised start; the
+mean period of its steps is compared with the optimum's (the issue's check: within 3 %). A
+walker with phases (:func:`contact_replay_phased`) gets its optimised hip torque between the
+thighs (kneed) or the legs (flat feet); a walker whose legs differ
+(:func:`contact_replay_stride`) each step's own torque."""
 
 from __future__ import annotations
 

@@ -1,10 +1,9 @@
-"""The nonlinear program of a sequence of phases (:func:`walkerlab.optimal.transcription.
-mode_sequence.collocate_phases`): each phase's Hermite-Simpson defects, guard and path
-constraints (Kelly 2017, "An introduction to trajectory optimization", SIAM Review 59(4),
-sec. 4), the joins by reset or push-off and heel strike (Kuo 2002), the gait targets and the
-objective's terms (effort by Simpson's rule, peak torque, cost of transport from the positive
-work).
-"""
+"""The nonlinear program of a sequence of phases
+(:func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`): each phase's
+Hermite-Simpson defects, guard and path constraints (Kelly 2017, "An introduction to trajectory
+optimization", SIAM Review 59(4), sec. 4), the joins by reset or push-off and heel strike (Kuo
+2002), the gait targets and the objective's terms (effort by Simpson's rule, peak torque, cost
+of transport from the positive work)."""
 
 from __future__ import annotations
 
