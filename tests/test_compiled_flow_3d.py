@@ -28,7 +28,7 @@ def test_a_3d_stride_runs_the_compiled_flow_and_equals_the_python_one(monkeypatc
     from walkerlab.integrate.solver import Solver
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     assert all(p.compiled is not None for p in w.phases)
     calls = []
 
@@ -57,6 +57,6 @@ def test_a_planar_walker_keeps_its_python_flow():
     from walkerlab.integrate.solver import Solver
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    w = build_walker(scene, plant=Plant.from_scene(scene))
+    w = build_walker(Plant.from_scene(scene))
     backend = Solver.from_settings(scene.solver).resolved_backend()
     assert not any(_runs_compiled(p, backend) for p in w.phases)
