@@ -64,30 +64,29 @@ def first_steps(view: str, steps: int):
         return (*_verdict(times, period, steps, "contact-sim", end),
                 {"quantity": quantity(view, steps)})
 
+    def engine(fmt: str, engine_name: str, walk):
+        """The view that writes ``fmt`` and walks it in its engine (``walk(path, t_end)``)."""
+        def measure(scene, d, runs: Path):
+            from walkerlab.stages import export  # light
+
+            out = export.write(scene, runs, fmt)
+            period = float(out.step_period_s)
+            run = walk(out.path, (steps + 1.3) * period)
+            end = (f" (then fell at {run.t_end_s:.3f} s)" if run.fell else "")
+            if not run.alternating:
+                return math.nan, f"{engine_name}'s heel strikes do not alternate: {run.legs}", {}
+            return (*_verdict(run.times_s, period, steps, f"walked in {engine_name}", end),
+                    {"quantity": quantity(view, steps)})
+        return measure
+
     def mjcf(scene, d, runs: Path):
         from walkerlab.export.mujoco_walk import walk  # light: mujoco
-        from walkerlab.stages import export  # light
 
-        out = export.write(scene, runs, "mjcf")
-        period = float(out.step_period_s)
-        run = walk(out.path, (steps + 1.3) * period)
-        end = (f" (then fell at {run.t_end_s:.3f} s)" if run.fell else "")
-        if not run.alternating:
-            return math.nan, f"MuJoCo's heel strikes do not alternate: {run.legs}", {}
-        return (*_verdict(run.times_s, period, steps, "walked in MuJoCo", end),
-                {"quantity": quantity(view, steps)})
+        return engine("mjcf", "MuJoCo", walk)(scene, d, runs)
 
     def osim(scene, d, runs: Path):
         from walkerlab.export.opensim_walk import walk  # light: opensim, in its process
-        from walkerlab.stages import export  # light
 
-        out = export.write(scene, runs, "osim")
-        period = float(out.step_period_s)
-        run = walk(out.path, (steps + 1.3) * period)
-        end = (f" (then fell at {run.t_end_s:.3f} s)" if run.fell else "")
-        if not run.alternating:
-            return math.nan, f"OpenSim's heel strikes do not alternate: {run.legs}", {}
-        return (*_verdict(run.times_s, period, steps, "walked in OpenSim", end),
-                {"quantity": quantity(view, steps)})
+        return engine("osim", "OpenSim", walk)(scene, d, runs)
 
     return {"contact": contact, "mjcf": mjcf, "osim": osim}[view]

@@ -106,7 +106,7 @@ from walkerlab.export.adams_3d_actuation import actuation_3d_statements
 from walkerlab.export.adams_3d_knees import knee_3d_statements
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
-from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
+from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt, marker_statement
 from walkerlab.export.axes_3d import slope_axes
 from walkerlab.export.legs_3d_mjcf import (
     PATCH_ACROSS_L,
@@ -320,13 +320,6 @@ def part_ids_3d(start: Adams3dStart) -> dict[str, int]:
     return {b.name: 2 + k for k, b in enumerate(start.bodies)}
 
 
-def _marker(mid: int, part: int, qp, angles=(0.0, 0.0, 0.0)) -> list[str]:
-    args = [f"QP={_fs(*(np.asarray(qp, float) * MM))}"]
-    if any(angles):
-        args.append(f"REULER={', '.join(_deg(a) for a in angles)}")
-    return _stmt(f"MARKER/{mid}, PART={part}", *args)
-
-
 def _parts(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
     """Each body's PART (the pelvis turning with ``stance``, its FIXED joint), its CM,
     joint and foot markers and the foot spheres."""
@@ -350,28 +343,28 @@ def _parts(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
                      f"REULER={', '.join(_deg(a) for a in reuler_angles(R))}",
                      *(f"V{k}={_f(v * MM)}" for k, v in zip("XYZ", vcm)),
                      *(f"W{k}={_f(v)}" for k, v in zip("XYZ", wb)))
-        out += _marker(100 * p + 1, p, b.com_m)
+        out += marker_statement(100 * p + 1, p, b.com_m)
         for c in b.children:   # the child's (first) hinge on this part, z along its axis
             c0 = by_name[c.name]
             ax = c0.joints[0].axis if c0.joints else (0.0, 0.0, 1.0)
-            out += _marker(100 * p + 10 + ids[c.name], p, c.pos_m, _z_to(ax))
+            out += marker_statement(100 * p + 10 + ids[c.name], p, c.pos_m, _z_to(ax))
         hinged = [j for j in b.joints if j.kind == "hinge"]
         if hinged:   # its own (last) hinge: z along its axis (a leg's pitch axis)
-            out += _marker(100 * p + 2, p, (0.0, 0.0, 0.0), _z_to(hinged[-1].axis))
+            out += marker_statement(100 * p + 2, p, (0.0, 0.0, 0.0), _z_to(hinged[-1].axis))
         if start.law is not None and b.name in ("pelvis", "leg1", "leg2"):
-            out += _marker(100 * p + 5, p, (0.0, -1.0, 0.0))   # 1 m along the pitch axis
+            out += marker_statement(100 * p + 5, p, (0.0, -1.0, 0.0))   # 1 m along the pitch axis
         if b.name == stance and start.law is None:   # the pelvis' FIXED joint's J marker:
             # the pelvis' CM frame on the stance leg
             op, Rp = start.pose[start.bodies[0].name]
-            out += _marker(100 * p + 10 + ids[start.bodies[0].name], p, R.T @ (op - o),
+            out += marker_statement(100 * p + 10 + ids[start.bodies[0].name], p, R.T @ (op - o),
                            reuler_angles(R.T @ Rp))
         if b.name in start.feet:
             m, (down, disc) = 100 * p + 3, start.feet[b.name]
-            out += _marker(m, p, (0.0, 0.0, -down))
+            out += marker_statement(m, p, (0.0, 0.0, -down))
             if disc:   # the disc about the leg's pitch axis, from its base marker
                 half = DISC_HALF_THICKNESS_L * L
                 ax = np.asarray(hinged[-1].axis, float)
-                out += _marker(100 * p + 4, p, np.array([0.0, 0.0, -down]) - half * ax,
+                out += marker_statement(100 * p + 4, p, np.array([0.0, 0.0, -down]) - half * ax,
                                _z_to(ax))
                 out += _stmt(f"GRAPHICS/{m}, CYLINDER, CM={100 * p + 4}",
                              f"LENGTH={_f(2 * half * MM)}, RADIUS={_f(disc * MM)}")
@@ -440,12 +433,12 @@ def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
     tilt = (math.pi / 2, slope_rad, -math.pi / 2)  # Rz(90) Rx(phi) Rz(-90) = Rot(y, phi)
     out = ["!", "! ---- ground, gravity (along -z) and the footfall patches of each lane ----",
            "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
-           *(_marker(102, 1, start.foot_centre("leg2")) if start.disc_m else
+           *(marker_statement(102, 1, start.foot_centre("leg2")) if start.disc_m else
              ["MARKER/102, PART=1, QP=0.0, 0.0, 0.0"]),
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-g * MM)}"]
-    out += _marker(103, 1, (0.0, 0.0, 0.0), _z_to(t))   # z along the fall line
+    out += marker_statement(103, 1, (0.0, 0.0, 0.0), _z_to(t))   # z along the fall line
     if rolled or frame:  # the frame the law reads rolls in (x s, y n, z z_w)
-        out += _marker(ROLL_FRAME, 1, (0.0, 0.0, 0.0), reuler_angles(
+        out += marker_statement(ROLL_FRAME, 1, (0.0, 0.0, 0.0), reuler_angles(
             np.column_stack([t, n, np.cross(t, n)])))
     gid, ids = 1001, []
     for leg, falls in zip(("leg1", "leg2"), start.lanes):
@@ -454,7 +447,7 @@ def _ground(start: Adams3dStart, slope_rad: float, g: float, width_m: float,
             s = np.asarray(s, float)
             corner = s - (r + depth) * n - width_m / 2 * t - across / 2 * np.array([0, 1, 0])
             out.append(f"! patch of {leg} at ({s[0]:.6g}, {s[1]:.6g}, {s[2]:.6g}) m")
-            out += _marker(gid, 1, corner, tilt)
+            out += marker_statement(gid, 1, corner, tilt)
             out += _stmt(f"GRAPHICS/{gid}, BOX, CORNER={gid}",
                          f"X={_f(width_m * MM)}, Y={_f(across * MM)}, Z={_f(depth * MM)}")
             ids[-1].append(gid)

@@ -45,6 +45,8 @@ from walkerlab.export.adams_actuation import (
     PUSH_MIN_STEP_M,
     _law,
     hip_torque_ids,
+    push_forces,
+    push_impulse,
 )
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, role_statements
 from walkerlab.export.adams_statements import MM, _chain_sum, _f, _plus, _var
@@ -129,7 +131,7 @@ def _hip_torque(act, parts: dict, rolled: bool) -> list[str]:
 
 def _push_off(po, T: float, parts: dict, slope_rad: float) -> list[str]:
     """The push-off pulse (module docstring)."""
-    V, W = ACT_VARIABLES, ACT_3D_VARIABLES
+    W = ACT_3D_VARIABLES
     t, n = slope_axes(slope_rad)
     foot = {g: 100 * parts[g] + 3 for g in ("leg1", "leg2")}
     hip = {g: 100 * parts[g] + 2 for g in ("leg1", "leg2")}
@@ -145,14 +147,7 @@ def _push_off(po, T: float, parts: dict, slope_rad: float) -> list[str]:
            _var(W["nx"], _f(float(n[0]))), _var(W["nz"], _f(float(n[2]))),
            _var(W["tx"], _f(float(t[0]))), _var(W["tz"], _f(float(t[2]))),
            _var(W["pulse_s"], _f(T))]
-    if po.speed_gain_n_s2_per_m:
-        cm = 100 * parts["pelvis"] + 1
-        out += [_var(634, _f(po.impulse_n_s)), _var(635, _f(po.speed_gain_n_s2_per_m)),
-                _var(636, _f(po.reference_speed_m_per_s)),
-                _var(637, f"VARVAL(636)-VM({cm})/{_f(MM)}"),
-                _var(W["impulse"], "MAX(0.0,VARVAL(634)+VARVAL(635)*VARVAL(637))")]
-    else:
-        out.append(_var(W["impulse"], _f(po.impulse_n_s)))
+    out += push_impulse(po, W, 634, 100 * parts["pelvis"] + 1)
     nx, nz = f"VARVAL({W['nx']})", f"VARVAL({W['nz']})"
     for g in ("leg1", "leg2"):
         f = foot[g]
@@ -163,23 +158,8 @@ def _push_off(po, T: float, parts: dict, slope_rad: float) -> list[str]:
     f1, f2 = foot["leg1"], foot["leg2"]
     out.append(_var(W["ahead"], f"VARVAL({W['tx']})*DX({f2},{f1})+VARVAL({W['tz']})*"
                     f"DZ({f2},{f1})"))
-    for i, (g, o) in enumerate((("leg1", "leg2"), ("leg2", "leg1"))):
-        on = 650 + 2 * i
-        stands = "1,0,0" if g == "leg1" else "0,0,1"  # sign < 0: leg1 stands
-        ahead = f"VARVAL({W['ahead']})" if g == "leg1" else f"-VARVAL({W['ahead']})"
-        h, f = hip[g], foot[g]
-        push = W[f"push_{g}"]
-        out += [f"! {g} stands, {o}'s touchdown is predicted within T, {o} is ahead",
-                _var(on, f"IF(VARVAL({V['sign']}):{stands})*IF(VARVAL({W[f'lead_{o}']}):0,0,1)"),
-                _var(on + 1, f"VARVAL({on})*IF(VARVAL({W[f'pen_{o}']}):1,0,0)"),
-                _var(on + 5, f"VARVAL({on + 1})*IF({ahead}-{_f(min_step)}:0,0,1)"),
-                _var(push, f"VARVAL({on + 5})*VARVAL({W['impulse']})/VARVAL({W['pulse_s']})"),
-                f"GFORCE/{PUSH_3D_GFORCE[g]}, I={f}, JFLOAT={PUSH_3D_FLOAT_MARKER}, RM=101",
-                f", FX=VARVAL({push})*DX({h},{f})/DM({h},{f})\\",
-                f", FY=VARVAL({push})*DY({h},{f})/DM({h},{f})\\",
-                f", FZ=VARVAL({push})*DZ({h},{f})/DM({h},{f})\\",
-                ", TX=0.0\\TY=0.0\\TZ=0.0"]
-    return out
+    return out + push_forces(W, 650, hip, foot, PUSH_3D_GFORCE, PUSH_3D_FLOAT_MARKER,
+                             planar=False)
 
 
 def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float,

@@ -277,6 +277,92 @@ def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
     return out
 
 
+def push_impulse(po, W: dict, first: int, speed_marker: int) -> list[str]:
+    """The push-off's impulse ``P`` [N s] as VARIABLE ``W["impulse"]``: constant, or with a
+    speed gain ``P = max(0, P0 + k (v_ref - v))`` from the speed of ``speed_marker`` (Kuo 2002,
+    "Energetics of actively powered locomotion using the simplest walking model",
+    J. Biomech. Eng. 124(1); the rigid model's
+    :func:`walkerlab.models.actuation.push_off_impulse`).
+
+    Parameters
+    ----------
+    po : walkerlab.config.actuation.PushOff
+        ``impulse_n_s`` [N s], ``speed_gain_n_s2_per_m`` [N s^2/m], ``reference_speed_m_per_s``
+        [m/s].
+    W : dict
+        VARIABLE ids by name (``impulse``).
+    first : int
+        First of the four VARIABLE ids the speed gain's terms take (``P0``, ``k``, ``v_ref``,
+        ``v_ref - v`` [m/s]).
+    speed_marker : int
+        The marker whose speed ``VM`` [mm/s] is ``v``.
+
+    Returns
+    -------
+    list of str
+        The VARIABLE statements.
+    """
+    if not po.speed_gain_n_s2_per_m:
+        return [_var(W["impulse"], _f(po.impulse_n_s))]
+    p0, gain, ref, dv = first, first + 1, first + 2, first + 3
+    return [_var(p0, _f(po.impulse_n_s)), _var(gain, _f(po.speed_gain_n_s2_per_m)),
+            _var(ref, _f(po.reference_speed_m_per_s)),
+            _var(dv, f"VARVAL({ref})-VM({speed_marker})/{_f(MM)}"),
+            _var(W["impulse"], f"MAX(0.0,VARVAL({p0})+VARVAL({gain})*VARVAL({dv}))")]
+
+
+def push_forces(W: dict, first: int, hips: dict, feet: dict, gforce: dict, float_marker: int,
+                planar: bool) -> list[str]:
+    """Each leg's push-off switch and pulse: on while that leg stands (the role sign
+    ``ACT_VARIABLES["sign"]``), the other foot's touchdown is predicted within the pulse's
+    duration and that foot is at least :data:`PUSH_MIN_STEP_M` ahead; then a force
+    ``P / T`` [N] at the foot along the line to its own hip (a ``GFORCE``, the reaction on a
+    floating ground marker), the contact view's push-off (Kuo 2002, "Energetics of actively
+    powered locomotion using the simplest walking model", J. Biomech. Eng. 124(1)).
+
+    Parameters
+    ----------
+    W : dict
+        VARIABLE ids by name: ``pen_<leg>``, ``lead_<leg>``, ``ahead``, ``push_<leg>``,
+        ``impulse``, ``pulse_s``.
+    first : int
+        First VARIABLE id of the switches (``first + 2 i``, ``+ 1``, ``+ 5`` for leg ``i``).
+    hips, feet : dict
+        Marker ids by leg: the hip, the foot the force acts at.
+    gforce : dict
+        GFORCE id by leg.
+    float_marker : int
+        The floating ground marker that takes the reaction.
+    planar : bool
+        No force along z (the planar dataset).
+
+    Returns
+    -------
+    list of str
+        The statements, leg1's then leg2's.
+    """
+    sign = ACT_VARIABLES["sign"]
+    min_step = PUSH_MIN_STEP_M * MM
+    out = []
+    for i, (g, o) in enumerate((("leg1", "leg2"), ("leg2", "leg1"))):
+        on = first + 2 * i
+        stands = "1,0,0" if g == "leg1" else "0,0,1"  # sign < 0: leg1 stands
+        ahead = f"VARVAL({W['ahead']})" if g == "leg1" else f"-VARVAL({W['ahead']})"
+        h, f = hips[g], feet[g]
+        push = W[f"push_{g}"]
+        out += [f"! {g} stands, {o}'s touchdown is predicted within T, {o} is ahead",
+                _var(on, f"IF(VARVAL({sign}):{stands})*IF(VARVAL({W[f'lead_{o}']}):0,0,1)"),
+                _var(on + 1, f"VARVAL({on})*IF(VARVAL({W[f'pen_{o}']}):1,0,0)"),
+                _var(on + 5, f"VARVAL({on + 1})*IF({ahead}-{_f(min_step)}:0,0,1)"),
+                _var(push, f"VARVAL({on + 5})*VARVAL({W['impulse']})/VARVAL({W['pulse_s']})"),
+                f"GFORCE/{gforce[g]}, I={f}, JFLOAT={float_marker}, RM=101",
+                f", FX=VARVAL({push})*DX({h},{f})/DM({h},{f})\\",
+                f", FY=VARVAL({push})*DY({h},{f})/DM({h},{f})\\"]
+        out += ([", FZ=0.0\\TX=0.0\\TY=0.0\\TZ=0.0"] if planar else
+                [f", FZ=VARVAL({push})*DZ({h},{f})/DM({h},{f})\\", ", TX=0.0\\TY=0.0\\TZ=0.0"])
+    return out
+
+
 def _push_off(mb, T: float, po, feet: dict, hips: dict, touch: dict | None = None
               ) -> list[str]:
     """The push-off pulse: a GFORCE at each foot (marker ``feet[leg]``), on while that leg
@@ -300,13 +386,7 @@ def _push_off(mb, T: float, po, feet: dict, hips: dict, touch: dict | None = Non
            f"MARKER/{PUSH_FLOAT_MARKER}, PART=1, FLOATING",
            _var(V["sin"], _f(math.sin(mb.slope_rad))), _var(V["cos"], _f(math.cos(mb.slope_rad))),
            _var(V["pulse_s"], _f(T))]
-    if po.speed_gain_n_s2_per_m:
-        out += [_var(334, _f(po.impulse_n_s)), _var(335, _f(po.speed_gain_n_s2_per_m)),
-                _var(336, _f(po.reference_speed_m_per_s)),
-                _var(337, f"VARVAL(336)-VM({hips['leg1']})/{_f(MM)}"),
-                _var(V["impulse"], "MAX(0.0,VARVAL(334)+VARVAL(335)*VARVAL(337))")]
-    else:
-        out.append(_var(V["impulse"], _f(po.impulse_n_s)))
+    out += push_impulse(po, V, 334, hips["leg1"])
     for g in ("leg1", "leg2"):
         f = touch[g]
         out += [_var(V[f"pen_{g}"],
@@ -316,22 +396,7 @@ def _push_off(mb, T: float, po, feet: dict, hips: dict, touch: dict | None = Non
                      f"VARVAL({V[f'rate_{g}']})")]
     out.append(_var(V["ahead"], f"VARVAL(331)*DX({touch['leg2']},{touch['leg1']})-VARVAL(330)*"
                     f"DY({touch['leg2']},{touch['leg1']})"))
-    for i, (g, o) in enumerate((("leg1", "leg2"), ("leg2", "leg1"))):
-        on = 350 + 2 * i
-        stands = "1,0,0" if g == "leg1" else "0,0,1"  # sign < 0: leg1 stands
-        ahead = f"VARVAL({V['ahead']})" if g == "leg1" else f"-VARVAL({V['ahead']})"
-        h, f = hips[g], feet[g]
-        push = V[f"push_{g}"]
-        out += [f"! {g} stands, {o}'s touchdown is predicted within T, {o} is ahead",
-                _var(on, f"IF(VARVAL({V['sign']}):{stands})*IF(VARVAL({V[f'lead_{o}']}):0,0,1)"),
-                _var(on + 1, f"VARVAL({on})*IF(VARVAL({V[f'pen_{o}']}):1,0,0)"),
-                _var(on + 5, f"VARVAL({on + 1})*IF({ahead}-{_f(min_step)}:0,0,1)"),
-                _var(push, f"VARVAL({on + 5})*VARVAL({V['impulse']})/VARVAL({V['pulse_s']})"),
-                f"GFORCE/{PUSH_GFORCE[g]}, I={f}, JFLOAT={PUSH_FLOAT_MARKER}, RM=101",
-                f", FX=VARVAL({push})*DX({h},{f})/DM({h},{f})\\",
-                f", FY=VARVAL({push})*DY({h},{f})/DM({h},{f})\\",
-                ", FZ=0.0\\TX=0.0\\TY=0.0\\TZ=0.0"]
-    return out
+    return out + push_forces(V, 350, hips, feet, PUSH_GFORCE, PUSH_FLOAT_MARKER, planar=True)
 
 
 def actuation_statements(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: bool

@@ -7,8 +7,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 __all__ = ["LANE_Z", "LINE_WIDTH", "MARKER_OFFSET", "MM", "AdamsStart", "marker_id",
-           "part_statement"]
+           "marker_statement", "part_statement"]
 
 #: Millimetres per metre (the file's length unit).
 MM = 1000.0
@@ -96,6 +98,31 @@ def _stmt(head: str, *args: str) -> list[str]:
         else:
             lines.append(f", {a}")
     return lines
+
+
+def marker_statement(mid: int, part: int, qp, angles=(0.0, 0.0, 0.0)) -> list[str]:
+    """A ``MARKER`` on PART ``part`` at ``qp`` (3,) [m] in the part's frame, turned by the
+    body-3-1-3 Euler ``angles`` (3,) [rad] (``REULER``; none written when all are 0), in the
+    file's units (mm, degrees; MSC Adams/Solver reference, the MARKER statement).
+
+    Parameters
+    ----------
+    mid, part : int
+        The MARKER's and its PART's ids.
+    qp : array_like (3,)
+        Its origin [m].
+    angles : tuple of float (3,)
+        Its orientation [rad].
+
+    Returns
+    -------
+    list of str
+        The statement's lines (:func:`_stmt`).
+    """
+    args = [f"QP={_fs(*(np.asarray(qp, float) * MM))}"]
+    if any(angles):
+        args.append(f"REULER={', '.join(_deg(a) for a in angles)}")
+    return _stmt(f"MARKER/{mid}, PART={part}", *args)
 
 
 def _rot(psi: float, p: tuple[float, float]) -> tuple[float, float]:

@@ -54,7 +54,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_3d import reuler_angles
 from walkerlab.export.adams_contact import contact_mm, contact_statement
-from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt
+from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt, marker_statement
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import Omission
@@ -230,13 +230,6 @@ def _boxes(start: WheelStart) -> list[tuple[str, np.ndarray, np.ndarray, tuple]]
              (math.pi / 2, start.slope_rad, -math.pi / 2), (length, across, depth))]
 
 
-def _marker(mid: int, part: int, qp, angles=(0.0, 0.0, 0.0)) -> list[str]:
-    args = [f"QP={_fs(*(np.asarray(qp, float) * MM))}"]
-    if any(angles):
-        args.append(f"REULER={', '.join(_deg(a) for a in angles)}")
-    return _stmt(f"MARKER/{mid}, PART={part}", *args)
-
-
 def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "") -> str:
     """The Adams Solver dataset of the scene's spoked wheel (mm-kg-s; module docstring).
 
@@ -277,12 +270,12 @@ def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "")
            "MARKER/102, PART=1, QP=0.0, 0.0, 0.0",
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY=0.0, KGRAVITY={_f(-data.gravity_m_per_s2 * MM)}"]
     if start.planar:   # z along the file's y: the plane of motion is x-z
-        out += _marker(103, 1, (0.0, 0.0, 0.0), (0.0, -math.pi / 2, 0.0))
+        out += marker_statement(103, 1, (0.0, 0.0, 0.0), (0.0, -math.pi / 2, 0.0))
     boxes = _boxes(start)
     out += [f"! the ground: {ground}, {len(boxes)} box(es), their tops r below it"]
     for k, (what, corner, angles, size) in enumerate(boxes):
         out += [f"! {what}"]
-        out += _marker(_BOX + k, 1, corner, angles)
+        out += marker_statement(_BOX + k, 1, corner, angles)
         out += _stmt(f"GRAPHICS/{_BOX + k}, BOX, CORNER={_BOX + k}",
                      *(f"{a}={_f(v * MM)}" for a, v in zip("XYZ", size)))
     vcm = start.velocity
@@ -295,16 +288,16 @@ def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "")
                  f"REULER={', '.join(_deg(a) for a in reuler_angles(R))}",
                  *(f"V{k}={_f(v * MM)}" for k, v in zip("XYZ", vcm)),
                  *(f"W{k}={_f(v)}" for k, v in zip("XYZ", wb)))
-    out += _marker(201, 2, start.com)
+    out += marker_statement(201, 2, start.com)
     if start.planar:   # the hub's plane marker: z along the axle
-        out += _marker(202, 2, start.com, reuler_angles(R.T @ np.array(   # 103's axes
+        out += marker_statement(202, 2, start.com, reuler_angles(R.T @ np.array(   # 103's axes
             [[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])))
     law = contact_mm(scene.contact or ContactSettings())
     contacts = []
     for k, (tip, qp) in enumerate(start.tips):
         m = TIP_MARKER + k
         out += [f"! {tip}"]
-        out += _marker(m, 2, qp)
+        out += marker_statement(m, 2, qp)
         out += _stmt(f"GRAPHICS/{m}, ELLIPSOID, CM={m}",
                      f"XSCALE={_f(2 * r * MM)}, YSCALE={_f(2 * r * MM)}, "
                      f"ZSCALE={_f(2 * r * MM)}")

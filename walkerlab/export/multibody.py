@@ -106,7 +106,7 @@ from walkerlab.export.motors import (  # noqa: F401 (part of this API)
     motor_target,
     motors,
 )
-from walkerlab.export.omitted import MJCF_KNEE_LATCH, Omission
+from walkerlab.export.omitted import MJCF_KNEE_LATCH, Omission, actuation_omissions
 from walkerlab.export.planar_bodies import planar_bodies
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_mjcf_text, wheel_urdf_text
 from walkerlab.export.text import arc_feet, header, num, nums
@@ -154,17 +154,8 @@ def mjcf_actuation_omissions(act) -> list[Omission]:
     stepping loop (:mod:`walkerlab.export.mujoco_walk`): the joint torque laws and the
     push-off (the planar walkers' MJCF, :func:`mjcf_omissions`, and the 3D straight legs',
     :mod:`walkerlab.export.legs_3d_mjcf`)."""
-    out = []
-    if act is not None and act.torques:
-        out.append(Omission("the joint torque laws (walker.actuation.torques)", "MJCF has no "
-                            "state-dependent torque law: the laws are in the custom text "
-                            "walkerlab_actuation, applied by a stepping loop "
-                            "(walkerlab.export.mujoco_walk)"))
-    if act is not None and act.push_off is not None:
-        out.append(Omission("the push-off (walker.actuation.push_off)", "MJCF has no "
-                            "event-switched force: a stepping loop applies it from each heel "
-                            "strike (walkerlab.export.mujoco_walk)"))
-    return out
+    return actuation_omissions("mjcf", act is not None and bool(act.torques),
+                               act is not None and act.push_off is not None)
 
 
 def _joint_springs(mb: Multibody) -> dict:

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 from walkerlab.export.text import comment
 
-__all__ = ["ADAMS_CONTINUATION", "MJCF_KNEE_LATCH", "PREFIX", "URDF_GROUND", "URDF_GROUND_3D",
-           "URDF_KNEE_LATCH",
-           "Omission", "adams_comments", "lines", "xml_comments"]
+__all__ = ["ADAMS_CONTINUATION", "ENGINE_ACTUATION", "MJCF_KNEE_LATCH", "OSIM_KNEE_LATCH",
+           "PREFIX", "URDF_GROUND", "URDF_GROUND_3D", "URDF_KNEE_LATCH",
+           "Omission", "actuation_omissions", "adams_comments", "lines", "xml_comments"]
 
 #: The text every omission comment starts with (after an XML comment's opening or an Adams
 #: comment's exclamation mark and a space).
@@ -72,11 +72,65 @@ URDF_GROUND_3D = Omission(
 MJCF_KNEE_LATCH = Omission(
     "the knee latch's switching", "MuJoCo has no contact-switched lock: the equalities "
     "leg<i>_latch are switched by a stepping loop (walkerlab.export.mujoco_walk.latch_rule)")
+#: A kneed walker's OpenSim model (planar, :func:`walkerlab.export.opensim.osim_omissions`; in
+#: 3D, :func:`walkerlab.export.opensim_3d.osim3d_omissions`): the latch force is switched
+#: outside the file.
+OSIM_KNEE_LATCH = Omission(
+    "the knee latch's switching", "OpenSim has no contact-switched force: leg<i>_knee_latch "
+    "applies no force by default, a stepping loop switches it (walkerlab.export.opensim_walk)")
 #: A kneed walker's URDF (planar, :func:`walkerlab.export.urdf_omitted.urdf_omissions`; in 3D,
 #: :func:`walkerlab.export.urdf_omitted.legs_urdf_omissions`): no latch, the stop its joint limit.
 URDF_KNEE_LATCH = Omission(
     "the knee latch (contact.knee_stop.latch)", "URDF has no contact-switched lock (the "
     "joint limit at 0 is the straight-leg stop)")
+
+
+#: What an engine's file (``"mjcf"``, ``"osim"``) leaves of ``walker.actuation`` to its stepping
+#: loop (:mod:`walkerlab.export.mujoco_walk`, :mod:`walkerlab.export.opensim_walk`):
+#: ``(the joint torque laws, the push-off)``, planar and in 3D alike.
+ENGINE_ACTUATION = {
+    "mjcf": (Omission("the joint torque laws (walker.actuation.torques)", "MJCF has no "
+                      "state-dependent torque law: the laws are in the custom text "
+                      "walkerlab_actuation, applied by a stepping loop "
+                      "(walkerlab.export.mujoco_walk)"),
+             Omission("the push-off (walker.actuation.push_off)", "MJCF has no event-switched "
+                      "force: a stepping loop applies it from each heel strike "
+                      "(walkerlab.export.mujoco_walk)")),
+    "osim": (Omission("the joint torque laws (walker.actuation.torques)", "OpenSim has no "
+                      "state-dependent torque law: the laws are in the comment "
+                      "walkerlab_actuation, a stepping loop sets the CoordinateActuators' "
+                      "controls (walkerlab.export.opensim_walk)"),
+             Omission("the push-off's switching (walker.actuation.push_off)", "OpenSim has "
+                      "no event-switched force: leg<i>_push_off applies no force by default, "
+                      "a stepping loop switches it from each heel strike "
+                      "(walkerlab.export.opensim_walk)")),
+}
+
+
+def actuation_omissions(engine: str, torques: bool, push_off: bool) -> list[Omission]:
+    """What ``engine``'s file leaves of the actuation to its stepping loop
+    (:data:`ENGINE_ACTUATION`).
+
+    Parameters
+    ----------
+    engine : {"mjcf", "osim"}
+        The format.
+    torques, push_off : bool
+        The scene has joint torque laws (``walker.actuation.torques``), a push-off
+        (``walker.actuation.push_off``).
+
+    Returns
+    -------
+    list of Omission
+        The torque laws' item, then the push-off's, each where the scene has it.
+
+    Raises
+    ------
+    KeyError
+        An engine without a stepping loop.
+    """
+    laws, push = ENGINE_ACTUATION[engine]
+    return [item for item, has in ((laws, torques), (push, push_off)) if has]
 
 
 def lines(items) -> tuple[str, ...]:

@@ -86,7 +86,7 @@ from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
-from walkerlab.export.omitted import Omission, xml_comments
+from walkerlab.export.omitted import OSIM_KNEE_LATCH, Omission, actuation_omissions, xml_comments
 from walkerlab.export.opensim_comments import header_comments
 from walkerlab.export.opensim_contact import (
     hunt_crossley,
@@ -299,22 +299,10 @@ def osim_omissions(mb, gait: OsimGait) -> tuple[Omission, ...]:
     (:mod:`walkerlab.export.omitted`; :mod:`walkerlab.export.opensim_walk` is walkerlab's):
     the knee latch's switching, the joint torque laws and the push-off's switching (OpenSim
     has no contact- or event-switched force)."""
-    out = []
-    if export_part(mb).knee_stops:
-        out.append(Omission("the knee latch's switching", "OpenSim has no contact-switched "
-                            "force: leg<i>_knee_latch applies no force by default, a stepping "
-                            "loop switches it (walkerlab.export.opensim_walk)"))
+    out = [OSIM_KNEE_LATCH] if export_part(mb).knee_stops else []
     act = gait.actuation
-    if act is not None and act.torques:
-        out.append(Omission("the joint torque laws (walker.actuation.torques)", "OpenSim has "
-                            "no state-dependent torque law: the laws are in the comment "
-                            "walkerlab_actuation, a stepping loop sets the CoordinateActuators' "
-                            "controls (walkerlab.export.opensim_walk)"))
-    if gait.push_off is not None:
-        out.append(Omission("the push-off's switching (walker.actuation.push_off)", "OpenSim "
-                            "has no event-switched force: leg<i>_push_off applies no force by "
-                            "default, a stepping loop switches it from each heel strike "
-                            "(walkerlab.export.opensim_walk)"))
+    out += actuation_omissions("osim", act is not None and bool(act.torques),
+                               gait.push_off is not None)
     return tuple(out)
 
 

@@ -81,7 +81,7 @@ from walkerlab.export.legs_3d_parts import (
     walker_tree,
 )
 from walkerlab.export.mjcf_scene import actuation_text
-from walkerlab.export.omitted import Omission, xml_comments
+from walkerlab.export.omitted import OSIM_KNEE_LATCH, Omission, actuation_omissions, xml_comments
 from walkerlab.export.opensim_comments import knee_comment
 from walkerlab.export.opensim_contact import (
     hunt_crossley,
@@ -262,27 +262,15 @@ def osim3d_omissions(data, gait: Osim3dGait) -> tuple[Omission, ...]:
     """What the 3D OpenSim model leaves to a stepping loop
     (:mod:`walkerlab.export.opensim_walk`): the planar model's (the knee latch's switching,
     the joint torque laws, the push-off's switching) and the hip-roll law."""
-    out = []
-    if kneed(data):
-        out.append(Omission("the knee latch's switching", "OpenSim has no contact-switched "
-                            "force: leg<i>_knee_latch applies no force by default, a stepping "
-                            "loop switches it (walkerlab.export.opensim_walk)"))
+    out = [OSIM_KNEE_LATCH] if kneed(data) else []
     if hip_roll_law(data) is not None:
         out.append(Omission("the hip-roll law (walker.hip_roll)", "OpenSim has no "
                             "state-dependent torque law that swaps with the stance leg: the "
                             "gains are in the comment walkerlab_hip_roll, a stepping loop sets "
                             "the roll CoordinateActuators (walkerlab.export.opensim_walk)"))
     act = gait.scene.actuation
-    if act is not None and act.torques:
-        out.append(Omission("the joint torque laws (walker.actuation.torques)", "OpenSim has "
-                            "no state-dependent torque law: the laws are in the comment "
-                            "walkerlab_actuation, a stepping loop sets the CoordinateActuators' "
-                            "controls (walkerlab.export.opensim_walk)"))
-    if act is not None and act.push_off is not None:
-        out.append(Omission("the push-off's switching (walker.actuation.push_off)", "OpenSim "
-                            "has no event-switched force: leg<i>_push_off applies no force by "
-                            "default, a stepping loop switches it from each heel strike "
-                            "(walkerlab.export.opensim_walk)"))
+    out += actuation_omissions("osim", act is not None and bool(act.torques),
+                               act is not None and act.push_off is not None)
     return tuple(out)
 
 

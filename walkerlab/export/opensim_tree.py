@@ -29,7 +29,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from walkerlab.export.axes_3d import TO_MUJOCO
-from walkerlab.export.opensim_xml import _coordinate, _frame
+from walkerlab.export.opensim_xml import _coordinate, _frame, transform_axis
 from walkerlab.export.text import num, nums
 
 __all__ = ["osim_axis", "osim_inertia", "tree_body_set", "tree_constraint_set",
@@ -94,20 +94,13 @@ def _completed(axes: list[np.ndarray]) -> list[np.ndarray]:
 def _transform(rotations, translations) -> list[str]:
     """A ``SpatialTransform``: ``rotations`` and ``translations`` each a list of (axis (3,),
     coordinate or None) (at most three; the rotations completed by constant ones)."""
-    i = "\t\t\t\t\t\t"
     rot = list(rotations) + [(a, None) for a in
                              _completed([a for a, _ in rotations])[len(rotations):]]
     trans = list(translations) + [(e, None) for e in np.eye(3)[len(translations):]]
     out = ["\t\t\t\t\t<SpatialTransform>"]
     for kind, axes in (("rotation", rot), ("translation", trans)):
         for k, (axis, coord) in enumerate(axes, 1):
-            fn = ('<LinearFunction name="function"><coefficients>1 0</coefficients>'
-                  "</LinearFunction>" if coord else
-                  '<Constant name="function"><value>0</value></Constant>')
-            out += [f'{i}<TransformAxis name="{kind}{k}">',
-                    f"{i}\t<coordinates>{coord or ''}</coordinates>",
-                    f"{i}\t<axis>{_axis_text(axis)}</axis>", f"{i}\t{fn}",
-                    f"{i}</TransformAxis>"]
+            out += transform_axis(f"{kind}{k}", _axis_text(axis), coord)
     return out + ["\t\t\t\t\t</SpatialTransform>"]
 
 

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
 
 __all__ = ["ankle_springs", "body_set", "contact_forces", "contact_geometry_set", "couplers",
            "joint_set", "knee_stop_forces", "motor_forces", "push_off_forces",
-           "spring_forces", "torque_joints"]
+           "spring_forces", "torque_joints", "transform_axis"]
 
 
 def _frame(name: str, parent: str, translation=(0.0, 0.0, 0.0), orientation=(0.0, 0.0, 0.0),
@@ -28,6 +28,35 @@ def _frame(name: str, parent: str, translation=(0.0, 0.0, 0.0), orientation=(0.0
             f"{ind}\t<translation>{nums(*translation)}</translation>",
             f"{ind}\t<orientation>{nums(*orientation)}</orientation>",
             f"{ind}</PhysicalOffsetFrame>"]
+
+
+def transform_axis(name: str, axis: str, coord: str | None) -> list[str]:
+    """One ``TransformAxis`` of a ``CustomJoint``'s ``SpatialTransform`` (OpenSim 4; Seth et
+    al. 2018, "OpenSim: Simulating musculoskeletal dynamics and neuromuscular control to study
+    human and animal movement", PLoS Comput. Biol. 14(7)): about or along ``axis`` (its text,
+    three numbers), the coordinate ``coord`` [rad or m] through a unit ``LinearFunction``, or
+    none (a ``Constant`` 0).
+
+    Parameters
+    ----------
+    name : str
+        ``rotation1`` .. ``rotation3``, ``translation1`` .. ``translation3``.
+    axis : str
+        The axis' three components, as written.
+    coord : str or None
+        The coordinate's name, or None for a fixed axis.
+
+    Returns
+    -------
+    list of str
+        The element's lines, indented inside a ``SpatialTransform``.
+    """
+    i = "\t\t\t\t\t\t"
+    fn = ('<LinearFunction name="function"><coefficients>1 0</coefficients>'
+          "</LinearFunction>" if coord else
+          '<Constant name="function"><value>0</value></Constant>')
+    return [f'{i}<TransformAxis name="{name}">', f"{i}\t<coordinates>{coord or ''}</coordinates>",
+            f"{i}\t<axis>{axis}</axis>", f"{i}\t{fn}", f"{i}</TransformAxis>"]
 
 
 def _coordinate(name: str, value: float, speed: float, ind: str = "\t\t\t\t\t\t") -> list[str]:
@@ -134,13 +163,7 @@ def joint_set(mb, q0: dict, v0: dict, ankles=()) -> list[str]:
                                    ("translation1", "1 0 0", "hip_x"),
                                    ("translation2", "0 1 0", "hip_y"),
                                    ("translation3", "0 0 1", None)):
-        fn = ('<LinearFunction name="function"><coefficients>1 0</coefficients>'
-              "</LinearFunction>" if coord else
-              '<Constant name="function"><value>0</value></Constant>')
-        out += [f'\t\t\t\t\t\t<TransformAxis name="{axis_name}">',
-                f"\t\t\t\t\t\t\t<coordinates>{coord or ''}</coordinates>",
-                f"\t\t\t\t\t\t\t<axis>{axis}</axis>", f"\t\t\t\t\t\t\t{fn}",
-                "\t\t\t\t\t\t</TransformAxis>"]
+        out += transform_axis(axis_name, axis, coord)
     out += ["\t\t\t\t\t</SpatialTransform>", "\t\t\t\t</CustomJoint>"]
     for ln in mb.links:
         parent = "hip" if ln.parent == "hip" else ln.parent

@@ -97,8 +97,8 @@ class Plant:
         -------
         WalkerData
         """
-        key = (slope_rad, math.copysign(1.0, slope_rad))  # -0.0 and 0.0 apart
-        if key == (self.data.slope_rad, math.copysign(1.0, self.data.slope_rad)):
+        key = _slope_key(slope_rad)
+        if key == _slope_key(self.data.slope_rad):
             return self.data
         if key not in self._slopes:
             self._slopes[key] = walker_data(self.scene.walker, slope_rad)
@@ -129,8 +129,7 @@ class Plant:
             return self
         if scene.walker != self.scene.walker:
             return Plant.from_scene(scene)
-        own = self.data.slope_rad
-        self._slopes.setdefault((own, math.copysign(1.0, own)), self.data)
+        self._slopes.setdefault(_slope_key(self.data.slope_rad), self.data)
         return Plant(scene, self.data_at(scene.slope.phi_rad), self._slopes)
 
     def on_slope(self, slope_rad: float) -> Plant:
@@ -151,6 +150,12 @@ class Plant:
         scene = self.scene.model_copy(update={"slope": self.scene.slope.model_copy(
             update={"angle_rad": g, "angle_deg": None})})
         return Plant(scene, self.data_at(g), self._slopes)
+
+
+def _slope_key(slope_rad: float) -> tuple[float, float]:
+    """A slope's key among a plant's descriptions: the angle and its sign (-0.0 and 0.0
+    apart)."""
+    return slope_rad, math.copysign(1.0, slope_rad)
 
 
 def compass_gait_data(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: float,
