@@ -202,7 +202,7 @@ def test_the_five_link_step_map_on_lsoda_calls_no_python_flow_and_agrees_with_it
     x0 = np.asarray(initial_guess(scene, w), float)
     x1, T1, _ = poincare_map(w, x0, solver)
     assert calls == []
-    monkeypatch.setattr(rigid, "_runs_compiled", lambda phase, backend: False)
+    monkeypatch.setattr(rigid, "_runs_compiled_on_scipy", lambda phase: False)
     x2, T2, _ = poincare_map(w, x0, solver)
     assert calls  # the Python flow, as before
     assert np.max(np.abs(x1 - x2)) < 1e-9 and abs(T1 - T2) < 1e-10

@@ -65,10 +65,10 @@ def test_compiled_closed_loop_is_the_python_flow_and_jacobian(walker_and_scene):
 def test_the_scenes_lsoda_keeps_the_python_flow(walker_and_scene):
     """A scipy method runs the phases' Python flow (the shipped scenes' numbers as they
     were): the compiled closed loop is the compiled backend's."""
-    from walkerlab.integrate.rigid import _runs_compiled
+    from walkerlab.integrate.rigid import _runs_compiled_on_scipy
 
     walker, _ = walker_and_scene
-    assert not any(_runs_compiled(ph, "scipy") for ph in walker.phases)
+    assert not any(_runs_compiled_on_scipy(ph) for ph in walker.phases)
 
 
 @pytest.mark.slow

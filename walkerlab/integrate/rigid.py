@@ -236,25 +236,16 @@ def _enter_step(walker: HybridWalker, st: _StepState, variational: bool) -> int:
     return 0 if name is None else [p.name for p in walker.phases].index(name)
 
 
-def _runs_compiled(phase: Phase, backend: str) -> bool:
-    """Whether a phase run by a library integrator (scipy's ``solve_ivp`` or CyRK's Python
-    interface) calls its compiled flow instead of its printed Python one: where the Python
-    flow is slow and the compiled one is the same function, to round-off.
-
-    - a walker in 3D (:attr:`walkerlab.walker.kinds.Kind.in_3d`): its printed flow is long
-      (about 100 µs a call on a quiet 2-core machine for ``hip_width_stabilised``, against
-      4 µs for the paper's compass gait), its compiled flow a few µs through ctypes;
-    - on scipy (a stiff method, e.g. LSODA, which CyRK does not have), an actuated flow of
-      a free-jointed walker (:attr:`~walkerlab.walker.kinds.Kind.joints_free`: the
-      five-link biped's and the three-link walker's Python flow evaluates the laws and
-      differentiates them by the complex step on every call).
-    """
+def _runs_compiled_on_scipy(phase: Phase) -> bool:
+    """Whether a phase run by scipy (a stiff method, e.g. LSODA) calls its compiled flow
+    instead of its Python one: an actuated flow of a kind whose Python flow is slow (the
+    free-jointed walkers', :attr:`walkerlab.walker.kinds.Kind.joints_free`: the five-link
+    biped's and the three-link walker's Python flow evaluates the laws and differentiates
+    them by the complex step on every call; the compiled flow is the same function, to
+    round-off)."""
     c = phase.compiled
-    if c is None or backend not in ("scipy", "cyrk"):
-        return False
-    kind = c.structure.kind
-    return kind.in_3d or (backend == "scipy" and getattr(c, "actuators", None) is not None
-                          and kind.joints_free)
+    return (c is not None and getattr(c, "actuators", None) is not None
+            and c.structure.kind.joints_free)
 
 
 def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, n: int,
@@ -270,7 +261,7 @@ def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, 
         st.phase_log.append((phase.name, st.t, st.t, broken.name))
         return None
     rhs, jac = phase_rhs(walker, phase, n, variational)
-    if _runs_compiled(phase, backend):
+    if backend == "scipy" and _runs_compiled_on_scipy(phase):
         from walkerlab.integrate._compiled import callable_flow
 
         rhs, jac = callable_flow(phase.compiled, n, variational)
