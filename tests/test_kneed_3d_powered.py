@@ -74,6 +74,7 @@ def test_the_kneed_walker_in_3d_takes_hip_and_knee_torques_and_push_off_in_the_r
     Scene.model_validate(_raw("kneed_3d.yaml", actuation=ACTUATION))
 
 
+@pytest.mark.slow  # ~1.5 min on a fresh cache: the driven 3D kneed derivation
 def test_zero_torque_and_zero_impulse_give_the_passive_kneed_walker_in_3d():
     """A law of zero at the hip and the knee and a push-off of 0 N s: every phase's flow
     and the heel strike are the passive walker's (configs/kneed_3d.yaml, both hip sides:

@@ -45,6 +45,7 @@ def _states(n: int, count: int, seed: int = 3) -> list:
             for _ in range(count)]
 
 
+@pytest.mark.slow  # ~2-4 min on a fresh cache: three 3D torso derivations (torso, hip, none)
 def test_a_torso_torque_in_3d_is_minus_half_the_hip_torque_on_the_bisecting_hip():
     """On the bisecting hip the upper body's pitch is the legs' mean, so the stance hip's
     angle (stance leg minus torso) is ``-delta / 2`` (``delta`` = swing - stance) and a
