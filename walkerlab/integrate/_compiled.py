@@ -202,11 +202,13 @@ def callable_flow(compiled, n: int, variational: bool):
     fn = proto(compiled.address(variational))
     m = n + n * n if variational else n
     # the call's buffers, their addresses read once (numpy's ``.ctypes.data`` costs more
-    # than the cfunc's call): the state copied in, the flow copied out
+    # than the cfunc's call): the state copied in, the flow copied out; each closure holds
+    # every buffer whose address it passes (``_alive``: the data vector, which the cfunc
+    # writes its call count into, must outlive this frame)
     y_in, out = np.empty(m), np.empty(m + extra)
     at_y, at_out, at_data = (int(a.ctypes.data) for a in (y_in, out, data))
 
-    def rhs(t, y):
+    def rhs(t, y, _alive=data):
         y_in[:] = y
         fn(at_out, float(t), at_y, at_data)
         return out[:m].copy()
@@ -218,7 +220,7 @@ def callable_flow(compiled, n: int, variational: bool):
     y_jac[n:] = np.eye(n).ravel()
     at_yj, at_oj = int(y_jac.ctypes.data), int(out_jac.ctypes.data)
 
-    def jac(t, x):
+    def jac(t, x, _alive=data):
         y_jac[:n] = x
         fv(at_oj, float(t), at_yj, at_data)
         return out_jac[n:n + n * n].reshape(n, n).copy()
