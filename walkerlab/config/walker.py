@@ -289,8 +289,6 @@ class BipedParams(_Actuated):
         if leg.knee is not None:  # what the kneed walker in 3D does not carry yet
             if self.torso is not None:
                 raise ValueError(f"walker.torso: {KNEED_3D_TORSO}")
-            if self.hip_roll is not None:
-                raise ValueError(f"walker.hip_roll: {KNEED_3D_HIP_ROLL}")
         for field, bad, what in (
                 ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
                 ("walker.legs", self.legs is not None and pair[0] != pair[1],

@@ -397,10 +397,12 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
         ("torso_torque", "*"): KNEED_3D_TORSO,
-        # hip-roll joints: the 3D straight legs' law on the kneed tree derives
+        # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
-        # straight at the heel strike); the scene refuses them (no measured gait)
+        # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's
+        # in the rigid model and the gym's rigid view (it steps the rigid model)
         ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
+        **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf")},
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
