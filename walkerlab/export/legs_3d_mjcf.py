@@ -205,8 +205,7 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
 
     Returns
     -------
-    (qpos (9,), qvel (8,)); knees (11,), (10,); hip-roll joints (8,), (8,); both (10,),
-    (10,) : tuple of float
+    (qpos (9,), qvel (8,)); knees (11,), (10,); hip-roll joints (8,), (8,); both (10,) each
     """
     from scipy.spatial.transform import Rotation
 
@@ -214,8 +213,7 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
     rolled = x.size in (10, 12)  # hip-roll joints: the pelvis' and the swing leg's own rolls
     kneed = x.size in (8, 12)    # a knee on the swing leg: its shank's own angle
     if rolled and kneed:
-        (lean, sw, shank, st, pelvis_roll, swing_roll,
-         dlean, dsw, dshank, dst, dpelvis, dswing) = x
+        lean, sw, shank, st, pelvis_roll, swing_roll, dlean, dsw, dshank, dst, dpelvis, dswing = x
     elif rolled:
         lean, sw, st, pelvis_roll, swing_roll, dlean, dsw, dst, dpelvis, dswing = x
     else:   # the pelvis and the swing leg roll with the stance leg's lean
@@ -498,8 +496,7 @@ def _bodies(data) -> tuple:
     roles = legs3d_roles(data)
     root, couplings = export_bodies(tree, coords, p, roles)
     if kneed(data) and not data.structure.hip_roll:  # the pelvis a rod between the hips
-        # (module docstring); on its slides and roll (hip-roll joints) it cannot yaw, and
-        # keeps the law's roll inertia
+        # (module docstring); on slides and a roll (hip-roll joints) it keeps the law's inertia
         root = replace(root, inertia_kg_m2=pelvis_rod_inertia(p))
     return (root, _geoms(p, roles, round_feet(data)), *mjcf_coupling_lines(couplings))
 
