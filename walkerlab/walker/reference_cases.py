@@ -116,8 +116,9 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         # ones: refused) and its gait's start (its roles with the two rolls)
         stabilised = _shipped(SHIPPED.get((kind, feature), "hip_width_stabilised"))
         w["hip_roll"] = stabilised["walker"]["hip_roll"]
-        if (kind, feature) in SHIPPED:
+        if (kind, feature) in SHIPPED:  # and the precision its gait was searched at
             d["fixedpoint"]["initial_guess"] = stabilised["fixedpoint"]["initial_guess"]
+            d["solver"] = stabilised["solver"]
     elif feature == "round_feet_3d":  # configs/round_feet_3d.yaml's disc feet (refused by
         w["foot_radius_m"] = 0.2  # any walker but the 3D straight legs: the scene's check)
     elif feature in TERRAIN:
