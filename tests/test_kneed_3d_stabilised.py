@@ -209,3 +209,26 @@ def test_the_stabilised_kneed_gait_is_a_fixed_point_and_every_multiplier_inside_
     assert np.max(np.abs(x_next - x)) < 1e-8
     assert np.max(np.abs(mu)) < 0.95
     assert abs(period - 1.0905) < 0.02 * 1.0905
+
+
+@pytest.mark.slow   # ~1.5 min: the rigid gait's search, the export and 11 steps in MuJoCo
+def test_the_stabilised_kneed_mjcf_walks_ten_steps_within_1_percent_of_the_rigid_period(
+        tmp_path):
+    """The scene's MJCF (the pelvis on slides and a roll, each leg's roll, hip and knee
+    hinges, the knee latch and the hip-roll law run by walkerlab's walk loop) makes >= 10
+    alternating heel strikes in MuJoCo without falling (the passive kneed walker's leaves
+    its gait within its first stride), every step period within 3 % (the table's MJCF
+    tolerance) and the mean within 1 % of the rigid one (the issue's target; measured
+    -0.55 %)."""
+    pytest.importorskip("mujoco")
+    from walkerlab.cli.options import load
+    from walkerlab.export.mujoco_walk import walk
+    from walkerlab.stages import export
+
+    out = export.write(load(str(ROOT / "configs" / SCENE)), tmp_path, "mjcf", walk=True)
+    assert not out.walk.fell and out.walk.alternating and out.walk.strikes >= 10, out.walk.line
+    run = walk(out.path, 11.3 * out.step_period_s)
+    periods = np.asarray(run.step_periods_s)
+    assert len(run.times_s) >= 10 and not run.fell
+    assert np.max(np.abs(periods / out.step_period_s - 1.0)) < 0.03
+    assert abs(np.mean(periods) / out.step_period_s - 1.0) < 0.01
