@@ -81,8 +81,10 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
         with pytest.raises(KindRefused) as err:
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
-    for feature in ("round_feet_3d", "profile", "torso_torque", "hip_roll"):
+    for feature in ("round_feet_3d", "profile", "torso_torque"):
         assert not kind.supports(feature, "rigid"), feature
+    # hip-roll joints: configs/kneed_3d_stabilised.yaml (tests/test_kneed_3d_stabilised.py)
+    assert kind.supports("hip_roll", "rigid")
     # the planar kneed walker's torques and push-off (tests/test_kneed_3d_powered.py)
     for feature in ("hip_torque", "knee_torque", "push_off"):
         assert kind.supports(feature, "rigid"), feature

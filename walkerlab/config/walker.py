@@ -87,15 +87,16 @@ class HipRollLaw(Strict):
 #: the one line refusing hip-roll joints elsewhere (the capability table's reason)
 HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged walker's with "
                   "hip width (walker.space: 3d, hip_width_m > 0)")
-#: what a walker with locking knees in 3D does not carry yet (``walker.space: 3d`` with a
-#: ``leg.knee``), each the reason after its field in the scene's one line and in the
-#: capability table (:data:`walkerlab.walker.capability_cells.CAPABILITIES`,
-#: ``locking_knees_3d``)
+#: what a walker with locking knees in 3D does not carry (``walker.space: 3d`` with a
+#: ``leg.knee``): the upper body is the reason after its field in the scene's one line;
+#: both are reasons of the capability table (:data:`walkerlab.walker.capability_cells.
+#: CAPABILITIES`, ``locking_knees_3d``: the hip-roll joints' views that refuse them)
 KNEED_3D_TORSO = "a kneed walker in 3D carries no upper body so far"
-KNEED_3D_HIP_ROLL = ("hip-roll joints on a kneed walker in 3D: its equations derive "
-                     "(walkerlab.codegen.legged: lean, thigh, shank, stance, then the rolls) "
-                     "but no gait of them is measured, so no view takes them; "
-                     "configs/hip_width_stabilised.yaml steadies the straight legs")
+KNEED_3D_HIP_ROLL = ("OpenSim has no contact-switched force: the knee latch and the "
+                     "hip-roll law both run in walkerlab's stepping loop between Manager "
+                     "windows (walkerlab.export.opensim_walk), a pair no OpenSim walk has "
+                     "checked; configs/kneed_3d_stabilised.yaml walks in the rigid and "
+                     "contact models and in MuJoCo (export --format mjcf)")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "
@@ -289,8 +290,6 @@ class BipedParams(_Actuated):
         if leg.knee is not None:  # what the kneed walker in 3D does not carry yet
             if self.torso is not None:
                 raise ValueError(f"walker.torso: {KNEED_3D_TORSO}")
-            if self.hip_roll is not None:
-                raise ValueError(f"walker.hip_roll: {KNEED_3D_HIP_ROLL}")
         for field, bad, what in (
                 ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
                 ("walker.legs", self.legs is not None and pair[0] != pair[1],

@@ -187,7 +187,7 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
         The rigid walker's generated ``points`` and ``point_velocities``
         (:func:`walkerlab.codegen.cache.functions`; world axes of walkerlab, the stance foot
         at the origin): ``hip`` (the pelvis), ``stance_hip``.
-    x : ndarray (6,), (8,) or (10,)
+    x : ndarray (6,), (8,), (10,) or (12,)
         ``[lean, swing, stance]`` [rad] and their rates [rad/s]; knees: ``[lean,
         swing_thigh, swing_shank, stance]``, each leg's hip then knee ``swing_thigh,
         swing_shank - swing_thigh, stance, 0`` and their rates; with hip-roll joints
@@ -195,7 +195,9 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
         (8,) = the pelvis' slides, its roll, ``leg1_roll`` = ``swing_roll - pelvis_roll``,
         ``leg1_hip``, ``leg2_roll`` = ``lean - pelvis_roll``, ``leg2_hip``, ``qvel`` (8,)
         their rates (the pelvis rolled by ``pelvis_roll``, the stance leg's pitch axis
-        ``Rot(s, lean) z``).
+        ``Rot(s, lean) z``); knees with hip-roll joints ``[lean, swing_thigh,
+        swing_shank, stance, pelvis_roll, swing_roll]`` and their rates: each leg's roll,
+        hip, then knee (the stance knee straight).
     slope_rad : float
     foot_radius_m : float
         The foot sphere's radius ``r`` [m]; 0 for round feet (the rigid model's discs are
@@ -203,14 +205,16 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
 
     Returns
     -------
-    (qpos (9,), qvel (8,)); knees (11,), (10,); hip-roll joints (8,), (8,) : tuple of float
+    (qpos (9,), qvel (8,)); knees (11,), (10,); hip-roll joints (8,), (8,); both (10,) each
     """
     from scipy.spatial.transform import Rotation
 
     x = np.asarray(x, float)
-    rolled = x.size == 10  # hip-roll joints: the pelvis' and the swing leg's own rolls
-    kneed = x.size == 8    # a knee on the swing leg: its shank's own angle
-    if rolled:
+    rolled = x.size in (10, 12)  # hip-roll joints: the pelvis' and the swing leg's own rolls
+    kneed = x.size in (8, 12)    # a knee on the swing leg: its shank's own angle
+    if rolled and kneed:
+        lean, sw, shank, st, pelvis_roll, swing_roll, dlean, dsw, dshank, dst, dpelvis, dswing = x
+    elif rolled:
         lean, sw, st, pelvis_roll, swing_roll, dlean, dsw, dst, dpelvis, dswing = x
     else:   # the pelvis and the swing leg roll with the stance leg's lean
         if kneed:
@@ -234,10 +238,15 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
     qx, qy, qz, qw = Rotation.from_matrix(Rm).as_quat()
     qpos = (*(C @ pelvis), qw, qx, qy, qz, sw, st)
     qvel = (*(C @ v_pelvis), *(Rm.T @ (C @ (dpelvis * fall))), dsw, dst)
-    if rolled:  # the pelvis on slides, yaw (0) and roll; each leg's roll, then its hinge
+    if rolled and kneed:  # ... each leg's roll, its hip, then its knee (the stance's straight)
+        qpos = (*qpos[:3], pelvis_roll, swing_roll - pelvis_roll, sw, shank - sw,
+                lean - pelvis_roll, st, 0.0)
+        qvel = (*qvel[:3], dpelvis, dswing - dpelvis, dsw, dshank - dsw, dlean - dpelvis,
+                dst, 0.0)
+    elif rolled:  # the pelvis on slides, yaw (0) and roll; each leg's roll, then its hinge
         qpos = (*qpos[:3], pelvis_roll, swing_roll - pelvis_roll, sw, lean - pelvis_roll, st)
         qvel = (*qvel[:3], dpelvis, dswing - dpelvis, dsw, dlean - dpelvis, dst)
-    if kneed:   # each leg's hip, then its knee (the stance knee straight)
+    elif kneed:   # each leg's hip, then its knee (the stance knee straight)
         qpos = (*qpos[:7], sw, shank - sw, st, 0.0)
         qvel = (*qvel[:6], dsw, dshank - dsw, dst, 0.0)
     return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
@@ -486,7 +495,8 @@ def _bodies(data) -> tuple:
     tree, coords, p = walker_tree(data)
     roles = legs3d_roles(data)
     root, couplings = export_bodies(tree, coords, p, roles)
-    if kneed(data):  # the pelvis a rod between the hips (module docstring)
+    if kneed(data) and not data.structure.hip_roll:  # the pelvis a rod between the hips
+        # (module docstring); on slides and a roll (hip-roll joints) it keeps the law's inertia
         root = replace(root, inertia_kg_m2=pelvis_rod_inertia(p))
     return (root, _geoms(p, roles, round_feet(data)), *mjcf_coupling_lines(couplings))
 

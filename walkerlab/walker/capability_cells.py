@@ -86,8 +86,9 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
 #: why the kneed walker in 3D's MJCF refuses stairs and footholds
-KNEED_3D_GROUND_MJCF = ("the kneed walker in 3D is laterally unstable (x40 a stride) and no "
-                        "hip-roll law steadies it: its MuJoCo walk holds the rigid gait over "
+KNEED_3D_GROUND_MJCF = ("the passive kneed walker in 3D is laterally unstable (x40 a stride; "
+                        "its hip-roll law steadies it on the slope: configs/"
+                        "kneed_3d_stabilised.yaml): its MuJoCo walk holds the rigid gait over "
                         "its first stride on the slope (its walk cell), and its MJCF lays no "
                         "stairs or footholds")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
@@ -134,9 +135,10 @@ EXPORT_3D = ("the OpenSim export writes legs (a tree of leg links, or the 3D leg
 #: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
 #: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
 KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
-                         "gait is laterally unstable (x40 a stride) and no hip-roll law "
-                         "steadies a kneed walker in 3D, so a walk started a little off it "
-                         "capsizes within a few steps, as the rigid walk would")
+                         "gait is laterally unstable (x40 a stride), so a walk started a "
+                         "little off it capsizes within a few steps, as the rigid walk would "
+                         "(its hip-roll cell's law steadies it: configs/"
+                         "kneed_3d_stabilised.yaml)")
 #: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
 #: rigid view) refuse its joint torques and push-off: the powered gait
 #: (configs/kneed_3d_powered.yaml's) keeps the passive one's lateral instability, and it
@@ -397,10 +399,15 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
         ("torso_torque", "*"): KNEED_3D_TORSO,
-        # hip-roll joints: the 3D straight legs' law on the kneed tree derives
+        # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
-        # straight at the heel strike); the scene refuses them (no measured gait)
+        # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's
+        # in the rigid model and the gym's rigid view (it steps the rigid model)
+        # the compliant-contact model (the floating tree's rolls and knees, the law's
+        # stance_forces), the MJCF (its pelvis on slides and a roll, the knees' latch and
+        # HipRollLoop together), the URDF and the Adams dataset
         ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
+        **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams")},
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
@@ -465,13 +472,14 @@ ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk 
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
 CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
-              ("locking_knees_3d", "osim"): KNEE_LATCH_OSIM,
-              ("locking_knees_3d", "contact"): KNEED_3D_FIRST_STRIDE,
-              ("locking_knees_3d", "mjcf"): KNEED_3D_FIRST_STRIDE}
+              ("locking_knees_3d", "osim"): KNEE_LATCH_OSIM}
 #: (kind, feature, view) -> what one supported cell rests on beyond its measurement, where
 #: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
 FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
-                 ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT}
+                 ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
+                 # the passive gait's first stride (the stabilised one, hip_roll, walks on)
+                 ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
+                 ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE}
 
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``
@@ -479,10 +487,12 @@ FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
 STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
                "stability-map": ("walk", "contact")}
 #: why the robustness study refuses a 3D kneed walker (:mod:`walkerlab.studies.robustness_study`)
-ROBUSTNESS_KNEED_3D = ("a kneed walker in 3D is passive and laterally unstable (a stride "
-                       "multiplier of about 40, configs/kneed_3d.yaml) and takes no hip-roll "
-                       "law to steady it: its sensitivity norms are infinite and it survives "
-                       "no disturbance; its metastability is walkerlab mfpt's")
+ROBUSTNESS_KNEED_3D = ("the robustness study's pushes in 3D are checked on straight legs "
+                       "(configs/hip_width_stabilised.yaml) and on no kneed walker: the "
+                       "passive one (configs/kneed_3d.yaml, a stride multiplier of about 40) "
+                       "has infinite norms and survives no disturbance, and no run has "
+                       "measured the stabilised one's (configs/kneed_3d_stabilised.yaml); a "
+                       "kneed walker's metastability is walkerlab mfpt's")
 #: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
 #: robustness_study`)
 ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance leg's "

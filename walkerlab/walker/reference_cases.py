@@ -112,11 +112,13 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
                 vc["outputs"].append({"link": "torso", "bezier_rad": [0.1] * 5})
             vc.pop("max_torque_n_m")
         w["actuation"] = {"virtual_constraints": vc}
-    elif feature == "hip_roll":  # the stabilised 3D walker's law (on any kind: refused),
-        stabilised = _shipped("hip_width_stabilised")  # and its gait's start (its 5 roles)
+    elif feature == "hip_roll":  # the stabilised 3D walker's law (on any kind but the 3D
+        # ones: refused) and its gait's start (its roles with the two rolls)
+        stabilised = _shipped(SHIPPED.get((kind, feature), "hip_width_stabilised"))
         w["hip_roll"] = stabilised["walker"]["hip_roll"]
-        if kind == "straight_legs_3d":
+        if (kind, feature) in SHIPPED:  # and the precision its gait was searched at
             d["fixedpoint"]["initial_guess"] = stabilised["fixedpoint"]["initial_guess"]
+            d["solver"] = stabilised["solver"]
     elif feature == "round_feet_3d":  # configs/round_feet_3d.yaml's disc feet (refused by
         w["foot_radius_m"] = 0.2  # any walker but the 3D straight legs: the scene's check)
     elif feature in TERRAIN:
@@ -202,6 +204,9 @@ SHIPPED = {
     # multiplier of 39.9), its contact and MJCF cells held over its first stride
     # (:data:`FIRST_STEPS`)
     ("locking_knees_3d", "walk"): "kneed_3d",
+    # ... with hip-roll joints and Kuo's foot placement, scaled to its mass: a stable stride
+    # gait (the passive walker's lateral multiplier of ~40 made stable)
+    ("locking_knees_3d", "hip_roll"): "kneed_3d_stabilised",
     # ... down stairs of its slope step
     ("locking_knees_3d", "stairs"): "kneed_3d_stairs",
     # ... with a push-off, a hip and a knee spring-damper (laterally unstable as the
