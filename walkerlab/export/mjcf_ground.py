@@ -16,7 +16,7 @@ from walkerlab.models.ground import landing_drops, stair_treads
 if TYPE_CHECKING:
     from walkerlab.walker.multibody import Multibody
 
-__all__ = ["ground_geoms", "profile_asset", "wheel_ground"]
+__all__ = ["ground_geoms", "lane_tops", "profile_asset", "wheel_ground"]
 
 
 def ground_geoms(mb: Multibody, extra: MjcfScene | None) -> list[str]:
@@ -203,3 +203,35 @@ def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int) -> list[st
                    f'pos="{nums(centre[0], 0, centre[1])}" euler="{nums(0, phi, 0)}" '
                    'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>')
     return out
+
+
+def lane_tops(mujoco, model, data, t, n, legs=("leg1", "leg2")) -> tuple | None:
+    """Each leg's footfall patches (``leg<i>_patch<k>``: a 3D walker's lanes) as
+    ``(positions along the slope (k,) [m], tops above the slope's plane (k,) [m])``, the
+    ground the knee latch measures its foot's height from (:func:`latch_rule`); None when
+    the file has no such patches or all lie on the slope's plane (to 1e-9 m: the plain
+    slope, whose latch measures from the plane itself).
+
+    Parameters
+    ----------
+    mujoco : module
+    model, data : mujoco.MjModel, mujoco.MjData
+        The loaded MJCF after ``mj_forward``.
+    t, n : ndarray (3,)
+        The slope's tangent and outward normal in MuJoCo's axes.
+    legs : tuple of str
+        The legs' names.
+    """
+    out = []
+    for leg in legs:
+        s, h = [], []
+        while (g := mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM,
+                                      f"{leg}_patch{len(s)}")) >= 0:
+            s.append(float(data.geom_xpos[g] @ t))
+            h.append(float(data.geom_xpos[g] @ n) + float(model.geom_size[g][2]))
+        if not s:
+            return None
+        out.append((np.array(s), np.array(h)))
+    if max(float(np.max(np.abs(h))) for _, h in out) < 1e-9:
+        return None
+    return tuple(out)

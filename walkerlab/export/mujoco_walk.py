@@ -65,6 +65,7 @@ from walkerlab.export.joint_torques import (
     stance_phase,
     torque_generalized_forces,
 )
+from walkerlab.export.mjcf_ground import lane_tops
 from walkerlab.extras import require
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.models.virtual_constraints import VirtualConstraintController
@@ -506,6 +507,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
         loops.append(HipRollLoop(model))  # a 3D walker's hip-roll law
     nstep = 1 if latched or loops else LOOK_EVERY
     mujoco.mj_forward(model, data)
+    tops = lane_tops(mujoco, model, data, t, n, LEGS) if latched else None
     L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, up]])))
     last_contact = [data.time, data.time]  # both feet at the ground at the keyframe
     times, legs, pos = [], [], []
@@ -513,8 +515,10 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1,
     while data.time < t_final_s:
         if latched:
             for i in range(2):
-                data.eq_active[latch[i]] = latch_rule(float(data.site_xpos[site[i]] @ n) - off,
-                                                      float(data.qpos[knee[i]]), h_rel, cap)
+                up_i = float(data.site_xpos[site[i]] @ n) - off  # stairs, footholds: from
+                if tops is not None:  # the nearest patch's top (lane_tops)
+                    up_i -= tops[i][1][np.argmin(abs(tops[i][0] - data.site_xpos[site[i]] @ t))]
+                data.eq_active[latch[i]] = latch_rule(up_i, float(data.qpos[knee[i]]), h_rel, cap)
         for loop in loops:
             loop.control(data)
         mujoco.mj_step(model, data, nstep)

@@ -85,12 +85,12 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
                        "stride apart from the keyframe's trailing foot (its two steps mirror "
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
-#: why the kneed walker in 3D's MJCF refuses stairs and footholds
-KNEED_3D_GROUND_MJCF = ("the passive kneed walker in 3D is laterally unstable (x40 a stride; "
-                        "its hip-roll law steadies it on the slope: configs/"
-                        "kneed_3d_stabilised.yaml): its MuJoCo walk holds the rigid gait over "
-                        "its first stride on the slope (its walk cell), and its MJCF lays no "
-                        "stairs or footholds")
+#: why the kneed walker in 3D's contact model and MJCF refuse footholds (its stairs are the
+#: stabilised walker's, configs/kneed_3d_stabilised_stairs.yaml)
+KNEED_3D_GROUND_MJCF = ("the footholds' reference walker, the passive kneed walker in 3D, is "
+                        "laterally unstable (x40 a stride): a compliant walk from its gait "
+                        "capsizes within a few steps; its hip-roll law steadies it on stairs "
+                        "(configs/kneed_3d_stabilised_stairs.yaml) and the slope")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
@@ -414,8 +414,14 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stairs and footholds in the rigid model and the gym's rigid view: the straight
         # legs' landing (the generated swing clearance with the knee locked plus the
         # landing's depth: walkerlab.models.hybrid.ground)
+        # stairs in the contact model and the MJCF: the stabilised walker
+        # (configs/kneed_3d_stabilised_stairs.yaml) on the 3D straight legs' footfall
+        # patches (walkerlab.export.legs_3d_mjcf.legs3d_footfalls), its knee latch measured
+        # from the nearest patch's top (walkerlab.models.contact.assembly.latch_ground,
+        # walkerlab.export.mjcf_ground.lane_tops)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},
-        **{(g, "mjcf"): KNEED_3D_GROUND_MJCF for g in ("stairs", "footholds")},
+        **{("stairs", v): None for v in ("contact", "mjcf")},
+        **{("footholds", v): KNEED_3D_GROUND_MJCF for v in ("contact", "mjcf")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.

@@ -207,8 +207,9 @@ SHIPPED = {
     # ... with hip-roll joints and Kuo's foot placement, scaled to its mass: a stable stride
     # gait (the passive walker's lateral multiplier of ~40 made stable)
     ("locking_knees_3d", "hip_roll"): "kneed_3d_stabilised",
-    # ... down stairs of its slope step
-    ("locking_knees_3d", "stairs"): "kneed_3d_stairs",
+    # ... the stabilised walker down stairs of its slope step (the passive one down
+    # configs/kneed_3d_stairs.yaml's leaves a contact or MuJoCo walk within a few steps)
+    ("locking_knees_3d", "stairs"): "kneed_3d_stabilised_stairs",
     # ... with a push-off, a hip and a knee spring-damper (laterally unstable as the
     # passive gait: x39 a stride)
     **{("locking_knees_3d", f): "kneed_3d_powered"

@@ -187,6 +187,24 @@ def on_line(px, py, vx, vy, sp, cp, PC, line):
 
 
 @njit(cache=True)
+def latch_ground(s, cen, PC):
+    """Height [m] (along the slope's outward normal) of the ground a foot at along-slope
+    coordinate ``s`` [m] is measured from for its knee latch: the top of the nearest patch
+    of its lane ``cen`` (stairs and footholds: over a gap too, so a swing foot below the
+    slope line is not taken for one on the ground); 0.0 on continuous ground and on the
+    plain slope (all heights 0: the latch's penetration bit for bit the slope's)."""
+    n = (cen.shape[0] - 1) // 2
+    if PC[I_CONT] > 0.5 or n == 0:
+        return 0.0
+    best, h = np.inf, 0.0
+    for j in range(n):
+        d = abs(s - cen[j])
+        if d < best:
+            best, h = d, cen[n + j]
+    return h
+
+
+@njit(cache=True)
 def latch_weight(delta, ext, PC):
     """Latch engagement in [0, 1] of a knee at extension ext [rad] (< 0 flexed) whose foot
     has the penetration delta [m] (< 0: above the ground)."""

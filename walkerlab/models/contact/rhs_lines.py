@@ -65,9 +65,12 @@ def _knee_lines(eq, red, pr, Q, power: list, d: int = 2) -> list[str]:
         T = sp.Symbol(f"_T{k}", real=True)
         # penetration of leg k's foot, -(p . n)
         # (a polyline ground: the penetration into it, _point's)
+        # on patches of several heights (stairs, footholds) from the nearest patch's top
+        # (the latch's ground: assembly.latch_ground; 0.0 on the slope)
         dl = (f"(_r{k}[0] if PC[I_CONT] > 1.5 else "
               f"-(({pr.doprint(red[2 * d * k])}) * _sp + "
-              f"({pr.doprint(red[2 * d * k + 1])}) * _cp))")
+              f"({pr.doprint(red[2 * d * k + 1])}) * _cp) "
+              f"+ _asm.latch_ground(_r{k}[3], {('c1', 'c2')[k]}, PC))")
         lines.append(f"    {T} = _knee_torque({eq.q[sh]} - {eq.q[t]}, "
                      f"{eq.dq[sh]} - {eq.dq[t]}, PC, {dl})")
         Q[t] += T
