@@ -1,0 +1,152 @@
+"""The stabilised kneed walker in 3D down stairs (``configs/kneed_3d_stabilised_stairs.yaml``:
+configs/kneed_3d_stabilised.yaml's walker - locking knees, hip-roll joints and Kuo's 1999
+lateral foot placement - on stairs whose riser and tread are its slope gait's step).
+
+Physics checks: the stairs ground changes no equation (the walker's structure, and so its
+generated model, is the slope walker's); the shipped stairs gait is a fixed point of the
+stride map to the map's round-off; a zero riser (the landing's clearance guard at depth 0)
+is the level ground's heel strike; the knee latch measures a foot's height from the nearest
+footfall patch of its lane, which is the slope's plane itself where every patch lies on it;
+and (slow) the compliant-contact walk and the MuJoCo walk of its MJCF keep the rigid step
+period within 3 %.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.analysis.gait.poincare import poincare_map
+from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.assembly import latch_ground
+from walkerlab.models.hybrid.ground import with_clearance_guard
+from walkerlab.models.registry import build_walker
+from walkerlab.walker.plant import Plant
+
+ROOT = Path(__file__).resolve().parents[1]
+STAIRS = "kneed_3d_stabilised_stairs.yaml"
+#: the scene's solver (rtol = atol = 1e-10): the generated flow's round-off leaves the stride
+#: map 1e-9 of noise (configs/kneed_3d_stabilised.yaml), and the shipped guess has 10 digits
+MAP_TOL = 1e-8
+#: the rigid gait's step period [s] (walkerlab fixedpoint on the scene, residual 1.7e-10)
+STEP_PERIOD_S = 0.5390862882
+
+
+def _guess(scene, walker) -> np.ndarray:
+    g = scene.fixedpoint.initial_guess.model_extra
+    return np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                     for n in walker.state_names()])
+
+
+@pytest.fixture(scope="module")
+def stairs():
+    scene = load_scene(ROOT / "configs" / STAIRS)
+    plant = Plant.from_scene(scene)
+    walker = build_walker(plant)
+    s = scene.solver
+    return scene, plant, walker, _guess(scene, walker), Solver(method=s.method, rtol=s.rtol,
+                                                               atol=s.atol)
+
+
+def test_the_stairs_change_no_equation_of_the_stabilised_walker(stairs):
+    """The stairs scene's walker is configs/kneed_3d_stabilised.yaml's: the same structure
+    (the key of its generated equations: the ground is a guard offset, not an equation), on
+    treads of the slope gait's step (0.46010 m along its 0.0504 rad slope), solved at the
+    slope scene's tolerances."""
+    scene, plant, _walker, _x0, solver = stairs
+    slope = load_scene(ROOT / "configs" / "kneed_3d_stabilised.yaml")
+    assert plant.data.structure == Plant.from_scene(slope).data.structure
+    assert scene.slope.angle_rad == 0.0 and scene.terrain.kind == "stairs"
+    gamma = slope.slope.angle_rad
+    step = np.hypot(scene.terrain.riser_m, scene.terrain.tread_m)
+    assert step == pytest.approx(0.4601001618, abs=1e-9)
+    assert scene.terrain.riser_m / scene.terrain.tread_m == pytest.approx(np.tan(gamma),
+                                                                          rel=1e-8)
+    assert (solver.rtol, solver.atol) == (slope.solver.rtol, slope.solver.atol) == (1e-10,
+                                                                                  1e-10)
+
+
+def test_the_shipped_stairs_gait_is_a_fixed_point_of_the_stride_map(stairs):
+    """One stride of the rigid map (two steps, each landing a riser lower) from the shipped
+    gait returns to it within :data:`MAP_TOL` (measured 4.4e-10), in twice the step period
+    walkerlab fixedpoint printed (to 1e-8 s)."""
+    _scene, _plant, walker, x0, solver = stairs
+    x1, t = poincare_map(walker, x0, solver)[:2]
+    assert np.max(np.abs(x1 - x0)) < MAP_TOL
+    assert t == pytest.approx(2 * STEP_PERIOD_S, abs=1e-8)
+    assert walker.params["landing_drop_m"] == pytest.approx(0.023164765)
+
+
+def test_a_zero_riser_is_the_level_grounds_heel_strike(stairs):
+    """Stairs need a riser (terrain.riser_m > 0), so the zero riser is the stairs' landing at
+    depth 0 (the clearance guard the riser offsets, its section solved on the post-impact
+    surface) on the level ground (slope 0, no terrain): from the stairs gait's state its
+    section gives the same state to 1e-15, and one stride of each map - the passive walker
+    slowing on level ground - the same state and time to 1e-12 (measured: identical)."""
+    scene, _plant, _walker, x0, solver = stairs
+    d = scene.model_dump(mode="json")
+    d.pop("terrain")
+    level = Plant.from_scene(scene_from_dict(d))
+    walker = build_walker(level)
+    zero = with_clearance_guard(walker, level.data)
+    z = walker.section(x0)
+    assert np.max(np.abs(walker.from_section(z) - zero.from_section(z))) < 1e-15
+    pa, ta = poincare_map(walker, x0, solver)[:2]
+    pb, tb = poincare_map(zero, x0, solver)[:2]
+    assert np.max(np.abs(pa - pb)) < 1e-12 and abs(ta - tb) < 1e-12
+
+
+def test_the_knee_latch_measures_from_the_nearest_patch_top():
+    """:func:`walkerlab.models.contact.assembly.latch_ground`: on patches of several heights
+    the top of the lane's nearest patch (over a gap too: a swing foot a riser below the
+    slope line is not on the ground); on the plain slope (all heights 0) and on continuous
+    ground exactly 0.0, so the latch's penetration there is the plane's, bit for bit."""
+    from walkerlab.models.contact.assembly import I_CONT, NPC
+
+    PC = np.zeros(NPC)
+    stairs = np.array([0.46, 1.38, 2.30, -0.023, -0.069, -0.116, -0.023])  # centres, heights
+    assert latch_ground(0.5, stairs, PC) == -0.023
+    assert latch_ground(0.95, stairs, PC) == -0.069  # over the gap, nearer the next patch
+    assert latch_ground(-0.4, stairs, PC) == -0.023  # behind the first
+    flat = np.array([0.0, 0.46, 0.0, 0.0, 0.0])
+    assert latch_ground(0.2, flat, PC) == 0.0
+    PC[I_CONT] = 1.0
+    assert latch_ground(0.95, stairs, PC) == 0.0
+
+
+@pytest.mark.slow  # ~6 min cold: the stairs gait, its contact walk and its MuJoCo walk
+def test_the_contact_and_mujoco_walks_keep_the_rigid_step_period(tmp_path):
+    """The compliant-contact walk (walkerlab contact-sim: 6 strides on the rigid gait's
+    footfall patches, 0.2 m long) makes 12 heel strikes; its mean step period over steps
+    7-10 is within 3 % of the rigid walk's same steps (measured +2.66 %; its speed -3.91 %:
+    each swing knee's strike unloads the stance foot for about 5 ms on the level treads,
+    which it does not on the slope).  The MJCF walked in MuJoCo (export --walk) makes >= 10
+    alternating heel strikes without falling, its mean step period within 3 % of the rigid
+    gait's (measured 11 strikes, -0.72 %)."""
+    import h5py
+
+    pytest.importorskip("mujoco")
+    from walkerlab.api.capabilities import _contact_against_rigid
+    from walkerlab.stages import export as export_stage
+    from walkerlab.stages import pipeline
+
+    scene = load_scene(ROOT / "configs" / STAIRS)
+    cs = pipeline.run("contact-sim", scene, tmp_path).path
+    fp = pipeline.run("fixedpoint", scene, tmp_path).path
+    sim = pipeline.run("simulate", scene, tmp_path).path
+    with h5py.File(cs) as f, h5py.File(sim) as s:
+        assert int(f["summary/heel_strikes"][()]) >= 10
+        h = np.asarray(f["events/heel_strike_times"][:], float)
+        hr = np.asarray(s["steps/t_end"][:], float)
+    k = min(h.size, hr.size)
+    period = (h[k - 1] - h[k - 5]) / (hr[k - 1] - hr[k - 5]) - 1.0
+    assert abs(period) < 0.03, period
+    _value, line = _contact_against_rigid(cs, fp, sim)
+    assert f"period {100 * period:+.2f} %" in line
+    check = export_stage.write(scene, tmp_path, "mjcf", walk=True).walk
+    assert check.walked and not check.fell and check.alternating, check.line
+    assert check.strikes >= 10, check.line
+    assert check.period_s == pytest.approx(check.rigid_period_s, rel=0.03), check.line
