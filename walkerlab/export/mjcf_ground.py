@@ -206,11 +206,13 @@ def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int) -> list[st
 
 
 def lane_tops(mujoco, model, data, t, n, legs=("leg1", "leg2")) -> tuple | None:
-    """Each leg's footfall patches (``leg<i>_patch<k>``: a 3D walker's lanes) as
-    ``(positions along the slope (k,) [m], tops above the slope's plane (k,) [m])``, the
-    ground the knee latch measures its foot's height from (:func:`latch_rule`); None when
-    the file has no such patches or all lie on the slope's plane (to 1e-9 m: the plain
-    slope, whose latch measures from the plane itself).
+    """Each leg's footfall patches (``leg<i>_patch<k>``) as ``(positions along the slope
+    (k,) [m], tops (k,) [m])``, each top above that of the stance foot's patch at the
+    keyframe (leg2's nearest the origin; a planar MJCF lowers every patch by its ground
+    offset): the ground the knee latch measures its foot's height from
+    (:func:`walkerlab.export.mujoco_walk.latch_rule`); None when the file has no such
+    patches or all lie at one height (to 1e-9 m: the plain slope, whose latch measures from
+    the plane itself).
 
     Parameters
     ----------
@@ -232,6 +234,8 @@ def lane_tops(mujoco, model, data, t, n, legs=("leg1", "leg2")) -> tuple | None:
         if not s:
             return None
         out.append((np.array(s), np.array(h)))
+    ref = out[1][1][np.argmin(np.abs(out[1][0]))]
+    out = [(s, h - ref) for s, h in out]
     if max(float(np.max(np.abs(h))) for _, h in out) < 1e-9:
         return None
     return tuple(out)
