@@ -5,7 +5,7 @@ The generated module defines one function, ``make(p) -> dict[str, callable]``, t
 parameter vector ``p`` (``Structure.param_names`` order) in closures.  The hot functions
 (``flow``, ``flow_jacobian``, ``reset``, ``reset_jacobian``, guards) are straight-line scalar
 code on Python floats (sympy ``cse`` + ``pycode``, ``math`` functions) with the small linear
-solve written out as an adjugate / determinant (the matrices are n x n with n <= 3); the
+solve written out as an adjugate / determinant for n <= 3, by LU factors above; the
 functions used on whole trajectories (``energies``, ``points``, ``leg_angles``) are numpy code
 that accepts states of shape (2n,) or (2n, k).
 
@@ -107,9 +107,23 @@ def _bind(names, exprs) -> tuple[list[str], list[str]]:
     return lines, out
 
 
+#: the largest matrix whose inverse is written as its adjugate over its determinant; a
+#: larger one (a walker in 3D, the five-link biped) is inverted by its LU factors
+ADJUGATE_MAX_N = 3
+
+
 def _solve_lines(n: int, mnames, prefix: str) -> tuple[list[str], list[list[str]]]:
     """Lines computing the inverse of the n x n matrix whose entries are named ``mnames``
-    (``"0"`` for an entry known to vanish: the adjugate then drops its terms)."""
+    (``"0"`` for an entry known to vanish: the adjugate then drops its terms), named
+    ``{prefix}{i}{j}`` (``"0"`` for an entry that vanishes).
+
+    Up to :data:`ADJUGATE_MAX_N` the adjugate over the determinant; above it the LU factors
+    (:func:`_lu_inverse_lines`): a determinant expanded for n >= 4 sums many products much
+    larger than itself, and the cancellation left the six-coordinate kneed walker's
+    accelerations with round-off of 1e-10 relative (cond(M) about 1.5e3), 1e-16 by its
+    factors."""
+    if n > ADJUGATE_MAX_N:
+        return _lu_inverse_lines(n, mnames, prefix)
     S = sp.Matrix(n, n, lambda i, j: 0 if mnames[i][j] == "0" else sp.Symbol(mnames[i][j]))
     det = S.det(method="berkowitz")
     adj = S.adjugate()
@@ -120,6 +134,54 @@ def _solve_lines(n: int, mnames, prefix: str) -> tuple[list[str], list[list[str]
             if adj[i, j] != 0:
                 inv[i][j] = f"{prefix}{i}{j}"
                 lines.append(f"{IND}{inv[i][j]} = ({PRINTER.doprint(adj[i, j])}) * {prefix}id")
+    return lines, inv
+
+
+def _lu_inverse_lines(n: int, mnames, prefix: str) -> tuple[list[str], list[list[str]]]:
+    """Lines computing the inverse of the n x n matrix whose entries are named ``mnames``
+    from its LU factors (Doolittle, no pivoting: the matrices inverted are a walker's mass
+    matrix or its impact matrix, symmetric positive definite, whose elimination without
+    pivoting is backward stable; Golub & Van Loan 2013, Sec. 4.2), then the inverse's
+    columns by forward and back substitution on the unit vectors.  Every intermediate is a
+    named line, so the code grows as n^3 (the adjugate's as n!), and entries known to vanish
+    (``"0"``) drop their terms.  Returns the lines and the inverse's entry names, as
+    :func:`_solve_lines`."""
+    zero, one = sp.Integer(0), sp.Integer(1)
+    A = [[zero if mnames[i][j] == "0" else sp.Symbol(mnames[i][j]) for j in range(n)]
+         for i in range(n)]
+    lines: list[str] = []
+
+    def bind(tag: str, e):
+        if e == 0 or e == 1 or e.is_Symbol:
+            return e
+        s = sp.Symbol(f"{prefix}{tag}")
+        lines.append(f"{IND}{s} = {PRINTER.doprint(e)}")
+        return s
+
+    L = [[zero] * n for _ in range(n)]
+    rp = [zero] * n  # the pivots' reciprocals
+    for k in range(n):
+        rp[k] = bind(f"p{k}", 1 / A[k][k])
+        for i in range(k + 1, n):
+            if A[i][k] == 0:
+                continue
+            L[i][k] = bind(f"l{i}_{k}", A[i][k] * rp[k])
+            for j in range(k + 1, n):
+                if A[k][j] != 0:
+                    A[i][j] = bind(f"u{k}_{i}_{j}", A[i][j] - L[i][k] * A[k][j])
+    inv = [["0"] * n for _ in range(n)]
+    for c in range(n):
+        y = [zero] * n
+        for i in range(n):
+            y[i] = bind(f"y{c}_{i}", (one if i == c else zero)
+                        - sum((L[i][k] * y[k] for k in range(i)), zero))
+        x = [zero] * n
+        for i in reversed(range(n)):
+            e = (y[i] - sum((A[i][j] * x[j] for j in range(i + 1, n)), zero)) * rp[i]
+            if e != 0:
+                x[i] = sp.Symbol(f"{prefix}{i}{c}")
+                inv[i][c] = str(x[i])
+                lines.append(f"{IND}{x[i]} = {PRINTER.doprint(e)}")
     return lines, inv
 
 
