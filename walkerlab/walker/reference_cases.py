@@ -207,6 +207,9 @@ SHIPPED = {
     # ... with hip-roll joints and Kuo's foot placement, scaled to its mass: a stable stride
     # gait (the passive walker's lateral multiplier of ~40 made stable)
     ("locking_knees_3d", "hip_roll"): "kneed_3d_stabilised",
+    # ... with an upper body on the bisecting hip driven by a torque between it and the
+    # stance leg (configs/torso_powered_3d.yaml's on the kneed walker): a stable stride gait
+    ("locking_knees_3d", "torso_torque"): "kneed_torso_powered_3d",
     # ... down stairs of its slope step
     ("locking_knees_3d", "stairs"): "kneed_3d_stairs",
     # ... with a push-off, a hip and a knee spring-damper (laterally unstable as the
