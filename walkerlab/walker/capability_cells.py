@@ -370,6 +370,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # actuated._Legs3d, walkerlab.models.contact.parts.Legs3DPart.actuators, the MJCF's
         # torso_hip hinge held to the legs' mean by its equality)
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
+        # its reference case walks with hip-roll joints (the passive lateral mode, x40 a
+        # stride, steadied): OpenSim's is the hip-roll cell's
+        ("torso_torque", "osim"): KNEED_3D_HIP_ROLL,
         ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
