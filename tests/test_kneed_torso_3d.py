@@ -17,11 +17,11 @@ body and the stance leg (``joint: stance_hip``), derived from its body tree by
   Floquet multiplier lies inside the unit circle.
 
 Tolerances: the flow terms are of order 0.1-10 and both sides solve nothing (products and
-sums of 3-vectors): 1e-11 absolute.  The torque's accelerations solve a 6 x 6 system (condition
-number ~2e3) for a torque of ~0.1 N m: 1e-10.  A wrong upper body (0.04 kg, 2 cm) moves the
-terms by 0.23-0.27 and 0.024-0.047 (measured): far above the check's 1e-11.  The fixed point is stored to 10 decimals and
-the stride map (DOP853 at 1e-12) returns it to ~1e-9; 1e-7 leaves room for the map's
-conditioning.
+sums of 3-vectors): 1e-11 absolute (measured 7e-15).  The torque's accelerations solve a
+6 x 6 system (condition number ~2e3) for a torque of ~0.1 N m: 1e-10 (measured 8e-14).  A
+wrong upper body (0.04 kg, 2 cm) moves the terms by 0.23-0.27 and 0.024-0.047 (measured):
+far above the check's 1e-11.  The fixed point is stored to 10 decimals and the stride map
+(DOP853 at 1e-12) returns it to ~3e-10; 1e-7 leaves room for the map's conditioning.
 """
 
 from __future__ import annotations

@@ -14,8 +14,9 @@ from walkerlab.config.walker import KNEED_3D_HIP_ROLL
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF",
-           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_PASSIVE",
+           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
+           "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
+           "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
@@ -157,6 +158,13 @@ KNEED_3D_TORSO = ("the floating tree of the kneed walker in 3D (the contact mode
                   "Hobbelen & Schwab 2007) is a relation of the rigid tree's coordinates, "
                   "not a joint of that tree; the rigid model walks it "
                   "(configs/kneed_torso_powered_3d.yaml)")
+#: why the kneed walker in 3D's MJCF refuses its upper body's torque
+#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_scene`: the keyframe's torso hinge)
+KNEED_3D_TORSO_MJCF = ("the 3D MJCF's keyframe sets the upper body's hinge to the straight "
+                       "legs' mean pitch; on knees the bisecting hip holds it on the thighs' "
+                       "mean, which this export does not read, so MuJoCo would start the "
+                       "upper body off its equality: walk it in the rigid model "
+                       "(configs/kneed_torso_powered_3d.yaml)")
 #: what the views of the 3D kinds refuse: a ground other than a plane
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -373,6 +381,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # its reference case walks with hip-roll joints (the passive lateral mode, x40 a
         # stride, steadied): OpenSim's is the hip-roll cell's
         ("torso_torque", "osim"): KNEED_3D_HIP_ROLL,
+        ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
         ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
