@@ -378,10 +378,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # actuated._Legs3d, walkerlab.models.contact.parts.Legs3DPart.actuators, the MJCF's
         # torso_hip hinge held to the legs' mean by its equality)
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
-        # its reference case walks with hip-roll joints (the passive lateral mode, x40 a
-        # stride, steadied): OpenSim's is the hip-roll cell's
-        ("torso_torque", "osim"): KNEED_3D_HIP_ROLL,
-        ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
         ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
@@ -428,6 +424,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("torso_torque", "*"): KNEED_3D_TORSO,
         **{("torso_torque", v): None for v in ("rigid", "gym", "urdf")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
+        # its reference case walks with hip-roll joints (the passive lateral mode, x40 a
+        # stride, steadied): OpenSim's is the hip-roll cell's
+        ("torso_torque", "osim"): KNEED_3D_HIP_ROLL,
+        ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
         # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
         # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's
