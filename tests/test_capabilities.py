@@ -212,8 +212,10 @@ def _check(kind, feature, view, tmp_path, monkeypatch):
 
 #: features whose walker no other quick test derives: their cold derivation takes minutes
 #: (the 3D kneed walker with hip-roll joints: ~3 min; the 3D upper body with hip-roll
-#: joints and a torso torque: ~6 min), so the slow suite tries their cells
-COLD_DERIVATIONS = {("locking_knees_3d", "hip_roll"), ("straight_legs_3d", "torso_torque")}
+#: joints and a torso torque: ~6 min; the 3D kneed walker with an upper body: ~10 min),
+#: so the slow suite tries their cells
+COLD_DERIVATIONS = {("locking_knees_3d", "hip_roll"), ("straight_legs_3d", "torso_torque"),
+                    ("locking_knees_3d", "torso_torque")}
 
 #: the cells the quick suite tries (each under ~1 s with the walkers' code cached: set-ups
 #: and the refusals that come before any gait search)

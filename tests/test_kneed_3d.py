@@ -81,8 +81,11 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
         with pytest.raises(KindRefused) as err:
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
-    for feature in ("round_feet_3d", "profile", "torso_torque"):
+    for feature in ("round_feet_3d", "profile"):
         assert not kind.supports(feature, "rigid"), feature
+    # an upper body on the bisecting hip: configs/kneed_torso_powered_3d.yaml
+    # (tests/test_kneed_torso_3d.py)
+    assert kind.supports("torso_torque", "rigid")
     # hip-roll joints: configs/kneed_3d_stabilised.yaml (tests/test_kneed_3d_stabilised.py)
     assert kind.supports("hip_roll", "rigid")
     # the planar kneed walker's torques and push-off (tests/test_kneed_3d_powered.py)
@@ -97,14 +100,12 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     (lambda w: w["leg"]["knee"].update(spring={"stiffness_n_m_per_rad": 1.0}),
      "walker.leg.knee"),
     (lambda w: w["leg"].update(foot={"kind": "arc", "radius_m": 0.1}), "walker.leg.foot.kind"),
-    (lambda w: w.update(torso={"coupling": "bisecting_hip", "bodies": [
-        {"kind": "point_mass", "name": "m", "mass_kg": 1.0, "from_hip_m": 0.2}]}),
-     "walker.torso"),
 ])
 def test_what_a_kneed_walker_in_3d_does_not_take_is_refused_in_one_line_naming_the_field(
         change, field):
-    """Free knees, a knee spring, arc feet and an upper body on locking knees in 3D: one
-    line naming the field (the tree would carry them; their derivations are not checked)."""
+    """Free knees, a knee spring and arc feet on locking knees in 3D: one line naming the
+    field (the tree would carry them; their derivations are not checked).  An upper body
+    on the bisecting hip is taken (tests/test_kneed_torso_3d.py)."""
     raw = _kneed_in_3d(0.1)
     change(raw["walker"])
     with pytest.raises(Exception) as err:

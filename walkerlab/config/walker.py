@@ -87,11 +87,9 @@ class HipRollLaw(Strict):
 #: the one line refusing hip-roll joints elsewhere (the capability table's reason)
 HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged walker's with "
                   "hip width (walker.space: 3d, hip_width_m > 0)")
-#: what a walker with locking knees in 3D does not carry (``walker.space: 3d`` with a
-#: ``leg.knee``): the upper body is the reason after its field in the scene's one line;
-#: both are reasons of the capability table (:data:`walkerlab.walker.capability_cells.
-#: CAPABILITIES`, ``locking_knees_3d``: the hip-roll joints' views that refuse them)
-KNEED_3D_TORSO = "a kneed walker in 3D carries no upper body so far"
+#: why the OpenSim view of a walker with locking knees in 3D (``walker.space: 3d`` with a
+#: ``leg.knee``) refuses its hip-roll joints: a reason of the capability table
+#: (:data:`walkerlab.walker.capability_cells.CAPABILITIES`, ``locking_knees_3d``)
 KNEED_3D_HIP_ROLL = ("OpenSim has no contact-switched force: the knee latch and the "
                      "hip-roll law both run in walkerlab's stepping loop between Manager "
                      "windows (walkerlab.export.opensim_walk), a pair no OpenSim walk has "
@@ -287,9 +285,6 @@ class BipedParams(_Actuated):
                                  "walker's hips are one point)")
             return
         leg = pair[0]
-        if leg.knee is not None:  # what the kneed walker in 3D does not carry yet
-            if self.torso is not None:
-                raise ValueError(f"walker.torso: {KNEED_3D_TORSO}")
         for field, bad, what in (
                 ("walker.coordinates", self.coordinates != "absolute", "'absolute'"),
                 ("walker.legs", self.legs is not None and pair[0] != pair[1],

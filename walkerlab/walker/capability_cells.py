@@ -10,14 +10,16 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_TORSO
+from walkerlab.config.walker import KNEED_3D_HIP_ROLL
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEE_LATCH_OSIM", "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL",
-           "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_PASSIVE", "ROUND_FEET_OPTIMIZE_3D",
-           "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS", "STAGE_VIEWS",
-           "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND", "ZERO_WIDTH_3D_UPRIGHT"]
+           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
+           "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
+           "PROFILE_PASSIVE",
+           "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND",
+           "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
 _NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
@@ -147,6 +149,22 @@ KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keep
                     "passive one's unstable lateral mode (a stride multiplier of about 40): "
                     "a walk in this view started off the rigid gait capsizes within a few "
                     "steps, so its torques and push-off are measured in the rigid model")
+#: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
+#: rigid view, the URDF's masses) refuse its upper body's torque: the floating tree
+#: (:func:`walkerlab.walker.trees.legs_tree` with ``floating``) frees both knees
+KNEED_3D_TORSO = ("the floating tree of the kneed walker in 3D (the contact model's) frees "
+                  "both knees and every link's pitch, and its upper body then hangs on a "
+                  "free hinge: the bisecting hip (the upper body on the thighs' mean, Wisse, "
+                  "Hobbelen & Schwab 2007) is a relation of the rigid tree's coordinates, "
+                  "not a joint of that tree; the rigid model walks it "
+                  "(configs/kneed_torso_powered_3d.yaml)")
+#: why the kneed walker in 3D's MJCF refuses its upper body's torque
+#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_scene`: the keyframe's torso hinge)
+KNEED_3D_TORSO_MJCF = ("the 3D MJCF's keyframe sets the upper body's hinge to the straight "
+                       "legs' mean pitch; on knees the bisecting hip holds it on the thighs' "
+                       "mean, which this export does not read, so MuJoCo would start the "
+                       "upper body off its equality: walk it in the rigid model "
+                       "(configs/kneed_torso_powered_3d.yaml)")
 #: what the views of the 3D kinds refuse: a ground other than a plane
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -398,7 +416,18 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
            for v in ("rigid", "gym")},
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
+        # an upper body on the bisecting hip driven by a torque between it and the stance
+        # leg: the 3D straight legs' (walkerlab.models.hybrid.actuated._Legs3d) on the
+        # kneed tree (the thigh's pitch for the swing leg's), its stable gait
+        # configs/kneed_torso_powered_3d.yaml's in the rigid model and the gym's rigid view
+        # (it steps the rigid model); the URDF writes its tree (the masses)
         ("torso_torque", "*"): KNEED_3D_TORSO,
+        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf")},
+        ("torso_torque", "adams"): TORSO_ADAMS_3D,
+        # its reference case walks with hip-roll joints (the passive lateral mode, x40 a
+        # stride, steadied): OpenSim's is the hip-roll cell's
+        ("torso_torque", "osim"): KNEED_3D_HIP_ROLL,
+        ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
         # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
         # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's

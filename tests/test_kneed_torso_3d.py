@@ -1,0 +1,287 @@
+"""The kneed walker in 3D with an upper body (``configs/kneed_torso_powered_3d.yaml``):
+configs/kneed_3d_stabilised.yaml's locking knees (McGeer 1990) with hip-roll joints and
+Kuo's (1999) lateral foot placement, carrying an upper body on the bisecting hip (Wisse,
+Hobbelen & Schwab 2007, IEEE Trans. Robotics 23(1)) driven by a torque between the upper
+body and the stance leg (``joint: stance_hip``), derived from its body tree by
+:func:`walkerlab.codegen.legged.derive_legged`, against:
+
+- Newton's law for its six point masses and the pelvis' roll inertia, written here with no
+  code shared with that derivation (each point a sum of rotated offsets, its Jacobian and
+  velocity-product term by hand; the upper body's pitch the mean of the stance leg's and
+  the swing thigh's; the laws' torques as couples whose generalised forces are their virtual
+  work): the knee-free flow ``M qdd + C dq + G`` of both mirror steps, and the torso
+  torque's accelerations ``M^-1 Q_torso``;
+- the same law with a wrong upper body (its mass or its height off by 10 %): the check can
+  fail;
+- the rigid gait itself: the scene's fixed point maps to itself over a stride and every
+  Floquet multiplier lies inside the unit circle.
+
+Tolerances: the flow terms are of order 0.1-10 and both sides solve nothing (products and
+sums of 3-vectors): 1e-11 absolute (measured 7e-15).  The torque's accelerations solve a
+6 x 6 system (condition number ~2e3) for a torque of ~0.1 N m: 1e-10 (measured 8e-14).  A
+wrong upper body (0.04 kg, 2 cm) moves the terms by 0.23-0.27 and 0.024-0.047 (measured):
+far above the check's 1e-11.  The fixed point is stored to 10 decimals and the stride map
+(DOP853 at 1e-12) returns it to ~3e-10; 1e-7 leaves room for the map's conditioning.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scipy.spatial.transform import Rotation
+
+from walkerlab.config import scene_from_dict
+from walkerlab.config.schema import Scene
+from walkerlab.integrate.solver import Solver
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.kinds import KINDS, kind_of
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = "kneed_torso_powered_3d.yaml"
+SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+# coordinates: lean (the stance leg's roll), swing thigh, swing shank, stance (pitches),
+# pelvis roll, swing roll
+LEAN, THIGH, SHANK, STANCE, PELVIS, SWROLL = range(6)
+N = 6
+
+
+def _raw() -> dict:
+    return yaml.safe_load((ROOT / "configs" / SCENE).read_text())
+
+
+def _unit(i: int) -> np.ndarray:
+    e = np.zeros(N)
+    e[i] = 1.0
+    return e
+
+
+class KneedTorsoNewton:
+    """The walker from Newton's law (module docstring) in world axes (``y`` up, ``z``
+    across the slope, the fall line ``s = (cos gamma, -sin gamma, 0)``), the stance foot at
+    the origin.  Each body's roll is about ``s``, each link's pitch (from the vertical)
+    about its rolled ``z``; the upper body rolls with the pelvis and pitches by the mean of
+    the stance leg's and the swing thigh's pitch (the bisecting hip); ``w`` the swing hip's
+    offset along the pelvis' hip axis (its sign: the side).  ``torso_mass``,
+    ``torso_height``: the upper body's, overriding the scene's (a wrong model)."""
+
+    def __init__(self, scene: Scene, torso_mass: float | None = None,
+                 torso_height: float | None = None):
+        wc, law = scene.walker, scene.walker.hip_roll
+        leg = wc.leg
+        bodies = {b.name: b for b in leg.bodies}
+        (torso,) = wc.torso.bodies
+        self.g, self.gamma = wc.gravity_m_per_s2, scene.slope.angle_rad
+        self.L, self.L_thigh = leg.length_m, leg.knee.thigh_length_m
+        self.M_hip = wc.hip_mass_kg
+        self.m_thigh, self.d_thigh = (bodies["thigh_mass"].mass_kg,
+                                      bodies["thigh_mass"].from_hip_m)
+        self.m_shank, self.d_shank = (bodies["shank_mass"].mass_kg,
+                                      bodies["shank_mass"].from_hip_m)
+        self.m_torso = torso.mass_kg if torso_mass is None else torso_mass
+        self.d_torso = torso.from_hip_m if torso_height is None else torso_height
+        self.I_pelvis = law.pelvis_roll_inertia_kg_m2
+        self.law = (law.pelvis_stiffness_n_m_per_rad, law.pelvis_damping_n_m_s_per_rad,
+                    law.swing_stiffness_n_m_per_rad, law.swing_damping_n_m_s_per_rad,
+                    law.lean_gain, law.lean_rate_gain_s)
+        (t,) = wc.actuation.torques
+        self.torso_law = (t.law.constant_n_m, t.law.stiffness_n_m_per_rad,
+                          t.law.damping_n_m_s_per_rad, t.law.rest_angle_rad)
+        self.s = np.array([math.cos(self.gamma), -math.sin(self.gamma), 0.0])
+        self.z = np.array([0.0, 0.0, 1.0])
+        self.S = np.array([[0, -self.s[2], self.s[1]], [self.s[2], 0, -self.s[0]],
+                           [-self.s[1], self.s[0], 0]])
+        self.Z = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+
+    def masses(self, w: float) -> list:
+        """``(mass, terms)``: each point a sum of terms ``(roll, pitch, c)``, the term
+        ``R_s(q_roll) R_z(pitch . q) c`` (``pitch`` (6,) the pitch's coefficients of the
+        coordinates, or None: no pitch)."""
+        L, Lt = self.L, self.L_thigh
+        st, th, sh = _unit(STANCE), _unit(THIGH), _unit(SHANK)
+        hip_st = [(LEAN, st, np.array([0.0, L, 0.0]))]
+        mid = hip_st + [(PELVIS, None, w / 2 * self.z)]
+        hip_sw = hip_st + [(PELVIS, None, w * self.z)]
+        knee_sw = hip_sw + [(SWROLL, th, np.array([0.0, -Lt, 0.0]))]
+        return [
+            (self.M_hip, mid),
+            (self.m_thigh, [(LEAN, st, np.array([0.0, L - self.d_thigh, 0.0]))]),
+            (self.m_shank, [(LEAN, st, np.array([0.0, L - self.d_shank, 0.0]))]),
+            (self.m_thigh, hip_sw + [(SWROLL, th, np.array([0.0, -self.d_thigh, 0.0]))]),
+            (self.m_shank, knee_sw + [(SWROLL, sh, np.array([0.0, -(self.d_shank - Lt),
+                                                            0.0]))]),
+            # the bisecting hip: the upper body up the bisector of the legs' pitches
+            (self.m_torso, mid + [(PELVIS, (st + th) / 2, np.array([0.0, self.d_torso, 0.0]))]),
+        ]
+
+    def kin(self, terms, q, dq):
+        """Position (3,), Jacobian (3, 6) and ``Jdot dq`` (3,) of a point."""
+        r, J, h = np.zeros(3), np.zeros((3, N)), np.zeros(3)
+        for ro, pitch, c in terms:
+            R = Rotation.from_rotvec(q[ro] * self.s).as_matrix()
+            b, db = (0.0, 0.0) if pitch is None else (pitch @ q, pitch @ dq)
+            T = Rotation.from_rotvec(b * self.z).as_matrix()
+            p = R @ T @ c
+            r += p
+            J[:, ro] += self.S @ p
+            h += self.S @ self.S @ p * dq[ro] ** 2
+            if pitch is not None:
+                d = R @ self.Z @ T @ c
+                J += np.outer(d, pitch)
+                h += 2 * self.S @ d * dq[ro] * db + R @ self.Z @ self.Z @ T @ c * db ** 2
+        return r, J, h
+
+    def law_forces(self, q, dq) -> np.ndarray:
+        """The hip-roll law's generalised forces (6,): a couple ``tau s`` on the leg and
+        ``-tau s`` on the pelvis at each hip (virtual work ``tau s . (omega_leg -
+        omega_pelvis)``; ``s . omega`` of a body rolled by ``q_roll`` then pitched about
+        its rolled ``z`` is ``dq_roll``)."""
+        k_p, c_p, k_s, c_s, g_l, g_r = self.law
+        tau_st = k_p * q[PELVIS] + c_p * dq[PELVIS]
+        tau_sw = -k_s * (q[SWROLL] - g_l * q[LEAN] - g_r * dq[LEAN]) - c_s * (
+            dq[SWROLL] - dq[PELVIS])
+        Q = np.zeros(N)
+        Q[LEAN] += tau_st
+        Q[SWROLL] += tau_sw
+        Q[PELVIS] -= tau_st + tau_sw
+        return Q
+
+    def torso_forces(self, q, dq) -> np.ndarray:
+        """The torso torque's generalised forces (6,): ``tau`` on the stance leg about its
+        pitch axis ``R_s(lean) z``, ``-tau`` on the upper body about its own ``R_s(phi_p)
+        z`` and the difference on the pelvis (about a direction normal to ``s``, which the
+        pelvis, rolling about ``s`` alone, does no work against): virtual work ``tau
+        (delta theta_st - delta theta_torso)``, ``tau = c - k (alpha - r) - d alpha'`` on
+        ``alpha = theta_st - theta_torso``."""
+        c, k, d, r = self.torso_law
+        grad = _unit(STANCE) - (_unit(STANCE) + _unit(THIGH)) / 2
+        alpha, dalpha = grad @ q, grad @ dq
+        return (c - k * (alpha - r) - d * dalpha) * grad
+
+    def inverse_dynamics(self, w, q, dq, qdd) -> np.ndarray:
+        """``sum m J^T (a - g) + I_p ddphi_p e_p - Q_law`` (6,): what ``M qdd + C dq + G``
+        of the generated passive flow (the hip-roll law's forces in ``G``) must equal."""
+        grav = np.array([0.0, -self.g, 0.0])
+        out = -self.law_forces(q, dq)
+        out[PELVIS] += self.I_pelvis * qdd[PELVIS]
+        for m, terms in self.masses(w):
+            _, J, h = self.kin(terms, q, dq)
+            out += m * J.T @ (J @ qdd + h - grav)
+        return out
+
+
+# --- the scene and its kind (quick) -----------------------------------------------------
+
+
+def test_the_kneed_walker_in_3d_carries_an_upper_body_on_the_bisecting_hip():
+    """The scene validates (an upper body on locking knees in 3D, with hip-roll joints and a
+    torso torque), is the kind ``locking_knees_3d``, whose rigid and gym cells take the
+    torso torque, its roles the stabilised kneed walker's (the upper body has no
+    coordinate of its own) and its parameters carry the upper body's."""
+    scene = scene_from_dict(_raw())
+    data = walker_data(scene.walker, scene.slope.angle_rad)
+    kind = kind_of(data.structure)
+    assert kind is KINDS["locking_knees_3d"]
+    assert kind.supports("torso_torque", "rigid") and kind.supports("torso_torque", "gym")
+    assert data.structure.roles == ("lean", "swing_thigh", "swing_shank", "stance",
+                                    "pelvis_roll", "swing_roll")
+    assert {"m_torso_mass", "d_torso_mass"} <= set(data.structure.param_names)
+
+
+# --- against the independent model and the gait (slow: the derivation) ------------------
+
+
+@pytest.fixture(scope="module")
+def powered():
+    from walkerlab.models.registry import build_walker
+    from walkerlab.walker.plant import Plant
+
+    scene = Scene.model_validate(_raw())
+    passive = _raw()
+    passive["walker"].pop("actuation")
+    return (build_walker(Plant.from_scene(scene)),
+            build_walker(Plant.from_scene(Scene.model_validate(passive))), scene)
+
+
+def _states(seed: int, count: int = 5):
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        yield rng.uniform(-0.4, 0.4, N), rng.uniform(-2, 2, N), rng.uniform(-5, 5, N)
+
+
+@pytest.mark.slow   # ~13 min cold: the kneed walker's derivation with hip rolls and a torso
+def test_the_kneed_torso_flow_is_newtons_law_with_the_laws_couples(powered, capsys):
+    """At random states (every roll and pitch different, rates nonzero) and
+    accelerations, ``M qdd + C dq + G`` of the generated passive knee-free flow (the
+    hip-roll law's forces in ``G``) equals :class:`KneedTorsoNewton`'s inverse dynamics to
+    1e-11, and the torso torque's accelerations (the driven flow's less the passive
+    one's) its ``M^-1 Q_torso`` to 1e-10, on both mirror steps (the swing hip at +w and at
+    -w).  (The accelerations themselves agree to ~1e-7 only: ``M``'s smallest eigenvalue,
+    ~1e-3 kg m^2 (the swing shank's), turns the terms' 1e-11 into 1e-8 of qdd ~500 rad/s^2
+    at these states.)"""
+    walker, passive, scene = powered
+    ref = KneedTorsoNewton(scene)
+    w = scene.walker.hip_width_m
+    worst = [0.0, 0.0]
+    for (step, free), side in (((walker, passive), w), ((walker.mirror, passive.mirror), -w)):
+        for q, dq, qdd in _states(7):
+            x = np.concatenate([q, dq])
+            M, C, G = free.matrices(x)
+            ours = M @ qdd + C @ dq + np.ravel(G)
+            theirs = ref.inverse_dynamics(side, q, dq, qdd)
+            driven = (np.asarray(step.phases[0].flow(0.0, x))[N:]
+                      - np.asarray(free.phases[0].flow(0.0, x))[N:])
+            bias = ref.inverse_dynamics(side, q, dq, np.zeros(N))
+            M_ref = np.column_stack([ref.inverse_dynamics(side, q, dq, _unit(i)) - bias
+                                     for i in range(N)])
+            torque = np.linalg.solve(M_ref, ref.torso_forces(q, dq))
+            assert np.max(np.abs(torque)) > 1e-2   # the torque does act
+            worst = [max(worst[0], np.max(np.abs(ours - theirs))),
+                     max(worst[1], np.max(np.abs(driven - torque)))]
+            assert np.max(np.abs(ours - theirs)) < 1e-11, (side, ours, theirs)
+            assert np.max(np.abs(driven - torque)) < 1e-10, (side, driven, torque)
+    with capsys.disabled():
+        print(f"\nkneed_torso: |M qdd + C dq + G - Newton| {worst[0]:.1e}, "
+              f"|qdd_torque - Newton's| {worst[1]:.1e}")
+
+
+@pytest.mark.slow   # the derivation (the fixture's)
+def test_a_wrong_upper_body_misses_the_kneed_torso_flow(powered):
+    """The check can fail: the same Newton's law with the upper body's mass or height 10 %
+    off (0.04 kg, 2 cm) misses the generated flow by more than 1e-3 at every state
+    (measured: at least 0.23 and 0.024)."""
+    _, passive, scene = powered
+    (torso,) = scene.walker.torso.bodies
+    w = scene.walker.hip_width_m
+    for wrong in (KneedTorsoNewton(scene, torso_mass=1.1 * torso.mass_kg),
+                  KneedTorsoNewton(scene, torso_height=1.1 * torso.from_hip_m)):
+        for q, dq, qdd in _states(11, 3):
+            M, C, G = passive.matrices(np.concatenate([q, dq]))
+            ours = M @ qdd + C @ dq + np.ravel(G)
+            assert np.max(np.abs(ours - wrong.inverse_dynamics(w, q, dq, qdd))) > 1e-3
+
+
+@pytest.mark.slow   # the derivation and a stride's variational equations
+def test_the_kneed_torso_gait_is_a_fixed_point_and_every_multiplier_inside_the_circle(
+        powered, capsys):
+    """The scene's initial guess (the gait, ``walkerlab fixedpoint``) maps to itself over a
+    stride (both steps: a knee strike, then the heel strike) to 1e-7, and the stride map's
+    Jacobian (the variational equations with saltation) has every multiplier inside the
+    unit circle."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    walker, _, scene = powered
+    g = scene.fixedpoint.initial_guess.model_extra
+    x = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                  for n in walker.state_names()])
+    x_next, period, DP, _ = poincare_map(walker, x, SOLVER, jacobian=True)
+    mu = np.linalg.eigvals(DP)
+    with capsys.disabled():
+        print(f"\nkneed_torso_powered_3d: stride period {period:.8f} s, |P(x) - x| "
+              f"{np.max(np.abs(x_next - x)):.1e}, multipliers "
+              f"{np.round(mu[np.argsort(-np.abs(mu))][:6], 4)}")
+    assert np.max(np.abs(x_next - x)) < 1e-7
+    assert np.max(np.abs(mu)) < 1.0
