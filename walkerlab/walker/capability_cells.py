@@ -407,7 +407,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stance_forces), the MJCF (its pelvis on slides and a roll, the knees' latch and
         # HipRollLoop together), the URDF and the Adams dataset
         ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
-        **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams")},
+        **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams",
+                                           "osim")},
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
