@@ -88,15 +88,10 @@ class HipRollLaw(Strict):
 HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged walker's with "
                   "hip width (walker.space: 3d, hip_width_m > 0)")
 #: what a walker with locking knees in 3D does not carry (``walker.space: 3d`` with a
-#: ``leg.knee``): the upper body is the reason after its field in the scene's one line;
-#: both are reasons of the capability table (:data:`walkerlab.walker.capability_cells.
-#: CAPABILITIES`, ``locking_knees_3d``: the hip-roll joints' views that refuse them)
+#: ``leg.knee``): the upper body, the reason after its field in the scene's one line and a
+#: reason of the capability table (:data:`walkerlab.walker.capability_cells.
+#: CAPABILITIES`, ``locking_knees_3d``)
 KNEED_3D_TORSO = "a kneed walker in 3D carries no upper body so far"
-KNEED_3D_HIP_ROLL = ("OpenSim has no contact-switched force: the knee latch and the "
-                     "hip-roll law both run in walkerlab's stepping loop between Manager "
-                     "windows (walkerlab.export.opensim_walk), a pair no OpenSim walk has "
-                     "checked; configs/kneed_3d_stabilised.yaml walks in the rigid and "
-                     "contact models and in MuJoCo (export --format mjcf)")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "

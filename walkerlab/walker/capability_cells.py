@@ -10,7 +10,7 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-from walkerlab.config.walker import KNEED_3D_HIP_ROLL, KNEED_3D_TORSO
+from walkerlab.config.walker import KNEED_3D_TORSO
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
@@ -405,8 +405,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # in the rigid model and the gym's rigid view (it steps the rigid model)
         # the compliant-contact model (the floating tree's rolls and knees, the law's
         # stance_forces), the MJCF (its pelvis on slides and a roll, the knees' latch and
-        # HipRollLoop together), the URDF and the Adams dataset
-        ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
+        # HipRollLoop together), the URDF, the Adams dataset and the OpenSim model (walkerlab's
+        # stepping loop switching the knee latch and setting the hip-roll law between the
+        # Manager's windows: walkerlab.export.opensim_walk)
         **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams",
                                            "osim")},
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
