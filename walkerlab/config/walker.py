@@ -87,14 +87,6 @@ class HipRollLaw(Strict):
 #: the one line refusing hip-roll joints elsewhere (the capability table's reason)
 HIP_ROLL_NEEDS = ("walker.hip_roll: hip-roll joints are a 3D straight-legged walker's with "
                   "hip width (walker.space: 3d, hip_width_m > 0)")
-#: why the OpenSim view of a walker with locking knees in 3D (``walker.space: 3d`` with a
-#: ``leg.knee``) refuses its hip-roll joints: a reason of the capability table
-#: (:data:`walkerlab.walker.capability_cells.CAPABILITIES`, ``locking_knees_3d``)
-KNEED_3D_HIP_ROLL = ("OpenSim has no contact-switched force: the knee latch and the "
-                     "hip-roll law both run in walkerlab's stepping loop between Manager "
-                     "windows (walkerlab.export.opensim_walk), a pair no OpenSim walk has "
-                     "checked; configs/kneed_3d_stabilised.yaml walks in the rigid and "
-                     "contact models and in MuJoCo (export --format mjcf)")
 #: ``walker.hip_roll`` of the straight-legged walkers in 3D
 _HipRoll = Annotated[HipRollLaw | None, Field(
     description="hip-roll (abduction) joints and their lateral foot-placement law (space: 3d "

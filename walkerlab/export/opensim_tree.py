@@ -156,7 +156,14 @@ def tree_constraint_set(couplings) -> list[str]:
     (:class:`walkerlab.export.tree_bodies.Coupling`: ``sum(coef angle) = 0``, the coupled
     hinge's first): the coupled hinge a first-order ``MultivariatePolynomialFunction`` of the
     others (OpenSim orders its coefficients as the constant, then the last coordinate's,
-    ..., the first's); empty without couplings."""
+    ..., the first's); empty without couplings.
+
+    OpenSim 4.6's ``MultivariatePolynomialFunction`` answers a second derivative with the
+    first (its ``calcDerivative`` reads only the first component), and Simbody's coordinate
+    coupler adds ``sum_ij f_ij u_i u_j`` to the dependent coordinate's acceleration: the
+    bisecting hip's torso (``f_i = 1/2``) gains ``(u1 + u2)^2 / 2`` [rad/s^2] (0.99 at
+    configs/torso_powered_3d.yaml's default state, where the rigid model has 0), and its
+    3D walk leaves the rigid gait (the capability table's torso_torque/osim cell)."""
     if not couplings:
         return []
     out = ['\t\t<ConstraintSet name="constraintset">', "\t\t\t<objects>"]

@@ -260,6 +260,25 @@ class _HipRoll:
             m.setOverrideActuation(state, float(tau[i]))
             m.overrideActuation(state, True)
 
+def advance(state, integrated) -> None:
+    """Carry a Manager's integrated state over onto the loop's own ``state``: its time and
+    continuous variables ``y`` (q, u, z); the discrete ones (the motors' overrides, the
+    forces' on/off switches) are the loop's and integration leaves them alone.
+
+    The loop keeps one ``State`` for the whole walk and never copies a Manager's: in a copy
+    (``opensim.State(manager.integrate(t))``) the frames' lazily computed kinematics (the
+    cache variables behind ``Frame.getTransformInGround``, ``expressVectorInGround``,
+    ``findStationLocationInGround``, ``getAngularVelocityInGround``) can read as valid with
+    the values of an earlier window (OpenSim 4.6: the copy's stage versions repeat the ones
+    they were computed at): the hip-roll law then read the bodies' rolls and roll rates of
+    a window, or of several, before (in configs/hip_width_powered.yaml 12 of the first
+    40 windows of 5 ms), and the powered walker struck 65 ms early and fell.  ``setY``
+    on the loop's realised state invalidates its positions and velocities, so every frame
+    is read afresh."""
+    state.setTime(integrated.getTime())
+    state.setY(integrated.getY())
+
+
 def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
          min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
     """Simulate ``walker.osim`` for ``duration_s`` from its default state (module docstring),
@@ -461,7 +480,7 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
             restart = False
         step = window_s if pushing is None else pulse_until - t
         t = min(t + step, duration_s)
-        state = osim.State(manager.integrate(t))
+        advance(state, manager.integrate(t))
         model.realizeDynamics(state)
         now_on = {g: loaded(g, state) for g in LEGS}  # before a switch drops the stage
         for g in LEGS:

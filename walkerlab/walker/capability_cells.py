@@ -10,7 +10,6 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-from walkerlab.config.walker import KNEED_3D_HIP_ROLL
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
@@ -18,7 +17,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD
            "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -93,6 +92,13 @@ KNEED_3D_GROUND_MJCF = ("the footholds' reference walker, the passive kneed walk
                         "laterally unstable (x40 a stride): a compliant walk from its gait "
                         "capsizes within a few steps; its hip-roll law steadies it on stairs "
                         "(configs/kneed_3d_stabilised_stairs.yaml) and the slope")
+#: why the kneed walker in 3D's OpenSim view refuses its upper body: OpenSim 4.6's coupler
+#: of the bisecting hip (:func:`walkerlab.export.opensim_tree.tree_constraint_set`)
+TORSO_OSIM_COUPLER = ("OpenSim 4.6's MultivariatePolynomialFunction, the bisecting hip's "
+                      "coupler, returns its first derivative for its second, so the upper "
+                      "body's acceleration constraint gains 0.5 (u1 + u2)^2: the 3D straight "
+                      "legs' torso walker (configs/torso_powered_3d.yaml) measured -27 % and "
+                      "fell after 7 heel strikes")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
@@ -424,9 +430,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("torso_torque", "*"): KNEED_3D_TORSO,
         **{("torso_torque", v): None for v in ("rigid", "gym", "urdf")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
-        # its reference case walks with hip-roll joints (the passive lateral mode, x40 a
-        # stride, steadied): OpenSim's is the hip-roll cell's
-        ("torso_torque", "osim"): KNEED_3D_HIP_ROLL,
+        # OpenSim: the bisecting hip's coupler (the 3D straight legs' torso cell's measure)
+        ("torso_torque", "osim"): TORSO_OSIM_COUPLER,
         ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
         # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
@@ -434,9 +439,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # in the rigid model and the gym's rigid view (it steps the rigid model)
         # the compliant-contact model (the floating tree's rolls and knees, the law's
         # stance_forces), the MJCF (its pelvis on slides and a roll, the knees' latch and
-        # HipRollLoop together), the URDF and the Adams dataset
-        ("hip_roll", "*"): KNEED_3D_HIP_ROLL,
-        **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams")},
+        # HipRollLoop together), the URDF, the Adams dataset and the OpenSim model (walkerlab's
+        # stepping loop switching the knee latch and setting the hip-roll law between the
+        # Manager's windows: walkerlab.export.opensim_walk)
+        **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams",
+                                           "osim")},
         ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
                                  "(walker.foot_radius_m)"),
         **_CELLS_3D,
