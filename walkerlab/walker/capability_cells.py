@@ -10,14 +10,14 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
            "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER", "URDF_GROUND",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER",
+           "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
