@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import json
+
 import typer
 
 from walkerlab.cli.errors import guard
+from walkerlab.walker.capability_tables import text
+from walkerlab.walker.kinds import table_rows
 
 
 @guard
@@ -18,12 +22,6 @@ def capabilities(as_json: bool = typer.Option(False, "--json", help="print every
     the agreement measured on its reference case (✓ -0.4 %; ~ n: runs, not verified), and
     the one-line reason of each refusal (no model is built)."""
     if as_json:
-        import json
-
-        from walkerlab.walker.kinds import table_rows  # light
-
         typer.echo(json.dumps(table_rows(), indent=1, ensure_ascii=False))
         return
-    from walkerlab.walker.capability_tables import text  # light
-
     typer.echo(text(), nl=False)
