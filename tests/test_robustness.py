@@ -166,11 +166,12 @@ def test_stability_map_prints_the_path_of_the_figure_it_drew(tmp_path, monkeypat
         in out
 
 
-@pytest.mark.parametrize("name, why", [("rimless_wheel_3d", "a spoked wheel")])
+@pytest.mark.parametrize("name, why", [("rimless_wheel_3d", "a spoked wheel"),
+                                       ("kneed_3d", "checked on straight legs")])
 def test_robustness_refuses_the_3d_kinds_it_does_not_take_before_any_work(tmp_path, name, why):
-    """The robustness study takes the 3D straight legs and the 3D kneed walker
-    (tests/test_robustness_3d.py); the 3D spoked wheel (no hip to push, no legs to read) is
-    refused in one line naming walker.space, from the table
+    """The robustness study takes the 3D straight legs (tests/test_robustness_3d.py); the 3D
+    spoked wheel (no hip to push, no legs to read) and the kneed walker in 3D (its pushes
+    checked on straight legs only) are refused in one line naming walker.space, from the table
     (:data:`walkerlab.walker.capability_cells.STAGE_CELLS`), before the gait is searched or
     the walker built; the study's own entry refuses them too, and nothing is written."""
     import time

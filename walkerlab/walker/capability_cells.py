@@ -533,8 +533,10 @@ ROBUSTNESS_KNEED_3D = ("the robustness study's pushes in 3D are checked on strai
                        "(configs/hip_width_stabilised.yaml) and on no kneed walker: the "
                        "passive one (configs/kneed_3d.yaml, a stride multiplier of about 40) "
                        "has infinite norms and survives no disturbance, and no run has "
-                       "measured the stabilised one's (configs/kneed_3d_stabilised.yaml); a "
-                       "kneed walker's metastability is walkerlab mfpt's")
+                       "measured the stabilised one's (configs/kneed_3d_stabilised.yaml: the "
+                       "whole study, with its 400-walk Monte Carlo on the six-coordinate "
+                       "flows, did not end in 42 CPU minutes); a kneed walker's "
+                       "metastability is walkerlab mfpt's")
 #: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
 #: robustness_study`)
 ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance leg's "
