@@ -26,7 +26,6 @@ far above the check's 1e-11.  The fixed point is stored to 10 decimals and the s
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +33,7 @@ import pytest
 import yaml
 from scipy.spatial.transform import Rotation
 
+from tests.test_kneed_3d_stabilised import KneedNewton
 from walkerlab.config import scene_from_dict
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -59,68 +59,40 @@ def _unit(i: int) -> np.ndarray:
     return e
 
 
-class KneedTorsoNewton:
-    """The walker from Newton's law (module docstring) in world axes (``y`` up, ``z``
-    across the slope, the fall line ``s = (cos gamma, -sin gamma, 0)``), the stance foot at
-    the origin.  Each body's roll is about ``s``, each link's pitch (from the vertical)
-    about its rolled ``z``; the upper body rolls with the pelvis and pitches by the mean of
-    the stance leg's and the swing thigh's pitch (the bisecting hip); ``w`` the swing hip's
-    offset along the pelvis' hip axis (its sign: the side).  ``torso_mass``,
-    ``torso_height``: the upper body's, overriding the scene's (a wrong model)."""
+class KneedTorsoNewton(KneedNewton):
+    """The stabilised kneed walker from Newton's law (:class:`tests.test_kneed_3d_stabilised.
+    KneedNewton`: world axes, the stance foot at the origin, each body's roll about the fall
+    line ``s``, each link's pitch about its rolled ``z``) with the upper body, which rolls
+    with the pelvis and pitches by the mean of the stance leg's and the swing thigh's pitch
+    (the bisecting hip).  ``torso_mass``, ``torso_height``: the upper body's, overriding the
+    scene's (a wrong model)."""
 
     def __init__(self, scene: Scene, torso_mass: float | None = None,
                  torso_height: float | None = None):
-        wc, law = scene.walker, scene.walker.hip_roll
-        leg = wc.leg
-        bodies = {b.name: b for b in leg.bodies}
+        super().__init__(scene)
+        wc = scene.walker
         (torso,) = wc.torso.bodies
-        self.g, self.gamma = wc.gravity_m_per_s2, scene.slope.angle_rad
-        self.L, self.L_thigh = leg.length_m, leg.knee.thigh_length_m
-        self.M_hip = wc.hip_mass_kg
-        self.m_thigh, self.d_thigh = (bodies["thigh_mass"].mass_kg,
-                                      bodies["thigh_mass"].from_hip_m)
-        self.m_shank, self.d_shank = (bodies["shank_mass"].mass_kg,
-                                      bodies["shank_mass"].from_hip_m)
         self.m_torso = torso.mass_kg if torso_mass is None else torso_mass
         self.d_torso = torso.from_hip_m if torso_height is None else torso_height
-        self.I_pelvis = law.pelvis_roll_inertia_kg_m2
-        self.law = (law.pelvis_stiffness_n_m_per_rad, law.pelvis_damping_n_m_s_per_rad,
-                    law.swing_stiffness_n_m_per_rad, law.swing_damping_n_m_s_per_rad,
-                    law.lean_gain, law.lean_rate_gain_s)
         (t,) = wc.actuation.torques
         self.torso_law = (t.law.constant_n_m, t.law.stiffness_n_m_per_rad,
                           t.law.damping_n_m_s_per_rad, t.law.rest_angle_rad)
-        self.s = np.array([math.cos(self.gamma), -math.sin(self.gamma), 0.0])
-        self.z = np.array([0.0, 0.0, 1.0])
-        self.S = np.array([[0, -self.s[2], self.s[1]], [self.s[2], 0, -self.s[0]],
-                           [-self.s[1], self.s[0], 0]])
-        self.Z = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
 
     def masses(self, w: float) -> list:
-        """``(mass, terms)``: each point a sum of terms ``(roll, pitch, c)``, the term
-        ``R_s(q_roll) R_z(pitch . q) c`` (``pitch`` (6,) the pitch's coefficients of the
-        coordinates, or None: no pitch)."""
-        L, Lt = self.L, self.L_thigh
-        st, th, sh = _unit(STANCE), _unit(THIGH), _unit(SHANK)
-        hip_st = [(LEAN, st, np.array([0.0, L, 0.0]))]
-        mid = hip_st + [(PELVIS, None, w / 2 * self.z)]
-        hip_sw = hip_st + [(PELVIS, None, w * self.z)]
-        knee_sw = hip_sw + [(SWROLL, th, np.array([0.0, -Lt, 0.0]))]
-        return [
-            (self.M_hip, mid),
-            (self.m_thigh, [(LEAN, st, np.array([0.0, L - self.d_thigh, 0.0]))]),
-            (self.m_shank, [(LEAN, st, np.array([0.0, L - self.d_shank, 0.0]))]),
-            (self.m_thigh, hip_sw + [(SWROLL, th, np.array([0.0, -self.d_thigh, 0.0]))]),
-            (self.m_shank, knee_sw + [(SWROLL, sh, np.array([0.0, -(self.d_shank - Lt),
-                                                            0.0]))]),
-            # the bisecting hip: the upper body up the bisector of the legs' pitches
-            (self.m_torso, mid + [(PELVIS, (st + th) / 2, np.array([0.0, self.d_torso, 0.0]))]),
-        ]
+        """The kneed walker's points and the upper body's, up the bisector of the legs'
+        pitches (its pitch a term's coefficients of the coordinates, (6,): :meth:`kin`)."""
+        mid = [(LEAN, STANCE, np.array([0.0, self.L, 0.0])), (PELVIS, None, w / 2 * self.z)]
+        bisector = (_unit(STANCE) + _unit(THIGH)) / 2
+        return [*super().masses(w),
+                (self.m_torso, mid + [(PELVIS, bisector, np.array([0.0, self.d_torso, 0.0]))])]
 
     def kin(self, terms, q, dq):
-        """Position (3,), Jacobian (3, 6) and ``Jdot dq`` (3,) of a point."""
+        """Position (3,), Jacobian (3, 6) and ``Jdot dq`` (3,) of a point whose terms'
+        pitches are a coordinate's index or coefficients of the coordinates (6,)."""
         r, J, h = np.zeros(3), np.zeros((3, N)), np.zeros(3)
         for ro, pitch, c in terms:
+            if isinstance(pitch, int):
+                pitch = _unit(pitch)
             R = Rotation.from_rotvec(q[ro] * self.s).as_matrix()
             b, db = (0.0, 0.0) if pitch is None else (pitch @ q, pitch @ dq)
             T = Rotation.from_rotvec(b * self.z).as_matrix()
@@ -134,21 +106,6 @@ class KneedTorsoNewton:
                 h += 2 * self.S @ d * dq[ro] * db + R @ self.Z @ self.Z @ T @ c * db ** 2
         return r, J, h
 
-    def law_forces(self, q, dq) -> np.ndarray:
-        """The hip-roll law's generalised forces (6,): a couple ``tau s`` on the leg and
-        ``-tau s`` on the pelvis at each hip (virtual work ``tau s . (omega_leg -
-        omega_pelvis)``; ``s . omega`` of a body rolled by ``q_roll`` then pitched about
-        its rolled ``z`` is ``dq_roll``)."""
-        k_p, c_p, k_s, c_s, g_l, g_r = self.law
-        tau_st = k_p * q[PELVIS] + c_p * dq[PELVIS]
-        tau_sw = -k_s * (q[SWROLL] - g_l * q[LEAN] - g_r * dq[LEAN]) - c_s * (
-            dq[SWROLL] - dq[PELVIS])
-        Q = np.zeros(N)
-        Q[LEAN] += tau_st
-        Q[SWROLL] += tau_sw
-        Q[PELVIS] -= tau_st + tau_sw
-        return Q
-
     def torso_forces(self, q, dq) -> np.ndarray:
         """The torso torque's generalised forces (6,): ``tau`` on the stance leg about its
         pitch axis ``R_s(lean) z``, ``-tau`` on the upper body about its own ``R_s(phi_p)
@@ -160,17 +117,6 @@ class KneedTorsoNewton:
         grad = _unit(STANCE) - (_unit(STANCE) + _unit(THIGH)) / 2
         alpha, dalpha = grad @ q, grad @ dq
         return (c - k * (alpha - r) - d * dalpha) * grad
-
-    def inverse_dynamics(self, w, q, dq, qdd) -> np.ndarray:
-        """``sum m J^T (a - g) + I_p ddphi_p e_p - Q_law`` (6,): what ``M qdd + C dq + G``
-        of the generated passive flow (the hip-roll law's forces in ``G``) must equal."""
-        grav = np.array([0.0, -self.g, 0.0])
-        out = -self.law_forces(q, dq)
-        out[PELVIS] += self.I_pelvis * qdd[PELVIS]
-        for m, terms in self.masses(w):
-            _, J, h = self.kin(terms, q, dq)
-            out += m * J.T @ (J @ qdd + h - grav)
-        return out
 
 
 # --- the scene and its kind (quick) -----------------------------------------------------
