@@ -32,9 +32,13 @@ from walkerlab.analysis.continuation.gait_map import (
 )
 from walkerlab.analysis.continuation.validity import VALIDITY
 
-__all__ = ["BranchPoint", "SpecialPoint", "bordered_jacobian", "branch_point", "correct",
-           "locate_end", "locate_on_bound", "locate_special", "scaled_point",
-           "switch_period_doubling"]
+__all__ = ["CRITICAL_MULTIPLIER", "BranchPoint", "SpecialPoint", "bordered_jacobian",
+           "branch_point", "correct", "critical_pair", "locate_end", "locate_on_bound",
+           "locate_special", "scaled_point", "switch_period_doubling", "tests_at"]
+
+#: the Floquet multiplier that crosses the unit circle at each special point's kind with one
+#: (a fold: +1, a period doubling: -1; Kuznetsov 2004, ch. 10)
+CRITICAL_MULTIPLIER = {"fold": 1.0, "period_doubling": -1.0}
 
 
 @dataclass
@@ -108,6 +112,37 @@ class SpecialPoint:
     point: BranchPoint | None = None
     branch: int = 0
 
+
+
+def tests_at(info: dict) -> dict:
+    """The test functions (:func:`~walkerlab.analysis.continuation.gait_map.test_functions`)
+    at a point of :meth:`~walkerlab.analysis.continuation.gait_map.BranchSystem.full`'s
+    ``info``: of its reduced Jacobian ``M``, its walker's neutral multipliers left out.
+
+    Parameters
+    ----------
+    info : dict
+        ``BranchSystem.full``'s result (``M`` (m, m), ``walker``).
+
+    Returns
+    -------
+    dict
+        ``fold``, ``period_doubling``, ``neimark_sacker`` [-] and ``mu`` (complex (m,)).
+    """
+    return test_functions(info["M"], len(info["walker"].neutral))
+
+
+def critical_pair(q: BranchPoint, kind: str) -> tuple[np.ndarray, complex]:
+    """The eigenvector (m,) and eigenvalue of ``q``'s reduced Jacobian nearest the critical
+    multiplier of ``kind`` (:data:`CRITICAL_MULTIPLIER`: ``fold`` or ``period_doubling``),
+    as :func:`~walkerlab.analysis.continuation.gait_map.critical_vector`.
+
+    Raises
+    ------
+    KeyError
+        ``kind`` has no critical multiplier (a Neimark-Sacker point, a branch end).
+    """
+    return critical_vector(q.M, CRITICAL_MULTIPLIER[kind])
 
 
 def _null_tangent(Fz: np.ndarray, Fp_scaled: np.ndarray) -> np.ndarray:
@@ -219,7 +254,7 @@ def branch_point(sys: BranchSystem, u: np.ndarray, info: dict,
     t = _null_tangent(info["Fz"], Fp * s)
     if t_prev is not None and t @ t_prev < 0:
         t = -t
-    tests = test_functions(info["M"], len(info["walker"].neutral))
+    tests = tests_at(info)
     return BranchPoint(p=float(u[-1] * s), z=u[:-1].copy(), x=info["x"],
                        period_s=float(info["period"]),
                        multipliers=sort_multipliers(np.linalg.eigvals(info["J"])),
@@ -286,7 +321,7 @@ def locate_special(sys: BranchSystem, a: BranchPoint, b_s: float, kind: str, gue
             raise MapFailed("correction failed while locating a special point")
         if kind in VALIDITY:
             return VALIDITY[kind][0](sys, u, sc)
-        return test_functions(info["M"], len(info["walker"].neutral))[kind]
+        return tests_at(info)[kind]
 
     try:
         s_star = brentq(f, 0.0, b_s, xtol=1e-12, rtol=4 * np.finfo(float).eps)
@@ -297,10 +332,7 @@ def locate_special(sys: BranchSystem, a: BranchPoint, b_s: float, kind: str, gue
         q = branch_point(sys, u, info, t)
     except MapFailed:
         return None
-    target = {"fold": 1.0, "period_doubling": -1.0}.get(kind)
-    vec = None
-    if target is not None:
-        vec, _ = critical_vector(q.M, target)
+    vec = critical_pair(q, kind)[0] if kind in CRITICAL_MULTIPLIER else None
     if kind == "neimark_sacker":
         mu = q.tests["mu"]
         prods = [(abs(mu[i] * mu[j] - 1), i, j) for i in range(mu.size)

@@ -20,10 +20,15 @@ from walkerlab.analysis.continuation.gait_map import (
     BranchSystem,
     MapFailed,
     WalkerFamily,
-    critical_vector,
-    test_functions,
 )
-from walkerlab.analysis.continuation.points import BranchPoint, SpecialPoint, branch_point
+from walkerlab.analysis.continuation.points import (
+    CRITICAL_MULTIPLIER,
+    BranchPoint,
+    SpecialPoint,
+    branch_point,
+    critical_pair,
+    tests_at,
+)
 
 __all__ = ["TwoParameterCurve", "special_point_at", "two_parameter"]
 
@@ -69,11 +74,10 @@ def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
     from scipy.optimize import root
 
     sys = BranchSystem(family, k, p_scale)
-    target = 1.0 if kind == "fold" else -1.0
 
     def psi(u):
         info = sys.full(u[:-1], u[-1] * p_scale)
-        return test_functions(info["M"], len(info["walker"].neutral))[kind], info
+        return tests_at(info)[kind], info
 
     def G(u):
         try:
@@ -106,8 +110,8 @@ def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
     if float(np.max(np.abs(info["F"]))) > RESIDUAL_TOL or not sol.success:
         raise MapFailed("no special point", " ".join(str(sol.message).split()))
     q = branch_point(sys, u, info, None)
-    _v, mu = critical_vector(q.M, target)
-    if abs(mu - target) > 1e-5:
+    mu = critical_pair(q, kind)[1]
+    if abs(mu - CRITICAL_MULTIPLIER[kind]) > 1e-5:
         raise MapFailed("no special point", f"critical multiplier {mu:.6g}")
     return float(u[-1] * p_scale), q
 
@@ -124,7 +128,7 @@ def two_parameter(family: WalkerFamily, sp: SpecialPoint, path2: str, p2_start: 
     TwoParameterCurve
         Points sorted by ``p2``.
     """
-    rows = [(p2_start, sp.p, sp.x, sp.point.z, complex(-1 if sp.kind != "fold" else 1))]
+    rows = [(p2_start, sp.p, sp.x, sp.point.z, complex(CRITICAL_MULTIPLIER[sp.kind]))]
     vals = np.asarray(p2_values, float)
     for side in (vals[vals > p2_start], vals[vals < p2_start][::-1]):
         hist = [(p2_start, sp.p, sp.point.z)]
@@ -140,7 +144,7 @@ def two_parameter(family: WalkerFamily, sp: SpecialPoint, path2: str, p2_start: 
                 p, q = special_point_at(fam, sp.kind, sp.period, pg, zg, p_scale)
             except MapFailed:
                 break
-            mu = critical_vector(q.M, 1.0 if sp.kind == "fold" else -1.0)[1]
+            mu = critical_pair(q, sp.kind)[1]
             rows.append((float(p2), p, q.x, q.z, mu))
             hist.append((float(p2), p, q.z))
     rows.sort(key=lambda r: r[0])
