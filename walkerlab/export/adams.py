@@ -154,12 +154,12 @@ from walkerlab.export.adams_statements import (
     LANE_Z,
     MM,
     AdamsStart,
-    _deg,
     _f,
     _fs,
     _rot,
     _stmt,
     marker_id,
+    marker_statement,
     part_statement,
 )
 from walkerlab.export.omitted import Omission, adams_comments
@@ -297,16 +297,11 @@ def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = N
     """The PART and MARKER statements of the hip and the links, and the foot spheres (flat
     feet, ``feet`` of :func:`walkerlab.export.scene_feet.flat_foot_bodies`: their parts)."""
     out = ["!", "! ---- parts: the hip (fixed to leg2) and the links ----"]
-    hip_x, hip_y = start.hip
-    hip_cm = marker_id(2, "cm")
     if mb.hip_mass_kg > 0:
         stance = hip_link(mb, "leg2")  # the hip turns with leg2 (FIXED)
-        out += _stmt(f"PART/2, MASS={_f(mb.hip_mass_kg)}, CM={hip_cm}, IP=0.0, 0.0, 0.0",
-                     f"QG={_fs(hip_x * MM, hip_y * MM, 0.0)}",
-                     f"REULER={_deg(start.angles[stance])}, 0.0D, 0.0D",
-                     f"VX={_f(start.hip_velocity[0] * MM)}",
-                     f"VY={_f(start.hip_velocity[1] * MM)}, WZ={_f(start.rates[stance])}")
-        out += [f"MARKER/{hip_cm}, PART=2, QP=0.0, 0.0, 0.0"]
+        out += part_statement(2, mb.hip_mass_kg, 0.0, start.hip, 0.0, start.angles[stance],
+                              start.hip_velocity, start.rates[stance])
+        out += marker_statement(marker_id(2, "cm"), 2, (0.0, 0.0, 0.0))
     frames = _link_frames(mb, start)
     for ln in mb.links:
         p = ids[ln.name]
@@ -318,19 +313,17 @@ def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = N
         inertia = ln.inertia_kg_m2 * MM * MM  # about z (planar) and x; none along the axis
         out += [f"! {ln.name}: {ln.mass_kg:g} kg, joint {ln.joint}"]
         out += part_statement(p, ln.mass_kg, inertia, joint, 0.0, psi, vcm, w)
-        out += _stmt(f"MARKER/{marker_id(p, 'cm')}, PART={p}",
-                     f"QP={_fs(com[0] * MM, com[1] * MM, 0.0)}")
-        out.append(f"MARKER/{marker_id(p, 'joint')}, PART={p}, QP=0.0, 0.0, 0.0")
+        out += marker_statement(marker_id(p, "cm"), p, (*com, 0.0))
+        out += marker_statement(marker_id(p, "joint"), p, (0.0, 0.0, 0.0))
         if ln.foot_m is not None:
             leg = ln.name.split("_")[0]
-            zl = LANE_Z[leg] * mb.leg_length_m * MM if lanes else 0.0
-            out += _stmt(f"MARKER/{marker_id(p, 'foot')}, PART={p}",
-                         f"QP={_fs(0.0, -ln.foot_m * MM, zl)}")
+            zl = LANE_Z[leg] * mb.leg_length_m if lanes else 0.0
+            out += marker_statement(marker_id(p, "foot"), p, (0.0, -ln.foot_m, zl))
             out += adams_feet(mb).on_leg(mb, marker_id(p, "foot"))
         kids = [k for k in mb.links if k.parent == ln.name]
         if kids:
-            out += _stmt(f"MARKER/{marker_id(p, 'knee')}, PART={p}",
-                         f"QP={_fs(0.0, -kids[0].joint_from_parent_m * MM, 0.0)}")
+            out += marker_statement(marker_id(p, "knee"), p,
+                                    (0.0, -kids[0].joint_from_parent_m, 0.0))
     return out + adams_feet(mb).parts(mb, start, ids, lanes, frames, feet)
 
 
