@@ -17,7 +17,7 @@ from walkerlab.walker.tree import (
     Root,
     diagonal,
 )
-from walkerlab.walker.trees import Part, S, Z, welded
+from walkerlab.walker.trees import S, Z, leg_parts, torso_parts, welded
 
 __all__ = ["floating_planar_tree"]
 
@@ -62,13 +62,9 @@ def floating_planar_tree(structure, params: tuple[str, ...]
                    Joint("hip_y", "prismatic", "hip_x", (0, 0, 0), ((0, 1, 0),), ("hip_y",)))]
     contacts, angles, hips = [], [("hip_x", "hip_x"), ("hip_y", "hip_y")], []
     feet_angles, names = [], ["hip_x", "hip_y"]
-    for i, leg in enumerate(("leg1", "leg2")):
-        tag = (f"{ROLE_TAG['swing']}_", f"{ROLE_TAG['stance']}_")[i] if structure.asymmetric \
-            else ""
-        parts = [Part(b.name, f"m_{tag}{b.name}", f"d_{tag}{b.name}",
-                      f"I_{tag}{b.name}" if b.kind == "rod" else None,
-                      f"e_{tag}{b.name}" if b.off_axis else None, b.link)
-                 for b in structure.bodies]
+    for leg, role in (("leg1", "swing"), ("leg2", "stance")):
+        tag = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
+        parts = leg_parts(structure, role)
         upper = f"{leg}_thigh" if knee else leg
         hips.append(f"{upper}_angle")
         names += [f"{leg}_thigh_angle", f"{leg}_shank_angle"] if knee else [f"{leg}_angle"]
@@ -100,13 +96,9 @@ def floating_planar_tree(structure, params: tuple[str, ...]
         names += ["leg1_foot_angle", "leg2_foot_angle"]
     angles += feet_angles
     if structure.torso:
-        torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
-                           f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
-                           f"e_torso_{b.name}" if b.off_axis else None)
-                      for b in structure.torso)
         bodies += [Body("torso", 0, ZERO_INERTIA, (0, 0, 0),
                         Joint("torso_pitch", "revolute", "pelvis", (0, 0, 0), (Z,),
-                              ("torso_pitch",))), *welded("torso", torso, up=True)]
+                              ("torso_pitch",))), *welded("torso", torso_parts(structure), up=True)]
         pitch = "torso_angle" if structure.hinged_torso else f"({hips[0]} + {hips[1]}) / 2"
         angles.append(("torso_pitch", pitch))
         if structure.hinged_torso:

@@ -74,8 +74,8 @@ from walkerlab.walker.tree import (
     diagonal,
 )
 
-__all__ = ["Part", "Soles", "biped_tree", "legs_tree", "spoked_wheel_3d_tree",
-           "welded"]
+__all__ = ["Part", "Soles", "biped_tree", "leg_parts", "legs_tree", "spoked_wheel_3d_tree",
+           "torso_parts", "welded"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 
@@ -488,19 +488,10 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
             raise ValueError("walker.leg.bodies: a massless body is the mass -> 0 limit of "
                              "the equations (Garcia et al. 1998), not a body of a tree")
     if structure.parts_3d or planar:
-        def leg(role):
-            tag = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
-            return tuple(Part(b.name, massless_mass if b.massless else f"m_{tag}{b.name}",
-                              f"d_{tag}{b.name}",
-                              f"I_{tag}{b.name}" if b.kind == "rod" else None,
-                              f"e_{tag}{b.name}" if b.off_axis else None, b.link)
-                         for b in structure.bodies)
         roles = ("swing", "stance") if swap_roles else ("stance", "swing")
-        legs, swing = leg(roles[0]), leg(roles[1]) if structure.asymmetric else None
-        torso = tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
-                           f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
-                           f"e_torso_{b.name}" if b.off_axis else None)
-                      for b in structure.torso)
+        legs = leg_parts(structure, roles[0], massless_mass)
+        swing = leg_parts(structure, roles[1], massless_mass) if structure.asymmetric else None
+        torso = torso_parts(structure)
     else:
         legs = (Part(structure.bodies[0].name, "m_leg", "L - a_leg",
                      "I_leg" if structure.bodies[0].kind == "rod" else None),)
@@ -519,6 +510,28 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                       soles=_soles(structure, swap_roles) if structure.foot == "flat" else None,
                       lateral_radius="R_lat" if structure.foot == "toroidal" else None)
     return with_arms(*tree, structure.arms, structure.knee) if structure.arms else tree
+
+
+def leg_parts(structure, role: str, massless_mass: str | None = None) -> tuple[Part, ...]:
+    """A leg's bodies (``structure.bodies``, in order) as parts named by the ``role``'s
+    numbers (``"swing"`` or ``"stance"``): ``m_<name>, d_<name>[, I_<name>][, e_<name>]``,
+    with the role's tag (:data:`~walkerlab.walker.description.ROLE_TAG`) when the legs
+    differ; a massless body's mass ``massless_mass`` (:func:`legs_tree`'s)."""
+    tag = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
+    return tuple(Part(b.name, massless_mass if b.massless else f"m_{tag}{b.name}",
+                      f"d_{tag}{b.name}", f"I_{tag}{b.name}" if b.kind == "rod" else None,
+                      f"e_{tag}{b.name}" if b.off_axis else None, b.link)
+                 for b in structure.bodies)
+
+
+def torso_parts(structure) -> tuple[Part, ...]:
+    """The upper body's bodies (``structure.torso``) as parts: ``m_torso_<name>,
+    d_torso_<name>[, I_torso_<name>][, e_torso_<name>]`` (a rigid body's inertia, an
+    off-axis body's offset); none without an upper body."""
+    return tuple(Part(b.name, f"m_torso_{b.name}", f"d_torso_{b.name}",
+                      f"I_torso_{b.name}" if b.kind == "rigid_body" else None,
+                      f"e_torso_{b.name}" if b.off_axis else None)
+                 for b in structure.torso)
 
 
 def _soles(structure, swap_roles: bool = False) -> Soles:
