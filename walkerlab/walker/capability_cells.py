@@ -532,11 +532,12 @@ STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"
 ROBUSTNESS_KNEED_3D = ("the robustness study's pushes in 3D are checked on straight legs "
                        "(configs/hip_width_stabilised.yaml) and on no kneed walker: the "
                        "passive one (configs/kneed_3d.yaml, a stride multiplier of about 40) "
-                       "has infinite norms and survives no disturbance, and no run has "
-                       "measured the stabilised one's (configs/kneed_3d_stabilised.yaml: the "
-                       "whole study, with its 400-walk Monte Carlo on the six-coordinate "
-                       "flows, did not end in 42 CPU minutes); a kneed walker's "
-                       "metastability is walkerlab mfpt's")
+                       "has infinite norms and survives no disturbance, and the stabilised "
+                       "one's study (configs/kneed_3d_stabilised.yaml) stalls in its first "
+                       "step-down bisection: after a 0.219 m step-down the walker falls "
+                       "onto its stance leg, and that step reaches neither a heel strike nor "
+                       "the hip on the ground in 90 CPU seconds of either integrator; a "
+                       "kneed walker's metastability is walkerlab mfpt's")
 #: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
 #: robustness_study`)
 ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance leg's "

@@ -119,7 +119,12 @@ def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
         :data:`LATERAL_DISTURBANCES`.
     """
     e = np.asarray(e, dtype=float)
-    if disturbance == "push":  # pushed rows one by one (scipy), the others batched
+    if disturbance not in disturbances_of(step_walker(sm)):
+        raise ValueError(f"disturbance: unknown {disturbance!r} for this walker; choose "
+                         f"from {', '.join(disturbances_of(step_walker(sm)))}")
+    if not e.any():  # the undisturbed map: the compiled per-row steps (a zero step-down
+        r = sm.step(X, None)  # would take the stacked step-down integrator, in Python)
+    elif disturbance == "push":  # pushed rows one by one (scipy), the others batched
         e = np.broadcast_to(e, (X.shape[0],))
         r = sm.step(X, None)
         w = step_walker(sm)
@@ -129,15 +134,12 @@ def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
                 p.x_next = sm.walker.reflect(p.x_next)
             for name in ("outcome", "x_pre", "x_next", "step_time_s"):
                 getattr(r, name)[i] = getattr(p, name)[0]
-    elif disturbance == "lateral_push" and lateral_axis(step_walker(sm)) is not None:
+    elif disturbance == "lateral_push":
         r = sm.step(push_rows(step_walker(sm), X, e)[0], None)
     elif disturbance == "slope":
         r = sm.step(X, sm.slope_rad + e)
-    elif disturbance == "floor_height":
+    else:  # floor_height
         r = sm.step(X, None, drop_m=e)
-    else:
-        raise ValueError(f"disturbance: unknown {disturbance!r} for this walker; choose "
-                         f"from {', '.join(disturbances_of(step_walker(sm)))}")
     return r.x_next, _indicators(sm, r), r.outcome == HEEL_STRIKE
 
 
