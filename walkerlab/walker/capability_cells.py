@@ -534,9 +534,10 @@ ROBUSTNESS_KNEED_3D = ("the robustness study's pushes in 3D are checked on strai
                        "passive one (configs/kneed_3d.yaml, a stride multiplier of about 40) "
                        "has infinite norms and survives no disturbance, and the stabilised "
                        "one's study (configs/kneed_3d_stabilised.yaml) stalls in its first "
-                       "step-down bisection: after a 0.219 m step-down the walker falls "
-                       "onto its stance leg, and that step reaches neither a heel strike nor "
-                       "the hip on the ground in 90 CPU seconds of either integrator; a "
+                       "step-down bisection: after a 0.219 m step-down the walker capsizes "
+                       "sideways (0.15 s into the next step its lean is 1.15 rad at 23 "
+                       "rad/s), and both integrators' steps shrink to 1e-9 s there before "
+                       "the hip reaches the ground, the rigid model's only fall guard; a "
                        "kneed walker's metastability is walkerlab mfpt's")
 #: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
 #: robustness_study`)
