@@ -13,7 +13,7 @@ from __future__ import annotations
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
-           "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
+           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER",
@@ -86,12 +86,6 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
                        "stride apart from the keyframe's trailing foot (its two steps mirror "
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
-#: why the kneed walker in 3D's contact model and MJCF refuse footholds (its stairs are the
-#: stabilised walker's, configs/kneed_3d_stabilised_stairs.yaml)
-KNEED_3D_GROUND_MJCF = ("the footholds' reference walker, the passive kneed walker in 3D, is "
-                        "laterally unstable (x40 a stride): a compliant walk from its gait "
-                        "capsizes within a few steps; its hip-roll law steadies it on stairs "
-                        "(configs/kneed_3d_stabilised_stairs.yaml) and the slope")
 #: why the kneed walker in 3D's OpenSim view refuses its upper body: OpenSim 4.6's coupler
 #: of the bisecting hip (:func:`walkerlab.export.opensim_tree.tree_constraint_set`)
 TORSO_OSIM_COUPLER = ("OpenSim 4.6's MultivariatePolynomialFunction, the bisecting hip's "
@@ -450,14 +444,14 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stairs and footholds in the rigid model and the gym's rigid view: the straight
         # legs' landing (the generated swing clearance with the knee locked plus the
         # landing's depth: walkerlab.models.hybrid.ground)
-        # stairs in the contact model and the MJCF: the stabilised walker
-        # (configs/kneed_3d_stabilised_stairs.yaml) on the 3D straight legs' footfall
+        # stairs and footholds (of one height) in the contact model and the MJCF: the
+        # stabilised walker (configs/kneed_3d_stabilised_stairs.yaml,
+        # configs/kneed_3d_stabilised_footholds.yaml) on the 3D straight legs' footfall
         # patches (walkerlab.export.legs_3d_mjcf.legs3d_footfalls), its knee latch measured
         # from the nearest patch's top (walkerlab.models.contact.assembly.latch_ground,
         # walkerlab.export.mjcf_ground.lane_tops)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},
-        **{("stairs", v): None for v in ("contact", "mjcf")},
-        **{("footholds", v): KNEED_3D_GROUND_MJCF for v in ("contact", "mjcf")},
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("contact", "mjcf")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
