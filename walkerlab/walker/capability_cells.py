@@ -12,7 +12,8 @@ from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
+           "KNEED_3D_POWERED", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
+           "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
            "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
@@ -141,6 +142,17 @@ KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the
                          "little off it capsizes within a few steps, as the rigid walk would "
                          "(its hip-roll cell's law steadies it: configs/"
                          "kneed_3d_stabilised.yaml)")
+#: why the stabilised kneed walker's contact walk down stairs runs slower than its rigid walk
+#: (configs/kneed_3d_stabilised_stairs.yaml, measured at 50 kHz: tests/test_kneed_3d_stairs.py)
+KNEED_3D_STAIRS_KNEE_STRIKE = (
+    "the contact model's knee stop ends a swing knee's strike in about 20 us, before the "
+    "stance foot's compliant contact responds, so the strike jerks that nearly free foot "
+    "0.4-0.65 m/s backward: on the 0.0504 rad slope this drives it 16 mm/s into the ground, "
+    "which grips it within 0.1 ms; on a level tread it runs along the tread, 27 mm/s upward, "
+    "the normal force clips to 0 and the foot flies 3.5 ms, slipping about 1 mm back a step "
+    "(the rigid knee strike pins it: normal impulse +0.020 N s, tangential -0.005 N s on "
+    "both grounds); a knee stop damped from 1e-3 rad instead of 1e-5 rad keeps the foot "
+    "loaded and measures -2.33 % (its slope -1.87 %, against -1.68 %)")
 #: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
 #: rigid view) refuse its joint torques and push-off: the powered gait
 #: (configs/kneed_3d_powered.yaml's) keeps the passive one's lateral instability, and it
@@ -515,7 +527,9 @@ FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
-                 ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE}
+                 ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE,
+                 # why the stairs' contact walk is slower than the rigid one (not verified)
+                 ("locking_knees_3d", "stairs", "contact"): KNEED_3D_STAIRS_KNEE_STRIKE}
 
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``
