@@ -148,3 +148,18 @@ def test_the_contact_and_mujoco_walks_keep_the_rigid_step_period(tmp_path):
     assert check.walked and not check.fell and check.alternating, check.line
     assert check.strikes >= 10, check.line
     assert check.period_s == pytest.approx(check.rigid_period_s, rel=0.03), check.line
+
+
+@pytest.mark.parametrize("name", [FOOTHOLDS, "kneed_3d_stabilised_stairs.yaml"])
+def test_the_kneed_3d_adams_latch_refuses_a_ground_off_the_slope_plane(name):
+    """The 3D kneed dataset's knee latch reads a foot's height from the slope's plane
+    through the first footfall: on footholds (2 mm down a step) and stairs a foot below that
+    plane would keep its latch through the swing, so the statements refuse the ground in one
+    line naming terrain.kind; on the slope they are written (the shipped dataset's)."""
+    from walkerlab.export.adams_3d_knees import knee_3d_statements
+
+    parts = {"leg1": 2, "leg1_shank": 3, "leg2": 4, "leg2_shank": 5}
+    with pytest.raises(KindRefused, match=r"^terrain\.kind: .*tread under it"):
+        knee_3d_statements(load_scene(ROOT / "configs" / name), parts, 0.0)
+    slope = load_scene(ROOT / "configs" / SLOPE)
+    assert any("SFORCE/3" in line for line in knee_3d_statements(slope, parts, 0.05))

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
+           "KNEED_3D_ADAMS_GROUND", "KNEED_3D_POWERED",
+           "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
            "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
            "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
@@ -87,6 +88,13 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
                        "stride apart from the keyframe's trailing foot (its two steps mirror "
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
+#: why the kneed walker in 3D's Adams dataset refuses stairs and footholds
+#: (:func:`walkerlab.export.adams_3d_knees.knee_3d_statements`' latch height)
+KNEED_3D_ADAMS_GROUND = ("the kneed 3D dataset's knee latch measures a foot's height from the "
+                         "slope's plane through the first footfall, not from the tread under "
+                         "it (the planar dataset's IF over the patches): on stairs and "
+                         "footholds a foot that has stepped a riser or a foothold below that "
+                         "plane keeps its latch, and its knee straight, through the swing")
 #: why the kneed walker in 3D's OpenSim view refuses its upper body: OpenSim 4.6's coupler
 #: of the bisecting hip (:func:`walkerlab.export.opensim_tree.tree_constraint_set`)
 TORSO_OSIM_COUPLER = ("OpenSim 4.6's MultivariatePolynomialFunction, the bisecting hip's "
@@ -464,6 +472,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # walkerlab.export.mjcf_ground.lane_tops)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},
         **{(g, v): None for g in ("stairs", "footholds") for v in ("contact", "mjcf")},
+        # the OpenSim model: the 3D straight legs' patches at the treads' heights, the
+        # stepping loop's knee latch reading each foot above the tread under it
+        # (walkerlab.export.opensim_walk.contact_height)
+        **{(g, "osim"): None for g in ("stairs", "footholds")},
+        **{(g, "adams"): KNEED_3D_ADAMS_GROUND for g in ("stairs", "footholds")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
