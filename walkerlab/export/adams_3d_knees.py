@@ -29,6 +29,8 @@ from walkerlab.export.adams_latch import latch_law, latch_sforce
 from walkerlab.export.adams_statements import MM, _f, _stmt, _var
 from walkerlab.export.axes_3d import slope_axes
 from walkerlab.models.contact.rigid_limit import contact_si
+from walkerlab.walker.capability_cells import KNEED_3D_ADAMS_GROUND
+from walkerlab.walker.kinds import KindRefused
 
 __all__ = ["KNEE_3D_VARIABLES", "KNEE_STOP_SFORCE", "knee_3d_statements"]
 
@@ -59,6 +61,13 @@ def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
     Returns
     -------
     list of str
+
+    Raises
+    ------
+    walkerlab.walker.kinds.KindRefused
+        A latch on stairs or footholds (the latch's height is the slope plane's:
+        :data:`walkerlab.walker.capability_cells.KNEED_3D_ADAMS_GROUND`), one line naming
+        terrain.kind.
     """
     _, ks = contact_si(scene.contact or ContactSettings())
     law = latch_law(ks)
@@ -73,6 +82,9 @@ def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
                      f"FUNCTION=-IMPACT(-AZ({i_m},{j_m}),-WZ({i_m},{j_m},{j_m}),0.0,{law})")
     if not ks.latch:
         return out
+    terrain = scene.terrain
+    if terrain is not None and not terrain.is_slope:  # the latch reads the slope's plane
+        raise KindRefused(f"terrain.kind: {KNEED_3D_ADAMS_GROUND}")
     V = KNEE_3D_VARIABLES
     _t, n = slope_axes(slope_rad)
     h_rel, cap = ks.latch_height * MM, ks.latch_capture

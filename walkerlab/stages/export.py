@@ -33,6 +33,8 @@ from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.models.contact.terrain import ground_drops
 from walkerlab.stages.pipeline import fresh_fixedpoint, stage_module
+from walkerlab.walker.capability_cells import FOOTHOLDS_EXPORT_3D
+from walkerlab.walker.kinds import KindRefused
 from walkerlab.walker.plant import Plant
 
 
@@ -122,7 +124,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         :data:`walkerlab.walker.capability_cells.URDF_GROUND`), or no rigid gait to start from; a
         spoked wheel to a format other than urdf or mjcf (naming walker.model); footholds
         of several heights where the capability table refuses them (the Adams dataset,
-        the OpenSim model: naming terrain.foothold_heights_m); MJCF options for a format
+        the OpenSim model: naming terrain.foothold_heights_m) and for any walker in 3D
+        (its footfall patches are a stride of mirrored steps); MJCF options for a format
         other than mjcf or a spoked wheel; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
@@ -154,6 +157,10 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         kind.require("walk", writer.view, kind.field)
     if ground and len(drops) > 1:  # footholds of several heights: the table's cell
         kind.require("footholds", writer.view, "terrain.foothold_heights_m")
+        if not job.tree.in_plane:  # a 3D walker's patches: a stride of mirrored steps (the
+            # kneed walker's footholds cells hold on one height: its table's cell is not
+            # the straight legs' refusal)
+            raise KindRefused(f"terrain.foothold_heights_m: {FOOTHOLDS_EXPORT_3D}")
     if ground and scene.terrain.kind in ("stairs", "profile"):  # the kind's cell of it
         kind.require(scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")
     if mjcf is not None and mjcf != MjcfOptions() and (fmt != "mjcf" or job.tree.one_body):

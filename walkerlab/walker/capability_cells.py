@@ -12,8 +12,10 @@ from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
-           "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
+           "KNEED_3D_ADAMS_GROUND", "KNEED_3D_POWERED",
+           "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
+           "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
+           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER",
@@ -86,12 +88,13 @@ FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model la
                        "stride apart from the keyframe's trailing foot (its two steps mirror "
                        "each other about the fall line); footholds of several heights make "
                        "the steps differ: give footholds of one height for this view")
-#: why the kneed walker in 3D's contact model and MJCF refuse footholds (its stairs are the
-#: stabilised walker's, configs/kneed_3d_stabilised_stairs.yaml)
-KNEED_3D_GROUND_MJCF = ("the footholds' reference walker, the passive kneed walker in 3D, is "
-                        "laterally unstable (x40 a stride): a compliant walk from its gait "
-                        "capsizes within a few steps; its hip-roll law steadies it on stairs "
-                        "(configs/kneed_3d_stabilised_stairs.yaml) and the slope")
+#: why the kneed walker in 3D's Adams dataset refuses stairs and footholds
+#: (:func:`walkerlab.export.adams_3d_knees.knee_3d_statements`' latch height)
+KNEED_3D_ADAMS_GROUND = ("the kneed 3D dataset's knee latch measures a foot's height from the "
+                         "slope's plane through the first footfall, not from the tread under "
+                         "it (the planar dataset's IF over the patches): on stairs and "
+                         "footholds a foot that has stepped a riser or a foothold below that "
+                         "plane keeps its latch, and its knee straight, through the swing")
 #: why the kneed walker in 3D's OpenSim view refuses its upper body: OpenSim 4.6's coupler
 #: of the bisecting hip (:func:`walkerlab.export.opensim_tree.tree_constraint_set`)
 TORSO_OSIM_COUPLER = ("OpenSim 4.6's MultivariatePolynomialFunction, the bisecting hip's "
@@ -147,6 +150,17 @@ KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the
                          "little off it capsizes within a few steps, as the rigid walk would "
                          "(its hip-roll cell's law steadies it: configs/"
                          "kneed_3d_stabilised.yaml)")
+#: why the stabilised kneed walker's contact walk down stairs runs slower than its rigid walk
+#: (configs/kneed_3d_stabilised_stairs.yaml, measured at 50 kHz: tests/test_kneed_3d_stairs.py)
+KNEED_3D_STAIRS_KNEE_STRIKE = (
+    "the contact model's knee stop ends a swing knee's strike in about 20 us, before the "
+    "stance foot's compliant contact responds, so the strike jerks that nearly free foot "
+    "0.4-0.65 m/s backward: on the 0.0504 rad slope this drives it 16 mm/s into the ground, "
+    "which grips it within 0.1 ms; on a level tread it runs along the tread, 27 mm/s upward, "
+    "the normal force clips to 0 and the foot flies 3.5 ms, slipping about 1 mm back a step "
+    "(the rigid knee strike pins it: normal impulse +0.020 N s, tangential -0.005 N s on "
+    "both grounds); a knee stop damped from 1e-3 rad instead of 1e-5 rad keeps the foot "
+    "loaded and measures -2.33 % (its slope -1.87 %, against -1.68 %)")
 #: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
 #: rigid view) refuse its joint torques and push-off: the powered gait
 #: (configs/kneed_3d_powered.yaml's) keeps the passive one's lateral instability, and it
@@ -450,14 +464,19 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stairs and footholds in the rigid model and the gym's rigid view: the straight
         # legs' landing (the generated swing clearance with the knee locked plus the
         # landing's depth: walkerlab.models.hybrid.ground)
-        # stairs in the contact model and the MJCF: the stabilised walker
-        # (configs/kneed_3d_stabilised_stairs.yaml) on the 3D straight legs' footfall
+        # stairs and footholds (of one height) in the contact model and the MJCF: the
+        # stabilised walker (configs/kneed_3d_stabilised_stairs.yaml,
+        # configs/kneed_3d_stabilised_footholds.yaml) on the 3D straight legs' footfall
         # patches (walkerlab.export.legs_3d_mjcf.legs3d_footfalls), its knee latch measured
         # from the nearest patch's top (walkerlab.models.contact.assembly.latch_ground,
         # walkerlab.export.mjcf_ground.lane_tops)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},
-        **{("stairs", v): None for v in ("contact", "mjcf")},
-        **{("footholds", v): KNEED_3D_GROUND_MJCF for v in ("contact", "mjcf")},
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("contact", "mjcf")},
+        # the OpenSim model: the 3D straight legs' patches at the treads' heights, the
+        # stepping loop's knee latch reading each foot above the tread under it
+        # (walkerlab.export.opensim_walk.contact_height)
+        **{(g, "osim"): None for g in ("stairs", "footholds")},
+        **{(g, "adams"): KNEED_3D_ADAMS_GROUND for g in ("stairs", "footholds")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
@@ -521,7 +540,9 @@ FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
-                 ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE}
+                 ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE,
+                 # why the stairs' contact walk is slower than the rigid one (not verified)
+                 ("locking_knees_3d", "stairs", "contact"): KNEED_3D_STAIRS_KNEE_STRIKE}
 
 #: the pipeline's stages that are a view of the table, or that read one: stage ->
 #: ``(feature, view)`` (:meth:`walkerlab.walker.kinds.Kind.require_stage`; ``compare``

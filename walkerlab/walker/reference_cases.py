@@ -210,6 +210,9 @@ SHIPPED = {
     # ... the stabilised walker down stairs of its slope step (the passive one down
     # configs/kneed_3d_stairs.yaml's leaves a contact or MuJoCo walk within a few steps)
     ("locking_knees_3d", "stairs"): "kneed_3d_stabilised_stairs",
+    # ... and on footholds 2 mm below its slope (configs/footholds.yaml's ground, one height:
+    # the 3D MJCF lays a stride's mirrored steps)
+    ("locking_knees_3d", "footholds"): "kneed_3d_stabilised_footholds",
     # ... with an upper body on the bisecting hip driven by a torque between it and the
     # stance leg (configs/torso_powered_3d.yaml's on the kneed walker): a stable stride gait
     ("locking_knees_3d", "torso_torque"): "kneed_torso_powered_3d",
