@@ -416,10 +416,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the hip and knee torques and the push-off in the rigid model (walkerlab.models.
         # hybrid.actuated._KneedLegs3d: the 3D straight legs' actuators with the planar
         # kneed walker's knee held through the push-off and the heel strike)
-        **{(f, "*"): KNEED_3D_POWERED for f in ("hip_torque", "knee_torque", "push_off")},
-        # and the Gymnasium environment's rigid view (it steps the rigid model)
-        **{(f, v): None for f in ("hip_torque", "knee_torque", "push_off")
-           for v in ("rigid", "gym")},
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
         # an upper body on the bisecting hip driven by a torque between it and the stance
