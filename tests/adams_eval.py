@@ -16,7 +16,7 @@ def evaluate(model, ids, extra: dict | None = None) -> dict:
     """The dataset's VARIABLEs ``ids`` at its start (Adams Solver function semantics:
     ``DX(i, j, k)`` the displacement of marker i from j along k's x (k default ground),
     ``DM`` its length, ``VX(i)`` i's velocity along ground x, ``WZ(i, j, k)`` i's angular
-    velocity relative to ground marker j along k's z, ``AZ(i, j)`` the turn of i's x axis
+    velocity less j's (its part's) along k's z, ``AZ(i, j)`` the turn of i's x axis
     about j's z (``ATAN2(x_i . y_j, x_i . x_j)``), ``STEP(x, x0, h0, x1, h1)`` the cubic
     step ``h0 + (h1 - h0) u^2 (3 - 2 u)``, ``IF(e: a, b, c)`` a, b, c for e <, =, > 0;
     ``CONTACT`` 0: the start's feet touch without penetrating)."""
@@ -43,9 +43,12 @@ def evaluate(model, ids, extra: dict | None = None) -> dict:
         cm = pose(model.get("PART", part).integer("CM"))[0]
         return (v + np.cross(w, pose(i)[0] - cm)) / model.length
 
-    def wz(i, _j, k):
-        part = model.get("MARKER", i).integer("PART")
-        return (pose(k)[1].T @ model.part_velocity(part)[1])[2]
+    def wz(i, j, k):  # i's angular velocity relative to j's, along k's z
+        w = model.part_velocity(model.get("MARKER", i).integer("PART"))[1]
+        pj = model.get("MARKER", j).integer("PART")
+        if pj != 1:  # not the ground's
+            w = w - model.part_velocity(pj)[1]
+        return (pose(k)[1].T @ w)[2]
 
     def az(i, j):
         Ri, Rj = pose(i)[1], pose(j)[1]

@@ -7,8 +7,12 @@ centres of mass, the knees and the feet are the rigid model's generated ``points
 exports' axes, z up: ``X = x, Y = -z, Z = y``, written out here); the kinetic energy is the
 rigid model's ``0.5 dq^T M(q) dq``; the knee angles the state's (``swing_shank -
 swing_thigh``; the stance knee straight); the stop's and latch's numbers the contact
-model's (:func:`walkerlab.models.contact.rigid_limit.contact_si`).  The state is not a gait
-(the file's statements are functions of the state): no gait search.  Tolerance 1e-9.
+model's (:func:`walkerlab.models.contact.rigid_limit.contact_si`); the actuation's hip and
+knee torques the laws ``constant - K (angle - rest) - D rate`` written out here on the
+state's thigh pitches and knee angles, its push-off the rigid stance leg's line from foot to
+hip (also on the stabilised powered walker, configs/kneed_3d_powered_stabilised.yaml).  The
+state is not a gait (the file's statements are functions of the state): no gait search.
+Tolerance 1e-9.
 """
 
 from __future__ import annotations
@@ -122,3 +126,90 @@ def test_a_kneed_3d_datasets_knee_stop_and_latch_are_the_contact_models(kneed):
     assert v[372] == pytest.approx(0.0, abs=1e-9)
     assert v[373] == 0.0   # the swing knee bent 0.085 rad, past the 0.01 rad capture
     assert v[374] == 1.0   # the stance foot on the ground, its knee straight
+
+
+# --- the actuation on knees (walkerlab.export.adams_3d_actuation) ------------------------
+
+#: laws under test at the hip, the swing knee and the stance knee (every term nonzero)
+LAWS = {"hip": {"constant_n_m": 0.03, "stiffness_n_m_per_rad": 0.5,
+                "damping_n_m_s_per_rad": 0.07, "rest_angle_rad": 0.05},
+        "swing_knee": {"constant_n_m": -0.02, "stiffness_n_m_per_rad": 0.3,
+                       "damping_n_m_s_per_rad": 0.04, "rest_angle_rad": -0.1},
+        "stance_knee": {"constant_n_m": 0.01, "stiffness_n_m_per_rad": 0.2,
+                        "damping_n_m_s_per_rad": 0.03, "rest_angle_rad": 0.02}}
+#: the stabilised walker's state (lean, swing thigh, swing shank, stance, pelvis roll, swing
+#: roll, then the rates): its gait with the swing knee bent 0.09 rad at -0.4 rad/s
+X_ROLLED = [0.0286, -0.2826, -0.3726, 0.1886, -0.0088, -0.0473,
+            -0.2724, -0.3836, -0.7836, -1.1826, 1.4023, -0.2526]
+
+
+def _law(law, angle, rate):
+    """``constant - K (angle - rest) - D rate`` [N m] (walkerlab.config.actuation)."""
+    return (law["constant_n_m"] - law["stiffness_n_m_per_rad"] * (angle - law["rest_angle_rad"])
+            - law["damping_n_m_s_per_rad"] * rate)
+
+
+@pytest.fixture(scope="module", params=[
+    "kneed_3d", pytest.param("kneed_3d_powered_stabilised", marks=pytest.mark.slow)])
+def powered(request):
+    """The scene's walker with :data:`LAWS` and a push-off, its dataset at a state with the
+    swing knee bent (the stabilised walker: ~3 min cold, its derivation with hip-roll
+    joints)."""
+    scene = load_scene(ROOT / "configs" / f"{request.param}.yaml")
+    raw = scene.model_dump(exclude_none=True)
+    raw["walker"]["actuation"] = {
+        "torques": [{"joint": j, "law": law} for j, law in LAWS.items()],
+        "push_off": {"impulse_n_s": 0.02}}
+    scene = type(scene).model_validate(raw)
+    data = Plant.from_scene(scene).data
+    x = np.asarray(X_ROLLED if data.structure.hip_roll else X, float)
+    start = adams3d_start(data, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.3,)), 2)
+    return scene, data, x, read_adm(adm3d_text(scene, data, start, "walker"))
+
+
+def test_a_kneed_3d_datasets_knee_and_hip_torques_are_the_rigid_laws(powered):
+    """Leg1 swings at the start: the legs' pitches are the thighs' (the rigid swing thigh
+    and stance pitches and rates), the hip law (alone in VARIABLE/9099) is on swing thigh -
+    stance, the swing knee's law on the state's knee angle ``swing_shank - swing_thigh`` and
+    rate, the stance knee's on its straight knee (0, 0); SFORCE/13 on leg1's knee revolute
+    (I on the shank, J on the thigh) carries the swing law, SFORCE/14 on leg2's the stance
+    law [N mm]."""
+    _scene, data, x, model = powered
+    n = x.size // 2
+    s = dict(zip(data.structure.roles, zip(x[:n], x[n:])))
+    (th, dth), (sh, dsh), (st, dst) = s["swing_thigh"], s["swing_shank"], s["stance"]
+    v = evaluate(model, (303, 611, 612, 613, 614, 621, 622, 623, 624, 9099, 9103, 9104))
+    assert v[303] == 1
+    for k, want in ((611, th), (612, st), (613, dth), (614, dst)):
+        assert v[k] == pytest.approx(want, rel=TOL, abs=1e-12), k
+    assert (v[621], v[622]) == pytest.approx((0.0, 0.0), abs=TOL)
+    assert (v[623], v[624]) == pytest.approx((sh - th, dsh - dth), rel=TOL, abs=1e-12)
+    assert v[9099] / 1000 == pytest.approx(_law(LAWS["hip"], th - st, dth - dst), rel=TOL)
+    assert v[9104] / 1000 == pytest.approx(_law(LAWS["swing_knee"], sh - th, dsh - dth),
+                                           rel=TOL)
+    assert v[9103] / 1000 == pytest.approx(_law(LAWS["stance_knee"], 0.0, 0.0), rel=TOL,
+                                           abs=1e-12)
+    for sid, (i, j), total in ((13, (402, 314), 9104), (14, (602, 516), 9103)):
+        sf = model.get("SFORCE", sid)
+        assert "ROTATION" in sf.flags and (sf.integer("I"), sf.integer("J")) == (i, j)
+        got = evaluate(model, (-1,), {-1: sf.args["FUNCTION"][0]})[-1]
+        assert got == pytest.approx(v[total], rel=1e-15)
+
+
+def test_a_kneed_3d_datasets_push_off_acts_at_the_shanks_foot_towards_its_hip(powered):
+    """The push-off's GFORCE at the stance leg's foot (on its shank, marker 603) points
+    along the rigid stance leg from its foot to its own hip; each foot's penetration is
+    minus its rigid height above the slope."""
+    _scene, data, x, model = powered
+    pts = {k: C @ np.ravel(p) for k, p in functions(data)["points"](x).items()}
+    phi = data.slope_rad
+    nrm = np.array([np.sin(phi), 0.0, np.cos(phi)])
+    v = evaluate(model, (641, 642))
+    assert v[641] / 1000 == pytest.approx(-(nrm @ pts["swing_foot"]), rel=TOL, abs=1e-12)
+    assert v[642] / 1000 == pytest.approx(0.0, abs=1e-12)
+    g = model.gforce(2)
+    assert (g["I"], g["RM"]) == ("603", "101")
+    want = pts["stance_hip"] - pts["stance_foot"]
+    got = [evaluate(model, (-1,), {-1: g[k].replace("VARVAL(662)*", "")})[-1]
+           for k in ("FX", "FY", "FZ")]
+    np.testing.assert_allclose(got, want / np.linalg.norm(want), atol=TOL)

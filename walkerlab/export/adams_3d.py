@@ -81,8 +81,9 @@ foot marker ``100 p + 3`` its centre, where the stance-foot pin holds it (ground
 there).  The legs' inertia (``walker.leg_inertia_kg_m2``, a rod's) is the tree's, as every
 body's.
 
-Actuation (``walker.actuation``: a hip torque, ``joint: hip``, and the push-off): the planar
-dataset's statements on each leg's pitch (:mod:`walkerlab.export.adams_3d_actuation`).
+Actuation (``walker.actuation``: a hip torque, ``joint: hip``, a kneed walker's knee torques
+and the push-off): the planar dataset's statements on each leg's pitch and each knee
+revolute (:mod:`walkerlab.export.adams_3d_actuation`).
 
 Knees (``locking_knees_3d``): the tree's export bodies with the MJCF's roles
 (:func:`walkerlab.export.legs_3d_parts.legs3d_roles`): each thigh ``leg<i>`` carries its
@@ -498,6 +499,8 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
     if act is not None:
         out += ["! walker.actuation: its hip torque (SFORCE or GFORCE) and push-off (GFORCE",
                 "! pulses) are written below, after the contacts"]
+        if any(t.joint.endswith("_knee") for t in act.torques):
+            out += ["! (its knee torques an SFORCE on each knee revolute)"]
     ground, patches = _ground(start, data.slope_rad, p["g"], float(
         scene.terrain_or_default().patch_width_m), start.law is not None, act is not None)
     out += ground

@@ -1,8 +1,9 @@
 """The actuation of a 3D walker's Adams dataset (``walker.actuation``;
-:mod:`walkerlab.export.adams_3d`): the hip torque law (``joint: hip``) and the push-off pulse,
-the planar dataset's statements (:mod:`walkerlab.export.adams_actuation`: the same laws as
-``VARIABLE`` expressions, an ``SFORCE`` or ``GFORCE`` per torque, a ``GFORCE`` pulse at the
-trailing foot) on the 3D walker's parts, as the rigid model has them
+:mod:`walkerlab.export.adams_3d`): the hip torque law (``joint: hip``), a kneed walker's knee
+torques and the push-off pulse, the planar dataset's statements
+(:mod:`walkerlab.export.adams_actuation`: the same laws as ``VARIABLE`` expressions, an
+``SFORCE`` or ``GFORCE`` per torque, a ``GFORCE`` pulse at the trailing foot) on the 3D
+walker's parts, as the rigid model has them
 (:class:`walkerlab.models.hybrid.actuated._Legs3d`; Kuo 2002, "Energetics of actively powered
 locomotion using the simplest walking model", J. Biomech. Eng. 124(1)).
 
@@ -26,6 +27,16 @@ planar dataset's between the legs; with hip-roll joints the pitch axes differ, s
 has a ``GFORCE`` torque about its own pitch axis (``RM`` its hip marker), the reaction on
 the pelvis (an ``SFORCE/ROTATION`` needs its I and J z axes parallel).
 
+A kneed walker (``locking_knees_3d``): a leg's pitch is its thigh's (the hip marker to the
+knee revolute's J marker ``100 t + 10 + s``, as the rigid model's hip law reads the thighs:
+:class:`walkerlab.models.hybrid.actuated._KneedLegs3d`), its foot the shank's, and a knee
+torque (``stance_knee``, ``swing_knee``: the law on the knee angle ``shank - thigh``, the
+phase variable the stance leg's pitch) one ``SFORCE/ROTATION`` on each knee revolute (I on
+the shank, J on the thigh, z along the leg's own pitch axis, so ``AZ(I, J)`` is the knee
+angle and ``+tau`` on the shank about it is the rigid model's generalised force ``tau
+d(theta_sh - theta_th)``), the role sign picking the stance or the swing law, as the planar
+five-link dataset's knees (:mod:`walkerlab.export.adams_actuation`).
+
 The push-off: the planar dataset's pulse ``P / T`` at the stance foot along the line to its
 own hip (a ``GFORCE``, the reaction on a floating ground marker), on while that leg stands,
 the other foot's touchdown extrapolated ``T`` ahead at its rate is reached and that foot is
@@ -42,7 +53,9 @@ from walkerlab.export.adams_actuation import (
     ACT_VARIABLES,
     HIP_SFORCE,
     HIP_TORQUE_SUM,
+    JOINT_SFORCE,
     PUSH_MIN_STEP_M,
+    ROLE_TORQUE_SUM,
     _law,
     hip_torque_ids,
     push_forces,
@@ -69,7 +82,9 @@ ACT_3D_VARIABLES = {"pitch_leg1": 611, "pitch_leg2": 612, "rate_leg1": 613, "rat
                     "nx": 630, "nz": 631, "pulse_s": 632, "impulse": 633, "tx": 638,
                     "tz": 639, "pen_leg1": 641, "pen_leg2": 642, "dpen_leg1": 643,
                     "dpen_leg2": 644, "lead_leg1": 645, "lead_leg2": 646, "ahead": 647,
-                    "push_leg1": 661, "push_leg2": 662}
+                    "push_leg1": 661, "push_leg2": 662,
+                    "knee_stance": 621, "knee_rate_stance": 622, "knee_swing": 623,
+                    "knee_rate_swing": 624}
 #: GFORCE ids of the push-off at leg1's and leg2's foot (the hip-roll law's are 31, 32).
 PUSH_3D_GFORCE = {"leg1": 1, "leg2": 2}
 #: GFORCE ids of each leg's hip torque with hip-roll joints.
@@ -79,12 +94,22 @@ HIP_TORQUE_GFORCE = {"leg1": 41, "leg2": 42}
 PUSH_3D_FLOAT_MARKER = 105
 
 
+def _ends(parts: dict, leg: str) -> tuple[int, int, int]:
+    """Leg ``leg``'s hip marker, the marker at the far end of its hip link (a straight
+    leg's foot, a thigh's knee: the J marker ``100 t + 10 + s`` of its knee revolute) and
+    its foot marker (on the leg, or on its shank ``leg<i>_shank``)."""
+    hip, shank = 100 * parts[leg] + 2, parts.get(f"{leg}_shank")
+    if shank is None:
+        return hip, 100 * parts[leg] + 3, 100 * parts[leg] + 3
+    return hip, 100 * parts[leg] + 10 + shank, 100 * shank + 3
+
+
 def _pitches(parts: dict, slope_rad: float) -> list[str]:
-    """Each leg's pitch and rate (module docstring)."""
+    """Each leg's pitch and rate (module docstring): a kneed leg's its thigh's."""
     V = ACT_3D_VARIABLES
     out = []
     for g in ("leg1", "leg2"):
-        h, f = 100 * parts[g] + 2, 100 * parts[g] + 3
+        h, f, _foot = _ends(parts, g)
         d = [f"D{a}({f},{h},{ROLL_FRAME})" for a in "XYZ"]
         a, b = V[f"along_{g}"], V[f"across_{g}"]
         out += [_var(a, d[0]), _var(b, f"SQRT({d[1]}**2+{d[2]}**2)"),
@@ -93,8 +118,19 @@ def _pitches(parts: dict, slope_rad: float) -> list[str]:
     return out
 
 
-def _hip_torque(act, parts: dict, rolled: bool) -> list[str]:
-    """The hip torques' laws and their force (module docstring)."""
+def _phase() -> list[str]:
+    """The laws' phase variable, the stance leg's pitch, and its rate (VARIABLE/306, 307)."""
+    V, W = ACT_VARIABLES, ACT_3D_VARIABLES
+    sgn = f"VARVAL({V['sign']})"
+    return [_var(V["phase"], f"IF({sgn}:VARVAL({W['pitch_leg1']}),0,"
+                 f"VARVAL({W['pitch_leg2']}))"),
+            _var(V["dphase"], f"IF({sgn}:VARVAL({W['rate_leg1']}),0,"
+                 f"VARVAL({W['rate_leg2']}))")]
+
+
+def _hip_torque(act, parts: dict, rolled: bool, ks: list) -> list[str]:
+    """The hip torques' laws (actuators ``ks``, ``joint: hip``) and their force (module
+    docstring)."""
     V, W = ACT_VARIABLES, ACT_3D_VARIABLES
     sgn = f"VARVAL({V['sign']})"
     out = ["! hip torques (walker.actuation.torques) [N mm]: +tau on the swing leg about",
@@ -102,11 +138,7 @@ def _hip_torque(act, parts: dict, rolled: bool) -> list[str]:
            "! pitch (times the role sign), the phase variable the stance leg's pitch",
            _var(V["delta"], f"{sgn}*(VARVAL({W['pitch_leg1']})-VARVAL({W['pitch_leg2']}))"),
            _var(V["ddelta"], f"{sgn}*(VARVAL({W['rate_leg1']})-VARVAL({W['rate_leg2']}))"),
-           _var(V["phase"], f"IF({sgn}:VARVAL({W['pitch_leg1']}),0,"
-                f"VARVAL({W['pitch_leg2']}))"),
-           _var(V["dphase"], f"IF({sgn}:VARVAL({W['rate_leg1']}),0,"
-                f"VARVAL({W['rate_leg2']}))")]
-    ks = range(len(act.torques))
+           *_phase()]
     for k in ks:
         out += _law(k, act.torques[k], V["delta"], V["ddelta"])
     out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
@@ -129,11 +161,44 @@ def _hip_torque(act, parts: dict, rolled: bool) -> list[str]:
     return out
 
 
+def _knee_torques(act, parts: dict, ks: list, phase: bool) -> list[str]:
+    """A kneed walker's knee torques (actuators ``ks``: ``stance_knee``, ``swing_knee``;
+    module docstring), with the phase variable's VARIABLEs where no hip torque wrote them
+    (``phase``)."""
+    V, W = ACT_VARIABLES, ACT_3D_VARIABLES
+    sgn = f"VARVAL({V['sign']})"
+    knee = {}
+    for g in ("leg1", "leg2"):
+        i_m, j_m = 100 * parts[f"{g}_shank"] + 2, 100 * parts[g] + 10 + parts[f"{g}_shank"]
+        knee[g] = (i_m, j_m, f"AZ({i_m},{j_m})", f"WZ({i_m},{j_m},{j_m})")
+    out = ["! knee torques (walker.actuation.torques) [N mm]: +tau on the shank about its",
+           "! knee revolute's axis (the leg's pitch axis), -tau on the thigh; the knee angle",
+           "! shank - thigh (AZ of the revolute's I about J), the role sign picking the leg",
+           *(_phase() if phase else [])]
+    for role, (a, b) in (("stance", ("leg1", "leg2")), ("swing", ("leg2", "leg1"))):
+        out += [_var(W[f"knee_{role}"], f"IF({sgn}:{knee[a][2]},0,{knee[b][2]})"),
+                _var(W[f"knee_rate_{role}"], f"IF({sgn}:{knee[a][3]},0,{knee[b][3]})")]
+    for k in ks:
+        role = act.torques[k].joint.split("_")[0]
+        out += _law(k, act.torques[k], W[f"knee_{role}"], W[f"knee_rate_{role}"])
+    for j, role in enumerate(("stance", "swing")):
+        total = ROLE_TORQUE_SUM[f"{role}_knee"]
+        out += _chain_sum(total - 100 + 10 * (2 + j), total,
+                          [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks
+                           if act.torques[k].joint == f"{role}_knee"])
+    st, sw = ROLE_TORQUE_SUM["stance_knee"], ROLE_TORQUE_SUM["swing_knee"]
+    for g, (a, b) in (("leg1", (st, sw)), ("leg2", (sw, st))):  # sign < 0: leg1 stands
+        out += [f"! {g}'s knee: the stance law while {g} stands, else the swing law",
+                f"SFORCE/{JOINT_SFORCE[('knee', g)]}, ROTATION, I={knee[g][0]}, "
+                f"J={knee[g][1]}", f", FUNCTION=IF({sgn}:VARVAL({a}),0,VARVAL({b}))"]
+    return out
+
+
 def _push_off(po, T: float, parts: dict, slope_rad: float) -> list[str]:
     """The push-off pulse (module docstring)."""
     W = ACT_3D_VARIABLES
     t, n = slope_axes(slope_rad)
-    foot = {g: 100 * parts[g] + 3 for g in ("leg1", "leg2")}
+    foot = {g: _ends(parts, g)[2] for g in ("leg1", "leg2")}
     hip = {g: 100 * parts[g] + 2 for g in ("leg1", "leg2")}
     min_step = PUSH_MIN_STEP_M * MM
     out = [f"! push-off (walker.actuation.push_off): a force P / T for T = {T:g} s",
@@ -169,12 +234,14 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     Parameters
     ----------
     scene : walkerlab.config.Scene
-        Its ``walker.actuation`` (hip torques ``joint: hip``, a push-off) and
-        ``contact.push_off_duration_s``.
+        Its ``walker.actuation`` (hip torques ``joint: hip``, a kneed walker's knee torques,
+        a push-off) and ``contact.push_off_duration_s``.
     parts : dict
         PART id by body: ``pelvis``, ``leg1``, ``leg2`` (markers ``100 p + 2`` at each hip,
         z along the leg's pitch axis, ``100 p + 3`` its foot; the pelvis' ``100 p + 10 + q``
-        the J marker of leg ``q``'s revolute).
+        the J marker of leg ``q``'s revolute) and a kneed walker's ``leg1_shank``,
+        ``leg2_shank`` (the foot ``100 s + 3``, the knee revolute's I ``100 s + 2`` and J
+        ``100 t + 10 + s`` on the thigh ``t``).
     contacts : dict
         CONTACT ids by leg (the roles' force test).
     slope_rad : float
@@ -186,6 +253,12 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     Returns
     -------
     list of str
+
+    Raises
+    ------
+    ValueError
+        A torque at a joint other than the hip and a kneed walker's knees (one line naming
+        ``walker.actuation.torques.<i>.joint``).
     """
     act = scene.walker.actuation
     if act is None:
@@ -199,8 +272,18 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     out += ["! each leg's pitch [rad] about its own hip axis from the vertical, and its "
             "rate", f"! (the ground frame MARKER/{ROLL_FRAME}: x the fall line, y the normal)"]
     out += _pitches(parts, slope_rad)
-    if act.torques:
-        out += _hip_torque(act, parts, rolled)
+    hip = [k for k, t in enumerate(act.torques) if t.joint == "hip"]
+    knees = [k for k, t in enumerate(act.torques) if t.joint.endswith("_knee")]
+    if len(hip) + len(knees) < len(act.torques) or (knees and "leg1_shank" not in parts):
+        k = next(k for k, t in enumerate(act.torques) if k not in hip and (
+            k not in knees or "leg1_shank" not in parts))
+        raise ValueError(f"walker.actuation.torques.{k}.joint: the 3D walker's Adams dataset "
+                         "drives the hips (joint: hip) and a kneed walker's knees "
+                         f"(stance_knee, swing_knee), not {act.torques[k].joint}")
+    if hip:
+        out += _hip_torque(act, parts, rolled, hip)
+    if knees:
+        out += _knee_torques(act, parts, knees, phase=not hip)
     if act.push_off is not None:
         T = (scene.contact or ContactSettings()).push_off_pulse_s()
         out += _push_off(act.push_off, T, parts, slope_rad)

@@ -12,8 +12,7 @@ from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_ADAMS_GROUND", "KNEED_3D_POWERED",
-           "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
+           "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
            "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
            "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
@@ -161,14 +160,6 @@ KNEED_3D_STAIRS_KNEE_STRIKE = (
     "(the rigid knee strike pins it: normal impulse +0.020 N s, tangential -0.005 N s on "
     "both grounds); a knee stop damped from 1e-3 rad instead of 1e-5 rad keeps the foot "
     "loaded and measures -2.33 % (its slope -1.87 %, against -1.68 %)")
-#: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
-#: rigid view) refuse its joint torques and push-off: the powered gait
-#: (configs/kneed_3d_powered.yaml's) keeps the passive one's lateral instability, and it
-#: has no hip roll to steady it
-KNEED_3D_POWERED = ("the powered kneed walker in 3D without hip-roll joints keeps the "
-                    "passive one's unstable lateral mode (a stride multiplier of about 40): "
-                    "a walk in this view started off the rigid gait capsizes within a few "
-                    "steps, so its torques and push-off are measured in the rigid model")
 #: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
 #: rigid view, the URDF's masses) refuse its upper body's torque: the floating tree
 #: (:func:`walkerlab.walker.trees.legs_tree` with ``floating``) frees both knees
@@ -427,13 +418,18 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     },
     "locking_knees_3d": {
         # the scene's own check says the same (walkerlab.config.walker.BipedParams)
-        # the hip and knee torques and the push-off in the rigid model (walkerlab.models.
-        # hybrid.actuated._KneedLegs3d: the 3D straight legs' actuators with the planar
-        # kneed walker's knee held through the push-off and the heel strike)
-        **{(f, "*"): KNEED_3D_POWERED for f in ("hip_torque", "knee_torque", "push_off")},
-        # and the Gymnasium environment's rigid view (it steps the rigid model)
-        **{(f, v): None for f in ("hip_torque", "knee_torque", "push_off")
-           for v in ("rigid", "gym")},
+        # the hip and knee torques and the push-off in every view but optimize, measured on
+        # the stabilised walker (configs/kneed_3d_powered_stabilised.yaml: a stable stride
+        # gait; the same laws without hip-roll joints, configs/kneed_3d_powered.yaml, keep
+        # the passive lateral multiplier of ~39): the rigid model (walkerlab.models.hybrid.
+        # actuated._KneedLegs3d: the 3D straight legs' actuators with the planar kneed
+        # walker's knee held through the push-off and the heel strike) and the gym's rigid
+        # view; the contact model (walkerlab.models.contact.actuation: any joint's torque
+        # on the floating tree's link angles, the push-off pulse at the trailing shank's
+        # foot); the MJCF (walkerlab.export.mujoco_walk.PoweredLoop beside HipRollLoop) and
+        # OpenSim (walkerlab.export.opensim_walk's motors and push-off between windows);
+        # the URDF (masses); the Adams dataset (walkerlab.export.adams_3d_actuation: the
+        # thighs' pitches, an SFORCE on each knee revolute, the pulse at the shank's foot)
         ("virtual_constraints", "*"): VC_3D,
         **_NO_ANKLES,
         # an upper body on the bisecting hip driven by a torque between it and the stance

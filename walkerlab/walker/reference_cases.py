@@ -216,9 +216,11 @@ SHIPPED = {
     # ... with an upper body on the bisecting hip driven by a torque between it and the
     # stance leg (configs/torso_powered_3d.yaml's on the kneed walker): a stable stride gait
     ("locking_knees_3d", "torso_torque"): "kneed_torso_powered_3d",
-    # ... with a push-off, a hip and a knee spring-damper (laterally unstable as the
-    # passive gait: x39 a stride)
-    **{("locking_knees_3d", f): "kneed_3d_powered"
+    # ... the stabilised walker with a push-off, a hip and a knee spring-damper: a stable
+    # stride gait (the same laws on the passive walker, configs/kneed_3d_powered.yaml, keep
+    # its lateral multiplier of ~39 a stride: a walk from its gait capsizes within a few
+    # steps)
+    **{("locking_knees_3d", f): "kneed_3d_powered_stabilised"
        for f in ("hip_torque", "knee_torque", "push_off")},
 }
 
