@@ -385,10 +385,13 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
                                  data.slope_rad, 0.0 if round_feet(data) else p["r"])
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order):
-        # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma)
+        # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma);
+        # on knees the swing thigh's and the stance leg's (Wisse et al. 2007: the mechanism
+        # bisects the hip, the angle between the thighs)
         s = dict(zip(state_names(data.structure.roles), np.asarray(ideal.x, float)))
-        qpos += ((s["swing_angle"] + s["stance_angle"]) / 2,)
-        qvel += ((s["swing_rate"] + s["stance_rate"]) / 2,)
+        swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
+        qpos += ((s[f"{swing}_angle"] + s["stance_angle"]) / 2,)
+        qvel += ((s[f"{swing}_rate"] + s["stance_rate"]) / 2,)
     lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
     c, knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],

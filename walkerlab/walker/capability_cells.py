@@ -428,11 +428,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # configs/kneed_torso_powered_3d.yaml's in the rigid model and the gym's rigid view
         # (it steps the rigid model); the URDF writes its tree (the masses)
         ("torso_torque", "*"): KNEED_3D_TORSO,
-        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf")},
+        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
         # OpenSim: the bisecting hip's coupler (the 3D straight legs' torso cell's measure)
         ("torso_torque", "osim"): TORSO_OSIM_COUPLER,
-        ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
         # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
         # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's
