@@ -55,6 +55,9 @@ def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
         return {"torso_hip": 1.0}
     if link == "torso" and "torso_pitch" in coordinates:  # a 3D walker's (the pelvis'
         return {"torso_pitch": 1.0}                      # pitch axis: no pitch of its own)
+    if link == "torso" and "torso_pitch_half1" in coordinates:  # the 3D OpenSim model's:
+        # its bisector's hinge and the upper body's on it (opensim_tree.bisected_tree)
+        return {"torso_pitch_half1": 1.0, "torso_pitch_half2": 1.0}
     role, _, part = link.partition("_")
     part = part or "leg"  # a straight leg's role is its leg's angle (``stance``, ``swing``)
     leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"
