@@ -12,7 +12,7 @@ from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
+           "KNEED_3D_POWERED", "KNEED_3D_TORSO", "KNEE_LATCH_OSIM",
            "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
@@ -164,13 +164,6 @@ KNEED_3D_TORSO = ("the floating tree of the kneed walker in 3D (the contact mode
                   "Hobbelen & Schwab 2007) is a relation of the rigid tree's coordinates, "
                   "not a joint of that tree; the rigid model walks it "
                   "(configs/kneed_torso_powered_3d.yaml)")
-#: why the kneed walker in 3D's MJCF refuses its upper body's torque
-#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_scene`: the keyframe's torso hinge)
-KNEED_3D_TORSO_MJCF = ("the 3D MJCF's keyframe sets the upper body's hinge to the straight "
-                       "legs' mean pitch; on knees the bisecting hip holds it on the thighs' "
-                       "mean, which this export does not read, so MuJoCo would start the "
-                       "upper body off its equality: walk it in the rigid model "
-                       "(configs/kneed_torso_powered_3d.yaml)")
 #: what the views of the 3D kinds refuse: a ground other than a plane
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -426,7 +419,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # leg: the 3D straight legs' (walkerlab.models.hybrid.actuated._Legs3d) on the
         # kneed tree (the thigh's pitch for the swing leg's), its stable gait
         # configs/kneed_torso_powered_3d.yaml's in the rigid model and the gym's rigid view
-        # (it steps the rigid model); the URDF writes its tree (the masses)
+        # (it steps the rigid model); the URDF writes its tree (the masses); the MJCF its
+        # torso hinge held to the thighs' mean by its equality, the keyframe on it
+        # (walkerlab.export.legs_3d_parts.bisector_keyframe)
         ("torso_torque", "*"): KNEED_3D_TORSO,
         **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
