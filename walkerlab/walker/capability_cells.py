@@ -425,8 +425,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("torso_torque", "*"): KNEED_3D_TORSO,
         **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
-        # OpenSim: the bisecting hip's coupler (the 3D straight legs' torso cell's measure)
-        ("torso_torque", "osim"): TORSO_OSIM_COUPLER,
+        # OpenSim: the bisecting hip as a bisector body on two one-coordinate couplers
+        # (walkerlab.export.opensim_tree.bisected_tree) on the thighs' hinges
+        ("torso_torque", "osim"): None,
         # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
         # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's
