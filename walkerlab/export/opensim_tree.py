@@ -30,7 +30,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from walkerlab.export.axes_3d import TO_MUJOCO
-from walkerlab.export.opensim_xml import _coordinate, _frame, transform_axis
+from walkerlab.export.opensim_xml import BISECTOR_FRACTION, _coordinate, _frame, transform_axis
 from walkerlab.export.text import num, nums
 
 __all__ = ["BISECTOR_FRACTION", "bisected_state", "bisected_tree", "osim_axis",
@@ -151,13 +151,6 @@ def _custom(name, parent, pos_m, b, q0, v0) -> list[str]:
             *_frame(f"{b.name}_at_{name}", f"/bodyset/{b.name}"),
             f"{_IND}\t</frames>", f"{_IND}</CustomJoint>"]
     return out
-
-
-#: the bisector body's mass and inertia, a fraction of the upper body's (its mass, and its
-#: pitch inertia about its hinge): Simbody needs a mass matrix it can invert, and two hinges
-#: about one axis with a massless body between them leave it singular; at 1e-6 the walker's
-#: accelerations move ~1e-7 (1e-4 and 1e-8 of configs/torso_powered_3d.yaml's: 1e-7 apart)
-BISECTOR_FRACTION = 1e-6
 
 
 def bisected_tree(root, couplings):
