@@ -16,7 +16,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD
            "KNEED_3D_GROUND_MJCF", "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D",
            "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
@@ -92,13 +92,6 @@ KNEED_3D_GROUND_MJCF = ("the footholds' reference walker, the passive kneed walk
                         "laterally unstable (x40 a stride): a compliant walk from its gait "
                         "capsizes within a few steps; its hip-roll law steadies it on stairs "
                         "(configs/kneed_3d_stabilised_stairs.yaml) and the slope")
-#: why the kneed walker in 3D's OpenSim view refuses its upper body: OpenSim 4.6's coupler
-#: of the bisecting hip (:func:`walkerlab.export.opensim_tree.tree_constraint_set`)
-TORSO_OSIM_COUPLER = ("OpenSim 4.6's MultivariatePolynomialFunction, the bisecting hip's "
-                      "coupler, returns its first derivative for its second, so the upper "
-                      "body's acceleration constraint gains 0.5 (u1 + u2)^2: the 3D straight "
-                      "legs' torso walker (configs/torso_powered_3d.yaml) measured -27 % and "
-                      "fell after 7 heel strikes")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
@@ -375,7 +368,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # swing_hip): the torso's pitch is the legs' mean (Wisse, Hobbelen & Schwab 2007),
         # so its generalised force is the planar walkers' (walkerlab.models.hybrid.
         # actuated._Legs3d, walkerlab.models.contact.parts.Legs3DPart.actuators, the MJCF's
-        # torso_hip hinge held to the legs' mean by its equality)
+        # torso_hip hinge held to the legs' mean by its equality, the OpenSim model's upper
+        # body on a bisector body, each hinge a one-coordinate coupler: walkerlab.export.
+        # opensim_tree.bisected_tree)
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
         ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
         ("virtual_constraints", "*"): VC_3D,
