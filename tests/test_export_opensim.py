@@ -302,19 +302,29 @@ def test_osim_flat_feet_carry_the_scenes_feet(name, foot_kg, foot_inertia, tmp_p
     assert toe2 @ n_hat > 0.01 and heel1 @ n_hat > 0.01
 
 
-def test_the_bisecting_torso_is_a_coordinate_coupler(tmp_path):
-    """torso_bhm's bisecting hip mechanism: a CoordinateCouplerConstraint torso_hip =
-    0.5 leg1_hip + 0.5 leg2_hip (before: refused), the default torso angle the legs' mean."""
+def test_the_bisecting_torso_is_a_bisector_on_two_one_coordinate_couplers(tmp_path):
+    """torso_bhm's bisecting hip mechanism: a body torso_bisector on the hip by
+    torso_hip_half1 = 0.5 leg1_hip, the upper body on it by torso_hip_half2 = 0.5 leg2_hip,
+    each a CoordinateCouplerConstraint with a LinearFunction of one coordinate (OpenSim
+    4.6's MultivariatePolynomialFunction, the coupler of both legs before, returns its
+    first derivative for its second: tests/test_export_opensim_bisector.py); the default
+    halves sum to the legs' mean."""
     root = ET.fromstring(export_stage.run(_scene("torso_bhm"), tmp_path, "osim").read_text()
                          .replace("::", "__"))
-    (c,) = list(root.iter("CoordinateCouplerConstraint"))
-    assert c.find("dependent_coordinate_name").text == "torso_hip"
-    assert c.find("independent_coordinate_names").text.split() == ["leg1_hip", "leg2_hip"]
-    f = c.find("coupled_coordinates_function/MultivariatePolynomialFunction")
-    assert [float(x) for x in f.find("coefficients").text.split()] == [0.0, 0.5, 0.5]
-    assert (f.find("dimension").text, f.find("order").text) == ("2", "1")
+    got = [(c.find("dependent_coordinate_name").text,
+            c.find("independent_coordinate_names").text,
+            [float(x) for x in c.find("coupled_coordinates_function/LinearFunction/"
+                                      "coefficients").text.split()])
+           for c in root.iter("CoordinateCouplerConstraint")]
+    assert got == [("torso_hip_half1", "leg1_hip", [0.5, 0.0]),
+                   ("torso_hip_half2", "leg2_hip", [0.5, 0.0])]
+    joints = {j.get("name"): j.findtext("socket_parent_frame") for j in root.iter("PinJoint")}
+    assert joints["torso_hip_half1"] == "hip_at_torso_hip_half1"
+    assert joints["torso_hip_half2"] == "torso_bisector_at_torso_hip_half2"
     q = {k.get("name"): float(k.find("default_value").text) for k in root.iter("Coordinate")}
-    assert q["torso_hip"] == pytest.approx(0.5 * (q["leg1_hip"] + q["leg2_hip"]), abs=1e-15)
+    assert "torso_hip" not in q
+    assert q["torso_hip_half1"] + q["torso_hip_half2"] == pytest.approx(
+        0.5 * (q["leg1_hip"] + q["leg2_hip"]), abs=1e-15)
 
 
 _COUPLER_CHECK = """
@@ -331,8 +341,9 @@ manager.initialize(state)
 gaps = []
 for t in np.linspace(0.05, 0.5, 10):
     st = manager.integrate(float(t))
-    q = [cs.get(n).getValue(st) for n in ("leg1_hip", "leg2_hip", "torso_hip")]
-    gaps.append(abs(q[2] - 0.5 * (q[0] + q[1])))
+    q = [cs.get(n).getValue(st)
+         for n in ("leg1_hip", "leg2_hip", "torso_hip_half1", "torso_hip_half2")]
+    gaps.append(abs(q[2] + q[3] - 0.5 * (q[0] + q[1])))
 print(max(gaps), model.getTotalMass(state))
 """
 
@@ -341,8 +352,10 @@ print(max(gaps), model.getTotalMass(state))
 @needs_opensim
 def test_the_bisecting_torso_holds_in_opensim(tmp_path):
     """OpenSim enforces the coupler: over 0.5 s of torso_bhm's walk (its first heel strike
-    at 0.86 s) the torso angle stays the legs' mean to OpenSim's constraint tolerance, and
-    the model has the scene's mass (20.x kg with the torso).  OpenSim runs in a child
+    at 0.86 s) the torso angle (its bisector's and its own hinge's sum) stays the legs' mean
+    to OpenSim's constraint tolerance, and the model has the scene's mass (20.x kg with the
+    torso) and the bisector's millionth of the upper body's
+    (:data:`walkerlab.export.opensim_xml.BISECTOR_FRACTION`).  OpenSim runs in a child
     process (:data:`needs_opensim`)."""
     import subprocess
     import sys
@@ -353,12 +366,14 @@ def test_the_bisecting_torso_holds_in_opensim(tmp_path):
     gap, mass = float(out[-2]), float(out[-1])
     assert gap < 1e-6
     sc = _scene("torso_bhm")
+    from walkerlab.export.opensim_xml import BISECTOR_FRACTION
     from walkerlab.walker.description import walker_data
     from walkerlab.walker.multibody import multibody
 
     mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
-    assert mass == pytest.approx(mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links),
-                                 rel=1e-12)
+    torso = next(ln.mass_kg for ln in mb.links if ln.name == "torso")
+    assert mass == pytest.approx(mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
+                                 + BISECTOR_FRACTION * torso, rel=1e-12)
 
 
 def test_osim_export_refuses_walker_only(tmp_path):

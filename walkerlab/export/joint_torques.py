@@ -28,7 +28,9 @@ def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
     shank's angle minus the thigh's, ``leg<i>_ankle`` a flat foot's angle from its leg's
     perpendicular and ``torso_hip`` the torso's, so the thigh (or a straight leg) is
     ``leg<i>_hip``, the shank ``leg<i>_hip + leg<i>_knee``, the foot that plus
-    ``leg<i>_ankle`` (up to a constant), the torso ``torso_hip``.
+    ``leg<i>_ankle`` (up to a constant), the torso ``torso_hip`` (on the OpenSim models'
+    bisecting hip ``torso_hip_half1 + torso_hip_half2``, in 3D ``torso_pitch_half1 +
+    torso_pitch_half2``: :func:`walkerlab.export.opensim_xml.bisected_links`).
 
     Parameters
     ----------
@@ -55,6 +57,9 @@ def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
         return {"torso_hip": 1.0}
     if link == "torso" and "torso_pitch" in coordinates:  # a 3D walker's (the pelvis'
         return {"torso_pitch": 1.0}                      # pitch axis: no pitch of its own)
+    for base in ("torso_hip", "torso_pitch"):  # the OpenSim models' bisecting hip: the
+        if link == "torso" and f"{base}_half1" in coordinates:  # bisector's hinge and the
+            return {f"{base}_half1": 1.0, f"{base}_half2": 1.0}  # upper body's on it
     role, _, part = link.partition("_")
     part = part or "leg"  # a straight leg's role is its leg's angle (``stance``, ``swing``)
     leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"

@@ -107,6 +107,7 @@ from walkerlab.config.contact import ContactSettings
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
+    bisector_keyframe,
     hip_roll_law,
     kneed,
     leg_links,
@@ -128,7 +129,6 @@ from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.models.contact.rigid_limit import contact_si
-from walkerlab.walker.description import state_names
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_CCD_TOLERANCE_L", "TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls",
@@ -384,11 +384,9 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
                                  data.slope_rad, 0.0 if round_feet(data) else p["r"])
-    if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order):
-        # the bisecting hip's pitch, the legs' mean (the tree's torso_pitch less its gamma)
-        s = dict(zip(state_names(data.structure.roles), np.asarray(ideal.x, float)))
-        qpos += ((s["swing_angle"] + s["stance_angle"]) / 2,)
-        qvel += ((s["swing_rate"] + s["stance_rate"]) / 2,)
+    if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order)
+        q, v = bisector_keyframe(data.structure.roles, ideal.x)
+        qpos, qvel = qpos + (q,), qvel + (v,)
     lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
     c, knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],

@@ -7,15 +7,18 @@ files' headers.  Shared by :mod:`walkerlab.export.legs_3d_mjcf`,
 
 from __future__ import annotations
 
+import numpy as np
+
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import num
 from walkerlab.export.tree_bodies import PelvisRoles
+from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_tree
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
-__all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "hip_roll_law", "kneed", "leg_links",
-           "legs3d_numbers", "legs3d_roles", "legs_summary", "legs_words", "round_feet",
-           "walker_tree"]
+__all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "bisector_keyframe", "hip_roll_law", "kneed",
+           "leg_links", "legs3d_numbers", "legs3d_roles", "legs_summary", "legs_words",
+           "round_feet", "walker_tree"]
 
 #: a round foot's disc: its half-thickness along the hip axis, as a fraction of the leg
 #: length (the leg capsule's radius: thin against the disc's radius, the rigid model's disc
@@ -105,3 +108,27 @@ def legs_words(data, p: dict) -> tuple[str, str]:
     return "kneed", (f"; knees {num(p['L_thigh'])} m below the hips on hinges leg<i>_knee "
                      "about the leg's own pitch axis (shank - thigh angle, limit [-pi, 0], "
                      "0 = straight-leg stop)")
+
+
+def bisector_keyframe(roles, x) -> tuple[float, float]:
+    """The upper body's hinge on the bisecting hip at the rigid state ``x``: the pitch [rad]
+    and its rate [rad/s] of the legs' mean (Wisse, Hobbelen & Schwab 2007, "Adding an upper
+    body to passive dynamic walking robots by means of a bisecting hip mechanism", IEEE
+    Trans. Robotics 23(1)), the tree's torso pitch less its gamma; on knees the mean of the
+    swing thigh's and the stance leg's (the mechanism bisects the angle between the thighs).
+
+    Parameters
+    ----------
+    roles : sequence of str
+        The walker's coordinate roles (``swing`` or ``swing_thigh``, ``stance``, ...).
+    x : array_like (2 len(roles),)
+        The rigid state: the roles' angles [rad], then their rates [rad/s].
+
+    Returns
+    -------
+    (float, float)
+    """
+    s = dict(zip(state_names(roles), np.asarray(x, float)))
+    swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
+    return ((s[f"{swing}_angle"] + s["stance_angle"]) / 2,
+            (s[f"{swing}_rate"] + s["stance_rate"]) / 2)

@@ -94,12 +94,13 @@ from walkerlab.export.opensim_contact import (
     patch_radius,
     terrain_patch_radius,
 )
+from walkerlab.export.opensim_tree import bisected_state, tree_constraint_set
 from walkerlab.export.opensim_xml import (
     ankle_springs,
+    bisected_links,
     body_set,
     contact_forces,
     contact_geometry_set,
-    couplers,
     joint_set,
     knee_stop_forces,
     motor_forces,
@@ -108,7 +109,7 @@ from walkerlab.export.opensim_xml import (
     torque_joints,
 )
 from walkerlab.export.parts import export_part
-from walkerlab.export.text import nums
+from walkerlab.export.text import comment, nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 from walkerlab.walker.kinds import KINDS
 
@@ -340,6 +341,10 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     joints = osim_coordinates(mb)
     q0, v0 = dict(zip(joints, gait.qpos)), dict(zip(joints, gait.qvel))
     knee_stops = export_part(mb).knee_stops
+    mb, couplers = bisected_links(mb)   # the bisecting hip's upper body
+    q0, v0 = bisected_state(q0, v0, couplers)
+    joints = [c for j in joints for c in ((f"{j}_half1", f"{j}_half2")
+                                          if couplers and f"{j}_half1" in q0 else (j,))]
     motors = torque_joints(gait.actuation, mb, joints[2:])
     feet = [ln for ln in mb.links if ln.foot_m is not None]
 
@@ -347,11 +352,18 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
            *header_comments(mb, gait, name, version, total, contact_note, rg, r_foot, motors,
                             knee_stops),
+           *([comment("Bisecting hip (walker.torso.coupling): body torso_bisector (a "
+                      "millionth of the upper body's mass and pitch inertia) on the hip by "
+                      "torso_hip_half1 = leg1_hip / 2, the upper body on it by torso_hip_half2 "
+                      "= leg2_hip / 2, each a CoordinateCouplerConstraint with a "
+                      "LinearFunction (OpenSim 4.6's functions of two coordinates return their "
+                      "first derivative for their second): the upper body's absolute angle is "
+                      "their sum.")] if couplers else []),
            *xml_comments(osim_omissions(mb, gait))]
     out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
     out += body_set(mb, feet, gait.flat_feet)
     out += joint_set(mb, q0, v0, feet if gait.flat_feet else ())
-    out += couplers(mb)
+    out += tree_constraint_set(couplers)
     out += ['\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
     out += contact_forces(feet, gait, rg, stiff, diss, vt)
     out += spring_forces(mb)

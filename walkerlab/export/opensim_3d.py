@@ -90,6 +90,8 @@ from walkerlab.export.opensim_contact import (
     terrain_patch_radius,
 )
 from walkerlab.export.opensim_tree import (
+    bisected_state,
+    bisected_tree,
     osim_axis,
     tree_body_set,
     tree_constraint_set,
@@ -295,6 +297,8 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
     phi, g = data.slope_rad, p["g"]
     root, couplings = osim3d_bodies(data)
     q0, v0 = osim3d_state(root, gait.scene.qpos, gait.scene.qvel, phi)
+    root, couplers = bisected_tree(root, couplings)   # the bisecting hip's upper body
+    q0, v0 = bisected_state(q0, v0, couplers)
     feet = _feet(data, root)
     r_point = p["L"] / 1000 if round_feet(data) else p["r"]
     r_foot = p["r"]
@@ -317,7 +321,13 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
                    "axis: a positive angle moves a foot ahead). Coordinates: pelvis_x, "
                    "pelvis_y, pelvis_z (the pelvis' position [m]); pelvis_roll about the fall "
                    "line; leg<i>_roll (hip-roll joints) about the fall line, leg<i>_hip the "
-                   "leg's pitch about its own hip axis, leg<i>_knee shank - thigh [rad]."),
+                   "leg's pitch about its own hip axis, leg<i>_knee shank - thigh [rad]"
+                   + ("; the upper body on the bisecting hip: body torso_bisector (a "
+                      "millionth of the upper body's mass and inertia) on torso_pitch_half1 "
+                      "= leg1_hip / 2, the upper body on it on torso_pitch_half2 = leg2_hip "
+                      "/ 2, each a CoordinateCouplerConstraint with a LinearFunction (OpenSim "
+                      "4.6's functions of two coordinates return their first derivative for "
+                      "their second): its pitch is their sum." if couplers else ".")),
            comment(f"Gravity g = {num(g)} m/s^2 along -y. Ground: slope {num(phi)} rad, "
                    f"falling towards +x. Total mass {num(total)} kg."),
            comment(f"Default state: the rigid gait just after heel strike (leg2 in stance, its "
@@ -357,7 +367,7 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
     out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>"]
     out += tree_body_set(root)
     out += tree_joint_set(root, q0, v0)
-    out += tree_constraint_set(couplings)
+    out += tree_constraint_set(couplers)
     out += ['\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
     out += contact_forces(feet, SimpleNamespace(lanes=lanes, flat_feet=None,
                                                 contact=gait.contact), rg, stiff, diss, vt)

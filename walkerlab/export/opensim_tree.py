@@ -18,21 +18,23 @@ set, no translation; the root's joint ``base`` to the ground carries its slides 
 ``translation1..3`` (the ground's ``x``, ``y``, ``z``) and its hinges as rotations.  A
 ``CustomJoint``'s coordinate speed is its angle's rate (``qdot = u``), so the default
 speeds are the rates of the angles.  A coupled hinge (:class:`walkerlab.export.tree_bodies.
-Coupling`: the bisecting hip's torso) is a ``CoordinateCouplerConstraint`` of the hinges it
-sums.
+Coupling`: the bisecting hip's torso) is two hinges, each a ``CoordinateCouplerConstraint``
+of one leg's (:func:`bisected_tree`).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from walkerlab.export.axes_3d import TO_MUJOCO
-from walkerlab.export.opensim_xml import _coordinate, _frame, transform_axis
+from walkerlab.export.opensim_xml import BISECTOR_FRACTION, _coordinate, _frame, transform_axis
 from walkerlab.export.text import num, nums
 
-__all__ = ["osim_axis", "osim_inertia", "tree_body_set", "tree_constraint_set",
+__all__ = ["BISECTOR_FRACTION", "bisected_state", "bisected_tree", "osim_axis",
+           "osim_inertia", "tree_body_set", "tree_constraint_set",
            "tree_coordinates", "tree_joint_set"]
 
 _C = np.array(TO_MUJOCO)
@@ -151,36 +153,98 @@ def _custom(name, parent, pos_m, b, q0, v0) -> list[str]:
     return out
 
 
-def tree_constraint_set(couplings) -> list[str]:
-    """A ``ConstraintSet`` of one ``CoordinateCouplerConstraint`` per coupling
-    (:class:`walkerlab.export.tree_bodies.Coupling`: ``sum(coef angle) = 0``, the coupled
-    hinge's first): the coupled hinge a first-order ``MultivariatePolynomialFunction`` of the
-    others (OpenSim orders its coefficients as the constant, then the last coordinate's,
-    ..., the first's); empty without couplings.
+def bisected_tree(root, couplings):
+    """The bisecting hip as two hinges of one coordinate each (OpenSim 4.6's
+    ``MultivariatePolynomialFunction`` and ``ExpressionBasedFunction`` answer a second
+    derivative with the first, so a coupler of two coordinates gains ``(u1 + u2)^2 / 2``
+    in the upper body's acceleration: Simbody's coordinate coupler, Sherman, Seth & Delp
+    2011, "Simbody: multibody dynamics for biomedical research", Procedia IUTAM 2, adds
+    ``sum_ij f_ij u_i u_j``).
 
-    OpenSim 4.6's ``MultivariatePolynomialFunction`` answers a second derivative with the
-    first (its ``calcDerivative`` reads only the first component), and Simbody's coordinate
-    coupler adds ``sum_ij f_ij u_i u_j`` to the dependent coordinate's acceleration: the
-    bisecting hip's torso (``f_i = 1/2``) gains ``(u1 + u2)^2 / 2`` [rad/s^2] (0.99 at
-    configs/torso_powered_3d.yaml's default state, where the rigid model has 0), and its
-    3D walk leaves the rigid gait (the capability table's torso_torque/osim cell)."""
-    if not couplings:
-        return []
-    out = ['\t\t<ConstraintSet name="constraintset">', "\t\t\t<objects>"]
+    A coupling ``2 c - a - b = 0`` (:class:`walkerlab.export.tree_bodies.Coupling`: the
+    upper body's pitch ``c`` the mean of the legs' ``a``, ``b``) becomes a body
+    ``<body>_bisector`` on ``c``'s parent at its origin, turning about ``c``'s axis by
+    ``<c>_half1 = a / 2``, carrying the upper body on ``<c>_half2 = b / 2`` about the same
+    axis: the upper body's pitch is their sum, each coupler a ``LinearFunction`` of one
+    coordinate (slope 1/2), whose derivatives OpenSim has right.  The bisector's mass and
+    inertia are :data:`BISECTOR_FRACTION` of the upper body's.
+
+    Parameters
+    ----------
+    root : walkerlab.export.tree_bodies.ExportBody
+    couplings : sequence of walkerlab.export.tree_bodies.Coupling
+
+    Returns
+    -------
+    root : ExportBody
+        The tree with each coupled body on its bisector.
+    linear : list of (str, str, float)
+        ``(dependent, independent, slope)`` per coupler.
+
+    Raises
+    ------
+    ValueError
+        A coupling other than a bisector's (one line naming ``walker``).
+    """
+    linear, split = [], {}
     for cp in couplings:
         (dep, k0), *rest = cp.terms
-        coefs = [0.0, *(-k / k0 for _, k in reversed(rest))]
-        out += [f"{_IND}<CoordinateCouplerConstraint name={quoteattr(cp.name)}>",
+        if k0 != 2 or sorted(k for _, k in rest) != [-1, -1]:
+            raise ValueError(f"walker: the coupling {cp.name} is not a bisector's (2 c = a + "
+                             "b): not in the OpenSim tree writer")
+        split[dep] = [j for j, _ in rest]
+
+    def rebuilt(b):
+        kids = []
+        for c in b.children:
+            c = rebuilt(c)
+            hinge = [j for j in c.joints if j.kind == "hinge" and j.name in split]
+            if hinge:
+                (j,) = hinge
+                a, bb = split[j.name]
+                linear.extend([(f"{j.name}_half1", a, 0.5), (f"{j.name}_half2", bb, 0.5)])
+                com = np.asarray(c.com_m, float)
+                inertia = float(c.mass_kg * com @ com + np.trace(c.inertia_kg_m2))
+                upper = replace(c, pos_m=np.zeros(3),
+                                joints=(replace(j, name=f"{j.name}_half2"),))
+                c = replace(c, name=f"{c.name}_bisector",
+                            joints=(replace(j, name=f"{j.name}_half1"),),
+                            mass_kg=BISECTOR_FRACTION * c.mass_kg, com_m=np.zeros(3),
+                            inertia_kg_m2=BISECTOR_FRACTION * inertia * np.eye(3),
+                            children=(upper,))
+            kids.append(c)
+        return replace(b, children=tuple(kids))
+
+    return rebuilt(root), linear
+
+
+def bisected_state(q0: dict, v0: dict, linear) -> tuple[dict, dict]:
+    """The default coordinates and speeds ``q0``, ``v0`` (by name [rad, rad/s]) of the tree
+    before :func:`bisected_tree` on its bisectors' coordinates: each ``<c>_half<i>`` its
+    slope times its leg's, ``c`` dropped."""
+    q, v = dict(q0), dict(v0)
+    for dep, ind, k in linear:
+        q[dep], v[dep] = k * q0[ind], k * v0[ind]
+        q.pop(dep.rpartition("_half")[0], None)
+        v.pop(dep.rpartition("_half")[0], None)
+    return q, v
+
+
+def tree_constraint_set(linear) -> list[str]:
+    """A ``ConstraintSet`` of one ``CoordinateCouplerConstraint`` per ``(dependent,
+    independent, slope)`` of ``linear`` (:func:`bisected_tree`): ``dependent = slope
+    independent``, a ``LinearFunction``; empty without couplers."""
+    if not linear:
+        return []
+    out = ['\t\t<ConstraintSet name="constraintset">', "\t\t\t<objects>"]
+    for dep, ind, k in linear:
+        out += [f"{_IND}<CoordinateCouplerConstraint name={quoteattr(dep + '_coupling')}>",
                 f"{_IND}\t<isEnforced>true</isEnforced>",
                 f"{_IND}\t<coupled_coordinates_function>",
-                f"{_IND}\t\t<MultivariatePolynomialFunction>",
-                f"{_IND}\t\t\t<coefficients>{nums(*coefs)}</coefficients>",
-                f"{_IND}\t\t\t<dimension>{len(rest)}</dimension>",
-                f"{_IND}\t\t\t<order>1</order>",
-                f"{_IND}\t\t</MultivariatePolynomialFunction>",
+                f"{_IND}\t\t<LinearFunction><coefficients>{nums(k, 0.0)}</coefficients>"
+                "</LinearFunction>",
                 f"{_IND}\t</coupled_coordinates_function>",
-                f"{_IND}\t<independent_coordinate_names>{' '.join(j for j, _ in rest)}"
-                "</independent_coordinate_names>",
+                f"{_IND}\t<independent_coordinate_names>{ind}</independent_coordinate_names>",
                 f"{_IND}\t<dependent_coordinate_name>{dep}</dependent_coordinate_name>",
                 f"{_IND}\t<scale_factor>1</scale_factor>",
                 f"{_IND}</CoordinateCouplerConstraint>"]

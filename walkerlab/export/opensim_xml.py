@@ -7,6 +7,7 @@ document's order, after the comments of :mod:`walkerlab.export.opensim_comments`
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
@@ -16,7 +17,8 @@ from walkerlab.export.text import num, nums
 if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
-__all__ = ["ankle_springs", "body_set", "contact_forces", "contact_geometry_set", "couplers",
+__all__ = ["BISECTOR_FRACTION", "ankle_springs", "bisected_links", "body_set",
+           "contact_forces", "contact_geometry_set",
            "joint_set", "knee_stop_forces", "motor_forces", "push_off_forces",
            "spring_forces", "torque_joints", "transform_axis"]
 
@@ -86,32 +88,57 @@ def _expression_force(name: str, coord: str, expression: str, applies: bool = Tr
             f"{i}</ExpressionBasedCoordinateForce>"]
 
 
-def couplers(mb) -> list[str]:
-    """A ``ConstraintSet`` of one ``CoordinateCouplerConstraint`` per coupling of ``mb`` (the
-    bisecting hip: ``torso_hip = 0.5 leg1_hip + 0.5 leg2_hip``, the links' absolute angles):
-    a first-order ``MultivariatePolynomialFunction`` of the independent coordinates, whose
-    coefficients OpenSim orders as the constant, then the last coordinate's, ..., the first's."""
-    if not mb.couplings:
-        return []
-    i = "\t\t\t\t"
-    out = ['\t\t<ConstraintSet name="constraintset">', "\t\t\t<objects>"]
+#: the bisector body's mass and inertia, a fraction of the upper body's (its mass, and its
+#: pitch inertia about its hinge): Simbody needs a mass matrix it can invert, and two hinges
+#: about one axis with a massless body between them leave it singular; at 1e-6 the walker's
+#: accelerations move ~1e-7 (1e-4 and 1e-8 of configs/torso_powered_3d.yaml's: 1e-7 apart)
+BISECTOR_FRACTION = 1e-6
+
+
+def bisected_links(mb):
+    """The planar walker's bisecting hip (``torso_hip = 0.5 leg1_hip + 0.5 leg2_hip``,
+    :class:`walkerlab.walker.multibody.Coupling`) as two hinges of one coordinate each, as
+    :func:`walkerlab.export.opensim_tree.bisected_tree` writes the 3D walker's (OpenSim 4.6's
+    functions of two coordinates return their first derivative for their second): a link
+    ``torso_bisector`` on the hip turning by ``torso_hip_half1 = leg1_hip / 2`` (a
+    :data:`BISECTOR_FRACTION` of the upper body's mass and inertia at the hip), the upper body
+    on it by ``torso_hip_half2 = leg2_hip / 2``: its absolute angle their sum.
+
+    Parameters
+    ----------
+    mb : walkerlab.walker.multibody.Multibody
+
+    Returns
+    -------
+    mb : Multibody
+        ``mb`` with the bisector link and no couplings (unchanged without couplings).
+    linear : list of (str, str, float)
+        ``(dependent, independent, slope)`` per coupler
+        (:func:`walkerlab.export.opensim_tree.tree_constraint_set`).
+
+    Raises
+    ------
+    ValueError
+        A coupling other than a bisector's (one line naming ``walker``).
+    """
+    links, linear = list(mb.links), []
     for cp in mb.couplings:
-        coefs = [0.0, *(c for _, c in reversed(cp.terms))]
-        out += [f"{i}<CoordinateCouplerConstraint name={quoteattr(cp.name)}>",
-                f"{i}\t<isEnforced>true</isEnforced>",
-                f"{i}\t<coupled_coordinates_function>",
-                f"{i}\t\t<MultivariatePolynomialFunction>",
-                f"{i}\t\t\t<coefficients>{nums(*coefs)}</coefficients>",
-                f"{i}\t\t\t<dimension>{len(cp.terms)}</dimension>",
-                f"{i}\t\t\t<order>1</order>",
-                f"{i}\t\t</MultivariatePolynomialFunction>",
-                f"{i}\t</coupled_coordinates_function>",
-                f"{i}\t<independent_coordinate_names>{' '.join(j for j, _ in cp.terms)}"
-                "</independent_coordinate_names>",
-                f"{i}\t<dependent_coordinate_name>{cp.joint}</dependent_coordinate_name>",
-                f"{i}\t<scale_factor>1</scale_factor>",
-                f"{i}</CoordinateCouplerConstraint>"]
-    return out + ["\t\t\t</objects>", "\t\t</ConstraintSet>"]
+        if sorted(k for _, k in cp.terms) != [0.5, 0.5]:
+            raise ValueError(f"walker: the coupling {cp.name} is not a bisector's: not in the "
+                             "OpenSim writer")
+        k = next(n for n, ln in enumerate(links) if ln.joint == cp.joint)
+        ln = links[k]
+        pitch = ln.mass_kg * (ln.com_m ** 2 + ln.com_off_axis_m ** 2) + ln.inertia_kg_m2
+        bis = replace(ln, name=f"{ln.name}_bisector", joint=f"{cp.joint}_half1",
+                      mass_kg=BISECTOR_FRACTION * ln.mass_kg, com_m=0.0, com_off_axis_m=0.0,
+                      inertia_kg_m2=BISECTOR_FRACTION * pitch, foot_m=None)
+        links[k:k + 1] = [bis, replace(ln, parent=bis.name, joint=f"{cp.joint}_half2",
+                                       joint_from_parent_m=0.0)]
+        (a, _), (b, _) = cp.terms
+        linear += [(bis.joint, a, 0.5), (f"{cp.joint}_half2", b, 0.5)]
+    if not linear:
+        return mb, []
+    return replace(mb, links=tuple(links), couplings=()), linear
 
 
 def torque_joints(act: Actuation | None, mb, coords=None) -> list[str]:

@@ -13,11 +13,11 @@ from __future__ import annotations
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
-           "KNEED_3D_TORSO_MJCF", "KNEE_LATCH_OSIM",
+           "KNEE_LATCH_OSIM",
            "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "TORSO_OSIM_COUPLER",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D",
            "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
@@ -94,13 +94,6 @@ KNEED_3D_ADAMS_GROUND = ("the kneed 3D dataset's knee latch measures a foot's he
                          "it (the planar dataset's IF over the patches): on stairs and "
                          "footholds a foot that has stepped a riser or a foothold below that "
                          "plane keeps its latch, and its knee straight, through the swing")
-#: why the kneed walker in 3D's OpenSim view refuses its upper body: OpenSim 4.6's coupler
-#: of the bisecting hip (:func:`walkerlab.export.opensim_tree.tree_constraint_set`)
-TORSO_OSIM_COUPLER = ("OpenSim 4.6's MultivariatePolynomialFunction, the bisecting hip's "
-                      "coupler, returns its first derivative for its second, so the upper "
-                      "body's acceleration constraint gains 0.5 (u1 + u2)^2: the 3D straight "
-                      "legs' torso walker (configs/torso_powered_3d.yaml) measured -27 % and "
-                      "fell after 7 heel strikes")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
@@ -169,13 +162,6 @@ KNEED_3D_TORSO = ("the floating tree of the kneed walker in 3D (the contact mode
                   "Hobbelen & Schwab 2007) is a relation of the rigid tree's coordinates, "
                   "not a joint of that tree; the rigid model walks it "
                   "(configs/kneed_torso_powered_3d.yaml)")
-#: why the kneed walker in 3D's MJCF refuses its upper body's torque
-#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_scene`: the keyframe's torso hinge)
-KNEED_3D_TORSO_MJCF = ("the 3D MJCF's keyframe sets the upper body's hinge to the straight "
-                       "legs' mean pitch; on knees the bisecting hip holds it on the thighs' "
-                       "mean, which this export does not read, so MuJoCo would start the "
-                       "upper body off its equality: walk it in the rigid model "
-                       "(configs/kneed_torso_powered_3d.yaml)")
 #: what the views of the 3D kinds refuse: a ground other than a plane
 _CELLS_3D = {
     **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
@@ -387,7 +373,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # swing_hip): the torso's pitch is the legs' mean (Wisse, Hobbelen & Schwab 2007),
         # so its generalised force is the planar walkers' (walkerlab.models.hybrid.
         # actuated._Legs3d, walkerlab.models.contact.parts.Legs3DPart.actuators, the MJCF's
-        # torso_hip hinge held to the legs' mean by its equality)
+        # torso_hip hinge held to the legs' mean by its equality, the OpenSim model's upper
+        # body on a bisector body, each hinge a one-coordinate coupler: walkerlab.export.
+        # opensim_tree.bisected_tree)
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
         ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
         ("virtual_constraints", "*"): VC_3D,
@@ -436,13 +424,15 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # leg: the 3D straight legs' (walkerlab.models.hybrid.actuated._Legs3d) on the
         # kneed tree (the thigh's pitch for the swing leg's), its stable gait
         # configs/kneed_torso_powered_3d.yaml's in the rigid model and the gym's rigid view
-        # (it steps the rigid model); the URDF writes its tree (the masses)
+        # (it steps the rigid model); the URDF writes its tree (the masses); the MJCF its
+        # torso hinge held to the thighs' mean by its equality, the keyframe on it
+        # (walkerlab.export.legs_3d_parts.bisector_keyframe)
         ("torso_torque", "*"): KNEED_3D_TORSO,
-        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf")},
+        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
-        # OpenSim: the bisecting hip's coupler (the 3D straight legs' torso cell's measure)
-        ("torso_torque", "osim"): TORSO_OSIM_COUPLER,
-        ("torso_torque", "mjcf"): KNEED_3D_TORSO_MJCF,
+        # OpenSim: the bisecting hip as a bisector body on two one-coordinate couplers
+        # (walkerlab.export.opensim_tree.bisected_tree) on the thighs' hinges
+        ("torso_torque", "osim"): None,
         # hip-roll joints: the 3D straight legs' law on the kneed tree
         # (walkerlab.codegen.legged.derive_legged: the rolls last, the new swing knee
         # straight at the heel strike), its stable gait configs/kneed_3d_stabilised.yaml's
