@@ -35,11 +35,6 @@ MAP_TOL = 1e-8
 STEP_PERIOD_S = 0.5472503291
 
 
-def _guess(scene, walker) -> np.ndarray:
-    g = scene.fixedpoint.initial_guess.model_extra
-    return np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
-                     for n in walker.state_names()])
-
 
 def _solver(scene) -> Solver:
     s = scene.solver
@@ -51,7 +46,8 @@ def footholds():
     scene = load_scene(ROOT / "configs" / FOOTHOLDS)
     plant = Plant.from_scene(scene)
     walker = build_walker(plant)
-    return scene, plant, walker, _guess(scene, walker), _solver(scene)
+    x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
+    return scene, plant, walker, x0, _solver(scene)
 
 
 def test_the_footholds_change_no_equation_of_the_stabilised_walker(footholds):
@@ -98,7 +94,7 @@ def test_footholds_of_zero_height_are_the_slope(footholds):
     scene, _plant, _walker, _x0, solver = footholds
     slope_scene = load_scene(ROOT / "configs" / SLOPE)
     slope = build_walker(Plant.from_scene(slope_scene))
-    x0 = _guess(slope_scene, slope)
+    x0 = slope_scene.fixedpoint.initial_guess.as_array(slope.state_names())
     d = scene.model_dump(mode="json")
     d["terrain"]["foothold_heights_m"] = [0.0]
     zero = build_walker(Plant.from_scene(scene_from_dict(d)))

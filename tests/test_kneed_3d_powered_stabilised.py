@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.contact_walks import contact_period_against_rigid
 from walkerlab.analysis.gait.poincare import poincare_map
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
@@ -40,11 +41,6 @@ PASSIVE_STEP_PERIOD_S = 0.539454
 #: map 1e-9 of noise (configs/kneed_3d_stabilised.yaml), and the shipped guess has 10 digits
 MAP_TOL = 1e-8
 
-
-def _guess(scene, walker) -> np.ndarray:
-    g = scene.fixedpoint.initial_guess.model_extra
-    return np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
-                     for n in walker.state_names()])
 
 
 @pytest.fixture(scope="module")
@@ -86,7 +82,7 @@ def test_the_powered_gait_is_a_stable_fixed_point_and_quicker_than_the_passive(p
     were dropped)."""
     scene, _plant, walker = powered
     s = scene.solver
-    x0 = _guess(scene, walker)
+    x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     x1, period, DP, _ = poincare_map(walker, x0, Solver(method=s.method, rtol=s.rtol,
                                                         atol=s.atol), jacobian=True)
     assert np.max(np.abs(x1 - x0)) < MAP_TOL
@@ -110,27 +106,14 @@ def test_the_contact_and_mujoco_walks_keep_the_powered_rigid_step_period(tmp_pat
     gait's keyframe) steps slower: the actuators' effect on MuJoCo's mean step period lies
     within a factor 2 of the rigid model's -0.58 % (measured -0.85 %: MuJoCo's soft contact
     and the passive walk's transient from the powered keyframe; dropped actuators: 0)."""
-    import h5py
 
     pytest.importorskip("mujoco")
-    from walkerlab.api.capabilities import _contact_against_rigid
     from walkerlab.export.mujoco_walk import walk
     from walkerlab.stages import export as export_stage
-    from walkerlab.stages import pipeline
 
     scene = load_scene(ROOT / "configs" / f"{SCENE}.yaml")
-    cs = pipeline.run("contact-sim", scene, tmp_path).path
-    fp = pipeline.run("fixedpoint", scene, tmp_path).path
-    sim = pipeline.run("simulate", scene, tmp_path).path
-    with h5py.File(cs) as f, h5py.File(sim) as s:
-        assert int(f["summary/heel_strikes"][()]) >= 10
-        h = np.asarray(f["events/heel_strike_times"][:], float)
-        hr = np.asarray(s["steps/t_end"][:], float)
-    k = min(h.size, hr.size)
-    period = (h[k - 1] - h[k - 5]) / (hr[k - 1] - hr[k - 5]) - 1.0
+    period = contact_period_against_rigid(scene, tmp_path)
     assert abs(period) < 0.01, period
-    _value, line = _contact_against_rigid(cs, fp, sim)
-    assert f"period {100 * period:+.2f} %" in line
     out = export_stage.write(scene, tmp_path, "mjcf", walk=True)
     check = out.walk
     assert check.walked and not check.fell and check.alternating, check.line
