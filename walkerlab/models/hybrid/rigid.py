@@ -200,8 +200,9 @@ def _make_legged(legs: _Legs, data: WalkerData, name: str, variant: str, printed
     var = f.get("flow_variational") if generated_flow else None
 
     def compiled(name, *guards):  # guards: (generated guard, offset) of each Phase guard
-        if generated_flow:
-            return CompiledFlow(data.structure, tuple(data.params), name, guards)
+        if generated_flow:   # a 3D walker's Python flow is slow: compiled under "auto"
+            return CompiledFlow(data.structure, tuple(data.params), name, guards,
+                                by_default=data.structure.in_3d)
         return None
     flow = flow or f["flow"]
     fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
