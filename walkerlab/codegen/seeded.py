@@ -17,7 +17,9 @@ def seeded(derive):
     """``derive`` with sympy's random number generator (``sympy.core.random.rng``) seeded
     with :data:`SYMPY_SEED` while it runs, its state restored after.
 
-    ``trigsimp`` (the mass and impact matrices of the 3D walkers) calls ``factor``, whose
+    ``trigsimp`` (the 3D walkers' mass and impact matrices', until they were simplified
+    product-to-sum; still the exports' axes, :mod:`walkerlab.export.tree_bodies`, and a
+    caller's own ``simplify``) calls ``factor``, whose
     multivariate factorisation (Wang's, ``dmp_zz_wang``) draws its evaluation points at
     random.  The factors are the same whatever it draws (measured: the same generated text
     from eight generator states), but its time is not: in a test process whose generator had

@@ -55,7 +55,8 @@ class SolverSettings(BaseModel):
     max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
     backend: Literal["auto", "scipy", "cyrk", "cyrk_compiled"] = Field(
         "auto", description="solver only: library that integrates the rigid model: auto "
-        "(cyrk for RK23/RK45/DOP853, else scipy), scipy, cyrk, or cyrk_compiled (CyRK with "
+        "(cyrk for RK23/RK45/DOP853, else scipy; a 3D walker's phases cyrk_compiled, its "
+        "Python flow being slow), scipy, cyrk, or cyrk_compiled (CyRK with "
         "the flow compiled by numba: no Python callbacks, ~1 s numba import per process; "
         "for many-point studies); the contact model's library is its method")
 
