@@ -76,7 +76,9 @@ class CompiledFlow:
         (``cyrk_compiled`` instead of ``cyrk``): set by the model for a walker whose printed
         Python flow is slow to call (a 3D walker's: about 100 us a call for
         ``configs/hip_width_stabilised.yaml``'s, against 4 us for the compass gait's), so
-        that its gait search is not spent in Python callbacks.  The result moves by the
+        that its gait search is not spent in Python callbacks; its variational equations
+        (a few integrations a run: the multipliers) stay in Python, as numba would take
+        longer to compile them than Python to run them.  The result moves by the
         integrators' round-off only (the same Runge-Kutta pair and step control).
     """
 

@@ -253,9 +253,12 @@ def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, 
     """Run ``phase`` from ``st`` and record it (its dense output and log line, the state, the
     variational state); returns the guard that ended it, or None when the step ends without
     one (a fall guard violated as the phase begins, a solver failure, ``t_stop``)."""
-    if (backend == "cyrk" and solver.backend == "auto"
+    if (backend == "cyrk" and solver.backend == "auto" and not variational
             and getattr(phase.compiled, "by_default", False)):
-        backend = "cyrk_compiled"   # a slow Python flow (CompiledFlow.by_default)
+        # a slow Python flow (CompiledFlow.by_default); its variational equations stay in
+        # Python: a run asks them a few times (the multipliers), and numba would take
+        # longer to compile them (collins2001's: ~15 s) than Python takes to run them
+        backend = "cyrk_compiled"
     broken = _violated_at_entry(phase, st.t, st.x, backend)
     if broken is not None:  # e.g. a unilateral contact already pulling as its mode begins
         st.termination, st.event = RunEnd.FALL, broken.name
