@@ -4,7 +4,9 @@ push where the points have a lateral axis, the lean and rolls kept absolute in t
 coordinates), the reflected step map's Jacobian against the gait search's stride
 multipliers, the gait sensitivity norm of each disturbance against the nonlinear response
 to a small impulse, and the largest sideways push of the passive and the stabilised
-hip-width walkers (configs/hip_width.yaml, configs/hip_width_stabilised.yaml).
+hip-width walkers (configs/hip_width.yaml, configs/hip_width_stabilised.yaml); the rigid
+model's fall of a walker in 3D (its hip at half its leg length, where a sideways capsize
+would otherwise stall the integrator).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from walkerlab.analysis.robustness import push
 from walkerlab.config import load_scene
 from walkerlab.integrate.python_step import ReflectedStepMap, make_step_map
 from walkerlab.integrate.solver import Solver
+from walkerlab.published import paper
 from walkerlab.studies.mfpt import scene_walker_at
 from walkerlab.walker.plant import Plant
 
@@ -43,6 +46,45 @@ def _walk(name: str):
 @pytest.fixture(scope="module")
 def stabilised():
     return _walk("hip_width_stabilised")
+
+
+def _fall(phase):
+    """The phase's fall guard of the hip's height (the rigid model's ``fall``)."""
+    return next(g for g in phase.guards if g.name == "fall")
+
+
+def test_a_3d_walker_falls_with_its_hip_at_half_its_leg_length_a_planar_one_at_the_ground(
+        paper_walker):
+    """The rigid model's fall of the hip: a walker in 3D falls once its hip is half its leg
+    length (:data:`walkerlab.walker.description.FALL_HIP_FRACTION`, the compliant-contact
+    model's fall) above the slope - a sideways capsize stalls the integrator's steps at 1e-9
+    s before the hip reaches the ground (configs/kneed_3d_stabilised.yaml after a 0.25 m
+    step-down, the robustness study's first bisection) - in every phase of both steps, on
+    the Python guard (against the hip point's height along the slope's normal
+    ``(sin gamma, cos gamma, 0)``, world ``y`` up) and on the compiled flow's (the generated
+    guard and its offset); a planar walker's fall stays its hip at the ground."""
+    from walkerlab.models.registry import build_walker
+    from walkerlab.walker.description import FALL_HIP_FRACTION
+
+    scene = load_scene(ROOT / "configs" / "kneed_3d_stabilised.yaml")
+    walker = build_walker(Plant.from_scene(scene))
+    g = scene.fixedpoint.initial_guess.model_extra
+    x = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                  for n in walker.state_names()])
+    L, gamma = walker.params["leg_length_m"], walker.slope_rad
+    assert FALL_HIP_FRACTION == 0.5 and L == 1.0
+    for w in (walker, walker.mirror):
+        height = float(np.asarray(w.points(x)["hip"]) @ [np.sin(gamma), np.cos(gamma), 0.0])
+        assert 0.9 < height < 1.0
+        for phase in w.phases:
+            assert _fall(phase).function(0.0, x) == pytest.approx(height - 0.5, abs=1e-12)
+            assert ("hip_height", -0.5) in phase.compiled.guards, phase.name
+    xp = np.array(paper.EQ11_STATE)
+    height = float(np.asarray(paper_walker.points(xp)["hip"])
+                   @ [np.sin(paper_walker.slope_rad), np.cos(paper_walker.slope_rad)])
+    for phase in paper_walker.phases:
+        assert _fall(phase).function(0.0, xp) == pytest.approx(height, abs=1e-12)
+        assert ("hip_height", 0.0) in phase.compiled.guards, phase.name
 
 
 def test_relative_coordinates_keep_a_3d_walkers_lean_and_rolls_absolute():
