@@ -56,15 +56,15 @@ def _fall(phase):
 def test_a_3d_walker_falls_with_its_hip_at_half_its_leg_length_a_planar_one_at_the_ground(
         paper_walker):
     """The rigid model's fall of the hip: a walker in 3D falls once its hip is half its leg
-    length (:data:`walkerlab.walker.description.FALL_HIP_FRACTION`, the compliant-contact
+    length (:data:`walkerlab.models.ground.FALL_HIP_FRACTION`, the compliant-contact
     model's fall) above the slope - a sideways capsize stalls the integrator's steps at 1e-9
     s before the hip reaches the ground (configs/kneed_3d_stabilised.yaml after a 0.25 m
     step-down, the robustness study's first bisection) - in every phase of both steps, on
     the Python guard (against the hip point's height along the slope's normal
     ``(sin gamma, cos gamma, 0)``, world ``y`` up) and on the compiled flow's (the generated
     guard and its offset); a planar walker's fall stays its hip at the ground."""
+    from walkerlab.models.ground import FALL_HIP_FRACTION
     from walkerlab.models.registry import build_walker
-    from walkerlab.walker.description import FALL_HIP_FRACTION
 
     scene = load_scene(ROOT / "configs" / "kneed_3d_stabilised.yaml")
     walker = build_walker(Plant.from_scene(scene))

@@ -84,11 +84,6 @@ FLAT_FOOT_MODES = ("heel_contact", "foot_flat", "heel_off")
 ROLE_TAG = {"swing": "sw", "stance": "st"}
 #: Order of the links a spring may join (a spring's pair is stored in this order).
 SPRING_LINKS = ("swing", "stance", "torso")
-#: A walk has fallen once its hip is below this fraction of the leg length above the ground
-#: [-]: the compliant-contact model's fall (``contact_sim.fall_hip_height_m`` by default)
-#: and the rigid model's for a walker in 3D, whose sideways capsize stalls the integrator
-#: before its hip reaches the ground (a planar rigid walker falls with its hip at the ground).
-FALL_HIP_FRACTION = 0.5
 
 
 @dataclass(frozen=True)

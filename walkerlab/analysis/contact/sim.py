@@ -29,7 +29,7 @@ from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ContactSceneError, ContactSetup
-from walkerlab.walker.description import FALL_HIP_FRACTION
+from walkerlab.models.ground import FALL_HIP_FRACTION
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
            "rigid_mid_stance", "scene_start", "simulate_contact", "simulate_from",

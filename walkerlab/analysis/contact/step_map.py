@@ -99,7 +99,7 @@ from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.powered_events import pulse_lead, pulse_lead_s
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
-from walkerlab.walker.description import FALL_HIP_FRACTION
+from walkerlab.models.ground import FALL_HIP_FRACTION
 from walkerlab.walker.layout import StateIndex
 
 from .search_budget import PeriodicGaitError, SearchBudget

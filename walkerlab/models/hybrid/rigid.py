@@ -37,7 +37,7 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
   starts straight and free.
 
 A walker in 3D (straight legs or locking knees) falls when its hip is half its leg length
-above the ground (:data:`~walkerlab.walker.description.FALL_HIP_FRACTION`, the
+above the ground (:data:`~walkerlab.models.ground.FALL_HIP_FRACTION`, the
 compliant-contact model's fall), not at the ground: a sideways capsize (a lean of 1 rad at
 15 rad/s) stalls the integrator's steps at 1e-9 s before the hip gets there.
 """
@@ -52,12 +52,13 @@ import numpy as np
 
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
+from walkerlab.models.ground import FALL_HIP_FRACTION
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
 from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
 from walkerlab.walker import parts as P
-from walkerlab.walker.description import FALL_HIP_FRACTION, WalkerData
+from walkerlab.walker.description import WalkerData
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
 SCUFF_DEPTH = 1e-9
@@ -70,7 +71,7 @@ def _below(clearance, depth, t, x):
 
 def _fall_offset(data: WalkerData) -> float:
     """The offset [m] of the generated ``hip_height`` guard at which a step is a fall: a
-    walker in 3D falls with its hip :data:`~walkerlab.walker.description.FALL_HIP_FRACTION`
+    walker in 3D falls with its hip :data:`~walkerlab.models.ground.FALL_HIP_FRACTION`
     of its leg length above the ground (the compliant-contact model's fall: a sideways
     capsize stalls the integrator before the hip reaches the ground), a planar one with its
     hip at the ground (0)."""
