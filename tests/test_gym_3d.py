@@ -90,7 +90,7 @@ def test_a_3d_walker_pushed_sideways_falls_as_the_episode_s_termination():
     """The passive 3D walker (configs/hip_width.yaml, Kuo 1999: its lateral mode unstable,
     a multiplier of about 100 a stride) started from its gait with the lean rate 5 %
     larger leans over to the side: the episode ends as a ``fall`` (the rigid model's own
-    fall guard: the hip's height reaches the ground), its last observation leaning far
+    fall guard: a 3D walker's hip at half its leg length), its last observation leaning far
     over (|lean| past 0.5 rad) - the sideways fall, not the sagittal one."""
     env = _env("hip_width", max_episode_steps=1500)
     x = np.array(env.gait.x, float)

@@ -4,7 +4,10 @@ push where the points have a lateral axis, the lean and rolls kept absolute in t
 coordinates), the reflected step map's Jacobian against the gait search's stride
 multipliers, the gait sensitivity norm of each disturbance against the nonlinear response
 to a small impulse, and the largest sideways push of the passive and the stabilised
-hip-width walkers (configs/hip_width.yaml, configs/hip_width_stabilised.yaml).
+hip-width walkers (configs/hip_width.yaml, configs/hip_width_stabilised.yaml) and of the
+stabilised kneed walker (configs/kneed_3d_stabilised.yaml), walked by the rigid model's own
+simulation on both sides of each bracket; the rigid model's fall of a walker in 3D (its hip
+at half its leg length, where a sideways capsize would otherwise stall the integrator).
 """
 
 from __future__ import annotations
@@ -18,8 +21,10 @@ from walkerlab.analysis.gait.poincare import find_fixed_point, poincare_map
 from walkerlab.analysis.robustness import measures as R
 from walkerlab.analysis.robustness import push
 from walkerlab.config import load_scene
+from walkerlab.integrate.batch_step import FALL
 from walkerlab.integrate.python_step import ReflectedStepMap, make_step_map
 from walkerlab.integrate.solver import Solver
+from walkerlab.published import paper
 from walkerlab.studies.mfpt import scene_walker_at
 from walkerlab.walker.plant import Plant
 
@@ -43,6 +48,45 @@ def _walk(name: str):
 @pytest.fixture(scope="module")
 def stabilised():
     return _walk("hip_width_stabilised")
+
+
+def _fall(phase):
+    """The phase's fall guard of the hip's height (the rigid model's ``fall``)."""
+    return next(g for g in phase.guards if g.name == "fall")
+
+
+def test_a_3d_walker_falls_with_its_hip_at_half_its_leg_length_a_planar_one_at_the_ground(
+        paper_walker):
+    """The rigid model's fall of the hip: a walker in 3D falls once its hip is half its leg
+    length (:data:`walkerlab.models.ground.FALL_HIP_FRACTION`, the compliant-contact
+    model's fall) above the slope - a sideways capsize stalls the integrator's steps at 1e-9
+    s before the hip reaches the ground (configs/kneed_3d_stabilised.yaml after a 0.25 m
+    step-down, the robustness study's first bisection) - in every phase of both steps, on
+    the Python guard (against the hip point's height along the slope's normal
+    ``(sin gamma, cos gamma, 0)``, world ``y`` up) and on the compiled flow's (the generated
+    guard and its offset); a planar walker's fall stays its hip at the ground."""
+    from walkerlab.models.ground import FALL_HIP_FRACTION
+    from walkerlab.models.registry import build_walker
+
+    scene = load_scene(ROOT / "configs" / "kneed_3d_stabilised.yaml")
+    walker = build_walker(Plant.from_scene(scene))
+    g = scene.fixedpoint.initial_guess.model_extra
+    x = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                  for n in walker.state_names()])
+    L, gamma = walker.params["leg_length_m"], walker.slope_rad
+    assert FALL_HIP_FRACTION == 0.5 and L == 1.0
+    for w in (walker, walker.mirror):
+        height = float(np.asarray(w.points(x)["hip"]) @ [np.sin(gamma), np.cos(gamma), 0.0])
+        assert 0.9 < height < 1.0
+        for phase in w.phases:
+            assert _fall(phase).function(0.0, x) == pytest.approx(height - 0.5, abs=1e-12)
+            assert ("hip_height", -0.5) in phase.compiled.guards, phase.name
+    xp = np.array(paper.EQ11_STATE)
+    height = float(np.asarray(paper_walker.points(xp)["hip"])
+                   @ [np.sin(paper_walker.slope_rad), np.cos(paper_walker.slope_rad)])
+    for phase in paper_walker.phases:
+        assert _fall(phase).function(0.0, xp) == pytest.approx(height, abs=1e-12)
+        assert ("hip_height", 0.0) in phase.compiled.guards, phase.name
 
 
 def test_relative_coordinates_keep_a_3d_walkers_lean_and_rolls_absolute():
@@ -138,10 +182,66 @@ def test_the_passive_hip_width_walker_survives_no_sideways_push_the_stabilised_o
     assert lo == 0.0 and hi <= 0.02
 
 
+#: the stabilised kneed walker's largest sideways pushes at heel strike [m/s], toward the
+#: swing leg's side and the stance leg's: walkerlab robustness's brackets (lower end
+#: survives 40 steps, upper end falls; configs/kneed_3d_stabilised.yaml, the capability
+#: evidence's locking_knees_3d/robustness)
+KNEED_SIDEWAYS = {1.0: (0.113037109375, 0.11328125), -1.0: (0.294921875, 0.295166015625)}
+
+
+@pytest.fixture(scope="module")
+def kneed_stabilised():
+    return _walk("kneed_3d_stabilised")
+
+
+@pytest.mark.slow  # the kneed 3D walker's gait search and compiled maps (15 s, fixture)
+def test_the_kneed_3d_walker_falls_with_its_hip_at_half_its_leg_length_after_a_big_step_down(
+        kneed_stabilised):
+    """The robustness study's first step-downs of the stabilised kneed walker (a quarter
+    and seven eighths of it of its leg length, the bisection's cap and its first round's
+    largest), which once stalled the integrator in a sideways capsize: each walk of 41
+    steps ends, dead (a fall, not a timeout), and the 0.25 m step's own step ends in the
+    fall guard with the hip half a leg length above the slope (its height along the
+    slope's normal)."""
+    walker, sm, x = kneed_stabilised
+    assert not R.survives(sm, x, "floor_height", np.array([0.25, 0.21875]), 40).any()
+    r = sm.step(x[None], None, drop_m=np.array([0.25]))
+    assert r.outcome[0] == FALL
+    gamma = walker.slope_rad
+    hip = np.asarray(R.step_walker(sm).points(r.x_pre[0])["hip"])
+    assert hip @ [np.sin(gamma), np.cos(gamma), 0.0] == pytest.approx(0.5, abs=1e-9)
+
+
+@pytest.mark.slow  # the kneed 3D gait (fixture: 15 s), then four walks of 41 steps (1 s)
+def test_the_kneed_3d_walkers_largest_sideways_push_separates_a_walk_from_a_fall(
+        kneed_stabilised):
+    """The study's largest sideways pushes of the stabilised kneed walker
+    (:data:`KNEED_SIDEWAYS`, from its batched step map) walked by the rigid model's own
+    simulation (:func:`walkerlab.integrate.rigid.simulate_steps`: both legs' walkers, no
+    reflection, another integrator): pushed by each bracket's lower end at the gait's
+    section it makes the 41 heel strikes of the study's survival (the pushed step and 40
+    more), pushed by its upper end it falls before them (a fall guard, not a timeout or a
+    solver failure).  The gait itself is the scene's fixed point."""
+    from walkerlab.integrate.rigid import simulate_steps
+
+    walker, sm, x = kneed_stabilised
+    w = R.step_walker(sm)
+    solver = Solver("DOP853", 1e-12, 1e-12)
+    for sign, (lo, hi) in KNEED_SIDEWAYS.items():
+        for v, lives in ((lo, True), (hi, False)):
+            xp = push.apply_push(w, x, sign * v, axis=push.LATERAL_AXIS)[0]
+            run = simulate_steps(walker, xp, 41, solver)
+            strikes = sum(s.termination == "heel_strike" for s in run.segments)
+            assert (strikes == 41) is lives, (sign, v, strikes, run.termination)
+            assert lives or run.termination == "fall", (sign, v, run.termination)
+
+
 def test_each_3d_kind_either_refuses_robustness_or_has_its_verified_measurement():
     """The capability table's robustness study on the 3D kinds: refused in one line
     (:data:`walkerlab.walker.capability_cells.STAGE_CELLS`) or measured and verified
-    (:func:`walkerlab.walker.capability_evidence.stage_evidence`: the 3D straight legs),
+    (:func:`walkerlab.walker.capability_evidence.stage_evidence`: the 3D straight legs and
+    locking knees, the latter's detail with the largest sideways pushes walked in
+    :func:`test_the_kneed_3d_walkers_largest_sideways_push_separates_a_walk_from_a_fall`),
     never both; ``walkerlab capabilities`` prints the measurement with its ✓."""
     from walkerlab.walker.capability_cells import STAGE_CELLS
     from walkerlab.walker.capability_evidence import stage_evidence, stage_verified
@@ -157,6 +257,10 @@ def test_each_3d_kind_either_refuses_robustness_or_has_its_verified_measurement(
     e = stage_evidence("straight_legs_3d", "robustness")
     assert e["case"] == "configs/hip_width_stabilised.yaml" and e["check"] == "self"
     assert "walkerlab robustness: ✓ 1.2e-06 self: configs/hip_width_stabilised.yaml" in text()
+    e = stage_evidence("locking_knees_3d", "robustness")
+    assert e["case"] == "configs/kneed_3d_stabilised.yaml" and e["check"] == "self"
+    assert "walkerlab robustness: ✓ 4.4e-07 self: configs/kneed_3d_stabilised.yaml" in text()
+    assert all(f"{lo:.3f} m/s" in e["detail"] for lo, _hi in KNEED_SIDEWAYS.values())
 
 
 def test_the_report_shows_the_sideways_push_with_its_units_and_a_planar_walker_none():

@@ -42,7 +42,7 @@ cached; :meth:`walkerlab.rigid_walker.SceneWalker.fixed_point`), leg1 swinging, 
 or in the contact view its floating state (N,)); ``start_noise`` (at most 1) multiplies the
 start's rates by ``1 + U(-s, s)`` drawn by the reset's seed, before the start is checked.
 Terminated on a fall (a fall guard of the rigid model - a 3D walker's sideways fall too, its
-hip's height guard; in the contact view the hip below ``contact_sim.fall_hip_height_m``), a
+hip at half its leg length; in the contact view the hip below ``contact_sim.fall_hip_height_m``), a
 stall (no heel strike within
 ``fixedpoint.max_step_time_s``), a launch (contact view: the hip thrown above
 :data:`walkerlab.gym.contact_view.LAUNCH_HIP_FACTOR` leg lengths, a foot having met a raised

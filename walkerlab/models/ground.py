@@ -1,7 +1,8 @@
 """The ground's facts both views of a walker read (the rigid hybrid model,
 :mod:`walkerlab.models.hybrid.ground`, and the compliant-contact model's terrain,
 :mod:`walkerlab.models.contact.terrain`): how far below the stance foot's level each step
-lands, from the scene's ``terrain`` section alone.
+lands, from the scene's ``terrain`` section alone; how far above it a walker's hip has
+fallen (:data:`FALL_HIP_FRACTION`).
 
 A stair ``riser_m`` down is a landing ``riser_m`` below the stance foot's level (up: above
 it); footholds of one height ``h`` a landing at ``-h``; footholds of several heights or of
@@ -23,8 +24,14 @@ import numpy as np
 
 from walkerlab.walker.capability_cells import FOOTHOLD_SLOPES, SEVERAL_FOOTHOLDS
 
-__all__ = ["Ground", "foothold_steps", "landing_drop", "landing_drops", "scene_ground",
-           "stair_treads"]
+__all__ = ["FALL_HIP_FRACTION", "Ground", "foothold_steps", "landing_drop", "landing_drops",
+           "scene_ground", "stair_treads"]
+
+#: A walk has fallen once its hip is below this fraction of the leg length above the ground
+#: [-]: the compliant-contact model's fall (``contact_sim.fall_hip_height_m`` by default)
+#: and the rigid model's for a walker in 3D, whose sideways capsize stalls the integrator
+#: before its hip reaches the ground (a planar rigid walker falls with its hip at the ground).
+FALL_HIP_FRACTION = 0.5
 
 
 def landing_drop(terrain) -> float:

@@ -535,17 +535,6 @@ FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
 #: reads the contact walk)
 STAGE_VIEWS = {"contact-sim": ("walk", "contact"), "compare": ("walk", "contact"),
                "stability-map": ("walk", "contact")}
-#: why the robustness study refuses a 3D kneed walker (:mod:`walkerlab.studies.robustness_study`)
-ROBUSTNESS_KNEED_3D = ("the robustness study's pushes in 3D are checked on straight legs "
-                       "(configs/hip_width_stabilised.yaml) and on no kneed walker: the "
-                       "passive one (configs/kneed_3d.yaml, a stride multiplier of about 40) "
-                       "has infinite norms and survives no disturbance, and the stabilised "
-                       "one's study (configs/kneed_3d_stabilised.yaml) stalls in its first "
-                       "step-down bisection: after a 0.219 m step-down the walker capsizes "
-                       "sideways (0.15 s into the next step its lean is 1.15 rad at 23 "
-                       "rad/s), and both integrators' steps shrink to 1e-9 s there before "
-                       "the hip reaches the ground, the rigid model's only fall guard; a "
-                       "kneed walker's metastability is walkerlab mfpt's")
 #: why the robustness study refuses the 3D spoked wheel (:mod:`walkerlab.studies.
 #: robustness_study`)
 ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance leg's "
@@ -554,11 +543,11 @@ ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance
 #: kind -> {stage: reason}: the studies (stages of :mod:`walkerlab.stages.pipeline`) a kind
 #: does not take at all; a stage not listed takes it (``optimize`` of a kind whose ``walk``
 #: it refuses may still design virtual constraints, so only the 3D kinds' is here).  The
-#: 3D straight legs take ``robustness``: its evidence is :data:`walkerlab.walker.
-#: capability_evidence.stage_evidence`'s.
+#: 3D straight legs and the 3D locking knees take ``robustness``: their evidence is
+#: :data:`walkerlab.walker.capability_evidence.stage_evidence`'s (configs/
+#: hip_width_stabilised.yaml, configs/kneed_3d_stabilised.yaml).
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    "locking_knees_3d": {"robustness": ROBUSTNESS_KNEED_3D,
-                         "optimize": CAPABILITIES["locking_knees_3d"][("walk", "optimize")]},
+    "locking_knees_3d": {"optimize": CAPABILITIES["locking_knees_3d"][("walk", "optimize")]},
     "rolling_polygon_3d": {"robustness": ROBUSTNESS_WHEEL_3D,
                            "optimize": CAPABILITIES["rolling_polygon_3d"][("walk",
                                                                           "optimize")]},

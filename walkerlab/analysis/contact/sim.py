@@ -29,6 +29,7 @@ from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ContactSceneError, ContactSetup
+from walkerlab.models.ground import FALL_HIP_FRACTION
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
            "rigid_mid_stance", "scene_start", "simulate_contact", "simulate_from",
@@ -249,7 +250,7 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     d = ContactLimits()
     upd = {}
     if limits.fall_hip_height_m == d.fall_hip_height_m:
-        upd["fall_hip_height_m"] = 0.5 * walker.L
+        upd["fall_hip_height_m"] = FALL_HIP_FRACTION * walker.L
     if limits.airborne_hip_height_m == d.airborne_hip_height_m:
         upd["airborne_hip_height_m"] = AIRBORNE_HEIGHT_FACTOR * walker.L
     return replace(limits, **upd)

@@ -99,6 +99,7 @@ from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.powered_events import pulse_lead, pulse_lead_s
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
+from walkerlab.models.ground import FALL_HIP_FRACTION
 from walkerlab.walker.layout import StateIndex
 
 from .search_budget import PeriodicGaitError, SearchBudget
@@ -298,7 +299,7 @@ class StepMap:
             ``time_limit``: the search's wall-time deadline passed during the integration.
         """
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
-        hth = 0.5 * self.walker.L
+        hth = FALL_HIP_FRACTION * self.walker.L
         events = [Event("mid_stance", lambda t, x: x[isw] - x[ist], 1.0),
                   Event("fall", lambda t, x: self.walker.fall_margin(x, hth), -1.0,
                         RunEnd.FALL)]
@@ -342,7 +343,7 @@ class StepMap:
     def _section(self, x0, stance_to_come: int, dt: float, chunk_s: float, passive: bool):
         """:meth:`next_section` without its memory of the last call."""
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
-        hth = 0.5 * self.walker.L
+        hth = FALL_HIP_FRACTION * self.walker.L
         if self.powered and not passive:
             return self._powered_section(x0, stance_to_come, ist, isw, hth)
         return self._grid_crossing(x0, lambda X: X[:, isw] - X[:, ist], 0.0, dt, chunk_s,

@@ -35,6 +35,11 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
   the stance leg (``swing_foot_scuffs``: its foot would go through the ground), or the hip
   reaches the slope.  The heel strike takes place with the knee locked; the new swing knee
   starts straight and free.
+
+A walker in 3D (straight legs or locking knees) falls when its hip is half its leg length
+above the ground (:data:`~walkerlab.models.ground.FALL_HIP_FRACTION`, the
+compliant-contact model's fall), not at the ground: a sideways capsize (a lean of 1 rad at
+15 rad/s) stalls the integrator's steps at 1e-9 s before the hip gets there.
 """
 
 from __future__ import annotations
@@ -47,6 +52,7 @@ import numpy as np
 
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
+from walkerlab.models.ground import FALL_HIP_FRACTION
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
@@ -61,6 +67,15 @@ SCUFF_DEPTH = 1e-9
 def _below(clearance, depth, t, x):
     """``clearance + depth``: crosses zero downward when the foot is ``depth`` deep."""
     return clearance(t, x) + depth
+
+
+def _fall_offset(data: WalkerData) -> float:
+    """The offset [m] of the generated ``hip_height`` guard at which a step is a fall: a
+    walker in 3D falls with its hip :data:`~walkerlab.models.ground.FALL_HIP_FRACTION`
+    of its leg length above the ground (the compliant-contact model's fall: a sideways
+    capsize stalls the integrator before the hip reaches the ground), a planar one with its
+    hip at the ground (0)."""
+    return -FALL_HIP_FRACTION * data.leg_length_m if data.structure.in_3d else 0.0
 
 
 def _kneed_phases(data: WalkerData, f: dict, flow, flow_jacobian, var, compiled, heel: Guard,
@@ -83,13 +98,13 @@ def _kneed_phases(data: WalkerData, f: dict, flow, flow_jacobian, var, compiled,
             jacobian=f["flow_jacobian"], variational=var,
             compiled=compiled("flow", ("knee_extension", 0.0),
                               ("swing_clearance", SCUFF_DEPTH * data.leg_length_m),
-                              ("hip_height", 0.0))),
+                              ("hip_height", _fall_offset(data)))),
         Phase("locked_swing", f["flow_locked"], (
             heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
             jacobian=f["flow_locked_jacobian"],
             variational=f.get("flow_locked_variational"),
             compiled=compiled("flow_locked", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
-                              ("swing_foot_ahead", 0.0), ("hip_height", 0.0)),
+                              ("swing_foot_ahead", 0.0), ("hip_height", _fall_offset(data))),
             constraint=partial(_lock_gradient, f["grad_knee_extension"])),
     )
 
@@ -106,19 +121,20 @@ def _straight_leg_phases(data: WalkerData, f: dict, flow, flow_jacobian, var, co
     """The two phases of a straight-leg walker for :func:`make_rigid_walker`:
     ``early_swing`` until mid-stance (the swing foot passing the stance foot) and
     ``late_swing`` until the heel strike or the swing leg falling back, each also ended by a
-    fall; ``data`` the walker's description (unused: as :func:`_kneed_phases`), ``f`` the
-    generated functions, ``flow``/``flow_jacobian`` the flow and its
+    fall; ``data`` the walker's description (its fall's hip height, :func:`_fall_offset`),
+    ``f`` the generated functions, ``flow``/``flow_jacobian`` the flow and its
     Jacobian (``flow_jacobian`` None: the generated one), ``var`` the variational
     right-hand side and ``compiled(name, *guards)`` the compiled flow (or None)."""
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
     early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
                                         fall), jacobian=flow_jacobian or f["flow_jacobian"],
                   variational=var,
-                  compiled=compiled("flow", ("swing_foot_ahead", 0.0), ("hip_height", 0.0)))
+                  compiled=compiled("flow", ("swing_foot_ahead", 0.0),
+                                    ("hip_height", _fall_offset(data))))
     late = Phase("late_swing", flow, (heel, falls_back, fall),
                  jacobian=flow_jacobian or f["flow_jacobian"], variational=var,
                  compiled=compiled("flow", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
-                                   ("hip_height", 0.0)))
+                                   ("hip_height", _fall_offset(data))))
     return early, late
 
 
@@ -205,7 +221,11 @@ def _make_legged(legs: _Legs, data: WalkerData, name: str, variant: str, printed
                                 by_default=data.structure.in_3d)
         return None
     flow = flow or f["flow"]
-    fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
+    # the hip at the ground, or a walker in 3D's at half its leg length (_fall_offset)
+    hip = f["guard_hip_height"]
+    if _fall_offset(data):
+        hip = partial(_below, hip, _fall_offset(data))
+    fall = Guard("fall", hip, -1, "fall", gradient=f["grad_hip_height"])
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
     heel = Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike", f["grad_heel_strike"])
     falls_back = Guard("swing_leg_falls_back", ahead, -1, "fall", dahead)
