@@ -67,14 +67,17 @@ class _Result:
 
 class CompiledDense:
     """Dense output of a compiled phase, scipy's ``OdeSolution`` calling convention:
-    ``(t,) -> (m,)``, ``(k,) -> (m, k)``.
+    ``(t,) -> (rows,)``, ``(k,) -> (rows, k)``: the integrated state's ``rows``, as the
+    Python backends' dense output (the cfunc's ``m`` outputs end with the guards' values,
+    its extra outputs, which stay inside).
 
     Pieces are ``(t_a, t_b, result or recipe)``; a recipe (the arguments of a CyRK run that
     repeats steps already taken, now with dense output) is run on the first call only, so a
     Poincaré map that never samples its trajectory does not pay for it."""
 
-    def __init__(self, m: int):
+    def __init__(self, m: int, rows: int | None = None):
         self.m = m
+        self.rows = m if rows is None else rows
         self.pieces: list[list] = []
 
     def _result(self, piece) -> _Result:
@@ -83,8 +86,8 @@ class CompiledDense:
         return piece[2]
 
     def _fill(self, times: np.ndarray, out: np.ndarray) -> None:
-        """The dense state (and guards) at each of ``times`` (k,) into the columns of ``out``
-        (m, k): one CyRK call per time, no Python per call beyond it."""
+        """The dense state at each of ``times`` (k,) into the columns of ``out`` (rows, k):
+        one CyRK call per time, no Python per call beyond it."""
         ns = _numba_solver()
 
         call, last = ns.c_call, len(self.pieces) - 1
@@ -97,12 +100,12 @@ class CompiledDense:
                 ta, tb = piece[0], piece[1]
                 if t <= tb or j == last:
                     call(self._result(piece).ptr, min(max(t, ta), tb), addr)
-                    out[:, c] = row  # state, then the guards (extra outputs) if any
+                    out[:, c] = row[:out.shape[0]]  # the state (the guards after it)
                     break
 
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
-        out = np.empty((self.m, t.size))
+        out = np.empty((self.rows, t.size))
         self._fill(t.ravel(), out)
         return out[:, 0] if t.ndim == 0 else out
 
@@ -427,7 +430,7 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     else:
         def values(T, Y):
             return np.array([[f(t, y[:n]) for f in fns] for t, y in zip(T, Y)])
-    dense = CompiledDense(m + plan.n_extra)
+    dense = CompiledDense(m + plan.n_extra, m)
     ta, ya, h0, nfev, K = float(t0), np.asarray(y0, float), 0.0, 0, plan.K
     while True:
         _res, T, Y, ok, msg, nf = plan.run(data, ta, t1, ya, K, h0, False)
