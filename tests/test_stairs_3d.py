@@ -271,3 +271,25 @@ def test_stairs_mjcf_walks_in_mujoco_within_3_percent_of_the_rigid_step_period(t
     run = walk(out.path, 11.3 * out.step_period_s)
     assert len(run.times_s) >= 10
     assert np.max(np.abs(run.step_periods_s / out.step_period_s - 1.0)) < 0.03
+
+
+def test_a_3d_steps_dense_output_is_its_state_on_the_compiled_phases(stairs):
+    """A 3D walker's phases run compiled under the default backend (``CompiledFlow.
+    by_default``); their dense output must be the state's 2n rows, as the Python backends'
+    (the cfunc's guard outputs, after the state, stay inside): the stairs' tread landing
+    samples the swing foot from it (``walker.points(sol(t))``, which failed on the extra
+    rows), and it must agree with the step's end state."""
+    from walkerlab.integrate.rigid import integrate_step
+
+    _scene, _plant, walker, x0 = stairs
+    assert all(getattr(ph.compiled, "by_default", False) for ph in walker.phases)
+    seg = integrate_step(walker, x0, SOLVER)
+    assert seg.termination == "heel_strike"
+    n = x0.size
+    for _phase, sol, (ta, tb) in seg.pieces:
+        t = np.linspace(ta, tb, 7)
+        assert np.asarray(sol(t)).shape == (n, 7)
+        assert np.asarray(sol(tb)).shape == (n,)
+        walker.points(sol(t))  # the landing's read: the generated points of (2n, k) states
+    _phase, sol, (_ta, tb) = seg.pieces[-1]
+    assert np.allclose(sol(tb), seg.x_end, rtol=0, atol=1e-9)  # the event state, pre-reset
