@@ -197,8 +197,10 @@ def _derive_module(structure, key: str, path: Path | None) -> dict:
 
 #: the symbolic equations derived in this process, by cache key: every generated module of
 #: a structure (the Python model, its compiled twin, the actuated flow, the collocation's
-#: functions) is printed from one derivation
+#: functions) is printed from one derivation; the last :data:`_EQUATIONS_MAX` structures'
+#: are kept (a 3D walker's hold tens of MB of sympy expressions)
 _equations: dict[str, object] = {}
+_EQUATIONS_MAX = 4
 
 
 def derive_equations(structure):
@@ -217,6 +219,8 @@ def derive_equations(structure):
             from walkerlab.codegen import legged  # light
 
             _equations[key] = legged.derive_legged(structure)
+        while len(_equations) > _EQUATIONS_MAX:
+            _equations.pop(next(iter(_equations)))
     return _equations[key]
 
 
