@@ -186,15 +186,14 @@ def test_stability_map_prints_the_path_of_the_figure_it_drew(tmp_path, monkeypat
         in out
 
 
-@pytest.mark.parametrize("name, why", [("rimless_wheel_3d", "a spoked wheel"),
-                                       ("kneed_3d", "checked on straight legs")])
+@pytest.mark.parametrize("name, why", [("rimless_wheel_3d", "a spoked wheel")])
 def test_robustness_refuses_the_3d_kinds_it_does_not_take_before_any_work(tmp_path, monkeypatch,
                                                                            name, why):
-    """The robustness study takes the 3D straight legs (tests/test_robustness_3d.py); the 3D
-    spoked wheel (no hip to push, no legs to read) and the kneed walker in 3D (its pushes
-    checked on straight legs only) are refused in one line naming walker.space, from the table
+    """The robustness study takes the 3D straight legs and the 3D locking knees
+    (tests/test_robustness_3d.py); the 3D spoked wheel (no hip to push, no legs to read) is
+    refused in one line naming walker.space, from the table
     (:data:`walkerlab.walker.capability_cells.STAGE_CELLS`), before the gait is searched or
-    the walker built (building it fails this test); the study's own entry refuses them too,
+    the walker built (building it fails this test); the study's own entry refuses it too,
     and nothing is written."""
     from walkerlab.models import registry
     from walkerlab.stages import pipeline
