@@ -222,9 +222,9 @@ def _make_legged(legs: _Legs, data: WalkerData, name: str, variant: str, printed
         return None
     flow = flow or f["flow"]
     # the hip at the ground, or a walker in 3D's at half its leg length (_fall_offset)
-    hip = f["guard_hip_height"]
-    if _fall_offset(data):
-        hip = partial(_below, hip, _fall_offset(data))
+    hip, drop = f["guard_hip_height"], _fall_offset(data)
+    if drop:
+        hip = partial(_below, hip, drop)
     fall = Guard("fall", hip, -1, "fall", gradient=f["grad_hip_height"])
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
     heel = Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike", f["grad_heel_strike"])
