@@ -81,8 +81,9 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
         with pytest.raises(KindRefused) as err:
             kind.require("walk", view, "walker.space: 3d")
         assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
-    for feature in ("round_feet_3d", "profile"):
-        assert not kind.supports(feature, "rigid"), feature
+    assert not kind.supports("profile", "rigid")
+    # round feet on the shanks: configs/kneed_round_feet_3d.yaml (the slow test below)
+    assert kind.supports("round_feet_3d", "rigid") and kind.supports("round_feet_3d", "contact")
     # an upper body on the bisecting hip: configs/kneed_torso_powered_3d.yaml
     # (tests/test_kneed_torso_3d.py)
     assert kind.supports("torso_torque", "rigid")
@@ -99,12 +100,11 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     (lambda w: w["leg"]["knee"].update(lock="free"), "walker.leg.knee"),
     (lambda w: w["leg"]["knee"].update(spring={"stiffness_n_m_per_rad": 1.0}),
      "walker.leg.knee"),
-    (lambda w: w["leg"].update(foot={"kind": "arc", "radius_m": 0.1}), "walker.leg.foot.kind"),
 ])
 def test_what_a_kneed_walker_in_3d_does_not_take_is_refused_in_one_line_naming_the_field(
         change, field):
-    """Free knees, a knee spring and arc feet on locking knees in 3D: one line naming the
-    field (the tree would carry them; their derivations are not checked).  An upper body
+    """Free knees and a knee spring on locking knees in 3D: one line naming the field
+    (the tree would carry them; their derivations are not checked).  An upper body
     on the bisecting hip is taken (tests/test_kneed_torso_3d.py)."""
     raw = _kneed_in_3d(0.1)
     change(raw["walker"])
@@ -164,6 +164,31 @@ def test_the_kneed_walker_in_3d_with_zero_hip_width_walks_the_planar_kneed_gait(
                           tiny=1e-6)
     print(f"planar step period {f.period_s:.12f} s, 3D {s.period_s:.12f} s; multipliers "
           f"3D {np.round(np.abs(s.multipliers_variational), 6)}")
+
+
+@pytest.mark.slow   # ~1 min cold: the planar and the 3D kneed derivations on round feet
+def test_the_kneed_walker_on_round_feet_in_3d_walks_the_planar_kneed_gait_on_arc_feet():
+    """configs/kneed_round_feet_3d.yaml (each shank's foot a disc of radius 0.1 m in its
+    leg's plane, zero hip width), started upright from the gait of configs/kneed.yaml on
+    arc feet of that radius (the planar tree's arc foot rolling on the slope, leg-vector
+    sums in the plane; the 3D tree's disc, its lowest point on the slope's normal): the
+    same fixed point and step period to 1e-9 relative, the lean and its rate 0, the planar
+    multipliers among the 3D ones.  The same feet on straight legs:
+    tests/test_round_feet_3d.py."""
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+
+    raw = _raw("kneed.yaml")
+    raw["walker"]["leg"]["foot"] = {"kind": "arc", "radius_m": 0.1}
+    flat_scene = Scene.model_validate({k: v for k, v in raw.items()
+                                       if k not in ("contact", "terrain", "contact_sim",
+                                                    "contact_solver")})
+    shipped = Scene.model_validate(_raw("kneed_round_feet_3d.yaml"))
+    flat = _walker(flat_scene)
+    start = _guess(shipped, _walker(shipped).state_names())[[1, 2, 3, 5, 6, 7]]
+    f = find_fixed_point(flat, start, SOLVER, fd_check=False)
+    s = _planar_embedding(flat, f, _walker(shipped), tiny=1e-6)
+    assert abs(s.period_s - 0.53683) < 1e-5      # the scene's comment
+    assert np.max(np.abs(s.multipliers_variational)) > 6.0   # the unstable lean
 
 
 @pytest.fixture(scope="module")

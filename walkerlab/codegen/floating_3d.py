@@ -104,8 +104,8 @@ def derive_legs_3d(structure: Structure) -> FloatingEquations:
     feet, points = [], {}
     if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
         radius = dict(zip(tree.params, kin.params))["R_foot"]
-        for leg, link, centre in (("leg1", "swing_leg", kin.contacts["swing_foot_centre"]),
-                                  ("leg2", "stance_leg", kin.origins["stance_leg"])):
+        for leg, link, centre in (("leg1", feet_links[0], kin.contacts["swing_foot_centre"]),
+                                  ("leg2", feet_links[1], kin.origins[feet_links[1]])):
             low, J = _disc_contact(kin, link, centre, radius)
             pos = to_world * low.xreplace(rename)
             feet.append((pos, (to_world * J).xreplace(rename)))

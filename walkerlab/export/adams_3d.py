@@ -310,7 +310,7 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
     disc = float(p["R_foot"]) if round_feet(data) else 0.0
-    feet = ({f"{leg}_shank": (p["L"] - p["L_thigh"], 0.0) for leg in ("leg1", "leg2")}
+    feet = ({f"{leg}_shank": (p["L"] - p["L_thigh"] - disc, disc) for leg in ("leg1", "leg2")}
             if knees else {leg: (p["L"] - disc, disc) for leg in ("leg1", "leg2")})
     return Adams3dStart(list(root.walk()), couplings, pose, velocity, hinges, lanes,
                         float(ideal.period_s) / steps, p, law, feet)
@@ -517,6 +517,6 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
         out += hip_roll_statements(start.law, ids, contacts)
     out += actuation_3d_statements(scene, ids, contacts, data.slope_rad, start.law is not None)
     if any(b.endswith("_shank") for b in start.feet):
-        out += knee_3d_statements(scene, ids, data.slope_rad)
+        out += knee_3d_statements(scene, ids, data.slope_rad, start.disc_m)
     out += ["!", "OUTPUT/REQSAVE, GRSAVE"]
     return "\n".join([*out, "END", ""])

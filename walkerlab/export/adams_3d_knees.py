@@ -44,7 +44,8 @@ KNEE_3D_VARIABLES = {"nx": 370, "nz": 375, "height_leg1": 371, "height_leg2": 37
                      "foot_leg2": 377, "knee_leg1": 378, "knee_leg2": 379}
 
 
-def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
+def knee_3d_statements(scene, parts: dict, slope_rad: float, disc_m: float = 0.0
+                       ) -> list[str]:
     """The knee stops and, with ``contact.knee_stop.latch``, the latches (module
     docstring).
 
@@ -57,6 +58,10 @@ def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
         PART id by body: ``leg<i>`` (the thigh) and ``leg<i>_shank`` (its foot marker
         ``100 s + 3``).
     slope_rad : float
+    disc_m : float
+        Round feet's disc radius [m] (0: point feet): the latch's foot height is the disc
+        centre's (marker ``100 s + 3``) less it, its lowest point's with the disc's plane
+        normal to the slope.
 
     Returns
     -------
@@ -95,6 +100,7 @@ def knee_3d_statements(scene, parts: dict, slope_rad: float) -> list[str]:
             _var(V["nx"], _f(float(n[0]))), _var(V["nz"], _f(float(n[2])))]
     for leg, (i_m, j_m, foot) in knees.items():
         out += [_var(V[f"height_{leg}"], f"VARVAL({V['nx']})*DX({foot},101)+"
-                     f"VARVAL({V['nz']})*DZ({foot},101)"),
+                     f"VARVAL({V['nz']})*DZ({foot},101)"
+                     + (f"-{_f(disc_m * MM)}" if disc_m else "")),
                 *latch_sforce(V, leg, i_m, j_m, h_rel, cap, law)]
     return out

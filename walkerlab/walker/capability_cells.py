@@ -444,8 +444,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # Manager's windows: walkerlab.export.opensim_walk)
         **{("hip_roll", v): None for v in ("rigid", "gym", "contact", "mjcf", "urdf", "adams",
                                            "osim")},
-        ("round_feet_3d", "*"): ("a kneed walker in 3D walks on point feet so far "
-                                 "(walker.foot_radius_m)"),
+        # round feet (configs/kneed_round_feet_3d.yaml: each shank's disc, the straight
+        # legs' disc on the kneed tree): the rigid model, the gym's rigid view, the contact
+        # model (walkerlab.models.contact.parts.Kneed3DPart.foot_pitches: the discs roll by
+        # the shanks' pitches); OpenSim has no disc (the straight legs' reason)
+        ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
         **_CELLS_3D,
         # stairs and footholds in the rigid model and the gym's rigid view: the straight
         # legs' landing (the generated swing clearance with the knee locked plus the
@@ -524,6 +527,7 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
 #: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
 FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
+                 ("locking_knees_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
                  ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE,

@@ -119,8 +119,11 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         if (kind, feature) in SHIPPED:  # and the precision its gait was searched at
             d["fixedpoint"]["initial_guess"] = stabilised["fixedpoint"]["initial_guess"]
             d["solver"] = stabilised["solver"]
+    elif feature == "round_feet_3d" and "leg" in w and w.get("space") == "3d":  # its shanks'
+        # discs (configs/kneed_round_feet_3d.yaml's radius: the kneed gait folds at 0.124 m)
+        w["leg"]["foot"] = {"kind": "arc", "radius_m": 0.1}
     elif feature == "round_feet_3d":  # configs/round_feet_3d.yaml's disc feet (refused by
-        w["foot_radius_m"] = 0.2  # any walker but the 3D straight legs: the scene's check)
+        w["foot_radius_m"] = 0.2  # a planar walker: the scene's check)
     elif feature in TERRAIN:
         terrain = copy.deepcopy(TERRAIN[feature])
         if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
@@ -185,6 +188,9 @@ SHIPPED = {
     ("straight_legs_3d", "hip_roll"): "hip_width_stabilised",
     # configs/round_feet.yaml's walker in 3D on disc feet, upright: the planar gait
     ("straight_legs_3d", "round_feet_3d"): "round_feet_3d",
+    # configs/kneed.yaml's walker in 3D on disc feet (0.1 m: its gait folds at 0.124 m),
+    # upright: the planar kneed gait on arc feet
+    ("locking_knees_3d", "round_feet_3d"): "kneed_round_feet_3d",
     # the stabilised walker with a push-off and a hip spring (a stable powered 3D gait:
     # the generated cases on configs/hip_width.yaml's lateral multiplier of ~100 a stride
     # fall in contact within a few steps)

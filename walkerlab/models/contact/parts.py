@@ -353,6 +353,9 @@ class Legs3DPart(ContactPart):
     #: floating coordinates the rigid state has no role of its own for -> the rigid role
     #: whose angle and rate they take (locking knees: the straight stance leg's links)
     same_as: dict = {}
+    #: the floating coordinates of the links the feet are on (leg1's, leg2's): the pitches
+    #: a round foot rolls by
+    foot_pitches = ("leg1_angle", "leg2_angle")
 
     def link_state(self, walker, x, rate_scale) -> np.ndarray:
         """The floating state after the base's slides (``[heading, the rigid roles' angles,
@@ -375,14 +378,15 @@ class Legs3DPart(ContactPart):
     def step_length(self, walker, x_ideal, along_slope: bool) -> float:
         """The feet's distance along the slope's fall line at the heel strike (the
         patches are strips across the slope; the hip width lies across it), plus round
-        feet's roll over the step, ``R (theta_stance - theta_swing)`` (the legs' pitches),
-        as a planar walker's arc feet."""
+        feet's roll over the step, ``R (theta_stance - theta_swing)`` (the pitches of the
+        links the feet are on, :attr:`foot_pitches`), as a planar walker's arc feet."""
         z, chord = self._chord(walker, x_ideal, True)[:2]
         if walker.structure.foot != "arc":
             return chord
         R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
         links = walker.coordinate_names()[walker.dim:]
-        return chord + R * (z[links.index("leg2_angle")] - z[links.index("leg1_angle")])
+        swing, stance = (links.index(c) for c in self.foot_pitches)
+        return chord + R * (z[stance] - z[swing])
 
     def patch_shift(self, walker, x_ideal) -> float:
         """A disc foot rolls on its patch: from its touchdown point its contact (the disc's
@@ -455,6 +459,7 @@ class Kneed3DPart(Legs3DPart):
     both take its pitch."""
 
     same_as = {"leg2_thigh_angle": "stance", "leg2_shank_angle": "stance"}
+    foot_pitches = ("leg1_shank_angle", "leg2_shank_angle")
 
 
 # each kind's contact part (:attr:`walkerlab.walker.kinds.Kind.contact`) given the
