@@ -13,6 +13,7 @@ from __future__ import annotations
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
            "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
+           "KNEED_ZERO_WIDTH_UPRIGHT",
            "KNEE_LATCH_OSIM",
            "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
            "PROFILE_PASSIVE",
@@ -518,6 +519,14 @@ ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk 
                          "lean_rate_rad_per_s: 0.001) configs/paper_3d.yaml capsizes after 3 "
                          "heel strikes, as the rigid walk would")
 
+#: what the kneed walker's round-feet contact cell of zero hip width rests on
+#: (configs/kneed_round_feet_3d.yaml): its ten steps are the sagittal gait's
+KNEED_ZERO_WIDTH_UPRIGHT = ("held to the rigid gait over 10 steps because the walk stays in "
+                            "its sagittal plane: zero hip width and an upright start keep it "
+                            "mirror-symmetric, its roll seeded at 3e-36 rad and growing x8.6 "
+                            "a step (the rigid gait's lean multiplier: 6.5 a step), 9e-28 "
+                            "rad by heel strike 10")
+
 #: (kind, view) -> what each supported cell of that kind in that view rests on beyond its
 #: measurement (:meth:`Kind.note`): shown with the cell in the table (a numbered note under
 #: the kind's grid) and in ``walkerlab capabilities --json`` (``note``, and in ``detail``)
@@ -527,7 +536,7 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
 #: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
 FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
-                 ("locking_knees_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
+                 ("locking_knees_3d", "round_feet_3d", "contact"): KNEED_ZERO_WIDTH_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
                  ("locking_knees_3d", "walk", "mjcf"): KNEED_3D_FIRST_STRIDE,
