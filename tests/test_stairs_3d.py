@@ -253,6 +253,39 @@ def test_footholds_adams_patches_lie_at_the_rigid_walks_footfalls(footholds_walk
     _lanes_match_the_rigid_walk(scene, feet, lanes)
 
 
+def test_footholds_osim_patches_lie_at_the_rigid_walks_footfalls(footholds_walk):
+    """The OpenSim model's text (written by its writer: the export refuses footholds of
+    several heights in OpenSim, its walk on them not measured) lays the MJCF's patches:
+    each ``ContactSphere`` ``leg<i>_patch<k>``'s top (its centre plus its radius along the
+    slope's normal, OpenSim's axes walkerlab's) at the rigid walk's footfall, at its
+    foothold's height (:func:`_lanes_match_the_rigid_walk`)."""
+    import xml.etree.ElementTree as ET
+
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.export.opensim_3d import osim3d_gait, osim3d_text
+
+    scene, feet = footholds_walk
+    plant = Plant.from_scene(scene)
+    text = osim3d_text(plant.data, osim3d_gait(scene, plant.data, ideal_gait(scene, plant)),
+                       scene.name)
+    phi = scene.slope.angle_rad
+    normal = np.array([math.sin(phi), math.cos(phi), 0.0])  # walkerlab's axes: y up
+    spheres = {c.get("name"): c for c in  # OpenSim's "::" names are no XML names
+               ET.fromstring(text.replace("::", "__")).iter("ContactSphere")}
+    lanes = []
+    for leg in ("leg1", "leg2"):
+        k = 0
+        lane = []
+        while f"{leg}_patch{k}" in spheres:
+            c = spheres[f"{leg}_patch{k}"]
+            top = np.array(c.find("location").text.split(), float) \
+                + float(c.find("radius").text) * normal
+            lane.append(TO_MJ @ top)  # the lanes' check reads MuJoCo's axes
+            k += 1
+        lanes.append(lane)
+    _lanes_match_the_rigid_walk(scene, feet, lanes)
+
+
 def test_kneed_3d_stairs_footfalls_land_on_the_treads():
     """configs/kneed_3d_stairs.yaml (locking knees in 3D, its two phases): four steps from
     the shipped gait, heel strike ``k`` on tread ``k`` at its height ``-k H`` to 1e-10 m
