@@ -25,7 +25,11 @@ ground at mid-stance (it is ignored there), so the slope is laid as patches
 contact bits (:data:`~walkerlab.export.mjcf_scene.LANE_BITS`) only its own foot touches:
 leg2 (in stance at the keyframe, its contact point at the origin) at footfalls ``k S``,
 leg1 at ``f + k S`` (``f`` the keyframe's trailing foot, ``S`` the stride: twice the
-step's advance, its lateral part cancelling step by step).  With hip width the lanes lie
+step's advance, its lateral part cancelling step by step).  On footholds of several heights
+the steps differ (in length, lean and lateral offset: the walker crabs across the slope), and
+the patches lie at the rigid walk's own footfalls, each at its foothold's height
+(:func:`walkerlab.export.legs_3d_parts.legs3d_lanes`: one period walked from the fixed
+point and repeated, as the contact model's patches).  With hip width the lanes lie
 apart laterally, each through its leg's footfalls; with none they coincide and the bits
 alone keep them apart.
 
