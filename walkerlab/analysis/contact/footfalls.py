@@ -9,7 +9,10 @@ rigid gait from its fixed point and measures each step's advance along the slope
 contact view's own geometry (:func:`walkerlab.models.contact.scene.ideal_step_length`: the
 chord between the feet's reference points at heel strike along the slope, plus an arc
 foot's roll), so footfall ``k`` lies at ``l_0 + ... + l_{k-1}``
-(:func:`walkerlab.models.contact.terrain.footfall_positions`).
+(:func:`walkerlab.models.contact.terrain.footfall_positions`).  The same walk gives the
+footfalls as points (:func:`rigid_footfalls`: the rigid model's own stance feet, their
+lateral offsets and heights too), where a 3D walker's exports lay their patches (its steps
+on footholds of several heights differ across the slope as well: it crabs).
 
 The contact walker's steps differ from the rigid ones (the paper walker's are ~9 mm
 shorter), so its footfalls drift off these patches; footholds are where the feet land (each
