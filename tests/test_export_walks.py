@@ -41,9 +41,7 @@ def _scene(name):
 #: have no multibody form (flat feet and their ankle push-off are exported:
 #: tests/test_export_flat_feet.py).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies",
-           # the 3D walkers' cells: patches a stride apart (footholds of two heights)
-           "hip_width_footholds": "terrain.foothold_heights_m"}
+           "simplest": "walker.leg.bodies"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.
@@ -101,7 +99,9 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
     threelink_footholds +0.16 %, threelink_hzd +0.21 %, rabbit +0.05 %, rabbit_footholds
     +0.20 %, rabbit_hzd and rabbit_hzd_optimal +0.20 %, paper_3d (the free pelvis in 3D)
     -0.005 %, round_feet_3d (its disc feet: MuJoCo cylinders) +0.01 %, hip_width_stairs
-    (patches at the treads' heights) +0.01 %, kneed_3d_stabilised_stairs -0.72 %,
+    (patches at the treads' heights) +0.01 %, hip_width_footholds (patches at the rigid
+    walk's footfalls, each at its foothold's height) -0.00 %, kneed_3d_stabilised_stairs
+    -0.72 %,
     kneed_3d_powered_stabilised -0.63 %; hip_width falls
     after 3 heel strikes (:data:`FALLS`).  About 5-40 s each under load."""
     scene = _scene(name)

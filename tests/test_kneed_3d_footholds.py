@@ -105,14 +105,15 @@ def test_footholds_of_zero_height_are_the_slope(footholds):
 
 
 def test_the_3d_mjcf_refuses_footholds_of_several_heights(tmp_path):
-    """Footholds of two heights make the stride's two steps differ, and the 3D MJCF lays its
-    patches a stride of mirrored steps apart: the export refuses them in one line naming
-    the field, before any gait is searched."""
+    """Footholds of two heights make the stride's two steps differ; the 3D exports lay the
+    patches at the rigid walk's footfalls, measured for the straight legs only (the kneed
+    walker's knee latch on patches of alternating heights is not): the kneed walker's
+    export refuses them in one line naming the field, before any gait is searched."""
     from walkerlab.stages import export as export_stage
 
     d = load_scene(ROOT / "configs" / FOOTHOLDS).model_dump(mode="json")
     d["terrain"]["foothold_heights_m"] = [-0.002, 0.002]
-    with pytest.raises(KindRefused, match=r"^terrain\.foothold_heights_m: .*mirror"):
+    with pytest.raises(KindRefused, match=r"^terrain\.foothold_heights_m: .*kneed walker"):
         export_stage.write(scene_from_dict(d), tmp_path, "mjcf")
     assert not any(tmp_path.rglob("*.xml"))
 

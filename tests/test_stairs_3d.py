@@ -153,6 +153,139 @@ def test_footholds_map_section_is_the_state_a_cycle_ends_in():
     assert np.max(np.abs(walker.from_section(walker.section(x)) - x)) < 1e-12
 
 
+#: MuJoCo's axes (and the Adams dataset's) from walkerlab's: x, y up, z across -> x, -z, y
+TO_MJ = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+#: rigid steps whose footfalls are checked against the exported patches (footfalls 0 to 11)
+FOOTHOLD_STEPS = 12
+#: an exported patch at its rigid footfall [m]: the layout walks one period of the fixed
+#: point (1e-12) and repeats it, the check walks 12 steps (a stable gait: the walk stays on
+#: it); the files write 16 significant digits
+PATCH_TOL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def footholds_walk():
+    """configs/hip_width_footholds.yaml's rigid gait (searched as the export searches it),
+    and its rigid walk of :data:`FOOTHOLD_STEPS` steps from it: the keyframe's trailing
+    foot (the rigid ``points`` at the fixed point) and each heel strike's new stance foot
+    (``simulate_steps``' world feet), in walkerlab's axes [m] - footfall ``k`` (0 the
+    keyframe's stance foot, leg2's) at row ``k + 1``, the trailing foot (leg1's) at row 0."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+
+    scene, plant, walker, _x0 = _built("hip_width_footholds.yaml")
+    x = np.asarray(ideal_gait(scene, plant).x, float)
+    traj = simulate_steps(walker, x, FOOTHOLD_STEPS, SOLVER)
+    assert [sg.termination for sg in traj.segments] == ["heel_strike"] * FOOTHOLD_STEPS
+    trailing = np.ravel(walker.points(x)["swing_foot"])
+    feet = np.array([trailing] + [sg.stance_foot_world for sg in traj.segments], float)
+    return scene, feet
+
+
+def _lanes_match_the_rigid_walk(scene, feet, lanes) -> None:
+    """Each leg's patches (footfalls in MuJoCo's axes [m], leg1's from the trailing foot,
+    leg2's from the keyframe's stance foot) at the rigid walk's footfalls ``feet``
+    (:func:`footholds_walk`) to :data:`PATCH_TOL`, each a foothold's height
+    ``h[k mod 2]`` above the slope line through the last one along the vertical; the
+    walker crabs (its lateral offset changes stride by stride: the steps do not mirror
+    each other)."""
+    leg1, leg2 = (np.asarray(lane, float) @ TO_MJ for lane in lanes)  # walkerlab's axes
+    n = FOOTHOLD_STEPS // 2
+    np.testing.assert_allclose(leg1[:n + 1], feet[0::2][:n + 1], rtol=0, atol=PATCH_TOL)
+    np.testing.assert_allclose(leg2[:n], feet[1::2][:n], rtol=0, atol=PATCH_TOL)
+    falls = np.empty((2 * n + 1, 3))
+    falls[0::2], falls[1::2] = leg1[:n + 1], leg2[:n]  # footfall -1, 0, 1, ... in turn
+    h, slope = scene.terrain.foothold_heights_m, math.tan(scene.slope.angle_rad)
+    for k in range(1, len(falls) - 1):  # footfall k - 1's landing: step k - 1 of the cycle
+        (xa, ya, _), (xb, yb, _) = falls[k], falls[k + 1]
+        assert abs(yb - (ya - (xb - xa) * slope + h[(k - 1) % 2])) < PATCH_TOL
+    assert abs((falls[4, 2] - falls[2, 2]) - (falls[2, 2] - falls[0, 2])) < 1e-6
+    assert abs(falls[2, 2] - falls[0, 2]) > 0.01  # 0.041 m a stride measured
+
+
+def test_footholds_mjcf_patches_lie_at_the_rigid_walks_footfalls(footholds_walk, tmp_path):
+    """configs/hip_width_footholds.yaml's MJCF (footholds 0.5 mm above and below the slope
+    line in turn): each patch box's top centre (its centre plus its half-depth along the
+    slope's normal) at the rigid walk's footfall, at its foothold's height
+    (:func:`_lanes_match_the_rigid_walk`)."""
+    import xml.etree.ElementTree as ET
+
+    from walkerlab.stages import export
+
+    scene, feet = footholds_walk
+    out = export.write(scene, tmp_path, "mjcf")
+    phi = scene.slope.angle_rad
+    normal = np.array([math.sin(phi), 0.0, math.cos(phi)])  # the box's z, turned about y
+    geoms = {g.get("name"): g for g in ET.parse(out.path).getroot().iter("geom")
+             if g.get("name")}
+    lanes = []
+    for leg in ("leg1", "leg2"):
+        boxes = sorted(((int(k.rsplit("patch", 1)[1]), g) for k, g in geoms.items()
+                        if k.startswith(f"{leg}_patch")), key=lambda kg: kg[0])
+        lanes.append([np.array(g.get("pos").split(), float)
+                      + float(g.get("size").split()[2]) * normal for _k, g in boxes])
+    _lanes_match_the_rigid_walk(scene, feet, lanes)
+
+
+def test_footholds_adams_patches_lie_at_the_rigid_walks_footfalls(footholds_walk, tmp_path):
+    """The Adams dataset of configs/hip_width_footholds.yaml read back: each foot's
+    CONTACT patches (GRAPHICS boxes from their corner markers, their tops ``r = L / 1000``
+    below the footfall along the box's normal: the foot sphere's centre at the rigid point
+    foot) at the rigid walk's footfalls, at their footholds' heights
+    (:func:`_lanes_match_the_rigid_walk`); leg1's foot touches leg1's lane only."""
+    from walkerlab.export.adams_reader import read_adm
+    from walkerlab.stages import export
+
+    scene, feet = footholds_walk
+    out = export.write(scene, tmp_path, "adm")
+    model = read_adm(out.path.read_text())
+    r = scene.walker.leg_length_m / 1000
+    lanes = []
+    for foot in (303, 403):   # leg1's and leg2's foot-sphere markers
+        lane = []
+        for c in model.by_kind["CONTACT"].values():
+            if c.integer("IGEOM") != foot:
+                continue
+            g = model.get("GRAPHICS", c.integer("JGEOM"))
+            o, R = model.marker_pose(g.integer("CORNER"))
+            size = np.array([g.number(k) for k in "XYZ"]) * model.length
+            lane.append(o + R @ (size * [0.5, 0.5, 1.0]) + r * R[:, 2])
+        lanes.append(sorted(lane, key=lambda p: p[0]))
+    _lanes_match_the_rigid_walk(scene, feet, lanes)
+
+
+def test_footholds_osim_patches_lie_at_the_rigid_walks_footfalls(footholds_walk):
+    """The OpenSim model's text (written by its writer: the export refuses footholds of
+    several heights in OpenSim, its walk on them not measured) lays the MJCF's patches:
+    each ``ContactSphere`` ``leg<i>_patch<k>``'s top (its centre plus its radius along the
+    slope's normal, OpenSim's axes walkerlab's) at the rigid walk's footfall, at its
+    foothold's height (:func:`_lanes_match_the_rigid_walk`)."""
+    import xml.etree.ElementTree as ET
+
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.export.opensim_3d import osim3d_gait, osim3d_text
+
+    scene, feet = footholds_walk
+    plant = Plant.from_scene(scene)
+    text = osim3d_text(plant.data, osim3d_gait(scene, plant.data, ideal_gait(scene, plant)),
+                       scene.name)
+    phi = scene.slope.angle_rad
+    normal = np.array([math.sin(phi), math.cos(phi), 0.0])  # walkerlab's axes: y up
+    spheres = {c.get("name"): c for c in  # OpenSim's "::" names are no XML names
+               ET.fromstring(text.replace("::", "__")).iter("ContactSphere")}
+    lanes = []
+    for leg in ("leg1", "leg2"):
+        k = 0
+        lane = []
+        while f"{leg}_patch{k}" in spheres:
+            c = spheres[f"{leg}_patch{k}"]
+            top = np.array(c.find("location").text.split(), float) \
+                + float(c.find("radius").text) * normal
+            lane.append(TO_MJ @ top)  # the lanes' check reads MuJoCo's axes
+            k += 1
+        lanes.append(lane)
+    _lanes_match_the_rigid_walk(scene, feet, lanes)
+
+
 def test_kneed_3d_stairs_footfalls_land_on_the_treads():
     """configs/kneed_3d_stairs.yaml (locking knees in 3D, its two phases): four steps from
     the shipped gait, heel strike ``k`` on tread ``k`` at its height ``-k H`` to 1e-10 m
@@ -271,6 +404,22 @@ def test_stairs_mjcf_walks_in_mujoco_within_3_percent_of_the_rigid_step_period(t
     run = walk(out.path, 11.3 * out.step_period_s)
     assert len(run.times_s) >= 10
     assert np.max(np.abs(run.step_periods_s / out.step_period_s - 1.0)) < 0.03
+
+
+@pytest.mark.slow  # ~40 s: the rigid gait and 8 s of MuJoCo stepped one timestep at a time
+def test_footholds_mjcf_walks_in_mujoco_within_3_percent_of_the_rigid_step_period(tmp_path):
+    """configs/hip_width_footholds.yaml's MJCF (patches at the rigid walk's footfalls, each
+    at its foothold's height: the period-2 gait's steps of 0.6958 and 0.7100 s, the walker
+    crabbing 4.1 cm a stride) walked by MuJoCo with the hip-roll law in the walk loop:
+    >= 10 alternating heel strikes without falling, the mean step period within 3 % of the
+    rigid gait's (measured 11 strikes, 0.702884 s against 0.702897 s: -0.002 %)."""
+    pytest.importorskip("mujoco")
+    from walkerlab.stages import export
+
+    scene = load_scene(ROOT / "configs" / "hip_width_footholds.yaml")
+    w = export.write(scene, tmp_path, "mjcf", walk=True).walk
+    assert not w.fell and w.alternating and w.strikes >= 10, w.line
+    assert abs(w.period_s / w.rigid_period_s - 1.0) < 0.03, w.line
 
 
 def test_a_3d_steps_dense_output_is_its_state_on_the_compiled_phases(stairs):

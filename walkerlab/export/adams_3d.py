@@ -55,8 +55,9 @@ rolls move under the walk's forces, as in the rigid model and the MJCF's loop).
 
 Feet and ground: each foot a sphere of radius ``r = L / 1000`` (the planar dataset's bevel)
 whose centre is the rigid point foot (``L`` down the leg, marker ``100 p + 3``); the ground
-the MJCF's footfall patches (:func:`walkerlab.export.legs_3d_mjcf.legs3d_footfalls`: the
-rigid swing foot passes through the ground at mid-stance), boxes ``terrain.patch_width_m``
+the MJCF's footfall patches (:func:`walkerlab.export.legs_3d_parts.legs3d_lanes`: the
+rigid swing foot passes through the ground at mid-stance; on footholds of several heights
+at the rigid walk's footfalls), boxes ``terrain.patch_width_m``
 along the slope and :data:`~walkerlab.export.legs_3d_mjcf.PATCH_ACROSS_L` leg lengths
 across (:data:`~walkerlab.export.legs_3d_mjcf.PATCH_ACROSS_PUSHED_L` with the hip-roll law,
 as the MJCF), their tops ``r`` below the slope's plane through the footfalls (the sphere touches
@@ -113,12 +114,13 @@ from walkerlab.export.legs_3d_mjcf import (
     PATCH_ACROSS_L,
     PATCH_ACROSS_PUSHED_L,
     _rotation,
-    legs3d_footfalls,
     legs3d_keyframe,
 )
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
     kneed,
+    legs3d_footfalls,
+    legs3d_lanes,
     legs3d_roles,
     legs_summary,
     round_feet,
@@ -187,7 +189,8 @@ class Adams3dStart:
     hinges : dict
         ``joint name -> (axis (3,) in its body's frame, angle [rad], rate [rad/s])``.
     lanes : (ndarray (k1, 3), ndarray (k2, 3))
-        leg1's and leg2's footfalls [m] (:func:`legs3d_footfalls`).
+        leg1's and leg2's footfalls [m] (:func:`~walkerlab.export.legs_3d_parts.
+        legs3d_lanes`).
     period_s : float
         The rigid gait's step period [s].
     numbers : dict
@@ -231,7 +234,7 @@ class Adams3dStart:
         return v + np.cross(w, R @ b.com_m)
 
 
-def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
+def adams3d_start(data, ideal, strides: int, scene=None) -> Adams3dStart:
     """The start of :func:`adm3d_text` at the rigid gait ``ideal`` (module docstring).
 
     Parameters
@@ -246,6 +249,10 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
         ``period_s`` [s], ``step_lengths_m``.
     strides : int
         Strides of the run: footfall patches for ``2 strides + 2`` steps.
+    scene : walkerlab.config.Scene, optional
+        Its ground: on footholds of several heights the patches lie at the rigid walk's
+        footfalls (:func:`walkerlab.export.legs_3d_parts.legs3d_lanes`, the MJCF's); None:
+        the keyframe's mirrored steps.
 
     Returns
     -------
@@ -306,7 +313,8 @@ def adams3d_start(data, ideal, strides: int) -> Adams3dStart:
             velocity[c.name] = (v + np.cross(w, r), wc)
             down(c)
     down(root)
-    lanes = legs3d_footfalls(f["points"], x, 2 * strides + 2)
+    lanes = (legs3d_lanes(scene, f["points"], x, 2 * strides + 2) if scene is not None
+             else legs3d_footfalls(f["points"], x, 2 * strides + 2))
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
     disc = float(p["R_foot"]) if round_feet(data) else 0.0

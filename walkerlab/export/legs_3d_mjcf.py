@@ -25,7 +25,11 @@ ground at mid-stance (it is ignored there), so the slope is laid as patches
 contact bits (:data:`~walkerlab.export.mjcf_scene.LANE_BITS`) only its own foot touches:
 leg2 (in stance at the keyframe, its contact point at the origin) at footfalls ``k S``,
 leg1 at ``f + k S`` (``f`` the keyframe's trailing foot, ``S`` the stride: twice the
-step's advance, its lateral part cancelling step by step).  With hip width the lanes lie
+step's advance, its lateral part cancelling step by step).  On footholds of several heights
+the steps differ (in length, lean and lateral offset: the walker crabs across the slope), and
+the patches lie at the rigid walk's own footfalls, each at its foothold's height
+(:func:`walkerlab.export.legs_3d_parts.legs3d_lanes`: one period walked from the fixed
+point and repeated, as the contact model's patches).  With hip width the lanes lie
 apart laterally, each through its leg's footfalls; with none they coincide and the bits
 alone keep them apart.
 
@@ -111,6 +115,8 @@ from walkerlab.export.legs_3d_parts import (
     hip_roll_law,
     kneed,
     leg_links,
+    legs3d_footfalls,
+    legs3d_lanes,
     legs3d_numbers,
     legs3d_roles,
     legs_summary,
@@ -252,36 +258,6 @@ def legs3d_keyframe(points, velocities, x, slope_rad: float,
     return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
 
 
-def legs3d_footfalls(points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """The rigid gait's footfalls in MuJoCo's axes [m], leg1's and leg2's, from the
-    keyframe's (leg2 in stance at the origin, leg1 trailing): leg2 at ``k S``
-    (``k`` from 0 to ``steps // 2``), leg1 at ``f + k S`` (``k`` from 0 to
-    ``steps // 2 + 1``: the trailing foot, then its landings), ``f`` the trailing foot,
-    ``S = -2 (f - (f·z) z)``
-    the stride (the gait's two steps mirror each other about the fall line: their
-    advances add, their lateral offsets cancel).
-
-    Parameters
-    ----------
-    points : callable ``x -> dict[str, ndarray (3,)]``
-        The rigid walker's generated ``points``: ``swing_foot`` (the trailing foot just
-        after the heel strike).
-    x : ndarray (6,) or (8,)
-    steps : int
-        Footfalls ahead of the keyframe (both legs'), ``EXPORT_STEPS``.
-
-    Returns
-    -------
-    leg1, leg2 : ndarray (k, 3)
-    """
-    C = np.array(TO_MUJOCO)
-    f = np.ravel(np.asarray(points(np.asarray(x, float))["swing_foot"], float))
-    stride = -2.0 * np.array([f[0], f[1], 0.0])
-    k2 = np.arange(steps // 2 + 1)[:, None]
-    k1 = np.arange(steps // 2 + 2)[:, None]
-    return (f + k1 * stride) @ C.T, (k2 * stride) @ C.T
-
-
 @dataclass(frozen=True)
 class Legs3dScene:
     """What the 3D walker's MJCF carries beyond the walker (:func:`legs3d_scene`).
@@ -387,7 +363,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order)
         q, v = bisector_keyframe(data.structure.roles, ideal.x)
         qpos, qvel = qpos + (q,), qvel + (v,)
-    lanes = legs3d_footfalls(f["points"], ideal.x, EXPORT_STEPS)
+    lanes = legs3d_lanes(scene, f["points"], ideal.x, EXPORT_STEPS)
     c, knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
                                                    data.slope_rad, options)

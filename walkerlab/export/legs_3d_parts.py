@@ -2,13 +2,16 @@
 walker's numbers by name, its body tree, the export roles of its bodies and joints (pelvis,
 legs, knees), each leg link's length and foot, the round feet's disc, the words of the
 files' headers.  Shared by :mod:`walkerlab.export.legs_3d_mjcf`,
-:mod:`walkerlab.export.urdf` and :mod:`walkerlab.export.adams_3d`.
+:mod:`walkerlab.export.urdf`, :mod:`walkerlab.export.adams_3d` and (through the MJCF's
+lanes) :mod:`walkerlab.export.opensim_3d`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.contact.footfalls import rigid_footfalls
+from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import num
 from walkerlab.export.tree_bodies import PelvisRoles
@@ -17,7 +20,8 @@ from walkerlab.walker.trees import legs_tree
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "bisector_keyframe", "hip_roll_law", "kneed",
-           "leg_links", "legs3d_numbers", "legs3d_roles", "legs_summary", "legs_words",
+           "leg_links", "legs3d_footfalls", "legs3d_lanes", "legs3d_numbers", "legs3d_roles",
+           "legs_summary", "legs_words",
            "round_feet", "walker_tree"]
 
 #: a round foot's disc: its half-thickness along the hip axis, as a fraction of the leg
@@ -132,3 +136,73 @@ def bisector_keyframe(roles, x) -> tuple[float, float]:
     swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
     return ((s[f"{swing}_angle"] + s["stance_angle"]) / 2,
             (s[f"{swing}_rate"] + s["stance_rate"]) / 2)
+
+
+def legs3d_footfalls(points, x, steps: int, walked=None) -> tuple[np.ndarray, np.ndarray]:
+    """The rigid gait's footfalls in MuJoCo's axes [m], leg1's and leg2's, from the
+    keyframe's (leg2 in stance at the origin, leg1 trailing): leg2 at ``k S``
+    (``k`` from 0 to ``steps // 2``), leg1 at ``f + k S`` (``k`` from 0 to
+    ``steps // 2 + 1``: the trailing foot, then its landings), ``f`` the trailing foot,
+    ``S = -2 (f - (f·z) z)``
+    the stride (the gait's two steps mirror each other about the fall line: their
+    advances add, their lateral offsets cancel).  With ``walked`` (a ground whose steps
+    differ: the steps do not mirror each other) leg2 at its even footfalls, leg1 at the
+    trailing foot ``f`` and its odd ones.
+
+    Parameters
+    ----------
+    points : callable ``x -> dict[str, ndarray (3,)]``
+        The rigid walker's generated ``points``: ``swing_foot`` (the trailing foot just
+        after the heel strike).
+    x : ndarray (6,), (8,) or (10,)
+        The keyframe's rigid state (role order) [rad, rad/s].
+    steps : int
+        Footfalls ahead of the keyframe (both legs'), ``EXPORT_STEPS``; even.
+    walked : ndarray (steps + 2, 3), optional
+        The rigid walk's footfalls from ``x`` in walkerlab's world axes [m], footfall 0
+        leg2's at the origin (:func:`walkerlab.analysis.contact.footfalls.rigid_footfalls`).
+
+    Returns
+    -------
+    leg1, leg2 : ndarray (steps // 2 + 2, 3), ndarray (steps // 2 + 1, 3)
+    """
+    C = np.array(TO_MUJOCO)
+    f = np.ravel(np.asarray(points(np.asarray(x, float))["swing_foot"], float))
+    if walked is not None:  # the steps differ: the rigid walk's own footfalls
+        w = np.asarray(walked, float)[:steps + 2]
+        return np.vstack([f, w[1::2]]) @ C.T, w[0::2] @ C.T
+    stride = -2.0 * np.array([f[0], f[1], 0.0])
+    k2 = np.arange(steps // 2 + 1)[:, None]
+    k1 = np.arange(steps // 2 + 2)[:, None]
+    return (f + k1 * stride) @ C.T, (k2 * stride) @ C.T
+
+
+def legs3d_lanes(scene, points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """The footfall lanes of ``scene``'s 3D walker at its rigid gait ``x``: leg1's and
+    leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`), on footholds of
+    several heights (the steps differ: a period-``p`` gait whose steps differ in length,
+    lean and lateral offset, the walker crabbing across the slope) the footfalls of its
+    rigid walk from ``x`` (:func:`walkerlab.analysis.contact.footfalls.rigid_footfalls`, the
+    contact model's patches' walk), each at its foothold's height; else the keyframe's
+    mirrored steps.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    points : callable ``x -> dict[str, ndarray (3,)]``
+        The rigid walker's generated ``points``.
+    x : ndarray (6,), (8,) or (10,)
+        The rigid gait's fixed point (post-impact, leg2 in stance; role order) [rad, rad/s].
+    steps : int
+        Footfalls ahead of the keyframe (both legs'); even.
+
+    Returns
+    -------
+    leg1, leg2 : ndarray (steps // 2 + 2, 3), ndarray (steps // 2 + 1, 3)
+
+    Raises
+    ------
+    ValueError
+        The rigid gait does not make its steps from ``x`` (one line).
+    """
+    return legs3d_footfalls(points, x, steps, rigid_footfalls(scene, x, None, steps + 2))

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.export.engine_walk import DEFAULT_STEPS
+from walkerlab.export.legs_3d_parts import kneed
 from walkerlab.export.mjcf_scene import MjcfOptions
 from walkerlab.export.multibody import SIDECAR  # noqa: F401 (part of this API)
 from walkerlab.export.writers import WRITERS, Exported, ExportJob, walk_file
@@ -124,8 +125,8 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         :data:`walkerlab.walker.capability_cells.URDF_GROUND`), or no rigid gait to start from; a
         spoked wheel to a format other than urdf or mjcf (naming walker.model); footholds
         of several heights where the capability table refuses them (the Adams dataset,
-        the OpenSim model: naming terrain.foothold_heights_m) and for any walker in 3D
-        (its footfall patches are a stride of mirrored steps); MJCF options for a format
+        the OpenSim model: naming terrain.foothold_heights_m) and for the kneed walker in
+        3D; MJCF options for a format
         other than mjcf or a spoked wheel; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
@@ -157,9 +158,9 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         kind.require("walk", writer.view, kind.field)
     if ground and len(drops) > 1:  # footholds of several heights: the table's cell
         kind.require("footholds", writer.view, "terrain.foothold_heights_m")
-        if not job.tree.in_plane:  # a 3D walker's patches: a stride of mirrored steps (the
-            # kneed walker's footholds cells hold on one height: its table's cell is not
-            # the straight legs' refusal)
+        if not job.tree.in_plane and kneed(data):  # the kneed walker in 3D: its footholds
+            # cells hold on one height (the straight legs' patches at their rigid walk's
+            # footfalls are measured: walkerlab.export.legs_3d_parts.legs3d_lanes)
             raise KindRefused(f"terrain.foothold_heights_m: {FOOTHOLDS_EXPORT_3D}")
     if ground and scene.terrain.kind in ("stairs", "profile"):  # the kind's cell of it
         kind.require(scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")

@@ -81,13 +81,16 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
               "turning that axis between steps, which the rigid state does not carry; "
               "stairs and footholds of several heights keep one fall line")
-#: why the 3D straight legs' MJCF and Adams dataset refuse footholds of several heights
-#: (:func:`walkerlab.export.legs_3d_mjcf.legs3d_footfalls`)
-FOOTHOLDS_EXPORT_3D = ("the 3D walker's MJCF, Adams dataset and OpenSim model lay its "
-                       "footfall patches a "
-                       "stride apart from the keyframe's trailing foot (its two steps mirror "
-                       "each other about the fall line); footholds of several heights make "
-                       "the steps differ: give footholds of one height for this view")
+#: why the 3D straight legs' OpenSim model and the kneed walker in 3D's exports refuse
+#: footholds of several heights (the straight legs' MJCF and Adams dataset take them:
+#: :func:`walkerlab.export.legs_3d_parts.legs3d_lanes`)
+FOOTHOLDS_EXPORT_3D = ("on footholds of several heights the 3D walker's steps differ in "
+                       "length, lean and lateral offset (it crabs across the slope): the "
+                       "exports lay its patches at its rigid walk's footfalls, measured in "
+                       "MuJoCo and the Adams dataset for the straight legs only; this view's "
+                       "walk on them is not measured (OpenSim is not installed where the "
+                       "layout was made; the kneed walker's knee latch on patches of "
+                       "alternating heights): give footholds of one height for this view")
 #: why the kneed walker in 3D's Adams dataset refuses stairs and footholds
 #: (:func:`walkerlab.export.adams_3d_knees.knee_3d_statements`' latch height)
 KNEED_3D_ADAMS_GROUND = ("the kneed 3D dataset's knee latch measures a foot's height from the "
@@ -387,11 +390,15 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # across it; the rigid model lands on them as the planar walkers do (the generated
         # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground), the
         # contact model, the MJCF and the Adams dataset lay their footfall patches at the
-        # rigid gait's footfalls (walkerlab.export.legs_3d_mjcf.legs3d_footfalls: the
-        # trailing foot's height included), the gym's rigid view steps them as simulate
+        # rigid gait's footfalls (walkerlab.export.legs_3d_parts.legs3d_footfalls: the
+        # trailing foot's height included; on footholds of several heights the footfalls
+        # of the rigid walk of one period, as the contact model's:
+        # walkerlab.export.legs_3d_parts.legs3d_lanes), the gym's rigid view steps them as
+        # simulate; the OpenSim model lays the MJCF's patches, its walk on footholds of
+        # several heights not measured
         **{(g, v): None for g in ("stairs", "footholds")
            for v in ("rigid", "contact", "mjcf", "adams", "gym", "osim")},
-        **{("footholds", v): FOOTHOLDS_EXPORT_3D for v in ("mjcf", "adams", "osim")},
+        ("footholds", "osim"): FOOTHOLDS_EXPORT_3D,
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints
@@ -457,7 +464,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stairs and footholds (of one height) in the contact model and the MJCF: the
         # stabilised walker (configs/kneed_3d_stabilised_stairs.yaml,
         # configs/kneed_3d_stabilised_footholds.yaml) on the 3D straight legs' footfall
-        # patches (walkerlab.export.legs_3d_mjcf.legs3d_footfalls), its knee latch measured
+        # patches (walkerlab.export.legs_3d_parts.legs3d_footfalls), its knee latch measured
         # from the nearest patch's top (walkerlab.models.contact.assembly.latch_ground,
         # walkerlab.export.mjcf_ground.lane_tops)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "gym")},

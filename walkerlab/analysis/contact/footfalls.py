@@ -9,7 +9,10 @@ rigid gait from its fixed point and measures each step's advance along the slope
 contact view's own geometry (:func:`walkerlab.models.contact.scene.ideal_step_length`: the
 chord between the feet's reference points at heel strike along the slope, plus an arc
 foot's roll), so footfall ``k`` lies at ``l_0 + ... + l_{k-1}``
-(:func:`walkerlab.models.contact.terrain.footfall_positions`).
+(:func:`walkerlab.models.contact.terrain.footfall_positions`).  The same walk gives the
+footfalls as points (:func:`rigid_footfalls`: the rigid model's own stance feet, their
+lateral offsets and heights too), where a 3D walker's exports lay their patches (its steps
+on footholds of several heights differ across the slope as well: it crabs).
 
 The contact walker's steps differ from the rigid ones (the paper walker's are ~9 mm
 shorter), so its footfalls drift off these patches; footholds are where the feet land (each
@@ -22,12 +25,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.rigid import simulate_steps, walker_of_step
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ideal_step_length
-from walkerlab.models.contact.terrain import ground_drops
+from walkerlab.models.contact.terrain import footfall_positions, ground_drops
+from walkerlab.walker.plant import Plant
 
-__all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_step_lengths"]
+__all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_footfalls", "rigid_step_lengths"]
 
 
 def rigid_step_lengths(scene, walker, x_ideal, plant) -> tuple[float, ...] | None:
@@ -61,11 +65,69 @@ def rigid_step_lengths(scene, walker, x_ideal, plant) -> tuple[float, ...] | Non
     ValueError
         The rigid gait does not make its steps from ``x_ideal`` (a fall: one line).
     """
+    period = _rigid_period(scene, x_ideal, plant)
+    if period is None:
+        return None
+    return tuple(float(ideal_step_length(walker, sg.x_next, along_slope=True))
+                 for sg in period[1])
+
+
+def rigid_footfalls(scene, x_ideal, plant, n_footfalls: int) -> np.ndarray | None:
+    """The rigid gait's footfalls on a ground whose steps differ, as points in the rigid
+    model's world axes [m] (walkerlab's: x downhill along the horizontal, y up, z across;
+    footfall 0 the stance foot of ``x_ideal`` at the origin), from the walk of one period
+    from its fixed point (each step's landing: the stance foot's world place the rigid walk
+    carries, :func:`walkerlab.integrate.rigid.simulate_steps`), the period repeated
+    (:func:`walkerlab.models.contact.terrain.footfall_positions`); None on a ground whose
+    every step is alike.  The footfalls :func:`rigid_step_lengths` measures along the slope
+    for the contact model, with their lateral offsets and heights: a 3D walker's steps on
+    footholds of several heights differ across the slope too (its lean differs step by
+    step: the walker crabs), which a 3D export's patches must follow.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        Its rigid walker and ``solver`` section.
+    x_ideal : ndarray (2n,)
+        The rigid gait's fixed point (post-impact state before step 0 of the cycle, role
+        order) [rad, rad/s].
+    plant : walkerlab.walker.plant.Plant or None
+        The scene's walker described once (None: described here).
+    n_footfalls : int
+        Footfalls wanted (footfall 0 included).
+
+    Returns
+    -------
+    ndarray (n_footfalls, d) or None
+        Footfall ``k`` (``d`` 3 in 3D, 2 in the plane) [m]: footfall ``k`` is the landing of
+        step ``k - 1``, the legs alternating (footfall 0 the stance leg's of ``x_ideal``).
+
+    Raises
+    ------
+    ValueError
+        The rigid gait does not make its steps from ``x_ideal`` (a fall: one line).
+    """
+    period = _rigid_period(scene, x_ideal, plant)
+    if period is None:
+        return None
+    rigid, segs = period
+    last = segs[-1]  # the period's last landing, as the walk carries its stance foot
+    end = last.stance_foot_world + np.ravel(walker_of_step(rigid, last.index, last.stance_leg)
+                                            .points(last.x_end)["swing_foot"])
+    falls = np.array([sg.stance_foot_world for sg in segs] + [end], float)
+    return footfall_positions(np.diff(falls, axis=0), n_footfalls)
+
+
+def _rigid_period(scene, x_ideal, plant) -> tuple | None:
+    """``(walker, segments)``: the scene's rigid walker (on its footholds' cycle of per-step
+    landings) and the segments of one period of its gait walked from ``x_ideal``
+    (:func:`walkerlab.integrate.rigid.simulate_steps`); None on a ground whose every step is
+    alike; a walk that does not make its steps: one line (ValueError)."""
     from walkerlab.models.registry import build_walker
 
     if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:
         return None
-    rigid = build_walker(plant.with_(scene))
+    rigid = build_walker(plant.with_(scene) if plant is not None else Plant.from_scene(scene))
     m = len(rigid.cycle) if rigid.cycle is not None else 1
     traj = simulate_steps(rigid, np.asarray(x_ideal, float), m,
                           Solver.from_settings(scene.solver))
@@ -74,7 +136,7 @@ def rigid_step_lengths(scene, walker, x_ideal, plant) -> tuple[float, ...] | Non
         raise ValueError(f"scene '{scene.name}': fixedpoint: the rigid gait on "
                          "terrain.foothold_heights_m does not make its steps from its fixed "
                          "point (its footfalls lay the contact model's patches)")
-    return tuple(float(ideal_step_length(walker, sg.x_next, along_slope=True)) for sg in segs)
+    return rigid, segs
 
 
 #: relays of the patches at the contact walker's own footfalls a run on footholds may take

@@ -173,10 +173,13 @@ def ground_drops(terrain) -> tuple[float, ...]:
 def footfall_positions(step_lengths_m, n_footfalls: int) -> np.ndarray:
     """Along-slope positions [m] (n_footfalls,) of the footfalls of a gait whose steps
     advance ``step_lengths_m`` (p,) in turn: footfall 0 at 0, footfall ``k`` at
-    ``sum_{j<k} l_j`` (``l_j = step_lengths_m[j mod p]``)."""
-    ell = np.asarray(step_lengths_m, float).ravel()
-    steps = ell[np.arange(max(int(n_footfalls) - 1, 0)) % ell.size]
-    return np.concatenate([[0.0], np.cumsum(steps)])
+    ``sum_{j<k} l_j`` (``l_j = step_lengths_m[j mod p]``).  Steps given as vectors
+    ``(p, d)`` [m] (a 3D walker's advance, its lateral offset and its drop): the footfalls
+    as points ``(n_footfalls, d)``, footfall 0 at the origin."""
+    ell = np.asarray(step_lengths_m, float)
+    ell = ell.ravel() if ell.ndim < 2 else ell
+    steps = ell[np.arange(max(int(n_footfalls) - 1, 0)) % len(ell)]
+    return np.concatenate([np.zeros((1, *ell.shape[1:])), np.cumsum(steps, axis=0)])
 
 
 def footfall_heights(drops_m, n_footfalls: int, phi: float) -> np.ndarray:
