@@ -22,7 +22,6 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.export.engine_walk import DEFAULT_STEPS
-from walkerlab.export.legs_3d_parts import kneed
 from walkerlab.export.mjcf_scene import MjcfOptions
 from walkerlab.export.multibody import SIDECAR  # noqa: F401 (part of this API)
 from walkerlab.export.writers import WRITERS, Exported, ExportJob, walk_file
@@ -34,8 +33,6 @@ from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.stage_files import CONTACT_SIM
 from walkerlab.models.contact.terrain import ground_drops
 from walkerlab.stages.pipeline import fresh_fixedpoint, stage_module
-from walkerlab.walker.capability_cells import FOOTHOLDS_EXPORT_3D
-from walkerlab.walker.kinds import KindRefused
 from walkerlab.walker.plant import Plant
 
 
@@ -125,8 +122,7 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         :data:`walkerlab.walker.capability_cells.URDF_GROUND`), or no rigid gait to start from; a
         spoked wheel to a format other than urdf or mjcf (naming walker.model); footholds
         of several heights where the capability table refuses them (the Adams dataset,
-        the OpenSim model: naming terrain.foothold_heights_m) and for the kneed walker in
-        3D; MJCF options for a format
+        the OpenSim model: naming terrain.foothold_heights_m); MJCF options for a format
         other than mjcf or a spoked wheel; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
@@ -158,10 +154,6 @@ def write(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         kind.require("walk", writer.view, kind.field)
     if ground and len(drops) > 1:  # footholds of several heights: the table's cell
         kind.require("footholds", writer.view, "terrain.foothold_heights_m")
-        if not job.tree.in_plane and kneed(data):  # the kneed walker in 3D: its footholds
-            # cells hold on one height (the straight legs' patches at their rigid walk's
-            # footfalls are measured: walkerlab.export.legs_3d_parts.legs3d_lanes)
-            raise KindRefused(f"terrain.foothold_heights_m: {FOOTHOLDS_EXPORT_3D}")
     if ground and scene.terrain.kind in ("stairs", "profile"):  # the kind's cell of it
         kind.require(scene.terrain.kind, writer.view, f"terrain.kind: {scene.terrain.kind}")
     if mjcf is not None and mjcf != MjcfOptions() and (fmt != "mjcf" or job.tree.one_body):
