@@ -191,6 +191,24 @@ def test_the_kneed_walker_on_round_feet_in_3d_walks_the_planar_kneed_gait_on_arc
     assert np.max(np.abs(s.multipliers_variational)) > 6.0   # the unstable lean
 
 
+@pytest.mark.slow   # ~1 min: the round-feet gait's MJCF walked in MuJoCo
+def test_the_kneed_walker_on_round_feet_walks_in_mujoco_at_the_rigid_step_period(tmp_path):
+    """configs/kneed_round_feet_3d.yaml's MJCF (each shank's disc a MuJoCo cylinder, the
+    knee latch stiffer under discs: walkerlab.export.legs_3d_mjcf.DISC_LATCH_SOLREF, no patch
+    under the trailing disc at the keyframe) walked by MuJoCo: >= 10 alternating heel
+    strikes without falling, the mean step period within 3 % of the rigid gait's (measured
+    11 strikes, -0.11 %; with MuJoCo's default latch the stance knee buckles and the walker
+    falls before its first heel strike)."""
+    pytest.importorskip("mujoco")
+    from walkerlab.stages import export as export_stage
+
+    scene = Scene.model_validate(_raw("kneed_round_feet_3d.yaml"))
+    check = export_stage.write(scene, tmp_path, "mjcf", walk=True).walk
+    assert check.walked and not check.fell and check.alternating, check.line
+    assert check.strikes >= 10, check.line
+    assert check.period_s == pytest.approx(check.rigid_period_s, rel=0.03), check.line
+
+
 @pytest.fixture(scope="module")
 def kneed_3d():
     """configs/kneed_3d.yaml's walker (0.1 m hip width) and its scene."""

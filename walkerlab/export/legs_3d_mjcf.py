@@ -95,7 +95,15 @@ at contact), and the keyframe is the rigid state as it is (the rigid discs are M
 no shift).  The footfall patches are centred on the rigid gait's reference points (the
 contact with the leg normal to the slope), the contact rolling ``-R (theta + gamma)``
 along the fall line from them.  A leg's rod inertia (``walker.leg_inertia_kg_m2``) is the
-tree's, as every body's.
+tree's, as every body's.  Discs on the shanks of locking knees
+(configs/kneed_round_feet_3d.yaml) change two things: the knee latches' equalities are
+stiffer (:data:`DISC_LATCH_SOLREF`: the disc's reaction bends the latched stance knee),
+and the trailing disc has no
+patch at the keyframe (the rigid heel strike leaves it just off the ground; MuJoCo's convex
+collider, which has no analytic cylinder-box pair, finds a contact there at the round-off
+distance, -1e-11 m, with its normal tilted against the slope's, and pushes the trailing disc
+with 13 kN for a timestep: its knee flexes six times faster than the rigid swing knee and
+the walker falls before its first heel strike; measured).
 """
 
 from __future__ import annotations
@@ -137,8 +145,8 @@ from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
-__all__ = ["DISC_CCD_TOLERANCE_L", "TORSION_FRACTION", "Legs3dScene", "legs3d_footfalls",
-           "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad",
+__all__ = ["DISC_CCD_TOLERANCE_L", "DISC_LATCH_SOLREF", "TORSION_FRACTION", "Legs3dScene",
+           "legs3d_footfalls", "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad",
            "pelvis_rod_inertia"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
@@ -158,6 +166,15 @@ PATCH_ACROSS_PUSHED_L = 0.30
 #: 11 % late and the walker falls at its second step; at 1e-10 L it walks 24 heel strikes
 #: (60 s) at the rigid step period to 0.01 % (measured in MuJoCo)
 DISC_CCD_TOLERANCE_L = 1e-10
+#: ... and the knee latches' ``solref`` (time constant [s], damping ratio) under discs on
+#: locking knees: a disc's reaction acts ``R sin(pitch)`` off the shank's axis, a moment on
+#: the latched stance knee that MuJoCo's default equality (0.02 s: in acceleration, about
+#: 5 N m/rad on configs/kneed_round_feet_3d.yaml's light shank) yields to past the latch's
+#: capture angle within 40 ms (the stance knee buckles); at 1 ms the walker makes 14 heel
+#: strikes in 8 s at -0.46 % of the rigid step period (2 ms: +1.3 %, 5 ms: +1.2 %), at the
+#: contact's own 0.1 ms the latch jerks the shank as it switches on at a landing and the
+#: walker falls at its second step (measured)
+DISC_LATCH_SOLREF = (0.001, 1.0)
 
 
 def _rotation(axis, angle: float) -> np.ndarray:
@@ -364,6 +381,8 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         q, v = bisector_keyframe(data.structure.roles, ideal.x)
         qpos, qvel = qpos + (q,), qvel + (v,)
     lanes = legs3d_lanes(scene, f["points"], ideal.x, EXPORT_STEPS)
+    if kneed(data) and round_feet(data):  # no patch under the trailing disc (module docstring)
+        lanes = (lanes[0][1:], lanes[1])
     c, knee = contact_si(scene.contact or ContactSettings())
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
                                                    data.slope_rad, options)
@@ -537,7 +556,8 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     texts, left_out = (), tuple(mjcf_actuation_omissions(act))
     if extra is not None and extra.latch is not None:  # the planar kneed MJCF's latch
         equality += latch_equality_lines([j.name for b in root.walk() for j in b.joints
-                                          if j.name.endswith("_knee")])
+                                          if j.name.endswith("_knee")],
+                                         DISC_LATCH_SOLREF if disc else None)
         numerics += (("latch_release_height_m", extra.latch[0]),
                      ("latch_capture_rad", extra.latch[1]))
         left_out = (MJCF_KNEE_LATCH,) + left_out

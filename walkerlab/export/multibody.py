@@ -311,14 +311,16 @@ def _equality(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     return out
 
 
-def latch_equality_lines(knees) -> list[str]:
+def latch_equality_lines(knees, solref: tuple | None = None) -> list[str]:
     """The knee latches as MJCF joint equalities ``leg<i>_latch`` holding each knee of
     ``knees`` (joint names ``leg<i>_knee``) at 0, leg2's active (the gait keyframe starts
     with leg2 in stance), switched by a stepping loop
     (:func:`walkerlab.export.mujoco_walk.latch_rule`); the planar and the 3D kneed walkers'
-    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`)."""
+    (:func:`walkerlab.export.legs_3d_mjcf.legs3d_mjcf`).  ``solref`` (time constant [s],
+    damping ratio): the equalities' own (None: MuJoCo's default, 0.02 s)."""
+    ref = "" if solref is None else f' solref="{" ".join(repr(float(v)) for v in solref)}"'
     return [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
-            f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>' for k in knees]
+            f'polycoef="0 1 0 0 0"{ref} active="{str("leg2" in k).lower()}"/>' for k in knees]
 
 
 def _custom(mb: Multibody, extra: MjcfScene | None) -> tuple[tuple, tuple]:
