@@ -129,6 +129,8 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         if "patch_width_m" in (d.get("terrain") or {}) and feature == "stairs":
             terrain.pop("lanes")
             terrain.update(lanes="checkerboard", patch_width_m=d["terrain"]["patch_width_m"])
+        elif feature == "stairs" and w.get("space") == "3d" and "spokes" not in w:  # legs:
+            terrain.pop("lanes")  # the swing foot passes through the ground: footfall patches
         d["terrain"] = terrain
         if feature == "stairs":
             d["slope"] = {"angle_rad": 0.0}
