@@ -320,7 +320,7 @@ KINDS = {k.name: k for k in (
          scene="configs/rimless_wheel.yaml"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
          "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", in_3d=True, spoked=True,
-         rigid=P.RIGID_SPOKES, landing=None, reaction=P.REACTION_HUB,
+         rigid=P.RIGID_SPOKES, reaction=P.REACTION_HUB,
          contact=P.CONTACT_WHEEL_3D, scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", in_3d=True, rigid=P.RIGID_STRAIGHT_LEGS_3D,
