@@ -504,7 +504,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # across it; the next spoke's tip lands as the planar wheel's (its generated
         # clearance along the slope's normal plus the landing's depth, the section's
         # trailing tip by the spin's mirror: walkerlab.models.hybrid.ground)
-        **{(g, "rigid"): None for g in ("stairs", "footholds")},
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "mjcf")},
         ("profile", "*"): PROFILE_WHEEL_3D,
         # the MJCF, the URDF and the Adams dataset: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text,
