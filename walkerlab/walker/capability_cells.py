@@ -81,6 +81,9 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
               "turning that axis between steps, which the rigid state does not carry; "
               "stairs and footholds of several heights keep one fall line")
+#: why the spoked wheels' contact model refuses footholds (planar and 3D)
+WHEEL_FOOTHOLDS_CONTACT = ("a rimless wheel's contact model runs on continuous ground (its "
+                           "spokes have no lanes of their own)")
 #: why the 3D spoked wheel refuses a height profile
 PROFILE_WHEEL_3D = ("the 3D wheel's heading and lean are angles about its ground's normal "
                     "and fall line through the stance spoke's tip: a profile's slope changes "
@@ -351,8 +354,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): _WHEEL_GYM,
         # footholds have no ground between them; the wheel's contact model needs it
-        ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
-                                   "ground (its spokes have no lanes of their own)"),
+        ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
         **_URDF_GROUNDS,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
@@ -505,6 +507,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # clearance along the slope's normal plus the landing's depth, the section's
         # trailing tip by the spin's mirror: walkerlab.models.hybrid.ground)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "mjcf")},
+        ("stairs", "contact"): None,
+        ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
         ("profile", "*"): PROFILE_WHEEL_3D,
         # the MJCF, the URDF and the Adams dataset: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text,
