@@ -501,15 +501,23 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_WHEEL_JOINTS,
         # the compliant-contact model: a free body on its spoke tips
         # (walkerlab.codegen.floating_3d.derive_wheel_3d)
-        **_CELLS_3D,
-        # stairs and footholds in the rigid model: a height along the fall line, level
-        # across it; the next spoke's tip lands as the planar wheel's (its generated
-        # clearance along the slope's normal plus the landing's depth, the section's
-        # trailing tip by the spin's mirror: walkerlab.models.hybrid.ground)
+        # stairs and footholds (a height along the fall line, level across it) in the rigid
+        # model: the next spoke's tip lands as the planar wheel's (its generated clearance
+        # along the slope's normal plus the landing's depth, the section's trailing tip by
+        # the spin's mirror: walkerlab.models.hybrid.ground); the MJCF lays the planar
+        # wheel's treads and footfall patches (walkerlab.export.mjcf_ground.wheel_ground,
+        # wider: walkerlab.export.spoked.WHEEL_3D_GROUND_HALF_WIDTH); the contact model its
+        # treads and risers as a polyline, level across the fall line
+        # (walkerlab.models.contact.assembly.point3), on continuous ground as the planar
+        # wheel's; the Adams dataset a box per tread (walkerlab.export.adams_wheel)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "mjcf")},
         ("stairs", "contact"): None,
         ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
+        ("stairs", "adams"): None,
+        ("footholds", "adams"): WHEEL_ADAMS_FOOTHOLDS,
+        **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_WHEEL_3D,
+        ("profile", "urdf"): URDF_GROUND,
         # the MJCF, the URDF and the Adams dataset: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text,
         # walkerlab.export.adams_wheel.adm_wheel_text)
