@@ -52,7 +52,10 @@ walker's :class:`Kind`:
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
     rigid model, the compliant-contact model (a free body on its spoke tips), the MJCF (a
-    free body: it rolls in MuJoCo) and the URDF, so far; the other views' cells say so.
+    free body: it rolls in MuJoCo), the URDF and the Adams dataset; stairs and footholds (a
+    height along the fall line, level across it) in the rigid model and the MJCF, stairs in
+    the contact model and the Adams dataset, landing as the planar wheel's
+    (:mod:`walkerlab.models.hybrid.ground`); the other views' cells say why not.
 
 The layers ask the kind (:func:`kind_of`, once), never the switches, and never its name:
 the kind holds its parts as objects (:mod:`walkerlab.walker.parts`: :attr:`Kind.rigid`,

@@ -29,6 +29,26 @@ direction, ``n`` up.  The walker's rolls are about that fall line, so a ground w
 changes from step to step (footholds of their own slopes, a profile) is refused
 (:data:`walkerlab.walker.capability_cells.PROFILE_3D`).
 
+The spoked wheel in 3D (Coleman, Chatterjee & Ruina 1997, "Motions of a rimless spoked
+wheel: a simple three-dimensional system with impacts", Dynamics and Stability of Systems
+12(3); :func:`walkerlab.codegen.derive_3d.derive_spoked`) lands the same way: its generated
+``swing_clearance`` is the next spoke's tip's height ``n . r_next`` along the slope's normal
+above the plane through the stance tip, whatever its heading ``psi`` and lean ``phi`` (a tip
+at ``w`` in the wheel's plane from the stance tip stands ``cos(phi) (w_x sin(beta) + w_y
+cos(beta))`` above it, ``beta`` the spin from the normal), so a leaned or turned wheel's
+landing is that tip reaching ``-drop_m cos(gamma)`` along the normal, the ground a height
+along the fall line and level across it.  Its section's old stance tip is the spoke behind,
+``drop_m cos(gamma)`` above: the next tip's clearance at the spin mirrored about the normal
+(``beta -> -beta``, heading and lean kept: :class:`_Mirrored`).  A zero landing is the
+slope's walker itself (the plane's gait bit for bit); the upright wheel rolling down the
+fall line is the planar wheel (its heading and lean rates stay 0), so on stairs too its
+gait is the planar wheel's on them.  On level treads (``gamma = 0``) the landing reads the
+riser alone: the section's stance spoke leans back by ``asin(riser / (2 L sin alpha))``,
+the slope on which the spokes' chord drops a riser - the stairs' mean slope ``atan(riser /
+tread)`` when the tread is the chord's run, where the stairs' gait is that slope's.  A
+profile is refused (:data:`walkerlab.walker.capability_cells.PROFILE_WHEEL_3D`: the heading
+and lean turn about the plane's normal and fall line).
+
 Poincaré section: the state just after heel strike, where the new swing foot (the old stance
 foot) lies ``drop_m`` above the new stance foot's line: ``swing_clearance(x+) = drop_m
 cos(gamma)`` (both feet on their treads: for point feet exactly, for arc feet their lowest
