@@ -537,6 +537,7 @@ def test_the_shipped_disc_wheel_down_stairs_rolls_stably(tmp_path):
     code, err, out = run_cli("fixedpoint", scene, "--runs-dir", tmp_path)
     assert code == 0, err
     assert "verdict: STABLE" in out and "step period     0.3962678048 s" in out
+    assert "stays ahead of the riser edge" in out and "SCUFF" not in out
     code, err, out = run_cli("simulate", scene, "--runs-dir", tmp_path)
     assert code == 0, err
     assert "20 heel strikes" in out and "mean step period  0.3962678 s" in out
