@@ -270,7 +270,8 @@ def test_the_stairs_cases_are_their_slopes_step_as_a_stair():
 #: (kind, feature) -> the walking case's rigid step period [s] as its comment states
 WALKING_PERIODS = {("locking_knees", "stairs"): 0.5461442,
                    ("locking_knees", "hip_torque"): 0.5394385,
-                   ("rolling_polygon", "stairs"): 1.0333695}
+                   ("rolling_polygon", "stairs"): 1.0333695,
+                   ("rolling_polygon_3d", "footholds"): 0.3962190}
 
 
 @pytest.mark.slow

@@ -398,3 +398,158 @@ def test_the_planar_wheel_closed_form_gait_is_a_fixed_point():
         xi = wi.closed_form_gait()
         xn, _, _ = poincare_map(wi, xi, Solver(method="DOP853", rtol=1e-12, atol=1e-12))
         np.testing.assert_allclose(xn, xi, atol=1e-10)
+
+
+# ---- the 3D wheel down stairs and on footholds (the rigid model's landing) -------------
+
+DISC_STAIRS = ROOT / "configs" / "rimless_wheel_3d_disc_stairs.yaml"
+#: the disc wheel's slope (configs/rimless_wheel_3d_disc.yaml) and its spokes' chord: its
+#: drop and run, the riser and tread on which the spoke tips land as on that slope
+DISC_SLOPE = 0.2
+CHORD_DROP, CHORD_RUN = (2 * L * math.sin(ALPHA) * math.sin(DISC_SLOPE),
+                         2 * L * math.sin(ALPHA) * math.cos(DISC_SLOPE))
+SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+
+
+def _raw(path, **changes):
+    """The scene mapping of ``path`` with the dotted ``changes`` set."""
+    import yaml
+
+    raw = yaml.safe_load(Path(path).read_text())
+    for key, value in changes.items():
+        *head, last = key.split(".")
+        d = raw
+        for k in head:
+            d = d.setdefault(k, {})
+        d[last] = value
+    return raw
+
+
+def _built(raw):
+    from walkerlab.config.schema import Scene
+
+    plant = Plant.from_scene(Scene.model_validate(raw))
+    return plant, build_walker(plant)
+
+
+def _planar(raw):
+    """The planar wheel of the 3D scene mapping ``raw`` (its axle inertia, no diameters')."""
+    import copy
+
+    raw = copy.deepcopy(raw)
+    raw["walker"]["space"] = "2d"
+    raw["walker"].pop("diametral_inertia_kg_m2")
+    raw["contact"].pop("torsional_friction_m", None)
+    return raw
+
+
+@pytest.mark.parametrize("riser_m, tread_m", [(CHORD_DROP, CHORD_RUN), (0.152, 0.75),
+                                              (0.1, 0.75)], ids=["chord", "shipped", "0.1"])
+def test_the_upright_3d_wheel_down_stairs_is_the_planar_wheel_down_them(riser_m, tread_m):
+    """Upright and rolling straight down the stairs' fall line, the 3D disc wheel's gait is
+    the planar wheel's (its axle inertia) on the same stairs: a different generated model
+    (one coordinate, a hinge) landing by the same shared code (walkerlab.models.hybrid.
+    ground).  Both searched to 1e-12: fixed point and step period to 1e-9.  On stairs whose
+    riser and tread are the spokes' chord's drop and run on the 0.2 rad slope, the gait is
+    that slope's (the tips land on its plane: the stairs' mean slope), to 1e-9 too."""
+    raw = _raw(DISC_STAIRS, **{"terrain.riser_m": riser_m, "terrain.tread_m": tread_m})
+    _p, wheel = _built(raw)
+    _p, planar = _built(_planar(raw))
+    g3 = find_fixed_point(wheel, np.array([0, 0, ALPHA - DISC_SLOPE, 0, 0, -1.9]), SOLVER,
+                          fd_check=False)
+    g2 = find_fixed_point(planar, np.array([ALPHA - DISC_SLOPE, -1.9]), SOLVER,
+                          fd_check=False)
+    assert g3.residual < 1e-11 and g2.residual < 1e-11
+    assert np.max(np.abs(g3.x[[0, 1, 3, 4]])) < 1e-12  # upright, straight down
+    assert abs(g3.x[2] - g2.x[0]) < 1e-9 and abs(g3.x[5] - g2.x[1]) < 1e-9
+    assert abs(g3.period_s - g2.period_s) < 1e-9
+    # the section's stance spoke leans back by the slope on which the chord drops the
+    # riser, asin(riser / (2 L sin alpha)): the stairs' mean slope atan(riser / tread)
+    # when the tread is the chord's run (the rigid landing reads the riser only)
+    assert abs(g3.x[2] - (ALPHA - math.asin(riser_m / (2 * L * math.sin(ALPHA))))) < 1e-12
+    if riser_m == CHORD_DROP:
+        _p, plane = _built(_raw(ROOT / "configs" / "rimless_wheel_3d_disc.yaml"))
+        gp = find_fixed_point(plane, np.array([0, 0, ALPHA - DISC_SLOPE, 0, 0, -1.9]),
+                              SOLVER, fd_check=False)
+        assert np.max(np.abs(g3.x - gp.x)) < 1e-9 and abs(g3.period_s - gp.period_s) < 1e-9
+
+
+def test_a_zero_landing_gives_the_plane_slopes_gait_exactly():
+    """Footholds of height 0 on the disc wheel's 0.2 rad slope: the slope's walker itself
+    (landing_drop 0: no guard changed), so its gait is the plane's bit for bit; and the
+    landing's own guard at depth 0 (the generated clearance, the section's trailing tip
+    solved by Newton on the spin's mirror: walkerlab.models.hybrid.ground.
+    with_clearance_guard) gives the plane's section state, map and gait to 1e-12."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.models.hybrid.ground import with_clearance_guard
+
+    disc = ROOT / "configs" / "rimless_wheel_3d_disc.yaml"
+    plant, plane = _built(_raw(disc))
+    _p, zero = _built(_raw(disc, terrain={"kind": "footholds", "foothold_heights_m": [0.0],
+                                          "lanes": "continuous"}))
+    guess = np.array([0, 0, ALPHA - DISC_SLOPE, 0, 0, -1.9])
+    gp = find_fixed_point(plane, guess, SOLVER, fd_check=False)
+    gz = find_fixed_point(zero, guess, SOLVER, fd_check=False)
+    assert np.array_equal(gp.x, gz.x) and gp.period_s == gz.period_s
+    clear = with_clearance_guard(plane, plant.data)
+    # a leaned, turned, wobbling state's section: the trailing tip found on the slope
+    for x0 in (gp.x, np.array([0.1, -0.05, 0.2, 0.3, -0.2, -1.8])):
+        z = plane.section(x0)
+        xa, xb = plane.from_section(z), clear.from_section(z)
+        assert np.max(np.abs(xa - xb)) < 1e-12
+        pa, ta = poincare_map(plane, xa, SOLVER)[:2]
+        pb, tb = poincare_map(clear, xb, SOLVER)[:2]
+        assert np.max(np.abs(pa - pb)) < 1e-12 and abs(ta - tb) < 1e-12
+    gc = find_fixed_point(clear, guess, SOLVER, fd_check=False)
+    assert np.max(np.abs(gc.x - gp.x)) < 1e-12 and abs(gc.period_s - gp.period_s) < 1e-12
+
+
+def test_a_leaned_turned_wheels_landing_is_measured_along_the_normal_at_the_tips():
+    """The landing's section for a leaned, heading-turned wheel: its trailing spoke's tip
+    (the generated trailing_foot point, not the mirrored clearance the section solves) lies
+    ``drop cos(gamma)`` above the plane through the stance tip, along the slope's normal;
+    and the step from it ends with the next tip that far below that plane (on footholds
+    2 cm below the 0.2 rad slope)."""
+    from walkerlab.integrate.rigid import integrate_step
+
+    disc = ROOT / "configs" / "rimless_wheel_3d_disc.yaml"
+    _p, w = _built(_raw(disc, terrain={"kind": "footholds", "foothold_heights_m": [-0.02],
+                                       "lanes": "continuous"}))
+    nrm = np.array([math.sin(DISC_SLOPE), math.cos(DISC_SLOPE), 0.0])
+    level = 0.02 * math.cos(DISC_SLOPE)
+    x = w.from_section(np.array([0.3, 0.1, 0.05, -0.1, -1.9]))
+    assert abs(x[1] - 0.1) < 1e-15 and abs(x[0] - 0.3) < 1e-15
+    trailing = np.asarray(w.points(x)["trailing_foot"], float).reshape(-1)
+    assert abs(trailing @ nrm - level) < 1e-13
+    seg = integrate_step(w, x, SOLVER)
+    assert seg.termination == "heel_strike"
+    nxt = np.asarray(w.points(seg.x_end)["swing_foot"], float).reshape(-1)
+    assert abs(nxt @ nrm + level) < 1e-10
+
+
+def test_the_shipped_disc_wheel_down_stairs_rolls_stably(tmp_path):
+    """configs/rimless_wheel_3d_disc_stairs.yaml through the CLI: its gait (the numbers in
+    the scene's header) stable besides the neutral heading, and simulate's 20 spoke
+    strikes at that period."""
+    from tests.cli_run import run_cli
+
+    scene = str(DISC_STAIRS)
+    code, err, out = run_cli("fixedpoint", scene, "--runs-dir", tmp_path)
+    assert code == 0, err
+    assert "verdict: STABLE" in out and "step period     0.3962678048 s" in out
+    assert "stays ahead of the riser edge" in out and "SCUFF" not in out
+    code, err, out = run_cli("simulate", scene, "--runs-dir", tmp_path)
+    assert code == 0, err
+    assert "20 heel strikes" in out and "mean step period  0.3962678 s" in out
+
+
+@pytest.mark.slow  # ~25 s: a contact run and a MuJoCo roll of 11 spoke strikes
+@pytest.mark.parametrize("view", ["contact", "mjcf"])
+def test_the_disc_wheel_rolls_down_stairs_in_contact_and_in_mujoco(view, tmp_path):
+    """configs/rimless_wheel_3d_disc_stairs.yaml in the contact model (its treads and risers
+    a polyline, level across the fall line) and in MuJoCo (the treads as boxes): >= 10
+    spoke strikes at the rigid step period within 3 % (measured -0.03 % and -0.36 %)."""
+    from walkerlab.api.capabilities import measure
+
+    m = measure("rolling_polygon_3d", "stairs", view, tmp_path)
+    assert m.ok and abs(m.value) < 0.03, m.detail

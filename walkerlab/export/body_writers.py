@@ -34,6 +34,7 @@ from walkerlab.export.multibody import (
 from walkerlab.export.scene import check_exportable, mjcf_scene
 from walkerlab.export.scene_feet import scene_feet
 from walkerlab.export.spoked import (
+    WHEEL_3D_GROUND_HALF_WIDTH,
     WHEEL_TIP_FRACTION,
     WHEEL_URDF_OMISSIONS,
     wheel3d_keyframe,
@@ -249,7 +250,11 @@ class MjcfWriter(TreeWriter):
     def wheel_3d(self, job: ExportJob, w: Writer) -> Written:
         """The 3D wheel's free body (:func:`walkerlab.export.spoked.wheel3d_mjcf_text`),
         the rigid gait as its ``gait`` keyframe (:func:`~walkerlab.export.spoked.
-        wheel3d_keyframe`), the scene's static friction coefficient on the spoke tips."""
+        wheel3d_keyframe`), the scene's static friction coefficient on the spoke tips, a
+        ground other than the slope as the planar wheel's
+        (:func:`walkerlab.export.mjcf_ground.wheel_ground`: stairs a box per tread,
+        footholds a patch per footfall of the upright wheel down the fall line),
+        :data:`WHEEL_3D_GROUND_HALF_WIDTH` spokes across it each side."""
 
         data = job.data
         job.kind.require("walk", w.view, "walker.space: 3d")
@@ -261,10 +266,16 @@ class MjcfWriter(TreeWriter):
         f = functions(data)
         r = WHEEL_TIP_FRACTION * data.leg_length_m
 
+        t = job.scene.terrain
+        ground = None if t is None or t.is_slope else wheel_ground(
+            t, data.leg_length_m, chord_m=wheel_chord_m(data), slope_rad=data.slope_rad,
+            half_width_m=WHEEL_3D_GROUND_HALF_WIDTH * data.leg_length_m)
+
         def build(ideal):
             qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
                                           data.slope_rad, r)
-            return wheel3d_mjcf_text(data, job.name, version, qpos, qvel, friction=mu)
+            return wheel3d_mjcf_text(data, job.name, version, qpos, qvel, friction=mu,
+                                     ground=ground)
         ideal, text = job.gait(build)
         return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 

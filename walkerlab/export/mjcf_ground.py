@@ -104,16 +104,19 @@ def _profile_geom(mb: Multibody, extra: MjcfScene) -> list[str]:
             'rgba="0.8 0.8 0.8 1"/>']
 
 
-def _tread_boxes(mb: Multibody, extra: MjcfScene) -> list[str]:
+def _tread_boxes(mb: Multibody, extra: MjcfScene, half_width_m: float | None = None
+                 ) -> list[str]:
     """Continuous stairs: one box per tread (``extra.treads``), its top the tread at the
     ground offset below it, reaching a leg length below the lowest tread (so each riser is
-    a box face a toe can hit), both lanes' contact bits."""
+    a box face a toe can hit), both lanes' contact bits; ``half_width_m`` [m] across the
+    fall line each side (default a tenth of the leg length)."""
     off = extra.ground_offset_m
     floor = min(h for _, _, h in extra.treads) - off - mb.leg_length_m
+    half = 0.1 * mb.leg_length_m if half_width_m is None else float(half_width_m)
     out = []
     for i, (a, b, h) in enumerate(extra.treads):
         top = h - off
-        size = nums((b - a) / 2, 0.1 * mb.leg_length_m, (top - floor) / 2)
+        size = nums((b - a) / 2, half, (top - floor) / 2)
         pos = nums((a + b) / 2, 0, (top + floor) / 2)
         out.append(f'    <geom name="tread{i}" type="box" size="{size}" pos="{pos}" '
                    'contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>')
@@ -121,7 +124,8 @@ def _tread_boxes(mb: Multibody, extra: MjcfScene) -> list[str]:
 
 
 def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: float = 0.0,
-                 slope_rad: float = 0.0) -> tuple[list[str], list[str]]:
+                 slope_rad: float = 0.0, half_width_m: float | None = None
+                 ) -> tuple[list[str], list[str]]:
     """A spoked wheel's MJCF ground other than its slope plane, laid as its contact model
     lays it (continuous ground, :func:`walkerlab.models.contact.terrain.terrain_ground`),
     the stance spoke's tip at the origin as the ``gait`` keyframe stands it: stairs as one
@@ -151,6 +155,11 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
         :func:`walkerlab.export.spoked.wheel_chord_m`).
     slope_rad : float
         The scene's slope [rad] (footholds lie on it).
+    half_width_m : float, optional
+        How far [m] the treads and footholds reach across the fall line each side (default:
+        the planar wheel's, a tenth of a spoke for the treads, 0.04 spoke for the
+        footholds); the 3D wheel's (:func:`walkerlab.export.spoked.wheel3d_mjcf_text`) are
+        wider, for its lean and heading.
 
     Returns
     -------
@@ -165,7 +174,7 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
         extra = SimpleNamespace(treads=stair_treads(terrain, 0.0, n_treads),
                                 ground_offset_m=0.0)
         return [], [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
-                    for g in _tread_boxes(mb, extra)]
+                    for g in _tread_boxes(mb, extra, half_width_m)]
     if terrain.kind == "profile":
         extra = SimpleNamespace(profile=profile_line(terrain, 0.0, 0.0), ground_offset_m=0.0)
         geoms = [g.replace('contype="6" conaffinity="0"', 'contype="1" conaffinity="1"')
@@ -173,14 +182,16 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
         return profile_asset(mb, extra), geoms
     if terrain.kind == "footholds" and chord_m > 0.0:
         return [], _wheel_footholds(terrain, float(spoke_length_m), float(chord_m),
-                                    float(slope_rad), n_treads)
+                                    float(slope_rad), n_treads, half_width_m)
     raise ValueError(f"terrain.kind: {terrain.kind}: a spoked wheel's MJCF lays stairs, "
                      "footholds and profiles")
 
 
-def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int) -> list[str]:
+def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int,
+                     half_width_m: float | None = None) -> list[str]:
     """:func:`wheel_ground`'s footholds: a box per footfall, footfall -1 (behind the first
-    stance tip) to ``n`` (a finite list, ``periodic: false``: its own footfalls)."""
+    stance tip) to ``n`` (a finite list, ``periodic: false``: its own footfalls),
+    ``half_width_m`` across the fall line each side (default ``0.04 L``)."""
     h = [-d for d in landing_drops(terrain)]  # each step's landing above the stance tip
     t = np.array([math.cos(phi), -math.sin(phi)])
     nrm = np.array([math.sin(phi), math.cos(phi)])
@@ -195,11 +206,12 @@ def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int) -> list[st
         falls[k + 1] = falls[k] + step(k)
     w = float(terrain.patch_width_m)
     depth = w / 10
+    half = 0.04 * L if half_width_m is None else float(half_width_m)
     out = []
     for k in sorted(falls):
         centre = falls[k] - depth * nrm
         out.append(f'    <geom name="footfall{k}" type="box" '
-                   f'size="{nums(w / 2, 0.04 * L, depth)}" '
+                   f'size="{nums(w / 2, half, depth)}" '
                    f'pos="{nums(centre[0], 0, centre[1])}" euler="{nums(0, phi, 0)}" '
                    'contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>')
     return out

@@ -21,13 +21,17 @@ from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import URDF_GROUND, xml_comments
 from walkerlab.export.text import comment, num, nums
 
-__all__ = ["TO_MUJOCO", "WHEEL_TIP_FRACTION", "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe",
-           "wheel3d_mjcf_text", "wheel3d_urdf_text", "wheel_chord_m", "wheel_mjcf_text",
-           "wheel_urdf_text"]
+__all__ = ["TO_MUJOCO", "WHEEL_3D_GROUND_HALF_WIDTH", "WHEEL_TIP_FRACTION",
+           "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe", "wheel3d_mjcf_text", "wheel3d_urdf_text",
+           "wheel_chord_m", "wheel_mjcf_text", "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
 WHEEL_TIP_FRACTION = 1e-3
+#: How far the 3D wheel's MJCF treads and footholds reach across the fall line each side, in
+#: spokes [-] (:func:`walkerlab.export.mjcf_ground.wheel_ground`'s ``half_width_m``): a
+#: leaning or turning wheel's tips stay on them
+WHEEL_3D_GROUND_HALF_WIDTH = 2.0
 
 
 def _wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
@@ -273,7 +277,7 @@ def wheel3d_keyframe(points, velocities, x, slope_rad: float,
 
 def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
                       timestep_s: float = 1e-4, solref=(0.002, 1.0),
-                      friction: float = 1.0) -> str:
+                      friction: float = 1.0, ground=None) -> str:
     """A spoked wheel in three dimensions (``walker.space: 3d``) as a MuJoCo model (MJCF):
     the ground plane tilted by the slope, the wheel one body on a free joint ``free`` (no
     plane constraint), its axle along the body's y (MuJoCo axes, :data:`TO_MUJOCO`), the
@@ -295,6 +299,11 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
         MuJoCo's contact time constant [s] and damping ratio [-].
     friction : float
         Sliding friction coefficient [-].
+    ground : (list of str, list of str), optional
+        The ground's ``asset`` lines and ``worldbody`` geoms in place of the slope's plane:
+        stairs (a box per tread, across the fall line ``2 L`` wide each side) or footholds
+        (a patch per footfall of the upright wheel rolling down the fall line),
+        :func:`walkerlab.export.mjcf_ground.wheel_ground` with ``half_width_m``.
 
     Returns
     -------
@@ -314,9 +323,10 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
                       (p["I_diam"], I_axle, p["I_diam"]), timestep_s, solref, friction,
                       qpos, qvel),
         header=(head,),
+        asset=tuple(ground[0]) if ground is not None else (),
         ground=(f'    <geom name="ground" type="plane" size="400 400 0.1" '
                 f'euler="0 {num(phi)} 0" contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>',
-                )))
+                ) if ground is None else tuple(ground[1])))
 
 
 def wheel3d_urdf_text(data, name: str, version: str = "") -> str:

@@ -197,9 +197,10 @@ def scene_ground(terrain, slope_rad: float, footfalls=None, step_slopes=None) ->
     terrain : walkerlab.config.TerrainSettings or None
     slope_rad : float
         The scene's slope [rad].
-    footfalls : ndarray (k, 2), optional
+    footfalls : ndarray (k, 2) or (k, 3), optional
         Where the feet stood [m], in walking order: the first swing foot's start, each
-        step's stance foot, the last step's landing (the contact points,
+        step's stance foot, the last step's landing (a walker in 3D: its ``z`` across the
+        fall line, where the ground is level, not read; the contact points,
         :func:`walkerlab.analysis.gait.checks.footfalls`).  Needed for footholds and a
         drawn per-step ground (their pieces are where the feet stood).
     step_slopes : sequence of float, optional
@@ -233,7 +234,7 @@ def scene_ground(terrain, slope_rad: float, footfalls=None, step_slopes=None) ->
         return _pieces([(edges[k], f[k, 0], f[k, 1], gk[k]) for k in range(len(f))],
                        "footholds" if kind == "footholds" else "ground")
     if kind == "stairs":
-        x0, y0 = (0.0, 0.0) if footfalls is None else np.asarray(footfalls, float)[1]
+        x0, y0 = (0.0, 0.0) if footfalls is None else np.asarray(footfalls, float)[1, :2]
         n = 2 if footfalls is None else len(footfalls)
         return _pieces([(a, a, y0 + h, 0.0) for a, _b, h in stair_treads(terrain, x0, n)],
                        "treads")

@@ -74,16 +74,29 @@ def footholds_text(fh: dict) -> str:
     over the tread behind, the stance tread and the riser edge ahead."""
     miss = int(fh["steps_until_miss"])
     edge = float(fh["riser_clearance_m"])
-    return "\n".join([
+    mid, back = float(fh["midstance_clearance_m"]), float(fh["back_clearance_m"])
+    if edge != edge and mid != mid and back != back and not fh["riser_scuff"]:
+        # a spoked wheel: its next spoke lands on the tread ahead from above, never over
+        # the stance tread, the tread behind or the riser edge between
+        return "\n".join(_footholds_head(fh, miss) + [
+            "  swing-foot clearance: the landing spoke stays ahead of the riser edge (it "
+            "lands on the tread ahead from above; no foot swings over the treads)"])
+    return "\n".join(_footholds_head(fh, miss) + [
+        f"  swing-foot clearance: riser edge ahead {1e3 * edge:.4g} mm"
+        + (" (SCUFFS the riser: not modelled)" if fh["riser_scuff"] else "")
+        + f", stance tread {1e3 * mid:.4g} mm (mid-stance "
+        f"foot-through as on a slope), tread behind {1e3 * back:.4g} mm"])
+
+
+def _footholds_head(fh: dict, miss: int) -> list[str]:
+    """:func:`footholds_text`'s first two lines: the stairs, the step advance and drift,
+    the footfall that would miss its tread."""
+    return [
         f"stairs ({fh['direction']}, riser {1e3 * fh['riser_m']:.4g} mm, tread "
         f"{1e3 * fh['tread_m']:.4g} mm): step advance {1e3 * fh['step_advance_m']:.4f} mm, "
         f"the foot drifts {1e3 * fh['drift_per_step_m']:+.4f} mm per tread",
         f"  from {1e3 * fh['first_foothold_m']:.4g} mm on the first tread: "
-        + ("never misses a tread" if miss < 0 else f"footfall {miss} misses its tread"),
-        f"  swing-foot clearance: riser edge ahead {1e3 * edge:.4g} mm"
-        + (" (SCUFFS the riser: not modelled)" if fh["riser_scuff"] else "")
-        + f", stance tread {1e3 * fh['midstance_clearance_m']:.4g} mm (mid-stance "
-        f"foot-through as on a slope), tread behind {1e3 * fh['back_clearance_m']:.4g} mm"])
+        + ("never misses a tread" if miss < 0 else f"footfall {miss} misses its tread")]
 
 
 def ground_word(g, u) -> str:

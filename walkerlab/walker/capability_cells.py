@@ -15,7 +15,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD
            "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
            "KNEED_ZERO_WIDTH_UPRIGHT",
            "KNEE_LATCH_OSIM",
-           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D",
+           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D",
            "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D",
@@ -81,6 +81,14 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
               "turning that axis between steps, which the rigid state does not carry; "
               "stairs and footholds of several heights keep one fall line")
+#: why the spoked wheels' contact model refuses footholds (planar and 3D)
+WHEEL_FOOTHOLDS_CONTACT = ("a rimless wheel's contact model runs on continuous ground (its "
+                           "spokes have no lanes of their own)")
+#: why the 3D spoked wheel refuses a height profile
+PROFILE_WHEEL_3D = ("the 3D wheel's heading and lean are angles about its ground's normal "
+                    "and fall line through the stance spoke's tip: a profile's slope changes "
+                    "from step to step, turning those axes at each landing, which the rigid "
+                    "state does not carry; stairs and footholds keep one plane's axes")
 #: why the 3D straight legs' OpenSim model and the kneed walker in 3D's exports refuse
 #: footholds of several heights (the straight legs' MJCF and Adams dataset take them:
 #: :func:`walkerlab.export.legs_3d_parts.legs3d_lanes`)
@@ -346,8 +354,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): _WHEEL_GYM,
         # footholds have no ground between them; the wheel's contact model needs it
-        ("footholds", "contact"): ("a rimless wheel's contact model runs on continuous "
-                                   "ground (its spokes have no lanes of their own)"),
+        ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
         **_URDF_GROUNDS,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
@@ -494,7 +501,23 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_WHEEL_JOINTS,
         # the compliant-contact model: a free body on its spoke tips
         # (walkerlab.codegen.floating_3d.derive_wheel_3d)
-        **_CELLS_3D,
+        # stairs and footholds (a height along the fall line, level across it) in the rigid
+        # model: the next spoke's tip lands as the planar wheel's (its generated clearance
+        # along the slope's normal plus the landing's depth, the section's trailing tip by
+        # the spin's mirror: walkerlab.models.hybrid.ground); the MJCF lays the planar
+        # wheel's treads and footfall patches (walkerlab.export.mjcf_ground.wheel_ground,
+        # wider: walkerlab.export.spoked.WHEEL_3D_GROUND_HALF_WIDTH); the contact model its
+        # treads and risers as a polyline, level across the fall line
+        # (walkerlab.models.contact.assembly.point3), on continuous ground as the planar
+        # wheel's; the Adams dataset a box per tread (walkerlab.export.adams_wheel)
+        **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "mjcf")},
+        ("stairs", "contact"): None,
+        ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
+        ("stairs", "adams"): None,
+        ("footholds", "adams"): WHEEL_ADAMS_FOOTHOLDS,
+        **_URDF_GROUNDS,
+        ("profile", "*"): PROFILE_WHEEL_3D,
+        ("profile", "urdf"): URDF_GROUND,
         # the MJCF, the URDF and the Adams dataset: a free body on its spoke tips
         # (walkerlab.export.spoked.wheel3d_mjcf_text, wheel3d_urdf_text,
         # walkerlab.export.adams_wheel.adm_wheel_text)

@@ -52,7 +52,10 @@ walker's :class:`Kind`:
     The rimless wheel in three dimensions (``walker.space: 3d``): free about every axis of
     its stance foot - heading, lean and spin (Coleman, Chatterjee & Ruina 1997).  The
     rigid model, the compliant-contact model (a free body on its spoke tips), the MJCF (a
-    free body: it rolls in MuJoCo) and the URDF, so far; the other views' cells say so.
+    free body: it rolls in MuJoCo), the URDF and the Adams dataset; stairs and footholds (a
+    height along the fall line, level across it) in the rigid model and the MJCF, stairs in
+    the contact model and the Adams dataset, landing as the planar wheel's
+    (:mod:`walkerlab.models.hybrid.ground`); the other views' cells say why not.
 
 The layers ask the kind (:func:`kind_of`, once), never the switches, and never its name:
 the kind holds its parts as objects (:mod:`walkerlab.walker.parts`: :attr:`Kind.rigid`,
@@ -320,7 +323,7 @@ KINDS = {k.name: k for k in (
          scene="configs/rimless_wheel.yaml"),
     Kind("rolling_polygon_3d", "rimless (spoked) wheel in 3D (heading, lean, spin)",
          "Coleman, Chatterjee & Ruina 1997", "walker.space: 3d", in_3d=True, spoked=True,
-         rigid=P.RIGID_SPOKES, landing=None, reaction=P.REACTION_HUB,
+         rigid=P.RIGID_SPOKES, reaction=P.REACTION_HUB,
          contact=P.CONTACT_WHEEL_3D, scene="configs/rimless_wheel_3d.yaml"),
     Kind("straight_legs_3d", "straight legs in 3D with hip width (roll and pitch)",
          "Kuo 1999", "walker.space: 3d", in_3d=True, rigid=P.RIGID_STRAIGHT_LEGS_3D,

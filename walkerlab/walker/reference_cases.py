@@ -183,6 +183,10 @@ SHIPPED = {
     ("rolling_polygon", "walk"): "rimless_wheel",
     # the disc-like wheel: stable above its critical slope (the point-mass wheel falls over)
     ("rolling_polygon_3d", "walk"): "rimless_wheel_3d_disc",
+    # ... down stairs of its chord (riser and tread its spoke tips' drop and run on 0.2 rad):
+    # the slope's gait on level treads, stable (the generated case's point-mass wheel on 1 cm
+    # risers has no gait: on so small a drop it stops)
+    ("rolling_polygon_3d", "stairs"): "rimless_wheel_3d_disc_stairs",
     # the paper's walker in 3D with zero hip width: the planar gait, rolled about nothing
     ("straight_legs_3d", "walk"): "paper_3d",
     # the hip-width walker with its lateral foot-placement law: stride multipliers all
@@ -346,6 +350,21 @@ WALKING = {
         {"terrain.riser_m": 0.0612, "terrain.tread_m": 0.763,
          "fixedpoint.initial_guess": {"stance_angle_rad": 0.3126519715,
                                       "stance_rate_rad_per_s": -1.0957846504}}),
+    # the 3D wheel on footholds 5 mm below and above its slope: the disc wheel's inertias and
+    # slope (configs/rimless_wheel_3d_disc.yaml: stable above its critical slope; the
+    # point-mass wheel of the kind's base scene falls over sideways, x22.4 a step, at every
+    # slope), started from its gait on the plane.  Gait: 0.3962190 s steps (0.4037 s and
+    # 0.3887 s: up 5 mm, down 5 mm), stable, |multipliers| 0.843 a stride besides the
+    # neutral heading (the plane's 0.918 a step)
+    ("rolling_polygon_3d", "footholds"): (
+        "the disc wheel's inertias on its 0.2 rad slope (the point-mass wheel falls over "
+        "sideways)",
+        {"walker.hub_inertia_kg_m2": 0.5, "walker.diametral_inertia_kg_m2": 0.25,
+         "slope.angle_rad": 0.2,
+         "fixedpoint.initial_guess": {"heading_angle_rad": 0.0, "lean_angle_rad": 0.0,
+                                      "stance_angle_rad": 0.1927, "heading_rate_rad_per_s": 0.0,
+                                      "lean_rate_rad_per_s": 0.0,
+                                      "stance_rate_rad_per_s": -1.9}}),
 }
 
 

@@ -61,9 +61,12 @@ class TreadLanding:
         foot-through of the point-foot model, ignored as on a slope).
     riser_clearance_m : float
         Height [m] of the swing foot above the riser's top edge ahead as it passes it
-        (NaN: it does not pass it before heel strike, the landing misses the tread).
+        (NaN: it does not pass it before heel strike: the landing misses the tread, or the
+        foot was ahead of the edge all along - a spoked wheel's next spoke, which lands on
+        the tread ahead from above).
     riser_scuff : bool
-        ``riser_clearance_m < 0`` or NaN: the foot hits the riser (reported, not modelled).
+        ``riser_clearance_m < 0``, or NaN with the foot starting behind the edge: the foot
+        hits the riser (reported, not modelled).
     """
 
     riser_m: float
@@ -127,10 +130,13 @@ def tread_landing(walker, x, terrain, solver) -> TreadLanding:
     ground = scene_ground(terrain, 0.0)  # the stance foot at the origin, on tread 0
     back, mid = np.inf, np.inf
     cross = []
+    x_start = None  # the swing foot's place at the step's start [m]
     for _phase, sol, (ta, tb) in seg.pieces:
         t = np.linspace(ta, tb, _SAMPLES)
         p = np.asarray(walker.points(sol(t))["swing_foot"])
         xf = p[0]
+        if x_start is None:
+            x_start = float(xf[0])
         c = ground.clearance(xf, p[1])  # the report's quantity (checks.swing_foot_clearance)
         over_back = xf < -u0
         over_stance = (xf >= -u0) & (xf <= D - u0)
@@ -153,4 +159,5 @@ def tread_landing(walker, x, terrain, solver) -> TreadLanding:
         steps_until_miss=steps_until_miss(u0, drift, D),
         back_clearance_m=float(back) if np.isfinite(back) else float("nan"),
         midstance_clearance_m=float(mid) if np.isfinite(mid) else float("nan"),
-        riser_clearance_m=edge, riser_scuff=not edge >= 0)
+        riser_clearance_m=edge,
+        riser_scuff=edge < 0 or (edge != edge and not x_start >= D - u0))

@@ -159,15 +159,35 @@ def point3(px, py, pz, vx, vy, vz, sp, cp, PC, cen):
     nx, ny, vz, Fz, w): :func:`point`'s first 12 with ``Ft`` the friction along ``t``
     [N], ``g = mu(w) / w`` [s/m] (the friction per unit slip and normal force) and
     ``dmu/dw`` at the slip speed ``w = |v_t|`` [m/s], then the lateral slip ``vz`` [m/s],
-    the lateral friction ``Fz`` [N] and ``w``.  Raises nothing: a polyline ground is
-    planar (a scene of one in 3D is refused before)."""
+    the lateral friction ``Fz`` [N] and ``w``.  On a polyline ground (``PC[I_CONT] == 2``:
+    ``cen`` its vertices in the ``x, y`` plane, :func:`ground_line`; stairs' treads and
+    risers, level across the fall line along ``z``) the penetration, the normal ``(nx, ny,
+    0)`` and the slip along ``(ny, -nx, 0)`` are the nearest segment's (:func:`on_line`'s),
+    the lateral slip ``vz`` the same."""
+    if PC[I_CONT] > 1.5:
+        delta, nx, ny = ground_line(px, py, cen)
+        ddot = -(vx * nx + vy * ny)
+        vt = vx * ny - vy * nx
+        s = px * cp - py * sp
+        fn, dfd, dfdd = 0.0, 0.0, 0.0
+        if delta > 0.0:
+            fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX],
+                                         PC[I_DMAX])
+        return _slip3(delta, ddot, vt, s, fn, dfd, dfdd, nx, ny, vz, PC)
     delta, ddot, vt, s, fn, dfd, dfdd = pressed(px, py, vx, vy, sp, cp, PC, cen)
+    return _slip3(delta, ddot, vt, s, fn, dfd, dfdd, sp, cp, vz, PC)
+
+
+@njit(cache=True)
+def _slip3(delta, ddot, vt, s, fn, dfd, dfdd, nx, ny, vz, PC):
+    """:func:`point3`'s 15 entries from the normal contact of a point on the ground of
+    outward normal ``(nx, ny, 0)``: the Coulomb friction on the slip ``(vt, vz)``."""
     w = np.sqrt(vt * vt + vz * vz)
     g, dmu = 0.0, 0.0
     if fn > 0.0:
         mu, dmu = friction_mu(w, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
         g = mu / w if w > 0.0 else dmu
-    return (delta, ddot, vt, s, fn, g * fn * vt, dfd, dfdd, g, dmu, sp, cp, vz, g * fn * vz, w)
+    return (delta, ddot, vt, s, fn, g * fn * vt, dfd, dfdd, g, dmu, nx, ny, vz, g * fn * vz, w)
 
 
 @njit(cache=True)

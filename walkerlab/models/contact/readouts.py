@@ -125,13 +125,28 @@ class ContactReadouts:
     def hip_height(self, X) -> np.ndarray:
         """Hip height above the ground line, hip . n [m], for X (n, 2 nq) -> (n,) (numpy: a
         dot product is not worth a compiled kernel per walker structure, compiled anew in
-        a fresh user cache; the same operations as that kernel had)."""
+        a fresh user cache; the same operations as that kernel had).  On a polyline ground
+        (:attr:`~walkerlab.models.contact.model.ContactWalker.ground_line`: stairs, a
+        profile on continuous ground) above the ground under the hip: less that point's
+        ``g . n``, ``g = (x_hip, y(x_hip))`` on the polyline (stairs: the tread under the
+        hip), so a walker many risers down has not fallen."""
         X = self._rows(X)
         phi = float(self.contact_params[self.kernels.I_PHI])
         if self.dim == 3:  # the base is the stance foot: the hip from the kinematics
             hip = np.atleast_2d(self.points(X)["hip"].T)
-            return hip[:, 0] * math.sin(phi) + hip[:, 1] * math.cos(phi)
-        return X[:, 0] * math.sin(phi) + X[:, 1] * math.cos(phi)
+            h = hip[:, 0] * math.sin(phi) + hip[:, 1] * math.cos(phi)
+            return self._above_line(h, hip[:, 0], phi)
+        h = X[:, 0] * math.sin(phi) + X[:, 1] * math.cos(phi)
+        return self._above_line(h, X[:, 0], phi)
+
+    def _above_line(self, h, x, phi: float) -> np.ndarray:
+        """``h`` (n,) [m] less the polyline ground's height along the slope's normal at
+        ``x`` (n,) [m]; ``h`` itself without a polyline ground."""
+        line = getattr(self, "ground_line", None)
+        if line is None:
+            return h
+        y = np.interp(x, line[:, 0], line[:, 1])
+        return h - (x * math.sin(phi) + y * math.cos(phi))
 
     def hip_height_rate(self, X) -> np.ndarray:
         """Rate of :meth:`hip_height` [m/s] for X (n, 2 nq) -> (n,): the hip's velocity

@@ -29,6 +29,26 @@ direction, ``n`` up.  The walker's rolls are about that fall line, so a ground w
 changes from step to step (footholds of their own slopes, a profile) is refused
 (:data:`walkerlab.walker.capability_cells.PROFILE_3D`).
 
+The spoked wheel in 3D (Coleman, Chatterjee & Ruina 1997, "Motions of a rimless spoked
+wheel: a simple three-dimensional system with impacts", Dynamics and Stability of Systems
+12(3); :func:`walkerlab.codegen.derive_3d.derive_spoked`) lands the same way: its generated
+``swing_clearance`` is the next spoke's tip's height ``n . r_next`` along the slope's normal
+above the plane through the stance tip, whatever its heading ``psi`` and lean ``phi`` (a tip
+at ``w`` in the wheel's plane from the stance tip stands ``cos(phi) (w_x sin(beta) + w_y
+cos(beta))`` above it, ``beta`` the spin from the normal), so a leaned or turned wheel's
+landing is that tip reaching ``-drop_m cos(gamma)`` along the normal, the ground a height
+along the fall line and level across it.  Its section's old stance tip is the spoke behind,
+``drop_m cos(gamma)`` above: the next tip's clearance at the spin mirrored about the normal
+(``beta -> -beta``, heading and lean kept: :class:`_Mirrored`).  A zero landing is the
+slope's walker itself (the plane's gait bit for bit); the upright wheel rolling down the
+fall line is the planar wheel (its heading and lean rates stay 0), so on stairs too its
+gait is the planar wheel's on them.  On level treads (``gamma = 0``) the landing reads the
+riser alone: the section's stance spoke leans back by ``asin(riser / (2 L sin alpha))``,
+the slope on which the spokes' chord drops a riser - the stairs' mean slope ``atan(riser /
+tread)`` when the tread is the chord's run, where the stairs' gait is that slope's.  A
+profile is refused (:data:`walkerlab.walker.capability_cells.PROFILE_WHEEL_3D`: the heading
+and lean turn about the plane's normal and fall line).
+
 Poincaré section: the state just after heel strike, where the new swing foot (the old stance
 foot) lies ``drop_m`` above the new stance foot's line: ``swing_clearance(x+) = drop_m
 cos(gamma)`` (both feet on their treads: for point feet exactly, for arc feet their lowest
@@ -88,11 +108,11 @@ def _at(clearance, offset, t, x):
     return clearance(t, x) + offset
 
 
-def _flip(x, n, shift=0.0):
-    """``x`` with its first ``n`` entries (the coordinates) ``q`` mirrored to ``-q - shift``
+def _flip_at(x, idx, shift=0.0):
+    """``x`` with its entries ``idx`` (the spin coordinates) ``q`` mirrored to ``-q - shift``
     (``shift = 0``: negated)."""
     y = np.array(x, copy=True)
-    y[:n] = -y[:n] - shift
+    y[idx] = -y[idx] - shift
     return y
 
 
@@ -102,15 +122,23 @@ class _Mirrored:
     whose generated ``swing_clearance`` is the next spoke's, ahead (the spokes are
     ``2 alpha`` apart, so the spoke behind at ``theta`` from the slope's normal stands as
     the spoke ahead at ``-theta``; its angle ``q`` from the vertical, ``theta = q + phi``,
-    mirrors to ``-q - 2 phi``)."""
+    mirrors to ``-q - 2 phi``).
 
-    def __init__(self, f, n: int, gradient: bool, slope_rad: float):
-        self.f, self.n, self.gradient, self.shift = f, n, gradient, 2.0 * slope_rad
+    Only the spin (``idx``: the ``stance`` coordinate and its rate's sign) is mirrored: in
+    3D (:func:`walkerlab.codegen.derive_3d.derive_spoked`, ``R = Rot(n, psi) Rot(s, phi)
+    Rot(z, beta)``, ``beta = q + gamma``) a spoke's tip at ``w`` in the wheel's plane from
+    the stance tip is ``cos(phi) (w_x sin(beta) + w_y cos(beta))`` above the slope's plane
+    through the stance tip, whatever the heading ``psi``: the trailing tip's
+    ``w = (-L sin 2 alpha, L - L cos 2 alpha)`` at ``beta`` is the next tip's
+    ``(L sin 2 alpha, L - L cos 2 alpha)`` at ``-beta``, the lean ``phi`` unchanged."""
+
+    def __init__(self, f, idx, gradient: bool, slope_rad: float):
+        self.f, self.idx, self.gradient, self.shift = f, list(idx), gradient, 2.0 * slope_rad
 
     def __call__(self, *args):
         *t, x = args
-        out = self.f(*t, _flip(x, self.n, self.shift))
-        return _flip(np.asarray(out), self.n) if self.gradient else out
+        out = self.f(*t, _flip_at(x, self.idx, self.shift))
+        return _flip_at(np.asarray(out), self.idx) if self.gradient else out
 
 
 def _probe(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
@@ -264,9 +292,9 @@ def _on_clearance(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     if data.structure.kind.spoked:  # (:class:`_Mirrored`): a spoked wheel's old stance
         # spoke is behind, its generated clearance the spoke's ahead; the legged kinds'
         # swing foot is the old stance foot
-        n = walker.n_coordinates
-        g = float(data.slope_rad)
-        s_clear, s_grad = _Mirrored(clear, n, False, g), _Mirrored(grad, n, True, g)
+        spin = [walker.roles.index("stance")]  # the spin: the planar wheel's one
+        g = float(data.slope_rad)  # coordinate, the 3D wheel's third (after heading, lean)
+        s_clear, s_grad = _Mirrored(clear, spin, False, g), _Mirrored(grad, spin, True, g)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
                    from_section=_LandingSection(walker, s_clear, s_grad, offset),
