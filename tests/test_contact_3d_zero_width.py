@@ -84,9 +84,13 @@ def _hip_speed(f, times) -> float:
 @pytest.mark.parametrize("name", ["round_feet_3d", "paper_3d"])
 def test_the_zero_width_3d_walkers_walk_in_contact_at_the_rigid_gait(name, tmp_path):
     """``walkerlab contact-sim`` against ``walkerlab simulate`` of the same scene: ten heel
-    strikes; over steps 7-10 (whole periods, transients settled) the mean step period and
-    the hip's speed within 1 % of the rigid walk's (the capability cell's tolerance is 3 %);
-    the walk upright (roll under 0.05 rad); a disc's patches centred on its roll."""
+    strikes; over steps 6-9 (whole periods, transients settled) the mean step period and
+    the hip's speed within 1 % of the rigid walk's (the capability cell's tolerance is 3 %;
+    measured on round_feet_3d +0.05 %, -0.68 %); the walk upright (roll under 0.05 rad); a
+    disc's patches centred on its roll.  Not step 10: the roll, seeded at round-off and
+    growing x11 a step (the rigid lateral multiplier), reaches 2.5e-2 rad there on the discs
+    and the swing disc may scuff (round_feet_3d since the 3D product-to-sum simplification
+    moved its round-off: step 10 4 % short), which round-off, not the walker, decides."""
     import h5py
 
     from walkerlab.stages import pipeline
@@ -100,7 +104,7 @@ def test_the_zero_width_3d_walkers_walk_in_contact_at_the_rigid_gait(name, tmp_p
         ok = s["steps/termination"][:].astype(str) == "heel_strike"
         hr = np.asarray(s["steps/t_end"][:][ok], float)
         assert hr.size >= 10
-        hc, hr = h[5:10], hr[5:10]  # heel strikes 6-10: steps 7-10
+        hc, hr = h[4:9], hr[4:9]  # heel strikes 5-9: steps 6-9
         period = np.diff(hc).sum() / np.diff(hr).sum() - 1.0
         speed = _hip_speed(f, hc) / _hip_speed(s, hr) - 1.0
         assert abs(period) < 0.01 and abs(speed) < 0.01, (period, speed)
