@@ -128,24 +128,24 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     assert out.replay_error <= 1e-6
 
 
-def test_a_3d_walker_off_the_plane_slope_is_refused_before_any_stage(tmp_path):
-    """The 3D straight legs' optimize cells that cannot hold - a ground other than the
-    plane (its walker walks a plane slope only) - are refused in one line before
-    fixedpoint runs, with the capability table's reason."""
+def test_a_3d_walker_on_footholds_is_refused_before_any_stage(tmp_path):
+    """The 3D straight legs' optimize cell that cannot hold - footholds (the stride of two
+    mirrored steps lands both at one depth; which leg lands on which foothold is part of a
+    gait on footholds of several heights) - is refused in one line before fixedpoint runs,
+    with the capability table's reason."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
-    from walkerlab.walker.capability_cells import GROUND_3D
+    from walkerlab.walker.capability_cells import FOOTHOLDS_OPTIMIZE_3D
 
-    d = yaml.safe_load((CONFIGS / "hip_width_optimal.yaml").read_text())
-    d["terrain"] = {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.4}
-    d["slope"] = {"angle_rad": 0.0}
-    scene = tmp_path / "stairs_3d.yaml"
+    d = yaml.safe_load((CONFIGS / "hip_width_footholds.yaml").read_text())
+    d["optimize"] = {"objective": "effort", "intervals": 40}
+    scene = tmp_path / "footholds_3d.yaml"
     scene.write_text(yaml.safe_dump(d))
     r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
     assert r.exit_code != 0 and r.output.count("error:") == 1, r.output
-    assert GROUND_3D[:40] in " ".join(r.output.split()), r.output
+    assert FOOTHOLDS_OPTIMIZE_3D[:40] in " ".join(r.output.split()), r.output
     assert "Traceback" not in r.output
     assert not list((tmp_path / "r").rglob("*.h5"))
 

@@ -48,6 +48,7 @@ import numpy as np
 from walkerlab.config.actuation import Actuation, PushOff
 from walkerlab.io.schemas.optimize import OptimizeData
 from walkerlab.models.hybrid.actuated import actuate
+from walkerlab.models.hybrid.ground import on_landing
 from walkerlab.optimal import outcome as reported
 from walkerlab.optimal.free_joints import optimize_five_link
 from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
@@ -346,11 +347,6 @@ def _straight_legs(scene, plant, x_gait, period_s) -> OptimizeData:
     differ (:func:`_stride`)."""
     data = plant.data
     spec = collocation_spec(scene)
-    if data.mirror is not None and scene.terrain is not None \
-            and scene.terrain.kind in ("stairs", "footholds"):
-        raise ValueError(f"terrain.kind: {scene.terrain.kind}: legs that differ take a stride "
-                         "of two steps, whose landing is not transcribed yet; optimise legs "
-                         "of one build, or on the slope")
     return (_step(scene, plant, spec, x_gait, period_s) if data.mirror is None
             else _stride(scene, plant, spec, x_gait, period_s))
 
@@ -607,24 +603,29 @@ def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
     ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
-    map's, each step's energies from its own walker (leg B's step: the mirror's masses)."""
+    map's, each step's energies from its own walker (leg B's step: the mirror's masses);
+    on stairs both steps land on the next tread, started and replayed on the stairs
+    (:func:`walkerlab.models.hybrid.ground.on_landing`)."""
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.transcription.landing import step_ground  # light
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
 
     o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
-    walker = make_rigid_walker(data)
+    ground = step_ground(scene)
+    drop = 0.0 if ground is None else ground.drops_m[0]
+    walker = on_landing(make_rigid_walker(data), data, drop)  # drop 0: the walker itself
     guess, guess_u = starting_stride(scene, _guide(walker, data, spec), x_gait, period_s,
                                      spec.intervals)
     t0 = time.perf_counter()
-    fns = stride_functions(data)
+    fns = stride_functions(data, ground, hold_advance=spec.target_step_length_m is None)
     build = time.perf_counter() - t0
     res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
                            guess_u)
-    err, replayed = replay_stride(data, res)
+    err, replayed = replay_stride(data, res, drop_m=drop)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))

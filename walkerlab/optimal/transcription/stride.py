@@ -39,8 +39,10 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["STEP_PHASES", "STRIDE_PHASES", "replay_stride", "step_of", "stride_functions",
-           "stride_guess", "stride_walker"]
+from walkerlab.walker.capability_cells import FOOTHOLDS_OPTIMIZE_3D
+
+__all__ = ["FOOTHOLDS_STRIDE", "STEP_PHASES", "STRIDE_PHASES", "replay_stride", "step_of",
+           "stride_functions", "stride_guess", "stride_walker"]
 
 #: the rigid model's phases of a straight-legged step
 #: (:func:`walkerlab.optimal.transcription.phases.
@@ -59,17 +61,34 @@ def _named(leg: str, name: str) -> str:
 STRIDE_PHASES = tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in STEP_PHASES)
 
 
-def stride_functions(data) -> dict:
+def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
     """CasADi functions of the stride of ``data``'s walker (legs that differ: ``data.mirror``
     not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases`` the
     four
     of the stride (module docstring), named ``leg1_swing:early_swing`` ...
 
+    Parameters
+    ----------
+    data : WalkerData
+    ground : walkerlab.optimal.transcription.landing.StepGround, optional
+        Stairs, or footholds of one height (one drop): each step's late swing lands
+        ``ground.drops_m[0]`` [m] below its stance foot's level
+        (:func:`walkerlab.optimal.transcription.landing.landing_phase` on that step's own
+        phase: the guard ``swing_clearance + drop cos(gamma)`` of
+        :func:`walkerlab.models.hybrid.ground.on_landing`, the advance along the slope
+        ``sqrt(|foot|^2 - (drop cos gamma)^2)``, ``|foot|`` the swing foot's distance in the
+        sagittal plane (along the slope and its normal; the hip width's lateral offset is not
+        part of it)); None: the slope's heel strike, bit for bit.
+    hold_advance : bool
+        Stairs (``ground.advance_m``): each step advances one tread (``constrain``: both
+        steps' advance ``== ground.advance_m`` [m]); False when a target step length holds
+        the mean step instead.
+
     Raises
     ------
     ValueError
         Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
-        legs (one line).
+        legs; footholds of several heights (one line).
     """
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
@@ -82,12 +101,38 @@ def stride_functions(data) -> dict:
             or any(b.massless for b in st.bodies)):
         raise ValueError("optimize: a stride of legs that differ takes straight massive legs "
                          "with point feet today (knees, flat or arc feet, a torso: not yet)")
+    if ground is not None and len(ground.drops_m) != 1:
+        raise ValueError(FOOTHOLDS_STRIDE)
     fns, phases = None, []
     for leg, d in zip(SWINGING, (replace(data, mirror_params=None), data.mirror)):
         f = cached_mode_functions(d, None, list(STEP_PHASES))
-        phases += [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
+        step = [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
+        if ground is not None:
+            step[-1] = _landing(step[-1], f["n"], ground)
+        phases += step
         fns = fns or f
-    return {**fns, "phases": phases}
+    out = {**fns, "phases": phases}
+    if ground is not None and ground.advance_m is not None and hold_advance:
+        ends = [k for k, p in enumerate(phases) if p.guard_name == "heel_strike"]
+
+        def constrain(opti, Xs, _Us, _Ts, advance=float(ground.advance_m)):
+            for k in ends:  # one tread a step (the stairs' period is one step)
+                opti.subject_to(phases[k].step(Xs[k][:, -1]) == advance)
+        out["constrain"] = constrain
+    return out
+
+
+#: why the stride transcription refuses footholds of several heights
+FOOTHOLDS_STRIDE = f"terrain.foothold_heights_m: {FOOTHOLDS_OPTIMIZE_3D}"
+
+
+def _landing(phase, n: int, ground):
+    """A step's heel-strike ``phase`` landing on ``ground`` (:func:`walkerlab.optimal.
+    transcription.landing.landing_phase` on the step's own flow, clearance and step)."""
+    from walkerlab.optimal.transcription.landing import landing_phase  # light
+
+    own = {"n": n, "flow": phase.flow, "clearance": phase.clearance, "step": phase.step}
+    return landing_phase(phase, own, ground.drops_m[0], ground.slope_rad, phase.name)
 
 
 def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
@@ -138,21 +183,24 @@ def step_of(res, k: int):
                    step_period_s=float(np.sum(res.phase_duration_s[k * P:(k + 1) * P])))
 
 
-def stride_walker(data, res):
+def stride_walker(data, res, drop_m: float = 0.0):
     """The rigid walker of ``data`` and its mirror with a hip actuator each, whose torque is
     the optimised one of its own step (:func:`walkerlab.optimal.transcription.mode_sequence.
     phase_torque_of_time` of :func:`step_of`) from that step's heel strike, and the
     stride's push-off impulse ``res.push_off_n_s`` [N s] before each heel strike (if
-    any)."""
+    any); its heel strikes at a landing ``drop_m`` [m] below the stance foot's level
+    (:func:`walkerlab.models.hybrid.ground.on_landing`, the mirror's too; 0: the slope's)."""
     from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.models.hybrid.actuated import actuate  # light
+    from walkerlab.models.hybrid.ground import on_landing  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
 
     push = PushOff(impulse_n_s=res.push_off_n_s) if res.push_off_n_s > 0.0 else None
     spec = Actuation(push_off=push, torques=[JointTorque(joint="hip", law=TorqueLaw(),
                                                          max_torque_n_m=1e6)])
-    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
+    passive = on_landing(make_rigid_walker(data, "biped", "derived"), data, drop_m)
+    walker = actuate(passive, data, spec)
     for k, w in enumerate((walker, walker.mirror)):
         tau, acts = phase_torque_of_time(step_of(res, k)), w.actuators
         acts.torques = (lambda tau_k, a: lambda t, x: np.array(
@@ -160,11 +208,12 @@ def stride_walker(data, res):
     return walker
 
 
-def replay_stride(data, res, solver=None):
+def replay_stride(data, res, solver=None, drop_m: float = 0.0):
     """The optimised stride replayed on the rigid model (its generated code, its own phases,
     guards and resets; not the CasADi expressions): :func:`stride_walker`, one stride
     (:func:`walkerlab.analysis.gait.poincare.poincare_map`) from ``x_0`` (DOP853 at rtol =
-    atol = 1e-12 unless ``solver`` is given).
+    atol = 1e-12 unless ``solver`` is given), each heel strike at a landing ``drop_m`` [m]
+    below the stance foot's level (stairs, footholds of one height; 0: the slope).
 
     Returns
     -------
@@ -177,7 +226,7 @@ def replay_stride(data, res, solver=None):
     from walkerlab.analysis.gait.poincare import StepFailed, poincare_map  # light
     from walkerlab.integrate.solver import Solver
 
-    walker = stride_walker(data, res)
+    walker = stride_walker(data, res, drop_m)
     solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     x0, segs = np.asarray(res.x[0], float), []
     try:
