@@ -212,3 +212,90 @@ def test_a_powered_3d_stride_on_level_ground_replays_on_the_rigid_model():
     assert sum(steps) == pytest.approx(res.step_period_s, rel=1e-12)
     err, _walker = replay_stride(ldata, res)
     assert err <= 1e-6
+
+
+def _stairs_optimum(tread_m: float | None = None):
+    """configs/hip_width_stairs.yaml (treads ``tread_m`` [m] if given) optimised for least
+    effort on 40 intervals a step (the capability cell's section), from its passive stair
+    gait; returns ``(optimum, fixed point (2n,), mean step period [s], the passive gait's
+    advance a step [m]: its swing foot's horizontal distance ahead at heel strike)``."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.hybrid.ground import on_landing
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _scene("hip_width_stairs", intervals=40, objective="effort")
+    if tread_m is not None:
+        d = scene.model_dump(mode="json", exclude_none=True)
+        d["terrain"]["tread_m"] = tread_m
+        scene = type(scene).model_validate(d)
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, plant=plant)
+    r = search.gaits[search.selected].result
+    period = float(np.mean(r.step_periods_s))
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    walker = on_landing(make_rigid_walker(data), data, scene.terrain.riser_m)
+    run = simulate_steps(walker, np.asarray(r.x, float), 1,
+                         Solver(method="DOP853", rtol=1e-12, atol=1e-12),
+                         max_step_time=3.0 * period)
+    advance = float(walker.points(run.segments[0].x_end)["swing_foot"][0])
+    out = optimize_scene(scene, np.asarray(r.x, float), period, plant=plant)
+    return out, np.asarray(r.x, float), period, advance
+
+
+@pytest.mark.slow
+def test_the_least_effort_3d_gait_down_stairs_is_the_passive_stair_gait():
+    """The stabilised hip-width walker down stairs of its slope's step
+    (configs/hip_width_stairs.yaml: riser 5.9328 mm, tread 0.34093 m), least effort: the
+    stride's heel strikes land on the next tread (the planar stairs' guard
+    ``swing_clearance + riser``, one tread a step) and the optimum replays on the rigid
+    walker on the stairs to 1e-6 (the optimize view's tolerance; seen 7.9e-7 on 40
+    intervals a step, 1.6e-7 on 60).  The passive stair gait (``walkerlab fixedpoint``)
+    advances 0.3409354 m a step, 5 um more than the tread the stride holds, so on the
+    shipped treads the least effort is small, not zero: seen 2.3e-7 N^2 m^2 s (peak torque
+    0.6 mN m), the start 1e-4 off the passive gait.  On treads of the passive advance the
+    rigid passive gait's advance (0.34093545 m) the optimum is that gait to the mesh's error:
+    the effort <= 1e-9 N^2 m^2 s (seen 2.2e-10), the start within 1e-5 of the fixed point
+    (seen 3.7e-6, against 1e-4 on the shipped treads), the mean step period within 1e-5
+    relative (seen 3.3e-6, against 1.0e-4): the collocated passive gait advances 0.2 um
+    less than the rigid one on 40 intervals (0.04 um on 60; Hermite-Simpson's O(h^4)), and
+    the held tread pays for that mesh error (with the advance free: effort 1e-25, the start
+    within 9.6e-7)."""
+    pytest.importorskip("casadi")
+    out, x_fix, period, advance = _stairs_optimum()
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.replay_error <= 1e-6
+    assert out.step_length_m == pytest.approx(0.34093, abs=1e-9)
+    assert 1e-8 < out.objective <= 1e-6, out.objective
+    assert advance == pytest.approx(0.3409354, abs=1e-7)
+    out, x_fix, period, _ = _stairs_optimum(advance)
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.replay_error <= 1e-6
+    assert out.objective <= 1e-9, out.objective
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, x_fix, atol=1e-5)
+    assert out.step_period_s == pytest.approx(period, rel=1e-5)
+
+
+@pytest.mark.parametrize("heights", [[0.0], [0.0, 0.0]])
+def test_footholds_at_the_stance_foots_level_are_the_plane_slopes_stride(heights):
+    """Footholds of height 0 (a zero riser: stairs take risers > 0) are the plane slope:
+    :func:`~walkerlab.optimal.transcription.landing.step_ground` returns None, so the stride
+    is the slope's, its heel strikes the generated ``heel_strike`` guard bit for bit (not
+    the landing's ``swing_clearance + 0``), and on stairs each step's is the landing's."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.transcription.landing import step_ground
+    from walkerlab.optimal.transcription.stride import stride_functions
+
+    scene = _scene("hip_width_stairs", objective="effort")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["terrain"] = {"kind": "footholds", "foothold_heights_m": heights}
+    assert step_ground(type(scene).model_validate(d)) is None
+    plane = stride_functions(data)
+    stairs = stride_functions(data, step_ground(scene))
+    assert [p.name for p in stairs["phases"]] == [p.name for p in plane["phases"]]
+    for k, (a, b) in enumerate(zip(plane["phases"], stairs["phases"])):
+        assert (a.guard is b.guard) == (k % 2 == 0)  # early swing kept, late swing landed
+    assert "constrain" in stairs and "constrain" not in plane

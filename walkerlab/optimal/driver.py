@@ -30,8 +30,8 @@ capability table (:func:`check_kind`):
 The ground (:mod:`walkerlab.optimal.transcription.landing`): the slope for every kind; for
 straight legs of one build also stairs (the heel strike on the next tread, one tread a
 step) and footholds (of one height: one step; of several: a period of one step per
-foothold, :func:`_footholds`), each replayed on that ground; a profile (no periodic gait)
-and the other kinds on stairs or footholds are refused from the capability table.
+foothold, :func:`_footholds`), legs that differ (a stride) stairs, each replayed on that
+ground; a profile and the other kinds on stairs or footholds are refused from the table.
 
 What every set-up reports of its optimum (outcome, units, replays' multipliers) is
 :mod:`walkerlab.optimal.outcome`'s.

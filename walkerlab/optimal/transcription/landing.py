@@ -22,6 +22,9 @@ Stairs take one step per stair: a gait that repeats on them advances one tread a
 step's advance is constrained to ``terrain.tread_m`` (:class:`StepGround`); footholds are
 period-``p`` (one phase per foothold, :func:`walkerlab.optimal.transcription.mode_sequence.
 collocate_step`): each step lands at its foothold's height, the stride is the ``p`` steps.
+A walker whose legs differ (the 3D straight legs with hip width) lands each step of its
+stride on stairs through :func:`landing_phase` as well (:func:`walkerlab.optimal.
+transcription.stride.stride_functions`).
 """
 
 from __future__ import annotations

@@ -27,6 +27,18 @@ variable) acts before both heel strikes, each with its own leg's numbers (the ex
 coordinate impact of :mod:`walkerlab.models.hybrid.actuated`); its work joins the cost of
 transport and can be the objective (``push_off_work``, both strikes').
 
+On stairs (:func:`walkerlab.optimal.transcription.landing.step_ground`) each step's late
+swing is :func:`walkerlab.optimal.transcription.landing.landing_phase` of that step's own
+phase (the rigid model's guard ``swing_clearance + riser cos(gamma)``, Kuo 1999's walker
+with hip width as the planar legs: the treads are level across the walking direction, so
+the lateral offset of the feet does not move the landing; :func:`walkerlab.models.hybrid.
+ground.on_landing`), each step advancing one tread.  Measured on configs/hip_width_stairs.
+yaml (least effort, 40 intervals a step): effort 2.3e-7 N^2 m^2 s (peak 0.6 mN m), the
+replay closing to 7.9e-7 - the passive stair gait advances 0.3409354 m, 5 um more than the
+tread, so the held tread costs that little torque; on treads of the passive advance the
+optimum is the passive gait (tests/test_optimize_3d.py).  Footholds of several heights are
+refused (:data:`walkerlab.walker.capability_cells.FOOTHOLDS_OPTIMIZE_3D`).
+
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
 actuated walker and its mirror, each step's torque the optimised one as a function of the
 time since that step's heel strike, one stride from the optimised start; its return error
