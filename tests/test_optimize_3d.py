@@ -128,24 +128,24 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     assert out.replay_error <= 1e-6
 
 
-def test_a_3d_walker_on_footholds_is_refused_before_any_stage(tmp_path):
-    """The 3D straight legs' optimize cell that cannot hold - footholds (the stride of two
-    mirrored steps lands both at one depth; which leg lands on which foothold is part of a
-    gait on footholds of several heights) - is refused in one line before fixedpoint runs,
-    with the capability table's reason."""
+def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path):
+    """Footholds of three heights for the hip-width walker (legs that differ: a stride of
+    two steps, each landing on its foothold; three make a period of six steps) are refused
+    in one line before fixedpoint runs, naming terrain.foothold_heights_m."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
-    from walkerlab.walker.capability_cells import FOOTHOLDS_OPTIMIZE_3D
+    from walkerlab.optimal.transcription.landing import FOOTHOLDS_STRIDE
 
     d = yaml.safe_load((CONFIGS / "hip_width_footholds.yaml").read_text())
     d["optimize"] = {"objective": "effort", "intervals": 40}
+    d["terrain"]["foothold_heights_m"] = [0.0005, -0.0005, 0.0]
     scene = tmp_path / "footholds_3d.yaml"
     scene.write_text(yaml.safe_dump(d))
     r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
     assert r.exit_code != 0 and r.output.count("error:") == 1, r.output
-    assert FOOTHOLDS_OPTIMIZE_3D[:40] in " ".join(r.output.split()), r.output
+    assert FOOTHOLDS_STRIDE[:60] in " ".join(r.output.split()), r.output
     assert "Traceback" not in r.output
     assert not list((tmp_path / "r").rglob("*.h5"))
 
@@ -299,3 +299,31 @@ def test_footholds_at_the_stance_foots_level_are_the_plane_slopes_stride(heights
     for k, (a, b) in enumerate(zip(plane["phases"], stairs["phases"])):
         assert (a.guard is b.guard) == (k % 2 == 0)  # early swing kept, late swing landed
     assert "constrain" in stairs and "constrain" not in plane
+
+
+@pytest.mark.slow
+def test_the_least_effort_3d_gait_on_two_footholds_is_the_passive_period_two_gait():
+    """configs/hip_width_footholds.yaml (footholds +0.5 mm and -0.5 mm, a period-2 stride
+    gait), least effort on 60 intervals a step (the capability cell's section): leg A's
+    step lands on the first foothold, leg B's on the second, the advance free, so the
+    passive gait ``walkerlab fixedpoint`` finds is feasible and the optimum is it:
+    IPOPT converged, effort <= 1e-10 N^2 m^2 s (seen 1e-25), the start within 1e-6 of the
+    fixed point, the mean step period within 1e-7 relative and the replay on the rigid
+    walker on the footholds closing to 1e-6 (seen 2.0e-7; 1.0e-6 on 40 intervals)."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _scene("hip_width_footholds", intervals=60, objective="effort")
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, plant=plant)
+    r = search.gaits[search.selected].result
+    periods = np.asarray(r.step_periods_s, float)
+    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
+                         plant=plant)
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.objective <= 1e-10, out.objective
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, r.x, atol=1e-6)
+    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
+    assert out.replay_error <= 1e-6

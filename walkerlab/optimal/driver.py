@@ -30,8 +30,9 @@ capability table (:func:`check_kind`):
 The ground (:mod:`walkerlab.optimal.transcription.landing`): the slope for every kind; for
 straight legs of one build also stairs (the heel strike on the next tread, one tread a
 step) and footholds (of one height: one step; of several: a period of one step per
-foothold, :func:`_footholds`), legs that differ (a stride) stairs, each replayed on that
-ground; a profile and the other kinds on stairs or footholds are refused from the table.
+foothold, :func:`_footholds`), legs that differ (a stride) stairs and footholds of one or
+two heights, each replayed on that ground; a profile and the other kinds on stairs or
+footholds are refused from the table.
 
 What every set-up reports of its optimum (outcome, units, replays' multipliers) is
 :mod:`walkerlab.optimal.outcome`'s.
@@ -48,7 +49,6 @@ import numpy as np
 from walkerlab.config.actuation import Actuation, PushOff
 from walkerlab.io.schemas.optimize import OptimizeData
 from walkerlab.models.hybrid.actuated import actuate
-from walkerlab.models.hybrid.ground import on_landing
 from walkerlab.optimal import outcome as reported
 from walkerlab.optimal.free_joints import optimize_five_link
 from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
@@ -57,6 +57,7 @@ from walkerlab.optimal.replay.contact import (
     contact_replay_phased,
     contact_replay_stride,
 )
+from walkerlab.optimal.transcription.landing import step_ground
 from walkerlab.optimal.virtual_constraints import (
     check_design,
     designs_controller,
@@ -313,9 +314,9 @@ def check_scene(scene, data) -> None:
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
     if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
-        from walkerlab.optimal.transcription.landing import step_ground
+        from walkerlab.optimal.transcription.landing import check_stride_ground
 
-        step_ground(scene)
+        check_stride_ground(step_ground(scene), data)
     if (o.min_clearance_m or 0.0) > 0.0 and _feet_level_when_legs_cross(scene, data):
         raise ValueError(
             "optimize.min_clearance_m: straight legs cannot clear the ground mid-swing: the "
@@ -604,35 +605,33 @@ def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
     ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
     map's, each step's energies from its own walker (leg B's step: the mirror's masses);
-    on stairs both steps land on the next tread, started and replayed on the stairs
-    (:func:`walkerlab.models.hybrid.ground.on_landing`)."""
+    on stairs or footholds started and replayed there (:func:`~walkerlab.optimal.
+    transcription.stride.on_ground`)."""
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.transcription.landing import step_ground  # light
+    from walkerlab.optimal.transcription import stride
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
-    from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
 
     o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
-    ground = step_ground(scene)
-    drop = 0.0 if ground is None else ground.drops_m[0]
-    walker = on_landing(make_rigid_walker(data), data, drop)  # drop 0: the walker itself
-    guess, guess_u = starting_stride(scene, _guide(walker, data, spec), x_gait, period_s,
-                                     spec.intervals)
+    ground, base = step_ground(scene), make_rigid_walker(data)
+    walker = stride.on_ground(base, data, ground)  # no ground: the walker itself
+    guide = stride.on_ground(base, data, ground, lambda w, d: _guide(w, d, spec))
+    guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
-    fns = stride_functions(data, ground, hold_advance=spec.target_step_length_m is None)
+    fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None)
     build = time.perf_counter() - t0
     res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
                            guess_u)
-    err, replayed = replay_stride(data, res, drop_m=drop)
+    err, replayed = stride.replay_stride(data, res, ground=ground)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
     record = history_and_energies(scene, walker, res)
-    parts = [history_and_energies(scene, w, step_of(res, k))
+    parts = [history_and_energies(scene, w, stride.step_of(res, k))
              for k, w in enumerate((walker, walker.mirror))]
     record["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
                         for kind in record["energy"]}

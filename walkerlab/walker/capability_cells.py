@@ -11,7 +11,7 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
-           "FOOTHOLDS_EXPORT_3D", "FOOTHOLDS_OPTIMIZE_3D", "FREE_JOINT_TORQUES", "GROUND_3D",
+           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D",
            "KNEED_3D_FIRST_STRIDE", "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_3D_TORSO", "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
@@ -78,10 +78,6 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
               "turning that axis between steps, which the rigid state does not carry; "
               "stairs and footholds of several heights keep one fall line")
-#: why the 3D straight legs' collocation (walkerlab.optimal.transcription.stride) refuses footholds
-FOOTHOLDS_OPTIMIZE_3D = ("a hip-width walker is collocated as a stride of two mirrored steps "
-                         "at one landing depth (stairs); on footholds of several heights which "
-                         "leg lands where is part of the gait (lcm(p, 2) steps), beyond a stride")
 #: why the spoked wheels' contact model refuses footholds (planar and 3D)
 WHEEL_FOOTHOLDS_CONTACT = ("a rimless wheel's contact model runs on continuous ground (its "
                            "spokes have no lanes of their own)")
@@ -407,8 +403,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{(g, v): None for g in ("stairs", "footholds")
            for v in ("rigid", "contact", "mjcf", "adams", "gym", "osim")},
         ("footholds", "osim"): FOOTHOLDS_EXPORT_3D,
-        ("stairs", "optimize"): None,  # walkerlab.optimal.transcription.stride, .landing
-        ("footholds", "optimize"): FOOTHOLDS_OPTIMIZE_3D,
+        # the collocation's stride lands each step on its tread or foothold
+        # (walkerlab.optimal.transcription.stride, .landing)
+        ("stairs", "optimize"): None,
+        ("footholds", "optimize"): None,
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints

@@ -32,7 +32,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-__all__ = ["StepGround", "landing_phase", "replay_footholds", "step_ground"]
+__all__ = ["FOOTHOLDS_STRIDE", "StepGround", "check_stride_ground", "landing_phase",
+           "replay_footholds", "step_ground"]
+
+#: why a stride (legs that differ) refuses footholds of more than two heights
+FOOTHOLDS_STRIDE = ("terrain.foothold_heights_m: legs that differ (a walker with hip width) "
+                    "are collocated as a stride of two steps, the walker's and its "
+                    "mirror's, each landing on its foothold: p > 2 heights make a period of "
+                    "lcm(p, 2) steps, more than one stride; give one or two heights")
 
 
 @dataclass(frozen=True)
@@ -91,6 +98,13 @@ def step_ground(scene) -> StepGround | None:
     if all(d == 0.0 for d in drops) and advance is None:
         return None  # footholds at the stance foot's level: the slope itself
     return StepGround(drops, float(scene.slope.phi_rad), advance, t.kind)
+
+
+def check_stride_ground(ground: StepGround | None, data) -> None:
+    """Refuse footholds of more than two heights for legs that differ (``data.mirror``):
+    :data:`FOOTHOLDS_STRIDE` (a ValueError; one line)."""
+    if ground is not None and data.mirror is not None and len(ground.drops_m) > 2:
+        raise ValueError(FOOTHOLDS_STRIDE)
 
 
 def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = "step"):
