@@ -139,7 +139,12 @@ def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = 
     guard = clear + offset
     rate = ca.jacobian(guard, x) @ fns["flow"](x, u)
     advance = ca.sqrt(ca.fmax(fns["step"](x) ** 2 - offset ** 2, 0.0))
-    return replace(base, name=name, guard=ca.Function("guard", [x, u], [guard]),
+    # a landing above the stance foot's level (offset < 0): the swing foot passes below it
+    # as the legs cross (the planar legs' scuff, which the rigid model ignores: its heel
+    # strike is the downward crossing), so the guard's sign is not kept inside the phase
+    inside = base.inside and offset >= 0.0
+    return replace(base, name=name, inside=inside,
+                   guard=ca.Function("guard", [x, u], [guard]),
                    guard_rate=ca.Function("guard_rate", [x, u], [rate]),
                    clearance=ca.Function("clearance", [x], [clear + max(offset, 0.0)]),
                    step=ca.Function("step", [x], [advance]))
