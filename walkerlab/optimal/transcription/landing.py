@@ -23,8 +23,8 @@ step's advance is constrained to ``terrain.tread_m`` (:class:`StepGround`); foot
 period-``p`` (one phase per foothold, :func:`walkerlab.optimal.transcription.mode_sequence.
 collocate_step`): each step lands at its foothold's height, the stride is the ``p`` steps.
 A walker whose legs differ (the 3D straight legs with hip width) lands each step of its
-stride on stairs through :func:`landing_phase` as well (:func:`walkerlab.optimal.
-transcription.stride.stride_functions`).
+stride on stairs or on footholds of one or two heights through :func:`landing_phase` as
+well (:func:`walkerlab.optimal.transcription.stride.stride_functions`).
 """
 
 from __future__ import annotations

@@ -29,19 +29,19 @@ transport and can be the objective (``push_off_work``, both strikes').
 
 On stairs and footholds (:func:`walkerlab.optimal.transcription.landing.step_ground`) each
 step's late swing is :func:`walkerlab.optimal.transcription.landing.landing_phase` of that
-step's own phase (the rigid model's guard ``swing_clearance + riser cos(gamma)``, Kuo 1999's walker
-with hip width as the planar legs: the treads are level across the walking direction, so
-the lateral offset of the feet does not move the landing; :func:`walkerlab.models.hybrid.
-ground.on_landing`), each step advancing one tread on stairs; on footholds of two heights
-leg A's step lands on the first, leg B's on the second (:func:`walkerlab.models.hybrid.
-ground.on_footholds`' order: the stride is the footholds' period).  Measured on
-configs/hip_width_stairs.yaml (least effort, 40 intervals a step): effort 2.3e-7 N^2 m^2 s
-(peak 0.6 mN m), the replay closing to 7.9e-7 (1.6e-7 on 60) - the passive stair gait
-advances 0.3409354 m, 5 um more than the tread, so the held tread costs that little
-torque; on treads of the passive advance the optimum is the passive gait.  On
-configs/hip_width_footholds.yaml (+-0.5 mm) the least effort is 1e-25 N^2 m^2 s, the
-passive period-2 gait, its replay closing to 2.0e-7 on 60 intervals
-(tests/test_optimize_3d.py).  More than two heights are refused
+step's own phase (the rigid model's guard ``swing_clearance + riser cos(gamma)``; Kuo 1999's
+walker with hip width as the planar legs: the treads are level across the walking direction,
+so the lateral offset of the feet does not move the landing;
+:func:`walkerlab.models.hybrid.ground.on_landing`), each step advancing one tread on stairs;
+on footholds of two heights leg A's step lands on the first, leg B's on the second
+(:func:`walkerlab.models.hybrid.ground.on_footholds`' order: the stride is their period).
+Measured on configs/hip_width_stairs.yaml (least effort, 40 intervals a step): effort 2.3e-7
+N^2 m^2 s (peak 0.6 mN m), the replay closing to 7.9e-7 (1.6e-7 on 60) - the passive stair
+gait advances 0.3409354 m, 5 um more than the tread, so the held tread costs that little
+torque; on treads of the passive advance the optimum is the passive gait. On
+configs/hip_width_footholds.yaml (+-0.5 mm) the least effort is 1e-25 N^2 m^2 s, the passive
+period-2 gait, its replay closing to 2.0e-7 on 60 intervals (tests/test_optimize_3d.py).
+More than two heights are refused
 (:data:`walkerlab.optimal.transcription.landing.FOOTHOLDS_STRIDE`).
 
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
@@ -140,7 +140,6 @@ def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
     return out
 
 
-
 def _landing(phase, n: int, ground, k: int):
     """Step ``k``'s heel-strike ``phase`` landing on ``ground`` (:func:`walkerlab.optimal.
     transcription.landing.landing_phase` on the step's own flow, clearance and step)."""
@@ -151,7 +150,8 @@ def _landing(phase, n: int, ground, k: int):
 
 def on_ground(walker, data, ground, finish=None):
     """The rigid ``walker`` of ``data`` (legs that differ: with its ``mirror``) on the
-    stride's ``ground``: None, the walker itself; stairs (one drop): :func:`walkerlab.
+    stride's ``ground``: None, the walker itself; stairs or footholds of one height (one
+    drop): :func:`walkerlab.
     models.hybrid.ground.on_landing`; footholds of two heights: :func:`walkerlab.models.
     hybrid.ground.on_footholds` (its ``cycle``: leg A's step on the first, leg B's on the
     second).  ``finish(walker, data)`` (the actuators) is applied to every step's walker."""
