@@ -128,24 +128,24 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     assert out.replay_error <= 1e-6
 
 
-def test_a_3d_walker_off_the_plane_slope_is_refused_before_any_stage(tmp_path):
-    """The 3D straight legs' optimize cells that cannot hold - a ground other than the
-    plane (its walker walks a plane slope only) - are refused in one line before
-    fixedpoint runs, with the capability table's reason."""
+def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path):
+    """Footholds of three heights for the hip-width walker (legs that differ: a stride of
+    two steps, each landing on its foothold; three make a period of six steps) are refused
+    in one line before fixedpoint runs, naming terrain.foothold_heights_m."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
-    from walkerlab.walker.capability_cells import GROUND_3D
+    from walkerlab.optimal.transcription.landing import FOOTHOLDS_STRIDE
 
-    d = yaml.safe_load((CONFIGS / "hip_width_optimal.yaml").read_text())
-    d["terrain"] = {"kind": "stairs", "riser_m": 0.01, "tread_m": 0.4}
-    d["slope"] = {"angle_rad": 0.0}
-    scene = tmp_path / "stairs_3d.yaml"
+    d = yaml.safe_load((CONFIGS / "hip_width_footholds.yaml").read_text())
+    d["optimize"] = {"objective": "effort", "intervals": 40}
+    d["terrain"]["foothold_heights_m"] = [0.0005, -0.0005, 0.0]
+    scene = tmp_path / "footholds_3d.yaml"
     scene.write_text(yaml.safe_dump(d))
     r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
     assert r.exit_code != 0 and r.output.count("error:") == 1, r.output
-    assert GROUND_3D[:40] in " ".join(r.output.split()), r.output
+    assert FOOTHOLDS_STRIDE[:60] in " ".join(r.output.split()), r.output
     assert "Traceback" not in r.output
     assert not list((tmp_path / "r").rglob("*.h5"))
 
@@ -212,3 +212,118 @@ def test_a_powered_3d_stride_on_level_ground_replays_on_the_rigid_model():
     assert sum(steps) == pytest.approx(res.step_period_s, rel=1e-12)
     err, _walker = replay_stride(ldata, res)
     assert err <= 1e-6
+
+
+def _stairs_optimum(tread_m: float | None = None):
+    """configs/hip_width_stairs.yaml (treads ``tread_m`` [m] if given) optimised for least
+    effort on 40 intervals a step (the capability cell's section), from its passive stair
+    gait; returns ``(optimum, fixed point (2n,), mean step period [s], the passive gait's
+    advance a step [m]: its swing foot's horizontal distance ahead at heel strike)``."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.hybrid.ground import on_landing
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _scene("hip_width_stairs", intervals=40, objective="effort")
+    if tread_m is not None:
+        d = scene.model_dump(mode="json", exclude_none=True)
+        d["terrain"]["tread_m"] = tread_m
+        scene = type(scene).model_validate(d)
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, plant=plant)
+    r = search.gaits[search.selected].result
+    period = float(np.mean(r.step_periods_s))
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    walker = on_landing(make_rigid_walker(data), data, scene.terrain.riser_m)
+    run = simulate_steps(walker, np.asarray(r.x, float), 1,
+                         Solver(method="DOP853", rtol=1e-12, atol=1e-12),
+                         max_step_time=3.0 * period)
+    advance = float(walker.points(run.segments[0].x_end)["swing_foot"][0])
+    out = optimize_scene(scene, np.asarray(r.x, float), period, plant=plant)
+    return out, np.asarray(r.x, float), period, advance
+
+
+@pytest.mark.slow
+def test_the_least_effort_3d_gait_down_stairs_is_the_passive_stair_gait():
+    """The stabilised hip-width walker down stairs of its slope's step
+    (configs/hip_width_stairs.yaml: riser 5.9328 mm, tread 0.34093 m), least effort: the
+    stride's heel strikes land on the next tread (the planar stairs' guard
+    ``swing_clearance + riser``, one tread a step) and the optimum replays on the rigid
+    walker on the stairs to 1e-6 (the optimize view's tolerance; seen 7.9e-7 on 40
+    intervals a step, 1.6e-7 on 60).  The passive stair gait (``walkerlab fixedpoint``)
+    advances 0.3409354 m a step, 5 um more than the tread the stride holds, so on the
+    shipped treads the least effort is small, not zero: seen 2.3e-7 N^2 m^2 s (peak torque
+    0.6 mN m), the start 1e-4 off the passive gait.  On treads of the passive advance the
+    rigid passive gait's advance (0.34093545 m) the optimum is that gait to the mesh's error:
+    the effort <= 1e-9 N^2 m^2 s (seen 2.2e-10), the start within 1e-5 of the fixed point
+    (seen 3.7e-6, against 1e-4 on the shipped treads), the mean step period within 1e-5
+    relative (seen 3.3e-6, against 1.0e-4): the collocated passive gait advances 0.2 um
+    less than the rigid one on 40 intervals (0.04 um on 60; Hermite-Simpson's O(h^4)), and
+    the held tread pays for that mesh error (with the advance free: effort 1e-25, the start
+    within 9.6e-7)."""
+    pytest.importorskip("casadi")
+    out, x_fix, period, advance = _stairs_optimum()
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.replay_error <= 1e-6
+    assert out.step_length_m == pytest.approx(0.34093, abs=1e-9)
+    assert 1e-8 < out.objective <= 1e-6, out.objective
+    assert advance == pytest.approx(0.3409354, abs=1e-7)
+    out, x_fix, period, _ = _stairs_optimum(advance)
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.replay_error <= 1e-6
+    assert out.objective <= 1e-9, out.objective
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, x_fix, atol=1e-5)
+    assert out.step_period_s == pytest.approx(period, rel=1e-5)
+
+
+@pytest.mark.parametrize("heights", [[0.0], [0.0, 0.0]])
+def test_footholds_at_the_stance_foots_level_are_the_plane_slopes_stride(heights):
+    """Footholds of height 0 (a zero riser: stairs take risers > 0) are the plane slope:
+    :func:`~walkerlab.optimal.transcription.landing.step_ground` returns None, so the stride
+    is the slope's, its heel strikes the generated ``heel_strike`` guard bit for bit (not
+    the landing's ``swing_clearance + 0``), and on stairs each step's is the landing's."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.transcription.landing import step_ground
+    from walkerlab.optimal.transcription.stride import stride_functions
+
+    scene = _scene("hip_width_stairs", objective="effort")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["terrain"] = {"kind": "footholds", "foothold_heights_m": heights}
+    assert step_ground(type(scene).model_validate(d)) is None
+    plane = stride_functions(data)
+    stairs = stride_functions(data, step_ground(scene))
+    assert [p.name for p in stairs["phases"]] == [p.name for p in plane["phases"]]
+    for k, (a, b) in enumerate(zip(plane["phases"], stairs["phases"])):
+        assert (a.guard is b.guard) == (k % 2 == 0)  # early swing kept, late swing landed
+    assert "constrain" in stairs and "constrain" not in plane
+
+
+@pytest.mark.slow
+def test_the_least_effort_3d_gait_on_two_footholds_is_the_passive_period_two_gait():
+    """configs/hip_width_footholds.yaml (footholds +0.5 mm and -0.5 mm, a period-2 stride
+    gait), least effort on 60 intervals a step (the capability cell's section): leg A's
+    step lands on the first foothold, leg B's on the second, the advance free, so the
+    passive gait ``walkerlab fixedpoint`` finds is feasible and the optimum is it:
+    IPOPT converged, effort <= 1e-10 N^2 m^2 s (seen 1e-25), the start within 1e-6 of the
+    fixed point, the mean step period within 1e-7 relative and the replay on the rigid
+    walker on the footholds closing to 1e-6 (seen 2.0e-7; 1.0e-6 on 40 intervals)."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _scene("hip_width_footholds", intervals=60, objective="effort")
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, plant=plant)
+    r = search.gaits[search.selected].result
+    periods = np.asarray(r.step_periods_s, float)
+    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
+                         plant=plant)
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.objective <= 1e-10, out.objective
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, r.x, atol=1e-6)
+    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
+    assert out.replay_error <= 1e-6

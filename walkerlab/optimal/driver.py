@@ -30,8 +30,9 @@ capability table (:func:`check_kind`):
 The ground (:mod:`walkerlab.optimal.transcription.landing`): the slope for every kind; for
 straight legs of one build also stairs (the heel strike on the next tread, one tread a
 step) and footholds (of one height: one step; of several: a period of one step per
-foothold, :func:`_footholds`), each replayed on that ground; a profile (no periodic gait)
-and the other kinds on stairs or footholds are refused from the capability table.
+foothold, :func:`_footholds`), legs that differ (a stride) stairs and footholds of one or
+two heights, each replayed on that ground; a profile and the other kinds on stairs or
+footholds are refused from the table.
 
 What every set-up reports of its optimum (outcome, units, replays' multipliers) is
 :mod:`walkerlab.optimal.outcome`'s.
@@ -56,6 +57,7 @@ from walkerlab.optimal.replay.contact import (
     contact_replay_phased,
     contact_replay_stride,
 )
+from walkerlab.optimal.transcription.landing import step_ground
 from walkerlab.optimal.virtual_constraints import (
     check_design,
     designs_controller,
@@ -285,7 +287,7 @@ def check_kind(scene, kind) -> None:
 def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
     kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
-    flat-footed or five-link walker, 3D disc feet) and a clearance that cannot hold
+    flat-footed or five-link walker, 3D disc feet, a 3D torso) and a clearance that cannot hold
     (``optimize.min_clearance_m > 0``: :func:`_feet_level_when_legs_cross`).
 
     Parameters
@@ -311,10 +313,12 @@ def check_scene(scene, data) -> None:
     check_kind(scene, data.structure.kind)
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
+    if data.structure.in_3d and data.structure.torso:  # an upper body on the bisecting hip
+        data.structure.kind.require("torso_torque", "optimize", "walker.torso")
     if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
-        from walkerlab.optimal.transcription.landing import step_ground
+        from walkerlab.optimal.transcription.landing import check_stride_ground
 
-        step_ground(scene)
+        check_stride_ground(step_ground(scene), data)
     if (o.min_clearance_m or 0.0) > 0.0 and _feet_level_when_legs_cross(scene, data):
         raise ValueError(
             "optimize.min_clearance_m: straight legs cannot clear the ground mid-swing: the "
@@ -344,13 +348,7 @@ def _feet_level_when_legs_cross(scene, data) -> bool:
 def _straight_legs(scene, plant, x_gait, period_s) -> OptimizeData:
     """Straight legs: one step (:func:`_step`), or a stride of two steps when the legs
     differ (:func:`_stride`)."""
-    data = plant.data
-    spec = collocation_spec(scene)
-    if data.mirror is not None and scene.terrain is not None \
-            and scene.terrain.kind in ("stairs", "footholds"):
-        raise ValueError(f"terrain.kind: {scene.terrain.kind}: legs that differ take a stride "
-                         "of two steps, whose landing is not transcribed yet; optimise legs "
-                         "of one build, or on the slope")
+    data, spec = plant.data, collocation_spec(scene)
     return (_step(scene, plant, spec, x_gait, period_s) if data.mirror is None
             else _stride(scene, plant, spec, x_gait, period_s))
 
@@ -607,31 +605,34 @@ def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
     mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
     ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
-    map's, each step's energies from its own walker (leg B's step: the mirror's masses)."""
+    map's, each step's energies from its own walker (leg B's step: the mirror's masses);
+    on stairs or footholds started and replayed there (:func:`~walkerlab.optimal.
+    transcription.stride.on_ground`)."""
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.transcription import stride
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
-    from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
 
     o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
-    walker = make_rigid_walker(data)
-    guess, guess_u = starting_stride(scene, _guide(walker, data, spec), x_gait, period_s,
-                                     spec.intervals)
+    ground, base = step_ground(scene), make_rigid_walker(data)
+    walker = stride.on_ground(base, data, ground)  # no ground: the walker itself
+    guide = stride.on_ground(base, data, ground, lambda w, d: _guide(w, d, spec))
+    guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
-    fns = stride_functions(data)
+    fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None)
     build = time.perf_counter() - t0
     res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
                            guess_u)
-    err, replayed = replay_stride(data, res)
+    err, replayed = stride.replay_stride(data, res, ground=ground)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
     record = history_and_energies(scene, walker, res)
-    parts = [history_and_energies(scene, w, step_of(res, k))
+    parts = [history_and_energies(scene, w, stride.step_of(res, k))
              for k, w in enumerate((walker, walker.mirror))]
     record["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
                         for kind in record["energy"]}

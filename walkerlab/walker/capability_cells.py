@@ -11,15 +11,12 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
-           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D", "KNEED_3D_FIRST_STRIDE",
-           "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE", "KNEED_3D_TORSO",
-           "KNEED_ZERO_WIDTH_UPRIGHT",
-           "KNEE_LATCH_OSIM",
-           "NO_HIP_ROLL", "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D",
-           "PROFILE_PASSIVE",
+           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D",
+           "KNEED_3D_FIRST_STRIDE", "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE",
+           "KNEED_3D_TORSO", "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
+           "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D",
-           "URDF_GROUND",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -406,6 +403,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **{(g, v): None for g in ("stairs", "footholds")
            for v in ("rigid", "contact", "mjcf", "adams", "gym", "osim")},
         ("footholds", "osim"): FOOTHOLDS_EXPORT_3D,
+        # the collocation's stride lands each step on its tread or foothold
+        # (walkerlab.optimal.transcription.stride, .landing)
+        ("stairs", "optimize"): None,
+        ("footholds", "optimize"): None,
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: a free pelvis and two legs on hip joints

@@ -22,6 +22,9 @@ Stairs take one step per stair: a gait that repeats on them advances one tread a
 step's advance is constrained to ``terrain.tread_m`` (:class:`StepGround`); footholds are
 period-``p`` (one phase per foothold, :func:`walkerlab.optimal.transcription.mode_sequence.
 collocate_step`): each step lands at its foothold's height, the stride is the ``p`` steps.
+A walker whose legs differ (the 3D straight legs with hip width) lands each step of its
+stride on stairs or on footholds of one or two heights through :func:`landing_phase` as
+well (:func:`walkerlab.optimal.transcription.stride.stride_functions`).
 """
 
 from __future__ import annotations
@@ -29,7 +32,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-__all__ = ["StepGround", "landing_phase", "replay_footholds", "step_ground"]
+__all__ = ["FOOTHOLDS_STRIDE", "StepGround", "check_stride_ground", "landing_phase",
+           "replay_footholds", "step_ground"]
+
+#: why a stride (legs that differ) refuses footholds of more than two heights
+FOOTHOLDS_STRIDE = ("terrain.foothold_heights_m: legs that differ (a walker with hip width) "
+                    "are collocated as a stride of two steps, the walker's and its "
+                    "mirror's, each landing on its foothold: p > 2 heights make a period of "
+                    "lcm(p, 2) steps, more than one stride; give one or two heights")
 
 
 @dataclass(frozen=True)
@@ -90,6 +100,13 @@ def step_ground(scene) -> StepGround | None:
     return StepGround(drops, float(scene.slope.phi_rad), advance, t.kind)
 
 
+def check_stride_ground(ground: StepGround | None, data) -> None:
+    """Refuse footholds of more than two heights for legs that differ (``data.mirror``):
+    :data:`FOOTHOLDS_STRIDE` (a ValueError; one line)."""
+    if ground is not None and data.mirror is not None and len(ground.drops_m) > 2:
+        raise ValueError(FOOTHOLDS_STRIDE)
+
+
 def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = "step"):
     """One step of straight legs landing ``drop_m`` [m] below the stance foot's level
     (module docstring): :func:`walkerlab.optimal.transcription.mode_sequence.step_phase`'s
@@ -122,7 +139,12 @@ def landing_phase(base, fns: dict, drop_m: float, slope_rad: float, name: str = 
     guard = clear + offset
     rate = ca.jacobian(guard, x) @ fns["flow"](x, u)
     advance = ca.sqrt(ca.fmax(fns["step"](x) ** 2 - offset ** 2, 0.0))
-    return replace(base, name=name, guard=ca.Function("guard", [x, u], [guard]),
+    # a landing above the stance foot's level (offset < 0): the swing foot passes below it
+    # as the legs cross (the planar legs' scuff, which the rigid model ignores: its heel
+    # strike is the downward crossing), so the guard's sign is not kept inside the phase
+    inside = base.inside and offset >= 0.0
+    return replace(base, name=name, inside=inside,
+                   guard=ca.Function("guard", [x, u], [guard]),
                    guard_rate=ca.Function("guard_rate", [x, u], [rate]),
                    clearance=ca.Function("clearance", [x], [clear + max(offset, 0.0)]),
                    step=ca.Function("step", [x], [advance]))

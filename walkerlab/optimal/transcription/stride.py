@@ -27,6 +27,23 @@ variable) acts before both heel strikes, each with its own leg's numbers (the ex
 coordinate impact of :mod:`walkerlab.models.hybrid.actuated`); its work joins the cost of
 transport and can be the objective (``push_off_work``, both strikes').
 
+On stairs and footholds (:func:`walkerlab.optimal.transcription.landing.step_ground`) each
+step's late swing is :func:`walkerlab.optimal.transcription.landing.landing_phase` of that
+step's own phase (the rigid model's guard ``swing_clearance + riser cos(gamma)``; Kuo 1999's
+walker with hip width as the planar legs: the treads are level across the walking direction,
+so the lateral offset of the feet does not move the landing;
+:func:`walkerlab.models.hybrid.ground.on_landing`), each step advancing one tread on stairs;
+on footholds of two heights leg A's step lands on the first, leg B's on the second
+(:func:`walkerlab.models.hybrid.ground.on_footholds`' order: the stride is their period).
+Measured on configs/hip_width_stairs.yaml (least effort, 40 intervals a step): effort 2.3e-7
+N^2 m^2 s (peak 0.6 mN m), the replay closing to 7.9e-7 (1.6e-7 on 60) - the passive stair
+gait advances 0.3409354 m, 5 um more than the tread, so the held tread costs that little
+torque; on treads of the passive advance the optimum is the passive gait. On
+configs/hip_width_footholds.yaml (+-0.5 mm) the least effort is 1e-25 N^2 m^2 s, the passive
+period-2 gait, its replay closing to 2.0e-7 on 60 intervals (tests/test_optimize_3d.py).
+More than two heights are refused
+(:data:`walkerlab.optimal.transcription.landing.FOOTHOLDS_STRIDE`).
+
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
 actuated walker and its mirror, each step's torque the optimised one as a function of the
 time since that step's heel strike, one stride from the optimised start; its return error
@@ -39,8 +56,10 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["STEP_PHASES", "STRIDE_PHASES", "replay_stride", "step_of", "stride_functions",
-           "stride_guess", "stride_walker"]
+from walkerlab.optimal.transcription.landing import check_stride_ground, landing_phase
+
+__all__ = ["STEP_PHASES", "STRIDE_PHASES", "on_ground", "replay_stride",
+           "step_of", "stride_functions", "stride_guess", "stride_walker"]
 
 #: the rigid model's phases of a straight-legged step
 #: (:func:`walkerlab.optimal.transcription.phases.
@@ -59,17 +78,35 @@ def _named(leg: str, name: str) -> str:
 STRIDE_PHASES = tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in STEP_PHASES)
 
 
-def stride_functions(data) -> dict:
+def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
     """CasADi functions of the stride of ``data``'s walker (legs that differ: ``data.mirror``
     not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases`` the
     four
     of the stride (module docstring), named ``leg1_swing:early_swing`` ...
 
+    Parameters
+    ----------
+    data : WalkerData
+    ground : walkerlab.optimal.transcription.landing.StepGround, optional
+        Stairs, or footholds of one or two heights: step ``k`` (0: leg A's, 1: leg B's)
+        lands ``ground.drops_m[k % p]`` [m] below its stance foot's level (``p`` the
+        footholds' period; the order of :func:`walkerlab.models.hybrid.ground.on_footholds`)
+        (:func:`walkerlab.optimal.transcription.landing.landing_phase` on that step's own
+        phase: the guard ``swing_clearance + drop cos(gamma)`` of
+        :func:`walkerlab.models.hybrid.ground.on_landing`, the advance along the slope
+        ``sqrt(|foot|^2 - (drop cos gamma)^2)``, ``|foot|`` the swing foot's distance in the
+        sagittal plane (along the slope and its normal; the hip width's lateral offset is not
+        part of it)); None: the slope's heel strike, bit for bit.
+    hold_advance : bool
+        Stairs (``ground.advance_m``): each step advances one tread (``constrain``: both
+        steps' advance ``== ground.advance_m`` [m]); False when a target step length holds
+        the mean step instead.
+
     Raises
     ------
     ValueError
         Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
-        legs (one line).
+        legs; footholds of more than two heights (one line).
     """
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
@@ -82,12 +119,55 @@ def stride_functions(data) -> dict:
             or any(b.massless for b in st.bodies)):
         raise ValueError("optimize: a stride of legs that differ takes straight massive legs "
                          "with point feet today (knees, flat or arc feet, a torso: not yet)")
+    check_stride_ground(ground, data)
     fns, phases = None, []
-    for leg, d in zip(SWINGING, (replace(data, mirror_params=None), data.mirror)):
+    for k, (leg, d) in enumerate(zip(SWINGING, (replace(data, mirror_params=None),
+                                                data.mirror))):
         f = cached_mode_functions(d, None, list(STEP_PHASES))
-        phases += [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
+        step = [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
+        if ground is not None:
+            step[-1] = _landing(step[-1], f["n"], ground, k)
+        phases += step
         fns = fns or f
-    return {**fns, "phases": phases}
+    out = {**fns, "phases": phases}
+    if ground is not None and ground.advance_m is not None and hold_advance:
+        ends = [k for k, p in enumerate(phases) if p.guard_name == "heel_strike"]
+
+        def constrain(opti, Xs, _Us, _Ts, advance=float(ground.advance_m)):
+            for k in ends:  # one tread a step (the stairs' period is one step)
+                opti.subject_to(phases[k].step(Xs[k][:, -1]) == advance)
+        out["constrain"] = constrain
+    return out
+
+
+def _landing(phase, n: int, ground, k: int):
+    """Step ``k``'s heel-strike ``phase`` landing on ``ground`` (:func:`walkerlab.optimal.
+    transcription.landing.landing_phase` on the step's own flow, clearance and step)."""
+    own = {"n": n, "flow": phase.flow, "clearance": phase.clearance, "step": phase.step}
+    drop = ground.drops_m[k % len(ground.drops_m)]
+    return landing_phase(phase, own, drop, ground.slope_rad, phase.name)
+
+
+def on_ground(walker, data, ground, finish=None):
+    """The rigid ``walker`` of ``data`` (legs that differ: with its ``mirror``) on the
+    stride's ``ground``: None, the walker itself; stairs or footholds of one height (one
+    drop): :func:`walkerlab.
+    models.hybrid.ground.on_landing`; footholds of two heights: :func:`walkerlab.models.
+    hybrid.ground.on_footholds` (its ``cycle``: leg A's step on the first, leg B's on the
+    second).  ``finish(walker, data)`` (the actuators) is applied to every step's walker."""
+    from walkerlab.models.hybrid.ground import on_footholds, on_landing  # light
+
+    finish = finish or (lambda w, _d: w)
+    if ground is None or len(ground.drops_m) == 1:
+        drop = 0.0 if ground is None else ground.drops_m[0]
+        return finish(on_landing(walker, data, drop), data)  # drop 0: the walker itself
+    return on_footholds(lambda _g: walker, lambda _g: data,
+                        [(d, ground.slope_rad) for d in ground.drops_m], True, finish)
+
+
+def _steps(walker) -> tuple:
+    """The stride's two steps' walkers: its ``cycle`` (footholds) or it and its mirror."""
+    return tuple(walker.cycle) if walker.cycle else (walker, walker.mirror)
 
 
 def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
@@ -113,7 +193,7 @@ def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
     from walkerlab.optimal.transcription.mode_sequence import phased_guess
 
     out, x = [], np.asarray(x0, float)
-    for leg, w in zip(SWINGING, (walker, walker.mirror)):
+    for leg, w in zip(SWINGING, _steps(walker)):
         guess, log = phased_guess(w, x, period_s, solver, intervals)
         if tuple(g[0] for g in guess) != tuple(p for p, _g, _d in STEP_PHASES):
             raise ValueError(f"optimize: the starting gait's {leg} step crosses "
@@ -138,12 +218,13 @@ def step_of(res, k: int):
                    step_period_s=float(np.sum(res.phase_duration_s[k * P:(k + 1) * P])))
 
 
-def stride_walker(data, res):
+def stride_walker(data, res, ground=None):
     """The rigid walker of ``data`` and its mirror with a hip actuator each, whose torque is
     the optimised one of its own step (:func:`walkerlab.optimal.transcription.mode_sequence.
     phase_torque_of_time` of :func:`step_of`) from that step's heel strike, and the
     stride's push-off impulse ``res.push_off_n_s`` [N s] before each heel strike (if
-    any)."""
+    any); its heel strikes on the stride's ``ground`` (:func:`on_ground`; None: the
+    slope's)."""
     from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw  # light
     from walkerlab.models.hybrid.actuated import actuate  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -152,19 +233,21 @@ def stride_walker(data, res):
     push = PushOff(impulse_n_s=res.push_off_n_s) if res.push_off_n_s > 0.0 else None
     spec = Actuation(push_off=push, torques=[JointTorque(joint="hip", law=TorqueLaw(),
                                                          max_torque_n_m=1e6)])
-    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
-    for k, w in enumerate((walker, walker.mirror)):
+    walker = on_ground(make_rigid_walker(data, "biped", "derived"), data, ground,
+                       lambda w, d: actuate(w, d, spec))
+    for k, w in enumerate(_steps(walker)):
         tau, acts = phase_torque_of_time(step_of(res, k)), w.actuators
         acts.torques = (lambda tau_k, a: lambda t, x: np.array(
             [tau_k(float(np.real(t)) - a.t_origin)]))(tau, acts)
     return walker
 
 
-def replay_stride(data, res, solver=None):
+def replay_stride(data, res, solver=None, ground=None):
     """The optimised stride replayed on the rigid model (its generated code, its own phases,
     guards and resets; not the CasADi expressions): :func:`stride_walker`, one stride
     (:func:`walkerlab.analysis.gait.poincare.poincare_map`) from ``x_0`` (DOP853 at rtol =
-    atol = 1e-12 unless ``solver`` is given).
+    atol = 1e-12 unless ``solver`` is given), on the stride's ``ground`` (:func:`on_ground`;
+    None: the slope).
 
     Returns
     -------
@@ -177,7 +260,7 @@ def replay_stride(data, res, solver=None):
     from walkerlab.analysis.gait.poincare import StepFailed, poincare_map  # light
     from walkerlab.integrate.solver import Solver
 
-    walker = stride_walker(data, res)
+    walker = stride_walker(data, res, ground)
     solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     x0, segs = np.asarray(res.x[0], float), []
     try:
