@@ -539,13 +539,14 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
                    "file alone under OpenSim's Manager does not hold the stance knee "
                    "straight (the kneed walker falls at 0.34 s, in its first step)")
 
-#: what the contact cells of the 3D straight legs of zero hip width rest on (configs/paper_3d.yaml,
-#: configs/round_feet_3d.yaml): their ten steps are the sagittal gait's
+#: what the contact walk cell of the 3D straight legs of zero hip width rests on
+#: (configs/paper_3d.yaml): its ten steps are the sagittal gait's (configs/round_feet_3d.yaml's
+#: discs: their roll reaches 0.1 rad by heel strike 9 and the swing disc scuffs in step 10)
 ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk stays in its "
                          "sagittal plane: zero hip width and an upright start keep it "
                          "mirror-symmetric, its roll seeded at round-off and growing x11 a step "
                          "(the rigid gait's lateral multiplier): by heel strike 10 5e-4 rad "
-                         "(configs/paper_3d.yaml), 2.5e-2 rad (configs/round_feet_3d.yaml); "
+                         "(configs/paper_3d.yaml); "
                          "started 1 mrad/s off upright (contact_sim.start_offset: "
                          "lean_rate_rad_per_s: 0.001) configs/paper_3d.yaml capsizes after 3 "
                          "heel strikes, as the rigid walk would")
@@ -566,7 +567,6 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
 #: (kind, feature, view) -> what one supported cell rests on beyond its measurement, where
 #: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
 FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
-                 ("straight_legs_3d", "round_feet_3d", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  ("locking_knees_3d", "round_feet_3d", "contact"): KNEED_ZERO_WIDTH_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
