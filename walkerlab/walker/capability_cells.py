@@ -11,7 +11,7 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
-           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES", "GROUND_3D",
+           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES",
            "KNEED_3D_FIRST_STRIDE", "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_3D_TORSO", "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
@@ -70,9 +70,6 @@ URDF_GROUND = ("the URDF carries the walker on a slope only (URDF has no ground 
                "profiles are in the MJCF, the OpenSim model and the Adams dataset; "
                "--walker-only writes the walker alone")
 _URDF_GROUNDS = {(g, "urdf"): URDF_GROUND for g in ("stairs", "footholds", "profile")}
-#: why a 3D walker's views refuse a ground other than a plane
-GROUND_3D = ("this view lays a plane slope only for this walker in 3D (terrain.kind: slope); "
-             "the views its row marks take stairs and footholds")
 #: why the 3D straight legs refuse a height profile
 PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall line (the "
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
@@ -171,10 +168,6 @@ KNEED_3D_TORSO = ("the floating tree of the kneed walker in 3D (the contact mode
                   "Hobbelen & Schwab 2007) is a relation of the rigid tree's coordinates, "
                   "not a joint of that tree; the rigid model walks it "
                   "(configs/kneed_torso_powered_3d.yaml)")
-#: what the views of the 3D kinds refuse: a ground other than a plane
-_CELLS_3D = {
-    **{(g, "*"): GROUND_3D for g in ("stairs", "footholds", "profile")},
-}
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -389,7 +382,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)
-        **_CELLS_3D,
         # stairs and footholds: the ground a height along the walking direction, level
         # across it; the rigid model lands on them as the planar walkers do (the generated
         # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground), the
@@ -465,7 +457,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # model (walkerlab.models.contact.parts.Kneed3DPart.foot_pitches: the discs roll by
         # the shanks' pitches); OpenSim has no disc (the straight legs' reason)
         ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
-        **_CELLS_3D,
         # stairs and footholds in the rigid model and the gym's rigid view: the straight
         # legs' landing (the generated swing clearance with the knee locked plus the
         # landing's depth: walkerlab.models.hybrid.ground)
