@@ -58,10 +58,11 @@ def _scene(name):
 @pytest.fixture(scope="module", params=["paper_3d", "hip_width_powered"])
 def case(request):
     scene = _scene(request.param)
-    data = Plant.from_scene(scene).data
+    plant = Plant.from_scene(scene)
+    data = plant.data
     x = np.asarray(STATES[request.param], float)
     ideal = SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.4,))
-    start = adams3d_start(data, ideal, 2)
+    start = adams3d_start(plant, ideal, 2)
     text = adm3d_text(scene, data, start, "walker")
     return scene, data, x, read_adm(text), text
 

@@ -35,9 +35,10 @@ FLOOR = 1e-12  # kg m^2: the export's moment of a rod about its own axis
 @pytest.fixture(scope="module")
 def round_feet():
     scene = load_scene(ROOT / "configs" / "round_feet_3d.yaml")
-    data = Plant.from_scene(scene).data
+    plant = Plant.from_scene(scene)
+    data = plant.data
     x = np.array([0.02, -0.19947, 0.17947, -0.05, -0.185, -0.239])
-    start = adams3d_start(data, SimpleNamespace(x=x, period_s=2.0, step_lengths_m=(0.4,)), 2)
+    start = adams3d_start(plant, SimpleNamespace(x=x, period_s=2.0, step_lengths_m=(0.4,)), 2)
     text = adm3d_text(scene, data, start, "walker")
     return scene, data, x, read_adm(text), text
 

@@ -50,9 +50,10 @@ def kneed(request):
         raw = scene.model_dump(exclude_none=True)
         raw["contact"] = {"knee_stop": {"latch": True}}
         scene = type(scene).model_validate(raw)
-    data = Plant.from_scene(scene).data
+    plant = Plant.from_scene(scene)
+    data = plant.data
     x = np.asarray(X, float)
-    start = adams3d_start(data, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.3,)), 2)
+    start = adams3d_start(plant, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.3,)), 2)
     return scene, data, x, read_adm(adm3d_text(scene, data, start, "walker"))
 
 
@@ -161,9 +162,10 @@ def powered(request):
         "torques": [{"joint": j, "law": law} for j, law in LAWS.items()],
         "push_off": {"impulse_n_s": 0.02}}
     scene = type(scene).model_validate(raw)
-    data = Plant.from_scene(scene).data
+    plant = Plant.from_scene(scene)
+    data = plant.data
     x = np.asarray(X_ROLLED if data.structure.hip_roll else X, float)
-    start = adams3d_start(data, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.3,)), 2)
+    start = adams3d_start(plant, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.3,)), 2)
     return scene, data, x, read_adm(adm3d_text(scene, data, start, "walker"))
 
 

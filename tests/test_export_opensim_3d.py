@@ -41,6 +41,7 @@ def stabilised(tmp_path_factory):
     kinematics, not of the gait): (scene, the file's path, that state x (10,))."""
     from walkerlab.export.opensim_3d import osim3d_gait, osim3d_text
     from walkerlab.walker.description import state_names, walker_data
+    from walkerlab.walker.plant import Plant
 
     scene = load_scene(ROOT / "configs" / "hip_width_stabilised.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -49,7 +50,8 @@ def stabilised(tmp_path_factory):
                   for n in state_names(data.structure.roles)], float)
     ideal = SimpleNamespace(x=x, period_s=0.703242, step_lengths_m=())
     path = tmp_path_factory.mktemp("osim3d") / "walker.osim"
-    path.write_text(osim3d_text(data, osim3d_gait(scene, data, ideal), "stabilised"))
+    plant = Plant.from_scene(scene)
+    path.write_text(osim3d_text(data, osim3d_gait(plant, ideal), "stabilised"))
     return scene, path, x
 
 

@@ -270,7 +270,7 @@ def test_footholds_osim_patches_lie_at_the_rigid_walks_footfalls(footholds_walk)
 
     scene, feet = footholds_walk
     plant = Plant.from_scene(scene)
-    text = osim3d_text(plant.data, osim3d_gait(scene, plant.data, ideal_gait(scene, plant)),
+    text = osim3d_text(plant.data, osim3d_gait(plant, ideal_gait(scene, plant)),
                        scene.name)
     phi = scene.slope.angle_rad
     normal = np.array([math.sin(phi), math.cos(phi), 0.0])  # walkerlab's axes: y up

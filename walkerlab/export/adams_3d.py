@@ -119,7 +119,6 @@ from walkerlab.export.legs_3d_mjcf import (
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
     kneed,
-    legs3d_footfalls,
     legs3d_lanes,
     legs3d_roles,
     legs_summary,
@@ -234,13 +233,17 @@ class Adams3dStart:
         return v + np.cross(w, R @ b.com_m)
 
 
-def adams3d_start(data, ideal, strides: int, scene=None) -> Adams3dStart:
+def adams3d_start(plant, ideal, strides: int) -> Adams3dStart:
     """The start of :func:`adm3d_text` at the rigid gait ``ideal`` (module docstring).
 
     Parameters
     ----------
-    data : WalkerData
-        The 3D legged walker (straight or kneed legs, point or round feet).
+    plant : walkerlab.walker.plant.Plant
+        The scene's 3D legged walker described once (straight or kneed legs, point or round
+        feet; its ``data``), on its scene's ground: on footholds of several heights the
+        patches lie at the rigid walk's footfalls
+        (:func:`walkerlab.export.legs_3d_parts.legs3d_lanes`, the MJCF's), else the
+        keyframe's mirrored steps.
     ideal : gait
         ``x`` (6,) (roles ``lean``, ``swing``, ``stance`` and their rates, just after a
         heel strike), knees (8,) (``lean``, ``swing_thigh``, ``swing_shank``, ``stance``;
@@ -249,16 +252,13 @@ def adams3d_start(data, ideal, strides: int, scene=None) -> Adams3dStart:
         ``period_s`` [s], ``step_lengths_m``.
     strides : int
         Strides of the run: footfall patches for ``2 strides + 2`` steps.
-    scene : walkerlab.config.Scene, optional
-        Its ground: on footholds of several heights the patches lie at the rigid walk's
-        footfalls (:func:`walkerlab.export.legs_3d_parts.legs3d_lanes`, the MJCF's); None:
-        the keyframe's mirrored steps.
 
     Returns
     -------
     Adams3dStart
     """
 
+    data = plant.data
     tree, coords, p = walker_tree(data)
     rolled = bool(data.structure.hip_roll)
     knees = kneed(data)
@@ -313,8 +313,7 @@ def adams3d_start(data, ideal, strides: int, scene=None) -> Adams3dStart:
             velocity[c.name] = (v + np.cross(w, r), wc)
             down(c)
     down(root)
-    lanes = (legs3d_lanes(scene, f["points"], x, 2 * strides + 2) if scene is not None
-             else legs3d_footfalls(f["points"], x, 2 * strides + 2))
+    lanes = legs3d_lanes(plant, f["points"], x, 2 * strides + 2)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     law = getattr(data, "extra", {}).get("hip_roll") if rolled else None
     disc = float(p["R_foot"]) if round_feet(data) else 0.0

@@ -72,7 +72,7 @@ class AdamsWriter(TreeWriter):
         scene = job.scene
         check_adams_actuation(scene)  # before the gait search
         strides = _strides(scene)
-        ideal, start = job.gait(lambda ideal: adams3d_start(job.data, ideal, strides, scene))
+        ideal, start = job.gait(lambda ideal: adams3d_start(job.plant, ideal, strides))
         adm = adm3d_text(scene, job.data, start, job.name, walkerlab.__version__)
         return Written(((w.file, adm), (ADAMS_FILES["acf"], acf_text(scene, start))),
                        tuple(o.line for o in ADAMS_3D_OMISSIONS), step_period(ideal))

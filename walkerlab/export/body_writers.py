@@ -223,7 +223,7 @@ class MjcfWriter(TreeWriter):
         if job.walker_only:
             text = walker_mjcf_text(legs3d_mjcf(data, job.name, version))
             return Written((xml_file(job, w, text),), xml_lines((), scene), None)
-        ideal, extra = job.gait(lambda ideal: legs3d_scene(scene, data, ideal, job.options))
+        ideal, extra = job.gait(lambda ideal: legs3d_scene(job.plant, ideal, job.options))
         m = legs3d_mjcf(data, job.name, version, extra)
         return Written((xml_file(job, w, walker_mjcf_text(m)),), xml_lines(m.left_out, scene),
                        step_period(ideal))  # m.left_out: the stepping loop's

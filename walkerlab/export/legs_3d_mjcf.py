@@ -344,15 +344,14 @@ def _patches_across(data, L: float) -> tuple[float, str]:
                     "under any push)")
 
 
-def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
-    """The keyframe, footfall lanes and contact of ``scene``'s 3D walker at the rigid gait
+def legs3d_scene(plant, ideal, options=None) -> Legs3dScene:
+    """The keyframe, footfall lanes and contact of ``plant``'s 3D walker at the rigid gait
     ``ideal`` (``x``, ``period_s``; legs that alternate sides: a stride of two steps).
 
     Parameters
     ----------
-    scene : walkerlab.config.Scene
-    data : WalkerData
-        The 3D walker (:func:`walkerlab.walker.description.walker_data`).
+    plant : walkerlab.walker.plant.Plant
+        The scene's 3D walker described once (its ``scene`` and ``data``).
     ideal : gait
         ``x`` (6,), (8,) or (10,), ``period_s`` [s], ``step_lengths_m`` (one per step).
     options : walkerlab.export.mjcf_scene.MjcfOptions, optional
@@ -368,6 +367,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
         A ground other than the slope laid as a checkerboard (one line naming
         ``terrain.lanes``).
     """
+    scene, data = plant.scene, plant.data
     terrain = scene.terrain_or_default()
     if terrain.lanes != "checkerboard":
         raise ValueError("terrain.lanes: the 3D walker's MJCF lays footfall patches "
@@ -380,7 +380,7 @@ def legs3d_scene(scene, data, ideal, options=None) -> Legs3dScene:
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order)
         q, v = bisector_keyframe(data.structure.roles, ideal.x)
         qpos, qvel = qpos + (q,), qvel + (v,)
-    lanes = legs3d_lanes(scene, f["points"], ideal.x, EXPORT_STEPS)
+    lanes = legs3d_lanes(plant, f["points"], ideal.x, EXPORT_STEPS)
     if kneed(data) and round_feet(data):  # no patch under the trailing disc (module docstring)
         lanes = (lanes[0][1:], lanes[1])
     c, knee = contact_si(scene.contact or ContactSettings())

@@ -177,18 +177,20 @@ def legs3d_footfalls(points, x, steps: int, walked=None) -> tuple[np.ndarray, np
     return (f + k1 * stride) @ C.T, (k2 * stride) @ C.T
 
 
-def legs3d_lanes(scene, points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """The footfall lanes of ``scene``'s 3D walker at its rigid gait ``x``: leg1's and
-    leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`), on footholds of
-    several heights (the steps differ: a period-``p`` gait whose steps differ in length,
-    lean and lateral offset, the walker crabbing across the slope) the footfalls of its
+def legs3d_lanes(plant, points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """The footfall lanes of ``plant``'s 3D walker on its scene's ground at its rigid gait
+    ``x``: leg1's and leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`), on
+    footholds of several heights (the steps differ: a period-``p`` gait whose steps differ
+    in length, lean and lateral offset, the walker crabbing across the slope) the footfalls
+    of its
     rigid walk from ``x`` (:func:`walkerlab.analysis.contact.footfalls.rigid_footfalls`, the
     contact model's patches' walk), each at its foothold's height; else the keyframe's
     mirrored steps.
 
     Parameters
     ----------
-    scene : walkerlab.config.Scene
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (its ``scene``: the ground, the solver).
     points : callable ``x -> dict[str, ndarray (3,)]``
         The rigid walker's generated ``points``.
     x : ndarray (6,), (8,) or (10,)
@@ -205,4 +207,5 @@ def legs3d_lanes(scene, points, x, steps: int) -> tuple[np.ndarray, np.ndarray]:
     ValueError
         The rigid gait does not make its steps from ``x`` (one line).
     """
-    return legs3d_footfalls(points, x, steps, rigid_footfalls(scene, x, None, steps + 2))
+    return legs3d_footfalls(points, x, steps,
+                            rigid_footfalls(plant.scene, x, plant, steps + 2))

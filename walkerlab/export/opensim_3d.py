@@ -149,9 +149,9 @@ class Osim3dGait:
         return self.scene.step_period_s
 
 
-def osim3d_gait(scene, data, ideal) -> Osim3dGait:
-    """The rigid gait ``ideal`` of ``scene``'s 3D walker ``data`` (its description) with the
-    ground and contact of its OpenSim model.
+def osim3d_gait(plant, ideal) -> Osim3dGait:
+    """The rigid gait ``ideal`` of ``plant``'s 3D walker (its scene's walker described once)
+    with the ground and contact of its OpenSim model.
 
     Raises
     ------
@@ -159,10 +159,10 @@ def osim3d_gait(scene, data, ideal) -> Osim3dGait:
         As :func:`walkerlab.export.legs_3d_mjcf.legs3d_scene` (a ground other than the
         checkerboard lanes, naming ``terrain.lanes``).
     """
-    settings = scene.contact or ContactSettings()
+    settings = plant.scene.contact or ContactSettings()
     c, knee = contact_si(settings)
-    s3 = legs3d_scene(scene, data, ideal)
-    fall, _ = slope_axes(data.slope_rad)
+    s3 = legs3d_scene(plant, ideal)
+    fall, _ = slope_axes(plant.data.slope_rad)
     lane = np.asarray(s3.lanes[1], float)
     ell = float((lane[1] - lane[0]) @ fall) / 2 if len(lane) > 1 else 0.0
     return Osim3dGait(s3, c, knee, settings.push_off_pulse_s(), ell)

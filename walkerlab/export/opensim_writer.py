@@ -58,7 +58,7 @@ class OsimWriter(TreeWriter):
         check_legs_3d(job, w)
         if job.walker_only:
             raise ValueError(WALKER_ONLY)
-        ideal, gait = job.gait(lambda ideal: osim3d_gait(scene, data, ideal))
+        ideal, gait = job.gait(lambda ideal: osim3d_gait(job.plant, ideal))
         text = osim3d_text(data, gait, job.name, walkerlab.__version__)
         return Written((xml_file(job, w, text),),
                        xml_lines(osim3d_omissions(data, gait), scene), step_period(ideal))

@@ -29,7 +29,6 @@ from walkerlab.integrate.rigid import simulate_steps, walker_of_step
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ideal_step_length
 from walkerlab.models.contact.terrain import footfall_positions, ground_drops
-from walkerlab.walker.plant import Plant
 
 __all__ = ["MAX_RELAYS", "own_footfall_lanes", "rigid_footfalls", "rigid_step_lengths"]
 
@@ -91,8 +90,8 @@ def rigid_footfalls(scene, x_ideal, plant, n_footfalls: int) -> np.ndarray | Non
     x_ideal : ndarray (2n,)
         The rigid gait's fixed point (post-impact state before step 0 of the cycle, role
         order) [rad, rad/s].
-    plant : walkerlab.walker.plant.Plant or None
-        The scene's walker described once (None: described here).
+    plant : walkerlab.walker.plant.Plant
+        The scene's walker described once (handed down by the caller).
     n_footfalls : int
         Footfalls wanted (footfall 0 included).
 
@@ -127,7 +126,7 @@ def _rigid_period(scene, x_ideal, plant) -> tuple | None:
 
     if scene.terrain is None or scene.terrain.is_slope or len(ground_drops(scene.terrain)) < 2:
         return None
-    rigid = build_walker(plant.with_(scene) if plant is not None else Plant.from_scene(scene))
+    rigid = build_walker(plant.with_(scene))
     m = len(rigid.cycle) if rigid.cycle is not None else 1
     traj = simulate_steps(rigid, np.asarray(x_ideal, float), m,
                           Solver.from_settings(scene.solver))
