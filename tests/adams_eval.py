@@ -19,7 +19,7 @@ def evaluate(model, ids, extra: dict | None = None) -> dict:
     velocity less j's (its part's) along k's z, ``AZ(i, j)`` the turn of i's x axis
     about j's z (``ATAN2(x_i . y_j, x_i . x_j)``), ``STEP(x, x0, h0, x1, h1)`` the cubic
     step ``h0 + (h1 - h0) u^2 (3 - 2 u)``, ``IF(e: a, b, c)`` a, b, c for e <, =, > 0;
-    ``CONTACT`` 0: the start's feet touch without penetrating)."""
+    ``ABS`` the absolute value, ``CONTACT`` 0: the start's feet touch without penetrating)."""
     fns = {**model.functions("VARIABLE"), **(extra or {})}
     cache: dict = {}
 
@@ -63,7 +63,7 @@ def evaluate(model, ids, extra: dict | None = None) -> dict:
         return h0 + (h1 - h0) * u * u * (3 - 2 * u)
 
     env = {"VARVAL": varval, "AZ": az, "STEP": step, "ATAN2": math.atan2, "SQRT": math.sqrt,
-           "CONTACT": lambda *a: 0.0, "MIN": min, "MAX": max,
+           "CONTACT": lambda *a: 0.0, "MIN": min, "MAX": max, "ABS": abs,
            "DX": lambda *a: disp(*a)[0], "DY": lambda *a: disp(*a)[1],
            "DZ": lambda *a: disp(*a)[2], "DM": lambda i, j: float(np.linalg.norm(disp(i, j))),
            "VX": lambda i: vel(i)[0], "VY": lambda i: vel(i)[1], "VZ": lambda i: vel(i)[2],

@@ -22,7 +22,6 @@ from walkerlab.analysis.gait.poincare import poincare_map
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.walker.kinds import KindRefused
 from walkerlab.walker.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -152,16 +151,62 @@ def test_the_contact_and_mujoco_walks_keep_the_rigid_step_period(tmp_path):
     assert check.period_s == pytest.approx(check.rigid_period_s, rel=0.03), check.line
 
 
-@pytest.mark.parametrize("name", [FOOTHOLDS, "kneed_3d_stabilised_stairs.yaml"])
-def test_the_kneed_3d_adams_latch_refuses_a_ground_off_the_slope_plane(name):
-    """The 3D kneed dataset's knee latch reads a foot's height from the slope's plane
-    through the first footfall: on footholds (2 mm down a step) and stairs a foot below that
-    plane would keep its latch through the swing, so the statements refuse the ground in one
-    line naming terrain.kind; on the slope they are written (the shipped dataset's)."""
-    from walkerlab.export.adams_3d_knees import knee_3d_statements
+class _Moved:
+    """An Adams dataset read back with some markers moved (positions [m] by marker id)."""
 
-    parts = {"leg1": 2, "leg1_shank": 3, "leg2": 4, "leg2_shank": 5}
-    with pytest.raises(KindRefused, match=r"^terrain\.kind: .*tread under it"):
-        knee_3d_statements(load_scene(ROOT / "configs" / name), parts, 0.0)
-    slope = load_scene(ROOT / "configs" / SLOPE)
-    assert any("SFORCE/3" in line for line in knee_3d_statements(slope, parts, 0.05))
+    def __init__(self, model, moved: dict):
+        self._model, self._moved = model, moved
+
+    def __getattr__(self, name):
+        return getattr(self._model, name)
+
+    def marker_pose(self, m):
+        pos, R = self._model.marker_pose(m)
+        return (self._moved[m], R) if m in self._moved else (pos, R)
+
+
+def test_the_kneed_3d_adams_latch_reads_the_foothold_under_the_foot():
+    """The 3D kneed dataset on footholds (each footfall 2 mm below the last): its patches'
+    tops lie at the scene's foothold heights (footfall m 2 m mm below the slope's plane,
+    read from the file's patches), and each knee latch's foot height (VARIABLE 371,
+    372 [mm]) is the foot's height above the tread of its lane's patch under it: 1 mm with
+    the foot put 1 mm above its k-th patch (k = 1, 2: 4 and 8 mm below the slope's plane,
+    where the plane's reading would release the latch, or hold it with the foot up), the
+    latch's foot factor then 0.5 (half the 2 mm release height); between two patches its
+    height above the slope's plane (the contact model's rule for a point over no patch)."""
+    from types import SimpleNamespace
+
+    from tests.adams_eval import evaluate
+    from walkerlab.export.adams_3d import adams3d_start, adm3d_text, part_ids_3d
+    from walkerlab.export.adams_reader import read_adm
+    from walkerlab.export.axes_3d import slope_axes
+
+    scene = load_scene(ROOT / "configs" / FOOTHOLDS)
+    plant = Plant.from_scene(scene)
+    x0 = scene.fixedpoint.initial_guess.as_array(build_walker(plant).state_names())
+    start = adams3d_start(plant, SimpleNamespace(x=x0, period_s=STEP_PERIOD_S,
+                                                 step_lengths_m=(0.46,)), 2)
+    model = read_adm(adm3d_text(scene, plant.data, start, "walker"))
+    ids = part_ids_3d(start)
+    t, n = slope_axes(scene.slope.angle_rad)
+    drop = -scene.terrain.foothold_heights_m[0]
+    for leg, lane in zip(("leg1", "leg2"), start.lanes):
+        lane = np.asarray(lane, float)  # its height above the slope's plane, up (z)
+        tops = (lane[:, 2] + lane[:, 0] * np.tan(scene.slope.angle_rad)) / drop
+        # to 1e-6 of a foothold (2 nm): the shipped guess's 10 digits, mirrored
+        np.testing.assert_allclose(tops, (1.0 if leg == "leg1" else 0.0)
+                                   - 2 * np.arange(len(tops)), atol=1e-6)
+    foot = 100 * ids["leg2_shank"] + 3
+    lane = np.asarray(start.lanes[1], float)
+    for k in (1, 2):
+        pos = lane[k] + 0.001 * n
+        v = evaluate(_Moved(model, {foot: pos}), (372, 377))
+        assert v[372] == pytest.approx(1.0, abs=1e-9)  # mm above its tread
+        assert v[377] == pytest.approx(0.5, abs=1e-12)
+        line = 0.001 + lane[k] @ n
+        assert line < -0.002  # the plane's reading: 3 and 7 mm in the ground
+        mid = (lane[k] + lane[k + 1]) / 2
+        gap = mid + (0.001 - mid @ n) * n  # 1 mm above the plane, between two patches
+        v = evaluate(_Moved(model, {foot: gap}), (372,))
+        assert v[372] == pytest.approx(1.0, abs=1e-9)
+    assert (lane[1] - lane[0]) @ t > 0.3  # the patches (0.2 m) leave a gap between them

@@ -508,8 +508,9 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
                 "! pulses) are written below, after the contacts"]
         if any(t.joint.endswith("_knee") for t in act.torques):
             out += ["! (its knee torques an SFORCE on each knee revolute)"]
-    ground, patches = _ground(start, data.slope_rad, p["g"], float(
-        scene.terrain_or_default().patch_width_m), start.law is not None, act is not None)
+    width_m = float(scene.terrain_or_default().patch_width_m)
+    ground, patches = _ground(start, data.slope_rad, p["g"], width_m, start.law is not None,
+                              act is not None)
     out += ground
     out += _parts(start, ids, stance)
     out += _joints(start, ids, stance)
@@ -524,6 +525,7 @@ def adm3d_text(scene, data, start: Adams3dStart, name: str, version: str = "") -
         out += hip_roll_statements(start.law, ids, contacts)
     out += actuation_3d_statements(scene, ids, contacts, data.slope_rad, start.law is not None)
     if any(b.endswith("_shank") for b in start.feet):
-        out += knee_3d_statements(scene, ids, data.slope_rad, start.disc_m)
+        out += knee_3d_statements(scene, ids, data.slope_rad, start.disc_m, start.lanes,
+                                  width_m)
     out += ["!", "OUTPUT/REQSAVE, GRSAVE"]
     return "\n".join([*out, "END", ""])

@@ -34,7 +34,7 @@ from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.opensim_contact import latch_foot_offset
 
 __all__ = ["LATCH_SFORCE", "LATCH_VARIABLES", "TREAD_BLOCK", "knee_latches", "latch_law",
-           "latch_sforce"]
+           "latch_sforce", "tread_under"]
 
 #: VARIABLE ids of the knee latch (:func:`knee_latches`): the slope's sine and cosine, each
 #: leg's contact height [mm], the latch's engagement and its two factors (foot, knee); on
@@ -137,28 +137,58 @@ def latch_sforce(V: dict, leg: str, i_m: int, j_m: int, h_rel: float, cap: float
 def _tread_under(leg: str, marker: int, start: AdamsStart | None, out_id: int) -> list[str]:
     """VARIABLE ``out_id``: ``leg``'s contact height [mm] above the tread of its lane's patch
     under ``marker`` (the foot sphere's centre: its position along the slope is the contact
-    point's) on stairs and footholds, from its height above the slope line (VARIABLE
-    ``LATCH_VARIABLES["line_<leg>"]``); the contact model's rule
-    (:func:`walkerlab.models.contact.generated._point`): a patch is under the point when its
-    centre lies within half the patch width along the slope, and a point above the lane's
-    highest tread reads its height above the slope line.  None ([]) without tread heights
-    (the slope's patches lie on its line)."""
+    point's) on stairs and footholds (:func:`tread_under` on the start's lanes).  None ([])
+    without tread heights (the slope's patches lie on its line)."""
     if start is None or start.lane_heights is None or start.lanes is None:
         return []
     i = 0 if leg == "leg1" else 1
-    centres, heights = start.lanes[i], start.lane_heights[i]
     V = LATCH_VARIABLES
-    line, along = V[f"line_{leg}"], V[f"along_{leg}"]
-    base, half = TREAD_BLOCK[leg], start.patch_width_m / 2 * MM
-    out = [_var(along, f"VARVAL({V['cos']})*DX({marker},101)-VARVAL({V['sin']})*"
-                       f"DY({marker},101)")]
+    along = (f"VARVAL({V['cos']})*DX({marker},101)-VARVAL({V['sin']})*"
+             f"DY({marker},101)")
+    return tread_under(V, leg, along, start.lanes[i], start.lane_heights[i],
+                       start.patch_width_m, out_id)
+
+
+def tread_under(V: dict, leg: str, along: str, centres, heights, width_m: float,
+                out_id: int) -> list[str]:
+    """VARIABLE ``out_id``: ``leg``'s contact height [mm] above the tread of its lane's patch
+    under its foot, from its height above the slope's plane through the origin (VARIABLE
+    ``V["line_<leg>"]``) and the expression ``along`` of its position along the fall line
+    [mm] (the planar and the 3D datasets'); the contact model's rule
+    (:func:`walkerlab.models.contact.assembly.pressed`): a patch is under the point when its
+    centre lies within half the patch width along the slope, and a point above the lane's
+    highest tread reads its height above the slope line.
+
+    Parameters
+    ----------
+    V : dict
+        VARIABLE ids: ``line_<leg>``, ``along_<leg>``, ``tread_<leg>``, ``above_<leg>``,
+        ``below_top_<leg>`` (:data:`LATCH_VARIABLES`); the patch terms' ids from
+        :data:`TREAD_BLOCK`.
+    leg : {"leg1", "leg2"}
+    along : str
+        The foot's position along the fall line [mm] (an Adams expression).
+    centres, heights : sequence of float
+        The lane's patch centres along the fall line and their tops' heights along the
+        normal [m] (a height of 0: a tread on the slope's plane, no term).
+    width_m : float
+        The patches' length along the fall line [m].
+    out_id : int
+
+    Returns
+    -------
+    list of str
+    """
+    line, along_id = V[f"line_{leg}"], V[f"along_{leg}"]
+    base, half = TREAD_BLOCK[leg], width_m / 2 * MM
+    out = [_var(along_id, along)]
     terms = []
     for j, (c, h) in enumerate(zip(centres, heights)):
         if h == 0.0:
             continue  # a tread on the slope line
         d, t = base + 2 * j, base + 2 * j + 1
         off = f"-{_f(c * MM)}" if c >= 0 else f"+{_f(-c * MM)}"
-        out += [_var(d, f"ABS(VARVAL({along}){off})"),
+        out += [_var(d, f"ABS(VARVAL({along_id}){off})"),
                 _var(t, f"{_f(h * MM)}*IF(VARVAL({d})-{_f(half)}:1,1,0)")]
         terms.append(f"VARVAL({t})")
     top = max([0.0, *heights]) * MM

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES",
-           "KNEED_3D_FIRST_STRIDE", "KNEED_3D_ADAMS_GROUND", "KNEED_3D_STAIRS_KNEE_STRIKE",
+           "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_3D_TORSO", "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
@@ -93,13 +93,6 @@ FOOTHOLDS_EXPORT_3D = ("on footholds of several heights the 3D walker's steps di
                        "walk on them is not measured (OpenSim is not installed where the "
                        "layout was made; the kneed walker's knee latch on patches of "
                        "alternating heights): give footholds of one height for this view")
-#: why the kneed walker in 3D's Adams dataset refuses stairs and footholds
-#: (:func:`walkerlab.export.adams_3d_knees.knee_3d_statements`' latch height)
-KNEED_3D_ADAMS_GROUND = ("the kneed 3D dataset's knee latch measures a foot's height from the "
-                         "slope's plane through the first footfall, not from the tread under "
-                         "it (the planar dataset's IF over the patches): on stairs and "
-                         "footholds a foot that has stepped a riser or a foothold below that "
-                         "plane keeps its latch, and its knee straight, through the swing")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
@@ -472,7 +465,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # stepping loop's knee latch reading each foot above the tread under it
         # (walkerlab.export.opensim_walk.contact_height)
         **{(g, "osim"): None for g in ("stairs", "footholds")},
-        **{(g, "adams"): KNEED_3D_ADAMS_GROUND for g in ("stairs", "footholds")},
+        # the Adams dataset: the patches at the footfalls, the knee latch reading each foot
+        # above the tread under it (walkerlab.export.adams_latch.tread_under)
+        **{(g, "adams"): None for g in ("stairs", "footholds")},
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_3D,
         # the MJCF and the URDF: the 3D straight legs' (walkerlab.export.legs_3d_mjcf.
