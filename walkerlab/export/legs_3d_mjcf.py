@@ -123,14 +123,12 @@ from walkerlab.export.legs_3d_parts import (
     hip_roll_law,
     kneed,
     leg_links,
+    legs3d_bodies,
     legs3d_footfalls,
     legs3d_lanes,
     legs3d_numbers,
-    legs3d_roles,
-    legs_summary,
-    legs_words,
+    legs_header,
     round_feet,
-    walker_tree,
 )
 from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_scene import LANE_BITS, MJCF_MIN_INERTIA_KG_M2, actuation_text
@@ -140,7 +138,7 @@ from walkerlab.export.parts import tree_part
 from walkerlab.export.scene import latch_note, mujoco_contact
 from walkerlab.export.scene_ground import EXPORT_STEPS
 from walkerlab.export.text import comment, num, nums
-from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
+from walkerlab.export.tree_bodies import PelvisRoles, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.walker.walker_trees import walker_tree as body_tree
@@ -485,9 +483,7 @@ def _bodies(data) -> tuple:
     walker's tree (:func:`walkerlab.export.tree_bodies.export_bodies`), its geoms
     (:func:`_geoms`) and the MJCF lines of its couplings' tendons and equalities (none
     without an upper body)."""
-    tree, coords, p = walker_tree(data)
-    roles = legs3d_roles(data)
-    root, couplings = export_bodies(tree, coords, p, roles)
+    root, couplings, p, roles = legs3d_bodies(data)
     if kneed(data) and not data.structure.hip_roll:  # the pelvis a rod between the hips
         # (module docstring); on slides and a roll (hip-roll joints) it keeps the law's inertia
         root = replace(root, inertia_kg_m2=pelvis_rod_inertia(p))
@@ -533,12 +529,11 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
         (hip-roll joints); knees: ``latch_release_height_m``, ``latch_capture_rad``.
     """
     p = legs3d_numbers(data)
-    w, r, phi = p["w_hip"], p["r"], data.slope_rad
+    r, phi = p["r"], data.slope_rad
     disc = round_feet(data)
     law = hip_roll_law(data)
-    word, knees = legs_words(data, p)
-    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): {word} "
-                   f"{legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope {num(phi)} "
+    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): "
+                   f"{legs_header(data, p)}; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
                    "x downhill, z up, leg1 on the side of -y; a foot "
