@@ -13,10 +13,11 @@ above its foot and a sphere of radius ``r = L / 1000`` whose centre is ``L - r``
 leg (its lowest point at ``L`` with the leg upright, as the 3D wheel's spoke tips), with a
 site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest inertia
 (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).  The bodies, their masses,
-inertias and joint axes are read from the walker's body tree (:func:`walker_tree`;
-:mod:`walkerlab.export.tree_bodies`, where walkerlab's axes meet MuJoCo's); this module adds
-the geoms, the ground, the contact and the keyframe (:func:`legs3d_mjcf`, the record the
-legged walkers' one MJCF writer, :func:`walkerlab.export.mjcf_document.walker_mjcf_text`, writes).
+inertias and joint axes are read from the walker's body tree
+(:func:`~walkerlab.export.legs_3d_parts.legs3d_bodies`; :mod:`walkerlab.export.tree_bodies`,
+where walkerlab's axes meet MuJoCo's); this module adds the geoms, the ground, the contact and
+the keyframe (:func:`legs3d_mjcf`, the record the legged walkers' one MJCF writer,
+:func:`walkerlab.export.mjcf_document.walker_mjcf_text`, writes).
 
 The ground is the planar straight-legged walker's checkerboard
 (:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
@@ -47,10 +48,11 @@ upright (< 1e-23 rad over 11 heel strikes).
 
 Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
 
-Knees (``locking_knees_3d``, :func:`legs3d_roles`): each thigh ``leg<i>`` carries its shank
-``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about its pitch axis, its range
-the tree's straight-leg stop ``[-pi, 0]``; with the gait the planar kneed MJCF's latch
-(:func:`walkerlab.export.multibody.latch_equality_lines`), listed as left out.  The pelvis
+Knees (``locking_knees_3d``, :func:`~walkerlab.export.legs_3d_parts.legs3d_roles`): each thigh
+``leg<i>`` carries its shank ``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about
+its pitch axis, its range the tree's straight-leg stop ``[-pi, 0]``; with the gait the
+planar kneed MJCF's latch (:func:`walkerlab.export.multibody.latch_equality_lines`), listed
+as left out.  The pelvis
 carries the hip mass as a slender rod between the hips (``M_hip w^2 / 12`` about the roll
 and yaw axes, :func:`pelvis_rod_inertia`) where the rigid model has a point: a pelvis of a
 point mass on a free joint leaves a mechanism (its yaw with the hips' and knees' pitches)
@@ -511,7 +513,8 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     ----------
     data : WalkerData
         Its structure and parameters by name (the ``compass_gait`` shorthand's or the parts'
-        in 3D; :func:`walker_tree`), ``w_hip`` when the hips are apart.
+        in 3D; :func:`~walkerlab.export.legs_3d_parts.walker_tree`), ``w_hip`` when the hips
+        are apart.
     name, version : str
         Model name (the scene's) and walkerlab's version (header comment).
     extra : Legs3dScene, optional
