@@ -34,6 +34,15 @@ _LegLink = Annotated[Literal["leg", "thigh", "shank"],
                     Field(description="leg link carrying the body ('thigh'/'shank' need a knee)")]
 
 
+def _unique_names(bodies) -> list[str]:
+    """The names of ``bodies`` (a leg's, the upper body's or an arm's), refused (one line)
+    where one repeats."""
+    names = [b.name for b in bodies]
+    if len(set(names)) != len(names):
+        raise ValueError(f"bodies: duplicate body names {names}")
+    return names
+
+
 class PointMassBody(Strict):
     """A point mass on a leg link, at ``from_hip_m`` along the link from the hip."""
 
@@ -230,9 +239,7 @@ class LegSpec(Strict):
     def _bodies_on_leg(self) -> LegSpec:
         if self.knee is not None and self.knee.thigh_length_m >= self.length_m:
             raise ValueError("knee.thigh_length_m: the knee must lie above the foot")
-        names = [b.name for b in self.bodies]
-        if len(set(names)) != len(names):
-            raise ValueError(f"bodies: duplicate body names {names}")
+        names = _unique_names(self.bodies)
         if "foot" in names or "hip" in names:
             raise ValueError("bodies: 'foot' and 'hip' are reserved point names")
         if not any((b.from_hip_m if b.kind == "point_mass" else b.com_from_hip_m) > 0
@@ -327,9 +334,7 @@ class TorsoSpec(Strict):
 
     @model_validator(mode="after")
     def _names(self) -> TorsoSpec:
-        names = [b.name for b in self.bodies]
-        if len(set(names)) != len(names):
-            raise ValueError(f"bodies: duplicate body names {names}")
+        _unique_names(self.bodies)
         return self
 
 
@@ -373,8 +378,6 @@ class ArmsSpec(Strict):
 
     @model_validator(mode="after")
     def _names(self) -> ArmsSpec:
-        names = [b.name for b in self.bodies]
-        if len(set(names)) != len(names):
-            raise ValueError(f"bodies: duplicate body names {names}")
+        _unique_names(self.bodies)
         return self
 

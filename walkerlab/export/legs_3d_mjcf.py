@@ -13,10 +13,11 @@ above its foot and a sphere of radius ``r = L / 1000`` whose centre is ``L - r``
 leg (its lowest point at ``L`` with the leg upright, as the 3D wheel's spoke tips), with a
 site ``leg<i>_foot`` at its centre.  Point masses get the export's smallest inertia
 (:data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`).  The bodies, their masses,
-inertias and joint axes are read from the walker's body tree (:func:`walker_tree`;
-:mod:`walkerlab.export.tree_bodies`, where walkerlab's axes meet MuJoCo's); this module adds
-the geoms, the ground, the contact and the keyframe (:func:`legs3d_mjcf`, the record the
-legged walkers' one MJCF writer, :func:`walkerlab.export.mjcf_document.walker_mjcf_text`, writes).
+inertias and joint axes are read from the walker's body tree
+(:func:`~walkerlab.export.legs_3d_parts.legs3d_bodies`; :mod:`walkerlab.export.tree_bodies`,
+where walkerlab's axes meet MuJoCo's); this module adds the geoms, the ground, the contact and
+the keyframe (:func:`legs3d_mjcf`, the record the legged walkers' one MJCF writer,
+:func:`walkerlab.export.mjcf_document.walker_mjcf_text`, writes).
 
 The ground is the planar straight-legged walker's checkerboard
 (:mod:`walkerlab.export.mjcf_ground`): in the rigid model the swing foot passes through the
@@ -47,10 +48,11 @@ upright (< 1e-23 rad over 11 heel strikes).
 
 Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
 
-Knees (``locking_knees_3d``, :func:`legs3d_roles`): each thigh ``leg<i>`` carries its shank
-``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about its pitch axis, its range
-the tree's straight-leg stop ``[-pi, 0]``; with the gait the planar kneed MJCF's latch
-(:func:`walkerlab.export.multibody.latch_equality_lines`), listed as left out.  The pelvis
+Knees (``locking_knees_3d``, :func:`~walkerlab.export.legs_3d_parts.legs3d_roles`): each thigh
+``leg<i>`` carries its shank ``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about
+its pitch axis, its range the tree's straight-leg stop ``[-pi, 0]``; with the gait the
+planar kneed MJCF's latch (:func:`walkerlab.export.multibody.latch_equality_lines`), listed
+as left out.  The pelvis
 carries the hip mass as a slender rod between the hips (``M_hip w^2 / 12`` about the roll
 and yaw axes, :func:`pelvis_rod_inertia`) where the rigid model has a point: a pelvis of a
 point mass on a free joint leaves a mechanism (its yaw with the hips' and knees' pitches)
@@ -123,14 +125,12 @@ from walkerlab.export.legs_3d_parts import (
     hip_roll_law,
     kneed,
     leg_links,
+    legs3d_bodies,
     legs3d_footfalls,
     legs3d_lanes,
     legs3d_numbers,
-    legs3d_roles,
-    legs_summary,
-    legs_words,
+    legs_header,
     round_feet,
-    walker_tree,
 )
 from walkerlab.export.mjcf_document import MjcfContact, WalkerMjcf
 from walkerlab.export.mjcf_scene import LANE_BITS, MJCF_MIN_INERTIA_KG_M2, actuation_text
@@ -140,7 +140,7 @@ from walkerlab.export.parts import tree_part
 from walkerlab.export.scene import latch_note, mujoco_contact
 from walkerlab.export.scene_ground import EXPORT_STEPS
 from walkerlab.export.text import comment, num, nums
-from walkerlab.export.tree_bodies import PelvisRoles, export_bodies, mjcf_coupling_lines
+from walkerlab.export.tree_bodies import PelvisRoles, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.models.contact.rigid_limit import contact_si
 from walkerlab.walker.walker_trees import walker_tree as body_tree
@@ -485,9 +485,7 @@ def _bodies(data) -> tuple:
     walker's tree (:func:`walkerlab.export.tree_bodies.export_bodies`), its geoms
     (:func:`_geoms`) and the MJCF lines of its couplings' tendons and equalities (none
     without an upper body)."""
-    tree, coords, p = walker_tree(data)
-    roles = legs3d_roles(data)
-    root, couplings = export_bodies(tree, coords, p, roles)
+    root, couplings, p, roles = legs3d_bodies(data)
     if kneed(data) and not data.structure.hip_roll:  # the pelvis a rod between the hips
         # (module docstring); on slides and a roll (hip-roll joints) it keeps the law's inertia
         root = replace(root, inertia_kg_m2=pelvis_rod_inertia(p))
@@ -515,7 +513,8 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     ----------
     data : WalkerData
         Its structure and parameters by name (the ``compass_gait`` shorthand's or the parts'
-        in 3D; :func:`walker_tree`), ``w_hip`` when the hips are apart.
+        in 3D; :func:`~walkerlab.export.legs_3d_parts.walker_tree`), ``w_hip`` when the hips
+        are apart.
     name, version : str
         Model name (the scene's) and walkerlab's version (header comment).
     extra : Legs3dScene, optional
@@ -533,12 +532,11 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
         (hip-roll joints); knees: ``latch_release_height_m``, ``latch_capture_rad``.
     """
     p = legs3d_numbers(data)
-    w, r, phi = p["w_hip"], p["r"], data.slope_rad
+    r, phi = p["r"], data.slope_rad
     disc = round_feet(data)
     law = hip_roll_law(data)
-    word, knees = legs_words(data, p)
-    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): {word} "
-                   f"{legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope {num(phi)} "
+    head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): "
+                   f"{legs_header(data, p)}; slope {num(phi)} "
                    "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
                    "x downhill, z up, leg1 on the side of -y; a foot "

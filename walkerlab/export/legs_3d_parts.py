@@ -14,14 +14,14 @@ from walkerlab.analysis.contact.footfalls import rigid_footfalls
 from walkerlab.export.axes_3d import TO_MUJOCO
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import num
-from walkerlab.export.tree_bodies import PelvisRoles
+from walkerlab.export.tree_bodies import PelvisRoles, export_bodies
 from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_tree
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "bisector_keyframe", "hip_roll_law", "kneed",
-           "leg_links", "legs3d_footfalls", "legs3d_lanes", "legs3d_numbers", "legs3d_roles",
-           "legs_summary", "legs_words",
+           "leg_links", "legs3d_bodies", "legs3d_footfalls", "legs3d_lanes", "legs3d_numbers",
+           "legs3d_roles", "legs_header", "legs_summary", "legs_words",
            "round_feet", "walker_tree"]
 
 #: a round foot's disc: its half-thickness along the hip axis, as a fraction of the leg
@@ -56,6 +56,30 @@ def walker_tree(data) -> tuple:
     (:func:`walkerlab.walker.trees.legs_tree`; ``data``'s parameters by name,
     :func:`legs3d_numbers`)."""
     return (*legs_tree(data.structure), legs3d_numbers(data))
+
+
+def legs3d_bodies(data, **options) -> tuple:
+    """The 3D legged walker's export bodies, read from its body tree (:func:`walker_tree`)
+    with its roles (:func:`legs3d_roles`) by
+    :func:`walkerlab.export.tree_bodies.export_bodies` (``options``: its keywords).
+
+    Parameters
+    ----------
+    data : WalkerData
+        The 3D legged walker.
+    **options
+        :func:`~walkerlab.export.tree_bodies.export_bodies`'s keywords (``inertia_floor``).
+
+    Returns
+    -------
+    (root, couplings, p, roles)
+        The root export body and the couplings (as ``export_bodies`` gives them), the
+        walker's numbers by name (:func:`legs3d_numbers`) and its export roles.
+    """
+    tree, coords, p = walker_tree(data)
+    roles = legs3d_roles(data)
+    root, couplings = export_bodies(tree, coords, p, roles, **options)
+    return root, couplings, p, roles
 
 
 def legs_summary(data, p: dict) -> str:
@@ -112,6 +136,26 @@ def legs_words(data, p: dict) -> tuple[str, str]:
     return "kneed", (f"; knees {num(p['L_thigh'])} m below the hips on hinges leg<i>_knee "
                      "about the leg's own pitch axis (shank - thigh angle, limit [-pi, 0], "
                      "0 = straight-leg stop)")
+
+
+def legs_header(data, p: dict) -> str:
+    """The legs in a clause for the files' header comment: their word and numbers
+    (:func:`legs_words`, :func:`legs_summary`), the hips' spacing and the knees' clause.
+
+    Parameters
+    ----------
+    data : WalkerData
+        The 3D legged walker.
+    p : dict
+        Its numbers by name (its parameters', or :func:`legs3d_numbers`).
+
+    Returns
+    -------
+    str
+        ``"<word> <summary>, hips <w> m apart<knees>"``.
+    """
+    word, knees = legs_words(data, p)
+    return f"{word} {legs_summary(data, p)}, hips {num(p.get('w_hip', 0.0))} m apart{knees}"
 
 
 def bisector_keyframe(roles, x) -> tuple[float, float]:

@@ -73,12 +73,11 @@ from walkerlab.export.legs_3d_parts import (
     hip_roll_law,
     kneed,
     leg_links,
+    legs3d_bodies,
     legs3d_numbers,
     legs3d_roles,
-    legs_summary,
-    legs_words,
+    legs_header,
     round_feet,
-    walker_tree,
 )
 from walkerlab.export.mjcf_scene import actuation_text
 from walkerlab.export.omitted import OSIM_KNEE_LATCH, Omission, actuation_omissions, xml_comments
@@ -106,7 +105,7 @@ from walkerlab.export.opensim_xml import (
     torque_joints,
 )
 from walkerlab.export.text import comment, num, nums
-from walkerlab.export.tree_bodies import ExportJoint, export_bodies
+from walkerlab.export.tree_bodies import ExportJoint
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 from walkerlab.models.contact.rigid_limit import contact_si
 
@@ -173,8 +172,7 @@ def osim3d_bodies(data):
     ``pelvis_x``, ``pelvis_y`` (up), ``pelvis_z`` and the roll ``pelvis_roll`` about the fall
     line, the tree's masses and inertias without a floor; and its couplings
     (:func:`walkerlab.export.tree_bodies.export_bodies`)."""
-    tree, coords, p = walker_tree(data)
-    root, couplings = export_bodies(tree, coords, p, legs3d_roles(data), inertia_floor=0.0)
+    root, couplings, _, _ = legs3d_bodies(data, inertia_floor=0.0)
     fall, _ = slope_axes(data.slope_rad)
     joints = (ExportJoint("pelvis_x", "slide", (1.0, 0.0, 0.0)),     # the exports' axes:
               ExportJoint("pelvis_y", "slide", (0.0, 0.0, 1.0)),     # OpenSim's y up,
@@ -311,11 +309,9 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
     motors = torque_joints(act, None, coords[4:])
     law = hip_roll_law(data)
     knees = [c for c in coords if c.endswith("_knee")]
-    word, knee_words = legs_words(data, p)
     out = ['<?xml version="1.0" encoding="UTF-8" ?>', '<OpenSimDocument Version="40600">',
            comment(f"walker {name!s} in 3D exported by walkerlab {version} (OpenSim model): "
-                   f"{word} {legs_summary(data, p)}, hips {num(p['w_hip'])} m apart"
-                   f"{knee_words}; written from its body tree "
+                   f"{legs_header(data, p)}; written from its body tree "
                    "(walkerlab.export.opensim_3d)."),
            comment("Axes: x downhill (horizontal), y up, z to the walker's right (the pitch "
                    "axis: a positive angle moves a foot ahead). Coordinates: pelvis_x, "

@@ -56,11 +56,9 @@ from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
     hip_roll_law,
     leg_links,
-    legs3d_roles,
-    legs_summary,
-    legs_words,
+    legs3d_bodies,
+    legs_header,
     round_feet,
-    walker_tree,
 )
 from walkerlab.export.mjcf_scene import (
     MjcfScene,
@@ -73,7 +71,7 @@ from walkerlab.export.parts import export_part
 from walkerlab.export.planar_bodies import planar_bodies, sole_points
 from walkerlab.export.spoked import WHEEL_TIP_FRACTION
 from walkerlab.export.text import arc_feet, comment, header, num, nums
-from walkerlab.export.tree_bodies import axis_text, export_bodies
+from walkerlab.export.tree_bodies import axis_text
 from walkerlab.export.tree_links import tree_multibody
 from walkerlab.export.urdf_omitted import (
     flat_feet_comments,
@@ -284,11 +282,10 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
     (:func:`walkerlab.export.legs_3d_parts.walker_tree`), each leg's rod and foot sphere
     (round feet: its disc)."""
     p = dict(zip(data.structure.param_names, data.params))
-    L, w = p["L"], p.get("w_hip", 0.0)
+    L = p["L"]
     r = p["R_foot"] if round_feet(data) else WHEEL_TIP_FRACTION * L
-    word, knees = legs_words(data, p)
     comments = [comment(f"walker {name!s} in 3D exported by walkerlab {version} (URDF): "
-                        f"{word} {legs_summary(data, p)}, hips {num(w)} m apart{knees}; slope "
+                        f"{legs_header(data, p)}; slope "
                         f"{num(data.slope_rad)} rad (not in the file: URDF has no ground); "
                         "the pelvis is the free root link"),
                 *xml_comments(legs_urdf_omissions(data, actuation))]
@@ -297,10 +294,8 @@ def _legs_3d_text(data, name: str, version: str, actuation) -> str:
         comments.append(comment(f"walkerlab_hip_roll: {json.dumps(law)}"))
     if actuation is not None:
         comments.append(comment(f"walkerlab_actuation: {actuation_text(actuation)}"))
-    tree, coords, p = walker_tree(data)
     # with hip-roll joints the pelvis' roll and each leg's roll then pitch; knees (the MJCF's)
-    roles = legs3d_roles(data)
-    root, couplings = export_bodies(tree, coords, p, roles)
+    root, couplings, p, roles = legs3d_bodies(data)
     links = leg_links(p, roles)
 
     def visuals(b, pad: str) -> list[str]:   # each leg link's rod, the foot's sphere (disc)

@@ -64,8 +64,7 @@ def contact_replay(scene, res, strides: int = 1, *, plant) -> tuple[float, str]:
               for b in leg.get("bodies", [])]
     if bodies and all(b.get("mass_kg", 1.0) == 0.0 for b in bodies):
         return float("nan"), "not replayed: massless legs (the contact view needs masses)"
-    setup, why = _powered_setup(scene, _hip_actuation(res),
-                                {"n_strides": strides, "sample_rate_hz": 500}, plant=plant)
+    setup, why = _powered_setup(scene, _hip_actuation(res), strides, plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.laws = TorqueOfTime(torque_of_time(res), _nodes(res))
@@ -108,8 +107,7 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
         ended, or why there is no replay (one line), as :func:`contact_replay`.
     """
     setup, why = _powered_setup(scene, {"torques": [{"joint": j, "law": {}} for j in JOINTS]},
-                                {"n_strides": strides, "sample_rate_hz": 500}, terrain=True,
-                                plant=plant)
+                                strides, terrain=True, plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.rigid.laws = law
@@ -153,8 +151,8 @@ def contact_replay_phased(scene, res, strides: int = 1, *, plant) -> tuple[float
     """
     # a powered run is on a Python RHS (slow on a flat-footed walker's stride): bounded by
     # its work (contact_sim.max_rhs_evaluations' default), the same on any machine
-    setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
-                                {"n_strides": strides, "sample_rate_hz": 500}, plant=plant)
+    setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]}, strides,
+                                plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.laws = TorqueOfTime(phase_torque_of_time(res),
@@ -192,8 +190,7 @@ def contact_replay_stride(scene, res, strides: int = 2, *, plant) -> tuple[float
     """
     if plant.kind.in_3d:
         return float("nan"), STRIDE_3D
-    setup, why = _powered_setup(scene, _hip_actuation(res),
-                                {"n_strides": strides, "sample_rate_hz": 500}, plant=plant)
+    setup, why = _powered_setup(scene, _hip_actuation(res), strides, plant=plant)
     if setup is None:
         return float("nan"), why
     acts = setup.actuators
@@ -240,10 +237,11 @@ def _law_of_time(tau):
     return lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
 
 
-def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = False, *,
+def _powered_setup(scene, actuation: dict, strides: int, terrain: bool = False, *,
                    plant):
-    """The contact set-up of ``scene`` with ``actuation`` in place of its walker's and
-    ``contact_sim`` as its run section (its ``contact`` law, the paper's default one if none;
+    """The contact set-up of ``scene`` with ``actuation`` in place of its walker's and a run
+    section of ``strides`` strides sampled at 500 Hz (its ``contact`` law, the paper's
+    default one if none;
     ``terrain``: continuous level ground if none), or ``(None, why)`` in one line; the
     replay's walker is :meth:`~walkerlab.walker.plant.Plant.with_` of ``plant`` (the
     scene's, handed down)."""
@@ -254,7 +252,7 @@ def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = Fa
     d.setdefault("contact", {})
     if terrain:
         d.setdefault("terrain", {})
-    d["contact_sim"] = contact_sim
+    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
     try:
         sc = type(scene).model_validate(d)  # the replay's scene: a neighbour of the plant's
         return contact_setup(sc, plant=plant.with_(sc)), ""
