@@ -93,15 +93,32 @@ def test_upright_the_3d_kneed_floating_view_has_the_planar_kneed_walkers_energie
     assert float(Tp) > 0.1   # the check sees the rates
 
 
-def test_the_3d_kneed_floating_view_with_its_stance_foot_held_is_the_rigid_model():
+def _with_torso(name: str):
+    """``name``'s walker carrying configs/kneed_torso_powered_3d.yaml's upper body (0.4 kg
+    0.2 m above the hips' midpoint, on the bisecting hip)."""
+    from walkerlab.config import scene_from_dict
+
+    d = load_scene(f"configs/{name}.yaml").model_dump(mode="json", exclude_none=True)
+    d["walker"]["torso"] = {"coupling": "bisecting_hip", "bodies": [
+        {"kind": "point_mass", "name": "mass", "mass_kg": 0.4, "from_hip_m": 0.2}]}
+    scene = scene_from_dict(d)
+    return walker_data(scene.walker, scene.slope.phi_rad)
+
+
+@pytest.mark.parametrize("torso", [False, True], ids=["legs", "upper_body"])
+def test_the_3d_kneed_floating_view_with_its_stance_foot_held_is_the_rigid_model(torso):
     """At a configuration with lean, a bent swing knee and the legs apart, the floating
     view's mass matrix and gravity pulled back through ``J`` (rigid rates ``lean,
     swing_thigh, swing_shank, stance`` -> floating rates: the foot and heading at rest,
     leg2's roll the lean, leg2's thigh and shank the stance leg's pitch) are the rigid
     model's, ``J^T M_f J = M`` and ``J^T G_f = G``, to 1e-12 of their largest entries; a
     map with leg2's shank left out (a straight stance leg's inertia split) misses by far
-    more."""
-    data = _data("kneed_3d")
+    more.  With an upper body on the bisecting hip (Wisse, Hobbelen & Schwab 2007) the
+    floating view has no coordinate of its own for it (its pitch the thighs' mean, as the
+    rigid model's is the swing thigh's and the stance leg's), and the same holds: the rigid
+    kneed model with an upper body is Newton's law of its point masses
+    (tests/test_kneed_torso_3d.py)."""
+    data = _with_torso("kneed_3d") if torso else _data("kneed_3d")
     ns, p, nq = _view(data)
     names = ns["COORDINATES"]
     q = {"lean": 0.07, "swing_thigh": -0.31, "swing_shank": -0.74, "stance": 0.22}

@@ -147,8 +147,8 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
                thigh: str | None = None, knee_stop: bool = False, hip_mass: bool = True,
                hip_width: str | float = 0, hip_roll: bool = False, foot_radius: str | None =
                None, coordinates: str = "absolute", free_joints: bool = False,
-               soles: Soles | None = None, lateral_radius: str | None = None
-               ) -> tuple[BodyTree, CoordinateMap]:
+               soles: Soles | None = None, lateral_radius: str | None = None,
+               hinged_torso: bool | None = None) -> tuple[BodyTree, CoordinateMap]:
     """A biped on legs of parts as a tree (module docstring), in three dimensions (Kuo 1999)
     or in the plane, its special case: each leg a frame carrying ``legs`` (welded), the
     pelvis with ``M_hip`` midway between the hips, and an upper body carrying ``torso`` held
@@ -195,7 +195,8 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         stance_thigh, swing_thigh, swing_shank`` with a knee, else ``stance, swing``, then
         ``torso``): with ``thigh`` the stance leg a shank ``stance_shank`` at the foot and a
         thigh ``stance_leg`` on the knee ``stance_knee``; the upper body's pitch the
-        coordinate ``torso`` (from the upward vertical, leaning back) in place of the legs'.
+        coordinate ``torso`` (from the upward vertical, leaning back) in place of the legs'
+        (unless ``hinged_torso`` is False: then the thighs' mean).
     soles : Soles, optional
         Planar flat feet (module docstring): the stance sole at the root, each leg on its
         ankle; coordinates ``stance_ankle, swing_ankle`` after the legs'.
@@ -204,6 +205,10 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         each foot a torus patch whose lateral section has this radius ``R_l`` (module
         docstring); the stance foot's travel along the fall line is then the coordinate
         ``travel`` (its rolling is not holonomic: :mod:`walkerlab.codegen.rolling_feet`).
+    hinged_torso : bool, optional
+        The upper body on a hinge of its own (its coordinate ``torso``); False: on the
+        bisecting hip, also on a tree of free joints (the 3D kneed walker's floating tree:
+        the thighs' mean); default ``free_joints``.
 
     Returns
     -------
@@ -238,7 +243,9 @@ def biped_tree(params: tuple[str, ...], legs: tuple[Part, ...], torso: tuple[Par
         swing.append(sole)
     bodies += swing + _torso(torso, hip_width)
     tree = BodyTree(params, Root(stance_contact=contacts[0].name), tuple(bodies), contacts)
-    return tree, _coordinates(planar, thigh is not None, hip_roll, foot_radius, bool(torso),
+    hinged = free_joints if hinged_torso is None else hinged_torso
+    return tree, _coordinates(planar, thigh is not None, hip_roll, foot_radius,
+                              ("hinged" if hinged else "bisecting") if torso else None,
                               coordinates, free_joints, soles is not None, lateral_radius)
 
 
@@ -336,17 +343,18 @@ def _swing_leg(swing: tuple[Part, ...], thigh: str | None, up_leg: str, R: str |
     return bodies, ContactPoint(name, foot_link, (0, to_foot, 0))
 
 
-def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: bool,
+def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso: str | None,
                  coordinates: str, free: bool = False, flat: bool = False,
                  lateral: str | None = None) -> CoordinateMap:
     """The walker's coordinates and its tree's joint angles in them (:func:`biped_tree`;
-    ``free``: every joint free, :mod:`walkerlab.codegen.legged`' coordinates;
+    ``torso``: ``"hinged"`` (its coordinate ``torso``), ``"bisecting"`` (the legs' mean) or
+    None; ``free``: every joint free, :mod:`walkerlab.codegen.legged`' coordinates;
     ``flat``: flat feet, the ankles' after the legs'; ``lateral``: toroidal feet, the
     stance foot's travel ``travel`` last and its sideways travel ``R_l lean``)."""
     ankle = None          # the stance shank's angle, on a stance knee
     if free:
         names = (("stance_shank", "stance_thigh", "swing_thigh", "swing_shank") if knee
-                 else ("stance", "swing")) + (("torso",) if torso else ())
+                 else ("stance", "swing")) + (("torso",) if torso == "hinged" else ())
         swing, stance = ("swing_thigh", "stance_thigh") if knee else ("swing", "stance")
         ankle = "stance_shank" if knee else None
     elif coordinates == "slope_relative":  # Garcia et al. (1998): theta, and phi between legs
@@ -377,8 +385,8 @@ def _coordinates(planar: bool, knee: bool, hip_roll: bool, R: str | None, torso:
     angles += (("swing_ankle_pitch", "swing_ankle"),) if flat else ()
     if knee:
         angles += (("swing_knee", "swing_shank - swing_thigh"),)
-    if torso:   # hinged, or the bisecting hip: the legs' mean
-        angles += (("torso_pitch", "torso + gamma" if free else
+    if torso:   # hinged, or the bisecting hip: the legs' (the thighs') mean
+        angles += (("torso_pitch", "torso + gamma" if torso == "hinged" else
                     f"({swing} + {stance}) / 2 + gamma"),)
     return CoordinateMap(names, angles)
 
@@ -508,7 +516,8 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                       free_joints=(planar and (structure.free_knees or structure.hinged_torso))
                       or (floating and not planar and structure.knee),
                       soles=_soles(structure, swap_roles) if structure.foot == "flat" else None,
-                      lateral_radius="R_lat" if structure.foot == "toroidal" else None)
+                      lateral_radius="R_lat" if structure.foot == "toroidal" else None,
+                      hinged_torso=structure.hinged_torso)
     return with_arms(*tree, structure.arms, structure.knee) if structure.arms else tree
 
 
