@@ -191,3 +191,25 @@ def test_the_3d_kneed_walker_walks_its_first_stride_in_contact_at_the_rigid_step
     assert times.size >= 2
     assert abs(times[1] / 2 / rigid - 1.0) < 0.01
     assert out.failure and "capsized sideways" in out.failure and times.size <= 6
+
+
+@pytest.mark.slow  # ~3 min cold (the floating tree's kernels with an upper body), 10 s warm
+def test_the_3d_kneed_walker_with_an_upper_body_walks_in_contact_at_the_rigid_gait(tmp_path):
+    """configs/kneed_torso_powered_3d.yaml (the stabilised kneed walker in 3D with a 0.4 kg
+    upper body on the bisecting hip, driven by a torque between it and the stance leg) in
+    the contact model: 6 strides on the rigid footfalls' 0.2 m patches make >= 12 heel
+    strikes without a fall, and over steps 9-12 the mean step period and the hip's speed
+    are within 3 % of the rigid walk's same steps (measured +0.12 %, -1.64 %)."""
+    from walkerlab.api.capabilities import _contact_against_rigid
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import pipeline
+
+    d = load_scene("configs/kneed_torso_powered_3d.yaml").model_dump(mode="json")
+    d["simulate"]["strides"] = 7  # the rigid walk as long as the contact walk
+    scene = scene_from_dict(d)
+    cs = pipeline.run("contact-sim", scene, tmp_path).path
+    fp = pipeline.run("fixedpoint", scene, tmp_path).path
+    sim = pipeline.run("simulate", scene, tmp_path).path
+    value, line = _contact_against_rigid(cs, fp, sim)
+    assert "heel strikes" in line and int(line.split()[0]) >= 12, line
+    assert abs(value) < 0.03, line

@@ -13,7 +13,7 @@ from __future__ import annotations
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES",
            "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
-           "KNEED_3D_TORSO", "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
+           "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND",
@@ -152,15 +152,6 @@ KNEED_3D_STAIRS_KNEE_STRIKE = (
     "(the rigid knee strike pins it: normal impulse +0.020 N s, tangential -0.005 N s on "
     "both grounds); a knee stop damped from 1e-3 rad instead of 1e-5 rad keeps the foot "
     "loaded and measures -2.33 % (its slope -1.87 %, against -1.68 %)")
-#: why the kneed walker in 3D's views other than the rigid ones (the rigid model, the gym's
-#: rigid view, the URDF's masses) refuse its upper body's torque: the floating tree
-#: (:func:`walkerlab.walker.trees.legs_tree` with ``floating``) frees both knees
-KNEED_3D_TORSO = ("the floating tree of the kneed walker in 3D (the contact model's) frees "
-                  "both knees and every link's pitch, and its upper body then hangs on a "
-                  "free hinge: the bisecting hip (the upper body on the thighs' mean, Wisse, "
-                  "Hobbelen & Schwab 2007) is a relation of the rigid tree's coordinates, "
-                  "not a joint of that tree; the rigid model walks it "
-                  "(configs/kneed_torso_powered_3d.yaml)")
 #: what the views of every legged kind refuse: a profile in the OpenSim model, a ground
 #: other than the slope in the URDF (the contact
 #: model, the MJCF, the OpenSim model, the Adams dataset and the gym's contact view lay their
@@ -425,11 +416,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # leg: the 3D straight legs' (walkerlab.models.hybrid.actuated._Legs3d) on the
         # kneed tree (the thigh's pitch for the swing leg's), its stable gait
         # configs/kneed_torso_powered_3d.yaml's in the rigid model and the gym's rigid view
-        # (it steps the rigid model); the URDF writes its tree (the masses); the MJCF its
-        # torso hinge held to the thighs' mean by its equality, the keyframe on it
-        # (walkerlab.export.legs_3d_parts.bisector_keyframe)
-        ("torso_torque", "*"): KNEED_3D_TORSO,
-        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf")},
+        # (it steps the rigid model); the contact model's floating tree carries it on the
+        # thighs' mean (walkerlab.walker.trees.biped_tree's hinged_torso); the URDF writes
+        # its tree (the masses); the MJCF its torso hinge held to the thighs' mean by its
+        # equality, the keyframe on it (walkerlab.export.legs_3d_parts.bisector_keyframe)
+        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf", "contact")},
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
         # OpenSim: the bisecting hip as a bisector body on two one-coordinate couplers
         # (walkerlab.export.opensim_tree.bisected_tree) on the thighs' hinges
