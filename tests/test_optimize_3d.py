@@ -52,7 +52,7 @@ def _states(scene, rng, n: int = 4):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["paper_3d", "hip_width_powered"])
+@pytest.mark.parametrize("name", ["paper_3d", "hip_width_powered", "torso_bhm_3d_stabilised"])
 def test_the_3d_collocation_functions_are_the_rigid_models(name):
     """At states near the gait, against the rigid model's generated code (not the CasADi
     expressions): the flow with a hip torque of 0.7 N m, the heel strike, the heel strike
@@ -60,7 +60,8 @@ def test_the_3d_collocation_functions_are_the_rigid_models(name):
     and the stance foot's ground reaction (the rigid model's floating view, Newton's rows):
     round-off (1e-9; the reaction 1e-6 N of ~200 N: the floating view's accelerations by
     differences).  paper_3d: one step's functions (zero hip width); hip_width_powered: the
-    stride's first step (hip width, the hip-roll law)."""
+    stride's first step (hip width, the hip-roll law); torso_bhm_3d_stabilised: the same
+    with a 5 kg upper body on the bisecting hip (its mass in the reaction's momentum)."""
     pytest.importorskip("casadi")
     from walkerlab.models.hybrid.ground_reaction import StanceReaction
     from walkerlab.optimal.transcription.step_cache import (
@@ -100,7 +101,8 @@ def test_the_3d_collocation_functions_are_the_rigid_models(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "intervals"), [("paper_3d", 60),
-                                                 ("hip_width_optimal", 60)])
+                                                 ("hip_width_optimal", 60),
+                                                 ("torso_bhm_3d_stabilised", 60)])
 def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name, intervals):
     """int u^2 dt = 0 at the gait that walks without the hip torque, so the optimum is it
     (with hip-roll joints: the gait under the foot-placement law, part of the walker's
@@ -108,7 +110,9 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     the fixed point ``walkerlab fixedpoint`` finds by shooting (Hermite-Simpson's O(h^4):
     seen 2.3e-8 (paper_3d) and 9.1e-7 (hip width) on 40 intervals a step, 1.8e-7 (hip
     width) on 60), each step's
-    period within 1e-7 relative and the replay on the rigid model closing to 1e-6."""
+    period within 1e-7 relative and the replay on the rigid model closing to 1e-6.  With an
+    upper body on the bisecting hip (torso_bhm_3d_stabilised, Wisse, Hobbelen & Schwab
+    2007) the same: the upper body is part of the walker's equations, not an input."""
     pytest.importorskip("casadi")
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.optimal.driver import optimize_scene

@@ -287,7 +287,7 @@ def check_kind(scene, kind) -> None:
 def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
     kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
-    flat-footed or five-link walker, 3D disc feet, a 3D torso) and a clearance that cannot hold
+    flat-footed or five-link walker, 3D disc feet) and a clearance that cannot hold
     (``optimize.min_clearance_m > 0``: :func:`_feet_level_when_legs_cross`).
 
     Parameters
@@ -313,8 +313,6 @@ def check_scene(scene, data) -> None:
     check_kind(scene, data.structure.kind)
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
-    if data.structure.in_3d and data.structure.torso:  # an upper body on the bisecting hip
-        data.structure.kind.require("torso_torque", "optimize", "walker.torso")
     if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
         from walkerlab.optimal.transcription.landing import check_stride_ground
 

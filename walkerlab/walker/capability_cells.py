@@ -16,7 +16,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "TORSO_OPTIMIZE_3D", "URDF_GROUND",
+           "STAGE_VIEWS", "TORSO_ADAMS_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -99,11 +99,6 @@ TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the
                   "alone: on the bisecting hip the torso's pitch is the legs' mean, so a "
                   "torque tau between torso and stance leg is the hip torque -tau/2 (give "
                   "it as joint: hip)")
-#: why the collocation refuses a 3D walker's upper body (:func:`walkerlab.optimal.
-#: transcription.stride.stride_functions`)
-TORSO_OPTIMIZE_3D = ("a 3D walker's collocation is a stride of two mirrored steps (its hip "
-                     "width puts them on either side), whose transcription carries straight "
-                     "legs without an upper body: optimise the walker without walker.torso")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("the hybrid zero dynamics of Bezier outputs (Westervelt, Grizzle & Koditschek 2003) "
          "take one unactuated degree of freedom, the stance foot's pitch: a 3D walker's lean "
@@ -362,7 +357,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # body on a bisector body, each hinge a one-coordinate coupler: walkerlab.export.
         # opensim_tree.bisected_tree)
         ("torso_torque", "adams"): TORSO_ADAMS_3D,
-        ("torso_torque", "optimize"): TORSO_OPTIMIZE_3D,
+        # an upper body on the bisecting hip: part of the stride's equations (the tree's),
+        # its mass in the ground reaction's momentum rows
+        ("torso_torque", "optimize"): None,
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
         # d-dimensional: walkerlab.models.contact.assembly.point3)

@@ -175,13 +175,14 @@ def mode_functions(data, walker, order=None) -> dict:
     ------
     ValueError
         A walker or phase this transcription has no symbolic form for (massless legs, a
-        torso, arc feet, free knees; one line).
+        planar walker's torso, arc feet, free knees; one line).
     """
     import casadi as ca
 
     st = data.structure
     modes = st.kind.phases.behaviour if st.kind.phases is not None else None
-    if modes is None or st.torso or st.foot == "arc" or any(b.massless for b in st.bodies):
+    if (modes is None or (st.torso and not st.in_3d) or st.foot == "arc"
+            or any(b.massless for b in st.bodies)):
         raise ValueError("optimize: the phased transcription takes massive legs with point "
                          "or flat feet and no torso today")
     order = order if order is not None else phase_order(walker)

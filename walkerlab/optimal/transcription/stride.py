@@ -105,7 +105,8 @@ def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
     Raises
     ------
     ValueError
-        Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
+        Mirror-image legs (one step is the map), knees, flat or arc feet, a planar walker's
+        torso (a 3D walker's upper body on the bisecting hip is in its equations), massless
         legs; footholds of more than two heights (one line).
     """
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
@@ -115,10 +116,11 @@ def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
         raise ValueError("optimize: a stride is for legs that differ (mirror-image legs take "
                          "one step)")
     one_step = st.kind.collocation is not None and st.kind.collocation.one_step
-    if (not one_step or st.foot == "arc" or st.torso
+    if (not one_step or st.foot == "arc" or (st.torso and not st.in_3d)
             or any(b.massless for b in st.bodies)):
         raise ValueError("optimize: a stride of legs that differ takes straight massive legs "
-                         "with point feet today (knees, flat or arc feet, a torso: not yet)")
+                         "with point feet today (knees, flat or arc feet, a planar torso: "
+                         "not yet)")
     check_stride_ground(ground, data)
     fns, phases = None, []
     for k, (leg, d) in enumerate(zip(SWINGING, (replace(data, mirror_params=None),
