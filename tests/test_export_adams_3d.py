@@ -242,15 +242,19 @@ def test_a_3d_acf_runs_the_requested_strides(case):
     assert max(len(s) for s in adm.splitlines()[1:]) <= 80
 
 
-def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_a_wheel_on_footholds(
-        tmp_path):
-    """``walkerlab export configs/hip_width_stabilised.yaml --format adm`` writes both files;
-    a spoked wheel on footholds (its dataset lays continuous ground) is refused in one line
-    naming the field, nothing written."""
+def test_the_cli_writes_the_hip_roll_walkers_dataset_and_a_wheel_on_footholds(tmp_path):
+    """``walkerlab export configs/hip_width_stabilised.yaml --format adm`` writes both files.
+    A spoked wheel on footholds 5 mm below and above its slope in turn (its contact model's
+    continuous ground: a tread through each landing, risers half-way) writes its dataset
+    too: a box per segment of that ground, and each landing of the rigid wheel - two tips a
+    chord ``c = 2 L sin(pi / n)`` apart, footfall ``k + 1`` at ``h_k cos(phi)`` along the
+    slope's normal and ``sqrt(c^2 - (h_k cos phi)^2)`` along it from footfall ``k``, written
+    out here from the scene's numbers - lies on a box's top face raised by the tip sphere's
+    radius, to 1e-9 m (footfalls -1 to 6)."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
-    from walkerlab.walker.capability_cells import WHEEL_ADAMS_FOOTHOLDS
+    from walkerlab.export.spoked import WHEEL_TIP_FRACTION
     from walkerlab.walker.reference_cases import reference_scene
 
     run = CliRunner().invoke
@@ -265,10 +269,33 @@ def test_the_cli_writes_the_hip_roll_walkers_dataset_and_refuses_a_wheel_on_foot
     cfg = tmp_path / "wheel_footholds.yaml"
     cfg.write_text(yaml.safe_dump(d))
     r = run(app, ["export", str(cfg), "--format", "adm", "--runs-dir", str(tmp_path)])
-    assert r.exit_code != 0 and r.output.strip().count("\n") == 0, r.output
-    assert WHEEL_ADAMS_FOOTHOLDS in " ".join(r.output.split()) and "terrain." in r.output
-    assert "Traceback" not in r.output
-    assert not (tmp_path / "wheel_footholds" / "walker.adm").exists()
+    assert r.exit_code == 0, r.output
+    model = read_adm((tmp_path / "wheel_footholds" / "walker.adm").read_text())
+    L, n_spokes = d["walker"]["spoke_length_m"], d["walker"]["spokes"]
+    phi, h = d["slope"]["angle_rad"], d["terrain"]["foothold_heights_m"]
+    c, radius = 2 * L * math.sin(math.pi / n_spokes), WHEEL_TIP_FRACTION * L
+    t, nrm = np.array([math.cos(phi), -math.sin(phi)]), np.array([math.sin(phi), math.cos(phi)])
+
+    def step(k):
+        up = h[k % len(h)] * math.cos(phi)
+        return math.sqrt(c * c - up * up) * t + up * nrm
+
+    falls = [-step(-1), np.zeros(2)]
+    for k in range(6):
+        falls.append(falls[-1] + step(k))
+    tops = []  # each box's top face (x, z) [m], raised by the tip sphere's radius
+    for g in model.by_kind["GRAPHICS"].values():
+        if "BOX" not in g.flags:
+            continue
+        origin, rot = model.marker_pose(g.integer("CORNER"))
+        up = rot @ np.array([0.0, 0.0, g.number("Z") / 1000.0])
+        along = rot @ np.array([g.number("X") / 1000.0, 0.0, 0.0])
+        a = (origin + up + radius * up / np.linalg.norm(up))[[0, 2]]
+        tops.append((a, along[[0, 2]]))
+    for p in falls:
+        on = [np.linalg.norm(p - (a + np.clip((p - a) @ e / (e @ e), 0, 1) * e)) < 1e-9
+              for a, e in tops]
+        assert any(on), p
 
 
 def _evaluate(model, ids=(331, 332, 333, 334, 341, 343, 351, 352)) -> dict:

@@ -85,9 +85,58 @@ def test_stairs_as_patches_at_the_footholds_and_as_treads_and_risers():
     assert line[i[0], 0] == pytest.approx(-0.205) and line[i[0] + 1, 0] == pytest.approx(0.205)
 
 
+def test_footholds_on_continuous_ground_are_treads_through_the_footfalls():
+    """Footholds 1 cm below each other on continuous lanes (before: refused, "no ground
+    between the footholds"): one polyline of level treads (the stairs scene's level slope)
+    through the footfalls ``k l`` at ``-k`` cm, footfall -1 (the trailing foot's) at
+    +1 cm, joined by vertical risers half-way between footfalls; the first and last treads
+    run on 100 m."""
+    from walkerlab.models.contact.model import ContactWalker
+    from walkerlab.models.contact.rigid_limit import contact_si
+
+    sc = _stairs(kind="footholds", foothold_heights_m=[-0.01], lanes="continuous",
+                 riser_m=None, tread_m=None, direction=None)
+    si, knee = contact_si(sc.contact)
+    w = ContactWalker(contact=si, phi=0.0, knee_stop=knee)
+    ell = 0.414
+    line = w.on_terrain(sc.terrain, step_length=ell, n_steps=6).ground_line
+    seg = np.diff(line, axis=0)
+    assert np.all((seg[:, 0] == 0) | (seg[:, 1] == 0))  # level treads, vertical risers
+    assert line[0, 0] == pytest.approx(-ell - 100.0) and line[0, 1] == pytest.approx(0.01)
+    risers = line[1:-1:2, 0]
+    np.testing.assert_allclose(risers, (np.arange(risers.size) - 0.5) * ell, atol=1e-12)
+    np.testing.assert_allclose(line[1:-1:2, 1], 0.01 - 0.01 * np.arange(risers.size),
+                               atol=1e-12)
+    np.testing.assert_allclose(seg[1::2, 1], -0.01, atol=1e-12)
+
+
+def test_a_point_beyond_a_convex_corner_is_outside_the_ground():
+    """The polyline's signed distance past the top of an up-riser (a convex corner: the
+    riser's line has the point inside, the upper tread's outside): the point is outside,
+    at its distance from the corner, the normal from the corner to it; in the concave
+    corner at the riser's foot a point is inside by its distance to the nearer face.
+    (Before: the riser, listed first, decided the side, and a wheel's spoke tip 1.9 m above
+    such a corner was taken 1.9 m deep in the ground.)"""
+    from walkerlab.models.contact._kernels import ground_line
+
+    line = np.ascontiguousarray(np.array([[-5.0, 0.0], [0.0, 0.0], [0.0, 0.05],
+                                          [5.0, 0.05]]).ravel())
+    for p in ((0.01, 1.9), (0.3, 1.0), (1e-6, 0.06)):
+        delta, nx, ny = ground_line(*p, line)
+        assert delta < 0.0
+        if p[0] < 0.05:  # nearest the tread: above it
+            assert delta == pytest.approx(-(p[1] - 0.05), abs=1e-12)
+    delta, nx, ny = ground_line(-0.01, 0.06, line)  # above the corner, behind the riser
+    r = np.hypot(0.01, 0.01)
+    assert delta == pytest.approx(-r, abs=1e-12) and (nx, ny) == pytest.approx((-0.01 / r,
+                                                                                 0.01 / r))
+    delta, _, _ = ground_line(0.002, 0.001, line)  # inside the step at its foot
+    assert delta == pytest.approx(0.002, abs=1e-12)  # 2 mm behind the riser's face
+
+
 @pytest.mark.parametrize("terrain, field", [
-    ({"kind": "footholds", "foothold_heights_m": [-0.01], "lanes": "continuous",
-      "riser_m": None, "tread_m": None, "direction": None}, "terrain.lanes"),
+    ({"kind": "footholds", "foothold_heights_m": [-0.01], "foothold_slopes_rad": [0.02],
+      "riser_m": None, "tread_m": None, "direction": None}, "terrain.foothold_slopes_rad"),
 ])
 def test_ground_the_contact_model_does_not_build_is_refused_in_one_line(terrain, field):
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup

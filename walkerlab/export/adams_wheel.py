@@ -56,10 +56,11 @@ from walkerlab.export.adams_3d import reuler_angles
 from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt, marker_statement
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
+from walkerlab.export.mjcf_ground import wheel_footfalls
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import Omission
-from walkerlab.export.spoked import WHEEL_TIP_FRACTION, _wheel_numbers
-from walkerlab.models.contact.terrain import profile_line
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION, _wheel_numbers, wheel_chord_m
+from walkerlab.models.contact.terrain import footholds_line, profile_line
 from walkerlab.models.ground import stair_treads
 from walkerlab.walker.walker_trees import walker_tree
 
@@ -104,8 +105,9 @@ class WheelStart:
         A planar wheel's stairs: each tread's ``(x_start, x_end, height)`` [m] in walkerlab's
         world (:func:`walkerlab.models.ground.stair_treads`); None: not stairs.
     profile : ndarray (m, 2) or None
-        A planar wheel's height profile's vertices [m] (walkerlab's world, x ahead, y up:
-        :func:`walkerlab.models.contact.terrain.profile_line`); None: not a profile.
+        A height profile's vertices [m] (walkerlab's world, x ahead, y up:
+        :func:`walkerlab.models.contact.terrain.profile_line`), or footholds as a polyline
+        (:func:`_footholds_line`); None: neither.
     """
 
     origin: np.ndarray
@@ -144,9 +146,10 @@ def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = Non
     hub_inertia_kg_m2 : float, optional
         A point-mass hub's moment about the axle (``contact.hub_inertia_kg_m2``).
     terrain : walkerlab.config.TerrainSettings, optional
-        A planar wheel's stairs or height profile, laid as its MJCF lays them
+        A wheel's stairs or height profile, laid as its MJCF lays them
         (:func:`walkerlab.export.mjcf_ground.wheel_ground`: the first stance tip at the
-        origin); None or a slope: the slope.
+        origin), or footholds as its contact model lays them on continuous ground
+        (:func:`_footholds_line`); None or a slope: the slope.
 
     Returns
     -------
@@ -188,12 +191,25 @@ def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = Non
     kind = getattr(terrain, "kind", "slope")
     treads = (tuple(stair_treads(terrain, 0.0, 2 * strides + 6)) if kind == "stairs"
               else None)
-    profile = profile_line(terrain, 0.0, 0.0) if kind == "profile" else None
+    profile = (profile_line(terrain, 0.0, 0.0) if kind == "profile" else
+               _footholds_line(terrain, data) if kind == "footholds" else None)
     return WheelStart(C @ pts["stance_foot"], C @ Rb @ C.T, C @ vel["hip"], C @ omega,
                       C @ np.array([_value(v, values) for v in body.com_m]),
                       C @ inertia @ C.T, _value(body.mass_kg, values), tips, p["L"],
                       float(ideal.period_s), data.slope_rad, planar, 2 * strides + 2,
                       treads, profile)
+
+
+def _footholds_line(terrain, data, n: int = 60) -> np.ndarray:
+    """Footholds as the contact model lays them on continuous ground
+    (:func:`walkerlab.models.contact.terrain.footholds_line`: a tread through each footfall,
+    risers half-way) at the rigid wheel's landings (:func:`walkerlab.export.mjcf_ground.
+    wheel_footfalls`, the MJCF's patches), the first stance tip at the origin."""
+    phi = data.slope_rad
+    falls = wheel_footfalls(terrain, wheel_chord_m(data), phi, n)
+    pts = np.array([falls[k] for k in sorted(falls)])
+    t, nrm = np.array([math.cos(phi), -math.sin(phi)]), np.array([math.sin(phi), math.cos(phi)])
+    return footholds_line(pts @ t, pts @ nrm, phi)
 
 
 def _boxes(start: WheelStart) -> list[tuple[str, np.ndarray, np.ndarray, tuple]]:
@@ -252,7 +268,9 @@ def adm_wheel_text(scene, data, start: WheelStart, name: str, version: str = "")
     J = start.inertia * MM * MM
     R = start.rotation
     wb = R.T @ start.omega
+    footholds = getattr(scene.terrain, "kind", "slope") == "footholds"
     ground = ("stairs" if start.treads is not None else
+              "footholds (a tread through each landing, risers half-way)" if footholds else
               "a height profile" if start.profile is not None else "the slope")
     out = [f"walker {name} exported by walkerlab {version} (Adams Solver dataset, "
            f"{'planar' if start.planar else '3D'} spoked wheel)",

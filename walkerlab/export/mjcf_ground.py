@@ -187,11 +187,12 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
                      "footholds and profiles")
 
 
-def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int,
-                     half_width_m: float | None = None) -> list[str]:
-    """:func:`wheel_ground`'s footholds: a box per footfall, footfall -1 (behind the first
-    stance tip) to ``n`` (a finite list, ``periodic: false``: its own footfalls),
-    ``half_width_m`` across the fall line each side (default ``0.04 L``)."""
+def wheel_footfalls(terrain, c: float, phi: float, n: int) -> dict[int, np.ndarray]:
+    """Where a spoked wheel's tips land on footholds (:func:`wheel_ground`'s rule): footfall
+    ``k`` [m] (2,) in the world (x downhill, up), footfall 0 (the first stance tip) at the
+    origin, footfall -1 behind it, up to ``n`` (a finite list, ``periodic: false``: its own
+    footfalls); two tips a chord ``c`` [m] apart, step ``k`` landing ``h_k`` above the
+    stance tip's level on the slope ``phi`` [rad]."""
     h = [-d for d in landing_drops(terrain)]  # each step's landing above the stance tip
     t = np.array([math.cos(phi), -math.sin(phi)])
     nrm = np.array([math.sin(phi), math.cos(phi)])
@@ -204,6 +205,15 @@ def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int,
     falls = {0: np.zeros(2), -1: -step(-1)}
     for k in range(last):
         falls[k + 1] = falls[k] + step(k)
+    return falls
+
+
+def _wheel_footholds(terrain, L: float, c: float, phi: float, n: int,
+                     half_width_m: float | None = None) -> list[str]:
+    """:func:`wheel_ground`'s footholds: a box per footfall (:func:`wheel_footfalls`),
+    ``half_width_m`` across the fall line each side (default ``0.04 L``)."""
+    nrm = np.array([math.sin(phi), math.cos(phi)])
+    falls = wheel_footfalls(terrain, c, phi, n)
     w = float(terrain.patch_width_m)
     depth = w / 10
     half = 0.04 * L if half_width_m is None else float(half_width_m)

@@ -75,9 +75,6 @@ PROFILE_3D = ("a 3D walker's lean and pelvis roll turn about its ground's fall l
               "pelvis' roll axis held on it): a profile's slope changes from step to step, "
               "turning that axis between steps, which the rigid state does not carry; "
               "stairs and footholds of several heights keep one fall line")
-#: why the spoked wheels' contact model refuses footholds (planar and 3D)
-WHEEL_FOOTHOLDS_CONTACT = ("a rimless wheel's contact model runs on continuous ground (its "
-                           "spokes have no lanes of their own)")
 #: why the 3D spoked wheel refuses a height profile
 PROFILE_WHEEL_3D = ("the 3D wheel's heading and lean are angles about its ground's normal "
                     "and fall line through the stance spoke's tip: a profile's slope changes "
@@ -174,11 +171,6 @@ _WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ank
                                               "torso_torque", "push_off", "ankle_push_off",
                                               "virtual_constraints")}
 _WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
-#: why the planar wheel's Adams dataset refuses footholds
-WHEEL_ADAMS_FOOTHOLDS = ("footholds are patches at the rigid wheel's own landings (a chord "
-                         "apart, each step's height along the normal), which its MJCF lays "
-                         "(--format mjcf); its Adams dataset lays continuous ground under "
-                         "the spoke tips: the slope, stairs, a profile")
 _WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
                    "one, walkerlab fixedpoint)")
 _PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
@@ -318,12 +310,13 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # the Adams dataset: the tree's one body on its spoke tips, on the slope, stairs
         # (a box per tread) or a profile (a box per segment)
         # (walkerlab.export.adams_wheel.adm_wheel_text)
-        ("footholds", "adams"): WHEEL_ADAMS_FOOTHOLDS,
+        ("footholds", "adams"): None,
         ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
                            "(one rigid body) is exported as urdf or mjcf"),
         ("walk", "gym"): _WHEEL_GYM,
-        # footholds have no ground between them; the wheel's contact model needs it
-        ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
+        # footholds on continuous ground (the wheel's): a tread through each landing,
+        # risers half-way (walkerlab.models.contact.terrain.footholds_line)
+        ("footholds", "contact"): None,
         **_URDF_GROUNDS,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
     },
@@ -487,9 +480,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # wheel's; the Adams dataset a box per tread (walkerlab.export.adams_wheel)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "mjcf")},
         ("stairs", "contact"): None,
-        ("footholds", "contact"): WHEEL_FOOTHOLDS_CONTACT,
+        ("footholds", "contact"): None,
         ("stairs", "adams"): None,
-        ("footholds", "adams"): WHEEL_ADAMS_FOOTHOLDS,
+        ("footholds", "adams"): None,
         **_URDF_GROUNDS,
         ("profile", "*"): PROFILE_WHEEL_3D,
         ("profile", "urdf"): URDF_GROUND,

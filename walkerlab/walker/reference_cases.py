@@ -134,6 +134,8 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
             terrain.update(lanes="checkerboard", patch_width_m=d["terrain"]["patch_width_m"])
         elif feature == "stairs" and w.get("space") == "3d" and "spokes" not in w:  # legs:
             terrain.pop("lanes")  # the swing foot passes through the ground: footfall patches
+        elif feature == "footholds" and "spokes" in w:  # a wheel's spokes have no lanes:
+            terrain["lanes"] = "continuous"  # a tread through each landing, risers half-way
         d["terrain"] = terrain
         if feature == "stairs":
             d["slope"] = {"angle_rad": 0.0}

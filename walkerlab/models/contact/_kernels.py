@@ -85,7 +85,10 @@ def ground_line(px, py, line):
     closest point (clamped to the segment) is nearest; the sign is the side of that segment's
     line.  Past a segment's end (a corner) the normal is the direction from that end to the
     point, so penetration and normal are continuous around corners; the penetration is the
-    distance to the ground's surface (a signed distance function of the polyline)."""
+    distance to the ground's surface (a signed distance function of the polyline).  A point
+    nearest to a vertex that ends two segments is inside only when it is inside both
+    segments' lines: beyond a convex corner (the top of a riser up) it lies inside one line
+    and outside the other, and is outside the ground."""
     m = line.shape[0] // 2
     best = np.inf
     delta, nx, ny = -np.inf, 0.0, 1.0
@@ -97,15 +100,21 @@ def ground_line(px, py, line):
             continue
         u = ((px - ax) * ex + (py - ay) * ey) / l2
         clamped = u < 0.0 or u > 1.0
-        u = min(max(u, 0.0), 1.0)
-        dx, dy = px - (ax + u * ex), py - (ay + u * ey)
+        if u <= 0.0:    # past an end: the vertex itself (a tie between the two segments
+            dx, dy = px - ax, py - ay   # that share it is exact)
+        elif u >= 1.0:
+            dx, dy = px - line[2 * j + 2], py - line[2 * j + 3]
+        else:
+            dx, dy = px - (ax + u * ex), py - (ay + u * ey)
         r2 = dx * dx + dy * dy
-        if r2 >= best:
+        if r2 > best:
             continue
-        best = r2
         ln = np.sqrt(l2)
         sx, sy = -ey / ln, ex / ln  # the segment's outward normal
         side = -((px - ax) * sx + (py - ay) * sy)  # > 0: inside the ground
+        if r2 == best and not (clamped and delta > 0.0 and side <= 0.0):
+            continue  # a tie at a vertex two segments share: inside only inside both
+        best = r2
         r = np.sqrt(r2)
         if clamped and r > 0.0:
             sg = 1.0 if side > 0.0 else -1.0

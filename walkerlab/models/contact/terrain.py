@@ -115,6 +115,43 @@ def footfall_lanes(walker, heights_m: np.ndarray):
                    heights1=h[1:2 * walker.lane1.size:2], **ground)
 
 
+def footholds_line(footfalls_m, heights_m, phi: float, run_m: float = 100.0) -> np.ndarray:
+    """Vertices (m, 2) [m] of footholds on continuous ground as a polyline in the world frame
+    (x downhill, y up): a tread through each footfall ``k`` (at ``footfalls_m[k]`` along the
+    slope and ``heights_m[k]`` along its outward normal), along the slope's line, joined to
+    the next by a vertical riser half-way (in x) between the two footfalls; the first and
+    last treads run on ``run_m`` beyond their footfalls.  The footholds say where the feet
+    land (:func:`walkerlab.models.ground.landing_drops`), not what lies between them: a
+    tread to the half-way riser is the ground a walker's stance foot or a wheel's stance
+    spoke rolls on until the next footfall takes over.
+
+    Parameters
+    ----------
+    footfalls_m : ndarray (n,)
+        The footfalls along the slope [m], in walking order (increasing).
+    heights_m : ndarray (n,)
+        Their heights along the slope's outward normal [m]
+        (:func:`footfall_heights`).
+    phi : float
+        The slope [rad] (the treads' angle, downhill).
+    run_m : float
+        How far the first and last treads run on [m].
+    """
+    s, h = np.asarray(footfalls_m, float), np.asarray(heights_m, float)
+    c, sn = math.cos(phi), math.sin(phi)
+    x, y = s * c + h * sn, -s * sn + h * c     # the footfalls in the world frame
+
+    def on(k: int, xx: float) -> tuple[float, float]:   # tread k's point above xx
+        return xx, float(y[k] - (xx - x[k]) * math.tan(phi))
+
+    pts = [on(0, float(x[0] - run_m * c))]
+    for k in range(s.size - 1):
+        mid = 0.5 * float(x[k] + x[k + 1])
+        pts += [on(k, mid), on(k + 1, mid)]
+    pts.append(on(s.size - 1, float(x[-1] + run_m * c)))
+    return np.asarray(pts, dtype=float)
+
+
 def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np.ndarray:
     """Vertices (m, 2) [m] of stairs as a polyline in the world frame: the level treads of
     :func:`walkerlab.models.ground.stair_treads` (the rigid view's, the same ground) joined
@@ -163,11 +200,7 @@ def ground_drops(terrain) -> tuple[float, ...]:
             raise ValueError("terrain.profile_csv: the contact model reads inline profiles "
                              "(terrain.profile_m) only so far, as the rigid walk does")
         return (0.0,)
-    drops = landing_drops(terrain)
-    if terrain.kind == "footholds" and terrain.lanes == "continuous":
-        raise ValueError("terrain.lanes: continuous footholds have no ground between the "
-                         "footholds: use lanes: checkerboard (patches at the footholds)")
-    return drops
+    return landing_drops(terrain)
 
 
 def footfall_positions(step_lengths_m, n_footfalls: int) -> np.ndarray:
@@ -298,16 +331,17 @@ def terrain_ground(walker, terrain, n_steps: int):
         :func:`footfall_lanes`); footholds of several heights: footfall ``k`` at
         :func:`footfall_heights` (the lanes laid at the rigid gait's footfalls, step by
         step).  Stairs on continuous ground: the treads and risers as a polyline
-        (:func:`stairs_line`); a profile: its polyline (:func:`profile_line`), or on the
-        checkerboard lanes flat patches at its height (:func:`profile_patch_heights`).
+        (:func:`stairs_line`); footholds on continuous ground: a tread through each
+        footfall, risers half-way (:func:`footholds_line`); a profile: its polyline
+        (:func:`profile_line`), or on the checkerboard lanes flat patches at its height
+        (:func:`profile_patch_heights`).
 
     Raises
     ------
     ValueError
         A ground the contact model does not build (one line, naming the field): a profile
         that is not flat across a checkerboard patch (:func:`profile_patch_heights`),
-        footholds of their own slopes, footholds on continuous ground
-        (:func:`ground_drops`).
+        footholds of their own slopes (:func:`ground_drops`).
     """
     if terrain is None or terrain.kind == "slope":
         return walker
@@ -330,4 +364,16 @@ def terrain_ground(walker, terrain, n_steps: int):
         phi = float(walker.phi)
         return replace(walker, ground_line=profile_line(
             terrain, first * math.cos(phi), -first * math.sin(phi)))
+    if terrain.kind == "footholds":  # treads through the footfalls, risers half-way
+        phi, p = float(walker.phi), len(drops)
+        n = 2 * min(walker.lane1.size, walker.lane2.size)
+        falls = np.empty(n)
+        falls[0::2], falls[1::2] = walker.lane2[:n // 2], walker.lane1[:n // 2]
+        heights = footfall_heights(drops, n, phi)
+        # the footfall before the first (the trailing foot's, a wheel's trailing spoke's):
+        # the period's last step before it, periodic footholds; else level with the first
+        back = drops[-1] if terrain.periodic is not False else 0.0
+        falls = np.r_[falls[0] - (falls[p] - falls[p - 1]), falls]
+        heights = np.r_[heights[0] + back * math.cos(phi), heights]
+        return replace(walker, ground_line=footholds_line(falls, heights, phi))
     return replace(walker, ground_line=stairs_line(terrain, first, int(n_steps) + 2))
