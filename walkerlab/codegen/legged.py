@@ -354,9 +354,9 @@ def derive_legged(structure) -> Equations:
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     knee, arc = structure.knee, structure.foot in ("arc", "toroidal")
     torus = structure.foot == "toroidal"   # curved both ways (walkerlab.codegen.rolling_feet)
-    if torus and (planar or knee or structure.hip_roll):
-        raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D straight-legged "
-                         "walker's (no knee, no hip-roll joints)")
+    if torus and (planar or structure.hip_roll):
+        raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D walker's (no "
+                         "hip-roll joints)")
     free = planar and structure.kind.joints_free
     if free:
         _check_free(structure)
