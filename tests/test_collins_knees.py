@@ -119,3 +119,44 @@ def test_the_kneed_walker_on_toroidal_feet_conserves_energy_over_each_passive_ph
         assert np.ptp(kinetic + potential) > 1e-8, phase.name   # not holonomic
         if phase.name == "locked_swing":
             assert np.max(np.abs(ys[2] - ys[1])) < 1e-12
+
+
+# --- configs/collins2001_knees.yaml -----------------------------------------------------------
+
+#: the straight-legged walker's lateral multiplier a stride (configs/collins2001.yaml,
+#: tests/test_collins2001.py)
+STRAIGHT_LATERAL = 1.473069
+
+
+@pytest.fixture(scope="module")
+def collins_knees():
+    from walkerlab.analysis.gait.poincare import find_fixed_point, poincare_map
+
+    scene = Scene.model_validate(_raw("collins2001_knees.yaml"))
+    walker = _walker(scene)
+    x = _guess(scene, walker.state_names())
+    start = poincare_map(walker, x, SOLVER)[0] - x
+    return walker, x, start, find_fixed_point(walker, x, SOLVER, fd_check=False)
+
+
+@pytest.mark.slow   # the arms' tree on knees and toroidal feet: minutes cold
+def test_the_collins_walker_with_knees_ships_its_gait_and_is_laterally_unstable(collins_knees):
+    """configs/collins2001_knees.yaml: the shipped guess is the stride's fixed point to 1e-9
+    (its map's residual there); step period 0.608591 s, step 0.426403 m, 0.7006 m/s
+    against the robot's 0.51 m/s; the multipliers a stride 2.1185 (real: the lateral mode,
+    lean and lean rate), 0.5992, |0.0033 +- 0.2300i|, 0.0303 and three 0s (the section and
+    the knee locked at heel strike): unstable, as the straight-legged walker
+    (configs/collins2001.yaml: a complex pair of 1.473 a stride).  To 1e-5 relative."""
+    walker, x, start, res = collins_knees
+    assert np.max(np.abs(start)) < 1e-9
+    assert np.max(np.abs(res.x - x)) < 1e-9
+    step = res.period_s / 2
+    length = res.step_lengths_m[0]
+    assert abs(step - 0.6085913) < 1e-5 * step
+    assert abs(length - 0.4264032) < 1e-5 * length
+    assert abs(length / step / 0.51 - 1.3738) < 1e-3     # the robot's 0.51 m/s
+    mu = res.multipliers_variational
+    lead = mu[np.argmax(np.abs(mu))]
+    assert abs(lead.imag) < 1e-9 and abs(lead.real - 2.118538) < 1e-5 * 2.118538
+    assert lead.real > STRAIGHT_LATERAL                 # the knees raise it
+    assert np.sort(np.abs(mu))[-2] < 1.0                # the rest inside the unit circle
