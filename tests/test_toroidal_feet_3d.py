@@ -108,14 +108,14 @@ def test_toroidal_contact_moves_sideways_and_conserves_energy():
 
 @pytest.mark.parametrize(("change", "says"), [
     ({"space": "2d", "hip_width_m": 0.0}, "walker.leg.foot.kind: toroidal feet are a 3D"),
-    ({"leg": {"length_m": 1.2, "knee": {"thigh_length_m": 0.6, "lock": "plastic"},
-              "bodies": [{"kind": "point_mass", "name": "shank_mass", "link": "shank",
-                          "mass_kg": 0.1, "from_hip_m": 0.9}],
-              "foot": {"kind": "toroidal", "radius_m": 0.2, "lateral_radius_m": 0.1}}},
-     "walker.leg.foot.kind"),
+    ({"hip_roll": {"pelvis_roll_inertia_kg_m2": 0.3, "pelvis_stiffness_n_m_per_rad": 1.0,
+                   "pelvis_damping_n_m_s_per_rad": 0.1, "swing_stiffness_n_m_per_rad": 1.0,
+                   "swing_damping_n_m_s_per_rad": 0.1, "lean_gain": -1.0,
+                   "lean_rate_gain_s": -0.18}}, "walker.hip_roll"),
 ])
 def test_toroidal_feet_refused_where_not_carried(change, says):
-    """A planar walker and locking knees refuse toroidal feet in one line naming the field."""
+    """A planar walker and hip-roll joints refuse toroidal feet in one line naming the field
+    (locking knees take them: tests/test_collins_knees.py)."""
     raw = _raw(0.1)
     raw["walker"].update(change)
     with pytest.raises(ValueError, match=says):

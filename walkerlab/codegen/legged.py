@@ -319,7 +319,11 @@ def derive_legged(structure) -> Equations:
     (:func:`walkerlab.codegen.lagrange.knee_lock`: ``locked``, ``knee_impact``, the heel
     strike with the knee locked in ``Mi``, ``B``); the guard ``knee_extension`` ``shank -
     thigh``; after heel strike the new swing knee is straight and the section ties the
-    shank's angle and rate to the thigh's.
+    shank's angle and rate to the thigh's.  On toroidal feet (Collins, Wisse & Ruina 2001)
+    the stance foot rolls on the straight stance leg (the reduction's pitch the stance
+    leg's), the swing foot sits on the shank (the heel strike's material point rolls by the
+    shank's pitch), and the knee strike is the reduced flow's (its mass matrix ``S^T M_f
+    S``: the rolling holds through the impulse).
 
     Free joints (``structure.kind.joints_free``, planar): free knees on both legs (the
     five-link biped of Westervelt, Grizzle & Koditschek 2003, "Hybrid zero dynamics of
@@ -354,9 +358,9 @@ def derive_legged(structure) -> Equations:
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     knee, arc = structure.knee, structure.foot in ("arc", "toroidal")
     torus = structure.foot == "toroidal"   # curved both ways (walkerlab.codegen.rolling_feet)
-    if torus and (planar or knee or structure.hip_roll):
-        raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D straight-legged "
-                         "walker's (no knee, no hip-roll joints)")
+    if torus and (planar or structure.hip_roll):
+        raise ValueError("walker.leg.foot.kind: toroidal feet are a 3D walker's (no "
+                         "hip-roll joints)")
     free = planar and structure.kind.joints_free
     if free:
         _check_free(structure)

@@ -284,8 +284,6 @@ class BipedParams(_Actuated):
                 ("walker.leg.knee", leg.knee is not None and (
                     leg.knee.lock != "plastic" or leg.knee.spring is not None),
                  "straight legs or locking knees (knee.lock: plastic, no knee.spring)"),
-                ("walker.leg.foot.kind", leg.knee is not None and leg.foot.kind == "toroidal",
-                 "point or arc feet on locking knees (toroidal feet roll on straight legs)"),
                 ("walker.leg.foot.kind", leg.foot.kind not in ("point", "arc", "toroidal"),
                  "point, arc or toroidal feet"),
                 ("walker.leg.bodies", any(b.mass_kg == 0 for b in leg.bodies),
