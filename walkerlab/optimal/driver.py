@@ -499,9 +499,13 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
     kneed walker's thighs, between a flat-footed walker's legs).  ``resolve_gait``: the
     scene's gait has a double-support phase the collocation's walker has not (flat feet),
     so the start is that walker's own gait, solved here (``x_gait``, ``period_s``
-    unused)."""
+    unused).  A walker whose steps differ (a 3D kneed walker with hip width: its steps mirror
+    each other sideways, ``data.mirror``) takes a stride of two phased steps
+    (:func:`_stride`)."""
     import time
 
+    if plant.kind.in_3d and plant.data.mirror is not None:  # steps mirrored sideways
+        return _stride(scene, plant, collocation_spec(scene), x_gait, period_s, phased=True)
     from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription.mode_sequence import (
@@ -560,17 +564,20 @@ def _check_stride(o, pushes: bool) -> None:
                                                 "optimize.push_off: free)"))
 
 
-def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
+def starting_stride(scene, walker, x_gait, period_s: float, intervals: int, order=None):
     """The stride collocation's start for ``scene``: its ``optimize.initial_guess`` (another
-    stride's ``optimize.h5``: its four phases' states and torque; a continuation artifact's
+    stride's ``optimize.h5``: its phases' states and torque; a continuation artifact's
     gait at ``at``: the stride map's start there), else one stride of its gait ``x_gait``
-    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step.
+    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step, each step through
+    ``order`` (its ``(phase, guard, direction)``; None: the straight legs'
+    :data:`walkerlab.optimal.transcription.stride.STEP_PHASES`).
 
     Returns
     -------
     guess : list of (name, t, x)
-        The four phases :data:`walkerlab.optimal.transcription.stride.STRIDE_PHASES`
-        (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
+        The stride's phases (:func:`walkerlab.optimal.transcription.stride.stride_phases`
+        of ``order``; straight legs: :data:`~walkerlab.optimal.transcription.stride.
+        STRIDE_PHASES`) (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
         :func:`walkerlab.optimal.transcription.mode_sequence.optimized_guess` on
         ``2 intervals``).
     torque : list of ndarray or None
@@ -586,49 +593,59 @@ def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.guess import read_guess
     from walkerlab.optimal.transcription.mode_sequence import optimized_guess
-    from walkerlab.optimal.transcription.stride import STRIDE_PHASES, stride_guess
+    from walkerlab.optimal.transcription.stride import STEP_PHASES, stride_guess, stride_phases
 
     kind, got = None, None
     if scene.optimize.initial_guess is not None:
         kind, got = read_guess(scene, list(walker.state_names()))
     if kind == "optimize":
-        return optimized_guess(got, list(STRIDE_PHASES), 2 * intervals)
+        return optimized_guess(got, list(stride_phases(order or STEP_PHASES)), 2 * intervals)
     x0 = got if kind == "continuation" else x_gait
     return stride_guess(walker, x0, period_s, Solver.from_settings(scene.solver),
-                        intervals), None
+                        intervals, order), None
 
 
-def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
+def _stride(scene, plant, spec, x_gait, period_s, phased: bool = False) -> OptimizeData:
     """One stride of a walker whose legs differ (the step sequence of the walker and its
     mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
     ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
     map's, each step's energies from its own walker (leg B's step: the mirror's masses);
     on stairs or footholds started and replayed there (:func:`~walkerlab.optimal.
-    transcription.stride.on_ground`)."""
+    transcription.stride.on_ground`).  ``phased``: each step goes through the rigid
+    walker's own phases (:func:`walkerlab.optimal.transcription.phases.phase_order`: a 3D
+    kneed walker's unlocked swing, knee strike, locked swing, heel strike), else the
+    straight legs' early and late swing."""
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription import stride
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.phases import phase_order
+    from walkerlab.optimal.transcription.step import ipopt_options
 
     o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
     ground, base = step_ground(scene), make_rigid_walker(data)
+    order = phase_order(base) if phased else None  # None: the straight legs' STEP_PHASES
     walker = stride.on_ground(base, data, ground)  # no ground: the walker itself
     guide = stride.on_ground(base, data, ground, lambda w, d: _guide(w, d, spec))
-    guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals)
+    guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals, order)
     t0 = time.perf_counter()
-    fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None)
+    fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None,
+                                  order=order)
     build = time.perf_counter() - t0
-    res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
-                           guess_u)
+    spec = replace(spec, warm_start=guess_u is not None)
+    if phased:  # from the gait itself, a small barrier (IPOPT's 0.1 pushes it away)
+        fns = {**fns, "solver": ({}, {**ipopt_options(spec), "mu_init": 1e-9})}
+    res = collocate_phases(fns, spec, guess, guess_u)
     err, replayed = stride.replay_stride(data, res, ground=ground)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))
+    per = len(fns["phases"]) // 2  # each step's phases: its last ends in the heel strike
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
-        [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
+        [*res.phase_start[per::per], res.t.size], fns["phases"][per - 1::per])]
     record = history_and_energies(scene, walker, res)
     parts = [history_and_energies(scene, w, stride.step_of(res, k))
              for k, w in enumerate((walker, walker.mirror))]
