@@ -58,6 +58,7 @@ from walkerlab.optimal.replay.contact import (
     contact_replay_stride,
 )
 from walkerlab.optimal.transcription.landing import step_ground
+from walkerlab.optimal.transcription.stride import check_objective as _check_stride
 from walkerlab.optimal.virtual_constraints import (
     check_design,
     designs_controller,
@@ -499,9 +500,7 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
     kneed walker's thighs, between a flat-footed walker's legs).  ``resolve_gait``: the
     scene's gait has a double-support phase the collocation's walker has not (flat feet),
     so the start is that walker's own gait, solved here (``x_gait``, ``period_s``
-    unused).  A walker whose steps differ (a 3D kneed walker with hip width: its steps mirror
-    each other sideways, ``data.mirror``) takes a stride of two phased steps
-    (:func:`_stride`)."""
+    unused).  A 3D walker's steps mirror each other: a stride (:func:`_stride`, phased)."""
     import time
 
     if plant.kind.in_3d and plant.data.mirror is not None:  # steps mirrored sideways
@@ -548,36 +547,18 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
 
 # -- a stride of two steps (legs that differ) --------------------------------------------
 
-def _check_stride(o, pushes: bool) -> None:
-    """Refuse what the stride transcription does not take (one line naming the field);
-    ``pushes``: the stride has a push-off (fixed or free)."""
-    from walkerlab.optimal.transcription.mode_sequence import PHASED_OBJECTIVES
-
-    asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
-    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
-    bad = [k for k in asked if k not in known]
-    if bad:
-        raise ValueError(f"optimize.objective: legs that differ take "
-                         f"{', '.join(known)} (or their weighted sum), not "
-                         f"{', '.join(bad)}" + ("" if pushes else " (push_off_work: with a "
-                                                "push-off, walker.actuation.push_off or "
-                                                "optimize.push_off: free)"))
-
-
 def starting_stride(scene, walker, x_gait, period_s: float, intervals: int, order=None):
     """The stride collocation's start for ``scene``: its ``optimize.initial_guess`` (another
     stride's ``optimize.h5``: its phases' states and torque; a continuation artifact's
     gait at ``at``: the stride map's start there), else one stride of its gait ``x_gait``
-    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step, each step through
-    ``order`` (its ``(phase, guard, direction)``; None: the straight legs'
-    :data:`walkerlab.optimal.transcription.stride.STEP_PHASES`).
+    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step; ``order`` each step's
+    phases (None: the straight legs' :data:`~walkerlab.optimal.transcription.stride.STEP_PHASES`).
 
     Returns
     -------
     guess : list of (name, t, x)
-        The stride's phases (:func:`walkerlab.optimal.transcription.stride.stride_phases`
-        of ``order``; straight legs: :data:`~walkerlab.optimal.transcription.stride.
-        STRIDE_PHASES`) (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
+        :func:`walkerlab.optimal.transcription.stride.stride_phases` of ``order``
+        (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
         :func:`walkerlab.optimal.transcription.mode_sequence.optimized_guess` on
         ``2 intervals``).
     torque : list of ndarray or None
@@ -612,17 +593,15 @@ def _stride(scene, plant, spec, x_gait, period_s, phased: bool = False) -> Optim
     ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
     map's, each step's energies from its own walker (leg B's step: the mirror's masses);
     on stairs or footholds started and replayed there (:func:`~walkerlab.optimal.
-    transcription.stride.on_ground`).  ``phased``: each step goes through the rigid
-    walker's own phases (:func:`walkerlab.optimal.transcription.phases.phase_order`: a 3D
-    kneed walker's unlocked swing, knee strike, locked swing, heel strike), else the
-    straight legs' early and late swing."""
+    transcription.stride.on_ground`).  ``phased``: each step through the rigid walker's own
+    phases (a 3D kneed walker's: :func:`~walkerlab.optimal.transcription.phases.phase_order`)."""
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription import stride
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
-    from walkerlab.optimal.transcription.phases import phase_order
-    from walkerlab.optimal.transcription.step import ipopt_options
+    from walkerlab.optimal.transcription.phases import phase_order  # the kneed steps'
+    from walkerlab.optimal.transcription.step import ipopt_options  # their barrier's
 
     o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
@@ -635,10 +614,10 @@ def _stride(scene, plant, spec, x_gait, period_s, phased: bool = False) -> Optim
     fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None,
                                   order=order)
     build = time.perf_counter() - t0
-    spec = replace(spec, warm_start=guess_u is not None)
     if phased:  # from the gait itself, a small barrier (IPOPT's 0.1 pushes it away)
-        fns = {**fns, "solver": ({}, {**ipopt_options(spec), "mu_init": 1e-9})}
-    res = collocate_phases(fns, spec, guess, guess_u)
+        fns["solver"] = ({}, {**ipopt_options(spec), "mu_init": 1e-9})
+    res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
+                           guess_u)
     err, replayed = stride.replay_stride(data, res, ground=ground)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(

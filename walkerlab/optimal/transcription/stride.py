@@ -58,7 +58,7 @@ import numpy as np
 
 from walkerlab.optimal.transcription.landing import check_stride_ground, landing_phase
 
-__all__ = ["STEP_PHASES", "STRIDE_PHASES", "on_ground", "replay_stride",
+__all__ = ["STEP_PHASES", "STRIDE_PHASES", "check_objective", "on_ground", "replay_stride",
            "step_of", "stride_functions", "stride_guess", "stride_phases", "stride_walker"]
 
 #: the rigid model's phases of a straight-legged step
@@ -83,6 +83,23 @@ def stride_phases(order=STEP_PHASES) -> tuple[str, ...]:
 
 #: the straight legs' stride's four phases in order (:func:`stride_functions`' ``phases``)
 STRIDE_PHASES = stride_phases()
+
+
+def check_objective(o, pushes: bool) -> None:
+    """Refuse an objective of the ``optimize`` section ``o`` the stride transcription does
+    not take (one line naming the field); ``pushes``: the stride has a push-off (fixed or
+    free)."""
+    from walkerlab.optimal.transcription.mode_sequence import PHASED_OBJECTIVES
+
+    asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
+    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
+    bad = [k for k in asked if k not in known]
+    if bad:
+        raise ValueError(f"optimize.objective: legs that differ take "
+                         f"{', '.join(known)} (or their weighted sum), not "
+                         f"{', '.join(bad)}" + ("" if pushes else " (push_off_work: with a "
+                                                "push-off, walker.actuation.push_off or "
+                                                "optimize.push_off: free)"))
 
 
 def stride_functions(data, ground=None, hold_advance: bool = True, order=None) -> dict:
