@@ -20,7 +20,8 @@ capability table (:func:`check_kind`):
   stride`, on the multi-phase transcription);
 - ``locking_knees``, ``flat_feet``: the step as the walker's sequence of phases, each with
   its guard and reset from the generated model
-  (:mod:`walkerlab.optimal.transcription.mode_sequence`);
+  (:mod:`walkerlab.optimal.transcription.mode_sequence`); ``locking_knees_3d``: a stride
+  of two such steps, the walker's and its mirror's;
 - ``free_joints`` (a five-link biped): one phase with its four joint torques, from the
   targets (Kelly 2017's set-up; :mod:`walkerlab.optimal.transcription.free_joints`),
   closed by shooting and replayed as virtual constraints (:mod:`walkerlab.optimal.

@@ -66,9 +66,12 @@ TERRAIN = {
 #: an optimize section a kind's optimisation needs (a five-link biped's least effort needs
 #: a target: configs/rabbit_optimal.yaml's 0.5 m in 0.7 s; the 3D stride 60 intervals a
 #: step, as configs/hip_width_optimal.yaml's: on 40 its replay closes to about 1e-6, at the
-#: optimize view's tolerance, Hermite-Simpson's error O(h^4))
+#: optimize view's tolerance, Hermite-Simpson's error O(h^4); the 3D kneed stride 80, as
+#: tests/test_optimize_3d.py's: configs/kneed_3d_stabilised.yaml's least effort starts
+#: 1.5e-6 off its fixed point on 60, 4.8e-7 on 80)
 OPTIMIZE = {"free_joints": {"target_step_length_m": 0.5, "target_step_period_s": 0.7},
-            "straight_legs_3d": {"objective": "effort", "intervals": 60}}
+            "straight_legs_3d": {"objective": "effort", "intervals": 60},
+            "locking_knees_3d": {"objective": "effort", "intervals": 80}}
 
 
 def scene_for(kind: str, feature: str, view: str) -> dict:
@@ -272,7 +275,11 @@ GROUND_OPTIMIZE = {"stairs": {"objective": "effort", "intervals": 40},
 #: stride's 60, as configs/hip_width_optimal.yaml's (on 40 its replay closes to 0.8-1.0e-6,
 #: at the optimize view's tolerance; on 60 to 1.6e-7: Hermite-Simpson's O(h^4))
 GROUND_OPTIMIZE_INTERVALS = {("straight_legs_3d", "stairs"): 60,
-                             ("straight_legs_3d", "footholds"): 60}
+                             ("straight_legs_3d", "footholds"): 60,
+                             # the 3D kneed stride's, as its slope's (OPTIMIZE): on 40 the
+                             # replays close to 3.7e-6 (stairs) and 4.5e-6 (footholds)
+                             ("locking_knees_3d", "stairs"): 80,
+                             ("locking_knees_3d", "footholds"): 80}
 
 
 def _pd(joint: str, stiffness_n_m_per_rad: float, damping_n_m_s_per_rad: float) -> dict:
@@ -320,6 +327,18 @@ WALKING = {
         {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
          "fixedpoint.initial_guess": _locked_knee_guess(-0.2894504099, 0.1887133761,
                                                         -0.1404460373, -1.1432061038)}),
+    # the kneed walker in 3D (configs/kneed_3d.yaml) with the planar case's hip PD: with
+    # SMALL_PD the fixed point search finds no gait; with 0.01 N m/rad one of 0.5386 s steps
+    # (passive 0.5452 s), started here from its fixed point (the optimize cell's case: the
+    # other views' is configs/kneed_3d_powered_stabilised.yaml)
+    ("locking_knees_3d", "hip_torque"): (
+        "PD 0.01 N m/rad, 0.001 N m s/rad about 0 (at 0.1 N m/rad: no gait)",
+        {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": {
+             "lean_angle_rad": -0.0058922779,
+             **_locked_knee_guess(-0.2844247049, 0.1862149054, -0.1508715657,
+                                  -1.1280176171),
+             "lean_rate_rad_per_s": -0.1239947955}}),
     # an upper body scaled to the kneed walker: configs/torso_bhm.yaml's 5 kg on a 20 kg
     # walker is 0.4 kg on this 1.6 kg one (the generic 5 kg body with the 0.1 N m/rad law:
     # no gait), held on the legs' bisector, and the torso law as weak as the hip's case.

@@ -44,6 +44,16 @@ period-2 gait, its replay closing to 2.0e-7 on 60 intervals (tests/test_optimize
 More than two heights are refused
 (:data:`walkerlab.optimal.transcription.landing.FOOTHOLDS_STRIDE`).
 
+A 3D walker with locking knees (``order``: :func:`walkerlab.optimal.transcription.phases.
+phase_order` of its rigid model) takes each step as the planar kneed walker's phases,
+``unlocked_swing`` until ``knee_strike`` (its plastic reset links the phases) and
+``locked_swing`` until ``heel_strike`` (the stride's four phases
+``leg1_swing:unlocked_swing`` ... ``leg2_swing:locked_swing``), the hip torque between the
+thighs; started from one stride of its rigid gait and replayed alike.  Measured on
+configs/kneed_3d_stabilised.yaml (least effort, 80 intervals a step): objective 1.6e-20
+N^2 m^2 s, the start 4.8e-7 from the shooting fixed point, the replay closing to 2.2e-7
+(tests/test_optimize_3d.py).
+
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
 actuated walker and its mirror, each step's torque the optimised one as a function of the
 time since that step's heel strike, one stride from the optimised start; its return error
