@@ -470,10 +470,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # optimize: a stride of two phased steps (the planar kneed walker's unlocked swing,
         # knee strike, locked swing, heel strike; leg B's with the mirror's numbers:
         # walkerlab.optimal.transcription.stride on walkerlab.optimal.transcription.phases'
-        # kneed modes, which take the 3D walker's equations), the hip torque between the
-        # thighs; its push-off and torso as the planar kneed walker's
+        # kneed modes, which take the 3D walker's equations: an upper body on the bisecting
+        # hip is in them, as the 3D straight legs'), the hip torque between the thighs; its
+        # push-off as the planar kneed walker's
         ("push_off", "optimize"): _PHASED_PUSH_OFF,
-        ("torso_torque", "optimize"): _PHASED_TORSO,
         ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
     },
     "rolling_polygon_3d": {

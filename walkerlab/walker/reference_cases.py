@@ -352,6 +352,21 @@ WALKING = {
          "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
          "fixedpoint.initial_guess": _locked_knee_guess(-0.3407594714, 0.2400224376,
                                                         -0.3259477384, -1.0823455559)}),
+    # ... the planar case's upper body and law on the kneed walker in 3D
+    # (configs/kneed_3d.yaml): 0.7199 s steps, started here from its fixed point (the
+    # optimize cell's case: the other views' is configs/kneed_torso_powered_3d.yaml)
+    ("locking_knees_3d", "torso_torque"): (
+        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
+        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
+        {"walker.torso": {"coupling": "bisecting_hip",
+                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
+                                      "from_hip_m": 0.2}]},
+         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": {
+             "lean_angle_rad": -0.0063230986,
+             **_locked_knee_guess(-0.3356683451, 0.2371694574, -0.3271603306,
+                                  -1.0680204371),
+             "lean_rate_rad_per_s": -0.1236924401}}),
     # one output, the swing leg's angle, of the stance leg's (the compass walker's one
     # actuator, the hip): a step of 0.1 rad behind to 0.1348 rad ahead (the heel strike's
     # symmetry about the 0.0174 rad slope's normal).  The generic +-0.2 rad step stalls
