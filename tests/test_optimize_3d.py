@@ -197,17 +197,18 @@ def test_the_least_effort_3d_kneed_gait_on_its_passive_slope_is_its_passive_gait
     assert out.replay_error <= 1e-6
 
 
-def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path):
-    """Footholds of three heights for the hip-width walker (legs that differ: a stride of
-    two steps, each landing on its foothold; three make a period of six steps) are refused
-    in one line before fixedpoint runs, naming terrain.foothold_heights_m."""
+@pytest.mark.parametrize("name", ["hip_width_footholds", "kneed_3d_stabilised_footholds"])
+def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path, name):
+    """Footholds of three heights for the hip-width walker or the 3D kneed walker (a stride
+    of two steps, each landing on its foothold; three make a period of six steps) are
+    refused in one line before fixedpoint runs, naming terrain.foothold_heights_m."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
     from walkerlab.optimal.transcription.landing import FOOTHOLDS_STRIDE
 
-    d = yaml.safe_load((CONFIGS / "hip_width_footholds.yaml").read_text())
+    d = yaml.safe_load((CONFIGS / f"{name}.yaml").read_text())
     d["optimize"] = {"objective": "effort", "intervals": 40}
     d["terrain"]["foothold_heights_m"] = [0.0005, -0.0005, 0.0]
     scene = tmp_path / "footholds_3d.yaml"

@@ -315,7 +315,8 @@ def check_scene(scene, data) -> None:
     check_kind(scene, data.structure.kind)
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
-    if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
+    if data.structure.kind.collocation.one_step or data.structure.in_3d:  # the ground a step
+        # lands on (a 3D stride's steps too): refused early
         from walkerlab.optimal.transcription.landing import check_stride_ground
 
         check_stride_ground(step_ground(scene), data)
