@@ -21,7 +21,7 @@ from walkerlab.config.loader import shipped_scene_path
 from walkerlab.walker.kinds import KINDS
 
 __all__ = ["FIRST_STEPS", "JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "WALKING",
-           "reference_scene", "scene_for"]
+           "WALKING_OPTIMIZE", "reference_scene", "scene_for"]
 
 
 def _shipped(name: str) -> dict:
@@ -298,6 +298,40 @@ def _locked_knee_guess(thigh_rad: float, stance_rad: float, thigh_rate_rad_per_s
             "stance_rate_rad_per_s": stance_rate_rad_per_s}
 
 
+#: (kind, feature) -> (why, changes): as :data:`WALKING`, for the ``optimize`` cell alone
+#: (the feature's other views take a shipped scene, :data:`SHIPPED`, that walks): the
+#: generated case's changes so that it has a gait to start the optimisation from
+WALKING_OPTIMIZE = {
+    # the kneed walker in 3D (configs/kneed_3d.yaml) with the planar case's hip PD: with
+    # SMALL_PD the fixed point search finds no gait; with 0.01 N m/rad one of 0.5386 s steps
+    # (passive 0.5452 s), started here from its fixed point (the optimize cell's case: the
+    # other views' is configs/kneed_3d_powered_stabilised.yaml)
+    ("locking_knees_3d", "hip_torque"): (
+        "PD 0.01 N m/rad, 0.001 N m s/rad about 0 (at 0.1 N m/rad: no gait)",
+        {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": {
+             "lean_angle_rad": -0.0058922779,
+             **_locked_knee_guess(-0.2844247049, 0.1862149054, -0.1508715657,
+                                  -1.1280176171),
+             "lean_rate_rad_per_s": -0.1239947955}}),
+    # the planar kneed case's upper body and law on the kneed walker in 3D
+    # (configs/kneed_3d.yaml): 0.7199 s steps, started here from its fixed point (the
+    # optimize cell's case: the other views' is configs/kneed_torso_powered_3d.yaml)
+    ("locking_knees_3d", "torso_torque"): (
+        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
+        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
+        {"walker.torso": {"coupling": "bisecting_hip",
+                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
+                                      "from_hip_m": 0.2}]},
+         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": {
+             "lean_angle_rad": -0.0063230986,
+             **_locked_knee_guess(-0.3356683451, 0.2371694574, -0.3271603306,
+                                  -1.0680204371),
+             "lean_rate_rad_per_s": -0.1236924401}}),
+}
+
+
 #: (kind, feature) -> (why, changes): the generated case of a feature on which the kind's
 #: base walker with the plain feature (:func:`scene_for`) has no gait, changed so that it
 #: walks - a case without a gait measures nothing.  ``changes`` maps a dotted scene path to
@@ -327,18 +361,6 @@ WALKING = {
         {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
          "fixedpoint.initial_guess": _locked_knee_guess(-0.2894504099, 0.1887133761,
                                                         -0.1404460373, -1.1432061038)}),
-    # the kneed walker in 3D (configs/kneed_3d.yaml) with the planar case's hip PD: with
-    # SMALL_PD the fixed point search finds no gait; with 0.01 N m/rad one of 0.5386 s steps
-    # (passive 0.5452 s), started here from its fixed point (the optimize cell's case: the
-    # other views' is configs/kneed_3d_powered_stabilised.yaml)
-    ("locking_knees_3d", "hip_torque"): (
-        "PD 0.01 N m/rad, 0.001 N m s/rad about 0 (at 0.1 N m/rad: no gait)",
-        {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
-         "fixedpoint.initial_guess": {
-             "lean_angle_rad": -0.0058922779,
-             **_locked_knee_guess(-0.2844247049, 0.1862149054, -0.1508715657,
-                                  -1.1280176171),
-             "lean_rate_rad_per_s": -0.1239947955}}),
     # an upper body scaled to the kneed walker: configs/torso_bhm.yaml's 5 kg on a 20 kg
     # walker is 0.4 kg on this 1.6 kg one (the generic 5 kg body with the 0.1 N m/rad law:
     # no gait), held on the legs' bisector, and the torso law as weak as the hip's case.
@@ -352,21 +374,6 @@ WALKING = {
          "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
          "fixedpoint.initial_guess": _locked_knee_guess(-0.3407594714, 0.2400224376,
                                                         -0.3259477384, -1.0823455559)}),
-    # ... the planar case's upper body and law on the kneed walker in 3D
-    # (configs/kneed_3d.yaml): 0.7199 s steps, started here from its fixed point (the
-    # optimize cell's case: the other views' is configs/kneed_torso_powered_3d.yaml)
-    ("locking_knees_3d", "torso_torque"): (
-        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
-        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
-        {"walker.torso": {"coupling": "bisecting_hip",
-                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
-                                      "from_hip_m": 0.2}]},
-         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
-         "fixedpoint.initial_guess": {
-             "lean_angle_rad": -0.0063230986,
-             **_locked_knee_guess(-0.3356683451, 0.2371694574, -0.3271603306,
-                                  -1.0680204371),
-             "lean_rate_rad_per_s": -0.1236924401}}),
     # one output, the swing leg's angle, of the stance leg's (the compass walker's one
     # actuator, the hip): a step of 0.1 rad behind to 0.1348 rad ahead (the heel strike's
     # symmetry about the 0.0174 rad slope's normal).  The generic +-0.2 rad step stalls
@@ -422,7 +429,7 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`; a ground's ``optimize`` cell: the shipped
     ground scene with :data:`GROUND_OPTIMIZE`'s section), else the kind's base walker with
     the feature and the ground (:func:`scene_for`), changed as :data:`WALKING` says where
-    that walker has no gait.
+    that walker has no gait (an ``optimize`` cell: :data:`WALKING_OPTIMIZE` first).
 
     Returns
     -------
@@ -450,8 +457,10 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         shipped = _shipped(base)
         d["terrain"] = slope_profile(shipped["slope"], terrain=shipped.get("terrain"))
         return f"generated: configs/{base} on a profile equal to its slope", d
-    if (kind, feature) in WALKING:
-        why, changes = WALKING[(kind, feature)]
+    cases = WALKING_OPTIMIZE if view == "optimize" and (kind, feature) in WALKING_OPTIMIZE \
+        else WALKING
+    if (kind, feature) in cases:
+        why, changes = cases[(kind, feature)]
         for path, value in changes.items():
             _set(d, path, value)
         return f"generated: configs/{base} with {feature}: {why}", d
