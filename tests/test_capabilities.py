@@ -464,15 +464,15 @@ def test_the_osim_cells_of_a_kind_with_a_knee_latch_say_walkerlabs_loop_switches
 
 
 @pytest.mark.parametrize("name, stage", [
-    *((n, "optimize") for n in ("rimless_wheel_3d", "kneed_3d")),
+    ("rimless_wheel_3d", "optimize"),
     ("rimless_wheel_3d", "robustness")])
 def test_a_stage_a_3d_walker_does_not_take_is_refused_before_any_work(tmp_path, name, stage):
     """Every pipeline stage a 3D kind does not take - its view's cell
     (:data:`walkerlab.walker.capability_cells.STAGE_VIEWS`) or its study's
     (:data:`~walkerlab.walker.capability_cells.STAGE_CELLS`) - is refused in one line naming
     walker.space before any upstream stage runs, and nothing is written.  (contact-sim and
-    compare take both 3D kinds: tests/test_contact_3d.py; optimize the 3D straight legs:
-    tests/test_optimize_3d.py; robustness the 3D straight legs and locking knees:
+    compare take both 3D kinds: tests/test_contact_3d.py; optimize the 3D straight legs and
+    locking knees: tests/test_optimize_3d.py; robustness the 3D straight legs and locking knees:
     tests/test_robustness_3d.py.)"""
     from walkerlab.config import load_scene
     from walkerlab.stages import pipeline

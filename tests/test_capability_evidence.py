@@ -248,6 +248,24 @@ def test_a_walking_generated_case_carries_its_changes_and_says_why():
         scene_from_dict(reference_scene(kind, feature, "rigid")[1])
 
 
+def test_an_optimize_generated_case_carries_its_changes_and_says_why():
+    """Each generated case changed so that its optimisation has a gait to start from
+    (reference_cases.WALKING_OPTIMIZE) carries its changes in the optimize cell's scene,
+    validates, and names why in its case; the feature's other views keep their own."""
+    from walkerlab.walker.reference_cases import WALKING_OPTIMIZE
+
+    for (kind, feature), (why, changes) in WALKING_OPTIMIZE.items():
+        case, d = reference_scene(kind, feature, "optimize")
+        assert case.endswith(why) and case.startswith("generated: "), case
+        for path, value in changes.items():
+            node = d
+            for k in path.split("."):
+                node = node[k]
+            assert node == value, (kind, feature, path)
+        scene_from_dict(d)
+        assert not reference_scene(kind, feature, "rigid")[0].endswith(why)
+
+
 def test_the_stairs_cases_are_their_slopes_step_as_a_stair():
     """The rimless wheel's stairs are its slope's geometry: spokes 2 alpha apart (alpha =
     pi / n) landing a riser 2 l sin(alpha) sin(phi) below and a tread 2 l sin(alpha)

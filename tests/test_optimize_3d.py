@@ -132,17 +132,83 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     assert out.replay_error <= 1e-6
 
 
-def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path):
-    """Footholds of three heights for the hip-width walker (legs that differ: a stride of
-    two steps, each landing on its foothold; three make a period of six steps) are refused
-    in one line before fixedpoint runs, naming terrain.foothold_heights_m."""
+@pytest.mark.slow
+def test_the_3d_kneed_strides_functions_are_the_rigid_models():
+    """The 3D kneed walker's stride (configs/kneed_3d_stabilised.yaml: locking knees, hip
+    width, hip-roll joints and Kuo's law) goes through each step's rigid phases - unlocked
+    swing, knee strike, locked swing, heel strike - leg A's with the walker's numbers, leg
+    B's with its mirror's: each phase's CasADi flow (with a hip torque between the thighs)
+    is the rigid model's actuated flow and its reset the rigid model's, for both legs."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.transcription.phases import phase_order
+    from walkerlab.optimal.transcription.stride import stride_functions, stride_phases
+
+    scene = _scene("kneed_3d_stabilised")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    order = phase_order(make_rigid_walker(data))
+    assert [p for p, _g, _d in order] == ["unlocked_swing", "locked_swing"]
+    fns = stride_functions(data, order=order)
+    assert tuple(p.name for p in fns["phases"]) == stride_phases(order)
+    x = _guess_of(scene)
+    rng = np.random.default_rng(5)
+    for k, d in enumerate((replace(data, mirror_params=None), data.mirror)):
+        w = actuate(make_rigid_walker(d), d, Actuation(torques=[JointTorque(
+            joint="hip", law=TorqueLaw(constant_n_m=0.3))]))
+        for ph, rigid in zip(fns["phases"][2 * k:2 * k + 2], w.phases):
+            for _ in range(3):
+                xs = x + 0.05 * rng.standard_normal(x.size)
+                if ph.name.endswith("locked_swing") and "unlocked" not in ph.name:
+                    xs[2], xs[8] = xs[1], xs[7]  # the swing knee locked straight
+                np.testing.assert_allclose(ph.flow(xs, 0.3).full().ravel(),
+                                           rigid.flow(0.0, xs), atol=1e-9)
+        np.testing.assert_allclose(fns["phases"][2 * k + 1].reset(x).full().ravel(),
+                                   w.reset(x), atol=1e-9)
+
+
+@pytest.mark.slow
+def test_the_least_effort_3d_kneed_gait_on_its_passive_slope_is_its_passive_gait():
+    """The 3D kneed walker with hip-roll joints (configs/kneed_3d_stabilised.yaml) as a
+    stride of two phased steps: with nothing imposed the least effort is the gait that walks
+    without the hip torque (the foot-placement law part of the walker's equations): IPOPT
+    converged, objective <= 1e-8 N^2 m^2 s (seen 1.6e-20), the start within 1e-6 of the
+    fixed point ``walkerlab fixedpoint`` finds by shooting, the mean step period within
+    1e-7 relative and the replay on the rigid model closing to 1e-6.  Hermite-Simpson's
+    O(h^4) in the start's distance: 7.5e-6 on 40 intervals a step, 1.5e-6 on 60, 8.2e-7 on
+    70, 4.8e-7 on 80 (the replay 6.9e-7 on 60, 2.2e-7 on 80), so 80 here."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.driver import optimize_scene
+    from walkerlab.optimal.transcription.stride import stride_phases
+
+    scene = _scene("kneed_3d_stabilised", intervals=80, objective="effort")
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, plant=plant)
+    r = search.gaits[search.selected].result
+    periods = np.asarray(r.step_periods_s, float)
+    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
+                         plant=plant)
+    assert tuple(out.phase_names) == stride_phases([("unlocked_swing", "knee_strike", 1),
+                                                    ("locked_swing", "heel_strike", -1)])
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.objective <= 1e-8
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, r.x, atol=1e-6)
+    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
+    assert out.replay_error <= 1e-6
+
+
+@pytest.mark.parametrize("name", ["hip_width_footholds", "kneed_3d_stabilised_footholds"])
+def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path, name):
+    """Footholds of three heights for the hip-width walker or the 3D kneed walker (a stride
+    of two steps, each landing on its foothold; three make a period of six steps) are
+    refused in one line before fixedpoint runs, naming terrain.foothold_heights_m."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
     from walkerlab.optimal.transcription.landing import FOOTHOLDS_STRIDE
 
-    d = yaml.safe_load((CONFIGS / "hip_width_footholds.yaml").read_text())
+    d = yaml.safe_load((CONFIGS / f"{name}.yaml").read_text())
     d["optimize"] = {"objective": "effort", "intervals": 40}
     d["terrain"]["foothold_heights_m"] = [0.0005, -0.0005, 0.0]
     scene = tmp_path / "footholds_3d.yaml"

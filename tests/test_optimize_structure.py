@@ -101,8 +101,7 @@ def test_the_transcription_is_reached_through_the_walker_kind():
     taken = {k for k, kind in KINDS.items()
              if kind.collocation is not None and kind.collocation.provided}
     assert taken == {k for k, kind in KINDS.items() if kind.supports("walk", "optimize")}
-    assert set(KINDS) - taken == {"rolling_polygon", "rolling_polygon_3d", "hinged_torso",
-                                  "locking_knees_3d"}
+    assert set(KINDS) - taken == {"rolling_polygon", "rolling_polygon_3d", "hinged_torso"}
     assert not KINDS["rolling_polygon"].supports("walk", "optimize")
     mods = sorted((PKG / "optimal").rglob("*.py")) + [PKG / "stages" / "optimize.py"]
     bad = {str(p.relative_to(PKG)): got for p in mods

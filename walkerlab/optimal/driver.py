@@ -20,7 +20,8 @@ capability table (:func:`check_kind`):
   stride`, on the multi-phase transcription);
 - ``locking_knees``, ``flat_feet``: the step as the walker's sequence of phases, each with
   its guard and reset from the generated model
-  (:mod:`walkerlab.optimal.transcription.mode_sequence`);
+  (:mod:`walkerlab.optimal.transcription.mode_sequence`); ``locking_knees_3d``: a stride
+  of two such steps, the walker's and its mirror's;
 - ``free_joints`` (a five-link biped): one phase with its four joint torques, from the
   targets (Kelly 2017's set-up; :mod:`walkerlab.optimal.transcription.free_joints`),
   closed by shooting and replayed as virtual constraints (:mod:`walkerlab.optimal.
@@ -58,6 +59,7 @@ from walkerlab.optimal.replay.contact import (
     contact_replay_stride,
 )
 from walkerlab.optimal.transcription.landing import step_ground
+from walkerlab.optimal.transcription.stride import check_objective as _check_stride
 from walkerlab.optimal.virtual_constraints import (
     check_design,
     designs_controller,
@@ -313,7 +315,8 @@ def check_scene(scene, data) -> None:
     check_kind(scene, data.structure.kind)
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
-    if data.structure.kind.collocation.one_step:  # the ground one step lands on: refused early
+    if data.structure.kind.collocation.one_step or data.structure.in_3d:  # the ground a step
+        # lands on (a 3D stride's steps too): refused early
         from walkerlab.optimal.transcription.landing import check_stride_ground
 
         check_stride_ground(step_ground(scene), data)
@@ -499,9 +502,11 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
     kneed walker's thighs, between a flat-footed walker's legs).  ``resolve_gait``: the
     scene's gait has a double-support phase the collocation's walker has not (flat feet),
     so the start is that walker's own gait, solved here (``x_gait``, ``period_s``
-    unused)."""
+    unused).  A 3D walker's steps mirror each other: a stride (:func:`_stride`, phased)."""
     import time
 
+    if plant.kind.in_3d and plant.data.mirror is not None:  # steps mirrored sideways
+        return _stride(scene, plant, collocation_spec(scene), x_gait, period_s, phased=True)
     from walkerlab.analysis.gait.scene import solve_scene  # light
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription.mode_sequence import (
@@ -544,32 +549,17 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
 
 # -- a stride of two steps (legs that differ) --------------------------------------------
 
-def _check_stride(o, pushes: bool) -> None:
-    """Refuse what the stride transcription does not take (one line naming the field);
-    ``pushes``: the stride has a push-off (fixed or free)."""
-    from walkerlab.optimal.transcription.mode_sequence import PHASED_OBJECTIVES
-
-    asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
-    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
-    bad = [k for k in asked if k not in known]
-    if bad:
-        raise ValueError(f"optimize.objective: legs that differ take "
-                         f"{', '.join(known)} (or their weighted sum), not "
-                         f"{', '.join(bad)}" + ("" if pushes else " (push_off_work: with a "
-                                                "push-off, walker.actuation.push_off or "
-                                                "optimize.push_off: free)"))
-
-
-def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
+def starting_stride(scene, walker, x_gait, period_s: float, intervals: int, order=None):
     """The stride collocation's start for ``scene``: its ``optimize.initial_guess`` (another
-    stride's ``optimize.h5``: its four phases' states and torque; a continuation artifact's
+    stride's ``optimize.h5``: its phases' states and torque; a continuation artifact's
     gait at ``at``: the stride map's start there), else one stride of its gait ``x_gait``
-    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step.
+    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step; ``order`` each step's
+    phases (None: the straight legs' :data:`~walkerlab.optimal.transcription.stride.STEP_PHASES`).
 
     Returns
     -------
     guess : list of (name, t, x)
-        The four phases :data:`walkerlab.optimal.transcription.stride.STRIDE_PHASES`
+        :func:`walkerlab.optimal.transcription.stride.stride_phases` of ``order``
         (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
         :func:`walkerlab.optimal.transcription.mode_sequence.optimized_guess` on
         ``2 intervals``).
@@ -586,49 +576,57 @@ def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.guess import read_guess
     from walkerlab.optimal.transcription.mode_sequence import optimized_guess
-    from walkerlab.optimal.transcription.stride import STRIDE_PHASES, stride_guess
+    from walkerlab.optimal.transcription.stride import STEP_PHASES, stride_guess, stride_phases
 
     kind, got = None, None
     if scene.optimize.initial_guess is not None:
         kind, got = read_guess(scene, list(walker.state_names()))
     if kind == "optimize":
-        return optimized_guess(got, list(STRIDE_PHASES), 2 * intervals)
+        return optimized_guess(got, list(stride_phases(order or STEP_PHASES)), 2 * intervals)
     x0 = got if kind == "continuation" else x_gait
     return stride_guess(walker, x0, period_s, Solver.from_settings(scene.solver),
-                        intervals), None
+                        intervals, order), None
 
 
-def _stride(scene, plant, spec, x_gait, period_s) -> OptimizeData:
+def _stride(scene, plant, spec, x_gait, period_s, phased: bool = False) -> OptimizeData:
     """One stride of a walker whose legs differ (the step sequence of the walker and its
     mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
     :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
     ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
     map's, each step's energies from its own walker (leg B's step: the mirror's masses);
     on stairs or footholds started and replayed there (:func:`~walkerlab.optimal.
-    transcription.stride.on_ground`)."""
+    transcription.stride.on_ground`).  ``phased``: each step through the rigid walker's own
+    phases (a 3D kneed walker's: :func:`~walkerlab.optimal.transcription.phases.phase_order`)."""
     import time
 
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.transcription import stride
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.phases import phase_order  # the kneed steps'
+    from walkerlab.optimal.transcription.step import ipopt_options  # their barrier's
 
     o, data = scene.optimize, plant.data
     _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
     ground, base = step_ground(scene), make_rigid_walker(data)
+    order = phase_order(base) if phased else None  # None: the straight legs' STEP_PHASES
     walker = stride.on_ground(base, data, ground)  # no ground: the walker itself
     guide = stride.on_ground(base, data, ground, lambda w, d: _guide(w, d, spec))
-    guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals)
+    guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals, order)
     t0 = time.perf_counter()
-    fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None)
+    fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None,
+                                  order=order)
     build = time.perf_counter() - t0
+    if phased:  # from the gait itself, a small barrier (IPOPT's 0.1 pushes it away)
+        fns["solver"] = ({}, {**ipopt_options(spec), "mu_init": 1e-9})
     res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
                            guess_u)
     err, replayed = stride.replay_stride(data, res, ground=ground)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     gait, contact_period, contact_outcome = reported.optimum_outcome(
         scene, res, err, lambda: contact_replay_stride(scene, res, strides=2, plant=plant))
+    per = len(fns["phases"]) // 2  # each step's phases: its last ends in the heel strike
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
-        [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
+        [*res.phase_start[per::per], res.t.size], fns["phases"][per - 1::per])]
     record = history_and_energies(scene, walker, res)
     parts = [history_and_energies(scene, w, stride.step_of(res, k))
              for k, w in enumerate((walker, walker.mirror))]

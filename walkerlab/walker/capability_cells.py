@@ -460,9 +460,14 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # each leg, its stop and latch the planar kneed dataset's
         # (walkerlab.export.adams_3d_knees)
         # the Gymnasium environment's rigid view (its contact view: the contact cell's)
-        ("walk", "optimize"): ("a locking knee makes the collocation phased (knee free, "
-                               "knee locked), and the 3D transcription takes straight legs "
-                               "only (straight_legs_3d): optimise the walker without knees"),
+        # optimize: a stride of two phased steps (the planar kneed walker's unlocked swing,
+        # knee strike, locked swing, heel strike; leg B's with the mirror's numbers:
+        # walkerlab.optimal.transcription.stride on walkerlab.optimal.transcription.phases'
+        # kneed modes, which take the 3D walker's equations: an upper body on the bisecting
+        # hip is in them, as the 3D straight legs'), the hip torque between the thighs; its
+        # push-off as the planar kneed walker's
+        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
     },
     "rolling_polygon_3d": {
         **_PLANAR,
@@ -558,7 +563,6 @@ ROBUSTNESS_WHEEL_3D = ("the robustness study pushes the hip and reads the stance
 #: :data:`walkerlab.walker.capability_evidence.stage_evidence`'s (configs/
 #: hip_width_stabilised.yaml, configs/kneed_3d_stabilised.yaml).
 STAGE_CELLS: dict[str, dict[str, str]] = {
-    "locking_knees_3d": {"optimize": CAPABILITIES["locking_knees_3d"][("walk", "optimize")]},
     "rolling_polygon_3d": {"robustness": ROBUSTNESS_WHEEL_3D,
                            "optimize": CAPABILITIES["rolling_polygon_3d"][("walk",
                                                                           "optimize")]},

@@ -334,7 +334,8 @@ KINDS = {k.name: k for k in (
          "McGeer 1990 (passive walking with knees); Kuo 1999", "walker.space: 3d",
          in_3d=True, has_knees=True, knees_lock=True, rigid=P.RIGID_LOCKING_KNEES,
          actuators=P.ACTUATORS_KNEES_3D, reaction=P.REACTION_NONE,
-         contact=P.CONTACT_KNEES_3D, scene="configs/kneed_3d.yaml"),
+         contact=P.CONTACT_KNEES_3D, collocation=P.COLLOCATION_LOCKING_KNEES,
+         phases=P.PHASES_LOCKING_KNEES, scene="configs/kneed_3d.yaml"),
 )}
 
 

@@ -21,7 +21,7 @@ from walkerlab.config.loader import shipped_scene_path
 from walkerlab.walker.kinds import KINDS
 
 __all__ = ["FIRST_STEPS", "JOINT", "FIVE_LINK_JOINT", "TORSO_HIPS", "SCENES", "TERRAIN", "WALKING",
-           "reference_scene", "scene_for"]
+           "WALKING_OPTIMIZE", "reference_scene", "scene_for"]
 
 
 def _shipped(name: str) -> dict:
@@ -66,9 +66,12 @@ TERRAIN = {
 #: an optimize section a kind's optimisation needs (a five-link biped's least effort needs
 #: a target: configs/rabbit_optimal.yaml's 0.5 m in 0.7 s; the 3D stride 60 intervals a
 #: step, as configs/hip_width_optimal.yaml's: on 40 its replay closes to about 1e-6, at the
-#: optimize view's tolerance, Hermite-Simpson's error O(h^4))
+#: optimize view's tolerance, Hermite-Simpson's error O(h^4); the 3D kneed stride 80, as
+#: tests/test_optimize_3d.py's: configs/kneed_3d_stabilised.yaml's least effort starts
+#: 1.5e-6 off its fixed point on 60, 4.8e-7 on 80)
 OPTIMIZE = {"free_joints": {"target_step_length_m": 0.5, "target_step_period_s": 0.7},
-            "straight_legs_3d": {"objective": "effort", "intervals": 60}}
+            "straight_legs_3d": {"objective": "effort", "intervals": 60},
+            "locking_knees_3d": {"objective": "effort", "intervals": 80}}
 
 
 def scene_for(kind: str, feature: str, view: str) -> dict:
@@ -274,7 +277,11 @@ GROUND_OPTIMIZE = {"stairs": {"objective": "effort", "intervals": 40},
 #: stride's 60, as configs/hip_width_optimal.yaml's (on 40 its replay closes to 0.8-1.0e-6,
 #: at the optimize view's tolerance; on 60 to 1.6e-7: Hermite-Simpson's O(h^4))
 GROUND_OPTIMIZE_INTERVALS = {("straight_legs_3d", "stairs"): 60,
-                             ("straight_legs_3d", "footholds"): 60}
+                             ("straight_legs_3d", "footholds"): 60,
+                             # the 3D kneed stride's, as its slope's (OPTIMIZE): on 40 the
+                             # replays close to 3.7e-6 (stairs) and 4.5e-6 (footholds)
+                             ("locking_knees_3d", "stairs"): 80,
+                             ("locking_knees_3d", "footholds"): 80}
 
 
 def _pd(joint: str, stiffness_n_m_per_rad: float, damping_n_m_s_per_rad: float) -> dict:
@@ -291,6 +298,40 @@ def _locked_knee_guess(thigh_rad: float, stance_rad: float, thigh_rate_rad_per_s
             "stance_angle_rad": stance_rad, "swing_thigh_rate_rad_per_s": thigh_rate_rad_per_s,
             "swing_shank_rate_rad_per_s": thigh_rate_rad_per_s,
             "stance_rate_rad_per_s": stance_rate_rad_per_s}
+
+
+#: (kind, feature) -> (why, changes): as :data:`WALKING`, for the ``optimize`` cell alone
+#: (the feature's other views take a shipped scene, :data:`SHIPPED`, that walks): the
+#: generated case's changes so that it has a gait to start the optimisation from
+WALKING_OPTIMIZE = {
+    # the kneed walker in 3D (configs/kneed_3d.yaml) with the planar case's hip PD: with
+    # SMALL_PD the fixed point search finds no gait; with 0.01 N m/rad one of 0.5386 s steps
+    # (passive 0.5452 s), started here from its fixed point (the optimize cell's case: the
+    # other views' is configs/kneed_3d_powered_stabilised.yaml)
+    ("locking_knees_3d", "hip_torque"): (
+        "PD 0.01 N m/rad, 0.001 N m s/rad about 0 (at 0.1 N m/rad: no gait)",
+        {"walker.actuation.torques": [_pd("hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": {
+             "lean_angle_rad": -0.0058922779,
+             **_locked_knee_guess(-0.2844247049, 0.1862149054, -0.1508715657,
+                                  -1.1280176171),
+             "lean_rate_rad_per_s": -0.1239947955}}),
+    # the planar kneed case's upper body and law on the kneed walker in 3D
+    # (configs/kneed_3d.yaml): 0.7199 s steps, started here from its fixed point (the
+    # optimize cell's case: the other views' is configs/kneed_torso_powered_3d.yaml)
+    ("locking_knees_3d", "torso_torque"): (
+        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
+        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
+        {"walker.torso": {"coupling": "bisecting_hip",
+                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
+                                      "from_hip_m": 0.2}]},
+         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
+         "fixedpoint.initial_guess": {
+             "lean_angle_rad": -0.0063230986,
+             **_locked_knee_guess(-0.3356683451, 0.2371694574, -0.3271603306,
+                                  -1.0680204371),
+             "lean_rate_rad_per_s": -0.1236924401}}),
+}
 
 
 #: (kind, feature) -> (why, changes): the generated case of a feature on which the kind's
@@ -390,7 +431,7 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`; a ground's ``optimize`` cell: the shipped
     ground scene with :data:`GROUND_OPTIMIZE`'s section), else the kind's base walker with
     the feature and the ground (:func:`scene_for`), changed as :data:`WALKING` says where
-    that walker has no gait.
+    that walker has no gait (an ``optimize`` cell: :data:`WALKING_OPTIMIZE` first).
 
     Returns
     -------
@@ -418,8 +459,10 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         shipped = _shipped(base)
         d["terrain"] = slope_profile(shipped["slope"], terrain=shipped.get("terrain"))
         return f"generated: configs/{base} on a profile equal to its slope", d
-    if (kind, feature) in WALKING:
-        why, changes = WALKING[(kind, feature)]
+    cases = WALKING_OPTIMIZE if view == "optimize" and (kind, feature) in WALKING_OPTIMIZE \
+        else WALKING
+    if (kind, feature) in cases:
+        why, changes = cases[(kind, feature)]
         for path, value in changes.items():
             _set(d, path, value)
         return f"generated: configs/{base} with {feature}: {why}", d

@@ -44,6 +44,16 @@ period-2 gait, its replay closing to 2.0e-7 on 60 intervals (tests/test_optimize
 More than two heights are refused
 (:data:`walkerlab.optimal.transcription.landing.FOOTHOLDS_STRIDE`).
 
+A 3D walker with locking knees (``order``: :func:`walkerlab.optimal.transcription.phases.
+phase_order` of its rigid model) takes each step as the planar kneed walker's phases,
+``unlocked_swing`` until ``knee_strike`` (its plastic reset links the phases) and
+``locked_swing`` until ``heel_strike`` (the stride's four phases
+``leg1_swing:unlocked_swing`` ... ``leg2_swing:locked_swing``), the hip torque between the
+thighs; started from one stride of its rigid gait and replayed alike.  Measured on
+configs/kneed_3d_stabilised.yaml (least effort, 80 intervals a step): objective 1.6e-20
+N^2 m^2 s, the start 4.8e-7 from the shooting fixed point, the replay closing to 2.2e-7
+(tests/test_optimize_3d.py).
+
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
 actuated walker and its mirror, each step's torque the optimised one as a function of the
 time since that step's heel strike, one stride from the optimised start; its return error
@@ -58,8 +68,8 @@ import numpy as np
 
 from walkerlab.optimal.transcription.landing import check_stride_ground, landing_phase
 
-__all__ = ["STEP_PHASES", "STRIDE_PHASES", "on_ground", "replay_stride",
-           "step_of", "stride_functions", "stride_guess", "stride_walker"]
+__all__ = ["STEP_PHASES", "STRIDE_PHASES", "check_objective", "on_ground", "replay_stride",
+           "step_of", "stride_functions", "stride_guess", "stride_phases", "stride_walker"]
 
 #: the rigid model's phases of a straight-legged step
 #: (:func:`walkerlab.optimal.transcription.phases.
@@ -74,15 +84,39 @@ def _named(leg: str, name: str) -> str:
     return f"{leg}_swing:{name}"
 
 
-#: the stride's four phases in order (:func:`stride_functions`' ``phases``)
-STRIDE_PHASES = tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in STEP_PHASES)
+def stride_phases(order=STEP_PHASES) -> tuple[str, ...]:
+    """The stride's phase names in order, each step going through ``order`` (a step's
+    ``(phase, guard, direction)``: :func:`walkerlab.optimal.transcription.phases.
+    phase_order`; default the straight legs' :data:`STEP_PHASES`)."""
+    return tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in order)
 
 
-def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
+#: the straight legs' stride's four phases in order (:func:`stride_functions`' ``phases``)
+STRIDE_PHASES = stride_phases()
+
+
+def check_objective(o, pushes: bool) -> None:
+    """Refuse an objective of the ``optimize`` section ``o`` the stride transcription does
+    not take (one line naming the field); ``pushes``: the stride has a push-off (fixed or
+    free)."""
+    from walkerlab.optimal.transcription.mode_sequence import PHASED_OBJECTIVES
+
+    asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
+    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
+    bad = [k for k in asked if k not in known]
+    if bad:
+        raise ValueError(f"optimize.objective: legs that differ take "
+                         f"{', '.join(known)} (or their weighted sum), not "
+                         f"{', '.join(bad)}" + ("" if pushes else " (push_off_work: with a "
+                                                "push-off, walker.actuation.push_off or "
+                                                "optimize.push_off: free)"))
+
+
+def stride_functions(data, ground=None, hold_advance: bool = True, order=None) -> dict:
     """CasADi functions of the stride of ``data``'s walker (legs that differ: ``data.mirror``
-    not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases`` the
-    four
-    of the stride (module docstring), named ``leg1_swing:early_swing`` ...
+    not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases``
+    those of the stride (module docstring): each step's ``order``, named
+    ``leg1_swing:early_swing`` ...
 
     Parameters
     ----------
@@ -97,6 +131,11 @@ def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
         ``sqrt(|foot|^2 - (drop cos gamma)^2)``, ``|foot|`` the swing foot's distance in the
         sagittal plane (along the slope and its normal; the hip width's lateral offset is not
         part of it)); None: the slope's heel strike, bit for bit.
+    order : list of (phase, guard, direction), optional
+        Each step's phases (:func:`walkerlab.optimal.transcription.phases.phase_order` of
+        the rigid walker: a 3D kneed walker's ``unlocked_swing`` until ``knee_strike``,
+        ``locked_swing`` until ``heel_strike``); None: the straight legs'
+        :data:`STEP_PHASES`.
     hold_advance : bool
         Stairs (``ground.advance_m``): each step advances one tread (``constrain``: both
         steps' advance ``== ground.advance_m`` [m]); False when a target step length holds
@@ -105,9 +144,10 @@ def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
     Raises
     ------
     ValueError
-        Mirror-image legs (one step is the map), knees, flat or arc feet, a planar walker's
-        torso (a 3D walker's upper body on the bisecting hip is in its equations), massless
-        legs; footholds of more than two heights (one line).
+        Mirror-image legs (one step is the map), flat or arc feet, knees without their
+        ``order`` (or knees that do not lock), a planar walker's torso (a 3D walker's upper
+        body on the bisecting hip is in its equations), massless legs; footholds of more
+        than two heights (one line).
     """
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
@@ -116,16 +156,18 @@ def stride_functions(data, ground=None, hold_advance: bool = True) -> dict:
         raise ValueError("optimize: a stride is for legs that differ (mirror-image legs take "
                          "one step)")
     one_step = st.kind.collocation is not None and st.kind.collocation.one_step
-    if (not one_step or st.foot == "arc" or (st.torso and not st.in_3d)
+    kneed = order is not None and st.kind.knees_lock and st.kind.phases is not None
+    if (not (one_step or kneed) or st.foot == "arc" or (st.torso and not st.in_3d)
             or any(b.massless for b in st.bodies)):
-        raise ValueError("optimize: a stride of legs that differ takes straight massive legs "
-                         "with point feet today (knees, flat or arc feet, a planar torso: "
-                         "not yet)")
+        raise ValueError("optimize: a stride of legs that differ takes massive straight or "
+                         "locking-knee legs with point feet today (flat or arc feet, a "
+                         "planar torso: not yet)")
     check_stride_ground(ground, data)
+    order = list(order) if order is not None else list(STEP_PHASES)
     fns, phases = None, []
     for k, (leg, d) in enumerate(zip(SWINGING, (replace(data, mirror_params=None),
                                                 data.mirror))):
-        f = cached_mode_functions(d, None, list(STEP_PHASES))
+        f = cached_mode_functions(d, None, order)
         step = [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
         if ground is not None:
             step[-1] = _landing(step[-1], f["n"], ground, k)
@@ -172,7 +214,7 @@ def _steps(walker) -> tuple:
     return tuple(walker.cycle) if walker.cycle else (walker, walker.mirror)
 
 
-def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
+def stride_guess(walker, x0, period_s: float, solver, intervals: int, order=None) -> list:
     """One stride of the rigid ``walker`` (legs that differ: ``walker.mirror``) from the
     post-impact state ``x0`` (2n,), each step sampled on ``intervals`` intervals shared
     among its phases (:func:`walkerlab.optimal.transcription.mode_sequence.phased_guess`).
@@ -181,11 +223,14 @@ def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
     ----------
     period_s : float
         The gait's (mean) step period [s]: a step longer than three is no step.
+    order : list of (phase, guard, direction), optional
+        Each step's phases (:func:`stride_functions`' ``order``); None: the straight legs'
+        :data:`STEP_PHASES`.
 
     Returns
     -------
     list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
-        The four phases of :func:`stride_functions` in order.
+        The phases of :func:`stride_functions` in order (each step's ``order``).
 
     Raises
     ------
@@ -194,12 +239,13 @@ def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
     """
     from walkerlab.optimal.transcription.mode_sequence import phased_guess
 
+    names = tuple(p for p, _g, _d in (order if order is not None else STEP_PHASES))
     out, x = [], np.asarray(x0, float)
     for leg, w in zip(SWINGING, _steps(walker)):
         guess, log = phased_guess(w, x, period_s, solver, intervals)
-        if tuple(g[0] for g in guess) != tuple(p for p, _g, _d in STEP_PHASES):
+        if tuple(g[0] for g in guess) != names:
             raise ValueError(f"optimize: the starting gait's {leg} step crosses "
-                             f"{[g[0] for g in guess]}, not early and late swing")
+                             f"{[g[0] for g in guess]}, not {' and '.join(names)}")
         out += [(_named(leg, name), t, xs) for name, t, xs in guess]
         x = np.asarray(w.reset(guess[-1][2][-1]), float)
     return out
@@ -208,8 +254,9 @@ def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
 def step_of(res, k: int):
     """Step ``k`` (0: leg A's, 1: leg B's) of an optimised stride
     (:class:`walkerlab.optimal.transcription.mode_sequence.PhasedResult`) as a result of its own:
-    its points, phases and durations, its times from its heel strike [s]."""
-    P = len(STEP_PHASES)
+    its points, phases and durations, its times from its heel strike [s] (each step has half
+    the stride's phases)."""
+    P = len(res.phase_names) // 2
     bounds = list(res.phase_start) + [res.t.size]
     a, b = bounds[k * P], bounds[(k + 1) * P]
     t0 = float(res.t[a])
