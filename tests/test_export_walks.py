@@ -39,9 +39,13 @@ def _scene(name):
 
 #: Shipped scenes the MJCF export refuses, and the field its one line names: massless legs
 #: have no multibody form (flat feet and their ankle push-off are exported:
-#: tests/test_export_flat_feet.py).
+#: tests/test_export_flat_feet.py); arms coupled to the opposite legs and feet curved in
+#: both directions walk in the rigid model only (no floating view carries the coupling or
+#: a rolling radius that changes with the lean: walkerlab.walker.multibody).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies"}
+           "simplest": "walker.leg.bodies", "collins2001": "walker.arms",
+           "collins2001_knees": "walker.arms", "toroidal_arms_3d": "walker.arms",
+           "toroidal_feet_3d": "walker.leg.foot.kind"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py): the export refuses it in one line (no rigid gait);
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.

@@ -16,9 +16,11 @@ fall line as a coordinate of its own.
 
 from __future__ import annotations
 
+import math
+
 from walkerlab.walker.tree import ZERO_INERTIA, Body, Joint
 
-__all__ = ["stance_torus"]
+__all__ = ["creep_rate", "stance_torus"]
 
 S, Z = (1, 0, 0), (0, 0, 1)
 
@@ -42,3 +44,34 @@ def stance_torus(R: str, lateral: str, leg: str = "stance_leg") -> list:
             Body(leg, 0, ZERO_INERTIA, (0, 0, 0),
                  Joint("stance_ankle_pitch", "revolute", "stance_roll",
                        (0, f"{R} - {lateral}", 0), (Z,), ("stance_ankle_pitch",)))]
+
+
+def creep_rate(roles: tuple, params: dict):
+    """The rate [m/s] at which a toroidal stance foot's contact runs along the fall line
+    ahead of the holonomic reference travel ``-R beta`` the printed points and potential
+    are measured at (module docstring): ``-(R - R_l + R_l cos phi) beta' + R beta' =
+    R_l (1 - cos phi) beta'``, ``phi`` the lean, ``beta' `` the stance leg's pitch rate.
+    Over a step its integral moves every point of the walker that far along the fall line
+    (the energy ledger's true potential, :func:`walkerlab.analysis.gait.energy.
+    step_ledger`).
+
+    Parameters
+    ----------
+    roles : tuple of str
+        The walker's coordinates (``lean`` and ``stance`` among them).
+    params : dict
+        The numbers by parameter name; the lateral radius ``R_lat`` [m].
+
+    Returns
+    -------
+    callable ``x (2n,) -> float`` or None
+        None without a lateral radius (holonomic feet: the reference is the travel).
+    """
+    if "R_lat" not in params:
+        return None
+    r_l, n = float(params["R_lat"]), len(roles)
+    lean, stance = roles.index("lean"), n + roles.index("stance")
+
+    def rate(x) -> float:
+        return r_l * (1.0 - math.cos(float(x[lean]))) * float(x[stance])
+    return rate

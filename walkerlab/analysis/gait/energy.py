@@ -33,6 +33,8 @@ of transport is then ``h / d``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from walkerlab.analysis.gait.energy_modes import flat_trajectory_ledger
@@ -111,7 +113,12 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     wpos, wneg, wdamp, internal = _flow_work(walker, seg, scale)
     ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
     pts = walker.points(seg.x_end)
-    step = np.asarray(pts["swing_foot"], float)
+    step = np.array(pts["swing_foot"], float)
+    # feet whose rolling is not holonomic: the whole walker this far further along the fall
+    # line than its printed points (walkerlab.walker.foot_trees.creep_rate)
+    creep = _creep(walker, seg, scale)
+    phi = float(walker.slope_rad)
+    step[:2] += creep * np.array([math.cos(phi), -math.sin(phi)])
     nxt = walker if next_walker is None else next_walker
     push, loss, impulse, ke_plus = _heel_strike(walker, nxt, seg, ke_end)
     # the next stance foot (this step's swing foot) is step[1] higher in the world
@@ -121,7 +128,7 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     if abs(closure) > CLOSURE_RECHECK * scale:  # a kinked work integrand quad missed
         wpos, wneg, wdamp, internal = _flow_work(walker, seg, scale, split=True)
         closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
-    d = step_length(walker, seg)
+    d = step_length(walker, seg) if not creep else float(np.linalg.norm(step[:2]))
     slope_energy = released_energy(walker, d, float(step[1]))
     cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
     out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
@@ -171,6 +178,22 @@ def _flow_work(walker, seg, scale: float, split: bool = False
         if damped:
             wdamp += quad_work(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
     return wpos, wneg, wdamp, internal
+
+
+def _creep(walker, seg, scale: float) -> float:
+    """How far [m] the stance contact ran along the fall line ahead of its reference travel
+    over the step (the integral of :attr:`walkerlab.models.hybrid.base.HybridWalker.
+    creep_rate`); 0.0 for feet whose rolling is holonomic."""
+    rate = walker.creep_rate
+    if rate is None:
+        return 0.0
+    n2, out = seg.x_start.size, 0.0
+    for _ph, sol, (ta, tb) in seg.pieces:
+        def r(t, sol=sol):
+            y = np.asarray(sol(np.atleast_1d(float(t))), float)
+            return rate((y[:, 0] if y.ndim == 2 else y)[:n2])
+        out += quad_work(r, ta, tb, scale)
+    return out
 
 
 def _signed_work(power, a: float, b: float, scale: float, split: bool = False

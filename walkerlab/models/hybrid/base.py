@@ -287,6 +287,11 @@ class HybridWalker:
         one is known (the planar rimless wheel's, McGeer 1990), None when it has none at
         these numbers (it cannot roll over its stance foot); the attribute None: no closed
         form.
+    creep_rate : callable or None
+        ``x (2n,) -> float`` [m/s]: how fast the stance contact runs along the fall line
+        ahead of the reference travel :attr:`points` and :attr:`energies` are measured at
+        (feet curved in both directions, whose rolling is not holonomic:
+        :func:`walkerlab.walker.foot_trees.creep_rate`); None: the points are the true ones.
     """
 
     name: str
@@ -318,6 +323,7 @@ class HybridWalker:
     hip_x: Callable[[np.ndarray], float] | None = None
     section_words: str = "state just after heel strike"
     closed_form_gait: Callable[[], np.ndarray | None] | None = None
+    creep_rate: Callable[[np.ndarray], float] | None = None
 
     def __post_init__(self):
         # the inverse of the section raises OffSection off the surface (SectionInverse)

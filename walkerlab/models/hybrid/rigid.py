@@ -59,6 +59,7 @@ from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
 from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
 from walkerlab.walker import parts as P
 from walkerlab.walker.description import WalkerData
+from walkerlab.walker.foot_trees import creep_rate
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
 SCUFF_DEPTH = 1e-9
@@ -252,6 +253,7 @@ def _make_legged(legs: _Legs, data: WalkerData, name: str, variant: str, printed
         reset_jacobian=reset_jacobian or f["reset_jacobian"],
         heel_strike_guard=f["guard_heel_strike"], leg_angles=coords, mirror=mirror,
         mirror_reflection=odd, matrices=f["matrices"],
+        creep_rate=creep_rate(structure.roles, params),
     )
 
 
