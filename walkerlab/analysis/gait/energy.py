@@ -39,7 +39,7 @@ import numpy as np
 
 from walkerlab.analysis.gait.energy_modes import flat_trajectory_ledger
 from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work, released_energy
-from walkerlab.analysis.gait.metrics import step_length
+from walkerlab.analysis.gait.metrics import creep_along, step_length
 from walkerlab.integrate.rigid import other_leg, simulate_steps
 
 __all__ = ["gait_ledger", "gait_measures", "step_ledger", "trajectory_ledger"]
@@ -116,7 +116,7 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     step = np.array(pts["swing_foot"], float)
     # feet whose rolling is not holonomic: the whole walker this far further along the fall
     # line than its printed points (walkerlab.walker.foot_trees.creep_rate)
-    creep = _creep(walker, seg, scale)
+    creep = float(creep_along(walker, seg, [seg.t_end])[-1])
     phi = float(walker.slope_rad)
     step[:2] += creep * np.array([math.cos(phi), -math.sin(phi)])
     nxt = walker if next_walker is None else next_walker
@@ -178,22 +178,6 @@ def _flow_work(walker, seg, scale: float, split: bool = False
         if damped:
             wdamp += quad_work(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
     return wpos, wneg, wdamp, internal
-
-
-def _creep(walker, seg, scale: float) -> float:
-    """How far [m] the stance contact ran along the fall line ahead of its reference travel
-    over the step (the integral of :attr:`walkerlab.models.hybrid.base.HybridWalker.
-    creep_rate`); 0.0 for feet whose rolling is holonomic."""
-    rate = walker.creep_rate
-    if rate is None:
-        return 0.0
-    n2, out = seg.x_start.size, 0.0
-    for _ph, sol, (ta, tb) in seg.pieces:
-        def r(t, sol=sol):
-            y = np.asarray(sol(np.atleast_1d(float(t))), float)
-            return rate((y[:, 0] if y.ndim == 2 else y)[:n2])
-        out += quad_work(r, ta, tb, scale)
-    return out
 
 
 def _signed_work(power, a: float, b: float, scale: float, split: bool = False

@@ -75,6 +75,8 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
     pts: dict[str, list] = {}
     g = w.params["gravity_m_per_s2"]
     mass = total_mass_kg(w)
+    fall = np.array([math.cos(w.slope_rad), -math.sin(w.slope_rad)])
+    ahead = 0.0  # how far the stance contacts ran ahead of their reference travel so far
     for seg in traj.segments:
         dt = 1.0 / rate_hz
         times = np.arange(seg.t_start, seg.t_end, dt)
@@ -86,6 +88,12 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         sw = w.for_stance(seg.stance_leg)  # legs that differ: that step's own numbers
         ke, pe = sw.energies(X)
         pe = pe + mass * g * seg.stance_foot_world[1]
+        # feet curved in both directions: the walker further along the fall line than its
+        # printed points and potential say (walkerlab.walker.foot_trees.creep_rate)
+        shift = ahead + creep_along(sw, seg, times) if sw.creep_rate is not None else None
+        if shift is not None:
+            pe = pe + mass * g * fall[1] * shift
+            ahead = float(shift[-1])
         chunks["t"].append(times)
         chunks["ke"].append(np.broadcast_to(ke, times.shape))
         chunks["pe"].append(np.broadcast_to(pe, times.shape))
@@ -94,7 +102,10 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         chunks["phase"].append(_phase_of(seg, times, [p.name for p in w.phases]))
         for name, xy in sw.points(X).items():
             key = _leg_point_name(name, r2l)
-            pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
+            xy = np.array(xy, float) + seg.stance_foot_world[:, None]
+            if shift is not None:
+                xy[:2] += fall[:, None] * shift
+            pts.setdefault(key, []).append(xy)
     cat = np.concatenate
     return NamedTrajectory(
         time=cat(chunks["t"]), legs=legs,
@@ -104,6 +115,40 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         points={k: np.hstack(v) for k, v in pts.items()},
         phase=cat(chunks["phase"]), phase_names=[p.name for p in w.phases],
     )
+
+
+def creep_along(walker, seg, times) -> np.ndarray:
+    """How far [m] the stance contact of feet curved in both directions has run along the
+    fall line ahead of its reference travel (the integral of
+    :attr:`walkerlab.models.hybrid.base.HybridWalker.creep_rate` from the step's start),
+    at ``times`` (k,) [s] within the segment ``seg``: adaptive quadrature of the dense
+    output, split at the step's resets (a knee strike's jump in the stance rate).
+
+    Returns
+    -------
+    ndarray (k,)
+        Zeros for a walker whose feet roll holonomically (``creep_rate`` None).
+    """
+    from scipy.integrate import quad
+
+    times = np.asarray(times, float)
+    rate = walker.creep_rate
+    out = np.zeros(times.size)
+    if rate is None:
+        return out
+    cuts = sorted({c for _ph, _sol, span in seg.pieces for c in span})
+
+    def r(t):
+        return rate(seg.sample(np.array([t]))[:, 0])
+
+    acc, prev = 0.0, seg.t_start
+    for i, t in enumerate(times):
+        edges = [prev, *(c for c in cuts if prev < c < t), t]
+        for a, b in zip(edges[:-1], edges[1:]):
+            if b > a:
+                acc += quad(r, a, b, epsabs=1e-15, epsrel=1e-12, limit=200)[0]
+        out[i], prev = acc, max(prev, t)
+    return out
 
 
 def step_length(walker, seg) -> float:
