@@ -300,6 +300,22 @@ def _locked_knee_guess(thigh_rad: float, stance_rad: float, thigh_rate_rad_per_s
             "stance_rate_rad_per_s": stance_rate_rad_per_s}
 
 
+#: why the kneed walkers' torso_torque cases carry a light upper body and a weak law
+_KNEED_UPPER_BODY = ("a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), "
+                    "stance_hip PD 0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no "
+                    "gait)")
+
+
+def _kneed_upper_body(guess: dict) -> dict:
+    """The changes of a kneed walker's torso_torque case (:data:`_KNEED_UPPER_BODY`): the
+    upper body on the bisecting hip, the weak stance_hip PD, and the gait's ``guess``."""
+    return {"walker.torso": {"coupling": "bisecting_hip",
+                             "bodies": [{"kind": "point_mass", "name": "mass",
+                                         "mass_kg": 0.4, "from_hip_m": 0.2}]},
+            "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
+            "fixedpoint.initial_guess": guess}
+
+
 #: (kind, feature) -> (why, changes): as :data:`WALKING`, for the ``optimize`` cell alone
 #: (the feature's other views take a shipped scene, :data:`SHIPPED`, that walks): the
 #: generated case's changes so that it has a gait to start the optimisation from
@@ -319,18 +335,10 @@ WALKING_OPTIMIZE = {
     # the planar kneed case's upper body and law on the kneed walker in 3D
     # (configs/kneed_3d.yaml): 0.7199 s steps, started here from its fixed point (the
     # optimize cell's case: the other views' is configs/kneed_torso_powered_3d.yaml)
-    ("locking_knees_3d", "torso_torque"): (
-        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
-        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
-        {"walker.torso": {"coupling": "bisecting_hip",
-                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
-                                      "from_hip_m": 0.2}]},
-         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
-         "fixedpoint.initial_guess": {
-             "lean_angle_rad": -0.0063230986,
-             **_locked_knee_guess(-0.3356683451, 0.2371694574, -0.3271603306,
-                                  -1.0680204371),
-             "lean_rate_rad_per_s": -0.1236924401}}),
+    ("locking_knees_3d", "torso_torque"): (_KNEED_UPPER_BODY, _kneed_upper_body({
+        "lean_angle_rad": -0.0063230986,
+        **_locked_knee_guess(-0.3356683451, 0.2371694574, -0.3271603306, -1.0680204371),
+        "lean_rate_rad_per_s": -0.1236924401})),
 }
 
 
@@ -367,15 +375,8 @@ WALKING = {
     # walker is 0.4 kg on this 1.6 kg one (the generic 5 kg body with the 0.1 N m/rad law:
     # no gait), held on the legs' bisector, and the torso law as weak as the hip's case.
     # Gait: 0.7197 s steps, |multipliers| 0.488.
-    ("locking_knees", "torso_torque"): (
-        "a 0.4 kg upper body (torso_bhm's quarter of the walker's mass), stance_hip PD "
-        "0.01 N m/rad, 0.001 N m s/rad (5 kg and 0.1 N m/rad: no gait)",
-        {"walker.torso": {"coupling": "bisecting_hip",
-                          "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.4,
-                                      "from_hip_m": 0.2}]},
-         "walker.actuation.torques": [_pd("stance_hip", 0.01, 0.001)],
-         "fixedpoint.initial_guess": _locked_knee_guess(-0.3407594714, 0.2400224376,
-                                                        -0.3259477384, -1.0823455559)}),
+    ("locking_knees", "torso_torque"): (_KNEED_UPPER_BODY, _kneed_upper_body(
+        _locked_knee_guess(-0.3407594714, 0.2400224376, -0.3259477384, -1.0823455559))),
     # one output, the swing leg's angle, of the stance leg's (the compass walker's one
     # actuator, the hip): a step of 0.1 rad behind to 0.1348 rad ahead (the heel strike's
     # symmetry about the 0.0174 rad slope's normal).  The generic +-0.2 rad step stalls
