@@ -63,10 +63,11 @@ def _kneed_in_3d(width: float) -> dict:
 def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and_exports():
     """``space: 3d`` with a plastic knee validates and is the kind ``locking_knees_3d``
     (knees ``locking``, the 3D legs' body); its roles are the planar kneed walker's with
-    the lean first; the rigid view, the contact model (tests/test_kneed_3d_contact.py), the
-    MJCF, the URDF, the gym (tests/test_kneed_3d_export.py) and the Adams dataset
-    (tests/test_export_adams_3d_knees.py) take it, every other view
-    refuses it in one line naming the field."""
+    the lean first; every view takes it: the rigid view, the contact model
+    (tests/test_kneed_3d_contact.py), the MJCF, the URDF, the gym
+    (tests/test_kneed_3d_export.py), the Adams dataset (tests/test_export_adams_3d_knees.py)
+    and the collocation (a stride of phased steps: tests/test_optimize_3d.py), which
+    refuses its push-off in one line naming the field."""
     from walkerlab.walker.description import walker_data
 
     scene = scene_from_dict(_kneed_in_3d(0.1))
@@ -76,11 +77,11 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     assert data.structure.roles == ("lean", "swing_thigh", "swing_shank", "stance")
     assert data.structure.mirror_odd_roles == ("lean",)   # steps on alternate sides
     assert all(kind.supports("walk", v)
-               for v in ("rigid", "contact", "mjcf", "urdf", "gym", "adams", "osim"))
-    for view in ("optimize",):
-        with pytest.raises(KindRefused) as err:
-            kind.require("walk", view, "walker.space: 3d")
-        assert str(err.value).startswith("walker.space: 3d: ") and "\n" not in str(err.value)
+               for v in ("rigid", "contact", "mjcf", "urdf", "gym", "adams", "osim",
+                         "optimize"))
+    with pytest.raises(KindRefused) as err:
+        kind.require("push_off", "optimize", "walker.actuation.push_off")
+    assert str(err.value).startswith("walker.actuation.push_off: ") and "\n" not in str(err.value)
     assert not kind.supports("profile", "rigid")
     # round feet on the shanks: configs/kneed_round_feet_3d.yaml (the slow test below)
     assert kind.supports("round_feet_3d", "rigid") and kind.supports("round_feet_3d", "contact")
