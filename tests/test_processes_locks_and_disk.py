@@ -299,8 +299,36 @@ def test_numba_cache_is_written_to_the_user_cache(tmp_path):
         print(os.environ.get("NUMBA_CACHE_DIR"))
         """)], env=env, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == str(tmp_path / "uc" / "numba")
+    from walkerlab.usercache import numba_sources_key
+
+    # keyed on the numba modules' sources: machine code that inlined another module's
+    # kernel never outlives that kernel's change
+    assert out.stdout.strip() == str(tmp_path / "uc" / "numba" / numba_sources_key())
     assert list((tmp_path / "uc" / "numba").rglob("*.nbi")), "numba cached nothing there"
+
+
+def test_other_numba_cache_keys_are_pruned_after_a_day_never_through_a_link(tmp_path):
+    """The numba cache's key folder is created private; the folders of other keys (another
+    version's sources, the old flat layout) are removed once unused for a day, a fresh one
+    is kept, and a symbolic link is left alone (its target untouched)."""
+    from walkerlab.usercache import _keyed
+
+    d = tmp_path / "numba"
+    d.mkdir(mode=0o700)
+    old, fresh = d / "0123456789abcdef", d / "contact_feedface"
+    for f in (old, fresh):
+        f.mkdir()
+        (f / "x.nbi").write_bytes(b"")
+    os.utime(old, (time.time() - 2 * 86400,) * 2)
+    target = tmp_path / "elsewhere"
+    target.mkdir()
+    (target / "keep").write_text("precious\n")
+    os.utime(target, (time.time() - 2 * 86400,) * 2)
+    (d / "link").symlink_to(target)
+    sub = _keyed(d, "fedcba9876543210")
+    assert sub == d / "fedcba9876543210" and stat.S_IMODE(sub.stat().st_mode) == 0o700
+    assert not old.exists() and fresh.exists() and (d / "link").is_symlink()
+    assert (target / "keep").read_text() == "precious\n"
 
 
 # ------------------------------------------------------------------ 3: symbolic links

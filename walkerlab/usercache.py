@@ -9,7 +9,8 @@ machine code it compiled earlier.  Both live in one folder per user, never in a 
 - ``$WALKERLAB_CACHE_DIR`` if set, else the platform's user cache folder:
   ``$XDG_CACHE_HOME/walkerlab`` (``~/.cache/walkerlab`` when unset) on Linux,
   ``~/Library/Caches/walkerlab`` on macOS, ``%LOCALAPPDATA%\\walkerlab`` on Windows;
-- sub-folders ``models/`` (generated Python), ``numba/`` (``NUMBA_CACHE_DIR``), ``drop/``
+- sub-folders ``models/`` (generated Python), ``numba/<key>/`` (``NUMBA_CACHE_DIR``, keyed on
+  the numba modules' sources: :func:`use_for_numba`), ``drop/``
   (drop tests of contact laws, JSON numbers: :mod:`walkerlab.analysis.contact.drop`) and
   ``hashes/`` (recomputed content hashes of artifacts by file stamp, JSON: never trusted
   for a file changed since, :mod:`walkerlab.io.artifacts`; at most 4096 entries, the
@@ -39,6 +40,8 @@ imports numba), so numba never writes into the installed package.
 from __future__ import annotations
 
 import contextlib
+import functools
+import hashlib
 import os
 import stat
 import sys
@@ -201,8 +204,14 @@ def write_private(path: Path, text: str, errors: list | None = None) -> bool:
 
 
 def use_for_numba() -> None:
-    """Point numba's on-disk cache at ``<root>/numba`` unless ``NUMBA_CACHE_DIR`` is set,
-    and guard numba's cache reads (:func:`guard_numba_cache`).
+    """Point numba's on-disk cache at ``<root>/numba/<key>`` unless ``NUMBA_CACHE_DIR`` is
+    set, and guard numba's cache reads (:func:`guard_numba_cache`).
+
+    ``<key>`` is :func:`numba_sources_key`: numba stamps a cached function with its own
+    source file only, so machine code that inlined a kernel of another module would
+    outlive that kernel's change (an editable install updated in place, a developer's
+    edit) and run the old physics; keyed on the numba modules' sources, any change starts
+    a fresh cache.  Key folders not used for a day are removed (:func:`_prune`).
 
     Call before numba compiles a ``cache=True`` function (numba reads the variable when it is
     imported; if it already is, its configuration is updated too).  Without a private,
@@ -213,6 +222,8 @@ def use_for_numba() -> None:
     if os.environ.get(NUMBA_ENV):
         return
     d = private_dir("numba", writable=True)
+    if d is not None:
+        d = _keyed(d, numba_sources_key())
     if d is None:
         d = private_tmp() / "numba"
         d.mkdir(mode=0o700, exist_ok=True)
@@ -220,6 +231,58 @@ def use_for_numba() -> None:
     cfg = sys.modules.get("numba.core.config")
     if cfg is not None:
         cfg.CACHE_DIR = str(d)
+
+
+@functools.cache
+def numba_sources_key() -> str:
+    """The first 16 hex digits of the sha256 of walkerlab's modules that name numba (their
+    paths in the package and their bytes, in order): the numba cache's folder
+    (:func:`use_for_numba`)."""
+    pkg = Path(__file__).parent
+    h = hashlib.sha256()
+    for p in sorted(pkg.rglob("*.py")):
+        body = p.read_bytes()
+        if b"numba" in body or b"njit" in body:
+            h.update(p.relative_to(pkg).as_posix().encode() + b"\0" + body)
+    return h.hexdigest()[:16]
+
+
+def _keyed(d: Path, key: str) -> Path | None:
+    """``d / key``, created private (mode 0700) and writable, the other folders of ``d``
+    pruned (:func:`_prune`); None where it cannot be (a link, another owner, read-only)."""
+    sub = d / key
+    if os.path.islink(sub):
+        return None
+    try:
+        sub.mkdir(mode=0o700, exist_ok=True)
+    except OSError:
+        return None
+    if not is_private(sub) or not os.access(sub, os.W_OK | os.X_OK):
+        return None
+    os.utime(sub)  # in use: its mtime is the day's
+    _prune(d, key)
+    return sub
+
+
+def _prune(d: Path, key: str, age_s: float = 86400.0) -> None:
+    """Remove the folders of ``d`` other than ``key`` not used for ``age_s`` [s] (other
+    versions' numba caches: each key folder's mtime is refreshed by every run using it),
+    never through a link; errors are ignored (another process may be at it)."""
+    import shutil
+    import time
+
+    now = time.time()
+    try:
+        entries = list(os.scandir(d))
+    except OSError:
+        return
+    for e in entries:
+        try:
+            if (e.name != key and e.is_dir(follow_symlinks=False)
+                    and now - e.stat(follow_symlinks=False).st_mtime > age_s):
+                shutil.rmtree(e.path, ignore_errors=True)
+        except OSError:
+            pass
 
 
 # ------------------------------------------------------------------ numba's cache reads
