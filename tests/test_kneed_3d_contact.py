@@ -200,16 +200,11 @@ def test_the_3d_kneed_walker_with_an_upper_body_walks_in_contact_at_the_rigid_ga
     the contact model: 6 strides on the rigid footfalls' 0.2 m patches make >= 12 heel
     strikes without a fall, and over steps 9-12 the mean step period and the hip's speed
     are within 3 % of the rigid walk's same steps (measured +0.12 %, -1.64 %)."""
-    from walkerlab.api.capabilities import _contact_against_rigid
+    from walkerlab.api.capabilities import _contact  # the capability cell's measurement
     from walkerlab.config import scene_from_dict
-    from walkerlab.stages import pipeline
 
     d = load_scene("configs/kneed_torso_powered_3d.yaml").model_dump(mode="json")
     d["simulate"]["strides"] = 7  # the rigid walk as long as the contact walk
-    scene = scene_from_dict(d)
-    cs = pipeline.run("contact-sim", scene, tmp_path).path
-    fp = pipeline.run("fixedpoint", scene, tmp_path).path
-    sim = pipeline.run("simulate", scene, tmp_path).path
-    value, line = _contact_against_rigid(cs, fp, sim)
+    value, line = _contact(scene_from_dict(d), d, tmp_path)
     assert "heel strikes" in line and int(line.split()[0]) >= 12, line
     assert abs(value) < 0.03, line

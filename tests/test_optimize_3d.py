@@ -37,6 +37,23 @@ def _scene(name: str, **optimize):
     return type(scene).model_validate(d)
 
 
+def _least_effort(name: str, intervals: int):
+    """The shipped scene's least-effort optimum on ``intervals`` a step, started from the
+    gait ``walkerlab fixedpoint`` finds by shooting: ``(optimize's result, that gait's
+    search result, its step periods [s])``."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.driver import optimize_scene
+
+    scene = _scene(name, intervals=intervals, objective="effort")
+    plant = Plant.from_scene(scene)
+    _, search = solve_scene(scene, plant=plant)
+    r = search.gaits[search.selected].result
+    periods = np.asarray(r.step_periods_s, float)
+    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
+                         plant=plant)
+    return out, r, periods
+
+
 def _guess_of(scene) -> np.ndarray:
     """The scene's ``fixedpoint.initial_guess`` as a state (2n,) [rad, rad/s]."""
     g = scene.fixedpoint.initial_guess.model_dump()
@@ -114,16 +131,7 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     upper body on the bisecting hip (torso_bhm_3d_stabilised, Wisse, Hobbelen & Schwab
     2007) the same: the upper body is part of the walker's equations, not an input."""
     pytest.importorskip("casadi")
-    from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.driver import optimize_scene
-
-    scene = _scene(name, intervals=intervals, objective="effort")
-    plant = Plant.from_scene(scene)
-    _, search = solve_scene(scene, plant=plant)
-    r = search.gaits[search.selected].result
-    periods = np.asarray(r.step_periods_s, float)
-    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
-                         plant=plant)
+    out, r, periods = _least_effort(name, intervals)
     assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
     assert out.objective <= 1e-10
     x0 = np.array([v[0] for v in out.states.values()])
@@ -176,17 +184,9 @@ def test_the_least_effort_3d_kneed_gait_on_its_passive_slope_is_its_passive_gait
     O(h^4) in the start's distance: 7.5e-6 on 40 intervals a step, 1.5e-6 on 60, 8.2e-7 on
     70, 4.8e-7 on 80 (the replay 6.9e-7 on 60, 2.2e-7 on 80), so 80 here."""
     pytest.importorskip("casadi")
-    from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.driver import optimize_scene
     from walkerlab.optimal.transcription.stride import stride_phases
 
-    scene = _scene("kneed_3d_stabilised", intervals=80, objective="effort")
-    plant = Plant.from_scene(scene)
-    _, search = solve_scene(scene, plant=plant)
-    r = search.gaits[search.selected].result
-    periods = np.asarray(r.step_periods_s, float)
-    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
-                         plant=plant)
+    out, r, periods = _least_effort("kneed_3d_stabilised", 80)
     assert tuple(out.phase_names) == stride_phases([("unlocked_swing", "knee_strike", 1),
                                                     ("locked_swing", "heel_strike", -1)])
     assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
@@ -381,16 +381,7 @@ def test_the_least_effort_3d_gait_on_two_footholds_is_the_passive_period_two_gai
     fixed point, the mean step period within 1e-7 relative and the replay on the rigid
     walker on the footholds closing to 1e-6 (seen 2.0e-7; 1.0e-6 on 40 intervals)."""
     pytest.importorskip("casadi")
-    from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.driver import optimize_scene
-
-    scene = _scene("hip_width_footholds", intervals=60, objective="effort")
-    plant = Plant.from_scene(scene)
-    _, search = solve_scene(scene, plant=plant)
-    r = search.gaits[search.selected].result
-    periods = np.asarray(r.step_periods_s, float)
-    out = optimize_scene(scene, np.asarray(r.x, float), float(r.period_s) / len(periods),
-                         plant=plant)
+    out, r, periods = _least_effort("hip_width_footholds", 60)
     assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
     assert out.objective <= 1e-10, out.objective
     x0 = np.array([v[0] for v in out.states.values()])

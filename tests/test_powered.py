@@ -183,7 +183,8 @@ def test_the_energy_ledger_closes_and_cost_of_transport(name):
         assert np.all(h > 0)  # down the stairs, down onto the footholds
         np.testing.assert_allclose(led["slope_energy"], m * g * h, rtol=1e-12)
         np.testing.assert_allclose(led["cost_of_transport"],
-                                   h / np.array([np.hypot(*f) for f in feet]), rtol=1e-12)
+                                   h / np.array([np.hypot(f[0], f[1]) for f in feet]),
+                                   rtol=1e-12)  # along the ground (a 3D foot: its width apart)
     elif name in PASSIVE:
         # a passive gait: the collisions (and dampers) take what the slope releases, so the
         # cost of transport is sin(slope)

@@ -128,7 +128,7 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     if abs(closure) > CLOSURE_RECHECK * scale:  # a kinked work integrand quad missed
         wpos, wneg, wdamp, internal = _flow_work(walker, seg, scale, split=True)
         closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
-    d = step_length(walker, seg) if not creep else float(np.linalg.norm(step[:2]))
+    d = float(np.linalg.norm(step[:2]))  # the step's length (metrics.step_length's)
     slope_energy = released_energy(walker, d, float(step[1]))
     cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
     out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
