@@ -266,7 +266,7 @@ SKIP = {
     "walker/walker_trees.py", "codegen/frames.py",
     "codegen/tree_derive.py", "walker/tree.py", "walker/trees.py",
     "codegen/actuated.py", "codegen/torque_law.py", "codegen/floating.py",
-    "codegen/floating_equations.py", "codegen/floating_3d.py", "codegen/floating_names.py",
+    "codegen/floating_equations.py", "codegen/floating_names.py",
     "walker/floating_tree.py",
     "models/contact/generated.py", "models/contact/powered_source.py",
     "models/contact/rhs_lines.py", "models/contact/assembly.py",

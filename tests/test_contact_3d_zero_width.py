@@ -3,7 +3,7 @@ configs/round_feet_3d.yaml, a disc in each leg's sagittal plane) in the complian
 model, against references the contact view does not compute:
 
 - where the legs pass each other (equal pitches) every mass lies on one line, so without
-  the legs' axial inertia (:func:`walkerlab.codegen.floating_3d.legs_axial_inertia`) the
+  the legs' axial inertia (:func:`walkerlab.codegen.floating_equations.legs_axial_inertia`) the
   floating view's mass matrix is singular there; with it, its smallest eigenvalue is the
   two legs' axial inertia, ``2 m (0.01 L)^2 / 2`` (the rod's formula, not the view's);
 - the contact walk (slow) against the rigid walk (``walkerlab simulate``, the rigid
@@ -22,8 +22,11 @@ import pytest
 import sympy as sp
 
 from walkerlab.codegen.floating import floating_params
-from walkerlab.codegen.floating_3d import AXIAL_RADIUS_L, legs_axial_inertia
-from walkerlab.codegen.floating_equations import derive_floating
+from walkerlab.codegen.floating_equations import (
+    AXIAL_RADIUS_L,
+    derive_floating,
+    legs_axial_inertia,
+)
 from walkerlab.config import load_scene
 from walkerlab.walker.description import walker_data
 

@@ -1,6 +1,6 @@
 """The 3D kneed walker (configs/kneed_3d.yaml, the kind ``locking_knees_3d``) in the
 compliant-contact model: its floating view, the body tree with both knees set free on the
-ground (:func:`walkerlab.codegen.floating_3d.derive_legs_3d`), against references that do
+ground (:func:`walkerlab.codegen.floating_equations.derive_floating`), against references that do
 not share it:
 
 - the planar kneed walker's floating view (configs/kneed.yaml,

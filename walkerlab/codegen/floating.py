@@ -262,14 +262,14 @@ def _source_hash(paths: tuple) -> str:
 def module_key(structure: Structure, tag: str, sources=()) -> str:
     """Cache key: the rigid generator's key of ``structure`` (structure + generator + sympy),
     this file, the derivations' (:mod:`walkerlab.codegen.floating_equations`,
-    :mod:`walkerlab.codegen.floating_3d`, :mod:`walkerlab.codegen.floating_names`, the
+    :mod:`walkerlab.codegen.floating_names`, the
     planar floating tree :mod:`walkerlab.walker.floating_tree`) and ``sources`` (files whose
     text is part of the module), and ``tag``."""
-    from walkerlab.codegen import cache, floating_3d, floating_equations, floating_names
+    from walkerlab.codegen import cache, floating_equations, floating_names
 
     h = hashlib.sha256(cache.cache_key(structure).encode())
     h.update(tag.encode())
-    h.update(_source_hash((__file__, floating_equations.__file__, floating_3d.__file__,
+    h.update(_source_hash((__file__, floating_equations.__file__,
                            floating_names.__file__, floating_tree.__file__,
                            *sources)).encode())
     return h.hexdigest()[:24]

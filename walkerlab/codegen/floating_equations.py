@@ -45,8 +45,24 @@ point is
   parameter vector (:func:`param_names`).
 
 The contact points are named by :func:`contact_names` (``leg1``, ``leg2``; flat feet
-their heels and toes; a spoked wheel its spoke tips).  Walkers in 3D (straight legs, the
-spoked wheel) derive from their body trees: :mod:`walkerlab.codegen.floating_3d`.
+their heels and toes; a spoked wheel its spoke tips).
+
+Walkers in 3D (straight legs, locking knees, the spoked wheel) have the same equations with
+points of three components in world axes (``x`` downhill, ``y`` up, ``z`` lateral) and, per
+contact point, the Jacobian of its body's spin about the slope's normal (``spins``, where
+the contact's torsional friction acts); the generated contact module
+(:mod:`walkerlab.models.contact.generated`) reads the dimension from the points.
+
+One derivation for every walker (:func:`_flow`): its floating tree (planar:
+:func:`walkerlab.walker.floating_tree.floating_planar_tree`, the pelvis or a wheel's hub on
+the world's slides; 3D: the rigid tree set free at its stance contact by
+:func:`walkerlab.walker.tree.free_root`), its kinematics
+(:func:`walkerlab.codegen.tree_derive.kinematics`), the mass matrix and potential of
+:func:`walkerlab.codegen.tree_derive.mass_and_potential` (a planar tree's mass matrix in the
+closed form of sums of ``cos(q_i - q_j)``, :func:`walkerlab.codegen.tree_derive.
+product_to_sum`; a 3D tree's unsimplified: common subexpressions are the generated code's)
+and the bias ``h`` of :func:`walkerlab.codegen.lagrange.bias`; then the walker's contact
+points and named points (:func:`_planar_feet`, :func:`_legs_3d`, :func:`_wheel_tips`).
 
 Massless bodies (the simplest walker's legs) have no floating model: :func:`check_masses`
 raises.
@@ -54,9 +70,9 @@ raises.
 
 from __future__ import annotations
 
+import dataclasses
 from functools import cache
 
-from walkerlab.codegen.floating_3d import derive_legs_3d, derive_wheel_3d
 from walkerlab.codegen.floating_names import (  # noqa: F401 (re-exported)
     FOOT_PARAMS,
     FREE_3D,
@@ -75,17 +91,21 @@ from walkerlab.codegen.floating_names import (  # noqa: F401 (re-exported)
 from walkerlab.walker.description import Structure
 from walkerlab.walker.floating_tree import floating_planar_tree
 from walkerlab.walker.multibody import check_floating_view
+from walkerlab.walker.tree import free_root
+from walkerlab.walker.trees import legs_tree, spoked_wheel_3d_tree
+
+#: the radius of the solid rod, as a fraction of the leg length, whose axial moment of
+#: inertia each leg of a 3D walker of zero hip width carries in the contact view
+#: (:func:`legs_axial_inertia`): ``m (0.01 L)^2 / 2`` for a leg of mass ``m``
+AXIAL_RADIUS_L = 0.01
 
 
 @cache
 def derive_floating(structure: Structure) -> FloatingEquations:
-    """Derive the floating view of ``structure`` (memoised per process): a planar legged
-    walker's from its floating tree (:func:`walkerlab.walker.floating_tree.
-    floating_planar_tree`; every body and foot where the tree's kinematics puts it, read as
-    a sum of link vectors, :func:`_link_sums`), the mass matrix and potential of its bodies
-    (:func:`_mass_and_potential`), its feet (:func:`_feet`), the spring-dampers
-    (:func:`_springs`), then the bias ``h`` (module docstring); a 3D walker's and a spoked
-    wheel's from theirs.
+    """Derive the floating view of ``structure`` (memoised per process; module docstring):
+    its floating tree's flow (:func:`_flow`) with the walker's contact points, planar
+    (:func:`_planar_legs`, :func:`_wheel_tips`) or in 3D (:func:`_legs_3d`, the wheel's
+    :func:`_wheel_tips`).
 
     Raises
     ------
@@ -94,126 +114,79 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         flat, or free knees on feet other than points, legs that differ or with springs
         (:func:`walkerlab.walker.multibody.check_floating_view`).
     """
+    check_floating_view(structure)
+    check_masses(structure)
+    if structure.spokes:
+        return _wheel_tips(structure)
+    if structure.in_3d:
+        return _legs_3d(structure)
+    if structure.foot not in ("point", "arc", "flat"):
+        raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
+    return _planar_legs(structure)
+
+
+def _flow(structure: Structure, tree, coords):
+    """The flow of a floating tree ``tree`` (its map ``coords``) in the floating view's
+    coordinates (:func:`coordinate_names`): ``(kin, q, dq, rename, M, V, h)``, ``kin`` the
+    tree's kinematics (:func:`walkerlab.codegen.tree_derive.kinematics`), ``rename`` its
+    symbols to ``q``, ``dq``; a planar tree's mass matrix by
+    :func:`walkerlab.codegen.tree_derive.product_to_sum`, its bias with the spring-dampers
+    (:func:`_springs`) and expanded."""
     import sympy as sp
 
     from walkerlab.codegen.lagrange import bias  # light: sympy on first derivation only
-    from walkerlab.codegen.tree_derive import kinematics  # light
+    from walkerlab.codegen.tree_derive import (  # light
+        kinematics,
+        mass_and_potential,
+        product_to_sum,
+    )
 
-    check_floating_view(structure)
-    check_masses(structure)
-    if structure.in_3d:  # from the body trees (walkerlab.codegen.floating_3d)
-        return derive_wheel_3d(structure) if structure.spokes else derive_legs_3d(structure)
-    if structure.spokes:
-        return _derive_spoked(structure)
-    if structure.foot not in ("point", "arc", "flat"):
-        raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
-    tree, coords = floating_planar_tree(structure, param_names(structure))
-    kin = kinematics(tree, coords)   # the root is the world: world axes
-    q = sp.symbols(coords.names, real=True)
-    dq = sp.symbols([f"d_{n}" for n in coords.names], real=True)
+    kin = kinematics(tree, coords)
+    names = coordinate_names(structure)
+    q = sp.symbols(names, real=True)
+    dq = sp.symbols([f"d_{n}" for n in names], real=True)
     rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
-    P = dict(zip(tree.params, kin.params))
-    hip = sp.Matrix(q[:2])
-    bodies = [(kin.masses[b], _link_sums(kin.coms[b].xreplace(rename), hip),
-               kin.inertias[b][2, 2], kin.omegas[b][2].xreplace(rename))
-              for b in kin.coms if kin.masses[b] != 0]
-    M, V = _mass_and_potential(q, dq, P["g"], bodies)
+    M, _, _, V = mass_and_potential(kin)
+    M, V = M.xreplace(rename), V.xreplace(rename)
+    if structure.in_3d:
+        return kin, q, dq, rename, M, V, bias(M, V, q, dq)
+    M = M.applyfunc(product_to_sum)
+    damping = sp.zeros(len(q), len(q))
+    if not structure.spokes:   # the legs' spring-dampers
+        Vs, damping = _springs(structure, q, dict(zip(tree.params, kin.params)))
+        V = V + Vs
+    return kin, q, dq, rename, M, V, (bias(M, V, q, dq) + damping * sp.Matrix(dq)).applyfunc(
+        sp.expand)
+
+
+def _equations(kin, q, dq, M, V, h, feet, points, **more) -> FloatingEquations:
+    """The :class:`FloatingEquations` of a flow and its contact points (``more``: knees,
+    contacts, point legs, stance forces, spins)."""
+    import sympy as sp
+
     dqv = sp.Matrix(dq)
-    T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
-    names = list(coords.names)
-    hips = [q[names.index(f"{leg}_thigh_angle" if structure.knee else f"{leg}_angle")]
-            for leg in LEGS]
-    psi_t = None
-    if structure.torso:
-        psi_t = (q[names.index("torso_angle")] if structure.hinged_torso
-                 else (hips[0] + hips[1]) / 2)
-    Vs, damping = _springs(structure, q, P, hips, psi_t)
-    V = V + Vs
-    h = (bias(M, V, q, dq) + damping * dqv).applyfunc(sp.expand)
-    feet, points = _feet(structure, kin, rename, q, P)
     return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(kin.params), M=M, h=h,
-                             feet=tuple(feet), kinetic=T, potential=V, points=points,
-                             knees=tuple((names.index(f"{leg}_thigh_angle"),
-                                          names.index(f"{leg}_shank_angle"))
-                                         for leg in LEGS
-                                         if structure.knee and not structure.free_knees),
-                             contacts=contact_names(structure),
-                             point_legs=tuple(int(c[3]) - 1 for c in contact_names(structure)))
+                             feet=tuple(feet), kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0],
+                             potential=V, points=points, **more)
 
 
-def _link_sums(point, hip) -> dict:
-    """A planar point of the floating tree (3, 1; world axes) as ``hip + sum(length *
-    e(angle))`` (``e(a) = (sin a, -cos a)``, :func:`walkerlab.codegen.frames.leg_unit`):
-    ``{angle: length}``, each angle a link's absolute angle (a linear expression of the
-    coordinates: the bisecting torso's mean; ``+ pi/2`` for a length ahead of the link's
-    axis), so that velocities and the mass matrix come out in ``cos(a - b)`` form without a
-    trigonometric simplifier.
-
-    Raises
-    ------
-    ValueError
-        The point is not such a sum (its height does not match its run).
-    """
-    import sympy as sp
-
-
-    lin: dict = {}
-    for term in sp.Add.make_args(sp.expand(point[0] - hip[0])):
-        if term == 0:   # the hip itself
-            continue
-        (trig,) = [f for f in sp.Mul.make_args(term) if isinstance(f, sp.sin | sp.cos)]
-        angle = trig.args[0]
-        key = angle if isinstance(trig, sp.sin) else angle + sp.pi / 2
-        lin[key] = lin.get(key, 0) + term / trig
-    if sp.expand(_at(lin, hip)[1] - point[1]) != 0:
-        raise ValueError("floating tree: a point is not a sum of link vectors from the hip")
-    return lin
+def _planar_legs(structure: Structure) -> FloatingEquations:
+    """A planar legged walker's floating view: its floating tree
+    (:func:`walkerlab.walker.floating_tree.floating_planar_tree`; every body and foot where
+    the tree's kinematics puts it), the flow (:func:`_flow`) and the feet
+    (:func:`_planar_feet`)."""
+    tree, coords = floating_planar_tree(structure, param_names(structure))
+    kin, q, dq, rename, M, V, h = _flow(structure, tree, coords)
+    feet, points = _planar_feet(structure, kin, rename, q)
+    names = list(coordinate_names(structure))
+    knees = tuple((names.index(f"{leg}_thigh_angle"), names.index(f"{leg}_shank_angle"))
+                  for leg in LEGS if structure.knee and not structure.free_knees)
+    contacts = contact_names(structure)
+    return _equations(kin, q, dq, M, V, h, feet, points, knees=knees, contacts=contacts,
+                      point_legs=tuple(int(c[3]) - 1 for c in contacts))
 
 
-def _at(lin: dict, hip):
-    """``hip + sum(length * e(angle))`` of a ``{angle: length}`` sum (:func:`_link_sums`)."""
-    import sympy as sp
-
-    from walkerlab.codegen.frames import leg_unit  # light
-
-    return hip + sum((v * leg_unit(a) for a, v in lin.items()), sp.zeros(2, 1))
-
-
-def _mass_and_potential(q, dq, g, bodies: list):
-    """The mass matrix ``M`` (nq, nq) (``factor_terms`` applied) and the gravitational
-    potential ``V`` of ``bodies`` ``(mass, {angle: length}, inertia about z, spin)`` (the
-    spin ``omega_z``, linear in ``dq``): ``T = sum m |v|^2 / 2 + I omega_z^2 / 2``, each
-    velocity ``(dhip_x, dhip_y) + sum length a' (cos a, sin a)``."""
-    import sympy as sp
-
-    nq = len(q)
-    M = sp.zeros(nq, nq)
-    V = sp.Integer(0)
-    for mass, lin, inertia, spin in bodies:
-        M[0, 0] += mass
-        M[1, 1] += mass
-        # d position / d q_k = sum over angles a of length * da/dq_k * (cos a, sin a)
-        terms = [[(a, lk * sp.diff(a, q[k])) for a, lk in lin.items() if sp.diff(a, q[k]) != 0]
-                 for k in range(nq)]
-        for k in range(2, nq):
-            for a, ca in terms[k]:
-                M[0, k] += mass * ca * sp.cos(a)
-                M[1, k] += mass * ca * sp.sin(a)
-            for j in range(2, nq):
-                for a, ca in terms[k]:
-                    for b_, cb in terms[j]:
-                        M[k, j] += mass * ca * cb * sp.cos(a - b_)
-        if inertia != 0:
-            w = sp.Matrix([[sp.diff(spin, v) for v in dq]])
-            M += inertia * w.T * w
-        y = q[1] - sum((lk * sp.cos(a) for a, lk in lin.items()), sp.Integer(0))
-        V += mass * g * y
-    for k in range(2, nq):
-        M[k, 0], M[k, 1] = M[0, k], M[1, k]
-    return M.applyfunc(sp.factor_terms), V
-
-
-def _feet(structure: Structure, kin, rename: dict, q, P: dict) -> tuple[list, dict]:
+def _planar_feet(structure: Structure, kin, rename: dict, q) -> tuple[list, dict]:
     """The contact points ``(position (2, 1), Jacobian (2, nq))`` of the feet and the named
     points, in world axes, of a planar floating tree's kinematics (module docstring: an
     arc's lowest point with its material point's Jacobian, a flat foot's heel and toe)."""
@@ -222,15 +195,15 @@ def _feet(structure: Structure, kin, rename: dict, q, P: dict) -> tuple[list, di
     from walkerlab.codegen.frames import leg_unit, planar_slope_axes  # light
 
     qv = sp.Matrix(q)
-    hip = sp.Matrix(q[:2])
+    P = {str(p): p for p in kin.params}
 
-    def at(v):
-        return _at(_link_sums(v.xreplace(rename), hip), hip)
+    def at(v):   # the root is the world: world axes, the plane's two rows
+        return v.xreplace(rename)[:2, :]
 
     n_vec, t_vec = planar_slope_axes(P["gamma"])
     R = P["R_foot"] if structure.foot == "arc" else 0
     names = [str(c) for c in q]
-    feet, points = [], {"hip": hip}
+    feet, points = [], {"hip": sp.Matrix(q[:2])}
     for leg in LEGS:
         lower = q[names.index(f"{leg}_shank_angle" if structure.knee else f"{leg}_angle")]
         upper = f"{leg}_thigh" if structure.knee else leg
@@ -262,7 +235,7 @@ def _feet(structure: Structure, kin, rename: dict, q, P: dict) -> tuple[list, di
     return feet, points
 
 
-def _springs(structure: Structure, q, P: dict, hips: list, psi_t):
+def _springs(structure: Structure, q, P: dict):
     """The torsional spring-dampers' potential ``sum k (delta - r)^2 / 2`` [J] (added to
     gravity's) and damping matrix (the damper's ``-c J^T J dq`` joins the bias).
 
@@ -272,6 +245,12 @@ def _springs(structure: Structure, q, P: dict, hips: list, psi_t):
     from walkerlab.codegen.lagrange import spring_dampers  # light: sympy on first use
 
     names = [str(c) for c in q]
+    hips = [q[names.index(f"{leg}_thigh_angle" if structure.knee else f"{leg}_angle")]
+            for leg in LEGS]
+    psi_t = None
+    if structure.torso:
+        psi_t = (q[names.index("torso_angle")] if structure.hinged_torso
+                 else (hips[0] + hips[1]) / 2)
     tags = ("sw_", "st_") if structure.asymmetric else ("", "")
     angle = {"swing": hips[0], "stance": hips[1], "torso": psi_t}
     joints = [(angle[second] - angle[first], f"s{i}")
@@ -285,41 +264,228 @@ def _springs(structure: Structure, q, P: dict, hips: list, psi_t):
     return spring_dampers(joints, P, q)
 
 
-def _derive_spoked(structure: Structure) -> FloatingEquations:
-    """The floating view of a spoked wheel (``model: rimless_wheel``; McGeer 1990, Coleman,
-    Chatterjee & Ruina 1997): one rigid body, the hub (mass ``M_hub`` at its centre, inertia
-    ``I_hub`` about it) with ``n`` massless spokes of length ``L``; ``q = [hip_x, hip_y,
-    wheel_angle]`` (:data:`WHEEL_COORDINATES`).  Spoke ``k``'s tip, the contact point
-    ``spoke<k>``, is at ``hub + L e(theta + 2 pi k / n)``: spoke 1 is the next ahead of
-    spoke 0 (the rigid view's swing spoke when spoke 0 is in stance), so rolling downhill
-    the spokes touch down in the order 0, 1, 2, ...  ``T = M |v|^2 / 2 + I w^2 / 2``,
-    ``V = M g y``; the mass matrix is ``diag(M, M, I)``.  The contact points alternate
-    between the legs' lanes (spoke ``k`` on leg2's for even ``k``, leg1's for odd: spoke 0
-    is the first stance, the pinned point of a pinned start)."""
+def _legs_3d(structure: Structure) -> FloatingEquations:
+    """The floating view of a 3D legged walker from its body tree
+    (:func:`walkerlab.walker.trees.legs_tree` with ``floating``, Kuo 1999), set free at
+    leg2's foot (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y,
+    z`` and a heading, :data:`FREE_3D`, then the tree's joints in its own coordinates
+    renamed by :data:`ROLES_3D`).  The feet ``leg1`` (the rigid
+    model's swing foot) and ``leg2`` (its stance foot, the root's contact); round feet's the
+    discs' lowest points with their material points' Jacobians (:func:`_disc_contact`).
+    The hip-roll law's torques act between bodies (no force on the free coordinates): the
+    view leaves them out of the flow (they are ``stance_forces``).
+
+    Locking knees (McGeer 1990): both legs carry their knee (the floating tree's stance
+    knee), each link's pitch a coordinate (``leg<i>_thigh_angle``, ``leg<i>_shank_angle``
+    in the leg's rolled sagittal plane, the knee's angle their difference), ``knees`` their
+    indices (the contact model's knee stop and latch act there, as on the planar kneed
+    walker's), the points ``leg<i>_knee``.
+    """
     import sympy as sp
 
-    from walkerlab.codegen.frames import leg_unit as e  # light
+    from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
+    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
 
-    names = coordinate_names(structure)
-    q = sp.symbols(names, real=True)
-    dq = sp.symbols([f"d_{n}" for n in names], real=True)
-    par = sp.symbols(param_names(structure), real=True)
-    P = dict(zip(param_names(structure), par))
-    g, L, m, inertia, alpha = P["g"], P["L"], P["M_hub"], P["I_hub"], P["alpha"]
-    hub = sp.Matrix([q[0], q[1]])
-    feet, points = [], {"hip": hub}
-    for k in range(structure.spokes):
-        psi = q[2] + 2 * k * alpha
-        tip = hub + L * e(psi)
-        feet.append((tip, tip.jacobian(sp.Matrix(q))))
-        points[f"spoke{k}_foot"] = tip
-    M = sp.diag(m, m, inertia)
-    dqv = sp.Matrix(dq)
-    T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
-    V = m * g * q[1]
-    h = sp.Matrix([0, m * g, 0])
+    tree, coords = free_root(*legs_tree(structure, floating=True), FREE_3D)
+    kin, q, dq, rename, M, V, h = _flow(structure, tree, coords)
+    qv = sp.Matrix(q)
+    to_world = slope_to_world(kin.gamma)
+    # each leg's links by role: the foot's (the shank with a knee) and the thigh's
+    knee = structure.knee
+    feet_links = ("swing_shank", "stance_shank") if knee else ("swing_leg", "stance_leg")
+    feet, points = [], {}
+    if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
+        radius = dict(zip(tree.params, kin.params))["R_foot"]
+        for leg, link, centre in (("leg1", feet_links[0], kin.contacts["swing_foot_centre"]),
+                                  ("leg2", feet_links[1], kin.origins[feet_links[1]])):
+            low, J = _disc_contact(kin, link, centre, radius)
+            pos = to_world * low.xreplace(rename)
+            feet.append((pos, (to_world * J).xreplace(rename)))
+            points[f"{leg}_contact"] = pos
+            points[f"{leg}_foot_centre"] = to_world * centre.xreplace(rename)
+    else:
+        for leg, contact in (("leg1", "swing_foot"), ("leg2", "stance_foot")):
+            pos = to_world * kin.contacts[contact].xreplace(rename)
+            feet.append((pos, pos.jacobian(qv)))
+            points[f"{leg}_foot"] = pos
+    # each foot's spin about the slope's normal: its link's angular velocity there
+    spins = tuple(_spin(kin, link, rename) for link in feet_links)
+    points["hip"] = to_world * kin.coms["pelvis"].xreplace(rename)
+    # each leg's own hip, w/2 from the pelvis' (the push-off's line: the rigid model's
+    # stance_hip and swing_hip, walkerlab.codegen.derive_3d)
+    points["leg1_hip"] = to_world * kin.origins["swing_leg"].xreplace(rename)
+    points["leg2_hip"] = to_world * kin.origins["pelvis"].xreplace(rename)
+    for b in structure.bodies:
+        for leg, role in (("leg1", "swing"), ("leg2", "stance")):
+            link = f"{role}_shank" if knee and b.link == "shank" else f"{role}_leg"
+            points[f"{leg}_{b.name}"] = to_world * kin.coms[f"{link}_{b.name}"].xreplace(rename)
+    for b in structure.torso:
+        points[f"torso_{b.name}"] = to_world * kin.coms[f"torso_{b.name}"].xreplace(rename)
+    knees = ()
+    if knee:  # the knees at the shank's (swing) and the thigh's (stance) frame origin
+        points["leg1_knee"] = to_world * kin.origins["swing_shank"].xreplace(rename)
+        points["leg2_knee"] = to_world * kin.origins["stance_leg"].xreplace(rename)
+        names = [str(c) for c in q]
+        knees = tuple((names.index(f"{leg}_thigh_angle"), names.index(f"{leg}_shank_angle"))
+                      for leg in LEGS)
+    return _equations(kin, q, dq, M, V, h, feet, points, knees=knees, contacts=LEGS,
+                      point_legs=(0, 1), spins=spins,
+                      stance_forces=stance_forces(structure, q, dq, kin.params, ROLES_3D))
+
+
+def _spin(kin, body: str, rename):
+    """The Jacobian (1, nq) of ``body``'s angular velocity about the slope's normal (the
+    slope frame's ``y``): ``omega = R_b omega_b``."""
+    import sympy as sp
+
+    return ((kin.rotations[body] * kin.omegas[body]).jacobian(sp.Matrix(kin.dq))[1, :]
+            .xreplace(rename))
+
+
+def _wheel_tips(structure: Structure) -> FloatingEquations:
+    """The floating view of a spoked wheel (``model: rimless_wheel``; McGeer 1990; Coleman,
+    Chatterjee & Ruina 1997): one body, the hub (mass ``M_hub`` at its centre; inertia
+    ``I_hub`` about the axle, in 3D ``I_diam`` about any diameter) with ``n`` massless
+    spokes of length ``L``.  Planar: its floating tree's (the hub on the world's slides,
+    :func:`walkerlab.walker.floating_tree.floating_planar_tree`), ``q = [hip_x, hip_y,
+    wheel_angle]`` (:data:`WHEEL_COORDINATES`); in 3D its rigid tree
+    (:func:`walkerlab.walker.trees.spoked_wheel_3d_tree`: a spherical joint at spoke 0's tip,
+    heading, lean, spin) set free there by three slides along the world's axes
+    (:func:`walkerlab.walker.tree.free_root` with :data:`FREE_WHEEL_3D`: no heading of its
+    own), ``q = [spoke0_foot_x, spoke0_foot_y, spoke0_foot_z, heading, lean, wheel_angle]``
+    (:data:`WHEEL_3D_COORDINATES`), each tip with the wheel's spin about the slope's normal
+    (``spins``).  Upright the sagittal rows are the planar wheel's.
+
+    Spoke ``k``'s tip, the contact point ``spoke<k>`` (a material point of the wheel, its
+    Jacobian the position's), is ``k`` spokes ahead of spoke 0, so rolling downhill the
+    spokes touch down in the order 0, 1, 2, ...; the points ``hip`` (the hub) and
+    ``spoke<k>_foot``.  The contact points alternate between the legs' lanes (spoke ``k`` on
+    leg2's for even ``k``, leg1's for odd: spoke 0 is the first stance, the pinned point of
+    a pinned start).
+
+    Raises
+    ------
+    ValueError
+        The tree's parameters are not the walker's, in order.
+    """
+    import sympy as sp
+
+    from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
+
+    if structure.in_3d:
+        tree, coords = free_root(*spoked_wheel_3d_tree(structure.spokes), FREE_WHEEL_3D)
+        tips, hub = wheel_tip_names(structure.spokes), "wheel"
+    else:
+        tree, coords = floating_planar_tree(structure, param_names(structure))
+        tips, hub = tuple(f"spoke{k}_foot" for k in range(structure.spokes)), "pelvis"
+    kin, q, dq, rename, M, V, h = _flow(structure, tree, coords)
+    if tuple(str(p) for p in kin.params) != tuple(structure.param_names):
+        raise ValueError("floating_equations: the wheel tree's parameters are not the "
+                         "walker's, in order")  # floating_params' vector is the walker's
+    d = 3 if structure.in_3d else 2
+    to_world = slope_to_world(kin.gamma)[:d, :]
+    qv = sp.Matrix(q)
+    feet, points = [], {"hip": to_world * kin.coms[hub].xreplace(rename)}
+    for k, tip in enumerate(tips):
+        pos = to_world * kin.contacts[tip].xreplace(rename)
+        feet.append((pos, pos.jacobian(qv)))
+        points[f"spoke{k}_foot"] = pos
     contacts = contact_names(structure)
-    return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, h=h,
-                             feet=tuple(feet), kinetic=T, potential=V, points=points,
-                             knees=(), contacts=contacts,
-                             point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
+    spins = (_spin(kin, "wheel", rename),) * len(contacts) if structure.in_3d else ()
+    return _equations(kin, q, dq, M, V, h, feet, points, contacts=contacts, spins=spins,
+                      point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
+
+
+def wheel_tip_names(spokes: int) -> tuple[str, ...]:
+    """The contact points of :func:`walkerlab.walker.trees.spoked_wheel_3d_tree` that are
+    spoke ``0, 1, ..., spokes - 1``'s tips (spoke ``k`` is ``k`` spokes ahead of spoke 0, the
+    tree's stance spoke): ``stance_foot``, ``next_foot``, ``spoke2_foot``, ...,
+    ``trailing_foot``."""
+    inner = tuple(f"spoke{k}_foot" for k in range(2, spokes - 1))
+    return ("stance_foot", "next_foot") + inner + ("trailing_foot",)
+
+
+def legs_axial_inertia(structure: Structure, eq: FloatingEquations) -> FloatingEquations:
+    """The floating view ``eq`` of a 3D legged walker of zero hip width with each leg's
+    axial moment of inertia added, as the contact view integrates it: every leg link a solid
+    rod of radius :data:`AXIAL_RADIUS_L` ``L`` about its own axis (its frame's ``y``),
+    ``I_a = m r^2 / 2`` with ``m`` the mass welded to the link; any other walker's ``eq``
+    as it is.
+
+    Why: the rigid view's legs are slender (no inertia about their axes) and its stance foot
+    does not twist, so it has no heading; the contact view's floating base turns about the
+    slope's normal.  With zero hip width every mass lies on the legs' axes, and when the legs
+    pass each other (equal pitches) they lie on one line: the walker has no inertia about it,
+    the mass matrix is singular (its smallest eigenvalue goes as the square of the pitches'
+    difference: 1e-6 at 4 mrad for configs/round_feet_3d.yaml) and the twist's friction
+    drives a mode that no step size resolves: the integrator stalls at a leg crossing
+    (measured on configs/paper_3d.yaml and configs/round_feet_3d.yaml).  The added inertia
+    acts only through a leg's spin about its axis, which a walk upright in its sagittal
+    plane (no heading, no roll: the rigid gait's) never excites, so that walk and its
+    comparison with the rigid gait do not depend on it; it adds ``I_a sin^2(theta)``
+    (under 1e-5 of the walker's) to the roll inertia about the stance foot.
+
+    Parameters
+    ----------
+    structure : Structure
+        The walker (:func:`derive_floating`'s).
+    eq : FloatingEquations
+        Its floating view (:func:`derive_floating`).
+
+    Returns
+    -------
+    FloatingEquations
+        ``M + sum_i I_a J_i^T J_i`` with ``J_i`` (1, nq) the Jacobian of leg link ``i``'s
+        spin about its axis, the bias of that kinetic energy added to ``h``
+        (:func:`walkerlab.codegen.lagrange.bias`) and to ``kinetic``.
+    """
+    import sympy as sp
+
+    from walkerlab.codegen.lagrange import bias  # light: sympy on first use
+    from walkerlab.codegen.tree_derive import kinematics  # light: sympy on first use
+
+    if not structure.in_3d or structure.spokes:
+        return eq
+    rigid, coords = legs_tree(structure, floating=True)
+    swing_hip = next(b.joint for b in rigid.bodies if b.name == "swing_leg")
+    if any(c != 0 for c in swing_hip.origin_m):  # the hips apart (a hip width): no line
+        return eq
+    tree, fcoords = free_root(rigid, coords, FREE_3D)
+    kin = kinematics(tree, fcoords)
+    rename = {**dict(zip(kin.q, eq.q)), **dict(zip(kin.dq, eq.dq))}
+    par = {str(p): p for p in kin.params}
+    links = ("swing_leg", "stance_leg") + (("swing_shank", "stance_shank")
+                                            if structure.knee else ())
+    dM = sp.zeros(len(eq.q), len(eq.q))
+    for link in links:
+        mass = sum((sp.sympify(b.mass_kg, locals=par) for b in tree.bodies
+                    if b.joint.parent == link and b.joint.kind == "fixed"), sp.Integer(0))
+        if mass == 0:
+            continue
+        J = kin.omegas[link][1, :].jacobian(sp.Matrix(kin.dq)).xreplace(rename)
+        axial = mass * (sp.Float(AXIAL_RADIUS_L) * par["L"]) ** 2 / 2
+        dM += axial * (J.T * J)
+    dqv = sp.Matrix(eq.dq)
+    return dataclasses.replace(eq, M=eq.M + dM, h=eq.h + bias(dM, 0, eq.q, eq.dq),
+                               kinetic=eq.kinetic + sp.Rational(1, 2) * (dqv.T * dM * dqv)[0])
+
+
+def _disc_contact(kin, body: str, centre, radius):
+    """A round foot's contact on the slope: the lowest point of the disc of ``radius``
+    about ``centre`` (3, 1) in the plane normal to ``body``'s ``z`` axis (its leg's
+    sagittal plane; McGeer 1990), ``centre - R u / |u|`` with ``u = n - (n . a) a`` the
+    slope's normal ``n`` without its part along the disc's axis ``a``, and the Jacobian
+    (3, nq) of the disc's material point there, ``v = v_centre + omega x (low - centre)``
+    (``omega`` the body's angular velocity: a disc that rolls without slip has that point
+    at rest).  Slope frame, the tree's own coordinates (``kin``:
+    :class:`walkerlab.codegen.tree_derive.TreeKinematics`)."""
+    import sympy as sp
+
+    R_b = kin.rotations[body]
+    a = R_b * sp.Matrix([0, 0, 1])
+    u = sp.Matrix([0, 1, 0]) - a[1] * a
+    low = centre - radius * u / sp.sqrt(1 - a[1] ** 2)
+    r = low - centre
+    skew = sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+    omega = R_b * kin.omegas[body].jacobian(sp.Matrix(kin.dq))
+    return low, centre.jacobian(sp.Matrix(kin.q)) - skew * omega

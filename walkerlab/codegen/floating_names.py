@@ -1,8 +1,8 @@
-"""The floating view's names, shared by its derivations (planar:
-:mod:`walkerlab.codegen.floating_equations`; :mod:`walkerlab.codegen.floating_3d`, from the
-body trees in 3D): the coordinates, parameters and contact points of a structure, the free
-coordinates of the 3D views and the equations' container (:class:`FloatingEquations`).
-Conventions: the module docstring of :mod:`walkerlab.codegen.floating_equations`."""
+"""The floating view's names, shared by its derivation
+(:mod:`walkerlab.codegen.floating_equations`) and its readers: the coordinates, parameters
+and contact points of a structure, the free coordinates of the 3D views and the equations'
+container (:class:`FloatingEquations`).  Conventions: the module docstring of
+:mod:`walkerlab.codegen.floating_equations`."""
 
 from __future__ import annotations
 

@@ -455,7 +455,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # legs3d_mjcf, walkerlab.export.urdf.legs_urdf_text), each knee a hinge with its
         # straight-leg stop, the MJCF's latch the planar kneed walker's
         # the compliant-contact model: the floating tree with both knees
-        # (walkerlab.codegen.floating_3d.derive_legs_3d), the planar kneed walker's knee
+        # (walkerlab.codegen.floating_equations.derive_floating), the planar kneed walker's knee
         # stop and latch; the Adams dataset: the 3D straight legs' with a knee revolute on
         # each leg, its stop and latch the planar kneed dataset's
         # (walkerlab.export.adams_3d_knees)
@@ -473,7 +473,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         **_PLANAR,
         **_WHEEL_JOINTS,
         # the compliant-contact model: a free body on its spoke tips
-        # (walkerlab.codegen.floating_3d.derive_wheel_3d)
+        # (walkerlab.codegen.floating_equations.derive_floating)
         # stairs and footholds (a height along the fall line, level across it) in the rigid
         # model: the next spoke's tip lands as the planar wheel's (its generated clearance
         # along the slope's normal plus the landing's depth, the section's trailing tip by

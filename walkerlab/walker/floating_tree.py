@@ -1,7 +1,7 @@
-"""A planar legged walker's floating (contact) view as a body tree
-(:func:`floating_planar_tree`): the pelvis free on the world's axes, the legs hanging from it,
-which :mod:`walkerlab.codegen.floating_equations` derives as the 3D walkers' floating trees
-(:func:`walkerlab.walker.tree.free_root` on :func:`walkerlab.walker.trees.legs_tree`) are.
+"""A planar walker's floating (contact) view as a body tree (:func:`floating_planar_tree`):
+the pelvis (a spoked wheel's hub) free on the world's axes, the legs hanging from it, which
+:mod:`walkerlab.codegen.floating_equations` derives as it derives the 3D walkers' floating
+trees (:func:`walkerlab.walker.tree.free_root` on :func:`walkerlab.walker.trees.legs_tree`).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def floating_planar_tree(structure, params: tuple[str, ...]
     Parameters
     ----------
     structure : walkerlab.walker.description.Structure
-        Planar, legged (no spokes).
+        Planar: legs, or a spoked wheel (:func:`_floating_wheel`).
     params : tuple of str
         The floating view's parameter names (the walker's, then a flat foot's ``m_foot,
         I_foot`` when the walker's feet are massless).
@@ -54,12 +54,11 @@ def floating_planar_tree(structure, params: tuple[str, ...]
         ``leg<i>_thigh_angle, leg<i>_shank_angle``), the feet's ``leg<i>_foot_angle``, a
         hinged torso's ``torso_angle``.
     """
+    if structure.spokes:
+        return _floating_wheel(structure.spokes, params)
     knee, flat, arc = structure.knee, structure.foot == "flat", structure.foot == "arc"
     up_foot = "L - R_foot" if arc else "L"
-    bodies = [Body("hip_x", 0, ZERO_INERTIA, (0, 0, 0),
-                   Joint("hip_x", "prismatic", "world", (0, 0, 0), (S,), ("hip_x",))),
-              Body("pelvis", "M_hip" if structure.hip_mass else 0, ZERO_INERTIA, (0, 0, 0),
-                   Joint("hip_y", "prismatic", "hip_x", (0, 0, 0), ((0, 1, 0),), ("hip_y",)))]
+    bodies = _hub_slides("M_hip" if structure.hip_mass else 0)
     contacts, angles, hips = [], [("hip_x", "hip_x"), ("hip_y", "hip_y")], []
     feet_angles, names = [], ["hip_x", "hip_y"]
     for leg, role in (("leg1", "swing"), ("leg2", "stance")):
@@ -106,3 +105,32 @@ def floating_planar_tree(structure, params: tuple[str, ...]
     tree = BodyTree(params, Root("world", 0, "g", contacts[0].name), tuple(bodies),
                     tuple(contacts))
     return tree, CoordinateMap(tuple(names), tuple(angles))
+
+
+def _hub_slides(hub_mass: str | float) -> list:
+    """The pelvis (a wheel's hub) on two slides along the world's ``x`` and ``y``: the
+    bodies ``hip_x`` (massless) and ``pelvis`` (``hub_mass`` at its origin)."""
+    return [Body("hip_x", 0, ZERO_INERTIA, (0, 0, 0),
+                 Joint("hip_x", "prismatic", "world", (0, 0, 0), (S,), ("hip_x",))),
+            Body("pelvis", hub_mass, ZERO_INERTIA, (0, 0, 0),
+                 Joint("hip_y", "prismatic", "hip_x", (0, 0, 0), ((0, 1, 0),), ("hip_y",)))]
+
+
+def _floating_wheel(spokes: int, params: tuple[str, ...]) -> tuple[BodyTree, CoordinateMap]:
+    """A planar spoked wheel's floating tree (McGeer 1990; Coleman, Chatterjee & Ruina 1997):
+    the hub (``M_hub``) on the world's slides, the wheel (``I_hub`` about its axle) on a
+    pitch joint at the hub, spoke ``k``'s tip the contact ``spoke<k>_foot`` at ``L e(theta
+    + 2 k alpha)`` from the hub (``e(a) = (sin a, -cos a)``, ``theta`` spoke 0's absolute
+    angle, positive when its tip is ahead of the hub); coordinates ``hip_x, hip_y,
+    wheel_angle``."""
+    tips = tuple(ContactPoint(f"spoke{k}_foot", "wheel",
+                              (f"L * sin({2 * k} * alpha)", f"-L * cos({2 * k} * alpha)", 0))
+                 for k in range(spokes))
+    bodies = (*_hub_slides("M_hub"),
+              Body("wheel", 0, diagonal(0, 0, "I_hub"), (0, 0, 0),
+                   Joint("wheel_spin", "revolute", "pelvis", (0, 0, 0), (Z,),
+                         ("wheel_spin",))))
+    tree = BodyTree(params, Root("world", 0, "g", tips[0].name), bodies, tips)
+    return tree, CoordinateMap(("hip_x", "hip_y", "wheel_angle"),
+                               (("hip_x", "hip_x"), ("hip_y", "hip_y"),
+                                ("wheel_spin", "wheel_angle")))

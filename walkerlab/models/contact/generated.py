@@ -98,7 +98,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.codegen.contact_glue import contact_glue
-from walkerlab.codegen.floating_3d import legs_axial_inertia
+from walkerlab.codegen.floating_equations import legs_axial_inertia
 from walkerlab.models.contact.assembly import NPC
 from walkerlab.models.contact.rhs_lines import rhs_source
 from walkerlab.walker.description import Structure
@@ -112,7 +112,7 @@ _SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
             _HERE / "assembly.py", _HERE / "powered_kernels.py", _HERE / "_kernels.py",
             _HERE.parent.parent / "codegen" / "torque_law.py",
             _HERE.parent.parent / "codegen" / "contact_glue.py",
-            _HERE.parent.parent / "codegen" / "floating_3d.py")  # legs_axial_inertia
+            _HERE.parent.parent / "codegen" / "floating_equations.py")  # legs_axial_inertia
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
