@@ -32,7 +32,7 @@ from walkerlab.models.contact.assembly import (I_PHI, I_K, I_E, I_CMAX, I_DMAX, 
                                                D_N1, D_N2, D_PC, D_P)
 from walkerlab.models.contact.assembly import chol as _chol, chol_solve as _chol_solve
 from walkerlab.models.contact.assembly import point as _point, knee_torque as _knee_torque
-from walkerlab.models.contact.assembly import point3 as _point3, twist as _twist
+from walkerlab.models.contact.assembly import twist as _twist
 from walkerlab.models.contact.powered_kernels import A_HEAD
 from walkerlab.codegen.torque_law import HEAD
 
@@ -110,7 +110,7 @@ def contact_table(X, PC, p, c1, c2):
     out = np.zeros((X.shape[0], NF, 8 if DIM == 2 else 12))
     sp, cp = _asm.slope(PC)
     P, V, J = _asm.point_buffers(NQ, NF, DIM)
-    S, Jn = np.empty(NF), np.empty((NF, NQ))
+    S, Jn = np.zeros(NF), np.empty((NF, NQ))
     for r in range(X.shape[0]):
         feet(X[r], p, P, V, J)
         if DIM == 3:

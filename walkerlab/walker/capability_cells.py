@@ -355,7 +355,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("torso_torque", "optimize"): None,
         ("virtual_constraints", "*"): VC_3D,
         # the compliant-contact model takes the straight legs in 3D (its vectors are
-        # d-dimensional: walkerlab.models.contact.assembly.point3)
+        # d-dimensional: walkerlab.models.contact.assembly.point)
         # stairs and footholds: the ground a height along the walking direction, level
         # across it; the rigid model lands on them as the planar walkers do (the generated
         # swing clearance plus the landing's depth: walkerlab.models.hybrid.ground), the
@@ -481,7 +481,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # wheel's treads and footfall patches (walkerlab.export.mjcf_ground.wheel_ground,
         # wider: walkerlab.export.spoked.WHEEL_3D_GROUND_HALF_WIDTH); the contact model its
         # treads and risers as a polyline, level across the fall line
-        # (walkerlab.models.contact.assembly.point3), on continuous ground as the planar
+        # (walkerlab.models.contact.assembly.point), on continuous ground as the planar
         # wheel's; the Adams dataset a box per tread (walkerlab.export.adams_wheel)
         **{(g, v): None for g in ("stairs", "footholds") for v in ("rigid", "mjcf")},
         ("stairs", "contact"): None,

@@ -20,9 +20,9 @@ Shapes: ``nq`` generalised coordinates, ``nf`` contact points, ``d`` the world's
 lateral); ``P``, ``V`` (nf, d) the points' positions [m] and material velocities [m/s],
 ``J`` (nf, d, nq) their Jacobians, ``point_leg`` (nf,) each point's leg (0: leg1, on lane
 ``c1``; 1: leg2, on ``c2``), ``info`` (nf, :data:`NINFO`) each point's :func:`point`
-(planar) or :func:`point3` (3D) result, ``knees`` (2, 5) each knee's :func:`knee` result.
-The kernels read ``d`` from the arrays' shapes: one assembly, whose planar case is the
-walkers' before 3D contact, operation for operation.
+result, ``knees`` (2, 5) each knee's :func:`knee` result.  The kernels read ``d`` from the
+arrays' shapes and take a planar point as a 3D one in its plane (``z = 0``, no lateral slip):
+one path for either dimension.
 The contact parameter vector ``PC`` is read through the named indices ``I_*``
 (:mod:`walkerlab.models.contact.generated`'s table).
 """
@@ -49,8 +49,7 @@ I_KK, I_KE, I_KC, I_KD, I_KL, I_KF, I_KA = 11, 12, 13, 14, 15, 16, 17
 I_TOR, I_WEPS = 18, 19
 #: Number of contact parameters.
 NPC = 20
-#: Columns of a contact point's ``info`` row: :func:`point3`'s 15 (a planar point fills the
-#: first 12, :func:`point`'s).
+#: Columns of a contact point's ``info`` row: :func:`point`'s 15.
 NINFO = 15
 #: The packed data vector's head: ``[n1, n2, PC (NPC), p, ...]``.
 D_N1, D_N2, D_PC = 0, 1, 2
@@ -108,7 +107,7 @@ def pressed(px, py, vx, vy, sp, cp, PC, cen):
     (delta, ddot, vt, s, Fn, dFn/ddelta, dFn/dddot), the penetration [m] below the top of
     the patch under it (a gap: none), its rate [m/s], the slip along the fall line [m/s],
     the along-slope position [m] and the IMPACT normal force [N] with its partials; the
-    slope's (sin, cos) = (sp, cp).  :func:`point`'s and :func:`point3`'s shared part."""
+    slope's (sin, cos) = (sp, cp).  :func:`point`'s normal part."""
     delta = -(px * sp + py * cp)
     ddot = -(vx * sp + vy * cp)
     vt = vx * cp - vy * sp
@@ -125,45 +124,27 @@ def pressed(px, py, vx, vy, sp, cp, PC, cen):
 
 
 @njit(cache=True)
-def point(px, py, vx, vy, sp, cp, PC, cen):
-    """Contact of a point at (px, py) [m] whose material velocity is (vx, vy) [m/s] on the
-    lane ``cen``, the slope's (sin, cos) = (sp, cp): (delta, ddot, vt, s, Fn, Ff, dFn/ddelta,
-    dFn/dddot, mu, dmu/dvt, nx, ny), (nx, ny) the ground's outward normal there (the
-    friction acts along (ny, -nx)).  The one contact kernel of the right-hand side, the
-    Jacobian, the pinned dynamics and the tables (one compile).  On a polyline ground
-    (``PC[I_CONT] == 2``: ``cen`` its vertices, :func:`ground_line`) the penetration and
-    normal are the nearest segment's."""
-    if PC[I_CONT] > 1.5:
-        return on_line(px, py, vx, vy, sp, cp, PC, cen)
-    delta, ddot, vt, s, fn, dfd, dfdd = pressed(px, py, vx, vy, sp, cp, PC, cen)
-    mu, dmu = 0.0, 0.0
-    if fn > 0.0:
-        mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
-    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, sp, cp
-
-
-@njit(cache=True)
-def point3(px, py, pz, vx, vy, vz, sp, cp, PC, cen):
+def point(px, py, pz, vx, vy, vz, sp, cp, PC, cen):
     """Contact of a point at (px, py, pz) [m] whose material velocity is (vx, vy, vz) [m/s]
-    with the slope of a walker in 3D (the plane ``y = -x tan phi``, outward normal
-    ``n = (sin phi, cos phi, 0)``, its lines of greatest slope along ``t = (cos phi,
-    -sin phi, 0)``, level across them along ``z``), on the lane ``cen``: the penetration,
-    its rate, ``s`` and the patches are :func:`point`'s (the ground does not change across
-    the slope); the friction acts against the slip velocity ``v_t = (vt, vz)`` in the
+    (a planar walker's: ``pz = vz = 0``) with the slope (the plane ``y = -x tan phi``,
+    outward normal ``n = (sin phi, cos phi, 0)``, its lines of greatest slope along ``t =
+    (cos phi, -sin phi, 0)``, level across them along ``z``), on the lane ``cen``: the
+    penetration, its rate, ``s`` and the patches are :func:`pressed`'s (the ground does not
+    change across the slope); the friction acts against the slip velocity ``v_t = (vt, vz)`` in the
     tangent plane with the ADAMS Coulomb coefficient of the slip speed ``|v_t|``
     (stiction and transition velocities on ``|v_t|``, MSC Adams/Solver's CONTACT
     friction): ``F_t = mu(|v_t|) Fn v_t / |v_t|`` (``mu`` signed, < 0: against the slip;
     ``mu(w) / w`` -> ``dmu(0)`` as ``w`` -> 0, so the force is smooth through rest).
 
     Returns the 15 entries (delta, ddot, vt, s, Fn, Ft, dFn/ddelta, dFn/dddot, g, dmu/dw,
-    nx, ny, vz, Fz, w): :func:`point`'s first 12 with ``Ft`` the friction along ``t``
-    [N], ``g = mu(w) / w`` [s/m] (the friction per unit slip and normal force) and
-    ``dmu/dw`` at the slip speed ``w = |v_t|`` [m/s], then the lateral slip ``vz`` [m/s],
-    the lateral friction ``Fz`` [N] and ``w``.  On a polyline ground (``PC[I_CONT] == 2``:
-    ``cen`` its vertices in the ``x, y`` plane, :func:`ground_line`; stairs' treads and
-    risers, level across the fall line along ``z``) the penetration, the normal ``(nx, ny,
-    0)`` and the slip along ``(ny, -nx, 0)`` are the nearest segment's (:func:`on_line`'s),
-    the lateral slip ``vz`` the same."""
+    nx, ny, vz, Fz, w): ``Ft`` the friction along ``t`` [N], ``g = mu(w) / w`` [s/m] (the
+    friction per unit slip and normal force) and ``dmu/dw`` at the slip speed ``w = |v_t|``
+    [m/s], then the lateral slip ``vz`` [m/s], the lateral friction ``Fz`` [N] and ``w``.
+    On a polyline ground (``PC[I_CONT] == 2``: ``cen`` its vertices in the ``x, y`` plane,
+    :func:`ground_line`; stairs' treads and risers, level across the fall line along ``z``)
+    the penetration, the normal ``(nx, ny, 0)`` and the slip along ``(ny, -nx, 0)`` are the
+    nearest segment's, the lateral slip ``vz`` the same.  The one contact kernel of the
+    right-hand side, the Jacobian, the pinned dynamics and the tables (one compile)."""
     if PC[I_CONT] > 1.5:
         delta, nx, ny = ground_line(px, py, cen)
         ddot = -(vx * nx + vy * ny)
@@ -180,7 +161,7 @@ def point3(px, py, pz, vx, vy, vz, sp, cp, PC, cen):
 
 @njit(cache=True)
 def _slip3(delta, ddot, vt, s, fn, dfd, dfdd, nx, ny, vz, PC):
-    """:func:`point3`'s 15 entries from the normal contact of a point on the ground of
+    """:func:`point`'s 15 entries from the normal contact of a point on the ground of
     outward normal ``(nx, ny, 0)``: the Coulomb friction on the slip ``(vt, vz)``."""
     w = np.sqrt(vt * vt + vz * vz)
     g, dmu = 0.0, 0.0
@@ -188,22 +169,6 @@ def _slip3(delta, ddot, vt, s, fn, dfd, dfdd, nx, ny, vz, PC):
         mu, dmu = friction_mu(w, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
         g = mu / w if w > 0.0 else dmu
     return (delta, ddot, vt, s, fn, g * fn * vt, dfd, dfdd, g, dmu, nx, ny, vz, g * fn * vz, w)
-
-
-@njit(cache=True)
-def on_line(px, py, vx, vy, sp, cp, PC, line):
-    """:func:`point` on the polyline ground ``line`` (stairs' treads and risers): the
-    IMPACT and Coulomb laws on the penetration into the nearest segment, along its normal."""
-    delta, nx, ny = ground_line(px, py, line)
-    ddot = -(vx * nx + vy * ny)
-    vt = vx * ny - vy * nx
-    s = px * cp - py * sp
-    fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
-    if delta > 0.0:
-        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
-        if fn > 0.0:
-            mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
-    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, nx, ny
 
 
 @njit(cache=True)
@@ -275,8 +240,8 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
     legs used (``use1``, ``use2``) and, ``has_knees``, the knee stops (knee k's foot: point
     k; its thigh's and shank's coordinates ``knee_idx[k]``, (2, 2)); fills ``info`` and
     ``knees``.  Points in ``d = P.shape[1]`` dimensions
-    (:func:`point` in the plane, :func:`point3` in 3D)."""
-    nq = h.shape[0]
+    (:func:`point`; a planar point in its plane)."""
+    nq, d = h.shape[0], P.shape[1]
     Q = -h
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
     for i in range(P.shape[0]):
@@ -284,25 +249,15 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
         if not ((leg == 0 and use1) or (leg == 1 and use2)):
             continue
         cen = c1 if leg == 0 else c2
-        if P.shape[1] == 3:
-            r3 = point3(P[i, 0], P[i, 1], P[i, 2], V[i, 0], V[i, 1], V[i, 2], sp, cp, PC, cen)
-            for k in range(15):
-                info[i, k] = r3[k]
-            if r3[4] > 0.0:
-                F = world_force(info[i])
-                for k in range(nq):
-                    Q[k] += J[i, 0, k] * F[0] + J[i, 1, k] * F[1] + J[i, 2, k] * F[2]
-            continue
-        res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
-        for k in range(12):
-            info[i, k] = res[k]
-        fn, ff = res[4], res[5]
-        if fn > 0.0:
-            nx, ny = res[10], res[11]  # the ground's normal (the slope's: sp, cp)
-            Fx = fn * nx + ff * ny
-            Fy = fn * ny - ff * nx
+        r = point(P[i, 0], P[i, 1], P[i, 2] if d == 3 else 0.0, V[i, 0], V[i, 1],
+                  V[i, 2] if d == 3 else 0.0, sp, cp, PC, cen)
+        for k in range(NINFO):
+            info[i, k] = r[k]
+        if r[4] > 0.0:
+            F = world_force(info[i])
             for k in range(nq):
-                Q[k] += J[i, 0, k] * Fx + J[i, 1, k] * Fy
+                for c in range(d):
+                    Q[k] += J[i, c, k] * F[c]
     if has_knees:
         for k in range(2):
             used = (k == 0 and use1) or (k == 1 and use2)
@@ -347,8 +302,8 @@ def add_twists(Q, info, S, Jn, PC):
 
 @njit(cache=True)
 def world_force(row):
-    """A 3D point's contact force (3,) [N] in the world from its ``info`` row
-    (:func:`point3`): ``Fn n + Ft t + Fz e_z``."""
+    """A point's contact force (3,) [N] in the world from its ``info`` row
+    (:func:`point`): ``Fn n + Ft t + Fz e_z`` (a planar point's ``Fz`` 0)."""
     fn, ft, nx, ny = row[4], row[5], row[10], row[11]
     return np.array((fn * nx + ft * ny, fn * ny - ft * nx, row[13]))
 
@@ -372,14 +327,8 @@ def world_forces(info, d):
     """(nf, d) each point's contact force [N] in the world from its ``info`` row."""
     F = np.zeros((info.shape[0], d))
     for i in range(info.shape[0]):
-        fn, ff = info[i, 4], info[i, 5]
-        if fn > 0.0:
-            if d == 3:
-                F[i] = world_force(info[i])
-                continue
-            sp, cp = info[i, 10], info[i, 11]  # the ground's normal at the point
-            F[i, 0] = fn * sp + ff * cp
-            F[i, 1] = fn * cp - ff * sp
+        if info[i, 4] > 0.0:
+            F[i] = world_force(info[i])[:d]
     return F
 
 
@@ -388,8 +337,8 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees, knee_idx):
     """d rhs / dx (2 nq, 2 nq) from the Cholesky factor ``L`` of M, the partials ``Dq``,
     ``Dv`` (nq, nq) of ``M a + h`` at the acceleration ``a``, ``dJtF`` (nq, nq) of ``J^T F``
     at the forces held, the points' Jacobians ``J`` and their rates' partials ``dV``
-    (nf, d, nq); patch membership and each point's normal locally constant (3D points:
-    :func:`point3_partials`)."""
+    (nf, d, nq); patch membership and each point's normal locally constant
+    (:func:`point_partials`)."""
     nq = L.shape[0]
     B = np.empty((nq, 2 * nq))
     for r in range(nq):
@@ -400,29 +349,7 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees, knee_idx):
         fn = info[i, 4]
         if fn <= 0.0:
             continue
-        if J.shape[1] == 3:
-            point3_partials(B, J, dV, info[i], i)
-            continue
-        dfd, dfdd, mu, dmu = info[i, 6], info[i, 7], info[i, 8], info[i, 9]
-        sp, cp = info[i, 10], info[i, 11]  # the normal, locally constant
-        dFx = np.empty(2 * nq)
-        dFy = np.empty(2 * nq)
-        for k in range(nq):
-            d_delta = -(sp * J[i, 0, k] + cp * J[i, 1, k])  # = d ddot / d dq_k
-            d_ddot = -(sp * dV[i, 0, k] + cp * dV[i, 1, k])
-            d_vt_q = cp * dV[i, 0, k] - sp * dV[i, 1, k]
-            d_vt_v = cp * J[i, 0, k] - sp * J[i, 1, k]
-            dfn_q = dfd * d_delta + dfdd * d_ddot
-            dfn_v = dfdd * d_delta
-            dff_q = mu * dfn_q + fn * dmu * d_vt_q
-            dff_v = mu * dfn_v + fn * dmu * d_vt_v
-            dFx[k] = sp * dfn_q + cp * dff_q
-            dFy[k] = cp * dfn_q - sp * dff_q
-            dFx[nq + k] = sp * dfn_v + cp * dff_v
-            dFy[nq + k] = cp * dfn_v - sp * dff_v
-        for r in range(nq):
-            for k in range(2 * nq):
-                B[r, k] += J[i, 0, r] * dFx[k] + J[i, 1, r] * dFy[k]
+        point_partials(B, J, dV, info[i], i)
     if has_knees:
         for kk in range(2):
             t, s = knee_idx[kk, 0], knee_idx[kk, 1]
@@ -444,11 +371,12 @@ def jac_assembly(L, Dq, Dv, dJtF, J, dV, info, knees, has_knees, knee_idx):
 
 
 @njit(cache=True)
-def point3_partials(B, J, dV, row, i):
-    """Add ``J_i^T dF_i/dx`` (nq, 2 nq) of the 3D point ``i`` (its :func:`point3` ``row``)
-    to ``B``: ``F = Fn n + g Fn (vt t + vz e_z)`` with ``g = mu(w) / w`` and
-    ``dg/dw = (dmu/dw - g) / w`` (0 at rest, where ``g`` is even in ``w``)."""
-    nq = J.shape[2]
+def point_partials(B, J, dV, row, i):
+    """Add ``J_i^T dF_i/dx`` (nq, 2 nq) of the point ``i`` (its :func:`point` ``row``; a
+    planar point's ``J``, ``dV`` of two rows, its lateral slip 0) to ``B``: ``F = Fn n + g
+    Fn (vt t + vz e_z)`` with ``g = mu(w) / w`` and ``dg/dw = (dmu/dw - g) / w`` (0 at rest,
+    where ``g`` is even in ``w``)."""
+    nq, d = J.shape[2], J.shape[1]
     fn, vt, dfd, dfdd, g, dmu = row[4], row[2], row[6], row[7], row[8], row[9]
     sp, cp, vz, w = row[10], row[11], row[12], row[14]
     dgdw = (dmu - g) / w if w > 0.0 else 0.0
@@ -456,11 +384,11 @@ def point3_partials(B, J, dV, row, i):
     for k in range(2 * nq):
         if k < nq:  # a coordinate: the point moves, its material velocity changes
             dn, dndot = -(sp * J[i, 0, k] + cp * J[i, 1, k]), -(sp * dV[i, 0, k] + cp * dV[i, 1, k])
-            dvt, dvz = cp * dV[i, 0, k] - sp * dV[i, 1, k], dV[i, 2, k]
+            dvt, dvz = cp * dV[i, 0, k] - sp * dV[i, 1, k], dV[i, 2, k] if d == 3 else 0.0
         else:  # a rate: only the velocity changes
             c = k - nq
             dn, dndot = 0.0, -(sp * J[i, 0, c] + cp * J[i, 1, c])
-            dvt, dvz = cp * J[i, 0, c] - sp * J[i, 1, c], J[i, 2, c]
+            dvt, dvz = cp * J[i, 0, c] - sp * J[i, 1, c], J[i, 2, c] if d == 3 else 0.0
         dfn = dfd * dn + dfdd * dndot
         dg = dgdw * (vt * dvt + vz * dvz) / w if w > 0.0 else 0.0
         dft = (dg * fn + g * dfn) * vt + g * fn * dvt
@@ -469,7 +397,8 @@ def point3_partials(B, J, dV, row, i):
         dF[2, k] = (dg * fn + g * dfn) * vz + g * fn * dvz
     for r in range(nq):
         for k in range(2 * nq):
-            B[r, k] += J[i, 0, r] * dF[0, k] + J[i, 1, r] * dF[1, k] + J[i, 2, r] * dF[2, k]
+            for c in range(d):
+                B[r, k] += J[i, c, r] * dF[c, k]
 
 
 @njit(cache=True)
@@ -547,28 +476,24 @@ def contact_row(P, V, sp, cp, PC, c1, c2, point_leg, out, r, S):
     about the normal ``S`` (nf,) [rad/s] and the torsional friction moment [N m]."""
     for i in range(P.shape[0]):
         cen = c1 if point_leg[i] == 0 else c2
-        if P.shape[1] == 3:
-            r3 = point3(P[i, 0], P[i, 1], P[i, 2], V[i, 0], V[i, 1], V[i, 2], sp, cp, PC,
-                        cen)
-            for k in range(6):
-                out[r, i, k] = r3[k]
-            F = world_force(np.array(r3))
-            m = twist(S[i], r3[4], PC)
-            out[r, i, 6] = F[0] * V[i, 0] + F[1] * V[i, 1] + F[2] * V[i, 2] + m * S[i]
-            out[r, i, 8] = r3[12]
-            out[r, i, 9] = r3[13]
+        d = P.shape[1]
+        res = point(P[i, 0], P[i, 1], P[i, 2] if d == 3 else 0.0, V[i, 0], V[i, 1],
+                    V[i, 2] if d == 3 else 0.0, sp, cp, PC, cen)
+        for k in range(6):
+            out[r, i, k] = res[k]
+        F = world_force(np.array(res))
+        power = 0.0
+        for c in range(d):
+            power += F[c] * V[i, c]
+        if d == 3:   # the lateral slip and friction, the spin and its torsional moment
+            m = twist(S[i], res[4], PC)
+            power += m * S[i]
+            out[r, i, 8] = res[12]
+            out[r, i, 9] = res[13]
             out[r, i, 10] = S[i]
             out[r, i, 11] = m
-            s = r3[3]
-        else:
-            res = point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
-            fn, ff = res[4], res[5]
-            Fx = fn * res[10] + ff * res[11]
-            Fy = fn * res[11] - ff * res[10]
-            for k in range(6):
-                out[r, i, k] = res[k]
-            out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
-            s = res[3]
+        out[r, i, 6] = power
+        s = res[3]
         hq = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
         out[r, i, 7] = 1.0 if hq == hq else 0.0
 
@@ -581,11 +506,9 @@ def knee_row(x, nq, P, V, sp, cp, PC, c1, c2, out, r, knee_idx):
     coordinates, then their rates)."""
     for k in range(2):
         cen = c1 if k == 0 else c2
-        if P.shape[1] == 3:
-            delta = point3(P[k, 0], P[k, 1], P[k, 2], V[k, 0], V[k, 1], V[k, 2], sp, cp, PC,
-                           cen)[0]
-        else:
-            delta = point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC, cen)[0]
+        d = P.shape[1]
+        delta = point(P[k, 0], P[k, 1], P[k, 2] if d == 3 else 0.0, V[k, 0], V[k, 1],
+                      V[k, 2] if d == 3 else 0.0, sp, cp, PC, cen)[0]
         ext, rate, T, _, _ = knee(x, knee_idx[k, 0], knee_idx[k, 1], PC, delta, nq)
         out[r, k, 0] = ext
         out[r, k, 1] = rate

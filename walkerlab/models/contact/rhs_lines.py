@@ -35,7 +35,7 @@ def _cholesky_lines(nq: int, nz: set) -> list[str]:
 
 def _force_lines(point_legs, Fs, forced: bool, d: int = 2) -> list[str]:
     """:func:`rhs_source`'s contact forces ``Fs`` (``d`` per point: x, y (, z)) in the world
-    from each point's ``_point`` (``_point3``) result ``_r<i>`` (normal and friction force
+    from each point's ``_point`` result ``_r<i>`` (normal and friction force
     along the ground's normal and tangent; in 3D the lateral friction); ``forced``: a ghost
     point's (of leg ``G[0]``, ``G[1]`` ahead of the other leg's points) zero."""
     lines = []
@@ -115,7 +115,8 @@ def _stance_lines(eq, Q, pr=None, power=None) -> list[str]:
 def _point_lines(eq, pr, dqv, d: int, lines: list) -> tuple:
     """:func:`rhs_source`'s contact points, appended to ``lines``: each point's position
     and material velocity (``d`` components) and its spin about the normal (3D), common
-    subexpressions shared, and its ``_point`` (``_point3``) result ``_r<i>`` on its leg's
+    subexpressions shared, and its ``_point`` result ``_r<i>`` (a planar point in its plane,
+    ``z = 0``) on its leg's
     lane.  Returns the reduced kinematics, the force symbols (``d`` per point) and each
     point's power ``F . v`` as text."""
     import sympy as sp
@@ -132,11 +133,12 @@ def _point_lines(eq, pr, dqv, d: int, lines: list) -> tuple:
                     real=True)
     power = []  # forced: each point's F . v
     for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
-        args = ", ".join(pr.doprint(e) for e in red[2 * d * i:2 * d * (i + 1)])
+        pos, vel = ([pr.doprint(e) for e in red[2 * d * i + k * d:2 * d * i + (k + 1) * d]]
+                    + ["0.0"] * (3 - d) for k in (0, 1))
+        args = ", ".join(pos + vel)
         power.append(" + ".join(f"{Fs[d * i + k]} * ({pr.doprint(red[2 * d * i + d + k])})"
                                 for k in range(d)))
-        fn = "_point" if d == 2 else "_point3"
-        lines += [f"    _r{i} = {fn}({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
+        lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})"]
     return red, Fs, power
 
 
