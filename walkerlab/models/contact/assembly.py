@@ -255,9 +255,9 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
             info[i, k] = r[k]
         if r[4] > 0.0:
             F = world_force(info[i])
-            for k in range(nq):
-                for c in range(d):
-                    Q[k] += J[i, c, k] * F[c]
+            for k in range(nq):   # a planar point's third term 0.0: its sum as the plane's
+                Q[k] += J[i, 0, k] * F[0] + J[i, 1, k] * F[1] + (
+                    J[i, 2, k] * F[2] if d == 3 else 0.0)
     if has_knees:
         for k in range(2):
             used = (k == 0 and use1) or (k == 1 and use2)
@@ -397,8 +397,8 @@ def point_partials(B, J, dV, row, i):
         dF[2, k] = (dg * fn + g * dfn) * vz + g * fn * dvz
     for r in range(nq):
         for k in range(2 * nq):
-            for c in range(d):
-                B[r, k] += J[i, c, r] * dF[c, k]
+            B[r, k] += J[i, 0, r] * dF[0, k] + J[i, 1, r] * dF[1, k] + (
+                J[i, 2, r] * dF[2, k] if d == 3 else 0.0)
 
 
 @njit(cache=True)
