@@ -361,25 +361,25 @@ def test_a_positive_clearance_on_straight_legs_is_refused_before_any_stage_runs(
     assert not list((tmp_path / "r").rglob("*.h5"))  # refused before fixedpoint ran
 
 
-@pytest.mark.parametrize("foot", [{"kind": "point"}, {"kind": "arc", "radius_m": 0.2}])
-def test_a_kneed_walker_with_a_push_off_is_refused_in_one_true_line(tmp_path, foot):
-    """Before: round feet ended in "does not make a step (fall)" (the passive guess) and
-    point feet in "the rigid kneed ... models carry none", though the rigid kneed model
-    carries the push-off; now one line, before any stage runs: the phased transcription
-    has none yet."""
+def test_a_flat_footed_walker_with_a_push_off_is_refused_in_one_true_line(tmp_path):
+    """Before, a kneed walker's push-off was refused too (the phased transcription had
+    none; now its heel strike takes one: tests/test_optimize_phases.py); a flat foot's
+    toe push-off is not transcribed: one line, before any stage runs, naming the field."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
+    from walkerlab.walker.kinds import KINDS
 
-    d = yaml.safe_load((CONFIGS / "kneed_optimal.yaml").read_text())
+    assert KINDS["locking_knees"].supports("push_off", "optimize")
+    assert KINDS["locking_knees_3d"].supports("push_off", "optimize")
+    d = yaml.safe_load((CONFIGS / "flat_feet_optimal.yaml").read_text())
     d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.05}}
-    d["walker"]["leg"]["foot"] = foot
-    scene = tmp_path / "kneed_push.yaml"
+    scene = tmp_path / "flat_push.yaml"
     scene.write_text(yaml.safe_dump(d))
     r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
     assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
-    assert "optimize.push_off: the phased transcription (knees or flat feet) has no " \
+    assert "optimize.push_off: the phased transcription's flat-foot heel strike has no " \
         "push-off yet" in r.output
     assert "carry none" not in r.output and "fall" not in r.output
     assert not list((tmp_path / "r").rglob("*.h5"))

@@ -44,8 +44,16 @@ every phase, per weight and step length, with a small effort weight; as
 :mod:`walkerlab.optimal.transcription.step`) or a weighted sum.  Optional friction cone: the
 ground's resultant on the stance foot (``sum m_i (a_i + g)``, the phase's accelerations;
 a kneed walker's stance foot, flat feet's pinned point or whole flat foot) with ``F_n >= 0``
-and ``|F_t| <= mu F_n`` at every point.  No push-off: the rigid kneed and flat-footed
-models carry no push-off impulse.  The step period is ``sum T_p``.
+and ``|F_t| <= mu F_n`` at every point.  Push-off (a kneed walker, planar or in 3D): Kuo's
+(2002) pre-emptive impulse ``P`` [N s] from the trailing foot to its hip just before the
+heel strike, fixed or a decision variable (its work ``W`` [J] in the cost of transport, its
+square in the effort: :mod:`walkerlab.optimal.transcription.phase_nlp`), the heel strike's
+link then ``x_0(0) = push_off(x_last(T_last), P)``: the rigid kneed model's transition
+(:class:`walkerlab.models.hybrid.push_off.PushOffTransition` with the swing knee held
+locked through both impulses, McGeer 1990) in the one-step transcription's CasADi form
+(:func:`walkerlab.optimal.transcription.step._reset_extended` with the knee's lock); flat
+feet have none here (the rigid model's toe push-off is not transcribed).  The step period
+is ``sum T_p``.
 
 A result is a gait after its replay on the rigid model (its generated code, its own
 guards and resets) with the optimised torque as a function of the time since the heel
@@ -92,9 +100,9 @@ class ModePhase:
     push_off : casadi.Function or None
         ``(x, P) -> (x+, W)``: a heel strike preceded by a push-off impulse ``P`` [N s]
         along the trailing leg (the extended-coordinate impact of
-        :mod:`walkerlab.models.hybrid.actuated`) and the push-off's work ``W`` [J]; straight
-        legs on point feet only (None elsewhere: the rigid kneed and flat-footed models
-        carry no push-off).
+        :mod:`walkerlab.models.hybrid.actuated`; a kneed walker's with its swing knee held
+        locked) and the push-off's work ``W`` [J]; straight or kneed legs on point feet
+        (None elsewhere: flat feet, and every phase not ending in the heel strike).
     inside : bool
         The guard's sign is kept at the phase's interior points (the event has not
         happened earlier); False for a step of one phase, whose heel-strike guard the
@@ -291,7 +299,7 @@ class _KneedModes(_Modes):
     """A kneed walker (or straight legs: :class:`_StraightModes`): ``unlocked_swing`` /
     ``early_swing`` / ``late_swing`` on the free flow, ``locked_swing`` on the locked one;
     ``knee_strike`` (the plastic knee strike), ``midstance`` (no jump), ``heel_strike``
-    (the plain impact: the rigid kneed model's push-off is not transcribed)."""
+    (the plain impact, or after a push-off: :meth:`push_off`)."""
 
     def __init__(self, data):
         eq = derive_equations(data.structure)  # a planar walker's or a 3D one's
@@ -325,6 +333,26 @@ class _KneedModes(_Modes):
         if gname == "heel_strike":
             return self.impact(_Impact(eq.Mi, eq.B, eq.relabel_q, eq.relabel_rate), x)
         return x
+
+    def push_off(self, gname, x, P, k):
+        """The heel strike after a push-off ``P`` [N s] along the trailing leg with the swing
+        knee held locked through both impulses (the rigid kneed model's transition,
+        :meth:`walkerlab.models.hybrid.push_off.PushOffTransition.hold_lock`): the one-step
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.
+        step`) holding the knee's extension; None at another guard."""
+        return self._push_off(gname, x, P, k, self.eq.guards["knee_extension"])
+
+    def _push_off(self, gname, x, P, k, lock):
+        """The heel strike's push-off map holding ``lock`` (None: nothing held)."""
+        import casadi as ca
+
+        from walkerlab.optimal.transcription.step import _reset_extended
+
+        if gname != "heel_strike":
+            return None
+        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
+                                       self.data.total_mass_kg, lock=lock)
+        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
 
     def clearance(self, name, x):
         return self.cas([self.eq.guards["swing_clearance"]], x)
@@ -364,16 +392,9 @@ class _StraightModes(_KneedModes):
 
     def push_off(self, gname, x, P, k):
         """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step
-        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`)."""
-        import casadi as ca
-
-        from walkerlab.optimal.transcription.step import _reset_extended
-
-        if gname != "heel_strike":
-            return None
-        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
-                                       self.data.total_mass_kg)
-        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`),
+        nothing held."""
+        return self._push_off(gname, x, P, k, None)
 
 
 class _FlatModes(_Modes):
