@@ -518,14 +518,13 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
 
     data = plant.data
     o = scene.optimize
-    spec = collocation_spec(scene)  # a flat foot's push-off refused before (check_kind)
+    spec = collocation_spec(scene)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
+    guide = _guide(walker, data, spec)  # with the scene's push-off, whose gait x_gait is
     if resolve_gait:  # fixedpoint's gait has its double support
-        g = solve_scene(scene, False, walker=walker, plant=plant)[1].gait.result
+        g = solve_scene(scene, False, walker=guide, plant=plant)[1].gait.result
         x_gait, period_s = g.x, float(g.period_s)
-    # the start stepped with the scene's push-off, whose gait x_gait is (:func:`_guide`)
-    guess, guess_u, order = starting_phases(scene, _guide(walker, data, spec), x_gait,
-                                            period_s, spec.intervals)
+    guess, guess_u, order = starting_phases(scene, guide, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
     fns = cached_mode_functions(data, walker, order)
     build = time.perf_counter() - t0

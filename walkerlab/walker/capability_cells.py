@@ -173,13 +173,6 @@ _WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ank
 _WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
 _WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
                    "one, walkerlab fixedpoint)")
-#: why optimize refuses a flat foot's push-off (the kneed walkers' heel strike takes one: the
-#: extended impact with the swing knee held, :mod:`walkerlab.optimal.transcription.phases`)
-_PHASED_PUSH_OFF = ("the phased transcription's flat-foot heel strike has no push-off yet: "
-                    "it is the plain impact (the rigid model's push-off at the trailing toe, "
-                    "walkerlab.models.hybrid.toe_push_off, runs in fixedpoint and simulate, "
-                    "not here); optimise the hip torque alone (no walker.actuation.push_off, "
-                    "optimize.push_off: fixed)")
 #: why optimize refuses a torso on knees or flat feet (the phased transcription,
 #: :mod:`walkerlab.optimal.transcription.phases`, has no torso's symbolic form; measured on
 #: the kneed walker with a 0.4 kg upper body, whose rigid gait walks in every other view)
@@ -271,7 +264,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
         **{("profile", v): _FLAT_PROFILE for v in ("rigid", "adams", "gym")},
         **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
-        ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("torso_torque", "optimize"): _PHASED_TORSO,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "

@@ -349,6 +349,15 @@ WALKING_OPTIMIZE = {
         {**_PUSH_OFF_SECTION, "optimize.intervals": 60}),
     # ... and the kneed walker in 3D (configs/kneed_3d.yaml, 80 intervals a step: OPTIMIZE)
     ("locking_knees_3d", "push_off"): (_PUSH_OFF_OPTIMUM, dict(_PUSH_OFF_SECTION)),
+    # flat feet (configs/flat_feet.yaml, collocated without the double support: its passive
+    # gait's 0.5980 m steps) asked for 0.62 m steps, the push-off at the trailing toe free:
+    # P = 0.1768 N s, int u^2 dt = 0.0739 N^2 m^2 s, peak |u| 0.403 N m, 0.7785 s steps; the
+    # replay closes to 3.8e-8 on 300 intervals (9.1e-7 on 200, as configs/
+    # flat_feet_optimal.yaml's; 0.65 m steps on 200: 2.6e-6, P = 0.579 N s)
+    ("flat_feet", "push_off"): (
+        "optimize.push_off: free, 0.62 m steps (the passive gait's: 0.598 m), 300 intervals",
+        {"optimize.push_off": "free", "optimize.target_step_length_m": 0.62,
+         "optimize.intervals": 300}),
     # the kneed walker in 3D (configs/kneed_3d.yaml) with the planar case's hip PD: with
     # SMALL_PD the fixed point search finds no gait; with 0.01 N m/rad one of 0.5386 s steps
     # (passive 0.5452 s), started here from its fixed point (the optimize cell's case: the

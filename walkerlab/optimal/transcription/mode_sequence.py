@@ -28,7 +28,6 @@ from walkerlab.optimal.transcription.ipopt import (
     solve,
 )
 from walkerlab.optimal.transcription.phase_nlp import _chain_phases, _objective, _pushes
-from walkerlab.walker.kinds import KINDS
 
 __all__ = ["PhasedResult", "collocate_footholds", "collocate_phases", "collocate_step",
            "footholds_guess", "optimized_guess",
@@ -192,12 +191,12 @@ def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
     return t, cumulative_trapezoid(rho, t, initial=0.0)
 
 
-#: why a walker with phases whose heel strike has no push-off map (flat feet) is not
-#: optimised with a push-off (one line: the capability table's,
-#: :data:`walkerlab.walker.kinds.CAPABILITIES`)
-PHASED_PUSH_OFF = "optimize.push_off: " + next(
-    why for k in KINDS.values() if k.phases is not None and k.collocation is not None
-    and not k.collocation.one_step and (why := k.cell("push_off", "optimize")))
+#: why a sequence of phases whose heel strike has no push-off map is not optimised with a
+#: push-off (one line; every kind with phases has one: the capability table,
+#: :data:`walkerlab.walker.kinds.CAPABILITIES`, refuses the others before)
+PHASED_PUSH_OFF = ("optimize.push_off: this step's heel strike has no push-off map in the "
+                   "collocation (give optimize.push_off: fixed and no "
+                   "walker.actuation.push_off)")
 
 
 def _check(spec, phases) -> None:
@@ -363,6 +362,8 @@ def replay_phases(data, res: PhasedResult, solver=None):
     walker = actuate(make_rigid_walker(data, "biped", "derived", double_support=False), data,
                      spec)  # the transcription has no double support yet
     acts = walker.actuators
+    if hasattr(acts.torques, "begin_step"):  # a flat foot's push-off holds the torques'
+        acts = acts.torques  # actuators (walkerlab.models.hybrid.toe_push_off.FlatPushOff)
     tau = phase_torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
     solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
