@@ -35,7 +35,7 @@ from tests.test_parts_3d import (  # the same walker, guess and planar-embedding
 from walkerlab.config import scene_from_dict
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
-from walkerlab.walker.kinds import KINDS, KindRefused, kind_of
+from walkerlab.walker.kinds import KINDS, kind_of
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
@@ -66,8 +66,8 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     the lean first; every view takes it: the rigid view, the contact model
     (tests/test_kneed_3d_contact.py), the MJCF, the URDF, the gym
     (tests/test_kneed_3d_export.py), the Adams dataset (tests/test_export_adams_3d_knees.py)
-    and the collocation (a stride of phased steps: tests/test_optimize_3d.py), which
-    refuses its push-off in one line naming the field."""
+    and the collocation (a stride of phased steps: tests/test_optimize_3d.py), its
+    push-off included (the extended impact with the swing knee held)."""
     from walkerlab.walker.description import walker_data
 
     scene = scene_from_dict(_kneed_in_3d(0.1))
@@ -79,9 +79,7 @@ def test_a_kneed_walker_in_3d_is_the_locking_knees_3d_kind_of_the_rigid_view_and
     assert all(kind.supports("walk", v)
                for v in ("rigid", "contact", "mjcf", "urdf", "gym", "adams", "osim",
                          "optimize"))
-    with pytest.raises(KindRefused) as err:
-        kind.require("push_off", "optimize", "walker.actuation.push_off")
-    assert str(err.value).startswith("walker.actuation.push_off: ") and "\n" not in str(err.value)
+    kind.require("push_off", "optimize", "walker.actuation.push_off")  # taken
     assert not kind.supports("profile", "rigid")
     # round feet on the shanks: configs/kneed_round_feet_3d.yaml (the slow test below)
     assert kind.supports("round_feet_3d", "rigid") and kind.supports("round_feet_3d", "contact")

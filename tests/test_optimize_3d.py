@@ -174,6 +174,39 @@ def test_the_3d_kneed_strides_functions_are_the_rigid_models():
 
 
 @pytest.mark.slow
+def test_the_3d_kneed_strides_push_off_reset_is_the_rigid_models_for_both_legs():
+    """The 3D kneed stride's heel strikes after a push-off ``P`` (configs/kneed_3d.yaml,
+    the push-off cell's walker: the extended impact in world axes along the trailing leg to
+    its own hip, the swing knee held, in CasADi) against the rigid model's transition with
+    that push-off, leg A's with the walker's numbers and leg B's with its mirror's, at
+    states about its gait and random impulses: the post-impact state to 1e-10, the
+    push-off's work to the rigid transition's kinetic energy gain (1e-10 J)."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.transcription.phases import phase_order
+    from walkerlab.optimal.transcription.stride import stride_functions
+
+    scene = _scene("kneed_3d")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    fns = stride_functions(data, order=phase_order(make_rigid_walker(data)))
+    strikes = [p for p in fns["phases"] if p.guard_name == "heel_strike"]
+    assert len(strikes) == 2 and all(p.push_off is not None for p in strikes)
+    x = _guess_of(scene)
+    rng = np.random.default_rng(7)
+    for strike, d in zip(strikes, (replace(data, mirror_params=None), data.mirror)):
+        for P in rng.uniform(0.0, 0.5, 3):
+            acts = actuate(make_rigid_walker(d), d,
+                           Actuation(push_off=PushOff(impulse_n_s=float(P)))).actuators
+            xs = x + 0.05 * rng.standard_normal(x.size)
+            xs[2], xs[6] = xs[1], xs[5]  # the swing knee locked straight
+            x_plus, work = strike.push_off(xs, P)
+            ref = acts.transition(xs)
+            np.testing.assert_allclose(x_plus.full().ravel(), ref["x_plus"], rtol=0,
+                                       atol=1e-10)
+            assert float(work) == pytest.approx(ref["ke_push_off"] - ref["ke_minus"],
+                                                abs=1e-10)
+
+
+@pytest.mark.slow
 def test_the_least_effort_3d_kneed_gait_on_its_passive_slope_is_its_passive_gait():
     """The 3D kneed walker with hip-roll joints (configs/kneed_3d_stabilised.yaml) as a
     stride of two phased steps: with nothing imposed the least effort is the gait that walks

@@ -361,28 +361,18 @@ def test_a_positive_clearance_on_straight_legs_is_refused_before_any_stage_runs(
     assert not list((tmp_path / "r").rglob("*.h5"))  # refused before fixedpoint ran
 
 
-@pytest.mark.parametrize("foot", [{"kind": "point"}, {"kind": "arc", "radius_m": 0.2}])
-def test_a_kneed_walker_with_a_push_off_is_refused_in_one_true_line(tmp_path, foot):
-    """Before: round feet ended in "does not make a step (fall)" (the passive guess) and
-    point feet in "the rigid kneed ... models carry none", though the rigid kneed model
-    carries the push-off; now one line, before any stage runs: the phased transcription
-    has none yet."""
-    import yaml
-    from typer.testing import CliRunner
+def test_every_phased_walker_takes_a_push_off_and_a_five_link_biped_is_refused_in_one_line():
+    """Before, a kneed or flat-footed walker's push-off was refused (the phased
+    transcription had none); now every heel strike of the phased transcription takes one
+    (tests/test_optimize_phases.py, tests/test_optimize_3d.py); the five-link collocation
+    has none: one line naming the field."""
+    from walkerlab.walker.kinds import KINDS, KindRefused
 
-    from walkerlab.cli import app
-
-    d = yaml.safe_load((CONFIGS / "kneed_optimal.yaml").read_text())
-    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.05}}
-    d["walker"]["leg"]["foot"] = foot
-    scene = tmp_path / "kneed_push.yaml"
-    scene.write_text(yaml.safe_dump(d))
-    r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
-    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
-    assert "optimize.push_off: the phased transcription (knees or flat feet) has no " \
-        "push-off yet" in r.output
-    assert "carry none" not in r.output and "fall" not in r.output
-    assert not list((tmp_path / "r").rglob("*.h5"))
+    for kind in ("locking_knees", "locking_knees_3d", "flat_feet"):
+        assert KINDS[kind].supports("push_off", "optimize"), kind
+    with pytest.raises(KindRefused) as err:
+        KINDS["free_joints"].require("push_off", "optimize", "optimize.push_off")
+    assert str(err.value).startswith("optimize.push_off: ") and "\n" not in str(err.value)
 
 
 def test_an_infeasible_optimum_names_the_constraint_that_cannot_hold(tmp_path):

@@ -5,7 +5,8 @@ feet of configs/flat_feet.yaml (heel contact, foot slap, foot flat, mid-stance, 
 heel strike).  Their CasADi phases are the rigid model's, a hip torque acts through a lock
 (the knee, the flat foot) without breaking it and its power is the energy's rate, and each
 walker's least-effort gait on its slope is its passive gait (found independently by
-shooting, ``fixedpoint``)."""
+shooting, ``fixedpoint``); the kneed and flat-footed walkers' push-off (Kuo 2002) is the
+rigid model's transition, and an optimum that uses it is the rigid gait of that push-off."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
-from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
 from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.walker.description import walker_data
@@ -257,6 +258,160 @@ def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed, kneed_st
     assert res.phase_duration_s[0] == pytest.approx(passive_knee_time, rel=1e-6)
     np.testing.assert_allclose(res.x[0], g.x, atol=1e-6)
     assert replay_phases(data, res)[0] <= 1e-6
+
+
+def _pushed(data, P: float):
+    """The rigid kneed walker with Kuo's push-off ``P`` [N s] before every heel strike (its
+    transition holds the locked swing knee: walkerlab.models.hybrid.push_off)."""
+    return actuate(make_rigid_walker(data), data, Actuation(push_off=PushOff(impulse_n_s=P)))
+
+
+@pytest.mark.slow
+def test_the_kneed_push_off_reset_is_the_rigid_models_push_off_and_heel_strike(kneed):
+    """The transcription's heel strike after a push-off ``P`` (the extended impact with the
+    swing knee held, in CasADi) against the rigid model's numpy transition at random
+    states and impulses: the post-impact state to 1e-10, the push-off's work to the rigid
+    transition's kinetic energy gain (1e-10 J); with ``P = 0`` the plain heel strike."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.transcription.phases import mode_functions
+
+    _, data, walker = kneed
+    strike = mode_functions(data, walker)["phases"][-1]
+    assert strike.guard_name == "heel_strike" and strike.push_off is not None
+    rng = np.random.default_rng(11)
+    for P in (0.0, 0.05, 0.3, 1.0):
+        acts = _pushed(data, P).actuators
+        for _ in range(4):
+            x = rng.normal(0.0, [0.2, 0.2, 0.2, 1.0, 1.0, 1.0])
+            x[1], x[4] = x[0], x[3]  # the swing knee locked straight, as at a heel strike
+            x_plus, work = strike.push_off(x, P)
+            ref = acts.transition(x)
+            np.testing.assert_allclose(x_plus.full().ravel(), ref["x_plus"], rtol=0,
+                                       atol=1e-10)
+            assert float(work) == pytest.approx(ref["ke_push_off"] - ref["ke_minus"],
+                                                abs=1e-10)
+            if P == 0.0:
+                np.testing.assert_allclose(x_plus.full().ravel(),
+                                           strike.reset(x).full().ravel(), atol=1e-12)
+
+
+@pytest.mark.slow
+def test_a_kneed_optimum_with_a_free_push_off_is_the_rigid_gait_of_that_push_off(kneed):
+    """configs/kneed.yaml's walker on its slope asked for 0.55 m steps, longer than its
+    passive gaits' (0.4747 m, 0.468 m), with the push-off free (its square in the effort):
+    the optimum supplies energy by both inputs, P = 0.1622 N s and int u^2 dt = 0.0128
+    N^2 m^2 s (60 intervals, from the gait of a 0.05 N s push-off).  Independent check: the
+    rigid model with that push-off and the optimised hip torque of time (its generated code,
+    guards and transition) has a fixed point ``walkerlab fixedpoint``'s root finder finds
+    within 1e-6 of the optimum's start (1.5e-7 seen), with the optimum's step period
+    (1e-6 relative), and the replay closes to 1e-6 (2.6e-7 seen)."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.transcription.mode_sequence import (
+        collocate_phases,
+        phased_guess,
+        replay_phases,
+    )
+    from walkerlab.optimal.transcription.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.step import CollocationSpec
+
+    scene, data, walker = kneed
+    solver = Solver.from_settings(scene.solver)
+    start = _pushed(data, 0.05)
+    g = find_fixed_point(start, _gait(kneed).x, solver, fd_check=False)
+    guess, log = phased_guess(start, g.x, g.period_s, solver, 60)
+    fns = mode_functions(data, walker, phase_order(walker, log))
+    res = collocate_phases(fns, CollocationSpec(intervals=60, push_off_free=True,
+                                                push_off_n_s=0.05,
+                                                target_step_length_m=0.55), guess)
+    assert res.status == "Solve_Succeeded"
+    assert res.step_length_m == pytest.approx(0.55, abs=1e-9)
+    assert res.push_off_n_s == pytest.approx(0.1622, abs=5e-4)
+    assert res.terms["effort"] == pytest.approx(0.01283, rel=2e-3)
+    assert res.objective == pytest.approx(res.terms["effort"] + res.push_off_n_s ** 2,
+                                          rel=1e-9)
+    err, replayed = replay_phases(data, res)
+    assert err <= 1e-6
+    assert replayed.actuators.impulse(res.x[-1]) == res.push_off_n_s
+    fp = find_fixed_point(replayed, res.x[0], solver, xtol=1e-10, fd_check=False)
+    np.testing.assert_allclose(fp.x, res.x[0], rtol=0, atol=1e-6)
+    assert fp.period_s == pytest.approx(res.step_period_s, rel=1e-6)
+
+
+@pytest.mark.slow
+def test_the_flat_feet_push_off_reset_is_the_rigid_models_toe_push_off_and_heel_strike(flat):
+    """The flat feet's heel strike after a push-off ``P`` at the trailing toe (in heel off,
+    the toe pinned; the stance ankle held through the impulse) in CasADi against the rigid
+    model's numpy transition (walkerlab.models.hybrid.toe_push_off) at random states and
+    impulses: the post-impact state to 1e-10, the push-off's work to the rigid transition's
+    kinetic energy gain (1e-10 J); ``P = 0``: the plain heel strike."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.transcription.phases import mode_functions
+
+    _, data, walker = flat
+    strike = mode_functions(data, walker, FLAT_ORDER)["phases"][-1]
+    assert strike.name == "heel_off:late_swing" and strike.push_off is not None
+    rng = np.random.default_rng(3)
+    for P in (0.0, 0.05, 0.3, 1.0):
+        pushed = actuate(make_rigid_walker(data, double_support=False), data,
+                         Actuation(push_off=PushOff(impulse_n_s=P)))
+        acts = pushed.actuators.at("toe")
+        for _ in range(4):
+            x = rng.normal(0.0, [0.2, 0.2, 0.1, 1.0, 1.0, 0.5])
+            x_plus, work = strike.push_off(x, P)
+            ref = acts.transition(x)
+            np.testing.assert_allclose(x_plus.full().ravel(), ref["x_plus"], rtol=0,
+                                       atol=1e-10)
+            assert float(work) == pytest.approx(ref["ke_push_off"] - ref["ke_minus"],
+                                                abs=1e-10)
+            if P == 0.0:
+                np.testing.assert_allclose(x_plus.full().ravel(),
+                                           strike.reset(x).full().ravel(), atol=1e-12)
+
+
+@pytest.mark.slow
+def test_a_flat_footed_optimum_with_a_free_push_off_is_the_rigid_gait_of_that_push_off(flat):
+    """Flat feet (without the double support, as optimize collocates them: passive steps of
+    0.598 m) asked for 0.62 m steps with the toe push-off free: P = 0.1768 N s and a hip
+    torque (300 intervals, from the gait of a 0.05 N s push-off); the rigid model with that
+    push-off and the optimised torque of time (its generated flows, guards and toe
+    push-off) returns to the optimum's start within 1e-6 in one step (3.8e-8 seen; 9.1e-7
+    on 200 intervals), through the optimum's phases, with its step period (1e-7
+    relative).  (The root finder on that walker, whose torque law runs in Python on flat
+    feet, takes ~5 min: the kneed walker's test above runs it.)  ~1-2 min."""
+    pytest.importorskip("casadi")
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.transcription.mode_sequence import (
+        collocate_phases,
+        phased_guess,
+        replay_phases,
+    )
+    from walkerlab.optimal.transcription.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.step import CollocationSpec
+
+    scene, data, walker = flat
+    solver = Solver.from_settings(scene.solver)
+    start = actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=0.05)))
+    g = find_fixed_point(start, _gait(flat).x, solver, fd_check=False)
+    guess, log = phased_guess(start, g.x, g.period_s, solver, 300)
+    assert phase_order(walker, log) == FLAT_ORDER
+    res = collocate_phases(mode_functions(data, walker, FLAT_ORDER),
+                           CollocationSpec(intervals=300, push_off_free=True,
+                                           push_off_n_s=0.05, target_step_length_m=0.62),
+                           guess)
+    assert res.status == "Solve_Succeeded"
+    assert res.push_off_n_s == pytest.approx(0.1768, abs=5e-4)
+    assert res.terms["effort"] > 0.01  # the hip torque works too
+    err, replayed = replay_phases(data, res)
+    assert err <= 1e-6
+    seg = integrate_step(replayed, res.x[0], solver, max_step_time=3.0 * res.step_period_s)
+    assert seg.termination == "heel_strike"
+    assert tuple(ph.name for ph, _s, _ab in seg.pieces) == res.phase_names
+    assert seg.t_end - seg.t_start == pytest.approx(res.step_period_s, rel=1e-7)
+    np.testing.assert_allclose(seg.x_next, res.x[0], rtol=0, atol=1e-6)
 
 
 def test_what_the_phased_transcription_does_not_take_is_refused_in_one_line():

@@ -518,12 +518,13 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
 
     data = plant.data
     o = scene.optimize
-    spec = collocation_spec(scene)  # its push-off refused before (check_kind)
+    spec = collocation_spec(scene)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
+    guide = _guide(walker, data, spec)  # with the scene's push-off, whose gait x_gait is
     if resolve_gait:  # fixedpoint's gait has its double support
-        g = solve_scene(scene, False, walker=walker, plant=plant)[1].gait.result
+        g = solve_scene(scene, False, walker=guide, plant=plant)[1].gait.result
         x_gait, period_s = g.x, float(g.period_s)
-    guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
+    guess, guess_u, order = starting_phases(scene, guide, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
     fns = cached_mode_functions(data, walker, order)
     build = time.perf_counter() - t0
@@ -535,9 +536,9 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
         scene, res, err, lambda: contact_replay_phased(scene, res, strides=2, plant=plant))
     phases, phase_note = reported.hip_phase_replays_of(scene, data, res, phase_torque_of_time(res))
     states, units = reported.named_states(walker, res)
-    return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
-                        res.objective, err, mu, gait, res.status, res.iterations,
-                        res.wall_time_s, units, objective_name=o.objective,
+    return OptimizeData(res.t, states, res.u, res.step_period_s, res.step_length_m,
+                        res.push_off_n_s, res.objective, err, mu, gait, res.status,
+                        res.iterations, res.wall_time_s, units, objective_name=o.objective,
                         objective_unit=reported.unit_of_objective(o), terms=res.terms,
                         contact_step_period_s=contact_period, contact_outcome=contact_outcome,
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,

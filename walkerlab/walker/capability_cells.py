@@ -173,10 +173,6 @@ _WHEEL_JOINTS = {(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ank
 _WHEEL_GYM = "the rimless wheel is one rigid body: it has no joint to drive"
 _WHEEL_OPTIMIZE = (f"{_NO_JOINT}: there is no input to optimise (its gait is the passive "
                    "one, walkerlab fixedpoint)")
-_PHASED_PUSH_OFF = ("the phased transcription (knees or flat feet) has no push-off yet: "
-                    "its heel strike is the plain impact (the rigid kneed model's push-off "
-                    "runs in fixedpoint and simulate, not here); optimise the hip torque "
-                    "alone (no walker.actuation.push_off, optimize.push_off: fixed)")
 #: why optimize refuses a torso on knees or flat feet (the phased transcription,
 #: :mod:`walkerlab.optimal.transcription.phases`, has no torso's symbolic form; measured on
 #: the kneed walker with a 0.4 kg upper body, whose rigid gait walks in every other view)
@@ -242,7 +238,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                        "in number): give free knees (knee.lock: free)"),
         ("knee_torque", "adams"): FREE_JOINT_TORQUES,
         ("torso_torque", "adams"): FREE_JOINT_TORQUES,
-        ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("torso_torque", "optimize"): _PHASED_TORSO,
         **_GROUNDS,
         **_OPTIMIZE_GROUNDS,
@@ -269,7 +264,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("stairs", "contact"): _FLAT_STAIRS_CONTACT,
         **{("profile", v): _FLAT_PROFILE for v in ("rigid", "adams", "gym")},
         **{("footholds", v): _FLAT_LANDING for v in ("adams", "optimize", "osim")},
-        ("push_off", "optimize"): _PHASED_PUSH_OFF,
         ("torso_torque", "optimize"): _PHASED_TORSO,
         ("ankle_push_off", "optimize"): ("the phased transcription has a hip torque only "
                                          "(the rigid flat feet take an ankle push-off or "
@@ -465,8 +459,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # walkerlab.optimal.transcription.stride on walkerlab.optimal.transcription.phases'
         # kneed modes, which take the 3D walker's equations: an upper body on the bisecting
         # hip is in them, as the 3D straight legs'), the hip torque between the thighs; its
-        # push-off as the planar kneed walker's
-        ("push_off", "optimize"): _PHASED_PUSH_OFF,
+        # push-off as the planar kneed walker's (the extended impact, the swing knee held)
         ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
     },
     "rolling_polygon_3d": {

@@ -316,10 +316,48 @@ def _kneed_upper_body(guess: dict) -> dict:
             "fixedpoint.initial_guess": guess}
 
 
+#: the push-off cells' optimize section (planar and 3D kneed walkers): the push-off a
+#: decision variable (its square in the effort, weight 1/s), started from the case's gait
+#: with its fixed 0.05 N s push-off, and a step longer than the passive gaits' (0.4747 m
+#: and, the short-period one, 0.468 m on configs/kneed.yaml's slope): no passive gait takes
+#: it, so the optimum must supply energy, and it does so with the push-off as well as the
+#: hip torque (Kuo 2002: a push-off before heel strike is the cheaper input).  Measured on
+#: the planar walker (60 intervals): P = 0.1622 N s, int u^2 dt = 0.01283 N^2 m^2 s, peak
+#: |u| 0.266 N m, 0.6226 s steps; the rigid model's fixed point with that push-off and hip
+#: torque 1.5e-7 from the optimum's start, its replay closing to 2.6e-7 (40 intervals:
+#: 1.3e-6, Hermite-Simpson's O(h^4))
+_PUSH_OFF_OPTIMUM = ("optimize.push_off: free, 0.55 m steps (no passive gait takes them: "
+                     "the optimum must supply energy)")
+_PUSH_OFF_SECTION = {"optimize.push_off": "free", "optimize.target_step_length_m": 0.55}
+
 #: (kind, feature) -> (why, changes): as :data:`WALKING`, for the ``optimize`` cell alone
 #: (the feature's other views take a shipped scene, :data:`SHIPPED`, that walks): the
-#: generated case's changes so that it has a gait to start the optimisation from
+#: generated case's changes so that it has a gait to start the optimisation from, so that
+#: its optimum uses the feature (a push-off), or so that its replay closes within the
+#: view's tolerance (more intervals: Hermite-Simpson's error O(h^4))
 WALKING_OPTIMIZE = {
+    # the planar kneed walker with SMALL_PD at its swing knee (the start's gait; the
+    # collocation drives the hip alone, so its least effort is the passive gait, 0.545846 s):
+    # the replay returns 9.9e-6 from its start on 40 intervals (the default), 2.0e-6 on 60,
+    # 1.7e-7 on 100 (Hermite-Simpson's O(h^4)).  From this start IPOPT ends elsewhere on
+    # 80 (1.95 s steps, 5 N m, which do not replay) and 120 (the short-period passive gait,
+    # 0.4921 s, unstable: |multiplier| 2.28)
+    ("locking_knees", "knee_torque"): (
+        "100 intervals (40: the replay closes to 9.9e-6)", {"optimize.intervals": 100}),
+    ("locking_knees", "push_off"): (
+        f"{_PUSH_OFF_OPTIMUM}, 60 intervals",
+        {**_PUSH_OFF_SECTION, "optimize.intervals": 60}),
+    # ... and the kneed walker in 3D (configs/kneed_3d.yaml, 80 intervals a step: OPTIMIZE)
+    ("locking_knees_3d", "push_off"): (_PUSH_OFF_OPTIMUM, dict(_PUSH_OFF_SECTION)),
+    # flat feet (configs/flat_feet.yaml, collocated without the double support: its passive
+    # gait's 0.5980 m steps) asked for 0.62 m steps, the push-off at the trailing toe free:
+    # P = 0.1768 N s, int u^2 dt = 0.0739 N^2 m^2 s, peak |u| 0.403 N m, 0.7785 s steps; the
+    # replay closes to 3.8e-8 on 300 intervals (9.1e-7 on 200, as configs/
+    # flat_feet_optimal.yaml's; 0.65 m steps on 200: 2.6e-6, P = 0.579 N s)
+    ("flat_feet", "push_off"): (
+        "optimize.push_off: free, 0.62 m steps (the passive gait's: 0.598 m), 300 intervals",
+        {"optimize.push_off": "free", "optimize.target_step_length_m": 0.62,
+         "optimize.intervals": 300}),
     # the kneed walker in 3D (configs/kneed_3d.yaml) with the planar case's hip PD: with
     # SMALL_PD the fixed point search finds no gait; with 0.01 N m/rad one of 0.5386 s steps
     # (passive 0.5452 s), started here from its fixed point (the optimize cell's case: the

@@ -121,8 +121,8 @@ def contact_replay_phased(scene, res, strides: int = 1, *, plant) -> tuple[float
 
     The scene's walker gets a hip torque whose law is replaced by
     :func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time` of the time since
-    each
-    touchdown (between the thighs, or the legs of a flat-footed walker:
+    each touchdown, and the optimum's push-off impulse before each touchdown if it has one
+    (:func:`_hip_actuation`) (the torque between the thighs, or the legs of a flat-footed walker:
     :class:`walkerlab.models.contact.actuation.ContactActuators`), from the collocated start
     ``res.x[0]``; the scene's ``contact`` law (a kneed walker needs its ``knee_stop.latch``
     to hold the stance knee as the rigid model's lock does; flat feet their regularising
@@ -151,8 +151,7 @@ def contact_replay_phased(scene, res, strides: int = 1, *, plant) -> tuple[float
     """
     # a powered run is on a Python RHS (slow on a flat-footed walker's stride): bounded by
     # its work (contact_sim.max_rhs_evaluations' default), the same on any machine
-    setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]}, strides,
-                                plant=plant)
+    setup, why = _powered_setup(scene, _hip_actuation(res), strides, plant=plant)
     if setup is None:
         return float("nan"), why
     setup.actuators.laws = TorqueOfTime(phase_torque_of_time(res),

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
 from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.optimal.transcription.ipopt import (
     CollocatedStep,
@@ -28,7 +28,6 @@ from walkerlab.optimal.transcription.ipopt import (
     solve,
 )
 from walkerlab.optimal.transcription.phase_nlp import _chain_phases, _objective, _pushes
-from walkerlab.walker.kinds import KINDS
 
 __all__ = ["PhasedResult", "collocate_footholds", "collocate_phases", "collocate_step",
            "footholds_guess", "optimized_guess",
@@ -192,11 +191,12 @@ def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
     return t, cumulative_trapezoid(rho, t, initial=0.0)
 
 
-#: why a walker with phases is not optimised with a push-off (one line: the capability
-#: table's, :data:`walkerlab.walker.kinds.CAPABILITIES`)
-PHASED_PUSH_OFF = "optimize.push_off: " + next(
-    k for k in KINDS.values() if k.phases is not None and k.collocation is not None
-    and not k.collocation.one_step).cell("push_off", "optimize")
+#: why a sequence of phases whose heel strike has no push-off map is not optimised with a
+#: push-off (one line; every kind with phases has one: the capability table,
+#: :data:`walkerlab.walker.kinds.CAPABILITIES`, refuses the others before)
+PHASED_PUSH_OFF = ("optimize.push_off: this step's heel strike has no push-off map in the "
+                   "collocation (give optimize.push_off: fixed and no "
+                   "walker.actuation.push_off)")
 
 
 def _check(spec, phases) -> None:
@@ -338,8 +338,10 @@ def phase_torque_of_time(res: PhasedResult):
 def replay_phases(data, res: PhasedResult, solver=None):
     """The optimised step replayed on the rigid model (its generated code, its own phases,
     guards and resets; not the CasADi expressions): the walker with a hip actuator whose
-    torque is :func:`phase_torque_of_time` from each step's heel strike, one step from
-    ``x_0`` (DOP853 at rtol = atol = 1e-12 unless ``solver`` is given).
+    torque is :func:`phase_torque_of_time` from each step's heel strike, and the optimum's
+    push-off impulse ``res.push_off_n_s`` [N s] before each heel strike when it is positive
+    (the rigid model's :mod:`walkerlab.models.hybrid.push_off`), one step from ``x_0``
+    (DOP853 at rtol = atol = 1e-12 unless ``solver`` is given).
 
     Returns
     -------
@@ -354,9 +356,14 @@ def replay_phases(data, res: PhasedResult, solver=None):
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
+    if res.push_off_n_s > 0.0:  # the optimum's push-off before each heel strike
+        spec = Actuation(push_off=PushOff(impulse_n_s=float(res.push_off_n_s)),
+                         torques=spec.torques)
     walker = actuate(make_rigid_walker(data, "biped", "derived", double_support=False), data,
                      spec)  # the transcription has no double support yet
     acts = walker.actuators
+    if hasattr(acts.torques, "begin_step"):  # a flat foot's push-off holds the torques'
+        acts = acts.torques  # actuators (walkerlab.models.hybrid.toe_push_off.FlatPushOff)
     tau = phase_torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
     solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)

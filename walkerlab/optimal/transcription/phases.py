@@ -44,8 +44,17 @@ every phase, per weight and step length, with a small effort weight; as
 :mod:`walkerlab.optimal.transcription.step`) or a weighted sum.  Optional friction cone: the
 ground's resultant on the stance foot (``sum m_i (a_i + g)``, the phase's accelerations;
 a kneed walker's stance foot, flat feet's pinned point or whole flat foot) with ``F_n >= 0``
-and ``|F_t| <= mu F_n`` at every point.  No push-off: the rigid kneed and flat-footed
-models carry no push-off impulse.  The step period is ``sum T_p``.
+and ``|F_t| <= mu F_n`` at every point.  Push-off: Kuo's (2002) pre-emptive impulse ``P``
+[N s] just before the heel strike, fixed or a decision variable (its work ``W`` [J] in the
+cost of transport, its square in the effort: :mod:`walkerlab.optimal.transcription.
+phase_nlp`), the heel strike's link then ``x_0(0) = push_off(x_last(T_last), P)``, the
+rigid model's transition in CasADi: a kneed walker's (planar or in 3D) from its trailing
+foot to its hip with the swing knee held locked through both impulses (McGeer 1990;
+:class:`walkerlab.models.hybrid.push_off.PushOffTransition`), the one-step
+transcription's form (:func:`walkerlab.optimal.transcription.step._reset_extended` with the
+knee's lock); flat feet's at the trailing toe with the stance ankle held
+(:class:`walkerlab.models.hybrid.toe_push_off.FlatPushOff`, from the same symbolic
+systems).  The step period is ``sum T_p``.
 
 A result is a gait after its replay on the rigid model (its generated code, its own
 guards and resets) with the optimised torque as a function of the time since the heel
@@ -92,9 +101,10 @@ class ModePhase:
     push_off : casadi.Function or None
         ``(x, P) -> (x+, W)``: a heel strike preceded by a push-off impulse ``P`` [N s]
         along the trailing leg (the extended-coordinate impact of
-        :mod:`walkerlab.models.hybrid.actuated`) and the push-off's work ``W`` [J]; straight
-        legs on point feet only (None elsewhere: the rigid kneed and flat-footed models
-        carry no push-off).
+        :mod:`walkerlab.models.hybrid.actuated`; a kneed walker's with its swing knee held
+        locked; flat feet's at the trailing toe, :mod:`walkerlab.models.hybrid.
+        toe_push_off`) and the push-off's work ``W`` [J]; None for a phase that does not
+        end in the heel strike.
     inside : bool
         The guard's sign is kept at the phase's interior points (the event has not
         happened earlier); False for a step of one phase, whose heel-strike guard the
@@ -202,7 +212,7 @@ def mode_functions(data, walker, order=None) -> dict:
             clearance=ca.Function("clearance", [x], [kind.clearance(name, x)]),
             step=ca.Function("step", [x], [kind.step(name, x)]),
             grf=ca.Function(f"grf_{len(phases)}", [x, u], [kind.grf(name, x, f)]),
-            push_off=kind.push_off(gname, x, P, len(phases)),
+            push_off=kind.push_off(gname, x, P, len(phases), name),
             inside=kind.inside(gname)))
     hip = kind.cas([kind.hip], x)
     return {"phases": phases, "n": n,
@@ -270,9 +280,9 @@ class _Modes:
         (:attr:`ModePhase.inside`): yes."""
         return True
 
-    def push_off(self, gname, x, P, k):
-        """The phase's heel strike with a push-off (:class:`ModePhase` ``push_off``), or
-        None."""
+    def push_off(self, gname, x, P, k, name=None):
+        """The phase ``name``'s heel strike with a push-off (:class:`ModePhase`
+        ``push_off``), or None."""
         return None
 
     def resultant(self, points, x, f):
@@ -291,7 +301,7 @@ class _KneedModes(_Modes):
     """A kneed walker (or straight legs: :class:`_StraightModes`): ``unlocked_swing`` /
     ``early_swing`` / ``late_swing`` on the free flow, ``locked_swing`` on the locked one;
     ``knee_strike`` (the plastic knee strike), ``midstance`` (no jump), ``heel_strike``
-    (the plain impact: the rigid kneed model's push-off is not transcribed)."""
+    (the plain impact, or after a push-off: :meth:`push_off`)."""
 
     def __init__(self, data):
         eq = derive_equations(data.structure)  # a planar walker's or a 3D one's
@@ -325,6 +335,26 @@ class _KneedModes(_Modes):
         if gname == "heel_strike":
             return self.impact(_Impact(eq.Mi, eq.B, eq.relabel_q, eq.relabel_rate), x)
         return x
+
+    def push_off(self, gname, x, P, k, name=None):
+        """The heel strike after a push-off ``P`` [N s] along the trailing leg with the swing
+        knee held locked through both impulses (the rigid kneed model's transition,
+        :meth:`walkerlab.models.hybrid.push_off.PushOffTransition.hold_lock`): the one-step
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.
+        step`) holding the knee's extension; None at another guard."""
+        return self._push_off(gname, x, P, k, self.eq.guards["knee_extension"])
+
+    def _push_off(self, gname, x, P, k, lock):
+        """The heel strike's push-off map holding ``lock`` (None: nothing held)."""
+        import casadi as ca
+
+        from walkerlab.optimal.transcription.step import _reset_extended
+
+        if gname != "heel_strike":
+            return None
+        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
+                                       self.data.total_mass_kg, lock=lock)
+        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
 
     def clearance(self, name, x):
         return self.cas([self.eq.guards["swing_clearance"]], x)
@@ -362,18 +392,11 @@ class _StraightModes(_KneedModes):
         h = self.eq.guards["swing_clearance"].subs(crossed).subs(self.vals)
         return sp.simplify(h) == 0
 
-    def push_off(self, gname, x, P, k):
+    def push_off(self, gname, x, P, k, name=None):
         """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step
-        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`)."""
-        import casadi as ca
-
-        from walkerlab.optimal.transcription.step import _reset_extended
-
-        if gname != "heel_strike":
-            return None
-        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
-                                       self.data.total_mass_kg)
-        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`),
+        nothing held."""
+        return self._push_off(gname, x, P, k, None)
 
 
 class _FlatModes(_Modes):
@@ -381,7 +404,8 @@ class _FlatModes(_Modes):
     mode's flow (foot flat: the locked one, the lock ``phi = stance + ankle + gamma``);
     ``foot_slap`` (plastic), ``midstance`` (no jump), ``heel_off`` (the heel's normal force
     ``N - N_toe`` from the mode's accelerations; no jump), ``heel_strike`` (the mode's own
-    map); the stance contacts' normal forces kept ``>= 0``."""
+    map, or after a push-off at the trailing toe: :meth:`push_off`); the stance contacts'
+    normal forces kept ``>= 0``."""
 
     PIN = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
@@ -429,6 +453,43 @@ class _FlatModes(_Modes):
         if gname == "heel_strike":
             return self.impact(self.eq.resets[f"heel_strike_{pin}"], x)
         return x
+
+    def push_off(self, gname, x, P, k, name=None):
+        """The heel strike of the phase ``name`` after a push-off ``P`` [N s] at the trailing
+        toe, from it to the hip, the stance ankle held through it (a massless foot passes
+        an impulse off its ankle's line only with an impulsive ankle torque), then the
+        heel strike with the trailing foot free and the role swap: the rigid model's
+        :class:`walkerlab.models.hybrid.toe_push_off.FlatPushOff` in CasADi, from the
+        same symbolic systems (:func:`walkerlab.codegen.foot_modes.derive_flat`'s
+        ``push_off[pin]``, the pin the phase's mode's)::
+
+            [De  -a^T] [dqe' - dqe-]   [Jt^T P e]
+            [a     0 ] [    lam    ] = [   0    ],      a = d(ankle)/dqe
+
+            Mi dq+ = Be dqe',   x+ = (relabel_q, relabel_rate dq+)
+
+        and the push-off's work ``(dqe'^T De dqe' - dqe-^T De dqe-) / 2`` [J]; None at
+        another guard."""
+        import casadi as ca
+
+        if gname != "heel_strike":
+            return None
+        n = self.n
+        sysm = self.eq.push_off[self._mode(name)[1]]
+        De, Jt, Mi, Be = (self.cas(sysm[key], x) for key in ("De", "Jt", "Mi", "Be"))
+        r = self.cas(sysm["push"], x)
+        e = r / ca.sqrt(r[0] ** 2 + r[1] ** 2)
+        m = De.shape[0]  # the extended coordinates: q and the pinned point's translations
+        a = ca.DM.zeros(1, m)
+        a[2] = 1.0  # the stance ankle's angle
+        K = ca.vertcat(ca.horzcat(De, -a.T), ca.horzcat(a, ca.DM.zeros(1, 1)))
+        dqe = ca.vertcat(x[n:], ca.SX.zeros(m - n))
+        dqe_po = dqe + ca.solve(K, ca.vertcat(Jt.T @ (P * e), 0))[:m]
+        dq_plus = ca.solve(Mi, Be @ dqe_po)
+        x_plus = ca.vertcat(self.cas(sysm["relabel_q"], x),
+                            self.cas(sysm["relabel_rate"], x) @ dq_plus)
+        work = 0.5 * (dqe_po.T @ De @ dqe_po - dqe.T @ De @ dqe)
+        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
 
     def keep(self, name, x, f, u):
         import casadi as ca

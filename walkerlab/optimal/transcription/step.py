@@ -251,7 +251,7 @@ def _relabel(eq, xs, vals, x, dq_plus):
     return ca.vertcat(qn, ca.DM(R) @ dq_plus)
 
 
-def _reset_extended(eq, xs, vals, x, P, _mass):
+def _reset_extended(eq, xs, vals, x, P, _mass, lock=None):
     """Push-off + heel strike in extended coordinates ``[q, p]``, ``p`` the stance foot's
     ``k`` translations (``E``'s rows: 2 for a planar walker, ``(x_f, y_f)``; 3 for a walker
     in 3D, :func:`walkerlab.codegen.legged.extended_impact`) as the rigid view's
@@ -259,7 +259,16 @@ def _reset_extended(eq, xs, vals, x, P, _mass):
     trailing foot's material contact point - a point foot, an arc's rolling contact
     ``stance_contact`` - to the trailing leg's hip (a 3D walker's ``stance_hip``, else the
     ``hip``); the generated ``De, E``, an arc's ``E`` at the leading arc's material contact
-    point), and the push-off's work [J]."""
+    point), and the push-off's work [J].
+
+    ``lock`` (a sympy expression of ``eq.q``, None: nothing held): a constraint held through
+    both impulses with gradient ``a = d(lock)/dq`` (a kneed walker's locked swing knee, the
+    knee's extension: McGeer 1990; :meth:`PushOffTransition.hold_lock`)::
+
+        [De  -a^T] [dqe_po]   [De dqe- + E_f^T P e]
+        [a     0 ] [ lam  ] = [        0          ]
+
+    then the heel strike with ``[E; a]`` in place of ``E``."""
     import casadi as ca
     import sympy as sp
 
@@ -277,9 +286,18 @@ def _reset_extended(eq, xs, vals, x, P, _mass):
     e = hip / ca.sqrt(r2)
     dqe = ca.vertcat(x[n:], *[0] * k)
     Ef = ca.horzcat(ca.SX.zeros(k, n), ca.SX.eye(k))
-    dqe_po = dqe + ca.solve(De, Ef.T @ (P * e))
-    K = ca.vertcat(ca.horzcat(De, -E.T), ca.horzcat(E, ca.SX.zeros(k, k)))
-    sol = ca.solve(K, ca.vertcat(De @ dqe_po, *[0] * k))
+    if lock is None:
+        dqe_po = dqe + ca.solve(De, Ef.T @ (P * e))
+        K = ca.vertcat(ca.horzcat(De, -E.T), ca.horzcat(E, ca.SX.zeros(k, k)))
+        sol = ca.solve(K, ca.vertcat(De @ dqe_po, *[0] * k))
+    else:  # the lock held through both impulses (as the rigid model's transition)
+        a = ca.horzcat(casadi_function(sp.Matrix([lock]).jacobian(eq.q), xs, vals)(x),
+                       ca.SX.zeros(1, k))
+        A = ca.vertcat(ca.horzcat(De, -a.T), ca.horzcat(a, ca.SX.zeros(1, 1)))
+        dqe_po = ca.solve(A, ca.vertcat(De @ dqe + Ef.T @ (P * e), 0))[:n + k]
+        Cl = ca.vertcat(E, a)
+        K = ca.vertcat(ca.horzcat(De, -Cl.T), ca.horzcat(Cl, ca.SX.zeros(k + 1, k + 1)))
+        sol = ca.solve(K, ca.vertcat(De @ dqe_po, *[0] * (k + 1)))
     work = 0.5 * (dqe_po.T @ De @ dqe_po - dqe.T @ De @ dqe)
     return _relabel(eq, xs, vals, x, sol[:n]), work
 
