@@ -361,6 +361,27 @@ def test_a_positive_clearance_on_straight_legs_is_refused_before_any_stage_runs(
     assert not list((tmp_path / "r").rglob("*.h5"))  # refused before fixedpoint ran
 
 
+def test_a_kneed_walker_on_arc_feet_is_refused_before_any_stage_runs(tmp_path):
+    """The phased step (knees) pins its stance foot: arc feet, which roll, are refused in
+    one line naming the field before the gait search runs (it used to end in the search's
+    "no gait" after fixedpoint)."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((CONFIGS / "kneed_optimal.yaml").read_text())
+    d["walker"]["leg"]["foot"] = {"kind": "arc", "radius_m": 0.2}
+    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.05}}
+    scene = tmp_path / "kneed_arc.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
+    assert "walker.leg.foot.kind: arc feet on a walker with knees" in r.output
+    assert "Traceback" not in r.output
+    assert not list((tmp_path / "r").rglob("*.h5"))  # refused before fixedpoint ran
+
+
 def test_every_phased_walker_takes_a_push_off_and_a_five_link_biped_is_refused_in_one_line():
     """Before, a kneed or flat-footed walker's push-off was refused (the phased
     transcription had none); now every heel strike of the phased transcription takes one

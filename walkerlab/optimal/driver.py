@@ -286,10 +286,17 @@ def check_kind(scene, kind) -> None:
             kind.require("ankle_torque", "optimize", f"walker.actuation.torques.{i}.joint")
 
 
+#: why knees on arc feet are refused before any stage runs (the phased transcription's
+#: modes have no rolling contact: :func:`walkerlab.optimal.transcription.phases`)
+PHASED_ARC = ("walker.leg.foot.kind: arc feet on a walker with knees are not in the "
+              "collocation's phased step (knees or flat feet: point or flat feet, the stance "
+              "foot pinned); optimise the walker on point feet (leg.foot.kind: point)")
+
+
 def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
-    kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a kneed,
-    flat-footed or five-link walker, 3D disc feet) and a clearance that cannot hold
+    kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a five-link
+    walker, 3D disc feet; knees on arc feet, :data:`PHASED_ARC`) and a clearance that cannot hold
     (``optimize.min_clearance_m > 0``: :func:`_feet_level_when_legs_cross`).
 
     Parameters
@@ -315,6 +322,8 @@ def check_scene(scene, data) -> None:
     check_kind(scene, data.structure.kind)
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
+    elif data.structure.foot == "arc" and not data.structure.kind.collocation.one_step:
+        raise ValueError(PHASED_ARC)
     if data.structure.kind.collocation.one_step or data.structure.in_3d:  # the ground a step
         # lands on (a 3D stride's steps too): refused early
         from walkerlab.optimal.transcription.landing import check_stride_ground
