@@ -53,9 +53,12 @@ NO_GAIT = ("no period-1 gait", "no rigid gait", "gave up after")
 #: rigid model's strides), never by how fast this machine was; the cell keeps its last entry
 CELL_LIMIT_S = 300
 #: ... an OpenSim cell's at least: its Manager integrates the Hunt-Crossley contact in windows of
-#: 0.5 ms (a 3D walker's hip-roll law and torques are set between them), 30-40 s of wall
-#: time per simulated second on a shared machine (configs/hip_width_stabilised.yaml: 6.6
-#: min for its gait search, export and 10-step walk, 2.4 min of it CPU)
+#: 0.5 ms (a 3D walker's hip-roll law and torques are set between them, each a restart of the
+#: integrator), about 25 s of CPU per simulated second for a 3D kneed walker with CPodes
+#: (walkerlab.export.opensim_walk; 100-140 s with Runge-Kutta-Merson, which left the 3D
+#: kneed walkers' powered cells unmeasured past 3600 s); on a shared machine (load 5-7 on 2
+#: cores) configs/kneed_3d_stabilised_footholds.yaml's cell took 4 min, its gait search,
+#: export and 11-strike walk (6.2 s), kneed_torso_powered_3d.yaml's 12 min (8.1 s)
 CELL_LIMIT_OSIM_S = 900
 
 

@@ -9,7 +9,8 @@ session that walks first and optimises after); in its own process OpenSim never 
 another CasADi, so a session (or an environment with both extras) can optimise a gait and
 walk its OpenSim export.
 
-OpenSim's ``Manager`` integrates the model in windows of ``window_s``; after each window the
+OpenSim's ``Manager`` integrates the model in windows of ``window_s`` with Simbody's CPodes
+(an implicit BDF integrator, :data:`INTEGRATOR`); after each window the
 loop reads each leg's ``HuntCrossleyForce`` (the force on the leg's body).  A heel strike of
 leg i is the first window with contact on its foot after the foot has been off the ground for
 at least ``min_air_s`` (shorter gaps are bounces of the compliant contact).  The stepping
@@ -40,6 +41,20 @@ from it; OpenSim has no contact-switched force):
   strike; a pulse ending at the swing foot's predicted touchdown (the contact model's rule)
   was tried on powered_compass with the paper's friction velocities and made the steps
   shrink (a fall after 9 strikes).
+
+The integrator is implicit because the model is stiff: the stance foot's Hunt-Crossley
+contact (its damping, about 8000 N s/m at the resting depth of a 1.6 kg walker, and the
+friction's slope ``mu N / v_t``) acts on the foot point of a light shank, which the knee
+lets move on its own (a 3D kneed walker's 0.05 kg shank: about 5 g at the foot), a mode of
+about 1e6 /s (the stance foot's contact switched off, the same run costs a twentieth).  An
+explicit integrator (OpenSim's default Runge-Kutta-Merson) is held to steps
+of a few microseconds by that mode's stability whatever its accuracy (1e-5 to 1e-8 cost the
+same): about 100 s of CPU per simulated second for configs/kneed_3d_stabilised.yaml, 140 s
+for its powered twin (configs/kneed_3d_powered_stabilised.yaml).  CPodes at the same
+accuracy steps over it: 5 times less CPU for the walk (each window's restart is most of what
+is left), 10 times less for an uninterrupted run; the heel strikes fall in the same windows
+(kneed_3d_stabilised's 11 in 6.096 s, mean step period 0.5481 s, +1.60 % of the rigid one,
+as with Runge-Kutta-Merson; its powered twin's first two at 0.5405 and 1.0821 s with both).
 """
 
 from __future__ import annotations
@@ -68,6 +83,10 @@ from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 __all__ = ["OpensimWalk", "contact_height", "walk", "walk_here"]
 
 LEGS = ("leg1", "leg2")
+
+#: the Manager's integrator (``opensim.Manager.IntegratorMethod_<name>``): CPodes, implicit
+#: (the module docstring says why); ``RungeKuttaMerson`` is OpenSim's default
+INTEGRATOR = "CPodes"
 
 
 @dataclass
@@ -280,7 +299,8 @@ def advance(state, integrated) -> None:
 
 
 def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
-         min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
+         min_air_s: float = 0.05, accuracy: float = 1e-7,
+         integrator: str = INTEGRATOR) -> OpensimWalk:
     """Simulate ``walker.osim`` for ``duration_s`` from its default state (module docstring),
     in a child process that alone imports OpenSim (``python -m
     walkerlab.export.opensim_walk``: the module docstring says why).
@@ -296,7 +316,10 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
     min_air_s : float
         Shortest time off the ground before a contact counts as a heel strike [s].
     accuracy : float
-        The integrator's accuracy (OpenSim's default integrator, Runge-Kutta-Merson).
+        The integrator's accuracy.
+    integrator : str
+        The Manager's integrator, ``opensim.Manager.IntegratorMethod_<integrator>``
+        (:data:`INTEGRATOR`, CPodes; ``"RungeKuttaMerson"``: OpenSim's default).
 
     Returns
     -------
@@ -322,7 +345,8 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
         out = Path(tmp) / "walk.json"
         args = {"path": str(Path(path).resolve()), "duration_s": float(duration_s),
                 "window_s": float(window_s), "min_air_s": float(min_air_s),
-                "accuracy": float(accuracy), "out": str(out)}
+                "accuracy": float(accuracy), "integrator": str(integrator),
+                "out": str(out)}
         proc = subprocess.run([sys.executable, "-m", "walkerlab.export.opensim_walk",
                                json.dumps(args)], env=env, cwd=tmp, capture_output=True,
                               text=True, check=False)
@@ -351,7 +375,7 @@ def _main(argv: list[str]) -> int:
     a = json.loads(argv[0])
     try:
         w = walk_here(a["path"], a["duration_s"], a["window_s"], a["min_air_s"],
-                      a["accuracy"])
+                      a["accuracy"], a["integrator"])
     except MissingExtra as exc:
         print(str(exc), file=sys.stderr)
         return _MISSING_EXIT
@@ -361,13 +385,14 @@ def _main(argv: list[str]) -> int:
 
 
 def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
-              min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
+              min_air_s: float = 0.05, accuracy: float = 1e-7,
+              integrator: str = INTEGRATOR) -> OpensimWalk:
     """Simulate ``walker.osim`` for ``duration_s`` from its default state in this process
     (imports OpenSim here: :func:`walk` runs it in a process of its own).
 
     Parameters
     ----------
-    path, duration_s, window_s, min_air_s, accuracy
+    path, duration_s, window_s, min_air_s, accuracy, integrator
         As :func:`walk`, which also gives what it returns (:class:`OpensimWalk`) and raises
         (:class:`walkerlab.extras.MissingExtra` without OpenSim).
     """
@@ -439,8 +464,15 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         return float(model.calcMassCenterPosition(s).to_numpy()[:2] @ t_hat)
 
     h0 = hip_x.getValue(state) * n_hat[0] + hip_y.getValue(state) * n_hat[1]
-    manager = osim.Manager(model)
-    manager.setIntegratorAccuracy(accuracy)
+    method = getattr(osim.Manager, f"IntegratorMethod_{integrator}")
+
+    def new_manager():
+        m = osim.Manager(model)
+        m.setIntegratorMethod(method)
+        m.setIntegratorAccuracy(accuracy)
+        m.initialize(state)
+        return m
+
     state.setTime(0.0)
     model.realizeDynamics(state)
     # both feet start on the ground (the trailing one just left it, or stays on its toe in
@@ -474,9 +506,7 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         if roll is not None:  # after the drive: the roll motors are the law's
             roll.control(state, tau)
         if changed or restart or drive is not None or roll is not None:
-            manager = osim.Manager(model)
-            manager.setIntegratorAccuracy(accuracy)
-            manager.initialize(state)
+            manager = new_manager()
             restart = False
         step = window_s if pushing is None else pulse_until - t
         t = min(t + step, duration_s)
