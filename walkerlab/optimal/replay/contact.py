@@ -210,8 +210,9 @@ def _hip_actuation(res) -> dict:
     """The actuation section of a replay of ``res``: a hip torque (its law set after) and the
     optimum's push-off impulse before each touchdown (as in the rigid model) if it has one."""
     act = {"torques": [{"joint": "hip", "law": {}}]}
-    if res.push_off_n_s > 0.0:
-        act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
+    push_off = getattr(res, "push_off_n_s", 0.0)   # a result without one: none
+    if push_off > 0.0:
+        act["push_off"] = {"impulse_n_s": float(push_off)}
     return act
 
 
