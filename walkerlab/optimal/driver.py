@@ -47,11 +47,10 @@ from functools import partial
 
 import numpy as np
 
-from walkerlab.config.actuation import Actuation, PushOff
 from walkerlab.io.schemas.optimize import OptimizeData
-from walkerlab.models.hybrid.actuated import actuate
 from walkerlab.optimal import outcome as reported
 from walkerlab.optimal.free_joints import optimize_five_link
+from walkerlab.optimal.guess import pushed
 from walkerlab.optimal.outcome import history_and_energies, not_a_gait_outcome, replay_multipliers
 from walkerlab.optimal.replay.contact import (
     contact_replay,
@@ -59,6 +58,7 @@ from walkerlab.optimal.replay.contact import (
     contact_replay_stride,
 )
 from walkerlab.optimal.transcription.landing import step_ground
+from walkerlab.optimal.transcription.phases import refusal as phased_refusal
 from walkerlab.optimal.transcription.stride import check_objective as _check_stride
 from walkerlab.optimal.virtual_constraints import (
     check_design,
@@ -286,17 +286,11 @@ def check_kind(scene, kind) -> None:
             kind.require("ankle_torque", "optimize", f"walker.actuation.torques.{i}.joint")
 
 
-#: why knees on arc feet are refused before any stage runs (the phased transcription's
-#: modes have no rolling contact: :func:`walkerlab.optimal.transcription.phases`)
-PHASED_ARC = ("walker.leg.foot.kind: arc feet on a walker with knees are not in the "
-              "collocation's phased step (knees or flat feet: point or flat feet, the stance "
-              "foot pinned); optimise the walker on point feet (leg.foot.kind: point)")
-
-
 def check_scene(scene, data) -> None:
     """Refuse, before any stage runs, what the collocation cannot do: what the walker's
     kind does not have (:func:`check_kind`: a spoked wheel, a push-off on a five-link
-    walker, 3D disc feet; knees on arc feet, :data:`PHASED_ARC`) and a clearance that cannot hold
+    walker, 3D disc feet; knees on arc feet: the phased step's
+    :func:`~walkerlab.optimal.transcription.phases.refusal`) and a clearance that cannot hold
     (``optimize.min_clearance_m > 0``: :func:`_feet_level_when_legs_cross`).
 
     Parameters
@@ -323,7 +317,7 @@ def check_scene(scene, data) -> None:
     if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
     elif data.structure.foot == "arc" and not data.structure.kind.collocation.one_step:
-        raise ValueError(PHASED_ARC)
+        raise ValueError(phased_refusal(data.structure))   # knees on rolling feet
     if data.structure.kind.collocation.one_step or data.structure.in_3d:  # the ground a step
         # lands on (a 3D stride's steps too): refused early
         from walkerlab.optimal.transcription.landing import check_stride_ground
@@ -529,7 +523,7 @@ def _phased(scene, plant, x_gait, period_s, resolve_gait: bool = False) -> Optim
     o = scene.optimize
     spec = collocation_spec(scene)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
-    guide = _guide(walker, data, spec)  # with the scene's push-off, whose gait x_gait is
+    guide = pushed(walker, data, spec.push_off_n_s)  # the scene's push-off: x_gait is its gait
     if resolve_gait:  # fixedpoint's gait has its double support
         g = solve_scene(scene, False, walker=guide, plant=plant)[1].gait.result
         x_gait, period_s = g.x, float(g.period_s)
@@ -620,7 +614,7 @@ def _stride(scene, plant, spec, x_gait, period_s, phased: bool = False) -> Optim
     ground, base = step_ground(scene), make_rigid_walker(data)
     order = phase_order(base) if phased else None  # None: the straight legs' STEP_PHASES
     walker = stride.on_ground(base, data, ground)  # no ground: the walker itself
-    guide = stride.on_ground(base, data, ground, lambda w, d: _guide(w, d, spec))
+    guide = stride.on_ground(base, data, ground, lambda w, d: pushed(w, d, spec.push_off_n_s))
     guess, guess_u = starting_stride(scene, guide, x_gait, period_s, spec.intervals, order)
     t0 = time.perf_counter()
     fns = stride.stride_functions(data, ground, hold_advance=spec.target_step_length_m is None,
@@ -654,16 +648,6 @@ def _stride(scene, plant, spec, x_gait, period_s, phased: bool = False) -> Optim
                         phase_replay_outcome="not replayed: a stride of legs that differ is "
                         "replayed as a function of time only" if o.phase_replay else "",
                         **record)
-
-
-def _guide(walker, data, spec):
-    """The walker that steps the starting stride: ``walker``, with the scene's push-off
-    (``spec.push_off_n_s`` > 0) before each heel strike when it has one (its gait, from
-    ``fixedpoint``, is the pushed walker's)."""
-    if not spec.push_off_n_s:
-        return walker
-
-    return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=spec.push_off_n_s)))
 
 
 # -- the collocation's part per walker kind ----------------------------------------------

@@ -10,9 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.config.actuation import Actuation, PushOff
 from walkerlab.config.studies import GuessFromArtifact
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.hybrid.actuated import actuate
 
 __all__ = ["has_target", "read_guess", "simulated_step", "starting_segment", "starting_step",
            "stairs_targets", "target_numbers", "target_step"]
@@ -179,6 +181,15 @@ def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
         if sel.any():
             x[sel] = np.asarray(sol(t[sel]), float)[:x0.size].T
     return t - t[0], x
+
+
+def pushed(walker, data, push_off_n_s: float):
+    """The walker that steps a starting guess: ``walker``, with the scene's push-off
+    ``push_off_n_s`` [N s] (> 0) before each heel strike (Kuo 2002; the scene's gait, from
+    ``fixedpoint``, is the pushed walker's); ``walker`` itself without one."""
+    if not push_off_n_s:
+        return walker
+    return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=push_off_n_s)))
 
 
 def starting_step(scene, walker, x_gait, period_s: float):

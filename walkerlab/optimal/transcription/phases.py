@@ -173,6 +173,22 @@ def phase_order(walker, phase_log=None) -> list[tuple[str, str, int]]:
     raise ValueError("optimize: the step's phases loop without a heel strike")
 
 
+def refusal(structure) -> str | None:
+    """Why this transcription has no symbolic form for ``structure``'s walker (one line
+    naming the field), or None: a kind without phases, a planar walker's torso, arc feet
+    (its modes pin the stance foot; an arc foot rolls), massless legs."""
+    if structure.kind.phases is None:
+        return "optimize: the walker's kind has no phased step"
+    if structure.foot == "arc":
+        return ("walker.leg.foot.kind: arc feet on a walker with knees are not in the "
+                "collocation's phased step (knees or flat feet: point or flat feet, the "
+                "stance foot pinned); optimise the walker on point feet (leg.foot.kind: point)")
+    if (structure.torso and not structure.in_3d) or any(b.massless for b in structure.bodies):
+        return ("optimize: the phased transcription takes massive legs with point or flat "
+                "feet and no torso today")
+    return None
+
+
 def mode_functions(data, walker, order=None) -> dict:
     """CasADi functions of the step of ``data``'s walker (module docstring) from its
     symbolic equations, in the phase order ``order`` (:func:`phase_order`; default: the
@@ -190,11 +206,10 @@ def mode_functions(data, walker, order=None) -> dict:
     import casadi as ca
 
     st = data.structure
-    modes = st.kind.phases.behaviour if st.kind.phases is not None else None
-    if (modes is None or (st.torso and not st.in_3d) or st.foot == "arc"
-            or any(b.massless for b in st.bodies)):
-        raise ValueError("optimize: the phased transcription takes massive legs with point "
-                         "or flat feet and no torso today")
+    why = refusal(st)
+    if why is not None:
+        raise ValueError(why)
+    modes = st.kind.phases.behaviour
     order = order if order is not None else phase_order(walker)
     kind = modes(data)
     n = kind.n
