@@ -266,6 +266,19 @@ def _pushed(data, P: float):
     return actuate(make_rigid_walker(data), data, Actuation(push_off=PushOff(impulse_n_s=P)))
 
 
+def _assert_push_off_is_the_rigid_transition(strike, acts, x, P):
+    """The collocation's push-off and heel strike at ``x`` with impulse ``P`` [N s] equal the
+    rigid model's transition (``acts``) to 1e-10, its work the rigid kinetic-energy gain;
+    with no impulse, the plain heel strike."""
+    x_plus, work = strike.push_off(x, P)
+    ref = acts.transition(x)
+    np.testing.assert_allclose(x_plus.full().ravel(), ref["x_plus"], rtol=0, atol=1e-10)
+    assert float(work) == pytest.approx(ref["ke_push_off"] - ref["ke_minus"], abs=1e-10)
+    if P == 0.0:
+        np.testing.assert_allclose(x_plus.full().ravel(), strike.reset(x).full().ravel(),
+                                   atol=1e-12)
+
+
 @pytest.mark.slow
 def test_the_kneed_push_off_reset_is_the_rigid_models_push_off_and_heel_strike(kneed):
     """The transcription's heel strike after a push-off ``P`` (the extended impact with the
@@ -284,15 +297,7 @@ def test_the_kneed_push_off_reset_is_the_rigid_models_push_off_and_heel_strike(k
         for _ in range(4):
             x = rng.normal(0.0, [0.2, 0.2, 0.2, 1.0, 1.0, 1.0])
             x[1], x[4] = x[0], x[3]  # the swing knee locked straight, as at a heel strike
-            x_plus, work = strike.push_off(x, P)
-            ref = acts.transition(x)
-            np.testing.assert_allclose(x_plus.full().ravel(), ref["x_plus"], rtol=0,
-                                       atol=1e-10)
-            assert float(work) == pytest.approx(ref["ke_push_off"] - ref["ke_minus"],
-                                                abs=1e-10)
-            if P == 0.0:
-                np.testing.assert_allclose(x_plus.full().ravel(),
-                                           strike.reset(x).full().ravel(), atol=1e-12)
+            _assert_push_off_is_the_rigid_transition(strike, acts, x, P)
 
 
 @pytest.mark.slow
@@ -359,15 +364,7 @@ def test_the_flat_feet_push_off_reset_is_the_rigid_models_toe_push_off_and_heel_
         acts = pushed.actuators.at("toe")
         for _ in range(4):
             x = rng.normal(0.0, [0.2, 0.2, 0.1, 1.0, 1.0, 0.5])
-            x_plus, work = strike.push_off(x, P)
-            ref = acts.transition(x)
-            np.testing.assert_allclose(x_plus.full().ravel(), ref["x_plus"], rtol=0,
-                                       atol=1e-10)
-            assert float(work) == pytest.approx(ref["ke_push_off"] - ref["ke_minus"],
-                                                abs=1e-10)
-            if P == 0.0:
-                np.testing.assert_allclose(x_plus.full().ravel(),
-                                           strike.reset(x).full().ravel(), atol=1e-12)
+            _assert_push_off_is_the_rigid_transition(strike, acts, x, P)
 
 
 @pytest.mark.slow
