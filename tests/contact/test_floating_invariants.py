@@ -20,6 +20,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.codegen.floating import MASSLESS_MESSAGE, floating_view
 from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
+from walkerlab.models.contact.assembly import NINFO
 from walkerlab.models.contact.laws import contact_params_si, knee_stop_si
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.walker.description import walker_data
@@ -418,12 +419,31 @@ def test_straight_line_rhs_is_the_array_assembly_with_contact_and_latch():
         x[1] -= 1e-4  # both feet a little deeper
         M, P, V, J = (np.empty((nq, nq)), np.empty((2, 2)), np.empty((2, 2)),
                       np.empty((2, 2, nq)))
-        info, knees = np.zeros((2, 12)), np.zeros((2, 5))
+        info, knees = np.zeros((2, NINFO)), np.zeros((2, 5))
         Q = w.kernels._force(x, *w._args(), True, True, M, P, V, J, info, knees)
         assert np.all(knees[:, 2] < 0) and np.all(info[:, 4] > 0)  # latches hold, feet loaded
         want = np.linalg.solve(M, Q)
         np.testing.assert_allclose(w.rhs(0, x)[nq:], want, rtol=1e-9,
                                    atol=1e-9 * np.max(np.abs(want)))
+
+
+def test_the_array_assembly_refuses_buffers_narrower_than_its_rows():
+    """``_force`` writes each point's NINFO-entry row and each knee's 5 entries into the
+    caller's arrays: narrower arrays are refused with ValueError, never written past their
+    end (a 12-column ``info``, the planar kernel's width before the two dimensions merged,
+    had each row's last three entries land past the buffer: heap corruption that aborted
+    the process later, elsewhere)."""
+    w = _latched(_data("kneed"))
+    nq = w.nq
+    x = np.zeros(2 * nq)
+    bufs = (np.empty((nq, nq)), np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, nq)))
+    for info, knees in ((np.zeros((2, NINFO - 3)), np.zeros((2, 5))),
+                        (np.zeros((2, NINFO)), np.zeros((2, 4)))):
+        with pytest.raises(ValueError, match="info must be"):
+            w.kernels._force(x, *w._args(), True, True, *bufs, info, knees)
+    Q = w.kernels._force(x, *w._args(), True, True, *bufs, np.zeros((2, NINFO)),
+                         np.zeros((2, 5)))
+    assert Q.shape == (nq,) and np.all(np.isfinite(Q))
 
 
 def test_knee_latch_holds_a_loaded_knee_against_flexion_and_releases_in_the_air():

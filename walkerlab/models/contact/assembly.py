@@ -242,6 +242,8 @@ def contact_forces(x, h, PC, c1, c2, use1, use2, P, V, J, info, knees, point_leg
     ``knees``.  Points in ``d = P.shape[1]`` dimensions
     (:func:`point`; a planar point in its plane)."""
     nq, d = h.shape[0], P.shape[1]
+    if info.shape[0] < P.shape[0] or info.shape[1] < NINFO or knees.shape[1] < 5:
+        raise ValueError("contact_forces: info must be (nf, NINFO) and knees (2, 5)")
     Q = -h
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
     for i in range(P.shape[0]):
