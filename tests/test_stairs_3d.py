@@ -258,8 +258,8 @@ def test_footholds_adams_patches_lie_at_the_rigid_walks_footfalls(footholds_walk
 
 
 def test_footholds_osim_patches_lie_at_the_rigid_walks_footfalls(footholds_walk):
-    """The OpenSim model's text (written by its writer: the export refuses footholds of
-    several heights in OpenSim, its walk on them not measured) lays the MJCF's patches:
+    """The OpenSim model's text (written by its writer; its walk on these footholds is the
+    capability table's measured cell straight_legs_3d/footholds/osim) lays the MJCF's patches:
     each ``ContactSphere`` ``leg<i>_patch<k>``'s top (its centre plus its radius along the
     slope's normal, OpenSim's axes walkerlab's) at the rigid walk's footfall, at its
     foothold's height (:func:`_lanes_match_the_rigid_walk`)."""

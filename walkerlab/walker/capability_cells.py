@@ -11,8 +11,7 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 from __future__ import annotations
 
 __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
-           "FOOTHOLDS_EXPORT_3D", "FREE_JOINT_TORQUES",
-           "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
+           "FREE_JOINT_TORQUES", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
            "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
@@ -80,16 +79,6 @@ PROFILE_WHEEL_3D = ("the 3D wheel's heading and lean are angles about its ground
                     "and fall line through the stance spoke's tip: a profile's slope changes "
                     "from step to step, turning those axes at each landing, which the rigid "
                     "state does not carry; stairs and footholds keep one plane's axes")
-#: why the 3D straight legs' OpenSim model and the kneed walker in 3D's exports refuse
-#: footholds of several heights (the straight legs' MJCF and Adams dataset take them:
-#: :func:`walkerlab.export.legs_3d_parts.legs3d_lanes`)
-FOOTHOLDS_EXPORT_3D = ("on footholds of several heights the 3D walker's steps differ in "
-                       "length, lean and lateral offset (it crabs across the slope): the "
-                       "exports lay its patches at its rigid walk's footfalls, measured in "
-                       "MuJoCo and the Adams dataset for the straight legs only; this view's "
-                       "walk on them is not measured (OpenSim is not installed where the "
-                       "layout was made; the kneed walker's knee latch on patches of "
-                       "alternating heights): give footholds of one height for this view")
 #: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
 #: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
 TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
@@ -358,11 +347,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # trailing foot's height included; on footholds of several heights the footfalls
         # of the rigid walk of one period, as the contact model's:
         # walkerlab.export.legs_3d_parts.legs3d_lanes), the gym's rigid view steps them as
-        # simulate; the OpenSim model lays the MJCF's patches, its walk on footholds of
-        # several heights not measured
+        # simulate; the OpenSim model lays the MJCF's patches (walkerlab.export.opensim_3d,
+        # its walk on footholds of two heights measured: configs/hip_width_footholds.yaml)
         **{(g, v): None for g in ("stairs", "footholds")
            for v in ("rigid", "contact", "mjcf", "adams", "gym", "osim")},
-        ("footholds", "osim"): FOOTHOLDS_EXPORT_3D,
         # the collocation's stride lands each step on its tread or foothold
         # (walkerlab.optimal.transcription.stride, .landing)
         ("stairs", "optimize"): None,
