@@ -14,7 +14,8 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD
            "FREE_JOINT_TORQUES", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D", "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
+           "ROUND_FEET_3D_UPRIGHT", "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D",
+           "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TORSO_ADAMS_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
@@ -493,8 +494,7 @@ KNEE_LATCH_OSIM = ("walked with walkerlab's stepping loop (walkerlab.export.open
                    "straight (the kneed walker falls at 0.34 s, in its first step)")
 
 #: what the contact walk cell of the 3D straight legs of zero hip width rests on
-#: (configs/paper_3d.yaml): its ten steps are the sagittal gait's (configs/round_feet_3d.yaml's
-#: discs: their roll reaches 0.1 rad by heel strike 9 and the swing disc scuffs in step 10)
+#: (configs/paper_3d.yaml): its ten steps are the sagittal gait's
 ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk stays in its "
                          "sagittal plane: zero hip width and an upright start keep it "
                          "mirror-symmetric, its roll seeded at round-off and growing x11 a step "
@@ -503,6 +503,18 @@ ZERO_WIDTH_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk 
                          "started 1 mrad/s off upright (contact_sim.start_offset: "
                          "lean_rate_rad_per_s: 0.001) configs/paper_3d.yaml capsizes after 3 "
                          "heel strikes, as the rigid walk would")
+
+#: what the straight legs' round-feet contact cell rests on (configs/round_feet_3d.yaml:
+#: zero hip width, a disc in each leg's plane): its ten steps are the sagittal gait's, the
+#: roll kept there by the integrator's absolute tolerance
+ROUND_FEET_3D_UPRIGHT = ("held to the rigid gait over 10 steps because the walk stays in its "
+                         "sagittal plane: zero hip width and an upright start keep it "
+                         "mirror-symmetric, its roll 0 but for the integrator's error there, "
+                         "which only contact_solver.atol bounds (1e-13: under 1e-8 rad by heel "
+                         "strike 10, growing x11 a step, the rigid gait's lateral multiplier; "
+                         "at 1e-10 seeded at 1e-11 rad in the first stance, 0.1 rad by heel "
+                         "strike 9, and the walk capsizes in step 10, as the rigid walk would "
+                         "from that roll)")
 
 #: what the kneed walker's round-feet contact cell of zero hip width rests on
 #: (configs/kneed_round_feet_3d.yaml): its ten steps are the sagittal gait's
@@ -520,6 +532,7 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
 #: (kind, feature, view) -> what one supported cell rests on beyond its measurement, where
 #: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
 FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
+                 ("straight_legs_3d", "round_feet_3d", "contact"): ROUND_FEET_3D_UPRIGHT,
                  ("locking_knees_3d", "round_feet_3d", "contact"): KNEED_ZERO_WIDTH_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,
