@@ -7,7 +7,9 @@ URDF's and the MJCF's:
   (:func:`walkerlab.export.opensim.osim_text`);
 - legs in 3D (:meth:`OsimWriter.legs_3d`): the export bodies of the tree
   (:func:`walkerlab.export.opensim_3d.osim3d_text`);
-- a spoked wheel (one body, planar or 3D): refused, as the capability table has it.
+- a planar spoked wheel (:meth:`OsimWriter.wheel`): its one body on its spoke tips
+  (:func:`walkerlab.export.opensim_wheel.osim_wheel_text`);
+- a spoked wheel in 3D: refused, as the capability table has it.
 
 OpenSim's model carries its default state (the rigid gait), so the walker alone
 (``--walker-only``) is refused.
@@ -16,6 +18,7 @@ OpenSim's model carries its default state (the rigid gait), so the walker alone
 from __future__ import annotations
 
 import walkerlab
+from walkerlab.config.contact import ContactSettings
 from walkerlab.export.body_writers import TreeWriter, check_legs_3d, planar_legs_only
 from walkerlab.export.jobs import ExportJob, Writer, Written, step_period, xml_file, xml_lines
 from walkerlab.export.opensim import (
@@ -25,8 +28,11 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.opensim_3d import osim3d_gait, osim3d_omissions, osim3d_text
+from walkerlab.export.opensim_wheel import osim_wheel_text
 from walkerlab.export.scene import check_exportable
 from walkerlab.export.tree_links import tree_multibody
+from walkerlab.export.wheel_scene import check_wheel_exportable
+from walkerlab.models.contact.rigid_limit import contact_si
 
 __all__ = ["OSIM", "OsimWriter"]
 
@@ -64,11 +70,21 @@ class OsimWriter(TreeWriter):
                        xml_lines(osim3d_omissions(data, gait), scene), step_period(ideal))
 
     def wheel(self, job: ExportJob, w: Writer) -> Written:
+        """The planar spoked wheel (:mod:`walkerlab.export.opensim_wheel`): the rigid gait
+        as its default state, the slope's half-space and a Hunt-Crossley force per spoke
+        tip (its other grounds: the capability table's cells)."""
+        if job.walker_only:
+            check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
+            raise ValueError(WALKER_ONLY)
+        _, ideal, key = self.wheel_gait(job, w)
+        c, _ = contact_si(job.scene.contact or ContactSettings())
+        text = osim_wheel_text(job.data, key, c, job.name, walkerlab.__version__)
+        return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
+
+    def wheel_3d(self, job: ExportJob, w: Writer) -> Written:
         """Refused (the capability table's cell)."""
         planar_legs_only(job, w)
         raise AssertionError("unreachable")  # pragma: no cover
-
-    wheel_3d = wheel
 
 
 #: the OpenSim writer object

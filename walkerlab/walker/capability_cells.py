@@ -115,7 +115,12 @@ ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) h
                       "as MJCF (--format mjcf) or an Adams dataset")
 #: why the OpenSim export refuses the 3D spoked wheel
 EXPORT_3D = ("the OpenSim export writes legs (a tree of leg links, or the 3D legs' "
-             "pelvis and legs); a spoked wheel (one rigid body) is exported as urdf or mjcf")
+             "pelvis and legs) and the planar spoked wheel; the 3D wheel's free body is "
+             "exported as urdf, mjcf or adm")
+#: why the planar wheel's OpenSim model refuses a ground other than the slope
+_OSIM_WHEEL_GROUNDS = ("the OpenSim export writes the spoked wheel on the slope's "
+                       "half-space only (no treads, footfall patches or profile); "
+                       "--format mjcf or adm writes them")
 #: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
 #: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
 KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
@@ -295,8 +300,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (a box per tread) or a profile (a box per segment)
         # (walkerlab.export.adams_wheel.adm_wheel_text)
         ("footholds", "adams"): None,
-        ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
-                           "(one rigid body) is exported as urdf or mjcf"),
+        # the OpenSim model: the hub on its spoke tips, a Hunt-Crossley force per tip on the
+        # slope's half-space (walkerlab.export.opensim_wheel); its other grounds are not
+        # written
+        **{(g, "osim"): _OSIM_WHEEL_GROUNDS for g in ("stairs", "footholds", "profile")},
         ("walk", "gym"): _WHEEL_GYM,
         # footholds on continuous ground (the wheel's): a tread through each landing,
         # risers half-way (walkerlab.models.contact.terrain.footholds_line)
