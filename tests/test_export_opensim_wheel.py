@@ -1,9 +1,10 @@
 """``walkerlab export --format osim`` of the planar spoked wheel (configs/rimless_wheel.yaml:
 Drake's RimlessWheel defaults, mass 1 kg, spoke 1 m, 8 spokes, slope 0.08 rad), its file's
 numbers checked against the scene here (no walkerlab export code), and its walk in OpenSim
-(skips without the ``osim`` extra).  Measured (OpenSim 4.6, CPodes): 11 spoke strikes, each
-by the next spoke, in 11.69 s, mean step period 1.02895 s against the rigid gait's
-1.03455 s (-0.54 %).
+(skips without the ``osim`` extra), and the 3D wheel's (configs/rimless_wheel_3d_disc.yaml).
+Measured (OpenSim 4.6, CPodes): the planar wheel 11 spoke strikes, each by the next spoke,
+in 11.69 s, mean step period 1.02895 s against the rigid gait's 1.03455 s (-0.54 %); the 3D
+disc wheel 11 in 4.477 s, 0.39575 s against 0.396183 s (-0.11 %).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import importlib.util
 import math
 import xml.etree.ElementTree as ET
 
+import numpy as np
 import pytest
 
 from walkerlab.config import load_scene, scene_from_dict
@@ -86,13 +88,78 @@ def test_wheel_osim_has_the_scenes_hub_spokes_and_gait(wheel_osim):
     assert out.step_period_s == pytest.approx(1.03455, rel=1e-5)
 
 
+def test_wheel3d_osim_has_the_disc_wheels_inertia_spokes_and_upright_gait(tmp_path):
+    """configs/rimless_wheel_3d_disc.yaml's .osim: the hub's mass, its diametral inertia
+    about the body's x and y and its axle inertia about z, the spokes' spheres as the planar
+    wheel's, and its default state the upright gait: no heading, lean or sideways motion,
+    spin ``pi/n - phi``, the stance sphere's lowest point at the origin (its centre ``L - r``
+    along the spoke, ``r`` above the slope along its normal)."""
+    out = export_stage.write(load_scene("configs/rimless_wheel_3d_disc.yaml"), tmp_path, "osim")
+    model = ET.fromstring(out.path.read_text().replace("::", "__")).find("Model")
+    hub = model.find("BodySet").find("objects").find("Body")
+    assert float(hub.find("mass").text) == pytest.approx(1.0, rel=1e-15)
+    assert _floats(hub.find("inertia").text) == pytest.approx([0.25, 0.25, 0.5, 0, 0, 0],
+                                                              abs=1e-15)
+    r, phi = L / 1000, 0.2
+    for s in model.iter("ContactSphere"):
+        k = int(s.get("name").removeprefix("spoke").removesuffix("_foot"))
+        psi = 2 * math.pi * k / N
+        assert _floats(s.find("location").text) == pytest.approx(
+            [(L - r) * math.sin(psi), -(L - r) * math.cos(psi), 0.0], abs=1e-15)
+    coords = {c.get("name"): (float(c.find("default_value").text),
+                              float(c.find("default_speed_value").text))
+              for c in model.iter("Coordinate")}
+    q = math.pi / N - phi
+    assert coords["spin"][0] == pytest.approx(q, abs=1e-9)
+    for c in ("hip_z", "heading", "lean"):
+        assert coords[c] == pytest.approx((0.0, 0.0), abs=1e-12), c
+    assert coords["hip_x"][0] == pytest.approx(-(L - r) * math.sin(q) + r * math.sin(phi),
+                                               abs=1e-12)
+    assert coords["hip_y"][0] == pytest.approx((L - r) * math.cos(q) + r * math.cos(phi),
+                                               abs=1e-12)
+    # turning about the stance sphere's lowest point (the origin) at the spin rate
+    w = coords["spin"][1]
+    assert coords["hip_x"][1] == pytest.approx(-w * coords["hip_y"][0], rel=1e-9)
+    assert coords["hip_y"][1] == pytest.approx(w * coords["hip_x"][0], rel=1e-9)
+    assert out.step_period_s == pytest.approx(0.396183, rel=1e-5)
+
+
+def test_wheel3d_state_angles_compose_the_keyframes_orientation_and_spin():
+    """:func:`walkerlab.export.opensim_wheel.osim_wheel3d_state` of a leaning, turned
+    keyframe: the body-fixed rotations heading (y), lean (x), spin (z) compose the
+    keyframe's orientation (MuJoCo's axes: OpenSim's x, -z, y), and their rates give its
+    angular velocity (OpenSim's CustomJoint, checked against OpenSim 4.6 when this was
+    written: its rotations are body-fixed in order, its speeds the angles' rates)."""
+    from scipy.spatial.transform import Rotation
+
+    from walkerlab.export.opensim_wheel import osim_wheel3d_state
+
+    C = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # OpenSim -> MuJoCo axes
+    R = Rotation.from_euler("yxz", [0.3, -0.2, 2.5])          # any orientation (OpenSim)
+    Rm = C @ R.as_matrix() @ C.T
+    x, y, z, w = Rotation.from_matrix(Rm).as_quat()
+    omega_body = np.array([0.4, -1.1, 0.7])                   # MuJoCo body axes
+    st = dict((n, (q, v)) for n, q, v in osim_wheel3d_state(
+        (0.1, 0.2, 0.9, w, x, y, z), (1.0, 2.0, 3.0, *omega_body)))
+    a, b, c = (st[n][0] for n in ("heading", "lean", "spin"))
+    got = Rotation.from_rotvec([0, a, 0]) * Rotation.from_rotvec([b, 0, 0]) \
+        * Rotation.from_rotvec([0, 0, c])
+    assert np.allclose(got.as_matrix(), R.as_matrix(), atol=1e-12)
+    Ra = Rotation.from_rotvec([0, a, 0]).as_matrix()
+    Rab = Ra @ Rotation.from_rotvec([b, 0, 0]).as_matrix()
+    e = np.eye(3)
+    omega = st["heading"][1] * e[1] + st["lean"][1] * Ra @ e[0] + st["spin"][1] * Rab @ e[2]
+    assert np.allclose(C @ omega, Rm @ omega_body, atol=1e-12)
+    assert [st[n][0] for n in ("hip_x", "hip_y", "hip_z")] == pytest.approx([0.1, 0.9, -0.2])
+    assert [st[n][1] for n in ("hip_x", "hip_y", "hip_z")] == pytest.approx([1.0, 3.0, -2.0])
+
+
 @pytest.mark.parametrize("scene, field", [
-    ("configs/rimless_wheel_3d_disc.yaml", "walker.space: 3d"),
+    ("configs/rimless_wheel_3d_disc_stairs.yaml", "terrain.kind: stairs"),
     ({}, "terrain.kind: stairs")])
-def test_wheel_osim_refuses_the_3d_wheel_and_other_grounds_in_one_line(scene, field,
-                                                                       tmp_path):
-    """The 3D wheel and the planar wheel on stairs: one line naming the field (the
-    capability table's cells), nothing written."""
+def test_wheel_osim_refuses_other_grounds_in_one_line(scene, field, tmp_path):
+    """The 3D and the planar wheel on stairs: one line naming the field (the capability
+    table's cells), nothing written."""
     if isinstance(scene, dict):  # the capability table's reference case of the cell
         from walkerlab.walker.reference_cases import reference_scene
 
@@ -108,14 +175,15 @@ def test_wheel_osim_refuses_the_3d_wheel_and_other_grounds_in_one_line(scene, fi
 
 @pytest.mark.slow
 @needs_opensim
-def test_wheel_osim_rolls_in_opensim_within_3_percent(wheel_osim):
+@pytest.mark.parametrize("name", ["rimless_wheel", "rimless_wheel_3d_disc"])
+def test_wheel_osim_rolls_in_opensim_within_3_percent(name, tmp_path):
     """OpenSim's Manager rolls the wheel from its default state (walkerlab's loop reading
     each spoke's Hunt-Crossley force): 10 or more spoke strikes, each by the next spoke, no
     fall, the mean step period within 3 % of the rigid gait's (the capability table's
-    OpenSim tolerance; measured -0.54 %)."""
+    OpenSim tolerance; measured -0.54 % and -0.11 %)."""
     from walkerlab.export.engine_walk import walk_export
 
-    out, _ = wheel_osim
+    out = export_stage.write(load_scene(f"configs/{name}.yaml"), tmp_path, "osim")
     w = walk_export(out.path, "osim", out.step_period_s, 10, tolerance=0.03, spokes=True)
     assert w.walked and not w.fell, w.line
     assert w.strikes >= 10 and w.rolling and w.first_leg == "spoke1", w.line
