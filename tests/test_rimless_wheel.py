@@ -402,21 +402,6 @@ def test_rimless_wheel_contact_trajectory_alternates_its_legs(wheel_runs):
         assert np.max(np.abs(n @ foot[:, on])) < 1e-4
 
 
-@pytest.mark.parametrize("fmt", ["osim"])
-def test_rimless_wheel_export_refuses_leg_formats_in_one_line(fmt, tmp_path):
-    """``walkerlab export --format osim``: the OpenSim writer builds a tree of leg links;
-    the wheel is refused in one line naming walker.model, nothing written (its Adams
-    dataset: tests/test_export_adams_wheel.py)."""
-    from walkerlab.stages import export as export_stage
-
-    with pytest.raises(ValueError) as exc:
-        export_stage.run(load_scene(SCENE), tmp_path, fmt)
-    msg = str(exc.value)
-    assert msg.startswith("walker.model: rimless_wheel") and "\n" not in msg
-    assert "urdf or mjcf" in msg
-    assert not list(tmp_path.rglob("walker.*"))
-
-
 def _keyframe_closed_form():
     """The gait keyframe from the closed form: spoke 0's tip at the origin, the hub at
     ``L (-sin q, cos q)``, ``q = alpha - phi``, turning at ``-w+`` (hub velocity

@@ -59,7 +59,7 @@ from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.mjcf_ground import wheel_footfalls
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.export.omitted import Omission
-from walkerlab.export.spoked import WHEEL_TIP_FRACTION, _wheel_numbers, wheel_chord_m
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel_chord_m, wheel_numbers
 from walkerlab.models.contact.terrain import footholds_line, profile_line
 from walkerlab.models.ground import stair_treads
 from walkerlab.walker.walker_trees import walker_tree
@@ -158,7 +158,7 @@ def wheel_start(data, ideal, strides: int, hub_inertia_kg_m2: float | None = Non
     tree, _coords = walker_tree(data.structure)
     body, = tree.bodies
     values = dict(zip(data.structure.param_names, data.params))
-    p = _wheel_numbers(data, hub_inertia_kg_m2)
+    p = wheel_numbers(data, hub_inertia_kg_m2)
     C = np.array(TO_MUJOCO)
     f = functions(data)
     x = np.asarray(ideal.x, float)

@@ -6,8 +6,10 @@ gait just after heel strike) for ``steps`` rigid step periods and a third, its h
 mean step period set against the rigid gait's.
 
 A spoked wheel's MJCF rolls (:func:`walkerlab.export.mujoco_walk.roll`: its spoke strikes
-are its steps).  A format no engine here walks (a URDF has no ground, an Adams dataset needs
-Adams Solver) and an engine that is not installed give one line saying why, and no walk.
+are its steps), as its OpenSim model does (the spokes' touchdowns,
+:mod:`walkerlab.export.opensim_walk`).  A format no engine here walks (a URDF has no
+ground, an Adams dataset needs Adams Solver) and an engine that is not installed give one
+line saying why, and no walk.
 """
 
 from __future__ import annotations
@@ -148,8 +150,8 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
     tolerance : float
         Relative step-period tolerance.
     spokes : bool
-        A spoked wheel's MJCF: its spoke strikes (:func:`walkerlab.export.mujoco_walk.roll`)
-        instead of two legs' heel strikes.
+        A spoked wheel: its spoke strikes (the MJCF's :func:`walkerlab.export.mujoco_walk.
+        roll`, the OpenSim model's spoke touchdowns) instead of two legs' heel strikes.
     feedback : walkerlab.export.mujoco_walk.VirtualConstraintFeedback, optional
         The scene's virtual constraints (the MJCF's stepping loop evaluates them).
 
@@ -178,4 +180,4 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
                       t_end_s=float(run.t_end_s),
                       period_s=float(periods.mean()) if len(periods) else math.nan,
                       rigid_period_s=float(rigid_period_s), steps=steps, tolerance=tolerance,
-                      rolling=bool(fmt == "mjcf" and spokes))
+                      rolling=bool(spokes))

@@ -13,7 +13,11 @@ OpenSim's ``Manager`` integrates the model in windows of ``window_s`` with Simbo
 (an implicit BDF integrator, :data:`INTEGRATOR`); after each window the
 loop reads each leg's ``HuntCrossleyForce`` (the force on the leg's body).  A heel strike of
 leg i is the first window with contact on its foot after the foot has been off the ground for
-at least ``min_air_s`` (shorter gaps are bounces of the compliant contact).  The stepping
+at least ``min_air_s`` (shorter gaps are bounces of the compliant contact).  A spoked wheel
+(:mod:`walkerlab.export.opensim_wheel`: a ``spoke<k>_contact`` per spoke tip, spoke 0
+standing at the start) steps as the legs do, each spoke a group of its own: a step is a
+spoke other than the standing one touching down after ``min_air_s`` off the ground, which
+then stands.  The stepping
 rules act between windows (``Force.setAppliesForce`` on the state, then the manager restarts
 from it; OpenSim has no contact-switched force):
 
@@ -279,6 +283,19 @@ class _HipRoll:
             m.setOverrideActuation(state, float(tau[i]))
             m.overrideActuation(state, True)
 
+def _contact_groups(forces) -> tuple[list[str], str]:
+    """The model's contact groups, each a ``<group>_contact`` force on its sphere
+    ``<group>_foot``, and the one standing in the default state: a legged walker's legs
+    (leg2 stands), or a spoked wheel's spokes ``spoke<k>`` (spoke 0 stands:
+    :mod:`walkerlab.export.opensim_wheel`), whose touchdowns are its steps."""
+    if forces.contains("leg1_contact"):
+        return list(LEGS), "leg2"
+    spokes = []
+    while forces.contains(f"spoke{len(spokes)}_contact"):
+        spokes.append(f"spoke{len(spokes)}")
+    return spokes, "spoke0"
+
+
 def advance(state, integrated) -> None:
     """Carry a Manager's integrated state over onto the loop's own ``state``: its time and
     continuous variables ``y`` (q, u, z); the discrete ones (the motors' overrides, the
@@ -407,12 +424,13 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     model = osim.Model(str(path))
     state = model.initSystem()
     fs = model.getForceSet()
-    contact = {g: fs.get(f"{g}_contact") for g in LEGS}
+    groups, stance = _contact_groups(fs)
+    contact = {g: fs.get(f"{g}_contact") for g in groups}
     feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
-            for g in LEGS}
+            for g in groups}
     # the body that carries the foot sphere (a leg, a shank; a 3D kneed leg's leg<i>_shank)
-    bodies = {g: model.getBodySet().get(feet[g].getFrame().getName()) for g in LEGS}
-    foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in LEGS}
+    bodies = {g: model.getBodySet().get(feet[g].getFrame().getName()) for g in groups}
+    foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in groups}
     for g in LEGS:  # a flat foot: the foot point is the ankle, its sole's frame origin
         if model.getBodySet().contains(f"{g}_sole"):
             bodies[g], foot_loc[g] = model.getBodySet().get(f"{g}_sole"), osim.Vec3(0, 0, 0)
@@ -443,8 +461,8 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         return float(p @ t_hat)
 
     cg = model.getContactGeometrySet()
-    patches = {g: [] for g in LEGS}  # each lane's patch tops: (along, height) [m]
-    for g in LEGS:
+    patches = {g: [] for g in groups}  # each lane's patch tops: (along, height) [m]
+    for g in groups:
         while cg.contains(f"{g}_patch{len(patches[g])}"):
             sph = osim.ContactSphere.safeDownCast(cg.get(f"{g}_patch{len(patches[g])}"))
             loc = osim.Vec3(sph.get_location()).to_numpy()[:2]
@@ -477,10 +495,9 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     model.realizeDynamics(state)
     # both feet start on the ground (the trailing one just left it, or stays on its toe in
     # a flat foot's double support): a heel strike needs min_air_s off it first
-    air = {g: 0.0 for g in LEGS}
-    on = {g: loaded(g, state) for g in LEGS}
+    air = {g: 0.0 for g in groups}
+    on = {g: loaded(g, state) for g in groups}
     latched = {g: False for g in LEGS}
-    stance = "leg2"  # the default state: leg2 in stance
     times, legs, com, feet_at = [], [], [], []
     fell, t = False, 0.0
     pulse_until, pushing, t_step = -1.0, None, 0.0
@@ -512,8 +529,8 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
         t = min(t + step, duration_s)
         advance(state, manager.integrate(t))
         model.realizeDynamics(state)
-        now_on = {g: loaded(g, state) for g in LEGS}  # before a switch drops the stage
-        for g in LEGS:
+        now_on = {g: loaded(g, state) for g in groups}  # before a switch drops the stage
+        for g in groups:
             now = now_on[g]
             if now and not on[g] and air[g] >= min_air_s and g != stance:
                 times.append(t)

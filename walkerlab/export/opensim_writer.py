@@ -7,7 +7,10 @@ URDF's and the MJCF's:
   (:func:`walkerlab.export.opensim.osim_text`);
 - legs in 3D (:meth:`OsimWriter.legs_3d`): the export bodies of the tree
   (:func:`walkerlab.export.opensim_3d.osim3d_text`);
-- a spoked wheel (one body, planar or 3D): refused, as the capability table has it.
+- a planar spoked wheel (:meth:`OsimWriter.wheel`): its one body on its spoke tips
+  (:func:`walkerlab.export.opensim_wheel.osim_wheel_text`);
+- a spoked wheel in 3D (:meth:`OsimWriter.wheel_3d`): its free body on its spoke tips
+  (:func:`walkerlab.export.opensim_wheel.osim_wheel3d_text`).
 
 OpenSim's model carries its default state (the rigid gait), so the walker alone
 (``--walker-only``) is refused.
@@ -16,7 +19,9 @@ OpenSim's model carries its default state (the rigid gait), so the walker alone
 from __future__ import annotations
 
 import walkerlab
-from walkerlab.export.body_writers import TreeWriter, check_legs_3d, planar_legs_only
+from walkerlab.codegen.cache import functions
+from walkerlab.config.contact import ContactSettings
+from walkerlab.export.body_writers import TreeWriter, check_legs_3d
 from walkerlab.export.jobs import ExportJob, Writer, Written, step_period, xml_file, xml_lines
 from walkerlab.export.opensim import (
     check_osim_exportable,
@@ -25,8 +30,12 @@ from walkerlab.export.opensim import (
     osim_text,
 )
 from walkerlab.export.opensim_3d import osim3d_gait, osim3d_omissions, osim3d_text
+from walkerlab.export.opensim_wheel import osim_wheel3d_text, osim_wheel_text
 from walkerlab.export.scene import check_exportable
+from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel3d_keyframe
 from walkerlab.export.tree_links import tree_multibody
+from walkerlab.export.wheel_scene import check_wheel_exportable
+from walkerlab.models.contact.rigid_limit import contact_si
 
 __all__ = ["OSIM", "OsimWriter"]
 
@@ -64,11 +73,37 @@ class OsimWriter(TreeWriter):
                        xml_lines(osim3d_omissions(data, gait), scene), step_period(ideal))
 
     def wheel(self, job: ExportJob, w: Writer) -> Written:
-        """Refused (the capability table's cell)."""
-        planar_legs_only(job, w)
-        raise AssertionError("unreachable")  # pragma: no cover
+        """The planar spoked wheel (:mod:`walkerlab.export.opensim_wheel`): the rigid gait
+        as its default state, the slope's half-space and a Hunt-Crossley force per spoke
+        tip (its other grounds: the capability table's cells)."""
+        if job.walker_only:
+            check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
+            raise ValueError(WALKER_ONLY)
+        _, ideal, key = self.wheel_gait(job, w)
+        c, _ = contact_si(job.scene.contact or ContactSettings())
+        text = osim_wheel_text(job.data, key, c, job.name, walkerlab.__version__)
+        return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 
-    wheel_3d = wheel
+    def wheel_3d(self, job: ExportJob, w: Writer) -> Written:
+        """The spoked wheel in 3D (:func:`walkerlab.export.opensim_wheel.osim_wheel3d_text`):
+        the rigid gait (the MJCF's keyframe, :func:`walkerlab.export.spoked.
+        wheel3d_keyframe`) as its default state, the slope's half-space."""
+        data = job.data
+        job.kind.require("walk", w.view, "walker.space: 3d")
+        check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
+        if job.walker_only:
+            raise ValueError(WALKER_ONLY)
+        c, _ = contact_si(job.scene.contact or ContactSettings())
+        f = functions(data)
+        r = WHEEL_TIP_FRACTION * data.leg_length_m
+
+        def build(ideal):
+            qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
+                                          data.slope_rad, r)
+            return osim_wheel3d_text(data, qpos, qvel, float(ideal.period_s), c, job.name,
+                                     walkerlab.__version__)
+        ideal, text = job.gait(build)
+        return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 
 
 #: the OpenSim writer object

@@ -18,7 +18,8 @@ if TYPE_CHECKING:
     from walkerlab.config.actuation import Actuation
 
 __all__ = ["BISECTOR_FRACTION", "ankle_springs", "bisected_links", "body_set",
-           "contact_forces", "contact_geometry_set",
+           "contact_forces", "contact_geometry_set", "contact_half_space", "contact_sphere",
+           "hunt_crossley_force",
            "joint_set", "knee_stop_forces", "motor_forces", "push_off_forces",
            "spring_forces", "torque_joints", "transform_axis"]
 
@@ -217,6 +218,27 @@ def joint_set(mb, q0: dict, v0: dict, ankles=()) -> list[str]:
     return out + ["\t\t\t</objects>", "\t\t</JointSet>"]
 
 
+def hunt_crossley_force(name: str, geometry: list[str], stiff: float, diss: float,
+                        mu_s: float, mu_d: float, vt: float) -> list[str]:
+    """One ``HuntCrossleyForce`` ``name`` between the contact geometries ``geometry`` (the
+    foot's sphere first), stiffness ``stiff``, dissipation ``diss``, static and dynamic
+    friction ``mu_s``, ``mu_d`` and transition velocity ``vt`` [m/s]
+    (:func:`walkerlab.export.opensim.hunt_crossley`)."""
+    return [f"\t\t\t\t<HuntCrossleyForce name=\"{name}\">",
+            '\t\t\t\t\t<HuntCrossleyForce::ContactParametersSet name="contact_parameters">',
+            "\t\t\t\t\t\t<objects>", "\t\t\t\t\t\t\t<HuntCrossleyForce::ContactParameters>",
+            f"\t\t\t\t\t\t\t\t<geometry>{' '.join(geometry)}</geometry>",
+            f"\t\t\t\t\t\t\t\t<stiffness>{num(stiff)}</stiffness>",
+            f"\t\t\t\t\t\t\t\t<dissipation>{num(diss)}</dissipation>",
+            f"\t\t\t\t\t\t\t\t<static_friction>{num(mu_s)}</static_friction>",
+            f"\t\t\t\t\t\t\t\t<dynamic_friction>{num(mu_d)}</dynamic_friction>",
+            "\t\t\t\t\t\t\t\t<viscous_friction>0</viscous_friction>",
+            "\t\t\t\t\t\t\t</HuntCrossleyForce::ContactParameters>",
+            "\t\t\t\t\t\t</objects>", "\t\t\t\t\t</HuntCrossleyForce::ContactParametersSet>",
+            f"\t\t\t\t\t<transition_velocity>{num(vt)}</transition_velocity>",
+            "\t\t\t\t</HuntCrossleyForce>"]
+
+
 def contact_forces(feet, gait, rg: float | None, stiff: float, diss: float,
                    vt: float) -> list[str]:
     """A ``HuntCrossleyForce`` per foot between its sphere and the ground (or its lane's
@@ -229,20 +251,8 @@ def contact_forces(feet, gait, rg: float | None, stiff: float, diss: float,
             f"{leg}_patch{j}" for j in range(len(gait.lanes[i]))]
         if gait.flat_feet:  # the heel (leg<i>_foot) and the toe
             grounds.insert(0, f"{leg}_toe")
-        out += [f"\t\t\t\t<HuntCrossleyForce name=\"{leg}_contact\">",
-                '\t\t\t\t\t<HuntCrossleyForce::ContactParametersSet name="contact_parameters">',
-                "\t\t\t\t\t\t<objects>", "\t\t\t\t\t\t\t<HuntCrossleyForce::ContactParameters>",
-                f"\t\t\t\t\t\t\t\t<geometry>{leg}_foot {' '.join(grounds)}</geometry>",
-                f"\t\t\t\t\t\t\t\t<stiffness>{num(stiff)}</stiffness>",
-                f"\t\t\t\t\t\t\t\t<dissipation>{num(diss)}</dissipation>",
-                f"\t\t\t\t\t\t\t\t<static_friction>{num(gait.contact.mu_s)}</static_friction>",
-                f"\t\t\t\t\t\t\t\t<dynamic_friction>{num(gait.contact.mu_d)}"
-                "</dynamic_friction>",
-                "\t\t\t\t\t\t\t\t<viscous_friction>0</viscous_friction>",
-                "\t\t\t\t\t\t\t</HuntCrossleyForce::ContactParameters>",
-                "\t\t\t\t\t\t</objects>", "\t\t\t\t\t</HuntCrossleyForce::ContactParametersSet>",
-                f"\t\t\t\t\t<transition_velocity>{num(vt)}</transition_velocity>",
-                "\t\t\t\t</HuntCrossleyForce>"]
+        out += hunt_crossley_force(f"{leg}_contact", [f"{leg}_foot", *grounds], stiff, diss,
+                                   gait.contact.mu_s, gait.contact.mu_d, vt)
     return out
 
 
@@ -343,6 +353,27 @@ def push_off_forces(feet, force: float) -> list[str]:
     return out
 
 
+def contact_sphere(name: str, frame: str, location, radius: float) -> list[str]:
+    """One ``ContactSphere`` ``name`` of radius ``radius`` [m] at ``location`` (x, y) [m] in
+    the frame ``frame`` (``/bodyset/<body>``, ``/ground``)."""
+    return [f"\t\t\t\t<ContactSphere name=\"{name}\">",
+            f"\t\t\t\t\t<socket_frame>{frame}</socket_frame>",
+            f"\t\t\t\t\t<location>{nums(location[0], location[1], 0.0)}</location>",
+            f"\t\t\t\t\t<radius>{num(radius)}</radius>", "\t\t\t\t</ContactSphere>"]
+
+
+def contact_half_space(offset: float, phi: float, n_hat) -> list[str]:
+    """The ground ``ContactHalfSpace`` ``ground``: ``offset`` [m] below the slope line
+    (slope ``phi`` [rad], normal ``n_hat``, up).  OpenSim's half-space fills local x > 0:
+    it is turned so that its normal is ``n_hat``."""
+    p = -offset * n_hat
+    return ['\t\t\t\t<ContactHalfSpace name="ground">',
+            "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
+            f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
+            f"\t\t\t\t\t<orientation>{nums(0.0, 0.0, -math.pi / 2 - phi)}</orientation>",
+            "\t\t\t\t</ContactHalfSpace>"]
+
+
 def contact_geometry_set(feet, gait, r_foot: float, rg: float | None, offset: float,
                          phi: float, t_hat, n_hat) -> list[str]:
     """The ``ContactGeometrySet``: a sphere of radius ``r_foot`` [m] per foot (flat feet:
@@ -358,27 +389,15 @@ def contact_geometry_set(feet, gait, r_foot: float, rg: float | None, offset: fl
             heel, toe = gait.flat_feet[i][:2]
             spheres = [(f"{leg}_foot", f"{leg}_sole", (-heel, 0.0)),
                        (f"{leg}_toe", f"{leg}_sole", (toe, 0.0))]
-        for name, body, (x, y) in spheres:
-            out += [f"\t\t\t\t<ContactSphere name=\"{name}\">",
-                    f"\t\t\t\t\t<socket_frame>/bodyset/{body}</socket_frame>",
-                    f"\t\t\t\t\t<location>{nums(x, y, 0.0)}</location>",
-                    f"\t\t\t\t\t<radius>{num(r_foot)}</radius>",
-                    "\t\t\t\t</ContactSphere>"]
-    if rg is None:  # OpenSim's half-space fills local x > 0: turned so its normal is n_hat
-        p = -offset * n_hat
-        out += ['\t\t\t\t<ContactHalfSpace name="ground">',
-                "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
-                f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
-                f"\t\t\t\t\t<orientation>{nums(0.0, 0.0, -math.pi / 2 - phi)}</orientation>",
-                "\t\t\t\t</ContactHalfSpace>"]
+        for name, body, xy in spheres:
+            out += contact_sphere(name, f"/bodyset/{body}", xy, r_foot)
+    if rg is None:
+        out += contact_half_space(offset, phi, n_hat)
     else:
         for i, ln in enumerate(feet):
             leg = ln.name.split("_")[0]
             for j, s in enumerate(gait.lanes[i]):
                 h = 0.0 if gait.lane_heights is None else gait.lane_heights[i][j]
                 p = s * t_hat + (h - offset - rg) * n_hat
-                out += [f"\t\t\t\t<ContactSphere name=\"{leg}_patch{j}\">",
-                        "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
-                        f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
-                        f"\t\t\t\t\t<radius>{num(rg)}</radius>", "\t\t\t\t</ContactSphere>"]
+                out += contact_sphere(f"{leg}_patch{j}", "/ground", p, rg)
     return out + ["\t\t\t</objects>", "\t\t</ContactGeometrySet>"]

@@ -23,7 +23,8 @@ from walkerlab.export.text import comment, num, nums
 
 __all__ = ["TO_MUJOCO", "WHEEL_3D_GROUND_HALF_WIDTH", "WHEEL_TIP_FRACTION",
            "WHEEL_URDF_OMISSIONS", "wheel3d_keyframe", "wheel3d_mjcf_text", "wheel3d_urdf_text",
-           "wheel_chord_m", "wheel_mjcf_text", "wheel_urdf_text"]
+           "spoke_point", "wheel_chord_m", "wheel_mjcf_text", "wheel_numbers",
+           "wheel_urdf_text"]
 
 #: Radius of a rimless wheel's tip spheres as a fraction of its spoke length [-] (the point
 #: feet's ``L/1000``, :func:`walkerlab.export.mjcf_scene.point_foot_radius`).
@@ -34,7 +35,7 @@ WHEEL_TIP_FRACTION = 1e-3
 WHEEL_3D_GROUND_HALF_WIDTH = 2.0
 
 
-def _wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
+def wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
     """A spoked wheel's numbers by name (:data:`walkerlab.walker.description.SPOKED_PARAMS`)
     with its hub inertia [kg m^2]: the walker's, else ``hub_inertia_kg_m2`` (the contact
     view's regularisation), else :data:`MJCF_MIN_INERTIA_KG_M2`."""
@@ -49,11 +50,11 @@ def _wheel_numbers(data, hub_inertia_kg_m2: float | None) -> dict:
 def wheel_chord_m(data) -> float:
     """The distance [m] between two neighbouring spoke tips of a spoked wheel,
     ``2 L sin(pi / spokes)`` (where its footfalls lie apart; McGeer 1990)."""
-    p = _wheel_numbers(data, None)
+    p = wheel_numbers(data, None)
     return 2.0 * p["L"] * math.sin(math.pi / p["n"])
 
 
-def _spoke_tip(p: dict, k: int, to: float) -> tuple[float, float]:
+def spoke_point(p: dict, k: int, to: float) -> tuple[float, float]:
     """(x, z) [m] in the hub's frame of the point at ``to`` [m] along spoke ``k`` (wheel
     angle 0: spoke 0 hangs straight down; spoke k at ``2 pi k / n`` ahead of it)."""
     psi = 2.0 * math.pi * k / p["n"]
@@ -61,13 +62,13 @@ def _spoke_tip(p: dict, k: int, to: float) -> tuple[float, float]:
 
 
 def _urdf_spokes(p: dict) -> list[str]:
-    """Each spoke of a wheel (numbers :func:`_wheel_numbers`) as a URDF cylinder (visual) and
+    """Each spoke of a wheel (numbers :func:`wheel_numbers`) as a URDF cylinder (visual) and
     its tip's sphere (collision), in the hub link's frame."""
     L, r, n = p["L"], p["r"], p["n"]
     out = []
     for k in range(n):
-        mx, mz = _spoke_tip(p, k, (L - r) / 2)
-        tx, tz = _spoke_tip(p, k, L - r)
+        mx, mz = spoke_point(p, k, (L - r) / 2)
+        tx, tz = spoke_point(p, k, L - r)
         pitch = -2.0 * math.pi * k / n  # the cylinder's z axis turned onto the spoke
         out += [f'    <visual name="spoke{k}"><origin xyz="{nums(mx, 0, mz)}" '
                 f'rpy="0 {num(pitch)} 0"/><geometry><cylinder radius="{num(L / 100)}" '
@@ -104,7 +105,7 @@ def _mjcf_spokes(p: dict, pad: str) -> list[str]:
     L, r = p["L"], p["r"]
     out = []
     for k in range(p["n"]):
-        tx, tz = _spoke_tip(p, k, L - r)
+        tx, tz = spoke_point(p, k, L - r)
         out += [f'{pad}<geom name="spoke{k}" type="capsule" size="{num(L / 100)}" '
                 f'fromto="0 0 0 {nums(tx, 0, tz)}"/>',
                 f'{pad}<geom name="spoke{k}_tip" type="sphere" size="{num(r)}" '
@@ -151,7 +152,7 @@ def wheel_urdf_text(data, name: str, version: str = "",
     str
         URDF XML (ROS URDF XML specification).
     """
-    p = _wheel_numbers(data, hub_inertia_kg_m2)
+    p = wheel_numbers(data, hub_inertia_kg_m2)
     out = ['<?xml version="1.0"?>', *_wheel_header(name, "URDF", version, p, data.slope_rad),
            *xml_comments(WHEEL_URDF_OMISSIONS), f"<robot name={quoteattr(name)}>",
            '  <link name="world"/>',
@@ -205,7 +206,7 @@ def wheel_mjcf_text(data, name: str, version: str = "", hub_inertia_kg_m2: float
     """
     from walkerlab.export.tree_bodies import ExportJoint  # light: sympy with the bodies
 
-    p = _wheel_numbers(data, hub_inertia_kg_m2)
+    p = wheel_numbers(data, hub_inertia_kg_m2)
     phi = data.slope_rad
     joints = [ExportJoint("hip_x", "slide", (1.0, 0.0, 0.0)),
               ExportJoint("hip_z", "slide", (0.0, 0.0, 1.0)),
@@ -312,7 +313,7 @@ def wheel3d_mjcf_text(data, name: str, version: str = "", qpos=None, qvel=None,
     """
     from walkerlab.export.tree_bodies import ExportJoint  # light: sympy with the bodies
 
-    p = _wheel_numbers(data, None)
+    p = wheel_numbers(data, None)
     n, L, phi, I_axle = p["n"], p["L"], data.slope_rad, p["I_hub"]
     head = comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (MJCF): "
                    f"{n} spokes of {num(L)} m, hub {num(p['M_hub'])} kg, inertia "
@@ -348,7 +349,7 @@ def wheel3d_urdf_text(data, name: str, version: str = "") -> str:
     str
         URDF XML (ROS URDF XML specification).
     """
-    p = _wheel_numbers(data, None)
+    p = wheel_numbers(data, None)
     n, L, I_axle = p["n"], p["L"], p["I_hub"]
     out = ['<?xml version="1.0"?>',
            comment(f"rimless wheel {name!s} in 3D exported by walkerlab {version} (URDF): "

@@ -19,9 +19,9 @@ __all__ = ["WHEEL_FORMATS", "WheelKeyframe", "check_wheel_exportable", "wheel_ke
 
 #: The formats whose writers take a walker that is one rigid body on its spokes (a
 #: spoked wheel: :func:`walkerlab.export.spoked.wheel_urdf_text`, ``wheel_mjcf_text``,
-#: :func:`walkerlab.export.adams_wheel.adm_wheel_text`); the OpenSim writer builds a tree of
-#: leg links.
-WHEEL_FORMATS = ("urdf", "mjcf", "adm")
+#: :func:`walkerlab.export.adams_wheel.adm_wheel_text`,
+#: :func:`walkerlab.export.opensim_wheel.osim_wheel_text`, ``osim_wheel3d_text``).
+WHEEL_FORMATS = ("urdf", "mjcf", "adm", "osim")
 
 
 def check_wheel_exportable(scene: Scene, kind: Kind, fmt: str,
@@ -32,8 +32,8 @@ def check_wheel_exportable(scene: Scene, kind: Kind, fmt: str,
     Raises
     ------
     walkerlab.walker.kinds.KindRefused
-        One line naming the field: ``walker.model`` for a format other than
-        :data:`WHEEL_FORMATS` (the OpenSim writer builds leg links);
+        One line naming the field: ``walker.model`` for a format whose cell refuses the
+        wheel;
         ``terrain.kind`` for a ground other than the slope where the format's cell of that
         ground refuses it, unless ``walker_only``.
     """

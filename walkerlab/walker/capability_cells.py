@@ -10,7 +10,7 @@ that names a cell's reason itself (a refusal of its own, a test) imports it from
 
 from __future__ import annotations
 
-__all__ = ["CAPABILITIES", "CELL_NOTES", "EXPORT_3D", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
+__all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
@@ -113,9 +113,10 @@ ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) h
                       "R sin(lean) across the disc's rim point once the leg's plane leans, so "
                       "it rolls sideways where the rigid disc cannot; export the disc feet "
                       "as MJCF (--format mjcf) or an Adams dataset")
-#: why the OpenSim export refuses the 3D spoked wheel
-EXPORT_3D = ("the OpenSim export writes legs (a tree of leg links, or the 3D legs' "
-             "pelvis and legs); a spoked wheel (one rigid body) is exported as urdf or mjcf")
+#: why the spoked wheels' OpenSim models refuse a ground other than the slope
+_OSIM_WHEEL_GROUNDS = ("the OpenSim export writes the spoked wheel on the slope's "
+                       "half-space only (no treads, footfall patches or profile); "
+                       "--format mjcf or adm writes them")
 #: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
 #: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
 KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
@@ -295,8 +296,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (a box per tread) or a profile (a box per segment)
         # (walkerlab.export.adams_wheel.adm_wheel_text)
         ("footholds", "adams"): None,
-        ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
-                           "(one rigid body) is exported as urdf or mjcf"),
+        # the OpenSim model: the hub on its spoke tips, a Hunt-Crossley force per tip on the
+        # slope's half-space (walkerlab.export.opensim_wheel); its other grounds are not
+        # written
+        **{(g, "osim"): _OSIM_WHEEL_GROUNDS for g in ("stairs", "footholds", "profile")},
         ("walk", "gym"): _WHEEL_GYM,
         # footholds on continuous ground (the wheel's): a tread through each landing,
         # risers half-way (walkerlab.models.contact.terrain.footholds_line)
@@ -478,7 +481,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # walkerlab.export.adams_wheel.adm_wheel_text)
         ("walk", "gym"): _WHEEL_GYM,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
-        ("walk", "osim"): EXPORT_3D,
+        # the OpenSim model: the hub on six coordinates, a Hunt-Crossley force per spoke
+        # tip on the slope's half-space (walkerlab.export.opensim_wheel)
+        **{(g, "osim"): _OSIM_WHEEL_GROUNDS for g in ("stairs", "footholds")},
     },
 }
 
