@@ -154,33 +154,108 @@ def test_wheel3d_state_angles_compose_the_keyframes_orientation_and_spin():
     assert [st[n][1] for n in ("hip_x", "hip_y", "hip_z")] == pytest.approx([1.0, 3.0, -2.0])
 
 
-@pytest.mark.parametrize("scene, field", [
-    ("configs/rimless_wheel_3d_disc_stairs.yaml", "terrain.kind: stairs"),
-    ({}, "terrain.kind: stairs")])
-def test_wheel_osim_refuses_other_grounds_in_one_line(scene, field, tmp_path):
-    """The 3D and the planar wheel on stairs: one line naming the field (the capability
-    table's cells), nothing written."""
-    if isinstance(scene, dict):  # the capability table's reference case of the cell
-        from walkerlab.walker.reference_cases import reference_scene
+def _patches(model) -> dict[str, tuple[np.ndarray, float]]:
+    """Each ground sphere's (centre (2,), radius) by name."""
+    return {s.get("name"): (np.array(_floats(s.find("location").text)[:2]),
+                            float(s.find("radius").text))
+            for s in model.iter("ContactSphere") if "_patch" in s.get("name")}
 
-        scene = scene_from_dict(reference_scene("rolling_polygon", "stairs", "osim")[1])
-    else:
-        scene = load_scene(scene)
+
+def _lane_checks(model, tops: list[np.ndarray], nrm: np.ndarray) -> float:
+    """The spheres ``spoke<k>_patch<m>`` are the footfalls ``tops`` (from the one behind
+    the first stance tip), footfall ``j`` spoke ``j mod N``'s ``m``-th, their tops at the
+    footfalls along ``nrm``; each spoke's force touches its own lane only, no half-space.
+    Returns the spheres' one radius."""
+    got = _patches(model)
+    seen = dict.fromkeys(range(N), 0)
+    radii = set()
+    for j, top in enumerate(tops, start=-1):
+        k = j % N
+        centre, rg = got.pop(f"spoke{k}_patch{seen[k]}")
+        seen[k] += 1
+        assert centre + rg * nrm == pytest.approx(top, abs=1e-12), j
+        radii.add(rg)
+    assert not got and len(radii) == 1
+    assert model.find(".//ContactHalfSpace") is None
+    forces = {f.get("name"): f.find(".//geometry").text.split()
+              for f in model.iter("HuntCrossleyForce")}
+    assert forces == {f"spoke{k}_contact": [f"spoke{k}_foot"]
+                      + [f"spoke{k}_patch{m}" for m in range(seen[k])] for k in range(N)}
+    return radii.pop()
+
+
+def test_wheel_osim_on_stairs_puts_a_sphere_top_on_each_footfall_of_its_tread(tmp_path):
+    """configs/rimless_wheel_3d_disc_stairs.yaml (0.152 m risers, 0.750 m treads, the
+    first stance tip mid-tread 0): footfall ``j`` lies ``j`` chords ``2 L sin(pi/N)`` from the
+    first along the line that drops one riser per ``sqrt(c^2 - riser^2)`` of run, its
+    height tread ``j``'s (``-j riser``, the tread that holds its x); a sphere's top at
+    each; the radius the legs' rule ``d^2 / (2 (riser + 2 r))``, ``d = c / 3``."""
+    out = export_stage.write(load_scene("configs/rimless_wheel_3d_disc_stairs.yaml"),
+                             tmp_path, "osim")
+    model = ET.fromstring(out.path.read_text().replace("::", "__")).find("Model")
+    riser, tread, c = 0.152, 0.750, 2 * L * math.sin(math.pi / N)
+    run = math.sqrt(c * c - riser * riser)
+    tops = []
+    for j in range(-1, 61):
+        x = j * run
+        i = math.floor((x + tread / 2) / tread)      # the tread under it (0: [-D/2, D/2))
+        assert i == j
+        tops.append(np.array([x, -i * riser]))
+    assert all(np.linalg.norm(b - a) == pytest.approx(c, rel=1e-12)
+               for a, b in zip(tops, tops[1:]))
+    rg = _lane_checks(model, tops, np.array([0.0, 1.0]))
+    assert rg == pytest.approx((c / 3) ** 2 / (2 * (riser + 2 * L / 1000)), rel=1e-12)
+
+
+def test_wheel_osim_on_footholds_puts_a_sphere_top_on_each_footfall(tmp_path):
+    """The planar wheel's footholds cell (configs/rimless_wheel.yaml, footholds 5 mm below
+    and above its 0.08 rad slope in turn, 0.3 m patches): footfall ``j + 1`` a chord from
+    footfall ``j``, ``h_j`` (-5 mm, +5 mm, ...) above its level along the vertical, i.e.
+    ``h_j cos(phi)`` along the slope's normal; a sphere's top at each along the normal."""
+    from walkerlab.walker.reference_cases import reference_scene
+
+    scene = scene_from_dict(reference_scene("rolling_polygon", "footholds", "osim")[1])
+    out = export_stage.write(scene, tmp_path, "osim")
+    model = ET.fromstring(out.path.read_text().replace("::", "__")).find("Model")
+    c = 2 * L * math.sin(math.pi / N)
+    t, nrm = np.array([math.cos(PHI), -math.sin(PHI)]), np.array([math.sin(PHI), math.cos(PHI)])
+    heights = (-0.005, 0.005)
+
+    def step(j):
+        up = heights[j % 2] * math.cos(PHI)
+        return math.sqrt(c * c - up * up) * t + up * nrm
+    tops = [-step(-1), np.zeros(2)]
+    for j in range(60):
+        tops.append(tops[-1] + step(j))
+    rg = _lane_checks(model, tops, nrm)
+    assert rg == pytest.approx((c / 3) ** 2 / (2 * (0.005 * math.cos(PHI) + 2 * L / 1000)),
+                               rel=1e-12)
+
+
+def test_wheel_osim_refuses_a_profile_in_one_line(tmp_path):
+    """The planar wheel on a profile: one line naming the field (the capability table's
+    cell, the legs' OpenSim profile refusal), nothing written."""
+    from walkerlab.walker.reference_cases import reference_scene
+
+    scene = scene_from_dict(reference_scene("rolling_polygon", "profile", "mjcf")[1])
     with pytest.raises(ValueError) as err:
         export_stage.run(scene, tmp_path, "osim")
     msg = str(err.value)
-    assert msg.startswith(field) and "\n" not in msg
+    assert msg.startswith("terrain.kind: profile") and "\n" not in msg
+    assert "polyline" in msg
     assert not any(tmp_path.rglob("*.osim"))
 
 
 @pytest.mark.slow
 @needs_opensim
-@pytest.mark.parametrize("name", ["rimless_wheel", "rimless_wheel_3d_disc"])
+@pytest.mark.parametrize("name", ["rimless_wheel", "rimless_wheel_3d_disc",
+                                  "rimless_wheel_3d_disc_stairs"])
 def test_wheel_osim_rolls_in_opensim_within_3_percent(name, tmp_path):
     """OpenSim's Manager rolls the wheel from its default state (walkerlab's loop reading
     each spoke's Hunt-Crossley force): 10 or more spoke strikes, each by the next spoke, no
     fall, the mean step period within 3 % of the rigid gait's (the capability table's
-    OpenSim tolerance; measured -0.54 % and -0.11 %)."""
+    OpenSim tolerance; measured -0.54 %, -0.11 % and down the stairs, on a sphere per
+    footfall, -0.13 %)."""
     from walkerlab.export.engine_walk import walk_export
 
     out = export_stage.write(load_scene(f"configs/{name}.yaml"), tmp_path, "osim")

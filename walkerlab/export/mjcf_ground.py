@@ -188,7 +188,9 @@ def wheel_ground(terrain, spoke_length_m: float, n_treads: int = 60, chord_m: fl
 
 
 def wheel_footfalls(terrain, c: float, phi: float, n: int) -> dict[int, np.ndarray]:
-    """Where a spoked wheel's tips land on footholds (:func:`wheel_ground`'s rule): footfall
+    """Where a spoked wheel's tips land on footholds (:func:`wheel_ground`'s rule; the Adams
+    dataset's footholds, the OpenSim model's patches on stairs and footholds,
+    :func:`walkerlab.export.opensim_wheel.wheel_patches`, stairs a riser a step): footfall
     ``k`` [m] (2,) in the world (x downhill, up), footfall 0 (the first stance tip) at the
     origin, footfall -1 behind it, up to ``n`` (a finite list, ``periodic: false``: its own
     footfalls); two tips a chord ``c`` [m] apart, step ``k`` landing ``h_k`` above the

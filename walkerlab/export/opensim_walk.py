@@ -98,7 +98,7 @@ class OpensimWalk(MujocoWalk):
     """Heel strikes and the centre of mass of an OpenSim run: a
     :class:`walkerlab.export.mujoco_walk.MujocoWalk` (``times_s`` the end of the window in
     which the contact began; ``fell``: the hip below half its starting height above the
-    slope) with
+    slope, a wheel's hub above its stance spoke's tip, as the MJCF's roll reads it) with
 
     Attributes
     ----------
@@ -481,7 +481,14 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     def com_along(s):
         return float(model.calcMassCenterPosition(s).to_numpy()[:2] @ t_hat)
 
-    h0 = hip_x.getValue(state) * n_hat[0] + hip_y.getValue(state) * n_hat[1]
+    def hub_height(s):  # the hip above the slope line; a wheel's hub above its stance tip
+        h = hip_x.getValue(s) * n_hat[0] + hip_y.getValue(s) * n_hat[1]  # (stairs: a riser
+        if stance.startswith("spoke"):  # a step, the ground under the hub is the tip's)
+            h -= bodies[stance].findStationLocationInGround(s, foot_loc[stance]).to_numpy(
+            )[:2] @ n_hat
+        return float(h)
+
+    h0 = hub_height(state)
     method = getattr(osim.Manager, f"IntegratorMethod_{integrator}")
 
     def new_manager():
@@ -548,8 +555,7 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
             air[g] = 0.0 if now else air[g] + step
             on[g] = now
         model.realizeDynamics(state)  # after a switch
-        hip_h = hip_x.getValue(state) * n_hat[0] + hip_y.getValue(state) * n_hat[1]
-        if hip_h < 0.5 * h0:
+        if hub_height(state) < 0.5 * h0:
             fell = True
             break
     return OpensimWalk(times_s=np.array(times), legs=legs, positions_m=np.array(feet_at),

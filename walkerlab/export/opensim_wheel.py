@@ -22,18 +22,26 @@ SCENE --format osim``: ``walker.osim``), in the frame of the legged walkers' Ope
   spoke strike (spoke 0 in stance, its tip at the origin: the MJCF's ``gait`` keyframe,
   :func:`walkerlab.export.wheel_scene.wheel_keyframe`).
 
-Stairs, footholds and profiles are not written (the capability table's cells): the ground
-is the slope's half-space.
+On stairs and footholds (:func:`wheel_patches`) the ground is a ``ContactSphere`` per
+footfall of the rigid wheel's spoke tips (:func:`walkerlab.export.mjcf_ground.wheel_footfalls`,
+the MJCF's and the Adams dataset's footfalls: two tips a chord apart, each landing a riser or
+foothold height from the last), its top at the footfall, of the legs' patch radius on stairs
+and footholds (:func:`walkerlab.export.opensim_contact.terrain_patch_radius`); footfall ``j``
+is spoke ``j mod n``'s (the rigid wheel strikes with each next spoke): ``spoke<k>_patch<m>``,
+spoke ``k``'s lane, which its force alone touches (the legs' lanes).  A profile is not
+written (the capability table's cell).
 """
 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from walkerlab.export.opensim_contact import hunt_crossley
+from walkerlab.export.mjcf_ground import wheel_footfalls
+from walkerlab.export.opensim_contact import hunt_crossley, terrain_patch_radius
 from walkerlab.export.opensim_xml import (
     _body,
     _coordinate,
@@ -42,16 +50,44 @@ from walkerlab.export.opensim_xml import (
     hunt_crossley_force,
     transform_axis,
 )
-from walkerlab.export.spoked import TO_MUJOCO, spoke_point, wheel_numbers
+from walkerlab.export.spoked import TO_MUJOCO, spoke_point, wheel_chord_m, wheel_numbers
 from walkerlab.export.text import comment, num, nums
 
-__all__ = ["osim_wheel3d_state", "osim_wheel3d_text", "osim_wheel_text"]
+__all__ = ["WHEEL_FOOTFALLS", "osim_wheel3d_state", "osim_wheel3d_text", "osim_wheel_text",
+           "wheel_patches"]
 
 #: OpenSim's document version written (:data:`walkerlab.export.opensim.DOCUMENT_VERSION`)
 DOCUMENT_VERSION = 40600
+#: Footfalls ahead of the first stance tip laid as patches on stairs and footholds (the
+#: MJCF's treads' count, :func:`walkerlab.export.mjcf_ground.wheel_ground`)
+WHEEL_FOOTFALLS = 60
 
 
-def osim_wheel_text(data, key, contact, name: str, version: str = "") -> str:
+def wheel_patches(terrain, data, footfalls: int = WHEEL_FOOTFALLS
+                  ) -> tuple[list[tuple[int, np.ndarray]], float]:
+    """A spoked wheel's ground on stairs or footholds as OpenSim patches (module
+    docstring): ``([(spoke, top (2,) [m]), ...], radius [m])``, one per footfall from the
+    one behind the first stance tip (the last spoke's) to ``footfalls`` ahead, each top
+    the footfall in the model's (x downhill, y up) frame
+    (:func:`walkerlab.export.mjcf_ground.wheel_footfalls`;
+    each sphere's centre lies the radius below it along the slope's normal), the radius
+    the legs' on stairs and footholds (:func:`walkerlab.export.opensim_contact.
+    terrain_patch_radius`: the patch width, the largest rise between consecutive
+    footfalls, the chord as the step)."""
+    p = wheel_numbers(data, None)
+    phi = data.slope_rad   # stairs: 0 (level treads, the scene's check)
+    chord = wheel_chord_m(data)
+    falls = wheel_footfalls(terrain, chord, phi, footfalls)
+    t, nrm = np.array([math.cos(phi), -math.sin(phi)]), np.array([math.sin(phi), math.cos(phi)])
+    ks = sorted(falls)
+    lane = SimpleNamespace(patch_width_m=float(terrain.patch_width_m), flat_feet=None,
+                           lanes=([float(falls[k] @ t) for k in ks],),
+                           lane_heights=([float(falls[k] @ nrm) for k in ks],),
+                           step_length_m=chord)
+    return [(k % p["n"], falls[k]) for k in ks], terrain_patch_radius(lane, p["r"])
+
+
+def osim_wheel_text(data, key, contact, name: str, version: str = "", terrain=None) -> str:
     """The planar spoked wheel's OpenSim model (module docstring).
 
     Parameters
@@ -65,6 +101,8 @@ def osim_wheel_text(data, key, contact, name: str, version: str = "") -> str:
         The scene's contact law in SI.
     name, version : str
         The model's name, walkerlab's version (the header comment).
+    terrain : walkerlab.config.TerrainSettings, optional
+        Stairs or footholds (:func:`wheel_patches`); None or the slope: its half-space.
 
     Returns
     -------
@@ -81,7 +119,7 @@ def osim_wheel_text(data, key, contact, name: str, version: str = "") -> str:
                     "hip_x, hip_y (the hub's position [m]) and wheel (spoke 0's angle from the "
                     "downward vertical about z [rad], positive = its tip ahead of the hub).")
     return _document(data, p, (p["I_hub"],) * 3, state, axes, frame, key.period_s, contact,
-                     name, version, "rimless wheel")
+                     name, version, "rimless wheel", terrain)
 
 
 def osim_wheel3d_state(qpos, qvel) -> list[tuple[str, float, float]]:
@@ -110,7 +148,7 @@ def osim_wheel3d_state(qpos, qvel) -> list[tuple[str, float, float]]:
 
 
 def osim_wheel3d_text(data, qpos, qvel, period_s: float, contact, name: str,
-                      version: str = "") -> str:
+                      version: str = "", terrain=None) -> str:
     """The spoked wheel in 3D (``walker.space: 3d``) as an OpenSim model: the planar
     wheel's (module docstring) with its hub on a ``CustomJoint`` ``base`` of six
     coordinates (:func:`osim_wheel3d_state`: ``heading``, ``lean``, ``spin``, then
@@ -125,7 +163,7 @@ def osim_wheel3d_text(data, qpos, qvel, period_s: float, contact, name: str,
         Its MJCF ``gait`` keyframe (:func:`walkerlab.export.spoked.wheel3d_keyframe`).
     period_s : float
         The rigid gait's step period [s].
-    contact, name, version
+    contact, name, version, terrain
         As :func:`osim_wheel_text`.
     """
     p = wheel_numbers(data, None)
@@ -138,19 +176,25 @@ def osim_wheel3d_text(data, qpos, qvel, period_s: float, contact, name: str,
                     "the axle) [rad]; the spokes in the body's x-y plane.")
     return _document(data, p, (p["I_diam"], p["I_diam"], p["I_hub"]),
                      osim_wheel3d_state(qpos, qvel), axes, frame, period_s, contact, name,
-                     version, "rimless wheel in 3D")
+                     version, "rimless wheel in 3D", terrain)
 
 
 def _document(data, p: dict, inertia, state, axes, frame: str, period_s: float, contact,
-              name: str, version: str, what: str) -> str:
+              name: str, version: str, what: str, terrain=None) -> str:
     """A spoked wheel's ``OpenSimDocument``: the hub (numbers ``p``,
     :func:`walkerlab.export.spoked.wheel_numbers`; principal moments ``inertia``) on the
     ``CustomJoint`` ``base`` with the ``TransformAxis`` triples ``axes`` and the coordinates
     ``state`` (name, default value, default speed), the frame's comment ``frame``, a
-    contact sphere and a ``HuntCrossleyForce`` per spoke tip, the slope's half-space."""
+    contact sphere and a ``HuntCrossleyForce`` per spoke tip, the slope's half-space (on
+    stairs and footholds ``terrain``: each spoke's lane of patches, :func:`wheel_patches`)."""
     phi, g, n, L, r = data.slope_rad, p["g"], p["n"], p["L"], p["r"]
     n_hat = np.array([math.sin(phi), math.cos(phi)])
-    stiff, diss, vt, note = hunt_crossley(contact, p["M_hub"] * g * math.cos(phi), r)
+    patches, rg = (None, None) if terrain is None or terrain.is_slope else \
+        wheel_patches(terrain, data)
+    lanes = {k: [f"spoke{k}_patch{m}" for m in range(sum(s == k for s, _ in patches or ()))]
+             for k in range(n)}
+    r_eff = r if rg is None else r * rg / (r + rg)
+    stiff, diss, vt, note = hunt_crossley(contact, p["M_hub"] * g * math.cos(phi), r_eff)
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
            f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
            comment(f"{what} {name!s} exported by walkerlab {version} (OpenSim model)."),
@@ -167,6 +211,12 @@ def _document(data, p: dict, inertia, state, axes, frame: str, period_s: float, 
                    f"(spoke 0 in stance, its tip at the origin): step period "
                    f"{period_s:.8g} s."),
            comment(note),
+           *([] if patches is None else [comment(
+               f"Ground: {terrain.kind}, a ContactSphere spoke<k>_patch<m> of radius "
+               f"{num(rg)} m per footfall of the rigid wheel's spoke tips (two tips a chord "
+               f"{num(wheel_chord_m(data))} m apart), its top at the footfall; footfall j "
+               f"is spoke (j mod {n})'s, its lane, from the one behind the first stance tip "
+               f"(spoke {n - 1}'s); no half-space.")]),
            f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>",
            '\t\t<BodySet name="bodyset">', "\t\t\t<objects>",
            *_body("hub", p["M_hub"], (0.0, 0.0), 0.0)[:3],
@@ -186,13 +236,20 @@ def _document(data, p: dict, inertia, state, axes, frame: str, period_s: float, 
             "\t\t\t</objects>", "\t\t</JointSet>",
             '\t\t<ForceSet name="forceset">', "\t\t\t<objects>"]
     for k in range(n):
-        out += hunt_crossley_force(f"spoke{k}_contact", [f"spoke{k}_foot", "ground"], stiff,
+        ground = ["ground"] if patches is None else lanes[k]
+        out += hunt_crossley_force(f"spoke{k}_contact", [f"spoke{k}_foot", *ground], stiff,
                                    diss, contact.mu_s, contact.mu_d, vt)
     out += ["\t\t\t</objects>", "\t\t</ForceSet>",
             '\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
     for k in range(n):
         out += contact_sphere(f"spoke{k}_foot", "/bodyset/hub", spoke_point(p, k, L - r), r)
-    out += contact_half_space(0.0, phi, n_hat)
+    if patches is None:
+        out += contact_half_space(0.0, phi, n_hat)
+    else:
+        seen = {k: 0 for k in range(n)}
+        for k, top in patches:
+            out += contact_sphere(f"spoke{k}_patch{seen[k]}", "/ground", top - rg * n_hat, rg)
+            seen[k] += 1
     out += ["\t\t\t</objects>", "\t\t</ContactGeometrySet>",
             "\t</Model>", "</OpenSimDocument>", ""]
     return "\n".join(out)

@@ -74,20 +74,23 @@ class OsimWriter(TreeWriter):
 
     def wheel(self, job: ExportJob, w: Writer) -> Written:
         """The planar spoked wheel (:mod:`walkerlab.export.opensim_wheel`): the rigid gait
-        as its default state, the slope's half-space and a Hunt-Crossley force per spoke
-        tip (its other grounds: the capability table's cells)."""
+        as its default state, the slope's half-space (stairs and footholds: a patch per
+        footfall, :func:`walkerlab.export.opensim_wheel.wheel_patches`; a profile: the
+        capability table's cell) and a Hunt-Crossley force per spoke tip."""
         if job.walker_only:
             check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
             raise ValueError(WALKER_ONLY)
         _, ideal, key = self.wheel_gait(job, w)
         c, _ = contact_si(job.scene.contact or ContactSettings())
-        text = osim_wheel_text(job.data, key, c, job.name, walkerlab.__version__)
+        text = osim_wheel_text(job.data, key, c, job.name, walkerlab.__version__,
+                               job.scene.terrain)
         return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 
     def wheel_3d(self, job: ExportJob, w: Writer) -> Written:
         """The spoked wheel in 3D (:func:`walkerlab.export.opensim_wheel.osim_wheel3d_text`):
         the rigid gait (the MJCF's keyframe, :func:`walkerlab.export.spoked.
-        wheel3d_keyframe`) as its default state, the slope's half-space."""
+        wheel3d_keyframe`) as its default state, the slope's half-space or the planar
+        wheel's patches."""
         data = job.data
         job.kind.require("walk", w.view, "walker.space: 3d")
         check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
@@ -101,7 +104,7 @@ class OsimWriter(TreeWriter):
             qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
                                           data.slope_rad, r)
             return osim_wheel3d_text(data, qpos, qvel, float(ideal.period_s), c, job.name,
-                                     walkerlab.__version__)
+                                     walkerlab.__version__, job.scene.terrain)
         ideal, text = job.gait(build)
         return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 

@@ -113,10 +113,6 @@ ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) h
                       "R sin(lean) across the disc's rim point once the leg's plane leans, so "
                       "it rolls sideways where the rigid disc cannot; export the disc feet "
                       "as MJCF (--format mjcf) or an Adams dataset")
-#: why the spoked wheels' OpenSim models refuse a ground other than the slope
-_OSIM_WHEEL_GROUNDS = ("the OpenSim export writes the spoked wheel on the slope's "
-                       "half-space only (no treads, footfall patches or profile); "
-                       "--format mjcf or adm writes them")
 #: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
 #: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
 KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
@@ -297,9 +293,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # (walkerlab.export.adams_wheel.adm_wheel_text)
         ("footholds", "adams"): None,
         # the OpenSim model: the hub on its spoke tips, a Hunt-Crossley force per tip on the
-        # slope's half-space (walkerlab.export.opensim_wheel); its other grounds are not
-        # written
-        **{(g, "osim"): _OSIM_WHEEL_GROUNDS for g in ("stairs", "footholds", "profile")},
+        # slope's half-space, on stairs and footholds on a sphere per footfall, its top at
+        # the footfall (walkerlab.export.opensim_wheel.wheel_patches); a profile as the
+        # legs' (spheres following a polyline)
+        **{(g, "osim"): None for g in ("stairs", "footholds")},
+        ("profile", "osim"): _OSIM_PROFILE,
         ("walk", "gym"): _WHEEL_GYM,
         # footholds on continuous ground (the wheel's): a tread through each landing,
         # risers half-way (walkerlab.models.contact.terrain.footholds_line)
@@ -482,8 +480,9 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         ("walk", "gym"): _WHEEL_GYM,
         ("walk", "optimize"): _WHEEL_OPTIMIZE,
         # the OpenSim model: the hub on six coordinates, a Hunt-Crossley force per spoke
-        # tip on the slope's half-space (walkerlab.export.opensim_wheel)
-        **{(g, "osim"): _OSIM_WHEEL_GROUNDS for g in ("stairs", "footholds")},
+        # tip on the slope's half-space, on stairs and footholds the planar wheel's patches
+        # (walkerlab.export.opensim_wheel)
+        **{(g, "osim"): None for g in ("stairs", "footholds")},
     },
 }
 
