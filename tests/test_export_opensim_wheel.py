@@ -4,7 +4,10 @@ numbers checked against the scene here (no walkerlab export code), and its walk 
 (skips without the ``osim`` extra), and the 3D wheel's (configs/rimless_wheel_3d_disc.yaml).
 Measured (OpenSim 4.6, CPodes): the planar wheel 11 spoke strikes, each by the next spoke,
 in 11.69 s, mean step period 1.02895 s against the rigid gait's 1.03455 s (-0.54 %); the 3D
-disc wheel 11 in 4.477 s, 0.39575 s against 0.396183 s (-0.11 %).
+disc wheel 11 in 4.477 s, 0.39575 s against 0.396183 s (-0.11 %), down its stairs
+(configs/rimless_wheel_3d_disc_stairs.yaml, a sphere per footfall) 11 in 4.478 s, 0.39575 s
+against 0.396268 s (-0.13 %).  On stairs and footholds the ground spheres' tops are checked
+against the footfalls computed here from the treads and the spoke tips' chord.
 """
 
 from __future__ import annotations
