@@ -150,8 +150,9 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
     tolerance : float
         Relative step-period tolerance.
     spokes : bool
-        A spoked wheel: its spoke strikes (the MJCF's :func:`walkerlab.export.mujoco_walk.
-        roll`, the OpenSim model's spoke touchdowns) instead of two legs' heel strikes.
+        A spoked wheel: its spoke strikes (the MJCF's
+        :func:`walkerlab.export.mujoco_walk.roll`, the OpenSim model's spoke touchdowns)
+        instead of two legs' heel strikes.
     feedback : walkerlab.export.mujoco_walk.VirtualConstraintFeedback, optional
         The scene's virtual constraints (the MJCF's stepping loop evaluates them).
 

@@ -1,6 +1,7 @@
-"""A spoked wheel (``model: rimless_wheel``, planar or in 3D: :func:`osim_wheel3d_text`) as an
-OpenSim model (``walkerlab export
-SCENE --format osim``: ``walker.osim``), in the frame of the legged walkers' OpenSim model
+"""The spoked wheel's OpenSim model, planar or in 3D.
+
+``model: rimless_wheel`` (in 3D: :func:`osim_wheel3d_text`), written by ``walkerlab export
+SCENE --format osim`` as ``walker.osim`` in the frame of the legged walkers' OpenSim model
 (:mod:`walkerlab.export.opensim`): x downhill (horizontal), **y up**, rotations about **z**.
 
 - ``hub``: one ``Body``, the hub's mass and its inertia ``I_hub`` about every axis (a
@@ -15,8 +16,9 @@ SCENE --format osim``: ``walker.osim``), in the frame of the legged walkers' Ope
   :func:`walkerlab.export.spoked.spoke_point`), and the slope a ``ContactHalfSpace``
   ``ground`` through the origin;
 - a ``HuntCrossleyForce`` ``spoke<k>_contact`` per spoke between its sphere and the ground
-  (the scene's IMPACT law translated by :func:`walkerlab.export.opensim_contact.
-  hunt_crossley` at the wheel's weight on one spoke): the stepping loop
+  (the scene's IMPACT law translated by
+  :func:`walkerlab.export.opensim_contact.hunt_crossley` at the wheel's weight on one
+  spoke): the stepping loop
   (:mod:`walkerlab.export.opensim_walk`) reads each spoke's touchdown from it;
 - the coordinates' default values and speeds: the rigid gait's fixed point just after a
   spoke strike (spoke 0 in stance, its tip at the origin: the MJCF's ``gait`` keyframe,
@@ -71,9 +73,9 @@ def wheel_patches(terrain, data, footfalls: int = WHEEL_FOOTFALLS
     the footfall in the model's (x downhill, y up) frame
     (:func:`walkerlab.export.mjcf_ground.wheel_footfalls`;
     each sphere's centre lies the radius below it along the slope's normal), the radius
-    the legs' on stairs and footholds (:func:`walkerlab.export.opensim_contact.
-    terrain_patch_radius`: the patch width, the largest rise between consecutive
-    footfalls, the chord as the step)."""
+    the legs' on stairs and footholds
+    (:func:`walkerlab.export.opensim_contact.terrain_patch_radius`: the patch width, the
+    largest rise between consecutive footfalls, the chord as the step)."""
     p = wheel_numbers(data, None)
     phi = data.slope_rad   # stairs: 0 (level treads, the scene's check)
     chord = wheel_chord_m(data)

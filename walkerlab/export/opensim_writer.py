@@ -88,9 +88,9 @@ class OsimWriter(TreeWriter):
 
     def wheel_3d(self, job: ExportJob, w: Writer) -> Written:
         """The spoked wheel in 3D (:func:`walkerlab.export.opensim_wheel.osim_wheel3d_text`):
-        the rigid gait (the MJCF's keyframe, :func:`walkerlab.export.spoked.
-        wheel3d_keyframe`) as its default state, the slope's half-space or the planar
-        wheel's patches."""
+        the rigid gait (the MJCF's keyframe,
+        :func:`walkerlab.export.spoked.wheel3d_keyframe`) as its default state, the slope's
+        half-space or the planar wheel's patches."""
         data = job.data
         job.kind.require("walk", w.view, "walker.space: 3d")
         check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
