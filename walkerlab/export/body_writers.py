@@ -131,6 +131,22 @@ class TreeWriter:
             lambda ideal: wheel_keyframe(scene, job.plant, ideal))
         return hub, ideal, key
 
+    @staticmethod
+    def wheel3d_gait(job: ExportJob, text):
+        """``(ideal, text(qpos, qvel, ideal))``: the 3D spoked wheel's rigid gait and the
+        file ``text`` writes from its MJCF ``gait`` keyframe
+        (:func:`walkerlab.export.spoked.wheel3d_keyframe`; the MJCF's and the OpenSim
+        model's default state)."""
+        data = job.data
+        f = functions(data)
+        r = WHEEL_TIP_FRACTION * data.leg_length_m
+
+        def build(ideal):
+            qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
+                                          data.slope_rad, r)
+            return text(qpos, qvel, ideal)
+        return job.gait(build)
+
     def legs(self, job: ExportJob, w: Writer) -> Written:
         """A tree of leg links in the plane."""
         raise NotImplementedError
@@ -263,20 +279,12 @@ class MjcfWriter(TreeWriter):
         if job.walker_only:
             text = wheel3d_mjcf_text(data, job.name, version, friction=mu)
             return Written((xml_file(job, w, text),), xml_lines((), job.scene), None)
-        f = functions(data)
-        r = WHEEL_TIP_FRACTION * data.leg_length_m
-
         t = job.scene.terrain
         ground = None if t is None or t.is_slope else wheel_ground(
             t, data.leg_length_m, chord_m=wheel_chord_m(data), slope_rad=data.slope_rad,
             half_width_m=WHEEL_3D_GROUND_HALF_WIDTH * data.leg_length_m)
-
-        def build(ideal):
-            qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
-                                          data.slope_rad, r)
-            return wheel3d_mjcf_text(data, job.name, version, qpos, qvel, friction=mu,
-                                     ground=ground)
-        ideal, text = job.gait(build)
+        ideal, text = self.wheel3d_gait(job, lambda qpos, qvel, ideal: wheel3d_mjcf_text(
+            data, job.name, version, qpos, qvel, friction=mu, ground=ground))
         return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 
 

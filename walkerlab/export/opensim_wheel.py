@@ -43,6 +43,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from walkerlab.export.mjcf_ground import wheel_footfalls
+from walkerlab.export.opensim import DOCUMENT_VERSION
 from walkerlab.export.opensim_contact import hunt_crossley, terrain_patch_radius
 from walkerlab.export.opensim_xml import (
     _body,
@@ -58,8 +59,6 @@ from walkerlab.export.text import comment, num, nums
 __all__ = ["WHEEL_FOOTFALLS", "osim_wheel3d_state", "osim_wheel3d_text", "osim_wheel_text",
            "wheel_patches"]
 
-#: OpenSim's document version written (:data:`walkerlab.export.opensim.DOCUMENT_VERSION`)
-DOCUMENT_VERSION = 40600
 #: Footfalls ahead of the first stance tip laid as patches on stairs and footholds (the
 #: MJCF's treads' count, :func:`walkerlab.export.mjcf_ground.wheel_ground`)
 WHEEL_FOOTFALLS = 60
@@ -109,7 +108,8 @@ def osim_wheel_text(data, key, contact, name: str, version: str = "", terrain=No
     Returns
     -------
     str
-        An ``OpenSimDocument`` (version :data:`DOCUMENT_VERSION`).
+        An ``OpenSimDocument`` (version
+        :data:`walkerlab.export.opensim.DOCUMENT_VERSION`, the legs' files).
     """
     p = wheel_numbers(data, key.hub_inertia_kg_m2)
     names = ("hip_x", "hip_y", "wheel")
@@ -193,8 +193,11 @@ def _document(data, p: dict, inertia, state, axes, frame: str, period_s: float, 
     n_hat = np.array([math.sin(phi), math.cos(phi)])
     patches, rg = (None, None) if terrain is None or terrain.is_slope else \
         wheel_patches(terrain, data)
-    lanes = {k: [f"spoke{k}_patch{m}" for m in range(sum(s == k for s, _ in patches or ()))]
-             for k in range(n)}
+    lanes = {k: [] for k in range(n)}  # each spoke's patch names
+    spheres = []                        # every patch (name, top (2,) [m]), footfall order
+    for k, top in patches or ():
+        lanes[k].append(f"spoke{k}_patch{len(lanes[k])}")
+        spheres.append((lanes[k][-1], top))
     r_eff = r if rg is None else r * rg / (r + rg)
     stiff, diss, vt, note = hunt_crossley(contact, p["M_hub"] * g * math.cos(phi), r_eff)
     out = ['<?xml version="1.0" encoding="UTF-8" ?>',
@@ -247,11 +250,8 @@ def _document(data, p: dict, inertia, state, axes, frame: str, period_s: float, 
         out += contact_sphere(f"spoke{k}_foot", "/bodyset/hub", spoke_point(p, k, L - r), r)
     if patches is None:
         out += contact_half_space(0.0, phi, n_hat)
-    else:
-        seen = {k: 0 for k in range(n)}
-        for k, top in patches:
-            out += contact_sphere(f"spoke{k}_patch{seen[k]}", "/ground", top - rg * n_hat, rg)
-            seen[k] += 1
+    for name, top in spheres:  # none on the slope
+        out += contact_sphere(name, "/ground", top - rg * n_hat, rg)
     out += ["\t\t\t</objects>", "\t\t</ContactGeometrySet>",
             "\t</Model>", "</OpenSimDocument>", ""]
     return "\n".join(out)

@@ -19,7 +19,6 @@ OpenSim's model carries its default state (the rigid gait), so the walker alone
 from __future__ import annotations
 
 import walkerlab
-from walkerlab.codegen.cache import functions
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.body_writers import TreeWriter, check_legs_3d
 from walkerlab.export.jobs import ExportJob, Writer, Written, step_period, xml_file, xml_lines
@@ -32,7 +31,6 @@ from walkerlab.export.opensim import (
 from walkerlab.export.opensim_3d import osim3d_gait, osim3d_omissions, osim3d_text
 from walkerlab.export.opensim_wheel import osim_wheel3d_text, osim_wheel_text
 from walkerlab.export.scene import check_exportable
-from walkerlab.export.spoked import WHEEL_TIP_FRACTION, wheel3d_keyframe
 from walkerlab.export.tree_links import tree_multibody
 from walkerlab.export.wheel_scene import check_wheel_exportable
 from walkerlab.models.contact.rigid_limit import contact_si
@@ -77,10 +75,9 @@ class OsimWriter(TreeWriter):
         as its default state, the slope's half-space (stairs and footholds: a patch per
         footfall, :func:`walkerlab.export.opensim_wheel.wheel_patches`; a profile: the
         capability table's cell) and a Hunt-Crossley force per spoke tip."""
+        _, ideal, key = self.wheel_gait(job, w)  # checked; no gait search for the wheel alone
         if job.walker_only:
-            check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
             raise ValueError(WALKER_ONLY)
-        _, ideal, key = self.wheel_gait(job, w)
         c, _ = contact_si(job.scene.contact or ContactSettings())
         text = osim_wheel_text(job.data, key, c, job.name, walkerlab.__version__,
                                job.scene.terrain)
@@ -97,15 +94,9 @@ class OsimWriter(TreeWriter):
         if job.walker_only:
             raise ValueError(WALKER_ONLY)
         c, _ = contact_si(job.scene.contact or ContactSettings())
-        f = functions(data)
-        r = WHEEL_TIP_FRACTION * data.leg_length_m
-
-        def build(ideal):
-            qpos, qvel = wheel3d_keyframe(f["points"], f["point_velocities"], ideal.x,
-                                          data.slope_rad, r)
-            return osim_wheel3d_text(data, qpos, qvel, float(ideal.period_s), c, job.name,
-                                     walkerlab.__version__, job.scene.terrain)
-        ideal, text = job.gait(build)
+        ideal, text = self.wheel3d_gait(job, lambda qpos, qvel, ideal: osim_wheel3d_text(
+            data, qpos, qvel, float(ideal.period_s), c, job.name, walkerlab.__version__,
+            job.scene.terrain))
         return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
 
 
