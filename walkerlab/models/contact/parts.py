@@ -343,10 +343,16 @@ class Legs3DPart(ContactPart):
     #: s a stride at 1, 0.6 s at 10, 35 s at 100, 440 s at 1000 times the stiffness; the
     #: family's stiction velocity, which the twist's law shares, falls as kappa^-1/2)
     rigid_limit_kappas = (1.0, 2.0, 4.0, 8.0)
+    #: measured (5 ms of stance at 100 times the stiffness): the stance foot's torsional
+    #: friction makes the heading's rate a mode of -1e7 1/s at the scene's contact (-1e8 at
+    #: 100 times); CyRK's BDF, whose Jacobian is its own differences, takes 1.85 M
+    #: right-hand-side calls there, scipy's BDF with its own differences 581 (135 steps)
     attribution_refusal = (
         "the attribution's creep-free (stiction velocity / 100) and 1000 times stiffer "
-        "contacts are beyond the stride map's integrator in 3D (440 s a stride at 1000 "
-        "times the stiffness): walkerlab compare --rigid-limit shows the gap's orders")
+        "contacts are beyond the stride map's integrator in 3D: the stance foot's torsional "
+        "friction makes the heading's rate a mode of -1e7 1/s (-1e8 at 100 times the "
+        "stiffness), on which CyRK's BDF takes 440 s a stride at 1000 times: walkerlab "
+        "compare --rigid-limit shows the gap's orders")
     #: the heading: the rigid stance foot holds its yaw (the rigid state has no heading),
     #: the compliant one turns, with a multiplier near 1 (heading is nearly neutral)
     free_modes = 1
