@@ -395,7 +395,7 @@ def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None,
     if export_part(mb).knee_stops:
         from walkerlab.models.contact.rigid_limit import contact_si
 
-        _, ks = contact_si(scene.contact or ContactSettings())
+        _, ks = contact_si(scene.contact)
         out += ["! knee stops: IMPACT on the hyperextension shank - thigh (> 0 past straight)"]
         for leg in ("leg1", "leg2"):
             sh, th = ids[f"{leg}_shank"], ids[f"{leg}_thigh"]

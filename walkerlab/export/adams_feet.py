@@ -78,11 +78,10 @@ class LegEndFeet:
     def start(self, scene: Scene, mb, data, ideal, extra, lanes, heights) -> AdamsStart:
         """The rigid gait's post-impact state as the contact view has it (rates times
         ``contact_sim.initial_rate_scale``); a bisecting torso at the legs' mean angle."""
-        from walkerlab.config.contact import ContactSettings
         from walkerlab.models.contact.model import ContactWalker
         from walkerlab.models.contact.rigid_limit import contact_si
 
-        c, knee = contact_si(scene.contact or ContactSettings())
+        c, knee = contact_si(scene.contact)
         scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
         walker = ContactWalker(contact=c, data=data, knee_stop=knee)
         z = walker.link_state_from_ideal(ideal.x, scale)

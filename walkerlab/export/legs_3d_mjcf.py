@@ -117,7 +117,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.config.contact import ContactSettings
 from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
@@ -383,7 +382,7 @@ def legs3d_scene(plant, ideal, options=None) -> Legs3dScene:
     lanes = legs3d_lanes(plant, f["points"], ideal.x, EXPORT_STEPS)
     if kneed(data) and round_feet(data):  # no patch under the trailing disc (module docstring)
         lanes = (lanes[0][1:], lanes[1])
-    c, knee = contact_si(scene.contact or ContactSettings())
+    c, knee = contact_si(scene.contact)
     dt, solref, solimp, mu, notes = mujoco_contact(c, float(data.total_mass_kg), p["g"],
                                                    data.slope_rad, options)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))

@@ -19,7 +19,6 @@ OpenSim's model carries its default state (the rigid gait), so the walker alone
 from __future__ import annotations
 
 import walkerlab
-from walkerlab.config.contact import ContactSettings
 from walkerlab.export.body_writers import TreeWriter, check_legs_3d
 from walkerlab.export.jobs import ExportJob, Writer, Written, step_period, xml_file, xml_lines
 from walkerlab.export.opensim import (
@@ -78,7 +77,7 @@ class OsimWriter(TreeWriter):
         _, ideal, key = self.wheel_gait(job, w)  # checked; no gait search for the wheel alone
         if job.walker_only:
             raise ValueError(WALKER_ONLY)
-        c, _ = contact_si(job.scene.contact or ContactSettings())
+        c, _ = contact_si(job.scene.contact)
         text = osim_wheel_text(job.data, key, c, job.name, walkerlab.__version__,
                                job.scene.terrain)
         return Written((xml_file(job, w, text),), xml_lines((), job.scene), step_period(ideal))
@@ -93,7 +92,7 @@ class OsimWriter(TreeWriter):
         check_wheel_exportable(job.scene, job.kind, w.name, job.walker_only)
         if job.walker_only:
             raise ValueError(WALKER_ONLY)
-        c, _ = contact_si(job.scene.contact or ContactSettings())
+        c, _ = contact_si(job.scene.contact)
         ideal, text = self.wheel3d_gait(job, lambda qpos, qvel, ideal: osim_wheel3d_text(
             data, qpos, qvel, float(ideal.period_s), c, job.name, walkerlab.__version__,
             job.scene.terrain))

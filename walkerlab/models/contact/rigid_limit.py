@@ -114,10 +114,11 @@ def scale(contact: ContactParamsSI, knee: KneeStopSI, kappa: float
                                     latch_height=knee.latch_height * length)
 
 
-def contact_si(settings: ContactSettings) -> tuple[ContactParamsSI, KneeStopSI]:
+def contact_si(settings: ContactSettings | None) -> tuple[ContactParamsSI, KneeStopSI]:
     """The scene's contact and knee stop in SI, with its ``stiffness_family`` applied: the
     contact model's parameters of a run (built once per run,
-    :func:`walkerlab.models.contact.scene.build`).
+    :func:`walkerlab.models.contact.scene.build`).  ``settings`` None (a scene without a
+    ``contact`` section): the paper's contact law, :class:`ContactSettings`' defaults.
 
     ``stiffness_family: paper`` returns the numbers as written, converted to SI
     (:func:`walkerlab.models.contact.laws.contact_params_si`).  ``rigid_limit`` reads the maximum
@@ -130,6 +131,7 @@ def contact_si(settings: ContactSettings) -> tuple[ContactParamsSI, KneeStopSI]:
     -------
     (ContactParamsSI, KneeStopSI)
     """
+    settings = ContactSettings() if settings is None else settings
     si, knee = contact_params_si(settings), knee_stop_si(settings.knee_stop)
     if settings.stiffness_family != "rigid_limit":
         return si, knee
