@@ -69,7 +69,8 @@ def _states(scene, rng, n: int = 4):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["paper_3d", "hip_width_powered", "torso_bhm_3d_stabilised"])
+@pytest.mark.parametrize("name", ["paper_3d", "hip_width_powered", "torso_bhm_3d_stabilised",
+                                  "round_feet_3d"])
 def test_the_3d_collocation_functions_are_the_rigid_models(name):
     """At states near the gait, against the rigid model's generated code (not the CasADi
     expressions): the flow with a hip torque of 0.7 N m, the heel strike, the heel strike
@@ -78,7 +79,9 @@ def test_the_3d_collocation_functions_are_the_rigid_models(name):
     round-off (1e-9; the reaction 1e-6 N of ~200 N: the floating view's accelerations by
     differences).  paper_3d: one step's functions (zero hip width); hip_width_powered: the
     stride's first step (hip width, the hip-roll law); torso_bhm_3d_stabilised: the same
-    with a 5 kg upper body on the bisecting hip (its mass in the reaction's momentum)."""
+    with a 5 kg upper body on the bisecting hip (its mass in the reaction's momentum);
+    round_feet_3d: disc feet (the push-off at the trailing disc's material contact point,
+    the rigid model's checked against Newton-Euler's in tests/test_round_feet_3d.py)."""
     pytest.importorskip("casadi")
     from walkerlab.models.hybrid.ground_reaction import StanceReaction
     from walkerlab.optimal.transcription.step_cache import (
@@ -119,7 +122,8 @@ def test_the_3d_collocation_functions_are_the_rigid_models(name):
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "intervals"), [("paper_3d", 60),
                                                  ("hip_width_optimal", 60),
-                                                 ("torso_bhm_3d_stabilised", 60)])
+                                                 ("torso_bhm_3d_stabilised", 60),
+                                                 ("round_feet_3d", 60)])
 def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name, intervals):
     """int u^2 dt = 0 at the gait that walks without the hip torque, so the optimum is it
     (with hip-roll joints: the gait under the foot-placement law, part of the walker's
@@ -129,7 +133,9 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     width) on 60), each step's
     period within 1e-7 relative and the replay on the rigid model closing to 1e-6.  With an
     upper body on the bisecting hip (torso_bhm_3d_stabilised, Wisse, Hobbelen & Schwab
-    2007) the same: the upper body is part of the walker's equations, not an input."""
+    2007) the same: the upper body is part of the walker's equations, not an input.  On
+    disc feet (round_feet_3d, McGeer's round feet in 3D) the heel strike is the extended
+    impact at the leading disc's material contact point."""
     pytest.importorskip("casadi")
     out, r, periods = _least_effort(name, intervals)
     assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
@@ -230,6 +236,26 @@ def test_the_least_effort_3d_kneed_gait_on_its_passive_slope_is_its_passive_gait
     assert out.replay_error <= 1e-6
 
 
+@pytest.mark.slow
+def test_the_least_effort_3d_kneed_gait_on_disc_feet_is_its_passive_gait():
+    """configs/kneed_round_feet_3d.yaml (locking knees, a disc on each shank, zero hip
+    width: one step of the phased modes, unlocked swing, knee strike, locked swing, heel
+    strike on the extended impact at the leading disc's material contact point, the swing
+    knee held): the least effort is the passive gait, as on point feet: IPOPT converged,
+    objective <= 1e-8 N^2 m^2 s, the start within 1e-6 of the fixed point ``walkerlab
+    fixedpoint`` finds by shooting, the period within 1e-7 relative (4e-7 on 40
+    intervals, Hermite-Simpson's O(h^4)) and the replay on the rigid model closing to
+    1e-6."""
+    pytest.importorskip("casadi")
+    out, r, periods = _least_effort("kneed_round_feet_3d", 80)
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.objective <= 1e-8
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, r.x, atol=1e-6)
+    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
+    assert out.replay_error <= 1e-6
+
+
 @pytest.mark.parametrize("name", ["hip_width_footholds", "kneed_3d_stabilised_footholds"])
 def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path, name):
     """Footholds of three heights for the hip-width walker or the 3D kneed walker (a stride
@@ -253,25 +279,26 @@ def test_a_3d_walker_on_three_footholds_is_refused_before_any_stage(tmp_path, na
     assert not list((tmp_path / "r").rglob("*.h5"))
 
 
-def test_a_3d_walkers_disc_feet_are_refused_before_any_stage(tmp_path):
-    """configs/round_feet_3d.yaml (disc feet in each leg's plane) with an optimize section:
-    refused in one line naming walker.foot_radius_m, with the capability table's reason
-    (the collocation's heel strike is the extended impact system, which the disc foot's
-    equations do not have), before fixedpoint runs."""
+def test_a_3d_walkers_toroidal_feet_are_refused_before_any_stage(tmp_path):
+    """configs/collins2001.yaml (feet curved in both directions, whose travel along the fall
+    line is no function of the configuration) with an optimize section: refused in one line
+    naming walker.leg.foot.kind, with the capability table's reason, before fixedpoint
+    runs (disc feet, lateral_radius_m 0's limit, are transcribed: the tests below)."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
-    from walkerlab.walker.capability_cells import ROUND_FEET_OPTIMIZE_3D
+    from walkerlab.walker.capability_cells import TOROIDAL_OPTIMIZE
 
-    d = yaml.safe_load((CONFIGS / "round_feet_3d.yaml").read_text())
+    d = yaml.safe_load((CONFIGS / "collins2001.yaml").read_text())
     d["optimize"] = {"objective": "effort", "intervals": 40}
-    scene = tmp_path / "discs.yaml"
+    scene = tmp_path / "torus.yaml"
     scene.write_text(yaml.safe_dump(d))
     r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
     out = " ".join(r.output.split())
     assert r.exit_code != 0 and r.output.count("error:") == 1, r.output
-    assert "walker.foot_radius_m" in out and ROUND_FEET_OPTIMIZE_3D[:50] in out, r.output
+    assert "walker.leg.foot.kind" in out and TOROIDAL_OPTIMIZE[:60] in out, r.output
+    assert "Traceback" not in r.output
     assert not list((tmp_path / "r").rglob("*.h5"))
 
 

@@ -97,6 +97,7 @@ class Reference:
             vel[name] = vel[base] + np.cross(omega, r)
             acc[name] = acc[base] + np.cross(alpha, r) + np.cross(omega, np.cross(omega, r))
 
+        rigid("contact", "centre", -R * e2, w_st, al_st)   # the stance disc's material point
         rigid("hip", "centre", (L - R) * u_st, w_st, al_st)
         rigid("stance_mass", "centre", (a - R) * u_st, w_st, al_st)
         rigid("pelvis", "hip", w / 2 * e3, w_p, al_p)
@@ -158,26 +159,34 @@ class Reference:
     def foot_height(self, w, x):
         return float(self.n @ self.kinematics(w, x[:3], x[3:], np.zeros(3))[0]["swing_contact"])
 
-    def impact_rates(self, w, y):
+    def impact_rates(self, w, y, push=0.0):
         """The plastic impact: extended rates ``[dq, v_centre]`` (the old stance disc's
         centre free), ``M_e (v+ - v-) = E^T F`` and ``E v+ = 0`` (the new foot's material
-        contact point at rest); returns ``dq+`` (before the roles swap) and ``v_centre+``."""
+        contact point at rest); returns ``dq+`` (before the roles swap) and ``v_centre+``.
+
+        ``push`` [N s]: a push-off first, the impulse ``push e`` at the old stance disc's
+        material contact point along ``e`` from it to its leg's hip (Kuo 2002's push-off,
+        the trailing foot free): ``M_e (v_po - v-) = J_c^T push e``; the extended rates
+        after it are ``v_po``, and the third value the kinetic energy it adds [J]."""
         q, dq = y[:3], y[3:]
         vel, om = self._partials(w, q, v_centre=True)
-        _, _, _, legs = self.kinematics(w, q, dq, np.zeros(3))
+        pos, vel0, _, legs = self.kinematics(w, q, dq, np.zeros(3))
         Me = np.zeros((6, 6))
         for p, m in self.bodies():
             Me += m * vel[p].T @ vel[p]
         for W, (_, _, u) in zip(om, legs):
             Me += W.T @ self._inertia(u) @ W
         E = vel["swing_contact"]
-        v_minus = np.concatenate([dq, self.kinematics(w, q, dq, np.zeros(3))[1]["centre"]])
+        v_minus = np.concatenate([dq, vel0["centre"]])
+        e = pos["hip"] - pos["contact"]
+        v_po = v_minus + np.linalg.solve(Me, vel["contact"].T @ (push * e / np.linalg.norm(e)))
         K = np.block([[Me, -E.T], [E, np.zeros((3, 3))]])
-        sol = np.linalg.solve(K, np.concatenate([Me @ v_minus, np.zeros(3)]))
-        return sol[:3], sol[3:6]
+        sol = np.linalg.solve(K, np.concatenate([Me @ v_po, np.zeros(3)]))
+        added = 0.5 * (v_po @ Me @ v_po - v_minus @ Me @ v_minus)
+        return sol[:3], sol[3:6], added
 
-    def impact(self, w, y):
-        dqp = self.impact_rates(w, y)[0]
+    def impact(self, w, y, push=0.0):
+        dqp = self.impact_rates(w, y, push)[0]
         q = y[:3]
         return np.array([q[0], q[2], q[1], dqp[0], dqp[2], dqp[1]])
 
@@ -255,6 +264,29 @@ def test_round_feet_flow_and_impact_match_newton_euler(walkers, width):
     for x in _states(5):
         assert np.max(np.abs(walker.phases[0].flow(0.0, x) - ref.rhs(width)(0.0, x))) < 1e-11
         assert np.max(np.abs(walker.reset(x) - ref.impact(width, x))) < 1e-11
+
+
+@pytest.mark.parametrize("width", [0.0, WIDTH])
+def test_round_feet_push_off_and_heel_strike_match_newton_euler(width):
+    """The rigid model's push-off on disc feet (walker.actuation.push_off: the impulse at
+    the trailing disc's material contact point along the trailing leg to its own hip, then
+    the heel strike, on the generated extended impact system) against the reference's, the
+    trailing disc's centre free, at rolled states, with and without hip width, three
+    impulses: the post-impact state to 1e-11 (roundoff of two independent linear solves)
+    and the push-off's kinetic energy gain to 1e-12 J."""
+    from walkerlab.config.actuation import Actuation, PushOff
+    from walkerlab.models.hybrid.actuated import actuate
+
+    plant = Plant.from_scene(_scene("round_feet_3d.yaml", hip_width_m=width))
+    passive = build_walker(plant)
+    ref = Reference(**ROUND)
+    for P in (0.0, 0.05, 0.2):
+        acts = actuate(passive, plant.data, Actuation(push_off=PushOff(impulse_n_s=P)))
+        for x in _states(13, 3):
+            out = acts.actuators.transition(x)
+            assert np.max(np.abs(out["x_plus"] - ref.impact(width, x, P))) < 1e-11
+            gain = out["ke_push_off"] - out["ke_minus"]
+            assert abs(gain - ref.impact_rates(width, x, P)[2]) < 1e-12
 
 
 def test_round_feet_points_are_the_rolling_discs(walkers):

@@ -529,7 +529,7 @@ def derive_legged(structure) -> Equations:
     if structure.torso and not free:   # the bisecting hip: the upper body's pitch
         leg_angles["torso"] = (th_sw + th_st) / 2
     De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)   # none: the printers' empty system
-    if planar or not arc:  # the push-off's extended impact (a 3D walker's round feet: none)
+    if planar or not torus:  # the push-off's extended impact (toroidal feet: none)
         De, E = extended_impact(M0, A, total, F[:d, :], to_world,
                                 simplify if planar else sp.expand)
     return Equations(

@@ -66,6 +66,7 @@ from walkerlab.optimal.virtual_constraints import (
     optimize_virtual_constraints,
 )
 from walkerlab.walker import parts as P
+from walkerlab.walker.capability_cells import TOROIDAL_OPTIMIZE
 from walkerlab.walker.plant import Plant
 
 __all__ = ["Collocation", "check_kind", "check_scene", "check_targets",
@@ -314,7 +315,9 @@ def check_scene(scene, data) -> None:
         check_design(scene, data.structure.kind)
         return
     check_kind(scene, data.structure.kind)
-    if data.structure.in_3d and data.structure.foot in ("arc", "toroidal"):  # round feet
+    if data.structure.in_3d and data.structure.foot == "toroidal":
+        raise ValueError(TOROIDAL_OPTIMIZE)
+    if data.structure.in_3d and data.structure.foot == "arc":  # a 3D walker's discs
         data.structure.kind.require("round_feet_3d", "optimize", "walker.foot_radius_m")
     elif data.structure.foot == "arc" and not data.structure.kind.collocation.one_step:
         raise ValueError(phased_refusal(data.structure))   # knees on rolling feet

@@ -14,9 +14,9 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_3D_UPRIGHT", "ROUND_FEET_OPTIMIZE_3D", "ROUND_FEET_OSIM_3D",
+           "ROUND_FEET_3D_UPRIGHT", "ROUND_FEET_OSIM_3D",
            "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
-           "STAGE_VIEWS", "TORSO_ADAMS_3D", "URDF_GROUND",
+           "STAGE_VIEWS", "TOROIDAL_OPTIMIZE", "TORSO_ADAMS_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
 
 _NO_KNEE = "the legs are straight: there is no knee"
@@ -102,11 +102,14 @@ NO_HIP_ROLL = ("hip-roll joints are a 3D straight-legged walker's with hip width
 NO_ROUND_FEET_3D = ("a disc foot in each leg's plane (walker.foot_radius_m) is a 3D "
                     "straight-legged walker's (walker.space: 3d); a planar walker's round "
                     "feet are walker.leg.foot.kind: arc")
-#: why the collocation refuses a 3D walker's disc feet
-ROUND_FEET_OPTIMIZE_3D = ("the collocation's heel strike, push-off and ground reaction are "
-                          "the stance foot's extended impact system, which a 3D walker's "
-                          "disc foot (its rolling contact) does not have in its equations: "
-                          "optimise point feet (drop walker.foot_radius_m)")
+#: why the collocation refuses feet curved in both directions (walker.leg.foot.kind:
+#: toroidal), which the rigid model walks
+TOROIDAL_OPTIMIZE = ("walker.leg.foot.kind: toroidal feet roll without a holonomic contact "
+                     "(their travel along the fall line is no function of the configuration: "
+                     "the rigid flow is its Chaplygin reduction, walkerlab.codegen."
+                     "rolling_feet), and the collocation's push-off and ground reaction are "
+                     "the extended impact system of a foot whose position the configuration "
+                     "gives (point feet, discs: lateral_radius_m: 0)")
 #: why the OpenSim export refuses a 3D walker's disc feet
 ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) have no disc: "
                       "a disc foot written as a sphere of its radius R touches the ground "
@@ -308,12 +311,11 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
     "straight_legs_3d": {
         # round feet and leg inertia: the MJCF's disc (cylinder) feet, the URDF's
         # cylinder collisions, the Adams dataset's GRAPHICS/CYLINDER contact and the
-        # files' leg inertia (walkerlab.export.legs_3d_mjcf, walkerlab.export.adams_3d)
+        # files' leg inertia (walkerlab.export.legs_3d_mjcf, walkerlab.export.adams_3d);
         # the collocation (walkerlab.optimal.transcription.step, .stride) writes the heel
         # strike, the push-off and the stance foot's reaction on the walker's extended
-        # impact system (walkerlab.codegen.legged.extended_impact), which the derivation
-        # gives point feet only
-        ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
+        # impact system (walkerlab.codegen.legged.extended_impact), a disc foot's at its
+        # material contact point
         ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
@@ -449,8 +451,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # walkerlab.optimal.transcription.stride on walkerlab.optimal.transcription.phases'
         # kneed modes, which take the 3D walker's equations: an upper body on the bisecting
         # hip is in them, as the 3D straight legs'), the hip torque between the thighs; its
-        # push-off as the planar kneed walker's (the extended impact, the swing knee held)
-        ("round_feet_3d", "optimize"): ROUND_FEET_OPTIMIZE_3D,
+        # push-off as the planar kneed walker's (the extended impact, the swing knee held;
+        # on the shanks' discs at the leading disc's material contact point)
     },
     "rolling_polygon_3d": {
         **_PLANAR,

@@ -433,16 +433,11 @@ class Legs3DPart(ContactPart):
         (Wisse, Hobbelen & Schwab 2007): half on each leg's pitch coordinate, as the
         planar walkers'.
 
-        Raises
-        ------
-        ValueError
-            A push-off on disc feet (the rigid view's refusal, one line).
+        On disc feet the pulse acts at the trailing disc's material point at its rolling
+        contact (the generated ``feet``), as the rigid view's impulse.
         """
 
         st = data.structure
-        if spec.push_off is not None and st.foot == "arc":
-            raise ValueError("walker.actuation.push_off: a 3D walker's push-off is a point "
-                             "foot's so far (the rigid view's): drop walker.foot_radius_m")
         return ContactActuators(spec, coordinates, pulse_s, st.kind, torso=bool(st.torso),
                                 flow_law=bool(st.hip_roll))
 

@@ -316,12 +316,8 @@ class _Legs3d(_Joints):
     hip_spring = False  # the 3D flow has no generated hip spring: the laws are compiled
 
     def actuators(self, walker: HybridWalker, data, spec):
-        """``(acts, False)`` (legs with mass: the 3D walker has no massless limit); a
-        push-off on round feet refused (one line)."""
-        if spec.push_off is not None and data.structure.foot == "arc":
-            raise ValueError("walker.actuation.push_off: a 3D walker's push-off is a point "
-                             "foot's so far (the disc foot's rolling contact point is not "
-                             "in its extended impact system): drop walker.foot_radius_m")
+        """``(acts, False)`` (legs with mass: the 3D walker has no massless limit); a disc
+        foot's push-off from its rolling contact (``stance_contact``), as a planar arc's."""
         acts, limit = super().actuators(walker, data, spec)
         if limit:
             raise ValueError("walker.actuation: a 3D walker's legs carry mass")

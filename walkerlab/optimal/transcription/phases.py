@@ -175,11 +175,14 @@ def phase_order(walker, phase_log=None) -> list[tuple[str, str, int]]:
 
 def refusal(structure) -> str | None:
     """Why this transcription has no symbolic form for ``structure``'s walker (one line
-    naming the field), or None: a kind without phases, a planar walker's torso, arc feet
-    (its modes pin the stance foot; an arc foot rolls), massless legs."""
+    naming the field), or None: a kind without phases, a planar walker's torso, a planar
+    walker's arc feet (its modes pin the stance foot; an arc foot rolls), massless legs.  A
+    3D kneed walker's discs (on its shanks) are in its equations: their rolling is the
+    tree's holonomic advance, its push-off the extended impact at the disc's material
+    contact point (:func:`walkerlab.optimal.transcription.step._reset_extended`)."""
     if structure.kind.phases is None:
         return "optimize: the walker's kind has no phased step"
-    if structure.foot == "arc":
+    if structure.foot == "arc" and not structure.in_3d:
         return ("walker.leg.foot.kind: arc feet on a walker with knees are not in the "
                 "collocation's phased step (knees or flat feet: point or flat feet, the "
                 "stance foot pinned); optimise the walker on point feet (leg.foot.kind: point)")

@@ -144,7 +144,7 @@ def stride_functions(data, ground=None, hold_advance: bool = True, order=None) -
     Raises
     ------
     ValueError
-        Mirror-image legs (one step is the map), flat or arc feet, knees without their
+        Mirror-image legs (one step is the map), flat or planar arc feet, knees without their
         ``order`` (or knees that do not lock), a planar walker's torso (a 3D walker's upper
         body on the bisecting hip is in its equations), massless legs; footholds of more
         than two heights (one line).
@@ -157,11 +157,11 @@ def stride_functions(data, ground=None, hold_advance: bool = True, order=None) -
                          "one step)")
     one_step = st.kind.collocation is not None and st.kind.collocation.one_step
     kneed = order is not None and st.kind.knees_lock and st.kind.phases is not None
-    if (not (one_step or kneed) or st.foot == "arc" or (st.torso and not st.in_3d)
-            or any(b.massless for b in st.bodies)):
+    if (not (one_step or kneed) or (st.foot == "arc" and not st.in_3d)
+            or (st.torso and not st.in_3d) or any(b.massless for b in st.bodies)):
         raise ValueError("optimize: a stride of legs that differ takes massive straight or "
-                         "locking-knee legs with point feet today (flat or arc feet, a "
-                         "planar torso: not yet)")
+                         "locking-knee legs with point feet (a 3D walker's discs too) today "
+                         "(flat or planar arc feet, a planar torso: not yet)")
     check_stride_ground(ground, data)
     order = list(order) if order is not None else list(STEP_PHASES)
     fns, phases = None, []
