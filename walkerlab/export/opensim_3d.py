@@ -37,15 +37,20 @@ surface one point-foot radius below the top at the patch's edge; on stairs no la
 leg's foot only (one ``HuntCrossleyForce`` per leg, the scene's IMPACT law through
 :func:`~walkerlab.export.opensim_contact.hunt_crossley`).  A foot is a ``ContactSphere``
 ``leg<i>_foot`` of radius ``r = L / 1000`` whose centre is ``L - r`` down the leg (the
-MJCF's).  Round feet are refused (the capability table's cell,
-:data:`walkerlab.walker.capability_cells.ROUND_FEET_OSIM_3D`): OpenSim's contact geometries
-(sphere, half-space, mesh) have no disc, and the disc of radius ``R`` in the leg's rolled
-sagittal plane written as a sphere of radius ``R`` at its centre touches the ground where
-the disc does only while the leg's plane is upright; with a lean ``phi`` the sphere's lowest
-point lies ``R sin(phi)`` across the disc's rim point (and ``R (1 - cos phi)`` lower), a
-lateral rolling the rigid disc does not have.  The writer below still writes a round foot
-as that sphere (what ``legs3d_numbers`` gives, ``r = R``), for a user who lifts the
-refusal on an upright gait.
+MJCF's).  A round foot (the disc of radius ``R`` in the leg's rolled sagittal plane) is a
+``ContactEllipsoid`` ``leg<i>_foot`` centred ``L - R`` down the leg with semi-axes ``(R, R,
+R / 10)``, the thin one along the leg's pitch axis (OpenSim 4.6's ``ContactCylinder`` and
+``ContactTorus`` meet no sphere or half-space in the Hunt-Crossley force: a cylinder
+dropped on a half-space falls through it).  It rolls as the disc does: leaned by ``phi``
+its lowest point lies ``(R / 100) tan(phi)`` across the disc's plane and
+``R sin(phi)^2 / 200`` below the disc's rim point, where a sphere of radius ``R`` would
+touch ``R sin(phi)`` across it.  Simbody's Hunt-Crossley force between it and a patch
+sphere of radius ``Rg`` takes the effective radius ``sqrt(r1 r2)`` of the pair's principal
+radii ``r1 = R Rg / (R + Rg)`` and ``r2 = rho Rg / (rho + Rg)``, ``rho = (R/10)^2 / R`` the
+rim's (:func:`disc_contact_radius`; measured in OpenSim: a body resting on it sinks to the
+IMPACT law's rest depth to 2e-10), and the stiffness is set from it.  A push-off on round feet is
+refused: the file's push-off force acts at a point fixed on the leg, the rigid model's at
+the disc's rolling contact.
 
 Stepping rules (OpenSim has no contact- or event-switched force; walkerlab's loop,
 :mod:`walkerlab.export.opensim_walk`, runs them between Manager windows): the hip-roll law
@@ -109,9 +114,12 @@ from walkerlab.export.tree_bodies import ExportJoint
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 from walkerlab.models.contact.rigid_limit import contact_si
 
-__all__ = ["ROLL_MOTORS", "Osim3dGait", "osim3d_bodies", "osim3d_gait", "osim3d_omissions",
-           "osim3d_state", "osim3d_text"]
+__all__ = ["DISC_THICKNESS", "ROLL_MOTORS", "Osim3dGait", "disc_contact_radius",
+           "osim3d_bodies", "osim3d_gait", "osim3d_omissions", "osim3d_state", "osim3d_text"]
 
+#: a round foot's ellipsoid: its semi-axis along the leg's pitch axis over the disc's radius
+#: (module docstring)
+DISC_THICKNESS = 0.1
 #: the hip-roll law's actuators (the rolls of the legs)
 ROLL_MOTORS = ("leg1_roll", "leg2_roll")
 _LEGS = ("leg1", "leg2")
@@ -236,18 +244,34 @@ def _patches(gait: Osim3dGait, r_point: float, slope_rad: float):
     return rg, lanes
 
 
-def _geometry(feet, lanes, r_foot: float, rg: float, slope_rad: float) -> list[str]:
-    """The ``ContactGeometrySet``: each foot's sphere, each lane's patch spheres (their tops
-    at the footfalls)."""
+def disc_contact_radius(r_disc: float, r_patch: float) -> float:
+    """Effective radius [m] of Simbody's Hunt-Crossley contact between a round foot's
+    ellipsoid (semi-axes ``(R, R, R DISC_THICKNESS)``, module docstring) on its rim and a
+    patch sphere of radius ``r_patch``: ``sqrt(r1 r2)`` of the pair's principal radii,
+    ``r1 = R Rg / (R + Rg)`` along the disc, ``r2`` across it from the rim's radius
+    ``(R DISC_THICKNESS)^2 / R``."""
+    rho = r_disc * DISC_THICKNESS ** 2
+    r1 = r_disc * r_patch / (r_disc + r_patch)
+    r2 = rho * r_patch / (rho + r_patch)
+    return math.sqrt(r1 * r2)
+
+
+def _geometry(feet, lanes, r_foot: float, rg: float, slope_rad: float,
+              disc: bool = False) -> list[str]:
+    """The ``ContactGeometrySet``: each foot's sphere (``disc``: its disc's ellipsoid), each
+    lane's patch spheres (their tops at the footfalls)."""
     _, nrm = slope_axes(slope_rad)
     i = "\t\t\t\t"
     out = ['\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
     for ft in feet:
         leg = ft.name.split("_")[0]
-        out += [f"{i}<ContactSphere name=\"{leg}_foot\">",
+        radii = nums(r_foot, r_foot, r_foot * DISC_THICKNESS)
+        shape, size = (("ContactEllipsoid", f"<radii>{radii}</radii>") if disc else
+                       ("ContactSphere", f"<radius>{num(r_foot)}</radius>"))
+        out += [f"{i}<{shape} name=\"{leg}_foot\">",
                 f"{i}\t<socket_frame>/bodyset/{ft.name}</socket_frame>",
                 f"{i}\t<location>{nums(0.0, -ft.foot_m, 0.0)}</location>",
-                f"{i}\t<radius>{num(r_foot)}</radius>", f"{i}</ContactSphere>"]
+                f"{i}\t{size}", f"{i}</{shape}>"]
     for leg, lane in zip(_LEGS, lanes):
         for k, s in enumerate(lane):
             c = osim_axis(s - rg * nrm)
@@ -298,12 +322,14 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
     root, couplers = bisected_tree(root, couplings)   # the bisecting hip's upper body
     q0, v0 = bisected_state(q0, v0, couplers)
     feet = _feet(data, root)
-    r_point = p["L"] / 1000 if round_feet(data) else p["r"]
+    disc = round_feet(data)
+    r_point = p["L"] / 1000 if disc else p["r"]
     r_foot = p["r"]
     rg, lanes = _patches(gait, r_point, phi)
     total = sum(b.mass_kg for b in root.walk())
-    stiff, diss, vt, contact_note = hunt_crossley(gait.contact, total * g * math.cos(phi),
-                                                  r_foot * rg / (r_foot + rg))
+    stiff, diss, vt, contact_note = hunt_crossley(
+        gait.contact, total * g * math.cos(phi),
+        disc_contact_radius(r_foot, rg) if disc else r_foot * rg / (r_foot + rg))
     coords = tree_coordinates(root)
     act = gait.scene.actuation
     motors = torque_joints(act, None, coords[4:])
@@ -334,10 +360,12 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
                    f"width {num(gait.scene.patch_width_m)} m is a sphere of radius {rg:.6g} m "
                    "whose top is at the rigid gait's footfall (it falls one point-foot radius "
                    "below it at the patch's edge: walkerlab.export.opensim.patch_radius)."),
-           comment(f"Feet: a sphere of radius {num(r_foot)} m, its centre L - r down the leg"
-                   + (" (round feet: the disc of that radius in the leg's plane as a sphere: "
-                      "the same contact on an upright leg, walkerlab.export.opensim_3d)"
-                      if round_feet(data) else "") + ".")]
+           comment(f"Feet: a sphere of radius {num(r_foot)} m, its centre L - r down the leg."
+                   if not disc else
+                   f"Feet: the disc of radius {num(r_foot)} m in each leg's plane as an "
+                   f"ellipsoid of semi-axes ({nums(r_foot, r_foot, r_foot * DISC_THICKNESS)}) "
+                   "m, the thin one along the leg's pitch axis, its centre L - R down the leg "
+                   "(walkerlab.export.opensim_3d).")]
     if act is not None and act.push_off is not None:
         out.append(comment(
             "Push-off (walker.actuation.push_off, walkerlab_actuation below): PrescribedForce "
@@ -378,6 +406,6 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
     if act is not None and act.push_off is not None:
         out += push_off_forces(feet, act.push_off.impulse_n_s / gait.push_off_duration_s)
     out += ["\t\t\t</objects>", "\t\t</ForceSet>"]
-    out += _geometry(feet, lanes, r_foot, rg, phi)
+    out += _geometry(feet, lanes, r_foot, rg, phi, disc)
     out += ["\t</Model>", "</OpenSimDocument>", ""]
     return "\n".join(out)

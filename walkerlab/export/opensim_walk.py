@@ -118,6 +118,13 @@ class OpensimWalk(MujocoWalk):
                      / (self.times_s[-1] - self.times_s[skip]))
 
 
+def _foot_geometry(osim, geometry):
+    """A foot's contact geometry as its own type: a point or arc foot's ``ContactSphere``,
+    a 3D round foot's ``ContactEllipsoid`` (:mod:`walkerlab.export.opensim_3d`)."""
+    sphere = osim.ContactSphere.safeDownCast(geometry)
+    return sphere if sphere is not None else osim.ContactEllipsoid.safeDownCast(geometry)
+
+
 def _header(text: str) -> dict:
     """Slope, latch and push-off numbers from the file's comments."""
     out: dict = {}
@@ -426,7 +433,7 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     fs = model.getForceSet()
     groups, stance = _contact_groups(fs)
     contact = {g: fs.get(f"{g}_contact") for g in groups}
-    feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
+    feet = {g: _foot_geometry(osim, model.getContactGeometrySet().get(f"{g}_foot"))
             for g in groups}
     # the body that carries the foot sphere (a leg, a shank; a 3D kneed leg's leg<i>_shank)
     bodies = {g: model.getBodySet().get(feet[g].getFrame().getName()) for g in groups}
@@ -467,12 +474,15 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
             sph = osim.ContactSphere.safeDownCast(cg.get(f"{g}_patch{len(patches[g])}"))
             loc = osim.Vec3(sph.get_location()).to_numpy()[:2]
             patches[g].append((float(loc @ t_hat), float(loc @ n_hat) + sph.getRadius()))
+    # a foot sphere's radius; a round foot's ellipsoid: its disc's (the first semi-axis)
+    radius = {g: (feet[g].getRadius() if hasattr(feet[g], "getRadius")
+                  else feet[g].getRadii().get(0)) for g in groups}
     half = info.get("patch_width", 0.0) / 2
     off = info.get("latch_offset", 0.0)  # the contact point below the sphere's centre
 
     def height(g, s):  # the foot's contact point above the ground under it [m]
         p = bodies[g].findStationLocationInGround(s, foot_loc[g]).to_numpy()[:2]
-        return contact_height(p, feet[g].getRadius(), off, patches[g], half, t_hat, n_hat)
+        return contact_height(p, radius[g], off, patches[g], half, t_hat, n_hat)
 
     def loaded(g, s):
         v = contact[g].getRecordValues(s)

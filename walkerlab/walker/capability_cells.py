@@ -14,7 +14,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_3D_UPRIGHT", "ROUND_FEET_OSIM_3D",
+           "ROUND_FEET_3D_UPRIGHT",
            "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TOROIDAL_OPTIMIZE", "TORSO_ADAMS_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
@@ -110,12 +110,6 @@ TOROIDAL_OPTIMIZE = ("walker.leg.foot.kind: toroidal feet roll without a holonom
                      "rolling_feet), and the collocation's push-off and ground reaction are "
                      "the extended impact system of a foot whose position the configuration "
                      "gives (point feet, discs: lateral_radius_m: 0)")
-#: why the OpenSim export refuses a 3D walker's disc feet
-ROUND_FEET_OSIM_3D = ("OpenSim's contact geometries (sphere, half-space, mesh) have no disc: "
-                      "a disc foot written as a sphere of its radius R touches the ground "
-                      "R sin(lean) across the disc's rim point once the leg's plane leans, so "
-                      "it rolls sideways where the rigid disc cannot; export the disc feet "
-                      "as MJCF (--format mjcf) or an Adams dataset")
 #: what the 3D kneed walker's contact and MJCF cells rest on: their first stride only
 #: (:data:`walkerlab.walker.reference_cases.FIRST_STEPS`)
 KNEED_3D_FIRST_STRIDE = ("held to the rigid gait over its first stride only: the passive "
@@ -316,7 +310,6 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # strike, the push-off and the stance foot's reaction on the walker's extended
         # impact system (walkerlab.codegen.legged.extended_impact), a disc foot's at its
         # material contact point
-        ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
         # the hip torque and the push-off in the rigid model (walkerlab.models.hybrid.
         # actuated._Legs3d: the planar walkers' actuators on the legs' pitch joints), the
         # contact model (walkerlab.models.contact.parts.Legs3DPart.actuators: the planar
@@ -415,8 +408,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # round feet (configs/kneed_round_feet_3d.yaml: each shank's disc, the straight
         # legs' disc on the kneed tree): the rigid model, the gym's rigid view, the contact
         # model (walkerlab.models.contact.parts.Kneed3DPart.foot_pitches: the discs roll by
-        # the shanks' pitches); OpenSim has no disc (the straight legs' reason)
-        ("round_feet_3d", "osim"): ROUND_FEET_OSIM_3D,
+        # the shanks' pitches); OpenSim: the disc as a thin ellipsoid on the shank
+        # (walkerlab.export.opensim_3d, the straight legs' foot)
         # stairs and footholds in the rigid model and the gym's rigid view: the straight
         # legs' landing (the generated swing clearance with the knee locked plus the
         # landing's depth: walkerlab.models.hybrid.ground)
