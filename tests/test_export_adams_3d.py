@@ -356,3 +356,20 @@ def test_a_3d_datasets_hip_roll_law_at_the_start_is_the_rigid_models(tmp_path_fa
     g = {gid: model.gforce(gid) for gid in (31, 32)}
     assert g[31]["TZ"] == "VARVAL(351)" and g[32]["TZ"] == "VARVAL(352)"
     assert (g[31]["I"], g[32]["I"]) == ("302", "402")
+
+
+def test_an_upper_body_on_hip_roll_joints_is_refused_in_one_line(tmp_path):
+    """configs/torso_bhm_3d_stabilised.yaml (an upper body on the bisecting hip, hip-roll
+    joints): each leg's pitch is the second axis of its UNIVERSAL joint, which Adams'
+    COUPLER cannot relate, so the dataset is refused in one line naming walker.torso (it was
+    an internal KeyError), nothing written."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["export", str(ROOT / "configs" / "torso_bhm_3d_stabilised.yaml"),
+                                 "--format", "adm", "--runs-dir", str(tmp_path)])
+    assert r.exit_code != 0 and r.output.count("error:") == 1, r.output
+    assert "walker.torso:" in r.output and "COUPLER" in r.output, r.output
+    assert "internal error" not in r.output and "Traceback" not in r.output
+    assert not list(tmp_path.rglob("*.adm"))

@@ -410,10 +410,13 @@ def _joints(start: Adams3dStart, ids: dict, stance: str) -> list[str]:
                     f"J={100 * ids[b.name] + 10 + ids[c.name]}"]
     stance_joint = next(c.joints[0].name for c in pelvis.children if c.name == stance)
     for cp in start.couplings:   # measured from the pelvis, which turns with the stance leg
-        terms = [(jid[j], c) for j, c in cp.terms if j != stance_joint]
-        if len(terms) != 2 or any(j not in jid for j, _c in cp.terms if j != stance_joint):
+        moving = [(j, c) for j, c in cp.terms if j != stance_joint]
+        if len(moving) != 2 or any(j not in jid for j, _c in moving):
             raise ValueError(f"walker.torso: the coupling {cp.name} is not a relation of "
-                             "two revolutes a COUPLER can hold")
+                             "two revolutes a COUPLER can hold (Adams' COUPLER relates "
+                             "REVOLUTE joints; with hip-roll joints a leg's pitch is the "
+                             "second axis of its UNIVERSAL joint)")
+        terms = [(jid[j], c) for j, c in moving]
         out += [f"! {cp.name}: {' + '.join(f'({c:g}) {j}' for j, c in cp.terms)} = 0;",
                 f"! the revolutes measured from the pelvis (fixed to {stance}); the start "
                 "satisfies it",
