@@ -97,3 +97,63 @@ def test_arms_lower_the_collins_lateral_multiplier(gait):
         if f in measured:
             mu = np.max(np.abs(res.multipliers_variational))
             assert abs(mu - measured[f]) < 1e-4 * mu, (f, mu)
+
+
+#: configs/collins2001_stable.yaml's walker in the reference's names: its legs' mass 0.35 m
+#: above their feet, its shoulders 0.3 m apart (r hip widths)
+STABLE = dict(g=9.81, L=0.6, gamma=GAMMA, M=1.2, m=1.46, a=0.35, I_leg=0.02, R=0.21,
+              R_l=0.37)
+STABLE_ARMS = dict(h=0.25, r=0.3 / 0.18, m=0.34, d=0.24, I=0.0046)
+
+
+@pytest.fixture(scope="module")
+def stable():
+    scene = Scene.model_validate(yaml.safe_load((ROOT / "configs" / "collins2001_stable.yaml")
+                                                .read_text()))
+    walker = build_walker(Plant.from_scene(scene))
+    g = scene.fixedpoint.initial_guess.model_extra
+    x = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                  for n in walker.state_names()])
+    return walker, find_fixed_point(walker, x, SOLVER, fd_check=False)
+
+
+@pytest.mark.slow
+def test_the_stable_collins_gait_and_multipliers_match_newton_euler(stable):
+    """configs/collins2001_stable.yaml against the reference's own stride, root and central
+    differences: the fixed point and period to 1e-8, every multiplier to 1e-6 relative to
+    max(1, |mu|), so the reference, which shares no code with the generator, finds the
+    gait stable too."""
+    _, res = stable
+    ref = TorusReference(**STABLE, arms=STABLE_ARMS)
+    dx, dt, dmu = stride_against(ref, 0.18, res, [0, 2, 3, 4, 5])
+    assert dx < 1e-8 and dt < 1e-8 and dmu < 1e-6
+
+
+@pytest.mark.slow
+def test_the_stable_collins_walker_is_laterally_stable_and_returns_from_a_sideways_kick(
+        stable):
+    """The 4.8 kg, 0.85 m walker on the robot's 3.1 degree slope with 0.18 m of hip width:
+    step period 0.513434 s, step 0.384164 m (0.748 m/s against the robot's 0.51 m/s), every
+    stride multiplier inside the unit circle, the largest the rocking pair (modulus 0.88503,
+    to 1e-5: the fixed point's tolerance 1e-12); and a nonlinear walk of 40 strides from
+    the gait with its lean rate kicked by 0.01 rad/s (and its lean by 1 mrad) ends within
+    1e-3 of the fixed point (measured 1e-4; 0.029 after the first stride)."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    walker, res = stable
+    step = res.period_s / 2
+    length = res.step_lengths_m[0]
+    assert abs(step - 0.5134339) < 1e-5 * step
+    assert abs(length - 0.3841643) < 1e-5 * length
+    mu = res.multipliers_variational
+    assert np.max(np.abs(mu)) < 1
+    assert abs(np.max(np.abs(mu)) - 0.885033) < 1e-5
+    lead = mu[np.argmax(np.abs(mu))]
+    assert abs(lead.imag) > 0.5                        # a complex pair: the rocking
+    names = walker.state_names()
+    x = np.array(res.x, float)
+    x[names.index("lean_rate")] += 0.01
+    x[names.index("lean_angle")] += 0.001
+    for _ in range(40):
+        x = poincare_map(walker, x, SOLVER, 5.0)[0]
+    assert np.max(np.abs(x - res.x)) < 1e-3
