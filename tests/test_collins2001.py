@@ -157,3 +157,23 @@ def test_the_stable_collins_walker_is_laterally_stable_and_returns_from_a_sidewa
     for _ in range(40):
         x = poincare_map(walker, x, SOLVER, 5.0)[0]
     assert np.max(np.abs(x - res.x)) < 1e-3
+
+
+@pytest.mark.slow
+def test_the_collins_walkers_lateral_pair_turns_stable_with_the_hip_width_before_a_fold():
+    """``walkerlab continuation`` of configs/collins2001.yaml in the hip width (0.15 to
+    0.21 m; the rigid model's validity checks on its 3D points, which gave a numpy error
+    before): the rocking pair crosses the unit circle inward at a Neimark-Sacker point,
+    0.20521 m, and the branch folds at 0.20664 m, so the gait is laterally stable between
+    them (configs/collins2001_stable.yaml's parts move that window to 0.175-0.18 m); to
+    1e-4 m (the located points' tolerance is far finer)."""
+    from walkerlab.studies.continuation import run_continuation
+
+    scene = Scene.model_validate(yaml.safe_load((ROOT / "configs" / "collins2001.yaml")
+                                                .read_text()))
+    res, _ = run_continuation(scene, "walker.hip_width_m", 0.15, 0.21,
+                              plant=Plant.from_scene(scene))
+    ns = [s.p for s in res.specials if s.kind == "neimark_sacker" and s.period == 1]
+    folds = [s.p for s in res.specials if s.kind == "fold" and s.period == 1]
+    assert len(ns) == 1 and abs(ns[0] - 0.20521) < 1e-4, res.specials
+    assert len(folds) == 1 and abs(folds[0] - 0.20664) < 1e-4, res.specials

@@ -61,7 +61,8 @@ def normal_force_ratio(w: HybridWalker, segs, n: int = 200) -> float:
 
     The only external forces in a step are gravity and the stance foot's contact force, so
     ``F = M (a_com - g_vec)``; its component along the slope normal ``(sin phi, cos phi)`` is
-    ``N = M (a_com . n + g cos phi)``.  ``a_com`` is the second time derivative of the centre
+    ``N = M (a_com . n + g cos phi)`` (points of either dimension: a walker in 3D has its
+    lateral axis last, across the normal).  ``a_com`` is the second time derivative of the centre
     of mass (the named mass points, :func:`_mass_points`) on the dense output of each phase
     (central differences on ``n`` points inside the phase, so an intra-step impact such as a
     knee strike is not differentiated across).  A negative value means the stance foot would
@@ -74,7 +75,6 @@ def normal_force_ratio(w: HybridWalker, segs, n: int = 200) -> float:
     M = sum(masses.values())
     g = float(w.params["gravity_m_per_s2"])
     phi = float(w.slope_rad)
-    nrm = np.array([math.sin(phi), math.cos(phi)])
     low = math.inf
     for seg in segs:
         for _ph, dense, (ta, tb) in seg.pieces:
@@ -86,6 +86,10 @@ def normal_force_ratio(w: HybridWalker, segs, n: int = 200) -> float:
             com = sum(m * np.asarray(pts[k], float) for k, m in masses.items()) / M
             dt = ts[1] - ts[0]
             acc = np.gradient(np.gradient(com, dt, axis=1), dt, axis=1)[:, 2:-2]
+            # the slope's normal in the points' world axes (x downhill, y up; a walker in
+            # 3D has z across, along which the normal has no component)
+            nrm = np.zeros(len(acc))
+            nrm[:2] = math.sin(phi), math.cos(phi)
             N = (nrm @ acc + g * math.cos(phi)) / g
             low = min(low, float(np.min(N)))
     return low
