@@ -44,6 +44,7 @@ def _scene(name):
 #: a rolling radius that changes with the lean: walkerlab.walker.multibody).
 REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
            "simplest": "walker.leg.bodies", "collins2001": "walker.arms",
+           "collins2001_stable": "walker.arms",
            "collins2001_knees": "walker.arms", "toroidal_arms_3d": "walker.arms",
            "toroidal_feet_3d": "walker.leg.foot.kind"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
