@@ -34,15 +34,20 @@ ARMS = dict(h=0.25, r=2.0, m=0.3, d=0.2, I=0.004)
 WIDTH = 0.15
 
 
-@pytest.fixture(scope="module")
-def gait():
-    scene = Scene.model_validate(yaml.safe_load((ROOT / "configs" / "collins2001.yaml")
+def _gait(name: str):
+    """The shipped scene's walker and its fixed point from its scene's initial guess."""
+    scene = Scene.model_validate(yaml.safe_load((ROOT / "configs" / f"{name}.yaml")
                                                 .read_text()))
     walker = build_walker(Plant.from_scene(scene))
     g = scene.fixedpoint.initial_guess.model_extra
     x = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
                   for n in walker.state_names()])
     return walker, find_fixed_point(walker, x, SOLVER, fd_check=False)
+
+
+@pytest.fixture(scope="module")
+def gait():
+    return _gait("collins2001")
 
 
 @pytest.mark.slow
@@ -108,13 +113,7 @@ STABLE_ARMS = dict(h=0.25, r=0.3 / 0.18, m=0.34, d=0.24, I=0.0046)
 
 @pytest.fixture(scope="module")
 def stable():
-    scene = Scene.model_validate(yaml.safe_load((ROOT / "configs" / "collins2001_stable.yaml")
-                                                .read_text()))
-    walker = build_walker(Plant.from_scene(scene))
-    g = scene.fixedpoint.initial_guess.model_extra
-    x = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
-                  for n in walker.state_names()])
-    return walker, find_fixed_point(walker, x, SOLVER, fd_check=False)
+    return _gait("collins2001_stable")
 
 
 @pytest.mark.slow

@@ -159,6 +159,18 @@ def test_opensim_loads_the_3d_osim_with_the_trees_bodies_at_the_rigid_gait(stabi
     assert got["stations"]["leg1_foot"] == pytest.approx(pts["swing_foot"] + shift, abs=1e-9)
 
 
+def _walks_within_3_percent(name: str, tmp_path):
+    """The shipped scene's .osim walked by OpenSim (``export --walk``): at least 10
+    alternating heel strikes without a fall, the mean step period within 3 % of the rigid
+    gait's (the capability table's OpenSim tolerance); returns the walk's check."""
+    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+    w = export_stage.write(scene, tmp_path, "osim", walk=True, walk_steps=10).walk
+    assert w.walked and not w.fell and w.alternating, w.line
+    assert w.strikes >= 10, w.line
+    assert abs(w.relative) <= 0.03, w.line
+    return w
+
+
 @pytest.mark.slow
 @needs_opensim
 @pytest.mark.parametrize("name", ["hip_width_stabilised", "hip_width_powered"])
@@ -171,12 +183,7 @@ def test_the_stabilised_3d_walkers_walk_in_opensim_within_3_percent(tmp_path, na
     step period 0.646 s against 0.644452 s, +0.24 %).  Before the loop kept its own state
     (the rolls of earlier windows, the test below) the powered walker struck once, at
     0.579 s against 0.6445 s, and fell."""
-    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    ex = export_stage.write(scene, tmp_path, "osim", walk=True, walk_steps=10)
-    w = ex.walk
-    assert w.walked and not w.fell and w.alternating, w.line
-    assert w.strikes >= 10, w.line
-    assert abs(w.relative) <= 0.03, w.line
+    _walks_within_3_percent(name, tmp_path)
 
 
 _ROLLS = """
@@ -324,10 +331,5 @@ def test_the_3d_round_feet_walk_in_opensim_within_3_percent(tmp_path, name, meas
     alternating heel strikes without a fall, the mean step period within 3 % of the rigid
     gait's (the capability table's OpenSim tolerance; measured +0.38 % and +1.79 %, the
     MJCF's -0.02 % and -0.11 %, the contact model's +0.09 % and +0.93 %)."""
-    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    ex = export_stage.write(scene, tmp_path, "osim", walk=True, walk_steps=10)
-    w = ex.walk
-    assert w.walked and not w.fell and w.alternating, w.line
-    assert w.strikes >= 10, w.line
-    assert abs(w.relative) <= 0.03, w.line
+    w = _walks_within_3_percent(name, tmp_path)
     assert w.relative == pytest.approx(measured, abs=0.005), w.line

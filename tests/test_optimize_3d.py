@@ -54,6 +54,19 @@ def _least_effort(name: str, intervals: int):
     return out, r, periods
 
 
+def _assert_passive(out, r, periods, objective: float) -> None:
+    """The least-effort optimum ``out`` is the passive gait ``r`` (``walkerlab fixedpoint``'s,
+    its step periods ``periods`` [s]): IPOPT converged, the objective at most ``objective``
+    [N^2 m^2 s], the start within 1e-6 of the fixed point, the mean step period within
+    1e-7 relative and the replay on the rigid model closing to 1e-6."""
+    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
+    assert out.objective <= objective, out.objective
+    x0 = np.array([v[0] for v in out.states.values()])
+    np.testing.assert_allclose(x0, r.x, atol=1e-6)
+    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
+    assert out.replay_error <= 1e-6
+
+
 def _guess_of(scene) -> np.ndarray:
     """The scene's ``fixedpoint.initial_guess`` as a state (2n,) [rad, rad/s]."""
     g = scene.fixedpoint.initial_guess.model_dump()
@@ -138,12 +151,7 @@ def test_the_least_effort_3d_gait_on_its_passive_slope_is_its_passive_gait(name,
     impact at the leading disc's material contact point."""
     pytest.importorskip("casadi")
     out, r, periods = _least_effort(name, intervals)
-    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
-    assert out.objective <= 1e-10
-    x0 = np.array([v[0] for v in out.states.values()])
-    np.testing.assert_allclose(x0, r.x, atol=1e-6)
-    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
-    assert out.replay_error <= 1e-6
+    _assert_passive(out, r, periods, 1e-10)
 
 
 @pytest.mark.slow
@@ -228,12 +236,7 @@ def test_the_least_effort_3d_kneed_gait_on_its_passive_slope_is_its_passive_gait
     out, r, periods = _least_effort("kneed_3d_stabilised", 80)
     assert tuple(out.phase_names) == stride_phases([("unlocked_swing", "knee_strike", 1),
                                                     ("locked_swing", "heel_strike", -1)])
-    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
-    assert out.objective <= 1e-8
-    x0 = np.array([v[0] for v in out.states.values()])
-    np.testing.assert_allclose(x0, r.x, atol=1e-6)
-    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
-    assert out.replay_error <= 1e-6
+    _assert_passive(out, r, periods, 1e-8)
 
 
 @pytest.mark.slow
@@ -248,12 +251,7 @@ def test_the_least_effort_3d_kneed_gait_on_disc_feet_is_its_passive_gait():
     1e-6."""
     pytest.importorskip("casadi")
     out, r, periods = _least_effort("kneed_round_feet_3d", 80)
-    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
-    assert out.objective <= 1e-8
-    x0 = np.array([v[0] for v in out.states.values()])
-    np.testing.assert_allclose(x0, r.x, atol=1e-6)
-    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
-    assert out.replay_error <= 1e-6
+    _assert_passive(out, r, periods, 1e-8)
 
 
 @pytest.mark.parametrize("name", ["hip_width_footholds", "kneed_3d_stabilised_footholds"])
@@ -442,9 +440,4 @@ def test_the_least_effort_3d_gait_on_two_footholds_is_the_passive_period_two_gai
     walker on the footholds closing to 1e-6 (seen 2.0e-7; 1.0e-6 on 40 intervals)."""
     pytest.importorskip("casadi")
     out, r, periods = _least_effort("hip_width_footholds", 60)
-    assert out.status == "Solve_Succeeded" and out.gait, (out.status, out.replay_error)
-    assert out.objective <= 1e-10, out.objective
-    x0 = np.array([v[0] for v in out.states.values()])
-    np.testing.assert_allclose(x0, r.x, atol=1e-6)
-    assert out.step_period_s == pytest.approx(periods.mean(), rel=1e-7)
-    assert out.replay_error <= 1e-6
+    _assert_passive(out, r, periods, 1e-10)

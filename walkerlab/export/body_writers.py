@@ -86,12 +86,6 @@ def check_legs_3d(job: ExportJob, w: Writer) -> None:
     if scene.walker.actuation is not None:  # passive so far: the table's reason
 
         refuse_actuators(kind, scene.walker.actuation, w.view)
-        if (st.foot == "arc" and w.view == "osim"
-                and scene.walker.actuation.push_off is not None):
-            raise ValueError("walker.actuation.push_off: on round feet the OpenSim model's "
-                             "push-off force would act at a point fixed on the leg, the rigid "
-                             "model's at the disc's rolling contact: export the disc feet's "
-                             "push-off as MJCF (--format mjcf) or walk it with contact-sim")
 
 
 def round_feet_3d_fields(job: ExportJob) -> str:

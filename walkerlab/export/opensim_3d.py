@@ -114,7 +114,7 @@ from walkerlab.export.tree_bodies import ExportJoint
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 from walkerlab.models.contact.rigid_limit import contact_si
 
-__all__ = ["DISC_THICKNESS", "ROLL_MOTORS", "Osim3dGait", "disc_contact_radius",
+__all__ = ["DISC_THICKNESS", "ROLL_MOTORS", "Osim3dGait", "check_osim3d", "disc_contact_radius",
            "osim3d_bodies", "osim3d_gait", "osim3d_omissions", "osim3d_state", "osim3d_text"]
 
 #: a round foot's ellipsoid: its semi-axis along the leg's pitch axis over the disc's radius
@@ -244,6 +244,29 @@ def _patches(gait: Osim3dGait, r_point: float, slope_rad: float):
     return rg, lanes
 
 
+def check_osim3d(scene, data) -> None:
+    """Refuse in one line what the 3D OpenSim model does not carry beyond the capability
+    table's cells: a push-off on round feet (its ``PrescribedForce`` acts at a point fixed
+    on the leg, the rigid model's impulse at the disc's rolling contact).
+
+    Raises
+    ------
+    ValueError
+        Naming ``walker.actuation.push_off``.
+    """
+    act = scene.walker.actuation
+    if round_feet(data) and act is not None and act.push_off is not None:
+        raise ValueError("walker.actuation.push_off: on round feet the OpenSim model's "
+                         "push-off force would act at a point fixed on the leg, the rigid "
+                         "model's at the disc's rolling contact: export the disc feet's "
+                         "push-off as MJCF (--format mjcf) or walk it with contact-sim")
+
+
+def _disc_radii(r_disc: float) -> str:
+    """A round foot's ellipsoid's semi-axes ``(R, R, R DISC_THICKNESS)`` [m] as written."""
+    return nums(r_disc, r_disc, r_disc * DISC_THICKNESS)
+
+
 def disc_contact_radius(r_disc: float, r_patch: float) -> float:
     """Effective radius [m] of Simbody's Hunt-Crossley contact between a round foot's
     ellipsoid (semi-axes ``(R, R, R DISC_THICKNESS)``, module docstring) on its rim and a
@@ -265,8 +288,7 @@ def _geometry(feet, lanes, r_foot: float, rg: float, slope_rad: float,
     out = ['\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
     for ft in feet:
         leg = ft.name.split("_")[0]
-        radii = nums(r_foot, r_foot, r_foot * DISC_THICKNESS)
-        shape, size = (("ContactEllipsoid", f"<radii>{radii}</radii>") if disc else
+        shape, size = (("ContactEllipsoid", f"<radii>{_disc_radii(r_foot)}</radii>") if disc else
                        ("ContactSphere", f"<radius>{num(r_foot)}</radius>"))
         out += [f"{i}<{shape} name=\"{leg}_foot\">",
                 f"{i}\t<socket_frame>/bodyset/{ft.name}</socket_frame>",
@@ -363,7 +385,7 @@ def osim3d_text(data, gait: Osim3dGait, name: str, version: str = "") -> str:
            comment(f"Feet: a sphere of radius {num(r_foot)} m, its centre L - r down the leg."
                    if not disc else
                    f"Feet: the disc of radius {num(r_foot)} m in each leg's plane as an "
-                   f"ellipsoid of semi-axes ({nums(r_foot, r_foot, r_foot * DISC_THICKNESS)}) "
+                   f"ellipsoid of semi-axes ({_disc_radii(r_foot)}) "
                    "m, the thin one along the leg's pitch axis, its centre L - R down the leg "
                    "(walkerlab.export.opensim_3d).")]
     if act is not None and act.push_off is not None:

@@ -119,10 +119,14 @@ class OpensimWalk(MujocoWalk):
 
 
 def _foot_geometry(osim, geometry):
-    """A foot's contact geometry as its own type: a point or arc foot's ``ContactSphere``,
-    a 3D round foot's ``ContactEllipsoid`` (:mod:`walkerlab.export.opensim_3d`)."""
+    """``(geometry, radius [m])``: a foot's contact geometry as its own type, a point or arc
+    foot's ``ContactSphere`` and its radius, or a 3D round foot's ``ContactEllipsoid`` and its
+    disc's radius, the first semi-axis (:mod:`walkerlab.export.opensim_3d`)."""
     sphere = osim.ContactSphere.safeDownCast(geometry)
-    return sphere if sphere is not None else osim.ContactEllipsoid.safeDownCast(geometry)
+    if sphere is not None:
+        return sphere, sphere.getRadius()
+    disc = osim.ContactEllipsoid.safeDownCast(geometry)
+    return disc, disc.getRadii().get(0)
 
 
 def _header(text: str) -> dict:
@@ -433,8 +437,10 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
     fs = model.getForceSet()
     groups, stance = _contact_groups(fs)
     contact = {g: fs.get(f"{g}_contact") for g in groups}
-    feet = {g: _foot_geometry(osim, model.getContactGeometrySet().get(f"{g}_foot"))
-            for g in groups}
+    geometries = {g: _foot_geometry(osim, model.getContactGeometrySet().get(f"{g}_foot"))
+                  for g in groups}
+    feet = {g: geometry for g, (geometry, _r) in geometries.items()}
+    radius = {g: r for g, (_geometry, r) in geometries.items()}
     # the body that carries the foot sphere (a leg, a shank; a 3D kneed leg's leg<i>_shank)
     bodies = {g: model.getBodySet().get(feet[g].getFrame().getName()) for g in groups}
     foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in groups}
@@ -474,9 +480,6 @@ def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
             sph = osim.ContactSphere.safeDownCast(cg.get(f"{g}_patch{len(patches[g])}"))
             loc = osim.Vec3(sph.get_location()).to_numpy()[:2]
             patches[g].append((float(loc @ t_hat), float(loc @ n_hat) + sph.getRadius()))
-    # a foot sphere's radius; a round foot's ellipsoid: its disc's (the first semi-axis)
-    radius = {g: (feet[g].getRadius() if hasattr(feet[g], "getRadius")
-                  else feet[g].getRadii().get(0)) for g in groups}
     half = info.get("patch_width", 0.0) / 2
     off = info.get("latch_offset", 0.0)  # the contact point below the sphere's centre
 

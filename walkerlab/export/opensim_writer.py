@@ -27,7 +27,12 @@ from walkerlab.export.opensim import (
     osim_omissions,
     osim_text,
 )
-from walkerlab.export.opensim_3d import osim3d_gait, osim3d_omissions, osim3d_text
+from walkerlab.export.opensim_3d import (
+    check_osim3d,
+    osim3d_gait,
+    osim3d_omissions,
+    osim3d_text,
+)
 from walkerlab.export.opensim_wheel import osim_wheel3d_text, osim_wheel_text
 from walkerlab.export.scene import check_exportable
 from walkerlab.export.tree_links import tree_multibody
@@ -62,6 +67,7 @@ class OsimWriter(TreeWriter):
         """The 3D legs from their body tree (:mod:`walkerlab.export.opensim_3d`)."""
         scene, data = job.scene, job.data
         check_legs_3d(job, w)
+        check_osim3d(scene, data)
         if job.walker_only:
             raise ValueError(WALKER_ONLY)
         ideal, gait = job.gait(lambda ideal: osim3d_gait(job.plant, ideal))
