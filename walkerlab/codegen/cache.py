@@ -30,7 +30,10 @@ ENV = usercache.ENV
 _GENERATOR_FILES = ("codegen/legged.py", "codegen/tree_derive.py", "walker/tree.py",
                     "walker/trees.py", "codegen/seeded.py", "codegen/source.py",
                     "walker/description.py", "codegen/cache.py", "codegen/equations.py",
-                    "codegen/lagrange.py", "codegen/compiled_source.py", "codegen/frames.py")
+                    "codegen/lagrange.py", "codegen/compiled_source.py", "codegen/frames.py",
+                    # the parts trees.py hangs on a biped (arms, a torus' stance side) and
+                    # the torus' rolling: an edit there changes the equations too
+                    "walker/arm_trees.py", "walker/foot_trees.py", "codegen/rolling_feet.py")
 _memo: dict[str, dict] = {}
 #: what each generated module of the cache folder is, by a part of its file name (the first
 #: key here that is a part of it: ``<key>_act_<tag>_nb.py`` is an actuated flow, not ``nb``)

@@ -294,11 +294,12 @@ def _legs_3d(structure: Structure) -> FloatingEquations:
     knee = structure.knee
     feet_links = ("swing_shank", "stance_shank") if knee else ("swing_leg", "stance_leg")
     feet, points = [], {}
-    if structure.foot == "arc":  # each disc's lowest point, its material point's Jacobian
-        radius = dict(zip(tree.params, kin.params))["R_foot"]
+    if structure.foot in ("arc", "toroidal"):  # each foot's lowest point, its material
+        P = dict(zip(tree.params, kin.params))  # point's Jacobian
+        radius, lateral = P["R_foot"], P.get("R_lat", 0)
         for leg, link, centre in (("leg1", feet_links[0], kin.contacts["swing_foot_centre"]),
                                   ("leg2", feet_links[1], kin.origins[feet_links[1]])):
-            low, J = _disc_contact(kin, link, centre, radius)
+            low, J = _disc_contact(kin, link, centre, radius, lateral)
             pos = to_world * low.xreplace(rename)
             feet.append((pos, (to_world * J).xreplace(rename)))
             points[f"{leg}_contact"] = pos
@@ -470,21 +471,25 @@ def legs_axial_inertia(structure: Structure, eq: FloatingEquations) -> FloatingE
                                kinetic=eq.kinetic + sp.Rational(1, 2) * (dqv.T * dM * dqv)[0])
 
 
-def _disc_contact(kin, body: str, centre, radius):
+def _disc_contact(kin, body: str, centre, radius, lateral=0):
     """A round foot's contact on the slope: the lowest point of the disc of ``radius``
     about ``centre`` (3, 1) in the plane normal to ``body``'s ``z`` axis (its leg's
     sagittal plane; McGeer 1990), ``centre - R u / |u|`` with ``u = n - (n . a) a`` the
     slope's normal ``n`` without its part along the disc's axis ``a``, and the Jacobian
     (3, nq) of the disc's material point there, ``v = v_centre + omega x (low - centre)``
     (``omega`` the body's angular velocity: a disc that rolls without slip has that point
-    at rest).  Slope frame, the tree's own coordinates (``kin``:
+    at rest).  A foot curved both ways (``lateral`` the tube's radius ``R_l``, the torus'
+    major radius ``R - R_l``; Coleman & Ruina 1998, :mod:`walkerlab.codegen.rolling_feet`):
+    the tube's centre circle's lowest point, ``R_l`` lower, ``centre - (R - R_l) u / |u| -
+    R_l n``.  Slope frame, the tree's own coordinates (``kin``:
     :class:`walkerlab.codegen.tree_derive.TreeKinematics`)."""
     import sympy as sp
 
     R_b = kin.rotations[body]
     a = R_b * sp.Matrix([0, 0, 1])
-    u = sp.Matrix([0, 1, 0]) - a[1] * a
-    low = centre - radius * u / sp.sqrt(1 - a[1] ** 2)
+    n = sp.Matrix([0, 1, 0])
+    u = n - a[1] * a
+    low = centre - (radius - lateral) * u / sp.sqrt(1 - a[1] ** 2) - lateral * n
     r = low - centre
     skew = sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
     omega = R_b * kin.omegas[body].jacobian(sp.Matrix(kin.dq))

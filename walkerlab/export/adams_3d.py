@@ -66,7 +66,7 @@ friction, :func:`walkerlab.export.adams_contact.contact_mm`) with its own lane's
 
 Start: the rigid gait's post-heel-strike state (``fixedpoint.h5``'s, or searched), leg2 in
 stance, its foot point at the origin: the pelvis' pose and velocity and the hinges' angles
-and rates of :func:`walkerlab.export.legs_3d_mjcf.legs3d_keyframe` (with no foot-sphere
+and rates of :func:`walkerlab.export.legs_3d_keyframe.legs3d_keyframe` (with no foot-sphere
 shift: the sphere's centre is the rigid foot), each part's pose and velocity composed down
 the tree; the pelvis turns with leg2 (its FIXED joint), its centre of mass on the hip axis
 moving as the rigid hip does.  No rate scale (``contact_sim.initial_rate_scale`` is the
@@ -110,12 +110,8 @@ from walkerlab.export.adams_contact import contact_mm, contact_statement
 from walkerlab.export.adams_hip_roll import ROLL_FRAME, hip_roll_statements
 from walkerlab.export.adams_statements import MM, _deg, _f, _fs, _stmt, marker_statement
 from walkerlab.export.axes_3d import slope_axes
-from walkerlab.export.legs_3d_mjcf import (
-    PATCH_ACROSS_L,
-    PATCH_ACROSS_PUSHED_L,
-    _rotation,
-    legs3d_keyframe,
-)
+from walkerlab.export.legs_3d_keyframe import legs3d_keyframe, rotation_about
+from walkerlab.export.legs_3d_mjcf import PATCH_ACROSS_L, PATCH_ACROSS_PUSHED_L
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
     kneed,
@@ -292,7 +288,7 @@ def adams3d_start(plant, ideal, strides: int) -> Adams3dStart:
                              for q in j.angle.free_symbols))
             hinges[j.name] = (np.asarray(j.axis, float), ang, rate)
             w = w + rate * (R @ np.asarray(j.axis, float))
-            R = R @ _rotation(j.axis, ang)
+            R = R @ rotation_about(j.axis, ang)
         return R, w
 
     if rolled:  # the pelvis on slides and its roll hinge

@@ -76,9 +76,8 @@ def check_legs_3d(job: ExportJob, w: Writer) -> None:
     scene, data, kind = job.scene, job.data, job.kind
     kind.require("walk", w.view, "walker.space: 3d")
     st = data.structure
-    if st.foot == "toroidal":   # the floating view's refusal (its rolling radius, the lean)
-        check_floating_view(st)
-    if st.foot == "arc" or any(b.kind == "rod" for b in st.bodies):
+    check_floating_view(st)
+    if st.rolling_feet or any(b.kind == "rod" for b in st.bodies):
         kind.require("round_feet_3d", w.view, round_feet_3d_fields(job))
     if data.structure.hip_roll:
         kind.require("hip_roll", w.view, "walker.hip_roll")
@@ -187,6 +186,10 @@ class UrdfWriter(TreeWriter):
         keyframe."""
         scene = job.scene
         check_legs_3d(job, w)
+        if job.data.structure.foot == "toroidal":
+            raise ValueError("walker.leg.foot.kind: toroidal feet are not in the URDF (its "
+                             "geometries are boxes, cylinders, spheres and meshes: no "
+                             "spheroid); export --format mjcf carries them")
         text = legs_urdf_text(job.data, job.name, walkerlab.__version__,
                               scene.walker.actuation)
         left_out = legs_urdf_omissions(job.data, scene.walker.actuation)

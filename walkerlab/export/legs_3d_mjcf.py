@@ -46,7 +46,8 @@ lean at the first step of configs/paper_3d.yaml), which the unstable roll (x 11.
 grows to 1e-6 rad by the tenth heel strike; the elliptic cone keeps an upright walker
 upright (< 1e-23 rad over 11 heel strikes).
 
-Keyframe ``gait``: the rigid gait's post-heel-strike state (:func:`legs3d_keyframe`).
+Keyframe ``gait``: the rigid gait's post-heel-strike state
+(:func:`walkerlab.export.legs_3d_keyframe.legs3d_keyframe`).
 
 Knees (``locking_knees_3d``, :func:`~walkerlab.export.legs_3d_parts.legs3d_roles`): each thigh
 ``leg<i>`` carries its shank ``leg<i>_shank`` (and the foot) on a hinge ``leg<i>_knee`` about
@@ -117,10 +118,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.export.axes_3d import TO_MUJOCO, slope_axes
+from walkerlab.export.axes_3d import slope_axes
+from walkerlab.export.legs_3d_keyframe import legs3d_keyframe
 from walkerlab.export.legs_3d_parts import (
     DISC_HALF_THICKNESS_L,
+    arms_keyframe,
     bisector_keyframe,
+    foot_spheroid,
+    held_pelvis,
     hip_roll_law,
     kneed,
     leg_links,
@@ -142,10 +147,11 @@ from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.models.contact.rigid_limit import contact_si
+from walkerlab.walker.foot_trees import creep_rate
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
 __all__ = ["DISC_CCD_TOLERANCE_L", "DISC_LATCH_SOLREF", "TORSION_FRACTION", "Legs3dScene",
-           "legs3d_footfalls", "legs3d_keyframe", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad",
+           "legs3d_footfalls", "legs3d_mjcf", "legs3d_scene", "pelvis_lean_rad",
            "pelvis_rod_inertia"]
 
 #: footfall patches across the slope, as a fraction of the leg length: a passive walker's
@@ -176,104 +182,6 @@ DISC_CCD_TOLERANCE_L = 1e-10
 DISC_LATCH_SOLREF = (0.001, 1.0)
 
 
-def _rotation(axis, angle: float) -> np.ndarray:
-    """Rotation matrix (3, 3) by ``angle`` [rad] about the unit vector ``axis`` (3,)."""
-    k = np.asarray(axis, float)
-    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
-
-
-def legs3d_keyframe(points, velocities, x, slope_rad: float,
-                    foot_radius_m: float) -> tuple[tuple, tuple]:
-    """The ``gait`` keyframe of the 3D legged walker at the rigid state ``x`` after a heel
-    strike (leg2 in stance): MuJoCo's ``qpos`` (9,) and ``qvel`` (8,) (:data:`TO_MUJOCO`).
-
-    ``qpos`` = the pelvis' position [m], its orientation as the unit quaternion ``w, x, y,
-    z`` (the rigid model's roll ``lean`` about the fall line ``s``: ``C Rot(s, lean) C^T``,
-    ``C`` = :data:`TO_MUJOCO`), then ``leg1_hip`` = the swing angle and ``leg2_hip`` = the
-    stance angle [rad] (the rigid legs are ``Rot(s, lean) Rot(z, theta)``: the hinge angle
-    about the pelvis' hip axis is ``theta``).  ``qvel`` = the pelvis' velocity [m/s] (world
-    axes), its angular velocity ``lean' s`` [rad/s] in the body's axes (MuJoCo's free
-    joint), then the two legs' rates [rad/s].
-
-    The stance foot's sphere (radius ``r``, centre ``L - r`` down the leg) touches the
-    slope at the origin, where the rigid point foot is: the walker is moved by
-    ``r (e + n)`` (``e`` the stance leg's unit vector from hip to foot, ``n`` the slope's
-    normal), and its velocities are the rigid ones plus ``r omega x (e + n)`` (``omega``
-    the stance leg's angular velocity, ``lean' s + theta_st' a``, ``a`` the hip axis): the
-    stance leg turning about its contact point, as the sphere rolls.
-
-    Parameters
-    ----------
-    points, velocities : callable ``x -> dict[str, ndarray (3,)]``
-        The rigid walker's generated ``points`` and ``point_velocities``
-        (:func:`walkerlab.codegen.cache.functions`; world axes of walkerlab, the stance foot
-        at the origin): ``hip`` (the pelvis), ``stance_hip``.
-    x : ndarray (6,), (8,), (10,) or (12,)
-        ``[lean, swing, stance]`` [rad] and their rates [rad/s]; knees: ``[lean,
-        swing_thigh, swing_shank, stance]``, each leg's hip then knee ``swing_thigh,
-        swing_shank - swing_thigh, stance, 0`` and their rates; with hip-roll joints
-        ``[lean, swing, stance, pelvis_roll, swing_roll]`` and their rates: then ``qpos``
-        (8,) = the pelvis' slides, its roll, ``leg1_roll`` = ``swing_roll - pelvis_roll``,
-        ``leg1_hip``, ``leg2_roll`` = ``lean - pelvis_roll``, ``leg2_hip``, ``qvel`` (8,)
-        their rates (the pelvis rolled by ``pelvis_roll``, the stance leg's pitch axis
-        ``Rot(s, lean) z``); knees with hip-roll joints ``[lean, swing_thigh,
-        swing_shank, stance, pelvis_roll, swing_roll]`` and their rates: each leg's roll,
-        hip, then knee (the stance knee straight).
-    slope_rad : float
-    foot_radius_m : float
-        The foot sphere's radius ``r`` [m]; 0 for round feet (the rigid model's discs are
-        the file's: its state needs no shift).
-
-    Returns
-    -------
-    (qpos (9,), qvel (8,)); knees (11,), (10,); hip-roll joints (8,), (8,); both (10,) each
-    """
-    from scipy.spatial.transform import Rotation
-
-    x = np.asarray(x, float)
-    rolled = x.size in (10, 12)  # hip-roll joints: the pelvis' and the swing leg's own rolls
-    kneed = x.size in (8, 12)    # a knee on the swing leg: its shank's own angle
-    if rolled and kneed:
-        lean, sw, shank, st, pelvis_roll, swing_roll, dlean, dsw, dshank, dst, dpelvis, dswing = x
-    elif rolled:
-        lean, sw, st, pelvis_roll, swing_roll, dlean, dsw, dst, dpelvis, dswing = x
-    else:   # the pelvis and the swing leg roll with the stance leg's lean
-        if kneed:
-            lean, sw, shank, st, dlean, dsw, dshank, dst = x
-        else:
-            lean, sw, st, dlean, dsw, dst = x
-        pelvis_roll, swing_roll, dpelvis, dswing = lean, lean, dlean, dlean
-    C = np.array(TO_MUJOCO)
-    fall, nrm = np.array([[math.cos(slope_rad), -math.sin(slope_rad), 0.0],   # walkerlab's
-                          [math.sin(slope_rad), math.cos(slope_rad), 0.0]])    # world axes
-    R = _rotation(fall, pelvis_roll)                        # pelvis -> world (walkerlab)
-    axis = _rotation(fall, lean) @ np.array([0.0, 0.0, 1.0])   # the stance leg's pitch axis
-    pts = {k: np.ravel(np.asarray(v, float)) for k, v in points(x).items()}
-    vel = {k: np.ravel(np.asarray(v, float)) for k, v in velocities(x).items()}
-    e = -pts["stance_hip"] / np.linalg.norm(pts["stance_hip"])   # stance hip -> foot
-    omega_st = dlean * fall + dst * axis
-    shift = foot_radius_m * (e + nrm)
-    pelvis = pts["hip"] + shift
-    v_pelvis = vel["hip"] + foot_radius_m * np.cross(omega_st, e + nrm)
-    Rm = C @ R @ C.T
-    qx, qy, qz, qw = Rotation.from_matrix(Rm).as_quat()
-    qpos = (*(C @ pelvis), qw, qx, qy, qz, sw, st)
-    qvel = (*(C @ v_pelvis), *(Rm.T @ (C @ (dpelvis * fall))), dsw, dst)
-    if rolled and kneed:  # ... each leg's roll, its hip, then its knee (the stance's straight)
-        qpos = (*qpos[:3], pelvis_roll, swing_roll - pelvis_roll, sw, shank - sw,
-                lean - pelvis_roll, st, 0.0)
-        qvel = (*qvel[:3], dpelvis, dswing - dpelvis, dsw, dshank - dsw, dlean - dpelvis,
-                dst, 0.0)
-    elif rolled:  # the pelvis on slides, yaw (0) and roll; each leg's roll, then its hinge
-        qpos = (*qpos[:3], pelvis_roll, swing_roll - pelvis_roll, sw, lean - pelvis_roll, st)
-        qvel = (*qvel[:3], dpelvis, dswing - dpelvis, dsw, dlean - dpelvis, dst)
-    elif kneed:   # each leg's hip, then its knee (the stance knee straight)
-        qpos = (*qpos[:7], sw, shank - sw, st, 0.0)
-        qvel = (*qvel[:6], dsw, dshank - dsw, dst, 0.0)
-    return tuple(float(v) for v in qpos), tuple(float(v) for v in qvel)
-
-
 @dataclass(frozen=True)
 class Legs3dScene:
     """What the 3D walker's MJCF carries beyond the walker (:func:`legs3d_scene`).
@@ -282,7 +190,7 @@ class Legs3dScene:
     ----------
     qpos, qvel : tuple of float
         The ``gait`` keyframe (9,), (8,) or, with hip-roll joints, (8,), (8,)
-        (:func:`legs3d_keyframe`).
+        (:func:`walkerlab.export.legs_3d_keyframe.legs3d_keyframe`).
     lanes : (ndarray (k1, 3), ndarray (k2, 3))
         leg1's and leg2's footfalls in MuJoCo's axes [m] (:func:`legs3d_footfalls`).
     patch_width_m : float
@@ -332,7 +240,12 @@ class Legs3dScene:
 def _patches_across(data, L: float) -> tuple[float, str]:
     """The footfall patches' width across the slope [m] (:data:`PATCH_ACROSS_L`, with the
     hip-roll law :data:`PATCH_ACROSS_PUSHED_L`, of the leg length ``L``) and why, for the
-    file's note."""
+    file's note; toroidal feet: wider by the lateral radius ``R_l``)."""
+    if data.structure.foot == "toroidal":   # the contact rolls R_l lean across the foot
+        p = dict(zip(data.structure.param_names, data.params))
+        across = PATCH_ACROSS_L * L + p["R_lat"]
+        return across, (f"{across:g} m across: a toroidal foot's contact runs R_l lean "
+                        "across it, R_l for every lean up to 0.5 rad either way")
     if data.structure.hip_roll:
         across = PATCH_ACROSS_PUSHED_L * L
         return across, (f"{across:g} m across: the stabilised gait pushed by +-5 % of its "
@@ -375,10 +288,15 @@ def legs3d_scene(plant, ideal, options=None) -> Legs3dScene:
     p = legs3d_numbers(data)
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
-                                 data.slope_rad, 0.0 if round_feet(data) else p["r"])
+                                 data.slope_rad, 0.0 if round_feet(data) else p["r"],
+                                 creep_rate(data.structure.roles, p),
+                                 held_pelvis(data) and not data.structure.hip_roll)
     if data.structure.torso:   # the upper body's hinge after leg2's (MuJoCo's body order)
         q, v = bisector_keyframe(data.structure.roles, ideal.x)
         qpos, qvel = qpos + (q,), qvel + (v,)
+    if data.structure.arms:    # then the arms', each at its opposite leg's hinge
+        q, v = arms_keyframe(data.structure.roles, ideal.x)
+        qpos, qvel = qpos + q, qvel + v
     lanes = legs3d_lanes(plant, f["points"], ideal.x, EXPORT_STEPS)
     if kneed(data) and round_feet(data):  # no patch under the trailing disc (module docstring)
         lanes = (lanes[0][1:], lanes[1])
@@ -452,7 +370,9 @@ def _geoms(p: dict, roles: PelvisRoles, disc: bool = False):
     lane's), a sphere at each other massive body's centre of mass."""
     L, w, r = p["L"], p["w_hip"], p["r"]
     links = leg_links(p, roles)
-    foot_geom = (f'type="cylinder" size="{nums(r, DISC_HALF_THICKNESS_L * L)}" zaxis="0 1 0" '
+    foot_geom = (f'type="ellipsoid" size="{nums(*foot_spheroid(r, p["R_lat"]))}" '
+                 if disc and "R_lat" in p else
+                 f'type="cylinder" size="{nums(r, DISC_HALF_THICKNESS_L * L)}" zaxis="0 1 0" '
                  if disc else 'type="sphere" ')
     size = "" if disc else f' size="{num(r)}"'
 
@@ -534,18 +454,25 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     r, phi = p["r"], data.slope_rad
     disc = round_feet(data)
     law = hip_roll_law(data)
+    pelvis = ("on three slides and a roll about the fall line (it neither pitches nor yaws, "
+              "as the rigid model's: the arms' shoulders held above the hips, the stance "
+              "foot free to spin about the ground's normal)" if held_pelvis(data)
+              and not law else "a free body (joint 'free', no plane constraint)")
+    foot = ("spheroid about the hip axis (module docstring: the toroidal foot's rim and "
+            "curvatures)" if "R_lat" in p else
+            "disc (a cylinder about the hip axis)" if disc else "sphere")
     head = comment(f"walker {name!s} in 3D exported by walkerlab {version} (MJCF): "
                    f"{legs_header(data, p)}; slope {num(phi)} "
-                   "rad; the pelvis a free body (joint 'free', no plane constraint), the legs "
+                   f"rad; the pelvis {pelvis}, the legs "
                    "on hinges leg<i>_hip about the hip axis (0 -1 0: positive = foot ahead); "
-                   "x downhill, z up, leg1 on the side of -y; a foot "
-                   f"{'disc (a cylinder about the hip axis)' if disc else 'sphere'} of radius "
+                   f"x downhill, z up, leg1 on the side of -y; a foot {foot} of radius "
                    f"{num(r)} m, its centre L - r down the leg (site leg<i>_foot).")
-    # with hip-roll joints the joints hold the feet from twisting (the pelvis neither
-    # pitches nor yaws): a torsional friction on top is a redundant constraint (condim 3)
+    # a pelvis that neither pitches nor yaws holds the feet from twisting: a torsional
+    # friction on top is a redundant constraint (condim 3)
     contact = None if extra is None else MjcfContact(
         extra.timestep_s, extra.solref, extra.solimp,
-        (extra.friction, TORSION_FRACTION * p["L"], 0), 4 if law is None else 3, "elliptic",
+        (extra.friction, TORSION_FRACTION * p["L"], 0), 3 if held_pelvis(data) else 4,
+        "elliptic",
         DISC_CCD_TOLERANCE_L * p["L"] if disc else None)
     act = extra.actuation if extra is not None else None
     root, geoms, tendons, equality = _bodies(data)

@@ -8,6 +8,8 @@ lanes) :mod:`walkerlab.export.opensim_3d`.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from walkerlab.analysis.contact.footfalls import rigid_footfalls
@@ -19,19 +21,31 @@ from walkerlab.walker.description import state_names
 from walkerlab.walker.trees import legs_tree
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
-__all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "bisector_keyframe", "hip_roll_law", "kneed",
-           "leg_links", "legs3d_bodies", "legs3d_footfalls", "legs3d_lanes", "legs3d_numbers",
-           "legs3d_roles", "legs_header", "legs_summary", "legs_words",
-           "round_feet", "walker_tree"]
+__all__ = ["DISC_HALF_THICKNESS_L", "SHANK", "arms_keyframe", "bisector_keyframe",
+           "foot_spheroid", "held_pelvis", "hip_roll_law", "kneed", "leg_links", "legs3d_bodies",
+           "legs3d_footfalls", "legs3d_lanes", "legs3d_numbers", "legs3d_roles", "legs_header",
+           "legs_summary", "legs_words", "round_feet", "walker_tree"]
 
 #: a round foot's disc: its half-thickness along the hip axis, as a fraction of the leg
 #: length (the leg capsule's radius: thin against the disc's radius, the rigid model's disc
 #: having none)
 DISC_HALF_THICKNESS_L = 0.01
 
+def foot_spheroid(R: float, R_l: float) -> tuple[float, float, float]:
+    """A toroidal foot's MJCF geom (MuJoCo has no torus): the spheroid of semi-axes ``(R,
+    sqrt(R R_l), R)`` [m] about the torus' axis (the leg frame's ``y``), whose rim is the
+    foot's sagittal circle of radius ``R`` and whose meridian's radius of curvature there
+    is ``sqrt(R R_l)^2 / R = R_l``, the torus' lateral radius: the two surfaces share both
+    principal curvatures all along the rim and part at the lean's fourth power (the lowest
+    point 3.5 um apart at 0.1 rad on configs/collins2001_stable.yaml's 0.21 / 0.37 m
+    feet)."""
+    return (R, math.sqrt(R * R_l), R)
+
+
 def round_feet(data) -> bool:
-    """The 3D walker has round feet (a disc of radius ``R_foot`` in each leg's plane)."""
-    return data.structure.foot == "arc"
+    """The 3D walker has round feet: a disc of radius ``R_foot`` in each leg's plane, or a
+    torus patch (``toroidal``: its rim that disc, its lateral radius ``R_lat``)."""
+    return data.structure.rolling_feet
 
 
 def legs3d_numbers(data) -> dict:
@@ -103,12 +117,21 @@ def kneed(data) -> bool:
     return body_tree(data.structure)[0].has_joint("swing_knee")
 
 
+def held_pelvis(data) -> bool:
+    """The export's pelvis neither pitches nor yaws, as the rigid model's (three slides and
+    a roll about the fall line): with hip-roll joints (their law holds the feet from
+    twisting) and with arms, whose shoulders the pelvis holds above the hips (free, the
+    pelvis would turn about the hip axis with the arms' weight above it; the rigid model's
+    pelvis keeps its pitch, :mod:`walkerlab.walker.arm_trees`)."""
+    return hip_roll_law(data) is not None or bool(data.structure.arms)
+
+
 def legs3d_roles(data) -> PelvisRoles:
     """The 3D legs' export roles, the MJCF's and the URDF's: the pelvis free, or on its roll
-    (hip-roll joints); knees ``leg<i>_knee`` on shanks ``leg<i>_shank``, leg2's knee a
+    (:func:`held_pelvis`); knees ``leg<i>_knee`` on shanks ``leg<i>_shank``, leg2's knee a
     coordinate of its own (the planar kneed walker's,
     :func:`walkerlab.export.planar_bodies.planar_roles`)."""
-    hinges = ("stance_hip_roll",) if hip_roll_law(data) is not None else ()
+    hinges = ("stance_hip_roll",) if held_pelvis(data) else ()
     if not kneed(data):
         return PelvisRoles(pelvis_hinges=hinges)
     return PelvisRoles(pelvis_hinges=hinges,
@@ -180,6 +203,30 @@ def bisector_keyframe(roles, x) -> tuple[float, float]:
     swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
     return ((s[f"{swing}_angle"] + s["stance_angle"]) / 2,
             (s[f"{swing}_rate"] + s["stance_rate"]) / 2)
+
+
+def arms_keyframe(roles, x) -> tuple[tuple, tuple]:
+    """The arms' hinges at the rigid state ``x`` (``walker.arms``; Collins, Wisse & Ruina
+    2001): the stance side's arm at the swing leg's pitch (its thigh's on knees), the swing
+    side's at the stance leg's, angles [rad] and rates [rad/s] in the tree's body order
+    (the stance side's first), as the couplings hold them
+    (:func:`walkerlab.walker.arm_trees.with_arms`).
+
+    Parameters
+    ----------
+    roles : sequence of str
+        The walker's coordinate roles.
+    x : array_like (2 len(roles),)
+        The rigid state: the roles' angles [rad], then their rates [rad/s].
+
+    Returns
+    -------
+    (tuple of 2 float, tuple of 2 float)
+    """
+    s = dict(zip(state_names(roles), np.asarray(x, float)))
+    swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
+    return ((float(s[f"{swing}_angle"]), float(s["stance_angle"])),
+            (float(s[f"{swing}_rate"]), float(s["stance_rate"])))
 
 
 def legs3d_footfalls(points, x, steps: int, walked=None) -> tuple[np.ndarray, np.ndarray]:

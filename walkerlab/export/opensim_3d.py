@@ -23,7 +23,7 @@ the shank ``leg<i>_shank``.  The masses and inertias are the tree's as they are 
 no body turns about an axis on which it has no inertia and nothing else does).
 
 Default state: the rigid gait just after a heel strike, leg2 in stance, its foot sphere's
-lowest point at the origin (:func:`walkerlab.export.legs_3d_mjcf.legs3d_keyframe`, the MJCF
+lowest point at the origin (:func:`walkerlab.export.legs_3d_keyframe.legs3d_keyframe`, the MJCF
 keyframe's state in these coordinates).
 
 Ground and contact: the rigid swing foot passes through the ground at mid-stance, so the
@@ -192,7 +192,7 @@ def osim3d_bodies(data):
 def osim3d_state(root, qpos, qvel, slope_rad: float) -> tuple[dict, dict]:
     """The MJCF keyframe's ``qpos``, ``qvel`` as the OpenSim model's coordinates and speeds.
 
-    The keyframe (:func:`walkerlab.export.legs_3d_mjcf.legs3d_keyframe`): a free pelvis'
+    The keyframe (:func:`walkerlab.export.legs_3d_keyframe.legs3d_keyframe`): a free pelvis'
     position and quaternion, or its slides and roll, then the hinges in body order; the
     coordinates and speeds by name [m, rad; m/s, rad/s]: the pelvis' position in OpenSim's
     axes, its roll about the fall line (a quaternion's rotation vector along it; the body's

@@ -57,8 +57,7 @@ def arm_numbers(cfg, hip_width: float) -> tuple[list[tuple], list[float]]:
     return bodies, vals
 
 
-def with_arms(tree: BodyTree, coords: CoordinateMap, arms, knee: bool
-              ) -> tuple[BodyTree, CoordinateMap]:
+def with_arms(tree: BodyTree, coords: CoordinateMap, arms) -> tuple[BodyTree, CoordinateMap]:
     """``tree`` and ``coords`` with the arms (module docstring) on its pelvis.
 
     Parameters
@@ -67,17 +66,18 @@ def with_arms(tree: BodyTree, coords: CoordinateMap, arms, knee: bool
         A 3D biped's (:func:`walkerlab.walker.trees.biped_tree`), its params holding
         :func:`arm_names`.
     coords : CoordinateMap
+        Its joint angles ``swing_hip_pitch`` and ``stance_hip_pitch`` (each leg's pitch
+        from the pelvis: on knees the thigh's), which the opposite arms take.
     arms : tuple of walkerlab.walker.description.BodySpec
-    knee : bool
-        The swing leg has a knee (its thigh's angle ``swing_thigh`` is the leg's pitch).
 
     Returns
     -------
     BodyTree, CoordinateMap
     """
     width = "w_hip" if "w_hip" in tree.params else "0"
-    pitch = {"stance": ("swing_thigh" if knee else "swing") + " + gamma",
-             "swing": "stance + gamma"}
+    hips = dict(coords.joint_angles)   # each leg's pitch from the pelvis, in the tree's own
+    pitch = {"stance": hips["swing_hip_pitch"],   # coordinates (a floating tree's too)
+             "swing": f"-({hips['stance_hip_pitch']})"}
     bodies, angles = list(tree.bodies), list(coords.joint_angles)
     for role, sign in (("stance", "-"), ("swing", "+")):
         arm = f"{role}_arm"

@@ -183,8 +183,7 @@ class Structure:
 
     @property
     def kind(self) -> Kind:
-        """The walker's structural kind (:func:`walkerlab.walker.kinds.kind_of`): what the
-        layers consult instead of this structure's switches."""
+        """The walker's kind (:func:`walkerlab.walker.kinds.kind_of`), not its switches."""
         return kind_of(self)
 
     @property
@@ -220,11 +219,15 @@ class Structure:
 
     @property
     def swing_foot_clears(self) -> bool:
-        """Whether the swing foot can clear the ground through the step (a knee flexes it):
-        a free-jointed walker's early swing then ends in a fall if the foot scuffs; straight
-        legs pass their foot through the ground at mid-stance, which the ideal model
-        ignores (as the compass gait's, Goswami, Thuilot & Espiau 1996)."""
+        """Whether the swing foot can clear the ground (a knee flexes it): a free-jointed
+        walker's early swing then ends in a fall if the foot scuffs; straight legs pass it
+        through the ground at mid-stance (Goswami, Thuilot & Espiau 1996's ideal model)."""
         return self.knee
+
+    @property
+    def rolling_feet(self) -> bool:
+        """The feet roll on the ground (``arc``, ``toroidal``; ``R_foot`` fore-aft)."""
+        return self.foot in ("arc", "toroidal")
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -249,10 +252,8 @@ class Structure:
                     names.append(f"e_{t}{b.name}")
         if self.knee:
             names.append("L_thigh")
-        if self.foot == "arc":
-            names.append("R_foot")
-        if self.foot == "toroidal":   # fore-aft and lateral radii
-            names += ["R_foot", "R_lat"]
+        if self.rolling_feet:   # the fore-aft radius (and a torus' lateral one)
+            names += ["R_foot"] + (["R_lat"] if self.foot == "toroidal" else [])
         if self.foot == "flat":
             for t in tags:
                 names += [f"heel_{t}m", f"toe_{t}m", f"k_{t}ankle", f"r_{t}ankle",

@@ -232,10 +232,11 @@ def multibody(data: WalkerData) -> Multibody:
     ------
     ValueError
         A link carries no mass (naming it), or free knees the floating view does not carry
-        (:func:`check_floating_view`; one line, both).
+        (:func:`check_floating_view`; one line, both), or parts no export carries
+        (:func:`check_export_parts`).
     """
     s = data.structure
-    check_floating_view(s)
+    check_export_parts(s)
     if s.spokes:  # one rigid body, no links: walkerlab.export.spoked
         raise ValueError("walker.model: rimless_wheel is one rigid body, not a tree of leg "
                          "links: its URDF/MJCF come from walkerlab.export.spoked's "
@@ -324,6 +325,27 @@ def _springs(s, p: dict) -> list[Spring]:
     return springs
 
 
+def check_export_parts(structure) -> None:
+    """Refuse (one line) the parts the Adams dataset and the OpenSim model, whose bodies are
+    this module's :class:`Multibody`, do not carry (``structure``:
+    :class:`walkerlab.walker.description.Structure`): arms coupled to the opposite legs and
+    feet curved both ways, which the MJCF (and the URDF, arms) read from the body tree.
+
+    Raises
+    ------
+    ValueError
+    """
+    if structure.arms:
+        raise ValueError("walker.arms: arms coupled to the opposite legs are in the MJCF and "
+                         "the URDF (export --format mjcf, urdf) and the contact model, not in "
+                         "this format's links")
+    if structure.foot == "toroidal":
+        raise ValueError("walker.leg.foot.kind: toroidal feet are in the MJCF (export "
+                         "--format mjcf: a spheroid on each foot's rim) and the contact "
+                         "model, not in this format's feet")
+    check_floating_view(structure)
+
+
 def check_floating_view(structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet
     (``structure``: :class:`walkerlab.walker.description.Structure`): free
@@ -338,15 +360,6 @@ def check_floating_view(structure) -> None:
     ------
     ValueError
     """
-    if structure.arms:
-        raise ValueError("walker.arms: arms coupled to the opposite legs walk in the rigid "
-                         "model only (walkerlab fixedpoint, simulate): the floating view "
-                         "has no coupling between its links")
-    if structure.foot == "toroidal":
-        raise ValueError("walker.leg.foot.kind: toroidal feet walk in the rigid model only "
-                         "(walkerlab fixedpoint, simulate): their rolling radius changes "
-                         "with the lean, which the contact model's and the exports' disc "
-                         "and point feet do not carry")
     if structure.free_knees and (structure.foot != "point" or structure.asymmetric
                                  or structure.springs or structure.knee_spring):
         raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "

@@ -467,7 +467,8 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
         knee free: the contact model's knee stop and latch hold it), the stance leg a shank
         ``stance_shank`` at the foot and a thigh on the knee ``stance_knee`` as a
         free-jointed planar walker's (coordinates ``lean, stance_shank, stance_thigh,
-        swing_thigh, swing_shank``); the rigid tree otherwise.
+        swing_thigh, swing_shank``); toroidal feet a disc's tree (the floating view's contact
+        geometry carries the torus); the rigid tree otherwise.
     massless_mass : str or None
         The name of a symbolic mass every massless body carries, appended to the tree's
         parameters: the derivation's massless limit (Garcia et al. 1998,
@@ -511,14 +512,17 @@ def legs_tree(structure, floating: bool = False, massless_mass: str | None = Non
                       hip_mass=structure.hip_mass,
                       hip_width="w_hip" if structure.hip_width else 0,
                       hip_roll=structure.hip_roll,
-                      foot_radius="R_foot" if structure.foot in ("arc", "toroidal") else None,
+                      foot_radius="R_foot" if structure.rolling_feet else None,
                       coordinates=structure.coordinates,
                       free_joints=(planar and (structure.free_knees or structure.hinged_torso))
                       or (floating and not planar and structure.knee),
                       soles=_soles(structure, swap_roles) if structure.foot == "flat" else None,
-                      lateral_radius="R_lat" if structure.foot == "toroidal" else None,
+                      # the floating view's torus is its contact geometry (its stance
+                      # foot's travel a slide like any foot's): a disc's tree
+                      lateral_radius=("R_lat" if structure.foot == "toroidal" and not floating
+                                      else None),
                       hinged_torso=structure.hinged_torso)
-    return with_arms(*tree, structure.arms, structure.knee) if structure.arms else tree
+    return with_arms(*tree, structure.arms) if structure.arms else tree
 
 
 def leg_parts(structure, role: str, massless_mass: str | None = None) -> tuple[Part, ...]:

@@ -78,12 +78,12 @@ class ContactPart:
     def foot_point(self, structure) -> str:
         """The name (``leg{i}_<name>`` among the generated points) of a foot's reference
         contact point: the foot point, an arc's lowest point."""
-        return "contact" if structure.foot == "arc" else "foot"
+        return "contact" if structure.rolling_feet else "foot"
 
     def foot_rolls(self, structure) -> bool:
         """Whether the foot's loaded contact point moves along it during stance (an arc rolls;
         a point does not): its slip is then the material point's tangential velocity."""
-        return structure.foot == "arc"
+        return structure.rolling_feet
 
     def rigid_values(self, walker, x) -> dict:
         """The rigid state ``x`` (role order) by link name (absolute coordinates: the rigid
@@ -102,7 +102,7 @@ class ContactPart:
         """:func:`walkerlab.models.contact.scene.ideal_step_length`: the foot-to-foot chord
         at heel strike, plus an arc foot's roll over the step."""
         z, chord = self._chord(walker, x_ideal, along_slope)[:2]
-        if walker.structure.foot != "arc":
+        if not walker.structure.rolling_feet:
             return chord
         R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
         # link angles (the floating coordinates after the hip's): leg1's, then leg2's (then
@@ -387,7 +387,7 @@ class Legs3DPart(ContactPart):
         feet's roll over the step, ``R (theta_stance - theta_swing)`` (the pitches of the
         links the feet are on, :attr:`foot_pitches`), as a planar walker's arc feet."""
         z, chord = self._chord(walker, x_ideal, True)[:2]
-        if walker.structure.foot != "arc":
+        if not walker.structure.rolling_feet:
             return chord
         R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
         links = walker.coordinate_names()[walker.dim:]
@@ -403,7 +403,7 @@ class Legs3DPart(ContactPart):
         stance pitch ``theta``, half the roll of a period-1 gait (0.038 l of
         configs/round_feet_3d.yaml's 0.076 l roll, where its patch is 0.1 l long); point
         feet: 0."""
-        if walker.structure.foot != "arc":
+        if not walker.structure.rolling_feet:
             return 0.0
         x = self._chord(walker, x_ideal, True)[2]
         root = np.asarray(x[:walker.dim], float)

@@ -204,14 +204,43 @@ class ContactSetup:
         """
         probe = self.model()
         shift = contact_part(probe.structure).patch_shift(probe, x_ideal)  # a disc's roll
+        terrain = self._holding_the_roll(shift)
         if step_lengths_m is not None:
-            return (probe.on_terrain(self.terrain, step_length=float(np.mean(step_lengths_m)),
+            return (probe.on_terrain(terrain, step_length=float(np.mean(step_lengths_m)),
                                      n_steps=n_steps + 4, step_lengths=tuple(step_lengths_m),
                                      shift=shift),
                     float(np.mean(step_lengths_m)))
         step_length = ideal_step_length(probe, x_ideal, along_slope=not self.terrain.is_slope)
-        return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
+        return probe.on_terrain(terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4, shift=shift), step_length
+
+    def _holding_the_roll(self, shift: float) -> TerrainSettings:
+        """The ground's patches, long enough to hold a rolling foot: a 3D walker's round
+        foot touches down ``shift`` [m] behind its patch's centre (the middle of its roll
+        over the stance, :meth:`walkerlab.models.contact.parts.Legs3DPart.patch_shift`).
+        A default ground (no ``terrain`` section) whose patch would leave the touchdown off
+        it is lengthened by the roll, keeping the default's margin at either end
+        (``2 (|shift| + w / 2)``; configs/collins2001_stable.yaml's feet, 0.21 m fore-aft,
+        roll 0.145 m a stance on the 0.10 m default); a scene's own patches are kept.
+
+        Raises
+        ------
+        ContactSceneError
+            The scene's ``terrain.patch_width_m`` leaves the touchdown off its patch (one
+            line, the width that holds it).
+        """
+        half = 0.5 * self.terrain.patch_width_m
+        if abs(shift) < half:
+            return self.terrain
+        wide = 2.0 * (abs(shift) + half)
+        if self.scene is not None and self.scene.terrain is not None:
+            raise ContactSceneError(
+                f"scene '{self.name}': terrain.patch_width_m: {self.terrain.patch_width_m:g} m "
+                f"patches do not hold the rolling foot, which touches down {abs(shift):.3g} m "
+                f"behind its patch's centre (its roll over a stance about {2 * abs(shift):.3g} "
+                f"m): give at least {2 * abs(shift) + 0.02:.2g} m ({wide:.2g} m keeps the "
+                "margin of the default's)")
+        return self.terrain.model_copy(update={"patch_width_m": wide})
 
 
 def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetup:
