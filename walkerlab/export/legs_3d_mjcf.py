@@ -147,6 +147,8 @@ from walkerlab.export.text import comment, num, nums
 from walkerlab.export.tree_bodies import PelvisRoles, mjcf_coupling_lines
 from walkerlab.models.contact.laws import TORSION_FRACTION
 from walkerlab.models.contact.rigid_limit import contact_si
+from walkerlab.models.contact.scene import patches_holding_the_roll
+from walkerlab.walker.description import state_names
 from walkerlab.walker.foot_trees import creep_rate
 from walkerlab.walker.walker_trees import walker_tree as body_tree
 
@@ -281,11 +283,15 @@ def legs3d_scene(plant, ideal, options=None) -> Legs3dScene:
     """
     scene, data = plant.scene, plant.data
     terrain = scene.terrain_or_default()
+    p = legs3d_numbers(data)
+    if round_feet(data):  # the patch centred on the foot's reference point, its roll about it
+        roles = dict(zip(state_names(data.structure.roles), ideal.x))
+        terrain = patches_holding_the_roll(terrain, p["R_foot"] * (
+            roles["stance_angle"] + data.slope_rad), scene.terrain is not None)
     if terrain.lanes != "checkerboard":
         raise ValueError("terrain.lanes: the 3D walker's MJCF lays footfall patches "
                          "(checkerboard): its swing foot passes through the ground at "
                          "mid-stance, as the rigid model's does")
-    p = legs3d_numbers(data)
     f = functions(data)
     qpos, qvel = legs3d_keyframe(f["points"], f["point_velocities"], ideal.x,
                                  data.slope_rad, 0.0 if round_feet(data) else p["r"],
@@ -472,8 +478,7 @@ def legs3d_mjcf(data, name: str, version: str = "", extra: Legs3dScene | None = 
     contact = None if extra is None else MjcfContact(
         extra.timestep_s, extra.solref, extra.solimp,
         (extra.friction, TORSION_FRACTION * p["L"], 0), 3 if held_pelvis(data) else 4,
-        "elliptic",
-        DISC_CCD_TOLERANCE_L * p["L"] if disc else None)
+        "elliptic", DISC_CCD_TOLERANCE_L * p["L"] if disc else None, "R_lat" in p)
     act = extra.actuation if extra is not None else None
     root, geoms, tendons, equality = _bodies(data)
     numerics = (("slope_rad", phi), ("foot_height_offset_m", r if disc else 0.0))

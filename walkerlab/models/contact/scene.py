@@ -40,7 +40,8 @@ if TYPE_CHECKING:
     from walkerlab.codegen.pending import CompiledElsewhere
     from walkerlab.walker.description import WalkerData
 
-__all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length"]
+__all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length",
+           "patches_holding_the_roll"]
 
 
 #: why the contact periodic gait refuses a ground whose steps differ
@@ -215,32 +216,56 @@ class ContactSetup:
                                 n_steps=n_steps + 4, shift=shift), step_length
 
     def _holding_the_roll(self, shift: float) -> TerrainSettings:
-        """The ground's patches, long enough to hold a rolling foot: a 3D walker's round
-        foot touches down ``shift`` [m] behind its patch's centre (the middle of its roll
-        over the stance, :meth:`walkerlab.models.contact.parts.Legs3DPart.patch_shift`).
-        A default ground (no ``terrain`` section) whose patch would leave the touchdown off
-        it is lengthened by the roll, keeping the default's margin at either end
-        (``2 (|shift| + w / 2)``; configs/collins2001_stable.yaml's feet, 0.21 m fore-aft,
-        roll 0.145 m a stance on the 0.10 m default); a scene's own patches are kept.
+        """The ground's patches, long enough to hold a rolling foot
+        (:func:`patches_holding_the_roll`, ``shift`` from
+        :meth:`walkerlab.models.contact.parts.Legs3DPart.patch_shift`)."""
+        try:
+            return patches_holding_the_roll(self.terrain, shift, self.scene is not None
+                                            and self.scene.terrain is not None)
+        except ValueError as err:
+            raise ContactSceneError(f"scene '{self.name}': {err}") from None
 
-        Raises
-        ------
-        ContactSceneError
-            The scene's ``terrain.patch_width_m`` leaves the touchdown off its patch (one
-            line, the width that holds it).
-        """
-        half = 0.5 * self.terrain.patch_width_m
-        if abs(shift) < half:
-            return self.terrain
-        wide = 2.0 * (abs(shift) + half)
-        if self.scene is not None and self.scene.terrain is not None:
-            raise ContactSceneError(
-                f"scene '{self.name}': terrain.patch_width_m: {self.terrain.patch_width_m:g} m "
-                f"patches do not hold the rolling foot, which touches down {abs(shift):.3g} m "
-                f"behind its patch's centre (its roll over a stance about {2 * abs(shift):.3g} "
-                f"m): give at least {2 * abs(shift) + 0.02:.2g} m ({wide:.2g} m keeps the "
-                "margin of the default's)")
-        return self.terrain.model_copy(update={"patch_width_m": wide})
+
+def patches_holding_the_roll(terrain: TerrainSettings, shift: float, own: bool
+                             ) -> TerrainSettings:
+    """The ground's patches, long enough to hold a rolling foot: a 3D walker's round foot
+    touches down ``shift`` [m] behind its patch's centre (the middle of its roll over the
+    stance: the contact model's and the MJCF's patches are centred there).  A default
+    ground (``own`` False: no ``terrain`` section) whose patch would leave the touchdown off
+    it is lengthened by the roll, keeping the default's margin at either end (``2 (|shift|
+    + w / 2)``; configs/collins2001_stable.yaml's feet, 0.21 m fore-aft, roll 0.145 m a
+    stance on the 0.10 m default); a scene's own patches are kept.
+
+    Parameters
+    ----------
+    terrain : TerrainSettings
+    shift : float
+        [m].
+    own : bool
+        The scene gives its ``terrain`` section.
+
+    Returns
+    -------
+    TerrainSettings
+        ``terrain`` itself when its patches hold the touchdown.
+
+    Raises
+    ------
+    ValueError
+        The scene's ``terrain.patch_width_m`` leaves the touchdown off its patch (one line,
+        the width that holds it).
+    """
+    half = 0.5 * terrain.patch_width_m
+    if abs(shift) < half:
+        return terrain
+    wide = 2.0 * (abs(shift) + half)
+    if own:
+        raise ValueError(
+            f"terrain.patch_width_m: {terrain.patch_width_m:g} m patches do not hold the "
+            f"rolling foot, which touches down {abs(shift):.3g} m behind its patch's centre "
+            f"(its roll over a stance about {2 * abs(shift):.3g} m): give at least "
+            f"{2 * abs(shift) + 0.02:.2g} m ({wide:.2g} m keeps the margin of the default's)")
+    return terrain.model_copy(update={"patch_width_m": wide})
 
 
 def contact_setup(scene: Scene, periodic: bool = False, *, plant) -> ContactSetup:
