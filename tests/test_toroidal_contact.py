@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.config import TerrainSettings
 from walkerlab.analysis.gait.poincare import find_fixed_point
+from walkerlab.config import TerrainSettings
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
@@ -213,3 +213,26 @@ def test_the_stable_collins_mjcf_starts_at_the_rigid_gait(collins, tmp_path):
         w = A.T @ n
         low = d.geom_xpos[foot] - A @ (w / np.linalg.norm(w))
         assert abs((low - top) @ n) < 1e-6
+
+
+@pytest.mark.parametrize(("scene_name", "fmt", "field"), [
+    ("toroidal_feet_3d", "urdf", "walker.leg.foot.kind"),
+    ("toroidal_feet_3d", "adm", "walker.leg.foot.kind"),
+    ("toroidal_feet_3d", "osim", "walker.leg.foot.kind"),
+    ("collins2001_stable", "adm", "walker.arms"),
+    ("collins2001_stable", "osim", "walker.arms"),
+])
+def test_formats_without_a_spheroid_or_the_arms_coupling_refuse_them(scene_name, fmt, field,
+                                                                     tmp_path):
+    """The URDF (no spheroid geometry), the Adams dataset and the OpenSim model refuse
+    toroidal feet, and the latter two arms, in one line naming the field and pointing at
+    the MJCF, before any gait search, writing nothing (a torus written as their disc would
+    be a different foot)."""
+    from walkerlab.stages import export as export_stage
+
+    scene = Scene.model_validate(yaml.safe_load(
+        (ROOT / "configs" / f"{scene_name}.yaml").read_text()))
+    with pytest.raises(ValueError, match=field) as err:
+        export_stage.run(scene, tmp_path, fmt)
+    assert "--format mjcf" in str(err.value) and "\n" not in str(err.value)
+    assert not list(tmp_path.rglob("walker.*"))

@@ -69,6 +69,7 @@ class AdamsWriter(TreeWriter):
         dataset's."""
         job.kind.require("walk", w.view, "walker.space: 3d")
         check_legs_3d(job, w)
+        self.check_parts(job, w)
         scene = job.scene
         check_adams_actuation(scene)  # before the gait search
         strides = _strides(scene)

@@ -96,7 +96,32 @@ def round_feet_3d_fields(job: ExportJob) -> str:
 
 class TreeWriter:
     """A format's writer over the walker's body tree (module docstring): :meth:`write` asks
-    the tree its form and calls the method of that form."""
+    the tree its form and calls the method of that form.
+
+    Attributes
+    ----------
+    carries : frozenset of str
+        The 3D parts beyond legs, feet of points and discs, an upper body and hip-roll
+        joints that the format's file holds: ``"arms"`` (shoulder hinges coupled to the
+        opposite legs), ``"toroidal"`` (feet curved both ways); the others are refused
+        in one line (:meth:`check_parts`).
+    """
+
+    carries: frozenset = frozenset()
+
+    def check_parts(self, job: ExportJob, w: Writer) -> None:
+        """Refuse, in one line naming the field, a 3D walker's arms or toroidal feet where
+        this format does not carry them (:attr:`carries`)."""
+        st = job.data.structure
+        if st.arms and "arms" not in self.carries:
+            raise ValueError(f"walker.arms: arms coupled to the opposite legs are not in the "
+                             f"{w.name} export (its links hold no such coupling); export "
+                             "--format mjcf carries them, as the contact model does")
+        if st.foot == "toroidal" and "toroidal" not in self.carries:
+            raise ValueError(f"walker.leg.foot.kind: toroidal feet are not in the {w.name} "
+                             "export (its geometry would be a disc's); export --format mjcf "
+                             "carries them (a spheroid on each foot's rim), as the contact "
+                             "model does")
 
     def write(self, job: ExportJob, w: Writer) -> Written:
         """The format's files of the walker: one body (a spoked wheel) or legs, in the
@@ -166,7 +191,11 @@ class TreeWriter:
 
 class UrdfWriter(TreeWriter):
     """The URDF: the walker's text (no state, no ground) and, with a gait, its keyframe
-    sidecar :data:`~walkerlab.export.multibody.SIDECAR` beside it."""
+    sidecar :data:`~walkerlab.export.multibody.SIDECAR` beside it.  Arms, their couplings
+    as comments (URDF's ``mimic`` follows one joint); no toroidal feet (its geometries are
+    boxes, cylinders, spheres and meshes: no spheroid)."""
+
+    carries = frozenset({"arms"})
 
     def legs(self, job: ExportJob, w: Writer) -> Written:
         """The legged walkers' one URDF writer (:func:`walkerlab.export.urdf.
@@ -186,10 +215,7 @@ class UrdfWriter(TreeWriter):
         keyframe."""
         scene = job.scene
         check_legs_3d(job, w)
-        if job.data.structure.foot == "toroidal":
-            raise ValueError("walker.leg.foot.kind: toroidal feet are not in the URDF (its "
-                             "geometries are boxes, cylinders, spheres and meshes: no "
-                             "spheroid); export --format mjcf carries them")
+        self.check_parts(job, w)
         text = legs_urdf_text(job.data, job.name, walkerlab.__version__,
                               scene.walker.actuation)
         left_out = legs_urdf_omissions(job.data, scene.walker.actuation)
@@ -216,7 +242,10 @@ class UrdfWriter(TreeWriter):
 
 class MjcfWriter(TreeWriter):
     """The MJCF: the walker's text with the rigid gait as its ``gait`` keyframe, its
-    terrain and contact (the walker alone: a plane and MuJoCo's default contact)."""
+    terrain and contact (the walker alone: a plane and MuJoCo's default contact); arms and
+    toroidal feet (:mod:`walkerlab.export.legs_3d_mjcf`)."""
+
+    carries = frozenset({"arms", "toroidal"})
 
     def legs(self, job: ExportJob, w: Writer) -> Written:
         """The legged walkers' one MJCF writer (:func:`walkerlab.export.mjcf_document.
@@ -238,6 +267,7 @@ class MjcfWriter(TreeWriter):
 
         scene, data = job.scene, job.data
         check_legs_3d(job, w)
+        self.check_parts(job, w)
         version = walkerlab.__version__
         if job.walker_only:
             text = walker_mjcf_text(legs3d_mjcf(data, job.name, version))

@@ -67,6 +67,7 @@ class OsimWriter(TreeWriter):
         """The 3D legs from their body tree (:mod:`walkerlab.export.opensim_3d`)."""
         scene, data = job.scene, job.data
         check_legs_3d(job, w)
+        self.check_parts(job, w)
         check_osim3d(scene, data)
         if job.walker_only:
             raise ValueError(WALKER_ONLY)

@@ -232,11 +232,10 @@ def multibody(data: WalkerData) -> Multibody:
     ------
     ValueError
         A link carries no mass (naming it), or free knees the floating view does not carry
-        (:func:`check_floating_view`; one line, both), or parts no export carries
-        (:func:`check_export_parts`).
+        (:func:`check_floating_view`; one line, both).
     """
     s = data.structure
-    check_export_parts(s)
+    check_floating_view(s)
     if s.spokes:  # one rigid body, no links: walkerlab.export.spoked
         raise ValueError("walker.model: rimless_wheel is one rigid body, not a tree of leg "
                          "links: its URDF/MJCF come from walkerlab.export.spoked's "
@@ -323,27 +322,6 @@ def _springs(s, p: dict) -> list[Spring]:
                                   ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
                                   p["c_knee"]))
     return springs
-
-
-def check_export_parts(structure) -> None:
-    """Refuse (one line) the parts the Adams dataset and the OpenSim model, whose bodies are
-    this module's :class:`Multibody`, do not carry (``structure``:
-    :class:`walkerlab.walker.description.Structure`): arms coupled to the opposite legs and
-    feet curved both ways, which the MJCF (and the URDF, arms) read from the body tree.
-
-    Raises
-    ------
-    ValueError
-    """
-    if structure.arms:
-        raise ValueError("walker.arms: arms coupled to the opposite legs are in the MJCF and "
-                         "the URDF (export --format mjcf, urdf) and the contact model, not in "
-                         "this format's links")
-    if structure.foot == "toroidal":
-        raise ValueError("walker.leg.foot.kind: toroidal feet are in the MJCF (export "
-                         "--format mjcf: a spheroid on each foot's rim) and the contact "
-                         "model, not in this format's feet")
-    check_floating_view(structure)
 
 
 def check_floating_view(structure) -> None:
