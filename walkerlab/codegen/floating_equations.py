@@ -294,8 +294,8 @@ def _legs_3d(structure: Structure) -> FloatingEquations:
     knee = structure.knee
     feet_links = ("swing_shank", "stance_shank") if knee else ("swing_leg", "stance_leg")
     feet, points = [], {}
-    if structure.foot in ("arc", "toroidal"):  # each foot's lowest point, its material
-        P = dict(zip(tree.params, kin.params))  # point's Jacobian
+    if structure.rolling_feet:  # each foot's lowest point, its material point's Jacobian
+        P = dict(zip(tree.params, kin.params))
         radius, lateral = P["R_foot"], P.get("R_lat", 0)
         for leg, link, centre in (("leg1", feet_links[0], kin.contacts["swing_foot_centre"]),
                                   ("leg2", feet_links[1], kin.origins[feet_links[1]])):

@@ -239,12 +239,13 @@ class Legs3dScene:
     latch: tuple | None = None
 
 
-def _patches_across(data, L: float) -> tuple[float, str]:
+def _patches_across(data, p: dict) -> tuple[float, str]:
     """The footfall patches' width across the slope [m] (:data:`PATCH_ACROSS_L`, with the
     hip-roll law :data:`PATCH_ACROSS_PUSHED_L`, of the leg length ``L``) and why, for the
-    file's note; toroidal feet: wider by the lateral radius ``R_l``)."""
-    if data.structure.foot == "toroidal":   # the contact rolls R_l lean across the foot
-        p = dict(zip(data.structure.param_names, data.params))
+    file's note; toroidal feet: wider by the lateral radius ``R_l`` (``p``: the walker's
+    numbers, :func:`legs3d_numbers`)."""
+    L = p["L"]
+    if "R_lat" in p:   # a toroidal foot's contact rolls R_l lean across it
         across = PATCH_ACROSS_L * L + p["R_lat"]
         return across, (f"{across:g} m across: a toroidal foot's contact runs R_l lean "
                         "across it, R_l for every lean up to 0.5 rad either way")
@@ -311,7 +312,7 @@ def legs3d_scene(plant, ideal, options=None) -> Legs3dScene:
                                                    data.slope_rad, options)
     steps = max(1, len(getattr(ideal, "step_lengths_m", ()) or ()))
     period = float(ideal.period_s) / steps
-    across, why = _patches_across(data, p["L"])
+    across, why = _patches_across(data, p)
     on = ("its foot disc rolling on the slope as the rigid model's (the origin its "
           "reference point)" if round_feet(data) else
           "its foot sphere on the slope at the origin")

@@ -199,10 +199,8 @@ def bisector_keyframe(roles, x) -> tuple[float, float]:
     -------
     (float, float)
     """
-    s = dict(zip(state_names(roles), np.asarray(x, float)))
-    swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
-    return ((s[f"{swing}_angle"] + s["stance_angle"]) / 2,
-            (s[f"{swing}_rate"] + s["stance_rate"]) / 2)
+    (sw, st), (dsw, dst) = _leg_pitches(roles, x)
+    return (sw + st) / 2, (dsw + dst) / 2
 
 
 def arms_keyframe(roles, x) -> tuple[tuple, tuple]:
@@ -223,6 +221,12 @@ def arms_keyframe(roles, x) -> tuple[tuple, tuple]:
     -------
     (tuple of 2 float, tuple of 2 float)
     """
+    return _leg_pitches(roles, x)
+
+
+def _leg_pitches(roles, x) -> tuple[tuple, tuple]:
+    """The swing leg's pitch (its thigh's on knees) and the stance leg's at the rigid state
+    ``x`` [rad], then their rates [rad/s] (``roles``: the walker's coordinate roles)."""
     s = dict(zip(state_names(roles), np.asarray(x, float)))
     swing = "swing_thigh" if "swing_thigh_angle" in s else "swing"
     return ((float(s[f"{swing}_angle"]), float(s["stance_angle"])),
