@@ -247,8 +247,10 @@ def test_the_shipped_3d_torso_gait_and_multipliers_match_an_independent_model(to
     ({"hip_width_m": 2.5}, "walker.hip_width_m"),
     ({"space": "2d", "hip_width_m": 0.1}, "walker.hip_width_m"),
     ({"hip_width_m": 0.0, "hip_roll": LAW}, "walker.hip_roll"),
-    ({"leg": {"length_m": 1.0, "foot": {"kind": "arc", "radius_m": 0.2}, "bodies": [
-        {"kind": "point_mass", "name": "mass", "mass_kg": 5.0, "from_hip_m": 0.5}]},
+    # arc feet take hip-roll joints (tests/test_round_feet_hip_roll_3d.py); rods do not
+    ({"leg": {"length_m": 1.0, "bodies": [
+        {"kind": "rod", "name": "rod", "mass_kg": 5.0, "com_from_hip_m": 0.5,
+         "inertia_about_com_kg_m2": 0.4}]},
       "hip_roll": LAW}, "walker.hip_roll"),
 ])
 def test_a_3d_biped_refuses_what_it_cannot_walk_yet_naming_the_field(change, field):

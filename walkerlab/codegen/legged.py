@@ -463,9 +463,11 @@ def derive_legged(structure) -> Equations:
             heel = height
             # just after heel strike the swing foot (the old stance foot) is on the slope
             drop_solution = -gamma - sp.acos(sp.cos(th_st + gamma) - w * sp.tan(phi) / (L - R))
-            if structure.hip_roll:
-                drop_solution = -gamma - sp.acos((L * sp.cos(phi) * sp.cos(th_st + gamma)
-                                                  - w * sp.sin(phi_p)) / (L * sp.cos(phi_w)))
+            if structure.hip_roll:   # the feet's centres L - R from the hips, each foot's
+                # contact R cos(roll) below its centre (point feet: R = 0)
+                drop_solution = -gamma - sp.acos(
+                    ((L - R) * sp.cos(phi) * sp.cos(th_st + gamma) - w * sp.sin(phi_p)
+                     + R * (sp.cos(phi) - sp.cos(phi_w))) / ((L - R) * sp.cos(phi_w)))
         else:
             heel = sigma
             drop_solution = -th_st - 2 * gamma

@@ -151,9 +151,9 @@ class CompassGaitParams(_Actuated):
             if getattr(self, name) is not None and self.space == "2d":
                 raise ValueError(f"walker.{name}: needs space: 3d (a planar walker's round "
                                  "feet and leg inertia are model: biped's leg.foot, bodies)")
-            if getattr(self, name) is not None and self.hip_roll is not None:
-                raise ValueError(f"walker.{name}: not with walker.hip_roll yet (round feet "
-                                 "and leg inertia are the passive 3D walker's so far)")
+        if self.leg_inertia_kg_m2 is not None and self.hip_roll is not None:
+            raise ValueError("walker.leg_inertia_kg_m2: not with walker.hip_roll (the hip-roll "
+                             "walker's legs carry point masses)")
         if self.foot_radius_m is not None and not self.foot_radius_m < self.leg_length_m:
             raise ValueError("walker.foot_radius_m must be smaller than walker.leg_length_m")
         return self
@@ -292,9 +292,9 @@ class BipedParams(_Actuated):
                 ("walker.torso.coupling", self.torso is not None
                  and self.torso.coupling != "bisecting_hip", "a bisecting_hip torso"),
                 ("walker.hip_roll", self.hip_roll is not None and (
-                    leg.foot.kind != "point" or any(b.kind != "point_mass"
-                                                    for b in leg.bodies)),
-                 "point feet and point masses on the legs with hip-roll joints")):
+                    leg.foot.kind not in ("point", "arc") or any(b.kind != "point_mass"
+                                                                 for b in leg.bodies)),
+                 "point or arc feet and point masses on the legs with hip-roll joints")):
             if bad:
                 raise ValueError(f"{field}: a walker in space: 3d needs {what} today")
         if not self.hip_width_m < 2 * leg.length_m:   # as CompassGaitParams' check

@@ -277,6 +277,8 @@ def _absolute_angle(ev: _Evaluator, tree: BodyTree, body: str, coordinate: str):
         name = b.joint.parent
     chain: list = []
     for j in path:
+        if j.kind == "prismatic":   # a travel turns nothing (a disc foot's rolling advance)
+            continue
         for axis, c in zip(j.axes, j.coordinates):
             key = tuple(ev.sym(v) for v in axis)
             angle = ev.angle[c]
