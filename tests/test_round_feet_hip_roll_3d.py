@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from scipy.spatial.transform import Rotation
 
 from tests.independent.mirror_stride import stride_against
 from tests.test_hip_roll_3d import LEAN, PELVIS, STANCE, SWING, SWROLL
@@ -44,6 +43,12 @@ def _scene(radius: float = RADIUS_M) -> Scene:
     return Scene.model_validate(raw)
 
 
+def _cross(a, b):
+    """a x b of two 3-vectors (np.cross's general path costs ~20 times more)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
+
+
 class Reference(HipRollReference):
     """Newton-Euler's walker (module docstring), its state ``[lean, swing, stance, pelvis
     roll, swing roll, rates]`` as walkerlab's; the law's couples from the hip-roll
@@ -54,66 +59,86 @@ class Reference(HipRollReference):
         self.R = R
 
     def _roll(self, phi):
-        return Rotation.from_rotvec(phi * self.s).as_matrix()
+        """Rot(s, phi) by Rodrigues' formula."""
+        return np.eye(3) + np.sin(phi) * self.S + (1 - np.cos(phi)) * self.S @ self.S
 
-    def kinematics(self, w, q, dq, ddq, v_centre=None):
-        """Positions (from the stance disc's contact point), velocities and accelerations
-        of the points; ``omega``, each body's angular velocity.  ``v_centre``: the stance
-        disc centre's velocity given (the impact's free old foot), else rolling."""
-        L, R, a, s, n, z = self.L, self.R, self.a, self.s, self.n, self.z
+    def _frames(self, q):
+        """Each leg's hip axis ``e3``, its axis up from the foot ``up`` and its rolled normal
+        ``e2``; the pelvis' hip axis."""
         frames = {}
         for body, roll, pitch in (("stance", LEAN, STANCE), ("swing", SWROLL, SWING)):
             Rr = self._roll(q[roll])
-            e3 = Rr @ z
-            up = Rr @ Rotation.from_rotvec(q[pitch] * z).as_matrix() @ [0.0, 1.0, 0.0]
-            omega = dq[roll] * s + dq[pitch] * e3
-            alpha = ddq[roll] * s + ddq[pitch] * e3 + dq[pitch] * np.cross(dq[roll] * s, e3)
-            frames[body] = (omega, alpha, up, Rr @ n)
-        frames["pelvis"] = (dq[PELVIS] * s, ddq[PELVIS] * s, None, None)
-        hip_axis = self._roll(q[PELVIS]) @ z
-        w_st, al_st, u_st, e2_st = frames["stance"]
-        pos, vel, acc = {"centre": R * e2_st}, {}, {}
-        if v_centre is None:   # no slip: the contact's material point at rest
-            de2 = np.cross(dq[LEAN] * s, e2_st)
-            vel["centre"] = np.cross(w_st, R * e2_st)
-            acc["centre"] = np.cross(al_st, R * e2_st) + np.cross(w_st, R * de2)
-        else:
-            vel["centre"], acc["centre"] = np.asarray(v_centre), np.zeros(3)
+            c, s_ = np.cos(q[pitch]), np.sin(q[pitch])
+            frames[body] = (Rr @ self.z, Rr @ np.array([-s_, c, 0.0]), Rr @ self.n)
+        return frames, self._roll(q[PELVIS]) @ self.z
 
-        def rigid(name, base, r, body):
-            omega, alpha = frames[body][:2]
+    def _chain(self, w, q):
+        """The points as ``(name, base, offset, body)``, each ``base + offset`` moving
+        with ``body``, from the stance disc's centre."""
+        L, R, a = self.L, self.R, self.a
+        frames, hip_axis = self._frames(q)
+        (_, u_st, e2_st), (_, u_sw, e2_sw) = frames["stance"], frames["swing"]
+        return [("contact", "centre", -R * e2_st, "stance"),   # the stance disc's material point
+                ("hip", "centre", (L - R) * u_st, "stance"),
+                ("stance_mass", "centre", (a - R) * u_st, "stance"),
+                ("pelvis", "hip", w / 2 * hip_axis, "pelvis"),
+                ("swing_hip", "hip", w * hip_axis, "pelvis"),
+                ("swing_mass", "swing_hip", -(L - a) * u_sw, "swing"),
+                ("swing_centre", "swing_hip", -(L - R) * u_sw, "swing"),
+                ("swing_contact", "swing_centre", -R * e2_sw, "swing")]   # its material point
+
+    def kinematics(self, w, q, dq, ddq):
+        """Positions (from the stance disc's contact point), velocities and accelerations
+        of the points (the stance disc rolling); ``omega``, each body's angular velocity."""
+        s, R = self.s, self.R
+        frames, _ = self._frames(q)
+        rates = {}
+        for body, roll, pitch in (("stance", LEAN, STANCE), ("swing", SWROLL, SWING)):
+            e3 = frames[body][0]
+            rates[body] = (dq[roll] * s + dq[pitch] * e3, ddq[roll] * s + ddq[pitch] * e3
+                           + dq[pitch] * _cross(dq[roll] * s, e3))
+        rates["pelvis"] = (dq[PELVIS] * s, ddq[PELVIS] * s)
+        w_st, al_st = rates["stance"]
+        e2_st = frames["stance"][2]
+        de2 = _cross(dq[LEAN] * s, e2_st)
+        pos = {"centre": R * e2_st}
+        vel = {"centre": _cross(w_st, R * e2_st)}   # no slip: the contact at rest
+        acc = {"centre": _cross(al_st, R * e2_st) + _cross(w_st, R * de2)}
+        for name, base, r, body in self._chain(w, q):
+            omega, alpha = rates[body]
             pos[name] = pos[base] + r
-            vel[name] = vel[base] + np.cross(omega, r)
-            acc[name] = acc[base] + np.cross(alpha, r) + np.cross(omega, np.cross(omega, r))
+            vel[name] = vel[base] + _cross(omega, r)
+            acc[name] = acc[base] + _cross(alpha, r) + _cross(omega, _cross(omega, r))
+        return pos, vel, acc, {b: r[0] for b, r in rates.items()}
 
-        w_sw, _al, u_sw, e2_sw = frames["swing"]
-        rigid("contact", "centre", -R * e2_st, "stance")   # the stance disc's material point
-        rigid("hip", "centre", (L - R) * u_st, "stance")
-        rigid("stance_mass", "centre", (a - R) * u_st, "stance")
-        rigid("pelvis", "hip", w / 2 * hip_axis, "pelvis")
-        rigid("swing_hip", "hip", w * hip_axis, "pelvis")
-        rigid("swing_mass", "swing_hip", -(L - a) * u_sw, "swing")
-        rigid("swing_centre", "swing_hip", -(L - R) * u_sw, "swing")
-        rigid("swing_contact", "swing_centre", -R * e2_sw, "swing")   # its material point
-        return pos, vel, acc, {b: f[0] for b, f in frames.items()}
+    def jacobians(self, w, q, free_centre=False):
+        """Kane's partial velocities: each point's ``d v / d dq`` (3, 5) from the bodies'
+        ``d omega / d dq`` (``v = v_base + omega x r``), the stance disc's centre rolling;
+        with ``free_centre`` (3, 8), its velocity three more rates (the impact's old foot)."""
+        k = 8 if free_centre else 5
+        frames, _ = self._frames(q)
+        W = {b: np.zeros((3, k)) for b in ("stance", "swing", "pelvis")}
+        W["stance"][:, LEAN], W["stance"][:, STANCE] = self.s, frames["stance"][0]
+        W["swing"][:, SWROLL], W["swing"][:, SWING] = self.s, frames["swing"][0]
+        W["pelvis"][:, PELVIS] = self.s
+        J = {"centre": np.zeros((3, k))}
+        if free_centre:
+            J["centre"][:, 5:] = np.eye(3)
+        else:
+            J["centre"] = -self._skew(self.R * frames["stance"][2]) @ W["stance"]
+        for name, base, r, body in self._chain(w, q):
+            J[name] = J[base] - self._skew(r) @ W[body]
+        return J
 
     def bodies(self):
         return [("pelvis", self.M), ("stance_mass", self.m), ("swing_mass", self.m)]
-
-    def _partials(self, w, q, v_centre=False):
-        """Partial velocities (3, k) of the points: the five rates, and with ``v_centre``
-        the stance centre's velocity (k = 8)."""
-        k = 8 if v_centre else 5
-        cols = [self.kinematics(w, q, e[:5], np.zeros(5), e[5:] if v_centre else None)
-                for e in np.eye(k)]
-        return {p: np.column_stack([c[1][p] for c in cols]) for p in cols[0][1]}
 
     def rhs(self, w):
         grav = np.array([0.0, -self.g, 0.0])
 
         def f(t, x):
             q, dq = x[:5], x[5:]
-            vel = self._partials(w, q)
+            vel = self.jacobians(w, q)
             acc = self.kinematics(w, q, dq, np.zeros(5))[2]   # the bias
             Mq, rhs = np.zeros((5, 5)), self.law_forces(q, dq)
             Mq[PELVIS, PELVIS] = self.I_pelvis    # the pelvis' roll about the fall line
@@ -143,7 +168,7 @@ class Reference(HipRollReference):
         ``E v+ = 0`` (the new disc's material contact point at rest; the law's torques
         finite: no impulse); ``dq+`` before the roles swap and ``v_centre+``."""
         q, dq = y[:5], y[5:]
-        vel = self._partials(w, q, v_centre=True)
+        vel = self.jacobians(w, q, free_centre=True)
         Me = np.zeros((8, 8))
         Me[PELVIS, PELVIS] = self.I_pelvis
         for p, m in self.bodies():
@@ -220,7 +245,7 @@ def test_round_feet_hip_roll_section_lands_the_swing_disc_on_the_slope(discs):
         assert y[SWING] != x[SWING]
 
 
-@pytest.mark.slow  # ~90 s: the generated gait and the reference's own, central differences
+@pytest.mark.slow  # ~110 s: the generated gait and the reference's own, central differences
 def test_round_feet_hip_roll_gait_and_multipliers_match_newton_euler(discs):
     """The gait of the stabilised walker on 5 cm discs: found to 1e-12 (it stopped at a
     residual of R x 8e-3 before the section's fix), stable, and equal to the reference's
