@@ -97,3 +97,35 @@ def test_attribution_stage_writes_and_reuses(tmp_path, monkeypatch):
     assert calls[0].period_s == pytest.approx(0.7036, abs=5e-5)  # from fixedpoint.h5
     assert isinstance(calls[0], SimpleNamespace)
     assert pipeline.run("attribution", scene, tmp_path).reused and len(calls) == 1
+
+
+@pytest.mark.slow  # ~60 s cold: the held view's kernels, the gait, seven stride-map searches
+def test_a_3d_walker_holding_its_heading_gets_the_sections_attribution(tmp_path):
+    """configs/hip_width_stabilised.yaml with the rigid stance foot's assumption in its
+    contact (``contact.hold_heading: true``, ``torsional_friction_m: 0``: the base does not
+    turn, the foot spins freely) has no stiff torsional mode, so the attribution's creep-free
+    and 1000 times stiffer contacts are affordable in 3D (measured 20 s; with the heading
+    free it is refused, the test above).  Its gap to the rigid step period closes as creep +
+    compliance + residual to rounding; the residual, the stiff creep-free contact's period
+    against the rigid one, is under a fifth of the gap (measured: gap +0.786 ms, creep
+    +0.437, compliance +0.263, residual +0.087), and the gap is the contact periodic gait's
+    period less the rigid one, within 0.2 % of it."""
+    import h5py
+    import yaml
+
+    from walkerlab.config.schema import Scene
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.pipeline import report_plan
+
+    raw = yaml.safe_load((ROOT / "configs" / "hip_width_stabilised.yaml").read_text())
+    raw["contact"].update(hold_heading=True, torsional_friction_m=0.0)
+    scene = Scene.model_validate(raw)
+    assert report_plan(scene, full=True)[-1] == "attribution"
+    out = pipeline.run("attribution", scene, tmp_path)
+    with h5py.File(out.path) as f:
+        gap, creep, comp, res = (float(f[k]["period"][()]) for k in
+                                 ("gap", "creep", "compliance", "residual"))
+        rigid = float(f.attrs["rigid_period_s"])
+    assert gap == pytest.approx(creep + comp + res, abs=1e-12)
+    assert 0 < abs(res) < 0.2 * abs(gap)
+    assert 1e-4 < gap / rigid < 3e-3

@@ -14,6 +14,8 @@ against the planar contact model it contains.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -174,6 +176,65 @@ def test_the_3d_contact_flow_matches_an_independent_newton_model(hip_width):
         worst = max(worst, err)
         assert err < 1e-8, (name, err, got_, want)
     assert worst > 0  # two codes, not one
+
+
+def _held_accelerations(ref, x):
+    """The reference's accelerations (6,) with its heading held (coordinate 3 and its rate
+    0): its Newton rows without the heading's row and column (the held coordinate's
+    constraint force is that row's multiplier)."""
+    q, dq = np.asarray(x[:7], float), np.asarray(x[7:], float)
+    grav = np.array([0.0, -ref.g, 0.0])
+    M, Q = np.zeros((7, 7)), np.zeros(7)
+    for name, mass in ref.masses():
+        J = ref.jacobian(name, q)
+        M += mass * J.T @ J
+        Q += mass * J.T @ (grav - ref.jdot_dq(name, q, dq))
+    for leg in (1, 2):
+        c = ref.foot_contact(q, dq, leg)
+        Q += c["J"].T @ c["F"] + c["Jw"] * c["moment"]
+    keep = [0, 1, 2, 4, 5, 6]
+    return np.linalg.solve(M[np.ix_(keep, keep)], Q[keep])
+
+
+def test_the_held_heading_contact_flow_is_the_newton_models_with_its_heading_held(hip_width):
+    """``contact.hold_heading``: configs/hip_width.yaml's contact walker on three slides (no
+    heading coordinate) has the independent Newton model's flow with the heading's row and
+    column removed, at the double-support states of :data:`STATES` turned to heading 0 and
+    its rate 0 (the feet then slip and spin otherwise, both loaded), relative 1e-8 as the
+    free-heading test; the torsional friction acts through the feet's spin with the lean
+    and pitch rates alone."""
+    cw, _x0, ref, perm = hip_width
+    scene = load_scene("configs/hip_width.yaml").model_copy(
+        update={"contact": ContactSettings(hold_heading=True)})
+    held, _ = _contact_walker(_continuous(scene))
+    names = held.coordinate_names()
+    assert names == tuple(n for n in cw.coordinate_names() if n != "heading")
+    perm_held = np.array([TO_REF[n] for n in names])
+    for name, (args, _regimes) in STATES.items():
+        xr = _double_support(ref, 0.0, *args[1:])
+        xr[7 + 3] = 0.0   # the heading's rate
+        c = [ref.foot_contact(xr[:7], xr[7:], leg) for leg in (1, 2)]
+        assert c[0]["fn"] > 0 and c[1]["fn"] > 0 and abs(c[1]["spin"]) > 0, name
+        x = np.concatenate([xr[:7][perm_held], xr[7:][perm_held]])
+        want = _held_accelerations(ref, xr)[[list(range(7)).index(k) - (k > 3)
+                                             for k in perm_held]]
+        got = np.asarray(held.rhs(0.0, x))[len(names):]
+        assert np.max(np.abs(got - want)) / np.max(np.abs(want)) < 1e-8, (name, got, want)
+
+
+def test_hold_heading_is_refused_in_one_line_where_there_is_no_heading(tmp_path):
+    """A planar walker and a 3D spoked wheel (whose heading is a rigid coordinate) refuse
+    ``contact.hold_heading`` in one line naming it, as the scene loader reports it."""
+    import yaml
+
+    for name in ("paper", "rimless_wheel_3d"):
+        raw = yaml.safe_load(Path(f"configs/{name}.yaml").read_text())
+        raw.setdefault("contact", {})["hold_heading"] = True
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(raw))
+        with pytest.raises(ValueError, match="contact.hold_heading") as err:
+            load_scene(path)
+        assert "\n" not in str(err.value)
 
 
 def _planar_and_3d():

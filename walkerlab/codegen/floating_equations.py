@@ -101,11 +101,12 @@ AXIAL_RADIUS_L = 0.01
 
 
 @cache
-def derive_floating(structure: Structure) -> FloatingEquations:
+def derive_floating(structure: Structure, held_heading: bool = False) -> FloatingEquations:
     """Derive the floating view of ``structure`` (memoised per process; module docstring):
     its floating tree's flow (:func:`_flow`) with the walker's contact points, planar
     (:func:`_planar_legs`, :func:`_wheel_tips`) or in 3D (:func:`_legs_3d`, the wheel's
-    :func:`_wheel_tips`).
+    :func:`_wheel_tips`); ``held_heading``: a legged walker in 3D on three slides, its
+    heading held (``contact.hold_heading``, :func:`_legs_3d`).
 
     Raises
     ------
@@ -119,13 +120,16 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     if structure.spokes:
         return _wheel_tips(structure)
     if structure.in_3d:
-        return _legs_3d(structure)
+        return _legs_3d(structure, held_heading)
+    if held_heading:
+        raise ValueError("contact.hold_heading: a planar walker has no heading (its feet "
+                         "turn in its plane only)")
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     return _planar_legs(structure)
 
 
-def _flow(structure: Structure, tree, coords):
+def _flow(structure: Structure, tree, coords, held_heading: bool = False):
     """The flow of a floating tree ``tree`` (its map ``coords``) in the floating view's
     coordinates (:func:`coordinate_names`): ``(kin, q, dq, rename, M, V, h)``, ``kin`` the
     tree's kinematics (:func:`walkerlab.codegen.tree_derive.kinematics`), ``rename`` its
@@ -142,7 +146,7 @@ def _flow(structure: Structure, tree, coords):
     )
 
     kin = kinematics(tree, coords)
-    names = coordinate_names(structure)
+    names = coordinate_names(structure, held_heading)
     q = sp.symbols(names, real=True)
     dq = sp.symbols([f"d_{n}" for n in names], real=True)
     rename = {**dict(zip(kin.q, q)), **dict(zip(kin.dq, dq))}
@@ -264,12 +268,15 @@ def _springs(structure: Structure, q, P: dict):
     return spring_dampers(joints, P, q)
 
 
-def _legs_3d(structure: Structure) -> FloatingEquations:
+def _legs_3d(structure: Structure, held_heading: bool = False) -> FloatingEquations:
     """The floating view of a 3D legged walker from its body tree
     (:func:`walkerlab.walker.trees.legs_tree` with ``floating``, Kuo 1999), set free at
     leg2's foot (:func:`walkerlab.walker.tree.free_root`: slides along the world's ``x, y,
     z`` and a heading, :data:`FREE_3D`, then the tree's joints in its own coordinates
-    renamed by :data:`ROLES_3D`).  The feet ``leg1`` (the rigid
+    renamed by :data:`ROLES_3D`; ``held_heading``: the slides only, the heading held as
+    the rigid model's stance foot holds it, so the whole walker does not yaw and the stance
+    foot turns about the ground's normal with its leg's lean and pitch, the rigid universal
+    ankle's ``-beta' sin(phi)``).  The feet ``leg1`` (the rigid
     model's swing foot) and ``leg2`` (its stance foot, the root's contact); round feet's the
     discs' lowest points with their material points' Jacobians (:func:`_disc_contact`).
     The hip-roll law's torques act between bodies (no force on the free coordinates): the
@@ -286,8 +293,9 @@ def _legs_3d(structure: Structure) -> FloatingEquations:
     from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
     from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
 
-    tree, coords = free_root(*legs_tree(structure, floating=True), FREE_3D)
-    kin, q, dq, rename, M, V, h = _flow(structure, tree, coords)
+    free = FREE_3D[:3] if held_heading else FREE_3D
+    tree, coords = free_root(*legs_tree(structure, floating=True), free)
+    kin, q, dq, rename, M, V, h = _flow(structure, tree, coords, held_heading)
     qv = sp.Matrix(q)
     to_world = slope_to_world(kin.gamma)
     # each leg's links by role: the foot's (the shank with a knee) and the thigh's

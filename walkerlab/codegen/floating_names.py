@@ -45,12 +45,15 @@ WHEEL_3D_COORDINATES = FREE_WHEEL_3D + ("heading", "lean", "wheel_angle")
 WHEEL_COORDINATES = ("hip_x", "hip_y", "wheel_angle")
 
 
-def coordinate_names(structure: Structure) -> tuple[str, ...]:
-    """Names of the floating view's generalised coordinates (module docstring)."""
+def coordinate_names(structure: Structure, held_heading: bool = False) -> tuple[str, ...]:
+    """Names of the floating view's generalised coordinates (module docstring);
+    ``held_heading``: a legged walker in 3D without the heading (``contact.hold_heading``:
+    its base slides only, as the rigid model's stance foot, which does not yaw)."""
     if structure.in_3d:
         if structure.spokes:  # the slides, then the tree's heading, lean and spin
             return WHEEL_3D_COORDINATES
-        return FREE_3D + tuple(ROLES_3D[r] for r in floating_roles_3d(structure))
+        free = FREE_3D[:3] if held_heading else FREE_3D
+        return free + tuple(ROLES_3D[r] for r in floating_roles_3d(structure))
     if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
         return WHEEL_COORDINATES
     if structure.knee:

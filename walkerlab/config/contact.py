@@ -276,6 +276,16 @@ class ContactSettings(BaseModel):
         "mu_static).  Default (null) 0.05 leg lengths, the MJCF export's.",
         json_schema_extra={"unit": "m"})
 
+    hold_heading: bool = Field(
+        False, description="Legged walkers in 3D only: hold the walker's heading, its turn "
+        "about the ground's normal, as the rigid model's stance foot does (it rolls and "
+        "pitches, never yaws, so it spins about the normal with its leg, -beta' sin(lean): "
+        "Kuo 1999's universal ankle).  The floating base then slides without turning, and "
+        "the stance foot's torsional friction acts on that spin; with "
+        "torsional_friction_m: 0 the contact walker makes the rigid model's assumptions. "
+        "Default false: the whole walker turns when its stance foot's friction holds the "
+        "foot's spin (a real walker's heading change).")
+
     push_off_duration_s: float | None = Field(
         None, ge=0, le=0.5, description="Powered walkers only: the duration [s] of the "
         "push-off pulse, a constant force P / duration along the trailing leg (from its foot "
@@ -316,7 +326,7 @@ class ContactSettings(BaseModel):
         return drop_unset(handler(self), [
             *(name for names in CONTACT_QUANTITIES.values() for name, _unit in names.values()),
             "flat_foot_mass_kg", "flat_foot_inertia_kg_m2", "push_off_duration_s",
-            "hub_inertia_kg_m2"])
+            "hub_inertia_kg_m2", "hold_heading"])
 
     def written(self, quantity: str) -> tuple[float, str, str]:
         """A dimensional quantity as the scene writes it.

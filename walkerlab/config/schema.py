@@ -179,6 +179,12 @@ class Scene(Strict):
             raise ValueError("contact.torsional_friction_m: a planar walker's feet hold no "
                              "moment about the ground's normal (they turn in its plane "
                              "only): remove it, or give the walker walker.space: 3d")
+        # a heading is a legged walker's in 3D (a 3D spoked wheel's is its rigid state's)
+        if c.hold_heading and (getattr(self.walker, "space", "2d") != "3d"
+                               or getattr(self.walker, "model", "") == "rimless_wheel"):
+            raise ValueError("contact.hold_heading: a legged walker in 3D's option (walker."
+                             "space: 3d; a planar walker has no heading, a 3D spoked "
+                             "wheel's heading is a coordinate of its rigid state)")
         # feet with mass (walker.leg.foot.mass_kg) are the same feet in every view: the
         # contact section's regularising foot mass would be a second, different foot
         foot = legs[0].foot if legs else None

@@ -100,7 +100,7 @@ def rhs_beside(setup: ContactSetup, side: Callable[[], SideWorker]
     either way."""
     from walkerlab.models.contact.generated import contact_module_state  # light
 
-    name, cached = contact_module_state(setup.walker.structure)
+    name, cached = contact_module_state(setup.walker.structure, setup.law.hold_heading)
     if cached is not False or not _compiled_walk(setup):
         return None
     worker = side()

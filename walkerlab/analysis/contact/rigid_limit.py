@@ -148,7 +148,9 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
     if walker.steps_per_map % rigid_steps == 0:  # the rigid map's multipliers, on the
         lam_r = lam_r ** (walker.steps_per_map // rigid_steps)  # contact map's steps
     lam_r = sort_multipliers(lam_r)
-    free = contact_part(walker.structure).free_modes
+    # a held heading is no free mode (contact.hold_heading)
+    free = (0 if getattr(walker, "hold_heading", False)
+            else contact_part(walker.structure).free_modes)
     search.setdefault("check_fd", False)
     rows, guess = [], ideal.x
     for kappa in kappas:

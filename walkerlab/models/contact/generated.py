@@ -114,7 +114,7 @@ _SOURCES = (Path(__file__), _HERE / "powered_source.py", _HERE / "rhs_lines.py",
             _HERE.parent.parent / "codegen" / "contact_glue.py",
             _HERE.parent.parent / "codegen" / "floating_equations.py")  # legs_axial_inertia
 
-def contact_source(structure: Structure, key: str) -> str:
+def contact_source(structure: Structure, key: str, held_heading: bool = False) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
     constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``KNEES``
     (2, 2) (each knee's thigh and shank coordinates in ``q``), ``NF``,
@@ -136,7 +136,7 @@ def contact_source(structure: Structure, key: str) -> str:
     from .powered_source import powered_source
 
     # a 3D walker of zero hip width: its legs' axial inertia (legs_axial_inertia)
-    eq = legs_axial_inertia(structure, floating.derive_floating(structure))
+    eq = legs_axial_inertia(structure, floating.derive_floating(structure, held_heading))
     if structure.knee and len(eq.feet) != 2:
         raise ValueError("a kneed walker's contact model needs one contact point per leg")
     fl = floating.generate_floating(eq, key)
@@ -151,9 +151,16 @@ def contact_source(structure: Structure, key: str) -> str:
             + "\n\n" + rhs_source(eq, forced=True) + "\n\n" + powered_source())
 
 
-def contact_module(structure: Structure):
+def _tag(held_heading: bool) -> str:
+    """The generated contact module's name tag: ``contact``, or ``contact_held`` with the
+    heading held (``contact.hold_heading``: another floating view of the same structure)."""
+    return "contact_held" if held_heading else "contact"
+
+
+def contact_module(structure: Structure, held_heading: bool = False):
     """The imported generated contact module of ``structure`` (compiled lazily by numba,
-    cached on disk).
+    cached on disk); ``held_heading``: its floating view without the heading
+    (:func:`walkerlab.codegen.floating_equations.derive_floating`).
 
     Raises
     ------
@@ -163,12 +170,13 @@ def contact_module(structure: Structure):
     from walkerlab.codegen import floating
 
     floating.check_masses(structure)
-    return floating.load_generated(structure, "contact",
-                                   lambda key: contact_source(structure, key),
+    return floating.load_generated(structure, _tag(held_heading),
+                                   lambda key: contact_source(structure, key, held_heading),
                                    sources=_SOURCES)
 
 
-def contact_module_state(structure: Structure) -> tuple[str, bool | None]:
+def contact_module_state(structure: Structure, held_heading: bool = False
+                         ) -> tuple[str, bool | None]:
     """The module name :func:`contact_module` gives ``structure``'s generated contact module
     (``ContactWalker.kernels.__name__``) and whether its source is in the user cache already
     (:func:`walkerlab.codegen.floating.generated_state`: False on the first contact run of
@@ -176,4 +184,4 @@ def contact_module_state(structure: Structure) -> tuple[str, bool | None]:
     folder), without generating or importing it."""
     from walkerlab.codegen import floating
 
-    return floating.generated_state(structure, "contact", sources=_SOURCES)
+    return floating.generated_state(structure, _tag(held_heading), sources=_SOURCES)

@@ -133,6 +133,10 @@ class ContactWalker(ContactReadouts):
         A walker in 3D: each contact's torsional friction coefficient [m]
         (:func:`walkerlab.models.contact.assembly.twist`; ``contact.torsional_friction_m``);
         0: none (a planar walker's contact has no spin about the normal).
+    hold_heading : bool
+        A legged walker in 3D: its floating base on three slides, no heading
+        (``contact.hold_heading``; the rigid model's assumption: its stance foot does not
+        yaw), so the whole walker cannot turn about the ground's normal.
     rhs_ready : walkerlab.codegen.pending.CompiledElsewhere, optional
         A side process compiling the compiled solvers' right-hand side: the first compiled
         chunk waits for it and loads the kernel from the cache (the caller's hand-off,
@@ -167,6 +171,7 @@ class ContactWalker(ContactReadouts):
     hub_inertia: float | None = None
     ground_line: np.ndarray | None = None
     torsion: float = 0.0
+    hold_heading: bool = False
 
     def __post_init__(self):
         from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
@@ -191,7 +196,7 @@ class ContactWalker(ContactReadouts):
         if self.knee_stop is None:
             set_(self, "knee_stop", knee_stop_si(KneeStopSettings()))
         c, ks = self.contact, self.knee_stop
-        mod = contact_module(d.structure)
+        mod = contact_module(d.structure, self.hold_heading)
         PC = np.empty(NPC)
         PC[mod.I_PHI] = self.phi
         PC[mod.I_K], PC[mod.I_E], PC[mod.I_CMAX], PC[mod.I_DMAX] = c.k, c.e, c.cmax, c.dmax
@@ -229,7 +234,7 @@ class ContactWalker(ContactReadouts):
         set_(self, "kernels", mod)
         set_(self, "contact_params", PC)
         set_(self, "walker_params", params)
-        set_(self, "_coords", coordinate_names(d.structure))
+        set_(self, "_coords", coordinate_names(d.structure, self.hold_heading))
         set_(self, "_contacts", tuple(mod.CONTACTS))
         set_(self, "_point_legs", tuple(mod.POINT_LEG))
 

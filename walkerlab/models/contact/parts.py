@@ -349,10 +349,12 @@ class Legs3DPart(ContactPart):
     #: right-hand-side calls there, scipy's BDF with its own differences 581 (135 steps)
     attribution_refusal = (
         "the attribution's creep-free (stiction velocity / 100) and 1000 times stiffer "
-        "contacts are beyond the stride map's integrator in 3D: the stance foot's torsional "
-        "friction makes the heading's rate a mode of -1e7 1/s (-1e8 at 100 times the "
-        "stiffness), on which CyRK's BDF takes 440 s a stride at 1000 times: walkerlab "
-        "compare --rigid-limit shows the gap's orders")
+        "contacts are beyond the stride map's integrator in 3D with the heading free: the "
+        "stance foot's torsional friction makes the heading's rate a mode of -1e7 1/s (-1e8 "
+        "at 100 times the stiffness), on which CyRK's BDF takes 440 s a stride at 1000 "
+        "times; hold the heading as the rigid stance foot does (contact.hold_heading: "
+        "true; with torsional_friction_m: 0 its foot also spins freely, as the rigid one: "
+        "configs/hip_width_stabilised.yaml's attribution then takes 20 s)")
     #: the heading: the rigid stance foot holds its yaw (the rigid state has no heading),
     #: the compliant one turns, with a multiplier near 1 (heading is nearly neutral)
     free_modes = 1
@@ -493,9 +495,12 @@ def attribution_refusal(scene, data) -> str | None:
     (:mod:`walkerlab.analysis.contact.attribution`: seven periodic-gait searches) is not
     computed for the scene's walker, in one line without the scene's name, or None: no
     contact periodic gait (:func:`periodic_gait_refusal`), or the kind's
-    :attr:`ContactPart.attribution_refusal` (a walker in 3D).  ``data`` is the walker's
-    WalkerData."""
-    return periodic_gait_refusal(scene, data) or contact_part(data.structure).attribution_refusal
+    :attr:`ContactPart.attribution_refusal` (a walker in 3D whose contact does not hold the
+    heading, ``contact.hold_heading``).  ``data`` is the walker's WalkerData."""
+    why = periodic_gait_refusal(scene, data)
+    if why is None and not (scene.contact is not None and scene.contact.hold_heading):
+        why = contact_part(data.structure).attribution_refusal
+    return why
 
 
 def contact_part(structure) -> ContactPart:

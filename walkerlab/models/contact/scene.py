@@ -157,7 +157,8 @@ class ContactSetup:
                              flat_foot=self.law.flat_foot(), actuators=self.actuators,
                              rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2,
                              torsion=torsional_friction_m(self.law, self.walker.leg_length_m,
-                                                          st.in_3d))
+                                                          st.in_3d),
+                             hold_heading=self.law.hold_heading)
 
     def held_actuators(self):
         """Actuators with no law of the scene's (an empty actuation): what a run that holds a
@@ -170,7 +171,8 @@ class ContactSetup:
         """
         st = self.walker.structure
         empty = Actuation.model_construct(torques=[], push_off=None, ankle_push_off=None)
-        return contact_part(st).actuators(self.walker, empty, coordinate_names(st), 0.0)
+        return contact_part(st).actuators(self.walker, empty,
+                                          coordinate_names(st, self.law.hold_heading), 0.0)
 
     def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None,
               step_lengths_m: tuple | None = None):
@@ -430,7 +432,8 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
                                     "(start: ideal, periodic_gait: false)")
     pulse = scene.contact.push_off_pulse_s()
     try:  # the kind's actuators (a five-link biped's: the rigid view's joint torques)
-        return part.actuators(data, spec, coordinate_names(st), pulse)
+        return part.actuators(data, spec, coordinate_names(st, scene.contact.hold_heading),
+                              pulse)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
 
