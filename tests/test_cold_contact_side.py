@@ -79,7 +79,7 @@ def test_the_right_hand_side_is_compiled_beside_only_on_a_cold_run(cached, fake_
 
     sc = load_scene(ROOT / "configs" / "paper.yaml")
     setup = contact_setup(sc, plant=Plant.from_scene(sc))
-    monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_x", cached))
+    monkeypatch.setattr(generated, "contact_module_state", lambda s, held=False: ("mod_x", cached))
     used: list[bool] = []
     with contact_sim._rhs_beside(setup, None) as run_setup:
         # the walk's first use of the compiled right-hand side (the hand-off it was given)
@@ -107,7 +107,7 @@ def test_a_run_whose_kernel_a_caller_compiles_beside_starts_nothing(fake_side, m
 
     sc = load_scene(ROOT / "configs" / "paper.yaml")
     setup = contact_setup(sc, plant=Plant.from_scene(sc))
-    monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_r", False))
+    monkeypatch.setattr(generated, "contact_module_state", lambda s, held=False: ("mod_r", False))
     seen: list[str] = []
     ready = pending.CompiledElsewhere("mod_r", "build_cyrk", lambda: seen.append("report's"))
     with contact_sim._rhs_beside(setup, ready) as run_setup:
@@ -125,7 +125,7 @@ def test_a_side_process_that_was_never_needed_is_stopped(fake_side, monkeypatch)
 
     sc = load_scene(ROOT / "configs" / "paper.yaml")
     setup = contact_setup(sc, plant=Plant.from_scene(sc))
-    monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_y", False))
+    monkeypatch.setattr(generated, "contact_module_state", lambda s, held=False: ("mod_y", False))
     monkeypatch.setattr(_FakeSide, "submit", lambda self, fn, *a: Future())  # still running
     with contact_sim._rhs_beside(setup, None):
         pass

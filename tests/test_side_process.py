@@ -109,12 +109,12 @@ def test_warm_up_only_for_a_contact_run_the_report_computes(ideal_scene,  # noqa
     paper = load_scene(ROOT / "configs" / "paper.yaml")
     # the walker's generated module in the user cache: the side process loads every kernel
     # (cheap) and the run waits for it
-    monkeypatch.setattr(generated, "contact_module_state", lambda st: ("m_warm", True))
+    monkeypatch.setattr(generated, "contact_module_state", lambda st, held=False: ("m_warm", True))
     fut, module = _warm_up(paper, tmp_path, False, report_plan(paper), side)
     assert side.submitted[0] is contact_sim.warm_up and module is None
     # its first contact run: the side process compiles the right-hand side only, and the
     # run (not waiting for it first) waits for it just before its walk
-    monkeypatch.setattr(generated, "contact_module_state", lambda st: ("m_cold", False))
+    monkeypatch.setattr(generated, "contact_module_state", lambda st, held=False: ("m_cold", False))
     side = _Recorder()
     fut, module = _warm_up(paper, tmp_path, False, report_plan(paper), side)
     assert side.submitted[0] is contact_sim.warm_rhs

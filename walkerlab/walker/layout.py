@@ -199,12 +199,9 @@ class StateLayout:
         ------
         ValueError
             A coordinate belongs to no leg of ``scale`` (its rate could not be scaled
-            consistently, e.g. the slope-relative ``hip`` angle, a 3D walker's lean), unless
-            every factor is 1 (the state unchanged).
+            consistently, e.g. the slope-relative ``hip`` angle).
         """
         out = np.array(x, dtype=float)
-        if all(float(f) == 1.0 for f in scale.values()):
-            return out
         n = self.n_coordinates
         for i, c in enumerate(self.coordinates):
             leg = self.leg_of(c)

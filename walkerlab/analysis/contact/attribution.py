@@ -195,7 +195,9 @@ def adjustment_effect(scene, ideal, strides: int = 5, *, plant) -> dict:
             else float("nan")
     iw = build_walker(setup.plant.with_(scene))  # the set-up's plant: the walker described once
     # leg1 swings first (paper Eq. 11): its rates take scale[0], the stance leg's scale[1]
-    x = iw.layout().scale_rates(ideal.x, {"swing": scale[0], "stance": scale[1]})
+    # (none asked: the gait itself, whatever its coordinates, a 3D walker's lean too)
+    x = (np.array(ideal.x, float) if scale == (1.0, 1.0) else
+         iw.layout().scale_rates(ideal.x, {"swing": scale[0], "stance": scale[1]}))
     run = simulate_steps(iw, x, 2 * strides, Solver.from_settings(scene.solver))
     out["rigid_from_adjusted"] = run.termination
     out["rigid_heel_strikes"] = sum(s.termination == "heel_strike" for s in run.segments)
