@@ -3,7 +3,8 @@
 
 For each stiffness factor ``kappa`` (default the walker kind's,
 :attr:`walkerlab.models.contact.parts.ContactPart.rigid_limit_kappas`: :data:`KAPPAS`, a
-walker in 3D one octave at a time to 8) the scene's contact is scaled by
+walker in 3D one octave at a time to 8, or the three decades with its heading held,
+``contact.hold_heading``) the scene's contact is scaled by
 :mod:`walkerlab.models.contact.rigid_limit` and the contact walker's own periodic gait is found
 (:func:`walkerlab.analysis.contact.rigid_limit.convergence`); the artifact holds its step period,
 step length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
@@ -18,7 +19,7 @@ from pathlib import Path
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, write_rigid_limit
-from walkerlab.models.contact.parts import contact_part, periodic_gait_refusal
+from walkerlab.models.contact.parts import ContactPart, contact_part, periodic_gait_refusal
 from walkerlab.models.contact.rigid_limit import expected_order
 from walkerlab.models.contact.scene import build
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
@@ -43,9 +44,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     scene = with_defaults(scene, "contact", "rigid-limit")  # left out: the paper's contact law
     require(scene, "fixedpoint", "rigid-limit")
     _periodic_gait_taken(scene)
-    if kappas is None:
-
-        kappas = contact_part(Plant.from_scene(scene).data.structure).rigid_limit_kappas
+    if kappas is None:   # the kind's; with the heading held no stiff torsional mode
+        # limits a 3D walker's: the three decades of ContactPart's (planar walkers')
+        part = contact_part(Plant.from_scene(scene).data.structure)
+        kappas = (ContactPart.rigid_limit_kappas if scene.contact.hold_heading
+                  else part.rigid_limit_kappas)
     kappas = tuple(float(k) for k in kappas)
 
     def compute():
