@@ -276,15 +276,10 @@ class ContactSettings(BaseModel):
         "mu_static).  Default (null) 0.05 leg lengths, the MJCF export's.",
         json_schema_extra={"unit": "m"})
 
-    hold_heading: bool = Field(
-        False, description="Legged walkers in 3D only: hold the walker's heading, its turn "
-        "about the ground's normal, as the rigid model's stance foot does (it rolls and "
-        "pitches, never yaws, so it spins about the normal with its leg, -beta' sin(lean): "
-        "Kuo 1999's universal ankle).  The floating base then slides without turning, and "
-        "the stance foot's torsional friction acts on that spin; with "
-        "torsional_friction_m: 0 the contact walker makes the rigid model's assumptions. "
-        "Default false: the whole walker turns when its stance foot's friction holds the "
-        "foot's spin (a real walker's heading change).")
+    hold_heading: bool = Field(False, description=(
+        "3D legged walkers: hold the heading (no turn about the ground's normal), as the "
+        "rigid stance foot does, which spins with its leg instead (Kuo 1999); with "
+        "torsional_friction_m: 0 the contact makes the rigid model's assumptions"))
 
     push_off_duration_s: float | None = Field(
         None, ge=0, le=0.5, description="Powered walkers only: the duration [s] of the "
