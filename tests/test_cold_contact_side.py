@@ -215,3 +215,23 @@ def test_a_cold_contact_run_loads_the_right_hand_side_the_side_process_compiled(
     assert cold.keys() == warm.keys() and len(cold) > 10
     for k in cold:
         np.testing.assert_array_equal(cold[k], warm[k], err_msg=k)
+
+
+@pytest.mark.parametrize("held", [False, True])
+def test_the_side_process_compiles_the_module_the_run_will_load(monkeypatch, held):
+    """The side process compiles the right-hand side of the generated module the run loads:
+    with ``contact.hold_heading`` the held floating view's (its own module), not the
+    free-heading one's (stand-ins record which module is built and compiled)."""
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.contact import warm
+    from walkerlab.models.contact import generated
+
+    built, compiled = [], []
+    monkeypatch.setattr(generated, "contact_module",
+                        lambda s, held=False: built.append((s, held)) or f"mod_{held}")
+    monkeypatch.setattr(warm, "compile_rhs", compiled.append)
+    setup = SimpleNamespace(walker=SimpleNamespace(structure="st"),
+                            law=SimpleNamespace(hold_heading=held))
+    assert warm.compile_rhs_kernels(setup)
+    assert built == [("st", held)] and compiled == [f"mod_{held}"]

@@ -72,6 +72,6 @@ def compile_rhs_kernels(setup: ContactSetup) -> bool:
         return False
     from walkerlab.models.contact.generated import contact_module  # light
 
-    compile_rhs(contact_module(setup.walker.structure))
+    compile_rhs(contact_module(setup.walker.structure, setup.law.hold_heading))
     return True
 
