@@ -178,24 +178,6 @@ def test_the_3d_contact_flow_matches_an_independent_newton_model(hip_width):
     assert worst > 0  # two codes, not one
 
 
-def _held_accelerations(ref, x):
-    """The reference's accelerations (6,) with its heading held (coordinate 3 and its rate
-    0): its Newton rows without the heading's row and column (the held coordinate's
-    constraint force is that row's multiplier)."""
-    q, dq = np.asarray(x[:7], float), np.asarray(x[7:], float)
-    grav = np.array([0.0, -ref.g, 0.0])
-    M, Q = np.zeros((7, 7)), np.zeros(7)
-    for name, mass in ref.masses():
-        J = ref.jacobian(name, q)
-        M += mass * J.T @ J
-        Q += mass * J.T @ (grav - ref.jdot_dq(name, q, dq))
-    for leg in (1, 2):
-        c = ref.foot_contact(q, dq, leg)
-        Q += c["J"].T @ c["F"] + c["Jw"] * c["moment"]
-    keep = [0, 1, 2, 4, 5, 6]
-    return np.linalg.solve(M[np.ix_(keep, keep)], Q[keep])
-
-
 def test_the_held_heading_contact_flow_is_the_newton_models_with_its_heading_held(hip_width):
     """``contact.hold_heading``: configs/hip_width.yaml's contact walker on three slides (no
     heading coordinate) has the independent Newton model's flow with the heading's row and
@@ -216,8 +198,7 @@ def test_the_held_heading_contact_flow_is_the_newton_models_with_its_heading_hel
         c = [ref.foot_contact(xr[:7], xr[7:], leg) for leg in (1, 2)]
         assert c[0]["fn"] > 0 and c[1]["fn"] > 0 and abs(c[1]["spin"]) > 0, name
         x = np.concatenate([xr[:7][perm_held], xr[7:][perm_held]])
-        want = _held_accelerations(ref, xr)[[list(range(7)).index(k) - (k > 3)
-                                             for k in perm_held]]
+        want = ref.accelerations(xr, held=(3,))[[k - (k > 3) for k in perm_held]]
         got = np.asarray(held.rhs(0.0, x))[len(names):]
         assert np.max(np.abs(got - want)) / np.max(np.abs(want)) < 1e-8, (name, got, want)
 

@@ -23,8 +23,9 @@ import pytest
 import yaml
 
 from tests.independent.mirror_stride import stride_against
-from tests.test_hip_roll_3d import LEAN, PELVIS, STANCE, SWING, SWROLL
+from tests.test_hip_roll_3d import LEAN, PELVIS, STANCE, SWING, SWROLL, flow_and_impact_errors
 from tests.test_hip_roll_3d import Reference as HipRollReference
+from tests.test_hip_roll_3d import reference_of as hip_roll_reference_of
 from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config.schema import Scene
 from walkerlab.integrate.solver import Solver
@@ -181,13 +182,8 @@ class Reference(HipRollReference):
 
 
 def reference_of(scene: Scene) -> Reference:
-    wc, h = scene.walker, scene.walker.hip_roll
-    gains = (h.pelvis_stiffness_n_m_per_rad, h.pelvis_damping_n_m_s_per_rad,
-             h.swing_stiffness_n_m_per_rad, h.swing_damping_n_m_s_per_rad, h.lean_gain,
-             h.lean_rate_gain_s)
-    return Reference(wc.gravity_m_per_s2, wc.leg_length_m, scene.slope.angle_rad,
-                     wc.hip_mass_kg, wc.leg_mass_kg, wc.leg_mass_from_foot_m,
-                     h.pelvis_roll_inertia_kg_m2, gains, wc.foot_radius_m)
+    """The Newton-Euler model of the scene's walker on its discs."""
+    return hip_roll_reference_of(scene, Reference, R=scene.walker.foot_radius_m)
 
 
 @pytest.fixture(scope="module")
@@ -209,13 +205,9 @@ def test_round_feet_hip_roll_flow_and_impact_match_newton_euler(discs):
     max(1, |value|), 1e-10 (stiff hips: accelerations to 1e3 rad/s^2; both solve a 5x5
     system, roundoff ~1e-13 relative)."""
     scene, walker, ref = discs
-    w = scene.walker.hip_width_m
-    for side, phase in ((w, walker), (-w, walker.mirror)):
-        for x in _states(3, 4):
-            theirs = ref.rhs(side)(0.0, x)
-            err = np.abs(phase.phases[0].flow(0.0, x) - theirs) / np.maximum(1, np.abs(theirs))
-            assert np.max(err) < 1e-10
-            assert np.max(np.abs(phase.reset(x) - ref.impact(side, x))) < 1e-10
+    flow, reset = flow_and_impact_errors(walker, ref, scene.walker.hip_width_m, _states(3, 4))
+    assert flow < 1e-10
+    assert reset < 1e-10
 
 
 def test_round_feet_hip_roll_energies_are_the_rolling_walkers(discs):

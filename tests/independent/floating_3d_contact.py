@@ -228,8 +228,10 @@ class Floating3DContact:
             M += mass * J.T @ J
         return M
 
-    def accelerations(self, x):
-        """``qdd`` (7,) at the state ``x = [q, dq]`` (14,)."""
+    def accelerations(self, x, held=()):
+        """``qdd`` (7,) at the state ``x = [q, dq]`` (14,); with coordinates ``held`` (indices,
+        at rest in ``x``) those rows and columns removed, the accelerations of the others
+        (the held coordinates' constraint forces are their rows' multipliers)."""
         q, dq = np.asarray(x[:7], float), np.asarray(x[7:], float)
         grav = np.array([0.0, -self.g, 0.0])
         M, Q = np.zeros((7, 7)), np.zeros(7)
@@ -240,7 +242,8 @@ class Floating3DContact:
         for leg in (1, 2):
             c = self.foot_contact(q, dq, leg)
             Q += c["J"].T @ c["F"] + c["Jw"] * c["moment"]
-        return np.linalg.solve(M, Q)
+        keep = [k for k in range(7) if k not in held]
+        return np.linalg.solve(M[np.ix_(keep, keep)], Q[keep])
 
     def rhs(self, t, x):
         """dx/dt (14,)."""

@@ -149,8 +149,7 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
         lam_r = lam_r ** (walker.steps_per_map // rigid_steps)  # contact map's steps
     lam_r = sort_multipliers(lam_r)
     # a held heading is no free mode (contact.hold_heading)
-    free = (0 if getattr(walker, "hold_heading", False)
-            else contact_part(walker.structure).free_modes)
+    free = 0 if walker.hold_heading else contact_part(walker.structure).free_modes
     search.setdefault("check_fd", False)
     rows, guess = [], ideal.x
     for kappa in kappas:
