@@ -15,8 +15,8 @@ import h5py
 import numpy as np
 import pytest
 
-from walkerlab.codegen import pending
 from walkerlab.config import load_scene
+from walkerlab.execution import pending
 from walkerlab.models.contact.scene import contact_setup
 from walkerlab.stages import contact_sim
 from walkerlab.walker.plant import Plant
@@ -147,7 +147,7 @@ def test_a_compiled_walk_is_what_the_side_process_serves():
 _COLD = r"""
 import json, sys, time
 from pathlib import Path
-from walkerlab.codegen import pending
+from walkerlab.execution import pending
 
 waits = []
 register = pending.CompiledElsewhere.__init__

@@ -34,6 +34,7 @@ import yaml
 from tests.independent import floating_reference as ref
 from tests.test_export import _joint_map, _states
 from walkerlab.config import load_scene
+from walkerlab.models.hybrid.floating_view import FloatingView
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.plant import Plant
@@ -81,18 +82,17 @@ def test_urdf_in_drake_has_walkerlabs_mass_matrix(name, tmp_path):
     (1e-10 relative, as Pinocchio's and MuJoCo's in tests/test_export.py) at random states;
     the paper walker, the kneed walker, the torso's bisecting hip (a free joint in the URDF,
     the coupling applied through T) and arc feet."""
-    floating = pytest.importorskip("walkerlab.codegen.floating")
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     names = ref.coordinate_names(data)
     drake = Drake(export_stage.run(scene, tmp_path, "urdf"), names, data.gravity_m_per_s2,
                   bool(data.structure.torso))
-    view = floating.floating_view(data)
+    view = FloatingView(data)
     seen = []
     for q, dq in _states(len(names), seed=23):
         M, b = drake(q, dq)
-        Mw = np.asarray(view.mass_matrix(q), float)
-        bw = np.asarray(view.bias(q, dq), float) + ref.spring_force(data, q, dq)
+        Mw, bw = view.dynamics(np.asarray(q, float), np.asarray(dq, float))
+        bw = bw + ref.spring_force(data, q, dq)
         assert np.abs(M - Mw).max() <= 1e-9
         assert np.abs(b - bw).max() <= 1e-10 * np.abs(bw).max()
         seen.append(M)

@@ -57,7 +57,7 @@ CHAINS = ("pipeline.py", "report_dag.py", "report.py")
 #: analysis that writes them; ``rigid_walker`` (a scene's rigid walker and its gait) below the
 #: two front doors that hold one, the gym and the API.
 LAYERS = (
-    ("numerics", "units", "safefs", "usercache", "extras", "freshstack", "progress",
+    ("numerics", "units", "safefs", "usercache", "codestore", "extras", "freshstack", "progress",
      "published", "execution"),
     ("config",),
     ("walker",),

@@ -577,8 +577,8 @@ def test_sigterm_during_a_write_leaves_no_lock_nor_temporary_file(tmp_path):
 def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(monkeypatch):
     import walkerlab.safefs as safefs
     import walkerlab.usercache as usercache
+    from walkerlab import codestore
     from walkerlab.cli.errors import _disk_full_line
-    from walkerlab.codegen import cache
     from walkerlab.io.artifacts import is_disk_full
 
     def full(path, fill, **kw):
@@ -587,7 +587,7 @@ def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(
     monkeypatch.setattr(safefs, "atomic_replace", full)
     monkeypatch.setattr(usercache, "atomic_replace", full)  # the name the cache writes by
     with pytest.raises(OSError) as exc:
-        cache.import_generated("zz_never_written_nb.py", "walkerlab_zz_never", lambda: "X = 1")
+        codestore.import_generated("zz_never_written_nb.py", "walkerlab_zz_never", lambda: "X = 1")
     assert is_disk_full(exc.value) and "cannot write the generated module" in str(exc.value)
     line = _disk_full_line(exc.value)
     assert line.startswith("error: disk full: cannot write ") and "zz_never_written" in line

@@ -96,7 +96,7 @@ class _Recorder:
 
 def test_warm_up_only_for_a_contact_run_the_report_computes(ideal_scene,  # noqa: F811
                                                             tmp_path, monkeypatch):
-    from walkerlab.codegen import pending
+    from walkerlab.execution import pending
     from walkerlab.io.runpaths import stage_artifact
     from walkerlab.models.contact import generated
     from walkerlab.stages import contact_sim

@@ -36,8 +36,8 @@ def walker_and_scene(request):
 
 
 def test_compiled_closed_loop_is_the_python_flow_and_jacobian(walker_and_scene):
-    from walkerlab.codegen.virtual_constraint_flow import VirtualConstraintFlow
     from walkerlab.integrate._compiled import callable_flow
+    from walkerlab.models.compiled_flows import VirtualConstraintFlow
 
     walker, _ = walker_and_scene
     ctrl = walker.actuators.controller

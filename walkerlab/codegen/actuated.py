@@ -21,18 +21,15 @@ its length first), then the call counter (last, as every compiled flow's).
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import re
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
+from walkerlab import codestore
 from walkerlab.codegen import cache
-from walkerlab.codegen.compiled import CompiledFlow
 
-__all__ = ["ActuatedFlow", "actuated_module", "generate_actuated"]
+__all__ = ["actuated_module", "generate_actuated"]
 
 
 def _defined(lines: list[str]) -> set[str]:
@@ -221,6 +218,7 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     key : str
         Written into the header.
     """
+    from walkerlab.codegen.compiled_source import compiled_head  # light
     from walkerlab.codegen.source import PRINTER, cse_lines, start_module  # light
     from walkerlab.codegen.torque_law import kernel_source
 
@@ -250,27 +248,11 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
             f"NCONST = {len(consts)}",
             f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", "",
             *kernel_source(), *text]
-    head = [
-        f"# walkerlab compiled actuated model code (walkerlab.codegen.actuated); key {key}",
-        "# Do not edit: regenerated when the walker description or the generator changes.",
-        "from math import sin, cos, tan, sqrt, atan, acos  # noqa: F401",
-        "import numpy as np",
-        "from numba import carray, cfunc, njit, types",
-        "",
-        "SIG = types.void(types.CPointer(types.float64), types.float64,",
-        "                 types.CPointer(types.float64), types.CPointer(types.float64))",
-        "",
-    ]
-    return "\n".join(head + body) + "\n"
+    return "\n".join(compiled_head("actuated model code (walkerlab.codegen.actuated)", key,
+                                   "sin, cos, tan, sqrt, atan, acos",
+                                   "carray, cfunc, njit, types") + body) + "\n"
 
 
-@functools.cache  # the source does not change within a process
-def _source_hash() -> str:
-    here = Path(__file__).parent
-    h = hashlib.sha256()
-    for name in ("actuated.py", "torque_law.py"):
-        h.update((here / name).read_bytes())
-    return h.hexdigest()[:12]
 
 
 def actuated_module(structure, joints):
@@ -284,121 +266,13 @@ def actuated_module(structure, joints):
         numba is not installed.
     """
     key = cache.cache_key(structure)
-    tag = hashlib.sha256(f"{joints!r}{_source_hash()}".encode()).hexdigest()[:12]
+    here = Path(__file__).parent
+    sources = codestore.source_hash(here / "actuated.py", here / "torque_law.py")
+    tag = hashlib.sha256(f"{joints!r}{sources[:12]}".encode()).hexdigest()[:12]
 
     def build() -> str:
         eq = cache.derive_equations(structure)   # a biped's, planar or 3D
         return generate_actuated(eq, structure.param_names, tuple(joints), key)
 
-    return cache.import_generated(f"{key}_act_{tag}_nb.py", f"walkerlab_actuated_{key}_{tag}",
+    return codestore.import_generated(f"{key}_act_{tag}_nb.py", f"walkerlab_actuated_{key}_{tag}",
                                   build)
-
-
-#: constants of compiled flows by their numbers (:meth:`ActuatedFlow.constants`: one array
-#: per value)
-_CONSTANTS: dict = {}
-
-#: most entries of :data:`_SHARED_ROWS` (cleared when full)
-SHARED_ROWS_KEPT = 4096
-#: :meth:`ActuatedFlow.data_rows`' flows (by their ids, in order) -> ``(the flows, their
-#: shared constants or None)``: whether a batch of flows shares its constants, found once
-_SHARED_ROWS: dict = {}
-
-
-@dataclass(frozen=True, eq=False)
-class ActuatedFlow(CompiledFlow):
-    """Handle on an actuated walker's compiled flow (:class:`CompiledFlow` with laws).
-
-    Attributes
-    ----------
-    joints : tuple of (str, str)
-        Each actuator's (first, second) link (keys of the generated ``leg_angles``).
-    laws : ndarray
-        The law block (:func:`walkerlab.codegen.torque_law.pack_laws`).
-    actuators : object
-        Holds ``t_origin`` [s], the time the present step began (written into the law
-        block by :meth:`data`).
-    """
-
-    joints: tuple = ()
-    laws: np.ndarray | None = None
-    actuators: object = None
-    #: the batched step map runs the passive module's flows: not this one
-    batchable = False
-
-    def module(self):
-        return actuated_module(self.structure, self.joints)
-
-    def address(self, variational: bool = False) -> int:
-        """C address of the cfunc ``(dy, t, y, d)`` (:meth:`CompiledFlow.address`), compiled
-        or loaded on first use (the module's ``cfunc_of``)."""
-        k = (self.name, variational)
-        if k not in self._memo:
-            name = f"{self.name}_variational" if variational else self.name
-            self._memo[k] = self.module().cfunc_of(name).address
-        return self._memo[k]
-
-    def data(self) -> np.ndarray:
-        """Constants, the law block (with the present step's start time) and a zeroed
-        call counter."""
-        key = ("blank", self.laws.size)  # (a flow replaced with other laws: its own)
-        blank = self._memo.get(key)
-        if blank is None:  # the constants and a zeroed counter, kept (data_into's numbers)
-            blank = np.empty(self.data_size())
-            self.data_into(blank)
-            blank = self._memo[key] = (blank, blank.size - 1 - self.laws.size)
-        out = blank[0].copy()
-        nc = blank[1]
-        out[nc:-1] = self.laws
-        out[nc + 2] = float(getattr(self.actuators, "t_origin", 0.0))
-        return out
-
-    def data_size(self) -> int:
-        """The length of :meth:`data`'s vector."""
-        return self.constants().size + self.laws.size + 1
-
-    def constants(self) -> np.ndarray:
-        """The constants at the head of :meth:`data`'s vector (read only), one array for
-        every flow with the same numbers (:data:`_CONSTANTS`: the walkers of a scene share
-        it, so :meth:`data_rows` writes it once for all)."""
-        c = self._memo.get("consts")
-        if c is None:
-            c = np.array(self.module().constants(self.params), dtype=float)
-            c.flags.writeable = False
-            c = self._memo["consts"] = _CONSTANTS.setdefault((c.size, c.tobytes()), c)
-        return c
-
-    def data_into(self, out: np.ndarray) -> None:
-        """:meth:`data` written into ``out`` (:meth:`data_size`,) (a row of many walkers'
-        data vectors: :mod:`walkerlab.gym.rigid_rows`), the same numbers."""
-        c = self.constants()
-        nc = c.size
-        out[:nc] = c
-        out[nc:-1] = self.laws
-        out[nc + 2] = float(getattr(self.actuators, "t_origin", 0.0))
-        out[-1] = 0.0
-
-    @staticmethod
-    def data_rows(flows, out: np.ndarray) -> None:
-        """Each flow's :meth:`data` written into its row of ``out`` (N, size) (``flows``:
-        N flows of one module and law block size, each row the numbers :meth:`data_into`
-        writes), the rows' shared parts at once where the flows share their constants
-        (:meth:`constants`), else row by row."""
-        key = tuple(map(id, flows))
-        shared = _SHARED_ROWS.get(key)
-        if shared is None:  # (the flows kept with their answer: their ids stay theirs)
-            if len(_SHARED_ROWS) >= SHARED_ROWS_KEPT:
-                _SHARED_ROWS.clear()
-            c = flows[0].constants()
-            shared = _SHARED_ROWS[key] = (tuple(flows), None if any(
-                f.constants() is not c for f in flows) else c)
-        c = shared[1]
-        if c is None:
-            for f, row in zip(flows, out):
-                f.data_into(row)
-            return
-        nc = c.size
-        out[:, :nc] = c
-        out[:, nc:-1] = [f.laws for f in flows]
-        out[:, nc + 2] = [float(getattr(f.actuators, "t_origin", 0.0)) for f in flows]
-        out[:, -1] = 0.0

@@ -95,7 +95,7 @@ def cached_functions(key: str, build, encode=None, decode=None) -> dict:
     -------
     dict
     """
-    from walkerlab.codegen.cache import cache_dir, read_source, write_source
+    from walkerlab.codestore import cache_dir, read_source, write_source
 
     if key in _memo:
         return _memo[key]

@@ -202,15 +202,16 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
              "    if name.endswith('_variational') and f'_{name}' in globals():",
              "        return _lazy(f'_{name}')",
              "    raise AttributeError(name)", ""]
-    head = [
-        f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
-        "# Do not edit: regenerated when the walker description or the generator changes.",
-        "from math import sin, cos, tan, sqrt  # noqa: F401",
-        "import numpy as np",
-        "from numba import cfunc, njit, types",
-        "",
-        "SIG = types.void(types.CPointer(types.float64), types.float64,",
-        "                 types.CPointer(types.float64), types.CPointer(types.float64))",
-        "",
-    ]
-    return "\n".join(head + body) + "\n"
+    return "\n".join(compiled_head("model code (walkerlab.codegen.source)", key,
+                                   "sin, cos, tan, sqrt", "cfunc, njit, types") + body) + "\n"
+
+
+def compiled_head(what: str, key: str, maths: str, numba: str) -> list[str]:
+    """The first lines of a compiled module: what it is, its key, the names it imports from
+    ``math`` and ``numba``, and CyRK's cfunc signature ``SIG``."""
+    return [f"# walkerlab compiled {what}; key {key}",
+            "# Do not edit: regenerated when the walker description or the generator changes.",
+            f"from math import {maths}  # noqa: F401", "import numpy as np",
+            f"from numba import {numba}", "",
+            "SIG = types.void(types.CPointer(types.float64), types.float64,",
+            "                 types.CPointer(types.float64), types.CPointer(types.float64))", ""]

@@ -2,8 +2,9 @@
 (:mod:`walkerlab.codegen.legged`), with no foot pinned (what the compliant-contact model
 integrates): its coordinates, contact points and symbolic equations are derived in
 :mod:`walkerlab.codegen.floating_equations` (conventions and equations there); here they
-are emitted as numba-compiled code, cached on disk through :mod:`walkerlab.codegen.cache`,
-and read through :class:`FloatingView`.
+are emitted as numba-compiled code, kept in the user cache (:mod:`walkerlab.codestore`) and
+read by the contact model (:mod:`walkerlab.models.contact`) and, as plain Python, by
+:class:`walkerlab.models.hybrid.floating_view.FloatingView`.
 
 Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
 :func:`param_names` order, outputs written into preallocated arrays):
@@ -38,12 +39,11 @@ raises.
 
 from __future__ import annotations
 
-import functools
 import hashlib
-from pathlib import Path
 
 import numpy as np
 
+from walkerlab import codestore
 from walkerlab.codegen.floating_equations import (
     FOOT_PARAMS,
     FREE_3D,
@@ -63,8 +63,8 @@ from walkerlab.walker.description import Structure, WalkerData
 __all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "FREE_3D", "HUB_INERTIA_MESSAGE",
            "MASSLESS_MESSAGE", "ROLES_3D",
            "WHEEL_COORDINATES", "FloatingEquations",
-           "FloatingView", "check_masses", "contact_names", "coordinate_names",
-           "derive_floating", "floating_module", "floating_params", "floating_view",
+           "check_masses", "contact_names", "coordinate_names",
+           "derive_floating", "floating_module", "floating_params",
            "generated_state", "param_names"]
 
 HUB_INERTIA_MESSAGE = ("contact.hub_inertia_kg_m2: a rimless wheel with a point-mass hub "
@@ -112,12 +112,6 @@ def floating_params(data: WalkerData, foot_mass_kg: float | None = None,
 
 
 # ---------------------------------------------------------------------------- code generation
-def _printer():
-    from sympy.printing.pycode import PythonCodePrinter
-
-    return PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
-
-
 def _fn(name: str, args: str, eq: FloatingEquations, outputs, pr, jit: bool = True) -> list[str]:
     """A straight-line numba function assigning ``outputs`` [(target, expr)] after a cse."""
     import sympy as sp
@@ -176,7 +170,7 @@ def generate_floating(eq: FloatingEquations, key: str, dynamics_jacobian: bool =
     the rigid gait's ground-reaction check, :func:`floating_plain`, does not need)."""
     import sympy as sp
 
-    pr = _printer()
+    from walkerlab.codegen.source import PRINTER as pr
     nq = len(eq.q)
     qv, dqv = sp.Matrix(eq.q), sp.Matrix(eq.dq)
     a = sp.Matrix(sp.symbols(f"a0:{nq}", real=True))
@@ -249,16 +243,6 @@ def generate_floating(eq: FloatingEquations, key: str, dynamics_jacobian: bool =
 # ---------------------------------------------------------------------------- cache
 
 
-# the sources do not change within a process (a gym reset builds a contact model: the files
-# were read and hashed at each)
-@functools.cache
-def _source_hash(paths: tuple) -> str:
-    h = hashlib.sha256()
-    for p in paths:
-        h.update(Path(p).read_bytes())
-    return h.hexdigest()
-
-
 def module_key(structure: Structure, tag: str, sources=()) -> str:
     """Cache key: the rigid generator's key of ``structure`` (structure + generator + sympy),
     this file, the derivations' (:mod:`walkerlab.codegen.floating_equations`,
@@ -269,20 +253,18 @@ def module_key(structure: Structure, tag: str, sources=()) -> str:
 
     h = hashlib.sha256(cache.cache_key(structure).encode())
     h.update(tag.encode())
-    h.update(_source_hash((__file__, floating_equations.__file__,
-                           floating_names.__file__, floating_tree.__file__,
-                           *sources)).encode())
+    h.update(codestore.source_hash(__file__, floating_equations.__file__,
+                                   floating_names.__file__, floating_tree.__file__,
+                                   *sources).encode())
     return h.hexdigest()[:24]
 
 
 def load_generated(structure: Structure, tag: str, build, sources=()):
     """Import the generated module ``<key>_<tag>.py`` of the cache folder, writing it with
     ``build(key) -> str`` on a miss (or a damaged or untrusted file): one mechanism with the
-    rigid compiled flows, :func:`walkerlab.codegen.cache.import_generated`."""
-    from walkerlab.codegen import cache
-
+    rigid compiled flows, :func:`walkerlab.codestore.import_generated`."""
     key, filename, module_name = _generated_names(structure, tag, sources)
-    return cache.import_generated(filename, module_name, lambda: build(key))
+    return codestore.import_generated(filename, module_name, lambda: build(key))
 
 
 def _generated_names(structure: Structure, tag: str, sources=()) -> tuple[str, str, str]:
@@ -298,10 +280,8 @@ def generated_state(structure: Structure, tag: str, sources=()) -> tuple[str, bo
     so the first process to load it generates it and numba compiles its kernels; None: no
     user cache folder, nothing shared between processes), without generating or importing
     it."""
-    from walkerlab.codegen import cache
-
     _key, filename, module_name = _generated_names(structure, tag, sources)
-    folder = cache.cache_dir()
+    folder = codestore.cache_dir()
     return module_name, None if folder is None else (folder / filename).is_file()
 
 
@@ -330,7 +310,7 @@ _plain: dict[str, dict] = {}
 def floating_plain(structure: Structure) -> dict:
     """The floating module's functions of ``structure`` as the plain Python they are
     generated from (``njit`` the identity): the generated text
-    (:func:`walkerlab.codegen.cache.generated_source`, as :func:`load_generated` reads and
+    (:func:`walkerlab.codestore.generated_source`, as :func:`load_generated` reads and
     writes it), executed without
     numba, for a check of a few hundred states that should load no compiler (the rigid
     gait's ground reaction, :mod:`walkerlab.models.hybrid.ground_reaction`).  Memoised per
@@ -347,12 +327,10 @@ def floating_plain(structure: Structure) -> dict:
         Massless bodies (:data:`MASSLESS_MESSAGE`).
     """
     check_masses(structure)
-    from walkerlab.codegen import cache
-
     key, filename, _ = _generated_names(structure, "floating")
     if key in _plain:
         return _plain[key]
-    body, _ = cache.generated_source(filename, lambda: floating_source(structure, key))
+    body, _ = codestore.generated_source(filename, lambda: floating_source(structure, key))
     body = body.replace("from numba import njit\n", "", 1)
 
     def njit(*_args, **_kwargs):
@@ -362,90 +340,3 @@ def floating_plain(structure: Structure) -> dict:
     exec(compile(body, f"<walkerlab floating model {key}>", "exec"), ns)  # codegen's text
     _plain[key] = ns
     return ns
-
-
-class FloatingView:
-    """The floating view of one walker (structure + numbers).
-
-    Parameters
-    ----------
-    data : WalkerData
-    foot_mass_kg, foot_inertia_kg_m2 : float, optional
-        A flat foot's mass [kg] (at the ankle) and inertia about the ankle [kg m^2]
-        (required for flat feet, ignored otherwise).
-
-    Raises
-    ------
-    ValueError
-        Massless bodies; a flat foot without its mass and inertia.
-    """
-
-    def __init__(self, data: WalkerData, foot_mass_kg: float | None = None,
-                 foot_inertia_kg_m2: float | None = None):
-        check_masses(data.structure)
-        self.data = data
-        self.structure = data.structure
-        self.params = floating_params(data, foot_mass_kg, foot_inertia_kg_m2)
-        self._mod = floating_module(data.structure)
-        self.nq = int(self._mod.NQ)
-
-    def coordinate_names(self) -> tuple[str, ...]:
-        """Generalised coordinates, in order (module docstring)."""
-        return coordinate_names(self.structure)
-
-    def _x(self, q, dq=None) -> np.ndarray:
-        x = np.zeros(2 * self.nq)
-        x[:self.nq] = np.asarray(q, dtype=float)
-        if dq is not None:
-            x[self.nq:] = np.asarray(dq, dtype=float)
-        return x
-
-    def mass_matrix(self, q) -> np.ndarray:
-        """M(q) (nq, nq) [kg, kg m, kg m^2]."""
-        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
-        self._mod.dyn(self._x(q), self.params, M, h)
-        return M
-
-    def bias(self, q, dq) -> np.ndarray:
-        """h(q, dq) = C(q, dq) dq + G(q) (nq,) [N, N m]: ``M qdd + h = sum J^T F``."""
-        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
-        self._mod.dyn(self._x(q, dq), self.params, M, h)
-        return h
-
-    def gravity(self, q) -> np.ndarray:
-        """G(q) = h(q, 0) (nq,) [N, N m]."""
-        return self.bias(q, np.zeros(self.nq))
-
-    def contact_names(self) -> tuple[str, ...]:
-        """Names of the contact points (:func:`contact_names`)."""
-        return contact_names(self.structure)
-
-    def contact_points(self, q, dq=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per contact point (:meth:`contact_names`): its position (nf, 2) [m], the velocity
-        of the material point there (nf, 2) [m/s] and its Jacobian (nf, 2, nq)."""
-        nf = len(self.contact_names())
-        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, self.nq))
-        self._mod.feet(self._x(q, dq), self.params, P, V, J)
-        return P, V, J
-
-    def energies(self, X) -> tuple[np.ndarray, np.ndarray]:
-        """Kinetic and potential energy [J] of states ``X`` (2 nq,) or (2 nq, k)."""
-        return self._mod.energies(X, self.params)
-
-    def points(self, X) -> dict:
-        """Named points (hip, each body, feet, arc feet's centres and contact points, knees)
-        (2,) or (2, k) [m], named as the rigid model's."""
-        return self._mod.points(X, self.params)
-
-
-def floating_view(data: WalkerData, foot_mass_kg: float | None = None,
-                  foot_inertia_kg_m2: float | None = None) -> FloatingView:
-    """The floating view of a walker (see :class:`FloatingView`).
-
-    Raises
-    ------
-    ValueError
-        A body with mass 0: :data:`MASSLESS_MESSAGE`; flat feet without their mass and
-        inertia: :data:`FLAT_FOOT_MESSAGE`.
-    """
-    return FloatingView(data, foot_mass_kg, foot_inertia_kg_m2)

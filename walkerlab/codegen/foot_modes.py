@@ -67,7 +67,7 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen import source as codegen
-from walkerlab.codegen.compiled_source import cfunc_lines
+from walkerlab.codegen.compiled_source import cfunc_lines, compiled_head
 from walkerlab.codegen.double_support import (
     DOUBLE_SUPPORT_LEADS,
     derive_double_support,
@@ -577,15 +577,5 @@ def generate_flat_compiled(structure: Structure, key: str) -> str:
         for var in (False, True):
             name = f"flow_{mode}_variational" if var else f"flow_{mode}"
             body += cfunc_lines(name, system, consts, parts[mode], var, extras[mode]) + [""]
-    head = [
-        f"# walkerlab compiled model code (walkerlab.codegen.foot_modes); key {key}",
-        "# Do not edit: regenerated when the walker description or the generator changes.",
-        "from math import sin, cos, tan, sqrt, pi  # noqa: F401",
-        "import numpy as np",
-        "from numba import cfunc, types",
-        "",
-        "SIG = types.void(types.CPointer(types.float64), types.float64,",
-        "                 types.CPointer(types.float64), types.CPointer(types.float64))",
-        "",
-    ]
-    return "\n".join(head + body) + "\n"
+    return "\n".join(compiled_head("model code (walkerlab.codegen.foot_modes)", key,
+                                   "sin, cos, tan, sqrt, pi", "cfunc, types") + body) + "\n"

@@ -17,22 +17,16 @@ states: exact to round-off, as the Python flow's complex-step Jacobian.
 
 The module is generated per compiled controller module (file ``<hash>_vcflow.py`` in the
 user cache, its hash of the controller module's name and this module's source); its data
-vector (:meth:`VirtualConstraintFlow.data`): ``[theta+, theta- - theta+, kp, kd, limit (-1:
-none), M + 1, B (n k, row-major), alpha (k (M + 1), row-major), call counter]``.
+vector (:meth:`walkerlab.models.compiled_flows.VirtualConstraintFlow.data`): ``[theta+,
+theta- - theta+, kp, kd, limit (-1: none), M + 1, B (n k, row-major), alpha (k (M + 1),
+row-major), call counter]``.
 """
 
 from __future__ import annotations
 
-import functools
 import hashlib
-from dataclasses import dataclass
-from pathlib import Path
 
-import numpy as np
-
-from walkerlab.codegen.compiled import CompiledFlow
-
-__all__ = ["VirtualConstraintFlow", "closed_loop_module"]
+__all__ = ["closed_loop_module"]
 
 #: The module of :func:`closed_loop_module` (``{law}``: the compiled controller's module name).
 _SOURCE = '''# walkerlab: the rigid closed loop under virtual constraints, compiled
@@ -124,12 +118,6 @@ def cfunc_of(name):
 '''
 
 
-@functools.cache
-def _this_source_hash() -> str:
-    """sha256 of this module's source (read once per process)."""
-    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
-
-
 def closed_loop_module(law_module):
     """The generated module of the compiled closed loop (module docstring) of the compiled
     controller module ``law_module``
@@ -141,66 +129,11 @@ def closed_loop_module(law_module):
     ImportError
         numba is not installed.
     """
-    from walkerlab.codegen import cache
+    from walkerlab import codestore
 
     source = _SOURCE.format(law=law_module.__name__)
     h = hashlib.sha256(source.encode())
-    h.update(_this_source_hash().encode())
+    h.update(codestore.source_hash(__file__).encode())
     tag = h.hexdigest()[:24]
-    return cache.import_generated(f"{tag}_vcflow.py", f"walkerlab_vcflow_{tag}",
-                                  lambda: source)
-
-
-@dataclass(frozen=True, eq=False)
-class VirtualConstraintFlow(CompiledFlow):
-    """Handle on a phase's compiled closed loop under virtual constraints (module
-    docstring): a :class:`~walkerlab.codegen.compiled.CompiledFlow` whose cfuncs live in
-    :func:`closed_loop_module`'s module.  Its guards are the phase's Python functions
-    (:attr:`CompiledFlow.guards` None: the integrator calls them at its step points).
-    It runs where a solver asks the compiled backend (``backend: cyrk_compiled``); a
-    scipy method (the shipped scenes' LSODA) keeps the Python flow.
-
-    Attributes
-    ----------
-    law_module : module
-        The controller's compiled module (its ``law`` and ``flow_terms``).
-    numbers : ndarray
-        The data vector without its call counter (module docstring).
-    """
-
-    law_module: object = None
-    numbers: np.ndarray | None = None
-    #: the batched step map runs the passive module's flows: not this one
-    batchable = False
-
-    @classmethod
-    def of(cls, controller, structure, params):
-        """The closed loop of ``controller`` (a :class:`walkerlab.models.virtual_constraints.
-        VirtualConstraintController`) on the walker ``structure`` with ``params``, or None
-        where its law is not compiled (no numba, a Bezier degree of 16 or more)."""
-        mod = controller.compiled_module()
-        if mod is None:
-            return None
-        d = controller.design
-        alpha = np.asarray(d.alpha, float)
-        limit = -1.0 if controller.limit is None else float(controller.limit)
-        head = [d.theta_plus, d.theta_minus - d.theta_plus, controller.kp, controller.kd,
-                limit, alpha.shape[1]]
-        numbers = np.concatenate([np.asarray(head, float),
-                                  np.asarray(controller.B, float).ravel(), alpha.ravel()])
-        return cls(structure, tuple(params), law_module=mod, numbers=numbers)
-
-    def module(self):
-        return closed_loop_module(self.law_module)
-
-    def address(self, variational: bool = False) -> int:
-        """C address of the cfunc ``(dy, t, y, d)`` (:meth:`CompiledFlow.address`),
-        compiled or loaded on first use."""
-        if variational not in self._memo:
-            name = "flow_variational" if variational else "flow"
-            self._memo[variational] = self.module().cfunc_of(name).address
-        return self._memo[variational]
-
-    def data(self) -> np.ndarray:
-        """The controller's numbers and a zeroed call counter (a fresh vector)."""
-        return np.append(self.numbers, 0.0)
+    return codestore.import_generated(f"{tag}_vcflow.py", f"walkerlab_vcflow_{tag}",
+                                      lambda: source)

@@ -18,11 +18,10 @@ For ``h0`` (k outputs) and ``theta`` the module returns numpy functions of the s
 
 from __future__ import annotations
 
-import functools
 import hashlib
 
-__all__ = ["OutputPieces", "derive_equations", "generate_pieces", "output_expressions",
-           "output_pieces", "resolve_link"]
+__all__ = ["derive_equations", "generate_pieces", "output_expressions", "output_module",
+           "resolve_link"]
 
 
 def derive_equations(structure):
@@ -172,59 +171,27 @@ def _global_names(code) -> set[str]:
     return names
 
 
-class OutputPieces:
-    """Numpy functions of the outputs and the phase variable (module docstring), from the
-    generated module (:func:`generate_pieces`, cached on disk as the walker's flow).
+def _module(name: str, generate, structure, params, outputs, phase, joints, prefix):
+    """The generated module ``<key>_<name>_<hash>.py`` of ``generate(eq, params, outputs,
+    phase, joints, prefix, key) -> str`` on ``structure``'s derivation, the hash covering
+    the parameters, outputs, phase, joints and this generator's source."""
+    from walkerlab import codestore
+    from walkerlab.codegen import cache
 
-    Parameters
-    ----------
-    module : module
-        The generated module.
-    """
-
-    def __init__(self, module):
-        self._mod = module
-        self.k, self.n = module.K, module.N
-
-    def __call__(self, x):
-        """``(h0 (k,), Jh0 (k, n), dd0 (k,), theta, dtheta (n,), ddtheta)`` at the state
-        ``x`` (2n,) (see the module docstring)."""
-        import numpy as np
-
-        v = np.array(self._mod.out(x), dtype=complex if np.iscomplexobj(x) else float)
-        k, n = self.k, self.n
-        a = k + k * n
-        return (v[:k], v[k:a].reshape(k, n), v[a:a + k], v[a + k], v[a + k + 1:a + k + 1 + n],
-                v[-1])
-
-    def foot(self, q):
-        """``(swing foot height [m], swing foot ahead (> 0: ahead of the stance foot; an
-        angle or a distance, as the walker's guard), hip along the ground [m])`` at the
-        configuration ``q`` (n,)."""
-        import numpy as np
-
-        return tuple(float(np.real(v))
-                     for v in self._mod.foot(np.concatenate([q, np.zeros(self.n)])))
-
-    def B(self):
-        """``B`` (n, k): each actuated joint's column ``d(delta)/dq`` (constant)."""
-        import numpy as np
-
-        return np.array(self._mod.B(np.zeros(2 * self.n)), dtype=float).reshape(self.n, self.k)
+    key = cache.cache_key(structure)
+    what = repr((tuple(float(p) for p in params), tuple(outputs), phase.model_dump_json(),
+                 tuple(joints), codestore.source_hash(__file__)[:12]))
+    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
+    return codestore.import_generated(
+        f"{key}_{name}_{tag}.py", f"walkerlab_{name}_{key}_{tag}",
+        lambda: generate(derive_equations(structure), params, outputs, phase, joints, prefix,
+                         key))
 
 
-@functools.cache  # the source does not change within a process
-def _source_hash() -> str:
-    from pathlib import Path
-
-    return hashlib.sha256((Path(__file__).parent / "virtual_constraints.py").read_bytes()
-                          ).hexdigest()[:12]
-
-
-def output_pieces(structure, params, outputs, phase, joints, prefix):
-    """:class:`OutputPieces` of ``structure``'s derivation with ``params`` (its module
-    generated on a cache miss, file ``<key>_vc_<hash>.py``, the hash covering the
-    parameters, outputs, phase, joints and this generator's source).
+def output_module(structure, params, outputs, phase, joints, prefix):
+    """The generated module of the outputs and phase variable (module docstring; read by
+    :class:`walkerlab.models.compiled_flows.OutputPieces`) of ``structure``'s derivation
+    with ``params`` (generated on a cache miss, file ``<key>_vc_<hash>.py``: :func:`_module`).
 
     Raises
     ------
@@ -232,18 +199,7 @@ def output_pieces(structure, params, outputs, phase, joints, prefix):
         A link, joint or coordinate the walker does not have (one line naming the key; on
         a cache miss, from the derivation).
     """
-    from walkerlab.codegen import cache
-
-    key = cache.cache_key(structure)
-    what = repr((tuple(float(p) for p in params), tuple(outputs), phase.model_dump_json(),
-                 tuple(joints), _source_hash()))
-    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
-
-    def build() -> str:
-        return generate_pieces(derive_equations(structure), params, outputs, phase, joints,
-                               prefix, key)
-    return OutputPieces(cache.import_generated(f"{key}_vc_{tag}.py",
-                                               f"walkerlab_vc_{key}_{tag}", build))
+    return _module("vc", generate_pieces, structure, params, outputs, phase, joints, prefix)
 
 
 #: the computed-torque law over the generated ``pieces`` and ``flow_terms`` (numba source,
@@ -378,20 +334,11 @@ def compiled_controller(structure, params, outputs, phase, joints, prefix):
     Raises
     ------
     ValueError
-        As :func:`output_pieces`.
+        As :func:`output_module`.
     """
     try:
         import numba  # noqa: F401
     except ImportError:  # pragma: no cover - numba is a dependency
         return None
-    from walkerlab.codegen import cache
-
-    key = cache.cache_key(structure)
-    what = repr((tuple(float(p) for p in params), tuple(outputs), phase.model_dump_json(),
-                 tuple(joints), _source_hash()))
-    tag = hashlib.sha256(what.encode()).hexdigest()[:12]
-
-    def build() -> str:
-        return generate_compiled_controller(derive_equations(structure), params, outputs,
-                                            phase, joints, prefix, key)
-    return cache.import_generated(f"{key}_vcnb_{tag}.py", f"walkerlab_vcnb_{key}_{tag}", build)
+    return _module("vcnb", generate_compiled_controller, structure, params, outputs, phase,
+                   joints, prefix)

@@ -11,6 +11,8 @@ Dask) and the worker processes behind it.
   (``walkerlab report``)
 - :mod:`walkerlab.execution.workers`   worker processes that end with their parent
   (forkserver/spawn, parent watch)
+- :mod:`walkerlab.execution.pending`   a kernel another process is compiling, waited for
+  before its first use
 
 Importing this package loads nothing heavy.
 """

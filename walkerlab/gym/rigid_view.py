@@ -28,7 +28,7 @@ trip` says when and where the foot met the profile).
 The compiled control step (``compiled``, the default): a phase of a step walker without
 torque laws of its own (the passive walker, or one powered by a push-off alone) runs its
 flow with the action's torques compiled in (:func:`walkerlab.models.hybrid.actuated.
-compiled_with`: an :class:`walkerlab.codegen.actuated.ActuatedFlow` whose laws are constant
+compiled_with`: an :class:`walkerlab.models.compiled_flows.ActuatedFlow` whose laws are constant
 torques, the action written into its law block each period), integrated by DOP853 at the
 scene solver's tolerances in compiled code: no Python per right-hand-side call.  It is the
 native vector environment's step of one walker (:meth:`RigidView.advance`:
@@ -271,7 +271,7 @@ class RigidView:
     # ------------------------------------------------------------------ stepping
     def _compiled_phase(self, w, phase, acts):
         """``phase`` with its flow compiled with the action's torques in it (an
-        :class:`walkerlab.codegen.actuated.ActuatedFlow` whose laws are the action's
+        :class:`walkerlab.models.compiled_flows.ActuatedFlow` whose laws are the action's
         actuators, each a constant torque: :attr:`ActionTorques.u` written into the law
         block before each period), or None where the compiled step does not run: a step
         walker with torque laws of its own (their Python flows), a phase without a compiled
@@ -279,7 +279,7 @@ class RigidView:
         key = (id(phase), id(acts))
         if key in self._compiled:
             return self._compiled[key]
-        from walkerlab.codegen.compiled import CompiledFlow
+        from walkerlab.models.compiled_flows import CompiledFlow
         from walkerlab.models.hybrid.actuated import compiled_with
 
         own, comp = w.actuators, phase.compiled

@@ -72,7 +72,7 @@ def _hold(view, fast, u: np.ndarray) -> None:
 
 def _flow_row(flow, acts) -> tuple:
     """``(row, u_cols, t_col, same)``: the kernel's data row (1, size) of a walker's
-    compiled flow as :meth:`walkerlab.codegen.actuated.ActuatedFlow.data_rows` writes it
+    compiled flow as :meth:`walkerlab.models.compiled_flows.ActuatedFlow.data_rows` writes it
     (its constants, its law block, its step clock), where the held torques of ``acts``
     go (the law block's constants: each actuator's ``HEAD``-th slot from
     :data:`~walkerlab.gym.rigid_view._CONSTANT_0`, as columns ``u_cols``) and its step

@@ -1,9 +1,11 @@
 """``cyrk_compiled`` backend: one phase integrated by CyRK's C++ solver with a compiled RHS.
 
 Internal module of :mod:`walkerlab.integrate.rigid`.  The phase's flow (or flow plus
-variational equations) is the numba ``cfunc`` of :class:`walkerlab.codegen.compiled.CompiledFlow`,
-handed to CyRK's C entry point (``CyRK.nb.numba_solver.c_numba_cysolve_ivp``, through ctypes
-as in :mod:`walkerlab.models.contact._cyrk`), so the Runge-Kutta steps run without Python callbacks.
+variational equations) is the numba ``cfunc`` of
+:class:`walkerlab.models.compiled_flows.CompiledFlow`, handed to CyRK's C entry point
+(``CyRK.nb.numba_solver.c_numba_cysolve_ivp``, through ctypes as in
+:mod:`walkerlab.models.contact._cyrk`), so the Runge-Kutta steps run without Python
+callbacks.
 
 CyRK's numba bridge takes no events, so guards are located here with scipy's rules:
 

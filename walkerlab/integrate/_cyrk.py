@@ -40,7 +40,7 @@ FIRST = [0.0]  # CyRK's first step [s] of every call (0: its own estimate)
 
 def address(kernels, ready=None) -> int:
     """C address of the cfunc of ``kernels.rhs_packed`` (compiled once per walker structure,
-    numba disk cache); ``ready``: a :class:`walkerlab.codegen.pending.CompiledElsewhere`
+    numba disk cache); ``ready``: a :class:`walkerlab.execution.pending.CompiledElsewhere`
     (a side process compiling it: waited for first, then the kernel is loaded)."""
     if kernels.__name__ not in _FPTR:
         if ready is not None:  # a side process is compiling it (a cold contact run)
@@ -76,7 +76,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     kernels : module
         The walker's generated kernels (``ContactWalker.kernels``), or a stand-in with
         ``__name__`` and ``build_cyrk()``.
-    ready : walkerlab.codegen.pending.CompiledElsewhere, optional
+    ready : walkerlab.execution.pending.CompiledElsewhere, optional
         The caller's hand-off when a side process compiles the right-hand side
         (``ContactWalker.rhs_ready``).
     dense : bool

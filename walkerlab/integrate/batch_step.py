@@ -3,7 +3,7 @@ own slope: the workhorse of the metastability studies (:mod:`walkerlab.analysis.
 
 One step of ``N`` walkers: each row is integrated on its own, phase after phase, by a
 compiled DOP853 calling the walker's compiled flow (the numba ``cfunc`` of
-:class:`walkerlab.codegen.compiled.CompiledFlow`, the same generated equations as every other
+:class:`walkerlab.models.compiled_flows.CompiledFlow`, the same generated equations as every other
 rigid integration; where the generated module allows it, that loop compiled with the flow
 inlined, :func:`walkerlab.integrate.rows_dop853.kernels`, the same numbers) to its first
 guard crossing, located on the step's dense output

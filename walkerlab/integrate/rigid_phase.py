@@ -18,7 +18,7 @@ Integrators come from libraries, chosen by :class:`~walkerlab.integrate.solver.S
   (a replaced flow) falls back to ``cyrk``.
 - ``"auto"`` (default): ``cyrk`` for the methods it shares with scipy when it is installed,
   else ``scipy``; ``cyrk_compiled`` for a phase whose model marks its compiled flow as the
-  default (:attr:`walkerlab.codegen.compiled.CompiledFlow.by_default`: a 3D walker's).
+  default (:attr:`walkerlab.models.compiled_flows.CompiledFlow.by_default`: a 3D walker's).
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ the scaled error (``atol + rtol max(|y|, |y_new|)``): the criterion
 equals scipy's RMS norm at tolerances divided by ``sqrt(2n)``).
 
 The flow is the walker's compiled ``cfunc`` ``(dy, t, y, d)``
-(:class:`walkerlab.codegen.compiled.CompiledFlow`), called as a first-class function or by
+(:class:`walkerlab.models.compiled_flows.CompiledFlow`), called as a first-class function or by
 its process address (an ``int``: :func:`_call_address`, the same machine code); its
 extra outputs are the guards (``G[gcols] + goffs``).  Where the generated module has them
 (:func:`cfuncs`), a step's inner stages call the flow without its guard outputs and a
@@ -573,8 +573,9 @@ def kernels(structure, name: str) -> tuple | None:
     entry points, their arguments those of :func:`walk_rows` and :func:`phase_rows` after
     the functions, the same numbers bit for bit (the flow inlined into the loop).  The
     kernels module is generated and imported once (``<key>_rows_<source_hash()>_nb.py``
-    beside the compiled module, :func:`walkerlab.codegen.cache.import_generated`'s checks)
+    beside the compiled module, :func:`walkerlab.codestore.import_generated`'s checks)
     and compiled on first call or loaded from numba's cache (``cache=True``: its file)."""
+    from walkerlab import codestore
     from walkerlab.codegen import cache
     from walkerlab.codegen.compiled import compiled_module
 
@@ -583,7 +584,7 @@ def kernels(structure, name: str) -> tuple | None:
     if name not in flows:
         return None
     key = cache.cache_key(structure)
-    kern = cache.import_generated(f"{key}_rows_{source_hash()}_nb.py",
-                                  f"walkerlab_rows_{key}_{source_hash()}",
-                                  lambda: kernels_source(mod.__name__, flows))
+    kern = codestore.import_generated(f"{key}_rows_{source_hash()}_nb.py",
+                                      f"walkerlab_rows_{key}_{source_hash()}",
+                                      lambda: kernels_source(mod.__name__, flows))
     return tuple(getattr(kern, f"{loop}_{name}") for loop in _LOOPS)

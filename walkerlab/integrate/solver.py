@@ -13,7 +13,7 @@ Rigid backends (``backend``):
 - ``"cyrk_compiled"``: CyRK with the phase's flow compiled by numba;
 - ``"auto"``: ``cyrk`` for the methods it shares with scipy when CyRK is installed, else
   ``scipy``; a phase whose model marks its compiled flow
-  (:attr:`walkerlab.codegen.compiled.CompiledFlow.by_default`: a 3D walker's, whose Python
+  (:attr:`walkerlab.models.compiled_flows.CompiledFlow.by_default`: a 3D walker's, whose Python
   flow costs about 100 us a call) runs ``cyrk_compiled``.
 
 The contact model names its library in ``method`` (``odeint``, ``cyrk_bdf``, ``numbalsoda``

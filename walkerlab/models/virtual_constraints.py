@@ -140,7 +140,8 @@ class VirtualConstraintController:
     """
 
     def __init__(self, spec, fns, structure, params):
-        from walkerlab.codegen.virtual_constraints import output_pieces
+        from walkerlab.codegen.virtual_constraints import output_module
+        from walkerlab.models.compiled_flows import OutputPieces
         from walkerlab.walker.joints import link_angles  # light
 
         self.spec, self.fns = spec, fns
@@ -166,7 +167,8 @@ class VirtualConstraintController:
         if k != n - 1:
             raise ValueError(f"{KEY}.outputs: the walker has {n} coordinates: {n - 1} outputs "
                              f"(and actuators) leave a two-dimensional zero dynamics, not {k}")
-        self.pieces = output_pieces(structure, params, outputs, spec.phase, joints, KEY)
+        self.pieces = OutputPieces(output_module(structure, params, outputs, spec.phase, joints,
+                                                 KEY))
         self._pieces_args = (structure, params, outputs, spec.phase, joints, KEY)
         self._law = None  # the compiled law (:meth:`_compiled_law`)
         self.B = self.pieces.B()

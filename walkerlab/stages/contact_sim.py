@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING
 from walkerlab.analysis.contact.record import contact_sim_run
 from walkerlab.analysis.contact.step_map import PeriodicGaitError
 from walkerlab.analysis.contact.warm import compile_rhs_kernels, compile_run_kernels
-from walkerlab.codegen.pending import CompiledElsewhere
 from walkerlab.config import Scene, SceneError
 from walkerlab.config.options import with_contact_strides
+from walkerlab.execution.pending import CompiledElsewhere
 from walkerlab.integrate.contact_grid import COMPILED_METHODS
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.artifacts import ArtifactError
@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from concurrent.futures import Future
 
-    from walkerlab.codegen.pending import CompiledElsewhere
+    from walkerlab.execution.pending import CompiledElsewhere
     from walkerlab.execution.side import SideWorker
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
@@ -93,7 +93,7 @@ def rhs_beside(setup: ContactSetup, side: Callable[[], SideWorker]
     process's walk wait for it there and load it while this process generates the model
     and compiles the other kernels (the contact table, the pinned start).
 
-    Returns the hand-off (a :class:`walkerlab.codegen.pending.CompiledElsewhere`: the
+    Returns the hand-off (a :class:`walkerlab.execution.pending.CompiledElsewhere`: the
     caller passes it to the run as ``ContactSetup.rhs_ready``), the side worker and its
     future, else None: a warm run, no user cache to share the kernel through, a walk on
     scipy's solvers, or no side process (disabled, or it broke).  The numbers are the same

@@ -12,7 +12,7 @@ the solve of ``M qdd = Q - h``, the tables) and
 :mod:`walkerlab.models.contact.powered_kernels` (the actuators of
 :mod:`walkerlab.models.contact.powered_source`).  No mechanics is written by hand: every
 position, velocity, Jacobian, mass matrix and bias comes from the generator.  The module is
-cached on disk next to the rigid models' code (:func:`walkerlab.codegen.cache.cache_dir`),
+cached on disk next to the rigid models' code (:func:`walkerlab.codestore.cache_dir`),
 keyed on the structure, the generators, the glue and the kernels' files (``_SOURCES``).
 
 Contact parameter vector ``PC`` (float64, (NPC,)), read through named indices:

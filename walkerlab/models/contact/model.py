@@ -137,7 +137,7 @@ class ContactWalker(ContactReadouts):
         A legged walker in 3D: its floating base on three slides, no heading
         (``contact.hold_heading``; the rigid model's assumption: its stance foot does not
         yaw), so the whole walker cannot turn about the ground's normal.
-    rhs_ready : walkerlab.codegen.pending.CompiledElsewhere, optional
+    rhs_ready : walkerlab.execution.pending.CompiledElsewhere, optional
         A side process compiling the compiled solvers' right-hand side: the first compiled
         chunk waits for it and loads the kernel from the cache (the caller's hand-off,
         passed down with the walker; None: compile it here when needed).

@@ -37,7 +37,7 @@ from .rigid_limit import contact_si
 from .terrain import check_ground, ground_drops
 
 if TYPE_CHECKING:
-    from walkerlab.codegen.pending import CompiledElsewhere
+    from walkerlab.execution.pending import CompiledElsewhere
     from walkerlab.walker.description import WalkerData
 
 __all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length",
@@ -103,7 +103,7 @@ class ContactSetup:
         The walker's actuators as forces (:mod:`walkerlab.models.contact.actuation`; a
         free-jointed biped's joint torques :mod:`walkerlab.models.contact.joint_torques`);
         None for a passive walker.
-    rhs_ready : walkerlab.codegen.pending.CompiledElsewhere or None
+    rhs_ready : walkerlab.execution.pending.CompiledElsewhere or None
         A side process compiling the walker's compiled right-hand side (the stage's hand-off:
         the walkers :meth:`build` makes carry it to the compiled backend); None: none.
     scene : Scene or None

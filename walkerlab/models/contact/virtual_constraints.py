@@ -44,9 +44,7 @@ scenes ask LSODA).
 
 from __future__ import annotations
 
-import functools
 import hashlib
-from pathlib import Path
 
 import numpy as np
 
@@ -230,12 +228,6 @@ def powered_packed(t, y, d, dy):
 ''' + CYRK_POWERED_SOURCE
 
 
-@functools.cache
-def _this_source_hash() -> str:
-    """sha256 of this module's source (read once per process)."""
-    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
-
-
 def compiled_rhs_module(kernels, law_module):
     """The generated module of a contact walker's compiled right-hand side under virtual
     constraints (module docstring, "Compiled"), with the kernels' interface:
@@ -245,11 +237,11 @@ def compiled_rhs_module(kernels, law_module):
     (:meth:`VirtualConstraintController.compiled_module`); file
     ``<hash>_vcrhs.py`` in the user cache, its hash of both modules' names (each a hash of
     its own source) and this module's source; numba's machine code cached there too."""
-    from walkerlab.codegen import cache
+    from walkerlab import codestore
 
     source = _RHS_SOURCE.format(kernels=kernels.__name__, law=law_module.__name__)
     h = hashlib.sha256(source.encode())
-    h.update(_this_source_hash().encode())
+    h.update(codestore.source_hash(__file__).encode())
     tag = h.hexdigest()[:24]
-    return cache.import_generated(f"{tag}_vcrhs.py", f"walkerlab_vcrhs_{tag}",
-                                  lambda: source)
+    return codestore.import_generated(f"{tag}_vcrhs.py", f"walkerlab_vcrhs_{tag}",
+                                      lambda: source)

@@ -80,10 +80,10 @@ def spring_equivalent(data, spec):
 
 def _compiled_laws(phase: Phase, data, acts, limit: bool):
     """The phase's flow with its torque laws compiled
-    (:class:`walkerlab.codegen.actuated.ActuatedFlow`: the laws evaluated in the cfunc, the
+    (:class:`walkerlab.models.compiled_flows.ActuatedFlow`: the laws evaluated in the cfunc, the
     same guards as extra outputs), or None: torques scaled by a massless foot's mass (they
     act on the swing row alone), or a phase whose guards have no compiled outputs."""
-    from walkerlab.codegen.actuated import ActuatedFlow
+    from walkerlab.models.compiled_flows import ActuatedFlow
 
     # a kneed walker's phases: the free flow and the knee-locked one (``flow_locked``)
     if limit or acts.rows is not None:  # the force in the massless limit's rows: Python
@@ -91,7 +91,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     if getattr(spec_of(acts), "virtual_constraints", None) is not None:  # computed torque:
         if phase.constraint is not None:  # a held constraint's rows: the Python flow
             return None
-        from walkerlab.codegen.virtual_constraint_flow import VirtualConstraintFlow
+        from walkerlab.models.compiled_flows import VirtualConstraintFlow
 
         # the closed loop compiled, for the cyrk_compiled backend (None where the
         # controller's law is not compiled)
@@ -110,7 +110,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
 
 def compiled_with(phase: Phase, data, acts):
     """``phase``'s flow compiled with the actuators ``acts`` acting in it (their laws
-    evaluated in the cfunc: :class:`walkerlab.codegen.actuated.ActuatedFlow`), for a phase
+    evaluated in the cfunc: :class:`walkerlab.models.compiled_flows.ActuatedFlow`), for a phase
     of the passive walker built from ``data``; None where no compiled flow can carry them
     (a massless limit's rows, a computed-torque controller, guards without compiled
     outputs).  The Gymnasium environment's compiled control step holds its action so
@@ -136,7 +136,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         With ``actuators`` set (:class:`walkerlab.models.hybrid.actuators.Actuators`);
         every phase's flow in Python (the
         actuation added to the generated flow) and compiled with its laws
-        (``cyrk_compiled``: :class:`walkerlab.codegen.actuated.ActuatedFlow`).
+        (``cyrk_compiled``: :class:`walkerlab.models.compiled_flows.ActuatedFlow`).
 
     Raises
     ------

@@ -161,7 +161,7 @@ class Phase:
     ``(t, [x, Phi.ravel()]) -> [flow(t, x), (jacobian(t, x) @ Phi).ravel()]`` (2n + 4n^2,).
 
     ``compiled`` (optional) is a handle on the same flow compiled for CyRK's C++ integrators
-    (:class:`walkerlab.codegen.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
+    (:class:`walkerlab.models.compiled_flows.CompiledFlow`: ``address(variational)``, ``data()``),
     used by the ``cyrk_compiled`` solver backend.
 
     ``constraint`` (optional) is ``x -> (n,)``, the gradient in ``q`` of a holonomic

@@ -51,7 +51,7 @@ from functools import partial
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.codegen.compiled import CompiledFlow
+from walkerlab.models.compiled_flows import CompiledFlow
 from walkerlab.models.ground import FALL_HIP_FRACTION
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker

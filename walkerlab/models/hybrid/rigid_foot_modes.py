@@ -42,7 +42,7 @@ from functools import partial
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.codegen.compiled import CompiledFlow
+from walkerlab.models.compiled_flows import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.numerics import fd_jacobian
 from walkerlab.walker.description import FLAT_FOOT_MODES as MODES

@@ -45,7 +45,7 @@ def _below(clearance, depth, t, x):
 
 def guard_outputs(phase, data: WalkerData) -> tuple:
     """Each guard of ``phase`` as ``(generated guard, offset)``: the outputs of a compiled
-    flow (:class:`walkerlab.codegen.compiled.CompiledFlow` ``guards``) that are the same
+    flow (:class:`walkerlab.models.compiled_flows.CompiledFlow` ``guards``) that are the same
     functions of the state as the phase's Python guards."""
     depth = SCUFF_DEPTH * data.leg_length_m
     table = {"midstance": ("swing_foot_ahead", 0.0),

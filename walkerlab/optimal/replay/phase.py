@@ -30,8 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.codegen.actuated import ActuatedFlow
 from walkerlab.integrate.rigid import integrate_step
+from walkerlab.models.compiled_flows import ActuatedFlow
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
 __all__ = ["LIMIT_N_M", "PhaseLaw", "PhaseReplay", "control_of_time", "driven_by",
@@ -176,7 +176,7 @@ def _stacked(polys):
 
 def driven_by(walker, law, limit: float):
     """``walker`` (actuated, its actuators' laws set to ``law``) with each phase's compiled
-    actuated flow (:class:`walkerlab.codegen.actuated.ActuatedFlow`) carrying ``law``'s
+    actuated flow (:class:`walkerlab.models.compiled_flows.ActuatedFlow`) carrying ``law``'s
     block (``law.packed(limit)``, the same splines, saturated at ``limit`` [N m]) and every
     other compiled flow dropped (it would run without the law); ``law`` None: none kept."""
     from dataclasses import replace
