@@ -262,7 +262,7 @@ SKIP = {
     # hashed into a code cache key (codegen/cache.py and the modules hashing __file__)
     "codegen/legged.py", "codegen/source.py", "walker/description.py", "codegen/cache.py",
     "codegen/equations.py", "codegen/lagrange.py",
-    "codegen/compiled_source.py", "codegen/foot_modes.py", "codegen/double_support.py",
+    "codegen/compiled_source.py", "codegen/foot_modes.py", "codegen/printers.py",
     "walker/walker_trees.py", "codegen/frames.py",
     "codegen/tree_derive.py", "walker/tree.py", "walker/trees.py",
     "codegen/actuated.py", "codegen/torque_law.py", "codegen/floating.py",

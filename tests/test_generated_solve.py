@@ -1,4 +1,4 @@
-"""The printed inverse of a walker's mass (and impact) matrix (:func:`walkerlab.codegen.source.
+"""The printed inverse of a walker's mass (and impact) matrix (:func:`walkerlab.codegen.printers.
 _solve_lines`): the adjugate over the determinant up to 3 x 3, LU factors above, checked
 against numpy's LAPACK inverse; and the round-off of a six-coordinate walker's printed flow
 (the stabilised 3D kneed walker, whose expanded 6 x 6 determinant cancelled to 1e-10)."""
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.codegen.source import ADJUGATE_MAX_N, _solve_lines
+from walkerlab.codegen.printers import ADJUGATE_MAX_N, _solve_lines
 
 ROOT = Path(__file__).resolve().parents[1]
 

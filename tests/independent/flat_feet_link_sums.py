@@ -71,8 +71,11 @@ from functools import cache
 import sympy as sp
 
 from tests.independent.link_sums import add_length, dot_terms, position_of, velocity_terms
-from walkerlab.codegen.double_support import derive_double_support
-from walkerlab.codegen.foot_modes import FlatEquations, _System  # the containers only
+from walkerlab.codegen.foot_modes import (  # the containers, and the double support
+    FlatEquations,
+    _System,
+    derive_double_support,
+)
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.walker.description import ROLE_TAG, Structure

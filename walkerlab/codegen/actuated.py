@@ -8,7 +8,7 @@ leg_angles[first_k]`` the joint angle of actuator ``k`` and ``B_k = d delta_k / 
 generalised-force direction (``+tau`` on the second link, ``-tau`` on the first: the hip of a
 straight-legged walker, ``(stance, swing)``; a five-link biped's joints), the phase variable
 ``s = leg_angles["stance"]``; the torques are symbols ``_tau_k`` in the generated lines
-(:func:`walkerlab.codegen.source.flow_lines` on ``G - sum_k B_k _tau_k``) and take the law's
+(:func:`walkerlab.codegen.printers.flow_lines` on ``G - sum_k B_k _tau_k``) and take the law's
 values at run time.  The variational right-hand side adds the chain term
 ``(M^-1 B_k) (d tau_k / dx)`` to the Jacobian at fixed torques, with ``d tau_k / dx`` from the
 law's partial derivatives and the symbolic gradients of ``delta_k``, its rate, ``s`` and
@@ -108,7 +108,7 @@ def _body(eq, joints, variational, guards, printer, locked: bool = False) -> lis
     :func:`lock_basis`)."""
     import sympy as sp
 
-    from walkerlab.codegen.source import cse_lines, flow_lines  # light
+    from walkerlab.codegen.printers import cse_lines, flow_lines  # light
 
     n = len(eq.q)
     m = 2 * n
@@ -219,7 +219,7 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
         Written into the header.
     """
     from walkerlab.codegen.compiled_source import compiled_head  # light
-    from walkerlab.codegen.source import PRINTER, cse_lines, start_module  # light
+    from walkerlab.codegen.printers import PRINTER, cse_lines, start_module  # light
     from walkerlab.codegen.torque_law import kernel_source
 
     hoisted = start_module(eq.params)  # filled as the bodies are generated

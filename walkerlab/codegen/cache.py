@@ -21,6 +21,7 @@ _GENERATOR_FILES = ("codegen/legged.py", "codegen/tree_derive.py", "walker/tree.
                     "walker/trees.py", "codegen/seeded.py", "codegen/source.py",
                     "walker/description.py", "codegen/cache.py", "codegen/equations.py",
                     "codegen/lagrange.py", "codegen/compiled_source.py", "codegen/frames.py",
+                    "codegen/printers.py",
                     # the parts trees.py hangs on a biped (arms, a torus' stance side) and
                     # the torus' rolling: an edit there changes the equations too
                     "walker/arm_trees.py", "walker/foot_trees.py", "codegen/rolling_feet.py")
@@ -41,14 +42,13 @@ def _sympy_version() -> str:
 def cache_key(structure) -> str:
     """Cache key (hex, 24 characters) of a structure for the current generator (every
     biped's derivation from its body tree, :mod:`walkerlab.codegen.legged`; a flat-footed
-    walker's also covers :mod:`walkerlab.codegen.foot_modes` (with
-    :mod:`~walkerlab.codegen.double_support` and :mod:`~walkerlab.codegen.push_off`), a
+    walker's also covers :mod:`walkerlab.codegen.foot_modes`, a
     spoked wheel's :mod:`walkerlab.codegen.derive_3d` and its planar tree, which no other
     structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update((_sources(*_GENERATOR_FILES) + _sympy_version()).encode())
     if structure.foot == "flat":
-        h.update(_sources("codegen/foot_modes.py", "codegen/double_support.py").encode())
+        h.update(_sources("codegen/foot_modes.py").encode())
     if structure.spokes:
         h.update(_sources("codegen/derive_3d.py", "walker/walker_trees.py").encode())
     return h.hexdigest()[:24]
@@ -94,23 +94,20 @@ def generated_module(structure) -> dict:
 
 
 def _derive_module(structure, key: str, path: Path | None) -> dict:
-    """:func:`generated_module`'s miss: derive, generate, execute and write the module."""
-    ns = None
+    """:func:`generated_module`'s miss: derive, generate, execute and write the module (a
+    flat foot's modes: :func:`walkerlab.codegen.foot_modes.derive_flat`, printed by
+    :func:`walkerlab.codegen.source.generate_flat`)."""
+    from walkerlab.codegen import source as codegen  # light
+
     if structure.foot == "flat":
-        from walkerlab.codegen import foot_modes as flatfoot  # light
+        from walkerlab.codegen.foot_modes import derive_flat  # light
 
-        body = flatfoot.generate_flat(structure, key)
-        ns = _exec(body, str(path or f"<walkerlab model {key}>"))
-        if path is not None:
-            codestore.write_source(path, body)
-    if ns is None:
-        from walkerlab.codegen import source as codegen  # light
-
-        eq = derive_equations(structure)
-        body = codegen.generate(eq, structure.param_names, key)
-        ns = _exec(body, str(path or f"<walkerlab model {key}>"))
-        if path is not None:
-            codestore.write_source(path, body)
+        body = codegen.generate_flat(derive_flat(structure), structure, key)
+    else:
+        body = codegen.generate(derive_equations(structure), structure.param_names, key)
+    ns = _exec(body, str(path or f"<walkerlab model {key}>"))
+    if path is not None:
+        codestore.write_source(path, body)
     return ns
 
 

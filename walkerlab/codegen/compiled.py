@@ -31,13 +31,14 @@ def compiled_module(structure):
     key = cache.cache_key(structure)
 
     def build() -> str:
-        if structure.foot == "flat":  # a flat foot's modes: their own generator
-            from walkerlab.codegen import foot_modes as flatfoot  # light
+        from walkerlab.codegen import compiled_source  # light
 
-            return flatfoot.generate_flat_compiled(structure, key)
-        from walkerlab.codegen.compiled_source import generate_compiled  # light
+        if structure.foot == "flat":  # a flat foot's modes
+            from walkerlab.codegen.foot_modes import derive_flat  # light
 
-        return generate_compiled(cache.derive_equations(structure),
-                                         structure.param_names, key)
+            return compiled_source.generate_flat_compiled(derive_flat(structure), structure,
+                                                          key)
+        return compiled_source.generate_compiled(cache.derive_equations(structure),
+                                                 structure.param_names, key)
 
     return codestore.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)

@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import sympy as sp
 
 from walkerlab.codegen.equations import Equations
-from walkerlab.codegen.source import (
+from walkerlab.codegen.printers import (
     IND,
     PRINTER,
     cse_lines,
@@ -21,7 +24,11 @@ from walkerlab.codegen.source import (
     start_module,
 )
 
-__all__ = ["cfunc_lines", "generate_compiled"]
+if TYPE_CHECKING:
+    from walkerlab.codegen.foot_modes import FlatEquations
+    from walkerlab.walker.description import Structure
+
+__all__ = ["cfunc_lines", "compiled_head", "generate_compiled", "generate_flat_compiled"]
 
 
 def _reset_cfunc(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
@@ -215,3 +222,55 @@ def compiled_head(what: str, key: str, maths: str, numba: str) -> list[str]:
             f"from numba import {numba}", "",
             "SIG = types.void(types.CPointer(types.float64), types.float64,",
             "                 types.CPointer(types.float64), types.CPointer(types.float64))", ""]
+
+
+#: Ground reactions each compiled flow writes after the state guards (extra outputs) [N]:
+#: the pinned contact's normal force ``N``; the toe's share ``N_toe`` in a heel-pinned mode
+#: (the moment balance about the heel) or ``N`` in heel off; the heel's ``N - N_toe`` (0 in
+#: heel off).  Each mode writes them with its own ``qdd``, as the Python guards read them.
+FORCES = ("normal_force", "toe_force", "heel_force")
+
+
+def _extra_outputs(eq: FlatEquations, mode: str) -> tuple[list[str], list]:
+    """Lines and expressions of a mode's extra outputs: every state guard of ``eq.guards``
+    (each through its own ``cse``, as its Python function) then :data:`FORCES` (the ground
+    reactions of ``ground_<pin>``, through the same ``cse``; ``qdd`` the mode's ``_a0..``)."""
+    lines, exprs = [], []
+    for expr in eq.guards.values():
+        gl, red = cse_lines([expr], PRINTER)
+        lines += gl
+        exprs.append(red[0])
+    pin = "toe" if mode == "heel_off" else "heel"
+    lines += [f"{IND}{s} = _a{i}" for i, s in enumerate(eq.qdd)]
+    gl, red = cse_lines(eq.ground[pin], PRINTER)
+    lines += gl + [f"{IND}_gN = {PRINTER.doprint(red[0])}"]
+    normal = sp.Symbol("_gN")
+    if pin == "toe":
+        return lines, exprs + [normal, normal, sp.Integer(0)]
+    lines += [f"{IND}_gT = {PRINTER.doprint(red[1])}", f"{IND}_gH = _gN - _gT"]
+    return lines, exprs + [normal, sp.Symbol("_gT"), sp.Symbol("_gH")]
+
+
+def generate_flat_compiled(eq: FlatEquations, structure: Structure, key: str) -> str:
+    """Source of a flat-footed walker's compiled module: numba ``cfunc`` right-hand sides
+    ``flow_<mode>`` (2n outputs) and ``flow_<mode>_variational`` (``2n + (2n)^2``) for CyRK's
+    C++ integrators, the same equations as :func:`generate_flat` (same lines, same key),
+    each writing ``GUARDS`` after its outputs (the state guards, then :data:`FORCES`);
+    ``constants(p)`` (the data vector: parameters, parameter-only subexpressions, a zeroed
+    call counter) and ``NCONST``, as :func:`walkerlab.codegen.compiled_source.generate_compiled`."""
+
+    hoisted = start_module(eq.params)  # filled as the lines below are generated
+    parts = {mode: (flow_lines(system, False, parts=True), flow_lines(system, True, parts=True))
+             for mode, system in eq.flows.items()}
+    extras = {mode: _extra_outputs(eq, mode) for mode in eq.flows}
+    consts = list(structure.param_names) + [h.split("=")[0].strip() for h in hoisted]
+    body = ["def constants(p):", f"    {', '.join(structure.param_names)}, = p", *hoisted,
+            f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)", "",
+            f"NCONST = {len(consts)}",
+            f"GUARDS = {(*eq.guards, *FORCES)!r}  # extra outputs, in this order", ""]
+    for mode, system in eq.flows.items():
+        for var in (False, True):
+            name = f"flow_{mode}_variational" if var else f"flow_{mode}"
+            body += cfunc_lines(name, system, consts, parts[mode], var, extras[mode]) + [""]
+    return "\n".join(compiled_head("model code (walkerlab.codegen.compiled_source, flat feet)", key,
+                                   "sin, cos, tan, sqrt, pi", "cfunc, types") + body) + "\n"

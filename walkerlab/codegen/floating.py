@@ -170,7 +170,7 @@ def generate_floating(eq: FloatingEquations, key: str, dynamics_jacobian: bool =
     the rigid gait's ground-reaction check, :func:`floating_plain`, does not need)."""
     import sympy as sp
 
-    from walkerlab.codegen.source import PRINTER as pr
+    from walkerlab.codegen.printers import PRINTER as pr
     nq = len(eq.q)
     qv, dqv = sp.Matrix(eq.q), sp.Matrix(eq.dq)
     a = sp.Matrix(sp.symbols(f"a0:{nq}", real=True))

@@ -2,8 +2,9 @@
 walker's body tree (:func:`walkerlab.walker.trees.legs_tree` with its soles: the stance heel
 the root, each leg on its ankle; :func:`walkerlab.codegen.tree_derive.kinematics` in world
 axes, as every other legged walker's equations come from its tree in
-:mod:`walkerlab.codegen.legged`) and written as Python source (the same ``make(p)`` module
-form as :mod:`walkerlab.codegen.source`, through its printers and solvers).
+:mod:`walkerlab.codegen.legged`), printed as every walker's: Python source
+(:func:`walkerlab.codegen.source.generate_flat`, the same ``make(p)`` module form) and its
+compiled twin (:func:`walkerlab.codegen.compiled_source.generate_flat_compiled`).
 
 Coordinates ``q = (swing, stance, stance_ankle)``: the absolute leg angles (from the
 vertical, positive foot ahead of the hip) and the stance ankle's angle ``a``: the sole's
@@ -45,7 +46,7 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
   support keeps its toe down (below).
 
 Double support (after heel strike, roles swapped;
-:func:`walkerlab.codegen.double_support.derive_double_support`): the leading foot
+:func:`derive_double_support`): the leading foot
 on its heel (or flat), the trailing foot on its toe, pinned (no slip); its ankle angle ``b``
 follows from the toe on the slope, the flow is Lagrange's equations on ``(q, b)`` with the
 toe's constraint and its force as multipliers (a numeric KKT solve in the generated code);
@@ -66,25 +67,9 @@ from functools import cache
 
 import sympy as sp
 
-from walkerlab.codegen import source as codegen
-from walkerlab.codegen.compiled_source import cfunc_lines, compiled_head
-from walkerlab.codegen.double_support import (
-    DOUBLE_SUPPORT_LEADS,
-    derive_double_support,
-    double_support_lines,
-)
 from walkerlab.codegen.frames import planar_slope_axes
 from walkerlab.codegen.lagrange import christoffel
 from walkerlab.codegen.legged import link_springs
-from walkerlab.codegen.source import (
-    IND,
-    PRINTER,
-    cse_lines,
-    flow_lines,
-    numpy_fn,
-    reset_lines,
-    start_module,
-)
 from walkerlab.codegen.tree_derive import kinematics, product_to_sum
 from walkerlab.walker.description import ROLE_TAG, Structure
 from walkerlab.walker.tree import CoordinateMap
@@ -104,8 +89,8 @@ HEEL_OFF_PHI_RAD = 1e-12
 
 @dataclass(frozen=True)
 class _System:
-    """What :func:`~walkerlab.codegen.source.flow_lines` and
-    :func:`~walkerlab.codegen.source.reset_lines` read (duck-typed Equations)."""
+    """What :func:`~walkerlab.codegen.printers.flow_lines` and
+    :func:`~walkerlab.codegen.printers.reset_lines` read (duck-typed Equations)."""
 
     q: tuple
     dq: tuple
@@ -151,6 +136,7 @@ class FlatEquations:
     leg_angles: dict
     push_off: dict | None = None
     double_support: dict | None = None
+    heel_off_phi_rad: float = HEEL_OFF_PHI_RAD
 
 
 def _foot_name(structure: Structure, kind: str, role: str) -> str:
@@ -418,164 +404,110 @@ def _push_off_systems(q, kin_pins, pre, flows, resets, trans) -> dict:
     return out
 
 
-def _scalar_fn(name: str, eq: FlatEquations, exprs: list, with_acc: bool) -> list[str]:
-    """A Python function ``(t, x)`` or ``(x, qdd)`` returning a float or a tuple."""
-    lines, red = cse_lines(exprs, PRINTER)
-    unpack = codegen.unpack(eq)
-    head = [f"    def {name}(x, qdd):" if with_acc else f"    def {name}(t, x):", unpack]
-    if with_acc:
-        head.append(f"{IND}{', '.join(str(s) for s in eq.qdd)}, = qdd")
-    vals = [PRINTER.doprint(e) for e in red]
-    ret = vals[0] if len(vals) == 1 and not with_acc else f"({', '.join(vals)},)"
-    return head + lines + [f"{IND}return {ret}"]
+#: The leading foot's modes in double support (the trailing foot on its toe): on its heel
+#: (turning about it) or flat (its angle locked).
+DOUBLE_SUPPORT_LEADS = ("heel_contact", "foot_flat")
 
 
-def _grad_fn(name: str, eq: FlatEquations, expr) -> list[str]:
-    x = [*eq.q, *eq.dq]
-    lines, red = cse_lines([sp.diff(expr, s) for s in x], PRINTER)
-    return [f"    def {name}(x):", codegen.unpack(eq), *lines,
-            f"{IND}return np.array(({', '.join(PRINTER.doprint(e) for e in red)},))"]
+def _lead_system(lead: str, M4, rhs, J, dJ, M, g_row, Jl, dq, foot_inertia) -> dict:
+    """One leading-foot mode's double support (:func:`derive_double_support`): the flow's
+    system ``K [Qdd; lam] = rhs`` (``M4``, the toe's ``J``, ``dJ dQ``; foot flat adds the
+    lock's row) and the entry's ``Ki [dq+; Lam] = Ki_rhs`` (on ``q`` with the pin's row
+    ``g_row``, ``M`` the heel contact's mass matrix; with ``foot_inertia`` the impact on
+    ``Q``, ``entry_on_Q``)."""
+    rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
+    gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
+    m = rows.rows
+    K = sp.zeros(4 + m, 4 + m)
+    K[:4, :4] = M4
+    K[:4, 4:] = -rows.T
+    K[4:, :4] = rows
+    imp_rows = g_row if lead == "heel_contact" else g_row.col_join(Jl)
+    mi = imp_rows.rows
+    Ki = sp.zeros(3 + mi, 3 + mi)
+    Ki[:3, :3] = M
+    Ki[:3, 3:] = -imp_rows.T
+    Ki[3:, :3] = imp_rows
+    out = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
+           "Ki_rhs": (M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
+    if foot_inertia != 0:  # the toe pinned on Q (see derive_double_support)
+        out["Ki"] = K
+        out["Ki_rhs"] = (M4 * sp.Matrix([*dq, 0])).col_join(sp.zeros(m, 1))
+        out["entry_on_Q"] = True
+    return out
 
 
-def _fast_lines(eq) -> list[str]:
-    """:func:`generate_flat`'s flows, resets, guards, ground reactions, double supports."""
-    fast = []
-    for mode, system in eq.flows.items():
-        fast += flow_lines(system, False, f"flow_{mode}")
-        fast += flow_lines(system, True, f"flow_{mode}_jacobian",
-                           variational=f"flow_{mode}_variational")
-    for name, system in eq.resets.items():
-        fast += reset_lines(system, False, f"reset_{name}")
-        fast += reset_lines(system, True, f"reset_{name}_jacobian")
-    for name, expr in eq.guards.items():
-        fast += _scalar_fn(f"guard_{name}", eq, [expr], False)
-        fast += _grad_fn(f"grad_{name}", eq, expr)
-    for pin, exprs in eq.ground.items():
-        fast += _scalar_fn(f"ground_{pin}", eq, exprs, True)
+def derive_double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma, normal,
+                    tangent, Jl, foot_inertia=0) -> dict:
+    """Double support after heel strike (roles already swapped): the leading (stance) foot
+    on its heel at ``O`` (heel contact) or flat (foot flat), the trailing (swing) foot on its
+    toe at a point ``P`` of the slope.  The trailing foot's ankle angle ``b`` (its sole at
+    ``swing + b``) is no state: with the toe on the slope, ``sin(swing + b + gamma) = -h/t``
+    (``h`` the trailing ankle's height above the slope, ``t`` the toe length), the branch
+    with the heel up (a toe on a line ``level`` [m] above the leading heel's, the tread it
+    stood on when the heel struck a landing lower down: ``sin(swing + b + gamma) = (level -
+    h)/t``); its rate from the toe's zero normal velocity.  The flow: Lagrange's
+    equations on ``Q = (swing, stance, stance_ankle, b)`` (the foot massless: ``b``'s row
+    holds the spring ``k (b - r)`` and damper ``c db`` against the toe's force), the toe
+    pinned, ``[M, -J^T; J, 0] [Qdd; lam] = [-C dQ - G; -dJ dQ]`` (``J = dT/dQ`` (2 x 4) of
+    the toe ``T``; foot flat adds ``phi = 0``'s row ``[0, 1, 1, 0]``), ``lam`` the ground's
+    force on the toe (world axes) [N].  Entry (the plastic impact that pins the toe, Newton's
+    restitution 0): in ``q`` the toe's pin is one row ``g = u^T dA/dq`` (``A`` the trailing
+    ankle, ``u`` the unit vector from toe to ankle: a massless foot takes no impulsive
+    moment, so the toe's impulse ``Lam u`` passes through the ankle) and
+    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``.
+
+    Feet with mass (``foot_inertia`` ``I`` [kg m^2] about the ankle, the mass at the ankle
+    already a body of ``flows``, whose swing foot turns with its leg): the trailing sole
+    turns at ``d(swing + b)/dt``, so ``M`` gains ``I`` in the ``(swing, b)`` block beyond
+    the locked foot's ``I`` in ``(swing, swing)``; the entry is then the impact on ``Q``
+    with the toe pinned in both directions, ``[M4, -J^T (, -Jl4^T); J, 0 (; Jl4, 0)]
+    [dQ+; Lam] = [M4 (dq-, 0); 0 (; 0)]`` (the foot turning with its leg before it,
+    ``db- = 0``; ``Lam`` (2,) the toe's impulse in world axes [N s]), whose limit ``I -> 0``
+    is the massless entry above."""
+    b, db = sp.symbols("b_trail db_trail", real=True)
+    t_len, k_b, r_b, c_b = trailing
+    sw = q[0]
+    h = (ankle.T * normal)[0]
+    theta = sw + b
+    toe = ankle + t_len * sp.Matrix([sp.cos(theta), sp.sin(theta)])
+    Q, dQ = (*q, b), (*dq, db)
+    Qv, dQv = sp.Matrix(Q), sp.Matrix(dQ)
+    J = toe.jacobian(Qv)
+    dJ = (J * dQv).jacobian(Qv) * dQv
+    hc = flows["heel_contact"]
+    M4 = sp.zeros(4, 4)
+    M4[:3, :3] = hc.M
+    M4[0, 3] = M4[3, 0] = M4[3, 3] = foot_inertia
+    rhs = sp.zeros(4, 1)
+    rhs[:3, 0] = -hc.C * sp.Matrix(dq) - hc.G
+    rhs[3, 0] = -c_b * db - k_b * (b - r_b)
+    b_of = sp.asin(-h / t_len) - gamma - sw
+    # the trailing toe on a line ``level`` [m] above the leading heel's (along the normal):
+    # the tread it stood on when the heel struck a lower landing (stairs, footholds)
+    level = sp.Symbol("level", real=True)
+    b_of_level = sp.asin((level - h) / t_len) - gamma - sw
+    hdot = (sp.Matrix([h]).jacobian(sp.Matrix(q)) * sp.Matrix(dq))[0]
+    db_of = -hdot / (t_len * sp.cos(theta + gamma)) - dq[0]
+    dA = ankle.jacobian(sp.Matrix(q))
+    u = -sp.Matrix([sp.cos(theta), sp.sin(theta)])  # toe -> ankle
+    g_row = u.T * dA
+    F, mom = lead_force
+    held = k_b * (b - r_b) ** 2 / 2
+    if foot_inertia != 0:  # the sole's kinetic energy beyond turning with its leg (held in M)
+        held += foot_inertia * ((dq[0] + db) ** 2 - dq[0] ** 2) / 2
+    out = {"b": b, "db": db, "b_of": b_of, "b_of_level": b_of_level, "db_of": db_of, "u": u,
+           "toe": toe, "trailing_spring": held, "foot_angle": theta + gamma,
+           "leads": DOUBLE_SUPPORT_LEADS}
     for lead in DOUBLE_SUPPORT_LEADS:
-        fast += double_support_lines(eq, lead)
-    return fast
-
-
-def generate_flat(structure: Structure, key: str) -> str:
-    """Source text of a flat-footed walker's generated module (``make(p)`` returns, by name:
-    ``flow_<mode>``, ``flow_<mode>_jacobian``, ``flow_<mode>_variational`` for the three
-    modes; ``reset_<name>`` and ``reset_<name>_jacobian`` for ``foot_slap``,
-    ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
-    ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
-    per leading-foot mode ``m`` of the double support (``heel_contact``, ``foot_flat``):
-    ``flow_double_support_<m>(t, x, gen=None, level=0.0)``, ``double_support_<m>_forces(t,
-    x, gen=None, level=0.0)`` (trailing toe normal and tangential, leading foot normal and
-    its toe's share [N]; ``gen`` (3,) [N m] a generalised force in ``q``'s rows, joint
-    torques' ``B tau``), ``double_support_<m>_entry(x, level=0.0) -> (x+, (Lam_n, Lam_t))``
-    [N s]; and ``double_support_trailing(x, level=0.0) -> (b, db, held energy [J], trailing
-    sole angle from the slope [rad])`` (``level`` [m]: the trailing toe's tread above the
-    leading heel's line, along the normal: stairs, footholds; held: the trailing spring's
-    energy, with feet of mass plus the trailing sole's kinetic energy beyond turning with
-    its leg);
-    ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
-    ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
-    eq = derive_flat(structure)
-    hoisted = codegen.start_module(eq.params)
-    fast = _fast_lines(eq)
-    rest = "r_st_ankle" if structure.asymmetric else "r_ankle"
-    section = [
-        "    def section(x):",
-        f"{IND}return np.asarray(x)[[0, 1, 3, 4, 5]]",
-        "    def from_section(z):",
-        f"{IND}z0, z1, z2, z3, z4, = z",
-        f"{IND}return np.array((z0, z1, {rest} + 0.0 * z0, z2, z3, z4))",
-    ]
-    kin = eq.kinematics
-    numpy = [
-        *numpy_fn("_points_heel", eq, kin["heel"]["points"]),
-        *numpy_fn("_points_toe", eq, kin["toe"]["points"]),
-        *numpy_fn("energies_heel", eq, {"kinetic": kin["heel"]["kinetic"],
-                                          "potential": kin["heel"]["potential"]}),
-        *numpy_fn("energies_toe", eq, {"kinetic": kin["toe"]["kinetic"],
-                                         "potential": kin["toe"]["potential"]}),
-        "    def _on_toe(x):  # heel off: the foot turned heel up (phi < 0)",
-        f"{IND}x = np.asarray(x)",
-        f"{IND}return x[1] + x[2] + gamma < {-HEEL_OFF_PHI_RAD!r}",
-        "    def points(x):",
-        f"{IND}if np.ndim(x) == 1:  # one state: one kinematics",
-        f"{IND}    return _points_toe(x) if _on_toe(x) else _points_heel(x)",
-        f"{IND}toe, h, o = _on_toe(x), _points_heel(x), _points_toe(x)",
-        f"{IND}return {{k: np.where(toe, o[k], h[k]) for k in h}}",
-        "    def energies(x):",
-        f"{IND}toe, h, o = _on_toe(x), energies_heel(x), energies_toe(x)",
-        f"{IND}return (np.where(toe, o['kinetic'], h['kinetic']),",
-        f"{IND}        np.where(toe, o['potential'], h['potential']))",
-        *numpy_fn("leg_angles", eq, eq.leg_angles),
-        # last: the functions above keep their cse symbols' numbering
-        *numpy_fn("push_off_heel", eq, eq.push_off["heel"], args="q"),
-        *numpy_fn("push_off_toe", eq, eq.push_off["toe"], args="q"),
-    ]
-    body = [
-        "def make(p):",
-        f"    {', '.join(structure.param_names)}, = p",
-        *hoisted, *fast, *section, *numpy,
-        "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
-    ]
-    head = [
-        f"# walkerlab generated model code (walkerlab.codegen.foot_modes); key {key}",
-        "# Do not edit: regenerated when the walker description or the generator changes.",
-        "from math import sin, cos, tan, sqrt, pi, asin  # noqa: F401",
-        "import numpy  # noqa: F401",
-        "import numpy as np",
-        "",
-    ]
-    return "\n".join(head + body) + "\n"
-
-
-#: Ground reactions each compiled flow writes after the state guards (extra outputs) [N]:
-#: the pinned contact's normal force ``N``; the toe's share ``N_toe`` in a heel-pinned mode
-#: (the moment balance about the heel) or ``N`` in heel off; the heel's ``N - N_toe`` (0 in
-#: heel off).  Each mode writes them with its own ``qdd``, as the Python guards read them.
-FORCES = ("normal_force", "toe_force", "heel_force")
-
-
-def _extra_outputs(eq: FlatEquations, mode: str) -> tuple[list[str], list]:
-    """Lines and expressions of a mode's extra outputs: every state guard of ``eq.guards``
-    (each through its own ``cse``, as its Python function) then :data:`FORCES` (the ground
-    reactions of ``ground_<pin>``, through the same ``cse``; ``qdd`` the mode's ``_a0..``)."""
-    lines, exprs = [], []
-    for expr in eq.guards.values():
-        gl, red = cse_lines([expr], PRINTER)
-        lines += gl
-        exprs.append(red[0])
-    pin = "toe" if mode == "heel_off" else "heel"
-    lines += [f"{IND}{s} = _a{i}" for i, s in enumerate(eq.qdd)]
-    gl, red = cse_lines(eq.ground[pin], PRINTER)
-    lines += gl + [f"{IND}_gN = {PRINTER.doprint(red[0])}"]
-    normal = sp.Symbol("_gN")
-    if pin == "toe":
-        return lines, exprs + [normal, normal, sp.Integer(0)]
-    lines += [f"{IND}_gT = {PRINTER.doprint(red[1])}", f"{IND}_gH = _gN - _gT"]
-    return lines, exprs + [normal, sp.Symbol("_gT"), sp.Symbol("_gH")]
-
-
-def generate_flat_compiled(structure: Structure, key: str) -> str:
-    """Source of a flat-footed walker's compiled module: numba ``cfunc`` right-hand sides
-    ``flow_<mode>`` (2n outputs) and ``flow_<mode>_variational`` (``2n + (2n)^2``) for CyRK's
-    C++ integrators, the same equations as :func:`generate_flat` (same lines, same key),
-    each writing ``GUARDS`` after its outputs (the state guards, then :data:`FORCES`);
-    ``constants(p)`` (the data vector: parameters, parameter-only subexpressions, a zeroed
-    call counter) and ``NCONST``, as :func:`walkerlab.codegen.compiled_source.generate_compiled`."""
-
-    eq = derive_flat(structure)
-    hoisted = start_module(eq.params)  # filled as the lines below are generated
-    parts = {mode: (flow_lines(system, False, parts=True), flow_lines(system, True, parts=True))
-             for mode, system in eq.flows.items()}
-    extras = {mode: _extra_outputs(eq, mode) for mode in eq.flows}
-    consts = list(structure.param_names) + [h.split("=")[0].strip() for h in hoisted]
-    body = ["def constants(p):", f"    {', '.join(structure.param_names)}, = p", *hoisted,
-            f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)", "",
-            f"NCONST = {len(consts)}",
-            f"GUARDS = {(*eq.guards, *FORCES)!r}  # extra outputs, in this order", ""]
-    for mode, system in eq.flows.items():
-        for var in (False, True):
-            name = f"flow_{mode}_variational" if var else f"flow_{mode}"
-            body += cfunc_lines(name, system, consts, parts[mode], var, extras[mode]) + [""]
-    return "\n".join(compiled_head("model code (walkerlab.codegen.foot_modes)", key,
-                                   "sin, cos, tan, sqrt, pi", "cfunc, types") + body) + "\n"
+        out[lead] = _lead_system(lead, M4, rhs, J, dJ, hc.M, g_row, Jl, dq, foot_inertia)
+    # the leading foot's ground force: Newton's total (feet massless) less the toe's; in
+    # foot flat its toe's share from the moment balance about its heel, less the trailing
+    # toe's moment (the lock's multiplier is that moment: its toe force times the sole)
+    lam = sp.Matrix(sp.symbols("lam_x lam_y", real=True))
+    out["lead_normal"] = ((F - lam).T * normal)[0]
+    out["trail_normal"] = (lam.T * normal)[0]
+    out["trail_tangential"] = (lam.T * tangent)[0]
+    out["lam"] = lam
+    out["sole"] = sole
+    return out

@@ -276,7 +276,7 @@ class HybridWalker:
     hip_x : callable or None
         ``x (2n,) or (2n, k) -> float or (k,)``: the hip's x [m] relative to the stance
         foot alone, ``points(x)["hip"][0]`` bit for bit (generated beside ``points``:
-        :func:`walkerlab.codegen.source.numpy_fn`'s slices); None: read it from
+        :func:`walkerlab.codegen.printers.numpy_fn`'s slices); None: read it from
         ``points``.
     section_words : str
         What the Poincaré section's state is, in words for the outputs that print it
