@@ -23,6 +23,7 @@ import yaml
 from tests.independent import floating_reference as ref
 from walkerlab.config import load_scene
 from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.models.hybrid.floating_view import FloatingView
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 
@@ -206,9 +207,8 @@ def test_reference_is_not_trivially_equal(tmp_path):
 def test_libraries_match_floating_view(name, tmp_path):
     """Pinocchio and MuJoCo equal the generated floating view: same coordinate names, mass
     matrix and bias at random states."""
-    floating = pytest.importorskip("walkerlab.codegen.floating")
     scene = _scene(name)
-    view = floating.floating_view(_data(scene))
+    view = FloatingView(_data(scene))
     assert tuple(view.coordinate_names()) == ref.coordinate_names(_data(scene))
 
     def generated(q, dq):  # without its springs (URDF has none; MuJoCo's are passive forces,
@@ -343,7 +343,6 @@ def test_mujoco_springs_are_ours(variant, tmp_path):
     writer's orientation of the tendon (MuJoCo reads springlength -1 as "the length at
     qpos0", which would silently give rest 0)."""
     mujoco = pytest.importorskip("mujoco")
-    floating = pytest.importorskip("walkerlab.codegen.floating")
     base, edit = _sprung_variants()[variant]
     scene = _scene(base) if edit is None else _edited_scene(tmp_path, base, edit)
     data = _data(scene)
@@ -351,7 +350,7 @@ def test_mujoco_springs_are_ours(variant, tmp_path):
     mj = MuJoCo(export_stage.run(scene, tmp_path, "mjcf", walker_only=edit is not None), names,
                 bool(data.structure.torso))
     mj.model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
-    view = floating.floating_view(data)
+    view = FloatingView(data)
     assert data.structure.springs
     for q, dq in _states(len(names), seed=11):
         mj(q, dq)

@@ -16,8 +16,8 @@ import yaml
 
 from tests.independent import five_link as ref
 from tests.test_five_link import SCENE, P
-from walkerlab.codegen.floating import floating_view
 from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.models.hybrid.floating_view import FloatingView
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.plant import Plant
@@ -128,7 +128,7 @@ def test_urdf_and_mjcf_dynamics_are_the_floating_views(exported):
     walkerlab's floating mass matrix and bias (the contact model's mechanics) at random
     states, to 1e-10 of the largest entry (MuJoCo: plus its 1e-12 kg m^2 inertia floor)."""
     scene, urdf, mjcf = exported
-    view = floating_view(walker_data(scene.walker, scene.slope.phi_rad))
+    view = FloatingView(walker_data(scene.walker, scene.slope.phi_rad))
     assert view.coordinate_names()[-1] == "torso_angle"
     libs = {"pinocchio": _pinocchio(urdf, 9.81), "mujoco": _mujoco(mjcf)[0]}
     for lib, f in libs.items():

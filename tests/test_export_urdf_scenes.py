@@ -7,8 +7,8 @@ its own articulated-body algorithms) against walkerlab's own rigid model, for th
 
 - planar: the mass matrix (CRBA), the gravity torques and the bias (RNEA) of the URDF, carried
   to walkerlab's floating coordinates (``tests/test_export.py``'s :class:`Pinocchio`), equal the
-  generated floating view's (:func:`walkerlab.codegen.floating.floating_view`) at the gait
-  keyframe of the file's sidecar (``walker.gait.json``) and at random states;
+  generated floating view's (:class:`walkerlab.models.hybrid.floating_view.FloatingView`) at
+  the gait keyframe of the file's sidecar (``walker.gait.json``) and at random states;
 - 3D: the URDF on a free-flyer root put in the rigid walker's state (its pelvis where the
   generated model's hip is, turned by its roll; each hinge at its angle, the bisecting hip's
   torso at the legs' mean): Pinocchio's kinetic and potential energies equal the generated
@@ -65,11 +65,11 @@ def _close(what, got, want):
 def test_a_planar_scenes_urdf_has_the_floating_views_dynamics(name, tmp_path):
     """Pinocchio's mass matrix, gravity torques and bias on the exported URDF equal the
     floating view's at the sidecar's keyframe and at random states (module docstring)."""
-    from walkerlab.codegen.floating import floating_view
+    from walkerlab.models.hybrid.floating_view import FloatingView
 
     scene, data = _scene_and_data(name)
     assert not data.structure.springs  # URDF has no springs; the view's bias has them
-    view = floating_view(data)
+    view = FloatingView(data)
     names = tuple(view.coordinate_names())
     coupled = bool(data.structure.torso) and "torso_angle" not in names  # bisecting hip
     urdf = export_stage.run(scene, tmp_path, "urdf")

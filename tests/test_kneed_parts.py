@@ -238,11 +238,11 @@ def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(name, gai
 def test_floating_view_matches_the_floating_reference(variant):
     """The contact view's equations (floating base, both knees free): mass matrix and bias,
     springs included, against the independent floating reference."""
-    from walkerlab.codegen.floating import floating_view
+    from walkerlab.models.hybrid.floating_view import FloatingView
 
     sc = _scene(variant)
     data = walker_data(sc.walker, sc.slope.phi_rad)
-    view = floating_view(data)
+    view = FloatingView(data)
     assert tuple(view.coordinate_names()) == fref.coordinate_names(data)
     rng = np.random.default_rng(13)
     for _ in range(4):

@@ -11,10 +11,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from tests.independent import flat_feet_floating_reference as ref
-from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, floating_view
+from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE
 from walkerlab.config import scene_from_dict
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.models.contact.scene import ContactSceneError, build
+from walkerlab.models.hybrid.floating_view import FloatingView
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.layout import StateIndex
 from walkerlab.walker.plant import Plant
@@ -65,7 +66,7 @@ def test_floating_view_matches_the_independent_reference():
     O(1) numbers: 1e-12 relative is round-off; G = dV/dq by central differences (h = 1e-6:
     truncation ~h^2 V''' ~ 1e-10, round-off ~1e-16 V / h ~ 1e-8 N on |G| ~ 100 N)."""
     sc = _scene()
-    view = floating_view(walker_data(sc.walker, sc.slope.phi_rad), MF, IF)
+    view = FloatingView(walker_data(sc.walker, sc.slope.phi_rad), MF, IF)
     assert view.coordinate_names() == ("hip_x", "hip_y", "leg1_angle", "leg2_angle",
                                        "leg1_foot_angle", "leg2_foot_angle")
     assert view.contact_names() == ("leg1_heel", "leg1_toe", "leg2_heel", "leg2_toe")
@@ -309,7 +310,7 @@ def test_floating_view_matches_pinocchio():
     minus the ankle springs, which Pinocchio does not model).  Round-off agreement: 1e-10."""
     pin = pytest.importorskip("pinocchio")
     sc = _scene()
-    view = floating_view(walker_data(sc.walker, sc.slope.phi_rad), MF, IF)
+    view = FloatingView(walker_data(sc.walker, sc.slope.phi_rad), MF, IF)
     p = _ref_params(None)
     model = pin.Model()
     model.gravity.linear = np.array([0.0, 0.0, -p["g"]])

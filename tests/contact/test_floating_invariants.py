@@ -17,12 +17,13 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from walkerlab.codegen.cache import functions
-from walkerlab.codegen.floating import MASSLESS_MESSAGE, floating_view
+from walkerlab.codegen.floating import MASSLESS_MESSAGE
 from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.models.contact.assembly import NINFO
 from walkerlab.models.contact.laws import contact_params_si, knee_stop_si
 from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.hybrid.floating_view import FloatingView
 from walkerlab.walker.description import walker_data
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
@@ -205,7 +206,7 @@ def test_massless_legs_have_no_floating_view():
     sc = load_scene(CONFIGS / "simplest.yaml")
     data = walker_data(sc.walker, sc.slope.phi_rad)
     with pytest.raises(ValueError, match=re.escape(MASSLESS_MESSAGE)):
-        floating_view(data)
+        FloatingView(data)
     with pytest.raises(ValueError, match=re.escape(MASSLESS_MESSAGE)):
         ContactWalker(data=data)
 
@@ -215,7 +216,7 @@ def test_floating_view_api(name):
     """The agreed public API: coordinate names, M symmetric positive definite, the bias at
     rest is gravity (total weight on hip_y)."""
     data = _data(name)
-    v = floating_view(data)
+    v = FloatingView(data)
     names = v.coordinate_names()
     if data.structure.knee:
         assert names == ("hip_x", "hip_y", "leg1_thigh_angle", "leg1_shank_angle",
@@ -314,7 +315,7 @@ def test_straight_line_rhs_is_the_floating_view(name):
     solves M qdd = -h of the floating view (feet in the air, knees open); 1e-12 relative."""
     data = _data(name)
     w = _walker(data)
-    v = floating_view(data)
+    v = FloatingView(data)
     rng = np.random.default_rng(6)
     for _ in range(10):
         x = np.concatenate([[0.1, 3.0], rng.uniform(-0.4, 0.4, w.nq - 2),
@@ -337,7 +338,7 @@ def _constrained(w, q_links, dq_links, lock_leg1_knee):
     w.kernels.feet(x, w.walker_params, P, V, J)
     dV, dJtF = np.empty((2, 2, nq)), np.empty((nq, nq))
     w.kernels.feet_jac(x, np.zeros((2, 2)), w.walker_params, dV, dJtF)
-    h = floating_view(w.data).bias(x[:nq], x[nq:])
+    h = FloatingView(w.data).bias(x[:nq], x[nq:])
     rows, rhs = [J[1]], [-(dV[1] @ x[nq:])]
     if w.structure.knee:
         rows.append(np.array([[0, 0, 0, 0, -1.0, 1]]))  # stance knee locked

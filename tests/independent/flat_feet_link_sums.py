@@ -49,7 +49,7 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
   support keeps its toe down (below).
 
 Double support (after heel strike, roles swapped;
-:func:`walkerlab.codegen.double_support.derive_double_support`): the leading foot
+:func:`walkerlab.codegen.foot_modes.derive_double_support`): the leading foot
 on its heel (or flat), the trailing foot on its toe, pinned (no slip); its ankle angle ``b``
 follows from the toe on the slope, the flow is Lagrange's equations on ``(q, b)`` with the
 toe's constraint and its force as multipliers (a numeric KKT solve in the generated code);
@@ -165,7 +165,7 @@ def derive_flat(structure: Structure) -> FlatEquations:
     the pinned modes (:func:`_pinned_modes`), foot flat and the resets
     (:func:`_locked_and_resets`), the push-off systems
     (:func:`walkerlab.codegen.push_off.push_off_systems`) and the
-    double support (:func:`walkerlab.codegen.double_support.derive_double_support`).
+    double support (:func:`walkerlab.codegen.foot_modes.derive_double_support`).
 
     Returns
     -------

@@ -168,7 +168,7 @@ def derive_flat(structure: Structure) -> FlatEquations:
     Lagrange's equations by :func:`walkerlab.codegen.tree_derive.derive_tree`): the pinned
     modes (:func:`_pinned_modes`), foot flat and the resets (:func:`_locked_and_resets`),
     the push-off systems (:func:`_push_off_systems`) and the double support
-    (:func:`walkerlab.codegen.double_support.derive_double_support`).
+    (:func:`walkerlab.codegen.foot_modes.derive_double_support`).
 
     Returns
     -------

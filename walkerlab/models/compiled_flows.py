@@ -34,7 +34,7 @@ class CompiledFlow:
         Parameter vector (``structure.param_names`` order).
     name : str
         ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked); a flat foot's
-        ``"flow_<mode>"`` (:func:`walkerlab.codegen.foot_modes.generate_flat_compiled`).
+        ``"flow_<mode>"`` (:func:`walkerlab.codegen.compiled_source.generate_flat_compiled`).
     guards : tuple of (str, float), optional
         For each guard of the phase, in order: the generated guard it is and a constant added
         to it (``Guard.function = guard_<name> + offset``); the guards are then evaluated in

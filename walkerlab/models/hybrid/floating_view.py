@@ -1,9 +1,10 @@
-"""A rigid walker's floating view (:mod:`walkerlab.codegen.floating`: the same walker with no
+"""A walker's floating view (:mod:`walkerlab.codegen.floating`: the same walker with no
 foot pinned, coordinates ``[hip_x, hip_y, link angles]`` in the plane, a 3D body tree set
 free at its stance foot) as plain Python: its mass matrix and bias ``M(q)``, ``h(q, dq)``,
-its feet's contact points, material velocities and Jacobians, and their velocity
-gradients (:class:`FloatingView`), which the ground reaction of
-:mod:`walkerlab.models.hybrid.ground_reaction` reads.
+its feet's contact points, material velocities and Jacobians, their velocity gradients,
+its energies and named points (:class:`FloatingView`), which the ground reaction of
+:mod:`walkerlab.models.hybrid.ground_reaction` reads and the checks against other libraries
+(Pinocchio, MuJoCo, Drake) compare.
 """
 
 from __future__ import annotations
@@ -30,6 +31,9 @@ class FloatingView:
     ----------
     data : walkerlab.walker.description.WalkerData
         The walker's structure and numbers.
+    foot_mass_kg, foot_inertia_kg_m2 : float, optional
+        A flat foot's mass [kg] (at the ankle) and inertia about the ankle [kg m^2], for
+        a walker whose feet carry none (:func:`~walkerlab.codegen.floating.floating_params`).
 
     Attributes
     ----------
@@ -43,16 +47,28 @@ class FloatingView:
     Raises
     ------
     ValueError
-        A massless body beside massive ones (no floating view).
+        A massless body (:data:`walkerlab.codegen.floating.MASSLESS_MESSAGE`); flat feet of
+        no mass without ``foot_mass_kg`` and ``foot_inertia_kg_m2``.
     """
 
-    def __init__(self, data):
+    def __init__(self, data, foot_mass_kg: float | None = None,
+                 foot_inertia_kg_m2: float | None = None):
         mod = floating_plain(data.structure)  # raises for a massless body
-        self.params = np.asarray(floating_params(data), float)
+        self.params = np.asarray(floating_params(data, foot_mass_kg, foot_inertia_kg_m2),
+                                 float)
         self.nq, self.dim = int(mod["NQ"]), int(mod["DIM"])
         self.names = contact_names(data.structure)
         self.coordinates = coordinate_names(data.structure)
         self._dyn, self._feet, self._feet_jac = mod["dyn"], mod["feet"], mod["feet_jac"]
+        self._energies, self._points = mod["energies"], mod["points"]
+
+    def coordinate_names(self) -> tuple[str, ...]:
+        """The generalised coordinates, in order (:attr:`coordinates`)."""
+        return self.coordinates
+
+    def contact_names(self) -> tuple[str, ...]:
+        """The contact points, in order (:attr:`names`)."""
+        return self.names
 
     def _x(self, q, dq=None) -> np.ndarray:
         return np.concatenate([q, np.zeros(self.nq) if dq is None else dq])
@@ -62,6 +78,27 @@ class FloatingView:
         M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
         self._dyn(self._x(q, dq), self.params, M, h)
         return M, h
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """``M(q)`` (nq, nq) [kg, kg m, kg m^2]."""
+        return self.dynamics(q, None)[0]
+
+    def bias(self, q, dq) -> np.ndarray:
+        """``h(q, dq) = C(q, dq) dq + G(q)`` (nq,) [N, N m]: ``M qdd + h = sum J^T F``."""
+        return self.dynamics(q, dq)[1]
+
+    def gravity(self, q) -> np.ndarray:
+        """``G(q) = h(q, 0)`` (nq,) [N, N m]."""
+        return self.dynamics(q, None)[1]
+
+    def energies(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic and potential energy [J] of states ``X`` (2 nq,) or (2 nq, k)."""
+        return self._energies(X, self.params)
+
+    def points(self, X) -> dict:
+        """Named points (hip, bodies, feet, knees) (d,) or (d, k) [m], named as the rigid
+        model's, of states ``X`` (2 nq,) or (2 nq, k)."""
+        return self._points(X, self.params)
 
     def contact_points(self, q, dq=None):
         """Contact points (nf, d) [m], material velocities (nf, d) [m/s], Jacobians

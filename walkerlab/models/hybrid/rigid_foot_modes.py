@@ -62,7 +62,7 @@ FIRST_CHUNK_STEPS = {"heel_contact:early_swing": 42, "heel_contact:late_swing": 
 #: The tolerance the chunks of :data:`FIRST_CHUNK_STEPS` were measured at [-].
 CHUNK_RTOL = 1e-10
 #: Each guard's extra output of the compiled flows (``GUARDS`` of
-#: :func:`walkerlab.codegen.foot_modes.generate_flat_compiled`; ``{pin}`` the mode's pinned
+#: :func:`walkerlab.codegen.compiled_source.generate_flat_compiled`; ``{pin}`` the mode's pinned
 #: point): the same function of the state as the Python guard of that name.
 GUARD_OUTPUT = {"heel_strike": "swing_heel_height_{pin}", "foot_slap": "foot_angle",
                 "stance_foot_lifts": "normal_force", "heel_off": "heel_force",
@@ -370,7 +370,7 @@ def _held(f: dict, c: float, level: float, x) -> tuple[float, float]:
 def double_support_phases(f: dict, c_trailing: float = 0.0,
                           force=None, level: float = 0.0) -> tuple[Phase, ...]:
     """The double-support phases of a flat-footed walker's generated functions ``f``
-    (:func:`walkerlab.codegen.foot_modes.generate_flat`): the trailing foot on its toe (a
+    (:func:`walkerlab.codegen.source.generate_flat`): the trailing foot on its toe (a
     pin: no slip assumed; ``c_trailing`` its ankle damper [N m s/rad], for the phases'
     ``held_energy``), the leading foot on its heel (``double_support:heel_contact``)
     or flat (``double_support:foot_flat``).  ``force(t, x) -> (3,)`` [N m], if given: joint
