@@ -159,13 +159,15 @@ def test_opensim_loads_the_3d_osim_with_the_trees_bodies_at_the_rigid_gait(stabi
     assert got["stations"]["leg1_foot"] == pytest.approx(pts["swing_foot"] + shift, abs=1e-9)
 
 
-def _walks_within_3_percent(name: str, tmp_path):
+def _walks_within_3_percent(name: str, tmp_path, capsizes: bool = False):
     """The shipped scene's .osim walked by OpenSim (``export --walk``): at least 10
     alternating heel strikes without a fall, the mean step period within 3 % of the rigid
-    gait's (the capability table's OpenSim tolerance); returns the walk's check."""
+    gait's (the capability table's OpenSim tolerance); returns the walk's check.
+    ``capsizes``: a laterally unstable gait, whose roll grows from what the engine's
+    integrator lets into it until it capsizes: the 10 heel strikes before any fall."""
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
     w = export_stage.write(scene, tmp_path, "osim", walk=True, walk_steps=10).walk
-    assert w.walked and not w.fell and w.alternating, w.line
+    assert w.walked and (capsizes or not w.fell) and w.alternating, w.line
     assert w.strikes >= 10, w.line
     assert abs(w.relative) <= 0.03, w.line
     return w
@@ -323,13 +325,19 @@ def test_a_push_off_on_round_feet_is_refused_in_the_osim_in_one_line(tmp_path):
 
 @pytest.mark.slow
 @needs_opensim
-@pytest.mark.parametrize(("name", "measured"), [("round_feet_3d", 0.0038),
-                                                ("kneed_round_feet_3d", 0.0179)])
-def test_the_3d_round_feet_walk_in_opensim_within_3_percent(tmp_path, name, measured):
+@pytest.mark.parametrize(("name", "measured", "capsizes"),
+                         [("round_feet_3d", 0.0038, True), ("kneed_round_feet_3d", 0.0179, False)])
+def test_the_3d_round_feet_walk_in_opensim_within_3_percent(tmp_path, name, measured,
+                                                             capsizes):
     """The discs as thin ellipsoids (straight legs; the kneed walker's on its shanks, its knee
     latch switched by walkerlab's loop) stepped by OpenSim's Manager: at least 10
     alternating heel strikes without a fall, the mean step period within 3 % of the rigid
     gait's (the capability table's OpenSim tolerance; measured +0.38 % and +1.79 %, the
-    MJCF's -0.02 % and -0.11 %, the contact model's +0.09 % and +0.93 %)."""
-    w = _walks_within_3_percent(name, tmp_path)
+    MJCF's -0.02 % and -0.11 %, the contact model's +0.09 % and +0.93 %).
+    ``round_feet_3d`` has no hip width: its gait is laterally unstable, its roll growing x11
+    a step from what the integrator lets into it (configs/round_feet_3d.yaml), so its walk
+    capsizes some steps after that seed, which is the machine's round-off (measured: after
+    heel strike 10 at +0.84 %, 24.9 s, on one machine, later on another): the 10 strikes
+    are asked for before any fall."""
+    w = _walks_within_3_percent(name, tmp_path, capsizes)
     assert w.relative == pytest.approx(measured, abs=0.005), w.line
