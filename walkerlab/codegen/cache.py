@@ -94,21 +94,30 @@ def generated_module(structure) -> dict:
 
 
 def _derive_module(structure, key: str, path: Path | None) -> dict:
-    """:func:`generated_module`'s miss: derive, generate, execute and write the module (a
-    flat foot's modes: :func:`walkerlab.codegen.foot_modes.derive_flat`, printed by
-    :func:`walkerlab.codegen.source.generate_flat`)."""
-    from walkerlab.codegen import source as codegen  # light
-
-    if structure.foot == "flat":
-        from walkerlab.codegen.foot_modes import derive_flat  # light
-
-        body = codegen.generate_flat(derive_flat(structure), structure, key)
-    else:
-        body = codegen.generate(derive_equations(structure), structure.param_names, key)
+    """:func:`generated_module`'s miss: derive, generate, execute and write the module."""
+    body = module_source(structure, key)
     ns = _exec(body, str(path or f"<walkerlab model {key}>"))
     if path is not None:
         codestore.write_source(path, body)
     return ns
+
+
+def module_source(structure, key: str, compiled: bool = False) -> str:
+    """The source of ``structure``'s rigid module (``compiled``: its numba twin,
+    :mod:`walkerlab.codegen.compiled_source`), printed from its one derivation: a flat foot's
+    modes (:func:`walkerlab.codegen.foot_modes.derive_flat`), every other walker's
+    :func:`derive_equations`; ``key`` written into its header."""
+    if compiled:
+        from walkerlab.codegen import compiled_source as printer  # light
+    else:
+        from walkerlab.codegen import source as printer  # light
+    if structure.foot == "flat":
+        from walkerlab.codegen.foot_modes import derive_flat  # light
+
+        flat = printer.generate_flat_compiled if compiled else printer.generate_flat
+        return flat(derive_flat(structure), structure, key)
+    whole = printer.generate_compiled if compiled else printer.generate
+    return whole(derive_equations(structure), structure.param_names, key)
 
 
 #: the symbolic equations derived in this process, by cache key: every generated module of

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import json
 
+from walkerlab import codestore
+
 __all__ = ["cached_functions", "casadi_function", "casadi_matrix"]
 
 #: the functions the printed expressions call (sympy name -> CasADi's), filled on first use
@@ -95,15 +97,13 @@ def cached_functions(key: str, build, encode=None, decode=None) -> dict:
     -------
     dict
     """
-    from walkerlab.codestore import cache_dir, read_source, write_source
-
     if key in _memo:
         return _memo[key]
     encode = encode or _encode
     decode = decode or _decode
-    folder = cache_dir()
+    folder = codestore.cache_dir()
     path = folder / f"{key}.casadi" if folder is not None else None
-    text = read_source(path) if path is not None else None
+    text = codestore.read_source(path) if path is not None else None
     fns = None
     if text is not None:
         try:
@@ -113,7 +113,7 @@ def cached_functions(key: str, build, encode=None, decode=None) -> dict:
     if fns is None:
         fns = build()
         if path is not None:
-            write_source(path, encode(fns))
+            codestore.write_source(path, encode(fns))
     _memo[key] = fns
     return fns
 

@@ -29,16 +29,5 @@ def compiled_module(structure):
         numba is not installed.
     """
     key = cache.cache_key(structure)
-
-    def build() -> str:
-        from walkerlab.codegen import compiled_source  # light
-
-        if structure.foot == "flat":  # a flat foot's modes
-            from walkerlab.codegen.foot_modes import derive_flat  # light
-
-            return compiled_source.generate_flat_compiled(derive_flat(structure), structure,
-                                                          key)
-        return compiled_source.generate_compiled(cache.derive_equations(structure),
-                                                 structure.param_names, key)
-
-    return codestore.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)
+    return codestore.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}",
+                                      lambda: cache.module_source(structure, key, compiled=True))

@@ -254,7 +254,8 @@ def _extra_outputs(eq: FlatEquations, mode: str) -> tuple[list[str], list]:
 def generate_flat_compiled(eq: FlatEquations, structure: Structure, key: str) -> str:
     """Source of a flat-footed walker's compiled module: numba ``cfunc`` right-hand sides
     ``flow_<mode>`` (2n outputs) and ``flow_<mode>_variational`` (``2n + (2n)^2``) for CyRK's
-    C++ integrators, the same equations as :func:`generate_flat` (same lines, same key),
+    C++ integrators, the same equations as :func:`walkerlab.codegen.source.generate_flat`
+    (same lines, same key),
     each writing ``GUARDS`` after its outputs (the state guards, then :data:`FORCES`);
     ``constants(p)`` (the data vector: parameters, parameter-only subexpressions, a zeroed
     call counter) and ``NCONST``, as :func:`walkerlab.codegen.compiled_source.generate_compiled`."""

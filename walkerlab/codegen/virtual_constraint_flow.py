@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import hashlib
 
+from walkerlab import codestore
+
 __all__ = ["closed_loop_module"]
 
 #: The module of :func:`closed_loop_module` (``{law}``: the compiled controller's module name).
@@ -129,8 +131,6 @@ def closed_loop_module(law_module):
     ImportError
         numba is not installed.
     """
-    from walkerlab import codestore
-
     source = _SOURCE.format(law=law_module.__name__)
     h = hashlib.sha256(source.encode())
     h.update(codestore.source_hash(__file__).encode())

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import hashlib
 
+from walkerlab import codestore
+
 __all__ = ["derive_equations", "generate_pieces", "output_expressions", "output_module",
            "resolve_link"]
 
@@ -175,7 +177,6 @@ def _module(name: str, generate, structure, params, outputs, phase, joints, pref
     """The generated module ``<key>_<name>_<hash>.py`` of ``generate(eq, params, outputs,
     phase, joints, prefix, key) -> str`` on ``structure``'s derivation, the hash covering
     the parameters, outputs, phase, joints and this generator's source."""
-    from walkerlab import codestore
     from walkerlab.codegen import cache
 
     key = cache.cache_key(structure)

@@ -55,6 +55,7 @@ this loop stays.  It is also what every stored Monte Carlo result was computed w
 
 from __future__ import annotations
 
+from walkerlab import codestore
 from walkerlab.usercache import use_for_numba
 
 use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
@@ -575,7 +576,6 @@ def kernels(structure, name: str) -> tuple | None:
     kernels module is generated and imported once (``<key>_rows_<source_hash()>_nb.py``
     beside the compiled module, :func:`walkerlab.codestore.import_generated`'s checks)
     and compiled on first call or loaded from numba's cache (``cache=True``: its file)."""
-    from walkerlab import codestore
     from walkerlab.codegen import cache
     from walkerlab.codegen.compiled import compiled_module
 

@@ -48,6 +48,7 @@ import hashlib
 
 import numpy as np
 
+from walkerlab import codestore
 from walkerlab.models.contact.joint_torques import JointTorqueActuators
 from walkerlab.models.contact.powered_source import CYRK_POWERED_SOURCE
 from walkerlab.models.virtual_constraints import VirtualConstraintController
@@ -237,8 +238,6 @@ def compiled_rhs_module(kernels, law_module):
     (:meth:`VirtualConstraintController.compiled_module`); file
     ``<hash>_vcrhs.py`` in the user cache, its hash of both modules' names (each a hash of
     its own source) and this module's source; numba's machine code cached there too."""
-    from walkerlab import codestore
-
     source = _RHS_SOURCE.format(kernels=kernels.__name__, law=law_module.__name__)
     h = hashlib.sha256(source.encode())
     h.update(codestore.source_hash(__file__).encode())
