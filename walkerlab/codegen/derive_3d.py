@@ -94,11 +94,12 @@ def _planar_spoked(structure) -> Equations:
     simplify = simplifier(kin)
     V = simplify(te.potential)
     # the impact and the points from the tree's kinematics in world axes (the slope's turn
-    # merged with the wheel's: angles q + 2 k alpha, no gamma; the impact's matrices are
-    # the frame's invariants)
+    # merged with the wheel's: angles q + 2 k alpha, no gamma); the impact's matrices, the
+    # frame's invariants, taken upright (q = 0: the same closed forms, far fewer products)
     world = kinematics(tree, coords, world=True)
-    Mi, B = impact_of_bodies(world, world.contacts["next_foot"].jacobian(sp.Matrix([q])),
-                             simplify)
+    upright = {q: 0}
+    F = world.contacts["next_foot"].jacobian(sp.Matrix([q])).subs(upright)
+    Mi, B = impact_of_bodies(world, F, simplify, at=upright)
     hub, nxt = kin.coms["wheel"], kin.contacts["next_foot"]
     # each point's sums of products gathered into sines of sums (sympy's fu.TR10i, Fu et al.
     # 2006: L sin(q + 2 alpha), ...): the closed forms product-to-sum gives (1.5 s), in 0.07 s
